@@ -1,0 +1,44 @@
+"""Built-in robots: description files shipped in this folder, usable by name anywhere a robot is expected."""
+
+from __future__ import annotations
+
+import difflib
+import functools
+from importlib import resources
+from pathlib import Path
+
+from ..description import robot_from_text
+from ..errors import UnknownNameError
+from ..robot import Robot
+
+
+def names() -> tuple[str, ...]:
+    """Names of the catalog robots, sorted."""
+    return tuple(sorted(p.name[:-5] for p in resources.files(__name__).iterdir() if p.name.endswith(".yaml")))
+
+
+@functools.lru_cache(maxsize=None)
+def load(name: str) -> Robot:
+    """The catalog robot `name`, or :class:`UnknownNameError` with a suggestion."""
+    if name not in names():
+        close = difflib.get_close_matches(name, names(), n=1)
+        hint = f" (did you mean '{close[0]}'?)" if close else ""
+        raise UnknownNameError(f"no robot '{name}' in the catalog{hint}; 'wmrkit robots' lists them")
+    text = resources.files(__name__).joinpath(f"{name}.yaml").read_text(encoding="utf-8")
+    return robot_from_text(text, source=f"catalog:{name}")
+
+
+def source_text(name: str) -> str:
+    """The description file of catalog robot `name`, with its comments on where the numbers come from."""
+    load(name)
+    return resources.files(__name__).joinpath(f"{name}.yaml").read_text(encoding="utf-8")
+
+
+def resolve(spec: str) -> Robot:
+    """A robot from a command-line argument: a description file path if one exists, else a catalog name."""
+    path = Path(spec)
+    if path.suffix.lower() in (".yaml", ".yml", ".json") or path.exists():
+        if not path.exists():
+            raise UnknownNameError(f"{spec}: no such file")
+        return Robot.from_file(path)
+    return load(spec)

@@ -1,0 +1,62 @@
+"""Small helpers shared by the command modules: robot argument, JSON output, angle parsing."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from typing import Any
+
+from .. import catalog
+from ..errors import WmrkitError
+from ..robot import Robot
+from ..units import UnitError, parse_quantity
+
+
+def add_robot_argument(parser: argparse.ArgumentParser) -> None:
+    """The ROBOT positional: a catalog name or a description file."""
+    parser.add_argument("robot", metavar="ROBOT", help="catalog name (see 'wmrkit robots') or a .yaml/.json file")
+
+
+def add_json_flag(parser: argparse.ArgumentParser) -> None:
+    """``--json``: machine-readable output on stdout."""
+    parser.add_argument("--json", action="store_true", help="print machine-readable JSON")
+
+
+def load_robot(spec: str) -> Robot:
+    """The robot named by a ROBOT argument."""
+    return catalog.resolve(spec)
+
+
+def print_json(data: Any) -> None:
+    """Print `data` as JSON (NaN and infinities become null: JSON has none)."""
+    print(json.dumps(_finite(data), indent=2))
+
+
+def _finite(x: Any) -> Any:
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_finite(v) for v in x]
+    return x
+
+
+def parse_angle(text: str, what: str) -> float:
+    """An angle from the command line: radians, or degrees with a ``deg`` suffix."""
+    try:
+        return parse_quantity(text, "angle")
+    except UnitError as err:
+        raise WmrkitError(f"{what}: {err}") from None
+
+
+def parse_assignments(items: list[str] | None, what: str) -> dict[str, str]:
+    """``NAME=VALUE`` pairs from repeated options, as a dict of strings."""
+    out: dict[str, str] = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not sep or not name or not value:
+            raise WmrkitError(f"{what}: expected NAME=VALUE, got '{item}'")
+        out[name] = value
+    return out

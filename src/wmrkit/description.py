@@ -1,0 +1,251 @@
+"""Robot description files: load, validate with located one-line errors, save losslessly.
+
+The format (YAML or JSON) is documented in ``docs/description-format.md``. YAML goes through ``safe_load``
+only; user text is never evaluated. Every error names the file, the line where known, the wheel and the field.
+"""
+
+from __future__ import annotations
+
+import difflib
+import json
+import math
+import os
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from .errors import DescriptionError
+from .robot import Robot
+from .units import UnitError, parse_quantity
+from .wheels import GEOMETRY_FIELDS, KINDS, Wheel
+
+TOP_FIELDS = ("name", "wheels", "notes")
+COMMON_WHEEL_FIELDS = ("name", "type", "position", "l", "alpha", "actuated", "sensed")
+ALL_WHEEL_FIELDS = COMMON_WHEEL_FIELDS + tuple(f for f in GEOMETRY_FIELDS if f not in ("l", "alpha"))
+
+Loc = tuple[str | int, ...]
+LineOf = Callable[[Loc], int | None]
+
+
+def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None = None) -> Robot:
+    """Validate a description mapping and build the :class:`Robot` (SI units; strings with units accepted)."""
+    check = _Checker(source, line_of or (lambda loc: None))
+    if not isinstance(data, Mapping):
+        check.fail("a robot description is a mapping with the fields 'name' and 'wheels'", ())
+    check.reject_unknown(data, TOP_FIELDS, ())
+    name = check.text(data, "name", ())
+    notes = check.text(data, "notes", (), required=False)
+    wheels_data = check.require(data, "wheels", ())
+    if not isinstance(wheels_data, list) or not wheels_data:
+        check.fail("must be a non-empty list of wheels", ("wheels",))
+    wheels: list[Wheel] = []
+    for i, item in enumerate(wheels_data):
+        wheel = _wheel_from_dict(item, check, ("wheels", i))
+        if wheel.name in (w.name for w in wheels):
+            check.fail(f"duplicate wheel name '{wheel.name}'", ("wheels", i, "name"))
+        wheels.append(wheel)
+    return Robot(name=name, wheels=tuple(wheels), notes=notes)
+
+
+def _wheel_from_dict(item: Any, check: _Checker, loc: Loc) -> Wheel:
+    if not isinstance(item, Mapping):
+        check.fail("a wheel is a mapping with at least 'name', 'type' and its geometry", loc)
+    type_name = check.text(item, "type", loc)
+    if type_name not in KINDS:
+        check.fail(f"unknown wheel type '{type_name}'{_hint(type_name, KINDS)} (types: {', '.join(KINDS)})",
+                   (*loc, "type"))
+    kind = KINDS[type_name]
+    name = check.text(item, "name", loc)
+    allowed = COMMON_WHEEL_FIELDS + kind.required + tuple(kind.optional)
+    for key in item:
+        if key not in allowed and key in ALL_WHEEL_FIELDS:
+            check.fail(f"field '{key}' does not apply to a {type_name} wheel", (*loc, key))
+    check.reject_unknown(item, allowed, loc)
+
+    values: dict[str, float] = {}
+    if "position" in item:
+        if "l" in item or "alpha" in item:
+            check.fail("give either 'position' or 'l' and 'alpha', not both", (*loc, "position"))
+        pos = item["position"]
+        if not isinstance(pos, list | tuple) or len(pos) != 2:
+            check.fail("must be a list [x, y] of two lengths", (*loc, "position"))
+        x, y = (check.quantity(v, "length", (*loc, "position", j)) for j, v in enumerate(pos))
+        values["l"], values["alpha"] = math.hypot(x, y), math.atan2(y, x)
+    elif "l" in item or "alpha" in item:
+        values["l"] = check.quantity(check.require(item, "l", loc), "length", (*loc, "l"))
+        values["alpha"] = check.quantity(check.require(item, "alpha", loc), "angle", (*loc, "alpha"))
+        if values["l"] < 0:
+            check.fail(f"must be >= 0 (the direction is alpha), got {values['l']} m", (*loc, "l"))
+    else:
+        check.fail("missing the wheel's place: 'position: [x, y]' or 'l' and 'alpha'", loc)
+    for key in kind.required:
+        values[key] = check.quantity(check.require(item, key, loc), GEOMETRY_FIELDS[key], (*loc, key))
+    for key, default in kind.optional.items():
+        values[key] = check.quantity(item[key], GEOMETRY_FIELDS[key], (*loc, key)) if key in item else default
+    _check_geometry(type_name, values, check, loc)
+    actuated = check.joints(item, "actuated", kind.joints, loc)
+    sensed = check.joints(item, "sensed", kind.joints, loc)
+    return Wheel(name=name, type=type_name, actuated=actuated, sensed=sensed, **values)
+
+
+def _check_geometry(type_name: str, v: dict[str, float], check: _Checker, loc: Loc) -> None:
+    for key in ("r", "r_r", "b"):
+        if key in v and v[key] <= 0:
+            check.fail(f"must be > 0, got {v[key]} m", (*loc, key))
+    if type_name in ("castor", "double_castor") and v["d"] == 0:
+        other = "steerable" if type_name == "castor" else "double"
+        check.fail(f"a {type_name} needs an offset d != 0 (with d = 0 it is a '{other}' wheel)", (*loc, "d"))
+    if type_name == "castor" and abs(math.cos(v["delta"])) < 1e-9:
+        check.fail("a castor with delta = +-90 deg has its axle along the arm and cannot steer itself "
+                   "(det J_c = -r d cos(delta) = 0, eq. 3.19)", (*loc, "delta"))
+    if type_name == "swedish" and abs(math.sin(v["gamma"])) < 1e-9:
+        check.fail("a Swedish wheel with gamma = 0 (or 180 deg) has rollers parallel to the axle and does not "
+                   "roll (det J_s = r r_r sin(gamma) = 0, eq. 3.19); omni: 90 deg, Mecanum: 45 deg",
+                   (*loc, "gamma"))
+
+
+class _Checker:
+    """Reads fields and raises :class:`DescriptionError` at their location."""
+
+    def __init__(self, source: str, line_of: LineOf) -> None:
+        self.source, self.line_of = source, line_of
+
+    def fail(self, message: str, loc: Loc) -> None:
+        raise DescriptionError(message, source=self.source, loc=loc, line=self.line_of(loc))
+
+    def require(self, data: Mapping[str, Any], key: str, loc: Loc) -> Any:
+        if key not in data:
+            self.fail(f"missing field '{key}'", (*loc, key) if not loc else loc)
+        return data[key]
+
+    def text(self, data: Mapping[str, Any], key: str, loc: Loc, *, required: bool = True) -> str:
+        if key not in data and not required:
+            return ""
+        value = self.require(data, key, loc)
+        if not isinstance(value, str) or (required and not value.strip()):
+            self.fail(f"must be a non-empty string, got {value!r}", (*loc, key))
+        return value
+
+    def quantity(self, value: Any, kind: str, loc: Loc) -> float:
+        try:
+            return parse_quantity(value, kind)  # type: ignore[arg-type]
+        except UnitError as err:
+            self.fail(str(err), loc)
+        raise AssertionError  # unreachable: fail raises
+
+    def joints(self, item: Mapping[str, Any], key: str, allowed: tuple[str, ...], loc: Loc) -> tuple[str, ...]:
+        value = item.get(key, [])
+        if isinstance(value, str):
+            value = [value]
+        if not isinstance(value, list) or not all(isinstance(j, str) for j in value):
+            self.fail(f"must be a list of joint names (any of: {', '.join(allowed)})", (*loc, key))
+        for j, joint in enumerate(value):
+            if joint not in allowed:
+                self.fail(f"no joint '{joint}' on a {item.get('type')} wheel{_hint(joint, allowed)} "
+                          f"(joints: {', '.join(allowed)})", (*loc, key, j))
+            if joint in value[:j]:
+                self.fail(f"joint '{joint}' listed twice", (*loc, key, j))
+        return tuple(sorted(value, key=allowed.index))
+
+    def reject_unknown(self, data: Mapping[str, Any], allowed: tuple[str, ...], loc: Loc) -> None:
+        for key in data:
+            if not isinstance(key, str):
+                self.fail(f"field names are strings, got {key!r}", loc)
+            if key not in allowed:
+                self.fail(f"unknown field '{key}'{_hint(key, allowed)}", (*loc, key))
+
+
+def _hint(word: str, choices: Any) -> str:
+    close = difflib.get_close_matches(str(word), list(choices), n=1)
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+# ---- serialisation ---------------------------------------------------------------------------------------
+def robot_to_dict(robot: Robot) -> dict[str, Any]:
+    """The description mapping of `robot` in SI numbers; ``robot_from_dict(robot_to_dict(r)) == r``."""
+    out: dict[str, Any] = {"name": robot.name}
+    if robot.notes:
+        out["notes"] = robot.notes
+    out["wheels"] = [_wheel_to_dict(w) for w in robot.wheels]
+    return out
+
+
+def _wheel_to_dict(w: Wheel) -> dict[str, Any]:
+    kind = w.kind
+    out: dict[str, Any] = {"name": w.name, "type": w.type, "l": w.l, "alpha": w.alpha}
+    for key in GEOMETRY_FIELDS:
+        if key in kind.required or key in kind.optional:
+            out[key] = getattr(w, key)
+    if w.actuated:
+        out["actuated"] = list(w.actuated)
+    if w.sensed:
+        out["sensed"] = list(w.sensed)
+    return out
+
+
+def load_robot_file(path: str | os.PathLike[str]) -> Robot:
+    """Load a ``.yaml``/``.yml``/``.json`` description, with located errors."""
+    path = Path(path)
+    source = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as err:
+        raise DescriptionError(f"cannot read the file ({err.__class__.__name__}: {err.strerror or err})",
+                               source=source) from None
+    return robot_from_text(text, source=source, fmt="json" if path.suffix.lower() == ".json" else "yaml")
+
+
+def robot_from_text(text: str, *, source: str, fmt: str = "yaml") -> Robot:
+    """Parse description `text` (``fmt`` "yaml" or "json") into a :class:`Robot`."""
+    if fmt == "json":
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as err:
+            raise DescriptionError(f"malformed JSON: {err.msg} (column {err.colno})", source=source,
+                                   line=err.lineno) from None
+    else:
+        try:
+            data = yaml.safe_load(text)
+        except yaml.YAMLError as err:
+            mark = getattr(err, "problem_mark", None)
+            problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+            raise DescriptionError(f"malformed YAML: {problem}", source=source,
+                                   line=None if mark is None else mark.line + 1) from None
+    return robot_from_dict(data, source=source, line_of=_line_finder(text))
+
+
+def _line_finder(text: str) -> LineOf:
+    """Map a field location to its 1-based line, from the YAML node tree (JSON is YAML enough for this)."""
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError:
+        root = None
+
+    def line_of(loc: Loc) -> int | None:
+        node, line = root, None
+        for part in loc:
+            if isinstance(node, yaml.MappingNode):
+                match = [(k, v) for k, v in node.value if k.value == part]
+                if not match:
+                    break
+                line, node = match[0][0].start_mark.line + 1, match[0][1]
+            elif isinstance(node, yaml.SequenceNode) and isinstance(part, int) and part < len(node.value):
+                node = node.value[part]
+                line = node.start_mark.line + 1
+            else:
+                break
+        return line
+
+    return line_of
+
+
+def save_robot_file(robot: Robot, path: str | os.PathLike[str]) -> None:
+    """Write `robot` as YAML or JSON (by the file's extension)."""
+    path = Path(path)
+    data = robot_to_dict(robot)
+    if path.suffix.lower() == ".json":
+        path.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
+    else:
+        path.write_text(yaml.safe_dump(data, sort_keys=False, allow_unicode=True), encoding="utf-8")

@@ -1,0 +1,43 @@
+"""Errors a user can cause. The CLI turns every :class:`WmrkitError` into one line and exit code 2."""
+
+from __future__ import annotations
+
+
+class WmrkitError(Exception):
+    """Base of every error a user can cause (bad input, impossible request)."""
+
+
+class ShapeError(WmrkitError, ValueError):
+    """An array argument has the wrong shape; the message names the argument."""
+
+
+class UnknownNameError(WmrkitError, LookupError):
+    """A wheel, joint, robot or velocity name that does not exist."""
+
+    def __str__(self) -> str:  # LookupError would otherwise repr() the message
+        return str(self.args[0]) if self.args else ""
+
+
+class DescriptionError(WmrkitError, ValueError):
+    """A robot description is wrong at a known place: file, wheel, field.
+
+    Printed as ``source:line: wheels[0].r: message`` (line 1-based, omitted when unknown).
+    """
+
+    def __init__(
+        self, message: str, *, source: str, loc: tuple[str | int, ...] = (), line: int | None = None
+    ) -> None:
+        self.message, self.source, self.loc, self.line = message, source, tuple(loc), line
+        super().__init__(self._format())
+
+    def _format(self) -> str:
+        where = self.source if self.line is None else f"{self.source}:{self.line}"
+        path = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in self.loc).lstrip(".")
+        return f"{where}: {path}: {self.message}" if path else f"{where}: {self.message}"
+
+    def __str__(self) -> str:
+        return self._format()
+
+
+class SingularError(WmrkitError, ValueError):
+    """A requested model does not exist at this configuration (non-assignable set, singular wheel)."""

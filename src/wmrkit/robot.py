@@ -1,0 +1,229 @@
+"""A robot: a name and its wheels; the composite equations (3.20)-(3.23), batched over configurations.
+
+The velocity vector ``q_dot`` of the slip form (3.21)-(3.22) is ordered: the body twist ``(vx, vy, omega)``,
+then each wheel's joint rates in wheel order (``Robot.velocity_names``, e.g. ``left.spin``, ``caster.steer``).
+The steering configuration ``beta`` is ordered as ``Robot.steer_names``: one angle per wheel whose type steers.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ._shapes import as_vectors, readonly
+from .errors import UnknownNameError
+from .wheels import Wheel, generic_slip_rows, generic_wheel_jacobian, rotate_rows_to_robot
+
+TWIST_NAMES = ("vx", "vy", "omega")
+
+
+@dataclass(frozen=True, slots=True)
+class Robot:
+    """A wheeled robot: a name and an ordered tuple of wheels. Never mutated; change it with ``replace``."""
+
+    name: str
+    wheels: tuple[Wheel, ...]
+    notes: str = ""
+
+    # ---- names -------------------------------------------------------------------------------------------
+    @property
+    def wheel_names(self) -> tuple[str, ...]:
+        """Wheel names, in order."""
+        return tuple(w.name for w in self.wheels)
+
+    def wheel(self, name: str) -> Wheel:
+        """The wheel called `name`, or :class:`UnknownNameError` listing the wheels."""
+        for w in self.wheels:
+            if w.name == name:
+                return w
+        raise UnknownNameError(f"robot '{self.name}' has no wheel '{name}' (wheels: {', '.join(self.wheel_names)})")
+
+    @property
+    def velocity_names(self) -> tuple[str, ...]:
+        """Names of the columns of the slip form (3.22): ``vx, vy, omega`` then every wheel's rates."""
+        return TWIST_NAMES + tuple(n for w in self.wheels for n in w.rate_names)
+
+    @property
+    def rate_names(self) -> tuple[str, ...]:
+        """Names of the wheel joint rates (the velocity vector without the twist)."""
+        return self.velocity_names[3:]
+
+    @property
+    def steer_names(self) -> tuple[str, ...]:
+        """Wheels whose steering angle is a configuration variable, in the order of ``beta``."""
+        return tuple(w.name for w in self.wheels if w.kind.steers)
+
+    @property
+    def beta(self) -> np.ndarray:
+        """The described steering configuration, ``(n_steer,)`` [rad]."""
+        return readonly(np.array([w.beta for w in self.wheels if w.kind.steers], dtype=float))
+
+    @property
+    def actuated(self) -> tuple[str, ...]:
+        """Actuated joints, qualified ``wheel.joint``."""
+        return tuple(f"{w.name}.{j}" for w in self.wheels for j in w.actuated)
+
+    @property
+    def sensed(self) -> tuple[str, ...]:
+        """Sensed joints, qualified ``wheel.joint``."""
+        return tuple(f"{w.name}.{j}" for w in self.wheels for j in w.sensed)
+
+    def velocity_index(self, name: str) -> int:
+        """Column of `name` in the velocity vector, or :class:`UnknownNameError`."""
+        names = self.velocity_names
+        if name in names:
+            return names.index(name)
+        raise UnknownNameError(f"robot '{self.name}' has no velocity '{name}' (velocities: {', '.join(names)})")
+
+    # ---- changes -----------------------------------------------------------------------------------------
+    def with_beta(self, beta: ArrayLike) -> Robot:
+        """The same robot at steering configuration `beta` ``(n_steer,)``."""
+        beta = as_vectors(beta, len(self.steer_names), "beta")
+        if beta.ndim != 1:
+            raise ValueError("with_beta takes one configuration; batched functions take beta directly")
+        angles = iter(beta.tolist())
+        return replace(self, wheels=tuple(w.with_beta(next(angles)) if w.kind.steers else w for w in self.wheels))
+
+    def with_steering(self, angles: Mapping[str, float]) -> Robot:
+        """The same robot with the named wheels steered to the given angles [rad]."""
+        for name in angles:
+            if self.wheel(name).kind.steers is False:
+                raise UnknownNameError(f"wheel '{name}' of robot '{self.name}' does not steer")
+        return replace(self, wheels=tuple(w.with_beta(angles[w.name]) if w.name in angles else w for w in self.wheels))
+
+    # ---- composite equations -----------------------------------------------------------------------------
+    def constraint_matrix(
+        self, beta: ArrayLike | None = None, *, frame: Literal["roller", "robot"] = "roller"
+    ) -> np.ndarray:
+        """The slip matrix ``A`` of eq. (3.22): ``v_slip = A @ q_dot``; no slip is ``A @ q_dot = 0`` (3.23).
+
+        ``(..., n_steer) -> (..., 2 * n_contacts, 3 + n_rates)``; columns named by ``velocity_names``.
+        ``frame="roller"`` gives each wheel's rows along its roller axes (3.6), ``"robot"`` in the robot frame
+        (3.5); the two differ by a rotation per wheel, so ranks, null spaces and least squares agree.
+        """
+        t = _table(self)
+        beta_e = _element_beta(self, t, beta)
+        g = generic_slip_rows(beta_e, t.l, t.alpha, t.d, t.delta, t.gamma, t.r, t.r_r)  # (..., E, 2, 6)
+        if frame == "robot":
+            g = rotate_rows_to_robot(g, beta_e + t.delta + t.gamma)
+        elif frame != "roller":
+            raise ValueError(f"frame must be 'roller' or 'robot', got {frame!r}")
+        a_w = g[..., 3:] @ t.rate_map  # (..., E, 2, n_rates)
+        a = np.concatenate([g[..., :3], a_w], axis=-1)
+        return a.reshape(*a.shape[:-3], 2 * t.n_elements, 3 + t.n_rates)
+
+    def slip_velocity(self, q_dot: ArrayLike, beta: ArrayLike | None = None) -> np.ndarray:
+        """Slip of every contact along its roller axes, ``A @ q_dot`` (3.22). ``(..., k) -> (..., 2 n_contacts)``."""
+        q_dot = as_vectors(q_dot, 3 + _table(self).n_rates, "q_dot")
+        return (self.constraint_matrix(beta) @ q_dot[..., None])[..., 0]
+
+    def jacobian_form(self, beta: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The composite Jacobian form (3.20): ``I_bar @ twist_robot = J @ q_dot_w``.
+
+        Returns ``(I_bar, J)`` of shapes ``(3 E, 3)`` and ``(..., 3 E, n_rates + E)``; ``q_dot_w`` is the
+        wheel rates (as in ``rate_names``) followed by one copy of ``omega`` per contact (3.17)-(3.19).
+        For one-element wheels J is block diagonal with the blocks (3.19).
+        """
+        t = _table(self)
+        beta_e = _element_beta(self, t, beta)
+        jac = generic_wheel_jacobian(beta_e, t.l, t.alpha, t.d, t.delta, t.gamma, t.r, t.r_r)  # (..., E, 3, 4)
+        j_rates = jac[..., :3] @ t.rate_map  # (..., E, 3, n_rates)
+        j_omega = jac[..., 3:] * np.eye(t.n_elements)[:, None, :]  # (..., E, 3, E)
+        j = np.concatenate([j_rates, j_omega], axis=-1)
+        j = j.reshape(*j.shape[:-3], 3 * t.n_elements, t.n_rates + t.n_elements)
+        return np.tile(np.eye(3), (t.n_elements, 1)), j
+
+    # ---- conversions -------------------------------------------------------------------------------------
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], *, source: str = "<dict>") -> Robot:
+        """A robot from a description mapping (the file format of ``docs/description-format.md``)."""
+        from .description import robot_from_dict
+
+        return robot_from_dict(data, source=source)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The description mapping; ``Robot.from_dict(r.to_dict()) == r``."""
+        from .description import robot_to_dict
+
+        return robot_to_dict(self)
+
+    @classmethod
+    def from_file(cls, path: str | os.PathLike[str]) -> Robot:
+        """A robot from a YAML (``.yaml``/``.yml``) or JSON (``.json``) description file."""
+        from .description import load_robot_file
+
+        return load_robot_file(path)
+
+    def to_file(self, path: str | os.PathLike[str]) -> None:
+        """Write the description to a YAML or JSON file (by extension); loading it gives this robot back."""
+        from .description import save_robot_file
+
+        save_robot_file(self, path)
+
+
+@dataclass(frozen=True, eq=False)
+class _Table:
+    """Per-contact-element parameters of a robot, as arrays (derived once per robot, read-only)."""
+
+    l: np.ndarray
+    alpha: np.ndarray
+    beta_offset: np.ndarray
+    d: np.ndarray
+    delta: np.ndarray
+    gamma: np.ndarray
+    r: np.ndarray
+    r_r: np.ndarray
+    rate_map: np.ndarray  # (E, 3, n_rates)
+    element_wheel: np.ndarray  # (E,) wheel index of each element
+    steer_wheels: np.ndarray  # (n_steer,) wheel indices of the steering wheels
+    beta_described: np.ndarray  # (N,)
+    n_rates: int
+
+    @property
+    def n_elements(self) -> int:
+        return len(self.l)
+
+
+@functools.lru_cache(maxsize=256)
+def _table(robot: Robot) -> _Table:
+    rows, maps, owner = [], [], []
+    n_rates = sum(len(w.kind.rates) for w in robot.wheels)
+    start = 0
+    for i, w in enumerate(robot.wheels):
+        n = len(w.kind.rates)
+        for e in w.elements():
+            rows.append(e[:8])
+            m = np.zeros((3, n_rates))
+            m[:, start:start + n] = e.rate_map
+            maps.append(m)
+            owner.append(i)
+        start += n
+    cols = np.array(rows, dtype=float).reshape(-1, 8).T
+    arrays = [readonly(np.ascontiguousarray(c)) for c in cols]
+    return _Table(
+        *arrays,
+        rate_map=readonly(np.array(maps).reshape(-1, 3, n_rates)),
+        element_wheel=readonly(np.array(owner, dtype=int)),
+        steer_wheels=readonly(np.array([i for i, w in enumerate(robot.wheels) if w.kind.steers], dtype=int)),
+        beta_described=readonly(np.array([w.beta for w in robot.wheels], dtype=float)),
+        n_rates=n_rates,
+    )
+
+
+def _element_beta(robot: Robot, t: _Table, beta: ArrayLike | None) -> np.ndarray:
+    """Absolute angle of every contact element's steering frame, ``(..., E)``."""
+    described = t.beta_described[t.element_wheel] + t.beta_offset
+    if beta is None:
+        return described
+    beta = as_vectors(beta, len(t.steer_wheels), "beta")
+    if len(t.steer_wheels) == 0:
+        return np.broadcast_to(described, (*beta.shape[:-1], len(described)))
+    wheels = np.broadcast_to(t.beta_described, (*beta.shape[:-1], len(t.beta_described))).copy()
+    wheels[..., t.steer_wheels] = beta
+    return wheels[..., t.element_wheel] + t.beta_offset

@@ -1,0 +1,74 @@
+"""Quantities with units in descriptions and on the command line ("90 deg", "250 mm", "0.5 rad").
+
+Everything inside wmrkit is SI: metres and radians. A plain number is taken as SI. Strings are parsed with a
+small fixed grammar (number, optional space, unit); nothing is ever evaluated.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Literal
+
+Kind = Literal["length", "angle", "number"]
+
+#: Factor to SI for every unit accepted, by kind.
+UNITS: dict[str, dict[str, float]] = {
+    "length": {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "dm": 0.1, "km": 1e3, "in": 0.0254, "ft": 0.3048},
+    "angle": {"rad": 1.0, "mrad": 1e-3, "deg": math.pi / 180, "°": math.pi / 180, "turn": 2 * math.pi},
+    "number": {},
+}
+_SI = {"length": "m", "angle": "rad", "number": ""}
+_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([^\s\d.+-][^\s]*)?\s*$")
+
+
+class UnitError(ValueError):
+    """A value that is not a number of the expected kind; the message says why."""
+
+
+def parse_quantity(value: object, kind: Kind) -> float:
+    """Return `value` in SI units (m or rad) as a finite float.
+
+    Accepts ints, floats and strings such as ``"90 deg"``, ``"250 mm"``, ``"-0.5rad"``, ``"1e-3"``.
+    Raises :class:`UnitError` for booleans, NaN, infinities, unknown units and units of the wrong kind.
+    """
+    if isinstance(value, bool):
+        raise UnitError(f"expected {_a(kind)}, got a boolean")
+    if isinstance(value, int | float):
+        number, factor = float(value), 1.0
+    elif isinstance(value, str):
+        match = _QUANTITY.match(value)
+        if match is None:
+            raise UnitError(f"cannot read {value!r} as {_a(kind)} (write e.g. {_example(kind)})")
+        number, unit = float(match.group(1)), match.group(2) or ""
+        factor = _factor(unit, kind, value)
+    else:
+        raise UnitError(f"expected {_a(kind)}, got {type(value).__name__}")
+    if not math.isfinite(number):
+        raise UnitError(f"must be finite, got {value!r}")
+    return number * factor
+
+
+def _factor(unit: str, kind: Kind, text: str) -> float:
+    if not unit:
+        return 1.0
+    if unit in UNITS[kind]:
+        return UNITS[kind][unit]
+    for other, table in UNITS.items():
+        if unit in table:
+            raise UnitError(f"{text!r} is {_a(other)}, expected {_a(kind)}")
+    accepted = ", ".join(UNITS[kind]) or "none (a plain number)"
+    raise UnitError(f"unknown unit {unit!r} in {text!r} (accepted: {accepted})")
+
+
+def _a(kind: str) -> str:
+    return f"an {kind}" if kind[0] in "aeiou" else f"a {kind}"
+
+
+def _example(kind: Kind) -> str:
+    return {"length": "'0.25' or '250 mm'", "angle": "'1.57' or '90 deg'", "number": "'0.5'"}[kind]
+
+
+def si_unit(kind: Kind) -> str:
+    """The SI unit wmrkit uses inside for `kind` ("m", "rad" or "")."""
+    return _SI[kind]

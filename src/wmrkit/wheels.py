@@ -1,0 +1,274 @@
+"""The generic wheel (thesis ch. 3): parameters, slip rows (3.5)/(3.6)/(3.10), Jacobians (3.16)-(3.19).
+
+One kernel, :func:`generic_slip_rows`, serves every wheel type. A wheel is described by the thesis's
+parameters (``l, alpha, beta, d, delta, gamma, r, r_r``; see ``docs/conventions.md``) and expands into one or
+two *contact elements*: generic wheels whose variables ``(beta_dot, phi_dot, phi_dot_r)`` are linear maps of
+the wheel's own joint rates. Fixed, steerable, castor and Swedish wheels have one element; the double wheel and
+the double castor (§3.5.1) are two castors that share the steering joint (3.24), (3.31); the ball and the
+orthogonal wheel (§3.5.2-3.5.3) are Swedish-equivalent wheels with ``gamma = 90 deg`` and ``r_r = r``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .errors import UnknownNameError
+
+HALF_PI = math.pi / 2
+
+
+@dataclass(frozen=True, slots=True)
+class WheelKind:
+    """What a wheel type is: its joint rates (velocity-vector columns), joints and fields."""
+
+    name: str
+    rates: tuple[str, ...]  # joint rates that enter the slip equations, in column order
+    joints: tuple[str, ...]  # joints that may be actuated or sensed
+    steers: bool  # its steering angle beta is a configuration variable
+    required: tuple[str, ...]  # geometric fields that must be given (besides the position)
+    optional: dict[str, float] = field(default_factory=dict)  # fields with their default
+    summary: str = ""
+
+
+KINDS: dict[str, WheelKind] = {
+    k.name: k
+    for k in (
+        WheelKind("fixed", ("spin",), ("spin",), False, ("beta", "r"),
+                  summary="conventional wheel with a fixed axle (3.11)"),
+        WheelKind("steerable", ("spin",), ("spin", "steer"), True, ("r",), {"beta": 0.0},
+                  summary="centred orientable wheel: steering axis through the wheel centre (3.11)"),
+        WheelKind("castor", ("steer", "spin"), ("steer", "spin"), True, ("d", "r"), {"beta": 0.0, "delta": 0.0},
+                  summary="off-centred orientable wheel, offset d along the steering arm (3.12)"),
+        WheelKind("swedish", ("spin", "roller"), ("spin",), False, ("beta", "gamma", "r", "r_r"),
+                  summary="Swedish/Mecanum/omni wheel, rollers at angle gamma to the axle (3.13)"),
+        WheelKind("double", ("steer", "spin1", "spin2"), ("steer", "spin1", "spin2"), True, ("b", "r"),
+                  {"beta": 0.0},
+                  summary="two coaxial wheels at +-b about a centred steering axis (3.24)-(3.30)"),
+        WheelKind("double_castor", ("steer", "spin1", "spin2"), ("steer", "spin1", "spin2"), True,
+                  ("d", "b", "r"), {"beta": 0.0},
+                  summary="two coaxial wheels at +-b, trailing the steering axis by d (3.31)-(3.37)"),
+        WheelKind("ball", ("spin", "roller"), ("spin",), False, ("beta", "r"),
+                  summary="driven sphere; Swedish-equivalent with gamma = 90 deg, r_r = r (§3.5.2)"),
+        WheelKind("orthogonal", ("spin", "roller"), ("spin",), False, ("beta", "r"),
+                  summary="orthogonal wheel (lateral assembly); Swedish-equivalent, gamma = 90 deg (§3.5.3)"),
+    )
+}
+
+#: Geometric fields of a wheel, with their kind of quantity.
+GEOMETRY_FIELDS: dict[str, str] = {
+    "l": "length", "alpha": "angle", "beta": "angle", "d": "length", "delta": "angle",
+    "gamma": "angle", "r": "length", "r_r": "length", "b": "length",
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Wheel:
+    """One wheel (or wheel unit) of a robot. A frozen value in SI units (m, rad).
+
+    ``l, alpha``: polar coordinates of the steering joint (or mount point) in the robot frame (3.8).
+    ``beta``: absolute angle of the axle (fixed, Swedish, ball, orthogonal, double) or of the steering frame
+    S_x (steerable: equal to the axle; castor: axle at ``beta + delta``). ``d``: castor offset along S_y.
+    ``gamma``: roller angle from the axle. ``r``, ``r_r``: wheel and roller radii. ``b``: half the spacing of a
+    double wheel or double castor. ``actuated``/``sensed``: names of the wheel's joints (``spin``, ``steer``...).
+    """
+
+    name: str
+    type: str
+    l: float
+    alpha: float
+    beta: float
+    r: float
+    d: float = 0.0
+    delta: float = 0.0
+    gamma: float = 0.0
+    r_r: float = 0.0
+    b: float = 0.0
+    actuated: tuple[str, ...] = ()
+    sensed: tuple[str, ...] = ()
+
+    @property
+    def kind(self) -> WheelKind:
+        """The :class:`WheelKind` of this wheel's type."""
+        return KINDS[self.type]
+
+    @property
+    def position(self) -> tuple[float, float]:
+        """``(x, y)`` of the steering joint / mount point in the robot frame [m]."""
+        return (self.l * math.cos(self.alpha), self.l * math.sin(self.alpha))
+
+    @property
+    def rate_names(self) -> tuple[str, ...]:
+        """Qualified names ``wheel.joint`` of this wheel's rates in the velocity vector."""
+        return tuple(f"{self.name}.{j}" for j in self.kind.rates)
+
+    def with_beta(self, beta: float) -> Wheel:
+        """The same wheel at another steering angle (or axle direction)."""
+        return replace(self, beta=float(beta))
+
+    def elements(self) -> tuple[Element, ...]:
+        """The contact elements this wheel expands into (see module docstring)."""
+        return _ELEMENTS[self.type](self)
+
+
+class Element(NamedTuple):
+    """A generic wheel (3.8) standing for one contact point of a wheel unit.
+
+    ``beta_offset`` is added to the unit's beta; ``rate_map`` (3, n_rates) maps the unit's joint rates to the
+    element's ``(beta_dot, phi_dot, phi_dot_r)``.
+    """
+
+    l: float
+    alpha: float
+    beta_offset: float
+    d: float
+    delta: float
+    gamma: float
+    r: float
+    r_r: float
+    rate_map: tuple[tuple[float, ...], ...]
+
+
+def _single(w: Wheel, d: float, delta: float, gamma: float, r_r: float, rate_map) -> tuple[Element, ...]:
+    return (Element(w.l, w.alpha, 0.0, d, delta, gamma, w.r, r_r, rate_map),)
+
+
+def _double(w: Wheel) -> tuple[Element, ...]:
+    # (3.24) corrected: steering frame at beta + 90 deg so that the common axle is at beta; delta = -90 deg,
+    # sub-wheel 1 at d = -b (which puts it at +b along the axle), sub-wheel 2 at d = +b.
+    return (
+        Element(w.l, w.alpha, HALF_PI, -w.b, -HALF_PI, 0.0, w.r, 0.0, ((1, 0, 0), (0, 1, 0), (0, 0, 0))),
+        Element(w.l, w.alpha, HALF_PI, w.b, -HALF_PI, 0.0, w.r, 0.0, ((1, 0, 0), (0, 0, 1), (0, 0, 0))),
+    )
+
+
+def _double_castor(w: Wheel) -> tuple[Element, ...]:
+    # (3.31): beta_i = beta_ik + delta_ik, d_ik = sqrt(a^2 + b^2), delta_i1 = -delta_i2 = atan(b / a), a = d.
+    # atan2 extends atan(b/a) to a leading wheel (a < 0): sub-wheel 1 stays at +b along the axle.
+    arm, skew = math.hypot(w.d, w.b), math.atan2(w.b, w.d)
+    return (
+        Element(w.l, w.alpha, -skew, arm, skew, 0.0, w.r, 0.0, ((1, 0, 0), (0, 1, 0), (0, 0, 0))),
+        Element(w.l, w.alpha, skew, arm, -skew, 0.0, w.r, 0.0, ((1, 0, 0), (0, 0, 1), (0, 0, 0))),
+    )
+
+
+_SPIN = ((0,), (1,), (0,))
+_ELEMENTS = {
+    "fixed": lambda w: _single(w, 0.0, 0.0, 0.0, 0.0, _SPIN),
+    "steerable": lambda w: _single(w, 0.0, 0.0, 0.0, 0.0, _SPIN),
+    "castor": lambda w: _single(w, w.d, w.delta, 0.0, 0.0, ((1, 0), (0, 1), (0, 0))),
+    "swedish": lambda w: _single(w, 0.0, 0.0, w.gamma, w.r_r, ((0, 0), (1, 0), (0, 1))),
+    "ball": lambda w: _single(w, 0.0, 0.0, HALF_PI, w.r, ((0, 0), (1, 0), (0, 1))),
+    "orthogonal": lambda w: _single(w, 0.0, 0.0, HALF_PI, w.r, ((0, 0), (1, 0), (0, 1))),
+    "double": _double,
+    "double_castor": _double_castor,
+}
+
+
+def generic_slip_rows(
+    beta: ArrayLike, l: ArrayLike, alpha: ArrayLike, d: ArrayLike, delta: ArrayLike,
+    gamma: ArrayLike, r: ArrayLike, r_r: ArrayLike,
+) -> np.ndarray:
+    """Slip rows of the generic wheel along the roller axes (frame E-bar), thesis eqs. (3.6), (3.10).
+
+    ``(...) -> (..., 2, 6)``: all arguments broadcast; columns ``(v_x, v_y, omega, beta_dot, phi_dot,
+    phi_dot_r)``. ``v_slip = rows @ (twist_robot; beta_dot; phi_dot; phi_dot_r)`` [m/s]. Row 0 is the slip
+    along the roller axis E_x, row 1 across it. With ``d = delta = gamma = r_r = 0`` these are the rows
+    (3.11) of a fixed wheel: row 0 the lateral constraint, row 1 the rolling constraint.
+    """
+    beta, l, alpha, d, delta, gamma, r, r_r = np.broadcast_arrays(
+        *(np.asarray(a, dtype=float) for a in (beta, l, alpha, d, delta, gamma, r, r_r))
+    )
+    theta = beta + delta + gamma  # ^R theta_E
+    c, s = np.cos(theta), np.sin(theta)
+    cdg, sdg = np.cos(delta + gamma), np.sin(delta + gamma)
+    out = np.empty((*theta.shape, 2, 6))
+    out[..., 0, 0], out[..., 0, 1] = c, s
+    out[..., 0, 2] = l * np.sin(theta - alpha) - d * cdg
+    out[..., 0, 3] = -d * cdg
+    out[..., 0, 4] = r * np.sin(gamma)
+    out[..., 0, 5] = 0.0
+    out[..., 1, 0], out[..., 1, 1] = -s, c
+    out[..., 1, 2] = l * np.cos(theta - alpha) + d * sdg
+    out[..., 1, 3] = d * sdg
+    out[..., 1, 4] = r * np.cos(gamma)
+    out[..., 1, 5] = r_r
+    return out
+
+
+def rotate_rows_to_robot(rows: ArrayLike, theta: ArrayLike) -> np.ndarray:
+    """Slip rows in the robot-coincident frame R-bar, eq. (3.5): ``Rot(theta) @ rows``, theta = beta+delta+gamma.
+
+    ``(..., 2, k), (...) -> (..., 2, k)``. Inverse of (3.6): ``v_slip,E = Rot(-theta) v_slip,R`` (3.7).
+    """
+    rows, theta = np.asarray(rows, dtype=float), np.asarray(theta, dtype=float)
+    c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
+    return np.stack([c * rows[..., 0, :] - s * rows[..., 1, :], s * rows[..., 0, :] + c * rows[..., 1, :]], -2)
+
+
+def generic_wheel_jacobian(
+    beta: ArrayLike, l: ArrayLike, alpha: ArrayLike, d: ArrayLike, delta: ArrayLike,
+    gamma: ArrayLike, r: ArrayLike, r_r: ArrayLike,
+) -> np.ndarray:
+    """Wheel Jacobian of the generic wheel with zero slip, thesis eqs. (3.16)-(3.17).
+
+    ``(...) -> (..., 3, 4)``: ``twist_robot = J @ (beta_dot, phi_dot, phi_dot_r, omega)``. The columns of the
+    joints a type lacks are zero; keeping the non-zero ones gives the per-type matrices (3.19).
+    """
+    beta, l, alpha, d, delta, gamma, r, r_r = np.broadcast_arrays(
+        *(np.asarray(a, dtype=float) for a in (beta, l, alpha, d, delta, gamma, r, r_r))
+    )
+    theta = beta + delta + gamma
+    cb, sb = np.cos(beta), np.sin(beta)
+    out = np.zeros((*beta.shape, 3, 4))
+    out[..., 0, 0], out[..., 1, 0] = d * cb, d * sb
+    out[..., 0, 1], out[..., 1, 1] = r * np.sin(beta + delta), -r * np.cos(beta + delta)
+    out[..., 0, 2], out[..., 1, 2] = r_r * np.sin(theta), -r_r * np.cos(theta)
+    out[..., 0, 3] = l * np.sin(alpha) + d * cb
+    out[..., 1, 3] = -l * np.cos(alpha) + d * sb
+    out[..., 2, 3] = 1.0
+    return out
+
+
+def wheel_slip_rows(wheel: Wheel, beta: ArrayLike | None = None) -> np.ndarray:
+    """Slip rows (3.6) of one wheel over ``(twist; the wheel's own rates)``, eqs. (3.11)-(3.13).
+
+    ``(...) -> (..., 2 * n_elements, 3 + n_rates)``; `beta` defaults to the wheel's own.
+    """
+    beta = np.asarray(wheel.beta if beta is None else beta, dtype=float)
+    blocks = []
+    for e in wheel.elements():
+        g = generic_slip_rows(beta + e.beta_offset, e.l, e.alpha, e.d, e.delta, e.gamma, e.r, e.r_r)
+        blocks.append(np.concatenate([g[..., :3], g[..., 3:] @ np.asarray(e.rate_map, dtype=float)], -1))
+    return np.concatenate(blocks, axis=-2)
+
+
+def wheel_jacobian(wheel: Wheel, beta: ArrayLike | None = None) -> np.ndarray:
+    """Jacobian (3.19) of a one-element wheel: ``twist_robot = J @ (the wheel's rates; omega)``.
+
+    ``(...) -> (..., 3, n_rates + 1)``. Fixed/steerable: ``(phi_dot, omega)``; castor: ``(beta_dot, phi_dot,
+    omega)``; Swedish, ball, orthogonal: ``(phi_dot, phi_dot_r, omega)``. Double wheels have two contact points
+    and no single Jacobian: use :meth:`wmrkit.Robot.jacobian_form`.
+    """
+    elements = wheel.elements()
+    if len(elements) != 1:
+        raise UnknownNameError(
+            f"wheel '{wheel.name}' ({wheel.type}) has {len(elements)} contact points and no single Jacobian; "
+            "use Robot.jacobian_form"
+        )
+    e = elements[0]
+    beta = np.asarray(wheel.beta if beta is None else beta, dtype=float)
+    j = generic_wheel_jacobian(beta + e.beta_offset, e.l, e.alpha, e.d, e.delta, e.gamma, e.r, e.r_r)
+    return np.concatenate([j[..., :3] @ np.asarray(e.rate_map, dtype=float), j[..., 3:]], -1)
+
+
+def kind_of(type_name: str) -> WheelKind:
+    """The :class:`WheelKind` named `type_name`, or :class:`UnknownNameError`."""
+    try:
+        return KINDS[type_name]
+    except KeyError:
+        raise UnknownNameError(f"unknown wheel type '{type_name}' (types: {', '.join(KINDS)})") from None
