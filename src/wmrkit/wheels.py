@@ -169,6 +169,41 @@ _ELEMENTS = {
 }
 
 
+def slip_row_entries(beta, l, alpha, d, delta, gamma, r, r_r, sin=np.sin, cos=np.cos):
+    """Entries of the generic slip rows (3.10) for any backend: numpy arrays, sympy symbols, floats.
+
+    Returns two rows of six entries, columns ``(v_x, v_y, omega, beta_dot, phi_dot, phi_dot_r)``.
+    """
+    theta = beta + delta + gamma  # ^R theta_E = beta + delta + gamma (3.8)
+    c, s, cdg, sdg = cos(theta), sin(theta), cos(delta + gamma), sin(delta + gamma)
+    return (
+        (c, s, l * sin(theta - alpha) - d * cdg, -d * cdg, r * sin(gamma), 0 * r_r),
+        (-s, c, l * cos(theta - alpha) + d * sdg, d * sdg, r * cos(gamma), r_r),
+    )
+
+
+def jacobian_entries(beta, l, alpha, d, delta, gamma, r, r_r, sin=np.sin, cos=np.cos):
+    """Entries of the generic wheel Jacobian (3.16)-(3.17) for any backend.
+
+    Three rows of four entries, columns ``(beta_dot, phi_dot, phi_dot_r, omega)``.
+    """
+    theta = beta + delta + gamma
+    cb, sb = cos(beta), sin(beta)
+    return (
+        (d * cb, r * sin(beta + delta), r_r * sin(theta), l * sin(alpha) + d * cb),
+        (d * sb, -r * cos(beta + delta), -r_r * cos(theta), -l * cos(alpha) + d * sb),
+        (0 * r, 0 * r, 0 * r, 0 * r + 1),
+    )
+
+
+def _fill(entries, shape: tuple[int, ...]) -> np.ndarray:
+    out = np.empty((*shape, len(entries), len(entries[0])))
+    for i, row in enumerate(entries):
+        for j, value in enumerate(row):
+            out[..., i, j] = value
+    return out
+
+
 def generic_slip_rows(
     beta: ArrayLike, l: ArrayLike, alpha: ArrayLike, d: ArrayLike, delta: ArrayLike,
     gamma: ArrayLike, r: ArrayLike, r_r: ArrayLike,
@@ -180,24 +215,8 @@ def generic_slip_rows(
     along the roller axis E_x, row 1 across it. With ``d = delta = gamma = r_r = 0`` these are the rows
     (3.11) of a fixed wheel: row 0 the lateral constraint, row 1 the rolling constraint.
     """
-    beta, l, alpha, d, delta, gamma, r, r_r = np.broadcast_arrays(
-        *(np.asarray(a, dtype=float) for a in (beta, l, alpha, d, delta, gamma, r, r_r))
-    )
-    theta = beta + delta + gamma  # ^R theta_E
-    c, s = np.cos(theta), np.sin(theta)
-    cdg, sdg = np.cos(delta + gamma), np.sin(delta + gamma)
-    out = np.empty((*theta.shape, 2, 6))
-    out[..., 0, 0], out[..., 0, 1] = c, s
-    out[..., 0, 2] = l * np.sin(theta - alpha) - d * cdg
-    out[..., 0, 3] = -d * cdg
-    out[..., 0, 4] = r * np.sin(gamma)
-    out[..., 0, 5] = 0.0
-    out[..., 1, 0], out[..., 1, 1] = -s, c
-    out[..., 1, 2] = l * np.cos(theta - alpha) + d * sdg
-    out[..., 1, 3] = d * sdg
-    out[..., 1, 4] = r * np.cos(gamma)
-    out[..., 1, 5] = r_r
-    return out
+    args = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (beta, l, alpha, d, delta, gamma, r, r_r)))
+    return _fill(slip_row_entries(*args), args[0].shape)
 
 
 def rotate_rows_to_robot(rows: ArrayLike, theta: ArrayLike) -> np.ndarray:
@@ -219,19 +238,8 @@ def generic_wheel_jacobian(
     ``(...) -> (..., 3, 4)``: ``twist_robot = J @ (beta_dot, phi_dot, phi_dot_r, omega)``. The columns of the
     joints a type lacks are zero; keeping the non-zero ones gives the per-type matrices (3.19).
     """
-    beta, l, alpha, d, delta, gamma, r, r_r = np.broadcast_arrays(
-        *(np.asarray(a, dtype=float) for a in (beta, l, alpha, d, delta, gamma, r, r_r))
-    )
-    theta = beta + delta + gamma
-    cb, sb = np.cos(beta), np.sin(beta)
-    out = np.zeros((*beta.shape, 3, 4))
-    out[..., 0, 0], out[..., 1, 0] = d * cb, d * sb
-    out[..., 0, 1], out[..., 1, 1] = r * np.sin(beta + delta), -r * np.cos(beta + delta)
-    out[..., 0, 2], out[..., 1, 2] = r_r * np.sin(theta), -r_r * np.cos(theta)
-    out[..., 0, 3] = l * np.sin(alpha) + d * cb
-    out[..., 1, 3] = -l * np.cos(alpha) + d * sb
-    out[..., 2, 3] = 1.0
-    return out
+    args = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (beta, l, alpha, d, delta, gamma, r, r_r)))
+    return _fill(jacobian_entries(*args), args[0].shape)
 
 
 def wheel_slip_rows(wheel: Wheel, beta: ArrayLike | None = None) -> np.ndarray:

@@ -1,0 +1,58 @@
+"""Linear algebra of chapter 4, batched: numeric rank, the projector Delta (4.17), least squares (4.11)/(4.15)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+#: Relative tolerance on singular values for numeric rank (times the largest singular value and the size).
+RANK_RTOL = 1e-9
+
+
+def matrix_rank(m: ArrayLike, *, rtol: float = RANK_RTOL) -> np.ndarray:
+    """Numeric rank by SVD, ``(..., r, c) -> (...)`` int; singular values below ``rtol * max(r, c) * s_max`` count as 0.
+
+    The scale floor is 1: a matrix of tiny but meaningful entries (lengths in km) keeps its rank; an all-zero
+    matrix has rank 0.
+    """
+    m = np.asarray(m, dtype=float)
+    if m.shape[-1] == 0 or m.shape[-2] == 0:
+        return np.zeros(m.shape[:-2], dtype=int)
+    s = np.linalg.svd(m, compute_uv=False)
+    scale = np.maximum(s[..., :1], 1.0)
+    return np.sum(s > rtol * max(m.shape[-2:]) * scale, axis=-1)
+
+
+def delta_projector(m: ArrayLike) -> np.ndarray:
+    """Delta(M) of eq. (4.17): ``M pinv(M) - I`` (minus the projector onto col(M)^perp); ``-I`` for empty M.
+
+    ``(..., r, c) -> (..., r, r)``. ``Delta(M) @ y = 0`` iff ``y`` is in the column space of M (4.18).
+    """
+    m = np.asarray(m, dtype=float)
+    eye = np.eye(m.shape[-2])
+    if m.shape[-1] == 0:
+        return np.broadcast_to(-eye, (*m.shape[:-2], *eye.shape)).copy()
+    return m @ np.linalg.pinv(m) - eye
+
+
+def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """Ranks-method solution (4.9)-(4.11): the velocities not assigned, by least squares, and the residual.
+
+    ``a``: ``(..., R, k)`` slip matrix (3.22); ``assigned``: column indices (n_a,); ``q_assigned``:
+    ``(..., n_a)``. Returns ``(q_dot, residual)``: the full velocity vector ``(..., k)`` (assigned entries
+    copied in) and ``a @ q_dot`` ``(..., R)``, zero when the assignment is consistent with no slip; its norm is
+    the slip indicator of (4.11)/(4.82). Uses the pseudo-inverse, so a non-assignable set returns the
+    minimum-norm solution rather than failing: check assignability with ``matrix_rank`` (4.10).
+    """
+    a = np.asarray(a, dtype=float)
+    assigned = np.asarray(assigned, dtype=int)
+    q_assigned = np.asarray(q_assigned, dtype=float)
+    free = np.setdiff1d(np.arange(a.shape[-1]), assigned)
+    a_na, a_a = a[..., free], a[..., assigned]
+    rhs = -(a_a @ q_assigned[..., None])
+    q_na = (np.linalg.pinv(a_na) @ rhs)[..., 0]
+    batch = np.broadcast_shapes(q_na.shape[:-1], q_assigned.shape[:-1])
+    q = np.empty((*batch, a.shape[-1]))
+    q[..., free] = q_na
+    q[..., assigned] = q_assigned
+    return q, (a @ q[..., None])[..., 0]
