@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 
 from ..errors import WmrkitError
-from . import robots
 
-COMMAND_MODULES = (robots,)
+#: Command modules of ``wmrkit.cli``, in the order ``wmrkit --help`` lists them; each has ``add_parsers``.
+COMMAND_MODULES = ("robots", "kinematics", "ik", "analyze", "odometry")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -19,7 +20,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"wmrkit {_version()}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for module in COMMAND_MODULES:
+    for name in COMMAND_MODULES:
+        try:
+            module = importlib.import_module(f"{__package__}.{name}")
+        except ModuleNotFoundError as err:
+            if err.name != f"{__package__}.{name}":
+                raise
+            continue  # a command group not built yet
         module.add_parsers(commands)
     return parser
 

@@ -1,0 +1,1 @@
+"""Same-run performance comparisons of wmrkit against the peers a user would otherwise pick."""

@@ -1,0 +1,47 @@
+"""Timing helpers shared by the benchmark modules: best-of-N wall time and one printed line per comparison."""
+
+from __future__ import annotations
+
+import importlib
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Result:
+    """One comparison: wmrkit's time against a peer's on the same work (`n` items)."""
+
+    name: str
+    n: int
+    ours_s: float
+    peer: str
+    peer_s: float | None  # None when the peer is absent
+    target: str = ""
+
+    def line(self) -> str:
+        rate = self.n / self.ours_s
+        text = f"{self.name:<46} {self.n:>10,d} items  {self.ours_s * 1e3:9.2f} ms  {rate / 1e6:8.2f} M/s"
+        if self.peer_s is None:
+            text += f"  | peer {self.peer}: ABSENT"
+        else:
+            text += f"  | {self.peer}: {self.peer_s * 1e3:9.2f} ms  ratio {self.peer_s / self.ours_s:8.1f}x"
+        return text + (f"  [target: {self.target}]" if self.target else "")
+
+
+def best_time(fn: Callable[[], object], *, repeat: int = 3) -> float:
+    """Best wall time of `repeat` calls of `fn` [s]."""
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def peer(module: str):
+    """Import a peer library, or None when it is absent (the runner then says so)."""
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        return None
