@@ -1,4 +1,6 @@
-"""Run every benchmark: ``python -m benchmarks [--quick]``. Each module ``bench_*.py`` has ``run(quick) -> list[Result]``.
+"""Run every benchmark: ``python -m benchmarks [--quick] [MODULE ...]``.
+
+Each module ``bench_*.py`` has ``run(quick) -> list[Result]``.
 
 Peers come from the optional ``bench`` extra (``pip install -e ".[bench]"``); an absent peer is reported, not hidden.
 """

@@ -17,7 +17,7 @@ def names() -> tuple[str, ...]:
     return tuple(sorted(p.name[:-5] for p in resources.files(__name__).iterdir() if p.name.endswith(".yaml")))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def load(name: str) -> Robot:
     """The catalog robot `name`, or :class:`UnknownNameError` with a suggestion."""
     if name not in names():

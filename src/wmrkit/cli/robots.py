@@ -65,7 +65,8 @@ def summary(robot: Robot) -> dict:
 def format_summary(robot: Robot) -> str:
     """Human-readable summary: one line per wheel in the robot frame (x forward, y left)."""
     lines = [f"robot {robot.name}: {len(robot.wheels)} wheels" + (f"  ({robot.notes})" if robot.notes else "")]
-    lines.append(f"  {'wheel':<14}{'type':<14}{'x [m]':>8}{'y [m]':>8}{'beta':>9}{'r [m]':>8}  joints (A actuated, S sensed)")
+    header = f"  {'wheel':<14}{'type':<14}{'x [m]':>8}{'y [m]':>8}{'beta':>9}{'r [m]':>8}"
+    lines.append(header + "  joints (A actuated, S sensed)")
     for w in robot.wheels:
         x, y = w.position
         joints = ", ".join(
@@ -74,7 +75,8 @@ def format_summary(robot: Robot) -> str:
         )
         extra = {"castor": f"  d={w.d:g}", "double_castor": f"  d={w.d:g} b={w.b:g}", "double": f"  b={w.b:g}",
                  "swedish": f"  gamma={math.degrees(w.gamma):g}deg r_r={w.r_r:g}"}.get(w.type, "")
-        lines.append(f"  {w.name:<14}{w.type:<14}{x:>8.3f}{y:>8.3f}{math.degrees(w.beta):>7.1f}°{w.r:>8.3f}  {joints}{extra}")
+        row = f"  {w.name:<14}{w.type:<14}{x:>8.3f}{y:>8.3f}{math.degrees(w.beta):>7.1f}°{w.r:>8.3f}"
+        lines.append(f"{row}  {joints}{extra}")
     lines.append(f"  velocity vector q_dot ({len(robot.velocity_names)}): {', '.join(robot.velocity_names)}")
     if robot.steer_names:
         lines.append(f"  steering configuration beta: {', '.join(robot.steer_names)}")
