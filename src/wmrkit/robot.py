@@ -114,8 +114,9 @@ class Robot:
             g = rotate_rows_to_robot(g, beta_e + t.delta + t.gamma)
         elif frame != "roller":
             raise ValueError(f"frame must be 'roller' or 'robot', got {frame!r}")
-        a_w = g[..., 3:] @ t.rate_map  # (..., E, 2, n_rates)
-        a = np.concatenate([g[..., :3], a_w], axis=-1)
+        a = np.empty((*g.shape[:-1], 3 + t.n_rates))  # one allocation: large batches are memory-bound
+        a[..., :3] = g[..., :3]
+        np.matmul(g[..., 3:], t.rate_map, out=a[..., 3:])  # wheel-rate columns, (..., E, 2, n_rates)
         return a.reshape(*a.shape[:-3], 2 * t.n_elements, 3 + t.n_rates)
 
     def slip_velocity(self, q_dot: ArrayLike, beta: ArrayLike | None = None) -> np.ndarray:
