@@ -185,6 +185,9 @@ class _Table:
     steer_wheels: np.ndarray  # (n_steer,) wheel indices of the steering wheels
     beta_described: np.ndarray  # (N,)
     n_rates: int
+    element_beta_fixed: np.ndarray  # (E,) element angle, the steering wheels' described beta left out
+    element_steers: np.ndarray  # (E,) bool: the element follows a steering angle
+    element_steer_index: np.ndarray  # (E,) index into beta of that angle (0 where it follows none)
 
     @property
     def n_elements(self) -> int:
@@ -207,13 +210,20 @@ def _table(robot: Robot) -> _Table:
         start += n
     cols = np.array(rows, dtype=float).reshape(-1, 8).T
     arrays = [readonly(np.ascontiguousarray(c)) for c in cols]
+    steer_wheels = [i for i, w in enumerate(robot.wheels) if w.kind.steers]
+    steers = np.array([i in steer_wheels for i in owner], dtype=bool)
+    steer_index = np.array([steer_wheels.index(i) if i in steer_wheels else 0 for i in owner], dtype=int)
+    fixed = np.where(steers, 0.0, np.array([robot.wheels[i].beta for i in owner], dtype=float)) + cols[2]
     return _Table(
         *arrays,
         rate_map=readonly(np.array(maps).reshape(-1, 3, n_rates)),
         element_wheel=readonly(np.array(owner, dtype=int)),
-        steer_wheels=readonly(np.array([i for i, w in enumerate(robot.wheels) if w.kind.steers], dtype=int)),
+        steer_wheels=readonly(np.array(steer_wheels, dtype=int)),
         beta_described=readonly(np.array([w.beta for w in robot.wheels], dtype=float)),
         n_rates=n_rates,
+        element_beta_fixed=readonly(fixed),
+        element_steers=readonly(steers),
+        element_steer_index=readonly(steer_index),
     )
 
 
@@ -225,6 +235,4 @@ def _element_beta(robot: Robot, t: _Table, beta: ArrayLike | None) -> np.ndarray
     beta = as_vectors(beta, len(t.steer_wheels), "beta")
     if len(t.steer_wheels) == 0:
         return np.broadcast_to(described, (*beta.shape[:-1], len(described)))
-    wheels = np.broadcast_to(t.beta_described, (*beta.shape[:-1], len(t.beta_described))).copy()
-    wheels[..., t.steer_wheels] = beta
-    return wheels[..., t.element_wheel] + t.beta_offset
+    return np.where(t.element_steers, beta[..., t.element_steer_index], 0.0) + t.element_beta_fixed

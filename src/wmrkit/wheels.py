@@ -215,8 +215,8 @@ def generic_slip_rows(
     along the roller axis E_x, row 1 across it. With ``d = delta = gamma = r_r = 0`` these are the rows
     (3.11) of a fixed wheel: row 0 the lateral constraint, row 1 the rolling constraint.
     """
-    args = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (beta, l, alpha, d, delta, gamma, r, r_r)))
-    return _fill(slip_row_entries(*args), args[0].shape)
+    args = [np.asarray(a, dtype=float) for a in (beta, l, alpha, d, delta, gamma, r, r_r)]
+    return _fill(slip_row_entries(*args), np.broadcast_shapes(*(a.shape for a in args)))
 
 
 def rotate_rows_to_robot(rows: ArrayLike, theta: ArrayLike) -> np.ndarray:
@@ -238,8 +238,8 @@ def generic_wheel_jacobian(
     ``(...) -> (..., 3, 4)``: ``twist_robot = J @ (beta_dot, phi_dot, phi_dot_r, omega)``. The columns of the
     joints a type lacks are zero; keeping the non-zero ones gives the per-type matrices (3.19).
     """
-    args = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (beta, l, alpha, d, delta, gamma, r, r_r)))
-    return _fill(jacobian_entries(*args), args[0].shape)
+    args = [np.asarray(a, dtype=float) for a in (beta, l, alpha, d, delta, gamma, r, r_r)]
+    return _fill(jacobian_entries(*args), np.broadcast_shapes(*(a.shape for a in args)))
 
 
 def wheel_slip_rows(wheel: Wheel, beta: ArrayLike | None = None) -> np.ndarray:

@@ -47,7 +47,9 @@ def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike) -> 
     a = np.asarray(a, dtype=float)
     assigned = np.asarray(assigned, dtype=int)
     q_assigned = np.asarray(q_assigned, dtype=float)
-    free = np.setdiff1d(np.arange(a.shape[-1]), assigned)
+    free_mask = np.ones(a.shape[-1], dtype=bool)
+    free_mask[assigned] = False
+    free = np.flatnonzero(free_mask)  # (np.setdiff1d costs ~20 us, a quarter of a small solve)
     a_na, a_a = a[..., free], a[..., assigned]
     rhs = -(a_a @ q_assigned[..., None])
     q_na = (np.linalg.pinv(a_na) @ rhs)[..., 0]
