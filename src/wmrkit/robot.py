@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._shapes import as_vectors, readonly
-from .errors import UnknownNameError
+from .errors import ShapeError, UnknownNameError
 from .wheels import Wheel, generic_slip_rows, generic_wheel_jacobian, rotate_rows_to_robot
 
 TWIST_NAMES = ("vx", "vy", "omega")
@@ -86,7 +86,8 @@ class Robot:
         """The same robot at steering configuration `beta` ``(n_steer,)``."""
         beta = as_vectors(beta, len(self.steer_names), "beta")
         if beta.ndim != 1:
-            raise ValueError("with_beta takes one configuration; batched functions take beta directly")
+            raise ShapeError(f"beta: with_beta takes one configuration (n_steer,), got {beta.shape}; "
+                             "batched functions take beta directly")
         angles = iter(beta.tolist())
         return replace(self, wheels=tuple(w.with_beta(next(angles)) if w.kind.steers else w for w in self.wheels))
 
