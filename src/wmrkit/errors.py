@@ -41,3 +41,7 @@ class DescriptionError(WmrkitError, ValueError):
 
 class SingularError(WmrkitError, ValueError):
     """A requested model does not exist at this configuration (non-assignable set, singular wheel)."""
+
+
+class SelectionError(WmrkitError, ValueError):
+    """A choice of velocities or joints a method refuses (e.g. omega as an actuator); the message says why."""
