@@ -58,3 +58,41 @@ def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike) -> 
     q[..., free] = q_na
     q[..., assigned] = q_assigned
     return q, (a @ q[..., None])[..., 0]
+
+
+def rref(m: ArrayLike, *, rtol: float = RANK_RTOL) -> tuple[np.ndarray, np.ndarray]:
+    """Reduced row-echelon form by Gauss-Jordan elimination with partial pivoting, batched (thesis §4.2, 4.6).
+
+    ``(..., r, c) -> ((..., r, c), (..., c) bool)``: the RREF and which columns hold a pivot. Pivots are taken
+    left to right, so the free (non-pivot) columns are the right-most set of columns that can act as the
+    mobility vector of (4.2): put the variables to assign last and read ``q_na = -R[:g, free] @ q_a``.
+    A pivot candidate below ``rtol * max(r, c) * max(|m|_max, 1)`` counts as zero (as in :func:`matrix_rank`).
+    """
+    m = np.asarray(m, dtype=float)
+    n_rows, n_cols = m.shape[-2:]
+    out = m.reshape(-1, n_rows, n_cols).copy()
+    n_batch = out.shape[0]
+    scale = np.maximum(np.abs(out).max(axis=(1, 2), initial=0.0), 1.0)
+    tol = rtol * max(n_rows, n_cols) * scale
+    next_row = np.zeros(n_batch, dtype=int)
+    pivots = np.zeros((n_batch, n_cols), dtype=bool)
+    batch, rows = np.arange(n_batch), np.arange(n_rows)
+    for j in range(n_cols):  # a loop over columns (a handful), never over the batch
+        col = np.where(rows >= next_row[:, None], np.abs(out[:, :, j]), -1.0)
+        p = np.argmax(col, axis=1) if n_rows else np.zeros(n_batch, dtype=int)
+        ok = (next_row < n_rows) & (col[batch, p] > tol) if n_rows else np.zeros(n_batch, dtype=bool)
+        if not ok.any():
+            continue
+        b, src, dst = batch[ok], p[ok], next_row[ok]
+        pivot_rows = out[b, src].copy()
+        out[b, src] = out[b, dst]
+        pivot_rows /= pivot_rows[:, j : j + 1]
+        factors = out[b, :, j].copy()
+        factors[np.arange(len(b)), dst] = 0.0
+        out[b] -= factors[:, :, None] * pivot_rows[:, None, :]
+        out[b, dst] = pivot_rows
+        out[b, :, j] = 0.0
+        out[b, dst, j] = 1.0
+        pivots[b, j] = True
+        next_row[b] += 1
+    return out.reshape(m.shape), pivots.reshape(*m.shape[:-2], n_cols)

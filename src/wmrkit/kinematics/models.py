@@ -1,0 +1,264 @@
+"""No-slip kinematic models of a robot (thesis ch. 4): mobility, assignable sets, direct/inverse/mixed models.
+
+A model assigns (chooses freely) ``m`` of the velocities ``q_dot = (vx, vy, omega, wheel rates)`` and gives the
+others: ``q_solved = matrix @ q_assigned``. Assigning wheel rates gives the *direct* model, twist components the
+*inverse* model, a mixture a *mixed* model (§4.2). Everything is batched over steering configurations
+``beta`` ``(..., n_steer)`` (``None``: the described configuration, batch shape ``()``); assignability depends
+on the configuration, and a set assignable at generic angles can fail at a singular one.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors, readonly
+from ..errors import SingularError, WmrkitError
+from ..robot import TWIST_NAMES, Robot
+from .linalg import matrix_rank
+from .nullspace import enumerate_subsets, null_space_assignable, null_space_solution, rref_solution
+from .ranks import ranks_assignable, ranks_solution
+
+Method = Literal["ranks", "nullspace", "rref"]
+
+#: Random configurations tried by :func:`generically_assignable_sets` (a fixed seed: results are reproducible).
+GENERIC_SAMPLES = 3
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class KinematicModel:
+    """A no-slip kinematic model at a batch of configurations, eqs. (4.5)/(4.6)/(4.11).
+
+    ``matrix``: ``(..., n_solved, n_assigned)`` read-only, ``q_solved = matrix @ q_assigned``;
+    ``beta``: ``(..., n_steer)`` read-only. Units: m/s, rad/s.
+    """
+
+    robot_name: str
+    velocity_names: tuple[str, ...]  # all of q_dot, in the robot's order
+    assigned: tuple[str, ...]
+    solved: tuple[str, ...]  # the others, in the robot's order
+    beta: np.ndarray
+    matrix: np.ndarray
+    method: str
+
+    @property
+    def kind(self) -> str:
+        """``'direct'`` (wheel rates assigned), ``'inverse'`` (twist components assigned) or ``'mixed'``."""
+        twist = [n in TWIST_NAMES for n in self.assigned]
+        return "inverse" if all(twist) else "direct" if not any(twist) else "mixed"
+
+    def solve(self, q_assigned: ArrayLike) -> np.ndarray:
+        """The solved velocities for assigned ones: ``(..., n_assigned) -> (..., n_solved)``."""
+        q = as_vectors(q_assigned, len(self.assigned), "q_assigned")
+        return (self.matrix @ q[..., None])[..., 0]
+
+    def velocities(self, q_assigned: ArrayLike) -> np.ndarray:
+        """The whole velocity vector ``q_dot`` (robot order): ``(..., n_assigned) -> (..., k)``; ``A q_dot = 0``."""
+        q = as_vectors(q_assigned, len(self.assigned), "q_assigned")
+        solved = self.solve(q)
+        out = np.empty((*solved.shape[:-1], len(self.velocity_names)))
+        out[..., [self.velocity_names.index(n) for n in self.solved]] = solved
+        out[..., [self.velocity_names.index(n) for n in self.assigned]] = q
+        return out
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready description: names, kind, configuration and matrix (nested lists)."""
+        return {
+            "robot": self.robot_name, "kind": self.kind, "method": self.method,
+            "assigned": list(self.assigned), "solved": list(self.solved),
+            "beta": self.beta.tolist(), "matrix": self.matrix.tolist(),
+        }
+
+
+def configuration(robot: Robot, beta: ArrayLike | None) -> np.ndarray:
+    """`beta` checked as ``(..., n_steer)``, or the described configuration ``(n_steer,)`` when None."""
+    return robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
+
+
+def describe_configuration(robot: Robot, beta: np.ndarray, index: tuple[int, ...] = ()) -> str:
+    """``"beta (w3=0.4 rad)"``, with ``[i, j]`` for an element of a batch; ``"the fixed geometry"`` if no steering."""
+    if not robot.steer_names:
+        return "the fixed geometry"
+    values = beta[index] if beta.ndim > 1 else beta
+    angles = ", ".join(f"{n}={v:.6g} rad" for n, v in zip(robot.steer_names, values.tolist(), strict=True))
+    where = f"configuration {list(index)} " if index else ""
+    return f"{where}beta ({angles})"
+
+
+def mobility(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
+    """Degree of mobility ``m = k - rank A`` (4.3): ``(..., n_steer) -> (...)`` int."""
+    a = robot.constraint_matrix(configuration(robot, beta))
+    return a.shape[-1] - matrix_rank(a)
+
+
+def _indices(robot: Robot, names: Sequence[str]) -> np.ndarray:
+    if isinstance(names, str):
+        raise WmrkitError(f"assigned velocities: expected a sequence of names, got the string '{names}'")
+    if len(set(names)) != len(names):
+        raise WmrkitError(f"assigned velocities: repeated name in {tuple(names)}")
+    return np.array([robot.velocity_index(n) for n in names], dtype=int).reshape(len(names))
+
+
+def _assignable(a: np.ndarray, subsets: np.ndarray, method: Method) -> np.ndarray:
+    if method == "ranks":
+        return ranks_assignable(a, subsets)
+    if method == "nullspace":
+        return null_space_assignable(a, subsets)
+    if method == "rref":
+        return np.stack([rref_solution(a, s)[1] for s in subsets]).reshape(len(subsets), *a.shape[:-2])
+    raise WmrkitError(f"method must be 'ranks', 'nullspace' or 'rref', got {method!r}")
+
+
+def is_assignable(
+    robot: Robot, names: Sequence[str], beta: ArrayLike | None = None, *, method: Method = "ranks"
+) -> np.ndarray:
+    """Whether the velocities `names` can be assigned, (4.5)/(4.6)/(4.10): ``(..., n_steer) -> (...)`` bool."""
+    a = robot.constraint_matrix(configuration(robot, beta))
+    return _assignable(a, _indices(robot, names)[None, :], method)[0]
+
+
+def _sets_at(robot: Robot, a: np.ndarray, method: Method) -> tuple[tuple[str, ...], ...]:
+    m = np.unique(a.shape[-1] - matrix_rank(a))
+    if len(m) != 1:  # the mobility changes within the batch: no set fits every configuration
+        return ()
+    subsets = enumerate_subsets(a.shape[-1], int(m[0]))
+    ok = _assignable(a, subsets, method).reshape(len(subsets), -1).all(axis=1)
+    names = robot.velocity_names
+    return tuple(tuple(names[i] for i in s) for s, good in zip(subsets, ok, strict=True) if good)
+
+
+def assignable_sets(
+    robot: Robot, beta: ArrayLike | None = None, *, method: Method = "ranks"
+) -> tuple[tuple[str, ...], ...]:
+    """Every set of m velocities that can be assigned at every configuration of `beta` (4.8: C(k, m) tests).
+
+    Sets are tuples of velocity names in the robot's order, listed lexicographically.
+    """
+    return _sets_at(robot, robot.constraint_matrix(configuration(robot, beta)), method)
+
+
+def generic_configurations(robot: Robot) -> np.ndarray:
+    """A few random steering configurations (fixed seed): ``(GENERIC_SAMPLES, n_steer)`` [rad]."""
+    rng = np.random.default_rng(20040101)
+    return rng.uniform(-np.pi, np.pi, size=(GENERIC_SAMPLES, len(robot.steer_names)))
+
+
+def generic_mobility(robot: Robot) -> int:
+    """The mobility at generic (random) steering angles: the smallest m over :func:`generic_configurations`."""
+    return int(np.min(mobility(robot, generic_configurations(robot))))
+
+
+def generically_assignable_sets(robot: Robot) -> tuple[tuple[str, ...], ...]:
+    """The sets assignable at generic steering angles (almost every configuration); some fail at singular ones.
+
+    A set is generically assignable when it is assignable at one of a few random configurations of generic
+    mobility: assignability is the non-vanishing of an analytic function of beta, true almost everywhere or
+    nowhere.
+    """
+    samples = generic_configurations(robot)
+    a = robot.constraint_matrix(samples)
+    m = generic_mobility(robot)
+    generic = a.shape[-1] - matrix_rank(a) == m
+    subsets = enumerate_subsets(a.shape[-1], m)
+    ok = (ranks_assignable(a, subsets) & generic).any(axis=1)
+    names = robot.velocity_names
+    return tuple(tuple(names[i] for i in s) for s, good in zip(subsets, ok, strict=True) if good)
+
+
+def _refuse(robot: Robot, names: Sequence[str], beta: np.ndarray, ok: np.ndarray) -> SingularError:
+    bad = tuple(int(i) for i in np.argwhere(~ok)[0]) if ok.ndim else ()
+    beta_bad = beta[bad] if beta.ndim > 1 else beta
+    m_here, m_generic = int(mobility(robot, beta_bad)), generic_mobility(robot)
+    label = f"({', '.join(names)})" if names else "() (no velocity)"
+    if len(names) != m_here:
+        why = f"a model assigns exactly m = {m_here} velocities here, got {len(names)}"
+        why += f" (m = {m_generic} at generic angles)" if m_generic != m_here else ""
+    elif tuple(names) in generically_assignable_sets(robot):
+        why = "assignable at generic steering angles but not at this singular configuration"
+    else:
+        why = "not assignable at generic steering angles either"
+    here = ["(" + ", ".join(s) + ")" for s in assignable_sets(robot, beta_bad)]
+    hint = f"; assignable here: {' '.join(here[:8])}{' ...' if len(here) > 8 else ''}" if here else ""
+    where = describe_configuration(robot, beta, bad)
+    return SingularError(f"robot '{robot.name}': velocities {label} cannot be assigned at {where}: {why}{hint}")
+
+
+def kinematic_model(
+    robot: Robot, assigned: Sequence[str], beta: ArrayLike | None = None, *, method: Method = "ranks"
+) -> KinematicModel:
+    """The kinematic model with the velocities `assigned` chosen freely (4.5, 4.6 or 4.11 by `method`).
+
+    ``beta``: ``(..., n_steer)`` or None; the model's matrix is ``(..., n_solved, n_assigned)``. Raises
+    :class:`~wmrkit.errors.SingularError` naming the set and the first configuration where it is not
+    assignable, and whether it is assignable at generic angles.
+    """
+    beta = configuration(robot, beta)
+    idx = _indices(robot, assigned)
+    a = robot.constraint_matrix(beta)
+    if method == "ranks":
+        ok, matrix = ranks_assignable(a, idx[None, :])[0], ranks_solution(a, idx)
+    elif method in ("nullspace", "rref"):
+        matrix, ok = (null_space_solution if method == "nullspace" else rref_solution)(a, idx)
+    else:
+        raise WmrkitError(f"method must be 'ranks', 'nullspace' or 'rref', got {method!r}")
+    if not np.all(ok):
+        raise _refuse(robot, tuple(assigned), beta, np.asarray(ok))
+    names = robot.velocity_names
+    solved = tuple(n for n in names if n not in assigned)
+    return KinematicModel(robot.name, names, tuple(assigned), solved, readonly(np.array(beta)),
+                          readonly(np.ascontiguousarray(matrix)), method)
+
+
+def _first_assignable(robot: Robot, a: np.ndarray, candidates: Sequence[str], m: int) -> tuple[str, ...] | None:
+    sets = [c for c in itertools.combinations(candidates, m)]
+    if not sets:
+        return None
+    ok = ranks_assignable(a, np.array([[robot.velocity_index(n) for n in s] for s in sets]).reshape(len(sets), m))
+    ok = ok.reshape(len(sets), -1).all(axis=1)
+    return next((s for s, good in zip(sets, ok, strict=True) if good), None)
+
+
+def direct_model(
+    robot: Robot, rates: Sequence[str] | None = None, beta: ArrayLike | None = None
+) -> KinematicModel:
+    """Direct model (§4.2): the twist and the other rates from m assigned wheel rates.
+
+    ``rates=None`` takes the first assignable set of the robot's *sensed* rates, or failing that of all its
+    wheel rates (roller rates excluded: they cannot be measured, §3.3.3).
+    """
+    if rates is not None:
+        return kinematic_model(robot, rates, beta)
+    beta = configuration(robot, beta)
+    a = robot.constraint_matrix(beta)
+    m = int(np.max(a.shape[-1] - matrix_rank(a)))
+    usable = [n for n in robot.rate_names if not n.endswith(".roller")]
+    sensed = [n for n in usable if n in robot.sensed]
+    choice = _first_assignable(robot, a, sensed, m) or _first_assignable(robot, a, usable, m)
+    if choice is None:
+        raise SingularError(f"robot '{robot.name}': no set of {m} wheel rates can be assigned at "
+                            f"{describe_configuration(robot, beta)}")
+    return kinematic_model(robot, choice, beta)
+
+
+def inverse_model(
+    robot: Robot, twist_names: Sequence[str] | None = None, beta: ArrayLike | None = None
+) -> KinematicModel:
+    """Inverse model (§4.2): the wheel rates (and remaining twist components) from m assigned twist components.
+
+    ``twist_names=None`` takes the first assignable subset of ``(vx, vy, omega)`` of size m.
+    """
+    if twist_names is not None:
+        return kinematic_model(robot, twist_names, beta)
+    beta = configuration(robot, beta)
+    a = robot.constraint_matrix(beta)
+    m = int(np.max(a.shape[-1] - matrix_rank(a)))
+    choice = _first_assignable(robot, a, TWIST_NAMES, m)
+    if choice is None:
+        raise SingularError(f"robot '{robot.name}': no {m} of (vx, vy, omega) can be assigned at "
+                            f"{describe_configuration(robot, beta)}")
+    return kinematic_model(robot, choice, beta)
