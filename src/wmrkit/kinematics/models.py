@@ -96,7 +96,8 @@ def mobility(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
     return a.shape[-1] - matrix_rank(a)
 
 
-def _indices(robot: Robot, names: Sequence[str]) -> np.ndarray:
+def velocity_indices(robot: Robot, names: Sequence[str]) -> np.ndarray:
+    """Columns of ``A`` (3.22) of the velocities `names` ``(n,)``; unknown or repeated names raise."""
     if isinstance(names, str):
         raise WmrkitError(f"assigned velocities: expected a sequence of names, got the string '{names}'")
     if len(set(names)) != len(names):
@@ -119,7 +120,7 @@ def is_assignable(
 ) -> np.ndarray:
     """Whether the velocities `names` can be assigned, (4.5)/(4.6)/(4.10): ``(..., n_steer) -> (...)`` bool."""
     a = robot.constraint_matrix(configuration(robot, beta))
-    return _assignable(a, _indices(robot, names)[None, :], method)[0]
+    return _assignable(a, velocity_indices(robot, names)[None, :], method)[0]
 
 
 def _sets_at(robot: Robot, a: np.ndarray, method: Method) -> tuple[tuple[str, ...], ...]:
@@ -198,7 +199,7 @@ def kinematic_model(
     assignable, and whether it is assignable at generic angles.
     """
     beta = configuration(robot, beta)
-    idx = _indices(robot, assigned)
+    idx = velocity_indices(robot, assigned)
     a = robot.constraint_matrix(beta)
     if method == "ranks":
         ok, matrix = ranks_assignable(a, idx[None, :])[0], ranks_solution(a, idx)

@@ -1,0 +1,219 @@
+"""Actuation (thesis §4.4.3-4.4.4): actuated inverse solution (4.26)/(4.27), actuation equation (4.28), Fig. 4.4.
+
+The actuated joints are ``wheel.joint`` names (default: the robot's ``actuated``). Wheel rates (spins, castor and
+double-wheel steering rates) are columns of the Jacobian form; the ``steer`` joint of a centred steerable wheel
+is a *configuration* actuator: it sets beta and does not appear in the instantaneous equations, but the thesis
+requires it to be actuated for the model to hold (§4.5). ``omega`` and roller rates are refused (§4.4.3).
+Batched over ``beta`` ``(..., n_steer)``; ``None`` is the described configuration.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors, readonly
+from ..robot import Robot
+from .linalg import matrix_rank
+from .models import configuration
+from .trees import (
+    TreeVerdict,
+    classify_system,
+    jacobian_names,
+    partitioned_solution,
+    reduced_equation,
+    select_columns,
+)
+
+
+def split_jacobian(
+    robot: Robot, columns: Sequence[int], beta: ArrayLike | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(I_bar, J_sel, J_rest)`` of the Jacobian form (3.20) split by columns (4.24); ``J_rest`` keeps omega.
+
+    ``(..., n_steer) -> (3E, 3), (..., 3E, n_sel), (..., 3E, n_w - n_sel)``.
+    """
+    i_bar, j = robot.jacobian_form(configuration(robot, beta))
+    rest = [c for c in range(j.shape[-1]) if c not in columns]
+    return i_bar, j[..., list(columns)], j[..., rest]
+
+
+def actuation_equation(
+    robot: Robot, actuated: Sequence[str] | None = None, beta: ArrayLike | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """The vehicle actuation equation (4.28), ``I_u @ twist_robot = J_u @ q_dot_u``.
+
+    ``(..., n_steer) -> (I_u (..., 3E, 3), J_u (..., 3E, n_u))``. A wheel with no actuated rate contributes
+    its motion constraint ``-Delta(J_i)``; the others ``I - J_inu (J_inu^T Delta(J_iu) J_inu)^-1 J_inu^T
+    Delta(J_iu)``.
+    """
+    columns, _ = select_columns(robot, robot.actuated if actuated is None else actuated, "actuated")
+    i_bar, j_u, j_nu = split_jacobian(robot, columns, beta)
+    return reduced_equation(i_bar, j_u, j_nu), j_u
+
+
+def actuated_inverse_matrix(
+    robot: Robot, actuated: Sequence[str] | None = None, beta: ArrayLike | None = None
+) -> np.ndarray:
+    """Actuated inverse solution (4.26)/(4.27): ``q_dot_u = M @ twist_robot``, ``(..., n_steer) -> (..., n_u, 3)``.
+
+    Per wheel ``(J_iu^T Delta(J_inu) J_iu)^-1 J_iu^T Delta(J_inu)``; ``J_i^-1`` for an omnidirectional wheel with
+    every variable actuated. The twist must satisfy the motion constraints or the wheels slip.
+    """
+    columns, _ = select_columns(robot, robot.actuated if actuated is None else actuated, "actuated")
+    i_bar, j_u, j_nu = split_jacobian(robot, columns, beta)
+    return partitioned_solution(j_u, j_nu) @ i_bar
+
+
+def actuation_tree(
+    robot: Robot, actuated: Sequence[str] | None = None, beta: ArrayLike | None = None,
+    q_dot_u: ArrayLike | None = None,
+) -> TreeVerdict:
+    """The actuation tree of Fig. 4.4: Fig. 4.1 on (4.28) with ``A = I_u``, ``B = J_u``, ``y = q_dot_u``.
+
+    ``determined``: consistent actuation (sufficient, no conflict possible); ``overdetermined``: possible
+    conflict, and with commands ``q_dot_u`` ``(..., n_u)`` ``consistent`` (actuator coupling respected) or
+    ``inconsistent`` (the wheels fight and slip); ``indeterminate``/``underdetermined``/``incompatible``:
+    insufficient actuators.
+    """
+    i_u, j_u = actuation_equation(robot, actuated, beta)
+    return classify_system(i_u, j_u, q_dot_u)
+
+
+_ACTUATION_TEXT = {
+    "determined": "consistent actuation: the actuated rates drive every degree of freedom and cannot conflict",
+    "overdetermined": "possible actuator conflict: redundant actuated rates must respect the actuator coupling "
+                      "or the wheels slip",
+    "indeterminate": "insufficient actuators: some degrees of freedom are not actuated",
+    "underdetermined": "insufficient and conflicting actuators: some degrees of freedom are not actuated and "
+                       "the actuated rates can fight",
+}
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class ActuationAnalysis:
+    """Actuation of a robot at a batch of configurations (§4.4.3-4.4.4, Fig. 4.4); arrays of the batch shape."""
+
+    robot_name: str
+    actuated: tuple[str, ...]  # actuated columns of the Jacobian form (wheel rates)
+    steering: tuple[str, ...]  # steerable wheels whose steering joint is actuated
+    steering_missing: tuple[str, ...]  # steerable wheels whose steering is not actuated
+    mobility: np.ndarray  # (...) int, m = G
+    tree: TreeVerdict
+    inverse_matrix: np.ndarray  # (..., n_u, 3), (4.26)
+
+    @property
+    def sufficient(self) -> np.ndarray:
+        """``rank I_u = 3``: every feasible motion is reached by the actuators (sufficient actuators)."""
+        return self.tree.rank_a == 3
+
+    @property
+    def consistent(self) -> np.ndarray:
+        """``rank [I_u, J_u] = rank I_u``: the actuated rates can be set independently without fighting."""
+        return self.tree.rank_ab == self.tree.rank_a
+
+    @property
+    def leaf(self) -> np.ndarray:
+        """The leaf of Fig. 4.4 (``determined``, ``overdetermined``, ``indeterminate``, ``underdetermined``)."""
+        return self.tree.leaf
+
+    @property
+    def verdict(self) -> np.ndarray:
+        """One sentence per configuration: the tree's verdict, the counts, and missing steering actuators."""
+        return verdict_texts(self.leaf, _ACTUATION_TEXT, len(self.actuated), self.mobility,
+                         self.steering_missing, "actuated")
+
+    def inverse(self, twist_robot: ArrayLike) -> np.ndarray:
+        """Actuated rates for a (feasible) body twist, (4.26): ``(..., 3) -> (..., n_u)`` [rad/s, m/s]."""
+        t = as_vectors(twist_robot, 3, "twist_robot")
+        return (self.inverse_matrix @ t[..., None])[..., 0]
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (lists and plain values)."""
+        return {
+            "actuated": list(self.actuated), "steering_actuated": list(self.steering),
+            "steering_not_actuated": list(self.steering_missing), "mobility": self.mobility.tolist(),
+            "leaf": self.leaf.tolist(), "sufficient": self.sufficient.tolist(),
+            "consistent": self.consistent.tolist(), "verdict": self.verdict.tolist(),
+            "inverse_matrix": self.inverse_matrix.tolist(),
+        }
+
+
+def verdict_texts(leaf: np.ndarray, texts: dict[str, str], n: int, m: np.ndarray,
+                  missing: tuple[str, ...], role: str) -> np.ndarray:
+    """One sentence per leaf of a tree ``(...)`` str: the leaf's text, counts, and missing steering joints."""
+    note = (f"; the thesis needs the steering of {', '.join(missing)} {role} too (the model depends on beta)"
+            if missing else "")
+    plural = "" if n == 1 else "s"
+    words = np.frompyfunc(lambda lf, mob: f"{texts[lf]} ({n} {role} rate{plural}, m = {mob}){note}", 2, 1)
+    return readonly(np.asarray(words(leaf, m), dtype=object))
+
+
+def steering_split(robot: Robot, steering: tuple[str, ...]) -> tuple[str, ...]:
+    """The centred steerable wheels not in `steering` (their steering is not actuated/sensed)."""
+    return tuple(w.name for w in robot.wheels if w.type == "steerable" and w.name not in steering)
+
+
+def actuation_analysis(
+    robot: Robot, beta: ArrayLike | None = None, actuated: Sequence[str] | None = None
+) -> ActuationAnalysis:
+    """Analyse the actuators of `robot` (default: its described ``actuated`` joints) at `beta`, Fig. 4.4.
+
+    ``beta``: ``(..., n_steer)`` or None. See :class:`ActuationAnalysis` for ``.consistent``,
+    ``.sufficient``, ``.verdict`` and the actuated inverse solution ``.inverse``.
+    """
+    beta = configuration(robot, beta)
+    columns, steering = select_columns(robot, robot.actuated if actuated is None else actuated, "actuated")
+    i_bar, j_u, j_nu = split_jacobian(robot, columns, beta)
+    a = robot.constraint_matrix(beta)
+    names = jacobian_names(robot)
+    return ActuationAnalysis(
+        robot.name, tuple(names[c] for c in columns), steering, steering_split(robot, steering),
+        readonly(np.asarray(a.shape[-1] - matrix_rank(a))),
+        classify_system(reduced_equation(i_bar, j_u, j_nu), j_u),
+        readonly(partitioned_solution(j_u, j_nu) @ i_bar),
+    )
+
+
+def subset_trees(robot: Robot, beta: np.ndarray, size: int) -> tuple[list[tuple[int, ...]], TreeVerdict | None]:
+    """The trees (4.28)/(4.34) of every set of `size` selectable wheel rates at once: leaves ``(S, ...)``.
+
+    Selectable: every wheel rate but rollers (column indices of :func:`jacobian_names`). ``None`` when there
+    is no such set.
+    """
+    n_w = len(jacobian_names(robot))
+    usable = [i for i, n in enumerate(robot.rate_names) if not n.endswith(".roller")]
+    subsets = list(itertools.combinations(usable, size))
+    if not subsets:
+        return [], None
+    i_bar, j = robot.jacobian_form(beta)
+    sel = np.array(subsets, dtype=int).reshape(len(subsets), size)
+    rest = np.array([[c for c in range(n_w) if c not in s] for s in subsets], dtype=int)
+    j_sel = np.moveaxis(j[..., sel], -2, 0)  # (..., 3E, S, size) -> (S, ..., 3E, size)
+    j_rest = np.moveaxis(j[..., rest], -2, 0)
+    return subsets, classify_system(reduced_equation(i_bar, j_sel, j_rest), j_sel)
+
+
+def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None) -> tuple[tuple[str, ...], ...]:
+    """The smallest actuator choices with consistent actuation (Fig. 4.4 ``determined``) at every configuration.
+
+    Each set has m = G wheel rates (B.3.8), followed by the ``steer`` joints of the centred steerable wheels,
+    which the thesis requires actuated. Empty when no choice of wheel rates works (e.g. m = 0).
+    """
+    beta = configuration(robot, beta)
+    a = robot.constraint_matrix(beta)
+    m = np.unique(a.shape[-1] - matrix_rank(a))
+    if len(m) != 1 or m[0] == 0:
+        return ()
+    subsets, tree = subset_trees(robot, beta, int(m[0]))
+    if tree is None:
+        return ()
+    ok = ((tree.leaf == "determined") & (tree.rank_a == 3)).reshape(len(subsets), -1).all(axis=1)
+    steer = tuple(f"{w}.steer" for w in steering_split(robot, ()))
+    names = jacobian_names(robot)
+    return tuple(tuple(names[c] for c in s) + steer for s, good in zip(subsets, ok, strict=True) if good)

@@ -1,0 +1,173 @@
+"""Extended kinematic solution (thesis §4.5, eqs. 4.76, 4.82-4.84): more assigned velocities than the mobility.
+
+A centred steerable wheel's steering rate is not a column of ``A`` (3.22), but steering the wheel changes
+``A(beta)``: with ``n_o`` such wheels one may assign ``m + n_o`` velocities and choose the steering angles that
+make them slip-free (4.76). At a given ``beta`` the least-squares solution (4.11) of the over-assigned system
+is (4.82); its residual ``A q_dot`` is the slip indicator. The steering-angle conditions (4.83) are the roots of
+that residual over the steering angles, found here numerically (batched Levenberg-Marquardt from several
+starts); substituting them gives the slip-free extended solution (4.84).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors, readonly
+from ..errors import SingularError
+from ..robot import Robot
+from .linalg import solve_assigned
+from .models import configuration, describe_configuration, generic_mobility, velocity_indices
+
+#: Residual norm [m/s] below which steering angles count as slip-free (times ``1 + |A|_max |q_assigned|``).
+ROOT_TOL = 1e-9
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class ExtendedSolution:
+    """Least-squares velocities for an over-assigned set at a batch of configurations, (4.11)/(4.82).
+
+    ``q_dot``: ``(..., k)`` in the robot's velocity order (assigned entries copied in); ``residual``:
+    ``(..., 2 n_contacts)`` slip along the roller axes (3.6) [m/s]; ``beta``: ``(..., n_steer)`` [rad].
+    """
+
+    robot_name: str
+    velocity_names: tuple[str, ...]
+    assigned: tuple[str, ...]
+    beta: np.ndarray
+    q_dot: np.ndarray
+    residual: np.ndarray
+
+    @property
+    def slip(self) -> np.ndarray:
+        """Norm of the residual ``|A q_dot|`` [m/s], ``(...)``: zero iff the assignment is slip-free here."""
+        return np.linalg.norm(self.residual, axis=-1)
+
+    @property
+    def solved(self) -> tuple[str, ...]:
+        """Names of the velocities not assigned, in the robot's order."""
+        return tuple(n for n in self.velocity_names if n not in self.assigned)
+
+    def values(self, names: Sequence[str]) -> np.ndarray:
+        """The entries of ``q_dot`` named `names`: ``(..., len(names))``."""
+        return self.q_dot[..., [self.velocity_names.index(n) for n in names]]
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (lists and plain values)."""
+        return {"assigned": list(self.assigned), "velocity_names": list(self.velocity_names),
+                "beta": self.beta.tolist(), "q_dot": self.q_dot.tolist(), "slip": self.slip.tolist()}
+
+
+def extended_dof(robot: Robot) -> int:
+    """Velocities an extended solution may assign: ``m + n_o`` (§4.5), n_o = centred steerable wheels."""
+    return generic_mobility(robot) + sum(w.type == "steerable" for w in robot.wheels)
+
+
+def extended_solution(
+    robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: ArrayLike | None = None
+) -> ExtendedSolution:
+    """Least-squares solution (4.11) for any assigned set at `beta`, eq. (4.82), with its slip residual.
+
+    ``q_assigned``: ``(..., n_a)``; ``beta``: ``(..., n_steer)`` or None; they broadcast. For a set that is
+    assignable (4.10) the residual is zero; with more than m assigned velocities it is zero only at the
+    steering angles of :func:`solve_steering`.
+    """
+    beta = configuration(robot, beta)
+    idx = velocity_indices(robot, assigned)
+    q = as_vectors(q_assigned, len(idx), "q_assigned")
+    q_dot, residual = solve_assigned(robot.constraint_matrix(beta), idx, q)
+    beta = np.broadcast_to(beta, (*q_dot.shape[:-1], beta.shape[-1]))
+    return ExtendedSolution(robot.name, robot.velocity_names, tuple(assigned), readonly(np.array(beta)),
+                            readonly(q_dot), readonly(residual))
+
+
+def _wrap(x: np.ndarray) -> np.ndarray:
+    return (x + np.pi) % (2 * np.pi) - np.pi
+
+
+def solve_steering(
+    robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta_guess: ArrayLike | None = None,
+    *, starts: int = 8, iterations: int = 60,
+) -> np.ndarray:
+    """Steering angles making an over-assigned set slip-free, the conditions (4.83) in general form.
+
+    Finds roots of the residual of (4.11) over the angles of the centred steerable wheels (the others, and
+    castor angles, stay at `beta_guess`), by Levenberg-Marquardt from `beta_guess` and a grid of ``starts``
+    angles per wheel. Of the roots found, returns the one closest to `beta_guess` (the thesis needs beta to
+    vary continuously). ``q_assigned``: ``(..., n_a)``; ``beta_guess``: ``(..., n_steer)`` or None (described).
+    Returns ``(..., n_steer)`` [rad], steerable angles wrapped to [-pi, pi). Raises
+    :class:`~wmrkit.errors.SingularError` where no angle makes the assignment slip-free.
+    """
+    guess = configuration(robot, beta_guess)
+    idx = velocity_indices(robot, assigned)
+    q = as_vectors(q_assigned, len(idx), "q_assigned")
+    batch = np.broadcast_shapes(q.shape[:-1], guess.shape[:-1])
+    guess = np.broadcast_to(guess, (*batch, guess.shape[-1]))
+    q = np.broadcast_to(q, (*batch, q.shape[-1]))
+    free = [i for i, n in enumerate(robot.steer_names) if robot.wheel(n).type == "steerable"]
+    if not free:
+        return readonly(np.array(guess))
+    grid = np.linspace(-np.pi, np.pi, starts, endpoint=False)
+    points = np.stack(np.meshgrid(*[grid] * len(free), indexing="ij"), -1).reshape(-1, len(free))
+    points = np.broadcast_to(points.reshape(-1, *[1] * len(batch), len(free)), (len(points), *batch, len(free)))
+    x0 = np.concatenate([guess[..., free][None], points])  # (1 + starts^n_o, ..., n_o)
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        beta = np.broadcast_to(guess, (*x.shape[:-1], guess.shape[-1])).copy()
+        beta[..., free] = x
+        return solve_assigned(robot.constraint_matrix(beta), idx, q)[1]
+
+    x, cost = _levenberg_marquardt(residual, x0, iterations)
+    scale = 1.0 + np.abs(robot.constraint_matrix(guess)).max(axis=(-1, -2)) * np.linalg.norm(q, axis=-1)
+    root = cost <= (ROOT_TOL * scale) ** 2
+    distance = np.where(root, np.sum(_wrap(x - guess[..., free]) ** 2, axis=-1), np.inf)
+    best = np.argmin(distance, axis=0)
+    found = np.take_along_axis(distance, best[None], 0)[0] < np.inf
+    if not np.all(found):
+        bad = tuple(int(i) for i in np.argwhere(~found)[0]) if batch else ()
+        worst = float(np.sqrt(np.min(cost, axis=0))[bad])
+        raise SingularError(
+            f"robot '{robot.name}': no steering angles make ({', '.join(assigned)}) = "
+            f"{np.round(q[bad], 6).tolist()} slip-free near {describe_configuration(robot, guess, bad)} "
+            f"(smallest residual {worst:.3g} m/s)")
+    out = np.array(guess)
+    out[..., free] = _wrap(np.take_along_axis(x, best[None, ..., None], 0)[0])
+    return readonly(out)
+
+
+def _levenberg_marquardt(f, x: np.ndarray, iterations: int) -> tuple[np.ndarray, np.ndarray]:
+    """Minimise ``|f(x)|^2`` for every start at once; ``x`` ``(..., n)``; central-difference Jacobian."""
+    h, n = 1e-6, x.shape[-1]
+    r = f(x)
+    cost = np.sum(r**2, axis=-1)
+    lam = np.full(cost.shape, 1e-3)
+    eye = np.eye(n)
+    for _ in range(iterations):
+        steps = np.stack([(f(x + h * eye[j]) - f(x - h * eye[j])) / (2 * h) for j in range(n)], axis=-1)
+        jtj = np.swapaxes(steps, -1, -2) @ steps
+        g = (np.swapaxes(steps, -1, -2) @ r[..., None])[..., 0]
+        damped = jtj + lam[..., None, None] * (np.diagonal(jtj, axis1=-2, axis2=-1)[..., None] * eye + 1e-12 * eye)
+        dx = -np.linalg.solve(damped, g[..., None])[..., 0]
+        r_new = f(x + dx)
+        cost_new = np.sum(r_new**2, axis=-1)
+        better = cost_new < cost
+        x = np.where(better[..., None], x + dx, x)
+        r = np.where(better[..., None], r_new, r)
+        cost = np.where(better, cost_new, cost)
+        lam = np.where(better, lam / 3, lam * 4)
+    return x, cost
+
+
+def no_slip_extended_solution(
+    robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta_guess: ArrayLike | None = None
+) -> ExtendedSolution:
+    """The slip-free extended solution (4.84): (4.82) at the steering angles of :func:`solve_steering`.
+
+    ``(..., n_a), (..., n_steer) -> ExtendedSolution`` whose ``beta`` holds the angles to steer to.
+    """
+    beta = solve_steering(robot, assigned, q_assigned, beta_guess)
+    return extended_solution(robot, assigned, q_assigned, beta)

@@ -1,0 +1,202 @@
+"""Sensing (thesis §4.4.5-4.4.6): sensed direct solution (4.31)/(4.32), sensing equation (4.34), Fig. 4.5.
+
+The sensed joints are ``wheel.joint`` names (default: the robot's ``sensed``); the conventions are those of
+:mod:`wmrkit.kinematics.actuation`: wheel rates are columns, the ``steer`` joint of a centred steerable wheel is a
+configuration sensor (the model needs beta, 4.33), ``omega`` and roller rates are refused. Batched over ``beta``
+``(..., n_steer)``; ``None`` is the described configuration.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors, readonly
+from ..robot import TWIST_NAMES, Robot
+from .actuation import split_jacobian, steering_split, subset_trees, verdict_texts
+from .linalg import matrix_rank
+from .models import configuration
+from .trees import TreeVerdict, classify_system, jacobian_names, partitioned_solution, reduced_equation, select_columns
+
+
+def _split(robot: Robot, sensed: Sequence[str] | None, beta: ArrayLike | None):
+    columns, steering = select_columns(robot, robot.sensed if sensed is None else sensed, "sensed")
+    return (columns, steering, *split_jacobian(robot, columns, beta))
+
+
+def sensing_equation(
+    robot: Robot, sensed: Sequence[str] | None = None, beta: ArrayLike | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """The vehicle sensing equation (4.34), ``I_s @ twist_robot = J_s @ q_dot_s``: ``(I_s (..., 3E, 3), J_s)``."""
+    _, _, i_bar, j_s, j_ns = _split(robot, sensed, beta)
+    return reduced_equation(i_bar, j_s, j_ns), j_s
+
+
+def sensed_direct_matrix(
+    robot: Robot, sensed: Sequence[str] | None = None, beta: ArrayLike | None = None
+) -> np.ndarray:
+    """Reduced sensed direct solution (4.32): ``twist_robot = M @ q_dot_s``, ``(..., n_steer) -> (..., 3, n_s)``.
+
+    ``M = (sum_i Delta(J_ins))^-1 (Delta(J_1ns) J_1s ... Delta(J_Nns) J_Ns)`` for one-contact wheels, here in
+    the composite form ``(I_bar^T Delta(J_ns) I_bar)^-1 I_bar^T Delta(J_ns) J_s``. Needs sufficient sensors;
+    otherwise the pseudo-inverse gives the minimum-norm twist.
+    """
+    _, _, i_bar, j_s, j_ns = _split(robot, sensed, beta)
+    return partitioned_solution(i_bar, j_ns) @ j_s
+
+
+def sensed_full_matrix(
+    robot: Robot, sensed: Sequence[str] | None = None, beta: ArrayLike | None = None
+) -> np.ndarray:
+    """Sensed direct solution (4.31) corrected: ``(twist; q_dot_ns) = (I_ns^T I_ns)^-1 I_ns^T J_s q_dot_s``.
+
+    ``(..., n_steer) -> (..., 3 + n_ns, n_s)`` with ``I_ns = [I_bar, -J_ns]`` (4.30); the non-sensed
+    velocities in :func:`jacobian_names` order (the omega copies included). Pseudo-inverse: ``I_ns`` is
+    rank-deficient when the sensors are insufficient.
+    """
+    _, _, i_bar, j_s, j_ns = _split(robot, sensed, beta)
+    return _full(i_bar, j_s, j_ns)
+
+
+def _full(i_bar: np.ndarray, j_s: np.ndarray, j_ns: np.ndarray) -> np.ndarray:
+    i_ns = np.concatenate([np.broadcast_to(i_bar, (*j_ns.shape[:-2], *i_bar.shape)), -j_ns], axis=-1)
+    return np.linalg.pinv(i_ns) @ j_s
+
+
+def sensing_tree(
+    robot: Robot, sensed: Sequence[str] | None = None, beta: ArrayLike | None = None,
+    q_dot_s: ArrayLike | None = None,
+) -> TreeVerdict:
+    """The sensing tree of Fig. 4.5: Fig. 4.1 on (4.34) with ``A = I_s``, ``B = J_s``, ``y = q_dot_s``.
+
+    ``determined``: basic sensing (twist known, slip not detectable); ``overdetermined``: consistent sensing
+    (redundant sensors, slip detectable), and with readings ``q_dot_s`` ``(..., n_s)`` ``consistent`` (no slip
+    nor noise) or ``inconsistent``; the other leaves: insufficient sensors.
+    """
+    i_s, j_s = sensing_equation(robot, sensed, beta)
+    return classify_system(i_s, j_s, q_dot_s)
+
+
+_SENSING_TEXT = {
+    "determined": "basic sensing: the sensed rates give the twist, slip cannot be detected",
+    "overdetermined": "consistent sensing: redundant sensed rates, slip (or sensor noise) is detectable",
+    "indeterminate": "insufficient sensors: some degrees of freedom are not sensed",
+    "underdetermined": "insufficient and redundant sensors: some degrees of freedom are not sensed and some "
+                       "sensors sense the same ones",
+}
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class SensingAnalysis:
+    """Sensing of a robot at a batch of configurations (§4.4.5-4.4.6, Fig. 4.5); arrays of the batch shape."""
+
+    robot_name: str
+    sensed: tuple[str, ...]  # sensed columns of the Jacobian form (wheel rates)
+    steering: tuple[str, ...]  # steerable wheels whose steering angle is sensed
+    steering_missing: tuple[str, ...]  # steerable wheels whose steering angle is not sensed
+    mobility: np.ndarray  # (...) int
+    tree: TreeVerdict
+    direct_matrix: np.ndarray  # (..., 3, n_s), (4.32)
+    full_matrix: np.ndarray  # (..., 3 + n_ns, n_s), (4.31)
+    full_names: tuple[str, ...]  # rows of full_matrix: vx, vy, omega, then the non-sensed velocities
+    residual_matrix: np.ndarray  # (..., 3E, n_s): least-squares error of (4.31) per sensed rate
+
+    @property
+    def sufficient(self) -> np.ndarray:
+        """``rank I_s = 3``: the sensed rates determine the twist (sufficient sensors)."""
+        return self.tree.rank_a == 3
+
+    @property
+    def slip_detectable(self) -> np.ndarray:
+        """Sufficient and redundant sensors (``rank [I_s, J_s] > rank I_s``): slip shows in the residual."""
+        return self.sufficient & (self.tree.rank_ab > self.tree.rank_a)
+
+    @property
+    def leaf(self) -> np.ndarray:
+        """The leaf of Fig. 4.5 (``determined``, ``overdetermined``, ``indeterminate``, ``underdetermined``)."""
+        return self.tree.leaf
+
+    @property
+    def verdict(self) -> np.ndarray:
+        """One sentence per configuration: the tree's verdict, the counts, and missing steering sensors."""
+        return verdict_texts(self.leaf, _SENSING_TEXT, len(self.sensed), self.mobility, self.steering_missing, "sensed")
+
+    def twist(self, q_dot_s: ArrayLike) -> np.ndarray:
+        """The body twist from sensed rates, (4.32): ``(..., n_s) -> (..., 3)`` [m/s, rad/s]."""
+        q = as_vectors(q_dot_s, len(self.sensed), "q_dot_s")
+        return (self.direct_matrix @ q[..., None])[..., 0]
+
+    def direct(self, q_dot_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """Twist and residual from sensed rates, (4.31): ``(..., n_s) -> ((..., 3), (..., 3E))``.
+
+        The residual is ``I_ns (twist; q_dot_ns) - J_s q_dot_s``: zero without slip or noise, the slip
+        indicator otherwise (when ``slip_detectable``).
+        """
+        q = as_vectors(q_dot_s, len(self.sensed), "q_dot_s")[..., None]
+        return (self.full_matrix @ q)[..., :3, 0], (self.residual_matrix @ q)[..., 0]
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (lists and plain values)."""
+        return {
+            "sensed": list(self.sensed), "steering_sensed": list(self.steering),
+            "steering_not_sensed": list(self.steering_missing), "mobility": self.mobility.tolist(),
+            "leaf": self.leaf.tolist(), "sufficient": self.sufficient.tolist(),
+            "slip_detectable": self.slip_detectable.tolist(), "verdict": self.verdict.tolist(),
+            "direct_matrix": self.direct_matrix.tolist(),
+        }
+
+
+def sensing_analysis(
+    robot: Robot, beta: ArrayLike | None = None, sensed: Sequence[str] | None = None
+) -> SensingAnalysis:
+    """Analyse the sensors of `robot` (default: its described ``sensed`` joints) at `beta`, Fig. 4.5.
+
+    ``beta``: ``(..., n_steer)`` or None. See :class:`SensingAnalysis` for ``.sufficient``,
+    ``.slip_detectable``, ``.verdict``, and the sensed direct solution ``.twist`` / ``.direct``.
+    """
+    beta = configuration(robot, beta)
+    columns, steering, i_bar, j_s, j_ns = _split(robot, sensed, beta)
+    a = robot.constraint_matrix(beta)
+    names = jacobian_names(robot)
+    full = _full(i_bar, j_s, j_ns)
+    i_ns = np.concatenate([np.broadcast_to(i_bar, (*j_ns.shape[:-2], *i_bar.shape)), -j_ns], axis=-1)
+    return SensingAnalysis(
+        robot.name, tuple(names[c] for c in columns), steering, steering_split(robot, steering),
+        readonly(np.asarray(a.shape[-1] - matrix_rank(a))),
+        classify_system(reduced_equation(i_bar, j_s, j_ns), j_s),
+        readonly(partitioned_solution(i_bar, j_ns) @ j_s), readonly(full),
+        TWIST_NAMES + tuple(n for c, n in enumerate(names) if c not in columns),
+        readonly(i_ns @ full - j_s),
+    )
+
+
+def minimal_sensor_sets(
+    robot: Robot, beta: ArrayLike | None = None, *, detect_slip: bool = False
+) -> tuple[tuple[str, ...], ...]:
+    """The smallest sensor choices that determine the twist at every configuration (Fig. 4.5).
+
+    ``detect_slip=False``: basic sensing (``determined``), m rates each; ``True``: the smallest sets with
+    sufficient *redundant* sensors (``overdetermined``, slip detectable). Each set lists the wheel rates, then
+    the ``steer`` joints of the centred steerable wheels (their angle must be sensed, 4.33).
+    """
+    beta = configuration(robot, beta)
+    a = robot.constraint_matrix(beta)
+    m = np.unique(a.shape[-1] - matrix_rank(a))
+    if len(m) != 1 or m[0] == 0:
+        return ()
+    names, steer = jacobian_names(robot), tuple(f"{w}.steer" for w in steering_split(robot, ()))
+    wanted = "overdetermined" if detect_slip else "determined"
+    sizes = range(int(m[0]) + 1, len(robot.rate_names) + 1) if detect_slip else (int(m[0]),)
+    for size in sizes:
+        subsets, tree = subset_trees(robot, beta, size)
+        if tree is None:
+            return ()
+        ok = ((tree.leaf == wanted) & (tree.rank_a == 3)).reshape(len(subsets), -1).all(axis=1)
+        found = tuple(tuple(names[c] for c in s) + steer for s, good in zip(subsets, ok, strict=True) if good)
+        if found:
+            return found
+    return ()
