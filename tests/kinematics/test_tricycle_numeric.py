@@ -96,7 +96,7 @@ def test_jacobian_method_gives_h_g_1_and_rank_8():
     assert (matrix_rank(stacked) == 8).all()  # (4.73): rank A + N = 5 + 3
     feasible = np.array(null_vectors_c5("w3.spin", B3), dtype=float)[:3]
     assert inverse_tree(TRI, None, feasible).leaf == "consistent"  # Fig. 4.3
-    assert inverse_tree(TRI, None, feasible + [0.01, 0, 0]).leaf == "inconsistent"  # v_x = 0 violated
+    assert inverse_tree(TRI, None, feasible + np.array([0.01, 0, 0])).leaf == "inconsistent"  # v_x = 0 violated
 
 
 def test_wheel_jacobians_are_477():
