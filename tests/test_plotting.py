@@ -1,0 +1,113 @@
+"""Robot drawings: every catalog robot draws to files; the wheels drawn are where the model puts them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from matplotlib.axes import Axes
+from matplotlib.colors import to_hex
+from matplotlib.figure import Figure
+
+from wmrkit import Robot, ShapeError, WmrkitError, catalog
+from wmrkit.cli.main import main
+from wmrkit.plotting import PlotError, draw_robot, save_robot_figure
+from wmrkit.plotting.robot import DRIVEN, PASSIVE
+
+HEADERS = {".png": b"\x89PNG\r\n\x1a\n", ".pdf": b"%PDF-"}
+
+SPECIALS = Robot.from_dict({"name": "specials", "wheels": [
+    {"name": "dbl", "type": "double", "position": [0.4, 0.3], "beta": "70 deg", "b": 0.08, "r": 0.06,
+     "actuated": ["spin1"], "sensed": ["spin1", "spin2", "steer"]},
+    {"name": "dcas", "type": "double_castor", "position": [0.4, -0.3], "beta": "100 deg", "d": 0.1, "b": 0.07,
+     "r": 0.05},
+    {"name": "cas", "type": "castor", "position": [-0.5, 0], "beta": "30 deg", "d": 0.08, "delta": "20 deg",
+     "r": 0.05, "actuated": ["steer", "spin"]},
+    {"name": "ball", "type": "ball", "position": [-0.3, 0.3], "beta": "90 deg", "r": 0.06, "actuated": ["spin"]},
+    {"name": "orth", "type": "orthogonal", "position": [-0.3, -0.3], "beta": "90 deg", "r": 0.06},
+    {"name": "mec", "type": "swedish", "position": [0.0, -0.5], "beta": "60 deg", "gamma": "45 deg", "r": 0.07,
+     "r_r": 0.01},
+]})
+
+
+def _wheel_patches(ax: Axes) -> list:
+    return [p for p in ax.patches if to_hex(p.get_facecolor()) in (DRIVEN, PASSIVE)]
+
+
+@pytest.mark.parametrize("name", catalog.names())
+def test_every_catalog_robot_draws_to_png_and_svg(name, tmp_path):
+    robot = catalog.load(name)
+    for suffix in (".png", ".svg"):
+        path = tmp_path / f"{name}{suffix}"
+        save_robot_figure(robot, path)
+        data = path.read_bytes()
+        assert len(data) > 5000
+        if suffix == ".png":
+            assert data.startswith(HEADERS[".png"])
+        else:
+            assert b"<svg" in data[:2000] and data.rstrip().endswith(b"</svg>")
+
+
+def test_pdf_and_unknown_extensions(tmp_path):
+    robot = catalog.load("omni-3")
+    save_robot_figure(robot, tmp_path / "r.pdf")
+    assert (tmp_path / "r.pdf").read_bytes().startswith(HEADERS[".pdf"])
+    with pytest.raises(PlotError, match=r"r\.txt: cannot draw to '\.txt'"):
+        save_robot_figure(robot, tmp_path / "r.txt")
+    assert issubclass(PlotError, WmrkitError)
+
+
+def test_cli_show_plot(tmp_path, capsys):
+    out = tmp_path / "x.png"
+    assert main(["show", "thesis-omni-castor", "--plot", str(out)]) == 0
+    assert out.read_bytes().startswith(HEADERS[".png"])
+    assert main(["show", "diff-drive", "--plot", str(tmp_path / "x.gif")]) == 2
+    assert "cannot draw to '.gif'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("robot", [SPECIALS, catalog.load("thesis-steer-castor"), catalog.load("mecanum-4")],
+                         ids=lambda r: r.name)
+def test_wheels_are_drawn_at_the_model_contact_points_with_the_model_axles(robot):
+    """Independent of the drawing code: a rotation about a drawn wheel centre, with the wheel's joints still,
+    leaves that contact point's slip zero (rows of (3.10)); the short side of a plain wheel lies along its axle,
+    the row-0 direction (cos, sin)(beta + delta) of (3.12). One patch per contact element, coloured driven
+    exactly when the element's spin is actuated."""
+    ax = draw_robot(robot)
+    patches = _wheel_patches(ax)
+    a = robot.constraint_matrix()
+    elements = [(w, spin) for w in robot.wheels
+                for spin in (("spin1", "spin2") if w.type in ("double", "double_castor") else ("spin",))]
+    assert len(patches) == len(elements)
+    for i, (patch, (wheel, spin)) in enumerate(zip(patches, elements, strict=True)):
+        corners = patch.get_xy()[:-1]  # a closed polygon repeats its first point
+        x, y = corners.mean(axis=0)
+        np.testing.assert_allclose(a[2 * i: 2 * i + 2, :3] @ [y, -x, 1.0], 0, atol=1e-12)
+        assert (to_hex(patch.get_facecolor()) == DRIVEN) == (spin in wheel.actuated), (wheel.name, spin)
+        if wheel.type in ("fixed", "steerable", "castor", "double", "double_castor"):
+            short = corners[0] - corners[3]  # _rect: corners 0 and 3 differ across the wheel width
+            row0 = a[2 * i, :2]
+            assert abs(short[0] * row0[1] - short[1] * row0[0]) < 1e-12
+
+
+def test_batched_and_other_configurations():
+    robot = catalog.load("thesis-tricycle")
+    sweep = np.radians(np.linspace(-60, 60, 7))[:, None]
+    ax = draw_robot(robot, beta=sweep)
+    # 2 fixed wheels once, the steered wheel once per configuration
+    assert len(_wheel_patches(ax)) == 2 + 7
+    two_d = draw_robot(robot, beta=np.zeros((2, 3, 1)), labels=False)
+    assert len(_wheel_patches(two_d)) == 2 + 6 and two_d.get_title() == "" and two_d.get_legend() is None
+    other = draw_robot(robot, beta=[0.3])
+    centre = _wheel_patches(other)[-1].get_xy()[:4].mean(axis=0)
+    np.testing.assert_allclose(centre, robot.wheel("o3").position, atol=1e-12)
+    with pytest.raises(ShapeError, match=r"beta: expected shape \(\.\.\., 1\)"):
+        draw_robot(robot, beta=[0.1, 0.2])
+
+
+def test_draws_into_a_given_axes():
+    fig = Figure()
+    axes = fig.subplots(1, 2)
+    got = draw_robot(catalog.load("ackermann"), axes[1])
+    assert got is axes[1] and got.figure is fig
+    assert got.get_title() == "ackermann" and got.get_legend() is not None
+    assert got.get_aspect() == 1.0
+    assert tuple(fig.get_size_inches()) == tuple(Figure().get_size_inches())  # a user's figure is not resized
