@@ -1,0 +1,106 @@
+"""``wmrkit ik`` (per-wheel commands for a body twist, thesis §8.4) and ``wmrkit fk`` (twist from joint rates, 4.11)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+import numpy as np
+
+from ..errors import WmrkitError
+from ..kinematics.wheel_ik import WheelCommands, forward_kinematics, twist_is_determined, wheel_commands
+from ..robot import Robot
+from ..units import UnitError, parse_quantity
+from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_assignments, print_json
+
+
+def add_parsers(commands: argparse._SubParsersAction) -> None:
+    """Register ``ik`` and ``fk``."""
+    p = commands.add_parser("ik", help="per-wheel steering angles and rates for a body twist (thesis 8.4)")
+    add_robot_argument(p)
+    p.add_argument("--twist", nargs=3, type=_finite, required=True, metavar=("VX", "VY", "OMEGA"),
+                   help="body twist: vx, vy [m/s], omega [rad/s] (x forward, y left)")
+    _add_steer(p, "current steering angle of a wheel (default: as described); the closest solution is kept")
+    add_json_flag(p)
+    p.set_defaults(run=run_ik)
+
+    p = commands.add_parser("fk", help="body twist from joint rates by least squares (thesis 4.11)")
+    add_robot_argument(p)
+    p.add_argument("--spin", action="append", metavar="NAME=RATE", default=[],
+                   help="a joint rate [rad/s]: a wheel name means its spin, or 'wheel.joint' (repeat)")
+    _add_steer(p, "steering angle of a wheel (default: as described)")
+    add_json_flag(p)
+    p.set_defaults(run=run_fk)
+
+
+def _add_steer(p: argparse.ArgumentParser, text: str) -> None:
+    p.add_argument("--steer", action="append", metavar="NAME=ANGLE", default=[],
+                   help=f"{text}; radians, or degrees with 'deg' (repeat)")
+
+
+def _steered(robot: Robot, items: list[str]) -> Robot:
+    given = parse_assignments(items, "--steer")
+    angles = {name: parse_angle(value, f"--steer {name}") for name, value in given.items()}
+    return robot.with_steering(angles)
+
+
+def run_ik(args: argparse.Namespace) -> int:
+    """Print the per-wheel commands; warn on stderr when the twist makes a fixed wheel slip."""
+    robot = _steered(load_robot(args.robot), args.steer)
+    commands = wheel_commands(robot, args.twist)
+    if not commands.feasible:
+        worst = int(np.argmax(np.abs(commands.slip)))
+        print(f"wmrkit: warning: twist not feasible for robot '{robot.name}': wheel '{robot.wheel_names[worst]}' "
+              f"slips sideways at {commands.slip[worst]:+.6g} m/s (fixed wheels allow no lateral motion)",
+              file=sys.stderr)
+    print_json(commands.to_dict()) if args.json else print(format_commands(robot, commands))
+    return 0
+
+
+def run_fk(args: argparse.Namespace) -> int:
+    """Print the twist and the slip residual; warn on stderr when the rates do not fix the twist."""
+    robot = _steered(load_robot(args.robot), args.steer)
+    rates = {name: _rate(name, value) for name, value in parse_assignments(args.spin, "--spin").items()}
+    twist, residual = forward_kinematics(robot, rates)
+    if not twist_is_determined(robot, list(rates)):
+        print(f"wmrkit: warning: these rates do not determine the twist of robot '{robot.name}'; "
+              "printing the minimum-norm one", file=sys.stderr)
+    if args.json:
+        print_json({"twist": twist.tolist(), "residual": float(residual)})
+    else:
+        print(f"twist (robot frame): vx = {twist[0]:.6g} m/s, vy = {twist[1]:.6g} m/s, omega = {twist[2]:.6g} rad/s")
+        print(f"residual (slip norm): {float(residual):.3g} m/s")
+    return 0
+
+
+def _finite(text: str) -> float:
+    try:
+        return parse_quantity(text, "number")
+    except UnitError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def _rate(name: str, value: str) -> float:
+    try:
+        return parse_quantity(value, "number")
+    except UnitError as err:
+        raise WmrkitError(f"--spin {name}: {err}") from None
+
+
+def format_commands(robot: Robot, commands: WheelCommands) -> str:
+    """Human-readable table of one twist's wheel commands (angles in degrees too)."""
+    data = commands.to_dict()
+    lines = [f"{'wheel':<14}{'type':<14}{'steer [deg]':>12}{'spin [rad/s]':>14}{'steer rate':>12}"
+             f"{'slip [m/s]':>12}  other rates [rad/s]"]
+    for w in robot.wheels:
+        entry = data["wheels"][w.name]
+        other = ", ".join(f"{k} {v:.6g}" for k, v in entry.items() if k not in ("steer", "spin", "steer_rate"))
+        lines.append(f"{w.name:<14}{w.type:<14}{_num(math.degrees(entry['steer'])):>12}{_num(entry['spin']):>14}"
+                     f"{_num(entry['steer_rate']):>12}{_num(data['slip'][w.name]):>12}  {other}")
+    lines.append("feasible: " + ("yes" if data["feasible"] else "NO (a fixed wheel would slip sideways)"))
+    return "\n".join(lines)
+
+
+def _num(x: float) -> str:
+    return "-" if math.isnan(x) else f"{x:.6g}"

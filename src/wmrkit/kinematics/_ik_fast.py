@@ -1,0 +1,221 @@
+"""Per-robot arrays and vectorised kernels behind :func:`wmrkit.kinematics.wheel_ik.wheel_commands` (thesis §8.4).
+
+A robot's wheels fall into three groups, each solved for a whole batch of twists at once:
+
+- *constant*: fixed, Swedish, ball and orthogonal wheels. Their rates are a constant matrix times the twist
+  (rolling row of (3.11); (8.27)/(8.28) for rollers) and a fixed wheel's lateral row (8.14) gives its slip.
+- *steered by the twist*: steerable (centred orientable) and double wheels. The angle zeroing the lateral slip is
+  (8.9), ``atan2(-u_x, u_y)`` with ``u`` the velocity of the steering axis; of it and its opposite the one closest to
+  the current angle is kept, and the spin follows from (8.12) with the matching sign.
+- *at the current angle*: castors, double castors (and the sub-wheels of a double wheel once its angle is chosen):
+  the element rows (3.10) at that angle give the steering rate (8.24) and the spins (8.25).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._shapes import readonly
+from ..robot import Robot
+from ..wheels import generic_slip_rows
+
+TWO_PI = 2.0 * math.pi
+CONSTANT_TYPES = ("fixed", "swedish", "ball", "orthogonal")
+TWIST_STEERED_TYPES = ("steerable", "double")
+
+
+def wrap_angle(angle: np.ndarray) -> np.ndarray:
+    """Angles wrapped to ``(-pi, pi]`` [rad]; exact (no rounding) for angles already in range. ``(...) -> (...)``."""
+    a = np.asarray(angle, dtype=float)
+    y = a - TWO_PI * np.round(a / TWO_PI)
+    return np.where(y <= -math.pi, y + TWO_PI, np.where(y > math.pi, y - TWO_PI, y))
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """Read-only arrays of one robot for the batched per-wheel IK (eq=False: array fields)."""
+
+    n_wheels: int
+    n_rates: int
+    n_steer: int
+    has_constant: bool  # some wheel is fixed, Swedish, ball or orthogonal
+    constant_rates: np.ndarray  # (3, n_rates): rates = twist @ constant_rates; zero columns for other wheels
+    fixed_wheels: np.ndarray  # (n_f,) wheel indices of fixed wheels
+    fixed_lateral: np.ndarray  # (3, n_f): lateral slip = twist @ fixed_lateral (3.11 row 0 / 8.14) [m/s]
+    steered_beta: np.ndarray  # (n_o,) index into beta of the twist-steered wheels
+    steered_x: np.ndarray  # (n_o,) steering-axis position [m]
+    steered_y: np.ndarray
+    steered_spin_col: np.ndarray  # (n_s,) rate column of each steerable (not double) wheel's spin
+    steered_spin_of: np.ndarray  # (n_s,) its position among the twist-steered wheels
+    steered_inv_r: np.ndarray  # (n_s,) 1 / r [1/m]
+    element_beta: np.ndarray  # (E_c,) index into beta of the elements solved at an angle
+    element_params: tuple[np.ndarray, ...]  # (beta_offset, l, alpha, d, delta, gamma, r, r_r), each (E_c,)
+    element_castor: np.ndarray  # (E_c,) bool: steering rate from the lateral row (8.24); False: held (double)
+    element_steer_col: np.ndarray  # (E_c,) rate column of the steering joint
+    element_spin_col: np.ndarray  # (E_c,) rate column of the sub-wheel's spin
+    steer_wheels: np.ndarray  # (n_steer,) wheel index of every steering angle
+    spin_col: np.ndarray  # (N,) rate column of the spin ('spin' or 'spin1'); -1 without one
+    spin2_col: np.ndarray  # (N,) rate column of 'spin2' (double wheels), -1 elsewhere
+    steer_rate_col: np.ndarray  # (N,) rate column of the steering joint rate, -1 where it is not a column
+    only_steerable: bool  # every wheel steerable, in order: the spins are the rates, the angles the config
+
+
+@functools.lru_cache(maxsize=256)
+def plan(robot: Robot) -> Plan:
+    """The IK arrays of `robot` (built once per robot)."""
+    n = len(robot.wheels)
+    steer_names = robot.steer_names
+    col = {name: i for i, name in enumerate(robot.rate_names)}
+    constant = np.zeros((3, len(col)))
+    fixed, lateral = [], []
+    steered_beta, sx, sy, spin_cols, spin_of, inv_r = [], [], [], [], [], []
+    e_beta, e_params, e_castor, e_steer, e_spin = [], [], [], [], []
+    spin_col, spin2_col, steer_rate_col = np.full(n, -1), np.full(n, -1), np.full(n, -1)
+    for i, w in enumerate(robot.wheels):
+        own = {j: col[f"{w.name}.{j}"] for j in w.kind.rates}
+        spin_col[i] = own.get("spin", own.get("spin1", -1))
+        spin2_col[i] = own.get("spin2", -1)
+        steer_rate_col[i] = own.get("steer", -1)
+        if w.type in CONSTANT_TYPES:
+            e = w.elements()[0]
+            rows = generic_slip_rows(w.beta + e.beta_offset, e.l, e.alpha, e.d, e.delta, e.gamma, e.r, e.r_r)
+            if w.type == "fixed":  # rolling row: phi_dot = -row1[:3] . twist / r (8.12 at constant beta)
+                constant[:, own["spin"]] = -rows[1, :3] / rows[1, 4]
+                fixed.append(i)
+                lateral.append(rows[0, :3])
+            else:  # Swedish (8.27), roller (8.28) from the second row with phi_dot substituted
+                spin = -rows[0, :3] / rows[0, 4]
+                constant[:, own["spin"]] = spin
+                constant[:, own["roller"]] = -(rows[1, :3] + rows[1, 4] * spin) / rows[1, 5]
+            continue
+        k = steer_names.index(w.name)
+        if w.type in TWIST_STEERED_TYPES:
+            if w.type == "steerable":
+                spin_cols.append(own["spin"])
+                spin_of.append(len(steered_beta))
+                inv_r.append(1.0 / w.r)
+            steered_beta.append(k)
+            sx.append(w.position[0])
+            sy.append(w.position[1])
+        if w.type != "steerable":
+            for e, sub in zip(w.elements(), ("spin1", "spin2") if len(w.elements()) == 2 else ("spin",), strict=True):
+                e_beta.append(k)
+                e_params.append((e.beta_offset, *e[:2], *e[3:8]))
+                e_castor.append(w.type != "double")
+                e_steer.append(own["steer"])
+                e_spin.append(own[sub])
+    params = np.array(e_params, dtype=float).reshape(-1, 8).T
+
+    def ints(x: list[int]) -> np.ndarray:
+        return readonly(np.array(x, dtype=int))
+
+    def floats(x: list[float]) -> np.ndarray:
+        return readonly(np.array(x, dtype=float))
+
+    return Plan(
+        n_wheels=n, n_rates=len(col), n_steer=len(steer_names), constant_rates=readonly(constant),
+        has_constant=any(w.type in CONSTANT_TYPES for w in robot.wheels),
+        fixed_wheels=ints(fixed), fixed_lateral=readonly(np.array(lateral, dtype=float).reshape(-1, 3).T.copy()),
+        steered_beta=ints(steered_beta), steered_x=floats(sx), steered_y=floats(sy),
+        steered_spin_col=ints(spin_cols), steered_spin_of=ints(spin_of), steered_inv_r=floats(inv_r),
+        element_beta=ints(e_beta), element_params=tuple(readonly(p.copy()) for p in params),
+        element_castor=readonly(np.array(e_castor, dtype=bool)), element_steer_col=ints(e_steer),
+        element_spin_col=ints(e_spin),
+        steer_wheels=ints([i for i, w in enumerate(robot.wheels) if w.kind.steers]),
+        spin_col=readonly(spin_col), spin2_col=readonly(spin2_col), steer_rate_col=readonly(steer_rate_col),
+        only_steerable=all(w.type == "steerable" for w in robot.wheels),
+    )
+
+
+def constant_rates(p: Plan, twist: np.ndarray) -> np.ndarray:
+    """``twist @ constant_rates`` as ``(C^T twist^T)^T``: a BLAS product that stays fast on one thread.
+
+    ``(..., 3) -> (..., n_rates)``; the result is a (read-only-able) transposed view, columns contiguous.
+    """
+    flat = twist.reshape(-1, 3)
+    return (p.constant_rates.T @ flat.T).T.reshape(*twist.shape[:-1], p.n_rates)
+
+
+#: Twists per block of the steering kernel: its temporaries stay in cache and are reused (no page faults).
+BLOCK = 16384
+
+
+def steer_to_twist(
+    p: Plan, twist: np.ndarray, current: np.ndarray, speed_tol: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Angles (8.9) closest to `current`, and the steerable wheels' spins (8.12), for a batch of twists.
+
+    ``(..., 3), (..., n_o) -> (..., n_o) angles [rad] in (-pi, pi], (..., n_s) spins [rad/s], (..., n_o) held``.
+    Where the steering axis does not move (speed <= `speed_tol` [m/s]) the angle is undefined: the current angle
+    (wrapped) is kept and the spin is 0. Vectorised over blocks of :data:`BLOCK` twists (cache-sized temporaries).
+    """
+    n_o, n_s = len(p.steered_x), len(p.steered_spin_of)
+    batch = np.broadcast_shapes(twist.shape[:-1], current.shape[:-1])
+    t = np.broadcast_to(twist, (*batch, 3)).reshape(-1, 3)
+    per_twist = current.ndim > 1
+    cur = np.broadcast_to(current, (*batch, n_o)).reshape(-1, n_o) if per_twist else current
+    m = t.shape[0]
+    beta, spin, held = np.empty((m, n_o)), np.empty((m, n_s)), np.empty((m, n_o), dtype=bool)
+    cos_cur, sin_cur = np.cos(cur), np.sin(cur)
+    for start in range(0, m, BLOCK):
+        b = slice(start, start + BLOCK)
+        c, s = (cos_cur[b], sin_cur[b]) if per_twist else (cos_cur, sin_cur)
+        _steer_block(p, t[b], c, s, speed_tol, beta[b], spin[b], held[b])
+    if held.any():
+        kept = np.broadcast_to(wrap_angle(cur), beta.shape)
+        beta[held] = kept[held]
+        spin[held[:, p.steered_spin_of]] = 0.0
+    return beta.reshape(*batch, n_o), spin.reshape(*batch, n_s), held.reshape(*batch, n_o)
+
+
+def _steer_block(
+    p: Plan, t: np.ndarray, cos_cur: np.ndarray, sin_cur: np.ndarray, speed_tol: float,
+    beta: np.ndarray, spin: np.ndarray, held: np.ndarray,
+) -> None:
+    """One block of :func:`steer_to_twist`, written into `beta`, `spin`, `held`."""
+    vx, vy, w = t[:, 0:1], t[:, 1:2], t[:, 2:3]
+    minus_ux = w * p.steered_y  # -u_x = omega y - v_x: the steering axis's velocity, x negated
+    minus_ux -= vx
+    uy = w * p.steered_x
+    uy += vy
+    speed = minus_ux * minus_ux
+    tmp = uy * uy
+    speed += tmp
+    np.sqrt(speed, out=speed)  # |phi_dot| r of (8.12)
+    # (8.9) gives b0 = atan2(-u_x, u_y), whose spin is -speed / r; b0 + pi (spin +speed / r) is the other root.
+    # sign(cos(b0 - current)) = -1 means b0 + pi is closer to the current angle: negate u, atan2 returns it.
+    sign = minus_ux * sin_cur
+    np.multiply(uy, cos_cur, out=tmp)
+    sign += tmp
+    np.copysign(1.0, sign, out=sign)  # a tie (exactly 90 deg away, +-0) goes either way, consistently
+    minus_ux *= sign
+    minus_ux += 0.0  # -0.0 -> +0.0: atan2 then returns +pi, never -pi, for a wheel rolling straight back
+    uy *= sign
+    np.arctan2(minus_ux, uy, out=beta)
+    if spin.shape == speed.shape:
+        np.multiply(speed, sign, out=spin)
+    else:
+        np.multiply(speed[:, p.steered_spin_of], sign[:, p.steered_spin_of], out=spin)
+    spin *= -p.steered_inv_r
+    np.less_equal(speed, speed_tol, out=held)
+
+
+def solve_elements(p: Plan, twist: np.ndarray, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Steering rates (8.24) and spins (8.25) of castor-like elements at angles `beta` (double: steering held).
+
+    ``(..., 3), (..., n_steer) -> (..., E_c), (..., E_c)`` [rad/s]. From the element rows (3.10): row 0 gives
+    ``beta_dot`` (``-d cos(delta)`` is its coefficient; a double wheel's is 0 and its rate is taken as 0, i.e. the
+    unit keeps its angle relative to the body), row 1 the spin. Unbatched `beta` evaluates the rows once.
+    """
+    offset, *geometry = p.element_params
+    g = generic_slip_rows(beta[..., p.element_beta] + offset, *geometry)  # (..., E_c, 2, 6)
+    lateral = np.einsum("...k,...ek->...e", twist, g[..., 0, :3])
+    rolling = np.einsum("...k,...ek->...e", twist, g[..., 1, :3])
+    coef = np.where(p.element_castor, g[..., 0, 3], 1.0)
+    beta_dot = np.where(p.element_castor, -lateral / coef, 0.0)
+    spin = -(rolling + g[..., 1, 3] * beta_dot) / g[..., 1, 4]
+    return beta_dot, spin

@@ -1,0 +1,246 @@
+"""Per-wheel inverse kinematics (thesis §8.4) and forward kinematics by least squares (4.11), batched.
+
+:func:`wheel_commands` turns desired body twists into what every wheel must do: steering angles, spin rates,
+steering rates, roller rates, and each fixed wheel's lateral slip so that an infeasible twist is reported, never
+silently accepted. :func:`forward_kinematics` goes the other way: some joint rates given, the twist that best
+explains them and the slip they leave. ``docs/wheel-ik.md`` states the policies (closest steering angle, zero speed).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors, readonly
+from ..errors import ShapeError, UnknownNameError
+from ..robot import Robot
+from ..units import UnitError, parse_quantity
+from . import _ik_fast
+from ._ik_fast import wrap_angle
+from .linalg import matrix_rank, solve_assigned
+
+__all__ = ["WheelCommands", "forward_kinematics", "resolve_rate_name", "twist_is_determined", "wheel_commands",
+           "wrap_angle"]
+
+
+@dataclass(frozen=True, eq=False)
+class WheelCommands:
+    """Per-wheel commands for a batch of body twists (§8.4). Frozen; every array is read-only.
+
+    ``eq=False``: array fields. With ``N`` wheels, ``n_steer`` steering angles and ``n_rates`` joint rates:
+
+    - ``steer`` ``(..., N)`` [rad] in ``(-pi, pi]``: steerable and double wheels the angle zeroing the lateral slip
+      (8.9), closest to the current one; castors the current angle; NaN for wheels that do not steer.
+    - ``spin`` ``(..., N)`` [rad/s]: spin rate; double wheels and double castors the mean of the two (3.28)/(3.35).
+    - ``steer_rate`` ``(..., N)`` [rad/s]: castors (8.24), double castors; 0 for double wheels (angle held
+      relative to the body); NaN where the twist alone does not define it (steerable) or there is no joint.
+    - ``rates`` ``(..., n_rates)``: every joint rate in ``robot.rate_names`` order (rollers, ``spin1``/``spin2``).
+    - ``slip`` ``(..., N)`` [m/s]: lateral slip (3.11) row 0 / (8.14) left at each fixed wheel, 0 elsewhere.
+    - ``feasible`` ``(...)`` bool: every ``|slip| <= slip_tol``.
+    - ``beta`` ``(..., n_steer)`` [rad]: the steering configuration the commands hold at (``steer_names`` order).
+    - ``held`` ``(..., N)`` bool: the steering axis does not move, the angle is undefined and was kept.
+    """
+
+    wheel_names: tuple[str, ...]
+    rate_names: tuple[str, ...]
+    steer: np.ndarray
+    spin: np.ndarray
+    steer_rate: np.ndarray
+    rates: np.ndarray
+    slip: np.ndarray
+    feasible: np.ndarray
+    beta: np.ndarray
+    held: np.ndarray
+
+    def velocity(self, twist_robot: ArrayLike) -> np.ndarray:
+        """The velocity vector ``(twist; rates)`` of ``Robot.velocity_names``. ``(..., 3) -> (..., 3 + n_rates)``."""
+        t = np.broadcast_to(as_vectors(twist_robot, 3, "twist_robot"), (*self.rates.shape[:-1], 3))
+        return np.concatenate([t, self.rates], axis=-1)
+
+    def to_dict(self) -> dict[str, Any]:
+        """One twist's commands as plain data (the ``wmrkit ik --json`` output); NaN stays NaN (JSON: null).
+
+        ``{"wheels": {name: {"steer", "spin", "steer_rate", other joint rates...}}, "slip": {name: m/s},
+        "feasible": bool}``. Only for a single twist (batch shape ``()``).
+        """
+        if self.feasible.shape != ():
+            raise ShapeError(f"to_dict: expected one twist (batch shape ()), got batch shape {self.feasible.shape}")
+        wheels: dict[str, dict[str, float]] = {}
+        for i, name in enumerate(self.wheel_names):
+            entry = {"steer": float(self.steer[i]), "spin": float(self.spin[i]),
+                     "steer_rate": float(self.steer_rate[i])}
+            for rate_name, value in zip(self.rate_names, self.rates.tolist(), strict=True):
+                wheel, _, joint = rate_name.partition(".")
+                if wheel == name and joint not in ("spin", "steer"):
+                    entry[joint] = value
+            wheels[name] = entry
+        return {"wheels": wheels, "slip": dict(zip(self.wheel_names, self.slip.tolist(), strict=True)),
+                "feasible": bool(self.feasible)}
+
+
+def wheel_commands(
+    robot: Robot, twist_robot: ArrayLike, beta: ArrayLike | None = None, *,
+    speed_tol: float = 1e-12, slip_tol: float = 1e-9,
+) -> WheelCommands:
+    """Per-wheel inverse kinematics of the thesis §8.4 for a batch of body twists.
+
+    ``(..., 3), (..., n_steer) -> WheelCommands`` with batch shape the broadcast of both. `twist_robot`:
+    ``(v_x [m/s], v_y [m/s], omega [rad/s])`` in the robot frame; `beta`: current steering angles [rad]
+    (``robot.steer_names`` order; default the described ones).
+
+    - steerable / double wheels: angle (8.9) of the two solutions ``b`` and ``b + pi`` closest to the current
+      angle (the spin sign flips rather than the wheel turning half round), spin (8.12) with that sign; where the
+      steering axis moves slower than `speed_tol` [m/s] the angle is undefined: current angle kept, spin 0.
+    - castor: steering rate (8.24) and spin (8.25) at the current angle; double castor likewise (3.31)-(3.36).
+    - Swedish, ball, orthogonal: spin (8.27) and roller rate (8.28, with the roller radius r_r).
+    - fixed: spin (8.12) at its constant angle, and the lateral slip (8.14) the twist leaves: ``feasible`` is
+      False when any exceeds `slip_tol` [m/s] (e.g. ``v_y != 0`` for a differential drive).
+    """
+    p = _ik_fast.plan(robot)
+    twist = as_vectors(twist_robot, 3, "twist_robot")
+    current = robot.beta if beta is None else as_vectors(beta, p.n_steer, "beta")
+    batch = np.broadcast_shapes(twist.shape[:-1], current.shape[:-1])
+    n = p.n_wheels
+    if p.only_steerable:  # swerve-like: the angles are the configuration, the spins the rates
+        config, rates, held = _ik_fast.steer_to_twist(p, twist, current, speed_tol)
+    else:
+        rates, config, held = _general(p, twist, current, batch, speed_tol)
+    spin = _columns(rates, p.spin_col, batch)
+    doubles = p.spin2_col >= 0
+    if doubles.any():
+        spin[..., doubles] = 0.5 * (spin[..., doubles] + rates[..., p.spin2_col[doubles]])
+    if len(p.fixed_wheels) == 0:
+        slip = np.broadcast_to(0.0, (*batch, n))
+        feasible = np.broadcast_to(True, batch)
+    else:
+        slip = np.zeros((*batch, n))
+        slip[..., p.fixed_wheels] = twist @ p.fixed_lateral
+        feasible = np.all(np.abs(slip) <= slip_tol, axis=-1)
+    if p.n_steer == n:
+        steer = config
+    elif p.n_steer == 0:
+        steer = np.broadcast_to(np.nan, (*batch, n))
+    else:
+        steer = np.full((*batch, n), np.nan)
+        steer[..., p.steer_wheels] = config
+    return WheelCommands(
+        wheel_names=robot.wheel_names, rate_names=robot.rate_names,
+        steer=_ro(steer), spin=_ro(spin), steer_rate=_ro(_columns(rates, p.steer_rate_col, batch)),
+        rates=_ro(rates), slip=_ro(slip), feasible=_ro(feasible), beta=_ro(config), held=_ro(held),
+    )
+
+
+def _general(
+    p: _ik_fast.Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...], speed_tol: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Rates ``(..., n_rates)``, configuration ``(..., n_steer)`` and held flags ``(..., N)`` of any robot."""
+    if p.has_constant:  # fixed wheels' spins (3.11), Swedish spins and rollers (8.27)/(8.28)
+        rates = _ik_fast.constant_rates(p, twist)
+        if rates.shape[:-1] != batch:
+            rates = np.broadcast_to(rates, (*batch, p.n_rates))
+        if p.n_steer:
+            rates = rates.copy()  # other wheels' columns are filled in below
+    else:
+        rates = np.zeros((*batch, p.n_rates))
+    if p.n_steer == 0:
+        return rates, np.broadcast_to(current, (*batch, 0)), np.broadcast_to(False, (*batch, p.n_wheels))
+    if len(p.steered_beta):
+        config = np.broadcast_to(wrap_angle(current), (*batch, p.n_steer)).copy()
+        held = np.zeros((*batch, p.n_wheels), dtype=bool)
+        angles, spins, held_o = _ik_fast.steer_to_twist(p, twist, current[..., p.steered_beta], speed_tol)
+        config[..., p.steered_beta] = angles
+        rates[..., p.steered_spin_col] = spins
+        held[..., p.steer_wheels[p.steered_beta]] = held_o
+    else:  # only castors steer: the configuration is the current one, unbatched if it is
+        config = wrap_angle(current)
+        held = np.broadcast_to(False, (*batch, p.n_wheels))
+    if len(p.element_beta):
+        beta_dot, spins = _ik_fast.solve_elements(p, twist, config)
+        rates[..., p.element_steer_col] = beta_dot
+        rates[..., p.element_spin_col] = spins
+    config = np.broadcast_to(config, (*batch, p.n_steer))
+    return rates, config, held
+
+
+def resolve_rate_name(robot: Robot, name: str) -> int:
+    """Column in ``robot.velocity_names`` of a joint-rate name: ``'wheel'`` (its spin) or ``'wheel.joint'``.
+
+    Twist components ``'vx'``, ``'vy'``, ``'omega'`` are accepted too (e.g. a gyro's rate). Unknown names raise
+    :class:`UnknownNameError` listing the valid ones.
+    """
+    names = robot.velocity_names
+    qualified = name if "." in name or name in names else f"{name}.spin"
+    if qualified in names:
+        return names.index(qualified)
+    valid = [w.name for w in robot.wheels if "spin" in w.kind.rates] + list(names)
+    raise UnknownNameError(f"robot '{robot.name}' has no joint rate '{name}' (valid: {', '.join(valid)})")
+
+
+def forward_kinematics(
+    robot: Robot, rates: Mapping[str, ArrayLike], beta: ArrayLike | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Body twist from some joint rates: the rest solved by least squares, ranks method (4.9)-(4.11).
+
+    `rates`: name -> rate [rad/s] (or [m/s] for ``vx``/``vy``), each ``(...)``; names as in
+    :func:`resolve_rate_name`. `beta`: ``(..., n_steer)`` steering angles [rad] (default the described ones).
+    Returns ``(twist_robot (..., 3), residual (...))``: the residual is the norm of the slip ``A q_dot`` [m/s]
+    left by the assignment, 0 when the rates are consistent (the slip indicator of (4.11)/(4.82)). When the
+    given rates do not determine the twist the minimum-norm one is returned: check :func:`twist_is_determined`.
+    """
+    columns = _assigned_columns(robot, list(rates))
+    values = np.broadcast_arrays(*(np.asarray(_rate_value(k, v), dtype=float) for k, v in rates.items()))
+    q_assigned = np.stack(values, axis=-1)
+    q_dot, slip = solve_assigned(robot.constraint_matrix(beta), columns, q_assigned)
+    return readonly(q_dot[..., :3]), readonly(np.linalg.norm(slip, axis=-1))
+
+
+def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: ArrayLike | None = None) -> np.ndarray:
+    """Whether the named rates fix the twist under no slip (all solutions share it). ``(..., n_steer) -> (...)``.
+
+    True iff ``rank(A_na) = n_twist_free + rank(A_rest)`` (4.10): ``A_na`` the columns not assigned, ``A_rest``
+    those of the unknown joint rates, ``n_twist_free`` the twist components not assigned.
+    """
+    columns = _assigned_columns(robot, list(names))
+    a = robot.constraint_matrix(beta)
+    free = np.setdiff1d(np.arange(a.shape[-1]), columns)
+    rest = free[free >= 3]
+    return readonly(np.asarray(matrix_rank(a[..., free]) == np.sum(free < 3) + matrix_rank(a[..., rest])))
+
+
+def _assigned_columns(robot: Robot, names: list[str]) -> np.ndarray:
+    if not names:
+        raise ShapeError(f"rates: expected at least one joint rate of robot '{robot.name}', got none")
+    columns = [resolve_rate_name(robot, name) for name in names]
+    for j, c in enumerate(columns):
+        if c in columns[:j]:
+            raise UnknownNameError(f"rates: '{robot.velocity_names[c]}' given twice")
+    return np.array(columns, dtype=int)
+
+
+def _rate_value(name: str, value: ArrayLike) -> ArrayLike:
+    if isinstance(value, str):  # e.g. from a file or the command line
+        try:
+            return parse_quantity(value, "number")
+        except UnitError as err:
+            raise ShapeError(f"rates: {name}: {err}") from None
+    return value
+
+
+def _columns(rates: np.ndarray, cols: np.ndarray, batch: tuple[int, ...]) -> np.ndarray:
+    """``rates[..., cols]`` with NaN where ``cols < 0``; the identity selection reuses `rates` (read-only)."""
+    if len(cols) == rates.shape[-1] and np.array_equal(cols, np.arange(len(cols))):
+        return rates
+    if (cols < 0).all():
+        return np.broadcast_to(np.nan, (*batch, len(cols)))
+    out = rates[..., np.maximum(cols, 0)]
+    if (cols < 0).any():
+        out[..., cols < 0] = np.nan
+    return out
+
+
+def _ro(a: np.ndarray) -> np.ndarray:
+    return a if not a.flags.writeable else readonly(a)
