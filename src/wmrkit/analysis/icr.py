@@ -1,0 +1,128 @@
+"""The instantaneous centre of rotation (ICR, "CIR"): thesis §5.3, eqs. (5.9)-(5.10) and (5.19)-(5.21) corrected.
+
+A twist ``(vx, vy, omega)`` turns the robot about ``(x_c, y_c) = (-vy / omega, vx / omega)``; in homogeneous
+coordinates ``(x, y, w) = (-vy, vx, omega)``, with ``w = 0`` for a translation (a point at infinity). The ICR
+lies on every constraint line of the robot (the axles of its fixed and steerable wheels, :mod:`.lines`), so the
+set of admissible ICRs is their common point, a line (all axles coincide), or the whole plane (no axles).
+The thesis's closed form (5.21) swaps x and y (errata, docs/errata.md); the null vector used here does not.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors
+from ..kinematics.linalg import matrix_rank
+from ..robot import Robot
+from .lines import common_point, constraint_lines, element_rows
+
+
+def icr_of_twist(twist_robot: ArrayLike) -> np.ndarray:
+    """Homogeneous ICR ``(-vy, vx, omega)`` of body twists (§2.2 of the digest). ``(..., 3) -> (..., 3)``."""
+    t = as_vectors(twist_robot, 3, "twist_robot")
+    return np.stack([-t[..., 1], t[..., 0], t[..., 2]], axis=-1)
+
+
+def twist_of_icr(icr_h: ArrayLike) -> np.ndarray:
+    """A unit twist turning about the homogeneous ICR ``(x, y, w)``: ``(y, -x, w)`` normalised. ``(..., 3) -> (..., 3)``."""
+    h = as_vectors(icr_h, 3, "icr_h")
+    t = np.stack([h[..., 1], -h[..., 0], h[..., 2]], axis=-1)
+    return t / np.linalg.norm(t, axis=-1, keepdims=True)
+
+
+def to_cartesian(icr_h: ArrayLike) -> np.ndarray:
+    """``(x / w, y / w)`` [m]; infinite where ``w = 0``. ``(..., 3) -> (..., 2)``."""
+    h = as_vectors(icr_h, 3, "icr_h")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return h[..., :2] / h[..., 2:]
+
+
+@dataclass(frozen=True)
+class ICRSet:
+    """The admissible ICRs of a robot at one configuration (5.9)-(5.10).
+
+    ``kind``: "point" (``point`` [m]), "infinity" (translation only, along ``direction``), "line" (any point of
+    ``line``, eq. 6.18), "plane" (anywhere: no axles), "none" (the robot cannot move).
+    """
+
+    kind: str
+    point: tuple[float, float] | None = None
+    direction: tuple[float, float] | None = None
+    line: tuple[float, float, float] | None = None
+
+    def describe(self) -> str:
+        """One line for people, e.g. ``ICR at (0.000, -2.747) m``."""
+        if self.kind == "point":
+            return f"ICR at ({self.point[0]:.3f}, {self.point[1]:.3f}) m"
+        if self.kind == "infinity":
+            return f"ICR at infinity: translation only, along ({self.direction[0]:.3f}, {self.direction[1]:.3f})"
+        if self.kind == "line":
+            lx, ly, d = self.line
+            return f"ICR anywhere on the line through ({d * ly:.3f}, {-d * lx:.3f}) m along ({lx:.3f}, {ly:.3f})"
+        if self.kind == "plane":
+            return "ICR anywhere in the plane (no wheel axle constrains it)"
+        return "no ICR: the robot cannot move without slipping"
+
+
+def icr(robot: Robot, beta: ArrayLike | None = None) -> ICRSet:
+    """The admissible ICRs of `robot` at one steering configuration `beta` ``(n_steer,)`` (5.9)-(5.10)."""
+    beta = robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
+    g = constraint_lines(robot).lines(beta)
+    rank = int(matrix_rank(g)) if len(g) else 0
+    if rank == 0:
+        return ICRSet("plane")
+    if rank == 3:
+        return ICRSet("none")
+    if rank == 1:
+        row = g[np.argmax(np.linalg.norm(g, axis=-1))]
+        return ICRSet("line", line=tuple(float(v) for v in row))
+    x, y, w = common_point(g)
+    if abs(w) < 1e-9 * max(abs(x), abs(y)):
+        n = np.hypot(x, y)
+        return ICRSet("infinity", direction=(float(y / n), float(-x / n)))
+    return ICRSet("point", point=(float(x / w), float(y / w)))
+
+
+def icr_points(robot: Robot, beta: ArrayLike) -> np.ndarray:
+    """Homogeneous common point of the axles at each configuration, ``(..., n_steer) -> (..., 3)``.
+
+    Meaningful where the robot has one degree of mobility (types 4 and 5, eqs. 5.18-5.21 corrected): then it is
+    the ICR. Least-squares nearest point otherwise.
+    """
+    return common_point(constraint_lines(robot).lines(beta))
+
+
+def steer_to_icr(robot: Robot, icr_h: ArrayLike) -> np.ndarray:
+    """Steering configuration turning every steerable wheel's axle through the ICR ``(..., 3) -> (..., n_steer)``.
+
+    Each axle is aimed at the ICR (the branch nearest the described angle, since beta and beta + pi give the same
+    axle); castors and wheels at the ICR keep their described angle. This is the coordination (Ackermann, swerve)
+    that lets a robot with several steered wheels move (§5.3, consequence 3 of 5.12).
+    """
+    h = as_vectors(icr_h, 3, "icr_h")
+    beta = np.broadcast_to(robot.beta, (*h.shape[:-1], len(robot.steer_names))).copy()
+    cl = constraint_lines(robot)
+    aimed = {w for w in cl.wheels if w in robot.steer_names}
+    for j, name in enumerate(robot.steer_names):
+        if name not in aimed:
+            continue
+        w = robot.wheel(name)
+        cx, cy = w.position
+        dx, dy = h[..., 0] - h[..., 2] * cx, h[..., 1] - h[..., 2] * cy
+        ok = np.hypot(dx, dy) > 1e-12 * np.maximum(np.abs(h).max(axis=-1), 1e-300)
+        axle = np.arctan2(dy, dx) + _axle_offset(robot, name)
+        branch = axle + np.pi * np.round((w.beta - axle) / np.pi)
+        beta[..., j] = np.where(ok, branch, w.beta)
+    return beta
+
+
+def _axle_offset(robot: Robot, name: str) -> float:
+    """Steering angle minus the direction of the wheel's axle line (0 for steerable and double wheels)."""
+    probe = element_rows(robot, robot.beta)
+    cl = constraint_lines(robot)
+    i = cl.wheels.index(name)
+    lam = np.einsum("k,kc->c", cl.coefficients[i], probe)
+    return float(robot.wheel(name).beta - np.arctan2(lam[1], lam[0]))

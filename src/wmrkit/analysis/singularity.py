@@ -1,0 +1,239 @@
+"""Singularity of kinematic models (thesis ch. 6): the rank test (6.12), the line test (6.17)-(6.20), singular sets.
+
+A model that computes the other velocities from a set of *assigned* velocities ``q_a`` exists at a
+configuration iff the non-assigned columns ``A_na`` of the slip matrix (3.22) have full column rank:
+``rank A_na = k - |q_a|`` (with ``|q_a| = m`` this is (6.12), ``rank A_na = rank A``; with fewer it also catches
+the "undefined" case of §6.3, with more it is the rank loss of the least-squares model (6.11)). Geometrically
+(§6.4, :mod:`wmrkit.analysis.lines`) the model is singular iff its constraint lines G are all concurrent or all
+parallel, ``rank G < 3``. Both tests are implemented and agree (tests/analysis/test_singularity.py).
+
+The singular set over the steering space is found exactly where it can be: every line is linear in
+``(cos beta_i, sin beta_i)`` of its wheel, so each 3x3 minor of G is a trigonometric polynomial of degree <= 3
+in any one steering angle; its roots are those of a degree-6 polynomial (companion matrix). One free angle gives
+the exact singular angles; with more, the last angle is solved exactly on a grid of the others.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors
+from ..errors import UnknownNameError
+from ..kinematics.linalg import matrix_rank
+from ..robot import Robot
+from ._sym import eigvalsh3
+from .lines import constraint_lines, element_rows
+
+#: Relative tolerance of the line test: ``sigma_min / sigma_max`` of the normalised lines below it is singular.
+SINGULAR_RTOL = 1e-8
+
+
+def is_singular_rank(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...]) -> np.ndarray:
+    """Rank test (6.12): ``rank A_na < k - |assigned|``. ``(..., n_steer) -> (...)`` bool.
+
+    `assigned` are names from ``robot.velocity_names`` (twist components and wheel joint rates).
+    """
+    cols = [robot.velocity_index(n) for n in assigned]
+    a = robot.constraint_matrix(beta)
+    free = [j for j in range(a.shape[-1]) if j not in cols]
+    return matrix_rank(a[..., free]) < len(free)
+
+
+def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], *,
+                rtol: float = SINGULAR_RTOL) -> np.ndarray:
+    """Line test (6.17)-(6.20): the constraint lines G are concurrent or parallel. ``(..., n_steer) -> (...)`` bool.
+
+    Also True when a wheel has joint rates the assigned set leaves undetermined (e.g. a double wheel with none of
+    its joints assigned). Equals :func:`is_singular_rank` away from numerical ties.
+    """
+    return singularity_distance(robot, beta, assigned) < rtol
+
+
+def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], *,
+                         length: float | None = None) -> np.ndarray:
+    """Distance to singularity: ``sigma_min / sigma_max`` of the lines G (6.17), rows scaled to unit norm.
+
+    ``(..., n_steer) -> (...)`` in [0, 1]; 0 exactly at singular configurations. The ``d_lambda`` column is
+    divided by `length` [m] (default: the robot's size, :func:`robot_size`) so the measure has no units.
+    """
+    cl = constraint_lines(robot, assigned)
+    beta = robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
+    batch = beta.shape[:-1]
+    if cl.internal or len(cl.labels) < 3:
+        return np.zeros(batch)
+    g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / (length or robot_size(robot))])
+    g = g / np.linalg.norm(g, axis=-1, keepdims=True)
+    small, _, large = eigvalsh3(np.einsum("...rc,...rd->...cd", g, g))
+    return np.sqrt(np.maximum(small, 0.0) / large)
+
+
+def robot_size(robot: Robot) -> float:
+    """RMS distance of the wheels' mount points from the robot origin [m] (at least 1 mm): a default length."""
+    return max(float(np.sqrt(np.mean([w.l**2 for w in robot.wheels]))), 1e-3)
+
+
+@dataclass(frozen=True, eq=False)
+class SingularSet:
+    """Where a model with `assigned` velocities is singular over the steering variables `variables`.
+
+    ``always``: singular at every configuration; otherwise ``configurations`` ``(n, len(variables))`` [rad] lists
+    singular configurations (the other steering angles at their described values): all of them when
+    ``exact`` (zero or one variable), points on the singular curves/surfaces sampled on a grid otherwise.
+    ``reasons`` explains an ``always``.
+    """
+
+    assigned: tuple[str, ...]
+    variables: tuple[str, ...]
+    always: bool
+    configurations: np.ndarray
+    exact: bool
+    reasons: tuple[str, ...] = ()
+
+    @property
+    def never(self) -> bool:
+        """No singular configuration found (certain when ``exact``)."""
+        return not self.always and len(self.configurations) == 0
+
+
+def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[str, ...] | None = None,
+                 resolution: int = 180, max_samples: int = 20000) -> SingularSet:
+    """The singular configurations of the model with `assigned` velocities (§6.3-6.5).
+
+    `variables`: steering wheels to vary (default: those whose lines enter G, since the others do not matter);
+    the rest stay at their described angles. With more than one variable, all but the last are sampled on a
+    grid of `resolution` points per turn (fewer if the grid would exceed `max_samples` points) and the last is
+    solved exactly.
+    """
+    cl = constraint_lines(robot, assigned)
+    steer = robot.steer_names
+    if variables is None:
+        variables = tuple(n for n in steer if n in set(cl.wheels))
+    for v in variables:
+        if v not in steer:
+            raise UnknownNameError(f"robot '{robot.name}' has no steering wheel '{v}' (steering: {', '.join(steer)})")
+    idx = [steer.index(v) for v in variables]
+    base = robot.beta
+    empty = np.zeros((0, len(variables)))
+    if cl.internal:
+        why = tuple(f"the joint rates of {w} are not determined by the assigned velocities" for w in cl.internal)
+        return SingularSet(cl.assigned, variables, True, empty, True, why)
+    if len(cl.labels) < 3:
+        why = (f"only {len(cl.labels)} constraint line(s): fewer assigned velocities than the mobility",)
+        return SingularSet(cl.assigned, variables, True, empty, True, why)
+    if not variables:
+        sing = bool(is_singular(robot, base, cl.assigned))
+        why = ("the lines " + ", ".join(cl.labels) + " are concurrent or parallel",) if sing else ()
+        return SingularSet(cl.assigned, variables, sing, empty, True, why)
+    per_axis = resolution if len(idx) <= 2 else min(resolution, int(max_samples ** (1 / (len(idx) - 1))))
+    grid = np.linspace(-np.pi, np.pi, per_axis, endpoint=False)
+    mesh = np.meshgrid(*([grid] * (len(idx) - 1)), indexing="ij")
+    outer = np.stack([g.ravel() for g in mesh], axis=-1) if mesh else np.zeros((1, 0))
+    configs = np.broadcast_to(base, (len(outer), len(steer))).copy()
+    configs[:, idx[:-1]] = outer
+    roots, always = _roots_last(cl, configs, idx[-1])
+    if always.all():
+        return SingularSet(cl.assigned, variables, True, empty, len(idx) == 1,
+                           ("the lines " + ", ".join(cl.labels) + " are always concurrent or parallel",))
+    found = [np.zeros((0, len(idx)))]
+    for i, rs in enumerate(roots):
+        values = grid if always[i] else rs  # a whole line of the last angle is singular: sample it
+        c = np.repeat(configs[i][None], len(values), axis=0)
+        c[:, idx[-1]] = values
+        found.append(c[:, idx])
+    found_arr = np.concatenate(found)
+    if len(found_arr):
+        found_arr = found_arr[np.lexsort(found_arr.T[::-1])]
+    return SingularSet(cl.assigned, variables, False, found_arr, len(idx) == 1)
+
+
+def _roots_last(cl, configs: np.ndarray, j: int) -> tuple[list[np.ndarray], np.ndarray]:
+    """Exact singular values of steering angle `j` for each row of `configs` ``(B, n_steer)``."""
+    n_fit = 7  # a trigonometric polynomial of degree 3 is fixed by 7 samples
+    t = 2 * np.pi * np.arange(n_fit) / n_fit
+    samples = np.repeat(configs[:, None, :], n_fit, axis=1)
+    samples[..., j] = t
+    raw = np.einsum("lk,...kc->...lc", cl.coefficients, element_rows(cl.robot, samples)) + cl.constant
+    triples = _triples(cl, raw.shape[-2])
+    minors = np.linalg.det(raw[..., triples, :])  # (B, 7, M)
+    basis = np.stack([np.ones(n_fit)] + [f(k * t) for k in (1, 2, 3) for f in (np.cos, np.sin)], axis=1)
+    coef = np.linalg.solve(basis, minors)  # (B, 7, M): a0, a1, b1, a2, b2, a3, b3
+    scale = np.maximum(np.abs(raw).max(axis=(1, 2, 3)), 1e-300) ** 3
+    size = np.abs(coef).max(axis=1)  # (B, M)
+    always = ~(size > 1e-10 * scale[:, None]).any(axis=1)
+    c = coef[np.arange(len(coef)), :, np.argmax(size, axis=1)]  # (B, 7)
+    a, b = c[:, 1::2], c[:, 2::2]
+    poly = np.concatenate([((a - 1j * b) / 2)[:, ::-1], c[:, :1], (a + 1j * b) / 2], axis=1)  # z^6 ... z^0
+    roots = _poly_roots(poly)
+    row = np.concatenate([np.full(len(z), i) for i, z in enumerate(roots)] + [np.zeros(0, int)]).astype(int)
+    z = np.concatenate([*roots, np.zeros(0, complex)])
+    on_circle = (np.abs(np.abs(z) - 1) < 1e-4) & ~always[row]
+    row, x = row[on_circle], _newton(c[row[on_circle]], np.angle(z[on_circle]))
+    beta = configs[row].copy()
+    beta[:, j] = x
+    ok = _rank_deficient(cl, beta)
+    row, x = row[ok], np.mod(x[ok] + np.pi, 2 * np.pi) - np.pi
+    out = []
+    for i in range(len(configs)):
+        keep = np.sort(x[row == i])
+        if len(keep) > 1:
+            gap = np.diff(np.concatenate([keep, keep[:1] + 2 * np.pi]))
+            keep = keep[gap > 1e-7]
+        out.append(keep)
+    return out, always
+
+
+def _triples(cl, n_lines: int) -> np.ndarray:
+    """Row triples whose minors are used: all of them, or the 20 largest at random configurations."""
+    triples = np.array(list(itertools.combinations(range(n_lines), 3)))
+    if len(triples) <= 20:
+        return triples
+    beta = np.random.default_rng(1).uniform(-np.pi, np.pi, (8, len(cl.robot.steer_names)))
+    g = cl.lines(beta)
+    size = np.abs(np.linalg.det(g[:, triples, :])).max(axis=0)
+    return triples[np.argsort(size)[::-1][:20]]
+
+
+def _poly_roots(poly: np.ndarray) -> list[np.ndarray]:
+    """Roots of each row's polynomial (highest power first), leading and trailing near-zeros trimmed; batched."""
+    mag = np.abs(poly)
+    big = mag > 1e-12 * np.maximum(mag.max(axis=1, keepdims=True), 1e-300)
+    first = np.argmax(big, axis=1)
+    last = poly.shape[1] - 1 - np.argmax(big[:, ::-1], axis=1)
+    out: list[np.ndarray] = [np.zeros(0, complex)] * len(poly)
+    for lo, hi in set(zip(first.tolist(), last.tolist(), strict=True)):
+        rows = np.flatnonzero((first == lo) & (last == hi) & big.any(axis=1))
+        deg = hi - lo
+        if deg <= 0:
+            continue
+        p = poly[rows, lo:hi + 1]
+        comp = np.zeros((len(rows), deg, deg), complex)
+        comp[:, 0, :] = -p[:, 1:] / p[:, :1]
+        comp[:, np.arange(1, deg), np.arange(deg - 1)] = 1.0
+        for r, z in zip(rows, np.linalg.eigvals(comp), strict=True):
+            out[r] = z
+    return out
+
+
+def _newton(c: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Two Newton steps on ``a0 + sum a_k cos(k x) + b_k sin(k x)`` (coefficient rows `c` ``(n, 7)``) from `x`."""
+    k = np.arange(1, 4)
+    a, b = c[:, 1::2], c[:, 2::2]
+    tiny = 1e-9 * np.abs(c).max(axis=1, initial=0.0)
+    for _ in range(2):
+        kx = x[:, None] * k
+        f = c[:, 0] + np.sum(np.cos(kx) * a + np.sin(kx) * b, axis=1)
+        df = np.sum(k * (np.cos(kx) * b - np.sin(kx) * a), axis=1)
+        step = np.where(np.abs(df) > tiny, f / np.where(df == 0, 1.0, df), 0.0)
+        x = x - np.clip(step, -1e-3, 1e-3)
+    return x
+
+
+def _rank_deficient(cl, beta: np.ndarray) -> np.ndarray:
+    """Where the lines really have rank < 3 (all minors vanish): ``(n, n_steer) -> (n,)`` bool."""
+    g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / robot_size(cl.robot)])
+    s = np.linalg.svd(g, compute_uv=False)
+    return s[:, -1] < 1e-6 * s[:, 0]
