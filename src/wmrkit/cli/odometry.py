@@ -1,0 +1,104 @@
+"""``wmrkit odometry ROBOT LOG``: a trajectory from a joint log (CSV or ROS 2 bag), papers 002/003, thesis (3.15)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from ..errors import WmrkitError
+from ..odometry.covariance import CrowleyNoise
+from ..odometry.encoders import encoders_for
+from ..odometry.files import odometry_file
+from ..odometry.integrators import METHODS
+from ..odometry.logs import TIME_UNITS, LogFormat
+from ..odometry.model import odometry_model
+from ..odometry.pipeline import OdometrySummary
+from ..units import UnitError, parse_quantity
+from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_assignments, print_json
+
+
+def add_parsers(commands: argparse._SubParsersAction) -> None:
+    """Register ``odometry``."""
+    p = commands.add_parser("odometry", help="integrate a joint log (CSV or ROS 2 bag) into a trajectory")
+    add_robot_argument(p)
+    p.add_argument("log", metavar="LOG", help="CSV log (time, WHEEL.spin, WHEEL.steer columns) or ROS 2 bag")
+    p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
+    p.add_argument("--out", metavar="FILE", help="trajectory output: .csv, .tum/.txt (TUM), else a new ROS 2 bag")
+    p.add_argument("--format", dest="out_format", choices=("csv", "tum", "bag"), help="output format (default: "
+                   "from the --out extension)")
+    p.add_argument("--plot", metavar="FILE", help="draw the path to FILE (.png, .svg or .pdf)")
+    p.add_argument("--pose", nargs=3, metavar=("X", "Y", "THETA"), default=("0", "0", "0"),
+                   help="pose at the first sample: x, y [m], theta [rad, or 'deg'] (default 0 0 0)")
+    p.add_argument("--sensed", action="append", metavar="WHEEL.JOINT", help="use only these sensed joints (repeat)")
+    p.add_argument("--covariance", action="store_true", help="propagate Crowley's pose covariance (003 eq. 17)")
+    p.add_argument("--crowley", nargs=3, type=float, metavar=("K_D", "K_DTHETA", "K_THETA"),
+                   default=(0.001, 0.003, 0.001), help="Crowley's coefficients (default 0.001 0.003 0.001)")
+    g = p.add_argument_group("CSV logs")
+    g.add_argument("--time-column", default="time", help="name of the time column (default: time)")
+    g.add_argument("--time-unit", choices=tuple(TIME_UNITS), default="s", help="unit of the time column")
+    g.add_argument("--column", action="append", metavar="JOINT=COLUMN", default=[], help="column of a joint (repeat)")
+    g.add_argument("--spin", choices=("angle", "counts", "velocity"), default="angle",
+                   help="spin columns: cumulative angle [rad], encoder counts, or velocity [rad/s]")
+    g.add_argument("--steer", choices=("angle", "counts"), default="angle", help="steer columns: angle [rad] or counts")
+    g.add_argument("--cpr", type=float, help="encoder counts per revolution (default: the catalog's, if any)")
+    g.add_argument("--gear", type=float, default=1.0, help="encoder revolutions per wheel revolution (default 1)")
+    g.add_argument("--counter-bits", type=int, help="width of a wrapping hardware counter")
+    g.add_argument("--signed-counter", action="store_true", help="the counter is signed")
+    g.add_argument("--steer-resolution", metavar="ANGLE", help="steering encoder resolution [rad, or 'deg']")
+    g.add_argument("--heading-column", help="absolute heading column [rad] used instead of the wheels' heading")
+    g.add_argument("--gyro-column", help="yaw-rate column [rad/s] integrated instead of the wheels' heading")
+    g.add_argument("--max-gap", type=float, metavar="SECONDS", help="refuse time steps longer than this")
+    g = p.add_argument_group("ROS 2 bags")
+    g.add_argument("--topic", default="/joint_states", help="JointState topic (default: /joint_states)")
+    g.add_argument("--joint-name", action="append", metavar="ROS=JOINT", default=[],
+                   help="map a ROS joint name to a robot joint WHEEL.spin/WHEEL.steer (repeat)")
+    p.add_argument("--chunk-size", type=int, default=1 << 16, help="samples per chunk (memory bound)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_json_flag(p)
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Parse the options into a log format, run :func:`wmrkit.odometry.files.odometry_file`, print the summary."""
+    robot = load_robot(args.robot)
+    if args.chunk_size < 1:
+        raise WmrkitError(f"--chunk-size must be >= 1, got {args.chunk_size}")
+    joints = odometry_model(robot, args.sensed).joints
+    counted = [j for j in joints if (args.steer if j.endswith(".steer") else args.spin) == "counts"]
+    steer_res = None if args.steer_resolution is None else parse_angle(args.steer_resolution, "--steer-resolution")
+    encoders = encoders_for(robot.name, counted, counts_per_rev=args.cpr, gear_ratio=args.gear,
+                            bits=args.counter_bits, signed=args.signed_counter, steer_resolution=steer_res)
+    fmt = LogFormat(time_column=args.time_column, time_unit=args.time_unit,
+                    columns=tuple(parse_assignments(args.column, "--column").items()), spin=args.spin,
+                    steer=args.steer, encoders=encoders, heading_column=args.heading_column,
+                    gyro_column=args.gyro_column, max_gap=args.max_gap)
+    pose0 = [_length(args.pose[0], "--pose X"), _length(args.pose[1], "--pose Y"), parse_angle(args.pose[2], "--pose")]
+    summary = odometry_file(
+        robot, args.log, fmt=fmt, method=args.method, pose0=pose0, sensed=args.sensed,
+        noise=CrowleyNoise(*args.crowley) if args.covariance else None, out=args.out, out_format=args.out_format,
+        plot=args.plot, progress=not args.quiet and sys.stderr.isatty(), chunk_size=args.chunk_size,
+        topic=args.topic, joint_names=parse_assignments(args.joint_name, "--joint-name"))
+    print_json(summary.to_dict()) if args.json else print(format_summary(summary))
+    return 0
+
+
+def _length(text: str, what: str) -> float:
+    try:
+        return parse_quantity(text, "length")
+    except UnitError as err:
+        raise WmrkitError(f"{what}: {err}") from None
+
+
+def format_summary(s: OdometrySummary) -> str:
+    """Human-readable summary of an odometry run."""
+    x, y, th = s.final_pose
+    lines = [f"robot {s.robot}, method {s.method}: {s.samples} samples over {s.end_time - s.start_time:.6g} s",
+             f"final pose: x = {x:.6f} m, y = {y:.6f} m, theta = {th:.6f} rad ({math.degrees(th):.3f} deg)",
+             f"path length {s.distance:.6g} m, rotation {s.rotation:.6g} rad, longest step {s.max_dt:.6g} s",
+             f"slip indicator: max {s.max_slip:.3g} m, rms {s.rms_slip:.3g} m per interval"]
+    if s.final_covariance is not None:
+        c = s.final_covariance
+        lines.append(f"final std: x {math.sqrt(c[0][0]):.4g} m, y {math.sqrt(c[1][1]):.4g} m, "
+                     f"theta {math.sqrt(c[2][2]):.4g} rad")
+    return "\n".join(lines)

@@ -1,0 +1,207 @@
+"""ROS 2 bags (via ``rosbags``): read ``sensor_msgs/msg/JointState`` as joint logs, write ``nav_msgs/msg/Odometry``.
+
+JointState ``position`` entries are read as cumulative wheel angles and steering angles [rad] (as ros2_control's
+joint state broadcaster publishes them). Joint names are the robot's ``WHEEL.spin`` / ``WHEEL.steer`` unless
+``names`` maps ROS names onto them. Messages naming none of the needed joints (other publishers on the topic)
+are skipped; a message naming some but not all is an error. Time is the header stamp (the bag's receive time
+when the stamp is zero).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from .logs import JointLog, LogError
+from .trajectories import Trajectory, quaternion_z, yaw_of_quaternion
+
+JOINT_STATE = "sensor_msgs/msg/JointState"
+ODOMETRY = "nav_msgs/msg/Odometry"
+
+
+def _typestore():
+    from rosbags.typesys import Stores, get_typestore
+
+    return get_typestore(Stores.ROS2_HUMBLE)
+
+
+def _stamp(t: float):
+    ts = _typestore()
+    sec = int(np.floor(t))
+    return ts.types["builtin_interfaces/msg/Time"](sec=sec, nanosec=round((t - sec) * 1e9) % 1_000_000_000)
+
+
+def bag_message_count(path: str | os.PathLike[str], topic: str) -> int:
+    """Number of messages on `topic` in the bag at `path` (for progress bars)."""
+    from rosbags.rosbag2 import Reader
+
+    with Reader(path) as reader:
+        return sum(c.msgcount for c in reader.connections if c.topic == topic)
+
+
+def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, topic: str = "/joint_states",
+                      names: Mapping[str, str] | None = None, chunk_size: int = 1 << 14,
+                      progress: Callable[[int], object] | None = None) -> Iterator[JointLog]:
+    """Joint logs from the ``JointState`` messages on `topic`, in chunks (bounded memory).
+
+    `names` maps ROS joint names to the robot's joint names. `progress` is called with the number of messages
+    read. Raises :class:`LogError` for a missing bag or topic and for messages lacking some joints.
+    """
+    from rosbags.rosbag2 import Reader
+
+    source, rename = os.fspath(path), dict(names or {})
+    if not Path(source).exists():
+        raise LogError(f"{source}: no such bag")
+    ts = _typestore()
+    try:
+        reader = Reader(source)
+        reader.open()
+    except Exception as err:  # rosbags raises its own error types for unreadable bags
+        raise LogError(f"{source}: cannot read as a ROS 2 bag: {err}") from None
+    try:
+        conns = [c for c in reader.connections if c.topic == topic]
+        if not conns:
+            topics = sorted({c.topic for c in reader.connections})
+            raise LogError(f"{source}: no topic '{topic}' (topics: {', '.join(topics) or 'none'})")
+        if any(c.msgtype != JOINT_STATE for c in conns):
+            raise LogError(f"{source}: topic '{topic}' carries {conns[0].msgtype}, not {JOINT_STATE}")
+        times, rows, index, first = [], [], 0, 0
+        for _, stamp_ns, data in reader.messages(connections=conns):
+            msg = ts.deserialize_cdr(data, JOINT_STATE)
+            got = {rename.get(n, n): k for k, n in enumerate(msg.name)}
+            have = [j for j in joints if j in got]
+            if progress is not None:
+                progress(1)
+            if not have:
+                continue
+            if len(have) != len(joints):
+                missing = [j for j in joints if j not in got]
+                raise LogError(f"{source}: {topic} message {index}: no position for {', '.join(missing)}")
+            if len(msg.position) != len(msg.name):
+                raise LogError(f"{source}: {topic} message {index}: {len(msg.name)} names but "
+                               f"{len(msg.position)} positions")
+            stamp = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+            times.append(stamp if stamp > 0 else 1e-9 * stamp_ns)
+            rows.append([msg.position[got[j]] for j in joints])
+            index += 1
+            if len(times) == chunk_size:
+                yield JointLog(np.array(times), tuple(joints), np.array(rows, dtype=float), None,
+                               f"{source}: {topic}", None, first)
+                first, times, rows = index, [], []
+        if times:
+            yield JointLog(np.array(times), tuple(joints), np.array(rows, dtype=float), None, f"{source}: {topic}",
+                           None, first)
+        if index == 0:
+            raise LogError(f"{source}: no JointState message on '{topic}' names the joints {', '.join(joints)}")
+    finally:
+        reader.close()
+
+
+def write_joint_states(path: str | os.PathLike[str], log: JointLog, *, topic: str = "/joint_states",
+                       names: Mapping[str, str] | None = None) -> None:
+    """Write `log` as ``JointState`` messages (one per sample) to a new bag; `names` maps joints to ROS names."""
+    ts = _typestore()
+    rename = dict(names or {})
+    header_t, state_t = ts.types["std_msgs/msg/Header"], ts.types[JOINT_STATE]
+    with _writer(path) as writer:
+        conn = writer.add_connection(topic, JOINT_STATE, typestore=ts)
+        names_out = [rename.get(j, j) for j in log.joints]
+        empty = np.zeros(0)
+        for t, row in zip(log.time.tolist(), log.positions, strict=True):
+            msg = state_t(header=header_t(stamp=_stamp(t), frame_id=""), name=names_out,
+                          position=np.asarray(row, dtype=np.float64), velocity=empty, effort=empty)
+            writer.write(conn, round(t * 1e9), ts.serialize_cdr(msg, JOINT_STATE))
+
+
+class OdometryBagWriter:
+    """Writes trajectory chunks as ``nav_msgs/msg/Odometry`` to a new bag (context manager).
+
+    Pose covariance: the ``(x, y, theta)`` covariance at rows/columns 0, 1, 5 of the 6x6 ROS matrix (z, roll,
+    pitch left 0: planar motion). Twist: the body twist ``(dx, dy, dtheta) / dt`` of the interval ending at each
+    pose (0 at the first).
+    """
+
+    def __init__(self, path: str | os.PathLike[str], *, topic: str = "/odom", frame_id: str = "odom",
+                 child_frame_id: str = "base_link") -> None:
+        self._ts = _typestore()
+        self._ctx = _writer(path)
+        self._writer = self._ctx.__enter__()
+        self._conn = self._writer.add_connection(topic, ODOMETRY, typestore=self._ts)
+        self.frame_id, self.child_frame_id = frame_id, child_frame_id
+        self._last: tuple[float, np.ndarray] | None = None
+
+    def write(self, chunk: Trajectory) -> None:
+        """Append one Odometry message per pose of `chunk`."""
+        t = self._ts.types
+        prev_t = chunk.time[:1] if self._last is None else np.array([self._last[0]])
+        prev_p = chunk.poses[:1] if self._last is None else self._last[1][None]
+        times, poses = np.concatenate([prev_t, chunk.time]), np.vstack([prev_p, chunk.poses])
+        dt = np.diff(times)
+        d = np.diff(poses, axis=0)
+        c, s = np.cos(poses[:-1, 2]), np.sin(poses[:-1, 2])
+        body = np.column_stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1], d[:, 2]])
+        twist = np.divide(body, dt[:, None], out=np.zeros_like(body), where=dt[:, None] > 0)
+        quats = quaternion_z(chunk.poses[:, 2])
+        zero6 = np.zeros(36)
+        for k in range(len(chunk)):
+            cov = np.zeros(36)
+            if chunk.covariance is not None:
+                cov.reshape(6, 6)[np.ix_([0, 1, 5], [0, 1, 5])] = chunk.covariance[k]
+            x, y, _th = chunk.poses[k]
+            pose = t["geometry_msgs/msg/Pose"](
+                position=t["geometry_msgs/msg/Point"](x=float(x), y=float(y), z=0.0),
+                orientation=t["geometry_msgs/msg/Quaternion"](*(float(v) for v in quats[k])))
+            tw = t["geometry_msgs/msg/Twist"](
+                linear=t["geometry_msgs/msg/Vector3"](x=float(twist[k, 0]), y=float(twist[k, 1]), z=0.0),
+                angular=t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=float(twist[k, 2])))
+            msg = t[ODOMETRY](
+                header=t["std_msgs/msg/Header"](stamp=_stamp(float(chunk.time[k])), frame_id=self.frame_id),
+                child_frame_id=self.child_frame_id,
+                pose=t["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=cov),
+                twist=t["geometry_msgs/msg/TwistWithCovariance"](twist=tw, covariance=zero6))
+            self._writer.write(self._conn, round(float(chunk.time[k]) * 1e9),
+                               self._ts.serialize_cdr(msg, ODOMETRY))
+        self._last = (float(chunk.time[-1]), chunk.poses[-1].copy())
+
+    def close(self) -> None:
+        """Finish the bag (writes its metadata)."""
+        self._ctx.__exit__(None, None, None)
+
+    def __enter__(self) -> OdometryBagWriter:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def read_odometry(path: str | os.PathLike[str], *, topic: str = "/odom") -> Trajectory:
+    """Odometry messages of a bag as a :class:`Trajectory` (poses, and the (x, y, theta) covariance)."""
+    from rosbags.rosbag2 import Reader
+
+    ts = _typestore()
+    times, poses, covs = [], [], []
+    with Reader(path) as reader:
+        conns = [c for c in reader.connections if c.topic == topic]
+        if not conns:
+            raise LogError(f"{os.fspath(path)}: no topic '{topic}'")
+        for _, _, data in reader.messages(connections=conns):
+            m = ts.deserialize_cdr(data, ODOMETRY)
+            q = m.pose.pose.orientation
+            times.append(m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec)
+            poses.append([m.pose.pose.position.x, m.pose.pose.position.y,
+                          float(yaw_of_quaternion(np.array([q.x, q.y, q.z, q.w])))])
+            covs.append(m.pose.covariance.reshape(6, 6)[np.ix_([0, 1, 5], [0, 1, 5])])
+    p = np.array(poses).reshape(-1, 3)
+    p[:, 2] = np.unwrap(p[:, 2])
+    return Trajectory(np.array(times), p, np.zeros(len(times)), np.array(covs).reshape(-1, 3, 3))
+
+
+def _writer(path: str | os.PathLike[str]):
+    from rosbags.rosbag2 import Writer
+
+    if Path(path).exists():
+        raise LogError(f"{os.fspath(path)}: already exists (a bag is a new directory)")
+    return Writer(path, version=8)

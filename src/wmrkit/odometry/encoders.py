@@ -1,0 +1,178 @@
+"""Encoders: incremental counts (with fixed-width counter wrap-around) and absolute steering angles, to radians.
+
+The conversion ``wheel angle = 2 pi counts / (counts_per_rev * gear_ratio)`` is [DERIVED] (neither paper gives it;
+papers-odometry.md Part D.1); the wheel's travel is then ``r * angle`` through the robot's own kinematics. The
+forklift of thesis §7.5.1 (8290 pulses per wheel revolution, absolute steering encoder of 1.4118 deg = 360/255 deg)
+is in :data:`CATALOG_ENCODERS`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import UnknownNameError, WmrkitError
+
+
+class EncoderError(WmrkitError, ValueError):
+    """Encoder settings or counts that cannot be right (zero resolution, counts outside the counter's range)."""
+
+
+@dataclass(frozen=True, slots=True)
+class IncrementalEncoder:
+    """A wheel encoder counting pulses: ``counts_per_rev`` per revolution of the encoder shaft.
+
+    ``gear_ratio``: encoder-shaft revolutions per wheel revolution (1 when the encoder is on the wheel).
+    ``bits``: width of the hardware counter, which wraps around modulo ``2**bits`` (None: counts are already
+    cumulative). ``signed``: the counter reads ``[-2**(bits-1), 2**(bits-1))`` instead of ``[0, 2**bits)``.
+    ``sign``: +1, or -1 when the encoder counts down for a positive spin (right-hand rule about the axle).
+    """
+
+    counts_per_rev: float
+    gear_ratio: float = 1.0
+    bits: int | None = None
+    signed: bool = False
+    sign: int = 1
+
+    def __post_init__(self) -> None:
+        if not self.counts_per_rev > 0 or not math.isfinite(self.counts_per_rev):
+            raise EncoderError(f"counts_per_rev must be > 0, got {self.counts_per_rev}")
+        if not self.gear_ratio > 0 or not math.isfinite(self.gear_ratio):
+            raise EncoderError(f"gear_ratio must be > 0, got {self.gear_ratio}")
+        if self.bits is not None and not 2 <= self.bits <= 62:
+            raise EncoderError(f"bits must be between 2 and 62, got {self.bits}")
+        if self.sign not in (1, -1):
+            raise EncoderError(f"sign must be +1 or -1, got {self.sign}")
+
+    @property
+    def radians_per_count(self) -> float:
+        """Wheel angle of one count [rad]."""
+        return self.sign * 2.0 * math.pi / (self.counts_per_rev * self.gear_ratio)
+
+    def count_increments(self, counts: ArrayLike, *, name: str = "counts") -> np.ndarray:
+        """Count differences between consecutive samples, unwrapped. ``(N, ...) -> (N - 1, ...)``.
+
+        With ``bits``, a difference is taken modulo ``2**bits`` into ``[-2**(bits-1), 2**(bits-1))``: correct
+        as long as the wheel turns less than half the counter's range between two samples (an assumption no
+        log can check). Counts outside the counter's range raise :class:`EncoderError` naming `name`.
+        """
+        c = np.asarray(counts)
+        if not np.issubdtype(c.dtype, np.integer):
+            c = _as_integer(c, name)
+        if self.bits is None:
+            return np.diff(c, axis=0)
+        span = 1 << self.bits
+        low = -(span >> 1) if self.signed else 0
+        if c.size and (c.min() < low or c.max() >= low + span):
+            bad = c.min() if c.min() < low else c.max()
+            raise EncoderError(f"{name}: count {bad} outside the {self.bits}-bit "
+                               f"{'signed' if self.signed else 'unsigned'} counter range [{low}, {low + span})")
+        d = np.diff(c, axis=0)
+        return (d + (span >> 1)) % span - (span >> 1)
+
+    def angle_increments(self, counts: ArrayLike, *, name: str = "counts") -> np.ndarray:
+        """Wheel angle increments [rad] between consecutive samples. ``(N, ...) -> (N - 1, ...)``."""
+        return self.count_increments(counts, name=name) * self.radians_per_count
+
+    def quantize(self, angle: ArrayLike) -> np.ndarray:
+        """Counts an ideal encoder reports at wheel angle `angle` [rad] (floor, cumulative, no wrap). ``(...)``."""
+        return np.floor(np.asarray(angle, dtype=float) / self.radians_per_count).astype(np.int64)
+
+    def wrap(self, counts: ArrayLike) -> np.ndarray:
+        """Cumulative counts as the fixed-width counter shows them (identity without ``bits``). ``(...)``."""
+        c = np.asarray(counts, dtype=np.int64)
+        if self.bits is None:
+            return c
+        span = 1 << self.bits
+        low = -(span >> 1) if self.signed else 0
+        return (c - low) % span + low
+
+
+@dataclass(frozen=True, slots=True)
+class AbsoluteEncoder:
+    """An absolute angle encoder (steering): ``angle = offset + sign * counts * resolution`` [rad]."""
+
+    resolution: float
+    offset: float = 0.0
+    sign: int = 1
+
+    def __post_init__(self) -> None:
+        if not self.resolution > 0 or not math.isfinite(self.resolution):
+            raise EncoderError(f"resolution must be > 0, got {self.resolution}")
+        if self.sign not in (1, -1):
+            raise EncoderError(f"sign must be +1 or -1, got {self.sign}")
+
+    def angle(self, counts: ArrayLike) -> np.ndarray:
+        """Angles [rad] of raw readings `counts`. ``(...) -> (...)``."""
+        return self.offset + self.sign * np.asarray(counts, dtype=float) * self.resolution
+
+    def quantize(self, angle: ArrayLike) -> np.ndarray:
+        """The reading (nearest count) of an ideal encoder at `angle` [rad]. ``(...) -> (...)`` int."""
+        return np.rint(self.sign * (np.asarray(angle, dtype=float) - self.offset) / self.resolution).astype(np.int64)
+
+    def round(self, angle: ArrayLike) -> np.ndarray:
+        """`angle` [rad] rounded to what this encoder can report. ``(...) -> (...)``."""
+        return self.angle(self.quantize(angle))
+
+
+Encoder = IncrementalEncoder | AbsoluteEncoder
+
+#: Encoders of catalog robots, by robot then joint (thesis §7.5.1: 8290 pulses/rev, 1.4118 deg = 360/255 deg).
+CATALOG_ENCODERS: Mapping[str, Mapping[str, Encoder]] = {
+    "forklift": {
+        "right_drive.spin": IncrementalEncoder(counts_per_rev=8290),
+        "left_drive.spin": IncrementalEncoder(counts_per_rev=8290),
+        "steer.steer": AbsoluteEncoder(resolution=math.radians(1.4118)),
+    },
+}
+
+
+def catalog_encoders(robot_name: str) -> Mapping[str, Encoder]:
+    """Encoders of catalog robot `robot_name` by joint, or :class:`UnknownNameError`."""
+    if robot_name not in CATALOG_ENCODERS:
+        raise UnknownNameError(f"no encoder data for robot '{robot_name}' (known: {', '.join(CATALOG_ENCODERS)}); "
+                               "give the counts per revolution")
+    return CATALOG_ENCODERS[robot_name]
+
+
+def _as_integer(c: np.ndarray, name: str) -> np.ndarray:
+    """Float counts (as read from text) to int64, refusing fractions, NaN and values beyond 2**53."""
+    c = np.asarray(c, dtype=float)
+    if not np.all(np.isfinite(c)):
+        raise EncoderError(f"{name}: counts must be finite")
+    if np.any(np.abs(c) > 2.0**53):
+        raise EncoderError(f"{name}: counts beyond 2**53 cannot be represented exactly (counter overflow?)")
+    if np.any(c != np.round(c)):
+        raise EncoderError(f"{name}: counts must be whole numbers")
+    return c.astype(np.int64)
+
+
+def encoders_for(robot_name: str, joints: Sequence[str], *, counts_per_rev: float | None = None,
+                 gear_ratio: float = 1.0, bits: int | None = None, signed: bool = False,
+                 steer_resolution: float | None = None) -> tuple[tuple[str, Encoder], ...]:
+    """Encoders of `joints` for a counts log: the given settings, else the catalog's (:data:`CATALOG_ENCODERS`).
+
+    Spin joints get an :class:`IncrementalEncoder` (`counts_per_rev`, `gear_ratio`, counter `bits`, `signed`),
+    steer joints an :class:`AbsoluteEncoder` of `steer_resolution` [rad]. Raises :class:`EncoderError` when a
+    joint has neither.
+    """
+    known = CATALOG_ENCODERS.get(robot_name, {})
+    out = []
+    for joint in joints:
+        if joint.endswith(".steer"):
+            enc = AbsoluteEncoder(steer_resolution) if steer_resolution is not None else known.get(joint)
+        elif counts_per_rev is not None:
+            enc = IncrementalEncoder(counts_per_rev, gear_ratio, bits, signed)
+        else:
+            enc = known.get(joint)
+            if isinstance(enc, IncrementalEncoder) and bits is not None:
+                enc = IncrementalEncoder(enc.counts_per_rev, enc.gear_ratio, bits, signed, enc.sign)
+        if enc is None:
+            what = "steering resolution" if joint.endswith(".steer") else "counts per revolution"
+            raise EncoderError(f"joint '{joint}' of robot '{robot_name}': no encoder data; give the {what}")
+        out.append((joint, enc))
+    return tuple(out)

@@ -1,0 +1,94 @@
+"""Odometry from a log file to trajectory files, streaming with a progress bar (what ``wmrkit odometry`` calls).
+
+Inputs: CSV logs (:mod:`.logs`) or ROS 2 bags (a bag directory, or a ``.db3``/``.mcap`` file; :mod:`.bags`).
+Outputs chosen by ``out_format`` or the extension of ``out``: ``.csv`` (time, pose, slip, covariance), ``.tum``
+or ``.txt`` (TUM), anything else a new ROS 2 bag of ``nav_msgs/msg/Odometry``. A plot keeps a decimated copy of
+the trajectory, so memory stays bounded for any log length.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Literal
+
+from numpy.typing import ArrayLike
+
+from ..robot import Robot
+from .bags import OdometryBagWriter, bag_message_count, read_joint_states
+from .integrators import Method, check_method
+from .logs import LogError, LogFormat, read_csv
+from .model import odometry_model
+from .pipeline import Decimator, Noise, OdometrySummary, run_odometry
+from .trajectories import TrajectoryWriter
+
+OutFormat = Literal["csv", "tum", "bag"]
+DEFAULT_FORMAT = LogFormat()
+
+
+def is_bag(path: str | os.PathLike[str]) -> bool:
+    """Whether `path` names a ROS 2 bag (a directory, or a ``.db3`` / ``.mcap`` file)."""
+    p = Path(path)
+    return p.is_dir() or p.suffix.lower() in (".db3", ".mcap")
+
+
+def out_format_of(path: str | os.PathLike[str]) -> OutFormat:
+    """Output format implied by a file name: ``.csv`` -> csv, ``.tum``/``.txt`` -> tum, else a bag."""
+    suffix = Path(path).suffix.lower()
+    return "csv" if suffix == ".csv" else "tum" if suffix in (".tum", ".txt") else "bag"
+
+
+def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFormat = DEFAULT_FORMAT,
+                  method: Method = "exact", pose0: ArrayLike = (0.0, 0.0, 0.0), sensed: Sequence[str] | None = None,
+                  noise: Noise | None = None, out: str | os.PathLike[str] | None = None,
+                  out_format: OutFormat | None = None, plot: str | os.PathLike[str] | None = None,
+                  progress: bool = False, chunk_size: int = 1 << 16, topic: str = "/joint_states",
+                  joint_names: Mapping[str, str] | None = None) -> OdometrySummary:
+    """Run odometry over the log at `log_path` and write the requested outputs (module docstring).
+
+    `fmt` describes a CSV log; `topic` and `joint_names` (ROS name -> robot joint) a bag. `progress` shows a
+    tqdm bar on stderr. Returns the run's :class:`~.pipeline.OdometrySummary`.
+    """
+    from tqdm import tqdm
+
+    check_method(method)
+    model = odometry_model(robot, sensed)
+    if not Path(log_path).exists():
+        raise LogError(f"{os.fspath(log_path)}: no such file")
+    bag = is_bag(log_path)
+    if bag and fmt != LogFormat():
+        raise LogError(f"{os.fspath(log_path)}: CSV options (columns, counts, heading...) do not apply to a bag")
+    total, unit = ((bag_message_count(log_path, topic), "msg") if bag
+                   else (os.path.getsize(log_path), "B"))
+    out_fmt = None if out is None else (out_format or out_format_of(out))
+    if out_fmt not in (None, "csv", "tum", "bag"):
+        raise LogError(f"unknown output format '{out_fmt}' (formats: csv, tum, bag)")
+    with tqdm(total=total, unit=unit, unit_scale=True, disable=not progress, leave=False) as bar:
+        if bag:
+            chunks = read_joint_states(log_path, model.joints, topic=topic, names=joint_names,
+                                       chunk_size=chunk_size, progress=bar.update)
+        else:
+            chunks = read_csv(log_path, model.joints, fmt, wheels=robot.wheel_names, chunk_size=chunk_size,
+                              progress=bar.update)
+        sinks, writer = [], None
+        if out_fmt == "bag":
+            writer = OdometryBagWriter(out)
+        elif out_fmt is not None:
+            writer = TrajectoryWriter(out, out_fmt, covariance=noise is not None)
+        if writer is not None:
+            sinks.append(writer.write)
+        decimated = Decimator() if plot is not None else None
+        if decimated is not None:
+            sinks.append(decimated)
+        try:
+            summary = run_odometry(model, chunks, method=method, pose0=pose0, noise=noise, sinks=sinks)
+        finally:
+            if writer is not None:
+                writer.close()
+    if decimated is not None:
+        from .plot import save_trajectory_plot
+
+        _time, poses = decimated.result()
+        save_trajectory_plot(plot, {f"{robot.name} ({method})": poses})
+    return summary

@@ -1,0 +1,178 @@
+"""Pose integration on SE(2): one step and whole trajectories, four schemes (papers 002 and 003; thesis (3.15)).
+
+Every scheme advances a world pose ``(x, y, theta)`` by a *body increment* ``(dx, dy, dtheta)``: the twist of the
+robot frame (thesis (3.15): ``^G p_dot = Rot_Z(theta) ^R p_dot``) integrated over one sample interval, which is what
+wheel encoders measure. The schemes differ only in the heading along which the body displacement is rotated and
+in a chord factor:
+
+============  ========================  ==============  =======================================================
+method        heading used              chord factor    source, order
+============  ========================  ==============  =======================================================
+``euler``     ``theta_k``               1               forward Euler; 003 (20) (translate, then rotate); 1st
+``paper002``  ``theta_k + dtheta``      1               002 eq. (15) (new heading); 1st
+``rk2``       ``theta_k + dtheta / 2``  1               midpoint / Runge-Kutta 2; 003 (26); 2nd
+``exact``     ``theta_k + dtheta / 2``  sinc(dtheta/2)  constant twist, SE(2) exponential; 003 (21)-(25),
+                                                        002 (11)-(12) corrected; exact for arcs and lines
+============  ========================  ==============  =======================================================
+
+The exact step is the chord form of the SE(2) exponential: ``Rot(h) sinc(h) = V(2h)`` with ``h = dtheta / 2``,
+where ``V`` is the left Jacobian of SO(2); it has no ``1 - cos`` cancellation, so the straight-line limit
+``dtheta -> 0`` loses no precision (papers-odometry.md A.3 [DERIVED]).
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors
+from ..errors import WmrkitError
+
+Method = Literal["exact", "rk2", "euler", "paper002"]
+#: Integration schemes, best first.
+METHODS: tuple[str, ...] = ("exact", "rk2", "euler", "paper002")
+#: Fraction of the step's heading change at which the displacement is rotated, per method.
+HEADING_FRACTION = {"exact": 0.5, "rk2": 0.5, "euler": 0.0, "paper002": 1.0}
+#: Below this |h| the chord factor uses its series (error < h^6 / 5040 < 1e-25).
+_SMALL = 1e-4
+
+
+def check_method(method: str) -> str:
+    """`method` if it is one of :data:`METHODS`, else :class:`WmrkitError` listing them."""
+    if method not in HEADING_FRACTION:
+        raise WmrkitError(f"unknown integration method '{method}' (methods: {', '.join(METHODS)})")
+    return method
+
+
+def sinc(h: ArrayLike) -> np.ndarray:
+    """``sin(h) / h`` with the value 1 at 0, safe pattern (no division by zero on the branch not taken).
+
+    ``(...) -> (...)``; chord factor of 003 eqs. (22)-(24): a chord is ``2 R sin(h) = arc * sinc(h)``, ``h = dtheta/2``.
+    """
+    h = np.asarray(h, dtype=float)
+    small = np.abs(h) < _SMALL
+    safe = np.where(small, 1.0, h)
+    return np.where(small, 1.0 - h * h / 6.0, np.sin(safe) / safe)
+
+
+def sinc_derivative(h: ArrayLike) -> np.ndarray:
+    """``d/dh sinc(h) = (h cos h - sin h) / h^2``, series ``-h/3 + h^3/30`` near 0. ``(...) -> (...)``.
+
+    Used by the Jacobians of the exact step (003 eqs. (22)-(25)).
+    """
+    h = np.asarray(h, dtype=float)
+    small = np.abs(h) < 1e-3
+    safe = np.where(small, 1.0, h)
+    return np.where(small, -h / 3.0 + h**3 / 30.0, (safe * np.cos(safe) - np.sin(safe)) / (safe * safe))
+
+
+def step(pose_world_robot: ArrayLike, increment_robot: ArrayLike, method: Method = "exact") -> np.ndarray:
+    """One pose update by a body increment, papers 002 (15) / 003 (20), (25), (26); thesis (3.15).
+
+    ``(..., 3), (..., 3) -> (..., 3)``. `pose_world_robot` is ``(x [m], y [m], theta [rad])`` in the world frame;
+    `increment_robot` is ``(dx [m], dy [m], dtheta [rad])``, the body twist times the time step. `method` is one
+    of :data:`METHODS` (module docstring).
+    """
+    check_method(method)
+    pose = as_vectors(pose_world_robot, 3, "pose_world_robot")
+    inc = as_vectors(increment_robot, 3, "increment_robot")
+    dth = inc[..., 2]
+    head = pose[..., 2] + HEADING_FRACTION[method] * dth
+    f = sinc(dth / 2) if method == "exact" else 1.0
+    c, s = np.cos(head) * f, np.sin(head) * f
+    return np.stack(
+        [pose[..., 0] + c * inc[..., 0] - s * inc[..., 1], pose[..., 1] + s * inc[..., 0] + c * inc[..., 1],
+         pose[..., 2] + dth], axis=-1)
+
+
+def _twist_step(pose_world_robot: ArrayLike, twist_robot: ArrayLike, dt: ArrayLike, method: Method) -> np.ndarray:
+    twist = as_vectors(twist_robot, 3, "twist_robot")
+    return step(pose_world_robot, twist * np.asarray(dt, dtype=float)[..., None], method)
+
+
+def integrate_exact(pose_world_robot: ArrayLike, twist_robot: ArrayLike, dt: ArrayLike) -> np.ndarray:
+    """Exact SE(2) step for a body twist held constant over `dt` (003 eqs. 21-25; 002 eqs. 11-12 corrected).
+
+    ``(..., 3), (..., 3), (...) -> (..., 3)``; poses ``(x [m], y [m], theta [rad])`` in the world frame, twist
+    ``(vx [m/s], vy [m/s], omega [rad/s])`` in the robot frame, `dt` [s]. Not the same as Euler: the heading turns
+    during the step.
+
+    Examples
+    --------
+    >>> x, y, theta = integrate_exact([0, 0, 0], [0.1, 0, 0.04], 1.0)   # papers-odometry.md A.6 oracle
+    >>> print(f"{x:.10f} {y:.10f} {theta:.2f}")
+    0.0999733355 0.0019997333 0.04
+    """
+    return _twist_step(pose_world_robot, twist_robot, dt, "exact")
+
+
+def integrate_rk2(pose_world_robot: ArrayLike, twist_robot: ArrayLike, dt: ArrayLike) -> np.ndarray:
+    """Midpoint (Runge-Kutta 2) step, 003 eq. (26): heading ``theta + omega dt / 2``. Same shapes as exact."""
+    return _twist_step(pose_world_robot, twist_robot, dt, "rk2")
+
+
+def integrate_euler(pose_world_robot: ArrayLike, twist_robot: ArrayLike, dt: ArrayLike) -> np.ndarray:
+    """Forward Euler step, 003 eq. (20): translate along the old heading, then rotate. Same shapes as exact."""
+    return _twist_step(pose_world_robot, twist_robot, dt, "euler")
+
+
+def integrate_paper002(pose_world_robot: ArrayLike, twist_robot: ArrayLike, dt: ArrayLike) -> np.ndarray:
+    """Step of 002 eq. (15): translate along the *new* heading ``theta + omega dt``. Same shapes as exact."""
+    return _twist_step(pose_world_robot, twist_robot, dt, "paper002")
+
+
+def integrate_increments(
+    pose_world_robot: ArrayLike,
+    increments_robot: ArrayLike,
+    method: Method = "exact",
+    *,
+    heading_world: ArrayLike | None = None,
+) -> np.ndarray:
+    """Compose a sequence of body increments into poses, vectorised (002 (15)/(22), 003 (20)-(26), thesis (3.15)).
+
+    ``(..., 3), (..., N, 3) -> (..., N, 3)``: the pose after each increment (the start pose is not repeated).
+    The heading is a cumulative sum, the world displacement of each step a rotation of its body displacement
+    (times the chord factor for ``exact``), and the positions a cumulative sum: no Python loop, float64
+    accumulation. Equal to applying :func:`step` N times (to round-off).
+
+    `heading_world` ``(..., N + 1)`` [rad], when given, is an external absolute heading (gyro, IMU, compass) at
+    the start and end of every interval: it replaces the wheels' ``dtheta`` and the start pose's theta (the
+    heading column of the result equals ``heading_world[..., 1:]``). It must be continuous (unwrapped).
+    """
+    check_method(method)
+    pose0 = as_vectors(pose_world_robot, 3, "pose_world_robot")
+    inc = np.asarray(increments_robot, dtype=float)
+    if inc.ndim < 2 or inc.shape[-1] != 3:
+        raise WmrkitError(f"increments_robot: expected shape (..., N, 3), got {inc.shape}")
+    n = inc.shape[-2]
+    if heading_world is None:
+        dth = inc[..., 2]
+        theta = np.cumsum(dth, axis=-1)
+        theta += pose0[..., 2, None]
+        prev = np.concatenate([np.broadcast_to(pose0[..., 2, None], (*theta.shape[:-1], 1)), theta[..., :-1]], -1)
+    else:
+        hw = np.asarray(heading_world, dtype=float)
+        if hw.shape[-1:] != (n + 1,):
+            raise WmrkitError(f"heading_world: expected shape (..., {n + 1}) (one more than the increments), "
+                              f"got {hw.shape}")
+        theta, prev = hw[..., 1:], hw[..., :-1]
+        dth = theta - prev
+    frac = HEADING_FRACTION[method]
+    head = prev if frac == 0.0 else theta if frac == 1.0 else prev + 0.5 * dth
+    c, s = np.cos(head), np.sin(head)
+    if method == "exact":
+        f = sinc(0.5 * dth)
+        c *= f
+        s *= f
+    dxb, dyb = inc[..., 0], inc[..., 1]
+    dx, dy = c * dxb, s * dxb
+    if np.any(dyb):
+        dx -= s * dyb
+        dy += c * dyb
+    x = np.cumsum(dx, axis=-1, out=dx)
+    y = np.cumsum(dy, axis=-1, out=dy)
+    x += pose0[..., 0, None]
+    y += pose0[..., 1, None]
+    return np.stack(np.broadcast_arrays(x, y, theta), axis=-1)

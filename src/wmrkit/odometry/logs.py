@@ -1,0 +1,331 @@
+"""Joint logs: samples of sensed joints over time, read from CSV in bounded memory, validated, written back.
+
+A log holds one row per sample: ``time`` [s] and, per sensed joint ``WHEEL.spin`` / ``WHEEL.steer``, the
+cumulative wheel angle / the steering angle [rad]. :class:`LogFormat` describes other CSV layouts: other column
+names, a time unit, encoder counts (with counter wrap-around), joint velocities, an external heading (absolute
+yaw, or a gyro rate that is integrated). Every reader turns them into the same :class:`JointLog` chunks.
+
+Bad input is refused with a one-line :class:`LogError` naming the file, the line and the column: missing columns,
+columns naming wheels the robot lacks, non-numeric or NaN values, time that repeats (a zero time step is
+rejected, never divided by) or goes backwards, and steps longer than ``LogFormat.max_gap`` when given. Gaps
+are otherwise integrated as one step: exact for the wheel travel (angles are cumulative), with the path shape
+inside the gap approximated by a constant twist.
+"""
+
+from __future__ import annotations
+
+import difflib
+import itertools
+import os
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from ..errors import WmrkitError
+from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
+
+#: Seconds per unit of the time column.
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+
+
+class LogError(WmrkitError, ValueError):
+    """A log that cannot be read as the robot's sensor record; the message names file, line and column."""
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class JointLog:
+    """Samples of sensed joints: ``time`` ``(N,)`` [s], ``positions`` ``(N, n)`` [rad] named by ``joints``.
+
+    Spin columns are cumulative wheel angles, steer columns steering angles. ``heading_world`` ``(N,)`` [rad] is
+    an optional external heading (continuous). ``source`` and ``first_line`` locate errors (``first_line``: the
+    file line of row 0, or None when rows are not lines; ``first_index`` is then the sample number of row 0).
+    """
+
+    time: np.ndarray
+    joints: tuple[str, ...]
+    positions: np.ndarray
+    heading_world: np.ndarray | None = None
+    source: str = "<log>"
+    first_line: int | None = None
+    first_index: int = 0
+
+    def __post_init__(self) -> None:
+        n = len(self.time)
+        if np.ndim(self.time) != 1 or np.shape(self.positions) != (n, len(self.joints)):
+            raise LogError(f"{self.source}: expected time (N,) and positions (N, {len(self.joints)}), got "
+                           f"{np.shape(self.time)} and {np.shape(self.positions)}")
+        if self.heading_world is not None and np.shape(self.heading_world) != (n,):
+            raise LogError(f"{self.source}: heading_world: expected shape ({n},), got {np.shape(self.heading_world)}")
+
+    def __len__(self) -> int:
+        return len(self.time)
+
+    def where(self, row: int) -> str:
+        """Location of `row` for messages: ``file:line`` or ``source: sample i``."""
+        if self.first_line is not None:
+            return f"{self.source}:{self.first_line + row}"
+        return f"{self.source}: sample {self.first_index + row}"
+
+    def select(self, joints: Sequence[str]) -> JointLog:
+        """The same log with the columns `joints` in that order; :class:`LogError` names any joint missing."""
+        missing = [j for j in joints if j not in self.joints]
+        if missing:
+            raise LogError(f"{self.source}: no samples of joint {_quoted(missing)} (the log has: "
+                           f"{', '.join(self.joints) or 'none'})")
+        idx = [self.joints.index(j) for j in joints]
+        return JointLog(self.time, tuple(joints), self.positions[:, idx], self.heading_world, self.source,
+                        self.first_line, self.first_index)
+
+    def slice(self, start: int, stop: int) -> JointLog:
+        """Rows ``start:stop`` (locations kept right)."""
+        h = None if self.heading_world is None else self.heading_world[start:stop]
+        return JointLog(self.time[start:stop], self.joints, self.positions[start:stop], h, self.source,
+                        None if self.first_line is None else self.first_line + start, self.first_index + start)
+
+
+@dataclass(frozen=True, slots=True)
+class LogFormat:
+    """How joints are stored in a CSV log; the defaults read ``time`` [s] and ``WHEEL.spin``/``WHEEL.steer`` [rad].
+
+    ``columns``: ``(joint, column)`` pairs renaming columns. ``spin``: ``"angle"`` (cumulative, rad),
+    ``"counts"`` (incremental encoder, see ``encoders``) or ``"velocity"`` (rad/s, integrated by the trapezoidal
+    rule). ``steer``: ``"angle"`` (rad) or ``"counts"`` (absolute encoder readings). ``encoders``: ``(joint,
+    encoder)`` pairs for counts. ``heading_column``: absolute heading [rad] (IMU yaw; unwrapped here) replacing
+    the wheels' heading; ``gyro_column``: yaw rate [rad/s] instead (integrated from 0). ``max_gap``: longest
+    time step accepted [s] (None: any). ``time_unit``: one of :data:`TIME_UNITS`.
+    """
+
+    time_column: str = "time"
+    time_unit: str = "s"
+    columns: tuple[tuple[str, str], ...] = ()
+    spin: Literal["angle", "counts", "velocity"] = "angle"
+    steer: Literal["angle", "counts"] = "angle"
+    encoders: tuple[tuple[str, Encoder], ...] = field(default=())
+    heading_column: str | None = None
+    gyro_column: str | None = None
+    max_gap: float | None = None
+    delimiter: str = ","
+
+    def __post_init__(self) -> None:
+        if self.time_unit not in TIME_UNITS:
+            raise LogError(f"unknown time unit '{self.time_unit}' (units: {', '.join(TIME_UNITS)})")
+        if self.spin not in ("angle", "counts", "velocity") or self.steer not in ("angle", "counts"):
+            raise LogError(f"spin must be angle, counts or velocity and steer angle or counts; got {self.spin}, "
+                           f"{self.steer}")
+        if self.heading_column is not None and self.gyro_column is not None:
+            raise LogError("give a heading column or a gyro column, not both")
+        if self.max_gap is not None and not self.max_gap > 0:
+            raise LogError(f"max_gap must be > 0 s, got {self.max_gap}")
+
+    def column_of(self, joint: str) -> str:
+        """The CSV column holding `joint`."""
+        return dict(self.columns).get(joint, joint)
+
+    def encoder_of(self, joint: str, source: str) -> Encoder:
+        """The encoder of `joint` (counts formats), or :class:`LogError`."""
+        enc = dict(self.encoders).get(joint)
+        steer = joint.endswith(".steer")
+        want = AbsoluteEncoder if steer else IncrementalEncoder
+        if not isinstance(enc, want):
+            raise LogError(f"{source}: joint '{joint}' is logged as counts but has no {want.__name__} "
+                           "(give the counts per revolution / the steering resolution)")
+        return enc
+
+
+class Decoder:
+    """Turns raw rows of one log into :class:`JointLog` chunks, carrying state across chunks (counts, rates)."""
+
+    def __init__(self, joints: Sequence[str], fmt: LogFormat, source: str) -> None:
+        self.joints, self.fmt, self.source = tuple(joints), fmt, source
+        self._last: np.ndarray | None = None  # last raw row (time, joints, heading)
+        self._positions: np.ndarray | None = None  # last decoded positions
+        self._heading = 0.0
+
+    def decode(self, raw: np.ndarray, first_line: int | None, first_index: int) -> JointLog:
+        """Rows ``(time, joint columns..., [heading or gyro])`` in file units to a validated chunk."""
+        fmt, n_j = self.fmt, len(self.joints)
+        probe = JointLog(raw[:, 0], self.joints, raw[:, 1:1 + n_j], None, self.source, first_line, first_index)
+        _check_finite(probe, raw)
+        scale = TIME_UNITS[fmt.time_unit]
+        time = raw[:, 0] * scale
+        check_time(probe, time, None if self._last is None else self._last[0] * scale, fmt.max_gap)
+        ext = raw if self._last is None else np.vstack([self._last[None], raw])
+        ext_time = ext[:, 0] * scale
+        pos = np.empty((len(raw), n_j))
+        for j, joint in enumerate(self.joints):
+            prev = None if self._positions is None else self._positions[j]
+            pos[:, j] = self._decode_joint(joint, ext[:, 1 + j], ext_time, prev, probe)
+        heading = None
+        if fmt.heading_column is not None:
+            u = np.unwrap(ext[:, -1])
+            heading = u if self._last is None else self._heading + (u[1:] - u[0])
+        elif fmt.gyro_column is not None:
+            heading = self._heading + _cumtrapz(ext[:, -1], ext_time, start=self._last is None)
+        if heading is not None:
+            self._heading = heading[-1]
+        self._last, self._positions = raw[-1].copy(), pos[-1].copy()
+        return JointLog(time, self.joints, pos, heading, self.source, first_line, first_index)
+
+    def _decode_joint(self, joint: str, col: np.ndarray, t: np.ndarray, prev: float | None, probe: JointLog):
+        kind = self.fmt.steer if joint.endswith(".steer") else self.fmt.spin
+        new = col if prev is None else col[1:]
+        if kind == "angle":
+            return new
+        if kind == "velocity":
+            return (0.0 if prev is None else prev) + _cumtrapz(col, t, start=prev is None)
+        enc = self.fmt.encoder_of(joint, self.source)
+        try:
+            if isinstance(enc, AbsoluteEncoder):
+                return enc.angle(new)
+            steps = enc.angle_increments(col, name=f"{probe.source}: column '{self.fmt.column_of(joint)}'")
+        except EncoderError as err:
+            raise LogError(str(err)) from None
+        start = np.zeros(1) if prev is None else np.full(1, prev)
+        out = start[0] + np.cumsum(steps)
+        return np.concatenate([start, out]) if prev is None else out
+
+
+def check_time(log: JointLog, time: np.ndarray, previous: float | None, max_gap: float | None) -> None:
+    """Refuse time that repeats, goes backwards or (with `max_gap`) jumps; `previous`: the last time before."""
+    t = time if previous is None else np.concatenate([[previous], time])
+    dt = np.diff(t)
+    shift = 0 if previous is None else 1
+    bad = np.flatnonzero(~(dt > 0))
+    if bad.size:
+        i = int(bad[0]) + 1 - shift
+        what = "repeats the previous sample (a zero time step)" if dt[bad[0]] == 0 else "goes backwards"
+        raise LogError(f"{log.where(i)}: time {time[i]!r} s {what}; time must increase strictly")
+    if max_gap is not None and dt.size and dt.max() > max_gap:
+        i = int(np.argmax(dt)) + 1 - shift
+        raise LogError(f"{log.where(i)}: time step of {dt.max():.6g} s exceeds max_gap = {max_gap:g} s (a gap)")
+
+
+def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat = LogFormat(), *,
+             wheels: Sequence[str] = (), chunk_size: int = 1 << 16,
+             progress: Callable[[int], object] | None = None) -> Iterator[JointLog]:
+    """Read a CSV log in chunks of `chunk_size` rows, validated and decoded (bounded memory).
+
+    `joints`: the joints needed (``model.joints``); `wheels`: the robot's wheel names, to refuse columns
+    ``X.spin``/``X.steer`` for a wheel ``X`` the robot lacks. `progress` is called with the bytes read.
+    """
+    source = os.fspath(path)
+    try:
+        f = open(source, encoding="utf-8", newline="")
+    except OSError as err:
+        raise LogError(f"{source}: cannot open: {err.strerror}") from None
+    try:
+        header_line = f.readline()
+        if not header_line.strip():
+            raise LogError(f"{source}:1: empty file or no header line")
+        header = [h.strip() for h in header_line.strip("\r\n").split(fmt.delimiter)]
+        usecols = _columns(header, joints, fmt, wheels, source)
+        if progress is not None:
+            progress(len(header_line.encode()))
+        line, index = 2, 0
+        decoder = Decoder(joints, fmt, source)
+        while True:
+            lines = list(itertools.islice(f, chunk_size))
+            if not lines:
+                break
+            rows = [ln for ln in lines if ln.strip()]
+            raw = _parse(rows, usecols, fmt.delimiter, source, line, lines, len(header))
+            if raw.size:
+                yield decoder.decode(raw, line if len(rows) == len(lines) else None, index)
+            if progress is not None:
+                progress(sum(map(len, lines)))
+            line, index = line + len(lines), index + len(rows)
+        if index == 0:
+            raise LogError(f"{source}: no samples after the header")
+    finally:
+        f.close()
+
+
+def load_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat = LogFormat(), *,
+             wheels: Sequence[str] = ()) -> JointLog:
+    """A whole CSV log in memory (see :func:`read_csv`)."""
+    return concatenate(list(read_csv(path, joints, fmt, wheels=wheels)))
+
+
+def concatenate(chunks: Sequence[JointLog]) -> JointLog:
+    """Chunks of one log joined into one :class:`JointLog`."""
+    first = chunks[0]
+    heading = None if first.heading_world is None else np.concatenate([c.heading_world for c in chunks])
+    return JointLog(np.concatenate([c.time for c in chunks]), first.joints,
+                    np.concatenate([c.positions for c in chunks]), heading, first.source, first.first_line,
+                    first.first_index)
+
+
+def write_csv(path: str | os.PathLike[str], names: Sequence[str], values: np.ndarray, *,
+              fmt: str = "%.17g") -> None:
+    """Write a CSV file with header `names` and rows `values` ``(N, len(names))`` (e.g. a synthetic log)."""
+    values = np.asarray(values)
+    with open(path, "w", encoding="utf-8", newline="") as f:
+        f.write(",".join(names) + "\n")
+        row = ",".join([fmt] * len(names)) + "\n"
+        for start in range(0, len(values), 1 << 16):
+            f.write("".join(row % tuple(r) for r in values[start:start + (1 << 16)].tolist()))
+
+
+def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: Sequence[str],
+             source: str) -> list[int]:
+    seen = set()
+    for name in header:
+        if name in seen:
+            raise LogError(f"{source}:1: column '{name}' appears twice")
+        seen.add(name)
+    renamed = {c for _, c in fmt.columns}
+    for name in header:
+        wheel, dot, joint = name.rpartition(".")
+        if dot and joint in ("spin", "steer") and wheels and wheel not in wheels and name not in renamed:
+            raise LogError(f"{source}:1: column '{name}' names no wheel of the robot (wheels: {', '.join(wheels)})")
+    wanted = [fmt.time_column, *(fmt.column_of(j) for j in joints)]
+    wanted += [c for c in (fmt.heading_column, fmt.gyro_column) if c is not None]
+    for name in wanted:
+        if name not in header:
+            close = difflib.get_close_matches(name, header, n=1)
+            hint = f" (did you mean '{close[0]}'?)" if close else ""
+            raise LogError(f"{source}:1: missing column '{name}'{hint} (columns: {', '.join(header)})")
+    return [header.index(n) for n in wanted]
+
+
+def _parse(rows: list[str], usecols: list[int], delimiter: str, source: str, line: int, lines: list[str],
+           width: int) -> np.ndarray:
+    try:
+        raw = np.loadtxt(rows, delimiter=delimiter, usecols=usecols, ndmin=2, comments=None, dtype=float)
+    except ValueError:
+        raw = None
+    if raw is not None and all(ln.count(delimiter) == width - 1 for ln in (rows[0], rows[-1])):
+        return raw
+    for k, ln in enumerate(lines):  # error path: find the first bad line
+        if not ln.strip():
+            continue
+        fields = ln.strip("\r\n").split(delimiter)
+        if len(fields) != width:
+            raise LogError(f"{source}:{line + k}: expected {width} fields, got {len(fields)}")
+        for c in usecols:
+            try:
+                float(fields[c])
+            except ValueError:
+                raise LogError(f"{source}:{line + k}: field {c + 1}: cannot read {fields[c].strip()!r} as a number"
+                               ) from None
+    raise LogError(f"{source}:{line}: cannot read the rows that start here")  # pragma: no cover
+
+
+def _check_finite(log: JointLog, raw: np.ndarray) -> None:
+    bad = ~np.isfinite(raw)
+    if bad.any():
+        i, c = (int(x) for x in np.argwhere(bad)[0])
+        name = "time" if c == 0 else log.joints[c - 1] if c <= len(log.joints) else "heading"
+        raise LogError(f"{log.where(i)}: {name}: value {raw[i, c]!r} is not a finite number")
+
+
+def _cumtrapz(rate: np.ndarray, t: np.ndarray, *, start: bool) -> np.ndarray:
+    """Trapezoidal running integral of `rate` over `t`; includes the leading 0 when `start`."""
+    steps = np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(t))
+    return np.concatenate([[0.0], steps]) if start else steps
+
+
+def _quoted(names: Sequence[str]) -> str:
+    return ", ".join(f"'{n}'" for n in names)

@@ -1,0 +1,233 @@
+"""The sensed direct model over samples: joint increments from encoders to body increments, for any robot.
+
+Between two samples the no-slip equations (3.22)-(3.23), ``A(beta) q_dot = 0``, are linear in the rates, so they
+hold for the rates integrated over the interval: ``A(beta_mid) dq = 0`` with ``beta_mid`` the steering angles at
+the middle of the interval (second order in the step). The sensed joint increments are *assigned* and the others
+(the body increment ``(dx, dy, dtheta)``, unsensed wheel rates) are solved by least squares with the ranks
+method (4.9)-(4.11) (:func:`wmrkit.kinematics.linalg.solve_assigned`); the residual ``A dq`` [m] is the slip
+indicator of (4.11)/(4.82), zero when the sensors agree with rolling without slip. No division by a time step.
+
+Steering angles come from the sensed ``WHEEL.steer`` joints. A steering wheel whose steer angle is not sensed and
+that has no sensed joint is left out (a passive castor's rows never constrain the twist; an unsensed steered
+wheel only adds a constraint the other wheels may or may not pin down). Robots without sensed steering have a
+constant matrix: its solution matrix is computed once. Otherwise one solution is computed per distinct
+steering configuration in the data (quantised steering encoders give few) and gathered per sample.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import UnknownNameError, WmrkitError
+from ..kinematics.linalg import matrix_rank, solve_assigned
+from ..robot import Robot
+
+
+class SensingError(WmrkitError, ValueError):
+    """The sensed joints cannot give the robot's motion (too few sensors, unusable sensors, singular steering)."""
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class ModelIncrements:
+    """Result of :meth:`OdometryModel.increments` for N sample intervals.
+
+    ``increments_robot`` ``(N, 3)``: body increments ``(dx [m], dy [m], dtheta [rad])``; ``joint_increments``
+    ``(N, n)``: every kept wheel rate integrated over the interval (names in ``joint_names``) [rad];
+    ``residual`` ``(N, R)``: ``A dq`` per constraint row [m], the slip over the interval. ``rate_increments``
+    ``(N, n_a)``: the assigned (sensed) increments; ``twist_map`` ``(N, 3, n_a)`` or ``(3, n_a)`` (constant
+    robots): the linear map from them to ``increments_robot``, for noise propagation.
+    """
+
+    increments_robot: np.ndarray
+    joint_names: tuple[str, ...]
+    joint_increments: np.ndarray
+    residual: np.ndarray
+    rate_increments: np.ndarray
+    twist_map: np.ndarray
+
+    @property
+    def slip(self) -> np.ndarray:
+        """Norm of the residual per interval [m], the slip indicator of (4.11). ``(N,)``."""
+        return np.sqrt(np.einsum("...i,...i->...", self.residual, self.residual))
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class OdometryModel:
+    """Sensed direct model of one robot over samples (module docstring); build it with :func:`odometry_model`.
+
+    ``joints``: the log columns it reads, ``wheel.joint``; ``rate_joints``: those whose increments are assigned
+    (spins, castor steering rates); ``steer_joints``: those giving the steering configuration ``beta``.
+    """
+
+    robot: Robot
+    joints: tuple[str, ...]
+    rate_joints: tuple[str, ...]
+    steer_joints: tuple[str, ...]
+    rows: np.ndarray  # constraint rows kept
+    cols: np.ndarray  # velocity columns kept (twist first)
+    assigned: np.ndarray  # positions of rate_joints among the kept columns
+    steer_index: np.ndarray  # position of each steer joint in the robot's beta
+    solution: np.ndarray | None  # (k, n_a), constant robots only
+    residual_map: np.ndarray | None  # (R, n_a), constant robots only
+
+    @property
+    def constant(self) -> bool:
+        """True when the constraint matrix does not depend on sensed steering angles (fast path)."""
+        return self.solution is not None
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Names of the kept wheel rates (``ModelIncrements.joint_increments`` columns)."""
+        return tuple(self.robot.velocity_names[c] for c in self.cols[3:])
+
+    def increments(self, rate_increments: ArrayLike, beta_mid: ArrayLike | None = None) -> ModelIncrements:
+        """Body increments from sensed joint increments, eqs. (3.22), (4.11).
+
+        ``(N, n_a), (N, n_steer_sensed) -> ModelIncrements``: `rate_increments` [rad] in the order of
+        ``rate_joints``; `beta_mid` [rad], the steering angles of ``steer_joints`` at the middle of each
+        interval (ignored and optional for a constant model).
+        """
+        dq = np.asarray(rate_increments, dtype=float)
+        if dq.ndim != 2 or dq.shape[1] != len(self.rate_joints):
+            raise WmrkitError(f"rate_increments: expected shape (N, {len(self.rate_joints)}), got {dq.shape}")
+        if self.constant:
+            q, res, s = dq @ self.solution.T, dq @ self.residual_map.T, self.solution[:3]
+        else:
+            q, res, s = self._solve_by_configuration(dq, beta_mid)
+        return ModelIncrements(q[:, :3], self.joint_names, q[:, 3:], res, dq, s)
+
+    def from_positions(self, positions: ArrayLike) -> ModelIncrements:
+        """Increments between consecutive samples of joint positions. ``(N + 1, n_joints) -> N intervals``.
+
+        Columns in the order of ``joints``: cumulative spin angles and steering angles [rad]. Steering angles
+        are differenced modulo 2 pi (they change by less than pi between samples).
+        """
+        p = np.asarray(positions, dtype=float)
+        if p.ndim != 2 or p.shape[1] != len(self.joints):
+            raise WmrkitError(f"positions: expected shape (N + 1, {len(self.joints)}), got {p.shape}")
+        d = np.diff(p, axis=0)
+        steer_cols = [self.joints.index(j) for j in self.steer_joints]
+        d[:, steer_cols] = wrap_angle(d[:, steer_cols])
+        beta_mid = p[:-1, steer_cols] + 0.5 * d[:, steer_cols]
+        return self.increments(d[:, [self.joints.index(j) for j in self.rate_joints]], beta_mid)
+
+    def matrices(self, beta: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Solution and residual maps at steering angles `beta` of ``steer_joints``.
+
+        ``(..., n_steer_sensed) -> (..., k, n_a), (..., R, n_a)``: ``q = S @ dq``, ``A q = Rm @ dq``.
+        """
+        if self.constant:
+            return self.solution, self.residual_map
+        beta = np.asarray(beta, dtype=float)
+        full = np.broadcast_to(self.robot.beta, (*beta.shape[:-1], len(self.robot.steer_names))).copy()
+        full[..., self.steer_index] = beta
+        return _solution_maps(self.robot, full, self.rows, self.cols, self.assigned)
+
+    def _solve_by_configuration(self, dq: np.ndarray, beta_mid: ArrayLike | None) -> tuple[np.ndarray, ...]:
+        if beta_mid is None:
+            raise WmrkitError(f"beta_mid: robot '{self.robot.name}' steers; the steering angles are needed")
+        beta = np.asarray(beta_mid, dtype=float)
+        if beta.shape != (dq.shape[0], len(self.steer_joints)):
+            raise WmrkitError(f"beta_mid: expected shape ({dq.shape[0]}, {len(self.steer_joints)}), got {beta.shape}")
+        if beta.shape[1] == 1:
+            configs, index = np.unique(beta[:, 0], return_inverse=True)
+            configs = configs[:, None]
+        else:
+            configs, index = np.unique(beta, axis=0, return_inverse=True)
+        index = index.reshape(-1)
+        s, rm = self.matrices(configs)
+        bad = ~_twist_determined(self.robot, configs, self)
+        if np.any(bad):
+            i = int(np.flatnonzero(bad[index])[0])
+            angles = ", ".join(f"{j}={np.degrees(b):.4g} deg" for j, b in zip(self.steer_joints, beta[i], strict=True))
+            raise SensingError(f"interval {i}: the sensed joints do not determine the motion at steering {angles}")
+        s_n = s[index]
+        return np.einsum("nka,na->nk", s_n, dq), np.einsum("nra,na->nr", rm[index], dq), s_n[:, :3]
+
+
+def odometry_model(robot: Robot, sensed: Sequence[str] | None = None) -> OdometryModel:
+    """The sensed direct model of `robot` over samples (ranks method, eqs. (4.9)-(4.11); module docstring).
+
+    `sensed`: joints ``wheel.joint`` the log provides (default ``robot.sensed``). Raises :class:`SensingError`
+    when they cannot give the motion, :class:`UnknownNameError` for a name the robot lacks.
+    """
+    sensed = tuple(robot.sensed if sensed is None else sensed)
+    for name in sensed:
+        wheel_name, _, joint = name.partition(".")
+        wheel = robot.wheel(wheel_name)
+        if joint not in wheel.kind.joints:
+            raise UnknownNameError(f"wheel '{wheel_name}' of robot '{robot.name}' has no joint '{joint}' "
+                                   f"(joints: {', '.join(wheel.kind.joints)})")
+    if len(set(sensed)) != len(sensed):
+        twice = sorted({s for s in sensed if sensed.count(s) > 1})
+        raise SensingError(f"sensed joints listed twice: {', '.join(twice)}")
+    rows, cols, row, col = [], list(range(3)), 0, 3
+    rate_joints, steer_joints, steer_index = [], [], []
+    for wheel in robot.wheels:
+        n_rows, n_rates = 2 * len(wheel.elements()), len(wheel.kind.rates)
+        mine = [s for s in sensed if s.partition(".")[0] == wheel.name]
+        steer = f"{wheel.name}.steer"
+        if wheel.kind.steers and steer not in mine and mine:
+            raise SensingError(f"wheel '{wheel.name}' steers but '{steer}' is not sensed, so {', '.join(mine)} "
+                               "cannot be used; sense the steering angle or leave the wheel out")
+        if wheel.kind.steers and steer in mine:
+            steer_joints.append(steer)
+            steer_index.append(robot.steer_names.index(wheel.name))
+        if not wheel.kind.steers or mine:
+            rows += range(row, row + n_rows)
+            cols += range(col, col + n_rates)
+            rate_joints += [s for s in mine if s.partition(".")[2] in wheel.kind.rates]
+        row, col = row + n_rows, col + n_rates
+    cols_a = np.array(cols)
+    assigned = np.array([cols.index(robot.velocity_index(j)) for j in rate_joints], dtype=int)
+    joints = tuple(dict.fromkeys([*rate_joints, *steer_joints]))
+    model = OdometryModel(robot, joints, tuple(rate_joints), tuple(steer_joints), np.array(rows), cols_a, assigned,
+                          np.array(steer_index, dtype=int), None, None)
+    if steer_joints:
+        return model
+    if not _twist_determined(robot, robot.beta[None, :], model)[0]:
+        raise SensingError(f"the sensed joints of robot '{robot.name}' ({', '.join(sensed) or 'none'}) do not "
+                           "determine its motion")
+    s, rm = _solution_maps(robot, robot.beta, model.rows, model.cols, model.assigned)
+    return OdometryModel(robot, joints, tuple(rate_joints), (), model.rows, cols_a, assigned,
+                         model.steer_index, _frozen(s), _frozen(rm))
+
+
+def wrap_angle(angle: ArrayLike) -> np.ndarray:
+    """`angle` [rad] wrapped into ``[-pi, pi)``. ``(...) -> (...)``."""
+    return (np.asarray(angle, dtype=float) + np.pi) % (2 * np.pi) - np.pi
+
+
+def _kept_matrix(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    a = robot.constraint_matrix(beta_full)
+    return a[..., rows, :][..., cols]
+
+
+def _solution_maps(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+                   assigned: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(S, Rm)`` from (4.11) for each configuration: solve_assigned on the unit vectors of the assigned rates."""
+    a = _kept_matrix(robot, beta_full, rows, cols)
+    n_a = len(assigned)
+    q, res = solve_assigned(a[..., None, :, :], assigned, np.eye(n_a))  # (..., n_a, k), (..., n_a, R)
+    return np.swapaxes(q, -1, -2), np.swapaxes(res, -1, -2)
+
+
+def _twist_determined(robot: Robot, beta_full: np.ndarray, model: OdometryModel) -> np.ndarray:
+    """Whether the free columns fix the twist: rank(A_free) = rank(A_free without the twist) + 3. ``(U,)``."""
+    if model.steer_joints:
+        full = np.broadcast_to(robot.beta, (len(beta_full), len(robot.steer_names))).copy()
+        full[:, model.steer_index] = beta_full
+        beta_full = full
+    a = _kept_matrix(robot, beta_full, model.rows, model.cols)
+    free = np.setdiff1d(np.arange(a.shape[-1]), model.assigned)
+    return matrix_rank(a[..., free]) == matrix_rank(a[..., free[3:]]) + 3
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a)
+    a.setflags(write=False)
+    return a

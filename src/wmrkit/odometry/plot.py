@@ -1,0 +1,39 @@
+"""Trajectory plots (matplotlib, no display needed): paths from above with start and end marked."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..errors import WmrkitError
+
+
+def save_trajectory_plot(path: str | os.PathLike[str], trajectories: Mapping[str, np.ndarray], *,
+                         title: str = "odometry") -> None:
+    """Draw planar paths ``{label: poses (N, 3)}`` [m] from above, equal axes, to `path` (.png, .svg, .pdf)."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    suffix = os.fspath(path).rsplit(".", 1)[-1].lower()
+    if suffix not in ("png", "svg", "pdf"):
+        raise WmrkitError(f"{os.fspath(path)}: plot files are .png, .svg or .pdf")
+    fig, ax = plt.subplots(figsize=(6, 6))
+    try:
+        for label, poses in trajectories.items():
+            p = np.asarray(poses, dtype=float)
+            (line,) = ax.plot(p[:, 0], p[:, 1], label=label, lw=1.2)
+            ax.plot(p[0, 0], p[0, 1], "o", color=line.get_color(), ms=5)
+            ax.plot(p[-1, 0], p[-1, 1], "s", color=line.get_color(), ms=5)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_title(title)
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="best", fontsize="small")
+        fig.savefig(path, dpi=120, bbox_inches="tight")
+    finally:
+        plt.close(fig)

@@ -1,0 +1,219 @@
+"""Synthetic sensor logs: drive a robot along a known path and record what its encoders would read.
+
+The path is a piecewise-constant body twist (:class:`TwistProfile`). The true pose is its exact integral
+(constant-twist SE(2) steps on a fine grid that contains every segment boundary), and the joint positions come
+from the robot's own no-slip equations (3.22) solved with the twist assigned (4.11). Steerable (and double)
+wheels point along the velocity of their steering joint (their lateral constraint, 3.11); while that velocity is
+zero they turn linearly in time to the next heading (steering while stopped). Castor angles follow their own
+kinematics, ``beta_dot`` from (3.12), integrated with ``solve_ivp``. Then the sensors: optional slip windows
+(a wheel turns ``1 + ratio`` times what rolling needs), random-walk noise on spins (variance ``per_rad * |dq|``,
+the :class:`~.covariance.JointNoise` model), Gaussian noise on steering readings, and encoder quantisation.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import WmrkitError
+from ..kinematics.linalg import solve_assigned
+from ..robot import Robot
+from ..wheels import wheel_slip_rows
+from .encoders import AbsoluteEncoder, Encoder, IncrementalEncoder
+from .integrators import integrate_increments
+from .logs import JointLog
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class TwistProfile:
+    """Piecewise-constant body twist: segment ``durations`` ``(S,)`` [s] and ``twists`` ``(S, 3)``
+    ``(vx [m/s], vy [m/s], omega [rad/s])`` of the robot frame, from time 0."""
+
+    durations: np.ndarray
+    twists: np.ndarray
+
+    @classmethod
+    def from_segments(cls, segments: Sequence[tuple[float, float, float, float]]) -> TwistProfile:
+        """From ``(duration, vx, vy, omega)`` rows."""
+        a = np.asarray(segments, dtype=float).reshape(-1, 4)
+        if np.any(a[:, 0] <= 0):
+            raise WmrkitError("every segment needs a duration > 0 s")
+        return cls(a[:, 0], a[:, 1:])
+
+    @property
+    def boundaries(self) -> np.ndarray:
+        """Segment start times and the end time ``(S + 1,)`` [s]."""
+        return np.concatenate([[0.0], np.cumsum(self.durations)])
+
+    @property
+    def duration(self) -> float:
+        """Total duration [s]."""
+        return float(self.durations.sum())
+
+    def at(self, t: ArrayLike) -> np.ndarray:
+        """Twist at times `t` ``(...) -> (..., 3)``; a segment holds on ``[start, end)``, the last also at its end."""
+        i = np.searchsorted(self.boundaries, np.asarray(t, dtype=float), side="right") - 1
+        return self.twists[np.clip(i, 0, len(self.durations) - 1)]
+
+    def about(self, point_robot: ArrayLike) -> TwistProfile:
+        """The same motion given as the twist of `point_robot` ``(x, y)`` [m]: the robot-origin twists.
+
+        ``v_origin = v_point + omega x (origin - point)`` (rigid body; thesis (3.1)).
+        """
+        px, py = (float(v) for v in point_robot)
+        tw = self.twists.copy()
+        tw[:, 0] += tw[:, 2] * py
+        tw[:, 1] -= tw[:, 2] * px
+        return TwistProfile(self.durations, tw)
+
+
+def square_path(side: float, *, speed: float = 0.5, turn_rate: float = 0.5, clockwise: bool = False,
+                pause: float = 0.0) -> TwistProfile:
+    """A closed square: four times (straight `side` [m] at `speed`, turn 90 deg in place at `turn_rate`), with an
+    optional stop of `pause` [s] between segments (time for steered wheels to turn). Counter-clockwise unless
+    `clockwise` (the two runs of the classic square-path benchmark)."""
+    w = -turn_rate if clockwise else turn_rate
+    seg = [(side / speed, speed, 0.0, 0.0), (math.pi / 2 / turn_rate, 0.0, 0.0, w)]
+    if pause > 0:
+        seg = [seg[0], (pause, 0.0, 0.0, 0.0), seg[1], (pause, 0.0, 0.0, 0.0)]
+    return TwistProfile.from_segments(seg * 4)
+
+
+@dataclass(frozen=True, slots=True)
+class Slip:
+    """Wheel slip: joint `joint` turns ``1 + ratio`` times what rolling needs during ``[start, stop)`` [s]."""
+
+    joint: str
+    start: float
+    stop: float
+    ratio: float
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class SyntheticRun:
+    """A simulated run: ``log`` (what the sensors report, angles), ``truth`` ``(N, 3)`` true poses at the sample
+    times, ``true_positions`` ``(N, n)`` exact joint positions, ``counts``: raw encoder readings by joint (as the
+    counters show them, wrapped) for the joints that have an encoder."""
+
+    log: JointLog
+    truth: np.ndarray
+    true_positions: np.ndarray
+    counts: Mapping[str, np.ndarray]
+
+
+def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLike = (0.0, 0.0, 0.0),
+             sensed: Sequence[str] | None = None, encoders: Mapping[str, Encoder] | None = None,
+             spin_noise_per_rad: float = 0.0, steer_noise: float = 0.0, slips: Sequence[Slip] = (),
+             oversample: int = 8, seed: int = 0) -> SyntheticRun:
+    """Drive `robot` along `profile` and record its sensed joints at `rate` [Hz] (module docstring).
+
+    `sensed` defaults to ``robot.sensed``. `encoders` quantise the named joints (spins: floor of the count,
+    steering: nearest reading). `spin_noise_per_rad` [rad^2/rad], `steer_noise` [rad] (standard deviation).
+    `oversample`: fine steps per sample interval for the joint kinematics. Deterministic for a given `seed`.
+    """
+    sensed = tuple(robot.sensed if sensed is None else sensed)
+    n = math.floor(profile.duration * rate + 1e-9) + 1
+    t_samples = np.arange(n) / rate
+    fine = np.union1d(np.linspace(0.0, t_samples[-1], (n - 1) * oversample + 1),
+                      profile.boundaries[profile.boundaries <= t_samples[-1]])
+    sample_idx = np.searchsorted(fine, t_samples)
+    dt = np.diff(fine)
+    twist = profile.at(0.5 * (fine[:-1] + fine[1:]))  # (M, 3)
+    beta_nodes = _steering(robot, profile, fine, twist)  # (M + 1, n_steer)
+    beta_mid = 0.5 * (beta_nodes[:-1] + beta_nodes[1:])
+    a = robot.constraint_matrix(beta_mid) if robot.steer_names else robot.constraint_matrix()
+    q, res = solve_assigned(a, [0, 1, 2], twist * dt[:, None])
+    bad = np.max(np.abs(res), axis=-1) > 1e-9 * max(1.0, float(np.max(np.abs(twist * dt[:, None]))))
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise WmrkitError(f"profile: at t = {fine[k]:.6g} s the twist {twist[k].tolist()} is not possible for "
+                          f"robot '{robot.name}' without slip (its fixed wheels forbid it)")
+    names = robot.velocity_names
+    rates = q[:, 3:]
+    truth = np.vstack([np.asarray(pose0, float)[None], integrate_increments(pose0, twist * dt[:, None], "exact")])
+    rng = np.random.default_rng(seed)
+    true_pos, meas_pos = {}, {}
+    for joint in sensed:
+        wheel, _, kind = joint.partition(".")
+        if kind == "steer" and robot.wheel(wheel).kind.steers:
+            b = beta_nodes[:, robot.steer_names.index(wheel)][sample_idx]
+            true_pos[joint] = b
+            meas_pos[joint] = b + (rng.normal(0.0, steer_noise, n) if steer_noise > 0 else 0.0)
+            continue
+        inc = rates[:, names.index(joint) - 3]
+        true_pos[joint] = np.concatenate([[0.0], np.cumsum(inc)])[sample_idx]
+        for s in slips:
+            if s.joint == joint:
+                mid = 0.5 * (fine[:-1] + fine[1:])
+                inc = np.where((mid >= s.start) & (mid < s.stop), inc * (1.0 + s.ratio), inc)
+        if spin_noise_per_rad > 0:
+            inc = inc + rng.normal(size=inc.shape) * np.sqrt(spin_noise_per_rad * np.abs(inc))
+        meas_pos[joint] = np.concatenate([[0.0], np.cumsum(inc)])[sample_idx]
+    counts = {}
+    for joint, enc in (encoders or {}).items():
+        if joint not in meas_pos:
+            raise WmrkitError(f"encoders: '{joint}' is not a sensed joint ({', '.join(sensed)})")
+        if isinstance(enc, IncrementalEncoder):
+            raw = enc.quantize(meas_pos[joint])
+            meas_pos[joint] = raw * enc.radians_per_count
+            counts[joint] = enc.wrap(raw)
+        elif isinstance(enc, AbsoluteEncoder):
+            counts[joint] = enc.quantize(meas_pos[joint])
+            meas_pos[joint] = enc.angle(counts[joint])
+    log = JointLog(t_samples, sensed, np.column_stack([meas_pos[j] for j in sensed]), source="<synthetic>")
+    return SyntheticRun(log, truth[sample_idx], np.column_stack([true_pos[j] for j in sensed]), counts)
+
+
+def _steering(robot: Robot, profile: TwistProfile, fine: np.ndarray, twist: np.ndarray) -> np.ndarray:
+    """Steering angles at the fine nodes ``(M + 1, n_steer)``: geometric for steerable/double, ODE for castors."""
+    out = np.empty((len(fine), len(robot.steer_names)))
+    for k, name in enumerate(robot.steer_names):
+        wheel = robot.wheel(name)
+        if wheel.type in ("castor", "double_castor"):
+            out[:, k] = _castor_angles(wheel, profile, fine)
+            continue
+        x, y = wheel.position
+        vx, vy = twist[:, 0] - twist[:, 2] * y, twist[:, 1] + twist[:, 2] * x  # steering joint velocity
+        moving = np.hypot(vx, vy) > 1e-12
+        b = np.arctan2(vx, -vy)  # axle (cos b, sin b) normal to v, positive spin along v (3.11)
+        b = wheel.beta + (b - wheel.beta + np.pi / 2) % np.pi - np.pi / 2  # within 90 deg of the described angle
+        out[:, k] = _nodes_from_intervals(np.where(moving, b, np.nan), fine, wheel.beta)
+    return out
+
+
+def _nodes_from_intervals(b: np.ndarray, fine: np.ndarray, default: float) -> np.ndarray:
+    """Node values: the angle of the interval after (or before) each node; linear in time across stops."""
+    nodes = np.concatenate([b, b[-1:]])
+    before = np.concatenate([b[:1], b])
+    nodes = np.where(np.isnan(nodes), before, nodes)
+    ok = ~np.isnan(nodes)
+    if not ok.any():
+        return np.full(len(fine), default)
+    return np.interp(fine, fine[ok], nodes[ok])
+
+
+def _castor_angles(wheel, profile: TwistProfile, fine: np.ndarray) -> np.ndarray:
+    from scipy.integrate import solve_ivp
+
+    beta = np.empty(len(fine))
+    beta[0] = wheel.beta
+    bounds = profile.boundaries
+    for s in range(len(profile.durations)):
+        mask = (fine >= bounds[s]) & (fine <= bounds[s + 1])
+        idx = np.flatnonzero(mask)
+        if len(idx) < 2:
+            continue
+        tw = profile.twists[s]
+
+        def rhs(_t, b, tw=tw):
+            rows = wheel_slip_rows(wheel, b[0])  # (2E, 3 + n_rates): steer rate is the first rate column
+            rates = np.linalg.lstsq(rows[:, 3:], -rows[:, :3] @ tw, rcond=None)[0]
+            return [rates[0]]
+
+        sol = solve_ivp(rhs, (fine[idx[0]], fine[idx[-1]]), [beta[idx[0]]], t_eval=fine[idx], rtol=1e-10, atol=1e-12)
+        beta[idx] = sol.y[0]
+    return beta

@@ -1,0 +1,128 @@
+"""Trajectories: poses over time with the slip indicator and covariance; CSV and TUM files, written in chunks.
+
+TUM is the format trajectory-evaluation tools (``evo``, the TUM RGB-D benchmark scripts) read: one line per pose,
+``timestamp tx ty tz qx qy qz qw``, space separated; a planar pose has ``tz = 0`` and the quaternion of a rotation
+``theta`` about z, ``(0, 0, sin(theta/2), cos(theta/2))``.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import IO, Literal
+
+import numpy as np
+
+from .logs import LogError
+
+TrajectoryFormat = Literal["csv", "tum"]
+#: Covariance entries written to CSV, in this order (upper triangle of the (x, y, theta) covariance).
+COV_COLUMNS = ("cov_xx", "cov_xy", "cov_xtheta", "cov_yy", "cov_ytheta", "cov_thetatheta")
+_TRIU = np.triu_indices(3)
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class Trajectory:
+    """Poses at sample times: ``time`` ``(N,)`` [s], ``poses`` ``(N, 3)`` ``(x [m], y [m], theta [rad])`` in the
+    world frame (theta continuous, not wrapped); ``slip`` ``(N,)`` [m], the residual norm of the interval ending
+    at each sample (0 at the first); ``covariance`` ``(N, 3, 3)`` or None.
+    """
+
+    time: np.ndarray
+    poses: np.ndarray
+    slip: np.ndarray
+    covariance: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return len(self.time)
+
+    @property
+    def final_pose(self) -> np.ndarray:
+        """The last pose ``(3,)``."""
+        return self.poses[-1]
+
+
+def quaternion_z(theta: np.ndarray) -> np.ndarray:
+    """Unit quaternion ``(qx, qy, qz, qw)`` of a rotation `theta` [rad] about z. ``(...) -> (..., 4)``."""
+    theta = np.asarray(theta, dtype=float)
+    z = np.zeros_like(theta)
+    return np.stack([z, z, np.sin(theta / 2), np.cos(theta / 2)], axis=-1)
+
+
+def yaw_of_quaternion(q: np.ndarray) -> np.ndarray:
+    """Yaw [rad] of quaternions ``(qx, qy, qz, qw)`` (ZYX convention). ``(..., 4) -> (...)``."""
+    q = np.asarray(q, dtype=float)
+    x, y, z, w = (q[..., i] for i in range(4))
+    return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+class TrajectoryWriter:
+    """Writes a trajectory to a CSV (``time,x,y,theta,slip[,cov_...]``) or TUM file chunk by chunk.
+
+    Use as a context manager; ``write`` appends a :class:`Trajectory` chunk.
+    """
+
+    def __init__(self, path: str | os.PathLike[str], fmt: TrajectoryFormat, *, covariance: bool = False) -> None:
+        if fmt not in ("csv", "tum"):
+            raise LogError(f"unknown trajectory format '{fmt}' (formats: csv, tum)")
+        self.path, self.fmt, self.covariance = os.fspath(path), fmt, covariance
+        try:
+            self._f: IO[str] = open(self.path, "w", encoding="utf-8", newline="")
+        except OSError as err:
+            raise LogError(f"{self.path}: cannot write: {err.strerror}") from None
+        if fmt == "csv":
+            self._f.write(",".join(("time", "x", "y", "theta", "slip", *(COV_COLUMNS if covariance else ()))) + "\n")
+        else:
+            self._f.write("# timestamp tx ty tz qx qy qz qw\n")
+
+    def write(self, chunk: Trajectory) -> None:
+        """Append the poses of `chunk`."""
+        if self.fmt == "csv":
+            cols = [chunk.time[:, None], chunk.poses, chunk.slip[:, None]]
+            if self.covariance:
+                cols.append(chunk.covariance[:, _TRIU[0], _TRIU[1]])
+            values, row = np.hstack(cols), "%.9f," + ",".join(["%.12g"] * (4 + 6 * self.covariance)) + "\n"
+        else:
+            z = np.zeros((len(chunk), 1))
+            values = np.hstack([chunk.time[:, None], chunk.poses[:, :2], z, quaternion_z(chunk.poses[:, 2])])
+            row = "%.9f " + " ".join(["%.12g"] * 7) + "\n"
+        self._f.write("".join(row % tuple(r) for r in values.tolist()))
+
+    def close(self) -> None:
+        """Close the file."""
+        self._f.close()
+
+    def __enter__(self) -> TrajectoryWriter:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def write_trajectory(path: str | os.PathLike[str], trajectory: Trajectory, fmt: TrajectoryFormat) -> None:
+    """Write a whole trajectory as CSV or TUM (see :class:`TrajectoryWriter`)."""
+    with TrajectoryWriter(path, fmt, covariance=trajectory.covariance is not None) as w:
+        w.write(trajectory)
+
+
+def read_tum(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
+    """A TUM file's times ``(N,)`` [s] and planar poses ``(N, 3)`` (yaw from the quaternion, z ignored)."""
+    data = np.loadtxt(path, comments="#", ndmin=2)
+    if data.shape[1] != 8:
+        raise LogError(f"{os.fspath(path)}: a TUM file has 8 columns, got {data.shape[1]}")
+    return data[:, 0], np.column_stack([data[:, 1], data[:, 2], np.unwrap(yaw_of_quaternion(data[:, 4:8]))])
+
+
+def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
+    """A trajectory CSV written by :class:`TrajectoryWriter` (covariance restored when present)."""
+    with open(path, encoding="utf-8") as f:
+        header = f.readline().strip().split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    if header[:5] != ["time", "x", "y", "theta", "slip"]:
+        raise LogError(f"{os.fspath(path)}:1: expected the columns time,x,y,theta,slip, got {','.join(header)}")
+    cov = None
+    if len(header) == 11:
+        cov = np.zeros((len(data), 3, 3))
+        cov[:, _TRIU[0], _TRIU[1]] = data[:, 5:]
+        cov = cov + np.swapaxes(np.triu(cov, 1), -1, -2)
+    return Trajectory(data[:, 0], data[:, 1:4], data[:, 4], cov)
