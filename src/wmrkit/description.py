@@ -192,36 +192,88 @@ def load_robot_file(path: str | os.PathLike[str]) -> Robot:
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as err:
-        raise DescriptionError(f"cannot read the file ({err.__class__.__name__}: {err.strerror or err})",
-                               source=source) from None
+        reason = getattr(err, "strerror", None) or err  # UnicodeDecodeError has no strerror
+        raise DescriptionError(f"cannot read the file ({err.__class__.__name__}: {reason})", source=source) from None
     return robot_from_text(text, source=source, fmt="json" if path.suffix.lower() == ".json" else "yaml")
 
 
 def robot_from_text(text: str, *, source: str, fmt: str = "yaml") -> Robot:
     """Parse description `text` (``fmt`` "yaml" or "json") into a :class:`Robot`."""
+    data = _parse(text, source, fmt)
+    root = _compose(text)
+    _reject_duplicate_keys(root, source)
+    return robot_from_dict(data, source=source, line_of=_line_finder(root))
+
+
+def _parse(text: str, source: str, fmt: str) -> Any:
     if fmt == "json":
         try:
-            data = json.loads(text)
+            return json.loads(text)
         except json.JSONDecodeError as err:
             raise DescriptionError(f"malformed JSON: {err.msg} (column {err.colno})", source=source,
                                    line=err.lineno) from None
-    else:
-        try:
-            data = yaml.safe_load(text)
-        except yaml.YAMLError as err:
-            mark = getattr(err, "problem_mark", None)
-            problem = getattr(err, "problem", None) or str(err).splitlines()[0]
-            raise DescriptionError(f"malformed YAML: {problem}", source=source,
-                                   line=None if mark is None else mark.line + 1) from None
-    return robot_from_dict(data, source=source, line_of=_line_finder(text))
-
-
-def _line_finder(text: str) -> LineOf:
-    """Map a field location to its 1-based line, from the YAML node tree (JSON is YAML enough for this)."""
+        except (ValueError, RecursionError) as err:  # integers of > 4300 digits, nesting too deep
+            raise DescriptionError(f"malformed JSON: {str(err).splitlines()[0]}", source=source) from None
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError:
-        root = None
+        loader = _SafeLoader(text)  # the reader already rejects some characters
+        try:
+            return loader.get_single_data()
+        finally:
+            loader.dispose()
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+        raise DescriptionError(f"malformed YAML: {problem}", source=source,
+                               line=None if mark is None else mark.line + 1) from None
+    except RecursionError:
+        raise DescriptionError("malformed YAML: nesting too deep", source=source) from None
+
+
+class _SafeLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` whose constructors fail with a located YAML error, never a bare ValueError."""
+
+    def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
+        try:
+            return super().construct_object(node, deep=deep)
+        except (ValueError, TypeError, KeyError, AttributeError, OverflowError) as err:  # e.g. "2020-13-45"
+            what = repr(node.value[:40]) if isinstance(node.value, str) else "this node"
+            raise yaml.constructor.ConstructorError(
+                None, None, f"cannot read {what} as {node.tag.rsplit(':', 1)[-1]} ({err})", node.start_mark
+            ) from None
+
+
+def _compose(text: str) -> yaml.Node | None:
+    """The YAML node tree of `text` (JSON is YAML enough for this), or None."""
+    try:
+        return yaml.compose(text, Loader=yaml.SafeLoader)
+    except (yaml.YAMLError, RecursionError):
+        return None
+
+
+def _reject_duplicate_keys(root: yaml.Node | None, source: str) -> None:
+    """YAML and JSON parsers keep the last of two equal keys; a description must not say a field twice."""
+    seen: set[int] = set()
+    stack: list[tuple[yaml.Node | None, Loc]] = [(root, ())]
+    while stack:
+        node, loc = stack.pop()
+        if node is None or id(node) in seen:
+            continue
+        seen.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            keys: set[str] = set()
+            for k, v in node.value:
+                if isinstance(k, yaml.ScalarNode) and k.value != "<<":
+                    if k.value in keys:
+                        raise DescriptionError(f"field '{k.value}' given twice", source=source, loc=(*loc, k.value),
+                                               line=k.start_mark.line + 1)
+                    keys.add(k.value)
+                stack.append((v, (*loc, k.value) if isinstance(k, yaml.ScalarNode) else loc))
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend((v, (*loc, i)) for i, v in enumerate(node.value))
+
+
+def _line_finder(root: yaml.Node | None) -> LineOf:
+    """Map a field location to its 1-based line in the node tree `root`."""
 
     def line_of(loc: Loc) -> int | None:
         node, line = root, None

@@ -18,6 +18,10 @@ class UnknownNameError(WmrkitError, LookupError):
         return str(self.args[0]) if self.args else ""
 
 
+#: Every character ``str.splitlines`` breaks at, escaped so that a message stays on one line.
+_ONE_LINE = str.maketrans({c: repr(c)[1:-1] for c in "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"})
+
+
 class DescriptionError(WmrkitError, ValueError):
     """A robot description is wrong at a known place: file, wheel, field.
 
@@ -33,7 +37,8 @@ class DescriptionError(WmrkitError, ValueError):
     def _format(self) -> str:
         where = self.source if self.line is None else f"{self.source}:{self.line}"
         path = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in self.loc).lstrip(".")
-        return f"{where}: {path}: {self.message}" if path else f"{where}: {self.message}"
+        text = f"{where}: {path}: {self.message}" if path else f"{where}: {self.message}"
+        return text.translate(_ONE_LINE)  # names and values quoted from a file may hold line breaks
 
     def __str__(self) -> str:
         return self._format()

@@ -35,7 +35,10 @@ def parse_quantity(value: object, kind: Kind) -> float:
     if isinstance(value, bool):
         raise UnitError(f"expected {_a(kind)}, got a boolean")
     if isinstance(value, int | float):
-        number, factor = float(value), 1.0
+        try:
+            number, factor = float(value), 1.0
+        except OverflowError:
+            raise UnitError(f"expected {_a(kind)}, got an integer too large for a float") from None
     elif isinstance(value, str):
         match = _QUANTITY.match(value)
         if match is None:

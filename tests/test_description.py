@@ -1,0 +1,385 @@
+"""Description files: every bad input gives one located line; valid ones load, save and load back unchanged."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from hypothesis import given
+from hypothesis import strategies as st
+
+from wmrkit import KINDS, DescriptionError, Robot, Wheel, parse_quantity
+from wmrkit.description import robot_from_text
+from wmrkit.units import UnitError
+
+DOC = Path(__file__).resolve().parents[1] / "docs" / "description-format.md"
+SRC = "robots/test.yaml"
+BASE = """\
+name: test-bot
+wheels:
+  - name: left
+    type: fixed
+    position: [0, 0.3]
+    beta: 90 deg
+    r: 0.1
+    actuated: [spin]
+  - name: caster
+    type: castor
+    l: 0.5
+    alpha: 180 deg
+    d: 0.05
+    r: 0.04
+  - name: omni
+    type: swedish
+    position: [0.2, -0.1]
+    beta: 0
+    gamma: 90 deg
+    r: 0.05
+    r_r: 0.01
+"""
+TYPES = ", ".join(KINDS)
+LENGTHS = "m, mm, cm, dm, km, in, ft"
+
+# (find, replace with, expected 1-based line, expected message after "file:line: "); BASE's lines counted by hand
+BAD = {
+    "malformed-yaml": ("type: fixed", "type: fixed: x", 4, "malformed YAML: mapping values are not allowed here"),
+    "unknown-type": ("type: castor", "type: castr", 10,
+                     f"wheels[1].type: unknown wheel type 'castr' (did you mean 'castor'?) (types: {TYPES})"),
+    "unknown-field": ("alpha: 180 deg", "alpah: 180 deg", 12,
+                      "wheels[1].alpah: unknown field 'alpah' (did you mean 'alpha'?)"),
+    "unknown-top-field": ("name: test-bot", "nmae: test-bot", 1, "nmae: unknown field 'nmae' (did you mean 'name'?)"),
+    "field-not-for-type": ("    r: 0.1\n", "    r: 0.1\n    d: 0.1\n", 8,
+                           "wheels[0].d: field 'd' does not apply to a fixed wheel"),
+    "duplicate-name": ("name: caster", "name: left", 9, "wheels[1].name: duplicate wheel name 'left'"),
+    "duplicate-key": ("    r: 0.1\n", "    r: 0.1\n    r: 0.2\n", 8, "wheels[0].r: field 'r' given twice"),
+    "zero-radius": ("r: 0.1", "r: 0", 7, "wheels[0].r: must be > 0, got 0.0 m"),
+    "negative-radius": ("r: 0.1", "r: -0.1", 7, "wheels[0].r: must be > 0, got -0.1 m"),
+    "negative-roller": ("r_r: 0.01", "r_r: -1 mm", 21, "wheels[2].r_r: must be > 0, got -0.001 m"),
+    "nan": ("r: 0.1", "r: .nan", 7, "wheels[0].r: must be finite, got nan"),
+    "inf": ("r: 0.1", "r: .inf", 7, "wheels[0].r: must be finite, got inf"),
+    "minus-inf": ("beta: 90 deg", "beta: -.inf", 6, "wheels[0].beta: must be finite, got -inf"),
+    "unknown-unit": ("r: 0.1", "r: 10 furlong", 7,
+                     f"wheels[0].r: unknown unit 'furlong' in '10 furlong' (accepted: {LENGTHS})"),
+    "angle-in-mm": ("beta: 90 deg", "beta: 90 mm", 6, "wheels[0].beta: '90 mm' is a length, expected an angle"),
+    "length-in-deg": ("d: 0.05", "d: 5 deg", 13, "wheels[1].d: '5 deg' is an angle, expected a length"),
+    "not-a-number": ("r: 0.1", "r: big", 7,
+                     "wheels[0].r: cannot read 'big' as a length (write e.g. '0.25' or '250 mm')"),
+    "boolean": ("r: 0.1", "r: yes", 7, "wheels[0].r: expected a length, got a boolean"),
+    "castor-d-zero": ("d: 0.05", "d: 0", 13,
+                      "wheels[1].d: a castor needs an offset d != 0 (with d = 0 it is a 'steerable' wheel)"),
+    "castor-delta-90": ("d: 0.05", "delta: 90 deg\n    d: 0.05", 13,
+                        "wheels[1].delta: a castor with delta = +-90 deg has its axle along the arm and cannot steer "
+                        "itself (det J_c = -r d cos(delta) = 0, eq. 3.19)"),
+    "swedish-gamma-zero": ("gamma: 90 deg", "gamma: 0", 19,
+                           "wheels[2].gamma: a Swedish wheel with gamma = 0 (or 180 deg) has rollers parallel to the "
+                           "axle and does not roll (det J_s = r r_r sin(gamma) = 0, eq. 3.19); omni: 90 deg, Mecanum: "
+                           "45 deg"),
+    "swedish-gamma-180": ("gamma: 90 deg", "gamma: 180 deg", 19, None),
+    "position-and-l": ("    position: [0, 0.3]\n", "    position: [0, 0.3]\n    l: 0.3\n", 5,
+                       "wheels[0].position: give either 'position' or 'l' and 'alpha', not both"),
+    "bad-position": ("[0, 0.3]", "[0, 0.3, 1]", 5, "wheels[0].position: must be a list [x, y] of two lengths"),
+    "joint-not-on-type": ("actuated: [spin]", "actuated: [steer]", 8,
+                          "wheels[0].actuated[0]: no joint 'steer' on a fixed wheel (joints: spin)"),
+    "bad-date": ("r: 0.1", "r: 2020-13-45", 7,
+                 "malformed YAML: cannot read '2020-13-45' as timestamp (month must be in 1..12)"),
+}
+
+
+def _line_of(text: str, fragment: str) -> int:
+    """1-based line where `fragment` starts in `text`."""
+    return text[: text.index(fragment)].count("\n") + 1
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_bad_input_gives_one_located_line(case, tmp_path):
+    find, replace, line, message = BAD[case]
+    assert BASE.count(find) == 1
+    text = BASE.replace(find, replace)
+    with pytest.raises(DescriptionError) as err:
+        robot_from_text(text, source=SRC)
+    assert err.value.line == line
+    if message is not None:
+        assert str(err.value) == f"{SRC}:{line}: {message}"
+    assert len(str(err.value).splitlines()) == 1
+    path = tmp_path / "bot.yaml"
+    path.write_text(text)
+    with pytest.raises(DescriptionError, match=rf"^{re.escape(str(path))}:{line}: "):
+        Robot.from_file(path)
+
+
+def test_missing_field_names_the_wheel_and_field():
+    text = BASE.replace("    r: 0.1\n", "")
+    with pytest.raises(DescriptionError) as err:
+        robot_from_text(text, source=SRC)
+    assert str(err.value) == f"{SRC}:3: wheels[0]: missing field 'r'"
+    with pytest.raises(DescriptionError, match=rf"^{SRC}:9: wheels\[1\]: missing field 'd'$"):
+        robot_from_text(BASE.replace("    d: 0.05\n", ""), source=SRC)
+    with pytest.raises(DescriptionError, match=rf"^{SRC}: wheels: missing field 'wheels'$"):
+        robot_from_text("name: x\n", source=SRC)
+    with pytest.raises(DescriptionError, match=rf"^{SRC}:2: wheels: must be a non-empty list of wheels$"):
+        robot_from_text("name: x\nwheels: []\n", source=SRC)
+    with pytest.raises(DescriptionError, match=rf"^{SRC}:3: wheels\[0\]: missing the wheel's place"):
+        robot_from_text(BASE.replace("    position: [0, 0.3]\n", ""), source=SRC)
+
+
+def test_malformed_json_and_json_nan():
+    with pytest.raises(DescriptionError, match=r"^bot\.json:2: malformed JSON: Expecting value \(column 13\)$"):
+        robot_from_text('{"name": "x",\n "wheels": [}', source="bot.json", fmt="json")
+    data = yaml.safe_load(BASE)
+    text = json.dumps(data, indent=1).replace('"r": 0.1', '"r": NaN')
+    with pytest.raises(DescriptionError) as err:
+        robot_from_text(text, source="bot.json", fmt="json")
+    assert str(err.value) == f"bot.json:{_line_of(text, 'NaN')}: wheels[0].r: must be finite, got nan"
+    for bad in ("Infinity", "-Infinity", "1e999", "1" * 400):
+        with pytest.raises(DescriptionError, match=r"wheels\[0\]\.r: "):
+            robot_from_text(text.replace("NaN", bad), source="bot.json", fmt="json")
+    with pytest.raises(DescriptionError, match=r"^bot\.json:\d+: wheels\[0\]\.r: field 'r' given twice$"):
+        robot_from_text(text.replace('"r": NaN', '"r": 0.1, "r": 0.2'), source="bot.json", fmt="json")
+
+
+def test_unreadable_files(tmp_path):
+    with pytest.raises(DescriptionError, match=r"cannot read the file \(FileNotFoundError"):
+        Robot.from_file(tmp_path / "none.yaml")
+    bad = tmp_path / "latin1.yaml"
+    bad.write_bytes("name: r\u00f6ver\n".encode("latin-1"))
+    with pytest.raises(DescriptionError, match=r"latin1\.yaml: cannot read the file \(UnicodeDecodeError"):
+        Robot.from_file(bad)
+
+
+def test_units_table():
+    """The units of ``units.py`` (docs/description-format.md lists the same)."""
+    cases = {("250 mm", "length"): 0.25, ("25cm", "length"): 0.25, ("1 in", "length"): 0.0254,
+             ("2 ft", "length"): 0.6096, ("0.5 km", "length"): 500.0, ("3 dm", "length"): 0.3,
+             ("90 deg", "angle"): math.pi / 2, ("90°", "angle"): math.pi / 2, ("0.25 turn", "angle"): math.pi / 2,
+             ("1500 mrad", "angle"): 1.5, ("-0.5rad", "angle"): -0.5, ("1e-3", "length"): 0.001, (3, "angle"): 3.0}
+    for (text, kind), si in cases.items():
+        assert parse_quantity(text, kind) == pytest.approx(si, rel=1e-15), text
+    for bad in ("90 deg deg", "deg", "1,5 m", "0x10", "nan", "inf m", "1e999 m", [1.0], None, True, 10**400):
+        with pytest.raises(UnitError):
+            parse_quantity(bad, "length")
+
+
+# ---- the documented format ----------------------------------------------------------------------------------------
+def _doc_blocks(lang: str) -> list[str]:
+    return re.findall(rf"^```{lang}\n(.*?)^```", DOC.read_text(), flags=re.S | re.M)
+
+
+def test_issue_example_from_the_doc_loads():
+    text = next(b for b in _doc_blocks("yaml") if b.startswith("name: tricycle-example"))
+    robot = robot_from_text(text, source="doc")
+    assert robot.wheel_names == ("rear_left", "caster", "omni")
+    rear, caster, omni = robot.wheels
+    assert (rear.type, rear.l, rear.alpha, rear.beta, rear.r) == ("fixed", 0.45, math.pi / 2, math.pi / 2, 0.23)
+    assert rear.actuated == rear.sensed == ("spin",)
+    assert (caster.type, caster.l, caster.alpha, caster.d, caster.delta, caster.r) == (
+        "castor", 0.8, math.pi, 0.05, 0.0, 0.05)
+    assert (omni.l, omni.alpha, omni.gamma, omni.r_r) == (0.3, 0.0, math.pi / 2, 0.01)
+    assert robot.velocity_names == ("vx", "vy", "omega", "rear_left.spin", "caster.steer", "caster.spin",
+                                    "omni.spin", "omni.roller")
+
+
+def test_every_doc_example_loads_and_every_doc_error_is_exact():
+    examples = [b for b in _doc_blocks("yaml") if "wheels:" in b]
+    assert len(examples) >= 3
+    errors = 0
+    for block in examples:
+        first = block.splitlines()[0]
+        if first.startswith("# file: "):  # an error example: the next ```text block is the message
+            source = first.removeprefix("# file: ")
+            expected = re.search(rf"```yaml\n{re.escape(block)}```\n+```text\n(.*?)\n```", DOC.read_text(), re.S)
+            with pytest.raises(DescriptionError) as err:
+                robot_from_text(block, source=source)
+            assert f"wmrkit: error: {err.value}" == expected.group(1)
+            errors += 1
+        else:
+            assert isinstance(robot_from_text(block, source="doc"), Robot)
+    assert errors >= 3
+    json_blocks = _doc_blocks("json")
+    assert json_blocks
+    for block in json_blocks:
+        assert isinstance(robot_from_text(block, source="doc.json", fmt="json"), Robot)
+
+
+def test_doc_lists_every_type_field_and_unit():
+    doc = DOC.read_text()
+    for name, kind in KINDS.items():
+        assert f"`{name}`" in doc
+        for field in (*kind.required, *kind.optional, *kind.joints):
+            assert f"`{field}`" in doc, (name, field)
+    from wmrkit.units import UNITS
+
+    for unit in (u for table in UNITS.values() for u in table):
+        assert f"`{unit}`" in doc, unit
+
+
+# ---- properties: random valid descriptions ------------------------------------------------------------------------
+FACTORS = {"length": {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "in": 0.0254, "ft": 0.3048},
+           "angle": {"rad": 1.0, "deg": math.pi / 180, "turn": 2 * math.pi}}
+KIND_OF = {"l": "length", "alpha": "angle", "beta": "angle", "d": "length", "delta": "angle", "gamma": "angle",
+           "r": "length", "r_r": "length", "b": "length"}
+RANGES = {"l": (0, 2), "alpha": (-3, 3), "beta": (-3, 3), "d": (0.01, 0.3), "delta": (-1.2, 1.2),
+          "gamma": (0.3, 2.8), "r": (0.01, 0.5), "r_r": (0.002, 0.05), "b": (0.01, 0.4)}
+
+
+@st.composite
+def _quantity(draw, field: str, signed: bool = False) -> tuple[object, float]:
+    """A value as written in a file (number or string with units) and its SI value."""
+    lo, hi = RANGES[field]
+    si = draw(st.floats(lo, hi)) * (draw(st.sampled_from([-1, 1])) if signed or field in ("d", "gamma") else 1)
+    if draw(st.booleans()):
+        return si, si
+    unit = draw(st.sampled_from(sorted(FACTORS[KIND_OF[field]])))
+    number = si / FACTORS[KIND_OF[field]][unit]
+    return f"{number!r}{draw(st.sampled_from(['', ' ']))}{unit}", number * FACTORS[KIND_OF[field]][unit]
+
+
+@st.composite
+def descriptions(draw) -> tuple[dict, list[dict]]:
+    """A random valid description and the SI values each wheel must get."""
+    items, expected = [], []
+    for i in range(draw(st.integers(1, 4))):
+        type_name = draw(st.sampled_from(list(KINDS)))
+        kind = KINDS[type_name]
+        item: dict = {"name": f"w{i}", "type": type_name}
+        si: dict = {"name": f"w{i}", "type": type_name}
+        if draw(st.booleans()):
+            (x, x_si), (y, y_si) = draw(_quantity("l", signed=True)), draw(_quantity("l", signed=True))
+            item["position"] = [x, y]
+            si["l"], si["alpha"] = math.hypot(x_si, y_si), math.atan2(y_si, x_si)
+        else:
+            for field in ("l", "alpha"):
+                item[field], si[field] = draw(_quantity(field))
+        for field in (*kind.required, *kind.optional):
+            if field in kind.required or draw(st.booleans()):
+                item[field], si[field] = draw(_quantity(field))
+            else:
+                si[field] = kind.optional[field]
+        for role in ("actuated", "sensed"):
+            joints = draw(st.lists(st.sampled_from(kind.joints), unique=True))
+            if joints or draw(st.booleans()):
+                item[role] = joints
+            si[role] = tuple(j for j in kind.joints if j in joints)
+        items.append(item)
+        expected.append(si)
+    data = {"name": draw(st.sampled_from(["bot", "yes", "1.5", "a robot: x"])), "wheels": items}
+    if draw(st.booleans()):
+        data["notes"] = draw(st.text(st.characters(codec="utf-8", exclude_categories=("Cs", "Cc")), max_size=20))
+    return data, expected
+
+
+@given(description=descriptions())
+def test_valid_descriptions_load_with_si_values_and_round_trip(description, tmp_path_factory):
+    data, expected = description
+    robot = Robot.from_dict(data)
+    for wheel, si in zip(robot.wheels, expected, strict=True):
+        for field, value in si.items():
+            got = getattr(wheel, field)
+            assert got == (pytest.approx(value, rel=1e-12, abs=1e-15) if isinstance(value, float) else value)
+    # the text forms of the same description give the same robot
+    assert robot_from_text(yaml.safe_dump(data, allow_unicode=True), source="t.yaml") == robot
+    assert robot_from_text(json.dumps(data), source="t.json", fmt="json") == robot
+    # saving and loading is lossless, in both formats
+    folder = tmp_path_factory.mktemp("rt")
+    for name in ("bot.yaml", "bot.json", "bot.yml"):
+        robot.to_file(folder / name)
+        assert Robot.from_file(folder / name) == robot
+    assert Robot.from_dict(robot.to_dict()) == robot
+
+
+@given(descriptions(), st.data())
+def test_line_numbers_are_one_based_and_right(description, data):
+    """Break one field of a dumped description: the error is on that field's line, found by scanning the text."""
+    doc, _ = description
+    i = data.draw(st.integers(0, len(doc["wheels"]) - 1))
+    field = data.draw(st.sampled_from(sorted(k for k in doc["wheels"][i] if k in KIND_OF)))
+    doc["wheels"][i][field] = "1 furlong"
+    text = yaml.safe_dump(doc, sort_keys=False)
+    lines = text.splitlines()
+    starts = [n for n, s in enumerate(lines) if s.startswith("- ")]
+    line = next(n for n in range(starts[i], len(lines)) if re.match(rf"^(- |  ){field}:", lines[n])) + 1
+    with pytest.raises(DescriptionError) as err:
+        robot_from_text(text, source="t.yaml")
+    assert err.value.line == line
+    assert str(err.value).startswith(f"t.yaml:{line}: wheels[{i}].{field}: unknown unit 'furlong'")
+
+
+# ---- properties: broken descriptions never raise anything but DescriptionError ------------------------------------
+_text = st.text(st.characters(codec="utf-8", exclude_categories=("Cs",)), max_size=12)
+_garbage = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.integers(10**300, 10**400) | st.floats() | _text
+    | st.sampled_from(["90 deg", "1 mm", "nan", ".inf", "1e999", "-0", "spin", "steer", "castor", "2020-01-01"]),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(_text, inner, max_size=3),
+    max_leaves=6,
+)
+
+
+def _assert_only_description_errors(load) -> None:
+    try:
+        robot = load()
+    except DescriptionError as err:
+        message = str(err)
+        assert len(message.splitlines()) == 1 and message.strip() == message
+        assert err.line is None or err.line >= 1
+    else:
+        assert isinstance(robot, Robot)
+
+
+@st.composite
+def _broken(draw) -> dict:
+    data, _ = draw(descriptions())
+    for _ in range(draw(st.integers(1, 3))):
+        wheels = data.get("wheels")
+        target = draw(st.sampled_from([data, *(wheels if isinstance(wheels, list) else [])]))
+        if not isinstance(target, dict) or not target:
+            continue
+        key = draw(st.sampled_from(sorted(target, key=str)))
+        op = draw(st.sampled_from(["drop", "rename", "retype", "add", "wheels"]))
+        if op == "drop":
+            del target[key]
+        elif op == "rename":
+            target[draw(_text)] = target.pop(key)
+        elif op == "retype":
+            target[key] = draw(_garbage)
+        elif op == "add":
+            target[draw(_text)] = draw(_garbage)
+        else:
+            old = data.get("wheels")
+            data["wheels"] = [*old, draw(_garbage)] if isinstance(old, list) and draw(st.booleans()) else draw(_garbage)
+    return data
+
+
+@given(_broken())
+def test_broken_descriptions_raise_only_description_errors(data):
+    _assert_only_description_errors(lambda: Robot.from_dict(data))
+    _assert_only_description_errors(lambda: robot_from_text(yaml.safe_dump(data, allow_unicode=True), source="b"))
+    _assert_only_description_errors(lambda: robot_from_text(json.dumps(data), source="b", fmt="json"))
+
+
+@given(st.text(max_size=300), st.sampled_from(["yaml", "json"]))
+def test_random_text_raises_only_description_errors(text, fmt):
+    _assert_only_description_errors(lambda: robot_from_text(text, source="r", fmt=fmt))
+
+
+@given(st.data())
+def test_damaged_valid_text_raises_only_description_errors(data):
+    text = yaml.safe_dump(data.draw(descriptions())[0], sort_keys=False)
+    for _ in range(data.draw(st.integers(1, 4))):
+        at = data.draw(st.integers(0, len(text)))
+        cut = data.draw(st.integers(0, 5))
+        text = text[:at] + data.draw(st.sampled_from(["", ":", "-", "[", "'", "\t", "&a", "*a", "!!", "#", "\n  "]))\
+            + text[at + cut:]
+    _assert_only_description_errors(lambda: robot_from_text(text, source="d"))
+
+
+def test_save_then_load_catalog_style_robot(tmp_path):
+    robot = Robot("r", (Wheel("a", "double_castor", l=0.3, alpha=1.0, beta=0.2, r=0.1, d=-0.05, b=0.1,
+                              actuated=("steer", "spin2")),))
+    for name in ("a.yaml", "a.json"):
+        robot.to_file(tmp_path / name)
+        assert Robot.from_file(tmp_path / name) == robot
+    assert np.isfinite(robot.constraint_matrix()).all()
