@@ -1,0 +1,94 @@
+"""The ``wmrkit`` command: user mistakes give one line on stderr and exit 2; --json output parses."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from wmrkit import catalog
+from wmrkit.cli.main import main
+
+BROKEN = {
+    "malformed.yaml": "name: x\nwheels:\n  - name: a\n    type: fixed: x\n",
+    "typo.yaml": "name: x\nwheels:\n  - {name: a, type: fixed, l: 0, alpah: 0, beta: 0, r: 0.1}\n",
+    "date.yaml": "name: x\nwheels:\n  - {name: a, type: fixed, position: [0, 0], beta: 0, r: 2020-13-45}\n",
+    "newline-name.yaml": 'name: x\nwheels:\n  - {name: "a\\nb", type: fixed, position: [0, 0], beta: 0, r: -1}\n',
+    "bad.json": '{"name": "x", "wheels": [{"name": "a", "type": "fixed", "position": [0, 0], "beta": 0, "r": NaN}]}',
+}
+
+
+def _wmrkit(*args: str, module: str = "wmrkit.cli.main", cwd: Path | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", module, *args], capture_output=True, text=True, cwd=cwd,
+                          timeout=120)
+
+
+def _one_error_line(out: subprocess.CompletedProcess) -> str:
+    assert out.returncode == 2, out.stderr
+    assert "Traceback" not in out.stderr
+    lines = out.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("wmrkit: error: "), out.stderr
+    assert out.stdout == ""
+    return lines[0]
+
+
+def test_show_broken_file_exits_2_with_one_line(tmp_path):
+    (tmp_path / "broken.yaml").write_text(BROKEN["malformed.yaml"])
+    line = _one_error_line(_wmrkit("show", "broken.yaml", cwd=tmp_path))
+    assert line == "wmrkit: error: broken.yaml:4: malformed YAML: mapping values are not allowed here"
+
+
+@pytest.mark.parametrize("name", sorted(BROKEN))
+def test_every_broken_file_is_one_line_in_process(name, tmp_path, capsys):
+    path = tmp_path / name
+    path.write_text(BROKEN[name])
+    assert main(["show", str(path)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    lines = captured.err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"wmrkit: error: {path}:")
+
+
+def test_undecodable_file_is_one_line(tmp_path):
+    (tmp_path / "bin.yaml").write_bytes(b"\xff\xfe\x00name")
+    assert "cannot read the file (UnicodeDecodeError" in _one_error_line(_wmrkit("show", "bin.yaml", cwd=tmp_path))
+
+
+def test_show_json_parses():
+    out = _wmrkit("show", "forklift", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    robot = catalog.load("forklift")
+    assert data["name"] == "forklift"
+    assert data["velocity_names"] == list(robot.velocity_names)
+    assert data["steer_names"] == ["steer"]
+    assert [w["name"] for w in data["wheels"]] == ["right_drive", "left_drive", "steer"]
+    assert data["actuated_joints"] == ["right_drive.spin", "left_drive.spin", "steer.steer"]
+
+
+def test_robots_json_parses_and_lists_the_catalog():
+    out = _wmrkit("robots", "--json", module="wmrkit")  # python -m wmrkit works too
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert [d["name"] for d in data] == list(catalog.names())
+    assert {d["name"]: d["wheels"] for d in data}["forklift"] == 3
+
+
+def test_unknown_robot_exits_2_with_a_suggestion():
+    line = _one_error_line(_wmrkit("show", "forklfit"))
+    assert line == ("wmrkit: error: no robot 'forklfit' in the catalog (did you mean 'forklift'?); "
+                    "'wmrkit robots' lists them")
+
+
+def test_missing_file_and_text_summary(tmp_path, capsys):
+    assert main(["show", str(tmp_path / "none.yaml")]) == 2
+    assert capsys.readouterr().err == f"wmrkit: error: {tmp_path / 'none.yaml'}: no such file\n"
+    good = tmp_path / "good.json"
+    catalog.load("forklift").to_file(good)
+    assert main(["show", str(good)]) == 0
+    text = capsys.readouterr().out
+    assert text.startswith("robot forklift: 3 wheels")
+    assert "velocity vector q_dot (6): vx, vy, omega, right_drive.spin, left_drive.spin, steer.spin" in text
