@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -281,3 +282,13 @@ def test_swerve_matches_wpimath():
         q = _no_slip_rates(robot, twist, beta)
         expected = [s.speed / w.r for s, w in zip(states, robot.wheels, strict=True)]
         np.testing.assert_allclose(q[3:], expected, rtol=1e-10, atol=1e-10)
+
+
+def test_docs_list_every_robot_with_its_drawing():
+    """docs/catalog.md has a row and a drawing (made by docs/figures/make_figures.py) for every catalog robot."""
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    text = (docs / "catalog.md").read_text(encoding="utf-8")
+    for name in NAMES:
+        assert f"| `{name}` |" in text, name
+        assert f'<img src="figures/catalog/{name}.png"' in text, name
+        assert (docs / "figures" / "catalog" / f"{name}.png").read_bytes().startswith(b"\x89PNG")

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import importlib.util
+from pathlib import Path
+
 import numpy as np
 import pytest
 from matplotlib.axes import Axes
@@ -111,3 +114,14 @@ def test_draws_into_a_given_axes():
     assert got.get_title() == "ackermann" and got.get_legend() is not None
     assert got.get_aspect() == 1.0
     assert tuple(fig.get_size_inches()) == tuple(Figure().get_size_inches())  # a user's figure is not resized
+
+
+def test_the_docs_figure_script_draws_the_wheel_parameters(tmp_path):
+    """docs/figures/make_figures.py stays runnable: its wheel-parameter figure draws (to a temporary file)."""
+    script = Path(__file__).resolve().parents[1] / "docs" / "figures" / "make_figures.py"
+    spec = importlib.util.spec_from_file_location("make_figures", script)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    fig = module.wheel_parameters_figure()
+    fig.savefig(tmp_path / "w.svg")
+    assert b"<svg" in (tmp_path / "w.svg").read_bytes()[:2000]
