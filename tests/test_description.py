@@ -13,9 +13,8 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 
-from wmrkit import KINDS, DescriptionError, Robot, Wheel, parse_quantity
+from wmrkit import KINDS, DescriptionError, Robot, Wheel
 from wmrkit.description import robot_from_text
-from wmrkit.units import UnitError
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "description-format.md"
 SRC = "robots/test.yaml"
@@ -149,19 +148,6 @@ def test_unreadable_files(tmp_path):
     bad.write_bytes("name: r\u00f6ver\n".encode("latin-1"))
     with pytest.raises(DescriptionError, match=r"latin1\.yaml: cannot read the file \(UnicodeDecodeError"):
         Robot.from_file(bad)
-
-
-def test_units_table():
-    """The units of ``units.py`` (docs/description-format.md lists the same)."""
-    cases = {("250 mm", "length"): 0.25, ("25cm", "length"): 0.25, ("1 in", "length"): 0.0254,
-             ("2 ft", "length"): 0.6096, ("0.5 km", "length"): 500.0, ("3 dm", "length"): 0.3,
-             ("90 deg", "angle"): math.pi / 2, ("90°", "angle"): math.pi / 2, ("0.25 turn", "angle"): math.pi / 2,
-             ("1500 mrad", "angle"): 1.5, ("-0.5rad", "angle"): -0.5, ("1e-3", "length"): 0.001, (3, "angle"): 3.0}
-    for (text, kind), si in cases.items():
-        assert parse_quantity(text, kind) == pytest.approx(si, rel=1e-15), text
-    for bad in ("90 deg deg", "deg", "1,5 m", "0x10", "nan", "inf m", "1e999 m", [1.0], None, True, 10**400):
-        with pytest.raises(UnitError):
-            parse_quantity(bad, "length")
 
 
 # ---- the documented format ----------------------------------------------------------------------------------------

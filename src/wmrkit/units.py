@@ -47,7 +47,7 @@ def parse_quantity(value: object, kind: Kind) -> float:
         factor = _factor(unit, kind, value)
     else:
         raise UnitError(f"expected {_a(kind)}, got {type(value).__name__}")
-    if not math.isfinite(number):
+    if not math.isfinite(number * factor):  # "1e308 km" overflows only in SI
         raise UnitError(f"must be finite, got {value!r}")
     return number * factor
 

@@ -1,0 +1,81 @@
+"""Quantities with units: "250 mm", "90 deg"; plain numbers are SI; nothing else is accepted."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from wmrkit import parse_quantity
+from wmrkit.units import UNITS, UnitError, si_unit
+
+# Factors to SI written out independently of units.py.
+FACTORS = {
+    "length": {"m": 1.0, "mm": 0.001, "cm": 0.01, "dm": 0.1, "km": 1000.0, "in": 0.0254, "ft": 0.3048},
+    "angle": {"rad": 1.0, "mrad": 0.001, "deg": math.pi / 180, "°": math.pi / 180, "turn": 2 * math.pi},
+}
+
+
+def test_the_unit_tables_are_the_documented_ones():
+    assert {k: set(v) for k, v in UNITS.items()} == {"length": set(FACTORS["length"]),
+                                                     "angle": set(FACTORS["angle"]), "number": set()}
+    assert (si_unit("length"), si_unit("angle"), si_unit("number")) == ("m", "rad", "")
+
+
+@pytest.mark.parametrize(("text", "kind", "si"), [
+    ("250 mm", "length", 0.25), ("25cm", "length", 0.25), ("1 in", "length", 0.0254), ("2 ft", "length", 0.6096),
+    ("0.5 km", "length", 500.0), ("3 dm", "length", 0.3), ("  1.5 m ", "length", 1.5), ("1e-3", "length", 0.001),
+    ("90 deg", "angle", math.pi / 2), ("90°", "angle", math.pi / 2), ("0.25 turn", "angle", math.pi / 2),
+    ("1500 mrad", "angle", 1.5), ("-0.5rad", "angle", -0.5), ("+.5 rad", "angle", 0.5),
+    ("-45 deg", "angle", -math.pi / 4),
+    (3, "angle", 3.0), (0.25, "length", 0.25), ("0.5", "number", 0.5), (-2, "number", -2.0),
+])
+def test_examples(text, kind, si):
+    assert parse_quantity(text, kind) == pytest.approx(si, rel=1e-15)
+
+
+@given(x=st.floats(-1e6, 1e6), data=st.data())
+def test_any_number_with_any_unit(x, data):
+    kind = data.draw(st.sampled_from(["length", "angle"]))
+    unit = data.draw(st.sampled_from(sorted(FACTORS[kind])))
+    text = data.draw(st.sampled_from(["{}{}", "{} {}", " {}  {} "])).format(repr(x), unit)
+    assert parse_quantity(text, kind) == pytest.approx(x * FACTORS[kind][unit], rel=1e-15, abs=1e-300)
+    assert parse_quantity(x, kind) == x  # a plain number is SI
+
+
+@pytest.mark.parametrize(("value", "kind", "message"), [
+    ("90 mm", "angle", "'90 mm' is a length, expected an angle"),
+    ("5 deg", "length", "'5 deg' is an angle, expected a length"),
+    ("1 m", "number", "'1 m' is a length, expected a number"),
+    ("3 furlong", "length", "unknown unit 'furlong' in '3 furlong' (accepted: m, mm, cm, dm, km, in, ft)"),
+    ("3 x", "number", "unknown unit 'x' in '3 x' (accepted: none (a plain number))"),
+    ("pi/2", "angle", "cannot read 'pi/2' as an angle (write e.g. '1.57' or '90 deg')"),
+    ("90 deg deg", "angle", "cannot read '90 deg deg' as an angle (write e.g. '1.57' or '90 deg')"),
+    ("", "length", "cannot read '' as a length (write e.g. '0.25' or '250 mm')"),
+    ("nan", "length", "cannot read 'nan' as a length (write e.g. '0.25' or '250 mm')"),
+    (float("nan"), "length", "must be finite, got nan"),
+    (float("-inf"), "angle", "must be finite, got -inf"),
+    ("1e999 m", "length", "must be finite, got '1e999 m'"),
+    ("1e308 km", "length", "must be finite, got '1e308 km'"),
+    (10**400, "length", "expected a length, got an integer too large for a float"),
+    (True, "angle", "expected an angle, got a boolean"),
+    (None, "length", "expected a length, got NoneType"),
+    ([1.0], "length", "expected a length, got list"),
+])
+def test_rejections_say_why(value, kind, message):
+    with pytest.raises(UnitError) as err:
+        parse_quantity(value, kind)
+    assert str(err.value) == message
+    assert isinstance(err.value, ValueError)
+
+
+@given(st.text(max_size=20) | st.from_type(object), st.sampled_from(["length", "angle", "number"]))
+def test_anything_else_is_a_unit_error_or_a_finite_float(value, kind):
+    try:
+        out = parse_quantity(value, kind)
+    except UnitError as err:
+        assert len(str(err).splitlines()) <= 1
+    else:
+        assert isinstance(out, float) and math.isfinite(out)
