@@ -164,10 +164,10 @@ def _draw_joint(ax: Axes, wheel: Wheel, els: list[_Element], alpha: float) -> li
     steer_driven = "steer" in wheel.actuated
     ax.plot(*joint, marker="s" if steer_driven else "o", markersize=8 if steer_driven else 7,
             markerfacecolor=DRIVEN if steer_driven else "white", markeredgecolor=INK, markeredgewidth=1.2,
-            alpha=alpha, zorder=7)
+            alpha=alpha, zorder=10)
     if "steer" in wheel.sensed:
         ax.plot(*joint, marker="o", markersize=13, markerfacecolor="none", markeredgecolor=SENSOR,
-                markeredgewidth=1.6, alpha=alpha, zorder=7)
+                markeredgewidth=1.6, alpha=alpha, zorder=10)
     return pts
 
 
