@@ -267,10 +267,15 @@ def test_ik_then_fk_returns_the_twist_and_no_wheel_slips(robot, raw):
         np.testing.assert_allclose(got, twist, atol=1e-9 * scale * cond)
 
 
+TWO_DOUBLES = Robot.from_dict({"name": "two-doubles", "wheels": [
+    {"name": "a", "type": "double", "position": [0.3, 0.1], "b": 0.05, "r": 0.04},
+    {"name": "b", "type": "double", "position": [-0.3, -0.1], "b": 0.06, "r": 0.05, "beta": 1.0}]})
+
+
 @pytest.mark.parametrize("batch_t", BATCHES, ids=str)
 @pytest.mark.parametrize("batch_b", [(), (1,), (2, 1)], ids=str)
-@pytest.mark.parametrize("robot", [ZOO, ZOO_FREE, catalog.load("swerve-4"), catalog.load("mecanum-4")],
-                         ids=lambda r: r.name)
+@pytest.mark.parametrize("robot", [ZOO, ZOO_FREE, TWO_DOUBLES, catalog.load("swerve-4"), catalog.load("mecanum-4"),
+                                   catalog.load("forklift")], ids=lambda r: r.name)
 def test_batch_equals_loop(robot, batch_t, batch_b):
     rng = np.random.default_rng(10)
     twist = random_twists(rng, batch_t)
@@ -287,6 +292,13 @@ def test_batch_equals_loop(robot, batch_t, batch_b):
             np.testing.assert_allclose(getattr(c, field)[idx], getattr(single, field), rtol=1e-13, atol=1e-13,
                                        err_msg=field)
         assert c.feasible[idx] == single.feasible and np.array_equal(c.held[idx], single.held)
+    spin_cols = [robot.rate_names.index(f"{w.name}.spin") for w in robot.wheels if "spin" in w.kind.rates]
+    spin_wheels = [i for i, w in enumerate(robot.wheels) if "spin" in w.kind.rates]
+    np.testing.assert_array_equal(c.spin[..., spin_wheels], c.rates[..., spin_cols])
+    for i, w in enumerate(robot.wheels):
+        if "spin2" in w.kind.rates:  # (3.28)/(3.35): the unit's spin is the mean of its two wheels'
+            pair = c.rates[..., [robot.rate_names.index(f"{w.name}.spin1"), robot.rate_names.index(f"{w.name}.spin2")]]
+            np.testing.assert_allclose(c.spin[..., i], pair.mean(axis=-1), rtol=1e-15, atol=1e-15)
 
 
 def test_large_batch_crosses_blocks_like_small_ones():

@@ -112,6 +112,7 @@ def wheel_commands(
     spin = _columns(rates, p.spin_col, batch)
     doubles = p.spin2_col >= 0
     if doubles.any():
+        spin = spin.copy()  # may be a view of rates
         spin[..., doubles] = 0.5 * (spin[..., doubles] + rates[..., p.spin2_col[doubles]])
     if len(p.fixed_wheels) == 0:
         slip = np.broadcast_to(0.0, (*batch, n))
@@ -236,6 +237,9 @@ def _columns(rates: np.ndarray, cols: np.ndarray, batch: tuple[int, ...]) -> np.
         return rates
     if (cols < 0).all():
         return np.broadcast_to(np.nan, (*batch, len(cols)))
+    step = np.diff(cols)
+    if len(cols) > 1 and cols[0] >= 0 and step[0] > 0 and (step == step[0]).all():  # e.g. Mecanum: spin, roller
+        return rates[..., cols[0]:cols[-1] + 1:step[0]]  # a view, no copy
     out = rates[..., np.maximum(cols, 0)]
     if (cols < 0).any():
         out[..., cols < 0] = np.nan
