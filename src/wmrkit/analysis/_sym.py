@@ -17,15 +17,22 @@ def gram(h: np.ndarray) -> np.ndarray:
 
 def eigvalsh2(g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Eigenvalues ``(small, large)`` of symmetric ``(..., 2, 2)`` matrices."""
-    a, b, d = g[..., 0, 0], g[..., 0, 1], g[..., 1, 1]
+    return eigvalsh2_entries(g[..., 0, 0], g[..., 0, 1], g[..., 1, 1])
+
+
+def eigvalsh2_entries(a: np.ndarray, b: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues ``(small, large)`` of ``[[a, b], [b, d]]``, elementwise."""
     mean, half = (a + d) / 2, np.hypot((a - d) / 2, b)
     return mean - half, mean + half
 
 
 def eigvalsh3(g: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Eigenvalues ``(small, middle, large)`` of symmetric ``(..., 3, 3)`` matrices (trigonometric method)."""
-    a11, a22, a33 = g[..., 0, 0], g[..., 1, 1], g[..., 2, 2]
-    a12, a13, a23 = g[..., 0, 1], g[..., 0, 2], g[..., 1, 2]
+    return eigvalsh3_entries(g[..., 0, 0], g[..., 1, 1], g[..., 2, 2], g[..., 0, 1], g[..., 0, 2], g[..., 1, 2])
+
+
+def eigvalsh3_entries(a11, a22, a33, a12, a13, a23) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Eigenvalues ``(small, middle, large)`` of the symmetric matrix with these entries, elementwise."""
     q = (a11 + a22 + a33) / 3
     b11, b22, b33 = a11 - q, a22 - q, a33 - q
     p2 = b11 * b11 + b22 * b22 + b33 * b33 + 2 * (a12 * a12 + a13 * a13 + a23 * a23)
@@ -49,7 +56,7 @@ def condition_from_gram(g: np.ndarray) -> np.ndarray:
         small = large = g[..., 0, 0]
     elif c == 2:
         small, large = eigvalsh2(g)
-    elif c == 3:
+    elif c == 3 and g[..., 0, 0].size > 4096:  # closed form for big batches, LAPACK (more accurate) otherwise
         small, _, large = eigvalsh3(g)
     else:
         w = np.linalg.eigvalsh(g)

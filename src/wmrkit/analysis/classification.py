@@ -76,7 +76,7 @@ class Classification:
 
 
 def instantaneous_mobility(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
-    """Degrees of freedom of the twist at each configuration, ``3 - rank K_r*(beta)`` (5.13). ``(..., n_steer) -> (...)``.
+    """Degrees of freedom of the twist, ``3 - rank K_r*(beta)`` (5.13). ``(..., n_steer) -> (...)``.
 
     Equals ``k - rank A`` (6.8) for robots whose wheel rates are all fixed by the twist (all but double wheels).
     """

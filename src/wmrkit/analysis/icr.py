@@ -27,7 +27,7 @@ def icr_of_twist(twist_robot: ArrayLike) -> np.ndarray:
 
 
 def twist_of_icr(icr_h: ArrayLike) -> np.ndarray:
-    """A unit twist turning about the homogeneous ICR ``(x, y, w)``: ``(y, -x, w)`` normalised. ``(..., 3) -> (..., 3)``."""
+    """A unit twist about the homogeneous ICR ``(x, y, w)``: ``(y, -x, w)`` normalised. ``(..., 3) -> (..., 3)``."""
     h = as_vectors(icr_h, 3, "icr_h")
     t = np.stack([h[..., 1], -h[..., 0], h[..., 2]], axis=-1)
     return t / np.linalg.norm(t, axis=-1, keepdims=True)

@@ -28,7 +28,8 @@ from ..robot import TWIST_NAMES, Robot
 
 #: Rows added for assigned vehicle velocities (rules 5-6 of §6.3): the X axis, the Y axis, the line at infinity.
 TWIST_LINES = {"vx": (1.0, 0.0, 0.0), "vy": (0.0, 1.0, 0.0), "omega": (0.0, 0.0, 1.0)}
-_TWIST_LABELS = {"vx": "X axis (vx assigned)", "vy": "Y axis (vy assigned)", "omega": "line at infinity (omega assigned)"}
+_TWIST_LABELS = {"vx": "X axis (vx assigned)", "vy": "Y axis (vy assigned)",
+                 "omega": "line at infinity (omega assigned)"}
 _ROW_NAMES = {
     "fixed": ("axle", "plane"), "steerable": ("axle", "plane"), "castor": ("axle", "plane"),
     "swedish": ("rollers", "cross-roller line"), "ball": ("rollers", "cross-roller line"),

@@ -25,8 +25,8 @@ from .._shapes import as_vectors
 from ..errors import UnknownNameError
 from ..kinematics.linalg import matrix_rank
 from ..robot import Robot
-from ._sym import eigvalsh3
-from .lines import constraint_lines, element_rows
+from . import _fast
+from .lines import _params, constraint_lines, element_rows
 
 #: Relative tolerance of the line test: ``sigma_min / sigma_max`` of the normalised lines below it is singular.
 SINGULAR_RTOL = 1e-8
@@ -62,13 +62,15 @@ def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[s
     """
     cl = constraint_lines(robot, assigned)
     beta = robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
-    batch = beta.shape[:-1]
     if cl.internal or len(cl.labels) < 3:
-        return np.zeros(batch)
-    g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / (length or robot_size(robot))])
-    g = g / np.linalg.norm(g, axis=-1, keepdims=True)
-    small, _, large = eigvalsh3(np.einsum("...rc,...rd->...cd", g, g))
-    return np.sqrt(np.maximum(small, 0.0) / large)
+        return np.zeros(beta.shape[:-1])
+    flat = beta.reshape(int(np.prod(beta.shape[:-1])), beta.shape[-1])
+    out = np.empty(len(flat))
+    p, length = _params(robot), float(length or robot_size(robot))
+    for s in range(0, len(flat), _fast.CHUNK):
+        rows = _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
+        out[s:s + _fast.CHUNK] = _fast.distance_cm(_fast.combine(cl.coefficients, rows, cl.constant), length)
+    return out.reshape(beta.shape[:-1])
 
 
 def robot_size(robot: Robot) -> float:
