@@ -28,6 +28,7 @@ from .trees import (
     partitioned_solution,
     reduced_equation,
     select_columns,
+    vehicle_dof,
 )
 
 
@@ -202,12 +203,11 @@ def subset_trees(robot: Robot, beta: np.ndarray, size: int) -> tuple[list[tuple[
 def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None) -> tuple[tuple[str, ...], ...]:
     """The smallest actuator choices with consistent actuation (Fig. 4.4 ``determined``) at every configuration.
 
-    Each set has m = G wheel rates (B.3.8), followed by the ``steer`` joints of the centred steerable wheels,
+    Each set has G (= m, B.3.8) wheel rates, followed by the ``steer`` joints of the centred steerable wheels,
     which the thesis requires actuated. Empty when no choice of wheel rates works (e.g. m = 0).
     """
     beta = configuration(robot, beta)
-    a = robot.constraint_matrix(beta)
-    m = np.unique(a.shape[-1] - matrix_rank(a))
+    m = np.unique(vehicle_dof(robot, beta))  # G = m unless a double wheel adds a self-motion (4.69)
     if len(m) != 1 or m[0] == 0:
         return ()
     subsets, tree = subset_trees(robot, beta, int(m[0]))

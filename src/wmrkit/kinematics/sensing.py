@@ -20,7 +20,15 @@ from ..robot import TWIST_NAMES, Robot
 from .actuation import split_jacobian, steering_split, subset_trees, verdict_texts
 from .linalg import matrix_rank
 from .models import configuration
-from .trees import TreeVerdict, classify_system, jacobian_names, partitioned_solution, reduced_equation, select_columns
+from .trees import (
+    TreeVerdict,
+    classify_system,
+    jacobian_names,
+    partitioned_solution,
+    reduced_equation,
+    select_columns,
+    vehicle_dof,
+)
 
 
 def _split(robot: Robot, sensed: Sequence[str] | None, beta: ArrayLike | None):
@@ -179,13 +187,12 @@ def minimal_sensor_sets(
 ) -> tuple[tuple[str, ...], ...]:
     """The smallest sensor choices that determine the twist at every configuration (Fig. 4.5).
 
-    ``detect_slip=False``: basic sensing (``determined``), m rates each; ``True``: the smallest sets with
+    ``detect_slip=False``: basic sensing (``determined``), G (= m) rates each; ``True``: the smallest sets with
     sufficient *redundant* sensors (``overdetermined``, slip detectable). Each set lists the wheel rates, then
     the ``steer`` joints of the centred steerable wheels (their angle must be sensed, 4.33).
     """
     beta = configuration(robot, beta)
-    a = robot.constraint_matrix(beta)
-    m = np.unique(a.shape[-1] - matrix_rank(a))
+    m = np.unique(vehicle_dof(robot, beta))  # G = m unless a double wheel adds a self-motion (4.69)
     if len(m) != 1 or m[0] == 0:
         return ()
     names, steer = jacobian_names(robot), tuple(f"{w}.steer" for w in steering_split(robot, ()))
