@@ -6,7 +6,10 @@ velocity (3.4) with numpy cross products: it shares no code with ``wmrkit.wheels
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -284,3 +287,120 @@ def test_wrong_shape_names_the_argument(type_name):
         robot.constraint_matrix(np.zeros((4, n + 1)))
     with pytest.raises(ShapeError, match=rf"^q_dot: expected shape \(\.\.\., {len(robot.velocity_names)}\)"):
         robot.slip_velocity(np.zeros(2))
+
+
+# ---- errata of chapter 3 (docs/errata.md, digest PART E 1-10) -----------------------------------------------------
+def test_errata_3_1_body_rate_in_the_recursion_is_absolute():
+    """(3.1) uses omega_{i-1} (absolute), not omega*_{i-1}: a turning body with the castor locked moves the
+    contact by omega x (the whole vector R -> E), arm included."""
+    l, alpha, beta, d, delta, r = 0.4, 0.9, -0.5, 0.07, 0.3, 0.05
+    w = Wheel("c", "castor", l=l, alpha=alpha, beta=beta, r=r, d=d, delta=delta)
+    S = np.array([l * cos(alpha), l * sin(alpha), 0.0])
+    E = S + d * _u(beta + math.pi / 2)
+    column = Robot("c", (w,)).constraint_matrix(frame="robot") @ [0, 0, 1.0, 0, 0]  # omega = 1, joints locked
+    np.testing.assert_allclose(column, np.cross(Z, E)[:2], atol=1e-15)
+    assert np.abs(column - np.cross(Z, S)[:2]).max() > 0.05  # the misprint's omega*_{i-1} = 0 would miss the arm
+
+
+@pytest.mark.parametrize("type_name", list(KINDS))
+def test_errata_3_4_body_velocity_is_planar(type_name):
+    """(3.4): the body's linear velocity is (v_x, v_y, 0), not (v_x, v_y, omega): in the robot frame every contact's
+    rows take (v_x, v_y) as the identity and omega only through omega x d_E."""
+    w = _example(type_name)
+    a = Robot("p", (w,)).constraint_matrix(frame="robot")
+    for k in range(a.shape[0] // 2):
+        np.testing.assert_allclose(a[2 * k:2 * k + 2, :2], np.eye(2), atol=1e-15)
+    expected = [np.cross(Z, c["S"] + c["off"])[:2] for c in contacts(w, w.beta)]
+    np.testing.assert_allclose(a[:, 2], np.concatenate(expected), atol=1e-15)
+
+
+@given(l=st.floats(0, 2), alpha=st.floats(-4, 4), beta=st.floats(-4, 4), d=st.floats(-1, 1), delta=st.floats(-4, 4),
+       gamma=st.floats(-4, 4), r=st.floats(0.01, 1), r_r=st.floats(0.01, 1))
+def test_errata_3_6_3_10_layout_and_distance_components(l, alpha, beta, d, delta, gamma, r, r_r):
+    """(3.6): Rot(-theta_E) is the (v_x, v_y) block only; the other entries are the distances (3.10) in E
+    coordinates, whose d_Sx/d_Six and d_Sy/d_Siy (printed both ways) are one quantity each."""
+    theta = beta + delta + gamma
+    S = np.array([l * cos(alpha), l * sin(alpha)])
+    E = S + d * np.array([-sin(beta), cos(beta)])
+    d_R = _rot(-theta) @ (0 - E)  # ^{E}d_R: from E to the robot origin, in E coordinates
+    d_S = _rot(-theta) @ (S - E)  # ^{E}d_S
+    # (3.10) as printed
+    np.testing.assert_allclose(d_R, [-l * cos(theta - alpha) - d * sin(delta + gamma),
+                                     l * sin(theta - alpha) - d * cos(delta + gamma)], atol=1e-12)
+    np.testing.assert_allclose(d_S, [-d * sin(delta + gamma), -d * cos(delta + gamma)], atol=1e-12)
+    rows = generic_slip_rows(beta, l, alpha, d, delta, gamma, r, r_r)
+    np.testing.assert_allclose(rows[:, :2], _rot(-theta), atol=1e-15)
+    expected = [[d_R[1], d_S[1], r * sin(gamma), 0], [-d_R[0], -d_S[0], r * cos(gamma), r_r]]
+    np.testing.assert_allclose(rows[:, 2:], expected, atol=1e-12)
+
+
+@pytest.mark.parametrize(("type_name", "singular"), [
+    ("castor", {"delta": math.pi / 2}), ("castor", {"delta": -math.pi / 2}), ("castor", {"d": 0.0}),
+    ("swedish", {"gamma": 0.0}), ("swedish", {"gamma": math.pi}),
+])
+def test_errata_3_19_omnidirectional_wheels_can_be_singular(type_name, singular):
+    """(3.19) says the wheel Jacobians are always (pseudo-)invertible: not for d = 0, delta = +-90 deg, gamma = 0."""
+    regular = _example(type_name)
+    assert np.linalg.matrix_rank(wheel_jacobian(regular)) == 3
+    j = wheel_jacobian(dataclasses.replace(regular, **singular))
+    assert np.linalg.matrix_rank(j) == 2
+    assert abs(np.linalg.det(j)) < 1e-15
+
+
+def test_errata_3_24_double_wheel_sub_wheels_at_minus_d_and_plus_d():
+    """(3.24) corrected: d_i1 = -d, d_i2 = +d (delta = -90 deg). The thesis's (3.26)/(3.27), written with its
+    steering angle beta_th = beta + 90 deg (axle at beta_th - 90 deg), are our spin1/spin2 rows."""
+    l, alpha, beta, b, r = 0.35, 2.0, 0.4, 0.06, 0.09
+    w = Wheel("u", "double", l=l, alpha=alpha, beta=beta, r=r, b=b)
+    bt = beta + math.pi / 2
+    sb, cb, s, c = sin(bt), cos(bt), sin(bt - alpha), cos(bt - alpha)
+    eq_3_26 = [[sb, -cb, -l * c, 0, 0], [cb, sb, l * s + b, b, r]]  # (v, omega, beta_dot, phi_1)
+    eq_3_27 = [[sb, -cb, -l * c, 0, 0], [cb, sb, l * s - b, -b, r]]  # (v, omega, beta_dot, phi_2)
+    rows = wheel_slip_rows(w)  # columns vx, vy, omega, steer, spin1, spin2
+    np.testing.assert_allclose(rows[:2][:, [0, 1, 2, 3, 4]], eq_3_26, atol=1e-15)
+    np.testing.assert_allclose(rows[2:][:, [0, 1, 2, 3, 5]], eq_3_27, atol=1e-15)
+    assert np.all(rows[:2, 5] == 0) and np.all(rows[2:, 4] == 0)
+
+
+def test_double_castor_rows_3_33_3_34():
+    """(3.31)-(3.34): the double castor's sub-wheels at (+-b, a) in the steering frame (a = d), written out."""
+    l, alpha, beta, a, b, r = 0.35, 2.0, 0.4, 0.1, 0.06, 0.09
+    w = Wheel("u", "double_castor", l=l, alpha=alpha, beta=beta, r=r, b=b, d=a)
+    sb, cb, s, c = sin(beta), cos(beta), sin(beta - alpha), cos(beta - alpha)
+    eq_3_33 = [[cb, sb, l * s - a, -a, 0], [-sb, cb, l * c + b, b, r]]
+    eq_3_34 = [[cb, sb, l * s - a, -a, 0], [-sb, cb, l * c - b, -b, r]]
+    rows = wheel_slip_rows(w)
+    np.testing.assert_allclose(rows[:2][:, [0, 1, 2, 3, 4]], eq_3_33, atol=1e-15)
+    np.testing.assert_allclose(rows[2:][:, [0, 1, 2, 3, 5]], eq_3_34, atol=1e-15)
+
+
+@pytest.mark.parametrize("unit", ["double", "double_castor"])
+def test_errata_3_30_steering_angle_follows_the_heading(unit):
+    """(3.30)/(3.37): beta = r (phi_2 - phi_1) / (2 b) - theta_R + const, with the heading theta_R itself (001 prints
+    its integral). Integrates a smooth no-slip motion of the unit, re-solving the constraints at every step."""
+    w = Wheel("u", unit, l=0.3, alpha=0.7, beta=0.2, r=0.08, b=0.05, d=0.1 if unit == "double_castor" else 0.0)
+    robot = Robot("u", (w,))
+    wanted = np.array([0.3, 0.1, 0.5, 0.4, 1.0, -2.0])  # projected on the no-slip motions: smooth in beta
+    dt, beta, theta, phi1, phi2, theta_integral = 0.01, w.beta, 0.0, 0.0, 0.0, 0.0
+    for _ in range(400):
+        a = robot.constraint_matrix([beta])
+        q = wanted - np.linalg.pinv(a) @ (a @ wanted)
+        np.testing.assert_allclose(a @ q, 0, atol=1e-12)
+        _, _, omega, steer, spin1, spin2 = q
+        beta, theta, phi1, phi2 = beta + steer * dt, theta + omega * dt, phi1 + spin1 * dt, phi2 + spin2 * dt
+        theta_integral += theta * dt
+    assert abs(theta) > 0.1 and abs(beta - w.beta) > 0.1  # the motion turned the robot and the unit
+    assert beta - w.beta == pytest.approx(w.r * (phi2 - phi1) / (2 * w.b) - theta, abs=1e-9)
+    assert abs(beta - w.beta - (w.r * (phi2 - phi1) / (2 * w.b) - theta_integral)) > 0.05
+
+
+def test_errata_chapter_3_cites_existing_tests():
+    """Every test that docs/errata.md's chapter-3 section cites exists."""
+    text = (Path(__file__).resolve().parents[1] / "docs" / "errata.md").read_text()
+    section = text[text.index("## Chapter 3"):]
+    section = section[: section.find("\n## ", 1) if "\n## " in section[1:] else None]
+    cited = re.findall(r"`tests/([\w/]+\.py)::(\w+)`", section)
+    assert len(cited) >= 9
+    for path, name in cited:
+        source = (Path(__file__).resolve().parent / path).read_text()
+        assert re.search(rf"^def {name}\(", source, flags=re.M), (path, name)
