@@ -123,10 +123,13 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     sample_idx = np.searchsorted(fine, t_samples)
     dt = np.diff(fine)
     twist = profile.at(0.5 * (fine[:-1] + fine[1:]))  # (M, 3)
-    beta_nodes = _steering(robot, profile, fine, twist)  # (M + 1, n_steer)
+    beta_nodes = _steering(robot, profile, fine, twist, sensed)  # (M + 1, n_steer)
     beta_mid = 0.5 * (beta_nodes[:-1] + beta_nodes[1:])
-    a = robot.constraint_matrix(beta_mid) if robot.steer_names else robot.constraint_matrix()
-    q, res = solve_assigned(a, [0, 1, 2], twist * dt[:, None])
+    configs, index = np.unique(beta_mid, axis=0, return_inverse=True)  # one solve per distinct configuration
+    q_unit, res_unit = solve_assigned(robot.constraint_matrix(configs)[:, None], [0, 1, 2], np.eye(3))
+    index = index.reshape(-1)
+    q = np.einsum("nik,ni->nk", q_unit[index], twist * dt[:, None])
+    res = np.einsum("nir,ni->nr", res_unit[index], twist * dt[:, None])
     bad = np.max(np.abs(res), axis=-1) > 1e-9 * max(1.0, float(np.max(np.abs(twist * dt[:, None]))))
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
@@ -168,13 +171,16 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     return SyntheticRun(log, truth[sample_idx], np.column_stack([true_pos[j] for j in sensed]), counts)
 
 
-def _steering(robot: Robot, profile: TwistProfile, fine: np.ndarray, twist: np.ndarray) -> np.ndarray:
-    """Steering angles at the fine nodes ``(M + 1, n_steer)``: geometric for steerable/double, ODE for castors."""
+def _steering(robot: Robot, profile: TwistProfile, fine: np.ndarray, twist: np.ndarray,
+              sensed: Sequence[str]) -> np.ndarray:
+    """Steering angles at the fine nodes ``(M + 1, n_steer)``: geometric for steerable/double, ODE for castors
+    (only for castors with a sensed joint: an unsensed castor's angle changes no other wheel's rates)."""
     out = np.empty((len(fine), len(robot.steer_names)))
     for k, name in enumerate(robot.steer_names):
         wheel = robot.wheel(name)
         if wheel.type in ("castor", "double_castor"):
-            out[:, k] = _castor_angles(wheel, profile, fine)
+            mine = any(j.partition(".")[0] == name for j in sensed)
+            out[:, k] = _castor_angles(wheel, profile, fine) if mine else wheel.beta
             continue
         x, y = wheel.position
         vx, vy = twist[:, 0] - twist[:, 2] * y, twist[:, 1] + twist[:, 2] * x  # steering joint velocity
