@@ -141,7 +141,7 @@ def constant_rates(p: Plan, twist: np.ndarray) -> np.ndarray:
 
 
 #: Twists per block of the steering kernel: its temporaries stay in cache and are reused (no page faults).
-BLOCK = 16384
+BLOCK = 8192
 
 
 def steer_to_twist(
@@ -151,36 +151,39 @@ def steer_to_twist(
 
     ``(..., 3), (..., n_o) -> (..., n_o) angles [rad] in (-pi, pi], (..., n_s) spins [rad/s], (..., n_o) held``.
     Where the steering axis does not move (speed <= `speed_tol` [m/s]) the angle is undefined: the current angle
-    (wrapped) is kept and the spin is 0. Vectorised over blocks of :data:`BLOCK` twists (cache-sized temporaries).
+    (wrapped) is kept and the spin is 0. Vectorised over blocks of :data:`BLOCK` twists, one row per wheel
+    (long inner loops, cache-sized temporaries); the results are transposed views of wheel-major arrays.
     """
     n_o, n_s = len(p.steered_x), len(p.steered_spin_of)
     batch = np.broadcast_shapes(twist.shape[:-1], current.shape[:-1])
     t = np.broadcast_to(twist, (*batch, 3)).reshape(-1, 3)
-    per_twist = current.ndim > 1
-    cur = np.broadcast_to(current, (*batch, n_o)).reshape(-1, n_o) if per_twist else current
     m = t.shape[0]
-    beta, spin, held = np.empty((m, n_o)), np.empty((m, n_s)), np.empty((m, n_o), dtype=bool)
+    if current.ndim > 1:  # one current angle per twist: wheel-major too
+        cur = np.ascontiguousarray(np.broadcast_to(current, (*batch, n_o)).reshape(-1, n_o).T)
+    else:
+        cur = current[:, None]
     cos_cur, sin_cur = np.cos(cur), np.sin(cur)
+    beta, spin, held = np.empty((n_o, m)), np.empty((n_s, m)), np.empty((n_o, m), dtype=bool)
     for start in range(0, m, BLOCK):
         b = slice(start, start + BLOCK)
-        c, s = (cos_cur[b], sin_cur[b]) if per_twist else (cos_cur, sin_cur)
-        _steer_block(p, t[b], c, s, speed_tol, beta[b], spin[b], held[b])
+        c, s = (cos_cur[:, b], sin_cur[:, b]) if current.ndim > 1 else (cos_cur, sin_cur)
+        _steer_block(p, t[b], c, s, speed_tol, beta[:, b], spin[:, b], held[:, b])
     if held.any():
         kept = np.broadcast_to(wrap_angle(cur), beta.shape)
         beta[held] = kept[held]
-        spin[held[:, p.steered_spin_of]] = 0.0
-    return beta.reshape(*batch, n_o), spin.reshape(*batch, n_s), held.reshape(*batch, n_o)
+        spin[held[p.steered_spin_of]] = 0.0
+    return (beta.T.reshape(*batch, n_o), spin.T.reshape(*batch, n_s), held.T.reshape(*batch, n_o))
 
 
 def _steer_block(
     p: Plan, t: np.ndarray, cos_cur: np.ndarray, sin_cur: np.ndarray, speed_tol: float,
     beta: np.ndarray, spin: np.ndarray, held: np.ndarray,
 ) -> None:
-    """One block of :func:`steer_to_twist`, written into `beta`, `spin`, `held`."""
-    vx, vy, w = t[:, 0:1], t[:, 1:2], t[:, 2:3]
-    minus_ux = w * p.steered_y  # -u_x = omega y - v_x: the steering axis's velocity, x negated
+    """One block of :func:`steer_to_twist`: twists ``(B, 3)``, outputs ``(n_o, B)`` written in place."""
+    vx, vy, w = t[:, 0], t[:, 1], t[:, 2]
+    minus_ux = p.steered_y[:, None] * w  # -u_x = omega y - v_x: the steering axis's velocity, x negated
     minus_ux -= vx
-    uy = w * p.steered_x
+    uy = p.steered_x[:, None] * w
     uy += vy
     speed = minus_ux * minus_ux
     tmp = uy * uy
@@ -199,8 +202,8 @@ def _steer_block(
     if spin.shape == speed.shape:
         np.multiply(speed, sign, out=spin)
     else:
-        np.multiply(speed[:, p.steered_spin_of], sign[:, p.steered_spin_of], out=spin)
-    spin *= -p.steered_inv_r
+        np.multiply(speed[p.steered_spin_of], sign[p.steered_spin_of], out=spin)
+    spin *= -p.steered_inv_r[:, None]
     np.less_equal(speed, speed_tol, out=held)
 
 
