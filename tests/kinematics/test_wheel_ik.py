@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 
 from conftest import robots
 from wmrkit import Robot, ShapeError, catalog
+from wmrkit.kinematics import _ik_fast
 from wmrkit.kinematics.wheel_ik import forward_kinematics, twist_is_determined, wheel_commands, wrap_angle
 
 PI = math.pi
@@ -304,10 +305,11 @@ def test_batch_equals_loop(robot, batch_t, batch_b):
 def test_large_batch_crosses_blocks_like_small_ones():
     rng = np.random.default_rng(11)
     swerve = catalog.load("swerve-4")
-    twist = random_twists(rng, (40_000,))  # more than one block of the steering kernel
+    block = _ik_fast.BLOCK
+    twist = random_twists(rng, (2 * block + 500,))  # more than one block of the steering kernel
     twist[::7] = 0.0
     c = wheel_commands(swerve, twist)
-    pick = [0, 1, 16383, 16384, 16385, 39999, 7 * 3000]
+    pick = [0, 1, block - 1, block, block + 1, 2 * block + 499, 7 * 300]
     small = wheel_commands(swerve, twist[pick])
     np.testing.assert_array_equal(c.steer[pick], small.steer)
     np.testing.assert_array_equal(c.spin[pick], small.spin)
