@@ -1,0 +1,52 @@
+"""``wmrkit kinematics``: the no-slip kinematic models of a robot (thesis ch. 4) at one steering configuration."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import WmrkitError
+from ..kinematics.summary import format_kinematics_summary, kinematics_summary
+from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_assignments, print_json
+
+CODEGEN_LANGUAGES = ("c", "python")
+
+
+def add_parsers(commands: argparse._SubParsersAction) -> None:
+    """Register ``kinematics``."""
+    p = commands.add_parser(
+        "kinematics", help="mobility, assignable sets, direct/inverse models, actuation and sensing (ch. 4)")
+    add_robot_argument(p)
+    p.add_argument("--steer", action="append", metavar="NAME=ANGLE",
+                   help="steering angle of a wheel: radians, or degrees with 'deg' (repeatable)")
+    add_json_flag(p)
+    p.add_argument("--symbolic", action="store_true", help="also print the closed-form models (sympy)")
+    p.add_argument("--codegen", nargs=2, metavar=("LANG", "DIR"),
+                   help="also write the models as code, LANG 'c' or 'python', into DIR")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print the chapter-4 summary; --symbolic and --codegen add closed forms and generated files."""
+    pairs = parse_assignments(args.steer, "--steer")
+    robot = load_robot(args.robot).with_steering({n: parse_angle(v, f"--steer {n}") for n, v in pairs.items()})
+    summary = kinematics_summary(robot)
+    if args.symbolic:
+        from ..kinematics.symbolic import format_symbolic
+
+        summary["symbolic"] = format_symbolic(robot)
+    if args.codegen:
+        lang, directory = args.codegen
+        if lang not in CODEGEN_LANGUAGES:
+            raise WmrkitError(f"--codegen: language must be one of {', '.join(CODEGEN_LANGUAGES)}, got '{lang}'")
+        from ..kinematics.codegen import write_code
+
+        summary["generated"] = [str(p) for p in write_code(robot, lang, directory)]
+    if args.json:
+        print_json(summary)
+        return 0
+    print(format_kinematics_summary(summary))
+    if args.symbolic:
+        print(summary["symbolic"])
+    for path in summary.get("generated", []):
+        print(f"wrote {path}")
+    return 0

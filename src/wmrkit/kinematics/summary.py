@@ -1,0 +1,96 @@
+"""A robot's chapter-4 summary at one configuration: what ``wmrkit kinematics`` prints, as data and as text."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import SingularError
+from ..robot import Robot
+from .actuation import actuation_analysis, minimal_actuator_sets
+from .extended import extended_dof
+from .models import (
+    KinematicModel,
+    assignable_sets,
+    direct_model,
+    generic_mobility,
+    generically_assignable_sets,
+    inverse_model,
+    mobility,
+)
+from .sensing import minimal_sensor_sets, sensing_analysis
+
+
+def _model(build, robot: Robot) -> dict[str, Any]:
+    try:
+        model: KinematicModel = build(robot)
+    except SingularError as err:
+        return {"error": str(err)}
+    return model.as_dict()
+
+
+def kinematics_summary(robot: Robot) -> dict[str, Any]:
+    """Mobility, assignable sets, direct (sensed) and inverse models, actuation and sensing at the described beta.
+
+    JSON-ready (plain lists and numbers). Steer the robot first with :meth:`wmrkit.Robot.with_steering`.
+    """
+    here = assignable_sets(robot)
+    generic = generically_assignable_sets(robot)
+    return {
+        "robot": robot.name,
+        "steering": dict(zip(robot.steer_names, robot.beta.tolist(), strict=True)),
+        "velocity_names": list(robot.velocity_names),
+        "mobility": int(mobility(robot)),
+        "generic_mobility": generic_mobility(robot),
+        "extended_dof": extended_dof(robot),
+        "assignable_sets": [list(s) for s in here],
+        "lost_here": [list(s) for s in generic if s not in here],
+        "direct_model": _model(direct_model, robot),
+        "inverse_model": _model(inverse_model, robot),
+        "actuation": actuation_analysis(robot).as_dict(),
+        "sensing": sensing_analysis(robot).as_dict(),
+        "minimal_actuator_sets": [list(s) for s in minimal_actuator_sets(robot)],
+        "minimal_sensor_sets": [list(s) for s in minimal_sensor_sets(robot)],
+    }
+
+
+def _matrix_table(model: dict[str, Any], indent: str = "    ") -> list[str]:
+    if "error" in model:
+        return [f"{indent}not available: {model['error']}"]
+    width = max(12, *(len(n) + 2 for n in model["assigned"]))
+    name_width = max(len(n) for n in model["solved"]) if model["solved"] else 1
+    head = f"{indent}{'':<{name_width}} = " + "".join(f"{n:>{width}}" for n in model["assigned"])
+    rows = [head]
+    for name, row in zip(model["solved"], np.asarray(model["matrix"]).reshape(len(model["solved"]), -1),
+                         strict=True):
+        clean = np.where(np.abs(row) < 1e-12, 0.0, row)  # round-off of the least squares, not a value
+        rows.append(f"{indent}{name:<{name_width}} = " + "".join(f"{v:>{width}.6g}" for v in clean))
+    return rows
+
+
+def format_kinematics_summary(summary: dict[str, Any]) -> str:
+    """Human-readable text of :func:`kinematics_summary`: counts, sets, model tables, verdicts."""
+    steer = ", ".join(f"{n} = {v:.6g} rad" for n, v in summary["steering"].items()) or "no steering"
+    lines = [f"robot {summary['robot']} ({steer})",
+             f"  mobility m = {summary['mobility']} (generic {summary['generic_mobility']}); "
+             f"extended solutions may assign {summary['extended_dof']} (m + steerable wheels, §4.5)",
+             f"  velocities: {', '.join(summary['velocity_names'])}",
+             f"  assignable sets ({len(summary['assignable_sets'])}): "
+             + "  ".join("(" + ", ".join(s) + ")" for s in summary["assignable_sets"])]
+    if summary["lost_here"]:
+        lines.append("  singular here: generically assignable but not now: "
+                     + "  ".join("(" + ", ".join(s) + ")" for s in summary["lost_here"]))
+    for title, key in (("direct model", "direct_model"), ("inverse model", "inverse_model")):
+        model = summary[key]
+        kind = "" if "error" in model else f" ({model['kind']}, assigned: {', '.join(model['assigned'])})"
+        lines += [f"  {title}{kind}:", *_matrix_table(model)]
+    act, sen = summary["actuation"], summary["sensing"]
+    lines.append(f"  actuation [{', '.join(act['actuated'] + [s + '.steer' for s in act['steering_actuated']])}]: "
+                 f"{act['verdict']}")
+    lines.append(f"  sensing [{', '.join(sen['sensed'] + [s + '.steer' for s in sen['steering_sensed']])}]: "
+                 f"{sen['verdict']}")
+    for title, key in (("minimal actuator sets", "minimal_actuator_sets"),
+                       ("minimal sensor sets", "minimal_sensor_sets")):
+        lines.append(f"  {title}: " + ("  ".join("(" + ", ".join(s) + ")" for s in summary[key]) or "none"))
+    return "\n".join(lines)

@@ -1,0 +1,107 @@
+"""``wmrkit kinematics`` in-process: exit codes, JSON shape, --steer parsing, --symbolic/--codegen wiring."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+import types
+from pathlib import Path
+
+import pytest
+import yaml
+
+from wmrkit import catalog
+from wmrkit.cli.main import main
+
+TRICYCLE = {
+    "name": "tri",
+    "wheels": [
+        {"name": "w1", "type": "fixed", "l": 0.5, "alpha": 0.0, "beta": 0.0, "r": 0.1, "sensed": ["spin"]},
+        {"name": "w2", "type": "fixed", "l": 0.5, "alpha": "180 deg", "beta": 0.0, "r": 0.1, "sensed": ["spin"]},
+        {"name": "w3", "type": "steerable", "l": 1.2, "alpha": "-90 deg", "beta": 0.4, "r": 0.1,
+         "actuated": ["spin", "steer"], "sensed": ["steer"]},
+    ],
+}
+
+
+@pytest.fixture
+def tricycle_file(tmp_path: Path) -> str:
+    path = tmp_path / "tri.yaml"
+    path.write_text(yaml.safe_dump(TRICYCLE))
+    return str(path)
+
+
+def run_json(capsys, argv: list[str]) -> dict:
+    assert main([*argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_json_summary_of_the_tricycle(capsys, tricycle_file):
+    data = run_json(capsys, ["kinematics", tricycle_file])
+    assert data["mobility"] == 1 and data["generic_mobility"] == 1 and data["extended_dof"] == 2
+    assert data["assignable_sets"] == [["vy"], ["omega"], ["w1.spin"], ["w2.spin"], ["w3.spin"]]
+    assert data["lost_here"] == []
+    direct = data["direct_model"]
+    assert direct["assigned"] == ["w1.spin"] and direct["kind"] == "direct"  # the first sensed rate
+    assert direct["solved"] == ["vx", "vy", "omega", "w2.spin", "w3.spin"]
+    assert direct["matrix"][1][0] == pytest.approx(-0.121383, abs=5e-7)  # C.5 numeric oracle
+    assert data["inverse_model"]["assigned"] == ["vy"]
+    assert data["actuation"]["leaf"] == "determined" and data["actuation"]["consistent"] is True
+    assert data["sensing"]["slip_detectable"] is True
+    assert ["w1.spin", "w3.steer"] in data["minimal_actuator_sets"]
+
+
+def test_steer_option_in_degrees_and_radians(capsys, tricycle_file):
+    data = run_json(capsys, ["kinematics", tricycle_file, "--steer", "w3=0deg"])
+    assert data["steering"] == {"w3": 0.0}
+    assert ["omega"] not in data["assignable_sets"] and data["lost_here"] == [["omega"]]  # C.4: beta3 = 0
+    data = run_json(capsys, ["kinematics", tricycle_file, "--steer", f"w3={math.pi / 2}"])
+    assert data["lost_here"] == [["vy"]]
+
+
+def test_text_output(capsys, tricycle_file):
+    assert main(["kinematics", tricycle_file, "--steer", "w3=0 deg"]) == 0
+    out = capsys.readouterr().out
+    assert "mobility m = 1" in out and "singular here" in out and "(omega)" in out
+    assert "direct model (direct, assigned: w1.spin)" in out and "consistent actuation" in out
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["--steer", "w9=0.1"], "no wheel 'w9'"),
+    (["--steer", "w1=0.1"], "does not steer"),
+    (["--steer", "w3"], "expected NAME=VALUE"),
+    (["--steer", "w3=north"], "--steer w3"),
+    (["--codegen", "fortran", "out"], "language must be one of c, python"),
+])
+def test_user_mistakes_exit_2_with_one_line(capsys, tricycle_file, argv, message):
+    assert main(["kinematics", tricycle_file, *argv]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+
+
+def test_unknown_robot_exits_2(capsys):
+    assert main(["kinematics", "no-such-robot"]) == 2
+    assert "no robot 'no-such-robot'" in capsys.readouterr().err
+
+
+def test_symbolic_and_codegen_call_the_library(capsys, monkeypatch, tricycle_file, tmp_path):
+    calls = []
+    symbolic = types.ModuleType("wmrkit.kinematics.symbolic")
+    symbolic.format_symbolic = lambda robot: calls.append(("symbolic", robot.name)) or "CLOSED FORMS"
+    codegen = types.ModuleType("wmrkit.kinematics.codegen")
+    codegen.write_code = lambda robot, lang, directory: calls.append(("codegen", lang)) or [Path(directory) / "m.c"]
+    monkeypatch.setitem(sys.modules, "wmrkit.kinematics.symbolic", symbolic)
+    monkeypatch.setitem(sys.modules, "wmrkit.kinematics.codegen", codegen)
+    data = run_json(capsys, ["kinematics", tricycle_file, "--symbolic", "--codegen", "c", str(tmp_path)])
+    assert data["symbolic"] == "CLOSED FORMS" and data["generated"] == [str(tmp_path / "m.c")]
+    assert calls == [("symbolic", "tri"), ("codegen", "c")]
+    assert main(["kinematics", tricycle_file, "--symbolic"]) == 0
+    assert "CLOSED FORMS" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name", catalog.names())
+def test_every_catalog_robot(capsys, name):
+    data = run_json(capsys, ["kinematics", name])
+    assert all(len(s) == data["mobility"] for s in data["assignable_sets"])
+    assert data["actuation"]["leaf"] in ("determined", "overdetermined", "indeterminate", "underdetermined")
