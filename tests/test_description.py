@@ -369,3 +369,11 @@ def test_save_then_load_catalog_style_robot(tmp_path):
         robot.to_file(tmp_path / name)
         assert Robot.from_file(tmp_path / name) == robot
     assert np.isfinite(robot.constraint_matrix()).all()
+
+
+@pytest.mark.parametrize("bad", ["a.b", "left wheel", "x=1", "", "1st", "é"])
+def test_wheel_names_must_be_identifiers(bad):
+    """Wheel names make velocity names 'wheel.joint' and CLI arguments NAME=VALUE: no dots, spaces or '='."""
+    data = {"name": "r", "wheels": [{"name": bad, "type": "fixed", "position": [0, 0], "beta": 0, "r": 0.1}]}
+    with pytest.raises(DescriptionError, match=r"wheels\[0\]\.name: "):
+        Robot.from_dict(data, source="x.yaml")

@@ -10,6 +10,7 @@ import difflib
 import json
 import math
 import os
+import re
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -24,6 +25,8 @@ from .wheels import GEOMETRY_FIELDS, KINDS, Wheel
 TOP_FIELDS = ("name", "wheels", "notes")
 COMMON_WHEEL_FIELDS = ("name", "type", "position", "l", "alpha", "actuated", "sensed")
 ALL_WHEEL_FIELDS = COMMON_WHEEL_FIELDS + tuple(f for f in GEOMETRY_FIELDS if f not in ("l", "alpha"))
+
+WHEEL_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
 
 Loc = tuple[str | int, ...]
 LineOf = Callable[[Loc], int | None]
@@ -58,6 +61,9 @@ def _wheel_from_dict(item: Any, check: _Checker, loc: Loc) -> Wheel:
                    (*loc, "type"))
     kind = KINDS[type_name]
     name = check.text(item, "name", loc)
+    if not WHEEL_NAME.fullmatch(name):
+        check.fail(f"wheel names are letters, digits, '_' and '-' (they name velocities 'wheel.joint'), got {name!r}",
+                   (*loc, "name"))
     allowed = COMMON_WHEEL_FIELDS + kind.required + tuple(kind.optional)
     for key in item:
         if key not in allowed and key in ALL_WHEEL_FIELDS:
