@@ -62,6 +62,10 @@ class Plan:
     spin2_col: np.ndarray  # (N,) rate column of 'spin2' (double wheels), -1 elsewhere
     steer_rate_col: np.ndarray  # (N,) rate column of the steering joint rate, -1 where it is not a column
     only_steerable: bool  # every wheel steerable, in order: the spins are the rates, the angles the config
+    spin_select: slice | np.ndarray | None  # how to take the spins out of the rates (see :func:`selector`)
+    steer_rate_select: slice | np.ndarray | None
+    wheel_names: tuple[str, ...]
+    rate_names: tuple[str, ...]
 
 
 @functools.lru_cache(maxsize=256)
@@ -128,7 +132,20 @@ def plan(robot: Robot) -> Plan:
         steer_wheels=ints([i for i, w in enumerate(robot.wheels) if w.kind.steers]),
         spin_col=readonly(spin_col), spin2_col=readonly(spin2_col), steer_rate_col=readonly(steer_rate_col),
         only_steerable=all(w.type == "steerable" for w in robot.wheels),
+        spin_select=selector(spin_col), steer_rate_select=selector(steer_rate_col),
+        wheel_names=robot.wheel_names, rate_names=robot.rate_names,
     )
+
+
+def selector(cols: np.ndarray) -> slice | np.ndarray | None:
+    """How to take columns `cols` (-1: none, NaN) of the rates: None if all are -1, a slice if evenly spaced
+    (a view, no copy: e.g. Mecanum's spins between rollers), else the index array itself."""
+    if (cols < 0).all():
+        return None
+    step = np.diff(cols)
+    if (cols >= 0).all() and (len(cols) == 1 or (step[0] > 0 and (step == step[0]).all())):
+        return slice(int(cols[0]), int(cols[-1]) + 1, int(step[0]) if len(cols) > 1 else 1)
+    return readonly(cols.copy())
 
 
 def constant_rates(p: Plan, twist: np.ndarray) -> np.ndarray:

@@ -109,7 +109,7 @@ def wheel_commands(
         config, rates, held = _ik_fast.steer_to_twist(p, twist, current, speed_tol)
     else:
         rates, config, held = _general(p, twist, current, batch, speed_tol)
-    spin = _columns(rates, p.spin_col, batch)
+    spin = _columns(rates, p.spin_select, batch, n)
     doubles = p.spin2_col >= 0
     if doubles.any():
         spin = spin.copy()  # may be a view of rates
@@ -129,8 +129,8 @@ def wheel_commands(
         steer = np.full((*batch, n), np.nan)
         steer[..., p.steer_wheels] = config
     return WheelCommands(
-        wheel_names=robot.wheel_names, rate_names=robot.rate_names,
-        steer=_ro(steer), spin=_ro(spin), steer_rate=_ro(_columns(rates, p.steer_rate_col, batch)),
+        wheel_names=p.wheel_names, rate_names=p.rate_names,
+        steer=_ro(steer), spin=_ro(spin), steer_rate=_ro(_columns(rates, p.steer_rate_select, batch, n)),
         rates=_ro(rates), slip=_ro(slip), feasible=_ro(feasible), beta=_ro(config), held=_ro(held),
     )
 
@@ -231,18 +231,15 @@ def _rate_value(name: str, value: ArrayLike) -> ArrayLike:
     return value
 
 
-def _columns(rates: np.ndarray, cols: np.ndarray, batch: tuple[int, ...]) -> np.ndarray:
-    """``rates[..., cols]`` with NaN where ``cols < 0``; the identity selection reuses `rates` (read-only)."""
-    if len(cols) == rates.shape[-1] and np.array_equal(cols, np.arange(len(cols))):
-        return rates
-    if (cols < 0).all():
-        return np.broadcast_to(np.nan, (*batch, len(cols)))
-    step = np.diff(cols)
-    if len(cols) > 1 and cols[0] >= 0 and step[0] > 0 and (step == step[0]).all():  # e.g. Mecanum: spin, roller
-        return rates[..., cols[0]:cols[-1] + 1:step[0]]  # a view, no copy
-    out = rates[..., np.maximum(cols, 0)]
-    if (cols < 0).any():
-        out[..., cols < 0] = np.nan
+def _columns(rates: np.ndarray, select: slice | np.ndarray | None, batch: tuple[int, ...], n: int) -> np.ndarray:
+    """Columns of `rates` chosen by a :func:`_ik_fast.selector`; NaN where the index is -1 or all are."""
+    if select is None:
+        return np.broadcast_to(np.nan, (*batch, n))
+    if isinstance(select, slice):
+        return rates[..., select]  # a view
+    out = rates[..., np.maximum(select, 0)]
+    if (select < 0).any():
+        out[..., select < 0] = np.nan
     return out
 
 
