@@ -122,11 +122,13 @@ class AbsoluteEncoder:
 Encoder = IncrementalEncoder | AbsoluteEncoder
 
 #: Encoders of catalog robots, by robot then joint (thesis §7.5.1: 8290 pulses/rev, 1.4118 deg = 360/255 deg).
+#: The forklift's steering encoder reads 0 when steered straight ahead (beta = 90 deg in the REP-103 frame of the
+#: catalog), so straight is representable; the thesis does not say where its zero is.
 CATALOG_ENCODERS: Mapping[str, Mapping[str, Encoder]] = {
     "forklift": {
         "right_drive.spin": IncrementalEncoder(counts_per_rev=8290),
         "left_drive.spin": IncrementalEncoder(counts_per_rev=8290),
-        "steer.steer": AbsoluteEncoder(resolution=math.radians(1.4118)),
+        "steer.steer": AbsoluteEncoder(resolution=math.radians(1.4118), offset=math.pi / 2),
     },
 }
 

@@ -196,7 +196,7 @@ def check_time(log: JointLog, time: np.ndarray, previous: float | None, max_gap:
     if bad.size:
         i = int(bad[0]) + 1 - shift
         what = "repeats the previous sample (a zero time step)" if dt[bad[0]] == 0 else "goes backwards"
-        raise LogError(f"{log.where(i)}: time {time[i]!r} s {what}; time must increase strictly")
+        raise LogError(f"{log.where(i)}: time {float(time[i])!r} s {what}; time must increase strictly")
     if max_gap is not None and dt.size and dt.max() > max_gap:
         i = int(np.argmax(dt)) + 1 - shift
         raise LogError(f"{log.where(i)}: time step of {dt.max():.6g} s exceeds max_gap = {max_gap:g} s (a gap)")
@@ -318,7 +318,7 @@ def _check_finite(log: JointLog, raw: np.ndarray) -> None:
     if bad.any():
         i, c = (int(x) for x in np.argwhere(bad)[0])
         name = "time" if c == 0 else log.joints[c - 1] if c <= len(log.joints) else "heading"
-        raise LogError(f"{log.where(i)}: {name}: value {raw[i, c]!r} is not a finite number")
+        raise LogError(f"{log.where(i)}: {name}: value {float(raw[i, c])!r} is not a finite number")
 
 
 def _cumtrapz(rate: np.ndarray, t: np.ndarray, *, start: bool) -> np.ndarray:

@@ -175,10 +175,10 @@ def _check_finite(log: JointLog) -> None:
         if bad.any():
             i, c = (int(x) for x in np.argwhere(bad)[0])
             what = "time" if name == "time" else log.joints[c]
-            raise LogError(f"{log.where(i)}: {what}: value {values[i, c]!r} is not a finite number")
+            raise LogError(f"{log.where(i)}: {what}: value {float(values[i, c])!r} is not a finite number")
     if log.heading_world is not None and not np.all(np.isfinite(log.heading_world)):
         i = int(np.flatnonzero(~np.isfinite(log.heading_world))[0])
-        raise LogError(f"{log.where(i)}: heading: value {log.heading_world[i]!r} is not a finite number")
+        raise LogError(f"{log.where(i)}: heading: value {float(log.heading_world[i])!r} is not a finite number")
 
 
 class _Stats:

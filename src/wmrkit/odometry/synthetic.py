@@ -123,8 +123,7 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     sample_idx = np.searchsorted(fine, t_samples)
     dt = np.diff(fine)
     twist = profile.at(0.5 * (fine[:-1] + fine[1:]))  # (M, 3)
-    beta_nodes = _steering(robot, profile, fine, twist, sensed)  # (M + 1, n_steer)
-    beta_mid = 0.5 * (beta_nodes[:-1] + beta_nodes[1:])
+    beta_nodes, beta_mid = _steering(robot, profile, fine, twist, sensed)  # (M + 1, n_steer), (M, n_steer)
     configs, index = np.unique(beta_mid, axis=0, return_inverse=True)  # one solve per distinct configuration
     q_unit, res_unit = solve_assigned(robot.constraint_matrix(configs)[:, None], [0, 1, 2], np.eye(3))
     index = index.reshape(-1)
@@ -172,15 +171,19 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
 
 
 def _steering(robot: Robot, profile: TwistProfile, fine: np.ndarray, twist: np.ndarray,
-              sensed: Sequence[str]) -> np.ndarray:
-    """Steering angles at the fine nodes ``(M + 1, n_steer)``: geometric for steerable/double, ODE for castors
-    (only for castors with a sensed joint: an unsensed castor's angle changes no other wheel's rates)."""
+              sensed: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Steering angles at the fine nodes ``(M + 1, n_steer)`` and over the fine intervals ``(M, n_steer)``:
+    geometric for steerable/double wheels (the interval's own angle while moving, so a steering change at a node
+    does not leak into the interval before it), an ODE for castors (only those with a sensed joint: an unsensed
+    castor's angle changes no other wheel's rates), midpoints of the nodes otherwise."""
     out = np.empty((len(fine), len(robot.steer_names)))
+    mid = np.empty((len(fine) - 1, len(robot.steer_names)))
     for k, name in enumerate(robot.steer_names):
         wheel = robot.wheel(name)
         if wheel.type in ("castor", "double_castor"):
             mine = any(j.partition(".")[0] == name for j in sensed)
             out[:, k] = _castor_angles(wheel, profile, fine) if mine else wheel.beta
+            mid[:, k] = 0.5 * (out[:-1, k] + out[1:, k])
             continue
         x, y = wheel.position
         vx, vy = twist[:, 0] - twist[:, 2] * y, twist[:, 1] + twist[:, 2] * x  # steering joint velocity
@@ -188,7 +191,8 @@ def _steering(robot: Robot, profile: TwistProfile, fine: np.ndarray, twist: np.n
         b = np.arctan2(vx, -vy)  # axle (cos b, sin b) normal to v, positive spin along v (3.11)
         b = wheel.beta + (b - wheel.beta + np.pi / 2) % np.pi - np.pi / 2  # within 90 deg of the described angle
         out[:, k] = _nodes_from_intervals(np.where(moving, b, np.nan), fine, wheel.beta)
-    return out
+        mid[:, k] = np.where(moving, b, 0.5 * (out[:-1, k] + out[1:, k]))
+    return out, mid
 
 
 def _nodes_from_intervals(b: np.ndarray, fine: np.ndarray, default: float) -> np.ndarray:

@@ -1,0 +1,192 @@
+"""CSV logs in (formats, chunks, validation with located errors) and trajectories out (CSV, TUM)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.odometry.encoders import IncrementalEncoder, catalog_encoders
+from wmrkit.odometry.logs import JointLog, LogError, LogFormat, concatenate, load_csv, read_csv, write_csv
+from wmrkit.odometry.pipeline import odometry
+from wmrkit.odometry.synthetic import TwistProfile, simulate
+from wmrkit.odometry.trajectories import (
+    Trajectory,
+    TrajectoryWriter,
+    quaternion_z,
+    read_trajectory_csv,
+    read_tum,
+    write_trajectory,
+    yaw_of_quaternion,
+)
+
+JOINTS = ("left.spin", "right.spin")
+WHEELS = ("left", "right", "caster")
+
+
+def _write(path, header, rows):
+    path.write_text(header + "\n" + "".join(r + "\n" for r in rows))
+    return str(path)
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 1 << 16])
+def test_csv_round_trip_in_any_chunk_size(diff_csv, diff_run, chunk):
+    chunks = list(read_csv(diff_csv, JOINTS, chunk_size=chunk))
+    assert len(chunks) == math.ceil(len(diff_run.log) / chunk)
+    log = concatenate(chunks)
+    np.testing.assert_array_equal(log.time, diff_run.log.time)
+    np.testing.assert_array_equal(log.positions, diff_run.log.positions)  # %.17g round-trips exactly
+    assert chunks[-1].first_line == 2 + chunk * (len(chunks) - 1)
+
+
+def test_renamed_columns_time_unit_and_column_order(tmp_path, diff_run, write_log):
+    path = write_log(tmp_path / "r.csv", diff_run, names=("t_ms", "enc_l", "enc_r"))
+    raw = np.column_stack([diff_run.log.time * 1000, diff_run.log.positions])
+    write_csv(path, ("t_ms", "enc_r", "enc_l"), raw[:, [0, 2, 1]])
+    fmt = LogFormat(time_column="t_ms", time_unit="ms", columns=(("left.spin", "enc_l"), ("right.spin", "enc_r")))
+    log = load_csv(path, JOINTS, fmt)
+    np.testing.assert_allclose(log.time, diff_run.log.time, rtol=1e-15)
+    np.testing.assert_array_equal(log.positions, diff_run.log.positions)
+
+
+def test_counts_with_a_wrapping_16_bit_counter(tmp_path):
+    """Forklift encoders (8290 pulses/rev) on 16-bit counters: the counters wrap during the run."""
+    robot = catalog.load("forklift")
+    enc = {**catalog_encoders("forklift"), "right_drive.spin": IncrementalEncoder(8290, bits=16),
+           "left_drive.spin": IncrementalEncoder(8290, bits=16)}
+    profile = TwistProfile.from_segments([(30.0, 1.0, 0.0, 0.0)])  # 30 m: 172000 counts, the counter wraps twice
+    run = simulate(robot, profile, 10.0, encoders=enc)
+    joints = run.log.joints
+    counts = np.column_stack([run.counts[j] for j in joints])
+    assert counts[:, 0].max() < 65536 and np.any(np.diff(counts[:, 0]) < 0)
+    path = str(tmp_path / "counts.csv")
+    write_csv(path, ("time", *joints), np.column_stack([run.log.time, counts]), fmt="%.10g")
+    fmt = LogFormat(spin="counts", steer="counts", encoders=tuple(enc.items()))
+    log = load_csv(path, joints, fmt)
+    np.testing.assert_allclose(log.positions[:, :2], run.log.positions[:, :2] - run.log.positions[0, :2],
+                               rtol=0, atol=1e-9)
+    np.testing.assert_allclose(log.positions[:, 2], run.log.positions[:, 2], atol=1e-12)
+    traj = odometry(robot, log)
+    assert traj.final_pose[0] == pytest.approx(30.0, abs=2 * math.pi * 0.23 / 8290 * 2)  # within two counts
+
+
+def test_velocity_logs_are_integrated_by_the_trapezoidal_rule(tmp_path):
+    t = np.linspace(0, 2, 41)
+    rates = np.column_stack([1.0 + 0.5 * t, 2.0 - 0.25 * t])  # linear rates: trapezoids are exact
+    path = _write(tmp_path / "v.csv", "time,left.spin,right.spin", [f"{a!r},{b!r},{c!r}" for a, b, c in
+                                                                    np.column_stack([t, rates]).tolist()])
+    for chunk in (3, 100):
+        log = concatenate(list(read_csv(path, JOINTS, LogFormat(spin="velocity"), chunk_size=chunk)))
+        np.testing.assert_allclose(log.positions[:, 0], t + 0.25 * t**2, atol=1e-13)
+        np.testing.assert_allclose(log.positions[:, 1], 2 * t - 0.125 * t**2, atol=1e-13)
+
+
+def test_heading_and_gyro_columns(tmp_path):
+    t = np.linspace(0, 4, 81)
+    yaw = 0.9 * t  # passes +pi: the IMU column wraps
+    wrapped = (yaw + math.pi) % (2 * math.pi) - math.pi
+    rows = [f"{a!r},0,0,{b!r},0.9" for a, b in zip(t.tolist(), wrapped.tolist(), strict=True)]
+    path = _write(tmp_path / "h.csv", "time,left.spin,right.spin,yaw,gyro_z", rows)
+    for chunk in (5, 1000):
+        log = concatenate(list(read_csv(path, JOINTS, LogFormat(heading_column="yaw"), chunk_size=chunk)))
+        np.testing.assert_allclose(log.heading_world, yaw, atol=1e-12)
+        log = concatenate(list(read_csv(path, JOINTS, LogFormat(gyro_column="gyro_z"), chunk_size=chunk)))
+        np.testing.assert_allclose(log.heading_world, yaw, atol=1e-12)
+
+
+@pytest.mark.parametrize(("header", "rows", "fmt", "message"), [
+    ("time,left.spin,right.spin", ["0,0,0", "0.1,1,1", "0.1,2,2"], LogFormat(),
+     r"x\.csv:4: time 0\.1 s repeats the previous sample \(a zero time step\)"),
+    ("time,left.spin,right.spin", ["0,0,0", "0.2,1,1", "0.1,2,2"], LogFormat(),
+     r"x\.csv:4: time 0\.1 s goes backwards"),
+    ("time,left.spin,right.spin", ["0,0,0", "0.1,nan,1"], LogFormat(),
+     r"x\.csv:3: left\.spin: value nan is not a finite number"),
+    ("time,left.spin,right.spin", ["0,0,0", "0.1,,1"], LogFormat(), r"x\.csv:3: field 2: cannot read '' as a number"),
+    ("time,left.spin,right.spin", ["0,0,0", "0.1,1"], LogFormat(), r"x\.csv:3: expected 3 fields, got 2"),
+    ("time,left.spin,right.spin", ["0,0,0", "0.1,abc,1"], LogFormat(), r"x\.csv:3: field 2: cannot read 'abc'"),
+    ("time,left.spin,rigth.spin", ["0,0,0"], LogFormat(),
+     r"x\.csv:1: column 'rigth\.spin' names no wheel of the robot \(wheels: left, right, caster\)"),
+    ("time,left.spin,right_spin", ["0,0,0"], LogFormat(),
+     r"x\.csv:1: missing column 'right\.spin' \(did you mean 'right_spin'\?\)"),
+    ("t,left.spin,right.spin", ["0,0,0"], LogFormat(), r"x\.csv:1: missing column 'time'"),
+    ("time,left.spin,right.spin,left.spin", ["0,0,0,0"], LogFormat(), r"x\.csv:1: column 'left\.spin' appears twice"),
+    ("time,left.spin,right.spin", [], LogFormat(), r"x\.csv: no samples after the header"),
+    ("time,left.spin,right.spin", ["0,0,0", "0.1,1,1", "5.0,2,2"], LogFormat(max_gap=1.0),
+     r"x\.csv:4: time step of 4\.9 s exceeds max_gap = 1 s \(a gap\)"),
+    ("time,left.spin,right.spin", ["0,0,0", "0.1,70000,1"],
+     LogFormat(spin="counts", encoders=(("left.spin", IncrementalEncoder(100, bits=16)),
+                                        ("right.spin", IncrementalEncoder(100, bits=16)))),
+     r"column 'left\.spin': count 70000 outside the 16-bit unsigned counter range"),
+    ("time,left.spin,right.spin", ["0,0,0"], LogFormat(spin="counts"),
+     r"joint 'left\.spin' is logged as counts but has no IncrementalEncoder"),
+])
+def test_bad_logs_are_refused_with_their_location(tmp_path, header, rows, fmt, message):
+    path = _write(tmp_path / "x.csv", header, rows)
+    with pytest.raises(LogError, match=message):
+        load_csv(path, JOINTS, fmt, wheels=WHEELS)
+
+
+def test_errors_in_later_chunks_name_the_right_line(tmp_path):
+    rows = [f"{0.1 * k!r},{k},{k}" for k in range(50)]
+    rows[37] = "3.6,nan,1"
+    path = _write(tmp_path / "x.csv", "time,left.spin,right.spin", rows)
+    with pytest.raises(LogError, match=r"x\.csv:39: left\.spin"):
+        list(read_csv(path, JOINTS, chunk_size=8))
+
+
+def test_missing_and_empty_files(tmp_path):
+    with pytest.raises(LogError, match=r"nope\.csv: cannot open"):
+        load_csv(tmp_path / "nope.csv", JOINTS)
+    (tmp_path / "e.csv").write_text("")
+    with pytest.raises(LogError, match=r"e\.csv:1: empty file"):
+        load_csv(tmp_path / "e.csv", JOINTS)
+
+
+def test_log_format_and_value_checks():
+    with pytest.raises(LogError, match="unknown time unit 'min'"):
+        LogFormat(time_unit="min")
+    with pytest.raises(LogError, match="not both"):
+        LogFormat(heading_column="a", gyro_column="b")
+    with pytest.raises(LogError, match="max_gap must be > 0"):
+        LogFormat(max_gap=0)
+    with pytest.raises(LogError, match=r"expected time \(N,\) and positions \(N, 2\)"):
+        JointLog(np.zeros(3), JOINTS, np.zeros((3, 3)))
+    log = JointLog(np.zeros(3), JOINTS, np.zeros((3, 2)), source="mem")
+    with pytest.raises(LogError, match=r"mem: no samples of joint 'steer\.steer'"):
+        log.select(["steer.steer"])
+
+
+def test_quaternions_and_yaw():
+    theta = np.array([0.0, 0.5, -2.0, math.pi - 1e-9, 4.0])
+    q = quaternion_z(theta)
+    np.testing.assert_allclose(np.linalg.norm(q, axis=-1), 1.0)
+    np.testing.assert_allclose(np.remainder(yaw_of_quaternion(q) - theta + math.pi, 2 * math.pi) - math.pi, 0,
+                               atol=1e-12)
+    scipy_rot = pytest.importorskip("scipy.spatial.transform").Rotation
+    np.testing.assert_allclose(q, scipy_rot.from_euler("z", theta[:, None]).as_quat(), atol=1e-15)
+
+
+def test_trajectory_files_round_trip(tmp_path):
+    rng = np.random.default_rng(0)
+    n = 30
+    a = rng.normal(size=(n, 3, 3)) * 0.1
+    traj = Trajectory(np.arange(n) * 0.05 + 1e9, np.cumsum(rng.normal(size=(n, 3)), axis=0), np.abs(rng.normal(size=n)),
+                      a @ np.swapaxes(a, -1, -2))
+    write_trajectory(tmp_path / "t.csv", traj, "csv")
+    back = read_trajectory_csv(tmp_path / "t.csv")
+    np.testing.assert_allclose(back.poses, traj.poses, rtol=1e-11)
+    np.testing.assert_allclose(back.covariance, traj.covariance, rtol=1e-11)
+    np.testing.assert_allclose(back.time, traj.time, atol=1e-9)
+    with TrajectoryWriter(tmp_path / "t.tum", "tum") as w:  # written in two chunks
+        w.write(Trajectory(traj.time[:10], traj.poses[:10], traj.slip[:10]))
+        w.write(Trajectory(traj.time[10:], traj.poses[10:], traj.slip[10:]))
+    lines = (tmp_path / "t.tum").read_text().splitlines()
+    assert lines[0].startswith("#") and all(len(ln.split(" ")) == 8 for ln in lines[1:])  # what evo reads
+    t, poses = read_tum(tmp_path / "t.tum")
+    np.testing.assert_allclose(t, traj.time, atol=1e-9)
+    np.testing.assert_allclose(poses[:, :2], traj.poses[:, :2], rtol=1e-11)
+    np.testing.assert_allclose(np.diff(poses[:, 2]), np.diff(np.unwrap(traj.poses[:, 2])), atol=1e-10)
+    with pytest.raises(LogError, match="unknown trajectory format 'kitti'"):
+        TrajectoryWriter(tmp_path / "t.x", "kitti")

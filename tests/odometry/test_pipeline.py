@@ -1,0 +1,155 @@
+"""The streaming pipeline: any robot from its sensors, chunk invariance, external heading, slip, bounded memory."""
+
+from __future__ import annotations
+
+import math
+import tracemalloc
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.odometry.covariance import CrowleyNoise
+from wmrkit.odometry.encoders import catalog_encoders
+from wmrkit.odometry.integrators import METHODS
+from wmrkit.odometry.logs import JointLog, LogError
+from wmrkit.odometry.model import odometry_model
+from wmrkit.odometry.pipeline import Decimator, odometry, run_odometry
+from wmrkit.odometry.synthetic import Slip, TwistProfile, simulate, square_path
+
+#: Robots and paths they can drive without slip: (robot, profile, tolerance on the final pose [m, rad]).
+#: The tolerances reflect sampling only: a sample interval that straddles a change of twist (or of steering) is
+#: integrated as one constant twist.
+CASES = {
+    "diff-drive": (square_path(2.0, turn_rate=math.pi / 8), 1e-9),  # 4 s sides and turns: on the sample grid
+    "line-follower": (square_path(1.0, speed=0.25, turn_rate=math.pi / 8).about((-0.39, 0.0)), 1e-9),
+    "mecanum-4": (TwistProfile.from_segments([(2.0, 0.3, 0.2, 0.4), (2.0, -0.1, 0.3, -0.2)]), 1e-9),
+    "omni-3": (TwistProfile.from_segments([(3.0, 0.2, -0.3, 0.5)]), 1e-9),
+    "omni-4": (TwistProfile.from_segments([(3.0, 0.2, 0.3, -0.5)]), 1e-9),
+    "swerve-4": (TwistProfile.from_segments([(2.0, 0.3, 0.3, 0.0), (1.0, 0, 0, 0), (2.0, 0.4, 0.0, 0.3)]), 1e-3),
+    "ackermann": (TwistProfile.from_segments([(3.0, 0.5, 0.0, 0.2), (1.0, 0, 0, 0), (3.0, 0.5, 0.0, -0.3)]), 1e-3),
+    "forklift": (square_path(3.0, pause=1.0).about((-1.0, 0.0)), 1e-3),
+}
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_any_robot_from_its_own_sensors(name):
+    robot = catalog.load(name)
+    profile, tol = CASES[name]
+    run = simulate(robot, profile, 40.0)
+    traj = odometry(robot, run.log)
+    err = np.abs(traj.poses - run.truth).max()
+    assert err < tol, err
+    assert traj.slip.max() < (1e-12 if tol < 1e-6 else 1e-3)
+
+
+def test_forklift_from_quantised_encoders_matches_within_the_resolution():
+    """8290 pulses/rev and the 1.4118 deg steering encoder (thesis §7.5.1): a drive around a closed square."""
+    robot = catalog.load("forklift")
+    run = simulate(robot, square_path(5.0, speed=1.0, pause=1.0).about((-1.0, 0.0)), 50.0,
+                   encoders=catalog_encoders("forklift"))
+    traj = odometry(robot, run.log)
+    closure = np.hypot(*traj.final_pose[:2] - run.truth[-1, :2])
+    assert closure < 0.05  # 20 m driven; steering quantised to 1.4 deg during the turns
+    assert traj.slip.max() > 0  # quantised steering is not exactly consistent with the drive wheels
+
+
+@pytest.mark.parametrize("chunk", [1, 2, 13, 1000])
+def test_result_does_not_depend_on_the_chunk_size(diff_run, chunk):
+    ref = odometry(catalog.load("diff-drive"), diff_run.log, noise=CrowleyNoise(), chunk_size=1 << 16)
+    got = odometry(catalog.load("diff-drive"), diff_run.log, noise=CrowleyNoise(), chunk_size=chunk)
+    np.testing.assert_allclose(got.poses, ref.poses, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got.covariance, ref.covariance, rtol=1e-10, atol=1e-16)
+    np.testing.assert_array_equal(got.time, ref.time)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_external_heading_from_a_perfect_gyro(diff_run, method):
+    """With the true heading (an ideal IMU), every scheme's heading is the truth's; positions stay close."""
+    robot = catalog.load("diff-drive")
+    log = replace(diff_run.log, heading_world=diff_run.truth[:, 2] + 5.0)  # absolute offset: only changes used
+    traj = odometry(robot, log, method=method, pose0=diff_run.truth[0])
+    np.testing.assert_allclose(traj.poses[:, 2], diff_run.truth[:, 2], atol=1e-12)
+    assert np.abs(traj.poses[:, :2] - diff_run.truth[:, :2]).max() < (1e-9 if method == "exact" else 0.05)
+
+
+def test_odometry_is_blind_to_slip_without_redundant_sensors():
+    """003 Fig. 4 / 002's caveat: one wheel slips; a differential drive has no spare sensor, so the slip
+    indicator stays 0 while the pose goes wrong. A Mecanum robot's fourth wheel sees it."""
+    diff = catalog.load("diff-drive")
+    profile = TwistProfile.from_segments([(6.0, 0.5, 0.0, 0.0)])
+    run = simulate(diff, profile, 20.0, slips=[Slip("left.spin", 2.0, 3.0, 0.2)])
+    traj = odometry(diff, run.log)
+    assert traj.slip.max() < 1e-14
+    assert abs(traj.final_pose[2]) > 0.05 and abs(traj.final_pose[1]) > 0.05  # believes it turned
+    mec = catalog.load("mecanum-4")
+    run = simulate(mec, profile, 20.0, slips=[Slip("front_left.spin", 2.0, 3.0, 0.2)])
+    traj = odometry(mec, run.log)
+    window = (traj.time > 2.0 + 1e-9) & (traj.time <= 3.0 + 1e-9)
+    assert traj.slip[window].min() > 1e-3
+    assert traj.slip[~window].max() < 1e-12
+
+
+def test_summary_of_a_streamed_run(diff_run):
+    robot = catalog.load("diff-drive")
+    model = odometry_model(robot)
+    kept = []
+    chunks = (diff_run.log.slice(i, i + 50) for i in range(0, len(diff_run.log), 50))
+    s = run_odometry(model, chunks, noise=CrowleyNoise(), sinks=[kept.append])
+    assert s.samples == len(diff_run.log) == sum(map(len, kept))
+    np.testing.assert_allclose(s.final_pose, diff_run.truth[-1], atol=1e-9)
+    assert s.distance == pytest.approx(3.0 * 0.4 + 2.0 * 0.5 + 3.0 * 0.4, rel=1e-9)  # path length of the profile
+    assert s.rotation == pytest.approx(3.0 * 0.5 + 3.0 * 0.6, rel=1e-9)
+    assert s.max_dt == pytest.approx(0.05)
+    assert s.to_dict()["pose"] == list(s.final_pose)
+    assert np.allclose(s.final_covariance, kept[-1].covariance[-1])
+
+
+def test_decimator_keeps_a_bounded_evenly_spaced_subset():
+    dec = Decimator(max_points=100)
+    n = 10_000
+    for start in range(0, n, 333):
+        t = np.arange(start, min(start + 333, n), dtype=float)
+        from wmrkit.odometry.trajectories import Trajectory
+
+        dec(Trajectory(t, np.column_stack([t, t, t]), np.zeros(len(t))))
+    time, poses = dec.result()
+    assert len(time) <= 100 and time[0] == 0
+    assert np.all(np.diff(time) == dec.stride)
+    np.testing.assert_array_equal(poses[:, 0], time)
+
+
+def test_memory_stays_bounded_for_long_streams():
+    """500 000 samples in chunks of 5000: peak traced memory is that of a few chunks, not of the log."""
+    model = odometry_model(catalog.load("diff-drive"))
+    n, chunk = 500_000, 5_000
+
+    def chunks():
+        for s in range(0, n, chunk):
+            t = (np.arange(s, s + chunk) + 1) * 1e-3
+            yield JointLog(t, model.joints, np.column_stack([t * 10, t * 11]))
+
+    tracemalloc.start()
+    summary = run_odometry(model, chunks(), noise=CrowleyNoise())
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert summary.samples == n
+    assert peak < 8 * 1024**2  # the whole log alone would be 12 MB, its trajectory with covariance 52 MB
+
+
+def test_bad_in_memory_logs_are_refused():
+    robot = catalog.load("diff-drive")
+    joints = ("left.spin", "right.spin")
+    with pytest.raises(LogError, match=r"<log>: sample 2: time 0\.1 s repeats the previous sample"):
+        odometry(robot, JointLog(np.array([0.0, 0.1, 0.1]), joints, np.zeros((3, 2))))
+    with pytest.raises(LogError, match=r"sample 1: right\.spin: value inf is not a finite number"):
+        odometry(robot, JointLog(np.array([0.0, 0.1]), joints, np.array([[0, 0], [0, math.inf]])))
+    with pytest.raises(LogError, match="the log has no samples"):
+        odometry(robot, JointLog(np.zeros(0), joints, np.zeros((0, 2))))
+    with pytest.raises(LogError, match=r"no samples of joint 'right\.spin'"):
+        odometry(robot, JointLog(np.zeros(1), joints[:1], np.zeros((1, 1))))
+    # across a chunk boundary
+    log = JointLog(np.array([0.0, 0.1, 0.2, 0.15]), joints, np.zeros((4, 2)))
+    with pytest.raises(LogError, match=r"sample 3: time 0\.15 s goes backwards"):
+        odometry(robot, log, chunk_size=2)
