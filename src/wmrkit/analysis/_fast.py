@@ -67,13 +67,13 @@ def kappa_cm(mobility: int, rates: np.ndarray, lines: np.ndarray, length: float)
     if mobility == 3:
         h = rates * np.array([1.0, 1.0, 1.0 / length])[None, :, None]
         small, _, large = _eig3(gram3(h))
-        return _ratio(small, large)
+        return ratio(small, large)
     if mobility == 2:
         a, b, ok = columns_m2(rates, lines)
         b = b / length
         small, large = eigvalsh2_entries(np.einsum("jn,jn->n", a, a), np.einsum("jn,jn->n", a, b),
                                          np.einsum("jn,jn->n", b, b))
-        return np.where(ok, _ratio(small, large), np.nan)
+        return np.where(ok, ratio(small, large), np.nan)
     if mobility == 1:
         g0 = lines[0]
         cross = np.stack([g0[1] * lines[:, 2] - g0[2] * lines[:, 1], g0[2] * lines[:, 0] - g0[0] * lines[:, 2],
@@ -122,6 +122,7 @@ def _eig3(entries: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray, np.n
     return w[..., 0], w[..., 1], w[..., 2]
 
 
-def _ratio(small: np.ndarray, large: np.ndarray) -> np.ndarray:
+def ratio(small: np.ndarray, large: np.ndarray) -> np.ndarray:
+    """``sqrt(large / small)``: a condition number from Gram eigenvalues; inf where small vanishes."""
     tiny = np.maximum(small, 0.0) <= 1e-14 * np.maximum(large, 1e-300)
     return np.where(tiny, np.inf, np.sqrt(large / np.where(tiny, 1.0, small)))

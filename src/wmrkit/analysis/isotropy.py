@@ -203,22 +203,27 @@ def _minimise_length(kappa, size: float) -> tuple[float, float]:
     if np.nanmax(values[finite]) - np.nanmin(values[finite]) < 1e-9 * np.nanmin(values[finite]):
         return size, k_size
     i = int(np.nanargmin(np.where(finite, values, np.inf)))
-    a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
-    ratio = (np.sqrt(5) - 1) / 2  # golden section: kappa(D) is unimodal but not smooth at its minimum
+    x = golden_section(lambda t: kappa(np.exp(t)), grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)])
+    fx = kappa(np.exp(x))
+    return (float(np.exp(x)), float(fx)) if fx <= values[i] else (float(np.exp(grid[i])), float(values[i]))
+
+
+def golden_section(f, a: float, b: float, *, tol: float = 1e-13) -> float:
+    """Minimiser of a unimodal `f` on ``[a, b]`` by golden-section search (no smoothness needed: kappa has a
+    kink at its isotropic minimum, where two singular values cross)."""
+    ratio = (np.sqrt(5) - 1) / 2
     c, d = b - ratio * (b - a), a + ratio * (b - a)
-    fc, fd = kappa(np.exp(c)), kappa(np.exp(d))
-    while b - a > 1e-13:
+    fc, fd = f(c), f(d)
+    while b - a > tol * max(1.0, abs(a) + abs(b)):
         if fc <= fd:
             b, d, fd = d, c, fc
             c = b - ratio * (b - a)
-            fc = kappa(np.exp(c))
+            fc = f(c)
         else:
             a, c, fc = c, d, fd
             d = a + ratio * (b - a)
-            fd = kappa(np.exp(d))
-    x = (a + b) / 2
-    fx = kappa(np.exp(x))
-    return (float(np.exp(x)), float(fx)) if fx <= values[i] else (float(np.exp(grid[i])), float(values[i]))
+            fd = f(d)
+    return (a + b) / 2
 
 
 def condition_map(robot: Robot, beta: ArrayLike, *, joints: tuple[str, ...] | None = None,

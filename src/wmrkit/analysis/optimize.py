@@ -1,0 +1,184 @@
+"""Finding isotropic or best-conditioned configurations and geometries (thesis §5.4-5.5 criteria).
+
+"Isotropy must be achieved" (§5.4): with steered wheels it is a planning criterion (stay near isotropic
+configurations, :func:`best_configurations`); without, a design criterion on the geometry
+(:func:`optimize_geometry`). Objectives: the condition number at the natural length (5.28), or the global
+isotropy of Kim et al. 05 (mean of 1/kappa over the steering space, §5.4 and digest §3.3).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.optimize import minimize
+
+from ..errors import UnknownNameError, WmrkitError
+from ..robot import Robot
+from . import _fast
+from ._sym import eigvalsh2_entries
+from .isotropy import _kappa, golden_section, natural_length, twist_model
+from .lines import _params, constraint_lines
+from .singularity import robot_size
+
+
+@dataclass(frozen=True)
+class Conditioning:
+    """A steering configuration ``beta`` ``(n_steer,)`` [rad], its length D [m] and condition number (5.28)."""
+
+    beta: tuple[float, ...]
+    length: float
+    condition_number: float
+
+
+def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, length: float | None = None,
+                        variables: tuple[str, ...] | None = None, resolution: int = 72,
+                        max_samples: int = 20000, count: int = 8) -> tuple[Conditioning, ...]:
+    """Local minima of the condition number over the steering configuration, best first (§5.5 criteria).
+
+    kappa is :func:`~wmrkit.analysis.isotropy.twist_condition_number` for `joints`, at `length` or at each
+    configuration's natural length. A grid (`resolution` per turn, at most `max_samples` points) finds the
+    basins; the best `count` are refined to machine precision. `variables` default to the steering wheels that
+    change kappa (those with an axle constraint or among the joints).
+    """
+    model = twist_model(robot, joints)
+    steer = robot.steer_names
+    if variables is None:
+        used = set(constraint_lines(robot).wheels) | {n.split(".")[0] for n in model.joints}
+        variables = tuple(n for n in steer if n in used)
+    for v in variables:
+        if v not in steer:
+            raise UnknownNameError(f"robot '{robot.name}' has no steering wheel '{v}' (steering: {', '.join(steer)})")
+    idx = [steer.index(v) for v in variables]
+
+    def full(x: np.ndarray) -> np.ndarray:
+        b = np.broadcast_to(robot.beta, (*np.shape(x)[:-1], len(steer))).copy()
+        b[..., idx] = x
+        return b
+
+    def score(x: np.ndarray) -> float:
+        b = full(np.asarray(x, dtype=float))
+        return natural_length(robot, b, joints=model.joints)[1] if length is None else float(_kappa(model, b, length))
+
+    if not idx:
+        d, k = natural_length(robot, joints=model.joints) if length is None else (length, score(np.zeros(0)))
+        return (Conditioning(tuple(robot.beta.tolist()), d, k),)
+    per_axis = resolution if len(idx) == 1 else max(4, min(resolution, int(max_samples ** (1 / len(idx)))))
+    axis = np.linspace(-np.pi, np.pi, per_axis, endpoint=False)
+    mesh = np.stack(np.meshgrid(*([axis] * len(idx)), indexing="ij"), axis=-1)  # (n, ..., n, v)
+    values = _grid_kappa(model, full(mesh), length)
+    finite = np.where(np.isfinite(values), values, np.inf)
+    is_min = np.ones(values.shape, bool)
+    for ax in range(len(idx)):
+        is_min &= (finite <= np.roll(finite, 1, ax)) & (finite <= np.roll(finite, -1, ax))
+    starts = np.argwhere(is_min & np.isfinite(values))
+    starts = starts[np.argsort(finite[tuple(starts.T)])][:count]
+    step = 2 * np.pi / per_axis
+    found: list[tuple[np.ndarray, float]] = []
+    for s in starts:
+        x0 = axis[s]
+        if len(idx) == 1:
+            x = np.array([golden_section(lambda t: score(np.array([t])), x0[0] - step, x0[0] + step)])
+        else:
+            x = minimize(score, x0, method="Nelder-Mead", options={"xatol": 1e-10, "fatol": 1e-14}).x
+        x = np.mod(x + np.pi, 2 * np.pi) - np.pi
+        if not any(np.all(np.abs(np.angle(np.exp(1j * (x - y)))) < 1e-6) for y, _ in found):
+            found.append((x, score(x)))
+    out = []
+    for x, k in sorted(found, key=lambda t: t[1]):
+        b = full(x)
+        d = natural_length(robot, b, joints=model.joints)[0] if length is None else length
+        out.append(Conditioning(tuple(float(v) for v in b), float(d), float(k)))
+    return tuple(out)
+
+
+def isotropic_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None,
+                             variables: tuple[str, ...] | None = None, resolution: int = 72,
+                             tol: float = 1e-6) -> tuple[Conditioning, ...]:
+    """Configurations where the model is isotropic, kappa = 1 at its natural length (5.29); may be empty."""
+    best = best_configurations(robot, joints=joints, variables=variables, resolution=resolution, count=16)
+    return tuple(c for c in best if c.condition_number < 1 + tol)
+
+
+def _grid_kappa(model, beta: np.ndarray, length: float | None) -> np.ndarray:
+    """kappa over a grid ``(..., n_steer) -> (...)``: at `length`, or minimised over D per configuration."""
+    if length is not None:
+        return _kappa(model, beta, length)
+    size = robot_size(model.robot)
+    if model.mobility == 2:  # closed form per configuration: D = |b| / |a|
+        flat = beta.reshape(-1, beta.shape[-1])
+        p, cl = _params(model.robot), constraint_lines(model.robot)
+        out = np.empty(len(flat))
+        for s in range(0, len(flat), _fast.CHUNK):
+            rows = _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
+            lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
+            rates = _fast.combine(model.coefficients, rows)
+            a, b, ok = _fast.columns_m2(rates, lines)
+            na, nb = np.linalg.norm(a, axis=0), np.linalg.norm(b, axis=0)
+            b = b / np.where((na > 0) & (nb > 0), nb / np.where(na > 0, na, 1.0), size)
+            small, large = eigvalsh2_entries(np.einsum("jn,jn->n", a, a), np.einsum("jn,jn->n", a, b),
+                                             np.einsum("jn,jn->n", b, b))
+            out[s:s + _fast.CHUNK] = np.where(ok, _fast.ratio(small, large), np.nan)
+        return out.reshape(beta.shape[:-1])
+    lengths = size * np.logspace(-2, 2, 33)
+    return np.min(np.stack([_kappa(model, beta, d) for d in lengths]), axis=0)
+
+
+@dataclass(frozen=True, eq=False)
+class GeometryOptimum:
+    """Result of :func:`optimize_geometry`: parameters ``x``, the robot, its length D [m] and objective value."""
+
+    x: np.ndarray
+    robot: Robot
+    length: float
+    condition_number: float
+
+
+def optimize_geometry(family: Callable[[np.ndarray], Robot], x0: ArrayLike, *,
+                      bounds: Sequence[tuple[float, float]] | None = None, joints: tuple[str, ...] | None = None,
+                      objective: Literal["described", "global"] = "described", samples: int = 256,
+                      starts: int = 4, seed: int = 0) -> GeometryOptimum:
+    """Parameters of a robot family with the best conditioning (design criterion of §5.4).
+
+    `family` maps a parameter vector to a :class:`~wmrkit.Robot` (raise a WmrkitError for invalid ones).
+    ``objective="described"``: kappa at the described configuration and natural length. ``"global"``
+    (Kim et al. 05): ``1 / mean(1 / kappa)`` over `samples` random steering configurations at the best common
+    length. Nelder-Mead from `x0` and ``starts - 1`` random points within `bounds`.
+    """
+    x0 = np.atleast_1d(np.asarray(x0, dtype=float))
+    rng = np.random.default_rng(seed)
+
+    def evaluate(x: np.ndarray) -> tuple[float, float]:
+        try:
+            robot = family(np.asarray(x, dtype=float))
+        except WmrkitError:
+            return np.inf, np.nan
+        if objective == "described":
+            d, k = natural_length(robot, joints=joints)
+            return (k if np.isfinite(k) else np.inf), d
+        model = twist_model(robot, joints)
+        beta = rng_fixed.uniform(-np.pi, np.pi, (samples, len(robot.steer_names)))
+        inv = lambda d: -float(np.mean(1 / np.nan_to_num(_kappa(model, beta, d), nan=np.inf)))  # noqa: E731
+        size = robot_size(robot)
+        d = float(np.exp(golden_section(lambda t: inv(np.exp(t)), np.log(size / 100), np.log(size * 100))))
+        mean_inv = -inv(d)
+        return (1 / mean_inv if mean_inv > 0 else np.inf), d
+
+    if objective not in ("described", "global"):
+        raise UnknownNameError(f"objective must be 'described' or 'global', got {objective!r}")
+    rng_fixed = np.random.default_rng(seed + 1)
+    points = [x0]
+    for _ in range(starts - 1):
+        points.append(rng.uniform(*np.array(bounds, dtype=float).T) if bounds is not None
+                      else x0 * (1 + 0.2 * rng.normal(size=x0.shape)))
+    best = None
+    for p in points:
+        res = minimize(lambda x: evaluate(x)[0], p, method="Nelder-Mead", bounds=bounds,
+                       options={"xatol": 1e-10, "fatol": 1e-13, "maxiter": 4000})
+        if best is None or res.fun < best.fun:
+            best = res
+    value, d = evaluate(best.x)
+    return GeometryOptimum(best.x, family(best.x), float(d), float(value))

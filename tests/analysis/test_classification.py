@@ -1,0 +1,182 @@
+"""Classification (§5.2-5.3, Table 5.1): thesis vehicles, catalog robots, degenerate robots, random robots."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from thesis_vehicles import DEG, bicycle, differential, omni_castor, omni_swedish, robot, tricycle, type3, type5
+
+from conftest import wheels
+from wmrkit import Robot, catalog
+from wmrkit.analysis.classification import TABLE_5_1, classify, instantaneous_mobility
+from wmrkit.analysis.icr import icr
+from wmrkit.kinematics.linalg import matrix_rank
+
+THESIS = [  # digest §9: (vehicle, m, d, type)
+    (omni_swedish(), 3, 0, 1), (omni_castor(), 3, 0, 1),
+    (differential(third="swedish"), 2, 0, 2), (differential(third="castor"), 2, 0, 2),
+    (type3(omni="swedish"), 2, 1, 3), (type3(omni="castor"), 2, 1, 3),
+    (tricycle(), 1, 1, 4), (bicycle(third="swedish"), 1, 1, 4), (bicycle(third="castor"), 1, 1, 4),
+    (type5(third="swedish"), 1, 2, 5), (type5(third="castor"), 1, 2, 5),
+]
+
+
+@pytest.mark.parametrize(("vehicle", "m", "d", "kind"), THESIS, ids=lambda v: getattr(v, "name", str(v)))
+def test_thesis_vehicles(vehicle, m, d, kind):
+    got = classify(vehicle)
+    assert (got.mobility, got.steerability, got.type, got.degenerate) == (m, d, kind, False)
+    assert not got.coordinated
+
+
+CATALOG = {  # what the thesis (or the template's own comments) says each catalog robot is
+    "thesis-omni-swedish": 1, "thesis-omni-castor": 1, "thesis-diff-swedish": 2, "thesis-diff-castor": 2,
+    "thesis-steer-swedish": 3, "thesis-steer-castor": 3, "thesis-tricycle": 4, "thesis-tricycle-ch4": 4,
+    "thesis-bicycle-swedish": 4, "thesis-bicycle-castor": 4, "thesis-two-steer-swedish": 5,
+    "thesis-two-steer-castor": 5, "forklift": 4, "line-follower": 2, "diff-drive": 2, "mecanum-4": 1, "omni-3": 1,
+    "omni-4": 1, "swerve-4": 5, "ackermann": 4, "bicycle": 4, "skid-steer-4": None,
+}
+
+
+@pytest.mark.parametrize("name", sorted(CATALOG))
+def test_catalog_robots(name):
+    got = classify(catalog.load(name))
+    assert got.type == CATALOG[name]
+    assert got.degenerate == (CATALOG[name] is None)
+    if got.type:
+        assert (got.mobility, got.steerability) == {v: k for k, v in TABLE_5_1.items()}[got.type]
+    assert got.coordinated == (name in ("ackermann", "swerve-4"))  # the car is a tricycle only when coordinated
+
+
+def test_skid_steer_fights_and_moves_straight_only():
+    got = classify(catalog.load("skid-steer-4"))
+    assert got.degenerate and got.mobility == 1 and any("fight" in r for r in got.reasons)
+
+
+def _fixed(name, x, y, beta):
+    return {"name": name, "type": "fixed", "l": math.hypot(x, y), "alpha": math.atan2(y, x), "beta": beta, "r": 0.1}
+
+
+def test_degenerate_robots():
+    # two fixed wheels whose axles cross: the robot can only turn about the crossing point (5.11)
+    crossing = classify(robot("x", _fixed("a", 1, 0, 0.0), _fixed("b", 0, 1, math.pi / 2)))
+    assert crossing.degenerate and crossing.mobility == 1 and crossing.type is None
+    # parallel distinct axles: straight motion only (5.11: "even if parallel")
+    parallel = classify(robot("p", _fixed("a", 0, 0.2, 0.0), _fixed("b", 0.5, -0.3, 0.0)))
+    assert parallel.degenerate and parallel.mobility == 1
+    # three fixed wheels with three different axles: cannot move (5.6-5.8)
+    stuck = classify(robot("s", _fixed("a", 1, 0, 0.0), _fixed("b", 0, 1, math.pi / 2), _fixed("c", 1, 1, 0.7)))
+    assert stuck.degenerate and stuck.mobility == 0 and any("cannot move" in r for r in stuck.reasons)
+    # an orientable wheel centred on the fixed axle pins the ICR (5.12b)
+    pinned = classify(robot("o", _fixed("a", 0.5, 0, 0.0), _fixed("b", -0.5, 0, 0.0),
+                            {"name": "o", "type": "steerable", "l": 1.0, "alpha": 0.0, "r": 0.1}))
+    assert pinned.degenerate and any("centred on the fixed axle" in r for r in pinned.reasons)
+    # two orientable wheels on the same centre
+    shared = classify(robot("s", {"name": "o1", "type": "steerable", "l": 0.3, "alpha": 0.2, "r": 0.1},
+                            {"name": "o2", "type": "steerable", "l": 0.3, "alpha": 0.2, "r": 0.1}))
+    assert shared.degenerate and any("share a centre" in r for r in shared.reasons)
+
+
+def test_type5_mobility_rises_at_aligned_wheels():
+    """Digest §7.5: with beta1, beta2 in {0, pi} both axles lie on the X axis and m = 2 (configuration dependence)."""
+    r = type5(third="castor")
+    got = classify(r)
+    assert got.mobility == 1 and len(got.special) == 1 and got.special[0].mobility == 2
+    for b1, b2 in [(0, 0), (0, math.pi), (math.pi, 0), (math.pi, math.pi)]:
+        beta = np.array([b1, b2, 0.7])
+        assert instantaneous_mobility(r, beta) == 2
+        a = r.constraint_matrix(beta)
+        assert a.shape[-1] - matrix_rank(a) == 2  # k - rank A (6.8), independently
+    assert instantaneous_mobility(r, np.array([0.1, 0.0, 0.7])) == 1
+    special = np.array(got.special[0].beta)
+    assert np.allclose(np.sin(special[:2]), 0.0, atol=1e-12)
+
+
+def test_icr_formula_erratum_5_21():
+    """Wheel 1 at (1, 0) with axle along X, wheel 2 at (2, 1) with axle along Y: ICR (2, 0), not (0, 2)."""
+    r = robot("icr", _fixed("a", 1, 0, 0.0), {"name": "b", "type": "steerable", "l": math.hypot(2, 1),
+                                                "alpha": math.atan2(1, 2), "beta": math.pi / 2, "r": 0.1})
+    got = icr(r)
+    assert got.kind == "point"
+    np.testing.assert_allclose(got.point, [2.0, 0.0], atol=1e-12)
+    b1, b2 = 0.0, math.pi / 2  # (5.21) as printed in the thesis
+    l1s, l2s = 1 * math.sin(b1 - 0.0), math.hypot(2, 1) * math.sin(b2 - math.atan2(1, 2))
+    thesis = ((l1s * math.sin(b2) - l2s * math.sin(b1)) / math.sin(b1 - b2),
+              (l1s * math.cos(b2) - l2s * math.cos(b1)) / math.sin(b1 - b2))
+    np.testing.assert_allclose(thesis, [0.0, 2.0], atol=1e-12)  # swapped
+    corrected = ((l1s * math.cos(b2) - l2s * math.cos(b1)) / math.sin(b1 - b2),
+                 (l1s * math.sin(b2) - l2s * math.sin(b1)) / math.sin(b1 - b2))
+    np.testing.assert_allclose(corrected, got.point, atol=1e-12)
+
+
+def test_icr_sets():
+    assert icr(omni_swedish()).kind == "plane"
+    line = icr(differential())
+    assert line.kind == "line" and np.allclose(np.abs(line.line), [1.0, 0.0, 0.0])
+    stuck = robot("s", _fixed("a", 1, 0, 0.0), _fixed("b", 0, 1, math.pi / 2), _fixed("c", 1, 1, 0.7))
+    assert icr(stuck).kind == "none"
+    assert "translation" in icr(tricycle(beta3=0.0)).describe()
+
+
+# ---- random robots: the classification agrees with the rank of the constraint matrix -------------------------
+_SIMPLE = ["fixed", "steerable", "castor", "swedish"]
+
+
+@st.composite
+def simple_robots(draw):
+    n = draw(st.integers(1, 4))
+    ws = tuple(draw(wheels(type_name=draw(st.sampled_from(_SIMPLE)), name=f"w{i}")) for i in range(n))
+    return Robot("random", ws)
+
+
+def _coordinated_beta(r: Robot, rng) -> np.ndarray:
+    """Steer every steerable wheel's axle through one ICR allowed by the fixed wheels (written out here)."""
+    fixed_rows = [np.array([math.cos(w.beta), math.sin(w.beta), w.l * math.sin(w.beta - w.alpha)])
+                  for w in r.wheels if w.type == "fixed"]
+    e = np.array(fixed_rows).reshape(-1, 3)
+    _, sv, vh = np.linalg.svd(np.vstack([e, np.zeros((3, 3))]))
+    rank = int(np.sum(sv > 1e-9 * max(sv.max(), 1.0)))
+    if rank == 3:
+        return r.beta
+    twist = vh[rank:].T @ rng.normal(size=3 - rank)
+    x, y = -twist[1], twist[0]  # homogeneous ICR (x, y, w) = (-vy, vx, omega)
+    w_icr = twist[2]
+    beta = []
+    for w in r.wheels:
+        if w.type == "steerable":
+            px, py = w.l * math.cos(w.alpha), w.l * math.sin(w.alpha)
+            beta.append(math.atan2(y - w_icr * py, x - w_icr * px))
+        elif w.kind.steers:
+            beta.append(rng.uniform(-math.pi, math.pi))
+    return np.array(beta)
+
+
+@settings(max_examples=150)
+@given(simple_robots(), st.integers(0, 2**16))
+def test_random_robots_agree_with_the_rank_of_the_constraint_matrix(r, seed):
+    got = classify(r)
+    beta = _coordinated_beta(r, np.random.default_rng(seed))
+    a = r.constraint_matrix(beta)
+    if got.mobility > 0:
+        assert a.shape[-1] - int(matrix_rank(a)) == got.mobility  # (6.8) at a generic admissible configuration
+    fixed_e = np.array([[math.cos(w.beta), math.sin(w.beta), w.l * math.sin(w.beta - w.alpha)]
+                        for w in r.wheels if w.type == "fixed"]).reshape(-1, 3)
+    rf = int(matrix_rank(fixed_e)) if len(fixed_e) else 0
+    assert got.fixed_rank == rf
+    if not got.degenerate:  # Table 5.1 bounds (5.15) and m + d = 3 - rank K_rf*
+        assert 1 <= got.mobility <= 3 and 0 <= got.steerability <= 2 and 2 <= got.mobility + got.steerability <= 3
+        assert got.mobility + got.steerability == 3 - rf
+        assert TABLE_5_1[(got.mobility, got.steerability)] == got.type
+    else:
+        assert got.type is None and got.reasons
+
+
+def test_synchro_drive_as_its_equivalent_wheel():
+    """§5.5.3: a synchro drive is modelled by one steerable wheel at the turret centre plus its omni support."""
+    r = type3(omni="castor", l2=0.3, a2=-2.0, l3=0.3, a3=2.0)
+    assert classify(r).type == 3
+    assert classify(r).name.startswith("one steered wheel")
+    assert classify(omni_swedish(gamma=45 * DEG)).type == 1

@@ -1,0 +1,165 @@
+"""Singularity (ch. 6): the line test (6.17)-(6.20) agrees with the rank test (6.12); singular sets are exact."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.optimize import brentq
+from thesis_vehicles import DEG, omni_castor, omni_swedish, robot
+
+from conftest import robots
+from wmrkit import UnknownNameError, catalog
+from wmrkit.analysis.icr import steer_to_icr
+from wmrkit.analysis.lines import constraint_lines, line_through
+from wmrkit.analysis.singularity import (
+    is_singular,
+    is_singular_rank,
+    singular_set,
+    singularity_distance,
+)
+from wmrkit.kinematics.linalg import matrix_rank
+
+
+@st.composite
+def cases(draw):
+    r = draw(robots(max_wheels=4))
+    names = r.velocity_names
+    assigned = tuple(draw(st.lists(st.sampled_from(names), unique=True, max_size=len(names))))
+    seed = draw(st.integers(0, 2**16))
+    rng = np.random.default_rng(seed)
+    if draw(st.booleans()):
+        beta = rng.uniform(-np.pi, np.pi, len(r.steer_names))
+    else:  # every steered axle through one ICR: the configurations where such robots move
+        beta = steer_to_icr(r, rng.normal(size=3))
+    return r, assigned, beta
+
+
+@settings(max_examples=300)
+@given(cases())
+def test_line_test_equals_rank_test_on_random_robots(case):
+    r, assigned, beta = case
+    assert bool(is_singular(r, beta, assigned)) == bool(is_singular_rank(r, beta, assigned))
+
+
+@settings(max_examples=60)
+@given(robots(max_wheels=3), st.integers(0, 2**16))
+def test_singular_set_points_are_rank_singular(r, seed):
+    rng = np.random.default_rng(seed)
+    names = [n for n in r.velocity_names if not n.endswith(".roller")]
+    m = 3 - int(matrix_rank(constraint_lines(r).lines()))
+    assigned = tuple(rng.choice(names, size=min(max(m, 1), len(names)), replace=False).tolist())
+    s = singular_set(r, assigned, resolution=24, max_samples=200)
+    if s.always or not len(s.configurations):
+        return
+    beta = np.broadcast_to(r.beta, (len(s.configurations), len(r.steer_names))).copy()
+    beta[:, [r.steer_names.index(v) for v in s.variables]] = s.configurations
+    assert is_singular_rank(r, beta, assigned).all()
+
+
+BATCHES = [(), (1,), (5,), (2, 3)]
+
+
+@pytest.mark.parametrize("batch", BATCHES, ids=str)
+def test_distance_batches_like_a_loop(batch):
+    r = catalog.load("thesis-steer-castor")
+    beta = np.random.default_rng(0).uniform(-np.pi, np.pi, (*batch, 3))
+    a = ("o1.spin", "c2.steer")
+    out = singularity_distance(r, beta, a)
+    assert out.shape == batch
+    for idx in np.ndindex(*batch):
+        assert out[idx] == pytest.approx(float(singularity_distance(r, beta[idx], a)), rel=1e-9)
+
+
+def test_big_batches_use_the_same_measure():
+    r = catalog.load("thesis-two-steer-castor")
+    beta = np.random.default_rng(2).uniform(-np.pi, np.pi, (5000, 3))
+    a = ("o1.spin",)
+    big = singularity_distance(r, beta, a)  # closed-form eigenvalues
+    small = np.array([float(singularity_distance(r, b, a)) for b in beta[:50]])  # LAPACK
+    np.testing.assert_allclose(big[:50], small, rtol=1e-6, atol=1e-7)
+
+
+def test_unknown_names_raise():
+    r = catalog.load("thesis-tricycle")
+    with pytest.raises(UnknownNameError, match=r"no velocity 'o3\.steer'"):
+        is_singular(r, None, ("o3.steer",))
+    with pytest.raises(UnknownNameError, match="no steering wheel 'f1'"):
+        singular_set(r, ("vy",), variables=("f1",))
+
+
+# ---- omnidirectional vehicles (Figs. 6.2, 6.3) -------------------------------------------------------------
+def test_omni_swedish_isotropic_design():
+    r = omni_swedish(L=0.7)
+    assert not is_singular(r, None, ("s1.spin", "s2.spin", "s3.spin"))
+    assert not is_singular(r, None, ("vx", "vy", "omega"))
+    # roller lines of wheels 2 and 3 meet at (-2L, 0), on the X axis (digest §7.1)
+    assert is_singular(r, None, ("s2.spin", "s3.spin", "vx"))
+    assert not is_singular(r, None, ("s1.spin", "s2.spin", "vx"))
+    assert not is_singular(r, None, ("s1.spin", "s2.spin", "omega"))
+    lines = constraint_lines(r, ("s2.spin", "s3.spin")).lines()
+    x, y = -2 * 0.7, 0.0
+    assert np.allclose(lines @ [y, -x, 1.0], 0.0, atol=1e-12)
+
+
+def test_omni_swedish_radial_wheels_are_singular():
+    r = omni_swedish(L=0.7, offset=math.pi / 2)  # wheel planes through the centre
+    assert is_singular(r, None, ("s1.spin", "s2.spin", "s3.spin"))
+
+
+def test_castor_delta_arm_lines_not_wheel_planes():
+    """Erratum 16: with delta != 0 and the spins assigned, concurrent *arm* lines are singular (not planes)."""
+    delta, d, L = 0.5, 0.15, 0.6
+    alphas = [0.0, 2.1, 4.2]
+    target = np.array([0.2, -0.1])
+
+    def make(betas):
+        return robot("c3", *({"name": f"c{i + 1}", "type": "castor", "l": L, "alpha": a, "beta": b, "d": d,
+                              "delta": delta, "r": 0.1} for i, (a, b) in enumerate(zip(alphas, betas, strict=True))))
+
+    joints = [L * np.array([math.cos(a), math.sin(a)]) for a in alphas]
+    # arm (S_y = (-sin b, cos b)) through the target: b = atan2(target - joint) - 90 deg
+    arm_betas = [math.atan2(*(target - j)[::-1]) - math.pi / 2 for j in joints]
+    spins = ("c1.spin", "c2.spin", "c3.spin")
+    assert is_singular(make(arm_betas), None, spins) and is_singular_rank(make(arm_betas), None, spins)
+    # wheel planes (along beta + delta + 90 deg, through the contact points) through the target instead
+    def plane_residual(b, j):
+        contact = j + d * np.array([-math.sin(b), math.cos(b)])
+        return float(line_through(contact, [-math.sin(b + delta), math.cos(b + delta)]) @ [target[1], -target[0], 1])
+
+    plane_betas = []
+    grid = np.linspace(-np.pi, np.pi, 721)
+    for j in joints:
+        vals = np.array([plane_residual(b, j) for b in grid])
+        i = int(np.flatnonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))[0])
+        plane_betas.append(brentq(plane_residual, grid[i], grid[i + 1], args=(j,), xtol=1e-14))
+    r = make(plane_betas)
+    assert not is_singular(r, None, spins) and not is_singular_rank(r, None, spins)
+
+
+def test_omni_castor_fig_6_3_sets_match_determinants():
+    """Fig. 6.3 (a), (b), (e), (f): det of the wheel-axis / arm lines, from the digest's formulas."""
+    L, d = 1.0, 0.2
+    rng = np.random.default_rng(5)
+    alphas = np.array([0.0, 120 * DEG, 240 * DEG])
+    for _ in range(20):
+        b = rng.uniform(-np.pi, np.pi, 3)
+        r = omni_castor(L=L, d=d, r=0.2, betas=tuple(b))
+        axis = np.stack([np.cos(b), np.sin(b), L * np.sin(b - alphas) - d], axis=-1)
+        arm = np.stack([-np.sin(b), np.cos(b), L * np.cos(b - alphas)], axis=-1)
+        for q_a, rows in [(("c1.steer", "c2.steer", "c3.steer"), axis), (("c1.spin", "c2.spin", "c3.spin"), arm),
+                          (("c1.spin", "c2.steer", "c3.steer"), np.stack([arm[0], axis[1], axis[2]])),
+                          (("c1.spin", "c2.spin", "c3.steer"), np.stack([arm[0], arm[1], axis[2]]))]:
+            distance = float(singularity_distance(r, None, q_a))
+            det = abs(np.linalg.det(rows)) / np.prod(np.linalg.norm(rows, axis=1))
+            assert (distance < 1e-3) == (det < 1e-3)
+        # exact singular set of (a) over beta3 with beta1, beta2 fixed: roots of the determinant
+        s = singular_set(r, ("c1.steer", "c2.steer", "c3.steer"), variables=("c3",))
+        for b3 in s.configurations[:, 0]:
+            bb = b.copy()
+            bb[2] = b3
+            rows = np.stack([np.cos(bb), np.sin(bb), L * np.sin(bb - alphas) - d], axis=-1)
+            assert abs(np.linalg.det(rows)) < 1e-9
