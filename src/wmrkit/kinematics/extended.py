@@ -96,57 +96,71 @@ def solve_steering(
     """Steering angles making an over-assigned set slip-free, the conditions (4.83) in general form.
 
     Finds roots of the residual of (4.11) over the angles of the centred steerable wheels (the others, and
-    castor angles, stay at `beta_guess`), by Levenberg-Marquardt from `beta_guess` and a grid of ``starts``
-    angles per wheel. Of the roots found, returns the one closest to `beta_guess` (the thesis needs beta to
-    vary continuously). ``q_assigned``: ``(..., n_a)``; ``beta_guess``: ``(..., n_steer)`` or None (described).
-    Returns ``(..., n_steer)`` [rad], steerable angles wrapped to [-pi, pi). Raises
+    castor angles, stay at `beta_guess`) by Levenberg-Marquardt from `beta_guess` (the thesis needs beta to vary
+    continuously, so the nearby root is wanted); where that fails, from a grid of ``starts`` angles per wheel,
+    keeping the root closest to the guess. ``q_assigned``: ``(..., n_a)``; ``beta_guess``: ``(..., n_steer)``
+    or None (described). Returns ``(..., n_steer)`` [rad], steerable angles wrapped to [-pi, pi). Raises
     :class:`~wmrkit.errors.SingularError` where no angle makes the assignment slip-free.
     """
     guess = configuration(robot, beta_guess)
     idx = velocity_indices(robot, assigned)
     q = as_vectors(q_assigned, len(idx), "q_assigned")
     batch = np.broadcast_shapes(q.shape[:-1], guess.shape[:-1])
-    guess = np.broadcast_to(guess, (*batch, guess.shape[-1]))
-    q = np.broadcast_to(q, (*batch, q.shape[-1]))
+    guess = np.broadcast_to(guess, (*batch, guess.shape[-1])).reshape(-1, guess.shape[-1])
+    q = np.broadcast_to(q, (*batch, q.shape[-1])).reshape(-1, q.shape[-1])
     free = [i for i, n in enumerate(robot.steer_names) if robot.wheel(n).type == "steerable"]
     if not free:
-        return readonly(np.array(guess))
-    grid = np.linspace(-np.pi, np.pi, starts, endpoint=False)
-    points = np.stack(np.meshgrid(*[grid] * len(free), indexing="ij"), -1).reshape(-1, len(free))
-    points = np.broadcast_to(points.reshape(-1, *[1] * len(batch), len(free)), (len(points), *batch, len(free)))
-    x0 = np.concatenate([guess[..., free][None], points])  # (1 + starts^n_o, ..., n_o)
-
-    def residual(x: np.ndarray) -> np.ndarray:
-        beta = np.broadcast_to(guess, (*x.shape[:-1], guess.shape[-1])).copy()
-        beta[..., free] = x
-        return solve_assigned(robot.constraint_matrix(beta), idx, q)[1]
-
-    x, cost = _levenberg_marquardt(residual, x0, iterations)
+        return readonly(guess.reshape(*batch, -1).copy())
     scale = 1.0 + np.abs(robot.constraint_matrix(guess)).max(axis=(-1, -2)) * np.linalg.norm(q, axis=-1)
-    root = cost <= (ROOT_TOL * scale) ** 2
-    distance = np.where(root, np.sum(_wrap(x - guess[..., free]) ** 2, axis=-1), np.inf)
-    best = np.argmin(distance, axis=0)
-    found = np.take_along_axis(distance, best[None], 0)[0] < np.inf
-    if not np.all(found):
-        bad = tuple(int(i) for i in np.argwhere(~found)[0]) if batch else ()
-        worst = float(np.sqrt(np.min(cost, axis=0))[bad])
+    tol = (ROOT_TOL * scale) ** 2  # (B,) on the squared residual
+
+    def solve(x0: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """LM from starts ``x0`` ``(P, len(rows), n_o)`` for the problems `rows`."""
+
+        def residual(x: np.ndarray) -> np.ndarray:
+            beta = np.broadcast_to(guess[rows], (*x.shape[:-1], guess.shape[-1])).copy()
+            beta[..., free] = x
+            return solve_assigned(robot.constraint_matrix(beta), idx, q[rows])[1]
+
+        return _levenberg_marquardt(residual, x0, iterations, tol[rows])
+
+    x, cost = solve(guess[None][..., free], np.arange(len(q)))
+    x, cost = x[0], cost[0]
+    failed = np.flatnonzero(cost > tol)
+    if len(failed):
+        grid = np.linspace(-np.pi, np.pi, starts, endpoint=False)
+        points = np.stack(np.meshgrid(*[grid] * len(free), indexing="ij"), -1).reshape(-1, 1, len(free))
+        xs, costs = solve(np.broadcast_to(points, (len(points), len(failed), len(free))), failed)
+        distance = np.where(costs <= tol[failed], np.sum(_wrap(xs - guess[failed][:, free]) ** 2, axis=-1), np.inf)
+        best = np.argmin(distance, axis=0)
+        x[failed] = xs[best, np.arange(len(failed))]
+        cost[failed] = costs[best, np.arange(len(failed))]
+    bad = np.flatnonzero(cost > tol)
+    if len(bad):
+        where = np.unravel_index(bad[0], batch) if batch else ()
         raise SingularError(
             f"robot '{robot.name}': no steering angles make ({', '.join(assigned)}) = "
-            f"{np.round(q[bad], 6).tolist()} slip-free near {describe_configuration(robot, guess, bad)} "
-            f"(smallest residual {worst:.3g} m/s)")
-    out = np.array(guess)
-    out[..., free] = _wrap(np.take_along_axis(x, best[None, ..., None], 0)[0])
-    return readonly(out)
+            f"{np.round(q[bad[0]], 6).tolist()} slip-free near "
+            f"{describe_configuration(robot, guess.reshape(*batch, -1), tuple(int(i) for i in where))} "
+            f"(smallest residual {float(np.sqrt(cost[bad[0]])):.3g} m/s)")
+    out = guess.copy()
+    out[:, free] = _wrap(x)
+    return readonly(out.reshape(*batch, -1))
 
 
-def _levenberg_marquardt(f, x: np.ndarray, iterations: int) -> tuple[np.ndarray, np.ndarray]:
-    """Minimise ``|f(x)|^2`` for every start at once; ``x`` ``(..., n)``; central-difference Jacobian."""
+def _levenberg_marquardt(f, x: np.ndarray, iterations: int, tol: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Minimise ``|f(x)|^2`` for every start at once, ``x`` ``(..., n)``, central-difference Jacobian.
+
+    Stops when every cost is below `tol` (broadcast against the costs ``(...)``) or after `iterations`.
+    """
     h, n = 1e-6, x.shape[-1]
     r = f(x)
     cost = np.sum(r**2, axis=-1)
     lam = np.full(cost.shape, 1e-3)
     eye = np.eye(n)
     for _ in range(iterations):
+        if np.all(cost <= tol):
+            break
         steps = np.stack([(f(x + h * eye[j]) - f(x - h * eye[j])) / (2 * h) for j in range(n)], axis=-1)
         jtj = np.swapaxes(steps, -1, -2) @ steps
         g = (np.swapaxes(steps, -1, -2) @ r[..., None])[..., 0]
