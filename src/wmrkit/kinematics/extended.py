@@ -151,15 +151,17 @@ def solve_steering(
 def _levenberg_marquardt(f, x: np.ndarray, iterations: int, tol: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Minimise ``|f(x)|^2`` for every start at once, ``x`` ``(..., n)``, central-difference Jacobian.
 
-    Stops when every cost is below `tol` (broadcast against the costs ``(...)``) or after `iterations`.
+    Stops after `iterations`, or once every cost is below ``1e-12 tol`` (a polished root), or below `tol` (broadcast
+    against the costs ``(...)``) with no step improving any more.
     """
     h, n = 1e-6, x.shape[-1]
     r = f(x)
     cost = np.sum(r**2, axis=-1)
     lam = np.full(cost.shape, 1e-3)
     eye = np.eye(n)
+    better = np.ones(cost.shape, dtype=bool)
     for _ in range(iterations):
-        if np.all(cost <= tol):
+        if np.all(cost <= 1e-12 * tol) or (np.all(cost <= tol) and not better.any()):
             break
         steps = np.stack([(f(x + h * eye[j]) - f(x - h * eye[j])) / (2 * h) for j in range(n)], axis=-1)
         jtj = np.swapaxes(steps, -1, -2) @ steps
