@@ -1,0 +1,144 @@
+"""``wmrkit odometry``, run in-process: outputs, options, and exit code 2 with one line for bad input."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.cli.main import main
+from wmrkit.odometry.encoders import IncrementalEncoder, catalog_encoders
+from wmrkit.odometry.logs import write_csv
+from wmrkit.odometry.pipeline import odometry
+from wmrkit.odometry.synthetic import TwistProfile, simulate
+from wmrkit.odometry.trajectories import read_trajectory_csv, read_tum
+
+
+def _json(capsys, argv):
+    assert main(argv) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_json_prints_the_final_pose(capsys, diff_csv, diff_run):
+    out = _json(capsys, ["odometry", "diff-drive", diff_csv, "--json"])
+    np.testing.assert_allclose(out["pose"], diff_run.truth[-1], atol=1e-9)
+    assert out["samples"] == len(diff_run.log) and out["method"] == "exact"
+
+
+@pytest.mark.parametrize("method", ["exact", "rk2", "euler", "paper002"])
+def test_methods_rank_as_expected(capsys, diff_csv, diff_run, method):
+    out = _json(capsys, ["odometry", "diff-drive", diff_csv, "--json", "--method", method])
+    err = np.hypot(*(np.array(out["pose"][:2]) - diff_run.truth[-1, :2]))
+    assert err < {"exact": 1e-9, "rk2": 1e-4, "euler": 0.05, "paper002": 0.05}[method]
+
+
+def test_text_summary_and_start_pose(capsys, diff_csv):
+    assert main(["odometry", "diff-drive", diff_csv, "--pose", "1", "2", "90 deg", "--covariance"]) == 0
+    text = capsys.readouterr().out
+    assert "robot diff-drive, method exact" in text and "final std:" in text
+    out = _json(capsys, ["odometry", "diff-drive", diff_csv, "--json", "--pose", "1 m", "200 mm", "0.5"])
+    base = _json(capsys, ["odometry", "diff-drive", diff_csv, "--json"])
+    x, y, th = base["pose"]
+    c, s = math.cos(0.5), math.sin(0.5)
+    np.testing.assert_allclose(out["pose"], [1 + c * x - s * y, 0.2 + s * x + c * y, th + 0.5], atol=1e-12)
+
+
+def test_outputs_csv_tum_bag_and_plot(capsys, tmp_path, diff_csv, diff_run):
+    assert main(["odometry", "diff-drive", diff_csv, "--out", str(tmp_path / "t.csv"), "--covariance",
+                 "--plot", str(tmp_path / "p.png"), "--quiet"]) == 0
+    traj = read_trajectory_csv(tmp_path / "t.csv")
+    np.testing.assert_allclose(traj.poses, diff_run.truth, atol=1e-9)
+    assert traj.covariance is not None and (tmp_path / "p.png").stat().st_size > 1000
+    assert main(["odometry", "diff-drive", diff_csv, "--out", str(tmp_path / "t.tum")]) == 0
+    t, poses = read_tum(tmp_path / "t.tum")
+    np.testing.assert_allclose(poses[:, :2], diff_run.truth[:, :2], atol=1e-9)
+    pytest.importorskip("rosbags")
+    assert main(["odometry", "diff-drive", diff_csv, "--out", str(tmp_path / "t_bag")]) == 0
+    from wmrkit.odometry.bags import read_odometry
+
+    np.testing.assert_allclose(read_odometry(tmp_path / "t_bag").poses, diff_run.truth, atol=1e-9)
+    assert main(["odometry", "diff-drive", diff_csv, "--out", str(tmp_path / "t.dat"), "--format", "tum"]) == 0
+    assert len(read_tum(tmp_path / "t.dat")[0]) == len(t)
+    capsys.readouterr()
+
+
+def test_forklift_counts_log_uses_the_catalog_encoders(capsys, tmp_path):
+    robot = catalog.load("forklift")
+    profile = TwistProfile.from_segments([(4.0, 1.0, 0.2, 0.2), (1.0, 0, 0, 0), (4.0, 1.0, 0.0, 0.0)])
+    enc = catalog_encoders("forklift")
+    run = simulate(robot, profile, 20.0, encoders=enc)
+    path = tmp_path / "fork.csv"
+    write_csv(path, ("stamp", "enc_r", "enc_l", "steer_raw"),
+              np.column_stack([run.log.time, *(run.counts[j] for j in run.log.joints)]), fmt="%.10g")
+    out = _json(capsys, ["odometry", "forklift", str(path), "--json", "--spin", "counts", "--steer", "counts",
+                         "--time-column", "stamp", "--column", "right_drive.spin=enc_r",
+                         "--column", "left_drive.spin=enc_l", "--column", "steer.steer=steer_raw"])
+    # what the library gives on the decoded angles (counts relative to the first sample)
+    log = run.log
+    log = type(log)(log.time, log.joints, log.positions - np.array([*log.positions[0, :2], 0.0]))
+    np.testing.assert_allclose(out["pose"], odometry(robot, log).final_pose, atol=1e-9)
+    # 8 m driven; steering quantised to 1.4 deg makes the least-squares blend turn a little: within 2 %
+    assert np.hypot(*(np.array(out["pose"][:2]) - run.truth[-1, :2])) < 0.16
+    # the same with explicit settings: --cpr and --steer-resolution
+    out2 = _json(capsys, ["odometry", "forklift", str(path), "--json", "--spin", "counts", "--steer", "counts",
+                          "--time-column", "stamp", "--cpr", "8290", "--steer-resolution", "1.4118 deg",
+                          "--column", "right_drive.spin=enc_r", "--column", "left_drive.spin=enc_l",
+                          "--column", "steer.steer=steer_raw"])
+    assert out2["pose"] != out["pose"]  # no offset given: straight ahead reads as 0 deg, not 90 deg
+
+
+def test_wrapping_counter_and_sensed_subset(capsys, tmp_path, diff_run):
+    enc = IncrementalEncoder(1024, bits=12)
+    counts = [enc.wrap(enc.quantize(diff_run.log.positions[:, k])) for k in range(2)]
+    path = tmp_path / "c.csv"
+    write_csv(path, ("time", "left.spin", "right.spin"), np.column_stack([diff_run.log.time, *counts]), fmt="%.10g")
+    out = _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--spin", "counts", "--cpr", "1024",
+                         "--counter-bits", "12"])
+    assert np.hypot(*(np.array(out["pose"][:2]) - diff_run.truth[-1, :2])) < 0.01
+
+
+def test_gyro_heading(capsys, tmp_path, diff_run):
+    gyro = np.gradient(diff_run.truth[:, 2], diff_run.log.time)
+    path = tmp_path / "g.csv"
+    write_csv(path, ("time", "left.spin", "right.spin", "gz"),
+              np.column_stack([diff_run.log.time, diff_run.log.positions, gyro]))
+    out = _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--gyro-column", "gz"])
+    assert out["pose"][2] == pytest.approx(diff_run.truth[-1, 2], abs=0.01)
+
+
+@pytest.mark.parametrize(("setup", "args", "message"), [
+    ("nan", [], r"x\.csv:4: right\.spin: value nan is not a finite number"),
+    ("repeat", [], r"x\.csv:4: time 0\.05 s repeats the previous sample \(a zero time step\)"),
+    ("ok", ["--time-column", "stamp"], r"missing column 'stamp'"),
+    ("wheels", [], r"column 'front\.spin' names no wheel of the robot"),
+    ("ok", ["--spin", "counts"], r"joint 'left\.spin' of robot 'diff-drive': no encoder data"),
+    ("ok", ["--pose", "0", "0", "abc"], r"--pose: cannot read 'abc' as an angle"),
+    ("ok", ["--sensed", "left.spin"], r"do not determine its motion"),
+    ("ok", ["--max-gap", "0.01"], r"x\.csv:3: time step of 0\.05 s exceeds max_gap"),
+    ("ok", ["--out", "/nonexistent/dir/t.csv"], r"cannot write"),
+    ("ok", ["--plot", "p.gif"], r"plot files are \.png, \.svg or \.pdf"),
+    ("ok", ["--chunk-size", "0"], r"--chunk-size must be >= 1"),
+    ("missing", [], r"no such file"),
+])
+def test_bad_input_exits_2_with_one_line(capsys, tmp_path, setup, args, message):
+    path = tmp_path / "x.csv"
+    rows = {"ok": ["0,0,0", "0.05,1,1", "0.1,2,2"], "nan": ["0,0,0", "0.05,1,1", "0.1,2,nan"],
+            "repeat": ["0,0,0", "0.05,1,1", "0.05,2,2"], "wheels": ["0,0,0,0"], "missing": None}[setup]
+    header = "time,left.spin,right.spin" + (",front.spin" if setup == "wheels" else "")
+    if rows is not None:
+        path.write_text(header + "\n" + "\n".join(rows) + "\n")
+    assert main(["odometry", "diff-drive", str(path), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wmrkit: error: ") and err.count("\n") == 1
+    assert __import__("re").search(message, err), err
+
+
+def test_usage_errors_exit_2(capsys, diff_csv):
+    with pytest.raises(SystemExit) as exc:
+        main(["odometry", "diff-drive", diff_csv, "--method", "rk4"])
+    assert exc.value.code == 2
+    assert main(["odometry", "no-such-robot", diff_csv]) == 2
+    assert "no robot 'no-such-robot'" in capsys.readouterr().err
