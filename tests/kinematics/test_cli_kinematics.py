@@ -105,3 +105,15 @@ def test_every_catalog_robot(capsys, name):
     data = run_json(capsys, ["kinematics", name])
     assert all(len(s) == data["mobility"] for s in data["assignable_sets"])
     assert data["actuation"]["leaf"] in ("determined", "overdetermined", "indeterminate", "underdetermined")
+
+
+def test_a_robot_that_cannot_move(capsys, tmp_path):
+    stuck = {"name": "stuck", "wheels": [
+        {"name": f"w{i}", "type": "fixed", "l": 0.4, "alpha": a, "beta": a + 0.3, "r": 0.05}
+        for i, a in enumerate((0.1, 2.0, 4.0))]}
+    path = tmp_path / "stuck.yaml"
+    path.write_text(yaml.safe_dump(stuck))
+    assert main(["kinematics", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "mobility m = 0" in out and "cannot move (m = 0)" in out
+    assert run_json(capsys, ["kinematics", str(path)])["assignable_sets"] == [[]]

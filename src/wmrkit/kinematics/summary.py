@@ -58,7 +58,9 @@ def kinematics_summary(robot: Robot) -> dict[str, Any]:
 def _matrix_table(model: dict[str, Any], indent: str = "    ") -> list[str]:
     if "error" in model:
         return [f"{indent}not available: {model['error']}"]
-    width = max(12, *(len(n) + 2 for n in model["assigned"]))
+    if not model["assigned"]:
+        return [f"{indent}the robot cannot move (m = 0): every velocity is zero"]
+    width = max([12, *(len(n) + 2 for n in model["assigned"])])
     name_width = max(len(n) for n in model["solved"]) if model["solved"] else 1
     head = f"{indent}{'':<{name_width}} = " + "".join(f"{n:>{width}}" for n in model["assigned"])
     rows = [head]
