@@ -47,7 +47,7 @@ def run(quick: bool) -> list[Result]:
     kin, geo = peer("wpimath.kinematics"), peer("wpimath.geometry")
     results = []
 
-    ours = best_time(lambda: wheel_commands(MECANUM, twists))
+    ours = best_time(lambda: wheel_commands(MECANUM, twists), repeat=7)
     peer_s = None
     if kin is not None:
         mk = kin.MecanumDriveKinematics(*(geo.Translation2d(*p) for p in CORNERS))
@@ -61,7 +61,7 @@ def run(quick: bool) -> list[Result]:
     results.append(Result("mecanum-4 IK, batched (peer: per twist)", n, ours,
                           "wpimath MecanumDriveKinematics.toWheelSpeeds", peer_s, ">= 10 M/s, >= 50x"))
 
-    ours = best_time(lambda: wheel_commands(SWERVE, twists))
+    ours = best_time(lambda: wheel_commands(SWERVE, twists), repeat=7)
     peer_s = None
     if kin is not None:
         sk = kin.SwerveDrive4Kinematics(*(geo.Translation2d(*p) for p in CORNERS))
