@@ -104,13 +104,15 @@ def test_three_methods_agree_on_every_set(robot):
 @EXAMPLES
 @given(robots(), st.data())
 def test_models_have_zero_slip(robot, data):
-    """Every model's velocities satisfy A q_dot = 0 (4.1), batched over configurations."""
+    """Every model's velocities satisfy A q_dot = 0 (4.1) to round-off, for a batch of assigned values."""
     sets = assignable_sets(robot)
-    assume(sets and clear_ranks(robot.constraint_matrix()))
+    a = robot.constraint_matrix()
+    assume(sets and clear_ranks(a))
     assigned = data.draw(st.sampled_from(sets))
     model = kinematic_model(robot, assigned)
-    q = np.random.default_rng(0).normal(size=(4, len(assigned)))
-    np.testing.assert_allclose(robot.slip_velocity(model.velocities(q)), 0, atol=1e-9)
+    q_dot = model.velocities(np.random.default_rng(0).normal(size=(4, len(assigned))))
+    scale = np.abs(a).max() * np.abs(q_dot).max(axis=-1, keepdims=True)
+    assert np.all(np.abs(robot.slip_velocity(q_dot)) <= 1e-10 * scale)
 
 
 @EXAMPLES
