@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from thesis_vehicles import DEG, bicycle, differential, omni_castor, omni_swedish, robot, tricycle, type3, type5
 
@@ -157,6 +157,9 @@ def _coordinated_beta(r: Robot, rng) -> np.ndarray:
 @settings(max_examples=150)
 @given(simple_robots(), st.integers(0, 2**16))
 def test_random_robots_agree_with_the_rank_of_the_constraint_matrix(r, seed):
+    pts = np.array([w.position for w in r.wheels])
+    gaps = np.linalg.norm(pts[:, None] - pts[None], axis=-1)
+    assume(np.all((gaps < 1e-12) | (gaps > 1e-3)))  # no sub-millimetre offsets: ranks need a length scale
     got = classify(r)
     beta = _coordinated_beta(r, np.random.default_rng(seed))
     a = r.constraint_matrix(beta)
@@ -180,3 +183,18 @@ def test_synchro_drive_as_its_equivalent_wheel():
     assert classify(r).type == 3
     assert classify(r).name.startswith("one steered wheel")
     assert classify(omni_swedish(gamma=45 * DEG)).type == 1
+
+
+def test_axle_rows_not_the_first_row_of_5_3():
+    """Erratum 2: (5.17)/(5.23) take the first row of (5.3), -cos(beta) E / |E|^2, which vanishes at beta = 90 deg.
+
+    With axles along y (beta = 90 deg, as in every REP-103 robot) that row is zero and the fixed axle would be lost;
+    the rows E_i keep it: a REP-103 differential drive is type 2, not omnidirectional.
+    """
+    b = math.pi / 2
+    l, a = 0.2, math.pi / 2
+    e = np.array([math.cos(b), math.sin(b), l * math.sin(b - a)])
+    first_row = -math.cos(b) * e / (e @ e)
+    assert np.allclose(first_row, 0.0)
+    got = classify(catalog.load("diff-drive"))
+    assert got.type == 2 and got.fixed_rank == 1

@@ -258,3 +258,26 @@ def test_icr_of_tricycle_and_bicycle():
     got = icr(bicycle(l2=1.0, beta2=30 * DEG))
     np.testing.assert_allclose(got.point, [-1.7320508, 0.0], atol=1e-7)
     assert icr(tricycle(beta3=0.0)).kind == "infinity"
+
+
+def test_tricycle_null_vector_5_72():
+    """(5.72) with L read as l12 (erratum 10): the null vector of the tricycle's slip matrix."""
+    l12, l3, r, b3 = 0.5, 1.2, 0.1, 0.4
+    t = tricycle(l12=l12, l3=l3, r=r, beta3=b3)
+    thesis = np.array([0.0, l3 * c(b3), s(b3), -(l12 * s(b3) + l3 * c(b3)) / r, (l12 * s(b3) - l3 * c(b3)) / r,
+                       -l3 / r])
+    a = t.constraint_matrix()
+    assert np.allclose(a @ thesis, 0.0, atol=1e-12)
+    assert np.linalg.matrix_rank(a) == a.shape[1] - 1
+
+
+def test_type3_simultaneous_isotropy_claim_erratum_7():
+    """§5.5.3.A: beta1 = beta2 = beta3 does not satisfy (5.65a); cos(b1 - b2) = cos(b1 - b3) = 0 does, and is
+    singular for (phi_2, phi_3)."""
+    from wmrkit.analysis.isotropy import natural_length
+
+    equal = type3(beta1=0.7, beta2=0.7, beta3=0.7)
+    assert natural_length(equal, joints=("o1.spin", "s2.spin"))[1] > 1.01  # (5.65a) fails
+    perp = type3(beta1=0.7 + np.pi / 2, beta2=0.7, beta3=0.7)
+    assert natural_length(perp, joints=("o1.spin", "s2.spin"))[1] == pytest.approx(1.0, abs=1e-9)
+    assert is_singular(perp, None, ("s2.spin", "s3.spin")) and is_singular_rank(perp, None, ("s2.spin", "s3.spin"))

@@ -33,8 +33,8 @@ from .lines import constraint_lines, line_residual
 #: Table 5.1: (m, d) -> type.
 TABLE_5_1 = {(3, 0): 1, (2, 0): 2, (2, 1): 3, (1, 1): 4, (1, 2): 5}
 TYPE_NAMES = {
-    1: "omnidirectional", 2: "differential", 3: "one steered wheel (synchro-like)",
-    4: "tricycle / bicycle / car", 5: "two steered wheels",
+    1: "omnidirectional", 2: "differential: one fixed axle", 3: "one steered wheel, synchro-like",
+    4: "fixed axle and steering: tricycle, bicycle, car", 5: "steered wheels only, like two independent ones",
 }
 
 
@@ -131,7 +131,7 @@ def _admissible_configurations(robot: Robot, g_fixed: np.ndarray, rf: int, n: in
         return np.zeros((0, len(robot.steer_names)))
     _, _, vh = np.linalg.svd(np.vstack([g_fixed, np.zeros((3, 3))]))
     basis = vh[rf:].T  # twists (scaled) allowed by the fixed wheels
-    twists = (rng.normal(size=(n, 3 - rf)) @ basis.T) / np.array([1.0, 1.0, 1.0 / _size(robot)])
+    twists = (rng.normal(size=(n, 3 - rf)) @ basis.T) * np.array([1.0, 1.0, 1.0 / _size(robot)])
     icr_h = np.stack([-twists[:, 1], twists[:, 0], twists[:, 2]], axis=-1)
     beta = steer_to_icr(robot, icr_h)
     castors = [j for j, s in enumerate(robot.steer_names) if s not in set(constraint_lines(robot).wheels)]
@@ -169,5 +169,5 @@ def _special(robot: Robot, steered: list[str], rf: int, m: int) -> tuple[Special
         return ()
     names = ", ".join(steered)
     text = (f"m = {m_here} when the axles of {names} all lie on the line through their centres "
-            f"(angle {np.degrees(np.arctan2(direction[1], direction[0])):.1f} deg, mod 180 deg)")
+            f"(at {np.degrees(np.arctan2(direction[1], direction[0])) % 180:.1f} deg, mod 180 deg)")
     return (SpecialConfiguration(tuple(float(b) for b in beta), m_here, text),)

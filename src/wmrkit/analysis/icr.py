@@ -58,7 +58,7 @@ class ICRSet:
         if self.kind == "point":
             return f"ICR at ({self.point[0]:.3f}, {self.point[1]:.3f}) m"
         if self.kind == "infinity":
-            return f"ICR at infinity: translation only, along ({self.direction[0]:.3f}, {self.direction[1]:.3f})"
+            return f"ICR at infinity: translation only, along +-({self.direction[0]:.3f}, {self.direction[1]:.3f})"
         if self.kind == "line":
             lx, ly, d = self.line
             return f"ICR anywhere on the line through ({d * ly:.3f}, {-d * lx:.3f}) m along ({lx:.3f}, {ly:.3f})"
@@ -81,7 +81,7 @@ def icr(robot: Robot, beta: ArrayLike | None = None) -> ICRSet:
         return ICRSet("line", line=tuple(float(v) for v in row))
     x, y, w = common_point(g)
     if abs(w) < 1e-9 * max(abs(x), abs(y)):
-        n = np.hypot(x, y)
+        n = np.hypot(x, y) * (1.0 if y > 1e-12 or (abs(y) <= 1e-12 and x < 0) else -1.0)  # either sign: +x first
         return ICRSet("infinity", direction=(float(y / n), float(-x / n)))
     return ICRSet("point", point=(float(x / w), float(y / w)))
 

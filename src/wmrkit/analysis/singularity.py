@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
+from scipy.optimize import minimize
 
 from .._shapes import as_vectors
 from ..errors import UnknownNameError
@@ -146,10 +147,39 @@ def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[st
         c = np.repeat(configs[i][None], len(values), axis=0)
         c[:, idx[-1]] = values
         found.append(c[:, idx])
+    if len(idx) >= 2 and sum(map(len, found)) == 0:  # isolated points (codimension 2) escape the curve sampling
+        found.append(_isolated(cl, base, idx, per_axis))
     found_arr = np.concatenate(found)
     if len(found_arr):
         found_arr = found_arr[np.lexsort(found_arr.T[::-1])]
     return SingularSet(cl.assigned, variables, False, found_arr, len(idx) == 1)
+
+
+def _isolated(cl, base: np.ndarray, idx: list[int], per_axis: int, count: int = 8) -> np.ndarray:
+    """Local minima of the singularity distance on a grid, refined by Nelder-Mead; those that reach zero."""
+    axis = np.linspace(-np.pi, np.pi, per_axis, endpoint=False)
+    mesh = np.stack(np.meshgrid(*([axis] * len(idx)), indexing="ij"), axis=-1)
+    beta = np.broadcast_to(base, (*mesh.shape[:-1], len(base))).copy()
+    beta[..., idx] = mesh
+    dist = singularity_distance(cl.robot, beta, cl.assigned)
+    is_min = dist < 0.2
+    for ax in range(len(idx)):
+        is_min &= (dist <= np.roll(dist, 1, ax)) & (dist <= np.roll(dist, -1, ax))
+    starts = np.argwhere(is_min)
+    starts = starts[np.argsort(dist[tuple(starts.T)])][:count]
+
+    def f(x):
+        b = base.copy()
+        b[idx] = x
+        return float(singularity_distance(cl.robot, b, cl.assigned))
+
+    out: list[np.ndarray] = []
+    for s in starts:
+        res = minimize(f, axis[s], method="Nelder-Mead", options={"xatol": 1e-12, "fatol": 1e-15, "maxiter": 800})
+        x = np.mod(res.x + np.pi, 2 * np.pi) - np.pi
+        if res.fun < 1e-9 and not any(np.abs(np.angle(np.exp(1j * (x - y)))).max() < 1e-6 for y in out):
+            out.append(x)
+    return np.array(out).reshape(-1, len(idx))
 
 
 def _roots_last(cl, configs: np.ndarray, j: int) -> tuple[list[np.ndarray], np.ndarray]:

@@ -1,0 +1,133 @@
+"""One call that tells a designer what their robot is: :func:`analyze` (thesis ch. 5-6, with ch. 4's verdicts).
+
+Type and degrees of mobility/steerability (Table 5.1), the ICR, the actuation and sensing verdicts of ch. 4
+(:mod:`wmrkit.kinematics.actuation`, :mod:`wmrkit.kinematics.sensing`), the condition number of the actuated
+model at the natural length (§5.4) and where the actuated and sensed models are singular (ch. 6).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..kinematics.actuation import actuation_analysis
+from ..kinematics.sensing import sensing_analysis
+from ..robot import Robot
+from .classification import Classification, classify, instantaneous_mobility
+from .icr import ICRSet, icr
+from .isotropy import default_joints, natural_length, twist_condition_number
+from .singularity import SingularSet, singular_set
+
+
+@dataclass(frozen=True, eq=False)
+class Analysis:
+    """Result of :func:`analyze` for a robot at its described configuration."""
+
+    robot: Robot
+    classification: Classification
+    instantaneous_mobility: int
+    icr: ICRSet
+    actuation: dict[str, Any]  # consistent, sufficient, verdict
+    sensing: dict[str, Any]  # sufficient, verdict
+    joints: tuple[str, ...]  # joint rates of the condition number
+    condition_number: float
+    characteristic_length: float
+    natural: bool  # the length is the natural one (not given)
+    singular: dict[str, SingularSet]  # "actuated", "sensed"
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (SI units, radians); the keys of ``wmrkit analyze --json``."""
+        c = self.classification
+        return {
+            "robot": self.robot.name,
+            "mobility": c.mobility, "steerability": c.steerability, "type": c.type, "type_name": c.name,
+            "degenerate": c.degenerate, "reasons": list(c.reasons), "coordinated_steering": c.coordinated,
+            "instantaneous_mobility": self.instantaneous_mobility,
+            "special_configurations": [{"beta": list(s.beta), "mobility": s.mobility, "description": s.description}
+                                       for s in c.special],
+            "icr": self.icr.describe(),
+            "actuation": {k: self.actuation[k] for k in ("consistent", "sufficient", "verdict")},
+            "sensing": {k: self.sensing[k] for k in ("sufficient", "verdict")},
+            "condition_number": self.condition_number, "characteristic_length": self.characteristic_length,
+            "condition_joints": list(self.joints), "natural_length": self.natural,
+            "singular": {k: _singular_dict(s) for k, s in self.singular.items()},
+        }
+
+    def format_text(self) -> str:
+        """A concise terminal summary."""
+        c, r = self.classification, self.robot
+        lines = [f"{r.name}: {c.describe()}"]
+        if self.instantaneous_mobility != c.mobility:
+            lines.append(f"  at the described steering: m = {self.instantaneous_mobility}")
+        lines += [f"  {s.description}" for s in c.special]
+        lines.append(f"  {self.icr.describe()}")
+        lines.append(f"  actuation: {_yes(self.actuation['consistent'], 'consistent', 'inconsistent')}, "
+                     f"{_yes(self.actuation['sufficient'], 'sufficient', 'insufficient')} "
+                     f"({', '.join(r.actuated) or 'nothing declared'})")
+        lines.append(f"  sensing: {_yes(self.sensing['sufficient'], 'sufficient', 'insufficient')} "
+                     f"({', '.join(r.sensed) or 'nothing declared'})")
+        how = "natural length" if self.natural else "given length"
+        note = "  (m = 1: isotropy does not apply)" if c.mobility == 1 else ""
+        lines.append(f"  condition number {self.condition_number:.4g} at the {how} D = "
+                     f"{self.characteristic_length:.4g} m, joints {', '.join(self.joints) or '-'}{note}")
+        for key, s in self.singular.items():
+            lines.append(f"  singular ({key}: {', '.join(s.assigned) or '-'}): {describe_singular(s)}")
+        return "\n".join(lines)
+
+
+def _yes(flag: bool, yes: str, no: str) -> str:
+    return yes if flag else no
+
+
+def _singular_dict(s: SingularSet) -> dict[str, Any]:
+    return {"assigned": list(s.assigned), "variables": list(s.variables), "always": s.always, "never": s.never,
+            "exact": s.exact, "count": len(s.configurations),
+            "configurations": s.configurations[:24].tolist(), "reasons": list(s.reasons)}
+
+
+def describe_singular(s: SingularSet, *, limit: int = 6) -> str:
+    """One line: never / always (why) / at which steering angles (degrees)."""
+    if s.always:
+        return "always" + (f" ({s.reasons[0]})" if s.reasons else "")
+    if s.never:
+        return "never" if s.exact else "none found on the sampled grid"
+    if s.exact:
+        angles = ", ".join(f"{math.degrees(v):.2f}" for v in s.configurations[:limit, 0])
+        more = f" and {len(s.configurations) - limit} more" if len(s.configurations) > limit else ""
+        return f"at {s.variables[0]} = {angles} deg{more}"
+    return f"on curves over ({', '.join(s.variables)}), {len(s.configurations)} sampled points"
+
+
+def model_rates(robot: Robot, joints: tuple[str, ...]) -> tuple[str, ...]:
+    """The joints that are rates of the velocity vector (a steerable wheel's steering joint is not one)."""
+    rates = set(robot.rate_names)
+    return tuple(j for j in joints if j in rates)
+
+
+def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) -> Analysis:
+    """Analyse `robot` at its described configuration (see the module docstring).
+
+    `length` [m]: characteristic length of the condition number (default: the natural one). `resolution`:
+    grid points per turn for singular sets over two or more steering angles.
+    """
+    cls = classify(robot)
+    joints = default_joints(robot)
+    if length is None:
+        d, kappa = natural_length(robot, joints=joints)
+    else:
+        d, kappa = float(length), float(twist_condition_number(robot, joints=joints, length=length))
+    act, sen = actuation_analysis(robot), sensing_analysis(robot)
+    singular = {}
+    for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed)):
+        assigned = model_rates(robot, names)
+        singular[key] = singular_set(robot, assigned, resolution=resolution, max_samples=resolution * 8)
+    return Analysis(
+        robot, cls, int(instantaneous_mobility(robot)), icr(robot),
+        {"consistent": bool(np.all(act.consistent)), "sufficient": bool(np.all(act.sufficient)),
+         "verdict": str(act.verdict)},
+        {"sufficient": bool(np.all(sen.sufficient)), "verdict": str(sen.verdict)},
+        joints, float(kappa), float(d), length is None, singular,
+    )

@@ -1,0 +1,55 @@
+"""``wmrkit analyze``: what the robot is (type, m, d), how well it transmits errors, where it breaks down (ch. 5-6)."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..analysis.summary import analyze
+from ..errors import WmrkitError
+from ..units import UnitError, parse_quantity
+from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_assignments, print_json
+
+
+def add_parsers(commands: argparse._SubParsersAction) -> None:
+    """Register ``analyze``."""
+    p = commands.add_parser(
+        "analyze", help="vehicle type, mobility, actuation/sensing, condition number, singularities (ch. 5-6)")
+    add_robot_argument(p)
+    p.add_argument("--steer", action="append", metavar="NAME=ANGLE", default=[],
+                   help="steering angle of a wheel: radians, or degrees with 'deg' (repeatable)")
+    p.add_argument("--length", metavar="D", help="characteristic length of the condition number, e.g. 0.3 or "
+                   "'300 mm' (default: the natural length, which minimises it)")
+    p.add_argument("--report", metavar="DIR", help="write an HTML report with pictures to DIR/index.html")
+    p.add_argument("--resolution", type=int, default=90, metavar="N",
+                   help="grid points per turn of a steering angle for maps and singular sets (default 90)")
+    add_json_flag(p)
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print the analysis; write the report with --report."""
+    pairs = parse_assignments(args.steer, "--steer")
+    robot = load_robot(args.robot).with_steering({n: parse_angle(v, f"--steer {n}") for n, v in pairs.items()})
+    if args.resolution < 8:
+        raise WmrkitError(f"--resolution: need at least 8 points per turn, got {args.resolution}")
+    result = analyze(robot, length=_length(args.length), resolution=args.resolution)
+    if args.report:
+        from ..analysis.report import write_report
+
+        path = write_report(result, args.report, resolution=args.resolution)
+    print_json(result.to_dict()) if args.json else print(result.format_text())
+    if args.report and not args.json:
+        print(f"report written to {path}")
+    return 0
+
+
+def _length(text: str | None) -> float | None:
+    if text is None:
+        return None
+    try:
+        value = parse_quantity(text, "length")
+    except UnitError as err:
+        raise WmrkitError(f"--length: {err}") from None
+    if not value > 0:
+        raise WmrkitError(f"--length: must be > 0, got {text}")
+    return value
