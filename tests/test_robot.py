@@ -11,7 +11,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy.linalg import null_space
 
-from conftest import robots
+from strategies import robots
 from wmrkit import Robot, ShapeError, UnknownNameError, Wheel, catalog
 
 BATCHES = [(), (1,), (5,), (2, 3)]

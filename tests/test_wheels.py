@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from numpy import cos, sin
 from scipy.linalg import null_space
 
-from conftest import wheels
+from strategies import wheels
 from wmrkit import KINDS, Robot, ShapeError, Wheel, generic_slip_rows, wheel_jacobian, wheel_slip_rows
 from wmrkit.errors import UnknownNameError
 

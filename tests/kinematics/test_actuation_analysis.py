@@ -11,7 +11,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from conftest import wheels
+from strategies import wheels
 from wmrkit import Robot, UnknownNameError, Wheel
 from wmrkit.errors import SelectionError
 from wmrkit.kinematics.actuation import actuation_analysis, actuation_tree, minimal_actuator_sets

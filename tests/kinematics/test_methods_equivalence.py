@@ -13,7 +13,7 @@ import numpy as np
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from conftest import robots, wheels
+from strategies import robots, wheels
 from wmrkit import Robot
 from wmrkit.kinematics.actuation import actuated_inverse_matrix, actuation_equation, actuation_tree
 from wmrkit.kinematics.linalg import delta_projector, matrix_rank

@@ -14,7 +14,7 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from conftest import robots
+from strategies import robots
 from wmrkit import Robot, ShapeError, catalog
 from wmrkit.kinematics import _ik_fast
 from wmrkit.kinematics.wheel_ik import forward_kinematics, twist_is_determined, wheel_commands, wrap_angle
