@@ -103,4 +103,5 @@ def format_commands(robot: Robot, commands: WheelCommands) -> str:
 
 
 def _num(x: float) -> str:
-    return "-" if math.isnan(x) else f"{x:.6g}"
+    """A table cell: '-' for undefined, rounding noise below 1e-12 printed as 0."""
+    return "-" if math.isnan(x) else f"{0.0 if abs(x) < 1e-12 else x:.6g}"
