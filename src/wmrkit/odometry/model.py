@@ -16,6 +16,7 @@ steering configuration in the data (quantised steering encoders give few) and ga
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -33,26 +34,90 @@ class SensingError(WmrkitError, ValueError):
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
 class ModelIncrements:
-    """Result of :meth:`OdometryModel.increments` for N sample intervals.
+    """Result of :meth:`OdometryModel.increments` for N sample intervals (outputs computed on demand).
 
-    ``increments_robot`` ``(N, 3)``: body increments ``(dx [m], dy [m], dtheta [rad])``; ``joint_increments``
-    ``(N, n)``: every kept wheel rate integrated over the interval (names in ``joint_names``) [rad];
-    ``residual`` ``(N, R)``: ``A dq`` per constraint row [m], the slip over the interval. ``rate_increments``
-    ``(N, n_a)``: the assigned (sensed) increments; ``twist_map`` ``(N, 3, n_a)`` or ``(3, n_a)`` (constant
-    robots): the linear map from them to ``increments_robot``, for noise propagation.
+    ``rate_increments`` ``(N, n_a)``: the assigned (sensed) increments [rad]. ``solution`` ``(k, n_a)`` maps them
+    to the solved velocity columns (body increment, then the kept wheel rates named ``joint_names``);
+    ``residual_map`` ``(R, n_a)`` to ``A dq``, or is None when the sensors have no redundancy (the residual is
+    then identically 0). For steering robots both carry a leading axis of distinct configurations ``(U, ...)``
+    and ``index`` ``(N,)`` says which one each interval uses. Products are written column by column (no BLAS
+    call, no per-sample matrix gather): the hot path of odometry.
     """
 
-    increments_robot: np.ndarray
-    joint_names: tuple[str, ...]
-    joint_increments: np.ndarray
-    residual: np.ndarray
     rate_increments: np.ndarray
-    twist_map: np.ndarray
+    joint_names: tuple[str, ...]
+    solution: np.ndarray
+    residual_map: np.ndarray | None
+    index: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return len(self.rate_increments)
+
+    def _entry(self, m: np.ndarray, i: int, a: int) -> np.ndarray | float:
+        return m[i, a] if self.index is None else m[:, i, a][self.index]
+
+    @functools.cached_property
+    def _columns(self) -> np.ndarray:
+        """``rate_increments`` transposed, ``(n_a, N)`` contiguous: its columns are read many times."""
+        return np.ascontiguousarray(self.rate_increments.T)
+
+    def _row(self, m: np.ndarray, i: int) -> np.ndarray | None:
+        dq = self._columns
+        terms = [a for a in range(len(dq)) if np.any(m[..., i, a])]
+        if not terms:
+            return None
+        out = self._entry(m, i, terms[0]) * dq[terms[0]]
+        for a in terms[1:]:
+            out += self._entry(m, i, a) * dq[a]
+        return out
+
+    def _rows(self, m: np.ndarray) -> np.ndarray:
+        rows = [self._row(m, i) for i in range(m.shape[-2])]
+        zero = np.zeros(len(self))
+        return np.stack([zero if r is None else r for r in rows], axis=-1) if rows else np.zeros((len(self), 0))
+
+    def column(self, i: int) -> np.ndarray | None:
+        """Solved column `i` ``(N,)`` (0, 1, 2: dx [m], dy [m], dtheta [rad]); None when identically 0."""
+        return self._row(self.solution, i)
+
+    @property
+    def increments_robot(self) -> np.ndarray:
+        """Body increments ``(N, 3)``: ``(dx [m], dy [m], dtheta [rad])`` over each interval."""
+        return self._rows(self.solution[..., :3, :])
+
+    @property
+    def joint_increments(self) -> np.ndarray:
+        """Every kept wheel rate integrated over each interval ``(N, n)`` [rad], names in ``joint_names``."""
+        return self._rows(self.solution[..., 3:, :])
+
+    @property
+    def twist_map(self) -> np.ndarray:
+        """The map from ``rate_increments`` to ``increments_robot``: ``(3, n_a)`` or per interval ``(N, 3, n_a)``."""
+        s = self.solution[..., :3, :]
+        return s if self.index is None else s[self.index]
+
+    @property
+    def residual(self) -> np.ndarray:
+        """``A dq`` per kept constraint row ``(N, R)`` [m]: the slip over each interval (4.11)."""
+        if self.residual_map is None:
+            return np.zeros((len(self), 0))
+        return self._rows(self.residual_map)
 
     @property
     def slip(self) -> np.ndarray:
-        """Norm of the residual per interval [m], the slip indicator of (4.11). ``(N,)``."""
-        return np.sqrt(np.einsum("...i,...i->...", self.residual, self.residual))
+        """Norm of the residual per interval [m], the slip indicator of (4.11). ``(N,)``.
+
+        Row by row, accumulating squares (a quadratic form ``dq^T Rm^T Rm dq`` would cancel: small residuals
+        are the interesting ones).
+        """
+        total = np.zeros(len(self))
+        if self.residual_map is None:
+            return total
+        for i in range(self.residual_map.shape[-2]):
+            r = self._row(self.residual_map, i)
+            if r is not None:
+                total += r * r
+        return np.sqrt(total)
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
@@ -72,7 +137,7 @@ class OdometryModel:
     assigned: np.ndarray  # positions of rate_joints among the kept columns
     steer_index: np.ndarray  # position of each steer joint in the robot's beta
     solution: np.ndarray | None  # (k, n_a), constant robots only
-    residual_map: np.ndarray | None  # (R, n_a), constant robots only
+    residual_map: np.ndarray | None  # (R, n_a), constant robots with redundant sensors only
 
     @property
     def constant(self) -> bool:
@@ -95,25 +160,36 @@ class OdometryModel:
         if dq.ndim != 2 or dq.shape[1] != len(self.rate_joints):
             raise WmrkitError(f"rate_increments: expected shape (N, {len(self.rate_joints)}), got {dq.shape}")
         if self.constant:
-            q, res, s = dq @ self.solution.T, dq @ self.residual_map.T, self.solution[:3]
-        else:
-            q, res, s = self._solve_by_configuration(dq, beta_mid)
-        return ModelIncrements(q[:, :3], self.joint_names, q[:, 3:], res, dq, s)
+            return ModelIncrements(dq, self.joint_names, self.solution, self.residual_map)
+        s, rm, index = self._solve_by_configuration(dq, beta_mid)
+        return ModelIncrements(dq, self.joint_names, s, rm, index)
 
-    def from_positions(self, positions: ArrayLike) -> ModelIncrements:
+    def from_positions(self, positions: ArrayLike, *, previous: ArrayLike | None = None) -> ModelIncrements:
         """Increments between consecutive samples of joint positions. ``(N + 1, n_joints) -> N intervals``.
 
         Columns in the order of ``joints``: cumulative spin angles and steering angles [rad]. Steering angles
-        are differenced modulo 2 pi (they change by less than pi between samples).
+        are differenced modulo 2 pi (they change by less than pi between samples). With `previous`
+        ``(n_joints,)``, the sample before ``positions[0]``, the result has one interval per row of `positions`.
         """
         p = np.asarray(positions, dtype=float)
         if p.ndim != 2 or p.shape[1] != len(self.joints):
             raise WmrkitError(f"positions: expected shape (N + 1, {len(self.joints)}), got {p.shape}")
-        d = np.diff(p, axis=0)
+        if previous is None:
+            d = np.diff(p, axis=0)
+        else:
+            d = np.empty_like(p)
+            np.subtract(p[0], previous, out=d[0])
+            np.subtract(p[1:], p[:-1], out=d[1:])
+            p = np.concatenate([np.asarray(previous, dtype=float)[None], p]) if self.steer_joints else p
+        n_a = len(self.rate_joints)
+        if not self.steer_joints:  # joints == rate_joints: no copies
+            return self.increments(d)
         steer_cols = [self.joints.index(j) for j in self.steer_joints]
         d[:, steer_cols] = wrap_angle(d[:, steer_cols])
         beta_mid = p[:-1, steer_cols] + 0.5 * d[:, steer_cols]
-        return self.increments(d[:, [self.joints.index(j) for j in self.rate_joints]], beta_mid)
+        rate = d[:, :n_a] if self.joints[:n_a] == self.rate_joints else d[:, [self.joints.index(j) for j in
+                                                                                self.rate_joints]]
+        return self.increments(rate, beta_mid)
 
     def matrices(self, beta: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Solution and residual maps at steering angles `beta` of ``steer_joints``.
@@ -121,7 +197,8 @@ class OdometryModel:
         ``(..., n_steer_sensed) -> (..., k, n_a), (..., R, n_a)``: ``q = S @ dq``, ``A q = Rm @ dq``.
         """
         if self.constant:
-            return self.solution, self.residual_map
+            rm = self.residual_map
+            return self.solution, np.zeros((len(self.rows), self.solution.shape[1])) if rm is None else rm
         beta = np.asarray(beta, dtype=float)
         full = np.broadcast_to(self.robot.beta, (*beta.shape[:-1], len(self.robot.steer_names))).copy()
         full[..., self.steer_index] = beta
@@ -145,8 +222,7 @@ class OdometryModel:
             i = int(np.flatnonzero(bad[index])[0])
             angles = ", ".join(f"{j}={np.degrees(b):.4g} deg" for j, b in zip(self.steer_joints, beta[i], strict=True))
             raise SensingError(f"interval {i}: the sensed joints do not determine the motion at steering {angles}")
-        s_n = s[index]
-        return np.einsum("nka,na->nk", s_n, dq), np.einsum("nra,na->nr", rm[index], dq), s_n[:, :3]
+        return s, rm, index
 
 
 def odometry_model(robot: Robot, sensed: Sequence[str] | None = None) -> OdometryModel:
@@ -193,8 +269,10 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None) -> Odometr
         raise SensingError(f"the sensed joints of robot '{robot.name}' ({', '.join(sensed) or 'none'}) do not "
                            "determine its motion")
     s, rm = _solution_maps(robot, robot.beta, model.rows, model.cols, model.assigned)
+    scale = np.max(np.abs(_kept_matrix(robot, robot.beta, model.rows, model.cols)))
+    redundant = np.max(np.abs(rm), initial=0.0) > 1e-12 * scale  # else A dq = 0 exactly: no spare sensor
     return OdometryModel(robot, joints, tuple(rate_joints), (), model.rows, cols_a, assigned,
-                         model.steer_index, _frozen(s), _frozen(rm))
+                         model.steer_index, _frozen(s), _frozen(rm) if redundant else None)
 
 
 def wrap_angle(angle: ArrayLike) -> np.ndarray:

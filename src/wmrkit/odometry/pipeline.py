@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors
 from ..robot import Robot
 from .covariance import CrowleyNoise, JointNoise, propagate_covariance
-from .integrators import Method, check_method, integrate_increments
+from .integrators import Method, check_method, compose_columns
 from .logs import JointLog, LogError, check_time
 from .model import ModelIncrements, OdometryModel, odometry_model
 from .trajectories import Trajectory
@@ -56,12 +56,14 @@ class OdometrySummary:
 def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Method = "exact",
                  pose0: ArrayLike = (0.0, 0.0, 0.0), noise: Noise | None = None,
                  initial_covariance: ArrayLike | None = None,
-                 sinks: Sequence[Callable[[Trajectory], object]] = ()) -> OdometrySummary:
+                 sinks: Sequence[Callable[[Trajectory], object]] = (),
+                 out: Trajectory | None = None) -> OdometrySummary:
     """Integrate a stream of log chunks; every sink is called with each :class:`Trajectory` chunk (002 (22)).
 
     `pose0` is the pose at the first sample. With an external heading in the log, the heading's *changes* are
     used: ``theta = pose0[2] + heading - heading[0]``. `noise` (Crowley's model of 003 (17) generalised, or
     per-joint noise through the robot's kinematics) turns on covariance propagation from `initial_covariance`.
+    `out`, a trajectory of preallocated arrays as long as the whole log, is filled in place (no copies).
     """
     check_method(method)
     pose = as_vectors(pose0, 3, "pose0").copy()
@@ -72,39 +74,50 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
     prev: JointLog | None = None
     heading0 = 0.0
     stats = _Stats()
+    row = 0  # index of the chunk's first sample in `out`
     for raw in chunks:
-        chunk = raw.select(model.joints)
+        chunk = raw if raw.joints == model.joints else raw.select(model.joints)
         if len(chunk) == 0:
             continue
-        check_time(chunk, chunk.time, None if prev is None else float(prev.time[-1]), None)
-        _check_finite(chunk)
         if prev is None:
+            _validate(chunk, None)
             heading0 = 0.0 if chunk.heading_world is None else float(chunk.heading_world[0]) - pose[2]
             stats.start(chunk.time[0])
             first = Trajectory(chunk.time[:1], pose[None].copy(), np.zeros(1), None if cov is None else cov[None])
             for sink in sinks:
                 sink(first)
-            prev, chunk = chunk.slice(0, 1), chunk.slice(1, len(chunk))
+            if out is not None:
+                _fill(out, first, 0)
+            prev, chunk, row = chunk.slice(0, 1), chunk.slice(1, len(chunk)), 1
             if len(chunk) == 0:
                 continue
-        positions = np.vstack([prev.positions[-1:], chunk.positions])
-        inc = model.from_positions(positions)
+        dt = _validate(chunk, prev)
+        inc = model.from_positions(chunk.positions, previous=prev.positions[-1])
+        dx, dy, dth = inc.column(0), inc.column(1), inc.column(2)
+        dx = np.zeros(len(chunk)) if dx is None else dx
         heading = None
         if chunk.heading_world is not None:
             if prev.heading_world is None:
                 raise LogError(f"{chunk.where(0)}: external heading starts in the middle of the log")
             heading = np.concatenate([prev.heading_world[-1:], chunk.heading_world]) - heading0
-        steps = inc.increments_robot if heading is None else _with_heading(inc, heading)
-        poses = integrate_increments(pose, steps, method, heading_world=heading)
+            dth = np.diff(heading)
+        dth = np.zeros(len(chunk)) if dth is None else dth
+        poses = compose_columns(pose, dx, dy, dth, method, heading_world=heading,
+                                out=None if out is None else out.poses[row:row + len(chunk)])
         covs = None
         if cov is not None:
+            steps = np.stack([dx, np.zeros(len(chunk)) if dy is None else dy, dth], axis=-1)
             q = _increment_covariance(noise, inc, steps)
             covs = propagate_covariance(np.vstack([pose[None], poses]), steps, q, method, initial=cov)
             cov = covs[-1]
-        out = Trajectory(chunk.time, poses, inc.slip, covs)
+        slip = inc.slip
+        result = Trajectory(chunk.time, poses, slip, covs)
         for sink in sinks:
-            sink(out)
-        stats.add(np.concatenate([prev.time[-1:], chunk.time]), steps, inc.slip)
+            sink(result)
+        if out is not None:
+            _fill(out, result, row, poses=False)
+        row += len(chunk)
+        stats.add(dt, float(chunk.time[-1]), dx, dy, dth, slip if inc.residual_map is not None else None)
         pose, prev = poses[-1].copy(), chunk.slice(len(chunk) - 1, len(chunk))
     if prev is None:
         raise LogError("the log has no samples")
@@ -119,11 +132,12 @@ def odometry(robot: Robot | OdometryModel, log: JointLog, *, method: Method = "e
     `robot` may be an :class:`OdometryModel` to choose the sensed joints (default: ``robot.sensed``).
     """
     model = robot if isinstance(robot, OdometryModel) else odometry_model(robot)
-    parts: list[Trajectory] = []
-    chunks = (log.slice(i, i + chunk_size) for i in range(0, max(len(log), 1), chunk_size))
+    n = len(log)
+    out = Trajectory(log.time, np.empty((n, 3)), np.empty(n), None if noise is None else np.empty((n, 3, 3)))
+    chunks = (log.slice(i, i + chunk_size) for i in range(0, max(n, 1), chunk_size))
     run_odometry(model, chunks, method=method, pose0=pose0, noise=noise, initial_covariance=initial_covariance,
-                 sinks=[parts.append])
-    return join(parts)
+                 out=out)
+    return out
 
 
 def join(parts: Sequence[Trajectory]) -> Trajectory:
@@ -157,16 +171,39 @@ class Decimator:
         return np.concatenate(self._time), np.concatenate(self._poses)
 
 
-def _with_heading(inc: ModelIncrements, heading: np.ndarray) -> np.ndarray:
-    steps = inc.increments_robot.copy()
-    steps[:, 2] = np.diff(heading)
-    return steps
-
-
 def _increment_covariance(noise: Noise, inc: ModelIncrements, steps: np.ndarray) -> np.ndarray:
     if isinstance(noise, CrowleyNoise):
         return noise.increment_covariance(steps)
     return np.broadcast_to(noise.increment_covariance(inc.twist_map, inc.rate_increments), (len(steps), 3, 3))
+
+
+def _fill(out: Trajectory, chunk: Trajectory, row: int, *, poses: bool = True) -> None:
+    stop = row + len(chunk)
+    if poses:
+        out.poses[row:stop] = chunk.poses
+    out.slip[row:stop] = chunk.slip
+    if out.covariance is not None:
+        out.covariance[row:stop] = chunk.covariance
+
+
+def _validate(chunk: JointLog, prev: JointLog | None) -> np.ndarray | None:
+    """Refuse non-finite values and time that does not increase; the time steps (from `prev`'s last sample)."""
+    t = chunk.time
+    ok = bool(np.isfinite(chunk.positions.sum()) and np.isfinite(t[0]) and np.isfinite(t[-1]))
+    if chunk.heading_world is not None:
+        ok = ok and bool(np.isfinite(chunk.heading_world.sum()))
+    dt = None
+    if prev is not None:
+        dt = np.empty(len(t))
+        dt[0] = t[0] - prev.time[-1]
+        np.subtract(t[1:], t[:-1], out=dt[1:])
+        ok = ok and bool(dt.min() > 0)
+    elif len(t) > 1:
+        ok = ok and bool(np.min(np.diff(t)) > 0)
+    if not ok:  # the slow path finds and names the first bad value
+        _check_finite(chunk)
+        check_time(chunk, t, None if prev is None else float(prev.time[-1]), None)
+    return dt
 
 
 def _check_finite(log: JointLog) -> None:
@@ -189,14 +226,16 @@ class _Stats:
     def start(self, t0: float) -> None:
         self.n, self.t0, self.t1 = 1, float(t0), float(t0)
 
-    def add(self, time: np.ndarray, steps: np.ndarray, slip: np.ndarray) -> None:
-        self.n += len(steps)
-        self.t1 = float(time[-1])
-        self.dist += float(np.hypot(steps[:, 0], steps[:, 1]).sum())
-        self.rot += float(np.abs(steps[:, 2]).sum())
-        self.max_slip = max(self.max_slip, float(slip.max()))
-        self.sq_slip += float(np.dot(slip, slip))
-        self.max_dt = max(self.max_dt, float(np.diff(time).max()))
+    def add(self, dt: np.ndarray, t_last: float, dx: np.ndarray, dy: np.ndarray | None, dth: np.ndarray,
+            slip: np.ndarray | None) -> None:
+        self.n += len(dt)
+        self.t1 = t_last
+        self.dist += float(np.abs(dx).sum() if dy is None else np.hypot(dx, dy).sum())
+        self.rot += float(np.abs(dth).sum())
+        if slip is not None:
+            self.max_slip = max(self.max_slip, float(slip.max()))
+            self.sq_slip += float(np.dot(slip, slip))
+        self.max_dt = max(self.max_dt, float(dt.max()))
 
     def summary(self, robot: str, method: str, pose: np.ndarray, cov: np.ndarray | None) -> OdometrySummary:
         rms = float(np.sqrt(self.sq_slip / (self.n - 1))) if self.n > 1 else 0.0
