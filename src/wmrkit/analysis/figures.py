@@ -71,9 +71,14 @@ def _velocity_arrows(ax, robot: Robot, twist: np.ndarray, size: float) -> None:
 
 def robot_figure(robot: Robot, cls: Classification) -> Figure:
     """The robot at its described configuration with its axles (the constraint lines K_r*) and ICR set (5.9)."""
-    fig = Figure(figsize=(7, 6.5), dpi=100)
-    ax = fig.add_subplot()
+    fig = Figure(figsize=(9.5, 6.5), dpi=100)
+    ax = fig.add_axes((0.08, 0.09, 0.6, 0.82))
     draw_robot(robot, ax)
+    legend = ax.get_legend()
+    if legend is not None:  # move the drawing's legend beside the axes
+        handles = legend.legend_handles
+        legend.remove()
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
     size = robot_size(robot)
     cl = constraint_lines(robot)
     for lam in cl.lines():
@@ -133,7 +138,7 @@ def motions_figure(robot: Robot, cls: Classification) -> Figure | None:
         steer = ", ".join(f"{n}={math.degrees(b):.0f}°" for n, b in zip(robot.steer_names, beta, strict=True)
                           if n in set(constraint_lines(robot).wheels))
         ax.set_title(what + (f"\n{steer}" if steer else ""), fontsize=9)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.08, right=0.97, bottom=0.06, top=0.93, wspace=0.3, hspace=0.35)
     return fig
 
 
@@ -153,7 +158,7 @@ def length_figure(robot: Robot, joints: tuple[str, ...]) -> Figure | None:
     ax.set_ylabel("condition number κ")
     ax.set_title(f"κ of ({', '.join(joints)}) ← (v, D·ω)", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.15, top=0.9)
     return fig
 
 
@@ -189,7 +194,7 @@ def condition_figure(robot: Robot, joints: tuple[str, ...], length: float, varia
         ax.set_ylabel(f"{variables[1]} [deg]")
         ax.legend(loc="upper right", fontsize=8)
     ax.set_title(f"κ of ({', '.join(joints)}) at D = {length:.3g} m", fontsize=10)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.13, top=0.9)
     return fig
 
 
@@ -226,5 +231,5 @@ def singular_figure(robot: Robot, s: SingularSet, title: str) -> Figure | None:
         ax2.set_ylabel(f"{s.variables[1]} [deg]" + (" (others projected)" if len(s.variables) > 2 else ""))
         ax2.set_title("singular configurations", fontsize=9)
         ax2.grid(True, alpha=0.3)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.08, right=0.97, bottom=0.1, top=0.92, wspace=0.25)
     return fig

@@ -56,15 +56,20 @@ class ICRSet:
     def describe(self) -> str:
         """One line for people, e.g. ``ICR at (0.000, -2.747) m``."""
         if self.kind == "point":
-            return f"ICR at ({self.point[0]:.3f}, {self.point[1]:.3f}) m"
+            return f"ICR at ({_f(self.point[0])}, {_f(self.point[1])}) m"
         if self.kind == "infinity":
-            return f"ICR at infinity: translation only, along +-({self.direction[0]:.3f}, {self.direction[1]:.3f})"
+            return f"ICR at infinity: translation only, along +-({_f(self.direction[0])}, {_f(self.direction[1])})"
         if self.kind == "line":
             lx, ly, d = self.line
-            return f"ICR anywhere on the line through ({d * ly:.3f}, {-d * lx:.3f}) m along ({lx:.3f}, {ly:.3f})"
+            return f"ICR anywhere on the line through ({_f(d * ly)}, {_f(-d * lx)}) m along ({_f(lx)}, {_f(ly)})"
         if self.kind == "plane":
             return "ICR anywhere in the plane (no wheel axle constrains it)"
         return "no ICR: the robot cannot move without slipping"
+
+
+def _f(x: float) -> str:
+    text = f"{x:.3f}"
+    return "0.000" if text == "-0.000" else text
 
 
 def icr(robot: Robot, beta: ArrayLike | None = None) -> ICRSet:

@@ -1,0 +1,88 @@
+"""The analysis report and ``wmrkit analyze``: a report for every catalog robot; the JSON keys of the issue."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+
+from wmrkit import catalog
+from wmrkit.analysis.classification import classify
+from wmrkit.analysis.isotropy import natural_length
+from wmrkit.analysis.report import write_report
+from wmrkit.analysis.summary import analyze
+from wmrkit.cli.main import main
+
+
+@pytest.mark.parametrize("name", catalog.names())
+def test_report_for_every_catalog_robot(name, tmp_path):
+    robot = catalog.load(name)
+    result = analyze(robot, resolution=12)
+    page = write_report(result, tmp_path / name, resolution=12, dpi=30)
+    text = page.read_text(encoding="utf-8")
+    images = re.findall(r"<img src='([^']+)'", text)
+    assert "robot.png" in images
+    for img in images:  # every picture the page shows is there and is a PNG
+        assert (page.parent / img).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    c = classify(robot)
+    if c.degenerate:
+        assert "Degenerate robot" in text
+    else:
+        assert f"Type {c.type} of the thesis" in text and f"m = {c.mobility}, d = {c.steerability}" in text
+    assert "Singular configurations" in text and "Isotropy" in text
+
+
+def test_json_output_has_the_keys_of_the_issue(capsys):
+    assert main(["analyze", "forklift", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert (out["mobility"], out["steerability"], out["type"], out["degenerate"]) == (1, 1, 4, False)
+    assert set(out["actuation"]) >= {"consistent", "sufficient"} and set(out["sensing"]) >= {"sufficient"}
+    assert out["actuation"]["consistent"] is False  # two driven wheels and one degree of mobility (ch. 4)
+    assert out["actuation"]["sufficient"] is True and out["sensing"]["sufficient"] is True
+    assert out["condition_number"] == pytest.approx(1.0)
+    assert out["characteristic_length"] > 0
+
+
+def test_json_condition_number_at_the_natural_or_given_length(capsys):
+    assert main(["analyze", "thesis-omni-swedish", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    d, k = natural_length(catalog.load("thesis-omni-swedish"))
+    assert out["characteristic_length"] == pytest.approx(d) and out["condition_number"] == pytest.approx(k)
+    assert out["type"] == 1 and out["mobility"] == 3 and out["steerability"] == 0
+    assert main(["analyze", "thesis-omni-swedish", "--json", "--length", "500 mm"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["characteristic_length"] == pytest.approx(0.5)
+    assert out["condition_number"] == pytest.approx(2**0.5)  # L = 0.5 m: kappa(D = L) = sqrt(2) (digest §9)
+
+
+def test_degenerate_robot_json(capsys):
+    assert main(["analyze", "skid-steer-4", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["degenerate"] is True and out["type"] is None and out["mobility"] == 1
+
+
+def test_text_summary_and_report_flag(capsys, tmp_path):
+    assert main(["analyze", "thesis-tricycle", "--report", str(tmp_path / "r"), "--resolution", "12"]) == 0
+    text = capsys.readouterr().out
+    assert "type 4" in text and "m = 1" in text and "singular" in text and "report written to" in text
+    assert (tmp_path / "r" / "index.html").exists()
+
+
+def test_steer_option_changes_the_configuration(capsys):
+    assert main(["analyze", "thesis-tricycle", "--steer", "o3=90 deg", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert "(0.000, 0.000)" in out["icr"]  # axle through the origin: pure rotation about O_R (Fig. 6.8a)
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["analyze", "no-such-robot"], "no robot 'no-such-robot'"),
+    (["analyze", "forklift", "--length", "3 deg"], "--length"),
+    (["analyze", "forklift", "--length", "-1"], "--length: must be > 0"),
+    (["analyze", "forklift", "--resolution", "3"], "--resolution"),
+    (["analyze", "forklift", "--steer", "right_drive=1"], "does not steer"),
+])
+def test_user_errors_exit_2_with_one_line(argv, message, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
