@@ -88,6 +88,11 @@ def test_forklift_counts_log_uses_the_catalog_encoders(capsys, tmp_path):
                           "--column", "right_drive.spin=enc_r", "--column", "left_drive.spin=enc_l",
                           "--column", "steer.steer=steer_raw"])
     assert out2["pose"] != out["pose"]  # no offset given: straight ahead reads as 0 deg, not 90 deg
+    out3 = _json(capsys, ["odometry", "forklift", str(path), "--json", "--spin", "counts", "--steer", "counts",
+                          "--time-column", "stamp", "--weight", "steer=0.01", "--column", "right_drive.spin=enc_r",
+                          "--column", "left_drive.spin=enc_l", "--column", "steer.steer=steer_raw"])
+    err3 = np.hypot(*(np.array(out3["pose"][:2]) - run.truth[-1, :2]))
+    assert err3 < 0.2 * np.hypot(*(np.array(out["pose"][:2]) - run.truth[-1, :2]))  # trusting the steering less
 
 
 def test_wrapping_counter_and_sensed_subset(capsys, tmp_path, diff_run):
@@ -121,6 +126,7 @@ def test_gyro_heading(capsys, tmp_path, diff_run):
     ("ok", ["--out", "/nonexistent/dir/t.csv"], r"cannot write"),
     ("ok", ["--plot", "p.gif"], r"plot files are \.png, \.svg or \.pdf"),
     ("ok", ["--chunk-size", "0"], r"--chunk-size must be >= 1"),
+    ("ok", ["--weight", "left=-1"], r"weight of wheel 'left' must be a finite number > 0"),
     ("missing", [], r"no such file"),
 ])
 def test_bad_input_exits_2_with_one_line(capsys, tmp_path, setup, args, message):

@@ -202,3 +202,36 @@ def test_sensing_errors_name_the_problem():
         odometry_model(diff).increments(np.zeros((3, 3)))
     with pytest.raises(WmrkitError, match="beta_mid: robot 'forklift' steers"):
         odometry_model(catalog.load("forklift")).increments(np.zeros((3, 2)))
+
+
+def test_row_weights_give_the_weighted_least_squares():
+    """Against numpy's lstsq on the weighted rows (an independent solver): min || W A q || with dq assigned."""
+    robot = catalog.load("forklift")
+    weights = {"steer": 0.05, "left_drive": 2.0}
+    model = odometry_model(robot, weights=weights)
+    dq, beta = np.array([[4.0, 4.6]]), np.array([[1.3]])
+    out = model.increments(dq, beta)
+    a = robot.constraint_matrix(beta[0])
+    w = np.repeat([weights.get(n, 1.0) for n in robot.wheel_names], 2)
+    assigned = [robot.velocity_index(j) for j in model.rate_joints]
+    free = [c for c in range(a.shape[1]) if c not in assigned]
+    q_free = np.linalg.lstsq(w[:, None] * a[:, free], -(w[:, None] * a[:, assigned]) @ dq[0], rcond=None)[0]
+    np.testing.assert_allclose(out.increments_robot[0], q_free[:3], atol=1e-12)
+    q = np.zeros(a.shape[1])
+    q[free], q[assigned] = q_free, dq[0]
+    np.testing.assert_allclose(out.slip[0], np.linalg.norm(a @ q), atol=1e-12)  # the residual is unweighted
+
+
+def test_small_steering_weight_tends_to_differential_odometry():
+    robot = catalog.load("forklift")
+    diff = odometry_model(robot, ["right_drive.spin", "left_drive.spin"])  # the classic differential odometry
+    dq, beta = np.array([[4.0, 4.6]]), np.array([[1.3]])  # steering inconsistent with the drive wheels
+    ref = diff.increments(dq).increments_robot[0]
+    errs = [np.abs(odometry_model(robot, weights={"steer": w}).increments(dq, beta).increments_robot[0] - ref).max()
+            for w in (1.0, 0.1, 0.01)]
+    assert errs[0] > 1e-2  # equal weights: the steering angle bends the estimate
+    assert errs[1] < 0.1 * errs[0] and errs[2] < 0.02 * errs[1]  # the blend vanishes like w^2
+    with pytest.raises(SensingError, match="weight of wheel 'steer' must be a finite number > 0"):
+        odometry_model(robot, weights={"steer": 0.0})
+    with pytest.raises(UnknownNameError, match="has no wheel 'ster'"):
+        odometry_model(robot, weights={"ster": 1.0})

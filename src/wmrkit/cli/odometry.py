@@ -31,6 +31,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--pose", nargs=3, metavar=("X", "Y", "THETA"), default=("0", "0", "0"),
                    help="pose at the first sample: x, y [m], theta [rad, or 'deg'] (default 0 0 0)")
     p.add_argument("--sensed", action="append", metavar="WHEEL.JOINT", help="use only these sensed joints (repeat)")
+    p.add_argument("--weight", action="append", metavar="WHEEL=W", default=[],
+                   help="least-squares weight of a wheel's no-slip equations (default 1; repeat)")
     p.add_argument("--covariance", action="store_true", help="propagate Crowley's pose covariance (003 eq. 17)")
     p.add_argument("--crowley", nargs=3, type=float, metavar=("K_D", "K_DTHETA", "K_THETA"),
                    default=(0.001, 0.003, 0.001), help="Crowley's coefficients (default 0.001 0.003 0.001)")
@@ -78,9 +80,17 @@ def run(args: argparse.Namespace) -> int:
         robot, args.log, fmt=fmt, method=args.method, pose0=pose0, sensed=args.sensed,
         noise=CrowleyNoise(*args.crowley) if args.covariance else None, out=args.out, out_format=args.out_format,
         plot=args.plot, progress=not args.quiet and sys.stderr.isatty(), chunk_size=args.chunk_size,
-        topic=args.topic, joint_names=parse_assignments(args.joint_name, "--joint-name"))
+        topic=args.topic, joint_names=parse_assignments(args.joint_name, "--joint-name"),
+        weights={w: _number(v, f"--weight {w}") for w, v in parse_assignments(args.weight, "--weight").items()})
     print_json(summary.to_dict()) if args.json else print(format_summary(summary))
     return 0
+
+
+def _number(text: str, what: str) -> float:
+    try:
+        return parse_quantity(text, "number")
+    except UnitError as err:
+        raise WmrkitError(f"{what}: {err}") from None
 
 
 def _length(text: str, what: str) -> float:

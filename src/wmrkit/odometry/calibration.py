@@ -19,7 +19,7 @@ approximation. :func:`square_path_error` gives the benchmark's figure of merit f
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -97,12 +97,13 @@ def apply_parameters(robot: Robot, parameters: Sequence[Parameter], p: ArrayLike
 
 
 def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence[Parameter], *,
-              method: Method = "exact", heading_weight: float = 1.0,
-              sensed: Sequence[str] | None = None) -> Calibration:
+              method: Method = "exact", heading_weight: float = 1.0, sensed: Sequence[str] | None = None,
+              weights: Mapping[str, float] | None = None) -> Calibration:
     """Fit `parameters` of `robot` so that its odometry over `runs` matches their references (least squares).
 
     Residuals per referenced sample: ``x``, ``y`` error [m] and ``heading_weight`` [m/rad] times the wrapped
     heading error. Needs at least as many residuals as parameters, and parameters the runs can tell apart.
+    `sensed` and `weights` choose the model as in :func:`~.model.odometry_model`.
     """
     if not runs:
         raise WmrkitError("calibrate: no runs")
@@ -110,7 +111,7 @@ def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence
     from scipy.optimize import least_squares
 
     def residuals(p: np.ndarray) -> np.ndarray:
-        model = odometry_model(apply_parameters(robot, parameters, p), sensed)
+        model = odometry_model(apply_parameters(robot, parameters, p), sensed, weights=weights)
         out = []
         for run in runs:
             poses = odometry(model, run.log, method=method, pose0=run.start()).poses[run.samples()]

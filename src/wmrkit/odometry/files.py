@@ -44,16 +44,18 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
                   noise: Noise | None = None, out: str | os.PathLike[str] | None = None,
                   out_format: OutFormat | None = None, plot: str | os.PathLike[str] | None = None,
                   progress: bool = False, chunk_size: int = 1 << 16, topic: str = "/joint_states",
-                  joint_names: Mapping[str, str] | None = None) -> OdometrySummary:
+                  joint_names: Mapping[str, str] | None = None,
+                  weights: Mapping[str, float] | None = None) -> OdometrySummary:
     """Run odometry over the log at `log_path` and write the requested outputs (module docstring).
 
-    `fmt` describes a CSV log; `topic` and `joint_names` (ROS name -> robot joint) a bag. `progress` shows a
-    tqdm bar on stderr. Returns the run's :class:`~.pipeline.OdometrySummary`.
+    `fmt` describes a CSV log; `topic` and `joint_names` (ROS name -> robot joint) a bag. `sensed` and `weights`
+    go to :func:`~.model.odometry_model`. `progress` shows a tqdm bar on stderr. Returns the run's
+    :class:`~.pipeline.OdometrySummary`.
     """
     from tqdm import tqdm
 
     check_method(method)
-    model = odometry_model(robot, sensed)
+    model = odometry_model(robot, sensed, weights=weights)
     if not Path(log_path).exists():
         raise LogError(f"{os.fspath(log_path)}: no such file")
     bag = is_bag(log_path)

@@ -17,7 +17,7 @@ steering configuration in the data (quantised steering encoders give few) and ga
 from __future__ import annotations
 
 import functools
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -136,6 +136,7 @@ class OdometryModel:
     cols: np.ndarray  # velocity columns kept (twist first)
     assigned: np.ndarray  # positions of rate_joints among the kept columns
     steer_index: np.ndarray  # position of each steer joint in the robot's beta
+    row_weights: np.ndarray  # weight of each kept row in the least squares
     solution: np.ndarray | None  # (k, n_a), constant robots only
     residual_map: np.ndarray | None  # (R, n_a), constant robots with redundant sensors only
 
@@ -202,7 +203,7 @@ class OdometryModel:
         beta = np.asarray(beta, dtype=float)
         full = np.broadcast_to(self.robot.beta, (*beta.shape[:-1], len(self.robot.steer_names))).copy()
         full[..., self.steer_index] = beta
-        return _solution_maps(self.robot, full, self.rows, self.cols, self.assigned)
+        return _solution_maps(self.robot, full, self.rows, self.cols, self.assigned, self.row_weights)
 
     def _solve_by_configuration(self, dq: np.ndarray, beta_mid: ArrayLike | None) -> tuple[np.ndarray, ...]:
         if beta_mid is None:
@@ -225,13 +226,24 @@ class OdometryModel:
         return s, rm, index
 
 
-def odometry_model(robot: Robot, sensed: Sequence[str] | None = None) -> OdometryModel:
+def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
+                   weights: Mapping[str, float] | None = None) -> OdometryModel:
     """The sensed direct model of `robot` over samples (ranks method, eqs. (4.9)-(4.11); module docstring).
 
-    `sensed`: joints ``wheel.joint`` the log provides (default ``robot.sensed``). Raises :class:`SensingError`
-    when they cannot give the motion, :class:`UnknownNameError` for a name the robot lacks.
+    `sensed`: joints ``wheel.joint`` the log provides (default ``robot.sensed``). `weights`: wheel name -> weight
+    > 0 of its constraint rows in the least squares (default 1): how much that wheel's no-slip equations are
+    trusted, the weighting idea of the thesis's WLS estimator (§7.4.4). A small weight on the forklift's steered
+    wheel, whose angle is coarsely quantised, gives nearly the drive wheels' differential odometry while its
+    residual still reports the disagreement. The residual is always the unweighted ``A dq``. Raises
+    :class:`SensingError` when the joints cannot give the motion, :class:`UnknownNameError` for a name the robot
+    lacks.
     """
     sensed = tuple(robot.sensed if sensed is None else sensed)
+    weights = dict(weights or {})
+    for name, w in weights.items():
+        robot.wheel(name)
+        if not (w > 0 and np.isfinite(w)):
+            raise SensingError(f"weight of wheel '{name}' must be a finite number > 0, got {w}")
     for name in sensed:
         wheel_name, _, joint = name.partition(".")
         wheel = robot.wheel(wheel_name)
@@ -242,7 +254,7 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None) -> Odometr
         twice = sorted({s for s in sensed if sensed.count(s) > 1})
         raise SensingError(f"sensed joints listed twice: {', '.join(twice)}")
     rows, cols, row, col = [], list(range(3)), 0, 3
-    rate_joints, steer_joints, steer_index = [], [], []
+    rate_joints, steer_joints, steer_index, row_weights = [], [], [], []
     for wheel in robot.wheels:
         n_rows, n_rates = 2 * len(wheel.elements()), len(wheel.kind.rates)
         mine = [s for s in sensed if s.partition(".")[0] == wheel.name]
@@ -255,6 +267,7 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None) -> Odometr
             steer_index.append(robot.steer_names.index(wheel.name))
         if not wheel.kind.steers or mine:
             rows += range(row, row + n_rows)
+            row_weights += [float(weights.get(wheel.name, 1.0))] * n_rows
             cols += range(col, col + n_rates)
             rate_joints += [s for s in mine if s.partition(".")[2] in wheel.kind.rates]
         row, col = row + n_rows, col + n_rates
@@ -262,17 +275,17 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None) -> Odometr
     assigned = np.array([cols.index(robot.velocity_index(j)) for j in rate_joints], dtype=int)
     joints = tuple(dict.fromkeys([*rate_joints, *steer_joints]))
     model = OdometryModel(robot, joints, tuple(rate_joints), tuple(steer_joints), np.array(rows), cols_a, assigned,
-                          np.array(steer_index, dtype=int), None, None)
+                          np.array(steer_index, dtype=int), _frozen(np.array(row_weights)), None, None)
     if steer_joints:
         return model
     if not _twist_determined(robot, robot.beta[None, :], model)[0]:
         raise SensingError(f"the sensed joints of robot '{robot.name}' ({', '.join(sensed) or 'none'}) do not "
                            "determine its motion")
-    s, rm = _solution_maps(robot, robot.beta, model.rows, model.cols, model.assigned)
+    s, rm = _solution_maps(robot, robot.beta, model.rows, model.cols, model.assigned, model.row_weights)
     scale = np.max(np.abs(_kept_matrix(robot, robot.beta, model.rows, model.cols)))
     redundant = np.max(np.abs(rm), initial=0.0) > 1e-12 * scale  # else A dq = 0 exactly: no spare sensor
     return OdometryModel(robot, joints, tuple(rate_joints), (), model.rows, cols_a, assigned,
-                         model.steer_index, _frozen(s), _frozen(rm) if redundant else None)
+                         model.steer_index, model.row_weights, _frozen(s), _frozen(rm) if redundant else None)
 
 
 def wrap_angle(angle: ArrayLike) -> np.ndarray:
@@ -286,12 +299,14 @@ def _kept_matrix(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np
 
 
 def _solution_maps(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np.ndarray,
-                   assigned: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(S, Rm)`` from (4.11) for each configuration: solve_assigned on the unit vectors of the assigned rates."""
+                   assigned: np.ndarray, row_weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(S, Rm)`` from (4.11) for each configuration: solve_assigned (on the rows scaled by their weights) for
+    the unit vectors of the assigned rates; ``Rm = A S``, the unweighted residual map."""
     a = _kept_matrix(robot, beta_full, rows, cols)
     n_a = len(assigned)
-    q, res = solve_assigned(a[..., None, :, :], assigned, np.eye(n_a))  # (..., n_a, k), (..., n_a, R)
-    return np.swapaxes(q, -1, -2), np.swapaxes(res, -1, -2)
+    q, _ = solve_assigned((a * row_weights[:, None])[..., None, :, :], assigned, np.eye(n_a))  # (..., n_a, k)
+    s = np.swapaxes(q, -1, -2)
+    return s, a @ s
 
 
 def _twist_determined(robot: Robot, beta_full: np.ndarray, model: OdometryModel) -> np.ndarray:
