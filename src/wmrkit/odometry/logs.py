@@ -265,7 +265,8 @@ def write_csv(path: str | os.PathLike[str], names: Sequence[str], values: np.nda
         f.write(",".join(names) + "\n")
         row = ",".join([fmt] * len(names)) + "\n"
         for start in range(0, len(values), 1 << 16):
-            f.write("".join(row % tuple(r) for r in values[start:start + (1 << 16)].tolist()))
+            block = values[start:start + (1 << 16)]
+            f.write((row * len(block)) % tuple(block.ravel().tolist()))  # one formatting call per block
 
 
 def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: Sequence[str],

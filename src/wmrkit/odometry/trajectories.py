@@ -86,7 +86,7 @@ class TrajectoryWriter:
             z = np.zeros((len(chunk), 1))
             values = np.hstack([chunk.time[:, None], chunk.poses[:, :2], z, quaternion_z(chunk.poses[:, 2])])
             row = "%.9f " + " ".join(["%.12g"] * 7) + "\n"
-        self._f.write("".join(row % tuple(r) for r in values.tolist()))
+        self._f.write((row * len(values)) % tuple(values.ravel().tolist()))  # one formatting call per chunk
 
     def close(self) -> None:
         """Close the file."""
