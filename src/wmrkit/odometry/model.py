@@ -148,7 +148,8 @@ class OdometryModel:
     @property
     def joint_names(self) -> tuple[str, ...]:
         """Names of the kept wheel rates (``ModelIncrements.joint_increments`` columns)."""
-        return tuple(self.robot.velocity_names[c] for c in self.cols[3:])
+        names = self.robot.velocity_names
+        return tuple(names[c] for c in self.cols[3:])
 
     def increments(self, rate_increments: ArrayLike, beta_mid: ArrayLike | None = None) -> ModelIncrements:
         """Body increments from sensed joint increments, eqs. (3.22), (4.11).

@@ -230,11 +230,11 @@ class _Stats:
             slip: np.ndarray | None) -> None:
         self.n += len(dt)
         self.t1 = t_last
-        self.dist += float(np.abs(dx).sum() if dy is None else np.hypot(dx, dy).sum())
+        self.dist += float(np.abs(dx).sum() if dy is None else np.sqrt(dx * dx + dy * dy).sum())  # hypot is slow
         self.rot += float(np.abs(dth).sum())
         if slip is not None:
             self.max_slip = max(self.max_slip, float(slip.max()))
-            self.sq_slip += float(np.dot(slip, slip))
+            self.sq_slip += float(np.square(slip).sum())  # not np.dot: BLAS threads stall on a busy machine
         self.max_dt = max(self.max_dt, float(dt.max()))
 
     def summary(self, robot: str, method: str, pose: np.ndarray, cov: np.ndarray | None) -> OdometrySummary:
