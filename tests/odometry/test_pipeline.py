@@ -153,3 +153,16 @@ def test_bad_in_memory_logs_are_refused():
     log = JointLog(np.array([0.0, 0.1, 0.2, 0.15]), joints, np.zeros((4, 2)))
     with pytest.raises(LogError, match=r"sample 3: time 0\.15 s goes backwards"):
         odometry(robot, log, chunk_size=2)
+
+
+def test_castor_robot_from_its_castors_converges_at_second_order():
+    """Three sensed castors (thesis type-1 robot): the steering angles change continuously, the model takes them
+    at mid-interval, so the error falls like the square of the sample period."""
+    robot = catalog.load("thesis-omni-castor")
+    profile = TwistProfile.from_segments([(2.0, 0.2, -0.3, 0.3), (2.0, -0.1, 0.2, -0.4)])
+    errs = []
+    for rate in (25.0, 50.0):
+        run = simulate(robot, profile, rate, oversample=16)
+        errs.append(np.abs(odometry(robot, run.log).poses - run.truth).max())
+    assert errs[1] < 1e-3
+    assert 3.0 < errs[0] / errs[1] < 5.5
