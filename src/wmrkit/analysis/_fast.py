@@ -108,7 +108,10 @@ def distance_cm(lines: np.ndarray, length: float) -> np.ndarray:
     """``sigma_min / sigma_max`` of the lines ``(L, 3, N)`` with d scaled by 1/length and unit rows, (6.17)."""
     g = lines * np.array([1.0, 1.0, 1.0 / length])[None, :, None]
     g = g / np.sqrt(np.einsum("lcn,lcn->ln", g, g))[:, None, :]
-    small, _, large = _eig3(gram3(g))
+    if g.shape[-1] <= 64:  # SVD: accurate to eps (the Gram route bottoms out at sqrt(eps))
+        sv = np.linalg.svd(np.moveaxis(g, -1, 0), compute_uv=False)
+        return sv[:, 2] / sv[:, 0]
+    small, _, large = eigvalsh3_entries(*gram3(g))
     return np.sqrt(np.maximum(small, 0.0) / large)
 
 

@@ -165,6 +165,15 @@ def _kappa(model: TwistModel, beta: np.ndarray, length: float) -> np.ndarray:
     return out.reshape(beta.shape[:-1])
 
 
+def kappa_function(model: TwistModel, beta: np.ndarray):
+    """``length -> kappa (N,)`` at configurations `beta` ``(N, n_steer)`` (one chunk), rows computed once."""
+    p, cl = _params(model.robot), constraint_lines(model.robot)
+    rows = _fast.element_rows_cm(p, beta)
+    lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
+    rates = _fast.combine(model.coefficients, rows)
+    return lambda length: _fast.kappa_cm(model.mobility, rates, lines, float(length))
+
+
 def natural_length(robot: Robot, beta: ArrayLike | None = None, *,
                    joints: tuple[str, ...] | None = None) -> tuple[float, float]:
     """The characteristic length minimising :func:`twist_condition_number` at one configuration: ``(D [m], kappa)``.

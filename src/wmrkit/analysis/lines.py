@@ -22,7 +22,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
-from ..errors import UnknownNameError
 from ..kinematics.linalg import rref
 from ..robot import TWIST_NAMES, Robot
 
@@ -243,11 +242,3 @@ def _params(robot: Robot) -> _Params:
         d_s=col(lambda e: e.d * np.sin(e.delta + e.gamma)),
     )
 
-
-def velocity_names_checked(robot: Robot, names: tuple[str, ...] | list[str], what: str) -> tuple[str, ...]:
-    """`names` as a tuple after checking each is a velocity of `robot` (:class:`UnknownNameError` otherwise)."""
-    for n in names:
-        if n not in robot.velocity_names:
-            raise UnknownNameError(f"{what}: robot '{robot.name}' has no velocity '{n}' "
-                                   f"(velocities: {', '.join(robot.velocity_names)})")
-    return tuple(names)

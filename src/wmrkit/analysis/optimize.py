@@ -20,7 +20,7 @@ from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
 from . import _fast
 from ._sym import eigvalsh2_entries
-from .isotropy import _kappa, golden_section, natural_length, twist_model
+from .isotropy import _kappa, golden_section, kappa_function, natural_length, twist_model
 from .lines import _params, constraint_lines
 from .singularity import robot_size
 
@@ -155,21 +155,23 @@ def optimize_geometry(family: Callable[[np.ndarray], Robot], x0: ArrayLike, *,
         try:
             robot = family(np.asarray(x, dtype=float))
         except WmrkitError:
-            return np.inf, np.nan
+            return 1e12, np.nan  # outside the family: a finite penalty keeps Nelder-Mead's arithmetic clean
         if objective == "described":
             d, k = natural_length(robot, joints=joints)
-            return (k if np.isfinite(k) else np.inf), d
-        model = twist_model(robot, joints)
-        beta = rng_fixed.uniform(-np.pi, np.pi, (samples, len(robot.steer_names)))
-        inv = lambda d: -float(np.mean(1 / np.nan_to_num(_kappa(model, beta, d), nan=np.inf)))  # noqa: E731
+            return (k if np.isfinite(k) else 1e12), d
+        kappa = kappa_function(twist_model(robot, joints),
+                               rng_fixed.uniform(-np.pi, np.pi, (samples, len(robot.steer_names))))
+        inv = lambda d: -float(np.mean(1 / np.nan_to_num(kappa(d), nan=np.inf)))  # noqa: E731
         size = robot_size(robot)
-        d = float(np.exp(golden_section(lambda t: inv(np.exp(t)), np.log(size / 100), np.log(size * 100))))
+        d = float(np.exp(golden_section(lambda t: inv(np.exp(t)), np.log(size / 100), np.log(size * 100),
+                                        tol=1e-6)))
         mean_inv = -inv(d)
-        return (1 / mean_inv if mean_inv > 0 else np.inf), d
+        return (1 / mean_inv if mean_inv > 0 else 1e12), d
 
     if objective not in ("described", "global"):
         raise UnknownNameError(f"objective must be 'described' or 'global', got {objective!r}")
     rng_fixed = np.random.default_rng(seed + 1)
+    xatol = 1e-9 if objective == "described" else 1e-6  # the global objective is a sample mean: no finer
     points = [x0]
     for _ in range(starts - 1):
         points.append(rng.uniform(*np.array(bounds, dtype=float).T) if bounds is not None
@@ -177,7 +179,7 @@ def optimize_geometry(family: Callable[[np.ndarray], Robot], x0: ArrayLike, *,
     best = None
     for p in points:
         res = minimize(lambda x: evaluate(x)[0], p, method="Nelder-Mead", bounds=bounds,
-                       options={"xatol": 1e-10, "fatol": 1e-13, "maxiter": 4000})
+                       options={"xatol": xatol, "fatol": xatol * 1e-3, "maxiter": 300 * len(x0)})
         if best is None or res.fun < best.fun:
             best = res
     value, d = evaluate(best.x)

@@ -49,9 +49,16 @@ def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...],
     """Line test (6.17)-(6.20): the constraint lines G are concurrent or parallel. ``(..., n_steer) -> (...)`` bool.
 
     Also True when a wheel has joint rates the assigned set leaves undetermined (e.g. a double wheel with none of
-    its joints assigned). Equals :func:`is_singular_rank` away from numerical ties.
+    its joints assigned). Equals :func:`is_singular_rank` away from numerical ties. Uses an SVD per configuration
+    (accurate to machine precision); :func:`singularity_distance` is the fast measure for maps.
     """
-    return singularity_distance(robot, beta, assigned) < rtol
+    cl = constraint_lines(robot, assigned)
+    beta = robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
+    if cl.internal or len(cl.labels) < 3:
+        return np.ones(beta.shape[:-1], bool)
+    g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / robot_size(robot)])
+    sv = np.linalg.svd(g / np.linalg.norm(g, axis=-1, keepdims=True), compute_uv=False)
+    return sv[..., 2] < rtol * sv[..., 0]
 
 
 def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], *,
