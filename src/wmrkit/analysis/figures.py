@@ -203,9 +203,11 @@ def singular_figure(robot: Robot, s: SingularSet, title: str) -> Figure | None:
     if s.never or len(s.assigned) == 0:
         return None
     beta = robot.beta.copy()
-    if not s.always:
-        beta[[robot.steer_names.index(v) for v in s.variables]] = s.configurations[0]
-    two = len(s.variables) >= 2 and len(s.configurations) > 1
+    idx = [robot.steer_names.index(v) for v in s.variables]
+    if not s.always:  # the singular configuration nearest the described one
+        gap = np.abs(np.angle(np.exp(1j * (s.configurations - beta[idx])))).sum(axis=1)
+        beta[idx] = s.configurations[int(np.argmin(gap))]
+    two = len(s.variables) == 2 and len(s.configurations) > 1
     fig = Figure(figsize=(11 if two else 6.5, 5.6), dpi=90)
     ax = fig.add_subplot(1, 2 if two else 1, 1)
     draw_robot(robot, ax, beta=beta, labels=False)
@@ -217,9 +219,7 @@ def singular_figure(robot: Robot, s: SingularSet, title: str) -> Figure | None:
     if len(lines) >= 2:
         _mark_icr(ax, common_point(lines), size, label="common point")
     ax.legend(loc="lower left", fontsize=7, framealpha=0.85)
-    where = ", ".join(f"{v}={math.degrees(b):.1f}°" for v, b in zip(s.variables, beta[[robot.steer_names.index(v)
-                                                                                          for v in s.variables]],
-                                                                    strict=True))
+    where = ", ".join(f"{v}={math.degrees(b):.1f}°" for v, b in zip(s.variables, beta[idx], strict=True))
     ax.set_title(f"{title}: {'always singular' if s.always else 'singular at ' + where}", fontsize=9)
     if two:
         ax2 = fig.add_subplot(1, 2, 2)
@@ -228,7 +228,9 @@ def singular_figure(robot: Robot, s: SingularSet, title: str) -> Figure | None:
         ax2.set_xlim(-180, 180)
         ax2.set_ylim(-180, 180)
         ax2.set_xlabel(f"{s.variables[0]} [deg]")
-        ax2.set_ylabel(f"{s.variables[1]} [deg]" + (" (others projected)" if len(s.variables) > 2 else ""))
+        ax2.set_ylabel(f"{s.variables[1]} [deg]")
+        ax2.plot(*np.degrees(robot.beta[idx]), "o", color="white", markeredgecolor="black", label="described")
+        ax2.legend(loc="upper right", fontsize=8)
         ax2.set_title("singular configurations", fontsize=9)
         ax2.grid(True, alpha=0.3)
     fig.subplots_adjust(left=0.08, right=0.97, bottom=0.1, top=0.92, wspace=0.25)
