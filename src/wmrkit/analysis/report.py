@@ -13,6 +13,7 @@ import os
 from pathlib import Path
 
 from ..errors import WmrkitError
+from .coordinated import coordinated_singular_set
 from .figures import condition_figure, length_figure, motions_figure, robot_figure, singular_figure
 from .lines import constraint_lines
 from .singularity import singular_set
@@ -174,7 +175,8 @@ def _assignable_table(a: Analysis, resolution: int, limit: int = 36) -> str:
     small = max(12, resolution // 4)
     rows = []
     for q_a in sets:
-        s = singular_set(r, q_a, resolution=small, max_samples=small * 4)
+        s = (coordinated_singular_set(r, q_a, resolution=small) if a.classification.coordinated
+             else singular_set(r, q_a, resolution=small, max_samples=small * 4))
         rows.append(f"<tr><td>{_e(', '.join(q_a))}</td><td>{_e(describe_singular(s, limit=4))}</td></tr>")
     return (f"<h3>Every choice of {m} assigned velocit{'y' if m == 1 else 'ies'} (m = {m})</h3>{note}"
             f"<table><tr><th>assigned</th><th>singular</th></tr>{''.join(rows)}</table>")

@@ -93,7 +93,9 @@ class SingularSet:
     ``always``: singular at every configuration; otherwise ``configurations`` ``(n, len(variables))`` [rad] lists
     singular configurations (the other steering angles at their described values): all of them when
     ``exact`` (zero or one variable), points on the singular curves/surfaces sampled on a grid otherwise.
-    ``reasons`` explains an ``always``.
+    ``reasons`` explains an ``always``. ``coordinated``: only configurations with all steered axles through one
+    ICR were searched (:func:`wmrkit.analysis.coordinated.coordinated_singular_set`); ``reasons`` then describes
+    the singular ICRs.
     """
 
     assigned: tuple[str, ...]
@@ -102,6 +104,7 @@ class SingularSet:
     configurations: np.ndarray
     exact: bool
     reasons: tuple[str, ...] = ()
+    coordinated: bool = False
 
     @property
     def never(self) -> bool:

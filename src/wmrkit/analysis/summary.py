@@ -17,6 +17,7 @@ from ..kinematics.actuation import actuation_analysis
 from ..kinematics.sensing import sensing_analysis
 from ..robot import Robot
 from .classification import Classification, classify, instantaneous_mobility
+from .coordinated import coordinated_singular_set
 from .icr import ICRSet, icr
 from .isotropy import default_joints, natural_length, twist_condition_number
 from .singularity import SingularSet, singular_set
@@ -93,7 +94,12 @@ def describe_singular(s: SingularSet, *, limit: int = 6) -> str:
     if s.always:
         return "always" + (f" ({s.reasons[0]})" if s.reasons else "")
     if s.never:
-        return "never" if s.exact else "none found on the sampled grid"
+        return ("never" if s.exact else "none found on the sampled grid") + (
+            " (coordinated steering)" if s.coordinated else "")
+    if s.coordinated:
+        more = f" and {len(s.configurations) - limit} more" if len(s.configurations) > limit else ""
+        return "with coordinated steering, when the " + "; ".join(
+            r.replace("ICR at", "ICR is at", 1) for r in s.reasons[:limit]) + more
     if s.exact:
         angles = ", ".join(f"{math.degrees(v):.2f}" for v in s.configurations[:limit, 0])
         more = f" and {len(s.configurations) - limit} more" if len(s.configurations) > limit else ""
@@ -105,6 +111,15 @@ def model_rates(robot: Robot, joints: tuple[str, ...]) -> tuple[str, ...]:
     """The joints that are rates of the velocity vector (a steerable wheel's steering joint is not one)."""
     rates = set(robot.rate_names)
     return tuple(j for j in joints if j in rates)
+
+
+def model_singular_set(robot: Robot, assigned: tuple[str, ...], cls: Classification,
+                       resolution: int) -> SingularSet:
+    """Singular set of a model: over admissible (coordinated) configurations when the steering must be coordinated
+    (:mod:`.coordinated`), else over the whole steering space (:func:`.singularity.singular_set`)."""
+    if cls.coordinated:
+        return coordinated_singular_set(robot, assigned, resolution=resolution)
+    return singular_set(robot, assigned, resolution=resolution, max_samples=resolution * 8)
 
 
 def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) -> Analysis:
@@ -120,10 +135,8 @@ def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) 
     else:
         d, kappa = float(length), float(twist_condition_number(robot, joints=joints, length=length))
     act, sen = actuation_analysis(robot), sensing_analysis(robot)
-    singular = {}
-    for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed)):
-        assigned = model_rates(robot, names)
-        singular[key] = singular_set(robot, assigned, resolution=resolution, max_samples=resolution * 8)
+    singular = {key: model_singular_set(robot, model_rates(robot, names), cls, resolution)
+                for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed))}
     return Analysis(
         robot, cls, int(instantaneous_mobility(robot)), icr(robot),
         {"consistent": bool(np.all(act.consistent)), "sufficient": bool(np.all(act.sufficient)),
