@@ -234,23 +234,31 @@ def test_type3_swedish_5_65a():
     np.testing.assert_allclose(got, np.sort(np.angle(np.exp(1j * (0.4 + np.array([-1, 1]) * np.pi / 2)))), atol=1e-9)
 
 
-@pytest.mark.parametrize("q_a", ["a4", "a5"])
+@pytest.mark.parametrize("q_a", ["a1", "a2", "a3", "a4", "a5", "a6"])
 def test_type3_castor_5_70(q_a):
+    """The six wheel-pair vs vehicle-pair isotropy conditions (5.70): their roots in beta1 give kappa = 1."""
     l2, a2, l3, a3, d, rr = 1.2, -120 * DEG, 1.0, -50 * DEG, 0.3, 0.2
     b2, b3 = 0.4, 1.3
-    if q_a == "a4":  # (beta_2, beta_3): s b12 (d - l2 s b22) = -s b13 (d - l3 s b33)
-        joints = ("c2.steer", "c3.steer")
-        cond = lambda b1: (math.sin(b1 - b2) * (d - l2 * math.sin(b2 - a2))  # noqa: E731
-                           + math.sin(b1 - b3) * (d - l3 * math.sin(b3 - a3)))
-    else:  # (phi_2, beta_2): l2 c b22 c b12 = -(r/d)^2 s b12 (d - l2 s b22)
-        joints = ("c2.spin", "c2.steer")
-        cond = lambda b1: (l2 * math.cos(b2 - a2) * math.cos(b1 - b2)  # noqa: E731
-                           + (rr / d) ** 2 * math.sin(b1 - b2) * (d - l2 * math.sin(b2 - a2)))
+    c, s = math.cos, math.sin
+    b22, b33 = b2 - a2, b3 - a3
+    joints, cond = {
+        "a1": (("o1.spin", "c2.spin"), lambda b1: c(b1 - b2) * c(b22)),
+        "a2": (("o1.spin", "c2.steer"), lambda b1: s(b1 - b2) * (d - l2 * s(b22))),
+        "a3": (("c2.spin", "c3.spin"), lambda b1: l2 * c(b22) * c(b1 - b2) + l3 * c(b33) * c(b1 - b3)),
+        "a4": (("c2.steer", "c3.steer"),
+               lambda b1: s(b1 - b2) * (d - l2 * s(b22)) + s(b1 - b3) * (d - l3 * s(b33))),
+        "a5": (("c2.spin", "c2.steer"),
+               lambda b1: l2 * c(b22) * c(b1 - b2) + (rr / d) ** 2 * s(b1 - b2) * (d - l2 * s(b22))),
+        "a6": (("c2.spin", "c3.steer"),
+               lambda b1: l2 * c(b22) * c(b1 - b2) + (rr / d) ** 2 * s(b1 - b3) * (d - l3 * s(b33))),
+    }[q_a]
     roots = _roots(cond)
     assert len(roots) == 2
     for b1 in roots:
         r = type3(omni="castor", l2=l2, a2=a2, l3=l3, a3=a3, beta1=b1, beta2=b2, beta3=b3, r=rr, d=d)
         assert natural_length(r, joints=joints)[1] == pytest.approx(1.0, abs=1e-9)
+    r = type3(omni="castor", l2=l2, a2=a2, l3=l3, a3=a3, beta1=roots[0] + 0.3, beta2=b2, beta3=b3, r=rr, d=d)
+    assert natural_length(r, joints=joints)[1] > 1.001
 
 
 # ---- batching, maps, defaults ---------------------------------------------------------------------------------
