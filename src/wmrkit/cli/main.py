@@ -8,32 +8,32 @@ import sys
 
 from ..errors import WmrkitError
 
-#: Command modules of ``wmrkit.cli``, in the order ``wmrkit --help`` lists them; each has ``add_parsers``.
-COMMAND_MODULES = ("robots", "kinematics", "ik", "analyze", "odometry")
+#: Each command and the module of ``wmrkit.cli`` that registers it (``add_parsers``), in ``--help`` order.
+COMMANDS = {
+    "robots": "robots", "show": "robots", "kinematics": "kinematics", "ik": "ik", "fk": "ik",
+    "analyze": "analyze", "odometry": "odometry",
+}
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of every ``wmrkit`` command."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser; with `command`, only that command's module is imported (a fast start)."""
     parser = argparse.ArgumentParser(
         prog="wmrkit",
         description="Kinematic models, analysis and odometry for any wheeled mobile robot.",
     )
     parser.add_argument("--version", action="version", version=f"wmrkit {_version()}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in COMMAND_MODULES:
-        try:
-            module = importlib.import_module(f"{__package__}.{name}")
-        except ModuleNotFoundError as err:
-            if err.name != f"{__package__}.{name}":
-                raise
-            continue  # a command group not built yet
-        module.add_parsers(commands)
+    wanted = [COMMANDS[command]] if command in COMMANDS else list(dict.fromkeys(COMMANDS.values()))
+    for name in wanted:
+        importlib.import_module(f"{__package__}.{name}").add_parsers(commands)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run ``wmrkit`` with `argv`; return the exit code (0 ok, 2 user error)."""
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else argv
+    command = next((a for a in argv if not a.startswith("-")), None)
+    args = build_parser(command).parse_args(argv)
     try:
         return int(args.run(args) or 0)
     except WmrkitError as err:
