@@ -1,0 +1,143 @@
+"""Exact linear algebra for the symbolic models: rational-function fields with sin^2 + cos^2 = 1 (private).
+
+Entries of the constraint matrix are polynomials in sin/cos of a few angles and in geometry symbols. Replacing
+each sin/cos (and each square root) by a polynomial variable turns the ranks method (4.9)-(4.11) into linear
+algebra over a field of rational functions, which sympy's ``DomainMatrix`` does exactly and fast; results are
+then reduced modulo the relations ``s^2 + c^2 - 1`` and ``g^2 - n``. Ranks and row choices are generic: taken
+numerically at random values of every symbol.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+from sympy.polys.matrices import DomainMatrix
+
+from .linalg import matrix_rank
+
+
+class _Generators:
+    """Polynomial generators for sin/cos of each argument and for square roots, with their relations.
+
+    ``s^2 + c^2 - 1`` per argument and ``g^2 - n`` per ``sqrt(n)``: pairwise coprime leading terms, so they are a
+    Groebner basis and reducing modulo them gives a normal form (zero iff the entry vanishes identically).
+    """
+
+    def __init__(self, exprs: list[sp.Expr], *, enabled: bool = True) -> None:
+        atoms = set().union(*(e.atoms(sp.sin, sp.cos) for e in exprs)) if enabled else set()
+        roots = {p for e in exprs for p in e.atoms(sp.Pow) if p.base.is_Integer and p.exp == sp.S.Half}
+        roots = roots if enabled else set()
+        self.forward: dict[sp.Expr, sp.Symbol] = {}
+        self.back: dict[sp.Symbol, sp.Expr] = {}
+        self.relations: list[sp.Expr] = []
+        for k, arg in enumerate(sorted({a.args[0] for a in atoms}, key=sp.default_sort_key)):
+            s, c = sp.Dummy(f"s{k}"), sp.Dummy(f"c{k}")
+            self.forward.update({sp.sin(arg): s, sp.cos(arg): c})
+            self.back.update({s: sp.sin(arg), c: sp.cos(arg)})
+            self.relations.append(s**2 + c**2 - 1)
+        for k, root in enumerate(sorted(roots, key=sp.default_sort_key)):
+            g = sp.Dummy(f"g{k}")
+            self.forward[root], self.back[g] = g, root
+            self.relations.append(g**2 - root.base)
+
+    def domain_matrix(self, m: sp.MatrixBase) -> DomainMatrix:
+        """`m` over a field of rational functions in the generators (and the other symbols)."""
+        return DomainMatrix.from_list_sympy(*m.shape, sp.Matrix(m).xreplace(self.forward).tolist()).to_field()
+
+    def reduce(self, dm: DomainMatrix) -> DomainMatrix:
+        """Entries reduced modulo the relations (numerator and denominator) and cancelled."""
+        field = dm.domain
+        if not hasattr(field, "field"):  # plain numbers (QQ, ZZ) or expressions (EX): nothing to reduce
+            return dm
+        ring = field.field.ring
+        basis = [ring.from_expr(r) for r in self.relations if r.free_symbols <= set(ring.symbols)]
+        rows = []
+        for row in dm.to_list():
+            out = []
+            for e in row:
+                num, den = e.numer.rem(basis), e.denom.rem(basis)
+                if not den:
+                    raise ZeroDivisionError("a pivot vanished on sin^2 + cos^2 = 1")
+                num, den = num.cancel(den)
+                out.append(field.field(num) / field.field(den))
+            rows.append(out)
+        return DomainMatrix(rows, dm.shape, field)
+
+    def to_expr(self, dm: DomainMatrix) -> sp.Matrix:
+        """Reduced entries as sympy expressions of sin/cos and roots."""
+        return self.reduce(dm).to_Matrix().applyfunc(lambda e: sp.factor_terms(sp.cancel(e)).xreplace(self.back))
+
+
+def numeric(m: sp.MatrixBase, point: dict[sp.Symbol, sp.Float]) -> np.ndarray:
+    return np.array(sp.Matrix(m).xreplace(point).evalf(), dtype=float).reshape(m.shape)
+
+
+def random_points(m: sp.MatrixBase, n: int = 2) -> list[dict[sp.Symbol, sp.Float]]:
+    rng = np.random.default_rng(20240607)
+    symbols = sorted(m.free_symbols, key=sp.default_sort_key)
+    return [{s: sp.Float(v) for s, v in zip(symbols, rng.uniform(0.3, 1.3, len(symbols)), strict=True)}
+            for _ in range(n)]
+
+
+def _components(a_na: sp.MatrixBase) -> list[tuple[list[int], list[int]]]:
+    """Blocks of unknowns coupled through shared rows, as ``(rows, columns)``: solved one by one."""
+    parent = list(range(a_na.cols))
+
+    def root(j: int) -> int:
+        while parent[j] != j:
+            j = parent[j]
+        return j
+
+    for i in range(a_na.rows):
+        cols = [j for j in range(a_na.cols) if a_na[i, j] != 0]
+        for j in cols[1:]:
+            parent[root(j)] = root(cols[0])
+    blocks: dict[int, list[int]] = {}
+    for j in range(a_na.cols):
+        blocks.setdefault(root(j), []).append(j)
+    return [([i for i in range(a_na.rows) if any(a_na[i, j] != 0 for j in cols)], cols) for cols in blocks.values()]
+
+
+def agrees(m: sp.MatrixBase, a: sp.MatrixBase, na_idx: list[int], a_idx: list[int],
+            point: dict[sp.Symbol, sp.Float]) -> bool:
+    """The closed form equals the numeric least-squares solution (4.11) at a random point."""
+    values = numeric(a, point)
+    expected = -np.linalg.lstsq(values[:, na_idx], values[:, a_idx], rcond=None)[0]
+    return bool(np.allclose(numeric(m, point), expected, rtol=1e-8, atol=1e-10))
+
+
+def _independent_rows(values: np.ndarray, rows: list[int], cols: list[int]) -> list[int]:
+    chosen: list[int] = []
+    for i in rows:
+        if matrix_rank(values[np.ix_([*chosen, i], cols)]) > len(chosen):
+            chosen.append(i)
+        if len(chosen) == len(cols):
+            break
+    return chosen
+
+
+def solve_exactly(a: sp.MatrixBase, na_idx: list[int], a_idx: list[int], exact: bool,
+                   values: np.ndarray, *, generators: bool = True) -> tuple[sp.Matrix, sp.Matrix]:
+    """``M`` with ``q_na = M q_a`` and the residual ``A_na M + A_a``, block by block, over a rational field.
+
+    With `generators`, sin/cos and roots are polynomial variables (fast); without, sympy expressions (EX).
+    """
+    gens = _Generators(list(a), enabled=generators)
+    full = gens.domain_matrix(a)
+    all_a = list(range(len(a_idx)))
+    a_na, a_a = full.extract(list(range(a.rows)), na_idx), full.extract(list(range(a.rows)), a_idx)
+    field = full.domain
+    rows_m = [[field.zero] * len(a_idx) for _ in na_idx]
+    for rows, cols in _components(a[:, na_idx]):
+        if exact:
+            rows = _independent_rows(values[:, na_idx], rows, cols)
+            lhs, rhs = a_na.extract(rows, cols), a_a.extract(rows, all_a)
+        else:
+            block = a_na.extract(rows, cols)
+            lhs, rhs = block.transpose() * block, block.transpose() * a_a.extract(rows, all_a)
+        if a_idx:
+            for j, x in zip(cols, (-lhs.lu_solve(rhs)).to_list(), strict=True):
+                rows_m[j] = x
+    m = gens.reduce(DomainMatrix(rows_m, (len(na_idx), len(a_idx)), field))
+    residual = (a_na * m + a_a) if not exact and a_idx else DomainMatrix.zeros((a.rows, len(a_idx)), field)
+    return gens.to_expr(m), gens.to_expr(residual)

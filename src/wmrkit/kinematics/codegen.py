@@ -1,0 +1,358 @@
+"""Code generation: a robot's kinematic models as dependency-free C99 or numpy code (from the symbolic models).
+
+``inverse(twist, beta) -> wheel rates`` is the closed form of :func:`~wmrkit.kinematics.symbolic.symbolic_model`
+with the twist assigned (4.11): exact when the twist is assignable, else least squares per wheel, as a
+controller needs it. ``forward(sensed, beta) -> twist`` solves the no-slip equations for the twist and every
+unsensed rate by least squares (4.11): the generated C carries a small Householder-QR routine (no closed form
+to blow up), the generated Python calls ``numpy.linalg.pinv``; the residual ``|A q|`` [m/s] is the slip (4.16).
+Both are printed from the same symbolic constraint matrix (3.22), with common-subexpression elimination.
+"""
+
+from __future__ import annotations
+
+import keyword
+import math
+import os
+import re
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+import sympy as sp
+from sympy.printing.c import C99CodePrinter
+from sympy.printing.numpy import NumPyPrinter
+
+from ..errors import SingularError, WmrkitError
+from ..robot import TWIST_NAMES, Robot
+from .linalg import matrix_rank
+from .symbolic import sensed_rates, symbolic_constraint_matrix, symbolic_model
+
+C_KEYWORDS = frozenset(
+    "auto break case char const continue default do double else enum extern float for goto if inline int long "
+    "register restrict return short signed sizeof static struct switch typedef union unsigned void volatile while "
+    "_Bool _Complex _Imaginary".split()
+)
+
+
+class CodegenError(WmrkitError, ValueError):
+    """A code-generation request that cannot be met (unknown language, sensed set, directory)."""
+
+
+def identifier(name: str) -> str:
+    """A C and Python identifier from a robot name: ``"diff-drive 2" -> "diff_drive_2"``, never a keyword."""
+    ident = re.sub(r"\W", "_", name, flags=re.ASCII).strip("_") or "robot"
+    if ident[0].isdigit():
+        ident = f"robot_{ident}"
+    return f"{ident}_" if ident in C_KEYWORDS or keyword.iskeyword(ident) else ident
+
+
+class _Plan:
+    """Everything the printers need: symbols, the constraint matrix, inverse closed form, forward split."""
+
+    def __init__(self, robot: Robot, sensed: Sequence[str] | None) -> None:
+        self.robot, self.name = robot, identifier(robot.name)
+        self.beta = tuple(sp.Symbol(f"b{i}", real=True) for i in range(len(robot.steer_names)))
+        self.twist = tuple(sp.Symbol(n, real=True) for n in TWIST_NAMES)
+        self.sensed = tuple(sensed) if sensed is not None else sensed_rates(robot)
+        for n in self.sensed:
+            if robot.velocity_index(n) < 3:
+                raise CodegenError(f"sensed: '{n}' is a body velocity; sensed inputs are wheel joint rates")
+        if len(set(self.sensed)) != len(self.sensed) or not self.sensed:
+            raise CodegenError(f"sensed: expected distinct wheel rates, got ({', '.join(self.sensed)})")
+        self.q = tuple(sp.Symbol(f"q{i}", real=True) for i in range(len(self.sensed)))
+        self.a = symbolic_constraint_matrix(robot, self.beta)
+        self.sensed_cols = [robot.velocity_index(n) for n in self.sensed]
+        self.unknown_cols = [j for j in range(self.a.cols) if j not in self.sensed_cols]
+        self._check_forward()
+        model = symbolic_model(robot, TWIST_NAMES, self.beta)
+        self.inverse_exact = model.exact
+        self.rates = model.solved
+        self.inverse = [e for e in model.matrix * sp.Matrix(self.twist)]
+
+    def _check_forward(self) -> None:
+        rng = np.random.default_rng(7)
+        a = self.robot.constraint_matrix(rng.uniform(-math.pi, math.pi, (3, len(self.robot.steer_names))))
+        if int(matrix_rank(a[..., self.unknown_cols]).max()) < len(self.unknown_cols):
+            names = ", ".join(self.robot.velocity_names[j] for j in self.unknown_cols)
+            raise SingularError(f"robot '{self.robot.name}': the sensed rates ({', '.join(self.sensed)}) do not "
+                                f"determine ({names}); sense more joints or pass sensed=")
+
+    def forward_exprs(self) -> tuple[list[sp.Expr], list[sp.Expr]]:
+        """Entries of ``A_na`` (row-major) and of ``b = -A_s q_s``."""
+        a_na = self.a[:, self.unknown_cols]
+        b = -self.a[:, self.sensed_cols] * sp.Matrix(self.q)
+        return list(a_na), list(b)
+
+
+def write_code(
+    robot: Robot,
+    lang: Literal["c", "python"],
+    directory: str | os.PathLike[str],
+    *,
+    sensed: Sequence[str] | None = None,
+) -> list[Path]:
+    """Write the robot's kinematic models as C99 (``NAME_kinematics.h`` + ``.c``) or Python (``.py``).
+
+    `sensed`: wheel-rate names that feed the forward model (default: the robot's sensed rates, see
+    :func:`~wmrkit.kinematics.symbolic.sensed_rates`). Returns the written paths. :class:`SingularError` if
+    the sensed rates do not determine the twist, or the twist the wheel rates.
+    """
+    if lang not in ("c", "python"):
+        raise CodegenError(f"lang: expected 'c' or 'python', got {lang!r}")
+    directory = Path(directory)
+    if directory.exists() and not directory.is_dir():
+        raise CodegenError(f"{directory}: not a directory")
+    plan = _Plan(robot, sensed)
+    directory.mkdir(parents=True, exist_ok=True)
+    files = _c_files(plan) if lang == "c" else _python_file(plan)
+    paths = []
+    for filename, text in files:
+        path = directory / filename
+        path.write_text(text, encoding="utf-8")
+        paths.append(path)
+    return paths
+
+
+def _cse(exprs: list[sp.Expr], printer: C99CodePrinter | NumPyPrinter) -> tuple[list[str], list[str]]:
+    """Common subexpressions ``t0, t1...`` as ``name = code`` lines, and the reduced expressions, printed."""
+    exprs = [e.xreplace({sp.pi: sp.Float(math.pi, 20)}) if isinstance(printer, C99CodePrinter) else e
+             for e in exprs]
+    replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), optimizations="basic")
+    lines = [f"{sym} = {printer.doprint(value)}" for sym, value in replacements]
+    return lines, [printer.doprint(e) for e in reduced]
+
+
+# ---- C ---------------------------------------------------------------------------------------------------
+_C_LSTSQ = """\
+/* min |A x - b| by Householder QR; A: m x n row-major (m >= n), A and b are overwritten.
+ * Returns 0, or -1 if A is rank deficient (a column norm <= 1e-9 m max|A_ij|, then x is not set).
+ * *residual (if not NULL) = |A x - b|. */
+static int lstsq(int m, int n, double *a, double *b, double *x, double *residual)
+{
+    double scale = 1.0;
+    for (int i = 0; i < m * n; ++i) scale = fmax(scale, fabs(a[i]));
+    const double tol = 1e-9 * m * scale;
+    for (int k = 0; k < n; ++k) {
+        double norm = 0.0;
+        for (int i = k; i < m; ++i) norm = hypot(norm, a[i * n + k]);
+        if (norm <= tol) return -1;
+        const double alpha = a[k * n + k] > 0.0 ? -norm : norm;
+        a[k * n + k] -= alpha; /* column k below the diagonal is now v = x - alpha e_k */
+        double vv = 0.0;
+        for (int i = k; i < m; ++i) vv += a[i * n + k] * a[i * n + k];
+        for (int j = k + 1; j <= n; ++j) { /* j == n: the right-hand side b */
+            double s = 0.0;
+            for (int i = k; i < m; ++i) s += a[i * n + k] * (j < n ? a[i * n + j] : b[i]);
+            s *= 2.0 / vv;
+            for (int i = k; i < m; ++i) {
+                if (j < n) a[i * n + j] -= s * a[i * n + k]; else b[i] -= s * a[i * n + k];
+            }
+        }
+        a[k * n + k] = alpha; /* R_kk */
+    }
+    for (int k = n - 1; k >= 0; --k) {
+        double s = b[k];
+        for (int j = k + 1; j < n; ++j) s -= a[k * n + j] * x[j];
+        x[k] = s / a[k * n + k];
+    }
+    if (residual) {
+        double r = 0.0;
+        for (int i = n; i < m; ++i) r = hypot(r, b[i]);
+        *residual = r;
+    }
+    return 0;
+}
+"""
+
+
+def _c_printer() -> C99CodePrinter:
+    return C99CodePrinter({"math_macros": {}})
+
+
+def _c_body(plan: _Plan, exprs: list[sp.Expr], targets: list[str], comments: list[str] | None = None) -> str:
+    temps, reduced = _cse(exprs, _c_printer())
+    lines = [f"    const double {t};" for t in temps]
+    for k, (target, code) in enumerate(zip(targets, reduced, strict=True)):
+        note = f" /* {comments[k]} */" if comments else ""
+        lines.append(f"    {target} = {code};{note}")
+    return "\n".join(lines)
+
+
+def _c_unpack(plan: _Plan, sensed: bool = False, twist: bool = False) -> str:
+    lines = []
+    if twist:
+        lines.append("    const double vx = twist[0], vy = twist[1], omega = twist[2];")
+    if sensed:
+        lines += [f"    const double q{i} = sensed[{i}]; /* {n} */" for i, n in enumerate(plan.sensed)]
+    lines += [f"    const double b{i} = beta[{i}]; /* {n} */" for i, n in enumerate(plan.robot.steer_names)]
+    if not plan.beta:
+        lines.append("    (void)beta;")
+    return "\n".join(lines)
+
+
+def _c_files(plan: _Plan) -> list[tuple[str, str]]:
+    r, n, p = plan.robot, plan.name, plan.name.upper()
+    beta_param = f"const double beta[{p}_N_STEER]" if plan.beta else "const double *beta"
+    sizes = {"N_STEER": len(plan.beta), "N_RATES": len(plan.rates), "N_SENSED": len(plan.sensed),
+             "N_ROWS": plan.a.rows, "N_VEL": plan.a.cols, "N_UNKNOWN": len(plan.unknown_cols)}
+    protos = [
+        f"void {n}_constraint({beta_param}, double a[{p}_N_ROWS * {p}_N_VEL]);",
+        f"void {n}_inverse(const double twist[3], {beta_param}, double rates[{p}_N_RATES]);",
+        f"int {n}_forward(const double sensed[{p}_N_SENSED], {beta_param}, double twist[3], double *residual);",
+    ]
+    header = "\n".join([
+        f"/* {n}_kinematics.h: no-slip kinematic models of robot '{_c_comment(r.name)}' (L. Gracia's thesis, ch. 4).",
+        " * Generated by wmrkit; do not edit, regenerate with `wmrkit kinematics ROBOT --codegen c DIR`.",
+        " * C99, needs only <math.h> (link with -lm). SI units; robot frame x forward, y left.",
+        " *",
+        " * Array orders:",
+        " *   twist[3]  = (vx [m/s], vy [m/s], omega [rad/s]), body twist in the robot frame",
+        _c_list(f" *   beta[{p}_N_STEER] = steering angles [rad]", r.steer_names),
+        _c_list(f" *   rates[{p}_N_RATES] = wheel joint rates [rad/s]", plan.rates),
+        _c_list(f" *   sensed[{p}_N_SENSED] = sensed joint rates [rad/s]", plan.sensed),
+        _c_list(f" *   a[{p}_N_ROWS * {p}_N_VEL] = slip matrix A (3.22), row-major, slip = A q; columns",
+                r.velocity_names),
+        " *",
+        f" * {n}_constraint: A(beta), two rows per contact point (along and across the roller axis).",
+        f" * {n}_inverse: wheel rates for a twist ({'exact' if plan.inverse_exact else 'least squares per wheel'},"
+        " thesis 4.11).",
+        f" * {n}_forward: least-squares twist from the sensed rates (4.11); *residual = |A q| [m/s], the slip",
+        " *   (may be NULL). Returns 0, or -1 if the sensed rates do not determine the twist at this beta.",
+        " */",
+        f"#ifndef {p}_KINEMATICS_H", f"#define {p}_KINEMATICS_H", "",
+        *[f"#define {p}_{k} {v}" for k, v in sizes.items()], "",
+        "#ifdef __cplusplus", 'extern "C" {', "#endif", "", *protos, "", "#ifdef __cplusplus", "}", "#endif", "",
+        f"#endif /* {p}_KINEMATICS_H */", "",
+    ])
+    a_targets = [f"a[{i * plan.a.cols + j}]" for i in range(plan.a.rows) for j in range(plan.a.cols)]
+    a_na, b = plan.forward_exprs()
+    na = len(plan.unknown_cols)
+    fw_targets = [f"a[{k}]" for k in range(len(a_na))] + [f"b[{i}]" for i in range(len(b))]
+    source = "\n".join([
+        f"/* {n}_kinematics.c: generated by wmrkit from robot '{_c_comment(r.name)}'; see {n}_kinematics.h. */",
+        "#include <math.h>", f'#include "{n}_kinematics.h"', "", _C_LSTSQ,
+        protos[0][:-1], "{", _c_unpack(plan), _c_body(plan, list(plan.a), a_targets), "}", "",
+        protos[1][:-1], "{", _c_unpack(plan, twist=True),
+        _c_body(plan, plan.inverse, [f"rates[{i}]" for i in range(len(plan.rates))], list(plan.rates)), "}", "",
+        protos[2][:-1], "{",
+        f"    double a[{p}_N_ROWS * {p}_N_UNKNOWN], b[{p}_N_ROWS], x[{p}_N_UNKNOWN];",
+        _c_unpack(plan, sensed=True),
+        f"    /* unknowns x: {', '.join(r.velocity_names[j] for j in plan.unknown_cols)} */",
+        _c_body(plan, a_na + b, fw_targets),
+        f"    const int status = lstsq({p}_N_ROWS, {na}, a, b, x, residual);",
+        "    for (int i = 0; i < 3; ++i) twist[i] = status == 0 ? x[i] : NAN;",
+        "    if (status != 0 && residual) *residual = NAN;",
+        "    return status;", "}", "",
+    ])
+    return [(f"{n}_kinematics.h", header), (f"{n}_kinematics.c", source)]
+
+
+def _c_comment(text: str) -> str:
+    return text.replace("*/", "* /")
+
+
+def _c_list(title: str, names: Sequence[str]) -> str:
+    items = ", ".join(f"{i} {_c_comment(name)}" for i, name in enumerate(names)) or "(none)"
+    return f"{title}: {items}"
+
+
+# ---- Python ----------------------------------------------------------------------------------------------
+def _py_body(exprs: list[sp.Expr], targets: list[str]) -> str:
+    temps, reduced = _cse(exprs, NumPyPrinter())
+    lines = [f"    {t}" for t in temps]
+    lines += [f"    {target} = {code}" for target, code in zip(targets, reduced, strict=True)]
+    return "\n".join(lines)
+
+
+def _python_file(plan: _Plan) -> list[tuple[str, str]]:
+    r = plan.robot
+    unpack = "\n".join(f"    b{i} = beta[..., {i}]  # {n}" for i, n in enumerate(r.steer_names))
+    a_targets = [f"out[..., {i}, {j}]" for i in range(plan.a.rows) for j in range(plan.a.cols)]
+    m = sp.Matrix(plan.inverse).jacobian(sp.Matrix(plan.twist))
+    m_targets = [f"out[..., {i}, {j}]" for i in range(m.rows) for j in range(3)]
+    text = f'''"""No-slip kinematic models of robot {r.name!r} (L. Gracia's thesis, ch. 4), generated by wmrkit.
+
+Do not edit; regenerate with ``wmrkit kinematics ROBOT --codegen python DIR``. Needs only numpy. SI units,
+robot frame x forward, y left. Arrays take leading batch axes, which broadcast:
+
+- ``twist``: ``(..., 3)`` = (vx [m/s], vy [m/s], omega [rad/s]) in the robot frame;
+- ``beta``: ``(..., {len(plan.beta)})`` steering angles [rad], order ``STEER_NAMES`` (None: as described);
+- wheel rates: ``(..., {len(plan.rates)})`` [rad/s], order ``RATE_NAMES``;
+- ``sensed``: ``(..., {len(plan.sensed)})`` [rad/s], order ``SENSED_NAMES``.
+"""
+
+import numpy
+
+STEER_NAMES = {tuple(r.steer_names)!r}
+RATE_NAMES = {tuple(plan.rates)!r}
+SENSED_NAMES = {tuple(plan.sensed)!r}
+VELOCITY_NAMES = {tuple(r.velocity_names)!r}
+BETA_DESCRIBED = {tuple(float(b) for b in r.beta)!r}
+_SENSED_COLUMNS = {list(plan.sensed_cols)!r}
+_UNKNOWN_COLUMNS = {list(plan.unknown_cols)!r}
+
+
+def _beta(beta):
+    beta = numpy.asarray(BETA_DESCRIBED if beta is None else beta, dtype=float)
+    if beta.shape[-1:] != ({len(plan.beta)},):
+        raise ValueError(f"beta: expected shape (..., {len(plan.beta)}), got {{beta.shape}}")
+    return beta
+
+
+def _vectors(x, n, name):
+    x = numpy.asarray(x, dtype=float)
+    if x.shape[-1:] != (n,):
+        raise ValueError(f"{{name}}: expected shape (..., {{n}}), got {{x.shape}}")
+    return x
+
+
+def constraint_matrix(beta=None):
+    """Slip matrix A (3.22), roller frame, columns VELOCITY_NAMES.
+
+    ``(..., {len(plan.beta)}) -> (..., {plan.a.rows}, {plan.a.cols})``.
+    """
+    beta = _beta(beta)
+{unpack}
+    out = numpy.zeros(beta.shape[:-1] + ({plan.a.rows}, {plan.a.cols}))
+{_py_body(list(plan.a), a_targets)}
+    return out
+
+
+def inverse_matrix(beta=None):
+    """``rates = M @ twist`` ({"exact" if plan.inverse_exact else "least squares per wheel"}, 4.11).
+
+    ``(..., {len(plan.beta)}) -> (..., {m.rows}, 3)``.
+    """
+    beta = _beta(beta)
+{unpack}
+    out = numpy.zeros(beta.shape[:-1] + ({m.rows}, 3))
+{_py_body(list(m), m_targets)}
+    return out
+
+
+def inverse(twist, beta=None):
+    """Wheel rates [rad/s] for body twists: ``(..., 3), (..., {len(plan.beta)}) -> (..., {m.rows})``."""
+    twist = _vectors(twist, 3, "twist")
+    return (inverse_matrix(beta) @ twist[..., None])[..., 0]
+
+
+def forward_with_residual(sensed, beta=None):
+    """Least-squares twist (4.11) and slip residual ``|A q|`` [m/s].
+
+    ``(..., {len(plan.sensed)}) -> (..., 3), (...)``.
+    """
+    sensed = _vectors(sensed, {len(plan.sensed)}, "sensed")
+    a = constraint_matrix(beta)
+    a_na = a[..., _UNKNOWN_COLUMNS]
+    rhs = -(a[..., _SENSED_COLUMNS] @ sensed[..., None])
+    x = numpy.linalg.pinv(a_na) @ rhs
+    residual = numpy.linalg.norm((a_na @ x - rhs)[..., 0], axis=-1)
+    return x[..., :3, 0], residual
+
+
+def forward(sensed, beta=None):
+    """Least-squares body twist from sensed rates (4.11): ``(..., {len(plan.sensed)}) -> (..., 3)``."""
+    return forward_with_residual(sensed, beta)[0]
+'''
+    return [(f"{plan.name}_kinematics.py", text)]

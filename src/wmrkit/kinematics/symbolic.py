@@ -1,0 +1,432 @@
+"""Closed-form (symbolic) no-slip kinematic models with sympy: the methods of thesis ch. 4 done exactly.
+
+The constraint matrix comes from the same kernels as the numeric one: :func:`wmrkit.wheels.slip_row_entries`
+with ``sin=sympy.sin, cos=sympy.cos`` over each wheel's contact elements (``Wheel.elements()`` and their
+``rate_map``), so the closed forms cannot drift from :meth:`wmrkit.Robot.constraint_matrix` (roller frame, 3.6).
+Steering angles are symbols ``beta_<wheel>``; geometry is either the robot's numbers made exact (0.45 -> 9/20,
+90 deg -> pi/2) or symbols (``l_<wheel>``, ``alpha_<wheel>``, ``r_<wheel>``...) so that the thesis's general
+formulas appear. Linear algebra runs over a field of rational functions (sympy ``DomainMatrix``) and every result
+is reduced modulo ``sin^2 + cos^2 = 1``: exact, and fast enough for the tricycle tables (4.80)-(4.82) in
+well under a second.
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Literal
+
+import sympy as sp
+
+from ..errors import SingularError, UnknownNameError, WmrkitError
+from ..robot import TWIST_NAMES, Robot
+from ..wheels import GEOMETRY_FIELDS, Wheel, slip_row_entries
+from ._exact_linalg import agrees, numeric, random_points, solve_exactly
+from .linalg import matrix_rank
+
+Geometry = Literal["numeric", "symbolic"] | Mapping[str, sp.Expr]
+_LENGTHS = {k for k, v in GEOMETRY_FIELDS.items() if v == "length"}
+
+
+class AssignmentError(WmrkitError, ValueError):
+    """An assigned-velocity set or a geometry substitution that cannot be used (names the culprit)."""
+
+
+# ---- exact numbers ---------------------------------------------------------------------------------------
+def exact_number(x: float, kind: Literal["length", "angle"]) -> sp.Expr:
+    """A float made exact for clean closed forms: ``0.45 -> 9/20``, ``1.5707963267948966 -> pi/2``.
+
+    Angles that are a simple fraction of pi (denominator <= 720) become that multiple of pi; other values become
+    the rational with a small denominator (<= 10^4) within 1e-12, else the float's shortest decimal, exactly.
+    """
+    x = float(x)
+    if not math.isfinite(x):
+        raise AssignmentError(f"cannot make {x!r} exact")
+    nice = _nice_number(x, kind)
+    if nice is not None:
+        return nice
+    q = Fraction(repr(x))
+    return sp.Rational(q.numerator, q.denominator)
+
+
+def _nice_number(x: float, kind: str) -> sp.Expr | None:
+    """``x`` as a simple multiple of pi (angles) or a rational of denominator <= 10^4, if within 1e-12."""
+    if kind == "angle":
+        q = Fraction(x / math.pi).limit_denominator(720)
+        if abs(float(q) * math.pi - x) <= 1e-12 * max(1.0, abs(x)):
+            return sp.Rational(q.numerator, q.denominator) * sp.pi
+    q = Fraction(x).limit_denominator(10_000)
+    if abs(float(q) - x) <= 1e-12 * max(1.0, abs(x)):
+        return sp.Rational(q.numerator, q.denominator)
+    return None
+
+
+# ---- symbols ---------------------------------------------------------------------------------------------
+def steering_symbols(robot: Robot) -> tuple[sp.Symbol, ...]:
+    """One real symbol ``beta_<wheel>`` per steering wheel, in the order of ``robot.steer_names`` [rad]."""
+    return tuple(sp.Symbol(f"beta_{name}", real=True) for name in robot.steer_names)
+
+
+def velocity_symbols(robot: Robot) -> tuple[sp.Symbol, ...]:
+    """One real symbol per column of the constraint matrix, named as ``robot.velocity_names`` (``vx``, ``w.spin``)."""
+    return tuple(sp.Symbol(name, real=True) for name in robot.velocity_names)
+
+
+def geometry_fields(wheel: Wheel) -> tuple[str, ...]:
+    """The geometric fields a wheel's type uses (its place ``l, alpha`` first); a steering angle is not one."""
+    kind = wheel.kind
+    fields = ("l", "alpha", *kind.required, *kind.optional)
+    return tuple(f for f in dict.fromkeys(fields) if not (f == "beta" and kind.steers))
+
+
+def geometry_symbols(robot: Robot) -> dict[str, sp.Symbol]:
+    """``{"wheel.field": symbol}`` for every geometric field of every wheel: ``l_<wheel>``, ``alpha_<wheel>``..."""
+    out = {}
+    for w in robot.wheels:
+        for f in geometry_fields(w):
+            assumptions = {"positive": True} if f in ("r", "r_r", "b") else {"real": True}
+            out[f"{w.name}.{f}"] = sp.Symbol(f"{f}_{w.name}", **assumptions)
+    return out
+
+
+def _geometry_table(robot: Robot, geometry: Geometry) -> dict[str, sp.Expr]:
+    if isinstance(geometry, str):
+        if geometry == "numeric":
+            return {}
+        if geometry == "symbolic":
+            return dict(geometry_symbols(robot))
+        raise AssignmentError(f"geometry: expected 'numeric', 'symbolic' or a mapping, got {geometry!r}")
+    table = {}
+    for key, value in geometry.items():
+        wheel_name, _, field = str(key).partition(".")
+        wheel = robot.wheel(wheel_name)
+        if field not in geometry_fields(wheel):
+            raise UnknownNameError(f"geometry: wheel '{wheel_name}' ({wheel.type}) has no geometric field "
+                                   f"'{field}' (fields: {', '.join(geometry_fields(wheel))})")
+        if not isinstance(value, sp.Basic | int | float):
+            raise AssignmentError(f"geometry['{key}']: expected a sympy expression or a number, got "
+                                  f"{type(value).__name__} (strings are never parsed)")
+        table[key] = value if isinstance(value, sp.Basic) else exact_number(value, GEOMETRY_FIELDS[field])
+    return table
+
+
+def _steering_values(robot: Robot, beta: Sequence[sp.Expr | float] | None) -> tuple[sp.Expr, ...]:
+    if beta is None:
+        return steering_symbols(robot)
+    values = tuple(beta)
+    if len(values) != len(robot.steer_names):
+        raise AssignmentError(f"beta: expected {len(robot.steer_names)} steering angles "
+                              f"({', '.join(robot.steer_names) or 'none'}), got {len(values)}")
+    for v in values:
+        if not isinstance(v, sp.Basic | int | float):
+            raise AssignmentError(f"beta: expected sympy expressions or numbers, got {type(v).__name__}")
+    return tuple(v if isinstance(v, sp.Basic) else exact_number(v, "angle") for v in values)
+
+
+# ---- the constraint matrix (3.22) ------------------------------------------------------------------------
+def _trig(name: str, place: Mapping[sp.Expr, sp.Expr]):
+    """sin or cos that expands algebraic offsets: ``sin(beta + pi/4) -> sqrt(2)/2 (sin beta + cos beta)``.
+
+    A place given as an exact position ``(x, y)`` enters as symbols ``L, A`` with ``place = {cos A: x/L,
+    sin A: y/L}``; splitting ``A`` off makes ``L*sin(theta - A)`` exactly ``x sin(theta) - y cos(theta)``. What
+    remains is sin/cos of the steering angles, of geometry symbols and of offsets with no algebraic value
+    (``beta + pi/18`` stays whole), ready for the exact linear algebra.
+    """
+
+    def sin(a: sp.Expr) -> sp.Expr:
+        return _split(a, sp.sin, lambda r, t: sin(r) * sp.cos(t) + cos(r) * sp.sin(t), place)
+
+    def cos(a: sp.Expr) -> sp.Expr:
+        return _split(a, sp.cos, lambda r, t: cos(r) * sp.cos(t) - sin(r) * sp.sin(t), place)
+
+    return sin if name == "sin" else cos
+
+
+def _split(a: sp.Expr, fn, addition, place: Mapping[sp.Expr, sp.Expr]) -> sp.Expr:
+    terms = sp.Add.make_args(a)
+    angles = {atom.args[0] for atom in place}
+    special = sp.Add(*(t for t in terms if t.free_symbols & angles))
+    if special == a:
+        return fn(a).xreplace(place)
+    if special != 0:
+        return sp.expand(addition(a - special, special).xreplace(place))
+    offset = sp.Add(*(t for t in terms if not t.free_symbols))
+    if offset != 0 and offset != a and not sp.cos(offset).has(sp.cos, sp.sin):
+        return sp.expand(addition(a - offset, offset))
+    return fn(a)
+
+
+def _wheel_blocks(wheel: Wheel, beta: sp.Expr | None, table: dict[str, sp.Expr]) -> list[list[sp.Expr]]:
+    """Rows of one wheel over ``(vx, vy, omega, its own rates)``: (3.10) per element, rates through rate_map."""
+    given = {f: table[f"{wheel.name}.{f}"] for f in geometry_fields(wheel) if f"{wheel.name}.{f}" in table}
+    symbolic = {k: v for k, v in given.items() if k not in ("l", "alpha")}
+    try:
+        elements = wheel.__class__(**{**_wheel_fields(wheel), **symbolic}).elements()
+    except TypeError:  # an expansion that needs numbers (double castor: hypot/atan2 of d, b) keeps them numeric
+        keep = {k: v for k, v in symbolic.items() if k == "r"}
+        elements = wheel.__class__(**{**_wheel_fields(wheel), **keep}).elements()
+    rows: list[list[sp.Expr]] = []
+    for e in elements:
+        l_e, alpha_e, place = _place(e.l, e.alpha, given)
+        beta_w = beta if beta is not None else _exact(given.get("beta", wheel.beta), "angle")
+        args = [beta_w + _exact(e.beta_offset, "angle"), l_e, alpha_e] + [
+            _exact(v, GEOMETRY_FIELDS[f]) for f, v in zip(("d", "delta", "gamma", "r", "r_r"), e[3:8], strict=True)
+        ]
+        entries = slip_row_entries(*args, sin=_trig("sin", place), cos=_trig("cos", place))
+        rate_map = sp.Matrix(e.rate_map)
+        for row in entries:
+            own = (sp.Matrix([list(row[3:])]) * rate_map)[0, :]
+            rows.append([sp.expand(_expr(v)) for v in (*row[:3], *own)])
+    return rows
+
+
+def _place(l: float, alpha: float, given: dict[str, sp.Expr]) -> tuple[sp.Expr, sp.Expr, dict]:
+    """Exact ``(l, alpha)``: given symbols, else nice numbers, else from the exact position ``(x, y)``.
+
+    A position ``[-1, 0.45]`` has no nice ``l, alpha``: they become symbols ``L, A`` that :func:`_trig` replaces
+    by ``cos A = x/L, sin A = y/L``, so the entries are in -1 and 9/20 (no square roots, no atan).
+    """
+    if "l" in given or "alpha" in given:
+        return given.get("l", exact_number(l, "length")), given.get("alpha", exact_number(alpha, "angle")), {}
+    nice_l, nice_alpha = _nice_number(l, "length"), _nice_number(alpha, "angle")
+    if nice_l is not None and nice_alpha is not None:
+        return nice_l, nice_alpha, {}
+    x, y = _snap(l * math.cos(alpha), l), _snap(l * math.sin(alpha), l)
+    big_l, big_a = sp.Dummy("L", positive=True), sp.Dummy("A", real=True)
+    return big_l, big_a, {sp.cos(big_a): x / big_l, sp.sin(big_a): y / big_l}
+
+
+def _expr(v) -> sp.Expr:
+    return v if isinstance(v, sp.Basic) else exact_number(v, "length")
+
+
+def _wheel_fields(wheel: Wheel) -> dict:
+    return {f: getattr(wheel, f) for f in wheel.__dataclass_fields__}
+
+
+def _snap(v: float, scale: float) -> sp.Expr:
+    return sp.Integer(0) if abs(v) <= 1e-12 * max(scale, 1e-300) else exact_number(v, "length")
+
+
+def _exact(v, kind: str) -> sp.Expr:
+    return v if isinstance(v, sp.Basic) else exact_number(v, "angle" if kind == "angle" else "length")
+
+
+def symbolic_constraint_matrix(
+    robot: Robot, beta: Sequence[sp.Expr | float] | None = None, *, geometry: Geometry = "numeric"
+) -> sp.ImmutableMatrix:
+    """The slip matrix ``A`` of eq. (3.22) in closed form, roller frame (3.6); columns ``robot.velocity_names``.
+
+    ``(2 * n_contacts, 3 + n_rates)``, the same matrix as :meth:`wmrkit.Robot.constraint_matrix` (built from the
+    same kernel). `beta`: one angle per ``robot.steer_names`` (symbols ``beta_<wheel>`` by default; numbers are
+    made exact). `geometry`: ``"numeric"`` (the robot's numbers, exact), ``"symbolic"`` (every field a symbol,
+    see :func:`geometry_symbols`) or a mapping ``{"wheel.field": expression}`` for chosen fields only.
+    """
+    return _constraint(robot, _steering_values(robot, beta), _geometry_key(robot, geometry))
+
+
+def _geometry_key(robot: Robot, geometry: Geometry) -> tuple[tuple[str, sp.Expr], ...]:
+    return tuple(sorted(_geometry_table(robot, geometry).items(), key=lambda kv: kv[0]))
+
+
+@functools.lru_cache(maxsize=64)
+def _constraint(robot: Robot, beta: tuple[sp.Expr, ...], geometry: tuple) -> sp.ImmutableMatrix:
+    table = dict(geometry)
+    steer = dict(zip(robot.steer_names, beta, strict=True))
+    n_rates = len(robot.rate_names)
+    rows, start = [], 0
+    for w in robot.wheels:
+        n = len(w.kind.rates)
+        for row in _wheel_blocks(w, steer.get(w.name), table):
+            rows.append([*row[:3], *([0] * start), *row[3:], *([0] * (n_rates - start - n))])
+        start += n
+    return sp.ImmutableMatrix(rows)
+
+
+# ---- models ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class SymbolicModel:
+    """A closed-form no-slip solution ``q_na = matrix @ q_a`` for one assigned set (thesis §4.2-4.3, §4.5).
+
+    ``assigned``/``solved``: velocity names (``robot.velocity_names``) of ``q_a`` and ``q_na``; ``matrix``:
+    ``(n_solved, n_assigned)``. ``exact``: the set is assignable (4.10) and ``matrix`` is the unique no-slip
+    solution (4.5)/(4.11); otherwise it is the least-squares (extended) solution (4.11)/(4.82) and
+    ``residual @ q_a`` (``(2 n_contacts, n_assigned)``, roller frame, m/s) is the slip it leaves (4.16).
+    ``steering``: the steering angles used (symbols or exact values); ``rank``/``mobility``: generic rank of A
+    and m = k - rank (4.3).
+    """
+
+    robot_name: str
+    assigned: tuple[str, ...]
+    solved: tuple[str, ...]
+    matrix: sp.ImmutableMatrix
+    residual: sp.ImmutableMatrix
+    exact: bool
+    steering: tuple[sp.Expr, ...]
+    rank: int
+    mobility: int
+
+    def solution(self) -> sp.ImmutableMatrix:
+        """``q_na`` as expressions of the assigned velocities' symbols (named as in :func:`velocity_symbols`)."""
+        q_a = sp.Matrix([sp.Symbol(n, real=True) for n in self.assigned])
+        return sp.ImmutableMatrix(self.matrix * q_a)
+
+    def substitute(self, values: Mapping[sp.Symbol, sp.Expr]) -> sp.ImmutableMatrix:
+        """The solution with `values` substituted (e.g. beta of (4.83) into (4.82)) and simplified: (4.84)."""
+        for key, value in values.items():
+            if not isinstance(key, sp.Symbol) or not isinstance(value, sp.Basic | int | float):
+                raise AssignmentError(f"substitute: expected sympy symbols mapped to expressions, got {key!r}")
+        return sp.ImmutableMatrix(self.solution().xreplace(dict(values)).applyfunc(sp.simplify))
+
+
+def symbolic_model(
+    robot: Robot,
+    assigned: Sequence[str],
+    beta: Sequence[sp.Expr | float] | None = None,
+    *,
+    geometry: Geometry = "numeric",
+) -> SymbolicModel:
+    """Closed-form solution of ``A q = 0`` for the velocities not in `assigned`, thesis (4.5)/(4.9)-(4.11).
+
+    Exact when the set is assignable, ``rank A_na = rank A`` (4.10): a maximal independent set of rows is solved
+    exactly (the ranks / null-space method). With more assigned velocities than the mobility m (the extended
+    solution of §4.5) it is the least-squares solution ``-(A_na^T A_na)^-1 A_na^T A_a`` (4.11)/(4.82), as long
+    as ``A_na`` keeps full column rank; otherwise :class:`SingularError`. Ranks are generic: evaluated at random
+    values of every symbol. `beta`, `geometry`: as in :func:`symbolic_constraint_matrix`.
+    """
+    names = tuple(assigned)
+    for n in names:
+        robot.velocity_index(n)
+        if names.count(n) > 1:
+            raise AssignmentError(f"assigned: velocity '{n}' listed twice")
+    return _solve(robot, names, _steering_values(robot, beta), _geometry_key(robot, geometry))
+
+
+@functools.lru_cache(maxsize=128)
+def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], geometry: tuple) -> SymbolicModel:
+    a = _constraint(robot, beta, geometry)
+    a_idx = [robot.velocity_index(n) for n in assigned]
+    na_idx = [j for j in range(a.cols) if j not in a_idx]
+    points = random_points(a)
+    values = [numeric(a, p) for p in points]
+    rank = max(int(matrix_rank(v)) for v in values)
+    rank_na = max(int(matrix_rank(v[:, na_idx])) for v in values)
+    solved = tuple(robot.velocity_names[j] for j in na_idx)
+    if rank_na < len(na_idx):
+        raise SingularError(
+            f"robot '{robot.name}': assigning ({', '.join(assigned) or 'nothing'}) does not determine "
+            f"({', '.join(solved)}): rank A_na = {rank_na} < {len(na_idx)} unknowns (mobility m = {a.cols - rank})"
+        )
+    exact = rank_na == rank
+    try:
+        m, residual = solve_exactly(a, na_idx, a_idx, exact, values[0])
+        ok = agrees(m, a, na_idx, a_idx, points[1])
+    except ZeroDivisionError:
+        ok = False
+    if not ok:  # a pivot that vanishes only on sin^2 + cos^2 = 1: redo over plain expressions (slower)
+        m, residual = solve_exactly(a, na_idx, a_idx, exact, values[0], generators=False)
+    return SymbolicModel(
+        robot_name=robot.name, assigned=assigned, solved=solved,
+        matrix=sp.ImmutableMatrix(m), residual=sp.ImmutableMatrix(residual),
+        exact=exact, steering=beta, rank=rank, mobility=a.cols - rank,
+    )
+
+
+# ---- default assignments and printing --------------------------------------------------------------------
+def sensed_rates(robot: Robot) -> tuple[str, ...]:
+    """Inputs of the direct model: the sensed joint rates (``wheel.joint`` columns of A).
+
+    Sensed steering angles of centred wheels are configuration (``beta``), not rates. With no sensed rates
+    declared, every wheel joint rate (spins, castor steering; never a free roller).
+    """
+    columns = set(robot.velocity_names)
+    sensed = tuple(n for n in robot.sensed if n in columns)
+    return sensed or tuple(f"{w.name}.{j}" for w in robot.wheels for j in w.kind.rates if j in w.kind.joints)
+
+
+def twist_assignment(robot: Robot) -> tuple[str, ...]:
+    """Inputs of the inverse model: the first assignable (4.10) subset of ``(vx, vy, omega)`` with m members,
+    else the whole twist (wheel rates by least squares, as a controller computes them)."""
+    rank = symbolic_model(robot, ("vx", "vy", "omega")).rank
+    m = len(robot.velocity_names) - rank
+    for subset in itertools.combinations(TWIST_NAMES, m) if 0 < m <= 3 else ():
+        try:
+            if symbolic_model(robot, subset).exact:
+                return subset
+        except SingularError:
+            continue
+    return TWIST_NAMES
+
+
+def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, latex: bool = False) -> str:
+    """The closed forms of the direct (sensed) and inverse models of `robot`, or of one `assigned` set.
+
+    Plain text (``name = expression``, velocity names as in ``robot.velocity_names``, steering angles
+    ``beta_<wheel>`` [rad], geometry exact from the robot's numbers), or LaTeX ``aligned`` blocks. Each model
+    says whether it is exact (4.5)/(4.11) or least squares (4.11)/(4.82), whose residual ``A q`` is slip.
+    """
+    sets = [("model", tuple(assigned))] if assigned is not None else [
+        ("direct model (sensed)", sensed_rates(robot)), ("inverse model", twist_assignment(robot))]
+    comment = "% " if latex else ""
+    lines = [f"{comment}{robot.name}: no-slip kinematic models in closed form (thesis ch. 4)",
+             f"{comment}  velocities: {', '.join(robot.velocity_names)}",
+             f"{comment}  steering [rad]: {', '.join(map(str, steering_symbols(robot))) or 'none'}; "
+             "geometry: the robot's numbers, exact (m, rad)"]
+    for title, names in sets:
+        lines.append("")
+        lines.append(f"{comment}{title}, assigned: {', '.join(names) or 'nothing'}")
+        try:
+            model = symbolic_model(robot, names)
+        except SingularError as err:
+            lines.append(f"{comment}  not determined: {err}")
+            continue
+        if model.exact:
+            how = f"exact (4.5)/(4.11): assignable set, generic rank A = {model.rank}, mobility m = {model.mobility}"
+        else:
+            how = (f"least squares (4.11)/(4.82): {len(names)} assigned for mobility m = {model.mobility}; "
+                   "a residual A q != 0 is slip")
+        lines.append(f"{comment}  {how}")
+        lines += _latex_block(model) if latex else [f"    {n} = {_linear_form(model, i)}" for i, n in
+                                                    enumerate(model.solved)]
+    return "\n".join(lines)
+
+
+def _linear_form(model: SymbolicModel, i: int, names: Mapping[str, str] | None = None) -> str:
+    """Row i of ``q_na = M q_a`` as ``(c1)*q1 + (c2)*q2``: text, or LaTeX when `names` maps symbols to LaTeX."""
+    terms = [(c, n) for c, n in zip(model.matrix.row(i), model.assigned, strict=True) if c != 0]
+    if not terms:
+        return "0"
+    if names is None:
+        parts = [n if c == 1 else f"-{n}" if c == -1 else f"{c}*{n}" if c.is_Number else f"({sp.sstr(c)})*{n}"
+                 for c, n in terms]
+    else:
+        symbols = {s: names.get(s.name, sp.latex(s)) for c, _ in terms for s in c.free_symbols}
+        parts = [names[n] if c == 1 else f"-{names[n]}" if c == -1 else f"{sp.latex(c)} {names[n]}" if c.is_Number
+                 else rf"\left({sp.latex(c, symbol_names=symbols)}\right) {names[n]}" for c, n in terms]
+    return " + ".join(parts).replace("+ -", "- ")
+
+
+def latex_name(name: str) -> str:
+    """LaTeX for a velocity or steering name: ``vx -> v_x``, ``left.spin -> \\dot{\\varphi}_{\\mathrm{left}}``."""
+    twist = {"vx": "v_x", "vy": "v_y", "omega": r"\omega"}
+    if name in twist:
+        return twist[name]
+    if name.startswith("beta_"):
+        return r"\beta_{\mathrm{" + name[5:].replace("_", r"\_") + "}}"
+    wheel, _, joint = name.partition(".")
+    wheel = r"\mathrm{" + wheel.replace("_", r"\_") + "}"
+    if joint == "steer":
+        return rf"\dot{{\beta}}_{{{wheel}}}"
+    sub = {"roller": "r,", "spin": ""}.get(joint, f"{joint[4:]},")  # spin1 -> phi_{1,wheel}
+    return rf"\dot{{\varphi}}_{{{sub}{wheel}}}"
+
+
+def _latex_block(model: SymbolicModel) -> list[str]:
+    names = {n: latex_name(n) for n in (*model.assigned, *model.solved)}
+    names.update({str(s): latex_name(str(s)) for e in model.steering for s in e.free_symbols})
+    rows = [f"  {names[n]} &= {_linear_form(model, i, names)}" for i, n in enumerate(model.solved)]
+    return [r"\begin{aligned}", " \\\\\n".join(rows), r"\end{aligned}"]

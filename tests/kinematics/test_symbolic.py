@@ -1,0 +1,337 @@
+"""Symbolic models (wmrkit.kinematics.symbolic): the constraint matrix against the numeric one, the ranks method done
+exactly against numeric least squares, and the tricycle tables (4.80)-(4.84) against the digest's corrected forms
+(spec/ch3-4-wheels-and-kinematic-models.md PART C), which were derived independently of wmrkit.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+from hypothesis import given, settings
+
+from strategies import robots
+from wmrkit import Robot, SingularError, UnknownNameError, Wheel
+from wmrkit.kinematics.linalg import solve_assigned
+from wmrkit.kinematics.symbolic import (
+    AssignmentError,
+    exact_number,
+    format_symbolic,
+    geometry_symbols,
+    sensed_rates,
+    steering_symbols,
+    symbolic_constraint_matrix,
+    symbolic_model,
+    twist_assignment,
+)
+
+r, l12, l3 = sp.symbols("r l12 l3", positive=True)
+b3 = sp.Symbol("beta3", real=True)
+c, s = sp.cos(b3), sp.sin(b3)
+vx, vy, om, p1, p2, p3 = sp.symbols("vx vy omega w1.spin w2.spin w3.spin", real=True)
+TRICYCLE = Robot("tricycle", (  # table C.1; the numbers are those of the oracles C.5/C.6
+    Wheel("w1", "fixed", 0.5, 0.0, 0.0, 0.1, sensed=("spin",)),
+    Wheel("w2", "fixed", 0.5, math.pi, 0.0, 0.1, sensed=("spin",)),
+    Wheel("w3", "steerable", 1.2, -math.pi / 2, 0.4, 0.1),
+))
+GEOMETRY = {"w1.l": l12, "w2.l": l12, "w3.l": l3, "w1.r": r, "w2.r": r, "w3.r": r}
+NUMBERS = {r: 0.1, l12: 0.5, l3: 1.2}
+
+
+def tri(assigned):
+    return symbolic_model(TRICYCLE, assigned, [b3], geometry=GEOMETRY)
+
+
+def is_zero(expr) -> bool:
+    """Exact zero test independent of wmrkit's reduction: tan half-angle substitution, then cancel."""
+    t = sp.Symbol("t", real=True)
+    e = sp.expand_trig(sp.sympify(expr)).xreplace({s: 2 * t / (1 + t**2), c: (1 - t**2) / (1 + t**2)})
+    return sp.cancel(sp.together(e)) == 0
+
+
+def column(model, expected: dict) -> bool:
+    """The closed form equals `expected` ({velocity name: expression in the assigned symbols})."""
+    sol = dict(zip(model.solved, model.solution(), strict=True))
+    return all(is_zero(sol[name] - value) for name, value in expected.items()) and set(sol) == set(expected)
+
+
+# ---- the constraint matrix -------------------------------------------------------------------------------
+def test_exact_numbers():
+    assert exact_number(0.45, "length") == sp.Rational(9, 20)
+    assert exact_number(math.radians(90), "angle") == sp.pi / 2
+    assert exact_number(math.radians(-90), "angle") == -sp.pi / 2
+    assert exact_number(0.4, "angle") == sp.Rational(2, 5)
+    assert exact_number(2.35, "length") == sp.Rational(47, 20)
+    assert exact_number(0.123456789, "length") == sp.Rational(123456789, 10**9)
+
+
+@settings(max_examples=12)
+@given(robots(max_wheels=3))
+def test_symbolic_matrix_is_the_numeric_one(robot):
+    """Built from the same kernel: equal to Robot.constraint_matrix at random steering angles."""
+    a = symbolic_constraint_matrix(robot)
+    betas = np.random.default_rng(1).uniform(-math.pi, math.pi, (2, len(robot.steer_names)))
+    for beta in betas:
+        values = a.xreplace({sym: sp.Float(v) for sym, v in zip(steering_symbols(robot), beta, strict=True)})
+        np.testing.assert_allclose(np.array(values.evalf(), dtype=float), robot.constraint_matrix(beta),
+                                   rtol=0, atol=1e-12)
+
+
+def test_catalog_forklift_entries_are_exact():
+    """Positions [-1, +-0.45], [-2.35, 0] and r = 0.23 appear as exact rationals (3.11), beta 90 deg as pi/2."""
+    from wmrkit import catalog
+
+    a = symbolic_constraint_matrix(catalog.load("forklift"), [sp.Symbol("b")])
+    bb = sp.Symbol("b")
+    # right drive wheel: l sin(beta - alpha) with (x, y) = (-1, -0.45) and beta = pi/2 is x sin(beta) - y cos(beta)
+    assert list(a.row(0)) == [0, 1, -1, 0, 0, 0]
+    assert list(a.row(1)) == [-1, 0, sp.Rational(-9, 20), sp.Rational(23, 100), 0, 0]
+    assert list(a.row(4)) == [sp.cos(bb), sp.sin(bb), sp.Rational(-47, 20) * sp.sin(bb), 0, 0, 0]
+
+
+def test_symbolic_geometry_gives_the_general_formulas():
+    """Castor (3.12) and Swedish (3.13) rows with symbols l, alpha, d, delta, gamma, r, r_r."""
+    robot = Robot("two", (Wheel("c", "castor", 0.3, 0.2, 0.1, 0.05, d=0.04, delta=0.2),
+                          Wheel("s", "swedish", 0.3, 1.0, 0.5, 0.05, gamma=0.7, r_r=0.01)))
+    g = geometry_symbols(robot)
+    a = symbolic_constraint_matrix(robot, geometry="symbolic")
+    (bc,) = steering_symbols(robot)
+    lc, ac, d, dl, rc = (g[f"c.{k}"] for k in ("l", "alpha", "d", "delta", "r"))
+    ls, as_, bs, gm, rs, rr = (g[f"s.{k}"] for k in ("l", "alpha", "beta", "gamma", "r", "r_r"))
+    th = bc + dl
+    castor = sp.Matrix([[sp.cos(th), sp.sin(th), lc * sp.sin(th - ac) - d * sp.cos(dl), -d * sp.cos(dl), 0],
+                        [-sp.sin(th), sp.cos(th), lc * sp.cos(th - ac) + d * sp.sin(dl), d * sp.sin(dl), rc]])
+    ts = bs + gm
+    swedish = sp.Matrix([[sp.cos(ts), sp.sin(ts), ls * sp.sin(ts - as_), rs * sp.sin(gm), 0],
+                         [-sp.sin(ts), sp.cos(ts), ls * sp.cos(ts - as_), rs * sp.cos(gm), rr]])
+    diff = (a[:2, :5] - castor).col_join(a[2:, [0, 1, 2, 5, 6]] - swedish)
+    assert diff.applyfunc(lambda e: sp.simplify(sp.expand_trig(e))) == sp.zeros(4, 5)
+
+
+# ---- the ranks method, exactly ---------------------------------------------------------------------------
+@settings(max_examples=10)
+@given(robots(max_wheels=3))
+def test_closed_form_is_the_numeric_least_squares(robot):
+    """M(beta) q_a equals solve_assigned (4.11) for the sensed rates and for the twist, when determined."""
+    rng = np.random.default_rng(2)
+    for assigned in (sensed_rates(robot), ("vx", "vy", "omega")):
+        try:
+            model = symbolic_model(robot, assigned)
+        except SingularError:
+            continue
+        beta = rng.uniform(-math.pi, math.pi, len(robot.steer_names))
+        q_a = rng.normal(size=len(assigned))
+        sub = {sym: sp.Float(v) for sym, v in zip(model.steering, beta, strict=True)}
+        m = np.array(model.matrix.xreplace(sub).evalf(), dtype=float).reshape(model.matrix.shape)
+        idx = [robot.velocity_index(n) for n in assigned]
+        q, res = solve_assigned(robot.constraint_matrix(beta), idx, q_a)
+        solved = [robot.velocity_index(n) for n in model.solved]
+        np.testing.assert_allclose(m @ q_a, q[solved], rtol=1e-8, atol=1e-8)
+        if model.exact:  # an assignable set (4.10): no slip for any assigned values
+            np.testing.assert_allclose(res, 0, atol=1e-9)
+        residual = np.array(model.residual.xreplace(sub).evalf(), dtype=float).reshape(model.residual.shape)
+        np.testing.assert_allclose(residual @ q_a, res, rtol=1e-8, atol=1e-8)
+
+
+def test_mobility_and_rank_of_the_tricycle_479():
+    model = tri(["w3.spin"])
+    assert (model.rank, model.mobility, model.exact) == (5, 1, True)
+
+
+def test_vx_cannot_be_assigned():
+    with pytest.raises(SingularError, match=r"assigning \(vx\) does not determine"):
+        tri(["vx"])
+
+
+# ---- the tricycle tables (4.80)/(4.81), digest C.5 (corrected) --------------------------------------------
+C5 = {  # assigned velocity -> the other five, as multiples of it
+    "w3.spin": {"vx": 0, "vy": -r * c, "omega": r * s / l3, "w1.spin": (l3 * c - l12 * s) / l3,
+                "w2.spin": (l3 * c + l12 * s) / l3},
+    "vy": {"vx": 0, "omega": -(s / c) / l3, "w1.spin": (-l3 + l12 * s / c) / (l3 * r),
+           "w2.spin": (-l3 - l12 * s / c) / (l3 * r), "w3.spin": -1 / (c * r)},
+    "omega": {"vx": 0, "vy": -l3 * c / s, "w1.spin": (-l12 + l3 * c / s) / r, "w2.spin": (l12 + l3 * c / s) / r,
+              "w3.spin": l3 / (r * s)},
+    "w1.spin": {"vx": 0, "vy": r * l3 * c / (-l3 * c + l12 * s), "omega": r * s / (l3 * c - l12 * s),
+                "w2.spin": (l3 * c + l12 * s) / (l3 * c - l12 * s), "w3.spin": l3 / (l3 * c - l12 * s)},
+    "w2.spin": {"vx": 0, "vy": -r * l3 * c / (l3 * c + l12 * s), "omega": r * s / (l3 * c + l12 * s),
+                "w1.spin": (l3 * c - l12 * s) / (l3 * c + l12 * s), "w3.spin": l3 / (l3 * c + l12 * s)},
+}
+
+
+@pytest.mark.parametrize("assigned", list(C5))
+def test_tricycle_480_481_corrected(assigned):
+    q = sp.Symbol(assigned, real=True)
+    model = tri([assigned])
+    assert model.exact
+    assert column(model, {k: v * q for k, v in C5[assigned].items()})
+
+
+def test_tricycle_480_481_printed_garbles_differ():
+    """001's (4.81) entries that the digest corrects are not the solution (errata)."""
+    sol = {a: dict(zip(tri([a]).solved, tri([a]).matrix, strict=True)) for a in C5}
+    assert not is_zero(sol["vy"]["omega"] - (-(s / c) / l3) / (l3 * r))  # printed (-tan(b3)/l3)/(l3 r)
+    assert not is_zero(sol["omega"]["vy"] - (-l3 * c / s) / r)  # printed -l3 cot(b3) / r
+    assert not is_zero(sol["w1.spin"]["w3.spin"] - (l3 * c + l12 * s) / (l3 * c - l12 * s))  # printed phi3
+    assert not is_zero(sol["w2.spin"]["w3.spin"] - 1)  # printed (l3 c + l12 s)/(l3 c + l12 s)
+
+
+def test_tricycle_numeric_oracle_c5():
+    """r = 0.1, l12 = 0.5, l3 = 1.2, beta3 = 0.4: (vx, vy, omega, phi1, phi2, phi3) with the named velocity = 1."""
+    oracle = {"w3.spin": (0, -0.092106, 0.032452, 0.758803, 1.083319, 1),
+              "w1.spin": (0, -0.121383, 0.042767, 1, 1.427667, 1.317865),
+              "w2.spin": (0, -0.085022, 0.029956, 0.700443, 1, 0.923089),
+              "vy": (0, 1, -0.352328, -8.238362, -11.761638, -10.857044),
+              "omega": (0, -2.838267, 1, 23.382669, 33.382669, 30.815189)}
+    names = TRICYCLE.velocity_names
+    for assigned, expected in oracle.items():
+        model = symbolic_model(TRICYCLE, [assigned])  # numeric geometry, exact: 1/10, 1/2, 6/5
+        values = dict(zip(model.solved, model.matrix.xreplace({model.steering[0]: sp.Float(0.4)}), strict=True))
+        got = [1.0 if n == assigned else float(values[n]) for n in names]
+        np.testing.assert_allclose(got, expected, atol=2e-6)
+
+
+# ---- extended solutions (4.82), conditions (4.83), simplified forms (4.84) --------------------------------
+D1 = 3 * l12**2 + 4 * l3**2
+C6 = {  # digest C.6: assigned pair -> (solved names, matrix)
+    ("w1.spin", "w3.spin"): (("vx", "vy", "omega", "w2.spin"), -r / D1 * sp.Matrix([
+        [-l12 * l3, l12 * (l3 * c - l12 * s)],
+        [2 * l3**2, (2 * l3**2 + 3 * l12**2) * c + 2 * l3 * l12 * s],
+        [3 * l12, -3 * l12 * c - 4 * l3 * s],
+        [(3 * l12**2 - 2 * l3**2) / r, -(2 * l3**2 + 6 * l12**2) * c / r - 6 * l3 * l12 * s / r]])),
+    ("w2.spin", "w3.spin"): (("vx", "vy", "omega", "w1.spin"), -r / D1 * sp.Matrix([
+        [l12 * l3, -l12 * (l3 * c + l12 * s)],
+        [2 * l3**2, (2 * l3**2 + 3 * l12**2) * c - 2 * l3 * l12 * s],
+        [-3 * l12, 3 * l12 * c - 4 * l3 * s],
+        [(3 * l12**2 - 2 * l3**2) / r, -(2 * l3**2 + 6 * l12**2) * c / r + 6 * l3 * l12 * s / r]])),
+    ("w1.spin", "w2.spin"): (("vx", "vy", "omega", "w3.spin"), -r / (6 * l12**2 + l3**2 * (1 + sp.cos(2 * b3)))
+                             * sp.Matrix([  # the 8-entry column of 001 read as a 4 x 2 matrix
+        [-l12 * c * (l3 * c + l12 * s), l12 * c * (l3 * c - l12 * s)],
+        [(l3**2 + 3 * l12**2) * c**2 - l3 * l12 * c * s + 2 * l12**2 * s**2,
+         (l3**2 + 3 * l12**2) * c**2 + l3 * l12 * c * s + 2 * l12**2 * s**2],
+        [3 * l12 - l3 * sp.sin(2 * b3) / 2, -3 * l12 - l3 * sp.sin(2 * b3) / 2],
+        [-(l3**2 + 3 * l12**2) * c / r + 3 * l3 * l12 * s / r, -(l3**2 + 3 * l12**2) * c / r - 3 * l3 * l12 * s / r]])),
+    ("vy", "omega"): (("vx", "w1.spin", "w2.spin", "w3.spin"), -1 / ((5 + sp.cos(2 * b3)) * r) * sp.Matrix([
+        [r * sp.sin(2 * b3), 2 * r * l3 * c**2],
+        [5 + sp.cos(2 * b3), l12 * (5 + sp.cos(2 * b3))],
+        [5 + sp.cos(2 * b3), -l12 * (5 + sp.cos(2 * b3))],
+        [6 * c, -4 * l3 * s]])),
+}
+
+
+@pytest.mark.parametrize("assigned", list(C6), ids=str)
+def test_extended_solutions_482(assigned):
+    model = tri(assigned)
+    solved, expected = C6[assigned]
+    assert not model.exact and model.solved == solved
+    assert all(is_zero(e) for e in model.matrix - expected)
+
+
+def test_extended_numeric_oracle_c6():
+    """Digest C.6 table: assigned values (1, 1) at beta3 = 0.4: the solution and the residual norm (slip)."""
+    oracle = {("w1.spin", "w3.spin"): ((0.002223, -0.102777, 0.026894, 1.162236), 0.016043),
+              ("w2.spin", "w3.spin"): ((0.000768, -0.08842, 0.030532, 0.731542), 0.005542),
+              ("w1.spin", "w2.spin"): ((0.004548, -0.098077, 0.02183, 1.023075), 0.019611),
+              ("vy", "omega"): ((-0.483333, -15.0, -5.0, -6.419776), 1.252477)}
+    for assigned, (solution, slip) in oracle.items():
+        model = tri(assigned)
+        sub = {**NUMBERS, b3: 0.4}
+        np.testing.assert_allclose(np.array(model.matrix.subs(sub) @ sp.Matrix([1, 1]), dtype=float).ravel(),
+                                   solution, atol=2e-6)
+        residual = np.array(model.residual.subs(sub) @ sp.Matrix([1, 1]), dtype=float)
+        assert np.linalg.norm(residual) == pytest.approx(slip, abs=2e-6)
+
+
+BETA_483 = {("w1.spin", "w2.spin"): sp.atan2(l3 * (p2 - p1), l12 * (p1 + p2)),  # corrected
+            ("vy", "omega"): sp.atan2(-l3 * om, vy)}
+
+
+@pytest.mark.parametrize("assigned", list(BETA_483), ids=str)
+def test_conditions_483_zero_the_residual(assigned):
+    """At the (corrected) steering angle of (4.83) the least-squares residual vanishes identically: no slip."""
+    model = tri(assigned)
+    q_a = sp.Matrix([sp.Symbol(n, real=True) for n in assigned])
+    residual = (model.residual * q_a).xreplace({b3: BETA_483[assigned]})
+    assert residual.applyfunc(sp.simplify) == sp.zeros(residual.rows, 1)
+
+
+def test_condition_483_as_printed_leaves_slip():
+    """001's (phi1, phi2) argument (l3 phi2 - phi1)/(l12 phi2 + phi1) is not a root (errata)."""
+    model = tri(("w1.spin", "w2.spin"))
+    printed = sp.atan((l3 * p2 - p1) / (l12 * p2 + p1))
+    residual = (model.residual * sp.Matrix([p1, p2])).xreplace({b3: printed}).subs({**NUMBERS, p1: 2, p2: 3})
+    assert np.linalg.norm(np.array(residual.evalf(), dtype=float)) > 1e-4
+
+
+def test_acos_branches_483_are_roots_only_for_negative_phi3():
+    """(phi1, phi3): the printed acos branches zero the residual for phi3 < 0 only; the general roots always."""
+    model = tri(("w1.spin", "w3.spin"))
+
+    def slip(beta, v1, v3):
+        res = (model.residual * sp.Matrix([v1, v3])).subs({**NUMBERS, b3: beta})
+        return float(sp.Matrix(res).norm().evalf())
+
+    a, b = 1.2, 0.5
+    for v1, v3 in ((0.7, -1.0), (0.7, 1.0)):
+        s1 = math.sqrt((a**2 + b**2) * v3**2 - a**2 * v1**2)
+        printed = (-math.acos((a**2 * v1 + b * s1) / ((a**2 + b**2) * v3)),
+                   math.acos((a**2 * v1 - b * s1) / ((a**2 + b**2) * v3)))
+        general = [-math.atan2(b, a) + k * math.acos(a * v1 / (math.hypot(a, b) * v3)) for k in (1, -1)]
+        assert all(slip(g, v1, v3) < 1e-12 for g in general)
+        assert all(slip(p, v1, v3) < 1e-12 for p in printed) == (v3 < 0)
+
+
+def test_simplified_484():
+    """(4.82) with beta3 of (4.83) substituted: the closed forms of (4.84), and the numbers of digest C.8."""
+    direct = tri(("w1.spin", "w2.spin")).substitute({b3: BETA_483[("w1.spin", "w2.spin")]})
+    root = sp.sqrt(l12**2 * (p1 + p2) ** 2 + l3**2 * (p1 - p2) ** 2)
+    expected = sp.Matrix([0, -r * (p1 + p2) * l12, -r * (p1 - p2), root]) / (2 * l12)
+    assert (direct - expected).applyfunc(sp.simplify) == sp.zeros(4, 1)
+    inverse = tri(("vy", "omega")).substitute({b3: BETA_483[("vy", "omega")]})
+    expected = -sp.Matrix([0, vy + l12 * om, vy - l12 * om, sp.sqrt(vy**2 + l3**2 * om**2)]) / r
+    assert (inverse - expected).applyfunc(sp.simplify) == sp.zeros(4, 1)
+    np.testing.assert_allclose(np.array(direct.subs({**NUMBERS, p1: 2, p2: 3}), dtype=float).ravel(),
+                               (0, -0.25, 0.1, 2.773085), atol=2e-6)
+    np.testing.assert_allclose(np.array(inverse.subs({**NUMBERS, vy: 0.3, om: 0.2}), dtype=float).ravel(),
+                               (0, -4, -2, -3.841875), atol=2e-6)
+
+
+# ---- printing and errors ---------------------------------------------------------------------------------
+DIFF = Robot.from_dict({"name": "diff", "wheels": [
+    {"name": "left", "type": "fixed", "position": [0, 0.2], "beta": "90 deg", "r": 0.05, "sensed": ["spin"]},
+    {"name": "right", "type": "fixed", "position": [0, -0.2], "beta": "90 deg", "r": 0.05, "sensed": ["spin"]},
+    {"name": "caster", "type": "castor", "position": [-0.3, 0], "d": 0.04, "r": 0.03}]})
+
+
+def test_format_symbolic_differential_drive():
+    """vx = r/2 (phi_l + phi_r), omega = r/(2 b) (phi_r - phi_l), phi = (vx -+ b omega)/r, with r = 1/20, b = 1/5."""
+    text = format_symbolic(DIFF)
+    assert "direct model (sensed), assigned: left.spin, right.spin" in text
+    assert "vx = 1/40*left.spin + 1/40*right.spin" in text
+    assert "omega = -1/8*left.spin + 1/8*right.spin" in text
+    assert "inverse model, assigned: vx, omega" in text
+    assert "left.spin = 20*vx - 4*omega" in text and "right.spin = 20*vx + 4*omega" in text
+    latex = format_symbolic(DIFF, ["left.spin", "right.spin"], latex=True)
+    assert r"\begin{aligned}" in latex
+    assert r"v_x &= \frac{1}{40} \dot{\varphi}_{\mathrm{left}} + \frac{1}{40} \dot{\varphi}_{\mathrm{right}}" in latex
+    assert r"\omega &=" in latex and r"\dot{\varphi}_{\mathrm{left}}" in latex
+
+
+def test_default_assignments():
+    assert sensed_rates(DIFF) == ("left.spin", "right.spin")
+    assert twist_assignment(DIFF) == ("vx", "omega")
+    assert twist_assignment(TRICYCLE) == ("vy",)  # m = 1; vx is never assignable (C.4)
+
+
+def test_errors_name_the_culprit():
+    with pytest.raises(UnknownNameError, match="no velocity 'vz'"):
+        tri(["vz"])
+    with pytest.raises(AssignmentError, match="'vy' listed twice"):
+        tri(["vy", "vy"])
+    with pytest.raises(UnknownNameError, match="wheel 'w1' \\(fixed\\) has no geometric field 'd'"):
+        symbolic_model(TRICYCLE, ["vy"], geometry={"w1.d": l12})
+    with pytest.raises(AssignmentError, match="strings are never parsed"):
+        symbolic_model(TRICYCLE, ["vy"], geometry={"w1.l": "l12"})
+    with pytest.raises(AssignmentError, match="beta: expected 1 steering angles"):
+        symbolic_model(TRICYCLE, ["vy"], [0.1, 0.2])
