@@ -87,13 +87,8 @@ def step(pose_world_robot: ArrayLike, increment_robot: ArrayLike, method: Method
     check_method(method)
     pose = as_vectors(pose_world_robot, 3, "pose_world_robot")
     inc = as_vectors(increment_robot, 3, "increment_robot")
-    dth = inc[..., 2]
-    head = pose[..., 2] + HEADING_FRACTION[method] * dth
-    f = sinc(dth / 2) if method == "exact" else 1.0
-    c, s = np.cos(head) * f, np.sin(head) * f
-    return np.stack(
-        [pose[..., 0] + c * inc[..., 0] - s * inc[..., 1], pose[..., 1] + s * inc[..., 0] + c * inc[..., 1],
-         pose[..., 2] + dth], axis=-1)
+    columns = [c[..., None] for c in np.broadcast_arrays(inc[..., 0], inc[..., 1], inc[..., 2])]
+    return compose_columns(pose, columns[0], columns[1], columns[2], method)[..., 0, :]
 
 
 def _twist_step(pose_world_robot: ArrayLike, twist_robot: ArrayLike, dt: ArrayLike, method: Method) -> np.ndarray:
@@ -155,93 +150,43 @@ def integrate_increments(
     inc = np.asarray(increments_robot, dtype=float)
     if inc.ndim < 2 or inc.shape[-1] != 3:
         raise WmrkitError(f"increments_robot: expected shape (..., N, 3), got {inc.shape}")
-    dy = inc[..., 1] if np.any(inc[..., 1]) else None
-    return compose_columns(pose0, inc[..., 0], dy, inc[..., 2], method, heading_world=heading_world)
+    return compose_columns(pose0, inc[..., 0], inc[..., 1], inc[..., 2], method, heading_world=heading_world)
 
 
-#: Samples per block of :func:`compose_columns`: its temporaries stay in the CPU cache.
-BLOCK = 4096
-
-
-def compose_columns(pose_world_robot: np.ndarray, dx_robot: np.ndarray, dy_robot: np.ndarray | None,
+def compose_columns(pose_world_robot: ArrayLike, dx_robot: np.ndarray, dy_robot: np.ndarray | None,
                     dtheta: np.ndarray, method: Method = "exact", *,
                     heading_world: ArrayLike | None = None, out: np.ndarray | None = None) -> np.ndarray:
     """:func:`integrate_increments` on separate columns (the streaming hot path; 003 (20)-(26), 002 (15)).
 
     ``(..., 3), (..., N), (..., N) or None, (..., N) -> (..., N, 3)``; ``dy_robot=None`` means all zero (a
-    differential drive), which saves work. Same `heading_world` rule. Works in blocks of :data:`BLOCK` samples
-    with preallocated scratch arrays, carrying the pose from block to block; `out` ``(..., N, 3)``, when given,
-    receives the result.
+    differential drive). Same `heading_world` rule. One compiled pass per row of the batch (:mod:`._kernels`):
+    the heading and positions are running sums, the pose after a step that of :func:`step`. `out`
+    ``(..., N, 3)``, when given, receives the result.
     """
+    from . import _kernels  # numba loads on first use
+
     pose = np.asarray(pose_world_robot, dtype=float)
+    n = np.shape(dtheta)[-1]
     hw = None
     if heading_world is not None:
         hw = np.asarray(heading_world, dtype=float)
-        if hw.shape[-1:] != (dtheta.shape[-1] + 1,):
-            raise WmrkitError(f"heading_world: expected shape (..., {dtheta.shape[-1] + 1}) (one more than the "
-                              f"increments), got {hw.shape}")
-        dtheta = np.diff(hw, axis=-1)
-    shape = np.broadcast_shapes((*pose.shape[:-1], 1), dx_robot.shape, dtheta.shape,
-                                () if dy_robot is None else dy_robot.shape)
-    n = shape[-1]
-    out = np.empty((*shape, 3)) if out is None else out
-    z0 = pose[..., 0, None] + 1j * pose[..., 1, None]  # positions as complex numbers: one cumulative sum
-    th0 = pose[..., 2, None].copy() if hw is None else hw[..., :1]
-    frac, exact = HEADING_FRACTION[method], method == "exact"
-    b = min(BLOCK, n)
-    th, head, c, s, f = (np.empty((*shape[:-1], b)) for _ in range(5))
-    zc = np.empty((*shape[:-1], b), dtype=complex)
-    for start in range(0, n, BLOCK):
-        stop = min(start + BLOCK, n)
-        m = stop - start
-        th_, head_, c_, s_, f_, z_ = th[..., :m], head[..., :m], c[..., :m], s[..., :m], f[..., :m], zc[..., :m]
-        dth = dtheta[..., start:stop]
-        if hw is None:
-            np.cumsum(np.broadcast_to(dth, th_.shape), axis=-1, out=th_)
-            th_ += th0
-        else:
-            th_[...] = hw[..., start + 1:stop + 1]
-        if frac == 0.0:
-            np.subtract(th_, dth, out=head_)
-        elif frac == 1.0:
-            head_[...] = th_
-        else:
-            np.multiply(dth, 0.5, out=f_)  # h
-            np.subtract(th_, f_, out=head_)
-        np.cos(head_, out=c_)
-        np.sin(head_, out=s_)
-        wx = dx_robot[..., start:stop]
-        wy = None if dy_robot is None else dy_robot[..., start:stop]
-        if exact:
-            _chord_factor(f_, head_)
-            wx = wx * head_
-            wy = None if wy is None else wy * head_
-        np.multiply(c_, wx, out=z_.real)
-        np.multiply(s_, wx, out=z_.imag)
-        if wy is not None:
-            z_.real -= s_ * wy
-            z_.imag += c_ * wy
-        np.cumsum(z_, axis=-1, out=z_)
-        z_ += z0
-        out[..., start:stop, 0] = z_.real
-        out[..., start:stop, 1] = z_.imag
-        out[..., start:stop, 2] = th_
-        z0, th0 = z_[..., -1:].copy(), th_[..., -1:].copy()
-    return out
+        if hw.shape[-1:] != (n + 1,):
+            raise WmrkitError(f"heading_world: expected shape (..., {n + 1}) (one more than the increments), "
+                              f"got {hw.shape}")
+    shapes = [np.shape(a)[:-1] for a in (dx_robot, dy_robot, dtheta, hw) if a is not None]
+    batch = np.broadcast_shapes(pose.shape[:-1], *shapes)
+    rows = math.prod(batch)
 
+    def matrix(a: ArrayLike | None, width: int) -> np.ndarray:  # (rows, width); a view unless broadcast
+        if a is None:
+            return np.empty((rows, 0))
+        return np.broadcast_to(np.asarray(a, dtype=float), (*batch, width)).reshape(rows, width)
 
-def _chord_factor(h: np.ndarray, out: np.ndarray) -> None:
-    """``sin(h) / h`` into `out`, 1 at 0: the series ``1 - h^2/6 + h^4/120`` when every ``|h| < 0.01`` (next term
-    below 2e-16 relative), else sine and division where ``h != 0`` (the safe pattern)."""
-    if h.size and np.max(np.abs(h)) < 0.01:
-        np.multiply(h, h, out=out)
-        h2 = out.copy()
-        out *= 1.0 / 120.0
-        out -= 1.0 / 6.0
-        out *= h2
-        out += 1.0
-        return
-    np.sin(h, out=out)
-    np.divide(out, h, out=out, where=h != 0)
-    if not np.all(h):
-        out[h == 0] = 1.0
+    result = np.empty((*batch, n, 3)) if out is None else out
+    flat = result.reshape(rows, n, 3)  # a view of `out` when it is contiguous, else a copy written back
+    dx = matrix(dx_robot, n)
+    _kernels.compose(matrix(pose, 3), dx, matrix(dy_robot, n), dx if hw is not None else matrix(dtheta, n),
+                     matrix(hw, n + 1), HEADING_FRACTION[method], method == "exact", flat)
+    if not np.may_share_memory(flat, result):
+        result[...] = flat.reshape(result.shape)
+    return result

@@ -40,8 +40,9 @@ class ModelIncrements:
     to the solved velocity columns (body increment, then the kept wheel rates named ``joint_names``);
     ``residual_map`` ``(R, n_a)`` to ``A dq``, or is None when the sensors have no redundancy (the residual is
     then identically 0). For steering robots both carry a leading axis of distinct configurations ``(U, ...)``
-    and ``index`` ``(N,)`` says which one each interval uses. Products are written column by column (no BLAS
-    call, no per-sample matrix gather): the hot path of odometry.
+    and ``index`` ``(N,)`` says which one each interval uses. The body increments and the slip come from one
+    compiled pass over the samples (:func:`._kernels.linear_maps`; no BLAS call, no per-sample matrix gather),
+    the hot path of odometry; the arrays handed out from it are read-only.
     """
 
     rate_increments: np.ndarray
@@ -53,42 +54,49 @@ class ModelIncrements:
     def __len__(self) -> int:
         return len(self.rate_increments)
 
-    def _entry(self, m: np.ndarray, i: int, a: int) -> np.ndarray | float:
-        return m[i, a] if self.index is None else m[:, i, a][self.index]
-
     @functools.cached_property
-    def _columns(self) -> np.ndarray:
-        """``rate_increments`` transposed, ``(n_a, N)`` contiguous: its columns are read many times."""
-        return np.ascontiguousarray(self.rate_increments.T)
+    def _body_and_slip(self) -> tuple[np.ndarray, np.ndarray]:
+        """Body increments ``(N, 3)`` and slip ``(N,)``, read-only, in one pass."""
+        body, slip = self._products(self.solution[..., :3, :], self.residual_map)
+        body.setflags(write=False)
+        slip.setflags(write=False)
+        return body, slip
 
-    def _row(self, m: np.ndarray, i: int) -> np.ndarray | None:
-        dq = self._columns
-        terms = [a for a in range(len(dq)) if np.any(m[..., i, a])]
-        if not terms:
-            return None
-        out = self._entry(m, i, terms[0]) * dq[terms[0]]
-        for a in terms[1:]:
-            out += self._entry(m, i, a) * dq[a]
-        return out
+    def kernel_maps(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The maps in the form the compiled kernels take, see :func:`kernel_maps`."""
+        return kernel_maps(self.solution, self.residual_map, self.index)
 
-    def _rows(self, m: np.ndarray) -> np.ndarray:
-        rows = [self._row(m, i) for i in range(m.shape[-2])]
-        zero = np.zeros(len(self))
-        return np.stack([zero if r is None else r for r in rows], axis=-1) if rows else np.zeros((len(self), 0))
+    def _products(self, plain: np.ndarray, squared: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        """``plain @ dq`` ``(N, P)`` and ``|squared @ dq|`` ``(N,)`` (0 when `squared` is None) per interval."""
+        from . import _kernels  # numba loads on first use
+
+        n, n_a = self.rate_increments.shape
+
+        def per_configuration(m: np.ndarray) -> np.ndarray:  # (U, rows, n_a)
+            return m if self.index is not None else m[None]
+
+        index = kernel_maps(self.solution, None, self.index)[2]
+        out, norm = np.empty((n, plain.shape[-2])), np.zeros(n)
+        _kernels.linear_maps(np.asarray(self.rate_increments, dtype=float), per_configuration(plain),
+                             np.empty((1, 0, n_a)) if squared is None else per_configuration(squared), index,
+                             out, norm)
+        return out, norm
 
     def column(self, i: int) -> np.ndarray | None:
-        """Solved column `i` ``(N,)`` (0, 1, 2: dx [m], dy [m], dtheta [rad]); None when identically 0."""
-        return self._row(self.solution, i)
+        """Solved column `i` ``(N,)`` (0, 1, 2: dx [m], dy [m], dtheta [rad]), read-only; None when identically 0."""
+        if not np.any(self.solution[..., i, :]):
+            return None
+        return self._body_and_slip[0][:, i]
 
     @property
     def increments_robot(self) -> np.ndarray:
         """Body increments ``(N, 3)``: ``(dx [m], dy [m], dtheta [rad])`` over each interval."""
-        return self._rows(self.solution[..., :3, :])
+        return self._body_and_slip[0].copy()
 
     @property
     def joint_increments(self) -> np.ndarray:
         """Every kept wheel rate integrated over each interval ``(N, n)`` [rad], names in ``joint_names``."""
-        return self._rows(self.solution[..., 3:, :])
+        return self._products(self.solution[..., 3:, :], None)[0]
 
     @property
     def twist_map(self) -> np.ndarray:
@@ -101,23 +109,16 @@ class ModelIncrements:
         """``A dq`` per kept constraint row ``(N, R)`` [m]: the slip over each interval (4.11)."""
         if self.residual_map is None:
             return np.zeros((len(self), 0))
-        return self._rows(self.residual_map)
+        return self._products(self.residual_map, None)[0]
 
     @property
     def slip(self) -> np.ndarray:
-        """Norm of the residual per interval [m], the slip indicator of (4.11). ``(N,)``.
+        """Norm of the residual per interval [m], the slip indicator of (4.11). ``(N,)``, read-only.
 
         Row by row, accumulating squares (a quadratic form ``dq^T Rm^T Rm dq`` would cancel: small residuals
         are the interesting ones).
         """
-        total = np.zeros(len(self))
-        if self.residual_map is None:
-            return total
-        for i in range(self.residual_map.shape[-2]):
-            r = self._row(self.residual_map, i)
-            if r is not None:
-                total += r * r
-        return np.sqrt(total)
+        return self._body_and_slip[1]
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
@@ -287,6 +288,18 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
     redundant = np.max(np.abs(rm), initial=0.0) > 1e-12 * scale  # else A dq = 0 exactly: no spare sensor
     return OdometryModel(robot, joints, tuple(rate_joints), (), model.rows, cols_a, assigned,
                          model.steer_index, model.row_weights, _frozen(s), _frozen(rm) if redundant else None)
+
+
+def kernel_maps(solution: np.ndarray, residual_map: np.ndarray | None,
+                index: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Maps in the form the compiled kernels take: body maps ``(U, 3, n_a)``, residual maps ``(U, R, n_a)`` (R = 0
+    when `residual_map` is None) and the configuration index ``(N,)`` int64 (empty for a constant model, whose
+    `solution` ``(k, n_a)`` and `residual_map` ``(R, n_a)`` have no configuration axis)."""
+    n_a = solution.shape[-1]
+    lead = (lambda m: m) if index is not None else (lambda m: m[None])
+    residual = np.empty((1, 0, n_a)) if residual_map is None else lead(residual_map)
+    flat = np.empty(0, dtype=np.int64) if index is None else np.asarray(index).astype(np.int64, copy=False)
+    return lead(solution[..., :3, :]), residual, flat
 
 
 def wrap_angle(angle: ArrayLike) -> np.ndarray:

@@ -17,9 +17,9 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors
 from ..robot import Robot
 from .covariance import CrowleyNoise, JointNoise, propagate_covariance
-from .integrators import Method, check_method, compose_columns
+from .integrators import HEADING_FRACTION, Method, check_method
 from .logs import JointLog, LogError, check_time
-from .model import ModelIncrements, OdometryModel, odometry_model
+from .model import ModelIncrements, OdometryModel, kernel_maps, odometry_model
 from .trajectories import Trajectory
 
 Noise = CrowleyNoise | JointNoise
@@ -91,34 +91,34 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
             prev, chunk, row = chunk.slice(0, 1), chunk.slice(1, len(chunk)), 1
             if len(chunk) == 0:
                 continue
-        dt = _validate(chunk, prev)
-        inc = model.from_positions(chunk.positions, previous=prev.positions[-1])
-        dx, dy, dth = inc.column(0), inc.column(1), inc.column(2)
-        dx = np.zeros(len(chunk)) if dx is None else dx
+        n = len(chunk)
+        max_dt = _validate(chunk, prev)
+        # steering robots need the configuration of each interval; others difference the positions in the kernel
+        inc = None if model.constant and cov is None else model.from_positions(chunk.positions,
+                                                                               previous=prev.positions[-1])
         heading = None
         if chunk.heading_world is not None:
             if prev.heading_world is None:
                 raise LogError(f"{chunk.where(0)}: external heading starts in the middle of the log")
             heading = np.concatenate([prev.heading_world[-1:], chunk.heading_world]) - heading0
-            dth = np.diff(heading)
-        dth = np.zeros(len(chunk)) if dth is None else dth
-        poses = compose_columns(pose, dx, dy, dth, method, heading_world=heading,
-                                out=None if out is None else out.poses[row:row + len(chunk)])
+        poses = np.empty((n, 3)) if out is None else out.poses[row:row + n]
+        slip = np.empty(n) if out is None else out.slip[row:row + n]
+        sums = _compose_chunk(model, chunk.positions, prev.positions[-1], inc, pose, heading, method, poses, slip)
         covs = None
         if cov is not None:
-            steps = np.stack([dx, np.zeros(len(chunk)) if dy is None else dy, dth], axis=-1)
+            dx, dy, dth = (np.zeros(n) if c is None else c for c in (inc.column(0), inc.column(1), inc.column(2)))
+            steps = np.stack([dx, dy, dth if heading is None else np.diff(heading)], axis=-1)
             q = _increment_covariance(noise, inc, steps)
             covs = propagate_covariance(np.vstack([pose[None], poses]), steps, q, method, initial=cov)
             cov = covs[-1]
-        slip = inc.slip
         result = Trajectory(chunk.time, poses, slip, covs)
         for sink in sinks:
             sink(result)
-        if out is not None:
-            _fill(out, result, row, poses=False)
-        row += len(chunk)
-        stats.add(dt, float(chunk.time[-1]), dx, dy, dth, slip if inc.residual_map is not None else None)
-        pose, prev = poses[-1].copy(), chunk.slice(len(chunk) - 1, len(chunk))
+        if out is not None and covs is not None:
+            out.covariance[row:row + n] = covs
+        row += n
+        stats.add(n, max_dt, float(chunk.time[-1]), sums)
+        pose, prev = poses[-1].copy(), chunk.slice(n - 1, n)
     if prev is None:
         raise LogError("the log has no samples")
     return stats.summary(model.robot.name, method, pose, cov)
@@ -171,39 +171,53 @@ class Decimator:
         return np.concatenate(self._time), np.concatenate(self._poses)
 
 
+def _compose_chunk(model: OdometryModel, positions: np.ndarray, before: np.ndarray, inc: ModelIncrements | None,
+                   pose: np.ndarray, heading: np.ndarray | None, method: Method, poses: np.ndarray,
+                   slip: np.ndarray) -> tuple[float, float, float, float]:
+    """Poses and slip of a chunk into `poses` ``(N, 3)`` and `slip` ``(N,)``, fused in one compiled pass over the
+    samples (joint increments, the sensed model's maps (4.11), the scheme's composition); the chunk's path sums
+    ``(distance, rotation, max slip, sum of slip^2)``. Without `inc` (a constant model), the joint increments are
+    the differences of `positions` ``(N, n)`` from `before` ``(n,)``, taken in the kernel."""
+    from . import _kernels  # numba loads on first use
+
+    if inc is None:
+        maps, residual, index = kernel_maps(model.solution, model.residual_map)
+        rates, first = positions, np.asarray(before, dtype=float)
+    else:
+        (maps, residual, index), rates, first = inc.kernel_maps(), inc.rate_increments, np.empty(0)
+    return _kernels.odometry_chunk(np.asarray(rates, dtype=float), first, maps, residual, index, pose,
+                                   np.empty(0) if heading is None else heading, HEADING_FRACTION[method],
+                                   method == "exact", poses, slip)
+
+
 def _increment_covariance(noise: Noise, inc: ModelIncrements, steps: np.ndarray) -> np.ndarray:
     if isinstance(noise, CrowleyNoise):
         return noise.increment_covariance(steps)
     return np.broadcast_to(noise.increment_covariance(inc.twist_map, inc.rate_increments), (len(steps), 3, 3))
 
 
-def _fill(out: Trajectory, chunk: Trajectory, row: int, *, poses: bool = True) -> None:
+def _fill(out: Trajectory, chunk: Trajectory, row: int) -> None:
     stop = row + len(chunk)
-    if poses:
-        out.poses[row:stop] = chunk.poses
+    out.poses[row:stop] = chunk.poses
     out.slip[row:stop] = chunk.slip
     if out.covariance is not None:
         out.covariance[row:stop] = chunk.covariance
 
 
-def _validate(chunk: JointLog, prev: JointLog | None) -> np.ndarray | None:
-    """Refuse non-finite values and time that does not increase; the time steps (from `prev`'s last sample)."""
-    t = chunk.time
-    ok = bool(np.isfinite(chunk.positions.sum()) and np.isfinite(t[0]) and np.isfinite(t[-1]))
+def _validate(chunk: JointLog, prev: JointLog | None) -> float:
+    """Refuse non-finite values and time that does not increase; the longest time step (from `prev`'s last
+    sample, 0 without steps)."""
+    from . import _kernels  # numba loads on first use
+
+    t = np.asarray(chunk.time, dtype=float)
+    bad, largest = _kernels.time_steps(t, np.empty(0) if prev is None else np.asarray(prev.time[-1:], dtype=float))
+    ok = bool(np.isfinite(chunk.positions.sum()) and np.isfinite(t[0]) and np.isfinite(t[-1]) and bad == 0)
     if chunk.heading_world is not None:
         ok = ok and bool(np.isfinite(chunk.heading_world.sum()))
-    dt = None
-    if prev is not None:
-        dt = np.empty(len(t))
-        dt[0] = t[0] - prev.time[-1]
-        np.subtract(t[1:], t[:-1], out=dt[1:])
-        ok = ok and bool(dt.min() > 0)
-    elif len(t) > 1:
-        ok = ok and bool(np.min(np.diff(t)) > 0)
     if not ok:  # the slow path finds and names the first bad value
         _check_finite(chunk)
         check_time(chunk, t, None if prev is None else float(prev.time[-1]), None)
-    return dt
+    return largest
 
 
 def _check_finite(log: JointLog) -> None:
@@ -226,16 +240,13 @@ class _Stats:
     def start(self, t0: float) -> None:
         self.n, self.t0, self.t1 = 1, float(t0), float(t0)
 
-    def add(self, dt: np.ndarray, t_last: float, dx: np.ndarray, dy: np.ndarray | None, dth: np.ndarray,
-            slip: np.ndarray | None) -> None:
-        self.n += len(dt)
+    def add(self, n: int, max_dt: float, t_last: float, sums: tuple[float, float, float, float]) -> None:
+        """Account for `n` more intervals, their longest step and their path sums (:func:`_compose_chunk`)."""
+        distance, rotation, max_slip, sq_slip = sums
+        self.n += n
         self.t1 = t_last
-        self.dist += float(np.abs(dx).sum() if dy is None else np.sqrt(dx * dx + dy * dy).sum())  # hypot is slow
-        self.rot += float(np.abs(dth).sum())
-        if slip is not None:
-            self.max_slip = max(self.max_slip, float(slip.max()))
-            self.sq_slip += float(np.square(slip).sum())  # not np.dot: BLAS threads stall on a busy machine
-        self.max_dt = max(self.max_dt, float(dt.max()))
+        self.dist, self.rot, self.sq_slip = self.dist + distance, self.rot + rotation, self.sq_slip + sq_slip
+        self.max_slip, self.max_dt = max(self.max_slip, max_slip), max(self.max_dt, max_dt)
 
     def summary(self, robot: str, method: str, pose: np.ndarray, cov: np.ndarray | None) -> OdometrySummary:
         rms = float(np.sqrt(self.sq_slip / (self.n - 1))) if self.n > 1 else 0.0

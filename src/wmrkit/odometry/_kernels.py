@@ -1,0 +1,351 @@
+"""Compiled hot loops of odometry (numba): the sensed model's linear maps, SE(2) composition, both fused.
+
+The block helpers below hold the one implementation of each step: :func:`_apply_row` / :func:`_norm_rows` of
+the sensed model's maps (4.11), :func:`_headings`, :func:`_rotations`, :func:`_positions` of the schemes of
+:mod:`.integrators`. The kernels chain them: :func:`compose` (increments to poses), :func:`linear_maps` (joint
+increments to body increments and slip), :func:`odometry_chunk` (joint increments to poses, slip and path
+sums in one pass over memory, the pipeline's hot path), :func:`time_steps`. This module is imported on
+first use (numba takes about 0.4 s to import). Each kernel is compiled on its first call for one signature of
+strided arrays that also accepts read-only ones (so any layout runs without a new compilation), cached on disk
+next to this file or in the user's cache directory, and compiled in memory when no cache directory is writable
+(a read-only installation).
+
+Every kernel works in blocks of :data:`BLOCK` samples held in small buffers (the L1 cache), with loops over
+the block innermost: loads into the buffers, the maps (vectorised by the compiler), the heading as a running
+sum (sequential), the rotation of every body displacement (independent per sample, vectorised), the positions
+as running sums (sequential). Sine and cosine are inlined: a Cody-Waite reduction by pi/2 in three 33-bit
+parts with exact error terms, then fdlibm's kernels on ``[-pi/4, pi/4]`` (Sun Microsystems 1993, freely
+redistributable); error below 0.8 ulp (tested against libm). Angles beyond :data:`TRIG_MAX` use libm, as do
+chord factors of steps turning more than ``pi/2``.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Callable
+
+import numba
+import numpy as np
+
+#: Samples per block: a dozen block buffers take about 25 KB.
+BLOCK = 256
+#: Largest |angle| [rad] for the inlined sine and cosine (the reduction's products stay exact below it).
+TRIG_MAX = 2.0**20
+#: Largest |h| [rad] for the sinc polynomial (fdlibm's sine kernel divided by h).
+SINC_MAX = math.pi / 4
+
+# fdlibm k_sin.c, k_cos.c: minimax polynomials of sin and cos on [-pi/4, pi/4]
+_S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
+_S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10
+_C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
+_C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
+# fdlibm e_rem_pio2.c: pi/2 = P1 + P2 + P3 + P3T, the first three of 33 bits (so n * Pi is exact for n < 2^20)
+_P1, _P2, _P3 = 1.57079632673412561417e+00, 6.07710050630396597660e-11, 2.02226624871116645580e-21
+_P3T = 8.47842766036889956997e-32
+_INV_PIO2 = 6.36619772367581382433e-01
+_ROUND = 6755399441055744.0  # 1.5 * 2^52: (x + _ROUND) - _ROUND rounds x to the nearest integer
+
+
+def _jit(signature) -> Callable[[Callable], Callable]:
+    """Compile the decorated function for `signature` on its first call; ``.py_func`` is the Python source."""
+    def decorate(fn: Callable) -> Callable:
+        compiled = None
+
+        @functools.wraps(fn)
+        def call(*args):
+            nonlocal compiled
+            if compiled is None:
+                compiled = _compile(fn, signature)
+            return compiled(*args)
+
+        call.py_func = fn
+        return call
+    return decorate
+
+
+def _compile(fn: Callable, signature) -> Callable:
+    """``numba.njit`` cached on disk when a cache directory is writable, else in memory only."""
+    try:
+        return numba.njit(signature, cache=True)(fn)
+    except RuntimeError:  # numba: "cannot cache function ...: no locator available for file ..."
+        return numba.njit(signature)(fn)
+
+
+_IN = numba.types.Array(numba.float64, 2, "A", readonly=True)  # inputs: any strides, read-only accepted
+_IN1 = numba.types.Array(numba.float64, 1, "A", readonly=True)
+_IN3 = numba.types.Array(numba.float64, 3, "A", readonly=True)
+_INDEX = numba.types.Array(numba.int64, 1, "A", readonly=True)
+_OUT1, _OUT2, _OUT3 = numba.float64[:], numba.float64[:, :], numba.float64[:, :, :]
+
+
+@numba.njit(inline="always")
+def _two_diff_error(a: float, b: float, d: float) -> float:
+    """Rounding error of ``d = a - b`` (Knuth's TwoSum): ``a - b = d + error`` exactly."""
+    bb = d - a
+    return (a - (d - bb)) + (-b - bb)
+
+
+@numba.njit(inline="always")
+def _cos_sin(x: float) -> tuple[float, float]:
+    """``(cos x, sin x)`` for ``|x| <= TRIG_MAX``, branch free (vectorisable), error below 0.8 ulp."""
+    n = (x * _INV_PIO2 + _ROUND) - _ROUND  # nearest multiple of pi/2
+    r1 = x - n * _P1  # exact
+    w = n * _P2  # exact
+    r2 = r1 - w
+    err = _two_diff_error(r1, w, r2)
+    w = n * _P3
+    r3 = r2 - w
+    err += _two_diff_error(r2, w, r3)
+    tail = err - n * _P3T
+    y0 = r3 + tail  # x - n pi/2 = y0 + y1, |y0| <= pi/4
+    y1 = (r3 - y0) + tail
+    z = y0 * y0
+    zz = z * z
+    v = z * y0
+    rs = _S2 + z * (_S3 + z * _S4) + z * zz * (_S5 + z * _S6)
+    s = y0 - ((z * (0.5 * y1 - v * rs) - y1) - v * _S1)
+    rc = z * (_C1 + z * (_C2 + z * _C3)) + zz * zz * (_C4 + z * (_C5 + z * _C6))
+    hz = 0.5 * z
+    wc = 1.0 - hz
+    c = wc + (((1.0 - wc) - hz) + (z * rc - y0 * y1))
+    q = n - 4.0 * math.floor(0.25 * n)  # quadrant 0..3, in floating point (no int conversion of a NaN)
+    swap = (q == 1.0) or (q == 3.0)
+    cos_x = s if swap else c
+    sin_x = c if swap else s
+    if q == 1.0 or q == 2.0:
+        cos_x = -cos_x
+    if q >= 2.0:
+        sin_x = -sin_x
+    return cos_x, sin_x
+
+
+@numba.njit(inline="always")
+def _sinc(h: float) -> float:
+    """``sin(h) / h`` for ``|h| <= SINC_MAX``: fdlibm's sine polynomial over h, no division (1 at 0)."""
+    z = h * h
+    zz = z * z
+    return 1.0 + z * (_S1 + z * (_S2 + z * (_S3 + z * _S4) + z * zz * (_S5 + z * _S6)))
+
+
+# -- block helpers: `m` samples from `start`; buffers are (BLOCK,) or (rows, BLOCK) ----------------------------
+
+@numba.njit
+def _load(source, start, m, buffer):
+    """``buffer[j] = source[start + j]`` for a strided 1-D `source`."""
+    for j in range(m):
+        buffer[j] = source[start + j]
+
+
+@numba.njit
+def _load_differences(source, before, start, m, buffer):
+    """``buffer[j] = source[start + j] - source[start + j - 1]``, with `before` as ``source[-1]``."""
+    last = before if start == 0 else source[start - 1]
+    for j in range(m):
+        value = source[start + j]
+        buffer[j] = value - last
+        last = value
+
+
+@numba.njit
+def _apply_row(maps, row, index, start, cols, m, acc):
+    """``acc[j] = maps[u, row] @ cols[:, j]``, ``u = index[start + j]`` (0 when `index` is empty); (4.11)."""
+    for j in range(m):
+        acc[j] = 0.0
+    if index.shape[0] == 0:
+        for a in range(cols.shape[0]):
+            c = maps[0, row, a]
+            for j in range(m):
+                acc[j] += c * cols[a, j]
+    else:
+        for a in range(cols.shape[0]):
+            for j in range(m):
+                acc[j] += maps[index[start + j], row, a] * cols[a, j]
+
+
+@numba.njit
+def _norm_rows(maps, index, start, cols, m, acc, norm):
+    """``norm[j] = |maps[u] @ cols[:, j]|``, squares accumulated row by row (no cancelling quadratic form)."""
+    for j in range(m):
+        norm[j] = 0.0
+    for row in range(maps.shape[1]):
+        _apply_row(maps, row, index, start, cols, m, acc)
+        for j in range(m):
+            norm[j] += acc[j] * acc[j]
+    for j in range(m):
+        norm[j] = math.sqrt(norm[j])
+
+
+@numba.njit
+def _headings(theta0, dtheta, heading, start, m, fraction, head, turn, theta):
+    """Pass 1 (sequential): ``theta[j]`` after each step from `theta0`, the step's turn and its rotation heading
+    ``theta_before + fraction * turn``; returns the last theta. `heading` ``(N + 1,)``, when not empty, replaces
+    `dtheta`: ``turn = heading[k + 1] - heading[k]``, ``theta = heading[k + 1]``."""
+    th = theta0
+    with_heading = heading.shape[0] > 0
+    for j in range(m):
+        if with_heading:
+            th_next = heading[start + j + 1]
+            d = th_next - th
+        else:
+            d = dtheta[j]
+            th_next = th + d
+        head[j], turn[j], theta[j] = th + fraction * d, d, th_next
+        th = th_next
+    return th
+
+
+@numba.njit
+def _rotations(head, turn, m, exact, cf, sf):
+    """Pass 2 (vectorised): ``(cf, sf) = f (cos head, sin head)``, ``f = sinc(turn / 2)`` when `exact`, else 1
+    (003 (20)-(26), 002 (15)); libm where an angle is out of the inlined functions' range (rare)."""
+    outside = 0
+    for j in range(m):
+        a, h = head[j], 0.5 * turn[j]
+        c, s = _cos_sin(a)
+        f = _sinc(h) if exact else 1.0
+        cf[j], sf[j] = c * f, s * f
+        outside += (abs(a) > TRIG_MAX) + (exact and abs(h) > SINC_MAX)
+    if outside:
+        for j in range(m):
+            a, h = head[j], 0.5 * turn[j]
+            c, s = (math.cos(a), math.sin(a)) if abs(a) > TRIG_MAX else _cos_sin(a)
+            f = (math.sin(h) / h if abs(h) > SINC_MAX else _sinc(h)) if exact else 1.0
+            cf[j], sf[j] = c * f, s * f
+
+
+@numba.njit
+def _positions(x, y, cf, sf, dx, dy, with_dy, theta, m, out, start):
+    """Pass 3 (sequential): positions after each step, ``(x, y) += Rot(cf, sf) (dx, dy)``; writes ``out[start +
+    j] = (x, y, theta[j])`` and returns the last ``(x, y)``. `dy` is ignored (zero) unless `with_dy`."""
+    for j in range(m):
+        u = dx[j]
+        if with_dy:
+            v = dy[j]
+            x += cf[j] * u - sf[j] * v
+            y += sf[j] * u + cf[j] * v
+        else:
+            x += cf[j] * u
+            y += sf[j] * u
+        k = start + j
+        out[k, 0], out[k, 1], out[k, 2] = x, y, theta[j]
+    return x, y
+
+
+# -- kernels ----------------------------------------------------------------------------------------------------
+
+@_jit(numba.void(_IN, _IN, _IN, _IN, _IN, numba.float64, numba.boolean, _OUT3))
+def compose(pose0, dx, dy, dtheta, heading, fraction, exact, out):
+    """Poses after each body increment: ``out[b, k] = step(out[b, k - 1], increment[b, k])``.
+
+    ``pose0 (B, 3), dx (B, N), dy (B, N) or (B, 0), dtheta (B, N), heading (B, N + 1) or (B, 0), out (B, N, 3)``.
+    The step of :func:`.integrators.step`: displacement rotated by ``theta + fraction * dtheta`` and, when
+    `exact`, scaled by ``sinc(dtheta / 2)``. An empty `dy` means zero; a non-empty `heading` replaces `dtheta`
+    and the start heading by the external heading (``dtheta = heading[k + 1] - heading[k]``).
+    """
+    n = out.shape[1]
+    with_dy, with_heading = dy.shape[1] > 0, heading.shape[1] > 0
+    bx, by, bth = np.empty(BLOCK), np.empty(BLOCK), np.empty(BLOCK)
+    head, turn, theta, cf, sf = (np.empty(BLOCK), np.empty(BLOCK), np.empty(BLOCK), np.empty(BLOCK),
+                                 np.empty(BLOCK))
+    for b in range(out.shape[0]):
+        x, y = pose0[b, 0], pose0[b, 1]
+        th = heading[b, 0] if with_heading else pose0[b, 2]
+        for start in range(0, n, BLOCK):
+            m = min(BLOCK, n - start)
+            _load(dx[b], start, m, bx)
+            if with_dy:
+                _load(dy[b], start, m, by)
+            if not with_heading:
+                _load(dtheta[b], start, m, bth)
+            th = _headings(th, bth, heading[b], start, m, fraction, head, turn, theta)
+            _rotations(head, turn, m, exact, cf, sf)
+            x, y = _positions(x, y, cf, sf, bx, by, with_dy, theta, m, out[b], start)
+
+
+@_jit(numba.void(_IN, _IN3, _IN3, _INDEX, _OUT2, _OUT1))
+def linear_maps(dq, plain, squared, index, out, norm):
+    """Products of per-interval matrices with joint increments, and norms of products, in one pass (4.11).
+
+    ``dq (N, n), plain (U, P, n), squared (U, Q, n), index (N,) or (0,) -> out (N, P), norm (N,)``:
+    ``out[k] = plain[u] @ dq[k]``, ``norm[k] = |squared[u] @ dq[k]|``, ``u = index[k]`` (0 when `index` is
+    empty); `norm` is left untouched when Q = 0.
+    """
+    n, n_a = dq.shape
+    cols, acc, norm_b = np.empty((n_a, BLOCK)), np.empty(BLOCK), np.empty(BLOCK)
+    for start in range(0, n, BLOCK):
+        m = min(BLOCK, n - start)
+        for a in range(n_a):
+            _load(dq[:, a], start, m, cols[a])
+        for row in range(plain.shape[1]):
+            _apply_row(plain, row, index, start, cols, m, acc)
+            for j in range(m):
+                out[start + j, row] = acc[j]
+        if squared.shape[1] > 0:
+            _norm_rows(squared, index, start, cols, m, acc, norm_b)
+            _load(norm_b, 0, m, norm[start:])
+
+
+@_jit(numba.types.UniTuple(numba.float64, 4)(_IN, _IN1, _IN3, _IN3, _INDEX, _IN1, _IN1, numba.float64,
+                                              numba.boolean, _OUT2, _OUT1))
+def odometry_chunk(rates, before, maps, residual, index, pose0, heading, fraction, exact, poses, slip):
+    """Joint increments to poses in one pass: :func:`linear_maps` then :func:`compose`, fused (4.11; 003 (20)-(26)).
+
+    ``rates (N, n), before (n,) or (0,), maps (U, 3, n), residual (U, R, n), index (N,) or (0,), pose0 (3,),
+    heading (N + 1,) or (0,) -> poses (N, 3), slip (N,)``. The joint increments ``dq[k]`` are the rows of
+    `rates`, or, when `before` is given, the differences of consecutive rows of `rates` (joint positions), with
+    `before` the row before the first. Body increments ``maps[u] @ dq[k]`` are composed from `pose0` (`heading`
+    as in :func:`compose`); the slip is ``|residual[u] @ dq[k]|`` (0 when R = 0). Returns the sums over the
+    chunk ``(sum |(dx, dy)|, sum |dtheta|, max slip, sum slip^2)``.
+    """
+    n, n_a = rates.shape
+    differences = before.shape[0] > 0
+    with_dy = False
+    for u in range(maps.shape[0]):
+        for a in range(n_a):
+            with_dy = with_dy or maps[u, 1, a] != 0.0
+    cols, acc = np.empty((n_a, BLOCK)), np.empty(BLOCK)
+    bx, by, bth, bslip = np.empty(BLOCK), np.empty(BLOCK), np.empty(BLOCK), np.empty(BLOCK)
+    head, turn, theta, cf, sf = (np.empty(BLOCK), np.empty(BLOCK), np.empty(BLOCK), np.empty(BLOCK),
+                                 np.empty(BLOCK))
+    x, y = pose0[0], pose0[1]
+    th = heading[0] if heading.shape[0] > 0 else pose0[2]
+    distance, rotation, max_slip, sq_slip = 0.0, 0.0, 0.0, 0.0
+    for start in range(0, n, BLOCK):
+        m = min(BLOCK, n - start)
+        for a in range(n_a):
+            if differences:
+                _load_differences(rates[:, a], before[a], start, m, cols[a])
+            else:
+                _load(rates[:, a], start, m, cols[a])
+        _apply_row(maps, 0, index, start, cols, m, bx)
+        if with_dy:
+            _apply_row(maps, 1, index, start, cols, m, by)
+        _apply_row(maps, 2, index, start, cols, m, bth)
+        th = _headings(th, bth, heading, start, m, fraction, head, turn, theta)
+        _rotations(head, turn, m, exact, cf, sf)
+        x, y = _positions(x, y, cf, sf, bx, by, with_dy, theta, m, poses, start)
+        if residual.shape[1] > 0:
+            _norm_rows(residual, index, start, cols, m, acc, bslip)
+        else:
+            bslip[:m] = 0.0
+        for j in range(m):
+            slip[start + j] = bslip[j]
+            distance += math.sqrt(bx[j] * bx[j] + by[j] * by[j]) if with_dy else abs(bx[j])
+            rotation += abs(turn[j])
+            max_slip = max(max_slip, bslip[j])
+            sq_slip += bslip[j] * bslip[j]
+    return distance, rotation, max_slip, sq_slip
+
+
+@_jit(numba.types.Tuple((numba.int64, numba.float64))(_IN1, _IN1))
+def time_steps(time, before):
+    """How many steps of `time` ``(N,)`` are not numbers > 0 (NaN included), and the largest step (0 without
+    steps); the first step is from ``before[0]`` when `before` ``(1,)`` is not empty."""
+    n, first = time.shape[0], 0 if before.shape[0] > 0 else 1
+    bad, largest = 0, np.zeros(4)  # four running maxima: independent dependency chains
+    for k in range(first, n):
+        d = time[k] - (before[0] if k == 0 else time[k - 1])
+        bad += not d > 0.0
+        largest[k % 4] = max(largest[k % 4], d)
+    return bad, largest.max()
