@@ -138,6 +138,17 @@ def test_redundant_sensors_report_the_inconsistency_as_slip():
     assert out.slip[0] < 1e-14 and out.slip[1] > 1e-4
 
 
+def test_increments_hand_out_read_only_columns_and_slip():
+    """Columns and slip come from one cached pass: handed out read-only, so no caller can corrupt the others'."""
+    out = odometry_model(catalog.load("mecanum-4")).increments(np.random.default_rng(2).normal(size=(9, 4)))
+    for a in (out.column(0), out.column(2), out.slip):
+        with pytest.raises(ValueError, match="read-only"):
+            a[0] = 1.0
+    body = out.increments_robot  # a private copy
+    body[:] = 0.0
+    assert np.any(out.increments_robot)
+
+
 def test_forklift_steering_inconsistent_with_the_drive_wheels_is_slip():
     robot = catalog.load("forklift")
     model = odometry_model(robot)

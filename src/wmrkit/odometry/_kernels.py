@@ -179,9 +179,9 @@ def _norm_rows(maps, index, start, cols, m, acc, norm):
 @numba.njit
 def _headings(theta0, dtheta, heading, start, m, fraction, head, turn, theta):
     """Pass 1 (sequential): ``theta[j]`` after each step from `theta0`, the step's turn and its rotation heading
-    ``theta_before + fraction * turn``; returns the last theta. `heading` ``(N + 1,)``, when not empty, replaces
-    `dtheta`: ``turn = heading[k + 1] - heading[k]``, ``theta = heading[k + 1]``."""
-    th = theta0
+    ``theta_before + fraction * turn``; returns the last theta and ``sum |turn|``. `heading` ``(N + 1,)``, when
+    not empty, replaces `dtheta`: ``turn = heading[k + 1] - heading[k]``, ``theta = heading[k + 1]``."""
+    th, rotation = theta0, 0.0
     with_heading = heading.shape[0] > 0
     for j in range(m):
         if with_heading:
@@ -191,8 +191,9 @@ def _headings(theta0, dtheta, heading, start, m, fraction, head, turn, theta):
             d = dtheta[j]
             th_next = th + d
         head[j], turn[j], theta[j] = th + fraction * d, d, th_next
+        rotation += abs(d)
         th = th_next
-    return th
+    return th, rotation
 
 
 @numba.njit
@@ -217,19 +218,23 @@ def _rotations(head, turn, m, exact, cf, sf):
 @numba.njit
 def _positions(x, y, cf, sf, dx, dy, with_dy, theta, m, out, start):
     """Pass 3 (sequential): positions after each step, ``(x, y) += Rot(cf, sf) (dx, dy)``; writes ``out[start +
-    j] = (x, y, theta[j])`` and returns the last ``(x, y)``. `dy` is ignored (zero) unless `with_dy`."""
+    j] = (x, y, theta[j])``, returns the last ``(x, y)`` and the path length ``sum |(dx, dy)|``. `dy` is ignored
+    (zero) unless `with_dy`."""
+    distance = 0.0
     for j in range(m):
         u = dx[j]
         if with_dy:
             v = dy[j]
             x += cf[j] * u - sf[j] * v
             y += sf[j] * u + cf[j] * v
+            distance += math.sqrt(u * u + v * v)
         else:
             x += cf[j] * u
             y += sf[j] * u
+            distance += abs(u)
         k = start + j
         out[k, 0], out[k, 1], out[k, 2] = x, y, theta[j]
-    return x, y
+    return x, y, distance
 
 
 # -- kernels ----------------------------------------------------------------------------------------------------
@@ -258,9 +263,9 @@ def compose(pose0, dx, dy, dtheta, heading, fraction, exact, out):
                 _load(dy[b], start, m, by)
             if not with_heading:
                 _load(dtheta[b], start, m, bth)
-            th = _headings(th, bth, heading[b], start, m, fraction, head, turn, theta)
+            th = _headings(th, bth, heading[b], start, m, fraction, head, turn, theta)[0]
             _rotations(head, turn, m, exact, cf, sf)
-            x, y = _positions(x, y, cf, sf, bx, by, with_dy, theta, m, out[b], start)
+            x, y = _positions(x, y, cf, sf, bx, by, with_dy, theta, m, out[b], start)[:2]
 
 
 @_jit(numba.void(_IN, _IN3, _IN3, _INDEX, _OUT2, _OUT1))
@@ -322,19 +327,19 @@ def odometry_chunk(rates, before, maps, residual, index, pose0, heading, fractio
         if with_dy:
             _apply_row(maps, 1, index, start, cols, m, by)
         _apply_row(maps, 2, index, start, cols, m, bth)
-        th = _headings(th, bth, heading, start, m, fraction, head, turn, theta)
+        th, turned = _headings(th, bth, heading, start, m, fraction, head, turn, theta)
         _rotations(head, turn, m, exact, cf, sf)
-        x, y = _positions(x, y, cf, sf, bx, by, with_dy, theta, m, poses, start)
+        x, y, travelled = _positions(x, y, cf, sf, bx, by, with_dy, theta, m, poses, start)
+        distance, rotation = distance + travelled, rotation + turned
         if residual.shape[1] > 0:
             _norm_rows(residual, index, start, cols, m, acc, bslip)
+            for j in range(m):
+                slip[start + j] = bslip[j]
+                max_slip = max(max_slip, bslip[j])
+                sq_slip += bslip[j] * bslip[j]
         else:
-            bslip[:m] = 0.0
-        for j in range(m):
-            slip[start + j] = bslip[j]
-            distance += math.sqrt(bx[j] * bx[j] + by[j] * by[j]) if with_dy else abs(bx[j])
-            rotation += abs(turn[j])
-            max_slip = max(max_slip, bslip[j])
-            sq_slip += bslip[j] * bslip[j]
+            for j in range(m):
+                slip[start + j] = 0.0
     return distance, rotation, max_slip, sq_slip
 
 
