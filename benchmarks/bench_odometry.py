@@ -1,8 +1,12 @@
 """Odometry throughput against per-sample Python loops over peers' odometry updates (same run, same machine).
 
 Targets (issue "odometry"): exact integration of a 10-million-sample log at >= 10 M samples/s on one core and
->= 50x the throughput of a per-sample Python loop calling a peer's odometry update. The peer loops are timed on
-a slice of the log (they are slow) and scaled linearly to the same sample count; the names say so.
+>= 50x the throughput of a per-sample Python loop calling a peer's odometry update; the first line says whether
+this run meets them (a ``--quick`` run has 1 million samples: indicative only). Both sides turn the same
+two-wheel angle log into poses, one update per sample; ours also stores every pose and the slip indicator, the
+peer (which is given the heading) keeps only its last pose. The peer loops are timed on a slice of the log (they
+are slow) and scaled linearly to the same sample count; the names say so. Times are the best of 3 calls, after
+a first call that compiles (or loads) the kernels.
 """
 
 from __future__ import annotations
@@ -39,7 +43,17 @@ def _wpimath_diff_loop(log: JointLog, headings: np.ndarray, m: int) -> float:
         for a, (left, right) in zip(th, d, strict=True):
             update(rot(a), left, right)
 
-    return best_time(loop, repeat=2)
+    return best_time(loop, repeat=3)
+
+
+def _verdict(n: int, ours_s: float, peer_s: float | None, quick: bool) -> str:
+    """The issue's target and whether this run meets it."""
+    rate_ok = n / ours_s >= 10e6
+    if peer_s is None:
+        verdict = "ratio NOT MEASURED (peer absent)"
+    else:
+        verdict = "MET" if rate_ok and peer_s / ours_s >= 50 else "NOT MET"
+    return f">= 10 M/s, >= 50x: {verdict}" + (" (quick run: 1e6 samples, the target is for 1e7)" if quick else "")
 
 
 def _wpimath_mecanum_loop(positions: np.ndarray, headings: np.ndarray, robot, m: int) -> float:
@@ -75,13 +89,12 @@ def run(quick: bool) -> list[Result]:
     peer_s = _wpimath_diff_loop(log, traj.poses[:, 2], m) * n / m if has_wpimath else None
     results.append(Result("odometry exact: diff-drive wheel-angle log -> poses", n, ours,
                           f"wpimath DifferentialDriveOdometry.update loop (x{n // m} of {m:,})", peer_s,
-                          ">= 10 M/s, >= 50x"))
+                          _verdict(n, ours, peer_s, quick)))
 
     inc = model.from_positions(log.positions).increments_robot
     ours = best_time(lambda: integrate_increments([0.0, 0.0, 0.0], inc, "exact"), repeat=3)
     results.append(Result("integrate_increments exact (kernel only)", n - 1, ours,
-                          f"wpimath DifferentialDriveOdometry.update loop (x{n // m} of {m:,})", peer_s,
-                          ">= 10 M/s"))
+                          f"wpimath DifferentialDriveOdometry.update loop (x{n // m} of {m:,})", peer_s))
 
     mec = catalog.load("mecanum-4")
     nm = n // 4

@@ -18,6 +18,10 @@ method        heading used              chord factor    source, order
 The exact step is the chord form of the SE(2) exponential: ``Rot(h) sinc(h) = V(2h)`` with ``h = dtheta / 2``,
 where ``V`` is the left Jacobian of SO(2); it has no ``1 - cos`` cancellation, so the straight-line limit
 ``dtheta -> 0`` loses no precision (papers-odometry.md A.3 [DERIVED]).
+
+Every scheme has one implementation, a compiled kernel (:func:`._kernels.compose`, numba, loaded on first
+use): :func:`step` is a trajectory of one increment, :func:`integrate_increments` one of N, and the pipeline's
+fused pass (:func:`._kernels.odometry_chunk`) runs the same block steps.
 """
 
 from __future__ import annotations
@@ -87,8 +91,7 @@ def step(pose_world_robot: ArrayLike, increment_robot: ArrayLike, method: Method
     check_method(method)
     pose = as_vectors(pose_world_robot, 3, "pose_world_robot")
     inc = as_vectors(increment_robot, 3, "increment_robot")
-    columns = [c[..., None] for c in np.broadcast_arrays(inc[..., 0], inc[..., 1], inc[..., 2])]
-    return compose_columns(pose, columns[0], columns[1], columns[2], method)[..., 0, :]
+    return compose_columns(pose, inc[..., 0, None], inc[..., 1, None], inc[..., 2, None], method)[..., 0, :]
 
 
 def _twist_step(pose_world_robot: ArrayLike, twist_robot: ArrayLike, dt: ArrayLike, method: Method) -> np.ndarray:
@@ -137,9 +140,9 @@ def integrate_increments(
     """Compose a sequence of body increments into poses, vectorised (002 (15)/(22), 003 (20)-(26), thesis (3.15)).
 
     ``(..., 3), (..., N, 3) -> (..., N, 3)``: the pose after each increment (the start pose is not repeated).
-    The heading is a cumulative sum, the world displacement of each step a rotation of its body displacement
-    (times the chord factor for ``exact``), and the positions a cumulative sum: no Python loop, float64
-    accumulation. Equal to applying :func:`step` N times (to round-off).
+    One compiled pass per row of the batch: the heading is a running sum, the world displacement of each step a
+    rotation of its body displacement (times the chord factor for ``exact``), the positions running sums, in
+    float64. Equal to applying :func:`step` N times.
 
     `heading_world` ``(..., N + 1)`` [rad], when given, is an external absolute heading (gyro, IMU, compass) at
     the start and end of every interval: it replaces the wheels' ``dtheta`` and the start pose's theta (the
@@ -159,9 +162,8 @@ def compose_columns(pose_world_robot: ArrayLike, dx_robot: np.ndarray, dy_robot:
     """:func:`integrate_increments` on separate columns (the streaming hot path; 003 (20)-(26), 002 (15)).
 
     ``(..., 3), (..., N), (..., N) or None, (..., N) -> (..., N, 3)``; ``dy_robot=None`` means all zero (a
-    differential drive). Same `heading_world` rule. One compiled pass per row of the batch (:mod:`._kernels`):
-    the heading and positions are running sums, the pose after a step that of :func:`step`. `out`
-    ``(..., N, 3)``, when given, receives the result.
+    differential drive). Same `heading_world` rule and kernel. `out` ``(..., N, 3)``, when given, receives the
+    result.
     """
     from . import _kernels  # numba loads on first use
 

@@ -3,7 +3,9 @@
 Per chunk: the sensed direct model (:mod:`.model`) gives body increments between consecutive samples, the chosen
 scheme (:mod:`.integrators`) composes them from the pose carried over from the previous chunk, and the
 covariance (:mod:`.covariance`) is propagated from the carried covariance. The last sample of each chunk is kept
-to difference against the next, so the result does not depend on the chunk size (to round-off).
+to difference against the next, so the result does not depend on the chunk size (to round-off). Increments,
+composition, slip and path sums are one compiled pass over the chunk (:func:`._kernels.odometry_chunk`); for
+robots that do not steer, it differences the joint positions itself.
 """
 
 from __future__ import annotations
