@@ -2,15 +2,17 @@
 
 Entries of the constraint matrix are polynomials in sin/cos of a few angles and in geometry symbols. Replacing
 each sin/cos (and each square root) by a polynomial variable turns the ranks method (4.9)-(4.11) into linear
-algebra over a field of rational functions, which sympy's ``DomainMatrix`` does exactly and fast; results are
-then reduced modulo the relations ``s^2 + c^2 - 1`` and ``g^2 - n``. Ranks and row choices are generic: taken
-numerically at random values of every symbol.
+algebra over a polynomial ring, which sympy's ``DomainMatrix.solve_den`` does exactly and fraction-free (one
+common denominator per block, no gcd per operation); each entry is then reduced modulo the relations
+``s^2 + c^2 - 1`` and ``g^2 - n`` and cancelled once. Ranks and row choices are generic: taken numerically at
+random values of every symbol, and the closed form is checked against numeric least squares at another point.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import sympy as sp
+from sympy.polys.domains import FractionField, PolynomialRing
 from sympy.polys.matrices import DomainMatrix
 
 from .linalg import matrix_rank
@@ -31,7 +33,7 @@ class _Generators:
         self.back: dict[sp.Symbol, sp.Expr] = {}
         self.relations: list[sp.Expr] = []
         for k, arg in enumerate(sorted({a.args[0] for a in atoms}, key=sp.default_sort_key)):
-            s, c = sp.Dummy(f"s{k}"), sp.Dummy(f"c{k}")
+            s, c = sp.Dummy(f"a{k}"), sp.Dummy(f"b{k}")  # sin before cos: reducing gives s^2 -> 1 - c^2
             self.forward.update({sp.sin(arg): s, sp.cos(arg): c})
             self.back.update({s: sp.sin(arg), c: sp.cos(arg)})
             self.relations.append(s**2 + c**2 - 1)
@@ -41,31 +43,31 @@ class _Generators:
             self.relations.append(g**2 - root.base)
 
     def domain_matrix(self, m: sp.MatrixBase) -> DomainMatrix:
-        """`m` over a field of rational functions in the generators (and the other symbols)."""
-        return DomainMatrix.from_list_sympy(*m.shape, sp.Matrix(m).xreplace(self.forward).tolist()).to_field()
+        """`m` over a ring of polynomials in the generators (and the other symbols), or numbers (QQ, EX)."""
+        return DomainMatrix.from_list_sympy(*m.shape, sp.Matrix(m).xreplace(self.forward).tolist())
 
-    def reduce(self, dm: DomainMatrix) -> DomainMatrix:
-        """Entries reduced modulo the relations (numerator and denominator) and cancelled."""
-        field = dm.domain
-        if not hasattr(field, "field"):  # plain numbers (QQ, ZZ) or expressions (EX): nothing to reduce
-            return dm
-        ring = field.field.ring
+    def fraction(self, num, den, domain) -> sp.Expr:
+        """``num / den`` (elements of `domain`) reduced modulo the relations, cancelled, as sin/cos and roots."""
+        ring = _poly_ring(domain)
+        if ring is None:
+            return sp.factor_terms(sp.cancel(domain.to_sympy(num) / domain.to_sympy(den))).xreplace(self.back)
         basis = [ring.from_expr(r) for r in self.relations if r.free_symbols <= set(ring.symbols)]
-        rows = []
-        for row in dm.to_list():
-            out = []
-            for e in row:
-                num, den = e.numer.rem(basis), e.denom.rem(basis)
-                if not den:
-                    raise ZeroDivisionError("a pivot vanished on sin^2 + cos^2 = 1")
-                num, den = num.cancel(den)
-                out.append(field.field(num) / field.field(den))
-            rows.append(out)
-        return DomainMatrix(rows, dm.shape, field)
+        num, den = num.rem(basis), den.rem(basis)
+        if not den:
+            raise ZeroDivisionError("a pivot vanished on sin^2 + cos^2 = 1")
+        num, den = num.cancel(den)
+        signs = [1 if c > 0 else -1 for c in den.coeffs()]
+        if sum(signs) < 0 or (sum(signs) == 0 and den.coeff(1) < 0):  # prefer 4 - 3 c^2 to 3 c^2 - 4
+            num, den = -num, -den
+        return sp.factor_terms(num.as_expr() / den.as_expr()).xreplace(self.back)
 
-    def to_expr(self, dm: DomainMatrix) -> sp.Matrix:
-        """Reduced entries as sympy expressions of sin/cos and roots."""
-        return self.reduce(dm).to_Matrix().applyfunc(lambda e: sp.factor_terms(sp.cancel(e)).xreplace(self.back))
+
+def _poly_ring(domain):
+    if isinstance(domain, PolynomialRing):
+        return domain.ring
+    if isinstance(domain, FractionField):
+        return domain.field.ring
+    return None
 
 
 def numeric(m: sp.MatrixBase, point: dict[sp.Symbol, sp.Float]) -> np.ndarray:
@@ -117,27 +119,38 @@ def _independent_rows(values: np.ndarray, rows: list[int], cols: list[int]) -> l
 
 
 def solve_exactly(a: sp.MatrixBase, na_idx: list[int], a_idx: list[int], exact: bool,
-                   values: np.ndarray, *, generators: bool = True) -> tuple[sp.Matrix, sp.Matrix]:
-    """``M`` with ``q_na = M q_a`` and the residual ``A_na M + A_a``, block by block, over a rational field.
+                  values: np.ndarray, *, generators: bool = True) -> tuple[sp.Matrix, sp.Matrix]:
+    """``M`` with ``q_na = M q_a`` and the residual ``A_na M + A_a``, block by block, fraction-free.
 
+    Each block is solved as ``lhs X = rhs`` with one common denominator (``DomainMatrix.solve_den``, no gcd per
+    operation); exact: a maximal independent set of rows (4.5); least squares: the normal equations (4.11).
     With `generators`, sin/cos and roots are polynomial variables (fast); without, sympy expressions (EX).
     """
     gens = _Generators(list(a), enabled=generators)
     full = gens.domain_matrix(a)
-    all_a = list(range(len(a_idx)))
-    a_na, a_a = full.extract(list(range(a.rows)), na_idx), full.extract(list(range(a.rows)), a_idx)
-    field = full.domain
-    rows_m = [[field.zero] * len(a_idx) for _ in na_idx]
+    domain, all_rows, all_a = full.domain, list(range(a.rows)), list(range(len(a_idx)))
+    a_na, a_a = full.extract(all_rows, na_idx), full.extract(all_rows, a_idx)
+    m = sp.zeros(len(na_idx), len(a_idx))
+    residual = sp.zeros(a.rows, len(a_idx))
+    covered: set[int] = set()
     for rows, cols in _components(a[:, na_idx]):
+        covered.update(rows)
+        if not a_idx:
+            continue
+        block, b = a_na.extract(rows, cols), a_a.extract(rows, all_a)
         if exact:
-            rows = _independent_rows(values[:, na_idx], rows, cols)
-            lhs, rhs = a_na.extract(rows, cols), a_a.extract(rows, all_a)
+            keep = _independent_rows(values[:, na_idx], rows, cols)
+            lhs, rhs = a_na.extract(keep, cols), a_a.extract(keep, all_a)
         else:
-            block = a_na.extract(rows, cols)
-            lhs, rhs = block.transpose() * block, block.transpose() * a_a.extract(rows, all_a)
-        if a_idx:
-            for j, x in zip(cols, (-lhs.lu_solve(rhs)).to_list(), strict=True):
-                rows_m[j] = x
-    m = gens.reduce(DomainMatrix(rows_m, (len(na_idx), len(a_idx)), field))
-    residual = (a_na * m + a_a) if not exact and a_idx else DomainMatrix.zeros((a.rows, len(a_idx)), field)
-    return gens.to_expr(m), gens.to_expr(residual)
+            lhs, rhs = block.transpose() * block, block.transpose() * b
+        x, den = lhs.solve_den(rhs)  # lhs x = rhs den, M = -x / den
+        for k, j in enumerate(cols):
+            m[j, :] = sp.Matrix([[gens.fraction(-e, den, domain) for e in x.to_list()[k]]])
+        if not exact:
+            slip = (b * den - block * x).to_list()  # (A_a den - A_na x) / den = A_na M + A_a
+            for k, i in enumerate(rows):
+                residual[i, :] = sp.Matrix([[gens.fraction(e, den, domain) for e in slip[k]]])
+    if not exact:
+        for i in set(all_rows) - covered:
+            residual[i, :] = sp.Matrix([[gens.fraction(e, domain.one, domain) for e in a_a.to_list()[i]]])
+    return m, residual

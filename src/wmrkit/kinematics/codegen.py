@@ -114,10 +114,18 @@ def write_code(
     return paths
 
 
+def _c_numbers(e: sp.Expr) -> sp.Expr:
+    table: dict[sp.Expr, sp.Expr] = {sp.pi: sp.Float(math.pi, 20)}
+    for n in e.atoms(sp.Rational):
+        if abs(n.p) > 2**31 or abs(n.q) > 2**31:
+            table[n] = sp.Float(n, 20)
+    return e.xreplace(table)
+
+
 def _cse(exprs: list[sp.Expr], printer: C99CodePrinter | NumPyPrinter) -> tuple[list[str], list[str]]:
     """Common subexpressions ``t0, t1...`` as ``name = code`` lines, and the reduced expressions, printed."""
-    exprs = [e.xreplace({sp.pi: sp.Float(math.pi, 20)}) if isinstance(printer, C99CodePrinter) else e
-             for e in exprs]
+    if isinstance(printer, C99CodePrinter):  # C: no M_PI in strict C99, no integer literal beyond 64 bits
+        exprs = [_c_numbers(e) for e in exprs]
     replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), optimizations="basic")
     lines = [f"{sym} = {printer.doprint(value)}" for sym, value in replacements]
     return lines, [printer.doprint(e) for e in reduced]
@@ -180,14 +188,17 @@ def _c_body(plan: _Plan, exprs: list[sp.Expr], targets: list[str], comments: lis
 
 
 def _c_unpack(plan: _Plan, sensed: bool = False, twist: bool = False) -> str:
-    lines = []
+    """Named locals for the inputs, each cast to void once: a model need not use every input."""
+    lines, names = [], []
     if twist:
         lines.append("    const double vx = twist[0], vy = twist[1], omega = twist[2];")
+        names += ["vx", "vy", "omega"]
     if sensed:
         lines += [f"    const double q{i} = sensed[{i}]; /* {n} */" for i, n in enumerate(plan.sensed)]
+        names += [f"q{i}" for i in range(len(plan.sensed))]
     lines += [f"    const double b{i} = beta[{i}]; /* {n} */" for i, n in enumerate(plan.robot.steer_names)]
-    if not plan.beta:
-        lines.append("    (void)beta;")
+    names += [f"b{i}" for i in range(len(plan.beta))] or ["beta"]
+    lines.append("    " + " ".join(f"(void){n};" for n in names))
     return "\n".join(lines)
 
 

@@ -5,9 +5,9 @@ with ``sin=sympy.sin, cos=sympy.cos`` over each wheel's contact elements (``Whee
 ``rate_map``), so the closed forms cannot drift from :meth:`wmrkit.Robot.constraint_matrix` (roller frame, 3.6).
 Steering angles are symbols ``beta_<wheel>``; geometry is either the robot's numbers made exact (0.45 -> 9/20,
 90 deg -> pi/2) or symbols (``l_<wheel>``, ``alpha_<wheel>``, ``r_<wheel>``...) so that the thesis's general
-formulas appear. Linear algebra runs over a field of rational functions (sympy ``DomainMatrix``) and every result
-is reduced modulo ``sin^2 + cos^2 = 1``: exact, and fast enough for the tricycle tables (4.80)-(4.82) in
-well under a second.
+formulas appear. The ranks method (4.9)-(4.11) then runs fraction-free over polynomial rings in sin/cos of the
+steering angles (sympy ``DomainMatrix``, see ``_exact_linalg``), and every result is reduced modulo
+``sin^2 + cos^2 = 1``: exact, and the tricycle tables (4.80)-(4.82) take a fraction of a second.
 """
 
 from __future__ import annotations
@@ -129,12 +129,12 @@ def _steering_values(robot: Robot, beta: Sequence[sp.Expr | float] | None) -> tu
 
 # ---- the constraint matrix (3.22) ------------------------------------------------------------------------
 def _trig(name: str, place: Mapping[sp.Expr, sp.Expr]):
-    """sin or cos that expands algebraic offsets: ``sin(beta + pi/4) -> sqrt(2)/2 (sin beta + cos beta)``.
+    """sin or cos that expands constant offsets: ``sin(beta + pi/4) -> sqrt(2)/2 (sin beta + cos beta)``.
 
     A place given as an exact position ``(x, y)`` enters as symbols ``L, A`` with ``place = {cos A: x/L,
     sin A: y/L}``; splitting ``A`` off makes ``L*sin(theta - A)`` exactly ``x sin(theta) - y cos(theta)``. What
-    remains is sin/cos of the steering angles, of geometry symbols and of offsets with no algebraic value
-    (``beta + pi/18`` stays whole), ready for the exact linear algebra.
+    remains is sin/cos of the steering angles, of geometry symbols and of constants (see :func:`_constants`),
+    so that one pair (sin, cos) per steering angle enters the exact linear algebra.
     """
 
     def sin(a: sp.Expr) -> sp.Expr:
@@ -155,7 +155,7 @@ def _split(a: sp.Expr, fn, addition, place: Mapping[sp.Expr, sp.Expr]) -> sp.Exp
     if special != 0:
         return sp.expand(addition(a - special, special).xreplace(place))
     offset = sp.Add(*(t for t in terms if not t.free_symbols))
-    if offset != 0 and offset != a and not sp.cos(offset).has(sp.cos, sp.sin):
+    if offset != 0 and offset != a:
         return sp.expand(addition(a - offset, offset))
     return fn(a)
 
@@ -180,7 +180,7 @@ def _wheel_blocks(wheel: Wheel, beta: sp.Expr | None, table: dict[str, sp.Expr])
         rate_map = sp.Matrix(e.rate_map)
         for row in entries:
             own = (sp.Matrix([list(row[3:])]) * rate_map)[0, :]
-            rows.append([sp.expand(_expr(v)) for v in (*row[:3], *own)])
+            rows.append([_constants(sp.expand(_expr(v))) for v in (*row[:3], *own)])
     return rows
 
 
@@ -198,6 +198,19 @@ def _place(l: float, alpha: float, given: dict[str, sp.Expr]) -> tuple[sp.Expr, 
     x, y = _snap(l * math.cos(alpha), l), _snap(l * math.sin(alpha), l)
     big_l, big_a = sp.Dummy("L", positive=True), sp.Dummy("A", real=True)
     return big_l, big_a, {sp.cos(big_a): x / big_l, sp.sin(big_a): y / big_l}
+
+
+def _constants(e: sp.Expr) -> sp.Expr:
+    """sin/cos of a number that is no simple multiple of pi (a fixed axle at 0.3 rad) -> its float, exactly.
+
+    ``cos(pi/18)`` stays; ``cos(3/10)`` would be one more variable of the rational-function field for nothing.
+    """
+    table = {}
+    for atom in e.atoms(sp.sin, sp.cos):
+        arg = atom.args[0]
+        if not arg.free_symbols and not (arg / sp.pi).is_Rational:
+            table[atom] = exact_number(float(atom), "length")
+    return e.xreplace(table) if table else e
 
 
 def _expr(v) -> sp.Expr:

@@ -1,0 +1,184 @@
+"""Generated code (wmrkit.kinematics.codegen): C99 compiled with gcc and called through ctypes, and the numpy module,
+against the numeric models (Robot.constraint_matrix + linalg.solve_assigned, 4.11) on random inputs."""
+
+from __future__ import annotations
+
+import ctypes
+import importlib.util
+import math
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from wmrkit import Robot, SingularError, catalog
+from wmrkit.kinematics.codegen import CodegenError, identifier, write_code
+from wmrkit.kinematics.linalg import solve_assigned
+from wmrkit.kinematics.symbolic import sensed_rates
+
+
+def _robot(name, wheels):
+    return Robot.from_dict({"name": name, "wheels": wheels})
+
+
+ROBOTS = {
+    "diff-castor": _robot("diff-castor", [
+        {"name": "left", "type": "fixed", "position": [0, 0.2], "beta": "90 deg", "r": 0.05, "sensed": ["spin"]},
+        {"name": "right", "type": "fixed", "position": [0, -0.2], "beta": "90 deg", "r": 0.05, "sensed": ["spin"]},
+        {"name": "caster", "type": "castor", "position": [-0.3, 0.02], "d": 0.04, "r": 0.03}]),
+    "forklift": catalog.load("forklift"),
+    "mecanum": _robot("mecanum", [
+        {"name": n, "type": "swedish", "position": [x, y], "beta": "90 deg", "gamma": g, "r": 0.05, "r_r": 0.01,
+         "sensed": ["spin"]}
+        for n, x, y, g in [("fl", 0.2, 0.15, "45 deg"), ("fr", 0.2, -0.15, "-45 deg"),
+                           ("rl", -0.2, 0.15, "-45 deg"), ("rr", -0.2, -0.15, "45 deg")]]),
+    "swerve": _robot("swerve", [
+        {"name": n, "type": "steerable", "position": [x, y], "r": 0.05, "sensed": ["spin", "steer"]}
+        for n, x, y in [("fl", 0.3, 0.25), ("fr", 0.3, -0.25), ("rl", -0.3, 0.25), ("rr", -0.3, -0.25)]]),
+    "omni castors": _robot("omni castors", [  # a name that is no C identifier
+        *({"name": f"o{i}", "type": "swedish", "l": 0.25, "alpha": f"{a} deg", "beta": f"{a} deg",
+           "gamma": "90 deg", "r": 0.04, "r_r": 0.01, "sensed": ["spin"]} for i, a in enumerate((0, 120, 240))),
+        {"name": "c1", "type": "castor", "position": [0.3, 0.1], "d": 0.03, "delta": "10 deg", "r": 0.02},
+        {"name": "c2", "type": "castor", "position": [-0.3, 0.1], "d": -0.03, "r": 0.02}]),
+    "double castor": _robot("double castor", [
+        {"name": "unit", "type": "double_castor", "position": [0.3, 0], "d": 0.08, "b": 0.1, "r": 0.05,
+         "sensed": ["spin1", "spin2"]},
+        {"name": "left", "type": "fixed", "position": [-0.2, 0.25], "beta": "90 deg", "r": 0.05},
+        {"name": "right", "type": "fixed", "position": [-0.2, -0.25], "beta": "90 deg", "r": 0.05}]),
+}
+N = 6  # random samples per robot
+
+
+def numeric(robot: Robot, sensed, beta, twist, q_sensed):
+    """Reference: the ranks method (4.11) on the numeric constraint matrix."""
+    a = robot.constraint_matrix(beta)
+    rates = solve_assigned(a, [0, 1, 2], twist)[0][..., 3:]
+    q, slip = solve_assigned(a, [robot.velocity_index(n) for n in sensed], q_sensed)
+    return rates, q[..., :3], np.linalg.norm(slip, axis=-1)
+
+
+def inputs(robot: Robot, sensed, seed=0):
+    rng = np.random.default_rng(seed)
+    beta = rng.uniform(-math.pi, math.pi, (N, len(robot.steer_names)))
+    return beta, rng.normal(size=(N, 3)), rng.normal(size=(N, len(sensed)))
+
+
+def load_module(path: Path):
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+ALL = {**ROBOTS, **{f"catalog:{n}": catalog.load(n) for n in catalog.names()}}
+
+
+@pytest.mark.parametrize("name", list(ALL))
+def test_python_module_equals_numeric_model(name, tmp_path):
+    robot = ALL[name]
+    (path,) = write_code(robot, "python", tmp_path)
+    mod = load_module(path)
+    sensed = sensed_rates(robot)
+    assert mod.SENSED_NAMES == sensed and mod.RATE_NAMES == robot.rate_names
+    beta, twist, q_s = inputs(robot, sensed)
+    rates, twist_fw, slip = numeric(robot, sensed, beta, twist, q_s)
+    np.testing.assert_allclose(mod.constraint_matrix(beta), robot.constraint_matrix(beta), atol=1e-12)
+    np.testing.assert_allclose(mod.inverse(twist, beta), rates, rtol=1e-9, atol=1e-9)
+    got_twist, got_slip = mod.forward_with_residual(q_s, beta)
+    np.testing.assert_allclose(got_twist, twist_fw, rtol=1e-8, atol=1e-9)
+    np.testing.assert_allclose(got_slip, slip, rtol=1e-8, atol=1e-9)
+    # batches broadcast: one configuration for many twists, and (2, 3) leading axes
+    np.testing.assert_allclose(mod.inverse(twist, beta[0]), numeric(robot, sensed, beta[0], twist, q_s)[0],
+                               rtol=1e-9, atol=1e-9)
+    assert mod.forward(q_s.reshape(2, 3, -1), beta.reshape(2, 3, -1)).shape == (2, 3, 3)
+
+
+def test_python_module_consistent_rates_give_the_twist_without_slip(tmp_path):
+    """Rates of a no-slip motion (the inverse of an assignable twist) come back as that twist, residual 0."""
+    robot = ROBOTS["diff-castor"]
+    mod = load_module(write_code(robot, "python", tmp_path)[0])
+    beta = np.array([0.7])
+    twist = np.array([0.3, 0.0, -0.4])  # vy = 0: the fixed wheels' lateral constraint
+    rates = mod.inverse(twist, beta)
+    got, slip = mod.forward_with_residual(rates[:2], beta)
+    np.testing.assert_allclose(got, twist, atol=1e-12)
+    assert slip == pytest.approx(0, abs=1e-12)
+    with pytest.raises(ValueError, match=r"twist: expected shape \(\.\.\., 3\)"):
+        mod.inverse([1.0, 2.0], beta)
+
+
+GCC = shutil.which("gcc")
+
+
+def compile_c(robot: Robot, directory: Path) -> tuple[ctypes.CDLL, str]:
+    header, source = write_code(robot, "c", directory)
+    lib = directory / f"lib{identifier(robot.name)}.so"
+    subprocess.run([GCC, "-O2", "-shared", "-fPIC", "-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror",
+                    "-o", str(lib), str(source), "-lm"], check=True, capture_output=True, text=True)
+    main = directory / "main.c"  # the header alone is enough for a user's program
+    main.write_text(f'#include "{header.name}"\nint main(void) {{ return 0; }}\n')
+    subprocess.run([GCC, "-std=c99", "-Wall", "-Werror", "-fsyntax-only", str(main)], check=True, cwd=directory)
+    return ctypes.CDLL(str(lib)), identifier(robot.name)
+
+
+def _ptr(a: np.ndarray):
+    return np.ascontiguousarray(a, dtype=float).ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+
+@pytest.mark.skipif(GCC is None, reason="gcc not installed")
+@pytest.mark.parametrize("name", list(ALL))
+def test_c_code_equals_numeric_model(name, tmp_path):
+    robot = ALL[name]
+    lib, ident = compile_c(robot, tmp_path)
+    sensed = sensed_rates(robot)
+    beta, twist, q_s = inputs(robot, sensed, seed=1)
+    rates, twist_fw, slip = numeric(robot, sensed, beta, twist, q_s)
+    forward = getattr(lib, f"{ident}_forward")
+    forward.restype = ctypes.c_int
+    n_rows, n_vel = robot.constraint_matrix().shape
+    for k in range(N):
+        b = beta[k] if beta.shape[1] else None
+        a_out, out, tw = np.zeros(n_rows * n_vel), np.zeros(len(robot.rate_names)), np.zeros(3)
+        res = ctypes.c_double(-1.0)
+        getattr(lib, f"{ident}_constraint")(_ptr(b) if b is not None else None, _ptr(a_out))
+        np.testing.assert_allclose(a_out.reshape(n_rows, n_vel), robot.constraint_matrix(beta[k]), atol=1e-12)
+        getattr(lib, f"{ident}_inverse")(_ptr(twist[k]), _ptr(b) if b is not None else None, _ptr(out))
+        np.testing.assert_allclose(out, rates[k], rtol=1e-9, atol=1e-9)
+        status = forward(_ptr(q_s[k]), _ptr(b) if b is not None else None, _ptr(tw), ctypes.byref(res))
+        assert status == 0
+        np.testing.assert_allclose(tw, twist_fw[k], rtol=1e-8, atol=1e-9)
+        assert res.value == pytest.approx(slip[k], rel=1e-8, abs=1e-9)
+
+
+@pytest.mark.skipif(GCC is None, reason="gcc not installed")
+def test_c_forward_reports_a_singular_configuration(tmp_path):
+    """Three castors sensing their spins: with parallel axles the rolling rows lose rank, the twist is undetermined."""
+    robot = _robot("castors", [
+        {"name": f"c{i}", "type": "castor", "l": 0.3, "alpha": f"{a} deg", "d": 0.05, "r": 0.03, "sensed": ["spin"]}
+        for i, a in enumerate((0, 120, 240))])
+    lib, ident = compile_c(robot, tmp_path)
+    forward = getattr(lib, f"{ident}_forward")
+    tw, res = np.zeros(3), ctypes.c_double(0.0)
+    assert forward(_ptr(np.ones(3)), _ptr(np.zeros(3)), _ptr(tw), ctypes.byref(res)) == -1
+    assert np.isnan(tw).all() and math.isnan(res.value)
+    assert forward(_ptr(np.ones(3)), _ptr(np.array([0.0, 1.0, 2.0])), _ptr(tw), None) == 0
+    assert np.isfinite(tw).all()
+
+
+def test_identifiers_and_errors(tmp_path):
+    assert identifier("omni castors") == "omni_castors"
+    assert identifier("3-wheel bot!") == "robot_3_wheel_bot"
+    assert identifier("double") == "double_"
+    with pytest.raises(CodegenError, match="lang: expected 'c' or 'python', got 'rust'"):
+        write_code(ROBOTS["forklift"], "rust", tmp_path)
+    with pytest.raises(CodegenError, match="'vx' is a body velocity"):
+        write_code(ROBOTS["forklift"], "python", tmp_path, sensed=["vx"])
+    double = _robot("double", [  # a double wheel's steering rate is free (3.29): the twist does not fix it
+        {"name": "unit", "type": "double", "position": [0.2, 0], "b": 0.1, "r": 0.05},
+        {"name": "back", "type": "fixed", "position": [-0.2, 0], "beta": "90 deg", "r": 0.05}])
+    with pytest.raises(SingularError, match=r"assigning \(vx, vy, omega\) does not determine \(unit.steer"):
+        write_code(double, "c", tmp_path)
+    with pytest.raises(SingularError, match=r"the sensed rates \(fl.spin, fr.spin\) do not determine"):
+        write_code(ROBOTS["mecanum"], "python", tmp_path, sensed=["fl.spin", "fr.spin"])
