@@ -80,6 +80,19 @@ def test_symbolic_matrix_is_the_numeric_one(robot):
                                    rtol=0, atol=1e-12)
 
 
+@settings(max_examples=10)
+@given(robots(max_wheels=3))
+def test_symbolic_geometry_evaluates_to_the_numeric_matrix(robot):
+    """geometry="symbolic" for every wheel type: substituting the wheels' numbers gives Robot.constraint_matrix."""
+    a = symbolic_constraint_matrix(robot, geometry="symbolic")
+    beta = np.random.default_rng(3).uniform(-math.pi, math.pi, len(robot.steer_names))
+    values = {sym: sp.Float(getattr(robot.wheel(key.split(".")[0]), key.split(".")[1]))
+              for key, sym in geometry_symbols(robot).items()}
+    values.update({sym: sp.Float(v) for sym, v in zip(steering_symbols(robot), beta, strict=True)})
+    np.testing.assert_allclose(np.array(a.xreplace(values).evalf(), dtype=float), robot.constraint_matrix(beta),
+                               rtol=0, atol=1e-12)
+
+
 def test_catalog_forklift_entries_are_exact():
     """Positions [-1, +-0.45], [-2.35, 0] and r = 0.23 appear as exact rationals (3.11), beta 90 deg as pi/2."""
     from wmrkit import catalog
@@ -324,6 +337,11 @@ def test_format_symbolic_differential_drive():
     assert r"\begin{aligned}" in latex
     assert r"v_x &= \frac{1}{40} \dot{\varphi}_{\mathrm{left}} + \frac{1}{40} \dot{\varphi}_{\mathrm{right}}" in latex
     assert r"\omega &=" in latex and r"\dot{\varphi}_{\mathrm{left}}" in latex
+
+
+def test_format_symbolic_says_when_a_set_does_not_determine_the_rest():
+    text = format_symbolic(TRICYCLE, ["vx"])
+    assert "model, assigned: vx" in text and "not determined" in text and "rank A_na = 4 < 5" in text
 
 
 def test_default_assignments():
