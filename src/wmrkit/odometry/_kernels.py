@@ -337,9 +337,10 @@ def odometry_chunk(rates, before, maps, residual, index, pose0, heading, fractio
                 slip[start + j] = bslip[j]
                 max_slip = max(max_slip, bslip[j])
                 sq_slip += bslip[j] * bslip[j]
-        else:
+        else:  # write only where not already 0: fresh zeroed memory stays untouched (no page written)
             for j in range(m):
-                slip[start + j] = 0.0
+                if slip[start + j] != 0.0:
+                    slip[start + j] = 0.0
     return distance, rotation, max_slip, sq_slip
 
 

@@ -104,7 +104,7 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
                 raise LogError(f"{chunk.where(0)}: external heading starts in the middle of the log")
             heading = np.concatenate([prev.heading_world[-1:], chunk.heading_world]) - heading0
         poses = np.empty((n, 3)) if out is None else out.poses[row:row + n]
-        slip = np.empty(n) if out is None else out.slip[row:row + n]
+        slip = np.zeros(n) if out is None else out.slip[row:row + n]
         sums = _compose_chunk(model, chunk.positions, prev.positions[-1], inc, pose, heading, method, poses, slip)
         covs = None
         if cov is not None:
@@ -135,7 +135,8 @@ def odometry(robot: Robot | OdometryModel, log: JointLog, *, method: Method = "e
     """
     model = robot if isinstance(robot, OdometryModel) else odometry_model(robot)
     n = len(log)
-    out = Trajectory(log.time, np.empty((n, 3)), np.empty(n), None if noise is None else np.empty((n, 3, 3)))
+    # slip from calloc: robots without redundant sensors leave it untouched (no page is written)
+    out = Trajectory(log.time, np.empty((n, 3)), np.zeros(n), None if noise is None else np.empty((n, 3, 3)))
     chunks = (log.slice(i, i + chunk_size) for i in range(0, max(n, 1), chunk_size))
     run_odometry(model, chunks, method=method, pose0=pose0, noise=noise, initial_covariance=initial_covariance,
                  out=out)
