@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wmrkit import Robot, SingularError, catalog
+from wmrkit import Robot, SingularError, Wheel, catalog
 from wmrkit.kinematics.codegen import CodegenError, identifier, write_code
 from wmrkit.kinematics.linalg import solve_assigned
 from wmrkit.kinematics.symbolic import sensed_rates
@@ -165,6 +165,18 @@ def test_c_forward_reports_a_singular_configuration(tmp_path):
     assert np.isnan(tw).all() and math.isnan(res.value)
     assert forward(_ptr(np.ones(3)), _ptr(np.array([0.0, 1.0, 2.0])), _ptr(tw), None) == 0
     assert np.isfinite(tw).all()
+
+
+def test_names_that_are_no_identifiers_or_break_comments(tmp_path):
+    """Robot and wheel names end up in identifiers, C comments and Python docstrings: none may break the code."""
+    robot = Robot('3 wheels */ /* """ \\', (  # built directly: description files allow only plain wheel names
+        Wheel('w */"""', "fixed", 0.2, math.pi / 2, math.pi / 2, 0.05, sensed=("spin",)),
+        Wheel("right", "fixed", 0.2, -math.pi / 2, math.pi / 2, 0.05, sensed=("spin",)),
+        Wheel("c/*", "castor", 0.3, math.pi, 0.0, 0.03, d=0.04)))
+    mod = load_module(write_code(robot, "python", tmp_path)[0])
+    assert mod.RATE_NAMES[0] == 'w */""".spin'
+    if GCC is not None:
+        compile_c(robot, tmp_path)
 
 
 def test_identifiers_and_errors(tmp_path):
