@@ -194,3 +194,18 @@ def test_identifiers_and_errors(tmp_path):
         write_code(double, "c", tmp_path)
     with pytest.raises(SingularError, match=r"the sensed rates \(fl.spin, fr.spin\) do not determine"):
         write_code(ROBOTS["mecanum"], "python", tmp_path, sensed=["fl.spin", "fr.spin"])
+
+
+def test_cli_symbolic_and_codegen_end_to_end(capsys, tmp_path):
+    """`wmrkit kinematics forklift --symbolic --codegen python DIR`: closed forms printed, a working module written."""
+    from wmrkit.cli.main import main
+
+    assert main(["kinematics", "forklift", "--symbolic", "--codegen", "python", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "direct model (sensed), assigned: right_drive.spin, left_drive.spin" in out
+    assert "inverse model, assigned: vx" in out
+    mod = load_module(tmp_path / "forklift_kinematics.py")
+    robot = catalog.load("forklift")
+    # straight ahead (steer axle along +y): vx = r phi for both drive wheels, the steered wheel rolls as fast
+    np.testing.assert_allclose(mod.inverse([0.46, 0, 0], robot.beta), [2.0, 2.0, 2.0], atol=1e-12)
+    assert main(["kinematics", "forklift", "--codegen", "python", str(tmp_path / "forklift_kinematics.py")]) == 2
