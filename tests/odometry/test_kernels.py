@@ -20,6 +20,7 @@ from wmrkit import catalog
 from wmrkit.odometry import _kernels
 from wmrkit.odometry.covariance import CrowleyNoise
 from wmrkit.odometry.integrators import integrate_increments, step
+from wmrkit.odometry.logs import JointLog, LogError
 from wmrkit.odometry.model import odometry_model
 from wmrkit.odometry.pipeline import odometry
 from wmrkit.odometry.synthetic import Slip, TwistProfile, simulate
@@ -111,6 +112,20 @@ def test_the_covariance_path_gives_the_same_poses(diff_run):
         with_cov = odometry(robot, log, chunk_size=50, noise=CrowleyNoise())
         np.testing.assert_array_equal(plain.poses, with_cov.poses)
         np.testing.assert_array_equal(plain.slip, with_cov.slip)
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+@pytest.mark.parametrize("noise", [None, CrowleyNoise()], ids=["fused", "model"])
+def test_a_bad_position_after_the_first_chunk_is_named(bad, noise):
+    """The fused path checks positions through the kernel's path length (non-finite exactly when a position
+    is); the message is the same as on the model path."""
+    robot = catalog.load("mecanum-4")
+    joints = odometry_model(robot).joints
+    positions = np.zeros((9, 4))
+    positions[6, 2] = bad
+    log = JointLog(np.arange(9) * 0.1, joints, positions)
+    with pytest.raises(LogError, match=rf"<log>: sample 6: {joints[2]}: value {bad!r} is not a finite number"):
+        odometry(robot, log, chunk_size=4, noise=noise)
 
 
 def test_time_steps_counts_bad_steps_and_finds_the_largest():

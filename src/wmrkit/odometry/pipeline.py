@@ -10,6 +10,7 @@ robots that do not steer, it differences the joint positions itself.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
@@ -94,10 +95,11 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
             if len(chunk) == 0:
                 continue
         n = len(chunk)
-        max_dt = _validate(chunk, prev)
-        # steering robots need the configuration of each interval; others difference the positions in the kernel
-        inc = None if model.constant and cov is None else model.from_positions(chunk.positions,
-                                                                               previous=prev.positions[-1])
+        # steering robots need the configuration of each interval; others difference the positions in the kernel,
+        # whose path length is then finite exactly when the positions are (checked below: one read of them)
+        fused = model.constant and cov is None
+        max_dt = _validate(chunk, prev, positions=not fused)
+        inc = None if fused else model.from_positions(chunk.positions, previous=prev.positions[-1])
         heading = None
         if chunk.heading_world is not None:
             if prev.heading_world is None:
@@ -106,6 +108,8 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
         poses = np.empty((n, 3)) if out is None else out.poses[row:row + n]
         slip = np.zeros(n) if out is None else out.slip[row:row + n]
         sums = _compose_chunk(model, chunk.positions, prev.positions[-1], inc, pose, heading, method, poses, slip)
+        if fused and not math.isfinite(sums[0]):  # a non-finite position makes every body increment NaN or inf
+            _check_finite(chunk)
         covs = None
         if cov is not None:
             dx, dy, dth = (np.zeros(n) if c is None else c for c in (inc.column(0), inc.column(1), inc.column(2)))
@@ -207,14 +211,15 @@ def _fill(out: Trajectory, chunk: Trajectory, row: int) -> None:
         out.covariance[row:stop] = chunk.covariance
 
 
-def _validate(chunk: JointLog, prev: JointLog | None) -> float:
+def _validate(chunk: JointLog, prev: JointLog | None, *, positions: bool = True) -> float:
     """Refuse non-finite values and time that does not increase; the longest time step (from `prev`'s last
-    sample, 0 without steps)."""
+    sample, 0 without steps). `positions=False` leaves the joint positions to the caller."""
     from . import _kernels  # numba loads on first use
 
     t = np.asarray(chunk.time, dtype=float)
     bad, largest = _kernels.time_steps(t, np.empty(0) if prev is None else np.asarray(prev.time[-1:], dtype=float))
-    ok = bool(np.isfinite(chunk.positions.sum()) and np.isfinite(t[0]) and np.isfinite(t[-1]) and bad == 0)
+    ok = bool((not positions or np.isfinite(chunk.positions.sum())) and np.isfinite(t[0]) and np.isfinite(t[-1])
+              and bad == 0)
     if chunk.heading_world is not None:
         ok = ok and bool(np.isfinite(chunk.heading_world.sum()))
     if not ok:  # the slow path finds and names the first bad value
