@@ -10,7 +10,7 @@ from typing import Any
 from .. import catalog
 from ..errors import WmrkitError
 from ..robot import Robot
-from ..units import UnitError, parse_quantity
+from ..units import Kind, UnitError, parse_quantity
 
 
 def add_robot_argument(parser: argparse.ArgumentParser) -> None:
@@ -43,12 +43,17 @@ def _finite(x: Any) -> Any:
     return x
 
 
-def parse_angle(text: str, what: str) -> float:
-    """An angle from the command line: radians, or degrees with a ``deg`` suffix."""
+def parse_value(text: str, kind: Kind, what: str) -> float:
+    """A number from the command line (SI, or with a unit such as ``deg``, ``mm``); errors name the option."""
     try:
-        return parse_quantity(text, "angle")
+        return parse_quantity(text, kind)
     except UnitError as err:
         raise WmrkitError(f"{what}: {err}") from None
+
+
+def parse_angle(text: str, what: str) -> float:
+    """An angle from the command line: radians, or degrees with a ``deg`` suffix."""
+    return parse_value(text, "angle", what)
 
 
 def parse_assignments(items: list[str] | None, what: str) -> dict[str, str]:

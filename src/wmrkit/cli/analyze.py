@@ -6,8 +6,15 @@ import argparse
 
 from ..analysis.summary import analyze
 from ..errors import WmrkitError
-from ..units import UnitError, parse_quantity
-from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_assignments, print_json
+from ._common import (
+    add_json_flag,
+    add_robot_argument,
+    load_robot,
+    parse_angle,
+    parse_assignments,
+    parse_value,
+    print_json,
+)
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -46,10 +53,7 @@ def run(args: argparse.Namespace) -> int:
 def _length(text: str | None) -> float | None:
     if text is None:
         return None
-    try:
-        value = parse_quantity(text, "length")
-    except UnitError as err:
-        raise WmrkitError(f"--length: {err}") from None
+    value = parse_value(text, "length", "--length")
     if not value > 0:
         raise WmrkitError(f"--length: must be > 0, got {text}")
     return value

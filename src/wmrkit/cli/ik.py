@@ -8,11 +8,18 @@ import sys
 
 import numpy as np
 
-from ..errors import WmrkitError
 from ..kinematics.wheel_ik import WheelCommands, forward_kinematics, twist_is_determined, wheel_commands
 from ..robot import Robot
 from ..units import UnitError, parse_quantity
-from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_assignments, print_json
+from ._common import (
+    add_json_flag,
+    add_robot_argument,
+    load_robot,
+    parse_angle,
+    parse_assignments,
+    parse_value,
+    print_json,
+)
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -61,7 +68,8 @@ def run_ik(args: argparse.Namespace) -> int:
 def run_fk(args: argparse.Namespace) -> int:
     """Print the twist and the slip residual; warn on stderr when the rates do not fix the twist."""
     robot = _steered(load_robot(args.robot), args.steer)
-    rates = {name: _rate(name, value) for name, value in parse_assignments(args.spin, "--spin").items()}
+    given = parse_assignments(args.spin, "--spin")
+    rates = {name: parse_value(value, "number", f"--spin {name}") for name, value in given.items()}
     twist, residual = forward_kinematics(robot, rates)
     if not twist_is_determined(robot, list(rates)):
         print(f"wmrkit: warning: these rates do not determine the twist of robot '{robot.name}'; "
@@ -79,13 +87,6 @@ def _finite(text: str) -> float:
         return parse_quantity(text, "number")
     except UnitError as err:
         raise argparse.ArgumentTypeError(str(err)) from None
-
-
-def _rate(name: str, value: str) -> float:
-    try:
-        return parse_quantity(value, "number")
-    except UnitError as err:
-        raise WmrkitError(f"--spin {name}: {err}") from None
 
 
 def format_commands(robot: Robot, commands: WheelCommands) -> str:

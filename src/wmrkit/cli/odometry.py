@@ -14,8 +14,15 @@ from ..odometry.integrators import METHODS
 from ..odometry.logs import TIME_UNITS, LogFormat
 from ..odometry.model import odometry_model
 from ..odometry.pipeline import OdometrySummary
-from ..units import UnitError, parse_quantity
-from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_assignments, print_json
+from ._common import (
+    add_json_flag,
+    add_robot_argument,
+    load_robot,
+    parse_angle,
+    parse_assignments,
+    parse_value,
+    print_json,
+)
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -75,29 +82,20 @@ def run(args: argparse.Namespace) -> int:
                     columns=tuple(parse_assignments(args.column, "--column").items()), spin=args.spin,
                     steer=args.steer, encoders=encoders, heading_column=args.heading_column,
                     gyro_column=args.gyro_column, max_gap=args.max_gap)
-    pose0 = [_length(args.pose[0], "--pose X"), _length(args.pose[1], "--pose Y"), parse_angle(args.pose[2], "--pose")]
+    pose0 = [parse_value(args.pose[0], "length", "--pose X"), parse_value(args.pose[1], "length", "--pose Y"),
+             parse_angle(args.pose[2], "--pose")]
     summary = odometry_file(
         robot, args.log, fmt=fmt, method=args.method, pose0=pose0, sensed=args.sensed,
         noise=CrowleyNoise(*args.crowley) if args.covariance else None, out=args.out, out_format=args.out_format,
         plot=args.plot, progress=not args.quiet and sys.stderr.isatty(), chunk_size=args.chunk_size,
         topic=args.topic, joint_names=parse_assignments(args.joint_name, "--joint-name"),
-        weights={w: _number(v, f"--weight {w}") for w, v in parse_assignments(args.weight, "--weight").items()})
+        weights={w: parse_value(v, "number", f"--weight {w}")
+                 for w, v in parse_assignments(args.weight, "--weight").items()})
     print_json(summary.to_dict()) if args.json else print(format_summary(summary))
     return 0
 
 
-def _number(text: str, what: str) -> float:
-    try:
-        return parse_quantity(text, "number")
-    except UnitError as err:
-        raise WmrkitError(f"{what}: {err}") from None
 
-
-def _length(text: str, what: str) -> float:
-    try:
-        return parse_quantity(text, "length")
-    except UnitError as err:
-        raise WmrkitError(f"{what}: {err}") from None
 
 
 def format_summary(s: OdometrySummary) -> str:
