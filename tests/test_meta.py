@@ -81,3 +81,15 @@ def test_ruff_clean():
     ruff = shutil.which("ruff") or str(Path(sys.executable).with_name("ruff"))
     out = subprocess.run([ruff, "check", "src", "tests", "benchmarks"], cwd=ROOT, capture_output=True, text=True)
     assert out.returncode == 0, out.stdout + out.stderr
+
+
+def test_every_test_cited_by_the_errata_exists():
+    """Each erratum names the test that proves the correction: that test must exist."""
+    text = (ROOT / "docs" / "errata.md").read_text()
+    cited = sorted(set(re.findall(r"(tests/[\w/]+\.py)::(\w+)", text)))
+    assert len(cited) > 30
+    def defined(path: str, name: str) -> bool:
+        return (ROOT / path).exists() and re.search(rf"^def {name}\b", (ROOT / path).read_text(), re.M) is not None
+
+    missing = [f"{path}::{name}" for path, name in cited if not defined(path, name)]
+    assert missing == []
