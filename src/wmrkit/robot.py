@@ -10,7 +10,7 @@ from __future__ import annotations
 import functools
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike
 
 from ._shapes import as_vectors, readonly
 from .errors import ShapeError, UnknownNameError
-from .wheels import Wheel, generic_slip_rows, generic_wheel_jacobian, rotate_rows_to_robot
+from .wheels import Wheel, generic_wheel_jacobian, rotate_rows_to_robot
 
 TWIST_NAMES = ("vx", "vy", "omega")
 
@@ -30,6 +30,17 @@ class Robot:
     name: str
     wheels: tuple[Wheel, ...]
     notes: str = ""
+    _hash: int = field(default=0, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        # Hashed once: derived arrays are cached per robot (keyed by it) and looked up on every batched call.
+        object.__setattr__(self, "_hash", hash((self.name, self.wheels, self.notes)))
+
+    def __hash__(self) -> int:
+        return self._hash
+
+    def __reduce__(self) -> tuple:
+        return (Robot, (self.name, self.wheels, self.notes))  # rebuilt, so the hash is this process's
 
     # ---- names -------------------------------------------------------------------------------------------
     @property
@@ -108,16 +119,18 @@ class Robot:
         ``frame="roller"`` gives each wheel's rows along its roller axes (3.6), ``"robot"`` in the robot frame
         (3.5); the two differ by a rotation per wheel, so ranks, null spaces and least squares agree.
         """
-        t = _table(self)
-        beta_e = _element_beta(self, t, beta)
-        g = generic_slip_rows(beta_e, t.l, t.alpha, t.d, t.delta, t.gamma, t.r, t.r_r)  # (..., E, 2, 6)
-        if frame == "robot":
-            g = rotate_rows_to_robot(g, beta_e + t.delta + t.gamma)
-        elif frame != "roller":
+        from ._constraint_kernel import fill_constraint_rows
+
+        if frame not in ("roller", "robot"):
             raise ValueError(f"frame must be 'roller' or 'robot', got {frame!r}")
-        a = np.empty((*g.shape[:-1], 3 + t.n_rates))  # one allocation: large batches are memory-bound
-        a[..., :3] = g[..., :3]
-        np.matmul(g[..., 3:], t.rate_map, out=a[..., 3:])  # wheel-rate columns, (..., E, 2, n_rates)
+        t = _table(self)
+        beta_e = _element_beta(self, t, beta)  # (..., E)
+        flat = beta_e.reshape(-1, t.n_elements)
+        a = np.empty((flat.shape[0], t.n_elements, 2, 3 + t.n_rates))
+        fill_constraint_rows(flat, t.l, t.alpha, t.d, t.delta, t.gamma, t.r, t.r_r, t.rate_map, a)
+        a = a.reshape(*beta_e.shape, 2, 3 + t.n_rates)
+        if frame == "robot":
+            a = rotate_rows_to_robot(a, beta_e + t.delta + t.gamma)
         return a.reshape(*a.shape[:-3], 2 * t.n_elements, 3 + t.n_rates)
 
     def slip_velocity(self, q_dot: ArrayLike, beta: ArrayLike | None = None) -> np.ndarray:

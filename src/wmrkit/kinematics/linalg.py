@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numpy.typing import ArrayLike
+from scipy.linalg import lapack
 
 #: Relative tolerance on singular values for numeric rank (times the largest singular value and the size).
 RANK_RTOL = 1e-9
@@ -53,7 +56,7 @@ def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike) -> 
     a_na, a_a = a[..., free], a[..., assigned]
     if a.ndim == 2 and len(free) and len(assigned):  # one matrix: LAPACK least squares on every right-hand
         rhs = -(a_a @ q_assigned.reshape(-1, len(assigned)).T)  # side at once; same minimum-norm solution, ~1.7x faster
-        q_na = np.linalg.lstsq(a_na, rhs, rcond=None)[0].T.reshape(*q_assigned.shape[:-1], len(free))
+        q_na = _min_norm_lstsq(a_na, rhs).T.reshape(*q_assigned.shape[:-1], len(free))
     else:
         rhs = -(a_a @ q_assigned[..., None])
         q_na = (np.linalg.pinv(a_na) @ rhs)[..., 0]
@@ -100,3 +103,25 @@ def rref(m: ArrayLike, *, rtol: float = RANK_RTOL) -> tuple[np.ndarray, np.ndarr
         pivots[b, j] = True
         next_row[b] += 1
     return out.reshape(m.shape), pivots.reshape(*m.shape[:-2], n_cols)
+
+
+def _min_norm_lstsq(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Minimum-norm least-squares solution of ``a x = b`` for one matrix, ``(r, c), (r, p) -> (c, p)``.
+
+    LAPACK ``dgelsy`` (complete orthogonal factorisation with column pivoting): the same solution as
+    ``numpy.linalg.lstsq`` with numpy's default cutoff, and about twice as fast on the small matrices of a robot.
+    """
+    rows, cols = a.shape
+    rcond = np.finfo(float).eps * max(rows, cols)
+    rhs = np.zeros((max(rows, cols), b.shape[1]), order="F")
+    rhs[:rows] = b
+    lwork = _gelsy_lwork(rows, cols, b.shape[1])
+    _, x, _, _, info = lapack.dgelsy(a, rhs, np.zeros(cols, dtype=np.int32), rcond, lwork=lwork)
+    if info != 0:  # pragma: no cover - LAPACK argument errors are bugs
+        raise RuntimeError(f"dgelsy failed with info = {info}")
+    return x[:cols]
+
+
+@functools.cache
+def _gelsy_lwork(rows: int, cols: int, nrhs: int) -> int:
+    return int(lapack.dgelsy_lwork(rows, cols, nrhs, np.finfo(float).eps)[0])

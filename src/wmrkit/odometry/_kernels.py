@@ -21,12 +21,12 @@ use libm, as do chord factors of steps turning more than ``pi/2``.
 
 from __future__ import annotations
 
-import functools
 import math
-from collections.abc import Callable
 
 import numba
 import numpy as np
+
+from .._jit import jit as _jit
 
 #: Samples per block: a dozen block buffers take about 25 KB.
 BLOCK = 256
@@ -45,31 +45,6 @@ _P1, _P2, _P3 = 1.57079632673412561417e+00, 6.07710050630396597660e-11, 2.022266
 _P3T = 8.47842766036889956997e-32
 _INV_PIO2 = 6.36619772367581382433e-01
 _ROUND = 6755399441055744.0  # 1.5 * 2^52: (x + _ROUND) - _ROUND rounds x to the nearest integer
-
-
-def _jit(signature) -> Callable[[Callable], Callable]:
-    """Compile the decorated function for `signature` on its first call; ``.py_func`` is the Python source."""
-    def decorate(fn: Callable) -> Callable:
-        compiled = None
-
-        @functools.wraps(fn)
-        def call(*args):
-            nonlocal compiled
-            if compiled is None:
-                compiled = _compile(fn, signature)
-            return compiled(*args)
-
-        call.py_func = fn
-        return call
-    return decorate
-
-
-def _compile(fn: Callable, signature) -> Callable:
-    """``numba.njit`` cached on disk when a cache directory is writable, else in memory only."""
-    try:
-        return numba.njit(signature, cache=True)(fn)
-    except RuntimeError:  # numba: "cannot cache function ...: no locator available for file ..."
-        return numba.njit(signature)(fn)
 
 
 _IN = numba.types.Array(numba.float64, 2, "A", readonly=True)  # inputs: any strides, read-only accepted
