@@ -9,11 +9,10 @@ from ..errors import WmrkitError
 from ._common import (
     add_json_flag,
     add_robot_argument,
-    load_robot,
-    parse_angle,
-    parse_assignments,
+    add_steer_option,
     parse_value,
     print_json,
+    steered_robot,
 )
 
 
@@ -22,8 +21,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = commands.add_parser(
         "analyze", help="vehicle type, mobility, actuation/sensing, condition number, singularities (ch. 5-6)")
     add_robot_argument(p)
-    p.add_argument("--steer", action="append", metavar="NAME=ANGLE", default=[],
-                   help="steering angle of a wheel: radians, or degrees with 'deg' (repeatable)")
+    add_steer_option(p)
     p.add_argument("--length", metavar="D", help="characteristic length of the condition number, e.g. 0.3 or "
                    "'300 mm' (default: the natural length, which minimises it)")
     p.add_argument("--report", metavar="DIR", help="write an HTML report with pictures to DIR/index.html")
@@ -35,8 +33,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print the analysis; write the report with --report."""
-    pairs = parse_assignments(args.steer, "--steer")
-    robot = load_robot(args.robot).with_steering({n: parse_angle(v, f"--steer {n}") for n, v in pairs.items()})
+    robot = steered_robot(args.robot, args.steer)
     if args.resolution < 8:
         raise WmrkitError(f"--resolution: need at least 8 points per turn, got {args.resolution}")
     result = analyze(robot, length=_length(args.length), resolution=args.resolution)

@@ -14,11 +14,11 @@ from ..units import UnitError, parse_quantity
 from ._common import (
     add_json_flag,
     add_robot_argument,
-    load_robot,
-    parse_angle,
+    add_steer_option,
     parse_assignments,
     parse_value,
     print_json,
+    steered_robot,
 )
 
 
@@ -28,7 +28,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     add_robot_argument(p)
     p.add_argument("--twist", nargs=3, type=_finite, required=True, metavar=("VX", "VY", "OMEGA"),
                    help="body twist: vx, vy [m/s], omega [rad/s] (x forward, y left)")
-    _add_steer(p, "current steering angle of a wheel (default: as described); the closest solution is kept")
+    add_steer_option(p, "current steering angle of a wheel (default: as described); the closest solution is kept")
     add_json_flag(p)
     p.set_defaults(run=run_ik)
 
@@ -36,25 +36,14 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     add_robot_argument(p)
     p.add_argument("--spin", action="append", metavar="NAME=RATE", default=[],
                    help="a joint rate [rad/s]: a wheel name means its spin, or 'wheel.joint' (repeat)")
-    _add_steer(p, "steering angle of a wheel (default: as described)")
+    add_steer_option(p, "steering angle of a wheel (default: as described)")
     add_json_flag(p)
     p.set_defaults(run=run_fk)
 
 
-def _add_steer(p: argparse.ArgumentParser, text: str) -> None:
-    p.add_argument("--steer", action="append", metavar="NAME=ANGLE", default=[],
-                   help=f"{text}; radians, or degrees with 'deg' (repeat)")
-
-
-def _steered(robot: Robot, items: list[str]) -> Robot:
-    given = parse_assignments(items, "--steer")
-    angles = {name: parse_angle(value, f"--steer {name}") for name, value in given.items()}
-    return robot.with_steering(angles)
-
-
 def run_ik(args: argparse.Namespace) -> int:
     """Print the per-wheel commands; warn on stderr when the twist makes a fixed wheel slip."""
-    robot = _steered(load_robot(args.robot), args.steer)
+    robot = steered_robot(args.robot, args.steer)
     commands = wheel_commands(robot, args.twist)
     if not commands.feasible:
         worst = int(np.argmax(np.abs(commands.slip)))
@@ -67,7 +56,7 @@ def run_ik(args: argparse.Namespace) -> int:
 
 def run_fk(args: argparse.Namespace) -> int:
     """Print the twist and the slip residual; warn on stderr when the rates do not fix the twist."""
-    robot = _steered(load_robot(args.robot), args.steer)
+    robot = steered_robot(args.robot, args.steer)
     given = parse_assignments(args.spin, "--spin")
     rates = {name: parse_value(value, "number", f"--spin {name}") for name, value in given.items()}
     twist, residual = forward_kinematics(robot, rates)

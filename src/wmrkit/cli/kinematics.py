@@ -6,7 +6,13 @@ import argparse
 
 from ..errors import WmrkitError
 from ..kinematics.summary import format_kinematics_summary, kinematics_summary
-from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_assignments, print_json
+from ._common import (
+    add_json_flag,
+    add_robot_argument,
+    add_steer_option,
+    print_json,
+    steered_robot,
+)
 
 CODEGEN_LANGUAGES = ("c", "python")
 
@@ -16,8 +22,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = commands.add_parser(
         "kinematics", help="mobility, assignable sets, direct/inverse models, actuation and sensing (ch. 4)")
     add_robot_argument(p)
-    p.add_argument("--steer", action="append", metavar="NAME=ANGLE",
-                   help="steering angle of a wheel: radians, or degrees with 'deg' (repeatable)")
+    add_steer_option(p)
     add_json_flag(p)
     p.add_argument("--symbolic", action="store_true", help="also print the closed-form models (sympy)")
     p.add_argument("--codegen", nargs=2, metavar=("LANG", "DIR"),
@@ -27,8 +32,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print the chapter-4 summary; --symbolic and --codegen add closed forms and generated files."""
-    pairs = parse_assignments(args.steer, "--steer")
-    robot = load_robot(args.robot).with_steering({n: parse_angle(v, f"--steer {n}") for n, v in pairs.items()})
+    robot = steered_robot(args.robot, args.steer)
     summary = kinematics_summary(robot)
     if args.symbolic:
         from ..kinematics.symbolic import format_symbolic
