@@ -9,6 +9,7 @@ import pytest
 from scipy.optimize import brentq
 from thesis_vehicles import DEG, differential, omni_castor, omni_swedish, type3
 
+from circle import assert_same_angles
 from wmrkit import UnknownNameError, catalog
 from wmrkit.analysis.isotropy import (
     condition_map,
@@ -133,7 +134,7 @@ def test_differential_castor_5_58():
     roots = np.sort(_roots(lambda b: math.sin(b) * (l3 * math.sin(b - a3) - d) + c2))
     np.testing.assert_allclose(np.degrees(roots), [-74.774, -6.428, 85.767, 175.435], atol=1e-3)
     got = isotropic_configurations(_castor_diff(r1, d), joints=("f1.spin", "c3.steer"))
-    np.testing.assert_allclose(np.sort([c.beta[0] for c in got]), roots, atol=1e-8)
+    assert_same_angles([c.beta[0] for c in got], roots, tol=1e-8)
     lengths = {round(math.degrees(c.beta[0]), 3): c.length for c in got}
     for b, d4 in zip(np.degrees(roots), [0.1727, 1.4887, 0.1671, 2.0943], strict=True):
         assert lengths[round(b, 3)] == pytest.approx(d4, abs=1e-4)
@@ -224,14 +225,14 @@ def test_type3_swedish_5_65b():
         assert isotropy_length(r, None, q_a, ("vx", "omega")) == pytest.approx((1.8174, 1.0), abs=1e-4)
         assert natural_length(r, joints=q_a)[1] == pytest.approx(1.0, abs=1e-9)  # same condition, another D
     got = isotropic_configurations(type3(beta1=0.0, **base), joints=("s2.spin", "s3.spin"))
-    np.testing.assert_allclose(np.sort([c.beta[0] for c in got]), roots, atol=1e-9)
+    assert_same_angles([c.beta[0] for c in got], roots, tol=1e-9)
 
 
 def test_type3_swedish_5_65a():
     """q_a = (phi_1, phi_2): the orientable wheel perpendicular to Swedish wheel 2, beta1 = beta2 +- 90 deg."""
     r = type3(beta1=0.0, beta2=0.4)
-    got = np.sort([c.beta[0] for c in isotropic_configurations(r, joints=("o1.spin", "s2.spin"))])
-    np.testing.assert_allclose(got, np.sort(np.angle(np.exp(1j * (0.4 + np.array([-1, 1]) * np.pi / 2)))), atol=1e-9)
+    got = [c.beta[0] for c in isotropic_configurations(r, joints=("o1.spin", "s2.spin"))]
+    assert_same_angles(got, 0.4 + np.array([-1, 1]) * np.pi / 2, tol=1e-9)
 
 
 @pytest.mark.parametrize("q_a", ["a1", "a2", "a3", "a4", "a5", "a6"])

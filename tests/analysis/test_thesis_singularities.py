@@ -11,6 +11,7 @@ import pytest
 from scipy.optimize import brentq
 from thesis_vehicles import DEG, bicycle, differential, tricycle, type3, type5
 
+from circle import same_angles as _same_angles
 from wmrkit.analysis.icr import icr
 from wmrkit.analysis.singularity import is_singular, is_singular_rank, singular_set
 
@@ -30,9 +31,11 @@ def _roots(f, n: int = 2880) -> np.ndarray:
     return x
 
 
-def _same_angles(a, b, tol=1e-7) -> bool:
-    a, b = np.sort(np.asarray(a)), np.sort(np.asarray(b))
-    return len(a) == len(b) and bool(np.all(np.abs(np.angle(np.exp(1j * (a - b)))) < tol))
+def test_same_angles_is_a_comparison_on_the_circle():
+    assert _same_angles([0.0, np.pi], [-np.pi, 0.0])  # the fresh-clone failure of issue 8
+    assert _same_angles([3.0, -1.0], [-1.0, 3.0 - 2 * np.pi])
+    assert not _same_angles([0.0, np.pi], [0.0, 0.5])
+    assert not _same_angles([0.0, 0.0], [0.0, 1.0])
 
 
 def check(robot, assigned, var, f):
