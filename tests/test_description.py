@@ -41,7 +41,7 @@ wheels:
     r: 0.05
     r_r: 0.01
 """
-TYPES = ", ".join(KINDS)
+TYPES = ", ".join((*KINDS, "mecanum"))
 LENGTHS = "m, mm, cm, dm, km, in, ft"
 
 # (find, replace with, expected 1-based line, expected message after "file:line: "); BASE's lines counted by hand

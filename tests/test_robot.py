@@ -80,8 +80,8 @@ def test_with_beta_and_with_steering():
     np.testing.assert_array_equal(r.beta, [0.2, 0.1, -0.3])  # the original is unchanged
     assert [w.beta for w in moved.wheels if not w.kind.steers] == [w.beta for w in r.wheels if not w.kind.steers]
     np.testing.assert_allclose(moved.constraint_matrix(), r.constraint_matrix(beta), rtol=0, atol=0)
-    assert r.with_steering({"dw": -2.0, "c": 1.0, "st": 0.5}) == moved
-    assert r.with_steering({}) == r
+    assert r.with_beta_angles({"dw": -2.0, "c": 1.0, "st": 0.5}) == moved
+    assert r.with_steering({}) == r == r.with_beta_angles({})
     with pytest.raises(ShapeError, match=r"^beta: expected shape \(\.\.\., 3\), got \(2,\)$"):
         r.with_beta([0.0, 0.0])
     with pytest.raises(ShapeError, match="one configuration"):
@@ -154,3 +154,35 @@ def test_robot_without_steering_takes_empty_beta():
     np.testing.assert_array_equal(r.constraint_matrix(np.zeros((4, 0)))[2], r.constraint_matrix())
     # differential drive (STYLE rule 5): (vx, omega) = (1, 0.5) needs spins 18 (left) and 22 (right) rad/s
     np.testing.assert_allclose(r.constraint_matrix() @ [1.0, 0.0, 0.5, 18.0, 22.0], 0, atol=1e-12)
+
+
+def test_heading_is_the_rolling_direction():
+    """Heading (users' steering angle, 0 = straight ahead): a forward spin moves the wheel's mount along it."""
+    r = _mixed()
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        heading = rng.uniform(-np.pi, np.pi, 3)
+        steered = r.with_steering(dict(zip(r.steer_names, heading, strict=True)))
+        np.testing.assert_allclose(np.angle(np.exp(1j * (steered.heading - heading))), 0, atol=1e-12)
+        np.testing.assert_allclose(steered.beta, r.beta_of_heading(heading), atol=0)
+        np.testing.assert_allclose(r.constraint_matrix(heading=heading), steered.constraint_matrix(), atol=0)
+    # independent of the conversion: the rolling row (3.11) of a centred steerable wheel at the origin says a pure
+    # translation along the heading needs spin r*phi_dot = speed, and one across it slips sideways.
+    wheel = {"name": "w", "type": "steerable", "position": [0, 0], "r": 0.1}
+    for h in (0.0, 0.5, -2.0, np.pi):
+        bot = Robot.from_dict({"name": "one", "wheels": [{**wheel, "heading": float(h)}]})
+        along = np.array([np.cos(h), np.sin(h), 0.0, 1 / 0.1])  # v along the heading, phi_dot = v / r
+        np.testing.assert_allclose(bot.constraint_matrix() @ along, 0, atol=1e-12)
+        across = np.array([-np.sin(h), np.cos(h), 0.0, 0.0])
+        assert np.linalg.norm(bot.constraint_matrix() @ across) > 0.99
+    with pytest.raises(ShapeError, match="not both"):
+        r.constraint_matrix([0.0, 0.0, 0.0], heading=[0.0, 0.0, 0.0])
+
+
+def test_castor_heading_follows_its_axle():
+    """A castor's heading is its wheel's rolling direction, beta + delta - 90 deg (docs/conventions.md)."""
+    c = Robot.from_dict({"name": "c", "wheels": [{"name": "c", "type": "castor", "position": [0, 0], "d": 0.05,
+                                                  "delta": "20 deg", "heading": "30 deg", "r": 0.1}]})
+    w = c.wheels[0]
+    assert np.degrees(w.beta) == pytest.approx(30 - 20 + 90)
+    assert np.degrees(w.heading) == pytest.approx(30)

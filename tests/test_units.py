@@ -42,7 +42,22 @@ def test_any_number_with_any_unit(x, data):
     unit = data.draw(st.sampled_from(sorted(FACTORS[kind])))
     text = data.draw(st.sampled_from(["{}{}", "{} {}", " {}  {} "])).format(repr(x), unit)
     assert parse_quantity(text, kind) == pytest.approx(x * FACTORS[kind][unit], rel=1e-15, abs=1e-300)
-    assert parse_quantity(x, kind) == x  # a plain number is SI
+    if kind == "length" or abs(x) <= 2 * math.pi:
+        assert parse_quantity(x, kind) == x  # a plain number is SI
+    else:  # a bare angle beyond a turn is refused (issue 8: "beta: 90" read as 90 rad)
+        with pytest.raises(UnitError, match="more than a turn"):
+            parse_quantity(x, kind)
+
+
+@pytest.mark.parametrize("value", [90, "90", -60, "7", 6.3, "1e3"])
+def test_a_bare_angle_beyond_a_turn_suggests_degrees(value):
+    with pytest.raises(UnitError, match=r"write '-?[\d.e+]+ deg' for degrees"):
+        parse_quantity(value, "angle")
+
+
+@pytest.mark.parametrize("value", [6.28, -6.28, "1.5", "-3.14", "90 deg", "400 rad", "-720 deg"])
+def test_angles_within_a_turn_or_with_a_unit_are_read(value):
+    assert math.isfinite(parse_quantity(value, "angle"))
 
 
 @pytest.mark.parametrize(("value", "kind", "message"), [

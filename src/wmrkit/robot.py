@@ -17,6 +17,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._shapes import as_vectors, readonly
+from .couplings import Coupling
+from .dynamics.mass import Body
 from .errors import ShapeError, UnknownNameError
 from .wheels import Wheel, generic_wheel_jacobian, rotate_rows_to_robot
 
@@ -30,17 +32,20 @@ class Robot:
     name: str
     wheels: tuple[Wheel, ...]
     notes: str = ""
+    couplings: tuple[Coupling, ...] = ()  # mechanical couplings between joints (wmrkit.couplings)
+    body: Body | None = None  # mass properties of the vehicle* (wmrkit.dynamics.mass), None when not described
     _hash: int = field(default=0, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         # Hashed once: derived arrays are cached per robot (keyed by it) and looked up on every batched call.
-        object.__setattr__(self, "_hash", hash((self.name, self.wheels, self.notes)))
+        object.__setattr__(self, "_hash", hash((self.name, self.wheels, self.notes, self.couplings, self.body)))
 
     def __hash__(self) -> int:
         return self._hash
 
     def __reduce__(self) -> tuple:
-        return (Robot, (self.name, self.wheels, self.notes))  # rebuilt, so the hash is this process's
+        # rebuilt: the hash is this process's
+        return (Robot, (self.name, self.wheels, self.notes, self.couplings, self.body))
 
     # ---- names -------------------------------------------------------------------------------------------
     @property
@@ -76,6 +81,37 @@ class Robot:
         return readonly(np.array([w.beta for w in self.wheels if w.kind.steers], dtype=float))
 
     @property
+    def heading(self) -> np.ndarray:
+        """The described steering configuration as headings (rolling directions, 0 = forward) ``(n_steer,)``."""
+        return self.heading_of_beta(self.beta)
+
+    def heading_of_beta(self, beta: ArrayLike) -> np.ndarray:
+        """Headings of the steering wheels from the thesis's β: ``(..., n_steer) -> (..., n_steer)`` [rad]."""
+        from .wheels import heading_from_beta
+
+        beta = as_vectors(beta, len(self.steer_names), "beta")
+        return heading_from_beta(beta, _steer_delta(self))
+
+    def steering(self, beta: ArrayLike | None = None, heading: ArrayLike | None = None) -> np.ndarray | None:
+        """The thesis's β from either keyword: `beta` as is, `heading` converted; None when neither is given.
+
+        Every function that takes a steering configuration accepts ``heading=`` (the users' angle, 0 = rolling
+        forward) as well as ``beta=`` (the thesis's angle); giving both is an error.
+        """
+        if heading is None:
+            return beta if beta is None else as_vectors(beta, len(self.steer_names), "beta")
+        if beta is not None:
+            raise ShapeError("give the steering configuration as beta (thesis) or heading (rolling direction), not both")
+        return self.beta_of_heading(heading)
+
+    def beta_of_heading(self, heading: ArrayLike) -> np.ndarray:
+        """The thesis's β of the steering wheels from headings: ``(..., n_steer) -> (..., n_steer)`` [rad]."""
+        from .wheels import beta_from_heading
+
+        heading = as_vectors(heading, len(self.steer_names), "heading")
+        return beta_from_heading(heading, _steer_delta(self))
+
+    @property
     def actuated(self) -> tuple[str, ...]:
         """Actuated joints, qualified ``wheel.joint``."""
         return tuple(f"{w.name}.{j}" for w in self.wheels for j in w.actuated)
@@ -102,20 +138,35 @@ class Robot:
         angles = iter(beta.tolist())
         return replace(self, wheels=tuple(w.with_beta(next(angles)) if w.kind.steers else w for w in self.wheels))
 
-    def with_steering(self, angles: Mapping[str, float]) -> Robot:
-        """The same robot with the named wheels steered to the given angles [rad]."""
-        for name in angles:
+    def with_steering(self, headings: Mapping[str, float]) -> Robot:
+        """The same robot with the named wheels steered to the given headings [rad] (0 = rolling forward, +x).
+
+        The users' convention (WPILib, ROS 2); :meth:`with_beta_angles` takes the thesis's β instead.
+        """
+        self._check_steers(headings)
+        return replace(self, wheels=tuple(w.with_heading(headings[w.name]) if w.name in headings else w
+                                          for w in self.wheels))
+
+    def with_beta_angles(self, angles: Mapping[str, float]) -> Robot:
+        """The same robot with the named wheels at the thesis's steering angles β [rad]."""
+        self._check_steers(angles)
+        return replace(self, wheels=tuple(w.with_beta(angles[w.name]) if w.name in angles else w for w in self.wheels))
+
+    def _check_steers(self, names: Mapping[str, float]) -> None:
+        for name in names:
             if self.wheel(name).kind.steers is False:
                 raise UnknownNameError(f"wheel '{name}' of robot '{self.name}' does not steer")
-        return replace(self, wheels=tuple(w.with_beta(angles[w.name]) if w.name in angles else w for w in self.wheels))
 
     # ---- composite equations -----------------------------------------------------------------------------
     def constraint_matrix(
-        self, beta: ArrayLike | None = None, *, frame: Literal["roller", "robot"] = "roller"
+        self, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None,
+        frame: Literal["roller", "robot"] = "roller",
     ) -> np.ndarray:
         """The slip matrix ``A`` of eq. (3.22): ``v_slip = A @ q_dot``; no slip is ``A @ q_dot = 0`` (3.23).
 
-        ``(..., n_steer) -> (..., 2 * n_contacts, 3 + n_rates)``; columns named by ``velocity_names``.
+        ``(..., n_steer) -> (..., 2 * n_contacts, 3 + n_rates)``; columns named by ``velocity_names``. The
+        steering configuration is the thesis's `beta` or the users' `heading` (see :meth:`steering`); default the
+        described one.
         ``frame="roller"`` gives each wheel's rows along its roller axes (3.6), ``"robot"`` in the robot frame
         (3.5); the two differ by a rotation per wheel, so ranks, null spaces and least squares agree.
         """
@@ -124,7 +175,7 @@ class Robot:
         if frame not in ("roller", "robot"):
             raise ValueError(f"frame must be 'roller' or 'robot', got {frame!r}")
         t = _table(self)
-        beta_e = _element_beta(self, t, beta)  # (..., E)
+        beta_e = _element_beta(self, t, self.steering(beta, heading))  # (..., E)
         flat = beta_e.reshape(-1, t.n_elements)
         a = np.empty((flat.shape[0], t.n_elements, 2, 3 + t.n_rates))
         fill_constraint_rows(flat, t.l, t.alpha, t.d, t.delta, t.gamma, t.r, t.r_r, t.rate_map, a)
@@ -180,6 +231,11 @@ class Robot:
         from .description import save_robot_file
 
         save_robot_file(self, path)
+
+
+@functools.lru_cache(maxsize=256)
+def _steer_delta(robot: Robot) -> np.ndarray:
+    return readonly(np.array([w.delta for w in robot.wheels if w.kind.steers], dtype=float))
 
 
 @dataclass(frozen=True, eq=False)

@@ -30,7 +30,8 @@ def parse_quantity(value: object, kind: Kind) -> float:
     """Return `value` in SI units (m or rad) as a finite float.
 
     Accepts ints, floats and strings such as ``"90 deg"``, ``"250 mm"``, ``"-0.5rad"``, ``"1e-3"``.
-    Raises :class:`UnitError` for booleans, NaN, infinities, unknown units and units of the wrong kind.
+    Raises :class:`UnitError` for booleans, NaN, infinities, unknown units and units of the wrong kind, and for
+    a bare angle (no unit, so radians) beyond a turn, ``|angle| > 2 pi``: almost surely degrees written bare.
     """
     if isinstance(value, bool):
         raise UnitError(f"expected {_a(kind)}, got a boolean")
@@ -49,7 +50,22 @@ def parse_quantity(value: object, kind: Kind) -> float:
         raise UnitError(f"expected {_a(kind)}, got {type(value).__name__}")
     if not math.isfinite(number * factor):  # "1e308 km" overflows only in SI
         raise UnitError(f"must be finite, got {value!r}")
+    if kind == "angle" and _bare(value) and abs(number) > BARE_ANGLE_LIMIT:
+        raise UnitError(f"a bare angle is read in radians, and {_plain(number)} rad is more than a turn: "
+                        f"write '{_plain(number)} deg' for degrees (or '{_plain(number)} rad' if you mean it)")
     return number * factor
+
+
+#: A bare angle (no unit: radians) beyond this is refused as probably degrees [rad].
+BARE_ANGLE_LIMIT = 2 * math.pi
+
+
+def _bare(value: object) -> bool:
+    return not isinstance(value, str) or _QUANTITY.match(value).group(2) in (None, "")  # type: ignore[union-attr]
+
+
+def _plain(number: float) -> str:
+    return f"{number:g}"
 
 
 def _factor(unit: str, kind: Kind, text: str) -> float:

@@ -12,12 +12,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from .errors import UnknownNameError
+
+if TYPE_CHECKING:
+    from .dynamics.tyres import Tyre
 
 HALF_PI = math.pi / 2
 
@@ -90,6 +93,13 @@ class Wheel:
     b: float = 0.0
     actuated: tuple[str, ...] = ()
     sensed: tuple[str, ...] = ()
+    # dynamics (thesis Table 7.2; wmrkit.dynamics.mass): inertias [kg m^2] about the axle, the steering axis and the
+    # roller axis, the mass [kg] of a castor unit, and the tyre model; zero / None when not described
+    spin_inertia: float = 0.0
+    steer_inertia: float = 0.0
+    roller_inertia: float = 0.0
+    mass: float = 0.0
+    tyre: Tyre | None = None
 
     @property
     def kind(self) -> WheelKind:
@@ -106,9 +116,22 @@ class Wheel:
         """Qualified names ``wheel.joint`` of this wheel's rates in the velocity vector."""
         return tuple(f"{self.name}.{j}" for j in self.kind.rates)
 
+    @property
+    def heading(self) -> float:
+        """Rolling direction [rad] in (-pi, pi]: where the robot moves when the wheel spins forward, 0 = +x.
+
+        The users' steering angle (WPILib, ROS 2, Ackermann texts); ``beta + delta - pi/2``, see
+        :func:`heading_from_beta`.
+        """
+        return float(heading_from_beta(self.beta, self.delta))
+
     def with_beta(self, beta: float) -> Wheel:
         """The same wheel at another steering angle (or axle direction)."""
         return replace(self, beta=float(beta))
+
+    def with_heading(self, heading: float) -> Wheel:
+        """The same wheel steered to rolling direction `heading` [rad] (0 = forward along +x)."""
+        return replace(self, beta=float(beta_from_heading(heading, self.delta)))
 
     def elements(self) -> tuple[Element, ...]:
         """The contact elements this wheel expands into (see module docstring)."""
@@ -167,6 +190,28 @@ _ELEMENTS = {
     "double": _double,
     "double_castor": _double_castor,
 }
+
+
+def wrap_angle(angle: ArrayLike) -> np.ndarray:
+    """Angles wrapped to (-pi, pi]; ``(...) -> (...)``."""
+    a = np.asarray(angle, dtype=float)
+    return np.pi - np.mod(np.pi - a, 2 * np.pi)
+
+
+def heading_from_beta(beta: ArrayLike, delta: ArrayLike = 0.0) -> np.ndarray:
+    """The users' steering angle from the thesis's: ``heading = beta + delta - pi/2``, wrapped to (-pi, pi].
+
+    The thesis's β is the angle of the steering frame S_x; the axle lies at ``beta + delta`` and a forward spin
+    moves the robot along ``-L_y``, the axle turned by -90 deg (``docs/conventions.md``). So a wheel whose axle
+    points left (β = 90°) has heading 0: it rolls straight ahead. For a castor the heading is the direction the
+    wheel itself rolls (its arm trails behind the steering joint at heading 0 when d > 0). ``(...) -> (...)``.
+    """
+    return wrap_angle(np.asarray(beta, dtype=float) + delta - HALF_PI)
+
+
+def beta_from_heading(heading: ArrayLike, delta: ArrayLike = 0.0) -> np.ndarray:
+    """The thesis's β from the users' heading: ``beta = heading - delta + pi/2`` (not wrapped). ``(...) -> (...)``."""
+    return np.asarray(heading, dtype=float) - delta + HALF_PI
 
 
 def slip_row_entries(beta, l, alpha, d, delta, gamma, r, r_r, sin=np.sin, cos=np.cos):

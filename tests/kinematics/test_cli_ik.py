@@ -27,17 +27,16 @@ def test_ik_json_has_the_documented_shape(capsys):
     assert list(data["wheels"]) == list(robot.wheel_names)
     for name, (x, y) in zip(robot.wheel_names, (w.position for w in robot.wheels), strict=True):
         entry = data["wheels"][name]
-        assert set(entry) == {"steer", "spin", "steer_rate"} and entry["steer_rate"] is None
-        ux, uy = 1 - 0.2 * y, 0.5 + 0.2 * x  # steering axis velocity; (8.9) and (8.12), closest to 90 deg
-        assert entry["steer"] == pytest.approx(math.atan2(-ux, uy) + math.pi, abs=1e-12)
+        assert set(entry) == {"heading", "spin", "steer_rate"} and entry["steer_rate"] is None
+        ux, uy = 1 - 0.2 * y, 0.5 + 0.2 * x  # steering axis velocity; its direction is the heading (WPILib's angle)
+        assert entry["heading"] == pytest.approx(math.atan2(uy, ux), abs=1e-12)
         assert entry["spin"] == pytest.approx(math.hypot(ux, uy) / 0.0508, rel=1e-12)
 
 
 def test_ik_json_of_other_wheel_types_adds_their_joints(capsys):
     code, out, _ = run(capsys, "ik", "mecanum-4", "--twist", "0.3", "0.2", "0.1", "--json")
     data = json.loads(out)
-    assert code == 0 and all(set(e) == {"steer", "spin", "steer_rate", "roller"} for e in data["wheels"].values())
-    assert all(e["steer"] is None for e in data["wheels"].values())
+    assert code == 0 and all(set(e) == {"spin", "steer_rate", "roller"} for e in data["wheels"].values())
 
 
 def test_ik_warns_about_an_infeasible_twist(capsys):
@@ -50,24 +49,34 @@ def test_ik_warns_about_an_infeasible_twist(capsys):
 
 
 def test_ik_steer_accepts_degrees_and_radians(capsys):
-    _, deg, _ = run(capsys, "ik", "forklift", "--twist", "-1", "0", "0", "--steer", "steer=-90deg", "--json")
-    _, rad, _ = run(capsys, "ik", "forklift", "--twist", "-1", "0", "0", "--steer", f"steer={-math.pi / 2}",
+    _, deg, _ = run(capsys, "ik", "forklift", "--twist", "-1", "0", "0", "--steer", "steer=170deg", "--json")
+    _, rad, _ = run(capsys, "ik", "forklift", "--twist", "-1", "0", "0", "--steer", f"steer={math.radians(170)}",
                     "--json")
     assert json.loads(deg) == json.loads(rad)
-    entry = json.loads(deg)["wheels"]["steer"]  # reversing with the wheel at -90 deg: it stays there
-    assert entry["steer"] == pytest.approx(-math.pi / 2) and entry["spin"] == pytest.approx(1 / 0.23)
+    entry = json.loads(deg)["wheels"]["steer"]  # reversing with the wheel turned round: it rolls forward, backwards
+    assert abs(entry["heading"]) == pytest.approx(math.pi) and entry["spin"] == pytest.approx(1 / 0.23)
+
+
+def test_ik_heading_in_the_text_table(capsys):
+    """The issue's case: a swerve module whose heading is 32.957 deg is printed as 32.957, not 122.957."""
+    code, out, _ = run(capsys, "ik", "swerve-4", "--twist", "1", "0.5", "0.3")
+    x, y = catalog.load("swerve-4").wheels[0].position
+    want = math.degrees(math.atan2(0.5 + 0.3 * x, 1 - 0.3 * y))
+    row = next(line for line in out.splitlines() if line.startswith("front_left"))
+    assert code == 0 and "heading [deg]" in out and float(row.split()[2]) == pytest.approx(want, abs=1e-4)
 
 
 def test_fk_json_and_text(capsys):
     code, out, err = run(capsys, "fk", "diff-drive", "--spin", "left=10", "--spin", "right.spin=12", "--json")
     assert code == 0 and err == ""
     data = json.loads(out)
-    assert set(data) == {"twist", "residual"}
+    assert set(data) == {"twist", "residual", "consistent", "slipping"} and data["consistent"] is True
     r, half_track = 0.075, 0.20
     np.testing.assert_allclose(data["twist"], [r * 11, 0.0, r * 2 / (2 * half_track)], atol=1e-12)
     assert data["residual"] < 1e-12
     code, out, err = run(capsys, "fk", "swerve-4", "--spin", "front_left=3", "--steer", "front_left=100deg")
-    assert code == 0 and "twist (robot frame)" in out and "residual" in out and err == ""  # 8 rows, 6 unknowns
+    assert code == 0 and "twist (robot frame)" in out and "residual" in out  # 8 rows, 6 unknowns
+    assert "contradict" in err  # one module turned to 100 deg, the others straight: no common ICR, they slip
     code, out, err = run(capsys, "fk", "diff-drive", "--spin", "left=3")
     assert code == 0 and "do not determine the twist" in err and err.count("\n") == 1
 
@@ -87,8 +96,36 @@ def test_user_mistakes_exit_2_with_one_line(capsys, argv, message):
     assert err.startswith("wmrkit: error: ") and message in err and err.count("\n") == 1
 
 
-def test_bad_twist_is_an_argparse_error(capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(["ik", "swerve-4", "--twist", "1", "0", "inf"])
-    assert exc.value.code == 2
-    assert "--twist" in capsys.readouterr().err
+def test_bad_twist_is_a_usage_error(capsys):
+    assert main(["ik", "swerve-4", "--twist", "1", "0", "inf"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("usage: wmrkit ik") and "wmrkit: error: ik: argument --twist: cannot read 'inf'" in err
+    assert main(["ik", "swerve-4", "--twist", "1", "0", "inf", "--json"]) == 2
+    data = json.loads(capsys.readouterr().err)
+    assert "argument --twist" in data["error"] and data["file"] is None
+
+
+def test_fk_textbook_ackermann_angles_are_consistent(capsys):
+    """The issue's car: rear spins and the textbook Ackermann steering angles, as headings, agree (small residual)."""
+    argv = ["fk", "ackermann", "--spin", "rear_left=14.4", "--spin", "rear_right=15.9",
+            "--steer", "front_left=9.66deg", "--steer", "front_right=8.79deg", "--json"]
+    code, out, err = run(capsys, *argv)
+    data = json.loads(out)
+    assert code == 0 and err == "" and data["consistent"] is True and data["residual"] < 0.05
+    r, wheelbase, half_track = 0.33, 2.70, 0.775
+    assert data["twist"][0] == pytest.approx(r * (14.4 + 15.9) / 2, rel=2e-3)  # the rear axle's mean speed
+    turn_radius = np.mean([wheelbase / math.tan(math.radians(9.66)) + half_track,  # the ICR of the steering
+                           wheelbase / math.tan(math.radians(8.79)) - half_track])
+    assert data["twist"][2] == pytest.approx(data["twist"][0] / turn_radius, rel=2e-2)
+
+
+def test_fk_contradicting_rates_warn_and_say_so_in_json(capsys):
+    """The same rates with the steering given in the thesis's axle angles (heading + 90 deg) contradict."""
+    argv = ["fk", "ackermann", "--spin", "rear_left=14.4", "--spin", "rear_right=15.9",
+            "--steer", "front_left=99.66deg", "--steer", "front_right=98.79deg"]
+    code, out, err = run(capsys, *argv, "--json")
+    data = json.loads(out)
+    assert code == 0 and data["consistent"] is False and set(data["slipping"]) >= {"front_left", "front_right"}
+    assert err.startswith("wmrkit: warning: the rates contradict each other") and err.count("\n") == 1
+    code, out, err = run(capsys, *argv)
+    assert "INCONSISTENT" in out and "front_left" in err

@@ -53,17 +53,17 @@ def test_json_summary_of_the_tricycle(capsys, tricycle_file):
 
 
 def test_steer_option_in_degrees_and_radians(capsys, tricycle_file):
-    data = run_json(capsys, ["kinematics", tricycle_file, "--steer", "w3=0deg"])
-    assert data["steering"] == {"w3": 0.0}
+    data = run_json(capsys, ["kinematics", tricycle_file, "--steer", "w3=-90deg"])  # heading -90 deg: beta3 = 0
+    assert data["steering"] == {"w3": pytest.approx(-math.pi / 2)} and data["beta"] == {"w3": pytest.approx(0.0)}
     assert ["omega"] not in data["assignable_sets"] and data["lost_here"] == [["omega"]]  # C.4: beta3 = 0
-    data = run_json(capsys, ["kinematics", tricycle_file, "--steer", f"w3={math.pi / 2}"])
+    data = run_json(capsys, ["kinematics", tricycle_file, "--steer", "w3=0"])  # heading 0: beta3 = 90 deg
     assert data["lost_here"] == [["vy"]]
 
 
 def test_text_output(capsys, tricycle_file):
-    assert main(["kinematics", tricycle_file, "--steer", "w3=0 deg"]) == 0
+    assert main(["kinematics", tricycle_file, "--steer", "w3=-90 deg"]) == 0
     out = capsys.readouterr().out
-    assert "mobility m = 1" in out and "singular here" in out and "(omega)" in out
+    assert "mobility m = 1" in out and "not assignable at this steering" in out and "(omega)" in out
     assert "direct model (direct, assigned: w1.spin)" in out and "consistent actuation" in out
 
 

@@ -323,15 +323,15 @@ def test_large_batch_crosses_blocks_like_small_ones():
 # ---- values and errors ---------------------------------------------------------------------------------------
 def test_results_are_read_only_and_to_dict_takes_one_twist():
     c = wheel_commands(ZOO, np.ones((2, 3)))
-    for field in ("steer", "spin", "steer_rate", "rates", "slip", "feasible", "beta", "held"):
+    for field in ("steer", "spin", "steer_rate", "rates", "slip", "feasible", "beta", "held", "heading"):
         with pytest.raises(ValueError, match="read-only"):
             getattr(c, field)[...] = 0
     with pytest.raises(ShapeError, match=r"to_dict: expected one twist"):
         c.to_dict()
     d = wheel_commands(ZOO, [0.1, 0.2, 0.3]).to_dict()
-    assert set(d["wheels"]["dbl"]) == {"steer", "spin", "steer_rate", "spin1", "spin2"}
-    assert set(d["wheels"]["swe"]) == {"steer", "spin", "steer_rate", "roller"}
-    assert math.isnan(d["wheels"]["ste"]["steer_rate"]) and math.isnan(d["wheels"]["fix"]["steer"])
+    assert set(d["wheels"]["dbl"]) == {"heading", "spin", "steer_rate", "spin1", "spin2"}
+    assert set(d["wheels"]["swe"]) == {"spin", "steer_rate", "roller"}  # no heading: it does not steer
+    assert math.isnan(d["wheels"]["ste"]["steer_rate"]) and "heading" not in d["wheels"]["fix"]
 
 
 def test_wrong_shapes_name_the_argument():
@@ -339,3 +339,33 @@ def test_wrong_shapes_name_the_argument():
         wheel_commands(ZOO, [1.0, 2.0])
     with pytest.raises(ShapeError, match=r"beta: expected shape \(\.\.\., 4\)"):
         wheel_commands(ZOO, [1.0, 2.0, 3.0], [0.0])
+
+
+def test_forward_kinematics_check_judges_rates_from_the_ik():
+    """Rates from the IK of a random twist are consistent; scaling one wheel's spin makes that wheel slip."""
+    import scipy.linalg
+
+    from wmrkit.kinematics import _ik_fast
+    from wmrkit.kinematics.wheel_ik import forward_kinematics_check
+
+    rng = np.random.default_rng(7)
+    for name in ("swerve-4", "mecanum-4", "diff-drive", "forklift"):
+        robot = catalog.load(name)
+        for _ in range(5):
+            twist = rng.uniform(-1, 1, 3)
+            cmd = wheel_commands(robot, twist)
+            if not cmd.feasible:  # project onto the twists the fixed wheels allow (their lateral rows)
+                basis = scipy.linalg.null_space(_ik_fast.plan(robot).fixed_lateral.T)
+                twist = basis @ (basis.T @ twist)
+                cmd = wheel_commands(robot, twist)
+                assert cmd.feasible
+            rates = {w.name: float(cmd.spin[i]) for i, w in enumerate(robot.wheels) if "spin" in w.kind.rates}
+            heading = robot.heading_of_beta(cmd.beta)
+            fk = forward_kinematics_check(robot, rates, heading=heading)
+            assert fk.consistent and fk.residual < 1e-9 and fk.slipping == ()
+            np.testing.assert_allclose(fk.twist, twist, atol=1e-9)
+            wrong = dict(rates)
+            first = next(iter(wrong))
+            wrong[first] += 5.0 + 0.5 * abs(wrong[first])
+            bad = forward_kinematics_check(robot, wrong, heading=heading)
+            assert not bad.consistent and first in bad.slipping

@@ -63,8 +63,20 @@ def _mecanum() -> Robot:
          "r_r": 0.01} for n, p, g in zip(NAMES, CORNERS, gammas, strict=True)]})
 
 
-def test_mecanum_inverse_and_forward():
-    mec = _mecanum()
+def _mecanum_type() -> Robot:
+    """The same robot written as users write it: ``type: mecanum``, no roller angle, no axle angle."""
+    return Robot.from_dict({"name": "mec", "wheels": [
+        {"name": n, "type": "mecanum", "position": list(p), "r": R, "r_r": 0.01} for n, p in zip(NAMES, CORNERS,
+                                                                                              strict=True)]})
+
+
+def test_type_mecanum_is_wpilibs_layout():
+    assert _mecanum_type() == _mecanum()
+
+
+@pytest.mark.parametrize("build", [_mecanum, _mecanum_type])
+def test_mecanum_inverse_and_forward(build):
+    mec = build()
     peer = kin.MecanumDriveKinematics(*_translations())
     twists = _twists(50, 1)
     ours = wheel_commands(mec, twists)
@@ -81,7 +93,7 @@ def test_mecanum_inverse_and_forward():
 
 def _swerve() -> Robot:
     return Robot.from_dict({"name": "swerve", "wheels": [
-        {"name": n, "type": "steerable", "position": list(p), "beta": "90 deg", "r": R}
+        {"name": n, "type": "steerable", "position": list(p), "heading": 0, "r": R}
         for n, p in zip(NAMES, CORNERS, strict=True)]})
 
 
@@ -91,14 +103,14 @@ def test_swerve_inverse_with_optimize_matches_closest_angle_policy():
     rng = np.random.default_rng(3)
     twists = _twists(60, 3)
     current_module = rng.uniform(-math.pi, math.pi, (60, 4))  # WPILib module angles, current
-    ours = wheel_commands(swerve, twists, current_module + math.pi / 2)
+    ours = wheel_commands(swerve, twists, heading=current_module)  # WPILib's module angle is our heading
     for i, twist in enumerate(twists):
         states = peer.toSwerveModuleStates(kin.ChassisSpeeds(*twist))
         for k, state in enumerate(states):
             state.optimize(geo.Rotation2d(current_module[i, k]))
             assert ours.spin[i, k] * R == pytest.approx(state.speed, rel=1e-10, abs=1e-12)
-            gap = wrap_angle(ours.steer[i, k] - (state.angle.radians() + math.pi / 2))
-            assert abs(gap) < 1e-10
+            assert abs(wrap_angle(ours.heading[i, k] - state.angle.radians())) < 1e-10
+            assert abs(wrap_angle(ours.steer[i, k] - (state.angle.radians() + math.pi / 2))) < 1e-10  # thesis β
 
 
 def test_swerve_forward_matches_to_chassis_speeds():
@@ -109,13 +121,13 @@ def test_swerve_forward_matches_to_chassis_speeds():
         speeds, angles = rng.normal(size=4), rng.uniform(-math.pi, math.pi, 4)
         back = peer.toChassisSpeeds(tuple(kin.SwerveModuleState(s, geo.Rotation2d(a))
                                           for s, a in zip(speeds, angles, strict=True)))
-        fk, residual = forward_kinematics(swerve, dict(zip(NAMES, speeds / R, strict=True)), angles + math.pi / 2)
+        fk, residual = forward_kinematics(swerve, dict(zip(NAMES, speeds / R, strict=True)), heading=angles)
         np.testing.assert_allclose(fk, [back.vx, back.vy, back.omega], rtol=1e-9, atol=1e-12)
     # consistent states: our residual vanishes
     twist = np.array([0.7, -0.4, 1.1])
     states = peer.toSwerveModuleStates(kin.ChassisSpeeds(*twist))
     speeds = np.array([s.speed for s in states])
     angles = np.array([s.angle.radians() for s in states])
-    fk, residual = forward_kinematics(swerve, dict(zip(NAMES, speeds / R, strict=True)), angles + math.pi / 2)
+    fk, residual = forward_kinematics(swerve, dict(zip(NAMES, speeds / R, strict=True)), heading=angles)
     np.testing.assert_allclose(fk, twist, rtol=1e-12)
     assert residual < 1e-12

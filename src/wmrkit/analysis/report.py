@@ -17,7 +17,7 @@ from .coordinated import coordinated_singular_set
 from .figures import condition_figure, length_figure, motions_figure, robot_figure, singular_figure
 from .lines import constraint_lines
 from .singularity import singular_set
-from .summary import Analysis, describe_singular
+from .summary import Analysis, actuation_words, describe_singular
 
 _CSS = """
 body { font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; color: #222; line-height: 1.45 }
@@ -105,18 +105,19 @@ def _summary_table(a: Analysis) -> str:
     c = a.classification
     rows = [
         ("type (Table 5.1)", f"{c.type} ({c.name})" if c.type else "degenerate"),
-        ("degree of mobility m (5.13)", f"{c.mobility} (here: {a.instantaneous_mobility})"),
+        ("degree of mobility m (5.13)", f"{c.mobility}" if a.instantaneous_mobility == c.mobility else
+         f"{c.mobility}; {a.instantaneous_mobility} at the described steering (a special configuration)"),
         ("degree of steerability d (5.14)", c.steerability),
-        ("actuation (ch. 4)", f"{'consistent' if a.actuation['consistent'] else 'inconsistent'}, "
-                              f"{'sufficient' if a.actuation['sufficient'] else 'insufficient'}: "
-                              f"{a.actuation['verdict']}"),
+        ("actuation (ch. 4)", f"{actuation_words(a.actuation)}: {a.actuation['verdict']}"),
         ("sensing (ch. 4)", f"{'sufficient' if a.sensing['sufficient'] else 'insufficient'}: {a.sensing['verdict']}"),
-        ("condition number κ (5.28)", f"{a.condition_number:.4g} for ({', '.join(a.joints)})"
-                                      + ("; m = 1: isotropy does not apply" if c.mobility == 1 else "")),
-        ("characteristic length D", f"{a.characteristic_length:.4g} m ({'natural' if a.natural else 'given'})"),
     ]
+    if c.mobility <= 1:
+        rows.append(("isotropy (5.28)", f"does not apply (m = {c.mobility}: no two motions to balance)"))
+    else:
+        rows += [("condition number κ (5.28)", f"{a.condition_number:.4g} for ({', '.join(a.joints)})"),
+                 ("characteristic length D", f"{a.characteristic_length:.4g} m ({'natural' if a.natural else 'given'})")]
     for key, s in a.singular.items():
-        rows.append((f"singular {key} model", f"({', '.join(s.assigned) or '-'}): {describe_singular(s)}"))
+        rows.append((f"singular {key} model", f"({', '.join(s.assigned) or '-'}): {describe_singular(s, a.robot)}"))
     rows += [("special configuration", s.description) for s in c.special]
     body = "".join(f"<tr><th>{_e(k)}</th><td>{_e(v)}</td></tr>" for k, v in rows)
     return f"<table>{body}</table>"
@@ -177,7 +178,7 @@ def _assignable_table(a: Analysis, resolution: int, limit: int = 36) -> str:
     for q_a in sets:
         s = (coordinated_singular_set(r, q_a, resolution=small) if a.classification.coordinated
              else singular_set(r, q_a, resolution=small, max_samples=small * 4))
-        rows.append(f"<tr><td>{_e(', '.join(q_a))}</td><td>{_e(describe_singular(s, limit=4))}</td></tr>")
+        rows.append(f"<tr><td>{_e(', '.join(q_a))}</td><td>{_e(describe_singular(s, r, limit=4))}</td></tr>")
     return (f"<h3>Every choice of {m} assigned velocit{'y' if m == 1 else 'ies'} (m = {m})</h3>{note}"
             f"<table><tr><th>assigned</th><th>singular</th></tr>{''.join(rows)}</table>")
 

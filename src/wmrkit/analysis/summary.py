@@ -16,6 +16,7 @@ import numpy as np
 from ..kinematics.actuation import actuation_analysis
 from ..kinematics.sensing import sensing_analysis
 from ..robot import Robot
+from ..wheels import heading_from_beta
 from .classification import Classification, classify, instantaneous_mobility
 from .coordinated import coordinated_singular_set
 from .icr import ICRSet, icr
@@ -47,14 +48,14 @@ class Analysis:
             "mobility": c.mobility, "steerability": c.steerability, "type": c.type, "type_name": c.name,
             "degenerate": c.degenerate, "reasons": list(c.reasons), "coordinated_steering": c.coordinated,
             "instantaneous_mobility": self.instantaneous_mobility,
-            "special_configurations": [{"beta": list(s.beta), "mobility": s.mobility, "description": s.description}
-                                       for s in c.special],
+            "special_configurations": [{"heading": self.robot.heading_of_beta(s.beta).tolist(), "beta": list(s.beta),
+                                        "mobility": s.mobility, "description": s.description} for s in c.special],
             "icr": self.icr.describe(),
             "actuation": {k: self.actuation[k] for k in ("consistent", "sufficient", "verdict")},
             "sensing": {k: self.sensing[k] for k in ("sufficient", "verdict")},
             "condition_number": self.condition_number, "characteristic_length": self.characteristic_length,
             "condition_joints": list(self.joints), "natural_length": self.natural,
-            "singular": {k: _singular_dict(s) for k, s in self.singular.items()},
+            "singular": {k: _singular_dict(s, self.robot) for k, s in self.singular.items()},
         }
 
     def format_text(self) -> str:
@@ -65,17 +66,17 @@ class Analysis:
             lines.append(f"  at the described steering: m = {self.instantaneous_mobility}")
         lines += [f"  {s.description}" for s in c.special]
         lines.append(f"  {self.icr.describe()}")
-        lines.append(f"  actuation: {_yes(self.actuation['consistent'], 'consistent', 'inconsistent')}, "
-                     f"{_yes(self.actuation['sufficient'], 'sufficient', 'insufficient')} "
-                     f"({', '.join(r.actuated) or 'nothing declared'})")
+        lines.append(f"  actuation: {actuation_words(self.actuation)} ({', '.join(r.actuated) or 'nothing declared'})")
         lines.append(f"  sensing: {_yes(self.sensing['sufficient'], 'sufficient', 'insufficient')} "
                      f"({', '.join(r.sensed) or 'nothing declared'})")
         how = "natural length" if self.natural else "given length"
-        note = "  (m = 1: isotropy does not apply)" if c.mobility == 1 else ""
-        lines.append(f"  condition number {self.condition_number:.4g} at the {how} D = "
-                     f"{self.characteristic_length:.4g} m, joints {', '.join(self.joints) or '-'}{note}")
+        if c.mobility <= 1:
+            lines.append(f"  isotropy: does not apply (m = {c.mobility}: no two motions to balance)")
+        else:
+            lines.append(f"  condition number {self.condition_number:.4g} at the {how} D = "
+                         f"{self.characteristic_length:.4g} m, joints {', '.join(self.joints) or '-'}")
         for key, s in self.singular.items():
-            lines.append(f"  singular ({key}: {', '.join(s.assigned) or '-'}): {describe_singular(s)}")
+            lines.append(f"  singular ({key}: {', '.join(s.assigned) or '-'}): {describe_singular(s, r)}")
         return "\n".join(lines)
 
 
@@ -83,14 +84,28 @@ def _yes(flag: bool, yes: str, no: str) -> str:
     return yes if flag else no
 
 
-def _singular_dict(s: SingularSet) -> dict[str, Any]:
+def actuation_words(actuation: dict[str, Any]) -> str:
+    """What the actuation verdict means for the user, in words (thesis Fig. 4.4)."""
+    if not actuation["sufficient"]:
+        return "insufficient: some motions are driven by no actuator"
+    if actuation["consistent"]:
+        return "sufficient, and the actuators cannot fight each other"
+    return ("over-actuated: the actuators must be coordinated or they fight and the wheels slip "
+            "(mechanical couplings go in the description's 'couplings')")
+
+
+def _singular_dict(s: SingularSet, robot: Robot) -> dict[str, Any]:
+    """JSON of a singular set: ``configurations`` as the thesis's β of `variables`, ``headings`` the same angles
+    as the wheels' headings (0 = rolling straight ahead)."""
+    delta = np.array([robot.wheel(v).delta for v in s.variables], dtype=float)
+    configs = s.configurations[:24]
     return {"assigned": list(s.assigned), "variables": list(s.variables), "always": s.always, "never": s.never,
-            "exact": s.exact, "count": len(s.configurations),
-            "configurations": s.configurations[:24].tolist(), "reasons": list(s.reasons)}
+            "exact": s.exact, "count": len(s.configurations), "configurations": configs.tolist(),
+            "headings": heading_from_beta(configs, delta).tolist(), "reasons": list(s.reasons)}
 
 
-def describe_singular(s: SingularSet, *, limit: int = 6) -> str:
-    """One line: never / always (why) / at which steering angles (degrees)."""
+def describe_singular(s: SingularSet, robot: Robot | None = None, *, limit: int = 6) -> str:
+    """One line: never / always (why) / at which steering angles: headings in degrees when `robot` is given."""
     if s.always:
         return "always" + (f" ({s.reasons[0]})" if s.reasons else "")
     if s.never:
@@ -101,10 +116,16 @@ def describe_singular(s: SingularSet, *, limit: int = 6) -> str:
         return "with coordinated steering, when the " + "; ".join(
             r.replace("ICR at", "ICR is at", 1) for r in s.reasons[:limit]) + more
     if s.exact:
-        angles = ", ".join(f"{math.degrees(v):.2f}" for v in s.configurations[:limit, 0])
+        values, what = (s.configurations[:, 0], "beta") if robot is None else (_headings(s, robot), "heading")
+        angles = ", ".join(f"{math.degrees(v):.2f}" for v in values[:limit])
         more = f" and {len(s.configurations) - limit} more" if len(s.configurations) > limit else ""
-        return f"at {s.variables[0]} = {angles} deg{more}"
+        return f"at {what} {s.variables[0]} = {angles} deg{more}"
     return f"on curves over ({', '.join(s.variables)}), {len(s.configurations)} sampled points"
+
+
+def _headings(s: SingularSet, robot: Robot) -> np.ndarray:
+    """The singular angles of a one-variable exact set as headings of that wheel (0 = rolling straight ahead)."""
+    return heading_from_beta(s.configurations[:, 0], robot.wheel(s.variables[0]).delta)
 
 
 def model_rates(robot: Robot, joints: tuple[str, ...]) -> tuple[str, ...]:

@@ -41,4 +41,8 @@ def resolve(spec: str) -> Robot:
         if not path.exists():
             raise UnknownNameError(f"{spec}: no such file")
         return Robot.from_file(path)
+    if spec not in names():
+        files = [p for p in (Path(spec + ext) for ext in (".yaml", ".yml", ".json")) if p.is_file()]
+        if files:
+            raise UnknownNameError(f"no robot '{spec}' in the catalog; did you mean the file '{files[0]}'?")
     return load(spec)

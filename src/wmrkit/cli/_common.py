@@ -67,13 +67,14 @@ def parse_assignments(items: list[str] | None, what: str) -> dict[str, str]:
     return out
 
 
-def add_steer_option(parser: argparse.ArgumentParser, text: str = "steering angle of a wheel") -> None:
-    """``--steer NAME=ANGLE`` (repeatable): radians, or degrees with ``deg``."""
+def add_steer_option(parser: argparse.ArgumentParser, text: str = "heading of a steered wheel") -> None:
+    """``--steer NAME=ANGLE`` (repeatable): the wheel's heading, radians or degrees with ``deg``."""
     parser.add_argument("--steer", action="append", metavar="NAME=ANGLE", default=[],
-                        help=f"{text}; radians, or degrees with 'deg' (repeatable)")
+                        help=f"{text}: its rolling direction, 0 = straight ahead, counter-clockwise positive; "
+                             "radians, or degrees with 'deg' (repeatable)")
 
 
 def steered_robot(spec: str, steer: list[str] | None) -> Robot:
-    """The robot named by a ROBOT argument, at the angles of its ``--steer`` options."""
+    """The robot named by a ROBOT argument, at the headings of its ``--steer`` options (0 = straight ahead)."""
     pairs = parse_assignments(steer, "--steer")
     return load_robot(spec).with_steering({n: parse_angle(v, f"--steer {n}") for n, v in pairs.items()})

@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from ..kinematics.wheel_ik import WheelCommands, forward_kinematics, twist_is_determined, wheel_commands
+from ..kinematics.wheel_ik import WheelCommands, forward_kinematics_check, twist_is_determined, wheel_commands
 from ..robot import Robot
 from ..units import UnitError, parse_quantity
 from ._common import (
@@ -28,7 +28,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     add_robot_argument(p)
     p.add_argument("--twist", nargs=3, type=_finite, required=True, metavar=("VX", "VY", "OMEGA"),
                    help="body twist: vx, vy [m/s], omega [rad/s] (x forward, y left)")
-    add_steer_option(p, "current steering angle of a wheel (default: as described); the closest solution is kept")
+    add_steer_option(p, "current heading of a steered wheel (default: as described); the closest solution is kept")
     add_json_flag(p)
     p.set_defaults(run=run_ik)
 
@@ -36,7 +36,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     add_robot_argument(p)
     p.add_argument("--spin", action="append", metavar="NAME=RATE", default=[],
                    help="a joint rate [rad/s]: a wheel name means its spin, or 'wheel.joint' (repeat)")
-    add_steer_option(p, "steering angle of a wheel (default: as described)")
+    add_steer_option(p, "heading of a steered wheel (default: as described)")
     add_json_flag(p)
     p.set_defaults(run=run_fk)
 
@@ -59,15 +59,22 @@ def run_fk(args: argparse.Namespace) -> int:
     robot = steered_robot(args.robot, args.steer)
     given = parse_assignments(args.spin, "--spin")
     rates = {name: parse_value(value, "number", f"--spin {name}") for name, value in given.items()}
-    twist, residual = forward_kinematics(robot, rates)
+    fk = forward_kinematics_check(robot, rates)
+    twist = fk.twist
     if not twist_is_determined(robot, list(rates)):
         print(f"wmrkit: warning: these rates do not determine the twist of robot '{robot.name}'; "
               "printing the minimum-norm one", file=sys.stderr)
+    if not fk.consistent:
+        worst = ", ".join(f"{n} {fk.wheel_slip[robot.wheel_names.index(n)]:.3g} m/s" for n in fk.slipping)
+        print(f"wmrkit: warning: the rates contradict each other: the wheels slip ({worst}; residual "
+              f"{fk.residual:.3g} m/s > tolerance {fk.tolerance:.3g} m/s); check units, signs and --steer headings",
+              file=sys.stderr)
     if args.json:
-        print_json({"twist": twist.tolist(), "residual": float(residual)})
+        print_json({"twist": twist.tolist(), "residual": fk.residual, "consistent": fk.consistent,
+                    "slipping": list(fk.slipping)})
     else:
         print(f"twist (robot frame): vx = {twist[0]:.6g} m/s, vy = {twist[1]:.6g} m/s, omega = {twist[2]:.6g} rad/s")
-        print(f"residual (slip norm): {float(residual):.3g} m/s")
+        print(f"residual (slip norm): {fk.residual:.3g} m/s ({'consistent' if fk.consistent else 'INCONSISTENT'})")
     return 0
 
 
@@ -79,14 +86,15 @@ def _finite(text: str) -> float:
 
 
 def format_commands(robot: Robot, commands: WheelCommands) -> str:
-    """Human-readable table of one twist's wheel commands (angles in degrees too)."""
+    """Human-readable table of one twist's wheel commands: heading in degrees (0 = rolling straight ahead)."""
     data = commands.to_dict()
-    lines = [f"{'wheel':<14}{'type':<14}{'steer [deg]':>12}{'spin [rad/s]':>14}{'steer rate':>12}"
+    lines = [f"{'wheel':<14}{'type':<14}{'heading [deg]':>14}{'spin [rad/s]':>14}{'steer rate':>12}"
              f"{'slip [m/s]':>12}  other rates [rad/s]"]
     for w in robot.wheels:
         entry = data["wheels"][w.name]
-        other = ", ".join(f"{k} {v:.6g}" for k, v in entry.items() if k not in ("steer", "spin", "steer_rate"))
-        lines.append(f"{w.name:<14}{w.type:<14}{_num(math.degrees(entry['steer'])):>12}{_num(entry['spin']):>14}"
+        other = ", ".join(f"{k} {v:.6g}" for k, v in entry.items() if k not in ("heading", "spin", "steer_rate"))
+        heading = math.degrees(entry.get("heading", math.nan))
+        lines.append(f"{w.name:<14}{w.type:<14}{_num(heading):>14}{_num(entry['spin']):>14}"
                      f"{_num(entry['steer_rate']):>12}{_num(data['slip'][w.name]):>12}  {other}")
     lines.append("feasible: " + ("yes" if data["feasible"] else "NO (a fixed wheel would slip sideways)"))
     return "\n".join(lines)

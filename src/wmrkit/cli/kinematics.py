@@ -24,6 +24,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     add_robot_argument(p)
     add_steer_option(p)
     add_json_flag(p)
+    p.add_argument("--all", action="store_true", help="list every assignable set (default: the first 12 of each)")
     p.add_argument("--symbolic", action="store_true", help="also print the closed-form models (sympy)")
     p.add_argument("--codegen", nargs=2, metavar=("LANG", "DIR"),
                    help="also write the models as code, LANG 'c' or 'python', into DIR")
@@ -48,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(summary)
         return 0
-    print(format_kinematics_summary(summary))
+    print(format_kinematics_summary(summary, limit=None if args.all else 12))
     if args.symbolic:
         print(summary["symbolic"])
     for path in summary.get("generated", []):

@@ -65,7 +65,7 @@ def summary(robot: Robot) -> dict:
 def format_summary(robot: Robot) -> str:
     """Human-readable summary: one line per wheel in the robot frame (x forward, y left)."""
     lines = [f"robot {robot.name}: {len(robot.wheels)} wheels" + (f"  ({robot.notes})" if robot.notes else "")]
-    header = f"  {'wheel':<14}{'type':<14}{'x [m]':>8}{'y [m]':>8}{'beta':>9}{'r [m]':>8}"
+    header = f"  {'wheel':<14}{'type':<14}{'x [m]':>10}{'y [m]':>10}{'heading':>10}{'r [m]':>10}"
     lines.append(header + "  joints (A actuated, S sensed)")
     for w in robot.wheels:
         x, y = w.position
@@ -73,11 +73,26 @@ def format_summary(robot: Robot) -> str:
             j + ("[" + "A" * (j in w.actuated) + "S" * (j in w.sensed) + "]" if j in w.actuated + w.sensed else "")
             for j in w.kind.joints
         )
-        extra = {"castor": f"  d={w.d:g}", "double_castor": f"  d={w.d:g} b={w.b:g}", "double": f"  b={w.b:g}",
-                 "swedish": f"  gamma={math.degrees(w.gamma):g}deg r_r={w.r_r:g}"}.get(w.type, "")
-        row = f"  {w.name:<14}{w.type:<14}{x:>8.3f}{y:>8.3f}{math.degrees(w.beta):>7.1f}°{w.r:>8.3f}"
+        extra = {"castor": f"  d={_g(w.d)} delta={_g(math.degrees(w.delta))}deg",
+                 "double_castor": f"  d={_g(w.d)} b={_g(w.b)}", "double": f"  b={_g(w.b)}",
+                 "swedish": f"  gamma={_g(math.degrees(w.gamma))}deg r_r={_g(w.r_r)}"}.get(w.type, "")
+        row = (f"  {w.name:<14}{w.type:<14}{_g(_zero(x)):>10}{_g(_zero(y)):>10}"
+               f"{_g(_zero(math.degrees(w.heading))) + '°':>10}{_g(w.r):>10}")
         lines.append(f"{row}  {joints}{extra}")
+    lines.append("  heading: the wheel's rolling direction, 0° = straight ahead (+x), counter-clockwise positive")
     lines.append(f"  velocity vector q_dot ({len(robot.velocity_names)}): {', '.join(robot.velocity_names)}")
     if robot.steer_names:
-        lines.append(f"  steering configuration beta: {', '.join(robot.steer_names)}")
+        lines.append(f"  steered wheels: {', '.join(robot.steer_names)}")
+    for c in robot.couplings:
+        lines.append(f"  coupling: {c.kind} of {', '.join(c.joints)} (ratios {', '.join(_g(k) for k in c.ratios)})")
+    return "\n".join(lines)
+
+
+def _g(x: float) -> str:
+    """A number to 5 significant digits, without trailing zeros (0.0475 stays 0.0475)."""
+    return f"{x:.5g}"
+
+
+def _zero(x: float) -> float:
+    return 0.0 if abs(x) < 1e-9 else x
     return "\n".join(lines)

@@ -66,6 +66,7 @@ class Plan:
     steer_rate_select: slice | np.ndarray | None
     wheel_names: tuple[str, ...]
     rate_names: tuple[str, ...]
+    wheel_delta: np.ndarray  # (N,) each wheel's delta: heading = steer + delta - pi/2
 
 
 @functools.lru_cache(maxsize=256)
@@ -134,6 +135,7 @@ def plan(robot: Robot) -> Plan:
         only_steerable=all(w.type == "steerable" for w in robot.wheels),
         spin_select=selector(spin_col), steer_rate_select=selector(steer_rate_col),
         wheel_names=robot.wheel_names, rate_names=robot.rate_names,
+        wheel_delta=readonly(np.array([w.delta for w in robot.wheels], dtype=float)),
     )
 
 

@@ -9,6 +9,8 @@ on the configuration, and a set assignable at generic angles can fail at a singu
 
 from __future__ import annotations
 
+import math
+
 import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -20,7 +22,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, readonly
 from ..errors import SingularError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
-from .linalg import matrix_rank
+from .linalg import matrix_rank, nondimensional, velocity_scale
 from .nullspace import enumerate_subsets, null_space_assignable, null_space_solution, rref_solution
 from .ranks import ranks_assignable, ranks_solution
 
@@ -75,24 +77,25 @@ class KinematicModel:
         }
 
 
-def configuration(robot: Robot, beta: ArrayLike | None) -> np.ndarray:
-    """`beta` checked as ``(..., n_steer)``, or the described configuration ``(n_steer,)`` when None."""
-    return robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
+def configuration(robot: Robot, beta: ArrayLike | None, heading: ArrayLike | None = None) -> np.ndarray:
+    """The thesis's β ``(..., n_steer)`` from `beta` or `heading` (users' angles), or the described one when None."""
+    beta = robot.steering(beta, heading)
+    return robot.beta if beta is None else beta
 
 
 def describe_configuration(robot: Robot, beta: np.ndarray, index: tuple[int, ...] = ()) -> str:
     """``"beta (w3=0.4 rad)"``, with ``[i, j]`` for an element of a batch; ``"the fixed geometry"`` if no steering."""
     if not robot.steer_names:
         return "the fixed geometry"
-    values = beta[index] if beta.ndim > 1 else beta
-    angles = ", ".join(f"{n}={v:.6g} rad" for n, v in zip(robot.steer_names, values.tolist(), strict=True))
+    values = robot.heading_of_beta(beta[index] if beta.ndim > 1 else beta)
+    angles = ", ".join(f"{n}={math.degrees(v):.6g} deg" for n, v in zip(robot.steer_names, values.tolist(), strict=True))
     where = f"configuration {list(index)} " if index else ""
-    return f"{where}beta ({angles})"
+    return f"{where}heading ({angles})"
 
 
-def mobility(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
-    """Degree of mobility ``m = k - rank A`` (4.3): ``(..., n_steer) -> (...)`` int."""
-    a = robot.constraint_matrix(configuration(robot, beta))
+def mobility(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None) -> np.ndarray:
+    """Degree of mobility ``m = k - rank A`` (4.3): ``(..., n_steer) -> (...)`` int (β or `heading`)."""
+    a = nondimensional(robot).constraint_matrix(configuration(robot, beta, heading))
     return a.shape[-1] - matrix_rank(a)
 
 
@@ -119,7 +122,7 @@ def is_assignable(
     robot: Robot, names: Sequence[str], beta: ArrayLike | None = None, *, method: Method = "ranks"
 ) -> np.ndarray:
     """Whether the velocities `names` can be assigned, (4.5)/(4.6)/(4.10): ``(..., n_steer) -> (...)`` bool."""
-    a = robot.constraint_matrix(configuration(robot, beta))
+    a = nondimensional(robot).constraint_matrix(configuration(robot, beta))
     return _assignable(a, velocity_indices(robot, names)[None, :], method)[0]
 
 
@@ -140,7 +143,7 @@ def assignable_sets(
 
     Sets are tuples of velocity names in the robot's order, listed lexicographically.
     """
-    return _sets_at(robot, robot.constraint_matrix(configuration(robot, beta)), method)
+    return _sets_at(robot, nondimensional(robot).constraint_matrix(configuration(robot, beta)), method)
 
 
 def generic_configurations(robot: Robot) -> np.ndarray:
@@ -162,7 +165,7 @@ def generically_assignable_sets(robot: Robot) -> tuple[tuple[str, ...], ...]:
     nowhere.
     """
     samples = generic_configurations(robot)
-    a = robot.constraint_matrix(samples)
+    a = nondimensional(robot).constraint_matrix(samples)
     m = generic_mobility(robot)
     generic = a.shape[-1] - matrix_rank(a) == m
     subsets = enumerate_subsets(a.shape[-1], m)
@@ -190,17 +193,18 @@ def _refuse(robot: Robot, names: Sequence[str], beta: np.ndarray, ok: np.ndarray
 
 
 def kinematic_model(
-    robot: Robot, assigned: Sequence[str], beta: ArrayLike | None = None, *, method: Method = "ranks"
+    robot: Robot, assigned: Sequence[str], beta: ArrayLike | None = None, *, method: Method = "ranks",
+    heading: ArrayLike | None = None,
 ) -> KinematicModel:
     """The kinematic model with the velocities `assigned` chosen freely (4.5, 4.6 or 4.11 by `method`).
 
     ``beta``: ``(..., n_steer)`` or None; the model's matrix is ``(..., n_solved, n_assigned)``. Raises
     :class:`~wmrkit.errors.SingularError` naming the set and the first configuration where it is not
-    assignable, and whether it is assignable at generic angles.
+    assignable, and whether it is assignable at generic angles. Steering as the thesis's `beta` or as `heading`.
     """
-    beta = configuration(robot, beta)
+    beta = configuration(robot, beta, heading)
     idx = velocity_indices(robot, assigned)
-    a = robot.constraint_matrix(beta)
+    a = nondimensional(robot).constraint_matrix(beta)
     if method == "ranks":
         ok, matrix = ranks_assignable(a, idx[None, :])[0], ranks_solution(a, idx)
     elif method in ("nullspace", "rref"):
@@ -212,7 +216,14 @@ def kinematic_model(
     names = robot.velocity_names
     solved = tuple(n for n in names if n not in assigned)
     return KinematicModel(robot.name, names, tuple(assigned), solved, readonly(np.array(beta)),
-                          readonly(np.ascontiguousarray(matrix)), method)
+                          readonly(np.ascontiguousarray(_dimensional(robot, matrix, idx))), method)
+
+
+def _dimensional(robot: Robot, matrix: np.ndarray, assigned: np.ndarray) -> np.ndarray:
+    """A model matrix of :func:`~.linalg.nondimensional` back in `robot`'s velocities (``q' = scale * q``)."""
+    scale = velocity_scale(robot)
+    solved = np.setdiff1d(np.arange(len(scale)), assigned)
+    return matrix * scale[assigned] / scale[solved][:, None]
 
 
 def _first_assignable(robot: Robot, a: np.ndarray, candidates: Sequence[str], m: int) -> tuple[str, ...] | None:
@@ -225,17 +236,18 @@ def _first_assignable(robot: Robot, a: np.ndarray, candidates: Sequence[str], m:
 
 
 def direct_model(
-    robot: Robot, rates: Sequence[str] | None = None, beta: ArrayLike | None = None
+    robot: Robot, rates: Sequence[str] | None = None, beta: ArrayLike | None = None, *,
+    heading: ArrayLike | None = None,
 ) -> KinematicModel:
     """Direct model (§4.2): the twist and the other rates from m assigned wheel rates.
 
     ``rates=None`` takes the first assignable set of the robot's *sensed* rates, or failing that of all its
     wheel rates (roller rates excluded: they cannot be measured, §3.3.3).
     """
+    beta = configuration(robot, beta, heading)
     if rates is not None:
         return kinematic_model(robot, rates, beta)
-    beta = configuration(robot, beta)
-    a = robot.constraint_matrix(beta)
+    a = nondimensional(robot).constraint_matrix(beta)
     m = int(np.max(a.shape[-1] - matrix_rank(a)))
     usable = [n for n in robot.rate_names if not n.endswith(".roller")]
     sensed = [n for n in usable if n in robot.sensed]
@@ -247,16 +259,17 @@ def direct_model(
 
 
 def inverse_model(
-    robot: Robot, twist_names: Sequence[str] | None = None, beta: ArrayLike | None = None
+    robot: Robot, twist_names: Sequence[str] | None = None, beta: ArrayLike | None = None, *,
+    heading: ArrayLike | None = None,
 ) -> KinematicModel:
     """Inverse model (§4.2): the wheel rates (and remaining twist components) from m assigned twist components.
 
     ``twist_names=None`` takes the first assignable subset of ``(vx, vy, omega)`` of size m.
     """
+    beta = configuration(robot, beta, heading)
     if twist_names is not None:
         return kinematic_model(robot, twist_names, beta)
-    beta = configuration(robot, beta)
-    a = robot.constraint_matrix(beta)
+    a = nondimensional(robot).constraint_matrix(beta)
     m = int(np.max(a.shape[-1] - matrix_rank(a)))
     choice = _first_assignable(robot, a, TWIST_NAMES, m)
     if choice is None:

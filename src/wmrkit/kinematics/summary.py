@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from typing import Any
 
 import numpy as np
@@ -39,7 +41,8 @@ def kinematics_summary(robot: Robot) -> dict[str, Any]:
     generic = generically_assignable_sets(robot)
     return {
         "robot": robot.name,
-        "steering": dict(zip(robot.steer_names, robot.beta.tolist(), strict=True)),
+        "steering": dict(zip(robot.steer_names, robot.heading.tolist(), strict=True)),  # headings [rad]
+        "beta": dict(zip(robot.steer_names, robot.beta.tolist(), strict=True)),  # the thesis's angles [rad]
         "velocity_names": list(robot.velocity_names),
         "mobility": int(mobility(robot)),
         "generic_mobility": generic_mobility(robot),
@@ -71,18 +74,44 @@ def _matrix_table(model: dict[str, Any], indent: str = "    ") -> list[str]:
     return rows
 
 
-def format_kinematics_summary(summary: dict[str, Any]) -> str:
-    """Human-readable text of :func:`kinematics_summary`: counts, sets, model tables, verdicts."""
-    steer = ", ".join(f"{n} = {v:.6g} rad" for n, v in summary["steering"].items()) or "no steering"
-    lines = [f"robot {summary['robot']} ({steer})",
-             f"  mobility m = {summary['mobility']} (generic {summary['generic_mobility']}); "
-             f"extended solutions may assign {summary['extended_dof']} (m + steerable wheels, §4.5)",
-             f"  velocities: {', '.join(summary['velocity_names'])}",
-             f"  assignable sets ({len(summary['assignable_sets'])}): "
-             + "  ".join("(" + ", ".join(s) + ")" for s in summary["assignable_sets"])]
-    if summary["lost_here"]:
-        lines.append("  singular here: generically assignable but not now: "
-                     + "  ".join("(" + ", ".join(s) + ")" for s in summary["lost_here"]))
+def _sets(sets: list[list[str]], limit: int | None, indent: str = "    ") -> list[str]:
+    """Sets of names, wrapped to lines of at most 110 characters; past `limit` sets, a count and how to see all."""
+    shown = sets if limit is None else sets[:limit]
+    lines, line = [], indent
+    for s in shown:
+        item = "(" + ", ".join(s) + ")"
+        if len(line) + len(item) > 110 and line.strip():
+            lines.append(line.rstrip())
+            line = indent
+        line += item + "  "
+    if line.strip():
+        lines.append(line.rstrip())
+    if len(shown) < len(sets):
+        lines.append(f"{indent}... and {len(sets) - len(shown)} more (--all lists every set)")
+    return lines
+
+
+def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12) -> str:
+    """Human-readable text of :func:`kinematics_summary`: counts, sets, model tables, verdicts.
+
+    Steering angles are headings in degrees (0 = rolling straight ahead). At most `limit` sets are listed per
+    list (None: all).
+    """
+    steer = ", ".join(f"heading {n} = {math.degrees(v):.6g} deg" for n, v in summary["steering"].items())
+    m, generic = summary["mobility"], summary["generic_mobility"]
+    mobility = (f"  mobility m = {m}" if m == generic else
+                f"  mobility m = {m} at this steering (m = {generic} at generic steering: a special configuration)")
+    extra = summary["extended_dof"] - m
+    lines = [f"robot {summary['robot']} ({steer or 'no steering'})", mobility]
+    if extra > 0:
+        lines.append(f"  with its {extra} steering rate{'s' if extra > 1 else ''} (extended solutions, §4.5), "
+                     f"{summary['extended_dof']} velocities can be assigned")
+    lines += [f"  velocities: {', '.join(summary['velocity_names'])}",
+              f"  assignable sets ({len(summary['assignable_sets'])}):", *_sets(summary["assignable_sets"], limit)]
+    lost = [s for s in summary["lost_here"] if s]
+    if lost:
+        lines += [f"  not assignable at this steering, though they are at generic steering ({len(lost)}):",
+                  *_sets(lost, limit)]
     for title, key in (("direct model", "direct_model"), ("inverse model", "inverse_model")):
         model = summary[key]
         kind = "" if "error" in model else f" ({model['kind']}, assigned: {', '.join(model['assigned'])})"
@@ -94,5 +123,5 @@ def format_kinematics_summary(summary: dict[str, Any]) -> str:
                  f"{sen['verdict']}")
     for title, key in (("minimal actuator sets", "minimal_actuator_sets"),
                        ("minimal sensor sets", "minimal_sensor_sets")):
-        lines.append(f"  {title}: " + ("  ".join("(" + ", ".join(s) + ")" for s in summary[key]) or "none"))
+        lines += [f"  {title} ({len(summary[key])}):", *(_sets(summary[key], limit) or ["    none"])]
     return "\n".join(lines)

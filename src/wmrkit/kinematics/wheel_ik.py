@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, readonly
 from ..errors import ShapeError, UnknownNameError
 from ..robot import Robot
+from ..wheels import heading_from_beta
 from ..units import UnitError, parse_quantity
 from . import _ik_fast
 from ._ik_fast import wrap_angle
@@ -42,6 +43,9 @@ class WheelCommands:
     - ``slip`` ``(..., N)`` [m/s]: lateral slip (3.11) row 0 / (8.14) left at each fixed wheel, 0 elsewhere.
     - ``feasible`` ``(...)`` bool: every ``|slip| <= slip_tol``.
     - ``beta`` ``(..., n_steer)`` [rad]: the steering configuration the commands hold at (``steer_names`` order).
+    - ``heading`` ``(..., N)`` [rad] in ``(-pi, pi]``: the users' steering angle, each wheel's rolling direction
+      (0 = straight ahead, +x), ``steer + delta - pi/2`` (:func:`wmrkit.wheels.heading_from_beta`); NaN for wheels
+      that do not steer. ``steer`` is the same angle in the thesis's convention (β, the axle).
     - ``held`` ``(..., N)`` bool: the steering axis does not move, the angle is undefined and was kept.
     """
 
@@ -55,6 +59,7 @@ class WheelCommands:
     feasible: np.ndarray
     beta: np.ndarray
     held: np.ndarray
+    heading: np.ndarray
 
     def velocity(self, twist_robot: ArrayLike) -> np.ndarray:
         """The velocity vector ``(twist; rates)`` of ``Robot.velocity_names``. ``(..., 3) -> (..., 3 + n_rates)``."""
@@ -64,15 +69,16 @@ class WheelCommands:
     def to_dict(self) -> dict[str, Any]:
         """One twist's commands as plain data (the ``wmrkit ik --json`` output); NaN stays NaN (JSON: null).
 
-        ``{"wheels": {name: {"steer", "spin", "steer_rate", other joint rates...}}, "slip": {name: m/s},
-        "feasible": bool}``. Only for a single twist (batch shape ``()``).
+        ``{"wheels": {name: {"heading", "spin", "steer_rate", other joint rates...}}, "slip": {name: m/s},
+        "feasible": bool}``: ``heading`` [rad] only for steered wheels (0 = rolling straight ahead). Only for a
+        single twist (batch shape ``()``).
         """
         if self.feasible.shape != ():
             raise ShapeError(f"to_dict: expected one twist (batch shape ()), got batch shape {self.feasible.shape}")
         wheels: dict[str, dict[str, float]] = {}
         for i, name in enumerate(self.wheel_names):
-            entry = {"steer": float(self.steer[i]), "spin": float(self.spin[i]),
-                     "steer_rate": float(self.steer_rate[i])}
+            entry = {"heading": float(self.heading[i])} if np.isfinite(self.heading[i]) else {}
+            entry |= {"spin": float(self.spin[i]), "steer_rate": float(self.steer_rate[i])}
             for rate_name, value in zip(self.rate_names, self.rates.tolist(), strict=True):
                 wheel, _, joint = rate_name.partition(".")
                 if wheel == name and joint not in ("spin", "steer"):
@@ -83,14 +89,14 @@ class WheelCommands:
 
 
 def wheel_commands(
-    robot: Robot, twist_robot: ArrayLike, beta: ArrayLike | None = None, *,
+    robot: Robot, twist_robot: ArrayLike, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None,
     speed_tol: float = 1e-12, slip_tol: float = 1e-9,
 ) -> WheelCommands:
     """Per-wheel inverse kinematics of the thesis §8.4 for a batch of body twists.
 
     ``(..., 3), (..., n_steer) -> WheelCommands`` with batch shape the broadcast of both. `twist_robot`:
-    ``(v_x [m/s], v_y [m/s], omega [rad/s])`` in the robot frame; `beta`: current steering angles [rad]
-    (``robot.steer_names`` order; default the described ones).
+    ``(v_x [m/s], v_y [m/s], omega [rad/s])`` in the robot frame; current steering angles [rad] as the thesis's
+    `beta` or the users' `heading` (``robot.steer_names`` order; default the described ones).
 
     - steerable / double wheels: angle (8.9) of the two solutions ``b`` and ``b + pi`` closest to the current
       angle (the spin sign flips rather than the wheel turning half round), spin (8.12) with that sign; where the
@@ -102,7 +108,8 @@ def wheel_commands(
     """
     p = _ik_fast.plan(robot)
     twist = as_vectors(twist_robot, 3, "twist_robot")
-    current = robot.beta if beta is None else as_vectors(beta, p.n_steer, "beta")
+    beta = robot.steering(beta, heading)
+    current = robot.beta if beta is None else beta
     batch = np.broadcast_shapes(twist.shape[:-1], current.shape[:-1])
     n = p.n_wheels
     if p.only_steerable:  # swerve-like: the angles are the configuration, the spins the rates
@@ -132,6 +139,7 @@ def wheel_commands(
         wheel_names=p.wheel_names, rate_names=p.rate_names,
         steer=_ro(steer), spin=_ro(spin), steer_rate=_ro(_columns(rates, p.steer_rate_select, batch, n)),
         rates=_ro(rates), slip=_ro(slip), feasible=_ro(feasible), beta=_ro(config), held=_ro(held),
+        heading=_ro(heading_from_beta(steer, p.wheel_delta)),
     )
 
 
@@ -182,12 +190,13 @@ def resolve_rate_name(robot: Robot, name: str) -> int:
 
 
 def forward_kinematics(
-    robot: Robot, rates: Mapping[str, ArrayLike], beta: ArrayLike | None = None
+    robot: Robot, rates: Mapping[str, ArrayLike], beta: ArrayLike | None = None, *, heading: ArrayLike | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Body twist from some joint rates: the rest solved by least squares, ranks method (4.9)-(4.11).
 
     `rates`: name -> rate [rad/s] (or [m/s] for ``vx``/``vy``), each ``(...)``; names as in
-    :func:`resolve_rate_name`. `beta`: ``(..., n_steer)`` steering angles [rad] (default the described ones).
+    :func:`resolve_rate_name`. Steering ``(..., n_steer)`` [rad] as the thesis's `beta` or the users' `heading`
+    (default the described ones).
     Returns ``(twist_robot (..., 3), residual (...))``: the residual is the norm of the slip ``A q_dot`` [m/s]
     left by the assignment, 0 when the rates are consistent (the slip indicator of (4.11)/(4.82)). When the
     given rates do not determine the twist the minimum-norm one is returned: check :func:`twist_is_determined`.
@@ -195,8 +204,58 @@ def forward_kinematics(
     columns = _assigned_columns(robot, list(rates))
     values = np.broadcast_arrays(*(np.asarray(_rate_value(k, v), dtype=float) for k, v in rates.items()))
     q_assigned = np.stack(values, axis=-1)
-    q_dot, slip = solve_assigned(robot.constraint_matrix(beta), columns, q_assigned)
+    q_dot, slip = solve_assigned(robot.constraint_matrix(beta, heading=heading), columns, q_assigned)
     return readonly(q_dot[..., :3]), readonly(np.linalg.norm(slip, axis=-1))
+
+
+#: Slip tolerance of :func:`forward_kinematics_check`: a residual above this fraction of the fastest wheel's
+#: surface speed (plus 1e-9 m/s) means the given rates contradict each other (documented in docs/wheel-ik.md).
+FK_SLIP_RTOL = 0.02
+
+
+@dataclass(frozen=True, eq=False)
+class ForwardKinematics:
+    """The twist that best explains some joint rates, and whether the rates agree with each other (one sample).
+
+    ``twist`` (3,) [m/s, rad/s]; ``residual`` the slip norm [m/s]; ``wheel_slip`` (N,) each wheel's slip norm
+    [m/s]; ``tolerance`` [m/s]; ``consistent``: ``residual <= tolerance``; ``slipping``: the wheels whose slip
+    exceeds the tolerance.
+    """
+
+    twist: np.ndarray
+    residual: float
+    wheel_slip: np.ndarray
+    tolerance: float
+    consistent: bool
+    slipping: tuple[str, ...]
+
+
+def forward_kinematics_check(
+    robot: Robot, rates: Mapping[str, float], beta: ArrayLike | None = None, *, heading: ArrayLike | None = None,
+    rtol: float = FK_SLIP_RTOL,
+) -> ForwardKinematics:
+    """:func:`forward_kinematics` for one sample, with the slip split by wheel and judged against a tolerance.
+
+    The tolerance is `rtol` times the fastest given wheel surface speed ``|r phi_dot|`` (or speed) plus 1e-9 m/s:
+    rates that contradict each other beyond it (slip larger than measurement noise) are not ``consistent``.
+    """
+    columns = _assigned_columns(robot, list(rates))
+    q_assigned = np.array([float(_rate_value(k, v)) for k, v in rates.items()])
+    a = robot.constraint_matrix(beta, heading=heading)
+    q_dot, slip = solve_assigned(a, columns, q_assigned)
+    owner = _contact_wheels(robot)
+    wheel_slip = np.sqrt(np.bincount(owner, weights=slip**2, minlength=len(robot.wheels)))
+    speeds = [abs(v) * (robot.wheel(n.partition(".")[0]).r if "." in n and not n.endswith(".steer") else 1.0)
+              for n, v in zip((robot.velocity_names[c] for c in columns), q_assigned, strict=True)]
+    tolerance = rtol * max(speeds, default=0.0) + 1e-9
+    residual = float(np.linalg.norm(slip))
+    slipping = tuple(robot.wheel_names[i] for i in np.flatnonzero(wheel_slip > tolerance))
+    return ForwardKinematics(_ro(q_dot[:3]), residual, _ro(wheel_slip), tolerance, bool(residual <= tolerance), slipping)
+
+
+def _contact_wheels(robot: Robot) -> np.ndarray:
+    """The wheel of every slip row (two rows per contact element)."""
+    return np.repeat([i for i, w in enumerate(robot.wheels) for _ in w.elements()], 2)
 
 
 def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: ArrayLike | None = None) -> np.ndarray:

@@ -1,0 +1,96 @@
+"""Mechanical couplings between joints: differentials, gear trains and chains, steering linkages.
+
+Real robots couple joints mechanically: a car drives its rear wheels through a differential, a synchro drive turns
+every wheel with one chain, an Ackermann linkage steers both front wheels with one actuator. A description says so
+with ``couplings:`` (``docs/description-format.md``); the actuation and sensing analyses (thesis §4.4) then count
+one actuator or sensor per coupling instead of one per joint, and no longer report such a robot as fighting itself.
+
+- ``differential``: one actuator drives the weighted sum ``sum(ratio_j * q_j)`` of the joints' rates (a mechanical
+  differential: the mean of the two wheel rates with ratios 1/2, 1/2); the other combinations stay free.
+- ``gear``: the joints turn together, rigidly, ``q_j = ratio_j * u`` (a chain, a gear train, a synchro drive).
+- ``linkage``: steering joints moved by one mechanism (an Ackermann linkage); the angles are a configuration, so
+  the coupling says that actuating (or sensing) one of them sets them all.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+COUPLING_KINDS = ("differential", "gear", "linkage")
+
+
+@dataclass(frozen=True, slots=True)
+class Coupling:
+    """Joints ``wheel.joint`` moved by one mechanism of `kind`, with one ratio per joint (see module docstring)."""
+
+    kind: str
+    joints: tuple[str, ...]
+    ratios: tuple[float, ...]
+
+    @property
+    def rates(self) -> bool:
+        """The coupling acts on joint rates (columns of the Jacobian form), not on steering angles."""
+        return self.kind != "linkage"
+
+
+def coupled_columns(
+    couplings: tuple[Coupling, ...], names: tuple[str, ...], selected: tuple[int, ...]
+) -> tuple[np.ndarray, tuple[str, ...], np.ndarray, np.ndarray]:
+    """Change of joint-rate variables for the actuation/sensing trees (4.28)/(4.34) under rate couplings.
+
+    `names`: the Jacobian-form columns; `selected`: the columns actuated (or sensed), in order. Returns
+    ``(T_sel, channel_names, T_rest, T_drop)``: matrices ``(n_w, k)`` whose columns span, in rate space, the
+    independent selected channels (one per coupling holding a selected joint, in the order of `selected`; the
+    identity column of every other selected joint), the free rest, and the directions a gear coupling forbids.
+    ``J @ T_sel`` and ``J @ T_rest`` replace ``J_sel`` and ``J_rest``; ``T_drop`` directions are held at zero.
+    """
+    n = len(names)
+    eye = np.eye(n)
+    owner: dict[int, Coupling] = {}
+    for c in couplings:
+        if c.rates:
+            owner.update({names.index(j): c for j in c.joints})
+    channel: dict[Coupling, np.ndarray] = {}
+    across: dict[Coupling, list[np.ndarray]] = {}
+    for c in dict.fromkeys(owner.values()):
+        idx = [names.index(j) for j in c.joints]
+        k = np.array(c.ratios, dtype=float)
+        t = np.zeros(n)
+        t[idx] = k if c.kind == "gear" else k / (k @ k)  # gear: q = k u; differential: u = k . q
+        channel[c] = t
+        across[c] = []
+        for b in np.linalg.svd(k[None, :])[2][1:]:  # the directions across the ratios
+            v = np.zeros(n)
+            v[idx] = b
+            across[c].append(v)
+    sel, sel_names, emitted = [], [], set()
+    for i in selected:
+        c = owner.get(i)
+        if c is None:
+            sel.append(eye[i])
+            sel_names.append(names[i])
+        elif c not in emitted:
+            emitted.add(c)
+            sel.append(channel[c])
+            sel_names.append(f"{c.kind}({', '.join(c.joints)})")
+    rest = [eye[i] for i in range(n) if i not in owner and i not in selected]
+    rest += [channel[c] for c in channel if c not in emitted]
+    rest += [v for c in channel if c.kind == "differential" for v in across[c]]
+    drop = [v for c in channel if c.kind == "gear" for v in across[c]]
+
+    def stack(cols: list[np.ndarray]) -> np.ndarray:
+        return np.array(cols, dtype=float).reshape(len(cols), n).T
+
+    return stack(sel), tuple(sel_names), stack(rest), stack(drop)
+
+
+def linked_steering(couplings: tuple[Coupling, ...], steering: tuple[str, ...]) -> tuple[str, ...]:
+    """The wheels whose steering is set through a linkage by one of the `steering` wheels (with them)."""
+    out = list(steering)
+    for c in couplings:
+        wheels = [j.partition(".")[0] for j in c.joints]
+        if c.kind == "linkage" and any(w in steering for w in wheels):
+            out += [w for w in wheels if w not in out]
+    return tuple(out)
