@@ -156,17 +156,22 @@ def _doc_blocks(lang: str) -> list[str]:
 
 
 def test_issue_example_from_the_doc_loads():
+    """The first example a newcomer copies is a real tricycle: type 4, sufficient and consistent actuators."""
+    from wmrkit.analysis import classify
+    from wmrkit.kinematics import actuation_analysis
+
     text = next(b for b in _doc_blocks("yaml") if b.startswith("name: tricycle-example"))
     robot = robot_from_text(text, source="doc")
-    assert robot.wheel_names == ("rear_left", "caster", "omni")
-    rear, caster, omni = robot.wheels
-    assert (rear.type, rear.l, rear.alpha, rear.beta, rear.r) == ("fixed", 0.45, math.pi / 2, math.pi / 2, 0.23)
-    assert rear.actuated == rear.sensed == ("spin",)
-    assert (caster.type, caster.l, caster.alpha, caster.d, caster.delta, caster.r) == (
-        "castor", 0.8, math.pi, 0.05, 0.0, 0.05)
-    assert (omni.l, omni.alpha, omni.gamma, omni.r_r) == (0.3, 0.0, math.pi / 2, 0.01)
-    assert robot.velocity_names == ("vx", "vy", "omega", "rear_left.spin", "caster.steer", "caster.spin",
-                                    "omni.spin", "omni.roller")
+    assert robot.wheel_names == ("front", "rear_left", "rear_right")
+    front, rear, _ = robot.wheels
+    assert (front.type, front.l, front.alpha, front.r) == ("steerable", 0.9, 0.0, 0.15)
+    assert front.beta == pytest.approx(math.radians(110)) and front.heading == pytest.approx(math.radians(20))
+    assert (rear.type, rear.beta, rear.heading) == ("fixed", math.pi / 2, 0.0)
+    assert robot.velocity_names == ("vx", "vy", "omega", "front.spin", "rear_left.spin", "rear_right.spin")
+    c = classify(robot)
+    assert (c.type, c.mobility, c.steerability, c.degenerate) == (4, 1, 1, False)
+    act = actuation_analysis(robot)
+    assert bool(act.sufficient) and bool(act.consistent)
 
 
 def test_every_doc_example_loads_and_every_doc_error_is_exact():

@@ -148,12 +148,46 @@ def _spin_inset(ax) -> None:
             "$\\dot\\varphi > 0$ drives $+x$.", transform=ax.transAxes, fontsize=10, va="bottom", ha="left")
 
 
+def heading_figure() -> Figure:
+    """Heading (users' steering angle) against the thesis's β: a centred steerable wheel and a castor, from above."""
+    fig = Figure(figsize=(10, 4.6))
+    for k, (title, d, delta) in enumerate((("centred steerable wheel", 0.0, 0.0), ("castor (offset d, δ = 0)", 0.5, 0.0))):
+        ax = fig.add_subplot(1, 2, k + 1)
+        heading = math.radians(35)
+        beta = heading - delta + math.pi / 2
+        joint = np.zeros(2)
+        centre = joint + d * unit(beta + math.pi / 2)  # the wheel centre is d along S_y (thesis 3.8)
+        dashed(ax, centre - unit(0) * 0.2, unit(0) * 1.6)
+        ax.text(centre[0] + 1.4, centre[1] - 0.08, "x (forward)", color=GREY, fontsize=10, ha="right")
+        axle = unit(beta + delta)
+        body = np.array([centre + 0.35 * unit(heading) + 0.09 * axle, centre + 0.35 * unit(heading) - 0.09 * axle,
+                         centre - 0.35 * unit(heading) - 0.09 * axle, centre - 0.35 * unit(heading) + 0.09 * axle])
+        ax.add_patch(Polygon(body, closed=True, facecolor="#dddddd", edgecolor=INK, lw=1.5, zorder=3))
+        if d:
+            ax.plot(*np.array([joint, centre]).T, color=INK, lw=2.5, zorder=4)
+            ax.plot(*joint, "o", color=INK, ms=6, zorder=6)
+            ax.text(*(joint + np.array([0.06, 0.08])), "steering joint", fontsize=10)
+        arrow(ax, centre, 0.55 * axle, BLUE, "axle: β + δ", offset=(0.0, 0.12))
+        arrow(ax, centre, 0.9 * unit(heading), RED, "heading", offset=(0.15, 0.05))
+        angle_mark(ax, centre, 0.6, 0.0, heading, "heading", RED, label_radius=0.75)
+        angle_mark(ax, centre, 0.3, 0.0, beta + delta, "β", BLUE, label_radius=0.2)
+        ax.set_title(title)
+        ax.set_aspect("equal")
+        ax.set_xlim(-0.9, 1.5)
+        ax.set_ylim(-1.0, 1.1)
+        ax.axis("off")
+    fig.suptitle("heading = β + δ − 90°: the direction the wheel rolls when it spins forward (0 = straight ahead)")
+    fig.tight_layout()
+    return fig
+
+
 def main() -> None:
     """Write every figure."""
     with matplotlib.rc_context({"svg.hashsalt": "wmrkit", "svg.fonttype": "none"}):
         fig = wheel_parameters_figure()
         fig.savefig(HERE / "wheel-parameters.png", dpi=100)
         fig.savefig(HERE / "wheel-parameters.svg", metadata={"Date": None})
+        heading_figure().savefig(HERE / "heading.png", dpi=100)
     out = HERE / "catalog"
     out.mkdir(exist_ok=True)
     for name in catalog.names():

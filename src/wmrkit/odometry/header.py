@@ -1,0 +1,104 @@
+"""Units written in a CSV log's header: a log says what its columns hold (``docs/odometry.md``).
+
+A column name may carry its unit in brackets: ``time [ms]``, ``left.spin [rad]``, ``left.spin [rad/s]``,
+``left.spin [counts]``, ``left.spin [counts:u16]`` (an incremental encoder on an unsigned 16-bit counter that wraps;
+``s16`` signed, any width from 8 to 64 bits), ``steer.steer [rad]``, ``steer.steer [counts]``. A log written this way
+needs no ``--spin``/``--steer``/``--counter-bits`` options, and an option that contradicts the header is an error
+rather than a silent misreading.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import WmrkitError
+
+#: Units a joint column may declare, and the log-format mode each means.
+SPIN_UNITS = {"rad": "angle", "rad/s": "velocity", "counts": "counts"}
+STEER_UNITS = {"rad": "angle", "counts": "counts"}
+TIME_UNITS = ("s", "ms", "us", "ns")
+
+_NAME = re.compile(r"^\s*([^\[\]]*?)\s*\[\s*([^\[\]]+?)\s*\]\s*$")
+_COUNTER = re.compile(r"^counts:([us])(\d{1,2})$")
+
+
+class HeaderError(WmrkitError, ValueError):
+    """A unit in a log's header that wmrkit cannot read, or that contradicts an option."""
+
+
+@dataclass(frozen=True)
+class HeaderUnits:
+    """What a header says: plain column names, per-kind modes (None: not said), counter width and signedness."""
+
+    columns: tuple[tuple[str, str], ...]  # (plain name, name as written) for every column with a unit
+    time_unit: str | None = None
+    spin: str | None = None
+    steer: str | None = None
+    bits: int | None = None
+    signed: bool = False
+
+    @property
+    def declared(self) -> bool:
+        return bool(self.columns)
+
+
+def read_header_units(path: str | Path, *, max_chars: int = 1 << 16, delimiter: str = ",") -> HeaderUnits:
+    """The units of a CSV log's header line (bounded read); an unreadable file says nothing here."""
+    try:
+        with open(path, encoding="utf-8", errors="replace", newline="") as f:
+            line = f.readline(max_chars)
+    except (OSError, IsADirectoryError):
+        return HeaderUnits(())
+    return parse_header_units(line.strip("\r\n").split(delimiter), source=str(path))
+
+
+def parse_header_units(names: list[str], *, source: str = "<log>") -> HeaderUnits:
+    """Parse ``name [unit]`` header entries (see the module docstring)."""
+    columns, modes, bits, signed, time_unit = [], {"spin": set(), "steer": set()}, set(), set(), None
+    for written in names:
+        match = _NAME.match(written)
+        if match is None:
+            continue
+        plain, unit = match.group(1), match.group(2)
+        columns.append((plain, written))
+        joint = plain.rpartition(".")[2]
+        if "." not in plain:  # time or another plain column
+            if unit not in TIME_UNITS:
+                raise HeaderError(f"{source}:1: column '{plain}': unknown unit '{unit}' (time units: "
+                                  f"{', '.join(TIME_UNITS)})")
+            time_unit = unit
+            continue
+        kind = "steer" if joint == "steer" else "spin"
+        table = STEER_UNITS if kind == "steer" else SPIN_UNITS
+        counter = _COUNTER.match(unit)
+        if counter is not None:
+            width = int(counter.group(2))
+            if not 8 <= width <= 64:
+                raise HeaderError(f"{source}:1: column '{plain}': counter width {width} bits (8 to 64)")
+            bits.add(width)
+            signed.add(counter.group(1) == "s")
+            unit = "counts"
+        if unit not in table:
+            raise HeaderError(f"{source}:1: column '{plain}': unknown unit '{unit}' (for a {kind} joint: "
+                              f"{', '.join(table)}; counters: counts:u16, counts:s32, ...)")
+        modes[kind].add(table[unit])
+    for kind, found in modes.items():
+        if len(found) > 1:
+            raise HeaderError(f"{source}:1: the {kind} columns mix units ({', '.join(sorted(found))}); one per log")
+    if len(bits) > 1 or len(signed) > 1:
+        raise HeaderError(f"{source}:1: the counter columns mix widths or signedness; one counter per log")
+    return HeaderUnits(tuple(columns), time_unit, next(iter(modes["spin"]), None), next(iter(modes["steer"]), None),
+                       next(iter(bits), None), next(iter(signed), False))
+
+
+def merge_option(name: str, given: object | None, declared: object | None, default: object, source: str) -> object:
+    """An option's value: the header's when the option was not given; the option's when the header is silent;
+    an error when both are given and disagree."""
+    if declared is None:
+        return default if given is None else given
+    if given is not None and given != declared:
+        raise HeaderError(f"{source}: the header says {name} {declared}, the option says {given}; drop the option "
+                          "or fix the header")
+    return declared
