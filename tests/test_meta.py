@@ -93,3 +93,12 @@ def test_every_test_cited_by_the_errata_exists():
 
     missing = [f"{path}::{name}" for path, name in cited if not defined(path, name)]
     assert missing == []
+
+
+def test_every_erratum_is_classified():
+    """Issue 8: each erratum says what it is (thesis error, extraction artefact, missing qualification, extension)."""
+    text = (ROOT / "docs" / "errata.md").read_text()
+    entries = re.split(r"^### ", text, flags=re.M)[1:]
+    classes = ("thesis error", "extraction artefact", "missing qualification", "wmrkit extension")
+    unclassified = [e.splitlines()[0] for e in entries if not any(c in e.lower() for c in classes)]
+    assert unclassified == []
