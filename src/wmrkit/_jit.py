@@ -1,32 +1,68 @@
 """Lazy numba compilation shared by the compiled kernels (constraint matrices, odometry).
 
-A kernel is compiled for one explicit signature on its first call, cached on disk when a cache directory is
-writable and compiled in memory otherwise (a read-only installation). ``.py_func`` keeps the Python source.
+A kernel is compiled for one explicit signature when the work it is given first exceeds a small budget, cached on
+disk when a cache directory is writable and compiled in memory otherwise (a read-only installation). Below the
+budget its Python source runs as plain Python (with every numba helper it calls replaced by that helper's Python
+source): a command on a small robot or a short log answers at once instead of spending seconds compiling kernels
+it barely uses (issue 8: the first run of every command under 2 s). ``.py_func`` keeps the Python source.
 """
 
 from __future__ import annotations
 
 import functools
+import os
+import types
 from collections.abc import Callable
 
 import numba
+import numpy as np
+
+#: Array elements a kernel may process as plain Python, over the whole process, before it is compiled. Set the
+#: environment variable ``WMRKIT_INTERPRET_BUDGET`` (0: always compile) to change it.
+INTERPRET_BUDGET = int(os.environ.get("WMRKIT_INTERPRET_BUDGET", "200000"))
 
 
 def jit(signature) -> Callable[[Callable], Callable]:
-    """Compile the decorated function for `signature` on its first call."""
+    """Compile the decorated function for `signature` once the work given to it exceeds the interpret budget."""
     def decorate(fn: Callable) -> Callable:
         compiled = None
+        interpreted = None
+        spent = 0
 
         @functools.wraps(fn)
         def call(*args):
-            nonlocal compiled
+            nonlocal compiled, interpreted, spent
             if compiled is None:
+                size = sum(a.size for a in args if isinstance(a, np.ndarray))
+                if spent + size <= INTERPRET_BUDGET:
+                    spent += size
+                    if interpreted is None:
+                        interpreted = as_python(fn)
+                    with np.errstate(all="ignore"):  # as compiled code: NaN and inf propagate silently
+                        return interpreted(*args)
                 compiled = compile_cached(fn, signature)
             return compiled(*args)
 
         call.py_func = fn
+        call.is_compiled = lambda: compiled is not None
         return call
     return decorate
+
+
+def as_python(fn: Callable) -> Callable:
+    """`fn` with every numba-compiled function it can reach through its module replaced by its Python source."""
+    shared = dict(fn.__globals__)
+    for name, value in fn.__globals__.items():
+        source = getattr(value, "py_func", None)
+        if source is not None and isinstance(source, types.FunctionType):
+            shared[name] = _rebind(source, shared)
+    return _rebind(fn, shared)
+
+
+def _rebind(fn: types.FunctionType, namespace: dict) -> types.FunctionType:
+    out = types.FunctionType(fn.__code__, namespace, fn.__name__, fn.__defaults__, fn.__closure__)
+    out.__kwdefaults__ = fn.__kwdefaults__
+    return out
 
 
 def compile_cached(fn: Callable, signature) -> Callable:

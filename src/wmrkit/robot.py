@@ -101,7 +101,8 @@ class Robot:
         if heading is None:
             return beta if beta is None else as_vectors(beta, len(self.steer_names), "beta")
         if beta is not None:
-            raise ShapeError("give the steering configuration as beta (thesis) or heading (rolling direction), not both")
+            raise ShapeError("give the steering configuration as beta (thesis) or heading (rolling direction), "
+                             "not both")
         return self.beta_of_heading(heading)
 
     def beta_of_heading(self, heading: ArrayLike) -> np.ndarray:

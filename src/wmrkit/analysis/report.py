@@ -115,7 +115,8 @@ def _summary_table(a: Analysis) -> str:
         rows.append(("isotropy (5.28)", f"does not apply (m = {c.mobility}: no two motions to balance)"))
     else:
         rows += [("condition number κ (5.28)", f"{a.condition_number:.4g} for ({', '.join(a.joints)})"),
-                 ("characteristic length D", f"{a.characteristic_length:.4g} m ({'natural' if a.natural else 'given'})")]
+                 ("characteristic length D",
+                  f"{a.characteristic_length:.4g} m ({'natural' if a.natural else 'given'})")]
     for key, s in a.singular.items():
         rows.append((f"singular {key} model", f"({', '.join(s.assigned) or '-'}): {describe_singular(s, a.robot)}"))
     rows += [("special configuration", s.description) for s in c.special]

@@ -95,4 +95,3 @@ def _g(x: float) -> str:
 
 def _zero(x: float) -> float:
     return 0.0 if abs(x) < 1e-9 else x
-    return "\n".join(lines)

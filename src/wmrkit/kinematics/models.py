@@ -9,9 +9,8 @@ on the configuration, and a set assignable at generic angles can fail at a singu
 
 from __future__ import annotations
 
-import math
-
 import itertools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -23,8 +22,9 @@ from .._shapes import as_vectors, readonly
 from ..errors import SingularError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
 from .linalg import matrix_rank, nondimensional, velocity_scale
-from .nullspace import enumerate_subsets, null_space_assignable, null_space_solution, rref_solution
+from .nullspace import null_space_assignable, null_space_solution, rref_solution
 from .ranks import ranks_assignable, ranks_solution
+from .search import SetList, null_space_prefilter, search_sets
 
 Method = Literal["ranks", "nullspace", "rref"]
 
@@ -88,7 +88,8 @@ def describe_configuration(robot: Robot, beta: np.ndarray, index: tuple[int, ...
     if not robot.steer_names:
         return "the fixed geometry"
     values = robot.heading_of_beta(beta[index] if beta.ndim > 1 else beta)
-    angles = ", ".join(f"{n}={math.degrees(v):.6g} deg" for n, v in zip(robot.steer_names, values.tolist(), strict=True))
+    angles = ", ".join(f"{n}={math.degrees(v):.6g} deg"
+                       for n, v in zip(robot.steer_names, values.tolist(), strict=True))
     where = f"configuration {list(index)} " if index else ""
     return f"{where}heading ({angles})"
 
@@ -129,11 +130,12 @@ def is_assignable(
 def _sets_at(robot: Robot, a: np.ndarray, method: Method) -> tuple[tuple[str, ...], ...]:
     m = np.unique(a.shape[-1] - matrix_rank(a))
     if len(m) != 1:  # the mobility changes within the batch: no set fits every configuration
-        return ()
-    subsets = enumerate_subsets(a.shape[-1], int(m[0]))
-    ok = _assignable(a, subsets, method).reshape(len(subsets), -1).all(axis=1)
+        return SetList()
+    sets, complete, note = search_sets(  # bounded, pruned by the null-space test (.search)
+        range(a.shape[-1]), int(m[0]), lambda s: _assignable(a, s, method).reshape(len(s), -1).all(axis=1),
+        prefilter=null_space_prefilter(a, int(m[0])), what="assignable sets")
     names = robot.velocity_names
-    return tuple(tuple(names[i] for i in s) for s, good in zip(subsets, ok, strict=True) if good)
+    return SetList([tuple(names[i] for i in s) for s in sets], complete, note)
 
 
 def assignable_sets(
@@ -168,10 +170,13 @@ def generically_assignable_sets(robot: Robot) -> tuple[tuple[str, ...], ...]:
     a = nondimensional(robot).constraint_matrix(samples)
     m = generic_mobility(robot)
     generic = a.shape[-1] - matrix_rank(a) == m
-    subsets = enumerate_subsets(a.shape[-1], m)
-    ok = (ranks_assignable(a, subsets) & generic).any(axis=1)
+    tests = [null_space_prefilter(a[i], m) for i in np.flatnonzero(generic)]
+    sets, complete, note = search_sets(  # bounded, pruned by the null-space test (.search)
+        range(a.shape[-1]), m, lambda s: (ranks_assignable(a, s) & generic).any(axis=1),
+        prefilter=lambda s: np.any([t(s) for t in tests], axis=0) if tests else np.zeros(len(s), dtype=bool),
+        what="generically assignable sets")
     names = robot.velocity_names
-    return tuple(tuple(names[i] for i in s) for s, good in zip(subsets, ok, strict=True) if good)
+    return SetList([tuple(names[i] for i in s) for s in sets], complete, note)
 
 
 def _refuse(robot: Robot, names: Sequence[str], beta: np.ndarray, ok: np.ndarray) -> SingularError:

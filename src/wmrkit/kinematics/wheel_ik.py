@@ -18,8 +18,8 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, readonly
 from ..errors import ShapeError, UnknownNameError
 from ..robot import Robot
-from ..wheels import heading_from_beta
 from ..units import UnitError, parse_quantity
+from ..wheels import heading_from_beta
 from . import _ik_fast
 from ._ik_fast import wrap_angle
 from .linalg import matrix_rank, solve_assigned
@@ -250,7 +250,8 @@ def forward_kinematics_check(
     tolerance = rtol * max(speeds, default=0.0) + 1e-9
     residual = float(np.linalg.norm(slip))
     slipping = tuple(robot.wheel_names[i] for i in np.flatnonzero(wheel_slip > tolerance))
-    return ForwardKinematics(_ro(q_dot[:3]), residual, _ro(wheel_slip), tolerance, bool(residual <= tolerance), slipping)
+    consistent = bool(residual <= tolerance)
+    return ForwardKinematics(_ro(q_dot[:3]), residual, _ro(wheel_slip), tolerance, consistent, slipping)
 
 
 def _contact_wheels(robot: Robot) -> np.ndarray:

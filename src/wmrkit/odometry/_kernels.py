@@ -84,7 +84,7 @@ def _cos_sin(x: float) -> tuple[float, float]:
     hz = 0.5 * z
     wc = 1.0 - hz
     c = wc + (((1.0 - wc) - hz) + (z * rc - y0 * y1))
-    q = n - 4.0 * math.floor(0.25 * n)  # quadrant 0..3, in floating point (no int conversion of a NaN)
+    q = n - 4.0 * np.floor(0.25 * n)  # quadrant 0..3, in floating point (no int conversion of a NaN)
     swap = (q == 1.0) or (q == 3.0)
     cos_x = s if swap else c
     sin_x = c if swap else s

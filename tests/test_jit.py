@@ -1,0 +1,59 @@
+"""Kernels run as plain Python below the interpret budget and compiled above it: the same numbers either way."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import wmrkit._jit as jit
+from wmrkit import catalog
+from wmrkit.odometry.pipeline import odometry
+from wmrkit.odometry.synthetic import TwistProfile, simulate
+
+
+def _fresh(monkeypatch, budget: int):
+    """Reload the kernel modules so their lazy wrappers start uncompiled, under `budget`."""
+    import importlib
+
+    import wmrkit._constraint_kernel
+    import wmrkit.odometry._kernels
+
+    monkeypatch.setattr(jit, "INTERPRET_BUDGET", budget)
+    importlib.reload(wmrkit._constraint_kernel)
+    importlib.reload(wmrkit.odometry._kernels)
+
+
+@pytest.mark.parametrize("name", ["forklift", "mecanum-4", "thesis-steer-castor", "swerve-4"])
+def test_constraint_matrix_interpreted_equals_compiled(monkeypatch, name):
+    robot = catalog.load(name)
+    beta = np.random.default_rng(0).uniform(-3, 3, (50, len(robot.steer_names)))
+    _fresh(monkeypatch, 10**9)
+    interpreted = robot.constraint_matrix(beta)
+    from wmrkit._constraint_kernel import fill_constraint_rows
+
+    assert not fill_constraint_rows.is_compiled()
+    _fresh(monkeypatch, 0)
+    compiled = robot.constraint_matrix(beta)
+    from wmrkit._constraint_kernel import fill_constraint_rows
+
+    assert fill_constraint_rows.is_compiled()
+    np.testing.assert_allclose(interpreted, compiled, rtol=0, atol=1e-15)
+
+
+def test_odometry_interpreted_equals_compiled(monkeypatch):
+    robot = catalog.load("forklift")
+    run = simulate(robot, TwistProfile.from_segments([(5.0, 1.0, 0.0, 0.2)]).about((-1.0, 0.0)), 100.0)
+    _fresh(monkeypatch, 10**9)
+    slow = odometry(robot, run.log)
+    _fresh(monkeypatch, 0)
+    fast = odometry(robot, run.log)
+    np.testing.assert_allclose(slow.poses, fast.poses, rtol=0, atol=1e-12)
+
+
+def test_the_python_source_calls_no_compiled_helper():
+    """as_python rebinds every numba helper to its source: nothing compiles while the budget lasts."""
+    from wmrkit.odometry import _kernels
+
+    py = jit.as_python(_kernels.odometry_chunk.py_func)
+    helpers = [v for v in py.__globals__.values() if hasattr(v, "py_func")]
+    assert helpers == []
