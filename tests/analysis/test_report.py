@@ -38,10 +38,26 @@ def test_json_output_has_the_keys_of_the_issue(capsys):
     out = json.loads(capsys.readouterr().out)
     assert (out["mobility"], out["steerability"], out["type"], out["degenerate"]) == (1, 1, 4, False)
     assert set(out["actuation"]) >= {"consistent", "sufficient"} and set(out["sensing"]) >= {"sufficient"}
-    assert out["actuation"]["consistent"] is False  # two driven wheels and one degree of mobility (ch. 4)
+    assert out["actuation"]["consistent"] is True  # two driven wheels, one motor: the catalog declares the differential
     assert out["actuation"]["sufficient"] is True and out["sensing"]["sufficient"] is True
     assert out["condition_number"] == pytest.approx(1.0)
     assert out["characteristic_length"] > 0
+
+
+def test_couplings_decide_the_actuation_verdict(capsys):
+    """Issue 8: the forklift drives both wheels through one differential; without that coupling its two driven
+    wheels and one degree of mobility are over-actuated (ch. 4), and the words say what that means."""
+    import dataclasses
+
+    from wmrkit.kinematics import actuation_analysis
+
+    robot = catalog.load("forklift")
+    assert robot.couplings and bool(actuation_analysis(robot).consistent)
+    free = dataclasses.replace(robot, couplings=())
+    assert not bool(actuation_analysis(free).consistent) and bool(actuation_analysis(free).sufficient)
+    assert main(["analyze", "mecanum-4"]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if "actuation:" in x)
+    assert "over-actuated" in line and "coordinated" in line and "inconsistent" not in line
 
 
 def test_json_condition_number_at_the_natural_or_given_length(capsys):
@@ -70,7 +86,7 @@ def test_text_summary_and_report_flag(capsys, tmp_path):
 
 
 def test_steer_option_changes_the_configuration(capsys):
-    assert main(["analyze", "thesis-tricycle", "--steer", "o3=90 deg", "--json"]) == 0
+    assert main(["analyze", "thesis-tricycle", "--steer", "o3=0 deg", "--json"]) == 0  # heading 0: beta = 90 deg
     out = json.loads(capsys.readouterr().out)
     assert "(0.000, 0.000)" in out["icr"]  # axle through the origin: pure rotation about O_R (Fig. 6.8a)
 

@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 
 from ..plotting.robot import draw_robot
 from ..robot import Robot
+from ..wheels import heading_from_beta
 from .classification import Classification
 from .icr import icr, steer_to_icr, twist_of_icr
 from .isotropy import condition_map, natural_length, twist_condition_number
@@ -46,18 +47,23 @@ def _include(ax, point, margin: float) -> None:
     ax.set_ylim(min(ylim[0], point[1] - margin), max(ylim[1], point[1] + margin))
 
 
-def _mark_icr(ax, h: np.ndarray, size: float, label: str = "ICR") -> None:
+def _mark_icr(ax, h: np.ndarray, size: float, label: str = "ICR") -> str:
+    """Mark the point `h` (homogeneous) when it is near; else return a note for the title (never text over the
+    drawing, where it would cover wheel labels)."""
     x, y, w = h
     if abs(w) > 1e-9 * max(abs(x), abs(y)) and math.hypot(x / w, y / w) < 6 * size:
         p = (x / w, y / w)
         _include(ax, p, 0.25 * size)
         ax.plot(*p, marker="*", markersize=18, color=ICR_COLOR, markeredgecolor="white", zorder=12, label=label)
-    else:
-        far = (x, y) if abs(w) <= 1e-9 * max(abs(x), abs(y)) else (x / w, y / w)
-        u = np.array(far) / np.hypot(*far)
-        ax.annotate(f"{label} far away ({'at infinity' if abs(w) < 1e-9 else f'{np.hypot(x / w, y / w):.1f} m'})",
-                    xy=(0.5 + 0.42 * u[0], 0.5 + 0.42 * u[1]), xycoords="axes fraction", color=ICR_COLOR,
-                    ha="center", fontsize=9, zorder=12)
+        return ""
+    return f"{label} far away ({'at infinity' if abs(w) < 1e-9 else f'{np.hypot(x / w, y / w):.1f} m'})"
+
+
+def _heading_ticks(ax, which: str = "x") -> None:
+    """Heading axes in degrees with a tick every 90 deg (never crowded)."""
+    ticks = [-180, -90, 0, 90, 180]
+    (ax.set_xticks if which == "x" else ax.set_yticks)(ticks)
+    (ax.set_xlim if which == "x" else ax.set_ylim)(-180, 180)
 
 
 def _velocity_arrows(ax, robot: Robot, twist: np.ndarray, size: float) -> None:
@@ -129,15 +135,17 @@ def motions_figure(robot: Robot, cls: Classification) -> Figure | None:
         draw_robot(robot, ax, beta=beta, labels=False)
         twist = twist_of_icr(h)
         _velocity_arrows(ax, robot, twist, size)
-        _mark_icr(ax, h, size)
+        far = _mark_icr(ax, h, size)
         if abs(h[2]) > 1e-12:
             c = h[:2] / h[2]
             for w in robot.wheels:
                 ax.plot([w.position[0], c[0]], [w.position[1], c[1]], color=ICR_COLOR, linewidth=0.6, alpha=0.5)
         what = "translation" if abs(h[2]) < 1e-12 else f"turn about ({h[0] / h[2]:.2f}, {h[1] / h[2]:.2f}) m"
-        steer = ", ".join(f"{n}={math.degrees(b):.0f}°" for n, b in zip(robot.steer_names, beta, strict=True)
+        headings = robot.heading_of_beta(beta)
+        steer = ", ".join(f"{n} {math.degrees(b):.0f}°" for n, b in zip(robot.steer_names, headings, strict=True)
                           if n in set(constraint_lines(robot).wheels))
-        ax.set_title(what + (f"\n{steer}" if steer else ""), fontsize=9)
+        what += f"; {far}" if far and abs(h[2]) > 1e-12 else ""
+        ax.set_title(what + (f"\nheadings: {steer}" if steer else ""), fontsize=9)
     fig.subplots_adjust(left=0.08, right=0.97, bottom=0.06, top=0.93, wspace=0.3, hspace=0.35)
     return fig
 
@@ -168,30 +176,33 @@ def condition_figure(robot: Robot, joints: tuple[str, ...], length: float, varia
     if not variables:
         return None
     idx = [robot.steer_names.index(v) for v in variables[:2]]
-    axis = np.linspace(-np.pi, np.pi, resolution + 1)
+    axis = np.linspace(-np.pi, np.pi, resolution + 1)  # headings
     fig = Figure(figsize=(6.4, 4.4), dpi=100)
     ax = fig.add_subplot()
     if len(idx) == 1:
-        beta = np.broadcast_to(robot.beta, (len(axis), len(robot.beta))).copy()
-        beta[:, idx[0]] = axis
-        kappa = condition_map(robot, beta, joints=joints, length=length)
+        heading = np.broadcast_to(robot.heading, (len(axis), len(robot.beta))).copy()
+        heading[:, idx[0]] = axis
+        kappa = condition_map(robot, robot.beta_of_heading(heading), joints=joints, length=length)
         ax.semilogy(np.degrees(axis), np.where(np.isfinite(kappa), kappa, np.nan), color="#1f77b4")
-        ax.axvline(math.degrees(robot.beta[idx[0]]), color="#999999", linestyle=":", label="described")
-        ax.set_xlabel(f"{variables[0]} steering angle [deg]")
+        ax.axvline(math.degrees(robot.heading[idx[0]]), color="#999999", linestyle=":", label="described")
+        _heading_ticks(ax)
+        ax.set_xlabel(f"heading of {variables[0]} [deg]")
         ax.set_ylabel("condition number κ")
         ax.legend(loc="upper right", fontsize=8)
     else:
         b1, b2 = np.meshgrid(axis, axis, indexing="ij")
-        beta = np.broadcast_to(robot.beta, (*b1.shape, len(robot.beta))).copy()
-        beta[..., idx[0]], beta[..., idx[1]] = b1, b2
-        kappa = condition_map(robot, beta, joints=joints, length=length)
+        heading = np.broadcast_to(robot.heading, (*b1.shape, len(robot.beta))).copy()
+        heading[..., idx[0]], heading[..., idx[1]] = b1, b2
+        kappa = condition_map(robot, robot.beta_of_heading(heading), joints=joints, length=length)
         shown = np.log10(np.clip(np.where(np.isfinite(kappa), kappa, np.nan), 1.0, 1e4))
         mesh = ax.pcolormesh(np.degrees(b1), np.degrees(b2), shown, cmap="viridis_r", shading="auto",
                              vmin=0.0, vmax=max(1.0, float(np.nanmax(shown)) if np.isfinite(shown).any() else 1.0))
         fig.colorbar(mesh, ax=ax, label="log10 κ")
-        ax.plot(*np.degrees(robot.beta[idx]), "o", color="white", markeredgecolor="black", label="described")
-        ax.set_xlabel(f"{variables[0]} [deg]")
-        ax.set_ylabel(f"{variables[1]} [deg]")
+        ax.plot(*np.degrees(robot.heading[idx]), "o", color="white", markeredgecolor="black", label="described")
+        _heading_ticks(ax, "x")
+        _heading_ticks(ax, "y")
+        ax.set_xlabel(f"heading of {variables[0]} [deg]")
+        ax.set_ylabel(f"heading of {variables[1]} [deg]")
         ax.legend(loc="upper right", fontsize=8)
     ax.set_title(f"κ of ({', '.join(joints)}) at D = {length:.3g} m", fontsize=10)
     fig.subplots_adjust(left=0.12, right=0.97, bottom=0.13, top=0.9)
@@ -217,19 +228,24 @@ def singular_figure(robot: Robot, s: SingularSet, title: str) -> Figure | None:
     for k, (lam, label) in enumerate(zip(lines, cl.labels, strict=True)):
         _draw_line(ax, lam, color=LINE_COLORS[k % len(LINE_COLORS)], linewidth=1.4, label=label, zorder=4)
     if len(lines) >= 2:
-        _mark_icr(ax, common_point(lines), size, label="common point")
+        far = _mark_icr(ax, common_point(lines), size, label="common point")
+    else:
+        far = ""
     ax.legend(loc="lower left", fontsize=7, framealpha=0.85)
-    where = ", ".join(f"{v}={math.degrees(b):.1f}°" for v, b in zip(s.variables, beta[idx], strict=True))
-    ax.set_title(f"{title}: {'always singular' if s.always else 'singular at ' + where}", fontsize=9)
+    shown = robot.heading_of_beta(beta)[[robot.steer_names.index(v) for v in s.variables]] if s.variables else []
+    where = "heading " + ", ".join(f"{v} {math.degrees(b):.1f}°" for v, b in zip(s.variables, shown, strict=True))
+    ax.set_title(f"{title}: {'always singular' if s.always else 'singular at ' + where}"
+                 + (f"\n{far}" if far else ""), fontsize=9)
     if two:
         ax2 = fig.add_subplot(1, 2, 2)
-        c = np.degrees(s.configurations)
+        delta = np.array([robot.wheel(v).delta for v in s.variables])
+        c = np.degrees(heading_from_beta(s.configurations, delta))
         ax2.plot(c[:, 0], c[:, 1], ".", markersize=3, color=ICR_COLOR)
-        ax2.set_xlim(-180, 180)
-        ax2.set_ylim(-180, 180)
-        ax2.set_xlabel(f"{s.variables[0]} [deg]")
-        ax2.set_ylabel(f"{s.variables[1]} [deg]")
-        ax2.plot(*np.degrees(robot.beta[idx]), "o", color="white", markeredgecolor="black", label="described")
+        _heading_ticks(ax2, "x")
+        _heading_ticks(ax2, "y")
+        ax2.set_xlabel(f"heading of {s.variables[0]} [deg]")
+        ax2.set_ylabel(f"heading of {s.variables[1]} [deg]")
+        ax2.plot(*np.degrees(robot.heading[idx]), "o", color="white", markeredgecolor="black", label="described")
         ax2.legend(loc="upper right", fontsize=8)
         ax2.set_title("singular configurations", fontsize=9)
         ax2.grid(True, alpha=0.3)
