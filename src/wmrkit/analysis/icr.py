@@ -72,9 +72,11 @@ def _f(x: float) -> str:
     return "0.000" if text == "-0.000" else text
 
 
-def icr(robot: Robot, beta: ArrayLike | None = None) -> ICRSet:
-    """The admissible ICRs of `robot` at one steering configuration `beta` ``(n_steer,)`` (5.9)-(5.10)."""
-    beta = robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
+def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None) -> ICRSet:
+    """The admissible ICRs of `robot` at one steering configuration ``(n_steer,)`` (5.9)-(5.10), given as the
+    thesis's `beta` or the users' `heading` (default the described one)."""
+    beta = robot.steering(beta, heading)
+    beta = robot.beta if beta is None else beta
     g = constraint_lines(robot).lines(beta)
     rank = int(matrix_rank(g)) if len(g) else 0
     if rank == 0:

@@ -137,16 +137,17 @@ def _twist_model(robot: Robot, joints: tuple[str, ...]) -> TwistModel:
 
 
 def twist_condition_number(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple[str, ...] | None = None,
-                           length: float | None = None) -> np.ndarray:
+                           length: float | None = None, heading: ArrayLike | None = None) -> np.ndarray:
     """Condition number (5.28) of the joint rates as a function of the admissible twists ``(vx, vy, D omega)``.
 
     ``(..., n_steer) -> (...)``; `joints` default to :func:`default_joints`, `length` D [m] to the natural
     length at the described configuration. ``inf`` where the joints cannot tell some motions apart (a singular
     model, ch. 6); ``nan`` where the robot cannot move (uncoordinated steering). With m = 1 it is 1 wherever
-    defined: isotropy does not apply to types 4 and 5 (§5.5.4-5.5.5).
+    defined: isotropy does not apply to types 4 and 5 (§5.5.4-5.5.5). Steering as `beta` or `heading`.
     """
     model = twist_model(robot, joints)
-    beta = robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
+    beta = robot.steering(beta, heading)
+    beta = robot.beta if beta is None else beta
     if length is None:
         length = natural_length(robot, joints=model.joints)[0]
     return _kappa(model, beta, float(length))

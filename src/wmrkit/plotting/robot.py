@@ -185,16 +185,17 @@ def _draw_frame(ax: Axes, scale: float) -> list[np.ndarray]:
 
 
 def draw_robot(robot: Robot, ax: Axes | None = None, *, beta: ArrayLike | None = None,
-               labels: bool = True) -> Axes:
+               labels: bool = True, heading: ArrayLike | None = None) -> Axes:
     """Draw `robot` seen from above (x right, y up) and return the Axes.
 
     ``beta``: steering configuration ``(..., n_steer)`` [rad] (``Robot.steer_names`` order); default the
     described one. With several configurations (leading batch axes) the first is drawn in full and the others'
     steering wheels faintly over it, e.g. to show a steering sweep. Orange wheels and square joints are
     actuated, blue dots and rings are sensed joints; see the legend. ``labels=False`` leaves out wheel names,
-    title and legend. Without `ax`, a new figure 800 px wide is sized to the robot's shape.
+    title and legend. Without `ax`, a new figure 800 px wide is sized to the robot's shape. ``heading``: the
+    steering as headings instead of `beta` (0 = rolling straight ahead).
     """
-    configs = _configurations(robot, beta)
+    configs = _configurations(robot, robot.steering(beta, heading))
     own = ax is None
     if ax is None:
         ax = Figure(figsize=(8, 8), dpi=100).add_subplot()
