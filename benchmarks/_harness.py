@@ -21,12 +21,17 @@ class Result:
 
     def line(self) -> str:
         rate = self.n / self.ours_s
-        text = f"{self.name:<46} {self.n:>10,d} items  {self.ours_s * 1e3:9.2f} ms  {rate / 1e6:8.2f} M/s"
+        text = f"{self.name:<46} {self.n:>10,d} items  {_time(self.ours_s)}  {rate / 1e6:8.2f} M/s"
         if self.peer_s is None:
             text += f"  | peer {self.peer}: ABSENT"
         else:
-            text += f"  | {self.peer}: {self.peer_s * 1e3:9.2f} ms  ratio {self.peer_s / self.ours_s:8.1f}x"
+            text += f"  | {self.peer}: {_time(self.peer_s)}  ratio {self.peer_s / self.ours_s:8.1f}x"
         return text + (f"  [target: {self.target}]" if self.target else "")
+
+
+def _time(seconds: float) -> str:
+    """Milliseconds, or microseconds below one millisecond (single calls)."""
+    return f"{seconds * 1e3:9.2f} ms" if seconds >= 1e-3 else f"{seconds * 1e6:9.2f} us"
 
 
 def best_time(fn: Callable[[], object], *, repeat: int = 3) -> float:

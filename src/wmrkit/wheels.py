@@ -100,6 +100,9 @@ class Wheel:
     roller_inertia: float = 0.0
     mass: float = 0.0
     tyre: Tyre | None = None
+    # steering range (wmrkit.control, thesis §8.4.1/§8.6.3): (min, max) HEADING [rad] the steering joint reaches,
+    # e.g. (-pi/2, pi/2) for the forklift; None: unlimited
+    steer_range: tuple[float, float] | None = None
 
     @property
     def kind(self) -> WheelKind:
@@ -193,9 +196,10 @@ _ELEMENTS = {
 
 
 def wrap_angle(angle: ArrayLike) -> np.ndarray:
-    """Angles wrapped to (-pi, pi]; ``(...) -> (...)``."""
+    """Angles wrapped to ``(-pi, pi]`` [rad]; exact (no rounding) for angles already in range. ``(...) -> (...)``."""
     a = np.asarray(angle, dtype=float)
-    return np.pi - np.mod(np.pi - a, 2 * np.pi)
+    y = a - 2 * math.pi * np.round(a / (2 * math.pi))
+    return np.where(y <= -math.pi, y + 2 * math.pi, np.where(y > math.pi, y - 2 * math.pi, y))
 
 
 def heading_from_beta(beta: ArrayLike, delta: ArrayLike = 0.0) -> np.ndarray:

@@ -21,18 +21,11 @@ import numpy as np
 
 from .._shapes import readonly
 from ..robot import Robot
-from ..wheels import generic_slip_rows
+from ..wheels import wrap_angle, generic_slip_rows
 
 TWO_PI = 2.0 * math.pi
 CONSTANT_TYPES = ("fixed", "swedish", "ball", "orthogonal")
 TWIST_STEERED_TYPES = ("steerable", "double")
-
-
-def wrap_angle(angle: np.ndarray) -> np.ndarray:
-    """Angles wrapped to ``(-pi, pi]`` [rad]; exact (no rounding) for angles already in range. ``(...) -> (...)``."""
-    a = np.asarray(angle, dtype=float)
-    y = a - TWO_PI * np.round(a / TWO_PI)
-    return np.where(y <= -math.pi, y + TWO_PI, np.where(y > math.pi, y - TWO_PI, y))
 
 
 @dataclass(frozen=True, eq=False)

@@ -276,8 +276,8 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
     cols_a = np.array(cols)
     assigned = np.array([cols.index(robot.velocity_index(j)) for j in rate_joints], dtype=int)
     joints = tuple(dict.fromkeys([*rate_joints, *steer_joints]))
-    model = OdometryModel(robot, joints, tuple(rate_joints), tuple(steer_joints), np.array(rows), cols_a, assigned,
-                          np.array(steer_index, dtype=int), _frozen(np.array(row_weights)), None, None)
+    model = OdometryModel(robot, joints, tuple(rate_joints), tuple(steer_joints), np.array(rows, dtype=int), cols_a,
+                          assigned, np.array(steer_index, dtype=int), _frozen(np.array(row_weights)), None, None)
     if steer_joints:
         return model
     if not _twist_determined(robot, robot.beta[None, :], model)[0]:

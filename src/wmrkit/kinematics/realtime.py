@@ -1,0 +1,206 @@
+"""Single-call kinematics for a controller's tick: per-wheel IK, FK and one odometry step, compiled per robot.
+
+The batched functions (:func:`~wmrkit.kinematics.wheel_ik.wheel_commands`, :func:`~wmrkit.kinematics.wheel_ik.
+forward_kinematics`, :func:`wmrkit.odometry.odometry`) are made for arrays of twists and samples; one call on one
+twist pays tens of microseconds of NumPy overhead. :func:`realtime` compiles, once per robot, a numba kernel with the
+robot's geometry frozen in as constants. Each call then takes scalars and caller-owned arrays and writes its results
+into them: no Python objects are created per call. The numbers are those of the batched path (same formulas: the
+three wheel groups of ``_ik_fast`` (§8.4), the sensed direct model (4.11) of :func:`wmrkit.odometry.odometry_model`,
+the exact SE(2) step of paper 003 with the same inlined sine and cosine). ``benchmarks/bench_realtime.py`` times them
+against WPILib per call.
+
+Steering angles at this door are headings (0 = rolling straight ahead), as everywhere a user types or reads one.
+FK and the odometry step are compiled for robots whose sensed model does not depend on steering angles (differential,
+skid-steer, Mecanum, omni, ...); for robots that steer they evaluate the model's matrices at the given headings per
+call (correct, slower).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numba
+import numpy as np
+
+from ..errors import WmrkitError
+from ..odometry._kernels import _cos_sin, _sinc
+from ..robot import Robot
+from . import _ik_fast
+
+HALF_PI = 0.5 * math.pi
+
+
+@dataclass(frozen=True, eq=False)
+class Realtime:
+    """Compiled single-call kinematics of one robot (build with :func:`realtime`). Arrays are caller-owned.
+
+    - ``ik(vx, vy, omega, heading, rates_out, heading_out) -> bool``: per-wheel IK of one twist. `heading`
+      ``(n_steer,)`` the current headings [rad]; writes the joint rates ``(n_rates,)`` (``robot.rate_names``) and
+      the new headings; returns whether the twist is feasible (no fixed wheel slips beyond 1e-9 m/s).
+    - ``fk(rates, heading, twist_out)``: the twist ``(3,)`` from the sensed joint rates ``(n_a,)`` (``rate_joints``)
+      by the least squares (4.11), at headings ``(n_steer_sensed,)`` of ``steer_joints`` (ignored when constant).
+    - ``odometry_step(pose, previous, positions, heading_mid)``: one exact SE(2) step; `pose` ``(3,)`` is updated
+      in place from the joint positions ``(n_a,)`` (``rate_joints``) and `previous` (updated to `positions`).
+    """
+
+    robot: Robot
+    rate_joints: tuple[str, ...]
+    steer_joints: tuple[str, ...]
+    constant: bool
+    ik: Any
+    fk: Any
+    odometry_step: Any
+
+
+def realtime(robot: Robot, sensed: tuple[str, ...] | None = None, *, speed_tol: float = 1e-12,
+             slip_tol: float = 1e-9) -> Realtime:
+    """Compile the single-call kinematics of `robot` (about a second, once); `sensed` as for the odometry model."""
+    from ..odometry.model import odometry_model
+
+    p = _ik_fast.plan(robot)
+    ik = _ik_kernel(p, robot, speed_tol, slip_tol)
+    try:
+        model = odometry_model(robot, sensed)
+    except WmrkitError as err:  # the sensors do not give the motion: the IK still works, FK and odometry cannot
+        refuse = _refusal(err)
+        return Realtime(robot, (), (), False, ik, refuse, refuse)
+    if model.constant:
+        twist_map = np.ascontiguousarray(model.solution[:3], dtype=float)
+        fk = _constant_fk(twist_map)
+        step = _constant_step(twist_map)
+    else:
+        fk, step = _steering_fk_and_step(model)
+    return Realtime(robot, model.rate_joints, model.steer_joints, model.constant, ik, fk, step)
+
+
+def _refusal(err: Exception):
+    def refuse(*_args):
+        raise type(err)(str(err))
+
+    return refuse
+
+
+def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float):
+    """The IK of ``wheel_commands`` for one twist, with the plan's arrays frozen in as constants."""
+    n_rates, n_steer = p.n_rates, p.n_steer
+    constant = np.ascontiguousarray(p.constant_rates, dtype=float) if p.has_constant else np.zeros((3, n_rates))
+    lateral = np.ascontiguousarray(p.fixed_lateral, dtype=float)
+    n_fixed = lateral.shape[1]
+    steered_beta, sx, sy = p.steered_beta.copy(), p.steered_x.copy(), p.steered_y.copy()
+    n_o = len(sx)
+    spin_col, inv_r = np.full(n_o, -1), np.zeros(n_o)  # per twist-steered wheel: its spin column (-1: a double)
+    spin_col[p.steered_spin_of], inv_r[p.steered_spin_of] = p.steered_spin_col, p.steered_inv_r
+    e_beta, e_castor = p.element_beta.copy(), p.element_castor.copy()
+    e_steer, e_spin = p.element_steer_col.copy(), p.element_spin_col.copy()
+    offset, el, ealpha, ed, edelta, egamma, er, _ = (a.copy() for a in p.element_params)
+    n_e = len(e_beta)
+    delta = np.array([w.delta for w in robot.wheels if w.kind.steers], dtype=float)
+    two_pi = 2.0 * math.pi
+
+    @numba.njit(cache=False)
+    def wrap(a):
+        y = a - two_pi * np.round(a / two_pi)
+        if y <= -math.pi:
+            return y + two_pi
+        if y > math.pi:
+            return y - two_pi
+        return y
+
+    @numba.njit(cache=False)
+    def ik(vx, vy, w, heading, rates_out, heading_out):
+        beta = heading_out  # the thesis's angles while computing, headings on return: nothing is allocated
+        for k in range(n_steer):
+            beta[k] = wrap(heading[k] - delta[k] + HALF_PI)
+        for j in range(n_rates):
+            rates_out[j] = vx * constant[0, j] + vy * constant[1, j] + w * constant[2, j]
+        for i in range(n_o):  # (8.9), (8.12): the steering axis's velocity u, the closer of b and b + pi
+            k = steered_beta[i]
+            minus_ux = sy[i] * w - vx
+            uy = sx[i] * w + vy
+            speed = math.sqrt(minus_ux * minus_ux + uy * uy)
+            sign = math.copysign(1.0, minus_ux * math.sin(beta[k]) + uy * math.cos(beta[k]))
+            moving = speed > speed_tol
+            if moving:
+                beta[k] = math.atan2(minus_ux * sign + 0.0, uy * sign)
+            if spin_col[i] >= 0:
+                rates_out[spin_col[i]] = -speed * sign * inv_r[i] if moving else 0.0
+        for e in range(n_e):  # castor-like elements at the (new) angle: rows (3.10), (8.24), (8.25)
+            theta = beta[e_beta[e]] + offset[e] + edelta[e] + egamma[e]
+            c, s = math.cos(theta), math.sin(theta)
+            cdg, sdg = math.cos(edelta[e] + egamma[e]), math.sin(edelta[e] + egamma[e])
+            lat = vx * c + vy * s + w * (el[e] * math.sin(theta - ealpha[e]) - ed[e] * cdg)
+            roll = -vx * s + vy * c + w * (el[e] * math.cos(theta - ealpha[e]) + ed[e] * sdg)
+            beta_dot = -lat / (-ed[e] * cdg) if e_castor[e] else 0.0
+            rates_out[e_steer[e]] = beta_dot
+            rates_out[e_spin[e]] = -(roll + ed[e] * sdg * beta_dot) / (er[e] * math.cos(egamma[e]))
+        feasible = True
+        for f in range(n_fixed):
+            slip = vx * lateral[0, f] + vy * lateral[1, f] + w * lateral[2, f]
+            if abs(slip) > slip_tol:
+                feasible = False
+        for k in range(n_steer):
+            beta[k] = wrap(beta[k] + delta[k] - HALF_PI)
+        return feasible
+
+    return ik
+
+
+def _constant_fk(twist_map: np.ndarray):
+    n_a = twist_map.shape[1]
+
+    @numba.njit(cache=False)
+    def fk(rates, heading, twist_out):
+        for r in range(3):
+            acc = 0.0
+            for j in range(n_a):
+                acc += twist_map[r, j] * rates[j]
+            twist_out[r] = acc
+
+    return fk
+
+
+def _constant_step(twist_map: np.ndarray):
+    @numba.njit(cache=False)
+    def step(pose, previous, positions, heading_mid):
+        _step(pose, previous, positions, twist_map)
+
+    return step
+
+
+@numba.njit(cache=True)
+def _step(pose, previous, positions, twist_map):
+    """One exact SE(2) step (paper 003 (21)-(25)): body increments ``twist_map @ dq``, chord ``sinc(h)`` along the
+    mid heading, with the odometry kernels' own sine and cosine (the batched path's numbers)."""
+    d0 = d1 = d2 = 0.0
+    for j in range(positions.shape[0]):
+        dq = positions[j] - previous[j]
+        previous[j] = positions[j]
+        d0 += twist_map[0, j] * dq
+        d1 += twist_map[1, j] * dq
+        d2 += twist_map[2, j] * dq
+    h = 0.5 * d2
+    f = _sinc(h)
+    c, s = _cos_sin(pose[2] + h)
+    pose[0] += f * (c * d0 - s * d1)
+    pose[1] += f * (s * d0 + c * d1)
+    pose[2] += d2
+
+
+def _steering_fk_and_step(model):
+    """Robots whose sensed model depends on steering: the model's matrices at the headings, per call."""
+    robot = model.robot
+    delta = np.array([robot.wheel(j.partition(".")[0]).delta for j in model.steer_joints], dtype=float)
+
+    def twist_map(heading) -> np.ndarray:
+        s, _ = model.matrices(np.asarray(heading, dtype=float) - delta + HALF_PI)
+        return np.ascontiguousarray(s[:3])
+
+    def fk(rates, heading, twist_out):
+        twist_out[:] = twist_map(heading) @ np.asarray(rates, dtype=float)
+
+    def step(pose, previous, positions, heading_mid):
+        _step(pose, previous, positions, twist_map(heading_mid))
+
+    return fk, step

@@ -1,0 +1,80 @@
+"""Single-call kinematics (issue 11, item 4): the same numbers as the batched path, outputs in caller arrays."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from circle import circular_gap
+from strategies import robots
+from wmrkit import catalog, forward_kinematics, wheel_commands
+from wmrkit.kinematics.realtime import realtime
+from wmrkit.odometry.model import odometry_model
+from wmrkit.odometry.pipeline import odometry
+from wmrkit.odometry.synthetic import TwistProfile, simulate
+
+CATALOG = ["swerve-4", "mecanum-4", "diff-drive", "forklift", "ackermann", "omni-3", "thesis-steer-castor",
+           "thesis-two-steer-castor", "thesis-omni-castor", "thesis-bicycle-castor"]
+
+
+def _same_ik(robot, rt, twist, heading):
+    ref = wheel_commands(robot, twist, heading=heading)
+    rates, out = np.full(len(robot.rate_names), np.nan), np.full(len(robot.steer_names), np.nan)
+    feasible = rt.ik(*map(float, twist), np.asarray(heading, dtype=float), rates, out)
+    np.testing.assert_allclose(rates, ref.rates, rtol=1e-12, atol=1e-12)
+    if len(out):
+        assert circular_gap(out, robot.heading_of_beta(ref.beta)).diagonal().max() < 1e-12
+    assert feasible == bool(ref.feasible)
+
+
+@pytest.mark.parametrize("name", CATALOG)
+def test_ik_equals_the_batched_ik(name):
+    robot = catalog.load(name)
+    rt = realtime(robot)
+    rng = np.random.default_rng(1)
+    for _ in range(40):
+        _same_ik(robot, rt, rng.uniform(-1, 1, 3), rng.uniform(-np.pi, np.pi, len(robot.steer_names)))
+    _same_ik(robot, rt, np.zeros(3), robot.heading)  # zero twist: angles held, spins 0
+
+
+@settings(max_examples=25)
+@given(robot=robots(max_wheels=3), data=st.data())
+def test_ik_equals_the_batched_ik_on_random_robots(robot, data):
+    rt = realtime(robot)
+    twist = np.array(data.draw(st.lists(st.floats(-2, 2), min_size=3, max_size=3)))
+    heading = np.array(data.draw(st.lists(st.floats(-3, 3), min_size=len(robot.steer_names),
+                                          max_size=len(robot.steer_names))))
+    _same_ik(robot, rt, twist, heading)
+
+
+@pytest.mark.parametrize("name", ["diff-drive", "mecanum-4", "omni-4", "swerve-4", "forklift"])
+def test_fk_equals_the_batched_least_squares(name):
+    robot = catalog.load(name)
+    rt = realtime(robot)
+    model = odometry_model(robot)
+    rng = np.random.default_rng(2)
+    for _ in range(20):
+        rates = rng.normal(size=len(rt.rate_joints))
+        heading = rng.uniform(-1.5, 1.5, len(rt.steer_joints))
+        twist = np.empty(3)
+        rt.fk(rates, heading, twist)
+        full = robot.heading.copy()
+        full[[robot.steer_names.index(j.partition(".")[0]) for j in rt.steer_joints]] = heading
+        ref, _ = forward_kinematics(robot, dict(zip(rt.rate_joints, rates, strict=True)), heading=full)
+        np.testing.assert_allclose(twist, ref, rtol=1e-10, atol=1e-12)
+    assert model.rate_joints == rt.rate_joints
+
+
+@pytest.mark.parametrize("name", ["diff-drive", "mecanum-4", "omni-4"])
+def test_odometry_steps_equal_the_batched_odometry(name):
+    robot = catalog.load(name)
+    profile = TwistProfile.from_segments([(2.0, 0.8, 0.0, 0.6), (2.0, 0.5, 0.0, -0.9)])
+    log = simulate(robot, profile, 100.0).log
+    rt = realtime(robot, log.joints)
+    ref = odometry(robot, log)
+    pose, previous = np.zeros(3), log.positions[0].copy()
+    for k in range(1, len(log)):
+        rt.odometry_step(pose, previous, log.positions[k], np.empty(0))
+    np.testing.assert_allclose(pose, ref.poses[-1], rtol=0, atol=1e-12)
