@@ -63,7 +63,7 @@ class Robot:
     @property
     def velocity_names(self) -> tuple[str, ...]:
         """Names of the columns of the slip form (3.22): ``vx, vy, omega`` then every wheel's rates."""
-        return TWIST_NAMES + tuple(n for w in self.wheels for n in w.rate_names)
+        return _velocity_names(self)
 
     @property
     def rate_names(self) -> tuple[str, ...]:
@@ -232,6 +232,11 @@ class Robot:
         from .description import save_robot_file
 
         save_robot_file(self, path)
+
+
+@functools.lru_cache(maxsize=256)
+def _velocity_names(robot: Robot) -> tuple[str, ...]:
+    return TWIST_NAMES + tuple(n for w in robot.wheels for n in w.rate_names)
 
 
 @functools.lru_cache(maxsize=256)
