@@ -1,0 +1,85 @@
+"""``wmrkit studio``: design a robot in the browser with live kinematics (a local web server; docs/studio.md)."""
+
+from __future__ import annotations
+
+import argparse
+import ipaddress
+import sys
+import threading
+import webbrowser
+from pathlib import Path
+
+from ..errors import WmrkitError
+
+
+def add_parsers(commands: argparse._SubParsersAction) -> None:
+    """Register ``studio``."""
+    p = commands.add_parser("studio", help="design a robot in the browser and see its kinematics live")
+    p.add_argument("robot", metavar="ROBOT", nargs="?", default="diff-drive",
+                   help="catalog name or a .yaml/.json file to start with (default: diff-drive); files are opened "
+                        "and saved only inside the file's folder (or the current folder)")
+    p.add_argument("--port", type=int, default=8765, help="TCP port (default 8765; 0 picks a free one)")
+    p.add_argument("--host", default="127.0.0.1",
+                   help="interface to listen on (default 127.0.0.1: this machine only)")
+    p.add_argument("--no-browser", action="store_true", help="do not open a web browser")
+    p.set_defaults(run=run_studio)
+
+
+def run_studio(args: argparse.Namespace) -> int:
+    """Start the server (blocking until Ctrl+C) and open the page."""
+    from .. import catalog
+    from ..studio.app import LOCAL_HOSTS, create_app
+
+    spec = args.robot
+    path = Path(spec)
+    if path.suffix.lower() in (".yaml", ".yml", ".json") or path.exists():
+        root = path.resolve().parent
+        spec = path.name
+    else:
+        root = Path.cwd()
+    robot = catalog.resolve(args.robot)
+    if not 0 <= args.port <= 65535:
+        raise WmrkitError(f"--port: from 0 to 65535, got {args.port}")
+    app = create_app(root, robot, robot_spec=spec, allowed_hosts=LOCAL_HOSTS if _loopback(args.host) else None)
+    from ..studio import api
+
+    api.analyze_live({"description": robot.to_dict()})  # warm the imports and compiled kernels before serving
+    import uvicorn
+
+    config = uvicorn.Config(app, host=args.host, port=args.port, log_level="warning")
+    server = uvicorn.Server(config)
+    shown = f"[{args.host}]" if ":" in args.host else args.host
+    if not _loopback(args.host):
+        print(f"wmrkit: warning: listening on {args.host}: other machines can reach the studio and its folder",
+              file=sys.stderr)
+
+    def announce() -> None:
+        while not server.started:
+            if server.should_exit:
+                return
+            threading.Event().wait(0.05)
+        port = server.servers[0].sockets[0].getsockname()[1] if server.servers else args.port
+        url = f"http://{'127.0.0.1' if args.host in ('0.0.0.0', '::') else shown}:{port}/"
+        print(f"wmrkit studio: {url} (folder {root}; Ctrl+C stops)", flush=True)
+        if not args.no_browser:
+            webbrowser.open(url)
+
+    threading.Thread(target=announce, daemon=True).start()
+    try:
+        server.run()
+    except OSError as err:
+        raise WmrkitError(f"cannot listen on {args.host}:{args.port}: {err.strerror or err}") from None
+    except KeyboardInterrupt:
+        pass
+    if not server.started:
+        raise WmrkitError(f"cannot listen on {args.host}:{args.port} (in use? try --port 0)")
+    return 0
+
+
+def _loopback(host: str) -> bool:
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False

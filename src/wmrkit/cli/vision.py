@@ -1,0 +1,175 @@
+"""``wmrkit vision locate|calibrate`` and ``wmrkit follow-line``: thesis §9.2 (camera model, positioning,
+calibration, closed-loop line following by vision)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import WmrkitError
+from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_value, print_json
+
+
+def add_parsers(commands: argparse._SubParsersAction) -> None:
+    """Register ``vision`` (subcommands locate, calibrate) and ``follow-line``."""
+    p = commands.add_parser("vision", help="camera positioning and calibration against lines (thesis 9.2)")
+    sub = p.add_subparsers(dest="vision_command", metavar="SUBCOMMAND", required=True)
+
+    loc = sub.add_parser("locate", help="heading psi and distance h to a line, from an image or image points")
+    src = loc.add_mutually_exclusive_group(required=True)
+    src.add_argument("image", nargs="?", metavar="IMAGE", help="camera image (PNG, JPEG, ...)")
+    src.add_argument("--points", metavar="FILE", help='JSON {"lines": [{"n": -1|0|1, "points": '
+                     '[[xu, yu], [xu, yu]]}]} [px from the centre, y down]')
+    loc.add_argument("--camera", required=True, metavar="FILE", help="camera file (what 'calibrate --out' writes)")
+    loc.add_argument("--spacing", default="0", metavar="D", help="distance between parallel lines [m, or 'cm']")
+    loc.add_argument("--lines", type=int, metavar="N", help="lines in the image: 1 (default without --spacing), "
+                     "2 (road: n = -1, 1) or 3 (crops: n = -1, 0, 1, default with --spacing)")
+    loc.add_argument("--z-p", default="0", metavar="Z", help="distance from the lens to P along the axis [m]")
+    loc.add_argument("--mode", choices=("threshold", "gradient"), default="threshold",
+                     help="pixels of interest: the reference (threshold) or its contour (gradient)")
+    add_json_flag(loc)
+    loc.set_defaults(run=run_locate)
+
+    cal = sub.add_parser("calibrate", help="tilt, focal length and height from two parallel stripes (9.18-9.24)")
+    cal.add_argument("image", nargs="?", metavar="IMAGE", help="image of two stripes in the calibration pose")
+    cal.add_argument("--rows", required=True, type=float, metavar="A", help="image rows +-A [px] used")
+    cal.add_argument("--x1", type=float, help="half-distance between the stripes on row +A [px] (instead of IMAGE)")
+    cal.add_argument("--x2", type=float, help="half-distance between the stripes on row -A [px]")
+    cal.add_argument("--half-separation", required=True, metavar="XW",
+                     help="real half-distance between the stripes [m]")
+    cal.add_argument("--row-distance", required=True, metavar="YW",
+                     help="real distance along the stripes between the points seen on rows +A and -A [m]")
+    cal.add_argument("--size", nargs=2, type=int, metavar=("W", "H"), default=(640, 480),
+                     help="image size for the camera file with --x1/--x2 (default 640 480)")
+    cal.add_argument("--out", metavar="FILE", help="write the camera file (YAML)")
+    add_json_flag(cal)
+    cal.set_defaults(run=run_calibrate)
+
+    f = commands.add_parser("follow-line", help="simulate vision line following (thesis 9.2.3)")
+    add_robot_argument(f)
+    f.add_argument("--camera", required=True, metavar="FILE", help="camera file of the robot's camera")
+    f.add_argument("--gain", type=float, default=0.3, metavar="A", help="lateral gain a_x [1/s] (default 0.3)")
+    f.add_argument("--speed", default="0.1", metavar="V", help="following speed [m/s] (default 0.1)")
+    f.add_argument("--period", type=float, default=0.5, metavar="T", help="control period = image time [s]")
+    f.add_argument("--duration", type=float, default=20.0, metavar="S", help="simulated time [s] (default 20)")
+    f.add_argument("--start", nargs=2, default=("0.3", "0"), metavar=("H", "THETA"),
+                   help="start: distance to the line [m, left positive] and heading [rad, or 'deg'] (default "
+                        "0.3 0: the thesis's p(0) = (-0.3 m, 0, 0))")
+    f.add_argument("--noise", nargs=2, metavar=("H", "PSI"), help="bounds of uniform noise on h [m] and psi [rad, "
+                   "or 'deg'] (the thesis's example 2: 0.02 3deg)")
+    f.add_argument("--image-noise", type=float, default=0.0, metavar="SIGMA", help="image noise [grey levels]")
+    f.add_argument("--blur", type=float, default=0.0, metavar="SIGMA", help="image blur [px]")
+    f.add_argument("--clutter", type=int, default=0, metavar="N", help="bright blobs on the ground")
+    f.add_argument("--line-width", default="0.02", metavar="W", help="painted line width [m] (default 0.02)")
+    f.add_argument("--z-p", default="0", metavar="Z", help="distance from the lens to P along the axis [m]")
+    f.add_argument("--seed", type=int, default=0, help="random seed (noise, clutter)")
+    f.add_argument("--animate", metavar="FILE", help="write a GIF: camera view beside the plan view")
+    add_json_flag(f)
+    f.set_defaults(run=run_follow)
+
+
+def _camera(path: str):
+    from ..vision.camera import Camera
+
+    return Camera.from_file(path)
+
+
+def read_image(path: str) -> np.ndarray:
+    """A grey image from a file, or a WmrkitError naming it."""
+    from ..vision.lines import cv2_module
+
+    if not Path(path).is_file():
+        raise WmrkitError(f"{path}: no such image file")
+    img = cv2_module().imread(path, 0)
+    if img is None:
+        raise WmrkitError(f"{path}: not an image OpenCV can read")
+    return img
+
+
+def run_locate(args: argparse.Namespace) -> int:
+    """``wmrkit vision locate``."""
+    from ..vision.follow import locate_image
+    from ..vision.positioning import locate_points, read_points
+
+    camera = _camera(args.camera)
+    spacing = parse_value(args.spacing, "length", "--spacing")
+    z_p = parse_value(args.z_p, "length", "--z-p")
+    if args.points:
+        fix = locate_points(camera, read_points(args.points), spacing=spacing, z_p=z_p)
+    else:
+        layouts = {1: (0,), 2: (-1, 1), 3: (-1, 0, 1)}
+        if args.lines is not None and args.lines not in layouts:
+            raise WmrkitError(f"--lines must be 1, 2 or 3, got {args.lines}")
+        ns = layouts[args.lines] if args.lines else None
+        image = read_image(args.image)
+        if image.shape != (camera.rows, camera.width):
+            raise WmrkitError(f"{args.image}: {image.shape[1]} x {image.shape[0]} px, the camera file says "
+                              f"{camera.width} x {camera.rows}")
+        fix = locate_image(camera, image, spacing=spacing, ns=ns, z_p=z_p, mode=args.mode)
+    if args.json:
+        print_json(fix.to_dict())
+    else:
+        print(f"psi = {fix.psi:.6f} rad ({math.degrees(fix.psi):.3f} deg), h = {fix.h:.5f} m")
+        for line in fix.lines:
+            print(f"  line n = {line.n:+d}: psi = {math.degrees(line.psi):.3f} deg, h = {line.h:.5f} m")
+    return 0
+
+
+def run_calibrate(args: argparse.Namespace) -> int:
+    """``wmrkit vision calibrate``."""
+    from ..vision.calibration import calibrate, calibrate_image
+
+    xw = parse_value(args.half_separation, "length", "--half-separation")
+    yw = parse_value(args.row_distance, "length", "--row-distance")
+    by_points = args.x1 is not None or args.x2 is not None
+    if by_points == (args.image is not None):
+        raise WmrkitError("calibrate: give either IMAGE or both --x1 and --x2")
+    if by_points:
+        if args.x1 is None or args.x2 is None:
+            raise WmrkitError("calibrate: --x1 and --x2 go together")
+        cal = calibrate(args.x1, args.x2, args.rows, xw, yw)
+        width, rows = args.size
+    else:
+        image = read_image(args.image)
+        cal = calibrate_image(image, args.rows, xw, yw)
+        rows, width = image.shape
+    if args.out:
+        cal.camera(width=width, rows=rows).to_file(args.out)
+    if args.json:
+        print_json(cal.to_dict())
+    else:
+        print(f"tilt = {cal.tilt:.6f} rad ({math.degrees(cal.tilt):.3f} deg), focal = {cal.focal_px:.2f} px, "
+              f"height = {cal.height:.5f} m" + (f"; camera file {args.out}" if args.out else ""))
+    return 0
+
+
+def run_follow(args: argparse.Namespace) -> int:
+    """``wmrkit follow-line``."""
+    from ..vision.follow import follow_line
+    from ..vision.render import Scene
+
+    robot, camera = load_robot(args.robot), _camera(args.camera)
+    noise = (0.0, 0.0) if not args.noise else (parse_value(args.noise[0], "length", "--noise H"),
+                                                parse_angle(args.noise[1], "--noise PSI"))
+    start = (0.0, parse_value(args.start[0], "length", "--start H"), parse_angle(args.start[1], "--start THETA"))
+    run = follow_line(robot, camera, gain=args.gain, speed=parse_value(args.speed, "number", "--speed"),
+                      period=args.period, duration=args.duration, start=start,
+                      z_p=parse_value(args.z_p, "length", "--z-p"), noise=noise, image_noise=args.image_noise,
+                      blur=args.blur, clutter=args.clutter, seed=args.seed, keep_images=bool(args.animate),
+                      scene=Scene(ns=(0,), width=parse_value(args.line_width, "length", "--line-width")))
+    if args.animate:
+        from ..vision.animation import save_animation
+
+        save_animation(run, robot, camera, args.animate)
+    summary = run.to_dict()
+    if args.json:
+        print_json(summary)
+    else:
+        print(f"robot {robot.name}: a = {run.gain:g} 1/s, T = {run.period:g} s, {len(run.time) - 1} periods; "
+              f"final h = {summary['final_h'] * 100:.2f} cm, psi = {math.degrees(summary['final_psi']):.2f} deg, "
+              f"overshoot {summary['overshoot'] * 100:.2f} cm, 95 % settling {summary['settling_time_95']:.1f} s"
+              + (f"; animation {args.animate}" if args.animate else ""))
+    return 0

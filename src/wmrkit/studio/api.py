@@ -1,0 +1,332 @@
+"""The studio's endpoints as pure functions: request JSON in, response JSON out, every number from the library.
+
+The page (``static/app.js``) only draws and edits; robot descriptions travel as the mappings of
+:func:`wmrkit.description.robot_from_dict` (numbers in SI or strings with units, ``"250 mm"``), validated there,
+so an invalid field fails with the same :class:`~wmrkit.errors.DescriptionError` message the CLI prints.
+Steering angles cross this boundary as *headings* (rolling direction, 0 = straight ahead,
+:func:`wmrkit.wheels.heading_from_beta`); a wheel may be given ``heading`` instead of ``beta``.
+
+Per edit the page calls :func:`analyze_live` (chapters 4-6 at the described configuration, without the singular
+sets over the whole steering space, which :func:`configurations` gives on demand): see ``docs/studio.md``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from ..analysis.classification import classify, instantaneous_mobility
+from ..analysis.icr import ICRSet, _f, icr, icr_of_twist
+from ..analysis.isotropy import (
+    _minimise_length,
+    condition_map,
+    default_joints,
+    kappa_function,
+    natural_length,
+    twist_model,
+)
+from ..analysis.optimize import isotropic_configurations
+from ..analysis.singularity import robot_size, singularity_distance
+from ..analysis.summary import describe_singular, model_rates, model_singular_set
+from ..description import COMMON_WHEEL_FIELDS, robot_from_dict, robot_to_dict
+from ..errors import DescriptionError, WmrkitError
+from ..kinematics.actuation import actuation_analysis
+from ..kinematics.sensing import sensing_analysis
+from ..kinematics.wheel_ik import wheel_commands
+from ..odometry.integrators import integrate_exact
+from ..robot import Robot
+from ..units import UnitError, parse_quantity
+from ..wheels import KINDS, beta_from_heading, heading_from_beta
+
+#: Distance to singularity (``sigma_min / sigma_max`` of the constraint lines, 6.17) below which the page warns.
+NEAR_SINGULAR = 0.05
+#: Largest κ-map grid per axis and largest trajectory sample count a request may ask for.
+MAX_RESOLUTION = 181
+SOURCE = "studio"
+#: The description format reads ``heading:`` itself (else :func:`headings_to_beta` converts it).
+NATIVE_HEADING = "heading" in COMMON_WHEEL_FIELDS
+
+
+class StudioError(WmrkitError, ValueError):
+    """A request the studio cannot answer (wrong shape of JSON, bad number); the message says which field."""
+
+
+# ---- descriptions ------------------------------------------------------------------------------------------
+def robot_of(request: Any) -> Robot:
+    """The :class:`Robot` of ``request["description"]`` (headings accepted in place of ``beta``)."""
+    data = _field(request, "description", Mapping)
+    return robot_from_dict(headings_to_beta(data), source=SOURCE)
+
+
+def headings_to_beta(data: Mapping[str, Any]) -> dict[str, Any]:
+    """A copy of description `data` where each wheel's ``heading`` became the thesis's ``beta`` (radians).
+
+    When the description format itself reads ``heading:`` (:mod:`wmrkit.description`), `data` is passed on as it
+    is, so that every message is the library's own.
+    """
+    out = dict(data)
+    wheels = data.get("wheels")
+    if not isinstance(wheels, list) or NATIVE_HEADING:
+        return out
+    out["wheels"] = []
+    for i, item in enumerate(wheels):
+        if isinstance(item, Mapping) and "heading" in item:
+            item = dict(item)
+            if "beta" in item:
+                raise DescriptionError("give either 'beta' or 'heading', not both", source=SOURCE,
+                                       loc=("wheels", i, "heading"))
+            try:
+                heading = parse_quantity(item.pop("heading"), "angle")
+            except UnitError as err:
+                raise DescriptionError(str(err), source=SOURCE, loc=("wheels", i, "heading")) from None
+            try:
+                delta = parse_quantity(item.get("delta", 0.0), "angle")
+            except UnitError:
+                delta = 0.0  # robot_from_dict reports the bad delta at its own field
+            item["beta"] = float(beta_from_heading(heading, delta))
+        out["wheels"].append(item)
+    return out
+
+
+def description_of(robot: Robot) -> dict[str, Any]:
+    """The description mapping of `robot` (SI numbers, exactly what ``Robot.to_file`` writes)."""
+    return robot_to_dict(robot)
+
+
+def geometry(robot: Robot) -> dict[str, Any]:
+    """What the plan view draws, in robot coordinates [m] and radians: per wheel its joint, heading, elements."""
+    from ..plotting.robot import _elements  # the drawing's own geometry (eq. 3.8), not re-derived here
+
+    wheels = []
+    for w in robot.wheels:
+        els = _elements(w, w.beta)
+        wheels.append({
+            "name": w.name, "type": w.type, "steers": w.kind.steers,
+            "joint": [float(v) for v in els[0].joint], "heading": float(w.heading), "beta": w.beta,
+            "actuated": list(w.actuated), "sensed": list(w.sensed),
+            "elements": [{"centre": [float(v) for v in e.centre], "axle": float(e.axle),
+                          "roller": None if e.roller is None else float(e.roller), "r": float(e.r),
+                          "spin_joint": e.spin_joint} for e in els],
+        })
+    return {"wheels": wheels, "size": robot_size(robot)}
+
+
+def kinds() -> dict[str, Any]:
+    """The wheel types: fields (required, optional with defaults), joints, whether they steer, a summary."""
+    return {k.name: {"required": list(k.required), "optional": dict(k.optional), "joints": list(k.joints),
+                     "steers": k.steers, "summary": k.summary} for k in KINDS.values()}
+
+
+# ---- analysis ----------------------------------------------------------------------------------------------
+def analyze_live(request: Any) -> dict[str, Any]:
+    """Per-edit analysis: type (m, s), degeneracy, verdicts, condition number, ICR set, distance to singularity.
+
+    The same numbers as :func:`wmrkit.analysis.analyze` (its ``to_dict`` keys), minus the singular sets over
+    the steering space (:func:`configurations`), plus ``singular_here`` and the drawing's ``geometry``.
+    """
+    robot = robot_of(request)
+    return {"robot": robot.name, "description": description_of(robot), "geometry": geometry(robot),
+            "analysis": live_summary(robot)}
+
+
+def live_summary(robot: Robot) -> dict[str, Any]:
+    """The live analysis of :func:`analyze_live` as a mapping (JSON-ready; headings in radians)."""
+    cls = classify(robot)
+    joints = default_joints(robot)
+    length, kappa = live_natural_length(robot, joints)
+    act, sen = actuation_analysis(robot), sensing_analysis(robot)
+    here = {}
+    for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed)):
+        assigned = model_rates(robot, names)
+        dist = float(singularity_distance(robot, None, assigned))
+        here[key] = {"assigned": list(assigned), "distance": dist, "singular": dist < 1e-8,
+                     "near": dist < NEAR_SINGULAR}
+    return {
+        "mobility": cls.mobility, "steerability": cls.steerability, "type": cls.type, "type_name": cls.name,
+        "degenerate": cls.degenerate, "reasons": list(cls.reasons), "coordinated_steering": cls.coordinated,
+        "instantaneous_mobility": int(instantaneous_mobility(robot)),
+        "special_configurations": [{"heading": _headings(robot, s.beta), "mobility": s.mobility,
+                                    "description": s.description} for s in cls.special],
+        "icr": icr_dict(icr(robot)),
+        "actuation": {"consistent": bool(np.all(act.consistent)), "sufficient": bool(np.all(act.sufficient)),
+                      "verdict": str(act.verdict), "joints": list(robot.actuated)},
+        "sensing": {"sufficient": bool(np.all(sen.sufficient)), "verdict": str(sen.verdict),
+                    "joints": list(robot.sensed)},
+        "condition_number": _finite(kappa), "characteristic_length": _finite(length),
+        "condition_joints": list(joints), "natural_length": True,
+        "steering": dict(zip(robot.steer_names, robot.heading.tolist(), strict=True)),
+        "singular_here": here,
+    }
+
+
+def live_natural_length(robot: Robot, joints: tuple[str, ...]) -> tuple[float, float]:
+    """:func:`~wmrkit.analysis.isotropy.natural_length` at the described configuration, the m = 3 search with
+    the element rows computed once (:func:`~wmrkit.analysis.isotropy.kappa_function`): same result, ~3x faster."""
+    model = twist_model(robot, joints)
+    if model.mobility != 3:
+        return natural_length(robot, joints=joints)
+    kappa = kappa_function(model, robot.beta[None])
+    return _minimise_length(lambda d: float(kappa(d)[0]), robot_size(robot))
+
+
+def icr_dict(s: ICRSet) -> dict[str, Any]:
+    """An :class:`ICRSet` as plain data, with its sentence."""
+    return {"kind": s.kind, "point": s.point, "direction": s.direction, "line": s.line, "text": s.describe()}
+
+
+def configurations(request: Any) -> dict[str, Any]:
+    """Singular sets of the actuated and sensed models (ch. 6) and isotropic configurations (5.29), as headings.
+
+    Slower than :func:`analyze_live` for robots with several steering angles; the page asks after an edit settles.
+    """
+    robot = robot_of(request)
+    cls = classify(robot)
+    out: dict[str, Any] = {"singular": {}}
+    for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed)):
+        s = model_singular_set(robot, model_rates(robot, names), cls, 90)
+        headings = [[float(heading_from_beta(v, robot.wheel(n).delta)) for n, v in zip(s.variables, row,
+                                                                                        strict=True)]
+                    for row in s.configurations[:24].tolist()]
+        out["singular"][key] = {"assigned": list(s.assigned), "variables": list(s.variables), "always": s.always,
+                                "never": s.never, "exact": s.exact, "count": len(s.configurations),
+                                "headings": headings, "reasons": list(s.reasons), "text": describe_singular(s)}
+    # The library's search refines each grid minimum at its own natural length: quick for m = 2 or one steering
+    # angle, but tens of seconds for m = 3 with several (a 1-D length search inside Nelder-Mead): not searched.
+    searched = bool(robot.steer_names) and cls.mobility > 1 and (cls.mobility == 2 or len(robot.steer_names) == 1)
+    iso = isotropic_configurations(robot) if searched else ()
+    out["isotropic_searched"] = searched
+    out["isotropic"] = [{"heading": _headings(robot, c.beta), "length": c.length,
+                         "condition_number": c.condition_number} for c in iso]
+    return out
+
+
+def kappa_map(request: Any) -> dict[str, Any]:
+    """Condition number (5.28) over the headings of one or two steering wheels (the others as described).
+
+    ``request``: ``description``, optional ``wheels`` (1-2 steering wheel names; default the first two) and
+    ``resolution`` (points per turn). κ at the natural length of the described configuration; null where the
+    robot cannot move (uncoordinated steering) or the model is singular (κ infinite).
+    """
+    robot = robot_of(request)
+    steer = robot.steer_names
+    if not steer:
+        raise StudioError(f"robot '{robot.name}' does not steer: no κ map over steering angles")
+    names = request.get("wheels") or list(steer[:2])
+    if not isinstance(names, list) or not 1 <= len(names) <= 2 or any(n not in steer for n in names):
+        raise StudioError(f"wheels: one or two of the steering wheels {', '.join(steer)}")
+    res = _integer(request.get("resolution", 72), "resolution", 8, MAX_RESOLUTION)
+    axis = np.linspace(-np.pi, np.pi, res, endpoint=False)
+    grids = np.meshgrid(*([axis] * len(names)), indexing="ij")
+    headings = np.broadcast_to(robot.heading, (*grids[0].shape, len(steer))).copy()
+    for name, g in zip(names, grids, strict=True):
+        headings[..., steer.index(name)] = g
+    joints = default_joints(robot)
+    length = live_natural_length(robot, joints)[0]
+    kappa = condition_map(robot, robot.beta_of_heading(headings), joints=joints, length=length)
+    finite = np.where(np.isfinite(kappa), kappa, np.nan)
+    best = int(np.nanargmin(finite)) if np.isfinite(finite).any() else None
+    return {"wheels": names, "axis": axis.tolist(), "length": length,
+            "kappa": [_finite(v) for v in kappa.ravel().tolist()], "shape": list(kappa.shape),
+            "current": [float(robot.heading[steer.index(n)]) for n in names],
+            "best": None if best is None else {"kappa": float(finite.ravel()[best]),
+                                               "heading": [float(g.ravel()[best]) for g in grids]}}
+
+
+# ---- driving -----------------------------------------------------------------------------------------------
+def drive(request: Any) -> dict[str, Any]:
+    """Per-wheel commands for ``twist`` (vx [m/s], vy [m/s], omega [rad/s]) from the current ``heading`` mapping.
+
+    Per wheel: heading [rad] and spin [rad/s] (§8.4), the rolling speed ``r * spin`` [m/s] for the arrows, the
+    lateral slip of fixed wheels; ``feasible`` and the residual ``|A q_dot|`` [m/s] of the no-slip equations
+    (3.22); the ICR of the twist; and the poses of the robot holding the twist for ``duration`` s (exact SE(2)).
+    """
+    robot = robot_of(request)
+    twist = np.array(_numbers(request.get("twist"), "twist", 3))
+    steering = request.get("heading") or {}
+    if not isinstance(steering, Mapping):
+        raise StudioError("heading: a mapping {steering wheel: heading [rad]}")
+    unknown = [n for n in steering if n not in robot.steer_names]
+    if unknown:
+        raise StudioError(f"heading: '{unknown[0]}' is not a steering wheel of '{robot.name}' "
+                          f"(steering: {', '.join(robot.steer_names) or 'none'})")
+    current = robot.heading.copy()
+    for name, value in steering.items():
+        current[robot.steer_names.index(name)] = _numbers([value], f"heading.{name}", 1)[0]
+    beta = robot.beta_of_heading(current)
+    c = wheel_commands(robot, twist, beta)
+    now_heading = robot.heading_of_beta(c.beta)
+    residual = float(np.linalg.norm(robot.slip_velocity(c.velocity(twist), c.beta)))
+    wheels = {}
+    for i, w in enumerate(robot.wheels):
+        h = float(now_heading[robot.steer_names.index(w.name)]) if w.kind.steers else float(w.heading)
+        spin = float(c.spin[i])
+        wheels[w.name] = {"heading": h, "spin": _finite(spin), "speed": _finite(spin * w.r),
+                          "steer_rate": _finite(float(c.steer_rate[i])), "slip": float(c.slip[i])}
+    scale = max(1.0, float(np.abs(twist[:2]).sum() + abs(twist[2]) * robot_size(robot)))
+    duration = float(_numbers([request.get("duration", 4.0)], "duration", 1)[0])
+    samples = _integer(request.get("samples", 120), "samples", 2, 2000)
+    if not 0 < duration <= 600:
+        raise StudioError(f"duration: between 0 and 600 s, got {duration}")
+    t = np.linspace(0.0, duration, samples)
+    poses = integrate_exact(np.zeros(3), twist, t)
+    return {"twist": twist.tolist(), "wheels": wheels, "heading": dict(zip(robot.steer_names, now_heading.tolist(),
+                                                                           strict=True)),
+            "feasible": bool(c.feasible) and residual <= 1e-9 * scale, "residual": residual,
+            "icr": twist_icr(twist), "times": t.tolist(), "poses": poses.tolist()}
+
+
+def twist_icr(twist: np.ndarray) -> dict[str, Any]:
+    """ICR of one twist (§5.3): a point [m], a direction at infinity (pure translation), or none (at rest)."""
+    x, y, w = icr_of_twist(twist).tolist()
+    if max(abs(x), abs(y), abs(w)) < 1e-12:
+        return {"kind": "none", "text": "at rest: no ICR"}
+    if abs(w) < 1e-9 * max(abs(x), abs(y)):
+        n = math.hypot(twist[0], twist[1])
+        return {"kind": "infinity", "direction": [twist[0] / n, twist[1] / n],
+                "text": "ICR at infinity: pure translation"}
+    return {"kind": "point", "point": [x / w, y / w], "text": f"ICR at ({_f(x / w)}, {_f(y / w)}) m"}
+
+
+# ---- helpers -----------------------------------------------------------------------------------------------
+def _headings(robot: Robot, beta: Any) -> list[float]:
+    return [float(v) for v in robot.heading_of_beta(np.asarray(beta, dtype=float))]
+
+
+def _finite(x: float) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _field(request: Any, key: str, kind: type) -> Any:
+    if not isinstance(request, Mapping):
+        raise StudioError("the request body must be a JSON object")
+    if key not in request:
+        raise StudioError(f"missing field '{key}'")
+    value = request[key]
+    if not isinstance(value, kind):
+        raise StudioError(f"{key}: expected a JSON {'object' if kind is Mapping else kind.__name__}")
+    return value
+
+
+def _numbers(value: Any, what: str, n: int) -> list[float]:
+    if not isinstance(value, list | tuple) or len(value) != n:
+        raise StudioError(f"{what}: expected a list of {n} numbers")
+    out = []
+    for v in value:
+        try:
+            x = parse_quantity(v, "number") if isinstance(v, str) else v
+        except UnitError as err:
+            raise StudioError(f"{what}: {err}") from None
+        if isinstance(x, bool) or not isinstance(x, int | float) or not math.isfinite(x):
+            raise StudioError(f"{what}: expected finite numbers, got {v!r}")
+        out.append(float(x))
+    return out
+
+
+def _integer(value: Any, what: str, lo: int, hi: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
+        raise StudioError(f"{what}: an integer from {lo} to {hi}, got {value!r}")
+    return value

@@ -1,0 +1,163 @@
+"""The studio's ASGI application (Starlette): the page, its static files and the JSON endpoints of :mod:`.api`.
+
+Every request body is JSON (``Content-Type: application/json``, so that other web sites cannot post to it without
+a CORS preflight), at most :data:`MAX_BODY` bytes. A user's mistake answers 4xx with ``{"error": message}``
+(and ``loc``/``field``/``message`` for a :class:`~wmrkit.errors.DescriptionError`); nothing a request holds can
+stop the server. Files: only the package's ``static/`` folder is served, and descriptions only inside `root`.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import time
+from collections.abc import Callable
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from .. import catalog
+from ..errors import DescriptionError, WmrkitError
+from ..robot import Robot
+from . import api, files
+
+#: Largest accepted request body [bytes].
+MAX_BODY = 1_000_000
+#: Host names of this machine: the ``Host`` headers a studio on a loopback interface answers.
+LOCAL_HOSTS = ["127.0.0.1", "localhost", "::1", "[::1]"]
+
+log = logging.getLogger("wmrkit.studio")
+
+
+def require_starlette() -> None:
+    """Raise a :class:`WmrkitError` naming the 'studio' extra when Starlette or uvicorn is missing."""
+    try:
+        import starlette  # noqa: F401
+        import uvicorn  # noqa: F401
+    except ImportError:
+        raise WmrkitError("the 'studio' extra is needed: pip install 'wmrkit[studio]'") from None
+
+
+def static_dir() -> Path:
+    """The folder of the page's files (package data)."""
+    return Path(str(resources.files("wmrkit.studio").joinpath("static")))
+
+
+class _HTTPError(Exception):
+    def __init__(self, status: int, message: str) -> None:
+        super().__init__(message)
+        self.status = status
+
+
+def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec: str | None = None,
+               allowed_hosts: list[str] | None = None):
+    """The Starlette app serving the studio for files under `root`, starting with `robot` (default: diff-drive).
+
+    `robot_spec` is what the user named (a catalog name or a file path relative to `root`), shown by the page.
+    `allowed_hosts`: the only ``Host`` headers answered (against DNS rebinding: a web page whose name is made to
+    resolve to 127.0.0.1 must not reach the studio); None answers any (the test client's ``testserver``).
+    """
+    require_starlette()
+    from starlette.applications import Starlette
+    from starlette.concurrency import run_in_threadpool
+    from starlette.responses import FileResponse, JSONResponse, Response
+    from starlette.routing import Mount, Route
+    from starlette.staticfiles import StaticFiles
+
+    root = Path(root).resolve()
+    start = robot or catalog.load("diff-drive")
+    static = static_dir()
+
+    def respond(data: Any, status: int = 200) -> Response:
+        return JSONResponse(_finite(data), status_code=status)
+
+    def endpoint(fn: Callable[[Any], Any], *, body: bool = True, thread: bool = False):
+        """`thread`: run in a worker thread, so that a slow answer does not hold up the live analysis."""
+
+        async def handle(request) -> Response:
+            t0 = time.perf_counter()
+            try:
+                payload = await _read_json(request) if body else None
+                data = await run_in_threadpool(fn, payload) if thread else fn(payload)
+            except _HTTPError as err:
+                return respond({"error": str(err)}, err.status)
+            except files.ForbiddenPathError as err:
+                return respond({"error": str(err)}, 403)
+            except DescriptionError as err:
+                return respond({"error": str(err), "message": err.message, "loc": list(err.loc),
+                                "field": _field_name(err.loc)}, 422)
+            except WmrkitError as err:
+                return respond({"error": str(err)}, 400)
+            except Exception as err:  # a bug: answer it, log it, keep serving
+                log.exception("studio: internal error")
+                return respond({"error": f"internal error ({err.__class__.__name__}); please report it"}, 500)
+            response = respond(data)
+            response.headers["Server-Timing"] = f"app;dur={(time.perf_counter() - t0) * 1e3:.2f}"
+            return response
+
+        return handle
+
+    def meta(_: Any) -> dict[str, Any]:
+        return {"catalog": list(catalog.names()), "kinds": api.kinds(), "root": root.name or str(root),
+                "files": files.list_files(root), "start": {"spec": robot_spec or start.name,
+                                                           "description": api.description_of(start)}}
+
+    async def index(request) -> Response:
+        return FileResponse(static / "index.html", headers={"Cache-Control": "no-store"})
+
+    routes = [
+        Route("/", index),
+        Route("/favicon.ico", lambda request: Response(status_code=204)),
+        Route("/api/meta", endpoint(meta, body=False)),
+        Route("/api/files", endpoint(lambda _: {"files": files.list_files(root)}, body=False)),
+        Route("/api/open", endpoint(lambda p: files.open_robot(root, p)), methods=["POST"]),
+        Route("/api/save", endpoint(lambda p: files.save_robot(root, p)), methods=["POST"]),
+        Route("/api/analyze", endpoint(api.analyze_live), methods=["POST"]),
+        Route("/api/configurations", endpoint(api.configurations, thread=True), methods=["POST"]),
+        Route("/api/drive", endpoint(api.drive), methods=["POST"]),
+        Route("/api/kappa", endpoint(api.kappa_map, thread=True), methods=["POST"]),
+        Mount("/static", app=StaticFiles(directory=str(static)), name="static"),
+    ]
+    middleware = []
+    if allowed_hosts is not None:
+        from starlette.middleware import Middleware
+        from starlette.middleware.trustedhost import TrustedHostMiddleware
+
+        middleware.append(Middleware(TrustedHostMiddleware, allowed_hosts=allowed_hosts))
+    return Starlette(routes=routes, middleware=middleware)
+
+
+async def _read_json(request) -> Any:
+    """The request's JSON body, refusing other content types, bodies over MAX_BODY and malformed JSON."""
+    kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
+    if kind != "application/json":
+        raise _HTTPError(415, "send JSON (Content-Type: application/json)")
+    declared = request.headers.get("content-length")
+    if declared is not None and (not declared.isdigit() or int(declared) > MAX_BODY):
+        raise _HTTPError(413, f"request too large (limit {MAX_BODY} bytes)")
+    chunks, size = [], 0
+    async for chunk in request.stream():
+        size += len(chunk)
+        if size > MAX_BODY:
+            raise _HTTPError(413, f"request too large (limit {MAX_BODY} bytes)")
+        chunks.append(chunk)
+    try:
+        return json.loads(b"".join(chunks).decode("utf-8"), parse_constant=_no_constant)
+    except (ValueError, RecursionError) as err:
+        raise _HTTPError(400, f"malformed JSON: {str(err).splitlines()[0][:200]}") from None
+
+
+def _no_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not a number JSON allows")
+
+
+def _field_name(loc: tuple) -> str:
+    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in loc).lstrip(".")
+
+
+def _finite(x: Any) -> Any:
+    """JSON has no NaN or infinities: they become null (recursively through lists and mappings)."""
+    if isinstance(x, dict | list | tuple):
+        return {k: _finite(v) for k, v in x.items()} if isinstance(x, dict) else [_finite(v) for v in x]
+    return None if isinstance(x, float) and not math.isfinite(x) else x

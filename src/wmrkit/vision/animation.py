@@ -1,0 +1,97 @@
+"""Figures of vision line following: a camera image with its detected lines, and the run as a GIF (camera view
+beside the plan view). matplotlib object API only (no pyplot); GIFs through matplotlib's PillowWriter."""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..errors import WmrkitError
+from ..robot import Robot
+from .camera import Camera, distort
+from .follow import LineFollowing
+from .lines import DetectedLine, extract_lines
+
+__all__ = ["draw_camera_view", "save_animation", "save_detection_figure"]
+
+
+def draw_camera_view(ax, camera: Camera, image: np.ndarray, lines: tuple[DetectedLine, ...]) -> None:
+    """The image with each detected line drawn over it, below the horizon (back through the lens distortion)."""
+    ax.imshow(image, cmap="gray", vmin=0, vmax=255)
+    cx, cy = camera.centre
+    horizon = -camera.focal_px / math.tan(camera.tilt)  # image row of the horizon (no roll)
+    ys = np.linspace(max(-cy, horizon), cy, 60)
+    for line in lines:
+        xy = distort(np.stack([line.x0 + line.slope * ys, ys], -1), camera.k1, camera.focal_px)
+        ax.plot(xy[:, 0] + cx, xy[:, 1] + cy, color="#f28e2b", linewidth=1.5)
+    ax.set_xlim(-0.5, camera.width - 0.5)
+    ax.set_ylim(camera.rows - 0.5, -0.5)
+    ax.set_xticks([])
+    ax.set_yticks([])
+
+
+def save_detection_figure(camera: Camera, image: np.ndarray, path: str | os.PathLike[str], *,
+                          n_lines: int = 1, title: str = "") -> None:
+    """A PNG/SVG of `image` with the lines :func:`.lines.extract_lines` finds in it."""
+    fig = Figure(figsize=(camera.width / 100, camera.rows / 100 + (0.3 if title else 0)), dpi=100)
+    ax = fig.add_axes((0, 0, 1, 1 if not title else camera.rows / (camera.rows + 30)))
+    draw_camera_view(ax, camera, image, extract_lines(image, n_lines=n_lines, k1=camera.k1,
+                                                      focal_px=camera.focal_px))
+    if title:
+        fig.suptitle(title, fontsize=9)
+    fig.savefig(path)
+
+
+def _footprint(robot: Robot) -> np.ndarray:
+    """Outline of the robot in its frame [m]: the wheels' mount points and the tracked point P."""
+    pts = [(w.l * math.cos(w.alpha), w.l * math.sin(w.alpha)) for w in robot.wheels] + [(0.0, 0.0)]
+    pts = np.array(pts)
+    centre = pts.mean(axis=0)
+    angle = np.arctan2(pts[:, 1] - centre[1], pts[:, 0] - centre[0])
+    return pts[np.argsort(angle)]
+
+
+def save_animation(run: LineFollowing, robot: Robot, camera: Camera, path: str | os.PathLike[str], *,
+                   fps: float = 4.0) -> None:
+    """A GIF of `run` (made with ``keep_images=True``): camera view (left) beside the plan view (right)."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    if run.images is None:
+        raise WmrkitError("animation: the run kept no camera images (follow_line(..., keep_images=True))")
+    if Path(path).suffix.lower() != ".gif":
+        raise WmrkitError(f"{path}: the animation is written as a GIF (.gif)")
+    fig = Figure(figsize=(9, 3.6), dpi=80)
+    cam_ax, plan_ax = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
+    pose = run.pose
+    outline = _footprint(robot)
+    span = max(np.ptp(pose[:, 1]), 0.3)
+    plan_ax.axhline(0.0, color="#222222", linewidth=2, label="line")
+    plan_ax.set_xlim(pose[0, 0] - 0.6, pose[-1, 0] + 0.6)
+    plan_ax.set_ylim(-0.8 * span - 0.3, pose[:, 1].max() + 0.8 * span)
+    plan_ax.set_aspect("equal")
+    plan_ax.set_xlabel("x along the line [m]")
+    plan_ax.set_ylabel("y [m]")
+    path_line, = plan_ax.plot([], [], "--", color="#1f77b4", label="P")
+    body = plan_ax.fill([], [], color="#c9d6e3", edgecolor="#6b7f94")[0]
+    plan_ax.legend(loc="upper right", fontsize=8)
+    text = fig.text(0.02, 0.02, "", fontsize=8)
+
+    def frame(k: int):
+        cam_ax.clear()
+        img = run.images[k]
+        draw_camera_view(cam_ax, camera, img, extract_lines(img, n_lines=1, k1=camera.k1, focal_px=camera.focal_px))
+        cam_ax.set_title("camera", fontsize=9)
+        path_line.set_data(pose[:k + 1, 0], pose[:k + 1, 1])
+        c, s = math.cos(pose[k, 2]), math.sin(pose[k, 2])
+        world = outline @ np.array([[c, s], [-s, c]]) + pose[k, :2]
+        body.set_xy(world)
+        text.set_text(f"t = {run.time[k]:.1f} s   h = {pose[k, 1] * 100:+.1f} cm   "
+                      f"psi = {math.degrees(-pose[k, 2]):+.1f} deg")
+        return body, path_line
+
+    anim = FuncAnimation(fig, frame, frames=len(run.images), blit=False)
+    anim.save(str(path), writer=PillowWriter(fps=fps))

@@ -1,0 +1,202 @@
+"""Camera model of the thesis §9.2.1.D, eqs. (9.1)-(9.4), with the true rotation R' of the digest (errata 9.3).
+
+Frames (thesis Figs. 9.2-9.4):
+
+- ground frame **W** (``_w``): ``X_w`` across the followed line, to its right, ``Y_w`` along it, ``Z_w`` up; the
+  followed line is ``x_w = 0`` and parallel lines are ``x_w = n d`` (9.8);
+- camera frame **C** (``_c``): ``Z_c`` the optical axis, ``X_c`` right and ``Y_c`` down in the image;
+- image plane (``_u``): ``(x_u, y_u)`` in pixels from the image centre, ``y_u`` downward (9.1)-(9.2) with
+  ``d_x = d_y = 1`` (the focal length is in pixels);
+- wmrkit's **line frame L** (REP-103, ``pose_line_robot``): ``x`` along the line, ``y`` to its left, so
+  ``x_w = -y_L``, ``y_w = x_L``. A robot at ``(x, y, theta)`` in L sees ``psi = -theta`` and ``h = y`` (9.25).
+
+The camera is mounted on the robot looking straight ahead, its lens at height `height` and ``z_p`` from the
+tracked point P (the robot origin) along the optical axis: the lens is ``z_p sin(tilt)`` behind P horizontally.
+Lens distortion (option) is one radial term: ``x_d = x_u (1 + k1 r^2)``, ``r^2 = (x_u^2 + y_u^2) / f^2``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors
+from ..errors import WmrkitError
+
+__all__ = ["Camera", "CameraError", "camera_coordinates", "distort", "extrinsics", "ground_from_image",
+           "project", "rotation", "undistort"]
+
+
+class CameraError(WmrkitError, ValueError):
+    """A camera description, image or measurement that cannot be used; the message names the field."""
+
+
+@dataclass(frozen=True, slots=True)
+class Camera:
+    """A calibrated camera looking at the ground (§9.2.1.D-E). Frozen.
+
+    - ``focal_px`` f [px] (9.1)-(9.2) with unit pixel size; ``tilt`` phi [rad], from the vertical (9.3);
+    - ``height`` v [m], of the lens above the ground (9.7); ``width``, ``rows``: image size [px];
+    - ``k1``: radial distortion coefficient (0: an ideal pinhole).
+    """
+
+    focal_px: float
+    tilt: float
+    height: float
+    width: int = 640
+    rows: int = 480
+    k1: float = 0.0
+
+    def __post_init__(self) -> None:
+        checks = {"focal_px": self.focal_px > 0, "tilt": 0 < self.tilt < math.pi / 2, "height": self.height > 0,
+                  "width": self.width >= 8, "rows": self.rows >= 8, "k1": abs(self.k1) < 1}
+        for name, ok in checks.items():
+            value = getattr(self, name)
+            if not ok or not math.isfinite(value):
+                raise CameraError(f"camera: {name}: out of range, got {value}")
+
+    @property
+    def centre(self) -> tuple[float, float]:
+        """Image centre (C_x, C_y) [px] of (9.2), in pixel-centre coordinates."""
+        return (self.width - 1) / 2, (self.rows - 1) / 2
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain SI numbers, the camera file's fields."""
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: Any, *, source: str = "<camera>") -> Camera:
+        """A camera from a mapping (a camera file's content); unknown fields are refused."""
+        if not isinstance(data, dict):
+            raise CameraError(f"{source}: expected a mapping of camera fields")
+        allowed = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - allowed)
+        if unknown:
+            raise CameraError(f"{source}: unknown field '{unknown[0]}' (fields: {', '.join(sorted(allowed))})")
+        missing = [n for n in ("focal_px", "tilt", "height") if n not in data]
+        if missing:
+            raise CameraError(f"{source}: missing field '{missing[0]}'")
+        values: dict[str, Any] = {}
+        for name, value in data.items():
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise CameraError(f"{source}: {name}: expected a number, got {value!r}")
+            if name in ("width", "rows") and not float(value).is_integer():
+                raise CameraError(f"{source}: {name}: expected a whole number of pixels, got {value!r}")
+            values[name] = int(value) if name in ("width", "rows") else float(value)
+        try:
+            return cls(**values)
+        except CameraError as err:
+            raise CameraError(f"{source}: {str(err).removeprefix('camera: ')}") from None
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> Camera:
+        """Read a camera file (YAML, as ``wmrkit vision calibrate --out`` writes)."""
+        path = Path(path)
+        try:
+            data = yaml.safe_load(path.read_text())
+        except OSError as err:
+            raise CameraError(f"{path}: cannot read camera file ({err.strerror})") from None
+        except yaml.YAMLError as err:
+            raise CameraError(f"{path}: not YAML ({str(err).splitlines()[0]})") from None
+        return cls.from_dict(data, source=str(path))
+
+    def to_file(self, path: str | Path) -> None:
+        """Write the camera file (YAML, plain SI numbers)."""
+        Path(path).write_text(yaml.safe_dump(self.to_dict(), sort_keys=False))
+
+
+def rotation(psi: ArrayLike, tilt: ArrayLike) -> np.ndarray:
+    """Ground-to-camera rotation R' (eq. 9.3 corrected: the printed matrix is not a rotation).
+
+    ``(...), (...) -> (..., 3, 3)``.
+
+    Rows are the camera axes in W: ``X_c = (c psi, -s psi, 0)``, ``Y_c = (-s psi c phi, -c psi c phi, -s phi)``,
+    ``Z_c = (s psi s phi, c psi s phi, -c phi)`` (the optical axis, tilted down by phi from the vertical).
+    """
+    psi, tilt = np.broadcast_arrays(np.asarray(psi, dtype=float), np.asarray(tilt, dtype=float))
+    cp, sp, cf, sf = np.cos(psi), np.sin(psi), np.cos(tilt), np.sin(tilt)
+    z = np.zeros_like(psi)
+    return np.stack([np.stack([cp, -sp, z], -1), np.stack([-sp * cf, -cp * cf, -sf], -1),
+                     np.stack([sp * sf, cp * sf, -cf], -1)], -2)
+
+
+def camera_coordinates(points_w: ArrayLike, psi: ArrayLike, tilt: ArrayLike, t: ArrayLike) -> np.ndarray:
+    """``(x_c, y_c, z_c) = R' (x_w, y_w, z_w) + t``, eq. (9.3) corrected.
+
+    ``(..., 3), (...), (...), (..., 3) -> (..., 3)``.
+    """
+    p = as_vectors(points_w, 3, "points_w")
+    return (rotation(psi, tilt) @ p[..., None])[..., 0] + as_vectors(t, 3, "t")
+
+
+def project(points_w: ArrayLike, psi: ArrayLike, tilt: ArrayLike, t: ArrayLike, focal_px: ArrayLike) -> np.ndarray:
+    """Image coordinates ``(x_u, y_u)`` [px] of ground-frame points, eqs. (9.1) and (9.4) with R'.
+
+    ``(..., 3) -> (..., 2)``. Points behind the camera (``z_c <= 0``) give NaN.
+    """
+    c = camera_coordinates(points_w, psi, tilt, t)
+    zc = c[..., 2:3]
+    safe = np.where(zc > 0, zc, np.nan)
+    return np.asarray(focal_px, dtype=float)[..., None] * c[..., :2] / safe
+
+
+def extrinsics(pose_line_robot: ArrayLike, camera: Camera, z_p: ArrayLike = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """``(psi (...), t (..., 3))`` of (9.3) for a robot at `pose_line_robot` ``(x, y, theta)`` in the line frame L.
+
+    ``psi = -theta`` (9.25); the lens is at height ``camera.height``, ``z_p sin(tilt)`` behind the robot origin P.
+    """
+    pose = as_vectors(pose_line_robot, 3, "pose_line_robot")
+    x, y, theta = pose[..., 0], pose[..., 1], pose[..., 2]
+    back = np.asarray(z_p, dtype=float) * math.sin(camera.tilt)
+    lens_w = np.stack(np.broadcast_arrays(-(y - back * np.sin(theta)), x - back * np.cos(theta),
+                                          np.full_like(x, camera.height)), -1)
+    psi = -theta
+    t = -(rotation(psi, camera.tilt) @ lens_w[..., None])[..., 0]
+    return psi, t
+
+
+def ground_from_image(xy_u: ArrayLike, psi: ArrayLike, tilt: ArrayLike, t: ArrayLike,
+                      focal_px: ArrayLike) -> np.ndarray:
+    """Ground points ``(x_w, y_w)`` seen at undistorted image points: eq. (9.4) inverted on ``z_w = 0``.
+
+    ``(..., 2) -> (..., 2)``. Rays that do not meet the ground ahead (above the horizon) give NaN.
+    """
+    xy = as_vectors(xy_u, 2, "xy_u")
+    r = rotation(psi, tilt)
+    ray_c = np.concatenate([xy, np.broadcast_to(np.asarray(focal_px, dtype=float)[..., None], xy[..., :1].shape)],
+                           -1)
+    ray_w = (np.swapaxes(r, -1, -2) @ ray_c[..., None])[..., 0]
+    lens_w = -(np.swapaxes(r, -1, -2) @ as_vectors(t, 3, "t")[..., None])[..., 0]
+    down = -ray_w[..., 2]
+    s = np.where(down > 1e-12, lens_w[..., 2] / np.where(down > 1e-12, down, 1.0), np.nan)
+    return lens_w[..., :2] + s[..., None] * ray_w[..., :2]
+
+
+def distort(xy_u: ArrayLike, k1: float, focal_px: float) -> np.ndarray:
+    """Radial distortion ``x_d = x_u (1 + k1 r^2)``, ``r^2 = |x_u|^2 / f^2``. ``(..., 2) -> (..., 2)``."""
+    xy = as_vectors(xy_u, 2, "xy_u")
+    if k1 == 0:
+        return xy
+    r2 = np.sum(xy * xy, axis=-1, keepdims=True) / focal_px**2
+    return xy * (1 + k1 * r2)
+
+
+def undistort(xy_d: ArrayLike, k1: float, focal_px: float, *, iterations: int = 8) -> np.ndarray:
+    """Inverse of :func:`distort` by fixed-point iteration (converges for ``|k1 r^2| < 1/3``).
+
+    ``(..., 2) -> (..., 2)``.
+    """
+    xy_d = as_vectors(xy_d, 2, "xy_d")
+    if k1 == 0:
+        return xy_d
+    xy = xy_d
+    for _ in range(iterations):
+        r2 = np.sum(xy * xy, axis=-1, keepdims=True) / focal_px**2
+        xy = xy_d / (1 + k1 * r2)
+    return xy

@@ -1,0 +1,210 @@
+"""Closed-loop line following by vision, thesis §9.2.2-9.2.3: camera image -> (psi, h) -> control -> wheels.
+
+Each control period T (the image processing time) the synthetic camera renders what the robot sees
+(:func:`.render.render`), the line is extracted and the robot positioned from the image (:func:`locate_image`),
+optionally with bounded uniform noise on (h, psi) (example 2). The command reaches the wheels one period
+later (the image is being processed meanwhile: the one-sample delay that makes example 3 oscillate, digest §2.6).
+
+Control (9.25)-(9.26) in wmrkit's line frame L (x along the line, y left; the thesis's G has X to the right):
+pose ``(y, theta) = (h, -psi)``; world velocity of P ``(v_follow, -a h)`` (erratum: the printed
+``-a_x h`` is in the thesis's X-right frame and has the wrong sign there; the lateral error must decay), turned
+into the robot frame with the measured heading. The law is :mod:`wmrkit.control`'s P law (8.2) with the poles
+of (9.26) (:func:`line_following_law`), the twist the one the robot's fixed wheels admit
+(:func:`wmrkit.control.points.twist_for_velocity`), the wheel commands come from
+:func:`wmrkit.kinematics.wheel_ik.wheel_commands` (8.48)-(8.51), the motion from those wheel commands by
+:func:`wmrkit.kinematics.wheel_ik.forward_kinematics` and :func:`wmrkit.odometry.integrators.integrate_exact`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors, readonly
+from ..control.laws import PositionLaw, law_velocity
+from ..control.points import control_point, twist_for_velocity
+from ..errors import WmrkitError
+from ..kinematics.wheel_ik import forward_kinematics, wheel_commands
+from ..odometry.integrators import integrate_exact
+from ..robot import Robot
+from .camera import Camera
+from .lines import extract_lines
+from .positioning import Positioning, locate_points
+from .render import Scene, render
+
+__all__ = ["LineFollowing", "follow_line", "line_following_law", "line_following_twist", "locate_image",
+           "thesis_initial_commands"]
+
+
+def locate_image(camera: Camera, image: ArrayLike, *, spacing: float = 0.0, ns: tuple[int, ...] | None = None,
+                 z_p: float = 0.0, mode: str = "threshold", rows_a: float | None = None) -> Positioning:
+    """Position (psi, h) from an image (§9.2.1.C then (9.10)-(9.11)): extraction, two points per line, mean.
+
+    `ns`: the index n (9.8) of each line expected, left to right in the image; default ``(0,)`` without
+    `spacing`, ``(-1, 0, 1)`` with it (crop rows); ``(-1, 1)`` is a road's two lines. Of the lines found (up to
+    two more than expected), the neighbouring ones centred on the image's near row are used. The points are
+    taken on rows ``+-rows_a`` [px] (default a quarter of the image height). Raises :class:`WmrkitError` when
+    fewer lines than expected are found.
+    """
+    ns = ns if ns is not None else ((-1, 0, 1) if spacing > 0 else (0,))
+    found = extract_lines(image, n_lines=len(ns) + 2, mode=mode, k1=camera.k1, focal_px=camera.focal_px)
+    if len(found) < len(ns):
+        raise WmrkitError(f"image: found {len(found)} line(s), expected {len(ns)}")
+    a = rows_a if rows_a is not None else camera.rows / 4
+    # the len(ns) neighbouring lines around the image's centre on the near row +A (more rows may be in view)
+    start = min(range(len(found) - len(ns) + 1),
+                key=lambda i: abs(sum(ln.x_at(a) for ln in found[i:i + len(ns)])))
+    lines = found[start:start + len(ns)]
+    a = rows_a if rows_a is not None else camera.rows / 4
+    undistorted = replace(camera, k1=0.0)  # the extracted lines are already undistorted
+    return locate_points(undistorted, [(n, ln.points(a)) for n, ln in zip(ns, lines, strict=True)],
+                         spacing=spacing, z_p=z_p)
+
+
+def line_following_law(gain: float) -> PositionLaw:
+    """(9.26) as a P law (8.2) of :mod:`wmrkit.control`: pole `gain` [1/s] across the line, none along it (the
+    longitudinal position is unobservable: pure velocity control) and none on the heading."""
+    return PositionLaw("p", (0.0, gain, 0.0), (0.0, 0.0, 0.0), None)
+
+
+def line_following_twist(robot: Robot, psi: float, h: float, gain: float, speed: float) -> np.ndarray:
+    """Body twist ``(v_x, v_y, omega)`` commanded from a positioning (psi, h), eqs. (9.25)-(9.26) corrected.
+
+    ``-> (3,)``. The pose in the line frame L is ``(?, h, -psi)`` (9.25); the law's world velocity of P is
+    ``(speed, -gain h)`` (lateral error ``exp(-gain t)``; the printed ``-a_x h`` is in the thesis's X-right frame
+    and has the wrong sign there); :func:`wmrkit.control.points.twist_for_velocity` turns it into the twist the
+    robot's fixed wheels admit, with P the robot origin.
+    """
+    pose = np.array([0.0, h, -psi])
+    v_world = law_velocity(line_following_law(gain), np.zeros(3), np.array([speed, 0.0, 0.0]), pose, np.zeros(3))
+    return twist_for_velocity(control_point(robot, (0.0, 0.0)), pose, v_world)
+
+
+@dataclass(frozen=True, eq=False)
+class LineFollowing:
+    """A simulated line-following run (§9.2.3). Frozen, arrays read-only; K control periods.
+
+    - ``time`` ``(K + 1,)`` [s]; ``pose`` ``(K + 1, 3)`` of P in the line frame L (x along, y left [m], theta);
+    - ``measured`` ``(K, 2)``: (psi [rad], h [m]) used by the command of each period (one period old);
+    - ``twist`` ``(K, 3)``: the twist the wheels produced; ``rates`` ``(K, n_rates)`` [rad/s] the wheel commands
+      (``rate_names``); ``steer`` ``(K, n_steer)`` [rad] steering headings of ``steer_names`` (0 = ahead);
+    - ``lost`` ``(K,)`` bool: no line found in that image (the previous positioning was kept);
+    - ``images``: the camera images, one per period, when asked for.
+    """
+
+    robot_name: str
+    rate_names: tuple[str, ...]
+    steer_names: tuple[str, ...]
+    gain: float
+    speed: float
+    period: float
+    time: np.ndarray
+    pose: np.ndarray
+    measured: np.ndarray
+    twist: np.ndarray
+    rates: np.ndarray
+    steer: np.ndarray
+    lost: np.ndarray
+    images: tuple[np.ndarray, ...] | None = None
+
+    @property
+    def lateral(self) -> np.ndarray:
+        """Signed distance h [m] of P to the line at each sample ``(K + 1,)``."""
+        return self.pose[:, 1]
+
+    def settling_time(self, fraction: float = 0.95) -> float:
+        """First time [s] after which |h| stays within ``(1 - fraction)`` of its initial value."""
+        h = np.abs(self.lateral)
+        outside = np.flatnonzero(h > (1 - fraction) * h[0])
+        return float(self.time[min(outside[-1] + 1, len(h) - 1)]) if outside.size else 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        """Summary and samples (the ``wmrkit follow-line --json`` output)."""
+        h = self.lateral
+        return {
+            "robot": self.robot_name, "gain": self.gain, "speed": self.speed, "period": self.period,
+            "final_h": float(h[-1]), "final_psi": float(-self.pose[-1, 2]),
+            "overshoot": float(max(0.0, -np.min(h * np.sign(h[0])))) if h[0] != 0 else 0.0,
+            "settling_time_95": self.settling_time(), "lost_images": int(np.count_nonzero(self.lost)),
+            "samples": [{"t": float(t), "x": float(p[0]), "h": float(p[1]), "psi": float(-p[2])}
+                        for t, p in zip(self.time, self.pose, strict=True)],
+            "wheel_rates": {n: self.rates[:, i].tolist() for i, n in enumerate(self.rate_names)},
+        }
+
+
+def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float = 0.1, period: float = 0.5,
+                duration: float = 20.0, start: ArrayLike = (0.0, 0.3, 0.0), z_p: float = 0.0,
+                scene: Scene | None = None, noise: tuple[float, float] = (0.0, 0.0), image_noise: float = 0.0,
+                blur: float = 0.0, clutter: int = 0, seed: int = 0, keep_images: bool = False,
+                from_image: bool = True) -> LineFollowing:
+    """Simulate the vision line follower of §9.2.3 (module docstring).
+
+    `gain` a_x [1/s]; `speed` v_follow [m/s]; `period` T [s]; `start`: pose of P ``(x, y, theta)`` in the line
+    frame L (the thesis's p(0) = (-0.3 m, 0, 0) with its X to the right is ``y = +0.3``); `scene`: default one
+    painted line 2 cm wide; `noise`: bounds (h [m], psi [rad]) of uniform noise added to each positioning;
+    `image_noise`, `blur`, `clutter`: options of the synthetic camera. ``from_image=False`` skips the camera and
+    measures the exact (psi, h) of the pose (what the thesis's simulation did), for comparison.
+    """
+    if not (gain > 0 and period > 0 and duration > 0 and speed > 0):
+        raise WmrkitError("follow-line: gain, period, duration and speed must be > 0")
+    if gain * period >= 1:
+        raise WmrkitError(f"follow-line: gain * period = {gain * period:g} >= 1: the delayed loop is unstable "
+                          "(digest §2.6: a_x T < 1)")
+    scene = scene or Scene(ns=(0,), width=0.02)
+    actuated = [n for n in robot.rate_names if n.endswith(".spin") and n in robot.actuated] or \
+        [n for n in robot.rate_names if n.endswith(".spin")]
+    rng = np.random.default_rng(seed)
+    n_steps = round(duration / period)
+    pose = np.empty((n_steps + 1, 3))
+    pose[0] = as_vectors(start, 3, "start")
+    measured = np.empty((n_steps, 2))
+    twists, rates, steers = np.empty((n_steps, 3)), np.empty((n_steps, len(robot.rate_names))), []
+    lost = np.zeros(n_steps, dtype=bool)
+    images: list[np.ndarray] = []
+    beta = robot.beta
+
+    def position(p: np.ndarray) -> tuple[float, float] | None:
+        if not from_image:
+            return (-p[2] + rng.uniform(-noise[1], noise[1]), p[1] + rng.uniform(-noise[0], noise[0]))
+        img = render(camera, p, scene, z_p=z_p, noise=image_noise, blur=blur, clutter=clutter,
+                     seed=int(rng.integers(1 << 31)))
+        if keep_images:
+            images.append(img)
+        try:
+            fix = locate_image(camera, img, spacing=scene.spacing, ns=scene.ns, z_p=z_p)
+        except WmrkitError:
+            return None
+        return (fix.psi + rng.uniform(-noise[1], noise[1]), fix.h + rng.uniform(-noise[0], noise[0]))
+
+    last = position(pose[0])  # the image taken before starting
+    if last is None:
+        raise WmrkitError("follow-line: the camera does not see the line at the start pose")
+    for k in range(n_steps):
+        psi, h = last
+        measured[k] = psi, h
+        cmd = wheel_commands(robot, line_following_twist(robot, psi, h, gain, speed), beta)
+        beta = cmd.beta
+        names = list(cmd.rate_names)
+        twist, _ = forward_kinematics(robot, {n: cmd.rates[names.index(n)] for n in actuated}, beta)
+        twists[k], rates[k] = twist, cmd.rates
+        steers.append(robot.heading_of_beta(beta))
+        new = position(pose[k])  # processed during this period, used in the next one
+        lost[k] = new is None
+        last = new if new is not None else last
+        pose[k + 1] = integrate_exact(pose[k], twist, period)
+    time = np.arange(n_steps + 1) * period
+    steer = np.array(steers).reshape(n_steps, len(robot.steer_names))
+    return LineFollowing(robot.name, tuple(robot.rate_names), tuple(robot.steer_names), gain, speed, period,
+                         readonly(time), readonly(pose), readonly(measured), readonly(twists), readonly(rates),
+                         readonly(steer), readonly(lost), tuple(images) if keep_images else None)
+
+
+def thesis_initial_commands(robot: Robot, h: float = 0.3, gain: float = 0.3, speed: float = 0.1) -> dict[str, float]:
+    """The twist and wheel rates [rad/s] of the first command of §9.2.3 example 1 (psi = 0), named."""
+    twist = line_following_twist(robot, 0.0, h, gain, speed)
+    cmd = wheel_commands(robot, twist)
+    return {"vx": float(twist[0]), "vy": float(twist[1]), "omega": float(twist[2]),
+            **dict(zip(cmd.rate_names, cmd.rates.tolist(), strict=True))}

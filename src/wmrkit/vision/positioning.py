@@ -1,0 +1,137 @@
+"""Positioning relative to a line from image points, thesis §9.2.1.D "Particularización", eqs. (9.5)-(9.11).
+
+Two image points on a line known to lie at ``x_w = n d`` (9.8) give the camera's yaw psi and lateral offset t_x
+in closed form (9.10), and the distance h of the tracked point P to the followed line (9.11). Several lines
+(a road's two lines, three crop rows) each give one estimate; the result is their mean.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors
+from ..errors import ShapeError
+from .camera import Camera, CameraError
+
+__all__ = ["LineFix", "Positioning", "line_position", "locate_points", "read_points"]
+
+
+def line_position(points_u: ArrayLike, n: ArrayLike, *, focal_px: float, tilt: float, height: float,
+                  spacing: float = 0.0, z_p: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(psi, t_x, h)`` from two undistorted image points of one line, eqs. (9.10)-(9.11).
+
+    ``(..., 2, 2), (...) -> 3 x (...)``.
+
+    `points_u`: ``[[x_u1, y_u1], [x_u2, y_u2]]`` [px] from the image centre, y down; `n` the line's index (9.8)
+    at ``x_w = n * spacing`` [m]; `height` v [m]; `tilt` phi [rad]; `z_p` [m] from the lens to P along the optical
+    axis. ``psi`` [rad] is the yaw of the camera relative to the line (the robot's heading is ``-psi``, (9.25)),
+    ``h`` [m] the signed distance from P to the followed line, positive when P is left of it (``h = -x_w(P)``).
+    Points on one image row (``y_u1 = y_u2``) give NaN.
+    """
+    p = np.asarray(points_u, dtype=float)
+    if p.shape[-2:] != (2, 2):
+        raise ShapeError(f"points_u: expected shape (..., 2, 2), got {p.shape}")
+    x1, y1, x2, y2 = p[..., 0, 0], p[..., 0, 1], p[..., 1, 0], p[..., 1, 1]
+    cf, sf = math.cos(tilt), math.sin(tilt)
+    dy = y1 - y2
+    safe = np.where(dy != 0, dy, np.nan)
+    psi = np.arctan(cf * (x1 - x2) / safe + (sf / focal_px) * (y2 * x1 - y1 * x2) / safe)
+    t_x = (height / (focal_px * cf)) * (y1 * x2 - y2 * x1) / safe - np.asarray(n, dtype=float) * spacing / np.cos(psi)
+    h = math.tan(tilt) * (height - z_p * cf) * np.sin(psi) + t_x * np.cos(psi)
+    return psi, t_x, h
+
+
+@dataclass(frozen=True, slots=True)
+class LineFix:
+    """The position given by one line: its index n (9.8), its two image points [px], psi [rad], h [m]."""
+
+    n: int
+    points: tuple[tuple[float, float], tuple[float, float]]
+    psi: float
+    h: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"n", "points", "psi", "h"}``, one entry of the ``lines`` list."""
+        return {"n": self.n, "points": [list(p) for p in self.points], "psi": self.psi, "h": self.h}
+
+
+@dataclass(frozen=True, slots=True)
+class Positioning:
+    """Heading psi [rad] and distance h [m] of P to the followed line (9.10)-(9.11): the mean over `lines`."""
+
+    psi: float
+    h: float
+    lines: tuple[LineFix, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"psi": rad, "h": m, "lines": [...]}``, the ``wmrkit vision locate --json`` output."""
+        return {"psi": self.psi, "h": self.h, "lines": [f.to_dict() for f in self.lines]}
+
+
+def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spacing: float = 0.0,
+                  z_p: float = 0.0) -> Positioning:
+    """Position from ``(n, [[x_u1, y_u1], [x_u2, y_u2]])`` per line (pixels from the image centre, y down).
+
+    Points are taken as measured on the camera's (possibly distorted) image and undistorted with ``camera.k1``.
+    A line with ``n != 0`` needs `spacing` d > 0 [m]. The mean psi is taken on the circle.
+    """
+    from .camera import undistort
+
+    if not lines:
+        raise CameraError("points: no lines given")
+    fixes = []
+    for i, (n, pts) in enumerate(lines):
+        pts = np.asarray(pts, dtype=float)
+        if pts.shape != (2, 2) or not np.all(np.isfinite(pts)):
+            raise CameraError(f"points: lines[{i}]: expected two finite points [[xu, yu], [xu, yu]]")
+        if n not in (-1, 0, 1):
+            raise CameraError(f"points: lines[{i}].n: must be -1, 0 or 1, got {n!r}")
+        if n != 0 and not spacing > 0:
+            raise CameraError(f"points: lines[{i}]: n = {n} needs the line spacing (--spacing D > 0)")
+        if abs(pts[0, 1] - pts[1, 1]) < 1e-9:
+            raise CameraError(f"points: lines[{i}]: the two points are on one image row (y_u1 = y_u2)")
+        und = undistort(pts, camera.k1, camera.focal_px)
+        psi, _, h = line_position(und, n, focal_px=camera.focal_px, tilt=camera.tilt, height=camera.height,
+                                  spacing=spacing, z_p=z_p)
+        fixes.append(LineFix(int(n), (tuple(pts[0].tolist()), tuple(pts[1].tolist())), float(psi), float(h)))
+    psi_mean = math.atan2(sum(math.sin(f.psi) for f in fixes), sum(math.cos(f.psi) for f in fixes))
+    return Positioning(psi_mean, float(np.mean([f.h for f in fixes])), tuple(fixes))
+
+
+def read_points(path: str | Path) -> list[tuple[int, np.ndarray]]:
+    """A points file: JSON ``{"lines": [{"n": -1|0|1, "points": [[xu, yu], [xu, yu]]}]}``.
+
+    Points in pixels from the image centre, y down.
+    """
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except OSError as err:
+        raise CameraError(f"{path}: cannot read points file ({err.strerror})") from None
+    except json.JSONDecodeError as err:
+        raise CameraError(f"{path}:{err.lineno}: not JSON ({err.msg})") from None
+    if not isinstance(data, dict) or not isinstance(data.get("lines"), list) or not data["lines"]:
+        raise CameraError(f"{path}: expected {{\"lines\": [{{\"n\": ..., \"points\": [[xu, yu], [xu, yu]]}}]}}")
+    out = []
+    for i, line in enumerate(data["lines"]):
+        if not isinstance(line, dict) or set(line) - {"n", "points"} or "points" not in line:
+            raise CameraError(f"{path}: lines[{i}]: expected the fields 'n' and 'points'")
+        n = line.get("n", 0)
+        if isinstance(n, bool) or not isinstance(n, int):
+            raise CameraError(f"{path}: lines[{i}].n: must be -1, 0 or 1, got {n!r}")
+        pts = line["points"]
+        ok = (isinstance(pts, list) and len(pts) == 2
+              and all(isinstance(p, list) and len(p) == 2 for p in pts)
+              and all(isinstance(c, int | float) and not isinstance(c, bool) for p in pts for c in p))
+        if not ok:
+            raise CameraError(f"{path}: lines[{i}].points: expected [[xu, yu], [xu, yu]] (numbers)")
+        out.append((n, as_vectors(pts, 2, f"lines[{i}].points")))
+    return out

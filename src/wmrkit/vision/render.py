@@ -1,0 +1,111 @@
+"""Synthetic camera: what the camera on the robot sees of painted lines or crop rows (§9.2.1, Figs. 9.5-9.10).
+
+Every pixel is traced back to the ground through the camera model (:mod:`.camera`, eqs. (9.1)-(9.4) with R'),
+after the lens distortion when ``camera.k1 != 0``; the ground's brightness there is the scene's. Edges are
+anti-aliased with each pixel's footprint on the ground, so line positions are exact to a fraction of a pixel.
+Options add Gaussian noise, blur and clutter (bright blobs lying on the ground). Pure NumPy; blur uses OpenCV.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .camera import Camera, CameraError, extrinsics, ground_from_image, undistort
+
+__all__ = ["Scene", "render"]
+
+#: Grey levels of the ground and of the paint (or plants).
+GROUND, PAINT = 70.0, 215.0
+
+
+@dataclass(frozen=True, slots=True)
+class Scene:
+    """Parallel lines on the ground at ``x_w = n * spacing`` (9.8), ``n`` in `ns`; `width` [m] of each.
+
+    ``style="paint"``: uniform painted stripes; ``"crops"``: rows of plants whose width and density vary along
+    the row (chufa field, Fig. 9.10), on textured soil. `extra` lists further lateral positions x_w [m] of
+    stripes (e.g. the calibration stripes, which are not at multiples of a spacing).
+    """
+
+    ns: tuple[int, ...] = (0,)
+    spacing: float = 0.0
+    width: float = 0.02
+    style: str = "paint"
+    extra: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.style not in ("paint", "crops"):
+            raise CameraError(f"scene: style must be 'paint' or 'crops', got {self.style!r}")
+        if not self.width > 0:
+            raise CameraError(f"scene: width must be > 0, got {self.width}")
+
+    @property
+    def offsets(self) -> np.ndarray:
+        """Lateral positions x_w [m] of every stripe (thesis ground frame: to the right of the followed line)."""
+        return np.array([n * self.spacing for n in self.ns] + list(self.extra), dtype=float)
+
+
+def _pixel_grid(camera: Camera) -> np.ndarray:
+    """Undistorted image coordinates ``(rows, width, 2)`` [px] of every pixel centre."""
+    cx, cy = camera.centre
+    xs = np.arange(camera.width, dtype=float) - cx
+    ys = np.arange(camera.rows, dtype=float) - cy
+    grid = np.stack(np.meshgrid(xs, ys), -1)
+    return undistort(grid, camera.k1, camera.focal_px)
+
+
+def _coverage(dist: np.ndarray, half: np.ndarray | float, footprint: np.ndarray) -> np.ndarray:
+    """Fraction of a pixel of ground size `footprint` covered by a stripe of half-width `half` at `dist`."""
+    return np.clip(0.5 + (half - np.abs(dist)) / footprint, 0.0, 1.0)
+
+
+def render(camera: Camera, pose_line_robot: ArrayLike, scene: Scene, *, z_p: float = 0.0, noise: float = 0.0,
+           blur: float = 0.0, clutter: int = 0, seed: int | None = 0) -> np.ndarray:
+    """Grey image ``(rows, width)`` uint8 seen by `camera` on a robot at `pose_line_robot` ``(x, y, theta)``.
+
+    The pose is in the line frame L (x along the followed line, y to its left, REP-103); `z_p` [m] places the
+    lens on the optical axis behind P (:func:`.camera.extrinsics`). `noise`: standard deviation of added
+    Gaussian noise [grey levels]; `blur`: Gaussian blur sigma [px]; `clutter`: number of bright blobs scattered
+    on the ground in view (drawn anew for each image); `seed` makes noise and clutter reproducible.
+    """
+    rng = np.random.default_rng(seed)
+    psi, t = extrinsics(pose_line_robot, camera, z_p)
+    ground = ground_from_image(_pixel_grid(camera), psi, camera.tilt, t, camera.focal_px)
+    xw, yw = ground[..., 0], ground[..., 1]
+    visible = np.isfinite(xw)
+    # ground size of a pixel across the stripes (the anti-aliasing width), from neighbouring pixels
+    fx = np.abs(np.gradient(np.where(visible, xw, 0.0), axis=1))
+    fy = np.abs(np.gradient(np.where(visible, xw, 0.0), axis=0))
+    footprint = np.maximum(np.hypot(fx, fy), 1e-6)
+    footprint = np.where(np.isfinite(footprint) & (footprint < 10 * scene.width + 1), footprint, 10 * scene.width)
+    xw0, yw0 = np.where(visible, xw, 1e9), np.where(visible, yw, 0.0)
+    cover = np.zeros_like(xw0)
+    for i, x0 in enumerate(scene.offsets):
+        half: np.ndarray | float = scene.width / 2
+        if scene.style == "crops":  # plants: width varying along the row, the same field in every image
+            phase = np.random.default_rng(1000 + i).uniform(0, 2 * np.pi, 2)
+            half = scene.width / 2 * (0.75 + 0.15 * np.sin(yw0 / 0.13 + phase[0]) + 0.1 * np.sin(yw0 / 0.047
+                                                                                                  + phase[1]))
+        cover = np.maximum(cover, _coverage(xw0 - x0, half, footprint))
+    if scene.style == "crops":
+        cover *= 0.8 + 0.2 * np.sin(yw0 / 0.021 + 3 * np.sin(xw0 / 0.05)) ** 2
+    if clutter:  # bright discs lying on the ground, centred on random visible pixels
+        idx = rng.choice(np.flatnonzero(visible), size=clutter)
+        for cx0, cy0 in zip(xw0.flat[idx], yw0.flat[idx], strict=True):
+            radius = rng.uniform(0.3, 1.0) * scene.width
+            cover = np.maximum(cover, 0.8 * _coverage(np.hypot(xw0 - cx0, yw0 - cy0), radius, footprint))
+    soil = GROUND
+    if scene.style == "crops":
+        fade = np.clip(1.0 - footprint / 0.006, 0.0, 1.0)  # texture finer than a pixel is averaged away
+        soil = GROUND + 12 * fade * np.sin(xw0 / 0.011) * np.sin(yw0 / 0.017)
+    img = np.where(visible, soil + (PAINT - soil) * cover, GROUND)
+    if blur > 0:
+        from .lines import cv2_module
+
+        img = cv2_module().GaussianBlur(img, (0, 0), blur)
+    if noise > 0:
+        img = img + rng.normal(0.0, noise, img.shape)
+    return np.clip(np.rint(img), 0, 255).astype(np.uint8)

@@ -1,0 +1,365 @@
+"""Studio endpoints through the ASGI test client: results equal the library's (or an independent check), bad input
+answers 4xx with the CLI's message, oversize bodies and paths outside the directory are refused."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("starlette")
+pytest.importorskip("httpx")
+
+from starlette.testclient import TestClient
+
+from wmrkit import Robot, catalog
+from wmrkit.analysis.summary import analyze
+from wmrkit.description import robot_from_dict
+from wmrkit.errors import DescriptionError
+from wmrkit.kinematics.wheel_ik import wheel_commands
+from wmrkit.studio.api import NATIVE_HEADING
+from wmrkit.studio.app import MAX_BODY, create_app
+
+STEERING = ("ackermann", "swerve-4", "diff-drive", "thesis-steer-castor", "thesis-two-steer-swedish")
+
+
+@pytest.fixture()
+def client(tmp_path: Path):
+    return TestClient(create_app(tmp_path))
+
+
+def desc(name: str) -> dict:
+    return catalog.load(name).to_dict()
+
+
+def angle_close(a: float, b: float, tol: float = 1e-9) -> bool:
+    return abs(math.remainder(a - b, 2 * math.pi)) < tol
+
+
+# ---- analysis -------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("name", catalog.names())
+def test_analyze_equals_library(client, name):
+    r = client.post("/api/analyze", json={"description": desc(name)})
+    assert r.status_code == 200
+    live, full = r.json()["analysis"], analyze(catalog.load(name)).to_dict()
+    for key in ("mobility", "steerability", "type", "type_name", "degenerate", "reasons", "coordinated_steering",
+                "instantaneous_mobility", "actuation", "sensing", "condition_joints"):
+        got = {k: v for k, v in live[key].items() if k != "joints"} if isinstance(live[key], dict) else live[key]
+        assert got == full[key], key
+    assert live["icr"]["text"] == full["icr"]
+    for key in ("condition_number", "characteristic_length"):
+        if full[key] is None or not math.isfinite(full[key]):
+            assert live[key] is None
+        else:
+            assert live[key] == pytest.approx(full[key], rel=1e-9)
+
+
+def test_analyze_headings_and_geometry(client):
+    robot = catalog.load("ackermann")
+    data = client.post("/api/analyze", json={"description": robot.to_dict()}).json()
+    assert data["description"] == robot.to_dict()
+    for name, h in data["analysis"]["steering"].items():
+        assert angle_close(h, robot.wheel(name).heading)
+    wheels = {w["name"]: w for w in data["geometry"]["wheels"]}
+    for w in robot.wheels:  # the joint is the mount point (3.8); a steered-ahead wheel's heading is 0
+        assert np.allclose(wheels[w.name]["joint"], w.position)
+        assert angle_close(wheels[w.name]["heading"], 0.0)
+
+
+def test_heading_replaces_beta(client):
+    d = desc("swerve-4")
+    del d["wheels"][0]["beta"]
+    d["wheels"][0]["heading"] = "30 deg"
+    data = client.post("/api/analyze", json={"description": d}).json()
+    got = robot_from_dict(data["description"]).wheel("front_left")
+    assert angle_close(got.heading, math.radians(30))
+    # the axle is perpendicular to the rolling direction, on its left (beta = heading + 90 deg for delta = 0)
+    assert angle_close(got.beta, math.radians(120))
+
+
+def test_castor_heading_with_delta(client):
+    d = {"name": "c", "wheels": [
+        {"name": "l", "type": "fixed", "position": [0, 0.2], "beta": "90 deg", "r": 0.05, "actuated": "spin"},
+        {"name": "r", "type": "fixed", "position": [0, -0.2], "beta": "90 deg", "r": 0.05, "actuated": "spin"},
+        {"name": "c", "type": "castor", "position": [-0.3, 0], "heading": "10 deg", "delta": "20 deg",
+         "d": 0.04, "r": 0.02}]}
+    data = client.post("/api/analyze", json={"description": d}).json()
+    wheel = robot_from_dict(data["description"]).wheel("c")
+    # the rolling direction is the axle (beta + delta) turned by -90 deg
+    assert angle_close(wheel.beta + wheel.delta - math.pi / 2, math.radians(10))
+
+
+@pytest.mark.parametrize(("edit", "field"), [
+    (("r", "-5 mm"), "wheels[0].r"),
+    (("r", "5 deg"), "wheels[0].r"),
+    (("beta", "pi/2"), "wheels[0].beta"),
+    (("d", 0.1), "wheels[0].d"),
+    (("type", "wheely"), "wheels[0].type"),
+    (("heading", "3 mm"), "wheels[0].heading"),
+])
+def test_invalid_field_has_cli_message(client, edit, field):
+    d = desc("diff-drive")
+    d["wheels"][0][edit[0]] = edit[1]
+    r = client.post("/api/analyze", json={"description": d})
+    assert r.status_code == 422
+    body = r.json()
+    assert body["field"] == field
+    if edit[0] != "heading" or NATIVE_HEADING:  # the library's own validation, the same text as the CLI's
+        with pytest.raises(DescriptionError) as err:
+            robot_from_dict(d, source="studio")
+        assert body["message"] == err.value.message and body["error"] == str(err.value)
+
+
+@pytest.mark.parametrize("body", [
+    [1, 2], {"description": 3}, {"nothing": 1}, {"description": {"name": "x", "wheels": []}},
+    {"description": {"name": "x", "wheels": [{"name": "a"}]}},
+])
+def test_bad_descriptions_are_4xx(client, body):
+    r = client.post("/api/analyze", json=body)
+    assert 400 <= r.status_code < 500 and r.json()["error"]
+
+
+def test_malformed_requests(client):
+    assert client.post("/api/analyze", content=b"{", headers={"content-type": "application/json"}).status_code == 400
+    nan = b'{"description": {"name": "x", "wheels": [{"name": "a", "type": "fixed", "l": NaN}]}}'
+    assert client.post("/api/analyze", content=nan, headers={"content-type": "application/json"}).status_code == 400
+    huge = json.dumps({"description": desc("diff-drive"), "twist": [0, 0, 0]})
+    huge = huge.replace("[0, 0, 0]", "[1e999, 0, 0]").encode()
+    r = client.post("/api/drive", content=huge, headers={"content-type": "application/json"})
+    assert r.status_code == 400 and "finite" in r.json()["error"]
+    assert client.post("/api/analyze", content=b"{}", headers={"content-type": "text/plain"}).status_code == 415
+    big = b'{"description": "' + b"x" * (MAX_BODY + 10) + b'"}'
+    r = client.post("/api/analyze", content=big, headers={"content-type": "application/json"})
+    assert r.status_code == 413
+    assert client.get("/api/analyze").status_code == 405
+    assert client.post("/api/meta", json={}).status_code == 405  # meta is read-only
+
+
+def test_server_survives_after_bad_input(client):
+    for _ in range(3):
+        client.post("/api/drive", json={"description": desc("diff-drive"), "twist": ["a", None, {}]})
+    assert client.post("/api/analyze", json={"description": desc("diff-drive")}).status_code == 200
+
+
+# ---- driving --------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("name", ["swerve-4", "mecanum-4", "diff-drive", "ackermann", "thesis-omni-castor"])
+def test_drive_matches_wheel_commands(client, name):
+    robot = catalog.load(name)
+    twist = [0.4, 0.0 if name in ("diff-drive", "ackermann") else 0.2, 0.3]
+    r = client.post("/api/drive", json={"description": robot.to_dict(), "twist": twist})
+    assert r.status_code == 200
+    data = r.json()
+    c = wheel_commands(robot, twist)
+    headings = robot.heading_of_beta(c.beta)
+    for i, w in enumerate(robot.wheels):
+        got = data["wheels"][w.name]
+        assert got["spin"] == pytest.approx(float(c.spin[i]), abs=1e-12)
+        want = headings[robot.steer_names.index(w.name)] if w.kind.steers else w.heading
+        assert angle_close(got["heading"], float(want))
+        if w.type in ("steerable", "fixed") and abs(got["speed"]) > 1e-9:
+            # rigid body: the wheel's centre moves at (vx - w y, vy + w x) = speed along the heading
+            x, y = w.position
+            v = np.array([twist[0] - twist[2] * y, twist[1] + twist[2] * x])
+            assert np.allclose(v, got["speed"] * np.array([math.cos(got["heading"]), math.sin(got["heading"])]))
+    # no-slip: the velocity vector is in the kernel of the constraint matrix (3.22) when feasible
+    q_dot = np.asarray(c.velocity(twist))
+    slip = np.linalg.norm(robot.constraint_matrix(c.beta) @ q_dot)
+    assert data["feasible"] == (slip < 1e-9 and bool(c.feasible))
+
+
+def test_drive_flags_infeasible_twist(client):
+    data = client.post("/api/drive", json={"description": desc("diff-drive"), "twist": [0, 0.3, 0]}).json()
+    assert data["feasible"] is False and data["residual"] > 0.1
+    assert max(abs(w["slip"]) for w in data["wheels"].values()) == pytest.approx(0.3)
+
+
+def test_drive_icr_and_trajectory(client):
+    twist = [0.5, 0.1, 0.25]
+    data = client.post("/api/drive", json={"description": desc("omni-3"), "twist": twist,
+                                           "duration": 2.0, "samples": 5}).json()
+    x, y = data["icr"]["point"]
+    assert twist[0] - twist[2] * y == pytest.approx(0) and twist[1] + twist[2] * x == pytest.approx(0)
+    poses = np.array(data["poses"])
+    assert poses.shape == (5, 3) and np.allclose(poses[0], 0)
+    # a constant twist turns the body about the ICR: every pose's origin stays at the ICR's distance
+    assert np.allclose(np.hypot(poses[:, 0] - x, poses[:, 1] - y), math.hypot(x, y))
+    assert np.allclose(poses[:, 2], 0.25 * np.array(data["times"]))
+    straight = client.post("/api/drive", json={"description": desc("omni-3"), "twist": [0, 1, 0]}).json()
+    assert straight["icr"]["kind"] == "infinity" and np.allclose(straight["icr"]["direction"], [0, 1])
+    assert client.post("/api/drive", json={"description": desc("omni-3"), "twist": [0, 0, 0]}).json()[
+        "icr"]["kind"] == "none"
+
+
+def test_drive_keeps_current_heading(client):
+    """Driving backwards from a swerve at heading 0 keeps the wheels at 0 and reverses the spin (closest angle)."""
+    d = desc("swerve-4")
+    data = client.post("/api/drive", json={"description": d, "twist": [-1, 0, 0],
+                                           "heading": {n: 0.0 for n in catalog.load("swerve-4").steer_names}}).json()
+    for w in data["wheels"].values():
+        assert angle_close(w["heading"], 0.0) and w["spin"] < 0
+
+
+@pytest.mark.parametrize("body", [
+    {"twist": [1, 2]}, {"twist": [1, 2, "inf"]}, {"twist": [True, 0, 0]}, {"twist": "fast"},
+    {"twist": [0, 0, 0], "heading": {"left": 0.2}}, {"twist": [0, 0, 0], "heading": [1]},
+    {"twist": [0, 0, 0], "duration": -1}, {"twist": [0, 0, 0], "samples": 10**9},
+])
+def test_drive_bad_input(client, body):
+    r = client.post("/api/drive", json={"description": desc("diff-drive"), **body})
+    assert r.status_code == 400 and r.json()["error"]
+
+
+# ---- κ map and configurations ---------------------------------------------------------------------------------
+@pytest.mark.parametrize("name", ["diff-drive", "thesis-steer-castor", "thesis-two-steer-swedish"])
+def test_kappa_map_equals_condition_number(client, name):
+    from wmrkit.analysis.isotropy import twist_condition_number
+
+    robot = catalog.load(name)
+    data = client.post("/api/kappa", json={"description": robot.to_dict(), "resolution": 24}).json()
+    axis = np.array(data["axis"])
+    kappa = np.array([np.nan if v is None else v for v in data["kappa"]]).reshape(data["shape"])
+    rng = np.random.default_rng(1)
+    for _ in range(5):
+        idx = tuple(rng.integers(0, len(axis), len(data["wheels"])))
+        headings = robot.heading.copy()
+        for name_, i in zip(data["wheels"], idx, strict=True):
+            headings[robot.steer_names.index(name_)] = axis[i]
+        want = float(twist_condition_number(robot, robot.beta_of_heading(headings), length=data["length"]))
+        got = kappa[idx]
+        assert (np.isnan(got) and not np.isfinite(want)) or got == pytest.approx(want, rel=1e-9)
+
+
+def test_kappa_map_bad_input(client):
+    assert client.post("/api/kappa", json={"description": desc("mecanum-4")}).status_code == 400
+    for extra in ({"wheels": ["left"]}, {"wheels": "caster"}, {"resolution": 10**6}, {"resolution": 2.5}):
+        assert client.post("/api/kappa", json={"description": desc("diff-drive"), **extra}).status_code == 400
+
+
+def test_configurations(client):
+    robot = catalog.load("thesis-steer-castor")
+    data = client.post("/api/configurations", json={"description": robot.to_dict()}).json()
+    full = analyze(robot).to_dict()["singular"]
+    for key in ("actuated", "sensed"):
+        assert data["singular"][key]["count"] == full[key]["count"]
+        for beta, heading in zip(full[key]["configurations"], data["singular"][key]["headings"], strict=False):
+            deltas = [robot.wheel(n).delta for n in full[key]["variables"]]
+            assert all(angle_close(b + dl - math.pi / 2, h) for b, dl, h in zip(beta, deltas, heading, strict=True))
+    diff = client.post("/api/configurations", json={"description": desc("diff-drive")}).json()
+    assert diff["isotropic_searched"] and diff["isotropic"]
+    assert all(c["condition_number"] == pytest.approx(1.0) for c in diff["isotropic"])
+
+
+# ---- files ----------------------------------------------------------------------------------------------------
+def test_meta_and_catalog(client):
+    meta = client.get("/api/meta").json()
+    assert set(meta["catalog"]) == set(catalog.names()) and "castor" in meta["kinds"]
+    r = client.post("/api/open", json={"catalog": "swerve-4"})
+    assert Robot.from_dict(r.json()["description"]) == catalog.load("swerve-4")
+    assert client.post("/api/open", json={"catalog": "swerv-4"}).status_code == 400
+
+
+def test_save_round_trips_like_to_file(tmp_path, client):
+    robot = catalog.load("thesis-steer-castor")
+    d = robot.to_dict()
+    d["wheels"][0]["r"] = "123 mm"  # a value with a unit, as typed in the page
+    r = client.post("/api/save", json={"path": "sub.yaml", "description": d})
+    assert r.status_code == 200
+    saved = Robot.from_file(tmp_path / "sub.yaml")
+    assert saved == robot_from_dict(d)
+    expected = tmp_path / "expected.yaml"
+    saved.to_file(expected)
+    assert (tmp_path / "sub.yaml").read_text() == expected.read_text()
+    opened = client.post("/api/open", json={"path": "sub.yaml"}).json()
+    assert Robot.from_dict(opened["description"]) == saved
+    assert "sub.yaml" in client.get("/api/files").json()["files"]
+    # JSON too, and the CLI shows the same robot
+    assert client.post("/api/save", json={"path": "s.json", "description": d}).status_code == 200
+    assert Robot.from_file(tmp_path / "s.json") == saved
+
+
+def test_show_reads_saved_file(tmp_path, client, capsys):
+    from wmrkit.cli.main import main
+
+    client.post("/api/save", json={"path": "r.yaml", "description": desc("ackermann")})
+    assert main(["show", str(tmp_path / "r.yaml")]) == 0
+    from_file = capsys.readouterr().out
+    assert main(["show", "ackermann"]) == 0
+    assert from_file.replace("r.yaml", "") .count("front_left") == capsys.readouterr().out.count("front_left")
+
+
+def test_invalid_description_is_not_saved(tmp_path, client):
+    d = desc("diff-drive")
+    d["wheels"][1]["r"] = 0
+    r = client.post("/api/save", json={"path": "bad.yaml", "description": d})
+    assert r.status_code == 422 and r.json()["field"] == "wheels[1].r"
+    assert not (tmp_path / "bad.yaml").exists()
+
+
+@pytest.mark.parametrize("path", ["../evil.yaml", "/tmp/evil.yaml", "a/../../evil.yaml", "x.py", "", "..",
+                                  "sub/..", "nul\x00.yaml", 7])
+def test_path_traversal_refused(tmp_path, client, path):
+    for endpoint in ("/api/save", "/api/open"):
+        r = client.post(endpoint, json={"path": path, "description": desc("diff-drive")})
+        assert r.status_code in (400, 403), (endpoint, path)
+    assert not (tmp_path.parent / "evil.yaml").exists()
+
+
+def test_symlink_out_of_root_refused(tmp_path):
+    root = tmp_path / "root"
+    root.mkdir()
+    outside = tmp_path / "outside.yaml"
+    catalog.load("diff-drive").to_file(outside)
+    os.symlink(outside, root / "link.yaml")
+    c = TestClient(create_app(root))
+    assert c.post("/api/open", json={"path": "link.yaml"}).status_code == 403
+    assert c.post("/api/save", json={"path": "link.yaml", "description": desc("omni-3")}).status_code == 403
+    assert Robot.from_file(outside) == catalog.load("diff-drive")
+    assert "link.yaml" not in c.get("/api/files").json()["files"]
+
+
+def test_open_missing_and_invalid_file(tmp_path, client):
+    assert client.post("/api/open", json={"path": "none.yaml"}).status_code == 400
+    (tmp_path / "bad.yaml").write_text("name: x\nwheels:\n  - {name: a, type: fixed, l: 1, alpha: 0, beta: 0, r: -1}\n")
+    r = client.post("/api/open", json={"path": "bad.yaml"})
+    assert r.status_code == 422 and "must be > 0" in r.json()["error"] and ":3:" in r.json()["error"]
+
+
+def test_static_files_only(client):
+    assert client.get("/").status_code == 200
+    for f in ("app.js", "style.css"):
+        assert client.get(f"/static/{f}").status_code == 200
+    for bad in ("/static/../app.py", "/static/%2e%2e/app.py", "/static/..%2fapp.py", "/app.py"):
+        r = client.get(bad)
+        assert r.status_code == 404, bad
+
+
+def test_missing_extra_is_named(monkeypatch):
+    import builtins
+
+    from wmrkit.errors import WmrkitError
+    from wmrkit.studio import app
+
+    real = builtins.__import__
+
+    def fake(name, *args, **kwargs):
+        if name.startswith("starlette"):
+            raise ImportError(name)
+        return real(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", fake)
+    with pytest.raises(WmrkitError, match=r"wmrkit\[studio\]"):
+        app.create_app(".")
+
+
+def test_other_host_names_refused(tmp_path):
+    """DNS rebinding: a page served as evil.example that resolves to 127.0.0.1 gets no answer."""
+    from wmrkit.studio.app import LOCAL_HOSTS
+
+    app = create_app(tmp_path, allowed_hosts=LOCAL_HOSTS)
+    assert TestClient(app, base_url="http://evil.example").get("/api/meta").status_code == 400
+    assert TestClient(app, base_url="http://127.0.0.1:8765").get("/api/meta").status_code == 200
+    assert TestClient(app, base_url="http://localhost:8765").get("/").status_code == 200

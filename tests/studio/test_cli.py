@@ -1,0 +1,53 @@
+"""``wmrkit studio`` on the command line: a real server process answers, user mistakes exit 2 with one line."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+import urllib.request
+
+import pytest
+
+from wmrkit import catalog
+from wmrkit.cli.main import main
+
+pytest.importorskip("uvicorn")
+pytest.importorskip("starlette")
+
+
+def test_unknown_robot_exits_2(capsys):
+    assert main(["studio", "no-such-robot", "--no-browser"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wmrkit: error:") and "no robot 'no-such-robot'" in err and len(err.splitlines()) == 1
+
+
+def test_bad_port_exits_2(capsys):
+    assert main(["studio", "diff-drive", "--port", "70000", "--no-browser"]) == 2
+    assert "--port" in capsys.readouterr().err
+
+
+def test_server_process_serves_the_file(tmp_path):
+    catalog.load("omni-3").to_file(tmp_path / "mine.yaml")
+    proc = subprocess.Popen([sys.executable, "-m", "wmrkit", "studio", str(tmp_path / "mine.yaml"), "--port", "0",
+                             "--no-browser"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        line = proc.stdout.readline()  # "wmrkit studio: http://127.0.0.1:PORT/ (folder ...)"
+        assert line.startswith("wmrkit studio: http://127.0.0.1:"), (line, proc.stderr.read() if proc.poll() else "")
+        url = line.split()[2]
+        deadline = time.monotonic() + 20
+        while True:
+            try:
+                meta = json.load(urllib.request.urlopen(url + "api/meta", timeout=5))
+                break
+            except OSError:
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.1)
+        assert meta["start"]["spec"] == "mine.yaml" and meta["files"] == ["mine.yaml"]
+        assert meta["start"]["description"] == catalog.load("omni-3").to_dict()
+        assert urllib.request.urlopen(url, timeout=5).read().startswith(b"<!doctype html>")
+    finally:
+        proc.terminate()
+        proc.wait(10)

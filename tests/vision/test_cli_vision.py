@@ -1,0 +1,101 @@
+"""``wmrkit vision locate|calibrate`` and ``wmrkit follow-line``: end to end, with errors as one line and exit 2."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import cv2
+import numpy as np
+import pytest
+
+from wmrkit.cli.main import main
+from wmrkit.vision.camera import Camera, extrinsics, ground_from_image
+from wmrkit.vision.render import Scene, render
+
+THESIS_CAMERA = Camera(325.7, math.radians(45), 0.134, 320, 240)
+
+
+def run(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_calibrate_then_locate_from_images(tmp_path, capsys):
+    cal_img = render(THESIS_CAMERA, [0, 0, 0], Scene(ns=(), extra=(-0.035, 0.035), width=0.008), noise=2)
+    cv2.imwrite(str(tmp_path / "cal.png"), cal_img)
+    psi, t = extrinsics([0, 0, 0], THESIS_CAMERA)
+    g = ground_from_image(np.array([[0.0, 60.0], [0.0, -60.0]]), psi, THESIS_CAMERA.tilt, t, 325.7)
+    cam_file = tmp_path / "cam.yaml"
+    code, out, _ = run(["vision", "calibrate", str(tmp_path / "cal.png"), "--rows", "60", "--half-separation",
+                        "3.5 cm", "--row-distance", f"{g[1, 1] - g[0, 1]:.6f}", "--out", str(cam_file), "--json"],
+                       capsys)
+    assert code == 0
+    data = json.loads(out)
+    assert data["height"] == pytest.approx(0.134, abs=5e-4)
+    assert data["tilt"] == pytest.approx(math.radians(45), abs=math.radians(0.2))
+    cam = Camera.from_file(cam_file)
+    assert (cam.width, cam.rows) == (320, 240)
+    pose = (0.0, -0.0583, math.radians(35.434))
+    cv2.imwrite(str(tmp_path / "three.png"), render(THESIS_CAMERA, pose, Scene((-1, 0, 1), 0.035, 0.006)))
+    code, out, _ = run(["vision", "locate", str(tmp_path / "three.png"), "--camera", str(cam_file), "--spacing",
+                        "3.5cm", "--json"], capsys)
+    assert code == 0
+    fix = json.loads(out)
+    assert set(fix) == {"psi", "h", "lines"} and [ln["n"] for ln in fix["lines"]] == [-1, 0, 1]
+    assert fix["psi"] == pytest.approx(-pose[2], abs=math.radians(0.5))
+    assert fix["h"] == pytest.approx(pose[1], abs=0.002)
+
+
+def test_locate_points_file_is_the_chufa_example(tmp_path, capsys):
+    (tmp_path / "cam.yaml").write_text(f"focal_px: 545\ntilt: {math.radians(76)}\nheight: 1.42\n")
+    lines = [{"n": -1, "points": [[-10, -93], [-90, 93]]}, {"n": 0, "points": [[4, -93], [-2, 93]]},
+             {"n": 1, "points": [[18, -93], [83, 93]]}]
+    (tmp_path / "p.json").write_text(json.dumps({"lines": lines}))
+    code, out, _ = run(["vision", "locate", "--points", str(tmp_path / "p.json"), "--camera",
+                        str(tmp_path / "cam.yaml"), "--spacing", "60cm", "--json"], capsys)
+    assert code == 0
+    psis = [math.degrees(ln["psi"]) for ln in json.loads(out)["lines"]]
+    np.testing.assert_allclose(psis, [-0.86, -0.55, -0.3], atol=0.01)
+    code, out, _ = run(["vision", "locate", "--points", str(tmp_path / "p.json"), "--camera",
+                        str(tmp_path / "cam.yaml"), "--spacing", "60cm"], capsys)
+    assert code == 0 and out.startswith("psi = ")
+
+
+def test_calibrate_from_measurements(capsys):
+    code, out, _ = run(["vision", "calibrate", "--x1", "71.2357", "--x2", "49.0727", "--rows", "60",
+                        "--half-separation", "0.035", "--row-distance", "0.10221"], capsys)
+    assert code == 0 and "tilt = " in out and "height = 0.134" in out
+
+
+def test_follow_line_json_and_animation(tmp_path, capsys):
+    Camera(150.0, math.radians(60), 0.3, 160, 120).to_file(tmp_path / "cam.yaml")
+    gif = tmp_path / "run.gif"
+    code, out, _ = run(["follow-line", "line-follower", "--camera", str(tmp_path / "cam.yaml"), "--duration", "3",
+                        "--noise", "0.02", "3deg", "--animate", str(gif), "--json"], capsys)
+    assert code == 0
+    data = json.loads(out)
+    assert data["robot"] == "line-follower" and len(data["samples"]) == 7
+    assert data["samples"][-1]["h"] < 0.3
+    assert gif.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["vision", "locate", "missing.png", "--camera", "CAM"], "no such image file"),
+    (["vision", "locate", "--points", "PTS", "--camera", "nocam.yaml"], "cannot read camera file"),
+    (["vision", "calibrate", "--rows", "60", "--half-separation", "1", "--row-distance", "1"], "either IMAGE"),
+    (["vision", "calibrate", "--x1", "40", "--x2", "50", "--rows", "60", "--half-separation", "0.03",
+      "--row-distance", "0.1"], "must exceed x2"),
+    (["vision", "calibrate", "--x1", "60", "--x2", "50", "--rows", "60", "--half-separation", "3 deg",
+      "--row-distance", "0.1"], "--half-separation"),
+    (["follow-line", "line-follower", "--camera", "CAM", "--gain", "3"], "unstable"),
+])
+def test_user_errors_exit_2_with_one_line(tmp_path, capsys, argv, message):
+    Camera(150.0, math.radians(60), 0.3, 160, 120).to_file(tmp_path / "cam.yaml")
+    (tmp_path / "p.json").write_text('{"lines": [{"n": 0, "points": [[0, -10], [1, 10]]}]}')
+    argv = [str(tmp_path / "cam.yaml") if a == "CAM" else str(tmp_path / "p.json") if a == "PTS" else a
+            for a in argv]
+    code, _, err = run(argv, capsys)
+    assert code == 2
+    assert err.startswith("wmrkit: error: ") and message in err and len(err.strip().splitlines()) == 1

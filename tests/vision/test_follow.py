@@ -1,0 +1,143 @@
+"""Closed-loop line following by vision (§9.2.2-9.2.3): the thesis's three examples and the forklift variant."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.errors import WmrkitError
+from wmrkit.kinematics.models import kinematic_model
+from wmrkit.vision.camera import Camera
+from wmrkit.vision.follow import follow_line, line_following_twist, thesis_initial_commands
+
+ROBOT = catalog.load("line-follower")
+#: A small camera on the line follower: 0.3 m high, 60 deg from the vertical, 320 x 240 px (sees 0.3 m aside).
+CAMERA = Camera(150.0, math.radians(60), 0.3, 320, 240)
+
+
+@pytest.fixture(scope="module")
+def runs():
+    return {
+        "a0.3": follow_line(ROBOT, CAMERA, gain=0.3, duration=20),
+        "a0.8": follow_line(ROBOT, CAMERA, gain=0.8, duration=20),
+        "noise": follow_line(ROBOT, CAMERA, gain=0.3, duration=20, noise=(0.02, math.radians(3)), seed=3),
+        "exact": follow_line(ROBOT, CAMERA, gain=0.3, duration=20, from_image=False),
+    }
+
+
+def test_thesis_initial_commands_example_1():
+    """Digest §2.6: h = 0.3, theta = 0 -> R v = (0.09 right, 0.1 ahead), omega = -0.2308 rad/s, wheel rates
+    1.2154 and 2.7846 rad/s (the thesis prints -1.2154, -2.7846: its spin sign is opposite to wmrkit's)."""
+    c = thesis_initial_commands(ROBOT, h=0.3, gain=0.3, speed=0.1)
+    assert (c["vx"], c["vy"]) == pytest.approx((0.1, -0.09))
+    assert c["omega"] == pytest.approx(-0.09 / 0.39)
+    assert c["right.spin"] == pytest.approx(1.2154, abs=1e-4)
+    assert c["left.spin"] == pytest.approx(2.7846, abs=1e-4)
+
+
+def test_errata_9_26_lateral_command_sign():
+    """(9.25) gives ^G x_R = -h in the thesis's frame (X to the right); (9.26) prints ^G v_x = -a h, which would
+    push P away from the line. Corrected: +a h there, i.e. -a h along wmrkit's y (left)."""
+    a, h, dt = 0.3, 0.3, 0.1
+    v = line_following_twist(ROBOT, 0.0, h, a, 0.1)  # robot aligned with the line: robot frame = line frame
+    thesis_gx = -v[1]  # thesis X_G = -y_L
+    assert thesis_gx == pytest.approx(+a * h)
+    assert abs(h + v[1] * dt) < abs(h)  # the corrected command reduces the error ...
+    assert abs(h + (a * h) * dt) > abs(h)  # ... the printed one, read in wmrkit's frame, increases it
+
+
+def test_example_1_gain_0_3_is_monotone(runs):
+    h = runs["a0.3"].lateral
+    assert np.all(np.diff(h) <= 1e-4)  # no oscillation
+    assert h.min() > -1e-3
+    assert abs(h[-1]) < 0.005
+    assert not runs["a0.3"].lost.any()
+    # the wheel commands settle at v / r = 0.1 / 0.05 = 2 rad/s (the thesis's -2 rad/s with its spin sign)
+    np.testing.assert_allclose(runs["a0.3"].rates[-1], [2.0, 2.0], atol=0.05)
+
+
+def test_example_3_gain_0_8_oscillates_slightly(runs):
+    slow, fast = runs["a0.3"], runs["a0.8"]
+    h = fast.lateral
+    assert h.min() < -0.01  # crosses the line: no longer an exponential approach
+    assert -h.min() < 0.25 * h[0]  # a small oscillation
+    assert abs(h[-1]) < 0.005
+    assert np.abs(fast.rates).max() > np.abs(slow.rates).max()  # larger wheel commands
+
+
+def test_example_2_noise_jitters_the_wheels_but_tracks(runs):
+    noisy, clean = runs["noise"], runs["a0.3"]
+    late = noisy.time > 10.0
+    assert np.abs(noisy.lateral[late]).max() < 0.03
+    jitter = np.abs(np.diff(noisy.rates[-20:], axis=0)).max()
+    assert jitter > 5 * np.abs(np.diff(clean.rates[-20:], axis=0)).max()
+    seen = np.concatenate([noisy.lateral[:1], noisy.lateral[:-2]])  # the image of the previous period
+    assert np.all(np.abs(noisy.measured[:, 1] - seen) <= 0.02 + 0.002)  # the noise bound, plus vision error
+
+
+def test_camera_in_the_loop_matches_exact_positioning(runs):
+    """Rendering, extraction and (9.10)-(9.11) at every period give the same run as measuring the pose exactly."""
+    np.testing.assert_allclose(runs["a0.3"].pose, runs["exact"].pose, atol=2e-3)
+
+
+def test_the_measurement_is_one_period_old(runs):
+    r = runs["exact"]
+    np.testing.assert_allclose(r.measured[1:, 1], r.lateral[:-2], atol=1e-12)
+    np.testing.assert_allclose(r.measured[1:, 0], -r.pose[:-2, 2], atol=1e-12)
+
+
+def test_wheel_commands_obey_the_differential_kinematics(runs):
+    r = runs["a0.3"]
+    model = kinematic_model(ROBOT, ["vx", "omega"])
+    rates = model.solve(r.twist[:, [0, 2]])
+    names = list(model.solved)
+    for wheel in ("left.spin", "right.spin"):
+        np.testing.assert_allclose(r.rates[:, r.rate_names.index(wheel)], rates[:, names.index(wheel)], atol=1e-9)
+    np.testing.assert_allclose(r.twist[:, 1], 0.39 * r.twist[:, 2], atol=1e-12)  # v_y = e omega
+
+
+def test_forklift_variant():
+    """The forklift of ch. 7-8 (rear-steered tricycle, P at the fork tips) following a line with a camera 1.42 m
+    high (the chufa camera's height and tilt), 1 m off the line at 0.5 m/s."""
+    forklift = catalog.load("forklift")
+    cam = Camera(272.5, math.radians(60), 1.42, 320, 240)
+    run = follow_line(forklift, cam, gain=0.3, speed=0.5, start=(0.0, 1.0, 0.0), duration=20)
+    assert not run.lost.any()
+    assert abs(run.lateral[-1]) < 0.01
+    assert np.all(np.abs(run.steer) <= math.radians(90))  # within the forklift's steering range
+    assert run.steer[0, 0] > 0  # the rear wheel steers left to turn the truck right, towards the line
+    assert run.steer_names == ("steer",)
+
+
+def test_a_lost_image_keeps_the_previous_positioning(monkeypatch):
+    from wmrkit.vision import follow as follow_module
+
+    real, calls = follow_module.locate_image, []
+
+    def flaky(*args, **kwargs):
+        calls.append(1)
+        if len(calls) % 3 == 0:
+            raise WmrkitError("image: found 0 line(s), expected 1")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(follow_module, "locate_image", flaky)
+    run = follow_line(ROBOT, CAMERA, gain=0.3, duration=5)
+    assert run.lost.sum() == len(calls) // 3
+    k = int(np.flatnonzero(run.lost)[0])
+    np.testing.assert_array_equal(run.measured[k + 1], run.measured[k])  # held, not invented
+    assert abs(run.lateral[-1]) < abs(run.lateral[0])
+
+
+def test_refused_setups():
+    with pytest.raises(WmrkitError, match="unstable"):
+        follow_line(ROBOT, CAMERA, gain=2.0)
+    with pytest.raises(WmrkitError, match="does not see the line"):
+        follow_line(ROBOT, CAMERA, start=(0.0, 5.0, 0.0))
+
+
+def test_an_omnidirectional_robot_follows_without_turning():
+    run = follow_line(catalog.load("omni-3"), CAMERA, gain=0.3, duration=6)
+    assert np.all(np.diff(run.lateral) < 0) and np.allclose(run.pose[:, 2], 0.0, atol=1e-9)
