@@ -2,8 +2,8 @@
 
 Its drive wheels have incremental encoders of 8290 pulses per revolution (here on 16-bit counters that wrap) and
 its steered wheel an absolute encoder of 1.4118 deg (thesis §7.5.1). A synthetic drive (an S-curve with stops to
-steer) is written as a counts log, then read back the way ``wmrkit odometry forklift LOG --spin counts --steer
-counts --counter-bits 16 --out path.tum`` does. The steering quantisation makes the sensors slightly
+steer) is written as a counts log whose header gives the units (``right_drive.spin [counts:u16]``), then read back
+the way ``wmrkit odometry forklift LOG --out path.tum`` does. The steering quantisation makes the sensors slightly
 inconsistent: the slip indicator (least-squares residual, thesis (4.11)) shows it, and with equal weights the
 least squares lets the coarse steering angle bend the path. Trusting the steered wheel's equations less
 (``--weight steer=0.02``, the weighting idea of the thesis's WLS, §7.4.4) brings the drive wheels' accuracy
@@ -37,10 +37,12 @@ path = TwistProfile.from_segments([(6.0, 1.5, 0.0, 0.15), (1.0, 0, 0, 0), (4.0, 
                                    (6.0, 1.5, 0.0, -0.2)]).about((-1.0, 0.0))
 run = simulate(robot, path, 100.0, encoders=encoders)
 log_path = out_dir / "forklift_counts.csv"
-write_csv(log_path, ("time", *joints), np.column_stack([run.log.time, *(run.counts[j] for j in joints)]),
-          fmt="%.10g")
+# the header says what the columns hold: counts of 16-bit counters, so `wmrkit odometry forklift LOG` needs no options
+write_csv(log_path, ("time [s]", *(f"{j} [counts:u16]" if j.endswith(".spin") else f"{j} [counts]" for j in joints)),
+          np.column_stack([run.log.time, *(run.counts[j] for j in joints)]), fmt="%.10g")
 
-fmt = LogFormat(spin="counts", steer="counts", encoders=tuple(encoders.items()))
+fmt = LogFormat(spin="counts", steer="counts", encoders=tuple(encoders.items()), time_column="time [s]",
+                columns=tuple((j, f"{j} [counts:u16]" if j.endswith(".spin") else f"{j} [counts]") for j in joints))
 for weights, name in (({}, "forklift"), ({"steer": 0.02}, "forklift_weighted")):
     summary = odometry_file(robot, log_path, fmt=fmt, weights=weights, out=out_dir / f"{name}.tum",
                             plot=out_dir / f"{name}.png")

@@ -147,3 +147,46 @@ def test_usage_errors_exit_2(capsys, diff_csv):
     assert "argument --method: invalid choice: 'rk4'" in capsys.readouterr().err
     assert main(["odometry", "no-such-robot", diff_csv]) == 2
     assert "no robot 'no-such-robot'" in capsys.readouterr().err
+
+
+def _forklift_log(tmp_path, *, steer_scale: float = 1.0, header=lambda j: j):
+    robot = catalog.load("forklift")
+    joints = ("right_drive.spin", "left_drive.spin", "steer.steer")
+    run = simulate(robot, TwistProfile.from_segments([(6.0, 1.0, 0.0, 0.15)]).about((-1.0, 0.0)), 50.0)
+    cols = [run.log.positions[:, run.log.joints.index(j)] * (steer_scale if j.endswith(".steer") else 1.0)
+            for j in joints]
+    path = tmp_path / "forklift.csv"
+    write_csv(path, ("time", *map(header, joints)), np.column_stack([run.log.time, *cols]))
+    return path
+
+
+def test_units_in_the_header_need_no_options_and_contradicting_options_are_refused(capsys, tmp_path):
+    """Issue 8: a log says what its columns hold; the README's odometry line runs as written on the example's log."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    subprocess.run([sys.executable, str(root / "examples" / "odometry_forklift_log.py"), str(tmp_path)], check=True,
+                   capture_output=True)
+    log = str(tmp_path / "forklift_counts.csv")
+    assert main(["odometry", "forklift", log, "--json"]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert main(["odometry", "forklift", log, "--spin", "counts", "--steer", "counts", "--counter-bits", "16",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["pose"] == plain["pose"] and plain["consistent"] is True
+    assert 20 < plain["distance"] < 30  # the example's 24 m drive, not 85.9 km of counts read as radians
+    assert main(["odometry", "forklift", log, "--spin", "angle"]) == 2
+    assert "the header says --spin counts, the option says angle" in capsys.readouterr().err
+
+
+def test_degrees_written_as_radians_warn_and_say_inconsistent(capsys, tmp_path):
+    good = _forklift_log(tmp_path)
+    assert main(["odometry", "forklift", str(good), "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["consistent"] is True and err == ""
+    bad = _forklift_log(tmp_path, steer_scale=180 / math.pi)  # the steering column in degrees, read as radians
+    assert main(["odometry", "forklift", str(bad), "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["consistent"] is False
+    assert err.startswith("wmrkit: warning: the sensed joints contradict each other") and err.count("\n") == 1

@@ -5,11 +5,14 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from dataclasses import replace
+from pathlib import Path
 
 from ..errors import WmrkitError
 from ..odometry.covariance import CrowleyNoise
 from ..odometry.encoders import encoders_for
 from ..odometry.files import odometry_file
+from ..odometry.header import HeaderUnits, merge_option, read_header_units
 from ..odometry.integrators import METHODS
 from ..odometry.logs import TIME_UNITS, LogFormat
 from ..odometry.model import odometry_model
@@ -23,6 +26,7 @@ from ._common import (
     parse_value,
     print_json,
 )
+from .slip import ESTIMATOR_METHODS, add_estimator_options, estimator_from_args
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -30,7 +34,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = commands.add_parser("odometry", help="integrate a joint log (CSV or ROS 2 bag) into a trajectory")
     add_robot_argument(p)
     p.add_argument("log", metavar="LOG", help="CSV log (time, WHEEL.spin, WHEEL.steer columns) or ROS 2 bag")
-    p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
+    p.add_argument("--method", choices=(*METHODS, *ESTIMATOR_METHODS), default="exact",
+                   help="integration scheme of the no-slip model (default: exact), or a slip-aware estimator: "
+                        "wls (weighted least squares), fk1, fk2 (Kalman filters), see docs/slip.md")
     p.add_argument("--out", metavar="FILE", help="trajectory output: .csv, .tum/.txt (TUM), else a new ROS 2 bag")
     p.add_argument("--format", dest="out_format", choices=("csv", "tum", "bag"), help="output format (default: "
                    "from the --out extension)")
@@ -45,14 +51,17 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    default=(0.001, 0.003, 0.001), help="Crowley's coefficients (default 0.001 0.003 0.001)")
     g = p.add_argument_group("CSV logs")
     g.add_argument("--time-column", default="time", help="name of the time column (default: time)")
-    g.add_argument("--time-unit", choices=tuple(TIME_UNITS), default="s", help="unit of the time column")
+    g.add_argument("--time-unit", choices=tuple(TIME_UNITS), help="unit of the time column (default: the header's "
+                   "'time [ms]', else s)")
     g.add_argument("--column", action="append", metavar="JOINT=COLUMN", default=[], help="column of a joint (repeat)")
-    g.add_argument("--spin", choices=("angle", "counts", "velocity"), default="angle",
-                   help="spin columns: cumulative angle [rad], encoder counts, or velocity [rad/s]")
-    g.add_argument("--steer", choices=("angle", "counts"), default="angle", help="steer columns: angle [rad] or counts")
+    g.add_argument("--spin", choices=("angle", "counts", "velocity"),
+                   help="spin columns: cumulative angle [rad], encoder counts, or velocity [rad/s] (default: the "
+                        "header's units, e.g. 'left.spin [counts:u16]', else angle)")
+    g.add_argument("--steer", choices=("angle", "counts"),
+                   help="steer columns: angle [rad] or counts (default: the header's units, else angle)")
     g.add_argument("--cpr", type=float, help="encoder counts per revolution (default: the catalog's, if any)")
     g.add_argument("--gear", type=float, default=1.0, help="encoder revolutions per wheel revolution (default 1)")
-    g.add_argument("--counter-bits", type=int, help="width of a wrapping hardware counter")
+    g.add_argument("--counter-bits", type=int, help="width of a wrapping hardware counter (default: the header's)")
     g.add_argument("--signed-counter", action="store_true", help="the counter is signed")
     g.add_argument("--steer-resolution", metavar="ANGLE", help="steering encoder resolution [rad, or 'deg']")
     g.add_argument("--heading-column", help="absolute heading column [rad] used instead of the wheels' heading")
@@ -64,6 +73,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    help="map a ROS joint name to a robot joint WHEEL.spin/WHEEL.steer (repeat)")
     p.add_argument("--chunk-size", type=int, default=1 << 16, help="samples per chunk (memory bound)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_estimator_options(p)
     add_json_flag(p)
     p.set_defaults(run=run)
 
@@ -74,25 +84,57 @@ def run(args: argparse.Namespace) -> int:
     if args.chunk_size < 1:
         raise WmrkitError(f"--chunk-size must be >= 1, got {args.chunk_size}")
     joints = odometry_model(robot, args.sensed).joints
-    counted = [j for j in joints if (args.steer if j.endswith(".steer") else args.spin) == "counts"]
+    units = read_header_units(args.log) if Path(args.log).is_file() else HeaderUnits(())
+    spin = merge_option("--spin", args.spin, units.spin, "angle", args.log)
+    steer = merge_option("--steer", args.steer, units.steer, "angle", args.log)
+    time_unit = merge_option("--time-unit", args.time_unit, units.time_unit, "s", args.log)
+    bits = merge_option("--counter-bits", args.counter_bits, units.bits, None, args.log)
+    signed = args.signed_counter or units.signed
+    counted = [j for j in joints if (steer if j.endswith(".steer") else spin) == "counts"]
     steer_res = None if args.steer_resolution is None else parse_angle(args.steer_resolution, "--steer-resolution")
     encoders = encoders_for(robot.name, counted, counts_per_rev=args.cpr, gear_ratio=args.gear,
-                            bits=args.counter_bits, signed=args.signed_counter, steer_resolution=steer_res)
-    fmt = LogFormat(time_column=args.time_column, time_unit=args.time_unit,
-                    columns=tuple(parse_assignments(args.column, "--column").items()), spin=args.spin,
-                    steer=args.steer, encoders=encoders, heading_column=args.heading_column,
-                    gyro_column=args.gyro_column, max_gap=args.max_gap)
+                            bits=bits, signed=signed, steer_resolution=steer_res)
+    renamed = {plain: written for plain, written in units.columns}  # 'left.spin [counts]' read as left.spin
+    columns = {j: renamed[j] for j in joints if j in renamed} | parse_assignments(args.column, "--column")
+    fmt = LogFormat(time_column=renamed.get(args.time_column, args.time_column), time_unit=time_unit,
+                    columns=tuple(columns.items()), spin=spin, steer=steer, encoders=encoders,
+                    heading_column=args.heading_column, gyro_column=args.gyro_column, max_gap=args.max_gap)
     pose0 = [parse_value(args.pose[0], "length", "--pose X"), parse_value(args.pose[1], "length", "--pose Y"),
              parse_angle(args.pose[2], "--pose")]
+    slip_model = estimator_from_args(robot, args) if args.method in ESTIMATOR_METHODS else None
     summary = odometry_file(
-        robot, args.log, fmt=fmt, method=args.method, pose0=pose0, sensed=args.sensed,
+        robot, args.log, fmt=fmt, method=args.scheme if slip_model is not None else args.method, pose0=pose0,
+        sensed=args.sensed, model=slip_model,
         noise=CrowleyNoise(*args.crowley) if args.covariance else None, out=args.out, out_format=args.out_format,
         plot=args.plot, progress=not args.quiet and sys.stderr.isatty(), chunk_size=args.chunk_size,
         topic=args.topic, joint_names=parse_assignments(args.joint_name, "--joint-name"),
         weights={w: parse_value(v, "number", f"--weight {w}")
                  for w, v in parse_assignments(args.weight, "--weight").items()})
-    print_json(summary.to_dict()) if args.json else print(format_summary(summary))
+    if slip_model is not None:
+        summary = replace(summary, method=f"{args.method} ({args.scheme})")
+    consistent = _check_consistency(summary)
+    print_json(summary.to_dict() | {"consistent": consistent}) if args.json else print(format_summary(summary))
     return 0
+
+
+#: Slip tolerance of a log: an RMS slip indicator above this fraction of the mean motion per interval means the
+#: sensed joints contradict each other (the same rule as ``wmrkit fk``, FK_SLIP_RTOL).
+LOG_SLIP_RTOL = 0.02
+
+
+def _check_consistency(s: OdometrySummary) -> bool:
+    """Warn (one line on stderr) when the sensors contradict each other beyond the tolerance; say whether they
+    agree. A slip indicator as large as the motion itself means units, signs or the description are wrong."""
+    motion = s.distance / max(s.samples - 1, 1)
+    if s.rms_slip <= LOG_SLIP_RTOL * motion + 1e-9:
+        return True
+    what = ("larger than the motion itself: check the columns' units (counts? degrees?), signs and the robot "
+            "description" if s.rms_slip > motion else "beyond measurement noise: wheels slip, or units or signs "
+            "are wrong")
+    print(f"wmrkit: warning: the sensed joints contradict each other: slip indicator rms {s.rms_slip:.3g} m per "
+          f"interval (max {s.max_slip:.3g} m) against {motion:.3g} m of motion per interval, {what}",
+          file=sys.stderr)
+    return False
 
 
 

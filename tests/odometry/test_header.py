@@ -1,0 +1,36 @@
+"""Units written in a log's header (wmrkit.odometry.header)."""
+
+from __future__ import annotations
+
+import pytest
+
+from wmrkit.odometry.header import HeaderError, merge_option, parse_header_units
+
+
+def test_units_are_read():
+    u = parse_header_units(["time [ms]", "left.spin [counts:s32]", "right.spin [counts:s32]", "c.steer [rad]", "x"])
+    assert (u.time_unit, u.spin, u.steer, u.bits, u.signed) == ("ms", "counts", "angle", 32, True)
+    assert dict(u.columns)["left.spin"] == "left.spin [counts:s32]" and "x" not in dict(u.columns)
+    assert parse_header_units(["t", "a.spin [rad/s]"]).spin == "velocity"
+    assert not parse_header_units(["time", "a.spin"]).declared
+
+
+@pytest.mark.parametrize(("names", "message"), [
+    (["a.spin [deg]"], "unknown unit 'deg'"),
+    (["a.spin [rad]", "b.spin [counts]"], "mix units"),
+    (["a.spin [counts:u16]", "b.spin [counts:u32]"], "mix widths"),
+    (["a.spin [counts:u99]"], "counter width 99"),
+    (["time [h]"], "time units"),
+    (["a.steer [rad/s]"], "for a steer joint"),
+])
+def test_bad_units_name_the_column(names, message):
+    with pytest.raises(HeaderError, match=message):
+        parse_header_units(names, source="log.csv")
+
+
+def test_options_and_header_must_agree():
+    assert merge_option("--spin", None, "counts", "angle", "f") == "counts"
+    assert merge_option("--spin", "counts", "counts", "angle", "f") == "counts"
+    assert merge_option("--spin", None, None, "angle", "f") == "angle"
+    with pytest.raises(HeaderError, match="the header says --spin counts, the option says angle"):
+        merge_option("--spin", "angle", "counts", "angle", "f")
