@@ -1,0 +1,201 @@
+"""Batch odometry over a fleet's logs: every log through :func:`wmrkit.odometry.files.odometry_file`, in parallel.
+
+One row per log (:data:`SUMMARY_SCHEMA`, Parquet): the final pose as columns ``x, y, theta``, duration, path
+length, closure error for closed paths, slip statistics, warnings, the error when the log failed. A log that
+fails is recorded with its error and the batch goes on; a rerun with the same output skips logs already done
+(an error row is retried) and redoes a log whose trajectory file is missing.
+"""
+
+from __future__ import annotations
+
+import glob
+import hashlib
+import math
+import os
+import time
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..odometry.logs import LogFormat
+from ..robot import Robot
+from .engine import BatchError, Engine, TaskFailure, engine
+from .parquet import RowSink, read_rows
+
+#: Columns of the batch-odometry table (name, type); lengths in m, angles in rad, times in s.
+SUMMARY_SCHEMA = (
+    ("log", "string"), ("robot", "string"), ("method", "string"), ("samples", "int64"),
+    ("start_time", "float64"), ("duration", "float64"), ("x", "float64"), ("y", "float64"), ("theta", "float64"),
+    ("path_length", "float64"), ("rotation", "float64"), ("closure_error", "float64"),
+    ("closure_heading", "float64"), ("max_slip", "float64"), ("rms_slip", "float64"), ("max_dt", "float64"),
+    ("warnings", "string"), ("error", "string"), ("trajectory", "string"), ("seconds", "float64"),
+)
+#: Suffixes of single-file logs found in a folder (CSV joint logs, ROS 2 bag files).
+LOG_SUFFIXES = (".csv", ".db3", ".mcap")
+
+
+@dataclass(frozen=True)
+class LogJob:
+    """What one task does: odometry of the log at ``path`` with the options of :func:`batch_odometry`."""
+
+    path: str
+    robot: Robot
+    method: str = "exact"
+    trajectory: str | None = None
+    closed: bool = False
+    slip_warning: float = 0.01
+    options: Mapping[str, Any] = field(default_factory=dict)  # more keyword arguments of odometry_file
+
+
+@dataclass(frozen=True)
+class FleetResult:
+    """A batch: ``rows`` (one mapping per log, input order, :data:`SUMMARY_SCHEMA`), how many were ``skipped``
+    (done by an earlier run) and how many ``failed``."""
+
+    rows: tuple[Mapping[str, Any], ...]
+    skipped: int
+    failed: int
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary of the batch."""
+        return {"logs": len(self.rows), "skipped": self.skipped, "failed": self.failed,
+                "errors": {r["log"]: r["error"] for r in self.rows if r["error"]}}
+
+
+def expand_logs(patterns: Sequence[str | os.PathLike[str]]) -> list[str]:
+    """Log paths from files, globs and folders (in order, each once). A folder holding a ROS 2 bag
+    (``metadata.yaml``) is one log; another folder gives its CSV/bag files and bag sub-folders, sorted."""
+    out: list[str] = []
+    for pattern in map(os.fspath, patterns):
+        matches = sorted(glob.glob(pattern)) if glob.has_magic(pattern) else [pattern]
+        if not matches:
+            raise BatchError(f"{pattern}: no file matches")
+        for m in matches:
+            p = Path(m)
+            if not p.exists():
+                raise BatchError(f"{m}: no such file or folder")
+            if p.is_dir() and not (p / "metadata.yaml").exists():
+                out.extend(os.fspath(c) for c in sorted(p.iterdir())
+                           if (c.is_file() and c.suffix.lower() in LOG_SUFFIXES)
+                           or (c.is_dir() and (c / "metadata.yaml").exists()))
+            else:
+                out.append(m)
+    return list(dict.fromkeys(out))
+
+
+def process_log(job: LogJob) -> dict[str, Any]:
+    """Odometry of one log to its summary row; never raises (an error becomes the row's ``error``)."""
+    from ..odometry.files import odometry_file
+
+    row: dict[str, Any] = {name: None for name, _ in SUMMARY_SCHEMA}
+    row.update(log=job.path, robot=job.robot.name, method=job.method, trajectory=job.trajectory)
+    t0 = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, **dict(job.options))
+        except Exception as err:
+            row.update(error=_message(err), trajectory=None, seconds=time.perf_counter() - t0)
+            return row
+    x, y, theta = s.final_pose
+    notes = [" ".join(str(w.message).split()) for w in caught]
+    if s.max_slip > job.slip_warning:
+        notes.append(f"slip indicator up to {s.max_slip:.3g} m per interval (threshold {job.slip_warning:g} m)")
+    if s.samples < 2:
+        notes.append("a single sample: no motion")
+    row.update(samples=s.samples, start_time=s.start_time, duration=s.end_time - s.start_time, x=x, y=y, theta=theta,
+               path_length=s.distance, rotation=s.rotation, max_slip=s.max_slip, rms_slip=s.rms_slip,
+               max_dt=s.max_dt, warnings="; ".join(notes) or None, seconds=time.perf_counter() - t0)
+    if job.closed:  # the run ends where it started (the start pose is the origin)
+        row.update(closure_error=math.hypot(x, y), closure_heading=float(np.angle(np.exp(1j * theta))))
+    return row
+
+
+def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runner: Engine | None = None,
+                   method: str = "exact", out: str | os.PathLike[str] | None = None,
+                   trajectories: str | os.PathLike[str] | None = None, trajectory_format: str = "tum",
+                   closed: bool = False, resume: bool = True, progress: bool = False, slip_warning: float = 0.01,
+                   fmt: LogFormat | None = None, topic: str = "/joint_states",
+                   joint_names: Mapping[str, str] | None = None, sensed: Sequence[str] | None = None,
+                   weights: Mapping[str, float] | None = None) -> FleetResult:
+    """Odometry of every log in `logs` (files, globs, folders; :func:`expand_logs`) on `runner` (default: a
+    serial engine); the table is written to `out` (Parquet) and each trajectory to `trajectories`/``NAME.EXT``.
+
+    `closed`: every run ends at its start (the closure error is reported). `fmt` (CSV layout), `topic` and
+    `joint_names` (bags), `sensed` and `weights` go to :func:`~wmrkit.odometry.files.odometry_file`.
+    With `resume`, rows of `out` (and of its part files) without error are kept and their logs skipped.
+    """
+    from ..odometry.integrators import check_method
+
+    check_method(method)  # type: ignore[arg-type]
+    options = {"topic": topic, "joint_names": joint_names, "sensed": sensed, "weights": weights}
+    if fmt is not None:
+        options["fmt"] = fmt
+    paths = expand_logs(logs)
+    if out is not None and not Path(out).absolute().parent.is_dir():
+        raise BatchError(f"--out {os.fspath(out)}: the folder {Path(out).absolute().parent} does not exist")
+    if trajectories is not None and not Path(trajectories).is_dir():
+        raise BatchError(f"--trajectories {os.fspath(trajectories)}: no such folder")
+    if trajectory_format not in ("csv", "tum"):
+        raise BatchError(f"trajectory format must be csv or tum, got '{trajectory_format}'")
+    targets = _trajectory_names(paths, trajectories, trajectory_format)
+    done = _done(out, robot, method, targets) if resume and out is not None else {}
+    jobs = [LogJob(p, robot, method, targets[p], closed, slip_warning, options) for p in paths if p not in done]
+    sink = RowSink(out, SUMMARY_SCHEMA)
+    rows: dict[str, Mapping[str, Any]] = dict(done)
+    own = runner is None
+    runner = engine(workers=0) if runner is None else runner
+    try:
+        chunk = max(1, min(16, len(jobs) // (8 * runner.workers)))  # a few logs per task: less scheduler traffic
+        for index, row in runner.as_completed(process_log, jobs, progress=progress, desc="logs", chunk=chunk):
+            if isinstance(row, TaskFailure):  # the worker died more often than the scheduler allows
+                row = {name: None for name, _ in SUMMARY_SCHEMA} | {"log": jobs[index].path, "robot": robot.name,
+                                                                     "method": method, "error": str(row)}
+            rows[row["log"]] = row
+            sink.add(row)
+    finally:
+        if own:
+            runner.close()
+        sink.flush()
+    ordered = tuple(rows[p] for p in paths)
+    sink.finish(ordered)
+    return FleetResult(ordered, len(done), sum(1 for r in ordered if r["error"]))
+
+
+def _done(out, robot: Robot, method: str, targets: Mapping[str, str | None]) -> dict[str, Mapping[str, Any]]:
+    """Rows of an earlier run that need no redoing: same log, robot and method, no error, trajectory present."""
+    keep: dict[str, Mapping[str, Any]] = {}
+    for row in read_rows(out):
+        p = row.get("log")
+        if p not in targets or row.get("robot") != robot.name or row.get("method") != method:
+            continue
+        want = targets[p]
+        if row.get("error") or (want is not None and (row.get("trajectory") != want or not Path(want).exists())):
+            keep.pop(p, None)
+            continue
+        keep[p] = row
+    return keep
+
+
+def _trajectory_names(paths: Sequence[str], folder, fmt: str) -> dict[str, str | None]:
+    """``folder/STEM.EXT`` per log; stems shared by several logs get a short hash of the path."""
+    if folder is None:
+        return dict.fromkeys(paths)
+    stems = [Path(p).stem for p in paths]
+    out = {}
+    for p, stem in zip(paths, stems, strict=True):
+        if stems.count(stem) > 1:
+            stem = f"{stem}-{hashlib.sha1(os.path.abspath(p).encode()).hexdigest()[:8]}"
+        out[p] = os.fspath(Path(folder) / f"{stem}.{fmt}")
+    return out
+
+
+def _message(err: BaseException) -> str:
+    from ..errors import WmrkitError
+
+    text = " ".join(str(err).split()) or type(err).__name__
+    return text if isinstance(err, WmrkitError) else f"{type(err).__name__}: {text}"

@@ -1,0 +1,237 @@
+"""``wmrkit batch odometry|calibrate|montecarlo`` and ``wmrkit sweep``: fleet-scale work on Dask (or serially)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from ..errors import WmrkitError
+from ._common import (
+    add_json_flag,
+    add_robot_argument,
+    load_robot,
+    parse_angle,
+    parse_assignments,
+    parse_value,
+    print_json,
+)
+
+
+def _engine_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("engine")
+    g.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address (default: an embedded local cluster)")
+    g.add_argument("--workers", type=int, metavar="N",
+                   help="worker processes of the local cluster (default: the CPU count; 0: serial, no Dask)")
+    g.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_json_flag(p)
+
+
+def add_parsers(commands: argparse._SubParsersAction) -> None:
+    """Register ``batch`` (subcommands) and ``sweep``."""
+    from ..odometry.integrators import METHODS
+
+    batch = commands.add_parser("batch", help="fleet-scale odometry, calibration and Monte Carlo (Dask)")
+    sub = batch.add_subparsers(dest="batch_command", metavar="SUBCOMMAND", required=True)
+
+    p = sub.add_parser("odometry", help="odometry of many logs in parallel, one summary row per log (Parquet)")
+    add_robot_argument(p)
+    p.add_argument("logs", nargs="+", metavar="LOG", help="CSV logs, ROS 2 bags, globs or folders")
+    p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
+    p.add_argument("--out", metavar="FILE", help="summary table (Parquet); a rerun skips the logs done")
+    p.add_argument("--trajectories", metavar="DIR", help="write each log's trajectory to DIR/NAME.tum")
+    p.add_argument("--trajectory-format", choices=("tum", "csv"), default="tum", help="trajectory files (default tum)")
+    p.add_argument("--closed", action="store_true", help="every run ends at its start: report the closure error")
+    p.add_argument("--no-resume", action="store_true", help="redo every log even if --out has it")
+    _log_options(p)
+    _engine_options(p)
+    p.set_defaults(run=run_odometry)
+
+    p = sub.add_parser("calibrate", help="fit wheel radii and track from many logs, with confidence intervals")
+    add_robot_argument(p)
+    p.add_argument("logs", nargs="+", metavar="LOG", help="CSV logs, ROS 2 bags, globs or folders")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--reference", metavar="DIR", help="reference trajectories DIR/NAME.tum (or .csv) per log")
+    src.add_argument("--closed", action="store_true", help="every run ends at its start")
+    p.add_argument("--param", action="append", metavar="FIELDS", default=[],
+                   help="a parameter: WHEEL.FIELD names moved together, comma-separated, '-' to oppose (repeat; "
+                        "default: spin wheels' radii (their ratio with --closed) and the track)")
+    p.add_argument("--ci", choices=("jacobian", "bootstrap"), default="jacobian", help="interval method")
+    p.add_argument("--level", type=float, default=0.95, help="confidence level (default 0.95)")
+    p.add_argument("--bootstrap", type=int, default=200, metavar="B", help="bootstrap replicates (default 200)")
+    p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
+    _log_options(p)
+    _engine_options(p)
+    p.set_defaults(run=run_calibrate)
+
+    p = sub.add_parser("montecarlo", help="sensor errors sampled N times vs the analytic covariance (paper 003)")
+    add_robot_argument(p)
+    p.add_argument("log", nargs="?", metavar="LOG", help="CSV log taken as the truth (or --path)")
+    p.add_argument("--path", metavar="NAME", help="a built-in path: square, loop, arc")
+    p.add_argument("-n", "--runs", type=int, default=1000, help="Monte Carlo runs (default 1000)")
+    p.add_argument("--noise", type=float, default=1e-4, metavar="RAD2_PER_RAD",
+                   help="random-walk variance per radian of joint travel (default 1e-4)")
+    p.add_argument("--resolution", metavar="ANGLE", default="0", help="encoder resolution [rad or deg] (default 0)")
+    p.add_argument("--slip", type=float, default=0.0, metavar="STD", help="std of a run's wheel slip ratio")
+    p.add_argument("--rate", type=float, default=20.0, help="sample rate of a built-in path [Hz] (default 20)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
+    p.add_argument("--plot", metavar="FILE", help="final positions with both 95 %% ellipses")
+    _engine_options(p)
+    p.set_defaults(run=run_montecarlo)
+
+    p = commands.add_parser("sweep", help="a design metric over a product of description fields (Dask)")
+    add_robot_argument(p)
+    p.add_argument("--vary", action="append", required=True, metavar="FIELD=START:STOP:N",
+                   help="wheels.NAME.FIELD or wheels[I].FIELD (comma-join fields moved together); units allowed")
+    p.add_argument("--metric", choices=("kappa_mean", "kappa_max", "inv_kappa_mean", "singular_margin"),
+                   default="kappa_mean", help="design metric (default kappa_mean; see docs/batch.md)")
+    p.add_argument("--length", metavar="D", help="characteristic length [m] (default: each design's natural one)")
+    p.add_argument("--configs", type=int, default=64, help="steering configurations per design (default 64)")
+    p.add_argument("--chunk", type=int, default=4096, help="designs per chunk (default 4096)")
+    p.add_argument("--top", type=int, default=10, help="best designs reported (default 10)")
+    p.add_argument("--out", metavar="FILE", help="every design and its metric (Parquet)")
+    p.add_argument("--plot", metavar="FILE", help="the metric over the first one or two axes")
+    _engine_options(p)
+    p.set_defaults(run=run_sweep)
+
+
+def _log_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("logs")
+    g.add_argument("--time-column", default="time", help="name of the CSV time column (default: time)")
+    g.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), default="s", help="unit of the time column")
+    g.add_argument("--column", action="append", metavar="JOINT=COLUMN", default=[], help="column of a joint (repeat)")
+    g.add_argument("--sensed", action="append", metavar="WHEEL.JOINT", help="use only these sensed joints (repeat)")
+    g.add_argument("--topic", default="/joint_states", help="JointState topic of bags (default: /joint_states)")
+    g.add_argument("--joint-name", action="append", metavar="ROS=JOINT", default=[], help="bag joint names (repeat)")
+
+
+def _options(args: argparse.Namespace) -> dict:
+    from ..odometry.logs import LogFormat
+
+    fmt = LogFormat(time_column=args.time_column, time_unit=args.time_unit,
+                    columns=tuple(parse_assignments(args.column, "--column").items()))
+    out = {"sensed": args.sensed, "topic": args.topic,
+           "joint_names": parse_assignments(args.joint_name, "--joint-name") or None}
+    if fmt != LogFormat():
+        out["fmt"] = fmt
+    return out
+
+
+def _runner(args: argparse.Namespace):
+    from ..batch.engine import engine
+
+    return engine(args.scheduler, args.workers, quiet=args.json)
+
+
+def _progress(args: argparse.Namespace) -> bool:
+    return not args.quiet and not args.json and sys.stderr.isatty()
+
+
+def run_odometry(args: argparse.Namespace) -> int:
+    """Batch odometry; prints the number of logs done, skipped and failed (and each failure)."""
+    from ..batch.fleet import batch_odometry
+
+    robot = load_robot(args.robot)
+    with _runner(args) as runner:
+        result = batch_odometry(robot, args.logs, runner=runner, method=args.method, out=args.out,
+                                trajectories=args.trajectories, trajectory_format=args.trajectory_format,
+                                closed=args.closed, resume=not args.no_resume, progress=_progress(args),
+                                **_options(args))
+    if args.json:
+        print_json(result.to_dict() | {"rows": [dict(r) for r in result.rows]})
+        return 0
+    print(f"{len(result.rows)} logs: {len(result.rows) - result.failed} done ({result.skipped} from an earlier run), "
+          f"{result.failed} failed" + (f"; table {args.out}" if args.out else ""))
+    for r in result.rows:
+        if r["error"]:
+            print(f"  failed: {r['error']}")
+        elif not args.out:
+            print(f"  {r['log']}: x {r['x']:.4f} m, y {r['y']:.4f} m, theta {r['theta']:.4f} rad, "
+                  f"path {r['path_length']:.4g} m")
+    return 0
+
+
+def run_calibrate(args: argparse.Namespace) -> int:
+    """Fleet calibration; prints each fitted field with its interval."""
+    from ..batch.calibrate import default_parameters, fleet_calibrate, load_runs
+    from ..batch.fleet import expand_logs
+
+    robot = load_robot(args.robot)
+    params = ([tuple(n.strip() for n in p.split(",") if n.strip()) for p in args.param] if args.param
+              else default_parameters(robot, closed=args.closed))
+    if args.bootstrap < 2:
+        raise WmrkitError(f"--bootstrap must be >= 2, got {args.bootstrap}")
+    with _runner(args) as runner:
+        runs = load_runs(robot, expand_logs(args.logs), reference_dir=args.reference, closed=args.closed,
+                         runner=runner, options=_options(args))
+        result = fleet_calibrate(robot, runs, params, runner=runner, ci=args.ci, level=args.level,
+                                 n_boot=args.bootstrap, method=args.method, sensed=args.sensed,
+                                 progress=_progress(args))
+    if args.json:
+        print_json(result.to_dict())
+        return 0
+    print(f"robot {robot.name}: {result.runs} runs, {result.residuals} residuals, RMS {result.rms_before:.4g} -> "
+          f"{result.rms_after:.4g}; {result.level:.0%} intervals ({result.ci})")
+    for name, nominal, value, lo, hi in result.values:
+        print(f"  {name:<24} {nominal:.6g} -> {value:.6g}  [{lo:.6g}, {hi:.6g}]")
+    return 0
+
+
+def run_montecarlo(args: argparse.Namespace) -> int:
+    """Monte Carlo against the analytic covariance; prints both standard deviations."""
+    from ..batch.montecarlo import monte_carlo, path_log, plot_monte_carlo
+
+    robot = load_robot(args.robot)
+    if (args.log is None) == (args.path is None):
+        raise WmrkitError("give a LOG or --path NAME (one of the two)")
+    if args.log is not None:
+        from ..odometry.logs import load_csv
+        from ..odometry.model import odometry_model
+
+        log = load_csv(args.log, odometry_model(robot).joints)
+    else:
+        if not args.rate > 0:
+            raise WmrkitError(f"--rate must be > 0 Hz, got {args.rate}")
+        log = path_log(robot, args.path, args.rate)
+    with _runner(args) as runner:
+        result = monte_carlo(robot, log, args.runs, per_rad=args.noise,
+                             resolution=parse_angle(args.resolution, "--resolution"), slip_std=args.slip,
+                             method=args.method, seed=args.seed, runner=runner, progress=_progress(args))
+    if args.plot:
+        plot_monte_carlo(result, args.plot)
+    if args.json:
+        print_json(result.to_dict())
+        return 0
+    d = result.to_dict()
+    print(f"robot {robot.name}: {result.runs} runs over {result.samples} samples")
+    for i, name in enumerate(("x [m]", "y [m]", "theta [rad]")):
+        print(f"  std {name:<12} Monte Carlo {d['std'][i]:.4g}   analytic (003) {d['analytic_std'][i]:.4g}")
+    return 0
+
+
+def run_sweep(args: argparse.Namespace) -> int:
+    """A design sweep; prints the best designs."""
+    from ..batch.sweep import plot_sweep, sweep
+    from ..batch.sweep_kernel import parse_vary
+
+    robot = load_robot(args.robot)
+    axes = [parse_vary(v, robot) for v in args.vary]
+    length = None if args.length is None else parse_value(args.length, "length", "--length")
+    if args.configs < 1:
+        raise WmrkitError(f"--configs must be >= 1, got {args.configs}")
+    with _runner(args) as runner:
+        result = sweep(robot, axes, args.metric, runner=runner, chunk=args.chunk, out=args.out, top=args.top,
+                       length=length, configs=args.configs, progress=_progress(args))
+    if args.plot:
+        plot_sweep(result, args.plot)
+    if args.json:
+        print_json(result.to_dict())
+        return 0
+    print(f"robot {robot.name}: {args.metric} over {result.total:,} designs in {result.seconds:.3g} s")
+    for b in result.best:
+        fields = ", ".join(f"{a.label} = {b[a.label]:.6g}" for a in axes)
+        value = b[args.metric]
+        print(f"  {args.metric} {value:.6g}" if math.isfinite(value) else f"  {args.metric} {value}",
+              f"(D {b['length']:.4g} m): {fields}")
+    return 0

@@ -1,0 +1,60 @@
+"""``wmrkit batch ...`` and ``wmrkit sweep``: end to end, serial engine (--workers 0), errors exit 2."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from wmrkit.cli.main import main
+
+
+def _json(capsys, argv):
+    assert main(argv) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_batch_odometry(capsys, fleet_dir, tmp_path):
+    out = tmp_path / "r.parquet"
+    data = _json(capsys, ["batch", "odometry", "diff-drive", str(fleet_dir), "--workers", "0", "--closed",
+                          "--out", str(out), "--trajectories", str(tmp_path), "--json"])
+    assert data["logs"] == 6 and data["failed"] == 1 and out.exists()
+    assert all(r["closure_error"] < 0.1 for r in data["rows"] if not r["error"])
+    assert main(["batch", "odometry", "diff-drive", str(fleet_dir), "--workers", "0", "--out", str(out)]) == 0
+    assert "5 from an earlier run" in capsys.readouterr().out
+
+
+def test_batch_calibrate_and_montecarlo(capsys, calibration_data, tmp_path):
+    data = _json(capsys, ["batch", "calibrate", "diff-drive", str(calibration_data / "*.csv"), "--reference",
+                          str(calibration_data / "ref"), "--workers", "0", "--json"])
+    assert [v["field"] for v in data["values"]] == ["left.r", "right.r", "left.l", "right.l"]
+    assert all(v["low"] < v["fitted"] < v["high"] for v in data["values"])
+    assert main(["batch", "calibrate", "diff-drive", str(calibration_data / "c*.csv"), "--closed", "--workers", "0",
+                 "--param", "left.r,-right.r"]) == 0
+    assert "left.r" in capsys.readouterr().out
+    plot = tmp_path / "mc.png"
+    data = _json(capsys, ["batch", "montecarlo", "diff-drive", "--path", "arc", "-n", "30", "--workers", "0",
+                          "--resolution", "0.5deg", "--plot", str(plot), "--json"])
+    assert data["runs"] == 30 and len(data["analytic_std"]) == 3 and plot.exists()
+
+
+def test_sweep(capsys, tmp_path):
+    data = _json(capsys, ["sweep", "omni-3", "--vary", "wheels[0].alpha,wheels[0].beta=30deg:90deg:7", "--vary",
+                          "wheels.back.l=0.15:0.25:3", "--workers", "0", "--top", "2", "--out",
+                          str(tmp_path / "s.parquet"), "--plot", str(tmp_path / "s.png"), "--json"])
+    assert data["designs"] == 21 and data["best"][0]["kappa_mean"] == pytest.approx(1.0)
+    assert (tmp_path / "s.png").exists() and (tmp_path / "s.parquet").exists()
+
+
+@pytest.mark.parametrize("argv", [
+    ["sweep", "omni-3", "--vary", "wheels[0].l=0:1", "--workers", "0"],
+    ["sweep", "omni-3", "--vary", "wheels[0].l=0.1:0.2:2", "--workers", "0", "--length", "-1"],
+    ["batch", "odometry", "diff-drive", "/nonexistent/*.csv", "--workers", "0"],
+    ["batch", "odometry", "diff-drive", "x.csv", "--workers", "-2"],
+    ["batch", "montecarlo", "diff-drive", "--workers", "0"],
+    ["batch", "montecarlo", "diff-drive", "--path", "nowhere", "--workers", "0"],
+])
+def test_errors_exit_2(capsys, argv):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wmrkit: error:") and "Traceback" not in err

@@ -1,0 +1,121 @@
+"""The same API on a real Dask cluster: two worker processes, one thread each, started once for this module.
+
+Results are compared bit for bit with the serial engine; the scheduler's address is also used as a "remote"
+scheduler (a new client connecting over TCP, what a user with a cluster does); a worker killed mid-batch
+does not stop the batch.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.batch.calibrate import fleet_calibrate, load_runs
+from wmrkit.batch.engine import engine
+from wmrkit.batch.fleet import LogJob, batch_odometry, expand_logs, process_log
+from wmrkit.batch.montecarlo import monte_carlo, path_log
+from wmrkit.batch.sweep import sweep
+from wmrkit.batch.sweep_kernel import parse_vary
+
+distributed = pytest.importorskip("distributed")
+pytest.importorskip("pyarrow")
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    import cloudpickle
+
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])  # the workers cannot import this test module
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  silence_logs=50) as c, distributed.Client(c) as client:
+        yield c, client
+
+
+@pytest.fixture(scope="module")
+def engines(cluster):
+    c, client = cluster
+    local = engine(client)
+    remote = engine(c.scheduler_address)
+    yield {"local": local, "remote": remote}
+    remote.close()
+
+
+def _strip(rows):
+    return [{k: v for k, v in r.items() if k != "seconds"} for r in rows]
+
+
+def test_batch_odometry_bit_identical_with_a_failing_log_and_resume(engines, fleet_dir, diff, tmp_path):
+    serial = batch_odometry(diff, [fleet_dir], closed=True)
+    assert serial.failed == 1
+    for name, runner in engines.items():
+        assert runner.workers == 2
+        out = tmp_path / f"{name}.parquet"
+        res = batch_odometry(diff, [fleet_dir], runner=runner, closed=True, out=out)
+        assert _strip(res.rows) == _strip(serial.rows), name  # == on floats: bit for bit
+        again = batch_odometry(diff, [fleet_dir], runner=runner, closed=True, out=out)
+        assert again.skipped == 5 and _strip(again.rows) == _strip(serial.rows)
+
+
+def test_sweep_montecarlo_calibration_identical(engines, diff, calibration_data):
+    robot = catalog.load("mecanum-4")
+    axes = [parse_vary("wheels[0].gamma,wheels[3].gamma=30deg:60deg:9", robot),
+            parse_vary("wheels.front_left.l,wheels.front_right.l=0.3:0.45:7", robot)]
+    s0 = sweep(robot, axes, chunk=10)
+    square = path_log(diff, "square", 5.0)
+    m0 = monte_carlo(diff, square, 40, block=8)
+    runs = load_runs(diff, expand_logs([calibration_data / "*.csv"]), reference_dir=calibration_data / "ref")
+    params = ["left.r", "right.r", ("left.l", "right.l")]
+    c0 = fleet_calibrate(diff, runs, params)
+    for name, runner in engines.items():
+        s = sweep(robot, axes, chunk=10, runner=runner)
+        assert s.best == s0.best and np.array_equal(s.grid, s0.grid), name
+        m = monte_carlo(diff, square, 40, block=8, runner=runner)
+        np.testing.assert_array_equal(m.poses, m0.poses)
+        c = fleet_calibrate(diff, runs, params, runner=runner)
+        assert c.values == c0.values and c.interval == c0.interval
+        assert load_runs(diff, [str(calibration_data / "c0.csv")], reference_dir=calibration_data / "ref",
+                         runner=runner)[0].reference.tolist() == runs[0].reference.tolist()
+
+
+def _die_once(args):
+    """Odometry of a log; the task for run2 first kills its worker process (as a crash or an OOM kill would)."""
+    job, marker = args
+    if job.path.endswith("run2.csv") and not os.path.exists(marker):
+        with open(marker, "w"):
+            pass
+        os._exit(1)
+    return process_log(job)
+
+
+def test_a_worker_killed_mid_batch(engines, fleet_dir, diff, tmp_path):
+    jobs = [LogJob(p, diff) for p in expand_logs([fleet_dir])]
+    marker = str(tmp_path / "killed")
+    runner = engines["local"]
+    out = runner.map(_die_once, [(j, marker) for j in jobs])
+    assert os.path.exists(marker)  # a worker did die
+    assert _strip(out) == _strip([process_log(j) for j in jobs])
+    runner.client.wait_for_workers(2, timeout=60)  # the nanny restarted it
+
+
+def test_embedded_cluster():
+    with engine(workers=1) as e:
+        assert e.mode == "local" and e.workers == 1
+        assert e.map(abs, [-1, -2]) == [1, 2]
+
+
+def test_cli_on_the_remote_scheduler(cluster, fleet_dir, capsys):
+    import json
+
+    from wmrkit.cli.main import main
+
+    c, _ = cluster
+    argv = ["batch", "odometry", "diff-drive", str(fleet_dir), "--closed", "--json"]
+    assert main([*argv, "--scheduler", c.scheduler_address]) == 0
+    remote = json.loads(capsys.readouterr().out)
+    assert main([*argv, "--workers", "0"]) == 0
+    serial = json.loads(capsys.readouterr().out)
+    assert _strip(remote["rows"]) == _strip(serial["rows"]) and remote["failed"] == 1

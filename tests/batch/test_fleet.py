@@ -1,0 +1,93 @@
+"""Batch odometry, serially: rows against the in-memory pipeline, failures, resume, Parquet, log expansion."""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+import pytest
+
+from wmrkit.batch.engine import BatchError
+from wmrkit.batch.fleet import SUMMARY_SCHEMA, batch_odometry, expand_logs
+from wmrkit.batch.parquet import RowSink, parts_dir, read_rows
+from wmrkit.odometry.bags import write_joint_states
+from wmrkit.odometry.logs import load_csv
+from wmrkit.odometry.pipeline import odometry
+from wmrkit.odometry.trajectories import read_tum
+
+pq = pytest.importorskip("pyarrow.parquet")
+
+
+def test_rows_match_the_in_memory_pipeline(fleet_dir, diff, tmp_path):
+    out = tmp_path / "res.parquet"
+    res = batch_odometry(diff, [fleet_dir], out=out, closed=True, trajectories=tmp_path)
+    assert len(res.rows) == 6 and res.failed == 1 and res.skipped == 0
+    for row in res.rows:
+        if row["error"]:
+            assert row["log"].endswith("broken.csv") and "repeats the previous sample" in row["error"]
+            assert row["x"] is None and row["trajectory"] is None
+            continue
+        log = load_csv(row["log"], ("left.spin", "right.spin"))
+        traj = odometry(diff, log)
+        x, y, th = traj.poses[-1]
+        assert (row["x"], row["y"], row["theta"]) == pytest.approx((x, y, th), abs=1e-12)
+        assert row["duration"] == pytest.approx(log.time[-1] - log.time[0])
+        dq = np.diff(log.positions, axis=0)  # wheel travel: the body moves r (dq_left + dq_right) / 2 per step
+        assert row["path_length"] == pytest.approx(np.sum(np.abs(0.075 * dq.sum(axis=1) / 2)), rel=1e-9)
+        assert row["closure_error"] == pytest.approx(math.hypot(x, y))
+        assert row["closure_heading"] == pytest.approx(math.remainder(th, 2 * math.pi), abs=1e-12)
+        assert row["samples"] == len(log) and row["max_slip"] == 0.0  # a differential drive cannot see slip
+        _, poses = read_tum(row["trajectory"])
+        np.testing.assert_allclose(poses[:, :2], traj.poses[:, :2], atol=1e-9)
+    table = pq.read_table(out)
+    assert table.schema.names == [n for n, _ in SUMMARY_SCHEMA] and table.num_rows == 6
+    assert not parts_dir(out).exists()
+
+
+def test_rerun_resumes_and_retries_failures(fleet_dir, diff, tmp_path):
+    out = tmp_path / "res.parquet"
+    first = batch_odometry(diff, [fleet_dir / "*.csv"], out=out, trajectories=tmp_path)
+    again = batch_odometry(diff, [fleet_dir / "*.csv"], out=out, trajectories=tmp_path)
+    assert again.skipped == 5 and again.failed == 1
+    assert [r["seconds"] for r in again.rows if not r["error"]] == [r["seconds"] for r in first.rows if not r["error"]]
+    os.remove(first.rows[-1]["trajectory"])  # a missing trajectory is redone
+    third = batch_odometry(diff, [fleet_dir / "*.csv"], out=out, trajectories=tmp_path)
+    assert third.skipped == 4 and os.path.exists(first.rows[-1]["trajectory"])
+    other = batch_odometry(diff, [fleet_dir / "*.csv"], out=out, method="euler")  # other options: all redone
+    assert other.skipped == 0
+
+
+def test_resume_from_the_parts_of_an_interrupted_run(fleet_dir, diff, tmp_path):
+    out = tmp_path / "res.parquet"
+    full = batch_odometry(diff, [fleet_dir], out=tmp_path / "ref.parquet")
+    sink = RowSink(out, SUMMARY_SCHEMA)  # a run that stopped after two logs left only its part file
+    for row in full.rows[1:3]:
+        sink.add(row)
+    sink.flush()
+    assert not out.exists() and len(read_rows(out)) == 2
+    res = batch_odometry(diff, [fleet_dir], out=out)
+    assert res.skipped == 2
+    strip = lambda rows: [{k: v for k, v in r.items() if k != "seconds"} for r in rows]  # noqa: E731
+    assert strip(res.rows) == strip(full.rows)
+    assert not parts_dir(out).exists() and len(read_rows(out)) == 6
+
+
+def test_expand_logs_and_bags(fleet_dir, diff, tmp_path):
+    log = load_csv(fleet_dir / "run0.csv", ("left.spin", "right.spin"))
+    bag = tmp_path / "bags" / "run0_bag"
+    bag.parent.mkdir()
+    write_joint_states(bag, log)
+    assert expand_logs([tmp_path / "bags"]) == [str(bag)]
+    assert expand_logs([fleet_dir / "run[01].csv", fleet_dir / "run0.csv"]) == [str(fleet_dir / "run0.csv"),
+                                                                                str(fleet_dir / "run1.csv")]
+    res = batch_odometry(diff, [bag, fleet_dir / "run0.csv"])
+    assert res.failed == 0 and res.rows[0]["x"] == pytest.approx(res.rows[1]["x"], abs=1e-9)
+    with pytest.raises(BatchError, match="no file matches"):
+        expand_logs([tmp_path / "nothing*.csv"])
+    with pytest.raises(BatchError, match="no such file"):
+        expand_logs([tmp_path / "missing.csv"])
+    with pytest.raises(BatchError, match="does not exist"):
+        batch_odometry(diff, [fleet_dir], out=tmp_path / "nope" / "r.parquet")
+    with pytest.raises(BatchError, match="no such folder"):
+        batch_odometry(diff, [fleet_dir], trajectories=tmp_path / "nope")

@@ -1,0 +1,66 @@
+"""Monte Carlo against the analytic propagation of paper 003: agreement for the random walk, the known
+over-estimate for quantisation, slip outside the model, and the ellipse geometry."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from wmrkit.batch.engine import BatchError
+from wmrkit.batch.montecarlo import ellipse, monte_carlo, path_log, plot_monte_carlo
+
+RUNS = 400
+#: Relative standard error of a sample variance of RUNS Gaussian draws is sqrt(2 / RUNS); allow 3 of them.
+TOL = 3 * math.sqrt(2 / RUNS)
+
+
+@pytest.fixture(scope="module")
+def square(diff):
+    return path_log(diff, "square", 5.0)
+
+
+def test_random_walk_matches_the_analytic_covariance(diff, square):
+    res = monte_carlo(diff, square, RUNS, per_rad=1e-4, seed=1)
+    ratio = np.diag(res.covariance) / np.diag(res.analytic)
+    assert np.all(np.abs(ratio - 1) < TOL), ratio
+    corr = lambda c: c[0, 1] / math.sqrt(c[0, 0] * c[1, 1])  # noqa: E731
+    assert abs(corr(res.covariance) - corr(res.analytic)) < 0.2
+    np.testing.assert_allclose(res.mean[:2], res.nominal[:2], atol=4 * math.sqrt(res.analytic[0, 0] / RUNS))
+
+
+def test_quantisation_is_over_estimated_and_slip_is_outside_the_model(diff, square):
+    res = 2 * math.pi / 256
+    quant = monte_carlo(diff, square, RUNS, per_rad=0.0, resolution=res, seed=2)
+    # quantisation errors of consecutive increments cancel: the empirical spread is far below the per-sample model
+    assert np.all(np.diag(quant.covariance) < 0.5 * np.diag(quant.analytic))
+    base = monte_carlo(diff, square, RUNS, per_rad=1e-5, seed=3)
+    slip = monte_carlo(diff, square, RUNS, per_rad=1e-5, slip_std=0.01, seed=3)
+    np.testing.assert_array_equal(slip.analytic, base.analytic)
+    assert slip.covariance[2, 2] > 3 * base.covariance[2, 2]
+
+
+def test_deterministic_for_a_seed_and_errors(diff, square):
+    a = monte_carlo(diff, square, 50, seed=5, block=16)
+    b = monte_carlo(diff, square, 50, seed=5, block=16)
+    np.testing.assert_array_equal(a.poses, b.poses)
+    assert not np.array_equal(a.poses, monte_carlo(diff, square, 50, seed=6, block=16).poses)
+    with pytest.raises(BatchError, match="at least 2"):
+        monte_carlo(diff, square, 1)
+    with pytest.raises(BatchError, match="unknown path"):
+        path_log(diff, "spiral")
+
+
+def test_ellipse_points_are_at_the_chi_square_quantile():
+    cov = np.array([[0.04, 0.01, 0.0], [0.01, 0.02, 0.0], [0.0, 0.0, 1.0]])
+    pts = ellipse(cov, np.array([1.0, 2.0, 0.0]), level=0.9)
+    d = pts - [1.0, 2.0]
+    m = np.einsum("ni,ij,nj->n", d, np.linalg.inv(cov[:2, :2]), d)
+    np.testing.assert_allclose(m, -2 * math.log(0.1), rtol=1e-12)
+
+
+def test_plot(diff, square, tmp_path):
+    res = monte_carlo(diff, square, 20, seed=0)
+    plot_monte_carlo(res, tmp_path / "mc.png")
+    assert (tmp_path / "mc.png").stat().st_size > 1000

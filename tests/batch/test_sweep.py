@@ -1,0 +1,111 @@
+"""Design sweeps: the vectorised kernel against wmrkit's per-robot functions, the driver, Parquet, errors."""
+
+from __future__ import annotations
+
+import math
+import sys
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.analysis.isotropy import default_joints, natural_length, twist_condition_number
+from wmrkit.analysis.singularity import singularity_distance
+from wmrkit.batch.engine import BatchError
+from wmrkit.batch.sweep import plot_sweep, sweep
+from wmrkit.batch.sweep_kernel import build_spec, evaluate, parse_vary, variant
+
+CASES = [
+    ("mecanum-4", ["wheels.front_left.l,wheels.rear_right.l=0.3:0.5:3", "wheels[0].gamma=30deg:60deg:3",
+                   "wheels[1].r=50mm:100mm:2"]),
+    ("omni-3", ["wheels[0].alpha=0deg:60deg:3", "wheels[1].l=0.1:0.3:3"]),
+    ("thesis-steer-castor", ["wheels.c2.l=0.3:0.6:3", "wheels.o1.r=0.05:0.2:2"]),
+    ("diff-drive", ["wheels.left.l=0.1:0.3:3"]),
+]
+
+
+def _reference(robot, axes, spec, flat):
+    sub = np.unravel_index(flat, spec.shape)
+    return variant(robot, {t: axes[k].values[sub[k]] for k in range(len(axes)) for t in axes[k].targets})
+
+
+@pytest.mark.parametrize(("name", "vary"), CASES)
+def test_kernel_equals_the_per_robot_functions(name, vary):
+    robot = catalog.load(name)
+    axes = [parse_vary(v, robot) for v in vary]
+    for metric in ("kappa_mean", "kappa_max", "inv_kappa_mean", "singular_margin"):
+        spec = build_spec(robot, axes, metric, configs=8)
+        total = int(np.prod(spec.shape))
+        out = evaluate(np.arange(total), spec)
+        for flat in range(total):
+            r = _reference(robot, axes, spec, flat)
+            beta = spec.configs if r.steer_names else None
+            if metric == "singular_margin":
+                ref = np.min(singularity_distance(r, beta, default_joints(r)))
+            else:
+                k = np.atleast_1d(twist_condition_number(r, beta, length=out[flat, 1]))
+                k = k[~np.isnan(k)]
+                ref = {"kappa_max": np.max(k), "kappa_mean": np.mean(k), "inv_kappa_mean": np.mean(1 / k)}[metric]
+            assert out[flat, 0] == pytest.approx(ref, rel=1e-9), (name, metric, flat)
+            if metric == "kappa_mean" and not r.steer_names:  # the natural length of a design that does not steer
+                d, kappa = natural_length(r)
+                assert out[flat, 1] == pytest.approx(d, rel=1e-6) and out[flat, 0] == pytest.approx(kappa, rel=1e-9)
+
+
+def test_sweep_driver_best_designs_parquet_and_chunks(tmp_path):
+    pq = pytest.importorskip("pyarrow.parquet")
+    robot = catalog.load("omni-3")
+    axes = [parse_vary("wheels[0].alpha,wheels[0].beta=30deg:90deg:7", robot),
+            parse_vary("wheels[1].l=0.1:0.3:5", robot), parse_vary("wheels[2].l=150mm:250mm:3", robot)]
+    res = sweep(robot, axes, "kappa_mean", chunk=16, out=tmp_path / "s.parquet", top=4)
+    brute = evaluate(np.arange(105), build_spec(robot, axes, "kappa_mean"))[:, 0]
+    order = np.lexsort((np.arange(105), brute))[:4]
+    assert [b["index"] for b in res.best] == order.tolist()
+    assert res.best[0]["kappa_mean"] == pytest.approx(1.0, abs=1e-9)  # the symmetric kiwi drive is isotropic
+    assert res.best[0]["wheels[0].alpha,wheels[0].beta"] == pytest.approx(math.radians(60))
+    assert res.best[0]["wheels[1].l"] == pytest.approx(0.2)
+    table = pq.read_table(tmp_path / "s.parquet").to_pydict()
+    assert sorted(table["index"]) == list(range(105))
+    # the chunk size changes only round-off (small chunks take LAPACK, large ones closed-form eigenvalues)
+    np.testing.assert_allclose(np.array(table["metric"])[np.argsort(table["index"])], brute, rtol=1e-12)
+    np.testing.assert_allclose(res.grid, brute.reshape(7, 5, 3).min(axis=2), rtol=1e-12)
+    other = sweep(robot, axes, "kappa_mean", chunk=1000, top=4)
+    assert [b["index"] for b in other.best] == [b["index"] for b in res.best]
+    margin = sweep(robot, axes, "singular_margin", top=2)
+    assert margin.best[0]["singular_margin"] == pytest.approx(np.max(evaluate(
+        np.arange(105), build_spec(robot, axes, "singular_margin"))[:, 0]))
+    plot_sweep(res, tmp_path / "s.png")
+    plot_sweep(sweep(robot, axes[:1], top=1), tmp_path / "s1.png")
+    assert (tmp_path / "s.png").stat().st_size > 1000
+
+
+def test_without_dask_the_same_kernel_runs(monkeypatch):
+    robot = catalog.load("omni-3")
+    axes = [parse_vary("wheels[0].alpha=0deg:60deg:5", robot)]
+    with_dask = sweep(robot, axes, chunk=2)
+
+    def need(module):
+        raise BatchError("the 'batch' extra is needed")
+
+    monkeypatch.setattr(sys.modules["wmrkit.batch.sweep"], "need_extra", need)  # the module, not the function
+    assert sweep(robot, axes, chunk=2).best == with_dask.best
+
+
+def test_parse_vary_units_and_errors():
+    robot = catalog.load("mecanum-4")
+    ax = parse_vary("wheels.front_left.alpha,wheels[3].alpha=30deg:60deg:4", robot)
+    assert ax.targets == ((0, "alpha"), (3, "alpha"))
+    np.testing.assert_allclose(ax.values, np.radians([30, 40, 50, 60]))
+    np.testing.assert_allclose(parse_vary("wheels[0].r=50mm:0.1:2", robot).values, [0.05, 0.1])
+    for bad, msg in [("wheels.nope.l=0:1:2", "no wheel 'nope'"), ("wheels[9].l=0:1:2", "out of range"),
+                     ("wheels[0].colour=0:1:2", "not a geometry field"), ("wheels[0].l=0:1", "START:STOP:N"),
+                     ("wheels[0].l,wheels[1].alpha=0:1:2", "share a unit"), ("wheels[0].l=0:1:0", "N must be"),
+                     ("wheels[0].l=0:1kg:3", "wheels"), ("robot.l=0:1:2", "is not wheels")]:
+        with pytest.raises(BatchError, match=msg):
+            parse_vary(bad, robot)
+    with pytest.raises(BatchError, match="--vary"):  # a value the description refuses
+        build_spec(robot, [parse_vary("wheels[0].r=-0.1:0.1:3", robot)], "kappa_mean")
+    with pytest.raises(BatchError, match="unknown metric"):
+        sweep(robot, [ax], "beauty")
+    assert math.isfinite(sweep(robot, [ax], length=0.4, top=1).best[0]["kappa_mean"])
+
