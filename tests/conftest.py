@@ -8,6 +8,9 @@ from pathlib import Path
 from hypothesis import HealthCheck, settings
 
 sys.path.insert(0, str(Path(__file__).parent))
+# Helper modules beside the tests of one folder (thesis_vehicles, helpers, ...) are imported by name: with
+# --import-mode=importlib pytest does not put a test's folder on sys.path, so every test folder goes on it here.
+sys.path[1:1] = [str(p) for p in sorted(Path(__file__).parent.iterdir()) if p.is_dir() and not p.name.startswith("_")]
 
 from strategies import robots, wheels  # noqa: F401  (re-exported for older imports)
 

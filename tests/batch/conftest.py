@@ -5,15 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+#: Parameters of the differential drive fitted in the calibration tests, and the "true" robot's offsets.
+from batch_params import PARAMS, TRUE_P
+
 from wmrkit import catalog
 from wmrkit.odometry.calibration import apply_parameters
 from wmrkit.odometry.logs import write_csv
 from wmrkit.odometry.synthetic import TwistProfile, simulate, square_path
 from wmrkit.odometry.trajectories import Trajectory, write_trajectory
-
-#: Parameters of the differential drive fitted in the calibration tests, and the "true" robot's offsets.
-PARAMS = ["left.r", "right.r", ("left.l", "right.l")]
-TRUE_P = [0.01, -0.005, 0.02]
 
 
 def write_log(path, run) -> str:

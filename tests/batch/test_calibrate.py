@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from batch_params import PARAMS, TRUE_P
 
-from conftest import PARAMS, TRUE_P
 from wmrkit.batch.calibrate import default_parameters, fleet_calibrate, load_runs
 from wmrkit.batch.engine import BatchError
 from wmrkit.batch.fleet import expand_logs
