@@ -1,0 +1,347 @@
+"""The parallel-parking planner of the thesis (§9.3.2): Algorithms 3, 4 and 5 and the three phases (Fig. 9.17).
+
+:func:`plan_parking` is the one call: detection pass (phase 1), a reverse S to the approach point (phase 2), then
+alternating backward/forward manoeuvres of two symmetric arcs (phase 3) until the lateral gap to the curb is
+below the desired one. Every loop is bounded; an impossible slot gets ``feasible=False`` and the reason
+(:func:`shortest_slot` then searches the length that works). The ambiguities of the printed algorithms are
+resolved as in ``docs/errata.md`` (§9.3 entries). World frame and poses: :mod:`wmrkit.parking.path`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from .collisions import approach_offset_closed_form, front_rear_collision, lateral_reach, trailing_dip
+from .geometry import (
+    Space,
+    Vehicle,
+    arcs_displacement,
+    arcs_through,
+    steering_angle,
+    xi_from_lateral,
+    xi_from_longitudinal,
+)
+from .path import Pose, Segment, arc_end
+
+#: Default decrement of the steering angle in Algorithm 3 (the thesis does not say; 1 deg reproduces §9.3.3).
+PHI_STEP = math.radians(1.0)
+#: Resolution and range of the pass-end search of Algorithm 4 (its Delta dy3 and the bound the thesis lacks) [m].
+DY3_STEP, DY3_RANGE = 0.01, 5.0
+#: Default bound on the number of manoeuvres (Fig. 9.30 shows 21 at a 20 % length ratio).
+MAX_MANEUVERS = 100
+#: Geometric tolerance of the stopping and inside-the-slot tests [m].
+TOL = 1e-9
+
+
+@dataclass(frozen=True, slots=True)
+class Maneuver:
+    """One symmetric-arc manoeuvre of phase 3: ``direction`` (+1 forward, -1 backward), radius ``rho`` [m],
+    arc angle ``xi`` [rad], lateral ``X`` and longitudinal ``Y`` displacement (9.31) [m], gap to the curb after it."""
+
+    direction: int
+    rho: float
+    xi: float
+    X: float
+    Y: float
+    gap_after: float
+
+
+@dataclass(frozen=True, slots=True)
+class ParkingPlan:
+    """Result of :func:`plan_parking`. Frozen.
+
+    ``feasible`` and ``reason`` (empty when feasible); ``maneuvers`` the phase-3 manoeuvres (the first backward
+    one included: the thesis's count); ``segments`` the whole path (phases 1-3) as stop-to-stop segments;
+    ``arcs`` the manoeuvres' geometry; ``dx1`` the approach point's lateral offset of P_f from the obstacles'
+    side line, ``dy3`` how far the pass runs past the front obstacle, ``pass_offset`` the lateral offset of the
+    pass actually driven [m]; ``final_gap`` the final gap to the curb [m]; ``warnings`` input adjustments.
+    """
+
+    vehicle: Vehicle
+    space: Space
+    feasible: bool
+    reason: str
+    maneuvers: int
+    segments: tuple[Segment, ...]
+    arcs: tuple[Maneuver, ...]
+    dx1: float
+    dy3: float
+    pass_offset: float
+    final_gap: float
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def final_pose(self) -> Pose:
+        """P_f's pose at the end of the path (world frame of :mod:`wmrkit.parking.path`)."""
+        return self.segments[-1].end if self.segments else (math.nan, math.nan, math.nan)
+
+
+def plan_parking(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
+                 max_maneuvers: int = MAX_MANEUVERS) -> ParkingPlan:
+    """Plan a parallel parking manoeuvre (thesis §9.3.2, Algorithms 1-5); never loops without bound.
+
+    `phi_step` [rad] is Algorithm 3's steering decrement; `max_maneuvers` bounds phase 3.
+    """
+    v, sp = vehicle, space
+    warnings: list[str] = []
+    pass_offset = sp.dx2
+    if sp.dx2 < v.c1 / 2 - TOL:  # (not "70 cm" against "140 cm" / 2 in floating point)
+        pass_offset = v.c1 / 2 + sp.MS
+        warnings.append(f"dx2 = {sp.dx2:.4g} m puts the car over the parked cars (c1/2 = {v.c1 / 2:.4g} m); "
+                        f"the detection pass is driven at c1/2 + MS = {pass_offset:.4g} m")
+    fail = _failure(v, sp, pass_offset, warnings)
+    free = sp.effective_length - v.length  # phase-3 longitudinal travel (Alg. 5, erratum: H' - (a1 + b1))
+    if free <= TOL:
+        return fail(f"the slot is too short: H - 2 MS = {sp.effective_length:.4g} m leaves no room for a car of "
+                    f"length a1 + b1 = {v.length:.4g} m")
+    if sp.J < v.c1:
+        return fail(f"the slot is narrower (J = {sp.J:.4g} m) than the car (c1 = {v.c1:.4g} m)")
+    first = approach_point(v, sp, pass_offset, phi_step)
+    if first is None:
+        smallest = v.phi_max - (math.ceil(v.phi_max / phi_step) - 1) * phi_step
+        span = 2 * v.h1 / math.tan(smallest) if smallest > 0 else math.inf
+        if sp.H - sp.MS - v.b1 > span:
+            return fail(f"the slot is longer than the first backward manoeuvre can span: Algorithm 3 reverses "
+                        f"along the whole slot, at most 2 rho = {span:.4g} m at the smallest steering angle tried")
+        return fail("no steering angle lets the first backward manoeuvre enter the slot without touching the "
+                    "curb, the rear obstacle or the front obstacle (Algorithm 3)")
+    rho1, xi1, dx1 = first
+    if abs(dx1 - pass_offset) <= TOL:
+        dx1 = pass_offset
+    pre = pass_end(v, dx1, pass_offset)
+    if pre is None and dx1 < pass_offset:  # the rear corner would cut the obstacle's corner: approach farther out
+        dx1 = min(pass_offset, dx1 + lead_overshoot(v, dx1, pass_offset))
+        pre = pass_end(v, dx1, pass_offset)
+    if pre is None:
+        return fail(f"from a pass at {pass_offset:.4g} m the approach point at {dx1:.4g} m cannot be reached "
+                    f"without touching the front obstacle (Algorithm 4 within {DY3_RANGE:g} m); pass farther out")
+    dy3, rho2, xi2 = pre
+
+    segments: list[Segment] = []
+    start: Pose = (-sp.H - v.a1, pass_offset, 0.0)
+    segments.append(_straight(v, 1, 0, start, dy3 - start[0]))
+    if dx1 != pass_offset:
+        segments += _symmetric_arcs(v, 2, 0, segments[-1].end, -1, 1 if dx1 > pass_offset else -1, rho2, xi2)
+    approach: Pose = (0.0, dx1, 0.0)
+    X1, Y1, _ = arcs_displacement(rho1, xi1)
+    segments += _symmetric_arcs(v, 3, 1, approach, -1, -1, rho1, xi1)
+    y = dx1 - X1
+    arcs = [Maneuver(-1, rho1, xi1, X1, Y1, y + sp.J - v.c1 / 2)]
+    direction = 1
+    while True:
+        gap = y + sp.J - v.c1 / 2
+        if gap < sp.final_gap and y + v.c1 / 2 <= TOL:
+            break
+        if len(arcs) >= max_maneuvers:
+            return fail(f"more than {max_maneuvers} manoeuvres needed (gap to the curb still {gap:.4g} m)")
+        step = maneuver_arcs(v, free, y + sp.J, direction)
+        if step is None:
+            return fail(f"no manoeuvre gets closer to the curb (gap {gap:.4g} m) without touching it")
+        rho, xi = step
+        X, Y, _ = arcs_displacement(rho, xi)
+        segments += _symmetric_arcs(v, 3, len(arcs) + 1, _end(segments), direction, -1, rho, xi)
+        y -= X
+        arcs.append(Maneuver(direction, rho, xi, X, Y, y + sp.J - v.c1 / 2))
+        direction = -direction
+    return ParkingPlan(v, sp, True, "", len(arcs), tuple(segments), tuple(arcs), dx1, dy3, pass_offset,
+                       y + sp.J - v.c1 / 2, tuple(warnings))
+
+
+def approach_point(vehicle: Vehicle, space: Space, pass_offset: float,
+                   phi_step: float = PHI_STEP) -> tuple[float, float, float] | None:
+    """Algorithm 3: ``(rho, xi, dx1)`` of the first backward manoeuvre from the approach point, or None.
+
+    The steering angle starts at ``phi_max`` and drops by `phi_step` (bounded: at most ``phi_max / phi_step``
+    tries) while the travel ``D_y = H - MS - b1`` exceeds ``2 rho`` ((9.31)b has no solution: erratum) or the
+    P1 sweep would need the approach point beyond the pass (step 7). A rear overshoot (Algorithm 1 with P3) sets
+    ``rho = c1/2``. ``dx1`` is the more restrictive of the curb sweep (9.33) and Algorithm 2, at least ``c1/2``.
+    """
+    v, sp = vehicle, space
+    d_y = sp.H - sp.MS - v.b1
+    tries = math.ceil(v.phi_max / phi_step)
+    for k in range(tries):
+        phi = v.phi_max - k * phi_step
+        rho = v.h1 / math.tan(phi)
+        xi = xi_from_longitudinal(d_y, rho)
+        if xi is not None and front_rear_collision(v, rho, xi, 3):
+            rho = v.c1 / 2
+            xi = xi_from_longitudinal(d_y, rho)
+        if xi is None:
+            continue
+        sweep = lateral_reach(v, rho, xi, 1) - sp.J
+        corner = approach_offset_closed_form(v, rho, xi)
+        corner = -math.inf if corner is None else corner
+        if sweep > corner:
+            if sweep > pass_offset:
+                continue
+            dx1 = sweep
+        else:
+            dx1 = corner
+        if not math.isfinite(dx1):
+            return None
+        return rho, xi, max(dx1, v.c1 / 2)
+    return None
+
+
+def pass_end(vehicle: Vehicle, dx1: float, pass_offset: float) -> tuple[float, float, float] | None:
+    """Algorithm 4: ``(dy3, rho, xi)`` of the reverse S from the end of the pass to the approach point, or None.
+
+    ``X = |dx1 - pass_offset|``; the shortest S uses ``rho_min`` (``xi <= 90 deg``: for ``X > 2 rho_min`` the
+    radius grows to ``X / 2``). The check (with its printed branches swapped back) is exact for the front
+    obstacle: moving toward it, the leading rear corner's reach (9.33) must stay on the road side of the
+    obstacle's side line, which it crosses exactly at the obstacle's face; moving away, the trailing front
+    corner's swing in the first arc (:func:`trailing_dip`) must fit in the pass's clearance. The printed loop
+    ``dy3 += Delta`` may never end (the overshoot only tends to 0); here it is a bisection over a bounded range.
+    """
+    v = vehicle
+    X = abs(dx1 - pass_offset)
+    if X <= TOL:
+        return 0.0, math.inf, 0.0
+
+    def arcs(dy3: float) -> tuple[float, float]:
+        return arcs_through(X, dy3)
+
+    def clear(rho: float, xi: float) -> bool:
+        if dx1 < pass_offset:
+            return lateral_reach(v, rho, xi, 1) <= pass_offset + TOL
+        return trailing_dip(v, rho, xi, 2) <= pass_offset - v.c1 / 2 + TOL
+
+    lo, rho, xi = shortest_s(v, X)
+    if clear(rho, xi):
+        return lo, rho, xi
+    hi = lo + DY3_RANGE
+    if not clear(*arcs(hi)):
+        return None
+    while hi - lo > DY3_STEP:
+        mid = 0.5 * (lo + hi)
+        if clear(*arcs(mid)):
+            hi = mid
+        else:
+            lo = mid
+    return (hi, *arcs(hi))
+
+
+def shortest_s(vehicle: Vehicle, X: float) -> tuple[float, float, float]:
+    """``(Y, rho, xi)`` of the shortest reverse S shifting P_f by ``X`` (9.31)a with ``rho_min``, ``xi <= 90 deg``."""
+    rho = vehicle.rho_min
+    xi = xi_from_lateral(X, rho) if X < 2 * rho else None
+    if xi is None:
+        rho, xi = X / 2, math.pi / 2
+    return 2 * rho * math.sin(xi), rho, xi
+
+
+def lead_overshoot(vehicle: Vehicle, dx1: float, pass_offset: float) -> float:
+    """How far the leading rear corner crosses the obstacles' side line on the longest S Algorithm 4 tries [m].
+
+    Moving toward the obstacles (``dx1 < pass_offset``) with ``dx1`` near ``c1/2`` the corner's overshoot only
+    tends to 0 as the S lengthens; moving the approach point out by this much makes the longest S clear.
+    """
+    X = pass_offset - dx1
+    rho, xi = arcs_through(X, shortest_s(vehicle, X)[0] + DY3_RANGE)
+    return max(0.0, lateral_reach(vehicle, rho, xi, 1) - pass_offset) + TOL
+
+
+def maneuver_arcs(vehicle: Vehicle, free: float, room: float, direction: int) -> tuple[float, float] | None:
+    """Algorithm 5: ``(rho, xi)`` of a phase-3 manoeuvre with longitudinal travel `free` and lateral `room`.
+
+    `room` (W_max) is P_f's distance to the curb; the leading outer corner (P2 forward, P1 backward) must stay
+    within it (9.33). ``rho = max(rho_min, c1/2)`` (Algorithm 1), ``xi`` from (9.31)b (for ``free > 2 rho`` the
+    radius grows to ``free / 2``, ``xi = 90 deg``); when the corner would pass the curb, ``rho`` grows until the
+    reach equals `room` (a root in ``rho``; it exists iff ``room > c1/2``). None when no manoeuvre fits.
+    """
+    v = vehicle
+    corner = 2 if direction > 0 else 1
+    rho = max(v.rho_min, v.c1 / 2)
+    if free > 2 * rho:
+        rho = free / 2
+    xi = xi_from_longitudinal(free, rho) or 0.0
+
+    def excess(r: float) -> float:
+        return lateral_reach(v, r, math.asin(min(1.0, free / (2 * r))), corner) - room
+
+    if excess(rho) <= 0:
+        return rho, xi
+    if room <= v.c1 / 2 + TOL:
+        return None
+    lo, hi = rho, 2 * rho
+    for _ in range(200):  # the reach tends to c1/2 as rho grows, so a bracket exists
+        if excess(hi) <= 0:
+            break
+        lo, hi = hi, 2 * hi
+    else:
+        return None
+    f_lo, f_hi = excess(lo), excess(hi)
+    for _ in range(100):  # Illinois false position, keeping the feasible end `hi`
+        mid = hi - f_hi * (hi - lo) / (f_hi - f_lo)
+        if not lo < mid < hi:
+            mid = 0.5 * (lo + hi)
+        f_mid = excess(mid)
+        if f_mid <= 0:
+            hi, f_hi = mid, f_mid
+            f_lo *= 0.5
+        else:
+            lo, f_lo = mid, f_mid
+            f_hi *= 0.5
+        if hi - lo <= 1e-9 * hi:
+            break
+    return hi, math.asin(free / (2 * hi))
+
+
+def shortest_slot(vehicle: Vehicle, space: Space, *, step: float = 0.01, span: float | None = None,
+                  max_maneuvers: int = MAX_MANEUVERS) -> float | None:
+    """The shortest slot length ``H`` [m] for which :func:`plan_parking` succeeds, the rest of `space` kept.
+
+    Scans upward from ``a1 + b1 + 2 MS`` in steps of `step` over `span` (default ten car lengths, at least 10 m;
+    at most 2000 steps: the step grows for huge cars), then bisects the last step to 1 mm. None when no length in
+    the range works (e.g. the slot is too narrow).
+    """
+    lo = vehicle.length + 2 * space.MS
+    span = max(10.0, 10 * vehicle.length) if span is None else span
+    step = max(step, span / 2000)
+
+    def works(h: float) -> bool:
+        return plan_parking(vehicle, replace(space, H=h), max_maneuvers=max_maneuvers).feasible
+
+    n = math.ceil(span / step)
+    prev = lo
+    for k in range(1, n + 1):
+        h = lo + k * step
+        if works(h):
+            while h - prev > 1e-3:
+                mid = 0.5 * (prev + h)
+                prev, h = (prev, mid) if works(mid) else (mid, h)
+            return h
+        prev = h
+    return None
+
+
+def _failure(v: Vehicle, sp: Space, pass_offset: float, warnings: list[str]):
+    def fail(reason: str) -> ParkingPlan:
+        return ParkingPlan(v, sp, False, reason, 0, (), (), math.nan, math.nan, pass_offset, math.nan,
+                           tuple(warnings))
+
+    return fail
+
+
+def _end(segments: list[Segment]) -> Pose:
+    end = segments[-1].end
+    return (end[0], end[1], 0.0)  # parallel at every stop between manoeuvres (exact up to rounding)
+
+
+def _straight(v: Vehicle, phase: int, maneuver: int, start: Pose, distance: float) -> Segment:
+    direction = 1 if distance >= 0 else -1
+    length = abs(distance)
+    return Segment(phase, maneuver, direction, 0.0, length, 0.0, start, arc_end(start, direction, 0.0, length))
+
+
+def _symmetric_arcs(v: Vehicle, phase: int, maneuver: int, start: Pose, direction: int, side: int,
+                    rho: float, xi: float) -> list[Segment]:
+    """Two arcs of angle `xi`, radius `rho`, opposite curvature, displacing toward `side` (+1 left, -1 right)."""
+    out = []
+    pose = start
+    for kappa in (side / rho, -side / rho):
+        end = arc_end(pose, direction, kappa, rho * xi)
+        out.append(Segment(phase, maneuver, direction, kappa, rho * xi, steering_angle(v.h1, kappa), pose, end))
+        pose = end
+    return out

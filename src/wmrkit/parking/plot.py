@@ -1,0 +1,160 @@
+"""Pictures of a parking plan: the scene, the path, the car at every stop (PNG/SVG/PDF), and an animation (GIF/HTML).
+
+matplotlib's object API (no pyplot, no GUI backend). World frame of :mod:`wmrkit.parking.path`.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.patches import Polygon, Rectangle
+
+from ..errors import WmrkitError
+from .execute import Execution, execute_plan
+from .geometry import Space, Vehicle, footprint
+from .path import sample_poses
+from .planner import ParkingPlan
+
+FORWARD, BACKWARD = "#1f77b4", "#d62728"
+
+
+def car_outline(vehicle: Vehicle, pose: np.ndarray) -> np.ndarray:
+    """The body's corners in the world at P_f's `pose` ``(3,)``: ``(4, 2)`` [m]."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    body = np.array(footprint(vehicle))
+    return pose[:2] + body @ np.array([[c, s], [-s, c]])
+
+
+def draw_scene(ax: Axes, space: Space, extent: float = 2.0) -> None:
+    """Parked cars (grey), the curb, the slot and its safety margins."""
+    H, J = space.H, space.J
+    ax.add_patch(Rectangle((0, -J), extent, J, color="0.75", zorder=0))
+    ax.add_patch(Rectangle((-H - extent, -J), extent, J, color="0.75", zorder=0))
+    ax.add_patch(Rectangle((-H - extent, -J - 0.3), H + 2 * extent, 0.3, color="0.45", zorder=0))
+    ax.plot([-H, 0, 0, -H, -H], [0, 0, -J, -J, 0], color="0.3", lw=0.8, ls="--", zorder=1)
+    for x in (-H + space.MS, -space.MS):
+        ax.plot([x, x], [-J, 0], color="0.5", lw=0.6, ls=":", zorder=1)
+
+
+def draw_car(ax: Axes, vehicle: Vehicle, pose: np.ndarray, steering: float = 0.0, *, color: str = "k",
+             alpha: float = 1.0, fill: bool = False) -> list:
+    """The car's body, rear axle and equivalent steering wheel at `pose`; returns the artists."""
+    corners = car_outline(vehicle, pose)
+    body = Polygon(corners, closed=True, fill=fill, facecolor=color if fill else "none", edgecolor=color,
+                   alpha=alpha, lw=1.2, zorder=3)
+    ax.add_patch(body)
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    front = pose[:2] + vehicle.h1 * np.array([c, s])
+    w = 0.15 * vehicle.h1
+    d = np.array([math.cos(pose[2] + steering), math.sin(pose[2] + steering)]) * w
+    wheel, = ax.plot([front[0] - d[0], front[0] + d[0]], [front[1] - d[1], front[1] + d[1]], color=color,
+                     lw=3, alpha=alpha, zorder=4)
+    half = np.array([-s, c]) * max(vehicle.track, 0.05) / 2
+    axle, = ax.plot([pose[0] - half[0], pose[0] + half[0]], [pose[1] - half[1], pose[1] + half[1]], color=color,
+                    lw=2, alpha=alpha, zorder=4)
+    return [body, wheel, axle]
+
+
+def plot_plan(plan: ParkingPlan, execution: Execution | None = None) -> Figure:
+    """The scene, P_f's path (blue forward, red backward), the car at every stop, the final car filled."""
+    fig = Figure(figsize=(9, 5.2))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    v, sp = plan.vehicle, plan.space
+    draw_scene(ax, sp)
+    for seg in plan.segments:
+        xy = sample_poses([seg], 0.02)
+        ax.plot(xy[:, 0], xy[:, 1], color=FORWARD if seg.direction > 0 else BACKWARD, lw=1.4, zorder=2)
+        if seg.phase == 3:
+            draw_car(ax, v, np.array(seg.end), seg.steering, color="0.35", alpha=0.45)
+    if execution is not None:
+        ax.plot(execution.pose[:, 0], execution.pose[:, 1], color="k", lw=0.8, ls="--", zorder=2,
+                label=f"executed ({execution.mode})")
+        ax.legend(loc="upper left", fontsize=8)
+    if plan.segments:
+        draw_car(ax, v, np.array(plan.final_pose), 0.0, color="#2ca02c", alpha=0.5, fill=True)
+    verdict = f"{plan.maneuvers} manoeuvres" if plan.feasible else f"infeasible: {plan.reason[:70]}"
+    ax.set_title(f"H = {sp.H:.3g} m, J = {sp.J:.3g} m, car {v.length:.3g} x {v.c1:.3g} m: {verdict}", fontsize=9)
+    _frame(ax, plan)
+    fig.tight_layout()
+    return fig
+
+
+def save_plan_figure(plan: ParkingPlan, path: str | os.PathLike[str], execution: Execution | None = None) -> None:
+    """Write :func:`plot_plan` to a PNG, SVG or PDF file."""
+    path = Path(path)
+    if path.suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise WmrkitError(f"{path}: the plot is written as .png, .svg or .pdf")
+    plot_plan(plan, execution).savefig(path, dpi=120)
+
+
+def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Execution | None = None, *,
+                 fps: int = 20, max_frames: int = 400) -> int:
+    """Write an animation of the executed plan: ``.gif`` (PillowWriter) or ``.html`` (``to_jshtml``).
+
+    The car drives P_f's executed poses with its steering wheel turned to the commanded heading; the trail is
+    coloured by direction. Returns the number of frames (at most `max_frames`, evenly spaced in time).
+    """
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".gif", ".html"):
+        raise WmrkitError(f"{path}: the animation is written as .gif or .html")
+    run = execute_plan(plan) if execution is None else execution
+    frames = np.unique(np.linspace(0, len(run.t) - 1, min(max_frames, len(run.t))).round().astype(int))
+    fig = Figure(figsize=(8, 4.6))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    draw_scene(ax, plan.space)
+    _frame(ax, plan)
+    direction = np.array([s.direction for s in plan.segments])[run.segment]
+    trail_f, = ax.plot([], [], ".", color=FORWARD, ms=1.5)
+    trail_b, = ax.plot([], [], ".", color=BACKWARD, ms=1.5)
+    artists: list = []
+    title = ax.set_title("", fontsize=9)
+
+    def update(k: int) -> list:
+        for a in artists:
+            a.remove()
+        artists.clear()
+        i = frames[k]
+        artists.extend(draw_car(ax, plan.vehicle, run.pose[i], float(run.steering[i]), color="#2ca02c",
+                                alpha=0.8, fill=True))
+        upto = slice(0, i + 1)
+        fwd = direction[upto] > 0
+        trail_f.set_data(run.pose[upto][fwd, 0], run.pose[upto][fwd, 1])
+        trail_b.set_data(run.pose[upto][~fwd, 0], run.pose[upto][~fwd, 1])
+        seg = plan.segments[run.segment[i]]
+        title.set_text(f"t = {run.t[i]:5.1f} s   phase {seg.phase}   manoeuvre {seg.maneuver}/{plan.maneuvers}   "
+                       f"steering {math.degrees(run.steering[i]):+5.1f} deg")
+        return [*artists, trail_f, trail_b, title]
+
+    anim = FuncAnimation(fig, update, frames=len(frames), interval=1000 / fps, blit=False)
+    if suffix == ".gif":
+        anim.save(path, writer=PillowWriter(fps=fps), dpi=80)
+    else:
+        path.write_text(anim.to_jshtml(fps=fps), encoding="utf-8")
+    return len(frames)
+
+
+def _frame(ax: Axes, plan: ParkingPlan) -> None:
+    sp, v = plan.space, plan.vehicle
+    xs = [-sp.H - 1.0, 1.0]
+    ys = [-sp.J - 0.4, 0.5]
+    for seg in plan.segments:
+        for p in (seg.start, seg.end):
+            xs.append(p[0])
+            ys.append(p[1])
+    pad = v.length
+    ax.set_xlim(min(xs) - pad * 0.3, max(xs) + pad)
+    ax.set_ylim(min(ys) - 0.2, max(ys) + v.c1 / 2 + 0.4)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m] (along the road)")
+    ax.set_ylabel("y [m]")

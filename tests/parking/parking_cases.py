@@ -1,0 +1,37 @@
+"""Shared helpers of the parking tests: the thesis's cars and an independent corner geometry."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wmrkit.parking.geometry import Space, Vehicle
+
+#: Tables 9.1 and 9.2 typed in here (independently of the shipped problem files).
+CAR_91 = Vehicle(a1=1.50, b1=0.50, c1=1.40, h1=1.05, track=0.50, phi_max=math.radians(46))
+SLOT_91 = Space(H=3.35, J=2.00, MS=0.20, dx2=0.70, final_gap=0.07)
+CAR_92 = Vehicle(a1=0.75, b1=0.15, c1=3.50, h1=0.60, track=1.30, phi_max=math.radians(46))
+SLOT_92 = Space(H=3.30, J=3.60, MS=0.12, dx2=0.17, final_gap=0.17)
+
+
+def corners_world(vehicle: Vehicle, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(x, y)`` ``(N, 4)`` of the body corners rear-right, front-right, front-left, rear-left at P_f's poses,
+    by plain rigid-body transformation (no planner code)."""
+    body = np.array([(-vehicle.b1, -vehicle.c1 / 2), (vehicle.a1, -vehicle.c1 / 2), (vehicle.a1, vehicle.c1 / 2),
+                     (-vehicle.b1, vehicle.c1 / 2)])
+    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    x = poses[:, None, 0] + c[:, None] * body[:, 0] - s[:, None] * body[:, 1]
+    y = poses[:, None, 1] + s[:, None] * body[:, 0] + c[:, None] * body[:, 1]
+    return x, y
+
+
+def arc_poses(start, direction: int, curvature: float, length: float, n: int = 4000) -> np.ndarray:
+    """P_f's poses along a constant-curvature stretch, from the unicycle ODE solved in closed form by hand."""
+    x0, y0, th0 = start
+    s = np.linspace(0.0, length, n + 1) * direction
+    th = th0 + curvature * s
+    if curvature == 0:
+        return np.column_stack([x0 + s * math.cos(th0), y0 + s * math.sin(th0), th])
+    r = 1 / curvature
+    return np.column_stack([x0 + r * (np.sin(th) - math.sin(th0)), y0 - r * (np.cos(th) - math.cos(th0)), th])

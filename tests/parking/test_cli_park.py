@@ -1,0 +1,82 @@
+"""``wmrkit park``: JSON shape, headings, infeasible answers, plot and animation files, errors."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from wmrkit.cli.main import main
+
+
+def run(capsys, *argv):
+    code = main(["park", *argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_json_output_of_table_9_2(capsys):
+    code, out, _ = run(capsys, "thesis-9.2", "--json")
+    assert code == 0
+    data = json.loads(out)
+    assert data["maneuvers"] == 4 and data["feasible"] is True
+    assert {"path", "poses", "time_ms", "warnings"} <= data.keys()
+    assert data["time_ms"] > 0 and data["warnings"]  # dx2 < c1/2 is reported
+    steering = [seg["steering"] for seg in data["path"]]
+    # headings: the equivalent front wheel, 0 = straight, |steering| <= phi_max = 46 deg, atan(h1 kappa)
+    assert max(abs(s) for s in steering) <= math.radians(46) + 1e-12
+    for seg in data["path"]:
+        assert seg["steering"] == pytest.approx(math.atan(0.60 * seg["curvature"]), abs=1e-12)
+    assert data["poses"][-1] == pytest.approx(data["path"][-1]["end"], abs=1e-9)
+    assert [a["direction"] for a in data["arcs"]] == ["backward", "forward", "backward", "forward"]
+
+
+def test_text_output_and_exact_check(capsys):
+    code, out, _ = run(capsys, "thesis-9.1", "--check")
+    assert code == 0
+    assert "feasible: 2 manoeuvres" in out and "collision-free, ends inside the slot" in out
+
+
+def test_infeasible_slot_says_why_and_the_shortest_slot(capsys, tmp_path):
+    f = tmp_path / "short.yaml"
+    f.write_text("vehicle: {a1: 150 cm, b1: 50 cm, c1: 140 cm, h1: 105 cm, d1: 50 cm, phi_max: 46 deg}\n"
+                 "space: {H: 230 cm, J: 200 cm, MS: 20 cm, dx2: 90 cm, final_gap: 7 cm}\n")
+    code, out, _ = run(capsys, str(f), "--json")
+    data = json.loads(out)
+    assert code == 0 and data["feasible"] is False and "too short" in data["reason"]
+    assert 2.4 < data["shortest_H"] < 3.35
+    code, out, _ = run(capsys, str(f))
+    assert "infeasible: the slot is too short" in out and "shortest slot that works" in out
+
+
+def test_plot_and_animation_files(capsys, tmp_path):
+    png, gif, html = tmp_path / "p.png", tmp_path / "a.gif", tmp_path / "a.html"
+    code, _, _ = run(capsys, "thesis-9.1", "--plot", str(png), "--animate", str(gif), "--frames", "4")
+    assert code == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    from PIL import Image
+
+    with Image.open(gif) as im:
+        assert im.n_frames == 4
+    code, _, _ = run(capsys, "thesis-9.2", "--animate", str(html), "--frames", "3")
+    assert code == 0 and "<script" in html.read_text()
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["nope.yaml"], "nope.yaml: cannot read the file"),
+    (["thesis-9.9"], "no parking problem 'thesis-9.9'"),
+    (["thesis-9.1", "--plot", "x.jpg"], "x.jpg: the plot is written as .png, .svg or .pdf"),
+])
+def test_errors_are_one_line_exit_2(capsys, tmp_path, monkeypatch, argv, message):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run(capsys, *argv)
+    assert code == 2 and message in err and err.count("\n") == 1
+
+
+def test_errors_as_json(capsys, tmp_path):
+    f = tmp_path / "bad.yaml"
+    f.write_text("vehicle:\n  a1: 1 deg\n")
+    code, _, err = run(capsys, str(f), "--json")
+    data = json.loads(err)
+    assert code == 2 and data["line"] == 2 and "expected a length" in data["error"]

@@ -1,0 +1,118 @@
+"""Execution: the timed reference, open loop through the robot's kinematics, closed loop through wmrkit.control."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from parking_cases import CAR_91, CAR_92, SLOT_91, SLOT_92
+
+from wmrkit import Robot
+from wmrkit.errors import WmrkitError
+from wmrkit.parking import plan_parking
+from wmrkit.parking.execute import execute_plan, timed_reference, trapezoid, trapezoid_duration, vehicle_robot
+from wmrkit.parking.problem import problem_from_text
+
+
+@pytest.mark.parametrize(("length", "v", "a"), [(2.0, 0.5, 0.5), (0.1, 0.5, 0.5), (1e-4, 1.0, 2.0)])
+def test_trapezoid_reaches_the_length_with_bounded_speed(length, v, a):
+    t = np.linspace(0, trapezoid_duration(length, v, a), 2001)
+    s = trapezoid(length, v, a, t)
+    assert s[0] == 0 and s[-1] == pytest.approx(length, rel=1e-12)
+    speed = np.diff(s) / np.diff(t)
+    assert speed.max() <= v * (1 + 1e-9) and (speed >= -1e-12).all()
+    assert np.abs(np.diff(speed) / np.diff(t)[1:]).max() <= a * (1 + 1e-6) + 1e-9
+
+
+def test_reference_stops_between_segments_and_waits_for_the_steering():
+    plan = plan_parking(CAR_92, SLOT_92)
+    t, pose, dist, seg = timed_reference(plan.segments, v_max=0.5, a_max=0.5, steer_rate=0.5, dt=0.02)
+    assert (np.diff(t) > 0).all()
+    for k, s in enumerate(plan.segments):
+        rows = np.flatnonzero(seg == k)
+        np.testing.assert_allclose(pose[rows[-1]], s.end, atol=1e-9)  # each segment ends where planned
+        assert (dist[rows] >= 0).all() and (dist[rows] <= s.length).all()
+    # between the two arcs of a manoeuvre the steering reverses: the car waits |2 phi| / rate at rest
+    k = 4
+    assert plan.segments[k].maneuver == plan.segments[k - 1].maneuver
+    rows = np.flatnonzero(seg == k)
+    wait = abs(plan.segments[k].steering - plan.segments[k - 1].steering) / 0.5
+    at_rest = t[rows][dist[rows] == 0.0]
+    assert at_rest[-1] - t[rows[0] - 1] == pytest.approx(wait, abs=0.02)
+
+
+@pytest.mark.parametrize(("car", "slot"), [(CAR_91, SLOT_91), (CAR_92, SLOT_92)], ids=["9.1", "9.2"])
+def test_open_loop_execution_follows_the_plan_exactly(car, slot):
+    plan = plan_parking(car, slot)
+    run = execute_plan(plan)
+    assert run.mode == "open-loop"
+    assert run.deviation.max() < 1e-9
+    np.testing.assert_allclose(run.pose[-1], plan.final_pose, atol=1e-9)
+    # the robot's own IK steers the equivalent front wheel to atan(h1 kappa) (9.27): the planner's heading
+    np.testing.assert_allclose(run.wheel_headings[:, 0], run.steering, atol=1e-9)
+    assert np.abs(run.steering).max() <= car.phi_max + 1e-12
+
+
+def test_ackermann_wheels_steer_to_their_own_angles_and_any_origin_works():
+    """A catalog car (two front wheels): each front wheel's heading is atan(h1 / (rho -+ track/2)) (Ackermann),
+    and moving the robot's origin off the rear axle changes nothing for P_f."""
+    text = ("vehicle: {robot: ackermann, a1: 3.6 m, b1: 1.0 m, c1: 1.8 m, phi_max: 35 deg}\n"
+            "space: {H: 7 m, J: 2.3 m, MS: 0.25 m, dx2: 1.4 m, final_gap: 0.1 m}\n")
+    problem = problem_from_text(text, source="car.yaml")
+    plan = plan_parking(problem.vehicle, problem.space)
+    assert plan.feasible
+    run = execute_plan(plan, problem.robot)
+    assert run.deviation.max() < 1e-9
+    kappa = np.array([s.curvature for s in plan.segments])[run.segment]
+    turning = np.abs(kappa) > 1e-9
+    h1, half = 2.70, 1.55 / 2
+    left = np.arctan(h1 * kappa[turning] / (1 - half * kappa[turning]))
+    right = np.arctan(h1 * kappa[turning] / (1 + half * kappa[turning]))
+    names = problem.robot.steer_names
+    np.testing.assert_allclose(run.wheel_headings[turning, names.index("front_left")], left, atol=1e-9)
+    np.testing.assert_allclose(run.wheel_headings[turning, names.index("front_right")], right, atol=1e-9)
+    data = problem.robot.to_dict()
+    for w in data["wheels"]:  # origin 1 m ahead of the rear axle
+        x, y = w["l"] * math.cos(w["alpha"]) - 1.0, w["l"] * math.sin(w["alpha"])
+        w["l"], w["alpha"] = math.hypot(x, y), math.atan2(y, x)
+    moved = execute_plan(plan, Robot.from_dict(data))
+    np.testing.assert_allclose(moved.pose, run.pose, atol=1e-9)
+
+
+def test_closed_loop_with_the_thesis_law_tracks_within_centimetres():
+    """wmrkit.control's P law (8.2) on the steering axle's midpoint, reversing included."""
+    plan = plan_parking(CAR_91, SLOT_91)
+    run = execute_plan(plan, controller="p", gain=2.0, dt=0.1)
+    assert run.mode == "p"
+    assert run.deviation.max() < 0.02
+    assert np.hypot(*(run.pose[-1, :2] - np.array(plan.final_pose[:2]))) < 0.01
+
+
+def test_execution_refuses_bad_requests():
+    with pytest.raises(WmrkitError, match="not feasible"):
+        execute_plan(plan_parking(CAR_91, replace(SLOT_91, H=2.0)))
+    with pytest.raises(WmrkitError, match="reverses"):
+        execute_plan(plan_parking(CAR_91, SLOT_91), controller="pure-pursuit")
+    with pytest.raises(WmrkitError, match="not car-like"):
+        execute_plan(plan_parking(CAR_91, SLOT_91), Robot.from_dict({"name": "d", "wheels": [
+            {"name": "l", "type": "fixed", "position": [0, 0.2], "beta": "90 deg", "r": 0.1},
+            {"name": "r", "type": "fixed", "position": [0, -0.2], "beta": "90 deg", "r": 0.1}]}))
+
+
+def test_vehicle_robot_is_the_thesis_car():
+    robot = vehicle_robot(CAR_91)
+    assert robot.steer_names == ("steer",)
+    assert {w.name for w in robot.wheels if w.type == "fixed"} == {"rear_left", "rear_right"}
+
+
+def test_open_loop_execution_passes_the_exact_check():
+    shapely = pytest.importorskip("shapely")
+    assert shapely
+    from wmrkit.parking.verify import check_poses
+
+    for car, slot in ((CAR_91, SLOT_91), (CAR_92, SLOT_92)):
+        run = execute_plan(plan_parking(car, slot), dt=0.02)
+        report = check_poses(car, slot, run.pose)
+        assert report.collision_free and report.inside
