@@ -21,7 +21,7 @@ import numpy as np
 
 from .._shapes import readonly
 from ..robot import Robot
-from ..wheels import wrap_angle, generic_slip_rows
+from ..wheels import generic_slip_rows, wrap_angle
 
 TWO_PI = 2.0 * math.pi
 CONSTANT_TYPES = ("fixed", "swedish", "ball", "orthogonal")

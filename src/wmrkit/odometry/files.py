@@ -19,7 +19,7 @@ from ..robot import Robot
 from .bags import OdometryBagWriter, bag_message_count, read_joint_states
 from .integrators import Method, check_method
 from .logs import LogError, LogFormat, read_csv
-from .model import odometry_model
+from .model import OdometryModel, odometry_model
 from .pipeline import Decimator, Noise, OdometrySummary, run_odometry
 from .trajectories import TrajectoryWriter
 
@@ -45,17 +45,19 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
                   out_format: OutFormat | None = None, plot: str | os.PathLike[str] | None = None,
                   progress: bool = False, chunk_size: int = 1 << 16, topic: str = "/joint_states",
                   joint_names: Mapping[str, str] | None = None,
-                  weights: Mapping[str, float] | None = None) -> OdometrySummary:
+                  weights: Mapping[str, float] | None = None, model=None) -> OdometrySummary:
     """Run odometry over the log at `log_path` and write the requested outputs (module docstring).
 
     `fmt` describes a CSV log; `topic` and `joint_names` (ROS name -> robot joint) a bag. `sensed` and `weights`
     go to :func:`~.model.odometry_model`. `progress` shows a tqdm bar on stderr. Returns the run's
-    :class:`~.pipeline.OdometrySummary`.
+    :class:`~.pipeline.OdometrySummary`. `model`, when given, replaces that model: an ``OdometryModel`` (e.g.
+    WLS, :func:`wmrkit.slip.weights.wls_model`) or an estimator with ``joints`` and ``run(chunks, method=,
+    pose0=, sinks=)`` (the Kalman filters of :mod:`wmrkit.slip.estimators`).
     """
     from tqdm import tqdm
 
     check_method(method)
-    model = odometry_model(robot, sensed, weights=weights)
+    model = odometry_model(robot, sensed, weights=weights) if model is None else model
     if not Path(log_path).exists():
         raise LogError(f"{os.fspath(log_path)}: no such file")
     bag = is_bag(log_path)
@@ -84,7 +86,9 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
         if decimated is not None:
             sinks.append(decimated)
         try:
-            summary = run_odometry(model, chunks, method=method, pose0=pose0, noise=noise, sinks=sinks)
+            summary = (run_odometry(model, chunks, method=method, pose0=pose0, noise=noise, sinks=sinks)
+                       if isinstance(model, OdometryModel) else model.run(chunks, method=method, pose0=pose0,
+                                                                          sinks=sinks))
         finally:
             if writer is not None:
                 writer.close()

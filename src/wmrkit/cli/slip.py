@@ -1,0 +1,173 @@
+"""Slip commands (thesis ch. 7): ``wmrkit calibrate`` (slip weights, effective track) and ``wmrkit slip-study``,
+and the options of the slip-aware estimators of ``wmrkit odometry --method wls|fk1|fk2``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+from ..errors import WmrkitError
+from ..robot import Robot
+from ._common import add_json_flag, add_robot_argument, load_robot, parse_assignments, print_json
+
+ESTIMATOR_METHODS = ("wls", "fk1", "fk2")
+
+
+def add_estimator_options(p: argparse.ArgumentParser) -> None:
+    """Options of ``odometry --method wls|fk1|fk2``."""
+    g = p.add_argument_group("slip-aware estimators (--method wls|fk1|fk2, thesis §7.4-7.5)")
+    g.add_argument("--scheme", choices=("exact", "rk2", "euler", "paper002"), default="exact",
+                   help="integration scheme of the estimated twists (default: exact)")
+    g.add_argument("--mu", action="append", metavar="WHEEL=LAT,LONG", default=[],
+                   help="WLS: friction coefficients of a wheel, lateral and longitudinal (only ratios matter; "
+                        "default 1,1; repeat)")
+    g.add_argument("--mu-default", metavar="LAT,LONG", help="WLS: coefficients of the wheels not named by --mu")
+    g.add_argument("--slip-weights", metavar="FILE", help="WLS: coefficients from 'wmrkit calibrate --json' output")
+    g.add_argument("--kf-noise", nargs=3, type=float, metavar=("PROCESS", "LAT", "LONG"),
+                   help="FK1/FK2: process noise k13 [m/s per sample] and the lateral / longitudinal row noise "
+                        "[m/s] (default 1 1 1)")
+    g.add_argument("--kf-wheel", action="append", metavar="WHEEL=LAT,LONG", default=[],
+                   help="FK1/FK2: row noise of one wheel (repeat)")
+    g.add_argument("--thesis-double-q", action="store_true",
+                   help="FK1/FK2: add Q again after the update, as (7.75) is printed (see docs/errata.md)")
+
+
+def _pair(text: str, what: str) -> tuple[float, float]:
+    parts = text.split(",")
+    try:
+        a, b = (float(x) for x in parts)
+    except ValueError:
+        raise WmrkitError(f"{what}: expected two numbers LAT,LONG, got '{text}'") from None
+    if not all(math.isfinite(v) and v > 0 for v in (a, b)):
+        raise WmrkitError(f"{what}: values must be finite numbers > 0, got '{text}'")
+    return a, b
+
+
+def weights_from_args(args: argparse.Namespace):
+    """The WLS friction coefficients of the command line (``--slip-weights`` file, then ``--mu`` options)."""
+    from ..slip.weights import SlipWeights
+
+    mu: dict[str, tuple[float, float]] = {}
+    default = (1.0, 1.0)
+    if args.slip_weights:
+        data = _read_json(args.slip_weights)
+        w = data.get("weights", data) if isinstance(data, dict) else None
+        try:
+            lat, lon = (float(v) for v in w["default"])
+            default = (lat, lon)
+            mu = {str(k): (float(a), float(b)) for k, (a, b) in w.get("wheels", {}).items()}
+        except (TypeError, KeyError, ValueError, AttributeError):
+            raise WmrkitError(f"{args.slip_weights}: expected {{\"weights\": {{\"default\": [LAT, LONG], "
+                              "\"wheels\": {NAME: [LAT, LONG]}}} (the output of 'wmrkit calibrate --json')") from None
+    if args.mu_default:
+        default = _pair(args.mu_default, "--mu-default")
+    for name, value in parse_assignments(args.mu, "--mu").items():
+        mu[name] = _pair(value, f"--mu {name}")
+    return SlipWeights.of(mu, default)
+
+
+def estimator_from_args(robot: Robot, args: argparse.Namespace):
+    """The estimator of ``--method wls|fk1|fk2`` with its options."""
+    from ..slip.estimators import estimator
+    from ..slip.kalman import noise_from_options
+
+    if args.weight:
+        raise WmrkitError("--weight applies to the kinematic methods; with --method wls use --mu WHEEL=LAT,LONG")
+    if args.covariance:
+        raise WmrkitError(f"--covariance is not available with --method {args.method} (kinematic methods only)")
+    k = args.kf_noise or (1.0, 1.0, 1.0)
+    wheels = {n: _pair(v, f"--kf-wheel {n}") for n, v in parse_assignments(args.kf_wheel, "--kf-wheel").items()}
+    noise = noise_from_options(k[0], k[1], k[2], wheels) if args.method != "wls" else None
+    weights = weights_from_args(args) if args.method == "wls" else None
+    return estimator(robot, args.method, sensed=args.sensed, weights=weights, noise=noise,
+                     thesis_double_q=args.thesis_double_q)
+
+
+def _read_json(path: str):
+    p = Path(path)
+    if not p.is_file():
+        raise WmrkitError(f"{path}: no such file")
+    try:
+        return json.loads(p.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as err:
+        raise WmrkitError(f"{path}: not JSON ({err})") from None
+
+
+def add_parsers(commands: argparse._SubParsersAction) -> None:
+    """Register ``calibrate`` and ``slip-study``."""
+    p = commands.add_parser("calibrate", help="calibrate slip weights and the effective track from a log with a "
+                                              "reference trajectory (skid steering)")
+    add_robot_argument(p)
+    p.add_argument("log", metavar="LOG", help="CSV joint log (time, WHEEL.spin ... cumulative angles [rad])")
+    p.add_argument("--reference", required=True, metavar="TRAJ.tum", help="reference trajectory (TUM) of the run")
+    p.add_argument("--scheme", choices=("exact", "rk2", "euler", "paper002"), default="exact",
+                   help="integration scheme (default: exact)")
+    add_json_flag(p)
+    p.set_defaults(run=run_calibrate)
+    add_study_parser(commands)
+
+
+def run_calibrate(args: argparse.Namespace) -> int:
+    """Fit the WLS lateral/longitudinal ratio and the effective track; print both and their errors."""
+    from ..odometry.logs import load_csv
+    from ..odometry.model import odometry_model
+    from ..odometry.trajectories import read_tum
+    from ..slip.calibration import calibrate_slip
+
+    robot = load_robot(args.robot)
+    joints = odometry_model(robot).joints
+    log = load_csv(args.log, joints)
+    if not Path(args.reference).is_file():
+        raise WmrkitError(f"{args.reference}: no such file")
+    try:
+        ref = read_tum(args.reference)
+    except ValueError as err:
+        raise WmrkitError(f"{args.reference}: not a TUM trajectory ({err})") from None
+    result = calibrate_slip(robot, log, ref, method=args.scheme)
+    if args.json:
+        print_json(result.to_dict())
+    else:
+        print(result.format())
+    return 0
+
+
+def add_study_parser(commands: argparse._SubParsersAction) -> None:
+    """Register ``slip-study``."""
+    p = commands.add_parser("slip-study", help="reproduce the slip studies: thesis §7.5 on the forklift, or the "
+                                               "skid-steer comparison of docs/slip.md")
+    p.add_argument("study", choices=("forklift", "skid-steer-4"), help="which study")
+    p.add_argument("--report", metavar="DIR", help="write the figures into DIR")
+    p.add_argument("--quick", action="store_true", help="fewer sweep points and shorter runs (a smoke run)")
+    p.add_argument("--source", choices=("md", "quasi-static"), default="md",
+                   help="skid-steer-4: motion from the dynamic model (default) or the quasi-static slip model")
+    add_json_flag(p)
+    p.set_defaults(run=run_study)
+
+
+def run_study(args: argparse.Namespace) -> int:
+    """Run a study, print its numbers (``--json``: the whole result), write figures with ``--report``."""
+    if args.study == "skid-steer-4":
+        from ..slip.skid import save_skid_figures, skid_comparison
+
+        result = skid_comparison(load_robot("skid-steer-4"), source=args.source)
+        figures = save_skid_figures(result, args.report) if args.report else []
+        data = {k: v for k, v in result.items() if k != "paths"} | {"figures": figures}
+        if args.json:
+            print_json(data)
+        else:
+            print(f"calibrated: WLS ratio {data['ratio']:.4g}, effective track multiplier {data['multiplier']:.4g}")
+            for name, models in data["runs"].items():
+                print(f"{name}: " + ", ".join(f"{m} rms {v['rms']:.3g} m" for m, v in models.items()))
+        return 0
+    from ..slip.study import forklift_study
+
+    result = forklift_study(report=args.report, quick=args.quick)
+    if args.json:
+        print_json(result)
+    else:
+        from ..slip.study import format_study
+
+        print(format_study(result))
+    return 0

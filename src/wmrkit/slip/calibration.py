@@ -1,0 +1,127 @@
+"""Calibration of slip models from a log with a reference trajectory (skid steering and other over-constrained robots).
+
+Two one-parameter models are fitted to the same run, by least squares of the position and heading errors at the
+reference's samples (heading in metres of arc at ``heading_weight`` m/rad):
+
+- **WLS** (7.52): the ratio ``k = mu_lateral / mu_longitudinal`` of every wheel's friction coefficients (7.59);
+  ``k = 1`` is today's unweighted least squares, ``k -> 0`` ignores the lateral rows.
+- **Effective track**, the ``wheel_separation_multiplier`` practice of ROS's diff_drive_controller: the wheels'
+  lateral positions scaled by ``m`` and only their rolling rows used.
+
+For a robot whose fixed wheels sit symmetrically at ``(+-a, +-b)`` the two are the same model: WLS's normal
+equations give ``omega = (u_r - u_l) / (2 b (1 + k a^2 / b^2))``, so ``m = 1 + k (a / b)^2`` (tested). WLS's
+coefficient is physical (a tyre's cornering to longitudinal stiffness ratio) and the model serves any robot.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import WmrkitError
+from ..odometry.integrators import Method
+from ..odometry.logs import JointLog
+from ..odometry.model import wrap_angle
+from ..odometry.pipeline import odometry
+from ..robot import Robot
+from .weights import SlipWeights, wls_model
+
+#: Lateral weight of the effective-track model (rolling rows only, to round-off).
+IGNORED = 1e-9
+
+
+@dataclass(frozen=True, slots=True)
+class SlipCalibration:
+    """Fitted ``ratio`` (WLS, mu_lateral / mu_longitudinal) and ``multiplier`` (effective track); RMS position
+    errors [m] and final position / heading errors against the reference for ``no_slip`` (unweighted LS),
+    ``wls`` and ``effective_track``."""
+
+    robot: str
+    ratio: float
+    multiplier: float
+    rms: tuple[tuple[str, float], ...]
+    final: tuple[tuple[str, float, float], ...]
+
+    @property
+    def weights(self) -> SlipWeights:
+        """The WLS coefficients to use in ``odometry --method wls``."""
+        return SlipWeights.uniform(self.ratio, 1.0)
+
+    def to_dict(self) -> dict:
+        """JSON-ready; ``weights`` is what ``wmrkit odometry --slip-weights FILE`` reads."""
+        return {"robot": self.robot, "weights": self.weights.to_dict(), "ratio": self.ratio,
+                "wheel_separation_multiplier": self.multiplier,
+                "rms_position_error": dict(self.rms),
+                "final_error": {n: {"position": p, "heading": h} for n, p, h in self.final}}
+
+    def format(self) -> str:
+        """Human-readable summary."""
+        lines = [f"robot {self.robot}: WLS mu_lateral / mu_longitudinal = {self.ratio:.6g}, "
+                 f"effective track multiplier = {self.multiplier:.6g}"]
+        for (name, rms), (_, p, h) in zip(self.rms, self.final, strict=True):
+            lines.append(f"  {name:<16} rms position error {rms:.4g} m, final {p:.4g} m, {math.degrees(h):.3g} deg")
+        return "\n".join(lines)
+
+
+def effective_track_model(robot: Robot, multiplier: float):
+    """The ``wheel_separation_multiplier`` model: lateral wheel positions times `multiplier`, rolling rows only."""
+    if not (math.isfinite(multiplier) and multiplier > 0):
+        raise WmrkitError(f"wheel separation multiplier must be a finite number > 0, got {multiplier}")
+    wheels = []
+    for w in robot.wheels:
+        x, y = w.position
+        y *= multiplier
+        wheels.append(replace(w, l=float(math.hypot(x, y)), alpha=float(math.atan2(y, x))))
+    return wls_model(replace(robot, wheels=tuple(wheels)), SlipWeights.uniform(IGNORED, 1.0))
+
+
+def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, ArrayLike], *, method: Method = "exact",
+                   heading_weight: float = 1.0) -> SlipCalibration:
+    """Fit the WLS ratio and the effective track of `robot` to `reference` ``(times (M,), poses (M, 3))`` (TUM).
+
+    The reference's first pose is the start pose; the odometry is interpolated linearly at the reference's times
+    (which must lie within the log's span).
+    """
+    from scipy.optimize import least_squares
+
+    t_ref, ref = (np.asarray(a, dtype=float) for a in reference)
+    ref = ref.reshape(-1, 3)
+    t = np.asarray(log.time, dtype=float)
+    inside = (t_ref >= t[0] - 1e-9) & (t_ref <= t[-1] + 1e-9)
+    if inside.sum() < 2:
+        raise WmrkitError("reference: fewer than two poses within the log's time span")
+    t_ref, ref = t_ref[inside], ref[inside]
+    pose0 = _interp(t_ref[:1], t_ref, ref)[0] if t_ref[0] > t[0] else ref[0]
+
+    def poses_of(model) -> np.ndarray:
+        return _interp(t_ref, t, odometry(model, log, method=method, pose0=pose0).poses)
+
+    def residuals(poses: np.ndarray) -> np.ndarray:
+        err = poses - ref
+        err[:, 2] = heading_weight * wrap_angle(err[:, 2])
+        return err.ravel()
+
+    fit_k = least_squares(lambda p: residuals(poses_of(wls_model(robot, SlipWeights.uniform(10.0 ** p[0], 1.0)))),
+                          [0.0], bounds=([-6.0], [6.0]), x_scale=[1.0], diff_step=[1e-6])
+    fit_m = least_squares(lambda p: residuals(poses_of(effective_track_model(robot, 10.0 ** p[0]))),
+                          [0.1], bounds=([-2.0], [2.0]), x_scale=[0.1], diff_step=[1e-6])
+    ratio, multiplier = 10.0 ** float(fit_k.x[0]), 10.0 ** float(fit_m.x[0])
+    runs = {"no_slip": wls_model(robot), "wls": wls_model(robot, SlipWeights.uniform(ratio, 1.0)),
+            "effective_track": effective_track_model(robot, multiplier)}
+    rms, final = [], []
+    for name, model in runs.items():
+        p = poses_of(model)
+        d = np.hypot(*(p[:, :2] - ref[:, :2]).T)
+        rms.append((name, float(np.sqrt(np.mean(d * d)))))
+        final.append((name, float(d[-1]), float(abs(wrap_angle(p[-1, 2] - ref[-1, 2])))))
+    return SlipCalibration(robot.name, ratio, multiplier, tuple(rms), tuple(final))
+
+
+def _interp(t_new: np.ndarray, t: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """Poses ``(N, 3)`` at times `t` interpolated at `t_new` (heading unwrapped first)."""
+    th = np.unwrap(poses[:, 2])
+    return np.column_stack([np.interp(t_new, t, poses[:, 0]), np.interp(t_new, t, poses[:, 1]),
+                            np.interp(t_new, t, th)])

@@ -1,0 +1,110 @@
+"""Slip-aware odometry estimators for a log stream: WLS (7.52) and the Kalman filters FK1/FK2 (7.68)-(7.75).
+
+:func:`estimator` builds what ``wmrkit odometry --method wls|fk1|fk2`` runs. WLS is an
+:class:`~wmrkit.odometry.model.OdometryModel` (:func:`.weights.wls_model`), run by the odometry pipeline itself.
+A filter is a :class:`KalmanEstimator`: chunks of the log in, the filter state carried from chunk to chunk, the
+filtered twists composed into poses with the chosen scheme, the same :class:`~wmrkit.odometry.pipeline.OdometrySummary`
+out (the slip indicator is the norm of the measurement residual times the step [m]).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import WmrkitError
+from ..odometry.integrators import Method, check_method, integrate_increments
+from ..odometry.logs import JointLog, LogError, check_time
+from ..odometry.model import OdometryModel
+from ..odometry.pipeline import OdometrySummary, _check_finite
+from ..odometry.trajectories import Trajectory
+from ..robot import Robot
+from .kalman import FILTERS, KalmanModel, KalmanNoise, kalman_filter, kalman_model
+from .weights import SlipWeights, wls_model
+
+ESTIMATORS = ("wls", *FILTERS)
+
+
+@dataclass(frozen=True, eq=False)
+class KalmanEstimator:
+    """A velocity filter over a stream of log chunks (module docstring)."""
+
+    model: KalmanModel
+    name: str = "fk2"
+
+    @property
+    def joints(self) -> tuple[str, ...]:
+        """The log columns read."""
+        return self.model.odometry.joints
+
+    @property
+    def robot(self) -> Robot:
+        """The robot."""
+        return self.model.odometry.robot
+
+    def run(self, chunks: Iterable[JointLog], *, method: Method = "exact", pose0: ArrayLike = (0.0, 0.0, 0.0),
+            sinks: Sequence[Callable[[Trajectory], object]] = ()) -> OdometrySummary:
+        """Filter and integrate every chunk; each sink gets each :class:`Trajectory` chunk."""
+        check_method(method)
+        pose = np.array(pose0, dtype=float).reshape(3)
+        prev: JointLog | None = None
+        x = p = None
+        n_total, t0, t1, dist, rot, max_slip, sq, max_dt = 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        for raw in chunks:
+            chunk = raw if raw.joints == self.joints else raw.select(self.joints)
+            if len(chunk) == 0:
+                continue
+            if chunk.heading_world is not None:
+                raise WmrkitError(f"{self.name} filters the wheels' twist; an external heading (heading or gyro "
+                                  "column) is not used by it: drop that option or use --method wls")
+            _check(chunk, None if prev is None else float(prev.time[-1]))
+            if prev is None:
+                t0 = float(chunk.time[0])
+                first = Trajectory(chunk.time[:1], pose[None].copy(), np.zeros(1))
+                for sink in sinks:
+                    sink(first)
+                n_total = 1
+            else:
+                chunk = JointLog(np.concatenate([prev.time[-1:], chunk.time]), chunk.joints,
+                                 np.vstack([prev.positions[-1:], chunk.positions]), source=chunk.source)
+            if len(chunk) >= 2:
+                run = kalman_filter(self.model, chunk, x0=x, p0=p)
+                x, p = run.twist[-1], run.covariance
+                poses = integrate_increments(pose, run.increments, method)
+                for sink in sinks:
+                    sink(Trajectory(chunk.time[1:], poses, run.slip))
+                n = len(run.slip)
+                n_total += n
+                dist += float(np.sum(np.hypot(run.increments[:, 0], run.increments[:, 1])))
+                rot += float(np.sum(np.abs(run.increments[:, 2])))
+                max_slip, sq = max(max_slip, float(run.slip.max())), sq + float(run.slip @ run.slip)
+                max_dt = max(max_dt, float(np.max(np.diff(chunk.time))))
+                pose = poses[-1]
+            t1 = float(chunk.time[-1])
+            prev = chunk.slice(len(chunk) - 1, len(chunk))
+        if prev is None:
+            raise LogError("the log has no samples")
+        rms = math.sqrt(sq / (n_total - 1)) if n_total > 1 else 0.0
+        return OdometrySummary(self.robot.name, self.name, n_total, t0, t1, tuple(float(v) for v in pose),
+                               dist, rot, max_slip, rms, max_dt)
+
+
+def estimator(robot: Robot, name: str, *, sensed: Sequence[str] | None = None, weights: SlipWeights | None = None,
+              noise: KalmanNoise | None = None, thesis_double_q: bool = False) -> OdometryModel | KalmanEstimator:
+    """The estimator `name` (``wls``, ``fk1``, ``fk2``) of `robot`: WLS with friction coefficients `weights`, a
+    filter with `noise` (defaults: unit coefficients, unit noise)."""
+    if name == "wls":
+        return wls_model(robot, weights, sensed)
+    if name in FILTERS:
+        return KalmanEstimator(kalman_model(robot, name, noise, sensed, thesis_double_q=thesis_double_q), name)
+    raise WmrkitError(f"estimator must be one of {', '.join(ESTIMATORS)}, got '{name}'")
+
+
+def _check(chunk: JointLog, previous: float | None) -> None:
+    """Refuse non-finite values and time that does not increase (the message names the row), as the pipeline."""
+    _check_finite(chunk)
+    check_time(chunk, np.asarray(chunk.time, dtype=float), previous, None)

@@ -1,0 +1,213 @@
+"""Velocity Kalman filters FK1 and FK2 (thesis §7.5.2, (7.68)-(7.77)) for any robot, and Kalman odometry.
+
+State: the body twist ``x = (vx, vy, omega)``, a random walk (7.68) with process variance ``Q = k13^2 I`` per
+sample. Measurements: the no-slip rows (3.22) that hold only the twist and sensed rates,
+``A_p x = -A_a qdot_a`` (the rows (7.69)/(7.70): a wheel's rolling row is a wheel-speed reading, a lateral row a
+pseudo-measurement with the steering angle inside ``C``), with noise ``R = diag(sigma^2)`` per row. Rows with an
+unsensed wheel rate (the steered wheel's free spin) are left out.
+
+- **FK2** (7.70): every such row. The thesis merges the two identical lateral rows of the forklift's drive wheels
+  into one of standard deviation ``k16``; kept apart, each has ``sqrt(2) k16``.
+- **FK1** (7.69): FK2 without the lateral rows of fixed wheels.
+
+The recursion is (7.71)-(7.74) with the standard covariance update; (7.75) as printed adds Q a second time
+(``docs/errata.md``), available as ``thesis_double_q=True``. Computed in information form (:mod:`._kalman_kernel`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import WmrkitError
+from ..odometry.integrators import Method, check_method, compose_columns
+from ..odometry.logs import JointLog
+from ..odometry.model import OdometryModel, odometry_model, wrap_angle
+from ..odometry.trajectories import Trajectory
+from ..robot import Robot
+
+FILTERS = ("fk1", "fk2")
+
+
+@dataclass(frozen=True, slots=True)
+class KalmanNoise:
+    """Noise of the velocity filter: ``process`` (k13) [m/s per sample, rad/s for omega], ``lateral`` and
+    ``longitudinal`` standard deviations [m/s] of every wheel's rows, per wheel in ``wheels``
+    ``((name, lateral, longitudinal), ...)``."""
+
+    process: float = 1.0
+    lateral: float = 1.0
+    longitudinal: float = 1.0
+    wheels: tuple[tuple[str, float, float], ...] = ()
+
+    def __post_init__(self) -> None:
+        for name, v in (("process", self.process), ("lateral", self.lateral), ("longitudinal", self.longitudinal),
+                        *((f"{w} ({d})", x) for w, a, b in self.wheels for d, x in (("lateral", a),
+                                                                                   ("longitudinal", b)))):
+            if not (np.isfinite(v) and v > 0):
+                raise WmrkitError(f"Kalman noise {name}: must be a finite number > 0, got {v}")
+
+    def of_wheel(self, name: str) -> tuple[float, float]:
+        """``(lateral, longitudinal)`` standard deviations of wheel `name`."""
+        for n, a, b in self.wheels:
+            if n == name:
+                return a, b
+        return self.lateral, self.longitudinal
+
+
+def fk1_noise(k14: float, k15: float, k13: float = 1.0) -> KalmanNoise:
+    """FK1 of the thesis's forklift (7.77): drive-wheel speeds ``k14``, steer lateral constraint ``k15``."""
+    return KalmanNoise(k13, k15, k14, (("right_drive", k15, k14), ("left_drive", k15, k14)))
+
+
+def fk2_noise(k16: float, k17: float, k18: float, k13: float = 1.0) -> KalmanNoise:
+    """FK2 of the thesis's forklift (7.77): merged drive lateral row ``k16`` (each row ``sqrt(2) k16``), drive
+    speeds ``k17``, steer lateral constraint ``k18``."""
+    s = float(np.sqrt(2.0) * k16)
+    return KalmanNoise(k13, k18, k18, (("right_drive", s, k17), ("left_drive", s, k17)))
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class KalmanModel:
+    """The filter's matrices for one robot and sensor set: ``rows`` kept of the slip matrix, their ``sigma``;
+    ``odometry``: the sensed model (joints, steering); ``thesis_double_q``: (7.75) as printed."""
+
+    odometry: OdometryModel
+    rows: np.ndarray
+    sigma: np.ndarray
+    process: float
+    thesis_double_q: bool = False
+
+    def matrices(self, beta_full: np.ndarray) -> tuple[np.ndarray, ...]:
+        """``(H, M, C, A_a)`` per configuration ``(U, n_steer) -> (U, 3, 3), (U, 3, n_a), (U, m, 3), (U, m, n_a)``."""
+        a = self.odometry.robot.constraint_matrix(beta_full)[..., self.rows, :]
+        cols = np.array([self.odometry.robot.velocity_index(j) for j in self.odometry.rate_joints], dtype=int)
+        c, aa = a[..., :3], a[..., cols]
+        ct_r = np.swapaxes(c, -1, -2) / self.sigma**2
+        return ct_r @ c, -(ct_r @ aa), np.ascontiguousarray(c), np.ascontiguousarray(aa)
+
+
+def kalman_model(robot: Robot, kind: str = "fk2", noise: KalmanNoise | None = None,
+                 sensed: Sequence[str] | None = None, *, thesis_double_q: bool = False) -> KalmanModel:
+    """FK1 or FK2 (module docstring) of `robot` with its sensed joints (default ``robot.sensed``)."""
+    if kind not in FILTERS:
+        raise WmrkitError(f"filter must be one of {', '.join(FILTERS)}, got '{kind}'")
+    noise = noise or KalmanNoise()
+    for name, _, _ in noise.wheels:
+        robot.wheel(name)
+    base = odometry_model(robot, sensed)
+    rng = np.random.default_rng(0)
+    probe = np.vstack([robot.beta, robot.beta + rng.uniform(-1, 1, (3, len(robot.beta)))])
+    a = robot.constraint_matrix(probe)
+    rate_cols = np.array([robot.velocity_index(j) for j in base.rate_joints], dtype=int)
+    unsensed = np.setdiff1d(np.arange(3, a.shape[-1]), rate_cols)
+    rows, sigma, row = [], [], 0
+    for w in robot.wheels:
+        lat, lon = noise.of_wheel(w.name)
+        for _ in w.elements():
+            for axis, s in ((0, lat), (1, lon)):
+                r = row + axis
+                if r not in base.rows or np.any(np.abs(a[:, r, unsensed]) > 0):
+                    continue
+                if kind == "fk1" and axis == 0 and w.type == "fixed":
+                    continue
+                rows.append(r)
+                sigma.append(s)
+            row += 2
+    rows_a = np.array(rows, dtype=int)
+    if np.linalg.matrix_rank(a[0][rows_a, :3]) < 3 and kind == "fk2":
+        raise WmrkitError(f"{kind}: the sensed rows of robot '{robot.name}' do not determine its twist")
+    return KalmanModel(base, rows_a, np.array(sigma), float(noise.process) ** 2, thesis_double_q)
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class KalmanRun:
+    """Filter output over a log: ``twist`` ``(N, 3)`` per interval, ``increments`` ``(N, 3)``, the final
+    covariance ``covariance`` ``(3, 3)`` of the twist, ``slip`` ``(N,)`` [m]."""
+
+    twist: np.ndarray
+    increments: np.ndarray
+    covariance: np.ndarray
+    slip: np.ndarray
+
+
+def kalman_filter(model: KalmanModel, log: JointLog, *, x0: ArrayLike | None = None,
+                  p0: ArrayLike | None = None) -> KalmanRun:
+    """Run the filter over the intervals of `log` (positions: cumulative spin angles, steering angles).
+
+    `x0` defaults to the least-squares twist of the first interval, `p0` to Q (the spec's choice; the thesis
+    gives neither). Rates are the increments over each interval divided by its duration.
+    """
+    from . import _kalman_kernel
+
+    om = model.odometry
+    chunk = log if log.joints == om.joints else log.select(om.joints)
+    p = np.asarray(chunk.positions, dtype=float)
+    t = np.asarray(chunk.time, dtype=float)
+    if len(t) < 2:
+        raise WmrkitError("the log needs at least two samples")
+    dt = np.diff(t)
+    d = np.diff(p, axis=0)
+    rate_idx = [om.joints.index(j) for j in om.rate_joints]
+    rates = d[:, rate_idx] / dt[:, None]
+    robot = om.robot
+    if om.steer_joints:
+        sc = [om.joints.index(j) for j in om.steer_joints]
+        steps = wrap_angle(d[:, sc])
+        beta_mid = p[:-1, sc] + 0.5 * steps
+        configs, index = _configurations(beta_mid)
+        full = np.broadcast_to(robot.beta, (len(configs), len(robot.steer_names))).copy()
+        full[:, om.steer_index] = configs
+    else:
+        full, index = robot.beta[None], np.empty(0, dtype=np.int64)
+    h, m, c, aa = model.matrices(full)
+    if x0 is None:
+        u0 = 0 if len(index) == 0 else int(index[0])
+        x0 = np.linalg.lstsq(c[u0] / model.sigma[:, None], -(aa[u0] @ rates[0]) / model.sigma, rcond=None)[0]
+    p_start = np.eye(3) * model.process if p0 is None else np.asarray(p0, dtype=float)
+    out, slip = np.empty((len(dt), 3)), np.empty(len(dt))
+    x_end, p_end = np.empty(3), np.empty((3, 3))
+    _kalman_kernel.kalman_chunk(rates, dt, h, m, c, aa, index, model.process, model.thesis_double_q,
+                                np.asarray(x0, dtype=float), p_start, out, slip, x_end, p_end)
+    return KalmanRun(out / dt[:, None], out, p_end, slip)
+
+
+def _configurations(beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distinct rows of `beta` ``(N, s)`` and the index of each row ``(N,)`` int64, in O(N) plus a sort of the
+    runs: quantised steering changes between few samples, so only the first sample of each run is sorted."""
+    n = len(beta)
+    change = np.empty(n, dtype=bool)
+    change[:1] = True
+    np.any(beta[1:] != beta[:-1], axis=1, out=change[1:])
+    starts = np.flatnonzero(change)
+    if beta.shape[1] == 1:  # one steering angle: a 1-D sort, several times faster than rows
+        values, inverse = np.unique(beta[starts, 0], return_inverse=True)
+        configs = values[:, None]
+    else:
+        configs, inverse = np.unique(beta[starts], axis=0, return_inverse=True)
+    return configs, np.repeat(inverse.reshape(-1).astype(np.int64), np.diff(np.append(starts, n)))
+
+
+def kalman_odometry(model: KalmanModel, log: JointLog, *, method: Method = "exact",
+                    pose0: ArrayLike = (0.0, 0.0, 0.0), x0: ArrayLike | None = None,
+                    p0: ArrayLike | None = None) -> Trajectory:
+    """Poses from the filtered twists (one per sample, the first `pose0`), composed with `method`; `x0`, `p0`
+    as in :func:`kalman_filter`."""
+    check_method(method)
+    run = kalman_filter(model, log, x0=x0, p0=p0)
+    pose0 = np.asarray(pose0, dtype=float)
+    poses = np.empty((len(run.increments) + 1, 3))
+    poses[0] = pose0
+    inc = run.increments
+    compose_columns(pose0, inc[:, 0], inc[:, 1], inc[:, 2], method, out=poses[1:])
+    return Trajectory(np.asarray(log.time, dtype=float), poses, np.concatenate([[0.0], run.slip]))
+
+
+def noise_from_options(process: float, lateral: float, longitudinal: float,
+                       wheels: Mapping[str, tuple[float, float]] | None = None) -> KalmanNoise:
+    """A :class:`KalmanNoise` from plain numbers (the CLI's options)."""
+    return KalmanNoise(process, lateral, longitudinal, tuple((k, float(a), float(b))
+                                                            for k, (a, b) in (wheels or {}).items()))

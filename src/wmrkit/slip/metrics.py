@@ -1,0 +1,50 @@
+"""Accuracy indices of thesis §7.5: J (7.78) of a slip model against the dynamic model, J_k (7.80) of closed paths."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import WmrkitError
+from ..odometry.model import wrap_angle
+
+
+def j_model(twist_reference: ArrayLike, twist_model: ArrayLike) -> float:
+    """(7.78): mean absolute twist error over samples and the three components, ``(N, 3), (N, 3) -> float``.
+
+    Mixes m/s and rad/s as the thesis does; the thesis reports it in percent (times 100).
+    """
+    ref, mod = np.asarray(twist_reference, dtype=float), np.asarray(twist_model, dtype=float)
+    if ref.shape != mod.shape or ref.ndim != 2 or ref.shape[1] != 3:
+        raise WmrkitError(f"j_model: expected two (N, 3) twist arrays, got {ref.shape} and {mod.shape}")
+    return float(np.mean(np.abs(ref - mod)))
+
+
+def closure_error(poses: ArrayLike, truth_final: ArrayLike | None = None) -> tuple[float, float]:
+    """One closed run's two terms of (7.80): final position error over the distance travelled and final heading
+    error (wrapped to ``(-pi, pi]``) over the rotation travelled, both measured on the estimated path ``(N, 3)``.
+
+    The error is against the start pose (a closed manoeuvre, as in the thesis's experiments) or, with
+    `truth_final` ``(3,)``, against the true final pose (synthetic runs, whose open-loop paths do not close).
+    """
+    p = np.asarray(poses, dtype=float)
+    goal = p[0] if truth_final is None else np.asarray(truth_final, dtype=float)
+    steps = np.diff(p, axis=0)
+    distance = float(np.sum(np.hypot(steps[:, 0], steps[:, 1])))
+    rotation = float(np.sum(np.abs(wrap_angle(steps[:, 2]))))
+    if distance <= 0 or rotation <= 0:
+        raise WmrkitError("closure_error: the path neither moves nor turns")
+    pos = float(np.hypot(*(p[-1, :2] - goal[:2])))
+    head = float(abs(wrap_angle(p[-1, 2] - goal[2])))
+    return pos / distance, head / rotation
+
+
+def j_closure(runs: Sequence[ArrayLike], truth_finals: Sequence[ArrayLike] | None = None) -> float:
+    """(7.80): ``1/(2 N_e) sum (position error / distance + heading error / rotation)`` over runs (closed, or
+    against `truth_finals` as in :func:`closure_error`)."""
+    if not runs:
+        raise WmrkitError("j_closure: no runs")
+    finals = [None] * len(runs) if truth_finals is None else list(truth_finals)
+    return float(sum(sum(closure_error(p, f)) for p, f in zip(runs, finals, strict=True)) / (2 * len(runs)))

@@ -1,0 +1,259 @@
+"""The three slip models of thesis §7.4 for any robot: quasi-static (MQE), kinematic with slip (MCD), WLS.
+
+All three take the assigned velocities (sensed or actuated wheel rates, §7.4.3 option 1/2) and return the
+unassigned ones, the body twist first. They are built on the slip matrix ``A`` (3.22), ``v_slip = A q_dot``,
+and the generalised force of friction ``Q = A^T F`` (7.16), whose twist part is the friction wrench on the
+vehicle about the robot origin ``(F_x, F_y, M_z)`` and whose wheel parts are the friction torques on the joints:
+
+- **MCD** (7.63 generalised): ``A_na^T F(A q_dot) = 0``: forces and moment balance (7.41) without its inertial
+  side and (7.42), free wheels (7.48), free castors (7.47), Swedish rollers (7.46), in one equation per
+  unassigned velocity.
+- **MQE** (7.41)-(7.48): the same with the centripetal term: the twist rows equal ``(M a_cm, c x M a_cm)``,
+  ``a_cm = omega J v_cm`` (7.40), and normal loads with that acceleration (7.64 generalised, :func:`normal_loads`).
+- **WLS** (7.50)-(7.53): least squares of ``sqrt(mu) A q_dot = 0`` (:func:`~wmrkit.kinematics.linalg.solve_assigned`
+  on the weighted rows). Its normal equations are MCD's with the linear law ``F = -mu v_slip`` (7.59): the
+  equivalence theorem of §7.4.4, tested.
+
+Friction laws are callables ``law(v_slip, v_body, loads) -> F`` on ``(..., E, 2)`` contact slips (lateral,
+longitudinal), the contact velocities due to the body motion alone (for slip ratios and angles), and normal loads
+``(..., E)`` [N]; they return the friction force on the vehicle in each contact frame ``(..., E, 2)`` [N].
+:func:`tyre_friction` makes one from the robot's described tyres (:mod:`wmrkit.dynamics.tyres`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..dynamics.mass import Body
+from ..errors import WmrkitError
+from ..kinematics.linalg import solve_assigned
+from ..robot import Robot
+from .weights import SlipWeights
+
+FrictionLaw = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+G = 9.81  # m/s^2 (the thesis gives no value)
+
+
+@dataclass(frozen=True, slots=True)
+class LinearFriction:
+    """The linear, uncoupled law (7.59): ``F_i = -diag(mu_x, mu_y) v_slip,i``; loads are ignored (absorbed in mu)."""
+
+    mu: tuple[float, ...]  # (2 E,) per row of the slip matrix, lateral then longitudinal per contact
+
+    @classmethod
+    def from_weights(cls, robot: Robot, weights: SlipWeights) -> LinearFriction:
+        """The law whose coefficients are `weights`."""
+        return cls(tuple(weights.row_mu(robot).tolist()))
+
+    def __call__(self, v_slip: np.ndarray, v_body: np.ndarray, loads: np.ndarray) -> np.ndarray:
+        return -np.asarray(self.mu).reshape(-1, 2) * v_slip
+
+
+@dataclass(frozen=True, slots=True)
+class TyreFriction:
+    """The friction law of the robot's tyres (:class:`wmrkit.dynamics.tyres.Tyre`), one per contact element."""
+
+    tyres: tuple  # (E,) Tyre
+
+    def __call__(self, v_slip: np.ndarray, v_body: np.ndarray, loads: np.ndarray) -> np.ndarray:
+        out = np.empty(np.broadcast_shapes(v_slip.shape, v_body.shape))
+        for e, tyre in enumerate(self.tyres):
+            v_wheel = v_body[..., e, 1]
+            f = tyre.forces(loads[..., e], v_slip[..., e, 0], v_slip[..., e, 1], v_wheel, v_slip[..., e, 1] - v_wheel)
+            out[..., e, 0], out[..., e, 1] = f.lateral, f.longitudinal
+        return out
+
+
+def tyre_friction(robot: Robot) -> TyreFriction:
+    """The friction law of `robot`'s described tyres (every wheel needs ``tyre:`` in its description)."""
+    missing = [w.name for w in robot.wheels if w.tyre is None]
+    if missing:
+        raise WmrkitError(f"robot '{robot.name}': wheel '{missing[0]}' has no tyre model ('tyre:' in its description)")
+    return TyreFriction(tuple(w.tyre for w in robot.wheels for _ in w.elements()))
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
+class SlipSolution:
+    """A slip model's answer, batched ``(...)``: ``q_dot`` ``(..., k)`` every velocity (named by
+    ``robot.velocity_names``), ``slip`` ``(..., 2E)`` [m/s] ``A q_dot``, ``forces`` ``(..., 2E)`` [N] friction in
+    the contact frames (WLS: ``-mu v_slip``), ``residual`` ``(...)`` the largest equation error [N] (0 for WLS),
+    ``converged`` ``(...)`` bool."""
+
+    q_dot: np.ndarray
+    slip: np.ndarray
+    forces: np.ndarray
+    residual: np.ndarray
+    converged: np.ndarray
+
+    @property
+    def twist(self) -> np.ndarray:
+        """``(..., 3)``: ``(vx [m/s], vy [m/s], omega [rad/s])``."""
+        return self.q_dot[..., :3]
+
+    @property
+    def dissipation(self) -> np.ndarray:
+        """Power dissipated by friction ``-F . v_slip`` (7.3) ``(...)`` [W]; for WLS it is J_LS (7.53)."""
+        return -np.sum(self.forces * self.slip, axis=-1)
+
+
+def assigned_columns(robot: Robot, assigned: Sequence[str]) -> np.ndarray:
+    """Column indices of the assigned velocity names (``WHEEL.spin``, ``WHEEL.steer``...)."""
+    return np.array([robot.velocity_index(n) for n in assigned], dtype=int)
+
+
+def wls(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: ArrayLike | None = None,
+        weights: SlipWeights | None = None) -> SlipSolution:
+    """Weighted least squares (7.52): ``(..., n_a) -> SlipSolution``; `beta` ``(..., n_steer)`` or described."""
+    mu = (weights or SlipWeights()).row_mu(robot)
+    a = robot.constraint_matrix(beta)
+    cols = assigned_columns(robot, assigned)
+    q_a = np.asarray(q_assigned, dtype=float)
+    q, _ = solve_assigned(np.sqrt(mu)[:, None] * a, cols, q_a)
+    slip = (a @ q[..., None])[..., 0]
+    zero = np.zeros(slip.shape[:-1])
+    return SlipSolution(q, slip, -mu * slip, zero, zero == 0)
+
+
+def mcd(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, friction: FrictionLaw,
+        beta: ArrayLike | None = None, *, loads: ArrayLike | None = None, start: SlipSolution | None = None,
+        tol: float = 1e-9) -> SlipSolution:
+    """Kinematic model with slip (7.63) generalised: ``A_na^T F(A q_dot) = 0`` (module docstring).
+
+    `loads` ``(E,)`` [N], the static normal loads (default 1 N each: the law's own normalisation). Solved per
+    sample by Newton's method (``scipy.optimize.root``) from `start` (default: the unweighted WLS solution).
+    """
+    return _solve(robot, assigned, q_assigned, friction, beta, loads, None, start, tol)
+
+
+def mqe(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, friction: FrictionLaw,
+        beta: ArrayLike | None = None, *, body: Body | None = None, start: SlipSolution | None = None,
+        g: float = G, tol: float = 1e-9) -> SlipSolution:
+    """Quasi-static motion model (7.41)-(7.48): MCD plus the centripetal force and its load transfer (7.64).
+
+    `body`: the mass properties (default the robot's described ``body``).
+    """
+    return _solve(robot, assigned, q_assigned, friction, beta, None, (_body(robot, body), g), start, tol)
+
+
+def contact_positions(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
+    """Contact point of every element in the robot frame ``(..., E, 2)`` [m]: the steering joint plus the castor
+    offset ``d`` along the steering arm (``S_y`` at angle ``beta + pi/2``)."""
+    beta_e = _element_beta(robot, beta)
+    l_, al, d = (np.array(v, dtype=float) for v in zip(*[(e.l, e.alpha, e.d) for w in robot.wheels
+                                                           for e in w.elements()], strict=True))
+    x = l_ * np.cos(al) - d * np.cos(beta_e)
+    y = l_ * np.sin(al) - d * np.sin(beta_e)
+    return np.stack([x, y], axis=-1)
+
+
+def normal_loads(robot: Robot, body: Body | None = None, accel_cm: ArrayLike = (0.0, 0.0),
+                 beta: ArrayLike | None = None, g: float = G) -> np.ndarray:
+    """Normal loads (7.64) generalised to any contact layout: ``sum F_N = M g`` and the pitch and roll moments
+    about the centre of mass balance the inertial moment of ``M a_cm`` at height ``h_cm``:
+    ``sum F_N (p - c) = -h M a_cm``. ``(..., 2) -> (..., E)`` [N]. With more than three contacts the loads are
+    statically indeterminate: the minimum-norm solution (equal loads on a symmetric layout) is returned.
+    The thesis's drive-torque reaction term of (7.64) is not included. `body`: default the robot's.
+    """
+    body = _body(robot, body)
+    p = contact_positions(robot, beta) - np.asarray(body.com, dtype=float)
+    a = np.asarray(accel_cm, dtype=float)
+    m = np.stack([np.ones(p.shape[:-1]), p[..., 0], p[..., 1]], axis=-2)  # (..., 3, E)
+    h = body.com_height
+    rhs = np.stack(np.broadcast_arrays(np.full(a.shape[:-1], body.mass * g), -h * body.mass * a[..., 0],
+                                       -h * body.mass * a[..., 1]), axis=-1)
+    return (np.linalg.pinv(m) @ rhs[..., None])[..., 0]
+
+
+def _body(robot: Robot, body: Body | None) -> Body:
+    body = robot.body if body is None else body
+    if body is None:
+        raise WmrkitError(f"robot '{robot.name}' has no mass properties ('body:' in its description)")
+    return body
+
+
+def _element_beta(robot: Robot, beta: ArrayLike | None) -> np.ndarray:
+    from ..robot import _element_beta as element_beta
+    from ..robot import _table
+
+    return element_beta(robot, _table(robot), beta)
+
+
+def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, start, tol) -> SlipSolution:
+    from scipy.optimize import root
+
+    cols = assigned_columns(robot, assigned)
+    q_a = np.asarray(q_assigned, dtype=float)
+    a_all = robot.constraint_matrix(beta)
+    batch = np.broadcast_shapes(q_a.shape[:-1], a_all.shape[:-2])
+    a_all = np.broadcast_to(a_all, (*batch, *a_all.shape[-2:])).reshape(-1, *a_all.shape[-2:])
+    q_a = np.broadcast_to(q_a, (*batch, len(cols))).reshape(-1, len(cols))
+    k = a_all.shape[-1]
+    free = np.setdiff1d(np.arange(k), cols)
+    n_e = a_all.shape[-2] // 2
+    n_s = len(robot.steer_names)
+    betas = (None if beta is None or n_s == 0
+             else np.broadcast_to(np.asarray(beta, float), (*batch, n_s)).reshape(-1, n_s))
+    q0 = (wls(robot, assigned, q_a, betas) if start is None else start).q_dot.reshape(-1, k)
+    static = np.ones(n_e) if loads is None else np.asarray(loads, dtype=float)
+    if static.shape != (n_e,):
+        raise WmrkitError(f"loads: expected {n_e} normal loads, one per contact, got shape {static.shape}")
+    q_out = np.empty((len(q_a), k))
+    res = np.empty(len(q_a))
+    ok = np.empty(len(q_a), dtype=bool)
+    for i in range(len(q_a)):
+        a = a_all[i]
+        a_na, fixed = a[:, free], a[:, cols] @ q_a[i]
+        body_part = a[:, :3]
+        beta_i = None if betas is None else betas[i]
+
+        def equations(z, a_na=a_na, fixed=fixed, body_part=body_part, beta_i=beta_i):
+            slip = a_na @ z + fixed
+            twist = z[:3] if free[2] == 2 else None
+            v_body = body_part @ (twist if twist is not None else np.zeros(3))
+            if quasi_static is None:
+                f_n = static
+                inertial = 0.0
+            else:
+                f_n, inertial = _centripetal(robot, quasi_static, twist, beta_i)
+            f = friction(slip.reshape(n_e, 2), v_body.reshape(n_e, 2), f_n).reshape(-1)
+            out = a_na.T @ f
+            if quasi_static is not None:
+                out[:3] -= inertial
+            return out
+
+        scale = max(1.0, float(np.max(np.abs(equations(q0[i][free])))))
+        sol = root(lambda z, s=scale: equations(z) / s, q0[i][free], method="hybr", tol=tol * 1e-3)
+        q = np.empty(k)
+        q[free], q[cols] = sol.x, q_a[i]
+        q_out[i] = q
+        res[i] = float(np.max(np.abs(equations(sol.x)), initial=0.0))
+        ok[i] = res[i] <= tol * scale  # hybr may report no progress when it starts at the root
+    a_b = a_all.reshape(*batch, *a_all.shape[-2:])
+    q_out = q_out.reshape(*batch, k)
+    slip = (a_b @ q_out[..., None])[..., 0]
+    f_n = np.broadcast_to(static, (*batch, n_e))
+    if quasi_static is not None:
+        f_n = np.stack([_centripetal(robot, quasi_static, q[:3], None if betas is None else betas[i])[0]
+                        for i, q in enumerate(q_out.reshape(-1, k))]).reshape(*batch, n_e)
+    body_v = (a_b[..., :3] @ q_out[..., :3, None])[..., 0]
+    forces = friction(slip.reshape(*batch, n_e, 2), body_v.reshape(*batch, n_e, 2), f_n).reshape(*batch, 2 * n_e)
+    return SlipSolution(q_out, slip, forces, res.reshape(batch), ok.reshape(batch))
+
+
+def _centripetal(robot: Robot, quasi: tuple[Body, float], twist: np.ndarray | None,
+                 beta_i) -> tuple[np.ndarray, np.ndarray]:
+    """Loads and the inertial wrench ``(M a_cm, c x M a_cm)`` about the origin of uniform curvilinear motion."""
+    body, g = quasi
+    if twist is None:
+        raise WmrkitError("MQE needs the body twist unassigned (the vehicle velocities are its unknowns)")
+    cx, cy = body.com
+    vx, vy, w = twist
+    v_cm = np.array([vx - w * cy, vy + w * cx])
+    a_cm = w * np.array([-v_cm[1], v_cm[0]])  # omega J v_cm (7.40)
+    f = body.mass * a_cm
+    loads = normal_loads(robot, body, a_cm, beta_i, g)
+    return loads, np.array([f[0], f[1], cx * f[1] - cy * f[0]])

@@ -1,0 +1,226 @@
+"""Thesis §7.5 on the simulated forklift: the k11/k12 sweep, examples 1 and 2 (MD vs MQE, MCD, WLS), the five
+paths (WLS, FK1, FK2, differential odometry). What ``wmrkit slip-study forklift`` runs; see ``docs/slip.md``.
+
+The dynamic model (MD) is :mod:`wmrkit.dynamics` (Lagrange model, appendix 7.A1 Pacejka tyres, 1 kHz
+semi-implicit steps). Parameters the thesis leaves open are in :data:`SETTINGS` (sample period, sensor
+resolutions, filter start). Twists are compared at the drive-axle mid-point (the chapter-7 origin), in REP-103
+axes (x forward): the thesis's ``v_y`` is ``vx`` here and its ``v_x`` is ``-vy``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from .. import catalog
+from ..errors import WmrkitError
+from ..odometry.logs import JointLog
+from ..odometry.model import odometry_model
+from ..odometry.pipeline import odometry
+from .kalman import fk1_noise, fk2_noise, kalman_model, kalman_odometry
+from .metrics import closure_error, j_model
+from .models import mcd, mqe, normal_loads, tyre_friction, wls
+from .weights import SlipWeights, wls_model
+
+DRIVES = ("right_drive.spin", "left_drive.spin")
+AXLE = (-1.0, 0.0)  # drive-axle mid-point in the catalog forklift's frame (origin at the fork tips)
+SETTINGS = {"sample_period_s": 0.05, "md_step_s": 1e-3, "encoder_counts_per_rev": 8290,
+            "steer_resolution_deg": 1.4118, "example_duration_s": 10.0, "example2_torque_nm": 30.0,
+            "kalman_x0": "least squares of the first interval", "kalman_p0": "Q = k13^2 I, k13 = 1",
+            "wls_thesis": (3.2e-3, 19.2), "fk1_thesis": (0.31, 1.09), "fk2_thesis": (0.28, 3.57, 0.28),
+            "path_speed_m_s": 2.0}
+PATH_NAMES = ("rectangle", "corkscrew", "d", "figure-eight", "triple-loop")
+
+
+def forklift_weights(k11: float, k12: float) -> SlipWeights:
+    """(7.67): mu_x12 = 1, mu_y12 = k11, mu_x3 = k12 (the steered wheel's rolling row has its free spin)."""
+    return SlipWeights.of({"right_drive": (1.0, k11), "left_drive": (1.0, k11), "steer": (k12, 1.0)})
+
+
+def at_axle(twist: np.ndarray) -> np.ndarray:
+    """Twists of the robot origin ``(..., 3)`` moved to the drive axle: ``v + omega x (axle - origin)``."""
+    t = np.array(twist, dtype=float)
+    t[..., 0] -= t[..., 2] * AXLE[1]
+    t[..., 1] += t[..., 2] * AXLE[0]
+    return t
+
+
+def sweep(robot, quick: bool = False) -> dict:
+    """§7.5.3: MCD (Pacejka tyres, static loads) at 11 x 21 x 5 = 1155 input points; k11, k12 fitted so that WLS
+    matches it (mean absolute twist difference, Nelder-Mead in log space)."""
+    from scipy.optimize import minimize
+
+    step = 1.0 if quick else 0.5
+    u1, u2 = np.meshgrid(np.arange(0, 5 + 1e-9, step), np.arange(-5, 5 + 1e-9, step), indexing="ij")
+    u1, u2 = u1.ravel(), u2.ravel()
+    res = math.radians(SETTINGS["steer_resolution_deg"])
+    v, w = (u1 + u2) / 2, (u1 - u2) / (2 * 0.45)
+    l3 = 1.35
+    heading = np.where(v != 0, np.arctan(-l3 * w / np.where(v != 0, v, 1.0)), -np.sign(w) * np.pi / 2)
+    base = np.round(heading / res) * res
+    offsets = (0,) if quick else (0, -2, -1, 1, 2)
+    rates, beta = [], []
+    for k in offsets:
+        h = np.clip(base + k * 2 * res, -np.pi / 2, np.pi / 2)
+        rates.append(np.stack([u1, u2], -1) / 0.23)
+        beta.append(robot.beta_of_heading(h[:, None]))
+    rates, beta = np.concatenate(rates), np.concatenate(beta)
+    law, loads = tyre_friction(robot), normal_loads(robot)
+    ref = mcd(robot, DRIVES, rates, law, beta, loads=loads)
+    ok = ref.converged
+    target = at_axle(ref.twist[ok])
+
+    def cost(p: np.ndarray) -> float:
+        got = at_axle(wls(robot, DRIVES, rates[ok], beta[ok], forklift_weights(*10.0 ** p)).twist)
+        return float(np.mean(np.abs(got - target)))
+
+    fit = minimize(cost, [0.0, 0.0], method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-10})
+    k11, k12 = (float(x) for x in 10.0 ** fit.x)
+    return {"k11": k11, "k12": k12, "points": len(rates), "converged": int(ok.sum()),
+            "mean_abs_difference": float(fit.fun), "max_residual_n": float(np.max(ref.residual)),
+            "_data": (rates, beta, ref, k11, k12)}
+
+
+def example(robot, number: int, weights: SlipWeights) -> dict:
+    """Examples 1 and 2 of §7.5.3: from rolling at (vx, omega) = (2 m/s, 0.3 rad/s) at the axle, the steering held
+    by its servo; no torque (1) or +30 N m on each drive wheel for 1 s (2; forward in REP-103 signs)."""
+    from ..dynamics.model import DynamicModel
+    from ..dynamics.simulate import Inputs, simulate
+    from ..kinematics.wheel_ik import wheel_commands
+
+    model = DynamicModel.of(robot)
+    twist0 = np.array([2.0, 0.3 * (0.0 - AXLE[0]), 0.3])  # v at the fork tips = v_axle + omega x (1, 0)
+    heading = float(wheel_commands(robot, twist0).heading[robot.wheel_names.index("steer")])
+    duration = SETTINGS["example_duration_s"]
+    t = np.array([0.0, 1.0, 1.0 + 1e-6, duration])
+    tau = np.zeros((4, model.n))
+    if number == 2:
+        for j in DRIVES:
+            tau[:2, model.names.index(j)] = SETTINGS["example2_torque_nm"]
+    steer = robot.wheel("steer")
+    bw = 30.0
+    inputs = Inputs(t, tau, np.zeros_like(tau), np.zeros(model.n), np.full(model.n, np.inf), np.full((4, 1), heading),
+                    np.array([steer.steer_inertia * bw**2]), np.array([2 * steer.steer_inertia * bw]))
+    sim = simulate(model, inputs, duration, step=SETTINGS["md_step_s"], initial_twist=twist0,
+                   record_step=SETTINGS["sample_period_s"])
+    names = list(sim.joint_names)
+    rates = sim.joint_rates[:, [names.index(j) for j in DRIVES]]
+    beta = sim.joint_positions[:, [names.index("steer.steer")]]
+    law = tyre_friction(robot)
+    twists = {"MD": at_axle(sim.twist),
+              "MQE": at_axle(mqe(robot, DRIVES, rates, law, beta).twist),
+              "MCD": at_axle(mcd(robot, DRIVES, rates, law, beta, loads=normal_loads(robot)).twist),
+              "WLS": at_axle(wls(robot, DRIVES, rates, beta, weights).twist)}
+    j = {m: j_model(twists["MD"], twists[m]) for m in ("MQE", "MCD", "WLS")}
+    return {"example": number, "J": j, "J_percent": {m: 100 * v for m, v in j.items()},
+            "_data": (sim.t, twists, sim.pose)}
+
+
+def sensor_log(robot, sim) -> JointLog:
+    """The forklift's sensors sampling a simulation: drive encoders (8290 counts/rev, floor), steering encoder
+    (1.4118 deg, nearest), at the simulation's record step."""
+    names = list(sim.joint_names)
+    per_count = 2 * np.pi / SETTINGS["encoder_counts_per_rev"]
+    res = math.radians(SETTINGS["steer_resolution_deg"])
+    spins = np.floor(sim.joint_positions[:, [names.index(j) for j in DRIVES]] / per_count) * per_count
+    heading = robot.heading_of_beta(sim.joint_positions[:, [names.index("steer.steer")]])
+    steer = robot.beta_of_heading(np.round(heading / res) * res)
+    joints = odometry_model(robot).joints
+    return JointLog(sim.t, joints, np.column_stack([spins, steer]), source="<forklift-sim>")
+
+
+def paths(robot, k11: float, k12: float, quick: bool = False) -> dict:
+    """The five experiment paths at 2 m/s, simulated with the MD, odometry by every estimator; J_k (7.80) against
+    the simulated final pose (open-loop programs do not close exactly)."""
+    from ..dynamics.model import DynamicModel
+    from ..dynamics.programs import path_program
+    from ..dynamics.simulate import simulate
+
+    model = DynamicModel.of(robot)
+    estimators = {
+        "WLS": lambda log: odometry(wls_model(robot, forklift_weights(k11, k12)), log).poses,
+        "WLS (thesis k)": lambda log: odometry(wls_model(robot, forklift_weights(*SETTINGS["wls_thesis"])),
+                                               log).poses,
+        "FK1": lambda log: kalman_odometry(kalman_model(robot, "fk1", fk1_noise(*SETTINGS["fk1_thesis"])), log).poses,
+        "FK2": lambda log: kalman_odometry(kalman_model(robot, "fk2", fk2_noise(*SETTINGS["fk2_thesis"])), log).poses,
+        "differential": lambda log: odometry(odometry_model(robot, DRIVES), log.select(DRIVES)).poses,
+    }
+    out, data, logs = {}, {}, []
+    for name in PATH_NAMES[:2] if quick else PATH_NAMES:
+        inputs, duration = path_program(model, name, speed=SETTINGS["path_speed_m_s"])
+        sim = simulate(model, inputs, duration, step=SETTINGS["md_step_s"], record_step=SETTINGS["sample_period_s"])
+        log = sensor_log(robot, sim)
+        logs.append((log, np.asarray(sim.pose[-1])))
+        est = {k: f(log) for k, f in estimators.items()}
+        jk = {k: float(sum(closure_error(p, sim.pose[-1])) / 2) for k, p in est.items()}
+        final = {k: float(np.hypot(*(p[-1, :2] - sim.pose[-1, :2]))) for k, p in est.items()}
+        out[name] = {"J_k": jk, "final_position_error_m": final}
+        data[name] = {"truth (MD)": np.asarray(sim.pose), **est}
+    mean = {k: float(np.mean([v["J_k"][k] for v in out.values()])) for k in estimators}
+    return {"runs": out, "mean_J_k": mean, "optimised": optimise(robot, logs, 25 if quick else 80), "_data": data}
+
+
+def optimise(robot, logs: list, maxiter: int) -> dict:
+    """The thesis's tuning (§7.5.4): each estimator's parameters minimising the mean J_k over the runs
+    (Nelder-Mead in log space from the thesis's optimum). ``{estimator: {"params": [...], "J_k": value}}``."""
+    from scipy.optimize import minimize
+
+    def mean_jk(poses_of) -> float:
+        return float(np.mean([sum(closure_error(poses_of(log), final)) / 2 for log, final in logs]))
+
+    makers = {
+        "WLS": (SETTINGS["wls_thesis"], lambda k: lambda log: odometry(wls_model(robot, forklift_weights(*k)),
+                                                                       log).poses),
+        "FK1": (SETTINGS["fk1_thesis"], lambda k: lambda log: kalman_odometry(
+            kalman_model(robot, "fk1", fk1_noise(*k)), log).poses),
+        "FK2": (SETTINGS["fk2_thesis"], lambda k: lambda log: kalman_odometry(
+            kalman_model(robot, "fk2", fk2_noise(*k)), log).poses),
+    }
+    out = {}
+    for name, (start, make) in makers.items():
+        fit = minimize(lambda p, make=make: mean_jk(make(10.0 ** p)), np.log10(start), method="Nelder-Mead",
+                       options={"maxiter": maxiter, "xatol": 1e-3, "fatol": 1e-7})
+        out[name] = {"params": [float(v) for v in 10.0 ** fit.x], "J_k": float(fit.fun)}
+    out["differential"] = {"params": [], "J_k": mean_jk(
+        lambda log: odometry(odometry_model(robot, DRIVES), log.select(DRIVES)).poses)}
+    return out
+
+
+def forklift_study(report: str | os.PathLike[str] | None = None, quick: bool = False) -> dict:
+    """Everything of §7.5 the simulator allows (module docstring); figures into `report` when given."""
+    robot = catalog.load("forklift")
+    if robot.body is None or any(w.tyre is None for w in robot.wheels):
+        raise WmrkitError("the catalog forklift lacks mass properties or tyres")
+    sw = sweep(robot, quick)
+    weights = forklift_weights(sw["k11"], sw["k12"])
+    examples = [example(robot, n, weights) for n in (1, 2)]
+    pth = paths(robot, sw["k11"], sw["k12"], quick)
+    figures = [] if report is None else _figures(report, sw, examples, pth)
+    strip = lambda d: {k: v for k, v in d.items() if not k.startswith("_")}  # noqa: E731
+    return {"settings": SETTINGS, "sweep": strip(sw), "examples": [strip(e) for e in examples],
+            "paths": {**pth["runs"], "mean_J_k": pth["mean_J_k"], "optimised": pth["optimised"]},
+            "figures": figures}
+
+
+def format_study(result: dict) -> str:
+    """Human-readable summary of :func:`forklift_study`."""
+    s = result["sweep"]
+    lines = [f"sweep: {s['converged']}/{s['points']} MCD solves converged; k11 = {s['k11']:.4g}, "
+             f"k12 = {s['k12']:.4g}, mean |MCD - WLS| = {s['mean_abs_difference']:.3g}"]
+    for e in result["examples"]:
+        lines.append(f"example {e['example']}: " + ", ".join(f"J_{m} = {v:.3g} %" for m, v in e["J_percent"].items()))
+    for name, run in result["paths"].items():
+        if name not in ("mean_J_k", "optimised"):
+            lines.append(f"{name}: " + ", ".join(f"{k} {100 * v:.3g} %" for k, v in run["J_k"].items()))
+    lines.append("mean J_k: " + ", ".join(f"{k} {100 * v:.3g} %" for k, v in result["paths"]["mean_J_k"].items()))
+    lines.append("optimised mean J_k: " + ", ".join(f"{k} {100 * v['J_k']:.3g} %"
+                                                    for k, v in result["paths"]["optimised"].items()))
+    return "\n".join(lines)
+
+
+def _figures(report, sw: dict, examples: list, pth: dict) -> list[str]:
+    from .study_plots import save_study_figures
+
+    return save_study_figures(report, sw, examples, pth)

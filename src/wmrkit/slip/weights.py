@@ -1,0 +1,94 @@
+"""Friction coefficients of the linear law (7.59) as weights of the no-slip rows, and the WLS odometry model.
+
+Each contact's slip ``v_slip,i`` (3.22) has a lateral component (row 0 of the wheel's rows, along the axle or
+roller axis E_x) and a longitudinal one (row 1, the rolling direction E_y). The linear friction law (7.59)
+``F_i = -diag(mu_x,i, mu_y,i) v_slip,i`` gives every row a coefficient; the weighted least squares (7.50)-(7.52)
+scales each row by ``sqrt(mu)``. Only ratios matter (the WLS solution is invariant to scaling every ``mu``,
+(7.67)); the default ``mu = 1`` on every row is the unweighted least squares of today's odometry (4.11).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..errors import WmrkitError
+from ..odometry.model import OdometryModel, _frozen, _solution_maps, odometry_model
+from ..robot import Robot
+
+
+class SlipWeightError(WmrkitError, ValueError):
+    """A friction coefficient that is not a finite number > 0, or names a wheel the robot lacks."""
+
+
+@dataclass(frozen=True, slots=True)
+class SlipWeights:
+    """Linear friction coefficients (7.59) per wheel: ``wheel name -> (mu_lateral, mu_longitudinal)``.
+
+    Units are any consistent force per slip speed [N s/m]; only ratios matter. Wheels not named get
+    ``default``. Build with :meth:`uniform` or :meth:`of`; ``mu`` is a tuple of pairs so the value is hashable.
+    """
+
+    mu: tuple[tuple[str, float, float], ...] = ()
+    default: tuple[float, float] = (1.0, 1.0)
+
+    @classmethod
+    def of(cls, mu: Mapping[str, tuple[float, float]], default: tuple[float, float] = (1.0, 1.0)) -> SlipWeights:
+        """From a mapping ``{wheel: (mu_lateral, mu_longitudinal)}``."""
+        out = cls(tuple((str(k), float(v[0]), float(v[1])) for k, v in mu.items()),
+                  (float(default[0]), float(default[1])))
+        for name, lat, lon in (*out.mu, ("default", *out.default)):
+            for what, v in (("lateral", lat), ("longitudinal", lon)):
+                if not (math.isfinite(v) and v > 0):
+                    raise SlipWeightError(f"friction coefficient of wheel '{name}' ({what}) must be a finite "
+                                          f"number > 0, got {v}")
+        return out
+
+    @classmethod
+    def uniform(cls, lateral: float = 1.0, longitudinal: float = 1.0) -> SlipWeights:
+        """The same coefficients on every wheel."""
+        return cls.of({}, (lateral, longitudinal))
+
+    def of_wheel(self, name: str) -> tuple[float, float]:
+        """``(mu_lateral, mu_longitudinal)`` of wheel `name`."""
+        for n, lat, lon in self.mu:
+            if n == name:
+                return lat, lon
+        return self.default
+
+    def to_dict(self) -> dict:
+        """JSON-ready: ``{"default": [lat, lon], "wheels": {name: [lat, lon]}}``."""
+        return {"default": list(self.default), "wheels": {n: [lat, lon] for n, lat, lon in self.mu}}
+
+    def row_mu(self, robot: Robot) -> np.ndarray:
+        """The coefficient of every row of ``robot.constraint_matrix()`` ``(2 n_contacts,)`` (lateral, longitudinal
+        alternate per contact element)."""
+        names = set(robot.wheel_names)
+        for n, _, _ in self.mu:
+            if n not in names:
+                raise SlipWeightError(f"friction coefficients given for wheel '{n}', which robot '{robot.name}' "
+                                      f"lacks (wheels: {', '.join(robot.wheel_names)})")
+        out = []
+        for w in robot.wheels:
+            out += list(self.of_wheel(w.name)) * len(w.elements())
+        return np.array(out, dtype=float)
+
+
+def wls_model(robot: Robot, weights: SlipWeights | None = None, sensed=None) -> OdometryModel:
+    """The sensed direct model solved by weighted least squares (7.50)-(7.52): WLS odometry for any robot.
+
+    The same :class:`~wmrkit.odometry.model.OdometryModel` as :func:`~wmrkit.odometry.model.odometry_model`
+    (so the same compiled pipeline, streaming and integration schemes run it), with every kept row scaled by
+    ``sqrt(mu)`` of its wheel and direction. Without slip the sensors satisfy ``A dq = 0`` exactly and every
+    weighting gives the same (exact) odometry.
+    """
+    base = odometry_model(robot, sensed)
+    w = np.sqrt((weights or SlipWeights()).row_mu(robot)[base.rows])
+    if not base.constant:
+        return replace(base, row_weights=_frozen(w))
+    s, rm = _solution_maps(robot, robot.beta, base.rows, base.cols, base.assigned, w)
+    return replace(base, row_weights=_frozen(w), solution=_frozen(s),
+                   residual_map=None if base.residual_map is None else _frozen(rm))

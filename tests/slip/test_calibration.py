@@ -1,0 +1,80 @@
+"""Skid steering: the simulated slip, calibration of WLS and of the effective track, and the CLI round trip."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.cli.main import main
+from wmrkit.odometry.logs import write_csv
+from wmrkit.odometry.pipeline import odometry
+from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+from wmrkit.slip.calibration import calibrate_slip, effective_track_model
+from wmrkit.slip.synthetic import wheel_speed_run
+from wmrkit.slip.weights import SlipWeights, wls_model
+
+SEGMENTS = [(3.0, [8, 12, 8, 12]), (2.0, [10, 10, 10, 10]), (3.0, [12, 8, 12, 8]), (2.0, [6, 14, 6, 14])]
+
+
+@pytest.fixture(scope="module")
+def husky_run():
+    return wheel_speed_run(catalog.load("skid-steer-4"), SEGMENTS, 20.0, model="mqe")
+
+
+def test_wls_ratio_is_an_effective_track_on_a_symmetric_skid_steer(husky_run):
+    """Normal equations of WLS on wheels at (+-a, +-b): omega = du / (2 b (1 + k a^2 / b^2)); a = b here."""
+    robot = catalog.load("skid-steer-4")
+    for k in (0.1, 0.75, 3.0):
+        wls = odometry(wls_model(robot, SlipWeights.uniform(k, 1.0)), husky_run.log).poses
+        track = odometry(effective_track_model(robot, 1 + k), husky_run.log).poses
+        assert np.allclose(wls, track, atol=1e-6)
+
+
+def test_simulated_skid_steer_slips_like_its_tyres(husky_run):
+    """Straight segments roll without slip; turns are slower than the no-slip differential model; the effective
+    multiplier is near 1 + c_alpha / c_s, the linear-region ratio of the Dugoff tyres (1500 / 2000)."""
+    straight = husky_run.twists[1]
+    assert np.allclose(straight, [1.0, 0.0, 0.0], atol=1e-9)
+    kinematic = (1.2 - 0.8) / 0.5
+    assert 0 < husky_run.twists[0, 2] < kinematic
+    cal = calibrate_slip(catalog.load("skid-steer-4"), husky_run.log, (husky_run.log.time, husky_run.truth))
+    assert math.isclose(cal.multiplier, 1 + cal.ratio, rel_tol=1e-3)
+    assert 0.6 < cal.ratio < 0.95
+    rms = dict(cal.rms)
+    assert rms["wls"] < 0.1 * rms["no_slip"]
+    assert math.isclose(rms["wls"], rms["effective_track"], rel_tol=1e-3, abs_tol=1e-6)
+
+
+def test_cli_calibrate_then_odometry(tmp_path, capsys, husky_run):
+    log = husky_run.log
+    log_path, ref_path, w_path = tmp_path / "log.csv", tmp_path / "ref.tum", tmp_path / "w.json"
+    write_csv(log_path, ("time", *log.joints), np.column_stack([log.time, log.positions]))
+    write_trajectory(ref_path, Trajectory(log.time, husky_run.truth, np.zeros(len(log))), "tum")
+    assert main(["calibrate", "skid-steer-4", str(log_path), "--reference", str(ref_path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out["rms_position_error"]) == {"no_slip", "wls", "effective_track"}
+    w_path.write_text(json.dumps(out))
+    assert main(["odometry", "skid-steer-4", str(log_path), "--method", "wls", "--slip-weights", str(w_path),
+                 "--json"]) == 0
+    pose = json.loads(capsys.readouterr().out)["pose"]
+    assert math.hypot(pose[0] - husky_run.truth[-1, 0], pose[1] - husky_run.truth[-1, 1]) < 0.2
+    assert main(["odometry", "skid-steer-4", str(log_path), "--json"]) == 0
+    plain = json.loads(capsys.readouterr().out)["pose"]
+    assert math.hypot(plain[0] - husky_run.truth[-1, 0], plain[1] - husky_run.truth[-1, 1]) > 0.5
+    assert main(["calibrate", "skid-steer-4", str(log_path), "--reference", str(tmp_path / "none.tum")]) == 2
+    assert capsys.readouterr().err.startswith("wmrkit: error:")
+
+
+def test_cli_skid_study_quasi_static(tmp_path, capsys):
+    """The docs' comparison on the quasi-static model: WLS = effective track, both far better than no slip on arcs."""
+    assert main(["slip-study", "skid-steer-4", "--source", "quasi-static", "--json", "--report", str(tmp_path)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["source"] == "quasi-static" and len(out["figures"]) == 4
+    for name in ("calibration run", "tight loop", "slalom"):
+        r = out["runs"][name]
+        assert r["WLS"]["rms"] == pytest.approx(r["effective track"]["rms"], rel=1e-4, abs=1e-6)
+        assert r["WLS"]["rms"] < 0.5 * r["no slip (LS)"]["rms"]

@@ -1,0 +1,123 @@
+"""FK1 / FK2 (7.68)-(7.77): the recursion as printed, its limits, and the corrected covariance update (7.75)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from slip_helpers import L3, L12, R, forklift_at_axle, thesis_twist_to_rep
+
+from wmrkit.odometry.logs import JointLog
+from wmrkit.slip.kalman import KalmanNoise, fk1_noise, fk2_noise, kalman_filter, kalman_model
+from wmrkit.slip.models import wls
+from wmrkit.slip.weights import SlipWeights
+
+JOINTS = ("right_drive.spin", "left_drive.spin", "steer.steer")
+
+
+def forklift_log(u1, u2, beta3_thesis, dt=0.05):
+    """A log of the forklift at axle origin from forward wheel speeds ``(N,)`` and thesis steering at the
+    samples: ``(N,)`` constant over each interval, or ``(N + 1,)`` (the filter uses the interval's mid-angle)."""
+    u1, u2 = np.broadcast_arrays(np.asarray(u1, dtype=float), np.asarray(u2, dtype=float))
+    n = len(u1)
+    b = np.asarray(beta3_thesis, dtype=float)
+    pos = np.zeros((n + 1, 3))
+    pos[1:, 0] = np.cumsum(u1 / R * dt)
+    pos[1:, 1] = np.cumsum(u2 / R * dt)
+    pos[:, 2] = (b if len(b) == n + 1 else np.concatenate([b[:1], b])) + np.pi / 2
+    return JointLog(np.arange(n + 1) * dt, JOINTS, pos)
+
+
+def literal_kf(c_seq, y_seq, q, r_diag, x0, p0, double_q):
+    """(7.71)-(7.75) literally, with the gain (7.73) and an m x m inverse: the reference."""
+    x, p = np.array(x0, float), np.array(p0, float)
+    out = []
+    for c, y in zip(c_seq, y_seq, strict=True):
+        p = p + q * np.eye(3)
+        k = p @ c.T @ np.linalg.inv(c @ p @ c.T + np.diag(r_diag))
+        x = x + k @ (y - c @ x)
+        p = (np.eye(3) - k @ c) @ p + (q * np.eye(3) if double_q else 0.0)
+        out.append(x)
+    return np.array(out), p
+
+
+@pytest.mark.parametrize("double_q", [False, True])
+def test_kernel_is_the_printed_recursion(double_q):
+    """The compiled information-form filter equals (7.71)-(7.75) evaluated literally (thesis frame, (7.70))."""
+    rng = np.random.default_rng(3)
+    n = 60
+    u1, u2 = 2 + 0.3 * rng.normal(size=n), 1.8 + 0.3 * rng.normal(size=n)
+    nodes = np.radians(-10) + 0.05 * rng.normal(size=n + 1)
+    b = 0.5 * (nodes[1:] + nodes[:-1])
+    k16, k17, k18 = 0.28, 3.57, 0.28
+    model = kalman_model(forklift_at_axle(), "fk2", fk2_noise(k16, k17, k18, k13=0.7), thesis_double_q=double_q)
+    x0, p0 = np.array([0.1, 2.0, 0.2]), np.diag([0.3, 0.2, 0.1])
+    run = kalman_filter(model, forklift_log(u1, u2, nodes), x0=thesis_twist_to_rep(x0), p0=p0)
+    # thesis FK2 output equation (7.70) in its own frame; state (vx, vy, omega) with x to the right
+    cs = [np.array([[1, 0, 0], [0, -1, -L12], [0, -1, L12], [np.cos(bk), np.sin(bk), L3 * np.cos(bk)]]) for bk in b]
+    ys = [np.array([0, -u1[k], -u2[k], 0]) for k in range(n)]  # phi_dot r = -u
+    p0_thesis = np.diag([0.2, 0.3, 0.1])  # (x, y) swapped: vx_thesis = -vy_rep, vy_thesis = vx_rep
+    want, p_end = literal_kf(cs, ys, 0.49, [k16**2, k17**2, k17**2, k18**2], x0, p0_thesis, double_q)
+    assert np.allclose(run.twist, thesis_twist_to_rep(want), atol=1e-9)
+    perm = [1, 0, 2]
+    sign = np.array([1, -1, 1])
+    assert np.allclose(run.covariance, (p_end[np.ix_(perm, perm)] * np.outer(sign, sign)), atol=1e-10)
+
+
+def test_fk1_without_filtering_is_the_inverse_of_c1():
+    """R << Q: FK1 reduces to x = C1^-1 y (7.76); the spec's value (-0.405, 2, 0.3) at (2.135, 1.865, 0 deg)."""
+    model = kalman_model(forklift_at_axle(), "fk1", fk1_noise(1e-6, 1e-6, k13=1e3))
+    run = kalman_filter(model, forklift_log([2.135] * 3, [1.865] * 3, [0.0] * 3))
+    assert np.allclose(run.twist[-1], thesis_twist_to_rep([-0.405, 2.0, 0.3]), atol=1e-6)
+
+
+def test_fk2_without_memory_is_wls():
+    """Q >> R: each update is the weighted least squares with mu = 1 / sigma^2 (spec §6.3)."""
+    rng = np.random.default_rng(4)
+    u1, u2, b = 2 + rng.normal(size=20), 2 + rng.normal(size=20), np.full(20, 0.2)
+    noise = KalmanNoise(1e4, 0.3, 0.3, (("right_drive", 0.1, 2.0), ("left_drive", 0.1, 2.0)))
+    run = kalman_filter(kalman_model(forklift_at_axle(), "fk2", noise), forklift_log(u1, u2, b))
+    w = SlipWeights.of({"right_drive": (100.0, 0.25), "left_drive": (100.0, 0.25), "steer": (1 / 0.09, 1.0)})
+    want = wls(forklift_at_axle(), JOINTS[:2], np.stack([u1, u2], -1) / R, b[:, None] + np.pi / 2, w).twist
+    assert np.allclose(run.twist, want, atol=1e-6)
+
+
+def test_standard_update_is_the_batch_estimate_and_the_printed_one_is_not():
+    """Erratum (7.75): the filtered state and covariance equal the batch least-squares (MAP) estimate of the
+    random walk (7.68) with all measurements so far, an independent formulation; the printed update, which adds
+    Q after the measurement as well, does not (its covariance is too large)."""
+    rng = np.random.default_rng(5)
+    n = 8
+    u1, u2, b = 2 + rng.normal(size=n), 2 + rng.normal(size=n), np.full(n, -0.15)
+    k13 = 0.5
+    noise = fk2_noise(0.3, 0.8, 0.4, k13)
+    log = forklift_log(u1, u2, b)
+    x0, p0 = np.array([2.0, 0.0, 0.0]), np.eye(3) * 0.2
+    model = kalman_model(forklift_at_axle(), "fk2", noise)
+    _, _, c, aa = model.matrices(b[:, None] + np.pi / 2)
+    rates = np.stack([u1, u2], -1) / R
+    # batch: unknowns x_1..x_n; prior x_1 ~ N(x0, p0 + Q), x_{k+1} - x_k ~ N(0, Q), rows C x_k = -A_a qdot_k
+    blocks, rhs = [], []
+    lp = np.linalg.cholesky(np.linalg.inv(p0 + k13**2 * np.eye(3))).T
+    e = np.zeros((3, 3 * n))
+    e[:, :3] = lp
+    blocks.append(e)
+    rhs.append(lp @ x0)
+    for k in range(n - 1):
+        e = np.zeros((3, 3 * n))
+        e[:, 3 * k:3 * k + 3], e[:, 3 * k + 3:3 * k + 6] = -np.eye(3) / k13, np.eye(3) / k13
+        blocks.append(e)
+        rhs.append(np.zeros(3))
+    for k in range(n):
+        e = np.zeros((len(model.sigma), 3 * n))
+        e[:, 3 * k:3 * k + 3] = c[k] / model.sigma[:, None]
+        blocks.append(e)
+        rhs.append(-(aa[k] @ rates[k]) / model.sigma)
+    big, y = np.vstack(blocks), np.concatenate(rhs)
+    sol = np.linalg.lstsq(big, y, rcond=None)[0]
+    cov_last = np.linalg.inv(big.T @ big)[-3:, -3:]
+    run = kalman_filter(model, log, x0=x0, p0=p0)
+    assert np.allclose(run.twist[-1], sol[-3:], atol=1e-9)
+    assert np.allclose(run.covariance, cov_last, atol=1e-12)
+    printed = kalman_filter(kalman_model(forklift_at_axle(), "fk2", noise, thesis_double_q=True), log, x0=x0, p0=p0)
+    assert not np.allclose(printed.covariance, cov_last, atol=1e-3)
+    assert np.all(np.linalg.eigvalsh(printed.covariance - cov_last) > 0)

@@ -1,0 +1,149 @@
+"""The three slip models (§7.4): WLS closed form (7.65)-(7.67), WLS = MCD under linear friction, MQE balance."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from slip_helpers import L3, L12, R, forklift_at_axle, thesis_twist_to_rep
+
+from wmrkit import catalog
+from wmrkit.dynamics.mass import Body
+from wmrkit.slip.models import LinearFriction, mcd, mqe, normal_loads, wls
+from wmrkit.slip.weights import SlipWeightError, SlipWeights
+
+SPINS = ("right_drive.spin", "left_drive.spin")
+
+
+def closed_form(u1, u2, beta3, k11, k12):
+    """The spec's closed form of the tricycle WLS (7.66) with mu_x12 = 1 (thesis frame, u = forward speeds)."""
+    a, b, c = 2.0, k11, k12
+    ub, dl = (u1 + u2) / 2, (u1 - u2) / (2 * L12)
+    cb, sb = np.cos(beta3), np.sin(beta3)
+    g = sb * ub + L3 * cb * dl
+    den = 1 + c * (cb**2 / a + sb**2 / (2 * b) + L3**2 * cb**2 / (2 * b * L12**2))
+    return np.stack([-(c * cb / a) * g / den, ub - (c * sb / (2 * b)) * g / den,
+                     dl - (c * L3 * cb / (2 * b * L12**2)) * g / den], axis=-1)
+
+
+def matrix_form(u1, u2, beta3, k11, k12):
+    """(7.65)-(7.66) literally: A_mu_na, A_mu_a and one 3x3 inverse (thesis frame, phi_dot = -u / r)."""
+    mx, my, m3 = 1.0, k11, k12
+    cb, sb = np.cos(beta3), np.sin(beta3)
+    ana = np.array([[np.sqrt(2 * mx), 0, 0], [0, np.sqrt(my), np.sqrt(my) * L12], [0, np.sqrt(my), -np.sqrt(my) * L12],
+                    [np.sqrt(m3) * cb, np.sqrt(m3) * sb, np.sqrt(m3) * L3 * cb]])
+    aa = np.array([[0, 0], [np.sqrt(my) * R, 0], [0, np.sqrt(my) * R], [0, 0]])
+    phi = -np.array([u1, u2]) / R
+    return -np.linalg.solve(ana.T @ ana, ana.T @ aa @ phi)
+
+
+def forklift_wls(u1, u2, beta3, k11, k12):
+    robot = forklift_at_axle()
+    w = SlipWeights.of({"right_drive": (1.0, k11), "left_drive": (1.0, k11), "steer": (k12, 1.0)})
+    # thesis beta3 (axle angle, 0 = straight) is the catalog's beta (axle +90 deg: straight) minus 90 deg;
+    # the spin of the steered wheel is free, so the axle's sign does not matter
+    return wls(robot, SPINS, np.stack([u1, u2], -1) / R, np.asarray(beta3)[..., None] + np.pi / 2, w)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(-5, 5), st.floats(-5, 5), st.floats(-1.5, 1.5), st.floats(-3, 2), st.floats(-3, 2))
+def test_general_wls_is_the_forklift_closed_form(u1, u2, beta3, lk11, lk12):
+    """(7.65)-(7.67) as a test of the general solver: the same twist for any speeds, steering and weights."""
+    k11, k12 = 10.0**lk11, 10.0**lk12
+    got = forklift_wls(u1, u2, beta3, k11, k12).twist
+    want = thesis_twist_to_rep(closed_form(u1, u2, beta3, k11, k12))
+    assert np.allclose(got, want, atol=1e-9 * (1 + abs(u1) + abs(u2)))
+    assert np.allclose(thesis_twist_to_rep(matrix_form(u1, u2, beta3, k11, k12)), want, atol=1e-9 * (1 + abs(u1)))
+
+
+def test_spec_oracles_and_consistent_inputs():
+    """The numeric WLS values of the spec's reproduction (§11) and the consistent initial state (0, 2, 0.3)."""
+    b = np.arctan(-1.35 * 0.3 / 2)
+    for k in ((3.2e-3, 19.2), (0.32, 2.0), (5.0, 0.1)):
+        assert np.allclose(forklift_wls(2.135, 1.865, b, *k).twist, thesis_twist_to_rep([0, 2, 0.3]), atol=1e-12)
+    got = forklift_wls(2.0, 2.0, np.radians(-10), 0.32, 2.0).twist
+    assert np.allclose(got, thesis_twist_to_rep([0.011657, 1.993577, 0.242849]), atol=2e-6)
+
+
+ROBOTS = ("forklift", "skid-steer-4", "mecanum-4", "thesis-diff-castor", "diff-drive", "swerve-4")
+
+
+def _inputs(robot, rng):
+    names = [n for n in robot.sensed if not n.endswith(".steer")]
+    q_a = rng.normal(size=(5, len(names))) * 5
+    beta = robot.beta + rng.normal(size=(5, len(robot.steer_names))) * 0.3
+    return names, q_a, beta
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_wls_equals_mcd_under_linear_friction(name):
+    """The equivalence theorem of §7.4.4: with F = -mu v_slip (7.59), MCD's balance equations are WLS's normal
+    equations; MCD is solved by Newton from a deliberately wrong start, WLS by least squares."""
+    robot = catalog.load(name)
+    rng = np.random.default_rng(1)
+    names, q_a, beta = _inputs(robot, rng)
+    mu = {w.name: tuple(10.0 ** rng.uniform(-2, 2, 2)) for w in robot.wheels}
+    weights = SlipWeights.of(mu)
+    law = LinearFriction.from_weights(robot, weights)
+    want = wls(robot, names, q_a, beta, weights)
+    start = wls(robot, names, q_a, beta)  # unweighted: a different answer
+    got = mcd(robot, names, q_a, law, beta, start=start)
+    assert got.converged.all()
+    scale = 1 + np.abs(want.q_dot).max()
+    assert np.allclose(got.q_dot, want.q_dot, atol=1e-7 * scale)
+    assert np.allclose(got.dissipation, want.dissipation, rtol=1e-6, atol=1e-9)
+
+
+def test_wls_minimises_the_weighted_slip():
+    """J_LS (7.53) at the WLS solution is below J_LS at any perturbed unassigned velocities."""
+    robot = catalog.load("skid-steer-4")
+    names = [n for n in robot.sensed]
+    w = SlipWeights.uniform(0.1, 1.0)
+    sol = wls(robot, names, [1.0, 2.0, 1.5, 2.5], None, w)
+    mu = w.row_mu(robot)
+    a = robot.constraint_matrix()
+    rng = np.random.default_rng(2)
+    for _ in range(20):
+        q = sol.q_dot.copy()
+        q[:3] += rng.normal(size=3) * 1e-3
+        s = a @ q
+        assert s @ (mu * s) > sol.dissipation
+
+
+def test_mqe_balances_the_centripetal_force():
+    """MQE: friction wrench = (M a_cm, c x M a_cm) with a_cm = omega J v_cm (7.40)-(7.42), computed here."""
+    robot = forklift_at_axle()
+    body = Body(2500.0, 1500.0, (-0.45, 0.0), 0.7)
+    w = SlipWeights.of({"right_drive": (1.0, 1.87), "left_drive": (1.0, 1.87), "steer": (0.645, 1.0)})
+    law = LinearFriction(tuple(x * 1e4 for x in w.row_mu(robot)))
+    beta = np.array([np.arctan(-1.35 * 0.3 / 2) + np.pi / 2])
+    sol = mqe(robot, SPINS, np.array([2.135, 1.865]) / R, law, beta, body=body)
+    assert sol.converged
+    vx, vy, om = sol.twist
+    v_cm = np.array([vx - om * 0.0, vy + om * -0.45])
+    f = 2500.0 * om * np.array([-v_cm[1], v_cm[0]])
+    wrench = robot.constraint_matrix(np.array([np.arctan(-1.35 * 0.3 / 2) + np.pi / 2]))[:, :3].T @ sol.forces
+    assert np.allclose(wrench, [f[0], f[1], -0.45 * f[1]], atol=1e-6 * np.abs(f).max())
+    plain = mcd(robot, SPINS, np.array([2.135, 1.865]) / R, law, np.array([np.arctan(-1.35 * 0.3 / 2) + np.pi / 2]))
+    assert np.allclose(plain.slip, 0, atol=1e-9)  # consistent inputs: no scrubbing in MCD
+    assert abs(sol.slip[0]) > 1e-3  # MQE: the centripetal force needs lateral slip at the drive wheels
+
+
+def test_static_normal_loads_of_the_forklift():
+    """(7.64) at rest: with l_CM / l3 = 1/3 every wheel carries a third of M g (8175 N)."""
+    loads = normal_loads(forklift_at_axle(), Body(2500.0, 1500.0, (-0.45, 0.0), 0.7))
+    assert np.allclose(loads, 2500 * 9.81 / 3)
+    # the forward-acceleration and lateral transfers of (7.64), closed form of the spec §5.8
+    ax_fwd, ay_left = 0.8, 0.5
+    loads = normal_loads(forklift_at_axle(), Body(2500.0, 1500.0, (-0.45, 0.0), 0.7), (ax_fwd, ay_left))
+    f3 = (0.45 * 2500 * 9.81 + 0.7 * 2500 * ax_fwd) / L3  # the rear steer wheel gains load
+    f1 = 0.5 * (2500 * 9.81 - f3 + 0.7 * 2500 * ay_left / L12)  # the outer (right) wheel gains load
+    assert np.allclose(loads, [f1, 2500 * 9.81 - f3 - f1, f3])
+
+
+def test_bad_weights_are_refused():
+    with pytest.raises(SlipWeightError, match="finite number > 0"):
+        SlipWeights.of({"a": (0.0, 1.0)})
+    with pytest.raises(SlipWeightError, match="lacks"):
+        SlipWeights.of({"nope": (1.0, 1.0)}).row_mu(catalog.load("diff-drive"))

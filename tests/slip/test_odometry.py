@@ -1,0 +1,113 @@
+"""Slip-aware odometry: WLS on slip-free logs is the exact odometry; FK1/FK2 streaming; the CLI's --method."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.cli.main import main
+from wmrkit.odometry.logs import JointLog, write_csv
+from wmrkit.odometry.pipeline import odometry
+from wmrkit.odometry.synthetic import TwistProfile, simulate
+from wmrkit.slip.estimators import estimator
+from wmrkit.slip.kalman import KalmanNoise
+from wmrkit.slip.weights import SlipWeights
+
+PROFILE = TwistProfile.from_segments([(2.0, 1.0, 0.0, 0.0), (3.0, 1.2, 0.0, 0.4), (2.0, 0.8, 0.0, -0.5)])
+# one arc: a steering jump at a segment boundary would fall inside a sample interval (not slip-free when sampled);
+# the drive axle's twist, the forklift's origin being at the fork tips
+FORKLIFT = TwistProfile.from_segments([(6.0, 1.2, 0.0, 0.4)]).about((-1.0, 0.0))
+
+
+@pytest.fixture(scope="module")
+def forklift_run():
+    return simulate(catalog.load("forklift"), FORKLIFT, 50.0)
+
+
+@pytest.mark.parametrize("name", ["forklift", "mecanum-4", "diff-drive"])
+def test_wls_on_slip_free_logs_is_exact_odometry(name):
+    """Without slip the sensors satisfy A dq = 0, so every weighting gives the exact poses."""
+    robot = catalog.load(name)
+    profile = {"forklift": FORKLIFT, "mecanum-4": TwistProfile.from_segments([(2.0, 0.5, 0.3, 0.2)])}.get(name, PROFILE)
+    run = simulate(robot, profile, 50.0)
+    rng = np.random.default_rng(0)
+    weights = SlipWeights.of({w.name: tuple(10.0 ** rng.uniform(-3, 3, 2)) for w in robot.wheels})
+    wls = odometry(estimator(robot, "wls", weights=weights), run.log)
+    plain = odometry(robot, run.log)
+    assert np.allclose(wls.poses, run.truth, atol=1e-9)
+    assert np.allclose(wls.poses, plain.poses, atol=1e-12)
+
+
+def test_filters_stream_in_chunks_and_track_slip_free_motion(forklift_run):
+    """FK2 over chunks equals FK2 over the whole log; on a slip-free log it stays near the truth."""
+    robot = catalog.load("forklift")
+    est = estimator(robot, "fk2", noise=KalmanNoise(2.0, 0.05, 0.05))
+    log = forklift_run.log
+    parts = []
+    whole = est.run([log], sinks=[parts.append])
+    chunked_parts = []
+    chunked = est.run([log.slice(i, i + 37) for i in range(0, len(log), 37)], sinks=[chunked_parts.append])
+    assert np.allclose(whole.final_pose, chunked.final_pose, atol=1e-12)
+    poses = np.vstack([p.poses for p in parts])
+    assert poses.shape == (len(log), 3)
+    err = np.hypot(*(poses[:, :2] - forklift_run.truth[:, :2]).T)
+    assert err.max() < 0.05 * whole.distance
+
+
+def test_cli_methods(tmp_path, forklift_run):
+    log = forklift_run.log
+    path = tmp_path / "log.csv"
+    write_csv(path, ("time", *log.joints), np.column_stack([log.time, log.positions]))
+    out = {}
+    for method in ("exact", "wls", "fk1", "fk2"):
+        assert main(["odometry", "forklift", str(path), "--method", method, "--json", "--mu", "steer=0.01,1",
+                     "--kf-noise", "2", "0.05", "0.05"]) == 0 or method == "exact"
+    import contextlib
+    import io
+
+    for method in ("exact", "wls"):
+        buf = io.StringIO()
+        with contextlib.redirect_stdout(buf):
+            args = ["odometry", "forklift", str(path), "--method", method, "--json"]
+            assert main(args + (["--mu", "steer=0.01,1"] if method == "wls" else [])) == 0
+        out[method] = json.loads(buf.getvalue())
+    assert out["wls"]["method"] == "wls (exact)"
+    assert np.allclose(out["wls"]["pose"], out["exact"]["pose"], atol=1e-9)
+    assert np.allclose(out["wls"]["pose"], forklift_run.truth[-1], atol=1e-9)
+
+
+def test_cli_refuses_bad_estimator_options(tmp_path, capsys, forklift_run):
+    log = forklift_run.log
+    path = tmp_path / "log.csv"
+    write_csv(path, ("time", *log.joints), np.column_stack([log.time, log.positions]))
+    for extra, message in ((["--method", "wls", "--mu", "steer=0,1"], "> 0"),
+                           (["--method", "wls", "--mu", "nope=1,1"], "lacks"),
+                           (["--method", "fk2", "--kf-noise", "1", "-1", "1"], "> 0"),
+                           (["--method", "wls", "--mu", "steer=abc"], "two numbers"),
+                           (["--method", "fk1", "--covariance"], "not available")):
+        assert main(["odometry", "forklift", str(path), *extra]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("wmrkit: error:") and message in err, err
+
+
+def test_filter_refuses_a_non_increasing_log():
+    robot = catalog.load("diff-drive")
+    log = JointLog(np.array([0.0, 0.1, 0.1]), ("left.spin", "right.spin"), np.zeros((3, 2)))
+    from wmrkit.odometry.logs import LogError
+
+    with pytest.raises(LogError, match="repeats"):
+        estimator(robot, "fk2").run([log])
+
+
+def test_filter_refuses_an_external_heading():
+    """A heading column would be silently ignored by the filters: refused instead."""
+    robot = catalog.load("diff-drive")
+    log = JointLog(np.array([0.0, 0.1, 0.2]), ("left.spin", "right.spin"), np.zeros((3, 2)),
+                   heading_world=np.zeros(3))
+    from wmrkit.errors import WmrkitError
+
+    with pytest.raises(WmrkitError, match="external heading"):
+        estimator(robot, "fk1").run([log])
