@@ -1,0 +1,120 @@
+"""Kinematic control (thesis ch. 8): the cost of one control tick against WPILib's, and simulation speed.
+
+- one tick of the thesis's loop for a differential drive (position law (8.2) at the point ahead of the axle, the
+  admissible twist, per-wheel IK ``wheel_commands``), against WPILib's ``RamseteController.calculate`` followed by
+  ``DifferentialDriveKinematics.toWheelSpeeds``, called once per tick from Python in both cases;
+- the same tick for a swerve-4 (full pose) against ``HolonomicDriveController.calculate`` + ``toSwerveModuleStates``;
+- both again through the single-call path :func:`wmrkit.control.tick.control_tick` (scalar law, compiled IK);
+- closed-loop simulation of the forklift on the figure-eight (30 s, continuous, ideal loops), with the real
+  truck's low-level loops at a 0.1 s period, and through the chapter-7 dynamics with Pacejka tyres at 1 kHz
+  (control at 50 Hz): how many times faster than real time (issue target for the last: 200x).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from wmrkit import catalog
+from wmrkit.control import builtin_reference, control_point, forklift_real_loops, law_controller, track
+from wmrkit.control.laws import PositionLaw
+from wmrkit.kinematics.wheel_ik import wheel_commands
+
+from ._harness import Result, best_time, peer
+
+
+def _ticks(robot, ref, n: int) -> float:
+    cp = control_point(robot)
+    ctrl = law_controller(cp, PositionLaw.uniform("p", 1.0), ref)
+    poses = ref.pose[:n] + 0.01
+    beta = robot.beta
+
+    def loop():
+        for k in range(n):
+            twist, _ = ctrl(ref.t[k], poses[k], np.zeros(3))
+            wheel_commands(robot, twist, beta)
+
+    return best_time(loop)
+
+
+def _single_call(robot, ref, n: int) -> float:
+    from wmrkit.control.tick import control_tick
+
+    tick = control_tick(robot).tick
+    twist, rates = np.zeros(3), np.zeros(len(robot.rate_names))
+    heading = np.array(robot.heading, dtype=float)
+    out = np.zeros_like(heading)
+    pose = (ref.pose[:n] + 0.01).tolist()
+    r, v = ref.pose[:n].tolist(), ref.velocity[:n].tolist()
+    tick(*pose[0], *r[0], *v[0], heading, twist, rates, out)  # compile
+
+    def loop():
+        for k in range(n):
+            tick(*pose[k], *r[k], *v[k], heading, twist, rates, out)
+
+    return best_time(loop)
+
+
+def _ramsete(n: int) -> float | None:
+    ctl, kin, geo = peer("wpimath.controller"), peer("wpimath.kinematics"), peer("wpimath.geometry")
+    if ctl is None:
+        return None
+    r, k = ctl.RamseteController(), kin.DifferentialDriveKinematics(0.4)
+    pose, goal = geo.Pose2d(0.0, 0.01, geo.Rotation2d(0.01)), geo.Pose2d(0.0, 0.0, geo.Rotation2d(0.0))
+
+    def loop():
+        for _ in range(n):
+            k.toWheelSpeeds(r.calculate(pose, goal, 0.5, 0.0))
+
+    return best_time(loop)
+
+
+def _holonomic(n: int) -> float | None:
+    ctl, kin, geo, traj = (peer("wpimath.controller"), peer("wpimath.kinematics"), peer("wpimath.geometry"),
+                           peer("wpimath.trajectory"))
+    if ctl is None:
+        return None
+    pid = ctl.PIDController(1.0, 0.0, 0.0)
+    prof = ctl.ProfiledPIDControllerRadians(1.0, 0.0, 0.0, traj.TrapezoidProfileRadians.Constraints(6.28, 3.14))
+    hdc = ctl.HolonomicDriveController(pid, ctl.PIDController(1.0, 0.0, 0.0), prof)
+    t2 = geo.Translation2d
+    k = kin.SwerveDrive4Kinematics(t2(0.28, 0.28), t2(0.28, -0.28), t2(-0.28, 0.28), t2(-0.28, -0.28))
+    pose, goal = geo.Pose2d(0.0, 0.01, geo.Rotation2d(0.01)), geo.Pose2d(0.0, 0.0, geo.Rotation2d(0.0))
+
+    def loop():
+        for _ in range(n):
+            k.toSwerveModuleStates(hdc.calculate(pose, goal, 0.5, geo.Rotation2d(0.0)))
+
+    return best_time(loop)
+
+
+def run(quick: bool) -> list[Result]:
+    """Per-tick costs against WPILib (ratio = WPILib time / ours) and closed-loop simulation speed."""
+    n = 2_000 if quick else 20_000
+    ref = builtin_reference("figure-eight")
+    out = [Result("diff-drive tick: law (8.2) + point twist + IK", n, _ticks(catalog.load("diff-drive"), ref, n),
+                  "wpimath Ramsete + toWheelSpeeds", _ramsete(n)),
+           Result("swerve-4 tick: law (8.2) + IK (closest angle)", n, _ticks(catalog.load("swerve-4"), ref, n),
+                  "wpimath HolonomicDriveController + toSwerveModuleStates", _holonomic(n))]
+    out += [Result("diff-drive single-call tick (control_tick)", n, _single_call(catalog.load("diff-drive"), ref, n),
+                   "wpimath Ramsete + toWheelSpeeds", _ramsete(n), target="no slower than WPILib"),
+            Result("swerve-4 single-call tick (control_tick)", n, _single_call(catalog.load("swerve-4"), ref, n),
+                   "wpimath HolonomicDriveController + toSwerveModuleStates", _holonomic(n),
+                   target="no slower than WPILib")]
+    fork = catalog.load("forklift")
+    for label, kwargs in (("ideal, continuous", {}),
+                          ("real loops, T = 0.1 s", {"loops": forklift_real_loops(), "period": 0.1, "delay": 1}),
+                          ("dynamics + Pacejka 1 kHz, T = 0.02 s", {"dynamics": True, "period": 0.02})):
+        duration = 10.0 if quick else 30.0
+        t0 = time.perf_counter()
+        track(fork, ref, gain=0.5, duration=duration, **kwargs)
+        wall = time.perf_counter() - t0
+        out.append(Result(f"forklift figure-eight {duration:g} s, {label}", int(duration * 1000), wall,
+                          "real time", duration, target=f"{duration / wall:.0f}x faster than real time"))
+    return out
+
+
+if __name__ == "__main__":
+    for r in run(quick=True):
+        print(r.line())

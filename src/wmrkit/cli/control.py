@@ -1,0 +1,130 @@
+"""``wmrkit track`` (closed-loop tracking, thesis ch. 8) and ``wmrkit feasibility`` (Table 8.1)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import warnings
+
+from ..errors import WmrkitError
+from ._common import add_json_flag, add_robot_argument, load_robot, parse_value, print_json
+
+
+def add_parsers(commands: argparse._SubParsersAction) -> None:
+    """Register ``track`` and ``feasibility``."""
+    p = commands.add_parser("track", help="track a reference in closed loop (thesis ch. 8): P, PI, pure pursuit, "
+                                          "Stanley; continuous or sampled")
+    add_robot_argument(p)
+    _reference_options(p)
+    p.add_argument("--from", dest="start", nargs=3, metavar=("X", "Y", "THETA"),
+                   help="initial pose: x, y [m], theta (radians, or degrees with 'deg'); default on the reference")
+    p.add_argument("--controller", default="p", choices=("p", "pi", "point", "pure-pursuit", "stanley"),
+                   help="p: P + feedforward (8.2); pi: PI + feedforward (8.3); point: (8.1); or a geometric tracker")
+    p.add_argument("--gain", default="1", metavar="A", help="pole a [1/s] of the position loop (default 1)")
+    p.add_argument("--gate", metavar="D", help="apply the feedforward only within D [m] of the reference (8.53)")
+    p.add_argument("--period", metavar="T", help="sample period [s]; without it the loop is continuous")
+    p.add_argument("--delay", type=int, default=0, metavar="N", help="measurement delay in samples (with --period)")
+    p.add_argument("--duration", metavar="S", help="seconds to simulate (default: the reference's length)")
+    p.add_argument("--steering", default="closest", choices=("closest", "4-quadrant", "2-quadrant"),
+                   help="which of the two steering solutions (8.9) a wheel takes (within its steer_range)")
+    p.add_argument("--dynamics", action="store_true",
+                   help="close the loop through the chapter-7 dynamics with tyres (needs mass properties; "
+                        "period default 0.02 s)")
+    p.add_argument("--plot", metavar="FILE", help="save a plot of the run (PNG/SVG/PDF)")
+    p.add_argument("--animate", metavar="FILE", help="save an animation of the run (GIF)")
+    add_json_flag(p)
+    p.set_defaults(run=run_track)
+
+    p = commands.add_parser("feasibility", help="which continuity a reference needs for this robot (Table 8.1), "
+                                                "where it breaks it, and the remedy")
+    add_robot_argument(p)
+    _reference_options(p)
+    p.add_argument("--framework", default="kinematic", choices=("kinematic", "dynamic"),
+                   help="kinematic: wheel rates may jump; dynamic: they must be continuous (§8.5)")
+    p.add_argument("--plot", metavar="FILE", help="save a plot of the reference with its violations")
+    add_json_flag(p)
+    p.set_defaults(run=run_feasibility)
+
+
+def _reference_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--reference", required=True, metavar="FILE|NAME",
+                   help="line, circle, figure-eight, square, arc-line, corner; or a TUM / CSV (t,x,y,theta) file")
+    p.add_argument("--speed", metavar="V", help="speed of a built-in reference [m/s] (default 0.5)")
+    p.add_argument("--size", metavar="L", help="size of a built-in reference [m] (radius, side...)")
+
+
+def _reference(args: argparse.Namespace):
+    from ..control.references import resolve_reference
+
+    speed = None if args.speed is None else _positive(args.speed, "--speed", "number")
+    size = None if args.size is None else _positive(args.size, "--size", "length")
+    return resolve_reference(args.reference, speed=speed, size=size)
+
+
+def _positive(text: str, what: str, kind: str = "number") -> float:
+    value = parse_value(text, kind, what)  # type: ignore[arg-type]
+    if not value > 0 or value == float("inf"):
+        raise WmrkitError(f"{what}: expected a positive number, got {text}")
+    return value
+
+
+def run_track(args: argparse.Namespace) -> int:
+    """Simulate, then print a summary (or the time series as JSON); warnings on stderr."""
+    from ..control.laws import SamplingWarning
+    from ..control.track import track
+
+    robot, reference = load_robot(args.robot), _reference(args)
+    start = None
+    if args.start:
+        start = [parse_value(args.start[0], "length", "--from X"), parse_value(args.start[1], "length", "--from Y"),
+                 parse_value(args.start[2], "angle", "--from THETA")]
+    gain = parse_value(args.gain, "number", "--gain")
+    period = None if args.period is None else _positive(args.period, "--period")
+    duration = None if args.duration is None else _positive(args.duration, "--duration")
+    gate = None if args.gate is None else _positive(args.gate, "--gate", "length")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", SamplingWarning)
+        run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
+                    period=period, delay=args.delay, duration=duration, policy=args.steering, dynamics=args.dynamics)
+    for w in caught:
+        if issubclass(w.category, SamplingWarning):
+            print(f"wmrkit: warning: {w.message}", file=sys.stderr)
+    if args.plot or args.animate:
+        from ..control.plots import animate_run, plot_run
+
+        if args.plot:
+            plot_run(run, args.plot)
+        if args.animate:
+            animate_run(run, args.animate)
+    if args.json:
+        print_json(run.to_dict())
+    else:
+        s = run.summary()
+        print(f"robot {robot.name}, reference {reference.name}, controller {args.controller}, "
+              f"{'continuous' if run.period is None else f'period {run.period:g} s, delay {args.delay}'}"
+              f"{', through the dynamics' if args.dynamics else ''}")
+        print(f"tracking error [m]: rms {s['rms_error']:.4g}, max {s['max_error']:.4g}, final {s['final_error']:.4g}")
+        print(f"cross-track error [m]: rms {s['rms_cross_track']:.4g}, max {s['max_cross_track']:.4g}")
+    return 0
+
+
+def run_feasibility(args: argparse.Namespace) -> int:
+    """Print the Table 8.1 requirement and every violation with its remedy."""
+    from ..control.feasibility import feasibility
+
+    robot, reference = load_robot(args.robot), _reference(args)
+    result = feasibility(robot, reference, args.framework)
+    if args.plot:
+        from ..control.plots import plot_feasibility
+
+        plot_feasibility(result, reference, args.plot)
+    if args.json:
+        print_json(result.to_dict())
+        return 0
+    r = result.requirement
+    print(f"robot {robot.name}: Table 8.1 column '{r.column}', {r.references} pose references; "
+          f"{r.framework} framework needs continuous: {', '.join(r.signals)}")
+    print("feasible: yes" if result.feasible else f"feasible: NO ({len(result.violations)} violation(s))")
+    for v in result.violations:
+        print(f"  t = {v.t:8.3f} s  {v.kind}, jump {v.size:.3g}: {v.remedy}")
+    return 0

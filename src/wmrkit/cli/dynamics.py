@@ -1,0 +1,194 @@
+"""``wmrkit tyre`` (traction models, thesis §7.3) and ``wmrkit simulate`` (the dynamic model, §7.2)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import WmrkitError
+from ._common import add_json_flag, add_robot_argument, load_robot, parse_assignments, parse_value, print_json
+
+
+def add_parsers(commands: argparse._SubParsersAction) -> None:
+    """Register ``tyre`` and ``simulate``."""
+    from ..dynamics.programs import PATHS
+    from ..dynamics.tyres import TYRES
+
+    p = commands.add_parser("tyre", help="tyre forces of a traction model at a slip ratio and slip angle (thesis 7.3)")
+    p.add_argument("model", metavar="MODEL", choices=list(TYRES), help=f"one of: {', '.join(TYRES)}")
+    p.add_argument("--load", required=True, metavar="FZ", help="normal load [N]")
+    p.add_argument("--slip-ratio", default="0", metavar="S",
+                   help="longitudinal slip ratio (7.31), > -1; positive: the contact slides forward (braking)")
+    p.add_argument("--slip-angle", default="0", metavar="A",
+                   help="slip angle (7.35): radians, or degrees with 'deg'; positive: the contact slides left")
+    p.add_argument("--speed", default="2", metavar="V", help="wheel speed [m/s] (pacejka's coefficients use it)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a model parameter (repeat)")
+    p.add_argument("--plot", metavar="FILE", help="plot the curves against slip ratio and slip angle (png/svg/pdf)")
+    add_json_flag(p)
+    p.set_defaults(run=run_tyre)
+
+    p = commands.add_parser("simulate", help="simulate the dynamic model from joint torques (thesis 7.2)")
+    add_robot_argument(p)
+    source = p.add_mutually_exclusive_group(required=True)
+    source.add_argument("--torques", metavar="FILE", help="CSV 'time,<wheel>.spin,...' of torques [N m]")
+    source.add_argument("--path", metavar="NAME", choices=list(PATHS), help=f"built-in program: {', '.join(PATHS)}")
+    p.add_argument("--tyre", choices=list(TYRES), help="tyre model for every wheel (default: each wheel's own)")
+    p.add_argument("--duration", metavar="S", help="simulated time [s] (default: the program's or the file's)")
+    p.add_argument("--step", default="0.001", metavar="DT", help="integration step [s] (default 0.001)")
+    p.add_argument("--method", default="semi-implicit", choices=["semi-implicit", "rk4", "adaptive"])
+    p.add_argument("--speed", default="2", metavar="V", help="speed of a --path program [m/s] (default 2)")
+    p.add_argument("--initial-twist", nargs=3, metavar=("VX", "VY", "OMEGA"), help="initial twist (rolling)")
+    p.add_argument("--out", metavar="FILE", help="write the samples: .csv (one row per sample) or .json")
+    p.add_argument("--plot", metavar="FILE", help="plot the path and the twist (png/svg/pdf)")
+    add_json_flag(p)
+    p.set_defaults(run=run_simulate)
+
+
+def run_tyre(args: argparse.Namespace) -> int:
+    """Print the forces (and plot the curves)."""
+    from ..dynamics.tyres import Tyre
+
+    params = {k: parse_value(v, "number", f"--param {k}") for k, v in parse_assignments(args.param, "--param").items()}
+    tyre = Tyre.of(args.model, params)
+    load = _positive(parse_value(args.load, "number", "--load"), "--load", zero=True)
+    s = parse_value(args.slip_ratio, "number", "--slip-ratio")
+    a = parse_value(args.slip_angle, "angle", "--slip-angle")
+    speed = _positive(parse_value(args.speed, "number", "--speed"), "--speed")
+    f = tyre.forces_at_slip(load, s, a, speed)
+    fx, fy = float(f.longitudinal) + 0.0, float(f.lateral) + 0.0  # no "-0"
+    if not (math.isfinite(fx) and math.isfinite(fy)):
+        raise WmrkitError("the model gives no finite force at these inputs")
+    if args.plot:
+        _plot_tyre(tyre, load, s, a, speed, args.plot)
+    if args.json:
+        print_json({"model": tyre.model, "params": tyre.as_dict(), "load": load, "slip_ratio": s, "slip_angle": a,
+                    "speed": speed, "Fx": fx, "Fy": fy, "mu_long": -fx / load if load else 0.0,
+                    "mu_lat": -fy / load if load else 0.0})
+    else:
+        print(f"{tyre.model} tyre, load {load:g} N, slip ratio {s:g}, slip angle {a:g} rad, wheel speed {speed:g} m/s")
+        print(f"Fx (longitudinal) = {fx:.6g} N")
+        print(f"Fy (lateral)      = {fy:.6g} N")
+        print("(force of the ground on the tyre, opposing the slip)")
+    return 0
+
+
+def run_simulate(args: argparse.Namespace) -> int:
+    """Simulate, print a summary, write and plot on request."""
+    from ..dynamics.model import DynamicModel
+    from ..dynamics.programs import path_program, read_torques
+    from ..dynamics.simulate import simulate
+
+    model = DynamicModel.of(load_robot(args.robot), args.tyre)
+    speed = _positive(parse_value(args.speed, "number", "--speed"), "--speed")
+    if args.path:
+        inputs, duration = path_program(model, args.path, speed=speed)
+    else:
+        inputs = read_torques(model, args.torques)
+        duration = float(inputs.time[-1])
+        if duration <= 0 and args.duration is None:
+            raise WmrkitError(f"{args.torques}: the file ends at t = {duration:g} s: give --duration")
+    if args.duration is not None:
+        duration = _positive(parse_value(args.duration, "number", "--duration"), "--duration")
+    step = _positive(parse_value(args.step, "number", "--step"), "--step")
+    if duration <= 0 or step > duration or duration / step > 5e7:
+        raise WmrkitError(f"--duration {duration:g} s and --step {step:g} s: need 0 < step <= duration and at most "
+                          "5e7 steps")
+    twist = [0.0, 0.0, 0.0] if args.initial_twist is None else [
+        parse_value(v, "number", "--initial-twist") for v in args.initial_twist]
+    sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
+                   record_step=max(step, 0.01), progress=False if args.json else None)
+    if args.out:
+        _write(sim, args.out)
+    if args.plot:
+        _plot_simulation(sim, model.robot.name, args.plot)
+    pose, tw = sim.pose[-1], sim.twist[-1]
+    travelled = float(np.sum(np.hypot(*np.diff(sim.pose[:, :2], axis=0).T)))
+    if args.json:
+        print_json({"robot": model.robot.name, "method": sim.method, "step": step, "duration": duration,
+                    "samples": len(sim.t), "final_pose": pose.tolist(), "final_twist": tw.tolist(),
+                    "distance": travelled, "max_slip": float(np.abs(sim.slip).max()), "out": args.out})
+    else:
+        print(f"{model.robot.name}: {duration:g} s simulated ({sim.method}, step {step:g} s), {len(sim.t)} samples")
+        print(f"final pose: x = {pose[0]:.6g} m, y = {pose[1]:.6g} m, theta = {pose[2]:.6g} rad")
+        print(f"final twist: vx = {tw[0]:.6g} m/s, vy = {tw[1]:.6g} m/s, omega = {tw[2]:.6g} rad/s")
+        print(f"distance travelled: {travelled:.6g} m; largest slip speed {np.abs(sim.slip).max():.3g} m/s")
+    return 0
+
+
+def _positive(x: float, what: str, *, zero: bool = False) -> float:
+    if x < 0 or (x == 0 and not zero):
+        raise WmrkitError(f"{what}: must be {'>= 0' if zero else '> 0'}, got {x:g}")
+    return x
+
+
+def _write(sim, out: str) -> None:
+    path = Path(out)
+    try:
+        if path.suffix.lower() == ".json":
+            import json
+
+            path.write_text(json.dumps(sim.to_dict()) + "\n", encoding="utf-8")
+            return
+        cols = ["time", "x", "y", "theta", "vx", "vy", "omega", *(f"{j}.position" for j in sim.joint_names),
+                *(f"{j}.rate" for j in sim.joint_names), *(f"{c}.{k}" for c in sim.contacts for k in
+                                                           ("f_lat", "f_long", "load"))]
+        data = np.column_stack([sim.t, sim.pose, sim.twist, sim.joint_positions, sim.joint_rates,
+                                np.concatenate([sim.forces, sim.loads[..., None]], axis=-1).reshape(len(sim.t), -1)])
+        np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.9g")
+    except OSError as err:
+        raise WmrkitError(f"--out {out}: cannot write ({err.strerror or err})") from None
+
+
+def _savefig(fig, out: str) -> None:
+    try:
+        fig.savefig(out)
+    except (OSError, ValueError) as err:
+        raise WmrkitError(f"--plot {out}: cannot write ({getattr(err, 'strerror', None) or err})") from None
+
+
+def _plot_tyre(tyre, load: float, s: float, a: float, speed: float, out: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
+    ss = np.linspace(-0.9, 1.0, 381)
+    aa = np.linspace(-1.2, 1.2, 481)
+    f1, f2 = tyre.forces_at_slip(load, ss, a, speed), tyre.forces_at_slip(load, s, aa, speed)
+    ax1.plot(ss, f1.longitudinal, label="Fx (longitudinal)")
+    ax1.plot(ss, f1.lateral, label="Fy (lateral)")
+    ax1.set(xlabel="slip ratio", ylabel="force [N]", title=f"slip angle {a:g} rad")
+    ax2.plot(aa, f2.lateral, label="Fy (lateral)")
+    ax2.plot(aa, f2.longitudinal, label="Fx (longitudinal)")
+    ax2.set(xlabel="slip angle [rad]", title=f"slip ratio {s:g}")
+    for ax in (ax1, ax2):
+        ax.grid(True)
+        ax.legend()
+    fig.suptitle(f"{tyre.model} tyre, load {load:g} N, wheel speed {speed:g} m/s")
+    fig.tight_layout()
+    _savefig(fig, out)
+    plt.close(fig)
+
+
+def _plot_simulation(sim, name: str, out: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
+    ax1.plot(sim.pose[:, 0], sim.pose[:, 1])
+    ax1.set(xlabel="x [m]", ylabel="y [m]", title=f"{name}: path", aspect="equal")
+    for k, label in enumerate(("vx [m/s]", "vy [m/s]", "omega [rad/s]")):
+        ax2.plot(sim.t, sim.twist[:, k], label=label)
+    ax2.set(xlabel="time [s]", title="twist (robot frame)")
+    for ax in (ax1, ax2):
+        ax.grid(True)
+    ax2.legend()
+    fig.tight_layout()
+    _savefig(fig, out)
+    plt.close(fig)

@@ -1,0 +1,199 @@
+"""Which references a robot can follow with zero error (thesis §8.5, Table 8.1), where a reference breaks that, and
+the remedy.
+
+The column of Table 8.1 follows from the vehicle type (:func:`wmrkit.analysis.classify`) and where the tracking
+point (the robot origin R, or a given point) lies: on the fixed axle (``beta_f - alpha_f = 0``) or off it, and for
+types 3 and 5 whether some steered wheel is away from it (``l_oi != 0``). The *kinematic* framework lets wheel
+rates jump; the *dynamic* one needs them continuous, so every condition goes one derivative higher (§8.5).
+
+Signals of the reference, sampled: position, tangent angle ``chi`` (8.29) and its rate ``omega_g`` (8.31),
+curvature ``kappa`` (8.33) and its rate, heading ``theta``, velocity and acceleration. A sample-to-sample change
+larger than ``jump_factor`` times the typical one and than an absolute floor is a discontinuity.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from ..analysis.classification import classify
+from ..robot import Robot
+from .points import ControlError, control_point
+from .references import Reference
+
+__all__ = ["COLUMNS", "Feasibility", "Requirement", "Violation", "feasibility", "requirement"]
+
+_VEHICLE = "stop and re-orient the vehicle"
+_WHEEL = "stop and re-orient the orientable wheel"
+_WHEELS = "stop and re-orient the orientable wheels"
+#: Table 8.1: column -> (pose references, kinematic signals, dynamic signals, remedy, footnote).
+COLUMNS: dict[str, tuple[int, tuple[str, ...], tuple[str, ...], str]] = {
+    "type 1": (3, ("position", "theta"), ("velocity", "omega"), "the reference must be continuous"),
+    "type 2, off axle": (2, ("position",), ("velocity",), "the reference must be continuous"),
+    "type 2, on axle": (2, ("position", "chi"), ("position", "chi", "chi_rate"), _VEHICLE),
+    "type 4, off axle": (2, ("position", "chi"), ("position", "chi", "chi_rate"), _WHEEL),
+    "type 4, on axle": (2, ("position", "chi", "kappa"), ("position", "chi", "kappa", "kappa_rate"),
+                        _WHEEL + " (both tangent and curvature jump: the vehicle, re-orienting the wheel twice)"),
+    "types 3 and 5, l_o != 0": (3, ("position", "theta", "velocity", "omega"),
+                                ("position", "theta", "velocity", "omega", "acceleration"), _WHEELS),
+    "type 3, l_o = 0": (3, ("position", "theta", "chi"), ("position", "theta", "chi", "velocity", "omega", "chi_rate"),
+                        _WHEEL),
+}
+#: What each signal's continuity means in the thesis's words.
+KINDS = {"position": "position jump (p_ref not C0)", "theta": "heading jump (theta_ref not C0)",
+         "velocity": "velocity jump (p_ref not C1)", "omega": "heading-rate jump (theta_ref not C1)",
+         "acceleration": "acceleration jump (p_ref not C2)", "chi": "tangent-angle jump (chi not C0)",
+         "chi_rate": "turn-rate jump (chi not C1)", "kappa": "curvature jump (kappa not C0)",
+         "kappa_rate": "curvature-rate jump (kappa not C1)"}
+
+
+@dataclass(frozen=True)
+class Requirement:
+    """The Table 8.1 cell of a robot: ``column``, vehicle ``type``, number of pose ``references`` (2 or 3), the
+    ``signals`` that must be continuous in the chosen ``framework``, and the ``remedy`` when one is not."""
+
+    column: str
+    type: int
+    references: int
+    framework: str
+    signals: tuple[str, ...]
+    remedy: str
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One discontinuity of the reference: time ``t`` [s], ``signal``, ``kind`` (text), ``size`` of the jump
+    (m, rad, m/s, ... per signal), ``remedy``."""
+
+    t: float
+    signal: str
+    kind: str
+    size: float
+    remedy: str
+
+    def to_dict(self) -> dict[str, object]:
+        """``{"t", "kind", "signal", "size", "remedy"}``."""
+        return {"t": self.t, "kind": self.kind, "signal": self.signal, "size": self.size, "remedy": self.remedy}
+
+
+@dataclass(frozen=True)
+class Feasibility:
+    """Result of :func:`feasibility`: ``feasible`` and the ``violations`` of ``requirement``."""
+
+    requirement: Requirement
+    violations: tuple[Violation, ...]
+
+    @property
+    def feasible(self) -> bool:
+        """No violation: the reference is followed with zero error by ideal blocks from matching initial conditions."""
+        return not self.violations
+
+    def to_dict(self) -> dict[str, object]:
+        """``{"feasible", "column", "type", "framework", "signals", "violations": [...]}`` (the CLI's JSON)."""
+        r = self.requirement
+        return {"feasible": self.feasible, "column": r.column, "type": r.type, "framework": r.framework,
+                "signals": list(r.signals), "violations": [v.to_dict() for v in self.violations]}
+
+
+def requirement(robot: Robot, framework: Literal["kinematic", "dynamic"] = "kinematic", *,
+                point: tuple[float, float] | None = None) -> Requirement:
+    """The Table 8.1 cell of `robot` tracked at `point` (default: its origin R, as in the thesis)."""
+    if framework not in ("kinematic", "dynamic"):
+        raise ControlError(f"framework must be 'kinematic' or 'dynamic', got {framework!r}")
+    c = classify(robot)
+    if c.type is None:
+        raise ControlError(f"robot '{robot.name}' is degenerate ({'; '.join(c.reasons)}): Table 8.1 does not apply")
+    p = np.zeros(2) if point is None else np.asarray(point, dtype=float)
+    if c.type in (2, 4):
+        on_axle = _on_axle(robot, p)
+        column = f"type {c.type}, {'on' if on_axle else 'off'} axle"
+    elif c.type == 1:
+        column = "type 1"
+    else:
+        steered = [w for w in robot.wheels if w.type in ("steerable", "double")]
+        away = any(np.hypot(*(np.asarray(w.position) - p)) > 1e-9 for w in steered)
+        column = "types 3 and 5, l_o != 0" if (away or c.type == 5) else "type 3, l_o = 0"
+    refs, kin, dyn, remedy = COLUMNS[column]
+    return Requirement(column, c.type, refs, framework, kin if framework == "kinematic" else dyn, remedy)
+
+
+def _on_axle(robot: Robot, p: np.ndarray) -> bool:
+    """The point's velocity cannot be assigned in the admissible twist space: it lies on the fixed axle."""
+    try:
+        control_point(robot, (float(p[0]), float(p[1])), reduced=True)
+    except ControlError:
+        return True
+    return False
+
+
+def signals(reference: Reference, *, speed_tol: float = 1e-6) -> dict[str, np.ndarray]:
+    """The sampled signals of `reference` ``(n,)`` each (NaN where undefined: ``chi`` and ``kappa`` at rest)."""
+    p, v, a = reference.pose, reference.velocity, reference.acceleration
+    speed = np.hypot(v[:, 0], v[:, 1])
+    moving = speed > speed_tol
+    with np.errstate(invalid="ignore", divide="ignore"):
+        chi = np.where(moving, np.arctan2(v[:, 1], v[:, 0]), np.nan)
+        cross = v[:, 0] * a[:, 1] - v[:, 1] * a[:, 0]
+        kappa = np.where(moving, cross / speed**3, np.nan)
+        chi_rate = np.where(moving, cross / speed**2, np.nan)
+    t = reference.t
+    return {"position": p[:, :2], "theta": p[:, 2], "velocity": v[:, :2], "omega": v[:, 2], "acceleration": a[:, :2],
+            "chi": chi, "chi_rate": chi_rate, "kappa": kappa,
+            "kappa_rate": np.gradient(np.nan_to_num(kappa), t) * (t[1] - t[0])}
+
+
+_FLOOR = {"position": 1e-3, "theta": 0.02, "velocity": 0.02, "omega": 0.02, "acceleration": 0.05, "chi": 0.05,
+          "chi_rate": 0.02, "kappa": 0.02, "kappa_rate": 0.02}
+
+
+def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float) -> list[tuple[int, float]]:
+    x = x.reshape(len(x), -1)
+    d = np.diff(x, axis=0)
+    if angle:
+        d = np.pi - np.mod(np.pi - d, 2 * np.pi)
+    size = np.sqrt(np.nansum(d * d, axis=-1))
+    size[np.any(np.isnan(d), axis=-1)] = 0.0
+    typical = np.median(size) if len(size) else 0.0
+    hit = np.flatnonzero(size > max(floor, factor * typical))
+    out: list[tuple[int, float]] = []
+    for k in hit:  # a jump spread over consecutive samples (finite differences) is one event
+        if out and k - out[-1][0] <= 2:
+            if size[k] > out[-1][1]:
+                out[-1] = (out[-1][0], float(size[k]))
+            continue
+        out.append((int(k), float(size[k])))
+    return out
+
+
+def feasibility(robot: Robot, reference: Reference, framework: Literal["kinematic", "dynamic"] = "kinematic", *,
+                point: tuple[float, float] | None = None, jump_factor: float = 20.0) -> Feasibility:
+    """Check `reference` against the Table 8.1 cell of `robot` (§8.5): every discontinuity and its remedy."""
+    req = requirement(robot, framework, point=point)
+    sig = signals(reference)
+    found: list[Violation] = []
+    for name in req.signals:
+        x = sig[name]
+        if name == "kappa_rate":
+            x = x / (reference.t[1] - reference.t[0])
+        floor = _FLOOR[name]
+        for k, size in _jumps(x, name in ("theta", "chi"), floor, jump_factor):
+            t = float(reference.t[k + 1])
+            if any(v.t == t and v.signal in ("chi", "position") for v in found) and name != "position":
+                continue  # already reported by a lower-order signal at the same instant
+            found.append(Violation(t, name, KINDS[name], size, _remedy(req, name)))
+    found.sort(key=lambda v: v.t)
+    return Feasibility(req, tuple(found))
+
+
+def _remedy(req: Requirement, signal: str) -> str:
+    if signal == "position":
+        return "the reference jumps: no vehicle can follow it; the position loop removes the error afterwards"
+    if req.column == "type 4, on axle" and signal == "chi":
+        return (f"{_VEHICLE}, re-orienting the orientable wheel twice (tangent and curvature both jump)")
+    if req.column == "type 4, on axle" and signal == "kappa":
+        return _WHEEL
+    if req.column.startswith("type 1") or req.column.startswith("type 2, off"):
+        return "an error appears that the position loop then removes (kinematics allows no jump here)"
+    return req.remedy

@@ -1,0 +1,94 @@
+"""Position control of the kinematic loop (thesis §8.3): laws (8.1)-(8.3), the gated feedforward (8.53).
+
+A law maps the reference ``(p_ref, p_dot_ref)`` and the estimated pose ``p`` (all in the world frame, G) to the
+velocity to impose, ``p_dot_control``. With diagonal gains ``A_c = diag(a)`` and ``B_c = diag(b)`` [1/s, 1/s^2]:
+
+- ``"point"`` (8.1): ``A_c (p_ref - p)``; constant error for ramps, rejected by the thesis.
+- ``"p"`` (8.2): ``p_dot_ref + A_c (p_ref - p)``; error ``e(t) = e(0) exp(-a t)`` per coordinate (8.5).
+- ``"pi"`` (8.3): ``p_dot_ref + A_c e + B_c int(e)``; second-order error (8.6), rejects a dead zone.
+
+``gate`` [m] (8.53): the feedforward is applied only while the position error is at most ``gate`` (a binary switch:
+the thesis warns that weighting it continuously leaves a steady-state error). Heading errors are wrapped to
+``(-pi, pi]``. Reduced references (types 2, 4) use the first two coordinates only.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from .points import ControlError
+
+__all__ = ["KINDS", "PositionLaw", "SamplingWarning", "check_sampling", "law_velocity"]
+
+KINDS = ("point", "p", "pi")
+
+
+class SamplingWarning(UserWarning):
+    """The discrete loop breaks the rule 1/a >= 10 T (§8.3, §9.2.2)."""
+
+
+@dataclass(frozen=True)
+class PositionLaw:
+    """A position-control law of §8.3: ``kind`` in :data:`KINDS`, gains ``a`` [1/s] and ``b`` [1/s^2] per
+    coordinate ``(x, y, theta)``, optional feedforward ``gate`` [m] (8.53). Frozen."""
+
+    kind: Literal["point", "p", "pi"] = "p"
+    a: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    b: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    gate: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ControlError(f"unknown position law '{self.kind}' (laws: {', '.join(KINDS)})")
+        for name, gains in (("a", self.a), ("b", self.b)):
+            if len(gains) != 3 or not all(math.isfinite(g) and g >= 0 for g in gains):
+                raise ControlError(f"gain {name}: expected three finite numbers >= 0, got {gains}")
+        if self.gate is not None and not (self.gate > 0 and math.isfinite(self.gate)):
+            raise ControlError(f"feedforward gate: expected a distance > 0 m, got {self.gate}")
+
+    @classmethod
+    def uniform(cls, kind: Literal["point", "p", "pi"] = "p", a: float = 1.0, b: float = 0.0,
+                gate: float | None = None) -> PositionLaw:
+        """The same pole `a` (and `b`) on every coordinate."""
+        return cls(kind, (a, a, a), (b, b, b), gate)
+
+
+def pose_error(pose_ref: np.ndarray, pose: np.ndarray) -> np.ndarray:
+    """``p_ref - p`` with the heading difference wrapped to (-pi, pi]. ``(..., 3), (..., 3) -> (..., 3)``."""
+    e = np.asarray(pose_ref, dtype=float) - np.asarray(pose, dtype=float)
+    e[..., 2] = np.pi - np.mod(np.pi - e[..., 2], 2 * np.pi)
+    return e
+
+
+def law_velocity(law: PositionLaw, pose_ref: np.ndarray, velocity_ref: np.ndarray, pose: np.ndarray,
+                 integral: np.ndarray) -> np.ndarray:
+    """``p_dot_control`` [world frame] of (8.1)-(8.3)/(8.53) for one instant. ``(3,) x 4 -> (3,)``.
+
+    `integral` is ``int (p_ref - p) dt`` (used by ``"pi"`` only).
+    """
+    e = pose_error(pose_ref, pose)
+    out = np.asarray(law.a) * e
+    if law.kind != "point":
+        ff = 1.0
+        if law.gate is not None and math.hypot(e[0], e[1]) > law.gate:
+            ff = 0.0
+        out = out + ff * np.asarray(velocity_ref, dtype=float)
+    if law.kind == "pi":
+        out = out + np.asarray(law.b) * integral
+    return out
+
+
+def check_sampling(law: PositionLaw, period: float, *, factor: float = 10.0, stacklevel: int = 2) -> bool:
+    """Whether ``1/a >= factor * T`` for every pole (§8.3); warns :class:`SamplingWarning` when not."""
+    fastest = max(law.a)
+    ok = fastest == 0 or 1.0 / fastest >= factor * period * (1 - 1e-12)
+    if not ok:
+        warnings.warn(f"discrete loop: 1/a = {1 / fastest:.3g} s < {factor:g} T = {factor * period:.3g} s "
+                      f"(thesis §8.3): expect oscillation; unstable with a one-sample delay once a T > 1",
+                      SamplingWarning, stacklevel=stacklevel)
+    return ok

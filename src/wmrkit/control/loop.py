@@ -1,0 +1,253 @@
+"""The kinematic loop of §8.2 (Fig. 8.1), closed in continuous time (scipy ``solve_ivp``) or at a sample period.
+
+Each instant: position control (a :class:`~wmrkit.control.laws.PositionLaw`, or a geometric tracker) gives the
+velocity to impose; :func:`~wmrkit.control.points.twist_for_velocity` turns it into an admissible body twist;
+:func:`~wmrkit.kinematics.wheel_ik.wheel_commands` gives every wheel's command at the current steering (castor
+angles fed back, §8.4.3); the steering policy and ranges pick the roots (:mod:`.steering`). The plant is ideal
+(the robot moves with the commanded twist) or goes through low-level loops (:mod:`.actuators`), the twist then
+being the least-squares one (4.11) of the joints' actual rates at the actual steering. The pose is measured
+exactly, optionally ``delay`` samples late (discrete loop).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kinematics.wheel_ik import forward_kinematics, wheel_commands
+from ..robot import Robot
+from .actuators import LowLevelLoops
+from .laws import PositionLaw, law_velocity, pose_error
+from .points import ControlError, ControlPoint, point_pose, twist_for_velocity
+from .references import Reference
+from .steering import choose_steering, discretize_twist, steer_ranges
+
+__all__ = ["Plant", "TwistController", "law_controller", "simulate"]
+
+#: ``(t, measured pose (3,), integral (3,)) -> (twist_robot (3,), d integral / dt (3,))``.
+TwistController = Callable[[float, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
+
+
+def law_controller(cp: ControlPoint, law: PositionLaw, reference: Reference) -> TwistController:
+    """The thesis's position control (8.1)-(8.3)/(8.53) of the controlled coordinates, then the admissible twist."""
+
+    def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        ref, vel = reference.at(t)
+        meas = point_pose(cp, pose)
+        if cp.reduced:  # the reference is followed by the point; its heading is free (zero dynamics)
+            ref = np.array([ref[0], ref[1], meas[2]])
+            vel = np.array([vel[0], vel[1], 0.0])
+        v = law_velocity(law, ref, vel, meas, integral)
+        return twist_for_velocity(cp, pose, v), pose_error(ref, meas)
+
+    return control
+
+
+@dataclass(frozen=True)
+class Plant:
+    """How the commands move the robot: `loops` (None: ideal joints), steering `policy` (see :mod:`.steering`)."""
+
+    loops: LowLevelLoops | None = None
+    policy: str = "closest"
+
+
+class _Sim:
+    """Per-run arrays: which steering angles are commanded, integrated (castors), or in a low-level loop."""
+
+    def __init__(self, robot: Robot, plant: Plant) -> None:
+        self.robot, self.plant = robot, plant
+        names = robot.steer_names
+        types = [robot.wheel(n).type for n in names]
+        self.passive = np.array([t in ("castor", "double_castor") for t in types], dtype=bool)
+        self.delta = np.array([robot.wheel(n).delta for n in names], dtype=float)
+        self.ranges = steer_ranges(robot)
+        self.wheel_of_steer = np.array([robot.wheel_names.index(n) for n in names], dtype=int)
+        loops = plant.loops
+        self.joints = () if loops is None else loops.joints
+        for j in self.joints:
+            wheel, _, joint = j.partition(".")
+            w = robot.wheel(wheel)
+            if joint == "steer" and w.type not in ("steerable", "double"):
+                raise ControlError(f"low-level loop on '{j}': only steerable and double wheels have a commanded angle")
+            if joint == "spin" and "spin" not in w.kind.rates:
+                raise ControlError(f"low-level loop on '{j}': wheel '{wheel}' has no 'spin' joint")
+        spins = [j for j in self.joints if j.endswith(".spin")]
+        if loops is not None and not spins:
+            spins = [j for j in robot.actuated if j.endswith(".spin")]
+        self.drive = tuple(spins)
+        self.n_loop = 0 if loops is None else loops.size
+
+    def commands(self, twist: np.ndarray, beta: np.ndarray):
+        """Wheel commands at steering `beta`, with the policy and ranges applied to the steered wheels."""
+        c = wheel_commands(self.robot, twist, beta)
+        target = np.array(c.beta)
+        if len(target) and (self.plant.policy != "closest" or np.isfinite(self.ranges).any()):
+            steered = ~self.passive
+            heading = target - math.pi / 2 + self.delta
+            spin = np.asarray(c.spin)[self.wheel_of_steer]
+            ch = choose_steering(heading, spin, beta - math.pi / 2 + self.delta, policy=self.plant.policy,
+                                 ranges=self.ranges)
+            target = np.where(steered, np.asarray(ch.heading) + math.pi / 2 - self.delta, target)
+        return c, target
+
+    def joint_commands(self, c, target: np.ndarray) -> np.ndarray:
+        out = np.zeros(len(self.joints))
+        for i, j in enumerate(self.joints):
+            wheel, _, joint = j.partition(".")
+            if joint == "steer":
+                out[i] = target[self.robot.steer_names.index(wheel)]
+            else:
+                out[i] = c.rates[self.robot.rate_names.index(j)]
+        return out
+
+    def plant_twist(self, twist_cmd: np.ndarray, c, beta: np.ndarray, loop_state: np.ndarray) -> np.ndarray:
+        if self.plant.loops is None or not self.drive:
+            return twist_cmd
+        rates = {}
+        for j in self.drive:
+            if j in self.joints:
+                rates[j] = loop_state[self.joints.index(j)]
+            else:
+                rates[j] = float(c.rates[self.robot.rate_names.index(j)])
+        twist, _ = forward_kinematics(self.robot, rates, beta)
+        return np.asarray(twist)
+
+    def actual_beta(self, target: np.ndarray, beta: np.ndarray, loop_state: np.ndarray) -> np.ndarray:
+        out = np.where(self.passive, beta, target)
+        for i, j in enumerate(self.joints):
+            if j.endswith(".steer"):
+                out[self.robot.steer_names.index(j.partition(".")[0])] = loop_state[i]
+        return out
+
+
+def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *,
+             period: float | None = None, delay: int = 0, plant: Plant | None = None, output_dt: float = 0.05,
+             skew_free: bool = False, rtol: float = 1e-8, atol: float = 1e-10,
+             breaks: tuple[float, ...] = ()) -> dict[str, np.ndarray]:
+    """Close the loop of `robot` under `controller` from `initial_pose` for `duration` [s].
+
+    Continuous time (``period`` None; ``solve_ivp`` RK45 with `rtol`/`atol`, sampled every `output_dt`) or discrete
+    (commands held for `period` [s], pose measured `delay` samples late, ``skew_free`` applies
+    :func:`discretize_twist` to the held twist). Returns arrays: ``t (n,)``, ``pose (n, 3)``, ``twist (n, 3)``
+    (commanded), ``beta (n, n_steer)`` (actual steering), ``target (n, n_steer)`` (commanded steering).
+    ``breaks``: times where the reference is discontinuous; the continuous integration restarts there.
+    """
+    plant = plant or Plant()
+    sim = _Sim(robot, plant)
+    n_s = len(robot.steer_names)
+    beta0 = np.array(robot.beta, dtype=float)
+    loop0 = np.zeros(sim.n_loop)
+    if plant.loops is not None:  # joints start at rest, steering at the described angle
+        for i, j in enumerate(sim.joints):
+            if j.endswith(".steer"):
+                loop0[i] = beta0[robot.steer_names.index(j.partition(".")[0])]
+    x0 = np.concatenate([np.asarray(initial_pose, dtype=float), np.zeros(3), beta0, loop0])
+    if not (math.isfinite(duration) and duration > 0):
+        raise ControlError(f"duration: expected a positive number of seconds, got {duration}")
+
+    def split(x: np.ndarray):
+        return x[:3], x[3:6], x[6:6 + n_s], x[6 + n_s:]
+
+    def rhs(t: float, x: np.ndarray, held: tuple | None = None) -> np.ndarray:
+        pose, integral, beta, ls = split(x)
+        if held is None:
+            twist, de = controller(t, pose, integral)
+        else:
+            twist, de = held
+        if plant.loops is None:  # ideal joints: the robot moves with the commanded twist
+            actual_beta, moving = beta, twist
+        else:
+            c, target = sim.commands(twist, beta)
+            ls = plant.loops.settle_ideal(ls, sim.joint_commands(c, target))
+            actual_beta = sim.actual_beta(target, beta, ls)
+            moving = sim.plant_twist(twist, c, actual_beta, ls)
+        th = pose[2]
+        dpose = np.array([math.cos(th) * moving[0] - math.sin(th) * moving[1],
+                          math.sin(th) * moving[0] + math.cos(th) * moving[1], moving[2]])
+        dbeta = np.zeros(n_s)
+        if sim.passive.any():  # castors turn by themselves (8.24): integrate at the actual twist
+            cc = wheel_commands(robot, moving, actual_beta)
+            dbeta[sim.passive] = np.asarray(cc.steer_rate)[sim.wheel_of_steer[sim.passive]]
+        dls = ls[:0] if plant.loops is None else plant.loops.derivative(ls, sim.joint_commands(c, target))
+        return np.concatenate([dpose, de if held is None else np.zeros(3), dbeta, dls])
+
+    if period is None:
+        from scipy.integrate import solve_ivp
+
+        t_out = np.arange(0.0, duration + 1e-9, output_dt)
+        edges = [0.0, *sorted(b for b in breaks if 0 < b < t_out[-1]), float(t_out[-1])]
+        ts, xs, x = [], [], x0
+        for lo, hi in itertools.pairwise(edges):  # restart at the reference's known corners
+            last = hi == edges[-1]
+            keep = t_out[(t_out >= lo) & ((t_out <= hi) if last else (t_out < hi))]
+            sol = solve_ivp(rhs, (lo, hi), x, t_eval=keep, rtol=rtol, atol=atol, max_step=0.25,
+                            dense_output=True)
+            if not sol.success:
+                raise ControlError(f"the closed loop could not be integrated: {sol.message}")
+            ts.extend(sol.t)
+            xs.extend(sol.y.T)
+            x = sol.sol(hi)
+        records, prev = [], beta0
+        for t, x in zip(ts, xs, strict=True):
+            records.append(_record(controller, sim, t, x, split, prev))
+            prev = records[-1]["beta"]
+    else:
+        if not (math.isfinite(period) and period > 0):
+            raise ControlError(f"period: expected a positive number of seconds, got {period}")
+        if delay < 0:
+            raise ControlError(f"delay: expected a number of samples >= 0, got {delay}")
+        n = math.floor(duration / period + 1e-9) + 1
+        x, history, records = x0.copy(), [x0[:3].copy()], []
+        integral = np.zeros(3)
+        subs = max(1, math.ceil(period / 0.02)) if (plant.loops is not None or sim.passive.any()) else 1
+        for k in range(n):
+            t = k * period
+            measured = history[max(0, k - delay)]
+            twist, de = controller(t, measured, integral)
+            integral = integral + period * de
+            held = discretize_twist(twist, period) if skew_free else twist
+            x[3:6] = integral
+            records.append(_record_held(sim, t, x, split, twist, x[6:6 + n_s]))
+            x[6:6 + n_s] = records[-1]["beta"]  # steered wheels keep the angle they were given
+            if k == n - 1:
+                break
+            x = _advance(rhs, x, t, period, subs, (held, de), plant.loops is None and not sim.passive.any())
+            history.append(x[:3].copy())
+    return {key: np.array([r[key] for r in records]) for key in ("t", "pose", "twist", "beta", "target")}
+
+
+def _advance(rhs, x: np.ndarray, t: float, period: float, subs: int, held: tuple, exact: bool) -> np.ndarray:
+    """One held period: the exact SE(2) step for an ideal plant, else RK4 substeps."""
+    if exact:
+        from ..odometry.integrators import integrate_exact
+
+        out = x.copy()
+        out[:3] = integrate_exact(x[:3], held[0], period)
+        return out
+    h = period / subs
+    for i in range(subs):
+        s = t + i * h
+        k1 = rhs(s, x, held)
+        k2 = rhs(s + h / 2, x + h / 2 * k1, held)
+        k3 = rhs(s + h / 2, x + h / 2 * k2, held)
+        k4 = rhs(s + h, x + h * k3, held)
+        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return x
+
+
+def _record(controller, sim: _Sim, t: float, x: np.ndarray, split, prev: np.ndarray) -> dict:
+    pose, integral, _, _ = split(x)
+    twist, _ = controller(t, pose, integral)
+    return _record_held(sim, t, x, split, twist, prev)
+
+
+def _record_held(sim: _Sim, t: float, x: np.ndarray, split, twist: np.ndarray, prev: np.ndarray) -> dict:
+    pose, _, beta, ls = split(x)
+    beta = np.where(sim.passive, beta, prev)  # castors: integrated state; steered wheels: the last angle given
+    _c, target = sim.commands(twist, beta)
+    actual = sim.actual_beta(target, beta, ls)
+    return {"t": t, "pose": pose.copy(), "twist": np.asarray(twist, dtype=float), "beta": actual, "target": target}

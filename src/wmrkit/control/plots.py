@@ -1,0 +1,125 @@
+"""Figures of the control chapter: a tracking run (path, error, steering headings), its animation, and a reference
+with its Table 8.1 violations. Matplotlib only, off-screen (Agg)."""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from ..errors import WmrkitError
+from .feasibility import Feasibility
+from .references import Reference
+from .track import TrackingRun
+
+__all__ = ["animate_run", "plot_feasibility", "plot_run"]
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig, path: str | os.PathLike[str]) -> None:
+    try:
+        fig.savefig(path, dpi=110)
+    except (OSError, ValueError) as err:
+        raise WmrkitError(f"{path}: cannot save the figure ({err})") from None
+    finally:
+        _pyplot().close(fig)
+
+
+def plot_run(run: TrackingRun, path: str | os.PathLike[str]) -> None:
+    """Path of R and of the tracked point over the reference; tracking error; steering headings [deg]."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+    ax = axes[0]
+    ax.plot(run.reference[:, 0], run.reference[:, 1], "k--", lw=1, label="reference")
+    ax.plot(run.tracked[:, 0], run.tracked[:, 1], "C0", lw=1.5, label="tracked point")
+    ax.plot(run.pose[:, 0], run.pose[:, 1], "C1", lw=0.8, label="robot origin R")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.legend(fontsize=8)
+    ax.set_title(f"{run.robot.name}: {run.controller}")
+    axes[1].semilogy(run.t, np.maximum(run.error, 1e-12), label="tracking error")
+    axes[1].semilogy(run.t, np.maximum(run.cross_track, 1e-12), label="cross-track error")
+    axes[1].set_xlabel("t [s]")
+    axes[1].set_ylabel("error [m]")
+    axes[1].legend(fontsize=8)
+    if run.heading.shape[1]:
+        for k, name in enumerate(run.robot.steer_names):
+            axes[2].plot(run.t, np.degrees(run.heading[:, k]), label=name)
+        axes[2].legend(fontsize=8)
+    axes[2].set_xlabel("t [s]")
+    axes[2].set_ylabel("steering heading [deg]")
+    fig.tight_layout()
+    _save(fig, path)
+
+
+def animate_run(run: TrackingRun, path: str | os.PathLike[str], *, frames: int = 80) -> None:
+    """A GIF of the robot (outline and wheels at their headings) following the reference."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(5, 5))
+    idx = np.linspace(0, len(run.t) - 1, min(frames, len(run.t))).astype(int)
+    pts = np.vstack([run.reference[:, :2], run.pose[:, :2]])
+    span = float(np.ptp(pts, axis=0).max()) + 2.0
+    centre = pts.min(axis=0) + np.ptp(pts, axis=0) / 2
+    robot = run.robot
+    mounts = np.array([w.position for w in robot.wheels] + [(0.0, 0.0)])
+    steer = robot.steer_names
+    fixed_heading = {w.name: w.heading for w in robot.wheels}
+
+    def frame(k: int):
+        i = int(idx[k])
+        ax.clear()
+        ax.plot(run.reference[:, 0], run.reference[:, 1], "k--", lw=1)
+        ax.plot(run.tracked[: i + 1, 0], run.tracked[: i + 1, 1], "C0")
+        x, y, th = run.pose[i]
+        c, s = math.cos(th), math.sin(th)
+        world = np.column_stack([x + c * mounts[:, 0] - s * mounts[:, 1], y + s * mounts[:, 0] + c * mounts[:, 1]])
+        ax.fill(world[:-1, 0], world[:-1, 1], color="#c9d6e3", alpha=0.6)
+        for j, w in enumerate(robot.wheels):
+            h = th + (run.heading[i, steer.index(w.name)] if w.name in steer else fixed_heading[w.name])
+            d = max(w.r, 0.05) * np.array([math.cos(h), math.sin(h)])
+            ax.plot([world[j, 0] - d[0], world[j, 0] + d[0]], [world[j, 1] - d[1], world[j, 1] + d[1]], "k", lw=3)
+        ax.plot(world[-1, 0], world[-1, 1], "C1o", ms=4)
+        ax.set_xlim(centre[0] - span / 2, centre[0] + span / 2)
+        ax.set_ylim(centre[1] - span / 2, centre[1] + span / 2)
+        ax.set_aspect("equal")
+        ax.set_title(f"{robot.name}, {run.controller}: t = {run.t[i]:.1f} s", fontsize=9)
+        return []
+
+    anim = FuncAnimation(fig, frame, frames=len(idx), blit=False)
+    try:
+        anim.save(path, writer=PillowWriter(fps=12))
+    except (OSError, ValueError) as err:
+        raise WmrkitError(f"{path}: cannot save the animation ({err})") from None
+    finally:
+        plt.close(fig)
+
+
+def plot_feasibility(result: Feasibility, reference: Reference, path: str | os.PathLike[str]) -> None:
+    """The reference path with its violations marked and labelled by kind."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6, 5))
+    ax.plot(reference.pose[:, 0], reference.pose[:, 1], "k", lw=1.2, label="reference")
+    for k, v in enumerate(result.violations):
+        p = reference.sample(np.array([v.t]))[0]
+        ax.plot(p[0], p[1], "rx", ms=9, mew=2, label="violation" if k == 0 else None)
+        ax.annotate(f"{v.signal} @ {v.t:.1f} s", (p[0], p[1]), fontsize=7, xytext=(4, 4), textcoords="offset points")
+    r = result.requirement
+    ax.set_title(f"{r.column}, {r.framework}: {'feasible' if result.feasible else 'NOT feasible'}", fontsize=10)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    _save(fig, path)

@@ -1,0 +1,243 @@
+"""Pose references for the kinematic loop (thesis §8.2, high-level loop of Fig. 8.1): built-in shapes and files.
+
+A :class:`Reference` is a sampled trajectory ``p_ref(t) = (x, y, theta)`` in the world frame with its velocity and
+acceleration (exact for the built-in shapes, finite differences for files). The built-ins start at the origin
+heading along +x, except the two forklift examples of §8.6.2, which are placed as the thesis describes them
+(``docs/control.md``). Files: TUM (8 columns) or CSV with a ``t,x,y,theta`` header (``time`` accepted).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .._shapes import readonly
+from ..errors import UnknownNameError, WmrkitError
+
+__all__ = ["BUILTIN", "Reference", "ReferenceError", "builtin_reference", "load_reference", "reference_from_samples",
+           "resolve_reference"]
+
+
+class ReferenceError(WmrkitError, ValueError):
+    """A reference file or name that cannot be used (located, one line)."""
+
+
+@dataclass(frozen=True, eq=False)
+class Reference:
+    """A sampled pose reference. Frozen; arrays read-only. ``eq=False``: array fields.
+
+    ``t`` ``(n,)`` [s], increasing; ``pose`` ``(n, 3)`` ``(x [m], y [m], theta [rad])`` world frame, theta
+    continuous (unwrapped); ``velocity`` ``(n, 3)`` its time derivative (world frame, the ``G p_dot_ref`` of
+    (8.2)); ``acceleration`` ``(n, 3)``. ``breaks``: times where the shape is known to be discontinuous.
+    """
+
+    name: str
+    t: np.ndarray
+    pose: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    breaks: tuple[float, ...] = ()
+
+    @property
+    def duration(self) -> float:
+        """Time span [s]."""
+        return float(self.t[-1] - self.t[0])
+
+    def at(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """``(pose (3,), velocity (3,))`` at time `t`: cubic Hermite between samples (pose from pose and velocity,
+        velocity from velocity and acceleration; exact to ``O(dt^4)``); after the end the last pose at rest."""
+        ts = self.t
+        if t >= ts[-1]:
+            return self.pose[-1].copy(), np.zeros(3)
+        k = min(max(int(np.searchsorted(ts, t, side="right")) - 1, 0), len(ts) - 2)
+        h = ts[k + 1] - ts[k]
+        corner = next((b for b in self.breaks if ts[k] < b <= ts[k + 1]), None)
+        if corner is not None:  # a corner inside the interval: Taylor from the sample on t's side of it
+            j = k if t < corner else k + 1
+            dt = t - ts[j]
+            p, v, a = self.pose[j], self.velocity[j], self.acceleration[j]
+            return p + dt * v + (0.5 * dt * dt) * a, v + dt * a
+        u = min(max((t - ts[k]) / h, 0.0), 1.0)
+        u2, u3 = u * u, u * u * u
+        h00, h10, h01, h11 = 2 * u3 - 3 * u2 + 1, u3 - 2 * u2 + u, -2 * u3 + 3 * u2, u3 - u2
+        p, v, a = self.pose, self.velocity, self.acceleration
+        pose = h00 * p[k] + (h10 * h) * v[k] + h01 * p[k + 1] + (h11 * h) * v[k + 1]
+        vel = h00 * v[k] + (h10 * h) * a[k] + h01 * v[k + 1] + (h11 * h) * a[k + 1]
+        return pose, vel
+
+    def sample(self, t: np.ndarray) -> np.ndarray:
+        """Poses at times `t` ``(m,) -> (m, 3)`` (linear interpolation, held after the end)."""
+        t = np.asarray(t, dtype=float)
+        return np.stack([np.interp(t, self.t, self.pose[:, j]) for j in range(3)], axis=-1)
+
+
+def reference_from_samples(name: str, t: np.ndarray, pose: np.ndarray) -> Reference:
+    """A reference from sampled poses ``(n,), (n, 3)``: velocities and accelerations by finite differences."""
+    t = np.asarray(t, dtype=float)
+    pose = np.asarray(pose, dtype=float).copy()
+    if t.ndim != 1 or pose.shape != (len(t), 3) or len(t) < 3:
+        raise ReferenceError(f"{name}: expected at least 3 samples of (t, x, y, theta), got {pose.shape}")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(pose))):
+        raise ReferenceError(f"{name}: times and poses must be finite numbers")
+    if np.any(np.diff(t) <= 0):
+        k = int(np.argmax(np.diff(t) <= 0))
+        raise ReferenceError(f"{name}: times must increase (sample {k + 1}: {t[k + 1]} after {t[k]})")
+    pose[:, 2] = np.unwrap(pose[:, 2])
+    vel = np.gradient(pose, t, axis=0)
+    acc = np.gradient(vel, t, axis=0)
+    return Reference(name, readonly(t), readonly(pose), readonly(vel), readonly(acc))
+
+
+def load_reference(path: str | os.PathLike[str]) -> Reference:
+    """A reference from a TUM file (``t x y z qx qy qz qw``) or a CSV with header ``t,x,y,theta``."""
+    path = Path(path)
+    if not path.exists():
+        raise ReferenceError(f"{path}: no such file")
+    try:
+        with open(path, encoding="utf-8") as f:
+            first = f.readline()
+        if "," in first:
+            with open(path, encoding="utf-8", newline="") as f:
+                rows = list(csv.reader(f))
+            header = [h.strip().lower() for h in rows[0]]
+            if header[:1] == ["time"]:
+                header[0] = "t"
+            if header[:4] != ["t", "x", "y", "theta"]:
+                raise ReferenceError(f"{path}:1: expected the columns t,x,y,theta, got {','.join(rows[0])}")
+            data = np.array([[float(v) for v in row[:4]] for row in rows[1:] if row], dtype=float)
+            return reference_from_samples(str(path), data[:, 0], data[:, 1:4])
+        from ..odometry.trajectories import read_tum
+
+        t, pose = read_tum(path)
+    except ReferenceError:
+        raise
+    except (ValueError, IndexError, UnicodeDecodeError, WmrkitError) as err:
+        raise ReferenceError(f"{path}: cannot read the reference ({str(err).splitlines()[0]})") from None
+    return reference_from_samples(str(path), t, pose)
+
+
+# ---- built-in shapes ------------------------------------------------------------------------------------
+def _line(t: np.ndarray, v: float, size: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[float, ...]]:
+    z = np.zeros_like(t)
+    return np.stack([v * t, z, z], -1), np.stack([v + z, z, z], -1), np.zeros((len(t), 3)), ()
+
+
+def _circle(t, v, size):
+    w = v / size
+    th = w * t
+    pose = np.stack([size * np.sin(th), size * (1 - np.cos(th)), th], -1)
+    vel = np.stack([v * np.cos(th), v * np.sin(th), np.full_like(t, w)], -1)
+    acc = np.stack([-v * w * np.sin(th), v * w * np.cos(th), 0 * t], -1)
+    return pose, vel, acc, ()
+
+
+def _figure_eight(t, v, size):
+    # Gerono lemniscate x = A sin(w t), y = (A / 2) sin(2 w t); w set so the mean speed is about v.
+    w = v / (1.2 * size)
+    s, c = np.sin(w * t), np.cos(w * t)
+    s2, c2 = np.sin(2 * w * t), np.cos(2 * w * t)
+    x, y = size * s, 0.5 * size * s2
+    dx, dy = size * w * c, size * w * c2
+    ddx, ddy = -size * w * w * s, -2 * size * w * w * s2
+    dddx, dddy = -size * w**3 * c, -4 * size * w**3 * c2
+    chi = np.unwrap(np.arctan2(dy, dx))
+    num, den = dx * ddy - dy * ddx, dx * dx + dy * dy
+    chi_dot = num / den
+    chi_ddot = ((dx * dddy - dy * dddx) * den - num * 2 * (dx * ddx + dy * ddy)) / den**2
+    return (np.stack([x, y, chi], -1), np.stack([dx, dy, chi_dot], -1), np.stack([ddx, ddy, chi_ddot], -1), ())
+
+
+def _polyline(t, v, corners):
+    """Constant speed `v` along straight legs through `corners` ``(k, 2)``; heading jumps at each corner."""
+    legs = np.diff(corners, axis=0)
+    lengths = np.hypot(legs[:, 0], legs[:, 1])
+    ends = np.concatenate([[0.0], np.cumsum(lengths)]) / v
+    i = np.clip(np.searchsorted(ends, t, side="right") - 1, 0, len(legs) - 1)
+    u = legs[i] / lengths[i, None]
+    xy = corners[i] + u * (v * (t - ends[i]))[:, None]
+    chi = np.unwrap(np.arctan2(legs[:, 1], legs[:, 0]))[i]
+    pose = np.column_stack([xy, chi])
+    vel = np.column_stack([v * u, np.zeros_like(t)])
+    return pose, vel, np.zeros((len(t), 3)), tuple(float(e) for e in ends[1:-1])
+
+
+def _square(t, v, size):
+    c = np.array([[0, 0], [size, 0], [size, size], [0, size], [0, 0]], dtype=float)
+    return _polyline(t, v, c)
+
+
+def _corner(t, v, size):
+    # §8.6.2 example 2: a reference with a tangent-angle discontinuity, from the origin (shape not given): an L,
+    # first along -y (behind a truck facing +y, hence the initial manoeuvre), then along +x.
+    return _polyline(t, v, np.array([[0, 0], [0, -size], [size, -size]], dtype=float))
+
+
+def _arc_line(t, v, size):
+    # §8.6.2 example 1: a half turn (arc of radius `size`) then a straight line; starts at the origin heading -y.
+    w = v / size
+    t1 = math.pi / w
+    on_arc = t < t1
+    th = np.where(on_arc, w * t, math.pi)
+    chi = th - math.pi / 2
+    x = np.where(on_arc, size * (1 - np.cos(th)), 2 * size)
+    y = np.where(on_arc, -size * np.sin(th), v * (t - t1))
+    vel = np.stack([v * np.cos(chi), v * np.sin(chi), np.where(on_arc, w, 0.0)], -1)
+    acc = np.stack([-v * np.sin(chi) * np.where(on_arc, w, 0), v * np.cos(chi) * np.where(on_arc, w, 0), 0 * t], -1)
+    return np.stack([x, y, chi], -1), vel, acc, (t1,)
+
+
+#: Built-in references: name -> (shape function, default speed [m/s], default size [m], duration(speed, size) [s]).
+BUILTIN = {
+    "line": (_line, 0.5, 1.0, lambda v, size: 20.0),
+    "circle": (_circle, 0.5, 3.0, lambda v, size: 2 * math.pi * size / v),
+    "figure-eight": (_figure_eight, 0.5, 6.0, lambda v, size: 2 * math.pi * 1.2 * size / v),
+    "square": (_square, 0.5, 6.0, lambda v, size: 4 * size / v),
+    "arc-line": (_arc_line, 0.5, 1.5, lambda v, size: math.pi * size / v + 10.0),
+    "corner": (_corner, 0.5, 3.0, lambda v, size: 2 * size / v),
+}
+
+
+def builtin_reference(name: str, *, speed: float | None = None, size: float | None = None,
+                      duration: float | None = None, dt: float = 0.01) -> Reference:
+    """A built-in reference by name (:data:`BUILTIN`), sampled every `dt` [s], with exact derivatives.
+
+    `speed` [m/s] along the path, `size` [m] (circle radius, square side, figure-eight half width, arc radius,
+    leg length of ``corner``), `duration` [s] (default: one lap); defaults per shape in :data:`BUILTIN`.
+    """
+    if name not in BUILTIN:
+        import difflib
+
+        close = difflib.get_close_matches(name, BUILTIN, n=1)
+        hint = f" (did you mean '{close[0]}'?)" if close else ""
+        raise UnknownNameError(f"no built-in reference '{name}'{hint} (built-in: {', '.join(BUILTIN)}; or a file)")
+    fn, v0, s0, d0 = BUILTIN[name]
+    v, size = (v0 if speed is None else speed), (s0 if size is None else size)
+    for what, value in (("speed", v), ("size", size), ("dt", dt)):
+        if not (math.isfinite(value) and value > 0):
+            raise ReferenceError(f"reference '{name}': {what} must be a positive number, got {value}")
+    dur = d0(v, size) if duration is None else duration
+    for what, value in (("duration", dur),):
+        if not (math.isfinite(value) and value > 0):
+            raise ReferenceError(f"reference '{name}': {what} must be a positive number, got {value}")
+    n = math.floor(dur / dt + 1e-9) + 1
+    if n < 3 or n > 10_000_000:
+        raise ReferenceError(f"reference '{name}': duration/dt gives {n} samples (3 to 10^7 allowed)")
+    t = np.arange(n) * dt
+    pose, vel, acc, breaks = fn(t, v, size)
+    return Reference(name, readonly(t), readonly(np.ascontiguousarray(pose, dtype=float)),
+                     readonly(np.ascontiguousarray(vel, dtype=float)), readonly(np.ascontiguousarray(acc, dtype=float)),
+                     tuple(b for b in breaks if b < dur))
+
+
+def resolve_reference(spec: str, *, speed: float | None = None, size: float | None = None) -> Reference:
+    """A built-in name (with `speed`, `size`) or a file path (what ``--reference`` takes)."""
+    if spec in BUILTIN:
+        return builtin_reference(spec, speed=speed, size=size)
+    if Path(spec).suffix or Path(spec).exists():
+        return load_reference(spec)
+    return builtin_reference(spec)  # raises with a suggestion

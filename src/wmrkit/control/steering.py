@@ -1,0 +1,133 @@
+"""Steering in the loop (§8.4): 4- and 2-quadrant angles within each wheel's range, swerve motion modes, skew-free
+discretisation of a twist over a period.
+
+Headings throughout (the rolling direction, 0 = straight ahead along +x, counter-clockwise positive). For a wheel
+whose steering axis moves with velocity ``u`` the lateral constraint (8.9) has two roots, ``atan2(u)`` with a
+positive spin and that plus pi with a negative one:
+
+- ``"4-quadrant"``: the thesis's choice, the spin keeps its sign (ours >= 0: always rolling forward); the wheel turns
+  half round when the robot reverses (the pi jump of §8.6.2).
+- ``"2-quadrant"``: heading in (-90, 90] deg, spin times ``sign`` (8.51), the usual +-90 deg steering range.
+- ``"closest"``: the root closest to the current heading (WPILib ``optimize``; :func:`wheel_commands`' policy).
+
+A wheel's ``steer_range`` (description field, headings) restricts the roots; when neither fits, the heading is
+clamped to the range and flagged: the vehicle must stop and re-orient the wheel (Table 8.1 remedies).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors, readonly
+from ..robot import Robot
+from ..wheels import wrap_angle
+from .points import ControlError
+
+__all__ = ["POLICIES", "SteeringChoice", "ackermann_twist", "choose_steering", "crab_twist", "discretize_twist",
+           "icr_twist", "steer_ranges"]
+
+POLICIES = ("closest", "4-quadrant", "2-quadrant")
+
+
+def steer_ranges(robot: Robot) -> np.ndarray:
+    """``(n_steer, 2)`` heading ranges [rad] of the steering wheels; ``(-inf, inf)`` where none is described."""
+    out = np.tile([-np.inf, np.inf], (len(robot.steer_names), 1))
+    for k, name in enumerate(robot.steer_names):
+        rng = getattr(robot.wheel(name), "steer_range", None)
+        if rng is not None:
+            out[k] = rng
+    return out
+
+
+def _in_range(h: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    full = ~np.isfinite(lo) | ~np.isfinite(hi)
+    lo_, width = np.where(full, 0.0, lo), np.where(full, 0.0, hi - lo)
+    off = np.mod(h - lo_ + 1e-12, 2 * np.pi) - 1e-12  # how far past lo, counter-clockwise, in [0, 2 pi)
+    return full | (off <= width + 1e-12)
+
+
+@dataclass(frozen=True, eq=False)
+class SteeringChoice:
+    """Chosen headings ``(..., n_steer)`` [rad], their spins ``(..., n_steer)`` [rad/s] and ``in_range`` flags."""
+
+    heading: np.ndarray
+    spin: np.ndarray
+    in_range: np.ndarray
+
+
+def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, policy: str = "closest",
+                    ranges: ArrayLike | None = None) -> SteeringChoice:
+    """Pick, per wheel, the root of (8.9) allowed by `policy` and the heading range.
+
+    `heading`, `spin`: one root and its spin ``(..., n)``; the other root is ``heading + pi`` with ``-spin``.
+    `current` ``(..., n)``: current headings (for ``"closest"`` and for ties). `ranges` ``(n, 2)`` heading ranges.
+    """
+    if policy not in POLICIES:
+        raise ControlError(f"unknown steering policy '{policy}' (policies: {', '.join(POLICIES)})")
+    h0 = wrap_angle(np.asarray(heading, dtype=float))
+    s0 = np.asarray(spin, dtype=float)
+    h1, s1 = wrap_angle(h0 + math.pi), -s0
+    cur = np.asarray(current, dtype=float)
+    if policy == "4-quadrant":
+        pref0 = s0 >= 0
+    elif policy == "2-quadrant":
+        pref0 = (h0 > -math.pi / 2 + 1e-12) & (h0 <= math.pi / 2 + 1e-12)
+    else:
+        pref0 = np.abs(wrap_angle(h0 - cur)) <= np.abs(wrap_angle(h1 - cur))
+    if ranges is None:
+        ok0 = ok1 = np.ones(h0.shape, dtype=bool)
+        lo = hi = None
+    else:
+        r = np.asarray(ranges, dtype=float)
+        lo, hi = r[..., 0], r[..., 1]
+        ok0, ok1 = _in_range(h0, lo, hi), _in_range(h1, lo, hi)
+    take0 = np.where(ok0 & ok1, pref0, ok0)
+    h = np.where(take0, h0, h1)
+    s = np.where(take0, s0, s1)
+    fits = ok0 | ok1
+    if lo is not None and not np.all(fits):
+        with np.errstate(invalid="ignore"):
+            clamp = np.where(np.abs(wrap_angle(h - lo)) < np.abs(wrap_angle(h - hi)), lo, hi)
+        h = np.where(fits, h, clamp)
+    return SteeringChoice(readonly(np.asarray(h)), readonly(np.asarray(s)), readonly(np.asarray(fits)))
+
+
+# ---- swerve motion modes ------------------------------------------------------------------------------------
+def crab_twist(speed: ArrayLike, direction: ArrayLike) -> np.ndarray:
+    """Crab (translation only): every wheel at heading `direction` [rad]. ``(...), (...) -> (..., 3)``."""
+    v, d = np.broadcast_arrays(np.asarray(speed, dtype=float), np.asarray(direction, dtype=float))
+    return np.stack([v * np.cos(d), v * np.sin(d), np.zeros_like(v)], axis=-1)
+
+
+def icr_twist(icr_xy: ArrayLike, omega: ArrayLike) -> np.ndarray:
+    """Rotation at rate `omega` [rad/s] about an arbitrary ICR ``(x, y)`` [m, robot frame] (§5.4, ros2_controllers
+    #2000): the origin's velocity is ``omega z x (0 - c) = omega (c_y, -c_x)``. ``(..., 2), (...) -> (..., 3)``."""
+    c = as_vectors(icr_xy, 2, "icr_xy")
+    w = np.asarray(omega, dtype=float)
+    return np.stack([w * c[..., 1], -w * c[..., 0], np.broadcast_to(w, c.shape[:-1])], axis=-1)
+
+
+def ackermann_twist(speed: ArrayLike, curvature: ArrayLike, axle_x: float = 0.0) -> np.ndarray:
+    """Ackermann mode: ICR on the line ``x = axle_x`` (a virtual rear axle), `speed` [m/s] of the point
+    ``(axle_x, 0)``, `curvature` [1/m]; finite for curvature 0. ``(...), (...) -> (..., 3)``."""
+    v, k = np.broadcast_arrays(np.asarray(speed, dtype=float), np.asarray(curvature, dtype=float))
+    return np.stack([v, -v * k * axle_x, v * k], axis=-1)
+
+
+def discretize_twist(twist_robot: ArrayLike, dt: float) -> np.ndarray:
+    """Second-order (skew-free) discretisation: the constant body twist that, held for `dt`, ends at the pose
+    ``(vx dt, vy dt, omega dt)`` of the body frame: the SE(2) logarithm of that pose over `dt` (WPILib
+    ``ChassisSpeeds.discretize``, #5349/#7332). Inverse of :func:`wmrkit.odometry.integrate_exact`'s chord form:
+    ``(vx, vy)' = Rot(-h) (vx, vy) / sinc(h)`` with ``h = omega dt / 2``. ``(..., 3) -> (..., 3)``."""
+    from ..odometry.integrators import sinc
+
+    t = as_vectors(twist_robot, 3, "twist_robot")
+    h = 0.5 * t[..., 2] * dt
+    c, s, k = np.cos(h), np.sin(h), 1.0 / sinc(h)
+    vx = k * (c * t[..., 0] + s * t[..., 1])
+    vy = k * (-s * t[..., 0] + c * t[..., 1])
+    return np.stack([vx, vy, t[..., 2]], axis=-1)

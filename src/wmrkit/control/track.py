@@ -1,0 +1,167 @@
+"""One call that tracks a reference with any robot: :func:`track` -> :class:`TrackingRun` (what ``wmrkit track``
+prints, and what a planner, e.g. the parking application, calls to execute a plan)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors, readonly
+from ..kinematics.wheel_ik import WheelCommands, wheel_commands
+from ..robot import Robot
+from ..wheels import heading_from_beta
+from .actuators import LowLevelLoops
+from .laws import PositionLaw, check_sampling
+from .loop import Plant, law_controller, simulate
+from .points import ControlError, ControlPoint, control_point, point_pose
+from .references import Reference
+from .trackers import PathIndex, default_wheelbase, pure_pursuit, stanley
+
+__all__ = ["CONTROLLERS", "TrackingRun", "initial_pose_on", "track"]
+
+#: Controllers: the thesis's laws (8.1)-(8.3) and the two geometric trackers users use.
+CONTROLLERS = ("p", "pi", "point", "pure-pursuit", "stanley")
+
+
+@dataclass(frozen=True, eq=False)
+class TrackingRun:
+    """A closed-loop run (frozen; arrays read-only; eq=False: array fields). ``n`` samples:
+
+    - ``t`` ``(n,)`` [s]; ``pose`` ``(n, 3)`` world pose of R ``(x, y, theta)``;
+    - ``reference`` ``(n, 3)`` the reference at ``t``; ``tracked`` ``(n, 3)`` the pose of the tracked point
+      (the control point for the thesis's laws, the axle point for pure pursuit, the front point for Stanley);
+    - ``error`` ``(n,)`` [m] distance of the tracked point from the reference at ``t``; ``cross_track`` ``(n,)``
+      [m] its distance from the reference path;
+    - ``twist`` ``(n, 3)`` commanded body twist; ``heading`` ``(n, n_steer)`` [rad] actual steering headings;
+    - ``commands``: the per-wheel commands (:class:`WheelCommands`, batch ``(n,)``) at the commanded steering;
+    - ``estimate`` ``(n, 3)``: the odometry's pose estimate when the loop was closed on it, else None.
+    """
+
+    robot: Robot
+    controller: str
+    t: np.ndarray
+    pose: np.ndarray
+    reference: np.ndarray
+    tracked: np.ndarray
+    error: np.ndarray
+    cross_track: np.ndarray
+    twist: np.ndarray
+    heading: np.ndarray
+    commands: WheelCommands
+    period: float | None = None
+    delay: int = 0
+    estimate: np.ndarray | None = None
+
+    def summary(self, settle: float = 0.0) -> dict[str, float]:
+        """RMS, max and final tracking and cross-track errors [m] after time `settle` [s]."""
+        m = self.t >= settle
+        e, c = self.error[m], self.cross_track[m]
+        return {"rms_error": float(np.sqrt(np.mean(e * e))), "max_error": float(e.max()),
+                "final_error": float(self.error[-1]), "rms_cross_track": float(np.sqrt(np.mean(c * c))),
+                "max_cross_track": float(c.max())}
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: ``t``, ``pose`` and ``reference`` as ``(x, y, theta)`` rows, per-wheel ``heading`` (steering,
+        null for wheels that do not steer) and ``spin`` series, errors and the summary."""
+        wheels: dict[str, dict[str, Any]] = {}
+        steer = self.robot.steer_names
+        for i, name in enumerate(self.robot.wheel_names):
+            h = self.heading[:, steer.index(name)].tolist() if name in steer else None
+            wheels[name] = {"heading": h, "spin": np.asarray(self.commands.spin[:, i]).tolist()}
+        out = {"robot": self.robot.name, "controller": self.controller, "period": self.period, "delay": self.delay,
+               "t": self.t.tolist(), "pose": self.pose.tolist(), "reference": self.reference.tolist(),
+               "error": self.error.tolist(), "wheels": wheels, "summary": self.summary()}
+        if self.estimate is not None:
+            out["estimate"] = self.estimate.tolist()
+        return out
+
+
+def initial_pose_on(cp: ControlPoint, reference: Reference) -> np.ndarray:
+    """The pose whose controlled point sits on the reference's start, rolling along it (zero initial error)."""
+    x, y, th = reference.pose[0]
+    theta = th - cp.forward if cp.reduced else th
+    c, s = math.cos(theta), math.sin(theta)
+    px, py = cp.point
+    return np.array([x - c * px + s * py, y - s * px - c * py, theta])
+
+
+def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: float = 1.0,
+          integral_gain: float | None = None, gate: float | None = None, initial_pose: ArrayLike | None = None,
+          period: float | None = None, delay: int = 0, duration: float | None = None,
+          point: ArrayLike | None = None, loops: LowLevelLoops | None = None, policy: str = "closest",
+          skew_free: bool = False, lookahead: float = 1.0, stanley_gain: float = 1.0,
+          output_dt: float = 0.05, dynamics: bool = False, tyre: str | None = None,
+          feedback: str = "pose") -> TrackingRun:
+    """Track `reference` with `robot` (thesis ch. 8): closed loop, continuous (``period`` None) or discrete.
+
+    `controller`: ``"p"`` (8.2), ``"pi"`` (8.3), ``"point"`` (8.1), ``"pure-pursuit"``, ``"stanley"``. `gain`: the
+    pole ``a`` [1/s] of every coordinate; `integral_gain` ``b`` [1/s^2] of ``"pi"`` (default ``a^2/4``, critically
+    damped); `gate` [m]: feedforward gate (8.53). `initial_pose` ``(3,)`` default: on the reference
+    (:func:`initial_pose_on`). `delay` in samples (discrete only). `point` ``(2,)`` [m]: controlled point of a
+    reduced-mobility robot (:func:`control_point`). `loops`: low-level actuator loops; `policy`: steering root
+    (:mod:`.steering`). `skew_free`: second-order discretisation of the held twist. Geometric trackers:
+    `lookahead` [m] (pure pursuit), `stanley_gain` [1/s]. `dynamics`: the plant is the chapter-7 dynamic model with
+    tyres (`tyre`: traction model name, default as described), driven by servos each period
+    (:func:`.dynamic_plant.simulate_dynamics`; period default 0.02 s); with it, `feedback="odometry"` measures the
+    pose by odometry from the sensed joints (``TrackingRun.estimate``) instead of exactly.
+    """
+    if controller not in CONTROLLERS:
+        raise ControlError(f"unknown controller '{controller}' (controllers: {', '.join(CONTROLLERS)})")
+    if not (math.isfinite(gain) and gain >= 0):
+        raise ControlError(f"gain: expected a pole a >= 0 (1/s), got {gain}")
+    if period is None and delay and not dynamics:
+        raise ControlError("delay: a measurement delay in samples needs a sample period (--period)")
+    cp = control_point(robot, point)
+    duration = reference.duration if duration is None else float(duration)
+    pose0 = initial_pose_on(cp, reference) if initial_pose is None else as_vectors(initial_pose, 3, "initial_pose")
+    if controller in ("p", "pi", "point"):
+        b = gain * gain / 4 if integral_gain is None else integral_gain
+        law = PositionLaw.uniform(controller, gain, b if controller == "pi" else 0.0, gate)  # type: ignore[arg-type]
+        if period is not None:
+            check_sampling(law, period, stacklevel=3)
+        ctrl, tracked_point = law_controller(cp, law, reference), cp.point
+    elif controller == "pure-pursuit":
+        ctrl, tracked_point = pure_pursuit(cp, reference, lookahead), cp.axle_point
+    else:
+        length = default_wheelbase(cp)
+        ctrl = stanley(cp, reference, stanley_gain, length)
+        tracked_point = cp.axle_point + length * np.array([math.cos(cp.forward), math.sin(cp.forward)])
+    geometric = controller in ("pure-pursuit", "stanley")  # switching goal points: a looser tolerance
+    if dynamics:
+        from .dynamic_plant import simulate_dynamics
+
+        if loops is not None or skew_free:
+            raise ControlError("dynamics: the wheels are driven by the dynamic model's servos; no low-level loops "
+                               "or skew-free option with it")
+        period = 0.02 if period is None else period
+        out = simulate_dynamics(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
+                                feedback=feedback)
+    elif feedback != "pose":
+        raise ControlError("feedback='odometry' needs the dynamic plant (dynamics=True): the ideal plant has no slip")
+    else:
+        out = simulate(robot, ctrl, pose0, duration, period=period, delay=delay, plant=Plant(loops, policy),
+                       output_dt=output_dt, skew_free=skew_free, breaks=reference.breaks,
+                       rtol=1e-5 if geometric else 1e-8, atol=1e-7 if geometric else 1e-10)
+    t, pose = out["t"], out["pose"]
+    tcp = _full_point(cp, tracked_point)
+    tracked = point_pose(tcp, pose)
+    ref = reference.sample(t)
+    error = np.hypot(tracked[:, 0] - ref[:, 0], tracked[:, 1] - ref[:, 1])
+    cross = PathIndex(reference).cross_track(tracked[:, :2])
+    commands = wheel_commands(robot, out["twist"], out["target"])
+    steer_delta = np.array([robot.wheel(n).delta for n in robot.steer_names])
+    heading = heading_from_beta(out["beta"], steer_delta)
+    return TrackingRun(robot, controller, readonly(t), readonly(pose), readonly(ref), readonly(tracked),
+                       readonly(error), readonly(cross), readonly(out["twist"]), readonly(np.asarray(heading)),
+                       commands, period, delay, readonly(out["estimate"]) if "estimate" in out and
+                       feedback == "odometry" else None)
+
+
+def _full_point(cp: ControlPoint, p: np.ndarray) -> ControlPoint:
+    from dataclasses import replace
+
+    return replace(cp, point=readonly(np.asarray(p, dtype=float).copy()))

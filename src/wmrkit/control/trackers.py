@@ -1,0 +1,162 @@
+"""What users use today, on the same robots and references: pure pursuit and Stanley (beyond the thesis).
+
+Both steer a point of the robot onto the reference *path* at the reference's speed (they do not correct timing):
+
+- **pure pursuit** (Coulter 1992): the axle point ``A`` (the foot of the fixed axle, the origin without fixed wheels)
+  drives on the arc through a goal point ``lookahead`` metres further along the path: curvature
+  ``kappa = 2 y_g / L_d^2``;
+- **Stanley** (Thrun et al. 2006): a front point ``F`` at ``wheelbase`` ahead of ``A``; steering
+  ``delta = psi_e - atan(k e / (v + eps))`` with the heading error ``psi_e`` and the signed cross-track error ``e`` of
+  ``F`` (positive left), curvature ``tan(delta) / wheelbase``.
+
+The resulting unicycle twist ``(v, omega)`` at ``A`` along the robot's rolling direction is moved to the origin
+(rigid body) and goes through the same per-wheel IK as the thesis's controller.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .loop import TwistController
+from .points import ControlPoint
+from .references import Reference
+
+__all__ = ["PathIndex", "default_wheelbase", "pure_pursuit", "stanley"]
+
+
+class PathIndex:
+    """The reference's path as a polyline with arc length, and nearest-point queries near a time."""
+
+    def __init__(self, reference: Reference, window: float = 5.0) -> None:
+        self.ref = reference
+        self.xy = np.ascontiguousarray(reference.pose[:, :2])
+        seg = np.hypot(*np.diff(self.xy, axis=0).T)
+        self.s = np.concatenate([[0.0], np.cumsum(seg)])
+        self.window = window
+
+    def nearest(self, point: np.ndarray, t: float) -> int:
+        """Index of the path sample nearest to `point` among those within ``window`` s of time `t`."""
+        lo, hi = np.searchsorted(self.ref.t, [t - self.window, t + self.window])
+        hi = max(hi, lo + 1)
+        d = np.sum((self.xy[lo:hi] - point) ** 2, axis=1)
+        return int(lo + np.argmin(d))
+
+    def project(self, point: np.ndarray, t: float) -> tuple[float, float, float]:
+        """Continuous projection of `point` on the path near time `t`: ``(s [m], chi [rad], e [m], signed, left
+        positive)`` on the segments either side of the nearest sample (so the trackers' inputs do not jump)."""
+        i = self.nearest(point, t)
+        best = None
+        for j in (i - 1, i):
+            if j < 0 or j + 1 >= len(self.xy):
+                continue
+            a, b = self.xy[j], self.xy[j + 1]
+            d = b - a
+            n2 = float(d @ d)
+            u = 0.0 if n2 == 0 else min(max(float((point - a) @ d) / n2, 0.0), 1.0)
+            q = a + u * d
+            dist = float(np.hypot(*(point - q)))
+            if best is None or dist < best[0]:
+                chi = math.atan2(d[1], d[0]) if n2 > 0 else self.tangent(j)
+                best = (dist, self.s[j] + u * math.sqrt(n2), chi, q)
+        if best is None:
+            return float(self.s[i]), self.tangent(i), 0.0
+        _, s_, chi, q = best
+        e = float((point - q) @ np.array([-math.sin(chi), math.cos(chi)]))
+        return float(s_), chi, e
+
+    def point_at(self, s: float) -> np.ndarray:
+        """Path point at arc length `s` [m] (clamped to the ends)."""
+        return np.array([np.interp(s, self.s, self.xy[:, 0]), np.interp(s, self.s, self.xy[:, 1])])
+
+    def tangent(self, i: int) -> float:
+        """Path direction [rad] at sample `i` (from the reference velocity, or the chord)."""
+        v = self.ref.velocity[i, :2]
+        if np.hypot(*v) > 1e-9:
+            return math.atan2(v[1], v[0])
+        j = min(i + 1, len(self.xy) - 1)
+        k = max(j - 1, 0)
+        return math.atan2(*(self.xy[j] - self.xy[k])[::-1])
+
+    def cross_track(self, points: np.ndarray) -> np.ndarray:
+        """Distance [m] from each of `points` ``(n, 2)`` to the path polyline (the segments either side of the
+        nearest sample). ``-> (n,)``."""
+        near = np.empty(len(points), dtype=int)
+        for k in range(0, len(points), 256):
+            d = np.sum((points[k:k + 256, None, :] - self.xy[None, :, :]) ** 2, axis=-1)
+            near[k:k + 256] = np.argmin(d, axis=1)
+        best = np.full(len(points), np.inf)
+        for shift in (-1, 0):
+            j = np.clip(near + shift, 0, len(self.xy) - 2)
+            a, b = self.xy[j], self.xy[j + 1]
+            d = b - a
+            n2 = np.maximum(np.sum(d * d, axis=1), 1e-300)
+            u = np.clip(np.sum((points - a) * d, axis=1) / n2, 0.0, 1.0)
+            best = np.minimum(best, np.hypot(*(points - a - u[:, None] * d).T))
+        return best
+
+
+def default_wheelbase(cp: ControlPoint) -> float:
+    """Distance [m] from the axle point to the steered wheels (type 4), else to the control point, else 0.5 m."""
+    a = cp.axle_point
+    steered = [w.position for w in cp.robot.wheels if w.type in ("steerable", "double")]
+    ahead = np.array([math.cos(cp.forward), math.sin(cp.forward)])
+    if cp.reduced and steered:
+        return float(max(abs((np.asarray(p) - a) @ ahead) for p in steered))
+    d = float(np.hypot(*(cp.point - a)))
+    return d if d > 1e-6 else 0.5
+
+
+def _axle_state(cp: ControlPoint, pose: np.ndarray) -> tuple[np.ndarray, float]:
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    a = cp.axle_point
+    return np.array([pose[0] + c * a[0] - s * a[1], pose[1] + s * a[0] + c * a[1]]), pose[2] + cp.forward
+
+
+def _twist_at_origin(cp: ControlPoint, v: float, omega: float) -> np.ndarray:
+    """Body twist of the origin for speed `v` of the axle point along the rolling direction and rate `omega`."""
+    ax, ay = cp.axle_point
+    vx, vy = v * math.cos(cp.forward), v * math.sin(cp.forward)
+    return np.array([vx + omega * ay, vy - omega * ax, omega])
+
+
+def _speed(ref: Reference, t: float) -> float:
+    return float(np.hypot(*ref.at(t)[1][:2]))
+
+
+def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0) -> TwistController:
+    """Pure-pursuit controller (see module doc); `lookahead` [m]."""
+    path = PathIndex(reference)
+
+    def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        a, psi = _axle_state(cp, pose)
+        s_near, _, _ = path.project(a, t)
+        d = path.point_at(s_near + lookahead) - a
+        c, s = math.cos(psi), math.sin(psi)
+        x_g, y_g = c * d[0] + s * d[1], -s * d[0] + c * d[1]
+        dist2 = x_g * x_g + y_g * y_g
+        kappa = 2.0 * y_g / dist2 if dist2 > 1e-12 else 0.0
+        v = _speed(reference, t)
+        return _twist_at_origin(cp, v, v * kappa), np.zeros(3)
+
+    return control
+
+
+def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase: float | None = None,
+            max_steer: float = 1.2) -> TwistController:
+    """Stanley controller (see module doc); cross-track `gain` [1/s], steering limited to ``+-max_steer`` [rad]."""
+    path = PathIndex(reference)
+    length = default_wheelbase(cp) if wheelbase is None else wheelbase
+
+    def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        a, psi = _axle_state(cp, pose)
+        f = a + length * np.array([math.cos(psi), math.sin(psi)])
+        _, chi, e = path.project(f, t)
+        v = _speed(reference, t)
+        psi_e = math.remainder(chi - psi, 2 * math.pi)
+        delta = psi_e - math.atan2(gain * e, v + 1e-3)
+        delta = min(max(delta, -max_steer), max_steer)
+        return _twist_at_origin(cp, v, v * math.tan(delta) / length), np.zeros(3)
+
+    return control

@@ -1,0 +1,186 @@
+"""Compiled time stepping of the dynamic model: joint inputs, the equations of motion, fixed-step integrators.
+
+State ``s (2n,)``: pose ``(x, y, theta)`` in the world, the joint positions of the columns ``3..n-1`` of the
+velocity vector (so the steering angle of column c is ``s[c]``), then the velocity vector ``nu (n,)``.
+Inputs ``inp``: ``(tk (K,), tau (K, n), rate_ref (K, n), rate_gain (n,), tau_max (n,), beta_ref (K, S), kp (S,),
+kd (S,))``, linear in time between the knots ``tk``, held outside them: feed-forward torques, wheel-rate servos
+``tau += rate_gain (rate_ref - rate)`` saturated at ``tau_max``, steering servos ``kp wrap(beta_ref - beta) - kd
+beta_dot``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._kernels import _inline, _njit, bias, contact_forces, mass_matrix, normal_loads, slip_matrix, solve
+
+
+@_inline
+def _segment(tk, t):
+    k = np.searchsorted(tk, t) - 1
+    if k < 0:
+        return 0, 0, 0.0
+    if k >= tk.shape[0] - 1:
+        return tk.shape[0] - 1, tk.shape[0] - 1, 0.0
+    return k, k + 1, (t - tk[k]) / (tk[k + 1] - tk[k])
+
+
+@_inline
+def _interp(values, k, k1, w, out):
+    for j in range(out.shape[0]):
+        out[j] = (1 - w) * values[k, j] + w * values[k1, j]
+
+
+@_njit
+def assemble(t, s, acc, pack, inp, jac, w):
+    """Everything at state `s`, time `t`, into the work arrays `w` (see :func:`work_arrays`); returns nothing.
+
+    ``w = (a, m, dm, fz, f, g, vw, tau, kdiag, rhs, beta, beta_rate, rate_ref, beta_ref, mat, filled)``:
+    ``rhs = tau + A' F + bias`` so that
+    ``m nu' = rhs``; ``kdiag`` holds the servo terms of ``d rhs / d nu``.
+    """
+    a, m, dm, fz, f, g, vw, tau, kdiag, rhs, beta, beta_rate = w[:12]
+    n = rhs.shape[0]
+    steer_col = pack[5]
+    nu = s[n:]
+    for k in range(steer_col.shape[0]):
+        beta[k], beta_rate[k] = s[steer_col[k]], nu[steer_col[k]]
+    filled = w[15][0] == 1.0
+    slip_matrix(beta, pack, n, a, filled)
+    if not filled or np.any(pack[6] == 1):  # without castor units M does not depend on the configuration
+        mass_matrix(beta, pack, n, m, dm)
+    w[15][0] = 1.0
+    normal_loads(beta, nu, acc, pack, fz)
+    contact_forces(a, nu, pack, fz, f, g, vw, jac)
+    tk, tff, rref, rgain, tmax, bref, kp, kd = inp
+    k0, k1, wt = _segment(tk, t)
+    rr, br = w[12], w[13]
+    _interp(tff, k0, k1, wt, tau)
+    _interp(rref, k0, k1, wt, rr)
+    _interp(bref, k0, k1, wt, br)
+    kdiag[:] = 0.0
+    for c in range(n):
+        if rgain[c] > 0:
+            u = tau[c] + rgain[c] * (rr[c] - nu[c])
+            if abs(u) > tmax[c]:
+                u = math.copysign(tmax[c], u)
+            else:
+                kdiag[c] = -rgain[c]
+            tau[c] = u
+    for k in range(steer_col.shape[0]):
+        c = steer_col[k]
+        err = br[k] - beta[k]
+        err = err - 2 * math.pi * math.floor((err + math.pi) / (2 * math.pi))
+        tau[c] += kp[k] * err - kd[k] * nu[c]
+        kdiag[c] -= kd[k]
+    bias(nu, beta_rate, m, dm, steer_col, pack[6], rhs)
+    for c in range(n):
+        acc_c = tau[c]
+        for e in range(f.shape[0]):
+            acc_c += a[2 * e, c] * f[e, 0] + a[2 * e + 1, c] * f[e, 1]
+        rhs[c] += acc_c
+
+
+def work_arrays(n: int, n_el: int, n_steer: int) -> tuple:
+    """Scratch arrays of :func:`assemble`."""
+    return (np.zeros((2 * n_el, n)), np.zeros((n, n)), np.zeros((n_steer, n, n)), np.zeros(n_el),
+            np.zeros((n_el, 2)), np.zeros((n_el, 2, 2)), np.zeros(n_el), np.zeros(n), np.zeros(n), np.zeros(n),
+            np.zeros(n_steer), np.zeros(n_steer), np.zeros(n), np.zeros(n_steer), np.zeros((n, n)), np.zeros(1))
+
+
+@_njit
+def derivative(t, s, acc, pack, inp, w):
+    """``ds/dt`` (explicit form): pose rate from the twist (3.15), joint rates, ``nu' = M^-1 rhs``."""
+    assemble(t, s, acc, pack, inp, False, w)
+    n = w[9].shape[0]
+    out = np.empty(2 * n)
+    th = s[2]
+    out[0] = math.cos(th) * s[n] - math.sin(th) * s[n + 1]
+    out[1] = math.sin(th) * s[n] + math.cos(th) * s[n + 1]
+    out[2:n] = s[n + 2:2 * n]
+    out[n:] = solve(w[1], w[9])
+    acc[:] = out[n:]
+    return out
+
+
+@_njit
+def step_semi_implicit(t, s, dt, acc, pack, inp, w, jac):
+    """One linearly implicit Euler step: friction and servo Jacobians implicit, then positions with the new velocity.
+
+    The tyre Jacobian ``dF/dv_slip`` is refreshed when `jac` is true and reused otherwise (a W-method).
+    """
+    assemble(t, s, acc, pack, inp, jac, w)
+    a, m, g, kdiag, rhs, mat = w[0], w[1], w[5], w[8], w[9], w[14]
+    n = rhs.shape[0]
+    mat[:] = m
+    for e in range(g.shape[0]):  # mat = M - dt (A' G A + servo terms)
+        for i in range(n):
+            a0, a1 = a[2 * e, i], a[2 * e + 1, i]
+            if a0 == 0.0 and a1 == 0.0:
+                continue
+            g00, g01 = a0 * g[e, 0, 0] + a1 * g[e, 1, 0], a0 * g[e, 0, 1] + a1 * g[e, 1, 1]
+            for j in range(n):
+                b0, b1 = a[2 * e, j], a[2 * e + 1, j]
+                if b0 == 0.0 and b1 == 0.0:
+                    continue
+                mat[i, j] -= dt * (g00 * b0 + g01 * b1)
+    for c in range(n):
+        mat[c, c] -= dt * kdiag[c]
+    dnu = solve(mat, rhs)  # (M - dt K) dnu/dt = rhs
+    for c in range(n):
+        acc[c] = dnu[c]
+        s[n + c] += dt * dnu[c]
+    th = s[2] + 0.5 * dt * s[n + 2]
+    s[0] += dt * (math.cos(th) * s[n] - math.sin(th) * s[n + 1])
+    s[1] += dt * (math.sin(th) * s[n] + math.cos(th) * s[n + 1])
+    for c in range(2, n):
+        s[c] += dt * s[n + c]
+
+
+@_njit
+def step_rk4(t, s, dt, acc, pack, inp, w):
+    """One classical Runge-Kutta step (explicit; for smooth, non-stiff cases such as frictionless checks)."""
+    k1 = derivative(t, s, acc, pack, inp, w)
+    k2 = derivative(t + dt / 2, s + dt / 2 * k1, acc, pack, inp, w)
+    k3 = derivative(t + dt / 2, s + dt / 2 * k2, acc, pack, inp, w)
+    k4 = derivative(t + dt, s + dt * k3, acc, pack, inp, w)
+    s += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+
+@_njit
+def observe(t, s, acc, pack, inp, w, rec, i):
+    """Store the state's outputs in the record arrays ``rec`` at row `i`."""
+    assemble(t, s, acc, pack, inp, False, w)
+    r_t, r_s, r_f, r_fz, r_v, r_vw, r_tau = rec
+    r_t[i] = t
+    r_s[i] = s
+    r_f[i] = w[4]
+    r_fz[i] = w[3]
+    n = w[9].shape[0]
+    for e in range(r_v.shape[1]):
+        for k in range(2):
+            r_v[i, e, k] = np.dot(w[0][2 * e + k], s[n:])
+    r_vw[i] = w[6]
+    r_tau[i] = w[7]
+
+
+@_njit
+def run(s, k0, dt, n_steps, every, method, jac_every, acc, pack, inp, w, rec, i0):
+    """`n_steps` fixed steps from `s` (changed in place) at step `k0` (``t = k0 dt``); a record every `every` steps
+    from row `i0`. Running in chunks gives the same result as one run.
+
+    `method` 0: semi-implicit, refreshing the tyre Jacobian every `jac_every` steps; 1: RK4.
+    """
+    i = i0
+    for j in range(n_steps):
+        k = k0 + j
+        if method == 0:
+            step_semi_implicit(k * dt, s, dt, acc, pack, inp, w, k % jac_every == 0)
+        else:
+            step_rk4(k * dt, s, dt, acc, pack, inp, w)
+        if (k + 1) % every == 0 and i < rec[0].shape[0]:
+            observe((k + 1) * dt, s, acc, pack, inp, w, rec, i)
+            i += 1
+    return i

@@ -1,0 +1,293 @@
+"""Compiled kernels of the dynamic model (thesis §7.2): slip matrix, mass matrix, contact forces, loads, steps.
+
+Imported lazily (numba takes a moment to import). No formula is written twice: the wheel rows are
+:func:`wmrkit.wheels.slip_row_entries` compiled as they are, the tyre kernels are those of
+:mod:`wmrkit.dynamics.tyres` compiled in a namespace where their helpers are compiled too.
+
+The model is passed as a tuple ``pack`` of arrays built by :func:`wmrkit.dynamics.model.DynamicModel.pack`:
+
+``el (E, 10)``: per contact element ``l, alpha, d, delta, gamma, r, r_r, beta_fixed, I_spin, I_roller``;
+``el_steer (E,)`` int: index of the steering angle the element follows, -1 for none; ``rate_map (E, 3, nr)``;
+``code (E,)`` int and ``tp (E, 4)``: tyre model and parameters; ``steer_col (S,)`` int: column of each steering
+rate in the velocity vector; ``steer_kind (S,)`` int: 0 centred (its z-inertia in I_T, (7.17)), 1 castor unit;
+``steer_prm (S, 5)``: ``I_s, m, l, alpha, d``; ``diag_I (n,)``: spin/roller inertia per column; ``carry (n,)``:
+1 for the columns that carry the wheel (twist, steering rates), 0 for rolling ones; ``body (6,)``: ``M, I, cx, cy,
+h, g``; ``pinv (E, 3)``: static load map when the contacts do not move (``fixed_loads``), ``fixed_loads (1,)``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import types
+from pathlib import Path
+
+import numba
+import numpy as np
+
+from .._jit import compile_cached
+from ..wheels import __file__ as wheels_file
+from ..wheels import slip_row_entries
+from . import tyres
+
+
+def _drop_stale_cache() -> None:
+    """Numba checks a cached kernel against its own file only, not against the functions it inlines (the tyre
+    formulas, the wheel rows): drop this package's cached kernels when any of those sources changed."""
+    here = Path(__file__).parent
+    sources = [here / f for f in ("_kernels.py", "_integrate.py", "tyres.py")] + [Path(wheels_file)]
+    try:
+        digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()
+        cache, stamp = here / "__pycache__", here / "__pycache__" / "dynamics-kernels.stamp"
+        if stamp.exists() and stamp.read_text() == digest:
+            return
+        for f in cache.glob("*.nb[ic]"):
+            f.unlink()
+        cache.mkdir(exist_ok=True)
+        stamp.write_text(digest)
+    except OSError:  # a read-only installation: numba compiles in memory anyway
+        pass
+
+
+def _inline(fn):
+    """Compiled and inlined into its callers (no call boundary: the model's arrays are not re-counted per call)."""
+    try:
+        return numba.njit(cache=True, inline="always", fastmath=True)(fn)
+    except RuntimeError:  # no writable cache location
+        return numba.njit(inline="always", fastmath=True)(fn)
+
+
+def _njit(fn, fastmath: bool = True):
+    """Compiled for the types of its first call, cached on disk where possible (:func:`wmrkit._jit.compile_cached`);
+    `fastmath`: no NaN or infinity reaches the kernels (the simulator checks the state between chunks)."""
+    if not fastmath:
+        return compile_cached(fn, None)
+    try:
+        return numba.njit(cache=True, fastmath=True)(fn)
+    except RuntimeError:  # no writable cache location
+        return numba.njit(fastmath=True)(fn)
+
+
+def _identity(x):
+    return x
+
+
+def _pair(a, b):
+    return (a, b)
+
+
+def _compiled_namespace():
+    """The tyre kernels compiled, each calling compiled helpers (same source, numba globals)."""
+    g = dict(vars(tyres))
+    g["_asarray"] = _njit(_identity)
+    g["TyreForces"] = _njit(_pair)
+    names = ("slip_ratio", "slip_angle", "magic_formula", "lu_longitudinal", "lu_lateral", "delft_combined",
+             "linear_forces", "coulomb_forces", "dugoff_forces", "pacejka_forces")
+    for name in names:
+        fn = getattr(tyres, name)
+        g[name] = _njit(types.FunctionType(fn.__code__, g, name, fn.__defaults__, fn.__closure__), fastmath=True)
+    return g
+
+
+_drop_stale_cache()
+_NS = _compiled_namespace()
+_linear, _coulomb, _dugoff, _pacejka = (_NS[n] for n in ("linear_forces", "coulomb_forces", "dugoff_forces",
+                                                          "pacejka_forces"))
+_rows = compile_cached(slip_row_entries, None)
+
+
+@_inline
+def tyre(code, p, fz, vl, vg, vw, vr):
+    """Force ``(F_lat, F_long)`` of tyre model `code` (see ``tyres.TYRES``) on one contact."""
+    if code == 0:
+        return _linear(p[0], p[1], p[2], p[3], fz, vl, vg, vw, vr)
+    if code == 1:
+        return _coulomb(p[0], p[1], p[2], p[3], fz, vl, vg, vw, vr)
+    if code == 2:
+        return _dugoff(p[0], p[1], p[2], p[3], fz, vl, vg, vw, vr)
+    return _pacejka(p[0], p[1], p[2], p[3], fz, vl, vg, vw, vr)
+
+
+@_njit
+def element_angles(beta, el, el_steer, out):
+    """Absolute angle of each element's steering frame into `out` ``(E,)``."""
+    for e in range(el.shape[0]):
+        out[e] = el[e, 7] + (beta[el_steer[e]] if el_steer[e] >= 0 else 0.0)
+    return out
+
+
+@_inline
+def slip_matrix(beta, pack, n, a, steer_only):
+    """Fill ``a (2E, n)``: the rows of (3.22) in frame Ē over the velocity vector (extra columns zero, as given);
+    with `steer_only`, only the rows of the steering wheels (the others do not change)."""
+    el, el_steer, rate_map = pack[0], pack[1], pack[2]
+    nr = rate_map.shape[2]
+    for e in range(el.shape[0]):
+        if steer_only and el_steer[e] < 0:
+            continue  # a wheel that does not steer: its rows are already in `a`
+        be_e = el[e, 7] + (beta[el_steer[e]] if el_steer[e] >= 0 else 0.0)
+        rows = _rows(be_e, el[e, 0], el[e, 1], el[e, 2], el[e, 3], el[e, 4], el[e, 5], el[e, 6])
+        for i in range(2):
+            row = rows[i]
+            a[2 * e + i, 0], a[2 * e + i, 1], a[2 * e + i, 2] = row[0], row[1], row[2]
+            for c in range(nr):
+                a[2 * e + i, 3 + c] = row[3] * rate_map[e, 0, c] + row[4] * rate_map[e, 1, c] \
+                    + row[5] * rate_map[e, 2, c]
+
+
+@_inline
+def mass_matrix(beta, pack, n, m, dm):
+    """Fill the mass matrix ``m (n, n)`` of (7.17) and its derivatives ``dm (S, n, n)`` along the steering angles."""
+    steer_col, steer_kind, steer_prm, diag_i, body = pack[5], pack[6], pack[7], pack[8], pack[10]
+    m[:] = 0.0
+    dm[:] = 0.0
+    mb, ib, cx, cy = body[0], body[1], body[2], body[3]
+    m[0, 0] += mb
+    m[1, 1] += mb
+    m[0, 2] -= mb * cy
+    m[2, 0] -= mb * cy
+    m[1, 2] += mb * cx
+    m[2, 1] += mb * cx
+    m[2, 2] += ib + mb * (cx * cx + cy * cy)
+    for j in range(n):
+        m[j, j] += diag_i[j]
+    for k in range(steer_col.shape[0]):
+        c, i_s, ms = steer_col[k], steer_prm[k, 0], steer_prm[k, 1]
+        m[c, c] += i_s
+        m[c, 2] += i_s
+        m[2, c] += i_s
+        if steer_kind[k] == 0:
+            continue  # centred: I_os (b'^2 + 2 b' w) / 2, its I_os w^2 / 2 being in I_T (7.17)
+        m[2, 2] += i_s  # castor unit: I_cs (b' + w)^2 / 2 and M_c |v_cm|^2 / 2, CM at the wheel centre (7.18)
+        ll, al, d, b = steer_prm[k, 2], steer_prm[k, 3], steer_prm[k, 4], beta[k]
+        px, py = ll * math.cos(al) - d * math.sin(b), ll * math.sin(al) + d * math.cos(b)
+        jx, jy, djx, djy = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+        jx[0], jx[2], jx[c] = 1.0, -py, -d * math.cos(b)
+        jy[1], jy[2], jy[c] = 1.0, px, -d * math.sin(b)
+        djx[2], djx[c] = d * math.sin(b), d * math.sin(b)
+        djy[2], djy[c] = -d * math.cos(b), -d * math.cos(b)
+        for i in range(n):
+            for j in range(n):
+                m[i, j] += ms * (jx[i] * jx[j] + jy[i] * jy[j])
+                dm[k, i, j] += ms * (djx[i] * jx[j] + jx[i] * djx[j] + djy[i] * jy[j] + jy[i] * djy[j])
+
+
+@_inline
+def bias(nu, beta_rate, m, dm, steer_col, steer_kind, out):
+    """Velocity terms of the Lagrange-Poincaré equations: ``ad*_xi p`` (SE(2)), ``-M' nu`` and ``nu' dM nu / 2``."""
+    n = nu.shape[0]
+    p0, p1 = 0.0, 0.0
+    for j in range(n):
+        p0 += m[0, j] * nu[j]
+        p1 += m[1, j] * nu[j]
+    out[:] = 0.0
+    out[0] = nu[2] * p1
+    out[1] = -nu[2] * p0
+    out[2] = nu[1] * p0 - nu[0] * p1
+    for k in range(steer_col.shape[0]):
+        if steer_kind[k] == 0:
+            continue  # a centred steering unit: dM/dbeta = 0
+        quad = 0.0
+        for i in range(n):
+            row = 0.0
+            for j in range(n):
+                row += dm[k, i, j] * nu[j]
+            out[i] -= beta_rate[k] * row
+            quad += nu[i] * row
+        out[steer_col[k]] += 0.5 * quad
+
+
+@_inline
+def contact_forces(a, nu, pack, fz, f, g, vw, jac):
+    """Tyre forces ``f (E, 2)`` on the slips ``a @ nu``; with `jac`, ``g (E, 2, 2) = dF/dv_slip`` (forward diff.)."""
+    code, tp, carry = pack[3], pack[4], pack[9]
+    for e in range(code.shape[0]):
+        vl, vg, w = 0.0, 0.0, 0.0
+        for c in range(nu.shape[0]):
+            vl += a[2 * e, c] * nu[c]
+            vg += a[2 * e + 1, c] * nu[c]
+            w += a[2 * e + 1, c] * nu[c] * carry[c]
+        vw[e] = w
+        fl, fg = tyre(code[e], tp[e], fz[e], vl, vg, w, vg - w)
+        f[e, 0], f[e, 1] = fl, fg
+        if jac:
+            h = 1e-7 * (1.0 + abs(vl) + abs(vg))
+            fl2, fg2 = tyre(code[e], tp[e], fz[e], vl + h, vg, w, vg - w)
+            fl3, fg3 = tyre(code[e], tp[e], fz[e], vl, vg + h, w, vg + h - w)
+            g[e, 0, 0], g[e, 1, 0] = (fl2 - fl) / h, (fg2 - fg) / h
+            g[e, 0, 1], g[e, 1, 1] = (fl3 - fl) / h, (fg3 - fg) / h
+
+
+@_inline
+def normal_loads(beta, nu, acc, pack, out):
+    """Normal loads (7.64) generalised: static + inertial transfer (h_CM) + spin-momentum rate; least norm.
+
+    ``sum F_N = m g``, ``sum dx F_N = -h m a_x``, ``sum dy F_N = -h m a_y + sum I phi'' u_x`` about the centre of
+    mass (a: its acceleration in body axes from `acc`, the velocity derivative); negative loads are set to 0.
+    """
+    el, el_steer, rate_map, steer_kind, steer_prm, body, pinv, fixed = (pack[0], pack[1], pack[2], pack[6],
+                                                                          pack[7], pack[10], pack[11], pack[12])
+    mb, cx, cy, h, grav = body[0], body[2], body[3], body[4], body[5]
+    mt, mx, my = mb, mb * cx, mb * cy
+    for k in range(steer_kind.shape[0]):
+        if steer_kind[k] == 1:
+            d, b = steer_prm[k, 4], beta[k]
+            mt += steer_prm[k, 1]
+            mx += steer_prm[k, 1] * (steer_prm[k, 2] * math.cos(steer_prm[k, 3]) - d * math.sin(b))
+            my += steer_prm[k, 1] * (steer_prm[k, 2] * math.sin(steer_prm[k, 3]) + d * math.cos(b))
+    gx, gy = mx / mt, my / mt
+    w = nu[2]
+    ax = acc[0] - w * nu[1] - acc[2] * gy - w * w * gx
+    ay = acc[1] + w * nu[0] + acc[2] * gx - w * w * gy
+    hx, hy = 0.0, 0.0
+    nr = rate_map.shape[2]
+    for e in range(el.shape[0]):
+        be_e = el[e, 7] + (beta[el_steer[e]] if el_steer[e] >= 0 else 0.0)
+        spin_acc, roll_acc = 0.0, 0.0
+        for c in range(nr):
+            spin_acc += rate_map[e, 1, c] * acc[3 + c]
+            roll_acc += rate_map[e, 2, c] * acc[3 + c]
+        t_l, t_e = be_e + el[e, 3], be_e + el[e, 3] + el[e, 4]
+        hx += el[e, 8] * spin_acc * math.cos(t_l) + el[e, 9] * roll_acc * math.cos(t_e)
+        hy += el[e, 8] * spin_acc * math.sin(t_l) + el[e, 9] * roll_acc * math.sin(t_e)
+    r0, r1, r2 = mt * grav, -h * mt * ax - hy, -h * mt * ay + hx
+    if fixed[0] == 1:
+        p = pinv
+    else:
+        gm = np.ones((3, el.shape[0]))
+        be = element_angles(beta, el, el_steer, np.empty(el.shape[0]))
+        for e in range(el.shape[0]):
+            gm[1, e] = el[e, 0] * math.cos(el[e, 1]) - el[e, 2] * math.sin(be[e]) - gx
+            gm[2, e] = el[e, 0] * math.sin(el[e, 1]) + el[e, 2] * math.cos(be[e]) - gy
+        p = np.linalg.pinv(gm)
+    for e in range(el.shape[0]):
+        out[e] = max(p[e, 0] * r0 + p[e, 1] * r1 + p[e, 2] * r2, 0.0)
+
+
+@_njit
+def solve(mat, rhs):
+    """Gaussian elimination with partial pivoting (small dense systems; no LAPACK call overhead)."""
+    n = rhs.shape[0]
+    a, x = mat.copy(), rhs.copy()
+    for i in range(n):
+        p = i
+        for r in range(i + 1, n):
+            if abs(a[r, i]) > abs(a[p, i]):
+                p = r
+        if p != i:
+            for c in range(n):
+                a[i, c], a[p, c] = a[p, c], a[i, c]
+            x[i], x[p] = x[p], x[i]
+        piv = a[i, i]
+        for r in range(i + 1, n):
+            f = a[r, i] / piv
+            if f != 0.0:
+                for c in range(i, n):
+                    a[r, c] -= f * a[i, c]
+                x[r] -= f * x[i]
+    for i in range(n - 1, -1, -1):
+        s = x[i]
+        for c in range(i + 1, n):
+            s -= a[i, c] * x[c]
+        x[i] = s / a[i, i]
+    return x

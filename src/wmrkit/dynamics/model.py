@@ -1,0 +1,214 @@
+"""The dynamic model (thesis §7.2, Tables 7.1-7.2) of any described robot, generated from its description.
+
+Generalized velocities ``nu`` (``DynamicModel.names``): the body twist ``(vx, vy, omega)`` in the robot frame, the
+wheel rates of ``Robot.rate_names`` (the columns of the slip matrix (3.22)), then the steering rate of every
+steerable wheel (``wheel.steer``: a degree of freedom with inertia and torque (7.24) that the slip matrix does not
+see). Configuration: the pose, the steering angles β (the thesis's, ``Robot.steer_names`` order) and the wheel
+angles. With the kinetic energy ``T = nu' M(beta) nu / 2`` of (7.17) the equations are the Lagrange equations (7.9)
+in the body-fixed (Lagrange-Poincaré / Hamel) form, which for the twist read ``d/dt p = ad*_xi p + F`` (SE(2)):
+
+    M(beta) nu' = tau + A(beta)' F_fric + b(beta, nu)          (7.11), (7.16), (7.21)-(7.26)
+
+``A`` is ``Robot.constraint_matrix(beta)`` (frame Ē) with zero columns for the steerable steering rates, so
+``v_slip = A nu`` and the virtual power of the contact forces is ``F' A nu`` (7.16); ``F_fric`` comes from each
+wheel's tyre model (:mod:`.tyres`) on those slips, with normal loads from (7.64) generalised
+(:meth:`DynamicModel.normal_loads`). R need not be at the centre of mass (the thesis puts it there, §7.2): the body
+term is ``M_T |v + omega x c|^2 / 2 + I_T omega^2 / 2``. Castor units are bodies of their own with their CM at
+the wheel centre (7.18)-(7.20), exact (no (7.21) approximation, ``docs/errata.md``).
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors, readonly
+from ..errors import WmrkitError
+from ..robot import Robot, _table
+from .mass import CASTOR_TYPES, Body
+from .tyres import Tyre
+
+GRAVITY = 9.81
+
+
+@dataclass(frozen=True, eq=False)
+class DynamicModel:
+    """A robot with mass properties and tyres, ready for the kernels. Build it with :meth:`of`.
+
+    ``names`` (n,): the generalized velocities; ``contacts`` (E,): one name per contact point (``wheel`` or
+    ``wheel.1``/``wheel.2`` for double wheels); ``steer_columns`` (n_steer,): column of each steering rate;
+    ``tyres`` (E,): the tyre of each contact; ``gravity`` [m/s^2].
+    """
+
+    robot: Robot
+    names: tuple[str, ...]
+    contacts: tuple[str, ...]
+    steer_columns: tuple[int, ...]
+    tyres: tuple[Tyre, ...]
+    gravity: float
+    pack: tuple  # arrays of the compiled kernels (see wmrkit.dynamics._kernels)
+
+    @classmethod
+    def of(cls, robot: Robot, tyre: Tyre | str | None = None, *, gravity: float = GRAVITY) -> DynamicModel:
+        """The model of `robot`; `tyre` (a :class:`Tyre` or a model name) replaces every wheel's own tyre.
+
+        Wheels without a tyre get ``pacejka`` (appendix 7.A1). Raises :class:`WmrkitError` when the description
+        lacks what the dynamics needs (``body``, a spin inertia, a roller or castor-steering inertia).
+        """
+        if isinstance(tyre, str):
+            tyre = Tyre.of(tyre)
+        return _build(robot, tyre, float(gravity))
+
+    @property
+    def n(self) -> int:
+        """Number of generalized velocities."""
+        return len(self.names)
+
+    @property
+    def body(self) -> Body:
+        """The robot's mass properties."""
+        return self.robot.body  # type: ignore[return-value]
+
+    def velocity(self, twist: ArrayLike, rates: ArrayLike | None = None) -> np.ndarray:
+        """A velocity vector ``(n,)`` from a twist and the other velocities (default 0)."""
+        nu = np.zeros(self.n)
+        nu[:3] = as_vectors(twist, 3, "twist")
+        if rates is not None:
+            nu[3:] = as_vectors(rates, self.n - 3, "rates")
+        return nu
+
+    def slip_matrix(self, beta: ArrayLike | None = None) -> np.ndarray:
+        """``A (2E, n)``: :meth:`Robot.constraint_matrix` (frame Ē), zero columns for steerable steering rates."""
+        a = self.robot.constraint_matrix(self._beta(beta))
+        return readonly(np.concatenate([a, np.zeros((*a.shape[:-1], self.n - a.shape[-1]))], axis=-1))
+
+    def mass_matrix(self, beta: ArrayLike | None = None) -> np.ndarray:
+        """Mass matrix ``M (n, n)`` of the kinetic energy (7.17) at steering angles `beta`."""
+        from ._kernels import mass_matrix
+
+        m, dm = np.zeros((self.n, self.n)), np.zeros((len(self.steer_columns), self.n, self.n))
+        mass_matrix(self._beta(beta), self.pack, self.n, m, dm)
+        return readonly(m)
+
+    def kinetic_energy(self, beta: ArrayLike | None, nu: ArrayLike) -> float:
+        """``T = nu' M nu / 2`` [J] (7.17)."""
+        nu = as_vectors(nu, self.n, "nu")
+        return float(0.5 * nu @ self.mass_matrix(beta) @ nu)
+
+    def normal_loads(self, beta: ArrayLike | None = None, nu: ArrayLike | None = None,
+                     acceleration: ArrayLike | None = None) -> np.ndarray:
+        """Normal loads ``(E,)`` [N], (7.64) generalised to any contacts (least-norm: equal-spring suspension).
+
+        `acceleration` is ``d nu / dt`` (n,) (default 0: the static loads, as MCD/WLS use; MQE passes the
+        centripetal state through `nu`). Load transfer uses ``com_height``; the wheels' spin accelerations
+        enter through their angular momentum (the thesis's ``tau_r`` terms, corrected in ``docs/errata.md``).
+        """
+        from ._kernels import normal_loads
+
+        out = np.zeros(len(self.contacts))
+        nu = np.zeros(self.n) if nu is None else np.array(as_vectors(nu, self.n, "nu"))
+        acc = np.zeros(self.n) if acceleration is None else np.array(as_vectors(acceleration, self.n, "acceleration"))
+        normal_loads(self._beta(beta), nu, acc, self.pack, out)
+        return readonly(out)
+
+    def contact_forces(self, beta: ArrayLike | None, nu: ArrayLike, loads: ArrayLike | None = None) -> np.ndarray:
+        """Tyre forces ``(E, 2)`` [N] (lateral, longitudinal; frame Ē) at velocities `nu` (default: static loads)."""
+        from ._kernels import contact_forces
+
+        nu = np.array(as_vectors(nu, self.n, "nu"))  # writable copies: one compiled signature
+        loads = self.normal_loads(beta) if loads is None else as_vectors(loads, len(self.contacts), "loads")
+        e = len(self.contacts)
+        f, g, vw = np.zeros((e, 2)), np.zeros((e, 2, 2)), np.zeros(e)
+        contact_forces(np.array(self.slip_matrix(beta)), nu, self.pack, np.array(loads, dtype=float),
+                       f, g, vw, False)
+        return readonly(f)
+
+    def accelerations(self, beta: ArrayLike | None, nu: ArrayLike, torques: ArrayLike | None = None,
+                      forces: ArrayLike | None = None) -> np.ndarray:
+        """``d nu / dt`` ``(n,)`` from the equations of motion, for given contact `forces` ``(E, 2)`` (default: the
+        tyres at static loads) and generalized `torques` ``(n,)`` (default 0)."""
+        from ._kernels import bias, mass_matrix
+
+        beta = self._beta(beta)
+        nu = np.array(as_vectors(nu, self.n, "nu"))  # writable copies: one compiled signature
+        f = self.contact_forces(beta, nu) if forces is None else np.asarray(forces, dtype=float)
+        tau = np.zeros(self.n) if torques is None else as_vectors(torques, self.n, "torques")
+        m, dm = np.zeros((self.n, self.n)), np.zeros((len(self.steer_columns), self.n, self.n))
+        mass_matrix(beta, self.pack, self.n, m, dm)
+        b = np.zeros(self.n)
+        bias(nu, nu[list(self.steer_columns)].copy(), m, dm, self.pack[5], self.pack[6], b)
+        rhs = tau + self.slip_matrix(beta).T @ f.reshape(-1) + b
+        return readonly(np.linalg.solve(m, rhs))
+
+    def _beta(self, beta: ArrayLike | None) -> np.ndarray:
+        if beta is None:
+            return np.array(self.robot.beta, dtype=float)
+        return np.array(as_vectors(beta, len(self.steer_columns), "beta"), dtype=float)
+
+
+@functools.lru_cache(maxsize=64)
+def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
+    body = robot.body
+    if body is None:
+        raise WmrkitError(f"robot '{robot.name}' has no mass properties: add a 'body: {{mass, inertia, com, "
+                          "com_height}' section to its description (docs/dynamics.md)")
+    t = _table(robot)
+    names = list(robot.velocity_names)
+    steer_cols = []
+    for w in robot.wheels:
+        if not w.kind.steers:
+            continue
+        if "steer" in w.kind.rates:
+            steer_cols.append(names.index(f"{w.name}.steer"))
+        else:
+            names.append(f"{w.name}.steer")
+            steer_cols.append(len(names) - 1)
+    n, n_el = len(names), t.n_elements
+    diag_i = np.zeros(n)
+    for c, name in enumerate(names[3:], start=3):
+        wheel, joint = name.split(".")
+        w = robot.wheel(wheel)
+        if joint.startswith("spin"):
+            diag_i[c] = _need(w.spin_inertia, robot, wheel, "inertia.spin")
+        elif joint == "roller":
+            diag_i[c] = _need(w.roller_inertia, robot, wheel, "inertia.roller")
+    steer_kind, steer_prm = [], []
+    for w in robot.wheels:
+        if w.kind.steers:
+            castor = w.type in CASTOR_TYPES
+            steer_kind.append(1 if castor else 0)
+            i_s = _need(w.steer_inertia, robot, w.name, "inertia.steer")
+            steer_prm.append((i_s, w.mass if castor else 0.0, w.l, w.alpha, w.d if castor else 0.0))
+    tyres_e = tuple(tyre or robot.wheels[i].tyre or Tyre.of("pacejka") for i in t.element_wheel)
+    el = np.column_stack([t.l, t.alpha, t.d, t.delta, t.gamma, t.r, t.r_r, t.element_beta_fixed,
+                          [robot.wheels[i].spin_inertia for i in t.element_wheel],
+                          [robot.wheels[i].roller_inertia for i in t.element_wheel]])
+    el_steer = np.where(t.element_steers, t.element_steer_index, -1).astype(np.int64)
+    carry = np.zeros(n)
+    carry[:3] = 1.0
+    carry[steer_cols] = 1.0
+    moving = bool(np.any(t.element_steers & (np.abs(t.d) > 0)))
+    geo = np.ones((3, n_el))
+    geo[1] = t.l * np.cos(t.alpha) - t.d * np.sin(t.element_beta_fixed) - body.com[0]  # moving: recomputed
+    geo[2] = t.l * np.sin(t.alpha) + t.d * np.cos(t.element_beta_fixed) - body.com[1]
+    pack = (np.array(el, dtype=float, order="C"), el_steer, np.array(t.rate_map, dtype=float, order="C"),
+            np.array([ty.kind.code for ty in tyres_e], dtype=np.int64), np.array([ty.vector() for ty in tyres_e]),
+            np.array(steer_cols, dtype=np.int64), np.array(steer_kind, dtype=np.int64),
+            np.array(steer_prm, dtype=float).reshape(-1, 5), diag_i, carry,
+            np.array([body.mass, body.inertia, *body.com, body.com_height, gravity]),
+            np.array(np.linalg.pinv(geo), order="C"), np.array([0 if moving else 1], dtype=np.int64))
+    contacts = []
+    for w in robot.wheels:
+        k = len(w.elements())
+        contacts.extend([w.name] if k == 1 else [f"{w.name}.{j + 1}" for j in range(k)])
+    return DynamicModel(robot, tuple(names), tuple(contacts), tuple(steer_cols), tyres_e, gravity, pack)
+
+
+def _need(value: float, robot: Robot, wheel: str, field: str) -> float:
+    if value <= 0:
+        raise WmrkitError(f"robot '{robot.name}': wheel '{wheel}' needs '{field}' > 0 for the dynamics "
+                          "(docs/dynamics.md)")
+    return value

@@ -1,0 +1,169 @@
+"""Inputs for the simulator: torque files and built-in programs (straight, turn, the paths of thesis §7.5.4).
+
+A torque file is a CSV with a header ``time,<wheel>.<joint>,...``: times [s] strictly increasing, torques [N m] on
+actuated joints (``spin``, ``spin1``/``spin2``, ``steer``), linear between rows; a ``<wheel>.heading`` column [rad]
+is a steering-servo reference instead (the users' heading, 0 = straight ahead).
+
+A built-in program (:func:`path_program`) is a schedule of body twists; each actuated wheel follows the no-slip
+rate of its twist (wheel IK, §8.4) through a saturated rate servo and each actuated steering the IK heading
+through a PD servo. The pose is not fed back: the robot slips and drifts as the tyres dictate, which is what a
+slip study needs (the thesis's experiments 7.5.4: rectangle, corkscrew, D, figure eight, triple loop).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import readonly
+from ..errors import WmrkitError
+from .model import DynamicModel
+from .simulate import Inputs, _knots, joint_column
+
+#: Built-in programs: name -> segments (duration [s], forward speed factor, curvature [1/m] at speed 1).
+PATHS: dict[str, tuple[tuple[float, float, float], ...]] = {
+    "straight": ((1.0, 0.0, 0.0), (1.0, 1.0, 0.0)),
+    "turn": ((1.0, 0.0, 0.0), (1.0, 1.0, 0.0), (1.0, 1.0, 1 / 3)),
+    "rectangle": ((1.0, 0.0, 0.0), *((4.0, 1.0, 0.0), (2.356, 1.0, 1 / 3), (2.0, 1.0, 0.0), (2.356, 1.0, 1 / 3)) * 2),
+    "corkscrew": ((1.0, 0.0, 0.0), (3.0, 1.0, 0.0), *((3.142, 1.0, 1 / 3), (1.5, 1.0, 0.0)) * 3),
+    "d": ((1.0, 0.0, 0.0), (5.0, 1.0, 0.0), (2.356, 1.0, 1 / 3), (4.712, 1.0, 1 / 3), (2.356, 1.0, 1 / 3)),
+    "figure-eight": ((1.0, 0.0, 0.0), (9.425, 1.0, 1 / 3), (9.425, 1.0, -1 / 3)),
+    "triple-loop": ((1.0, 0.0, 0.0), (28.274, 1.0, 1 / 3)),
+}
+
+
+def path_program(model: DynamicModel, name: str, *, speed: float = 2.0, radius_scale: float = 1.0,
+                 bandwidth: float = 30.0) -> tuple[Inputs, float]:
+    """Inputs of the built-in program `name` (:data:`PATHS`) at `speed` [m/s]; returns ``(inputs, duration)``.
+
+    Each segment holds a forward speed and a curvature (radius ``3 m x radius_scale`` in the turns); the first
+    second ramps the speed up from 0. The durations are for ``speed = 2`` with ``radius_scale = 1`` (a 90 deg turn
+    at radius 3 m takes 2.356 s) and scale with ``radius_scale / (speed / 2)``.
+    """
+    if name not in PATHS:
+        raise WmrkitError(f"unknown program '{name}' (programs: {', '.join(PATHS)})")
+    if not (speed > 0 and radius_scale > 0):
+        raise WmrkitError("speed and radius_scale must be > 0")
+    scale = radius_scale * 2.0 / speed
+    times, twists, t = [0.0], [(0.0, 0.0, 0.0)], 0.0
+    for k, (duration, v, curvature) in enumerate(PATHS[name]):
+        dt = duration if k == 0 else duration * scale
+        twist = (speed * (1.0 if k == 0 else v), 0.0, speed * curvature / radius_scale)
+        times += [t + min(0.2, dt / 4), t + dt] if k else [t + dt]
+        twists += [twist, twist] if k else [twist]
+        t += dt
+    return twist_program(model, np.array(times), feasible_twists(model, np.array(twists)), bandwidth=bandwidth), t
+
+
+def feasible_twists(model: DynamicModel, twists: ArrayLike) -> np.ndarray:
+    """`twists` ``(K, 3)`` with ``vy`` replaced by the value that least-squares zeroes the fixed wheels' side slip.
+
+    A robot with fixed wheels away from its origin (the forklift at its fork tips) must move sideways at the
+    origin when it turns; programs give ``(v, 0, omega)`` and this makes them feasible (unchanged without fixed
+    wheels: ``vy = 0``).
+    """
+    from ..kinematics.wheel_ik import wheel_commands
+
+    twists = np.array(twists, dtype=float).reshape(-1, 3)
+    at0 = wheel_commands(model.robot, twists * [1, 0, 1]).slip
+    at1 = wheel_commands(model.robot, twists * [1, 0, 1] + [0, 1, 0]).slip
+    slope = at1 - at0  # the side slip is affine in vy
+    denom = np.sum(slope * slope, axis=-1)
+    twists[:, 1] = np.where(denom > 0, -np.sum(slope * at0, axis=-1) / np.where(denom > 0, denom, 1), 0.0)
+    return twists
+
+
+def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, bandwidth: float = 30.0) -> Inputs:
+    """Servo inputs that make the actuated joints follow the no-slip joint motion of body `twists` ``(K, 3)``.
+
+    Rate servos on actuated wheel joints (gain ``bandwidth x`` the wheel's reflected inertia, at least the grip
+    torque per 0.1 rad/s, saturated at the grip ``mu Fz r`` with mu = 1), PD servos on actuated steering
+    (natural frequency `bandwidth` [rad/s]).
+    """
+    from ..kinematics.wheel_ik import wheel_commands
+
+    t = _knots(time)
+    twists = np.asarray(twists, dtype=float).reshape(len(t), 3)
+    robot, n = model.robot, model.n
+    cmd = wheel_commands(robot, twists)
+    rates = np.zeros((len(t), n))
+    rates[:, 3:3 + cmd.rates.shape[-1]] = np.nan_to_num(cmd.rates)
+    gain, limit = np.zeros(n), np.full(n, np.inf)
+    loads = model.normal_loads()
+    m_total = model.body.mass + sum(w.mass for w in robot.wheels)
+    driven = [c for c in range(3, n) if _actuated(model, c) and ".steer" not in model.names[c]]
+    for c in driven:
+        w = robot.wheel(model.names[c].split(".")[0])
+        reflected = w.spin_inertia + m_total * w.r ** 2 / max(len(driven), 1)
+        contact = [k for k, name in enumerate(model.contacts) if name.split(".")[0] == w.name]
+        limit[c] = max(loads[contact].max(), 1.0) * w.r
+        gain[c] = max(bandwidth * reflected, limit[c] / 0.1)  # full grip torque at 0.1 rad/s of error at most
+    headings = np.zeros((len(t), len(model.steer_columns)))
+    kp, kd = np.zeros(len(model.steer_columns)), np.zeros(len(model.steer_columns))
+    steer_wheels = [w for w in robot.wheels if w.kind.steers]
+    for k, (w, c) in enumerate(zip(steer_wheels, model.steer_columns, strict=True)):
+        wheel_index = robot.wheel_names.index(w.name)
+        h = cmd.heading[:, wheel_index]
+        headings[:, k] = np.where(np.isfinite(h), h, w.heading)
+        if _actuated(model, c):
+            kp[k] = w.steer_inertia * bandwidth ** 2
+            kd[k] = 2 * w.steer_inertia * bandwidth
+    return Inputs(*(readonly(a) for a in (t, np.zeros((len(t), n)), rates, gain, limit, headings, kp, kd)))
+
+
+def _actuated(model: DynamicModel, column: int) -> bool:
+    wheel, _, joint = model.names[column].partition(".")
+    return joint.rstrip("12") in model.robot.wheel(wheel).actuated
+
+
+def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
+    """:class:`Inputs` from a torque CSV (module docstring); errors name the file, the line and the column."""
+    source = str(path)
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.reader(fh))
+    except (OSError, UnicodeDecodeError) as err:
+        raise WmrkitError(f"{source}: cannot read the file ({err.__class__.__name__})") from None
+    if not rows or not rows[0] or rows[0][0].strip() != "time" or len(rows) < 2:
+        raise WmrkitError(f"{source}:1: expected a header 'time,<wheel>.<joint>,...' and at least one row")
+    header = [h.strip() for h in rows[0]]
+    values = np.zeros((len(rows) - 1, len(header)))
+    for i, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise WmrkitError(f"{source}:{i}: {len(row)} values for {len(header)} columns")
+        for j, cell in enumerate(row):
+            try:
+                values[i - 2, j] = float(cell)
+            except ValueError:
+                raise WmrkitError(f"{source}:{i}: column '{header[j]}': not a number: {cell!r}") from None
+            if not math.isfinite(values[i - 2, j]):
+                raise WmrkitError(f"{source}:{i}: column '{header[j]}': must be finite")
+    if np.any(np.diff(values[:, 0]) <= 0):
+        raise WmrkitError(f"{source}: times must be strictly increasing")
+    torques, headings = {}, {}
+    for j, name in enumerate(header[1:], start=1):
+        wheel, _, joint = name.partition(".")
+        try:
+            if joint == "heading":
+                headings[model.steer_columns[model.robot.steer_names.index(wheel)]] = values[:, j]
+            else:
+                torques[name] = values[:, j]
+                joint_column(model, name)
+        except (WmrkitError, ValueError) as err:
+            raise WmrkitError(f"{source}:1: column '{name}': {err}") from None
+    inputs = Inputs.torques_only(model, values[:, 0], torques)
+    if not headings:
+        return inputs
+    href = np.tile(model.robot.heading, (len(values), 1))
+    kp, kd = np.zeros(len(model.steer_columns)), np.zeros(len(model.steer_columns))
+    steer_wheels = [w for w in model.robot.wheels if w.kind.steers]
+    for k, c in enumerate(model.steer_columns):
+        if c in headings:
+            href[:, k] = headings[c]
+            kp[k], kd[k] = steer_wheels[k].steer_inertia * 900.0, steer_wheels[k].steer_inertia * 60.0
+    return Inputs(inputs.time, inputs.torques, inputs.rate_reference, inputs.rate_gain, inputs.torque_limit,
+                  readonly(href), readonly(kp), readonly(kd))

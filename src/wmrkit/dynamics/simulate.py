@@ -1,0 +1,236 @@
+"""Simulation of the dynamic model (thesis §7.2) from joint torques (and servo references) to motion.
+
+:func:`simulate` integrates :class:`~wmrkit.dynamics.model.DynamicModel` with a fixed step (``"semi-implicit"``:
+linearly implicit Euler, stable with stiff tyres at a 1 kHz step; ``"rk4"``) or adaptively (``"adaptive"``:
+scipy's LSODA), compiled with numba, with a ``tqdm`` bar on long runs. Inputs are an :class:`Inputs` value
+(see :mod:`.programs` for CSV torque files and built-in programs); the result is a frozen :class:`Simulation`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import as_vectors, readonly
+from ..errors import WmrkitError
+from ..robot import Robot
+from ..wheels import heading_from_beta
+from .model import DynamicModel
+from .tyres import Tyre
+
+Method = Literal["semi-implicit", "rk4", "adaptive"]
+METHODS = ("semi-implicit", "rk4", "adaptive")
+
+
+@dataclass(frozen=True, eq=False)
+class Inputs:
+    """Joint inputs over time, linear between the knots ``time`` and held outside them.
+
+    ``torques (K, n)`` [N m]: feed-forward generalized torques on the columns of ``DynamicModel.names`` (wheel
+    spins, steering); ``rate_reference (K, n)`` [rad/s] and ``rate_gain (n,)`` [N m s/rad]: wheel-rate servos
+    ``tau += gain (reference - rate)``, saturated at ``torque_limit (n,)``; ``heading_reference (K, n_steer)``
+    [rad, headings: 0 = rolling straight ahead] with ``steer_kp``, ``steer_kd (n_steer,)``: steering servos.
+    """
+
+    time: np.ndarray
+    torques: np.ndarray
+    rate_reference: np.ndarray
+    rate_gain: np.ndarray
+    torque_limit: np.ndarray
+    heading_reference: np.ndarray
+    steer_kp: np.ndarray
+    steer_kd: np.ndarray
+
+    @classmethod
+    def torques_only(cls, model: DynamicModel, time: ArrayLike, torques: dict[str, ArrayLike]) -> Inputs:
+        """Pure torque inputs: `torques` maps actuated joints (``wheel.spin``, ``wheel.steer``) to values (K,)."""
+        t = _knots(time)
+        tau = np.zeros((len(t), model.n))
+        for name, values in torques.items():
+            tau[:, joint_column(model, name)] = np.broadcast_to(np.asarray(values, dtype=float), t.shape)
+        s = len(model.steer_columns)
+        return cls(*(readonly(a) for a in (t, tau, np.zeros_like(tau), np.zeros(model.n), np.full(model.n, np.inf),
+                                            np.zeros((len(t), s)), np.zeros(s), np.zeros(s))))
+
+
+@dataclass(frozen=True, eq=False)
+class Simulation:
+    """A simulated run; frozen, every array read-only. N samples, n velocities, E contacts.
+
+    ``t (N,)`` [s]; ``pose (N, 3)`` world ``(x, y, theta)``; ``twist (N, 3)`` robot frame; ``joint_positions``,
+    ``joint_rates``, ``torques (N, n - 3)`` over ``joint_names`` (``names[3:]``; wheel angles, steering angles β);
+    ``heading (N, n_steer)`` steering headings; ``forces (N, E, 2)`` [N] tyre forces (lateral, longitudinal; frame
+    Ē); ``loads (N, E)`` [N]; ``slip (N, E, 2)`` [m/s] slip velocities; ``wheel_speed (N, E)`` [m/s].
+    """
+
+    names: tuple[str, ...]
+    contacts: tuple[str, ...]
+    t: np.ndarray
+    pose: np.ndarray
+    twist: np.ndarray
+    joint_positions: np.ndarray
+    joint_rates: np.ndarray
+    torques: np.ndarray
+    heading: np.ndarray
+    forces: np.ndarray
+    loads: np.ndarray
+    slip: np.ndarray
+    wheel_speed: np.ndarray
+    method: str
+    step: float
+    info: dict = field(default_factory=dict)
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Names of the joint columns."""
+        return self.names[3:]
+
+    def friction_power(self) -> np.ndarray:
+        """Power of the contact forces on the slips ``(N,)`` [W]; never positive for dissipative tyres."""
+        return np.einsum("nec,nec->n", self.forces, self.slip)
+
+    def to_dict(self) -> dict:
+        """Plain data (lists) for JSON: time, pose, twist, joints, loads and forces."""
+        return {"t": self.t.tolist(), "pose": self.pose.tolist(), "twist": self.twist.tolist(),
+                "joints": list(self.joint_names), "joint_rates": self.joint_rates.tolist(),
+                "contacts": list(self.contacts), "forces": self.forces.tolist(), "loads": self.loads.tolist(),
+                "method": self.method, "step": self.step}
+
+
+def joint_column(model: DynamicModel, name: str) -> int:
+    """Column of the actuated joint `name` (``wheel.spin``, ``wheel.steer``...), or a one-line error."""
+    wheel, _, joint = name.partition(".")
+    if name not in model.names[3:]:
+        raise WmrkitError(f"robot '{model.robot.name}' has no joint '{name}' (joints: {', '.join(model.names[3:])})")
+    if joint.rstrip("12") not in model.robot.wheel(wheel).actuated:
+        raise WmrkitError(f"joint '{name}' of robot '{model.robot.name}' is not actuated (actuated: "
+                          f"{', '.join(model.robot.actuated) or 'none'})")
+    return model.names.index(name)
+
+
+def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, step: float = 1e-3,
+             method: Method = "semi-implicit", tyre: Tyre | str | None = None, initial_twist: ArrayLike = (0, 0, 0),
+             initial_pose: ArrayLike = (0, 0, 0), record_step: float | None = None, rtol: float = 1e-6,
+             progress: bool | None = None, jac_every: int = 20) -> Simulation:
+    """Integrate the dynamic model for `duration` [s] from `inputs`.
+
+    The initial velocities roll without slip at `initial_twist` (wheel IK, §8.4) with the steering at its IK
+    headings (or as described when the twist is 0). `record_step` [s] (default `step`, at least 1 ms for
+    ``"adaptive"``) sets the output sampling; `progress` shows a tqdm bar (default: runs of 500 000 steps or more);
+    `jac_every`: steps between refreshes of the tyre Jacobian of the semi-implicit method (1: every step).
+    """
+    model = robot if isinstance(robot, DynamicModel) else DynamicModel.of(robot, tyre)
+    if method not in METHODS:
+        raise WmrkitError(f"unknown method '{method}' (methods: {', '.join(METHODS)})")
+    if not (math.isfinite(duration) and duration > 0 and math.isfinite(step) and 0 < step <= duration):
+        raise WmrkitError(f"duration and step must be finite with 0 < step <= duration, got {duration}, {step}")
+    s0 = initial_state(model, initial_twist, initial_pose)
+    inp = _compiled_inputs(model, inputs)
+    record = record_step or (max(step, 1e-3) if method == "adaptive" else step)
+    every = max(1, round(record / step))
+    if method == "adaptive":
+        rec, info = _adaptive(model, s0, inp, duration, record, rtol)
+    else:
+        rec, info = _fixed(model, s0, inp, duration, step, every, 0 if method == "semi-implicit" else 1, progress,
+                           jac_every)
+    return _result(model, rec, method, step, info)
+
+
+def initial_state(model: DynamicModel, twist: ArrayLike = (0, 0, 0), pose: ArrayLike = (0, 0, 0)) -> np.ndarray:
+    """State ``(2n,)`` rolling without slip at `twist`: pose, joint positions (steering at IK angles), velocities."""
+    from ..kinematics.wheel_ik import wheel_commands
+
+    twist, n = as_vectors(twist, 3, "initial_twist"), model.n
+    s = np.zeros(2 * n)
+    s[:3] = as_vectors(pose, 3, "initial_pose")
+    beta = np.array(model.robot.beta, dtype=float)
+    s[n:n + 3] = twist
+    if np.any(twist != 0):
+        cmd = wheel_commands(model.robot, twist)
+        beta = np.asarray(cmd.beta, dtype=float)
+        s[n + 3:n + 3 + len(cmd.rates)] = cmd.rates
+    for k, c in enumerate(model.steer_columns):
+        s[c] = beta[k]
+    return s
+
+
+def _knots(time: ArrayLike) -> np.ndarray:
+    t = np.atleast_1d(np.asarray(time, dtype=float))
+    if t.ndim != 1 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise WmrkitError("input times must be finite and strictly increasing")
+    return t
+
+
+def _compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
+    beta_ref = np.asarray(model.robot.beta_of_heading(inputs.heading_reference), dtype=float) \
+        if len(model.steer_columns) else np.zeros((len(inputs.time), 0))
+    return tuple(np.array(a, dtype=float, order="C") for a in (  # writable copies: one compiled signature
+        inputs.time, inputs.torques, inputs.rate_reference, inputs.rate_gain, inputs.torque_limit,
+        beta_ref.reshape(len(inputs.time), -1), inputs.steer_kp, inputs.steer_kd))
+
+
+def _records(model: DynamicModel, n_rec: int) -> tuple:
+    e = len(model.contacts)
+    return (np.zeros(n_rec), np.zeros((n_rec, 2 * model.n)), np.zeros((n_rec, e, 2)), np.zeros((n_rec, e)),
+            np.zeros((n_rec, e, 2)), np.zeros((n_rec, e)), np.zeros((n_rec, model.n)))
+
+
+def _fixed(model, s0, inp, duration, step, every, method, progress, jac_every):
+    from ._integrate import observe, run, work_arrays
+
+    n_steps = round(duration / step)
+    rec = _records(model, n_steps // every + 1)
+    w = work_arrays(model.n, len(model.contacts), len(model.steer_columns))
+    s, acc = s0.copy(), np.zeros(model.n)
+    observe(0.0, s, acc, model.pack, inp, w, rec, 0)
+    i, done = 1, 0
+    chunk = max(every, (n_steps // 200) // every * every) if n_steps >= 500_000 or progress else n_steps
+    bar = None
+    if progress or (progress is None and n_steps >= 500_000):
+        from tqdm import tqdm
+
+        bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
+    while done < n_steps:
+        k = min(chunk, n_steps - done)
+        i = run(s, done, step, k, every, method, jac_every, acc, model.pack, inp, w, rec, i)
+        done += k
+        if bar is not None:
+            bar.update(k)
+        if not np.all(np.isfinite(s)):
+            raise WmrkitError(f"the simulation diverged at t = {done * step:.6g} s; use a smaller --step")
+    if bar is not None:
+        bar.close()
+    return tuple(r[:i] for r in rec), {"steps": n_steps}
+
+
+def _adaptive(model, s0, inp, duration, record, rtol):
+    from scipy.integrate import solve_ivp
+
+    from ._integrate import derivative, observe, work_arrays
+
+    w = work_arrays(model.n, len(model.contacts), len(model.steer_columns))
+    acc = np.zeros(model.n)
+    t_eval = np.arange(0.0, duration + record / 2, record)
+    sol = solve_ivp(lambda t, s: derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w), (0.0, t_eval[-1]),
+                    s0, method="LSODA", t_eval=t_eval, rtol=rtol, atol=rtol * 1e-3)
+    if not sol.success:
+        raise WmrkitError(f"the adaptive integration failed: {sol.message}")
+    rec = _records(model, len(sol.t))
+    for i, (t, s) in enumerate(zip(sol.t, sol.y.T, strict=True)):
+        derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w)
+        observe(t, np.ascontiguousarray(s), acc, model.pack, inp, w, rec, i)
+    return rec, {"evaluations": int(sol.nfev)}
+
+
+def _result(model: DynamicModel, rec: tuple, method: str, step: float, info: dict) -> Simulation:
+    t, s, f, fz, v, vw, tau = rec
+    n = model.n
+    beta = s[:, list(model.steer_columns)]
+    delta = np.array([w.delta for w in model.robot.wheels if w.kind.steers])
+    return Simulation(model.names, model.contacts, *(readonly(np.ascontiguousarray(a)) for a in (
+        t, s[:, :3], s[:, n:n + 3], s[:, 3:n], s[:, n + 3:], tau[:, 3:], heading_from_beta(beta, delta), f, fz, v,
+        vw)), method=method, step=step, info=info)

@@ -1,0 +1,284 @@
+"""Traction (tyre-ground friction) models of thesis §7.3 and appendix 7.A1, vectorised, radians only.
+
+Every formula is written once, with numpy ufuncs and no branches, so that the same function serves numpy arrays
+(the public API) and is compiled as it is by numba for the simulator (:mod:`wmrkit.dynamics._kernels`).
+
+Axes and signs (``docs/dynamics.md``). A contact's slip velocity ``v_slip = (lateral, longitudinal)`` is the one of
+:meth:`wmrkit.Robot.constraint_matrix` (frame Ē: row 0 along the axle / roller axis, row 1 the rolling
+direction). Slip ratio and slip angle follow the slip velocity (positive when the contact point slides forward /
+to the axle's +x side), which resolves the sign conflict of (7.31) with the ch. 3 convention
+(``docs/errata.md``). Friction coefficients ``mu`` are odd functions of the slip with the slip's sign; the force of
+the ground on the wheel is ``F = -Fz * mu``: it always opposes the slip (7.27), (7.49).
+
+A tyre *model* is a :class:`TyreKind` of the table :data:`TYRES` (like ``wheels.KINDS``): its parameters with
+defaults and units, and one kernel ``forces(p0, p1, p2, p3, fz, v_lat, v_long, v_wheel, v_roll)`` returning
+``(F_lat, F_long)`` [N]. A wheel's tyre is a frozen :class:`Tyre` value (model name + parameters).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import UnknownNameError, WmrkitError
+
+TINY = 1e-300
+
+
+class TyreForces(NamedTuple):
+    """Force of the ground on the wheel at the contact, frame Ē [N]: along the axle and along the rolling line."""
+
+    lateral: np.ndarray
+    longitudinal: np.ndarray
+
+
+def _asarray(x: ArrayLike) -> np.ndarray:
+    """``np.asarray(x, float)``; the compiled kernels replace it by the identity (:mod:`._kernels`)."""
+    return np.asarray(x, dtype=float)
+
+
+# ---- elementary laws ------------------------------------------------------------------------------------------
+def coulomb(v: ArrayLike, mu: ArrayLike, k: ArrayLike = math.inf) -> np.ndarray:
+    """Coulomb friction coefficient with the slip's sign, smoothed as in (7.28): ``mu (2/pi) atan(k v)``.
+
+    `k` [s/m] sets the sharpness; ``k = inf`` is the discontinuous Coulomb law ``mu sign(v)``. ``(...) -> (...)``.
+    """
+    v, k = np.asarray(v, dtype=float), np.asarray(k, dtype=float)
+    smooth = mu * (2 / np.pi) * np.arctan(np.where(np.isinf(k), 0.0, k) * v)
+    return np.where(np.isinf(k), mu * np.sign(v), smooth)
+
+
+def friction_ellipse(v_lat: ArrayLike, v_long: ArrayLike, mu_lat: ArrayLike, mu_long: ArrayLike) -> TyreForces:
+    """Coupled anisotropic Coulomb coefficients of maximum dissipation (7.30), on the ellipse (7.29).
+
+    ``mu* = (mu_lat^2 v_lat, mu_long^2 v_long) / |(mu_lat v_lat, mu_long v_long)|`` (with the slip's sign; zero
+    at zero slip). Returned as coefficients (multiply by ``-Fz`` for the force). ``(...) -> (...), (...)``.
+    """
+    v_lat, v_long = _asarray(v_lat), _asarray(v_long)
+    w = np.maximum(np.sqrt((mu_lat * v_lat) ** 2 + (mu_long * v_long) ** 2), TINY)
+    return TyreForces(mu_lat ** 2 * v_lat / w, mu_long ** 2 * v_long / w)
+
+
+def slip_ratio(v_slip: ArrayLike, v_wheel: ArrayLike, v_roll: ArrayLike, eps: ArrayLike = 1e-3) -> np.ndarray:
+    """Longitudinal slip ratio (7.31), sign-corrected: ``s = v_slip / max(|v_roll|, |v_wheel|, eps)``.
+
+    `v_slip` is the longitudinal slip velocity (ch. 3: ``v_wheel + v_roll``, with ``v_roll = r phi_dot``),
+    `v_wheel` the wheel centre's speed along its rolling line; `eps` [m/s] regularises the standstill. A
+    driving wheel has ``s < 0`` (its contact slides backwards), a braking one ``s > 0``; ``|s| <= 2``.
+    """
+    return v_slip / np.maximum(np.maximum(np.abs(v_roll), np.abs(v_wheel)), eps)
+
+
+def slip_angle(v_lat: ArrayLike, v_wheel: ArrayLike, eps: ArrayLike = 1e-3) -> np.ndarray:
+    """Slip angle (7.35) [rad] with the lateral slip's sign: ``atan(v_lat / max(|v_wheel|, eps))``."""
+    return np.arctan2(v_lat, np.maximum(np.abs(v_wheel), eps))
+
+
+def magic_formula(x: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, e: ArrayLike) -> np.ndarray:
+    """Pacejka's magic formula (7.34)/(7.81): ``D sin(C atan(B (1 - E) x + E atan(B x)))``.
+
+    Thesis names: k7 = D (peak), k8 = C (shape), k9 = B (stiffness), k10 = E (curvature); slope at 0 is B C D.
+    """
+    bx = b * _asarray(x)
+    return d * np.sin(c * np.arctan(bx * (1 - e) + e * np.arctan(bx)))
+
+
+def lu_longitudinal(s: ArrayLike, v: ArrayLike, shifts: ArrayLike = 1.0) -> np.ndarray:
+    """Longitudinal coefficient mu_y(s, v) of appendix 7.A1, eq. (7.82) [Lu & Shih 05]; v = wheel speed [m/s].
+
+    ``shifts = 0`` drops the horizontal shift (then mu_y(0) = 0 and the curve is odd).
+    """
+    v = np.abs(v)
+    c_sy = np.tan(np.pi / 180 * (84.21 + 5.16 * np.exp(-6.094 / (1 + v))))
+    s_shifted = s + shifts * (0.0213 + 0.0086 * v) / c_sy
+    k8, k7 = 1.57, 0.8 - 0.0021 * v
+    k9 = c_sy / (k8 * k7)
+    s_m = 0.08 + 0.75 * np.exp(-v / 8)
+    k10 = (k9 * s_m - np.tan(0.5 * np.pi / k8)) / (k9 * s_m - np.arctan(k9 * s_m)) - 0.0162 * v
+    return magic_formula(s_shifted, k9, k8, k7, k10)
+
+
+def lu_lateral(alpha: ArrayLike, v: ArrayLike, shifts: ArrayLike = 1.0) -> np.ndarray:
+    """Lateral coefficient mu_x(alpha, v) of appendix 7.A1, eq. (7.83); alpha in radians, v [m/s]."""
+    v = np.abs(v)
+    c_sx = 0.3 * np.tan(np.pi / 180 * (84.21 + 5.16 * np.exp(-6.094 / (1 + 5 * v))))
+    a_shifted = alpha + shifts * (0.00639 + 0.0026 * v) / c_sx
+    k8, k7 = 1.2, 0.75 + 0.5 * np.exp(-v / 3)
+    k9 = c_sx / (k8 * k7)
+    a_m = 0.087 + 0.63 * np.exp(-v / 3)
+    k10 = (k9 * a_m - np.tan(0.5 * np.pi / k8)) / (k9 * a_m - np.arctan(k9 * a_m)) - 0.0162 * v
+    return magic_formula(a_shifted, k9, k8, k7, k10)
+
+
+def delft_combined(s: ArrayLike, alpha: ArrayLike, mu_long: ArrayLike, mu_lat: ArrayLike,
+                   shifts: ArrayLike = 1.0) -> TyreForces:
+    """Combined-slip weighting (7.84) (Delft-Tyre 97) of the pure coefficients: ``(mu_lat comb, mu_long comb)``.
+
+    Literal transcription of the thesis (constants 1.43, 1.25, 0.513, 0.0056; 1.01, 20.18, 0.137, 4.98, 0.204);
+    ``shifts = 0`` drops the horizontal shifts 0.0056 and 0.204 mu_y. Each weight is 1 when the other slip is 0.
+    """
+    sh_y, sh_x = shifts * 0.0056, shifts * 0.204 * mu_long
+    by = 1.25 / np.sqrt(1 + (0.513 * s) ** 2)  # 1.25 cos(atan(0.513 s))
+    g_long = np.cos(1.43 * np.arctan(by * (sh_y + alpha))) / np.cos(1.43 * np.arctan(by * sh_y))
+    bx = 20.18 / np.sqrt(1 + (0.137 * (alpha - 4.98)) ** 2)  # 20.18 cos(atan(0.137 (alpha - 4.98)))
+    g_lat = np.cos(1.01 * np.arctan(bx * (sh_x + s))) / np.cos(1.01 * np.arctan(bx * sh_x))
+    return TyreForces(mu_lat * g_lat, mu_long * g_long)
+
+
+# ---- the tyre models: one kernel each, (F_lat, F_long) from slip velocities ------------------------------------
+def linear_forces(c_lat, c_long, _p2, _p3, fz, v_lat, v_long, v_wheel, v_roll):
+    """Linear uncoupled friction (7.59): ``F = -(c_lat v_lat, c_long v_long)``, c in N s/m (load absorbed)."""
+    return -c_lat * v_lat + 0 * fz, -c_long * v_long + 0 * fz
+
+
+def coulomb_forces(mu_lat, mu_long, k, _p3, fz, v_lat, v_long, v_wheel, v_roll):
+    """Coupled Coulomb friction: direction of maximum dissipation (7.30), magnitude smoothed by (7.28)."""
+    w = np.maximum(np.sqrt((mu_lat * v_lat) ** 2 + (mu_long * v_long) ** 2), TINY)
+    scale = -fz * (2 / np.pi) * np.arctan(k * np.maximum(np.sqrt(v_lat ** 2 + v_long ** 2), TINY)) / w
+    return scale * mu_lat ** 2 * v_lat, scale * mu_long ** 2 * v_long
+
+
+def dugoff_forces(cs, calpha, mu, eps, fz, v_lat, v_long, v_wheel, v_roll):
+    """Dugoff's tyre [Dugoff 70]: stiffnesses cs [N], calpha [N/rad], friction mu; linear region Cs s/(1-s).
+
+    ``lambda = mu Fz (1-|s|) / (2 sqrt((cs s)^2 + (calpha tan a)^2))``, ``f = lambda (2 - lambda)`` below 1;
+    ``F_long = -cs s f/(1-|s|)``, ``F_lat = -calpha tan(a) f/(1-|s|)``, |s| clipped at 1 (full sliding).
+    """
+    s = np.minimum(np.maximum(slip_ratio(v_long, v_wheel, v_roll, eps), -1.0), 1.0)
+    tan_a = v_lat / np.maximum(np.abs(v_wheel), eps)
+    n = np.maximum(np.sqrt((cs * s) ** 2 + (calpha * tan_a) ** 2), TINY)
+    one_minus = 1.0 - np.abs(s)
+    lam = mu * np.maximum(fz, 0.0) * one_minus / (2 * n)
+    # f / (1 - |s|) without dividing by zero: min(1/(1-|s|), mu Fz (2 - min(lambda, 1)) / (2 n)).
+    g = np.minimum(1.0 / np.maximum(one_minus, TINY), mu * np.maximum(fz, 0.0) * (2 - np.minimum(lam, 1.0)) / (2 * n))
+    return -calpha * tan_a * g, -cs * s * g
+
+
+def pacejka_forces(shifts, mu_scale, eps, _p3, fz, v_lat, v_long, v_wheel, v_roll):
+    """Thesis appendix 7.A1: (7.82), (7.83) at the wheel speed, weighted by (7.84); mirrored in reverse (§10.1).
+
+    The horizontal shifts (rolling resistance, a lateral bias) are scaled by ``tanh(|v_wheel| / eps)`` so that a
+    wheel at rest feels no force without slip (the thesis does not treat standstill).
+    """
+    sigma = 1.0 - 2.0 * (v_wheel < 0)
+    s = sigma * slip_ratio(v_long, v_wheel, v_roll, eps)
+    a = sigma * slip_angle(v_lat, v_wheel, eps)
+    shifts = shifts * np.tanh(np.abs(v_wheel) / eps)  # the shifts fade out at standstill: no creep at rest
+    mu_long = lu_longitudinal(s, v_wheel, shifts)
+    mu_lat = lu_lateral(a, v_wheel, shifts)
+    comb = delft_combined(s, a, mu_long, mu_lat, shifts)
+    load = -sigma * mu_scale * np.maximum(fz, 0.0)
+    return load * comb[0], load * comb[1]
+
+
+@dataclass(frozen=True, slots=True)
+class TyreKind:
+    """A tyre model: its parameters (name -> default, in order) with units, and its force kernel."""
+
+    name: str
+    code: int
+    params: tuple[tuple[str, float, str], ...]  # (name, default, unit), the kernel's p0, p1, ... in this order
+    kernel: Callable
+    summary: str
+
+    @property
+    def defaults(self) -> dict[str, float]:
+        """Parameter defaults by name."""
+        return {n: d for n, d, _ in self.params}
+
+
+TYRES: dict[str, TyreKind] = {
+    k.name: k
+    for k in (
+        TyreKind("linear", 0, (("c_lat", 5e4, "N s/m"), ("c_long", 5e4, "N s/m")), linear_forces,
+                 "linear uncoupled friction (7.59), the law under which WLS = MCD"),
+        TyreKind("coulomb", 1, (("mu_lat", 0.8, ""), ("mu_long", 0.8, ""), ("k", 50.0, "s/m")), coulomb_forces,
+                 "coupled Coulomb friction: ellipse (7.29)-(7.30), smoothed as (7.28)"),
+        TyreKind("dugoff", 2, (("cs", 8e4, "N"), ("calpha", 5e4, "N/rad"), ("mu", 0.8, ""), ("eps", 0.01, "m/s")),
+                 dugoff_forces, "Dugoff's tyre: stiffnesses cs, calpha and friction mu"),
+        TyreKind("pacejka", 3, (("shifts", 1.0, ""), ("mu_scale", 1.0, ""), ("eps", 0.01, "m/s")), pacejka_forces,
+                 "magic formula with the speed-dependent coefficients and combined slip of appendix 7.A1"),
+    )
+}
+N_PARAMS = 4
+
+
+def tyre_kind(name: str) -> TyreKind:
+    """The :class:`TyreKind` called `name`, or :class:`UnknownNameError` listing the models."""
+    try:
+        return TYRES[name]
+    except KeyError:
+        raise UnknownNameError(f"unknown tyre model '{name}' (models: {', '.join(TYRES)})") from None
+
+
+@dataclass(frozen=True, slots=True)
+class Tyre:
+    """A wheel's tyre: a model of :data:`TYRES` and its parameters (SI), a frozen hashable value."""
+
+    model: str = "pacejka"
+    params: tuple[tuple[str, float], ...] = ()  # every parameter of the model, in the model's order
+
+    @classmethod
+    def of(cls, model: str, params: Mapping[str, float] | None = None) -> Tyre:
+        """A tyre of `model`; parameters not given take the model's defaults; unknown names raise."""
+        kind = tyre_kind(model)
+        params = dict(params or {})
+        unknown = [n for n in params if n not in kind.defaults]
+        if unknown:
+            raise UnknownNameError(f"tyre model '{model}' has no parameter '{unknown[0]}' "
+                                   f"(parameters: {', '.join(kind.defaults)})")
+        for n, v in params.items():
+            if not (math.isfinite(float(v)) or (n == "k" and v == math.inf)):  # k = inf: discontinuous Coulomb
+                raise WmrkitError(f"tyre parameter {n} must be finite, got {v}")
+        return cls(model, tuple((n, float(params.get(n, d))) for n, d, _ in kind.params))
+
+    @property
+    def kind(self) -> TyreKind:
+        """The model's :class:`TyreKind`."""
+        return tyre_kind(self.model)
+
+    def as_dict(self) -> dict[str, float]:
+        """Parameters by name."""
+        return dict(self.params)
+
+    def vector(self) -> np.ndarray:
+        """The kernel's parameters ``(N_PARAMS,)``, zero-padded."""
+        out = np.zeros(N_PARAMS)
+        out[:len(self.params)] = [v for _, v in self.params]
+        return out
+
+    def forces(self, fz: ArrayLike, v_lat: ArrayLike, v_long: ArrayLike, v_wheel: ArrayLike,
+               v_roll: ArrayLike) -> TyreForces:
+        """Contact forces from slip velocities [m/s] and the normal load `fz` [N]; all broadcast."""
+        p = self.vector()
+        args = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (fz, v_lat, v_long, v_wheel, v_roll)))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f_lat, f_long = self.kind.kernel(*p, *args)
+        return TyreForces(np.asarray(f_lat, dtype=float), np.asarray(f_long, dtype=float))
+
+    def forces_at_slip(self, fz: ArrayLike, slip_ratio: ArrayLike, slip_angle: ArrayLike,
+                       speed: ArrayLike = 2.0) -> TyreForces:
+        """Contact forces at a slip ratio, a slip angle [rad] and a wheel speed [m/s] (> 0), all broadcast.
+
+        The slip velocities are rebuilt exactly (see :func:`slip_velocities`) and passed to :meth:`forces`.
+        """
+        v_lat, v_long, v_wheel, v_roll = slip_velocities(slip_ratio, slip_angle, speed)
+        return self.forces(fz, v_lat, v_long, v_wheel, v_roll)
+
+
+def slip_velocities(s: ArrayLike, alpha: ArrayLike, speed: ArrayLike) -> tuple[np.ndarray, ...]:
+    """Slip velocities giving slip ratio `s` (> -1) and slip angle `alpha` (|alpha| < pi/2) at wheel `speed` > 0.
+
+    Inverse of :func:`slip_ratio` / :func:`slip_angle`: ``(v_lat, v_long, v_wheel, v_roll)``. For ``s >= 0``
+    (braking) ``v_roll = v (s - 1)``; for ``-1 < s < 0`` (driving) ``v_roll = -v / (1 + s)``.
+    """
+    s, alpha, v = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (s, alpha, speed)))
+    if np.any(s <= -1) or np.any(s > 2) or np.any(np.abs(alpha) >= np.pi / 2) or np.any(v <= 0):
+        raise WmrkitError("slip ratio must be in (-1, 2], slip angle in (-pi/2, pi/2) rad and speed > 0")
+    v_roll = np.where(s >= 0, v * (s - 1), -v / (1 + np.maximum(s, -0.999999)))
+    return v * np.tan(alpha), v + v_roll, v, v_roll

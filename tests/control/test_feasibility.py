@@ -1,0 +1,97 @@
+"""Table 8.1 (§8.5) for every vehicle of the catalog: the column, and which references each can follow."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.control.feasibility import COLUMNS, feasibility, requirement
+from wmrkit.control.points import ControlError
+from wmrkit.control.references import builtin_reference, reference_from_samples
+from wmrkit.control.track import track
+
+T1, T2_OFF, T2_ON = "type 1", "type 2, off axle", "type 2, on axle"
+T4_OFF, T4_ON = "type 4, off axle", "type 4, on axle"
+T35, T3_0 = "types 3 and 5, l_o != 0", "type 3, l_o = 0"
+#: By hand from each file's geometry: where R (the origin) lies against the fixed axle / the steered wheels.
+EXPECTED = {
+    "ackermann": T4_ON, "bicycle": T4_ON, "diff-drive": T2_ON, "forklift": T4_OFF, "line-follower": T2_OFF,
+    "mecanum-4": T1, "omni-3": T1, "omni-4": T1, "swerve-4": T35, "thesis-bicycle-castor": T4_ON,
+    "thesis-bicycle-swedish": T4_ON, "thesis-diff-castor": T2_ON, "thesis-diff-swedish": T2_ON,
+    "thesis-omni-castor": T1, "thesis-omni-swedish": T1, "thesis-steer-castor": T3_0, "thesis-steer-swedish": T3_0,
+    "thesis-tricycle": T4_ON, "thesis-tricycle-ch4": T4_ON, "thesis-two-steer-castor": T35,
+    "thesis-two-steer-swedish": T35,
+}
+#: Table 8.1 read per column: feasible in the kinematic framework for (square with theta along the path, square
+#: at a constant heading, arc-line, circle), and arc-line in the dynamic framework. square: tangent jumps, velocity
+#: jumps (and theta with it, unless held constant); arc-line: curvature and turn rate jump, the tangent is continuous.
+BEHAVIOUR = {
+    T1: (False, True, True, True, False), T2_OFF: (True, True, True, True, True),
+    T2_ON: (False, False, True, True, False), T4_OFF: (False, False, True, True, False),
+    T4_ON: (False, False, False, True, False), T35: (False, False, False, True, False),
+    T3_0: (False, False, True, True, False),
+}
+REFS = {name: builtin_reference(name) for name in ("square", "arc-line", "circle")}
+REFS["square-fixed"] = reference_from_samples(
+    "square at a constant heading", REFS["square"].t,
+    np.column_stack([REFS["square"].pose[:, :2], 0 * REFS["square"].t]))
+
+
+@pytest.mark.parametrize("name", catalog.names())
+def test_table_8_1_for_every_catalog_vehicle(name):
+    robot = catalog.load(name)
+    if name == "skid-steer-4":
+        with pytest.raises(ControlError, match="degenerate"):
+            requirement(robot)
+        return
+    assert name in EXPECTED, f"new catalog robot {name}: add its Table 8.1 column here"
+    req = requirement(robot)
+    assert req.column == EXPECTED[name]
+    assert req.references == (2 if req.type in (2, 4) else 3)
+    square, square_fixed, arc, circle, arc_dynamic = BEHAVIOUR[req.column]
+    assert feasibility(robot, REFS["square"]).feasible == square
+    assert feasibility(robot, REFS["square-fixed"]).feasible == square_fixed
+    assert feasibility(robot, REFS["arc-line"]).feasible == arc
+    assert feasibility(robot, REFS["circle"]).feasible == circle
+    assert feasibility(robot, REFS["arc-line"], "dynamic").feasible == arc_dynamic
+    assert feasibility(robot, REFS["circle"], "dynamic").feasible
+
+
+def test_every_column_is_covered_by_the_catalog():
+    assert set(EXPECTED.values()) == set(COLUMNS)
+
+
+def test_violations_at_the_corners_with_their_remedies():
+    square = REFS["square"]
+    res = feasibility(catalog.load("forklift"), square)
+    assert [v.t for v in res.violations] == pytest.approx(list(square.breaks), abs=0.011)
+    assert all(v.signal == "chi" and "orientable wheel" in v.remedy for v in res.violations)
+    assert all(v.size == pytest.approx(np.pi / 2, abs=1e-6) for v in res.violations)
+    res = feasibility(catalog.load("diff-drive"), square)
+    assert all("re-orient the vehicle" in v.remedy for v in res.violations)
+    arc = feasibility(catalog.load("ackermann"), REFS["arc-line"])
+    assert [v.signal for v in arc.violations] == ["kappa"]
+    assert arc.violations[0].t == pytest.approx(REFS["arc-line"].breaks[0], abs=0.011)
+
+
+def test_sampled_file_reference_gives_the_same_violations():
+    """The square as samples (derivatives by finite differences): the same corners are found."""
+    sq = REFS["square"]
+    sampled = reference_from_samples("square.csv", sq.t, sq.pose)
+    got = feasibility(catalog.load("forklift"), sampled)
+    assert [round(v.t, 1) for v in got.violations] == [round(b, 1) for b in sq.breaks]
+    assert feasibility(catalog.load("forklift"), reference_from_samples("c", REFS["circle"].t,
+                                                                        REFS["circle"].pose)).feasible
+
+
+def test_verdict_matches_the_closed_loop():
+    """Independent check: in the ideal loop the forklift's wheel must jump exactly where Table 8.1 says."""
+    robot, square = catalog.load("forklift"), REFS["square"]
+    run = track(robot, square, duration=26.0, output_dt=0.02)
+    dh = np.abs(np.angle(np.exp(1j * np.diff(run.heading[:, 0]))))
+    jumps = run.t[1:][dh > 0.3]
+    want = [v.t for v in feasibility(robot, square).violations if v.t < 26.0]
+    assert jumps == pytest.approx(want, abs=0.02)
+    smooth = track(robot, REFS["circle"], duration=10.0, output_dt=0.02)
+    assert np.abs(np.angle(np.exp(1j * np.diff(smooth.heading[:, 0])))).max() < 0.05

@@ -1,0 +1,134 @@
+"""The kinematic loop (§8.2-8.3): exact exponential decay in continuous time, the delayed discrete recursion."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.control.laws import PositionLaw, SamplingWarning, check_sampling, law_velocity
+from wmrkit.control.loop import law_controller, simulate
+from wmrkit.control.points import ControlError, control_point, point_pose
+from wmrkit.control.references import builtin_reference
+from wmrkit.control.track import track
+
+
+def _errors(robot, ref, a, pose0, duration, kind="p", period=None, delay=0):
+    cp = control_point(robot)
+    law = PositionLaw.uniform(kind, a, a * a / 4 if kind == "pi" else 0.0)
+    out = simulate(robot, law_controller(cp, law, ref), np.asarray(pose0, float), duration, period=period,
+                   delay=delay, output_dt=0.1)
+    got = point_pose(cp, out["pose"])
+    want = ref.sample(out["t"])
+    e = want - got
+    e[:, 2] = np.angle(np.exp(1j * e[:, 2]))
+    return out["t"], e, cp
+
+
+@pytest.mark.parametrize("name", ["mecanum-4", "swerve-4", "omni-3"])
+def test_holonomic_pose_error_decays_exactly_as_exp(name):
+    """(8.5): every pose coordinate's error is e(0) exp(-a t) (ideal continuous loop, full references)."""
+    t, e, cp = _errors(catalog.load(name), builtin_reference("circle"), 1.3, [0.4, -0.3, 0.5], 4.0)
+    assert not cp.reduced
+    np.testing.assert_allclose(e, e[:1] * np.exp(-1.3 * t)[:, None], atol=2e-7)
+
+
+@pytest.mark.parametrize("name", ["forklift", "diff-drive", "line-follower", "ackermann"])
+def test_reduced_mobility_point_error_decays_exactly_as_exp(name):
+    """Types 2 and 4: the controlled point's (x, y) error is e(0) exp(-a t); the heading is zero dynamics."""
+    robot = catalog.load(name)
+    t, e, cp = _errors(robot, builtin_reference("figure-eight"), 0.8, [0.3, 0.4, 0.2], 4.0)
+    assert cp.reduced
+    np.testing.assert_allclose(e[:, :2], e[:1, :2] * np.exp(-0.8 * t)[:, None], atol=2e-7)
+
+
+def test_pi_law_error_is_the_critically_damped_solution():
+    """(8.6) with b = a^2/4 and no initial integral: e(t) = e0 (1 - a t / 2) exp(-a t / 2) (e'(0) = -a e0)."""
+    a = 1.2
+    t, e, _ = _errors(catalog.load("mecanum-4"), builtin_reference("circle"), a, [0.2, -0.1, 0.3], 5.0, kind="pi")
+    want = e[:1] * ((1 - a * t / 2) * np.exp(-a * t / 2))[:, None]
+    np.testing.assert_allclose(e, want, atol=2e-7)
+
+
+def test_point_to_point_law_lags_a_ramp_by_v_over_a():
+    """(8.1) has a constant error v / a on a ramp (why the thesis rejects it)."""
+    run = track(catalog.load("mecanum-4"), builtin_reference("line", speed=0.4), controller="point", gain=2.0,
+                duration=8.0)
+    assert run.error[-1] == pytest.approx(0.4 / 2.0, rel=1e-5)
+
+
+def test_gated_feedforward_switches_off_beyond_the_gate():
+    """(8.53): the feedforward is applied only within d_max (binary), never weighted."""
+    law = PositionLaw.uniform("p", 1.0, gate=0.5)
+    vel = np.array([0.5, 0.0, 0.0])
+    near = law_velocity(law, np.array([0.3, 0, 0]), vel, np.zeros(3), np.zeros(3))
+    far = law_velocity(law, np.array([0.6, 0, 0]), vel, np.zeros(3), np.zeros(3))
+    np.testing.assert_allclose(near, [0.8, 0, 0])
+    np.testing.assert_allclose(far, [0.6, 0, 0])
+
+
+def _lateral(a, period, n=40, delay=1):
+    robot = catalog.load("mecanum-4")
+    ref = builtin_reference("line", duration=n * period + 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SamplingWarning)
+        _, e, _ = _errors(robot, ref, a, [0.0, 0.3, 0.0], n * period, period=period, delay=delay)
+    return e[:, 1]
+
+
+@pytest.mark.parametrize("a", [0.3, 0.8, 1.5])
+def test_delayed_discrete_loop_follows_the_recursion(a):
+    """With a one-sample-old measurement: y_{k+1} = y_k - a T y_{k-1} (digest §2.6), exactly."""
+    y, aT = _lateral(a, 0.5), a * 0.5
+    np.testing.assert_allclose(y[2:], y[1:-1] - aT * y[:-2], atol=1e-12)
+
+
+def test_delayed_loop_oscillates_at_0_8_not_at_0_3():
+    """Thesis §9.2.3 cases 1 and 3 (T = 0.5 s); roots of z^2 - z + aT are real for aT <= 1/4."""
+    slow, fast = -_lateral(0.3, 0.5), -_lateral(0.8, 0.5)  # the robot starts 0.3 m to the left: error -0.3
+    assert np.all(slow > 0) and np.all(np.diff(slow) <= 0)
+    assert np.any(fast < 0) and np.any(fast[np.argmax(fast < 0):] > 0)
+    assert np.all(np.isreal(np.roots([1, -1, 0.15]))) and not np.all(np.isreal(np.roots([1, -1, 0.4])))
+
+
+@pytest.mark.parametrize("aT, grows", [(0.9, False), (1.1, True)])
+def test_delayed_loop_is_unstable_above_aT_1(aT, grows):
+    y = _lateral(aT / 0.5, 0.5, n=80)
+    assert (abs(y[-1]) > abs(y[0])) == grows
+    assert (max(abs(np.roots([1, -1, aT]))) > 1) == grows
+
+
+def test_without_delay_the_discrete_loop_is_first_order():
+    y = _lateral(0.8, 0.5, delay=0)
+    np.testing.assert_allclose(y[1:], (1 - 0.4) * y[:-1], atol=1e-12)
+
+
+def test_sampling_rule_warns():
+    with pytest.warns(SamplingWarning, match="10 T"):
+        assert not check_sampling(PositionLaw.uniform("p", 0.8), 0.5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert check_sampling(PositionLaw.uniform("p", 0.2), 0.5)
+
+
+def test_bad_options_raise_located_errors():
+    robot, ref = catalog.load("forklift"), builtin_reference("line")
+    with pytest.raises(ControlError, match="unknown controller"):
+        track(robot, ref, controller="lqr")
+    with pytest.raises(ControlError, match="period"):
+        track(robot, ref, delay=2)
+    with pytest.raises(ControlError, match="on its fixed axle"):
+        control_point(catalog.load("diff-drive"), (0.0, 0.1))
+    with pytest.raises(ControlError, match="gain a"):
+        PositionLaw("p", (1.0, -1.0, 1.0))
+
+
+def test_skid_steer_is_controlled_with_slip_reported():
+    """Degenerate skid steering: the admissible space of the wheels' linear rows; IK reports the turning slip."""
+    run = track(catalog.load("skid-steer-4"), builtin_reference("circle"), duration=3.0)
+    assert run.error.max() < 1e-6
+    assert not np.all(run.commands.feasible)
+    assert math.isfinite(run.summary()["rms_error"])

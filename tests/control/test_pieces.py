@@ -1,0 +1,139 @@
+"""The loop's pieces: actuator-loop models (settling time, overshoot, coupling), admissible twists, castor feedback."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from wmrkit import catalog
+from wmrkit.control.actuators import ActuatorLoop, LowLevelLoops
+from wmrkit.control.points import ControlError, control_point, point_pose, twist_for_velocity
+from wmrkit.control.references import builtin_reference
+from wmrkit.control.track import track
+from wmrkit.kinematics.wheel_ik import wheel_commands
+
+
+def _step(loops: LowLevelLoops, command, duration=12.0, h=1e-3):
+    x = np.zeros(loops.size)
+    out = []
+    for _ in range(int(duration / h)):  # RK4 on the held command
+        k1 = loops.derivative(x, command)
+        k2 = loops.derivative(x + h / 2 * k1, command)
+        k3 = loops.derivative(x + h / 2 * k2, command)
+        k4 = loops.derivative(x + h * k3, command)
+        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        out.append(x[: len(command)].copy())
+    return np.arange(1, len(out) + 1) * h, np.array(out)
+
+
+def test_first_order_loop_settles_to_2_percent_at_the_settling_time():
+    t, y = _step(LowLevelLoops(("a.spin",), (ActuatorLoop(1.5),)), np.array([1.0]))
+    assert y[np.searchsorted(t, 1.5), 0] == pytest.approx(0.98, abs=1e-3)
+    np.testing.assert_allclose(y[:, 0], 1 - np.exp(-t * math.log(50) / 1.5), atol=1e-9)
+
+
+@pytest.mark.parametrize("overshoot", [0.05, 0.15, 0.3])
+def test_second_order_loop_has_the_given_overshoot(overshoot):
+    """Peak 1 + OS (closed form of an underdamped second-order step); within 2 % from about t_s on."""
+    t, y = _step(LowLevelLoops(("a.spin",), (ActuatorLoop(3.5, overshoot),)), np.array([1.0]))
+    assert y[:, 0].max() == pytest.approx(1 + overshoot, abs=1e-6)
+    assert np.all(np.abs(y[t >= 3.5 * 1.15, 0] - 1) < 0.02)
+
+
+def test_coupled_loops_disturb_each_other_and_uncoupled_do_not():
+    loops = (ActuatorLoop(1.0), ActuatorLoop(1.0))
+    alone = _step(LowLevelLoops(("a.spin", "b.spin"), loops), np.array([1.0, 0.0]), 3.0)[1]
+    coupled = _step(LowLevelLoops(("a.spin", "b.spin"), loops, ((0, 0.5), (0.5, 0))), np.array([1.0, 0.0]), 3.0)[1]
+    assert np.all(alone[:, 1] == 0) and np.abs(coupled[:, 1]).max() > 0.05
+    with pytest.raises(ControlError, match="zero diagonal"):
+        LowLevelLoops(("a.spin", "b.spin"), loops, ((1, 0), (0, 0)))
+
+
+REDUCED = [n for n in catalog.names() if control_point(catalog.load(n)).reduced]
+
+
+@settings(max_examples=30, deadline=None)
+@given(name=st.sampled_from(REDUCED), vx=st.floats(-2, 2), vy=st.floats(-2, 2), th=st.floats(-math.pi, math.pi))
+def test_point_twist_gives_the_point_its_velocity_and_no_slip(name, vx, vy, th):
+    """The admissible twist (null space of (8.14)) moves P at the wanted world velocity and the fixed wheels do not
+    slip sideways (skid steering excepted: it must slip to turn)."""
+    robot = catalog.load(name)
+    cp = control_point(robot)
+    pose = np.array([0.3, -0.2, th])
+    twist = twist_for_velocity(cp, pose, [vx, vy])
+    h = 1e-6
+    moved = pose + h * np.array([math.cos(th) * twist[0] - math.sin(th) * twist[1],
+                                 math.sin(th) * twist[0] + math.cos(th) * twist[1], twist[2]])
+    vel = (point_pose(cp, moved) - point_pose(cp, pose))[:2] / h
+    np.testing.assert_allclose(vel, [vx, vy], atol=1e-5)
+    assert bool(wheel_commands(robot, twist).feasible) or cp.skid
+
+
+def test_castor_angle_is_fed_back_and_trails():
+    """diff-drive: the castor starts across the motion and ends trailing it (heading 0) after a straight run."""
+    robot = catalog.load("diff-drive").with_steering({"caster": math.pi / 2})
+    run = track(robot, builtin_reference("line"), duration=8.0)
+    assert abs(run.heading[0, 0] - math.pi / 2) < 1e-9
+    assert abs(run.heading[-1, 0]) < 1e-3
+    assert run.error.max() < 1e-9
+
+
+def test_closed_loop_through_the_dynamics():
+    """The forklift with Pacejka tyres and servos (ch. 7) under the thesis's law: the fork tips converge to within a
+    few millimetres (tyre slip), close to the ideal kinematic loop's exponential early on."""
+    ref = builtin_reference("circle")
+    start = np.array([0.0, 0.3, 0.0])
+    fork = catalog.load("forklift")
+    dyn = track(fork, ref, initial_pose=start, duration=12.0, dynamics=True, period=0.02)
+    kin = track(fork, ref, initial_pose=start, duration=12.0, period=0.02)
+    assert dyn.error[0] == pytest.approx(0.3) and dyn.error[-1] < 5e-3
+    assert np.abs(dyn.error - kin.error).max() < 0.05
+    with pytest.raises(ControlError, match="low-level loops"):
+        track(fork, ref, dynamics=True, loops=LowLevelLoops(("steer.steer",), (ActuatorLoop(1.0),)))
+
+
+@pytest.mark.parametrize("name", ["forklift", "diff-drive", "swerve-4", "mecanum-4", "ackermann"])
+def test_single_call_tick_equals_the_batched_path(name):
+    """control_tick (scalar law + compiled IK) gives the twist of law_controller and the rates of wheel_commands."""
+    from wmrkit.control.laws import PositionLaw
+    from wmrkit.control.loop import law_controller
+    from wmrkit.control.tick import control_tick
+
+    robot = catalog.load(name)
+    ref = builtin_reference("figure-eight")
+    law = PositionLaw.uniform("p", 0.7, gate=0.4)
+    tick = control_tick(robot, law)
+    ctrl = law_controller(control_point(robot), law, ref)
+    twist_out, rates = np.zeros(3), np.zeros(len(robot.rate_names))
+    heading = np.array(robot.heading, dtype=float)
+    new = np.zeros_like(heading)
+    rng = np.random.default_rng(1)
+    for k in rng.integers(0, len(ref.t), 20):
+        pose = ref.pose[k] + rng.normal(0, 0.3, 3)
+        p, v = ref.at(float(ref.t[k]))
+        tick.tick(*pose, *p, *v, heading, twist_out, rates, new)
+        want, _ = ctrl(float(ref.t[k]), pose, np.zeros(3))
+        np.testing.assert_allclose(twist_out, want, atol=1e-12)
+        batched = wheel_commands(robot, want, robot.beta_of_heading(heading))
+        np.testing.assert_allclose(rates, batched.rates, atol=1e-9)
+
+
+def test_odometry_feedback_through_the_dynamics():
+    """Closed on the odometer (sensed drive spins and steering, one exact step per period): the *estimate* follows
+    the reference, so the true error is the odometry's drift caused by the tyre slip."""
+    from wmrkit.control.points import point_pose as pp
+
+    fork = catalog.load("forklift")
+    ref = builtin_reference("circle")
+    run = track(fork, ref, initial_pose=[0.0, 0.3, 0.0], duration=12.0, dynamics=True, feedback="odometry")
+    cp = control_point(fork)
+    est_error = np.hypot(*(pp(cp, run.estimate)[:, :2] - run.reference[:, :2]).T)
+    drift = np.hypot(*(pp(cp, run.estimate)[:, :2] - pp(cp, run.pose)[:, :2]).T)
+    assert est_error[-1] < 5e-3 and 1e-3 < drift[-1] < 0.3
+    assert abs(run.error[-1] - drift[-1]) < est_error[-1] + 1e-9
+    with pytest.raises(ControlError, match="dynamic plant"):
+        track(fork, ref, feedback="odometry")

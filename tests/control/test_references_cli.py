@@ -1,0 +1,108 @@
+"""References (built-in shapes, TUM/CSV files), the trackers, and the ``track`` / ``feasibility`` commands."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.cli.main import main
+from wmrkit.control.references import BUILTIN, ReferenceError, builtin_reference, load_reference
+from wmrkit.control.track import track
+from wmrkit.errors import UnknownNameError
+
+
+@pytest.mark.parametrize("name", list(BUILTIN))
+def test_builtin_derivatives_are_the_numeric_ones(name):
+    """Exact velocities and accelerations against central differences, away from the corners."""
+    ref = builtin_reference(name, dt=0.001)
+    ok = np.ones(len(ref.t), bool)
+    for b in ref.breaks:
+        ok &= np.abs(ref.t - b) > 0.005
+    ok[:2] = ok[-2:] = False
+    num_v = np.gradient(ref.pose, ref.t, axis=0)
+    num_a = np.gradient(ref.velocity, ref.t, axis=0)
+    np.testing.assert_allclose(num_v[ok], ref.velocity[ok], atol=1e-5)
+    np.testing.assert_allclose(num_a[ok], ref.acceleration[ok], atol=1e-4)
+    p, _v = ref.at(0.123)
+    np.testing.assert_allclose(p, ref.sample(np.array([0.123]))[0], atol=1e-6)
+
+
+def test_files_tum_and_csv(tmp_path):
+    ref = builtin_reference("circle")
+    th = ref.pose[:, 2]
+    tum = tmp_path / "ref.tum"
+    rows = np.column_stack([ref.t, ref.pose[:, :2], 0 * th, 0 * th, 0 * th, np.sin(th / 2), np.cos(th / 2)])
+    np.savetxt(tum, rows)
+    csv = tmp_path / "ref.csv"
+    np.savetxt(csv, np.column_stack([ref.t, ref.pose]), delimiter=",", header="t,x,y,theta", comments="", fmt="%.17g")
+    for path in (tum, csv):
+        got = load_reference(path)
+        np.testing.assert_allclose(got.pose, ref.pose, atol=1e-9)
+        np.testing.assert_allclose(got.velocity[5:-5], ref.velocity[5:-5], atol=1e-4)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t,x,y,theta\n0,0,0,0\n0,1,0,0\n1,2,0,0\n")
+    with pytest.raises(ReferenceError, match="times must increase"):
+        load_reference(bad)
+    with pytest.raises(ReferenceError, match="no such file"):
+        load_reference(tmp_path / "none.csv")
+    with pytest.raises(UnknownNameError, match="did you mean 'circle'"):
+        builtin_reference("circel")
+
+
+@pytest.mark.parametrize("controller", ["pure-pursuit", "stanley"])
+@pytest.mark.parametrize("name", ["diff-drive", "forklift", "swerve-4"])
+def test_geometric_trackers_converge_onto_the_path(controller, name):
+    run = track(catalog.load(name), builtin_reference("line", duration=40), controller=controller,
+                initial_pose=[0.0, 0.4, 0.0], duration=25.0, lookahead=1.0)
+    assert run.cross_track[0] > 0.3 and run.cross_track[-1] < 0.01
+
+
+def test_cli_track_json(capsys):
+    assert main(["track", "forklift", "--reference", "circle", "--from", "0", "0.5", "0deg", "--duration", "4",
+                 "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert {"t", "pose", "reference", "wheels", "summary"} <= set(data)
+    assert len(data["pose"][0]) == 3 and len(data["reference"][0]) == 3 and len(data["t"]) == len(data["pose"])
+    assert data["wheels"]["right_drive"]["heading"] is None
+    assert len(data["wheels"]["steer"]["heading"]) == len(data["t"])
+    assert data["error"][0] == pytest.approx(0.5) and data["error"][-1] < 0.5 * math.exp(-3.5)
+
+
+def test_cli_track_discrete_warns_and_plots(tmp_path, capsys):
+    png = tmp_path / "run.png"
+    assert main(["track", "mecanum-4", "--reference", "line", "--period", "0.5", "--delay", "1", "--gain", "0.8",
+                 "--duration", "5", "--plot", str(png)]) == 0
+    captured = capsys.readouterr()
+    assert "10 T" in captured.err and "tracking error" in captured.out and png.stat().st_size > 1000
+
+
+def test_cli_feasibility_json(capsys):
+    assert main(["feasibility", "forklift", "--reference", "square", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["feasible"] is False and {"t", "kind", "remedy"} <= set(data["violations"][0])
+    assert main(["feasibility", "mecanum-4", "--reference", "circle", "--framework", "dynamic", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["feasible"] is True
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["track", "forklift", "--reference", "nope"], "no built-in reference"),
+    (["track", "forklift", "--reference", "line", "--period", "-1"], "--period"),
+    (["track", "forklift", "--reference", "line", "--delay", "1"], "needs a sample period"),
+    (["feasibility", "skid-steer-4", "--reference", "line"], "degenerate"),
+    (["track", "forklift", "--reference", "missing.csv"], "no such file"),
+    (["track", "diff-drive", "--reference", "line", "--dynamics"], "no mass properties"),
+])
+def test_cli_errors_exit_2_with_one_line(argv, message, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+
+
+def test_cli_track_through_the_dynamics(capsys):
+    assert main(["track", "forklift", "--reference", "line", "--dynamics", "--duration", "2", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["period"] == 0.02 and len(data["t"]) == 101 and data["summary"]["max_error"] < 0.05  # starts at rest

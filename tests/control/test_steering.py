@@ -1,0 +1,142 @@
+"""Steering in the loop (§8.4): roots within range, 2/4 quadrants, swerve motion modes, skew-free discretisation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from wmrkit import catalog
+from wmrkit.control.forklift import from_thesis_pose, with_steer_range
+from wmrkit.control.references import builtin_reference
+from wmrkit.control.steering import ackermann_twist, choose_steering, crab_twist, discretize_twist, icr_twist
+from wmrkit.control.track import track
+from wmrkit.kinematics.wheel_ik import wheel_commands
+from wmrkit.odometry.integrators import integrate_exact
+
+angles = st.floats(-math.pi, math.pi)
+
+
+def _wrapped(a):
+    return np.angle(np.exp(1j * np.asarray(a)))
+
+
+@given(h=angles, s=st.floats(-5, 5), cur=angles, lo=st.floats(-math.pi, 0), width=st.floats(0.5, 2 * math.pi - 0.1))
+def test_choice_is_a_root_and_within_range(h, s, cur, lo, width):
+    """The chosen (heading, spin) is (h, s) or (h + pi, -s), and inside the range whenever one root fits."""
+    rng = np.array([[lo, lo + width]])
+    c = choose_steering([h], [s], [cur], ranges=rng)
+    same = abs(_wrapped(c.heading[0] - h)) < 1e-9 and c.spin[0] == s
+    flipped = abs(_wrapped(c.heading[0] - h - math.pi)) < 1e-9 and c.spin[0] == -s
+    fits = c.in_range[0]
+    assert (same or flipped) if fits else True
+    if width >= math.pi:  # a range of half a turn or more always holds one of two opposite roots
+        assert fits
+    if fits:
+        off = (c.heading[0] - lo) % (2 * math.pi)
+        assert off <= width + 1e-9 or off >= 2 * math.pi - 1e-9
+
+
+@given(h=angles, s=st.floats(-5, 5))
+def test_quadrant_policies(h, s):
+    four = choose_steering([h], [s], [0.0], policy="4-quadrant")
+    two = choose_steering([h], [s], [0.0], policy="2-quadrant")
+    assert four.spin[0] >= 0 or s == 0
+    assert -math.pi / 2 - 1e-9 < two.heading[0] <= math.pi / 2 + 1e-9
+
+
+def test_steering_stays_within_range_with_2_quadrant_steering():
+    """The forklift with its +-90 deg wheel on references with reversals and corners: never out of range."""
+    truck = with_steer_range(catalog.load("forklift"), "steer", -math.pi / 2, math.pi / 2)
+    for name, pose in (("corner", from_thesis_pose([0, 0, 0])), ("circle", [0.3, -0.5, 2.8])):
+        run = track(truck, builtin_reference(name), gain=1.0, initial_pose=pose, policy="2-quadrant", duration=10)
+        assert np.all(np.abs(run.heading[:, 0]) <= math.pi / 2 + 1e-9)
+    run = track(truck, builtin_reference("corner"), gain=1.0, initial_pose=from_thesis_pose([0, 0, 0]),
+                policy="4-quadrant", duration=10)  # the range wins over the policy
+    assert np.all(np.abs(run.heading[:, 0]) <= math.pi / 2 + 1e-9)
+
+
+SWERVE = catalog.load("swerve-4")
+
+
+def _headings(twist):
+    c = wheel_commands(SWERVE, twist)
+    return np.asarray(SWERVE.heading_of_beta(c.beta)), np.asarray(c.spin)
+
+
+def test_crab_mode_points_every_module_the_same_way():
+    h, s = _headings(crab_twist(1.0, 0.7))
+    assert np.allclose(_wrapped(h - 0.7), 0, atol=1e-12) or np.allclose(np.abs(_wrapped(h - 0.7)), math.pi)
+    assert np.allclose(np.abs(s), 1.0 / 0.0508)
+
+
+@given(cx=st.floats(-3, 3), cy=st.floats(-3, 3), w=st.floats(0.1, 2))
+@settings(max_examples=40)
+def test_icr_mode_rolls_every_module_perpendicular_to_the_icr(cx, cy, w):
+    """Arbitrary ICR (ros2_controllers #2000): each module's rolling direction is perpendicular to ICR -> module."""
+    pos = np.array([wh.position for wh in SWERVE.wheels])
+    if np.min(np.hypot(*(pos - [cx, cy]).T)) < 0.05:
+        return
+    h, _ = _headings(icr_twist([cx, cy], w))
+    radial = pos - [cx, cy]
+    roll = np.column_stack([np.cos(h), np.sin(h)])
+    np.testing.assert_allclose(np.sum(roll * radial, axis=1), 0, atol=1e-9)
+
+
+def test_ackermann_mode_puts_the_icr_on_the_virtual_rear_axle():
+    t = ackermann_twist(1.0, 0.5, axle_x=-0.28)
+    icr = np.array([-t[1] / t[2], t[0] / t[2]])  # v_origin = omega (c_y, -c_x)
+    np.testing.assert_allclose(icr, [-0.28, 2.0])
+    np.testing.assert_allclose(ackermann_twist(1.0, 0.0, -0.28), [1, 0, 0])
+
+
+@given(vx=st.floats(-3, 3), vy=st.floats(-3, 3), w=st.floats(-4, 4), dt=st.floats(0.005, 0.5))
+def test_skew_free_twist_ends_at_the_straight_pose(vx, vy, w, dt):
+    """Held for dt through the exact SE(2) step, the discretised twist ends at (vx dt, vy dt, omega dt)."""
+    end = integrate_exact([0.0, 0.0, 0.0], discretize_twist([vx, vy, w], dt), dt)
+    np.testing.assert_allclose(end, [vx * dt, vy * dt, w * dt], atol=1e-12)
+
+
+def test_skew_free_matches_wpilib():
+    kin = pytest.importorskip("wpimath.kinematics")
+    got = discretize_twist([1.0, 0.3, 2.0], 0.02)
+    want = kin.ChassisSpeeds.discretize(kin.ChassisSpeeds(1.0, 0.3, 2.0), 0.02)
+    np.testing.assert_allclose(got, [want.vx, want.vy, want.omega], atol=1e-12)
+
+
+def test_skew_free_discrete_loop_removes_the_drift_of_translating_while_rotating():
+    """A holonomic robot told to translate and spin: holding the plain twist skews the path, the discretised one
+    lands on the straight line at every sample (the WPILib #5349 symptom)."""
+    from wmrkit.control.loop import simulate
+
+    spin = np.array([0.5, 0.0, 2.0])  # world-frame x velocity 0.5 while turning at 2 rad/s
+
+    def ctrl(t, pose, integral):
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        return np.array([c * spin[0], -s * spin[0], spin[2]]), np.zeros(3)
+
+    robot = catalog.load("mecanum-4")
+    plain = simulate(robot, ctrl, np.zeros(3), 2.0, period=0.1)
+    fixed = simulate(robot, ctrl, np.zeros(3), 2.0, period=0.1, skew_free=True)
+    assert np.abs(plain["pose"][:, 1]).max() > 5e-3
+    np.testing.assert_allclose(fixed["pose"][:, 1], 0.0, atol=1e-12)
+
+
+def test_steer_range_description_field():
+    """``steer_range: [min, max]`` in headings: parsed with units, round-trips, located errors."""
+    from wmrkit import Robot
+    from wmrkit.errors import DescriptionError
+
+    wheel = {"name": "s", "type": "steerable", "position": [1, 0], "r": 0.1, "steer_range": ["-90 deg", "90 deg"]}
+    robot = Robot.from_dict({"name": "x", "wheels": [wheel]})
+    assert robot.wheel("s").steer_range == pytest.approx((-math.pi / 2, math.pi / 2))
+    assert Robot.from_dict(robot.to_dict()) == robot
+    for bad, message in ((["90 deg", "-90 deg"], "min < max"), ([0], "two headings"), (["1 m", 1], "angle")):
+        with pytest.raises(DescriptionError, match=message):
+            Robot.from_dict({"name": "x", "wheels": [{**wheel, "steer_range": bad}]})
+    fixed = {"name": "f", "type": "fixed", "position": [0, 0], "beta": 0, "r": 0.1, "steer_range": [0, 1]}
+    with pytest.raises(DescriptionError, match=r"wheels\[0\]\.steer_range: a fixed wheel does not steer"):
+        Robot.from_dict({"name": "x", "wheels": [fixed]})

@@ -1,0 +1,37 @@
+"""Robots with mass properties for the dynamics tests (imported by the test modules)."""
+
+from __future__ import annotations
+
+from wmrkit import Robot
+
+
+def tricycle(beta3: float = 0.0, tyre: str | dict = "pacejka") -> Robot:
+    """The forklift in the thesis's ch. 7 frame (7.60): x lateral (right), y forward, R at the drive-axle middle."""
+    return Robot.from_dict({
+        "name": "tricycle-ch7",
+        "body": {"mass": 2500, "inertia": 1500, "com": [0, -0.45], "com_height": 0.7},
+        "wheels": [
+            {"name": "w1", "type": "fixed", "position": [0.45, 0], "beta": 0, "r": 0.23, "actuated": ["spin"],
+             "inertia": {"spin": 1.0}, "tyre": tyre},
+            {"name": "w2", "type": "fixed", "position": [-0.45, 0], "beta": 0, "r": 0.23, "actuated": ["spin"],
+             "inertia": {"spin": 1.0}, "tyre": tyre},
+            {"name": "w3", "type": "steerable", "position": [0, -1.35], "beta": beta3, "r": 0.23,
+             "actuated": ["steer"], "inertia": {"spin": 1.5, "steer": 0.8}, "tyre": tyre},
+        ],
+    })
+
+
+def castor_robot(tyre: dict | str = "dugoff") -> Robot:
+    """A differential robot with a heavy castor (its CM moves with the steering angle) and an off-centre CM."""
+    return Robot.from_dict({
+        "name": "castor-bot",
+        "body": {"mass": 20, "inertia": 1.2, "com": [-0.08, 0.02], "com_height": 0.15},
+        "wheels": [
+            {"name": "left", "type": "fixed", "position": [0, 0.2], "beta": "90 deg", "r": 0.08,
+             "actuated": ["spin"], "inertia": {"spin": 0.004}, "tyre": tyre},
+            {"name": "right", "type": "fixed", "position": [0, -0.2], "beta": "90 deg", "r": 0.08,
+             "actuated": ["spin"], "inertia": {"spin": 0.004}, "tyre": tyre},
+            {"name": "caster", "type": "castor", "position": [-0.3, 0], "d": 0.06, "beta": "80 deg", "r": 0.04,
+             "inertia": {"spin": 0.0005, "steer": 0.002}, "mass": 1.5, "tyre": tyre},
+        ],
+    })

@@ -1,0 +1,74 @@
+"""``wmrkit tyre`` and ``wmrkit simulate``: JSON output, files, plots; user mistakes are one line and exit 2."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from wmrkit.cli.main import main
+from wmrkit.dynamics.tyres import Tyre
+
+
+def run(capsys, *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_tyre_json_is_the_library_value(capsys, tmp_path):
+    plot = tmp_path / "tyre.png"
+    code, out, err = run(capsys, "tyre", "pacejka", "--load", "8175", "--slip-ratio", "0.1", "--slip-angle",
+                         "2.8648 deg", "--param", "shifts=0", "--plot", str(plot), "--json")
+    assert code == 0 and err == ""
+    data = json.loads(out)
+    f = Tyre.of("pacejka", {"shifts": 0}).forces_at_slip(8175, 0.1, np.radians(2.8648), 2.0)
+    assert data["Fx"] == pytest.approx(float(f.longitudinal)) and data["Fy"] == pytest.approx(float(f.lateral))
+    assert data["Fx"] < 0 and data["Fy"] < 0  # the force opposes the slip
+    assert plot.stat().st_size > 1000
+
+
+def test_tyre_text(capsys):
+    code, out, _ = run(capsys, "tyre", "dugoff", "--load", "8000", "--slip-ratio", "0.01", "--param", "cs=80000")
+    assert code == 0 and "Fx (longitudinal) = -808.081 N" in out and "Fy (lateral)      = 0 N" in out
+
+
+@pytest.mark.parametrize("argv", [
+    ("tyre", "dugoff", "--load", "-1"),
+    ("tyre", "dugoff", "--load", "100", "--slip-ratio", "-1"),
+    ("tyre", "dugoff", "--load", "100", "--slip-angle", "30"),
+    ("tyre", "dugoff", "--load", "100", "--param", "cz=1"),
+    ("tyre", "dugoff", "--load", "100", "--param", "mu"),
+    ("tyre", "magic", "--load", "100"),
+    ("simulate", "diff-drive", "--path", "turn"),
+    ("simulate", "forklift", "--path", "turn", "--step", "0"),
+    ("simulate", "forklift", "--path", "turn", "--duration", "1e9"),
+    ("simulate", "forklift", "--torques", "/nonexistent.csv"),
+    ("simulate", "forklift", "--path", "loop"),
+])
+def test_user_mistakes_are_one_line_and_exit_2(capsys, argv):
+    code, out, err = run(capsys, *argv)
+    assert code == 2 and out == ""
+    assert err.strip().splitlines()[-1].startswith("wmrkit: error:")
+    assert "Traceback" not in err
+
+
+def test_simulate_path_json_out_and_plot(capsys, tmp_path):
+    out_file, plot = tmp_path / "run.csv", tmp_path / "run.png"
+    code, out, err = run(capsys, "simulate", "forklift", "--path", "turn", "--out", str(out_file), "--plot",
+                         str(plot), "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["final_twist"][2] == pytest.approx(2 / 3, abs=0.05) and data["samples"] == 301
+    table = np.loadtxt(out_file, delimiter=",", skiprows=1)
+    assert table.shape[0] == 301 and np.allclose(table[-1, 1:4], data["final_pose"])
+    assert plot.stat().st_size > 1000
+
+
+def test_simulate_torque_file(capsys, tmp_path):
+    path = tmp_path / "tau.csv"
+    path.write_text("time,left_drive.spin,right_drive.spin\n0,100,100\n1,100,100\n")
+    code, out, err = run(capsys, "simulate", "forklift", "--torques", str(path), "--tyre", "dugoff", "--json")
+    assert code == 0, err
+    assert json.loads(out)["final_twist"][0] > 0.05  # positive spin torque drives the truck forward

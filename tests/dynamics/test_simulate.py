@@ -1,0 +1,146 @@
+"""The simulator: integrators agree, friction dissipates, results are frozen, programs and torque files."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from dynamics_robots import castor_robot, tricycle
+
+from wmrkit import catalog
+from wmrkit.dynamics.model import DynamicModel
+from wmrkit.dynamics.programs import PATHS, feasible_twists, path_program, read_torques
+from wmrkit.dynamics.simulate import Inputs, simulate
+from wmrkit.dynamics.tyres import Tyre
+from wmrkit.errors import WmrkitError
+
+
+@pytest.fixture(scope="module")
+def forklift():
+    return DynamicModel.of(catalog.load("forklift"))
+
+
+def test_semi_implicit_and_rk4_agree_with_the_adaptive_solution():
+    model = DynamicModel.of(castor_robot({"model": "dugoff", "cs": 800, "calpha": 600}))
+    inputs = Inputs.torques_only(model, [0.0, 1.0], {"left.spin": [0.1, 0.1], "right.spin": [0.3, 0.3]})
+    ref = simulate(model, inputs, 1.0, method="adaptive", rtol=1e-9, record_step=0.01, initial_twist=[0.4, 0, 0])
+    for method, step, tol in (("rk4", 2e-4, 1e-4), ("semi-implicit", 2e-4, 5e-3)):
+        sim = simulate(model, inputs, 1.0, method=method, step=step, record_step=0.01, initial_twist=[0.4, 0, 0])
+        assert np.allclose(sim.t, ref.t)
+        assert np.allclose(sim.pose, ref.pose, atol=tol), method
+        assert np.allclose(sim.twist, ref.twist, atol=tol), method
+
+
+def test_forklift_pacejka_friction_never_adds_energy_and_the_truck_follows_its_program(forklift):
+    model = DynamicModel.of(catalog.load("forklift"), Tyre.of("pacejka", {"shifts": 0.0}))
+    inputs, duration = path_program(model, "turn", speed=2.0)
+    sim = simulate(model, inputs, duration, record_step=0.01)
+    assert np.all(sim.friction_power() <= 1e-9)
+    assert sim.twist[-1, 0] == pytest.approx(2.0, abs=0.05)  # forward speed of the program
+    assert sim.twist[-1, 2] == pytest.approx(2.0 / 3.0, abs=0.05)  # radius 3 m
+    assert np.all(sim.loads > 0) and np.allclose(sim.loads.sum(axis=1), 2500 * 9.81, rtol=1e-6)
+
+
+def test_simulation_is_frozen(forklift):
+    inputs, _ = path_program(forklift, "straight")
+    sim = simulate(forklift, inputs, 0.2, step=1e-3)
+    assert sim.pose.shape == (201, 3) and sim.forces.shape == (201, 3, 2) and sim.joint_rates.shape == (201, 4)
+    for arr in (sim.t, sim.pose, sim.twist, sim.joint_rates, sim.forces, sim.loads, sim.slip, sim.heading):
+        with pytest.raises(ValueError):
+            arr[0] = 0
+    assert sim.joint_names == forklift.names[3:]
+
+
+def test_skid_steer_turns_less_than_its_kinematics_say():
+    """The Husky effect of the issue: wheel speeds for omega are held, the robot turns much less."""
+    model = DynamicModel.of(catalog.load("skid-steer-4"))
+    inputs, duration = path_program(model, "turn", speed=1.0)
+    sim = simulate(model, inputs, duration, record_step=0.01)
+    assert 0.1 < sim.twist[-1, 2] < 0.8 * (1 / 3)
+
+
+def test_feasible_twists_move_sideways_at_the_fork_tips(forklift):
+    tw = feasible_twists(forklift, [[2.0, 0.0, 0.5]])
+    assert tw[0, 1] == pytest.approx(0.5 * 1.0)  # omega x (distance to the drive axle, 1 m)
+
+
+def test_every_path_program_runs(forklift):
+    for name in PATHS:
+        inputs, duration = path_program(forklift, name)
+        assert duration >= 2 and inputs.rate_reference.shape[1] == forklift.n
+
+
+def test_torque_file(tmp_path, forklift):
+    path = tmp_path / "tau.csv"
+    path.write_text("time,right_drive.spin,left_drive.spin,steer.heading\n0,50,50,0\n1,50,50,0.2\n2,0,0,0.2\n")
+    inputs = read_torques(forklift, path)
+    sim = simulate(forklift, inputs, 2.0, initial_twist=[1, 0, 0], record_step=0.01)
+    assert sim.twist[100, 0] > 1.0
+    assert sim.heading[-1, 0] == pytest.approx(0.2, abs=0.02)
+    for text, match in (("time,steer.spin\n0,1\n", "not actuated"), ("time,nope.spin\n0,1\n", "no joint"),
+                        ("time,left_drive.spin\n0,x\n", "not a number"), ("t,a\n", "header"),
+                        ("time,left_drive.spin\n1,0\n0,0\n", "increasing")):
+        path.write_text(text)
+        with pytest.raises(WmrkitError, match=match):
+            read_torques(forklift, path)
+
+
+def test_bad_arguments_are_errors(forklift):
+    inputs = Inputs.torques_only(forklift, [0.0], {})
+    with pytest.raises(WmrkitError):
+        simulate(forklift, inputs, -1.0)
+    with pytest.raises(WmrkitError):
+        simulate(forklift, inputs, 1.0, method="euler")  # type: ignore[arg-type]
+    with pytest.raises(WmrkitError, match="not actuated"):
+        Inputs.torques_only(forklift, [0.0], {"steer.spin": 1.0})
+
+
+def test_block_counter_example_7_4_to_7_8():
+    """Minimising dissipation = quasi-static balance only when f + |v| f' = k f (7.8): true for the Coulomb and
+    linear laws, false for the smoothed Coulomb law (7.28) (f = (2/pi) atan(k v), neither constant nor a power)."""
+    def k_ratio(tyre, v, h=1e-6):
+        f = lambda x: -tyre.forces(1.0, 0.0, x, x, 0.0).longitudinal  # noqa: E731 (block friction magnitude)
+        df = (f(v + h) - f(v - h)) / (2 * h)
+        return (f(v) + v * df) / f(v)
+
+    speeds = [0.05, 0.3, 2.0]
+    for tyre, law_holds in ((Tyre.of("coulomb", {"k": math.inf}), True), (Tyre.of("linear"), True),
+                            (Tyre.of("coulomb", {"k": 5.0}), False)):
+        ratios = [k_ratio(tyre, v) for v in speeds]
+        assert (np.ptp(ratios) < 1e-6) == law_holds, (tyre.model, ratios)
+    # the power laws of the text: f = 1, |v|, |v|^2, |v|^3 give k = 1, 2, 3, 4; f = 1 + |v| etc. give no constant k
+    for f, df, holds in ((lambda v: 1.0, lambda v: 0.0, True), (lambda v: v ** 3, lambda v: 3 * v ** 2, True),
+                         (lambda v: 1 + v, lambda v: 1.0, False), (lambda v: v + v ** 2, lambda v: 1 + 2 * v, False)):
+        ratios = [(f(v) + v * df(v)) / f(v) for v in speeds]
+        assert (np.ptp(ratios) < 1e-12) == holds
+
+
+def test_tricycle_straight_run_keeps_equal_drive_loads():
+    model = DynamicModel.of(tricycle(0.0, {"model": "pacejka", "shifts": 0}))  # no lateral bias
+    inputs = Inputs.torques_only(model, [0.0, 1.0], {"w1.spin": [-20, -20], "w2.spin": [-20, -20]})
+    sim = simulate(model, inputs, 0.5, initial_twist=[0, 1.0, 0], record_step=0.01)
+    assert np.allclose(sim.loads[:, 0], sim.loads[:, 1])
+    assert sim.twist[-1, 1] > 1.0  # -20 N m drives forward in the thesis convention (phi_dot < 0 forward)
+
+
+def test_mecanum_with_rollers_follows_its_program():
+    """Swedish wheels: the roller is a joint with its own inertia; a Mecanum robot turns as commanded."""
+    from wmrkit import Robot
+
+    data = catalog.load("mecanum-4").to_dict()
+    data["body"] = {"mass": 20, "inertia": 0.8, "com": [0, 0], "com_height": 0.1}
+    for w in data["wheels"]:
+        w["inertia"], w["tyre"] = {"spin": 0.005, "roller": 1e-5}, {"model": "coulomb", "k": 200}
+    model = DynamicModel.of(Robot.from_dict(data))
+    assert "front_left.roller" in model.names
+    inputs, duration = path_program(model, "turn", speed=0.5)
+    sim = simulate(model, inputs, duration, record_step=0.01)
+    assert sim.twist[-1] == pytest.approx([0.5, 0.0, 0.5 / 3], abs=2e-3)
+
+
+def test_progress_bar_runs_in_chunks_with_the_same_result(forklift, capsys):
+    inputs, _ = path_program(forklift, "turn")
+    plain = simulate(forklift, inputs, 0.5, record_step=0.01)
+    shown = simulate(forklift, inputs, 0.5, record_step=0.01, progress=True)
+    assert np.array_equal(plain.pose, shown.pose) and np.array_equal(plain.t, shown.t)

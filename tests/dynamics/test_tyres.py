@@ -1,0 +1,206 @@
+"""Traction models (thesis §7.3, appendix 7.A1): symmetry, slopes, peaks, saturation, peers and the spec's tables."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from wmrkit.dynamics.tyres import (
+    TYRES,
+    Tyre,
+    coulomb,
+    delft_combined,
+    friction_ellipse,
+    lu_lateral,
+    lu_longitudinal,
+    magic_formula,
+    slip_angle,
+    slip_ratio,
+    slip_velocities,
+)
+from wmrkit.errors import UnknownNameError, WmrkitError
+
+FZ = 8175.0
+speeds = st.floats(0.2, 15)
+slips = st.floats(-5, 5)
+
+
+def test_coulomb_smooth_7_28_limit_and_slope():
+    v = np.linspace(-2, 2, 41)
+    assert np.allclose(coulomb(v, 0.7, 1e9)[v != 0], 0.7 * np.sign(v[v != 0]))
+    assert np.array_equal(coulomb(v, 0.7), 0.7 * np.sign(v))
+    h = 1e-7
+    assert (coulomb(h, 0.7, 30.0) - coulomb(-h, 0.7, 30.0)) / (2 * h) == pytest.approx(0.7 * 2 / math.pi * 30, 1e-6)
+
+
+@given(st.floats(-3, 3), st.floats(-3, 3), st.floats(0.1, 2), st.floats(0.1, 2))
+def test_friction_ellipse_7_30_is_on_the_boundary_and_dissipates(vx, vy, mx, my):
+    if math.hypot(vx, vy) < 1e-6:
+        return
+    m = friction_ellipse(vx, vy, mx, my)
+    assert (m.lateral / mx) ** 2 + (m.longitudinal / my) ** 2 == pytest.approx(1.0, abs=1e-9)
+    assert m.lateral * vx + m.longitudinal * vy >= 0  # force -Fz mu opposes the slip
+    # maximum dissipation: no other point of the ellipse dissipates more
+    t = np.linspace(0, 2 * np.pi, 721)
+    assert m.lateral * vx + m.longitudinal * vy >= np.max(mx * np.cos(t) * vx + my * np.sin(t) * vy) - 1e-9
+
+
+def test_slip_ratio_and_angle_inverse():
+    s = np.array([-0.9, -0.3, 0.0, 0.2, 1.0, 1.8])
+    a = np.array([-1.2, -0.1, 0.0, 0.05, 0.3, 1.4])
+    v_lat, v_long, v_wheel, v_roll = slip_velocities(s, a, 2.0)
+    assert np.allclose(slip_ratio(v_long, v_wheel, v_roll), s)
+    assert np.allclose(slip_angle(v_lat, v_wheel), a)
+    # ch. 3 convention: forward rolling has r phi_dot = -v; a driving (faster) wheel has s < 0
+    assert slip_ratio(2.0 - 2.2, 2.0, -2.2) < 0
+    with pytest.raises(WmrkitError):
+        slip_velocities(-1.0, 0.0, 1.0)
+
+
+@pytest.mark.parametrize("model", ["linear", "coulomb", "dugoff", "pacejka"])
+@settings(max_examples=60, deadline=None)
+@given(v_lat=slips, v_long=slips, v_wheel=st.floats(-10, 10))
+def test_friction_never_adds_energy(model, v_lat, v_long, v_wheel):
+    """Power of the contact force on the slip velocity is <= 0 (pacejka without its shifts, see the docs)."""
+    tyre = Tyre.of(model, {"shifts": 0.0} if model == "pacejka" else {})
+    f = tyre.forces(FZ, v_lat, v_long, v_wheel, v_long - v_wheel)
+    assert f.lateral * v_lat + f.longitudinal * v_long <= 1e-9
+
+
+@pytest.mark.parametrize("model", ["linear", "coulomb", "dugoff", "pacejka"])
+@settings(max_examples=40, deadline=None)
+@given(v_lat=slips, v_long=slips, v_wheel=speeds)
+def test_odd_symmetry(model, v_lat, v_long, v_wheel):
+    """Reversing the slip reverses the force (pacejka: pure slips, shifts off; its r_By3 = 4.98 is not odd)."""
+    tyre = Tyre.of(model, {"shifts": 0.0} if model == "pacejka" else {})
+    roll = v_long - v_wheel
+    if model == "pacejka":  # odd in the slip ratio and in the slip angle, each alone
+        s, a = float(np.tanh(v_long)) * 0.9, float(np.tanh(v_lat)) * 1.4
+        for x, y in ((s, 0.0), (0.0, a)):
+            f, g = tyre.forces_at_slip(FZ, x, y, v_wheel), tyre.forces_at_slip(FZ, -x, -y, v_wheel)
+            assert np.allclose([f.lateral, f.longitudinal], [-g.lateral, -g.longitudinal], atol=1e-6)
+        return
+    f = tyre.forces(FZ, v_lat, v_long, v_wheel, roll)
+    g = tyre.forces(FZ, -v_lat, -v_long, -v_wheel, -roll)
+    assert np.allclose([f.lateral, f.longitudinal], [-g.lateral, -g.longitudinal], atol=1e-6)
+
+
+def test_slopes_at_the_origin():
+    h = 1e-7
+    dug = Tyre.of("dugoff", {"cs": 9e4, "calpha": 4e4})
+    assert -(dug.forces_at_slip(FZ, h, 0).longitudinal - dug.forces_at_slip(FZ, -h, 0).longitudinal) / (2 * h) \
+        == pytest.approx(9e4, rel=1e-5)
+    assert -(dug.forces_at_slip(FZ, 0, h).lateral - dug.forces_at_slip(FZ, 0, -h).lateral) / (2 * h) \
+        == pytest.approx(4e4, rel=1e-5)
+    for v in (1.0, 2.0, 9.0):  # (7.82): k9 = c_sy / (k8 k7), so the slope is c_sy; (7.83): c_sx
+        c_sy = math.tan(math.pi / 180 * (84.21 + 5.16 * math.exp(-6.094 / (1 + v))))
+        c_sx = 0.3 * math.tan(math.pi / 180 * (84.21 + 5.16 * math.exp(-6.094 / (1 + 5 * v))))
+        assert (lu_longitudinal(h, v, 0) - lu_longitudinal(-h, v, 0)) / (2 * h) == pytest.approx(c_sy, rel=1e-6)
+        assert (lu_lateral(h, v, 0) - lu_lateral(-h, v, 0)) / (2 * h) == pytest.approx(c_sx, rel=1e-6)
+    assert (magic_formula(h, 7.0, 1.3, 0.9, 0.2) - magic_formula(-h, 7.0, 1.3, 0.9, 0.2)) / (2 * h) \
+        == pytest.approx(7.0 * 1.3 * 0.9, rel=1e-6)
+
+
+def test_dugoff_linear_region_is_cs_s_over_1_minus_s():
+    dug = Tyre.of("dugoff", {"cs": 5e4, "calpha": 3e4, "mu": 0.9})
+    s = np.array([0.001, 0.01, 0.03, 0.05])
+    lam = 0.9 * FZ * (1 - s) / (2 * 5e4 * s)
+    assert np.all(lam >= 1)  # inside the linear region
+    assert np.allclose(-dug.forces_at_slip(FZ, s, 0.0).longitudinal, 5e4 * s / (1 - s))
+
+
+@pytest.mark.parametrize("model,params", [("coulomb", {"k": 1e6}), ("dugoff", {}), ("pacejka", {"shifts": 0.0})])
+def test_saturation_at_mu_fz(model, params):
+    tyre = Tyre.of(model, params)
+    big = tyre.forces(FZ, 0.0, 50.0, 0.0, 50.0).longitudinal
+    mu = {"coulomb": 0.8, "dugoff": 0.8}.get(model)
+    if mu is None:  # pacejka: the longitudinal curve tends to k7 sin(k8 atan(k9 (1 - k10) s)) -> k7 sin(k8 pi/2)
+        s = slip_ratio(50.0, 1e-3, 50.0, 0.01)
+        mu = lu_longitudinal(s, 0.0, 0.0)
+    assert abs(big) == pytest.approx(mu * FZ, rel=1e-3)
+    s = np.linspace(-1.5, 1.5, 3001)
+    f = tyre.forces_at_slip(FZ, np.clip(s, -0.99, 2), 0.0, 2.0).longitudinal
+    assert np.max(np.abs(f)) <= 1.0 * FZ * 1.0001
+
+
+@pytest.mark.parametrize("v,peak_y,s_y,peak_x,a_x", [
+    (1, 0.7979, 0.620, 1.1083, 0.535), (2, 0.7958, 0.497, 1.0067, 0.406), (5, 0.7895, 0.295, 0.8444, 0.201),
+    (9, 0.7811, 0.179, 0.7749, 0.114), (18, 0.7622, 0.0875, 0.7512, 0.0825)])
+def test_pacejka_peaks_match_the_spec_table(v, peak_y, s_y, peak_x, a_x):
+    """Digest §9.5 (evaluated independently when the spec was written): peak value k7 and where it is."""
+    s = np.linspace(0, 1.2, 120001)
+    mu = lu_longitudinal(s, v)
+    assert mu.max() == pytest.approx(peak_y, abs=1e-4)
+    assert mu.max() == pytest.approx(0.8 - 0.0021 * v, abs=1e-9)  # the peak factor k7 is reached
+    assert s[mu.argmax()] == pytest.approx(s_y, abs=2e-3)
+    mx = lu_lateral(s, v)
+    assert mx.max() == pytest.approx(peak_x, abs=1e-4)
+    assert s[mx.argmax()] == pytest.approx(a_x, abs=2e-3)
+
+
+@pytest.mark.parametrize("s,a,mu_long,mu_lat", [
+    (0.05, 0, 0.48878, 0.00825), (0, 0.05, 0.03827, 0.31487), (0.05, 0.05, 0.48640, 0.22417),
+    (0.1, 0.2, 0.63438, 0.54704), (-0.1, -0.2, -0.62394, -0.54139)])
+def test_pacejka_combined_matches_the_spec_table(s, a, mu_long, mu_lat):
+    c = delft_combined(s, a, lu_longitudinal(s, 2.0), lu_lateral(a, 2.0))
+    assert c.longitudinal == pytest.approx(mu_long, abs=2e-5)
+    assert c.lateral == pytest.approx(mu_lat, abs=2e-5)
+
+
+def test_combined_weights_are_one_without_cross_slip():
+    s = np.linspace(-0.5, 0.5, 11)
+    c = delft_combined(s, 0.0, lu_longitudinal(s, 3.0, 0), 0.0, shifts=0.0)
+    assert np.allclose(c.longitudinal, lu_longitudinal(s, 3.0, 0))
+
+
+def test_reverse_motion_is_mirrored():
+    t = Tyre.of("pacejka")
+    fwd = t.forces(FZ, 0.01, 0.02, 2.0, 0.02 - 2.0)
+    rev = t.forces(FZ, -0.01, -0.02, -2.0, -0.02 + 2.0)
+    assert np.allclose([fwd.lateral, fwd.longitudinal], [-rev.lateral, -rev.longitudinal])
+    # rolling resistance from the shift: a free-rolling wheel (no slip) is braked in both directions
+    assert t.forces(FZ, 0, 0, 2.0, -2.0).longitudinal < 0 < t.forces(FZ, 0, 0, -2.0, 2.0).longitudinal
+
+
+def test_magic_formula_agrees_with_the_pacejka_package():
+    pacejka = pytest.importorskip("pacejka")
+    b, c, e, mu = 11.0, 1.5, 0.3, 0.9
+    tire = pacejka.Tire.from_constants("t", mu, b_x=b, c_x=c, e_x=e, b_y=0.6 * b, c_y=1.3, e_y=-0.2)
+    x = np.linspace(-0.6, 0.6, 49)
+    fy, fx = tire.calculate_forces(FZ, x, x, friction_circle=False, alpha_unit="rad")
+    assert np.allclose(fx, magic_formula(x, b, c, mu * FZ, e), rtol=1e-12, atol=1e-9)
+    assert np.allclose(fy, magic_formula(x, 0.6 * b, 1.3, mu * FZ, -0.2), rtol=1e-12, atol=1e-9)
+
+
+def test_tyre_values_and_errors():
+    assert set(TYRES) == {"linear", "coulomb", "dugoff", "pacejka"}
+    t = Tyre.of("dugoff", {"mu": 0.5})
+    assert t.as_dict()["mu"] == 0.5 and t.as_dict()["cs"] == TYRES["dugoff"].defaults["cs"]
+    assert hash(t) == hash(Tyre.of("dugoff", {"mu": 0.5})) and t == Tyre.of("dugoff", {"mu": 0.5})
+    with pytest.raises(UnknownNameError, match="no parameter 'cz'"):
+        Tyre.of("dugoff", {"cz": 1})
+    with pytest.raises(UnknownNameError, match="unknown tyre model"):
+        Tyre.of("michelin")
+
+
+def test_errata_7_31_slip_ratio_follows_the_slip_velocity():
+    """(7.31) writes s = (phi_dot r - v) / max(...) but calls the numerator v_slip, which ch. 3 defines as
+    v + r phi_dot (forward rolling has r phi_dot = -v). wmrkit: s = v_slip / max(|r phi_dot|, |v|), so the force
+    -Fz mu(s) opposes the slip: a driving wheel (spinning faster) has s < 0 and is pushed forward (+)."""
+    v, roll = 2.0, -2.2  # wheel centre forward at 2 m/s, contact point turning backwards faster (driving)
+    assert slip_ratio(v + roll, v, roll) == pytest.approx(-0.2 / 2.2)
+    f = Tyre.of("pacejka", {"shifts": 0.0}).forces(FZ, 0.0, v + roll, v, roll)
+    assert f.longitudinal > 0  # along +E_y, the rolling direction of the ch. 3 frame: traction
+    literal = (-roll - v) / max(abs(roll), abs(v))  # (7.31) with phi_dot r = -roll (ch. 3 sign)
+    assert literal == pytest.approx(-slip_ratio(v + roll, v, roll))  # the opposite sign
+
+
+def test_pacejka_shifts_fade_out_at_standstill():
+    t = Tyre.of("pacejka")
+    assert t.forces(FZ, 0.0, 0.0, 0.0, 0.0) == (0.0, 0.0)
+    moving = t.forces(FZ, 0.0, 0.0, 2.0, -2.0)
+    assert moving.longitudinal < -100 and moving.lateral < -10  # rolling resistance and lateral bias at 2 m/s
