@@ -17,14 +17,38 @@ from typing import Any
 
 import yaml
 
+from .couplings import COUPLING_KINDS, Coupling
+from .dynamics import mass
 from .errors import DescriptionError
+from .limits import (  # noqa: F401  (the limits are part of the description format)
+    ANGLE_MARGIN,
+    MAX_FILE_SIZE,
+    MAX_NAME,
+    MAX_NOTES,
+    MAX_SIZE,
+    MAX_WHEELS,
+    MIN_RATIO,
+    MIN_SIZE,
+    _check_envelope,
+    _check_size,
+    _check_text_fields,
+)
 from .robot import Robot
 from .units import UnitError, parse_quantity
-from .wheels import GEOMETRY_FIELDS, KINDS, Wheel
+from .wheels import GEOMETRY_FIELDS, KINDS, Wheel, beta_from_heading
 
-TOP_FIELDS = ("name", "wheels", "notes")
-COMMON_WHEEL_FIELDS = ("name", "type", "position", "l", "alpha", "actuated", "sensed")
+#: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
+WHEEL_TYPES = (*KINDS, "mecanum")
+
+TOP_FIELDS = ("name", "wheels", "notes", "couplings", "body")
+COMMON_WHEEL_FIELDS = ("name", "type", "position", "l", "alpha", "actuated", "sensed", "heading",
+                       "inertia", "mass", "tyre",  # these three: wmrkit.dynamics.mass
+                       "steer_range")  # _steer_range_from_dict
 ALL_WHEEL_FIELDS = COMMON_WHEEL_FIELDS + tuple(f for f in GEOMETRY_FIELDS if f not in ("l", "alpha"))
+
+#: ``type: mecanum``: a Swedish wheel with the rollers of the standard layout (WPILib, ROS 2): ``gamma`` of
+#: magnitude 45 deg, its sign from the wheel's quadrant (``docs/conventions.md``); r_r defaults to r / 4.
+MECANUM_GAMMA = math.pi / 4
 
 WHEEL_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
 
@@ -40,27 +64,86 @@ def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None
     check.reject_unknown(data, TOP_FIELDS, ())
     name = check.text(data, "name", ())
     notes = check.text(data, "notes", (), required=False)
+    _check_text_fields(name, notes, check)
     wheels_data = check.require(data, "wheels", ())
     if not isinstance(wheels_data, list) or not wheels_data:
         check.fail("must be a non-empty list of wheels", ("wheels",))
+    if len(wheels_data) > MAX_WHEELS:
+        check.fail(f"{len(wheels_data)} wheels: wmrkit analyses at most {MAX_WHEELS} (docs/limits.md)", ("wheels",))
     wheels: list[Wheel] = []
+    names: set[str] = set()
     for i, item in enumerate(wheels_data):
         wheel = _wheel_from_dict(item, check, ("wheels", i))
-        if wheel.name in (w.name for w in wheels):
+        if wheel.name in names:
             check.fail(f"duplicate wheel name '{wheel.name}'", ("wheels", i, "name"))
+        names.add(wheel.name)
         wheels.append(wheel)
-    return Robot(name=name, wheels=tuple(wheels), notes=notes)
+    _check_envelope(wheels, check)
+    couplings = _couplings_from_dict(data.get("couplings", []), wheels, check)
+    return Robot(name=name, wheels=tuple(wheels), notes=notes, couplings=couplings,
+                 body=mass.body_from_dict(data, check))
+
+
+def _couplings_from_dict(items: Any, wheels: list[Wheel], check: _Checker) -> tuple[Coupling, ...]:
+    """``couplings:``: joints moved by one mechanism (``wmrkit.couplings``), each joint in one coupling at most."""
+    if not isinstance(items, list):
+        check.fail("must be a list of couplings {kind, joints, ratios}", ("couplings",))
+    by_name = {w.name: w for w in wheels}
+    used: set[str] = set()
+    out = []
+    for i, item in enumerate(items):
+        loc: Loc = ("couplings", i)
+        if not isinstance(item, Mapping):
+            check.fail("a coupling is a mapping {kind, joints, ratios}", loc)
+        check.reject_unknown(item, ("kind", "joints", "ratios"), loc)
+        kind = check.text(item, "kind", loc)
+        if kind not in COUPLING_KINDS:
+            check.fail(f"unknown coupling kind '{kind}'{_hint(kind, COUPLING_KINDS)} (kinds: "
+                       f"{', '.join(COUPLING_KINDS)})", (*loc, "kind"))
+        joints = check.require(item, "joints", loc)
+        if not isinstance(joints, list) or len(joints) < 2 or not all(isinstance(j, str) for j in joints):
+            check.fail("must be a list of two or more joint names 'wheel.joint'", (*loc, "joints"))
+        for j, joint in enumerate(joints):
+            wheel, _, part = joint.partition(".")
+            w = by_name.get(wheel)
+            if w is None or part not in w.kind.joints:
+                check.fail(f"no joint '{joint}' on this robot{_hint(joint, _joint_names(wheels))}", (*loc, "joints", j))
+            steer_angle = part == "steer" and "steer" not in w.kind.rates
+            if steer_angle != (kind == "linkage"):
+                check.fail(f"'{joint}' is {'a steering angle' if steer_angle else 'a joint rate'}: a "
+                           f"{kind} couples {'steering angles (kind: linkage)' if kind == 'linkage' else 'rates'}",
+                           (*loc, "joints", j))
+            if joint in used:
+                check.fail(f"joint '{joint}' is in two couplings", (*loc, "joints", j))
+            used.add(joint)
+        default = [1.0 / len(joints)] * len(joints) if kind == "differential" else [1.0] * len(joints)
+        raw = item.get("ratios", default)
+        if not isinstance(raw, list) or len(raw) != len(joints):
+            check.fail(f"must be a list of {len(joints)} numbers, one per joint", (*loc, "ratios"))
+        ratios = tuple(check.quantity(v, "number", (*loc, "ratios", j)) for j, v in enumerate(raw))
+        if any(r == 0 for r in ratios):
+            check.fail("ratios must be non-zero (a joint with ratio 0 is not coupled)", (*loc, "ratios"))
+        out.append(Coupling(kind, tuple(joints), ratios))
+    return tuple(out)
+
+
+def _joint_names(wheels: list[Wheel]) -> list[str]:
+    return [f"{w.name}.{j}" for w in wheels for j in w.kind.joints]
 
 
 def _wheel_from_dict(item: Any, check: _Checker, loc: Loc) -> Wheel:
     if not isinstance(item, Mapping):
         check.fail("a wheel is a mapping with at least 'name', 'type' and its geometry", loc)
     type_name = check.text(item, "type", loc)
+    if type_name == "mecanum":
+        return _mecanum_from_dict(item, check, loc)
     if type_name not in KINDS:
-        check.fail(f"unknown wheel type '{type_name}'{_hint(type_name, KINDS)} (types: {', '.join(KINDS)})",
+        check.fail(f"unknown wheel type '{type_name}'{_hint(type_name, WHEEL_TYPES)} (types: {', '.join(WHEEL_TYPES)})",
                    (*loc, "type"))
     kind = KINDS[type_name]
     name = check.text(item, "name", loc)
+    if len(loc) == 2 and isinstance(loc[1], int):
+        check.wheels[loc[1]:] = [name]
     if not WHEEL_NAME.fullmatch(name):
         check.fail(f"wheel names are letters, digits, '_' and '-' (they name velocities 'wheel.joint'), got {name!r}",
                    (*loc, "name"))
@@ -86,14 +169,71 @@ def _wheel_from_dict(item: Any, check: _Checker, loc: Loc) -> Wheel:
             check.fail(f"must be >= 0 (the direction is alpha), got {values['l']} m", (*loc, "l"))
     else:
         check.fail("missing the wheel's place: 'position: [x, y]' or 'l' and 'alpha'", loc)
-    for key in kind.required:
-        values[key] = check.quantity(check.require(item, key, loc), GEOMETRY_FIELDS[key], (*loc, key))
     for key, default in kind.optional.items():
         values[key] = check.quantity(item[key], GEOMETRY_FIELDS[key], (*loc, key)) if key in item else default
+    for key in kind.required:
+        if key == "beta" and "heading" in item:
+            continue
+        values[key] = check.quantity(check.require(item, key, loc), GEOMETRY_FIELDS[key], (*loc, key))
+    _read_heading(item, values, check, loc)
     _check_geometry(type_name, values, check, loc)
     actuated = check.joints(item, "actuated", kind.joints, loc)
     sensed = check.joints(item, "sensed", kind.joints, loc)
-    return Wheel(name=name, type=type_name, actuated=actuated, sensed=sensed, **values)
+    return Wheel(name=name, type=type_name, actuated=actuated, sensed=sensed, **values,
+                 **mass.wheel_dynamics_from_dict(item, check, loc, type_name),
+                 steer_range=_steer_range_from_dict(item, check, loc, kind.steers))
+
+
+def _steer_range_from_dict(item: Mapping[str, Any], check: _Checker, loc: Loc,
+                           steers: bool) -> tuple[float, float] | None:
+    """``steer_range: [min, max]``: the HEADINGS the steering joint reaches (0 = straight ahead), e.g. +-90 deg."""
+    if "steer_range" not in item:
+        return None
+    where = (*loc, "steer_range")
+    if not steers:
+        check.fail(f"a {item.get('type')} wheel does not steer: 'steer_range' does not apply", where)
+    value = item["steer_range"]
+    if not isinstance(value, list | tuple) or len(value) != 2:
+        check.fail("must be a list [min, max] of two headings (e.g. [-90 deg, 90 deg])", where)
+    lo, hi = (check.quantity(v, "angle", (*where, j)) for j, v in enumerate(value))
+    if not (-2 * math.pi <= lo < hi <= 2 * math.pi) or hi - lo > 2 * math.pi:
+        check.fail(f"must be min < max within one turn, got [{lo}, {hi}] rad", where)
+    return (lo, hi)
+
+
+def _read_heading(item: Mapping[str, Any], values: dict[str, float], check: _Checker, loc: Loc) -> None:
+    """``heading:`` (the users' steering angle: rolling direction, 0 = straight ahead) sets the thesis's β."""
+    if "heading" not in item:
+        return
+    if "beta" in item:
+        check.fail("give either 'heading' (rolling direction, 0 = straight ahead) or 'beta' (the thesis's axle "
+                   "angle, heading + 90 deg), not both", (*loc, "heading"))
+    heading = check.quantity(item["heading"], "angle", (*loc, "heading"))
+    values["beta"] = float(beta_from_heading(heading, values.get("delta", 0.0)))
+
+
+def _mecanum_from_dict(item: Mapping[str, Any], check: _Checker, loc: Loc) -> Wheel:
+    """``type: mecanum``: the Swedish wheel of the standard X layout; gamma from the wheel's quadrant.
+
+    Seen from above with every wheel rolling forward, the contact rollers of the front-left and rear-right wheels
+    run at +45 deg to the axle and those of the front-right and rear-left at -45 deg (the thesis's γ): WPILib's
+    ``MecanumDriveKinematics`` and ROS 2's ``mecanum_drive_controller``. ``gamma`` overrides it.
+    """
+    data = {k: v for k, v in item.items()}
+    data["type"] = "swedish"
+    if "beta" not in data and "heading" not in data:
+        data["heading"] = 0.0
+    if "gamma" not in data:
+        probe = _wheel_from_dict({**data, "gamma": MECANUM_GAMMA, "r_r": data.get("r_r", 1.0)}, check, loc)
+        x, y = probe.position
+        if abs(x * y) <= 1e-12 * max(probe.l * probe.l, 1e-300):  # l * l: inf, never OverflowError
+            check.fail("a mecanum wheel on an axis of the robot frame has no quadrant to take its roller angle "
+                       "from: give 'gamma' (the thesis's roller angle, +-45 deg)", (*loc, "gamma"))
+        data["gamma"] = math.copysign(MECANUM_GAMMA, x * y)
+    if "r_r" not in data:
+        r = check.quantity(check.require(item, "r", loc), "length", (*loc, "r"))
+        data["r_r"] = r / 4
+    return _wheel_from_dict(data, check, loc)
 
 
 def _check_geometry(type_name: str, v: dict[str, float], check: _Checker, loc: Loc) -> None:
@@ -117,9 +257,13 @@ class _Checker:
 
     def __init__(self, source: str, line_of: LineOf) -> None:
         self.source, self.line_of = source, line_of
+        self.wheels: list[str | None] = []  # names of the wheels read so far (None until the name is known)
 
     def fail(self, message: str, loc: Loc) -> None:
-        raise DescriptionError(message, source=self.source, loc=loc, line=self.line_of(loc))
+        wheel = None
+        if len(loc) >= 2 and loc[0] == "wheels" and isinstance(loc[1], int) and loc[1] < len(self.wheels):
+            wheel = self.wheels[loc[1]]
+        raise DescriptionError(message, source=self.source, loc=loc, line=self.line_of(loc), wheel=wheel)
 
     def require(self, data: Mapping[str, Any], key: str, loc: Loc) -> Any:
         if key not in data:
@@ -174,7 +318,11 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
     out: dict[str, Any] = {"name": robot.name}
     if robot.notes:
         out["notes"] = robot.notes
+    out |= mass.body_to_dict(robot.body)
     out["wheels"] = [_wheel_to_dict(w) for w in robot.wheels]
+    if robot.couplings:
+        out["couplings"] = [{"kind": c.kind, "joints": list(c.joints), "ratios": list(c.ratios)}
+                            for c in robot.couplings]
     return out
 
 
@@ -188,7 +336,9 @@ def _wheel_to_dict(w: Wheel) -> dict[str, Any]:
         out["actuated"] = list(w.actuated)
     if w.sensed:
         out["sensed"] = list(w.sensed)
-    return out
+    if w.steer_range is not None:
+        out["steer_range"] = list(w.steer_range)
+    return out | mass.wheel_dynamics_to_dict(w)
 
 
 def load_robot_file(path: str | os.PathLike[str]) -> Robot:
@@ -196,6 +346,7 @@ def load_robot_file(path: str | os.PathLike[str]) -> Robot:
     path = Path(path)
     source = str(path)
     try:
+        _check_size(path.stat().st_size, "bytes", source)
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as err:
         reason = getattr(err, "strerror", None) or err  # UnicodeDecodeError has no strerror
@@ -204,17 +355,27 @@ def load_robot_file(path: str | os.PathLike[str]) -> Robot:
 
 
 def robot_from_text(text: str, *, source: str, fmt: str = "yaml") -> Robot:
-    """Parse description `text` (``fmt`` "yaml" or "json") into a :class:`Robot`."""
-    data = _parse(text, source, fmt)
-    root = _compose(text)
-    _reject_duplicate_keys(root, source)
+    """Parse description `text` (``fmt`` "yaml" or "json") into a :class:`Robot`.
+
+    Parsed once; duplicate keys are refused in both formats; JSON lines are found (by composing the text as
+    YAML) only when an error is reported.
+    """
+    _check_size(len(text), "characters", source)
+    root, data = _parse(text, source, fmt)
+    if fmt == "json":  # the line of an error: by composing the text as YAML, when that is quick
+        line_of = (lambda loc: _line_finder(_compose(text))(loc)) if len(text) <= 1 << 16 else None
+        return robot_from_dict(data, source=source, line_of=line_of)
     return robot_from_dict(data, source=source, line_of=_line_finder(root))
 
 
-def _parse(text: str, source: str, fmt: str) -> Any:
+def _parse(text: str, source: str, fmt: str) -> tuple[yaml.Node | None, Any]:
+    """``(node tree or None, data)`` of `text`: JSON by ``json`` (no node tree), YAML composed once, checked for
+    duplicate keys, then constructed from the nodes."""
     if fmt == "json":
         try:
-            return json.loads(text)
+            return None, json.loads(text, object_pairs_hook=_JsonPairs(text, source))
+        except DescriptionError:
+            raise
         except json.JSONDecodeError as err:
             raise DescriptionError(f"malformed JSON: {err.msg} (column {err.colno})", source=source,
                                    line=err.lineno) from None
@@ -223,7 +384,9 @@ def _parse(text: str, source: str, fmt: str) -> Any:
     try:
         loader = _SafeLoader(text)  # the reader already rejects some characters
         try:
-            return loader.get_single_data()
+            root = loader.get_single_node()
+            _reject_duplicate_keys(root, source)
+            return root, None if root is None else loader.construct_document(root)
         finally:
             loader.dispose()
     except yaml.YAMLError as err:
@@ -233,6 +396,22 @@ def _parse(text: str, source: str, fmt: str) -> Any:
                                line=None if mark is None else mark.line + 1) from None
     except RecursionError:
         raise DescriptionError("malformed YAML: nesting too deep", source=source) from None
+
+
+class _JsonPairs:
+    """``object_pairs_hook`` of ``json.loads`` refusing a key given twice (JSON parsers keep the last one)."""
+
+    def __init__(self, text: str, source: str) -> None:
+        self.text, self.source = text, source
+
+    def __call__(self, pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+        out = dict(pairs)
+        if len(out) != len(pairs):
+            seen: set[str] = set()
+            key = next(k for k, _ in pairs if k in seen or seen.add(k))
+            _reject_duplicate_keys(_compose(self.text), self.source)  # locates it when the text composes as YAML
+            raise DescriptionError(f"field '{key}' given twice", source=self.source)
+        return out
 
 
 class _SafeLoader(yaml.SafeLoader):

@@ -29,9 +29,10 @@ class DescriptionError(WmrkitError, ValueError):
     """
 
     def __init__(
-        self, message: str, *, source: str, loc: tuple[str | int, ...] = (), line: int | None = None
+        self, message: str, *, source: str, loc: tuple[str | int, ...] = (), line: int | None = None,
+        wheel: str | None = None,
     ) -> None:
-        self.message, self.source, self.loc, self.line = message, source, tuple(loc), line
+        self.message, self.source, self.loc, self.line, self.wheel = message, source, tuple(loc), line, wheel
         super().__init__(self._format())
 
     def _format(self) -> str:

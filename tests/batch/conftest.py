@@ -6,19 +6,12 @@ import numpy as np
 import pytest
 
 #: Parameters of the differential drive fitted in the calibration tests, and the "true" robot's offsets.
-from batch_params import PARAMS, TRUE_P
+from batch_params import PARAMS, TRUE_P, write_log
 
 from wmrkit import catalog
 from wmrkit.odometry.calibration import apply_parameters
-from wmrkit.odometry.logs import write_csv
 from wmrkit.odometry.synthetic import TwistProfile, simulate, square_path
 from wmrkit.odometry.trajectories import Trajectory, write_trajectory
-
-
-def write_log(path, run) -> str:
-    """The run's log as a default-format CSV; the path as a string."""
-    write_csv(path, ("time", *run.log.joints), np.column_stack([run.log.time, run.log.positions]))
-    return str(path)
 
 
 @pytest.fixture(scope="session")

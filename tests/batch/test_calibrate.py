@@ -73,7 +73,7 @@ def test_closed_paths_fit_the_radius_ratio(diff, tmp_path):
     params = default_parameters(diff, closed=True)
     assert params == [("left.r", "-right.r"), ("left.l", "right.l")]
     true = apply_parameters(diff, params, [0.01, 0.03])
-    from conftest import write_log
+    from batch_params import write_log
 
     paths = [write_log(tmp_path / f"sq{i}.csv", simulate(true, square_path(1.5, clockwise=i % 2 == 1), 10.0,
                                                           spin_noise_per_rad=1e-6, seed=i)) for i in range(4)]

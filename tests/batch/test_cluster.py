@@ -8,10 +8,11 @@ does not stop the batch.
 from __future__ import annotations
 
 import os
-import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
+from batch_params import die_once
 
 from wmrkit import catalog
 from wmrkit.batch.calibrate import fleet_calibrate, load_runs
@@ -27,11 +28,10 @@ pytest.importorskip("pyarrow")
 
 @pytest.fixture(scope="module")
 def cluster():
-    import cloudpickle
-
-    cloudpickle.register_pickle_by_value(sys.modules[__name__])  # the workers cannot import this test module
+    # the workers import the tasks of batch_params by name: this folder goes on their path
+    path = os.pathsep.join(p for p in (str(Path(__file__).parent), os.environ.get("PYTHONPATH", "")) if p)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                  silence_logs=50) as c, distributed.Client(c) as client:
+                                  silence_logs=50, env={"PYTHONPATH": path}) as c, distributed.Client(c) as client:
         yield c, client
 
 
@@ -81,21 +81,11 @@ def test_sweep_montecarlo_calibration_identical(engines, diff, calibration_data)
                          runner=runner)[0].reference.tolist() == runs[0].reference.tolist()
 
 
-def _die_once(args):
-    """Odometry of a log; the task for run2 first kills its worker process (as a crash or an OOM kill would)."""
-    job, marker = args
-    if job.path.endswith("run2.csv") and not os.path.exists(marker):
-        with open(marker, "w"):
-            pass
-        os._exit(1)
-    return process_log(job)
-
-
 def test_a_worker_killed_mid_batch(engines, fleet_dir, diff, tmp_path):
     jobs = [LogJob(p, diff) for p in expand_logs([fleet_dir])]
     marker = str(tmp_path / "killed")
     runner = engines["local"]
-    out = runner.map(_die_once, [(j, marker) for j in jobs])
+    out = runner.map(die_once, [(j, marker) for j in jobs])
     assert os.path.exists(marker)  # a worker did die
     assert _strip(out) == _strip([process_log(j) for j in jobs])
     runner.client.wait_for_workers(2, timeout=60)  # the nanny restarted it

@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
-from ..kinematics.linalg import matrix_rank
+from ..kinematics.linalg import characteristic_length, matrix_rank
 from ..robot import Robot
 from .icr import steer_to_icr
 from .lines import constraint_lines, line_residual
@@ -122,7 +122,8 @@ def classify(robot: Robot, *, samples: int = 8, seed: int = 0) -> Classification
 
 
 def _size(robot: Robot) -> float:
-    return max(float(np.sqrt(np.mean([w.l**2 for w in robot.wheels]))), 1e-3)
+    """The length the rank decisions are made in: the robot's size (the tolerance policy of kinematics.linalg)."""
+    return characteristic_length(robot)
 
 
 def _admissible_configurations(robot: Robot, g_fixed: np.ndarray, rf: int, n: int, rng) -> np.ndarray:

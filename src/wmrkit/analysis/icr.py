@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
-from ..kinematics.linalg import matrix_rank
+from ..kinematics.linalg import characteristic_length, matrix_rank
 from ..robot import Robot
 from .lines import common_point, constraint_lines, element_rows
 
@@ -78,7 +78,7 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
     beta = robot.steering(beta, heading)
     beta = robot.beta if beta is None else beta
     g = constraint_lines(robot).lines(beta)
-    rank = int(matrix_rank(g)) if len(g) else 0
+    rank = int(matrix_rank(g * [1.0, 1.0, 1.0 / characteristic_length(robot)])) if len(g) else 0  # nondimensional
     if rank == 0:
         return ICRSet("plane")
     if rank == 3:

@@ -24,7 +24,7 @@ from scipy.optimize import minimize
 
 from .._shapes import as_vectors
 from ..errors import UnknownNameError
-from ..kinematics.linalg import matrix_rank
+from ..kinematics.linalg import matrix_rank, nondimensional
 from ..robot import Robot
 from . import _fast
 from .lines import _params, constraint_lines, element_rows
@@ -39,7 +39,7 @@ def is_singular_rank(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, 
     `assigned` are names from ``robot.velocity_names`` (twist components and wheel joint rates).
     """
     cols = [robot.velocity_index(n) for n in assigned]
-    a = robot.constraint_matrix(beta)
+    a = nondimensional(robot).constraint_matrix(beta)  # the tolerance policy of kinematics.linalg
     free = [j for j in range(a.shape[-1]) if j not in cols]
     return matrix_rank(a[..., free]) < len(free)
 
@@ -143,8 +143,11 @@ def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[st
         return SingularSet(cl.assigned, variables, sing, empty, True, why)
     per_axis = resolution if len(idx) <= 2 else min(resolution, int(max_samples ** (1 / (len(idx) - 1))))
     grid = np.linspace(-np.pi, np.pi, per_axis, endpoint=False)
-    mesh = np.meshgrid(*([grid] * (len(idx) - 1)), indexing="ij")
-    outer = np.stack([g.ravel() for g in mesh], axis=-1) if mesh else np.zeros((1, 0))
+    if per_axis < 4:  # too many variables for a grid (numpy has 32 axes at most): a seeded random sample
+        outer = np.random.default_rng(0).uniform(-np.pi, np.pi, (max_samples, len(idx) - 1))
+    else:
+        mesh = np.meshgrid(*([grid] * (len(idx) - 1)), indexing="ij")
+        outer = np.stack([g.ravel() for g in mesh], axis=-1) if mesh else np.zeros((1, 0))
     configs = np.broadcast_to(base, (len(outer), len(steer))).copy()
     configs[:, idx[:-1]] = outer
     roots, always = _roots_last(cl, configs, idx[-1])
@@ -157,7 +160,8 @@ def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[st
         c = np.repeat(configs[i][None], len(values), axis=0)
         c[:, idx[-1]] = values
         found.append(c[:, idx])
-    if len(idx) >= 2 and sum(map(len, found)) == 0:  # isolated points (codimension 2) escape the curve sampling
+    if 4 <= per_axis and len(idx) >= 2 and sum(map(len, found)) == 0:  # isolated points (codimension 2) escape
+        # the curve sampling (searched on a grid: not with a random sample)
         found.append(_isolated(cl, base, idx, per_axis))
     found_arr = np.concatenate(found)
     if len(found_arr):

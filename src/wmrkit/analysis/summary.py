@@ -73,7 +73,9 @@ class Analysis:
         if c.mobility <= 1:
             lines.append(f"  isotropy: does not apply (m = {c.mobility}: no two motions to balance)")
         else:
-            lines.append(f"  condition number {self.condition_number:.4g} at the {how} D = "
+            kappa = (f"{self.condition_number:.4g}" if np.isfinite(self.condition_number) else
+                     "infinite (these joints do not determine the twist)")
+            lines.append(f"  condition number {kappa} at the {how} D = "
                          f"{self.characteristic_length:.4g} m, joints {', '.join(self.joints) or '-'}")
         for key, s in self.singular.items():
             lines.append(f"  singular ({key}: {', '.join(s.assigned) or '-'}): {describe_singular(s, r)}")

@@ -4,20 +4,39 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import json
 import sys
+from typing import NoReturn
 
-from ..errors import WmrkitError
+from ..errors import DescriptionError, WmrkitError
 
 #: Each command and the module of ``wmrkit.cli`` that registers it (``add_parsers``), in ``--help`` order.
 COMMANDS = {
     "robots": "robots", "show": "robots", "kinematics": "kinematics", "ik": "ik", "fk": "ik",
-    "analyze": "analyze", "odometry": "odometry",
+    "analyze": "analyze", "odometry": "odometry", "studio": "studio",
+    "batch": "batch", "sweep": "batch", "calibrate": "slip", "slip-study": "slip",
+    "vision": "vision", "follow-line": "vision", "park": "park",
+    "tyre": "dynamics", "simulate": "dynamics", "track": "control", "feasibility": "control",
 }
+
+
+class UsageError(WmrkitError):
+    """A command line argparse refuses (printed with the usage in text mode, as JSON under ``--json``)."""
+
+    def __init__(self, message: str, usage: str) -> None:
+        super().__init__(message)
+        self.usage = usage
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> NoReturn:
+        command = self.prog.removeprefix("wmrkit").strip()
+        raise UsageError(f"{command}: {message}" if command else message, self.format_usage())
 
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The argument parser; with `command`, only that command's module is imported (a fast start)."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="wmrkit",
         description="Kinematic models, analysis and odometry for any wheeled mobile robot.",
     )
@@ -33,14 +52,50 @@ def main(argv: list[str] | None = None) -> int:
     """Run ``wmrkit`` with `argv`; return the exit code (0 ok, 2 user error)."""
     argv = sys.argv[1:] if argv is None else argv
     command = next((a for a in argv if not a.startswith("-")), None)
-    args = build_parser(command).parse_args(argv)
+    as_json = "--json" in argv
     try:
+        args = build_parser(command).parse_args(argv)
         return int(args.run(args) or 0)
     except WmrkitError as err:
-        print(f"wmrkit: error: {err}", file=sys.stderr)
+        report_error(err, as_json)
         return 2
     except BrokenPipeError:  # e.g. `wmrkit robots | head`
         return 0
+
+
+def report_error(err: WmrkitError, as_json: bool) -> None:
+    """One line on stderr: ``wmrkit: error: ...``, or under ``--json`` a JSON object with the error's place.
+
+    JSON: ``{"error": message, "file": ..., "wheel": ..., "field": ...}``; the place keys are null when the
+    error has no such place.
+    """
+    if not as_json:
+        if isinstance(err, UsageError):
+            print(err.usage, end="", file=sys.stderr)
+        print(f"wmrkit: error: {one_line(str(err))}", file=sys.stderr)
+        return
+    data = {"error": one_line(str(err)), "file": None, "wheel": None, "field": None}
+    if isinstance(err, DescriptionError):
+        loc = err.loc
+        data["error"], data["file"], data["line"] = one_line(err.message), err.source, err.line
+        if len(loc) >= 2 and loc[0] == "wheels" and isinstance(loc[1], int):
+            data["wheel"] = err.wheel if err.wheel is not None else loc[1]
+            loc = loc[2:]
+        data["field"] = ".".join(str(p) for p in loc) or None
+    print(json.dumps(data), file=sys.stderr)
+
+
+#: Longest error message printed [characters]; longer ones (quoting huge user text) are cut.
+MAX_MESSAGE = 2000
+
+
+def one_line(text: str) -> str:
+    """`text` as one printable line: line breaks and control characters escaped, lone surrogates (from bytes
+    that are not UTF-8) replaced, cut to :data:`MAX_MESSAGE` characters."""
+    text = text.encode("utf-8", "backslashreplace").decode("utf-8")
+    if not text.isprintable():
+        text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+    return text if len(text) <= MAX_MESSAGE else text[:MAX_MESSAGE] + f"... ({len(text)} characters)"
 
 
 def _version() -> str:

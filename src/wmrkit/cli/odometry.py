@@ -83,6 +83,8 @@ def run(args: argparse.Namespace) -> int:
     robot = load_robot(args.robot)
     if args.chunk_size < 1:
         raise WmrkitError(f"--chunk-size must be >= 1, got {args.chunk_size}")
+    if not all(math.isfinite(k) and k >= 0 for k in args.crowley):
+        raise WmrkitError(f"--crowley: coefficients must be finite and >= 0, got {' '.join(map(str, args.crowley))}")
     joints = odometry_model(robot, args.sensed).joints
     units = read_header_units(args.log) if Path(args.log).is_file() else HeaderUnits(())
     spin = merge_option("--spin", args.spin, units.spin, "angle", args.log)

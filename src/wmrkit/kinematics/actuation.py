@@ -18,9 +18,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
+from ..couplings import coupled_columns, linked_steering
 from ..robot import Robot
-from .linalg import matrix_rank
+from .linalg import matrix_rank, nondimensional
 from .models import configuration
+from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_prefilter, search_sets
 from .trees import (
     TreeVerdict,
     classify_system,
@@ -42,6 +44,23 @@ def split_jacobian(
     i_bar, j = robot.jacobian_form(configuration(robot, beta))
     rest = [c for c in range(j.shape[-1]) if c not in columns]
     return i_bar, j[..., list(columns)], j[..., rest]
+
+
+def coupled_split(
+    robot: Robot, columns: Sequence[int], beta: ArrayLike | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[str, ...]]:
+    """:func:`split_jacobian` under the robot's mechanical couplings (``wmrkit.couplings``), with channel names.
+
+    Without couplings the selected joints are the channels; a differential or gear coupling makes its joints one
+    channel (``"differential(a.spin, b.spin)"``), and a gear holds the rates across its ratios at zero.
+    """
+    if not any(c.rates for c in robot.couplings):
+        i_bar, j_sel, j_rest = split_jacobian(robot, columns, beta)
+        names = jacobian_names(robot)
+        return i_bar, j_sel, j_rest, tuple(names[c] for c in columns)
+    i_bar, j = robot.jacobian_form(configuration(robot, beta))
+    t_sel, channels, t_rest, _ = coupled_columns(robot.couplings, jacobian_names(robot), tuple(columns))
+    return i_bar, j @ t_sel, j @ t_rest, channels
 
 
 def actuation_equation(
@@ -82,14 +101,15 @@ def actuation_tree(
     ``inconsistent`` (the wheels fight and slip); ``indeterminate``/``underdetermined``/``incompatible``:
     insufficient actuators.
     """
-    i_u, j_u = actuation_equation(robot, actuated, beta)
+    i_u, j_u = actuation_equation(nondimensional(robot), actuated, beta)  # rates are angular: same units
     return classify_system(i_u, j_u, q_dot_u)
 
 
 _ACTUATION_TEXT = {
     "determined": "consistent actuation: the actuated rates drive every degree of freedom and cannot conflict",
-    "overdetermined": "possible actuator conflict: redundant actuated rates must respect the actuator coupling "
-                      "or the wheels slip",
+    "overdetermined": "over-actuated: more actuated rates than degrees of freedom, so the actuators must be "
+                      "coordinated (or mechanically coupled: 'couplings' in the description) or they fight and "
+                      "the wheels slip",
     "indeterminate": "insufficient actuators: some degrees of freedom are not actuated",
     "underdetermined": "insufficient and conflicting actuators: some degrees of freedom are not actuated and "
                        "the actuated rates can fight",
@@ -170,13 +190,15 @@ def actuation_analysis(
     """
     beta = configuration(robot, beta)
     columns, steering = select_columns(robot, robot.actuated if actuated is None else actuated, "actuated")
-    i_bar, j_u, j_nu = split_jacobian(robot, columns, beta)
-    a = robot.constraint_matrix(beta)
-    names = jacobian_names(robot)
+    i_bar, j_u, j_nu, channels = coupled_split(robot, columns, beta)
+    steering = linked_steering(robot.couplings, steering)
+    unit = nondimensional(robot)  # rank decisions: the tolerance policy of .linalg
+    a = unit.constraint_matrix(beta)
+    i_bar1, j_u1, j_nu1, _ = coupled_split(unit, columns, beta)
     return ActuationAnalysis(
-        robot.name, tuple(names[c] for c in columns), steering, steering_split(robot, steering),
+        robot.name, channels, steering, steering_split(robot, steering),
         readonly(np.asarray(a.shape[-1] - matrix_rank(a))),
-        classify_system(reduced_equation(i_bar, j_u, j_nu), j_u),
+        classify_system(reduced_equation(i_bar1, j_u1, j_nu1), j_u1),
         readonly(partitioned_solution(j_u, j_nu) @ i_bar),
     )
 
@@ -187,17 +209,43 @@ def subset_trees(robot: Robot, beta: np.ndarray, size: int) -> tuple[list[tuple[
     Selectable: every wheel rate but rollers (column indices of :func:`jacobian_names`). ``None`` when there
     is no such set.
     """
-    n_w = len(jacobian_names(robot))
-    usable = [i for i, n in enumerate(robot.rate_names) if not n.endswith(".roller")]
-    subsets = list(itertools.combinations(usable, size))
+    subsets = list(itertools.combinations(selectable_rates(robot), size))
     if not subsets:
         return [], None
-    i_bar, j = robot.jacobian_form(beta)
-    sel = np.array(subsets, dtype=int).reshape(len(subsets), size)
-    rest = np.array([[c for c in range(n_w) if c not in s] for s in subsets], dtype=int)
+    return subsets, trees_of(robot, beta, np.array(subsets, dtype=int).reshape(len(subsets), size))
+
+
+def selectable_rates(robot: Robot) -> list[int]:
+    """Columns of :func:`jacobian_names` an actuator or a sensor can be put on: every wheel rate but rollers."""
+    return [i for i, n in enumerate(robot.rate_names) if not n.endswith(".roller")]
+
+
+def minimal_set_search(robot: Robot, beta: np.ndarray, size: int, wanted: str, what: str) -> SetList:
+    """The sets of `size` selectable rates whose tree (4.28)/(4.34) is `wanted` with rank 3 at every
+    configuration: a bounded search (:mod:`.search`) pruned by the null-space test when ``size`` is the mobility
+    (then the rates must be an assignable set of the direct model), listing at most MAX_MINIMAL_SETS."""
+    def exact(sel: np.ndarray) -> np.ndarray:
+        tree = trees_of(robot, beta, sel)
+        return ((tree.leaf == wanted) & (tree.rank_a == 3)).reshape(len(sel), -1).all(axis=1)
+
+    a = nondimensional(robot).constraint_matrix(beta)
+    m = np.unique(a.shape[-1] - matrix_rank(a))
+    prefilter = null_space_prefilter(a, size, offset=3) if len(m) == 1 and m[0] == size else None
+    sets, complete, note = search_sets(selectable_rates(robot), size, exact, prefilter=prefilter,
+                                       limit=MAX_MINIMAL_SETS, max_exact=exact_budget(
+                                           nondimensional(robot).jacobian_form(beta)[1].shape, 4), what=what)
+    return SetList(sets, complete, note)
+
+
+def trees_of(robot: Robot, beta: np.ndarray, sel: np.ndarray) -> TreeVerdict:
+    """The trees (4.28)/(4.34) of the sets of rate columns `sel` ``(S, size)``: leaves ``(S, ...)``."""
+    n_w = len(jacobian_names(robot))
+    i_bar, j = nondimensional(robot).jacobian_form(beta)
+    rest = np.array([[c for c in range(n_w) if c not in s] for s in sel.tolist()], dtype=int).reshape(
+        len(sel), n_w - sel.shape[1])
     j_sel = np.moveaxis(j[..., sel], -2, 0)  # (..., 3E, S, size) -> (S, ..., 3E, size)
     j_rest = np.moveaxis(j[..., rest], -2, 0)
-    return subsets, classify_system(reduced_equation(i_bar, j_sel, j_rest), j_sel)
+    return classify_system(reduced_equation(i_bar, j_sel, j_rest), j_sel)
 
 
 def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None) -> tuple[tuple[str, ...], ...]:
@@ -210,10 +258,7 @@ def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None) -> tuple[
     m = np.unique(vehicle_dof(robot, beta))  # G = m unless a double wheel adds a self-motion (4.69)
     if len(m) != 1 or m[0] == 0:
         return ()
-    subsets, tree = subset_trees(robot, beta, int(m[0]))
-    if tree is None:
-        return ()
-    ok = ((tree.leaf == "determined") & (tree.rank_a == 3)).reshape(len(subsets), -1).all(axis=1)
+    found = minimal_set_search(robot, beta, int(m[0]), "determined", "minimal actuator sets")
     steer = tuple(f"{w}.steer" for w in steering_split(robot, ()))
     names = jacobian_names(robot)
-    return tuple(tuple(names[c] for c in s) + steer for s, good in zip(subsets, ok, strict=True) if good)
+    return SetList([tuple(names[c] for c in s) + steer for s in found], found.complete, found.note)

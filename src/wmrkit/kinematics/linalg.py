@@ -1,12 +1,27 @@
-"""Linear algebra of chapter 4, batched: numeric rank, the projector Delta (4.17), least squares (4.11)/(4.15)."""
+"""Linear algebra of chapter 4, batched: numeric rank, the projector Delta (4.17), least squares (4.11)/(4.15).
+
+The tolerance policy (one for the three methods of chapter 4, actuation, sensing and the analysis): rank
+decisions are made on *nondimensional* matrices, those of :func:`nondimensional` (the robot with every length
+divided by its :func:`characteristic_length`), with the one tolerance of :func:`matrix_rank`. Dividing the
+lengths by ``L`` maps the velocities ``(vx, vy, omega, rates)`` to ``(vx / L, vy / L, omega, rates)``
+(:func:`velocity_scale`), a diagonal change of variables that keeps every rank, null space and assignable set,
+so the decisions do not depend on the robot's scale (a micrometre robot and a kilometre one get the same
+answers). Descriptions keep radii and offsets at least ``MIN_RATIO`` of ``L`` (``docs/limits.md``), far above
+the tolerance.
+"""
 
 from __future__ import annotations
 
 import functools
+from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy.linalg import lapack
+
+if TYPE_CHECKING:
+    from ..robot import Robot
 
 #: Relative tolerance on singular values for numeric rank (times the largest singular value and the size).
 RANK_RTOL = 1e-9
@@ -24,6 +39,47 @@ def matrix_rank(m: ArrayLike, *, rtol: float = RANK_RTOL) -> np.ndarray:
     s = np.linalg.svd(m, compute_uv=False)
     scale = np.maximum(s[..., :1], 1.0)
     return np.sum(s > rtol * max(m.shape[-2:]) * scale, axis=-1)
+
+
+#: Wheel fields that are lengths [m] (scaled by :func:`nondimensional`).
+LENGTH_FIELDS = ("l", "d", "r", "r_r", "b")
+
+
+def characteristic_length(robot: Robot) -> float:
+    """The robot's size ``L`` [m]: its largest length (wheel distance from the origin, radius, offset, half-width).
+
+    The unit of the nondimensional matrices of the rank decisions; positive for any robot with a wheel off the
+    origin or of non-zero radius (1 m for a robot of no length at all).
+    """
+    return _characteristic_length(robot)
+
+
+@functools.lru_cache(maxsize=256)
+def _characteristic_length(robot: Robot) -> float:
+    size = max((abs(float(getattr(w, f))) for w in robot.wheels for f in LENGTH_FIELDS), default=0.0)
+    return size if 0.0 < size < np.inf else 1.0
+
+
+@functools.lru_cache(maxsize=256)
+def nondimensional(robot: Robot) -> Robot:
+    """`robot` with every length divided by :func:`characteristic_length`: the robot rank decisions are made on.
+
+    Its slip matrix and Jacobian form are those of `robot` in the velocities of :func:`velocity_scale` (same
+    ranks, null spaces, assignable sets and tree verdicts), with entries of order 1 at any scale.
+    """
+    size = characteristic_length(robot)
+    if size == 1.0:
+        return robot
+    wheels = tuple(replace(w, **{f: getattr(w, f) / size for f in LENGTH_FIELDS}) for w in robot.wheels)
+    return replace(robot, wheels=wheels)
+
+
+def velocity_scale(robot: Robot) -> np.ndarray:
+    """Factors from the velocities ``q_dot`` of `robot` to those of :func:`nondimensional` ``(k,)``: ``1 / L`` for
+    ``vx`` and ``vy``, 1 for ``omega`` and the wheel rates (angular)."""
+    out = np.ones(len(robot.velocity_names))
+    out[:2] = 1.0 / characteristic_length(robot)
+    return out
 
 
 def delta_projector(m: ArrayLike) -> np.ndarray:

@@ -17,9 +17,10 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..robot import TWIST_NAMES, Robot
-from .actuation import split_jacobian, steering_split, subset_trees, verdict_texts
-from .linalg import matrix_rank
+from .actuation import minimal_set_search, split_jacobian, steering_split, verdict_texts
+from .linalg import matrix_rank, nondimensional
 from .models import configuration
+from .search import SetList
 from .trees import (
     TreeVerdict,
     classify_system,
@@ -85,7 +86,7 @@ def sensing_tree(
     (redundant sensors, slip detectable), and with readings ``q_dot_s`` ``(..., n_s)`` ``consistent`` (no slip
     nor noise) or ``inconsistent``; the other leaves: insufficient sensors.
     """
-    i_s, j_s = sensing_equation(robot, sensed, beta)
+    i_s, j_s = sensing_equation(nondimensional(robot), sensed, beta)  # rates are angular: same units
     return classify_system(i_s, j_s, q_dot_s)
 
 
@@ -168,14 +169,16 @@ def sensing_analysis(
     """
     beta = configuration(robot, beta)
     columns, steering, i_bar, j_s, j_ns = _split(robot, sensed, beta)
-    a = robot.constraint_matrix(beta)
+    unit = nondimensional(robot)  # rank decisions: the tolerance policy of .linalg
+    a = unit.constraint_matrix(beta)
+    _, _, i_bar1, j_s1, j_ns1 = _split(unit, sensed, beta)
     names = jacobian_names(robot)
     full = _full(i_bar, j_s, j_ns)
     i_ns = np.concatenate([np.broadcast_to(i_bar, (*j_ns.shape[:-2], *i_bar.shape)), -j_ns], axis=-1)
     return SensingAnalysis(
         robot.name, tuple(names[c] for c in columns), steering, steering_split(robot, steering),
         readonly(np.asarray(a.shape[-1] - matrix_rank(a))),
-        classify_system(reduced_equation(i_bar, j_s, j_ns), j_s),
+        classify_system(reduced_equation(i_bar1, j_s1, j_ns1), j_s1),
         readonly(partitioned_solution(i_bar, j_ns) @ j_s), readonly(full),
         TWIST_NAMES + tuple(n for c, n in enumerate(names) if c not in columns),
         readonly(i_ns @ full - j_s),
@@ -198,12 +201,8 @@ def minimal_sensor_sets(
     names, steer = jacobian_names(robot), tuple(f"{w}.steer" for w in steering_split(robot, ()))
     wanted = "overdetermined" if detect_slip else "determined"
     sizes = range(int(m[0]) + 1, len(robot.rate_names) + 1) if detect_slip else (int(m[0]),)
-    for size in sizes:
-        subsets, tree = subset_trees(robot, beta, size)
-        if tree is None:
-            return ()
-        ok = ((tree.leaf == wanted) & (tree.rank_a == 3)).reshape(len(subsets), -1).all(axis=1)
-        found = tuple(tuple(names[c] for c in s) + steer for s, good in zip(subsets, ok, strict=True) if good)
-        if found:
-            return found
-    return ()
+    for size in sizes:  # bounded searches (.search), pruned by the null-space test at size m
+        found = minimal_set_search(robot, beta, size, wanted, "minimal sensor sets")
+        if found or not found.complete:
+            return SetList([tuple(names[c] for c in s) + steer for s in found], found.complete, found.note)
+    return SetList()

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-
 from typing import Any
 
 import numpy as np
@@ -39,6 +38,10 @@ def kinematics_summary(robot: Robot) -> dict[str, Any]:
     """
     here = assignable_sets(robot)
     generic = generically_assignable_sets(robot)
+    here_set = set(here)
+    act_sets, sen_sets = minimal_actuator_sets(robot), minimal_sensor_sets(robot)
+    searches = {"assignable_sets": here, "generically_assignable_sets": generic, "minimal_actuator_sets": act_sets,
+                "minimal_sensor_sets": sen_sets}
     return {
         "robot": robot.name,
         "steering": dict(zip(robot.steer_names, robot.heading.tolist(), strict=True)),  # headings [rad]
@@ -48,13 +51,15 @@ def kinematics_summary(robot: Robot) -> dict[str, Any]:
         "generic_mobility": generic_mobility(robot),
         "extended_dof": extended_dof(robot),
         "assignable_sets": [list(s) for s in here],
-        "lost_here": [list(s) for s in generic if s not in here],
+        "lost_here": [list(s) for s in generic if s not in here_set] if getattr(here, "complete", True) else [],
         "direct_model": _model(direct_model, robot),
         "inverse_model": _model(inverse_model, robot),
         "actuation": actuation_analysis(robot).as_dict(),
         "sensing": sensing_analysis(robot).as_dict(),
-        "minimal_actuator_sets": [list(s) for s in minimal_actuator_sets(robot)],
-        "minimal_sensor_sets": [list(s) for s in minimal_sensor_sets(robot)],
+        "minimal_actuator_sets": [list(s) for s in act_sets],
+        "minimal_sensor_sets": [list(s) for s in sen_sets],
+        # bounded searches that stopped early (.search, docs/limits.md): what was not listed
+        "incomplete": {k: v.note for k, v in searches.items() if not getattr(v, "complete", True)},
     }
 
 
@@ -124,4 +129,5 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
     for title, key in (("minimal actuator sets", "minimal_actuator_sets"),
                        ("minimal sensor sets", "minimal_sensor_sets")):
         lines += [f"  {title} ({len(summary[key])}):", *(_sets(summary[key], limit) or ["    none"])]
+    lines += [f"  note: {key.replace('_', ' ')}: {note}" for key, note in summary.get("incomplete", {}).items()]
     return "\n".join(lines)

@@ -5,24 +5,94 @@ joint state broadcaster publishes them). Joint names are the robot's ``WHEEL.spi
 ``names`` maps ROS names onto them. Messages naming none of the needed joints (other publishers on the topic)
 are skipped; a message naming some but not all is an error. Time is the header stamp (the bag's receive time
 when the stamp is zero).
+
+``rosbags`` is the optional extra ``bags``, imported on first use. A bag that cannot be read (no metadata, an
+unknown version, a file that is no SQLite or MCAP store, metadata larger than :data:`MAX_METADATA` or using
+YAML anchors, a message that does not decode) is refused with one :class:`LogError` line naming the file.
 """
 
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
-from .logs import JointLog, LogError
+from ..errors import WmrkitError
+from .logs import MAX_RATE, JointLog, LogError, check_jumps
 from .trajectories import Trajectory, quaternion_z, yaw_of_quaternion
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
 ODOMETRY = "nav_msgs/msg/Odometry"
 
 
+#: Largest ``metadata.yaml`` read [bytes]; ``ros2 bag`` writes a few kilobytes.
+MAX_METADATA = 1 << 20
+
+_YAML_ALIAS = re.compile(r"(?:^|[\s\[{,:-])[&*][^\s,\]}]")
+
+
+def _rosbags(module: str):
+    """The ``rosbags`` submodule `module`, or a :class:`WmrkitError` naming the extra to install."""
+    import importlib
+
+    try:
+        return importlib.import_module(f"rosbags.{module}")
+    except ImportError:
+        raise WmrkitError("reading and writing ROS 2 bags needs the 'bags' extra: pip install 'wmrkit[bags]'"
+                          ) from None
+
+
+def _open(path: str | os.PathLike[str]):
+    """An open ``rosbags`` reader of the bag at `path`, or one :class:`LogError` line naming the file."""
+    reader_cls = _rosbags("rosbag2").Reader
+    source = os.fspath(path)
+    p = Path(source)
+    if not p.exists():
+        raise LogError(f"{source}: no such bag")
+    meta = p / "metadata.yaml" if p.is_dir() else None
+    if meta is not None:
+        if not meta.is_file():
+            raise LogError(f"{source}: not a ROS 2 bag: the directory has no metadata.yaml")
+        if meta.stat().st_size > MAX_METADATA:
+            raise LogError(f"{meta}: {meta.stat().st_size} bytes of metadata (more than {MAX_METADATA}): not "
+                           "written by ros2 bag")
+        try:
+            text = meta.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as err:
+            raise LogError(f"{meta}: cannot read the bag's metadata ({err.__class__.__name__})") from None
+        if _YAML_ALIAS.search(text):
+            raise LogError(f"{meta}: YAML anchors or aliases in the bag's metadata (ros2 bag writes none; a YAML "
+                           "bomb?)")
+    try:
+        reader = reader_cls(source)
+        reader.open()
+    except Exception as err:  # rosbags raises its own and sqlite/mcap errors for unreadable bags
+        raise LogError(f"{source}: cannot read as a ROS 2 bag ({err.__class__.__name__}: {err})") from None
+    return reader
+
+
+def _messages(reader, conns, source: str, msgtype: str, typestore) -> Iterator[tuple[int, object]]:
+    """``(receive time [ns], message)`` of `conns`; a message or store that does not decode is a LogError."""
+    it = iter(reader.messages(connections=conns))
+    index = 0
+    while True:
+        try:
+            item = next(it, None)
+            if item is None:
+                return
+            _, stamp_ns, data = item
+            msg = typestore.deserialize_cdr(data, msgtype)
+        except Exception as err:  # corrupt store or message: rosbags, sqlite3, struct, index errors
+            raise LogError(f"{source}: message {index}: cannot decode ({err.__class__.__name__}: {err})") from None
+        yield stamp_ns, msg
+        index += 1
+
+
 def _typestore():
+    _rosbags("rosbag2")
     from rosbags.typesys import Stores, get_typestore
 
     return get_typestore(Stores.ROS2_HUMBLE)
@@ -36,31 +106,29 @@ def _stamp(t: float):
 
 def bag_message_count(path: str | os.PathLike[str], topic: str) -> int:
     """Number of messages on `topic` in the bag at `path` (for progress bars)."""
-    from rosbags.rosbag2 import Reader
-
-    with Reader(path) as reader:
-        return sum(c.msgcount for c in reader.connections if c.topic == topic)
+    reader = _open(path)
+    try:
+        count = sum(c.msgcount for c in reader.connections if c.topic == topic)
+    except Exception as err:  # counts of broken metadata
+        raise LogError(f"{os.fspath(path)}: unreadable message counts ({err.__class__.__name__})") from None
+    finally:
+        reader.close()
+    return int(count) if isinstance(count, int) else 0
 
 
 def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, topic: str = "/joint_states",
                       names: Mapping[str, str] | None = None, chunk_size: int = 1 << 14,
-                      progress: Callable[[int], object] | None = None) -> Iterator[JointLog]:
+                      progress: Callable[[int], object] | None = None,
+                      max_rate: float | None = MAX_RATE) -> Iterator[JointLog]:
     """Joint logs from the ``JointState`` messages on `topic`, in chunks (bounded memory).
 
     `names` maps ROS joint names to the robot's joint names. `progress` is called with the number of messages
-    read. Raises :class:`LogError` for a missing bag or topic and for messages lacking some joints.
+    read. Raises :class:`LogError` for a missing bag or topic and for messages lacking some joints, and for
+    spin joints turning faster than `max_rate` [rad/s] between two messages (:func:`.logs.check_jumps`).
     """
-    from rosbags.rosbag2 import Reader
-
     source, rename = os.fspath(path), dict(names or {})
-    if not Path(source).exists():
-        raise LogError(f"{source}: no such bag")
+    reader = _open(source)
     ts = _typestore()
-    try:
-        reader = Reader(source)
-        reader.open()
-    except Exception as err:  # rosbags raises its own error types for unreadable bags
-        raise LogError(f"{source}: cannot read as a ROS 2 bag: {err}") from None
     try:
         conns = [c for c in reader.connections if c.topic == topic]
         if not conns:
@@ -69,8 +137,8 @@ def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, to
         if any(c.msgtype != JOINT_STATE for c in conns):
             raise LogError(f"{source}: topic '{topic}' carries {conns[0].msgtype}, not {JOINT_STATE}")
         times, rows, index, first = [], [], 0, 0
-        for _, stamp_ns, data in reader.messages(connections=conns):
-            msg = ts.deserialize_cdr(data, JOINT_STATE)
+        last: tuple[float, np.ndarray] | None = None
+        for stamp_ns, msg in _messages(reader, conns, f"{source}: {topic}", JOINT_STATE, ts):
             got = {rename.get(n, n): k for k, n in enumerate(msg.name)}
             have = [j for j in joints if j in got]
             if progress is not None:
@@ -88,16 +156,25 @@ def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, to
             rows.append([msg.position[got[j]] for j in joints])
             index += 1
             if len(times) == chunk_size:
-                yield JointLog(np.array(times), tuple(joints), np.array(rows, dtype=float), None,
-                               f"{source}: {topic}", None, first)
+                last = yield from _chunk(times, joints, rows, f"{source}: {topic}", first, last, max_rate)
                 first, times, rows = index, [], []
         if times:
-            yield JointLog(np.array(times), tuple(joints), np.array(rows, dtype=float), None, f"{source}: {topic}",
-                           None, first)
+            yield from _chunk(times, joints, rows, f"{source}: {topic}", first, last, max_rate)
         if index == 0:
             raise LogError(f"{source}: no JointState message on '{topic}' names the joints {', '.join(joints)}")
     finally:
         reader.close()
+
+
+def _chunk(times: list[float], joints: Sequence[str], rows: list, source: str, first: int,
+           last: tuple[float, np.ndarray] | None, max_rate: float | None):
+    """Yield one chunk (checked for jumps against the `last` sample before it); return its own last sample."""
+    log = JointLog(np.array(times), tuple(joints), np.array(rows, dtype=float).reshape(len(times), len(joints)),
+                   None, source, None, first)
+    t = log.time if last is None else np.concatenate([[last[0]], log.time])
+    check_jumps(log, log.positions, None if last is None else last[1], t, max_rate)
+    yield log
+    return float(log.time[-1]), log.positions[-1].copy()
 
 
 def write_joint_states(path: str | os.PathLike[str], log: JointLog, *, topic: str = "/joint_states",
@@ -179,28 +256,28 @@ class OdometryBagWriter:
 
 def read_odometry(path: str | os.PathLike[str], *, topic: str = "/odom") -> Trajectory:
     """Odometry messages of a bag as a :class:`Trajectory` (poses, and the (x, y, theta) covariance)."""
-    from rosbags.rosbag2 import Reader
-
     ts = _typestore()
     times, poses, covs = [], [], []
-    with Reader(path) as reader:
+    reader = _open(path)
+    try:
         conns = [c for c in reader.connections if c.topic == topic]
         if not conns:
             raise LogError(f"{os.fspath(path)}: no topic '{topic}'")
-        for _, _, data in reader.messages(connections=conns):
-            m = ts.deserialize_cdr(data, ODOMETRY)
+        for _, m in _messages(reader, conns, f"{os.fspath(path)}: {topic}", ODOMETRY, ts):
             q = m.pose.pose.orientation
             times.append(m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec)
             poses.append([m.pose.pose.position.x, m.pose.pose.position.y,
                           float(yaw_of_quaternion(np.array([q.x, q.y, q.z, q.w])))])
             covs.append(m.pose.covariance.reshape(6, 6)[np.ix_([0, 1, 5], [0, 1, 5])])
+    finally:
+        reader.close()
     p = np.array(poses).reshape(-1, 3)
     p[:, 2] = np.unwrap(p[:, 2])
     return Trajectory(np.array(times), p, np.zeros(len(times)), np.array(covs).reshape(-1, 3, 3))
 
 
 def _writer(path: str | os.PathLike[str]):
-    from rosbags.rosbag2 import Writer
+    Writer = _rosbags("rosbag2").Writer
 
     if Path(path).exists():
         raise LogError(f"{os.fspath(path)}: already exists (a bag is a new directory)")

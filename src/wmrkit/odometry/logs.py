@@ -9,7 +9,12 @@ Bad input is refused with a one-line :class:`LogError` naming the file, the line
 columns naming wheels the robot lacks, non-numeric or NaN values, time that repeats (a zero time step is
 rejected, never divided by) or goes backwards, and steps longer than ``LogFormat.max_gap`` when given. Gaps
 are otherwise integrated as one step: exact for the wheel travel (angles are cumulative), with the path shape
-inside the gap approximated by a constant twist.
+inside the gap approximated by a constant twist. Every row's field count is checked (vectorised), bytes that are
+not UTF-8 and control characters are refused, a last line without its line end is reported as a truncated
+file, and a spin joint turning faster than ``LogFormat.max_rate`` between two samples is reported as an
+implausible jump (an encoder glitch, a wrong counter width or resolution) with its line. What parsing cannot
+see (a truncated last line that still ends in a newline and holds plausible numbers) is listed in
+``docs/limits.md``.
 """
 
 from __future__ import annotations
@@ -17,6 +22,7 @@ from __future__ import annotations
 import difflib
 import itertools
 import os
+import re
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Literal
@@ -28,6 +34,12 @@ from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
 
 #: Seconds per unit of the time column.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+
+#: Default largest plausible spin rate of a wheel [rad/s] (about 95,000 rpm): faster is an encoder glitch.
+MAX_RATE = 1e4
+
+#: Longest header line read [characters]: a longer first line is not a CSV log (e.g. a binary file).
+MAX_HEADER = 1 << 16
 
 
 class LogError(WmrkitError, ValueError):
@@ -94,7 +106,8 @@ class LogFormat:
     rule). ``steer``: ``"angle"`` (rad) or ``"counts"`` (absolute encoder readings). ``encoders``: ``(joint,
     encoder)`` pairs for counts. ``heading_column``: absolute heading [rad] (IMU yaw; unwrapped here) replacing
     the wheels' heading; ``gyro_column``: yaw rate [rad/s] instead (integrated from 0). ``max_gap``: longest
-    time step accepted [s] (None: any). ``time_unit``: one of :data:`TIME_UNITS`.
+    time step accepted [s] (None: any). ``time_unit``: one of :data:`TIME_UNITS`. ``max_rate``: largest
+    plausible spin rate [rad/s] between two samples (None: any); a faster step is refused as an encoder jump.
     """
 
     time_column: str = "time"
@@ -107,6 +120,7 @@ class LogFormat:
     gyro_column: str | None = None
     max_gap: float | None = None
     delimiter: str = ","
+    max_rate: float | None = MAX_RATE
 
     def __post_init__(self) -> None:
         if self.time_unit not in TIME_UNITS:
@@ -118,6 +132,11 @@ class LogFormat:
             raise LogError("give a heading column or a gyro column, not both")
         if self.max_gap is not None and not self.max_gap > 0:
             raise LogError(f"max_gap must be > 0 s, got {self.max_gap}")
+        if self.max_rate is not None and not self.max_rate > 0:
+            raise LogError(f"max_rate must be > 0 rad/s, got {self.max_rate}")
+        if len(self.delimiter) != 1 or self.delimiter.isspace() or self.delimiter in ".-+eE0123456789":
+            raise LogError(f"the delimiter must be one character that cannot be part of a number, got "
+                           f"{self.delimiter!r}")
 
     def column_of(self, joint: str) -> str:
         """The CSV column holding `joint`."""
@@ -157,6 +176,7 @@ class Decoder:
         for j, joint in enumerate(self.joints):
             prev = None if self._positions is None else self._positions[j]
             pos[:, j] = self._decode_joint(joint, ext[:, 1 + j], ext_time, prev, probe)
+        check_jumps(probe, pos, self._positions, ext_time, fmt.max_rate)
         heading = None
         if fmt.heading_column is not None:
             u = np.unwrap(ext[:, -1])
@@ -190,7 +210,8 @@ class Decoder:
 def check_time(log: JointLog, time: np.ndarray, previous: float | None, max_gap: float | None) -> None:
     """Refuse time that repeats, goes backwards or (with `max_gap`) jumps; `previous`: the last time before."""
     t = time if previous is None else np.concatenate([[previous], time])
-    dt = np.diff(t)
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflowing step is named by check_jumps
+        dt = np.diff(t)
     shift = 0 if previous is None else 1
     bad = np.flatnonzero(~(dt > 0))
     if bad.size:
@@ -200,6 +221,36 @@ def check_time(log: JointLog, time: np.ndarray, previous: float | None, max_gap:
     if max_gap is not None and dt.size and dt.max() > max_gap:
         i = int(np.argmax(dt)) + 1 - shift
         raise LogError(f"{log.where(i)}: time step of {dt.max():.6g} s exceeds max_gap = {max_gap:g} s (a gap)")
+
+
+def check_jumps(log: JointLog, positions: np.ndarray, previous: np.ndarray | None, time: np.ndarray,
+                max_rate: float | None) -> None:
+    """Refuse a spin joint (``*.spin``) turning faster than `max_rate` [rad/s] between two samples, and time
+    steps that overflow. `positions` ``(N, n)`` [rad] of `log`'s joints; `previous` ``(n,)`` the positions of the
+    sample before (None at the start); `time` ``(N + 1,)`` [s] with that sample's time first (``(N,)`` without).
+    Vectorised; the message names the first bad row."""
+    spin = [j for j, name in enumerate(log.joints) if name.endswith(".spin")]
+    full = positions if previous is None else np.vstack([np.asarray(previous, dtype=float)[None], positions])
+    shift = 1 if previous is None else 0  # row of `log` where step k ends
+    with np.errstate(over="ignore", invalid="ignore"):
+        dt = np.diff(time)
+        bad_t = np.flatnonzero(~np.isfinite(dt))
+        if bad_t.size:
+            i = int(bad_t[0]) + shift
+            raise LogError(f"{log.where(i)}: time {float(log.time[i])!r} s: the time step overflows (values too "
+                           "large to subtract)")
+        if max_rate is None or not spin or len(full) < 2:
+            return
+        step = np.abs(np.diff(full[:, spin], axis=0))
+        bad = ~(step <= max_rate * dt[:, None])
+        if not bad.any():
+            return
+        k, c = (int(x) for x in np.argwhere(bad)[0])
+        rate = float(step[k, c] / dt[k])
+    name = log.joints[spin[c]]
+    raise LogError(f"{log.where(k + shift)}: {name}: turns {float(step[k, c]):.6g} rad in {float(dt[k]):.6g} s "
+                   f"({rate:.3g} rad/s > {max_rate:g} rad/s): an implausible jump (encoder glitch, wrong "
+                   "counter width or counts per revolution?)")
 
 
 def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat = LogFormat(), *,
@@ -212,11 +263,14 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
     """
     source = os.fspath(path)
     try:
-        f = open(source, encoding="utf-8", newline="")
+        f = open(source, encoding="utf-8", errors="surrogateescape", newline="")  # bad bytes found per chunk
     except OSError as err:
         raise LogError(f"{source}: cannot open: {err.strerror}") from None
     try:
-        header_line = f.readline()
+        header_line = f.readline(MAX_HEADER + 1)
+        if len(header_line) > MAX_HEADER:
+            raise LogError(f"{source}:1: the header line is longer than {MAX_HEADER} characters: not a CSV log")
+        _encoded([header_line], source, 1)
         if not header_line.strip():
             raise LogError(f"{source}:1: empty file or no header line")
         header = [h.strip() for h in header_line.strip("\r\n").split(fmt.delimiter)]
@@ -229,7 +283,8 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
             lines = list(itertools.islice(f, chunk_size))
             if not lines:
                 break
-            rows = [ln for ln in lines if ln.strip()]
+            keep = _check_lines(lines, fmt.delimiter, len(header), source, line)
+            rows = lines if keep is None else [ln for ln, k in zip(lines, keep, strict=True) if k]
             raw = _parse(rows, usecols, fmt.delimiter, source, line, lines, len(header))
             if raw.size:
                 yield decoder.decode(raw, line if len(rows) == len(lines) else None, index)
@@ -287,18 +342,18 @@ def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: S
         if name not in header:
             close = difflib.get_close_matches(name, header, n=1)
             hint = f" (did you mean '{close[0]}'?)" if close else ""
-            raise LogError(f"{source}:1: missing column '{name}'{hint} (columns: {', '.join(header)})")
+            raise LogError(f"{source}:1: missing column '{name}'{hint} (columns: {_short(', '.join(header), 200)})")
     return [header.index(n) for n in wanted]
 
 
 def _parse(rows: list[str], usecols: list[int], delimiter: str, source: str, line: int, lines: list[str],
            width: int) -> np.ndarray:
+    if not rows:
+        return np.zeros((0, len(usecols)))
     try:
-        raw = np.loadtxt(rows, delimiter=delimiter, usecols=usecols, ndmin=2, comments=None, dtype=float)
-    except ValueError:
-        raw = None
-    if raw is not None and all(ln.count(delimiter) == width - 1 for ln in (rows[0], rows[-1])):
-        return raw
+        return np.loadtxt(rows, delimiter=delimiter, usecols=usecols, ndmin=2, comments=None, dtype=float)
+    except ValueError:  # field counts are already checked (_check_lines): a field is not a number
+        pass
     for k, ln in enumerate(lines):  # error path: find the first bad line
         if not ln.strip():
             continue
@@ -309,9 +364,62 @@ def _parse(rows: list[str], usecols: list[int], delimiter: str, source: str, lin
             try:
                 float(fields[c])
             except ValueError:
-                raise LogError(f"{source}:{line + k}: field {c + 1}: cannot read {fields[c].strip()!r} as a number"
-                               ) from None
+                raise LogError(f"{source}:{line + k}: field {c + 1}: cannot read {_short(fields[c].strip())} as a "
+                               "number") from None
     raise LogError(f"{source}:{line}: cannot read the rows that start here")  # pragma: no cover
+
+
+_CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")  # all but tab, newline, carriage return
+
+
+def _encoded(lines: list[str], source: str, line: int) -> tuple[np.ndarray, np.ndarray]:
+    """`lines` joined as UTF-8 bytes ``(B,)`` uint8, and where the newlines are; refuses bytes that are not UTF-8
+    (read as lone surrogates) and control characters other than tab and line ends, naming the line. Vectorised."""
+    text = "".join(lines)
+    try:
+        b = np.frombuffer(text.encode("utf-8"), dtype=np.uint8)
+    except UnicodeEncodeError as err:
+        where = line + text.count("\n", 0, err.start)
+        raise LogError(f"{source}:{where}: bytes that are not UTF-8 text (a binary file, or another encoding?)"
+                       ) from None
+    newlines = np.flatnonzero(b == 10)
+    if np.count_nonzero(b < 32) != len(newlines) or np.count_nonzero(b == 127):  # else only newlines: fine
+        bad = _CONTROL.search(text)
+        if bad is not None:
+            where = line + text.count("\n", 0, bad.start())
+            raise LogError(f"{source}:{where}: control character {bad.group()!r} in a text log (a binary file?)")
+    return b, newlines
+
+
+def _check_lines(lines: list[str], delimiter: str, width: int, source: str, line: int) -> np.ndarray | None:
+    """Check every line of a chunk at once (vectorised over the bytes): text, field count, line end.
+
+    Returns which lines hold data (None: all of them); blank lines are skipped. A last line without its line end
+    (only the file's last line can lack one) is reported: the file was probably cut while being written.
+    """
+    b, ends = _encoded(lines, source, line)
+    if not lines[-1].endswith("\n"):
+        ends = np.append(ends, len(b) - 1)
+    if len(ends) == len(lines):
+        counts = np.diff(np.searchsorted(np.flatnonzero(b == ord(delimiter)), ends), prepend=0)
+        suspects = np.flatnonzero(counts != width - 1)
+    else:  # lines ending in a lone carriage return: count per line
+        suspects = np.array([k for k, ln in enumerate(lines) if ln.count(delimiter) != width - 1], dtype=int)
+    if width == 1:
+        suspects = np.arange(len(lines))
+    data_lines = None
+    for k in suspects.tolist():  # blank lines, or the first bad one
+        if not lines[k].strip():
+            data_lines = np.ones(len(lines), dtype=bool) if data_lines is None else data_lines
+            data_lines[k] = False
+        elif lines[k].count(delimiter) != width - 1:
+            raise LogError(f"{source}:{line + k}: expected {width} fields, got {lines[k].count(delimiter) + 1} "
+                           f"(the header has {width})")
+    last = len(lines) - 1
+    if (data_lines is None or data_lines[last]) and not lines[last].endswith(("\n", "\r")):
+        raise LogError(f"{source}:{line + last}: the last line has no line end: the file looks truncated "
+                       "(end a complete line with a newline)")
+    return data_lines
 
 
 def _check_finite(log: JointLog, raw: np.ndarray) -> None:
@@ -326,6 +434,11 @@ def _cumtrapz(rate: np.ndarray, t: np.ndarray, *, start: bool) -> np.ndarray:
     """Trapezoidal running integral of `rate` over `t`; includes the leading 0 when `start`."""
     steps = np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(t))
     return np.concatenate([[0.0], steps]) if start else steps
+
+
+def _short(text: str, limit: int = 40) -> str:
+    """`text` quoted for a message, cut to about `limit` characters."""
+    return repr(text) if len(text) <= limit else repr(text[:limit]) + f"... ({len(text)} characters)"
 
 
 def _quoted(names: Sequence[str]) -> str:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -72,6 +72,7 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
     pose = as_vectors(pose0, 3, "pose0").copy()
     if pose.shape != (3,):
         raise LogError(f"pose0: expected one pose (3,), got {pose.shape}")
+    _check_inputs(pose, noise, initial_covariance)
     cov = None if noise is None else (np.zeros((3, 3)) if initial_covariance is None
                                       else np.array(initial_covariance, dtype=float))
     prev: JointLog | None = None
@@ -110,6 +111,8 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
         sums = _compose_chunk(model, chunk.positions, prev.positions[-1], inc, pose, heading, method, poses, slip)
         if fused and not math.isfinite(sums[0]):  # a non-finite position makes every body increment NaN or inf
             _check_finite(chunk)
+        if not (all(map(math.isfinite, sums)) and np.isfinite(poses[-1]).all()):
+            _overflow(chunk, poses)
         covs = None
         if cov is not None:
             dx, dy, dth = (np.zeros(n) if c is None else c for c in (inc.column(0), inc.column(1), inc.column(2)))
@@ -117,6 +120,8 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
             q = _increment_covariance(noise, inc, steps)
             covs = propagate_covariance(np.vstack([pose[None], poses]), steps, q, method, initial=cov)
             cov = covs[-1]
+            if not np.isfinite(cov).all():
+                _overflow(chunk, covs.reshape(n, 9), "covariance")
         result = Trajectory(chunk.time, poses, slip, covs)
         for sink in sinks:
             sink(result)
@@ -226,6 +231,29 @@ def _validate(chunk: JointLog, prev: JointLog | None, *, positions: bool = True)
         _check_finite(chunk)
         check_time(chunk, t, None if prev is None else float(prev.time[-1]), None)
     return largest
+
+
+def _check_inputs(pose: np.ndarray, noise: Noise | None, initial_covariance: ArrayLike | None) -> None:
+    """Refuse a non-finite start pose, noise coefficients that are not finite and >= 0, a bad initial covariance."""
+    if not np.isfinite(pose).all():
+        raise LogError(f"pose0: must be finite, got {pose.tolist()}")
+    if noise is not None:
+        for name, value in ((f.name, getattr(noise, f.name)) for f in fields(noise)):
+            if not (isinstance(value, int | float | np.floating) and math.isfinite(value) and value >= 0):
+                raise LogError(f"{type(noise).__name__}.{name}: a noise coefficient must be finite and >= 0, "
+                               f"got {value!r}")
+    if initial_covariance is not None:
+        c = np.asarray(initial_covariance, dtype=float)
+        if c.shape != (3, 3) or not np.isfinite(c).all():
+            raise LogError(f"initial_covariance: expected a finite (3, 3) matrix, got shape {c.shape}")
+
+
+def _overflow(chunk: JointLog, values: np.ndarray, what: str = "pose") -> None:
+    """Name the first row whose `values` ``(N, ...)`` are not finite: the log's numbers overflow the integration."""
+    bad = ~np.isfinite(values.reshape(len(values), -1)).all(axis=1)
+    i = int(np.argmax(bad)) if bad.any() else len(values) - 1
+    raise LogError(f"{chunk.where(i)}: the {what} overflows here (values too large for floating point: an "
+                   "implausible log)")
 
 
 def _check_finite(log: JointLog) -> None:

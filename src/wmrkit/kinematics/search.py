@@ -1,0 +1,118 @@
+"""Bounded searches over sets of velocities (assignable sets 4.8, minimal actuator and sensor sets, Figs. 4.4-4.5).
+
+The number of candidate sets grows as ``C(n, m)``: 6,545 for 16 castors, 341,376 for 64. A search here walks the
+candidates in lexicographic order, in batches, through a cheap *necessary* test (the null-space test (4.5): the
+rows ``B_a`` of a null-space basis invertible, a batch of ``m x m`` matrices), then confirms the survivors with
+the exact test of the caller, and stops after ``limit`` sets found or :data:`MAX_CANDIDATES` candidates walked.
+The result is a :class:`SetList`: a tuple of sets that says whether it is complete. A tqdm bar shows a long walk
+(on a terminal only). Costs against the wheel count are in ``docs/limits.md``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+#: Most sets a search lists; more are reported as "more than MAX_SETS".
+MAX_SETS = 1000
+#: Most minimal actuator / sensor sets listed (each is confirmed by an exact tree of the robot's size).
+MAX_MINIMAL_SETS = 24
+#: Most candidate sets walked by one search; a longer walk stops and says so.
+MAX_CANDIDATES = 2_000_000
+#: Work of the exact tests of one search, in units of ``rows * columns**2`` of the matrices decomposed (SVD,
+#: pseudo-inverse): about 5 s on the reference machine of ``docs/limits.md``; a search stops when it is spent.
+EXACT_WORK = 1e8
+#: Candidates tested at once (prefilter), and exact tests at once.
+BATCH, EXACT_BATCH = 8192, 64
+#: Searches of more candidates than this are pruned by the prefilter.
+PRUNE_FROM = 512
+#: Walks longer than this show a progress bar (on a terminal).
+PROGRESS_FROM = 50_000
+
+Test = Callable[[np.ndarray], np.ndarray]
+
+
+class SetList(tuple):
+    """A tuple of sets found by a search; ``complete`` is False when it stopped early (``note`` says why)."""
+
+    complete: bool
+    note: str
+
+    def __new__(cls, items: Sequence[tuple] = (), complete: bool = True, note: str = "") -> SetList:
+        out = super().__new__(cls, items)
+        out.complete, out.note = complete, note
+        return out
+
+    def describe_count(self) -> str:
+        """``"12"``, or ``"more than 1000 (the first 1000 listed)"`` when incomplete."""
+        return str(len(self)) if self.complete else f"{len(self)} listed; {self.note}"
+
+
+def null_space_prefilter(a: np.ndarray, m: int, offset: int = 0) -> Test:
+    """The null-space test (4.5) as a prefilter: candidates (columns of A, minus `offset`) whose rows ``B_a`` of a
+    null-space basis of `a` ``(..., R, k)`` are invertible at every configuration of the batch."""
+    from .linalg import matrix_rank
+    from .nullspace import null_space_basis
+
+    basis = null_space_basis(a, m)
+
+    def test(sets: np.ndarray) -> np.ndarray:
+        b_a = np.moveaxis(basis[..., sets + offset, :], -3, 0)  # (S, ..., m, m)
+        return (matrix_rank(b_a) == m).reshape(len(sets), -1).all(axis=1)
+
+    return test
+
+
+def exact_budget(shape: Sequence[int], per_test: int = 1) -> int:
+    """How many exact tests of matrices of `shape` ``(..., R, k)`` fit in :data:`EXACT_WORK` (at least 4);
+    `per_test`: decompositions per test."""
+    *batch, rows, cols = shape
+    work = max(rows, cols) * min(rows, cols) ** 2 * max(math.prod(batch), 1) * per_test
+    return max(4, int(EXACT_WORK / max(work, 1)))
+
+
+def search_sets(columns: Sequence[int], size: int, exact: Test, *, prefilter: Test | None = None,
+                limit: int = MAX_SETS, max_exact: int | None = None,
+                what: str = "sets") -> tuple[list[tuple[int, ...]], bool, str]:
+    """Sets of `size` of `columns` passing `exact`, lexicographic, at most `limit` of them.
+
+    `exact` and `prefilter` map candidates ``(S, size)`` int to ``(S,)`` bool; `prefilter` must be a necessary
+    condition of `exact` (it only prunes). At most `max_exact` candidates reach `exact` (None: no bound; see
+    :func:`exact_budget`). Returns ``(sets, complete, note)``.
+    """
+    total = math.comb(len(columns), size)
+    candidates = itertools.combinations(columns, size)
+    found: list[tuple[int, ...]] = []
+    walked = tested = 0
+    from tqdm import tqdm
+
+    if total <= PRUNE_FROM:  # small searches: the exact test alone, as it always was
+        prefilter = None
+    with tqdm(total=total, disable=None if total > PROGRESS_FROM else True, leave=False, unit="set",
+              desc=f"searching {what}") as bar:
+        while True:
+            chunk = list(itertools.islice(candidates, BATCH))
+            if not chunk:
+                return found, True, ""
+            batch = np.array(chunk, dtype=int).reshape(len(chunk), size)
+            walked += len(batch)
+            bar.update(len(batch))
+            if prefilter is not None:
+                batch = batch[np.asarray(prefilter(batch), dtype=bool)]
+            start = 0
+            while start < len(batch):
+                if max_exact is not None and tested >= max_exact:
+                    return found, False, f"search stopped after {tested} exact tests (docs/limits.md)"
+                size_ = min(EXACT_BATCH, max(limit + 1 - len(found), 8))
+                part = batch[start:start + (size_ if max_exact is None else min(size_, max_exact - tested))]
+                tested += len(part)
+                found += [tuple(int(c) for c in s) for s in part[np.asarray(exact(part), dtype=bool)]]
+                start += len(part)
+                if len(found) > limit:
+                    return found[:limit], False, f"more than {limit} {what} (the first {limit} listed)"
+            if walked >= MAX_CANDIDATES and walked < total:
+                return found, False, (f"search stopped after {walked} of {total} candidate {what} "
+                                      "(docs/limits.md)")

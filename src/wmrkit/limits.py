@@ -1,0 +1,85 @@
+"""Limits of robot descriptions (``docs/limits.md``): sizes, printable text, and the physical envelope.
+
+Checks called by :mod:`wmrkit.description` while it validates a description; each raises the description's
+located one-line error through the checker's ``fail(message, loc)``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import TYPE_CHECKING, Any
+
+from .errors import DescriptionError
+
+if TYPE_CHECKING:
+    from .wheels import Wheel
+
+#: Largest description [bytes of a file, characters of a text]; one of MAX_WHEELS wheels takes ~300 bytes.
+MAX_FILE_SIZE = 1 << 18
+#: Most wheels in a robot: the chapter-4 searches grow combinatorially with the wheel count.
+MAX_WHEELS = 64
+#: Longest robot and wheel names, and notes [characters]: they are printed in tables and reports.
+MAX_NAME, MAX_NOTES = 64, 4096
+#: The robot's size (its largest length: wheel distance, radius, offset) lies in [MIN_SIZE, MAX_SIZE] [m].
+MIN_SIZE, MAX_SIZE = 1e-6, 1e3
+#: Radii, roller radii, castor offsets and half-widths are at least MIN_RATIO times the robot's size.
+MIN_RATIO = 1e-4
+#: Swedish gamma at least this far from 0 and 180 deg; castor delta at least this far from +-90 deg [rad].
+ANGLE_MARGIN = math.radians(1.0)
+
+
+#: Control characters (C0, DEL, C1) and lone surrogates (bytes that are not UTF-8): they break printing.
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff]")
+
+
+def _check_size(size: int, unit: str, source: str) -> None:
+    if size > MAX_FILE_SIZE:
+        raise DescriptionError(f"{size} {unit}: a description holds at most {MAX_FILE_SIZE} (docs/limits.md)",
+                               source=source)
+
+
+def _check_text_fields(name: str, notes: str, check: Any) -> None:
+    """The robot's name and notes are printed: text of bounded length that UTF-8 can encode (no lone surrogates)
+    and without control characters; the name is also printable on one line (``str.isprintable``). Wheel names are
+    identifiers (WHEEL_NAME) of at most MAX_NAME characters (checked in :func:`_check_envelope`)."""
+    for key, value, limit in (("name", name, MAX_NAME), ("notes", notes, MAX_NOTES)):
+        if len(value) > limit:
+            check.fail(f"at most {limit} characters, got {len(value)}", (key,))
+        bad = next((c for c in value if not c.isprintable()), None) if key == "name" else _CONTROL.search(value)
+        if bad is not None:
+            char = bad if isinstance(bad, str) else bad.group()
+            check.fail(f"must be printable text{' on one line' if key == 'name' else ''}, got the character "
+                       f"{char!a}", (key,))
+
+
+def _check_envelope(wheels: list[Wheel], check: Any) -> None:
+    """The physical envelope wmrkit's numbers are valid in (docs/limits.md): the robot's size (its largest length)
+    from 1 um to 1 km, radii and offsets not below MIN_RATIO of it (rank decisions are made relative to the size),
+    Swedish rollers and castor axles at least ANGLE_MARGIN away from the angles where the wheel degenerates."""
+    lengths = []
+    for i, w in enumerate(wheels):
+        if len(w.name) > MAX_NAME:
+            check.fail(f"at most {MAX_NAME} characters, got {len(w.name)}", ("wheels", i, "name"))
+        given = ("l", *(k for k in ("r", "r_r", "d", "b") if k in w.kind.required or k in w.kind.optional))
+        lengths += [(abs(getattr(w, k)), i, k) for k in given]
+    size, i, key = max(lengths)
+    if not size <= MAX_SIZE:
+        check.fail(f"{size:g} m: longer than {MAX_SIZE:g} m, outside the lengths wmrkit handles (1 um to 1 km)",
+                   ("wheels", i, key))
+    if size < MIN_SIZE:
+        check.fail(f"the robot's size ({size:g} m, its largest length) is below {MIN_SIZE:g} m (1 um)",
+                   ("wheels", i, key))
+    for value, i, key in lengths:
+        if key != "l" and value < MIN_RATIO * size:
+            check.fail(f"{value:g} m is less than {MIN_RATIO:g} of the robot's size ({size:g} m, its largest "
+                       "length): too small to tell from 0 in the rank decisions", ("wheels", i, key))
+    for i, w in enumerate(wheels):
+        if w.type == "swedish" and abs(math.sin(w.gamma)) < math.sin(ANGLE_MARGIN):
+            check.fail(f"gamma = {math.degrees(w.gamma):.6g} deg: rollers within {math.degrees(ANGLE_MARGIN):g} "
+                       "deg of the axle roll (almost) nowhere: the roller rate ~ 1/sin(gamma) explodes (eq. 3.19)",
+                       ("wheels", i, "gamma"))
+        if w.type == "castor" and abs(math.cos(w.delta)) < math.sin(ANGLE_MARGIN):
+            check.fail(f"delta = {math.degrees(w.delta):.6g} deg: an axle within {math.degrees(ANGLE_MARGIN):g} "
+                       "deg of the arm cannot steer the castor (det J_c = -r d cos(delta) ~ 0, eq. 3.19)",
+                       ("wheels", i, "delta"))

@@ -1,0 +1,66 @@
+"""Issue 9: the combinatorial searches of chapter 4 are bounded, pruned without losing sets, and say when they stop."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+
+from wmrkit.description import robot_from_dict
+from wmrkit.kinematics import assignable_sets, is_assignable, minimal_actuator_sets
+from wmrkit.kinematics.search import MAX_MINIMAL_SETS, search_sets
+
+
+def _brute(n: int, size: int, good) -> list[tuple[int, ...]]:
+    return [s for s in itertools.combinations(range(n), size) if good(s)]
+
+
+def test_a_search_finds_what_brute_force_finds_in_order_with_or_without_a_prefilter():
+    good = lambda s: sum(s) % 3 == 0  # noqa: E731
+    exact = lambda sets: np.array([good(tuple(s)) for s in sets], dtype=bool)  # noqa: E731
+    prefilter = lambda sets: sets.sum(axis=1) % 3 != 1  # noqa: E731  (necessary: keeps every good set)
+    expected = _brute(30, 3, good)  # C(30, 3) = 4060 candidates: pruned
+    for pre in (None, prefilter):
+        found, complete, note = search_sets(range(30), 3, exact, prefilter=pre, limit=10_000)
+        assert found == expected and complete and note == ""
+
+
+def test_a_search_stops_at_its_limit_and_says_so():
+    found, complete, note = search_sets(range(20), 2, lambda s: np.ones(len(s), bool), limit=50)
+    assert found == list(itertools.combinations(range(20), 2))[:50]
+    assert not complete and note == "more than 50 sets (the first 50 listed)"
+
+
+def test_a_search_stops_when_its_exact_budget_is_spent():
+    calls = []
+
+    def exact(sets):
+        calls.append(len(sets))
+        return np.zeros(len(sets), bool)
+
+    found, complete, note = search_sets(range(40), 3, exact, max_exact=100)
+    assert found == [] and not complete and sum(calls) == 100 and "after 100 exact tests" in note
+
+
+def _castors(n: int):
+    wheels = [{"name": f"c{i}", "type": "castor", "l": 0.3, "alpha": 2 * math.pi * i / n, "d": 0.05, "r": 0.05,
+               "actuated": ["spin"], "sensed": ["spin"]} for i in range(n)]
+    return robot_from_dict({"name": "castors", "wheels": wheels})
+
+
+def test_large_robots_get_a_bounded_list_of_true_sets():
+    robot = _castors(12)  # k = 27 velocities, m = 3: 2,925 candidate sets
+    sets = assignable_sets(robot)
+    assert len(sets) == 1000 and not sets.complete and "more than 1000" in sets.note
+    names = np.array(sets)
+    assert all(is_assignable(robot, list(s), method="nullspace") for s in names[::37])  # another method agrees
+    minimal = minimal_actuator_sets(robot)
+    assert len(minimal) == MAX_MINIMAL_SETS and not minimal.complete
+    assert all(is_assignable(robot, [n for n in s if n.endswith(".spin") or n.endswith(".steer")],
+                             method="rref") for s in minimal[:5])
+
+
+def test_small_robots_are_searched_completely():
+    sets = assignable_sets(_castors(3))  # C(9, 3) = 84 candidates: no pruning, no bound reached
+    assert sets.complete and sets.note == "" and len(sets) == len(set(sets))
