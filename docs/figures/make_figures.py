@@ -151,7 +151,8 @@ def _spin_inset(ax) -> None:
 def heading_figure() -> Figure:
     """Heading (users' steering angle) against the thesis's β: a centred steerable wheel and a castor, from above."""
     fig = Figure(figsize=(10, 4.6))
-    for k, (title, d, delta) in enumerate((("centred steerable wheel", 0.0, 0.0), ("castor (offset d, δ = 0)", 0.5, 0.0))):
+    cases = (("centred steerable wheel", 0.0, 0.0), ("castor (offset d, δ = 0)", 0.5, 0.0))
+    for k, (title, d, delta) in enumerate(cases):
         ax = fig.add_subplot(1, 2, k + 1)
         heading = math.radians(35)
         beta = heading - delta + math.pi / 2
