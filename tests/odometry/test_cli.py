@@ -190,3 +190,4 @@ def test_degrees_written_as_radians_warn_and_say_inconsistent(capsys, tmp_path):
     out, err = capsys.readouterr()
     assert json.loads(out)["consistent"] is False
     assert err.startswith("wmrkit: warning: the sensed joints contradict each other") and err.count("\n") == 1
+    assert "slip per wheel: steer" in err  # the steering wheel, whose column is wrong, slips most

@@ -338,3 +338,18 @@ def _frozen(a: np.ndarray) -> np.ndarray:
     a = np.ascontiguousarray(a)
     a.setflags(write=False)
     return a
+
+
+def wheel_slip(model: OdometryModel, positions: ArrayLike) -> dict[str, float]:
+    """RMS slip per wheel [m per interval] over consecutive joint positions ``(N + 1, n_joints)`` (``model.joints``):
+    the residual rows (4.11) of each wheel's contacts. Names the wheels whose sensors disagree with the others."""
+    res = model.from_positions(positions).residual  # (N, R) over model.rows
+    robot = model.robot
+    owner = np.repeat([i for i, w in enumerate(robot.wheels) for _ in w.elements()], 2)[model.rows]
+    out = {}
+    for i, w in enumerate(robot.wheels):
+        cols = owner == i
+        if cols.any() and len(res):
+            out[w.name] = float(np.sqrt(np.mean(np.sum(res[:, cols] ** 2, axis=1))))
+    return out
+
