@@ -2,30 +2,17 @@
 
 from __future__ import annotations
 
-import contextlib
-import io
 import os
 import re
 from pathlib import Path
+
+from doc_examples import check_python_examples
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_python_examples_of_the_vision_page_print_what_it_says():
-    text = (ROOT / "docs" / "vision.md").read_text()
-    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
-    assert len(blocks) == 2
-    cwd = os.getcwd()
-    os.chdir(ROOT)
-    try:
-        for block in blocks:
-            expected = [m.strip() for m in re.findall(r"print\(.*\)\s+#\s*(.*)$", block, flags=re.M)]
-            out = io.StringIO()
-            with contextlib.redirect_stdout(out):
-                exec(compile(block, "docs/vision.md", "exec"), {})  # our own documentation, not user text
-            assert out.getvalue().split("\n")[:-1] == expected
-    finally:
-        os.chdir(cwd)
+    check_python_examples("vision.md", 2)
 
 
 def test_command_examples_of_the_vision_page_print_what_it_says(tmp_path, capsys):
