@@ -129,3 +129,14 @@ def test_fk_contradicting_rates_warn_and_say_so_in_json(capsys):
     assert err.startswith("wmrkit: warning: the rates contradict each other") and err.count("\n") == 1
     code, out, err = run(capsys, *argv)
     assert "INCONSISTENT" in out and "front_left" in err
+
+
+@pytest.mark.parametrize("argv", [
+    ["ik", "swerve-4", "--twist", "1e308", "1e308", "1e308"],
+    ["ik", "mecanum-4", "--twist", "2e6", "0", "0"],
+    ["fk", "forklift", "--spin", "right_drive=1e308", "--spin", "left_drive=-1e308"],
+])
+def test_rates_beyond_any_robot_are_refused_not_printed_as_inf(capsys, argv):
+    """Issue 9: finite input whose result overflows gets one line and exit 2, never inf in the output."""
+    code, out, err = run(capsys, *argv)
+    assert code == 2 and out == "" and "beyond 1e+06" in err and "inf" not in err.replace("infeasible", "")

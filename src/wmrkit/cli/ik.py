@@ -8,6 +8,7 @@ import sys
 
 import numpy as np
 
+from ..errors import WmrkitError
 from ..kinematics.wheel_ik import WheelCommands, forward_kinematics_check, twist_is_determined, wheel_commands
 from ..robot import Robot
 from ..units import UnitError, parse_quantity
@@ -45,6 +46,7 @@ def run_ik(args: argparse.Namespace) -> int:
     """Print the per-wheel commands; warn on stderr when the twist makes a fixed wheel slip."""
     robot = steered_robot(args.robot, args.steer)
     commands = wheel_commands(robot, args.twist)
+    _check_finite("ik", commands.rates, commands.slip)
     if not commands.feasible:
         worst = int(np.argmax(np.abs(commands.slip)))
         print(f"wmrkit: warning: twist not feasible for robot '{robot.name}': wheel '{robot.wheel_names[worst]}' "
@@ -59,7 +61,11 @@ def run_fk(args: argparse.Namespace) -> int:
     robot = steered_robot(args.robot, args.steer)
     given = parse_assignments(args.spin, "--spin")
     rates = {name: parse_value(value, "number", f"--spin {name}") for name, value in given.items()}
+    for name, value in rates.items():
+        if abs(value) > MAX_RATE:
+            raise WmrkitError(f"--spin {name}: {value:g} is beyond {MAX_RATE:g} rad/s (m/s), no wheel turns so fast")
     fk = forward_kinematics_check(robot, rates)
+    _check_finite("fk", fk.twist, fk.residual)
     twist = fk.twist
     if not twist_is_determined(robot, list(rates)):
         print(f"wmrkit: warning: these rates do not determine the twist of robot '{robot.name}'; "
@@ -78,11 +84,27 @@ def run_fk(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Largest speed [m/s], turn rate [rad/s] or joint rate [rad/s] the commands accept: far beyond any wheeled robot,
+#: and small enough that no result overflows (docs/limits.md).
+MAX_RATE = 1e6
+
+
 def _finite(text: str) -> float:
     try:
-        return parse_quantity(text, "number")
+        value = parse_quantity(text, "number")
     except UnitError as err:
         raise argparse.ArgumentTypeError(str(err)) from None
+    if abs(value) > MAX_RATE:
+        raise argparse.ArgumentTypeError(f"{text}: beyond {MAX_RATE:g} (m/s or rad/s), no wheeled robot moves so fast")
+    return value
+
+
+def _check_finite(what: str, *arrays) -> None:
+    """A result that overflowed is an error, never a printed inf or nan."""
+    import numpy as np
+
+    if not all(np.all(np.isfinite(np.nan_to_num(np.asarray(a, dtype=float), nan=0.0))) for a in arrays):
+        raise WmrkitError(f"{what}: the result overflows for this robot; give smaller rates")
 
 
 def format_commands(robot: Robot, commands: WheelCommands) -> str:
