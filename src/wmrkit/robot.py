@@ -122,6 +122,11 @@ class Robot:
         """Sensed joints, qualified ``wheel.joint``."""
         return tuple(f"{w.name}.{j}" for w in self.wheels for j in w.sensed)
 
+    @property
+    def row_wheels(self) -> np.ndarray:
+        """The wheel (index into ``wheels``) of every row of :meth:`constraint_matrix`, ``(2 * n_contacts,)``."""
+        return readonly(np.repeat(_table(self).element_wheel, 2))
+
     def velocity_index(self, name: str) -> int:
         """Column of `name` in the velocity vector, or :class:`UnknownNameError`."""
         names = self.velocity_names

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..wheels import wrap_angle
 from .points import ControlError
 
 __all__ = ["ActuatorLoop", "LowLevelLoops"]
@@ -95,7 +96,7 @@ class LowLevelLoops:
         y, z = state[:n], state[n:]
         err = command - y
         steer = np.array([j.endswith(".steer") for j in self.joints])
-        err = np.where(steer, np.pi - np.mod(np.pi - err, 2 * np.pi), err)
+        err = np.where(steer, wrap_angle(err), err)
         if self.coupling is not None:
             err = err + np.asarray(self.coupling) @ err
         dy, dz = np.zeros(n), np.zeros(n)

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..analysis.classification import classify
 from ..robot import Robot
+from ..wheels import wrap_angle
 from .points import ControlError, control_point
 from .references import Reference
 
@@ -152,7 +153,7 @@ def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float) -> list[tupl
     x = x.reshape(len(x), -1)
     d = np.diff(x, axis=0)
     if angle:
-        d = np.pi - np.mod(np.pi - d, 2 * np.pi)
+        d = wrap_angle(d)
     size = np.sqrt(np.nansum(d * d, axis=-1))
     size[np.any(np.isnan(d), axis=-1)] = 0.0
     typical = np.median(size) if len(size) else 0.0

@@ -21,6 +21,7 @@ from typing import Literal
 
 import numpy as np
 
+from ..wheels import wrap_angle
 from .points import ControlError
 
 __all__ = ["KINDS", "PositionLaw", "SamplingWarning", "check_sampling", "law_velocity"]
@@ -61,7 +62,7 @@ class PositionLaw:
 def pose_error(pose_ref: np.ndarray, pose: np.ndarray) -> np.ndarray:
     """``p_ref - p`` with the heading difference wrapped to (-pi, pi]. ``(..., 3), (..., 3) -> (..., 3)``."""
     e = np.asarray(pose_ref, dtype=float) - np.asarray(pose, dtype=float)
-    e[..., 2] = np.pi - np.mod(np.pi - e[..., 2], 2 * np.pi)
+    e[..., 2] = wrap_angle(e[..., 2])
     return e
 
 

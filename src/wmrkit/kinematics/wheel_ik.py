@@ -243,7 +243,7 @@ def forward_kinematics_check(
     q_assigned = np.array([float(_rate_value(k, v)) for k, v in rates.items()])
     a = robot.constraint_matrix(beta, heading=heading)
     q_dot, slip = solve_assigned(a, columns, q_assigned)
-    owner = _contact_wheels(robot)
+    owner = robot.row_wheels
     wheel_slip = np.sqrt(np.bincount(owner, weights=slip**2, minlength=len(robot.wheels)))
     speeds = [abs(v) * (robot.wheel(n.partition(".")[0]).r if "." in n and not n.endswith(".steer") else 1.0)
               for n, v in zip((robot.velocity_names[c] for c in columns), q_assigned, strict=True)]
@@ -252,11 +252,6 @@ def forward_kinematics_check(
     slipping = tuple(robot.wheel_names[i] for i in np.flatnonzero(wheel_slip > tolerance))
     consistent = bool(residual <= tolerance)
     return ForwardKinematics(_ro(q_dot[:3]), residual, _ro(wheel_slip), tolerance, consistent, slipping)
-
-
-def _contact_wheels(robot: Robot) -> np.ndarray:
-    """The wheel of every slip row (two rows per contact element)."""
-    return np.repeat([i for i, w in enumerate(robot.wheels) for _ in w.elements()], 2)
 
 
 def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: ArrayLike | None = None) -> np.ndarray:

@@ -345,7 +345,7 @@ def wheel_slip(model: OdometryModel, positions: ArrayLike) -> dict[str, float]:
     the residual rows (4.11) of each wheel's contacts. Names the wheels whose sensors disagree with the others."""
     res = model.from_positions(positions).residual  # (N, R) over model.rows
     robot = model.robot
-    owner = np.repeat([i for i, w in enumerate(robot.wheels) for _ in w.elements()], 2)[model.rows]
+    owner = robot.row_wheels[model.rows]
     out = {}
     for i, w in enumerate(robot.wheels):
         cols = owner == i
