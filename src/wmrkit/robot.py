@@ -125,7 +125,7 @@ class Robot:
     @property
     def row_wheels(self) -> np.ndarray:
         """The wheel (index into ``wheels``) of every row of :meth:`constraint_matrix`, ``(2 * n_contacts,)``."""
-        return readonly(np.repeat(_table(self).element_wheel, 2))
+        return readonly(np.repeat(element_table(self).element_wheel, 2))
 
     def velocity_index(self, name: str) -> int:
         """Column of `name` in the velocity vector, or :class:`UnknownNameError`."""
@@ -180,8 +180,8 @@ class Robot:
 
         if frame not in ("roller", "robot"):
             raise ValueError(f"frame must be 'roller' or 'robot', got {frame!r}")
-        t = _table(self)
-        beta_e = _element_beta(self, t, self.steering(beta, heading))  # (..., E)
+        t = element_table(self)
+        beta_e = element_beta(self, self.steering(beta, heading))  # (..., E)
         flat = beta_e.reshape(-1, t.n_elements)
         a = np.empty((flat.shape[0], t.n_elements, 2, 3 + t.n_rates))
         fill_constraint_rows(flat, t.l, t.alpha, t.d, t.delta, t.gamma, t.r, t.r_r, t.rate_map, a)
@@ -192,7 +192,7 @@ class Robot:
 
     def slip_velocity(self, q_dot: ArrayLike, beta: ArrayLike | None = None) -> np.ndarray:
         """Slip of every contact along its roller axes, ``A @ q_dot`` (3.22). ``(..., k) -> (..., 2 n_contacts)``."""
-        q_dot = as_vectors(q_dot, 3 + _table(self).n_rates, "q_dot")
+        q_dot = as_vectors(q_dot, 3 + element_table(self).n_rates, "q_dot")
         return (self.constraint_matrix(beta) @ q_dot[..., None])[..., 0]
 
     def jacobian_form(self, beta: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -202,8 +202,8 @@ class Robot:
         wheel rates (as in ``rate_names``) followed by one copy of ``omega`` per contact (3.17)-(3.19).
         For one-element wheels J is block diagonal with the blocks (3.19).
         """
-        t = _table(self)
-        beta_e = _element_beta(self, t, beta)
+        t = element_table(self)
+        beta_e = element_beta(self, beta)
         jac = generic_wheel_jacobian(beta_e, t.l, t.alpha, t.d, t.delta, t.gamma, t.r, t.r_r)  # (..., E, 3, 4)
         j_rates = jac[..., :3] @ t.rate_map  # (..., E, 3, n_rates)
         j_omega = jac[..., 3:] * np.eye(t.n_elements)[:, None, :]  # (..., E, 3, E)
@@ -250,7 +250,7 @@ def _steer_delta(robot: Robot) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False)
-class _Table:
+class ElementTable:
     """Per-contact-element parameters of a robot, as arrays (derived once per robot, read-only)."""
 
     l: np.ndarray
@@ -276,7 +276,8 @@ class _Table:
 
 
 @functools.lru_cache(maxsize=256)
-def _table(robot: Robot) -> _Table:
+def element_table(robot: Robot) -> ElementTable:
+    """The per-contact-element arrays of `robot` (3.8) that every batched kernel reads (cached per robot)."""
     rows, maps, owner = [], [], []
     n_rates = sum(len(w.kind.rates) for w in robot.wheels)
     start = 0
@@ -295,7 +296,7 @@ def _table(robot: Robot) -> _Table:
     steers = np.array([i in steer_wheels for i in owner], dtype=bool)
     steer_index = np.array([steer_wheels.index(i) if i in steer_wheels else 0 for i in owner], dtype=int)
     fixed = np.where(steers, 0.0, np.array([robot.wheels[i].beta for i in owner], dtype=float)) + cols[2]
-    return _Table(
+    return ElementTable(
         *arrays,
         rate_map=readonly(np.array(maps).reshape(-1, 3, n_rates)),
         element_wheel=readonly(np.array(owner, dtype=int)),
@@ -308,8 +309,10 @@ def _table(robot: Robot) -> _Table:
     )
 
 
-def _element_beta(robot: Robot, t: _Table, beta: ArrayLike | None) -> np.ndarray:
-    """Absolute angle of every contact element's steering frame, ``(..., E)``."""
+def element_beta(robot: Robot, beta: ArrayLike | None) -> np.ndarray:
+    """Absolute angle of every contact element's steering frame, ``(..., E)``, at the steering angles `beta`
+    ``(..., n_steer)`` (the described ones when None)."""
+    t = element_table(robot)
     described = t.beta_described[t.element_wheel] + t.beta_offset
     if beta is None:
         return described

@@ -163,3 +163,16 @@ def test_omni_castor_fig_6_3_sets_match_determinants():
             bb[2] = b3
             rows = np.stack([np.cos(bb), np.sin(bb), L * np.sin(bb - alphas) - d], axis=-1)
             assert abs(np.linalg.det(rows)) < 1e-9
+
+
+def test_two_steerable_wheels_a_subnormal_distance_apart_are_always_singular():
+    """Found by hypothesis: minors of order 1e-309 used to overflow the root finder; they vanish identically."""
+    from wmrkit.robot import Robot
+    from wmrkit.wheels import Wheel
+
+    r = Robot(name="r", wheels=(Wheel(name="w0", type="steerable", l=0.0, alpha=0.0, beta=0.0, r=0.5),
+                                Wheel(name="w1", type="steerable", l=1.1125369292536007e-308, alpha=0.0, beta=0.0,
+                                      r=0.5)))
+    s = singular_set(r, ("w0.spin", "w1.spin"), resolution=24, max_samples=200)
+    assert s.always and len(s.configurations) == 0
+    assert is_singular_rank(r, np.zeros((4, 2)) + np.linspace(-3, 3, 4)[:, None], ("w0.spin", "w1.spin")).all()

@@ -16,7 +16,7 @@ CHUNK = 4096  # configurations per chunk: the working set stays in cache
 
 
 def element_rows_cm(p, beta: np.ndarray) -> np.ndarray:
-    """Slip-row twist columns ``(2E, 3, N)`` for configurations `beta` ``(N, n_steer)``; `p` from lines._params."""
+    """Slip-row twist columns ``(2E, 3, N)`` for configurations `beta` ``(N, n_steer)``; `p`: line_parameters."""
     n = beta.shape[0]
     n_el = len(p.element_wheel)
     out = np.empty((n_el, 2, 3, n))

@@ -55,19 +55,21 @@ class ICRSet:
 
     def describe(self) -> str:
         """One line for people, e.g. ``ICR at (0.000, -2.747) m``."""
+        f = format_coordinate
         if self.kind == "point":
-            return f"ICR at ({_f(self.point[0])}, {_f(self.point[1])}) m"
+            return f"ICR at ({f(self.point[0])}, {f(self.point[1])}) m"
         if self.kind == "infinity":
-            return f"ICR at infinity: translation only, along +-({_f(self.direction[0])}, {_f(self.direction[1])})"
+            return f"ICR at infinity: translation only, along +-({f(self.direction[0])}, {f(self.direction[1])})"
         if self.kind == "line":
             lx, ly, d = self.line
-            return f"ICR anywhere on the line through ({_f(d * ly)}, {_f(-d * lx)}) m along ({_f(lx)}, {_f(ly)})"
+            return f"ICR anywhere on the line through ({f(d * ly)}, {f(-d * lx)}) m along ({f(lx)}, {f(ly)})"
         if self.kind == "plane":
             return "ICR anywhere in the plane (no wheel axle constrains it)"
         return "no ICR: the robot cannot move without slipping"
 
 
-def _f(x: float) -> str:
+def format_coordinate(x: float) -> str:
+    """`x` with 3 decimals, never "-0.000" (the ICR texts)."""
     text = f"{x:.3f}"
     return "0.000" if text == "-0.000" else text
 

@@ -31,7 +31,7 @@ from ..errors import UnknownNameError
 from ..robot import Robot
 from . import _fast
 from .classification import classify
-from .lines import _params, _rate_block, constraint_lines, element_rows
+from .lines import _rate_block, constraint_lines, element_rows, line_parameters
 from .singularity import robot_size
 
 #: Search interval of the natural length, in robot sizes (see :func:`natural_length`).
@@ -157,7 +157,7 @@ def _kappa(model: TwistModel, beta: np.ndarray, length: float) -> np.ndarray:
     """Condition numbers at configurations `beta` ``(..., n_steer) -> (...)``, in cache-sized chunks."""
     flat = beta.reshape(int(np.prod(beta.shape[:-1])), beta.shape[-1])
     out = np.empty(len(flat))
-    p, cl = _params(model.robot), constraint_lines(model.robot)
+    p, cl = line_parameters(model.robot), constraint_lines(model.robot)
     for s in range(0, len(flat), _fast.CHUNK):
         rows = _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
         lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
@@ -168,7 +168,7 @@ def _kappa(model: TwistModel, beta: np.ndarray, length: float) -> np.ndarray:
 
 def kappa_function(model: TwistModel, beta: np.ndarray):
     """``length -> kappa (N,)`` at configurations `beta` ``(N, n_steer)`` (one chunk), rows computed once."""
-    p, cl = _params(model.robot), constraint_lines(model.robot)
+    p, cl = line_parameters(model.robot), constraint_lines(model.robot)
     rows = _fast.element_rows_cm(p, beta)
     lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
     rates = _fast.combine(model.coefficients, rows)
@@ -189,7 +189,7 @@ def natural_length(robot: Robot, beta: ArrayLike | None = None, *,
         raise UnknownNameError("natural_length takes one configuration (shape (n_steer,))")
     size = robot_size(robot)
     if model.mobility == 2:
-        rows = _fast.element_rows_cm(_params(robot), beta[None])
+        rows = _fast.element_rows_cm(line_parameters(robot), beta[None])
         cl = constraint_lines(robot)
         lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
         a, b, ok = _fast.columns_m2(_fast.combine(model.coefficients, rows), lines)

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..kinematics.linalg import rref
-from ..robot import TWIST_NAMES, Robot
+from ..robot import TWIST_NAMES, Robot, element_table
 
 #: Rows added for assigned vehicle velocities (rules 5-6 of §6.3): the X axis, the Y axis, the line at infinity.
 TWIST_LINES = {"vx": (1.0, 0.0, 0.0), "vy": (0.0, 1.0, 0.0), "omega": (0.0, 0.0, 1.0)}
@@ -196,7 +196,7 @@ def element_rows(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
     and ``(-s, c, l cos(theta - alpha) + d sin(delta+gamma))`` with ``theta = beta + delta + gamma`` (3.8); these
     are the lines E/F_beta/F_s and F/F_phi of (6.1)-(6.4).
     """
-    p = _params(robot)
+    p = line_parameters(robot)
     if beta is None:
         wheel_beta = p.beta_described
     else:
@@ -214,31 +214,28 @@ def element_rows(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False)
-class _Params:
-    beta_described: np.ndarray
-    steer_wheels: np.ndarray
-    element_wheel: np.ndarray
-    theta_offset: np.ndarray
-    l_c_alpha: np.ndarray
-    l_s_alpha: np.ndarray
-    l_s_alpha_neg: np.ndarray
-    d_c: np.ndarray
-    d_s: np.ndarray
+class LineParameters:
+    """Per-element constants of the constraint lines (6.1)-(6.4), derived from the robot's element table."""
+
+    beta_described: np.ndarray  # (N,) described beta of every wheel
+    steer_wheels: np.ndarray  # (n_steer,) wheel indices of the steering wheels
+    element_wheel: np.ndarray  # (E,) wheel index of each contact element
+    theta_offset: np.ndarray  # (E,) beta_offset + delta + gamma
+    l_c_alpha: np.ndarray  # l cos(alpha)
+    l_s_alpha: np.ndarray  # l sin(alpha)
+    l_s_alpha_neg: np.ndarray  # -l sin(alpha)
+    d_c: np.ndarray  # d cos(delta + gamma)
+    d_s: np.ndarray  # d sin(delta + gamma)
 
 
 @functools.lru_cache(maxsize=512)
-def _params(robot: Robot) -> _Params:
-    els = [(i, e) for i, w in enumerate(robot.wheels) for e in w.elements()]
-    col = lambda f: np.array([f(e) for _, e in els], dtype=float)  # noqa: E731
-    return _Params(
-        beta_described=np.array([w.beta for w in robot.wheels], dtype=float),
-        steer_wheels=np.array([i for i, w in enumerate(robot.wheels) if w.kind.steers], dtype=int),
-        element_wheel=np.array([i for i, _ in els], dtype=int),
-        theta_offset=col(lambda e: e.beta_offset + e.delta + e.gamma),
-        l_c_alpha=col(lambda e: e.l * np.cos(e.alpha)),
-        l_s_alpha=col(lambda e: e.l * np.sin(e.alpha)),
-        l_s_alpha_neg=col(lambda e: -e.l * np.sin(e.alpha)),
-        d_c=col(lambda e: e.d * np.cos(e.delta + e.gamma)),
-        d_s=col(lambda e: e.d * np.sin(e.delta + e.gamma)),
+def line_parameters(robot: Robot) -> LineParameters:
+    """The constants of :func:`element_rows` for `robot` (cached per robot)."""
+    t = element_table(robot)
+    dg = t.delta + t.gamma
+    return LineParameters(
+        beta_described=t.beta_described, steer_wheels=t.steer_wheels, element_wheel=t.element_wheel,
+        theta_offset=t.beta_offset + dg, l_c_alpha=t.l * np.cos(t.alpha), l_s_alpha=t.l * np.sin(t.alpha),
+        l_s_alpha_neg=-t.l * np.sin(t.alpha), d_c=t.d * np.cos(dg), d_s=t.d * np.sin(dg),
     )
 

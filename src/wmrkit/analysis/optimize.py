@@ -21,7 +21,7 @@ from ..robot import Robot
 from . import _fast
 from ._sym import eigvalsh2_entries
 from .isotropy import _kappa, golden_section, kappa_function, natural_length, twist_model
-from .lines import _params, constraint_lines
+from .lines import constraint_lines, line_parameters
 from .singularity import robot_size
 
 
@@ -110,7 +110,7 @@ def _grid_kappa(model, beta: np.ndarray, length: float | None) -> np.ndarray:
     size = robot_size(model.robot)
     if model.mobility == 2:  # closed form per configuration: D = |b| / |a|
         flat = beta.reshape(-1, beta.shape[-1])
-        p, cl = _params(model.robot), constraint_lines(model.robot)
+        p, cl = line_parameters(model.robot), constraint_lines(model.robot)
         out = np.empty(len(flat))
         for s in range(0, len(flat), _fast.CHUNK):
             rows = _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])

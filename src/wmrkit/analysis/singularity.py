@@ -27,7 +27,7 @@ from ..errors import UnknownNameError
 from ..kinematics.linalg import matrix_rank, nondimensional
 from ..robot import Robot
 from . import _fast
-from .lines import _params, constraint_lines, element_rows
+from .lines import constraint_lines, element_rows, line_parameters
 
 #: Relative tolerance of the line test: ``sigma_min / sigma_max`` of the normalised lines below it is singular.
 SINGULAR_RTOL = 1e-8
@@ -74,7 +74,7 @@ def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[s
         return np.zeros(beta.shape[:-1])
     flat = beta.reshape(int(np.prod(beta.shape[:-1])), beta.shape[-1])
     out = np.empty(len(flat))
-    p, length = _params(robot), float(length or robot_size(robot))
+    p, length = line_parameters(robot), float(length or robot_size(robot))
     for s in range(0, len(flat), _fast.CHUNK):
         rows = _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
         out[s:s + _fast.CHUNK] = _fast.distance_cm(_fast.combine(cl.coefficients, rows, cl.constant), length)
@@ -213,7 +213,9 @@ def _roots_last(cl, configs: np.ndarray, j: int) -> tuple[list[np.ndarray], np.n
     c = coef[np.arange(len(coef)), :, np.argmax(size, axis=1)]  # (B, 7)
     a, b = c[:, 1::2], c[:, 2::2]
     poly = np.concatenate([((a - 1j * b) / 2)[:, ::-1], c[:, :1], (a + 1j * b) / 2], axis=1)  # z^6 ... z^0
-    roots = _poly_roots(poly)
+    roots: list[np.ndarray] = [np.zeros(0, complex)] * len(poly)  # rows that vanish identically have no roots
+    for i, z in zip(np.flatnonzero(~always), _poly_roots(poly[~always]), strict=True):
+        roots[i] = z
     row = np.concatenate([np.full(len(z), i) for i, z in enumerate(roots)] + [np.zeros(0, int)]).astype(int)
     z = np.concatenate([*roots, np.zeros(0, complex)])
     on_circle = (np.abs(np.abs(z) - 1) < 1e-4) & ~always[row]

@@ -123,7 +123,7 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
     """Compile the per-wheel tables of a sweep (module docstring)."""
     from ..analysis.classification import classify
     from ..analysis.isotropy import default_joints, twist_model
-    from ..analysis.lines import _params, constraint_lines
+    from ..analysis.lines import constraint_lines, line_parameters
     from ..analysis.singularity import robot_size
 
     if metric not in METRICS:
@@ -133,7 +133,7 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
     if length is not None and not length > 0:
         raise BatchError(f"--length must be > 0 m, got {length}")
     joints = default_joints(robot)
-    p0 = _params(robot)
+    p0 = line_parameters(robot)
     row_wheel = np.repeat(p0.element_wheel, 2)
     n_steer = len(robot.steer_names)
     rng = np.random.default_rng(seed)
@@ -149,7 +149,7 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
             assign = {t: axes[k].values[c] for k, c in zip(mine, combo, strict=True)
                       for t in axes[k].targets if t[0] == w}
             r = variant(robot, assign) if assign else robot
-            p = _params(r)
+            p = line_parameters(r)
             for key, arr in (("theta", p.theta_offset), ("lc", p.l_c_alpha), ("ls", p.l_s_alpha),
                              ("lsn", p.l_s_alpha_neg), ("dc", p.d_c), ("ds", p.d_s)):
                 cols[key].append(arr[el])

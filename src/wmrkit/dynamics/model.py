@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..errors import WmrkitError
-from ..robot import Robot, _table
+from ..robot import Robot, element_table
 from .mass import CASTOR_TYPES, Body
 from .tyres import Tyre
 
@@ -155,7 +155,7 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
     if body is None:
         raise WmrkitError(f"robot '{robot.name}' has no mass properties: add a 'body: {{mass, inertia, com, "
                           "com_height}' section to its description (docs/dynamics.md)")
-    t = _table(robot)
+    t = element_table(robot)
     names = list(robot.velocity_names)
     steer_cols = []
     for w in robot.wheels:

@@ -44,7 +44,7 @@ class PlotError(WmrkitError, ValueError):
 
 
 @dataclass(frozen=True)
-class _Element:
+class ElementGeometry:
     """One contact element of a wheel at one configuration, in robot coordinates [m]."""
 
     joint: np.ndarray  # (2,) steering joint / mount point
@@ -55,7 +55,8 @@ class _Element:
     spin_joint: str  # the wheel joint that spins this element ("spin", "spin1", "spin2")
 
 
-def _elements(wheel: Wheel, beta: float) -> list[_Element]:
+def element_geometry(wheel: Wheel, beta: float) -> list[ElementGeometry]:
+    """Where each contact element of `wheel` is drawn at steering angle `beta` (3.8), in robot coordinates."""
     joints = ("spin1", "spin2") if wheel.type in ("double", "double_castor") else ("spin", "spin")
     out = []
     for e, spin in zip(wheel.elements(), joints, strict=False):
@@ -64,7 +65,7 @@ def _elements(wheel: Wheel, beta: float) -> list[_Element]:
         centre = joint + e.d * np.array([-math.sin(s_frame), math.cos(s_frame)])
         axle = s_frame + e.delta
         roller = axle + e.gamma if wheel.type in ROLLED_TYPES else None
-        out.append(_Element(joint, centre, axle, roller, e.r, spin))
+        out.append(ElementGeometry(joint, centre, axle, roller, e.r, spin))
     return out
 
 
@@ -86,7 +87,7 @@ def _wheel_betas(robot: Robot, config: np.ndarray) -> list[float]:
     return [next(it) if w.kind.steers else w.beta for w in robot.wheels]
 
 
-def _size(robot: Robot, elements: list[list[_Element]]) -> float:
+def _size(robot: Robot, elements: list[list[ElementGeometry]]) -> float:
     """A length scale of the drawing [m]: the extent of the wheel layout, at least a few wheel radii."""
     pts = np.array([p for els in elements for e in els for p in (e.joint, e.centre)])
     extent = float(np.max(np.ptp(pts, axis=0)))
@@ -107,7 +108,7 @@ def _rect(centre: np.ndarray, along: np.ndarray, across: np.ndarray, half_len: f
                      for sa, sc in ((1, 1), (-1, 1), (-1, -1), (1, -1))])
 
 
-def _draw_element(ax: Axes, wheel: Wheel, e: _Element, width: float, alpha: float) -> list[np.ndarray]:
+def _draw_element(ax: Axes, wheel: Wheel, e: ElementGeometry, width: float, alpha: float) -> list[np.ndarray]:
     """Draw one wheel element; return the points it covers (for the limits)."""
     axle = np.array([math.cos(e.axle), math.sin(e.axle)])
     roll = np.array([-axle[1], axle[0]])
@@ -135,7 +136,7 @@ def _circle(centre: np.ndarray, radius: float) -> np.ndarray:
     return centre + radius * np.stack([np.cos(t), np.sin(t)], axis=-1)
 
 
-def _draw_rollers(ax: Axes, e: _Element, axle: np.ndarray, roll: np.ndarray, width: float, alpha: float) -> None:
+def _draw_rollers(ax: Axes, e: ElementGeometry, axle: np.ndarray, roll: np.ndarray, width: float, alpha: float) -> None:
     """Short strokes along the contact rollers' axes (at gamma from the axle), spread along the wheel."""
     rel = e.roller - e.axle
     direction = math.cos(rel) * axle + math.sin(rel) * roll
@@ -149,7 +150,7 @@ def _draw_rollers(ax: Axes, e: _Element, axle: np.ndarray, roll: np.ndarray, wid
         ax.plot(seg[:, 0], seg[:, 1], color=INK, linewidth=1.3, alpha=alpha, solid_capstyle="round", zorder=5)
 
 
-def _draw_joint(ax: Axes, wheel: Wheel, els: list[_Element], alpha: float) -> list[np.ndarray]:
+def _draw_joint(ax: Axes, wheel: Wheel, els: list[ElementGeometry], alpha: float) -> list[np.ndarray]:
     """Steering arm(s) and the steering joint of a wheel that steers."""
     joint = els[0].joint
     pts = [joint[None]]
@@ -199,7 +200,7 @@ def draw_robot(robot: Robot, ax: Axes | None = None, *, beta: ArrayLike | None =
     own = ax is None
     if ax is None:
         ax = Figure(figsize=(8, 8), dpi=100).add_subplot()
-    per_config = [[_elements(w, b) for w, b in zip(robot.wheels, _wheel_betas(robot, c), strict=True)]
+    per_config = [[element_geometry(w, b) for w, b in zip(robot.wheels, _wheel_betas(robot, c), strict=True)]
                   for c in configs]
     first = per_config[0]
     scale = _size(robot, first)
@@ -251,7 +252,7 @@ def _layout(ax: Axes, aspect: float, legend_rows: int) -> None:
     ax.set_position((x0 / 8.0, bottom / fig_h, drawn_w / 8.0, height / fig_h))
 
 
-def _label(ax: Axes, wheel: Wheel, els: list[_Element], centroid: np.ndarray, width: float,
+def _label(ax: Axes, wheel: Wheel, els: list[ElementGeometry], centroid: np.ndarray, width: float,
            scale: float) -> np.ndarray:
     """Wheel name, placed just outside the wheel on the side away from the robot's centroid."""
     centre = np.mean([e.centre for e in els], axis=0)

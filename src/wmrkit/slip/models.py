@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 from ..dynamics.mass import Body
 from ..errors import WmrkitError
 from ..kinematics.linalg import solve_assigned
-from ..robot import Robot
+from ..robot import Robot, element_beta
 from .weights import SlipWeights
 
 FrictionLaw = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
@@ -142,7 +142,7 @@ def mqe(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, friction: 
 def contact_positions(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
     """Contact point of every element in the robot frame ``(..., E, 2)`` [m]: the steering joint plus the castor
     offset ``d`` along the steering arm (``S_y`` at angle ``beta + pi/2``)."""
-    beta_e = _element_beta(robot, beta)
+    beta_e = element_beta(robot, beta)
     l_, al, d = (np.array(v, dtype=float) for v in zip(*[(e.l, e.alpha, e.d) for w in robot.wheels
                                                            for e in w.elements()], strict=True))
     x = l_ * np.cos(al) - d * np.cos(beta_e)
@@ -173,13 +173,6 @@ def _body(robot: Robot, body: Body | None) -> Body:
     if body is None:
         raise WmrkitError(f"robot '{robot.name}' has no mass properties ('body:' in its description)")
     return body
-
-
-def _element_beta(robot: Robot, beta: ArrayLike | None) -> np.ndarray:
-    from ..robot import _element_beta as element_beta
-    from ..robot import _table
-
-    return element_beta(robot, _table(robot), beta)
 
 
 def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, start, tol) -> SlipSolution:

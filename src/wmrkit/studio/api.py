@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.classification import classify, instantaneous_mobility
-from ..analysis.icr import ICRSet, _f, icr, icr_of_twist
+from ..analysis.icr import ICRSet, icr, icr_of_twist
 from ..analysis.isotropy import (
     _minimise_length,
     condition_map,
@@ -98,11 +98,11 @@ def description_of(robot: Robot) -> dict[str, Any]:
 
 def geometry(robot: Robot) -> dict[str, Any]:
     """What the plan view draws, in robot coordinates [m] and radians: per wheel its joint, heading, elements."""
-    from ..plotting.robot import _elements  # the drawing's own geometry (eq. 3.8), not re-derived here
+    from ..plotting.robot import element_geometry  # the drawing's own geometry (eq. 3.8), not re-derived here
 
     wheels = []
     for w in robot.wheels:
-        els = _elements(w, w.beta)
+        els = element_geometry(w, w.beta)
         wheels.append({
             "name": w.name, "type": w.type, "steers": w.kind.steers,
             "joint": [float(v) for v in els[0].joint], "heading": float(w.heading), "beta": w.beta,
@@ -287,7 +287,7 @@ def twist_icr(twist: np.ndarray) -> dict[str, Any]:
         n = math.hypot(twist[0], twist[1])
         return {"kind": "infinity", "direction": [twist[0] / n, twist[1] / n],
                 "text": "ICR at infinity: pure translation"}
-    return {"kind": "point", "point": [x / w, y / w], "text": f"ICR at ({_f(x / w)}, {_f(y / w)}) m"}
+    return {"kind": "point", "point": [x / w, y / w], "text": ICRSet("point", point=(x / w, y / w)).describe()}
 
 
 # ---- helpers -----------------------------------------------------------------------------------------------
