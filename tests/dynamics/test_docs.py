@@ -11,7 +11,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_python_examples_of_the_dynamics_page_print_what_it_says():
-    check_python_examples("dynamics.md", 2)
+    check_python_examples("dynamics.md", 3)
 
 
 def test_figures_of_the_page_exist():

@@ -1,22 +1,33 @@
 """The kinematic loop closed through the chapter-7 dynamics (beyond the thesis, issue item 7).
 
-Each period the controller's twist becomes the servo inputs of :func:`wmrkit.dynamics.programs.twist_program`
+Each period the controller's twist becomes the servo references of :func:`wmrkit.dynamics.programs.twist_program`
 (rate servos on the actuated wheels, PD servos on the actuated steering, at the IK's no-slip joint motion), and the
-Lagrange model with tyres (:mod:`wmrkit.dynamics`) is integrated over the period from the *full* state it reached
-(pose, steering, wheel angles, every velocity: tyre slip carries over). The robot needs its mass properties and
-tyres in its description (the catalog ``forklift`` has them).
+Lagrange model with tyres (:mod:`wmrkit.dynamics`) is integrated over the period by a
+:class:`~wmrkit.dynamics.simulate.Stepper` that carries the *full* state (pose, steering, wheel angles, every
+velocity: tyre slip carries over, and the integrator's own state). The robot needs its mass properties and tyres in
+its description (the catalog ``forklift`` has them).
+
+Per period the work outside the dynamics is a few microseconds: the per-wheel IK is the robot's compiled
+single-call kernel (:func:`wmrkit.kinematics.realtime.realtime`), the references are written into the stepper's
+held inputs (:meth:`~wmrkit.dynamics.simulate.Stepper.hold`), and the thesis's laws (8.1)-(8.3)/(8.53) have a
+scalar form, :func:`fast_law_controller` (the numbers of :func:`.loop.law_controller`, tested).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 
+from .laws import PositionLaw
 from .loop import TwistController
-from .points import ControlError
+from .points import ControlError, ControlPoint
+from .references import Reference
 
-__all__ = ["simulate_dynamics"]
+__all__ = ["fast_law_controller", "simulate_dynamics"]
+
+TWO_PI = 2.0 * math.pi
 
 
 def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *,
@@ -28,50 +39,100 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
     name (default: as described); `step` [s]: integration step of the dynamics (1 kHz default, semi-implicit).
     `feedback`: ``"pose"`` (the true pose is measured) or ``"odometry"`` (the pose estimated from the sensed joints,
     one exact SE(2) step per period, :func:`wmrkit.kinematics.realtime.realtime`); the estimate is returned as
-    ``estimate (n, 3)``.
+    ``estimate (n, 3)``. The same run as a plain loop of ``controller``, ``twist_program(model, [t], [twist])`` and
+    ``Stepper.advance(inputs, period)`` (tested), with the per-period work done in place.
     """
-    from ..dynamics import simulate as dsim
     from ..dynamics.model import DynamicModel
     from ..dynamics.programs import twist_program
-
+    from ..dynamics.simulate import Stepper, initial_state
     if not (math.isfinite(period) and period >= step > 0):
         raise ControlError(f"period: expected a control period >= the dynamics step {step} s, got {period}")
     if feedback not in ("pose", "odometry"):
         raise ControlError(f"feedback must be 'pose' or 'odometry', got {feedback!r}")
+    if delay < 0:
+        raise ControlError(f"delay: expected a number of samples >= 0, got {delay}")
     model = DynamicModel.of(robot, tyre)
-    n_steps = max(1, round(period / step))
-    s = dsim.initial_state(model, (0.0, 0.0, 0.0), initial_pose)
-    steer = list(model.steer_columns)
+    held = max(1, round(period / step)) * step
+    stepper = Stepper(model, initial_state(model, (0.0, 0.0, 0.0), initial_pose), step=step)
+    stepper.advance(twist_program(model, [0.0], [(0.0, 0.0, 0.0)]), 0.0)  # the servo gains; references below
+    s, steer = stepper.state, list(model.steer_columns)
+    ik = _realtime(robot).ik
+    described = np.array(robot.heading, dtype=float)
+    rate_reference, heading = np.zeros(model.n), np.zeros(len(described))
+    rates = rate_reference[3:3 + len(robot.rate_names)]  # the IK writes the references in place
+    delta = np.array([w.delta for w in robot.wheels if w.kind.steers], dtype=float)
     n = math.floor(duration / period + 1e-9) + 1
     history, integral = [s[:3].copy()], np.zeros(3)
     odometer = _Odometer(robot, model, s) if feedback == "odometry" else None
-    keys = ("t", "pose", "twist", "beta", "target", "estimate")
-    records: dict[str, list] = {k: [] for k in keys}
+    out = {key: [] for key in ("t", "pose", "twist", "beta", "target", "estimate")}
     for k in range(n):
         t = k * period
         twist, de = controller(t, history[max(0, k - delay)], integral)
         integral = integral + period * de
-        inputs = twist_program(model, [0.0, period], [twist, twist])
-        target = np.asarray(robot.beta_of_heading(inputs.heading_reference[0]), dtype=float)
-        values = (t, s[:3].copy(), np.asarray(twist, float), s[steer].copy(), target, history[-1].copy())
-        for key, value in zip(keys, values, strict=True):
-            records[key].append(value)
+        ik(float(twist[0]), float(twist[1]), float(twist[2]), described, rates, heading)  # = wheel_commands(twist)
+        stepper.hold(rate_reference, heading)
+        out["t"].append(t)
+        out["pose"].append(s[:3].copy())
+        out["twist"].append(np.asarray(twist, dtype=float))
+        out["beta"].append(s[steer])
+        out["target"].append(heading - delta + 0.5 * math.pi)  # Robot.beta_of_heading
+        out["estimate"].append(history[-1].copy())
         if k == n - 1:
             break
-        rec, _ = dsim._fixed(model, s, dsim._compiled_inputs(model, inputs), n_steps * step, step, n_steps, 0,
-                             False, 20)
-        s = np.array(rec[1][-1], dtype=float)
+        stepper.advance(None, held)  # a WmrkitError if the dynamics diverge
         history.append(s[:3].copy() if odometer is None else odometer.step(s))
-    return {key: np.array(values) for key, values in records.items()}
+    return {key: np.array(values) for key, values in out.items()}
+
+
+def fast_law_controller(cp: ControlPoint, law: PositionLaw, reference: Reference) -> TwistController:
+    """:func:`.loop.law_controller` in scalar arithmetic (a few µs a call instead of tens): the same twist and
+    error for the laws (8.1)-(8.3) with the gate (8.53), full or reduced control point."""
+    px, py = float(cp.point[0]), float(cp.point[1])
+    reduced, kind = bool(cp.reduced), law.kind
+    (a0, a1, a2), (b0, b1, b2) = law.a, law.b
+    gate = law.gate
+    g = np.asarray(cp.gain, dtype=float) if cp.reduced else np.zeros((3, 2))
+    g00, g01, g10, g11, g20, g21 = (float(v) for v in g.ravel())
+
+    def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        ref, vel = reference.at(t)
+        x, y, th = float(pose[0]), float(pose[1]), float(pose[2])
+        c, s = math.cos(th), math.sin(th)
+        mx, my = x + c * px - s * py, y + s * px + c * py  # point_pose
+        r2, v2 = (th, 0.0) if reduced else (float(ref[2]), float(vel[2]))
+        e0, e1 = float(ref[0]) - mx, float(ref[1]) - my
+        e2 = r2 - th
+        e2 -= TWO_PI * round(e2 / TWO_PI)  # wrap_angle: (-pi, pi]
+        e2 = e2 + TWO_PI if e2 <= -math.pi else (e2 - TWO_PI if e2 > math.pi else e2)
+        u0, u1, u2 = a0 * e0, a1 * e1, a2 * e2  # law_velocity
+        if kind != "point":
+            ff = 0.0 if gate is not None and math.hypot(e0, e1) > gate else 1.0
+            u0, u1, u2 = u0 + ff * float(vel[0]), u1 + ff * float(vel[1]), u2 + ff * v2
+        if kind == "pi":
+            u0, u1, u2 = u0 + b0 * float(integral[0]), u1 + b1 * float(integral[1]), u2 + b2 * float(integral[2])
+        vr0, vr1 = c * u0 + s * u1, -s * u0 + c * u1  # twist_for_velocity
+        if reduced:
+            twist = np.array([g00 * vr0 + g01 * vr1, g10 * vr0 + g11 * vr1, g20 * vr0 + g21 * vr1])
+        else:
+            twist = np.array([vr0, vr1, u2])
+        return twist, np.array([e0, e1, e2])
+
+    return control
+
+
+@functools.lru_cache(maxsize=16)
+def _realtime(robot):
+    """The robot's compiled single-call kinematics, compiled once per robot and process."""
+    from ..kinematics.realtime import realtime
+
+    return realtime(robot)
 
 
 class _Odometer:
     """Odometry from the sensed joints of the simulated state (the robot's compiled single-call step)."""
 
     def __init__(self, robot, model, s: np.ndarray) -> None:
-        from ..kinematics.realtime import realtime
-
-        self.rt = realtime(robot)
+        self.rt = _realtime(robot)
         self.cols = [model.names.index(j) for j in self.rt.rate_joints]
         self.steer = [model.steer_columns[robot.steer_names.index(j.partition(".")[0])] for j in self.rt.steer_joints]
         self.delta = np.array([robot.wheel(j.partition(".")[0]).delta for j in self.rt.steer_joints], dtype=float)

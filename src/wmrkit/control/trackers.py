@@ -82,10 +82,9 @@ class PathIndex:
     def cross_track(self, points: np.ndarray) -> np.ndarray:
         """Distance [m] from each of `points` ``(n, 2)`` to the path polyline (the segments either side of the
         nearest sample). ``-> (n,)``."""
-        near = np.empty(len(points), dtype=int)
-        for k in range(0, len(points), 256):
-            d = np.sum((points[k:k + 256, None, :] - self.xy[None, :, :]) ** 2, axis=-1)
-            near[k:k + 256] = np.argmin(d, axis=1)
+        from scipy.spatial import cKDTree
+
+        near = cKDTree(self.xy).query(points)[1]
         best = np.full(len(points), np.inf)
         for shift in (-1, 0):
             j = np.clip(near + shift, 0, len(self.xy) - 2)

@@ -6,15 +6,29 @@ Inputs ``inp``: ``(tk (K,), tau (K, n), rate_ref (K, n), rate_gain (n,), tau_max
 kd (S,))``, linear in time between the knots ``tk``, held outside them: feed-forward torques, wheel-rate servos
 ``tau += rate_gain (rate_ref - rate)`` saturated at ``tau_max``, steering servos ``kp wrap(beta_ref - beta) - kd
 beta_dot``.
+
+Speed (issue 10): every kernel of a step is inlined into :func:`run_semi_implicit`, which is compiled without numba's
+reference counting (nothing in it allocates); a record reuses the assembly of the step that starts at its time.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 
-from ._kernels import _inline, _njit, bias, contact_forces, mass_matrix, normal_loads, slip_matrix, solve
+from ._kernels import (
+    _inline,
+    _njit,
+    bias,
+    contact_forces,
+    mass_matrix,
+    normal_loads,
+    slip_matrix,
+    solve,
+    solve_in_place,
+)
 
 
 @_inline
@@ -33,7 +47,7 @@ def _interp(values, k, k1, w, out):
         out[j] = (1 - w) * values[k, j] + w * values[k1, j]
 
 
-@_njit
+@_inline
 def assemble(t, s, acc, pack, inp, jac, w):
     """Everything at state `s`, time `t`, into the work arrays `w` (see :func:`work_arrays`); returns nothing.
 
@@ -49,7 +63,10 @@ def assemble(t, s, acc, pack, inp, jac, w):
         beta[k], beta_rate[k] = s[steer_col[k]], nu[steer_col[k]]
     filled = w[15][0] == 1.0
     slip_matrix(beta, pack, n, a, filled)
-    if not filled or np.any(pack[6] == 1):  # without castor units M does not depend on the configuration
+    castors = False
+    for k in range(steer_col.shape[0]):
+        castors = castors or pack[6][k] == 1
+    if not filled or castors:  # without castor units M does not depend on the configuration
         mass_matrix(beta, pack, n, m, dm)
     w[15][0] = 1.0
     normal_loads(beta, nu, acc, pack, fz)
@@ -87,7 +104,8 @@ def work_arrays(n: int, n_el: int, n_steer: int) -> tuple:
     """Scratch arrays of :func:`assemble`."""
     return (np.zeros((2 * n_el, n)), np.zeros((n, n)), np.zeros((n_steer, n, n)), np.zeros(n_el),
             np.zeros((n_el, 2)), np.zeros((n_el, 2, 2)), np.zeros(n_el), np.zeros(n), np.zeros(n), np.zeros(n),
-            np.zeros(n_steer), np.zeros(n_steer), np.zeros(n), np.zeros(n_steer), np.zeros((n, n)), np.zeros(1))
+            np.zeros(n_steer), np.zeros(n_steer), np.zeros(n), np.zeros(n_steer), np.zeros((n, n)),
+            np.zeros(1))
 
 
 @_njit
@@ -105,16 +123,24 @@ def derivative(t, s, acc, pack, inp, w):
     return out
 
 
-@_njit
+@_inline
 def step_semi_implicit(t, s, dt, acc, pack, inp, w, jac):
     """One linearly implicit Euler step: friction and servo Jacobians implicit, then positions with the new velocity.
 
     The tyre Jacobian ``dF/dv_slip`` is refreshed when `jac` is true and reused otherwise (a W-method).
     """
     assemble(t, s, acc, pack, inp, jac, w)
+    _update_semi_implicit(s, dt, acc, w)
+
+
+@_inline
+def _update_semi_implicit(s, dt, acc, w):
+    """The update of :func:`step_semi_implicit` from the assembled work arrays `w`."""
     a, m, g, kdiag, rhs, mat = w[0], w[1], w[5], w[8], w[9], w[14]
     n = rhs.shape[0]
-    mat[:] = m
+    for i in range(n):
+        for j in range(n):
+            mat[i, j] = m[i, j]
     for e in range(g.shape[0]):  # mat = M - dt (A' G A + servo terms)
         for i in range(n):
             a0, a1 = a[2 * e, i], a[2 * e + 1, i]
@@ -128,7 +154,8 @@ def step_semi_implicit(t, s, dt, acc, pack, inp, w, jac):
                 mat[i, j] -= dt * (g00 * b0 + g01 * b1)
     for c in range(n):
         mat[c, c] -= dt * kdiag[c]
-    dnu = solve(mat, rhs)  # (M - dt K) dnu/dt = rhs
+    solve_in_place(mat, rhs)  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt
+    dnu = rhs
     for c in range(n):
         acc[c] = dnu[c]
         s[n + c] += dt * dnu[c]
@@ -149,38 +176,77 @@ def step_rk4(t, s, dt, acc, pack, inp, w):
     s += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
+@_inline
+def _observe(t, s, acc, pack, inp, w, rec, i):
+    assemble(t, s, acc, pack, inp, False, w)
+    _store(t, s, w, rec, i)
+
+
+@_inline
+def _store(t, s, w, rec, i):
+    """Row `i` of the records from the state `s` at time `t` and its assembly `w`."""
+    r_t, r_s, r_f, r_fz, r_v, r_vw, r_tau = rec
+    a, n = w[0], w[9].shape[0]
+    r_t[i] = t
+    for c in range(2 * n):
+        r_s[i, c] = s[c]
+    for c in range(n):
+        r_tau[i, c] = w[7][c]
+    for e in range(r_v.shape[1]):
+        r_fz[i, e], r_vw[i, e] = w[3][e], w[6][e]
+        for k in range(2):
+            v = 0.0
+            for c in range(n):
+                v += a[2 * e + k, c] * s[n + c]
+            r_v[i, e, k], r_f[i, e, k] = v, w[4][e, k]
+
+
 @_njit
 def observe(t, s, acc, pack, inp, w, rec, i):
     """Store the state's outputs in the record arrays ``rec`` at row `i`."""
-    assemble(t, s, acc, pack, inp, False, w)
-    r_t, r_s, r_f, r_fz, r_v, r_vw, r_tau = rec
-    r_t[i] = t
-    r_s[i] = s
-    r_f[i] = w[4]
-    r_fz[i] = w[3]
-    n = w[9].shape[0]
-    for e in range(r_v.shape[1]):
-        for k in range(2):
-            r_v[i, e, k] = np.dot(w[0][2 * e + k], s[n:])
-    r_vw[i] = w[6]
-    r_tau[i] = w[7]
+    _observe(t, s, acc, pack, inp, w, rec, i)
 
 
-@_njit
-def run(s, k0, dt, n_steps, every, method, jac_every, acc, pack, inp, w, rec, i0):
-    """`n_steps` fixed steps from `s` (changed in place) at step `k0` (``t = k0 dt``); a record every `every` steps
-    from row `i0`. Running in chunks gives the same result as one run.
-
-    `method` 0: semi-implicit, refreshing the tyre Jacobian every `jac_every` steps; 1: RK4.
+@functools.partial(_njit, nrt=False)
+def run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0):
+    """`n_steps` semi-implicit steps (:func:`step_semi_implicit`) from `s` (changed in place) at step `k0`
+    (``t = k0 dt``), refreshing the tyre Jacobian at the steps ``k = jac_phase (mod jac_every)``; a record every
+    `every` steps from row `i0`; returns the next row. Compiled without reference counting (it allocates nothing).
     """
     i = i0
     for j in range(n_steps):
         k = k0 + j
-        if method == 0:
-            step_semi_implicit(k * dt, s, dt, acc, pack, inp, w, k % jac_every == 0)
-        else:
-            step_rk4(k * dt, s, dt, acc, pack, inp, w)
+        assemble(k * dt, s, acc, pack, inp, (k - jac_phase) % jac_every == 0, w)
+        if j > 0 and k % every == 0 and i < rec[0].shape[0]:  # the step's assembly is the record at t = k dt
+            _store(k * dt, s, w, rec, i)
+            i += 1
+        _update_semi_implicit(s, dt, acc, w)
+    k = k0 + n_steps
+    if n_steps > 0 and k % every == 0 and i < rec[0].shape[0]:
+        _observe(k * dt, s, acc, pack, inp, w, rec, i)
+        i += 1
+    return i
+
+
+@_njit
+def run_rk4(s, k0, dt, n_steps, every, acc, pack, inp, w, rec, i0):
+    """`n_steps` RK4 steps from `s` (changed in place) at step `k0`; records as :func:`run_semi_implicit`."""
+    i = i0
+    for j in range(n_steps):
+        k = k0 + j
+        step_rk4(k * dt, s, dt, acc, pack, inp, w)
         if (k + 1) % every == 0 and i < rec[0].shape[0]:
-            observe((k + 1) * dt, s, acc, pack, inp, w, rec, i)
+            _observe((k + 1) * dt, s, acc, pack, inp, w, rec, i)
             i += 1
     return i
+
+
+def run(s, k0, dt, n_steps, every, method, jac_every, acc, pack, inp, w, rec, i0, jac_phase=0):
+    """`n_steps` fixed steps from `s` (changed in place) at step `k0` (``t = k0 dt``); a record every `every` steps
+    from row `i0`. Running in chunks gives the same result as one run.
+
+    `method` 0: semi-implicit, refreshing the tyre Jacobian every `jac_every` steps (from step `jac_phase`); 1: RK4.
+    """
+    if method == 0:
+        return run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0)
+    return run_rk4(s, k0, dt, n_steps, every, acc, pack, inp, w, rec, i0)

@@ -23,7 +23,6 @@ import types
 from pathlib import Path
 
 import numba
-import numpy as np
 
 from .._jit import compile_cached
 from ..wheels import __file__ as wheels_file
@@ -57,15 +56,17 @@ def _inline(fn):
         return numba.njit(inline="always", fastmath=True)(fn)
 
 
-def _njit(fn, fastmath: bool = True):
+def _njit(fn, fastmath: bool = True, nrt: bool = True):
     """Compiled for the types of its first call, cached on disk where possible (:func:`wmrkit._jit.compile_cached`);
-    `fastmath`: no NaN or infinity reaches the kernels (the simulator checks the state between chunks)."""
+    `fastmath`: no NaN or infinity reaches the kernels (the simulator checks the state between chunks). ``nrt=False``
+    compiles without numba's reference counting: for the time-stepping loops, which allocate nothing and would
+    otherwise count references to every model and work array at every step (half the cost of a step)."""
     if not fastmath:
         return compile_cached(fn, None)
     try:
-        return numba.njit(cache=True, fastmath=True)(fn)
+        return numba.njit(cache=True, fastmath=True, _nrt=nrt)(fn)
     except RuntimeError:  # no writable cache location
-        return numba.njit(fastmath=True)(fn)
+        return numba.njit(fastmath=True, _nrt=nrt)(fn)
 
 
 def _identity(x):
@@ -106,14 +107,6 @@ def tyre(code, p, fz, vl, vg, vw, vr):
     if code == 2:
         return _dugoff(p[0], p[1], p[2], p[3], fz, vl, vg, vw, vr)
     return _pacejka(p[0], p[1], p[2], p[3], fz, vl, vg, vw, vr)
-
-
-@_njit
-def element_angles(beta, el, el_steer, out):
-    """Absolute angle of each element's steering frame into `out` ``(E,)``."""
-    for e in range(el.shape[0]):
-        out[e] = el[e, 7] + (beta[el_steer[e]] if el_steer[e] >= 0 else 0.0)
-    return out
 
 
 @_inline
@@ -161,15 +154,14 @@ def mass_matrix(beta, pack, n, m, dm):
         m[2, 2] += i_s  # castor unit: I_cs (b' + w)^2 / 2 and M_c |v_cm|^2 / 2, CM at the wheel centre (7.18)
         ll, al, d, b = steer_prm[k, 2], steer_prm[k, 3], steer_prm[k, 4], beta[k]
         px, py = ll * math.cos(al) - d * math.sin(b), ll * math.sin(al) + d * math.cos(b)
-        jx, jy, djx, djy = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-        jx[0], jx[2], jx[c] = 1.0, -py, -d * math.cos(b)
-        jy[1], jy[2], jy[c] = 1.0, px, -d * math.sin(b)
-        djx[2], djx[c] = d * math.sin(b), d * math.sin(b)
-        djy[2], djy[c] = -d * math.cos(b), -d * math.cos(b)
-        for i in range(n):
-            for j in range(n):
-                m[i, j] += ms * (jx[i] * jx[j] + jy[i] * jy[j])
-                dm[k, i, j] += ms * (djx[i] * jx[j] + jx[i] * djx[j] + djy[i] * jy[j] + jy[i] * djy[j])
+        # the wheel centre's velocity rows over the columns (0, 1, 2, c), and their derivatives along beta
+        cols = (0, 1, 2, c)
+        jx, jy = (1.0, 0.0, -py, -d * math.cos(b)), (0.0, 1.0, px, -d * math.sin(b))
+        djx, djy = (0.0, 0.0, d * math.sin(b), d * math.sin(b)), (0.0, 0.0, -d * math.cos(b), -d * math.cos(b))
+        for i in range(4):
+            for j in range(4):
+                m[cols[i], cols[j]] += ms * (jx[i] * jx[j] + jy[i] * jy[j])
+                dm[k, cols[i], cols[j]] += ms * (djx[i] * jx[j] + jx[i] * djx[j] + djy[i] * jy[j] + jy[i] * djy[j])
 
 
 @_inline
@@ -248,27 +240,57 @@ def normal_loads(beta, nu, acc, pack, out):
             spin_acc += rate_map[e, 1, c] * acc[3 + c]
             roll_acc += rate_map[e, 2, c] * acc[3 + c]
         t_l, t_e = be_e + el[e, 3], be_e + el[e, 3] + el[e, 4]
-        hx += el[e, 8] * spin_acc * math.cos(t_l) + el[e, 9] * roll_acc * math.cos(t_e)
-        hy += el[e, 8] * spin_acc * math.sin(t_l) + el[e, 9] * roll_acc * math.sin(t_e)
+        if el[e, 9] != 0.0:  # a roller's inertia
+            hx += el[e, 8] * spin_acc * math.cos(t_l) + el[e, 9] * roll_acc * math.cos(t_e)
+            hy += el[e, 8] * spin_acc * math.sin(t_l) + el[e, 9] * roll_acc * math.sin(t_e)
+        else:
+            hx += el[e, 8] * spin_acc * math.cos(t_l)
+            hy += el[e, 8] * spin_acc * math.sin(t_l)
     r0, r1, r2 = mt * grav, -h * mt * ax - hy, -h * mt * ay + hx
     if fixed[0] == 1:
-        p = pinv
-    else:
-        gm = np.ones((3, el.shape[0]))
-        be = element_angles(beta, el, el_steer, np.empty(el.shape[0]))
         for e in range(el.shape[0]):
-            gm[1, e] = el[e, 0] * math.cos(el[e, 1]) - el[e, 2] * math.sin(be[e]) - gx
-            gm[2, e] = el[e, 0] * math.sin(el[e, 1]) + el[e, 2] * math.cos(be[e]) - gy
-        p = np.linalg.pinv(gm)
+            out[e] = max(pinv[e, 0] * r0 + pinv[e, 1] * r1 + pinv[e, 2] * r2, 0.0)
+        return
+    # contacts that move with the steering (castors): the least-norm loads G' (G G')^-1 r, G = rows (1, dx, dy)
+    s00, s01, s02, s11, s12, s22 = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     for e in range(el.shape[0]):
-        out[e] = max(p[e, 0] * r0 + p[e, 1] * r1 + p[e, 2] * r2, 0.0)
+        dx, dy = _contact_offset(beta, el, el_steer, e, gx, gy)
+        s00, s01, s02, s11, s12, s22 = s00 + 1.0, s01 + dx, s02 + dy, s11 + dx * dx, s12 + dx * dy, s22 + dy * dy
+    c00, c01, c02 = s11 * s22 - s12 * s12, s02 * s12 - s01 * s22, s01 * s12 - s02 * s11
+    det = s00 * c00 + s01 * c01 + s02 * c02
+    if abs(det) <= 1e-12 * (s00 * s11 * s22 + 1e-300):  # contacts on a line: the moment about it is not carried
+        y0, y1, y2 = r0 / s00, 0.0, 0.0
+    else:
+        c11, c12, c22 = s00 * s22 - s02 * s02, s01 * s02 - s00 * s12, s00 * s11 - s01 * s01
+        y0 = (c00 * r0 + c01 * r1 + c02 * r2) / det
+        y1 = (c01 * r0 + c11 * r1 + c12 * r2) / det
+        y2 = (c02 * r0 + c12 * r1 + c22 * r2) / det
+    for e in range(el.shape[0]):
+        dx, dy = _contact_offset(beta, el, el_steer, e, gx, gy)
+        out[e] = max(y0 + dx * y1 + dy * y2, 0.0)
+
+
+@_inline
+def _contact_offset(beta, el, el_steer, e, gx, gy):
+    """Position of contact `e` relative to the centre of mass ``(gx, gy)`` (body axes)."""
+    be = el[e, 7] + (beta[el_steer[e]] if el_steer[e] >= 0 else 0.0)
+    return (el[e, 0] * math.cos(el[e, 1]) - el[e, 2] * math.sin(be) - gx,
+            el[e, 0] * math.sin(el[e, 1]) + el[e, 2] * math.cos(be) - gy)
 
 
 @_njit
 def solve(mat, rhs):
-    """Gaussian elimination with partial pivoting (small dense systems; no LAPACK call overhead)."""
-    n = rhs.shape[0]
-    a, x = mat.copy(), rhs.copy()
+    """``mat^-1 rhs`` by :func:`solve_in_place` on copies."""
+    x = rhs.copy()
+    solve_in_place(mat.copy(), x)
+    return x
+
+
+@_inline
+def solve_in_place(a, x):
+    """Gaussian elimination with partial pivoting (small dense systems; no LAPACK call overhead): `x` becomes
+    ``a^-1 x``; `a` is overwritten."""
+    n = x.shape[0]
     for i in range(n):
         p = i
         for r in range(i + 1, n):
@@ -290,4 +312,3 @@ def solve(mat, rhs):
         for c in range(i + 1, n):
             s -= a[i, c] * x[c]
         x[i] = s / a[i, i]
-    return x

@@ -4,6 +4,7 @@
 linearly implicit Euler, stable with stiff tyres at a 1 kHz step; ``"rk4"``) or adaptively (``"adaptive"``:
 scipy's LSODA), compiled with numba, with a ``tqdm`` bar on long runs. Inputs are an :class:`Inputs` value
 (see :mod:`.programs` for CSV torque files and built-in programs); the result is a frozen :class:`Simulation`.
+:class:`Stepper` (and the pure :func:`advance`) continue a run from its full state with new inputs: closed loops.
 """
 
 from __future__ import annotations
@@ -138,6 +139,114 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
         rec, info = _fixed(model, s0, inp, duration, step, every, 0 if method == "semi-implicit" else 1, progress,
                            jac_every)
     return _result(model, rec, method, step, info)
+
+
+class Stepper:
+    """A running fixed-step simulation that continues from its full state with new inputs (closed loops).
+
+    `state` ``(2n,)``: pose ``(x, y, theta)``, the joint positions of the columns ``model.names[3:]``, then the
+    velocities ``nu (n,)`` (default :func:`initial_state`, at rest); a float64 C-contiguous array is used in place
+    (caller-owned), anything else is copied. :meth:`advance` integrates with the semi-implicit method (or ``"rk4"``)
+    at `step` [s] from time `t` [s]. The stepper carries all the integrator carries (the last acceleration for the
+    load transfer, the tyre Jacobian and its refresh phase): advancing in pieces gives, bit for bit, the run of one
+    :func:`simulate` call.
+    """
+
+    def __init__(self, model: Robot | DynamicModel, state: ArrayLike | None = None, *, step: float = 1e-3,
+                 method: Literal["semi-implicit", "rk4"] = "semi-implicit", jac_every: int = 20, t: float = 0.0,
+                 tyre: Tyre | str | None = None) -> None:
+        from ._integrate import work_arrays
+
+        self.model = model if isinstance(model, DynamicModel) else DynamicModel.of(model, tyre)
+        if method not in ("semi-implicit", "rk4"):
+            raise WmrkitError(f"unknown stepping method '{method}' (methods: semi-implicit, rk4)")
+        if not (math.isfinite(step) and step > 0 and math.isfinite(t)):
+            raise WmrkitError(f"step must be finite and > 0 and t finite, got {step}, {t}")
+        if not (isinstance(jac_every, int) and jac_every >= 1):
+            raise WmrkitError(f"jac_every must be an integer >= 1, got {jac_every!r}")
+        n = self.model.n
+        if state is None:
+            state = initial_state(self.model)
+        elif not (isinstance(state, np.ndarray) and state.dtype == np.float64 and state.flags.c_contiguous
+                  and state.flags.writeable and state.shape == (2 * n,)):
+            state = np.array(as_vectors(state, 2 * n, "state"), dtype=float)
+        if not np.all(np.isfinite(state)):
+            raise WmrkitError("state: every entry must be finite")
+        self.state: np.ndarray = state
+        self.step, self.jac_every = float(step), jac_every
+        self._method = 0 if method == "semi-implicit" else 1
+        self._k = round(t / step)
+        self._phase = self._k  # the tyre Jacobian is refreshed at the first step, then every jac_every steps
+        self._acc = np.zeros(n)
+        self._w = work_arrays(n, len(self.model.contacts), len(self.model.steer_columns))
+        self._rec = _records(self.model, 0)
+        self._inputs: tuple | None = None
+        self._delta = np.array([w.delta for w in self.model.robot.wheels if w.kind.steers], dtype=float)
+
+    @property
+    def t(self) -> float:
+        """Simulation time [s] of :attr:`state`."""
+        return self._k * self.step
+
+    def advance(self, inputs: Inputs | None, duration: float) -> np.ndarray:
+        """Integrate ``round(duration / step)`` steps with `inputs` (time axis: the simulation time; None: the
+        last ones); changes :attr:`state` in place and returns it."""
+        from ._integrate import run
+
+        if inputs is not None:
+            self._inputs = _compiled_inputs(self.model, inputs)
+        if self._inputs is None:
+            raise WmrkitError("advance: no inputs given yet")
+        n_steps = round(duration / self.step) if math.isfinite(duration) and duration >= 0 else -1
+        if n_steps < 0:
+            raise WmrkitError(f"duration must be finite and >= 0, got {duration}")
+        run(self.state, self._k, self.step, n_steps, 1 << 62, self._method, self.jac_every, self._acc,
+            self.model.pack, self._inputs, self._w, self._rec, 0, self._phase)
+        self._k += n_steps
+        if not math.isfinite(self.state.sum()):  # NaN and infinities propagate into the sum
+            raise WmrkitError(f"the simulation diverged before t = {self.t:.6g} s; use a smaller step")
+        return self.state
+
+    def hold(self, rate_reference: ArrayLike | None = None, heading_reference: ArrayLike | None = None,
+             torques: ArrayLike | None = None) -> None:
+        """Hold new joint references from now on (a controller's period): wheel-rate references ``(n,)`` [rad/s]
+        over ``model.names``, steering headings ``(n_steer,)`` [rad], feed-forward torques ``(n,)`` [N m]. Gains,
+        limits and the values not given are those of the last inputs at the current time (in place, a few µs)."""
+        if self._inputs is None:
+            raise WmrkitError("hold: give inputs (their servo gains) to advance() first")
+        tk, tau, rref, gain, limit, bref, kp, kd = self._inputs
+        if tk.shape[0] != 1:  # the values at the current time, held from now on
+            t = self.t
+            tau, rref, bref = (np.array([np.interp(t, tk, col) for col in a.T], dtype=float).reshape(1, a.shape[1])
+                               for a in (tau, rref, bref))
+            tk = np.array([t])
+            self._inputs = (tk, tau, rref, gain, limit, bref, kp, kd)
+        if rate_reference is not None:
+            rref[0] = _held(rate_reference, rref.shape[1], "rate_reference")
+        if torques is not None:
+            tau[0] = _held(torques, tau.shape[1], "torques")
+        if heading_reference is not None:  # the thesis's beta = heading - delta + pi/2, as Robot.beta_of_heading
+            row = bref[0]
+            np.subtract(_held(heading_reference, bref.shape[1], "heading_reference"), self._delta, out=row)
+            row += 0.5 * math.pi
+
+
+def _held(value: ArrayLike, size: int, name: str) -> np.ndarray:
+    value = np.asarray(value, dtype=float)
+    if value.shape != (size,):
+        raise WmrkitError(f"hold: {name} must be {size} numbers, got shape {value.shape}")
+    return value  # not checked for NaN here: a NaN reference makes the state NaN, which advance() reports
+
+
+def advance(model: Robot | DynamicModel, state: ArrayLike, inputs: Inputs, duration: float, *, step: float = 1e-3,
+            t: float = 0.0, method: Literal["semi-implicit", "rk4"] = "semi-implicit",
+            jac_every: int = 20) -> np.ndarray:
+    """The state ``(2n,)`` after `duration` [s] of `inputs` from the full `state` at time `t` (a new array; a fresh
+    integrator: ``Stepper(model, copy of state, t=t).advance(inputs, duration)``)."""
+    m = model if isinstance(model, DynamicModel) else DynamicModel.of(model)
+    stepper = Stepper(m, np.array(as_vectors(state, 2 * m.n, "state"), dtype=float), step=step, method=method,
+                      jac_every=jac_every, t=t)
+    return stepper.advance(inputs, duration)
 
 
 def initial_state(model: DynamicModel, twist: ArrayLike = (0, 0, 0), pose: ArrayLike = (0, 0, 0)) -> np.ndarray:
