@@ -25,18 +25,14 @@ COMMANDS = [
 
 def _log(directory: Path) -> Path:
     """A 30 s forklift log with units in its header (what examples/odometry_forklift_log.py writes)."""
-    import numpy as np
-
     from wmrkit import catalog
-    from wmrkit.odometry.logs import write_csv
-    from wmrkit.odometry.model import odometry_model
+    from wmrkit.odometry.logs import write_log
     from wmrkit.odometry.synthetic import TwistProfile, simulate
 
     robot = catalog.load("forklift")
-    joints = odometry_model(robot).joints
     run = simulate(robot, TwistProfile.from_segments([(30.0, 1.0, 0.0, 0.1)]).about((-1.0, 0.0)), 100.0)
     path = directory / "forklift.csv"
-    write_csv(path, ("time", *joints), np.column_stack([run.log.time, *(run.log.positions.T)]))
+    write_log(path, run.log, robot)
     return path
 
 

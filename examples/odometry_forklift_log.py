@@ -1,7 +1,8 @@
 """The forklift of thesis ch. 7 from raw encoder counts: a CSV log in, a TUM trajectory and a plot out.
 
 Its drive wheels have incremental encoders of 8290 pulses per revolution (here on 16-bit counters that wrap) and
-its steered wheel an absolute encoder of 1.4118 deg (thesis §7.5.1). A synthetic drive (an S-curve with stops to
+its steered wheel an absolute encoder of 1.4118 deg (thesis §7.5.1) reading the wheel's heading, 0 straight ahead,
+like every steering angle in a log (docs/conventions.md). A synthetic drive (an S-curve with stops to
 steer) is written as a counts log whose header gives the units (``right_drive.spin [counts:u16]``), then read back
 the way ``wmrkit odometry forklift LOG --out path.tum`` does. The steering quantisation makes the sensors slightly
 inconsistent: the slip indicator (least-squares residual, thesis (4.11)) shows it, and with equal weights the

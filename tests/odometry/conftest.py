@@ -10,10 +10,11 @@ from wmrkit.odometry.logs import write_csv
 from wmrkit.odometry.synthetic import SyntheticRun, TwistProfile, simulate
 
 
-def csv_of(path, run: SyntheticRun, names=None) -> str:
-    """Write the log of `run` as a CSV (time + joint angles) and return the path as a string."""
+def csv_of(path, run: SyntheticRun, names=None, robot=None) -> str:
+    """Write the log of `run` as a CSV (time + joint angles, steering as headings of `robot`'s wheels) and return
+    the path as a string."""
     names = names or ("time", *run.log.joints)
-    write_csv(path, names, np.column_stack([run.log.time, run.log.positions]))
+    write_csv(path, names, np.column_stack([run.log.time, run.log.heading_positions(robot)]))
     return str(path)
 
 

@@ -87,7 +87,7 @@ def test_forklift_counts_log_uses_the_catalog_encoders(capsys, tmp_path):
                           "--time-column", "stamp", "--cpr", "8290", "--steer-resolution", "1.4118 deg",
                           "--column", "right_drive.spin=enc_r", "--column", "left_drive.spin=enc_l",
                           "--column", "steer.steer=steer_raw"])
-    assert out2["pose"] != out["pose"]  # no offset given: straight ahead reads as 0 deg, not 90 deg
+    assert out2["pose"] == out["pose"]  # one rule: every steering encoder reads 0 straight ahead, catalog or not
     out3 = _json(capsys, ["odometry", "forklift", str(path), "--json", "--spin", "counts", "--steer", "counts",
                           "--time-column", "stamp", "--weight", "steer=0.01", "--column", "right_drive.spin=enc_r",
                           "--column", "left_drive.spin=enc_l", "--column", "steer.steer=steer_raw"])
@@ -153,8 +153,8 @@ def _forklift_log(tmp_path, *, steer_scale: float = 1.0, header=lambda j: j):
     robot = catalog.load("forklift")
     joints = ("right_drive.spin", "left_drive.spin", "steer.steer")
     run = simulate(robot, TwistProfile.from_segments([(6.0, 1.0, 0.0, 0.15)]).about((-1.0, 0.0)), 50.0)
-    cols = [run.log.positions[:, run.log.joints.index(j)] * (steer_scale if j.endswith(".steer") else 1.0)
-            for j in joints]
+    headings = run.log.heading_positions(robot)  # what a log file holds: steering as headings
+    cols = [headings[:, run.log.joints.index(j)] * (steer_scale if j.endswith(".steer") else 1.0) for j in joints]
     path = tmp_path / "forklift.csv"
     write_csv(path, ("time", *map(header, joints)), np.column_stack([run.log.time, *cols]))
     return path
@@ -190,4 +190,8 @@ def test_degrees_written_as_radians_warn_and_say_inconsistent(capsys, tmp_path):
     out, err = capsys.readouterr()
     assert json.loads(out)["consistent"] is False
     assert err.startswith("wmrkit: warning: the sensed joints contradict each other") and err.count("\n") == 1
-    assert "slip per wheel: steer" in err  # the steering wheel, whose column is wrong, slips most
+    # the wheels named with their RMS slip, largest first (which one is largest depends on the wrong angle read)
+    listed = __import__("re").search(r"slip per wheel: ([^)]*)\)", err).group(1).split(", ")
+    slips = [float(item.split()[1]) for item in listed]
+    assert sorted(item.split()[0] for item in listed) == ["left_drive", "right_drive", "steer"]
+    assert slips == sorted(slips, reverse=True) and slips[0] > 0

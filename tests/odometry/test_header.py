@@ -15,6 +15,15 @@ def test_units_are_read():
     assert not parse_header_units(["time", "a.spin"]).declared
 
 
+def test_steering_units_and_conventions():
+    """Steering in degrees; ``[deg:beta]`` marks a file in the thesis's β (older wmrkit), ``:heading`` the default."""
+    u = parse_header_units(["time", "a.spin [rad]", "s.steer [deg:beta]", "t.steer [deg:beta]"])
+    assert (u.steer, u.steer_convention, dict(u.columns)["s.steer"]) == ("degrees", "beta", "s.steer [deg:beta]")
+    assert parse_header_units(["s.steer [counts:heading]"]).steer_convention == "heading"
+    plain = parse_header_units(["s.steer [rad]"])
+    assert (plain.steer, plain.steer_convention) == ("angle", None)  # a unit alone says no convention
+
+
 @pytest.mark.parametrize(("names", "message"), [
     (["a.spin [deg]"], "unknown unit 'deg'"),
     (["a.spin [rad]", "b.spin [counts]"], "mix units"),
@@ -22,6 +31,10 @@ def test_units_are_read():
     (["a.spin [counts:u99]"], "counter width 99"),
     (["time [h]"], "time units"),
     (["a.steer [rad/s]"], "for a steer joint"),
+    (["a.steer [grad]"], r"for a steer joint: rad, deg, counts; files in the thesis's beta: deg:beta"),
+    (["a.spin [rad:beta]"], "only steer columns have one"),
+    (["a.steer [deg:beta]", "b.steer [deg:heading]"], "mix conventions"),
+    (["a.steer [deg:alpha]"], "unknown unit 'deg:alpha'"),
 ])
 def test_bad_units_name_the_column(names, message):
     with pytest.raises(HeaderError, match=message):

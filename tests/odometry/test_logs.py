@@ -64,7 +64,7 @@ def test_counts_with_a_wrapping_16_bit_counter(tmp_path):
     path = str(tmp_path / "counts.csv")
     write_csv(path, ("time", *joints), np.column_stack([run.log.time, counts]), fmt="%.10g")
     fmt = LogFormat(spin="counts", steer="counts", encoders=tuple(enc.items()))
-    log = load_csv(path, joints, fmt)
+    log = load_csv(path, joints, fmt, robot=robot)
     np.testing.assert_allclose(log.positions[:, :2], run.log.positions[:, :2] - run.log.positions[0, :2],
                                rtol=0, atol=1e-9)
     np.testing.assert_allclose(log.positions[:, 2], run.log.positions[:, 2], atol=1e-12)

@@ -9,7 +9,7 @@ import pytest
 
 from wmrkit import catalog
 from wmrkit.cli.main import main
-from wmrkit.odometry.logs import JointLog, write_csv
+from wmrkit.odometry.logs import JointLog, write_log
 from wmrkit.odometry.pipeline import odometry
 from wmrkit.odometry.synthetic import TwistProfile, simulate
 from wmrkit.slip.estimators import estimator
@@ -60,7 +60,7 @@ def test_filters_stream_in_chunks_and_track_slip_free_motion(forklift_run):
 def test_cli_methods(tmp_path, forklift_run):
     log = forklift_run.log
     path = tmp_path / "log.csv"
-    write_csv(path, ("time", *log.joints), np.column_stack([log.time, log.positions]))
+    write_log(path, log, catalog.load("forklift"))
     out = {}
     for method in ("exact", "wls", "fk1", "fk2"):
         assert main(["odometry", "forklift", str(path), "--method", method, "--json", "--mu", "steer=0.01,1",
@@ -82,7 +82,7 @@ def test_cli_methods(tmp_path, forklift_run):
 def test_cli_refuses_bad_estimator_options(tmp_path, capsys, forklift_run):
     log = forklift_run.log
     path = tmp_path / "log.csv"
-    write_csv(path, ("time", *log.joints), np.column_stack([log.time, log.positions]))
+    write_log(path, log, catalog.load("forklift"))
     for extra, message in ((["--method", "wls", "--mu", "steer=0,1"], "> 0"),
                            (["--method", "wls", "--mu", "nope=1,1"], "lacks"),
                            (["--method", "fk2", "--kf-noise", "1", "-1", "1"], "> 0"),

@@ -18,8 +18,9 @@ ESTIMATOR_METHODS = ("wls", "fk1", "fk2")
 def add_estimator_options(p: argparse.ArgumentParser) -> None:
     """Options of ``odometry --method wls|fk1|fk2``."""
     g = p.add_argument_group("slip-aware estimators (--method wls|fk1|fk2, thesis §7.4-7.5)")
-    g.add_argument("--scheme", choices=("exact", "rk2", "euler", "paper002"), default="exact",
-                   help="integration scheme of the estimated twists (default: exact)")
+    g.add_argument("--scheme", choices=("exact", "rk2", "euler", "paper002"),
+                   help="integration scheme of the estimated twists (default: the description's odometry.scheme, "
+                        "else exact)")
     g.add_argument("--mu", action="append", metavar="WHEEL=LAT,LONG", default=[],
                    help="WLS: friction coefficients of a wheel, lateral and longitudinal (only ratios matter; "
                         "default 1,1; repeat)")
@@ -45,12 +46,25 @@ def _pair(text: str, what: str) -> tuple[float, float]:
     return a, b
 
 
-def weights_from_args(args: argparse.Namespace):
-    """The WLS friction coefficients of the command line (``--slip-weights`` file, then ``--mu`` options)."""
+def resolve_method(args: argparse.Namespace):
+    """Fill ``args.method`` and ``args.scheme`` from the description's ``odometry`` block where the command line
+    left them out (then ``exact``); returns the description's :class:`~wmrkit.slip.settings.OdometrySettings`."""
+    from ..slip.settings import odometry_settings
+
+    settings = odometry_settings(args.robot)
+    args.method = args.method or settings.method or "exact"
+    args.scheme = args.scheme or settings.scheme or "exact"
+    return settings
+
+
+def weights_from_args(args: argparse.Namespace, settings=None):
+    """The WLS friction coefficients: the description's (`settings`), replaced by a ``--slip-weights`` file, then
+    ``--mu-default`` and ``--mu`` options."""
     from ..slip.weights import SlipWeights
 
-    mu: dict[str, tuple[float, float]] = {}
-    default = (1.0, 1.0)
+    base = settings.weights() if settings is not None else SlipWeights()
+    mu: dict[str, tuple[float, float]] = {n: (a, b) for n, a, b in base.mu}
+    default = base.default
     if args.slip_weights:
         data = _read_json(args.slip_weights)
         w = data.get("weights", data) if isinstance(data, dict) else None
@@ -68,8 +82,8 @@ def weights_from_args(args: argparse.Namespace):
     return SlipWeights.of(mu, default)
 
 
-def estimator_from_args(robot: Robot, args: argparse.Namespace):
-    """The estimator of ``--method wls|fk1|fk2`` with its options."""
+def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
+    """The estimator of ``--method wls|fk1|fk2`` with its options over the description's `settings`."""
     from ..slip.estimators import estimator
     from ..slip.kalman import noise_from_options
 
@@ -77,10 +91,13 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace):
         raise WmrkitError("--weight applies to the kinematic methods; with --method wls use --mu WHEEL=LAT,LONG")
     if args.covariance:
         raise WmrkitError(f"--covariance is not available with --method {args.method} (kinematic methods only)")
-    k = args.kf_noise or (1.0, 1.0, 1.0)
-    wheels = {n: _pair(v, f"--kf-wheel {n}") for n, v in parse_assignments(args.kf_wheel, "--kf-wheel").items()}
+    described = settings.kalman_noise() if settings is not None else None
+    k = args.kf_noise or (described and (described.process, described.lateral, described.longitudinal)) \
+        or (1.0, 1.0, 1.0)
+    wheels = {n: (a, b) for n, a, b in (described.wheels if described else ())}
+    wheels |= {n: _pair(v, f"--kf-wheel {n}") for n, v in parse_assignments(args.kf_wheel, "--kf-wheel").items()}
     noise = noise_from_options(k[0], k[1], k[2], wheels) if args.method != "wls" else None
-    weights = weights_from_args(args) if args.method == "wls" else None
+    weights = weights_from_args(args, settings) if args.method == "wls" else None
     return estimator(robot, args.method, sensed=args.sensed, weights=weights, noise=noise,
                      thesis_double_q=args.thesis_double_q)
 
@@ -118,7 +135,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
 
     robot = load_robot(args.robot)
     joints = odometry_model(robot).joints
-    log = load_csv(args.log, joints)
+    log = load_csv(args.log, joints, robot=robot)
     if not Path(args.reference).is_file():
         raise WmrkitError(f"{args.reference}: no such file")
     try:
@@ -140,6 +157,11 @@ def add_study_parser(commands: argparse._SubParsersAction) -> None:
     p.add_argument("study", choices=("forklift", "skid-steer-4"), help="which study")
     p.add_argument("--report", metavar="DIR", help="write the figures into DIR")
     p.add_argument("--quick", action="store_true", help="fewer sweep points and shorter runs (a smoke run)")
+    p.add_argument("--seed", type=int, default=0, help="forklift: seed of the experiments' speeds and encoder "
+                                                        "phases (default 0)")
+    p.add_argument("--drive", choices=("differential", "servo"), default="differential",
+                   help="forklift: drive wheels through the open differential of one traction motor (default, the "
+                        "forklift's drivetrain) or each through its own rate servo")
     p.add_argument("--source", choices=("md", "quasi-static"), default="md",
                    help="skid-steer-4: motion from the dynamic model (default) or the quasi-static slip model")
     add_json_flag(p)
@@ -163,7 +185,7 @@ def run_study(args: argparse.Namespace) -> int:
         return 0
     from ..slip.study import forklift_study
 
-    result = forklift_study(report=args.report, quick=args.quick)
+    result = forklift_study(report=args.report, quick=args.quick, seed=args.seed, drive=args.drive)
     if args.json:
         print_json(result)
     else:

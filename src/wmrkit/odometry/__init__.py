@@ -2,9 +2,9 @@
 
 One module per concept: :mod:`.encoders` (counts to radians), :mod:`.model` (the sensed direct model over samples,
 (4.11)), :mod:`.integrators` (exact SE(2), RK2, Euler, 002 (15)), :mod:`.covariance` (003 (17), propagation),
-:mod:`.calibration`, :mod:`.logs` (CSV), :mod:`.trajectories` (CSV, TUM), :mod:`.bags` (ROS 2),
-:mod:`.pipeline` (streaming), :mod:`.files` (what the CLI calls), :mod:`.synthetic` (test data). See
-``docs/odometry.md``.
+:mod:`.calibration`, :mod:`.logs` (CSV), :mod:`.steering` (headings in files, β inside), :mod:`.trajectories`
+(CSV, TUM), :mod:`.bags` (ROS 2), :mod:`.pipeline` (streaming), :mod:`.files` (what the CLI calls),
+:mod:`.synthetic` (test data). See ``docs/odometry.md``.
 """
 
 from .calibration import Calibration, CalibrationRun, apply_parameters, calibrate, square_path_error
@@ -20,9 +20,10 @@ from .integrators import (
     integrate_rk2,
     step,
 )
-from .logs import JointLog, LogError, LogFormat, load_csv, read_csv
+from .logs import JointLog, LogError, LogFormat, load_csv, read_csv, write_log
 from .model import ModelIncrements, OdometryModel, SensingError, odometry_model
 from .pipeline import OdometrySummary, odometry, run_odometry
+from .steering import SteeringError
 from .synthetic import Slip, SyntheticRun, TwistProfile, simulate, square_path
 from .trajectories import Trajectory, TrajectoryWriter, read_tum, write_trajectory
 
@@ -44,6 +45,7 @@ __all__ = [
     "OdometrySummary",
     "SensingError",
     "Slip",
+    "SteeringError",
     "SyntheticRun",
     "Trajectory",
     "TrajectoryWriter",
@@ -69,5 +71,6 @@ __all__ = [
     "square_path_error",
     "step",
     "step_jacobians",
+    "write_log",
     "write_trajectory",
 ]

@@ -1,7 +1,9 @@
 """ROS 2 bags (via ``rosbags``): read ``sensor_msgs/msg/JointState`` as joint logs, write ``nav_msgs/msg/Odometry``.
 
-JointState ``position`` entries are read as cumulative wheel angles and steering angles [rad] (as ros2_control's
-joint state broadcaster publishes them). Joint names are the robot's ``WHEEL.spin`` / ``WHEEL.steer`` unless
+JointState ``position`` entries are read as cumulative wheel angles and steering **headings** [rad] (as
+ros2_control's joint state broadcaster publishes them: a steering joint reads 0 when its wheel rolls straight
+ahead), converted to the thesis's β of :class:`~.logs.JointLog` with the robot's wheels (:mod:`.steering`); the
+writer converts back. Joint names are the robot's ``WHEEL.spin`` / ``WHEEL.steer`` unless
 ``names`` maps ROS names onto them. Messages naming none of the needed joints (other publishers on the topic)
 are skipped; a message naming some but not all is an error. Time is the header stamp (the bag's receive time
 when the stamp is zero).
@@ -17,11 +19,16 @@ import os
 import re
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import WmrkitError
 from .logs import MAX_RATE, JointLog, LogError, check_jumps
+from .steering import check_robot, convert_steering
+
+if TYPE_CHECKING:
+    from ..robot import Robot
 from .trajectories import Trajectory, quaternion_z, yaw_of_quaternion
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -116,17 +123,20 @@ def bag_message_count(path: str | os.PathLike[str], topic: str) -> int:
     return int(count) if isinstance(count, int) else 0
 
 
-def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, topic: str = "/joint_states",
-                      names: Mapping[str, str] | None = None, chunk_size: int = 1 << 14,
-                      progress: Callable[[int], object] | None = None,
+def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, robot: Robot | None = None,
+                      topic: str = "/joint_states", names: Mapping[str, str] | None = None,
+                      chunk_size: int = 1 << 14, progress: Callable[[int], object] | None = None,
                       max_rate: float | None = MAX_RATE) -> Iterator[JointLog]:
     """Joint logs from the ``JointState`` messages on `topic`, in chunks (bounded memory).
 
-    `names` maps ROS joint names to the robot's joint names. `progress` is called with the number of messages
-    read. Raises :class:`LogError` for a missing bag or topic and for messages lacking some joints, and for
-    spin joints turning faster than `max_rate` [rad/s] between two messages (:func:`.logs.check_jumps`).
+    `robot`: the robot logged, whose wheels convert the steering headings to β (required when `joints` has
+    steering joints). `names` maps ROS joint names to the robot's joint names. `progress` is called with the
+    number of messages read. Raises :class:`LogError` for a missing bag or topic and for messages lacking some
+    joints, and for spin joints turning faster than `max_rate` [rad/s] between two messages
+    (:func:`.logs.check_jumps`).
     """
     source, rename = os.fspath(path), dict(names or {})
+    check_robot(joints, robot, source)
     reader = _open(source)
     ts = _typestore()
     try:
@@ -156,10 +166,10 @@ def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, to
             rows.append([msg.position[got[j]] for j in joints])
             index += 1
             if len(times) == chunk_size:
-                last = yield from _chunk(times, joints, rows, f"{source}: {topic}", first, last, max_rate)
+                last = yield from _chunk(times, joints, rows, f"{source}: {topic}", first, last, max_rate, robot)
                 first, times, rows = index, [], []
         if times:
-            yield from _chunk(times, joints, rows, f"{source}: {topic}", first, last, max_rate)
+            yield from _chunk(times, joints, rows, f"{source}: {topic}", first, last, max_rate, robot)
         if index == 0:
             raise LogError(f"{source}: no JointState message on '{topic}' names the joints {', '.join(joints)}")
     finally:
@@ -167,27 +177,31 @@ def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, to
 
 
 def _chunk(times: list[float], joints: Sequence[str], rows: list, source: str, first: int,
-           last: tuple[float, np.ndarray] | None, max_rate: float | None):
-    """Yield one chunk (checked for jumps against the `last` sample before it); return its own last sample."""
-    log = JointLog(np.array(times), tuple(joints), np.array(rows, dtype=float).reshape(len(times), len(joints)),
-                   None, source, None, first)
+           last: tuple[float, np.ndarray] | None, max_rate: float | None, robot: Robot | None):
+    """Yield one chunk (checked for jumps against the `last` sample before it, steering converted to β); return
+    its own last sample (as read)."""
+    raw = np.array(rows, dtype=float).reshape(len(times), len(joints))
+    log = JointLog(np.array(times), tuple(joints), raw, None, source, None, first)
     t = log.time if last is None else np.concatenate([[last[0]], log.time])
-    check_jumps(log, log.positions, None if last is None else last[1], t, max_rate)
-    yield log
-    return float(log.time[-1]), log.positions[-1].copy()
+    check_jumps(log, raw, None if last is None else last[1], t, max_rate)
+    yield JointLog(log.time, log.joints, convert_steering(robot, joints, raw, to="beta", source=source), None,
+                   source, None, first)
+    return float(log.time[-1]), raw[-1].copy()
 
 
-def write_joint_states(path: str | os.PathLike[str], log: JointLog, *, topic: str = "/joint_states",
-                       names: Mapping[str, str] | None = None) -> None:
-    """Write `log` as ``JointState`` messages (one per sample) to a new bag; `names` maps joints to ROS names."""
+def write_joint_states(path: str | os.PathLike[str], log: JointLog, *, robot: Robot | None = None,
+                       topic: str = "/joint_states", names: Mapping[str, str] | None = None) -> None:
+    """Write `log` as ``JointState`` messages (one per sample) to a new bag; `names` maps joints to ROS names.
+    Steering positions are written as headings, converted with `robot` (required when the log steers)."""
     ts = _typestore()
     rename = dict(names or {})
+    positions = log.heading_positions(robot)
     header_t, state_t = ts.types["std_msgs/msg/Header"], ts.types[JOINT_STATE]
     with _writer(path) as writer:
         conn = writer.add_connection(topic, JOINT_STATE, typestore=ts)
         names_out = [rename.get(j, j) for j in log.joints]
         empty = np.zeros(0)
-        for t, row in zip(log.time.tolist(), log.positions, strict=True):
+        for t, row in zip(log.time.tolist(), positions, strict=True):
             msg = state_t(header=header_t(stamp=_stamp(t), frame_id=""), name=names_out,
                           position=np.asarray(row, dtype=np.float64), velocity=empty, effort=empty)
             writer.write(conn, round(t * 1e9), ts.serialize_cdr(msg, JOINT_STATE))

@@ -3,7 +3,8 @@
 The conversion ``wheel angle = 2 pi counts / (counts_per_rev * gear_ratio)`` is [DERIVED] (neither paper gives it;
 papers-odometry.md Part D.1); the wheel's travel is then ``r * angle`` through the robot's own kinematics. The
 forklift of thesis §7.5.1 (8290 pulses per wheel revolution, absolute steering encoder of 1.4118 deg = 360/255 deg)
-is in :data:`CATALOG_ENCODERS`.
+is in :data:`CATALOG_ENCODERS`. An absolute steering encoder reads the wheel's **heading** (0 when it rolls
+straight ahead, counter-clockwise positive), as every steering angle in a log does (:mod:`.steering`).
 """
 
 from __future__ import annotations
@@ -94,7 +95,10 @@ class IncrementalEncoder:
 
 @dataclass(frozen=True, slots=True)
 class AbsoluteEncoder:
-    """An absolute angle encoder (steering): ``angle = offset + sign * counts * resolution`` [rad]."""
+    """An absolute angle encoder (steering): ``angle = offset + sign * counts * resolution`` [rad].
+
+    In a log the angle is the wheel's heading (0 = rolling straight ahead): ``offset`` is the heading at count 0,
+    so an encoder that reads 0 straight ahead (the default) needs none."""
 
     resolution: float
     offset: float = 0.0
@@ -122,13 +126,13 @@ class AbsoluteEncoder:
 Encoder = IncrementalEncoder | AbsoluteEncoder
 
 #: Encoders of catalog robots, by robot then joint (thesis §7.5.1: 8290 pulses/rev, 1.4118 deg = 360/255 deg).
-#: The forklift's steering encoder reads 0 when steered straight ahead (beta = 90 deg in the REP-103 frame of the
-#: catalog), so straight is representable; the thesis does not say where its zero is.
+#: The forklift's steering encoder reads 0 when steered straight ahead, the general rule of steering encoders
+#: (no offset), so straight is representable; the thesis does not say where its zero is.
 CATALOG_ENCODERS: Mapping[str, Mapping[str, Encoder]] = {
     "forklift": {
         "right_drive.spin": IncrementalEncoder(counts_per_rev=8290),
         "left_drive.spin": IncrementalEncoder(counts_per_rev=8290),
-        "steer.steer": AbsoluteEncoder(resolution=math.radians(1.4118), offset=math.pi / 2),
+        "steer.steer": AbsoluteEncoder(resolution=math.radians(1.4118)),
     },
 }
 
@@ -159,7 +163,8 @@ def encoders_for(robot_name: str, joints: Sequence[str], *, counts_per_rev: floa
     """Encoders of `joints` for a counts log: the given settings, else the catalog's (:data:`CATALOG_ENCODERS`).
 
     Spin joints get an :class:`IncrementalEncoder` (`counts_per_rev`, `gear_ratio`, counter `bits`, `signed`),
-    steer joints an :class:`AbsoluteEncoder` of `steer_resolution` [rad]. Raises :class:`EncoderError` when a
+    steer joints an :class:`AbsoluteEncoder` of `steer_resolution` [rad] reading 0 straight ahead (the rule of
+    every steering encoder, catalog ones included). Raises :class:`EncoderError` when a
     joint has neither.
     """
     known = CATALOG_ENCODERS.get(robot_name, {})

@@ -3,7 +3,8 @@
 Inputs: CSV logs (:mod:`.logs`) or ROS 2 bags (a bag directory, or a ``.db3``/``.mcap`` file; :mod:`.bags`).
 Outputs chosen by ``out_format`` or the extension of ``out``: ``.csv`` (time, pose, slip, covariance), ``.tum``
 or ``.txt`` (TUM), anything else a new ROS 2 bag of ``nav_msgs/msg/Odometry``. A plot keeps a decimated copy of
-the trajectory, so memory stays bounded for any log length.
+the trajectory, so memory stays bounded for any log length. Steering joints in either file are headings (0 =
+rolling straight ahead; :mod:`.steering`), converted to β with `robot`'s wheels by the readers.
 """
 
 from __future__ import annotations
@@ -70,11 +71,10 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
         raise LogError(f"unknown output format '{out_fmt}' (formats: csv, tum, bag)")
     with tqdm(total=total, unit=unit, unit_scale=True, disable=not progress, leave=False) as bar:
         if bag:
-            chunks = read_joint_states(log_path, model.joints, topic=topic, names=joint_names,
+            chunks = read_joint_states(log_path, model.joints, robot=robot, topic=topic, names=joint_names,
                                        chunk_size=chunk_size, progress=bar.update)
         else:
-            chunks = read_csv(log_path, model.joints, fmt, wheels=robot.wheel_names, chunk_size=chunk_size,
-                              progress=bar.update)
+            chunks = read_csv(log_path, model.joints, fmt, robot=robot, chunk_size=chunk_size, progress=bar.update)
         sinks, writer = [], None
         if out_fmt == "bag":
             writer = OdometryBagWriter(out)

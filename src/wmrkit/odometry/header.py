@@ -2,9 +2,13 @@
 
 A column name may carry its unit in brackets: ``time [ms]``, ``left.spin [rad]``, ``left.spin [rad/s]``,
 ``left.spin [counts]``, ``left.spin [counts:u16]`` (an incremental encoder on an unsigned 16-bit counter that wraps;
-``s16`` signed, any width from 8 to 64 bits), ``steer.steer [rad]``, ``steer.steer [counts]``. A log written this way
-needs no ``--spin``/``--steer``/``--counter-bits`` options, and an option that contradicts the header is an error
-rather than a silent misreading.
+``s16`` signed, any width from 8 to 64 bits), ``steer.steer [rad]``, ``steer.steer [deg]``, ``steer.steer [counts]``.
+A log written this way needs no ``--spin``/``--steer``/``--counter-bits`` options, and an option that contradicts
+the header is an error rather than a silent misreading.
+
+Steering columns are headings (0 = rolling straight ahead; :mod:`.steering`). A steering unit may name its
+convention: ``steer.steer [deg:beta]`` (also ``rad:beta``, ``counts:beta``) marks a file written in the thesis's β
+by an older wmrkit version, read as such; ``[deg:heading]`` says the default explicitly.
 """
 
 from __future__ import annotations
@@ -17,7 +21,9 @@ from ..errors import WmrkitError
 
 #: Units a joint column may declare, and the log-format mode each means.
 SPIN_UNITS = {"rad": "angle", "rad/s": "velocity", "counts": "counts"}
-STEER_UNITS = {"rad": "angle", "counts": "counts"}
+STEER_UNITS = {"rad": "angle", "deg": "degrees", "counts": "counts"}
+#: Conventions a steering unit may name after a colon (``deg:beta``).
+STEER_CONVENTIONS = ("heading", "beta")
 TIME_UNITS = ("s", "ms", "us", "ns")
 
 _NAME = re.compile(r"^\s*([^\[\]]*?)\s*\[\s*([^\[\]]+?)\s*\]\s*$")
@@ -38,6 +44,7 @@ class HeaderUnits:
     steer: str | None = None
     bits: int | None = None
     signed: bool = False
+    steer_convention: str | None = None
 
     @property
     def declared(self) -> bool:
@@ -57,6 +64,7 @@ def read_header_units(path: str | Path, *, max_chars: int = 1 << 16, delimiter: 
 def parse_header_units(names: list[str], *, source: str = "<log>") -> HeaderUnits:
     """Parse ``name [unit]`` header entries (see the module docstring)."""
     columns, modes, bits, signed, time_unit = [], {"spin": set(), "steer": set()}, set(), set(), None
+    conventions = set()
     for written in names:
         match = _NAME.match(written)
         if match is None:
@@ -72,6 +80,13 @@ def parse_header_units(names: list[str], *, source: str = "<log>") -> HeaderUnit
             continue
         kind = "steer" if joint == "steer" else "spin"
         table = STEER_UNITS if kind == "steer" else SPIN_UNITS
+        base, colon, convention = unit.rpartition(":")
+        if colon and convention in STEER_CONVENTIONS:
+            if kind != "steer":
+                raise HeaderError(f"{source}:1: column '{plain}': ':{convention}' names a steering convention; "
+                                  "only steer columns have one")
+            conventions.add(convention)
+            unit = base
         counter = _COUNTER.match(unit)
         if counter is not None:
             width = int(counter.group(2))
@@ -81,16 +96,19 @@ def parse_header_units(names: list[str], *, source: str = "<log>") -> HeaderUnit
             signed.add(counter.group(1) == "s")
             unit = "counts"
         if unit not in table:
+            extra = "files in the thesis's beta: deg:beta, rad:beta" if kind == "steer" else "counters: counts:u16"
             raise HeaderError(f"{source}:1: column '{plain}': unknown unit '{unit}' (for a {kind} joint: "
-                              f"{', '.join(table)}; counters: counts:u16, counts:s32, ...)")
+                              f"{', '.join(table)}; {extra}, ...)")
         modes[kind].add(table[unit])
     for kind, found in modes.items():
         if len(found) > 1:
             raise HeaderError(f"{source}:1: the {kind} columns mix units ({', '.join(sorted(found))}); one per log")
     if len(bits) > 1 or len(signed) > 1:
         raise HeaderError(f"{source}:1: the counter columns mix widths or signedness; one counter per log")
+    if len(conventions) > 1:
+        raise HeaderError(f"{source}:1: the steer columns mix conventions (heading, beta); one per log")
     return HeaderUnits(tuple(columns), time_unit, next(iter(modes["spin"]), None), next(iter(modes["steer"]), None),
-                       next(iter(bits), None), next(iter(signed), False))
+                       next(iter(bits), None), next(iter(signed), False), next(iter(conventions), None))
 
 
 def merge_option(name: str, given: object | None, declared: object | None, default: object, source: str) -> object:

@@ -1,9 +1,11 @@
 """Joint logs: samples of sensed joints over time, read from CSV in bounded memory, validated, written back.
 
 A log holds one row per sample: ``time`` [s] and, per sensed joint ``WHEEL.spin`` / ``WHEEL.steer``, the
-cumulative wheel angle / the steering angle [rad]. :class:`LogFormat` describes other CSV layouts: other column
-names, a time unit, encoder counts (with counter wrap-around), joint velocities, an external heading (absolute
-yaw, or a gyro rate that is integrated). Every reader turns them into the same :class:`JointLog` chunks.
+cumulative wheel angle / the steering **heading** [rad] (the wheel's rolling direction, 0 = straight ahead, as a
+ROS 2 steering joint reads; :mod:`.steering`). :class:`LogFormat` describes other CSV layouts: other column
+names, a time unit, encoder counts (with counter wrap-around), joint velocities, steering in degrees or in the
+thesis's β (files of older wmrkit versions), an external heading (absolute yaw, or a gyro rate that is
+integrated). Every reader turns them into the same :class:`JointLog` chunks, whose steering columns hold β.
 
 Bad input is refused with a one-line :class:`LogError` naming the file, the line and the column: missing columns,
 columns naming wheels the robot lacks, non-numeric or NaN values, time that repeats (a zero time step is
@@ -25,12 +27,16 @@ import os
 import re
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
 from ..errors import WmrkitError
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
+from .steering import CONVENTIONS, check_robot, convert_steering
+
+if TYPE_CHECKING:
+    from ..robot import Robot
 
 #: Seconds per unit of the time column.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
@@ -50,9 +56,12 @@ class LogError(WmrkitError, ValueError):
 class JointLog:
     """Samples of sensed joints: ``time`` ``(N,)`` [s], ``positions`` ``(N, n)`` [rad] named by ``joints``.
 
-    Spin columns are cumulative wheel angles, steer columns steering angles. ``heading_world`` ``(N,)`` [rad] is
-    an optional external heading (continuous). ``source`` and ``first_line`` locate errors (``first_line``: the
-    file line of row 0, or None when rows are not lines; ``first_index`` is then the sample number of row 0).
+    Spin columns are cumulative wheel angles, steer columns the thesis's **β** (the model's convention: straight
+    ahead is pi/2 for δ = 0). Joint data in the users' convention (ROS 2, WPILib: steering 0 = rolling straight
+    ahead) comes in through :meth:`from_headings` and goes out through :meth:`heading_positions`; the log
+    readers and writers do both. ``heading_world`` ``(N,)`` [rad] is an optional external yaw (continuous).
+    ``source`` and ``first_line`` locate errors (``first_line``: the file line of row 0, or None when rows are not
+    lines; ``first_index`` is then the sample number of row 0).
     """
 
     time: np.ndarray
@@ -73,6 +82,19 @@ class JointLog:
 
     def __len__(self) -> int:
         return len(self.time)
+
+    @classmethod
+    def from_headings(cls, robot: Robot, time: np.ndarray, joints: Sequence[str], positions: np.ndarray,
+                      heading_world: np.ndarray | None = None, source: str = "<log>") -> JointLog:
+        """A log from joint data whose steering columns are headings (0 = rolling straight ahead, CCW; ROS 2
+        ``JointState``, WPILib), converted to β with `robot`'s wheels (:func:`.steering.convert_steering`)."""
+        pos = convert_steering(robot, joints, np.asarray(positions, dtype=float), to="beta", source=source)
+        return cls(np.asarray(time, dtype=float), tuple(joints), pos, heading_world, source)
+
+    def heading_positions(self, robot: Robot) -> np.ndarray:
+        """``positions`` ``(N, n)`` with the steering columns as headings [rad] (what files hold; in (-pi, pi] at
+        the first sample, continuous after it)."""
+        return convert_steering(robot, self.joints, self.positions, to="heading", source=self.source)
 
     def where(self, row: int) -> str:
         """Location of `row` for messages: ``file:line`` or ``source: sample i``."""
@@ -103,7 +125,9 @@ class LogFormat:
 
     ``columns``: ``(joint, column)`` pairs renaming columns. ``spin``: ``"angle"`` (cumulative, rad),
     ``"counts"`` (incremental encoder, see ``encoders``) or ``"velocity"`` (rad/s, integrated by the trapezoidal
-    rule). ``steer``: ``"angle"`` (rad) or ``"counts"`` (absolute encoder readings). ``encoders``: ``(joint,
+    rule). ``steer``: ``"angle"`` (rad), ``"degrees"`` or ``"counts"`` (absolute encoder readings).
+    ``steer_convention``: ``"heading"`` (0 = rolling straight ahead, the default) or ``"beta"`` (the thesis's
+    angle, files of older wmrkit versions; header ``[deg:beta]``). ``encoders``: ``(joint,
     encoder)`` pairs for counts. ``heading_column``: absolute heading [rad] (IMU yaw; unwrapped here) replacing
     the wheels' heading; ``gyro_column``: yaw rate [rad/s] instead (integrated from 0). ``max_gap``: longest
     time step accepted [s] (None: any). ``time_unit``: one of :data:`TIME_UNITS`. ``max_rate``: largest
@@ -114,20 +138,23 @@ class LogFormat:
     time_unit: str = "s"
     columns: tuple[tuple[str, str], ...] = ()
     spin: Literal["angle", "counts", "velocity"] = "angle"
-    steer: Literal["angle", "counts"] = "angle"
+    steer: Literal["angle", "degrees", "counts"] = "angle"
     encoders: tuple[tuple[str, Encoder], ...] = field(default=())
     heading_column: str | None = None
     gyro_column: str | None = None
     max_gap: float | None = None
     delimiter: str = ","
     max_rate: float | None = MAX_RATE
+    steer_convention: Literal["heading", "beta"] = "heading"
 
     def __post_init__(self) -> None:
         if self.time_unit not in TIME_UNITS:
             raise LogError(f"unknown time unit '{self.time_unit}' (units: {', '.join(TIME_UNITS)})")
-        if self.spin not in ("angle", "counts", "velocity") or self.steer not in ("angle", "counts"):
-            raise LogError(f"spin must be angle, counts or velocity and steer angle or counts; got {self.spin}, "
-                           f"{self.steer}")
+        if self.spin not in ("angle", "counts", "velocity") or self.steer not in ("angle", "degrees", "counts"):
+            raise LogError(f"spin must be angle, counts or velocity and steer angle, degrees or counts; got "
+                           f"{self.spin}, {self.steer}")
+        if self.steer_convention not in CONVENTIONS:
+            raise LogError(f"steer_convention must be heading or beta, got {self.steer_convention!r}")
         if self.heading_column is not None and self.gyro_column is not None:
             raise LogError("give a heading column or a gyro column, not both")
         if self.max_gap is not None and not self.max_gap > 0:
@@ -154,10 +181,16 @@ class LogFormat:
 
 
 class Decoder:
-    """Turns raw rows of one log into :class:`JointLog` chunks, carrying state across chunks (counts, rates)."""
+    """Turns raw rows of one log into :class:`JointLog` chunks, carrying state across chunks (counts, rates).
 
-    def __init__(self, joints: Sequence[str], fmt: LogFormat, source: str) -> None:
-        self.joints, self.fmt, self.source = tuple(joints), fmt, source
+    Steering columns are decoded to angles (radians, degrees or encoder counts) in the file's convention, then
+    headings are converted to β with `robot` (:mod:`.steering`; required when the log has steering joints).
+    """
+
+    def __init__(self, joints: Sequence[str], fmt: LogFormat, source: str, robot: Robot | None = None) -> None:
+        self.joints, self.fmt, self.source, self.robot = tuple(joints), fmt, source, robot
+        if fmt.steer_convention == "heading":
+            check_robot(self.joints, robot, source)
         self._last: np.ndarray | None = None  # last raw row (time, joints, heading)
         self._positions: np.ndarray | None = None  # last decoded positions
         self._heading = 0.0
@@ -185,14 +218,16 @@ class Decoder:
             heading = self._heading + _cumtrapz(ext[:, -1], ext_time, start=self._last is None)
         if heading is not None:
             self._heading = heading[-1]
-        self._last, self._positions = raw[-1].copy(), pos[-1].copy()
+        self._last, self._positions = raw[-1].copy(), pos[-1].copy()  # as read: counts and rates continue from it
+        if fmt.steer_convention == "heading":
+            pos = convert_steering(self.robot, self.joints, pos, to="beta", source=self.source)
         return JointLog(time, self.joints, pos, heading, self.source, first_line, first_index)
 
     def _decode_joint(self, joint: str, col: np.ndarray, t: np.ndarray, prev: float | None, probe: JointLog):
         kind = self.fmt.steer if joint.endswith(".steer") else self.fmt.spin
         new = col if prev is None else col[1:]
-        if kind == "angle":
-            return new
+        if kind in ("angle", "degrees"):
+            return np.radians(new) if kind == "degrees" else new
         if kind == "velocity":
             return (0.0 if prev is None else prev) + _cumtrapz(col, t, start=prev is None)
         enc = self.fmt.encoder_of(joint, self.source)
@@ -254,14 +289,18 @@ def check_jumps(log: JointLog, positions: np.ndarray, previous: np.ndarray | Non
 
 
 def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat = LogFormat(), *,
-             wheels: Sequence[str] = (), chunk_size: int = 1 << 16,
+             robot: Robot | None = None, wheels: Sequence[str] = (), chunk_size: int = 1 << 16,
              progress: Callable[[int], object] | None = None) -> Iterator[JointLog]:
     """Read a CSV log in chunks of `chunk_size` rows, validated and decoded (bounded memory).
 
-    `joints`: the joints needed (``model.joints``); `wheels`: the robot's wheel names, to refuse columns
-    ``X.spin``/``X.steer`` for a wheel ``X`` the robot lacks. `progress` is called with the bytes read.
+    `joints`: the joints needed (``model.joints``). `robot`: the robot logged, whose wheels convert the steering
+    headings to β (required when `joints` has steering joints, unless ``fmt.steer_convention == "beta"``);
+    `wheels` (default: `robot`'s wheel names) to refuse columns ``X.spin``/``X.steer`` for a wheel ``X`` the robot
+    lacks. `progress` is called with the bytes read.
     """
     source = os.fspath(path)
+    wheels = robot.wheel_names if robot is not None and not wheels else wheels
+    decoder = Decoder(joints, fmt, source, robot)
     try:
         f = open(source, encoding="utf-8", errors="surrogateescape", newline="")  # bad bytes found per chunk
     except OSError as err:
@@ -278,7 +317,6 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
         if progress is not None:
             progress(len(header_line.encode()))
         line, index = 2, 0
-        decoder = Decoder(joints, fmt, source)
         while True:
             lines = list(itertools.islice(f, chunk_size))
             if not lines:
@@ -298,9 +336,9 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
 
 
 def load_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat = LogFormat(), *,
-             wheels: Sequence[str] = ()) -> JointLog:
+             robot: Robot | None = None, wheels: Sequence[str] = ()) -> JointLog:
     """A whole CSV log in memory (see :func:`read_csv`)."""
-    return concatenate(list(read_csv(path, joints, fmt, wheels=wheels)))
+    return concatenate(list(read_csv(path, joints, fmt, robot=robot, wheels=wheels)))
 
 
 def concatenate(chunks: Sequence[JointLog]) -> JointLog:
@@ -322,6 +360,13 @@ def write_csv(path: str | os.PathLike[str], names: Sequence[str], values: np.nda
         for start in range(0, len(values), 1 << 16):
             block = values[start:start + (1 << 16)]
             f.write((row * len(block)) % tuple(block.ravel().tolist()))  # one formatting call per block
+
+
+def write_log(path: str | os.PathLike[str], log: JointLog, robot: Robot | None = None, *,
+              fmt: str = "%.17g") -> None:
+    """Write `log` as a CSV log in the default format (``time``, then its joints; steering as headings, converted
+    with `robot`'s wheels, so that :func:`load_csv` with the same robot reads it back)."""
+    write_csv(path, ("time", *log.joints), np.column_stack([log.time, log.heading_positions(robot)]), fmt=fmt)
 
 
 def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: Sequence[str],

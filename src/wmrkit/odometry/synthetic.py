@@ -8,6 +8,8 @@ zero they turn linearly in time to the next heading (steering while stopped). Ca
 kinematics, ``beta_dot`` from (3.12), integrated with ``solve_ivp``. Then the sensors: optional slip windows
 (a wheel turns ``1 + ratio`` times what rolling needs), random-walk noise on spins (variance ``per_rad * |dq|``,
 the :class:`~.covariance.JointNoise` model), Gaussian noise on steering readings, and encoder quantisation.
+The run's :class:`~.logs.JointLog` holds the thesis's β; steering encoders read headings (0 = straight ahead), as
+in any log file, and :func:`~.logs.write_log` writes the log with headings.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from ..wheels import wheel_slip_rows
 from .encoders import AbsoluteEncoder, Encoder, IncrementalEncoder
 from .integrators import integrate_increments
 from .logs import JointLog
+from .steering import convert_steering
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
@@ -95,9 +98,10 @@ class Slip:
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
 class SyntheticRun:
-    """A simulated run: ``log`` (what the sensors report, angles), ``truth`` ``(N, 3)`` true poses at the sample
-    times, ``true_positions`` ``(N, n)`` exact joint positions, ``counts``: raw encoder readings by joint (as the
-    counters show them, wrapped) for the joints that have an encoder."""
+    """A simulated run: ``log`` (what the sensors report, angles; steering as β like every :class:`JointLog`),
+    ``truth`` ``(N, 3)`` true poses at the sample times, ``true_positions`` ``(N, n)`` exact joint positions (β),
+    ``counts``: raw encoder readings by joint (as the counters show them, wrapped; steering encoders read
+    headings) for the joints that have an encoder."""
 
     log: JointLog
     truth: np.ndarray
@@ -109,15 +113,19 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
              sensed: Sequence[str] | None = None, encoders: Mapping[str, Encoder] | None = None,
              spin_noise_per_rad: float = 0.0, steer_noise: float = 0.0, slips: Sequence[Slip] = (),
              oversample: int = 8, seed: int = 0) -> SyntheticRun:
-    """Drive `robot` along `profile` and record its sensed joints at `rate` [Hz] (module docstring).
+    """Drive `robot` along `profile` and record its sensed joints at `rate` [Hz] (module docstring); when the
+    profile's duration is not a whole number of sample periods, the robot rests until the next sample.
 
     `sensed` defaults to ``robot.sensed``. `encoders` quantise the named joints (spins: floor of the count,
     steering: nearest reading). `spin_noise_per_rad` [rad^2/rad], `steer_noise` [rad] (standard deviation).
     `oversample`: fine steps per sample interval for the joint kinematics. Deterministic for a given `seed`.
     """
     sensed = tuple(robot.sensed if sensed is None else sensed)
-    n = math.floor(profile.duration * rate + 1e-9) + 1
+    n = math.ceil(profile.duration * rate - 1e-9) + 1  # the whole profile: a log never stops short of its end
     t_samples = np.arange(n) / rate
+    if t_samples[-1] > profile.duration:  # the robot rests from the profile's end to the last sample
+        profile = TwistProfile(np.append(profile.durations, t_samples[-1] - profile.duration),
+                               np.vstack([profile.twists, np.zeros(3)]))
     fine = np.union1d(np.linspace(0.0, t_samples[-1], (n - 1) * oversample + 1),
                       profile.boundaries[profile.boundaries <= t_samples[-1]])
     sample_idx = np.searchsorted(fine, t_samples)
@@ -163,9 +171,10 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
             raw = enc.quantize(meas_pos[joint])
             meas_pos[joint] = raw * enc.radians_per_count
             counts[joint] = enc.wrap(raw)
-        elif isinstance(enc, AbsoluteEncoder):
-            counts[joint] = enc.quantize(meas_pos[joint])
-            meas_pos[joint] = enc.angle(counts[joint])
+        elif isinstance(enc, AbsoluteEncoder):  # reads the heading: converted at the door, as a log reader does
+            heading = convert_steering(robot, (joint,), meas_pos[joint][:, None], to="heading")[:, 0]
+            counts[joint] = enc.quantize(heading)
+            meas_pos[joint] = convert_steering(robot, (joint,), enc.angle(counts[joint])[:, None], to="beta")[:, 0]
     log = JointLog(t_samples, sensed, np.column_stack([meas_pos[j] for j in sensed]), source="<synthetic>")
     return SyntheticRun(log, truth[sample_idx], np.column_stack([true_pos[j] for j in sensed]), counts)
 
