@@ -86,6 +86,17 @@ BAD = {
                           "wheels[0].actuated[0]: no joint 'steer' on a fixed wheel (joints: spin)"),
     "bad-date": ("r: 0.1", "r: 2020-13-45", 7,
                  "malformed YAML: cannot read '2020-13-45' as timestamp (month must be in 1..12)"),
+    "slip-zero": ("    actuated: [spin]\n", "    actuated: [spin]\n    slip: {lateral: 0, longitudinal: 1}\n", 9,
+                  "wheels[0].slip.lateral: must be a number > 0, got 0.0"),
+    "slip-missing": ("    actuated: [spin]\n", "    actuated: [spin]\n    slip: {lateral: 2}\n", 9,
+                     "wheels[0].slip: missing field 'longitudinal'"),
+    "slip-noise-unit": ("    actuated: [spin]\n", "    actuated: [spin]\n    slip:\n      lateral: 1\n"
+                        "      longitudinal: 1\n      noise: {lateral: 2 deg, longitudinal: 1}\n", 12,
+                        "wheels[0].slip.noise.lateral: '2 deg' is an angle, expected a number"),
+    "odometry-method": ("name: test-bot\n", "name: test-bot\nodometry: {method: wsl}\n", 2,
+                        "odometry.method: must be one of exact, rk2, euler, paper002, wls, fk1, fk2, got 'wsl'"),
+    "odometry-noise": ("name: test-bot\n", "name: test-bot\nodometry:\n  noise: {process: -1}\n", 3,
+                       "odometry.noise.process: must be a number > 0, got -1.0"),
 }
 
 
@@ -382,3 +393,25 @@ def test_wheel_names_must_be_identifiers(bad):
     data = {"name": "r", "wheels": [{"name": bad, "type": "fixed", "position": [0, 0], "beta": 0, "r": 0.1}]}
     with pytest.raises(DescriptionError, match=r"wheels\[0\]\.name: "):
         Robot.from_dict(data, source="x.yaml")
+
+
+def test_odometry_settings_configure_the_estimator_not_the_vehicle(tmp_path):
+    """The documented ``odometry`` example: its settings read back as written (the thesis's optimised forklift
+    weights); the Robot is the same value with or without them, and saving it leaves them out."""
+    from wmrkit.slip.settings import odometry_settings
+
+    text = next(b for b in _doc_blocks("yaml") if b.startswith("name: forklift-wls"))
+    path = tmp_path / "fk.yaml"
+    path.write_text(text)
+    s = odometry_settings(str(path))
+    assert (s.method, s.scheme, s.slip, s.noise) == ("wls", "exact", (1.0, 1.0), (1.0, 1.0, 1.0))
+    w = s.weights()
+    (lat12, lon12), (lat3, _) = w.of_wheel("left_drive"), w.of_wheel("steer")
+    assert (lon12 / lat12, lat3 / lat12) == (pytest.approx(3.2e-3), pytest.approx(19.2))  # k11, k12 (7.67)
+    assert s.kalman_noise().of_wheel("steer") == (0.28, 0.28)
+    data = yaml.safe_load(text)
+    bare = {**{k: v for k, v in data.items() if k != "odometry"},
+            "wheels": [{k: v for k, v in w.items() if k != "slip"} for w in data["wheels"]]}
+    robot = Robot.from_file(path)
+    assert robot == Robot.from_dict(bare)
+    assert "odometry" not in robot.to_dict() and all("slip" not in w for w in robot.to_dict()["wheels"])

@@ -40,10 +40,11 @@ from .wheels import GEOMETRY_FIELDS, KINDS, Wheel, beta_from_heading
 #: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
 WHEEL_TYPES = (*KINDS, "mecanum")
 
-TOP_FIELDS = ("name", "wheels", "notes", "couplings", "body")
+TOP_FIELDS = ("name", "wheels", "notes", "couplings", "body", "odometry")  # odometry: wmrkit.slip.settings
 COMMON_WHEEL_FIELDS = ("name", "type", "position", "l", "alpha", "actuated", "sensed", "heading",
                        "inertia", "mass", "tyre",  # these three: wmrkit.dynamics.mass
-                       "steer_range")  # _steer_range_from_dict
+                       "steer_range",  # _steer_range_from_dict
+                       "slip")  # wmrkit.slip.settings
 ALL_WHEEL_FIELDS = COMMON_WHEEL_FIELDS + tuple(f for f in GEOMETRY_FIELDS if f not in ("l", "alpha"))
 
 #: ``type: mecanum``: a Swedish wheel with the rollers of the standard layout (WPILib, ROS 2): ``gamma`` of
@@ -80,6 +81,10 @@ def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None
         wheels.append(wheel)
     _check_envelope(wheels, check)
     couplings = _couplings_from_dict(data.get("couplings", []), wheels, check)
+    if "odometry" in data or any(isinstance(w, Mapping) and "slip" in w for w in wheels_data):
+        from .slip.settings import settings_from_dict  # validated here, read by wmrkit.slip.settings
+
+        settings_from_dict(data, check)
     return Robot(name=name, wheels=tuple(wheels), notes=notes, couplings=couplings,
                  body=mass.body_from_dict(data, check))
 

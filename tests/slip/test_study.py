@@ -57,8 +57,8 @@ def test_study_output_and_figures(study):
     result, d = study
     assert set(result) >= {"examples", "paths", "sweep", "settings", "figures"}
     assert result["sweep"]["converged"] > 0.7 * result["sweep"]["points"]
-    for name, run in result["paths"].items():
-        if name not in ("mean_J_k", "optimised"):
+    for run in result["paths"].values():
+        if isinstance(run, dict) and "J_k" in run:
             assert set(run["J_k"]) == {"WLS", "WLS (thesis k)", "FK1", "FK2", "differential"}
             assert all(0 <= v < 0.2 for v in run["J_k"].values())
     assert all((d / p.rsplit("/", 1)[-1]).exists() for p in result["figures"])
@@ -66,3 +66,53 @@ def test_study_output_and_figures(study):
     for name in ("WLS", "FK1", "FK2"):  # tuning never does worse than the thesis's values it starts from
         start = result["paths"]["mean_J_k"]["WLS (thesis k)" if name == "WLS" else name]
         assert opt[name]["J_k"] <= start + 1e-12
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_tuned_paths_rank_the_estimators_as_the_thesis(seed):
+    """§7.5.4's finding on the five paths driven through the forklift's open differential, each estimator tuned on
+    the runs as the thesis did: WLS and FK2 both better than FK1 and differential odometry (thesis: 2.02 / 2.1 % vs
+    7.11 / 7.14 %); optimised FK1 close to the differential model, as the thesis observed."""
+    from wmrkit import catalog
+    from wmrkit.slip.study import paths
+
+    result = paths(catalog.load("forklift"), 2.0, 0.6, seed=seed)
+    jk = {k: v["J_k"] for k, v in result["optimised"].items()}
+    assert max(jk["WLS"], jk["FK2"]) < min(jk["FK1"], jk["differential"]) / 1.5  # about 1.9x here, 3.4x in the thesis
+    assert jk["FK1"] == pytest.approx(jk["differential"], rel=0.25)
+    assert result["ranking"]["tuned"]["reproduced"]
+    speeds = [run["speed_m_s"] for run in result["runs"].values()]
+    assert len(speeds) == 5 and all(1.8 <= v <= 2.2 for v in speeds) and len(set(speeds)) == 5
+
+
+def test_traction_loop_gains_place_the_poles_as_specified():
+    """PI on J rate' = tau: closed-loop poles of J s^2 + kp s + ki at the damping of the overshoot and the 2 %
+    settling time (checked on the roots, not on the formula)."""
+    from wmrkit.slip.drivetrain import TractionLoop
+
+    loop = TractionLoop.tuned(135.0, 3.5, 0.15, 1e4)
+    roots = np.roots([135.0, loop.kp, loop.ki])
+    zeta = -roots[0].real / abs(roots[0])
+    assert zeta == pytest.approx(-math.log(0.15) / math.sqrt(math.pi**2 + math.log(0.15) ** 2), rel=1e-9)
+    assert 4.0 / -roots[0].real == pytest.approx(3.5, rel=1e-9)
+
+
+def test_open_differential_leaves_the_speed_difference_free_and_tracks_the_carrier():
+    """Driven through the differential (equal torques), the coupled wheels' rates differ in a turn
+    (the difference is left to the tyres); the carrier rate settles on the program's speed on the straight."""
+    from wmrkit import catalog
+    from wmrkit.dynamics.model import DynamicModel
+    from wmrkit.dynamics.programs import path_program
+    from wmrkit.slip.drivetrain import TractionLoop, carrier_inertia, simulate_differential
+
+    model = DynamicModel.of(catalog.load("forklift"))
+    inputs, duration = path_program(model, "turn", speed=2.0)
+    loop = TractionLoop.tuned(carrier_inertia(model), 0.8, 0.05, 4000.0)
+    run = simulate_differential(model, inputs, duration + 4.0, loop, record_step=0.05)
+    rates = run.joint_rates[:, :2]
+    straight = (run.t > 1.6) & (run.t < 2.0)
+    assert np.allclose(rates[straight].mean(axis=1), 2.0 / 0.23, rtol=0.02)
+    turning = run.t > duration
+    assert np.all(rates[turning, 1] < rates[turning, 0])  # the left (inner) wheel turns slower in a left turn
+    assert run.twist[turning, 2].mean() > 0.5
+    assert np.all(np.abs(run.carrier_torque) <= 4000.0 + 1e-9)

@@ -26,7 +26,7 @@ from ._common import (
     parse_value,
     print_json,
 )
-from .slip import ESTIMATOR_METHODS, add_estimator_options, estimator_from_args
+from .slip import ESTIMATOR_METHODS, add_estimator_options, estimator_from_args, resolve_method
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -34,9 +34,10 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = commands.add_parser("odometry", help="integrate a joint log (CSV or ROS 2 bag) into a trajectory")
     add_robot_argument(p)
     p.add_argument("log", metavar="LOG", help="CSV log (time, WHEEL.spin, WHEEL.steer columns) or ROS 2 bag")
-    p.add_argument("--method", choices=(*METHODS, *ESTIMATOR_METHODS), default="exact",
-                   help="integration scheme of the no-slip model (default: exact), or a slip-aware estimator: "
-                        "wls (weighted least squares), fk1, fk2 (Kalman filters), see docs/slip.md")
+    p.add_argument("--method", choices=(*METHODS, *ESTIMATOR_METHODS),
+                   help="integration scheme of the no-slip model, or a slip-aware estimator: wls (weighted least "
+                        "squares), fk1, fk2 (Kalman filters), see docs/slip.md (default: the description's "
+                        "odometry.method, else exact)")
     p.add_argument("--out", metavar="FILE", help="trajectory output: .csv, .tum/.txt (TUM), else a new ROS 2 bag")
     p.add_argument("--format", dest="out_format", choices=("csv", "tum", "bag"), help="output format (default: "
                    "from the --out extension)")
@@ -57,8 +58,11 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     g.add_argument("--spin", choices=("angle", "counts", "velocity"),
                    help="spin columns: cumulative angle [rad], encoder counts, or velocity [rad/s] (default: the "
                         "header's units, e.g. 'left.spin [counts:u16]', else angle)")
-    g.add_argument("--steer", choices=("angle", "counts"),
-                   help="steer columns: angle [rad] or counts (default: the header's units, else angle)")
+    g.add_argument("--steer", choices=("angle", "degrees", "counts"),
+                   help="steer columns: angle [rad], degrees or counts (default: the header's units, else angle)")
+    g.add_argument("--steer-convention", choices=("heading", "beta"),
+                   help="steer columns hold headings (0 = straight ahead) or the thesis's beta (logs of older "
+                        "wmrkit versions; default: the header's 'steer.steer [deg:beta]', else heading)")
     g.add_argument("--cpr", type=float, help="encoder counts per revolution (default: the catalog's, if any)")
     g.add_argument("--gear", type=float, default=1.0, help="encoder revolutions per wheel revolution (default 1)")
     g.add_argument("--counter-bits", type=int, help="width of a wrapping hardware counter (default: the header's)")
@@ -81,6 +85,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Parse the options into a log format, run :func:`wmrkit.odometry.files.odometry_file`, print the summary."""
     robot = load_robot(args.robot)
+    settings = resolve_method(args)  # --method, --scheme: the options, else the description's odometry block
     if args.chunk_size < 1:
         raise WmrkitError(f"--chunk-size must be >= 1, got {args.chunk_size}")
     if not all(math.isfinite(k) and k >= 0 for k in args.crowley):
@@ -89,6 +94,8 @@ def run(args: argparse.Namespace) -> int:
     units = read_header_units(args.log) if Path(args.log).is_file() else HeaderUnits(())
     spin = merge_option("--spin", args.spin, units.spin, "angle", args.log)
     steer = merge_option("--steer", args.steer, units.steer, "angle", args.log)
+    convention = merge_option("--steer-convention", args.steer_convention, units.steer_convention, "heading",
+                              args.log)
     time_unit = merge_option("--time-unit", args.time_unit, units.time_unit, "s", args.log)
     bits = merge_option("--counter-bits", args.counter_bits, units.bits, None, args.log)
     signed = args.signed_counter or units.signed
@@ -100,10 +107,11 @@ def run(args: argparse.Namespace) -> int:
     columns = {j: renamed[j] for j in joints if j in renamed} | parse_assignments(args.column, "--column")
     fmt = LogFormat(time_column=renamed.get(args.time_column, args.time_column), time_unit=time_unit,
                     columns=tuple(columns.items()), spin=spin, steer=steer, encoders=encoders,
-                    heading_column=args.heading_column, gyro_column=args.gyro_column, max_gap=args.max_gap)
+                    heading_column=args.heading_column, gyro_column=args.gyro_column, max_gap=args.max_gap,
+                    steer_convention=convention)
     pose0 = [parse_value(args.pose[0], "length", "--pose X"), parse_value(args.pose[1], "length", "--pose Y"),
              parse_angle(args.pose[2], "--pose")]
-    slip_model = estimator_from_args(robot, args) if args.method in ESTIMATOR_METHODS else None
+    slip_model = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None
     summary = odometry_file(
         robot, args.log, fmt=fmt, method=args.scheme if slip_model is not None else args.method, pose0=pose0,
         sensed=args.sensed, model=slip_model,
@@ -151,7 +159,7 @@ def _slipping(robot, log: str, joints, fmt: LogFormat, sensed) -> str:
     if is_bag(log):
         return ""
     model = odometry_model(robot, sensed)
-    first = next(iter(read_csv(log, model.joints, fmt, wheels=robot.wheel_names, chunk_size=20_000)))
+    first = next(iter(read_csv(log, model.joints, fmt, robot=robot, chunk_size=20_000)))
     slips = sorted(wheel_slip(model, first.positions).items(), key=lambda kv: -kv[1])
     return ", ".join(f"{name} {value:.3g} m" for name, value in slips)
 

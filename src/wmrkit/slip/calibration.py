@@ -50,9 +50,19 @@ class SlipCalibration:
         """The WLS coefficients to use in ``odometry --method wls``."""
         return SlipWeights.uniform(self.ratio, 1.0)
 
+    @property
+    def description(self) -> dict:
+        """The description block that makes ``wmrkit odometry`` use the calibrated WLS (to paste into the robot's
+        description: ``odometry: {method: wls, slip: {lateral: ratio, longitudinal: 1}}``)."""
+        from .settings import OdometrySettings, settings_to_dict
+
+        return settings_to_dict(OdometrySettings(method="wls", slip=(self.ratio, 1.0)))
+
     def to_dict(self) -> dict:
-        """JSON-ready; ``weights`` is what ``wmrkit odometry --slip-weights FILE`` reads."""
-        return {"robot": self.robot, "weights": self.weights.to_dict(), "ratio": self.ratio,
+        """JSON-ready; ``weights`` is what ``wmrkit odometry --slip-weights FILE`` reads, ``description`` the block
+        for the robot's description."""
+        return {"robot": self.robot, "weights": self.weights.to_dict(), "description": self.description,
+                "ratio": self.ratio,
                 "wheel_separation_multiplier": self.multiplier,
                 "rms_position_error": dict(self.rms),
                 "final_error": {n: {"position": p, "heading": h} for n, p, h in self.final}}
@@ -63,6 +73,10 @@ class SlipCalibration:
                  f"effective track multiplier = {self.multiplier:.6g}"]
         for (name, rms), (_, p, h) in zip(self.rms, self.final, strict=True):
             lines.append(f"  {name:<16} rms position error {rms:.4g} m, final {p:.4g} m, {math.degrees(h):.3g} deg")
+        block = self.description["odometry"]
+        lines += ["to use it by default, add to the robot's description:", "odometry:",
+                  f"  method: {block['method']}",
+                  f"  slip: {{lateral: {self.ratio!r}, longitudinal: 1.0}}   # WLS friction coefficients (7.59)"]
         return "\n".join(lines)
 
 

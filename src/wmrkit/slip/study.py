@@ -2,8 +2,10 @@
 paths (WLS, FK1, FK2, differential odometry). What ``wmrkit slip-study forklift`` runs; see ``docs/slip.md``.
 
 The dynamic model (MD) is :mod:`wmrkit.dynamics` (Lagrange model, appendix 7.A1 Pacejka tyres, 1 kHz
-semi-implicit steps). Parameters the thesis leaves open are in :data:`SETTINGS` (sample period, sensor
-resolutions, filter start). Twists are compared at the drive-axle mid-point (the chapter-7 origin), in REP-103
+semi-implicit steps). On the five paths the drive wheels are driven as on the real truck, by one speed-controlled
+traction motor through an open differential (:mod:`.drivetrain`, thesis §8.6.3). Parameters the thesis leaves open
+are in :data:`SETTINGS` (sample period, sensor resolutions, filter start, loops; ``docs/slip.md`` gives the source
+or reasoning of each). Twists are compared at the drive-axle mid-point (the chapter-7 origin), in REP-103
 axes (x forward): the thesis's ``v_y`` is ``vx`` here and its ``v_x`` is ``-vy``.
 """
 
@@ -30,7 +32,13 @@ SETTINGS = {"sample_period_s": 0.05, "md_step_s": 1e-3, "encoder_counts_per_rev"
             "steer_resolution_deg": 1.4118, "example_duration_s": 10.0, "example2_torque_nm": 30.0,
             "kalman_x0": "least squares of the first interval", "kalman_p0": "Q = k13^2 I, k13 = 1",
             "wls_thesis": (3.2e-3, 19.2), "fk1_thesis": (0.31, 1.09), "fk2_thesis": (0.28, 3.57, 0.28),
-            "path_speed_m_s": 2.0}
+            # the five paths (section "Thesis 7.5 on the simulated forklift" of docs/slip.md gives the sources)
+            "path_speed_m_s": (1.8, 2.2), "drive": "differential", "traction_settling_s": 3.5,
+            "traction_overshoot": 0.15, "traction_control_period_s": 0.01, "traction_grip": 1.0,
+            "steer_settling_s": 1.5, "encoder_phase": "uniform random per run", "seed": 0,
+            "tuning_iterations": 80}
+DRIVE_MODES = ("differential", "servo")
+TUNED = ("WLS", "FK1", "FK2", "differential")  # the estimators of §7.5.4
 PATH_NAMES = ("rectangle", "corkscrew", "d", "figure-eight", "triple-loop")
 
 
@@ -118,48 +126,81 @@ def example(robot, number: int, weights: SlipWeights) -> dict:
             "_data": (sim.t, twists, sim.pose)}
 
 
-def sensor_log(robot, sim) -> JointLog:
-    """The forklift's sensors sampling a simulation: drive encoders (8290 counts/rev, floor), steering encoder
-    (1.4118 deg, nearest), at the simulation's record step."""
+def sensor_log(robot, sim, phase: tuple[float, float] = (0.0, 0.0)) -> JointLog:
+    """The forklift's sensors sampling a simulation: drive encoders (8290 counts/rev, counting from an arbitrary
+    `phase` in counts, [0, 1) each), steering encoder (1.4118 deg, absolute, nearest), at the record step."""
     names = list(sim.joint_names)
     per_count = 2 * np.pi / SETTINGS["encoder_counts_per_rev"]
     res = math.radians(SETTINGS["steer_resolution_deg"])
-    spins = np.floor(sim.joint_positions[:, [names.index(j) for j in DRIVES]] / per_count) * per_count
+    offset = np.asarray(phase, dtype=float) * per_count
+    spins = np.floor((sim.joint_positions[:, [names.index(j) for j in DRIVES]] + offset) / per_count) * per_count
     heading = robot.heading_of_beta(sim.joint_positions[:, [names.index("steer.steer")]])
     steer = robot.beta_of_heading(np.round(heading / res) * res)
     joints = odometry_model(robot).joints
     return JointLog(sim.t, joints, np.column_stack([spins, steer]), source="<forklift-sim>")
 
 
-def paths(robot, k11: float, k12: float, quick: bool = False) -> dict:
-    """The five experiment paths at 2 m/s, simulated with the MD, odometry by every estimator; J_k (7.80) against
-    the simulated final pose (open-loop programs do not close exactly)."""
+def drive_path(robot, name: str, speed: float, drive: str = "differential"):
+    """One experiment path (``wmrkit.dynamics.programs``) at `speed` simulated with the MD (module docstring of
+    :mod:`.drivetrain`): ``differential`` drives both wheels with the equal torques of one speed-controlled
+    traction motor (the forklift's drivetrain, thesis §8.6.3), ``servo`` each with its own rate servo."""
     from ..dynamics.model import DynamicModel
     from ..dynamics.programs import path_program
     from ..dynamics.simulate import simulate
+    from .drivetrain import TractionLoop, carrier_inertia, differential_joints, simulate_differential
 
+    if drive not in DRIVE_MODES:
+        raise WmrkitError(f"drive must be one of {', '.join(DRIVE_MODES)}, got '{drive}'")
     model = DynamicModel.of(robot)
-    estimators = {
-        "WLS": lambda log: odometry(wls_model(robot, forklift_weights(k11, k12)), log).poses,
-        "WLS (thesis k)": lambda log: odometry(wls_model(robot, forklift_weights(*SETTINGS["wls_thesis"])),
-                                               log).poses,
-        "FK1": lambda log: kalman_odometry(kalman_model(robot, "fk1", fk1_noise(*SETTINGS["fk1_thesis"])), log).poses,
-        "FK2": lambda log: kalman_odometry(kalman_model(robot, "fk2", fk2_noise(*SETTINGS["fk2_thesis"])), log).poses,
-        "differential": lambda log: odometry(odometry_model(robot, DRIVES), log.select(DRIVES)).poses,
-    }
+    # the steering servo is critically damped (PD of natural frequency `bandwidth`): 2 % settling in 5.83 / wn
+    inputs, duration = path_program(model, name, speed=speed, bandwidth=5.83 / SETTINGS["steer_settling_s"])
+    step, record = SETTINGS["md_step_s"], SETTINGS["sample_period_s"]
+    if drive == "servo":
+        return simulate(model, inputs, duration, step=step, record_step=record)
+    contacts = [model.contacts.index(j.partition(".")[0]) for j in differential_joints(robot)]
+    grip = SETTINGS["traction_grip"] * sum(model.normal_loads()[contacts]) * robot.wheel(DRIVES[0].split(".")[0]).r
+    loop = TractionLoop.tuned(carrier_inertia(model), SETTINGS["traction_settling_s"], SETTINGS["traction_overshoot"],
+                              grip, SETTINGS["traction_control_period_s"])
+    return simulate_differential(model, inputs, duration, loop, step=step, record_step=record)
+
+
+def paths(robot, k11: float, k12: float, quick: bool = False, *, seed: int = 0, drive: str = "differential",
+          names: tuple[str, ...] | None = None) -> dict:
+    """The five experiment paths (speeds drawn in ``SETTINGS["path_speed_m_s"]`` from `seed`, encoder phases
+    too), simulated with the MD through `drive` (:func:`drive_path`), odometry by every estimator; J_k (7.80)
+    against the simulated final pose (open-loop programs do not close exactly), with the thesis's parameters and
+    tuned on these runs as the thesis did (``optimised``); ``ranking``: the thesis's finding checked on both."""
+    estimators = {"WLS": estimator_poses(robot, "WLS", (k11, k12)),
+                  "WLS (thesis k)": estimator_poses(robot, "WLS", SETTINGS["wls_thesis"]),
+                  **{k: estimator_poses(robot, k, SETTINGS.get(f"{k.lower()}_thesis", ())) for k in TUNED[1:]}}
     out, data, logs = {}, {}, []
-    for name in PATH_NAMES[:2] if quick else PATH_NAMES:
-        inputs, duration = path_program(model, name, speed=SETTINGS["path_speed_m_s"])
-        sim = simulate(model, inputs, duration, step=SETTINGS["md_step_s"], record_step=SETTINGS["sample_period_s"])
-        log = sensor_log(robot, sim)
+    rng = np.random.default_rng(seed)
+    for name in names or (PATH_NAMES[:2] if quick else PATH_NAMES):
+        speed, phase = float(rng.uniform(*SETTINGS["path_speed_m_s"])), tuple(rng.uniform(0.0, 1.0, 2))
+        sim = drive_path(robot, name, speed, drive)
+        log = sensor_log(robot, sim, phase)
         logs.append((log, np.asarray(sim.pose[-1])))
         est = {k: f(log) for k, f in estimators.items()}
         jk = {k: float(sum(closure_error(p, sim.pose[-1])) / 2) for k, p in est.items()}
         final = {k: float(np.hypot(*(p[-1, :2] - sim.pose[-1, :2]))) for k, p in est.items()}
-        out[name] = {"J_k": jk, "final_position_error_m": final}
-        data[name] = {"truth (MD)": np.asarray(sim.pose), **est}
+        out[name] = {"J_k": jk, "final_position_error_m": final, "speed_m_s": speed}
+        data[name] = {"truth (MD)": np.asarray(sim.pose)}
     mean = {k: float(np.mean([v["J_k"][k] for v in out.values()])) for k in estimators}
-    return {"runs": out, "mean_J_k": mean, "optimised": optimise(robot, logs, 25 if quick else 80), "_data": data}
+    opt = optimise(robot, logs, 25 if quick else SETTINGS["tuning_iterations"])
+    for name, (log, _) in zip(data, logs, strict=True):  # the figures: tuned estimators, as Figs 7.19-7.23
+        data[name] |= {f"{k} (tuned)" if v["params"] else k: estimator_poses(robot, k, v["params"])(log)
+                       for k, v in opt.items()}
+    ranking = {"thesis parameters": _ranking({k: mean[k] for k in ("WLS (thesis k)", "FK1", "FK2", "differential")}),
+               "tuned": _ranking({k: v["J_k"] for k, v in opt.items()})}
+    return {"runs": out, "mean_J_k": mean, "optimised": opt, "ranking": ranking, "drive": drive, "seed": seed,
+            "_data": data}
+
+
+def _ranking(jk: dict) -> dict:
+    """The thesis's finding (§7.5.4) on mean J_k values: WLS and FK2 both better than FK1 and differential."""
+    wls_key = next(k for k in jk if k.startswith("WLS"))
+    best, rest = max(jk[wls_key], jk["FK2"]), min(jk["FK1"], jk["differential"])
+    return {"order": sorted(jk, key=jk.get), "reproduced": bool(best < rest), "margin": float(rest / best)}
 
 
 def optimise(robot, logs: list, maxiter: int) -> dict:
@@ -170,37 +211,44 @@ def optimise(robot, logs: list, maxiter: int) -> dict:
     def mean_jk(poses_of) -> float:
         return float(np.mean([sum(closure_error(poses_of(log), final)) / 2 for log, final in logs]))
 
-    makers = {
-        "WLS": (SETTINGS["wls_thesis"], lambda k: lambda log: odometry(wls_model(robot, forklift_weights(*k)),
-                                                                       log).poses),
-        "FK1": (SETTINGS["fk1_thesis"], lambda k: lambda log: kalman_odometry(
-            kalman_model(robot, "fk1", fk1_noise(*k)), log).poses),
-        "FK2": (SETTINGS["fk2_thesis"], lambda k: lambda log: kalman_odometry(
-            kalman_model(robot, "fk2", fk2_noise(*k)), log).poses),
-    }
     out = {}
-    for name, (start, make) in makers.items():
-        fit = minimize(lambda p, make=make: mean_jk(make(10.0 ** p)), np.log10(start), method="Nelder-Mead",
+    for name in TUNED[:3]:
+        fit = minimize(lambda p, name=name: mean_jk(estimator_poses(robot, name, 10.0 ** p)),
+                       np.log10(SETTINGS[f"{name.lower()}_thesis"]), method="Nelder-Mead",
                        options={"maxiter": maxiter, "xatol": 1e-3, "fatol": 1e-7})
         out[name] = {"params": [float(v) for v in 10.0 ** fit.x], "J_k": float(fit.fun)}
-    out["differential"] = {"params": [], "J_k": mean_jk(
-        lambda log: odometry(odometry_model(robot, DRIVES), log.select(DRIVES)).poses)}
+    out["differential"] = {"params": [], "J_k": mean_jk(estimator_poses(robot, "differential", ()))}
     return out
 
 
-def forklift_study(report: str | os.PathLike[str] | None = None, quick: bool = False) -> dict:
-    """Everything of §7.5 the simulator allows (module docstring); figures into `report` when given."""
+def estimator_poses(robot, name: str, params):
+    """``log -> poses (N, 3)`` of estimator `name` (:data:`TUNED`) with the thesis's parameters `params`:
+    WLS (k11, k12) (7.67), FK1 (k14, k15), FK2 (k16, k17, k18) (7.77), differential odometry (7.79) (none)."""
+    k = tuple(float(v) for v in params)
+    if name == "WLS":
+        return lambda log: odometry(wls_model(robot, forklift_weights(*k)), log).poses
+    if name in ("FK1", "FK2"):
+        noise = fk1_noise(*k) if name == "FK1" else fk2_noise(*k)
+        return lambda log: kalman_odometry(kalman_model(robot, name.lower(), noise), log).poses
+    return lambda log: odometry(odometry_model(robot, DRIVES), log.select(DRIVES)).poses
+
+
+def forklift_study(report: str | os.PathLike[str] | None = None, quick: bool = False, *, seed: int = 0,
+                   drive: str = "differential") -> dict:
+    """Everything of §7.5 the simulator allows (module docstring); figures into `report` when given; `seed` and
+    `drive` as in :func:`paths`."""
     robot = catalog.load("forklift")
     if robot.body is None or any(w.tyre is None for w in robot.wheels):
         raise WmrkitError("the catalog forklift lacks mass properties or tyres")
     sw = sweep(robot, quick)
     weights = forklift_weights(sw["k11"], sw["k12"])
     examples = [example(robot, n, weights) for n in (1, 2)]
-    pth = paths(robot, sw["k11"], sw["k12"], quick)
+    pth = paths(robot, sw["k11"], sw["k12"], quick, seed=seed, drive=drive)
     figures = [] if report is None else _figures(report, sw, examples, pth)
     strip = lambda d: {k: v for k, v in d.items() if not k.startswith("_")}  # noqa: E731
     return {"settings": SETTINGS, "sweep": strip(sw), "examples": [strip(e) for e in examples],
-            "paths": {**pth["runs"], "mean_J_k": pth["mean_J_k"], "optimised": pth["optimised"]},
+            "paths": {**pth["runs"], "mean_J_k": pth["mean_J_k"], "optimised": pth["optimised"],
+                      "ranking": pth["ranking"], "drive": drive, "seed": seed},
             "figures": figures}
 
 
@@ -212,11 +260,14 @@ def format_study(result: dict) -> str:
     for e in result["examples"]:
         lines.append(f"example {e['example']}: " + ", ".join(f"J_{m} = {v:.3g} %" for m, v in e["J_percent"].items()))
     for name, run in result["paths"].items():
-        if name not in ("mean_J_k", "optimised"):
+        if isinstance(run, dict) and "J_k" in run:
             lines.append(f"{name}: " + ", ".join(f"{k} {100 * v:.3g} %" for k, v in run["J_k"].items()))
     lines.append("mean J_k: " + ", ".join(f"{k} {100 * v:.3g} %" for k, v in result["paths"]["mean_J_k"].items()))
     lines.append("optimised mean J_k: " + ", ".join(f"{k} {100 * v['J_k']:.3g} %"
                                                     for k, v in result["paths"]["optimised"].items()))
+    for what, r in result["paths"]["ranking"].items():
+        lines.append(f"ranking ({what}): {' < '.join(r['order'])}; WLS and FK2 better than FK1 and differential: "
+                     f"{'yes' if r['reproduced'] else 'no'} (margin x{r['margin']:.3g})")
     return "\n".join(lines)
 
 

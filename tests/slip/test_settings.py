@@ -1,0 +1,154 @@
+"""Slip weights and Kalman noise in robot descriptions: parsing, errors, the CLI's precedence, and the round trip
+``wmrkit calibrate`` -> description -> ``wmrkit odometry``."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import yaml
+
+from wmrkit import DescriptionError, catalog
+from wmrkit.cli.main import main
+from wmrkit.description import robot_from_text
+from wmrkit.odometry.logs import write_csv
+from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+from wmrkit.slip.settings import OdometrySettings, odometry_settings, settings_to_dict
+from wmrkit.slip.synthetic import wheel_speed_run
+from wmrkit.slip.weights import SlipWeights
+
+SKID = yaml.safe_load(catalog.source_text("skid-steer-4"))
+SEGMENTS = [(3.0, [8, 12, 8, 12]), (2.0, [10, 10, 10, 10]), (3.0, [12, 8, 12, 8]), (2.0, [6, 14, 6, 14])]
+
+
+def _skid(odometry=None, wheel_slip=None) -> dict:
+    data = json.loads(json.dumps(SKID))
+    if odometry is not None:
+        data["odometry"] = odometry
+    if wheel_slip is not None:
+        data["wheels"][1]["slip"] = wheel_slip
+    return data
+
+
+def _write(tmp_path, data, name="robot.yaml"):
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def test_settings_read_from_the_description(tmp_path):
+    path = _write(tmp_path, _skid({"method": "fk2", "scheme": "rk2", "slip": {"lateral": 0.5, "longitudinal": 2},
+                                   "noise": {"process": 3, "lateral": 0.1}},
+                                  {"lateral": 4, "longitudinal": 1, "noise": {"lateral": 0.2, "longitudinal": 0.3}}))
+    s = odometry_settings(str(path))
+    assert (s.method, s.scheme, s.slip, s.noise) == ("fk2", "rk2", (0.5, 2.0), (3.0, 0.1, 1.0))
+    assert s.wheel_slip == (("front_right", 4.0, 1.0),) and s.wheel_noise == (("front_right", 0.2, 0.3),)
+    w = s.weights()
+    assert w.of_wheel("front_right") == (4.0, 1.0) and w.of_wheel("rear_left") == (0.5, 2.0)
+    n = s.kalman_noise()
+    assert (n.process, n.of_wheel("front_right"), n.of_wheel("front_left")) == (3.0, (0.2, 0.3), (0.1, 1.0))
+    # written back and read again: the same settings
+    back = _skid()
+    block = settings_to_dict(s)
+    back["odometry"] = block["odometry"]
+    for wheel in back["wheels"]:
+        wheel.update(block["wheels"].get(wheel["name"], {}))
+    assert odometry_settings(str(_write(tmp_path, back, "back.yaml"))) == s
+    assert odometry_settings("skid-steer-4") == OdometrySettings()
+
+
+@pytest.mark.parametrize(("odometry", "wheel_slip", "message"), [
+    ({"method": "wsl"}, None, "odometry.method: must be one of exact, rk2, euler, paper002, wls, fk1, fk2, got 'wsl'"),
+    ({"slip": {"lateral": 1}}, None, "odometry.slip: missing field 'longitudinal'"),
+    ({"noise": {"process": 0}}, None, "odometry.noise.process: must be a number > 0, got 0.0"),
+    ({"nosie": 1}, None, "odometry.nosie: unknown field 'nosie' (did you mean 'noise'?)"),
+    ("wls", None, "odometry: must be a mapping"),
+    (None, {"lateral": -1, "longitudinal": 1}, "wheels[1].slip.lateral: must be a number > 0, got -1.0"),
+    (None, {"lateral": 1, "longitudinal": float("nan")}, "wheels[1].slip.longitudinal: must be finite"),
+    (None, {"lateral": 1, "longitudinal": 1, "noise": {"lateral": 1}},
+     "wheels[1].slip.noise: missing field 'longitudinal'"),
+    (None, {"lateral": "1 m", "longitudinal": 1}, "wheels[1].slip.lateral: '1 m' is a length, expected a number"),
+    (None, {"lat": 1}, "wheels[1].slip.lat: unknown field 'lat' (did you mean 'lateral'?)"),
+])
+def test_errors_name_the_file_line_wheel_and_field(odometry, wheel_slip, message):
+    text = yaml.safe_dump(_skid(odometry, wheel_slip), sort_keys=False)
+    with pytest.raises(DescriptionError) as err:
+        robot_from_text(text, source="robot.yaml")
+    line = str(err.value)
+    assert "\n" not in line and line.startswith("robot.yaml:") and message in line
+    assert err.value.line is not None
+    key = next(k for k in reversed(err.value.loc) if isinstance(k, str))
+    assert f"{key}:" in text.splitlines()[err.value.line - 1]
+
+
+@pytest.fixture(scope="module")
+def husky_files(tmp_path_factory):
+    run = wheel_speed_run(catalog.load("skid-steer-4"), SEGMENTS, 20.0, model="mqe")
+    d = tmp_path_factory.mktemp("husky")
+    write_csv(d / "log.csv", ("time", *run.log.joints), np.column_stack([run.log.time, run.log.positions]))
+    write_trajectory(d / "ref.tum", Trajectory(run.log.time, run.truth, np.zeros(len(run.log))), "tum")
+    return d, run
+
+
+def _pose(capsys, argv) -> list[float]:
+    assert main(argv) == 0
+    return json.loads(capsys.readouterr().out)["pose"]
+
+
+def test_calibrate_description_odometry_round_trip(husky_files, capsys, tmp_path):
+    """calibrate's description block pasted into the description makes plain ``odometry`` the calibrated WLS:
+    the same poses as the options, far closer to the truth than the no-slip model; options override it."""
+    d, run = husky_files
+    log = str(d / "log.csv")
+    assert main(["calibrate", "skid-steer-4", log, "--reference", str(d / "ref.tum"), "--json"]) == 0
+    cal = json.loads(capsys.readouterr().out)
+    assert cal["description"] == {"odometry": {"method": "wls", "slip": {"lateral": cal["ratio"],
+                                                                         "longitudinal": 1.0}}}
+    (tmp_path / "w.json").write_text(json.dumps(cal))
+    robot = _write(tmp_path, _skid() | cal["description"])
+    described = _pose(capsys, ["odometry", str(robot), log, "--json"])
+    options = _pose(capsys, ["odometry", "skid-steer-4", log, "--method", "wls", "--slip-weights",
+                             str(tmp_path / "w.json"), "--json"])
+    plain = _pose(capsys, ["odometry", "skid-steer-4", log, "--json"])
+    overridden = _pose(capsys, ["odometry", str(robot), log, "--method", "exact", "--json"])
+    assert np.allclose(described, options, atol=1e-12)
+    assert np.allclose(overridden, plain, atol=1e-12)
+    truth = run.truth[-1, :2]
+    assert np.hypot(*(np.array(described[:2]) - truth)) < 0.2 < np.hypot(*(np.array(plain[:2]) - truth))
+    # --mu-default overrides the described coefficients: unit weights are the unweighted least squares
+    unit = _pose(capsys, ["odometry", str(robot), log, "--mu-default", "1,1", "--json"])
+    assert np.allclose(unit, plain, atol=1e-9)
+    # the text output prints the same block, ready to paste
+    assert main(["calibrate", "skid-steer-4", log, "--reference", str(d / "ref.tum")]) == 0
+    text = capsys.readouterr().out
+    block = yaml.safe_load(text[text.index("odometry:"):])
+    assert block["odometry"]["method"] == "wls"
+    assert block["odometry"]["slip"] == {"lateral": cal["ratio"], "longitudinal": 1.0}
+
+
+def test_described_kalman_noise_is_used_and_options_override_it(husky_files, capsys, tmp_path):
+    d, _ = husky_files
+    log = str(d / "log.csv")
+    robot = _write(tmp_path, _skid({"method": "fk2", "noise": {"process": 0.5, "lateral": 0.05, "longitudinal": 2}}))
+    described = _pose(capsys, ["odometry", str(robot), log, "--json"])
+    options = _pose(capsys, ["odometry", "skid-steer-4", log, "--method", "fk2", "--kf-noise", "0.5", "0.05", "2",
+                             "--json"])
+    default = _pose(capsys, ["odometry", "skid-steer-4", log, "--method", "fk2", "--json"])
+    overridden = _pose(capsys, ["odometry", str(robot), log, "--kf-noise", "1", "1", "1", "--json"])
+    assert np.allclose(described, options, atol=1e-12) and np.allclose(overridden, default, atol=1e-12)
+    assert not np.allclose(described, default, atol=1e-3)
+
+
+def test_cli_reports_description_errors(tmp_path, capsys, husky_files):
+    d, _ = husky_files
+    robot = _write(tmp_path, _skid(None, {"lateral": 0, "longitudinal": 1}))
+    assert main(["odometry", str(robot), str(d / "log.csv")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wmrkit: error: ") and "wheels[1].slip.lateral: must be a number > 0" in err
+    assert err.count("\n") == 1
+
+
+def test_weights_of_settings_are_slip_weights():
+    s = OdometrySettings(slip=(2.0, 1.0), wheel_slip=(("a", 1.0, 3.0),))
+    assert s.weights() == SlipWeights.of({"a": (1.0, 3.0)}, (2.0, 1.0))
