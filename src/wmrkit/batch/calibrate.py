@@ -6,37 +6,51 @@ residuals of the runs are computed on the engine (runs split into one task per w
 logs uses the cluster, and the result carries confidence intervals:
 
 - ``ci="jacobian"``: from the least-squares Jacobian at the solution (first order), with the covariance
-  clustered by run (the "sandwich" estimator): errors along one trajectory accumulate, so its residuals are
-  correlated and the textbook ``s^2 (J^T J)^-1`` is far too narrow (tested); runs are independent;
+  clustered by run in its jackknife form (:func:`_sandwich_interval`): errors along one trajectory accumulate,
+  so its residuals are correlated and the textbook ``s^2 (J^T J)^-1`` is far too narrow (tested); runs are
+  independent; the 95 % intervals cover the truth in 90-99 % of 200 synthetic fleets (tested);
 - ``ci="bootstrap"``: runs resampled with replacement, one refit per replicate (a task each), percentile
   intervals; needs no linearity and captures run-to-run variation (e.g. floors, loads).
 
-Hook for slip weights: ``run_weights(run) -> (M,)`` multiplies the residuals of each referenced sample (e.g.
-down-weights samples where a slip detector fires); the slip package plugs in there. Default: uniform.
+Hook for sample weights: ``run_weights(run) -> (M,)`` multiplies the residuals of each referenced sample (e.g.
+down-weights samples where a slip detector fires). Default: uniform. The residuals and the solver are those of
+the single-log fit (:class:`~wmrkit.odometry.calibration.CalibrationProblem`, its ``residuals`` and
+:func:`~wmrkit.odometry.calibration.solve`): one implementation, mapped over many logs here.
+
+Slip weights of a fleet (:func:`fleet_slip_calibrate`): the slip calibration of one log
+(:func:`wmrkit.slip.calibration.calibrate_slip`: the WLS friction ratio and the effective-track multiplier) run on
+every log on the engine, combined as a geometric mean with a Student-t interval over the logs.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..odometry.calibration import CalibrationRun, Parameter, apply_parameters
+from ..odometry.calibration import (
+    CalibrationProblem,
+    CalibrationRun,
+    Parameter,
+    RunWeights,
+    apply_parameters,
+    rms,
+    solve,
+)
 from ..robot import Robot
 from .engine import BatchError, Engine, engine
-
-RunWeights = Callable[[CalibrationRun], np.ndarray]
 
 
 @dataclass(frozen=True)
 class FleetCalibration:
     """A fleet fit: the calibrated ``robot``; per parameter ``estimate`` ``p`` and its ``interval`` ``(low,
     high)``; per wheel field ``values``: ``(name, nominal, fitted, low, high)`` [m or rad] at confidence
-    ``level``; residual RMS before and after; ``runs``, ``residuals`` counts; ``ci`` the interval method."""
+    ``level``; residual RMS before and after; ``runs``, ``residuals`` counts; ``ci`` the interval method;
+    ``warnings``: runs whose data do not fit the method (e.g. a closed path cut short)."""
 
     robot: Robot
     parameters: tuple[tuple[str, ...], ...]
@@ -50,6 +64,7 @@ class FleetCalibration:
     ci: str
     level: float
     success: bool
+    warnings: tuple[str, ...] = ()
 
     def value(self, name: str) -> tuple[float, float, float]:
         """``(fitted, low, high)`` of the wheel field `name`."""
@@ -62,57 +77,26 @@ class FleetCalibration:
         """JSON-ready mapping."""
         return {"robot": self.robot.name, "ci": self.ci, "level": self.level, "runs": self.runs,
                 "residuals": self.residuals, "rms_before": self.rms_before, "rms_after": self.rms_after,
-                "success": self.success,
+                "success": self.success, "warnings": list(self.warnings),
                 "parameters": [{"group": list(g), "p": p, "low": lo, "high": hi}
                                for g, p, (lo, hi) in zip(self.parameters, self.estimate, self.interval, strict=True)],
                 "values": [{"field": n, "nominal": a, "fitted": v, "low": lo, "high": hi}
                            for n, a, v, lo, hi in self.values]}
 
 
-@dataclass(frozen=True)
-class _Task:
-    robot: Robot
-    parameters: tuple[Parameter, ...]
-    runs: tuple[CalibrationRun, ...]
-    method: str
-    heading_weight: float
-    sensed: tuple[str, ...] | None
-    weights: Mapping[str, float] | None
-    run_weights: RunWeights | None
+def _residuals_of(args: tuple[CalibrationProblem, np.ndarray]) -> np.ndarray:
+    problem, p = args
+    return problem.residuals(p)
 
 
-def run_residuals(task: _Task, p: np.ndarray) -> np.ndarray:
-    """Residuals of `task`'s runs at parameters `p` (those of :func:`wmrkit.odometry.calibration.calibrate`:
-    ``x, y`` error [m] and ``heading_weight`` times the wrapped heading error per referenced sample), each
-    sample's three scaled by the run weight."""
-    from ..odometry.model import odometry_model, wrap_angle
-    from ..odometry.pipeline import odometry
-
-    model = odometry_model(apply_parameters(task.robot, task.parameters, p), task.sensed, weights=task.weights)
-    out = []
-    for run in task.runs:
-        poses = odometry(model, run.log, method=task.method, pose0=run.start()).poses[run.samples()]
-        err = poses - np.asarray(run.reference, dtype=float).reshape(-1, 3)
-        err[:, 2] = task.heading_weight * wrap_angle(err[:, 2])
-        if task.run_weights is not None:
-            err *= np.asarray(task.run_weights(run), dtype=float).reshape(-1, 1)
-        out.append(err.ravel())
-    return np.concatenate(out) if out else np.zeros(0)
+def _jacobian_of(args: tuple[CalibrationProblem, np.ndarray, np.ndarray]) -> np.ndarray:
+    problem, p, r = args
+    return problem.jacobian(p, r)
 
 
-def _residuals_of(args: tuple[_Task, np.ndarray]) -> np.ndarray:
-    return run_residuals(*args)
-
-
-def _fit(n: int, residuals: Callable[[np.ndarray], np.ndarray]):
-    from scipy.optimize import least_squares
-
-    return least_squares(residuals, np.zeros(n), method="lm", x_scale=1e-2, xtol=1e-14, ftol=1e-14)
-
-
-def _refit(task: _Task) -> np.ndarray:
-    """A bootstrap replicate: the fit over `task`'s runs, in one process."""
-    return _fit(len(task.parameters), lambda p: run_residuals(task, p)).x
+def _refit(problem: CalibrationProblem) -> np.ndarray:
+    """A bootstrap replicate: the fit over `problem`'s runs, in one process."""
+    return problem.fit()
 
 
 def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence[Parameter], *,
@@ -129,44 +113,59 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
         raise BatchError(f"confidence level must be in (0, 1), got {level}")
     params = tuple(parameters)
     apply_parameters(robot, params, np.zeros(len(params)))  # names checked here, in the caller's process
+    problem = CalibrationProblem(robot, params, tuple(runs), method, heading_weight,
+                                 None if sensed is None else tuple(sensed), weights, run_weights)
     own = runner is None
     runner = engine(workers=0) if runner is None else runner
     try:
-        make = lambda rs: _Task(robot, params, tuple(rs), method, heading_weight,  # noqa: E731
-                                None if sensed is None else tuple(sensed), weights, run_weights)
         k = max(min(runner.workers, len(runs)), 1)
-        tasks = [make(runs[i::k]) for i in range(k)]
+        tasks = [problem.with_runs(runs[i::k]) for i in range(k)]
+        sizes = [t.sizes() for t in tasks]
+        shared = [runner.share(t) for t in tasks]  # the logs travel to the workers once, not at every evaluation
         order = np.argsort(np.concatenate([np.arange(len(runs))[i::k] for i in range(k)]), kind="stable")
 
+        def gather(parts: list[np.ndarray]) -> np.ndarray:
+            """Per-task rows (runs i, i + k, ...) -> rows in run order."""
+            per_run = [r for size, part in zip(sizes, parts, strict=True) for r in np.split(part, np.cumsum(size)[:-1])]
+            return np.concatenate([per_run[i] for i in order])
+
         def residuals(p: np.ndarray) -> np.ndarray:
-            parts = runner.map(_residuals_of, [(t, p) for t in tasks])
-            per_run = [r.reshape(-1, 3) for t, part in zip(tasks, parts, strict=True)
-                       for r in np.split(part, np.cumsum([3 * len(run.samples()) for run in t.runs])[:-1])]
-            return np.concatenate([per_run[i].ravel() for i in order])
+            return gather(runner.map(_residuals_of, [(t, p) for t in shared]))
+
+        def jacobian(p: np.ndarray, r: np.ndarray | None) -> np.ndarray:
+            """One round trip: each worker differentiates its own runs (their rows depend on them alone)."""
+            if r is None:
+                r = residuals(p)
+            runs_r = np.split(r, np.cumsum(problem.sizes())[:-1])
+            mine = [np.concatenate([runs_r[j] for j in range(i, len(runs), k)]) for i in range(k)]
+            return gather(runner.map(_jacobian_of, [(t, p, ri) for t, ri in zip(shared, mine, strict=True)]))
 
         r0 = residuals(np.zeros(len(params)))
         m, n = r0.size, len(params)
         if m <= n:
             raise BatchError(f"calibrate: {m} residuals cannot fix {n} parameters with an interval; add runs")
-        fit = _fit(n, residuals)
+        fit = solve(residuals, n, jacobian=jacobian)
         if ci == "jacobian":
-            lo, hi = _sandwich_interval(fit, [3 * len(run.samples()) for run in runs], level)
+            lo, hi = _sandwich_interval(fit, problem.sizes(), level)
         else:
             rng = np.random.default_rng(seed)
             picks = [rng.integers(0, len(runs), len(runs)) for _ in range(n_boot)]
-            reps = np.array(runner.map(_refit, [make([runs[i] for i in pick]) for pick in picks],
+            reps = np.array(runner.map(_refit, [problem.with_runs([runs[i] for i in pick]) for pick in picks],
                                        progress=progress, desc="bootstrap"))
             lo, hi = np.quantile(reps, 0.5 - level / 2, axis=0), np.quantile(reps, 0.5 + level / 2, axis=0)
     finally:
         if own:
             runner.close()
-    return _result(robot, params, fit, lo, hi, r0, len(runs), ci, level)
+    return _result(problem, fit, lo, hi, r0, ci, level)
 
 
 def _sandwich_interval(fit, sizes: Sequence[int], level: float) -> tuple[np.ndarray, np.ndarray]:
-    """Interval from the least-squares Jacobian with the run-clustered ("sandwich") covariance
-    ``(J^T J)^-1 (sum_g J_g^T r_g r_g^T J_g) (J^T J)^-1 G / (G - 1)``: the errors along one trajectory accumulate
-    (they are correlated), runs are independent; Student's t with ``G - 1`` degrees of freedom."""
+    """Interval from the least-squares Jacobian with the run-clustered ("sandwich") covariance in its jackknife
+    form (CR3): ``(G-1)/G sum_g d_g d_g^T`` with ``d_g = (J^T J - J_g^T J_g)^-1 J_g^T r_g``, the linearised change
+    of the estimate when run ``g`` is left out. The errors along one trajectory accumulate (they are correlated),
+    runs are independent; Student's t with ``G - 1`` degrees of freedom. The plain clustered form ``(J^T J)^-1
+    (sum_g J_g^T r_g r_g^T J_g) (J^T J)^-1 G/(G-1)`` (CR1) covered a track error in only 84-87 % of 200 fleets of
+    6-8 runs at 95 %; this one covers 92-97 % (tested)."""
     from scipy import stats
 
     g = len(sizes)
@@ -176,31 +175,111 @@ def _sandwich_interval(fit, sizes: Sequence[int], level: float) -> tuple[np.ndar
     if np.linalg.cond(jtj) > 1e14:
         raise BatchError("calibrate: the runs cannot tell these parameters apart (singular Jacobian); add runs "
                          "of other shapes or fit fewer parameters")
-    bread = np.linalg.inv(jtj)
-    scores = np.array([fit.jac[a:b].T @ fit.fun[a:b] for a, b in zip(np.cumsum([0, *sizes[:-1]]), np.cumsum(sizes),
-                                                                         strict=True)])
-    cov = bread @ (scores.T @ scores) @ bread * g / (g - 1)
+    change = []
+    for k, (a, b) in enumerate(zip(np.cumsum([0, *sizes[:-1]]), np.cumsum(sizes), strict=True)):
+        jg = fit.jac[a:b]
+        rest = jtj - jg.T @ jg
+        if np.linalg.cond(rest) > 1e14:
+            raise BatchError(f"calibrate: without run {k + 1} the other runs cannot tell these parameters apart, so "
+                             f"the interval cannot be estimated; add runs (closed squares: two in each direction)")
+        change.append(np.linalg.solve(rest, jg.T @ fit.fun[a:b]))
+    change = np.array(change)
+    cov = change.T @ change * (g - 1) / g
     half = float(stats.t.ppf(0.5 + level / 2, g - 1)) * np.sqrt(np.diag(cov))
     return fit.x - half, fit.x + half
 
 
-def _result(robot: Robot, params, fit, lo, hi, r0, n_runs: int, ci: str, level: float) -> FleetCalibration:
-    calibrated = apply_parameters(robot, params, fit.x)
+def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float) -> FleetCalibration:
+    robot, params = problem.robot, problem.parameters
     values = []
     for k, group in enumerate(params):
-        at_lo = apply_parameters(robot, params, np.where(np.arange(len(params)) == k, lo[k], fit.x))
-        at_hi = apply_parameters(robot, params, np.where(np.arange(len(params)) == k, hi[k], fit.x))
-        for signed in (group,) if isinstance(group, str) else group:
-            name = signed.lstrip("-")
-            wheel, _, fld = name.partition(".")
-            ends = sorted((float(getattr(at_lo.wheel(wheel), fld)), float(getattr(at_hi.wheel(wheel), fld))))
-            values.append((name, float(getattr(robot.wheel(wheel), fld)), float(getattr(calibrated.wheel(wheel), fld)),
-                           *ends))
-    rms = lambda r: float(np.sqrt(np.mean(r * r)))  # noqa: E731
+        mine = [(name, nominal, fitted) for name, nominal, fitted in problem.values(fit.x)
+                if name in {g.lstrip("-") for g in ((group,) if isinstance(group, str) else group)}]
+        ends = [problem.values(np.where(np.arange(len(params)) == k, e[k], fit.x)) for e in (lo, hi)]
+        for name, nominal, fitted in mine:
+            a, b = (next(v for n, _, v in end if n == name) for end in ends)
+            values.append((name, nominal, fitted, min(a, b), max(a, b)))
     groups = tuple((g,) if isinstance(g, str) else tuple(g) for g in params)
-    return FleetCalibration(calibrated, groups, tuple(map(float, fit.x)),
+    return FleetCalibration(apply_parameters(robot, params, fit.x), groups, tuple(map(float, fit.x)),
                             tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True)), tuple(values),
-                            rms(r0), rms(fit.fun), n_runs, int(r0.size), ci, level, bool(fit.success))
+                            rms(r0), rms(fit.fun), len(problem.runs), int(r0.size), ci, level, bool(fit.success),
+                            problem.warnings())
+
+
+@dataclass(frozen=True)
+class FleetSlipCalibration:
+    """Slip weights of a fleet: the WLS friction ratio ``mu_lateral / mu_longitudinal`` and the effective-track
+    multiplier, each the geometric mean over the runs with its interval at ``level`` (Student's t over the runs'
+    log values: run-to-run variation, e.g. floors and loads); ``per_run``: ``(ratio, multiplier)`` of each run."""
+
+    robot: str
+    ratio: float
+    ratio_interval: tuple[float, float]
+    multiplier: float
+    multiplier_interval: tuple[float, float]
+    per_run: tuple[tuple[float, float], ...]
+    level: float
+
+    @property
+    def weights(self):
+        """The WLS coefficients to use in ``odometry --method wls`` (:class:`wmrkit.slip.SlipWeights`)."""
+        from ..slip.weights import SlipWeights
+
+        return SlipWeights.uniform(self.ratio, 1.0)
+
+    def format(self) -> str:
+        """Human-readable summary."""
+        return (f"robot {self.robot}: {len(self.per_run)} runs; {self.level:.0%} intervals\n"
+                f"  WLS mu_lateral / mu_longitudinal  {self.ratio:.6g}  [{self.ratio_interval[0]:.6g}, "
+                f"{self.ratio_interval[1]:.6g}]\n"
+                f"  effective track multiplier        {self.multiplier:.6g}  [{self.multiplier_interval[0]:.6g}, "
+                f"{self.multiplier_interval[1]:.6g}]")
+
+    def to_dict(self) -> dict:
+        """JSON-ready; ``weights`` is what ``wmrkit odometry --slip-weights FILE`` reads."""
+        return {"robot": self.robot, "weights": self.weights.to_dict(), "level": self.level, "runs": len(self.per_run),
+                "ratio": self.ratio, "ratio_interval": list(self.ratio_interval),
+                "wheel_separation_multiplier": self.multiplier, "multiplier_interval": list(self.multiplier_interval),
+                "per_run": [{"ratio": k, "wheel_separation_multiplier": m} for k, m in self.per_run]}
+
+
+def _slip_of(args: tuple) -> tuple[float, float]:
+    from ..slip.calibration import calibrate_slip
+
+    robot, run, method, heading_weight = args
+    at, ref = run.samples(), np.asarray(run.reference, dtype=float).reshape(-1, 3)
+    if at[0] != 0:  # the start pose is a reference pose too (a closed path's only other one)
+        at, ref = np.concatenate([[0], at]), np.vstack([run.start()[None], ref])
+    cal = calibrate_slip(robot, run.log, (run.log.time[at], ref), method=method, heading_weight=heading_weight)
+    return cal.ratio, cal.multiplier
+
+
+def fleet_slip_calibrate(robot: Robot, runs: Sequence[CalibrationRun], *, runner: Engine | None = None,
+                         level: float = 0.95, method: str = "exact", heading_weight: float = 1.0,
+                         progress: bool = False) -> FleetSlipCalibration:
+    """Slip weights of `robot` from many `runs` (module docstring): :func:`wmrkit.slip.calibration.calibrate_slip`
+    on each run, on the engine, then the geometric mean over the runs and its Student-t interval at `level`."""
+    from scipy import stats
+
+    if len(runs) < 2:
+        raise BatchError("calibrate: slip weights with an interval need at least two runs")
+    if not 0 < level < 1:
+        raise BatchError(f"confidence level must be in (0, 1), got {level}")
+    own = runner is None
+    runner = engine(workers=0) if runner is None else runner
+    try:
+        per_run = runner.map(_slip_of, [(robot, run, method, heading_weight) for run in runs], progress=progress,
+                             desc="slip")
+    finally:
+        if own:
+            runner.close()
+    logs = np.log(np.array(per_run, dtype=float))  # (G, 2)
+    g = len(per_run)
+    half = float(stats.t.ppf(0.5 + level / 2, g - 1)) * logs.std(axis=0, ddof=1) / np.sqrt(g)
+    mean = logs.mean(axis=0)
+    lo, hi, mid = np.exp(mean - half), np.exp(mean + half), np.exp(mean)
+    return FleetSlipCalibration(robot.name, float(mid[0]), (float(lo[0]), float(hi[0])), float(mid[1]),
+                                (float(lo[1]), float(hi[1])), tuple((float(k), float(m)) for k, m in per_run), level)
 
 
 def default_parameters(robot: Robot, *, closed: bool) -> list[Parameter]:
@@ -232,11 +311,12 @@ def load_run(robot: Robot, path: str, *, reference: str | os.PathLike[str] | Non
         from ..odometry.bags import read_joint_states
 
         log = concatenate(list(read_joint_states(path, joints, topic=options.get("topic", "/joint_states"),
-                                                 names=options.get("joint_names"))))
+                                                 names=options.get("joint_names"), robot=robot)))
     else:
-        log = load_csv(path, joints, options["fmt"]) if "fmt" in options else load_csv(path, joints)
+        fmt = options.get("fmt")
+        log = load_csv(path, joints, fmt, robot=robot) if fmt is not None else load_csv(path, joints, robot=robot)
     if closed:
-        return CalibrationRun(log, np.zeros((1, 3)), np.array([len(log) - 1]), (0.0, 0.0, 0.0))
+        return CalibrationRun.closed_path(log)
     if reference is None:
         raise BatchError(f"{path}: needs a reference trajectory or --closed")
     ref = os.fspath(reference)
