@@ -6,18 +6,18 @@ only; user text is never evaluated. Every error names the file, the line where k
 
 from __future__ import annotations
 
-import difflib
 import json
 import math
 import os
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import yaml
 
 from .couplings import COUPLING_KINDS, Coupling
+from .documents import FieldReader, LineOf, Loc, hint, read_document
 from .dynamics import mass
 from .errors import DescriptionError
 from .limits import (  # noqa: F401  (the limits are part of the description format)
@@ -34,7 +34,6 @@ from .limits import (  # noqa: F401  (the limits are part of the description for
     _check_text_fields,
 )
 from .robot import Robot
-from .units import UnitError, parse_quantity
 from .wheels import GEOMETRY_FIELDS, KINDS, Wheel, beta_from_heading
 
 #: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
@@ -53,13 +52,11 @@ MECANUM_GAMMA = math.pi / 4
 
 WHEEL_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
 
-Loc = tuple[str | int, ...]
-LineOf = Callable[[Loc], int | None]
 
 
 def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None = None) -> Robot:
     """Validate a description mapping and build the :class:`Robot` (SI units; strings with units accepted)."""
-    check = _Checker(source, line_of or (lambda loc: None))
+    check = FieldReader(source, line_of or (lambda loc: None))
     if not isinstance(data, Mapping):
         check.fail("a robot description is a mapping with the fields 'name' and 'wheels'", ())
     check.reject_unknown(data, TOP_FIELDS, ())
@@ -89,7 +86,7 @@ def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None
                  body=mass.body_from_dict(data, check))
 
 
-def _couplings_from_dict(items: Any, wheels: list[Wheel], check: _Checker) -> tuple[Coupling, ...]:
+def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) -> tuple[Coupling, ...]:
     """``couplings:``: joints moved by one mechanism (``wmrkit.couplings``), each joint in one coupling at most."""
     if not isinstance(items, list):
         check.fail("must be a list of couplings {kind, joints, ratios}", ("couplings",))
@@ -103,7 +100,7 @@ def _couplings_from_dict(items: Any, wheels: list[Wheel], check: _Checker) -> tu
         check.reject_unknown(item, ("kind", "joints", "ratios"), loc)
         kind = check.text(item, "kind", loc)
         if kind not in COUPLING_KINDS:
-            check.fail(f"unknown coupling kind '{kind}'{_hint(kind, COUPLING_KINDS)} (kinds: "
+            check.fail(f"unknown coupling kind '{kind}'{hint(kind, COUPLING_KINDS)} (kinds: "
                        f"{', '.join(COUPLING_KINDS)})", (*loc, "kind"))
         joints = check.require(item, "joints", loc)
         if not isinstance(joints, list) or len(joints) < 2 or not all(isinstance(j, str) for j in joints):
@@ -112,7 +109,7 @@ def _couplings_from_dict(items: Any, wheels: list[Wheel], check: _Checker) -> tu
             wheel, _, part = joint.partition(".")
             w = by_name.get(wheel)
             if w is None or part not in w.kind.joints:
-                check.fail(f"no joint '{joint}' on this robot{_hint(joint, _joint_names(wheels))}", (*loc, "joints", j))
+                check.fail(f"no joint '{joint}' on this robot{hint(joint, _joint_names(wheels))}", (*loc, "joints", j))
             steer_angle = part == "steer" and "steer" not in w.kind.rates
             if steer_angle != (kind == "linkage"):
                 check.fail(f"'{joint}' is {'a steering angle' if steer_angle else 'a joint rate'}: a "
@@ -136,14 +133,14 @@ def _joint_names(wheels: list[Wheel]) -> list[str]:
     return [f"{w.name}.{j}" for w in wheels for j in w.kind.joints]
 
 
-def _wheel_from_dict(item: Any, check: _Checker, loc: Loc) -> Wheel:
+def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc) -> Wheel:
     if not isinstance(item, Mapping):
         check.fail("a wheel is a mapping with at least 'name', 'type' and its geometry", loc)
     type_name = check.text(item, "type", loc)
     if type_name == "mecanum":
         return _mecanum_from_dict(item, check, loc)
     if type_name not in KINDS:
-        check.fail(f"unknown wheel type '{type_name}'{_hint(type_name, WHEEL_TYPES)} (types: {', '.join(WHEEL_TYPES)})",
+        check.fail(f"unknown wheel type '{type_name}'{hint(type_name, WHEEL_TYPES)} (types: {', '.join(WHEEL_TYPES)})",
                    (*loc, "type"))
     kind = KINDS[type_name]
     name = check.text(item, "name", loc)
@@ -189,7 +186,7 @@ def _wheel_from_dict(item: Any, check: _Checker, loc: Loc) -> Wheel:
                  steer_range=_steer_range_from_dict(item, check, loc, kind.steers))
 
 
-def _steer_range_from_dict(item: Mapping[str, Any], check: _Checker, loc: Loc,
+def _steer_range_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc,
                            steers: bool) -> tuple[float, float] | None:
     """``steer_range: [min, max]``: the HEADINGS the steering joint reaches (0 = straight ahead), e.g. +-90 deg."""
     if "steer_range" not in item:
@@ -206,7 +203,7 @@ def _steer_range_from_dict(item: Mapping[str, Any], check: _Checker, loc: Loc,
     return (lo, hi)
 
 
-def _read_heading(item: Mapping[str, Any], values: dict[str, float], check: _Checker, loc: Loc) -> None:
+def _read_heading(item: Mapping[str, Any], values: dict[str, float], check: FieldReader, loc: Loc) -> None:
     """``heading:`` (the users' steering angle: rolling direction, 0 = straight ahead) sets the thesis's β."""
     if "heading" not in item:
         return
@@ -217,7 +214,7 @@ def _read_heading(item: Mapping[str, Any], values: dict[str, float], check: _Che
     values["beta"] = float(beta_from_heading(heading, values.get("delta", 0.0)))
 
 
-def _mecanum_from_dict(item: Mapping[str, Any], check: _Checker, loc: Loc) -> Wheel:
+def _mecanum_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc) -> Wheel:
     """``type: mecanum``: the Swedish wheel of the standard X layout; gamma from the wheel's quadrant.
 
     Seen from above with every wheel rolling forward, the contact rollers of the front-left and rear-right wheels
@@ -241,7 +238,7 @@ def _mecanum_from_dict(item: Mapping[str, Any], check: _Checker, loc: Loc) -> Wh
     return _wheel_from_dict(data, check, loc)
 
 
-def _check_geometry(type_name: str, v: dict[str, float], check: _Checker, loc: Loc) -> None:
+def _check_geometry(type_name: str, v: dict[str, float], check: FieldReader, loc: Loc) -> None:
     for key in ("r", "r_r", "b"):
         if key in v and v[key] <= 0:
             check.fail(f"must be > 0, got {v[key]} m", (*loc, key))
@@ -255,66 +252,6 @@ def _check_geometry(type_name: str, v: dict[str, float], check: _Checker, loc: L
         check.fail("a Swedish wheel with gamma = 0 (or 180 deg) has rollers parallel to the axle and does not "
                    "roll (det J_s = r r_r sin(gamma) = 0, eq. 3.19); omni: 90 deg, Mecanum: 45 deg",
                    (*loc, "gamma"))
-
-
-class _Checker:
-    """Reads fields and raises :class:`DescriptionError` at their location."""
-
-    def __init__(self, source: str, line_of: LineOf) -> None:
-        self.source, self.line_of = source, line_of
-        self.wheels: list[str | None] = []  # names of the wheels read so far (None until the name is known)
-
-    def fail(self, message: str, loc: Loc) -> None:
-        wheel = None
-        if len(loc) >= 2 and loc[0] == "wheels" and isinstance(loc[1], int) and loc[1] < len(self.wheels):
-            wheel = self.wheels[loc[1]]
-        raise DescriptionError(message, source=self.source, loc=loc, line=self.line_of(loc), wheel=wheel)
-
-    def require(self, data: Mapping[str, Any], key: str, loc: Loc) -> Any:
-        if key not in data:
-            self.fail(f"missing field '{key}'", (*loc, key) if not loc else loc)
-        return data[key]
-
-    def text(self, data: Mapping[str, Any], key: str, loc: Loc, *, required: bool = True) -> str:
-        if key not in data and not required:
-            return ""
-        value = self.require(data, key, loc)
-        if not isinstance(value, str) or (required and not value.strip()):
-            self.fail(f"must be a non-empty string, got {value!r}", (*loc, key))
-        return value
-
-    def quantity(self, value: Any, kind: str, loc: Loc) -> float:
-        try:
-            return parse_quantity(value, kind)  # type: ignore[arg-type]
-        except UnitError as err:
-            self.fail(str(err), loc)
-        raise AssertionError  # unreachable: fail raises
-
-    def joints(self, item: Mapping[str, Any], key: str, allowed: tuple[str, ...], loc: Loc) -> tuple[str, ...]:
-        value = item.get(key, [])
-        if isinstance(value, str):
-            value = [value]
-        if not isinstance(value, list) or not all(isinstance(j, str) for j in value):
-            self.fail(f"must be a list of joint names (any of: {', '.join(allowed)})", (*loc, key))
-        for j, joint in enumerate(value):
-            if joint not in allowed:
-                self.fail(f"no joint '{joint}' on a {item.get('type')} wheel{_hint(joint, allowed)} "
-                          f"(joints: {', '.join(allowed)})", (*loc, key, j))
-            if joint in value[:j]:
-                self.fail(f"joint '{joint}' listed twice", (*loc, key, j))
-        return tuple(sorted(value, key=allowed.index))
-
-    def reject_unknown(self, data: Mapping[str, Any], allowed: tuple[str, ...], loc: Loc) -> None:
-        for key in data:
-            if not isinstance(key, str):
-                self.fail(f"field names are strings, got {key!r}", loc)
-            if key not in allowed:
-                self.fail(f"unknown field '{key}'{_hint(key, allowed)}", (*loc, key))
-
-
-def _hint(word: str, choices: Any) -> str:
-    close = difflib.get_close_matches(str(word), list(choices), n=1)
-    return f" (did you mean '{close[0]}'?)" if close else ""
 
 
 # ---- serialisation ---------------------------------------------------------------------------------------
@@ -362,125 +299,11 @@ def load_robot_file(path: str | os.PathLike[str]) -> Robot:
 def robot_from_text(text: str, *, source: str, fmt: str = "yaml") -> Robot:
     """Parse description `text` (``fmt`` "yaml" or "json") into a :class:`Robot`.
 
-    Parsed once; duplicate keys are refused in both formats; JSON lines are found (by composing the text as
-    YAML) only when an error is reported.
+    Parsed once (:func:`wmrkit.documents.read_document`); duplicate keys are refused in both formats.
     """
     _check_size(len(text), "characters", source)
-    root, data = _parse(text, source, fmt)
-    if fmt == "json":  # the line of an error: by composing the text as YAML, when that is quick
-        line_of = (lambda loc: _line_finder(_compose(text))(loc)) if len(text) <= 1 << 16 else None
-        return robot_from_dict(data, source=source, line_of=line_of)
-    return robot_from_dict(data, source=source, line_of=_line_finder(root))
-
-
-def _parse(text: str, source: str, fmt: str) -> tuple[yaml.Node | None, Any]:
-    """``(node tree or None, data)`` of `text`: JSON by ``json`` (no node tree), YAML composed once, checked for
-    duplicate keys, then constructed from the nodes."""
-    if fmt == "json":
-        try:
-            return None, json.loads(text, object_pairs_hook=_JsonPairs(text, source))
-        except DescriptionError:
-            raise
-        except json.JSONDecodeError as err:
-            raise DescriptionError(f"malformed JSON: {err.msg} (column {err.colno})", source=source,
-                                   line=err.lineno) from None
-        except (ValueError, RecursionError) as err:  # integers of > 4300 digits, nesting too deep
-            raise DescriptionError(f"malformed JSON: {str(err).splitlines()[0]}", source=source) from None
-    try:
-        loader = _SafeLoader(text)  # the reader already rejects some characters
-        try:
-            root = loader.get_single_node()
-            _reject_duplicate_keys(root, source)
-            return root, None if root is None else loader.construct_document(root)
-        finally:
-            loader.dispose()
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
-        raise DescriptionError(f"malformed YAML: {problem}", source=source,
-                               line=None if mark is None else mark.line + 1) from None
-    except RecursionError:
-        raise DescriptionError("malformed YAML: nesting too deep", source=source) from None
-
-
-class _JsonPairs:
-    """``object_pairs_hook`` of ``json.loads`` refusing a key given twice (JSON parsers keep the last one)."""
-
-    def __init__(self, text: str, source: str) -> None:
-        self.text, self.source = text, source
-
-    def __call__(self, pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-        out = dict(pairs)
-        if len(out) != len(pairs):
-            seen: set[str] = set()
-            key = next(k for k, _ in pairs if k in seen or seen.add(k))
-            _reject_duplicate_keys(_compose(self.text), self.source)  # locates it when the text composes as YAML
-            raise DescriptionError(f"field '{key}' given twice", source=self.source)
-        return out
-
-
-class _SafeLoader(yaml.SafeLoader):
-    """``yaml.SafeLoader`` whose constructors fail with a located YAML error, never a bare ValueError."""
-
-    def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
-        try:
-            return super().construct_object(node, deep=deep)
-        except (ValueError, TypeError, KeyError, AttributeError, OverflowError) as err:  # e.g. "2020-13-45"
-            what = repr(node.value[:40]) if isinstance(node.value, str) else "this node"
-            raise yaml.constructor.ConstructorError(
-                None, None, f"cannot read {what} as {node.tag.rsplit(':', 1)[-1]} ({err})", node.start_mark
-            ) from None
-
-
-def _compose(text: str) -> yaml.Node | None:
-    """The YAML node tree of `text` (JSON is YAML enough for this), or None."""
-    try:
-        return yaml.compose(text, Loader=yaml.SafeLoader)
-    except (yaml.YAMLError, RecursionError):
-        return None
-
-
-def _reject_duplicate_keys(root: yaml.Node | None, source: str) -> None:
-    """YAML and JSON parsers keep the last of two equal keys; a description must not say a field twice."""
-    seen: set[int] = set()
-    stack: list[tuple[yaml.Node | None, Loc]] = [(root, ())]
-    while stack:
-        node, loc = stack.pop()
-        if node is None or id(node) in seen:
-            continue
-        seen.add(id(node))
-        if isinstance(node, yaml.MappingNode):
-            keys: set[str] = set()
-            for k, v in node.value:
-                if isinstance(k, yaml.ScalarNode) and k.value != "<<":
-                    if k.value in keys:
-                        raise DescriptionError(f"field '{k.value}' given twice", source=source, loc=(*loc, k.value),
-                                               line=k.start_mark.line + 1)
-                    keys.add(k.value)
-                stack.append((v, (*loc, k.value) if isinstance(k, yaml.ScalarNode) else loc))
-        elif isinstance(node, yaml.SequenceNode):
-            stack.extend((v, (*loc, i)) for i, v in enumerate(node.value))
-
-
-def _line_finder(root: yaml.Node | None) -> LineOf:
-    """Map a field location to its 1-based line in the node tree `root`."""
-
-    def line_of(loc: Loc) -> int | None:
-        node, line = root, None
-        for part in loc:
-            if isinstance(node, yaml.MappingNode):
-                match = [(k, v) for k, v in node.value if k.value == part]
-                if not match:
-                    break
-                line, node = match[0][0].start_mark.line + 1, match[0][1]
-            elif isinstance(node, yaml.SequenceNode) and isinstance(part, int) and part < len(node.value):
-                node = node.value[part]
-                line = node.start_mark.line + 1
-            else:
-                break
-        return line
-
-    return line_of
+    data, line_of = read_document(text, source, fmt)
+    return robot_from_dict(data, source=source, line_of=line_of)
 
 
 def save_robot_file(robot: Robot, path: str | os.PathLike[str]) -> None:

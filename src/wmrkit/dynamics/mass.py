@@ -41,7 +41,7 @@ class Body:
 
 
 def body_from_dict(data: Mapping[str, Any], check: Any) -> Body | None:
-    """The ``body`` section of a description, or None when absent; errors located by `check` (a ``_Checker``)."""
+    """The ``body`` section of a description, or None when absent; errors located by `check` (a ``FieldReader``)."""
     if "body" not in data:
         return None
     loc: tuple[str | int, ...] = ("body",)

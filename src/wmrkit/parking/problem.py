@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from ..catalog import resolve as resolve_robot
-from ..description import _Checker, _compose, _line_finder, _parse
+from ..documents import FieldReader, read_document
 from ..errors import DescriptionError, UnknownNameError, WmrkitError
 from ..robot import Robot
 from .geometry import Space, Vehicle
@@ -68,14 +68,13 @@ def load_problem(spec: str | os.PathLike[str]) -> ParkingProblem:
 
 def problem_from_text(text: str, *, source: str, fmt: str = "yaml", base: Path | None = None) -> ParkingProblem:
     """Parse problem `text` (YAML through ``safe_load`` only, or JSON)."""
-    root, data = _parse(text, source, fmt)  # duplicate keys refused there, in both formats
-    line_of = _line_finder(_compose(text) if root is None else root)
+    data, line_of = read_document(text, source, fmt)  # duplicate keys refused there, in both formats
     return problem_from_dict(data, source=source, line_of=line_of, base=base)
 
 
 def problem_from_dict(data: Any, *, source: str = "<dict>", line_of=None, base: Path | None = None) -> ParkingProblem:
     """Validate a problem mapping; every error is one located line (:class:`DescriptionError`)."""
-    check = _Checker(source, line_of or (lambda loc: None))
+    check = FieldReader(source, line_of or (lambda loc: None))
     if not isinstance(data, dict):
         check.fail("a parking problem is a mapping with the sections 'vehicle' and 'space'", ())
     check.reject_unknown(data, ("name", "vehicle", "space"), ())
@@ -85,7 +84,7 @@ def problem_from_dict(data: Any, *, source: str = "<dict>", line_of=None, base: 
     return ParkingProblem(name, vehicle, space, robot)
 
 
-def _section(check: _Checker, data: Any, key: str, allowed: tuple[str, ...]) -> dict[str, Any]:
+def _section(check: FieldReader, data: Any, key: str, allowed: tuple[str, ...]) -> dict[str, Any]:
     if not isinstance(data, dict):
         check.fail(f"must be a mapping with the fields {', '.join(allowed)}", (key,))
     check.reject_unknown(data, allowed, (key,))
@@ -96,7 +95,7 @@ def _section(check: _Checker, data: Any, key: str, allowed: tuple[str, ...]) -> 
 MAX_LENGTH = 1000.0
 
 
-def _lengths(check: _Checker, data: dict[str, Any], section: str, names: tuple[str, ...]) -> dict[str, float]:
+def _lengths(check: FieldReader, data: dict[str, Any], section: str, names: tuple[str, ...]) -> dict[str, float]:
     out = {}
     for name in names:
         kind = "angle" if name == "phi_max" else "length"
@@ -106,7 +105,7 @@ def _lengths(check: _Checker, data: dict[str, Any], section: str, names: tuple[s
     return out
 
 
-def _vehicle(check: _Checker, data: Any, base: Path | None) -> tuple[Vehicle, Robot | None]:
+def _vehicle(check: FieldReader, data: Any, base: Path | None) -> tuple[Vehicle, Robot | None]:
     robot = None
     if isinstance(data, dict) and "robot" in data:
         data = _section(check, data, "vehicle", ROBOT_VEHICLE_FIELDS)
@@ -136,7 +135,7 @@ def _vehicle(check: _Checker, data: Any, base: Path | None) -> tuple[Vehicle, Ro
     return vehicle, robot
 
 
-def _space(check: _Checker, data: Any) -> Space:
+def _space(check: FieldReader, data: Any) -> Space:
     data = _section(check, data, "space", SPACE_FIELDS)
     s = _lengths(check, data, "space", SPACE_FIELDS)
     for name in ("H", "J", "final_gap"):

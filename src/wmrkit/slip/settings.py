@@ -61,7 +61,7 @@ class OdometrySettings:
 
 
 def settings_from_dict(data: Mapping[str, Any], check: Any) -> OdometrySettings:
-    """The odometry settings of a description mapping; errors located by `check` (``description._Checker``)."""
+    """The odometry settings of a description mapping; errors located by `check` (a ``FieldReader``)."""
     block = data.get("odometry", {})
     loc: tuple[str | int, ...] = ("odometry",)
     if not isinstance(block, Mapping):
@@ -114,7 +114,7 @@ def odometry_settings(spec: str) -> OdometrySettings:
     """The settings of the robot named by a ROBOT argument (a description file, else a catalog name), as
     ``catalog.resolve`` finds it; the whole description is validated first."""
     from .. import catalog
-    from ..description import _Checker, _line_finder, _parse
+    from ..documents import FieldReader, read_document
 
     catalog.resolve(spec)  # validates (located errors) and refuses what is not a robot
     path = Path(spec)
@@ -123,8 +123,8 @@ def odometry_settings(spec: str) -> OdometrySettings:
             else "yaml"
     else:
         text, source, fmt = catalog.source_text(spec), f"catalog:{spec}", "yaml"
-    root, data = _parse(text, source, fmt)
-    return settings_from_dict(data, _Checker(source, _line_finder(root)))
+    data, line_of = read_document(text, source, fmt)
+    return settings_from_dict(data, FieldReader(source, line_of))
 
 
 def _choice(block: Mapping[str, Any], key: str, choices: tuple[str, ...], check: Any, loc: tuple) -> str | None:

@@ -1,0 +1,216 @@
+"""Located YAML/JSON documents: safe parsing, duplicate keys refused, field locations mapped to lines, and a
+field reader whose errors are one line naming the file, line and field (robot descriptions, parking problems).
+
+YAML goes through ``yaml.SafeLoader`` only; user text is never evaluated.
+"""
+
+from __future__ import annotations
+
+import difflib
+import json
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import yaml
+
+from .errors import DescriptionError
+from .units import UnitError, parse_quantity
+
+__all__ = ["FieldReader", "LineOf", "Loc", "compose", "hint", "line_finder", "parse_document", "read_document"]
+
+#: A field's location: keys and list indices from the document's root.
+Loc = tuple[str | int, ...]
+#: Maps a location to its 1-based line, or None.
+LineOf = Callable[[Loc], int | None]
+
+
+def read_document(text: str, source: str, fmt: str = "yaml") -> tuple[Any, LineOf]:
+    """``(data, line_of)`` of document `text` (``fmt`` "yaml" or "json"): parsed once, duplicate keys refused;
+    the lines of a JSON document are found (by composing it as YAML) only when an error asks, and only for texts
+    up to 64 kB."""
+    root, data = parse_document(text, source, fmt)
+    if fmt != "json":
+        return data, line_finder(root)
+    if len(text) > 1 << 16:
+        return data, lambda loc: None
+    return data, lambda loc: line_finder(compose(text))(loc)
+
+
+class FieldReader:
+    """Reads the fields of a located document and raises :class:`DescriptionError` at their location.
+
+    ``wheels``: names of the wheels read so far (a robot description names the wheel of an error).
+    """
+
+    def __init__(self, source: str, line_of: LineOf) -> None:
+        self.source, self.line_of = source, line_of
+        self.wheels: list[str | None] = []  # None until the wheel's name is known
+
+    def fail(self, message: str, loc: Loc) -> None:
+        """Raise :class:`DescriptionError` `message` at `loc` (its line and wheel when known)."""
+        wheel = None
+        if len(loc) >= 2 and loc[0] == "wheels" and isinstance(loc[1], int) and loc[1] < len(self.wheels):
+            wheel = self.wheels[loc[1]]
+        raise DescriptionError(message, source=self.source, loc=loc, line=self.line_of(loc), wheel=wheel)
+
+    def require(self, data: Mapping[str, Any], key: str, loc: Loc) -> Any:
+        """``data[key]``; a missing field is an error."""
+        if key not in data:
+            self.fail(f"missing field '{key}'", (*loc, key) if not loc else loc)
+        return data[key]
+
+    def text(self, data: Mapping[str, Any], key: str, loc: Loc, *, required: bool = True) -> str:
+        """A non-empty string field (an empty string when absent and not `required`)."""
+        if key not in data and not required:
+            return ""
+        value = self.require(data, key, loc)
+        if not isinstance(value, str) or (required and not value.strip()):
+            self.fail(f"must be a non-empty string, got {value!r}", (*loc, key))
+        return value
+
+    def quantity(self, value: Any, kind: str, loc: Loc) -> float:
+        """`value` in SI units (:func:`wmrkit.units.parse_quantity` of `kind`)."""
+        try:
+            return parse_quantity(value, kind)  # type: ignore[arg-type]
+        except UnitError as err:
+            self.fail(str(err), loc)
+        raise AssertionError  # unreachable: fail raises
+
+    def joints(self, item: Mapping[str, Any], key: str, allowed: tuple[str, ...], loc: Loc) -> tuple[str, ...]:
+        """A list of distinct joint names among `allowed`, in `allowed` order."""
+        value = item.get(key, [])
+        if isinstance(value, str):
+            value = [value]
+        if not isinstance(value, list) or not all(isinstance(j, str) for j in value):
+            self.fail(f"must be a list of joint names (any of: {', '.join(allowed)})", (*loc, key))
+        for j, joint in enumerate(value):
+            if joint not in allowed:
+                self.fail(f"no joint '{joint}' on a {item.get('type')} wheel{hint(joint, allowed)} "
+                          f"(joints: {', '.join(allowed)})", (*loc, key, j))
+            if joint in value[:j]:
+                self.fail(f"joint '{joint}' listed twice", (*loc, key, j))
+        return tuple(sorted(value, key=allowed.index))
+
+    def reject_unknown(self, data: Mapping[str, Any], allowed: tuple[str, ...], loc: Loc) -> None:
+        """Refuse any field of `data` not in `allowed`, with a did-you-mean."""
+        for key in data:
+            if not isinstance(key, str):
+                self.fail(f"field names are strings, got {key!r}", loc)
+            if key not in allowed:
+                self.fail(f"unknown field '{key}'{hint(key, allowed)}", (*loc, key))
+
+
+def hint(word: str, choices: Any) -> str:
+    """`` (did you mean '...'?)`` for the closest of `choices`, or an empty string."""
+    close = difflib.get_close_matches(str(word), list(choices), n=1)
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+def parse_document(text: str, source: str, fmt: str) -> tuple[yaml.Node | None, Any]:
+    """``(node tree or None, data)`` of `text`: JSON by ``json`` (no node tree), YAML composed once, checked for
+    duplicate keys, then constructed from the nodes."""
+    if fmt == "json":
+        try:
+            return None, json.loads(text, object_pairs_hook=_JsonPairs(text, source))
+        except DescriptionError:
+            raise
+        except json.JSONDecodeError as err:
+            raise DescriptionError(f"malformed JSON: {err.msg} (column {err.colno})", source=source,
+                                   line=err.lineno) from None
+        except (ValueError, RecursionError) as err:  # integers of > 4300 digits, nesting too deep
+            raise DescriptionError(f"malformed JSON: {str(err).splitlines()[0]}", source=source) from None
+    try:
+        loader = _SafeLoader(text)  # the reader already rejects some characters
+        try:
+            root = loader.get_single_node()
+            _reject_duplicate_keys(root, source)
+            return root, None if root is None else loader.construct_document(root)
+        finally:
+            loader.dispose()
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+        raise DescriptionError(f"malformed YAML: {problem}", source=source,
+                               line=None if mark is None else mark.line + 1) from None
+    except RecursionError:
+        raise DescriptionError("malformed YAML: nesting too deep", source=source) from None
+
+
+class _JsonPairs:
+    """``object_pairs_hook`` of ``json.loads`` refusing a key given twice (JSON parsers keep the last one)."""
+
+    def __init__(self, text: str, source: str) -> None:
+        self.text, self.source = text, source
+
+    def __call__(self, pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+        out = dict(pairs)
+        if len(out) != len(pairs):
+            seen: set[str] = set()
+            key = next(k for k, _ in pairs if k in seen or seen.add(k))
+            _reject_duplicate_keys(compose(self.text), self.source)  # locates it when the text composes as YAML
+            raise DescriptionError(f"field '{key}' given twice", source=self.source)
+        return out
+
+
+class _SafeLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` whose constructors fail with a located YAML error, never a bare ValueError."""
+
+    def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
+        try:
+            return super().construct_object(node, deep=deep)
+        except (ValueError, TypeError, KeyError, AttributeError, OverflowError) as err:  # e.g. "2020-13-45"
+            what = repr(node.value[:40]) if isinstance(node.value, str) else "this node"
+            raise yaml.constructor.ConstructorError(
+                None, None, f"cannot read {what} as {node.tag.rsplit(':', 1)[-1]} ({err})", node.start_mark
+            ) from None
+
+
+def compose(text: str) -> yaml.Node | None:
+    """The YAML node tree of `text` (JSON is YAML enough for this), or None."""
+    try:
+        return yaml.compose(text, Loader=yaml.SafeLoader)
+    except (yaml.YAMLError, RecursionError):
+        return None
+
+
+def _reject_duplicate_keys(root: yaml.Node | None, source: str) -> None:
+    """YAML and JSON parsers keep the last of two equal keys; a description must not say a field twice."""
+    seen: set[int] = set()
+    stack: list[tuple[yaml.Node | None, Loc]] = [(root, ())]
+    while stack:
+        node, loc = stack.pop()
+        if node is None or id(node) in seen:
+            continue
+        seen.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            keys: set[str] = set()
+            for k, v in node.value:
+                if isinstance(k, yaml.ScalarNode) and k.value != "<<":
+                    if k.value in keys:
+                        raise DescriptionError(f"field '{k.value}' given twice", source=source, loc=(*loc, k.value),
+                                               line=k.start_mark.line + 1)
+                    keys.add(k.value)
+                stack.append((v, (*loc, k.value) if isinstance(k, yaml.ScalarNode) else loc))
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend((v, (*loc, i)) for i, v in enumerate(node.value))
+
+
+def line_finder(root: yaml.Node | None) -> LineOf:
+    """Map a field location to its 1-based line in the node tree `root`."""
+
+    def line_of(loc: Loc) -> int | None:
+        node, line = root, None
+        for part in loc:
+            if isinstance(node, yaml.MappingNode):
+                match = [(k, v) for k, v in node.value if k.value == part]
+                if not match:
+                    break
+                line, node = match[0][0].start_mark.line + 1, match[0][1]
+            elif isinstance(node, yaml.SequenceNode) and isinstance(part, int) and part < len(node.value):
+                node = node.value[part]
+                line = node.start_mark.line + 1
+            else:
+                break
+        return line
+
+    return line_of
