@@ -395,9 +395,9 @@ def test_wheel_names_must_be_identifiers(bad):
         Robot.from_dict(data, source="x.yaml")
 
 
-def test_odometry_settings_configure_the_estimator_not_the_vehicle(tmp_path):
+def test_odometry_settings_are_read_kept_and_saved(tmp_path):
     """The documented ``odometry`` example: its settings read back as written (the thesis's optimised forklift
-    weights); the Robot is the same value with or without them, and saving it leaves them out."""
+    weights); the Robot keeps them (``robot.odometry``) and saving it writes them back."""
     from wmrkit.slip.settings import odometry_settings
 
     text = next(b for b in _doc_blocks("yaml") if b.startswith("name: forklift-wls"))
@@ -413,5 +413,6 @@ def test_odometry_settings_configure_the_estimator_not_the_vehicle(tmp_path):
     bare = {**{k: v for k, v in data.items() if k != "odometry"},
             "wheels": [{k: v for k, v in w.items() if k != "slip"} for w in data["wheels"]]}
     robot = Robot.from_file(path)
-    assert robot == Robot.from_dict(bare)
-    assert "odometry" not in robot.to_dict() and all("slip" not in w for w in robot.to_dict()["wheels"])
+    assert robot.odometry == s and robot != Robot.from_dict(bare)
+    assert robot.wheels == Robot.from_dict(bare).wheels
+    assert robot.to_dict()["odometry"] == data["odometry"] and Robot.from_dict(robot.to_dict()) == robot

@@ -78,12 +78,13 @@ def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None
         wheels.append(wheel)
     _check_envelope(wheels, check)
     couplings = _couplings_from_dict(data.get("couplings", []), wheels, check)
+    odometry = None
     if "odometry" in data or any(isinstance(w, Mapping) and "slip" in w for w in wheels_data):
-        from .slip.settings import settings_from_dict  # validated here, read by wmrkit.slip.settings
+        from .slip.settings import settings_from_dict
 
-        settings_from_dict(data, check)
+        odometry = settings_from_dict(data, check)
     return Robot(name=name, wheels=tuple(wheels), notes=notes, couplings=couplings,
-                 body=mass.body_from_dict(data, check))
+                 body=mass.body_from_dict(data, check), odometry=odometry)
 
 
 def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) -> tuple[Coupling, ...]:
@@ -262,6 +263,13 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         out["notes"] = robot.notes
     out |= mass.body_to_dict(robot.body)
     out["wheels"] = [_wheel_to_dict(w) for w in robot.wheels]
+    if robot.odometry is not None:
+        from .slip.settings import settings_to_dict
+
+        entries = settings_to_dict(robot.odometry)
+        out |= {k: v for k, v in entries.items() if k == "odometry"}
+        for w in out["wheels"]:
+            w |= entries.get("wheels", {}).get(w["name"], {})
     if robot.couplings:
         out["couplings"] = [{"kind": c.kind, "joints": list(c.joints), "ratios": list(c.ratios)}
                             for c in robot.couplings]

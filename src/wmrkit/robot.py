@@ -11,7 +11,7 @@ import functools
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -21,6 +21,9 @@ from .couplings import Coupling
 from .dynamics.mass import Body
 from .errors import ShapeError, UnknownNameError
 from .wheels import Wheel, generic_wheel_jacobian, rotate_rows_to_robot
+
+if TYPE_CHECKING:
+    from .slip.settings import OdometrySettings
 
 TWIST_NAMES = ("vx", "vy", "omega")
 
@@ -34,18 +37,20 @@ class Robot:
     notes: str = ""
     couplings: tuple[Coupling, ...] = ()  # mechanical couplings between joints (wmrkit.couplings)
     body: Body | None = None  # mass properties of the vehicle* (wmrkit.dynamics.mass), None when not described
+    odometry: OdometrySettings | None = None  # slip weights, Kalman noise, method (wmrkit.slip.settings)
     _hash: int = field(default=0, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         # Hashed once: derived arrays are cached per robot (keyed by it) and looked up on every batched call.
-        object.__setattr__(self, "_hash", hash((self.name, self.wheels, self.notes, self.couplings, self.body)))
+        object.__setattr__(self, "_hash", hash((self.name, self.wheels, self.notes, self.couplings, self.body,
+                                                   self.odometry)))
 
     def __hash__(self) -> int:
         return self._hash
 
     def __reduce__(self) -> tuple:
         # rebuilt: the hash is this process's
-        return (Robot, (self.name, self.wheels, self.notes, self.couplings, self.body))
+        return (Robot, (self.name, self.wheels, self.notes, self.couplings, self.body, self.odometry))
 
     # ---- names -------------------------------------------------------------------------------------------
     @property

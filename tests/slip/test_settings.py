@@ -55,7 +55,24 @@ def test_settings_read_from_the_description(tmp_path):
     for wheel in back["wheels"]:
         wheel.update(block["wheels"].get(wheel["name"], {}))
     assert odometry_settings(str(_write(tmp_path, back, "back.yaml"))) == s
-    assert odometry_settings("skid-steer-4") == OdometrySettings()
+    assert odometry_settings("skid-steer-4") == OdometrySettings() and catalog.load("skid-steer-4").odometry is None
+
+
+def test_the_robot_value_keeps_its_settings_through_dict_and_file(tmp_path):
+    """``Robot.odometry`` is part of the value: to_dict/from_dict and to_file/from_file keep it, and two robots
+    that differ only in it are different values."""
+    from wmrkit.robot import Robot
+
+    path = _write(tmp_path, _skid({"method": "wls", "slip": {"lateral": 2, "longitudinal": 1}},
+                                  {"lateral": 4, "longitudinal": 1, "noise": {"lateral": 0.2, "longitudinal": 0.3}}))
+    robot = Robot.from_file(path)
+    assert robot.odometry == odometry_settings(str(path)) and robot.odometry.method == "wls"
+    assert Robot.from_dict(robot.to_dict()) == robot
+    for name in ("again.yaml", "again.json"):
+        robot.to_file(tmp_path / name)
+        assert Robot.from_file(tmp_path / name) == robot
+    plain = Robot.from_dict(_skid())
+    assert plain.odometry is None and plain != robot and "odometry" not in plain.to_dict()
 
 
 @pytest.mark.parametrize(("odometry", "wheel_slip", "message"), [

@@ -14,8 +14,8 @@ A description may say how ``wmrkit odometry`` estimates the robot's motion (``do
 
 Everything is optional. The friction coefficients weight the no-slip rows in WLS (only their ratios matter); the
 noise sets the Kalman filters' ``Q`` and ``R``. Command-line options override the description. Validated when the
-description is loaded (:mod:`wmrkit.description` calls :func:`settings_from_dict` with its located-error checker);
-read back by :func:`odometry_settings`; :func:`settings_to_dict` writes the block (``wmrkit calibrate``).
+description is loaded (:mod:`wmrkit.description` calls :func:`settings_from_dict` with its located-error checker)
+and kept as ``Robot.odometry``; :func:`settings_to_dict` writes the block (``Robot.to_dict``, ``wmrkit calibrate``).
 """
 
 from __future__ import annotations
@@ -23,7 +23,6 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 #: The values of ``odometry.method``: the no-slip model's integration schemes, then the slip-aware estimators.
@@ -112,19 +111,10 @@ def settings_to_dict(settings: OdometrySettings) -> dict[str, Any]:
 
 def odometry_settings(spec: str) -> OdometrySettings:
     """The settings of the robot named by a ROBOT argument (a description file, else a catalog name), as
-    ``catalog.resolve`` finds it; the whole description is validated first."""
+    ``catalog.resolve`` finds it (``Robot.odometry``; empty settings when the description says none)."""
     from .. import catalog
-    from ..documents import FieldReader, read_document
 
-    catalog.resolve(spec)  # validates (located errors) and refuses what is not a robot
-    path = Path(spec)
-    if path.suffix.lower() in (".yaml", ".yml", ".json") or path.exists():
-        text, source, fmt = path.read_text(encoding="utf-8"), str(path), "json" if path.suffix.lower() == ".json" \
-            else "yaml"
-    else:
-        text, source, fmt = catalog.source_text(spec), f"catalog:{spec}", "yaml"
-    data, line_of = read_document(text, source, fmt)
-    return settings_from_dict(data, FieldReader(source, line_of))
+    return catalog.resolve(spec).odometry or OdometrySettings()
 
 
 def _choice(block: Mapping[str, Any], key: str, choices: tuple[str, ...], check: Any, loc: tuple) -> str | None:
