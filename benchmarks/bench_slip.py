@@ -3,11 +3,16 @@ the forklift's drive wheels alone), FK2 against WLS.
 
 Targets: WLS at most 2x differential odometry per sample in batch (the thesis reports 57x, Table 7.3), FK2 at most
 1.2x WLS (thesis: 55 / 46 ns). All three turn the same forklift log (two drive-wheel spins and a steering angle
-quantised to the 1.4118 deg encoder) into poses with the exact scheme, through the library's batch entry points
-(``odometry()`` and ``kalman_odometry()``). Times are the best of 3 calls after a first one that compiles.
+quantised to the 1.4118 deg encoder, 1 kHz) into poses with the exact scheme, through the library's batch entry
+points (``odometry()`` in chunks of 65536 samples and ``kalman_odometry()``), each on a model built once (its maps
+per steering configuration are computed on the first call and kept). The three are timed in turn, five rounds after
+a first one that compiles; the best wall time of each is printed, and the targets are judged on the best CPU
+times (the machine may be shared: CPU time is what the process itself spent), both ratios shown.
 """
 
 from __future__ import annotations
+
+import time
 
 import numpy as np
 
@@ -18,7 +23,7 @@ from wmrkit.odometry.pipeline import odometry
 from wmrkit.slip.kalman import fk2_noise, kalman_model, kalman_odometry
 from wmrkit.slip.weights import SlipWeights, wls_model
 
-from ._harness import Result, best_time
+from ._harness import Result
 
 
 def forklift_log(n: int) -> JointLog:
@@ -30,6 +35,17 @@ def forklift_log(n: int) -> JointLog:
     return JointLog(np.arange(n) * 1e-3, odometry_model(fork).joints, pos)
 
 
+def _best_times(fns: dict, rounds: int = 5) -> tuple[dict, dict]:
+    """Best wall and best CPU time [s] of each function, called in turn `rounds` times."""
+    wall, cpu = dict.fromkeys(fns, float("inf")), dict.fromkeys(fns, float("inf"))
+    for _ in range(rounds):
+        for name, fn in fns.items():
+            w0, c0 = time.perf_counter(), time.process_time()
+            fn()
+            wall[name], cpu[name] = min(wall[name], time.perf_counter() - w0), min(cpu[name], time.process_time() - c0)
+    return wall, cpu
+
+
 def run(quick: bool) -> list[Result]:
     n = 200_000 if quick else 2_000_000
     fork = catalog.load("forklift")
@@ -39,18 +55,20 @@ def run(quick: bool) -> list[Result]:
                                           "steer": (19.2, 1.0)}))
     fk2 = kalman_model(fork, "fk2", fk2_noise(0.28, 3.57, 0.28))
     dlog = log.select(differential.joints)
-    for f in (lambda: odometry(differential, dlog), lambda: odometry(wls, log), lambda: kalman_odometry(fk2, log)):
-        f()  # compile
-    t_diff = best_time(lambda: odometry(differential, dlog))
-    t_wls = best_time(lambda: odometry(wls, log))
-    t_fk2 = best_time(lambda: kalman_odometry(fk2, log))
+    fns = {"diff": lambda: odometry(differential, dlog), "wls": lambda: odometry(wls, log),
+           "fk2": lambda: kalman_odometry(fk2, log)}
+    for f in fns.values():
+        f()  # compile, and meet every steering configuration once
+    wall, cpu = _best_times(fns)
+    wls_ratio, fk2_ratio = cpu["wls"] / cpu["diff"], cpu["fk2"] / cpu["wls"]
     return [
-        Result("odometry wls: forklift (steering configurations)", n, t_wls,
-               "differential odometry (7.79), same run", t_diff,
-               f"wls <= 2x differential: {'MET' if t_wls <= 2 * t_diff else 'NOT MET'} "
-               f"({t_wls / t_diff:.2f}x)"),
-        Result("odometry fk2: forklift (information-form KF)", n, t_fk2, "wls, same run", t_wls,
-               f"fk2 <= 1.2x wls: {'MET' if t_fk2 <= 1.2 * t_wls else 'NOT MET'} ({t_fk2 / t_wls:.2f}x)"),
+        Result("odometry wls: forklift (steering configurations)", n, wall["wls"],
+               "differential odometry (7.79), same run", wall["diff"],
+               f"wls <= 2x differential: {'MET' if wls_ratio <= 2 else 'NOT MET'} (CPU {wls_ratio:.2f}x, "
+               f"wall {wall['wls'] / wall['diff']:.2f}x)"),
+        Result("odometry fk2: forklift (information-form KF)", n, wall["fk2"], "wls, same run", wall["wls"],
+               f"fk2 <= 1.2x wls: {'MET' if fk2_ratio <= 1.2 else 'NOT MET'} (CPU {fk2_ratio:.2f}x, "
+               f"wall {wall['fk2'] / wall['wls']:.2f}x)"),
     ]
 
 

@@ -50,13 +50,22 @@ def jit(signature) -> Callable[[Callable], Callable]:
 
 
 def as_python(fn: Callable) -> Callable:
-    """`fn` with every numba-compiled function it can reach through its module replaced by its Python source."""
-    shared = dict(fn.__globals__)
-    for name, value in fn.__globals__.items():
-        source = getattr(value, "py_func", None)
-        if source is not None and isinstance(source, types.FunctionType):
-            shared[name] = _rebind(source, shared)
-    return _rebind(fn, shared)
+    """`fn` with every numba-compiled function it can reach through its module replaced by its Python source (each
+    helper running in its own module's namespace, so that the names it uses are its module's)."""
+    return _rebind(fn, _python_namespace(fn.__globals__, {}))
+
+
+def _python_namespace(module_globals: dict, made: dict[int, dict]) -> dict:
+    """A copy of `module_globals` with its compiled functions replaced by their Python source, each rebound in its
+    own module's such namespace (built once per module in `made`, so import cycles end)."""
+    namespace = made.get(id(module_globals))
+    if namespace is None:
+        namespace = made[id(module_globals)] = dict(module_globals)
+        for name, value in module_globals.items():
+            source = getattr(value, "py_func", None)
+            if isinstance(source, types.FunctionType):
+                namespace[name] = _rebind(source, _python_namespace(source.__globals__, made))
+    return namespace
 
 
 def _rebind(fn: types.FunctionType, namespace: dict) -> types.FunctionType:

@@ -4,7 +4,9 @@ The block helpers below hold the one implementation of each step: :func:`_apply_
 the sensed model's maps (4.11), :func:`_headings`, :func:`_rotations`, :func:`_positions` of the schemes of
 :mod:`.integrators`. The kernels chain them: :func:`compose` (increments to poses), :func:`linear_maps` (joint
 increments to body increments and slip), :func:`odometry_chunk` (joint increments to poses, slip and path
-sums in one pass over memory, the pipeline's hot path), :func:`time_steps`. This module is imported on
+sums in one pass over memory, the pipeline's hot path), :func:`steered_chunk` (the same from the joint positions
+of a steering robot, each interval's maps found among those of the configurations met so far, looked up only
+when the steering angles change, and applied run by run), :func:`time_steps`. This module is imported on
 first use (numba takes about 0.4 s to import). Each kernel is compiled on its first call for one signature of
 strided arrays that also accepts read-only ones (so any layout runs without a new compilation), cached on disk
 next to this file or in the user's cache directory, and compiled in memory when no cache directory is writable
@@ -27,9 +29,12 @@ import numba
 import numpy as np
 
 from .._jit import jit as _jit
+from ._steering_kernels import _configurations_from, _find, _is_steering, _steering_mid, _wrap
 
 #: Samples per block: a dozen block buffers take about 25 KB.
 BLOCK = 256
+#: Runs of one configuration up to this many samples are mapped sample by sample, longer ones vectorised.
+SHORT = 4
 #: Largest |angle| [rad] for the inlined sine and cosine (the reduction's products stay exact below it).
 TRIG_MAX = 2.0**20
 #: Largest |h| [rad] for the sinc polynomial (fdlibm's sine kernel divided by h).
@@ -123,28 +128,49 @@ def _load_differences(source, before, start, m, buffer):
 
 
 @numba.njit
-def _apply_row(maps, row, index, start, cols, m, acc):
-    """``acc[j] = maps[u, row] @ cols[:, j]``, ``u = index[start + j]`` (0 when `index` is empty); (4.11)."""
-    for j in range(m):
-        acc[j] = 0.0
+def _segments(index, start, m, seg_u, seg_start):
+    """Runs of one configuration among the `m` samples from `start`: configuration ``seg_u[g]`` on samples
+    ``seg_start[g]:seg_start[g + 1]``; returns their count. An empty `index` is configuration 0 throughout."""
     if index.shape[0] == 0:
-        for a in range(cols.shape[0]):
-            c = maps[0, row, a]
-            for j in range(m):
-                acc[j] += c * cols[a, j]
-    else:
-        for a in range(cols.shape[0]):
-            for j in range(m):
-                acc[j] += maps[index[start + j], row, a] * cols[a, j]
+        seg_u[0], seg_start[0], seg_start[1] = 0, 0, m
+        return 1
+    count, last = 0, -1
+    for j in range(m):
+        u = index[start + j]
+        if u != last:
+            seg_u[count], seg_start[count], last = u, j, u
+            count += 1
+    seg_start[count] = m
+    return count
 
 
 @numba.njit
-def _norm_rows(maps, index, start, cols, m, acc, norm):
+def _apply_row(maps, row, seg_u, seg_start, count, cols, acc):
+    """``acc[j] = maps[u, row] @ cols[:, j]`` with ``u`` the configuration of sample j's segment; (4.11)."""
+    for g in range(count):
+        u, j0, j1 = seg_u[g], seg_start[g], seg_start[g + 1]
+        if j1 - j0 <= SHORT:  # too short to vectorise (a steering step's interval): the same sums, sample by sample
+            for j in range(j0, j1):
+                total = 0.0
+                for a in range(cols.shape[0]):
+                    total += maps[u, row, a] * cols[a, j]
+                acc[j] = total
+            continue
+        for j in range(j0, j1):
+            acc[j] = 0.0
+        for a in range(cols.shape[0]):
+            c = maps[u, row, a]
+            for j in range(j0, j1):
+                acc[j] += c * cols[a, j]
+
+
+@numba.njit
+def _norm_rows(maps, seg_u, seg_start, count, cols, m, acc, norm):
     """``norm[j] = |maps[u] @ cols[:, j]|``, squares accumulated row by row (no cancelling quadratic form)."""
     for j in range(m):
         norm[j] = 0.0
     for row in range(maps.shape[1]):
-        _apply_row(maps, row, index, start, cols, m, acc)
+        _apply_row(maps, row, seg_u, seg_start, count, cols, acc)
         for j in range(m):
             norm[j] += acc[j] * acc[j]
     for j in range(m):
@@ -253,17 +279,65 @@ def linear_maps(dq, plain, squared, index, out, norm):
     """
     n, n_a = dq.shape
     cols, acc, norm_b = np.empty((n_a, BLOCK)), np.empty(BLOCK), np.empty(BLOCK)
+    seg_u, seg_start = np.empty(BLOCK, dtype=np.int64), np.empty(BLOCK + 1, dtype=np.int64)
     for start in range(0, n, BLOCK):
         m = min(BLOCK, n - start)
         for a in range(n_a):
             _load(dq[:, a], start, m, cols[a])
+        count = _segments(index, start, m, seg_u, seg_start)
         for row in range(plain.shape[1]):
-            _apply_row(plain, row, index, start, cols, m, acc)
+            _apply_row(plain, row, seg_u, seg_start, count, cols, acc)
             for j in range(m):
                 out[start + j, row] = acc[j]
         if squared.shape[1] > 0:
-            _norm_rows(squared, index, start, cols, m, acc, norm_b)
+            _norm_rows(squared, seg_u, seg_start, count, cols, m, acc, norm_b)
             _load(norm_b, 0, m, norm[start:])
+
+
+@numba.njit
+def _maps_by_segments(maps, residual, seg_u, seg_start, count, cols, m, with_dy, buf):
+    """Body increments ``buf[0:3]`` and slip ``buf[3]`` of the `m` samples of `cols` ``(n, BLOCK)``, by segments
+    of one configuration (vectorised); ``buf[1]`` is left alone unless `with_dy`, ``buf[3]`` when R = 0."""
+    _apply_row(maps, 0, seg_u, seg_start, count, cols, buf[0])
+    if with_dy:
+        _apply_row(maps, 1, seg_u, seg_start, count, cols, buf[1])
+    _apply_row(maps, 2, seg_u, seg_start, count, cols, buf[2])
+    if residual.shape[1] > 0:
+        _norm_rows(residual, seg_u, seg_start, count, cols, m, buf[9], buf[3])
+
+
+@numba.njit
+def _compose_block(with_slip, start, m, with_dy, heading, fraction, exact, buf, state, poses, slip):
+    """The rest of a block of :func:`odometry_chunk`: the body increments ``buf[0:3]`` composed from ``state = (x,
+    y, theta, distance, rotation, max slip, sum slip^2)`` (updated), poses and the slip ``buf[3]`` (0 unless
+    `with_slip`) written from sample `start`. `buf` ``(10, BLOCK)``: the increments, slip, then scratch rows."""
+    bx, by, bth, bslip, head, turn, theta, cf, sf = buf[0], buf[1], buf[2], buf[3], buf[4], buf[5], buf[6], buf[7], \
+        buf[8]
+    th, turned = _headings(state[2], bth, heading, start, m, fraction, head, turn, theta)
+    _rotations(head, turn, m, exact, cf, sf)
+    x, y, travelled = _positions(state[0], state[1], cf, sf, bx, by, with_dy, theta, m, poses, start)
+    state[0], state[1], state[2], state[3], state[4] = x, y, th, state[3] + travelled, state[4] + turned
+    if with_slip:
+        max_slip, sq_slip = state[5], state[6]
+        for j in range(m):
+            slip[start + j] = bslip[j]
+            max_slip = max(max_slip, bslip[j])
+            sq_slip += bslip[j] * bslip[j]
+        state[5], state[6] = max_slip, sq_slip
+    else:  # write only where not already 0: fresh zeroed memory stays untouched (no page written)
+        for j in range(m):
+            if slip[start + j] != 0.0:
+                slip[start + j] = 0.0
+
+
+@numba.njit
+def _has_dy(maps):
+    """Whether any map has a lateral row (row 1) that is not zero."""
+    for u in range(maps.shape[0]):
+        for a in range(maps.shape[2]):
+            if maps[u, 1, a] != 0.0:
+                return True
+    return False
 
 
 @_jit(numba.types.UniTuple(numba.float64, 4)(_IN, _IN1, _IN3, _IN3, _INDEX, _IN1, _IN1, numba.float64,
@@ -280,17 +354,11 @@ def odometry_chunk(rates, before, maps, residual, index, pose0, heading, fractio
     """
     n, n_a = rates.shape
     differences = before.shape[0] > 0
-    with_dy = False
-    for u in range(maps.shape[0]):
-        for a in range(n_a):
-            with_dy = with_dy or maps[u, 1, a] != 0.0
-    cols, acc = np.empty((n_a, BLOCK)), np.empty(BLOCK)
-    bx, by, bth, bslip = np.empty(BLOCK), np.empty(BLOCK), np.empty(BLOCK), np.empty(BLOCK)
-    head, turn, theta, cf, sf = (np.empty(BLOCK), np.empty(BLOCK), np.empty(BLOCK), np.empty(BLOCK),
-                                 np.empty(BLOCK))
-    x, y = pose0[0], pose0[1]
-    th = heading[0] if heading.shape[0] > 0 else pose0[2]
-    distance, rotation, max_slip, sq_slip = 0.0, 0.0, 0.0, 0.0
+    with_dy = _has_dy(maps)
+    cols, buf = np.empty((n_a, BLOCK)), np.empty((10, BLOCK))
+    seg_u, seg_start = np.empty(BLOCK, dtype=np.int64), np.empty(BLOCK + 1, dtype=np.int64)
+    state = np.zeros(7)
+    state[0], state[1], state[2] = pose0[0], pose0[1], heading[0] if heading.shape[0] > 0 else pose0[2]
     for start in range(0, n, BLOCK):
         m = min(BLOCK, n - start)
         for a in range(n_a):
@@ -298,25 +366,57 @@ def odometry_chunk(rates, before, maps, residual, index, pose0, heading, fractio
                 _load_differences(rates[:, a], before[a], start, m, cols[a])
             else:
                 _load(rates[:, a], start, m, cols[a])
-        _apply_row(maps, 0, index, start, cols, m, bx)
-        if with_dy:
-            _apply_row(maps, 1, index, start, cols, m, by)
-        _apply_row(maps, 2, index, start, cols, m, bth)
-        th, turned = _headings(th, bth, heading, start, m, fraction, head, turn, theta)
-        _rotations(head, turn, m, exact, cf, sf)
-        x, y, travelled = _positions(x, y, cf, sf, bx, by, with_dy, theta, m, poses, start)
-        distance, rotation = distance + travelled, rotation + turned
-        if residual.shape[1] > 0:
-            _norm_rows(residual, index, start, cols, m, acc, bslip)
-            for j in range(m):
-                slip[start + j] = bslip[j]
-                max_slip = max(max_slip, bslip[j])
-                sq_slip += bslip[j] * bslip[j]
-        else:  # write only where not already 0: fresh zeroed memory stays untouched (no page written)
-            for j in range(m):
-                if slip[start + j] != 0.0:
-                    slip[start + j] = 0.0
-    return distance, rotation, max_slip, sq_slip
+        count = _segments(index, start, m, seg_u, seg_start)
+        _maps_by_segments(maps, residual, seg_u, seg_start, count, cols, m, with_dy, buf)
+        _compose_block(residual.shape[1] > 0, start, m, with_dy, heading, fraction, exact, buf, state, poses, slip)
+    return state[3], state[4], state[5], state[6]
+
+
+@_jit(numba.types.UniTuple(numba.int64, 2)(_IN, _IN1, _INDEX, _INDEX, numba.int64, _IN, _INDEX, _IN3, _IN3,
+                                           _IN1, numba.float64, numba.boolean, _OUT1, _OUT2, _OUT1, _OUT2))
+def steered_chunk(positions, before, rate_cols, steer_cols, start, keys, ids, maps, residual, heading, fraction,
+                  exact, state, poses, slip, missing):
+    """:func:`odometry_chunk` for a steering robot: joint positions to poses in one pass, the maps of each
+    interval's steering configuration (its angles at mid-interval) found among the known ones.
+
+    ``positions (N, n_j), before (n_j,)`` the sample before the first, ``rate_cols (n,)``, ``steer_cols (s,)``
+    their columns; ``keys (U, s)`` the known configurations sorted lexicographically, ``ids (U,)`` their maps'
+    rows in ``maps (V, 3, n)`` and ``residual (V, R, n)``; ``state (7,)`` = pose, then the path sums of
+    :func:`odometry_chunk`, updated; samples from `start` on. The maps are looked up only when the steering
+    angles change. Returns ``(reached, count)``: ``(N, 0)`` when done; else interval `reached` has a
+    configuration not in `keys`, and ``missing[:count]`` ``(M, s)`` holds the configurations of the intervals from
+    there on (each run of equal angles once, while `missing` has room): add their maps and call again from
+    `reached`.
+    """
+    n, n_a, n_s = positions.shape[0], rate_cols.shape[0], steer_cols.shape[0]
+    with_dy = _has_dy(maps)
+    cols, buf = np.empty((n_a, BLOCK)), np.empty((10, BLOCK))
+    seg_u, seg_start = np.empty(BLOCK, dtype=np.int64), np.empty(BLOCK + 1, dtype=np.int64)
+    mid = np.full(n_s, np.nan)
+    u = -1
+    for block in range(start, n, BLOCK):
+        m = min(BLOCK, n - block)
+        count, unknown = 0, False
+        for j in range(m):
+            if _steering_mid(positions, before, steer_cols, block + j, mid) or j == 0:
+                u = _find(keys, ids, mid)
+                if u < 0:  # the block ends here
+                    m, unknown = j, True
+                    break
+                seg_u[count], seg_start[count] = u, j
+                count += 1
+        seg_start[count] = m
+        for a in range(n_a):
+            c = rate_cols[a]
+            _load_differences(positions[:, c], before[c], block, m, cols[a])
+            if _is_steering(c, steer_cols):
+                for j in range(m):
+                    cols[a, j] = _wrap(cols[a, j])
+        _maps_by_segments(maps, residual, seg_u, seg_start, count, cols, m, with_dy, buf)
+        _compose_block(residual.shape[1] > 0, block, m, with_dy, heading, fraction, exact, buf, state, poses, slip)
+        if unknown:
+            return block + m, _configurations_from(positions, before, steer_cols, block + m, missing)
+    return n, 0
 
 
 @_jit(numba.types.Tuple((numba.int64, numba.float64))(_IN1, _IN1))

@@ -11,14 +11,15 @@ Steering angles come from the sensed ``WHEEL.steer`` joints. A steering wheel wh
 that has no sensed joint is left out (a passive castor's rows never constrain the twist; an unsensed steered
 wheel only adds a constraint the other wheels may or may not pin down). Robots without sensed steering have a
 constant matrix: its solution matrix is computed once. Otherwise one solution is computed per distinct
-steering configuration in the data (quantised steering encoders give few) and gathered per sample.
+steering configuration in the data (quantised steering encoders give few) and kept by the model
+(:meth:`OdometryModel.configuration_maps`, up to :data:`CACHE_SIZE` configurations) for the next chunks and logs.
 """
 
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -26,6 +27,9 @@ from numpy.typing import ArrayLike
 from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import matrix_rank, solve_assigned
 from ..robot import Robot
+
+#: Steering configurations whose maps a model keeps; a chunk with more new ones (continuous steering) starts afresh.
+CACHE_SIZE = 1 << 14
 
 
 class SensingError(WmrkitError, ValueError):
@@ -122,6 +126,56 @@ class ModelIncrements:
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
+class ConfigurationMaps:
+    """Matrices per steering configuration, kept by a model: ``keys`` ``(U, s)`` the configurations (angles of the
+    sensed steering joints [rad]) sorted lexicographically, ``ids`` ``(U,)`` int64 the row of each in every array
+    of ``arrays`` ``((U, ...), ...)``. Read-only. For :class:`OdometryModel`: the solution ``(U, k, n_a)`` and
+    residual ``(U, R, n_a)`` maps (see :meth:`OdometryModel.matrices`), and the triangular factor (QR)
+    ``(U, min(R, n_a), n_a)`` of the residual map, whose product with ``dq`` has the norm of the residual in fewer
+    rows (an orthogonal change of rows: no cancelling quadratic form)."""
+
+    keys: np.ndarray
+    ids: np.ndarray
+    arrays: tuple[np.ndarray, ...]
+
+    def find(self, configs: np.ndarray) -> np.ndarray:
+        """Row in ``arrays`` of each configuration ``(M, s) -> (M,)`` int64, -1 when unknown."""
+        from . import _steering_kernels  # numba loads on first use
+        out = np.empty(len(configs), dtype=np.int64)
+        _steering_kernels.find_configurations(self.keys, self.ids, np.asarray(configs, dtype=float), out)
+        return out
+
+
+def cached_maps(cache: dict, configs: np.ndarray, shapes: tuple[tuple[int, ...], ...],
+                compute: Callable[[np.ndarray], tuple[np.ndarray, tuple[np.ndarray, ...]]]
+                ) -> tuple[ConfigurationMaps, np.ndarray]:
+    """The maps kept in `cache` extended by those of the configurations `configs` ``(M, s)`` (distinct rows) not
+    yet there, and the rows of `configs` that `compute` refuses ``(B, s)``. ``compute(new) -> (ok (M',), arrays
+    of new[ok])``; `shapes`: each array's shape after the configuration axis. When the cache would grow beyond
+    :data:`CACHE_SIZE` configurations it starts afresh with those of `configs`, all of them (so a caller that
+    asks for every configuration it still needs finds them all)."""
+    cached = cache.get("maps")
+    n_s = configs.shape[1]
+    new = configs if cached is None or not len(cached.keys) or not len(configs) else configs[cached.find(configs) < 0]
+    if cached is None or len(cached.keys) + len(new) > CACHE_SIZE:  # afresh, with every configuration asked for
+        cached = ConfigurationMaps(_frozen(np.empty((0, n_s))), _frozen(np.empty(0, dtype=np.int64)),
+                                   tuple(_frozen(np.empty((0, *sh))) for sh in shapes))
+        new = configs
+    if len(new) == 0:
+        cache["maps"] = cached
+        return cached, new
+    ok, arrays = compute(new)
+    keys = np.empty((len(cached.keys) + int(ok.sum()), n_s))  # in the order of the arrays' rows
+    keys[cached.ids], keys[len(cached.keys):] = cached.keys, new[ok]
+    order = np.lexsort(keys.T[::-1]) if n_s else np.arange(len(keys))  # column 0 first, as _steering_kernels._find
+    maps = ConfigurationMaps(_frozen(keys[order]), _frozen(order.astype(np.int64)),
+                             tuple(_frozen(np.concatenate([old, a])) for old, a in zip(cached.arrays, arrays,
+                                                                                       strict=True)))
+    cache["maps"] = maps
+    return maps, new[~ok]
+
+
+@dataclass(frozen=True, eq=False)  # eq=False: array fields
 class OdometryModel:
     """Sensed direct model of one robot over samples (module docstring); build it with :func:`odometry_model`.
 
@@ -140,6 +194,8 @@ class OdometryModel:
     row_weights: np.ndarray  # weight of each kept row in the least squares
     solution: np.ndarray | None  # (k, n_a), constant robots only
     residual_map: np.ndarray | None  # (R, n_a), constant robots with redundant sensors only
+    # maps per steering configuration met so far; not an init field, so dataclasses.replace starts a new one
+    _cache: dict = field(init=False, default_factory=dict, compare=False, repr=False)
 
     @property
     def constant(self) -> bool:
@@ -207,25 +263,49 @@ class OdometryModel:
         full[..., self.steer_index] = beta
         return _solution_maps(self.robot, full, self.rows, self.cols, self.assigned, self.row_weights)
 
+    @property
+    def columns(self) -> tuple[np.ndarray, np.ndarray]:
+        """Positions in ``joints`` of ``rate_joints`` and of ``steer_joints`` (int64)."""
+        return (np.array([self.joints.index(j) for j in self.rate_joints], dtype=np.int64),
+                np.array([self.joints.index(j) for j in self.steer_joints], dtype=np.int64))
+
+    def configuration_maps(self, configs: ArrayLike | None = None) -> tuple[ConfigurationMaps, np.ndarray]:
+        """The maps (solution, residual, its QR factor: :class:`ConfigurationMaps`) of every configuration met so
+        far, extended by those of `configs` ``(M, s)`` (angles of ``steer_joints`` [rad], distinct rows); also
+        the rows of `configs` at which the sensed joints do not determine the motion ``(B, s)`` (left out). Kept
+        for the next calls (one model, many chunks and logs): each configuration's maps are computed once, by
+        :meth:`matrices`."""
+        n_s, n_a, k, r = len(self.steer_joints), len(self.rate_joints), len(self.cols), len(self.rows)
+        configs = np.empty((0, n_s)) if configs is None else np.asarray(configs, dtype=float)
+        configs = configs.reshape(len(configs), n_s)
+
+        def compute(new: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
+            ok = _twist_determined(self.robot, new, self)
+            s, rm = self.matrices(new[ok]) if ok.any() else (np.empty((0, k, n_a)), np.empty((0, r, n_a)))
+            return ok, (s, rm, np.linalg.qr(rm, mode="r"))
+
+        return cached_maps(self._cache, configs, ((k, n_a), (r, n_a), (min(r, n_a), n_a)), compute)
+
+    def undetermined(self, beta: np.ndarray, bad: np.ndarray) -> SensingError:
+        """The error naming the first interval whose steering angles, a row of `beta` ``(N, s)``, is among the
+        configurations `bad` ``(B, s)`` at which the sensed joints do not determine the motion."""
+        hit = (beta[:, None, :] == bad[None]).all(axis=2).any(axis=1)
+        i = int(np.flatnonzero(hit)[0])
+        angles = ", ".join(f"{j}={np.degrees(b):.4g} deg" for j, b in zip(self.steer_joints, beta[i], strict=True))
+        return SensingError(f"interval {i}: the sensed joints do not determine the motion at steering {angles}")
+
     def _solve_by_configuration(self, dq: np.ndarray, beta_mid: ArrayLike | None) -> tuple[np.ndarray, ...]:
         if beta_mid is None:
             raise WmrkitError(f"beta_mid: robot '{self.robot.name}' steers; the steering angles are needed")
         beta = np.asarray(beta_mid, dtype=float)
         if beta.shape != (dq.shape[0], len(self.steer_joints)):
             raise WmrkitError(f"beta_mid: expected shape ({dq.shape[0]}, {len(self.steer_joints)}), got {beta.shape}")
-        if beta.shape[1] == 1:
-            configs, index = np.unique(beta[:, 0], return_inverse=True)
-            configs = configs[:, None]
-        else:
-            configs, index = np.unique(beta, axis=0, return_inverse=True)
-        index = index.reshape(-1)
-        s, rm = self.matrices(configs)
-        bad = ~_twist_determined(self.robot, configs, self)
-        if np.any(bad):
-            i = int(np.flatnonzero(bad[index])[0])
-            angles = ", ".join(f"{j}={np.degrees(b):.4g} deg" for j, b in zip(self.steer_joints, beta[i], strict=True))
-            raise SensingError(f"interval {i}: the sensed joints do not determine the motion at steering {angles}")
-        return s, rm, index
+        configs, index = configurations(beta)
+        maps, bad = self.configuration_maps(configs)
+        if len(bad):
+            raise self.undetermined(beta, bad)
+        rows = maps.find(configs)
+        return maps.arrays[0][rows], maps.arrays[1][rows], index
 
 
 def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
@@ -305,6 +385,22 @@ def kernel_maps(solution: np.ndarray, residual_map: np.ndarray | None,
 def wrap_angle(angle: ArrayLike) -> np.ndarray:
     """`angle` [rad] wrapped into ``[-pi, pi)``. ``(...) -> (...)``."""
     return (np.asarray(angle, dtype=float) + np.pi) % (2 * np.pi) - np.pi
+
+
+def configurations(beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distinct rows of `beta` ``(N, s)`` (sorted) and the index of each row ``(N,)`` int64, in O(N) plus a sort
+    of the runs: quantised steering changes between few samples, so only the first sample of each run is sorted."""
+    n = len(beta)
+    change = np.empty(n, dtype=bool)
+    change[:1] = True
+    np.any(beta[1:] != beta[:-1], axis=1, out=change[1:])
+    starts = np.flatnonzero(change)
+    if beta.shape[1] == 1:  # one steering angle: a 1-D sort, several times faster than rows
+        values, inverse = np.unique(beta[starts, 0], return_inverse=True)
+        configs = values[:, None]
+    else:
+        configs, inverse = np.unique(beta[starts], axis=0, return_inverse=True)
+    return configs, np.repeat(inverse.reshape(-1).astype(np.int64), np.diff(np.append(starts, n)))
 
 
 def _kept_matrix(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:

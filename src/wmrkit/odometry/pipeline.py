@@ -4,8 +4,10 @@ Per chunk: the sensed direct model (:mod:`.model`) gives body increments between
 scheme (:mod:`.integrators`) composes them from the pose carried over from the previous chunk, and the
 covariance (:mod:`.covariance`) is propagated from the carried covariance. The last sample of each chunk is kept
 to difference against the next, so the result does not depend on the chunk size (to round-off). Increments,
-composition, slip and path sums are one compiled pass over the chunk (:func:`._kernels.odometry_chunk`); for
-robots that do not steer, it differences the joint positions itself.
+composition, slip and path sums are one compiled pass over the chunk (:func:`._kernels.odometry_chunk`) that
+differences the joint positions itself; for a steering robot (:func:`._kernels.steered_chunk`) it also takes the
+steering angles at mid-interval and finds their maps among those the model keeps (computed once per
+configuration, :meth:`.model.OdometryModel.configuration_maps`).
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from ..robot import Robot
 from .covariance import CrowleyNoise, JointNoise, propagate_covariance
 from .integrators import HEADING_FRACTION, Method, check_method
 from .logs import JointLog, LogError, check_time
-from .model import ModelIncrements, OdometryModel, kernel_maps, odometry_model
+from .model import ModelIncrements, OdometryModel, kernel_maps, odometry_model, wrap_angle
 from .trajectories import Trajectory
 
 Noise = CrowleyNoise | JointNoise
@@ -96,10 +98,11 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
             if len(chunk) == 0:
                 continue
         n = len(chunk)
-        # steering robots need the configuration of each interval; others difference the positions in the kernel,
-        # whose path length is then finite exactly when the positions are (checked below: one read of them)
-        fused = model.constant and cov is None
-        max_dt = _validate(chunk, prev, positions=not fused)
+        # without covariance the kernel differences the positions (and finds each interval's steering maps); the
+        # path length is then finite exactly when the positions are (checked below: one read of them). Steering
+        # angles are checked first: the configuration lookup needs numbers.
+        fused = cov is None
+        max_dt = _validate(chunk, prev, positions=not (fused and model.constant))
         inc = None if fused else model.from_positions(chunk.positions, previous=prev.positions[-1])
         heading = None
         if chunk.heading_world is not None:
@@ -192,6 +195,8 @@ def _compose_chunk(model: OdometryModel, positions: np.ndarray, before: np.ndarr
     the differences of `positions` ``(N, n)`` from `before` ``(n,)``, taken in the kernel."""
     from . import _kernels  # numba loads on first use
 
+    if inc is None and not model.constant:
+        return _steered_chunk(model, positions, before, pose, heading, method, poses, slip)
     if inc is None:
         maps, residual, index = kernel_maps(model.solution, model.residual_map)
         rates, first = positions, np.asarray(before, dtype=float)
@@ -200,6 +205,31 @@ def _compose_chunk(model: OdometryModel, positions: np.ndarray, before: np.ndarr
     return _kernels.odometry_chunk(np.asarray(rates, dtype=float), first, maps, residual, index, pose,
                                    np.empty(0) if heading is None else heading, HEADING_FRACTION[method],
                                    method == "exact", poses, slip)
+
+
+def _steered_chunk(model: OdometryModel, positions: np.ndarray, before: np.ndarray, pose: np.ndarray,
+                   heading: np.ndarray | None, method: Method, poses: np.ndarray,
+                   slip: np.ndarray) -> tuple[float, float, float, float]:
+    """:func:`_compose_chunk` of a steering robot in one compiled pass (:func:`._kernels.steered_chunk`), with the
+    maps of the configurations met so far; a pass that meets new ones stops, their maps are added, it resumes."""
+    from . import _kernels  # numba loads on first use
+
+    positions, before = np.asarray(positions, dtype=float), np.asarray(before, dtype=float)
+    rate_cols, steer_cols = model.columns
+    state = np.array([pose[0], pose[1], pose[2] if heading is None else heading[0], 0.0, 0.0, 0.0, 0.0])
+    missing = np.empty((len(positions), len(steer_cols)))
+    maps, start = model.configuration_maps()[0], 0
+    while True:
+        start, count = _kernels.steered_chunk(positions, before, rate_cols, steer_cols, start, maps.keys, maps.ids,
+                                              maps.arrays[0][:, :3], maps.arrays[2],
+                                              np.empty(0) if heading is None else heading, HEADING_FRACTION[method],
+                                              method == "exact", state, poses, slip, missing)
+        if count == 0:
+            return state[3], state[4], state[5], state[6]
+        maps, bad = model.configuration_maps(np.unique(missing[:count], axis=0))
+        if len(bad):
+            d = wrap_angle(np.diff(np.vstack([before[steer_cols], positions[:, steer_cols]]), axis=0))
+            raise model.undetermined(np.vstack([before[steer_cols], positions[:-1, steer_cols]]) + 0.5 * d, bad)
 
 
 def _increment_covariance(noise: Noise, inc: ModelIncrements, steps: np.ndarray) -> np.ndarray:

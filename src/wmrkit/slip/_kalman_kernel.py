@@ -1,9 +1,17 @@
 """Compiled loop of the velocity Kalman filters FK1/FK2 (thesis (7.71)-(7.75)) in information form (numba).
 
-Per sample, with ``H = C^T R^-1 C`` and ``M = -C^T R^-1 A_a`` precomputed per steering configuration:
+Per sample, with ``H = C^T R^-1 C`` and ``M = -C^T R^-1 A_a`` of the sample's steering configuration:
 ``P- = P + Q``, ``P+ = (P-^-1 + H)^-1``, ``x+ = P+ (P-^-1 x + M qdot_a)`` (the Woodbury form of the gain
 (7.73)-(7.75); two symmetric 3x3 inverses, no m x m inverse). ``double_q`` adds Q once more after the update, as
-(7.75) is printed. The increment of the sample is ``x+ dt``; its slip indicator ``|C x+ - y| dt`` [m].
+(7.75) is printed. The increment of the sample is ``x+ dt``; its slip indicator ``|C x+ + A_a qdot_a| dt`` [m],
+computed as ``|T (x+, qdot_a)| dt`` with T the triangular factor of ``[C, A_a]`` (an orthogonal change of rows).
+
+The covariance recursion does not depend on the data: while the configuration stays the same and the carried
+covariance is a fixed point of the step (bitwise: the step gave back the very numbers it started from), every
+next step would compute the same two inverses, so they are kept instead of recomputed. Exact, not an
+approximation: the results are those of the plain recursion, bit for bit. One pass reads the joint positions and
+times (increments, rates, the steering configuration at mid-interval, as :mod:`wmrkit.odometry.model` defines
+them), filters, and composes the poses with the blocks of :mod:`wmrkit.odometry._kernels`.
 """
 
 from __future__ import annotations
@@ -12,6 +20,8 @@ import numba
 import numpy as np
 
 from .._jit import jit as _jit
+from ..odometry._kernels import BLOCK, _headings, _positions, _rotations
+from ..odometry._steering_kernels import _configurations_from, _find, _is_steering, _steering_mid, _wrap
 
 _IN = numba.types.Array(numba.float64, 2, "A", readonly=True)
 _IN1 = numba.types.Array(numba.float64, 1, "A", readonly=True)
@@ -31,57 +41,120 @@ def _inverse_sym(a00, a01, a02, a11, a12, a22):
             (a00 * a11 - a01 * a01) * inv)
 
 
-@_jit(numba.void(_IN, _IN1, _IN3, _IN3, _IN3, _IN3, _INDEX, numba.float64, numba.boolean, _IN1, _IN,
-                 numba.float64[:, :], numba.float64[:], numba.float64[:], numba.float64[:, :]))
-def kalman_chunk(rates, dt, h, m, c, aa, index, q, double_q, x0, p0, out, slip, x_end, p_end):
-    """Filter `rates` ``(N, n_a)`` [rad/s] sampled with steps `dt` ``(N,)``; body increments into `out` ``(N, 3)``,
-    slip into `slip` ``(N,)``; the final state and covariance into `x_end` ``(3,)``, `p_end` ``(3, 3)``.
+@_jit(numba.types.UniTuple(numba.int64, 2)(_IN, _IN1, _IN1, numba.float64, _INDEX, _INDEX, numba.int64, _IN, _INDEX,
+                                           _IN3, _IN3, _IN3, numba.float64, numba.boolean, numba.float64[:],
+                                           numba.float64[:], numba.float64, numba.boolean, numba.float64[:, :],
+                                           numba.float64[:, :], numba.float64[:], numba.float64[:, :]))
+def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, start, keys, ids, h, m, ca, q,
+                 double_q, filt, pose, fraction, exact, increments, poses, slip, missing):
+    """Filter the intervals of joint `positions` ``(N, n_j)`` [rad] at `time` ``(N,)`` [s], each from the sample
+    before (`before` ``(n_j,)`` at `time_before` for the first), from interval `start` on.
 
-    `h` ``(U, 3, 3)``, `m` ``(U, 3, n_a)``, `c` ``(U, rows, 3)``, `aa` ``(U, rows, n_a)``; `index` ``(N,)`` the
-    configuration of each sample (empty: configuration 0 throughout); `q` the process variance per step.
+    ``rate_cols (n_a,)``, ``steer_cols (s,)``: the columns of the sensed rates and steering angles; ``keys (U, s)``
+    the known configurations sorted lexicographically, ``ids (U,)`` their rows in ``h (V, 3, 3)``, ``m (V, 3,
+    n_a)``, ``ca (V, r, 3 + n_a)`` the triangular factor T (QR) of ``[C, A_a]``, so that ``|C x + A_a qdot| =
+    |T (x, qdot)|`` (without steering: one key of length 0); `q` the process
+    variance per step. ``filt (9,)``: the state ``x`` then the upper entries of ``P`` (00, 01, 02, 11, 12, 22),
+    updated. Body increments into `increments` ``(N, 3)`` and poses composed from ``pose (7,)`` (pose, path sums as
+    :func:`wmrkit.odometry._kernels.steered_chunk`, updated) into `poses` ``(N, 3)``, each skipped when empty
+    ``(0, 3)``; slip into `slip` ``(N,)``. Returns ``(reached, count)`` as
+    :func:`wmrkit.odometry._kernels.steered_chunk`: ``missing[:count]`` the configurations to add before resuming.
     """
-    n, n_a = rates.shape
-    n_rows = c.shape[1]
-    x_0, x_1, x_2 = x0[0], x0[1], x0[2]
-    p00, p01, p02, p11, p12, p22 = p0[0, 0], p0[0, 1], p0[0, 2], p0[1, 1], p0[1, 2], p0[2, 2]
-    constant = index.shape[0] == 0
-    for k in range(n):
-        u = 0 if constant else index[k]
-        # prediction (7.71)-(7.72)
-        p00 += q
-        p11 += q
-        p22 += q
-        i00, i01, i02, i11, i12, i22 = _inverse_sym(p00, p01, p02, p11, p12, p22)
-        # information vector P-^-1 x + M qdot_a
-        b0 = i00 * x_0 + i01 * x_1 + i02 * x_2
-        b1 = i01 * x_0 + i11 * x_1 + i12 * x_2
-        b2 = i02 * x_0 + i12 * x_1 + i22 * x_2
-        for j in range(n_a):
-            r = rates[k, j]
-            b0 += m[u, 0, j] * r
-            b1 += m[u, 1, j] * r
-            b2 += m[u, 2, j] * r
-        p00, p01, p02, p11, p12, p22 = _inverse_sym(i00 + h[u, 0, 0], i01 + h[u, 0, 1], i02 + h[u, 0, 2],
-                                                    i11 + h[u, 1, 1], i12 + h[u, 1, 2], i22 + h[u, 2, 2])
-        x_0 = p00 * b0 + p01 * b1 + p02 * b2
-        x_1 = p01 * b0 + p11 * b1 + p12 * b2
-        x_2 = p02 * b0 + p12 * b1 + p22 * b2
-        if double_q:  # (7.75) as printed
-            p00 += q
-            p11 += q
-            p22 += q
-        d = dt[k]
-        out[k, 0] = x_0 * d
-        out[k, 1] = x_1 * d
-        out[k, 2] = x_2 * d
-        s = 0.0
-        for i in range(n_rows):
-            e = c[u, i, 0] * x_0 + c[u, i, 1] * x_1 + c[u, i, 2] * x_2
-            for j in range(n_a):
-                e += aa[u, i, j] * rates[k, j]
-            s += e * e
-        slip[k] = np.sqrt(s) * d
-    x_end[0], x_end[1], x_end[2] = x_0, x_1, x_2
-    p_end[0, 0], p_end[0, 1], p_end[0, 2] = p00, p01, p02
-    p_end[1, 0], p_end[1, 1], p_end[1, 2] = p01, p11, p12
-    p_end[2, 0], p_end[2, 1], p_end[2, 2] = p02, p12, p22
+    n, n_a, n_s = positions.shape[0], rate_cols.shape[0], steer_cols.shape[0]
+    with_increments, with_poses = increments.shape[0] > 0, poses.shape[0] > 0
+    x_0, x_1, x_2 = filt[0], filt[1], filt[2]
+    p00, p01, p02, p11, p12, p22 = filt[3], filt[4], filt[5], filt[6], filt[7], filt[8]
+    i00 = i01 = i02 = i11 = i12 = i22 = u00 = u01 = u02 = u11 = u12 = u22 = 0.0
+    steady, last_u = False, -1
+    mid = np.full(n_s, np.nan)
+    config = np.empty(BLOCK, dtype=np.int64)
+    z, buf = np.empty((3 + n_a, BLOCK)), np.empty((11, BLOCK))  # z: the twist, then the rates
+    sq, e_row = buf[9], buf[10]
+    rates = z[3:]
+    bx, by, bth, head, turn, theta, cf, sf, dt = buf[0], buf[1], buf[2], buf[3], buf[4], buf[5], buf[6], buf[7], buf[8]
+    u = -1
+    for block in range(start, n, BLOCK):
+        bm, unknown = min(BLOCK, n - block), False
+        for j in range(bm):  # the configuration of each interval, looked up when the steering angles change
+            if _steering_mid(positions, before, steer_cols, block + j, mid) or j == 0:
+                u = _find(keys, ids, mid)
+                if u < 0:  # the block ends here
+                    bm, unknown = j, True
+                    break
+            config[j] = u
+        _rates(positions, before, time, time_before, rate_cols, steer_cols, block, bm, dt, rates)
+        for j in range(bm):  # the recursion, sequential
+            u = config[j]
+            if u != last_u:
+                steady, last_u = False, u
+            if not steady:  # prediction (7.71)-(7.72), then the update's covariance
+                i00, i01, i02, i11, i12, i22 = _inverse_sym(p00 + q, p01, p02, p11 + q, p12, p22 + q)
+                u00, u01, u02, u11, u12, u22 = _inverse_sym(i00 + h[u, 0, 0], i01 + h[u, 0, 1], i02 + h[u, 0, 2],
+                                                            i11 + h[u, 1, 1], i12 + h[u, 1, 2], i22 + h[u, 2, 2])
+                n00, n11, n22 = (u00 + q, u11 + q, u22 + q) if double_q else (u00, u11, u22)  # (7.75) as printed
+                steady = (n00 == p00 and u01 == p01 and u02 == p02 and n11 == p11 and u12 == p12 and n22 == p22)
+                p00, p01, p02, p11, p12, p22 = n00, u01, u02, n11, u12, n22
+            # information vector P-^-1 x + M qdot_a, then x+ = P+ b
+            b0 = i00 * x_0 + i01 * x_1 + i02 * x_2
+            b1 = i01 * x_0 + i11 * x_1 + i12 * x_2
+            b2 = i02 * x_0 + i12 * x_1 + i22 * x_2
+            for a in range(n_a):
+                b0 += m[u, 0, a] * rates[a, j]
+                b1 += m[u, 1, a] * rates[a, j]
+                b2 += m[u, 2, a] * rates[a, j]
+            x_0 = u00 * b0 + u01 * b1 + u02 * b2
+            x_1 = u01 * b0 + u11 * b1 + u12 * b2
+            x_2 = u02 * b0 + u12 * b1 + u22 * b2
+            d = dt[j]
+            bx[j], by[j], bth[j] = x_0 * d, x_1 * d, x_2 * d
+            z[0, j], z[1, j], z[2, j] = x_0, x_1, x_2
+        for j in range(bm):
+            sq[j] = 0.0
+        for i in range(ca.shape[1]):  # |C x + A_a qdot| dt = |T z| dt, z = (x, qdot), T triangular
+            for j in range(bm):
+                e_row[j] = 0.0
+            for a in range(i, ca.shape[2]):
+                for j in range(bm):
+                    e_row[j] += ca[config[j], i, a] * z[a, j]
+            for j in range(bm):
+                sq[j] += e_row[j] * e_row[j]
+        for j in range(bm):
+            slip[block + j] = np.sqrt(sq[j]) * dt[j]
+        if with_increments:
+            for j in range(bm):
+                increments[block + j, 0], increments[block + j, 1], increments[block + j, 2] = bx[j], by[j], bth[j]
+        if with_poses:
+            th, turned = _headings(pose[2], bth, np.empty(0), block, bm, fraction, head, turn, theta)
+            _rotations(head, turn, bm, exact, cf, sf)
+            px, py, travelled = _positions(pose[0], pose[1], cf, sf, bx, by, True, theta, bm, poses, block)
+            pose[0], pose[1], pose[2], pose[3], pose[4] = px, py, th, pose[3] + travelled, pose[4] + turned
+        if unknown:
+            _store(filt, x_0, x_1, x_2, p00, p01, p02, p11, p12, p22)
+            return block + bm, _configurations_from(positions, before, steer_cols, block + bm, missing)
+    _store(filt, x_0, x_1, x_2, p00, p01, p02, p11, p12, p22)
+    return n, 0
+
+
+@numba.njit
+def _rates(positions, before, time, time_before, rate_cols, steer_cols, start, m, dt, rates):
+    """Steps ``dt[j]`` and rates ``rates[a, j]`` (increment over step) of the `m` intervals from `start` (a sensed
+    steering angle's increment wrapped: a turn is no motion)."""
+    for j in range(m):
+        k = start + j
+        dt[j] = time[k] - (time_before if k == 0 else time[k - 1])
+    for a in range(rate_cols.shape[0]):
+        col = rate_cols[a]
+        angle = _is_steering(col, steer_cols)
+        last = before[col] if start == 0 else positions[start - 1, col]
+        for j in range(m):
+            value = positions[start + j, col]
+            step = _wrap(value - last) if angle else value - last
+            rates[a, j] = step / dt[j]
+            last = value
+
+
+@numba.njit
+def _store(filt, x_0, x_1, x_2, p00, p01, p02, p11, p12, p22):
+    """The filter's state into `filt` ``(9,)``."""
+    filt[0], filt[1], filt[2] = x_0, x_1, x_2
+    filt[3], filt[4], filt[5], filt[6], filt[7], filt[8] = p00, p01, p02, p11, p12, p22

@@ -17,15 +17,15 @@ The recursion is (7.71)-(7.74) with the standard covariance update; (7.75) as pr
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import WmrkitError
-from ..odometry.integrators import Method, check_method, compose_columns
+from ..odometry.integrators import HEADING_FRACTION, Method, check_method
 from ..odometry.logs import JointLog
-from ..odometry.model import OdometryModel, odometry_model, wrap_angle
+from ..odometry.model import ConfigurationMaps, OdometryModel, cached_maps, odometry_model, wrap_angle
 from ..odometry.trajectories import Trajectory
 from ..robot import Robot
 
@@ -80,6 +80,8 @@ class KalmanModel:
     sigma: np.ndarray
     process: float
     thesis_double_q: bool = False
+    # matrices per steering configuration met so far; not an init field, so dataclasses.replace starts a new one
+    _cache: dict = field(init=False, default_factory=dict, compare=False, repr=False)
 
     def matrices(self, beta_full: np.ndarray) -> tuple[np.ndarray, ...]:
         """``(H, M, C, A_a)`` per configuration ``(U, n_steer) -> (U, 3, 3), (U, 3, n_a), (U, m, 3), (U, m, n_a)``."""
@@ -88,6 +90,26 @@ class KalmanModel:
         c, aa = a[..., :3], a[..., cols]
         ct_r = np.swapaxes(c, -1, -2) / self.sigma**2
         return ct_r @ c, -(ct_r @ aa), np.ascontiguousarray(c), np.ascontiguousarray(aa)
+
+    def configuration_maps(self, configs: ArrayLike | None = None) -> ConfigurationMaps:
+        """``(H, M, C, A_a, [C, A_a])`` (:meth:`matrices`) for every steering configuration met so far (angles of the
+        sensed steering joints [rad]), extended by the distinct rows of `configs` ``(U, s)``; kept for the next
+        calls (:func:`wmrkit.odometry.model.cached_maps`). A robot without sensed steering has one configuration,
+        of no angles."""
+        om = self.odometry
+        n_s, n_a, m = len(om.steer_joints), len(om.rate_joints), len(self.rows)
+        configs = np.empty((0 if n_s else 1, n_s)) if configs is None else np.asarray(configs, dtype=float)
+        configs = configs.reshape(len(configs), n_s)
+
+        def compute(new: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
+            full = np.broadcast_to(om.robot.beta, (len(new), len(om.robot.steer_names))).copy()
+            full[:, om.steer_index] = new
+            h, mm, c, aa = self.matrices(full)
+            slip = np.linalg.qr(np.concatenate([c, aa], axis=-1), mode="r")  # |[C, A_a] z| = |T z|, fewer rows
+            return np.ones(len(new), dtype=bool), (h, mm, c, aa, slip)
+
+        shapes = ((3, 3), (3, n_a), (m, 3), (m, n_a), (min(m, 3 + n_a), 3 + n_a))
+        return cached_maps(self._cache, configs, shapes, compute)[0]
 
 
 def kalman_model(robot: Robot, kind: str = "fk2", noise: KalmanNoise | None = None,
@@ -141,6 +163,18 @@ def kalman_filter(model: KalmanModel, log: JointLog, *, x0: ArrayLike | None = N
     `x0` defaults to the least-squares twist of the first interval, `p0` to Q (the spec's choice; the thesis
     gives neither). Rates are the increments over each interval divided by its duration.
     """
+    t = np.asarray(log.time, dtype=float)
+    increments = np.empty((max(len(t) - 1, 0), 3))
+    slip, filt = _run(model, log, x0, p0, increments, np.empty((0, 3)), np.zeros(7), "exact")
+    p = filt[[3, 4, 5, 4, 6, 7, 5, 7, 8]].reshape(3, 3)
+    return KalmanRun(increments / np.diff(t)[:, None], increments, p, slip)
+
+
+def _run(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike | None, increments: np.ndarray,
+         poses: np.ndarray, pose: np.ndarray, method: Method) -> tuple[np.ndarray, np.ndarray]:
+    """One compiled pass (:func:`._kalman_kernel.kalman_chunk`) over the intervals of `log`: increments and poses
+    into the given arrays (each skipped when ``(0, 3)``), from ``pose (7,)`` (pose, then path sums); the slip
+    ``(N,)`` and the final filter state ``(9,)`` (x, upper entries of P)."""
     from . import _kalman_kernel
 
     om = model.odometry
@@ -149,61 +183,43 @@ def kalman_filter(model: KalmanModel, log: JointLog, *, x0: ArrayLike | None = N
     t = np.asarray(chunk.time, dtype=float)
     if len(t) < 2:
         raise WmrkitError("the log needs at least two samples")
-    dt = np.diff(t)
-    d = np.diff(p, axis=0)
-    rate_idx = [om.joints.index(j) for j in om.rate_joints]
-    rates = d[:, rate_idx] / dt[:, None]
-    robot = om.robot
-    if om.steer_joints:
-        sc = [om.joints.index(j) for j in om.steer_joints]
-        steps = wrap_angle(d[:, sc])
-        beta_mid = p[:-1, sc] + 0.5 * steps
-        configs, index = _configurations(beta_mid)
-        full = np.broadcast_to(robot.beta, (len(configs), len(robot.steer_names))).copy()
-        full[:, om.steer_index] = configs
-    else:
-        full, index = robot.beta[None], np.empty(0, dtype=np.int64)
-    h, m, c, aa = model.matrices(full)
+    rate_cols, steer_cols = om.columns
+    first = p[0, steer_cols] + 0.5 * wrap_angle(p[1, steer_cols] - p[0, steer_cols])  # as the kernel computes
+    maps = model.configuration_maps(first[None])
     if x0 is None:
-        u0 = 0 if len(index) == 0 else int(index[0])
-        x0 = np.linalg.lstsq(c[u0] / model.sigma[:, None], -(aa[u0] @ rates[0]) / model.sigma, rcond=None)[0]
+        c, aa = (a[maps.find(first[None])[0]] for a in maps.arrays[2:4])
+        rate0 = (p[1, rate_cols] - p[0, rate_cols]) / (t[1] - t[0])
+        x0 = np.linalg.lstsq(c / model.sigma[:, None], -(aa @ rate0) / model.sigma, rcond=None)[0]
     p_start = np.eye(3) * model.process if p0 is None else np.asarray(p0, dtype=float)
-    out, slip = np.empty((len(dt), 3)), np.empty(len(dt))
-    x_end, p_end = np.empty(3), np.empty((3, 3))
-    _kalman_kernel.kalman_chunk(rates, dt, h, m, c, aa, index, model.process, model.thesis_double_q,
-                                np.asarray(x0, dtype=float), p_start, out, slip, x_end, p_end)
-    return KalmanRun(out / dt[:, None], out, p_end, slip)
-
-
-def _configurations(beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Distinct rows of `beta` ``(N, s)`` and the index of each row ``(N,)`` int64, in O(N) plus a sort of the
-    runs: quantised steering changes between few samples, so only the first sample of each run is sorted."""
-    n = len(beta)
-    change = np.empty(n, dtype=bool)
-    change[:1] = True
-    np.any(beta[1:] != beta[:-1], axis=1, out=change[1:])
-    starts = np.flatnonzero(change)
-    if beta.shape[1] == 1:  # one steering angle: a 1-D sort, several times faster than rows
-        values, inverse = np.unique(beta[starts, 0], return_inverse=True)
-        configs = values[:, None]
-    else:
-        configs, inverse = np.unique(beta[starts], axis=0, return_inverse=True)
-    return configs, np.repeat(inverse.reshape(-1).astype(np.int64), np.diff(np.append(starts, n)))
+    filt = np.concatenate([np.asarray(x0, dtype=float).reshape(3), p_start[[0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]])
+    slip = np.empty(len(t) - 1)
+    missing = np.empty((len(t) - 1, len(steer_cols)))
+    start = 0
+    while True:
+        start, count = _kalman_kernel.kalman_chunk(p[1:], p[0], t[1:], t[0], rate_cols, steer_cols, start, maps.keys,
+                                                   maps.ids, maps.arrays[0], maps.arrays[1], maps.arrays[4],
+                                                   model.process, model.thesis_double_q,
+                                                   filt, pose, HEADING_FRACTION[method], method == "exact",
+                                                   increments, poses, slip, missing)
+        if count == 0:
+            return slip, filt
+        maps = model.configuration_maps(np.unique(missing[:count], axis=0))
 
 
 def kalman_odometry(model: KalmanModel, log: JointLog, *, method: Method = "exact",
                     pose0: ArrayLike = (0.0, 0.0, 0.0), x0: ArrayLike | None = None,
                     p0: ArrayLike | None = None) -> Trajectory:
-    """Poses from the filtered twists (one per sample, the first `pose0`), composed with `method`; `x0`, `p0`
-    as in :func:`kalman_filter`."""
+    """Poses from the filtered twists (one per sample, the first `pose0`), composed with `method` in the same
+    pass as the filter; `x0`, `p0` as in :func:`kalman_filter`."""
     check_method(method)
-    run = kalman_filter(model, log, x0=x0, p0=p0)
     pose0 = np.asarray(pose0, dtype=float)
-    poses = np.empty((len(run.increments) + 1, 3))
+    n = len(log)
+    poses = np.empty((n, 3))
     poses[0] = pose0
-    inc = run.increments
-    compose_columns(pose0, inc[:, 0], inc[:, 1], inc[:, 2], method, out=poses[1:])
-    return Trajectory(np.asarray(log.time, dtype=float), poses, np.concatenate([[0.0], run.slip]))
+    slip = np.empty(n)
+    slip[0] = 0.0
+    slip[1:] = _run(model, log, x0, p0, np.empty((0, 3)), poses[1:], np.concatenate([pose0, np.zeros(4)]), method)[0]
+    return Trajectory(np.asarray(log.time, dtype=float), poses, slip)
 
 
 def noise_from_options(process: float, lateral: float, longitudinal: float,

@@ -1,0 +1,176 @@
+"""The one-pass Kalman filters FK1/FK2 against a textbook covariance-form Kalman filter in numpy, and the reuse of
+the covariance at a fixed point against the plain recursion, bit for bit."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import wmrkit._jit as jit
+from wmrkit import catalog
+from wmrkit.odometry.logs import JointLog
+from wmrkit.odometry.model import odometry_model
+from wmrkit.slip import _kalman_kernel
+from wmrkit.slip.kalman import KalmanNoise, fk1_noise, fk2_noise, kalman_filter, kalman_model, kalman_odometry
+
+
+def drive(robot, n: int, *, quantum: float, seed: int = 0, hold: int = 1) -> JointLog:
+    """Spins with noise at 100 Hz (jittered steps), steering a random walk quantised to `quantum` [rad], changing
+    at most every `hold` samples."""
+    model = odometry_model(robot)
+    rng = np.random.default_rng(seed)
+    cols = []
+    for j in model.joints:
+        if j.endswith(".steer"):
+            walk = np.repeat(np.pi / 2 + 0.2 + np.cumsum(rng.normal(0.0, 0.03, -(-n // hold))), hold)[:n]
+            cols.append(quantum * np.round(walk / quantum))
+        else:
+            cols.append(np.cumsum(rng.normal(0.05, 0.004, n)))
+    time = np.cumsum(rng.uniform(0.009, 0.011, n))
+    return JointLog(time, model.joints, np.column_stack(cols))
+
+
+def textbook(model, log: JointLog, x0, p0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Twists ``(N, 3)``, slip ``(N,)`` and the final covariance: predict ``P + Q``, gain
+    ``K = P C^T (C P C^T + R)^-1``, update ``x + K (y - C x)``, ``(I - K C) P`` (Joseph's form), with
+    ``y = -A_a qdot``."""
+    om = model.odometry
+    robot = om.robot
+    p = log.select(om.joints).positions
+    t = np.asarray(log.time)
+    rate = [om.joints.index(j) for j in om.rate_joints]
+    steer = [om.joints.index(j) for j in om.steer_joints]
+    cols = [robot.velocity_index(j) for j in om.rate_joints]
+    x, cov = np.array(x0, dtype=float), np.array(p0, dtype=float)
+    q, r = model.process * np.eye(3), np.diag(model.sigma**2)
+    twists, slip = [], []
+    for k in range(1, len(t)):
+        dt = t[k] - t[k - 1]
+        beta = np.array(robot.beta, dtype=float)
+        step = (p[k, steer] - p[k - 1, steer] + math.pi) % (2 * math.pi) - math.pi
+        beta[om.steer_index] = p[k - 1, steer] + 0.5 * step
+        a = robot.constraint_matrix(beta)[model.rows]
+        c, aa = a[:, :3], a[:, cols]
+        qdot = (p[k, rate] - p[k - 1, rate]) / dt
+        y = -aa @ qdot
+        cov = cov + q
+        gain = cov @ c.T @ np.linalg.inv(c @ cov @ c.T + r)
+        x = x + gain @ (y - c @ x)
+        keep = np.eye(3) - gain @ c
+        cov = keep @ cov @ keep.T + gain @ r @ gain.T  # Joseph's form: (I - K C) P, symmetric and stable
+        twists.append(x)
+        slip.append(np.linalg.norm(c @ x - y) * dt)
+    return np.array(twists), np.array(slip), cov
+
+
+@pytest.fixture(params=["python", "compiled"])
+def kernels(request, monkeypatch):
+    """The filter's kernel, fresh, run as Python (below the interpret budget) or compiled (budget 0)."""
+    import importlib
+
+    monkeypatch.setattr(jit, "INTERPRET_BUDGET", 10**9 if request.param == "python" else 0)
+    importlib.reload(_kalman_kernel)
+    return request.param
+
+
+CASES = [("forklift", "fk2", fk2_noise(0.28, 3.57, 0.28)), ("forklift", "fk1", fk1_noise(0.5, 0.3)),
+         ("skid-steer-4", "fk2", KalmanNoise(0.5, 0.05, 2.0)), ("swerve-4", "fk2", KalmanNoise(2.0, 0.1, 0.3))]
+
+
+@pytest.mark.parametrize(("name", "kind", "noise"), CASES)
+def test_filter_equals_the_textbook_kalman_filter(kernels, name, kind, noise):
+    robot = catalog.load(name)
+    model = kalman_model(robot, kind, noise)
+    log = drive(robot, 400, quantum=math.radians(1.4118), seed=1)
+    x0, p0 = [0.1, 0.0, 0.0], np.diag([0.5, 0.2, 0.3])
+    twists, slip, cov = textbook(model, log, x0, p0)
+    run = kalman_filter(model, log, x0=x0, p0=p0)
+    scale = np.abs(twists).max()
+    np.testing.assert_allclose(run.twist, twists, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(run.slip, slip, rtol=0, atol=1e-12 * scale * 0.011)
+    np.testing.assert_allclose(run.covariance, cov, rtol=0, atol=1e-12 * np.abs(cov).max())
+    poses = kalman_odometry(model, log, x0=x0, p0=p0).poses  # composed in the same pass: the exact SE(2) step
+    x, y, th = 0.0, 0.0, 0.0
+    for dx, dy, dth in run.increments:
+        s, c = (math.sin(dth) / dth, (1 - math.cos(dth)) / dth) if dth else (1.0, 0.0)
+        u, v = s * dx - c * dy, c * dx + s * dy
+        x, y, th = x + math.cos(th) * u - math.sin(th) * v, y + math.sin(th) * u + math.cos(th) * v, th + dth
+    np.testing.assert_allclose(poses[-1], [x, y, th], rtol=0, atol=1e-12 * len(log))
+
+
+def plain_recursion(model, log: JointLog, x0, p0) -> tuple[np.ndarray, int]:
+    """The information-form recursion of :mod:`wmrkit.slip._kalman_kernel` with both inverses computed at every
+    step (no reuse), in Python floats with the kernel's own 3x3 inverse: the twists ``(N, 3)``, and how many steps
+    gave back the covariance they started from (bit for bit)."""
+    inverse = _kalman_kernel._inverse_sym.py_func
+    om = model.odometry
+    p = log.select(om.joints).positions
+    t = np.asarray(log.time)
+    rate = [om.joints.index(j) for j in om.rate_joints]
+    steer = [om.joints.index(j) for j in om.steer_joints]
+    maps = model.configuration_maps()
+    x = [float(v) for v in x0]
+    cov = [float(p0[0][0]), float(p0[0][1]), float(p0[0][2]), float(p0[1][1]), float(p0[1][2]), float(p0[2][2])]
+    q, out, fixed = model.process, [], 0
+    for k in range(1, len(t)):
+        d = t[k] - t[k - 1]
+        step = (p[k, steer] - p[k - 1, steer] + math.pi) % (2 * math.pi) - math.pi
+        u = maps.find((p[k - 1, steer] + 0.5 * step)[None])[0]
+        h, m = maps.arrays[0][u], maps.arrays[1][u]
+        rates = [(p[k, j] - p[k - 1, j]) / d for j in rate]
+        i00, i01, i02, i11, i12, i22 = inverse(cov[0] + q, cov[1], cov[2], cov[3] + q, cov[4], cov[5] + q)
+        before, cov = cov, list(inverse(i00 + h[0, 0], i01 + h[0, 1], i02 + h[0, 2], i11 + h[1, 1],
+                                        i12 + h[1, 2], i22 + h[2, 2]))
+        fixed += cov == before
+        b0, b1, b2 = i00 * x[0] + i01 * x[1] + i02 * x[2], i01 * x[0] + i11 * x[1] + i12 * x[2], \
+            i02 * x[0] + i12 * x[1] + i22 * x[2]
+        for a, r in enumerate(rates):
+            b0, b1, b2 = b0 + m[0, a] * r, b1 + m[1, a] * r, b2 + m[2, a] * r
+        x = [cov[0] * b0 + cov[1] * b1 + cov[2] * b2, cov[1] * b0 + cov[3] * b1 + cov[4] * b2,
+             cov[2] * b0 + cov[4] * b1 + cov[5] * b2]
+        out.append(x)
+    return np.array(out), fixed
+
+
+def test_the_covariance_kept_at_its_fixed_point_changes_no_bit(kernels):
+    fork = catalog.load("forklift")
+    model = kalman_model(fork, "fk2", fk2_noise(0.28, 3.57, 0.28))
+    log = drive(fork, 1500, quantum=math.radians(1.4118), seed=2, hold=300)  # runs long enough to reach it
+    x0, p0 = [0.2, 0.0, 0.0], np.eye(3)
+    run = kalman_filter(model, log, x0=x0, p0=p0)
+    reference, fixed = plain_recursion(model, log, x0, p0)
+    assert fixed > 1000  # most steps start at the fixed point: the kernel skips their inverses
+    np.testing.assert_array_equal(run.increments, reference * np.diff(log.time)[:, None])
+    assert _kalman_kernel.kalman_chunk.is_compiled() == (kernels == "compiled")
+
+
+def test_new_configurations_met_mid_run_give_the_same_numbers():
+    fork = catalog.load("forklift")
+    log = drive(fork, 3000, quantum=math.radians(1.4118), seed=4)
+    fresh = kalman_model(fork, "fk2", fk2_noise(0.28, 3.57, 0.28))
+    first = kalman_odometry(fresh, log)  # every configuration new: the pass stops, adds them, resumes
+    known = len(fresh.configuration_maps().keys)
+    again = kalman_odometry(fresh, log)  # all known
+    np.testing.assert_array_equal(again.poses, first.poses)
+    np.testing.assert_array_equal(again.slip, first.slip)
+    assert known == len(fresh.configuration_maps().keys) > 10
+
+
+def test_a_full_cache_met_mid_run_starts_afresh_with_all_it_needs(monkeypatch):
+    import wmrkit.odometry.model as model_module
+
+    fork = catalog.load("forklift")
+    quantum = math.radians(1.4118)
+    held = drive(fork, 200, quantum=quantum, seed=6)
+    held.positions[:, 2] = 40 * quantum  # one configuration
+    turning = JointLog(held.time, held.joints, held.positions.copy())
+    turning.positions[100:, 2] = quantum * np.arange(40, 140)  # then a new one at every sample
+    noise = fk2_noise(0.28, 3.57, 0.28)
+    expected = kalman_odometry(kalman_model(fork, "fk2", noise), turning)
+    monkeypatch.setattr(model_module, "CACHE_SIZE", 8)
+    model = kalman_model(fork, "fk2", noise)
+    kalman_odometry(model, held)  # keeps the first configuration
+    out = kalman_odometry(model, turning)  # known, then more than 8 new
+    np.testing.assert_array_equal(out.poses, expected.poses)
