@@ -169,16 +169,14 @@ def paths(robot, k11: float, k12: float, quick: bool = False, *, seed: int = 0, 
     """The five experiment paths (speeds drawn in ``SETTINGS["path_speed_m_s"]`` from `seed`, encoder phases
     too), simulated with the MD through `drive` (:func:`drive_path`), odometry by every estimator; J_k (7.80)
     against the simulated final pose (open-loop programs do not close exactly), with the thesis's parameters and
-    tuned on these runs as the thesis did (``optimised``); ``ranking``: the thesis's finding checked on both."""
+    tuned on these runs as the thesis did (``optimised``), and those tuned parameters on fresh runs of seed + 1
+    (``held_out``: no tuning on the data judged); ``ranking``: the thesis's finding checked on all three."""
     estimators = {"WLS": estimator_poses(robot, "WLS", (k11, k12)),
                   "WLS (thesis k)": estimator_poses(robot, "WLS", SETTINGS["wls_thesis"]),
                   **{k: estimator_poses(robot, k, SETTINGS.get(f"{k.lower()}_thesis", ())) for k in TUNED[1:]}}
     out, data, logs = {}, {}, []
-    rng = np.random.default_rng(seed)
-    for name in names or (PATH_NAMES[:2] if quick else PATH_NAMES):
-        speed, phase = float(rng.uniform(*SETTINGS["path_speed_m_s"])), tuple(rng.uniform(0.0, 1.0, 2))
-        sim = drive_path(robot, name, speed, drive)
-        log = sensor_log(robot, sim, phase)
+    runs = _runs(robot, names or (PATH_NAMES[:2] if quick else PATH_NAMES), seed, drive)
+    for name, (speed, sim, log) in runs.items():
         logs.append((log, np.asarray(sim.pose[-1])))
         est = {k: f(log) for k, f in estimators.items()}
         jk = {k: float(sum(closure_error(p, sim.pose[-1])) / 2) for k, p in est.items()}
@@ -190,10 +188,29 @@ def paths(robot, k11: float, k12: float, quick: bool = False, *, seed: int = 0, 
     for name, (log, _) in zip(data, logs, strict=True):  # the figures: tuned estimators, as Figs 7.19-7.23
         data[name] |= {f"{k} (tuned)" if v["params"] else k: estimator_poses(robot, k, v["params"])(log)
                        for k, v in opt.items()}
+    fresh = [(log, np.asarray(sim.pose[-1])) for _, sim, log in _runs(robot, tuple(runs), seed + 1, drive).values()]
+    held_out = {k: _mean_jk(estimator_poses(robot, k, v["params"]), fresh) for k, v in opt.items()}
     ranking = {"thesis parameters": _ranking({k: mean[k] for k in ("WLS (thesis k)", "FK1", "FK2", "differential")}),
-               "tuned": _ranking({k: v["J_k"] for k, v in opt.items()})}
-    return {"runs": out, "mean_J_k": mean, "optimised": opt, "ranking": ranking, "drive": drive, "seed": seed,
-            "_data": data}
+               "tuned": _ranking({k: v["J_k"] for k, v in opt.items()}),
+               "held out": _ranking(held_out)}
+    return {"runs": out, "mean_J_k": mean, "optimised": opt, "held_out": {"seed": seed + 1, "J_k": held_out},
+            "ranking": ranking, "drive": drive, "seed": seed, "_data": data}
+
+
+def _runs(robot, names, seed: int, drive: str) -> dict:
+    """``{path: (speed, simulation, log)}``: each path driven at a speed drawn from `seed`, encoder phases too."""
+    rng = np.random.default_rng(seed)
+    out = {}
+    for name in names:
+        speed, phase = float(rng.uniform(*SETTINGS["path_speed_m_s"])), tuple(rng.uniform(0.0, 1.0, 2))
+        sim = drive_path(robot, name, speed, drive)
+        out[name] = (speed, sim, sensor_log(robot, sim, phase))
+    return out
+
+
+def _mean_jk(poses_of, logs: list) -> float:
+    """Mean J_k (7.80) of an estimator over ``(log, true final pose)`` runs."""
+    return float(np.mean([sum(closure_error(poses_of(log), final)) / 2 for log, final in logs]))
 
 
 def _ranking(jk: dict) -> dict:
@@ -208,16 +225,13 @@ def optimise(robot, logs: list, maxiter: int) -> dict:
     (Nelder-Mead in log space from the thesis's optimum). ``{estimator: {"params": [...], "J_k": value}}``."""
     from scipy.optimize import minimize
 
-    def mean_jk(poses_of) -> float:
-        return float(np.mean([sum(closure_error(poses_of(log), final)) / 2 for log, final in logs]))
-
     out = {}
     for name in TUNED[:3]:
-        fit = minimize(lambda p, name=name: mean_jk(estimator_poses(robot, name, 10.0 ** p)),
+        fit = minimize(lambda p, name=name: _mean_jk(estimator_poses(robot, name, 10.0 ** p), logs),
                        np.log10(SETTINGS[f"{name.lower()}_thesis"]), method="Nelder-Mead",
                        options={"maxiter": maxiter, "xatol": 1e-3, "fatol": 1e-7})
         out[name] = {"params": [float(v) for v in 10.0 ** fit.x], "J_k": float(fit.fun)}
-    out["differential"] = {"params": [], "J_k": mean_jk(estimator_poses(robot, "differential", ()))}
+    out["differential"] = {"params": [], "J_k": _mean_jk(estimator_poses(robot, "differential", ()), logs)}
     return out
 
 
@@ -248,7 +262,7 @@ def forklift_study(report: str | os.PathLike[str] | None = None, quick: bool = F
     strip = lambda d: {k: v for k, v in d.items() if not k.startswith("_")}  # noqa: E731
     return {"settings": SETTINGS, "sweep": strip(sw), "examples": [strip(e) for e in examples],
             "paths": {**pth["runs"], "mean_J_k": pth["mean_J_k"], "optimised": pth["optimised"],
-                      "ranking": pth["ranking"], "drive": drive, "seed": seed},
+                      "held_out": pth["held_out"], "ranking": pth["ranking"], "drive": drive, "seed": seed},
             "figures": figures}
 
 
