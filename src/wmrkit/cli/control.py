@@ -30,6 +30,15 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--dynamics", action="store_true",
                    help="close the loop through the chapter-7 dynamics with tyres (needs mass properties; "
                         "period default 0.02 s)")
+    p.add_argument("--slip-model", default="none", choices=("none", "mqe", "mcd"),
+                   help="with --dynamics: wheel commands from the inverse slip model (thesis future work 4) instead "
+                        "of the no-slip IK")
+    p.add_argument("--feedback", default="pose", choices=("pose", "odometry", "wls", "fk2", "mqe"),
+                   help="with --dynamics: what the controller measures: the true pose, no-slip odometry, WLS, the "
+                        "FK2 filter (weights and noise from the description), or the MQE slip model as odometry")
+    p.add_argument("--ramp", action="store_true",
+                   help="with --dynamics: reach each period's wheel commands linearly over the period (first-order "
+                        "hold) instead of holding them")
     p.add_argument("--plot", metavar="FILE", help="save a plot of the run (PNG/SVG/PDF)")
     p.add_argument("--animate", metavar="FILE", help="save an animation of the run (GIF)")
     add_json_flag(p)
@@ -82,10 +91,20 @@ def run_track(args: argparse.Namespace) -> int:
     period = None if args.period is None else _positive(args.period, "--period")
     duration = None if args.duration is None else _positive(args.duration, "--duration")
     gate = None if args.gate is None else _positive(args.gate, "--gate", "length")
+    weights = noise = None
+    if (args.slip_model != "none" or args.feedback != "pose" or args.ramp) and not args.dynamics:
+        option = "slip-model" if args.slip_model != "none" else "feedback" if args.feedback != "pose" else "ramp"
+        raise WmrkitError(f"--{option} needs --dynamics (it acts on the dynamic plant with tyres)")
+    if args.feedback in ("wls", "fk2"):
+        from ..slip.settings import odometry_settings
+
+        settings = odometry_settings(args.robot)
+        weights, noise = settings.weights(), settings.kalman_noise()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", SamplingWarning)
         run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
-                    period=period, delay=args.delay, duration=duration, policy=args.steering, dynamics=args.dynamics)
+                    period=period, delay=args.delay, duration=duration, policy=args.steering, dynamics=args.dynamics,
+                    slip_model=args.slip_model, feedback=args.feedback, weights=weights, noise=noise, ramp=args.ramp)
     for w in caught:
         if issubclass(w.category, SamplingWarning):
             print(f"wmrkit: warning: {w.message}", file=sys.stderr)
@@ -102,7 +121,9 @@ def run_track(args: argparse.Namespace) -> int:
         s = run.summary()
         print(f"robot {robot.name}, reference {reference.name}, controller {args.controller}, "
               f"{'continuous' if run.period is None else f'period {run.period:g} s, delay {args.delay}'}"
-              f"{', through the dynamics' if args.dynamics else ''}")
+              f"{', through the dynamics' if args.dynamics else ''}"
+              f"{f', {args.slip_model.upper()} commands' if args.slip_model != 'none' else ''}"
+              f"{f', {args.feedback} feedback' if args.feedback != 'pose' else ''}")
         print(f"tracking error [m]: rms {s['rms_error']:.4g}, max {s['max_error']:.4g}, final {s['final_error']:.4g}")
         print(f"cross-track error [m]: rms {s['rms_cross_track']:.4g}, max {s['max_cross_track']:.4g}")
     return 0

@@ -20,6 +20,8 @@ from .references import (
     reference_from_samples,
     resolve_reference,
 )
+from .slip_control import SLIP_MODELS, SlipCommander, SlipCommands, SlipInverse, slip_commands, slip_inverse
+from .slip_loop import FEEDBACK, simulate_slip_control
 from .steering import (
     POLICIES,
     SteeringChoice,
@@ -38,7 +40,9 @@ __all__ = [
     "BUILTIN",
     "COLUMNS",
     "CONTROLLERS",
+    "FEEDBACK",
     "POLICIES",
+    "SLIP_MODELS",
     "ActuatorLoop",
     "ControlError",
     "ControlPoint",
@@ -52,6 +56,9 @@ __all__ = [
     "ReferenceError",
     "Requirement",
     "SamplingWarning",
+    "SlipCommander",
+    "SlipCommands",
+    "SlipInverse",
     "SteeringChoice",
     "TrackingRun",
     "Violation",
@@ -79,6 +86,9 @@ __all__ = [
     "resolve_reference",
     "simulate",
     "simulate_dynamics",
+    "simulate_slip_control",
+    "slip_commands",
+    "slip_inverse",
     "stanley",
     "steer_ranges",
     "track",

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -20,6 +20,10 @@ from .loop import Plant, law_controller, simulate
 from .points import ControlError, ControlPoint, control_point, point_pose
 from .references import Reference
 from .trackers import PathIndex, default_wheelbase, pure_pursuit, stanley
+
+if TYPE_CHECKING:
+    from ..slip.kalman import KalmanNoise
+    from ..slip.weights import SlipWeights
 
 __all__ = ["CONTROLLERS", "TrackingRun", "initial_pose_on", "track"]
 
@@ -38,7 +42,9 @@ class TrackingRun:
       [m] its distance from the reference path;
     - ``twist`` ``(n, 3)`` commanded body twist; ``heading`` ``(n, n_steer)`` [rad] actual steering headings;
     - ``commands``: the per-wheel commands (:class:`WheelCommands`, batch ``(n,)``) at the commanded steering;
-    - ``estimate`` ``(n, 3)``: the odometry's pose estimate when the loop was closed on it, else None.
+    - ``estimate`` ``(n, 3)``: the odometry's pose estimate when the loop was closed on it, else None;
+    - ``slip_model``: where the wheel commands came from (``"none"``: the no-slip IK; ``"mqe"``, ``"mcd"``: the
+      inverse slip model, :mod:`.slip_control`); ``feedback``: what the controller measured (:mod:`.slip_loop`).
     """
 
     robot: Robot
@@ -55,6 +61,8 @@ class TrackingRun:
     period: float | None = None
     delay: int = 0
     estimate: np.ndarray | None = None
+    slip_model: str = "none"
+    feedback: str = "pose"
 
     def summary(self, settle: float = 0.0) -> dict[str, float]:
         """RMS, max and final tracking and cross-track errors [m] after time `settle` [s]."""
@@ -77,6 +85,8 @@ class TrackingRun:
                "error": self.error.tolist(), "wheels": wheels, "summary": self.summary()}
         if self.estimate is not None:
             out["estimate"] = self.estimate.tolist()
+        if self.slip_model != "none" or self.feedback != "pose":
+            out["slip_model"], out["feedback"] = self.slip_model, self.feedback
         return out
 
 
@@ -95,7 +105,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
           point: ArrayLike | None = None, loops: LowLevelLoops | None = None, policy: str = "closest",
           skew_free: bool = False, lookahead: float = 1.0, stanley_gain: float = 1.0,
           output_dt: float = 0.05, dynamics: bool = False, tyre: str | None = None,
-          feedback: str = "pose") -> TrackingRun:
+          feedback: str = "pose", slip_model: str = "none", weights: SlipWeights | None = None,
+          noise: KalmanNoise | None = None, ramp: bool = False) -> TrackingRun:
     """Track `reference` with `robot` (thesis ch. 8): closed loop, continuous (``period`` None) or discrete.
 
     `controller`: ``"p"`` (8.2), ``"pi"`` (8.3), ``"point"`` (8.1), ``"pure-pursuit"``, ``"stanley"``. `gain`: the
@@ -107,7 +118,11 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     `lookahead` [m] (pure pursuit), `stanley_gain` [1/s]. `dynamics`: the plant is the chapter-7 dynamic model with
     tyres (`tyre`: traction model name, default as described), driven by servos each period
     (:func:`.dynamic_plant.simulate_dynamics`; period default 0.02 s); with it, `feedback="odometry"` measures the
-    pose by odometry from the sensed joints (``TrackingRun.estimate``) instead of exactly.
+    pose by odometry from the sensed joints (``TrackingRun.estimate``) instead of exactly, ``"wls"`` by WLS odometry
+    with friction coefficients `weights`, ``"fk2"`` by the Kalman filter FK2 with `noise`; `slip_model` ``"mqe"`` or
+    ``"mcd"``: the wheel commands come from the inverse slip model instead of the no-slip IK (thesis future work 4,
+    :func:`.slip_loop.simulate_slip_control`); `ramp`: there, each period's commands are reached linearly over the
+    period instead of held (first-order hold).
     """
     if controller not in CONTROLLERS:
         raise ControlError(f"unknown controller '{controller}' (controllers: {', '.join(CONTROLLERS)})")
@@ -123,7 +138,12 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         law = PositionLaw.uniform(controller, gain, b if controller == "pi" else 0.0, gate)  # type: ignore[arg-type]
         if period is not None:
             check_sampling(law, period, stacklevel=3)
-        ctrl, tracked_point = law_controller(cp, law, reference), cp.point
+        if dynamics:  # the same law in scalar arithmetic: the dynamic loop's per-period cost (issue 11)
+            from .dynamic_plant import fast_law_controller
+
+            ctrl, tracked_point = fast_law_controller(cp, law, reference), cp.point
+        else:
+            ctrl, tracked_point = law_controller(cp, law, reference), cp.point
     elif controller == "pure-pursuit":
         ctrl, tracked_point = pure_pursuit(cp, reference, lookahead), cp.axle_point
     else:
@@ -138,10 +158,19 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
             raise ControlError("dynamics: the wheels are driven by the dynamic model's servos; no low-level loops "
                                "or skew-free option with it")
         period = 0.02 if period is None else period
-        out = simulate_dynamics(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
-                                feedback=feedback)
-    elif feedback != "pose":
-        raise ControlError("feedback='odometry' needs the dynamic plant (dynamics=True): the ideal plant has no slip")
+        if slip_model != "none" or feedback not in ("pose", "odometry") or ramp:
+            from .slip_loop import simulate_slip_control
+
+            out = simulate_slip_control(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
+                                        slip_model=slip_model, feedback=feedback, weights=weights, noise=noise,
+                                        ramp=ramp)
+        else:
+            out = simulate_dynamics(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
+                                    feedback=feedback)
+    elif feedback != "pose" or slip_model != "none" or ramp:
+        what = (f"feedback='{feedback}'" if feedback != "pose" else f"slip_model='{slip_model}'"
+                if slip_model != "none" else "ramp=True")
+        raise ControlError(f"{what} needs the dynamic plant (dynamics=True): it acts on the dynamics with tyres")
     else:
         out = simulate(robot, ctrl, pose0, duration, period=period, delay=delay, plant=Plant(loops, policy),
                        output_dt=output_dt, skew_free=skew_free, breaks=reference.breaks,
@@ -153,12 +182,16 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     error = np.hypot(tracked[:, 0] - ref[:, 0], tracked[:, 1] - ref[:, 1])
     cross = PathIndex(reference).cross_track(tracked[:, :2])
     commands = wheel_commands(robot, out["twist"], out["target"])
+    if "rates" in out:  # the commanded rates of the actuated wheels (the slip model's when it gave them)
+        from .slip_loop import with_commanded_rates
+
+        commands = with_commanded_rates(robot, commands, out["info"]["assigned"], out["rates"])
     steer_delta = np.array([robot.wheel(n).delta for n in robot.steer_names])
     heading = heading_from_beta(out["beta"], steer_delta)
     return TrackingRun(robot, controller, readonly(t), readonly(pose), readonly(ref), readonly(tracked),
                        readonly(error), readonly(cross), readonly(out["twist"]), readonly(np.asarray(heading)),
                        commands, period, delay, readonly(out["estimate"]) if "estimate" in out and
-                       feedback == "odometry" else None)
+                       feedback != "pose" else None, slip_model, feedback)
 
 
 def _full_point(cp: ControlPoint, p: np.ndarray) -> ControlPoint:

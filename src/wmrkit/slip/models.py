@@ -191,6 +191,9 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
     betas = (None if beta is None or n_s == 0
              else np.broadcast_to(np.asarray(beta, float), (*batch, n_s)).reshape(-1, n_s))
     q0 = (wls(robot, assigned, q_a, betas) if start is None else start).q_dot.reshape(-1, k)
+    # scipy's hybr differences each unknown with a step relative to its size: a start of 1e-17 (round-off of an
+    # exact 0) gives it a useless Jacobian column and it stalls (skid steer, tests/slip/test_models.py)
+    q0 = np.where(np.abs(q0) < 1e-9 * np.maximum(1.0, np.abs(q0).max(axis=-1, keepdims=True)), 0.0, q0)
     static = np.ones(n_e) if loads is None else np.asarray(loads, dtype=float)
     if static.shape != (n_e,):
         raise WmrkitError(f"loads: expected {n_e} normal loads, one per contact, got shape {static.shape}")
