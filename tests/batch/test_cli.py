@@ -51,6 +51,7 @@ def test_sweep(capsys, tmp_path):
     ["sweep", "omni-3", "--vary", "wheels[0].l=0.1:0.2:2", "--workers", "0", "--length", "-1"],
     ["batch", "odometry", "diff-drive", "/nonexistent/*.csv", "--workers", "0"],
     ["batch", "odometry", "diff-drive", "x.csv", "--workers", "-2"],
+    ["batch", "odometry", "diff-drive", "x.csv", "--workers", "0", "--sensed", "left.bogus"],  # the whole batch
     ["batch", "montecarlo", "diff-drive", "--workers", "0"],
     ["batch", "montecarlo", "diff-drive", "--path", "nowhere", "--workers", "0"],
 ])

@@ -81,11 +81,21 @@ def test_sweep_montecarlo_calibration_identical(engines, diff, calibration_data)
                          runner=runner)[0].reference.tolist() == runs[0].reference.tolist()
 
 
+def test_tasks_of_several_logs_with_a_shared_model(engines, fleet_dir, diff):
+    from wmrkit.odometry.model import odometry_model
+
+    model = odometry_model(diff)  # as batch_odometry sends it: one model, pickled once per task
+    jobs = [LogJob(p, diff, closed=True, model=model) for p in expand_logs([fleet_dir])] * 4
+    serial = [process_log(LogJob(j.path, diff, closed=True)) for j in jobs]  # the model built per log
+    out = engines["local"].map(process_log, jobs, chunk=5)
+    assert _strip(out) == _strip(serial) and sum(r["error"] is not None for r in out) == 4
+
+
 def test_a_worker_killed_mid_batch(engines, fleet_dir, diff, tmp_path):
     jobs = [LogJob(p, diff) for p in expand_logs([fleet_dir])]
     marker = str(tmp_path / "killed")
     runner = engines["local"]
-    out = runner.map(die_once, [(j, marker) for j in jobs])
+    out = runner.map(die_once, [(j, marker) for j in jobs], chunk=2)  # the dead worker's task of 2 logs is redone
     assert os.path.exists(marker)  # a worker did die
     assert _strip(out) == _strip([process_log(j) for j in jobs])
     runner.client.wait_for_workers(2, timeout=60)  # the nanny restarted it
@@ -95,6 +105,11 @@ def test_embedded_cluster():
     with engine(workers=1) as e:
         assert e.mode == "local" and e.workers == 1
         assert e.map(abs, [-1, -2]) == [1, 2]
+        # glibc's malloc defaults (not the nanny's 64 kB trim threshold, which the module's default cluster has
+        # meanwhile left in this process's os.environ) and no profiler
+        settings = e.client.run(lambda: (os.environ.get("MALLOC_TRIM_THRESHOLD_"),  # a lambda travels by value
+                                         __import__("dask").config.get("distributed.worker.profile.enabled")))
+        assert list(settings.values()) == [(None, False)]
 
 
 def test_cli_on_the_remote_scheduler(cluster, fleet_dir, capsys):

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import itertools
 import sys
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
-from wmrkit.batch.engine import BatchError, TaskFailure, engine
+from wmrkit.batch.engine import BatchError, TaskFailure, chunk_spans, engine
 
 
 def _square(x):
@@ -39,3 +42,18 @@ def test_without_dask_serial_fallback_and_scheduler_error(monkeypatch, capsys):
     assert e.map(_square, [2]) == [4]
     with pytest.raises(BatchError, match=r"pip install 'wmrkit\[batch\]'"):
         engine("tcp://127.0.0.1:8786")
+
+
+@given(st.integers(0, 3000), st.integers(1, 100), st.integers(1, 8))
+def test_chunk_spans_cover_the_items_in_shrinking_tasks(n, chunk, workers):
+    spans = chunk_spans(n, chunk, workers)
+    ends = [0, *(b for _, b in spans)]
+    assert [a for a, _ in spans] == ends[:-1] and ends[-1] == n  # contiguous, from 0 to n
+    sizes = [b - a for a, b in spans]
+    assert all(1 <= s <= chunk for s in sizes)
+    assert all(a >= b for a, b in itertools.pairwise(sizes))  # never growing
+    # the guided part: at the end a task holds at most a quarter of the remaining items per worker (or chunk // 8)
+    for a, b in spans:
+        assert b - a <= max(chunk // 8, 1, -(-(n - a) // (4 * workers)))
+    if n >= 16 * chunk * workers:  # a large batch is mostly full tasks: few round trips
+        assert len(spans) <= n / chunk + 8 * 4 * workers

@@ -4,6 +4,10 @@ One row per log (:data:`SUMMARY_SCHEMA`, Parquet): the final pose as columns ``x
 length, closure error for closed paths, slip statistics, warnings, the error when the log failed. A log that
 fails is recorded with its error and the batch goes on; a rerun with the same output skips logs already done
 (an error row is retried) and redoes a log whose trajectory file is missing.
+
+The serial engine and the workers run the same function, :func:`process_log`, on the same :class:`LogJob`s: a
+path (the worker reads the file itself; only a summary row comes back) and the odometry model, built once for
+the batch. The logs go out to the workers in tasks of up to 64 (:func:`~.engine.chunk_spans`).
 """
 
 from __future__ import annotations
@@ -49,6 +53,7 @@ class LogJob:
     closed: bool = False
     slip_warning: float = 0.01
     options: Mapping[str, Any] = field(default_factory=dict)  # more keyword arguments of odometry_file
+    model: Any = None  # the odometry model, built once per batch (else per log, from options' sensed/weights)
 
 
 @dataclass(frozen=True)
@@ -97,7 +102,8 @@ def process_log(job: LogJob) -> dict[str, Any]:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, **dict(job.options))
+            s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=job.model,
+                              **dict(job.options))
         except Exception as err:
             row.update(error=_message(err), trajectory=None, seconds=time.perf_counter() - t0)
             return row
@@ -130,9 +136,11 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     With `resume`, rows of `out` (and of its part files) without error are kept and their logs skipped.
     """
     from ..odometry.integrators import check_method
+    from ..odometry.model import odometry_model
 
     check_method(method)  # type: ignore[arg-type]
-    options = {"topic": topic, "joint_names": joint_names, "sensed": sensed, "weights": weights}
+    model = odometry_model(robot, sensed, weights=weights)  # once: the same for every log (a bad --sensed fails here)
+    options = {"topic": topic, "joint_names": joint_names}
     if fmt is not None:
         options["fmt"] = fmt
     paths = expand_logs(logs)
@@ -144,13 +152,13 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
         raise BatchError(f"trajectory format must be csv or tum, got '{trajectory_format}'")
     targets = _trajectory_names(paths, trajectories, trajectory_format)
     done = _done(out, robot, method, targets) if resume and out is not None else {}
-    jobs = [LogJob(p, robot, method, targets[p], closed, slip_warning, options) for p in paths if p not in done]
+    jobs = [LogJob(p, robot, method, targets[p], closed, slip_warning, options, model) for p in paths if p not in done]
     sink = RowSink(out, SUMMARY_SCHEMA)
     rows: dict[str, Mapping[str, Any]] = dict(done)
     own = runner is None
     runner = engine(workers=0) if runner is None else runner
     try:
-        chunk = max(1, min(16, len(jobs) // (8 * runner.workers)))  # a few logs per task: less scheduler traffic
+        chunk = max(1, min(64, len(jobs) // (4 * runner.workers)))  # up to 64 logs per task, fewer at the end
         for index, row in runner.as_completed(process_log, jobs, progress=progress, desc="logs", chunk=chunk):
             if isinstance(row, TaskFailure):  # the worker died more often than the scheduler allows
                 row = {name: None for name, _ in SUMMARY_SCHEMA} | {"log": jobs[index].path, "robot": robot.name,

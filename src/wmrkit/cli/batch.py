@@ -60,6 +60,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--level", type=float, default=0.95, help="confidence level (default 0.95)")
     p.add_argument("--bootstrap", type=int, default=200, metavar="B", help="bootstrap replicates (default 200)")
     p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
+    p.add_argument("--slip", action="store_true", help="fit the slip weights (WLS ratio, effective track) instead")
     _log_options(p)
     _engine_options(p)
     p.set_defaults(run=run_calibrate)
@@ -159,22 +160,33 @@ def run_calibrate(args: argparse.Namespace) -> int:
 
     robot = load_robot(args.robot)
     params = ([tuple(n.strip() for n in p.split(",") if n.strip()) for p in args.param] if args.param
-              else default_parameters(robot, closed=args.closed))
+              else [] if args.slip else default_parameters(robot, closed=args.closed))
     if args.bootstrap < 2:
         raise WmrkitError(f"--bootstrap must be >= 2, got {args.bootstrap}")
     with _runner(args) as runner:
         runs = load_runs(robot, expand_logs(args.logs), reference_dir=args.reference, closed=args.closed,
                          runner=runner, options=_options(args))
-        result = fleet_calibrate(robot, runs, params, runner=runner, ci=args.ci, level=args.level,
-                                 n_boot=args.bootstrap, method=args.method, sensed=args.sensed,
-                                 progress=_progress(args))
+        if args.slip:
+            from ..batch.calibrate import fleet_slip_calibrate
+
+            result = fleet_slip_calibrate(robot, runs, runner=runner, level=args.level, method=args.method,
+                                          progress=_progress(args))
+        else:
+            result = fleet_calibrate(robot, runs, params, runner=runner, ci=args.ci, level=args.level,
+                                     n_boot=args.bootstrap, method=args.method, sensed=args.sensed,
+                                     progress=_progress(args))
     if args.json:
         print_json(result.to_dict())
+        return 0
+    if args.slip:
+        print(result.format())
         return 0
     print(f"robot {robot.name}: {result.runs} runs, {result.residuals} residuals, RMS {result.rms_before:.4g} -> "
           f"{result.rms_after:.4g}; {result.level:.0%} intervals ({result.ci})")
     for name, nominal, value, lo, hi in result.values:
         print(f"  {name:<24} {nominal:.6g} -> {value:.6g}  [{lo:.6g}, {hi:.6g}]")
+    for warning in result.warnings:
+        print(f"wmrkit: warning: {warning}", file=sys.stderr)
     return 0
 
 
@@ -189,7 +201,7 @@ def run_montecarlo(args: argparse.Namespace) -> int:
         from ..odometry.logs import load_csv
         from ..odometry.model import odometry_model
 
-        log = load_csv(args.log, odometry_model(robot).joints)
+        log = load_csv(args.log, odometry_model(robot).joints, robot=robot)
     else:
         if not args.rate > 0:
             raise WmrkitError(f"--rate must be > 0 Hz, got {args.rate}")
