@@ -144,13 +144,17 @@ def _rates(positions, before, time, time_before, rate_cols, steer_cols, start, m
         dt[j] = time[k] - (time_before if k == 0 else time[k - 1])
     for a in range(rate_cols.shape[0]):
         col = rate_cols[a]
-        angle = _is_steering(col, steer_cols)
         last = before[col] if start == 0 else positions[start - 1, col]
-        for j in range(m):
-            value = positions[start + j, col]
-            step = _wrap(value - last) if angle else value - last
-            rates[a, j] = step / dt[j]
-            last = value
+        if _is_steering(col, steer_cols):
+            for j in range(m):
+                value = positions[start + j, col]
+                rates[a, j] = _wrap(value - last) / dt[j]
+                last = value
+        else:  # the common case, a loop the compiler vectorises
+            for j in range(m):
+                value = positions[start + j, col]
+                rates[a, j] = (value - last) / dt[j]
+                last = value
 
 
 @numba.njit
