@@ -91,8 +91,8 @@ def _holonomic(n: int) -> float | None:
 
 def run(quick: bool) -> list[Result]:
     """Per-tick costs against WPILib (ratio = WPILib time / ours) and closed-loop simulation speed."""
-    n = 2_000 if quick else 20_000
     ref = builtin_reference("figure-eight")
+    n = min(2_000 if quick else 20_000, len(ref.t))  # one tick per reference sample
     out = [Result("diff-drive tick: law (8.2) + point twist + IK", n, _ticks(catalog.load("diff-drive"), ref, n),
                   "wpimath Ramsete + toWheelSpeeds", _ramsete(n)),
            Result("swerve-4 tick: law (8.2) + IK (closest angle)", n, _ticks(catalog.load("swerve-4"), ref, n),
