@@ -92,3 +92,36 @@ def test_missing_file_and_text_summary(tmp_path, capsys):
     text = capsys.readouterr().out
     assert text.startswith("robot forklift: 3 wheels")
     assert "velocity vector q_dot (6): vx, vy, omega, right_drive.spin, left_drive.spin, steer.spin" in text
+
+
+def test_a_long_first_compilation_is_announced_once(monkeypatch, capsys):
+    """While another thread holds numba's compiler lock past the threshold the CLI says why it is quiet (a first
+    run compiles the dynamics kernels for about 20 s); with the lock free it says nothing."""
+    import threading
+
+    from numba.core.compiler_lock import global_compiler_lock
+
+    import wmrkit.cli.main as cli
+
+    monkeypatch.setattr(cli, "COMPILE_NOTICE_AFTER", 0.2)
+    done = threading.Event()
+    watcher = threading.Thread(target=cli._compile_notice, args=(done, 0.02))
+    watcher.start()
+    watcher.join(0.4)
+    assert watcher.is_alive() and capsys.readouterr().err == ""  # the lock is free: silence
+    held, release = threading.Event(), threading.Event()
+
+    def compile_for_a_while():
+        with global_compiler_lock:
+            held.set()
+            release.wait(5)
+
+    compiler = threading.Thread(target=compile_for_a_while)
+    compiler.start()
+    held.wait(5)
+    watcher.join(5)
+    release.set()
+    compiler.join(5)
+    done.set()
+    err = capsys.readouterr().err
+    assert not watcher.is_alive() and err.count("compiling numerical kernels") == 1

@@ -6,6 +6,7 @@ import argparse
 import importlib
 import json
 import sys
+import threading
 from typing import NoReturn
 
 from ..errors import DescriptionError, WmrkitError
@@ -53,6 +54,9 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     command = next((a for a in argv if not a.startswith("-")), None)
     as_json = "--json" in argv
+    done = threading.Event()
+    if not as_json:
+        threading.Thread(target=_compile_notice, args=(done,), daemon=True).start()
     try:
         args = build_parser(command).parse_args(argv)
         return int(args.run(args) or 0)
@@ -61,6 +65,25 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except BrokenPipeError:  # e.g. `wmrkit robots | head`
         return 0
+    finally:
+        done.set()
+
+
+#: Seconds of uninterrupted kernel compilation after which the command says why it is quiet.
+COMPILE_NOTICE_AFTER = 2.0
+
+
+def _compile_notice(done: threading.Event, poll: float = 0.25) -> None:
+    """Say once on stderr that numba is compiling, when it has compiled for :data:`COMPILE_NOTICE_AFTER` s without
+    a pause (a first run on a machine, e.g. the dynamics kernels: about 20 s, silent otherwise); numba is never
+    imported here, only watched once a command has imported it."""
+    busy = 0.0
+    while not done.wait(poll):
+        busy = busy + poll if _compiling() else 0.0
+        if busy >= COMPILE_NOTICE_AFTER:
+            print("wmrkit: compiling numerical kernels for this machine (first run only; cached for the next runs)...",
+                  file=sys.stderr, flush=True)
+            return
 
 
 def report_error(err: WmrkitError, as_json: bool) -> None:
@@ -106,3 +129,13 @@ def _version() -> str:
 
 if __name__ == "__main__":
     sys.exit(main())
+
+
+def _compiling() -> bool:
+    """Whether another thread holds numba's compiler lock (False while numba is not imported)."""
+    lock = getattr(getattr(sys.modules.get("numba.core.compiler_lock"), "global_compiler_lock", None), "_lock", None)
+    if lock is None or lock.acquire(blocking=False) is False:
+        return lock is not None
+    lock.release()
+    return False
+
