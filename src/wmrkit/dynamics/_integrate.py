@@ -78,13 +78,27 @@ def assemble(t, s, acc, pack, inp, jac, w):
     _interp(rref, k0, k1, wt, rr)
     _interp(bref, k0, k1, wt, br)
     kdiag[:] = 0.0
+    group, ratio = pack[13], pack[14]
     for c in range(n):
         if rgain[c] > 0:
-            u = tau[c] + rgain[c] * (rr[c] - nu[c])
-            if abs(u) > tmax[c]:
-                u = math.copysign(tmax[c], u)
-            else:
-                kdiag[c] = -rgain[c]
+            if group[c] < 0:
+                u = tau[c] + rgain[c] * (rr[c] - nu[c])
+                if abs(u) > tmax[c]:
+                    u = math.copysign(tmax[c], u)
+                else:
+                    kdiag[c] = -rgain[c]
+            else:  # a differential: one servo on the carrier's rate error (model._differentials)
+                err, total = 0.0, 0.0
+                for d in range(n):
+                    if group[d] == group[c]:
+                        err += ratio[d] * (rr[d] - nu[d])
+                        total += ratio[d]
+                k = rgain[c] / total  # the carrier gain: the joint's own stiffness while the others keep pace
+                u = tau[c] + k * err
+                if abs(u) > tmax[c]:
+                    u = math.copysign(tmax[c], u)
+                else:
+                    kdiag[c] = -k * ratio[c]  # d tau_c / d nu_c; the other members: -k ratio_d
             tau[c] = u
     for k in range(steer_col.shape[0]):
         c = steer_col[k]
@@ -130,11 +144,11 @@ def step_semi_implicit(t, s, dt, acc, pack, inp, w, jac):
     The tyre Jacobian ``dF/dv_slip`` is refreshed when `jac` is true and reused otherwise (a W-method).
     """
     assemble(t, s, acc, pack, inp, jac, w)
-    _update_semi_implicit(s, dt, acc, w)
+    _update_semi_implicit(s, dt, acc, w, pack)
 
 
 @_inline
-def _update_semi_implicit(s, dt, acc, w):
+def _update_semi_implicit(s, dt, acc, w, pack):
     """The update of :func:`step_semi_implicit` from the assembled work arrays `w`."""
     a, m, g, kdiag, rhs, mat = w[0], w[1], w[5], w[8], w[9], w[14]
     n = rhs.shape[0]
@@ -152,8 +166,13 @@ def _update_semi_implicit(s, dt, acc, w):
                 if b0 == 0.0 and b1 == 0.0:
                     continue
                 mat[i, j] -= dt * (g00 * b0 + g01 * b1)
+    group, ratio = pack[13], pack[14]
     for c in range(n):
         mat[c, c] -= dt * kdiag[c]
+        if group[c] >= 0 and kdiag[c] != 0.0:  # a differential's servo couples its joints: -k ratio_d
+            for d in range(n):
+                if d != c and group[d] == group[c]:
+                    mat[c, d] -= dt * kdiag[c] * ratio[d] / ratio[c]
     solve_in_place(mat, rhs)  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt
     dnu = rhs
     for c in range(n):
@@ -220,7 +239,7 @@ def run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack
         if j > 0 and k % every == 0 and i < rec[0].shape[0]:  # the step's assembly is the record at t = k dt
             _store(k * dt, s, w, rec, i)
             i += 1
-        _update_semi_implicit(s, dt, acc, w)
+        _update_semi_implicit(s, dt, acc, w, pack)
     k = k0 + n_steps
     if n_steps > 0 and k % every == 0 and i < rec[0].shape[0]:
         _observe(k * dt, s, acc, pack, inp, w, rec, i)

@@ -12,7 +12,8 @@ The model is passed as a tuple ``pack`` of arrays built by :func:`wmrkit.dynamic
 rate in the velocity vector; ``steer_kind (S,)`` int: 0 centred (its z-inertia in I_T, (7.17)), 1 castor unit;
 ``steer_prm (S, 5)``: ``I_s, m, l, alpha, d``; ``diag_I (n,)``: spin/roller inertia per column; ``carry (n,)``:
 1 for the columns that carry the wheel (twist, steering rates), 0 for rolling ones; ``body (6,)``: ``M, I, cx, cy,
-h, g``; ``pinv (E, 3)``: static load map when the contacts do not move (``fixed_loads``), ``fixed_loads (1,)``.
+h, g``; ``pinv (E, 3)``: static load map when the contacts do not move (``fixed_loads``), ``fixed_loads (1,)``;
+``group (n,)`` int: the differential coupling of each column (-1: none) and ``ratio (n,)`` its ratio there.
 """
 
 from __future__ import annotations

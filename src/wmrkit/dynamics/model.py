@@ -199,12 +199,24 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
             np.array(steer_cols, dtype=np.int64), np.array(steer_kind, dtype=np.int64),
             np.array(steer_prm, dtype=float).reshape(-1, 5), diag_i, carry,
             np.array([body.mass, body.inertia, *body.com, body.com_height, gravity]),
-            np.array(np.linalg.pinv(geo), order="C"), np.array([0 if moving else 1], dtype=np.int64))
+            np.array(np.linalg.pinv(geo), order="C"), np.array([0 if moving else 1], dtype=np.int64),
+            *_differentials(robot, names))
     contacts = []
     for w in robot.wheels:
         k = len(w.elements())
         contacts.extend([w.name] if k == 1 else [f"{w.name}.{j + 1}" for j in range(k)])
     return DynamicModel(robot, tuple(names), tuple(contacts), tuple(steer_cols), tyres_e, gravity, pack)
+
+
+def _differentials(robot: Robot, names: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Per velocity column, the differential coupling it belongs to (-1: none) and its ratio there: the wheel-rate
+    servos of those columns act as one motor on the carrier ``sum(ratio_j q_j')``, its torque split by the ratios
+    (an open differential: equal torques, the speed difference left to the tyres; ``wmrkit.couplings``)."""
+    group, ratio = np.full(len(names), -1, dtype=np.int64), np.zeros(len(names))
+    for k, c in enumerate(c for c in robot.couplings if c.kind == "differential"):
+        for joint, r in zip(c.joints, c.ratios, strict=True):
+            group[names.index(joint)], ratio[names.index(joint)] = k, r
+    return group, ratio
 
 
 def _need(value: float, robot: Robot, wheel: str, field: str) -> float:

@@ -81,8 +81,9 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     """Servo inputs that make the actuated joints follow the no-slip joint motion of body `twists` ``(K, 3)``.
 
     Rate servos on actuated wheel joints (gain ``bandwidth x`` the wheel's reflected inertia, at least the grip
-    torque per 0.1 rad/s, saturated at the grip ``mu Fz r`` with mu = 1), PD servos on actuated steering
-    (natural frequency `bandwidth` [rad/s]).
+    torque per 0.1 rad/s, saturated at the grip ``mu Fz r`` with mu = 1); the joints of a ``differential`` coupling
+    share one servo on their carrier rate, their torques in the coupling's ratios (an open differential: the speed
+    difference is the tyres'); PD servos on actuated steering (natural frequency `bandwidth` [rad/s]).
     """
     from ..kinematics.wheel_ik import wheel_commands
 
@@ -102,6 +103,11 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
         contact = [k for k, name in enumerate(model.contacts) if name.split(".")[0] == w.name]
         limit[c] = max(loads[contact].max(), 1.0) * w.r
         gain[c] = max(bandwidth * reflected, limit[c] / 0.1)  # full grip torque at 0.1 rad/s of error at most
+    group, ratio = model.pack[13], model.pack[14]
+    for k in set(group[driven].tolist()) - {-1}:  # one motor through a differential: torques in the ratios
+        members = [c for c in driven if group[c] == k]
+        r = ratio[members] / ratio[members].mean()
+        gain[members], limit[members] = r * gain[members].mean(), r * (limit[members] / r).min()
     headings = np.zeros((len(t), len(model.steer_columns)))
     kp, kd = np.zeros(len(model.steer_columns)), np.zeros(len(model.steer_columns))
     steer_wheels = [w for w in robot.wheels if w.kind.steers]
