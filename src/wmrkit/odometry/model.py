@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._shapes import readonly
 from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import matrix_rank, solve_assigned
 from ..robot import Robot
@@ -158,8 +159,8 @@ def cached_maps(cache: dict, configs: np.ndarray, shapes: tuple[tuple[int, ...],
     n_s = configs.shape[1]
     new = configs if cached is None or not len(cached.keys) or not len(configs) else configs[cached.find(configs) < 0]
     if cached is None or len(cached.keys) + len(new) > CACHE_SIZE:  # afresh, with every configuration asked for
-        cached = ConfigurationMaps(_frozen(np.empty((0, n_s))), _frozen(np.empty(0, dtype=np.int64)),
-                                   tuple(_frozen(np.empty((0, *sh))) for sh in shapes))
+        cached = ConfigurationMaps(frozen(np.empty((0, n_s))), frozen(np.empty(0, dtype=np.int64)),
+                                   tuple(frozen(np.empty((0, *sh))) for sh in shapes))
         new = configs
     if len(new) == 0:
         cache["maps"] = cached
@@ -168,8 +169,8 @@ def cached_maps(cache: dict, configs: np.ndarray, shapes: tuple[tuple[int, ...],
     keys = np.empty((len(cached.keys) + int(ok.sum()), n_s))  # in the order of the arrays' rows
     keys[cached.ids], keys[len(cached.keys):] = cached.keys, new[ok]
     order = np.lexsort(keys.T[::-1]) if n_s else np.arange(len(keys))  # column 0 first, as _steering_kernels._find
-    maps = ConfigurationMaps(_frozen(keys[order]), _frozen(order.astype(np.int64)),
-                             tuple(_frozen(np.concatenate([old, a])) for old, a in zip(cached.arrays, arrays,
+    maps = ConfigurationMaps(frozen(keys[order]), frozen(order.astype(np.int64)),
+                             tuple(frozen(np.concatenate([old, a])) for old, a in zip(cached.arrays, arrays,
                                                                                        strict=True)))
     cache["maps"] = maps
     return maps, new[~ok]
@@ -261,7 +262,7 @@ class OdometryModel:
         beta = np.asarray(beta, dtype=float)
         full = np.broadcast_to(self.robot.beta, (*beta.shape[:-1], len(self.robot.steer_names))).copy()
         full[..., self.steer_index] = beta
-        return _solution_maps(self.robot, full, self.rows, self.cols, self.assigned, self.row_weights)
+        return solution_maps(self.robot, full, self.rows, self.cols, self.assigned, self.row_weights)
 
     @property
     def columns(self) -> tuple[np.ndarray, np.ndarray]:
@@ -357,17 +358,17 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
     assigned = np.array([cols.index(robot.velocity_index(j)) for j in rate_joints], dtype=int)
     joints = tuple(dict.fromkeys([*rate_joints, *steer_joints]))
     model = OdometryModel(robot, joints, tuple(rate_joints), tuple(steer_joints), np.array(rows, dtype=int), cols_a,
-                          assigned, np.array(steer_index, dtype=int), _frozen(np.array(row_weights)), None, None)
+                          assigned, np.array(steer_index, dtype=int), frozen(np.array(row_weights)), None, None)
     if steer_joints:
         return model
     if not _twist_determined(robot, robot.beta[None, :], model)[0]:
         raise SensingError(f"the sensed joints of robot '{robot.name}' ({', '.join(sensed) or 'none'}) do not "
                            "determine its motion")
-    s, rm = _solution_maps(robot, robot.beta, model.rows, model.cols, model.assigned, model.row_weights)
+    s, rm = solution_maps(robot, robot.beta, model.rows, model.cols, model.assigned, model.row_weights)
     scale = np.max(np.abs(_kept_matrix(robot, robot.beta, model.rows, model.cols)))
     redundant = np.max(np.abs(rm), initial=0.0) > 1e-12 * scale  # else A dq = 0 exactly: no spare sensor
     return OdometryModel(robot, joints, tuple(rate_joints), (), model.rows, cols_a, assigned,
-                         model.steer_index, model.row_weights, _frozen(s), _frozen(rm) if redundant else None)
+                         model.steer_index, model.row_weights, frozen(s), frozen(rm) if redundant else None)
 
 
 def kernel_maps(solution: np.ndarray, residual_map: np.ndarray | None,
@@ -408,8 +409,8 @@ def _kept_matrix(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np
     return a[..., rows, :][..., cols]
 
 
-def _solution_maps(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np.ndarray,
-                   assigned: np.ndarray, row_weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def solution_maps(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+                  assigned: np.ndarray, row_weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(S, Rm)`` from (4.11) for each configuration: solve_assigned (on the rows scaled by their weights) for
     the unit vectors of the assigned rates; ``Rm = A S``, the unweighted residual map."""
     a = _kept_matrix(robot, beta_full, rows, cols)
@@ -430,10 +431,9 @@ def _twist_determined(robot: Robot, beta_full: np.ndarray, model: OdometryModel)
     return matrix_rank(a[..., free]) == matrix_rank(a[..., free[3:]]) + 3
 
 
-def _frozen(a: np.ndarray) -> np.ndarray:
-    a = np.ascontiguousarray(a)
-    a.setflags(write=False)
-    return a
+def frozen(a: ArrayLike) -> np.ndarray:
+    """`a` as a C-contiguous read-only array (the arrays a model holds)."""
+    return readonly(np.ascontiguousarray(a))
 
 
 def wheel_slip(model: OdometryModel, positions: ArrayLike) -> dict[str, float]:

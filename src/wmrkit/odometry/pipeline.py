@@ -113,7 +113,7 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
         slip = np.zeros(n) if out is None else out.slip[row:row + n]
         sums = _compose_chunk(model, chunk.positions, prev.positions[-1], inc, pose, heading, method, poses, slip)
         if fused and not math.isfinite(sums[0]):  # a non-finite position makes every body increment NaN or inf
-            _check_finite(chunk)
+            check_finite(chunk)
         if not (all(map(math.isfinite, sums)) and np.isfinite(poses[-1]).all()):
             _overflow(chunk, poses)
         covs = None
@@ -258,7 +258,7 @@ def _validate(chunk: JointLog, prev: JointLog | None, *, positions: bool = True)
     if chunk.heading_world is not None:
         ok = ok and bool(np.isfinite(chunk.heading_world.sum()))
     if not ok:  # the slow path finds and names the first bad value
-        _check_finite(chunk)
+        check_finite(chunk)
         check_time(chunk, t, None if prev is None else float(prev.time[-1]), None)
     return largest
 
@@ -286,7 +286,8 @@ def _overflow(chunk: JointLog, values: np.ndarray, what: str = "pose") -> None:
                    "implausible log)")
 
 
-def _check_finite(log: JointLog) -> None:
+def check_finite(log: JointLog) -> None:
+    """Raise :class:`LogError` at the first time, joint position or heading of `log` that is not a finite number."""
     for name, values in (("time", log.time[:, None]), ("joint", log.positions)):
         bad = ~np.isfinite(values)
         if bad.any():

@@ -20,7 +20,7 @@ from ..errors import WmrkitError
 from ..odometry.integrators import Method, check_method, integrate_increments
 from ..odometry.logs import JointLog, LogError, check_time
 from ..odometry.model import OdometryModel
-from ..odometry.pipeline import OdometrySummary, _check_finite
+from ..odometry.pipeline import OdometrySummary, check_finite
 from ..odometry.trajectories import Trajectory
 from ..robot import Robot
 from .kalman import FILTERS, KalmanModel, KalmanNoise, kalman_filter, kalman_model
@@ -106,5 +106,5 @@ def estimator(robot: Robot, name: str, *, sensed: Sequence[str] | None = None, w
 
 def _check(chunk: JointLog, previous: float | None) -> None:
     """Refuse non-finite values and time that does not increase (the message names the row), as the pipeline."""
-    _check_finite(chunk)
+    check_finite(chunk)
     check_time(chunk, np.asarray(chunk.time, dtype=float), previous, None)

@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import WmrkitError
-from ..odometry.model import OdometryModel, _frozen, _solution_maps, odometry_model
+from ..odometry.model import OdometryModel, frozen, odometry_model, solution_maps
 from ..robot import Robot
 
 
@@ -88,7 +88,7 @@ def wls_model(robot: Robot, weights: SlipWeights | None = None, sensed=None) -> 
     base = odometry_model(robot, sensed)
     w = np.sqrt((weights or SlipWeights()).row_mu(robot)[base.rows])
     if not base.constant:
-        return replace(base, row_weights=_frozen(w))
-    s, rm = _solution_maps(robot, robot.beta, base.rows, base.cols, base.assigned, w)
-    return replace(base, row_weights=_frozen(w), solution=_frozen(s),
-                   residual_map=None if base.residual_map is None else _frozen(rm))
+        return replace(base, row_weights=frozen(w))
+    s, rm = solution_maps(robot, robot.beta, base.rows, base.cols, base.assigned, w)
+    return replace(base, row_weights=frozen(w), solution=frozen(s),
+                   residual_map=None if base.residual_map is None else frozen(rm))
