@@ -15,20 +15,18 @@ scalar form, :func:`fast_law_controller` (the numbers of :func:`.loop.law_contro
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
 
+from ..wheels import beta_from_heading, heading_from_beta
 from .laws import PositionLaw
 from .loop import TwistController
 from .points import ControlError, ControlPoint
 from .references import Reference
+from .tick import scalar_law
 
 __all__ = ["fast_law_controller", "simulate_dynamics"]
-
-TWO_PI = 2.0 * math.pi
-
 
 def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *,
                       period: float, delay: int = 0, tyre: str | None = None, step: float = 1e-3,
@@ -45,6 +43,7 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
     from ..dynamics.model import DynamicModel
     from ..dynamics.programs import twist_program
     from ..dynamics.simulate import Stepper, initial_state
+    from ..kinematics.realtime import realtime
     if not (math.isfinite(period) and period >= step > 0):
         raise ControlError(f"period: expected a control period >= the dynamics step {step} s, got {period}")
     if feedback not in ("pose", "odometry"):
@@ -56,7 +55,7 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
     stepper = Stepper(model, initial_state(model, (0.0, 0.0, 0.0), initial_pose), step=step)
     stepper.advance(twist_program(model, [0.0], [(0.0, 0.0, 0.0)]), 0.0)  # the servo gains; references below
     s, steer = stepper.state, list(model.steer_columns)
-    ik = _realtime(robot).ik
+    ik = realtime(robot).ik
     described = np.array(robot.heading, dtype=float)
     rate_reference, heading = np.zeros(model.n), np.zeros(len(described))
     rates = rate_reference[3:3 + len(robot.rate_names)]  # the IK writes the references in place
@@ -75,7 +74,7 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
         out["pose"].append(s[:3].copy())
         out["twist"].append(np.asarray(twist, dtype=float))
         out["beta"].append(s[steer])
-        out["target"].append(heading - delta + 0.5 * math.pi)  # Robot.beta_of_heading
+        out["target"].append(beta_from_heading(heading, delta))  # Robot.beta_of_heading
         out["estimate"].append(history[-1].copy())
         if k == n - 1:
             break
@@ -85,54 +84,27 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
 
 
 def fast_law_controller(cp: ControlPoint, law: PositionLaw, reference: Reference) -> TwistController:
-    """:func:`.loop.law_controller` in scalar arithmetic (a few µs a call instead of tens): the same twist and
-    error for the laws (8.1)-(8.3) with the gate (8.53), full or reduced control point."""
-    px, py = float(cp.point[0]), float(cp.point[1])
-    reduced, kind = bool(cp.reduced), law.kind
-    (a0, a1, a2), (b0, b1, b2) = law.a, law.b
-    gate = law.gate
-    g = np.asarray(cp.gain, dtype=float) if cp.reduced else np.zeros((3, 2))
-    g00, g01, g10, g11, g20, g21 = (float(v) for v in g.ravel())
+    """:func:`.loop.law_controller` in scalar arithmetic (:func:`.tick.scalar_law`; a few µs a call instead of
+    tens): the same twist and error for the laws (8.1)-(8.3) with the gate (8.53), full or reduced control point."""
+    law_twist = scalar_law(cp, law)
 
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         ref, vel = reference.at(t)
-        x, y, th = float(pose[0]), float(pose[1]), float(pose[2])
-        c, s = math.cos(th), math.sin(th)
-        mx, my = x + c * px - s * py, y + s * px + c * py  # point_pose
-        r2, v2 = (th, 0.0) if reduced else (float(ref[2]), float(vel[2]))
-        e0, e1 = float(ref[0]) - mx, float(ref[1]) - my
-        e2 = r2 - th
-        e2 -= TWO_PI * round(e2 / TWO_PI)  # wrap_angle: (-pi, pi]
-        e2 = e2 + TWO_PI if e2 <= -math.pi else (e2 - TWO_PI if e2 > math.pi else e2)
-        u0, u1, u2 = a0 * e0, a1 * e1, a2 * e2  # law_velocity
-        if kind != "point":
-            ff = 0.0 if gate is not None and math.hypot(e0, e1) > gate else 1.0
-            u0, u1, u2 = u0 + ff * float(vel[0]), u1 + ff * float(vel[1]), u2 + ff * v2
-        if kind == "pi":
-            u0, u1, u2 = u0 + b0 * float(integral[0]), u1 + b1 * float(integral[1]), u2 + b2 * float(integral[2])
-        vr0, vr1 = c * u0 + s * u1, -s * u0 + c * u1  # twist_for_velocity
-        if reduced:
-            twist = np.array([g00 * vr0 + g01 * vr1, g10 * vr0 + g11 * vr1, g20 * vr0 + g21 * vr1])
-        else:
-            twist = np.array([vr0, vr1, u2])
-        return twist, np.array([e0, e1, e2])
+        vx, vy, w, e0, e1, e2 = law_twist(float(pose[0]), float(pose[1]), float(pose[2]), float(ref[0]),
+                                          float(ref[1]), float(ref[2]), float(vel[0]), float(vel[1]), float(vel[2]),
+                                          float(integral[0]), float(integral[1]), float(integral[2]))
+        return np.array([vx, vy, w]), np.array([e0, e1, e2])
 
     return control
-
-
-@functools.lru_cache(maxsize=16)
-def _realtime(robot):
-    """The robot's compiled single-call kinematics, compiled once per robot and process."""
-    from ..kinematics.realtime import realtime
-
-    return realtime(robot)
 
 
 class _Odometer:
     """Odometry from the sensed joints of the simulated state (the robot's compiled single-call step)."""
 
     def __init__(self, robot, model, s: np.ndarray) -> None:
-        self.rt = _realtime(robot)
+        from ..kinematics.realtime import realtime
+
+        self.rt = realtime(robot)
         self.cols = [model.names.index(j) for j in self.rt.rate_joints]
         self.steer = [model.steer_columns[robot.steer_names.index(j.partition(".")[0])] for j in self.rt.steer_joints]
         self.delta = np.array([robot.wheel(j.partition(".")[0]).delta for j in self.rt.steer_joints], dtype=float)
@@ -142,7 +114,7 @@ class _Odometer:
 
     def step(self, s: np.ndarray) -> np.ndarray:
         beta = s[self.steer]
-        heading_mid = 0.5 * (beta + self.beta) + self.delta - 0.5 * math.pi
+        heading_mid = heading_from_beta(0.5 * (beta + self.beta), self.delta)
         self.beta = beta.copy()
         self.rt.odometry_step(self.pose, self.previous, np.ascontiguousarray(s[self.cols]), heading_mid)
         return self.pose.copy()

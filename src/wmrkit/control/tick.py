@@ -1,9 +1,10 @@
 """One control tick in a single call (issue item 4): position law (8.2)/(8.53), admissible twist, per-wheel IK.
 
 For a controller that runs once per sample: scalars in, caller-owned arrays out, nothing allocated per call. The
-law and the point-velocity map are a few scalar operations in Python; the per-wheel IK is the robot's compiled
-kernel of :func:`wmrkit.kinematics.realtime.realtime`. The numbers are those of :func:`.loop.law_controller` followed
-by :func:`~wmrkit.kinematics.wheel_ik.wheel_commands` (tested).
+law and the point-velocity map are :func:`scalar_law` (a few scalar operations, also the dynamic loop's
+controller), compiled here together with the robot's per-wheel IK kernel of
+:func:`wmrkit.kinematics.realtime.realtime`. The numbers are those of :func:`.loop.law_controller` followed by
+:func:`~wmrkit.kinematics.wheel_ik.wheel_commands` (tested).
 """
 
 from __future__ import annotations
@@ -17,9 +18,9 @@ from numpy.typing import ArrayLike
 
 from ..robot import Robot
 from .laws import PositionLaw
-from .points import ControlError, control_point
+from .points import ControlError, ControlPoint, control_point
 
-__all__ = ["ControlTick", "control_tick"]
+__all__ = ["ControlTick", "control_tick", "scalar_law"]
 
 TWO_PI = 2.0 * math.pi
 
@@ -53,37 +54,57 @@ def control_tick(robot: Robot, law: PositionLaw | None = None, point: ArrayLike 
     if law.kind != "p":
         raise ControlError(f"control_tick: only the P + feedforward law (8.2)/(8.53), got '{law.kind}'")
     cp = control_point(robot, point)
-    gain = tuple(float(v) for v in np.asarray(cp.gain).ravel()) if cp.reduced else (0.0,) * 6
+    gain = tuple(float(v) for v in np.asarray(cp.gain).ravel()) if cp.reduced else ()
+    kernel = _tick_kernel(realtime(robot).ik, scalar_law(cp, law))
+    return ControlTick(robot, cp.reduced, (float(cp.point[0]), float(cp.point[1])), gain, law.a,
+                       math.inf if law.gate is None else float(law.gate), kernel)
+
+
+def scalar_law(cp: ControlPoint, law: PositionLaw):
+    """The laws (8.1)-(8.3) with the gate (8.53) at control point `cp`, then the admissible twist (3.15), on scalars:
+    ``law(x, y, theta, x_ref, y_ref, theta_ref, vx_ref, vy_ref, omega_ref, i0, i1, i2) -> (vx, vy, omega, e0, e1,
+    e2)`` (pose, reference and its velocity in G, the error's integral; the body twist and the error). Reduced
+    control points ignore ``theta_ref`` and ``omega_ref``. Plain Python that numba also compiles (the tick)."""
     px, py = float(cp.point[0]), float(cp.point[1])
+    reduced, integral, feedforward = bool(cp.reduced), law.kind == "pi", law.kind != "point"
+    (a0, a1, a2), (b0, b1, b2) = law.a, law.b
     gate = math.inf if law.gate is None else float(law.gate)
-    kernel = _tick_kernel(realtime(robot).ik, bool(cp.reduced), px, py, gain, tuple(float(v) for v in law.a), gate)
-    return ControlTick(robot, cp.reduced, (px, py), gain if cp.reduced else (), law.a, gate, kernel)
+    g00, g01, g10, g11, g20, g21 = (float(v) for v in (np.asarray(cp.gain, dtype=float).ravel() if reduced
+                                                       else np.zeros(6)))
+
+    def law_twist(x, y, theta, x_ref, y_ref, theta_ref, vx_ref, vy_ref, omega_ref, i0, i1, i2):
+        c, s = math.cos(theta), math.sin(theta)
+        e0 = x_ref - (x + c * px - s * py)  # point_pose
+        e1 = y_ref - (y + s * px + c * py)
+        if reduced:  # the reference is followed by the point; its heading is free (zero dynamics)
+            theta_ref, omega_ref = theta, 0.0
+        e2 = theta_ref - theta
+        e2 -= TWO_PI * math.floor(e2 / TWO_PI + 0.5)  # wheels.wrap_angle: (-pi, pi]
+        e2 = e2 + TWO_PI if e2 <= -math.pi else (e2 - TWO_PI if e2 > math.pi else e2)
+        u0, u1, u2 = a0 * e0, a1 * e1, a2 * e2  # law_velocity
+        if feedforward:
+            ff = 0.0 if math.hypot(e0, e1) > gate else 1.0
+            u0, u1, u2 = u0 + ff * vx_ref, u1 + ff * vy_ref, u2 + ff * omega_ref
+        if integral:
+            u0, u1, u2 = u0 + b0 * i0, u1 + b1 * i1, u2 + b2 * i2
+        r0, r1 = c * u0 + s * u1, -s * u0 + c * u1  # twist_for_velocity: the point's velocity in R
+        if reduced:
+            return g00 * r0 + g01 * r1, g10 * r0 + g11 * r1, g20 * r0 + g21 * r1, e0, e1, e2
+        return r0, r1, u2, e0, e1, e2
+
+    return law_twist
 
 
-def _tick_kernel(ik, reduced: bool, px: float, py: float, g: tuple[float, ...], a: tuple[float, float, float],
-                 gate: float):
-    """The tick of law (8.2)/(8.53) at the point ``(px, py)`` compiled around the robot's IK kernel `ik`."""
+def _tick_kernel(ik, law_twist):
+    """The tick: `law_twist` (:func:`scalar_law`) compiled around the robot's IK kernel `ik`."""
     import numba
 
-    g0, g1, g2, g3, g4, g5 = g
-    ax, ay, at = a
-    gate2 = gate * gate
+    law = numba.njit(inline="always")(law_twist)
 
     @numba.njit(cache=False)
     def tick(x, y, theta, x_ref, y_ref, theta_ref, vx_ref, vy_ref, omega_ref, heading, twist_out, rates_out,
              heading_out):
-        c, s = math.cos(theta), math.sin(theta)
-        ex = x_ref - (x + c * px - s * py)
-        ey = y_ref - (y + s * px + c * py)
-        ff = 1.0 if ex * ex + ey * ey <= gate2 else 0.0
-        gx, gy = ff * vx_ref + ax * ex, ff * vy_ref + ay * ey
-        rx, ry = c * gx + s * gy, -s * gx + c * gy  # (3.15) inverse: the point's velocity in R
-        if reduced:
-            vx, vy, w = g0 * rx + g1 * ry, g2 * rx + g3 * ry, g4 * rx + g5 * ry
-        else:
-            et = theta_ref - theta
-            et = et - TWO_PI * math.floor((et + math.pi) / TWO_PI)
-            vx, vy, w = rx, ry, ff * omega_ref + at * et
+        vx, vy, w, _, _, _ = law(x, y, theta, x_ref, y_ref, theta_ref, vx_ref, vy_ref, omega_ref, 0.0, 0.0, 0.0)
         twist_out[0], twist_out[1], twist_out[2] = vx, vy, w
         return ik(vx, vy, w, heading, rates_out, heading_out)
 

@@ -17,6 +17,7 @@ call (correct, slower).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -54,9 +55,11 @@ class Realtime:
     odometry_step: Any
 
 
+@functools.lru_cache(maxsize=16)
 def realtime(robot: Robot, sensed: tuple[str, ...] | None = None, *, speed_tol: float = 1e-12,
              slip_tol: float = 1e-9) -> Realtime:
-    """Compile the single-call kinematics of `robot` (about a second, once); `sensed` as for the odometry model."""
+    """Compile the single-call kinematics of `robot` (about a second, once per robot and process: kept); `sensed`
+    as for the odometry model."""
     from ..odometry.model import odometry_model
 
     p = _ik_fast.plan(robot)
