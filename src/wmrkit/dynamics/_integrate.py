@@ -79,26 +79,25 @@ def assemble(t, s, acc, pack, inp, jac, w):
     _interp(bref, k0, k1, wt, br)
     kdiag[:] = 0.0
     group, ratio = pack[13], pack[14]
+    met, err, total = -1, 0.0, 1.0
     for c in range(n):
         if rgain[c] > 0:
             if group[c] < 0:
-                u = tau[c] + rgain[c] * (rr[c] - nu[c])
-                if abs(u) > tmax[c]:
-                    u = math.copysign(tmax[c], u)
-                else:
-                    kdiag[c] = -rgain[c]
-            else:  # a differential: one servo on the carrier's rate error (model._differentials)
-                err, total = 0.0, 0.0
-                for d in range(n):
-                    if group[d] == group[c]:
-                        err += ratio[d] * (rr[d] - nu[d])
-                        total += ratio[d]
-                k = rgain[c] / total  # the carrier gain: the joint's own stiffness while the others keep pace
-                u = tau[c] + k * err
-                if abs(u) > tmax[c]:
-                    u = math.copysign(tmax[c], u)
-                else:
-                    kdiag[c] = -k * ratio[c]  # d tau_c / d nu_c; the other members: -k ratio_d
+                met, err, total, slope = -1, rr[c] - nu[c], 1.0, 1.0
+            else:  # a differential: one servo on the carrier's rate error (model._differentials), summed once
+                if group[c] != met:
+                    met, err, total = group[c], 0.0, 0.0
+                    for d in range(n):
+                        if group[d] == met:
+                            err += ratio[d] * (rr[d] - nu[d])
+                            total += ratio[d]
+                slope = ratio[c]  # d tau_c / d nu_d = -k ratio_d for every member d
+            k = rgain[c] / total  # a differential's: the joint's own stiffness while the others keep pace
+            u = tau[c] + k * err
+            if abs(u) > tmax[c]:
+                u = math.copysign(tmax[c], u)
+            else:
+                kdiag[c] = -k * slope
             tau[c] = u
     for k in range(steer_col.shape[0]):
         c = steer_col[k]
