@@ -7,7 +7,9 @@ quantised to the 1.4118 deg encoder, 1 kHz) into poses with the exact scheme, th
 points (``odometry()`` in chunks of 65536 samples and ``kalman_odometry()``), each on a model built once (its maps
 per steering configuration are computed on the first call and kept). The three are timed in turn, five rounds after
 a first one that compiles; the best wall time of each is printed, and the targets are judged on the best CPU
-times (the machine may be shared: CPU time is what the process itself spent), both ratios shown.
+times (the machine may be shared: CPU time is what the process itself spent), both ratios shown. FK2 and WLS
+also run on the same log with the steering held: the difference from the quantised log is what FK2's covariance
+transients cost (about half the samples of the quantised log, each two dependent 3x3 inverses; see docs/slip.md).
 """
 
 from __future__ import annotations
@@ -55,8 +57,10 @@ def run(quick: bool) -> list[Result]:
                                           "steer": (19.2, 1.0)}))
     fk2 = kalman_model(fork, "fk2", fk2_noise(0.28, 3.57, 0.28))
     dlog = log.select(differential.joints)
+    held = JointLog(log.time, log.joints, np.column_stack([log.positions[:, :2], np.full(n, log.positions[0, 2])]))
     fns = {"diff": lambda: odometry(differential, dlog), "wls": lambda: odometry(wls, log),
-           "fk2": lambda: kalman_odometry(fk2, log)}
+           "fk2": lambda: kalman_odometry(fk2, log), "wls held": lambda: odometry(wls, held),
+           "fk2 held": lambda: kalman_odometry(fk2, held)}
     for f in fns.values():
         f()  # compile, and meet every steering configuration once
     wall, cpu = _best_times(fns)
@@ -69,6 +73,8 @@ def run(quick: bool) -> list[Result]:
         Result("odometry fk2: forklift (information-form KF)", n, wall["fk2"], "wls, same run", wall["wls"],
                f"fk2 <= 1.2x wls: {'MET' if fk2_ratio <= 1.2 else 'NOT MET'} (CPU {fk2_ratio:.2f}x, "
                f"wall {wall['fk2'] / wall['wls']:.2f}x)"),
+        Result("  same, steering held (no covariance transients)", n, wall["fk2 held"], "wls, same log",
+               wall["wls held"], f"CPU {cpu['fk2 held'] / cpu['wls held']:.2f}x (for reference: no target)"),
     ]
 
 

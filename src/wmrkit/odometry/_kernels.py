@@ -146,35 +146,58 @@ def _segments(index, start, m, seg_u, seg_start):
 
 @numba.njit
 def _apply_row(maps, row, seg_u, seg_start, count, cols, acc):
-    """``acc[j] = maps[u, row] @ cols[:, j]`` with ``u`` the configuration of sample j's segment; (4.11)."""
+    """``acc[j] = maps[u, row] @ cols[:, j]`` with ``u`` the configuration of sample j's segment; (4.11).
+
+    Samples are indexed ``j0 + k`` with ``j0 = max(.., 0)``: an index the compiler cannot prove >= 0 costs a
+    wraparound test per element, which keeps a loop from vectorising."""
     for g in range(count):
-        u, j0, j1 = seg_u[g], seg_start[g], seg_start[g + 1]
-        if j1 - j0 <= SHORT:  # too short to vectorise (a steering step's interval): the same sums, sample by sample
-            for j in range(j0, j1):
+        u, j0 = seg_u[g], max(seg_start[g], 0)
+        length = seg_start[g + 1] - j0
+        if length <= SHORT:  # too short to vectorise (a steering step's interval): the same sums, sample by sample
+            for k in range(length):
                 total = 0.0
                 for a in range(cols.shape[0]):
-                    total += maps[u, row, a] * cols[a, j]
-                acc[j] = total
+                    total += maps[u, row, a] * cols[a, j0 + k]
+                acc[j0 + k] = total
             continue
-        for j in range(j0, j1):
-            acc[j] = 0.0
+        for k in range(length):
+            acc[j0 + k] = 0.0
         for a in range(cols.shape[0]):
             c = maps[u, row, a]
-            for j in range(j0, j1):
-                acc[j] += c * cols[a, j]
+            for k in range(length):
+                acc[j0 + k] += c * cols[a, j0 + k]
 
 
 @numba.njit
-def _norm_rows(maps, seg_u, seg_start, count, cols, m, acc, norm):
-    """``norm[j] = |maps[u] @ cols[:, j]|``, squares accumulated row by row (no cancelling quadratic form)."""
-    for j in range(m):
-        norm[j] = 0.0
-    for row in range(maps.shape[1]):
-        _apply_row(maps, row, seg_u, seg_start, count, cols, acc)
-        for j in range(m):
-            norm[j] += acc[j] * acc[j]
-    for j in range(m):
-        norm[j] = math.sqrt(norm[j])
+def _norm_rows(maps, seg_u, seg_start, count, cols, triangular, acc, norm):
+    """``norm[j] = |maps[u] @ cols[:, j]|``, squares accumulated row by row (no cancelling quadratic form),
+    segment by segment (indexed as :func:`_apply_row`); a `triangular` map's row ``i`` starts at column ``i``."""
+    for g in range(count):
+        u, j0 = seg_u[g], max(seg_start[g], 0)
+        length = seg_start[g + 1] - j0
+        if length <= SHORT:
+            for k in range(length):
+                total = 0.0
+                for row in range(maps.shape[1]):
+                    e = 0.0
+                    for a in range(row if triangular else 0, maps.shape[2]):
+                        e += maps[u, row, a] * cols[a, j0 + k]
+                    total += e * e
+                norm[j0 + k] = math.sqrt(total)
+            continue
+        for k in range(length):
+            norm[j0 + k] = 0.0
+        for row in range(maps.shape[1]):
+            for k in range(length):
+                acc[j0 + k] = 0.0
+            for a in range(row if triangular else 0, maps.shape[2]):
+                c = maps[u, row, a]
+                for k in range(length):
+                    acc[j0 + k] += c * cols[a, j0 + k]
+            for k in range(length):
+                norm[j0 + k] += acc[j0 + k] * acc[j0 + k]
+        for k in range(length):
+            norm[j0 + k] = math.sqrt(norm[j0 + k])
 
 
 @numba.njit
@@ -290,7 +313,7 @@ def linear_maps(dq, plain, squared, index, out, norm):
             for j in range(m):
                 out[start + j, row] = acc[j]
         if squared.shape[1] > 0:
-            _norm_rows(squared, seg_u, seg_start, count, cols, m, acc, norm_b)
+            _norm_rows(squared, seg_u, seg_start, count, cols, False, acc, norm_b)
             _load(norm_b, 0, m, norm[start:])
 
 
@@ -303,7 +326,7 @@ def _maps_by_segments(maps, residual, seg_u, seg_start, count, cols, m, with_dy,
         _apply_row(maps, 1, seg_u, seg_start, count, cols, buf[1])
     _apply_row(maps, 2, seg_u, seg_start, count, cols, buf[2])
     if residual.shape[1] > 0:
-        _norm_rows(residual, seg_u, seg_start, count, cols, m, buf[9], buf[3])
+        _norm_rows(residual, seg_u, seg_start, count, cols, False, buf[9], buf[3])
 
 
 @numba.njit

@@ -20,7 +20,7 @@ import numba
 import numpy as np
 
 from .._jit import jit as _jit
-from ..odometry._kernels import BLOCK, _headings, _positions, _rotations
+from ..odometry._kernels import BLOCK, _headings, _norm_rows, _positions, _rotations
 from ..odometry._steering_kernels import _configurations_from, _find, _is_steering, _steering_mid, _wrap
 
 _IN = numba.types.Array(numba.float64, 2, "A", readonly=True)
@@ -67,21 +67,25 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
     i00 = i01 = i02 = i11 = i12 = i22 = u00 = u01 = u02 = u11 = u12 = u22 = 0.0
     steady, last_u = False, -1
     mid = np.full(n_s, np.nan)
-    config = np.empty(BLOCK, dtype=np.int64)
+    config, seg_u, seg_start = (np.empty(BLOCK, dtype=np.int64), np.empty(BLOCK, dtype=np.int64),
+                                np.empty(BLOCK + 1, dtype=np.int64))
     z, buf = np.empty((3 + n_a, BLOCK)), np.empty((11, BLOCK))  # z: the twist, then the rates
-    sq, e_row = buf[9], buf[10]
+    norm, acc = buf[9], buf[10]
     rates = z[3:]
     bx, by, bth, head, turn, theta, cf, sf, dt = buf[0], buf[1], buf[2], buf[3], buf[4], buf[5], buf[6], buf[7], buf[8]
     u = -1
     for block in range(start, n, BLOCK):
-        bm, unknown = min(BLOCK, n - block), False
+        bm, count, unknown = min(BLOCK, n - block), 0, False
         for j in range(bm):  # the configuration of each interval, looked up when the steering angles change
             if _steering_mid(positions, before, steer_cols, block + j, mid) or j == 0:
                 u = _find(keys, ids, mid)
                 if u < 0:  # the block ends here
                     bm, unknown = j, True
                     break
+                seg_u[count], seg_start[count] = u, j
+                count += 1
             config[j] = u
+        seg_start[count] = bm
         _rates(positions, before, time, time_before, rate_cols, steer_cols, block, bm, dt, rates)
         for j in range(bm):  # the recursion, sequential
             u = config[j]
@@ -108,18 +112,9 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
             d = dt[j]
             bx[j], by[j], bth[j] = x_0 * d, x_1 * d, x_2 * d
             z[0, j], z[1, j], z[2, j] = x_0, x_1, x_2
+        _norm_rows(ca, seg_u, seg_start, count, z, True, acc, norm)  # |C x + A_a qdot| = |T z|, z = (x, qdot)
         for j in range(bm):
-            sq[j] = 0.0
-        for i in range(ca.shape[1]):  # |C x + A_a qdot| dt = |T z| dt, z = (x, qdot), T triangular
-            for j in range(bm):
-                e_row[j] = 0.0
-            for a in range(i, ca.shape[2]):
-                for j in range(bm):
-                    e_row[j] += ca[config[j], i, a] * z[a, j]
-            for j in range(bm):
-                sq[j] += e_row[j] * e_row[j]
-        for j in range(bm):
-            slip[block + j] = np.sqrt(sq[j]) * dt[j]
+            slip[block + j] = norm[j] * dt[j]
         if with_increments:
             for j in range(bm):
                 increments[block + j, 0], increments[block + j, 1], increments[block + j, 2] = bx[j], by[j], bth[j]
