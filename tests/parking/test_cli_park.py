@@ -89,3 +89,20 @@ def test_animation_executed_through_the_tracker(capsys, tmp_path):
     assert code == 0 and err == "" and out.stat().st_size > 1000
     code, _, err = run(capsys, "thesis-9.1", "--animate", str(out), "--controller", "stanley")
     assert code == 2 and "invalid choice" in err
+
+
+def test_check_reads_the_executed_path_too(capsys):
+    """--check with --controller also checks the path the closed loop drove: example 1's plan only touches the
+    front car (zero lateral clearance), and a tracker a fraction of a millimetre off clips it; example 2 stays
+    clear. Said in the text and in JSON (``executed_check``), exit 0: a collision is an answer."""
+    code, out, _ = run(capsys, "thesis-9.1", "--check", "--controller", "p", "--json")
+    data = json.loads(out)
+    assert code == 0 and data["check"]["collision_free"] is True
+    executed = data["executed_check"]
+    assert executed["mode"] == "p" and executed["collision_free"] is False and executed["first_hit"] == "front"
+    assert executed["colliding_poses"] > 0 and executed["inside_slot"] is True
+    code, out, _ = run(capsys, "thesis-9.2", "--check", "--controller", "pi")
+    assert code == 0 and "executed path, closed loop with the PI law" in out
+    assert out.count("collision-free") == 2
+    code, out, _ = run(capsys, "thesis-9.1", "--check")  # no execution asked: the plan alone
+    assert "executed" not in out

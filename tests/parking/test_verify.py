@@ -111,3 +111,23 @@ def test_errata_algorithm_5_travel_is_the_free_length(car, slot):
         assert report.collision_free == clear
         if not clear:
             assert report.what == "front"
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 10**6), step=st.floats(0.001, 0.01))
+def test_densified_poses_move_no_corner_more_than_the_step(seed, step):
+    """Between neighbours of :func:`densify` no corner of the car moves more than `step` (corners placed by
+    rotation, independent of the bound it uses), and every given pose is kept, in order."""
+    from wmrkit.parking.geometry import footprint
+    from wmrkit.parking.verify import densify
+
+    rng = np.random.default_rng(seed)
+    poses = np.cumsum(rng.normal(0.0, [0.03, 0.03, 0.05], size=(20, 3)), axis=0)
+    dense = densify(CAR_91, poses, step)
+    corners = np.array(footprint(CAR_91))
+    c, s = np.cos(dense[:, 2]), np.sin(dense[:, 2])
+    x = dense[:, None, 0] + c[:, None] * corners[:, 0] - s[:, None] * corners[:, 1]
+    y = dense[:, None, 1] + s[:, None] * corners[:, 0] + c[:, None] * corners[:, 1]
+    assert np.hypot(np.diff(x, axis=0), np.diff(y, axis=0)).max() <= step * (1 + 1e-9)
+    kept = [int(np.flatnonzero(np.all(np.isclose(dense, p, rtol=0, atol=1e-12), axis=1))[0]) for p in poses]
+    assert kept == sorted(kept) and kept[0] == 0 and kept[-1] == len(dense) - 1

@@ -16,27 +16,45 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--animate", metavar="FILE", help="animate the executed plan (.gif or .html)")
     p.add_argument("--frames", type=int, default=200, metavar="N", help="at most N animation frames (default 200)")
     p.add_argument("--controller", choices=("p", "pi"), default=None,
-                   help="execute closed loop with the thesis's law (8.2)/(8.3) for --animate (default: open loop)")
-    p.add_argument("--check", action="store_true", help="check every pose with exact polygons (needs shapely)")
+                   help="execute closed loop with the thesis's law (8.2)/(8.3) for --animate and --check (default: "
+                   "open loop)")
+    p.add_argument("--check", action="store_true", help="check every pose of the plan with exact polygons (needs "
+                   "shapely); with --controller or --animate, the executed path's too")
     add_json_flag(p)
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Plan, print (text or JSON), draw and animate on request."""
+    """Plan, execute and check on request, print (text or JSON), draw and animate on request."""
     from ..parking.problem import load_problem
-    from ..parking.solve import describe, solve
+    from ..parking.solve import check_dict, describe, describe_check, solve
 
     solution = solve(load_problem(args.problem), check=args.check)
-    print_json(solution.to_dict()) if args.json else print(describe(solution))
-    if args.plot or args.animate:
+    execution = executed = None
+    if args.animate or (args.check and args.controller and solution.plan.feasible):
+        from ..parking.execute import execute_plan  # refuses an infeasible plan (exit 2, the reason)
+
+        execution = execute_plan(solution.plan, solution.problem.robot, controller=args.controller)
+        if args.check:
+            from ..parking.verify import check_poses, densify
+
+            vehicle, space = solution.problem.vehicle, solution.problem.space
+            executed = check_poses(vehicle, space, densify(vehicle, execution.pose))
+    if args.json:
+        out = solution.to_dict()
+        if executed is not None:
+            out["executed_check"] = {"mode": execution.mode, **check_dict(executed)}
+        print_json(out)
+    else:
+        print(describe(solution))
+        if executed is not None:
+            law = execution.mode.upper()
+            mode = "open loop" if execution.mode == "open-loop" else f"closed loop with the {law} law"
+            print(describe_check(executed, f"executed path, {mode}"))
+    if args.animate or args.plot:
         from ..parking import plot
 
-        execution = None
         if args.animate:
-            from ..parking.execute import execute_plan  # refuses an infeasible plan (exit 2, the reason)
-
-            execution = execute_plan(solution.plan, solution.problem.robot, controller=args.controller)
             plot.animate_plan(solution.plan, args.animate, execution, max_frames=max(2, args.frames))
         if args.plot:
             plot.save_plan_figure(solution.plan, args.plot, execution)

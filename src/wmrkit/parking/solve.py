@@ -45,10 +45,25 @@ class Solution:
             "poses": sample_poses(p.segments, pose_step).tolist() if p.segments else [],
         }
         if self.check is not None:
-            out["check"] = {"collision_free": self.check.collision_free, "colliding_poses": self.check.n_collisions,
-                            "first_hit": self.check.what or None, "min_clearance": self.check.min_clearance,
-                            "inside_slot": self.check.inside, "poses_checked": len(self.check.poses)}
+            out["check"] = check_dict(self.check)
         return out
+
+
+def check_dict(report: CollisionReport) -> dict[str, Any]:
+    """An exact check as JSON: ``collision_free``, ``colliding_poses``, ``first_hit``, ``min_clearance`` [m],
+    ``inside_slot``, ``poses_checked``."""
+    return {"collision_free": report.collision_free, "colliding_poses": report.n_collisions,
+            "first_hit": report.what or None, "min_clearance": report.min_clearance, "inside_slot": report.inside,
+            "poses_checked": len(report.poses)}
+
+
+def describe_check(report: CollisionReport, what: str = "exact check") -> str:
+    """One line: `what` (N poses): collision-free or how many poses hit what, inside the slot, min clearance."""
+    c = report
+    return (f"{what} ({len(c.poses)} poses): "
+            f"{'collision-free' if c.collision_free else f'{c.n_collisions} poses hit the {c.what}'}, "
+            f"{'ends inside the slot' if c.inside else 'does NOT end inside the slot'}, "
+            f"min clearance {c.min_clearance * 100:.2f} cm")
 
 
 def solve(problem: ParkingProblem, *, check: bool = False, search: bool = True, repeat: int = 5) -> Solution:
@@ -90,9 +105,5 @@ def describe(solution: Solution) -> str:
         else:
             lines.append("no slot length works with this width, car and approach")
     if solution.check is not None:
-        c = solution.check
-        lines.append(f"exact check ({len(c.poses)} poses): "
-                     f"{'collision-free' if c.collision_free else f'{c.n_collisions} poses hit the {c.what}'}, "
-                     f"{'ends inside the slot' if c.inside else 'does NOT end inside the slot'}, "
-                     f"min clearance {c.min_clearance * 100:.2f} cm")
+        lines.append(describe_check(solution.check))
     return "\n".join(lines)
