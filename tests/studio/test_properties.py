@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from strategies import robots
 
 pytest.importorskip("starlette")
-pytest.importorskip("httpx")
+pytest.importorskip("httpx2")  # starlette.testclient's transport (plain httpx is deprecated there)
 
 from starlette.testclient import TestClient
 
