@@ -17,9 +17,8 @@ from typing import Any
 import yaml
 
 from .couplings import COUPLING_KINDS, Coupling
-from .documents import FieldReader, LineOf, Loc, hint, read_document
+from .documents import FieldReader, LineOf, Loc, hint, read_document, read_file
 from .dynamics import mass
-from .errors import DescriptionError
 from .limits import (  # noqa: F401  (the limits are part of the description format)
     ANGLE_MARGIN,
     MAX_FILE_SIZE,
@@ -294,14 +293,7 @@ def _wheel_to_dict(w: Wheel) -> dict[str, Any]:
 def load_robot_file(path: str | os.PathLike[str]) -> Robot:
     """Load a ``.yaml``/``.yml``/``.json`` description, with located errors."""
     path = Path(path)
-    source = str(path)
-    try:
-        _check_size(path.stat().st_size, "bytes", source)
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        reason = getattr(err, "strerror", None) or err  # UnicodeDecodeError has no strerror
-        raise DescriptionError(f"cannot read the file ({err.__class__.__name__}: {reason})", source=source) from None
-    return robot_from_text(text, source=source, fmt="json" if path.suffix.lower() == ".json" else "yaml")
+    return robot_from_text(read_file(path), source=str(path), fmt="json" if path.suffix.lower() == ".json" else "yaml")
 
 
 def robot_from_text(text: str, *, source: str, fmt: str = "yaml") -> Robot:

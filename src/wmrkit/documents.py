@@ -8,20 +8,37 @@ from __future__ import annotations
 
 import difflib
 import json
+import os
 from collections.abc import Callable, Mapping
+from pathlib import Path
 from typing import Any
 
 import yaml
 
 from .errors import DescriptionError
+from .limits import _check_size
 from .units import UnitError, parse_quantity
 
-__all__ = ["FieldReader", "LineOf", "Loc", "compose", "hint", "line_finder", "parse_document", "read_document"]
+__all__ = ["FieldReader", "LineOf", "Loc", "compose", "hint", "line_finder", "parse_document", "read_document",
+           "read_file"]
 
 #: A field's location: keys and list indices from the document's root.
 Loc = tuple[str | int, ...]
 #: Maps a location to its 1-based line, or None.
 LineOf = Callable[[Loc], int | None]
+
+
+def read_file(path: str | os.PathLike[str], what: str = "description") -> str:
+    """The UTF-8 text of the document file `path` (a `what`), at most :data:`wmrkit.limits.MAX_FILE_SIZE` bytes;
+    a :class:`DescriptionError` naming the file and the reason when it cannot be read."""
+    path = Path(path)
+    try:
+        _check_size(path.stat().st_size, "bytes", str(path), what)
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as err:
+        reason = getattr(err, "strerror", None) or err  # UnicodeDecodeError has no strerror
+        raise DescriptionError(f"cannot read the file ({err.__class__.__name__}: {reason})",
+                               source=str(path)) from None
 
 
 def read_document(text: str, source: str, fmt: str = "yaml") -> tuple[Any, LineOf]:

@@ -33,9 +33,9 @@ ANGLE_MARGIN = math.radians(1.0)
 _CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff]")
 
 
-def _check_size(size: int, unit: str, source: str) -> None:
+def _check_size(size: int, unit: str, source: str, what: str = "description") -> None:
     if size > MAX_FILE_SIZE:
-        raise DescriptionError(f"{size} {unit}: a description holds at most {MAX_FILE_SIZE} (docs/limits.md)",
+        raise DescriptionError(f"{size} {unit}: a {what} holds at most {MAX_FILE_SIZE} (docs/limits.md)",
                                source=source)
 
 

@@ -113,3 +113,6 @@ def test_camera_file_round_trip_and_errors(tmp_path):
         Camera.from_file(tmp_path / "neg.yaml")
     with pytest.raises(CameraError, match="cannot read"):
         Camera.from_file(tmp_path / "missing.yaml")
+    (tmp_path / "twice.yaml").write_text("focal_px: 300\ntilt: 0.8\nheight: 0.2\ntilt: 0.9\n")
+    with pytest.raises(CameraError, match=r"twice.yaml:4: tilt: field 'tilt' given twice"):  # not the last one kept
+        Camera.from_file(tmp_path / "twice.yaml")

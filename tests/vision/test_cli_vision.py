@@ -83,7 +83,7 @@ def test_follow_line_json_and_animation(tmp_path, capsys):
 
 @pytest.mark.parametrize("argv, message", [
     (["vision", "locate", "missing.png", "--camera", "CAM"], "no such image file"),
-    (["vision", "locate", "--points", "PTS", "--camera", "nocam.yaml"], "cannot read camera file"),
+    (["vision", "locate", "--points", "PTS", "--camera", "nocam.yaml"], "nocam.yaml: cannot read the file"),
     (["vision", "calibrate", "--rows", "60", "--half-separation", "1", "--row-distance", "1"], "either IMAGE"),
     (["vision", "calibrate", "--x1", "40", "--x2", "50", "--rows", "60", "--half-separation", "0.03",
       "--row-distance", "0.1"], "must exceed x2"),

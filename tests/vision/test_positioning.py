@@ -110,7 +110,8 @@ def test_points_file_and_its_errors(tmp_path):
     (n, pts), = read_points(good)
     assert n == 0 and pts.shape == (2, 2)
     cases = {
-        "notjson.json": ("{", r"not JSON"),
+        "notjson.json": ("{", r"notjson.json:1: malformed JSON"),
+        "twice.json": ('{"lines": [{"n": 0, "n": 1, "points": [[1, 2], [3, 4]]}]}', r"twice.json:1: .*'n' given twice"),
         "empty.json": ('{"lines": []}', r"expected"),
         "field.json": ('{"lines": [{"n": 0, "pts": [[1, 2], [3, 4]]}]}', r"lines\[0\]: expected the fields"),
         "n.json": ('{"lines": [{"n": "x", "points": [[1, 2], [3, 4]]}]}', r"lines\[0\].n"),

@@ -18,8 +18,8 @@ from pathlib import Path
 from typing import Any
 
 from ..catalog import resolve as resolve_robot
-from ..documents import FieldReader, read_document
-from ..errors import DescriptionError, UnknownNameError, WmrkitError
+from ..documents import FieldReader, read_document, read_file
+from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
 from .geometry import Space, Vehicle
 
@@ -48,14 +48,8 @@ def load_problem(spec: str | os.PathLike[str]) -> ParkingProblem:
     """A problem from a ``.yaml``/``.yml``/``.json`` file, or a built-in name (:func:`builtin_names`)."""
     path = Path(spec)
     if path.suffix.lower() in (".yaml", ".yml", ".json") or path.exists():
-        try:
-            text = path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as err:
-            reason = getattr(err, "strerror", None) or err
-            raise DescriptionError(f"cannot read the file ({err.__class__.__name__}: {reason})",
-                                   source=str(path)) from None
-        return problem_from_text(text, source=str(path), fmt="json" if path.suffix.lower() == ".json" else "yaml",
-                                 base=path.parent)
+        fmt = "json" if path.suffix.lower() == ".json" else "yaml"
+        return problem_from_text(read_file(path, "parking problem"), source=str(path), fmt=fmt, base=path.parent)
     name = str(spec)
     if name not in builtin_names():
         close = difflib.get_close_matches(name, builtin_names(), n=1)

@@ -27,7 +27,8 @@ import yaml
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
-from ..errors import WmrkitError
+from ..documents import read_document, read_file
+from ..errors import DescriptionError, WmrkitError
 
 __all__ = ["Camera", "CameraError", "camera_coordinates", "distort", "extrinsics", "ground_from_image",
            "project", "rotation", "undistort"]
@@ -97,18 +98,20 @@ class Camera:
     @classmethod
     def from_file(cls, path: str | Path) -> Camera:
         """Read a camera file (YAML, as ``wmrkit vision calibrate --out`` writes)."""
-        path = Path(path)
-        try:
-            data = yaml.safe_load(path.read_text())
-        except OSError as err:
-            raise CameraError(f"{path}: cannot read camera file ({err.strerror})") from None
-        except yaml.YAMLError as err:
-            raise CameraError(f"{path}: not YAML ({str(err).splitlines()[0]})") from None
-        return cls.from_dict(data, source=str(path))
+        return cls.from_dict(read_located(path, "camera file", "yaml"), source=str(path))
 
     def to_file(self, path: str | Path) -> None:
         """Write the camera file (YAML, plain SI numbers)."""
         Path(path).write_text(yaml.safe_dump(self.to_dict(), sort_keys=False))
+
+
+def read_located(path: str | Path, what: str, fmt: str) -> Any:
+    """The data of a YAML or JSON file read as :func:`wmrkit.documents.read_file` and ``read_document`` do
+    (bounded size, safe YAML, duplicate keys refused); their located errors as :class:`CameraError`."""
+    try:
+        return read_document(read_file(path, what), str(path), fmt)[0]
+    except DescriptionError as err:
+        raise CameraError(str(err)) from None
 
 
 def rotation(psi: ArrayLike, tilt: ArrayLike) -> np.ndarray:

@@ -7,7 +7,6 @@ in closed form (9.10), and the distance h of the tracked point P to the followed
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -19,7 +18,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
 from ..errors import ShapeError
-from .camera import Camera, CameraError
+from .camera import Camera, CameraError, read_located
 
 __all__ = ["LineFix", "Positioning", "line_position", "locate_points", "read_points"]
 
@@ -112,12 +111,7 @@ def read_points(path: str | Path) -> list[tuple[int, np.ndarray]]:
     Points in pixels from the image centre, y down.
     """
     path = Path(path)
-    try:
-        data = json.loads(path.read_text())
-    except OSError as err:
-        raise CameraError(f"{path}: cannot read points file ({err.strerror})") from None
-    except json.JSONDecodeError as err:
-        raise CameraError(f"{path}:{err.lineno}: not JSON ({err.msg})") from None
+    data = read_located(path, "points file", "json")
     if not isinstance(data, dict) or not isinstance(data.get("lines"), list) or not data["lines"]:
         raise CameraError(f"{path}: expected {{\"lines\": [{{\"n\": ..., \"points\": [[xu, yu], [xu, yu]]}}]}}")
     out = []
