@@ -169,3 +169,14 @@ def test_cli_reports_description_errors(tmp_path, capsys, husky_files):
 def test_weights_of_settings_are_slip_weights():
     s = OdometrySettings(slip=(2.0, 1.0), wheel_slip=(("a", 1.0, 3.0),))
     assert s.weights() == SlipWeights.of({"a": (1.0, 3.0)}, (2.0, 1.0))
+
+
+def test_a_slip_weights_file_giving_a_field_twice_is_refused(capsys, tmp_path):
+    """JSON parsers keep the last of two equal keys; the weights file is read as descriptions are: refused, with
+    the line and the field."""
+    path = tmp_path / "w.json"
+    path.write_text('{"weights": {"default": [1, 2],\n "default": [3, 4]}}')
+    assert main(["odometry", "skid-steer-4", str(tmp_path / "log.csv"), "--method", "wls", "--slip-weights",
+                 str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "w.json:2: weights.default: field 'default' given twice" in err and len(err.strip().splitlines()) == 1

@@ -4,7 +4,6 @@ and the options of the slip-aware estimators of ``wmrkit odometry --method wls|f
 from __future__ import annotations
 
 import argparse
-import json
 import math
 from pathlib import Path
 
@@ -103,13 +102,10 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
 
 
 def _read_json(path: str):
-    p = Path(path)
-    if not p.is_file():
-        raise WmrkitError(f"{path}: no such file")
-    try:
-        return json.loads(p.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as err:
-        raise WmrkitError(f"{path}: not JSON ({err})") from None
+    """A JSON file read as documents are (bounded size, duplicate keys refused, located errors)."""
+    from ..documents import read_document, read_file
+
+    return read_document(read_file(path, "slip weights file"), path, "json")[0]
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
