@@ -29,7 +29,7 @@ import numba
 import numpy as np
 
 from .._jit import jit as _jit
-from ._steering_kernels import _configurations_from, _find, _is_steering, _steering_mid, _wrap
+from ._steering_kernels import _block_segments, _configurations_from, _is_steering, _wrap
 
 #: Samples per block: a dozen block buffers take about 25 KB.
 BLOCK = 256
@@ -416,19 +416,10 @@ def steered_chunk(positions, before, rate_cols, steer_cols, start, keys, ids, ma
     cols, buf = np.empty((n_a, BLOCK)), np.empty((10, BLOCK))
     seg_u, seg_start = np.empty(BLOCK, dtype=np.int64), np.empty(BLOCK + 1, dtype=np.int64)
     mid = np.full(n_s, np.nan)
-    u = -1
     for block in range(start, n, BLOCK):
-        m = min(BLOCK, n - block)
-        count, unknown = 0, False
-        for j in range(m):
-            if _steering_mid(positions, before, steer_cols, block + j, mid) or j == 0:
-                u = _find(keys, ids, mid)
-                if u < 0:  # the block ends here
-                    m, unknown = j, True
-                    break
-                seg_u[count], seg_start[count] = u, j
-                count += 1
-        seg_start[count] = m
+        full = min(BLOCK, n - block)
+        m, count = _block_segments(positions, before, steer_cols, block, full, keys, ids, mid, seg_u, seg_start)
+        unknown = m < full  # the block ends at an unknown configuration
         for a in range(n_a):
             c = rate_cols[a]
             _load_differences(positions[:, c], before[c], block, m, cols[a])

@@ -68,6 +68,26 @@ def _steering_mid(positions, before, steer_cols, k, out):
 
 
 @numba.njit
+def _block_segments(positions, before, steer_cols, block, m, keys, ids, mid, seg_u, seg_start):
+    """Runs of one steering configuration among the `m` intervals from `block`: configuration ``seg_u[g]`` (its
+    row among the known ones, :func:`_find`) on intervals ``seg_start[g]:seg_start[g + 1]`` of the block, looked up
+    when the angles at mid-interval (`mid` ``(s,)``, carried from block to block) change. Returns ``(reached,
+    count)``: `reached` < `m` when interval ``block + reached`` has a configuration not in `keys` (the block ends
+    there)."""
+    count = 0
+    for j in range(m):
+        if _steering_mid(positions, before, steer_cols, block + j, mid) or j == 0:
+            u = _find(keys, ids, mid)
+            if u < 0:
+                m = j
+                break
+            seg_u[count], seg_start[count] = u, j
+            count += 1
+    seg_start[count] = m
+    return m, count
+
+
+@numba.njit
 def _configurations_from(positions, before, steer_cols, first, out):
     """The configuration of each run of equal steering angles from interval `first` on into `out` (rows, while
     there is room); their count (see :func:`steered_chunk`)."""

@@ -21,7 +21,7 @@ import numpy as np
 
 from .._jit import jit as _jit
 from ..odometry._kernels import BLOCK, _headings, _norm_rows, _positions, _rotations
-from ..odometry._steering_kernels import _configurations_from, _find, _is_steering, _steering_mid, _wrap
+from ..odometry._steering_kernels import _block_segments, _configurations_from, _is_steering, _wrap
 
 _IN = numba.types.Array(numba.float64, 2, "A", readonly=True)
 _IN1 = numba.types.Array(numba.float64, 1, "A", readonly=True)
@@ -73,19 +73,13 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
     norm, acc = buf[9], buf[10]
     rates = z[3:]
     bx, by, bth, head, turn, theta, cf, sf, dt = buf[0], buf[1], buf[2], buf[3], buf[4], buf[5], buf[6], buf[7], buf[8]
-    u = -1
     for block in range(start, n, BLOCK):
-        bm, count, unknown = min(BLOCK, n - block), 0, False
-        for j in range(bm):  # the configuration of each interval, looked up when the steering angles change
-            if _steering_mid(positions, before, steer_cols, block + j, mid) or j == 0:
-                u = _find(keys, ids, mid)
-                if u < 0:  # the block ends here
-                    bm, unknown = j, True
-                    break
-                seg_u[count], seg_start[count] = u, j
-                count += 1
-            config[j] = u
-        seg_start[count] = bm
+        full = min(BLOCK, n - block)
+        bm, count = _block_segments(positions, before, steer_cols, block, full, keys, ids, mid, seg_u, seg_start)
+        unknown = bm < full  # the block ends at an unknown configuration
+        for g in range(count):
+            for j in range(seg_start[g], seg_start[g + 1]):
+                config[j] = seg_u[g]
         _rates(positions, before, time, time_before, rate_cols, steer_cols, block, bm, dt, rates)
         for j in range(bm):  # the recursion, sequential
             u = config[j]
