@@ -1,5 +1,6 @@
-"""Located YAML/JSON documents: safe parsing, duplicate keys refused, field locations mapped to lines, and a
-field reader whose errors are one line naming the file, line and field (robot descriptions, parking problems).
+"""Located YAML/JSON documents: bounded reading, safe parsing, duplicate keys refused, field locations mapped to
+lines, and a field reader whose errors are one line naming the file, line and field (robot descriptions, parking
+problems, camera and points files, slip weights).
 
 YAML goes through ``yaml.SafeLoader`` only; user text is never evaluated.
 """
