@@ -176,3 +176,23 @@ def test_two_steerable_wheels_a_subnormal_distance_apart_are_always_singular():
     s = singular_set(r, ("w0.spin", "w1.spin"), resolution=24, max_samples=200)
     assert s.always and len(s.configurations) == 0
     assert is_singular_rank(r, np.zeros((4, 2)) + np.linspace(-3, 3, 4)[:, None], ("w0.spin", "w1.spin")).all()
+
+
+def test_a_subnormal_angle_gives_the_answer_of_zero_without_a_warning():
+    """Found by hypothesis: a fixed wheel at beta = 2.2e-311 rad (a subnormal) made LAPACK's LU flag a division
+    by a subnormal pivot while finding the exact singular values; the answer is that of beta = 0, silently."""
+    import warnings
+
+    from wmrkit.analysis.summary import analyze
+    from wmrkit.robot import Robot
+    from wmrkit.wheels import Wheel
+
+    def car(beta):
+        return Robot(name="r", wheels=(Wheel(name="w0", type="fixed", l=0.0, alpha=0.0, beta=0.0, r=0.5),
+                                       Wheel(name="w1", type="steerable", l=1.0, alpha=1.0, beta=0.0, r=0.5),
+                                       Wheel(name="w2", type="fixed", l=0.0, alpha=0.0, beta=beta, r=0.5)))
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tiny = analyze(car(2.225073858507e-311)).to_dict()
+    assert tiny["singular"] == analyze(car(0.0)).to_dict()["singular"]

@@ -204,7 +204,8 @@ def _roots_last(cl, configs: np.ndarray, j: int) -> tuple[list[np.ndarray], np.n
     samples[..., j] = t
     raw = np.einsum("lk,...kc->...lc", cl.coefficients, element_rows(cl.robot, samples)) + cl.constant
     triples = _triples(cl, raw.shape[-2])
-    minors = np.linalg.det(raw[..., triples, :])  # (B, 7, M)
+    with np.errstate(divide="ignore", under="ignore"):  # LAPACK's LU flags a subnormal pivot (an angle of 1e-311
+        minors = np.linalg.det(raw[..., triples, :])  # rad); the minor is then +-0, as it should be. (B, 7, M)
     basis = np.stack([np.ones(n_fit)] + [f(k * t) for k in (1, 2, 3) for f in (np.cos, np.sin)], axis=1)
     coef = np.linalg.solve(basis, minors)  # (B, 7, M): a0, a1, b1, a2, b2, a3, b3
     scale = np.maximum(np.abs(raw).max(axis=(1, 2, 3)), 1e-300) ** 3
