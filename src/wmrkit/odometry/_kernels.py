@@ -144,56 +144,46 @@ def _segments(index, start, m, seg_u, seg_start):
     return count
 
 
+@numba.njit(inline="always")
+def _segment_row(maps, u, row, first, j0, length, cols, acc):
+    """``acc[j0 + k] = maps[u, row, first:] @ cols[first:, j0 + k]`` for the `length` samples of one segment; (4.11).
+
+    Indexed ``j0 + k`` with `j0` >= 0 known to the compiler (callers pass ``max(.., 0)``): an index it cannot prove
+    >= 0 costs a wraparound test per element, which keeps a loop from vectorising."""
+    if length <= SHORT:  # too short to vectorise (a steering step's interval): the same sums, sample by sample
+        for k in range(length):
+            total = 0.0
+            for a in range(first, cols.shape[0]):
+                total += maps[u, row, a] * cols[a, j0 + k]
+            acc[j0 + k] = total
+        return
+    for k in range(length):
+        acc[j0 + k] = 0.0
+    for a in range(first, cols.shape[0]):
+        c = maps[u, row, a]
+        for k in range(length):
+            acc[j0 + k] += c * cols[a, j0 + k]
+
+
 @numba.njit
 def _apply_row(maps, row, seg_u, seg_start, count, cols, acc):
-    """``acc[j] = maps[u, row] @ cols[:, j]`` with ``u`` the configuration of sample j's segment; (4.11).
-
-    Samples are indexed ``j0 + k`` with ``j0 = max(.., 0)``: an index the compiler cannot prove >= 0 costs a
-    wraparound test per element, which keeps a loop from vectorising."""
+    """``acc[j] = maps[u, row] @ cols[:, j]`` with ``u`` the configuration of sample j's segment; (4.11)."""
     for g in range(count):
-        u, j0 = seg_u[g], max(seg_start[g], 0)
-        length = seg_start[g + 1] - j0
-        if length <= SHORT:  # too short to vectorise (a steering step's interval): the same sums, sample by sample
-            for k in range(length):
-                total = 0.0
-                for a in range(cols.shape[0]):
-                    total += maps[u, row, a] * cols[a, j0 + k]
-                acc[j0 + k] = total
-            continue
-        for k in range(length):
-            acc[j0 + k] = 0.0
-        for a in range(cols.shape[0]):
-            c = maps[u, row, a]
-            for k in range(length):
-                acc[j0 + k] += c * cols[a, j0 + k]
+        j0 = max(seg_start[g], 0)
+        _segment_row(maps, seg_u[g], row, 0, j0, seg_start[g + 1] - j0, cols, acc)
 
 
 @numba.njit
 def _norm_rows(maps, seg_u, seg_start, count, cols, triangular, acc, norm):
     """``norm[j] = |maps[u] @ cols[:, j]|``, squares accumulated row by row (no cancelling quadratic form),
-    segment by segment (indexed as :func:`_apply_row`); a `triangular` map's row ``i`` starts at column ``i``."""
+    segment by segment; a `triangular` map's row ``i`` starts at column ``i``."""
     for g in range(count):
-        u, j0 = seg_u[g], max(seg_start[g], 0)
+        j0 = max(seg_start[g], 0)
         length = seg_start[g + 1] - j0
-        if length <= SHORT:
-            for k in range(length):
-                total = 0.0
-                for row in range(maps.shape[1]):
-                    e = 0.0
-                    for a in range(row if triangular else 0, maps.shape[2]):
-                        e += maps[u, row, a] * cols[a, j0 + k]
-                    total += e * e
-                norm[j0 + k] = math.sqrt(total)
-            continue
         for k in range(length):
             norm[j0 + k] = 0.0
         for row in range(maps.shape[1]):
-            for k in range(length):
-                acc[j0 + k] = 0.0
-            for a in range(row if triangular else 0, maps.shape[2]):
-                c = maps[u, row, a]
-                for k in range(length):
-                    acc[j0 + k] += c * cols[a, j0 + k]
+            _segment_row(maps, seg_u[g], row, row if triangular else 0, j0, length, cols, acc)
             for k in range(length):
                 norm[j0 + k] += acc[j0 + k] * acc[j0 + k]
         for k in range(length):

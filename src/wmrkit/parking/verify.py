@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import WmrkitError
+from ..wheels import wrap_angle
 from .geometry import Space, Vehicle, footprint
 from .path import Segment, sample_poses
 
@@ -70,10 +71,16 @@ def footprints(vehicle: Vehicle, poses: np.ndarray):
     return shapely.polygons(np.stack([x, y], axis=-1))
 
 
+def _corner_reach(vehicle: Vehicle) -> float:
+    """The largest distance [m] from P_f to a corner of the car's body: a corner moves at most this much per
+    radian turned."""
+    return math.hypot(max(vehicle.a1, vehicle.b1), vehicle.c1 / 2)
+
+
 def dense_poses(vehicle: Vehicle, segments: tuple[Segment, ...] | list[Segment],
                 corner_step: float = 0.002) -> np.ndarray:
     """P_f's poses along the path with no body corner moving more than `corner_step` [m] between samples."""
-    reach = math.hypot(max(vehicle.a1, vehicle.b1), vehicle.c1 / 2)
+    reach = _corner_reach(vehicle)
     chunks = []
     for k, seg in enumerate(segments):
         factor = 1 + reach * abs(seg.curvature)  # corner speed / P_f speed
@@ -89,10 +96,9 @@ def densify(vehicle: Vehicle, poses: np.ndarray, corner_step: float = 0.002) -> 
     poses = np.asarray(poses, dtype=float).reshape(-1, 3)
     if len(poses) < 2:
         return poses
-    reach = math.hypot(max(vehicle.a1, vehicle.b1), vehicle.c1 / 2)
     step = np.diff(poses, axis=0)
-    step[:, 2] = (step[:, 2] + math.pi) % (2 * math.pi) - math.pi  # the short way round
-    moved = np.hypot(step[:, 0], step[:, 1]) + reach * np.abs(step[:, 2])  # bound on a corner's displacement
+    step[:, 2] = wrap_angle(step[:, 2])  # the short way round
+    moved = np.hypot(step[:, 0], step[:, 1]) + _corner_reach(vehicle) * np.abs(step[:, 2])  # a corner's bound
     parts = np.maximum(1, np.ceil(moved / corner_step)).astype(int)
     k = np.repeat(np.arange(len(step)), parts)
     frac = (np.arange(len(k)) - np.repeat(np.cumsum(parts) - parts, parts)) / np.repeat(parts, parts)
