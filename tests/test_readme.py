@@ -1,0 +1,45 @@
+"""The README's examples work as written: its Python block runs, and every command of "What you get" exits 0 from
+a fresh directory (the studio, a server that runs until stopped, is left to tests/studio)."""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+README = (ROOT / "README.md").read_text()
+
+
+def test_the_python_example_runs(tmp_path, monkeypatch):
+    blocks = re.findall(r"```python\n(.*?)```", README, flags=re.S)
+    assert blocks
+    monkeypatch.chdir(tmp_path)
+    for block in blocks:
+        exec(compile(block, "README.md", "exec"), {})  # our own README, not user text
+
+
+def what_you_get() -> list[str]:
+    """The commands of the README's "What you get" block, without their comments."""
+    section = README.split("## What you get", 1)[1].split("```", 2)[1]
+    lines = [re.sub(r"\s+#.*$", "", line).strip() for line in section.splitlines()]
+    return [line for line in lines if line.startswith(("wmrkit ", "python "))]
+
+
+def test_every_command_of_what_you_get_exits_0(tmp_path):
+    commands = [c for c in what_you_get() if not c.startswith("wmrkit studio")]
+    assert len(commands) >= 15
+    for folder in ("examples", "docs"):  # commands name files of the repository by relative path
+        (tmp_path / folder).symlink_to(ROOT / folder)
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    failed = []
+    for command in commands:  # in order: the odometry commands read the log the example script writes
+        words = shlex.split(command)
+        argv = [sys.executable, "-m", "wmrkit", *words[1:]] if words[0] == "wmrkit" else [sys.executable, *words[1:]]
+        out = subprocess.run(argv, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+        if out.returncode != 0:
+            failed.append(f"{command}: exit {out.returncode}: {out.stderr.strip()[-300:]}")
+    assert failed == []
