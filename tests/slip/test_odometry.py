@@ -85,7 +85,9 @@ def test_cli_refuses_bad_estimator_options(tmp_path, capsys, forklift_run):
     write_log(path, log, catalog.load("forklift"))
     for extra, message in ((["--method", "wls", "--mu", "steer=0,1"], "> 0"),
                            (["--method", "wls", "--mu", "nope=1,1"], "lacks"),
-                           (["--method", "fk2", "--kf-noise", "1", "-1", "1"], "> 0"),
+                           (["--method", "fk2", "--kf-noise", "1", "-1", "1"], "[1e-150, 1e+150]"),
+                           (["--method", "fk2", "--kf-noise", "1e308", "1", "1"], "process: must be"),
+                           (["--method", "fk2", "--kf-noise", "1", "1e-30", "1"], "differ by more than"),
                            (["--method", "wls", "--mu", "steer=abc"], "two numbers"),
                            (["--method", "fk1", "--covariance"], "not available")):
         assert main(["odometry", "forklift", str(path), *extra]) == 2
@@ -111,3 +113,25 @@ def test_filter_refuses_an_external_heading():
 
     with pytest.raises(WmrkitError, match="external heading"):
         estimator(robot, "fk1").run([log])
+
+
+def test_only_the_ratios_of_the_kalman_noises_matter(forklift_run):
+    """Scaling every standard deviation by c scales the covariance by c^2 and leaves the gain (the reason the spread,
+    not the size, of the noises is bounded): the same poses, to round-off."""
+    from wmrkit.slip.kalman import KalmanNoise, kalman_model, kalman_odometry
+
+    robot = catalog.load("forklift")
+    base = kalman_odometry(kalman_model(robot, "fk2", KalmanNoise(0.5, 0.05, 0.2)), forklift_run.log).poses
+    for c in (1e-4, 1e4):
+        scaled = kalman_odometry(kalman_model(robot, "fk2", KalmanNoise(0.5 * c, 0.05 * c, 0.2 * c)),
+                                 forklift_run.log).poses
+        np.testing.assert_allclose(scaled, base, rtol=0, atol=1e-9 * np.abs(base).max())
+
+
+def test_a_noise_spread_beyond_double_precision_is_refused():
+    from wmrkit.errors import WmrkitError
+    from wmrkit.slip.kalman import MAX_SPREAD, KalmanNoise
+
+    KalmanNoise(1.0, 1.0 / MAX_SPREAD, 1.0)  # the widest spread accepted
+    with pytest.raises(WmrkitError, match=r"front \(longitudinal\) \(1e-07\) and process \(1\)"):
+        KalmanNoise(1.0, 1.0, 1.0, (("front", 1.0, 1e-7),))

@@ -30,6 +30,11 @@ from ..odometry.trajectories import Trajectory
 from ..robot import Robot
 
 FILTERS = ("fk1", "fk2")
+#: Widest spread of the filter's standard deviations (process and rows), and their range: the information form
+#: adds inverse variances, so beyond a spread of 1e6 (1e12 in variance) the smaller ones are lost to round-off; only
+#: their ratios matter (scaling all of them scales the covariance and leaves the gain), and the range keeps their
+#: squares normal numbers.
+MAX_SPREAD, NOISE_RANGE = 1e6, (1e-150, 1e150)
 
 
 @dataclass(frozen=True, slots=True)
@@ -44,11 +49,16 @@ class KalmanNoise:
     wheels: tuple[tuple[str, float, float], ...] = ()
 
     def __post_init__(self) -> None:
-        for name, v in (("process", self.process), ("lateral", self.lateral), ("longitudinal", self.longitudinal),
-                        *((f"{w} ({d})", x) for w, a, b in self.wheels for d, x in (("lateral", a),
-                                                                                   ("longitudinal", b)))):
-            if not (np.isfinite(v) and v > 0):
-                raise WmrkitError(f"Kalman noise {name}: must be a finite number > 0, got {v}")
+        named = (("process", self.process), ("lateral", self.lateral), ("longitudinal", self.longitudinal),
+                 *((f"{w} ({d})", x) for w, a, b in self.wheels for d, x in (("lateral", a), ("longitudinal", b))))
+        lo, hi = NOISE_RANGE
+        for name, v in named:
+            if not (np.isfinite(v) and lo <= v <= hi):
+                raise WmrkitError(f"Kalman noise {name}: must be a finite number in [{lo:g}, {hi:g}], got {v}")
+        (small, a), (large, b) = min(named, key=lambda nv: nv[1]), max(named, key=lambda nv: nv[1])
+        if b > MAX_SPREAD * a:
+            raise WmrkitError(f"Kalman noise {small} ({a:g}) and {large} ({b:g}) differ by more than a factor "
+                              f"{MAX_SPREAD:g}: the filter would lose the smaller to round-off (only ratios matter)")
 
     def of_wheel(self, name: str) -> tuple[float, float]:
         """``(lateral, longitudinal)`` standard deviations of wheel `name`."""

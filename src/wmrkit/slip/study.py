@@ -227,12 +227,21 @@ def optimise(robot, logs: list, maxiter: int) -> dict:
 
     out = {}
     for name in TUNED[:3]:
-        fit = minimize(lambda p, name=name: _mean_jk(estimator_poses(robot, name, 10.0 ** p), logs),
+        fit = minimize(lambda p, name=name: _tuning_cost(robot, name, 10.0 ** p, logs),
                        np.log10(SETTINGS[f"{name.lower()}_thesis"]), method="Nelder-Mead",
                        options={"maxiter": maxiter, "xatol": 1e-3, "fatol": 1e-7})
         out[name] = {"params": [float(v) for v in 10.0 ** fit.x], "J_k": float(fit.fun)}
     out["differential"] = {"params": [], "J_k": _mean_jk(estimator_poses(robot, "differential", ()), logs)}
     return out
+
+
+def _tuning_cost(robot, name: str, params, logs: list) -> float:
+    """Mean J_k of estimator `name` with `params`; infinite where the parameters are refused (a spread of noises
+    or weights beyond what double precision resolves), so that the search turns back."""
+    try:
+        return _mean_jk(estimator_poses(robot, name, params), logs)
+    except WmrkitError:
+        return math.inf
 
 
 def estimator_poses(robot, name: str, params):
