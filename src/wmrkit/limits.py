@@ -17,6 +17,11 @@ if TYPE_CHECKING:
 
 #: Largest description [bytes of a file, characters of a text]; one of MAX_WHEELS wheels takes ~300 bytes.
 MAX_FILE_SIZE = 1 << 18
+#: Largest coordinate of a position in a trajectory or reference file [m] (beyond it differences of positions lose
+#: their precision and squares overflow).
+MAX_COORDINATE = 1e9
+#: Fastest speed a command or program may ask of a wheeled robot [m/s].
+MAX_SPEED = 1e3
 #: Most wheels in a robot: the chapter-4 searches grow combinatorially with the wheel count.
 MAX_WHEELS = 64
 #: Longest robot and wheel names, and notes [characters]: they are printed in tables and reports.

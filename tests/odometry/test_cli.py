@@ -124,7 +124,7 @@ def test_gyro_heading(capsys, tmp_path, diff_run):
     ("ok", ["--sensed", "left.spin"], r"do not determine its motion"),
     ("ok", ["--max-gap", "0.01"], r"x\.csv:3: time step of 0\.05 s exceeds max_gap"),
     ("ok", ["--out", "/nonexistent/dir/t.csv"], r"cannot write"),
-    ("ok", ["--plot", "p.gif"], r"plot files are \.png, \.svg or \.pdf"),
+    ("ok", ["--plot", "p.gif"], r"plot files are \.png, \.svg, \.pdf"),
     ("ok", ["--chunk-size", "0"], r"--chunk-size must be >= 1"),
     ("ok", ["--weight", "left=-1"], r"weight of wheel 'left' must be a finite number > 0"),
     ("missing", [], r"no such file"),

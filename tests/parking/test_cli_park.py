@@ -66,7 +66,7 @@ def test_plot_and_animation_files(capsys, tmp_path):
 @pytest.mark.parametrize(("argv", "message"), [
     (["nope.yaml"], "nope.yaml: cannot read the file"),
     (["thesis-9.9"], "no parking problem 'thesis-9.9'"),
-    (["thesis-9.1", "--plot", "x.jpg"], "x.jpg: the plot is written as .png, .svg or .pdf"),
+    (["thesis-9.1", "--plot", "x.jpg"], "x.jpg: cannot draw to '.jpg' (plot files are .png, .svg, .pdf)"),
 ])
 def test_errors_are_one_line_exit_2(capsys, tmp_path, monkeypatch, argv, message):
     monkeypatch.chdir(tmp_path)

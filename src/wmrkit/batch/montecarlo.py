@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._shapes import readonly
+from ..limits import MAX_SPEED
 from ..odometry.logs import JointLog
 from ..robot import Robot
 from .engine import BatchError, Engine, engine
@@ -128,6 +129,10 @@ def path_log(robot: Robot, name: str, rate: float = 20.0) -> JointLog:
     return simulate(robot, PATHS[name](), rate).log
 
 
+#: Most runs of one Monte Carlo study (each integrates the whole log once).
+MAX_RUNS = 10**6
+
+
 def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4, resolution: float = 0.0,
                 slip_std: float = 0.0, method: str = "exact", seed: int = 0, block: int = 64,
                 runner: Engine | None = None, progress: bool = False) -> MonteCarloResult:
@@ -135,10 +140,13 @@ def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4
     from ..odometry.covariance import JointNoise
     from ..odometry.pipeline import odometry
 
-    if runs < 2:
-        raise BatchError(f"Monte Carlo needs at least 2 runs, got {runs}")
-    if per_rad < 0 or resolution < 0 or slip_std < 0:
-        raise BatchError("noise, resolution and slip must be >= 0")
+    if not 2 <= runs <= MAX_RUNS:
+        raise BatchError(f"Monte Carlo needs at least 2 runs and at most {MAX_RUNS}, got {runs}")
+    if not (0 <= per_rad <= 1 and 0 <= resolution <= math.pi and 0 <= slip_std <= MAX_SPEED):
+        raise BatchError(f"noise must be in [0, 1] (per rad), resolution in [0, pi] rad and slip in [0, "
+                         f"{MAX_SPEED:g}] m/s, got {per_rad:g}, {resolution:g}, {slip_std:g}")
+    if not (isinstance(seed, int | np.integer) and seed >= 0):
+        raise BatchError(f"seed must be an integer >= 0, got {seed!r}")
     nominal = odometry(robot, log, method=method, noise=JointNoise(per_rad, resolution**2 / 6))
     sizes = [min(block, runs - s) for s in range(0, runs, block)]
     seeds = np.random.SeedSequence(seed).spawn(len(sizes))

@@ -142,6 +142,8 @@ class _Writer:
         self.path, self.axes, self._pa = Path(path), axes, pa
         if not self.path.parent.exists():
             raise BatchError(f"{self.path}: the folder {self.path.parent} does not exist")
+        if self.path.is_dir():
+            raise BatchError(f"{self.path}: a folder, not a file")
         names = [a.label for a in axes]
         if len(set(names)) != len(names):
             raise BatchError("two --vary axes have the same fields")

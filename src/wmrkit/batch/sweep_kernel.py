@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+import math
 import re
 from dataclasses import dataclass
 from types import SimpleNamespace
@@ -33,12 +34,18 @@ from typing import Any
 
 import numpy as np
 
+from ..limits import MAX_SIZE
 from ..robot import Robot
 from ..wheels import GEOMETRY_FIELDS
 from .engine import BatchError
 
 METRICS = ("kappa_mean", "kappa_max", "inv_kappa_mean", "singular_margin")
 _TARGET = re.compile(r"^wheels(?:\.([A-Za-z_][A-Za-z0-9_-]*)|\[(\d+)\])\.([a-z_]+)$")
+
+
+#: Most points of one --vary axis, designs of a sweep, designs over the first two axes (the map of the result,
+#: kept in memory), and steering configurations per design.
+MAX_POINTS, MAX_DESIGNS, MAX_MAP, MAX_CONFIGS = 10**6, 10**9, 10**7, 10**4
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: array field
@@ -82,8 +89,8 @@ def parse_vary(text: str, robot: Robot) -> Axis:
         n = int(parts[2])
     except (UnitError, ValueError) as err:
         raise BatchError(f"--vary {text}: {err}") from None
-    if n < 1:
-        raise BatchError(f"--vary {text}: N must be >= 1")
+    if not 1 <= n <= MAX_POINTS:
+        raise BatchError(f"--vary {text}: N must be in [1, {MAX_POINTS}]")
     return Axis(lhs.strip(), tuple(targets), np.linspace(start, stop, n))
 
 
@@ -130,8 +137,17 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
         raise BatchError(f"unknown metric '{metric}' (metrics: {', '.join(METRICS)})")
     if not axes:
         raise BatchError("a sweep needs at least one --vary")
-    if length is not None and not length > 0:
-        raise BatchError(f"--length must be > 0 m, got {length}")
+    if length is not None and not 0 < length <= MAX_SIZE:
+        raise BatchError(f"--length must be in (0, {MAX_SIZE:g}] m, got {length}")
+    if not 1 <= configs <= MAX_CONFIGS:
+        raise BatchError(f"--configs must be in [1, {MAX_CONFIGS}], got {configs}")
+    targets = [t for a in axes for t in a.targets]
+    if len(set(targets)) != len(targets):
+        raise BatchError("two --vary axes move the same field (one would overwrite the other)")
+    shape = [len(a.values) for a in axes]
+    if math.prod(shape[:2]) > MAX_MAP or math.prod(shape) > MAX_DESIGNS:
+        raise BatchError(f"{' x '.join(map(str, shape))} designs: at most {MAX_DESIGNS:.0e} designs, and "
+                         f"{MAX_MAP:.0e} over the first two --vary axes (the map kept in memory)")
     joints = default_joints(robot)
     p0 = line_parameters(robot)
     row_wheel = np.repeat(p0.element_wheel, 2)

@@ -43,6 +43,15 @@ def _finite(x: Any) -> Any:
     return x
 
 
+def check_plot_path(path: str | None, what: str = "--plot") -> None:
+    """A figure file given to `what` (when given) has an extension wmrkit draws to
+    (:func:`wmrkit.plotting.files.check_figure_path`), checked before the work that draws it."""
+    if path is not None:
+        from ..plotting.files import check_figure_path
+
+        check_figure_path(path, what)
+
+
 def parse_value(text: str, kind: Kind, what: str) -> float:
     """A number from the command line (SI, or with a unit such as ``deg``, ``mm``); errors name the option."""
     try:
@@ -63,6 +72,8 @@ def parse_assignments(items: list[str] | None, what: str) -> dict[str, str]:
         name, sep, value = item.partition("=")
         if not sep or not name or not value:
             raise WmrkitError(f"{what}: expected NAME=VALUE, got '{item}'")
+        if name in out:  # the last one would be kept silently
+            raise WmrkitError(f"{what} {name}: given twice ('{out[name]}' and '{value}')")
         out[name] = value
     return out
 

@@ -10,6 +10,7 @@ from ..errors import WmrkitError
 from ._common import (
     add_json_flag,
     add_robot_argument,
+    check_plot_path,
     load_robot,
     parse_angle,
     parse_assignments,
@@ -195,6 +196,7 @@ def run_montecarlo(args: argparse.Namespace) -> int:
     from ..batch.montecarlo import monte_carlo, path_log, plot_monte_carlo
 
     robot = load_robot(args.robot)
+    check_plot_path(args.plot)
     if (args.log is None) == (args.path is None):
         raise WmrkitError("give a LOG or --path NAME (one of the two)")
     if args.log is not None:
@@ -228,6 +230,7 @@ def run_sweep(args: argparse.Namespace) -> int:
     from ..batch.sweep_kernel import parse_vary
 
     robot = load_robot(args.robot)
+    check_plot_path(args.plot)
     axes = [parse_vary(v, robot) for v in args.vary]
     length = None if args.length is None else parse_value(args.length, "length", "--length")
     if args.configs < 1:

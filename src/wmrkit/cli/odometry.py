@@ -26,7 +26,7 @@ from ._common import (
     parse_value,
     print_json,
 )
-from .slip import ESTIMATOR_METHODS, add_estimator_options, estimator_from_args, resolve_method
+from .slip import ESTIMATOR_METHODS, add_estimator_options, check_estimator_options, estimator_from_args, resolve_method
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -86,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
     """Parse the options into a log format, run :func:`wmrkit.odometry.files.odometry_file`, print the summary."""
     robot = load_robot(args.robot)
     settings = resolve_method(args)  # --method, --scheme: the options, else the description's odometry block
+    check_estimator_options(args)
     if args.chunk_size < 1:
         raise WmrkitError(f"--chunk-size must be >= 1, got {args.chunk_size}")
     if not all(math.isfinite(k) and k >= 0 for k in args.crowley):
@@ -100,6 +101,12 @@ def run(args: argparse.Namespace) -> int:
     bits = merge_option("--counter-bits", args.counter_bits, units.bits, None, args.log)
     signed = args.signed_counter or units.signed
     counted = [j for j in joints if (steer if j.endswith(".steer") else spin) == "counts"]
+    options = {"--cpr": args.cpr is not None, "--gear": args.gear != 1.0,
+               "--counter-bits": args.counter_bits is not None, "--signed-counter": args.signed_counter}
+    given = [o for o, v in options.items() if v]
+    if given and not any(j.endswith(".spin") for j in counted):  # it would be ignored silently
+        raise WmrkitError(f"{given[0]} applies to spin columns of encoder counts (--spin counts, or a header "
+                          "'WHEEL.spin [counts]')")
     steer_res = None if args.steer_resolution is None else parse_angle(args.steer_resolution, "--steer-resolution")
     encoders = encoders_for(robot.name, counted, counts_per_rev=args.cpr, gear_ratio=args.gear,
                             bits=bits, signed=signed, steer_resolution=steer_res)

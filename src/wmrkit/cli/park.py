@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from ..errors import WmrkitError
 from ._common import add_json_flag, print_json
 
 
@@ -24,11 +25,17 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
+#: Most frames of an animation (matplotlib embeds at most 20 MB in an HTML page).
+MAX_FRAMES = 800
+
+
 def run(args: argparse.Namespace) -> int:
     """Plan, execute and check on request, print (text or JSON), draw and animate on request."""
     from ..parking.problem import load_problem
     from ..parking.solve import check_dict, describe, describe_check, solve
 
+    if not 2 <= args.frames <= MAX_FRAMES:  # below 2 was raised to 2 silently; thousands took minutes
+        raise WmrkitError(f"--frames: expected 2 to {MAX_FRAMES} animation frames, got {args.frames}")
     solution = solve(load_problem(args.problem), check=args.check)
     execution = executed = None
     if args.animate or (args.check and args.controller and solution.plan.feasible):

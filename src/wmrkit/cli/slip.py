@@ -74,11 +74,22 @@ def weights_from_args(args: argparse.Namespace, settings=None):
         except (TypeError, KeyError, ValueError, AttributeError):
             raise WmrkitError(f"{args.slip_weights}: expected {{\"weights\": {{\"default\": [LAT, LONG], "
                               "\"wheels\": {NAME: [LAT, LONG]}}} (the output of 'wmrkit calibrate --json')") from None
-    if args.mu_default:
+    if args.mu_default is not None:
         default = _pair(args.mu_default, "--mu-default")
     for name, value in parse_assignments(args.mu, "--mu").items():
         mu[name] = _pair(value, f"--mu {name}")
     return SlipWeights.of(mu, default)
+
+
+def check_estimator_options(args: argparse.Namespace) -> None:
+    """Refuse an estimator option with a kinematic ``--method`` (it would be ignored silently). The estimators'
+    options may be given together (one command line compares wls, fk1 and fk2)."""
+    given = {"--mu": args.mu, "--mu-default": args.mu_default is not None, "--slip-weights": args.slip_weights,
+             "--kf-noise": args.kf_noise, "--kf-wheel": args.kf_wheel, "--thesis-double-q": args.thesis_double_q}
+    for option, value in given.items():
+        if value and args.method not in ESTIMATOR_METHODS:
+            which = "wls" if option in ("--mu", "--mu-default", "--slip-weights") else "fk1 or fk2"
+            raise WmrkitError(f"{option} applies to --method {which}, not to --method {args.method}")
 
 
 def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
@@ -133,9 +144,11 @@ def run_calibrate(args: argparse.Namespace) -> int:
     joints = odometry_model(robot).joints
     log = load_csv(args.log, joints, robot=robot)
     if not Path(args.reference).is_file():
-        raise WmrkitError(f"{args.reference}: no such file")
+        raise WmrkitError(f"{args.reference}: {'not a file' if Path(args.reference).exists() else 'no such file'}")
     try:
         ref = read_tum(args.reference)
+    except WmrkitError:
+        raise
     except ValueError as err:
         raise WmrkitError(f"{args.reference}: not a TUM trajectory ({err})") from None
     result = calibrate_slip(robot, log, ref, method=args.scheme)

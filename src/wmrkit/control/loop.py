@@ -31,6 +31,10 @@ __all__ = ["Plant", "TwistController", "law_controller", "simulate"]
 #: ``(t, measured pose (3,), integral (3,)) -> (twist_robot (3,), d integral / dt (3,))``.
 TwistController = Callable[[float, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
 
+#: Evaluations of the continuous loop allowed: a base plus this many per simulated second (the examples take
+#: about 100 per second; a start kilometres off the reference makes the loop stiff and takes thousands).
+MAX_EVALUATIONS, EVALUATIONS_PER_SECOND = 20_000, 5_000
+
 
 def law_controller(cp: ControlPoint, law: PositionLaw, reference: Reference) -> TwistController:
     """The thesis's position control (8.1)-(8.3)/(8.53) of the controlled coordinates, then the admissible twist."""
@@ -179,12 +183,26 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
         from scipy.integrate import solve_ivp
 
         t_out = np.arange(0.0, duration + 1e-9, output_dt)
+        if t_out[-1] < duration - 1e-9 or len(t_out) == 1:  # the last sample at the end of the run
+            t_out = np.append(t_out, duration)
         edges = [0.0, *sorted(b for b in breaks if 0 < b < t_out[-1]), float(t_out[-1])]
         ts, xs, x = [], [], x0
+        budget = [MAX_EVALUATIONS + EVALUATIONS_PER_SECOND * duration]
+
+        def counted(t: float, x: np.ndarray) -> np.ndarray:
+            budget[0] -= 1
+            if budget[0] < 0:
+                speed = math.hypot(*controller(t, x[:3], x[3:6])[0][:2])
+                raise ControlError(f"the closed loop is too stiff to integrate over {duration:g} s (more than "
+                                   f"{MAX_EVALUATIONS + EVALUATIONS_PER_SECOND * duration:.0f} evaluations; "
+                                   f"commanded speed {speed:.3g} m/s): start closer to the reference, lower the "
+                                   "gain, or give a sample period")
+            return rhs(t, x)
+
         for lo, hi in itertools.pairwise(edges):  # restart at the reference's known corners
             last = hi == edges[-1]
             keep = t_out[(t_out >= lo) & ((t_out <= hi) if last else (t_out < hi))]
-            sol = solve_ivp(rhs, (lo, hi), x, t_eval=keep, rtol=rtol, atol=atol, max_step=0.25,
+            sol = solve_ivp(counted, (lo, hi), x, t_eval=keep, rtol=rtol, atol=atol, max_step=0.25,
                             dense_output=True)
             if not sol.success:
                 raise ControlError(f"the closed loop could not be integrated: {sol.message}")

@@ -26,8 +26,13 @@ def _pyplot():
 
 
 def _save(fig, path: str | os.PathLike[str]) -> None:
+    from ..plotting.files import PlotError, check_figure_path
+
     try:
+        check_figure_path(path)
         fig.savefig(path, dpi=110)
+    except PlotError:
+        raise
     except (OSError, ValueError) as err:
         raise WmrkitError(f"{path}: cannot save the figure ({err})") from None
     finally:

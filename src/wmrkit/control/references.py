@@ -18,6 +18,7 @@ import numpy as np
 
 from .._shapes import readonly
 from ..errors import UnknownNameError, WmrkitError
+from ..limits import MAX_COORDINATE
 
 __all__ = ["BUILTIN", "Reference", "ReferenceError", "builtin_reference", "load_reference", "reference_from_samples",
            "resolve_reference"]
@@ -84,6 +85,10 @@ def reference_from_samples(name: str, t: np.ndarray, pose: np.ndarray) -> Refere
         raise ReferenceError(f"{name}: expected at least 3 samples of (t, x, y, theta), got {pose.shape}")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(pose))):
         raise ReferenceError(f"{name}: times and poses must be finite numbers")
+    if np.abs(pose[:, :2]).max() > MAX_COORDINATE:
+        k = int(np.argmax(np.abs(pose[:, :2]).max(axis=1)))
+        raise ReferenceError(f"{name}: sample {k + 1}: position ({pose[k, 0]:g}, {pose[k, 1]:g}) m is beyond "
+                             f"{MAX_COORDINATE:g} m")
     if np.any(np.diff(t) <= 0):
         k = int(np.argmax(np.diff(t) <= 0))
         raise ReferenceError(f"{name}: times must increase (sample {k + 1}: {t[k + 1]} after {t[k]})")
@@ -109,7 +114,15 @@ def load_reference(path: str | os.PathLike[str]) -> Reference:
                 header[0] = "t"
             if header[:4] != ["t", "x", "y", "theta"]:
                 raise ReferenceError(f"{path}:1: expected the columns t,x,y,theta, got {','.join(rows[0])}")
-            data = np.array([[float(v) for v in row[:4]] for row in rows[1:] if row], dtype=float)
+            data = []
+            for line, row in enumerate(rows[1:], start=2):
+                if row and len(row) != len(header):
+                    raise ReferenceError(f"{path}:{line}: expected {len(header)} fields, got {len(row)}")
+                try:
+                    data += [[float(v) for v in row[:4]]] if row else []
+                except ValueError:
+                    raise ReferenceError(f"{path}:{line}: not a number in {','.join(row[:4])!r}") from None
+            data = np.array(data, dtype=float).reshape(-1, 4)
             return reference_from_samples(str(path), data[:, 0], data[:, 1:4])
         from ..odometry.trajectories import read_tum
 
@@ -118,6 +131,8 @@ def load_reference(path: str | os.PathLike[str]) -> Reference:
         raise
     except (ValueError, IndexError, UnicodeDecodeError, WmrkitError) as err:
         raise ReferenceError(f"{path}: cannot read the reference ({str(err).splitlines()[0]})") from None
+    except OSError as err:  # a directory, no permission
+        raise ReferenceError(f"{path}: cannot read the reference ({err.strerror or err})") from None
     return reference_from_samples(str(path), t, pose)
 
 

@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..kinematics.wheel_ik import WheelCommands, wheel_commands
+from ..limits import MAX_COORDINATE
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .actuators import LowLevelLoops
@@ -132,6 +133,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         raise ControlError("delay: a measurement delay in samples needs a sample period (--period)")
     cp = control_point(robot, point)
     duration = reference.duration if duration is None else float(duration)
+    _check_timing(duration, 0.02 if dynamics and period is None else period, output_dt)
     pose0 = initial_pose_on(cp, reference) if initial_pose is None else as_vectors(initial_pose, 3, "initial_pose")
     if controller in ("p", "pi", "point"):
         b = gain * gain / 4 if integral_gain is None else integral_gain
@@ -176,6 +178,10 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                        output_dt=output_dt, skew_free=skew_free, breaks=reference.breaks,
                        rtol=1e-5 if geometric else 1e-8, atol=1e-7 if geometric else 1e-10)
     t, pose = out["t"], out["pose"]
+    if not (np.all(np.isfinite(pose)) and np.all(np.abs(pose[:, :2]) <= MAX_COORDINATE)):
+        k = int(np.argmax(~(np.isfinite(pose).all(axis=1) & (np.abs(pose[:, :2]) <= MAX_COORDINATE).all(axis=1))))
+        raise ControlError(f"the closed loop diverged at t = {t[k]:.6g} s (the pose leaves {MAX_COORDINATE:g} m): "
+                           "lower the gain, or shorten the period")
     tcp = _full_point(cp, tracked_point)
     tracked = point_pose(tcp, pose)
     ref = reference.sample(t)
@@ -192,6 +198,22 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                        readonly(error), readonly(cross), readonly(out["twist"]), readonly(np.asarray(heading)),
                        commands, period, delay, readonly(out["estimate"]) if "estimate" in out and
                        feedback != "pose" else None, slip_model, feedback)
+
+
+#: Most samples of a run (control periods, or output samples of a continuous loop): each costs a control law
+#: evaluation in Python.
+MAX_SAMPLES = 10**6
+
+
+def _check_timing(duration: float, period: float | None, output_dt: float) -> None:
+    if not (math.isfinite(duration) and duration > 0):
+        raise ControlError(f"duration: expected a positive number of seconds, got {duration}")
+    if period is not None and not (math.isfinite(period) and 0 < period <= duration):
+        raise ControlError(f"period: expected a sample period in (0, duration = {duration:g} s], got {period:g} s")
+    step = output_dt if period is None else period
+    if not (math.isfinite(step) and step > 0) or duration / step > MAX_SAMPLES:
+        raise ControlError(f"duration {duration:g} s at {'a period' if period else 'an output step'} of {step:g} s: "
+                           f"more than {MAX_SAMPLES} samples")
 
 
 def _full_point(cp: ControlPoint, p: np.ndarray) -> ControlPoint:

@@ -22,7 +22,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from .tyres import TYRES, Tyre
+from ..limits import MAX_SIZE
+from .tyres import TYRES, Tyre, param_problem
 
 BODY_FIELDS = ("mass", "inertia", "com", "com_height")
 INERTIA_JOINTS = {"spin": "spin", "steer": "steer", "roller": "roller"}
@@ -58,6 +59,9 @@ def body_from_dict(data: Mapping[str, Any], check: Any) -> Body | None:
     height = check.quantity(item.get("com_height", 0.0), "length", (*loc, "com_height"))
     if height < 0:
         check.fail(f"must be >= 0, got {height} m", (*loc, "com_height"))
+    for key, value in ((("com", 0), x), (("com", 1), y), (("com_height",), height)):  # the envelope of limits.py
+        if abs(value) > MAX_SIZE:
+            check.fail(f"{value:g} m: farther than {MAX_SIZE:g} m, outside the lengths wmrkit handles", (*loc, *key))
     return Body(mass, inertia, (x, y), height)
 
 
@@ -113,10 +117,9 @@ def tyre_from_dict(item: Any, check: Any, loc: tuple) -> Tyre:
     for name, _, unit in kind.params:
         if name in item:
             value = check.quantity(item[name], "number", (*loc, name))
-            if value < 0 or (name in ("mu", "mu_lat", "mu_long", "eps", "mu_scale") and value == 0):
-                check.fail(f"must be {'>= 0' if value < 0 else '> 0'}, got {value} {unit}".rstrip(), (*loc, name))
-            if name == "shifts" and value not in (0.0, 1.0):
-                check.fail(f"must be 0 or 1, got {value}", (*loc, name))
+            problem = param_problem(name, value)
+            if problem:
+                check.fail(f"{problem} {unit}".rstrip(), (*loc, name))
             params[name] = value
     return Tyre.of(model, params)
 

@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import readonly
 from ..errors import WmrkitError
+from ..limits import MAX_SIZE, MAX_SPEED
 from .model import DynamicModel
 from .simulate import Inputs, _knots, joint_column
 
@@ -46,8 +47,10 @@ def path_program(model: DynamicModel, name: str, *, speed: float = 2.0, radius_s
     """
     if name not in PATHS:
         raise WmrkitError(f"unknown program '{name}' (programs: {', '.join(PATHS)})")
-    if not (speed > 0 and radius_scale > 0):
-        raise WmrkitError("speed and radius_scale must be > 0")
+    if not 0 < speed <= MAX_SPEED:
+        raise WmrkitError(f"speed: expected a program speed in (0, {MAX_SPEED:g}] m/s, got {speed:g} m/s")
+    if not 0 < radius_scale <= MAX_SIZE:
+        raise WmrkitError(f"radius_scale: expected a number in (0, {MAX_SIZE:g}], got {radius_scale:g}")
     scale = radius_scale * 2.0 / speed
     times, twists, t = [0.0], [(0.0, 0.0, 0.0)], 0.0
     for k, (duration, v, curvature) in enumerate(PATHS[name]):
@@ -137,6 +140,9 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     if not rows or not rows[0] or rows[0][0].strip() != "time" or len(rows) < 2:
         raise WmrkitError(f"{source}:1: expected a header 'time,<wheel>.<joint>,...' and at least one row")
     header = [h.strip() for h in rows[0]]
+    twice = next((h for i, h in enumerate(header) if h in header[:i]), None)
+    if twice is not None:
+        raise WmrkitError(f"{source}:1: column '{twice}' given twice")
     values = np.zeros((len(rows) - 1, len(header)))
     for i, row in enumerate(rows[1:], start=2):
         if len(row) != len(header):

@@ -141,6 +141,18 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     return _result(model, rec, method, step, info)
 
 
+def check_contact(model: DynamicModel, sim: Simulation) -> None:
+    """Refuse a run where a wheel that stands on the ground at rest loses its load (lifts off): the planar model
+    clips the load at 0 and keeps the wheel down, so the motion that follows is not physical (with friction)."""
+    static = model.normal_loads()
+    lifted = (sim.loads <= 0) & (static > 0)
+    if lifted.any():
+        k, e = (int(i[0]) for i in np.nonzero(lifted))
+        raise WmrkitError(f"contact '{model.contacts[e]}' lifts off the ground at t = {sim.t[k]:.6g} s (normal load "
+                          f"0; {static[e]:.4g} N at rest): the planar model keeps every wheel on the ground, so the "
+                          "motion would not be physical; use smaller torques or speeds")
+
+
 class Stepper:
     """A running fixed-step simulation that continues from its full state with new inputs (closed loops).
 
@@ -200,8 +212,11 @@ class Stepper:
         n_steps = round(duration / self.step) if math.isfinite(duration) and duration >= 0 else -1
         if n_steps < 0:
             raise WmrkitError(f"duration must be finite and >= 0, got {duration}")
-        run(self.state, self._k, self.step, n_steps, 1 << 62, self._method, self.jac_every, self._acc,
-            self.model.pack, self._inputs, self._w, self._rec, 0, self._phase)
+        try:
+            run(self.state, self._k, self.step, n_steps, 1 << 62, self._method, self.jac_every, self._acc,
+                self.model.pack, self._inputs, self._w, self._rec, 0, self._phase)
+        except ZeroDivisionError:  # the compiled kernels raise it where the state has overflowed
+            self.state[:] = math.nan
         self._k += n_steps
         if not math.isfinite(self.state.sum()):  # NaN and infinities propagate into the sum
             raise WmrkitError(f"the simulation diverged before t = {self.t:.6g} s; use a smaller step")
@@ -305,12 +320,16 @@ def _fixed(model, s0, inp, duration, step, every, method, progress, jac_every):
         bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
     while done < n_steps:
         k = min(chunk, n_steps - done)
-        i = run(s, done, step, k, every, method, jac_every, acc, model.pack, inp, w, rec, i)
+        try:
+            i = run(s, done, step, k, every, method, jac_every, acc, model.pack, inp, w, rec, i)
+        except ZeroDivisionError:  # the compiled kernels raise it where the state has overflowed
+            s[:] = math.nan
         done += k
         if bar is not None:
             bar.update(k)
         if not np.all(np.isfinite(s)):
-            raise WmrkitError(f"the simulation diverged at t = {done * step:.6g} s; use a smaller --step")
+            raise WmrkitError(f"the simulation diverged before t = {done * step:.6g} s; use a smaller --step (or "
+                              "smaller torques or speeds)")
     if bar is not None:
         bar.close()
     return tuple(r[:i] for r in rec), {"steps": n_steps}
@@ -324,8 +343,11 @@ def _adaptive(model, s0, inp, duration, record, rtol):
     w = work_arrays(model.n, len(model.contacts), len(model.steer_columns))
     acc = np.zeros(model.n)
     t_eval = np.arange(0.0, duration + record / 2, record)
-    sol = solve_ivp(lambda t, s: derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w), (0.0, t_eval[-1]),
-                    s0, method="LSODA", t_eval=t_eval, rtol=rtol, atol=rtol * 1e-3)
+    try:
+        sol = solve_ivp(lambda t, s: derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w),
+                        (0.0, t_eval[-1]), s0, method="LSODA", t_eval=t_eval, rtol=rtol, atol=rtol * 1e-3)
+    except ZeroDivisionError:  # the compiled kernels raise it where the state has overflowed
+        raise WmrkitError("the adaptive integration diverged (the state overflowed)") from None
     if not sol.success:
         raise WmrkitError(f"the adaptive integration failed: {sol.message}")
     rec = _records(model, len(sol.t))

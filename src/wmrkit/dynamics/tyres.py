@@ -216,6 +216,26 @@ def tyre_kind(name: str) -> TyreKind:
         raise UnknownNameError(f"unknown tyre model '{name}' (models: {', '.join(TYRES)})") from None
 
 
+#: Parameters that must be > 0 (a friction coefficient of 0 transmits nothing; eps regularises a division);
+#: every other one must be >= 0 (a negative stiffness would push with the slip), and ``shifts`` is 0 or 1.
+POSITIVE_PARAMS = ("mu", "mu_lat", "mu_long", "eps", "mu_scale")
+#: Largest tyre parameter (a stiffness of 1e12 N is rigid; beyond it the forces overflow).
+MAX_PARAM = 1e12
+
+
+def param_problem(name: str, value: float) -> str:
+    """Why `value` cannot be tyre parameter `name` (a phrase for a one-line error), or ``""``."""
+    if value < 0 or (name in POSITIVE_PARAMS and value == 0):
+        return f"must be {'>= 0' if value < 0 else '> 0'}, got {value:g}"
+    if name == "shifts" and value not in (0.0, 1.0):
+        return f"must be 0 or 1, got {value:g}"
+    if name == "eps" and value > 1.0:  # a regularisation speed: above 1 m/s it smooths away the friction of motion
+        return f"must be at most 1 m/s (a regularisation speed), got {value:g}"
+    if value > MAX_PARAM and not (name == "k" and value == math.inf):
+        return f"must be at most {MAX_PARAM:g}, got {value:g}"
+    return ""
+
+
 @dataclass(frozen=True, slots=True)
 class Tyre:
     """A wheel's tyre: a model of :data:`TYRES` and its parameters (SI), a frozen hashable value."""
@@ -235,6 +255,9 @@ class Tyre:
         for n, v in params.items():
             if not (math.isfinite(float(v)) or (n == "k" and v == math.inf)):  # k = inf: discontinuous Coulomb
                 raise WmrkitError(f"tyre parameter {n} must be finite, got {v}")
+            problem = param_problem(n, float(v))
+            if problem:
+                raise WmrkitError(f"tyre parameter {n}: {problem}")
         return cls(model, tuple((n, float(params.get(n, d))) for n, d, _ in kind.params))
 
     @property
@@ -257,7 +280,7 @@ class Tyre:
         """Contact forces from slip velocities [m/s] and the normal load `fz` [N]; all broadcast."""
         p = self.vector()
         args = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (fz, v_lat, v_long, v_wheel, v_roll)))
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # callers check the forces are finite
             f_lat, f_long = self.kind.kernel(*p, *args)
         return TyreForces(np.asarray(f_lat, dtype=float), np.asarray(f_long, dtype=float))
 

@@ -23,6 +23,10 @@ class EncoderError(WmrkitError, ValueError):
     """Encoder settings or counts that cannot be right (zero resolution, counts outside the counter's range)."""
 
 
+#: Most counts per wheel revolution (counts per revolution x gear ratio): 2^53, where counts stop being exact.
+MAX_COUNTS_PER_REV = 2.0**53
+
+
 @dataclass(frozen=True, slots=True)
 class IncrementalEncoder:
     """A wheel encoder counting pulses: ``counts_per_rev`` per revolution of the encoder shaft.
@@ -46,6 +50,9 @@ class IncrementalEncoder:
             raise EncoderError(f"gear_ratio must be > 0, got {self.gear_ratio}")
         if self.bits is not None and not 2 <= self.bits <= 62:
             raise EncoderError(f"bits must be between 2 and 62, got {self.bits}")
+        if self.counts_per_rev * self.gear_ratio > MAX_COUNTS_PER_REV:  # a count below round-off, or 0 rad
+            raise EncoderError(f"counts_per_rev x gear_ratio = {self.counts_per_rev * self.gear_ratio:g} counts per "
+                               f"wheel revolution: at most {MAX_COUNTS_PER_REV:g}")
         if self.sign not in (1, -1):
             raise EncoderError(f"sign must be +1 or -1, got {self.sign}")
 

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
+from ..limits import MAX_COORDINATE
 from ..robot import Robot
 from .covariance import CrowleyNoise, JointNoise, propagate_covariance
 from .integrators import HEADING_FRACTION, Method, check_method
@@ -121,7 +122,8 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
             dx, dy, dth = (np.zeros(n) if c is None else c for c in (inc.column(0), inc.column(1), inc.column(2)))
             steps = np.stack([dx, dy, dth if heading is None else np.diff(heading)], axis=-1)
             q = _increment_covariance(noise, inc, steps)
-            covs = propagate_covariance(np.vstack([pose[None], poses]), steps, q, method, initial=cov)
+            with np.errstate(over="ignore", invalid="ignore"):  # an overflow is reported below, located
+                covs = propagate_covariance(np.vstack([pose[None], poses]), steps, q, method, initial=cov)
             cov = covs[-1]
             if not np.isfinite(cov).all():
                 _overflow(chunk, covs.reshape(n, 9), "covariance")
@@ -267,6 +269,8 @@ def _check_inputs(pose: np.ndarray, noise: Noise | None, initial_covariance: Arr
     """Refuse a non-finite start pose, noise coefficients that are not finite and >= 0, a bad initial covariance."""
     if not np.isfinite(pose).all():
         raise LogError(f"pose0: must be finite, got {pose.tolist()}")
+    if np.abs(pose[:2]).max() > MAX_COORDINATE:
+        raise LogError(f"pose0: a position beyond {MAX_COORDINATE:g} m, got {pose[:2].tolist()}")
     if noise is not None:
         for name, value in ((f.name, getattr(noise, f.name)) for f in fields(noise)):
             if not (isinstance(value, int | float | np.floating) and math.isfinite(value) and value >= 0):

@@ -7,8 +7,6 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import WmrkitError
-
 
 def save_trajectory_plot(path: str | os.PathLike[str], trajectories: Mapping[str, np.ndarray], *,
                          title: str = "odometry") -> None:
@@ -18,9 +16,9 @@ def save_trajectory_plot(path: str | os.PathLike[str], trajectories: Mapping[str
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    suffix = os.fspath(path).rsplit(".", 1)[-1].lower()
-    if suffix not in ("png", "svg", "pdf"):
-        raise WmrkitError(f"{os.fspath(path)}: plot files are .png, .svg or .pdf")
+    from ..plotting.files import check_figure_path
+
+    check_figure_path(path)
     fig, ax = plt.subplots(figsize=(6, 6))
     try:
         for label, poses in trajectories.items():

@@ -109,6 +109,10 @@ class SyntheticRun:
     counts: Mapping[str, np.ndarray]
 
 
+#: Most samples of a synthetic log (each is a row of every joint array, fine-stepped `oversample` times).
+MAX_SAMPLES = 10**7
+
+
 def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLike = (0.0, 0.0, 0.0),
              sensed: Sequence[str] | None = None, encoders: Mapping[str, Encoder] | None = None,
              spin_noise_per_rad: float = 0.0, steer_noise: float = 0.0, slips: Sequence[Slip] = (),
@@ -121,6 +125,9 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     `oversample`: fine steps per sample interval for the joint kinematics. Deterministic for a given `seed`.
     """
     sensed = tuple(robot.sensed if sensed is None else sensed)
+    if not (1e-6 <= rate and profile.duration * rate <= MAX_SAMPLES):
+        raise WmrkitError(f"rate {rate:g} Hz over the profile's {profile.duration:g} s: need a rate >= 1e-06 Hz and "
+                          f"at most {MAX_SAMPLES} sample periods")
     n = math.ceil(profile.duration * rate - 1e-9) + 1  # the whole profile: a log never stops short of its end
     t_samples = np.arange(n) / rate
     if t_samples[-1] > profile.duration:  # the robot rests from the profile's end to the last sample

@@ -107,17 +107,59 @@ def write_trajectory(path: str | os.PathLike[str], trajectory: Trajectory, fmt: 
 
 def read_tum(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
     """A TUM file's times ``(N,)`` [s] and planar poses ``(N, 3)`` (yaw from the quaternion, z ignored)."""
-    data = np.loadtxt(path, comments="#", ndmin=2)
+    data = _load_table(path, comments="#")
     if data.shape[1] != 8:
         raise LogError(f"{os.fspath(path)}: a TUM file has 8 columns, got {data.shape[1]}")
+    _check_samples(path, data[:, 0], data[:, 1:4])
+    norm = np.linalg.norm(data[:, 4:8], axis=1)
+    if np.any(norm < 1e-6):
+        raise LogError(f"{os.fspath(path)}: pose {int(np.argmax(norm < 1e-6)) + 1}: the quaternion is (almost) zero")
     return data[:, 0], np.column_stack([data[:, 1], data[:, 2], np.unwrap(yaw_of_quaternion(data[:, 4:8]))])
+
+
+def _load_table(path: str | os.PathLike[str], **options) -> np.ndarray:
+    """``np.loadtxt`` of a trajectory file with at least one row; errors name the file in one line."""
+    import warnings
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # "input contained no data": refused below
+            data = np.loadtxt(path, ndmin=2, **options)
+    except (OSError, ValueError, UnicodeDecodeError) as err:
+        reason = getattr(err, "strerror", None) or str(err).splitlines()[0]
+        raise LogError(f"{os.fspath(path)}: cannot read the trajectory ({reason})") from None
+    if data.size == 0:
+        raise LogError(f"{os.fspath(path)}: no poses in the file")
+    return data
+
+
+def _check_samples(path: str | os.PathLike[str], t: np.ndarray, position: np.ndarray) -> None:
+    """Times finite and strictly increasing, positions finite within :data:`wmrkit.limits.MAX_COORDINATE`."""
+    from ..limits import MAX_COORDINATE
+
+    finite = np.isfinite(np.column_stack([t, position])).all(axis=1)
+    if not finite.all():
+        raise LogError(f"{os.fspath(path)}: pose {int(np.argmin(finite)) + 1}: times and positions must be finite "
+                       "numbers")
+    if np.abs(position).max() > MAX_COORDINATE:
+        raise LogError(f"{os.fspath(path)}: pose {int(np.argmax(np.abs(position).max(axis=1))) + 1}: a coordinate "
+                       f"beyond {MAX_COORDINATE:g} m")
+    if np.any(np.diff(t) <= 0):
+        k = int(np.argmax(np.diff(t) <= 0))
+        raise LogError(f"{os.fspath(path)}: pose {k + 2}: time {float(t[k + 1])!r} s does not increase (after "
+                       f"{float(t[k])!r} s)")
 
 
 def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
     """A trajectory CSV written by :class:`TrajectoryWriter` (covariance restored when present)."""
-    with open(path, encoding="utf-8") as f:
-        header = f.readline().strip().split(",")
-    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    try:
+        with open(path, encoding="utf-8") as f:
+            header = f.readline().strip().split(",")
+    except (OSError, UnicodeDecodeError) as err:
+        raise LogError(f"{os.fspath(path)}: cannot read the trajectory ({getattr(err, 'strerror', None) or err})") \
+            from None
+    data = _load_table(path, delimiter=",", skiprows=1)
+    _check_samples(path, data[:, 0], data[:, 1:3])
     if header[:5] != ["time", "x", "y", "theta", "slip"]:
         raise LogError(f"{os.fspath(path)}:1: expected the columns time,x,y,theta,slip, got {','.join(header)}")
     cov = None

@@ -88,9 +88,9 @@ def plot_plan(plan: ParkingPlan, execution: Execution | None = None) -> Figure:
 
 def save_plan_figure(plan: ParkingPlan, path: str | os.PathLike[str], execution: Execution | None = None) -> None:
     """Write :func:`plot_plan` to a PNG, SVG or PDF file."""
-    path = Path(path)
-    if path.suffix.lower() not in (".png", ".svg", ".pdf"):
-        raise WmrkitError(f"{path}: the plot is written as .png, .svg or .pdf")
+    from ..plotting.files import check_figure_path
+
+    check_figure_path(path)
     plot_plan(plan, execution).savefig(path, dpi=120)
 
 

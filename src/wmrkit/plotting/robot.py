@@ -23,12 +23,10 @@ from numpy.typing import ArrayLike
 from scipy.spatial import ConvexHull
 
 from .._shapes import as_vectors
-from ..errors import ShapeError, WmrkitError
+from ..errors import ShapeError
 from ..robot import Robot
 from ..wheels import Wheel
-
-#: File formats :func:`save_robot_figure` writes, by extension.
-FORMATS = (".png", ".svg", ".pdf")
+from .files import PlotError, check_figure_path
 
 DRIVEN = "#f28e2b"  # actuated spin: orange wheel
 PASSIVE = "#e6e6e6"  # passive wheel: light grey
@@ -37,10 +35,6 @@ BODY = "#c9d6e3"
 INK = "#222222"
 ROLLED_TYPES = ("swedish", "ball", "orthogonal")
 ARMED_TYPES = ("castor", "double_castor")
-
-
-class PlotError(WmrkitError, ValueError):
-    """A drawing cannot be made as asked (e.g. an unknown file extension)."""
 
 
 @dataclass(frozen=True)
@@ -325,9 +319,8 @@ def _set_limits(ax: Axes, points: np.ndarray, scale: float) -> tuple[np.ndarray,
 
 def save_robot_figure(robot: Robot, path: str | os.PathLike[str], *, beta: ArrayLike | None = None) -> None:
     """Draw `robot` (see :func:`draw_robot`) to a PNG, SVG or PDF file chosen by the extension of `path`."""
+    check_figure_path(path)
     path = Path(path)
-    if path.suffix.lower() not in FORMATS:
-        raise PlotError(f"{path}: cannot draw to '{path.suffix or 'no extension'}' (use {', '.join(FORMATS)})")
     ax = draw_robot(robot, beta=beta)
     try:
         ax.figure.savefig(path, dpi=100)

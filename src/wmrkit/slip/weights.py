@@ -19,6 +19,10 @@ from ..errors import WmrkitError
 from ..odometry.model import OdometryModel, frozen, odometry_model, solution_maps
 from ..robot import Robot
 
+#: Largest ratio of two friction coefficients of one robot: beyond ~1e20 the weighted rows (scaled by sqrt(mu))
+#: swamp the others in double precision and the solution collapses; 1e12 keeps six digits of margin.
+MAX_RATIO = 1e12
+
 
 class SlipWeightError(WmrkitError, ValueError):
     """A friction coefficient that is not a finite number > 0, or names a wheel the robot lacks."""
@@ -71,10 +75,17 @@ class SlipWeights:
             if n not in names:
                 raise SlipWeightError(f"friction coefficients given for wheel '{n}', which robot '{robot.name}' "
                                       f"lacks (wheels: {', '.join(robot.wheel_names)})")
-        out = []
+        out, rows = [], []
         for w in robot.wheels:
             out += list(self.of_wheel(w.name)) * len(w.elements())
-        return np.array(out, dtype=float)
+            rows += [f"{w.name} (lateral)", f"{w.name} (longitudinal)"] * len(w.elements())
+        mu = np.array(out, dtype=float)
+        if mu.size and mu.max() > MAX_RATIO * mu.min():
+            lo, hi = int(np.argmin(mu)), int(np.argmax(mu))
+            raise SlipWeightError(f"friction coefficients of wheel {rows[lo]} ({mu[lo]:g}) and {rows[hi]} "
+                                  f"({mu[hi]:g}) differ by more than a factor {MAX_RATIO:g}: the weighted least "
+                                  "squares would lose the smaller rows to round-off (only ratios matter)")
+        return mu
 
 
 def wls_model(robot: Robot, weights: SlipWeights | None = None, sensed=None) -> OdometryModel:

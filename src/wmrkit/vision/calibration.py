@@ -75,9 +75,10 @@ def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_d
             raise CameraError(f"calibration: {name} must be > 0, got {value}")
     if x1 <= x2:
         raise CameraError(f"calibration: x1 (near row +A, {x1:g} px) must exceed x2 (far row -A, {x2:g} px)")
-    tilt, focal, height = (float(v) for v in calibration_kernel(x1, x2, rows_a, half_separation, row_distance))
-    if not math.isfinite(tilt):
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow gives NaN, refused below
+        tilt, focal, height = (float(v) for v in calibration_kernel(x1, x2, rows_a, half_separation, row_distance))
         c = rows_a * (half_separation / row_distance) * (x1 + x2) / (x1 * x2)
+    if not math.isfinite(tilt):
         raise CameraError(f"calibration: the measurements give cos(tilt) = {c:.4g}, not in (0, 1): check the "
                           f"half-separation and row distance")
     return Calibration(tilt, focal, height, float(x1), float(x2), float(rows_a), float(half_separation),

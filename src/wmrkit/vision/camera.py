@@ -38,6 +38,10 @@ class CameraError(WmrkitError, ValueError):
     """A camera description, image or measurement that cannot be used; the message names the field."""
 
 
+#: Largest image side [px]: the synthetic camera holds several float arrays of the image's size.
+MAX_PIXELS = 4096
+
+
 @dataclass(frozen=True, slots=True)
 class Camera:
     """A calibrated camera looking at the ground (§9.2.1.D-E). Frozen.
@@ -56,7 +60,7 @@ class Camera:
 
     def __post_init__(self) -> None:
         checks = {"focal_px": self.focal_px > 0, "tilt": 0 < self.tilt < math.pi / 2, "height": self.height > 0,
-                  "width": self.width >= 8, "rows": self.rows >= 8, "k1": abs(self.k1) < 1}
+                  "width": 8 <= self.width <= MAX_PIXELS, "rows": 8 <= self.rows <= MAX_PIXELS, "k1": abs(self.k1) < 1}
         for name, ok in checks.items():
             value = getattr(self, name)
             if not ok or not math.isfinite(value):
@@ -102,7 +106,10 @@ class Camera:
 
     def to_file(self, path: str | Path) -> None:
         """Write the camera file (YAML, plain SI numbers)."""
-        Path(path).write_text(yaml.safe_dump(self.to_dict(), sort_keys=False))
+        try:
+            Path(path).write_text(yaml.safe_dump(self.to_dict(), sort_keys=False))
+        except OSError as err:
+            raise CameraError(f"{path}: cannot write the camera file ({err.strerror or err})") from None
 
 
 def read_located(path: str | Path, what: str, fmt: str) -> Any:

@@ -28,6 +28,7 @@ from ..control.laws import PositionLaw, law_velocity
 from ..control.points import control_point, twist_for_velocity
 from ..errors import WmrkitError
 from ..kinematics.wheel_ik import forward_kinematics, wheel_commands
+from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..odometry.integrators import integrate_exact
 from ..robot import Robot
 from .camera import Camera
@@ -135,6 +136,10 @@ class LineFollowing:
         }
 
 
+#: Most control periods of a run: each renders and processes one image (about 10 ms).
+MAX_PERIODS = 10**4
+
+
 def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float = 0.1, period: float = 0.5,
                 duration: float = 20.0, start: ArrayLike = (0.0, 0.3, 0.0), z_p: float = 0.0,
                 scene: Scene | None = None, noise: tuple[float, float] = (0.0, 0.0), image_noise: float = 0.0,
@@ -148,8 +153,19 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     `image_noise`, `blur`, `clutter`: options of the synthetic camera. ``from_image=False`` skips the camera and
     measures the exact (psi, h) of the pose (what the thesis's simulation did), for comparison.
     """
-    if not (gain > 0 and period > 0 and duration > 0 and speed > 0):
-        raise WmrkitError("follow-line: gain, period, duration and speed must be > 0")
+    if not all(np.isfinite([gain, period, duration, speed])) or not (gain > 0 and period > 0 and duration > 0
+                                                                      and speed > 0):
+        raise WmrkitError("follow-line: gain, period, duration and speed must be finite numbers > 0")
+    if speed > MAX_SPEED:
+        raise WmrkitError(f"follow-line: speed {speed:g} m/s is faster than {MAX_SPEED:g} m/s")
+    if not duration / period <= MAX_PERIODS:
+        raise WmrkitError(f"follow-line: duration {duration:g} s at a period of {period:g} s is more than "
+                          f"{MAX_PERIODS} periods (one image each)")
+    if not (all(np.isfinite(noise)) and 0 <= noise[0] <= MAX_COORDINATE and 0 <= noise[1] <= np.pi):
+        raise WmrkitError(f"follow-line: noise bounds must be h in [0, {MAX_COORDINATE:g}] m and psi in [0, pi] "
+                          f"rad, got {noise[0]:g} m, {noise[1]:g} rad")
+    if not (isinstance(seed, int | np.integer) and seed >= 0):
+        raise WmrkitError(f"follow-line: seed must be an integer >= 0, got {seed!r}")
     if gain * period >= 1:
         raise WmrkitError(f"follow-line: gain * period = {gain * period:g} >= 1: the delayed loop is unstable "
                           "(digest §2.6: a_x T < 1)")
@@ -160,6 +176,9 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     n_steps = round(duration / period)
     pose = np.empty((n_steps + 1, 3))
     pose[0] = as_vectors(start, 3, "start")
+    if not np.all(np.abs(pose[0, :2]) <= MAX_COORDINATE):
+        raise WmrkitError(f"follow-line: start position ({pose[0, 0]:g}, {pose[0, 1]:g}) m is beyond "
+                          f"{MAX_COORDINATE:g} m")
     measured = np.empty((n_steps, 2))
     twists, rates, steers = np.empty((n_steps, 3)), np.empty((n_steps, len(robot.rate_names))), []
     lost = np.zeros(n_steps, dtype=bool)

@@ -97,6 +97,11 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
             raise CameraError(f"points: lines[{i}]: n = {n} needs the line spacing (--spacing D > 0)")
         if abs(pts[0, 1] - pts[1, 1]) < 1e-9:
             raise CameraError(f"points: lines[{i}]: the two points are on one image row (y_u1 = y_u2)")
+        if np.any(np.abs(pts) > [camera.width, camera.rows]):  # outside the image (by more than its size)
+            raise CameraError(f"points: lines[{i}]: a point {pts.tolist()} lies outside the {camera.width} x "
+                              f"{camera.rows} image (pixels from its centre)")
+        if any(n == other for other, _ in lines[:i]):  # two lines said to be the same one would be averaged
+            raise CameraError(f"points: lines[{i}].n: line n = {n} given twice")
         und = undistort(pts, camera.k1, camera.focal_px)
         psi, _, h = line_position(und, n, focal_px=camera.focal_px, tilt=camera.tilt, height=camera.height,
                                   spacing=spacing, z_p=z_p)

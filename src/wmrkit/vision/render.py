@@ -8,17 +8,22 @@ Options add Gaussian noise, blur and clutter (bright blobs lying on the ground).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..limits import MAX_SIZE
 from .camera import Camera, CameraError, extrinsics, ground_from_image, undistort
 
 __all__ = ["Scene", "render"]
 
 #: Grey levels of the ground and of the paint (or plants).
 GROUND, PAINT = 70.0, 215.0
+#: Largest blur sigma [px] (wider blurs a camera image to a uniform grey) and most clutter blobs per image (each
+#: costs a pass over the image).
+MAX_BLUR, MAX_CLUTTER = 50.0, 100
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,8 +44,8 @@ class Scene:
     def __post_init__(self) -> None:
         if self.style not in ("paint", "crops"):
             raise CameraError(f"scene: style must be 'paint' or 'crops', got {self.style!r}")
-        if not self.width > 0:
-            raise CameraError(f"scene: width must be > 0, got {self.width}")
+        if not 0 < self.width <= MAX_SIZE:
+            raise CameraError(f"scene: width must be in (0, {MAX_SIZE:g}] m, got {self.width}")
 
     @property
     def offsets(self) -> np.ndarray:
@@ -71,6 +76,11 @@ def render(camera: Camera, pose_line_robot: ArrayLike, scene: Scene, *, z_p: flo
     Gaussian noise [grey levels]; `blur`: Gaussian blur sigma [px]; `clutter`: number of bright blobs scattered
     on the ground in view (drawn anew for each image); `seed` makes noise and clutter reproducible.
     """
+    if not (math.isfinite(noise) and noise >= 0 and math.isfinite(blur) and 0 <= blur <= MAX_BLUR):
+        raise CameraError(f"render: image noise must be finite and >= 0 and blur in [0, {MAX_BLUR:g}] px, got "
+                          f"{noise:g}, {blur:g}")
+    if not (isinstance(clutter, int | np.integer) and 0 <= clutter <= MAX_CLUTTER):
+        raise CameraError(f"render: clutter must be an integer in [0, {MAX_CLUTTER}] blobs, got {clutter!r}")
     rng = np.random.default_rng(seed)
     psi, t = extrinsics(pose_line_robot, camera, z_p)
     ground = ground_from_image(_pixel_grid(camera), psi, camera.tilt, t, camera.focal_px)
