@@ -97,6 +97,14 @@ BAD = {
                         "odometry.method: must be one of exact, rk2, euler, paper002, wls, fk1, fk2, got 'wsl'"),
     "odometry-noise": ("name: test-bot\n", "name: test-bot\nodometry:\n  noise: {process: -1}\n", 3,
                        "odometry.noise.process: must be a number > 0, got -1.0"),
+    "odometry-noise-spread": ("name: test-bot\n", "name: test-bot\nodometry:\n  noise: {lateral: 1e-9}\n", 3,
+                              "odometry.noise: Kalman noise lateral (1e-09) and process (1) differ by more than a "
+                              "factor 1e+06: the filter would lose the smaller to round-off (only ratios matter)"),
+    "slip-noise-spread": ("    actuated: [spin]\n", "    actuated: [spin]\n    slip:\n      lateral: 1\n"
+                          "      longitudinal: 1\n      noise: {lateral: 1e9, longitudinal: 1}\n", 12,
+                          "wheels[0].slip.noise: Kalman noise process (1) and left (lateral) (1e+09) differ by "
+                          "more than a factor 1e+06: the filter would lose the smaller to round-off (only ratios "
+                          "matter)"),
 }
 
 

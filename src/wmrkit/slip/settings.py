@@ -25,6 +25,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from ..errors import WmrkitError
+
 #: The values of ``odometry.method``: the no-slip model's integration schemes, then the slip-aware estimators.
 METHODS = ("exact", "rk2", "euler", "paper002", "wls", "fk1", "fk2")
 SCHEMES = ("exact", "rk2", "euler", "paper002")
@@ -80,6 +82,7 @@ def settings_from_dict(data: Mapping[str, Any], check: Any) -> OdometrySettings:
         noise = tuple(_positive(item.get(k, 1.0), check, (*loc, "noise", k))
                       for k in ("process", "lateral", "longitudinal"))
     wheel_slip, wheel_noise = [], []
+    noise_at = [(*loc, "noise")] if noise is not None else []
     for i, item in enumerate(data.get("wheels", [])):
         if not isinstance(item, Mapping) or "slip" not in item:
             continue
@@ -88,7 +91,14 @@ def settings_from_dict(data: Mapping[str, Any], check: Any) -> OdometrySettings:
         wheel_slip.append((name, *_pair(item["slip"], check, where, ("noise",))))
         if "noise" in item["slip"]:
             wheel_noise.append((name, *_pair(item["slip"]["noise"], check, (*where, "noise"), ())))
-    return OdometrySettings(method, scheme, slip, tuple(wheel_slip), noise, tuple(wheel_noise))  # type: ignore[arg-type]
+            noise_at.append((*where, "noise"))
+    settings = OdometrySettings(method, scheme, slip, tuple(wheel_slip), noise, tuple(wheel_noise))  # type: ignore[arg-type]
+    if noise_at:
+        try:
+            settings.kalman_noise()  # the spread of the noises (KalmanNoise), refused where the file gives them
+        except WmrkitError as err:
+            check.fail(str(err), noise_at[0])
+    return settings
 
 
 def settings_to_dict(settings: OdometrySettings) -> dict[str, Any]:
