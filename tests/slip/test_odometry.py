@@ -62,9 +62,11 @@ def test_cli_methods(tmp_path, forklift_run):
     path = tmp_path / "log.csv"
     write_log(path, log, catalog.load("forklift"))
     out = {}
-    for method in ("exact", "wls", "fk1", "fk2"):
-        assert main(["odometry", "forklift", str(path), "--method", method, "--json", "--mu", "steer=0.01,1",
-                     "--kf-noise", "2", "0.05", "0.05"]) == 0 or method == "exact"
+    for method, options in (("wls", ["--mu", "steer=0.01,1"]), ("fk1", ["--kf-noise", "2", "0.05", "0.05"]),
+                            ("fk2", ["--kf-noise", "2", "0.05", "0.05"])):
+        assert main(["odometry", "forklift", str(path), "--method", method, "--json", *options]) == 0
+    for method, options in (("wls", ["--kf-noise", "2", "0.05", "0.05"]), ("fk2", ["--mu", "steer=0.01,1"])):
+        assert main(["odometry", "forklift", str(path), "--method", method, *options]) == 2  # ignored before
     import contextlib
     import io
 
