@@ -12,8 +12,6 @@ sys.path.insert(0, str(Path(__file__).parent))
 # --import-mode=importlib pytest does not put a test's folder on sys.path, so every test folder goes on it here.
 sys.path[1:1] = [str(p) for p in sorted(Path(__file__).parent.iterdir()) if p.is_dir() and not p.name.startswith("_")]
 
-from strategies import robots, wheels  # noqa: E402, F401  (re-exported for older imports)
-
 # CPUs are shared: no per-example deadline; sizes are kept small in the tests themselves.
 settings.register_profile("wmrkit", deadline=None, suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile("wmrkit")

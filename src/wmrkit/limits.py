@@ -7,6 +7,7 @@ located one-line error through the checker's ``fail(message, loc)``.
 from __future__ import annotations
 
 import math
+import os
 import re
 from typing import TYPE_CHECKING, Any
 
@@ -20,6 +21,9 @@ MAX_FILE_SIZE = 1 << 18
 #: Largest coordinate of a position in a trajectory or reference file [m] (beyond it differences of positions lose
 #: their precision and squares overflow).
 MAX_COORDINATE = 1e9
+#: Largest file read whole into memory [bytes]: trajectories (TUM, CSV), references, torque files. Joint logs are
+#: read in chunks and have no such limit.
+MAX_TABLE_SIZE = 1 << 26
 #: Fastest speed a command or program may ask of a wheeled robot [m/s].
 MAX_SPEED = 1e3
 #: Most wheels in a robot: the chapter-4 searches grow combinatorially with the wheel count.
@@ -36,6 +40,18 @@ ANGLE_MARGIN = math.radians(1.0)
 
 #: Control characters (C0, DEL, C1) and lone surrogates (bytes that are not UTF-8): they break printing.
 _CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff]")
+
+
+def check_table_size(path: str | os.PathLike[str], error: type[Exception], what: str) -> None:
+    """Raise `error` naming `path` when the file (a `what`, read whole) is larger than :data:`MAX_TABLE_SIZE`;
+    a file that cannot be examined is left to its reader."""
+    try:
+        size = os.stat(path).st_size
+    except OSError:
+        return
+    if size > MAX_TABLE_SIZE:
+        raise error(f"{os.fspath(path)}: {size} bytes: a {what} is read whole and may hold at most "
+                    f"{MAX_TABLE_SIZE} bytes (docs/limits.md); decimate or split it")
 
 
 def _check_size(size: int, unit: str, source: str, what: str = "description") -> None:

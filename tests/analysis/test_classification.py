@@ -10,7 +10,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from thesis_vehicles import DEG, bicycle, differential, omni_castor, omni_swedish, robot, tricycle, type3, type5
 
-from conftest import wheels
+from strategies import wheels
 from wmrkit import Robot, catalog
 from wmrkit.analysis.classification import TABLE_5_1, classify, instantaneous_mobility
 from wmrkit.analysis.icr import icr

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from scipy.optimize import brentq
 from thesis_vehicles import DEG, omni_castor, omni_swedish, robot
 
-from conftest import robots
+from strategies import robots
 from wmrkit import UnknownNameError, catalog
 from wmrkit.analysis.icr import steer_to_icr
 from wmrkit.analysis.lines import constraint_lines, line_through

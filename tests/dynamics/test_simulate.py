@@ -80,10 +80,13 @@ def test_torque_file(tmp_path, forklift):
     assert sim.heading[-1, 0] == pytest.approx(0.2, abs=0.02)
     for text, match in (("time,steer.spin\n0,1\n", "not actuated"), ("time,nope.spin\n0,1\n", "no joint"),
                         ("time,left_drive.spin\n0,x\n", "not a number"), ("t,a\n", "header"),
-                        ("time,left_drive.spin\n1,0\n0,0\n", "increasing")):
+                        ("time,left_drive.spin\n1,0\n0,0\n", "increasing"),
+                        ("time,left_drive.spin\n100,9\n101,9\n", r":2: the first row is at t = 100 s")):
         path.write_text(text)
         with pytest.raises(WmrkitError, match=match):
             read_torques(forklift, path)
+    path.write_text("time,left_drive.spin\n-1,9\n1,9\n")  # starting before t = 0 is fine
+    assert read_torques(forklift, path).torques[0, forklift.names.index("left_drive.spin")] == 9
 
 
 def test_bad_arguments_are_errors(forklift):
@@ -144,3 +147,30 @@ def test_progress_bar_runs_in_chunks_with_the_same_result(forklift, capsys):
     plain = simulate(forklift, inputs, 0.5, record_step=0.01)
     shown = simulate(forklift, inputs, 0.5, record_step=0.01, progress=True)
     assert np.array_equal(plain.pose, shown.pose) and np.array_equal(plain.t, shown.t)
+
+
+def test_a_wheel_that_lifts_off_stops_the_run_where_the_load_reaches_zero():
+    """Braking the forklift from 1 m/s at the grip (rate servos referenced to 0) tips it forward: the steered rear
+    wheel loses its load. The planar model cannot follow, so every integrator and the stepper refuse to go on; with
+    ``allow_lift_off`` the run goes on and its records show the load at 0 from the reported time."""
+    from wmrkit.dynamics.programs import twist_program
+    from wmrkit.dynamics.simulate import Stepper, initial_state
+
+    model = DynamicModel.of(catalog.load("forklift"), "pacejka")
+    brake = twist_program(model, [0.0], [(0.0, 0.0, 0.0)])
+    for method in ("semi-implicit", "rk4", "adaptive"):
+        with pytest.raises(WmrkitError, match=r"contact 'steer' lifts off the ground at t = (\S+) s") as err:
+            simulate(model, brake, 0.3, method=method, initial_twist=(1.0, 0.0, 0.0))
+        assert 0 < float(err.value.args[0].split("t = ")[1].split(" s")[0]) < 0.3
+    with pytest.raises(WmrkitError, match="contact 'steer' lifts off"):
+        Stepper(model, initial_state(model, (1.0, 0.0, 0.0))).advance(brake, 0.3)
+    sim = simulate(model, brake, 0.3, initial_twist=(1.0, 0.0, 0.0), allow_lift_off=True)
+    steer = model.contacts.index("steer")
+    first = int(np.argmax(sim.loads[:, steer] <= 0))
+    assert sim.loads[first, steer] == 0 and np.all(sim.loads[:first, steer] > 0)
+    with pytest.raises(WmrkitError, match=f"at t = {sim.t[first]:.6g} s"):
+        simulate(model, brake, 0.3, initial_twist=(1.0, 0.0, 0.0))
+    # braking over 2 s (0.5 m/s^2) keeps every wheel down
+    gentle = twist_program(model, [0.0, 2.0], [(1.0, 0.0, 0.0), (0.0, 0.0, 0.0)])
+    sim = simulate(model, gentle, 2.5, initial_twist=(1.0, 0.0, 0.0))
+    assert sim.loads.min() > 0.5 * model.normal_loads().min()

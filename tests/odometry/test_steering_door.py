@@ -252,3 +252,35 @@ def test_the_pages_example_of_ros_data_runs():
     scope: dict = {}
     exec(compile(block, "docs/odometry.md", "exec"), scope)  # our own documentation
     np.testing.assert_allclose(scope["pose"], [math.cos(0.5), math.sin(0.5), 0.0], atol=1e-12)
+
+
+def test_headings_beyond_the_described_steer_range_are_refused(capsys, tmp_path):
+    """A forklift described with its +-90 deg steering range: a log whose steering column holds degrees, read as
+    radians, is refused at its line with a hint; the same log read with ``--steer degrees`` runs. Headings up to
+    3 deg past the stops pass (encoder offset); wheels without a range are not checked."""
+    from wmrkit.control.forklift import with_steer_range
+
+    plain = catalog.load("forklift")
+    ranged = with_steer_range(plain, "steer", -math.pi / 2, math.pi / 2)
+    description = tmp_path / "forklift.yaml"
+    ranged.to_file(description)
+    joints = ("right_drive.spin", "left_drive.spin", "steer.steer")
+    t = np.arange(5) * 0.1
+    spins = np.column_stack([t * 4, t * 4])
+    log = tmp_path / "deg.csv"
+    write_csv(log, ("time", *joints), np.column_stack([t, spins, [0, 10, 20, 30, 30]]))  # degrees
+    assert main(["odometry", str(description), str(log)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith(f"{log}:3: steer.steer: heading 10 rad (572.958 deg) outside the wheel's steer_range "
+                        "[-90, 90] deg; degrees read as radians? (CSV logs: --steer degrees)")
+    assert "\n" not in err
+    ok = _json(capsys, ["odometry", str(description), str(log), "--steer", "degrees", "--json"])
+    assert ok["pose"] == pytest.approx(_json(capsys, ["odometry", "forklift", str(log), "--steer", "degrees",
+                                                      "--json"])["pose"])
+    assert main(["odometry", "forklift", str(log)]) == 0  # no range described: not checked
+    capsys.readouterr()
+    past = np.radians([[92.9], [-92.9]])
+    JointLog.from_headings(ranged, t[:2], joints[2:], past)  # within 3 deg of the stops
+    with pytest.raises(SteeringError, match=r"^<log>: sample 1: steer\.steer: heading -1\.6249 rad \(-93\.1 deg\) "
+                       r"outside the wheel's steer_range \[-90, 90\] deg$"):
+        JointLog.from_headings(ranged, t[:2], joints[2:], np.radians([[92.9], [-93.1]]))

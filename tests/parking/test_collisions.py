@@ -21,8 +21,8 @@ from wmrkit.parking.collisions import (
 from wmrkit.parking.geometry import Vehicle, corner_angle, corner_distance
 from wmrkit.parking.planner import _symmetric_arcs
 
-vehicles = st.builds(Vehicle, st.floats(0.3, 4.0), st.floats(0.0, 1.5), st.floats(0.3, 3.0), st.just(1.0),
-                     st.just(0.5), st.just(0.7))
+vehicles = st.builds(Vehicle, st.floats(0.3, 4.0), st.floats(0.0, 1.5), st.floats(0.3, 3.0), st.just(0.3),
+                     st.just(0.3), st.just(0.7))  # h1 and the track within the smallest body (wheels inside it)
 
 
 def manoeuvre(vehicle, rho, xi, direction, n=3000):

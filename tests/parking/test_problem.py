@@ -70,8 +70,15 @@ space: {H: 7 m, J: 2.3 m, MS: 0.25 m, dx2: 1.4 m, final_gap: 0.1 m}
     ("- 1\n", r"a parking problem is a mapping"),
     ("vehicle: {a1: !!python/object:os.system ls}\n", r"malformed YAML"),
     ("vehicle: {a1: 1 + 1}\n", r"vehicle\.a1: cannot read"),
+    (TABLE_91.replace("a1: 1.5 m", "a1: 1.0 m"), r"^x\.yaml:2: vehicle\.a1: the front end \(1 m from the rear axle\) "
+     r"is behind the front axle \(h1 = 1\.05 m\)"),
+    (TABLE_91.replace("d1: 0.5", "d1: 1.5"), r"^x\.yaml:6: vehicle\.d1: the rear wheels \(1\.5 m apart\) stand "
+     r"outside"),
+    ("vehicle: {robot: ackermann, a1: 3.6 m, b1: 1.0 m, c1: 1.5 m, phi_max: 35 deg}\n",
+     r"^x\.yaml:1: vehicle\.c1: the rear wheels \(1\.55 m apart\) stand outside the body's width \(c1 = 1\.5 m\)"),
 ], ids=["missing", "angle-as-length", "phi-90", "negative", "typo", "zero-width", "unknown-top", "twice",
-        "not-car-like", "not-mapping", "list", "python-tag", "no-eval"])
+        "not-car-like", "not-mapping", "list", "python-tag", "no-eval", "front-axle-outside", "track-outside",
+        "robot-track-outside"])
 def test_bad_input_gives_one_located_line(text, message):
     with pytest.raises(DescriptionError, match=message) as info:
         problem_from_text(text, source="x.yaml")

@@ -51,7 +51,7 @@ def problems(draw):
     a1 = draw(st.floats(0.4, 4.0))
     b1 = draw(st.floats(0.0, 1.5))
     c1 = draw(st.floats(0.5, 3.5))
-    h1 = draw(st.floats(0.3, 3.0))
+    h1 = draw(st.floats(0.3, min(a1, 3.0)))  # the front axle within the body
     phi = draw(st.floats(math.radians(15), math.radians(60)))
     ms = draw(st.floats(0.0, 0.3))
     length = a1 + b1

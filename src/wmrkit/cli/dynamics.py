@@ -79,7 +79,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     """Simulate, print a summary, write and plot on request."""
     from ..dynamics.model import DynamicModel
     from ..dynamics.programs import path_program, read_torques
-    from ..dynamics.simulate import check_contact, simulate
+    from ..dynamics.simulate import simulate
 
     model = DynamicModel.of(load_robot(args.robot), args.tyre)
     speed = _positive(parse_value(args.speed, "number", "--speed"), "--speed")
@@ -100,7 +100,6 @@ def run_simulate(args: argparse.Namespace) -> int:
         parse_value(v, "number", "--initial-twist") for v in args.initial_twist]
     sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
                    record_step=max(step, 0.01), progress=False if args.json else None)
-    check_contact(model, sim)
     if args.out:
         _write(sim, args.out)
     if args.plot:

@@ -18,7 +18,7 @@ import numpy as np
 
 from .._shapes import readonly
 from ..errors import UnknownNameError, WmrkitError
-from ..limits import MAX_COORDINATE
+from ..limits import MAX_COORDINATE, check_table_size
 
 __all__ = ["BUILTIN", "Reference", "ReferenceError", "builtin_reference", "load_reference", "reference_from_samples",
            "resolve_reference"]
@@ -103,6 +103,7 @@ def load_reference(path: str | os.PathLike[str]) -> Reference:
     path = Path(path)
     if not path.exists():
         raise ReferenceError(f"{path}: no such file")
+    check_table_size(path, ReferenceError, "reference")
     try:
         with open(path, encoding="utf-8") as f:
             first = f.readline()

@@ -51,7 +51,8 @@ def _interp(values, k, k1, w, out):
 def assemble(t, s, acc, pack, inp, jac, w):
     """Everything at state `s`, time `t`, into the work arrays `w` (see :func:`work_arrays`); returns nothing.
 
-    ``w = (a, m, dm, fz, f, g, vw, tau, kdiag, rhs, beta, beta_rate, rate_ref, beta_ref, mat, filled)``:
+    ``w = (a, m, dm, fz, f, g, vw, tau, kdiag, rhs, beta, beta_rate, rate_ref, beta_ref, mat, filled, lift)``
+    (``lift``: 1, the time and the contact of the first lift-off, see :func:`lift_off`):
     ``rhs = tau + A' F + bias`` so that
     ``m nu' = rhs``; ``kdiag`` holds the servo terms of ``d rhs / d nu``.
     """
@@ -70,6 +71,12 @@ def assemble(t, s, acc, pack, inp, jac, w):
         mass_matrix(beta, pack, n, m, dm)
     w[15][0] = 1.0
     normal_loads(beta, nu, acc, pack, fz)
+    lift = w[16]
+    if lift[0] == 0.0:  # the first contact loaded at rest whose load is clipped to 0: it lifts off
+        for e in range(fz.shape[0]):
+            if fz[e] <= 0.0 and pack[15][e] > 0.0:
+                lift[0], lift[1], lift[2] = 1.0, t, e
+                break
     contact_forces(a, nu, pack, fz, f, g, vw, jac)
     tk, tff, rref, rgain, tmax, bref, kp, kd = inp
     k0, k1, wt = _segment(tk, t)
@@ -118,7 +125,7 @@ def work_arrays(n: int, n_el: int, n_steer: int) -> tuple:
     return (np.zeros((2 * n_el, n)), np.zeros((n, n)), np.zeros((n_steer, n, n)), np.zeros(n_el),
             np.zeros((n_el, 2)), np.zeros((n_el, 2, 2)), np.zeros(n_el), np.zeros(n), np.zeros(n), np.zeros(n),
             np.zeros(n_steer), np.zeros(n_steer), np.zeros(n), np.zeros(n_steer), np.zeros((n, n)),
-            np.zeros(1))
+            np.zeros(1), np.zeros(3))
 
 
 @_njit

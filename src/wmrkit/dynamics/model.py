@@ -201,6 +201,11 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
             np.array([body.mass, body.inertia, *body.com, body.com_height, gravity]),
             np.array(np.linalg.pinv(geo), order="C"), np.array([0 if moving else 1], dtype=np.int64),
             *_differentials(robot, names))
+    from ._kernels import normal_loads
+
+    static = np.zeros(n_el)
+    normal_loads(np.array(robot.beta, dtype=float), np.zeros(n), np.zeros(n), pack, static)
+    pack = (*pack, (static > 0).astype(float))  # 15: the contacts loaded at rest (lift-off: _integrate.assemble)
     contacts = []
     for w in robot.wheels:
         k = len(w.elements())

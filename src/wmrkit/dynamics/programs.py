@@ -1,8 +1,8 @@
 """Inputs for the simulator: torque files and built-in programs (straight, turn, the paths of thesis §7.5.4).
 
-A torque file is a CSV with a header ``time,<wheel>.<joint>,...``: times [s] strictly increasing, torques [N m] on
-actuated joints (``spin``, ``spin1``/``spin2``, ``steer``), linear between rows; a ``<wheel>.heading`` column [rad]
-is a steering-servo reference instead (the users' heading, 0 = straight ahead).
+A torque file is a CSV with a header ``time,<wheel>.<joint>,...``: times [s] strictly increasing from at most 0,
+torques [N m] on actuated joints (``spin``, ``spin1``/``spin2``, ``steer``), linear between rows, the last row held;
+a ``<wheel>.heading`` column [rad] is a steering-servo reference instead (the users' heading, 0 = straight ahead).
 
 A built-in program (:func:`path_program`) is a schedule of body twists; each actuated wheel follows the no-slip
 rate of its twist (wheel IK, §8.4) through a saturated rate servo and each actuated steering the IK heading
@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import readonly
 from ..errors import WmrkitError
-from ..limits import MAX_SIZE, MAX_SPEED
+from ..limits import MAX_SIZE, MAX_SPEED, check_table_size
 from .model import DynamicModel
 from .simulate import Inputs, _knots, joint_column
 
@@ -132,6 +132,7 @@ def _actuated(model: DynamicModel, column: int) -> bool:
 def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     """:class:`Inputs` from a torque CSV (module docstring); errors name the file, the line and the column."""
     source = str(path)
+    check_table_size(path, WmrkitError, "torque file")
     try:
         with open(path, newline="", encoding="utf-8") as fh:
             rows = list(csv.reader(fh))
@@ -156,6 +157,9 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
                 raise WmrkitError(f"{source}:{i}: column '{header[j]}': must be finite")
     if np.any(np.diff(values[:, 0]) <= 0):
         raise WmrkitError(f"{source}: times must be strictly increasing")
+    if values[0, 0] > 0:  # held before the first row, the first torques would act from t = 0
+        raise WmrkitError(f"{source}:2: the first row is at t = {values[0, 0]:g} s; the torques start at t = 0 (add a "
+                          "row at time 0, or subtract the first time)")
     torques, headings = {}, {}
     for j, name in enumerate(header[1:], start=1):
         wheel, _, joint = name.partition(".")

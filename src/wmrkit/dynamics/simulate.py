@@ -116,13 +116,17 @@ def joint_column(model: DynamicModel, name: str) -> int:
 def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, step: float = 1e-3,
              method: Method = "semi-implicit", tyre: Tyre | str | None = None, initial_twist: ArrayLike = (0, 0, 0),
              initial_pose: ArrayLike = (0, 0, 0), record_step: float | None = None, rtol: float = 1e-6,
-             progress: bool | None = None, jac_every: int = 20) -> Simulation:
+             progress: bool | None = None, jac_every: int = 20, allow_lift_off: bool = False) -> Simulation:
     """Integrate the dynamic model for `duration` [s] from `inputs`.
 
     The initial velocities roll without slip at `initial_twist` (wheel IK, §8.4) with the steering at its IK
     headings (or as described when the twist is 0). `record_step` [s] (default `step`, at least 1 ms for
     ``"adaptive"``) sets the output sampling; `progress` shows a tqdm bar (default: runs of 500 000 steps or more);
     `jac_every`: steps between refreshes of the tyre Jacobian of the semi-implicit method (1: every step).
+
+    A wheel loaded at rest whose normal load falls to 0 lifts off; the planar model cannot follow it (it clips the
+    load and keeps the wheel down), so the run stops with a :class:`WmrkitError` naming the contact and the time,
+    unless `allow_lift_off`.
     """
     model = robot if isinstance(robot, DynamicModel) else DynamicModel.of(robot, tyre)
     if method not in METHODS:
@@ -134,23 +138,23 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     record = record_step or (max(step, 1e-3) if method == "adaptive" else step)
     every = max(1, round(record / step))
     if method == "adaptive":
-        rec, info = _adaptive(model, s0, inp, duration, record, rtol)
+        rec, info = _adaptive(model, s0, inp, duration, record, rtol, allow_lift_off)
     else:
         rec, info = _fixed(model, s0, inp, duration, step, every, 0 if method == "semi-implicit" else 1, progress,
-                           jac_every)
+                           jac_every, allow_lift_off)
     return _result(model, rec, method, step, info)
 
 
-def check_contact(model: DynamicModel, sim: Simulation) -> None:
-    """Refuse a run where a wheel that stands on the ground at rest loses its load (lifts off): the planar model
-    clips the load at 0 and keeps the wheel down, so the motion that follows is not physical (with friction)."""
-    static = model.normal_loads()
-    lifted = (sim.loads <= 0) & (static > 0)
-    if lifted.any():
-        k, e = (int(i[0]) for i in np.nonzero(lifted))
-        raise WmrkitError(f"contact '{model.contacts[e]}' lifts off the ground at t = {sim.t[k]:.6g} s (normal load "
-                          f"0; {static[e]:.4g} N at rest): the planar model keeps every wheel on the ground, so the "
-                          "motion would not be physical; use smaller torques or speeds")
+def check_lift_off(model: DynamicModel, w: tuple) -> None:
+    """Refuse a run in which a wheel loaded at rest lost its load (lifts off), as the integrator's work arrays `w`
+    recorded it: the planar model clips the load at 0 and keeps the wheel down, so the motion that follows is not
+    physical (with friction)."""
+    lift = w[16]
+    if lift[0]:
+        e = int(lift[2])
+        raise WmrkitError(f"contact '{model.contacts[e]}' lifts off the ground at t = {lift[1]:.6g} s (normal load "
+                          f"0; {model.normal_loads()[e]:.4g} N at rest): the planar model keeps every wheel on the "
+                          "ground, so the motion would not be physical; use smaller torques or speeds")
 
 
 class Stepper:
@@ -159,14 +163,15 @@ class Stepper:
     `state` ``(2n,)``: pose ``(x, y, theta)``, the joint positions of the columns ``model.names[3:]``, then the
     velocities ``nu (n,)`` (default :func:`initial_state`, at rest); a float64 C-contiguous array is used in place
     (caller-owned), anything else is copied. :meth:`advance` integrates with the semi-implicit method (or ``"rk4"``)
-    at `step` [s] from time `t` [s]. The stepper carries all the integrator carries (the last acceleration for the
+    at `step` [s] from time `t` [s]; it raises when a wheel lifts off unless `allow_lift_off` (as
+    :func:`simulate`). The stepper carries all the integrator carries (the last acceleration for the
     load transfer, the tyre Jacobian and its refresh phase): advancing in pieces gives, bit for bit, the run of one
     :func:`simulate` call.
     """
 
     def __init__(self, model: Robot | DynamicModel, state: ArrayLike | None = None, *, step: float = 1e-3,
                  method: Literal["semi-implicit", "rk4"] = "semi-implicit", jac_every: int = 20, t: float = 0.0,
-                 tyre: Tyre | str | None = None) -> None:
+                 tyre: Tyre | str | None = None, allow_lift_off: bool = False) -> None:
         from ._integrate import work_arrays
 
         self.model = model if isinstance(model, DynamicModel) else DynamicModel.of(model, tyre)
@@ -185,7 +190,7 @@ class Stepper:
         if not np.all(np.isfinite(state)):
             raise WmrkitError("state: every entry must be finite")
         self.state: np.ndarray = state
-        self.step, self.jac_every = float(step), jac_every
+        self.step, self.jac_every, self.allow_lift_off = float(step), jac_every, allow_lift_off
         self._method = 0 if method == "semi-implicit" else 1
         self._k = round(t / step)
         self._phase = self._k  # the tyre Jacobian is refreshed at the first step, then every jac_every steps
@@ -220,6 +225,8 @@ class Stepper:
         self._k += n_steps
         if not math.isfinite(self.state.sum()):  # NaN and infinities propagate into the sum
             raise WmrkitError(f"the simulation diverged before t = {self.t:.6g} s; use a smaller step")
+        if not self.allow_lift_off:
+            check_lift_off(self.model, self._w)
         return self.state
 
     def hold(self, rate_reference: ArrayLike | None = None, heading_reference: ArrayLike | None = None,
@@ -255,12 +262,12 @@ def _held(value: ArrayLike, size: int, name: str) -> np.ndarray:
 
 def advance(model: Robot | DynamicModel, state: ArrayLike, inputs: Inputs, duration: float, *, step: float = 1e-3,
             t: float = 0.0, method: Literal["semi-implicit", "rk4"] = "semi-implicit",
-            jac_every: int = 20) -> np.ndarray:
+            jac_every: int = 20, allow_lift_off: bool = False) -> np.ndarray:
     """The state ``(2n,)`` after `duration` [s] of `inputs` from the full `state` at time `t` (a new array; a fresh
     integrator: ``Stepper(model, copy of state, t=t).advance(inputs, duration)``)."""
     m = model if isinstance(model, DynamicModel) else DynamicModel.of(model)
     stepper = Stepper(m, np.array(as_vectors(state, 2 * m.n, "state"), dtype=float), step=step, method=method,
-                      jac_every=jac_every, t=t)
+                      jac_every=jac_every, t=t, allow_lift_off=allow_lift_off)
     return stepper.advance(inputs, duration)
 
 
@@ -303,7 +310,7 @@ def _records(model: DynamicModel, n_rec: int) -> tuple:
             np.zeros((n_rec, e, 2)), np.zeros((n_rec, e)), np.zeros((n_rec, model.n)))
 
 
-def _fixed(model, s0, inp, duration, step, every, method, progress, jac_every):
+def _fixed(model, s0, inp, duration, step, every, method, progress, jac_every, allow_lift_off):
     from ._integrate import observe, run, work_arrays
 
     n_steps = round(duration / step)
@@ -330,12 +337,14 @@ def _fixed(model, s0, inp, duration, step, every, method, progress, jac_every):
         if not np.all(np.isfinite(s)):
             raise WmrkitError(f"the simulation diverged before t = {done * step:.6g} s; use a smaller --step (or "
                               "smaller torques or speeds)")
+        if not allow_lift_off:
+            check_lift_off(model, w)
     if bar is not None:
         bar.close()
     return tuple(r[:i] for r in rec), {"steps": n_steps}
 
 
-def _adaptive(model, s0, inp, duration, record, rtol):
+def _adaptive(model, s0, inp, duration, record, rtol, allow_lift_off):
     from scipy.integrate import solve_ivp
 
     from ._integrate import derivative, observe, work_arrays
@@ -351,9 +360,12 @@ def _adaptive(model, s0, inp, duration, record, rtol):
     if not sol.success:
         raise WmrkitError(f"the adaptive integration failed: {sol.message}")
     rec = _records(model, len(sol.t))
+    w[16][:] = 0.0  # lift-off judged on the accepted states only (not on the solver's trial evaluations)
     for i, (t, s) in enumerate(zip(sol.t, sol.y.T, strict=True)):
         derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w)
         observe(t, np.ascontiguousarray(s), acc, model.pack, inp, w, rec, i)
+    if not allow_lift_off:
+        check_lift_off(model, w)
     return rec, {"evaluations": int(sol.nfev)}
 
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import WmrkitError
 from .logs import MAX_RATE, JointLog, LogError, check_jumps
-from .steering import check_robot, convert_steering
+from .steering import check_robot, check_steer_range, convert_steering
 
 if TYPE_CHECKING:
     from ..robot import Robot
@@ -184,6 +184,7 @@ def _chunk(times: list[float], joints: Sequence[str], rows: list, source: str, f
     log = JointLog(np.array(times), tuple(joints), raw, None, source, None, first)
     t = log.time if last is None else np.concatenate([[last[0]], log.time])
     check_jumps(log, raw, None if last is None else last[1], t, max_rate)
+    check_steer_range(robot, joints, raw, log.where)
     yield JointLog(log.time, log.joints, convert_steering(robot, joints, raw, to="beta", source=source), None,
                    source, None, first)
     return float(log.time[-1]), raw[-1].copy()

@@ -33,7 +33,7 @@ import numpy as np
 
 from ..errors import WmrkitError
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
-from .steering import CONVENTIONS, check_robot, convert_steering
+from .steering import CONVENTIONS, check_robot, check_steer_range, convert_steering
 
 if TYPE_CHECKING:
     from ..robot import Robot
@@ -88,7 +88,9 @@ class JointLog:
                       heading_world: np.ndarray | None = None, source: str = "<log>") -> JointLog:
         """A log from joint data whose steering columns are headings (0 = rolling straight ahead, CCW; ROS 2
         ``JointState``, WPILib), converted to β with `robot`'s wheels (:func:`.steering.convert_steering`)."""
-        pos = convert_steering(robot, joints, np.asarray(positions, dtype=float), to="beta", source=source)
+        positions = np.asarray(positions, dtype=float)
+        check_steer_range(robot, joints, positions, lambda i: f"{source}: sample {i}")
+        pos = convert_steering(robot, joints, positions, to="beta", source=source)
         return cls(np.asarray(time, dtype=float), tuple(joints), pos, heading_world, source)
 
     def heading_positions(self, robot: Robot) -> np.ndarray:
@@ -220,6 +222,7 @@ class Decoder:
             self._heading = heading[-1]
         self._last, self._positions = raw[-1].copy(), pos[-1].copy()  # as read: counts and rates continue from it
         if fmt.steer_convention == "heading":
+            check_steer_range(self.robot, self.joints, pos, probe.where)
             pos = convert_steering(self.robot, self.joints, pos, to="beta", source=self.source)
         return JointLog(time, self.joints, pos, heading, self.source, first_line, first_index)
 

@@ -12,7 +12,7 @@ and every writer converts back. Files written in β by older wmrkit versions say
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Literal
 
 import numpy as np
@@ -39,6 +39,35 @@ def check_robot(joints: Sequence[str], robot: Robot | None, source: str) -> None
     if cols and robot is None:
         raise SteeringError(f"{source}: steering joints ({', '.join(joints[k] for k in cols)}) are headings "
                             "(0 = rolling straight ahead); converting them needs the robot: pass robot=")
+
+
+#: How far a logged heading may pass its wheel's ``steer_range`` [rad] (encoder offset, overshoot at the stops).
+RANGE_MARGIN = np.radians(3.0)
+
+
+def check_steer_range(robot: Robot | None, joints: Sequence[str], headings: np.ndarray,
+                      where: Callable[[int], str]) -> None:
+    """Refuse a logged heading [rad] beyond its wheel's described ``steer_range`` by more than
+    :data:`RANGE_MARGIN` (:class:`SteeringError` located by ``where(row)``): inconsistent data, often degrees read
+    as radians (said so when the value is past half a turn and, in degrees, within the range). `headings`
+    ``(N, len(joints))``; wheels without a ``steer_range`` are not checked (a multi-turn swerve module may count
+    past a turn)."""
+    if robot is None:
+        return
+    for k in steer_columns(joints):
+        wheel = joints[k].rpartition(".")[0]
+        rng = robot.wheel(wheel).steer_range if wheel in robot.steer_names else None  # else: convert_steering's
+        if rng is None:
+            continue
+        col = headings[:, k]
+        bad = np.flatnonzero((col < rng[0] - RANGE_MARGIN) | (col > rng[1] + RANGE_MARGIN))
+        if bad.size:
+            i, value = int(bad[0]), float(col[bad[0]])
+            hint = ("; degrees read as radians? (CSV logs: --steer degrees)"
+                    if abs(value) > np.pi and rng[0] <= np.radians(value) <= rng[1] else "")
+            raise SteeringError(f"{where(i)}: {joints[k]}: heading {value:.6g} rad ({np.degrees(value):.6g} deg) "
+                                f"outside the wheel's steer_range [{np.degrees(rng[0]):.6g}, "
+                                f"{np.degrees(rng[1]):.6g}] deg{hint}")
 
 
 def convert_steering(robot: Robot | None, joints: Sequence[str], positions: np.ndarray, *,

@@ -121,6 +121,10 @@ def _load_table(path: str | os.PathLike[str], **options) -> np.ndarray:
     """``np.loadtxt`` of a trajectory file with at least one row; errors name the file in one line."""
     import warnings
 
+    from ..limits import check_table_size
+
+    check_table_size(path, LogError, "trajectory")
+
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # "input contained no data": refused below

@@ -42,6 +42,9 @@ class Vehicle:
                 raise WmrkitError(f"vehicle.{name}: must be > 0, got {getattr(self, name)} m")
         if self.b1 < 0 or self.track < 0:
             raise WmrkitError("vehicle.b1 and vehicle.d1 (track) must be >= 0")
+        problem = wheels_outside(self.a1, self.c1, self.h1, self.track)
+        if problem is not None:
+            raise WmrkitError(f"vehicle.{problem[0]}: {problem[1]}")
         if not 0 < self.phi_max < math.pi / 2:
             raise WmrkitError(f"vehicle.phi_max: must be in (0, 90) deg, got {math.degrees(self.phi_max):.6g} deg")
 
@@ -54,6 +57,18 @@ class Vehicle:
     def rho_min(self) -> float:
         """Minimum turning radius of P_f, (9.27) at ``phi_max`` [m]."""
         return turning_radius(self.h1, self.phi_max)
+
+
+def wheels_outside(a1: float, c1: float, h1: float, track: float) -> tuple[str, str] | None:
+    """The field and the reason when wheels stand outside the body (front axle ahead of the front end, rear
+    wheels wider than the body): the collision checks see the body's corners only, so they would go unchecked."""
+    if a1 < h1:
+        return "a1", (f"the front end ({a1:g} m from the rear axle) is behind the front axle (h1 = {h1:g} m); the "
+                      "planner checks the body's corners only, so the front wheels would go unchecked")
+    if track > c1:
+        return "d1", (f"the rear wheels ({track:g} m apart) stand outside the body's width (c1 = {c1:g} m); the "
+                      "planner checks the body's corners only, so they would go unchecked")
+    return None
 
 
 @dataclass(frozen=True, slots=True)

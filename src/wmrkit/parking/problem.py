@@ -21,7 +21,7 @@ from ..catalog import resolve as resolve_robot
 from ..documents import FieldReader, read_document, read_file
 from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
-from .geometry import Space, Vehicle
+from .geometry import Space, Vehicle, wheels_outside
 
 VEHICLE_FIELDS = ("a1", "b1", "c1", "h1", "d1", "phi_max")
 ROBOT_VEHICLE_FIELDS = ("robot", "a1", "b1", "c1", "phi_max")
@@ -125,6 +125,9 @@ def _vehicle(check: FieldReader, data: Any, base: Path | None) -> tuple[Vehicle,
             check.fail(f"must be >= 0, got {v[name]} m", ("vehicle", name) if name in data else ("vehicle",))
     if not 0 < v["phi_max"] < math.pi / 2:
         check.fail(f"must be in (0, 90) deg, got {math.degrees(v['phi_max']):.6g} deg", ("vehicle", "phi_max"))
+    problem = wheels_outside(v["a1"], v["c1"], v["h1"], v["d1"])
+    if problem is not None:
+        check.fail(problem[1], ("vehicle", problem[0] if problem[0] in data else "c1"))  # d1 of a robot
     vehicle = Vehicle(a1=v["a1"], b1=v["b1"], c1=v["c1"], h1=v["h1"], track=v["d1"], phi_max=v["phi_max"])
     return vehicle, robot
 
