@@ -9,7 +9,15 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import WmrkitError
-from ._common import add_json_flag, add_robot_argument, load_robot, parse_assignments, parse_value, print_json
+from ._common import (
+    add_json_flag,
+    add_robot_argument,
+    check_plot_path,
+    load_robot,
+    parse_assignments,
+    parse_value,
+    print_json,
+)
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -51,6 +59,7 @@ def run_tyre(args: argparse.Namespace) -> int:
     """Print the forces (and plot the curves)."""
     from ..dynamics.tyres import Tyre
 
+    check_plot_path(args.plot)
     params = {k: parse_value(v, "number", f"--param {k}") for k, v in parse_assignments(args.param, "--param").items()}
     tyre = Tyre.of(args.model, params)
     load = _positive(parse_value(args.load, "number", "--load"), "--load", zero=True)
@@ -82,6 +91,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     from ..dynamics.simulate import simulate
 
     model = DynamicModel.of(load_robot(args.robot), args.tyre)
+    check_plot_path(args.plot)
     speed = _positive(parse_value(args.speed, "number", "--speed"), "--speed")
     if args.path:
         inputs, duration = path_program(model, args.path, speed=speed)
@@ -143,9 +153,6 @@ def _write(sim, out: str) -> None:
 
 
 def _savefig(fig, out: str) -> None:
-    from ..plotting.files import check_figure_path
-
-    check_figure_path(out, "--plot")
     try:
         fig.savefig(out)
     except (OSError, ValueError) as err:

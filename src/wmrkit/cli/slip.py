@@ -84,11 +84,13 @@ def weights_from_args(args: argparse.Namespace, settings=None):
 def check_estimator_options(args: argparse.Namespace) -> None:
     """Refuse an estimator option that the chosen ``--method`` does not use (it would be ignored silently): the
     friction coefficients belong to wls, the noises to fk1 and fk2."""
-    given = {"--mu": args.mu, "--mu-default": args.mu_default is not None, "--slip-weights": args.slip_weights,
-             "--kf-noise": args.kf_noise, "--kf-wheel": args.kf_wheel, "--thesis-double-q": args.thesis_double_q}
-    for option, value in given.items():
-        applies = ("wls",) if option in ("--mu", "--mu-default", "--slip-weights") else ("fk1", "fk2")
-        if value and args.method not in applies:
+    groups = {("wls",): {"--mu": args.mu, "--mu-default": args.mu_default is not None,
+                         "--slip-weights": args.slip_weights},
+              ("fk1", "fk2"): {"--kf-noise": args.kf_noise, "--kf-wheel": args.kf_wheel,
+                               "--thesis-double-q": args.thesis_double_q}}
+    for applies, given in groups.items():
+        option = next((o for o, value in given.items() if value), None)
+        if option is not None and args.method not in applies:
             raise WmrkitError(f"{option} applies to --method {' or '.join(applies)}, not to --method {args.method}")
 
 

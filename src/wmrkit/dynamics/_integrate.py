@@ -52,7 +52,8 @@ def assemble(t, s, acc, pack, inp, jac, w):
     """Everything at state `s`, time `t`, into the work arrays `w` (see :func:`work_arrays`); returns nothing.
 
     ``w = (a, m, dm, fz, f, g, vw, tau, kdiag, rhs, beta, beta_rate, rate_ref, beta_ref, mat, filled, lift)``
-    (``lift``: 1, the time and the contact of the first lift-off, see :func:`lift_off`):
+    (``lift``: 1, the time and the contact of the first lift-off, see
+    :func:`wmrkit.dynamics.simulate.check_lift_off`):
     ``rhs = tau + A' F + bias`` so that
     ``m nu' = rhs``; ``kdiag`` holds the servo terms of ``d rhs / d nu``.
     """
@@ -271,7 +272,13 @@ def run(s, k0, dt, n_steps, every, method, jac_every, acc, pack, inp, w, rec, i0
     from row `i0`. Running in chunks gives the same result as one run.
 
     `method` 0: semi-implicit, refreshing the tyre Jacobian every `jac_every` steps (from step `jac_phase`); 1: RK4.
+    A state that overflows (the compiled kernels then raise ZeroDivisionError) comes back as NaN, for the caller's
+    divergence check.
     """
-    if method == 0:
-        return run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0)
-    return run_rk4(s, k0, dt, n_steps, every, acc, pack, inp, w, rec, i0)
+    try:
+        if method == 0:
+            return run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0)
+        return run_rk4(s, k0, dt, n_steps, every, acc, pack, inp, w, rec, i0)
+    except ZeroDivisionError:
+        s[:] = math.nan
+        return i0

@@ -217,11 +217,8 @@ class Stepper:
         n_steps = round(duration / self.step) if math.isfinite(duration) and duration >= 0 else -1
         if n_steps < 0:
             raise WmrkitError(f"duration must be finite and >= 0, got {duration}")
-        try:
-            run(self.state, self._k, self.step, n_steps, 1 << 62, self._method, self.jac_every, self._acc,
-                self.model.pack, self._inputs, self._w, self._rec, 0, self._phase)
-        except ZeroDivisionError:  # the compiled kernels raise it where the state has overflowed
-            self.state[:] = math.nan
+        run(self.state, self._k, self.step, n_steps, 1 << 62, self._method, self.jac_every, self._acc,
+            self.model.pack, self._inputs, self._w, self._rec, 0, self._phase)
         self._k += n_steps
         if not math.isfinite(self.state.sum()):  # NaN and infinities propagate into the sum
             raise WmrkitError(f"the simulation diverged before t = {self.t:.6g} s; use a smaller step")
@@ -327,10 +324,7 @@ def _fixed(model, s0, inp, duration, step, every, method, progress, jac_every, a
         bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
     while done < n_steps:
         k = min(chunk, n_steps - done)
-        try:
-            i = run(s, done, step, k, every, method, jac_every, acc, model.pack, inp, w, rec, i)
-        except ZeroDivisionError:  # the compiled kernels raise it where the state has overflowed
-            s[:] = math.nan
+        i = run(s, done, step, k, every, method, jac_every, acc, model.pack, inp, w, rec, i)
         done += k
         if bar is not None:
             bar.update(k)

@@ -13,6 +13,7 @@ from typing import IO, Literal
 
 import numpy as np
 
+from ..limits import MAX_COORDINATE, check_table_size
 from .logs import LogError
 
 TrajectoryFormat = Literal["csv", "tum"]
@@ -121,10 +122,7 @@ def _load_table(path: str | os.PathLike[str], **options) -> np.ndarray:
     """``np.loadtxt`` of a trajectory file with at least one row; errors name the file in one line."""
     import warnings
 
-    from ..limits import check_table_size
-
     check_table_size(path, LogError, "trajectory")
-
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # "input contained no data": refused below
@@ -139,8 +137,6 @@ def _load_table(path: str | os.PathLike[str], **options) -> np.ndarray:
 
 def _check_samples(path: str | os.PathLike[str], t: np.ndarray, position: np.ndarray) -> None:
     """Times finite and strictly increasing, positions finite within :data:`wmrkit.limits.MAX_COORDINATE`."""
-    from ..limits import MAX_COORDINATE
-
     finite = np.isfinite(np.column_stack([t, position])).all(axis=1)
     if not finite.all():
         raise LogError(f"{os.fspath(path)}: pose {int(np.argmin(finite)) + 1}: times and positions must be finite "
