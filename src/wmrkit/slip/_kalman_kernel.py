@@ -6,12 +6,15 @@ Per sample, with ``H = C^T R^-1 C`` and ``M = -C^T R^-1 A_a`` of the sample's st
 (7.75) is printed. The increment of the sample is ``x+ dt``; its slip indicator ``|C x+ + A_a qdot_a| dt`` [m],
 computed as ``|T (x+, qdot_a)| dt`` with T the triangular factor of ``[C, A_a]`` (an orthogonal change of rows).
 
-The covariance recursion does not depend on the data: while the configuration stays the same and the carried
-covariance is a fixed point of the step (bitwise: the step gave back the very numbers it started from), every
-next step would compute the same two inverses, so they are kept instead of recomputed. Exact, not an
-approximation: the results are those of the plain recursion, bit for bit. One pass reads the joint positions and
-times (increments, rates, the steering configuration at mid-interval, as :mod:`wmrkit.odometry.model` defines
-them), filters, and composes the poses with the blocks of :mod:`wmrkit.odometry._kernels`.
+The covariance recursion does not depend on the data: when a step gives back the covariance it started from
+(bitwise) and the configuration stays the same, every next step would compute the same two inverses, so they are
+kept instead of recomputed, and such steps update ``x+ = A x + G qdot_a`` with the transition ``A = P+ P-^-1`` and
+the gain ``G = P+ M`` formed once (only ``A x`` is then on the chain from sample to sample; the rates' part is
+summed first in both forms). Exact, not an approximation: the results are those of the plain recursion that
+computes both inverses at every step and takes this form at its fixed points, bit for bit, and they do not depend
+on where the log is cut into chunks. One pass reads the joint positions and times (increments, rates, the steering
+configuration at mid-interval, as :mod:`wmrkit.odometry.model` defines them), filters, and composes the poses with
+the blocks of :mod:`wmrkit.odometry._kernels`.
 """
 
 from __future__ import annotations
@@ -65,10 +68,11 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
     x_0, x_1, x_2 = filt[0], filt[1], filt[2]
     p00, p01, p02, p11, p12, p22 = filt[3], filt[4], filt[5], filt[6], filt[7], filt[8]
     i00 = i01 = i02 = i11 = i12 = i22 = u00 = u01 = u02 = u11 = u12 = u22 = 0.0
+    a00 = a01 = a02 = a10 = a11 = a12 = a20 = a21 = a22 = 0.0
+    gain = np.zeros((3, n_a))
     steady, last_u = False, -1
     mid = np.full(n_s, np.nan)
-    config, seg_u, seg_start = (np.empty(BLOCK, dtype=np.int64), np.empty(BLOCK, dtype=np.int64),
-                                np.empty(BLOCK + 1, dtype=np.int64))
+    seg_u, seg_start = np.empty(BLOCK, dtype=np.int64), np.empty(BLOCK + 1, dtype=np.int64)
     z, buf = np.empty((3 + n_a, BLOCK)), np.empty((11, BLOCK))  # z: the twist, then the rates
     norm, acc = buf[9], buf[10]
     rates = z[3:]
@@ -77,35 +81,63 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
         full = min(BLOCK, n - block)
         bm, count = _block_segments(positions, before, steer_cols, block, full, keys, ids, mid, seg_u, seg_start)
         unknown = bm < full  # the block ends at an unknown configuration
-        for g in range(count):
-            for j in range(seg_start[g], seg_start[g + 1]):
-                config[j] = seg_u[g]
         _rates(positions, before, time, time_before, rate_cols, steer_cols, block, bm, dt, rates)
-        for j in range(bm):  # the recursion, sequential
-            u = config[j]
+        for g in range(count):  # the recursion, sequential, over the runs of one configuration
+            u, j, end = seg_u[g], seg_start[g], seg_start[g + 1]
             if u != last_u:
                 steady, last_u = False, u
-            if not steady:  # prediction (7.71)-(7.72), then the update's covariance
+            while j < end and not steady:  # a transient: prediction (7.71)-(7.72), the update's covariance
                 i00, i01, i02, i11, i12, i22 = _inverse_sym(p00 + q, p01, p02, p11 + q, p12, p22 + q)
                 u00, u01, u02, u11, u12, u22 = _inverse_sym(i00 + h[u, 0, 0], i01 + h[u, 0, 1], i02 + h[u, 0, 2],
                                                             i11 + h[u, 1, 1], i12 + h[u, 1, 2], i22 + h[u, 2, 2])
                 n00, n11, n22 = (u00 + q, u11 + q, u22 + q) if double_q else (u00, u11, u22)  # (7.75) as printed
                 steady = (n00 == p00 and u01 == p01 and u02 == p02 and n11 == p11 and u12 == p12 and n22 == p22)
                 p00, p01, p02, p11, p12, p22 = n00, u01, u02, n11, u12, n22
-            # information vector P-^-1 x + M qdot_a, then x+ = P+ b
-            b0 = i00 * x_0 + i01 * x_1 + i02 * x_2
-            b1 = i01 * x_0 + i11 * x_1 + i12 * x_2
-            b2 = i02 * x_0 + i12 * x_1 + i22 * x_2
-            for a in range(n_a):
-                b0 += m[u, 0, a] * rates[a, j]
-                b1 += m[u, 1, a] * rates[a, j]
-                b2 += m[u, 2, a] * rates[a, j]
-            x_0 = u00 * b0 + u01 * b1 + u02 * b2
-            x_1 = u01 * b0 + u11 * b1 + u12 * b2
-            x_2 = u02 * b0 + u12 * b1 + u22 * b2
+                if steady:  # a fixed point: this step and the next ones use x+ = A x + G qdot_a
+                    a00, a01, a02 = u00 * i00 + u01 * i01 + u02 * i02, u00 * i01 + u01 * i11 + u02 * i12, \
+                        u00 * i02 + u01 * i12 + u02 * i22
+                    a10, a11, a12 = u01 * i00 + u11 * i01 + u12 * i02, u01 * i01 + u11 * i11 + u12 * i12, \
+                        u01 * i02 + u11 * i12 + u12 * i22
+                    a20, a21, a22 = u02 * i00 + u12 * i01 + u22 * i02, u02 * i01 + u12 * i11 + u22 * i12, \
+                        u02 * i02 + u12 * i12 + u22 * i22
+                    for a in range(n_a):
+                        gain[0, a] = u00 * m[u, 0, a] + u01 * m[u, 1, a] + u02 * m[u, 2, a]
+                        gain[1, a] = u01 * m[u, 0, a] + u11 * m[u, 1, a] + u12 * m[u, 2, a]
+                        gain[2, a] = u02 * m[u, 0, a] + u12 * m[u, 1, a] + u22 * m[u, 2, a]
+                c0 = c1 = c2 = 0.0  # the rates' part first: only the product with x is on the chain
+                if steady:  # x+ = A x + G qdot_a, A = P+ P-^-1 and G = P+ M kept from the fixed point
+                    for a in range(n_a):
+                        c0 += gain[0, a] * rates[a, j]
+                        c1 += gain[1, a] * rates[a, j]
+                        c2 += gain[2, a] * rates[a, j]
+                    x_0, x_1, x_2 = ((c0 + a00 * x_0) + (a01 * x_1 + a02 * x_2),
+                                     (c1 + a10 * x_0) + (a11 * x_1 + a12 * x_2),
+                                     (c2 + a20 * x_0) + (a21 * x_1 + a22 * x_2))
+                else:  # x+ = P+ b, information vector b = P-^-1 x + M qdot_a
+                    for a in range(n_a):
+                        c0 += m[u, 0, a] * rates[a, j]
+                        c1 += m[u, 1, a] * rates[a, j]
+                        c2 += m[u, 2, a] * rates[a, j]
+                    b0 = (c0 + i00 * x_0) + (i01 * x_1 + i02 * x_2)
+                    b1 = (c1 + i01 * x_0) + (i11 * x_1 + i12 * x_2)
+                    b2 = (c2 + i02 * x_0) + (i12 * x_1 + i22 * x_2)
+                    x_0 = u00 * b0 + u01 * b1 + u02 * b2
+                    x_1 = u01 * b0 + u11 * b1 + u12 * b2
+                    x_2 = u02 * b0 + u12 * b1 + u22 * b2
+                z[0, j], z[1, j], z[2, j] = x_0, x_1, x_2
+                j += 1
+            for k in range(j, end):  # the rest of the run at the fixed point: x+ = A x + G qdot_a
+                c0 = c1 = c2 = 0.0
+                for a in range(n_a):
+                    c0 += gain[0, a] * rates[a, k]
+                    c1 += gain[1, a] * rates[a, k]
+                    c2 += gain[2, a] * rates[a, k]
+                x_0, x_1, x_2 = ((c0 + a00 * x_0) + (a01 * x_1 + a02 * x_2), (c1 + a10 * x_0) + (a11 * x_1 + a12 * x_2),
+                                 (c2 + a20 * x_0) + (a21 * x_1 + a22 * x_2))
+                z[0, k], z[1, k], z[2, k] = x_0, x_1, x_2
+        for j in range(bm):
             d = dt[j]
-            bx[j], by[j], bth[j] = x_0 * d, x_1 * d, x_2 * d
-            z[0, j], z[1, j], z[2, j] = x_0, x_1, x_2
+            bx[j], by[j], bth[j] = z[0, j] * d, z[1, j] * d, z[2, j] * d
         _norm_rows(ca, seg_u, seg_start, count, z, True, acc, norm)  # |C x + A_a qdot| = |T z|, z = (x, qdot)
         for j in range(bm):
             slip[block + j] = norm[j] * dt[j]
