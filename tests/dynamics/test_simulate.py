@@ -10,7 +10,7 @@ from dynamics_robots import castor_robot, tricycle
 
 from wmrkit import catalog
 from wmrkit.dynamics.model import DynamicModel
-from wmrkit.dynamics.programs import PATHS, feasible_twists, path_program, read_torques
+from wmrkit.dynamics.programs import PATHS, feasible_twists, path_program, read_torques, twist_program
 from wmrkit.dynamics.simulate import Inputs, simulate
 from wmrkit.dynamics.tyres import Tyre
 from wmrkit.errors import WmrkitError
@@ -63,6 +63,23 @@ def test_skid_steer_turns_less_than_its_kinematics_say():
 def test_feasible_twists_move_sideways_at_the_fork_tips(forklift):
     tw = feasible_twists(forklift, [[2.0, 0.0, 0.5]])
     assert tw[0, 1] == pytest.approx(0.5 * 1.0)  # omega x (distance to the drive axle, 1 m)
+
+
+def test_a_twist_without_a_no_slip_motion_is_refused_unless_slip_is_allowed(forklift):
+    turning = [(2.0, 0.0, 0.0), (2.0, 0.0, 0.5)]  # at the fork tips, 1 m ahead of the drive axle: needs vy = 0.5
+    with pytest.raises(WmrkitError, match=r"\(2\.0, 0\.0, 0\.5\) at t = 1 s .*'(left|right)_drive' would slip "
+                                          r"sideways at 0\.5 m/s"):
+        twist_program(forklift, [0.0, 1.0], turning)
+    feasible = twist_program(forklift, [0.0, 1.0], feasible_twists(forklift, turning))
+    slipping = twist_program(forklift, [0.0, 1.0], turning, allow_slip=True)
+    # the drive wheels roll the same either way (vy is along their axles); the steered wheel points elsewhere
+    drives = [forklift.names.index(j) for j in ("right_drive.spin", "left_drive.spin")]
+    np.testing.assert_array_equal(slipping.rate_reference[:, drives], feasible.rate_reference[:, drives])
+    assert not np.allclose(slipping.heading_reference, feasible.heading_reference)
+    skid = DynamicModel.of(catalog.load("skid-steer-4"))  # no twist that turns is feasible: the tyres must slip
+    with pytest.raises(WmrkitError, match="skid steering"):
+        twist_program(skid, [0.0], feasible_twists(skid, [(1.0, 0.0, 0.3)]))
+    twist_program(skid, [0.0], [(1.0, 0.0, 0.3)], allow_slip=True)
 
 
 def test_every_path_program_runs(forklift):

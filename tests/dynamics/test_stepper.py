@@ -7,7 +7,7 @@ import pytest
 
 from wmrkit import catalog
 from wmrkit.dynamics.model import DynamicModel
-from wmrkit.dynamics.programs import path_program, twist_program
+from wmrkit.dynamics.programs import feasible_twists, path_program, twist_program
 from wmrkit.dynamics.simulate import Stepper, advance, initial_state, simulate
 from wmrkit.errors import WmrkitError
 
@@ -48,7 +48,8 @@ def test_stepper_rk4_pieces_equal_simulate(forklift):
 
 def test_advance_is_pure_and_equals_a_fresh_simulation(forklift):
     model, _ = forklift  # a program that starts at the initial speed (braking from it at the grip would tip the truck)
-    inputs = twist_program(model, [0.0, 0.5, 1.0], [(1.0, 0.0, 0.0), (1.0, 0.0, 0.1), (1.2, 0.0, 0.2)])
+    twists = feasible_twists(model, [(1.0, 0.0, 0.0), (1.0, 0.0, 0.1), (1.2, 0.0, 0.2)])
+    inputs = twist_program(model, [0.0, 0.5, 1.0], twists)
     s0 = initial_state(model, (1.0, 0.0, 0.0), (1.0, -2.0, 0.3))
     before = s0.copy()
     out = advance(model, s0, inputs, 0.8)

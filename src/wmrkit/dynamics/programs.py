@@ -25,6 +25,8 @@ from ..limits import MAX_SIZE, MAX_SPEED, check_table_size
 from .model import DynamicModel
 from .simulate import Inputs, _knots, joint_column
 
+#: Side slip [m/s] of a fixed wheel above which :func:`twist_program` calls a twist infeasible.
+SLIP_TOL = 1e-6
 #: Built-in programs: name -> segments (duration [s], forward speed factor, curvature [1/m] at speed 1).
 PATHS: dict[str, tuple[tuple[float, float, float], ...]] = {
     "straight": ((1.0, 0.0, 0.0), (1.0, 1.0, 0.0)),
@@ -59,7 +61,8 @@ def path_program(model: DynamicModel, name: str, *, speed: float = 2.0, radius_s
         times += [t + min(0.2, dt / 4), t + dt] if k else [t + dt]
         twists += [twist, twist] if k else [twist]
         t += dt
-    return twist_program(model, np.array(times), feasible_twists(model, np.array(twists)), bandwidth=bandwidth), t
+    feasible = feasible_twists(model, np.array(twists))  # the slip left (a skid steer's turns) is the robot's
+    return twist_program(model, np.array(times), feasible, bandwidth=bandwidth, allow_slip=True), t
 
 
 def feasible_twists(model: DynamicModel, twists: ArrayLike) -> np.ndarray:
@@ -80,8 +83,14 @@ def feasible_twists(model: DynamicModel, twists: ArrayLike) -> np.ndarray:
     return twists
 
 
-def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, bandwidth: float = 30.0) -> Inputs:
+def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, bandwidth: float = 30.0,
+                  allow_slip: bool = False) -> Inputs:
     """Servo inputs that make the actuated joints follow the no-slip joint motion of body `twists` ``(K, 3)``.
+
+    A twist that has no no-slip motion (a fixed wheel would slip sideways by more than ``SLIP_TOL``: ``(v, 0,
+    omega)`` for the forklift, whose origin is at the fork tips, or any turn of a skid steer) raises
+    :class:`WmrkitError` naming the knot and the wheel; :func:`feasible_twists` gives the closest feasible twists,
+    and ``allow_slip=True`` commands the wheels' rolling components and lets the tyres slip (skid steering).
 
     Rate servos on actuated wheel joints (gain ``bandwidth x`` the wheel's reflected inertia, at least the grip
     torque per 0.1 rad/s, saturated at the grip ``mu Fz r`` with mu = 1); the joints of a ``differential`` coupling
@@ -93,7 +102,14 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     t = _knots(time)
     twists = np.asarray(twists, dtype=float).reshape(len(t), 3)
     robot, n = model.robot, model.n
-    cmd = wheel_commands(robot, twists)
+    cmd = wheel_commands(robot, twists, slip_tol=SLIP_TOL)
+    if not allow_slip and not cmd.feasible.all():
+        k = int(np.argmin(cmd.feasible))
+        w = int(np.argmax(np.abs(cmd.slip[k])))
+        raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion for "
+                          f"'{robot.name}': fixed wheel '{robot.wheel_names[w]}' would slip sideways at "
+                          f"{abs(cmd.slip[k, w]):.3g} m/s; use feasible_twists(model, twists) for the closest "
+                          "feasible motion, or allow_slip=True to let the tyres slip (skid steering)")
     rates = np.zeros((len(t), n))
     rates[:, 3:3 + cmd.rates.shape[-1]] = np.nan_to_num(cmd.rates)
     gain, limit = np.zeros(n), np.full(n, np.inf)

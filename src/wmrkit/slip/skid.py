@@ -54,7 +54,8 @@ def segment_run(robot: Robot, segments: Sequence[tuple[float, float, float]], ra
         t += [end + 0.2, end + d]
         twists += [(v, 0.0, w)] * 2
         end += d
-    sim = simulate(model, twist_program(model, np.array(t), np.array(twists)), end, step=1e-3, record_step=1 / rate)
+    sim = simulate(model, twist_program(model, np.array(t), np.array(twists), allow_slip=True), end, step=1e-3,
+                   record_step=1 / rate)
     names, joints = list(sim.joint_names), odometry_model(robot).joints
     log = JointLog(sim.t, joints, sim.joint_positions[:, [names.index(j) for j in joints]], source="<md>")
     return log, np.asarray(sim.pose)
