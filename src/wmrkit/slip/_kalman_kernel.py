@@ -93,7 +93,7 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
                 n00, n11, n22 = (u00 + q, u11 + q, u22 + q) if double_q else (u00, u11, u22)  # (7.75) as printed
                 steady = (n00 == p00 and u01 == p01 and u02 == p02 and n11 == p11 and u12 == p12 and n22 == p22)
                 p00, p01, p02, p11, p12, p22 = n00, u01, u02, n11, u12, n22
-                if steady:  # a fixed point: this step and the next ones use x+ = A x + G qdot_a
+                if steady:  # a fixed point: this sample and the rest of the run take the form below
                     a00, a01, a02 = u00 * i00 + u01 * i01 + u02 * i02, u00 * i01 + u01 * i11 + u02 * i12, \
                         u00 * i02 + u01 * i12 + u02 * i22
                     a10, a11, a12 = u01 * i00 + u11 * i01 + u12 * i02, u01 * i01 + u11 * i11 + u12 * i12, \
@@ -104,30 +104,22 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
                         gain[0, a] = u00 * m[u, 0, a] + u01 * m[u, 1, a] + u02 * m[u, 2, a]
                         gain[1, a] = u01 * m[u, 0, a] + u11 * m[u, 1, a] + u12 * m[u, 2, a]
                         gain[2, a] = u02 * m[u, 0, a] + u12 * m[u, 1, a] + u22 * m[u, 2, a]
-                c0 = c1 = c2 = 0.0  # the rates' part first: only the product with x is on the chain
-                if steady:  # x+ = A x + G qdot_a, A = P+ P-^-1 and G = P+ M kept from the fixed point
-                    for a in range(n_a):
-                        c0 += gain[0, a] * rates[a, j]
-                        c1 += gain[1, a] * rates[a, j]
-                        c2 += gain[2, a] * rates[a, j]
-                    x_0, x_1, x_2 = ((c0 + a00 * x_0) + (a01 * x_1 + a02 * x_2),
-                                     (c1 + a10 * x_0) + (a11 * x_1 + a12 * x_2),
-                                     (c2 + a20 * x_0) + (a21 * x_1 + a22 * x_2))
-                else:  # x+ = P+ b, information vector b = P-^-1 x + M qdot_a
-                    for a in range(n_a):
-                        c0 += m[u, 0, a] * rates[a, j]
-                        c1 += m[u, 1, a] * rates[a, j]
-                        c2 += m[u, 2, a] * rates[a, j]
-                    b0 = (c0 + i00 * x_0) + (i01 * x_1 + i02 * x_2)
-                    b1 = (c1 + i01 * x_0) + (i11 * x_1 + i12 * x_2)
-                    b2 = (c2 + i02 * x_0) + (i12 * x_1 + i22 * x_2)
-                    x_0 = u00 * b0 + u01 * b1 + u02 * b2
-                    x_1 = u01 * b0 + u11 * b1 + u12 * b2
-                    x_2 = u02 * b0 + u12 * b1 + u22 * b2
+                    break
+                c0 = c1 = c2 = 0.0  # x+ = P+ b, information vector b = P-^-1 x + M qdot_a, the rates' part first
+                for a in range(n_a):
+                    c0 += m[u, 0, a] * rates[a, j]
+                    c1 += m[u, 1, a] * rates[a, j]
+                    c2 += m[u, 2, a] * rates[a, j]
+                b0 = (c0 + i00 * x_0) + (i01 * x_1 + i02 * x_2)
+                b1 = (c1 + i01 * x_0) + (i11 * x_1 + i12 * x_2)
+                b2 = (c2 + i02 * x_0) + (i12 * x_1 + i22 * x_2)
+                x_0 = u00 * b0 + u01 * b1 + u02 * b2
+                x_1 = u01 * b0 + u11 * b1 + u12 * b2
+                x_2 = u02 * b0 + u12 * b1 + u22 * b2
                 z[0, j], z[1, j], z[2, j] = x_0, x_1, x_2
                 j += 1
-            for k in range(j, end):  # the rest of the run at the fixed point: x+ = A x + G qdot_a
-                c0 = c1 = c2 = 0.0
+            for k in range(j, end):  # at the fixed point: x+ = A x + G qdot_a, A = P+ P-^-1, G = P+ M kept
+                c0 = c1 = c2 = 0.0  # the rates' part first: only A x is on the chain from sample to sample
                 for a in range(n_a):
                     c0 += gain[0, a] * rates[a, k]
                     c1 += gain[1, a] * rates[a, k]
