@@ -190,3 +190,20 @@ def test_a_full_turn_in_a_sensed_castor_angle_is_no_motion(kernels):
     np.testing.assert_allclose(odometry(model, jumped).poses, straight.poses, rtol=0, atol=1e-12)
     np.testing.assert_allclose(model.from_positions(turned).rate_increments,  # the increments path wraps too
                                model.from_positions(log.positions).rate_increments, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("n_angles", [1, 2])
+def test_the_configuration_lookup_finds_every_key_and_nothing_else(n_angles):
+    from wmrkit.odometry._steering_kernels import _find
+
+    rng = np.random.default_rng(n_angles)
+    for size in (0, 1, 2, 3, 7, 64, 151):
+        keys = np.unique(np.round(rng.normal(0, 1, (size, n_angles)), 2), axis=0)  # sorted lexicographically
+        ids = rng.permutation(len(keys)).astype(np.int64)
+        known = {tuple(k): i for k, i in zip(keys.tolist(), ids.tolist(), strict=True)}
+        queries = [*keys, *np.round(rng.normal(0, 1, (50, n_angles)), 3), np.full(n_angles, np.nan),
+                   np.full(n_angles, -1e300), np.full(n_angles, 1e300)]
+        for q in queries:
+            expected = known.get(tuple(q.tolist()), -1)
+            for find in (_find, _find.py_func):
+                assert find(keys, ids, q) == expected, (size, q)
