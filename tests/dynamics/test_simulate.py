@@ -80,6 +80,9 @@ def test_a_twist_without_a_no_slip_motion_is_refused_unless_slip_is_allowed(fork
     with pytest.raises(WmrkitError, match="skid steering"):
         twist_program(skid, [0.0], feasible_twists(skid, [(1.0, 0.0, 0.3)]))
     twist_program(skid, [0.0], [(1.0, 0.0, 0.3)], allow_slip=True)
+    for wrong in (math.nan, math.inf, 1e300):  # one line naming the knot, no overflow warnings
+        with pytest.raises(WmrkitError, match=r"at t = 1 s: expected finite speeds within 1000 m/s"):
+            twist_program(forklift, [0.0, 1.0], [(1.0, 0.0, 0.0), (wrong, 0.0, 0.0)], allow_slip=True)
 
 
 def test_every_path_program_runs(forklift):

@@ -91,6 +91,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     omega)`` for the forklift, whose origin is at the fork tips, or any turn of a skid steer) raises
     :class:`WmrkitError` naming the knot and the wheel; :func:`feasible_twists` gives the closest feasible twists,
     and ``allow_slip=True`` commands the wheels' rolling components and lets the tyres slip (skid steering).
+    Twists are finite, their speeds within ``limits.MAX_SPEED`` [m/s] and their turn rates within as many rad/s.
 
     Rate servos on actuated wheel joints (gain ``bandwidth x`` the wheel's reflected inertia, at least the grip
     torque per 0.1 rad/s, saturated at the grip ``mu Fz r`` with mu = 1); the joints of a ``differential`` coupling
@@ -101,6 +102,11 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
 
     t = _knots(time)
     twists = np.asarray(twists, dtype=float).reshape(len(t), 3)
+    bad = ~(np.abs(twists) <= MAX_SPEED).all(axis=1)  # NaN included
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s: expected finite speeds "
+                          f"within {MAX_SPEED:g} m/s and a turn rate within {MAX_SPEED:g} rad/s")
     robot, n = model.robot, model.n
     cmd = wheel_commands(robot, twists, slip_tol=SLIP_TOL)
     if not allow_slip and not cmd.feasible.all():
