@@ -57,3 +57,29 @@ def test_the_python_source_calls_no_compiled_helper():
     py = jit.as_python(_kernels.odometry_chunk.py_func)
     helpers = [v for v in py.__globals__.values() if hasattr(v, "py_func")]
     assert helpers == []
+
+
+def test_a_changed_helper_file_drops_the_cached_kernels_that_call_it(tmp_path):
+    from wmrkit._jit import drop_stale_cache
+
+    kernel, helper, other = tmp_path / "kern.py", tmp_path / "help.py", tmp_path / "other.py"
+    for f in (kernel, helper, other):
+        f.write_text("x = 1\n")
+    cache = tmp_path / "__pycache__"
+    cache.mkdir()
+
+    def cached(module):  # as numba names them: module.qualname-line.pyXY.nbi/.nbc
+        files = [cache / f"{module}.f-3.py311.nbi", cache / f"{module}.f-3.py311.1.nbc"]
+        for f in files:
+            f.write_bytes(b"")
+        return files
+
+    first = cached("kern")
+    drop_stale_cache([str(kernel)], [str(helper)])  # no fingerprint yet: dropped
+    assert not any(f.exists() for f in first)
+    kept, unrelated = cached("kern"), cached("other")
+    drop_stale_cache([str(kernel)], [str(helper)])  # nothing changed: kept
+    assert all(f.exists() for f in kept)
+    helper.write_text("x = 2\n")
+    drop_stale_cache([str(kernel)], [str(helper)])  # the helper changed: dropped, other modules' caches kept
+    assert not any(f.exists() for f in kept) and all(f.exists() for f in unrelated)

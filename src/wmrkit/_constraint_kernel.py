@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import numba
 
-from ._jit import compile_cached, jit
+from . import wheels
+from ._jit import compile_cached, drop_stale_cache, jit
 from .wheels import slip_row_entries
 
+drop_stale_cache([__file__], [wheels.__file__])
 _entries = compile_cached(slip_row_entries, None)
 
 _IN1 = numba.types.Array(numba.float64, 1, "A", readonly=True)

@@ -10,9 +10,11 @@ it barely uses (issue 8: the first run of every command under 2 s). ``.py_func``
 from __future__ import annotations
 
 import functools
+import hashlib
 import os
 import types
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -81,3 +83,26 @@ def compile_cached(fn: Callable, signature) -> Callable:
         return numba.njit(*args, cache=True)(fn)
     except RuntimeError:  # numba: "cannot cache function ...: no locator available for file ..."
         return numba.njit(*args)(fn)
+
+
+def drop_stale_cache(kernels: Sequence[str], helpers: Sequence[str] = ()) -> None:
+    """Numba checks a cached kernel against its own file only, not against the compiled helpers it calls from other
+    files: drop the cached kernels of the `kernels` files when any of them or of the `helpers` files changed (a
+    fingerprint of their contents kept beside the cache). Call at the import of a kernel module, before any of its
+    kernels loads; an installed package never changes, so this only acts in a working copy."""
+    files = [Path(f) for f in kernels]
+    try:
+        digest = hashlib.sha256(b"".join(p.read_bytes() for p in (*files, *map(Path, helpers)))).hexdigest()
+        cache = files[0].parent / "__pycache__"
+        stamp = cache / f"{files[0].stem}.numba-stamp"
+        if stamp.exists() and stamp.read_text() == digest:
+            return
+        for f in files:
+            for cached in (f.parent / "__pycache__").glob(f"{f.stem}.*.nb[ic]"):
+                cached.unlink(missing_ok=True)
+        cache.mkdir(exist_ok=True)
+        scratch = cache / f"{stamp.name}.{os.getpid()}"
+        scratch.write_text(digest)
+        os.replace(scratch, stamp)  # atomic: processes starting together read a whole stamp or none
+    except OSError:  # a read-only installation: numba compiles in memory anyway
+        pass

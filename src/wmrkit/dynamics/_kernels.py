@@ -18,35 +18,16 @@ h, g``; ``pinv (E, 3)``: static load map when the contacts do not move (``fixed_
 
 from __future__ import annotations
 
-import hashlib
 import math
 import types
 from pathlib import Path
 
 import numba
 
-from .._jit import compile_cached
+from .._jit import compile_cached, drop_stale_cache
 from ..wheels import __file__ as wheels_file
 from ..wheels import slip_row_entries
 from . import tyres
-
-
-def _drop_stale_cache() -> None:
-    """Numba checks a cached kernel against its own file only, not against the functions it inlines (the tyre
-    formulas, the wheel rows): drop this package's cached kernels when any of those sources changed."""
-    here = Path(__file__).parent
-    sources = [here / f for f in ("_kernels.py", "_integrate.py", "tyres.py")] + [Path(wheels_file)]
-    try:
-        digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()
-        cache, stamp = here / "__pycache__", here / "__pycache__" / "dynamics-kernels.stamp"
-        if stamp.exists() and stamp.read_text() == digest:
-            return
-        for f in cache.glob("*.nb[ic]"):
-            f.unlink()
-        cache.mkdir(exist_ok=True)
-        stamp.write_text(digest)
-    except OSError:  # a read-only installation: numba compiles in memory anyway
-        pass
 
 
 def _inline(fn):
@@ -91,7 +72,7 @@ def _compiled_namespace():
     return g
 
 
-_drop_stale_cache()
+drop_stale_cache([__file__, str(Path(__file__).with_name("_integrate.py")), tyres.__file__], [wheels_file])
 _NS = _compiled_namespace()
 _linear, _coulomb, _dugoff, _pacejka = (_NS[n] for n in ("linear_forces", "coulomb_forces", "dugoff_forces",
                                                           "pacejka_forces"))

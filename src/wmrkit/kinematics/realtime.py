@@ -25,10 +25,14 @@ from typing import Any
 import numba
 import numpy as np
 
+from .._jit import drop_stale_cache
 from ..errors import WmrkitError
+from ..odometry import _kernels
 from ..odometry._kernels import _cos_sin, _sinc
 from ..robot import Robot
 from . import _ik_fast
+
+drop_stale_cache([__file__], [_kernels.__file__])
 
 HALF_PI = 0.5 * math.pi
 

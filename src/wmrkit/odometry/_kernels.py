@@ -28,8 +28,12 @@ import math
 import numba
 import numpy as np
 
+from .._jit import drop_stale_cache
 from .._jit import jit as _jit
+from . import _steering_kernels
 from ._steering_kernels import _block_segments, _configurations_from, _is_steering, _wrap
+
+drop_stale_cache([__file__], [_steering_kernels.__file__])
 
 #: Samples per block: a dozen block buffers take about 25 KB.
 BLOCK = 256

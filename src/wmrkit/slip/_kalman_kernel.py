@@ -22,9 +22,13 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from .._jit import drop_stale_cache
 from .._jit import jit as _jit
+from ..odometry import _kernels, _steering_kernels
 from ..odometry._kernels import BLOCK, _headings, _norm_rows, _positions, _rotations
 from ..odometry._steering_kernels import _block_segments, _configurations_from, _is_steering, _wrap
+
+drop_stale_cache([__file__], [_kernels.__file__, _steering_kernels.__file__])
 
 _IN = numba.types.Array(numba.float64, 2, "A", readonly=True)
 _IN1 = numba.types.Array(numba.float64, 1, "A", readonly=True)
