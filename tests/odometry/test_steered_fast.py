@@ -207,3 +207,26 @@ def test_the_configuration_lookup_finds_every_key_and_nothing_else(n_angles):
             expected = known.get(tuple(q.tolist()), -1)
             for find in (_find, _find.py_func):
                 assert find(keys, ids, q) == expected, (size, q)
+
+
+@pytest.mark.parametrize("rows", [0, 1, 2])
+def test_the_fused_two_rate_maps_give_the_row_by_row_numbers_bit_for_bit(rows):
+    from wmrkit.odometry import _kernels as k
+
+    rng = np.random.default_rng(rows)
+    maps, residual = rng.normal(size=(5, 3, 2)), rng.normal(size=(5, rows, 2))
+    cols = rng.normal(size=(2, k.BLOCK)) * rng.choice([0.0, -0.0, 1.0, 1e-300, 1e300], size=(2, k.BLOCK))
+    cuts = np.unique(np.concatenate([[0, k.BLOCK], rng.choice(k.BLOCK, 40)]))  # runs of 1 to ~20 samples
+    seg_start, seg_u = cuts.astype(np.int64), rng.integers(0, 5, len(cuts) - 1).astype(np.int64)
+    count = len(seg_u)
+    for with_dy in (False, True):
+        fused, rowwise = np.full((10, k.BLOCK), 7.0), np.full((10, k.BLOCK), 7.0)
+        k._maps_two_rates(maps, residual, seg_u, seg_start, count, cols, with_dy, fused)
+        k._apply_row(maps, 0, seg_u, seg_start, count, cols, rowwise[0])
+        if with_dy:
+            k._apply_row(maps, 1, seg_u, seg_start, count, cols, rowwise[1])
+        k._apply_row(maps, 2, seg_u, seg_start, count, cols, rowwise[2])
+        if rows:
+            k._norm_rows(residual, seg_u, seg_start, count, cols, False, rowwise[9], rowwise[3])
+        np.testing.assert_array_equal(fused[:4], rowwise[:4])
+        assert np.array_equal(np.signbit(fused[:4]), np.signbit(rowwise[:4]))  # zeros of the same sign too
