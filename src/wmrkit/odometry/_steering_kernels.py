@@ -69,6 +69,13 @@ def _find(keys, ids, value):
     return -1
 
 
+@numba.njit(inline="always")
+def _mid_angle(before, after):
+    """A steering angle at the middle of an interval from its values at the ends: the step wrapped (a turn is no
+    motion) and halved."""
+    return before + 0.5 * _wrap(after - before)
+
+
 @numba.njit
 def _steering_mid(positions, before, steer_cols, k, out):
     """Steering angles at the middle of interval `k` into `out`: the step wrapped into ``[-pi, pi)`` (as
@@ -77,7 +84,7 @@ def _steering_mid(positions, before, steer_cols, k, out):
     for s in range(steer_cols.shape[0]):
         c = steer_cols[s]
         last = before[c] if k == 0 else positions[k - 1, c]
-        mid = last + 0.5 * _wrap(positions[k, c] - last)
+        mid = _mid_angle(last, positions[k, c])
         changed = changed or mid != out[s]
         out[s] = mid
     return changed
@@ -96,7 +103,7 @@ def _block_segments(positions, before, steer_cols, block, m, keys, ids, mid, seg
         last, previous = before[c] if block == 0 else positions[block - 1, c], mid[0]
         for j in range(m):
             value = positions[block + j, c]
-            angle = last + 0.5 * _wrap(value - last)
+            angle = _mid_angle(last, value)
             last = value
             if angle != previous or j == 0:
                 u = _find_one(keys, ids, angle)
