@@ -8,7 +8,7 @@ points (``odometry()`` in chunks of 65536 samples and ``kalman_odometry()``), ea
 per steering configuration are computed on the first call and kept). Both odometries also run into preallocated
 arrays (``run_odometry(..., out=)``): a call that returns new arrays also pays the operating system's zeroing of
 their fresh pages, the same for both, which varies with the machine's memory state and pulls the ratio towards 1;
-the WLS target is met only when both ratios are. The three are timed in turn, five rounds after
+the WLS target is met only when both ratios are. All the runs are timed in turn, five rounds after
 a first one that compiles; the best wall time of each is printed, and the targets are judged on the best CPU
 times (the machine may be shared: CPU time is what the process itself spent), both ratios shown. FK2 and WLS
 also run on the same log with the steering held: the difference from the quantised log is what FK2's covariance
