@@ -284,3 +284,21 @@ def test_headings_beyond_the_described_steer_range_are_refused(capsys, tmp_path)
     with pytest.raises(SteeringError, match=r"^<log>: sample 1: steer\.steer: heading -1\.6249 rad \(-93\.1 deg\) "
                        r"outside the wheel's steer_range \[-90, 90\] deg$"):
         JointLog.from_headings(ranged, t[:2], joints[2:], np.radians([[92.9], [-93.1]]))
+
+
+def test_the_car_template_refuses_its_steering_logged_in_degrees(capsys, tmp_path):
+    """The catalog's car (``ackermann``) describes its +-40 deg steering range, so a log of its steering in degrees,
+    read as radians, is refused at its line with the hint, and runs with ``--steer degrees``."""
+    car = catalog.load("ackermann")
+    assert {w.name: w.steer_range for w in car.wheels if w.type == "steerable"} == {
+        "front_left": pytest.approx((-math.radians(40), math.radians(40))),
+        "front_right": pytest.approx((-math.radians(40), math.radians(40)))}
+    joints = odometry_model(car).joints
+    t = np.arange(4) * 0.1
+    columns = {j: (t * 3 if j.endswith(".spin") else np.array([0.0, 5.0, 10.0, 10.0])) for j in joints}
+    log = tmp_path / "car.csv"
+    write_csv(log, ("time", *joints), np.column_stack([t, *columns.values()]))
+    assert main(["odometry", "ackermann", str(log)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith("degrees read as radians? (CSV logs: --steer degrees)") and f"{log}:3: front_" in err
+    assert main(["odometry", "ackermann", str(log), "--steer", "degrees"]) == 0
