@@ -28,3 +28,88 @@ def check_python_examples(page: str, count: int) -> None:
             assert out.getvalue().split("\n")[:-1] == expected
     finally:
         os.chdir(cwd)
+
+
+#: Options whose value is a file the command writes: redirected into the test's temporary folder.
+OUTPUT_OPTIONS = ("--out", "--report", "--plot", "--animate")
+
+
+def command_examples(page: str) -> list[tuple[str, list[str]]]:
+    """Each ``$ wmrkit ...`` command of the ``` blocks of ``docs/<page>`` (continued by a trailing backslash, a
+    ``  # comment`` after it dropped) with the lines shown after it, up to the next command or the block's end."""
+    examples: list[tuple[str, list[str]]] = []
+    inside = False
+    for line in (ROOT / "docs" / page).read_text().splitlines():
+        if line.startswith("```"):
+            inside = not inside
+        elif inside and line.startswith("$ wmrkit "):
+            examples.append((line[2:], []))
+        elif inside and examples and examples[-1][0].endswith("\\") and not examples[-1][1]:
+            examples[-1] = (examples[-1][0][:-1].rstrip() + " " + line.strip(), [])
+        elif inside and examples and line.startswith("$ "):
+            examples.append(("", []))  # another program's command: its lines are not checked
+        elif inside and examples:
+            examples[-1][1].append(line.rstrip())
+        elif not inside and examples and examples[-1][1] is not None:
+            examples.append(("", []))  # the block ended: text after it is not output
+    return [(cmd.split("  #")[0].strip(), _trim(shown)) for cmd, shown in examples if cmd]
+
+
+def _trim(lines: list[str]) -> list[str]:
+    while lines and not lines[-1]:
+        lines = lines[:-1]
+    return lines
+
+
+NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def same_line(shown: str, out: str) -> bool:
+    """The same text, numbers equal within 1e-3 relative or 1e-9 absolute: round-off (a residual of 2e-16 or 5e-16,
+    the last printed digit) differs between machines, a stale number does not pass."""
+    if NUMBER.split(shown) != NUMBER.split(out):
+        return False
+    a, b = NUMBER.findall(shown), NUMBER.findall(out)
+    pairs = zip(map(float, a), map(float, b), strict=True)  # as many: the text between them is the same
+    return all(abs(x - y) <= 1e-9 + 1e-3 * abs(x) for x, y in pairs)
+
+
+def fits(shown: list[str], out: list[str]) -> bool:
+    """Whether `out` reads line by line as `shown` (:func:`same_line`), where a line ``...`` (indented or not) stands
+    for any number of lines."""
+    if not shown:
+        return not out
+    if shown[0].strip() == "...":
+        return any(fits(shown[1:], out[k:]) for k in range(len(out) + 1))
+    return bool(out) and same_line(shown[0], out[0]) and fits(shown[1:], out[1:])
+
+
+def check_command_examples(page: str, tmp_path: Path, capsys) -> int:
+    """Run every command example of ``docs/<page>`` (from the repository root, files it writes into `tmp_path`) and
+    compare: lines shown starting ``wmrkit: `` are its standard error, the others its standard output; exit code 2
+    when an error is shown, else 0. Returns the number of examples."""
+    import shlex
+
+    from wmrkit.cli.main import main
+
+    examples = command_examples(page)
+    cwd = os.getcwd()
+    os.chdir(ROOT)
+    try:
+        for command, shown in examples:
+            argv = shlex.split(command)[1:]
+            for k in range(1, len(argv)):
+                if argv[k - 1] in OUTPUT_OPTIONS:
+                    shown = [s.replace(argv[k], str(tmp_path / argv[k])) for s in shown]
+                    argv[k] = str(tmp_path / argv[k])
+            code = main(argv)
+            captured = capsys.readouterr()
+            err = [ln for ln in captured.err.splitlines() if not ln.startswith("wmrkit: compiling")]
+            out = [ln.rstrip() for ln in _trim(captured.out.splitlines())]
+            failed = any(s.startswith("wmrkit: error:") for s in shown)
+            assert code == (2 if failed else 0), (page, command, code, captured.err)
+            assert fits([s for s in shown if not s.startswith("wmrkit: ")], out), (page, command, out)
+            assert fits([s for s in shown if s.startswith("wmrkit: ")], err), (page, command, err)
+    finally:
+        os.chdir(cwd)
+    return len(examples)
