@@ -117,7 +117,7 @@ def format_commands(robot: Robot, commands: WheelCommands) -> str:
         other = ", ".join(f"{k} {v:.6g}" for k, v in entry.items() if k not in ("heading", "spin", "steer_rate"))
         heading = math.degrees(entry.get("heading", math.nan))
         lines.append(f"{w.name:<14}{w.type:<14}{_num(heading):>14}{_num(entry['spin']):>14}"
-                     f"{_num(entry['steer_rate']):>12}{_num(data['slip'][w.name]):>12}  {other}")
+                     f"{_num(entry['steer_rate']):>12}{_num(data['slip'][w.name]):>12}  {other}".rstrip())
     lines.append("feasible: " + ("yes" if data["feasible"] else "NO (a fixed wheel would slip sideways)"))
     return "\n".join(lines)
 
