@@ -1,4 +1,4 @@
-"""Timing helpers shared by the benchmark modules: best-of-N wall time and one printed line per comparison."""
+"""Helpers shared by the benchmark modules: best-of-N wall time, one printed line per comparison, the forklift log."""
 
 from __future__ import annotations
 
@@ -6,6 +6,12 @@ import importlib
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+
+import numpy as np
+
+from wmrkit import catalog
+from wmrkit.odometry.logs import JointLog
+from wmrkit.odometry.model import odometry_model
 
 
 @dataclass(frozen=True)
@@ -50,3 +56,13 @@ def peer(module: str):
         return importlib.import_module(module)
     except ImportError:
         return None
+
+
+def forklift_log(n: int) -> JointLog:
+    """A forklift log at 1 kHz: drive spins with noise, and a steering angle that wanders within +-30 encoder steps of
+    straight ahead (a random walk reflected at the ends, never jumping), quantised to the 1.4118 deg encoder."""
+    rng = np.random.default_rng(2)
+    walk = np.cumsum(rng.normal(0, 0.05, n))
+    steps = np.round(np.abs((walk - 30) % 120 - 60) - 30)  # reflected into [-30, 30]
+    pos = np.column_stack([np.cumsum(rng.normal(0.01, 0.001, size=(n, 2)), axis=0), np.radians(90 + 1.4118 * steps)])
+    return JointLog(np.arange(n) * 1e-3, odometry_model(catalog.load("forklift")).joints, pos)

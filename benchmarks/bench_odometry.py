@@ -24,7 +24,7 @@ from wmrkit.odometry.model import odometry_model
 from wmrkit.odometry.pipeline import odometry, run_odometry
 from wmrkit.odometry.trajectories import Trajectory
 
-from ._harness import Result, best_time, peer
+from ._harness import Result, best_time, forklift_log, peer
 
 
 def _diff_log(n: int) -> JointLog:
@@ -117,10 +117,7 @@ def run(quick: bool) -> list[Result]:
 
     fork = catalog.load("forklift")
     nf = n // 10
-    rng = np.random.default_rng(2)
-    steer = np.radians(90 + 1.4118 * np.round(np.cumsum(rng.normal(0, 0.05, nf)) % 60 - 30))
-    fpos = np.column_stack([np.cumsum(rng.normal(0.01, 0.001, size=(nf, 2)), axis=0), steer])
-    flog = JointLog(np.arange(nf) * 1e-3, odometry_model(fork).joints, fpos)
+    flog = forklift_log(nf)
     ours = best_time(lambda: odometry(fork, flog), repeat=3)
     results.append(Result("odometry exact: forklift, quantised steering", nf, ours, "none (no tricycle peer)", None))
 

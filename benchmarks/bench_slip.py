@@ -29,18 +29,9 @@ from wmrkit.odometry.trajectories import Trajectory
 from wmrkit.slip.kalman import fk2_noise, kalman_model, kalman_odometry
 from wmrkit.slip.weights import SlipWeights, wls_model
 
-from ._harness import Result
+from ._harness import Result, forklift_log
 
 CHUNK = 1 << 16  # as odometry()
-
-
-def forklift_log(n: int) -> JointLog:
-    """A forklift log at 1 kHz: drive spins with noise, steering quantised to 1.4118 deg."""
-    fork = catalog.load("forklift")
-    rng = np.random.default_rng(2)
-    steer = np.radians(90 + 1.4118 * np.round(np.cumsum(rng.normal(0, 0.05, n)) % 60 - 30))
-    pos = np.column_stack([np.cumsum(rng.normal(0.01, 0.001, size=(n, 2)), axis=0), steer])
-    return JointLog(np.arange(n) * 1e-3, odometry_model(fork).joints, pos)
 
 
 def _best_times(fns: dict, rounds: int = 5) -> tuple[dict, dict]:
