@@ -168,6 +168,29 @@ def test_quaternions_and_yaw():
     np.testing.assert_allclose(q, scipy_rot.from_euler("z", theta[:, None]).as_quat(), atol=1e-15)
 
 
+def test_yaw_of_any_nonzero_quaternion_is_scipys():
+    """The yaw of quaternions of any attitude and any nonzero norm (1e-3 .. 1e200) is the Z angle of scipy's ZYX
+    Euler angles of the normalised quaternion; the unit-only form got a scaled one wrong."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(3)
+    q = rng.normal(size=(200, 4))
+    expected = Rotation.from_quat(q).as_euler("ZYX")[:, 0]  # scipy normalises, (x, y, z, w) order as ours
+    for scale in (1e-3, 1.0, 7.5, 1e200):
+        np.testing.assert_allclose(yaw_of_quaternion(q * scale), expected, atol=1e-12)
+
+
+def test_trajectory_files_with_non_finite_values_are_refused_at_their_pose(tmp_path):
+    tum = tmp_path / "t.tum"
+    tum.write_text("0 0 0 0 0 0 0 1\n1 1 0 0 0 0 inf 1\n")
+    with pytest.raises(LogError, match=r"t\.tum: pose 2: the quaternion must be finite numbers$"):
+        read_tum(tum)
+    csv = tmp_path / "t.csv"
+    csv.write_text("time,x,y,theta,slip\n0,0,0,0,0\n1,1,0,nan,0\n")
+    with pytest.raises(LogError, match=r"t\.csv: pose 2: theta, slip and the covariance must be finite numbers$"):
+        read_trajectory_csv(csv)
+
+
 def test_trajectory_files_round_trip(tmp_path):
     rng = np.random.default_rng(0)
     n = 30

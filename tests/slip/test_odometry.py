@@ -97,6 +97,28 @@ def test_cli_refuses_bad_estimator_options(tmp_path, capsys, forklift_run):
         assert err.startswith("wmrkit: error:") and message in err, err
 
 
+def test_a_filter_that_lags_a_spike_warns_in_one_line_without_naming_wheels(tmp_path, capsys):
+    """A differential drive's two spins cannot contradict each other (no redundancy: the no-slip residual has no
+    rows), but a filter lags a spike in the log and its residual says so: one warning line, no wheel named (this
+    used to raise an IndexError from the per-wheel slip)."""
+    from wmrkit.odometry.model import odometry_model, wheel_slip
+
+    robot = catalog.load("diff-drive")
+    model = odometry_model(robot)
+    t = np.arange(50) * 0.02
+    spins = np.column_stack([t * 10, t * 12])
+    spins[7, 0] = 0.0  # one reading dropped to zero
+    assert wheel_slip(model, spins) == {}
+    path = tmp_path / "spike.csv"
+    write_log(path, JointLog(t, model.joints, spins), robot)
+    capsys.readouterr()
+    assert main(["odometry", "diff-drive", str(path), "--method", "fk2", "--json"]) == 0
+    captured = capsys.readouterr()
+    assert json.loads(captured.out)["consistent"] is False
+    assert captured.err.count("\n") == 1 and captured.err.startswith("wmrkit: warning: the sensed joints contradict")
+    assert "slip per wheel" not in captured.err
+
+
 def test_filter_refuses_a_non_increasing_log():
     robot = catalog.load("diff-drive")
     log = JointLog(np.array([0.0, 0.1, 0.1]), ("left.spin", "right.spin"), np.zeros((3, 2)))

@@ -438,8 +438,11 @@ def frozen(a: ArrayLike) -> np.ndarray:
 
 def wheel_slip(model: OdometryModel, positions: ArrayLike) -> dict[str, float]:
     """RMS slip per wheel [m per interval] over consecutive joint positions ``(N + 1, n_joints)`` (``model.joints``):
-    the residual rows (4.11) of each wheel's contacts. Names the wheels whose sensors disagree with the others."""
-    res = model.from_positions(positions).residual  # (N, R) over model.rows
+    the residual rows (4.11) of each wheel's contacts. Names the wheels whose sensors disagree with the others; none
+    when the sensors have no redundancy (they cannot disagree)."""
+    res = model.from_positions(positions).residual  # (N, R) over model.rows, (N, 0) without redundancy
+    if res.shape[1] == 0:
+        return {}
     robot = model.robot
     owner = robot.row_wheels[model.rows]
     out = {}

@@ -51,10 +51,13 @@ def quaternion_z(theta: np.ndarray) -> np.ndarray:
 
 
 def yaw_of_quaternion(q: np.ndarray) -> np.ndarray:
-    """Yaw [rad] of quaternions ``(qx, qy, qz, qw)`` (ZYX convention). ``(..., 4) -> (...)``."""
+    """Yaw [rad] of quaternions ``(qx, qy, qz, qw)`` (ZYX convention), of any nonzero finite norm: the homogeneous
+    form ``atan2(2 (w z + x y), w^2 + x^2 - y^2 - z^2)`` after scaling by the largest component (the unit form's
+    ``1 - 2 (y^2 + z^2)`` is wrong for a quaternion that is not normalised). ``(..., 4) -> (...)``."""
     q = np.asarray(q, dtype=float)
-    x, y, z, w = (q[..., i] for i in range(4))
-    return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    scale = np.max(np.abs(q), axis=-1, keepdims=True)
+    x, y, z, w = np.moveaxis(q / np.where(scale > 0, scale, 1.0), -1, 0)
+    return np.arctan2(2 * (w * z + x * y), (w * w + x * x) - (y * y + z * z))
 
 
 class TrajectoryWriter:
@@ -112,6 +115,7 @@ def read_tum(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
     if data.shape[1] != 8:
         raise LogError(f"{os.fspath(path)}: a TUM file has 8 columns, got {data.shape[1]}")
     _check_samples(path, data[:, 0], data[:, 1:4])
+    _check_finite(path, data[:, 4:8], "the quaternion")
     norm = np.linalg.norm(data[:, 4:8], axis=1)
     if np.any(norm < 1e-6):
         raise LogError(f"{os.fspath(path)}: pose {int(np.argmax(norm < 1e-6)) + 1}: the quaternion is (almost) zero")
@@ -137,10 +141,7 @@ def _load_table(path: str | os.PathLike[str], **options) -> np.ndarray:
 
 def _check_samples(path: str | os.PathLike[str], t: np.ndarray, position: np.ndarray) -> None:
     """Times finite and strictly increasing, positions finite within :data:`wmrkit.limits.MAX_COORDINATE`."""
-    finite = np.isfinite(np.column_stack([t, position])).all(axis=1)
-    if not finite.all():
-        raise LogError(f"{os.fspath(path)}: pose {int(np.argmin(finite)) + 1}: times and positions must be finite "
-                       "numbers")
+    _check_finite(path, np.column_stack([t, position]), "times and positions")
     if np.abs(position).max() > MAX_COORDINATE:
         raise LogError(f"{os.fspath(path)}: pose {int(np.argmax(np.abs(position).max(axis=1))) + 1}: a coordinate "
                        f"beyond {MAX_COORDINATE:g} m")
@@ -148,6 +149,13 @@ def _check_samples(path: str | os.PathLike[str], t: np.ndarray, position: np.nda
         k = int(np.argmax(np.diff(t) <= 0))
         raise LogError(f"{os.fspath(path)}: pose {k + 2}: time {float(t[k + 1])!r} s does not increase (after "
                        f"{float(t[k])!r} s)")
+
+
+def _check_finite(path: str | os.PathLike[str], values: np.ndarray, what: str) -> None:
+    """Every row of `values` ``(N, k)`` finite, or a :class:`LogError` naming the file, the pose and `what`."""
+    finite = np.isfinite(values).all(axis=1)
+    if not finite.all():
+        raise LogError(f"{os.fspath(path)}: pose {int(np.argmin(finite)) + 1}: {what} must be finite numbers")
 
 
 def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
@@ -162,6 +170,7 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
     _check_samples(path, data[:, 0], data[:, 1:3])
     if header[:5] != ["time", "x", "y", "theta", "slip"]:
         raise LogError(f"{os.fspath(path)}:1: expected the columns time,x,y,theta,slip, got {','.join(header)}")
+    _check_finite(path, data[:, 3:], "theta, slip and the covariance")
     cov = None
     if len(header) == 11:
         cov = np.zeros((len(data), 3, 3))
