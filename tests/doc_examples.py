@@ -6,6 +6,7 @@ import contextlib
 import io
 import os
 import re
+import shlex
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -38,21 +39,22 @@ def command_examples(page: str) -> list[tuple[str, list[str]]]:
     """Each ``$ wmrkit ...`` command of the ``` blocks of ``docs/<page>`` (continued by a trailing backslash, with
     its ``  # comment``) with the lines shown after it, up to the next command or the block's end."""
     examples: list[tuple[str, list[str]]] = []
-    inside = False
+    inside, shown = False, None  # shown: the lines after the command being read, None when none is
     for line in (ROOT / "docs" / page).read_text().splitlines():
         if line.startswith("```"):
-            inside = not inside
-        elif inside and line.startswith("$ wmrkit "):
-            examples.append((line[2:], []))
-        elif inside and examples and examples[-1][0].endswith("\\") and not examples[-1][1]:
-            examples[-1] = (examples[-1][0][:-1].rstrip() + " " + line.strip(), [])
-        elif inside and examples and line.startswith("$ "):
-            examples.append(("", []))  # another program's command: its lines are not checked
-        elif inside and examples:
-            examples[-1][1].append(line.rstrip())
-        elif not inside and examples and examples[-1][1] is not None:
-            examples.append(("", []))  # the block ended: text after it is not output
-    return [(cmd.strip(), _trim(shown)) for cmd, shown in examples if cmd]
+            inside, shown = not inside, None
+        elif not inside:
+            continue
+        elif line.startswith("$ wmrkit "):
+            shown = []
+            examples.append((line[2:], shown))
+        elif shown == [] and examples[-1][0].endswith("\\"):
+            examples[-1] = (examples[-1][0][:-1].rstrip() + " " + line.strip(), shown)
+        elif line.startswith("$ "):
+            shown = None  # another program's command: its lines are not checked
+        elif shown is not None:
+            shown.append(line.rstrip())
+    return [(cmd.strip(), _trim(lines)) for cmd, lines in examples]
 
 
 def _trim(lines: list[str]) -> list[str]:
@@ -93,8 +95,6 @@ def check_command_examples(page: str, tmp_path: Path, capsys) -> int:
     when an error is shown, else 0. A comment ``# numbers within N %`` on the command widens the numbers' tolerance
     (a closed loop that amplifies round-off, which differs with how the kernels were compiled). Returns the number
     of examples."""
-    import shlex
-
     from wmrkit.cli.main import main
 
     examples = command_examples(page)

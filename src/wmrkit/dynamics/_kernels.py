@@ -38,25 +38,24 @@ from . import tyres
 FASTMATH = ("nnan", "ninf", "nsz")
 
 
+def _compile(fn, inline: str = "never", nrt: bool = True):
+    """``numba.njit`` with the :data:`FASTMATH` flags, cached on disk where possible."""
+    try:
+        return numba.njit(cache=True, fastmath=set(FASTMATH), inline=inline, _nrt=nrt)(fn)
+    except RuntimeError:  # no writable cache location
+        return numba.njit(fastmath=set(FASTMATH), inline=inline, _nrt=nrt)(fn)
+
+
 def _inline(fn):
     """Compiled and inlined into its callers (no call boundary: the model's arrays are not re-counted per call)."""
-    try:
-        return numba.njit(cache=True, inline="always", fastmath=set(FASTMATH))(fn)
-    except RuntimeError:  # no writable cache location
-        return numba.njit(inline="always", fastmath=set(FASTMATH))(fn)
+    return _compile(fn, inline="always")
 
 
-def _njit(fn, fastmath: bool = True, nrt: bool = True):
-    """Compiled for the types of its first call, cached on disk where possible (:func:`wmrkit._jit.compile_cached`);
-    `fastmath`: with the flags :data:`FASTMATH`, else plain IEEE arithmetic (:func:`compile_cached`). ``nrt=False``
-    compiles without numba's reference counting: for the time-stepping loops, which allocate nothing and would
-    otherwise count references to every model and work array at every step (half the cost of a step)."""
-    if not fastmath:
-        return compile_cached(fn, None)
-    try:
-        return numba.njit(cache=True, fastmath=set(FASTMATH), _nrt=nrt)(fn)
-    except RuntimeError:  # no writable cache location
-        return numba.njit(fastmath=set(FASTMATH), _nrt=nrt)(fn)
+def _njit(fn, nrt: bool = True):
+    """Compiled for the types of its first call (:func:`_compile`). ``nrt=False`` compiles without numba's reference
+    counting: for the time-stepping loops, which allocate nothing and would otherwise count references to every model
+    and work array at every step (half the cost of a step)."""
+    return _compile(fn, nrt=nrt)
 
 
 def _identity(x):
