@@ -255,13 +255,21 @@ def _compiled_kernels() -> Iterator[None]:
         _jit.INTERPRET_BUDGET = saved
 
 
+#: Most worker processes of an embedded cluster per CPU: each is a Python process of about 100 MB, and more of
+#: them than CPUs only share the same cores.
+WORKERS_PER_CPU = 4
+
+
 def engine(scheduler: str | Any | None = None, workers: int | None = None, *, retries: int = 2,
            quiet: bool = False) -> Engine:
     """An :class:`Engine`: `scheduler` an address (``tcp://host:8786``) or a ``distributed.Client``; else, with
     ``workers`` 0 a serial engine, otherwise an embedded ``LocalCluster`` of `workers` processes (default: the
-    CPU count), one thread each. Without Dask installed and no scheduler: serial, with one line on stderr."""
-    if workers is not None and workers < 0:
-        raise BatchError(f"--workers must be >= 0, got {workers}")
+    CPU count, at most :data:`WORKERS_PER_CPU` per CPU), one thread each. Without Dask installed and no scheduler:
+    serial, with one line on stderr."""
+    cpus = os.cpu_count() or 1
+    if workers is not None and not 0 <= workers <= WORKERS_PER_CPU * cpus:
+        raise BatchError(f"--workers must be in [0, {WORKERS_PER_CPU * cpus}] ({WORKERS_PER_CPU} per CPU of this "
+                         f"machine; a larger fleet needs a cluster: --scheduler), got {workers}")
     if scheduler is None and workers == 0:
         return Engine("serial", retries=retries)
     if scheduler is None:
@@ -271,7 +279,7 @@ def engine(scheduler: str | Any | None = None, workers: int | None = None, *, re
             if not quiet:
                 print(f"wmrkit: {err}; running serially", file=sys.stderr)
             return Engine("serial", retries=retries)
-        n = workers or os.cpu_count() or 1
+        n = workers or cpus
         # ":0": the scheduler's HTTP server (and the dashboard, when bokeh is installed) on a free port, so that
         # several batches on one machine do not compete for port 8787
         with need_extra("dask").config.set(LOCAL_CLUSTER_CONFIG), _unset_env("MALLOC_TRIM_THRESHOLD_"):

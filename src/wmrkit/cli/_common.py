@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
+from pathlib import Path
 from typing import Any
 
 from .. import catalog
@@ -50,6 +52,40 @@ def check_plot_path(path: str | None, what: str = "--plot") -> None:
         from ..plotting.files import check_figure_path
 
         check_figure_path(path, what)
+
+
+#: Options naming a file a command writes, and those naming a folder it writes into (created with its parents when
+#: missing); ``--codegen LANG DIR`` names a folder too.
+OUTPUT_FILES, OUTPUT_FOLDERS = ("out", "plot", "animate"), ("report", "trajectories")
+
+
+def check_outputs(args: argparse.Namespace) -> None:
+    """Refuse, before any work, an output the command could not write: a file whose folder is missing or not
+    writable, or that is a folder; a folder that is a file, or whose nearest existing parent is not writable."""
+    given = [(f"--{dest}", getattr(args, dest), False) for dest in (*OUTPUT_FILES, *OUTPUT_FOLDERS)
+             if getattr(args, dest, None) is not None]
+    given = [(what, path, what[2:] in OUTPUT_FOLDERS) for what, path, _ in given]
+    if getattr(args, "codegen", None):
+        given.append(("--codegen", args.codegen[1], True))
+    for what, path, folder in given:
+        problem = output_problem(path, folder)
+        if problem:
+            raise WmrkitError(f"{what} {path}: {problem}")
+
+
+def output_problem(path: str, folder: bool) -> str | None:
+    """Why `path` cannot be written as a file (or, with `folder`, as a folder), or None."""
+    if not path.strip():
+        return "empty name"
+    p = Path(path)
+    if p.exists() and p.is_dir() != folder:
+        return "is a folder" if not folder else "is a file, not a folder"
+    parent = p.parent if not folder else next(a for a in (p, *p.parents) if a.exists())
+    if not parent.is_dir():
+        return f"no such folder '{parent}'" if not parent.exists() else f"'{parent}' is not a folder"
+    if not os.access(p if folder and p.exists() else parent, os.W_OK | os.X_OK):
+        return f"cannot write into '{p if folder and p.exists() else parent}' (permission denied)"
+    return None
 
 
 def parse_value(text: str, kind: Kind, what: str) -> float:

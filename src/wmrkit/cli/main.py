@@ -10,6 +10,7 @@ import threading
 from typing import NoReturn
 
 from ..errors import DescriptionError, WmrkitError
+from ._common import check_outputs
 
 #: Each command and the module of ``wmrkit.cli`` that registers it (``add_parsers``), in ``--help`` order.
 COMMANDS = {
@@ -59,9 +60,15 @@ def main(argv: list[str] | None = None) -> int:
         threading.Thread(target=_compile_notice, args=(done,), daemon=True).start()
     try:
         args = build_parser(command).parse_args(argv)
+        check_outputs(args)
         return int(args.run(args) or 0)
     except WmrkitError as err:
         report_error(err, as_json)
+        return 2
+    except OSError as err:
+        if err.filename is None:  # not about a file: a bug, with its traceback
+            raise
+        report_error(WmrkitError(f"{err.filename}: {err.strerror or err}"), as_json)  # e.g. a full disk
         return 2
     except BrokenPipeError:  # e.g. `wmrkit robots | head`
         return 0

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..wheels import beta_from_heading, heading_from_beta
 from .laws import PositionLaw
-from .loop import TwistController
+from .loop import TwistController, check_command
 from .points import ControlError, ControlPoint
 from .references import Reference
 from .tick import scalar_law
@@ -67,6 +67,7 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
     for k in range(n):
         t = k * period
         twist, de = controller(t, history[max(0, k - delay)], integral)
+        check_command(twist, t)
         integral = integral + period * de
         ik(float(twist[0]), float(twist[1]), float(twist[2]), described, rates, heading)  # = wheel_commands(twist)
         stepper.hold(rate_reference, heading)

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..kinematics.wheel_ik import forward_kinematics, wheel_commands
+from ..limits import MAX_SPEED
 from ..robot import Robot
 from .actuators import LowLevelLoops
 from .laws import PositionLaw, law_velocity, pose_error
@@ -30,6 +31,16 @@ __all__ = ["Plant", "TwistController", "law_controller", "simulate"]
 
 #: ``(t, measured pose (3,), integral (3,)) -> (twist_robot (3,), d integral / dt (3,))``.
 TwistController = Callable[[float, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
+
+
+def check_command(twist: np.ndarray, t: float) -> None:
+    """Refuse a law's twist beyond ``limits.MAX_SPEED`` (m/s, rad/s) at `t`: a loop through the dynamics has
+    diverged (the plant would be driven far outside any robot's envelope, slowly and meaninglessly)."""
+    if not np.all(np.abs(twist) <= MAX_SPEED):  # NaN included
+        raise ControlError(f"the loop diverged: at t = {t:.6g} s the law commands the twist "
+                           f"{tuple(float(v) for v in twist)}, beyond {MAX_SPEED:g} m/s or rad/s; lower the gain or "
+                           "the period")
+
 
 #: Evaluations of the continuous loop allowed: a base plus this many per simulated second (the examples take
 #: about 100 per second; a start kilometres off the reference makes the loop stiff and takes thousands).

@@ -30,7 +30,7 @@ from ..kinematics.wheel_ik import WheelCommands
 from ..robot import Robot
 from ..slip.kalman import KalmanNoise
 from ..slip.weights import SlipWeights
-from .loop import TwistController
+from .loop import TwistController, check_command
 from .points import ControlError
 from .slip_control import SLIP_MODELS, SlipCommander, SlipInverse, _Forward, slip_inverse
 
@@ -90,6 +90,7 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     for k in range(n):
         t = k * period
         twist, de = controller(t, history[max(0, k - delay)], integral)
+        check_command(twist, t)
         integral = integral + period * de
         beta_now = s[steer].copy()
         if commander is None:

@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..errors import WmrkitError
+from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .model import DynamicModel
@@ -269,12 +270,21 @@ def advance(model: Robot | DynamicModel, state: ArrayLike, inputs: Inputs, durat
 
 
 def initial_state(model: DynamicModel, twist: ArrayLike = (0, 0, 0), pose: ArrayLike = (0, 0, 0)) -> np.ndarray:
-    """State ``(2n,)`` rolling without slip at `twist`: pose, joint positions (steering at IK angles), velocities."""
+    """State ``(2n,)`` rolling without slip at `twist`: pose, joint positions (steering at IK angles), velocities.
+
+    The twist's speeds and turn rate are within ``limits.MAX_SPEED`` (m/s, rad/s), the pose's position within
+    ``limits.MAX_COORDINATE`` and its heading finite."""
     from ..kinematics.wheel_ik import wheel_commands
 
-    twist, n = as_vectors(twist, 3, "initial_twist"), model.n
+    twist, pose, n = as_vectors(twist, 3, "initial_twist"), as_vectors(pose, 3, "initial_pose"), model.n
+    if twist.shape != (3,) or not np.all(np.abs(twist) <= MAX_SPEED):  # NaN included
+        raise WmrkitError(f"initial twist {twist.tolist()}: expected three finite numbers, speeds within "
+                          f"{MAX_SPEED:g} m/s and a turn rate within {MAX_SPEED:g} rad/s")
+    if pose.shape != (3,) or not (np.all(np.abs(pose[:2]) <= MAX_COORDINATE) and math.isfinite(pose[2])):
+        raise WmrkitError(f"initial pose {pose.tolist()}: expected a position within {MAX_COORDINATE:g} m and a "
+                          "finite heading")
     s = np.zeros(2 * n)
-    s[:3] = as_vectors(pose, 3, "initial_pose")
+    s[:3] = pose
     beta = np.array(model.robot.beta, dtype=float)
     s[n:n + 3] = twist
     if np.any(twist != 0):
