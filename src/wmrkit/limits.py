@@ -24,8 +24,13 @@ MAX_COORDINATE = 1e9
 #: Largest file read whole into memory [bytes]: trajectories (TUM, CSV), references, torque files. Joint logs are
 #: read in chunks and have no such limit.
 MAX_TABLE_SIZE = 1 << 26
+#: Most samples of a joint log read at once (``chunk_size``): the chunks bound the memory of a log of any length.
+MAX_CHUNK = 1 << 22
 #: Fastest speed a command or program may ask of a wheeled robot [m/s].
 MAX_SPEED = 1e3
+#: Largest speed [m/s], turn rate [rad/s] or joint rate [rad/s] a kinematic query accepts (``wmrkit ik --twist``,
+#: ``fk --spin``, the studio's drive): far beyond any wheeled robot, and small enough that no result overflows.
+MAX_QUERY_RATE = 1e6
 #: Most wheels in a robot: the chapter-4 searches grow combinatorially with the wheel count.
 MAX_WHEELS = 64
 #: Longest robot and wheel names, and notes [characters]: they are printed in tables and reports.
@@ -40,6 +45,20 @@ ANGLE_MARGIN = math.radians(1.0)
 
 #: Control characters (C0, DEL, C1) and lone surrogates (bytes that are not UTF-8): they break printing.
 _CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff]")
+
+
+def check_seed(seed: object, error: type[Exception], what: str = "seed") -> None:
+    """Raise `error` unless `seed` is an integer >= 0 (what numpy's generators take)."""
+    import numpy as np
+
+    if isinstance(seed, bool) or not (isinstance(seed, int | np.integer) and seed >= 0):
+        raise error(f"{what} must be an integer >= 0, got {seed!r}")
+
+
+def check_chunk_size(chunk_size: object, error: type[Exception], what: str = "chunk_size") -> None:
+    """Raise `error` unless `chunk_size` is a number of samples in ``[1, MAX_CHUNK]``."""
+    if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or not 1 <= chunk_size <= MAX_CHUNK:
+        raise error(f"{what} must be in [1, {MAX_CHUNK}] samples (it bounds the memory), got {chunk_size}")
 
 
 def check_table_size(path: str | os.PathLike[str], error: type[Exception], what: str) -> None:

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq
 from thesis_vehicles import DEG, omni_castor, omni_swedish, robot
@@ -16,12 +16,13 @@ from wmrkit import UnknownNameError, catalog
 from wmrkit.analysis.icr import steer_to_icr
 from wmrkit.analysis.lines import constraint_lines, line_through
 from wmrkit.analysis.singularity import (
+    SINGULAR_RTOL,
     is_singular,
     is_singular_rank,
     singular_set,
     singularity_distance,
 )
-from wmrkit.kinematics.linalg import matrix_rank
+from wmrkit.kinematics.linalg import RANK_RTOL, matrix_rank, nondimensional
 
 
 @st.composite
@@ -38,10 +39,23 @@ def cases(draw):
     return r, assigned, beta
 
 
+def numerical_tie(r, beta, assigned) -> bool:
+    """Whether either test's decision changes when its tolerance is 100 times larger or smaller: the two tests
+    measure closeness to singularity differently, and agree away from such ties (e.g. two fixed wheels at one point
+    whose axles differ by 1.2e-7 rad: rank test singular, line test not)."""
+    line = {bool(is_singular(r, beta, assigned, rtol=SINGULAR_RTOL * f)) for f in (1e-2, 1e2)}
+    cols = [r.velocity_index(n) for n in assigned]
+    a = nondimensional(r).constraint_matrix(beta)
+    free = a[..., [j for j in range(a.shape[-1]) if j not in cols]]
+    rank = {int(matrix_rank(free, rtol=RANK_RTOL * f)) for f in (1e-2, 1e2)}
+    return len(line) > 1 or len(rank) > 1
+
+
 @settings(max_examples=300)
 @given(cases())
 def test_line_test_equals_rank_test_on_random_robots(case):
     r, assigned, beta = case
+    assume(not numerical_tie(r, beta, assigned))
     assert bool(is_singular(r, beta, assigned)) == bool(is_singular_rank(r, beta, assigned))
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -42,6 +43,7 @@ WRITERS = [
     ["track", "diff-drive", "--reference", "circle", "--animate"],
     ["feasibility", "forklift", "--reference", "square", "--plot"],
 ]
+VISION = Path(__file__).parents[2] / "docs" / "figures" / "vision"
 FOLDER_OPTIONS = {f"--{d}" for d in OUTPUT_FOLDERS} | {"--codegen"}
 
 
@@ -148,3 +150,50 @@ def test_a_loop_through_the_dynamics_that_diverges_is_stopped_at_once(model, cap
     message = _one_line(["track", "skid-steer-4", "--reference", "circle", "--size", "2", "--dynamics", "--period",
                          "0.05", "--slip-model", model, "--duration", "5", "--gain", "2147483648"], capsys)
     assert "the loop diverged: at t = 0.05 s" in message and "beyond 1000 m/s" in message
+
+
+@pytest.mark.parametrize("loop", [["--period", "0.05"], ["--dynamics", "--period", "0.05"],
+                                  ["--dynamics", "--period", "0.05", "--slip-model", "mqe"]])
+def test_a_negative_delay_is_refused_by_every_loop(loop, capsys):
+    # the loop with slip-model commands indexed its history with it (a traceback)
+    message = _one_line(["track", "skid-steer-4", "--reference", "circle", "--duration", "1", *loop, "--delay", "-1"],
+                        capsys)
+    assert "delay: expected a number of samples >= 0, got -1" in message
+
+
+@pytest.mark.parametrize("argv, expected", [
+    # a traceback from islice before
+    (["odometry", "diff-drive", "log.csv", "--chunk-size", "99999999999999999999999"],
+     "--chunk-size must be in [1, 4194304] samples"),
+    # ran forever before (1e23 bootstrap refits)
+    (["batch", "calibrate", "diff-drive", "log.csv", "--closed", "--workers", "0", "--ci", "bootstrap", "--bootstrap",
+      "99999999999999999999999"], "--bootstrap must be in [2, 10000] replicates"),
+    (["slip-study", "forklift", "--quick", "--seed", "-1"], "seed must be an integer >= 0, got -1"),  # a traceback
+    (["slip-study", "skid-steer-4", "--seed", "3"], "--seed applies to the forklift study"),  # ignored before
+    (["slip-study", "skid-steer-4", "--quick"], "--quick applies to the forklift study"),
+    (["slip-study", "forklift", "--source", "md"], "--source applies to the skid-steer-4 study"),
+    (["vision", "calibrate", "image.png", "--rows", "60", "--half-separation", "0.035", "--row-distance", "0.1",
+      "--size", "0", "0"], "--size applies to --x1/--x2"),  # ignored before
+    (["vision", "locate", "--points", f"{VISION}/chufa-points.json", "--camera", f"{VISION}/chufa-camera.yaml",
+      "--lines", "2"], "--lines applies to an IMAGE"),  # ignored before
+    (["vision", "locate", "--points", f"{VISION}/chufa-points.json", "--camera", f"{VISION}/chufa-camera.yaml",
+      "--mode", "gradient"], "--mode applies to an IMAGE"),  # ignored before
+    (["vision", "locate", "--points", "", "--camera", f"{VISION}/chufa-camera.yaml"], "cannot read"),  # TypeError
+    # 18849 s of loop at 1 mm/s: about an hour of slip-model solves before
+    (["track", "skid-steer-4", "--reference", "circle", "--dynamics", "--slip-model", "mqe", "--speed", "1e-3"],
+     "more than 50000 control periods with slip-model commands"),
+    (["track", "skid-steer-4", "--reference", "circle", "--dynamics", "--period", "0.1", "--duration", "60000"],
+     "more than 5e+07 integration steps"),
+])
+def test_options_that_ran_unbounded_or_were_ignored_are_refused(argv, expected, capsys):
+    assert expected in _one_line(argv, capsys)
+
+
+def test_library_checks_of_the_same_limits():
+    from wmrkit.batch.calibrate import fleet_calibrate
+    from wmrkit.odometry.logs import read_csv
+
+    with pytest.raises(WmrkitError, match="chunk_size must be in"):
+        next(read_csv("log.csv", ("left.spin",), chunk_size=0))
+    with pytest.raises(WmrkitError, match="n_boot must be in"):
+        fleet_calibrate(catalog.load("diff-drive"), [object()], [], ci="bootstrap", n_boot=10**9)

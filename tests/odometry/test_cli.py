@@ -123,9 +123,9 @@ def test_gyro_heading(capsys, tmp_path, diff_run):
     ("ok", ["--pose", "0", "0", "abc"], r"--pose: cannot read 'abc' as an angle"),
     ("ok", ["--sensed", "left.spin"], r"do not determine its motion"),
     ("ok", ["--max-gap", "0.01"], r"x\.csv:3: time step of 0\.05 s exceeds max_gap"),
-    ("ok", ["--out", "/nonexistent/dir/t.csv"], r"cannot write"),
+    ("ok", ["--out", "/nonexistent/dir/t.csv"], r"--out /nonexistent/dir/t.csv: no such folder '/nonexistent/dir'"),
     ("ok", ["--plot", "p.gif"], r"plot files are \.png, \.svg, \.pdf"),
-    ("ok", ["--chunk-size", "0"], r"--chunk-size must be >= 1"),
+    ("ok", ["--chunk-size", "0"], r"--chunk-size must be in \[1, 4194304\] samples"),
     ("ok", ["--weight", "left=-1"], r"weight of wheel 'left' must be a finite number > 0"),
     ("missing", [], r"no such file"),
 ])

@@ -207,10 +207,18 @@ def test_drive_keeps_current_heading(client):
     {"twist": [1, 2]}, {"twist": [1, 2, "inf"]}, {"twist": [True, 0, 0]}, {"twist": "fast"},
     {"twist": [0, 0, 0], "heading": {"left": 0.2}}, {"twist": [0, 0, 0], "heading": [1]},
     {"twist": [0, 0, 0], "duration": -1}, {"twist": [0, 0, 0], "samples": 10**9},
+    {"twist": [0.5, 1.0, "1e308"]}, {"twist": [1.1e6, 0, 0]},  # omni-3 answered 500 (math domain error) for 1e308
 ])
 def test_drive_bad_input(client, body):
     r = client.post("/api/drive", json={"description": desc("diff-drive"), **body})
     assert r.status_code == 400 and r.json()["error"]
+
+
+def test_drive_takes_twists_up_to_the_query_limit(client):
+    for twist, status in (([1e6, 0, -1e6], 200), ([0.5, 1.0, 1e308], 400), ([0, -1.1e6, 0], 400)):
+        r = client.post("/api/drive", json={"description": desc("omni-3"), "twist": twist})  # 1e308: a 500 before
+        assert r.status_code == status, r.json()
+        assert status == 400 or all(w["spin"] is not None for w in r.json()["wheels"].values())
 
 
 # ---- κ map and configurations ---------------------------------------------------------------------------------

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from ..limits import check_seed
 from ..odometry.calibration import (
     CalibrationProblem,
     CalibrationRun,
@@ -99,6 +100,16 @@ def _refit(problem: CalibrationProblem) -> np.ndarray:
     return problem.fit()
 
 
+#: Most bootstrap replicates (each refits every run): percentile intervals settle within a few thousand.
+MAX_BOOTSTRAP = 10_000
+
+
+def check_bootstrap(n_boot: int, what: str = "n_boot") -> None:
+    """A number of bootstrap replicates in ``[2, MAX_BOOTSTRAP]``."""
+    if isinstance(n_boot, bool) or not isinstance(n_boot, int) or not 2 <= n_boot <= MAX_BOOTSTRAP:
+        raise BatchError(f"{what} must be in [2, {MAX_BOOTSTRAP}] replicates, got {n_boot}")
+
+
 def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence[Parameter], *,
                     runner: Engine | None = None, ci: str = "jacobian", level: float = 0.95, n_boot: int = 200,
                     seed: int = 0, method: str = "exact", heading_weight: float = 1.0,
@@ -111,6 +122,9 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
         raise BatchError(f"ci must be 'jacobian' or 'bootstrap', got '{ci}'")
     if not 0 < level < 1:
         raise BatchError(f"confidence level must be in (0, 1), got {level}")
+    if ci == "bootstrap":
+        check_bootstrap(n_boot)
+        check_seed(seed, BatchError)
     params = tuple(parameters)
     apply_parameters(robot, params, np.zeros(len(params)))  # names checked here, in the caller's process
     problem = CalibrationProblem(robot, params, tuple(runs), method, heading_weight,

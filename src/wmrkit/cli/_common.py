@@ -62,19 +62,17 @@ OUTPUT_FILES, OUTPUT_FOLDERS = ("out", "plot", "animate"), ("report", "trajector
 def check_outputs(args: argparse.Namespace) -> None:
     """Refuse, before any work, an output the command could not write: a file whose folder is missing or not
     writable, or that is a folder; a folder that is a file, or whose nearest existing parent is not writable."""
-    given = [(f"--{dest}", getattr(args, dest), False) for dest in (*OUTPUT_FILES, *OUTPUT_FOLDERS)
-             if getattr(args, dest, None) is not None]
-    given = [(what, path, what[2:] in OUTPUT_FOLDERS) for what, path, _ in given]
+    given = [(f"--{dest}", getattr(args, dest, None), dest in OUTPUT_FOLDERS) for dest in OUTPUT_FILES + OUTPUT_FOLDERS]
     if getattr(args, "codegen", None):
         given.append(("--codegen", args.codegen[1], True))
     for what, path, folder in given:
-        problem = output_problem(path, folder)
+        problem = None if path is None else output_problem(path, folder)
         if problem:
             raise WmrkitError(f"{what} {path}: {problem}")
 
 
 def output_problem(path: str, folder: bool) -> str | None:
-    """Why `path` cannot be written as a file (or, with `folder`, as a folder), or None."""
+    """Why `path` cannot be written as a file (or, with `folder`, as a folder made with its parents), or None."""
     if not path.strip():
         return "empty name"
     p = Path(path)
@@ -83,8 +81,8 @@ def output_problem(path: str, folder: bool) -> str | None:
     parent = p.parent if not folder else next(a for a in (p, *p.parents) if a.exists())
     if not parent.is_dir():
         return f"no such folder '{parent}'" if not parent.exists() else f"'{parent}' is not a folder"
-    if not os.access(p if folder and p.exists() else parent, os.W_OK | os.X_OK):
-        return f"cannot write into '{p if folder and p.exists() else parent}' (permission denied)"
+    if not os.access(parent, os.W_OK | os.X_OK):
+        return f"cannot write into '{parent}' (permission denied)"
     return None
 
 

@@ -156,14 +156,13 @@ def run_odometry(args: argparse.Namespace) -> int:
 
 def run_calibrate(args: argparse.Namespace) -> int:
     """Fleet calibration; prints each fitted field with its interval."""
-    from ..batch.calibrate import default_parameters, fleet_calibrate, load_runs
+    from ..batch.calibrate import check_bootstrap, default_parameters, fleet_calibrate, load_runs
     from ..batch.fleet import expand_logs
 
     robot = load_robot(args.robot)
     params = ([tuple(n.strip() for n in p.split(",") if n.strip()) for p in args.param] if args.param
               else [] if args.slip else default_parameters(robot, closed=args.closed))
-    if args.bootstrap < 2:
-        raise WmrkitError(f"--bootstrap must be >= 2, got {args.bootstrap}")
+    check_bootstrap(args.bootstrap, "--bootstrap")
     with _runner(args) as runner:
         runs = load_runs(robot, expand_logs(args.logs), reference_dir=args.reference, closed=args.closed,
                          runner=runner, options=_options(args))

@@ -104,7 +104,8 @@ def run_track(args: argparse.Namespace) -> int:
         warnings.simplefilter("always", SamplingWarning)
         run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
                     period=period, delay=args.delay, duration=duration, policy=args.steering, dynamics=args.dynamics,
-                    slip_model=args.slip_model, feedback=args.feedback, weights=weights, noise=noise, ramp=args.ramp)
+                    slip_model=args.slip_model, feedback=args.feedback, weights=weights, noise=noise, ramp=args.ramp,
+                    progress=sys.stderr.isatty() and not args.json)
     for w in caught:
         if issubclass(w.category, SamplingWarning):
             print(f"wmrkit: warning: {w.message}", file=sys.stderr)

@@ -88,7 +88,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     """Simulate, print a summary, write and plot on request."""
     from ..dynamics.model import DynamicModel
     from ..dynamics.programs import path_program, read_torques
-    from ..dynamics.simulate import simulate
+    from ..dynamics.simulate import MAX_STEPS, simulate
 
     model = DynamicModel.of(load_robot(args.robot), args.tyre)
     check_plot_path(args.plot)
@@ -103,9 +103,9 @@ def run_simulate(args: argparse.Namespace) -> int:
     if args.duration is not None:
         duration = _positive(parse_value(args.duration, "number", "--duration"), "--duration")
     step = _positive(parse_value(args.step, "number", "--step"), "--step")
-    if duration <= 0 or step > duration or duration / step > 5e7:
+    if duration <= 0 or step > duration or duration / step > MAX_STEPS:
         raise WmrkitError(f"--duration {duration:g} s and --step {step:g} s: need 0 < step <= duration and at most "
-                          "5e7 steps")
+                          f"{MAX_STEPS:.0e} steps")
     twist = [0.0, 0.0, 0.0] if args.initial_twist is None else [
         parse_value(v, "number", "--initial-twist") for v in args.initial_twist]
     sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,

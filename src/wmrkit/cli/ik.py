@@ -10,6 +10,7 @@ import numpy as np
 
 from ..errors import WmrkitError
 from ..kinematics.wheel_ik import WheelCommands, forward_kinematics_check, twist_is_determined, wheel_commands
+from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from ..units import UnitError, parse_quantity
 from ._common import (
@@ -62,8 +63,9 @@ def run_fk(args: argparse.Namespace) -> int:
     given = parse_assignments(args.spin, "--spin")
     rates = {name: parse_value(value, "number", f"--spin {name}") for name, value in given.items()}
     for name, value in rates.items():
-        if abs(value) > MAX_RATE:
-            raise WmrkitError(f"--spin {name}: {value:g} is beyond {MAX_RATE:g} rad/s (m/s), no wheel turns so fast")
+        if abs(value) > MAX_QUERY_RATE:
+            raise WmrkitError(f"--spin {name}: {value:g} is beyond {MAX_QUERY_RATE:g} rad/s (m/s), no wheel turns so "
+                              "fast")
     fk = forward_kinematics_check(robot, rates)
     _check_finite("fk", fk.twist, fk.residual)
     twist = fk.twist
@@ -84,18 +86,14 @@ def run_fk(args: argparse.Namespace) -> int:
     return 0
 
 
-#: Largest speed [m/s], turn rate [rad/s] or joint rate [rad/s] the commands accept: far beyond any wheeled robot,
-#: and small enough that no result overflows (docs/limits.md).
-MAX_RATE = 1e6
-
-
 def _finite(text: str) -> float:
     try:
         value = parse_quantity(text, "number")
     except UnitError as err:
         raise argparse.ArgumentTypeError(str(err)) from None
-    if abs(value) > MAX_RATE:
-        raise argparse.ArgumentTypeError(f"{text}: beyond {MAX_RATE:g} (m/s or rad/s), no wheeled robot moves so fast")
+    if abs(value) > MAX_QUERY_RATE:
+        raise argparse.ArgumentTypeError(f"{text}: beyond {MAX_QUERY_RATE:g} (m/s or rad/s), no wheeled robot moves so "
+                                         "fast")
     return value
 
 

@@ -9,6 +9,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..errors import WmrkitError
+from ..limits import check_chunk_size
 from ..odometry.covariance import CrowleyNoise
 from ..odometry.encoders import encoders_for
 from ..odometry.files import odometry_file
@@ -87,8 +88,7 @@ def run(args: argparse.Namespace) -> int:
     robot = load_robot(args.robot)
     settings = resolve_method(args)  # --method, --scheme: the options, else the description's odometry block
     check_estimator_options(args)
-    if args.chunk_size < 1:
-        raise WmrkitError(f"--chunk-size must be >= 1, got {args.chunk_size}")
+    check_chunk_size(args.chunk_size, WmrkitError, "--chunk-size")
     if not all(math.isfinite(k) and k >= 0 for k in args.crowley):
         raise WmrkitError(f"--crowley: coefficients must be finite and >= 0, got {' '.join(map(str, args.crowley))}")
     joints = odometry_model(robot, args.sensed).joints

@@ -167,13 +167,12 @@ def add_study_parser(commands: argparse._SubParsersAction) -> None:
                                                "skid-steer comparison of docs/slip.md")
     p.add_argument("study", choices=("forklift", "skid-steer-4"), help="which study")
     p.add_argument("--report", metavar="DIR", help="write the figures into DIR")
-    p.add_argument("--quick", action="store_true", help="fewer sweep points and shorter runs (a smoke run)")
-    p.add_argument("--seed", type=int, default=0, help="forklift: seed of the experiments' speeds and encoder "
-                                                        "phases (default 0)")
-    p.add_argument("--drive", choices=("differential", "servo"), default="differential",
+    p.add_argument("--quick", action="store_true", help="forklift: fewer sweep points and shorter runs (a smoke run)")
+    p.add_argument("--seed", type=int, help="forklift: seed of the experiments' speeds and encoder phases (default 0)")
+    p.add_argument("--drive", choices=("differential", "servo"),
                    help="forklift: drive wheels through the open differential of one traction motor (default, the "
                         "forklift's drivetrain) or each through its own rate servo")
-    p.add_argument("--source", choices=("md", "quasi-static"), default="md",
+    p.add_argument("--source", choices=("md", "quasi-static"),
                    help="skid-steer-4: motion from the dynamic model (default) or the quasi-static slip model")
     add_json_flag(p)
     p.set_defaults(run=run_study)
@@ -181,10 +180,15 @@ def add_study_parser(commands: argparse._SubParsersAction) -> None:
 
 def run_study(args: argparse.Namespace) -> int:
     """Run a study, print its numbers (``--json``: the whole result), write figures with ``--report``."""
+    own = {"forklift": ("quick", "seed", "drive"), "skid-steer-4": ("source",)}[args.study]
+    for other in {"quick", "seed", "drive", "source"} - set(own):
+        if getattr(args, other) not in (None, False):  # it would be ignored
+            raise WmrkitError(f"slip-study {args.study}: --{other} applies to the "
+                              f"{'forklift' if args.study != 'forklift' else 'skid-steer-4'} study")
     if args.study == "skid-steer-4":
         from ..slip.skid import save_skid_figures, skid_comparison
 
-        result = skid_comparison(load_robot("skid-steer-4"), source=args.source)
+        result = skid_comparison(load_robot("skid-steer-4"), source=args.source or "md")
         figures = save_skid_figures(result, args.report) if args.report else []
         data = {k: v for k, v in result.items() if k != "paths"} | {"figures": figures}
         if args.json:
@@ -196,7 +200,8 @@ def run_study(args: argparse.Namespace) -> int:
         return 0
     from ..slip.study import forklift_study
 
-    result = forklift_study(report=args.report, quick=args.quick, seed=args.seed, drive=args.drive)
+    result = forklift_study(report=args.report, quick=args.quick, seed=0 if args.seed is None else args.seed,
+                            drive=args.drive or "differential")
     if args.json:
         print_json(result)
     else:

@@ -28,8 +28,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     loc.add_argument("--lines", type=int, metavar="N", help="lines in the image: 1 (default without --spacing), "
                      "2 (road: n = -1, 1) or 3 (crops: n = -1, 0, 1, default with --spacing)")
     loc.add_argument("--z-p", default="0", metavar="Z", help="distance from the lens to P along the axis [m]")
-    loc.add_argument("--mode", choices=("threshold", "gradient"), default="threshold",
-                     help="pixels of interest: the reference (threshold) or its contour (gradient)")
+    loc.add_argument("--mode", choices=("threshold", "gradient"),
+                     help="pixels of interest: the reference (threshold, default) or its contour (gradient)")
     add_json_flag(loc)
     loc.set_defaults(run=run_locate)
 
@@ -42,7 +42,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                      help="real half-distance between the stripes [m]")
     cal.add_argument("--row-distance", required=True, metavar="YW",
                      help="real distance along the stripes between the points seen on rows +A and -A [m]")
-    cal.add_argument("--size", nargs=2, type=int, metavar=("W", "H"), default=(640, 480),
+    cal.add_argument("--size", nargs=2, type=int, metavar=("W", "H"),
                      help="image size for the camera file with --x1/--x2 (default 640 480)")
     cal.add_argument("--out", metavar="FILE", help="write the camera file (YAML)")
     add_json_flag(cal)
@@ -97,7 +97,10 @@ def run_locate(args: argparse.Namespace) -> int:
     camera = _camera(args.camera)
     spacing = parse_value(args.spacing, "length", "--spacing")
     z_p = parse_value(args.z_p, "length", "--z-p")
-    if args.points:
+    if args.points is not None:
+        for option, value in (("--lines", args.lines), ("--mode", args.mode)):
+            if value is not None:  # it would be ignored
+                raise WmrkitError(f"locate: {option} applies to an IMAGE, not to --points")
         fix = locate_points(camera, read_points(args.points), spacing=spacing, z_p=z_p)
     else:
         layouts = {1: (0,), 2: (-1, 1), 3: (-1, 0, 1)}
@@ -108,7 +111,7 @@ def run_locate(args: argparse.Namespace) -> int:
         if image.shape != (camera.rows, camera.width):
             raise WmrkitError(f"{args.image}: {image.shape[1]} x {image.shape[0]} px, the camera file says "
                               f"{camera.width} x {camera.rows}")
-        fix = locate_image(camera, image, spacing=spacing, ns=ns, z_p=z_p, mode=args.mode)
+        fix = locate_image(camera, image, spacing=spacing, ns=ns, z_p=z_p, mode=args.mode or "threshold")
     if args.json:
         print_json(fix.to_dict())
     else:
@@ -131,8 +134,10 @@ def run_calibrate(args: argparse.Namespace) -> int:
         if args.x1 is None or args.x2 is None:
             raise WmrkitError("calibrate: --x1 and --x2 go together")
         cal = calibrate(args.x1, args.x2, args.rows, xw, yw)
-        width, rows = args.size
+        width, rows = args.size or (640, 480)
     else:
+        if args.size is not None:  # it would be ignored
+            raise WmrkitError("calibrate: --size applies to --x1/--x2 (the camera file of an image has its size)")
         image = read_image(args.image)
         cal = calibrate_image(image, args.rows, xw, yw)
         rows, width = image.shape

@@ -22,7 +22,7 @@ import numpy as np
 from ..wheels import beta_from_heading, heading_from_beta
 from .laws import PositionLaw
 from .loop import TwistController, check_command
-from .points import ControlError, ControlPoint
+from .points import ControlError, ControlPoint, check_delay
 from .references import Reference
 from .tick import scalar_law
 
@@ -48,8 +48,7 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
         raise ControlError(f"period: expected a control period >= the dynamics step {step} s, got {period}")
     if feedback not in ("pose", "odometry"):
         raise ControlError(f"feedback must be 'pose' or 'odometry', got {feedback!r}")
-    if delay < 0:
-        raise ControlError(f"delay: expected a number of samples >= 0, got {delay}")
+    check_delay(delay)
     model = DynamicModel.of(robot, tyre)
     held = max(1, round(period / step)) * step
     stepper = Stepper(model, initial_state(model, (0.0, 0.0, 0.0), initial_pose), step=step)

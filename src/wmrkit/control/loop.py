@@ -23,7 +23,7 @@ from ..limits import MAX_SPEED
 from ..robot import Robot
 from .actuators import LowLevelLoops
 from .laws import PositionLaw, law_velocity, pose_error
-from .points import ControlError, ControlPoint, point_pose, twist_for_velocity
+from .points import ControlError, ControlPoint, check_delay, point_pose, twist_for_velocity
 from .references import Reference
 from .steering import choose_steering, discretize_twist, steer_ranges
 
@@ -227,8 +227,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
     else:
         if not (math.isfinite(period) and period > 0):
             raise ControlError(f"period: expected a positive number of seconds, got {period}")
-        if delay < 0:
-            raise ControlError(f"delay: expected a number of samples >= 0, got {delay}")
+        check_delay(delay)
         n = math.floor(duration / period + 1e-9) + 1
         x, history, records = x0.copy(), [x0[:3].copy()], []
         integral = np.zeros(3)

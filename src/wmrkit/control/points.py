@@ -30,6 +30,12 @@ class ControlError(WmrkitError, ValueError):
     """A robot, reference or option the controller cannot use (one line, names the cause)."""
 
 
+def check_delay(delay: int) -> None:
+    """A measurement delay is a whole number of samples >= 0."""
+    if isinstance(delay, bool) or not isinstance(delay, int | np.integer) or delay < 0:
+        raise ControlError(f"delay: expected a number of samples >= 0, got {delay}")
+
+
 @dataclass(frozen=True, eq=False)
 class ControlPoint:
     """What is controlled and how twists are formed (eq=False: array fields, read-only).

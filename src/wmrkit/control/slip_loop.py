@@ -31,7 +31,7 @@ from ..robot import Robot
 from ..slip.kalman import KalmanNoise
 from ..slip.weights import SlipWeights
 from .loop import TwistController, check_command
-from .points import ControlError
+from .points import ControlError, check_delay
 from .slip_control import SLIP_MODELS, SlipCommander, SlipInverse, _Forward, slip_inverse
 
 __all__ = ["FEEDBACK", "simulate_slip_control", "with_commanded_rates"]
@@ -44,13 +44,14 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
                           period: float, delay: int = 0, tyre: str | None = None, step: float = 1e-3,
                           slip_model: str = "mqe", feedback: str = "pose", weights: SlipWeights | None = None,
                           noise: KalmanNoise | None = None, inverse: SlipInverse | None = None,
-                          ramp: bool = False) -> dict:
+                          ramp: bool = False, progress: bool = False) -> dict:
     """Close the loop of `controller` on the dynamic model of `robot` with commands from `slip_model`.
 
     `period` [s] control period; `delay` measurement delay in samples; `tyre` the plant's traction model (default
     as described; the slip model uses the described tyres unless `inverse` says otherwise); `step` [s] the dynamics'
     integration step. `ramp`: each period's commands are reached linearly over the period from the previous ones
-    (a first-order hold, half a period of delay) instead of held from its start (zero-order hold).
+    (a first-order hold, half a period of delay) instead of held from its start (zero-order hold). `progress`: a
+    tqdm bar over the periods.
 
     Returns arrays: ``t``, ``pose`` (true), ``twist`` (the law's), ``beta`` (actual steering), ``target``
     (commanded steering β), ``estimate`` (the fed-back pose), ``rates`` (commanded wheel rates of
@@ -69,6 +70,7 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
         raise ControlError(f"slip model must be one of {', '.join(SLIP_MODELS)}, got '{slip_model}'")
     if feedback not in FEEDBACK:
         raise ControlError(f"feedback must be one of {', '.join(FEEDBACK)}, got '{feedback}'")
+    check_delay(delay)
     model = DynamicModel.of(robot, tyre)
     commander = None
     if slip_model != "none":
@@ -87,7 +89,14 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     previous = None
     keys = ("t", "pose", "twist", "beta", "target", "estimate", "rates", "predicted", "velocity", "joint_rates")
     records: dict[str, list] = {k: [] for k in keys}
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=n, unit="period", desc="track", leave=False)
     for k in range(n):
+        if bar is not None:
+            bar.update(1)
         t = k * period
         twist, de = controller(t, history[max(0, k - delay)], integral)
         check_command(twist, t)
@@ -117,6 +126,8 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
         previous = (reference, heading)
         stepper.advance(inputs, period)  # the held commands, from the full state reached (tyre slip carries over)
         history.append(sensor.step(t + period, s))
+    if bar is not None:
+        bar.close()
     out: dict = {key: np.array(values) for key, values in records.items()}
     out["info"] = {"assigned": list(assigned), "failures": commander.failures if commander else 0,
                    "worst_error": commander.worst if commander else 0.0,

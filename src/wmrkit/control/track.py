@@ -107,7 +107,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
           skew_free: bool = False, lookahead: float = 1.0, stanley_gain: float = 1.0,
           output_dt: float = 0.05, dynamics: bool = False, tyre: str | None = None,
           feedback: str = "pose", slip_model: str = "none", weights: SlipWeights | None = None,
-          noise: KalmanNoise | None = None, ramp: bool = False) -> TrackingRun:
+          noise: KalmanNoise | None = None, ramp: bool = False, progress: bool = False) -> TrackingRun:
     """Track `reference` with `robot` (thesis ch. 8): closed loop, continuous (``period`` None) or discrete.
 
     `controller`: ``"p"`` (8.2), ``"pi"`` (8.3), ``"point"`` (8.1), ``"pure-pursuit"``, ``"stanley"``. `gain`: the
@@ -123,7 +123,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     with friction coefficients `weights`, ``"fk2"`` by the Kalman filter FK2 with `noise`; `slip_model` ``"mqe"`` or
     ``"mcd"``: the wheel commands come from the inverse slip model instead of the no-slip IK (thesis future work 4,
     :func:`.slip_loop.simulate_slip_control`); `ramp`: there, each period's commands are reached linearly over the
-    period instead of held (first-order hold).
+    period instead of held (first-order hold). `progress`: a tqdm bar over the periods of such a loop.
     """
     if controller not in CONTROLLERS:
         raise ControlError(f"unknown controller '{controller}' (controllers: {', '.join(CONTROLLERS)})")
@@ -160,15 +160,17 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
             raise ControlError("dynamics: the wheels are driven by the dynamic model's servos; no low-level loops "
                                "or skew-free option with it")
         period = 0.02 if period is None else period
-        if slip_model != "none" or feedback not in ("pose", "odometry") or ramp:
+        slipping = slip_model != "none" or feedback not in ("pose", "odometry") or ramp
+        _check_dynamic_work(duration, period, slipping)
+        if slipping:
             from .slip_loop import simulate_slip_control
 
             out = simulate_slip_control(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
                                         slip_model=slip_model, feedback=feedback, weights=weights, noise=noise,
-                                        ramp=ramp)
+                                        ramp=ramp, step=DYNAMICS_STEP, progress=progress)
         else:
             out = simulate_dynamics(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
-                                    feedback=feedback)
+                                    feedback=feedback, step=DYNAMICS_STEP)
     elif feedback != "pose" or slip_model != "none" or ramp:
         what = (f"feedback='{feedback}'" if feedback != "pose" else f"slip_model='{slip_model}'"
                 if slip_model != "none" else "ramp=True")
@@ -214,6 +216,24 @@ def _check_timing(duration: float, period: float | None, output_dt: float) -> No
     if not (math.isfinite(step) and step > 0) or duration / step > MAX_SAMPLES:
         raise ControlError(f"duration {duration:g} s at {'a period' if period else 'an output step'} of {step:g} s: "
                            f"more than {MAX_SAMPLES} samples")
+
+
+#: Integration step of the loops through the dynamics [s] (their default).
+DYNAMICS_STEP = 1e-3
+#: Most control periods of a loop with slip-model commands or slip-aware feedback: each solves the nonlinear slip
+#: model (3 to 7 ms a period for the skid steer: at most about 6 min).
+MAX_SLIP_PERIODS = 50_000
+
+
+def _check_dynamic_work(duration: float, period: float, slipping: bool) -> None:
+    from ..dynamics.simulate import MAX_STEPS
+
+    if duration / DYNAMICS_STEP > MAX_STEPS:
+        raise ControlError(f"duration {duration:g} s through the dynamics: more than {MAX_STEPS:.0e} integration "
+                           f"steps of {DYNAMICS_STEP:g} s")
+    if slipping and duration / period > MAX_SLIP_PERIODS:
+        raise ControlError(f"duration {duration:g} s at a period of {period:g} s: more than {MAX_SLIP_PERIODS} control "
+                           "periods with slip-model commands or feedback (each solves the slip model)")
 
 
 def _full_point(cp: ControlPoint, p: np.ndarray) -> ControlPoint:

@@ -114,6 +114,11 @@ def joint_column(model: DynamicModel, name: str) -> int:
     return model.names.index(name)
 
 
+#: Most integration steps a command runs (``wmrkit simulate``, ``track --dynamics``): the forklift takes about 1e6
+#: steps a second, so under a minute.
+MAX_STEPS = 50_000_000
+
+
 def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, step: float = 1e-3,
              method: Method = "semi-implicit", tyre: Tyre | str | None = None, initial_twist: ArrayLike = (0, 0, 0),
              initial_pose: ArrayLike = (0, 0, 0), record_step: float | None = None, rtol: float = 1e-6,

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from ..errors import WmrkitError
+from ..limits import check_chunk_size
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
 from .steering import CONVENTIONS, check_robot, check_steer_range, convert_steering
 
@@ -301,6 +302,7 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
     `wheels` (default: `robot`'s wheel names) to refuse columns ``X.spin``/``X.steer`` for a wheel ``X`` the robot
     lacks. `progress` is called with the bytes read.
     """
+    check_chunk_size(chunk_size, LogError)
     source = os.fspath(path)
     wheels = robot.wheel_names if robot is not None and not wheels else wheels
     decoder = Decoder(joints, fmt, source, robot)

@@ -18,6 +18,7 @@ import numpy as np
 
 from .. import catalog
 from ..errors import WmrkitError
+from ..limits import check_seed
 from ..odometry.logs import JointLog
 from ..odometry.model import odometry_model
 from ..odometry.pipeline import odometry
@@ -260,6 +261,7 @@ def forklift_study(report: str | os.PathLike[str] | None = None, quick: bool = F
                    drive: str = "differential") -> dict:
     """Everything of §7.5 the simulator allows (module docstring); figures into `report` when given; `seed` and
     `drive` as in :func:`paths`."""
+    check_seed(seed, WmrkitError)
     robot = catalog.load("forklift")
     if robot.body is None or any(w.tyre is None for w in robot.wheels):
         raise WmrkitError("the catalog forklift lacks mass properties or tyres")

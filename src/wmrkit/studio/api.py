@@ -36,6 +36,7 @@ from ..errors import DescriptionError, WmrkitError
 from ..kinematics.actuation import actuation_analysis
 from ..kinematics.sensing import sensing_analysis
 from ..kinematics.wheel_ik import wheel_commands
+from ..limits import MAX_QUERY_RATE
 from ..odometry.integrators import integrate_exact
 from ..robot import Robot
 from ..units import UnitError, parse_quantity
@@ -245,6 +246,8 @@ def drive(request: Any) -> dict[str, Any]:
     """
     robot = robot_of(request)
     twist = np.array(_numbers(request.get("twist"), "twist", 3))
+    if np.abs(twist).max() > MAX_QUERY_RATE:
+        raise StudioError(f"twist: beyond {MAX_QUERY_RATE:g} (m/s or rad/s), no wheeled robot moves so fast")
     steering = request.get("heading") or {}
     if not isinstance(steering, Mapping):
         raise StudioError("heading: a mapping {steering wheel: heading [rad]}")

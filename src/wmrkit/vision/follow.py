@@ -28,7 +28,7 @@ from ..control.laws import PositionLaw, law_velocity
 from ..control.points import control_point, twist_for_velocity
 from ..errors import WmrkitError
 from ..kinematics.wheel_ik import forward_kinematics, wheel_commands
-from ..limits import MAX_COORDINATE, MAX_SPEED
+from ..limits import MAX_COORDINATE, MAX_SPEED, check_seed
 from ..odometry.integrators import integrate_exact
 from ..robot import Robot
 from .camera import Camera
@@ -164,8 +164,7 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     if not (all(np.isfinite(noise)) and 0 <= noise[0] <= MAX_COORDINATE and 0 <= noise[1] <= np.pi):
         raise WmrkitError(f"follow-line: noise bounds must be h in [0, {MAX_COORDINATE:g}] m and psi in [0, pi] "
                           f"rad, got {noise[0]:g} m, {noise[1]:g} rad")
-    if not (isinstance(seed, int | np.integer) and seed >= 0):
-        raise WmrkitError(f"follow-line: seed must be an integer >= 0, got {seed!r}")
+    check_seed(seed, WmrkitError, "follow-line: seed")
     if gain * period >= 1:
         raise WmrkitError(f"follow-line: gain * period = {gain * period:g} >= 1: the delayed loop is unstable "
                           "(digest §2.6: a_x T < 1)")

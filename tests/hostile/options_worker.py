@@ -1,0 +1,51 @@
+"""Worker of test_hostile_options.py: reads one JSON command line per input line, runs ``wmrkit.cli.main.main`` on it
+in this process and answers one JSON line: the exit code (98 for an exception that escaped main), the output and
+whether the output is valid JSON without NaN or infinities (under ``--json``)."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import os
+import sys
+import traceback
+
+
+def _strict_json(text: str) -> str | None:
+    """Why `text` is not one JSON value with finite numbers, or None."""
+
+    def refuse(constant: str) -> None:
+        raise ValueError(f"{constant} in the JSON output")
+
+    try:
+        json.loads(text, parse_constant=refuse)
+    except ValueError as err:
+        return str(err)[:200]
+    return None
+
+
+def serve() -> None:
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    from wmrkit.cli.main import main
+
+    for line in sys.stdin:
+        argv = json.loads(line)
+        out, err = io.StringIO(), io.StringIO()
+        escaped = None
+        try:
+            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+                code = main(argv)
+        except SystemExit as exc:
+            code = exc.code if isinstance(exc.code, int) else 99
+        except BaseException:  # what the test looks for: an exception that escaped main
+            code, escaped = 98, traceback.format_exc()[-1500:]
+        text = out.getvalue()
+        answer = {"code": code, "out": text[-2000:], "err": err.getvalue()[-2000:], "escaped": escaped,
+                  "json": _strict_json(text) if code == 0 and "--json" in argv else None}
+        sys.__stdout__.write(json.dumps(answer) + "\n")
+        sys.__stdout__.flush()
+
+
+if __name__ == "__main__":  # the spawned worker processes of a Dask cluster import this module too
+    serve()
