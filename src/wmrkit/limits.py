@@ -47,6 +47,13 @@ ANGLE_MARGIN = math.radians(1.0)
 _CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff]")
 
 
+def check_length(length: float, error: type[Exception], what: str = "length") -> None:
+    """Raise `error` unless `length` [m] lies in the lengths wmrkit handles, ``[MIN_SIZE, MAX_SIZE]`` (a
+    characteristic length D far outside them makes the condition number overflow or lose its rank decisions)."""
+    if not MIN_SIZE <= length <= MAX_SIZE:  # NaN included
+        raise error(f"{what}: {length:g} m is outside the lengths wmrkit handles ({MIN_SIZE:g} to {MAX_SIZE:g} m)")
+
+
 def check_seed(seed: object, error: type[Exception], what: str = "seed") -> None:
     """Raise `error` unless `seed` is an integer >= 0 (what numpy's generators take)."""
     import numpy as np

@@ -94,7 +94,7 @@ def test_steer_option_changes_the_configuration(capsys):
 @pytest.mark.parametrize(("argv", "message"), [
     (["analyze", "no-such-robot"], "no robot 'no-such-robot'"),
     (["analyze", "forklift", "--length", "3 deg"], "--length"),
-    (["analyze", "forklift", "--length", "-1"], "--length: must be > 0"),
+    (["analyze", "forklift", "--length", "-1"], "--length: -1 m is outside the lengths"),
     (["analyze", "forklift", "--resolution", "3"], "--resolution"),
     (["analyze", "forklift", "--steer", "right_drive=1"], "does not steer"),
 ])

@@ -179,6 +179,11 @@ def test_a_negative_delay_is_refused_by_every_loop(loop, capsys):
     (["vision", "locate", "--points", f"{VISION}/chufa-points.json", "--camera", f"{VISION}/chufa-camera.yaml",
       "--mode", "gradient"], "--mode applies to an IMAGE"),  # ignored before
     (["vision", "locate", "--points", "", "--camera", f"{VISION}/chufa-camera.yaml"], "cannot read"),  # TypeError
+    # LinAlgError from the eigenvalues of kappa at D = 5e-324 m; analyze printed "condition number infinite (these
+    # joints do not determine the twist)" at D = 1e-9 m
+    (["sweep", "omni-3", "--vary", "wheels.back.l=0.1:0.2:3", "--workers", "0", "--length", "5e-324"],
+     "--length: 4.94066e-324 m is outside the lengths wmrkit handles"),
+    (["analyze", "thesis-steer-castor", "--length", "1e-9"], "--length: 1e-09 m is outside the lengths"),
     # 18849 s of loop at 1 mm/s: about an hour of slip-model solves before
     (["track", "skid-steer-4", "--reference", "circle", "--dynamics", "--slip-model", "mqe", "--speed", "1e-3"],
      "more than 50000 control periods with slip-model commands"),

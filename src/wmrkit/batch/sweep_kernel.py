@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..limits import MAX_SIZE
+from ..limits import check_length
 from ..robot import Robot
 from ..wheels import GEOMETRY_FIELDS
 from .engine import BatchError
@@ -137,8 +137,8 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
         raise BatchError(f"unknown metric '{metric}' (metrics: {', '.join(METRICS)})")
     if not axes:
         raise BatchError("a sweep needs at least one --vary")
-    if length is not None and not 0 < length <= MAX_SIZE:
-        raise BatchError(f"--length must be in (0, {MAX_SIZE:g}] m, got {length}")
+    if length is not None:
+        check_length(length, BatchError, "--length")
     if not 1 <= configs <= MAX_CONFIGS:
         raise BatchError(f"--configs must be in [1, {MAX_CONFIGS}], got {configs}")
     targets = [t for a in axes for t in a.targets]

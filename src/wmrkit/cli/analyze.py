@@ -6,6 +6,7 @@ import argparse
 
 from ..analysis.summary import analyze
 from ..errors import WmrkitError
+from ..limits import check_length
 from ._common import (
     add_json_flag,
     add_robot_argument,
@@ -56,6 +57,5 @@ def _length(text: str | None) -> float | None:
     if text is None:
         return None
     value = parse_value(text, "length", "--length")
-    if not value > 0:
-        raise WmrkitError(f"--length: must be > 0, got {text}")
+    check_length(value, WmrkitError, "--length")
     return value
