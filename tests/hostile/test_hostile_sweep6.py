@@ -202,3 +202,13 @@ def test_library_checks_of_the_same_limits():
         next(read_csv("log.csv", ("left.spin",), chunk_size=0))
     with pytest.raises(WmrkitError, match="n_boot must be in"):
         fleet_calibrate(catalog.load("diff-drive"), [object()], [], ci="bootstrap", n_boot=10**9)
+
+
+def test_a_noise_bound_of_minus_zero_is_zero(capsys):
+    # numpy's uniform(0.0, -0.0) raised "high - low < 0" (found by the options fuzzer, seed 11)
+    camera = str(VISION / "follower-camera.yaml")
+    argv = ["follow-line", "line-follower", "--camera", camera, "--duration", "3", "--json"]
+    assert main([*argv, "--noise", "0", "-0"]) == 0
+    with_minus_zero = capsys.readouterr().out
+    assert main([*argv, "--noise", "0", "0"]) == 0
+    assert capsys.readouterr().out == with_minus_zero

@@ -164,6 +164,7 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     if not (all(np.isfinite(noise)) and 0 <= noise[0] <= MAX_COORDINATE and 0 <= noise[1] <= np.pi):
         raise WmrkitError(f"follow-line: noise bounds must be h in [0, {MAX_COORDINATE:g}] m and psi in [0, pi] "
                           f"rad, got {noise[0]:g} m, {noise[1]:g} rad")
+    noise = (abs(float(noise[0])), abs(float(noise[1])))  # -0.0 is a bound of 0 (numpy's uniform refuses it)
     check_seed(seed, WmrkitError, "follow-line: seed")
     if gain * period >= 1:
         raise WmrkitError(f"follow-line: gain * period = {gain * period:g} >= 1: the delayed loop is unstable "
