@@ -11,6 +11,8 @@ import os
 import re
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from .errors import DescriptionError
 
 if TYPE_CHECKING:
@@ -56,8 +58,6 @@ def check_length(length: float, error: type[Exception], what: str = "length") ->
 
 def check_seed(seed: object, error: type[Exception], what: str = "seed") -> None:
     """Raise `error` unless `seed` is an integer >= 0 (what numpy's generators take)."""
-    import numpy as np
-
     if isinstance(seed, bool) or not (isinstance(seed, int | np.integer) and seed >= 0):
         raise error(f"{what} must be an integer >= 0, got {seed!r}")
 

@@ -212,3 +212,16 @@ def test_a_noise_bound_of_minus_zero_is_zero(capsys):
     with_minus_zero = capsys.readouterr().out
     assert main([*argv, "--noise", "0", "0"]) == 0
     assert capsys.readouterr().out == with_minus_zero
+
+
+def test_a_closed_pipe_still_ends_quietly_with_exit_0(monkeypatch):
+    # BrokenPipeError is an OSError without a file: the handler of OSErrors naming a file must not take it
+    class ClosedPipe:
+        def write(self, text):
+            raise BrokenPipeError(errno.EPIPE, "Broken pipe")
+
+        def flush(self):
+            pass
+
+    monkeypatch.setattr("sys.stdout", ClosedPipe())
+    assert main(["robots"]) == 0

@@ -65,13 +65,13 @@ def main(argv: list[str] | None = None) -> int:
     except WmrkitError as err:
         report_error(err, as_json)
         return 2
+    except BrokenPipeError:  # e.g. `wmrkit robots | head` (an OSError: caught first)
+        return 0
     except OSError as err:
         if err.filename is None:  # not about a file: a bug, with its traceback
             raise
         report_error(WmrkitError(f"{err.filename}: {err.strerror or err}"), as_json)  # e.g. a full disk
         return 2
-    except BrokenPipeError:  # e.g. `wmrkit robots | head`
-        return 0
     finally:
         done.set()
 

@@ -178,13 +178,16 @@ def add_study_parser(commands: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run_study)
 
 
+#: The options of each study (the others are refused: they would be ignored).
+STUDY_OPTIONS = {"forklift": ("quick", "seed", "drive"), "skid-steer-4": ("source",)}
+
+
 def run_study(args: argparse.Namespace) -> int:
     """Run a study, print its numbers (``--json``: the whole result), write figures with ``--report``."""
-    own = {"forklift": ("quick", "seed", "drive"), "skid-steer-4": ("source",)}[args.study]
-    for other in {"quick", "seed", "drive", "source"} - set(own):
-        if getattr(args, other) not in (None, False):  # it would be ignored
-            raise WmrkitError(f"slip-study {args.study}: --{other} applies to the "
-                              f"{'forklift' if args.study != 'forklift' else 'skid-steer-4'} study")
+    for study, options in STUDY_OPTIONS.items():
+        for option in options if study != args.study else ():
+            if getattr(args, option) not in (None, False):  # it would be ignored
+                raise WmrkitError(f"slip-study {args.study}: --{option} applies to the {study} study")
     if args.study == "skid-steer-4":
         from ..slip.skid import save_skid_figures, skid_comparison
 
