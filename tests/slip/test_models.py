@@ -164,3 +164,38 @@ def test_mqe_from_a_start_with_round_off_zeros_converges():
     sol = mqe(robot, spins, rates, tyre_friction(robot))
     assert bool(sol.converged) and float(sol.residual) < 1e-6
     assert 0 < sol.twist[2] < 0.3
+
+
+def test_tyre_friction_groups_equal_tyres_and_keeps_each_contact_its_own():
+    """The law calls each tyre model once for its contacts: the same forces as each contact's own Tyre."""
+    from wmrkit.dynamics.tyres import Tyre
+    from wmrkit.slip.models import TyreFriction
+
+    tyres = (Tyre.of("dugoff"), Tyre.of("pacejka"), Tyre.of("dugoff", {"mu": 0.4}), Tyre.of("dugoff"))
+    law = TyreFriction(tyres)
+    assert len(law.groups) == 3
+    rng = np.random.default_rng(5)
+    v_slip, v_body = rng.normal(size=(6, 4, 2)), rng.normal(size=(6, 4, 2)) * 3
+    loads = rng.uniform(100, 2000, (6, 4))
+    got = law(v_slip, v_body, loads)
+    for e, tyre in enumerate(tyres):
+        v_wheel, v_long = v_body[:, e, 1], v_slip[:, e, 1]
+        f = tyre.forces(loads[:, e], v_slip[:, e, 0], v_long, v_wheel, v_long - v_wheel)
+        assert np.allclose(got[:, e, 0], f.lateral, rtol=1e-12, atol=0)
+        assert np.allclose(got[:, e, 1], f.longitudinal, rtol=1e-12, atol=0)
+
+
+def test_mqe_over_a_batch_of_steering_angles_is_each_sample_solved_alone():
+    """A batch of steering configurations (one load transfer per sample) gives each sample's own answer."""
+    from wmrkit.slip.models import tyre_friction
+
+    robot = catalog.load("forklift")
+    law = tyre_friction(robot)
+    betas = np.pi / 2 + np.array([[0.1], [-0.3], [0.5]])  # beta: the axle angle (pi/2: straight ahead)
+    rates = np.array([[10.0, 9.0], [8.0, 9.5], [12.0, 12.5]])
+    batch = mqe(robot, SPINS, rates, law, betas)
+    assert batch.converged.all()
+    for i in range(3):
+        alone = mqe(robot, SPINS, rates[i], law, betas[i])
+        assert np.allclose(batch.q_dot[i], alone.q_dot, rtol=1e-9, atol=1e-12)
+        assert np.allclose(batch.forces[i], alone.forces, rtol=1e-9, atol=1e-9)

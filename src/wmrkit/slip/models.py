@@ -23,7 +23,7 @@ longitudinal), the contact velocities due to the body motion alone (for slip rat
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -58,13 +58,20 @@ class TyreFriction:
     """The friction law of the robot's tyres (:class:`wmrkit.dynamics.tyres.Tyre`), one per contact element."""
 
     tyres: tuple  # (E,) Tyre
+    groups: tuple = field(init=False, repr=False, compare=False)  # ((Tyre, contact indices), ...): one call each
+
+    def __post_init__(self) -> None:
+        groups: dict = {}
+        for e, tyre in enumerate(self.tyres):
+            groups.setdefault(tyre, []).append(e)
+        object.__setattr__(self, "groups", tuple((tyre, np.array(ix)) for tyre, ix in groups.items()))
 
     def __call__(self, v_slip: np.ndarray, v_body: np.ndarray, loads: np.ndarray) -> np.ndarray:
         out = np.empty(np.broadcast_shapes(v_slip.shape, v_body.shape))
-        for e, tyre in enumerate(self.tyres):
-            v_wheel = v_body[..., e, 1]
-            f = tyre.forces(loads[..., e], v_slip[..., e, 0], v_slip[..., e, 1], v_wheel, v_slip[..., e, 1] - v_wheel)
-            out[..., e, 0], out[..., e, 1] = f.lateral, f.longitudinal
+        for tyre, ix in self.groups:  # the contacts of one tyre model in one vectorised call
+            v_wheel, v_long = v_body[..., ix, 1], v_slip[..., ix, 1]
+            f = tyre.forces(loads[..., ix], v_slip[..., ix, 0], v_long, v_wheel, v_long - v_wheel)
+            out[..., ix, 0], out[..., ix, 1] = f.lateral, f.longitudinal
         return out
 
 
@@ -159,13 +166,18 @@ def normal_loads(robot: Robot, body: Body | None = None, accel_cm: ArrayLike = (
     The thesis's drive-torque reaction term of (7.64) is not included. `body`: default the robot's.
     """
     body = _body(robot, body)
-    p = contact_positions(robot, beta) - np.asarray(body.com, dtype=float)
     a = np.asarray(accel_cm, dtype=float)
-    m = np.stack([np.ones(p.shape[:-1]), p[..., 0], p[..., 1]], axis=-2)  # (..., 3, E)
     h = body.com_height
     rhs = np.stack(np.broadcast_arrays(np.full(a.shape[:-1], body.mass * g), -h * body.mass * a[..., 0],
                                        -h * body.mass * a[..., 1]), axis=-1)
-    return (np.linalg.pinv(m) @ rhs[..., None])[..., 0]
+    return (_load_map(robot, body, beta) @ rhs[..., None])[..., 0]
+
+
+def _load_map(robot: Robot, body: Body, beta: ArrayLike | None) -> np.ndarray:
+    """``(..., E, 3)``: the loads of :func:`normal_loads` are this map times ``(M g, -h M a_x, -h M a_y)``."""
+    p = contact_positions(robot, beta) - np.asarray(body.com, dtype=float)
+    m = np.stack([np.ones(p.shape[:-1]), p[..., 0], p[..., 1]], axis=-2)  # (..., 3, E)
+    return np.linalg.pinv(m)
 
 
 def _body(robot: Robot, body: Body | None) -> Body:
@@ -200,13 +212,14 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
     q_out = np.empty((len(q_a), k))
     res = np.empty(len(q_a))
     ok = np.empty(len(q_a), dtype=bool)
+    load_maps = None if quasi_static is None else _load_map(robot, quasi_static[0], betas)  # (E, 3) or (n, E, 3)
     for i in range(len(q_a)):
         a = a_all[i]
         a_na, fixed = a[:, free], a[:, cols] @ q_a[i]
         body_part = a[:, :3]
-        beta_i = None if betas is None else betas[i]
+        load_map = None if load_maps is None else load_maps[i] if load_maps.ndim == 3 else load_maps
 
-        def equations(z, a_na=a_na, fixed=fixed, body_part=body_part, beta_i=beta_i):
+        def equations(z, a_na=a_na, fixed=fixed, body_part=body_part, load_map=load_map):
             slip = a_na @ z + fixed
             twist = z[:3] if free[2] == 2 else None
             v_body = body_part @ (twist if twist is not None else np.zeros(3))
@@ -214,7 +227,7 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
                 f_n = static
                 inertial = 0.0
             else:
-                f_n, inertial = _centripetal(robot, quasi_static, twist, beta_i)
+                f_n, inertial = _centripetal(quasi_static, load_map, twist)
             f = friction(slip.reshape(n_e, 2), v_body.reshape(n_e, 2), f_n).reshape(-1)
             out = a_na.T @ f
             if quasi_static is not None:
@@ -233,16 +246,17 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
     slip = (a_b @ q_out[..., None])[..., 0]
     f_n = np.broadcast_to(static, (*batch, n_e))
     if quasi_static is not None:
-        f_n = np.stack([_centripetal(robot, quasi_static, q[:3], None if betas is None else betas[i])[0]
+        f_n = np.stack([_centripetal(quasi_static, load_maps[i] if load_maps.ndim == 3 else load_maps, q[:3])[0]
                         for i, q in enumerate(q_out.reshape(-1, k))]).reshape(*batch, n_e)
     body_v = (a_b[..., :3] @ q_out[..., :3, None])[..., 0]
     forces = friction(slip.reshape(*batch, n_e, 2), body_v.reshape(*batch, n_e, 2), f_n).reshape(*batch, 2 * n_e)
     return SlipSolution(q_out, slip, forces, res.reshape(batch), ok.reshape(batch))
 
 
-def _centripetal(robot: Robot, quasi: tuple[Body, float], twist: np.ndarray | None,
-                 beta_i) -> tuple[np.ndarray, np.ndarray]:
-    """Loads and the inertial wrench ``(M a_cm, c x M a_cm)`` about the origin of uniform curvilinear motion."""
+def _centripetal(quasi: tuple[Body, float], load_map: np.ndarray,
+                 twist: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """Loads (:func:`normal_loads` through its `load_map`) and the inertial wrench ``(M a_cm, c x M a_cm)`` about the
+    origin of uniform curvilinear motion."""
     body, g = quasi
     if twist is None:
         raise WmrkitError("MQE needs the body twist unassigned (the vehicle velocities are its unknowns)")
@@ -251,5 +265,6 @@ def _centripetal(robot: Robot, quasi: tuple[Body, float], twist: np.ndarray | No
     v_cm = np.array([vx - w * cy, vy + w * cx])
     a_cm = w * np.array([-v_cm[1], v_cm[0]])  # omega J v_cm (7.40)
     f = body.mass * a_cm
-    loads = normal_loads(robot, body, a_cm, beta_i, g)
+    h = body.com_height
+    loads = load_map @ np.array([body.mass * g, -h * f[0], -h * f[1]])
     return loads, np.array([f[0], f[1], cx * f[1] - cy * f[0]])
