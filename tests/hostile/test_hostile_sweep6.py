@@ -178,7 +178,7 @@ def test_a_negative_delay_is_refused_by_every_loop(loop, capsys):
       "--lines", "2"], "--lines applies to an IMAGE"),  # ignored before
     (["vision", "locate", "--points", f"{VISION}/chufa-points.json", "--camera", f"{VISION}/chufa-camera.yaml",
       "--mode", "gradient"], "--mode applies to an IMAGE"),  # ignored before
-    (["vision", "locate", "--points", "", "--camera", f"{VISION}/chufa-camera.yaml"], "cannot read"),  # TypeError
+    (["vision", "locate", "--points", "", "--camera", f"{VISION}/chufa-camera.yaml"], "--points: empty value"),
     # LinAlgError from the eigenvalues of kappa at D = 5e-324 m; analyze printed "condition number infinite (these
     # joints do not determine the twist)" at D = 1e-9 m
     (["sweep", "omni-3", "--vary", "wheels.back.l=0.1:0.2:3", "--workers", "0", "--length", "5e-324"],
@@ -225,3 +225,26 @@ def test_a_closed_pipe_still_ends_quietly_with_exit_0(monkeypatch):
 
     monkeypatch.setattr("sys.stdout", ClosedPipe())
     assert main(["robots"]) == 0
+
+
+BLANKS = [  # an argument given as empty text, and the name the one line gives it
+    (["analyze", ""], "ROBOT"),
+    (["odometry", "diff-drive", " "], "LOG"),
+    (["vision", "locate", "--points", "", "--camera", "camera.yaml"], "--points"),
+    (["vision", "locate", "image.png", "--camera", ""], "--camera"),
+    (["track", "forklift", "--reference", ""], "--reference"),
+    (["tyre", "dugoff", "--load", "1000", "--param", "mu=0.5", "--param", ""], "--param"),
+]
+
+
+@pytest.mark.parametrize("argv, name", BLANKS, ids=lambda a: " ".join(a) if isinstance(a, list) else a)
+def test_an_empty_argument_is_refused_by_name(argv, name, capsys):
+    """Read as a path, '' is the current folder: 'analyze ""' said '.: cannot read the file (IsADirectoryError)',
+    'odometry diff-drive ""' said ': not a ROS 2 bag' (the options fuzzer's empty values)."""
+    assert _one_line(argv, capsys) == f"wmrkit: error: {name}: empty value\n"
+
+
+@pytest.mark.parametrize("argv", WRITERS, ids=lambda a: " ".join(a[:2] + a[-1:]))
+def test_an_empty_output_name_is_refused_by_name(argv, capsys):
+    option = _option(argv)
+    assert _one_line([*argv, ""], capsys) == f"wmrkit: error: {option}: empty value\n"

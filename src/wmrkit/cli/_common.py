@@ -59,6 +59,23 @@ def check_plot_path(path: str | None, what: str = "--plot") -> None:
 OUTPUT_FILES, OUTPUT_FOLDERS = ("out", "plot", "animate"), ("report", "trajectories")
 
 
+def check_blank(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse, before any work, an argument given as empty text (a file or a robot named ''), naming it: read as a
+    path, '' would be the current folder."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            chosen = action.choices.get(getattr(args, action.dest, None))
+            if chosen is not None:
+                check_blank(chosen, args)
+            continue
+        value = getattr(args, action.dest, None)
+        values = [v for x in (value if isinstance(value, list) else [value])
+                  for v in (x if isinstance(x, list) else [x])]
+        if any(isinstance(v, str) and not v.strip() for v in values):
+            metavar = " ".join(action.metavar) if isinstance(action.metavar, tuple) else action.metavar
+            raise WmrkitError(f"{'/'.join(action.option_strings) or metavar or action.dest.upper()}: empty value")
+
+
 def check_outputs(args: argparse.Namespace) -> None:
     """Refuse, before any work, an output the command could not write: a file whose folder is missing or not
     writable, or that is a folder; a folder that is a file, or whose nearest existing parent is not writable."""

@@ -10,7 +10,7 @@ import threading
 from typing import NoReturn
 
 from ..errors import DescriptionError, WmrkitError
-from ._common import check_outputs
+from ._common import check_blank, check_outputs
 
 #: Each command and the module of ``wmrkit.cli`` that registers it (``add_parsers``), in ``--help`` order.
 COMMANDS = {
@@ -59,7 +59,9 @@ def main(argv: list[str] | None = None) -> int:
     if not as_json:
         threading.Thread(target=_compile_notice, args=(done,), daemon=True).start()
     try:
-        args = build_parser(command).parse_args(argv)
+        parser = build_parser(command)
+        args = parser.parse_args(argv)
+        check_blank(parser, args)
         check_outputs(args)
         return int(args.run(args) or 0)
     except WmrkitError as err:
