@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WmrkitError
+from .integrators import sinc
 from .logs import MAX_RATE, JointLog, LogError, check_jumps
 from .steering import check_robot, check_steer_range, convert_steering
 
@@ -212,8 +213,8 @@ class OdometryBagWriter:
     """Writes trajectory chunks as ``nav_msgs/msg/Odometry`` to a new bag (context manager).
 
     Pose covariance: the ``(x, y, theta)`` covariance at rows/columns 0, 1, 5 of the 6x6 ROS matrix (z, roll,
-    pitch left 0: planar motion). Twist: the body twist ``(dx, dy, dtheta) / dt`` of the interval ending at each
-    pose (0 at the first).
+    pitch left 0: planar motion). Twist: the constant body twist ``(vx, vy, omega)`` that moves the robot from the
+    pose before to each pose in its interval (the SE(2) logarithm of the step; 0 at the first).
     """
 
     def __init__(self, path: str | os.PathLike[str], *, topic: str = "/odom", frame_id: str = "odom",
@@ -233,8 +234,11 @@ class OdometryBagWriter:
         times, poses = np.concatenate([prev_t, chunk.time]), np.vstack([prev_p, chunk.poses])
         dt = np.diff(times)
         d = np.diff(poses, axis=0)
-        c, s = np.cos(poses[:-1, 2]), np.sin(poses[:-1, 2])
-        body = np.column_stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1], d[:, 2]])
+        # the SE(2) logarithm of the step (the exact scheme's chord form): the chord is Rot(theta + dtheta / 2)
+        # (vx, vy) dt sinc(dtheta / 2)
+        half = 0.5 * d[:, 2]
+        c, s, k = np.cos(poses[:-1, 2] + half), np.sin(poses[:-1, 2] + half), 1.0 / sinc(half)
+        body = np.column_stack([k * (c * d[:, 0] + s * d[:, 1]), k * (-s * d[:, 0] + c * d[:, 1]), d[:, 2]])
         twist = np.divide(body, dt[:, None], out=np.zeros_like(body), where=dt[:, None] > 0)
         quats = quaternion_z(chunk.poses[:, 2])
         zero6 = np.zeros(36)
