@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from wmrkit import catalog
@@ -125,3 +126,14 @@ def test_a_long_first_compilation_is_announced_once(monkeypatch, capsys):
     done.set()
     err = capsys.readouterr().err
     assert not watcher.is_alive() and err.count("compiling numerical kernels") == 1
+
+
+@pytest.mark.parametrize("value, expected", [("-5deg", -np.radians(5)), ("-0.5rad", -0.5), ("-1e-2", -0.01),
+                                             ("-.25", -0.25), ("-5 deg", -np.radians(5))])
+def test_a_negative_value_with_a_unit_is_a_value_not_an_option(value, expected, capsys):
+    """argparse reads a word starting with '-' as an option unless it is '-90' or '-0.5': '--slip-angle -5deg'
+    failed with 'expected one argument' although units are accepted everywhere (docs/conventions.md)."""
+    assert main(["tyre", "dugoff", "--load", "1000", "--slip-ratio", "0", "--slip-angle", value, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["slip_angle"] == pytest.approx(expected, rel=1e-15)
+    assert out["Fy"] > 0  # a negative slip angle: the force of the ground pushes to +y (independent of the parse)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import re
 import sys
 import threading
 from typing import NoReturn
@@ -30,7 +31,20 @@ class UsageError(WmrkitError):
         self.usage = usage
 
 
+#: A word that starts with a minus and a digit is a value, not an option: '-90deg', '-1e-3', '-0.5 rad' (no option
+#: of wmrkit starts with a digit; argparse's own test takes only '-90' and '-0.5').
+NEGATIVE_VALUE = re.compile(r"^-\.?\d|^-inf$")
+
+
 class _Parser(argparse.ArgumentParser):
+    @property
+    def _negative_number_matcher(self) -> re.Pattern:
+        return NEGATIVE_VALUE
+
+    @_negative_number_matcher.setter
+    def _negative_number_matcher(self, _default: re.Pattern) -> None:
+        pass  # argparse sets its own in __init__
+
     def error(self, message: str) -> NoReturn:
         command = self.prog.removeprefix("wmrkit").strip()
         raise UsageError(f"{command}: {message}" if command else message, self.format_usage())
