@@ -269,6 +269,8 @@ def descriptions(draw) -> tuple[dict, list[dict]]:
                 item[field], si[field] = draw(_quantity(field))
             else:
                 si[field] = kind.optional[field]
+        if "beta" in kind.optional and "beta" not in item:  # a steered wheel given no angle rolls straight ahead
+            si["beta"] = math.pi / 2 - si.get("delta", 0.0)
         for role in ("actuated", "sensed"):
             joints = draw(st.lists(st.sampled_from(kind.joints), unique=True))
             if joints or draw(st.booleans()):
@@ -424,3 +426,17 @@ def test_odometry_settings_are_read_kept_and_saved(tmp_path):
     assert robot.odometry == s and robot != Robot.from_dict(bare)
     assert robot.wheels == Robot.from_dict(bare).wheels
     assert robot.to_dict()["odometry"] == data["odometry"] and Robot.from_dict(robot.to_dict()) == robot
+
+
+@pytest.mark.parametrize("item", [{"type": "steerable", "r": 0.2}, {"type": "castor", "d": 0.05, "r": 0.1},
+                                  {"type": "castor", "d": 0.05, "r": 0.1, "delta": "20 deg"},
+                                  {"type": "double", "b": 0.1, "r": 0.1},
+                                  {"type": "double_castor", "d": 0.05, "b": 0.1, "r": 0.1}])
+def test_a_steered_wheel_given_no_angle_rolls_straight_ahead(item):
+    """The thesis's default beta = 0 put the axle along +x: the wheel rolled to the right (heading -90 deg), and the
+    car example of docs/description-format.md, whose front wheels give no angle, had no ICR."""
+    robot = Robot.from_dict({"name": "t", "wheels": [{"name": "w", "position": [1.0, 0.5], **item}]})
+    assert robot.heading == pytest.approx([0.0], abs=1e-15)
+    wheel = robot.wheels[0]
+    axle = wheel.beta + wheel.delta  # the axle of the rolling wheel (3.12): perpendicular to straight ahead
+    assert (np.cos(axle), np.sin(axle)) == pytest.approx((0.0, 1.0), abs=1e-15)

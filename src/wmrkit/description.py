@@ -177,7 +177,7 @@ def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc) -> Wheel:
         if key == "beta" and "heading" in item:
             continue
         values[key] = check.quantity(check.require(item, key, loc), GEOMETRY_FIELDS[key], (*loc, key))
-    _read_heading(item, values, check, loc)
+    _read_heading(item, values, check, loc, "beta" in kind.optional)
     _check_geometry(type_name, values, check, loc)
     actuated = check.joints(item, "actuated", kind.joints, loc)
     sensed = check.joints(item, "sensed", kind.joints, loc)
@@ -203,9 +203,14 @@ def _steer_range_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc
     return (lo, hi)
 
 
-def _read_heading(item: Mapping[str, Any], values: dict[str, float], check: FieldReader, loc: Loc) -> None:
-    """``heading:`` (the users' steering angle: rolling direction, 0 = straight ahead) sets the thesis's β."""
+def _read_heading(item: Mapping[str, Any], values: dict[str, float], check: FieldReader, loc: Loc,
+                  optional: bool) -> None:
+    """``heading:`` (the users' steering angle: rolling direction, 0 = straight ahead) sets the thesis's β; a
+    steered wheel given neither (`optional`) rolls straight ahead, as a fixed wheel is written with ``heading: 0``
+    (the thesis's default β = 0 would roll it to the right)."""
     if "heading" not in item:
+        if optional and "beta" not in item:
+            values["beta"] = float(beta_from_heading(0.0, values.get("delta", 0.0)))
         return
     if "beta" in item:
         check.fail("give either 'heading' (rolling direction, 0 = straight ahead) or 'beta' (the thesis's axle "
