@@ -199,3 +199,32 @@ def test_mqe_over_a_batch_of_steering_angles_is_each_sample_solved_alone():
         alone = mqe(robot, SPINS, rates[i], law, betas[i])
         assert np.allclose(batch.q_dot[i], alone.q_dot, rtol=1e-9, atol=1e-12)
         assert np.allclose(batch.forces[i], alone.forces, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["diff-drive", "thesis-omni-castor", "thesis-steer-castor", "thesis-two-steer-castor"])
+def test_contacts_are_where_the_slip_rows_put_them(name):
+    """The body part of a contact's two slip rows (3.12) is the velocity of the contact point p: the omega entry of
+    a row along u is u_y p_x - u_x p_y. A castor's contact sat along its axle (-d (cos b, sin b)) instead of along
+    its arm, so normal_loads and MQE's load transfer were wrong for castor robots (found by an audit of ch. 7)."""
+    from wmrkit.slip.models import contact_positions
+
+    robot = catalog.load(name)
+    beta = np.array(robot.beta) + 0.3  # not the described steering
+    rows = robot.constraint_matrix(beta)[:, :3].reshape(-1, 2, 3)
+    got = contact_positions(robot, beta)
+    for (u1, u2), p in zip(rows, got, strict=True):
+        m = np.array([[u1[1], -u1[0]], [u2[1], -u2[0]]])
+        assert p == pytest.approx(np.linalg.solve(m, [u1[2], u2[2]]), abs=1e-12)
+
+
+def test_normal_loads_equal_the_dynamic_model_s_on_a_castor_robot():
+    """Two implementations of (7.64): the slip models' and the dynamic model's (compiled), on a robot with a castor."""
+    from wmrkit.dynamics.model import DynamicModel
+    from wmrkit.robot import Robot
+
+    d = catalog.load("diff-drive").to_dict()
+    d["body"] = {"mass": 20, "inertia": 0.8, "com": [-0.05, 0.01], "com_height": 0.1}
+    for w in d["wheels"]:
+        w["inertia"] = {"spin": 0.01, **({"steer": 0.002} if w["type"] == "castor" else {})}
+    robot = Robot.from_dict(d)
+    assert normal_loads(robot) == pytest.approx(DynamicModel.of(robot).normal_loads(), rel=1e-9)

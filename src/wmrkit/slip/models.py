@@ -152,8 +152,8 @@ def contact_positions(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray
     beta_e = element_beta(robot, beta)
     l_, al, d = (np.array(v, dtype=float) for v in zip(*[(e.l, e.alpha, e.d) for w in robot.wheels
                                                            for e in w.elements()], strict=True))
-    x = l_ * np.cos(al) - d * np.cos(beta_e)
-    y = l_ * np.sin(al) - d * np.sin(beta_e)
+    x = l_ * np.cos(al) - d * np.sin(beta_e)  # + d (cos(beta + pi/2), sin(beta + pi/2)), (3.12), (7.18)
+    y = l_ * np.sin(al) + d * np.cos(beta_e)
     return np.stack([x, y], axis=-1)
 
 
