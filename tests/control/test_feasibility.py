@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from wmrkit import catalog
-from wmrkit.control.feasibility import COLUMNS, feasibility, requirement
+from wmrkit.control.feasibility import COLUMNS, feasibility, requirement, signals
 from wmrkit.control.points import ControlError
 from wmrkit.control.references import builtin_reference, reference_from_samples
 from wmrkit.control.track import track
@@ -95,3 +95,37 @@ def test_verdict_matches_the_closed_loop():
     assert jumps == pytest.approx(want, abs=0.02)
     smooth = track(robot, REFS["circle"], duration=10.0, output_dt=0.02)
     assert np.abs(np.angle(np.exp(1j * np.diff(smooth.heading[:, 0])))).max() < 0.05
+
+
+def test_a_sampled_circle_has_no_jump_at_its_ends():
+    """A reference from samples that starts and ends turning: first-order differences at the ends put the
+    curvature at 1/6, 1/4, 1/3... and a false 'curvature jump' at the first and last samples (audit of ch. 8)."""
+    t = np.arange(0.0, 37.7, 0.01)
+    th = 0.5 / 3.0 * t
+    ref = reference_from_samples("circle.csv", t, np.column_stack([3 * np.sin(th), 3 * (1 - np.cos(th)), th]))
+    assert feasibility(catalog.load("ackermann"), ref).feasible
+    assert feasibility(catalog.load("forklift"), ref, "dynamic").feasible
+    assert np.nanmax(np.abs(signals(ref)["kappa"] - 1 / 3)) < 1e-6
+
+
+def test_an_angular_acceleration_jump_breaks_the_dynamic_framework_of_steered_robots():
+    """Types 3 and 5 with l_o != 0 need p_ref = (x, y, theta) in C2 in the dynamic framework (Table 8.1): a heading
+    theta = 0.1 (t - 5)^2 from t = 5 s keeps theta and omega continuous but jumps theta'' from 0 to 0.2 rad/s^2,
+    and the steering rates of a swerve drive jump there (the no-slip IK, below)."""
+    from wmrkit.kinematics.wheel_ik import wheel_commands
+
+    t = np.arange(0.0, 10.0, 0.01)
+    theta = np.where(t > 5, 0.1 * (t - 5) ** 2, 0.0)
+    ref = reference_from_samples("turn.csv", t, np.column_stack([0.5 * t, np.zeros_like(t), theta]))
+    robot = catalog.load("swerve-4")
+    got = feasibility(robot, ref, "dynamic")
+    assert [v.signal for v in got.violations] == ["omega_rate"]
+    assert got.violations[0].t == pytest.approx(5.0, abs=0.02)
+    assert got.violations[0].size > 0.05  # a jump of 0.2 rad/s^2, spread over a few samples by the differences
+    assert feasibility(robot, ref, "kinematic").feasible  # wheel rates may jump there
+    # the independent check: module headings from the IK, their rate continuous, its derivative jumping at 5 s
+    w = np.where(t > 5, 0.2 * (t - 5), 0.0)
+    heading = wheel_commands(robot, np.column_stack([0.5 * np.cos(theta), -0.5 * np.sin(theta), w])).heading[:, 0]
+    rate = np.diff(np.unwrap(heading)) / 0.01
+    k = int(np.searchsorted(t, 5.0))
+    assert np.abs(rate[k - 100:k - 1]).max() < 1e-9 and np.abs(rate[k + 1:k + 10]).min() > 0.05

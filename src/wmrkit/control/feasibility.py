@@ -38,14 +38,15 @@ COLUMNS: dict[str, tuple[int, tuple[str, ...], tuple[str, ...], str]] = {
     "type 4, on axle": (2, ("position", "chi", "kappa"), ("position", "chi", "kappa", "kappa_rate"),
                         _WHEEL + " (both tangent and curvature jump: the vehicle, re-orienting the wheel twice)"),
     "types 3 and 5, l_o != 0": (3, ("position", "theta", "velocity", "omega"),
-                                ("position", "theta", "velocity", "omega", "acceleration"), _WHEELS),
+                                ("position", "theta", "velocity", "omega", "acceleration", "omega_rate"), _WHEELS),
     "type 3, l_o = 0": (3, ("position", "theta", "chi"), ("position", "theta", "chi", "velocity", "omega", "chi_rate"),
                         _WHEEL),
 }
 #: What each signal's continuity means in the thesis's words.
 KINDS = {"position": "position jump (p_ref not C0)", "theta": "heading jump (theta_ref not C0)",
          "velocity": "velocity jump (p_ref not C1)", "omega": "heading-rate jump (theta_ref not C1)",
-         "acceleration": "acceleration jump (p_ref not C2)", "chi": "tangent-angle jump (chi not C0)",
+         "acceleration": "acceleration jump (p_ref not C2)",
+         "omega_rate": "angular-acceleration jump (theta_ref not C2)", "chi": "tangent-angle jump (chi not C0)",
          "chi_rate": "turn-rate jump (chi not C1)", "kappa": "curvature jump (kappa not C0)",
          "kappa_rate": "curvature-rate jump (kappa not C1)"}
 
@@ -141,11 +142,13 @@ def signals(reference: Reference, *, speed_tol: float = 1e-6) -> dict[str, np.nd
         chi_rate = np.where(moving, cross / speed**2, np.nan)
     t = reference.t
     return {"position": p[:, :2], "theta": p[:, 2], "velocity": v[:, :2], "omega": v[:, 2], "acceleration": a[:, :2],
+            "omega_rate": a[:, 2],
             "chi": chi, "chi_rate": chi_rate, "kappa": kappa,
             "kappa_rate": np.gradient(np.nan_to_num(kappa), t) * (t[1] - t[0])}
 
 
-_FLOOR = {"position": 1e-3, "theta": 0.02, "velocity": 0.02, "omega": 0.02, "acceleration": 0.05, "chi": 0.05,
+_FLOOR = {"position": 1e-3, "theta": 0.02, "velocity": 0.02, "omega": 0.02, "acceleration": 0.05, "omega_rate": 0.05,
+          "chi": 0.05,
           "chi_rate": 0.02, "kappa": 0.02, "kappa_rate": 0.02}
 
 

@@ -93,8 +93,10 @@ def reference_from_samples(name: str, t: np.ndarray, pose: np.ndarray) -> Refere
         k = int(np.argmax(np.diff(t) <= 0))
         raise ReferenceError(f"{name}: times must increase (sample {k + 1}: {t[k + 1]} after {t[k]})")
     pose[:, 2] = np.unwrap(pose[:, 2])
-    vel = np.gradient(pose, t, axis=0)
-    acc = np.gradient(vel, t, axis=0)
+    # second-order differences at the ends too: first-order ones put a false curvature jump at the first and last
+    # samples of a reference that starts or ends turning
+    vel = np.gradient(pose, t, axis=0, edge_order=2)
+    acc = np.gradient(vel, t, axis=0, edge_order=2)
     return Reference(name, readonly(t), readonly(pose), readonly(vel), readonly(acc))
 
 
