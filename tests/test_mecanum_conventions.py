@@ -3,7 +3,9 @@
 Modern Robotics (Lynch & Park, eq. 13.5) writes a Swedish wheel's driving speed as
 ``u_i = (1/r) [1, tan γ_MR] [[cos β, sin β], [-sin β, cos β]] [[-y_i, 1, 0], [x_i, 0, 1]] (ω, vx, vy)``, with β the
 driving direction and γ_MR the sliding direction of the rollers measured from it; its Mecanum robot has
-γ_MR = -45° at front-left. The thesis's γ (axle to contact-roller axis) is the opposite angle: γ = -γ_MR.
+γ_MR = -45° at front-left. The thesis's γ (axle to contact-roller axis) is measured from the axle, 90° from the
+driving direction, and to the roller's axis, 90° from its sliding direction: γ = γ_MR + 90° (mod 180°), which for
+the ±45° of Mecanum rollers is γ = -γ_MR, and for omni wheels (γ_MR = 0) γ = 90°.
 """
 
 from __future__ import annotations
@@ -60,3 +62,14 @@ def test_mecanum_gamma_can_be_overridden_and_axis_wheels_need_it():
 
     with pytest.raises(DescriptionError, match="no quadrant"):
         _robot([{"name": "a", "type": "mecanum", "position": [0.3, 0.0], "r": R}])
+
+
+@pytest.mark.parametrize("gamma_mr", [0.0, 30.0, -45.0, 60.0, -80.0])
+def test_modern_robotics_gamma_is_the_thesis_gamma_minus_90_deg(gamma_mr):
+    """The general relation (audit of the doors): omni wheels have gamma_MR = 0 and the thesis's gamma = 90 deg, so
+    gamma = -gamma_MR holds only at +-45 deg."""
+    twist = np.array([0.3, -0.7, 1.1])
+    want = _modern_robotics_speeds(twist, dict.fromkeys(CORNERS, gamma_mr))
+    thesis = _robot([{"name": n, "type": "swedish", "position": list(p), "heading": 0, "r": R, "r_r": 0.01,
+                      "gamma": f"{gamma_mr + 90.0} deg"} for n, p in CORNERS.items()])
+    np.testing.assert_allclose(wheel_commands(thesis, twist).spin, want, atol=1e-9)
