@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -140,3 +141,43 @@ def test_steer_range_description_field():
     fixed = {"name": "f", "type": "fixed", "position": [0, 0], "beta": 0, "r": 0.1, "steer_range": [0, 1]}
     with pytest.raises(DescriptionError, match=r"wheels\[0\]\.steer_range: a fixed wheel does not steer"):
         Robot.from_dict({"name": "x", "wheels": [fixed]})
+
+
+@pytest.mark.parametrize("period", [None, 0.05])
+def test_a_reference_beyond_the_steering_range_is_reported_not_followed(period):
+    """The car's front wheels turn +-40 deg: a 1 m circle needs more. The ideal loop used to move the car with the
+    commanded twist whatever its wheels could do (a perfect 1e-8 m track of an impossible circle); now the wheels
+    stay within their range, the car moves with the least-squares twist of its drive wheels there, and the run
+    lists which wheel was held at its limit and when."""
+    car = catalog.load("ackermann")
+    run = track(car, builtin_reference("circle", size=1.0), period=period, duration=12)
+    assert np.all(np.abs(run.heading) <= math.radians(40) + 1e-9)
+    held = {v["wheel"]: v for v in run.range_violations()}
+    assert set(held) == {"front_left", "front_right"} and all(v["seconds"] > 5 for v in held.values())
+    assert run.summary()["max_error"] > 0.3  # the circle is not followed
+    assert run.to_dict()["beyond_steer_range"] == run.range_violations()
+    wide = track(car, builtin_reference("circle", size=8.0), period=period, duration=12)  # within the range
+    unlimited = replace(car, wheels=tuple(replace(w, steer_range=None) for w in car.wheels))
+    assert wide.range_violations() == []
+    assert np.array_equal(wide.pose, track(unlimited, builtin_reference("circle", size=8.0), period=period,
+                                           duration=12).pose)
+
+
+def test_the_dynamic_plant_keeps_the_wheel_within_its_range():
+    """Through the dynamics the steering servo is given the angle at the end of the range, never beyond."""
+    truck = with_steer_range(catalog.load("forklift"), "steer", -math.radians(25), math.radians(25))
+    run = track(truck, builtin_reference("circle", size=2.0), dynamics=True, duration=8)
+    assert np.abs(run.heading[:, 0]).max() <= math.radians(25) + 1e-3  # the servo's overshoot at most
+    assert [v["wheel"] for v in run.range_violations()] == ["steer"]
+    free = track(catalog.load("forklift"), builtin_reference("circle", size=2.0), dynamics=True, duration=8)
+    assert np.abs(free.heading[:, 0]).max() > math.radians(35) and free.range_violations() == []
+
+
+def test_track_cli_warns_when_a_wheel_is_held_at_its_range(capsys):
+    from wmrkit.cli.main import main
+
+    assert main(["track", "ackermann", "--reference", "circle", "--size", "1", "--duration", "5"]) == 0
+    err = capsys.readouterr().err
+    assert "wheel 'front_left' was asked to steer beyond its range [-40, 40] deg" in err
+    assert main(["track", "ackermann", "--reference", "circle", "--size", "8", "--duration", "5"]) == 0
+    assert capsys.readouterr().err == ""

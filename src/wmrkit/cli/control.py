@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import warnings
 
@@ -109,6 +110,12 @@ def run_track(args: argparse.Namespace) -> int:
     for w in caught:
         if issubclass(w.category, SamplingWarning):
             print(f"wmrkit: warning: {w.message}", file=sys.stderr)
+    for v in run.range_violations():
+        lo, hi = (math.degrees(a) for a in robot.wheel(v["wheel"]).steer_range)
+        print(f"wmrkit: warning: wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg for "
+              f"{v['seconds']:.3g} s (t = {v['from']:.4g} to {v['to']:.4g} s) and was held at its end: the robot "
+              "cannot follow this reference there (its wheels scrub; the tracking errors are the result)",
+              file=sys.stderr)
     if args.plot or args.animate:
         from ..control.plots import animate_run, plot_run
 

@@ -4,8 +4,10 @@ Each instant: position control (a :class:`~wmrkit.control.laws.PositionLaw`, or 
 velocity to impose; :func:`~wmrkit.control.points.twist_for_velocity` turns it into an admissible body twist;
 :func:`~wmrkit.kinematics.wheel_ik.wheel_commands` gives every wheel's command at the current steering (castor
 angles fed back, §8.4.3); the steering policy and ranges pick the roots (:mod:`.steering`). The plant is ideal
-(the robot moves with the commanded twist) or goes through low-level loops (:mod:`.actuators`), the twist then
-being the least-squares one (4.11) of the joints' actual rates at the actual steering. The pose is measured
+(the robot moves with the commanded twist, unless a wheel is held at the end of its steering range: then with the
+least-squares twist (4.11) of the actuated wheels' commanded rates at the steering reached) or goes through
+low-level loops (:mod:`.actuators`), the twist then being the least-squares one of the joints' actual rates at the
+actual steering. Each record says which steered wheels were within their range (``in_range``). The pose is measured
 exactly, optionally ``delay`` samples late (discrete loop).
 """
 
@@ -15,10 +17,11 @@ import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
-from ..kinematics.wheel_ik import forward_kinematics, wheel_commands
+from ..kinematics.wheel_ik import WheelCommands, forward_kinematics, wheel_commands
 from ..limits import MAX_SPEED
 from ..robot import Robot
 from .actuators import LowLevelLoops
@@ -62,6 +65,16 @@ def law_controller(cp: ControlPoint, law: PositionLaw, reference: Reference) -> 
     return control
 
 
+class _Commands(NamedTuple):
+    """One evaluation of the wheel commands: the IK, the steering targets (thesis beta), the spins of the steered
+    wheels for the chosen roots, and whether each steered wheel's target lies within its range."""
+
+    ik: WheelCommands
+    target: np.ndarray
+    spin: np.ndarray
+    fits: np.ndarray
+
+
 @dataclass(frozen=True)
 class Plant:
     """How the commands move the robot: `loops` (None: ideal joints), steering `policy` (see :mod:`.steering`)."""
@@ -90,46 +103,75 @@ class _Sim:
                 raise ControlError(f"low-level loop on '{j}': only steerable and double wheels have a commanded angle")
             if joint == "spin" and "spin" not in w.kind.rates:
                 raise ControlError(f"low-level loop on '{j}': wheel '{wheel}' has no 'spin' joint")
+        self.limited = bool(np.isfinite(self.ranges).any())
         spins = [j for j in self.joints if j.endswith(".spin")]
-        if loops is not None and not spins:
+        if (loops is not None or self.limited) and not spins:
             spins = [j for j in robot.actuated if j.endswith(".spin")]
         self.drive = tuple(spins)
+        if self.limited and not self.drive:
+            raise ControlError(f"robot '{robot.name}' has steering ranges but no actuated spin: the loop cannot tell "
+                               "how it moves when a wheel is held at the end of its range")
         self.n_loop = 0 if loops is None else loops.size
 
-    def commands(self, twist: np.ndarray, beta: np.ndarray):
+    def commands(self, twist: np.ndarray, beta: np.ndarray) -> _Commands:
         """Wheel commands at steering `beta`, with the policy and ranges applied to the steered wheels."""
         c = wheel_commands(self.robot, twist, beta)
         target = np.array(c.beta)
-        if len(target) and (self.plant.policy != "closest" or np.isfinite(self.ranges).any()):
+        spin = np.asarray(c.spin)[self.wheel_of_steer]
+        fits = np.ones(len(target), dtype=bool)
+        if len(target) and (self.plant.policy != "closest" or self.limited):
             steered = ~self.passive
             heading = target - math.pi / 2 + self.delta
-            spin = np.asarray(c.spin)[self.wheel_of_steer]
             ch = choose_steering(heading, spin, beta - math.pi / 2 + self.delta, policy=self.plant.policy,
                                  ranges=self.ranges)
             target = np.where(steered, np.asarray(ch.heading) + math.pi / 2 - self.delta, target)
-        return c, target
+            spin = np.where(steered, np.asarray(ch.spin), spin)
+            fits = np.asarray(ch.in_range) | self.passive
+        return _Commands(c, target, spin, fits)
 
-    def joint_commands(self, c, target: np.ndarray) -> np.ndarray:
+    def realised(self, twist: np.ndarray, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The ideal plant's twist and which steered wheels fit their ranges: the commanded twist, or, when a wheel
+        is held at the end of its range, the least-squares twist (4.11) of the actuated wheels' commanded rates at
+        the steering reached (the wheels scrub: the robot cannot move as commanded)."""
+        if not self.limited:
+            return twist, np.ones(len(self.ranges), dtype=bool)
+        cmd = self.commands(twist, beta)
+        if cmd.fits.all():
+            return twist, cmd.fits
+        return self.least_squares_twist(cmd, cmd.target, {}), cmd.fits
+
+    def least_squares_twist(self, cmd: _Commands, beta: np.ndarray, actual: dict[str, float]) -> np.ndarray:
+        """Twist (4.11) of the drive joints' rates (`actual` where given, else commanded) at steering `beta`."""
+        rates = {}
+        for j in self.drive:
+            wheel = j.partition(".")[0]
+            if j in actual:
+                rates[j] = actual[j]
+            elif wheel in self.robot.steer_names and j.endswith(".spin"):  # the spin of the chosen root
+                rates[j] = float(cmd.spin[self.robot.steer_names.index(wheel)])
+            else:
+                rates[j] = float(cmd.ik.rates[self.robot.rate_names.index(j)])
+        twist, _ = forward_kinematics(self.robot, rates, beta)
+        return np.asarray(twist)
+
+    def joint_commands(self, cmd: _Commands) -> np.ndarray:
         out = np.zeros(len(self.joints))
         for i, j in enumerate(self.joints):
             wheel, _, joint = j.partition(".")
             if joint == "steer":
-                out[i] = target[self.robot.steer_names.index(wheel)]
+                out[i] = cmd.target[self.robot.steer_names.index(wheel)]
+            elif joint == "spin" and wheel in self.robot.steer_names:  # the spin of the chosen root
+                out[i] = cmd.spin[self.robot.steer_names.index(wheel)]
             else:
-                out[i] = c.rates[self.robot.rate_names.index(j)]
+                out[i] = cmd.ik.rates[self.robot.rate_names.index(j)]
         return out
 
-    def plant_twist(self, twist_cmd: np.ndarray, c, beta: np.ndarray, loop_state: np.ndarray) -> np.ndarray:
+    def plant_twist(self, twist_cmd: np.ndarray, cmd: _Commands, beta: np.ndarray,
+                    loop_state: np.ndarray) -> np.ndarray:
         if self.plant.loops is None or not self.drive:
             return twist_cmd
-        rates = {}
-        for j in self.drive:
-            if j in self.joints:
-                rates[j] = loop_state[self.joints.index(j)]
-            else:
-                rates[j] = float(c.rates[self.robot.rate_names.index(j)])
-        twist, _ = forward_kinematics(self.robot, rates, beta)
-        return np.asarray(twist)
+        return self.least_squares_twist(cmd, beta, {j: loop_state[self.joints.index(j)] for j in self.drive
+                                                    if j in self.joints})
 
     def actual_beta(self, target: np.ndarray, beta: np.ndarray, loop_state: np.ndarray) -> np.ndarray:
         out = np.where(self.passive, beta, target)
@@ -173,13 +215,13 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
             twist, de = controller(t, pose, integral)
         else:
             twist, de = held
-        if plant.loops is None:  # ideal joints: the robot moves with the commanded twist
-            actual_beta, moving = beta, twist
+        if plant.loops is None:  # ideal joints: the robot moves with the commanded twist, if its wheels can
+            actual_beta, (moving, _) = beta, sim.realised(twist, beta)
         else:
-            c, target = sim.commands(twist, beta)
-            ls = plant.loops.settle_ideal(ls, sim.joint_commands(c, target))
-            actual_beta = sim.actual_beta(target, beta, ls)
-            moving = sim.plant_twist(twist, c, actual_beta, ls)
+            cmd = sim.commands(twist, beta)
+            ls = plant.loops.settle_ideal(ls, sim.joint_commands(cmd))
+            actual_beta = sim.actual_beta(cmd.target, beta, ls)
+            moving = sim.plant_twist(twist, cmd, actual_beta, ls)
         th = pose[2]
         dpose = np.array([math.cos(th) * moving[0] - math.sin(th) * moving[1],
                           math.sin(th) * moving[0] + math.cos(th) * moving[1], moving[2]])
@@ -187,7 +229,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
         if sim.passive.any():  # castors turn by themselves (8.24): integrate at the actual twist
             cc = wheel_commands(robot, moving, actual_beta)
             dbeta[sim.passive] = np.asarray(cc.steer_rate)[sim.wheel_of_steer[sim.passive]]
-        dls = ls[:0] if plant.loops is None else plant.loops.derivative(ls, sim.joint_commands(c, target))
+        dls = ls[:0] if plant.loops is None else plant.loops.derivative(ls, sim.joint_commands(cmd))
         return np.concatenate([dpose, de if held is None else np.zeros(3), dbeta, dls])
 
     if period is None:
@@ -231,7 +273,8 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
         n = math.floor(duration / period + 1e-9) + 1
         x, history, records = x0.copy(), [x0[:3].copy()], []
         integral = np.zeros(3)
-        subs = max(1, math.ceil(period / 0.02)) if (plant.loops is not None or sim.passive.any()) else 1
+        exact = plant.loops is None and not sim.passive.any()  # the ideal plant's exact SE(2) step
+        subs = 1 if exact else max(1, math.ceil(period / 0.02))
         for k in range(n):
             t = k * period
             measured = history[max(0, k - delay)]
@@ -241,11 +284,13 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
             x[3:6] = integral
             records.append(_record_held(sim, t, x, split, twist, x[6:6 + n_s]))
             x[6:6 + n_s] = records[-1]["beta"]  # steered wheels keep the angle they were given
+            if exact:  # a wheel held at the end of its range: the twist its wheels give instead (rhs does it else)
+                held = sim.realised(held, x[6:6 + n_s])[0]
             if k == n - 1:
                 break
-            x = _advance(rhs, x, t, period, subs, (held, de), plant.loops is None and not sim.passive.any())
+            x = _advance(rhs, x, t, period, subs, (held, de), exact)
             history.append(x[:3].copy())
-    return {key: np.array([r[key] for r in records]) for key in ("t", "pose", "twist", "beta", "target")}
+    return {key: np.array([r[key] for r in records]) for key in ("t", "pose", "twist", "beta", "target", "in_range")}
 
 
 def _advance(rhs, x: np.ndarray, t: float, period: float, subs: int, held: tuple, exact: bool) -> np.ndarray:
@@ -276,6 +321,7 @@ def _record(controller, sim: _Sim, t: float, x: np.ndarray, split, prev: np.ndar
 def _record_held(sim: _Sim, t: float, x: np.ndarray, split, twist: np.ndarray, prev: np.ndarray) -> dict:
     pose, _, beta, ls = split(x)
     beta = np.where(sim.passive, beta, prev)  # castors: integrated state; steered wheels: the last angle given
-    _c, target = sim.commands(twist, beta)
-    actual = sim.actual_beta(target, beta, ls)
-    return {"t": t, "pose": pose.copy(), "twist": np.asarray(twist, dtype=float), "beta": actual, "target": target}
+    cmd = sim.commands(twist, beta)
+    actual = sim.actual_beta(cmd.target, beta, ls)
+    return {"t": t, "pose": pose.copy(), "twist": np.asarray(twist, dtype=float), "beta": actual,
+            "target": cmd.target, "in_range": cmd.fits}

@@ -45,7 +45,10 @@ class TrackingRun:
     - ``commands``: the per-wheel commands (:class:`WheelCommands`, batch ``(n,)``) at the commanded steering;
     - ``estimate`` ``(n, 3)``: the odometry's pose estimate when the loop was closed on it, else None;
     - ``slip_model``: where the wheel commands came from (``"none"``: the no-slip IK; ``"mqe"``, ``"mcd"``: the
-      inverse slip model, :mod:`.slip_control`); ``feedback``: what the controller measured (:mod:`.slip_loop`).
+      inverse slip model, :mod:`.slip_control`); ``feedback``: what the controller measured (:mod:`.slip_loop`);
+    - ``beyond_range`` ``(n, n_steer)`` bool: where a steered wheel was asked for a heading outside its
+      ``steer_range`` and held at the end of it (the robot then moves with the least-squares twist of its drive
+      wheels: it cannot follow as commanded); :meth:`range_violations` lists them per wheel.
     """
 
     robot: Robot
@@ -64,6 +67,22 @@ class TrackingRun:
     estimate: np.ndarray | None = None
     slip_model: str = "none"
     feedback: str = "pose"
+    beyond_range: np.ndarray | None = None
+
+    def range_violations(self) -> list[dict[str, Any]]:
+        """Per steered wheel held at the end of its range: ``{"wheel", "from", "to", "seconds"}`` ([s]: first and
+        last sample, and the time spent beyond the range, counted in samples)."""
+        if self.beyond_range is None or not self.beyond_range.any():
+            return []
+        dt = np.diff(self.t, append=self.t[-1] + (self.t[-1] - self.t[-2] if len(self.t) > 1 else 0.0))
+        out = []
+        for k, name in enumerate(self.robot.steer_names):
+            hit = self.beyond_range[:, k]
+            if hit.any():
+                idx = np.flatnonzero(hit)
+                out.append({"wheel": name, "from": float(self.t[idx[0]]), "to": float(self.t[idx[-1]]),
+                            "seconds": float(dt[hit].sum())})
+        return out
 
     def summary(self, settle: float = 0.0) -> dict[str, float]:
         """RMS, max and final tracking and cross-track errors [m] after time `settle` [s]."""
@@ -88,6 +107,7 @@ class TrackingRun:
             out["estimate"] = self.estimate.tolist()
         if self.slip_model != "none" or self.feedback != "pose":
             out["slip_model"], out["feedback"] = self.slip_model, self.feedback
+        out["beyond_steer_range"] = self.range_violations()
         return out
 
 
@@ -199,7 +219,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     return TrackingRun(robot, controller, readonly(t), readonly(pose), readonly(ref), readonly(tracked),
                        readonly(error), readonly(cross), readonly(out["twist"]), readonly(np.asarray(heading)),
                        commands, period, delay, readonly(out["estimate"]) if "estimate" in out and
-                       feedback != "pose" else None, slip_model, feedback)
+                       feedback != "pose" else None, slip_model, feedback,
+                       readonly(~out["in_range"]) if "in_range" in out else None)
 
 
 #: Most samples of a run (control periods, or output samples of a continuous loop): each costs a control law
@@ -221,7 +242,7 @@ def _check_timing(duration: float, period: float | None, output_dt: float) -> No
 #: Integration step of the loops through the dynamics [s] (their default).
 DYNAMICS_STEP = 1e-3
 #: Most control periods of a loop with slip-model commands or slip-aware feedback: each solves the nonlinear slip
-#: model (3 to 7 ms a period for the skid steer: at most about 6 min).
+#: model (1 to 2.3 ms a period for the skid steer and the forklift: at most about 2 min).
 MAX_SLIP_PERIODS = 50_000
 
 
