@@ -193,3 +193,35 @@ def test_a_log_filtered_in_pieces_gives_the_same_bits():
         x, p = run.twist[-1], run.covariance
         increments.append(run.increments)
     np.testing.assert_array_equal(np.concatenate(increments), whole.increments)
+
+
+@pytest.mark.parametrize("scale", [1e100, 1e-100, 3.7])
+def test_only_the_ratios_of_the_noises_matter(scale):
+    """Scaling every standard deviation scales the covariance by its square and leaves the twists: the filter runs
+    on their ratios. Before, k13 = 1e100 (a valid noise) overflowed the 3x3 inverses and odometry printed a pose of
+    NaN (null in JSON) with exit 0."""
+    fork = catalog.load("forklift")
+    log = drive(fork, 300, quantum=math.radians(1.4118), seed=5)
+    base = kalman_model(fork, "fk2", fk2_noise(0.28, 3.57, 0.28))
+    scaled = kalman_model(fork, "fk2", fk2_noise(0.28 * scale, 3.57 * scale, 0.28 * scale, scale))
+    x0, p0 = [0.1, 0.0, 0.0], np.diag([0.5, 0.2, 0.3])
+    want = kalman_filter(base, log, x0=x0, p0=p0)
+    got = kalman_filter(scaled, log, x0=x0, p0=p0 * scale**2)
+    np.testing.assert_allclose(got.twist, want.twist, rtol=0, atol=1e-13 * np.abs(want.twist).max())
+    np.testing.assert_allclose(got.covariance / scale**2, want.covariance, rtol=1e-13)
+    poses = kalman_odometry(scaled, log).poses
+    np.testing.assert_allclose(poses, kalman_odometry(base, log).poses, rtol=0, atol=1e-12)
+
+
+def test_a_result_that_is_not_finite_is_refused_not_printed():
+    """The summary every odometry run returns refuses non-finite numbers (an overflow inside wmrkit): the CLI says
+    so in one line instead of printing null with exit 0."""
+    from wmrkit.errors import WmrkitError
+    from wmrkit.odometry.pipeline import OdometrySummary
+
+    good = OdometrySummary("forklift", "fk2", 3, 0.0, 1.0, (1.0, 2.0, 0.5), 3.0, 0.5, 0.0, 0.0, 0.01)
+    assert good.to_dict()["pose"] == [1.0, 2.0, 0.5]
+    with pytest.raises(WmrkitError, match="not finite"):
+        OdometrySummary("forklift", "fk2", 3, 0.0, 1.0, (math.nan, 2.0, 0.5), 3.0, 0.5, 0.0, 0.0, 0.01)
+    with pytest.raises(WmrkitError, match="not finite"):
+        OdometrySummary("forklift", "fk2", 3, 0.0, 1.0, (1.0, 2.0, 0.5), 3.0, 0.5, 0.0, math.inf, 0.01)

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
+from ..errors import WmrkitError
 from ..limits import MAX_COORDINATE
 from ..robot import Robot
 from .covariance import CrowleyNoise, JointNoise, propagate_covariance
@@ -49,6 +50,16 @@ class OdometrySummary:
     rms_slip: float
     max_dt: float
     final_covariance: tuple[tuple[float, ...], ...] | None = None
+
+    def __post_init__(self) -> None:
+        """Inputs are checked finite and bounded, so a result that is not is an overflow inside wmrkit: refused
+        here (one line from the CLI), never printed as NaN (null in JSON) with success."""
+        values = (*self.final_pose, self.distance, self.rotation, self.max_slip, self.rms_slip,
+                  *(v for row in self.final_covariance or () for v in row))
+        if not all(math.isfinite(v) for v in values):
+            raise WmrkitError(f"odometry ({self.method}) of robot '{self.robot}': the result is not finite (final "
+                              f"pose {list(self.final_pose)}, path length {self.distance}): a numerical overflow in "
+                              "wmrkit; please report it with the log")
 
     def to_dict(self) -> dict:
         """JSON-ready mapping; ``pose`` is the final pose ``[x, y, theta]``."""

@@ -94,12 +94,18 @@ class KalmanModel:
     _cache: dict = field(init=False, default_factory=dict, compare=False, repr=False)
 
     def matrices(self, beta_full: np.ndarray) -> tuple[np.ndarray, ...]:
-        """``(H, M, C, A_a)`` per configuration ``(U, n_steer) -> (U, 3, 3), (U, 3, n_a), (U, m, 3), (U, m, n_a)``."""
+        """``(H, M, C, A_a)`` per configuration ``(U, n_steer) -> (U, 3, 3), (U, 3, n_a), (U, m, 3), (U, m, n_a)``,
+        ``H`` and ``M`` per unit of process variance (``R`` divided by ``Q``, see :func:`_run`)."""
         a = self.odometry.robot.constraint_matrix(beta_full)[..., self.rows, :]
         cols = np.array([self.odometry.robot.velocity_index(j) for j in self.odometry.rate_joints], dtype=int)
         c, aa = a[..., :3], a[..., cols]
-        ct_r = np.swapaxes(c, -1, -2) / self.sigma**2
+        ct_r = np.swapaxes(c, -1, -2) / self.relative_variances
         return ct_r @ c, -(ct_r @ aa), np.ascontiguousarray(c), np.ascontiguousarray(aa)
+
+    @property
+    def relative_variances(self) -> np.ndarray:
+        """The rows' variances over the process variance ``sigma^2 / k13^2``: all the filter's twists depend on."""
+        return (self.sigma / np.sqrt(self.process)) ** 2
 
     def configuration_maps(self, configs: ArrayLike | None = None) -> ConfigurationMaps:
         """``(H, M, C, A_a, [C, A_a])`` (:meth:`matrices`) for every steering configuration met so far (angles of the
@@ -200,7 +206,9 @@ def _run(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike 
         c, aa = (a[maps.find(first[None])[0]] for a in maps.arrays[2:4])
         rate0 = (p[1, rate_cols] - p[0, rate_cols]) / (t[1] - t[0])
         x0 = np.linalg.lstsq(c / model.sigma[:, None], -(aa @ rate0) / model.sigma, rcond=None)[0]
-    p_start = np.eye(3) * model.process if p0 is None else np.asarray(p0, dtype=float)
+    # The kernel runs on the covariance over the process variance (Q = I, R / k13^2): the twists depend on those
+    # ratios alone, and a covariance of k13^2 = 1e200 would overflow in the 3x3 inverses (cubes of its entries).
+    p_start = np.eye(3) if p0 is None else np.asarray(p0, dtype=float) / model.process
     filt = np.concatenate([np.asarray(x0, dtype=float).reshape(3), p_start[[0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]])
     slip = np.empty(len(t) - 1)
     missing = np.empty((len(t) - 1, len(steer_cols)))
@@ -208,10 +216,11 @@ def _run(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike 
     while True:
         start, count = _kalman_kernel.kalman_chunk(p[1:], p[0], t[1:], t[0], rate_cols, steer_cols, start, maps.keys,
                                                    maps.ids, maps.arrays[0], maps.arrays[1], maps.arrays[4],
-                                                   model.process, model.thesis_double_q,
+                                                   1.0, model.thesis_double_q,
                                                    filt, pose, HEADING_FRACTION[method], method == "exact",
                                                    increments, poses, slip, missing)
         if count == 0:
+            filt[3:] *= model.process
             return slip, filt
         maps = model.configuration_maps(np.unique(missing[:count], axis=0))
 
