@@ -107,7 +107,8 @@ def test_calibrate_refuses_a_broken_reference_trajectory(tum, expected, tmp_path
 @pytest.mark.parametrize("option, expected", [
     (["--method", "wls", "--mu-default", "1e308,1e-308"], "differ by more than a factor"),  # pose 0, 0, 0 before
     (["--method", "wls", "--mu", "front_left=1e40,1"], "front_left (lateral) (1e+40)"),  # pose 0, 0, 0 before
-    (["--method", "wls", "--mu-default", ""], "expected two numbers"),  # ignored before
+    (["--method", "wls", "--mu-default", ""], "--mu-default: empty value"),  # ignored before
+    (["--method", "wls", "--mu-default", "1,"], "expected two numbers"),
     (["--mu", "front_left=2,1"], "--mu applies to --method wls, not to --method exact"),  # ignored before
     (["--kf-noise", "1", "1", "1"], "--kf-noise applies to --method fk1 or fk2"),  # ignored before
 ])
