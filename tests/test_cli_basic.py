@@ -70,6 +70,14 @@ def test_show_json_parses():
     assert data["actuated_joints"] == ["right_drive.spin", "left_drive.spin", "steer.steer"]
 
 
+@pytest.mark.parametrize("module", ["wmrkit", "wmrkit.cli.main"])
+def test_a_command_run_as_a_module_says_nothing_on_stderr(module):
+    """``python -m wmrkit.cli.main`` ran main() before the module had defined the compile notice's helper, so any
+    command lasting longer than the notice's first poll (0.25 s) printed a NameError traceback from its thread."""
+    out = _wmrkit("analyze", "forklift", module=module)
+    assert out.returncode == 0 and out.stderr == "", out.stderr
+
+
 def test_robots_json_parses_and_lists_the_catalog():
     out = _wmrkit("robots", "--json", module="wmrkit")  # python -m wmrkit works too
     assert out.returncode == 0, out.stderr

@@ -150,10 +150,6 @@ def _version() -> str:
     return __version__
 
 
-if __name__ == "__main__":
-    sys.exit(main())
-
-
 def _compiling() -> bool:
     """Whether another thread holds numba's compiler lock (False while numba is not imported)."""
     lock = getattr(getattr(sys.modules.get("numba.core.compiler_lock"), "global_compiler_lock", None), "_lock", None)
@@ -162,3 +158,6 @@ def _compiling() -> bool:
     lock.release()
     return False
 
+
+if __name__ == "__main__":
+    sys.exit(main())
