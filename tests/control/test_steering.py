@@ -181,3 +181,55 @@ def test_track_cli_warns_when_a_wheel_is_held_at_its_range(capsys):
     assert "wheel 'front_left' was asked to steer beyond its range [-40, 40] deg" in err
     assert main(["track", "ackermann", "--reference", "circle", "--size", "8", "--duration", "5"]) == 0
     assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize(("wanted", "held", "same_spin"), [
+    (70.0, 40.0, True), (45.0, 40.0, True), (-70.0, -40.0, True),  # past an end: that end, rolling forward
+    (120.0, -40.0, False), (-125.0, 40.0, False),  # nearer the other root's end: reversed
+])
+def test_a_wheel_that_cannot_fit_its_range_is_held_at_the_end_nearest_to_what_is_asked(wanted, held, same_spin):
+    """Neither root of (8.9) fits +-40 deg: the wheel is held at the end nearest to either root, with that root's
+    spin. 116bfba held every such wheel at the end nearest to the reversed root (70 deg asked, -40 deg held with
+    the spin reversed): a car told to turn left turned right."""
+    ch = choose_steering([math.radians(wanted)], [2.0], [0.0], ranges=[[-math.radians(40), math.radians(40)]])
+    assert not ch.in_range[0]
+    assert ch.heading[0] == pytest.approx(math.radians(held))
+    assert ch.spin[0] == (2.0 if same_spin else -2.0)
+
+
+def test_a_car_held_at_its_steering_stops_still_turns_the_way_it_is_told():
+    """The 1 m circle asks about 70 deg of the +-40 deg rack: whenever the front wheels are held at a stop, the car
+    turns the way the law asks (the sign of the realised rate of turn, from the poses of the held periods, is the
+    commanded one), and the wheels cross over only where the law's turn changes sign (116bfba: the wrong stop,
+    so turns the wrong way, and about 190 crossings in this run)."""
+    car = catalog.load("ackermann")
+    run = track(car, builtin_reference("circle", size=1.0), period=0.05, duration=12)
+    front = run.heading[:-1, 0]
+    held = np.isclose(np.abs(front), math.radians(40), rtol=0, atol=1e-9)
+    realised = np.diff(run.pose[:, 2]) / 0.05
+    assert held.sum() > 100
+    assert np.array_equal(np.sign(realised[held]), np.sign(run.twist[:-1, 2][held]))
+    assert np.count_nonzero(np.diff(np.sign(front))) <= 6
+
+
+def test_a_robot_without_actuators_described_is_tracked_with_its_steering_ranges():
+    """No `actuated:` joints: the robot is taken to move as the IK spins every wheel (116bfba refused every such
+    run, even with ranges a wheel never leaves)."""
+    swerve = catalog.load("swerve-4")
+    free = replace(swerve, wheels=tuple(replace(w, actuated=(), steer_range=(-math.pi / 2, math.pi / 2))
+                                        for w in swerve.wheels))
+    run = track(free, builtin_reference("circle", size=2.0), duration=8)
+    assert run.range_violations() == [] and run.summary()["max_error"] < 1e-6
+    car = catalog.load("ackermann")
+    bare = replace(car, wheels=tuple(replace(w, actuated=()) for w in car.wheels))
+    held = track(bare, builtin_reference("circle", size=1.0), duration=8)
+    assert {v["wheel"] for v in held.range_violations()} == {"front_left", "front_right"}
+
+
+def test_the_loop_through_the_slip_models_keeps_the_wheel_within_its_range():
+    """The loop that feeds back an estimate (or commands the slip models) applied no range before: the forklift held
+    to +-25 deg steered 34 deg with no violation reported."""
+    truck = with_steer_range(catalog.load("forklift"), "steer", -math.radians(25), math.radians(25))
+    run = track(truck, builtin_reference("circle", size=2.0), dynamics=True, feedback="wls", duration=8)
+    assert np.abs(run.heading[:, 0]).max() <= math.radians(25) + 1e-3
+    assert [v["wheel"] for v in run.range_violations()] == ["steer"]

@@ -16,7 +16,6 @@ scalar form, :func:`fast_law_controller` (the numbers of :func:`.loop.law_contro
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 
 import numpy as np
 
@@ -25,7 +24,7 @@ from .laws import PositionLaw
 from .loop import TwistController, check_command
 from .points import ControlError, ControlPoint, check_delay
 from .references import Reference
-from .steering import choose_steering, steer_ranges
+from .steering import range_keeper
 from .tick import scalar_law
 
 __all__ = ["fast_law_controller", "simulate_dynamics"]
@@ -65,7 +64,7 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
     history, integral = [s[:3].copy()], np.zeros(3)
     odometer = _Odometer(robot, model, s) if feedback == "odometry" else None
     out = {key: [] for key in ("t", "pose", "twist", "beta", "target", "estimate", "in_range")}
-    held_in_range = _range_keeper(robot)
+    held_in_range = range_keeper(robot)
     for k in range(n):
         t = k * period
         twist, de = controller(t, history[max(0, k - delay)], integral)
@@ -85,28 +84,6 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
         stepper.advance(None, held)  # a WmrkitError if the dynamics diverge
         history.append(s[:3].copy() if odometer is None else odometer.step(s))
     return {key: np.array(values) for key, values in out.items()}
-
-
-def _range_keeper(robot) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
-    """``(headings, rates) -> in_range``: moves, in place, each steered wheel's heading to a root of (8.9) within
-    its ``steer_range`` (its spin negated with the other root), or to the nearer end of the range when neither
-    fits; returns which fitted (:func:`.steering.choose_steering`)."""
-    ranges = steer_ranges(robot)
-    steered = np.array([robot.wheel(n).type in ("steerable", "double") for n in robot.steer_names], dtype=bool)
-    spin = np.array([robot.rate_names.index(f"{n}.spin") if f"{n}.spin" in robot.rate_names else -1
-                     for n in robot.steer_names], dtype=int)
-    limited = np.isfinite(ranges).any(axis=1) & steered & (spin >= 0)
-
-    def keep(heading: np.ndarray, rates: np.ndarray) -> np.ndarray:
-        if not limited.any():
-            return np.ones(len(heading), dtype=bool)
-        ch = choose_steering(heading[limited], rates[spin[limited]], heading[limited], ranges=ranges[limited])
-        heading[limited], rates[spin[limited]] = ch.heading, ch.spin
-        fits = np.ones(len(heading), dtype=bool)
-        fits[limited] = ch.in_range
-        return fits
-
-    return keep
 
 
 def fast_law_controller(cp: ControlPoint, law: PositionLaw, reference: Reference) -> TwistController:

@@ -107,10 +107,9 @@ class _Sim:
         spins = [j for j in self.joints if j.endswith(".spin")]
         if (loops is not None or self.limited) and not spins:
             spins = [j for j in robot.actuated if j.endswith(".spin")]
+        if self.limited and not spins:  # no actuator described: every wheel spins as the IK commands it
+            spins = [j for j in robot.rate_names if j.endswith(".spin")]
         self.drive = tuple(spins)
-        if self.limited and not self.drive:
-            raise ControlError(f"robot '{robot.name}' has steering ranges but no actuated spin: the loop cannot tell "
-                               "how it moves when a wheel is held at the end of its range")
         self.n_loop = 0 if loops is None else loops.size
 
     def commands(self, twist: np.ndarray, beta: np.ndarray) -> _Commands:

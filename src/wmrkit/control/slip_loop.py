@@ -33,6 +33,7 @@ from ..slip.weights import SlipWeights
 from .loop import TwistController, check_command
 from .points import ControlError, check_delay
 from .slip_control import SLIP_MODELS, SlipCommander, SlipInverse, _Forward, slip_inverse
+from .steering import range_keeper
 
 __all__ = ["FEEDBACK", "simulate_slip_control", "with_commanded_rates"]
 
@@ -87,7 +88,9 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     n = math.floor(duration / period + 1e-9) + 1
     history, integral = [s[:3].copy()], np.zeros(3)
     previous = None
-    keys = ("t", "pose", "twist", "beta", "target", "estimate", "rates", "predicted", "velocity", "joint_rates")
+    keys = ("t", "pose", "twist", "beta", "target", "estimate", "rates", "predicted", "velocity", "joint_rates",
+            "in_range")
+    held_in_range, all_rates = range_keeper(robot), np.zeros(len(robot.rate_names))
     records: dict[str, list] = {k: [] for k in keys}
     bar = None
     if progress:
@@ -108,15 +111,23 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
         else:
             c = commander(twist, beta_now)
             rates, target, predicted = np.asarray(c.rates), np.asarray(c.beta), c.twist
+        heading = np.asarray(robot.heading_of_beta(target), dtype=float).reshape(-1)
+        wanted = heading.copy()
+        all_rates[:] = 0.0
+        all_rates[spin_cols] = rates
+        in_range = held_in_range(heading, all_rates)  # a wheel beyond its steer_range: the other root, or its end
+        if not np.array_equal(heading, wanted):
+            rates, target = all_rates[spin_cols], np.asarray(robot.beta_of_heading(heading), dtype=float).reshape(-1)
         values = (t, s[:3].copy(), np.asarray(twist, float), beta_now, target, history[-1].copy(), rates,
-                  np.asarray(predicted, float), s[model.n:model.n + 3].copy(), s[[model.n + c for c in plant_cols]])
+                  np.asarray(predicted, float), s[model.n:model.n + 3].copy(), s[[model.n + c for c in plant_cols]],
+                  in_range)
         for key, value in zip(keys, values, strict=True):
             records[key].append(value)
         if k == n - 1:
             break
         reference = np.zeros((1, model.n))
         reference[0, plant_cols] = rates
-        heading = np.asarray(robot.heading_of_beta(target), dtype=float).reshape(1, -1)
+        heading = heading.reshape(1, -1)
         if ramp and previous is not None:  # from the previous commands to these over the period
             inputs = replace(template, time=np.array([stepper.t, stepper.t + period]),
                              torques=np.zeros((2, model.n)), rate_reference=np.vstack([previous[0], reference]),

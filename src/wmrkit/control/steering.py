@@ -17,6 +17,7 @@ clamped to the range and flagged: the vehicle must stop and re-orient the wheel 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,6 +44,12 @@ def steer_ranges(robot: Robot) -> np.ndarray:
     return out
 
 
+def _nearest_end(h: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The end of the range ``[lo, hi]`` nearest to heading `h`, and how far it is [rad]."""
+    to_lo, to_hi = np.abs(wrap_angle(h - lo)), np.abs(wrap_angle(h - hi))
+    return np.where(to_lo < to_hi, lo, hi), np.minimum(to_lo, to_hi)
+
+
 def _in_range(h: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     full = ~np.isfinite(lo) | ~np.isfinite(hi)
     lo_, width = np.where(full, 0.0, lo), np.where(full, 0.0, hi - lo)
@@ -65,6 +72,8 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
 
     `heading`, `spin`: one root and its spin ``(..., n)``; the other root is ``heading + pi`` with ``-spin``.
     `current` ``(..., n)``: current headings (for ``"closest"`` and for ties). `ranges` ``(n, 2)`` heading ranges.
+    When neither root fits, the wheel is held at the end of its range nearest to either root, with that root's spin
+    (a car asked for 70 deg left by a +-40 deg rack turns 40 deg left, not 40 deg right with its wheel reversed).
     """
     if policy not in POLICIES:
         raise ControlError(f"unknown steering policy '{policy}' (policies: {', '.join(POLICIES)})")
@@ -89,11 +98,37 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
     h = np.where(take0, h0, h1)
     s = np.where(take0, s0, s1)
     fits = ok0 | ok1
-    if lo is not None and not np.all(fits):
+    if lo is not None and not np.all(fits):  # neither root fits: the end of the range nearest to either root
         with np.errstate(invalid="ignore"):
-            clamp = np.where(np.abs(wrap_angle(h - lo)) < np.abs(wrap_angle(h - hi)), lo, hi)
-        h = np.where(fits, h, clamp)
+            end0, miss0 = _nearest_end(h0, lo, hi)
+            end1, miss1 = _nearest_end(h1, lo, hi)
+        near0 = (miss0 < miss1) | ((miss0 == miss1) & pref0)
+        h = np.where(fits, h, np.where(near0, end0, end1))
+        s = np.where(fits, s, np.where(near0, s0, s1))
     return SteeringChoice(readonly(np.asarray(h)), readonly(np.asarray(s)), readonly(np.asarray(fits)))
+
+
+def range_keeper(robot: Robot) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    """``(headings, rates) -> in_range``: moves, in place, each steered wheel's heading to a root of (8.9) within
+    its ``steer_range`` (its spin negated with the other root), or to the end of the range nearest to either root
+    when neither fits; returns which fitted (:func:`.steering.choose_steering`)."""
+    ranges = steer_ranges(robot)
+    steered = np.array([robot.wheel(n).type in ("steerable", "double") for n in robot.steer_names], dtype=bool)
+    spin = np.array([robot.rate_names.index(f"{n}.spin") if f"{n}.spin" in robot.rate_names else -1
+                     for n in robot.steer_names], dtype=int)
+    limited = np.isfinite(ranges).any(axis=1) & steered & (spin >= 0)
+
+    def keep(heading: np.ndarray, rates: np.ndarray) -> np.ndarray:
+        if not limited.any():
+            return np.ones(len(heading), dtype=bool)
+        ch = choose_steering(heading[limited], rates[spin[limited]], heading[limited], ranges=ranges[limited])
+        heading[limited], rates[spin[limited]] = ch.heading, ch.spin
+        fits = np.ones(len(heading), dtype=bool)
+        fits[limited] = ch.in_range
+        return fits
+
+    return keep
+
 
 
 # ---- swerve motion modes ------------------------------------------------------------------------------------
