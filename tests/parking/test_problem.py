@@ -76,9 +76,11 @@ space: {H: 7 m, J: 2.3 m, MS: 0.25 m, dx2: 1.4 m, final_gap: 0.1 m}
      r"outside"),
     ("vehicle: {robot: ackermann, a1: 3.6 m, b1: 1.0 m, c1: 1.5 m, phi_max: 35 deg}\n",
      r"^x\.yaml:1: vehicle\.c1: the rear wheels \(1\.55 m apart\) stand outside the body's width \(c1 = 1\.5 m\)"),
+    (TABLE_91.replace("H: 3.35", "H: 40 cm"), r"^x\.yaml:8: space\.MS: the margins at both ends \(0\.4 m\) leave "
+     r"nothing of the slot's length H = 0\.4 m"),  # a ZeroDivisionError traceback in the length ratio (9.37) before
 ], ids=["missing", "angle-as-length", "phi-90", "negative", "typo", "zero-width", "unknown-top", "twice",
         "not-car-like", "not-mapping", "list", "python-tag", "no-eval", "front-axle-outside", "track-outside",
-        "robot-track-outside"])
+        "robot-track-outside", "no-free-length"])
 def test_bad_input_gives_one_located_line(text, message):
     with pytest.raises(DescriptionError, match=message) as info:
         problem_from_text(text, source="x.yaml")
@@ -88,3 +90,11 @@ def test_bad_input_gives_one_located_line(text, message):
 def test_absurd_lengths_are_refused_not_sampled_forever():
     with pytest.raises(DescriptionError, match=r"space\.H: 1e\+12 m is not a parking length"):
         problem_from_text(TABLE_91.replace("H: 3.35", "H: 1e12"), source="x.yaml")
+
+
+def test_a_space_without_free_length_is_refused_in_python_too():
+    from wmrkit.errors import WmrkitError
+    from wmrkit.parking import Space
+
+    with pytest.raises(WmrkitError, match=r"H - 2 MS must be > 0"):
+        Space(H=0.4, J=2.0, MS=0.2, dx2=0.7, final_gap=0.07)

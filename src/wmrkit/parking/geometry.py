@@ -95,6 +95,9 @@ class Space:
                 raise WmrkitError(f"space.{name}: must be > 0, got {getattr(self, name)} m")
         if self.MS < 0:
             raise WmrkitError(f"space.MS: must be >= 0, got {self.MS} m")
+        if not self.effective_length > 0:  # no free length: the length ratio (9.37) divides by it
+            raise WmrkitError(f"space.MS: the margins at both ends ({2 * self.MS:g} m) leave nothing of the slot's "
+                              f"length H = {self.H:g} m (H - 2 MS must be > 0)")
 
     @property
     def effective_length(self) -> float:

@@ -141,6 +141,9 @@ def _space(check: FieldReader, data: Any) -> Space:
     for name in ("MS", "dx2"):
         if s[name] < 0:
             check.fail(f"must be >= 0, got {s[name]} m", ("space", name))
+    if not s["H"] - 2 * s["MS"] > 0:
+        check.fail(f"the margins at both ends ({2 * s['MS']:g} m) leave nothing of the slot's length H = {s['H']:g} m "
+                   "(H - 2 MS must be > 0)", ("space", "MS"))
     return Space(**s)
 
 
