@@ -93,6 +93,14 @@ def test_forklift_counts_log_uses_the_catalog_encoders(capsys, tmp_path):
                           "--column", "left_drive.spin=enc_l", "--column", "steer.steer=steer_raw"])
     err3 = np.hypot(*(np.array(out3["pose"][:2]) - run.truth[-1, :2]))
     assert err3 < 0.2 * np.hypot(*(np.array(out["pose"][:2]) - run.truth[-1, :2]))  # trusting the steering less
+    # --gear with the catalog's counts per revolution: 2 encoder turns per wheel turn halve every spin angle (it was
+    # ignored without --cpr: the same pose, exit 0)
+    columns = ["--column", "right_drive.spin=enc_r", "--column", "left_drive.spin=enc_l", "--column",
+               "steer.steer=steer_raw"]
+    geared = [_json(capsys, ["odometry", "forklift", str(path), "--json", "--spin", "counts", "--steer", "counts",
+                             "--time-column", "stamp", *columns, *gear]) for gear in (["--gear", "2"],
+                                                                                      ["--cpr", "8290", "--gear", "2"])]
+    assert geared[0] == geared[1] and geared[0]["distance"] == pytest.approx(out["distance"] / 2, rel=1e-9)
 
 
 def test_wrapping_counter_and_sensed_subset(capsys, tmp_path, diff_run):

@@ -65,7 +65,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    help="steer columns hold headings (0 = straight ahead) or the thesis's beta (logs of older "
                         "wmrkit versions; default: the header's 'steer.steer [deg:beta]', else heading)")
     g.add_argument("--cpr", type=float, help="encoder counts per revolution (default: the catalog's, if any)")
-    g.add_argument("--gear", type=float, default=1.0, help="encoder revolutions per wheel revolution (default 1)")
+    g.add_argument("--gear", type=float, help="encoder revolutions per wheel revolution (default: the catalog's, "
+                   "else 1)")
     g.add_argument("--counter-bits", type=int, help="width of a wrapping hardware counter (default: the header's)")
     g.add_argument("--signed-counter", action="store_true", help="the counter is signed")
     g.add_argument("--steer-resolution", metavar="ANGLE", help="steering encoder resolution [rad, or 'deg']")
@@ -101,7 +102,7 @@ def run(args: argparse.Namespace) -> int:
     bits = merge_option("--counter-bits", args.counter_bits, units.bits, None, args.log)
     signed = args.signed_counter or units.signed
     counted = [j for j in joints if (steer if j.endswith(".steer") else spin) == "counts"]
-    options = {"--cpr": args.cpr is not None, "--gear": args.gear != 1.0,
+    options = {"--cpr": args.cpr is not None, "--gear": args.gear is not None,
                "--counter-bits": args.counter_bits is not None, "--signed-counter": args.signed_counter}
     given = [o for o, v in options.items() if v]
     if given and not any(j.endswith(".spin") for j in counted):  # it would be ignored silently

@@ -165,11 +165,12 @@ def _as_integer(c: np.ndarray, name: str) -> np.ndarray:
 
 
 def encoders_for(robot_name: str, joints: Sequence[str], *, counts_per_rev: float | None = None,
-                 gear_ratio: float = 1.0, bits: int | None = None, signed: bool = False,
+                 gear_ratio: float | None = None, bits: int | None = None, signed: bool = False,
                  steer_resolution: float | None = None) -> tuple[tuple[str, Encoder], ...]:
     """Encoders of `joints` for a counts log: the given settings, else the catalog's (:data:`CATALOG_ENCODERS`).
 
-    Spin joints get an :class:`IncrementalEncoder` (`counts_per_rev`, `gear_ratio`, counter `bits`, `signed`),
+    Spin joints get an :class:`IncrementalEncoder` (`counts_per_rev`, `gear_ratio`, counter `bits`, `signed`; each
+    given one replaces the catalog encoder's, a `gear_ratio` not given is the catalog's or 1),
     steer joints an :class:`AbsoluteEncoder` of `steer_resolution` [rad] reading 0 straight ahead (the rule of
     every steering encoder, catalog ones included). Raises :class:`EncoderError` when a
     joint has neither.
@@ -180,11 +181,13 @@ def encoders_for(robot_name: str, joints: Sequence[str], *, counts_per_rev: floa
         if joint.endswith(".steer"):
             enc = AbsoluteEncoder(steer_resolution) if steer_resolution is not None else known.get(joint)
         elif counts_per_rev is not None:
-            enc = IncrementalEncoder(counts_per_rev, gear_ratio, bits, signed)
+            enc = IncrementalEncoder(counts_per_rev, 1.0 if gear_ratio is None else gear_ratio, bits, signed)
         else:
             enc = known.get(joint)
-            if isinstance(enc, IncrementalEncoder) and bits is not None:
-                enc = IncrementalEncoder(enc.counts_per_rev, enc.gear_ratio, bits, signed, enc.sign)
+            if isinstance(enc, IncrementalEncoder) and (bits is not None or gear_ratio is not None):
+                enc = IncrementalEncoder(enc.counts_per_rev, enc.gear_ratio if gear_ratio is None else gear_ratio,
+                                         enc.bits if bits is None else bits, signed if bits is not None else enc.signed,
+                                         enc.sign)
         if enc is None:
             what = "steering resolution" if joint.endswith(".steer") else "counts per revolution"
             raise EncoderError(f"joint '{joint}' of robot '{robot_name}': no encoder data; give the {what}")
