@@ -29,6 +29,16 @@ def test_tyre_json_is_the_library_value(capsys, tmp_path):
     assert plot.stat().st_size > 1000
 
 
+def test_tyre_friction_coefficients_are_the_forces_over_the_load(capsys):
+    code, out, _ = run(capsys, "tyre", "dugoff", "--load", "8000", "--slip-ratio", "0.1", "--json")
+    data = json.loads(out)
+    assert code == 0 and data["mu_long"] == pytest.approx(-data["Fx"] / 8000) and data["mu_lat"] == 0.0
+    assert str(data["mu_lat"]) == "0.0"  # not -0.0
+    code, out, _ = run(capsys, "tyre", "linear", "--load", "0", "--slip-ratio", "0.1", "--json")
+    data = json.loads(out)
+    assert code == 0 and data["Fx"] < 0 and data["mu_long"] is None and data["mu_lat"] is None  # not defined
+
+
 def test_tyre_text(capsys):
     code, out, _ = run(capsys, "tyre", "dugoff", "--load", "8000", "--slip-ratio", "0.01", "--param", "cs=80000")
     assert code == 0 and "Fx (longitudinal) = -808.081 N" in out and "Fy (lateral)      = 0 N" in out
@@ -41,6 +51,7 @@ def test_tyre_text(capsys):
     ("tyre", "dugoff", "--load", "100", "--param", "cz=1"),
     ("tyre", "dugoff", "--load", "100", "--param", "mu"),
     ("tyre", "magic", "--load", "100"),
+    ("tyre", "linear", "--load", "1e-320", "--slip-ratio", "0.1"),  # mu = Fx / Fz overflowed: null, exit 0
     ("simulate", "diff-drive", "--path", "turn"),
     ("simulate", "forklift", "--path", "turn", "--step", "0"),
     ("simulate", "forklift", "--path", "turn", "--duration", "1e9"),

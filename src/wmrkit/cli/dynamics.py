@@ -70,12 +70,15 @@ def run_tyre(args: argparse.Namespace) -> int:
     fx, fy = float(f.longitudinal) + 0.0, float(f.lateral) + 0.0  # no "-0"
     if not (math.isfinite(fx) and math.isfinite(fy)):
         raise WmrkitError("the model gives no finite force at these inputs")
+    mu_long, mu_lat = (-fx / load + 0.0, -fy / load + 0.0) if load else (None, None)  # undefined without a load
+    if mu_long is not None and not (math.isfinite(mu_long) and math.isfinite(mu_lat)):
+        raise WmrkitError(f"--load: at {load:g} N the friction coefficients Fx/Fz, Fy/Fz of the {tyre.model} model's "
+                          f"forces ({fx:.6g} N, {fy:.6g} N) overflow (its forces do not scale with the load)")
     if args.plot:
         _plot_tyre(tyre, load, s, a, speed, args.plot)
     if args.json:
         print_json({"model": tyre.model, "params": tyre.as_dict(), "load": load, "slip_ratio": s, "slip_angle": a,
-                    "speed": speed, "Fx": fx, "Fy": fy, "mu_long": -fx / load if load else 0.0,
-                    "mu_lat": -fy / load if load else 0.0})
+                    "speed": speed, "Fx": fx, "Fy": fy, "mu_long": mu_long, "mu_lat": mu_lat})
     else:
         print(f"{tyre.model} tyre, load {load:g} N, slip ratio {s:g}, slip angle {a:g} rad, wheel speed {speed:g} m/s")
         print(f"Fx (longitudinal) = {fx:.6g} N")
