@@ -203,3 +203,19 @@ def test_degrees_written_as_radians_warn_and_say_inconsistent(capsys, tmp_path):
     slips = [float(item.split()[1]) for item in listed]
     assert sorted(item.split()[0] for item in listed) == ["left_drive", "right_drive", "steer"]
     assert slips == sorted(slips, reverse=True) and slips[0] > 0
+
+
+@pytest.mark.parametrize("weight", ["steer=1e16", "steer=1e-7"])
+def test_weights_too_far_apart_are_refused(capsys, tmp_path, weight):
+    """At a ratio of 1e16 the forklift's drive-wheel rows fell below the rank tolerance: a pose of 4e-31 m, exit 0."""
+    from wmrkit.odometry.model import odometry_model
+
+    profile = TwistProfile.from_segments([(4.0, 1.0, 0.2, 0.2), (1.0, 0, 0, 0), (4.0, 1.0, 0.0, 0.0)])
+    run = simulate(catalog.load("forklift"), profile, 50.0)
+    path = tmp_path / "fork.csv"
+    write_csv(path, ("time", *run.log.joints), np.column_stack([run.log.time, run.log.positions]))
+    assert main(["odometry", "forklift", str(path), "--weight", weight]) == 2
+    assert "differ by more than a factor 1e+06" in capsys.readouterr().err
+    close = odometry_model(catalog.load("forklift"), weights={"steer": 1e6})  # at the limit: still the motion
+    assert np.hypot(*odometry(close, run.log).final_pose[:2]) == pytest.approx(np.hypot(*run.truth[-1, :2]),
+                                                                               abs=1e-6)

@@ -31,6 +31,10 @@ from ..robot import Robot
 
 #: Steering configurations whose maps a model keeps; a chunk with more new ones (continuous steering) starts afresh.
 CACHE_SIZE = 1 << 14
+#: Largest ratio of two wheels' least-squares weights: the rows are scaled by them, so the squared residuals by their
+#: squares; 1e6 is the 1e12 of the WLS friction coefficients (``slip.weights.MAX_RATIO``). At 1e16 the forklift's
+#: drive-wheel rows fell below the rank tolerance and its odometry stood still (a pose of 4e-31 m, exit 0).
+MAX_WEIGHT_RATIO = 1e6
 
 
 class SensingError(WmrkitError, ValueError):
@@ -354,6 +358,10 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
             cols += range(col, col + n_rates)
             rate_joints += [s for s in mine if s.partition(".")[2] in wheel.kind.rates]
         row, col = row + n_rows, col + n_rates
+    if row_weights and max(row_weights) > MAX_WEIGHT_RATIO * min(row_weights):
+        raise SensingError(f"weights {min(row_weights):g} and {max(row_weights):g} of the sensed wheels differ by more "
+                           f"than a factor {MAX_WEIGHT_RATIO:g}: the least squares would lose the smaller rows to "
+                           "round-off (only ratios matter; a wheel without a weight has 1)")
     cols_a = np.array(cols)
     assigned = np.array([cols.index(robot.velocity_index(j)) for j in rate_joints], dtype=int)
     joints = tuple(dict.fromkeys([*rate_joints, *steer_joints]))
