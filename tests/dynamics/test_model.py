@@ -169,3 +169,20 @@ def test_missing_mass_properties_are_one_line_errors():
 
     with pytest.raises(WmrkitError, match=r"caster.*inertia.spin"):
         DynamicModel.of(Robot.from_dict(robot))
+
+
+@pytest.mark.parametrize("com", [[1.0, 0.0], [0.0, 0.0], [-1.0, 1.0]])
+def test_a_centre_of_mass_the_wheels_do_not_support_is_refused(com):
+    """The forklift's wheels stand at x = -2.35 (steer) and x = -1 (drive), so a centre of mass at the fork tips
+    or ahead of them (or far to a side) tips the truck: the model clipped the negative load to 0 and ran with loads
+    that summed to 2.5 times the weight (60.9 kN against 24.5 kN, exit 0)."""
+    from wmrkit import Robot
+
+    data = catalog.load("forklift").to_dict()
+    data["body"]["com"] = com
+    with pytest.raises(WmrkitError, match=r"is not supported by its wheels.*tips over"):
+        DynamicModel.of(Robot.from_dict(data))
+    data["body"]["com"] = [-1.6, 0.1]  # inside: the loads balance the weight
+    model = DynamicModel.of(Robot.from_dict(data))
+    assert np.all(model.normal_loads() > 0)
+    assert model.normal_loads().sum() == pytest.approx(2500 * model.gravity)

@@ -210,6 +210,12 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
     for w in robot.wheels:
         k = len(w.elements())
         contacts.extend([w.name] if k == 1 else [f"{w.name}.{j + 1}" for j in range(k)])
+    weight = (body.mass + sum(prm[1] for prm in steer_prm)) * gravity
+    if gravity > 0 and static.sum() > weight * (1 + 1e-9):  # a load below 0 was clipped: no balance at rest
+        unloaded = [c for c, f in zip(contacts, static, strict=True) if f == 0.0]
+        raise WmrkitError(f"robot '{robot.name}': its centre of mass (body.com {list(body.com)} m) is not supported "
+                          f"by its wheels: at rest the normal loads (7.64) would pull {', '.join(unloaded)} down "
+                          "(negative), so the robot tips over; move body.com inside the wheels' contacts")
     return DynamicModel(robot, tuple(names), tuple(contacts), tuple(steer_cols), tyres_e, gravity, pack)
 
 
