@@ -333,3 +333,23 @@ def test_unknown_joint_names_raise():
         twist_condition_number(catalog.load("thesis-tricycle"), joints=("f9.spin",))
     with pytest.raises(UnknownNameError, match="as many selected as assigned"):
         isotropy_matrix(catalog.load("thesis-tricycle"), None, ("vy",), ("vy",))
+
+
+@pytest.mark.parametrize(("length", "kappa"), [(1e-4, 1e7), (1e-6, 1e9), (1e3, 1.0)])
+def test_a_large_condition_number_is_a_number_not_infinite(length, kappa):
+    """A differential drive of half track b = 1 km: its two wheel-rate columns per (v, D omega) are orthogonal, of
+    norms sqrt(2)/r and sqrt(2) b/(r D), so kappa = b / D for D < b. The Gram eigenvalues bottom out at sqrt(eps),
+    so 'analyze --length 1e-4' printed 'condition number infinite (these joints do not determine the twist)' for
+    this robot, whose joints do; the SVD (few configurations) resolves it to eps."""
+    from wmrkit import Robot
+
+    huge = Robot.from_dict({"name": "huge", "wheels": [
+        {"name": "left", "type": "fixed", "position": [0, 1000], "heading": 0, "r": 0.1, "sensed": ["spin"]},
+        {"name": "right", "type": "fixed", "position": [0, -1000], "heading": 0, "r": 0.1, "sensed": ["spin"]},
+        {"name": "caster", "type": "castor", "position": [-1000, 0], "heading": 0, "d": 0.1, "r": 0.1}]})
+    joints = ("left.spin", "right.spin")
+    assert float(twist_condition_number(huge, joints=joints, length=length)) == pytest.approx(kappa, rel=1e-9)
+    omni = catalog.load("omni-3")  # m = 3 against the reference SVD of the isotropy matrix (5.30)
+    reference = condition_number(isotropy_matrix(omni, None, default_joints(omni), ("vx", "vy", "omega"),
+                                                 length=length))
+    assert float(twist_condition_number(omni, length=length)) == pytest.approx(float(reference), rel=1e-9)

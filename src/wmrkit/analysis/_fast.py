@@ -13,6 +13,7 @@ import numpy as np
 from ._sym import eigvalsh2_entries, eigvalsh3_entries
 
 CHUNK = 4096  # configurations per chunk: the working set stays in cache
+FEW = 64  # configurations up to which LAPACK's SVD is used (accurate to eps) instead of closed-form Gram eigenvalues
 
 
 def element_rows_cm(p, beta: np.ndarray) -> np.ndarray:
@@ -66,11 +67,15 @@ def kappa_cm(mobility: int, rates: np.ndarray, lines: np.ndarray, length: float)
     n = rates.shape[-1]
     if mobility == 3:
         h = rates * np.array([1.0, 1.0, 1.0 / length])[None, :, None]
+        if n <= FEW:
+            return _condition_svd(np.moveaxis(h, -1, 0))
         small, _, large = _eig3(gram3(h))
         return ratio(small, large)
     if mobility == 2:
         a, b, ok = columns_m2(rates, lines)
         b = b / length
+        if n <= FEW:
+            return np.where(ok, _condition_svd(np.stack([a.T, b.T], axis=-1)), np.nan)
         small, large = eigvalsh2_entries(np.einsum("jn,jn->n", a, a), np.einsum("jn,jn->n", a, b),
                                          np.einsum("jn,jn->n", b, b))
         return np.where(ok, ratio(small, large), np.nan)
@@ -108,7 +113,7 @@ def distance_cm(lines: np.ndarray, length: float) -> np.ndarray:
     """``sigma_min / sigma_max`` of the lines ``(L, 3, N)`` with d scaled by 1/length and unit rows, (6.17)."""
     g = lines * np.array([1.0, 1.0, 1.0 / length])[None, :, None]
     g = g / np.sqrt(np.einsum("lcn,lcn->ln", g, g))[:, None, :]
-    if g.shape[-1] <= 64:  # SVD: accurate to eps (the Gram route bottoms out at sqrt(eps))
+    if g.shape[-1] <= FEW:  # SVD: accurate to eps (the Gram route bottoms out at sqrt(eps))
         sv = np.linalg.svd(np.moveaxis(g, -1, 0), compute_uv=False)
         return sv[:, 2] / sv[:, 0]
     small, _, large = eigvalsh3_entries(*gram3(g))
@@ -117,12 +122,21 @@ def distance_cm(lines: np.ndarray, length: float) -> np.ndarray:
 
 def _eig3(entries: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Closed form for big chunks; LAPACK (accurate to eps * lambda_max) for a few configurations."""
-    if entries[0].size > 64:
+    if entries[0].size > FEW:
         return eigvalsh3_entries(*entries)
     g11, g22, g33, g12, g13, g23 = entries
     g = np.stack([np.stack([g11, g12, g13], -1), np.stack([g12, g22, g23], -1), np.stack([g13, g23, g33], -1)], -2)
     w = np.linalg.eigvalsh(g)
     return w[..., 0], w[..., 1], w[..., 2]
+
+
+def _condition_svd(h: np.ndarray) -> np.ndarray:
+    """``sigma_max / sigma_min`` of ``h (N, J, k)`` by SVD, accurate to eps (the Gram route of :func:`ratio` bottoms
+    out at sqrt(eps): a condition number above 1e7 read as infinite); the threshold of
+    :func:`.isotropy.condition_number`."""
+    from .isotropy import condition_number
+
+    return condition_number(h)
 
 
 def ratio(small: np.ndarray, large: np.ndarray) -> np.ndarray:
