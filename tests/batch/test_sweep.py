@@ -109,3 +109,17 @@ def test_parse_vary_units_and_errors():
         sweep(robot, [ax], "beauty")
     assert math.isfinite(sweep(robot, [ax], length=0.4, top=1).best[0]["kappa_mean"])
 
+
+
+@pytest.mark.parametrize("name", ["swerve-4", "ackermann", "forklift"])
+def test_kappa_metrics_are_refused_for_robots_of_mobility_1(name):
+    """Types 4 and 5 have kappa 1 wherever they can move (§5.5.4-5.5.5): a swerve drive's random configurations are
+    never coordinated, so 'sweep swerve-4 --vary ...' printed 'kappa_mean nan' for every design, exit 0. The
+    singularity margin still sweeps, finite."""
+    robot = catalog.load(name)
+    axes = [parse_vary("wheels[0].l=0.3:0.5:2" if name != "forklift" else "wheels[0].l=0.8:1.2:2", robot)]
+    for metric in ("kappa_mean", "kappa_max", "inv_kappa_mean"):
+        with pytest.raises(BatchError, match=r"has mobility 1.*--metric singular_margin"):
+            build_spec(robot, axes, metric)
+    spec = build_spec(robot, axes, "singular_margin", configs=8)
+    assert np.all(np.isfinite(evaluate(np.arange(2), spec)))

@@ -179,10 +179,16 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
             raise BatchError(f"the swept values change the structure of wheel '{robot.wheels[w].name}' (e.g. a castor "
                              "offset through 0): sweep a range on one side")
         tables.append({k: np.asarray(v, dtype=float) for k, v in cols.items()})
+    mobility = classify(robot).mobility
+    if metric != "singular_margin" and mobility < 2:
+        raise BatchError(f"robot '{robot.name}' has mobility {mobility}: its condition number is 1 at every "
+                         "configuration it can move in and undefined elsewhere (isotropy does not apply to types 4 "
+                         "and 5, §5.5.4-5.5.5), so a --metric of kappa compares nothing; sweep --metric "
+                         "singular_margin")
     cl = constraint_lines(robot, joints)
     if metric == "singular_margin" and (cl.internal or len(cl.labels) < 3):
         raise BatchError(f"robot '{robot.name}': its actuated model is singular everywhere (fewer than 3 lines)")
-    return SweepSpec(tuple(len(a.values) for a in axes), metric, classify(robot).mobility, length, beta,
+    return SweepSpec(tuple(len(a.values) for a in axes), metric, mobility, length, beta,
                      p0.steer_wheels, p0.element_wheel, tuple(wheel_axes), tuple(tables), robot_size(robot))
 
 
