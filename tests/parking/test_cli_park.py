@@ -46,6 +46,7 @@ def test_infeasible_slot_says_why_and_the_shortest_slot(capsys, tmp_path):
     data = json.loads(out)
     assert code == 0 and data["feasible"] is False and "too short" in data["reason"]
     assert 2.4 < data["shortest_H"] < 3.35
+    assert data["approach"]["dx1"] is None and data["final_gap"] is None  # not defined: documented nulls, not NaN
     code, out, _ = run(capsys, str(f))
     assert "infeasible: the slot is too short" in out and "shortest slot that works" in out
 

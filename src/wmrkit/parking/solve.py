@@ -36,8 +36,8 @@ class Solution:
             "warnings": list(p.warnings), "time_ms": self.time_ms,
             "length_ratio_percent": length_ratio(v, sp), "blackburn_min_H": blackburn_min_length(v),
             "shortest_H": self.shortest_H,
-            "approach": {"dx1": p.dx1, "dy3": p.dy3, "pass_offset": p.pass_offset},
-            "final_gap": p.final_gap, "path_length": path_length(p.segments),
+            "approach": {"dx1": _defined(p.dx1), "dy3": _defined(p.dy3), "pass_offset": p.pass_offset},
+            "final_gap": _defined(p.final_gap), "path_length": path_length(p.segments),
             "direction_changes": direction_changes(p.segments),
             "arcs": [{"direction": "forward" if a.direction > 0 else "backward", "radius": a.rho, "xi": a.xi,
                       "X": a.X, "Y": a.Y, "gap_after": a.gap_after} for a in p.arcs],
@@ -47,6 +47,12 @@ class Solution:
         if self.check is not None:
             out["check"] = check_dict(self.check)
         return out
+
+
+def _defined(value: float) -> float | None:
+    """A plan's quantity, or None where the plan does not define it (NaN: an infeasible problem has no approach
+    point and no final gap)."""
+    return None if math.isnan(value) else value
 
 
 def check_dict(report: CollisionReport) -> dict[str, Any]:
