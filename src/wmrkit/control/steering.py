@@ -130,7 +130,6 @@ def range_keeper(robot: Robot) -> Callable[[np.ndarray, np.ndarray], np.ndarray]
     return keep
 
 
-
 # ---- swerve motion modes ------------------------------------------------------------------------------------
 def crab_twist(speed: ArrayLike, direction: ArrayLike) -> np.ndarray:
     """Crab (translation only): every wheel at heading `direction` [rad]. ``(...), (...) -> (..., 3)``."""
