@@ -205,6 +205,15 @@ def test_fleet_slip_weights_from_closed_paths_and_errors(skid_runs):
         fleet_slip_calibrate(robot, truth_end[:1])
     with pytest.raises(BatchError, match="confidence level"):
         fleet_slip_calibrate(robot, truth_end, level=1.5)
+    for level in (0.9999999999999999, 0.999999):  # 0.5 + level / 2 rounded to 1: [-inf, inf]; or +-6e5 errors
+        with pytest.raises(BatchError, match=r"confidence level must be in \(0, 0\.9999\]"):
+            fleet_slip_calibrate(robot, truth_end, level=level)
+    from scipy import stats
+
+    from wmrkit.batch.calibrate import _t_quantile
+
+    assert _t_quantile(0.9999, 1) == pytest.approx(stats.t.ppf(0.99995, 1), rel=1e-9) and np.isfinite(
+        _t_quantile(0.9999, 1))
 
 
 def test_cli_slip_weights_and_closure_warnings(skid_runs, diff, tmp_path, capsys):

@@ -120,8 +120,7 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
         raise BatchError("calibrate: no runs")
     if ci not in ("jacobian", "bootstrap"):
         raise BatchError(f"ci must be 'jacobian' or 'bootstrap', got '{ci}'")
-    if not 0 < level < 1:
-        raise BatchError(f"confidence level must be in (0, 1), got {level}")
+    check_level(level)
     if ci == "bootstrap":
         check_bootstrap(n_boot)
         check_seed(seed, BatchError)
@@ -173,6 +172,24 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
     return _result(problem, fit, lo, hi, r0, ci, level)
 
 
+#: Highest confidence level: beyond it Student's quantile with the few degrees of freedom of a fleet is astronomic (1
+#: run of freedom at 0.999999: +-636,619 standard errors), and 0.5 + level / 2 rounds to 1 (an infinite interval).
+MAX_LEVEL = 0.9999
+
+
+def check_level(level: float) -> None:
+    """Refuse a confidence level outside ``(0, MAX_LEVEL]``."""
+    if not 0 < level <= MAX_LEVEL:
+        raise BatchError(f"confidence level must be in (0, {MAX_LEVEL:g}], got {level!r}")
+
+
+def _t_quantile(level: float, dof: int) -> float:
+    """Student's two-sided quantile of `level` with `dof` degrees of freedom (upper tail, no rounding of 1 - level)."""
+    from scipy import stats
+
+    return float(stats.t.isf((1.0 - level) / 2, dof))
+
+
 def _sandwich_interval(fit, sizes: Sequence[int], level: float) -> tuple[np.ndarray, np.ndarray]:
     """Interval from the least-squares Jacobian with the run-clustered ("sandwich") covariance in its jackknife
     form (CR3): ``(G-1)/G sum_g d_g d_g^T`` with ``d_g = (J^T J - J_g^T J_g)^-1 J_g^T r_g``, the linearised change
@@ -180,7 +197,6 @@ def _sandwich_interval(fit, sizes: Sequence[int], level: float) -> tuple[np.ndar
     runs are independent; Student's t with ``G - 1`` degrees of freedom. The plain clustered form ``(J^T J)^-1
     (sum_g J_g^T r_g r_g^T J_g) (J^T J)^-1 G/(G-1)`` (CR1) covered a track error in only 84-87 % of 200 fleets of
     6-8 runs at 95 %; this one covers 92-97 % (tested)."""
-    from scipy import stats
 
     g = len(sizes)
     if g < 2:
@@ -199,7 +215,7 @@ def _sandwich_interval(fit, sizes: Sequence[int], level: float) -> tuple[np.ndar
         change.append(np.linalg.solve(rest, jg.T @ fit.fun[a:b]))
     change = np.array(change)
     cov = change.T @ change * (g - 1) / g
-    half = float(stats.t.ppf(0.5 + level / 2, g - 1)) * np.sqrt(np.diag(cov))
+    half = _t_quantile(level, g - 1) * np.sqrt(np.diag(cov))
     return fit.x - half, fit.x + half
 
 
@@ -273,12 +289,10 @@ def fleet_slip_calibrate(robot: Robot, runs: Sequence[CalibrationRun], *, runner
                          progress: bool = False) -> FleetSlipCalibration:
     """Slip weights of `robot` from many `runs` (module docstring): :func:`wmrkit.slip.calibration.calibrate_slip`
     on each run, on the engine, then the geometric mean over the runs and its Student-t interval at `level`."""
-    from scipy import stats
 
     if len(runs) < 2:
         raise BatchError("calibrate: slip weights with an interval need at least two runs")
-    if not 0 < level < 1:
-        raise BatchError(f"confidence level must be in (0, 1), got {level}")
+    check_level(level)
     own = runner is None
     runner = engine(workers=0) if runner is None else runner
     try:
@@ -289,7 +303,7 @@ def fleet_slip_calibrate(robot: Robot, runs: Sequence[CalibrationRun], *, runner
             runner.close()
     logs = np.log(np.array(per_run, dtype=float))  # (G, 2)
     g = len(per_run)
-    half = float(stats.t.ppf(0.5 + level / 2, g - 1)) * logs.std(axis=0, ddof=1) / np.sqrt(g)
+    half = _t_quantile(level, g - 1) * logs.std(axis=0, ddof=1) / np.sqrt(g)
     mean = logs.mean(axis=0)
     lo, hi, mid = np.exp(mean - half), np.exp(mean + half), np.exp(mean)
     return FleetSlipCalibration(robot.name, float(mid[0]), (float(lo[0]), float(hi[0])), float(mid[1]),
