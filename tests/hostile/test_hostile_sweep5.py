@@ -211,7 +211,8 @@ def test_sweep_out_and_plot_paths_are_checked_first(tmp_path, capsys):
 @pytest.mark.parametrize("option, expected", [
     (["-n", "1000000000"], "at least 2 runs and at most 1000000"),  # a hang
     (["--noise", "1e308"], "noise must be in [0, 1]"),  # numpy warnings before the error
-    (["--slip", "1e308"], "slip in [0, 1000] m/s"),  # numpy warnings, "value inf" of the synthetic log
+    (["--slip", "1e308"], "slip in [0, 1] (the standard deviation of a slip ratio)"),  # numpy warnings before
+    (["--slip", "1000"], "slip in [0, 1]"),  # a slip ratio's std of 1000: theta -537 rad, exit 0
     (["--rate", "1e308"], "at most 10000000 sample periods"),  # OverflowError traceback
     (["--rate", "1e-320"], "a rate >= 1e-06 Hz"),  # ValueError traceback
     (["--seed", "-1"], "seed must be an integer >= 0"),  # ValueError traceback

@@ -245,6 +245,8 @@ def test_kappa_map_bad_input(client):
     assert client.post("/api/kappa", json={"description": desc("mecanum-4")}).status_code == 400
     for extra in ({"wheels": ["left"]}, {"wheels": "caster"}, {"resolution": 10**6}, {"resolution": 2.5}):
         assert client.post("/api/kappa", json={"description": desc("diff-drive"), **extra}).status_code == 400
+    twice = client.post("/api/kappa", json={"description": desc("swerve-4"), "wheels": ["front_left", "front_left"]})
+    assert twice.status_code == 400 and "different" in twice.json()["error"]  # 200 with a mislabelled map before
 
 
 def test_configurations(client):

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._shapes import readonly
-from ..limits import MAX_SPEED, check_seed
+from ..limits import check_seed
 from ..odometry.logs import JointLog
 from ..robot import Robot
 from .engine import BatchError, Engine, engine
@@ -142,9 +142,9 @@ def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4
 
     if not 2 <= runs <= MAX_RUNS:
         raise BatchError(f"Monte Carlo needs at least 2 runs and at most {MAX_RUNS}, got {runs}")
-    if not (0 <= per_rad <= 1 and 0 <= resolution <= math.pi and 0 <= slip_std <= MAX_SPEED):
-        raise BatchError(f"noise must be in [0, 1] (per rad), resolution in [0, pi] rad and slip in [0, "
-                         f"{MAX_SPEED:g}] m/s, got {per_rad:g}, {resolution:g}, {slip_std:g}")
+    if not (0 <= per_rad <= 1 and 0 <= resolution <= math.pi and 0 <= slip_std <= 1):
+        raise BatchError(f"noise must be in [0, 1] (per rad), resolution in [0, pi] rad and slip in [0, 1] (the "
+                         f"standard deviation of a slip ratio), got {per_rad:g}, {resolution:g}, {slip_std:g}")
     check_seed(seed, BatchError)
     nominal = odometry(robot, log, method=method, noise=JointNoise(per_rad, resolution**2 / 6))
     sizes = [min(block, runs - s) for s in range(0, runs, block)]

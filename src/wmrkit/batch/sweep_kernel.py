@@ -105,7 +105,7 @@ def variant(robot: Robot, assignments: dict[tuple[int, str], float], *, where: s
     try:
         return robot_from_dict(data, source=where)
     except WmrkitError as err:
-        raise BatchError(f"{where}: {err}") from None
+        raise BatchError(str(err)) from None  # the description's message names `where` already
 
 
 @dataclass(frozen=True, eq=False)

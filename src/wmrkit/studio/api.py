@@ -216,8 +216,9 @@ def kappa_map(request: Any) -> dict[str, Any]:
     if not steer:
         raise StudioError(f"robot '{robot.name}' does not steer: no κ map over steering angles")
     names = request.get("wheels") or list(steer[:2])
-    if not isinstance(names, list) or not 1 <= len(names) <= 2 or any(n not in steer for n in names):
-        raise StudioError(f"wheels: one or two of the steering wheels {', '.join(steer)}")
+    if (not isinstance(names, list) or not 1 <= len(names) <= 2 or any(n not in steer for n in names)
+            or len(set(names)) != len(names)):  # a wheel twice: its second angle overwrote the first axis
+        raise StudioError(f"wheels: one or two different steering wheels of {', '.join(steer)}")
     res = _integer(request.get("resolution", 72), "resolution", 8, MAX_RESOLUTION)
     axis = np.linspace(-np.pi, np.pi, res, endpoint=False)
     grids = np.meshgrid(*([axis] * len(names)), indexing="ij")
