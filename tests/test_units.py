@@ -74,6 +74,8 @@ def test_angles_within_a_turn_or_with_a_unit_are_read(value):
     (float("-inf"), "angle", "must be finite, got -inf"),
     ("1e999 m", "length", "must be finite, got '1e999 m'"),
     ("1e308 km", "length", "must be finite, got '1e308 km'"),
+    ("1e308 deg", "angle", "'1e308 deg' is more than 1e+06 turns: no angle to steer, turn or roll by (its sine and "
+     "cosine would be round-off)"),  # read as 1.7e306 rad: a fixed wheel shown at 0 deg, computed at about 104 deg
     (10**400, "length", "expected a length, got an integer too large for a float"),
     (True, "angle", "expected an angle, got a boolean"),
     (None, "length", "expected a length, got NoneType"),

@@ -31,7 +31,8 @@ def parse_quantity(value: object, kind: Kind) -> float:
 
     Accepts ints, floats and strings such as ``"90 deg"``, ``"250 mm"``, ``"-0.5rad"``, ``"1e-3"``.
     Raises :class:`UnitError` for booleans, NaN, infinities, unknown units and units of the wrong kind, and for
-    a bare angle (no unit, so radians) beyond a turn, ``|angle| > 2 pi``: almost surely degrees written bare.
+    a bare angle (no unit, so radians) beyond a turn, ``|angle| > 2 pi``: almost surely degrees written bare; and
+    for an angle beyond :data:`MAX_TURNS` turns in any unit.
     """
     if isinstance(value, bool):
         raise UnitError(f"expected {_a(kind)}, got a boolean")
@@ -50,6 +51,9 @@ def parse_quantity(value: object, kind: Kind) -> float:
         raise UnitError(f"expected {_a(kind)}, got {type(value).__name__}")
     if not math.isfinite(number * factor):  # "1e308 km" overflows only in SI
         raise UnitError(f"must be finite, got {value!r}")
+    if kind == "angle" and abs(number * factor) > MAX_ANGLE:
+        raise UnitError(f"{value!r} is more than {MAX_TURNS:g} turns: no angle to steer, turn or roll by (its sine and "
+                        "cosine would be round-off)")
     if kind == "angle" and _bare(value) and abs(number) > BARE_ANGLE_LIMIT:
         raise UnitError(f"a bare angle is read in radians, and {_plain(number)} rad is more than a turn: "
                         f"write '{_plain(number)} deg' for degrees (or '{_plain(number)} rad' if you mean it)")
@@ -58,6 +62,10 @@ def parse_quantity(value: object, kind: Kind) -> float:
 
 #: A bare angle (no unit: radians) beyond this is refused as probably degrees [rad].
 BARE_ANGLE_LIMIT = 2 * math.pi
+#: Largest angle in any unit: 1e6 turns [rad]. '1e308 deg' was read as 1.7e306 rad, whose sine and cosine are noise
+#: (and which wheels.wrap_angle gave back as 0).
+MAX_TURNS = 1e6
+MAX_ANGLE = 2 * math.pi * MAX_TURNS
 
 
 def _bare(value: object) -> bool:
