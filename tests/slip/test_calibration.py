@@ -78,3 +78,20 @@ def test_cli_skid_study_quasi_static(tmp_path, capsys):
         r = out["runs"][name]
         assert r["WLS"]["rms"] == pytest.approx(r["effective track"]["rms"], rel=1e-4, abs=1e-6)
         assert r["WLS"]["rms"] < 0.5 * r["no slip (LS)"]["rms"]
+
+
+def test_a_run_without_turning_determines_no_slip_parameter(tmp_path, capsys):
+    """A straight run's poses do not depend on the WLS ratio or the track: the fit returned its start guess (track
+    multiplier 10^0.1 = 1.2589) and advised writing it into the description. Now refused, in one line."""
+    from wmrkit.errors import WmrkitError
+    from wmrkit.odometry.synthetic import TwistProfile, simulate
+
+    robot = catalog.load("skid-steer-4")
+    run = simulate(robot, TwistProfile.from_segments([(5.0, 1.0, 0.0, 0.0)]), 50.0)
+    with pytest.raises(WmrkitError, match=r"does not determine the WLS ratio.*a run without turning"):
+        calibrate_slip(robot, run.log, (run.log.time, run.truth))
+    log, ref = tmp_path / "straight.csv", tmp_path / "straight.tum"
+    write_csv(log, ("time", *run.log.joints), np.column_stack([run.log.time, run.log.positions]))
+    write_trajectory(ref, Trajectory(run.log.time, run.truth, np.zeros(len(run.log))), fmt="tum")
+    assert main(["calibrate", "skid-steer-4", str(log), "--reference", str(ref)]) == 2
+    assert "does not determine" in capsys.readouterr().err

@@ -92,6 +92,11 @@ def effective_track_model(robot: Robot, multiplier: float):
     return wls_model(replace(robot, wheels=tuple(wheels)), SlipWeights.uniform(IGNORED, 1.0))
 
 
+#: A slip parameter is determined by a log when changing it tenfold moves the odometry by more than this fraction of
+#: the run's extent (a straight run moves it by 0: the fit returned its start guess, 10^0.1 for the track).
+IDENTIFIED = 1e-6
+
+
 def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, ArrayLike], *, method: Method = "exact",
                    heading_weight: float = 1.0) -> SlipCalibration:
     """Fit the WLS ratio and the effective track of `robot` to `reference` ``(times (M,), poses (M, 3))`` (TUM).
@@ -122,6 +127,12 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
                           [0.0], bounds=([-6.0], [6.0]), x_scale=[1.0], diff_step=[1e-6])
     fit_m = least_squares(lambda p: residuals(poses_of(effective_track_model(robot, 10.0 ** p[0]))),
                           [0.1], bounds=([-2.0], [2.0]), x_scale=[0.1], diff_step=[1e-6])
+    scale = max(1.0, float(np.ptp(ref[:, :2], axis=0).max()))  # the run's extent [m]
+    for fit, what in ((fit_k, "WLS ratio"), (fit_m, "effective track")):
+        if not np.max(np.abs(fit.jac)) > IDENTIFIED * scale:  # the start guess would be reported as a fit
+            raise WmrkitError(f"the log does not determine the {what}: the odometry moves less than "
+                              f"{IDENTIFIED * scale:.2g} m when it changes tenfold (a run without turning?); "
+                              "calibrate on a log that turns")
     ratio, multiplier = 10.0 ** float(fit_k.x[0]), 10.0 ** float(fit_m.x[0])
     runs = {"no_slip": wls_model(robot), "wls": wls_model(robot, SlipWeights.uniform(ratio, 1.0)),
             "effective_track": effective_track_model(robot, multiplier)}
