@@ -46,6 +46,17 @@ def test_sweep(capsys, tmp_path):
     assert (tmp_path / "s.png").exists() and (tmp_path / "s.parquet").exists()
 
 
+def test_sweep_text_says_what_an_infinite_metric_means(capsys):
+    """Two steering joints at one point: singular wherever sampled. The text printed 'kappa_mean inf' and numpy's
+    'All-NaN slice' warning reached stderr."""
+    from wmrkit.cli.main import main
+
+    assert main(["sweep", "thesis-steer-castor", "--workers", "0", "--vary", "wheels.c2.alpha=0:0:1", "--vary",
+                 "wheels.o1.l=0.5:0.5:1"]) == 0
+    out, err = capsys.readouterr()
+    assert "kappa_mean infinite (singular at a configuration sampled)" in out and err == ""
+
+
 @pytest.mark.parametrize("argv", [
     ["sweep", "omni-3", "--vary", "wheels[0].l=0:1", "--workers", "0"],
     ["sweep", "omni-3", "--vary", "wheels[0].l=0.1:0.2:2", "--workers", "0", "--length", "-1"],

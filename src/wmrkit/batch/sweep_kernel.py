@@ -277,8 +277,9 @@ def _natural(score, n: int, size: float, *, points: int = 21, iterations: int = 
         f_new = score(probe)
         fc, fd = np.where(left, f_new, fd), np.where(left, fc, f_new)
     x = (a + b) / 2
-    flat = ~np.isfinite(finite).any(axis=1) | (np.nanmax(np.where(np.isfinite(values), values, np.nan), axis=1)
-                                               - np.min(finite, axis=1) < 1e-9 * np.abs(np.min(finite, axis=1)))
+    with np.errstate(invalid="ignore"), _no_warnings():  # a design singular everywhere: all inf, no warning
+        flat = ~np.isfinite(finite).any(axis=1) | (np.nanmax(np.where(np.isfinite(values), values, np.nan), axis=1)
+                                                   - np.min(finite, axis=1) < 1e-9 * np.abs(np.min(finite, axis=1)))
     best = np.where(score(np.exp(x)) <= finite[np.arange(n), i], x, grid[i])
     return np.where(flat, size, np.exp(best))
 

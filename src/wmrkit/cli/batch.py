@@ -246,6 +246,7 @@ def run_sweep(args: argparse.Namespace) -> int:
     for b in result.best:
         fields = ", ".join(f"{a.label} = {b[a.label]:.6g}" for a in axes)
         value = b[args.metric]
-        print(f"  {args.metric} {value:.6g}" if math.isfinite(value) else f"  {args.metric} {value}",
-              f"(D {b['length']:.4g} m): {fields}")
+        shown = (f"{value:.6g}" if math.isfinite(value) else "infinite (singular at a configuration sampled)"
+                 if value == math.inf else "undefined (it cannot move at any configuration sampled)")
+        print(f"  {args.metric} {shown} (D {b['length']:.4g} m): {fields}")
     return 0
