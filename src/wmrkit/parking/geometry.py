@@ -95,14 +95,23 @@ class Space:
                 raise WmrkitError(f"space.{name}: must be > 0, got {getattr(self, name)} m")
         if self.MS < 0:
             raise WmrkitError(f"space.MS: must be >= 0, got {self.MS} m")
-        if not self.effective_length > 0:  # no free length: the length ratio (9.37) divides by it
-            raise WmrkitError(f"space.MS: the margins at both ends ({2 * self.MS:g} m) leave nothing of the slot's "
-                              f"length H = {self.H:g} m (H - 2 MS must be > 0)")
+        problem = no_free_length(self.H, self.MS)
+        if problem is not None:
+            raise WmrkitError(f"space.MS: {problem}")
 
     @property
     def effective_length(self) -> float:
         """``H' = H - 2 MS`` [m] (§9.3.2.B)."""
         return self.H - 2 * self.MS
+
+
+def no_free_length(H: float, MS: float) -> str | None:
+    """Why a slot of length `H` with margins `MS` has no free length ``H - 2 MS > 0`` (the length ratio (9.37)
+    divides by it), or None."""
+    if H - 2 * MS > 0:
+        return None
+    return (f"the margins at both ends ({2 * MS:g} m) leave nothing of the slot's length H = {H:g} m "
+            "(H - 2 MS must be > 0)")
 
 
 def turning_radius(h1: float, phi: float) -> float:

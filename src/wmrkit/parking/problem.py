@@ -21,7 +21,7 @@ from ..catalog import resolve as resolve_robot
 from ..documents import FieldReader, read_document, read_file
 from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
-from .geometry import Space, Vehicle, wheels_outside
+from .geometry import Space, Vehicle, no_free_length, wheels_outside
 
 VEHICLE_FIELDS = ("a1", "b1", "c1", "h1", "d1", "phi_max")
 ROBOT_VEHICLE_FIELDS = ("robot", "a1", "b1", "c1", "phi_max")
@@ -141,9 +141,9 @@ def _space(check: FieldReader, data: Any) -> Space:
     for name in ("MS", "dx2"):
         if s[name] < 0:
             check.fail(f"must be >= 0, got {s[name]} m", ("space", name))
-    if not s["H"] - 2 * s["MS"] > 0:
-        check.fail(f"the margins at both ends ({2 * s['MS']:g} m) leave nothing of the slot's length H = {s['H']:g} m "
-                   "(H - 2 MS must be > 0)", ("space", "MS"))
+    problem = no_free_length(s["H"], s["MS"])
+    if problem is not None:
+        check.fail(problem, ("space", "MS"))
     return Space(**s)
 
 
