@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from wmrkit import catalog
 from wmrkit.control.forklift import from_thesis_pose, with_steer_range
+from wmrkit.control.points import ControlError
 from wmrkit.control.references import builtin_reference
 from wmrkit.control.steering import ackermann_twist, choose_steering, crab_twist, discretize_twist, icr_twist
 from wmrkit.control.track import track
@@ -233,3 +234,58 @@ def test_the_loop_through_the_slip_models_keeps_the_wheel_within_its_range():
     run = track(truck, builtin_reference("circle", size=2.0), dynamics=True, feedback="wls", duration=8)
     assert np.abs(run.heading[:, 0]).max() <= math.radians(25) + 1e-3
     assert [v["wheel"] for v in run.range_violations()] == ["steer"]
+
+
+def _double_unit(steer_range, heading=0.0, actuated=("spin1", "spin2")):
+    """A double wheel (a differential steering unit) in front, a double castor behind."""
+    from wmrkit import Robot
+
+    return Robot.from_dict({"name": "double-unit", "wheels": [
+        {"name": "drive", "type": "double", "position": [0.3, 0], "heading": heading, "b": 0.06, "r": 0.08,
+         "actuated": list(actuated), "sensed": ["steer"], "steer_range": steer_range},
+        {"name": "trailer", "type": "double_castor", "position": [-0.3, 0], "beta": "90 deg", "d": 0.1, "b": 0.05,
+         "r": 0.04}]})
+
+
+def test_the_other_root_is_flagged_and_a_double_wheel_swaps_its_sub_wheels():
+    from wmrkit.control.steering import reverse_spins, spin_columns
+
+    ch = choose_steering([0.3, 0.3, 0.8], [1.0, 1.0, 1.0], [0.3, 0.3 + math.pi, 0.0],
+                         ranges=[[-1.0, 1.0], [-4.0, -2.0], [-0.5, 0.5]])
+    assert ch.reversed.tolist() == [False, True, False]  # the last held at 0.5, nearer its own root
+    assert np.allclose(ch.spin, np.where(ch.reversed, -1.0, 1.0))
+    robot = _double_unit(["-10 deg", "10 deg"])
+    columns = spin_columns(robot)
+    drive = robot.steer_names.index("drive")
+    rates = np.arange(1.0, len(robot.rate_names) + 1)
+    c1, c2 = columns[drive]
+    assert (robot.rate_names[c1], robot.rate_names[c2]) == ("drive.spin1", "drive.spin2")
+    flipped = rates.copy()
+    reverse_spins(flipped, columns, np.arange(len(columns)) == drive)
+    assert (flipped[c1], flipped[c2]) == (-rates[c2], -rates[c1])
+    assert np.array_equal(np.delete(flipped, [c1, c2]), np.delete(rates, [c1, c2]))
+
+
+def test_a_double_wheel_held_at_its_range_moves_the_robot_the_same_either_way_round():
+    """A double wheel (a differential steering unit) held at +10 deg, or at 190 deg (the same axle line, its
+    sub-wheels on the other sides, reached through the other root of (8.9)), moves the robot the same way. Before,
+    every run of a double wheel with a steer_range stopped at 'expected at least one joint rate' (its spins,
+    spin1/spin2, were not taken as drive joints), and the other root kept the IK's spins of the first root."""
+    direct = track(_double_unit(["-10 deg", "10 deg"]), builtin_reference("circle", size=1.0), period=0.05,
+                   duration=6)
+    other = track(_double_unit(["170 deg", "190 deg"], heading=math.pi), builtin_reference("circle", size=1.0),
+                  period=0.05, duration=6)
+    assert [v["wheel"] for v in direct.range_violations()] == ["drive"]
+    assert np.allclose(np.cos(other.heading[:, 0] - direct.heading[:, 0]), -1.0, rtol=0, atol=1e-12)
+    assert np.allclose(other.pose, direct.pose, atol=1e-9)
+    assert np.abs(direct.pose[-1, :2]).max() > 0.5  # it moved
+
+
+def test_the_dynamics_refuse_a_range_on_a_steering_nothing_holds():
+    """The dynamic model has no steering stops: a double wheel steered by its spins alone cannot be held within a
+    range, and the loop used to report it 'held at its end' while it steered 94 deg."""
+    from wmrkit.control.steering import range_keeper
+
+    with pytest.raises(ControlError, match="'drive': a steer_range needs an actuated steering"):
+        range_keeper(_double_unit(["-10 deg", "10 deg"]))
+    range_keeper(_double_unit(["-10 deg", "10 deg"], actuated=("steer", "spin1", "spin2")))

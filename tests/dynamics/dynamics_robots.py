@@ -35,3 +35,20 @@ def castor_robot(tyre: dict | str = "dugoff") -> Robot:
              "inertia": {"spin": 0.0005, "steer": 0.002}, "mass": 1.5, "tyre": tyre},
         ],
     })
+
+
+def double_unit_robot(steer_range: list | None = None, actuated: tuple = ("spin1", "spin2")) -> Robot:
+    """A double wheel (a differential steering unit) in front, two castors behind (an AGV layout)."""
+    castor = {"type": "castor", "beta": "90 deg", "d": 0.05, "r": 0.05, "inertia": {"spin": 0.002, "steer": 0.001},
+              "tyre": {"model": "dugoff", "cs": 2000, "calpha": 1500, "mu": 0.8}}
+    drive = {"name": "drive", "type": "double", "position": [0.3, 0], "heading": 0, "b": 0.06, "r": 0.08,
+             "actuated": list(actuated), "sensed": ["steer", "spin1", "spin2"],
+             "inertia": {"spin": 0.01, "steer": 0.05},
+             "tyre": {"model": "dugoff", "cs": 2000, "calpha": 1500, "mu": 0.8}}
+    if steer_range is not None:
+        drive["steer_range"] = steer_range
+    return Robot.from_dict({
+        "name": "double-unit", "body": {"mass": 50, "inertia": 2.0, "com": [0, 0], "com_height": 0.2},
+        "wheels": [drive, {"name": "left", "position": [-0.3, 0.2], **castor},
+                   {"name": "right", "position": [-0.3, -0.2], **castor}],
+    })

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from dynamics_robots import castor_robot, tricycle
+from dynamics_robots import castor_robot, double_unit_robot, tricycle
 
 from wmrkit import catalog
 from wmrkit.dynamics.model import DynamicModel
@@ -160,6 +160,25 @@ def test_mecanum_with_rollers_follows_its_program():
     inputs, duration = path_program(model, "turn", speed=0.5)
     sim = simulate(model, inputs, duration, record_step=0.01)
     assert sim.twist[-1] == pytest.approx([0.5, 0.0, 0.5 / 3], abs=2e-3)
+
+
+def test_a_double_wheel_is_driven_by_its_two_spins(tmp_path):
+    """A double wheel's actuated joints are ``spin1`` and ``spin2``. Before, the servos and torque files looked
+    for ``spin`` (the joint name with its digit stripped): the unit had no servo, the robot stood still through
+    the whole program (exit 0 from ``simulate``), and a torque file for ``drive.spin1`` was refused."""
+    model = DynamicModel.of(double_unit_robot())
+    assert [model.names[c] for c in range(3, model.n) if model.is_actuated(c)] == ["drive.spin1", "drive.spin2"]
+    sim = simulate(model, twist_program(model, [0.0], [(0.5, 0.0, 0.0)]), 2.0, record_step=0.01)
+    assert sim.twist[-1] == pytest.approx([0.5, 0.0, 0.0], abs=5e-3)
+    path = tmp_path / "tau.csv"
+    path.write_text("time,drive.spin1,drive.spin2\n0,2,2\n1,2,2\n")
+    assert simulate(model, read_torques(model, path), 1.0, record_step=0.01).twist[-1, 0] > 0.1
+
+
+def test_a_robot_without_motors_is_refused_instead_of_standing_still():
+    bare = double_unit_robot(actuated=())
+    with pytest.raises(WmrkitError, match="has no actuated joint"):
+        twist_program(DynamicModel.of(bare), [0.0], [(0.5, 0.0, 0.0)])
 
 
 def test_progress_bar_runs_in_chunks_with_the_same_result(forklift, capsys):

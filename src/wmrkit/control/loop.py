@@ -28,7 +28,9 @@ from .actuators import LowLevelLoops
 from .laws import PositionLaw, law_velocity, pose_error
 from .points import ControlError, ControlPoint, check_delay, point_pose, twist_for_velocity
 from .references import Reference
-from .steering import choose_steering, discretize_twist, steer_ranges
+from .steering import choose_steering, discretize_twist, reverse_spins, spin_columns, steer_ranges, unit_spin
+
+_SPINS = (".spin", ".spin1", ".spin2")  # the joints that drive a wheel
 
 __all__ = ["Plant", "TwistController", "law_controller", "simulate"]
 
@@ -66,11 +68,13 @@ def law_controller(cp: ControlPoint, law: PositionLaw, reference: Reference) -> 
 
 
 class _Commands(NamedTuple):
-    """One evaluation of the wheel commands: the IK, the steering targets (thesis beta), the spins of the steered
-    wheels for the chosen roots, and whether each steered wheel's target lies within its range."""
+    """One evaluation of the wheel commands: the IK, the steering targets (thesis beta), the joint rates
+    (``robot.rate_names``) and the spins of the steered wheels for the chosen roots, and whether each steered
+    wheel's target lies within its range."""
 
     ik: WheelCommands
     target: np.ndarray
+    rates: np.ndarray
     spin: np.ndarray
     fits: np.ndarray
 
@@ -92,7 +96,7 @@ class _Sim:
         types = [robot.wheel(n).type for n in names]
         self.passive = np.array([t in ("castor", "double_castor") for t in types], dtype=bool)
         self.delta = np.array([robot.wheel(n).delta for n in names], dtype=float)
-        self.ranges = steer_ranges(robot)
+        self.ranges, self.spin_columns = steer_ranges(robot), spin_columns(robot)
         self.wheel_of_steer = np.array([robot.wheel_names.index(n) for n in names], dtype=int)
         loops = plant.loops
         self.joints = () if loops is None else loops.joints
@@ -106,27 +110,27 @@ class _Sim:
         self.limited = bool(np.isfinite(self.ranges).any())
         spins = [j for j in self.joints if j.endswith(".spin")]
         if (loops is not None or self.limited) and not spins:
-            spins = [j for j in robot.actuated if j.endswith(".spin")]
+            spins = [j for j in robot.actuated if j.endswith(_SPINS)]
         if self.limited and not spins:  # no actuator described: every wheel spins as the IK commands it
-            spins = [j for j in robot.rate_names if j.endswith(".spin")]
+            spins = [j for j in robot.rate_names if j.endswith(_SPINS)]
         self.drive = tuple(spins)
         self.n_loop = 0 if loops is None else loops.size
 
     def commands(self, twist: np.ndarray, beta: np.ndarray) -> _Commands:
         """Wheel commands at steering `beta`, with the policy and ranges applied to the steered wheels."""
         c = wheel_commands(self.robot, twist, beta)
-        target = np.array(c.beta)
-        spin = np.asarray(c.spin)[self.wheel_of_steer]
+        target, rates = np.array(c.beta), np.array(c.rates)
         fits = np.ones(len(target), dtype=bool)
         if len(target) and (self.plant.policy != "closest" or self.limited):
             steered = ~self.passive
             heading = target - math.pi / 2 + self.delta
-            ch = choose_steering(heading, spin, beta - math.pi / 2 + self.delta, policy=self.plant.policy,
-                                 ranges=self.ranges)
+            ch = choose_steering(heading, np.asarray(c.spin)[self.wheel_of_steer], beta - math.pi / 2 + self.delta,
+                                 policy=self.plant.policy, ranges=self.ranges)
             target = np.where(steered, np.asarray(ch.heading) + math.pi / 2 - self.delta, target)
-            spin = np.where(steered, np.asarray(ch.spin), spin)
+            reverse_spins(rates, self.spin_columns, np.asarray(ch.reversed) & steered)
             fits = np.asarray(ch.in_range) | self.passive
-        return _Commands(c, target, spin, fits)
+        spin = np.where(self.passive, np.asarray(c.spin)[self.wheel_of_steer], unit_spin(rates, self.spin_columns))
+        return _Commands(c, target, rates, spin, fits)
 
     def realised(self, twist: np.ndarray, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The ideal plant's twist and which steered wheels fit their ranges: the commanded twist, or, when a wheel
@@ -143,13 +147,7 @@ class _Sim:
         """Twist (4.11) of the drive joints' rates (`actual` where given, else commanded) at steering `beta`."""
         rates = {}
         for j in self.drive:
-            wheel = j.partition(".")[0]
-            if j in actual:
-                rates[j] = actual[j]
-            elif wheel in self.robot.steer_names and j.endswith(".spin"):  # the spin of the chosen root
-                rates[j] = float(cmd.spin[self.robot.steer_names.index(wheel)])
-            else:
-                rates[j] = float(cmd.ik.rates[self.robot.rate_names.index(j)])
+            rates[j] = actual[j] if j in actual else float(cmd.rates[self.robot.rate_names.index(j)])  # chosen roots
         twist, _ = forward_kinematics(self.robot, rates, beta)
         return np.asarray(twist)
 
@@ -159,10 +157,8 @@ class _Sim:
             wheel, _, joint = j.partition(".")
             if joint == "steer":
                 out[i] = cmd.target[self.robot.steer_names.index(wheel)]
-            elif joint == "spin" and wheel in self.robot.steer_names:  # the spin of the chosen root
-                out[i] = cmd.spin[self.robot.steer_names.index(wheel)]
-            else:
-                out[i] = cmd.ik.rates[self.robot.rate_names.index(j)]
+            else:  # the rate of the chosen root
+                out[i] = cmd.rates[self.robot.rate_names.index(j)]
         return out
 
     def plant_twist(self, twist_cmd: np.ndarray, cmd: _Commands, beta: np.ndarray,

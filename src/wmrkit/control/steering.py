@@ -59,11 +59,14 @@ def _in_range(h: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class SteeringChoice:
-    """Chosen headings ``(..., n_steer)`` [rad], their spins ``(..., n_steer)`` [rad/s] and ``in_range`` flags."""
+    """Chosen headings ``(..., n_steer)`` [rad], their spins ``(..., n_steer)`` [rad/s], ``in_range`` flags, and
+    ``reversed``: the root taken is the other one, ``heading + pi`` (the spin negated; a double wheel's sub-wheels
+    also change sides, :func:`reverse_spins`)."""
 
     heading: np.ndarray
     spin: np.ndarray
     in_range: np.ndarray
+    reversed: np.ndarray
 
 
 def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, policy: str = "closest",
@@ -96,7 +99,6 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
         ok0, ok1 = _in_range(h0, lo, hi), _in_range(h1, lo, hi)
     take0 = np.where(ok0 & ok1, pref0, ok0)
     h = np.where(take0, h0, h1)
-    s = np.where(take0, s0, s1)
     fits = ok0 | ok1
     if lo is not None and not np.all(fits):  # neither root fits: the end of the range nearest to either root
         with np.errstate(invalid="ignore"):
@@ -104,25 +106,60 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
             end1, miss1 = _nearest_end(h1, lo, hi)
         near0 = (miss0 < miss1) | ((miss0 == miss1) & pref0)
         h = np.where(fits, h, np.where(near0, end0, end1))
-        s = np.where(fits, s, np.where(near0, s0, s1))
-    return SteeringChoice(readonly(np.asarray(h)), readonly(np.asarray(s)), readonly(np.asarray(fits)))
+        take0 = np.where(fits, take0, near0)
+    s = np.where(take0, s0, s1)
+    return SteeringChoice(readonly(np.asarray(h)), readonly(np.asarray(s)), readonly(np.asarray(fits)),
+                          readonly(~np.asarray(take0)))
+
+
+def spin_columns(robot: Robot) -> np.ndarray:
+    """``(n_steer, 2)`` columns in ``robot.rate_names`` of each steering wheel's spins: ``(spin, -1)`` for a
+    steerable wheel, ``(spin1, spin2)`` for a double wheel, ``(-1, -1)`` for the passive ones (castors)."""
+    out = np.full((len(robot.steer_names), 2), -1, dtype=int)
+    for k, name in enumerate(robot.steer_names):
+        kind = robot.wheel(name).type
+        joints = ("spin",) if kind == "steerable" else ("spin1", "spin2") if kind == "double" else ()
+        for i, joint in enumerate(joints):
+            out[k, i] = robot.rate_names.index(f"{name}.{joint}")
+    return out
+
+
+def unit_spin(rates: np.ndarray, columns: np.ndarray) -> np.ndarray:
+    """The spin of each steered unit of `columns` (:func:`spin_columns`): its wheel's, the mean of a double's two."""
+    one = rates[..., columns[:, 0]]
+    return np.where(columns[:, 1] >= 0, 0.5 * (one + rates[..., columns[:, 1]]), one)
+
+
+def reverse_spins(rates: np.ndarray, columns: np.ndarray, reverse: np.ndarray) -> None:
+    """Joint `rates` (``robot.rate_names`` order) in place for the other root of each unit of `columns` where
+    `reverse`: a wheel turned half round rolls backwards (spin negated), and a double wheel's sub-wheels change
+    sides (``spin1, spin2 -> -spin2, -spin1``, from the rolling rows (3.24))."""
+    for c1, c2 in columns[np.asarray(reverse, dtype=bool)]:
+        if c2 < 0:
+            rates[..., c1] = -rates[..., c1]
+        else:
+            rates[..., [c1, c2]] = -rates[..., [c2, c1]]
 
 
 def range_keeper(robot: Robot) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
-    """``(headings, rates) -> in_range``: moves, in place, each steered wheel's heading to a root of (8.9) within
-    its ``steer_range`` (its spin negated with the other root), or to the end of the range nearest to either root
-    when neither fits; returns which fitted (:func:`.steering.choose_steering`)."""
-    ranges = steer_ranges(robot)
-    steered = np.array([robot.wheel(n).type in ("steerable", "double") for n in robot.steer_names], dtype=bool)
-    spin = np.array([robot.rate_names.index(f"{n}.spin") if f"{n}.spin" in robot.rate_names else -1
-                     for n in robot.steer_names], dtype=int)
-    limited = np.isfinite(ranges).any(axis=1) & steered & (spin >= 0)
+    """``(headings, rates) -> in_range`` for the loops through the dynamics: moves, in place, each steered wheel's
+    heading to a root of (8.9) within its ``steer_range`` (its spins for that root, :func:`reverse_spins`), or to
+    the end of the range nearest to either root when neither fits; returns which fitted
+    (:func:`.steering.choose_steering`). A range on a wheel whose steering is not actuated is refused."""
+    ranges, columns = steer_ranges(robot), spin_columns(robot)
+    limited = np.isfinite(ranges).any(axis=1) & (columns[:, 0] >= 0)
+    for name in np.asarray(robot.steer_names)[limited]:
+        if "steer" not in robot.wheel(name).actuated:
+            raise ControlError(f"wheel '{name}': a steer_range needs an actuated steering in the dynamics (it has "
+                               "no steering stops, and nothing else holds the wheel); add 'steer' to its 'actuated'")
+    columns = columns[limited]
 
     def keep(heading: np.ndarray, rates: np.ndarray) -> np.ndarray:
         if not limited.any():
             return np.ones(len(heading), dtype=bool)
-        ch = choose_steering(heading[limited], rates[spin[limited]], heading[limited], ranges=ranges[limited])
-        heading[limited], rates[spin[limited]] = ch.heading, ch.spin
+        ch = choose_steering(heading[limited], unit_spin(rates, columns), heading[limited], ranges=ranges[limited])
+        heading[limited] = ch.heading
+        reverse_spins(rates, columns, ch.reversed)
         fits = np.ones(len(heading), dtype=bool)
         fits[limited] = ch.in_range
         return fits

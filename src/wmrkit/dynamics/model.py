@@ -67,6 +67,12 @@ class DynamicModel:
         """Number of generalized velocities."""
         return len(self.names)
 
+    def is_actuated(self, column: int) -> bool:
+        """Whether generalized velocity `column` is a joint its wheel's motors drive (``actuated`` in the
+        description: ``spin``, ``steer``, a double wheel's ``spin1``/``spin2``)."""
+        wheel, _, joint = self.names[column].partition(".")
+        return bool(joint) and joint in self.robot.wheel(wheel).actuated
+
     @property
     def body(self) -> Body:
         """The robot's mass properties."""

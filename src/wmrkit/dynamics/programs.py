@@ -96,7 +96,8 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     Rate servos on actuated wheel joints (gain ``bandwidth x`` the wheel's reflected inertia, at least the grip
     torque per 0.1 rad/s, saturated at the grip ``mu Fz r`` with mu = 1); the joints of a ``differential`` coupling
     share one servo on their carrier rate, their torques in the coupling's ratios (an open differential: the speed
-    difference is the tyres'); PD servos on actuated steering (natural frequency `bandwidth` [rad/s]).
+    difference is the tyres'); PD servos on actuated steering (natural frequency `bandwidth` [rad/s]). A robot
+    without an actuated joint is refused.
     """
     from ..kinematics.wheel_ik import wheel_commands
 
@@ -108,6 +109,9 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
         raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s: expected finite speeds "
                           f"within {MAX_SPEED:g} m/s and a turn rate within {MAX_SPEED:g} rad/s")
     robot, n = model.robot, model.n
+    if not robot.actuated:
+        raise WmrkitError(f"robot '{robot.name}' has no actuated joint: no servo would drive it (it would not "
+                          "move); list the motors in its wheels' 'actuated' field")
     cmd = wheel_commands(robot, twists, slip_tol=SLIP_TOL)
     if not allow_slip and not cmd.feasible.all():
         k = int(np.argmin(cmd.feasible))
@@ -121,7 +125,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     gain, limit = np.zeros(n), np.full(n, np.inf)
     loads = model.normal_loads()
     m_total = model.body.mass + sum(w.mass for w in robot.wheels)
-    driven = [c for c in range(3, n) if _actuated(model, c) and ".steer" not in model.names[c]]
+    driven = [c for c in range(3, n) if model.is_actuated(c) and ".steer" not in model.names[c]]
     for c in driven:
         w = robot.wheel(model.names[c].split(".")[0])
         reflected = w.spin_inertia + m_total * w.r ** 2 / max(len(driven), 1)
@@ -140,15 +144,10 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
         wheel_index = robot.wheel_names.index(w.name)
         h = cmd.heading[:, wheel_index]
         headings[:, k] = np.where(np.isfinite(h), h, w.heading)
-        if _actuated(model, c):
+        if model.is_actuated(c):
             kp[k] = w.steer_inertia * bandwidth ** 2
             kd[k] = 2 * w.steer_inertia * bandwidth
     return Inputs(*(readonly(a) for a in (t, np.zeros((len(t), n)), rates, gain, limit, headings, kp, kd)))
-
-
-def _actuated(model: DynamicModel, column: int) -> bool:
-    wheel, _, joint = model.names[column].partition(".")
-    return joint.rstrip("12") in model.robot.wheel(wheel).actuated
 
 
 def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:

@@ -105,10 +105,9 @@ class Simulation:
 
 def joint_column(model: DynamicModel, name: str) -> int:
     """Column of the actuated joint `name` (``wheel.spin``, ``wheel.steer``...), or a one-line error."""
-    wheel, _, joint = name.partition(".")
     if name not in model.names[3:]:
         raise WmrkitError(f"robot '{model.robot.name}' has no joint '{name}' (joints: {', '.join(model.names[3:])})")
-    if joint.rstrip("12") not in model.robot.wheel(wheel).actuated:
+    if not model.is_actuated(model.names.index(name)):
         raise WmrkitError(f"joint '{name}' of robot '{model.robot.name}' is not actuated (actuated: "
                           f"{', '.join(model.robot.actuated) or 'none'})")
     return model.names.index(name)
