@@ -281,11 +281,20 @@ def test_a_double_wheel_held_at_its_range_moves_the_robot_the_same_either_way_ro
     assert np.abs(direct.pose[-1, :2]).max() > 0.5  # it moved
 
 
-def test_the_dynamics_refuse_a_range_on_a_steering_nothing_holds():
-    """The dynamic model has no steering stops: a double wheel steered by its spins alone cannot be held within a
-    range, and the loop used to report it 'held at its end' while it steered 94 deg."""
-    from wmrkit.control.steering import range_keeper
+def test_the_dynamics_refuse_a_steered_wheel_nothing_steers():
+    """Through the dynamics a steering joint without a servo is not steered: a double wheel steered by its spins
+    alone drifted 0.9 m off a 1 m circle in 3 s (its commanded spins have no steering loop), and was reported 'held
+    at its end' of a range while it steered 94 deg; the forklift without its steering motor drove straight."""
+    from wmrkit.control.steering import check_steering_driven
 
-    with pytest.raises(ControlError, match="'drive': a steer_range needs an actuated steering"):
-        range_keeper(_double_unit(["-10 deg", "10 deg"]))
-    range_keeper(_double_unit(["-10 deg", "10 deg"], actuated=("steer", "spin1", "spin2")))
+    circle = builtin_reference("circle", size=1.0)
+    with pytest.raises(ControlError, match="wheel 'drive': its steering is not actuated"):
+        track(_double_unit(["-10 deg", "10 deg"]), circle, dynamics=True, duration=1)
+    truck = catalog.load("forklift")
+    free = replace(truck, wheels=tuple(replace(w, actuated=tuple(a for a in w.actuated if a != "steer"))
+                                       for w in truck.wheels))
+    for kwargs in ({}, {"feedback": "wls"}):
+        with pytest.raises(ControlError, match="wheel 'steer': its steering is not actuated"):
+            track(free, circle, dynamics=True, duration=1, **kwargs)
+    check_steering_driven(_double_unit(["-10 deg", "10 deg"], actuated=("steer", "spin1", "spin2")))
+    check_steering_driven(truck)

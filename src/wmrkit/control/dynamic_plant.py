@@ -24,7 +24,7 @@ from .laws import PositionLaw
 from .loop import TwistController, check_command
 from .points import ControlError, ControlPoint, check_delay
 from .references import Reference
-from .steering import range_keeper
+from .steering import check_steering_driven, range_keeper
 from .tick import scalar_law
 
 __all__ = ["fast_law_controller", "simulate_dynamics"]
@@ -50,6 +50,7 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
     if feedback not in ("pose", "odometry"):
         raise ControlError(f"feedback must be 'pose' or 'odometry', got {feedback!r}")
     check_delay(delay)
+    check_steering_driven(robot)
     model = DynamicModel.of(robot, tyre)
     held = max(1, round(period / step)) * step
     stepper = Stepper(model, initial_state(model, (0.0, 0.0, 0.0), initial_pose), step=step)

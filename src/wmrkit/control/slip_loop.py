@@ -33,7 +33,7 @@ from ..slip.weights import SlipWeights
 from .loop import TwistController, check_command
 from .points import ControlError, check_delay
 from .slip_control import SLIP_MODELS, SlipCommander, SlipInverse, _Forward, slip_inverse
-from .steering import range_keeper
+from .steering import check_steering_driven, range_keeper
 
 __all__ = ["FEEDBACK", "simulate_slip_control", "with_commanded_rates"]
 
@@ -72,6 +72,7 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     if feedback not in FEEDBACK:
         raise ControlError(f"feedback must be one of {', '.join(FEEDBACK)}, got '{feedback}'")
     check_delay(delay)
+    check_steering_driven(robot)
     model = DynamicModel.of(robot, tyre)
     commander = None
     if slip_model != "none":

@@ -141,17 +141,24 @@ def reverse_spins(rates: np.ndarray, columns: np.ndarray, reverse: np.ndarray) -
             rates[..., [c1, c2]] = -rates[..., [c2, c1]]
 
 
+def check_steering_driven(robot: Robot) -> None:
+    """The loops through the dynamics steer a wheel through its steering servo: a steerable or double wheel whose
+    steering is not actuated would not follow the commands (nothing turns it, no stop holds it in its range)."""
+    for name in robot.steer_names:
+        w = robot.wheel(name)
+        if w.type in ("steerable", "double") and "steer" not in w.actuated:
+            raise ControlError(f"wheel '{name}': its steering is not actuated, so through the dynamics nothing would "
+                               f"steer it ({w.type} wheel, actuated: {', '.join(w.actuated) or 'none'}); add 'steer' "
+                               "to its 'actuated', or track without the dynamics (ideal joints)")
+
+
 def range_keeper(robot: Robot) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     """``(headings, rates) -> in_range`` for the loops through the dynamics: moves, in place, each steered wheel's
     heading to a root of (8.9) within its ``steer_range`` (its spins for that root, :func:`reverse_spins`), or to
     the end of the range nearest to either root when neither fits; returns which fitted
-    (:func:`.steering.choose_steering`). A range on a wheel whose steering is not actuated is refused."""
+    (:func:`.steering.choose_steering`); every steered wheel's steering is actuated (:func:`check_steering_driven`)."""
     ranges, columns = steer_ranges(robot), spin_columns(robot)
     limited = np.isfinite(ranges).any(axis=1) & (columns[:, 0] >= 0)
-    for name in np.asarray(robot.steer_names)[limited]:
-        if "steer" not in robot.wheel(name).actuated:
-            raise ControlError(f"wheel '{name}': a steer_range needs an actuated steering in the dynamics (it has "
-                               "no steering stops, and nothing else holds the wheel); add 'steer' to its 'actuated'")
     columns = columns[limited]
 
     def keep(heading: np.ndarray, rates: np.ndarray) -> np.ndarray:
