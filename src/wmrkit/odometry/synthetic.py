@@ -140,16 +140,22 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     twist = profile.at(0.5 * (fine[:-1] + fine[1:]))  # (M, 3)
     beta_nodes, beta_mid = _steering(robot, profile, fine, twist, sensed)  # (M + 1, n_steer), (M, n_steer)
     configs, index = np.unique(beta_mid, axis=0, return_inverse=True)  # one solve per distinct configuration
-    q_unit, res_unit = solve_assigned(robot.constraint_matrix(configs)[:, None], [0, 1, 2], np.eye(3))
+    # Assigned: the twist, and the steering rates of the steered wheels that have one among the velocities (a double
+    # wheel's sub-wheels roll to turn it, (3.24)): their angles are the geometry's, not a least-squares choice.
+    names = robot.velocity_names
+    steered = [k for k, name in enumerate(robot.steer_names)
+               if robot.wheel(name).type in ("steerable", "double") and f"{name}.steer" in names]
+    assigned = [0, 1, 2, *(names.index(f"{robot.steer_names[k]}.steer") for k in steered)]
+    q_unit, res_unit = solve_assigned(robot.constraint_matrix(configs)[:, None], assigned, np.eye(len(assigned)))
     index = index.reshape(-1)
-    q = np.einsum("nik,ni->nk", q_unit[index], twist * dt[:, None])
-    res = np.einsum("nir,ni->nr", res_unit[index], twist * dt[:, None])
+    motion = np.hstack([twist * dt[:, None], np.diff(beta_nodes[:, steered], axis=0)])
+    q = np.einsum("nik,ni->nk", q_unit[index], motion)
+    res = np.einsum("nir,ni->nr", res_unit[index], motion)
     bad = np.max(np.abs(res), axis=-1) > 1e-9 * max(1.0, float(np.max(np.abs(twist * dt[:, None]))))
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
         raise WmrkitError(f"profile: at t = {fine[k]:.6g} s the twist {twist[k].tolist()} is not possible for "
                           f"robot '{robot.name}' without slip (its fixed wheels forbid it)")
-    names = robot.velocity_names
     rates = q[:, 3:]
     truth = np.vstack([np.asarray(pose0, float)[None], integrate_increments(pose0, twist * dt[:, None], "exact")])
     rng = np.random.default_rng(seed)
