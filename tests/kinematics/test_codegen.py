@@ -16,7 +16,7 @@ import pytest
 from wmrkit import Robot, SingularError, Wheel, catalog
 from wmrkit.kinematics.codegen import CodegenError, identifier, write_code
 from wmrkit.kinematics.linalg import solve_assigned
-from wmrkit.kinematics.symbolic import sensed_rates
+from wmrkit.kinematics.symbolic import free_steering, sensed_rates
 
 
 def _robot(name, wheels):
@@ -47,14 +47,25 @@ ROBOTS = {
          "sensed": ["spin1", "spin2"]},
         {"name": "left", "type": "fixed", "position": [-0.2, 0.25], "beta": "90 deg", "r": 0.05},
         {"name": "right", "type": "fixed", "position": [-0.2, -0.25], "beta": "90 deg", "r": 0.05}]),
+    "double units": _robot("double units", [  # a double wheel: its steering rate is an input of the inverse
+        {"name": "drive", "type": "double", "position": [0.3, 0.05], "heading": 0, "b": 0.06, "r": 0.08,
+         "sensed": ["steer", "spin1", "spin2"]},
+        {"name": "rear", "type": "double", "position": [-0.3, 0], "heading": 0, "b": 0.05, "r": 0.07,
+         "sensed": ["steer"]},
+        {"name": "trailer", "type": "double_castor", "position": [-0.5, 0.1], "d": 0.1, "b": 0.05, "r": 0.04}]),
 }
 N = 6  # random samples per robot
 
 
-def numeric(robot: Robot, sensed, beta, twist, q_sensed):
-    """Reference: the ranks method (4.11) on the numeric constraint matrix."""
+def numeric(robot: Robot, sensed, beta, twist, q_sensed, steer_rate=None):
+    """Reference: the ranks method (4.11) on the numeric constraint matrix; the double wheels' steering rates
+    `steer_rate` assigned with the twist."""
     a = robot.constraint_matrix(beta)
-    rates = solve_assigned(a, [0, 1, 2], twist)[0][..., 3:]
+    free = [robot.velocity_index(n) for n in free_steering(robot)]
+    assigned = np.concatenate([twist, np.broadcast_to(steer_rate, (*twist.shape[:-1], len(free)))], axis=-1) \
+        if free else twist
+    q = solve_assigned(a, [0, 1, 2, *free], assigned)[0]
+    rates = np.delete(q, [0, 1, 2, *free], axis=-1)
     q, slip = solve_assigned(a, [robot.velocity_index(n) for n in sensed], q_sensed)
     return rates, q[..., :3], np.linalg.norm(slip, axis=-1)
 
@@ -62,7 +73,12 @@ def numeric(robot: Robot, sensed, beta, twist, q_sensed):
 def inputs(robot: Robot, sensed, seed=0):
     rng = np.random.default_rng(seed)
     beta = rng.uniform(-math.pi, math.pi, (N, len(robot.steer_names)))
-    return beta, rng.normal(size=(N, 3)), rng.normal(size=(N, len(sensed)))
+    steer_rate = rng.normal(size=(N, len(free_steering(robot))))
+    return beta, rng.normal(size=(N, 3)), rng.normal(size=(N, len(sensed))), steer_rate
+
+
+def _inverse(mod, twist, steer_rate, beta):
+    return mod.inverse(twist, steer_rate, beta) if mod.FREE_STEER_NAMES else mod.inverse(twist, beta)
 
 
 def load_module(path: Path):
@@ -80,17 +96,18 @@ def test_python_module_equals_numeric_model(name, tmp_path):
     robot = ALL[name]
     (path,) = write_code(robot, "python", tmp_path)
     mod = load_module(path)
-    sensed = sensed_rates(robot)
-    assert mod.SENSED_NAMES == sensed and mod.RATE_NAMES == robot.rate_names
-    beta, twist, q_s = inputs(robot, sensed)
-    rates, twist_fw, slip = numeric(robot, sensed, beta, twist, q_s)
+    sensed, free = sensed_rates(robot), free_steering(robot)
+    assert mod.SENSED_NAMES == sensed and mod.FREE_STEER_NAMES == free
+    assert mod.RATE_NAMES == tuple(n for n in robot.rate_names if n not in free)
+    beta, twist, q_s, s = inputs(robot, sensed)
+    rates, twist_fw, slip = numeric(robot, sensed, beta, twist, q_s, s)
     np.testing.assert_allclose(mod.constraint_matrix(beta), robot.constraint_matrix(beta), atol=1e-12)
-    np.testing.assert_allclose(mod.inverse(twist, beta), rates, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(_inverse(mod, twist, s, beta), rates, rtol=1e-9, atol=1e-9)
     got_twist, got_slip = mod.forward_with_residual(q_s, beta)
     np.testing.assert_allclose(got_twist, twist_fw, rtol=1e-8, atol=1e-9)
     np.testing.assert_allclose(got_slip, slip, rtol=1e-8, atol=1e-9)
     # batches broadcast: one configuration for many twists, and (2, 3) leading axes
-    np.testing.assert_allclose(mod.inverse(twist, beta[0]), numeric(robot, sensed, beta[0], twist, q_s)[0],
+    np.testing.assert_allclose(_inverse(mod, twist, s, beta[0]), numeric(robot, sensed, beta[0], twist, q_s, s)[0],
                                rtol=1e-9, atol=1e-9)
     assert mod.forward(q_s.reshape(2, 3, -1), beta.reshape(2, 3, -1)).shape == (2, 3, 3)
 
@@ -133,18 +150,19 @@ def test_c_code_equals_numeric_model(name, tmp_path):
     robot = ALL[name]
     lib, ident = compile_c(robot, tmp_path)
     sensed = sensed_rates(robot)
-    beta, twist, q_s = inputs(robot, sensed, seed=1)
-    rates, twist_fw, slip = numeric(robot, sensed, beta, twist, q_s)
+    beta, twist, q_s, s = inputs(robot, sensed, seed=1)
+    rates, twist_fw, slip = numeric(robot, sensed, beta, twist, q_s, s)
     forward = getattr(lib, f"{ident}_forward")
     forward.restype = ctypes.c_int
     n_rows, n_vel = robot.constraint_matrix().shape
     for k in range(N):
         b = beta[k] if beta.shape[1] else None
-        a_out, out, tw = np.zeros(n_rows * n_vel), np.zeros(len(robot.rate_names)), np.zeros(3)
+        a_out, out, tw = np.zeros(n_rows * n_vel), np.zeros(rates.shape[-1]), np.zeros(3)
         res = ctypes.c_double(-1.0)
         getattr(lib, f"{ident}_constraint")(_ptr(b) if b is not None else None, _ptr(a_out))
         np.testing.assert_allclose(a_out.reshape(n_rows, n_vel), robot.constraint_matrix(beta[k]), atol=1e-12)
-        getattr(lib, f"{ident}_inverse")(_ptr(twist[k]), _ptr(b) if b is not None else None, _ptr(out))
+        steer = (_ptr(s[k]),) if s.shape[1] else ()  # the double wheels' steering rates
+        getattr(lib, f"{ident}_inverse")(_ptr(twist[k]), *steer, _ptr(b) if b is not None else None, _ptr(out))
         np.testing.assert_allclose(out, rates[k], rtol=1e-9, atol=1e-9)
         status = forward(_ptr(q_s[k]), _ptr(b) if b is not None else None, _ptr(tw), ctypes.byref(res))
         assert status == 0
@@ -187,11 +205,6 @@ def test_identifiers_and_errors(tmp_path):
         write_code(ROBOTS["forklift"], "rust", tmp_path)
     with pytest.raises(CodegenError, match="'vx' is a body velocity"):
         write_code(ROBOTS["forklift"], "python", tmp_path, sensed=["vx"])
-    double = _robot("double", [  # a double wheel's steering rate is free (3.29): the twist does not fix it
-        {"name": "unit", "type": "double", "position": [0.2, 0], "b": 0.1, "r": 0.05},
-        {"name": "back", "type": "fixed", "position": [-0.2, 0], "beta": "90 deg", "r": 0.05}])
-    with pytest.raises(SingularError, match=r"assigning \(vx, vy, omega\) does not determine \(unit.steer"):
-        write_code(double, "c", tmp_path)
     with pytest.raises(SingularError, match=r"the sensed rates \(fl.spin, fr.spin\) do not determine"):
         write_code(ROBOTS["mecanum"], "python", tmp_path, sensed=["fl.spin", "fr.spin"])
 
@@ -209,3 +222,19 @@ def test_cli_symbolic_and_codegen_end_to_end(capsys, tmp_path):
     # straight ahead (steer axle along +y): vx = r phi for both drive wheels, the steered wheel rolls as fast
     np.testing.assert_allclose(mod.inverse([0.46, 0, 0], robot.beta), [2.0, 2.0, 2.0], atol=1e-12)
     assert main(["kinematics", "forklift", "--codegen", "python", str(tmp_path / "forklift_kinematics.py")]) == 2
+
+
+def test_a_double_wheel_turns_on_the_spot_by_rolling_its_sub_wheels_apart(tmp_path):
+    """A double wheel's steering rate is free (3.29): the twist does not fix it, so it is an input of the generated
+    inverse (before, codegen and ``kinematics --symbolic`` refused every robot with a double wheel). Closed form:
+    the robot at rest, the unit turning at s rad/s, its sub-wheels at +-b roll at -+b s / r (3.24)."""
+    double = _robot("double", [
+        {"name": "unit", "type": "double", "position": [0.2, 0], "b": 0.1, "r": 0.05, "sensed": ["steer"]},
+        {"name": "back", "type": "fixed", "position": [-0.2, 0], "beta": "90 deg", "r": 0.05, "sensed": ["spin"]}])
+    mod = load_module(write_code(double, "python", tmp_path)[0])
+    assert mod.FREE_STEER_NAMES == ("unit.steer",) and "unit.steer" not in mod.RATE_NAMES
+    rates = dict(zip(mod.RATE_NAMES, mod.inverse([0.0, 0.0, 0.0], [0.7], [0.4]), strict=True))
+    assert rates["unit.spin1"] == pytest.approx(-0.1 * 0.7 / 0.05) and rates["unit.spin2"] == pytest.approx(0.7 * 2)
+    assert rates["back.spin"] == pytest.approx(0.0, abs=1e-15)
+    with pytest.raises(ValueError, match=r"steer_rate: expected shape \(\.\.\., 1\)"):
+        mod.inverse([0.0, 0.0, 0.0], [0.7, 0.1])

@@ -27,7 +27,7 @@ from sympy.printing.numpy import NumPyPrinter
 from ..errors import SingularError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
 from .linalg import matrix_rank
-from .symbolic import sensed_rates, symbolic_constraint_matrix, symbolic_model
+from .symbolic import free_steering, sensed_rates, symbolic_constraint_matrix, symbolic_model
 
 C_KEYWORDS = frozenset(
     "auto break case char const continue default do double else enum extern float for goto if inline int long "
@@ -66,10 +66,12 @@ class _Plan:
         self.sensed_cols = [robot.velocity_index(n) for n in self.sensed]
         self.unknown_cols = [j for j in range(self.a.cols) if j not in self.sensed_cols]
         self._check_forward()
-        model = symbolic_model(robot, TWIST_NAMES, self.beta)
+        self.free_steer = free_steering(robot)  # a double wheel's steering rate: an input besides the twist
+        self.steer_rate = tuple(sp.Symbol(f"s{i}", real=True) for i in range(len(self.free_steer)))
+        model = symbolic_model(robot, TWIST_NAMES + self.free_steer, self.beta)
         self.inverse_exact = model.exact
         self.rates = model.solved
-        self.inverse = [e for e in model.matrix * sp.Matrix(self.twist)]
+        self.inverse = [e for e in model.matrix * sp.Matrix(self.twist + self.steer_rate)]
 
     def _check_forward(self) -> None:
         rng = np.random.default_rng(7)
@@ -194,6 +196,9 @@ def _c_unpack(plan: _Plan, sensed: bool = False, twist: bool = False) -> str:
     if twist:
         lines.append("    const double vx = twist[0], vy = twist[1], omega = twist[2];")
         names += ["vx", "vy", "omega"]
+        lines += [f"    const double s{i} = steer_rate[{i}]; /* {_c_comment(n)} */"
+                  for i, n in enumerate(plan.free_steer)]
+        names += [f"s{i}" for i in range(len(plan.free_steer))]
     if sensed:
         lines += [f"    const double q{i} = sensed[{i}]; /* {_c_comment(n)} */" for i, n in enumerate(plan.sensed)]
         names += [f"q{i}" for i in range(len(plan.sensed))]
@@ -208,9 +213,13 @@ def _c_files(plan: _Plan) -> list[tuple[str, str]]:
     beta_param = f"const double beta[{p}_N_STEER]" if plan.beta else "const double *beta"
     sizes = {"N_STEER": len(plan.beta), "N_RATES": len(plan.rates), "N_SENSED": len(plan.sensed),
              "N_ROWS": plan.a.rows, "N_VEL": plan.a.cols, "N_UNKNOWN": len(plan.unknown_cols)}
+    steer_param = ""
+    if plan.free_steer:  # double wheels: their steering rates are inputs of the inverse model
+        sizes["N_FREE_STEER"] = len(plan.free_steer)
+        steer_param = f"const double steer_rate[{p}_N_FREE_STEER], "
     protos = [
         f"void {n}_constraint({beta_param}, double a[{p}_N_ROWS * {p}_N_VEL]);",
-        f"void {n}_inverse(const double twist[3], {beta_param}, double rates[{p}_N_RATES]);",
+        f"void {n}_inverse(const double twist[3], {steer_param}{beta_param}, double rates[{p}_N_RATES]);",
         f"int {n}_forward(const double sensed[{p}_N_SENSED], {beta_param}, double twist[3], double *residual);",
     ]
     header = "\n".join([
@@ -220,6 +229,8 @@ def _c_files(plan: _Plan) -> list[tuple[str, str]]:
         " *",
         " * Array orders:",
         " *   twist[3]  = (vx [m/s], vy [m/s], omega [rad/s]), body twist in the robot frame",
+        *([_c_list(f" *   steer_rate[{p}_N_FREE_STEER] = steering rates of the double wheels [rad/s] (an input: "
+                   "no twist determines them)", plan.free_steer)] if plan.free_steer else []),
         _c_list(f" *   beta[{p}_N_STEER] = steering angles [rad]", r.steer_names),
         _c_list(f" *   rates[{p}_N_RATES] = wheel joint rates [rad/s]", plan.rates),
         _c_list(f" *   sensed[{p}_N_SENSED] = sensed joint rates [rad/s]", plan.sensed),
@@ -227,7 +238,8 @@ def _c_files(plan: _Plan) -> list[tuple[str, str]]:
                 r.velocity_names),
         " *",
         f" * {n}_constraint: A(beta), two rows per contact point (along and across the roller axis).",
-        f" * {n}_inverse: wheel rates for a twist ({'exact' if plan.inverse_exact else 'least squares per wheel'},"
+        f" * {n}_inverse: wheel rates for a twist{' and steering rates' if plan.free_steer else ''} "
+        f"({'exact' if plan.inverse_exact else 'least squares per wheel'},"
         " thesis 4.11).",
         f" * {n}_forward: least-squares twist from the sensed rates (4.11); *residual = |A q| [m/s], the slip",
         " *   (may be NULL). Returns 0, or -1 if the sensed rates do not determine the twist at this beta.",
@@ -281,14 +293,36 @@ def _python_file(plan: _Plan) -> list[tuple[str, str]]:
     r = plan.robot
     unpack = "\n".join(f"    b{i} = beta[..., {i}]  # {n}" for i, n in enumerate(r.steer_names))
     a_targets = [f"out[..., {i}, {j}]" for i in range(plan.a.rows) for j in range(plan.a.cols)]
-    m = sp.Matrix(plan.inverse).jacobian(sp.Matrix(plan.twist))
-    m_targets = [f"out[..., {i}, {j}]" for i in range(m.rows) for j in range(3)]
+    inputs, k = plan.twist + plan.steer_rate, 3 + len(plan.free_steer)
+    m = sp.Matrix(plan.inverse).jacobian(sp.Matrix(inputs))
+    m_targets = [f"out[..., {i}, {j}]" for i in range(m.rows) for j in range(k)]
+    inputs_doc = "(twist, steer_rate)" if plan.free_steer else "twist"
+    if plan.free_steer:
+        steer_doc = (f"\n- ``steer_rate``: ``(..., {len(plan.free_steer)})`` steering rates of the double wheels "
+                     "[rad/s], order ``FREE_STEER_NAMES``\n  (an input of the inverse model: no twist determines "
+                     "them);")
+        inverse_def = f'''def inverse(twist, steer_rate, beta=None):
+    """Wheel rates [rad/s] for body twists and double-wheel steering rates:
+    ``(..., 3), (..., {len(plan.free_steer)}), (..., {len(plan.beta)}) -> (..., {m.rows})``.
+    """
+    twist = _vectors(twist, 3, "twist")
+    steer_rate = _vectors(steer_rate, {len(plan.free_steer)}, "steer_rate")
+    shape = numpy.broadcast_shapes(twist.shape[:-1], steer_rate.shape[:-1])
+    inputs = numpy.concatenate([numpy.broadcast_to(twist, shape + (3,)),
+                                numpy.broadcast_to(steer_rate, shape + ({len(plan.free_steer)},))], axis=-1)
+    return (inverse_matrix(beta) @ inputs[..., None])[..., 0]'''
+    else:
+        steer_doc = ""
+        inverse_def = f'''def inverse(twist, beta=None):
+    """Wheel rates [rad/s] for body twists: ``(..., 3), (..., {len(plan.beta)}) -> (..., {m.rows})``."""
+    twist = _vectors(twist, 3, "twist")
+    return (inverse_matrix(beta) @ twist[..., None])[..., 0]'''
     text = f'''"""No-slip kinematic models of robot {json.dumps(r.name)} (thesis ch. 4), generated by wmrkit.
 
 Do not edit; regenerate with ``wmrkit kinematics ROBOT --codegen python DIR``. Needs only numpy. SI units,
 robot frame x forward, y left. Arrays take leading batch axes, which broadcast:
 
-- ``twist``: ``(..., 3)`` = (vx [m/s], vy [m/s], omega [rad/s]) in the robot frame;
+- ``twist``: ``(..., 3)`` = (vx [m/s], vy [m/s], omega [rad/s]) in the robot frame;{steer_doc}
 - ``beta``: ``(..., {len(plan.beta)})`` steering angles [rad], order ``STEER_NAMES`` (None: as described);
 - wheel rates: ``(..., {len(plan.rates)})`` [rad/s], order ``RATE_NAMES``;
 - ``sensed``: ``(..., {len(plan.sensed)})`` [rad/s], order ``SENSED_NAMES``.
@@ -299,6 +333,7 @@ import numpy
 STEER_NAMES = {tuple(r.steer_names)!r}
 RATE_NAMES = {tuple(plan.rates)!r}
 SENSED_NAMES = {tuple(plan.sensed)!r}
+FREE_STEER_NAMES = {tuple(plan.free_steer)!r}
 VELOCITY_NAMES = {tuple(r.velocity_names)!r}
 BETA_DESCRIBED = {tuple(float(b) for b in r.beta)!r}
 _SENSED_COLUMNS = {list(plan.sensed_cols)!r}
@@ -332,21 +367,18 @@ def constraint_matrix(beta=None):
 
 
 def inverse_matrix(beta=None):
-    """``rates = M @ twist`` ({"exact" if plan.inverse_exact else "least squares per wheel"}, 4.11).
+    """``rates = M @ {inputs_doc}`` ({"exact" if plan.inverse_exact else "least squares per wheel"}, 4.11).
 
-    ``(..., {len(plan.beta)}) -> (..., {m.rows}, 3)``.
+    ``(..., {len(plan.beta)}) -> (..., {m.rows}, {k})``.
     """
     beta = _beta(beta)
 {unpack}
-    out = numpy.zeros(beta.shape[:-1] + ({m.rows}, 3))
+    out = numpy.zeros(beta.shape[:-1] + ({m.rows}, {k}))
 {_py_body(list(m), m_targets)}
     return out
 
 
-def inverse(twist, beta=None):
-    """Wheel rates [rad/s] for body twists: ``(..., 3), (..., {len(plan.beta)}) -> (..., {m.rows})``."""
-    twist = _vectors(twist, 3, "twist")
-    return (inverse_matrix(beta) @ twist[..., None])[..., 0]
+{inverse_def}
 
 
 def forward_with_residual(sensed, beta=None):
