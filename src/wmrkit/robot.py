@@ -76,6 +76,13 @@ class Robot:
         return self.velocity_names[3:]
 
     @property
+    def free_steering(self) -> tuple[str, ...]:
+        """The steering rates no twist determines: a double wheel's (``wheel.steer``), which turns by rolling its
+        two sub-wheels apart (3.24), (3.29); inputs of the inverse model besides the twist (its degree of
+        steerability)."""
+        return tuple(f"{w.name}.steer" for w in self.wheels if w.type == "double")
+
+    @property
     def steer_names(self) -> tuple[str, ...]:
         """Wheels whose steering angle is a configuration variable, in the order of ``beta``."""
         return tuple(w.name for w in self.wheels if w.kind.steers)

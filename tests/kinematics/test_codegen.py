@@ -16,7 +16,7 @@ import pytest
 from wmrkit import Robot, SingularError, Wheel, catalog
 from wmrkit.kinematics.codegen import CodegenError, identifier, write_code
 from wmrkit.kinematics.linalg import solve_assigned
-from wmrkit.kinematics.symbolic import free_steering, sensed_rates
+from wmrkit.kinematics.symbolic import sensed_rates
 
 
 def _robot(name, wheels):
@@ -61,7 +61,7 @@ def numeric(robot: Robot, sensed, beta, twist, q_sensed, steer_rate=None):
     """Reference: the ranks method (4.11) on the numeric constraint matrix; the double wheels' steering rates
     `steer_rate` assigned with the twist."""
     a = robot.constraint_matrix(beta)
-    free = [robot.velocity_index(n) for n in free_steering(robot)]
+    free = [robot.velocity_index(n) for n in robot.free_steering]
     assigned = np.concatenate([twist, np.broadcast_to(steer_rate, (*twist.shape[:-1], len(free)))], axis=-1) \
         if free else twist
     q = solve_assigned(a, [0, 1, 2, *free], assigned)[0]
@@ -73,7 +73,7 @@ def numeric(robot: Robot, sensed, beta, twist, q_sensed, steer_rate=None):
 def inputs(robot: Robot, sensed, seed=0):
     rng = np.random.default_rng(seed)
     beta = rng.uniform(-math.pi, math.pi, (N, len(robot.steer_names)))
-    steer_rate = rng.normal(size=(N, len(free_steering(robot))))
+    steer_rate = rng.normal(size=(N, len(robot.free_steering)))
     return beta, rng.normal(size=(N, 3)), rng.normal(size=(N, len(sensed))), steer_rate
 
 
@@ -96,7 +96,7 @@ def test_python_module_equals_numeric_model(name, tmp_path):
     robot = ALL[name]
     (path,) = write_code(robot, "python", tmp_path)
     mod = load_module(path)
-    sensed, free = sensed_rates(robot), free_steering(robot)
+    sensed, free = sensed_rates(robot), robot.free_steering
     assert mod.SENSED_NAMES == sensed and mod.FREE_STEER_NAMES == free
     assert mod.RATE_NAMES == tuple(n for n in robot.rate_names if n not in free)
     beta, twist, q_s, s = inputs(robot, sensed)
@@ -238,3 +238,18 @@ def test_a_double_wheel_turns_on_the_spot_by_rolling_its_sub_wheels_apart(tmp_pa
     assert rates["back.spin"] == pytest.approx(0.0, abs=1e-15)
     with pytest.raises(ValueError, match=r"steer_rate: expected shape \(\.\.\., 1\)"):
         mod.inverse([0.0, 0.0, 0.0], [0.7, 0.1])
+    # the numeric inverse model (ranks method) assigns the free steering rate too (before: "no 1 of (vx, vy,
+    # omega) can be assigned"); its twist, a bicycle's (vy = 0 at the back axle, omega from the unit's heading),
+    # gives the generated rates
+    from wmrkit.kinematics.models import inverse_model
+
+    model = inverse_model(double, beta=[0.4])
+    assert model.assigned == ("vx", "unit.steer")
+    solved = dict(zip(model.solved, model.matrix @ np.array([0.3, 0.7]), strict=True))
+    heading = 0.4 - math.pi / 2  # the unit's rolling direction
+    assert solved["omega"] == pytest.approx(0.3 * math.tan(heading) / 0.4) and solved["vy"] == pytest.approx(
+        0.2 * solved["omega"])
+    twist = [0.3, solved["vy"], solved["omega"]]
+    expected = dict(zip(mod.RATE_NAMES, mod.inverse(twist, [0.7], [0.4]), strict=True))
+    for name, value in expected.items():
+        assert solved[name] == pytest.approx(value, rel=1e-12, abs=1e-12)

@@ -27,7 +27,7 @@ from sympy.printing.numpy import NumPyPrinter
 from ..errors import SingularError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
 from .linalg import matrix_rank
-from .symbolic import free_steering, sensed_rates, symbolic_constraint_matrix, symbolic_model
+from .symbolic import sensed_rates, symbolic_constraint_matrix, symbolic_model
 
 C_KEYWORDS = frozenset(
     "auto break case char const continue default do double else enum extern float for goto if inline int long "
@@ -66,7 +66,7 @@ class _Plan:
         self.sensed_cols = [robot.velocity_index(n) for n in self.sensed]
         self.unknown_cols = [j for j in range(self.a.cols) if j not in self.sensed_cols]
         self._check_forward()
-        self.free_steer = free_steering(robot)  # a double wheel's steering rate: an input besides the twist
+        self.free_steer = robot.free_steering  # a double wheel's steering rate: an input besides the twist
         self.steer_rate = tuple(sp.Symbol(f"s{i}", real=True) for i in range(len(self.free_steer)))
         model = symbolic_model(robot, TWIST_NAMES + self.free_steer, self.beta)
         self.inverse_exact = model.exact

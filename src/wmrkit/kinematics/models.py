@@ -9,6 +9,7 @@ on the configuration, and a set assignable at generic angles can fail at a singu
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -267,15 +268,23 @@ def inverse_model(
 ) -> KinematicModel:
     """Inverse model (§4.2): the wheel rates (and remaining twist components) from m assigned twist components.
 
-    ``twist_names=None`` takes the first assignable subset of ``(vx, vy, omega)`` of size m.
+    ``twist_names=None`` takes the first assignable subset of ``(vx, vy, omega)`` of size m, with the steering
+    rates of double wheels (``robot.free_steering``: no twist determines them) assigned too.
     """
     beta = configuration(robot, beta, heading)
     if twist_names is not None:
         return kinematic_model(robot, twist_names, beta)
     a = nondimensional(robot).constraint_matrix(beta)
-    m = int(np.max(a.shape[-1] - matrix_rank(a)))
-    choice = _first_assignable(robot, a, TWIST_NAMES, m)
+    free = robot.free_steering  # double wheels' steering rates: no twist determines them, always assigned
+    m = int(np.max(a.shape[-1] - matrix_rank(a))) - len(free)
+    if free:
+        fixed = [robot.velocity_index(n) for n in free]
+        choice = next((c + free for c in itertools.combinations(TWIST_NAMES, m) if 0 < m <= 3 and ranks_assignable(
+            a, [[robot.velocity_index(n) for n in c] + fixed]).all()), None)
+    else:
+        choice = _first_assignable(robot, a, TWIST_NAMES, m)
     if choice is None:
-        raise SingularError(f"robot '{robot.name}': no {m} of (vx, vy, omega) can be assigned at "
+        also = f" with {', '.join(free)}" if free else ""
+        raise SingularError(f"robot '{robot.name}': no {m} of (vx, vy, omega){also} can be assigned at "
                             f"{describe_configuration(robot, beta)}")
     return kinematic_model(robot, choice, beta)

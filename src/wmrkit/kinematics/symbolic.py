@@ -203,17 +203,11 @@ def sensed_rates(robot: Robot) -> tuple[str, ...]:
     return sensed or tuple(f"{w.name}.{j}" for w in robot.wheels for j in w.kind.rates if j in w.kind.joints)
 
 
-def free_steering(robot: Robot) -> tuple[str, ...]:
-    """The steering rates no twist determines: a double wheel's (``wheel.steer``), which turns by rolling its two
-    sub-wheels apart (3.24); an input of the inverse model besides the twist (the thesis's degree of steerability)."""
-    return tuple(f"{w.name}.steer" for w in robot.wheels if w.type == "double")
-
-
 def twist_assignment(robot: Robot) -> tuple[str, ...]:
     """Inputs of the inverse model: the first assignable (4.10) subset of ``(vx, vy, omega)`` with m members (less
-    the :func:`free_steering` rates, always assigned), else the whole twist (wheel rates by least squares, as a
+    the ``robot.free_steering`` rates, always assigned), else the whole twist (wheel rates by least squares, as a
     controller computes them); then the free steering rates."""
-    free = free_steering(robot)
+    free = robot.free_steering
     rank = symbolic_model(robot, TWIST_NAMES + free).rank
     m = len(robot.velocity_names) - rank - len(free)
     for subset in itertools.combinations(TWIST_NAMES, m) if 0 < m <= 3 else ():
