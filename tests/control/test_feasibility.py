@@ -16,12 +16,12 @@ T4_OFF, T4_ON = "type 4, off axle", "type 4, on axle"
 T35, T3_0 = "types 3 and 5, l_o != 0", "type 3, l_o = 0"
 #: By hand from each file's geometry: where R (the origin) lies against the fixed axle / the steered wheels.
 EXPECTED = {
-    "ackermann": T4_ON, "bicycle": T4_ON, "diff-drive": T2_ON, "forklift": T4_OFF, "line-follower": T2_OFF,
-    "mecanum-4": T1, "omni-3": T1, "omni-4": T1, "swerve-4": T35, "thesis-bicycle-castor": T4_ON,
-    "thesis-bicycle-swedish": T4_ON, "thesis-diff-castor": T2_ON, "thesis-diff-swedish": T2_ON,
-    "thesis-omni-castor": T1, "thesis-omni-swedish": T1, "thesis-steer-castor": T3_0, "thesis-steer-swedish": T3_0,
-    "thesis-tricycle": T4_ON, "thesis-tricycle-ch4": T4_ON, "thesis-two-steer-castor": T35,
-    "thesis-two-steer-swedish": T35,
+    "ackermann": T4_ON, "agv-drive-unit": T4_ON, "bicycle": T4_ON, "diff-drive": T2_ON, "forklift": T4_OFF,
+    "line-follower": T2_OFF, "mecanum-4": T1, "omni-3": T1, "omni-4": T1, "swerve-4": T35,
+    "thesis-bicycle-castor": T4_ON, "thesis-bicycle-swedish": T4_ON, "thesis-diff-castor": T2_ON,
+    "thesis-diff-swedish": T2_ON, "thesis-omni-castor": T1, "thesis-omni-swedish": T1, "thesis-steer-castor": T3_0,
+    "thesis-steer-swedish": T3_0, "thesis-tricycle": T4_ON, "thesis-tricycle-ch4": T4_ON,
+    "thesis-two-steer-castor": T35, "thesis-two-steer-swedish": T35,
 }
 #: Table 8.1 read per column: feasible in the kinematic framework for (square with theta along the path, square
 #: at a constant heading, arc-line, circle), and arc-line in the dynamic framework. square: tangent jumps, velocity

@@ -162,3 +162,57 @@ def test_minimal_actuator_sets_are_the_assignable_wheel_rate_sets(ws):
     steer = tuple(f"{w.name}.steer" for w in robot.wheels if w.type == "steerable")
     found = minimal_actuator_sets(robot)
     assert [s[: len(s) - len(steer)] for s in found] == (expected if m else [])
+
+
+def _tree_from_constraints(robot: Robot, joints) -> tuple[bool, bool]:
+    """Independent of the Jacobian form: the no-slip equations (3.22) with the `joints` rates given. Consistent:
+    any such rates have a no-slip motion (``col A_sel`` within ``col A_rest``); determined: they fix the twist
+    (no motion of the rest with a twist in it)."""
+    a = robot.constraint_matrix()
+    sel = [robot.velocity_index(n) for n in joints]
+    rest = [c for c in range(a.shape[1]) if c not in sel]
+    consistent = matrix_rank(np.hstack([a[:, rest], a[:, sel]])) == matrix_rank(a[:, rest])
+    _, s, vt = np.linalg.svd(a[:, rest])
+    null = vt[int(np.sum(s > 1e-9 * max(1.0, s.max(initial=0.0)))):]
+    return consistent, bool(np.abs(null[:, :3]).max(initial=0.0) < 1e-9)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.sampled_from([*ONE_CONTACT, "double", "double_castor"]), min_size=1, max_size=3).flatmap(
+    lambda types: st.tuples(*[wheels(t, name=f"w{i}") for i, t in enumerate(types)])))
+def test_the_trees_agree_with_the_no_slip_equations_double_wheels_included(ws):
+    """The actuation (4.28) and sensing (4.34) trees against the ranks of (3.22). The reduced equation, which
+    eliminates the unselected rates by least squares after projecting out the selected ones, called a double wheel
+    driven by its spins over-actuated and a robot it could not steer sufficiently actuated (its steering rate is
+    shared by its two contacts); the trees now eliminate them exactly."""
+    robot = Robot("r", tuple(ws))
+    a = robot.constraint_matrix()
+    s = np.linalg.svd(a, compute_uv=False)
+    assume(not np.any((s > 1e-12) & (s < 1e-4)))  # a generic configuration: ranks are clear
+    for analysis, joints in ((actuation_analysis, robot.actuated), (sensing_analysis, robot.sensed)):
+        columns = tuple(j for j in joints if j in robot.velocity_names)
+        assume(len(columns) == len(joints))  # no centred steering angle among them (a configuration, not a rate)
+        rest = [c for c in range(a.shape[1]) if robot.velocity_names[c] not in columns]
+        sv = np.linalg.svd(a[:, rest], compute_uv=False)
+        assume(not np.any((sv > 1e-12) & (sv < 1e-4)))
+        consistent, determined = _tree_from_constraints(robot, columns)
+        leaf = str(analysis(robot).tree.leaf)
+        expected = {(True, True): "determined", (False, True): "overdetermined", (True, False): "indeterminate",
+                    (False, False): "underdetermined"}[consistent, determined]
+        assert leaf == expected, (analysis.__name__, columns)
+
+
+def test_a_drive_unit_driven_by_its_two_wheels():
+    """The catalog AGV: the unit's two motors set its speed and its turn, nothing fights (before: over-actuated).
+    A double wheel and a double castor driven by the wheel's spins: the turn of the unit and the robot's turn
+    share the spins' difference, so the twist is not determined (before: sufficient)."""
+    from wmrkit import catalog
+
+    agv = catalog.load("agv-drive-unit")
+    assert str(actuation_analysis(agv).tree.leaf) == "determined"
+    trailer = Robot.from_dict({"name": "unit-and-trailer", "wheels": [
+        {"name": "drive", "type": "double", "position": [0.3, 0], "heading": 0, "b": 0.06, "r": 0.08,
+         "actuated": ["spin1", "spin2"]},
+        {"name": "trailer", "type": "double_castor", "position": [-0.3, 0], "beta": "90 deg", "d": 0.1, "b": 0.05,
+         "r": 0.04}]})
+    assert str(actuation_analysis(trailer).tree.leaf) == "indeterminate"

@@ -26,6 +26,7 @@ from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_prefilte
 from .trees import (
     TreeVerdict,
     classify_system,
+    eliminated_tree,
     jacobian_names,
     partitioned_solution,
     reduced_equation,
@@ -198,7 +199,7 @@ def actuation_analysis(
     return ActuationAnalysis(
         robot.name, channels, steering, steering_split(robot, steering),
         readonly(np.asarray(a.shape[-1] - matrix_rank(a))),
-        classify_system(reduced_equation(i_bar1, j_u1, j_nu1), j_u1),
+        eliminated_tree(i_bar1, j_u1, j_nu1),
         readonly(partitioned_solution(j_u, j_nu) @ i_bar),
     )
 
@@ -245,7 +246,7 @@ def trees_of(robot: Robot, beta: np.ndarray, sel: np.ndarray) -> TreeVerdict:
         len(sel), n_w - sel.shape[1])
     j_sel = np.moveaxis(j[..., sel], -2, 0)  # (..., 3E, S, size) -> (S, ..., 3E, size)
     j_rest = np.moveaxis(j[..., rest], -2, 0)
-    return classify_system(reduced_equation(i_bar, j_sel, j_rest), j_sel)
+    return eliminated_tree(i_bar, j_sel, j_rest)
 
 
 def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None) -> tuple[tuple[str, ...], ...]:

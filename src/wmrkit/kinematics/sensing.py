@@ -24,6 +24,7 @@ from .search import SetList
 from .trees import (
     TreeVerdict,
     classify_system,
+    eliminated_tree,
     jacobian_names,
     partitioned_solution,
     reduced_equation,
@@ -178,7 +179,7 @@ def sensing_analysis(
     return SensingAnalysis(
         robot.name, tuple(names[c] for c in columns), steering, steering_split(robot, steering),
         readonly(np.asarray(a.shape[-1] - matrix_rank(a))),
-        classify_system(reduced_equation(i_bar1, j_s1, j_ns1), j_s1),
+        eliminated_tree(i_bar1, j_s1, j_ns1),
         readonly(partitioned_solution(i_bar, j_ns) @ j_s), readonly(full),
         TWIST_NAMES + tuple(n for c, n in enumerate(names) if c not in columns),
         readonly(i_ns @ full - j_s),

@@ -208,6 +208,18 @@ def reduced_equation(i_bar: ArrayLike, j_sel: ArrayLike, j_rest: ArrayLike) -> n
     return i_bar - j_rest @ (partitioned_solution(j_rest, j_sel) @ i_bar)
 
 
+def eliminated_tree(i_bar: ArrayLike, j_sel: ArrayLike, j_rest: ArrayLike) -> TreeVerdict:
+    """The tree of the actuation (4.28) or sensing (4.34) equation, from ``I_bar twist = J_sel q_sel + J_rest
+    q_rest`` with ``q_rest`` eliminated exactly: ``Delta(J_rest) I_bar twist = Delta(J_rest) J_sel q_sel`` (the
+    rows orthogonal to every unselected velocity). :func:`reduced_equation` eliminates ``q_rest`` by least
+    squares after projecting out ``J_sel``, which is the same only while ``Delta(J_sel) J_rest`` has full column
+    rank: a double wheel whose spins are selected shares its unselected steering rate between its two contacts,
+    and there the reduced equation called a unit driven by its spins over-actuated (and a robot it could not
+    steer sufficiently actuated); the elimination gives the ranks of the no-slip equations (3.22)."""
+    delta = delta_projector(j_rest)
+    return classify_system(delta @ np.asarray(i_bar, dtype=float), delta @ np.asarray(j_sel, dtype=float))
+
+
 def select_columns(robot: Robot, joints: Sequence[str], role: str) -> tuple[tuple[int, ...], tuple[str, ...]]:
     """Columns of J for actuated/sensed joints ``wheel.joint``, and the steerable wheels among them.
 
