@@ -99,3 +99,45 @@ def test_user_errors_exit_2_with_one_line(tmp_path, capsys, argv, message):
     code, _, err = run(argv, capsys)
     assert code == 2
     assert err.startswith("wmrkit: error: ") and message in err and len(err.strip().splitlines()) == 1
+
+
+def test_follow_line_refuses_a_line_wider_than_the_view(tmp_path, capsys):
+    # --line-width 10 was accepted and the run (the robot spinning, 37 of 40 images without a line) exited 0
+    Camera(150.0, math.radians(60), 0.3, 320, 240).to_file(tmp_path / "cam.yaml")
+    code, out, err = run(["follow-line", "line-follower", "--camera", str(tmp_path / "cam.yaml"),
+                          "--line-width", "10", "--z-p", "1e-6"], capsys)
+    assert code == 2 and out == ""
+    assert "--line-width" in err and "0.7538 m" in err and len(err.strip().splitlines()) == 1
+
+
+def test_follow_line_with_lost_images_is_a_failed_run(tmp_path, capsys, monkeypatch):
+    # a run in which images lost the line printed a summary and exited 0 (the robot drove on stale positions)
+    from wmrkit.errors import WmrkitError
+    from wmrkit.vision import follow as follow_module
+
+    Camera(150.0, math.radians(60), 0.3, 160, 120).to_file(tmp_path / "cam.yaml")
+    real, calls = follow_module.locate_image, []
+
+    def flaky(*args, **kwargs):
+        calls.append(1)
+        if len(calls) > 3:
+            raise WmrkitError("image: found 0 line(s), expected 1")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(follow_module, "locate_image", flaky)
+    code, out, err = run(["follow-line", "line-follower", "--camera", str(tmp_path / "cam.yaml"), "--duration", "3",
+                          "--json"], capsys)
+    assert code == 2 and out == ""
+    error = json.loads(err)["error"]
+    assert "the line was lost in 4 of 6 images (first at t = 1 s" in error
+
+
+def test_follow_line_that_does_not_settle_says_so(tmp_path, capsys):
+    # --gain 1e-6 printed '95 % settling 20.0 s' (the end of the run) for an error that had not moved
+    Camera(150.0, math.radians(60), 0.3, 160, 120).to_file(tmp_path / "cam.yaml")
+    code, out, _ = run(["follow-line", "line-follower", "--camera", str(tmp_path / "cam.yaml"), "--duration", "3",
+                        "--gain", "1e-6"], capsys)
+    assert code == 0 and "95 % settling not reached within the run" in out
+    code, out, _ = run(["follow-line", "line-follower", "--camera", str(tmp_path / "cam.yaml"), "--duration", "3",
+                        "--gain", "1e-6", "--json"], capsys)
+    assert json.loads(out)["settling_time_95"] is None

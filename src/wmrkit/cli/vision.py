@@ -169,12 +169,17 @@ def run_follow(args: argparse.Namespace) -> int:
         from ..vision.animation import save_animation
 
         save_animation(run, robot, camera, args.animate)
+    failure = run.failure()
+    if failure is not None:  # a run that did not follow the line is no result (as track's diverged loop)
+        raise WmrkitError(failure)
     summary = run.to_dict()
     if args.json:
         print_json(summary)
     else:
         print(f"robot {robot.name}: a = {run.gain:g} 1/s, T = {run.period:g} s, {len(run.time) - 1} periods; "
               f"final h = {summary['final_h'] * 100:.2f} cm, psi = {math.degrees(summary['final_psi']):.2f} deg, "
-              f"overshoot {summary['overshoot'] * 100:.2f} cm, 95 % settling {summary['settling_time_95']:.1f} s"
+              f"overshoot {summary['overshoot'] * 100:.2f} cm, 95 % settling "
+              + ("not reached within the run" if summary['settling_time_95'] is None
+                 else f"{summary['settling_time_95']:.1f} s")
               + (f"; animation {args.animate}" if args.animate else ""))
     return 0

@@ -31,13 +31,13 @@ from ..kinematics.wheel_ik import forward_kinematics, wheel_commands
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_seed
 from ..odometry.integrators import integrate_exact
 from ..robot import Robot
-from .camera import Camera
+from .camera import Camera, extrinsics
 from .lines import extract_lines
 from .positioning import Positioning, locate_points
 from .render import Scene, render
 
 __all__ = ["LineFollowing", "follow_line", "line_following_law", "line_following_twist", "locate_image",
-           "thesis_initial_commands"]
+           "thesis_initial_commands", "view_width"]
 
 
 def locate_image(camera: Camera, image: ArrayLike, *, spacing: float = 0.0, ns: tuple[int, ...] | None = None,
@@ -116,11 +116,26 @@ class LineFollowing:
         """Signed distance h [m] of P to the line at each sample ``(K + 1,)``."""
         return self.pose[:, 1]
 
-    def settling_time(self, fraction: float = 0.95) -> float:
-        """First time [s] after which |h| stays within ``(1 - fraction)`` of its initial value."""
+    def settling_time(self, fraction: float = 0.95) -> float | None:
+        """First time [s] after which |h| stays within ``(1 - fraction)`` of its initial value; None when the last
+        sample is still outside (not settled within the run: the end of the run is no settling time)."""
         h = np.abs(self.lateral)
         outside = np.flatnonzero(h > (1 - fraction) * h[0])
-        return float(self.time[min(outside[-1] + 1, len(h) - 1)]) if outside.size else 0.0
+        if outside.size and outside[-1] == len(h) - 1:
+            return None
+        return float(self.time[outside[-1] + 1]) if outside.size else 0.0
+
+    def failure(self) -> str | None:
+        """Why the run is not a line following, or None: the line was lost in some images (the command then used
+        the last positioning found, so the robot drove blind; ``lost``)."""
+        n_lost = int(np.count_nonzero(self.lost))
+        if not n_lost:
+            return None
+        first = float(self.time[int(np.flatnonzero(self.lost)[0])])
+        return (f"follow-line: the line was lost in {n_lost} of {len(self.lost)} images (first at t = {first:g} s; "
+                f"the last positioning found was used meanwhile): the line was not followed (h went from "
+                f"{self.lateral[0]:.4g} m to {self.lateral[-1]:.4g} m, at most {np.max(np.abs(self.lateral)):.4g} m "
+                "from the line)")
 
     def to_dict(self) -> dict[str, Any]:
         """Summary and samples (the ``wmrkit follow-line --json`` output)."""
@@ -134,6 +149,18 @@ class LineFollowing:
                         for t, p in zip(self.time, self.pose, strict=True)],
             "wheel_rates": {n: self.rates[:, i].tolist() for i, n in enumerate(self.rate_names)},
         }
+
+
+def view_width(camera: Camera, rows_a: float | None = None) -> float:
+    """Width [m] of the ground seen across the image on row ``+rows_a`` [px] (default a quarter of the image
+    height, the near row :func:`locate_image` measures on), camera looking along the line (psi = 0)."""
+    from .camera import ground_from_image
+
+    a = rows_a if rows_a is not None else camera.rows / 4
+    half = (camera.width - 1) / 2
+    psi, t = extrinsics((0.0, 0.0, 0.0), camera)
+    ends = ground_from_image(np.array([[-half, a], [half, a]]), psi, camera.tilt, t, camera.focal_px)
+    return float(abs(ends[1, 0] - ends[0, 0]))
 
 
 #: Most control periods of a run: each renders and processes one image (about 10 ms).
@@ -170,6 +197,12 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
         raise WmrkitError(f"follow-line: gain * period = {gain * period:g} >= 1: the delayed loop is unstable "
                           "(digest §2.6: a_x T < 1)")
     scene = scene or Scene(ns=(0,), width=0.02)
+    view = view_width(camera)
+    if scene.width >= view:  # the line fills the positioning row: no edge, nothing to locate
+        raise WmrkitError(f"follow-line: line width (--line-width) {scene.width:g} m is not narrower than what the "
+                          f"camera sees across its image on the row where the line is measured ({view:.4g} m at "
+                          f"row +{camera.rows / 4:g} px, looking straight along the line): the line's edges "
+                          "are out of view")
     actuated = [n for n in robot.rate_names if n.endswith(".spin") and n in robot.actuated] or \
         [n for n in robot.rate_names if n.endswith(".spin")]
     rng = np.random.default_rng(seed)
