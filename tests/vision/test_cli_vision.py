@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -13,6 +14,7 @@ from wmrkit.cli.main import main
 from wmrkit.vision.camera import Camera, extrinsics, ground_from_image
 from wmrkit.vision.render import Scene, render
 
+FIGURES = Path(__file__).parents[2] / "docs" / "figures" / "vision"
 THESIS_CAMERA = Camera(325.7, math.radians(45), 0.134, 320, 240)
 
 
@@ -141,3 +143,31 @@ def test_follow_line_that_does_not_settle_says_so(tmp_path, capsys):
     code, out, _ = run(["follow-line", "line-follower", "--camera", str(tmp_path / "cam.yaml"), "--duration", "3",
                         "--gain", "1e-6", "--json"], capsys)
     assert json.loads(out)["settling_time_95"] is None
+
+
+@pytest.mark.parametrize("spacing, lines, seen", [
+    ("1e3", [], "are 0.035 m apart"),  # printed lines 999.9 m and -1000 m away, their mean -0.0583 m, exit 0
+    ("2cm", [], "are 0.035 m apart"),
+    ("3.5cm", ["--lines", "2"], "are 0.0175 m apart"),  # neighbouring lines read as a road's two (n = -1, +1)
+])
+def test_locate_refuses_a_spacing_the_image_contradicts(spacing, lines, seen, capsys):
+    image = str(FIGURES / "three-lines.png")
+    code, out, err = run(["vision", "locate", image, "--camera", str(FIGURES / "thesis-camera.yaml"),
+                          "--spacing", spacing, *lines], capsys)
+    assert code == 2 and out == ""
+    assert err.startswith("wmrkit: error: spacing: the lines n = -1 and +1 ") and seen in err
+    assert "--spacing says" in err and len(err.strip().splitlines()) == 1
+
+
+def test_locate_refuses_a_camera_height_the_image_contradicts(tmp_path, capsys):
+    # a camera file 10 times too high made every h 10 times too large (-0.583 m for -0.0583 m), exit 0
+    Camera(325.7, math.radians(45), 1.34, 320, 240).to_file(tmp_path / "cam.yaml")
+    code, _, err = run(["vision", "locate", str(FIGURES / "three-lines.png"), "--camera",
+                        str(tmp_path / "cam.yaml"), "--spacing", "3.5cm", "--json"], capsys)
+    assert code == 2 and "are 0.35 m apart" in json.loads(err)["error"]
+
+
+def test_locate_refuses_a_spacing_it_would_ignore(capsys):
+    code, _, err = run(["vision", "locate", str(FIGURES / "three-lines.png"), "--camera",
+                        str(FIGURES / "thesis-camera.yaml"), "--spacing", "3.5cm", "--lines", "1"], capsys)
+    assert code == 2 and "--spacing applies to 2 or 3 lines" in err

@@ -69,11 +69,15 @@ def test_thesis_chufa_field_with_the_digest_labels():
 
 
 def test_errata_chufa_printed_labels_give_nonsense():
-    """With the printed n = (1, -1, 0) line a is 1.22 m from the centre line, not 2.4 cm."""
-    fix = locate_points(CHUFA_CAMERA, [(n, CHUFA[k]) for k, n in zip("abc", (1, -1, 0), strict=True)],
-                        spacing=0.60)
-    assert fix.lines[0].h == pytest.approx(-1.224, abs=0.001)
-    assert abs(fix.lines[1].h - fix.lines[0].h) > 1.0
+    """With the printed n = (1, -1, 0) line a is 1.22 m from the centre line, not 2.4 cm; locate_points refuses
+    such labels (lines b and a then lie -0.29 m apart: check_spacing)."""
+    c = CHUFA_CAMERA
+    h = [float(line_position(CHUFA[k], n, focal_px=c.focal_px, tilt=c.tilt, height=c.height, spacing=0.60)[2])
+         for k, n in zip("abc", (1, -1, 0), strict=True)]
+    assert h[0] == pytest.approx(-1.224, abs=0.001)
+    assert abs(h[1] - h[0]) > 1.0
+    with pytest.raises(CameraError, match=r"the lines n = -1 and \+1 are -0.29\d* m apart"):
+        locate_points(CHUFA_CAMERA, [(n, CHUFA[k]) for k, n in zip("abc", (1, -1, 0), strict=True)], spacing=0.60)
 
 
 def test_errata_fig_9_9_deviations_need_the_label_fix():

@@ -106,6 +106,8 @@ def run_locate(args: argparse.Namespace) -> int:
         layouts = {1: (0,), 2: (-1, 1), 3: (-1, 0, 1)}
         if args.lines is not None and args.lines not in layouts:
             raise WmrkitError(f"--lines must be 1, 2 or 3, got {args.lines}")
+        if args.lines == 1 and spacing > 0:  # one line (n = 0) does not use it: it would be ignored
+            raise WmrkitError("locate: --spacing applies to 2 or 3 lines, not to --lines 1")
         ns = layouts[args.lines] if args.lines else None
         image = read_image(args.image)
         if image.shape != (camera.rows, camera.width):

@@ -20,7 +20,8 @@ from .._shapes import as_vectors
 from ..errors import ShapeError
 from .camera import Camera, CameraError, read_located
 
-__all__ = ["LineFix", "Positioning", "line_position", "locate_points", "read_points"]
+__all__ = ["SPACING_TOLERANCE", "LineFix", "Positioning", "check_spacing", "line_position", "locate_points",
+           "read_points"]
 
 
 def line_position(points_u: ArrayLike, n: ArrayLike, *, focal_px: float, tilt: float, height: float,
@@ -106,8 +107,31 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
         psi, _, h = line_position(und, n, focal_px=camera.focal_px, tilt=camera.tilt, height=camera.height,
                                   spacing=spacing, z_p=z_p)
         fixes.append(LineFix(int(n), (tuple(pts[0].tolist()), tuple(pts[1].tolist())), float(psi), float(h)))
+    check_spacing(fixes, spacing)
     psi_mean = math.atan2(sum(math.sin(f.psi) for f in fixes), sum(math.cos(f.psi) for f in fixes))
     return Positioning(psi_mean, float(np.mean([f.h for f in fixes])), tuple(fixes))
+
+
+#: Largest relative difference between the line spacing the image shows and the one given (the thesis's chufa field,
+#: real image points, shows 0.569 m for rows sown 0.60 m apart: 5 %).
+SPACING_TOLERANCE = 0.25
+
+
+def check_spacing(fixes: Sequence[LineFix], spacing: float) -> None:
+    """Refuse a line spacing the image contradicts. Each line n gives ``h_n = h + n (d_image - d)`` (9.10)-(9.11):
+    with the right spacing d the lines agree on h; their disagreement is the spacing the image shows through the
+    camera model, ``d_image = d + (h_i - h_j) / (n_i - n_j)`` (outermost lines). A wrong camera height scales it
+    too. More than :data:`SPACING_TOLERANCE` apart (relative), or not positive: :class:`CameraError`."""
+    ns = [f.n for f in fixes]
+    if not spacing > 0 or len(set(ns)) < 2:
+        return
+    lo, hi = fixes[ns.index(min(ns))], fixes[ns.index(max(ns))]
+    seen = spacing + (lo.h - hi.h) / (lo.n - hi.n)
+    if not (seen > 0 and abs(seen - spacing) <= SPACING_TOLERANCE * spacing):
+        raise CameraError(f"spacing: the lines n = {lo.n:+d} and {hi.n:+d} are {seen:.4g} m apart through the camera "
+                          f"model (their h: {lo.h:.4g} m and {hi.h:.4g} m), --spacing says {spacing:.4g} m: more "
+                          f"than {SPACING_TOLERANCE:.0%} apart; check --spacing, the lines' n and the camera's height, "
+                          "tilt and focal length")
 
 
 def read_points(path: str | Path) -> list[tuple[int, np.ndarray]]:
