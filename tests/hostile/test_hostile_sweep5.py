@@ -9,6 +9,7 @@ import json
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from wmrkit.cli.main import main
@@ -60,14 +61,54 @@ def test_track_ends_a_continuous_run_at_its_duration(capsys):
 def test_track_from_far_away_is_refused_in_bounded_time_not_a_hang(monkeypatch, capsys):
     from wmrkit.control import loop
 
-    # --from 1e4 0 0 ran for minutes (the loop is stiff at 1e4 m/s); the budget is lowered here to keep the test fast
+    # --from 1e4 0 0 ran for minutes (the loop is stiff at 1e4 m/s; now refused up front, below); a start 500 m off
+    # commands 500 m/s and is stiff too: the evaluation budget, lowered here to keep the test fast, ends it
     monkeypatch.setattr(loop, "MAX_EVALUATIONS", 2000)
     monkeypatch.setattr(loop, "EVALUATIONS_PER_SECOND", 500)
     assert main(["track", "diff-drive", "--reference", "circle", "--duration", "2"]) == 0  # ~200 evaluations
     capsys.readouterr()
-    message = _refused(["track", "diff-drive", "--reference", "circle", "--duration", "2", "--from", "1e4", "0", "0"],
+    message = _refused(["track", "diff-drive", "--reference", "circle", "--duration", "2", "--from", "500", "0", "0"],
                        capsys)
-    assert "too stiff" in message and "start closer to the reference" in message
+    assert "too stiff" in message and "start closer to the reference" in message and "evaluations" in message
+
+
+#: Seconds an up-front refusal of the continuous loop may take (the reference is built first: ~1 s for a 1 km circle).
+UP_FRONT = 10.0
+
+
+@pytest.mark.parametrize("robot", ["diff-drive", "ackermann"])
+def test_track_from_beyond_the_speed_limit_is_refused_up_front(robot, capsys):
+    # --from 1e9 1e9 3 integrated for 50 s (diff-drive; 68 s the ackermann) before 'too stiff'
+    start = time.perf_counter()
+    message = _refused(["track", robot, "--reference", "line", "--from", "1e9", "1e9", "3"], capsys)
+    assert time.perf_counter() - start < UP_FRONT
+    assert message.startswith("wmrkit: error: initial pose (--from): the controlled point starts 1.414e+09 m")
+    assert "beyond 1000 m/s" in message and "within 999.5 m at this gain" in message
+
+
+def test_track_continuous_loop_too_long_is_refused_up_front(capsys):
+    # a 1 km circle at 0.5 m/s (12,566 s) ran for 6 minutes on a loaded machine
+    start = time.perf_counter()
+    message = _refused(["track", "diff-drive", "--reference", "circle", "--size", "1e3"], capsys)
+    assert time.perf_counter() - start < UP_FRONT
+    assert "duration 12566.4 s" in message and "at most 2000 s (40000 output samples of 0.05 s" in message
+
+
+def test_track_limits_keep_runs_that_work():
+    # the checks refuse nothing that ran: a start 100 m off (4 s), a robot without fixed wheels far off (no
+    # stiffness), a 2000 s continuous run is allowed, and the discrete loop is not concerned
+    from wmrkit import catalog
+    from wmrkit.control.references import resolve_reference
+    from wmrkit.control.track import _check_continuous_work, control_point, track
+
+    line = resolve_reference("line")
+    run = track(catalog.load("diff-drive"), line, initial_pose=[100, 0, 0], duration=2)
+    assert run.error[0] == pytest.approx(100.2, abs=0.1)
+    run = track(catalog.load("omni-3"), line, initial_pose=[1e9, 1e9, 3], duration=2)
+    assert run.error[0] == pytest.approx(1.414e9, rel=1e-3)
+    _check_continuous_work(control_point(catalog.load("diff-drive")), line, np.zeros(3), 2000.0, 0.05, 1.0)
+    run = track(catalog.load("diff-drive"), line, initial_pose=[1e4, 1e4, 3], period=0.1, duration=2)
+    assert run.error[-1] < run.error[0]
 
 
 @pytest.mark.parametrize("text, expected", [

@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..kinematics.wheel_ik import WheelCommands, wheel_commands
-from ..limits import MAX_COORDINATE
+from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .actuators import LowLevelLoops
@@ -196,6 +196,9 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                 if slip_model != "none" else "ramp=True")
         raise ControlError(f"{what} needs the dynamic plant (dynamics=True): it acts on the dynamics with tyres")
     else:
+        if period is None:
+            _check_continuous_work(cp, reference, pose0, duration, output_dt,
+                                   gain if controller in ("p", "pi", "point") else None)
         out = simulate(robot, ctrl, pose0, duration, period=period, delay=delay, plant=Plant(loops, policy),
                        output_dt=output_dt, skew_free=skew_free, breaks=reference.breaks,
                        rtol=1e-5 if geometric else 1e-8, atol=1e-7 if geometric else 1e-10)
@@ -237,6 +240,35 @@ def _check_timing(duration: float, period: float | None, output_dt: float) -> No
     if not (math.isfinite(step) and step > 0) or duration / step > MAX_SAMPLES:
         raise ControlError(f"duration {duration:g} s at {'a period' if period else 'an output step'} of {step:g} s: "
                            f"more than {MAX_SAMPLES} samples")
+
+
+#: Most output samples of a continuous kinematic loop (2000 s at the 0.05 s output step): each costs about 1.7 ms
+#: (its share of the ODE's evaluations, and the record), so a 1 km circle at 0.5 m/s (12,566 s) took 6 min.
+MAX_CONTINUOUS_SAMPLES = 40_000
+
+
+def _check_continuous_work(cp: ControlPoint, reference: Reference, pose0: np.ndarray, duration: float,
+                           output_dt: float, gain: float | None) -> None:
+    """Refuse up front a continuous kinematic loop that would run for minutes: too long a run, or (a robot with
+    fixed wheels under a law) a start so far from the reference that the law commands beyond ``MAX_SPEED``: the
+    heading then turns at ``speed / |point|``, and the explicit integrator crawls until its evaluation budget
+    ends (``--from 1e9 1e9 3``: 50 s before 'too stiff')."""
+    if duration / output_dt > MAX_CONTINUOUS_SAMPLES:
+        raise ControlError(f"duration {duration:g} s (--duration, or the reference's length at its --speed and "
+                           f"--size): a continuous loop simulates at most {MAX_CONTINUOUS_SAMPLES * output_dt:g} s "
+                           f"({MAX_CONTINUOUS_SAMPLES} output samples of {output_dt:g} s, about 1 min of computing); "
+                           "give a shorter --duration, or a sample period (--period)")
+    if gain is None or not cp.reduced:
+        return
+    distance = float(np.hypot(*(point_pose(cp, pose0)[:2] - reference.pose[0, :2])))
+    speed = gain * distance + float(np.hypot(*reference.velocity[0, :2]))
+    if speed > MAX_SPEED:
+        reach = max(0.0, MAX_SPEED - float(np.hypot(*reference.velocity[0, :2]))) / gain
+        raise ControlError(f"initial pose (--from): the controlled point starts {distance:.4g} m from the reference, "
+                           f"and the law commands {speed:.4g} m/s at t = 0, beyond {MAX_SPEED:g} m/s: the continuous "
+                           f"loop would be too stiff to integrate (the heading turns at that speed over "
+                           f"{float(np.hypot(*cp.point)):.3g} m); start closer to the reference (within {reach:.4g} m "
+                           "at this gain), lower the gain, or give a sample period (--period)")
 
 
 #: Integration step of the loops through the dynamics [s] (their default).
