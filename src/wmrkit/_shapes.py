@@ -16,6 +16,19 @@ def as_vectors(x: ArrayLike, n: int, name: str) -> np.ndarray:
     return a
 
 
+def as_angles(x: ArrayLike, n: int, name: str) -> np.ndarray:
+    """:func:`as_vectors` for angles [rad]: also raise :class:`ShapeError` naming `name` for NaN, infinities and
+    angles beyond :data:`wmrkit.units.MAX_ANGLE` (1e6 turns), whose sine and cosine are round-off."""
+    from .units import MAX_ANGLE, MAX_TURNS
+
+    a = as_vectors(x, n, name)
+    bad = ~(np.abs(a) <= MAX_ANGLE)  # NaN included
+    if bad.any():
+        value = float(a[np.unravel_index(int(np.argmax(bad)), a.shape)])
+        raise ShapeError(f"{name}: angles must be finite numbers of at most {MAX_TURNS:g} turns [rad], got {value!r}")
+    return a
+
+
 def readonly(a: np.ndarray) -> np.ndarray:
     """Mark `a` read-only and return it (values handed out are never written into)."""
     a.setflags(write=False)

@@ -8,7 +8,7 @@ class WmrkitError(Exception):
 
 
 class ShapeError(WmrkitError, ValueError):
-    """An array argument has the wrong shape; the message names the argument."""
+    """An array argument has the wrong shape (or angles that are not finite); the message names the argument."""
 
 
 class UnknownNameError(WmrkitError, LookupError):

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._shapes import as_vectors, readonly
+from ._shapes import as_angles, as_vectors, readonly
 from .couplings import Coupling
 from .dynamics.mass import Body
 from .errors import ShapeError, UnknownNameError
@@ -101,7 +101,7 @@ class Robot:
         """Headings of the steering wheels from the thesis's β: ``(..., n_steer) -> (..., n_steer)`` [rad]."""
         from .wheels import heading_from_beta
 
-        beta = as_vectors(beta, len(self.steer_names), "beta")
+        beta = as_angles(beta, len(self.steer_names), "beta")
         return heading_from_beta(beta, _steer_delta(self))
 
     def steering(self, beta: ArrayLike | None = None, heading: ArrayLike | None = None) -> np.ndarray | None:
@@ -111,7 +111,7 @@ class Robot:
         forward) as well as ``beta=`` (the thesis's angle); giving both is an error.
         """
         if heading is None:
-            return beta if beta is None else as_vectors(beta, len(self.steer_names), "beta")
+            return beta if beta is None else as_angles(beta, len(self.steer_names), "beta")
         if beta is not None:
             raise ShapeError("give the steering configuration as beta (thesis) or heading (rolling direction), "
                              "not both")
@@ -121,7 +121,7 @@ class Robot:
         """The thesis's β of the steering wheels from headings: ``(..., n_steer) -> (..., n_steer)`` [rad]."""
         from .wheels import beta_from_heading
 
-        heading = as_vectors(heading, len(self.steer_names), "heading")
+        heading = as_angles(heading, len(self.steer_names), "heading")
         return beta_from_heading(heading, _steer_delta(self))
 
     @property
@@ -149,7 +149,7 @@ class Robot:
     # ---- changes -----------------------------------------------------------------------------------------
     def with_beta(self, beta: ArrayLike) -> Robot:
         """The same robot at steering configuration `beta` ``(n_steer,)``."""
-        beta = as_vectors(beta, len(self.steer_names), "beta")
+        beta = as_angles(beta, len(self.steer_names), "beta")
         if beta.ndim != 1:
             raise ShapeError(f"beta: with_beta takes one configuration (n_steer,), got {beta.shape}; "
                              "batched functions take beta directly")

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ._shapes import as_angles
 from .errors import UnknownNameError
 
 if TYPE_CHECKING:
@@ -130,10 +131,11 @@ class Wheel:
 
     def with_beta(self, beta: float) -> Wheel:
         """The same wheel at another steering angle (or axle direction)."""
-        return replace(self, beta=float(beta))
+        return replace(self, beta=float(as_angles([beta], 1, f"{self.name}: beta")[0]))
 
     def with_heading(self, heading: float) -> Wheel:
         """The same wheel steered to rolling direction `heading` [rad] (0 = forward along +x)."""
+        heading = as_angles([heading], 1, f"{self.name}: heading")[0]
         return replace(self, beta=float(beta_from_heading(heading, self.delta)))
 
     def elements(self) -> tuple[Element, ...]:

@@ -24,7 +24,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors
 from ..kinematics.linalg import characteristic_length, matrix_rank
 from ..robot import Robot
 from .icr import steer_to_icr
@@ -80,7 +79,7 @@ def instantaneous_mobility(robot: Robot, beta: ArrayLike | None = None) -> np.nd
 
     Equals ``k - rank A`` (6.8) for robots whose wheel rates are all fixed by the twist (all but double wheels).
     """
-    beta = robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
+    beta = robot.beta if beta is None else robot.steering(beta)
     cl = constraint_lines(robot)
     if not cl.labels:
         return np.full(beta.shape[:-1], 3)

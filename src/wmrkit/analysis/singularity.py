@@ -22,7 +22,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
-from .._shapes import as_vectors
 from ..errors import UnknownNameError
 from ..kinematics.linalg import matrix_rank, nondimensional
 from ..robot import Robot
@@ -53,7 +52,7 @@ def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...],
     (accurate to machine precision); :func:`singularity_distance` is the fast measure for maps.
     """
     cl = constraint_lines(robot, assigned)
-    beta = robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
+    beta = robot.beta if beta is None else robot.steering(beta)
     if cl.internal or len(cl.labels) < 3:
         return np.ones(beta.shape[:-1], bool)
     g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / robot_size(robot)])
@@ -69,7 +68,7 @@ def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[s
     divided by `length` [m] (default: the robot's size, :func:`robot_size`) so the measure has no units.
     """
     cl = constraint_lines(robot, assigned)
-    beta = robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
+    beta = robot.beta if beta is None else robot.steering(beta)
     if cl.internal or len(cl.labels) < 3:
         return np.zeros(beta.shape[:-1])
     flat = beta.reshape(int(np.prod(beta.shape[:-1])), beta.shape[-1])

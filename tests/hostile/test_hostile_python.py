@@ -1,0 +1,44 @@
+"""Hostile input at the Python doors (the functions ``wmrkit`` and its subpackages export), found by an audit that
+called them with NaN, infinities, empty or mismatched arrays and out-of-range numbers. Each case returned NaN or a
+number without meaning, or raised a bare numpy/Python exception; each now raises one :class:`WmrkitError` naming
+the argument."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog, direct_model, forward_kinematics, inverse_model, mobility, wheel_commands
+from wmrkit.analysis import icr, is_singular, singularity_distance
+from wmrkit.errors import ShapeError
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf, 1e300])
+@pytest.mark.parametrize("keyword", ["heading", "beta"])
+def test_a_steering_configuration_that_is_not_finite_is_refused_by_name(bad, keyword):
+    # heading=[nan] * 4 reached the SVD of inverse_model, direct_model, mobility and icr (LinAlgError 'SVD did not
+    # converge'), and gave NaN constraint matrices and wheel commands; beta = 1e300 rad gave round-off sines
+    robot = catalog.load("swerve-4")
+    config = {keyword: [0.0, 0.0, bad, 0.0]}
+    for call in (lambda: inverse_model(robot, **config), lambda: direct_model(robot, **config),
+                 lambda: mobility(robot, **config), lambda: icr(robot, **config),
+                 lambda: robot.constraint_matrix(**config), lambda: wheel_commands(robot, [1.0, 0.0, 0.0], **config),
+                 lambda: forward_kinematics(robot, {"front_left": 1.0, "front_right": 1.0}, **config)):
+        with pytest.raises(ShapeError, match=f"^{keyword}: angles must be finite"):
+            call()
+    joints = ("front_left.spin", "front_right.spin", "rear_left.spin")
+    with pytest.raises(ShapeError, match=r"^beta: angles must be finite"):
+        singularity_distance(robot, [0.0, 0.0, bad, 0.0], joints)
+    with pytest.raises(ShapeError, match=r"^beta: angles must be finite"):
+        is_singular(robot, [0.0, 0.0, bad, 0.0], joints)
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, 1e300])
+def test_a_robot_is_never_steered_to_an_angle_that_is_not_finite(bad):
+    robot = catalog.load("swerve-4")
+    with pytest.raises(ShapeError, match=r"^front_left: heading: angles must be finite"):
+        robot.with_steering({"front_left": bad})
+    with pytest.raises(ShapeError, match=r"^front_left: beta: angles must be finite"):
+        robot.with_beta_angles({"front_left": bad})
+    with pytest.raises(ShapeError, match=r"^beta: angles must be finite"):
+        robot.with_beta([bad, 0.0, 0.0, 0.0])
