@@ -397,6 +397,23 @@ def test_save_then_load_catalog_style_robot(tmp_path):
     assert np.isfinite(robot.constraint_matrix()).all()
 
 
+@pytest.mark.parametrize("wheel", [
+    {"type": "steerable", "heading": 6.0},  # beta = heading + 90 deg = 7.57 rad: beyond a turn
+    {"type": "castor", "d": 0.05, "delta": "-30 deg", "heading": "-350 deg"},
+    {"type": "steerable", "alpha": "400 deg", "beta": "720 deg"},
+])
+def test_angles_beyond_a_turn_are_saved_so_that_they_load_again(wheel, tmp_path):
+    # a valid description (heading: 6.0, beta: 720 deg) was saved as 'beta: 7.57...' or '12.56...', a bare angle
+    # beyond a turn, which loading refuses as degrees written bare: to_file wrote a file wmrkit could not read back
+    robot = Robot.from_dict({"name": "r", "wheels": [{"name": "w", "l": 0.3, "alpha": 0.5, "r": 0.1} | wheel]})
+    for name in ("a.yaml", "a.json"):
+        robot.to_file(tmp_path / name)
+        assert Robot.from_file(tmp_path / name) == robot
+    assert Robot.from_dict(robot.to_dict()) == robot
+    steered = robot.with_steering({"w": 90.0}) if robot.wheels[0].kind.steers else robot
+    assert Robot.from_dict(steered.to_dict()) == steered
+
+
 @pytest.mark.parametrize("bad", ["a.b", "left wheel", "x=1", "", "1st", "é"])
 def test_wheel_names_must_be_identifiers(bad):
     """Wheel names make velocity names 'wheel.joint' and CLI arguments NAME=VALUE: no dots, spaces or '='."""

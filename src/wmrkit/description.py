@@ -33,6 +33,7 @@ from .limits import (  # noqa: F401  (the limits are part of the description for
     _check_text_fields,
 )
 from .robot import Robot
+from .units import BARE_ANGLE_LIMIT
 from .wheels import GEOMETRY_FIELDS, KINDS, Wheel, beta_from_heading
 
 #: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
@@ -286,6 +287,9 @@ def _wheel_to_dict(w: Wheel) -> dict[str, Any]:
     for key in GEOMETRY_FIELDS:
         if key in kind.required or key in kind.optional:
             out[key] = getattr(w, key)
+    for key, value in out.items():  # a bare angle beyond a turn reads as degrees written bare: keep the unit
+        if GEOMETRY_FIELDS.get(key) == "angle" and abs(value) > BARE_ANGLE_LIMIT:
+            out[key] = f"{value!r} rad"
     if w.actuated:
         out["actuated"] = list(w.actuated)
     if w.sensed:
