@@ -42,3 +42,34 @@ def test_a_robot_is_never_steered_to_an_angle_that_is_not_finite(bad):
         robot.with_beta_angles({"front_left": bad})
     with pytest.raises(ShapeError, match=r"^beta: angles must be finite"):
         robot.with_beta([bad, 0.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("twist", [[np.nan, 0.0, 0.0], [np.inf, 0.0, 0.0], [1e300, 0.0, 0.0], [0.0, 0.0, -1e7]])
+@pytest.mark.parametrize("name", ["diff-drive", "swerve-4", "ackermann"])
+def test_wheel_commands_refuse_a_twist_that_is_not_finite_or_beyond_the_query_bound(twist, name):
+    # a NaN or infinite twist gave NaN spins (numpy warned 'invalid value'), 1e300 m/s spins of inf: wmrkit ik
+    # and the studio refuse beyond 1e6 (limits.MAX_QUERY_RATE), the Python door did not
+    with pytest.raises(ShapeError, match=r"^twist_robot: expected finite speeds and turn rates within 1e\+06"):
+        wheel_commands(catalog.load(name), twist)
+    with pytest.raises(ShapeError, match=r"^twist_robot"):
+        wheel_commands(catalog.load(name), [[0.1, 0.0, 0.0], twist])
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, 1e300])
+def test_forward_kinematics_refuses_a_rate_that_is_not_finite_by_name(bad):
+    # NaN gave the twist (nan, nan, nan); left = 1e300, right = -1e300 (a turn in place) gave vx = 1.5e282 m/s and an
+    # infinite residual
+    robot = catalog.load("diff-drive")
+    with pytest.raises(ShapeError, match=r"^rates: right: expected finite numbers within 1e\+06"):
+        forward_kinematics(robot, {"left": -1.0, "right": bad})
+    with pytest.raises(ShapeError, match=r"^rates: right: expected finite numbers"):
+        forward_kinematics(robot, {"left": [1.0, 2.0], "right": [1.0, bad]})
+
+
+def test_forward_kinematics_of_rates_that_do_not_broadcast_or_are_empty():
+    # shapes (2,) and (3,) raised numpy's 'shape mismatch' ValueError; empty arrays a LAPACK error (dgelsy: lwork)
+    robot = catalog.load("diff-drive")
+    with pytest.raises(ShapeError, match=r"^rates: the rates' shapes do not broadcast together: left \(2,\), right "):
+        forward_kinematics(robot, {"left": [1.0, 2.0], "right": [1.0, 2.0, 3.0]})
+    twist, residual = forward_kinematics(robot, {"left": [], "right": []})
+    assert twist.shape == (0, 3) and residual.shape == (0,)

@@ -110,8 +110,9 @@ def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike) -> 
     free_mask[assigned] = False
     free = np.flatnonzero(free_mask)  # (np.setdiff1d costs ~20 us, a quarter of a small solve)
     a_na, a_a = a[..., free], a[..., assigned]
-    if a.ndim == 2 and len(free) and len(assigned):  # one matrix: LAPACK least squares on every right-hand
-        rhs = -(a_a @ q_assigned.reshape(-1, len(assigned)).T)  # side at once; same minimum-norm solution, ~1.7x faster
+    if a.ndim == 2 and len(free) and len(assigned) and q_assigned.size:  # one matrix: LAPACK least squares on
+        rhs = -(a_a @ q_assigned.reshape(-1, len(assigned)).T)  # every right-hand side at once; same minimum-norm
+        # solution, ~1.7x faster (an empty batch takes the general path: LAPACK refuses zero right-hand sides)
         q_na = _min_norm_lstsq(a_na, rhs).T.reshape(*q_assigned.shape[:-1], len(free))
     else:
         rhs = -(a_a @ q_assigned[..., None])

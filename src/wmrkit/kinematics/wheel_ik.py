@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..errors import ShapeError, UnknownNameError
+from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from ..units import UnitError, parse_quantity
 from ..wheels import heading_from_beta
@@ -108,6 +109,9 @@ def wheel_commands(
     """
     p = _ik_fast.plan(robot)
     twist = as_vectors(twist_robot, 3, "twist_robot")
+    if not (np.abs(twist) <= MAX_QUERY_RATE).all():  # NaN included
+        raise ShapeError(f"twist_robot: expected finite speeds and turn rates within {MAX_QUERY_RATE:g} (m/s, "
+                         f"rad/s; beyond, the wheel rates overflow), got {_first_bad(twist)}")
     beta = robot.steering(beta, heading)
     current = robot.beta if beta is None else beta
     batch = np.broadcast_shapes(twist.shape[:-1], current.shape[:-1])
@@ -202,8 +206,14 @@ def forward_kinematics(
     given rates do not determine the twist the minimum-norm one is returned: check :func:`twist_is_determined`.
     """
     columns = _assigned_columns(robot, list(rates))
-    values = np.broadcast_arrays(*(np.asarray(_rate_value(k, v), dtype=float) for k, v in rates.items()))
+    given = {k: np.asarray(_rate_value(k, v), dtype=float) for k, v in rates.items()}
+    try:
+        values = np.broadcast_arrays(*given.values())
+    except ValueError:
+        shapes = ", ".join(f"{k} {v.shape}" for k, v in given.items())
+        raise ShapeError(f"rates: the rates' shapes do not broadcast together: {shapes}") from None
     q_assigned = np.stack(values, axis=-1)
+    _check_finite_rates(list(given), q_assigned)
     q_dot, slip = solve_assigned(robot.constraint_matrix(beta, heading=heading), columns, q_assigned)
     return readonly(q_dot[..., :3]), readonly(np.linalg.norm(slip, axis=-1))
 
@@ -241,6 +251,7 @@ def forward_kinematics_check(
     """
     columns = _assigned_columns(robot, list(rates))
     q_assigned = np.array([float(_rate_value(k, v)) for k, v in rates.items()])
+    _check_finite_rates(list(rates), q_assigned)
     a = robot.constraint_matrix(beta, heading=heading)
     q_dot, slip = solve_assigned(a, columns, q_assigned)
     owner = robot.row_wheels
@@ -275,6 +286,21 @@ def _assigned_columns(robot: Robot, names: list[str]) -> np.ndarray:
         if c in columns[:j]:
             raise UnknownNameError(f"rates: '{robot.velocity_names[c]}' given twice")
     return np.array(columns, dtype=int)
+
+
+def _first_bad(a: np.ndarray) -> float:
+    """The first entry of `a` that is not a finite number within :data:`MAX_QUERY_RATE`."""
+    return float(a[np.unravel_index(int(np.argmax(~(np.abs(a) <= MAX_QUERY_RATE))), a.shape)])
+
+
+def _check_finite_rates(names: list[str], q_assigned: np.ndarray) -> None:
+    """Raise :class:`ShapeError` naming the first rate (``(..., n_a)``, in `names` order) that is not a finite
+    number within :data:`MAX_QUERY_RATE` (the bound of ``wmrkit fk --spin``: beyond, the slip overflows)."""
+    ok = (np.abs(q_assigned) <= MAX_QUERY_RATE).reshape(-1, len(names)).all(axis=0)
+    if not ok.all():
+        j = int(np.argmin(ok))
+        raise ShapeError(f"rates: {names[j]}: expected finite numbers within {MAX_QUERY_RATE:g} (rad/s or m/s), "
+                         f"got {_first_bad(q_assigned[..., j])}")
 
 
 def _rate_value(name: str, value: ArrayLike) -> ArrayLike:
