@@ -10,7 +10,7 @@ import pytest
 
 from wmrkit import catalog, direct_model, forward_kinematics, inverse_model, mobility, wheel_commands
 from wmrkit.analysis import icr, is_singular, singularity_distance
-from wmrkit.errors import ShapeError
+from wmrkit.errors import ShapeError, WmrkitError
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf, 1e300])
@@ -73,3 +73,40 @@ def test_forward_kinematics_of_rates_that_do_not_broadcast_or_are_empty():
         forward_kinematics(robot, {"left": [1.0, 2.0], "right": [1.0, 2.0, 3.0]})
     twist, residual = forward_kinematics(robot, {"left": [], "right": []})
     assert twist.shape == (0, 3) and residual.shape == (0,)
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    (lambda o: o.square_path(1.0, speed=0.0), "square_path: speed must be a finite number > 0, got 0"),
+    (lambda o: o.square_path(np.nan), "square_path: side must be a finite number > 0, got nan"),
+    (lambda o: o.TwistProfile.from_segments([(np.nan, 1.0, 0.0, 0.0)]), "every segment needs a finite duration"),
+    (lambda o: o.TwistProfile.from_segments([(1.0, np.nan, 0.0, 0.0)]), "profile: segment 0: twist [nan, 0.0, 0.0]"),
+    (lambda o: o.TwistProfile(np.ones(2), np.zeros((1, 3))), "profile: expected durations (S,) and twists (S, 3)"),
+])
+def test_synthetic_profiles_refuse_what_has_no_duration_or_speed(call, message):
+    # square_path(1, speed=0) raised ZeroDivisionError; square_path(nan) and NaN segments made profiles of NaN
+    from wmrkit import odometry
+
+    with pytest.raises(WmrkitError) as err:
+        call(odometry)
+    assert str(err.value).startswith(message)
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    ({"pose0": (np.nan, 0.0, 0.0)}, "pose0: expected (x, y, theta), finite"),  # NaN poses, exit 'OK'
+    ({"seed": -1}, "seed must be an integer >= 0, got -1"),  # numpy's ValueError
+    ({"sensed": ["nope.spin"]}, "sensed: robot 'diff-drive' has no joint 'nope.spin'"),  # tuple.index ValueError
+    ({"spin_noise_per_rad": -1e-4}, "spin_noise_per_rad: a noise must be a finite number >= 0"),  # noiseless run
+    ({"steer_noise": np.nan}, "steer_noise: a noise must be a finite number >= 0"),
+    ({"oversample": 0}, "oversample: expected an integer >= 1"),
+    ({"slips": [("right.spn", 0.0, 1.0, 0.1)]}, "slips[0]: 'right.spn' is not a sensed spin joint"),  # ignored
+    ({"slips": [("right.spin", 3.0, 1.0, 0.1)]}, "slips[0]: expected finite times start < stop"),  # ignored
+    ({"slips": [("right.spin", 0.0, 1.0, np.nan)]}, "slips[0]: expected finite times start < stop and a finite"),
+])
+def test_a_synthetic_run_refuses_its_arguments_by_name(options, message):
+    from wmrkit import odometry
+
+    if "slips" in options:
+        options = {"slips": [odometry.Slip(*s) for s in options["slips"]]}
+    with pytest.raises(WmrkitError) as err:
+        odometry.simulate(catalog.load("diff-drive"), odometry.square_path(1.0), 20.0, **options)
+    assert str(err.value).startswith(message)

@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike
 
 from ..errors import WmrkitError
 from ..kinematics.linalg import solve_assigned
+from ..limits import MAX_COORDINATE, MAX_SPEED, check_seed
 from ..robot import Robot
 from ..wheels import wheel_slip_rows
 from .encoders import AbsoluteEncoder, Encoder, IncrementalEncoder
@@ -39,12 +40,21 @@ class TwistProfile:
     durations: np.ndarray
     twists: np.ndarray
 
+    def __post_init__(self) -> None:
+        d, tw = np.asarray(self.durations, dtype=float), np.asarray(self.twists, dtype=float)
+        if d.ndim != 1 or tw.shape != (len(d), 3):
+            raise WmrkitError(f"profile: expected durations (S,) and twists (S, 3), got {d.shape} and {tw.shape}")
+        if not (d > 0).all() or not np.isfinite(d).all():
+            raise WmrkitError("every segment needs a finite duration > 0 s")
+        if not (np.abs(tw) <= MAX_SPEED).all():  # NaN included
+            k = int(np.argmax(~(np.abs(tw) <= MAX_SPEED).all(axis=1)))
+            raise WmrkitError(f"profile: segment {k}: twist {tw[k].tolist()}: expected finite speeds within "
+                              f"{MAX_SPEED:g} m/s and turn rates within {MAX_SPEED:g} rad/s")
+
     @classmethod
     def from_segments(cls, segments: Sequence[tuple[float, float, float, float]]) -> TwistProfile:
         """From ``(duration, vx, vy, omega)`` rows."""
         a = np.asarray(segments, dtype=float).reshape(-1, 4)
-        if np.any(a[:, 0] <= 0):
-            raise WmrkitError("every segment needs a duration > 0 s")
         return cls(a[:, 0], a[:, 1:])
 
     @property
@@ -79,6 +89,11 @@ def square_path(side: float, *, speed: float = 0.5, turn_rate: float = 0.5, cloc
     """A closed square: four times (straight `side` [m] at `speed`, turn 90 deg in place at `turn_rate`), with an
     optional stop of `pause` [s] between segments (time for steered wheels to turn). Counter-clockwise unless
     `clockwise` (the two runs of the classic square-path benchmark)."""
+    for name, value in (("side", side), ("speed", speed), ("turn_rate", turn_rate)):
+        if not 0 < value < math.inf:
+            raise WmrkitError(f"square_path: {name} must be a finite number > 0, got {value}")
+    if not 0 <= pause < math.inf:
+        raise WmrkitError(f"square_path: pause must be a finite number >= 0 s, got {pause}")
     w = -turn_rate if clockwise else turn_rate
     seg = [(side / speed, speed, 0.0, 0.0), (math.pi / 2 / turn_rate, 0.0, 0.0, w)]
     if pause > 0:
@@ -125,6 +140,7 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     `oversample`: fine steps per sample interval for the joint kinematics. Deterministic for a given `seed`.
     """
     sensed = tuple(robot.sensed if sensed is None else sensed)
+    _check_arguments(robot, sensed, pose0, spin_noise_per_rad, steer_noise, slips, oversample, seed)
     if not (1e-6 <= rate and profile.duration * rate <= MAX_SAMPLES):
         raise WmrkitError(f"rate {rate:g} Hz over the profile's {profile.duration:g} s: need a rate >= 1e-06 Hz and "
                           f"at most {MAX_SAMPLES} sample periods")
@@ -190,6 +206,32 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
             meas_pos[joint] = convert_steering(robot, (joint,), enc.angle(counts[joint])[:, None], to="beta")[:, 0]
     log = JointLog(t_samples, sensed, np.column_stack([meas_pos[j] for j in sensed]), source="<synthetic>")
     return SyntheticRun(log, truth[sample_idx], np.column_stack([true_pos[j] for j in sensed]), counts)
+
+
+def _check_arguments(robot: Robot, sensed: tuple[str, ...], pose0: ArrayLike, spin_noise_per_rad: float,
+                     steer_noise: float, slips: Sequence[Slip], oversample: int, seed: int) -> None:
+    """Refuse, by name, the arguments of :func:`simulate` that would give NaN poses, a silently noiseless run
+    (a negative noise) or a numpy exception (a negative seed, a joint that does not exist)."""
+    for joint in sensed:
+        wheel, _, kind = joint.partition(".")
+        if joint not in robot.rate_names and not (kind == "steer" and robot.wheel(wheel).kind.steers):
+            raise WmrkitError(f"sensed: robot '{robot.name}' has no joint '{joint}' that can be sensed "
+                              f"(joints: {', '.join(robot.rate_names)})")
+    pose = np.asarray(pose0, dtype=float)
+    if pose.shape != (3,) or not (np.abs(pose) <= MAX_COORDINATE).all():
+        raise WmrkitError(f"pose0: expected (x, y, theta), finite and within {MAX_COORDINATE:g}, got {pose.tolist()}")
+    for name, value in (("spin_noise_per_rad", spin_noise_per_rad), ("steer_noise", steer_noise)):
+        if not 0 <= value < math.inf:
+            raise WmrkitError(f"{name}: a noise must be a finite number >= 0, got {value}")
+    if isinstance(oversample, bool) or not isinstance(oversample, int | np.integer) or oversample < 1:
+        raise WmrkitError(f"oversample: expected an integer >= 1 (fine steps per sample), got {oversample!r}")
+    check_seed(seed, WmrkitError)
+    for i, s in enumerate(slips):
+        if s.joint not in sensed or s.joint.endswith(".steer"):
+            raise WmrkitError(f"slips[{i}]: '{s.joint}' is not a sensed spin joint ({', '.join(sensed)})")
+        if not (-math.inf < s.start < s.stop < math.inf and math.isfinite(s.ratio)):
+            raise WmrkitError(f"slips[{i}]: expected finite times start < stop and a finite ratio, got start "
+                              f"{s.start}, stop {s.stop}, ratio {s.ratio}")
 
 
 def _steering(robot: Robot, profile: TwistProfile, fine: np.ndarray, twist: np.ndarray,
