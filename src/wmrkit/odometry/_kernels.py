@@ -228,8 +228,10 @@ def _rotations(head, turn, m, exact, cf, sf):
     if outside:
         for j in range(m):
             a, h = head[j], 0.5 * turn[j]
-            c, s = (math.cos(a), math.sin(a)) if abs(a) > TRIG_MAX else _cos_sin(a)
-            f = (math.sin(h) / h if abs(h) > SINC_MAX else _sinc(h)) if exact else 1.0
+            # an infinite angle (an infinite position in the log, named by the caller) takes the inlined branch:
+            # NaN there, as in compiled code, where Python's math.cos(inf) raises ValueError
+            c, s = (math.cos(a), math.sin(a)) if TRIG_MAX < abs(a) < math.inf else _cos_sin(a)
+            f = (math.sin(h) / h if SINC_MAX < abs(h) < math.inf else _sinc(h)) if exact else 1.0
             cf[j], sf[j] = c * f, s * f
 
 
