@@ -110,3 +110,20 @@ def test_a_synthetic_run_refuses_its_arguments_by_name(options, message):
     with pytest.raises(WmrkitError) as err:
         odometry.simulate(catalog.load("diff-drive"), odometry.square_path(1.0), 20.0, **options)
     assert str(err.value).startswith(message)
+
+
+@pytest.mark.parametrize("name", ["swerve-4", "forklift"])
+@pytest.mark.parametrize("noise", [False, True], ids=["fused", "model"])
+def test_a_steering_angle_beyond_a_million_turns_in_a_log_is_named_at_its_sample(name, noise):
+    # 1e300 rad in a steering column was integrated with round-off sines (a pose, exit 0); with the steering
+    # configurations checked (as_angles) it became an unlocated 'beta: ...' error: now the sample and joint
+    from wmrkit.odometry import CrowleyNoise, JointLog, LogError, odometry, odometry_model
+
+    robot = catalog.load(name)
+    joints = odometry_model(robot).joints
+    positions = np.zeros((9, len(joints)))
+    steer = next(c for c, j in enumerate(joints) if j.endswith(".steer"))
+    positions[6, steer] = 1e300
+    with pytest.raises(LogError, match=rf"^<log>: sample 6: {joints[steer]}: steering angle 1e\+300 rad is more "):
+        odometry(robot, JointLog(np.arange(9) * 0.1, joints, positions), chunk_size=4,
+                 noise=CrowleyNoise() if noise else None)

@@ -23,6 +23,7 @@ from .._shapes import as_vectors
 from ..errors import WmrkitError
 from ..limits import MAX_COORDINATE
 from ..robot import Robot
+from ..units import MAX_ANGLE, MAX_TURNS
 from .covariance import CrowleyNoise, JointNoise, propagate_covariance
 from .integrators import HEADING_FRACTION, Method, check_method
 from .logs import JointLog, LogError, check_time
@@ -270,6 +271,9 @@ def _validate(chunk: JointLog, prev: JointLog | None, *, positions: bool = True)
               and bad == 0)
     if chunk.heading_world is not None:
         ok = ok and bool(np.isfinite(chunk.heading_world.sum()))
+    steer = _steer_columns(chunk)
+    if steer and positions:
+        ok = ok and bool(np.abs(chunk.positions[:, steer]).max(initial=0.0) <= MAX_ANGLE)
     if not ok:  # the slow path finds and names the first bad value
         check_finite(chunk)
         check_time(chunk, t, None if prev is None else float(prev.time[-1]), None)
@@ -312,6 +316,16 @@ def check_finite(log: JointLog) -> None:
     if log.heading_world is not None and not np.all(np.isfinite(log.heading_world)):
         i = int(np.flatnonzero(~np.isfinite(log.heading_world))[0])
         raise LogError(f"{log.where(i)}: heading: value {float(log.heading_world[i])!r} is not a finite number")
+    steer = _steer_columns(log)
+    far = np.abs(log.positions[:, steer]) > MAX_ANGLE
+    if far.any():  # finite, but no angle to steer by: its sine and cosine are round-off
+        i, c = (int(x) for x in np.argwhere(far)[0])
+        raise LogError(f"{log.where(i)}: {log.joints[steer[c]]}: steering angle {float(log.positions[i, steer[c]])!r} "
+                       f"rad is more than {MAX_TURNS:g} turns")
+
+
+def _steer_columns(log: JointLog) -> list[int]:
+    return [c for c, joint in enumerate(log.joints) if joint.endswith(".steer")]
 
 
 class _Stats:
