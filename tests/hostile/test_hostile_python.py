@@ -127,3 +127,14 @@ def test_a_steering_angle_beyond_a_million_turns_in_a_log_is_named_at_its_sample
     with pytest.raises(LogError, match=rf"^<log>: sample 6: {joints[steer]}: steering angle 1e\+300 rad is more "):
         odometry(robot, JointLog(np.arange(9) * 0.1, joints, positions), chunk_size=4,
                  noise=CrowleyNoise() if noise else None)
+
+
+@pytest.mark.parametrize("chunk_size", [0, -5, 2.5, 1 << 23])
+def test_odometry_refuses_a_chunk_size_outside_the_limits_by_name(chunk_size):
+    # 0 raised range()'s ValueError, 2.5 a TypeError, -5 ran no chunk ('the log has no samples'); read_csv and the
+    # CLI's --chunk-size were already bounded (limits.check_chunk_size)
+    from wmrkit.odometry import JointLog, LogError, odometry
+
+    log = JointLog(np.arange(4) * 0.1, ("left.spin", "right.spin"), np.zeros((4, 2)))
+    with pytest.raises(LogError, match=r"^chunk_size must be in \[1, 4194304\] samples"):
+        odometry(catalog.load("diff-drive"), log, chunk_size=chunk_size)

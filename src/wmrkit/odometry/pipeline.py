@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
 from ..errors import WmrkitError
-from ..limits import MAX_COORDINATE
+from ..limits import MAX_COORDINATE, check_chunk_size
 from ..robot import Robot
 from ..units import MAX_ANGLE, MAX_TURNS
 from .covariance import CrowleyNoise, JointNoise, propagate_covariance
@@ -159,6 +159,7 @@ def odometry(robot: Robot | OdometryModel, log: JointLog, *, method: Method = "e
 
     `robot` may be an :class:`OdometryModel` to choose the sensed joints (default: ``robot.sensed``).
     """
+    check_chunk_size(chunk_size, LogError)
     model = robot if isinstance(robot, OdometryModel) else odometry_model(robot)
     n = len(log)
     # slip from calloc: robots without redundant sensors leave it untouched (no page is written)
