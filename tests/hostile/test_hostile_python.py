@@ -138,3 +138,28 @@ def test_odometry_refuses_a_chunk_size_outside_the_limits_by_name(chunk_size):
     log = JointLog(np.arange(4) * 0.1, ("left.spin", "right.spin"), np.zeros((4, 2)))
     with pytest.raises(LogError, match=r"^chunk_size must be in \[1, 4194304\] samples"):
         odometry(catalog.load("diff-drive"), log, chunk_size=chunk_size)
+
+
+@pytest.mark.parametrize("length", [0.0, -1.0, np.nan, np.inf])
+def test_a_characteristic_length_that_is_not_a_positive_number_is_refused_by_name(length):
+    # singularity_distance(length=0) silently used the default length ('length or robot_size'), length=-1 gave
+    # another number; twist_condition_number(length=nan) and analyze(length=nan) raised LinAlgError
+    from wmrkit.analysis import condition_map, isotropy_matrix
+
+    robot = catalog.load("swerve-4")
+    with pytest.raises(WmrkitError, match=r"^length: must be a finite number > 0 m"):
+        singularity_distance(robot, None, ("front_left.spin", "front_right.spin", "rear_left.spin"), length=length)
+    with pytest.raises(WmrkitError, match=r"^length: must be a finite number > 0 m"):
+        condition_map(catalog.load("diff-drive"), np.zeros((2, 1)), length=length)
+    with pytest.raises(WmrkitError, match=r"^length: must be a finite number > 0 m"):
+        isotropy_matrix(catalog.load("diff-drive"), None, ("left.spin", "right.spin"), ("vx", "omega"), length=length)
+
+
+@pytest.mark.parametrize("length", [0.0, np.nan, 1e-9, 1e9])
+def test_analyze_bounds_its_length_as_analyze_length_does(length):
+    # analyze(length=nan) raised LinAlgError, analyze(length=1e-9) called the twist undetermined: the CLI's
+    # --length was bounded (limits.check_length), the Python door was not
+    from wmrkit.analysis import analyze
+
+    with pytest.raises(WmrkitError, match=r"^length: .* m is outside the lengths wmrkit handles \(1e-06 to 1000 m\)"):
+        analyze(catalog.load("diff-drive"), length=length)

@@ -32,7 +32,7 @@ from ..robot import Robot
 from . import _fast
 from .classification import classify
 from .lines import _rate_block, constraint_lines, element_rows, line_parameters
-from .singularity import robot_size
+from .singularity import check_positive_length, robot_size
 
 #: Search interval of the natural length, in robot sizes (see :func:`natural_length`).
 LENGTH_RANGE = (1e-3, 1e3)
@@ -54,6 +54,7 @@ def isotropy_matrix(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, .
     `selected` its column is divided by `length`; if among `assigned` its row is multiplied by it (§5.4). B is a
     basis of the null space of the slip matrix (6.7); H does not depend on which basis.
     """
+    check_positive_length(length)
     if len(assigned) != len(selected) or set(assigned) & set(selected):
         raise UnknownNameError(f"isotropy_matrix: need as many selected as assigned velocities, disjoint; got "
                                f"{list(assigned)} and {list(selected)}")
@@ -150,6 +151,8 @@ def twist_condition_number(robot: Robot, beta: ArrayLike | None = None, *, joint
     beta = robot.beta if beta is None else beta
     if length is None:
         length = natural_length(robot, joints=model.joints)[0]
+    else:
+        check_positive_length(length)
     return _kappa(model, beta, float(length))
 
 

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
-from ..errors import UnknownNameError
+from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import matrix_rank, nondimensional
 from ..robot import Robot
 from . import _fast
@@ -73,11 +73,21 @@ def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[s
         return np.zeros(beta.shape[:-1])
     flat = beta.reshape(int(np.prod(beta.shape[:-1])), beta.shape[-1])
     out = np.empty(len(flat))
-    p, length = line_parameters(robot), float(length or robot_size(robot))
+    if length is not None:
+        check_positive_length(length)
+    p, length = line_parameters(robot), float(robot_size(robot) if length is None else length)
     for s in range(0, len(flat), _fast.CHUNK):
         rows = _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
         out[s:s + _fast.CHUNK] = _fast.distance_cm(_fast.combine(cl.coefficients, rows, cl.constant), length)
     return out.reshape(beta.shape[:-1])
+
+
+def check_positive_length(length: float) -> None:
+    """Raise :class:`WmrkitError` unless the characteristic length `length` [m] is a finite number > 0 (it divides
+    the omega column). Internal searches (natural lengths, their figures) reach beyond the lengths a user may give,
+    which the user's doors bound with :func:`wmrkit.limits.check_length` (``analyze``, ``--length``)."""
+    if not 0 < length < np.inf:  # NaN included
+        raise WmrkitError(f"length: must be a finite number > 0 m, got {length}")
 
 
 def robot_size(robot: Robot) -> float:

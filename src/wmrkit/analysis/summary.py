@@ -13,8 +13,10 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import WmrkitError
 from ..kinematics.actuation import actuation_analysis
 from ..kinematics.sensing import sensing_analysis
+from ..limits import check_length
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .classification import Classification, classify, instantaneous_mobility
@@ -153,6 +155,8 @@ def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) 
     """
     cls = classify(robot)
     joints = default_joints(robot)
+    if length is not None:  # as analyze --length: at 1e-9 m the twist read as undetermined
+        check_length(length, WmrkitError)
     if length is None:
         d, kappa = natural_length(robot, joints=joints)
     else:
