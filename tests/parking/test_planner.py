@@ -9,7 +9,8 @@ from dataclasses import replace
 import pytest
 from parking_cases import CAR_91, CAR_92, SLOT_91, SLOT_92
 
-from wmrkit.parking import length_ratio, plan_parking, shortest_slot
+from wmrkit.errors import WmrkitError
+from wmrkit.parking import Space, Vehicle, length_ratio, plan_parking, shortest_slot
 from wmrkit.parking.collisions import lateral_reach
 from wmrkit.parking.geometry import arcs_through, corner_distance
 from wmrkit.parking.planner import approach_point, pass_end
@@ -174,3 +175,33 @@ def test_huge_but_finite_inputs_return_quickly():
     assert time.perf_counter() - t0 < 0.5 and not plan.feasible
     assert shortest_slot(replace(CAR_91, a1=1e4), replace(SLOT_91, J=1.3)) is None
     assert time.perf_counter() - t0 < 5.0
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    ({"phi_step": 0.0}, "phi_step: must be a finite angle >= phi_max / 100000"),  # ZeroDivisionError
+    ({"phi_step": float("nan")}, "phi_step: must be a finite angle"),  # ValueError: NaN to integer
+    ({"phi_step": -0.01}, "phi_step: must be a finite angle"),  # 'no steering angle lets ...': a wrong reason
+    ({"phi_step": 1e-12}, "phi_step: must be a finite angle"),  # 6e11 steering angles: days of looping
+    ({"max_maneuvers": 0}, "max_maneuvers: must be an integer >= 1, got 0"),  # a plan of 1 manoeuvre anyway
+    ({"max_maneuvers": 2.5}, "max_maneuvers: must be an integer >= 1, got 2.5"),
+])
+def test_plan_parking_refuses_its_search_options_by_name(options, message):
+    vehicle = Vehicle(a1=3.5, b1=0.9, c1=1.8, h1=2.6, track=1.5, phi_max=0.6)
+    space = Space(H=7.0, J=2.5, MS=0.2, dx2=1.5, final_gap=0.1)
+    with pytest.raises(WmrkitError) as err:
+        plan_parking(vehicle, space, **options)
+    assert str(err.value).startswith(message)
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    ({"step": float("nan")}, "step: must be a finite length > 0 m, got nan"),  # ValueError: NaN to integer
+    ({"span": float("nan")}, "span: must be a finite length > 0 m, got nan"),
+    ({"span": -1.0}, "span: must be a finite length > 0 m, got -1.0"),  # None: 'no length works', a wrong answer
+    ({"max_maneuvers": -1}, "max_maneuvers: must be an integer >= 1, got -1"),
+])
+def test_shortest_slot_refuses_its_search_options_by_name(options, message):
+    vehicle = Vehicle(a1=3.5, b1=0.9, c1=1.8, h1=2.6, track=1.5, phi_max=0.6)
+    space = Space(H=7.0, J=2.5, MS=0.2, dx2=1.5, final_gap=0.1)
+    with pytest.raises(WmrkitError) as err:
+        shortest_slot(vehicle, space, **options)
+    assert str(err.value).startswith(message)

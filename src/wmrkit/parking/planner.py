@@ -10,8 +10,10 @@ resolved as in ``docs/errata.md`` (§9.3 entries). World frame and poses: :mod:`
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, replace
 
+from ..errors import WmrkitError
 from .collisions import approach_offset_closed_form, front_rear_collision, lateral_reach, trailing_dip
 from .geometry import (
     Space,
@@ -32,6 +34,9 @@ DY3_STEP, DY3_RANGE = 0.01, 5.0
 MAX_MANEUVERS = 100
 #: Geometric tolerance of the stopping and inside-the-slot tests [m].
 TOL = 1e-9
+#: Most steering angles Algorithm 3 tries (``phi_max / phi_step``): each costs ~5 us, and phi_step = 1e-12 rad
+#: meant 6e11 tries, days of looping.
+MAX_PHI_STEPS = 100_000
 
 
 @dataclass(frozen=True, slots=True)
@@ -81,9 +86,15 @@ def plan_parking(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
                  max_maneuvers: int = MAX_MANEUVERS) -> ParkingPlan:
     """Plan a parallel parking manoeuvre (thesis §9.3.2, Algorithms 1-5); never loops without bound.
 
-    `phi_step` [rad] is Algorithm 3's steering decrement; `max_maneuvers` bounds phase 3.
+    `phi_step` [rad] is Algorithm 3's steering decrement (at least ``phi_max / MAX_PHI_STEPS``); `max_maneuvers`
+    (an integer >= 1) bounds phase 3.
     """
     v, sp = vehicle, space
+    if not v.phi_max / MAX_PHI_STEPS <= phi_step < math.inf:  # NaN included
+        raise WmrkitError(f"phi_step: must be a finite angle >= phi_max / {MAX_PHI_STEPS} = "
+                          f"{v.phi_max / MAX_PHI_STEPS:.3g} rad (at most {MAX_PHI_STEPS} steering angles tried), "
+                          f"got {phi_step} rad")
+    _check_max_maneuvers(max_maneuvers)
     warnings: list[str] = []
     pass_offset = sp.dx2
     if sp.dx2 < v.c1 / 2 - TOL:  # (not "70 cm" against "140 cm" / 2 in floating point)
@@ -296,6 +307,10 @@ def shortest_slot(vehicle: Vehicle, space: Space, *, step: float = 0.01, span: f
     at most 2000 steps: the step grows for huge cars), then bisects the last step to 1 mm. None when no length in
     the range works (e.g. the slot is too narrow).
     """
+    for name, value in (("step", step), ("span", span)):
+        if value is not None and not 0 < value < math.inf:  # NaN included
+            raise WmrkitError(f"{name}: must be a finite length > 0 m, got {value}")
+    _check_max_maneuvers(max_maneuvers)
     lo = vehicle.length + 2 * space.MS
     span = max(10.0, 10 * vehicle.length) if span is None else span
     step = max(step, span / 2000)
@@ -314,6 +329,11 @@ def shortest_slot(vehicle: Vehicle, space: Space, *, step: float = 0.01, span: f
             return h
         prev = h
     return None
+
+
+def _check_max_maneuvers(max_maneuvers: object) -> None:
+    if isinstance(max_maneuvers, bool) or not isinstance(max_maneuvers, numbers.Integral) or max_maneuvers < 1:
+        raise WmrkitError(f"max_maneuvers: must be an integer >= 1, got {max_maneuvers!r}")
 
 
 def _failure(v: Vehicle, sp: Space, pass_offset: float, warnings: list[str]):
