@@ -163,3 +163,21 @@ def test_analyze_bounds_its_length_as_analyze_length_does(length):
 
     with pytest.raises(WmrkitError, match=r"^length: .* m is outside the lengths wmrkit handles \(1e-06 to 1000 m\)"):
         analyze(catalog.load("diff-drive"), length=length)
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    # lookahead 0 ran 82 s to end in 'the closed loop is too stiff ... start closer to the reference'; -1 aimed
+    # behind the robot and 'tracked' the circle 3.5 m off, exit OK
+    ({"controller": "pure-pursuit", "lookahead": 0.0}, "lookahead: expected a distance > 0 m along the path"),
+    ({"controller": "pure-pursuit", "lookahead": -1.0}, "lookahead: expected a distance > 0 m along the path"),
+    # NaN reached the wheel IK, whose message named twist_robot, not the gain
+    ({"controller": "stanley", "stanley_gain": np.nan}, "stanley gain: expected a cross-track gain >= 0"),
+    ({"initial_pose": [np.nan, 0.0, 0.0]}, "initial_pose: expected one pose (x, y, theta), finite"),  # scipy's y0
+    ({"point": [np.nan, 0.0]}, "point: expected finite coordinates"),  # '(nan, 0) m ... lies on its fixed axle'
+])
+def test_track_refuses_its_controller_options_by_name(options, message):
+    from wmrkit.control import builtin_reference, track
+
+    with pytest.raises(WmrkitError) as err:
+        track(catalog.load("diff-drive"), builtin_reference("circle"), **options)
+    assert str(err.value).startswith(message)

@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, readonly
 from ..errors import WmrkitError
 from ..kinematics.wheel_ik import wheel_commands
+from ..limits import MAX_SIZE
 from ..robot import Robot
 from ..wheels import heading_from_beta
 
@@ -131,6 +132,8 @@ def control_point(robot: Robot, point: ArrayLike | None = None, *, reduced: bool
     origin lies on the fixed axle, a point ahead of it at the robot's largest wheel distance.
     """
     key = None if point is None else tuple(float(v) for v in as_vectors(point, 2, "point"))
+    if key is not None and not all(abs(v) <= MAX_SIZE for v in key):  # NaN included
+        raise ControlError(f"point: expected finite coordinates within {MAX_SIZE:g} m of the robot origin, got {key}")
     return _cached(robot, key, reduced)
 
 

@@ -155,6 +155,9 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     duration = reference.duration if duration is None else float(duration)
     _check_timing(duration, 0.02 if dynamics and period is None else period, output_dt)
     pose0 = initial_pose_on(cp, reference) if initial_pose is None else as_vectors(initial_pose, 3, "initial_pose")
+    if not (np.abs(pose0) <= MAX_COORDINATE).all() or pose0.ndim != 1:  # NaN included
+        raise ControlError(f"initial_pose: expected one pose (x, y, theta), finite and within {MAX_COORDINATE:g}, "
+                           f"got {pose0.tolist()}")
     if controller in ("p", "pi", "point"):
         b = gain * gain / 4 if integral_gain is None else integral_gain
         law = PositionLaw.uniform(controller, gain, b if controller == "pi" else 0.0, gate)  # type: ignore[arg-type]

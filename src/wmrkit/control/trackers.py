@@ -20,7 +20,7 @@ import math
 import numpy as np
 
 from .loop import TwistController
-from .points import ControlPoint
+from .points import ControlError, ControlPoint
 from .references import Reference
 
 __all__ = ["PathIndex", "default_wheelbase", "pure_pursuit", "stanley"]
@@ -125,7 +125,9 @@ def _speed(ref: Reference, t: float) -> float:
 
 
 def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0) -> TwistController:
-    """Pure-pursuit controller (see module doc); `lookahead` [m]."""
+    """Pure-pursuit controller (see module doc); `lookahead` [m], > 0."""
+    if not 0 < lookahead < math.inf:  # NaN included
+        raise ControlError(f"lookahead: expected a distance > 0 m along the path, got {lookahead}")
     path = PathIndex(reference)
 
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -145,8 +147,14 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0)
 def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase: float | None = None,
             max_steer: float = 1.2) -> TwistController:
     """Stanley controller (see module doc); cross-track `gain` [1/s], steering limited to ``+-max_steer`` [rad]."""
-    path = PathIndex(reference)
     length = default_wheelbase(cp) if wheelbase is None else wheelbase
+    if not 0 <= gain < math.inf:
+        raise ControlError(f"stanley gain: expected a cross-track gain >= 0 (1/s), got {gain}")
+    if not 0 < length < math.inf:
+        raise ControlError(f"wheelbase: expected a distance > 0 m, got {length}")
+    if not 0 < max_steer < math.pi / 2:
+        raise ControlError(f"max_steer: expected a steering limit in (0, 90) deg [rad], got {max_steer}")
+    path = PathIndex(reference)
 
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         a, psi = _axle_state(cp, pose)
