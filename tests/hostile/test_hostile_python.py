@@ -181,3 +181,16 @@ def test_track_refuses_its_controller_options_by_name(options, message):
     with pytest.raises(WmrkitError) as err:
         track(catalog.load("diff-drive"), builtin_reference("circle"), **options)
     assert str(err.value).startswith(message)
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    ({"point": (np.nan, 0.0)}, "point: expected (x, y), finite"),  # read as a point on the axle: feasible
+    ({"jump_factor": 0.0}, "jump_factor: expected a finite number > 1"),  # every step a jump: not feasible
+    ({"jump_factor": np.nan}, "jump_factor: expected a finite number > 1"),
+])
+def test_feasibility_refuses_a_point_or_jump_factor_that_is_not_a_number_it_can_use(options, message):
+    from wmrkit.control import builtin_reference, feasibility
+
+    with pytest.raises(WmrkitError) as err:
+        feasibility(catalog.load("diff-drive"), builtin_reference("circle"), **options)
+    assert str(err.value).startswith(message)

@@ -13,12 +13,14 @@ larger than ``jump_factor`` times the typical one and than an absolute floor is 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 
 from ..analysis.classification import classify
+from ..limits import MAX_SIZE
 from ..robot import Robot
 from ..wheels import wrap_angle
 from .points import ControlError, control_point
@@ -108,6 +110,9 @@ def requirement(robot: Robot, framework: Literal["kinematic", "dynamic"] = "kine
     if c.type is None:
         raise ControlError(f"robot '{robot.name}' is degenerate ({'; '.join(c.reasons)}): Table 8.1 does not apply")
     p = np.zeros(2) if point is None else np.asarray(point, dtype=float)
+    if p.shape != (2,) or not (np.abs(p) <= MAX_SIZE).all():  # NaN read as a point on the axle
+        raise ControlError(f"point: expected (x, y), finite and within {MAX_SIZE:g} m of the robot origin, got "
+                           f"{p.tolist()}")
     if c.type in (2, 4):
         on_axle = _on_axle(robot, p)
         column = f"type {c.type}, {'on' if on_axle else 'off'} axle"
@@ -173,7 +178,11 @@ def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float) -> list[tupl
 
 def feasibility(robot: Robot, reference: Reference, framework: Literal["kinematic", "dynamic"] = "kinematic", *,
                 point: tuple[float, float] | None = None, jump_factor: float = 20.0) -> Feasibility:
-    """Check `reference` against the Table 8.1 cell of `robot` (§8.5): every discontinuity and its remedy."""
+    """Check `reference` against the Table 8.1 cell of `robot` (§8.5): every discontinuity and its remedy.
+
+    A jump is a step of a signal larger than `jump_factor` (> 1) times its median step (and than a floor)."""
+    if not 1 < jump_factor < math.inf:  # NaN included: at 0 or NaN every step above the floor was a jump
+        raise ControlError(f"jump_factor: expected a finite number > 1 (times the median step), got {jump_factor}")
     req = requirement(robot, framework, point=point)
     sig = signals(reference)
     found: list[Violation] = []
