@@ -22,7 +22,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..kinematics.wheel_ik import WheelCommands, forward_kinematics, wheel_commands
-from ..limits import MAX_SPEED
+from ..limits import MAX_QUERY_RATE, MAX_SPEED
 from ..robot import Robot
 from .actuators import LowLevelLoops
 from .laws import PositionLaw, law_velocity, pose_error
@@ -45,6 +45,15 @@ def check_command(twist: np.ndarray, t: float) -> None:
         raise ControlError(f"the loop diverged: at t = {t:.6g} s the law commands the twist "
                            f"{tuple(float(v) for v in twist)}, beyond {MAX_SPEED:g} m/s or rad/s; lower the gain or "
                            "the period")
+
+
+def check_diverged(twist: np.ndarray, t: float) -> None:
+    """Refuse a law's twist beyond ``limits.MAX_QUERY_RATE`` at `t` in a kinematic loop: no wheel command is defined
+    there (:func:`wheel_commands` refuses it), the loop has diverged."""
+    if not np.all(np.abs(twist) <= MAX_QUERY_RATE):  # NaN included
+        raise ControlError(f"the closed loop diverged at t = {t:.6g} s: the law commands the twist "
+                           f"{tuple(float(v) for v in twist)}, beyond {MAX_QUERY_RATE:g} m/s or rad/s; lower the gain "
+                           "or the period")
 
 
 #: Evaluations of the continuous loop allowed: a base plus this many per simulated second (the examples take
@@ -208,6 +217,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
         pose, integral, beta, ls = split(x)
         if held is None:
             twist, de = controller(t, pose, integral)
+            check_diverged(twist, t)
         else:
             twist, de = held
         if plant.loops is None:  # ideal joints: the robot moves with the commanded twist, if its wheels can
@@ -274,6 +284,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
             t = k * period
             measured = history[max(0, k - delay)]
             twist, de = controller(t, measured, integral)
+            check_diverged(twist, t)
             integral = integral + period * de
             held = discretize_twist(twist, period) if skew_free else twist
             x[3:6] = integral
@@ -310,6 +321,7 @@ def _advance(rhs, x: np.ndarray, t: float, period: float, subs: int, held: tuple
 def _record(controller, sim: _Sim, t: float, x: np.ndarray, split, prev: np.ndarray) -> dict:
     pose, integral, _, _ = split(x)
     twist, _ = controller(t, pose, integral)
+    check_diverged(twist, t)
     return _record_held(sim, t, x, split, twist, prev)
 
 
