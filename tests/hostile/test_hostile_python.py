@@ -194,3 +194,25 @@ def test_feasibility_refuses_a_point_or_jump_factor_that_is_not_a_number_it_can_
     with pytest.raises(WmrkitError) as err:
         feasibility(catalog.load("diff-drive"), builtin_reference("circle"), **options)
     assert str(err.value).startswith(message)
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    # NaN or 1e300 rates gave NaN or infinite velocities and forces as a solution
+    (lambda s, r, a: s.wls(r, a, [np.nan, 1.0]), "q_assigned: front_left.spin: expected finite numbers within 1e+06"),
+    (lambda s, r, a: s.mcd(r, a, [1.0, 1e300], s.tyre_friction(r)), "q_assigned: front_right.spin: expected finite"),
+    (lambda s, r, a: s.wls(r, a, [1.0]), "q_assigned: expected shape (..., 2), one value per assigned velocity"),
+    (lambda s, r, a: s.wls(r, [], []), "assigned: expected distinct velocity names, at least one, got []"),
+    (lambda s, r, a: s.wls(r, [a[0], a[0]], [1.0, 2.0]), "assigned: expected distinct velocity names"),  # last won
+    (lambda s, r, a: s.mqe(r, a, [1.0, 2.0], s.tyre_friction(r), g=-9.81), "g: expected a finite gravity > 0"),
+    (lambda s, r, a: s.mcd(r, a, [1.0, 2.0], s.tyre_friction(r), loads=[-1.0] * 4), "loads: expected finite normal"),
+    (lambda s, r, a: s.mcd(r, a, [1.0, 2.0], s.tyre_friction(r), tol=np.nan), "tol: expected a finite tolerance > 0"),
+])
+def test_the_slip_models_refuse_their_inputs_by_name(call, message):
+    # q_assigned of the wrong length raised numpy's 'cannot reshape'; g < 0, negative loads and tol = nan gave
+    # answers
+    from wmrkit import slip
+
+    robot = catalog.load("skid-steer-4")
+    with pytest.raises(WmrkitError) as err:
+        call(slip, robot, ["front_left.spin", "front_right.spin"])
+    assert str(err.value).startswith(message)

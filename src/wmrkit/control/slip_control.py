@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..dynamics.mass import Body
+from ..errors import WmrkitError
 from ..kinematics.wheel_ik import wheel_commands
 from ..robot import Robot
 from ..slip.models import FrictionLaw, G, SlipSolution, mcd, mqe, tyre_friction
@@ -194,7 +195,11 @@ def slip_commands(inverse: SlipInverse, twist: ArrayLike, beta: ArrayLike | None
         step = inverse.scale * (np.linalg.pinv(a, rcond=1e-10) @ (a @ delta - r)) - (u - u_ik)
         accepted = False
         for _ in range(6):  # halve the step until the error decreases
-            q_new, y_new = solver(u + step)
+            try:
+                q_new, y_new = solver(u + step)
+            except WmrkitError:  # a step beyond any rate or angle the slip model takes: too long, halve it
+                step = step / 2
+                continue
             r_new = s @ (y_new - twist_d)
             if np.linalg.norm(r_new) < err:
                 accepted = True

@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike
 from ..dynamics.mass import Body
 from ..errors import WmrkitError
 from ..kinematics.linalg import solve_assigned
+from ..limits import MAX_QUERY_RATE
 from ..robot import Robot, element_beta
 from .weights import SlipWeights
 
@@ -112,13 +113,30 @@ def assigned_columns(robot: Robot, assigned: Sequence[str]) -> np.ndarray:
     return np.array([robot.velocity_index(n) for n in assigned], dtype=int)
 
 
+def _assigned(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """Columns and values ``(..., n_a)`` of the assigned velocities; :class:`WmrkitError` naming `q_assigned` when
+    its last axis is not one value per name or a value is not a finite number within ``MAX_QUERY_RATE``."""
+    if not assigned or len(set(assigned)) != len(assigned):
+        raise WmrkitError(f"assigned: expected distinct velocity names, at least one, got {list(assigned)}")
+    cols = assigned_columns(robot, assigned)
+    q_a = np.asarray(q_assigned, dtype=float)
+    if q_a.shape[-1:] != (len(cols),):
+        raise WmrkitError(f"q_assigned: expected shape (..., {len(cols)}), one value per assigned velocity "
+                          f"({', '.join(assigned)}), got {q_a.shape}")
+    bad = ~(np.abs(q_a) <= MAX_QUERY_RATE).reshape(-1, len(cols))  # NaN included
+    if bad.any():
+        i, j = (int(x) for x in np.argwhere(bad)[0])
+        raise WmrkitError(f"q_assigned: {assigned[j]}: expected finite numbers within {MAX_QUERY_RATE:g} (rad/s or "
+                          f"m/s), got {float(q_a.reshape(-1, len(cols))[i, j])}")
+    return cols, q_a
+
+
 def wls(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: ArrayLike | None = None,
         weights: SlipWeights | None = None) -> SlipSolution:
     """Weighted least squares (7.52): ``(..., n_a) -> SlipSolution``; `beta` ``(..., n_steer)`` or described."""
     mu = (weights or SlipWeights()).row_mu(robot)
     a = robot.constraint_matrix(beta)
-    cols = assigned_columns(robot, assigned)
-    q_a = np.asarray(q_assigned, dtype=float)
+    cols, q_a = _assigned(robot, assigned, q_assigned)
     q, _ = solve_assigned(np.sqrt(mu)[:, None] * a, cols, q_a)
     slip = (a @ q[..., None])[..., 0]
     zero = np.zeros(slip.shape[:-1])
@@ -190,8 +208,12 @@ def _body(robot: Robot, body: Body | None) -> Body:
 def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, start, tol) -> SlipSolution:
     from scipy.optimize import root
 
-    cols = assigned_columns(robot, assigned)
-    q_a = np.asarray(q_assigned, dtype=float)
+    if not 0 < tol < np.inf:
+        raise WmrkitError(f"tol: expected a finite tolerance > 0, got {tol}")
+    if quasi_static is not None and not 0 < quasi_static[1] < np.inf:
+        raise WmrkitError(f"g: expected a finite gravity > 0 m/s^2, got {quasi_static[1]}")
+
+    cols, q_a = _assigned(robot, assigned, q_assigned)
     a_all = robot.constraint_matrix(beta)
     batch = np.broadcast_shapes(q_a.shape[:-1], a_all.shape[:-2])
     a_all = np.broadcast_to(a_all, (*batch, *a_all.shape[-2:])).reshape(-1, *a_all.shape[-2:])
@@ -209,6 +231,8 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
     static = np.ones(n_e) if loads is None else np.asarray(loads, dtype=float)
     if static.shape != (n_e,):
         raise WmrkitError(f"loads: expected {n_e} normal loads, one per contact, got shape {static.shape}")
+    if not (static >= 0).all() or not np.isfinite(static).all() or not static.any():
+        raise WmrkitError(f"loads: expected finite normal loads >= 0, not all 0, got {static.tolist()}")
     q_out = np.empty((len(q_a), k))
     res = np.empty(len(q_a))
     ok = np.empty(len(q_a), dtype=bool)
