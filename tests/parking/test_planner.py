@@ -177,31 +177,21 @@ def test_huge_but_finite_inputs_return_quickly():
     assert time.perf_counter() - t0 < 5.0
 
 
-@pytest.mark.parametrize(("options", "message"), [
-    ({"phi_step": 0.0}, "phi_step: must be a finite angle >= phi_max / 100000"),  # ZeroDivisionError
-    ({"phi_step": float("nan")}, "phi_step: must be a finite angle"),  # ValueError: NaN to integer
-    ({"phi_step": -0.01}, "phi_step: must be a finite angle"),  # 'no steering angle lets ...': a wrong reason
-    ({"phi_step": 1e-12}, "phi_step: must be a finite angle"),  # 6e11 steering angles: days of looping
-    ({"max_maneuvers": 0}, "max_maneuvers: must be an integer >= 1, got 0"),  # a plan of 1 manoeuvre anyway
-    ({"max_maneuvers": 2.5}, "max_maneuvers: must be an integer >= 1, got 2.5"),
+@pytest.mark.parametrize(("search", "options", "message"), [
+    (plan_parking, {"phi_step": 0.0}, "phi_step: must be a finite angle >= phi_max / 100000"),  # ZeroDivisionError
+    (plan_parking, {"phi_step": float("nan")}, "phi_step: must be a finite angle"),  # ValueError: NaN to integer
+    (plan_parking, {"phi_step": -0.01}, "phi_step: must be a finite angle"),  # 'no steering angle...': wrong reason
+    (plan_parking, {"phi_step": 1e-12}, "phi_step: must be a finite angle"),  # 6e11 steering angles: days of looping
+    (plan_parking, {"max_maneuvers": 0}, "max_maneuvers: must be an integer >= 1, got 0"),  # 1 manoeuvre anyway
+    (plan_parking, {"max_maneuvers": 2.5}, "max_maneuvers: must be an integer >= 1, got 2.5"),
+    (shortest_slot, {"step": float("nan")}, "step: must be a finite length > 0 m, got nan"),  # NaN to integer
+    (shortest_slot, {"span": float("nan")}, "span: must be a finite length > 0 m, got nan"),
+    (shortest_slot, {"span": -1.0}, "span: must be a finite length > 0 m, got -1.0"),  # None: 'no length works'
+    (shortest_slot, {"max_maneuvers": -1}, "max_maneuvers: must be an integer >= 1, got -1"),
 ])
-def test_plan_parking_refuses_its_search_options_by_name(options, message):
+def test_the_parking_searches_refuse_their_options_by_name(search, options, message):
     vehicle = Vehicle(a1=3.5, b1=0.9, c1=1.8, h1=2.6, track=1.5, phi_max=0.6)
     space = Space(H=7.0, J=2.5, MS=0.2, dx2=1.5, final_gap=0.1)
     with pytest.raises(WmrkitError) as err:
-        plan_parking(vehicle, space, **options)
-    assert str(err.value).startswith(message)
-
-
-@pytest.mark.parametrize(("options", "message"), [
-    ({"step": float("nan")}, "step: must be a finite length > 0 m, got nan"),  # ValueError: NaN to integer
-    ({"span": float("nan")}, "span: must be a finite length > 0 m, got nan"),
-    ({"span": -1.0}, "span: must be a finite length > 0 m, got -1.0"),  # None: 'no length works', a wrong answer
-    ({"max_maneuvers": -1}, "max_maneuvers: must be an integer >= 1, got -1"),
-])
-def test_shortest_slot_refuses_its_search_options_by_name(options, message):
-    vehicle = Vehicle(a1=3.5, b1=0.9, c1=1.8, h1=2.6, track=1.5, phi_max=0.6)
-    space = Space(H=7.0, J=2.5, MS=0.2, dx2=1.5, final_gap=0.1)
-    with pytest.raises(WmrkitError) as err:
-        shortest_slot(vehicle, space, **options)
+        search(vehicle, space, **options)
     assert str(err.value).startswith(message)
