@@ -74,12 +74,15 @@ class Classification:
         return head + ("; " + "; ".join(extra) if extra else "")
 
 
-def instantaneous_mobility(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
-    """Degrees of freedom of the twist, ``3 - rank K_r*(beta)`` (5.13). ``(..., n_steer) -> (...)``.
+def instantaneous_mobility(robot: Robot, beta: ArrayLike | None = None, *,
+                           heading: ArrayLike | None = None) -> np.ndarray:
+    """Degrees of freedom of the twist, ``3 - rank K_r*(beta)`` (5.13). ``(..., n_steer) -> (...)``; steering
+    `beta` (thesis) or `heading` (0 = rolling forward), default as described.
 
     Equals ``k - rank A`` (6.8) for robots whose wheel rates are all fixed by the twist (all but double wheels).
     """
-    beta = robot.beta if beta is None else robot.steering(beta)
+    beta = robot.steering(beta, heading)
+    beta = robot.beta if beta is None else beta
     cl = constraint_lines(robot)
     if not cl.labels:
         return np.full(beta.shape[:-1], 3)

@@ -95,17 +95,20 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
     return ICRSet("point", point=(float(x / w), float(y / w)))
 
 
-def icr_points(robot: Robot, beta: ArrayLike) -> np.ndarray:
-    """Homogeneous common point of the axles at each configuration, ``(..., n_steer) -> (..., 3)``.
+def icr_points(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None) -> np.ndarray:
+    """Homogeneous common point of the axles at each configuration, ``(..., n_steer) -> (..., 3)``, steering `beta`
+    (thesis, None: as described) or `heading` (0 = rolling forward).
 
     Meaningful where the robot has one degree of mobility (types 4 and 5, eqs. 5.18-5.21 corrected): then it is
     the ICR. Least-squares nearest point otherwise.
     """
-    return common_point(constraint_lines(robot).lines(beta))
+    beta = robot.steering(beta, heading)
+    return common_point(constraint_lines(robot).lines(robot.beta if beta is None else beta))
 
 
 def steer_to_icr(robot: Robot, icr_h: ArrayLike) -> np.ndarray:
-    """Steering configuration turning every steerable wheel's axle through the ICR ``(..., 3) -> (..., n_steer)``.
+    """Steering configuration turning every steerable wheel's axle through the ICR ``(..., 3) -> (..., n_steer)``,
+    as the thesis's β (``robot.heading_of_beta`` gives the headings, 0 = rolling forward).
 
     Each axle is aimed at the ICR (the branch nearest the described angle, since beta and beta + pi give the same
     axle); castors and wheels at the ICR keep their described angle. This is the coordination (Ackermann, swerve)

@@ -47,14 +47,16 @@ def condition_number(h: ArrayLike) -> np.ndarray:
 
 
 def isotropy_matrix(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], selected: tuple[str, ...],
-                    *, length: float = 1.0) -> np.ndarray:
+                    *, length: float = 1.0, heading: ArrayLike | None = None) -> np.ndarray:
     """``H = B_a B_na_s^-1`` of eqs. (5.30)-(5.31): ``H q_na_s = q_a``, with omega scaled by `length` [m].
 
     ``(..., n_steer) -> (..., m, m)`` with ``m = len(assigned) = len(selected)`` the mobility. If omega is among
     `selected` its column is divided by `length`; if among `assigned` its row is multiplied by it (§5.4). B is a
-    basis of the null space of the slip matrix (6.7); H does not depend on which basis.
+    basis of the null space of the slip matrix (6.7); H does not depend on which basis. Steering: `beta` (thesis,
+    None: as described) or `heading` (0 = rolling forward).
     """
     check_positive_length(length)
+    beta = robot.steering(beta, heading)
     if len(assigned) != len(selected) or set(assigned) & set(selected):
         raise UnknownNameError(f"isotropy_matrix: need as many selected as assigned velocities, disjoint; got "
                                f"{list(assigned)} and {list(selected)}")
@@ -72,11 +74,13 @@ def isotropy_matrix(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, .
 
 
 def isotropy_length(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...],
-                    selected: tuple[str, ...]) -> tuple[float, float]:
-    """Natural length and condition number of :func:`isotropy_matrix` at one configuration: ``(D [m], kappa)``.
+                    selected: tuple[str, ...], *, heading: ArrayLike | None = None) -> tuple[float, float]:
+    """Natural length and condition number of :func:`isotropy_matrix` at one configuration: ``(D [m], kappa)``;
+    steering `beta` (thesis) or `heading` (0 = rolling forward).
 
     Without omega among the velocities there is no D to choose: returns ``(nan, kappa)``.
     """
+    beta = robot.steering(beta, heading)
     if "omega" not in assigned + selected:
         return float("nan"), float(condition_number(isotropy_matrix(robot, beta, assigned, selected)))
     return _minimise_length(lambda d: float(condition_number(isotropy_matrix(robot, beta, assigned, selected,
@@ -178,15 +182,17 @@ def kappa_function(model: TwistModel, beta: np.ndarray):
     return lambda length: _fast.kappa_cm(model.mobility, rates, lines, float(length))
 
 
-def natural_length(robot: Robot, beta: ArrayLike | None = None, *,
-                   joints: tuple[str, ...] | None = None) -> tuple[float, float]:
+def natural_length(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple[str, ...] | None = None,
+                   heading: ArrayLike | None = None) -> tuple[float, float]:
     """The characteristic length minimising :func:`twist_condition_number` at one configuration: ``(D [m], kappa)``.
 
     m = 2: closed form ``D = |h_omega| / |h_v|``, the ratio of the column norms (equal diagonals of ``H^T H``,
     (5.50)-(5.51): D = l12 for a differential drive). m = 3: a 1-D search (D = sqrt(2) L for the isotropic
-    three-wheel omni robot). Where kappa does not depend on D (m = 1) D is the robot size.
+    three-wheel omni robot). Where kappa does not depend on D (m = 1) D is the robot size. Steering: `beta`
+    (thesis) or `heading` (0 = rolling forward), default as described.
     """
     model = twist_model(robot, joints)
+    beta = robot.steering(beta, heading)
     beta = robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
     if beta.ndim != 1:
         raise UnknownNameError("natural_length takes one configuration (shape (n_steer,))")
@@ -239,10 +245,11 @@ def golden_section(f, a: float, b: float, *, tol: float = 1e-13) -> float:
     return (a + b) / 2
 
 
-def condition_map(robot: Robot, beta: ArrayLike, *, joints: tuple[str, ...] | None = None,
-                  length: float | None = None) -> np.ndarray:
-    """:func:`twist_condition_number` over many configurations (the same kernel): ``(..., n_steer) -> (...)``.
+def condition_map(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple[str, ...] | None = None,
+                  length: float | None = None, heading: ArrayLike | None = None) -> np.ndarray:
+    """:func:`twist_condition_number` over many configurations (the same kernel): ``(..., n_steer) -> (...)``,
+    steering `beta` (thesis) or `heading` (0 = rolling forward).
 
     Closed-form eigenvalues in cache-sized chunks: 10^6 configurations in well under 2 s (benchmarks/).
     """
-    return twist_condition_number(robot, beta, joints=joints, length=length)
+    return twist_condition_number(robot, beta, joints=joints, length=length, heading=heading)

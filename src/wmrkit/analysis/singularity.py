@@ -32,27 +32,31 @@ from .lines import constraint_lines, element_rows, line_parameters
 SINGULAR_RTOL = 1e-8
 
 
-def is_singular_rank(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...]) -> np.ndarray:
+def is_singular_rank(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], *,
+                     heading: ArrayLike | None = None) -> np.ndarray:
     """Rank test (6.12): ``rank A_na < k - |assigned|``. ``(..., n_steer) -> (...)`` bool.
 
-    `assigned` are names from ``robot.velocity_names`` (twist components and wheel joint rates).
+    `assigned` are names from ``robot.velocity_names`` (twist components and wheel joint rates). Steering: `beta`
+    (thesis, None: as described) or `heading` (0 = rolling forward).
     """
     cols = [robot.velocity_index(n) for n in assigned]
-    a = nondimensional(robot).constraint_matrix(beta)  # the tolerance policy of kinematics.linalg
+    a = nondimensional(robot).constraint_matrix(robot.steering(beta, heading))  # kinematics.linalg's tolerances
     free = [j for j in range(a.shape[-1]) if j not in cols]
     return matrix_rank(a[..., free]) < len(free)
 
 
 def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], *,
-                rtol: float = SINGULAR_RTOL) -> np.ndarray:
+                rtol: float = SINGULAR_RTOL, heading: ArrayLike | None = None) -> np.ndarray:
     """Line test (6.17)-(6.20): the constraint lines G are concurrent or parallel. ``(..., n_steer) -> (...)`` bool.
 
     Also True when a wheel has joint rates the assigned set leaves undetermined (e.g. a double wheel with none of
     its joints assigned). Equals :func:`is_singular_rank` away from numerical ties. Uses an SVD per configuration
-    (accurate to machine precision); :func:`singularity_distance` is the fast measure for maps.
+    (accurate to machine precision); :func:`singularity_distance` is the fast measure for maps. Steering: `beta`
+    (thesis, None: as described) or `heading` (0 = rolling forward).
     """
     cl = constraint_lines(robot, assigned)
-    beta = robot.beta if beta is None else robot.steering(beta)
+    beta = robot.steering(beta, heading)
+    beta = robot.beta if beta is None else beta
     if cl.internal or len(cl.labels) < 3:
         return np.ones(beta.shape[:-1], bool)
     g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / robot_size(robot)])
@@ -61,14 +65,16 @@ def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...],
 
 
 def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], *,
-                         length: float | None = None) -> np.ndarray:
+                         length: float | None = None, heading: ArrayLike | None = None) -> np.ndarray:
     """Distance to singularity: ``sigma_min / sigma_max`` of the lines G (6.17), rows scaled to unit norm.
 
     ``(..., n_steer) -> (...)`` in [0, 1]; 0 exactly at singular configurations. The ``d_lambda`` column is
     divided by `length` [m] (default: the robot's size, :func:`robot_size`) so the measure has no units.
+    Steering: `beta` (thesis, None: as described) or `heading` (0 = rolling forward).
     """
     cl = constraint_lines(robot, assigned)
-    beta = robot.beta if beta is None else robot.steering(beta)
+    beta = robot.steering(beta, heading)
+    beta = robot.beta if beta is None else beta
     if cl.internal or len(cl.labels) < 3:
         return np.zeros(beta.shape[:-1])
     flat = beta.reshape(int(np.prod(beta.shape[:-1])), beta.shape[-1])

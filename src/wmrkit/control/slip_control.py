@@ -161,9 +161,11 @@ class SlipCommands:
 
 
 def slip_commands(inverse: SlipInverse, twist: ArrayLike, beta: ArrayLike | None = None, *,
-                  start: SlipCommands | None = None, tol: float = 1e-9, max_iter: int = 25) -> SlipCommands:
+                  start: SlipCommands | None = None, tol: float = 1e-9, max_iter: int = 25,
+                  heading: ArrayLike | None = None) -> SlipCommands:
     """Joint commands whose slip-model motion is `twist` ``(3,)`` (robot frame), at the current steering `beta`
-    (``(n_steer,)`` thesis β, default as described; castors stay there, commanded wheels start there).
+    (``(n_steer,)`` thesis β) or `heading` (0 = rolling forward), default as described; castors stay there,
+    commanded wheels start there.
 
     Warm start: the no-slip IK of `twist` (:func:`~wmrkit.kinematics.wheel_ik.wheel_commands`) plus `start`'s
     ``correction`` and its Jacobian (the previous instant's answer). Stops when the weighted error is below `tol`
@@ -171,6 +173,7 @@ def slip_commands(inverse: SlipInverse, twist: ArrayLike, beta: ArrayLike | None
     """
     robot = inverse.robot
     twist_d = as_vectors(twist, 3, "twist").astype(float)
+    beta = robot.steering(beta, heading)
     beta_now = np.array(robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta"), float)
     ik = wheel_commands(robot, twist_d, beta_now)
     spin_cols = [robot.rate_names.index(j) for j in inverse.assigned]

@@ -182,14 +182,16 @@ def steering_split(robot: Robot, steering: tuple[str, ...]) -> tuple[str, ...]:
 
 
 def actuation_analysis(
-    robot: Robot, beta: ArrayLike | None = None, actuated: Sequence[str] | None = None
+    robot: Robot, beta: ArrayLike | None = None, actuated: Sequence[str] | None = None, *,
+    heading: ArrayLike | None = None,
 ) -> ActuationAnalysis:
     """Analyse the actuators of `robot` (default: its described ``actuated`` joints) at `beta`, Fig. 4.4.
 
-    ``beta``: ``(..., n_steer)`` or None. See :class:`ActuationAnalysis` for ``.consistent``,
-    ``.sufficient``, ``.verdict`` and the actuated inverse solution ``.inverse``.
+    ``beta`` (thesis) or ``heading`` (0 = rolling forward): ``(..., n_steer)`` or None. See
+    :class:`ActuationAnalysis` for ``.consistent``, ``.sufficient``, ``.verdict`` and the actuated inverse
+    solution ``.inverse``.
     """
-    beta = configuration(robot, beta)
+    beta = configuration(robot, beta, heading)
     columns, steering = select_columns(robot, robot.actuated if actuated is None else actuated, "actuated")
     i_bar, j_u, j_nu, channels = coupled_split(robot, columns, beta)
     steering = linked_steering(robot.couplings, steering)
@@ -249,13 +251,15 @@ def trees_of(robot: Robot, beta: np.ndarray, sel: np.ndarray) -> TreeVerdict:
     return eliminated_tree(i_bar, j_sel, j_rest)
 
 
-def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None) -> tuple[tuple[str, ...], ...]:
+def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None, *,
+                          heading: ArrayLike | None = None) -> tuple[tuple[str, ...], ...]:
     """The smallest actuator choices with consistent actuation (Fig. 4.4 ``determined``) at every configuration.
 
     Each set has G (= m, B.3.8) wheel rates, followed by the ``steer`` joints of the centred steerable wheels,
-    which the thesis requires actuated. Empty when no choice of wheel rates works (e.g. m = 0).
+    which the thesis requires actuated. Empty when no choice of wheel rates works (e.g. m = 0). Steering: `beta`
+    (thesis) or `heading` (0 = rolling forward), default as described.
     """
-    beta = configuration(robot, beta)
+    beta = configuration(robot, beta, heading)
     m = np.unique(vehicle_dof(robot, beta))  # G = m unless a double wheel adds a self-motion (4.69)
     if len(m) != 1 or m[0] == 0:
         return ()

@@ -68,15 +68,16 @@ def extended_dof(robot: Robot) -> int:
 
 
 def extended_solution(
-    robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: ArrayLike | None = None
+    robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: ArrayLike | None = None, *,
+    heading: ArrayLike | None = None,
 ) -> ExtendedSolution:
     """Least-squares solution (4.11) for any assigned set at `beta`, eq. (4.82), with its slip residual.
 
     ``q_assigned``: ``(..., n_a)``; ``beta``: ``(..., n_steer)`` or None; they broadcast. For a set that is
     assignable (4.10) the residual is zero; with more than m assigned velocities it is zero only at the
-    steering angles of :func:`solve_steering`.
+    steering angles of :func:`solve_steering`. ``heading`` (0 = rolling forward) instead of ``beta``: the same.
     """
-    beta = configuration(robot, beta)
+    beta = configuration(robot, beta, heading)
     idx = velocity_indices(robot, assigned)
     q = as_vectors(q_assigned, len(idx), "q_assigned")
     q_dot, residual = solve_assigned(robot.constraint_matrix(beta), idx, q)

@@ -120,10 +120,12 @@ def _assignable(a: np.ndarray, subsets: np.ndarray, method: Method) -> np.ndarra
 
 
 def is_assignable(
-    robot: Robot, names: Sequence[str], beta: ArrayLike | None = None, *, method: Method = "ranks"
+    robot: Robot, names: Sequence[str], beta: ArrayLike | None = None, *, method: Method = "ranks",
+    heading: ArrayLike | None = None,
 ) -> np.ndarray:
-    """Whether the velocities `names` can be assigned, (4.5)/(4.6)/(4.10): ``(..., n_steer) -> (...)`` bool."""
-    a = nondimensional(robot).constraint_matrix(configuration(robot, beta))
+    """Whether the velocities `names` can be assigned, (4.5)/(4.6)/(4.10): ``(..., n_steer) -> (...)`` bool;
+    steering `beta` (thesis) or `heading` (0 = rolling forward)."""
+    a = nondimensional(robot).constraint_matrix(configuration(robot, beta, heading))
     return _assignable(a, velocity_indices(robot, names)[None, :], method)[0]
 
 
@@ -139,13 +141,14 @@ def _sets_at(robot: Robot, a: np.ndarray, method: Method) -> tuple[tuple[str, ..
 
 
 def assignable_sets(
-    robot: Robot, beta: ArrayLike | None = None, *, method: Method = "ranks"
+    robot: Robot, beta: ArrayLike | None = None, *, method: Method = "ranks", heading: ArrayLike | None = None,
 ) -> tuple[tuple[str, ...], ...]:
-    """Every set of m velocities that can be assigned at every configuration of `beta` (4.8: C(k, m) tests).
+    """Every set of m velocities that can be assigned at every configuration of `beta` (thesis) or `heading`
+    (0 = rolling forward) (4.8: C(k, m) tests).
 
     Sets are tuples of velocity names in the robot's order, listed lexicographically.
     """
-    return _sets_at(robot, nondimensional(robot).constraint_matrix(configuration(robot, beta)), method)
+    return _sets_at(robot, nondimensional(robot).constraint_matrix(configuration(robot, beta, heading)), method)
 
 
 def generic_configurations(robot: Robot) -> np.ndarray:

@@ -161,14 +161,16 @@ class SensingAnalysis:
 
 
 def sensing_analysis(
-    robot: Robot, beta: ArrayLike | None = None, sensed: Sequence[str] | None = None
+    robot: Robot, beta: ArrayLike | None = None, sensed: Sequence[str] | None = None, *,
+    heading: ArrayLike | None = None,
 ) -> SensingAnalysis:
     """Analyse the sensors of `robot` (default: its described ``sensed`` joints) at `beta`, Fig. 4.5.
 
-    ``beta``: ``(..., n_steer)`` or None. See :class:`SensingAnalysis` for ``.sufficient``,
-    ``.slip_detectable``, ``.verdict``, and the sensed direct solution ``.twist`` / ``.direct``.
+    ``beta`` (thesis) or ``heading`` (0 = rolling forward): ``(..., n_steer)`` or None. See
+    :class:`SensingAnalysis` for ``.sufficient``, ``.slip_detectable``, ``.verdict``, and the sensed direct
+    solution ``.twist`` / ``.direct``.
     """
-    beta = configuration(robot, beta)
+    beta = configuration(robot, beta, heading)
     columns, steering, i_bar, j_s, j_ns = _split(robot, sensed, beta)
     unit = nondimensional(robot)  # rank decisions: the tolerance policy of .linalg
     a = unit.constraint_matrix(beta)
@@ -187,15 +189,16 @@ def sensing_analysis(
 
 
 def minimal_sensor_sets(
-    robot: Robot, beta: ArrayLike | None = None, *, detect_slip: bool = False
+    robot: Robot, beta: ArrayLike | None = None, *, detect_slip: bool = False, heading: ArrayLike | None = None,
 ) -> tuple[tuple[str, ...], ...]:
     """The smallest sensor choices that determine the twist at every configuration (Fig. 4.5).
 
     ``detect_slip=False``: basic sensing (``determined``), G (= m) rates each; ``True``: the smallest sets with
     sufficient *redundant* sensors (``overdetermined``, slip detectable). Each set lists the wheel rates, then
-    the ``steer`` joints of the centred steerable wheels (their angle must be sensed, 4.33).
+    the ``steer`` joints of the centred steerable wheels (their angle must be sensed, 4.33). Steering: `beta`
+    (thesis) or `heading` (0 = rolling forward), default as described.
     """
-    beta = configuration(robot, beta)
+    beta = configuration(robot, beta, heading)
     m = np.unique(vehicle_dof(robot, beta))  # G = m unless a double wheel adds a self-motion (4.69)
     if len(m) != 1 or m[0] == 0:
         return ()

@@ -265,14 +265,16 @@ def forward_kinematics_check(
     return ForwardKinematics(_ro(q_dot[:3]), residual, _ro(wheel_slip), tolerance, consistent, slipping)
 
 
-def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: ArrayLike | None = None) -> np.ndarray:
-    """Whether the named rates fix the twist under no slip (all solutions share it). ``(..., n_steer) -> (...)``.
+def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: ArrayLike | None = None, *,
+                        heading: ArrayLike | None = None) -> np.ndarray:
+    """Whether the named rates fix the twist under no slip (all solutions share it). ``(..., n_steer) -> (...)``;
+    steering `beta` (thesis) or `heading` (0 = rolling forward).
 
     True iff ``rank(A_na) = n_twist_free + rank(A_rest)`` (4.10): ``A_na`` the columns not assigned, ``A_rest``
     those of the unknown joint rates, ``n_twist_free`` the twist components not assigned.
     """
     columns = _assigned_columns(robot, list(names))
-    a = robot.constraint_matrix(beta)
+    a = robot.constraint_matrix(robot.steering(beta, heading))
     free = np.setdiff1d(np.arange(a.shape[-1]), columns)
     rest = free[free >= 3]
     return readonly(np.asarray(matrix_rank(a[..., free]) == np.sum(free < 3) + matrix_rank(a[..., rest])))

@@ -132,10 +132,11 @@ def _assigned(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike) -> t
 
 
 def wls(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: ArrayLike | None = None,
-        weights: SlipWeights | None = None) -> SlipSolution:
-    """Weighted least squares (7.52): ``(..., n_a) -> SlipSolution``; `beta` ``(..., n_steer)`` or described."""
+        weights: SlipWeights | None = None, *, heading: ArrayLike | None = None) -> SlipSolution:
+    """Weighted least squares (7.52): ``(..., n_a) -> SlipSolution``; steering `beta` (thesis) or `heading`
+    (0 = rolling forward) ``(..., n_steer)``, default as described."""
     mu = (weights or SlipWeights()).row_mu(robot)
-    a = robot.constraint_matrix(beta)
+    a = robot.constraint_matrix(robot.steering(beta, heading))
     cols, q_a = _assigned(robot, assigned, q_assigned)
     q, _ = solve_assigned(np.sqrt(mu)[:, None] * a, cols, q_a)
     slip = (a @ q[..., None])[..., 0]
@@ -145,23 +146,26 @@ def wls(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: Arra
 
 def mcd(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, friction: FrictionLaw,
         beta: ArrayLike | None = None, *, loads: ArrayLike | None = None, start: SlipSolution | None = None,
-        tol: float = 1e-9) -> SlipSolution:
+        tol: float = 1e-9, heading: ArrayLike | None = None) -> SlipSolution:
     """Kinematic model with slip (7.63) generalised: ``A_na^T F(A q_dot) = 0`` (module docstring).
 
     `loads` ``(E,)`` [N], the static normal loads (default 1 N each: the law's own normalisation). Solved per
     sample by Newton's method (``scipy.optimize.root``) from `start` (default: the unweighted WLS solution).
+    Steering: `beta` (thesis) or `heading` (0 = rolling forward), default as described.
     """
-    return _solve(robot, assigned, q_assigned, friction, beta, loads, None, start, tol)
+    return _solve(robot, assigned, q_assigned, friction, robot.steering(beta, heading), loads, None, start, tol)
 
 
 def mqe(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, friction: FrictionLaw,
         beta: ArrayLike | None = None, *, body: Body | None = None, start: SlipSolution | None = None,
-        g: float = G, tol: float = 1e-9) -> SlipSolution:
+        g: float = G, tol: float = 1e-9, heading: ArrayLike | None = None) -> SlipSolution:
     """Quasi-static motion model (7.41)-(7.48): MCD plus the centripetal force and its load transfer (7.64).
 
-    `body`: the mass properties (default the robot's described ``body``).
+    `body`: the mass properties (default the robot's described ``body``). Steering: `beta` (thesis) or `heading`
+    (0 = rolling forward), default as described.
     """
-    return _solve(robot, assigned, q_assigned, friction, beta, None, (_body(robot, body), g), start, tol)
+    return _solve(robot, assigned, q_assigned, friction, robot.steering(beta, heading), None,
+                  (_body(robot, body), g), start, tol)
 
 
 def contact_positions(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
@@ -176,14 +180,15 @@ def contact_positions(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray
 
 
 def normal_loads(robot: Robot, body: Body | None = None, accel_cm: ArrayLike = (0.0, 0.0),
-                 beta: ArrayLike | None = None, g: float = G) -> np.ndarray:
+                 beta: ArrayLike | None = None, g: float = G, *, heading: ArrayLike | None = None) -> np.ndarray:
     """Normal loads (7.64) generalised to any contact layout: ``sum F_N = M g`` and the pitch and roll moments
     about the centre of mass balance the inertial moment of ``M a_cm`` at height ``h_cm``:
     ``sum F_N (p - c) = -h M a_cm``. ``(..., 2) -> (..., E)`` [N]. With more than three contacts the loads are
     statically indeterminate: the minimum-norm solution (equal loads on a symmetric layout) is returned.
-    The thesis's drive-torque reaction term of (7.64) is not included. `body`: default the robot's.
+    The thesis's drive-torque reaction term of (7.64) is not included. `body`: default the robot's. Steering:
+    `beta` (thesis) or `heading` (0 = rolling forward), default as described.
     """
-    body = _body(robot, body)
+    body, beta = _body(robot, body), robot.steering(beta, heading)
     a = np.asarray(accel_cm, dtype=float)
     h = body.com_height
     rhs = np.stack(np.broadcast_arrays(np.full(a.shape[:-1], body.mass * g), -h * body.mass * a[..., 0],
