@@ -13,7 +13,7 @@ from wmrkit.errors import WmrkitError
 from wmrkit.parking import Space, Vehicle, length_ratio, plan_parking, shortest_slot
 from wmrkit.parking.collisions import lateral_reach
 from wmrkit.parking.geometry import arcs_through, corner_distance
-from wmrkit.parking.planner import approach_point, pass_end
+from wmrkit.parking.planner import approach_point, first_reach, pass_end
 from wmrkit.parking.problem import load_problem
 
 
@@ -195,3 +195,17 @@ def test_the_parking_searches_refuse_their_options_by_name(search, options, mess
     with pytest.raises(WmrkitError) as err:
         search(vehicle, space, **options)
     assert str(err.value).startswith(message)
+
+
+def test_shortest_slot_over_a_huge_span_still_finds_the_window():
+    """Slots that work are not monotonic in H: past first_reach (2 rho at the smallest steering angle tried, 790 m
+    here) Algorithm 3 cannot enter them. With span=1e9 the scan's step grew to 5e5 m, jumped over every slot that
+    works, and answered None ('no length works'), though 5.32 m does; the scan now stops at that reach."""
+    vehicle = Vehicle(a1=3.5, b1=0.9, c1=1.8, h1=2.6, track=1.5, phi_max=0.6)
+    space = Space(H=7.0, J=2.5, MS=0.2, dx2=1.5, final_gap=0.1)
+    found = shortest_slot(vehicle, space)
+    assert found == pytest.approx(5.3246, abs=1e-3)
+    assert shortest_slot(vehicle, space, span=1e9) == pytest.approx(found, abs=1e-3)
+    reach = space.MS + vehicle.b1 + first_reach(vehicle)
+    assert plan_parking(vehicle, replace(space, H=reach - 1.0)).reason != plan_parking(
+        vehicle, replace(space, H=reach + 1.0)).reason  # the bound is where the planner's own reason changes

@@ -110,8 +110,7 @@ def plan_parking(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
         return fail(f"the slot is narrower (J = {sp.J:.4g} m) than the car (c1 = {v.c1:.4g} m)")
     first = approach_point(v, sp, pass_offset, phi_step)
     if first is None:
-        smallest = v.phi_max - (math.ceil(v.phi_max / phi_step) - 1) * phi_step
-        span = 2 * v.h1 / math.tan(smallest) if smallest > 0 else math.inf
+        span = first_reach(v, phi_step)
         if sp.H - sp.MS - v.b1 > span:
             return fail(f"the slot is longer than the first backward manoeuvre can span: Algorithm 3 reverses "
                         f"along the whole slot, at most 2 rho = {span:.4g} m at the smallest steering angle tried")
@@ -299,13 +298,22 @@ def maneuver_arcs(vehicle: Vehicle, free: float, room: float, direction: int) ->
     return hi, math.asin(free / (2 * hi))
 
 
+def first_reach(vehicle: Vehicle, phi_step: float = PHI_STEP) -> float:
+    """How far [m] Algorithm 3's first backward manoeuvre can reach along the slot: ``2 rho`` at the smallest
+    steering angle it tries (``phi_max`` down in steps of `phi_step`); a slot longer than ``MS + b1`` plus this
+    cannot be entered so."""
+    smallest = vehicle.phi_max - (math.ceil(vehicle.phi_max / phi_step) - 1) * phi_step
+    return 2 * vehicle.h1 / math.tan(smallest) if smallest > 0 else math.inf
+
+
 def shortest_slot(vehicle: Vehicle, space: Space, *, step: float = 0.01, span: float | None = None,
                   max_maneuvers: int = MAX_MANEUVERS) -> float | None:
     """The shortest slot length ``H`` [m] for which :func:`plan_parking` succeeds, the rest of `space` kept.
 
     Scans upward from ``a1 + b1 + 2 MS`` in steps of `step` over `span` (default ten car lengths, at least 10 m;
-    at most 2000 steps: the step grows for huge cars), then bisects the last step to 1 mm. None when no length in
-    the range works (e.g. the slot is too narrow).
+    never beyond the longest slot Algorithm 3 can enter, :func:`first_reach`; at most 2000 steps: the step grows
+    for huge cars), then bisects the last step to 1 mm. None when no length in the range works (e.g. the slot is
+    too narrow).
     """
     for name, value in (("step", step), ("span", span)):
         if value is not None and not 0 < value < math.inf:  # NaN included
@@ -313,6 +321,9 @@ def shortest_slot(vehicle: Vehicle, space: Space, *, step: float = 0.01, span: f
     _check_max_maneuvers(max_maneuvers)
     lo = vehicle.length + 2 * space.MS
     span = max(10.0, 10 * vehicle.length) if span is None else span
+    span = min(span, space.MS + vehicle.b1 + first_reach(vehicle) - lo)  # feasible slots are not monotonic in H:
+    if span <= 0:  # a coarse step over lengths no plan can enter would jump over the ones that work
+        return None
     step = max(step, span / 2000)
 
     def works(h: float) -> bool:
