@@ -298,3 +298,19 @@ def test_the_dynamics_refuse_a_steered_wheel_nothing_steers():
             track(free, circle, dynamics=True, duration=1, **kwargs)
     check_steering_driven(_double_unit(["-10 deg", "10 deg"], actuated=("steer", "spin1", "spin2")))
     check_steering_driven(truck)
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    (lambda: choose_steering([math.nan], [1.0], [0.0]), "heading: expected finite numbers, got nan"),
+    (lambda: choose_steering([0.0, 1.0], [1.0], [0.0, 0.0, 0.0]),
+     r"shapes that do not broadcast together: heading \(2,\), spin \(1,\), current \(3,\)"),
+    (lambda: crab_twist([1.0, 2.0], [0.0, 1.0, 2.0]), r"speed \(2,\), direction \(3,\)"),
+    (lambda: icr_twist(np.zeros((4, 2)), [1.0, 2.0]), r"icr_xy\[\.\.\., 0\] \(4,\).*omega \(2,\)"),
+    (lambda: ackermann_twist(1.0, math.inf), "curvature: expected finite numbers, got inf"),  # was [1, nan, inf]
+    (lambda: discretize_twist([1.0, 0.0, 1.0], math.nan), "dt = nan"),  # was NaN
+    (lambda: discretize_twist([1.0, 0.0, 1.0], -0.1), "dt = -0.1"),
+])
+def test_the_steering_helpers_refuse_what_they_cannot_use_by_name(call, message):
+    """Found by the audit of the Python doors: numpy's broadcast errors, or NaN results, before."""
+    with pytest.raises(ControlError, match=message):
+        call()

@@ -34,6 +34,20 @@ __all__ = ["POLICIES", "SteeringChoice", "ackermann_twist", "choose_steering", "
 POLICIES = ("closest", "4-quadrant", "2-quadrant")
 
 
+def _finite(named: dict[str, ArrayLike]) -> list[np.ndarray]:
+    """The named arrays broadcast together, as floats; a :class:`ControlError` naming the argument for a NaN or an
+    infinity, or naming both for shapes that do not broadcast (instead of numpy's message, or NaN results)."""
+    arrays = {name: np.asarray(value, dtype=float) for name, value in named.items()}
+    for name, a in arrays.items():
+        if not np.isfinite(a).all():
+            raise ControlError(f"{name}: expected finite numbers, got {a.ravel()[~np.isfinite(a.ravel())][0]}")
+    try:
+        return list(np.broadcast_arrays(*arrays.values()))
+    except ValueError:
+        shapes = ", ".join(f"{name} {a.shape}" for name, a in arrays.items())
+        raise ControlError(f"shapes that do not broadcast together: {shapes}") from None
+
+
 def steer_ranges(robot: Robot) -> np.ndarray:
     """``(n_steer, 2)`` heading ranges [rad] of the steering wheels; ``(-inf, inf)`` where none is described."""
     out = np.tile([-np.inf, np.inf], (len(robot.steer_names), 1))
@@ -80,10 +94,9 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
     """
     if policy not in POLICIES:
         raise ControlError(f"unknown steering policy '{policy}' (policies: {', '.join(POLICIES)})")
-    h0 = wrap_angle(np.asarray(heading, dtype=float))
-    s0 = np.asarray(spin, dtype=float)
+    h0, s0, cur = _finite({"heading": heading, "spin": spin, "current": current})
+    h0 = wrap_angle(h0)
     h1, s1 = wrap_angle(h0 + math.pi), -s0
-    cur = np.asarray(current, dtype=float)
     if policy == "4-quadrant":
         pref0 = s0 >= 0
     elif policy == "2-quadrant":
@@ -177,7 +190,7 @@ def range_keeper(robot: Robot) -> Callable[[np.ndarray, np.ndarray], np.ndarray]
 # ---- swerve motion modes ------------------------------------------------------------------------------------
 def crab_twist(speed: ArrayLike, direction: ArrayLike) -> np.ndarray:
     """Crab (translation only): every wheel at heading `direction` [rad]. ``(...), (...) -> (..., 3)``."""
-    v, d = np.broadcast_arrays(np.asarray(speed, dtype=float), np.asarray(direction, dtype=float))
+    v, d = _finite({"speed": speed, "direction": direction})
     return np.stack([v * np.cos(d), v * np.sin(d), np.zeros_like(v)], axis=-1)
 
 
@@ -185,15 +198,15 @@ def icr_twist(icr_xy: ArrayLike, omega: ArrayLike) -> np.ndarray:
     """Rotation at rate `omega` [rad/s] about an arbitrary ICR ``(x, y)`` [m, robot frame] (§5.4, ros2_controllers
     #2000): the origin's velocity is ``omega z x (0 - c) = omega (c_y, -c_x)``. ``(..., 2), (...) -> (..., 3)``."""
     c = as_vectors(icr_xy, 2, "icr_xy")
-    w = np.asarray(omega, dtype=float)
-    return np.stack([w * c[..., 1], -w * c[..., 0], np.broadcast_to(w, c.shape[:-1])], axis=-1)
+    cx, cy, w = _finite({"icr_xy[..., 0]": c[..., 0], "icr_xy[..., 1]": c[..., 1], "omega": omega})
+    return np.stack([w * cy, -w * cx, w], axis=-1)
 
 
 def ackermann_twist(speed: ArrayLike, curvature: ArrayLike, axle_x: float = 0.0) -> np.ndarray:
     """Ackermann mode: ICR on the line ``x = axle_x`` (a virtual rear axle), `speed` [m/s] of the point
     ``(axle_x, 0)``, `curvature` [1/m]; finite for curvature 0. ``(...), (...) -> (..., 3)``."""
-    v, k = np.broadcast_arrays(np.asarray(speed, dtype=float), np.asarray(curvature, dtype=float))
-    return np.stack([v, -v * k * axle_x, v * k], axis=-1)
+    v, k, x = _finite({"speed": speed, "curvature": curvature, "axle_x": axle_x})
+    return np.stack([v, -v * k * x, v * k], axis=-1)
 
 
 def discretize_twist(twist_robot: ArrayLike, dt: float) -> np.ndarray:
@@ -204,6 +217,8 @@ def discretize_twist(twist_robot: ArrayLike, dt: float) -> np.ndarray:
     from ..odometry.integrators import sinc
 
     t = as_vectors(twist_robot, 3, "twist_robot")
+    if not (0 < dt < math.inf) or not np.isfinite(t).all():  # NaN included
+        raise ControlError(f"discretize_twist: expected a finite twist and a period dt > 0 s, got dt = {dt}")
     h = 0.5 * t[..., 2] * dt
     c, s, k = np.cos(h), np.sin(h), 1.0 / sinc(h)
     vx = k * (c * t[..., 0] + s * t[..., 1])
