@@ -191,7 +191,7 @@ class Robot:
         from ._constraint_kernel import fill_constraint_rows
 
         if frame not in ("roller", "robot"):
-            raise ValueError(f"frame must be 'roller' or 'robot', got {frame!r}")
+            raise ShapeError(f"frame must be 'roller' or 'robot', got {frame!r}")
         t = element_table(self)
         beta_e = element_beta(self, self.steering(beta, heading))  # (..., E)
         flat = beta_e.reshape(-1, t.n_elements)

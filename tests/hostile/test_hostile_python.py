@@ -5,9 +5,14 @@ the argument."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
+import wmrkit
+import wmrkit.analysis
+import wmrkit.slip
 from wmrkit import catalog, direct_model, forward_kinematics, inverse_model, mobility, wheel_commands
 from wmrkit.analysis import icr, is_singular, singularity_distance
 from wmrkit.errors import ShapeError, WmrkitError
@@ -216,3 +221,17 @@ def test_the_slip_models_refuse_their_inputs_by_name(call, message):
     with pytest.raises(WmrkitError) as err:
         call(slip, robot, ["front_left.spin", "front_right.spin"])
     assert str(err.value).startswith(message)
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    (lambda: wmrkit.analysis.classify(catalog.load("forklift"), samples=0), r"samples must be an integer in \[1, "),
+    (lambda: wmrkit.analysis.classify(catalog.load("forklift"), seed=-1), "seed must be an integer >= 0"),
+    (lambda: catalog.load("forklift").constraint_matrix(frame="x"), "frame must be 'roller' or 'robot'"),
+    (lambda: wmrkit.slip.normal_loads(catalog.load("forklift"), g=math.nan), "g = nan"),  # NaN loads
+    (lambda: wmrkit.slip.normal_loads(catalog.load("forklift"), accel_cm=(math.nan, 0.0)), "finite accelerations"),
+])
+def test_more_python_doors_refuse_by_name(call, message):
+    """From the audit of the Python doors: numpy's ValueError for classify(samples=0) or seed=-1, a plain
+    ValueError (not a WmrkitError) for an unknown frame, NaN loads for a NaN gravity or acceleration."""
+    with pytest.raises(WmrkitError, match=message):
+        call()

@@ -24,7 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..errors import WmrkitError
 from ..kinematics.linalg import characteristic_length, matrix_rank
+from ..limits import check_seed
 from ..robot import Robot
 from .icr import steer_to_icr
 from .lines import constraint_lines, line_residual
@@ -95,6 +97,9 @@ def classify(robot: Robot, *, samples: int = 8, seed: int = 0) -> Classification
 
     `samples` random admissible configurations (axles aimed at random ICRs) give the generic ranks.
     """
+    if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or not 1 <= samples <= 10_000:
+        raise WmrkitError(f"samples must be an integer in [1, 10000], got {samples!r}")
+    check_seed(seed, WmrkitError)
     cl = constraint_lines(robot)
     steer = set(robot.steer_names)
     fixed_rows = [i for i, w in enumerate(cl.wheels) if w not in steer]

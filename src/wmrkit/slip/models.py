@@ -190,6 +190,9 @@ def normal_loads(robot: Robot, body: Body | None = None, accel_cm: ArrayLike = (
     """
     body, beta = _body(robot, body), robot.steering(beta, heading)
     a = np.asarray(accel_cm, dtype=float)
+    if not (0 < g < np.inf) or a.shape[-1:] != (2,) or not np.isfinite(a).all():
+        raise WmrkitError(f"normal_loads: expected a gravity g > 0 and finite accelerations accel_cm (..., 2), got "
+                          f"g = {g}, accel_cm of shape {a.shape}")
     h = body.com_height
     rhs = np.stack(np.broadcast_arrays(np.full(a.shape[:-1], body.mass * g), -h * body.mass * a[..., 0],
                                        -h * body.mass * a[..., 1]), axis=-1)
