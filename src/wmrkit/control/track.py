@@ -252,26 +252,28 @@ MAX_CONTINUOUS_SAMPLES = 40_000
 
 def _check_continuous_work(cp: ControlPoint, reference: Reference, pose0: np.ndarray, duration: float,
                            output_dt: float, gain: float | None) -> None:
-    """Refuse up front a continuous kinematic loop that would run for minutes: too long a run, or (a robot with
-    fixed wheels under a law) a start so far from the reference that the law commands beyond ``MAX_SPEED``: the
-    heading then turns at ``speed / |point|``, and the explicit integrator crawls until its evaluation budget
-    ends (``--from 1e9 1e9 3``: 50 s before 'too stiff')."""
+    """Refuse up front a continuous kinematic loop that would run for minutes, or command an impossible speed: too
+    long a run, or (under a law) a start so far from the reference that the law commands beyond ``MAX_SPEED``.
+    With fixed wheels the heading then turns at ``speed / |point|``, and the explicit integrator crawls until its
+    evaluation budget ends (``--from 1e9 1e9 3``: 50 s before 'too stiff'); without, the run would report motion
+    at that speed (or, beyond 1e6 m/s, a loop 'diverged at t = 0')."""
     if duration / output_dt > MAX_CONTINUOUS_SAMPLES:
         raise ControlError(f"duration {duration:g} s (--duration, or the reference's length at its --speed and "
                            f"--size): a continuous loop simulates at most {MAX_CONTINUOUS_SAMPLES * output_dt:g} s "
                            f"({MAX_CONTINUOUS_SAMPLES} output samples of {output_dt:g} s, about 1 min of computing); "
                            "give a shorter --duration, or a sample period (--period)")
-    if gain is None or not cp.reduced:
+    if gain is None:
         return
     distance = float(np.hypot(*(point_pose(cp, pose0)[:2] - reference.pose[0, :2])))
     speed = gain * distance + float(np.hypot(*reference.velocity[0, :2]))
     if speed > MAX_SPEED:
         reach = max(0.0, MAX_SPEED - float(np.hypot(*reference.velocity[0, :2]))) / gain
+        why = (f"the continuous loop would be too stiff to integrate (the heading turns at that speed over "
+               f"{float(np.hypot(*cp.point)):.3g} m)" if cp.reduced else "no wheeled robot moves so fast")
         raise ControlError(f"initial pose (--from): the controlled point starts {distance:.4g} m from the reference, "
-                           f"and the law commands {speed:.4g} m/s at t = 0, beyond {MAX_SPEED:g} m/s: the continuous "
-                           f"loop would be too stiff to integrate (the heading turns at that speed over "
-                           f"{float(np.hypot(*cp.point)):.3g} m); start closer to the reference (within {reach:.4g} m "
-                           "at this gain), lower the gain, or give a sample period (--period)")
+                           f"and the law commands {speed:.4g} m/s at t = 0, beyond {MAX_SPEED:g} m/s: {why}; start "
+                           f"closer to the reference (within {reach:.4g} m at this gain), lower the gain, or give a "
+                           "sample period (--period)")
 
 
 #: Integration step of the loops through the dynamics [s] (their default).
