@@ -70,3 +70,12 @@ def test_errors_exit_2(capsys, argv):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith("wmrkit: error:") and "Traceback" not in err
+
+
+def test_montecarlo_refuses_a_built_in_path_the_robot_cannot_steer(capsys):
+    # the square turns in place: the car's front wheels would steer to -74 deg, beyond their +-40 deg; the run was
+    # integrated anyway and its covariance printed with exit 0 (smoke matrix)
+    assert main(["batch", "montecarlo", "ackermann", "--path", "square", "-n", "3", "--workers", "0", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "wheel 'front_left' would steer to heading" in err and "steer_range [-40, 40] deg" in err
+    assert len(err.strip().splitlines()) == 1

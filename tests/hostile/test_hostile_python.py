@@ -117,6 +117,31 @@ def test_a_synthetic_run_refuses_its_arguments_by_name(options, message):
     assert str(err.value).startswith(message)
 
 
+def test_a_synthetic_profile_without_segments_is_refused_by_name():
+    # TwistProfile.from_segments([]) was accepted and simulate() then raised numpy's 'zero-size array to reduction
+    # operation maximum' ValueError (found by the smoke matrix: a skid steer's twists projected to nothing)
+    from wmrkit import odometry
+
+    with pytest.raises(WmrkitError, match=r"^profile: expected at least one segment"):
+        odometry.TwistProfile.from_segments([])
+
+
+@pytest.mark.parametrize(("profile", "wheel"), [
+    (lambda o: o.square_path(2.0, speed=0.5, turn_rate=0.5), "front_left"),  # turns in place: -74 deg
+    (lambda o: o.TwistProfile.from_segments([(2.0, 0.5, 0.0, 0.3)]), "front_left"),  # 2.7 m wheelbase, r 1.7 m
+])
+def test_a_synthetic_run_refuses_a_profile_beyond_a_wheels_steer_range(profile, wheel):
+    # simulate() steered the catalog car's front wheels to -74 deg (steer_range +-40 deg) without a word: the log it
+    # wrote was refused by 'wmrkit odometry' ('outside the wheel's steer_range'), and 'wmrkit batch montecarlo
+    # ackermann --path square' integrated the impossible path and printed its covariance (exit 0; smoke matrix)
+    from wmrkit import odometry
+
+    with pytest.raises(WmrkitError, match=rf"^profile: at t = [0-9.]+ s wheel '{wheel}' would steer to heading "
+                                          r"-?[0-9.]+ deg, outside its steer_range \[-40, 40\] deg"):
+        odometry.simulate(catalog.load("ackermann"), profile(odometry), 20.0)
+    odometry.simulate(catalog.load("ackermann"), odometry.TwistProfile.from_segments([(2.0, 1.5, 0.0, 0.3)]), 20.0)
+
+
 @pytest.mark.parametrize("name", ["swerve-4", "forklift"])
 @pytest.mark.parametrize("noise", [False, True], ids=["fused", "model"])
 def test_a_steering_angle_beyond_a_million_turns_in_a_log_is_named_at_its_sample(name, noise):

@@ -28,7 +28,8 @@ CASES = {
     "omni-3": (TwistProfile.from_segments([(3.0, 0.2, -0.3, 0.5)]), 1e-9),
     "omni-4": (TwistProfile.from_segments([(3.0, 0.2, 0.3, -0.5)]), 1e-9),
     "swerve-4": (TwistProfile.from_segments([(2.0, 0.3, 0.3, 0.0), (1.0, 0, 0, 0), (2.0, 0.4, 0.0, 0.3)]), 1e-3),
-    "ackermann": (TwistProfile.from_segments([(3.0, 0.5, 0.0, 0.2), (1.0, 0, 0, 0), (3.0, 0.5, 0.0, -0.3)]), 1e-3),
+    # within the car's +-40 deg steer_range (at 0.5 m/s these turns steered the inner wheel to 57 and 71 deg)
+    "ackermann": (TwistProfile.from_segments([(3.0, 1.5, 0.0, 0.2), (1.0, 0, 0, 0), (3.0, 1.5, 0.0, -0.3)]), 1e-3),
     "forklift": (square_path(3.0, pause=1.0).about((-1.0, 0.0)), 1e-3),
 }
 

@@ -44,6 +44,8 @@ class TwistProfile:
         d, tw = np.asarray(self.durations, dtype=float), np.asarray(self.twists, dtype=float)
         if d.ndim != 1 or tw.shape != (len(d), 3):
             raise WmrkitError(f"profile: expected durations (S,) and twists (S, 3), got {d.shape} and {tw.shape}")
+        if not len(d):
+            raise WmrkitError("profile: expected at least one segment, got none")
         if not (d > 0).all() or not np.isfinite(d).all():
             raise WmrkitError("every segment needs a finite duration > 0 s")
         if not (np.abs(tw) <= MAX_SPEED).all():  # NaN included
@@ -155,6 +157,7 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     dt = np.diff(fine)
     twist = profile.at(0.5 * (fine[:-1] + fine[1:]))  # (M, 3)
     beta_nodes, beta_mid = _steering(robot, profile, fine, twist, sensed)  # (M + 1, n_steer), (M, n_steer)
+    _check_steer_range(robot, beta_nodes, fine, twist)
     configs, index = np.unique(beta_mid, axis=0, return_inverse=True)  # one solve per distinct configuration
     # Assigned: the twist, and the steering rates of the steered wheels that have one among the velocities (a double
     # wheel's sub-wheels roll to turn it, (3.24)): their angles are the geometry's, not a least-squares choice.
@@ -257,6 +260,26 @@ def _steering(robot: Robot, profile: TwistProfile, fine: np.ndarray, twist: np.n
         out[:, k] = _nodes_from_intervals(np.where(moving, b, np.nan), fine, wheel.beta)
         mid[:, k] = np.where(moving, b, 0.5 * (out[:-1, k] + out[1:, k]))
     return out, mid
+
+
+def _check_steer_range(robot: Robot, beta_nodes: np.ndarray, fine: np.ndarray, twist: np.ndarray) -> None:
+    """Refuse a profile that steers a steerable or double wheel beyond its described ``steer_range`` (the log
+    readers refuse such a heading, :func:`.steering.check_steer_range`): the robot cannot drive it."""
+    heading = robot.heading_of_beta(beta_nodes)  # (M + 1, n_steer)
+    for k, name in enumerate(robot.steer_names):
+        wheel = robot.wheel(name)
+        if wheel.steer_range is None or wheel.type not in ("steerable", "double"):
+            continue
+        lo, hi = wheel.steer_range
+        h = lo + (heading[:, k] - lo) % (2 * np.pi)  # the turn of each heading nearest above lo
+        bad = np.flatnonzero(h > hi + 1e-9)
+        if bad.size:
+            i = int(bad[0])
+            value = (heading[i, k] + np.pi) % (2 * np.pi) - np.pi
+            raise WmrkitError(f"profile: at t = {fine[i]:.6g} s wheel '{name}' would steer to heading "
+                              f"{np.degrees(value):.6g} deg, outside its steer_range [{np.degrees(lo):.6g}, "
+                              f"{np.degrees(hi):.6g}] deg (twist {twist[min(i, len(twist) - 1)].tolist()}): "
+                              f"robot '{robot.name}' cannot drive this profile")
 
 
 def _nodes_from_intervals(b: np.ndarray, fine: np.ndarray, default: float) -> np.ndarray:
