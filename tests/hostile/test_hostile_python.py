@@ -254,9 +254,27 @@ def test_the_slip_models_refuse_their_inputs_by_name(call, message):
     (lambda: catalog.load("forklift").constraint_matrix(frame="x"), "frame must be 'roller' or 'robot'"),
     (lambda: wmrkit.slip.normal_loads(catalog.load("forklift"), g=math.nan), "g = nan"),  # NaN loads
     (lambda: wmrkit.slip.normal_loads(catalog.load("forklift"), accel_cm=(math.nan, 0.0)), "finite accelerations"),
+    (lambda: wmrkit.slip.closure_error(np.zeros((0, 3))), r"at least 2 poses \(N, 3\), got shape \(0, 3\)"),
+    (lambda: wmrkit.slip.closure_error(np.zeros((4, 2))), r"poses: expected shape \(\.\.\., 3\)"),  # IndexError
+    (lambda: _blackburn(math.nan), "rho = nan m: a finite radius >= c1/2"),  # NaN length before
+    (lambda: _line_position(focal_px=0.0), "focal_px: expected a finite number > 0, got 0.0"),  # ZeroDivisionError
+    (lambda: _line_position(tilt=math.nan), "tilt, z_p, spacing: expected finite numbers"),  # NaN pose before
 ])
 def test_more_python_doors_refuse_by_name(call, message):
     """From the audit of the Python doors: numpy's ValueError for classify(samples=0) or seed=-1, a plain
     ValueError (not a WmrkitError) for an unknown frame, NaN loads for a NaN gravity or acceleration."""
     with pytest.raises(WmrkitError, match=message):
         call()
+
+
+def _blackburn(rho: float) -> float:
+    from wmrkit.parking import Vehicle
+    from wmrkit.parking.geometry import blackburn_min_length
+
+    return blackburn_min_length(Vehicle(a1=3.5, b1=0.9, c1=1.8, h1=2.6, track=1.5, phi_max=0.6), rho)
+
+
+def _line_position(focal_px: float = 500.0, tilt: float = 0.3):
+    from wmrkit.vision.positioning import line_position
+
+    return line_position([[10.0, 40.0], [-5.0, 80.0]], 0, focal_px=focal_px, tilt=tilt, height=0.5)

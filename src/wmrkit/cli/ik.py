@@ -37,7 +37,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = commands.add_parser("fk", help="body twist from joint rates by least squares (thesis 4.11)")
     add_robot_argument(p)
     p.add_argument("--spin", action="append", metavar="NAME=RATE", default=[],
-                   help="a joint rate [rad/s]: a wheel name means its spin, or 'wheel.joint' (repeat)")
+                   help="a joint rate [rad/s]: a wheel name means its spin, or 'wheel.joint'; also vx, vy [m/s] "
+                        "or omega [rad/s] (a gyro) (repeat)")
     add_steer_option(p, "heading of a steered wheel (default: as described)")
     add_json_flag(p)
     p.set_defaults(run=run_fk)

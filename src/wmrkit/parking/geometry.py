@@ -187,8 +187,9 @@ def blackburn_min_length(vehicle: Vehicle, rho: float | None = None) -> float:
     S. Blackburn, "The geometry of perfect parking", Royal Holloway, University of London (2009).
     """
     rho = max(vehicle.rho_min, vehicle.c1 / 2) if rho is None else rho
-    if rho < vehicle.c1 / 2:
-        raise WmrkitError(f"blackburn_min_length: rho = {rho:.6g} m < c1/2: the ICR lies inside the body")
+    if not rho >= vehicle.c1 / 2 or not math.isfinite(rho):  # NaN included
+        raise WmrkitError(f"blackburn_min_length: rho = {rho:.6g} m: a finite radius >= c1/2 (an ICR outside the "
+                          "body) is needed")
     return vehicle.b1 + math.sqrt(vehicle.a1**2 + 2 * rho * vehicle.c1)
 
 

@@ -7,6 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._shapes import as_vectors
 from ..errors import WmrkitError
 from ..odometry.model import wrap_angle
 
@@ -29,8 +30,10 @@ def closure_error(poses: ArrayLike, truth_final: ArrayLike | None = None) -> tup
     The error is against the start pose (a closed manoeuvre, as in the thesis's experiments) or, with
     `truth_final` ``(3,)``, against the true final pose (synthetic runs, whose open-loop paths do not close).
     """
-    p = np.asarray(poses, dtype=float)
-    goal = p[0] if truth_final is None else np.asarray(truth_final, dtype=float)
+    p = as_vectors(poses, 3, "poses")
+    if p.ndim != 2 or len(p) < 2:
+        raise WmrkitError(f"closure_error: poses must be a path of at least 2 poses (N, 3), got shape {p.shape}")
+    goal = p[0] if truth_final is None else as_vectors(truth_final, 3, "truth_final").reshape(3)
     steps = np.diff(p, axis=0)
     distance = float(np.sum(np.hypot(steps[:, 0], steps[:, 1])))
     rotation = float(np.sum(np.abs(wrap_angle(steps[:, 2]))))

@@ -39,6 +39,11 @@ def line_position(points_u: ArrayLike, n: ArrayLike, *, focal_px: float, tilt: f
     p = np.asarray(points_u, dtype=float)
     if p.shape[-2:] != (2, 2):
         raise ShapeError(f"points_u: expected shape (..., 2, 2), got {p.shape}")
+    for name, value in (("focal_px", focal_px), ("height", height)):
+        if not 0 < value < math.inf:  # NaN included
+            raise ShapeError(f"{name}: expected a finite number > 0, got {value}")
+    if not (math.isfinite(tilt) and math.isfinite(z_p) and math.isfinite(spacing)):
+        raise ShapeError(f"tilt, z_p, spacing: expected finite numbers, got {tilt}, {z_p}, {spacing}")
     x1, y1, x2, y2 = p[..., 0, 0], p[..., 0, 1], p[..., 1, 0], p[..., 1, 1]
     cf, sf = math.cos(tilt), math.sin(tilt)
     dy = y1 - y2
