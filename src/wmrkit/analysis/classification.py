@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike
 
 from ..errors import WmrkitError
 from ..kinematics.linalg import characteristic_length, matrix_rank
+from ..kinematics.models import configuration
 from ..limits import check_seed
 from ..robot import Robot
 from .icr import steer_to_icr
@@ -83,8 +84,7 @@ def instantaneous_mobility(robot: Robot, beta: ArrayLike | None = None, *,
 
     Equals ``k - rank A`` (6.8) for robots whose wheel rates are all fixed by the twist (all but double wheels).
     """
-    beta = robot.steering(beta, heading)
-    beta = robot.beta if beta is None else beta
+    beta = configuration(robot, beta, heading)
     cl = constraint_lines(robot)
     if not cl.labels:
         return np.full(beta.shape[:-1], 3)

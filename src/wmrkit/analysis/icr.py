@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
 from ..kinematics.linalg import characteristic_length, matrix_rank
+from ..kinematics.models import configuration
 from ..robot import Robot
 from .lines import common_point, constraint_lines, element_rows
 
@@ -77,8 +78,7 @@ def format_coordinate(x: float) -> str:
 def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None) -> ICRSet:
     """The admissible ICRs of `robot` at one steering configuration ``(n_steer,)`` (5.9)-(5.10), given as the
     thesis's `beta` or the users' `heading` (default the described one)."""
-    beta = robot.steering(beta, heading)
-    beta = robot.beta if beta is None else beta
+    beta = configuration(robot, beta, heading)
     g = constraint_lines(robot).lines(beta)
     rank = int(matrix_rank(g * [1.0, 1.0, 1.0 / characteristic_length(robot)])) if len(g) else 0  # nondimensional
     if rank == 0:
@@ -102,8 +102,7 @@ def icr_points(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLik
     Meaningful where the robot has one degree of mobility (types 4 and 5, eqs. 5.18-5.21 corrected): then it is
     the ICR. Least-squares nearest point otherwise.
     """
-    beta = robot.steering(beta, heading)
-    return common_point(constraint_lines(robot).lines(robot.beta if beta is None else beta))
+    return common_point(constraint_lines(robot).lines(configuration(robot, beta, heading)))
 
 
 def steer_to_icr(robot: Robot, icr_h: ArrayLike) -> np.ndarray:

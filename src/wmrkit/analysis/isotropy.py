@@ -26,8 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, readonly
+from .._shapes import readonly
 from ..errors import UnknownNameError
+from ..kinematics.models import configuration
 from ..robot import Robot
 from . import _fast
 from .classification import classify
@@ -151,8 +152,7 @@ def twist_condition_number(robot: Robot, beta: ArrayLike | None = None, *, joint
     defined: isotropy does not apply to types 4 and 5 (§5.5.4-5.5.5). Steering as `beta` or `heading`.
     """
     model = twist_model(robot, joints)
-    beta = robot.steering(beta, heading)
-    beta = robot.beta if beta is None else beta
+    beta = configuration(robot, beta, heading)
     if length is None:
         length = natural_length(robot, joints=model.joints)[0]
     else:
@@ -192,8 +192,7 @@ def natural_length(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple
     (thesis) or `heading` (0 = rolling forward), default as described.
     """
     model = twist_model(robot, joints)
-    beta = robot.steering(beta, heading)
-    beta = robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta")
+    beta = configuration(robot, beta, heading)
     if beta.ndim != 1:
         raise UnknownNameError("natural_length takes one configuration (shape (n_steer,))")
     size = robot_size(robot)

@@ -24,6 +24,7 @@ from scipy.optimize import minimize
 
 from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import matrix_rank, nondimensional
+from ..kinematics.models import configuration
 from ..robot import Robot
 from . import _fast
 from .lines import constraint_lines, element_rows, line_parameters
@@ -40,7 +41,7 @@ def is_singular_rank(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, 
     (thesis, None: as described) or `heading` (0 = rolling forward).
     """
     cols = [robot.velocity_index(n) for n in assigned]
-    a = nondimensional(robot).constraint_matrix(robot.steering(beta, heading))  # kinematics.linalg's tolerances
+    a = nondimensional(robot).constraint_matrix(beta, heading=heading)  # kinematics.linalg's tolerances
     free = [j for j in range(a.shape[-1]) if j not in cols]
     return matrix_rank(a[..., free]) < len(free)
 
@@ -55,8 +56,7 @@ def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...],
     (thesis, None: as described) or `heading` (0 = rolling forward).
     """
     cl = constraint_lines(robot, assigned)
-    beta = robot.steering(beta, heading)
-    beta = robot.beta if beta is None else beta
+    beta = configuration(robot, beta, heading)
     if cl.internal or len(cl.labels) < 3:
         return np.ones(beta.shape[:-1], bool)
     g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / robot_size(robot)])
@@ -73,8 +73,7 @@ def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[s
     Steering: `beta` (thesis, None: as described) or `heading` (0 = rolling forward).
     """
     cl = constraint_lines(robot, assigned)
-    beta = robot.steering(beta, heading)
-    beta = robot.beta if beta is None else beta
+    beta = configuration(robot, beta, heading)
     if cl.internal or len(cl.labels) < 3:
         return np.zeros(beta.shape[:-1])
     flat = beta.reshape(int(np.prod(beta.shape[:-1])), beta.shape[-1])

@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, readonly
 from ..dynamics.mass import Body
 from ..errors import WmrkitError
+from ..kinematics.models import configuration
 from ..kinematics.wheel_ik import wheel_commands
 from ..robot import Robot
 from ..slip.models import FrictionLaw, G, SlipSolution, mcd, mqe, tyre_friction
@@ -173,8 +174,7 @@ def slip_commands(inverse: SlipInverse, twist: ArrayLike, beta: ArrayLike | None
     """
     robot = inverse.robot
     twist_d = as_vectors(twist, 3, "twist").astype(float)
-    beta = robot.steering(beta, heading)
-    beta_now = np.array(robot.beta if beta is None else as_vectors(beta, len(robot.steer_names), "beta"), float)
+    beta_now = np.array(configuration(robot, beta, heading), dtype=float)
     ik = wheel_commands(robot, twist_d, beta_now)
     spin_cols = [robot.rate_names.index(j) for j in inverse.assigned]
     u_ik = np.concatenate([np.nan_to_num(np.asarray(ik.rates)[spin_cols]), np.asarray(ik.beta)[inverse.steered]])

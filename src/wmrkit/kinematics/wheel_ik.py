@@ -274,7 +274,7 @@ def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: 
     those of the unknown joint rates, ``n_twist_free`` the twist components not assigned.
     """
     columns = _assigned_columns(robot, list(names))
-    a = robot.constraint_matrix(robot.steering(beta, heading))
+    a = robot.constraint_matrix(beta, heading=heading)
     free = np.setdiff1d(np.arange(a.shape[-1]), columns)
     rest = free[free >= 3]
     return readonly(np.asarray(matrix_rank(a[..., free]) == np.sum(free < 3) + matrix_rank(a[..., rest])))

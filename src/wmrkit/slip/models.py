@@ -136,7 +136,7 @@ def wls(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: Arra
     """Weighted least squares (7.52): ``(..., n_a) -> SlipSolution``; steering `beta` (thesis) or `heading`
     (0 = rolling forward) ``(..., n_steer)``, default as described."""
     mu = (weights or SlipWeights()).row_mu(robot)
-    a = robot.constraint_matrix(robot.steering(beta, heading))
+    a = robot.constraint_matrix(beta, heading=heading)
     cols, q_a = _assigned(robot, assigned, q_assigned)
     q, _ = solve_assigned(np.sqrt(mu)[:, None] * a, cols, q_a)
     slip = (a @ q[..., None])[..., 0]
