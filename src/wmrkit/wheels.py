@@ -204,6 +204,16 @@ def wrap_angle(angle: ArrayLike) -> np.ndarray:
     return np.where(y <= -math.pi, y + 2 * math.pi, np.where(y > math.pi, y - 2 * math.pi, y))
 
 
+def heading_in_range(heading: ArrayLike, lo: ArrayLike, hi: ArrayLike, tol: float = 1e-12) -> np.ndarray:
+    """Whether each `heading` [rad] lies in the steering range ``[lo, hi]`` (a ``steer_range``, counter-clockwise
+    from `lo`, any turn of the heading), within `tol`; an infinite end means no range. ``(...) -> (...)`` bool."""
+    h, lo, hi = (np.asarray(x, dtype=float) for x in (heading, lo, hi))
+    full = ~np.isfinite(lo) | ~np.isfinite(hi)
+    lo_, width = np.where(full, 0.0, lo), np.where(full, 0.0, hi - lo)
+    off = np.mod(h - lo_ + tol, 2 * np.pi) - tol  # how far past lo, counter-clockwise, in [-tol, 2 pi - tol)
+    return full | (off <= width + tol)
+
+
 def heading_from_beta(beta: ArrayLike, delta: ArrayLike = 0.0) -> np.ndarray:
     """The users' steering angle from the thesis's: ``heading = beta + delta - pi/2``, wrapped to (-pi, pi].
 

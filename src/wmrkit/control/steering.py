@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..robot import Robot
-from ..wheels import wrap_angle
+from ..wheels import heading_in_range, wrap_angle
 from .points import ControlError
 
 __all__ = ["POLICIES", "SteeringChoice", "ackermann_twist", "choose_steering", "crab_twist", "discretize_twist",
@@ -62,13 +62,6 @@ def _nearest_end(h: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndar
     """The end of the range ``[lo, hi]`` nearest to heading `h`, and how far it is [rad]."""
     to_lo, to_hi = np.abs(wrap_angle(h - lo)), np.abs(wrap_angle(h - hi))
     return np.where(to_lo < to_hi, lo, hi), np.minimum(to_lo, to_hi)
-
-
-def _in_range(h: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    full = ~np.isfinite(lo) | ~np.isfinite(hi)
-    lo_, width = np.where(full, 0.0, lo), np.where(full, 0.0, hi - lo)
-    off = np.mod(h - lo_ + 1e-12, 2 * np.pi) - 1e-12  # how far past lo, counter-clockwise, in [0, 2 pi)
-    return full | (off <= width + 1e-12)
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,7 +102,7 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
     else:
         r = np.asarray(ranges, dtype=float)
         lo, hi = r[..., 0], r[..., 1]
-        ok0, ok1 = _in_range(h0, lo, hi), _in_range(h1, lo, hi)
+        ok0, ok1 = heading_in_range(h0, lo, hi), heading_in_range(h1, lo, hi)
     take0 = np.where(ok0 & ok1, pref0, ok0)
     h = np.where(take0, h0, h1)
     fits = ok0 | ok1

@@ -25,7 +25,7 @@ from ..errors import WmrkitError
 from ..kinematics.linalg import solve_assigned
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_seed
 from ..robot import Robot
-from ..wheels import wheel_slip_rows
+from ..wheels import heading_in_range, wheel_slip_rows
 from .encoders import AbsoluteEncoder, Encoder, IncrementalEncoder
 from .integrators import integrate_increments
 from .logs import JointLog
@@ -271,8 +271,7 @@ def _check_steer_range(robot: Robot, beta_nodes: np.ndarray, fine: np.ndarray, t
         if wheel.steer_range is None or wheel.type not in ("steerable", "double"):
             continue
         lo, hi = wheel.steer_range
-        h = lo + (heading[:, k] - lo) % (2 * np.pi)  # the turn of each heading nearest above lo
-        bad = np.flatnonzero(h > hi + 1e-9)
+        bad = np.flatnonzero(~heading_in_range(heading[:, k], lo, hi, tol=1e-9))
         if bad.size:
             i = int(bad[0])
             value = (heading[i, k] + np.pi) % (2 * np.pi) - np.pi
