@@ -20,6 +20,7 @@ the wheel centre (7.18)-(7.20), exact (no (7.21) approximation, ``docs/errata.md
 from __future__ import annotations
 
 import functools
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -148,6 +149,30 @@ class DynamicModel:
         bias(nu, nu[list(self.steer_columns)].copy(), m, dm, self.pack[5], self.pack[6], b)
         rhs = tau + self.slip_matrix(beta).T @ f.reshape(-1) + b
         return readonly(np.linalg.solve(m, rhs))
+
+    def steering_inertia(self, held: Iterable[int] = ()) -> np.ndarray:
+        """Inertia [kg m^2] that each steering joint's servo moves at the described configuration ``(n_steer,)``.
+
+        The least kinetic energy ``nu' M nu`` (7.17) over the motions with unit steering rate in which the wheels
+        roll without slip (``A nu = 0``) and the columns `held` (the other servoed joints) stay at rest. A
+        steerable wheel turns alone (its ``inertia.steer``); a double wheel whose spins are held turns the body
+        about its pivot (``I + m x^2`` and more); where the constraints lock the joint (no such motion: the tyres
+        would have to slip) it is the wheel's own ``inertia.steer``.
+        """
+        from scipy.linalg import null_space
+
+        a, m = self.slip_matrix(), self.mass_matrix()
+        held = sorted(set(held))
+        out = np.zeros(len(self.steer_columns))
+        own = [w.steer_inertia for w in self.robot.wheels if w.kind.steers]
+        for k, c in enumerate(self.steer_columns):
+            basis = null_space(np.vstack([a, np.eye(self.n)[[j for j in held if j != c]]]))
+            g = basis[c]
+            if g @ g < 1e-18:  # locked: no rolling motion turns it
+                out[k] = own[k]
+                continue
+            out[k] = 1.0 / float(g @ np.linalg.solve(basis.T @ m @ basis, g))
+        return readonly(out)
 
     def _beta(self, beta: ArrayLike | None) -> np.ndarray:
         if beta is None:

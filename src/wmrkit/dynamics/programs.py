@@ -15,6 +15,7 @@ from __future__ import annotations
 import csv
 import math
 import os
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -96,8 +97,8 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     Rate servos on actuated wheel joints (gain ``bandwidth x`` the wheel's reflected inertia, at least the grip
     torque per 0.1 rad/s, saturated at the grip ``mu Fz r`` with mu = 1); the joints of a ``differential`` coupling
     share one servo on their carrier rate, their torques in the coupling's ratios (an open differential: the speed
-    difference is the tyres'); PD servos on actuated steering (natural frequency `bandwidth` [rad/s]). A robot
-    without an actuated joint is refused.
+    difference is the tyres'); critically damped PD servos on actuated steering (natural frequency `bandwidth`
+    [rad/s] on the inertia each one moves, :func:`steering_gains`). A robot without an actuated joint is refused.
     """
     from ..kinematics.wheel_ik import wheel_commands
 
@@ -138,16 +139,31 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
         r = ratio[members] / ratio[members].mean()
         gain[members], limit[members] = r * gain[members].mean(), r * (limit[members] / r).min()
     headings = np.zeros((len(t), len(model.steer_columns)))
-    kp, kd = np.zeros(len(model.steer_columns)), np.zeros(len(model.steer_columns))
     steer_wheels = [w for w in robot.wheels if w.kind.steers]
-    for k, (w, c) in enumerate(zip(steer_wheels, model.steer_columns, strict=True)):
-        wheel_index = robot.wheel_names.index(w.name)
-        h = cmd.heading[:, wheel_index]
+    for k, w in enumerate(steer_wheels):
+        h = cmd.heading[:, robot.wheel_names.index(w.name)]
         headings[:, k] = np.where(np.isfinite(h), h, w.heading)
-        if model.is_actuated(c):
-            kp[k] = w.steer_inertia * bandwidth ** 2
-            kd[k] = 2 * w.steer_inertia * bandwidth
+    servoed = [c for c in model.steer_columns if model.is_actuated(c)]
+    kp, kd = steering_gains(model, servoed, held=driven, bandwidth=bandwidth)
     return Inputs(*(readonly(a) for a in (t, np.zeros((len(t), n)), rates, gain, limit, headings, kp, kd)))
+
+
+def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequence[int] = (),
+                   bandwidth: float = 30.0) -> tuple[np.ndarray, np.ndarray]:
+    """Gains ``(kp, kd)`` ``(n_steer,)`` of critically damped PD steering servos of natural frequency `bandwidth`
+    [rad/s] on the steering columns `servoed` (0 elsewhere): ``kp = J w^2``, ``kd = 2 J w`` with ``J`` the
+    inertia each servo moves (:meth:`DynamicModel.steering_inertia`) while the servoed joints and the columns
+    `held` (wheel-rate servos) keep still. A double wheel whose spins are servoed turns the whole body about its
+    pivot: its own ``inertia.steer`` would leave that servo some 100 times too soft (damping ratio near 0.1).
+    """
+    kp, kd = np.zeros(len(model.steer_columns)), np.zeros(len(model.steer_columns))
+    if not servoed:
+        return kp, kd
+    inertia = model.steering_inertia([*servoed, *held])
+    on = np.isin(model.steer_columns, servoed)
+    kp[on] = inertia[on] * bandwidth ** 2
+    kd[on] = 2 * inertia[on] * bandwidth
+    return kp, kd
 
 
 def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
@@ -196,11 +212,9 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     if not headings:
         return inputs
     href = np.tile(model.robot.heading, (len(values), 1))
-    kp, kd = np.zeros(len(model.steer_columns)), np.zeros(len(model.steer_columns))
-    steer_wheels = [w for w in model.robot.wheels if w.kind.steers]
     for k, c in enumerate(model.steer_columns):
         if c in headings:
             href[:, k] = headings[c]
-            kp[k], kd[k] = steer_wheels[k].steer_inertia * 900.0, steer_wheels[k].steer_inertia * 60.0
+    kp, kd = steering_gains(model, list(headings))
     return Inputs(inputs.time, inputs.torques, inputs.rate_reference, inputs.rate_gain, inputs.torque_limit,
                   readonly(href), readonly(kp), readonly(kd))

@@ -96,6 +96,7 @@ def example(robot, number: int, weights: SlipWeights) -> dict:
     """Examples 1 and 2 of §7.5.3: from rolling at (vx, omega) = (2 m/s, 0.3 rad/s) at the axle, the steering held
     by its servo; no torque (1) or +30 N m on each drive wheel for 1 s (2; forward in REP-103 signs)."""
     from ..dynamics.model import DynamicModel
+    from ..dynamics.programs import steering_gains
     from ..dynamics.simulate import Inputs, simulate
     from ..kinematics.wheel_ik import wheel_commands
 
@@ -108,10 +109,9 @@ def example(robot, number: int, weights: SlipWeights) -> dict:
     if number == 2:
         for j in DRIVES:
             tau[:2, model.names.index(j)] = SETTINGS["example2_torque_nm"]
-    steer = robot.wheel("steer")
-    bw = 30.0
+    kp, kd = steering_gains(model, [model.names.index("steer.steer")])
     inputs = Inputs(t, tau, np.zeros_like(tau), np.zeros(model.n), np.full(model.n, np.inf), np.full((4, 1), heading),
-                    np.array([steer.steer_inertia * bw**2]), np.array([2 * steer.steer_inertia * bw]))
+                    kp, kd)
     sim = simulate(model, inputs, duration, step=SETTINGS["md_step_s"], initial_twist=twist0,
                    record_step=SETTINGS["sample_period_s"])
     names = list(sim.joint_names)
