@@ -1,4 +1,5 @@
-"""Steering servos sized on the inertia they move, checked against closed forms of a drive unit's turn."""
+"""Steering through the dynamics: servos sized on the inertia they move (checked against closed forms of a drive
+unit's turn), and the roots of (8.9) the loops command."""
 
 from __future__ import annotations
 
@@ -8,13 +9,17 @@ import numpy as np
 import pytest
 from dynamics_robots import double_unit_robot, tricycle
 
-from wmrkit import Robot
+from wmrkit import Robot, catalog
+from wmrkit.control.dynamic_plant import simulate_dynamics
+from wmrkit.control.points import ControlError
 from wmrkit.control.references import builtin_reference
+from wmrkit.control.slip_loop import simulate_slip_control
 from wmrkit.control.track import track
 from wmrkit.dynamics.model import DynamicModel
 from wmrkit.dynamics.programs import path_program
 from wmrkit.dynamics.simulate import simulate
 from wmrkit.kinematics.wheel_ik import wheel_commands
+from wmrkit.wheels import wrap_angle
 
 STEERED = ("steer", "spin1", "spin2")
 
@@ -98,3 +103,76 @@ def test_track_dynamics_of_a_drive_unit_with_a_steering_motor_follows_a_circle()
     for speed in (0.3, 0.5):
         run = track(robot, builtin_reference("circle", speed=speed), dynamics=True, duration=30)
         assert run.summary()["rms_error"] < 0.1, speed
+
+
+def _sideways(period: float, stop: float = math.inf):
+    """A controller asking for 0.1 m/s to the left with a forward component of +-1 mm/s alternating each period
+    (a wheel heading straddles +90 deg), slowing to rest over the half second before `stop`."""
+    def controller(t, pose, integral):
+        scale = min(1.0, max(0.0, (stop - t) / 0.5))
+        return scale * np.array([1e-3 * (-1) ** round(t / period), 0.1, 0.0]), np.zeros(3)
+    return controller
+
+
+def _backwards(t, pose, integral):
+    return np.array([-0.1, 0.0, 0.0]), np.zeros(3)
+
+
+def _swerve() -> Robot:
+    """The catalog's swerve drive with mass properties (its modules are steerable: each servo turns its wheel)."""
+    data = catalog.load("swerve-4").to_dict()
+    data["body"] = {"mass": 40.0, "inertia": 2.0, "com": [0.0, 0.0], "com_height": 0.05}
+    for w in data["wheels"]:
+        w.update(inertia={"spin": 0.001, "steer": 0.005}, tyre={"model": "dugoff"})
+    return Robot.from_dict(data)
+
+
+def _loops(robot, controller, duration, policy):
+    """The two loops through the dynamics: plain servos, and the slip-model loop (here without a slip model)."""
+    return [simulate_dynamics(robot, controller, np.zeros(3), duration, period=0.02, policy=policy),
+            simulate_slip_control(robot, controller, np.zeros(3), duration, period=0.02, slip_model="none",
+                                  policy=policy)]
+
+
+def test_the_dynamic_loop_steers_to_the_root_closest_to_the_current_heading():
+    """Each period's IK took the root closest to the *described* heading (0), not the current one: a heading
+    straddling +90 deg was commanded +89.4 deg and -89.4 deg (the other root, spins reversed) in turns, a half turn
+    of the steering every period; the kinematic loop (and the slip-model loop) always took the current heading. A
+    double wheel asked to steer 90 deg from rest also needs its servo's limit (the grip): 9600 N m lifted it."""
+    for robot in (double_unit_robot(actuated=STEERED), _swerve()):
+        out = simulate_dynamics(robot, _sideways(0.02), np.zeros(3), 2.0, period=0.02)
+        heading = robot.heading_of_beta(out["target"])[5:, 0]
+        assert np.abs(np.diff(heading)).max() < math.radians(2), robot.name
+        assert np.abs(heading - math.pi / 2).max() < math.radians(2), robot.name
+        assert out["pose"][-1, 1] > 0.15, robot.name  # it went left
+
+
+def test_the_dynamic_loop_holds_the_steering_when_the_robot_stops():
+    """At rest the IK keeps the current heading; it used to command the described one, so the wheels turned back
+    to straight ahead as soon as the robot stopped."""
+    robot = _swerve()
+    out = simulate_dynamics(robot, _sideways(0.02, stop=1.0), np.zeros(3), 2.0, period=0.02)
+    heading = robot.heading_of_beta(out["beta"])
+    assert np.abs(out["twist"][-20:]).max() == 0.0
+    assert np.abs(heading[-10:] - math.pi / 2).max() < math.radians(2)
+
+
+def test_the_dynamic_loops_follow_the_steering_policy():
+    """`policy` (`track --steering`) was ignored with `--dynamics`: both loops through the dynamics now pick the
+    root it asks for, as the kinematic loop does. Sideways with a heading straddling 90 deg, "2-quadrant" keeps
+    the headings within +-90 deg (flipping), "closest" and "4-quadrant" do not flip; backwards, "closest" keeps
+    the wheels straight and reverses them, "4-quadrant" turns them round to roll forwards."""
+    robot = _swerve()
+    for policy, flips in (("closest", False), ("2-quadrant", True), ("4-quadrant", False)):
+        for out in _loops(robot, _sideways(0.02), 1.0, policy):
+            heading = robot.heading_of_beta(out["target"])[5:]
+            assert (np.abs(np.diff(heading, axis=0)).max() > math.radians(170)) == flips, policy
+            if policy == "2-quadrant":
+                assert np.all(np.abs(wrap_angle(heading)) <= math.pi / 2 + 1e-9)
+    for policy, expected in (("closest", 0.0), ("4-quadrant", math.pi)):
+        for out in _loops(robot, _backwards, 1.0, policy):
+            heading = robot.heading_of_beta(out["beta"])[-1]
+            assert np.abs(wrap_angle(heading - expected)).max() < math.radians(2), policy
+            assert out["pose"][-1, 0] < -0.05, policy
+    with pytest.raises(ControlError, match="unknown steering policy"):
+        simulate_dynamics(robot, _sideways(0.02), np.zeros(3), 1.0, period=0.02, policy="nearest")

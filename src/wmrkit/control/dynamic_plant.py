@@ -31,15 +31,17 @@ __all__ = ["fast_law_controller", "simulate_dynamics"]
 
 def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *,
                       period: float, delay: int = 0, tyre: str | None = None, step: float = 1e-3,
-                      feedback: str = "pose") -> dict[str, np.ndarray]:
+                      feedback: str = "pose", policy: str = "closest") -> dict[str, np.ndarray]:
     """Close the loop of `controller` on the dynamic model of `robot` (same outputs as :func:`.loop.simulate`).
 
     `period` [s]: control period (commands held); `delay`: measurement delay in samples; `tyre`: traction model
     name (default: as described); `step` [s]: integration step of the dynamics (1 kHz default, semi-implicit).
     `feedback`: ``"pose"`` (the true pose is measured) or ``"odometry"`` (the pose estimated from the sensed joints,
     one exact SE(2) step per period, :func:`wmrkit.kinematics.realtime.realtime`); the estimate is returned as
-    ``estimate (n, 3)``. The same run as a plain loop of ``controller``, ``twist_program(model, [t], [twist])`` and
-    ``Stepper.advance(inputs, period)`` (tested), with the per-period work done in place.
+    ``estimate (n, 3)``. `policy`: which root of (8.9) each steered wheel takes, from its current heading
+    (:mod:`.steering`; ``"closest"`` turns the least, reversing the spins rather than the steering). The same run
+    as a plain loop of ``controller``, ``twist_program(model, [t], [twist])`` and ``Stepper.advance(inputs,
+    period)`` (tested), with the per-period work done in place.
     """
     from ..dynamics.model import DynamicModel
     from ..dynamics.programs import twist_program
@@ -57,22 +59,22 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
     stepper.advance(twist_program(model, [0.0], [(0.0, 0.0, 0.0)]), 0.0)  # the servo gains; references below
     s, steer = stepper.state, list(model.steer_columns)
     ik = realtime(robot).ik
-    described = np.array(robot.heading, dtype=float)
-    rate_reference, heading = np.zeros(model.n), np.zeros(len(described))
+    rate_reference, heading = np.zeros(model.n), np.zeros(len(steer))
     rates = rate_reference[3:3 + len(robot.rate_names)]  # the IK writes the references in place
     delta = np.array([w.delta for w in robot.wheels if w.kind.steers], dtype=float)
     n = math.floor(duration / period + 1e-9) + 1
     history, integral = [s[:3].copy()], np.zeros(3)
     odometer = _Odometer(robot, model, s) if feedback == "odometry" else None
     out = {key: [] for key in ("t", "pose", "twist", "beta", "target", "estimate", "in_range")}
-    held_in_range = range_keeper(robot)
+    held_in_range = range_keeper(robot, policy)
     for k in range(n):
         t = k * period
         twist, de = controller(t, history[max(0, k - delay)], integral)
         check_command(twist, t)
         integral = integral + period * de
-        ik(float(twist[0]), float(twist[1]), float(twist[2]), described, rates, heading)  # = wheel_commands(twist)
-        out["in_range"].append(held_in_range(heading, rates))
+        current = heading_from_beta(s[steer], delta)
+        ik(float(twist[0]), float(twist[1]), float(twist[2]), current, rates, heading)  # = wheel_commands(twist)
+        out["in_range"].append(held_in_range(heading, rates, current))
         stepper.hold(rate_reference, heading)
         out["t"].append(t)
         out["pose"].append(s[:3].copy())

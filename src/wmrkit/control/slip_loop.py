@@ -45,14 +45,14 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
                           period: float, delay: int = 0, tyre: str | None = None, step: float = 1e-3,
                           slip_model: str = "mqe", feedback: str = "pose", weights: SlipWeights | None = None,
                           noise: KalmanNoise | None = None, inverse: SlipInverse | None = None,
-                          ramp: bool = False, progress: bool = False) -> dict:
+                          ramp: bool = False, progress: bool = False, policy: str = "closest") -> dict:
     """Close the loop of `controller` on the dynamic model of `robot` with commands from `slip_model`.
 
     `period` [s] control period; `delay` measurement delay in samples; `tyre` the plant's traction model (default
     as described; the slip model uses the described tyres unless `inverse` says otherwise); `step` [s] the dynamics'
     integration step. `ramp`: each period's commands are reached linearly over the period from the previous ones
     (a first-order hold, half a period of delay) instead of held from its start (zero-order hold). `progress`: a
-    tqdm bar over the periods.
+    tqdm bar over the periods. `policy`: which root of (8.9) each steered wheel takes (:mod:`.steering`).
 
     Returns arrays: ``t``, ``pose`` (true), ``twist`` (the law's), ``beta`` (actual steering), ``target``
     (commanded steering β), ``estimate`` (the fed-back pose), ``rates`` (commanded wheel rates of
@@ -91,7 +91,7 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     previous = None
     keys = ("t", "pose", "twist", "beta", "target", "estimate", "rates", "predicted", "velocity", "joint_rates",
             "in_range")
-    held_in_range, all_rates = range_keeper(robot), np.zeros(len(robot.rate_names))
+    held_in_range, all_rates = range_keeper(robot, policy), np.zeros(len(robot.rate_names))
     records: dict[str, list] = {k: [] for k in keys}
     bar = None
     if progress:
@@ -116,7 +116,8 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
         wanted = heading.copy()
         all_rates[:] = 0.0
         all_rates[spin_cols] = rates
-        in_range = held_in_range(heading, all_rates)  # a wheel beyond its steer_range: the other root, or its end
+        current = np.asarray(robot.heading_of_beta(beta_now), dtype=float)
+        in_range = held_in_range(heading, all_rates, current)  # the policy's root; beyond a steer_range, its end
         if not np.array_equal(heading, wanted):
             rates, target = all_rates[spin_cols], np.asarray(robot.beta_of_heading(heading), dtype=float).reshape(-1)
         values = (t, s[:3].copy(), np.asarray(twist, float), beta_now, target, history[-1].copy(), rates,

@@ -158,23 +158,28 @@ def check_steering_driven(robot: Robot) -> None:
                                "to its 'actuated', or track without the dynamics (ideal joints)")
 
 
-def range_keeper(robot: Robot) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
-    """``(headings, rates) -> in_range`` for the loops through the dynamics: moves, in place, each steered wheel's
-    heading to a root of (8.9) within its ``steer_range`` (its spins for that root, :func:`reverse_spins`), or to
-    the end of the range nearest to either root when neither fits; returns which fitted
-    (:func:`.steering.choose_steering`); every steered wheel's steering is actuated (:func:`check_steering_driven`)."""
+def range_keeper(robot: Robot, policy: str = "closest") -> Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
+    """``(headings, rates, current) -> in_range`` for the loops through the dynamics: moves, in place, each steered
+    wheel's heading to the root of (8.9) that `policy` picks from the `current` headings, within its
+    ``steer_range`` (its spins for that root, :func:`reverse_spins`), or to the end of the range nearest to either
+    root when neither fits; returns which fitted (:func:`.steering.choose_steering`); every steered wheel's
+    steering is actuated (:func:`check_steering_driven`). With ``"closest"`` and no range it does nothing: the IK
+    has picked the root closest to `current` already."""
+    if policy not in POLICIES:
+        raise ControlError(f"unknown steering policy '{policy}' (policies: {', '.join(POLICIES)})")
     ranges, columns = steer_ranges(robot), spin_columns(robot)
-    limited = np.isfinite(ranges).any(axis=1) & (columns[:, 0] >= 0)
-    columns = columns[limited]
+    chosen = (np.isfinite(ranges).any(axis=1) | (policy != "closest")) & (columns[:, 0] >= 0)
+    columns = columns[chosen]
 
-    def keep(heading: np.ndarray, rates: np.ndarray) -> np.ndarray:
-        if not limited.any():
+    def keep(heading: np.ndarray, rates: np.ndarray, current: np.ndarray) -> np.ndarray:
+        if not chosen.any():
             return np.ones(len(heading), dtype=bool)
-        ch = choose_steering(heading[limited], unit_spin(rates, columns), heading[limited], ranges=ranges[limited])
-        heading[limited] = ch.heading
+        ch = choose_steering(heading[chosen], unit_spin(rates, columns), current[chosen], policy=policy,
+                             ranges=ranges[chosen])
+        heading[chosen] = ch.heading
         reverse_spins(rates, columns, ch.reversed)
         fits = np.ones(len(heading), dtype=bool)
-        fits[limited] = ch.in_range
+        fits[chosen] = ch.in_range
         return fits
 
     return keep

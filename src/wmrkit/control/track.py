@@ -190,10 +190,10 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
 
             out = simulate_slip_control(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
                                         slip_model=slip_model, feedback=feedback, weights=weights, noise=noise,
-                                        ramp=ramp, step=DYNAMICS_STEP, progress=progress)
+                                        ramp=ramp, step=DYNAMICS_STEP, progress=progress, policy=policy)
         else:
             out = simulate_dynamics(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
-                                    feedback=feedback, step=DYNAMICS_STEP)
+                                    feedback=feedback, step=DYNAMICS_STEP, policy=policy)
     elif feedback != "pose" or slip_model != "none" or ramp:
         what = (f"feedback='{feedback}'" if feedback != "pose" else f"slip_model='{slip_model}'"
                 if slip_model != "none" else "ramp=True")

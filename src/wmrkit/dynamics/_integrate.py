@@ -3,9 +3,10 @@
 State ``s (2n,)``: pose ``(x, y, theta)`` in the world, the joint positions of the columns ``3..n-1`` of the
 velocity vector (so the steering angle of column c is ``s[c]``), then the velocity vector ``nu (n,)``.
 Inputs ``inp``: ``(tk (K,), tau (K, n), rate_ref (K, n), rate_gain (n,), tau_max (n,), beta_ref (K, S), kp (S,),
-kd (S,))``, linear in time between the knots ``tk``, held outside them: feed-forward torques, wheel-rate servos
-``tau += rate_gain (rate_ref - rate)`` saturated at ``tau_max``, steering servos ``kp wrap(beta_ref - beta) - kd
-beta_dot``.
+kd (S,), steer_max (S,))``, linear in time between the knots ``tk``, held outside them: feed-forward torques,
+wheel-rate servos ``tau += rate_gain (rate_ref - rate)`` saturated at ``tau_max``, steering servos ``u = kp
+wrap(beta_ref - beta) - kd beta_dot``, saturated smoothly as ``steer_max tanh(u / steer_max)`` where ``steer_max >
+0``: the damping stays in the implicit matrix, so a saturated servo does not chatter between its limits.
 
 Speed (issue 10): every kernel of a step is inlined into :func:`run_semi_implicit`, which is compiled without numba's
 reference counting (nothing in it allocates); a record reuses the assembly of the step that starts at its time.
@@ -79,7 +80,7 @@ def assemble(t, s, acc, pack, inp, jac, w):
                 lift[0], lift[1], lift[2] = 1.0, t, e
                 break
     contact_forces(a, nu, pack, fz, f, g, vw, jac)
-    tk, tff, rref, rgain, tmax, bref, kp, kd = inp
+    tk, tff, rref, rgain, tmax, bref, kp, kd, smax = inp
     k0, k1, wt = _segment(tk, t)
     rr, br = w[12], w[13]
     _interp(tff, k0, k1, wt, tau)
@@ -111,8 +112,14 @@ def assemble(t, s, acc, pack, inp, jac, w):
         c = steer_col[k]
         err = br[k] - beta[k]
         err = err - 2 * math.pi * math.floor((err + math.pi) / (2 * math.pi))
-        tau[c] += kp[k] * err - kd[k] * nu[c]
-        kdiag[c] -= kd[k]
+        u = kp[k] * err - kd[k] * nu[c]
+        if smax[k] > 0.0:  # u -> smax tanh(u / smax): d/d nu = -kd (1 - tanh^2)
+            th = math.tanh(u / smax[k])
+            tau[c] += smax[k] * th
+            kdiag[c] -= kd[k] * (1.0 - th * th)
+        else:
+            tau[c] += u
+            kdiag[c] -= kd[k]
     bias(nu, beta_rate, m, dm, steer_col, pack[6], rhs)
     for c in range(n):
         acc_c = tau[c]

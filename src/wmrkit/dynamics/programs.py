@@ -98,7 +98,11 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     torque per 0.1 rad/s, saturated at the grip ``mu Fz r`` with mu = 1); the joints of a ``differential`` coupling
     share one servo on their carrier rate, their torques in the coupling's ratios (an open differential: the speed
     difference is the tyres'); critically damped PD servos on actuated steering (natural frequency `bandwidth`
-    [rad/s] on the inertia each one moves, :func:`steering_gains`). A robot without an actuated joint is refused.
+    [rad/s] on the inertia each one moves, :func:`steering_gains`), saturated (smoothly) where the tyres can hold
+    the steering torque no more: ``mu Fz`` (mu = 1) at the contacts' distance from the steering axis (a double
+    wheel's ``b``, a castor's ``d``; none for a steerable wheel, whose contact is on its axis). Without that limit
+    a double wheel asked to steer 90 deg from rest got 9600 N m and lifted the robot off its wheels in a
+    millisecond. A robot without an actuated joint is refused.
     """
     from ..kinematics.wheel_ik import wheel_commands
 
@@ -145,7 +149,14 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
         headings[:, k] = np.where(np.isfinite(h), h, w.heading)
     servoed = [c for c in model.steer_columns if model.is_actuated(c)]
     kp, kd = steering_gains(model, servoed, held=driven, bandwidth=bandwidth)
-    return Inputs(*(readonly(a) for a in (t, np.zeros((len(t), n)), rates, gain, limit, headings, kp, kd)))
+    steer_limit = np.full(len(steer_wheels), np.inf)
+    for k, (w, c) in enumerate(zip(steer_wheels, model.steer_columns, strict=True)):
+        lever = math.hypot(w.d, w.b)  # the contacts' distance from the steering axis
+        if c in servoed and lever > 0:
+            contact = [e for e, name in enumerate(model.contacts) if name.split(".")[0] == w.name]
+            steer_limit[k] = max(loads[contact].sum(), 1.0) * lever
+    return Inputs(*(readonly(a) for a in (t, np.zeros((len(t), n)), rates, gain, limit, headings, kp, kd,
+                                          steer_limit)))
 
 
 def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequence[int] = (),

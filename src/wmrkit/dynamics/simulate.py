@@ -35,7 +35,8 @@ class Inputs:
     ``torques (K, n)`` [N m]: feed-forward generalized torques on the columns of ``DynamicModel.names`` (wheel
     spins, steering); ``rate_reference (K, n)`` [rad/s] and ``rate_gain (n,)`` [N m s/rad]: wheel-rate servos
     ``tau += gain (reference - rate)``, saturated at ``torque_limit (n,)``; ``heading_reference (K, n_steer)``
-    [rad, headings: 0 = rolling straight ahead] with ``steer_kp``, ``steer_kd (n_steer,)``: steering servos.
+    [rad, headings: 0 = rolling straight ahead] with ``steer_kp``, ``steer_kd (n_steer,)``: steering servos,
+    saturated smoothly at ``steer_limit (n_steer,)`` [N m] (``limit tanh(pd / limit)``; default and inf: none).
     """
 
     time: np.ndarray
@@ -46,6 +47,7 @@ class Inputs:
     heading_reference: np.ndarray
     steer_kp: np.ndarray
     steer_kd: np.ndarray
+    steer_limit: np.ndarray | None = None
 
     @classmethod
     def torques_only(cls, model: DynamicModel, time: ArrayLike, torques: dict[str, ArrayLike]) -> Inputs:
@@ -238,13 +240,13 @@ class Stepper:
         limits and the values not given are those of the last inputs at the current time (in place, a few µs)."""
         if self._inputs is None:
             raise WmrkitError("hold: give inputs (their servo gains) to advance() first")
-        tk, tau, rref, gain, limit, bref, kp, kd = self._inputs
+        tk, tau, rref, gain, limit, bref, kp, kd, steer_limit = self._inputs
         if tk.shape[0] != 1:  # the values at the current time, held from now on
             t = self.t
             tau, rref, bref = (np.array([np.interp(t, tk, col) for col in a.T], dtype=float).reshape(1, a.shape[1])
                                for a in (tau, rref, bref))
             tk = np.array([t])
-            self._inputs = (tk, tau, rref, gain, limit, bref, kp, kd)
+            self._inputs = (tk, tau, rref, gain, limit, bref, kp, kd, steer_limit)
         if rate_reference is not None:
             rref[0] = _held(rate_reference, rref.shape[1], "rate_reference")
         if torques is not None:
@@ -312,7 +314,19 @@ def _compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
         if len(model.steer_columns) else np.zeros((len(inputs.time), 0))
     return tuple(np.array(a, dtype=float, order="C") for a in (  # writable copies: one compiled signature
         inputs.time, inputs.torques, inputs.rate_reference, inputs.rate_gain, inputs.torque_limit,
-        beta_ref.reshape(len(inputs.time), -1), inputs.steer_kp, inputs.steer_kd))
+        beta_ref.reshape(len(inputs.time), -1), inputs.steer_kp, inputs.steer_kd,
+        _steer_limits(model, inputs.steer_limit)))
+
+
+def _steer_limits(model: DynamicModel, limit: ArrayLike | None) -> np.ndarray:
+    """The compiled kernels' steering-servo limits, 0 where there is none (no infinity may reach them)."""
+    if limit is None:
+        return np.zeros(len(model.steer_columns))
+    limit = np.asarray(limit, dtype=float)
+    if limit.shape != (len(model.steer_columns),) or not np.all(limit > 0):  # NaN included
+        raise WmrkitError(f"steer_limit: expected {len(model.steer_columns)} torques > 0 N m (inf: none), got "
+                          f"{limit.tolist()}")
+    return np.where(np.isinf(limit), 0.0, limit)
 
 
 def _records(model: DynamicModel, n_rec: int) -> tuple:
