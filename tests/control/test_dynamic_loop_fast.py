@@ -42,9 +42,10 @@ def test_fast_law_controller_equals_law_controller(name, k, dx, dy, dth, integra
 
 
 def _plain_loop(robot, controller, pose0, duration, period, delay):
-    """The reference: the loop written with the public API only (twist_program + Stepper.advance each period)."""
+    """The reference: the loop written with the public API only (twist_program + Stepper.advance each period),
+    starting at `pose0` rolling at the law's first command."""
     model = DynamicModel.of(robot)
-    stepper = Stepper(model, initial_state(model, (0.0, 0.0, 0.0), pose0), step=1e-3)
+    stepper = Stepper(model, initial_state(model, controller(0.0, pose0.copy(), np.zeros(3))[0], pose0), step=1e-3)
     n = math.floor(duration / period + 1e-9) + 1
     history, integral, poses, twists, betas, targets = [pose0.copy()], np.zeros(3), [], [], [], []
     steer = list(model.steer_columns)

@@ -118,10 +118,10 @@ def _backwards(t, pose, integral):
     return np.array([-0.1, 0.0, 0.0]), np.zeros(3)
 
 
-def _swerve() -> Robot:
+def _swerve(com_height: float = 0.05) -> Robot:
     """The catalog's swerve drive with mass properties (its modules are steerable: each servo turns its wheel)."""
     data = catalog.load("swerve-4").to_dict()
-    data["body"] = {"mass": 40.0, "inertia": 2.0, "com": [0.0, 0.0], "com_height": 0.05}
+    data["body"] = {"mass": 40.0, "inertia": 2.0, "com": [0.0, 0.0], "com_height": com_height}
     for w in data["wheels"]:
         w.update(inertia={"spin": 0.001, "steer": 0.005}, tyre={"model": "dugoff"})
     return Robot.from_dict(data)
@@ -176,3 +176,15 @@ def test_the_dynamic_loops_follow_the_steering_policy():
             assert out["pose"][-1, 0] < -0.05, policy
     with pytest.raises(ControlError, match="unknown steering policy"):
         simulate_dynamics(robot, _sideways(0.02), np.zeros(3), 1.0, period=0.02, policy="nearest")
+
+
+def test_the_loops_through_the_dynamics_start_rolling_at_the_first_command():
+    """They started at rest, so the first period was a step from 0 to the reference speed that the servos took at
+    the grip (1 g): a swerve robot 0.56 m square with its centre of mass 0.3 m high (an FRC robot's) tipped over
+    at t = 1 ms on a straight line at 0.5 m/s, in every loop through the dynamics. Now it starts rolling at the
+    law's first command, as the kinematic loop moves at once, and follows the line."""
+    robot = _swerve(com_height=0.3)
+    line = builtin_reference("line", speed=0.5)
+    for kwargs in ({}, {"ramp": True}):
+        run = track(robot, line, dynamics=True, duration=4, **kwargs)
+        assert run.summary()["max_error"] < 1e-6, kwargs

@@ -30,6 +30,7 @@ from ..kinematics.wheel_ik import WheelCommands
 from ..robot import Robot
 from ..slip.kalman import KalmanNoise
 from ..slip.weights import SlipWeights
+from .dynamic_plant import rolling_start
 from .loop import TwistController, check_command
 from .points import ControlError, check_delay
 from .slip_control import SLIP_MODELS, SlipCommander, SlipInverse, _Forward, slip_inverse
@@ -62,7 +63,7 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     """
     from ..dynamics.model import DynamicModel
     from ..dynamics.programs import twist_program
-    from ..dynamics.simulate import Stepper, initial_state
+    from ..dynamics.simulate import Stepper
     from ..kinematics.wheel_ik import wheel_commands
 
     if not (math.isfinite(period) and period >= step > 0):
@@ -83,7 +84,7 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     plant_cols = [model.names.index(j) for j in assigned]
     steer = list(model.steer_columns)
     template = twist_program(model, [0.0], np.zeros((1, 3)))  # the servos' gains and limits
-    stepper = Stepper(model, initial_state(model, (0.0, 0.0, 0.0), initial_pose), step=step)
+    stepper = Stepper(model, rolling_start(model, controller, initial_pose), step=step)
     s = stepper.state
     sensor = _Sensor(robot, model, s, feedback, weights, noise)
     n = math.floor(duration / period + 1e-9) + 1
