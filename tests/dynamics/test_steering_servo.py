@@ -17,7 +17,7 @@ from wmrkit.control.slip_loop import simulate_slip_control
 from wmrkit.control.track import track
 from wmrkit.dynamics.model import DynamicModel
 from wmrkit.dynamics.programs import path_program
-from wmrkit.dynamics.simulate import simulate
+from wmrkit.dynamics.simulate import LiftOffError, simulate
 from wmrkit.kinematics.wheel_ik import wheel_commands
 from wmrkit.wheels import wrap_angle
 
@@ -188,3 +188,16 @@ def test_the_loops_through_the_dynamics_start_rolling_at_the_first_command():
     for kwargs in ({}, {"ramp": True}):
         run = track(robot, line, dynamics=True, duration=4, **kwargs)
         assert run.summary()["max_error"] < 1e-6, kwargs
+
+
+def test_a_loop_through_the_dynamics_that_tips_the_robot_says_why_and_what_to_change():
+    """`track --dynamics` told a user whose robot tipped at a corner to 'use smaller torques or speeds' (the advice
+    of `simulate`, whose torques are the user's); now it names the cause in the loop, a step in the command."""
+    robot = double_unit_robot(actuated=STEERED)
+    for kwargs in ({}, {"ramp": True}):
+        with pytest.raises(ControlError, match=r"contact '\w+' lifts off the ground at t = 6\.\d+ s .* a step in the "
+                                               r"command \(a corner of the reference"):
+            track(robot, builtin_reference("corner", speed=0.5), dynamics=True, duration=8, **kwargs)
+    with pytest.raises(LiftOffError, match="use smaller torques or speeds"):
+        simulate(DynamicModel.of(_swerve(com_height=0.5)), path_program(DynamicModel.of(_swerve(0.5)), "turn",
+                                                                         speed=8.0)[0], 1.0)

@@ -182,18 +182,26 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         if loops is not None or skew_free:
             raise ControlError("dynamics: the wheels are driven by the dynamic model's servos; no low-level loops "
                                "or skew-free option with it")
+        from ..dynamics.simulate import LiftOffError
+
         period = 0.02 if period is None else period
         slipping = slip_model != "none" or feedback not in ("pose", "odometry") or ramp
         _check_dynamic_work(duration, period, slipping)
-        if slipping:
-            from .slip_loop import simulate_slip_control
+        try:
+            if slipping:
+                from .slip_loop import simulate_slip_control
 
-            out = simulate_slip_control(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
-                                        slip_model=slip_model, feedback=feedback, weights=weights, noise=noise,
-                                        ramp=ramp, step=DYNAMICS_STEP, progress=progress, policy=policy)
-        else:
-            out = simulate_dynamics(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
-                                    feedback=feedback, step=DYNAMICS_STEP, policy=policy)
+                out = simulate_slip_control(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
+                                            slip_model=slip_model, feedback=feedback, weights=weights, noise=noise,
+                                            ramp=ramp, step=DYNAMICS_STEP, progress=progress, policy=policy)
+            else:
+                out = simulate_dynamics(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
+                                        feedback=feedback, step=DYNAMICS_STEP, policy=policy)
+        except LiftOffError as err:
+            raise ControlError(f"{err.what}; the servos follow each period's command with up to the grip's torque, "
+                               "so a step in the command (a corner of the reference, a start off it) can tip the "
+                               "robot: give a smoother reference, a lower speed or gain, or start on the "
+                               "reference") from None
     elif feedback != "pose" or slip_model != "none" or ramp:
         what = (f"feedback='{feedback}'" if feedback != "pose" else f"slip_model='{slip_model}'"
                 if slip_model != "none" else "ramp=True")

@@ -152,6 +152,15 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     return _result(model, rec, method, step, info)
 
 
+class LiftOffError(WmrkitError):
+    """A wheel loaded at rest lost its load: the run stops there (:func:`check_lift_off`). ``what`` states it
+    (contact, time, load at rest); the message adds what to change, which a caller may replace."""
+
+    def __init__(self, what: str, advice: str = "use smaller torques or speeds") -> None:
+        self.what, self.advice = what, advice
+        super().__init__(f"{what}; {advice}")
+
+
 def check_lift_off(model: DynamicModel, w: tuple) -> None:
     """Refuse a run in which a wheel loaded at rest lost its load (lifts off), as the integrator's work arrays `w`
     recorded it: the planar model clips the load at 0 and keeps the wheel down, so the motion that follows is not
@@ -159,9 +168,9 @@ def check_lift_off(model: DynamicModel, w: tuple) -> None:
     lift = w[16]
     if lift[0]:
         e = int(lift[2])
-        raise WmrkitError(f"contact '{model.contacts[e]}' lifts off the ground at t = {lift[1]:.6g} s (normal load "
-                          f"0; {model.normal_loads()[e]:.4g} N at rest): the planar model keeps every wheel on the "
-                          "ground, so the motion would not be physical; use smaller torques or speeds")
+        raise LiftOffError(f"contact '{model.contacts[e]}' lifts off the ground at t = {lift[1]:.6g} s (normal load "
+                           f"0; {model.normal_loads()[e]:.4g} N at rest): the planar model keeps every wheel on the "
+                           "ground, so the motion would not be physical")
 
 
 class Stepper:
