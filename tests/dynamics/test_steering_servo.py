@@ -3,6 +3,7 @@ unit's turn), and the roots of (8.9) the loops command."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -18,6 +19,7 @@ from wmrkit.control.track import track
 from wmrkit.dynamics.model import DynamicModel
 from wmrkit.dynamics.programs import path_program
 from wmrkit.dynamics.simulate import LiftOffError, simulate
+from wmrkit.errors import WmrkitError
 from wmrkit.kinematics.wheel_ik import wheel_commands
 from wmrkit.wheels import wrap_angle
 
@@ -201,3 +203,13 @@ def test_a_loop_through_the_dynamics_that_tips_the_robot_says_why_and_what_to_ch
     with pytest.raises(LiftOffError, match="use smaller torques or speeds"):
         simulate(DynamicModel.of(_swerve(com_height=0.5)), path_program(DynamicModel.of(_swerve(0.5)), "turn",
                                                                          speed=8.0)[0], 1.0)
+
+
+def test_steering_limits_are_torques_above_zero():
+    model = DynamicModel.of(double_unit_robot(actuated=STEERED))
+    inputs, _ = path_program(model, "straight", speed=0.5)
+    assert np.isfinite(inputs.steer_limit[0]) and np.isinf(inputs.steer_limit[1:]).all()  # the castors: none
+    assert inputs.steer_limit[0] == pytest.approx(model.normal_loads()[:2].sum() * 0.06)
+    for bad in ([0.0, 1.0, 1.0], [np.nan, 1.0, 1.0], [1.0, 1.0]):
+        with pytest.raises(WmrkitError, match="steer_limit: expected 3 torques > 0 N m"):
+            simulate(model, dataclasses.replace(inputs, steer_limit=np.array(bad)), 0.01)
