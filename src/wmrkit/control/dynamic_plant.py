@@ -59,9 +59,10 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
     stepper.advance(twist_program(model, [0.0], [(0.0, 0.0, 0.0)]), 0.0)  # the servo gains; references below
     s, steer = stepper.state, list(model.steer_columns)
     ik = realtime(robot).ik
-    rate_reference, heading = np.zeros(model.n), np.zeros(len(steer))
+    rate_reference, heading, current = np.zeros(model.n), np.zeros(len(steer)), np.zeros(len(steer))
     rates = rate_reference[3:3 + len(robot.rate_names)]  # the IK writes the references in place
     delta = np.array([w.delta for w in robot.wheels if w.kind.steers], dtype=float)
+    to_heading = delta - 0.5 * math.pi
     n = math.floor(duration / period + 1e-9) + 1
     history, integral = [s[:3].copy()], np.zeros(3)
     odometer = _Odometer(robot, model, s) if feedback == "odometry" else None
@@ -72,7 +73,7 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
         twist, de = controller(t, history[max(0, k - delay)], integral)
         check_command(twist, t)
         integral = integral + period * de
-        current = heading_from_beta(s[steer], delta)
+        np.add(np.take(s, steer), to_heading, out=current)  # heading_from_beta unwrapped (the IK wraps its input)
         ik(float(twist[0]), float(twist[1]), float(twist[2]), current, rates, heading)  # = wheel_commands(twist)
         out["in_range"].append(held_in_range(heading, rates, current))
         stepper.hold(rate_reference, heading)
