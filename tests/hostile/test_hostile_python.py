@@ -278,3 +278,12 @@ def _line_position(focal_px: float = 500.0, tilt: float = 0.3):
     from wmrkit.vision.positioning import line_position
 
     return line_position([[10.0, 40.0], [-5.0, 80.0]], 0, focal_px=focal_px, tilt=tilt, height=0.5)
+
+
+@pytest.mark.parametrize("h", [np.zeros((0, 0)), np.zeros((2, 0)), np.ones(3), np.array([[1.0, np.nan], [0.0, 1.0]])])
+def test_condition_number_refuses_what_is_not_a_finite_matrix(h):
+    # an empty matrix raised IndexError, a vector LinAlgError, NaN 'SVD did not converge'
+    from wmrkit.analysis.isotropy import condition_number
+
+    with pytest.raises(WmrkitError, match=r"^condition_number: expected matrices"):
+        condition_number(h)

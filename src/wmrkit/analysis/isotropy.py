@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import readonly
-from ..errors import UnknownNameError
+from ..errors import ShapeError, UnknownNameError
 from ..kinematics.models import configuration
 from ..robot import Robot
 from . import _fast
@@ -40,8 +40,12 @@ LENGTH_RANGE = (1e-3, 1e3)
 
 
 def condition_number(h: ArrayLike) -> np.ndarray:
-    """``kappa = sigma_max / sigma_min`` of eq. (5.28); ``inf`` where H is singular. ``(..., f, f') -> (...)``."""
+    """``kappa = sigma_max / sigma_min`` of eq. (5.28); ``inf`` where H is singular. ``(..., f, f') -> (...)``,
+    finite entries, ``f, f' >= 1``."""
     h = np.asarray(h, dtype=float)
+    if h.ndim < 2 or 0 in h.shape[-2:] or not np.all(np.isfinite(h)):
+        raise ShapeError(f"condition_number: expected matrices (..., f, f') with f, f' >= 1 and finite entries, got "
+                         f"shape {h.shape}" + ("" if np.all(np.isfinite(h)) else " with entries that are not finite"))
     s = np.linalg.svd(h, compute_uv=False)
     with np.errstate(divide="ignore"):
         return np.where(s[..., -1] > 1e-13 * s[..., 0], s[..., 0] / np.where(s[..., -1] > 0, s[..., -1], 1.0), np.inf)
