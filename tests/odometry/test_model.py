@@ -195,8 +195,10 @@ def test_wrap_angle(a):
 
 
 def test_sensing_errors_name_the_problem():
-    with pytest.raises(SensingError, match=r"interval 0: the sensed joints do not determine the motion at steering "
-                                           r"front.steer=0 deg"):
+    # the angle as a heading (what log files hold): it printed the thesis's beta, 'front.steer=0 deg', for a
+    # wheel turned sideways
+    with pytest.raises(SensingError, match=r"interval 0: the sensed joints \(rear.spin, front.steer\) do not "
+                                           r"determine the motion at steering headings front.steer=-90 deg"):
         odometry_model(catalog.load("bicycle")).increments(np.zeros((1, 1)), np.zeros((1, 1)))
     diff = catalog.load("diff-drive")
     with pytest.raises(SensingError, match=r"do not determine its motion"):

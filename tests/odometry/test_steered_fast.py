@@ -152,8 +152,9 @@ def test_an_undetermined_configuration_names_its_interval():
     steer = np.full(n, 0.5)
     steer[25:] = 0.0  # front.steer = 0 (beta): the rear spin no longer fixes the motion
     log = JointLog(np.arange(n) * 0.01, model.joints, np.column_stack([np.arange(n) * 0.1, steer]))
-    with pytest.raises(SensingError, match=r"interval 25: the sensed joints do not determine the motion at "
-                                           r"steering front.steer=0 deg"):  # interval 24 ends half-way: 0.25 rad
+    with pytest.raises(SensingError, match=r"interval 25: the sensed joints \(rear.spin, front.steer\) do not "
+                                           r"determine the motion at steering headings front.steer=-90 deg \(0 = "
+                                           r"straight ahead\)"):  # interval 24 ends half-way: 0.25 rad
         odometry(model, log)
 
 

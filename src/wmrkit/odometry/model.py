@@ -28,6 +28,7 @@ from .._shapes import readonly
 from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import matrix_rank, solve_assigned
 from ..robot import Robot
+from ..wheels import heading_from_beta
 
 #: Steering configurations whose maps a model keeps; a chunk with more new ones (continuous steering) starts afresh.
 CACHE_SIZE = 1 << 14
@@ -296,8 +297,11 @@ class OdometryModel:
         configurations `bad` ``(B, s)`` at which the sensed joints do not determine the motion."""
         hit = (beta[:, None, :] == bad[None]).all(axis=2).any(axis=1)
         i = int(np.flatnonzero(hit)[0])
-        angles = ", ".join(f"{j}={np.degrees(b):.4g} deg" for j, b in zip(self.steer_joints, beta[i], strict=True))
-        return SensingError(f"interval {i}: the sensed joints do not determine the motion at steering {angles}")
+        delta = [self.robot.wheel(j.partition(".")[0]).delta for j in self.steer_joints]
+        heading = heading_from_beta(beta[i], np.array(delta, dtype=float))
+        angles = ", ".join(f"{j}={np.degrees(h):.4g} deg" for j, h in zip(self.steer_joints, heading, strict=True))
+        return SensingError(f"interval {i}: the sensed joints ({', '.join(self.joints)}) do not determine the motion "
+                            f"at steering headings {angles} (0 = straight ahead)")
 
     def _solve_by_configuration(self, dq: np.ndarray, beta_mid: ArrayLike | None) -> tuple[np.ndarray, ...]:
         if beta_mid is None:
