@@ -174,10 +174,12 @@ def _double(w: Wheel) -> tuple[Element, ...]:
     )
 
 
-def _double_castor(w: Wheel) -> tuple[Element, ...]:
+def _double_castor(w: Wheel, arm=None, skew=None) -> tuple[Element, ...]:
     # (3.31): beta_i = beta_ik + delta_ik, d_ik = sqrt(a^2 + b^2), delta_i1 = -delta_i2 = atan(b / a), a = d.
-    # atan2 extends atan(b/a) to a leading wheel (a < 0): sub-wheel 1 stays at +b along the axle.
-    arm, skew = math.hypot(w.d, w.b), math.atan2(w.b, w.d)
+    # atan2 extends atan(b/a) to a leading wheel (a < 0): sub-wheel 1 stays at +b along the axle. The closed forms
+    # pass their own exact `arm` and `skew` (kinematics._symbolic_matrix).
+    if arm is None:
+        arm, skew = math.hypot(w.d, w.b), math.atan2(w.b, w.d)
     return (
         Element(w.l, w.alpha, -skew, arm, skew, 0.0, w.r, 0.0, ((1, 0, 0), (0, 1, 0), (0, 0, 0))),
         Element(w.l, w.alpha, skew, arm, -skew, 0.0, w.r, 0.0, ((1, 0, 0), (0, 0, 1), (0, 0, 0))),

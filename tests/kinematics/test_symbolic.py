@@ -361,3 +361,22 @@ def test_errors_name_the_culprit():
         symbolic_model(TRICYCLE, ["vy"], geometry={"w1.l": "l12"})
     with pytest.raises(AssignmentError, match="beta: expected 1 steering angles"):
         symbolic_model(TRICYCLE, ["vy"], [0.1, 0.2])
+
+
+def test_a_double_castor_is_exact_in_closed_form():
+    """(3.31) with ``cos(skew) = d / arm``, ``sin(skew) = b / arm``: the entries are plain fractions of the
+    description's numbers. Its hypot/atan2 were floats made exact, so `kinematics --symbolic` printed
+    4472135954999579/8944271909999159 for 1/2 and 30-digit ratios for 1/3."""
+    robot = Robot.from_dict({"name": "dc", "wheels": [
+        {"name": "drive", "type": "double", "position": [0.3, 0], "b": 0.06, "r": 0.08},
+        {"name": "trailer", "type": "double_castor", "position": [-0.3, 0], "beta": "90 deg", "d": 0.1, "b": 0.05,
+         "r": 0.04}]})
+    a = symbolic_constraint_matrix(robot)
+    numbers = [q for q in a.atoms(sp.Rational)]
+    assert max(max(abs(q.p), abs(q.q)) for q in numbers) < 1000, sorted(numbers, key=lambda q: -abs(q.q))[:3]
+    for beta in np.random.default_rng(2).uniform(-math.pi, math.pi, (3, 2)):
+        values = a.xreplace({sym: sp.Float(v) for sym, v in zip(steering_symbols(robot), beta, strict=True)})
+        np.testing.assert_allclose(np.array(values.evalf(), dtype=float), robot.constraint_matrix(beta),
+                                   rtol=0, atol=1e-12)
+    model = symbolic_model(robot, ("drive.steer", "drive.spin1", "drive.spin2"))
+    assert model.exact and "0000000" not in str(model.matrix)

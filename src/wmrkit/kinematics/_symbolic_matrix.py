@@ -17,7 +17,7 @@ import sympy as sp
 
 from ..errors import WmrkitError
 from ..robot import Robot
-from ..wheels import GEOMETRY_FIELDS, Wheel, slip_row_entries
+from ..wheels import GEOMETRY_FIELDS, Wheel, _double_castor, slip_row_entries
 
 
 class AssignmentError(WmrkitError, ValueError):
@@ -97,14 +97,19 @@ def _wheel_blocks(wheel: Wheel, beta: sp.Expr | None, table: dict[str, sp.Expr])
     """Rows of one wheel over ``(vx, vy, omega, its own rates)``: (3.10) per element, rates through rate_map."""
     given = {f: table[f"{wheel.name}.{f}"] for f in geometry_fields(wheel) if f"{wheel.name}.{f}" in table}
     symbolic = {k: v for k, v in given.items() if k not in ("l", "alpha")}
-    try:
-        elements = wheel.__class__(**{**_wheel_fields(wheel), **symbolic}).elements()
-    except TypeError:  # an expansion that needs numbers (double castor: hypot/atan2 of d, b) keeps them numeric
-        keep = {k: v for k, v in symbolic.items() if k == "r"}
-        elements = wheel.__class__(**{**_wheel_fields(wheel), **keep}).elements()
+    unit = wheel.__class__(**{**_wheel_fields(wheel), **symbolic})
+    skew_place: dict[sp.Expr, sp.Expr] = {}
+    if wheel.type == "double_castor":  # (3.31) exactly: cos(skew) = d / arm, sin(skew) = b / arm, as for a place
+        d, b = _exact(unit.d, "length"), _exact(unit.b, "length")
+        arm, skew = sp.sqrt(d * d + b * b), sp.Dummy("S", real=True)
+        skew_place = {sp.cos(skew): d / arm, sp.sin(skew): b / arm}
+        elements = _double_castor(unit, arm, skew)
+    else:
+        elements = unit.elements()
     rows: list[list[sp.Expr]] = []
     for e in elements:
         l_e, alpha_e, place = _place(e.l, e.alpha, given)
+        place = {**place, **skew_place}
         beta_w = beta if beta is not None else _exact(given.get("beta", wheel.beta), "angle")
         args = [beta_w + _exact(e.beta_offset, "angle"), l_e, alpha_e] + [
             _exact(v, GEOMETRY_FIELDS[f]) for f, v in zip(("d", "delta", "gamma", "r", "r_r"), e[3:8], strict=True)
