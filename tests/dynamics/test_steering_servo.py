@@ -213,3 +213,16 @@ def test_steering_limits_are_torques_above_zero():
     for bad in ([0.0, 1.0, 1.0], [np.nan, 1.0, 1.0], [1.0, 1.0]):
         with pytest.raises(WmrkitError, match="steer_limit: expected 3 torques > 0 N m"):
             simulate(model, dataclasses.replace(inputs, steer_limit=np.array(bad)), 0.01)
+
+
+def test_steering_gains_refuse_columns_that_are_not_joints():
+    from wmrkit.dynamics.programs import steering_gains
+
+    model = DynamicModel.of(tricycle())
+    for held in ([99], [-1], ["a"], [1.5], [2]):
+        with pytest.raises(WmrkitError, match="held: expected joint columns"):
+            model.steering_inertia(held)
+    with pytest.raises(WmrkitError, match="servoed: expected steering columns"):
+        steering_gains(model, [3])
+    with pytest.raises(WmrkitError, match="bandwidth: expected a natural frequency"):
+        steering_gains(model, list(model.steer_columns), bandwidth=float("nan"))

@@ -161,8 +161,11 @@ class DynamicModel:
         """
         from scipy.linalg import null_space
 
-        a, m = self.slip_matrix(), self.mass_matrix()
         held = sorted(set(held))
+        bad = [j for j in held if not (isinstance(j, int | np.integer) and 3 <= j < self.n)]
+        if bad:
+            raise WmrkitError(f"held: expected joint columns of model.names (3 to {self.n - 1}), got {bad}")
+        a, m = self.slip_matrix(), self.mass_matrix()
         out = np.zeros(len(self.steer_columns))
         own = [w.steer_inertia for w in self.robot.wheels if w.kind.steers]
         for k, c in enumerate(self.steer_columns):

@@ -168,6 +168,11 @@ def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequenc
     pivot: its own ``inertia.steer`` would leave that servo some 100 times too soft (damping ratio near 0.1).
     """
     kp, kd = np.zeros(len(model.steer_columns)), np.zeros(len(model.steer_columns))
+    if not set(servoed) <= set(model.steer_columns):
+        raise WmrkitError(f"servoed: expected steering columns of model.names {list(model.steer_columns)}, got "
+                          f"{list(servoed)}")
+    if not (math.isfinite(bandwidth) and bandwidth > 0):
+        raise WmrkitError(f"bandwidth: expected a natural frequency > 0 rad/s, got {bandwidth}")
     if not servoed:
         return kp, kd
     inertia = model.steering_inertia([*servoed, *held])
