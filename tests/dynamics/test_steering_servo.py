@@ -216,7 +216,7 @@ def test_steering_limits_are_torques_above_zero():
 
 
 def test_steering_gains_refuse_columns_that_are_not_joints():
-    from wmrkit.dynamics.programs import steering_gains
+    from wmrkit.dynamics.programs import steering_gains, twist_program
 
     model = DynamicModel.of(tricycle())
     for held in ([99], [-1], ["a"], [1.5], [2]):
@@ -224,5 +224,8 @@ def test_steering_gains_refuse_columns_that_are_not_joints():
             model.steering_inertia(held)
     with pytest.raises(WmrkitError, match="servoed: expected steering columns"):
         steering_gains(model, [3])
-    with pytest.raises(WmrkitError, match="bandwidth: expected a natural frequency"):
-        steering_gains(model, list(model.steer_columns), bandwidth=float("nan"))
+    for bandwidth in (float("nan"), 0.0, -30.0):
+        with pytest.raises(WmrkitError, match="bandwidth: expected a natural frequency"):
+            steering_gains(model, list(model.steer_columns), bandwidth=bandwidth)
+        with pytest.raises(WmrkitError, match="bandwidth: expected a natural frequency"):
+            twist_program(model, [0.0], [(1.0, 0.0, 0.0)], bandwidth=bandwidth)

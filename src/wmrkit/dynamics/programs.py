@@ -107,6 +107,8 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     from ..kinematics.wheel_ik import wheel_commands
 
     t = _knots(time)
+    if not (math.isfinite(bandwidth) and bandwidth > 0):
+        raise WmrkitError(f"bandwidth: expected a natural frequency > 0 rad/s, got {bandwidth}")
     twists = np.asarray(twists, dtype=float).reshape(len(t), 3)
     bad = ~(np.abs(twists) <= MAX_SPEED).all(axis=1)  # NaN included
     if bad.any():
