@@ -6,6 +6,7 @@ input is valid, the right answer)."""
 from __future__ import annotations
 
 import json
+import re
 import time
 from pathlib import Path
 
@@ -330,3 +331,18 @@ def test_track_a_diverging_sampled_loop_is_refused(capsys):
     assert "the closed loop diverged at t = " in _refused(
         ["track", "diff-drive", "--reference", "circle", "--duration", "2", "--gain", "1e308", "--period", "0.1"],
         capsys)
+
+
+def test_a_continuous_loop_stops_within_its_computing_time_and_names_a_wheel_held_at_its_range(monkeypatch, capsys):
+    # 'track ackermann --reference figure-eight --gain 3' ran 6 minutes before 'too stiff': the law asks for turns
+    # tighter than the +-40 deg rack allows, and a front wheel held at an end of its range switches ends where the
+    # heading asked of it passes 90 deg. Now at most MAX_CONTINUOUS_SECONDS of computing (lowered here), and the
+    # refusal says where it got and which wheel is held.
+    from wmrkit.control import loop
+
+    monkeypatch.setattr(loop, "MAX_CONTINUOUS_SECONDS", 2.0)
+    start = time.monotonic()
+    message = _refused(["track", "ackermann", "--reference", "figure-eight", "--gain", "3"], capsys)
+    assert time.monotonic() - start < 30
+    assert re.search(r"too stiff to integrate over 90.47 s: it reached t = \S+ s after \d+ evaluations and 2 s of "
+                     r"computing .*wheel 'front_(left|right)' is held at an end of its steer_range", message), message

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -57,8 +58,25 @@ def check_diverged(twist: np.ndarray, t: float) -> None:
 
 
 #: Evaluations of the continuous loop allowed: a base plus this many per simulated second (the examples take
-#: about 100 per second; a start kilometres off the reference makes the loop stiff and takes thousands).
-MAX_EVALUATIONS, EVALUATIONS_PER_SECOND = 20_000, 5_000
+#: 30 to 300 per second, a pole of 100/s about 1000; a start kilometres off the reference makes the loop stiff and
+#: takes thousands), and at most this many seconds of computing (each evaluation costs 0.2 to 1 ms: the
+#: evaluation budget alone let a car with its steering at the ends of its range run for 6 minutes).
+MAX_EVALUATIONS, EVALUATIONS_PER_SECOND, MAX_CONTINUOUS_SECONDS = 20_000, 2_000, 120.0
+
+
+def _too_stiff(controller: TwistController, sim: _Sim, t: float, x: np.ndarray, duration: float, evaluations: int,
+               seconds: float) -> ControlError:
+    """The refusal of a continuous loop that ran out of evaluations or time, with the likely cause."""
+    twist = controller(t, x[:3], x[3:6])[0]
+    beta = x[6:6 + len(sim.passive)]
+    held = [sim.robot.steer_names[k] for k in np.flatnonzero(~sim.realised(twist, beta)[1])]
+    why = (f"; wheel '{held[0]}' is held at an end of its steer_range (the law asks for turns sharper than the robot "
+           "can make; where the heading asked of it passes 90 deg the wheel switches ends, a jump the integrator "
+           "cannot step over)" if held else "")
+    return ControlError(f"the closed loop is too stiff to integrate over {duration:g} s: it reached t = {t:.4g} s "
+                        f"after {evaluations} evaluations and {seconds:.0f} s of computing (commanded speed "
+                        f"{math.hypot(*twist[:2]):.3g} m/s){why}; start closer to the reference, lower the gain, or "
+                        "give a sample period (--period)")
 
 
 def law_controller(cp: ControlPoint, law: PositionLaw, reference: Reference) -> TwistController:
@@ -245,16 +263,13 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
             t_out = np.append(t_out, duration)
         edges = [0.0, *sorted(b for b in breaks if 0 < b < t_out[-1]), float(t_out[-1])]
         ts, xs, x = [], [], x0
-        budget = [MAX_EVALUATIONS + EVALUATIONS_PER_SECOND * duration]
+        allowed = int(MAX_EVALUATIONS + EVALUATIONS_PER_SECOND * duration)
+        budget, start = [allowed], time.monotonic()
 
         def counted(t: float, x: np.ndarray) -> np.ndarray:
             budget[0] -= 1
-            if budget[0] < 0:
-                speed = math.hypot(*controller(t, x[:3], x[3:6])[0][:2])
-                raise ControlError(f"the closed loop is too stiff to integrate over {duration:g} s (more than "
-                                   f"{MAX_EVALUATIONS + EVALUATIONS_PER_SECOND * duration:.0f} evaluations; "
-                                   f"commanded speed {speed:.3g} m/s): start closer to the reference, lower the "
-                                   "gain, or give a sample period")
+            if budget[0] < 0 or (budget[0] % 1000 == 0 and time.monotonic() - start > MAX_CONTINUOUS_SECONDS):
+                raise _too_stiff(controller, sim, t, x, duration, allowed - budget[0], time.monotonic() - start)
             return rhs(t, x)
 
         for lo, hi in itertools.pairwise(edges):  # restart at the reference's known corners
