@@ -28,8 +28,8 @@ from ..robot import Robot
 from ..wheels import heading_in_range, wrap_angle
 from .points import ControlError
 
-__all__ = ["POLICIES", "SteeringChoice", "ackermann_twist", "choose_steering", "crab_twist", "discretize_twist",
-           "icr_twist", "steer_ranges"]
+__all__ = ["POLICIES", "SteeringChoice", "ackermann_twist", "check_policy", "choose_steering", "crab_twist",
+           "discretize_twist", "icr_twist", "steer_ranges"]
 
 POLICIES = ("closest", "4-quadrant", "2-quadrant")
 
@@ -76,6 +76,12 @@ class SteeringChoice:
     reversed: np.ndarray
 
 
+def check_policy(policy: str) -> None:
+    """Refuse a steering policy that is not one of :data:`POLICIES`."""
+    if policy not in POLICIES:
+        raise ControlError(f"unknown steering policy '{policy}' (policies: {', '.join(POLICIES)})")
+
+
 def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, policy: str = "closest",
                     ranges: ArrayLike | None = None) -> SteeringChoice:
     """Pick, per wheel, the root of (8.9) allowed by `policy` and the heading range.
@@ -85,8 +91,7 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
     When neither root fits, the wheel is held at the end of its range nearest to either root, with that root's spin
     (a car asked for 70 deg left by a +-40 deg rack turns 40 deg left, not 40 deg right with its wheel reversed).
     """
-    if policy not in POLICIES:
-        raise ControlError(f"unknown steering policy '{policy}' (policies: {', '.join(POLICIES)})")
+    check_policy(policy)
     h0, s0, cur = _finite({"heading": heading, "spin": spin, "current": current})
     h0 = wrap_angle(h0)
     h1, s1 = wrap_angle(h0 + math.pi), -s0
@@ -165,8 +170,7 @@ def range_keeper(robot: Robot, policy: str = "closest") -> Callable[[np.ndarray,
     root when neither fits; returns which fitted (:func:`.steering.choose_steering`); every steered wheel's
     steering is actuated (:func:`check_steering_driven`). With ``"closest"`` and no range it does nothing: the IK
     has picked the root closest to `current` already."""
-    if policy not in POLICIES:
-        raise ControlError(f"unknown steering policy '{policy}' (policies: {', '.join(POLICIES)})")
+    check_policy(policy)
     ranges, columns = steer_ranges(robot), spin_columns(robot)
     chosen = (np.isfinite(ranges).any(axis=1) | (policy != "closest")) & (columns[:, 0] >= 0)
     columns = columns[chosen]

@@ -107,8 +107,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     from ..kinematics.wheel_ik import wheel_commands
 
     t = _knots(time)
-    if not (math.isfinite(bandwidth) and bandwidth > 0):
-        raise WmrkitError(f"bandwidth: expected a natural frequency > 0 rad/s, got {bandwidth}")
+    _check_bandwidth(bandwidth)
     twists = np.asarray(twists, dtype=float).reshape(len(t), 3)
     bad = ~(np.abs(twists) <= MAX_SPEED).all(axis=1)  # NaN included
     if bad.any():
@@ -136,7 +135,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     for c in driven:
         w = robot.wheel(model.names[c].split(".")[0])
         reflected = w.spin_inertia + m_total * w.r ** 2 / max(len(driven), 1)
-        contact = [k for k, name in enumerate(model.contacts) if name.split(".")[0] == w.name]
+        contact = _contacts_of(model, w.name)
         limit[c] = max(loads[contact].max(), 1.0) * w.r
         gain[c] = max(bandwidth * reflected, limit[c] / 0.1)  # full grip torque at 0.1 rad/s of error at most
     group, ratio = model.pack[13], model.pack[14]
@@ -155,10 +154,20 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     for k, (w, c) in enumerate(zip(steer_wheels, model.steer_columns, strict=True)):
         lever = math.hypot(w.d, w.b)  # the contacts' distance from the steering axis
         if c in servoed and lever > 0:
-            contact = [e for e, name in enumerate(model.contacts) if name.split(".")[0] == w.name]
+            contact = _contacts_of(model, w.name)
             steer_limit[k] = max(loads[contact].sum(), 1.0) * lever
     return Inputs(*(readonly(a) for a in (t, np.zeros((len(t), n)), rates, gain, limit, headings, kp, kd,
                                           steer_limit)))
+
+
+def _check_bandwidth(bandwidth: float) -> None:
+    if not (math.isfinite(bandwidth) and bandwidth > 0):
+        raise WmrkitError(f"bandwidth: expected a natural frequency > 0 rad/s, got {bandwidth}")
+
+
+def _contacts_of(model: DynamicModel, wheel: str) -> list[int]:
+    """Indices in ``model.contacts`` of `wheel`'s contact points (``wheel`` or ``wheel.1``, ``wheel.2``)."""
+    return [e for e, name in enumerate(model.contacts) if name.split(".")[0] == wheel]
 
 
 def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequence[int] = (),
@@ -173,8 +182,7 @@ def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequenc
     if not set(servoed) <= set(model.steer_columns):
         raise WmrkitError(f"servoed: expected steering columns of model.names {list(model.steer_columns)}, got "
                           f"{list(servoed)}")
-    if not (math.isfinite(bandwidth) and bandwidth > 0):
-        raise WmrkitError(f"bandwidth: expected a natural frequency > 0 rad/s, got {bandwidth}")
+    _check_bandwidth(bandwidth)
     if not servoed:
         return kp, kd
     inertia = model.steering_inertia([*servoed, *held])
