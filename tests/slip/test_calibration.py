@@ -10,6 +10,7 @@ import pytest
 
 from wmrkit import catalog
 from wmrkit.cli.main import main
+from wmrkit.errors import WmrkitError
 from wmrkit.odometry.logs import write_csv
 from wmrkit.odometry.pipeline import odometry
 from wmrkit.odometry.trajectories import Trajectory, write_trajectory
@@ -47,6 +48,26 @@ def test_simulated_skid_steer_slips_like_its_tyres(husky_run):
     rms = dict(cal.rms)
     assert rms["wls"] < 0.1 * rms["no_slip"]
     assert math.isclose(rms["wls"], rms["effective_track"], rel_tol=1e-3, abs_tol=1e-6)
+
+
+@pytest.mark.parametrize("start", [0.5, 5.0])
+def test_a_reference_that_starts_after_the_log_gives_the_same_fit(husky_run, start):
+    """The odometry passes through the reference's first pose at its time, not at the log's first sample (it
+    used to start there, and a reference from 5 s ran the ratio to its bound, 1e6)."""
+    robot, log = catalog.load("skid-steer-4"), husky_run.log
+    full = calibrate_slip(robot, log, (log.time, husky_run.truth))
+    late = log.time >= start
+    part = calibrate_slip(robot, log, (log.time[late], husky_run.truth[late]))
+    assert part.ratio == pytest.approx(full.ratio, rel=0.05)
+    assert part.multiplier == pytest.approx(full.multiplier, rel=0.05)
+    assert dict(part.rms)["wls"] < 0.25 * dict(part.rms)["no_slip"]
+
+
+def test_a_reference_of_another_run_is_refused(husky_run):
+    """A fit that runs to the bound of its search is not a calibration: here the reference turns the other way."""
+    mirrored = husky_run.truth * [1.0, -1.0, -1.0]
+    with pytest.raises(WmrkitError, match="ran to the bound of its search"):
+        calibrate_slip(catalog.load("skid-steer-4"), husky_run.log, (husky_run.log.time, mirrored))
 
 
 def test_cli_calibrate_then_odometry(tmp_path, capsys, husky_run):

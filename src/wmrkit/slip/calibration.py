@@ -101,8 +101,10 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
                    heading_weight: float = 1.0) -> SlipCalibration:
     """Fit the WLS ratio and the effective track of `robot` to `reference` ``(times (M,), poses (M, 3))`` (TUM).
 
-    The reference's first pose is the start pose; the odometry is interpolated linearly at the reference's times
-    (which must lie within the log's span).
+    The odometry is placed so that it passes through the reference's first pose at the reference's first time (a
+    reference may start after the log), and interpolated linearly at the reference's times within the log's span.
+    A fit that runs to a bound of its search (ratio 1e-6 or 1e6, multiplier 0.01 or 100) is refused: the log and
+    the reference then disagree (another run, another time base).
     """
     from scipy.optimize import least_squares
 
@@ -113,10 +115,9 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
     if inside.sum() < 2:
         raise WmrkitError("reference: fewer than two poses within the log's time span")
     t_ref, ref = t_ref[inside], ref[inside]
-    pose0 = _interp(t_ref[:1], t_ref, ref)[0] if t_ref[0] > t[0] else ref[0]
 
     def poses_of(model) -> np.ndarray:
-        return _interp(t_ref, t, odometry(model, log, method=method, pose0=pose0).poses)
+        return _anchored(_interp(t_ref, t, odometry(model, log, method=method).poses), ref[0])
 
     def residuals(poses: np.ndarray) -> np.ndarray:
         err = poses - ref
@@ -133,6 +134,9 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
             raise WmrkitError(f"the log does not determine the {what}: the odometry moves less than "
                               f"{IDENTIFIED * scale:.2g} m when it changes tenfold (a run without turning?); "
                               "calibrate on a log that turns")
+        if np.any(fit.active_mask != 0):
+            raise WmrkitError(f"the {what} ran to the bound of its search ({_BOUNDS[what]}): the log and the "
+                              "reference disagree; check that they record the same run on the same clock")
     ratio, multiplier = 10.0 ** float(fit_k.x[0]), 10.0 ** float(fit_m.x[0])
     runs = {"no_slip": wls_model(robot), "wls": wls_model(robot, SlipWeights.uniform(ratio, 1.0)),
             "effective_track": effective_track_model(robot, multiplier)}
@@ -143,6 +147,18 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
         rms.append((name, float(np.sqrt(np.mean(d * d)))))
         final.append((name, float(d[-1]), float(abs(wrap_angle(p[-1, 2] - ref[-1, 2])))))
     return SlipCalibration(robot.name, ratio, multiplier, tuple(rms), tuple(final))
+
+
+_BOUNDS = {"WLS ratio": "1e-6 to 1e6", "effective track": "multiplier 0.01 to 100"}
+
+
+def _anchored(poses: np.ndarray, start: np.ndarray) -> np.ndarray:
+    """`poses` ``(N, 3)`` moved rigidly so that the first one is `start` (odometry from another start pose)."""
+    turn = start[2] - poses[0, 2]
+    c, s = math.cos(turn), math.sin(turn)
+    d = poses[:, :2] - poses[0, :2]
+    return np.column_stack([start[0] + c * d[:, 0] - s * d[:, 1], start[1] + s * d[:, 0] + c * d[:, 1],
+                            poses[:, 2] + turn])
 
 
 def _interp(t_new: np.ndarray, t: np.ndarray, poses: np.ndarray) -> np.ndarray:
