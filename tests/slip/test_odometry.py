@@ -136,7 +136,21 @@ def test_filter_refuses_an_external_heading():
     from wmrkit.errors import WmrkitError
 
     with pytest.raises(WmrkitError, match="external heading"):
-        estimator(robot, "fk1").run([log])
+        estimator(robot, "fk2").run([log])
+
+
+@pytest.mark.parametrize(("robot", "sensed", "advice"), [
+    ("forklift", ["steer.steer"], ""),
+    ("forklift", ["right_drive.spin", "steer.steer"], "use fk2"),  # FK2 has the drive wheels' lateral rows
+    ("diff-drive", None, "use fk2")])
+def test_fk1_refuses_rows_that_do_not_determine_the_twist(robot, sensed, advice):
+    """FK1 used to run on them: the random walk carried the unmeasured directions (a forklift's log of 24 m gave
+    a path of 0 m, or a heading 100 deg off FK2's)."""
+    from wmrkit.errors import WmrkitError
+    from wmrkit.slip.kalman import kalman_model
+
+    with pytest.raises(WmrkitError, match=f"fk1: the sensed rows .* do not determine its twist.*{advice}"):
+        kalman_model(catalog.load(robot), "fk1", sensed=sensed)
 
 
 def test_only_the_ratios_of_the_kalman_noises_matter(forklift_run):

@@ -156,8 +156,9 @@ def kalman_model(robot: Robot, kind: str = "fk2", noise: KalmanNoise | None = No
                 sigma.append(s)
             row += 2
     rows_a = np.array(rows, dtype=int)
-    if np.linalg.matrix_rank(a[0][rows_a, :3]) < 3 and kind == "fk2":
-        raise WmrkitError(f"{kind}: the sensed rows of robot '{robot.name}' do not determine its twist")
+    if np.linalg.matrix_rank(a[0][rows_a, :3]) < 3:  # the random walk would carry the undetermined directions
+        dropped = " (fk1 leaves out the lateral rows of fixed wheels, (7.69): use fk2)" if kind == "fk1" else ""
+        raise WmrkitError(f"{kind}: the sensed rows of robot '{robot.name}' do not determine its twist{dropped}")
     return KalmanModel(base, rows_a, np.array(sigma), float(noise.process) ** 2, thesis_double_q)
 
 
