@@ -256,3 +256,33 @@ def test_jacobian_interval_needs_each_run_removable(diff):
             for cw in (False, True)]
     with pytest.raises(BatchError, match="two in each direction"):
         fleet_calibrate(diff, runs, params)
+
+
+def test_bootstrap_drops_replicates_that_do_not_determine_the_parameters(diff):
+    """Four zero-noise closed squares, two each way: a resample of squares that all turn one way cannot tell the
+    radius ratio from the track, and its fit is arbitrary. Those replicates used to widen the interval to
+    [0.1515, 0.3416] m around a track fitted exactly (0.204 m); now they are dropped and counted, and the
+    interval is the exact fit's."""
+    params = default_parameters(diff, closed=True)
+    true = apply_parameters(diff, params, [0.01, 0.03])
+    runs = [CalibrationRun.closed_path(simulate(true, square_path(1.5, clockwise=i % 2 == 1, pause=0.3), 10.0).log)
+            for i in range(4)]
+    res = fleet_calibrate(diff, runs, params, ci="bootstrap", n_boot=40, seed=3)
+    np.testing.assert_allclose(res.estimate, [0.01, 0.03], rtol=1e-8)
+    for (lo, hi), p in zip(res.interval, res.estimate, strict=True):
+        assert lo == pytest.approx(p, abs=1e-8) and hi == pytest.approx(p, abs=1e-8)
+    (note,) = [w for w in res.warnings if w.startswith("bootstrap:")]
+    dropped = int(note.split()[1])
+    assert 0 < dropped < 20 and f"{dropped} of 40 replicates dropped" in note
+
+
+def test_bootstrap_refuses_when_most_replicates_do_not_determine_the_parameters(diff):
+    """One square each way: half of the resamples hold one square twice."""
+    params = default_parameters(diff, closed=True)
+    true = apply_parameters(diff, params, [0.01, 0.03])
+    runs = [CalibrationRun.closed_path(simulate(true, square_path(1.5, clockwise=cw, pause=0.3), 10.0).log)
+            for cw in (False, True)]
+    with pytest.raises(BatchError, match=r"in \d+ of 40 bootstrap replicates .* cannot tell"):
+        fleet_calibrate(diff, runs, params, ci="bootstrap", n_boot=40, seed=0)
+    with pytest.raises(BatchError, match="cannot tell these parameters apart"):  # the fit itself, either interval
+        fleet_calibrate(diff, runs[:1], params, ci="bootstrap", n_boot=40)

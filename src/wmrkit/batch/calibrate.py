@@ -95,9 +95,22 @@ def _jacobian_of(args: tuple[CalibrationProblem, np.ndarray, np.ndarray]) -> np.
     return problem.jacobian(p, r)
 
 
+#: Condition number of ``J^T J`` above which the runs cannot tell the parameters apart.
+MAX_CONDITION = 1e14
+#: Least fraction of bootstrap replicates that must determine the parameters (the others are dropped and counted).
+MIN_DETERMINED = 0.5
+
+
+def _determined(jac: np.ndarray) -> bool:
+    """Whether a least-squares Jacobian ``(R, n)`` determines all `n` parameters."""
+    return bool(np.linalg.cond(jac.T @ jac) <= MAX_CONDITION)
+
+
 def _refit(problem: CalibrationProblem) -> np.ndarray:
-    """A bootstrap replicate: the fit over `problem`'s runs, in one process."""
-    return problem.fit()
+    """A bootstrap replicate: the fit over `problem`'s runs, in one process; NaN where they do not determine the
+    parameters (a resample of closed squares that all turn the same way), which the fit would report as a value."""
+    fit = solve(problem.residuals, len(problem.parameters), jacobian=problem.jacobian)
+    return fit.x if _determined(fit.jac) else np.full(len(problem.parameters), np.nan)
 
 
 #: Most bootstrap replicates (each refits every run): percentile intervals settle within a few thousand.
@@ -158,6 +171,10 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
         if m <= n:
             raise BatchError(f"calibrate: {m} residuals cannot fix {n} parameters with an interval; add runs")
         fit = solve(residuals, n, jacobian=jacobian)
+        if not _determined(fit.jac):
+            raise BatchError("calibrate: the runs cannot tell these parameters apart (singular Jacobian); add runs "
+                             "of other shapes or fit fewer parameters")
+        notes = ()
         if ci == "jacobian":
             lo, hi = _sandwich_interval(fit, problem.sizes(), level)
         else:
@@ -165,11 +182,20 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
             picks = [rng.integers(0, len(runs), len(runs)) for _ in range(n_boot)]
             reps = np.array(runner.map(_refit, [problem.with_runs([runs[i] for i in pick]) for pick in picks],
                                        progress=progress, desc="bootstrap"))
-            lo, hi = np.quantile(reps, 0.5 - level / 2, axis=0), np.quantile(reps, 0.5 + level / 2, axis=0)
+            kept = reps[~np.isnan(reps).any(axis=1)]
+            dropped = n_boot - len(kept)
+            if len(kept) < max(2, MIN_DETERMINED * n_boot):
+                raise BatchError(f"calibrate: in {dropped} of {n_boot} bootstrap replicates the resampled runs "
+                                 "cannot tell these parameters apart; add runs (closed squares: two or more in each "
+                                 "direction) or use --ci jacobian")
+            if dropped:
+                notes = (f"bootstrap: {dropped} of {n_boot} replicates dropped, their resampled runs cannot tell "
+                         "the parameters apart (the interval is over the others)",)
+            lo, hi = np.quantile(kept, 0.5 - level / 2, axis=0), np.quantile(kept, 0.5 + level / 2, axis=0)
     finally:
         if own:
             runner.close()
-    return _result(problem, fit, lo, hi, r0, ci, level)
+    return _result(problem, fit, lo, hi, r0, ci, level, notes)
 
 
 #: Highest confidence level: beyond it Student's quantile with the few degrees of freedom of a fleet is astronomic (1
@@ -202,14 +228,11 @@ def _sandwich_interval(fit, sizes: Sequence[int], level: float) -> tuple[np.ndar
     if g < 2:
         raise BatchError("calibrate: a confidence interval needs at least two runs")
     jtj = fit.jac.T @ fit.jac
-    if np.linalg.cond(jtj) > 1e14:
-        raise BatchError("calibrate: the runs cannot tell these parameters apart (singular Jacobian); add runs "
-                         "of other shapes or fit fewer parameters")
     change = []
     for k, (a, b) in enumerate(zip(np.cumsum([0, *sizes[:-1]]), np.cumsum(sizes), strict=True)):
         jg = fit.jac[a:b]
         rest = jtj - jg.T @ jg
-        if np.linalg.cond(rest) > 1e14:
+        if np.linalg.cond(rest) > MAX_CONDITION:
             raise BatchError(f"calibrate: without run {k + 1} the other runs cannot tell these parameters apart, so "
                              f"the interval cannot be estimated; add runs (closed squares: two in each direction)")
         change.append(np.linalg.solve(rest, jg.T @ fit.fun[a:b]))
@@ -219,7 +242,8 @@ def _sandwich_interval(fit, sizes: Sequence[int], level: float) -> tuple[np.ndar
     return fit.x - half, fit.x + half
 
 
-def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float) -> FleetCalibration:
+def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float,
+            notes: tuple[str, ...] = ()) -> FleetCalibration:
     robot, params = problem.robot, problem.parameters
     values = []
     for k, group in enumerate(params):
@@ -233,7 +257,7 @@ def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float)
     return FleetCalibration(apply_parameters(robot, params, fit.x), groups, tuple(map(float, fit.x)),
                             tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True)), tuple(values),
                             rms(r0), rms(fit.fun), len(problem.runs), int(r0.size), ci, level, bool(fit.success),
-                            problem.warnings())
+                            problem.warnings() + notes)
 
 
 @dataclass(frozen=True)
