@@ -77,6 +77,23 @@ def test_simulate_path_json_out_and_plot(capsys, tmp_path):
     assert plot.stat().st_size > 1000
 
 
+def test_simulate_out_writes_steering_as_headings(capsys, tmp_path):
+    """It wrote the thesis's beta (pi/2 for a forklift rolling straight ahead) as 'steer.steer.position'."""
+    torques = tmp_path / "tau.csv"
+    torques.write_text("time,left_drive.spin,right_drive.spin\n0,100,100\n2,100,100\n")
+    csv_out, json_out = tmp_path / "run.csv", tmp_path / "run.json"
+    for out in (csv_out, json_out):
+        assert run(capsys, "simulate", "forklift", "--torques", str(torques), "--out", str(out))[0] == 0
+    header = csv_out.read_text().splitlines()[0].split(",")
+    table = np.loadtxt(csv_out, delimiter=",", skiprows=1)
+    assert "steer.heading" in header and "steer.steer.position" not in header
+    assert "right_drive.spin.position" in header and "steer.steer.rate" in header
+    assert np.abs(table[:, header.index("steer.heading")]).max() < 1e-3  # straight ahead (beta: pi/2)
+    data = json.loads(json_out.read_text())
+    heading = np.array(data["joint_positions"])[:, data["positions"].index("steer.heading")]
+    np.testing.assert_allclose(heading, table[:, header.index("steer.heading")], atol=1e-8)
+
+
 def test_simulate_torque_file(capsys, tmp_path):
     path = tmp_path / "tau.csv"
     path.write_text("time,left_drive.spin,right_drive.spin\n0,100,100\n1,100,100\n")

@@ -145,10 +145,12 @@ def _write(sim, out: str) -> None:
 
             path.write_text(json.dumps(sim.to_dict()) + "\n", encoding="utf-8")
             return
-        cols = ["time", "x", "y", "theta", "vx", "vy", "omega", *(f"{j}.position" for j in sim.joint_names),
+        position_names, positions = sim.joint_table()
+        cols = ["time", "x", "y", "theta", "vx", "vy", "omega",
+                *(n if n.endswith(".heading") else f"{n}.position" for n in position_names),
                 *(f"{j}.rate" for j in sim.joint_names), *(f"{c}.{k}" for c in sim.contacts for k in
                                                            ("f_lat", "f_long", "load"))]
-        data = np.column_stack([sim.t, sim.pose, sim.twist, sim.joint_positions, sim.joint_rates,
+        data = np.column_stack([sim.t, sim.pose, sim.twist, positions, sim.joint_rates,
                                 np.concatenate([sim.forces, sim.loads[..., None]], axis=-1).reshape(len(sim.t), -1)])
         np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.9g")
     except OSError as err:

@@ -245,7 +245,7 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
         k = len(w.elements())
         contacts.extend([w.name] if k == 1 else [f"{w.name}.{j + 1}" for j in range(k)])
     spread = np.linalg.svd(geo, compute_uv=False)
-    if len(spread) < 3 or spread[2] <= 1e-9 * spread[0]:  # (7.64) has no solution: the least-squares loads would leave a pitch moment
+    if len(spread) < 3 or spread[2] <= 1e-9 * spread[0]:  # (7.64) has no solution: a pitch moment would be left
         raise WmrkitError(f"robot '{robot.name}': the contacts of its wheels ({', '.join(contacts)}) lie on one "
                           "line, so nothing holds the body up about that line and the normal loads (7.64) cannot "
                           "balance it; add a wheel (a castor) off that line")

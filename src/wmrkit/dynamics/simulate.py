@@ -87,19 +87,32 @@ class Simulation:
     method: str
     step: float
     info: dict = field(default_factory=dict)
+    steered: tuple[str, ...] = ()  # the wheels of the heading columns
 
     @property
     def joint_names(self) -> tuple[str, ...]:
         """Names of the joint columns."""
         return self.names[3:]
 
+    def joint_table(self) -> tuple[tuple[str, ...], np.ndarray]:
+        """The joint positions as users read them: ``(names, (N, n - 3))``, each steering angle β replaced by the
+        wheel's heading (``wheel.heading`` [rad], 0 = straight ahead), wheel angles as ``wheel.spin`` [rad]."""
+        names, table = list(self.joint_names), np.array(self.joint_positions)
+        for k, wheel in enumerate(self.steered):
+            c = names.index(f"{wheel}.steer")
+            names[c], table[:, c] = f"{wheel}.heading", self.heading[:, k]
+        return tuple(names), table
+
     def friction_power(self) -> np.ndarray:
         """Power of the contact forces on the slips ``(N,)`` [W]; never positive for dissipative tyres."""
         return np.einsum("nec,nec->n", self.forces, self.slip)
 
     def to_dict(self) -> dict:
-        """Plain data (lists) for JSON: time, pose, twist, joints, loads and forces."""
+        """Plain data (lists) for JSON: time, pose, twist, joints (positions as :meth:`joint_table`: headings for
+        steering), loads and forces."""
+        position_names, positions = self.joint_table()
         return {"t": self.t.tolist(), "pose": self.pose.tolist(), "twist": self.twist.tolist(),
+                "positions": list(position_names), "joint_positions": positions.tolist(),
                 "joints": list(self.joint_names), "joint_rates": self.joint_rates.tolist(),
                 "contacts": list(self.contacts), "forces": self.forces.tolist(), "loads": self.loads.tolist(),
                 "method": self.method, "step": self.step}
@@ -407,4 +420,5 @@ def _result(model: DynamicModel, rec: tuple, method: str, step: float, info: dic
     delta = np.array([w.delta for w in model.robot.wheels if w.kind.steers])
     return Simulation(model.names, model.contacts, *(readonly(np.ascontiguousarray(a)) for a in (
         t, s[:, :3], s[:, n:n + 3], s[:, 3:n], s[:, n + 3:], tau[:, 3:], heading_from_beta(beta, delta), f, fz, v,
-        vw)), method=method, step=step, info=info)
+        vw)), method=method, step=step, info=info,
+        steered=tuple(w.name for w in model.robot.wheels if w.kind.steers))
