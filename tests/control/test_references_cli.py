@@ -53,6 +53,19 @@ def test_files_tum_and_csv(tmp_path):
         builtin_reference("circel")
 
 
+def test_headings_in_degrees_are_refused_and_unwrapped_radians_kept(tmp_path):
+    """'t,x,y,theta' with theta 90 was read as 90 rad and followed as 2.035 rad (exit 0)."""
+    deg = tmp_path / "deg.csv"
+    deg.write_text("t,x,y,theta\n0,0,0,0\n1,1,0,90\n2,2,0,0\n")
+    with pytest.raises(ReferenceError, match=r"sample 2: theta 90 rad.*degrees\? 90 deg = 1.5708 rad"):
+        load_reference(deg)
+    t = np.linspace(0, 20, 201)  # three turns on the spot, unwrapped: beyond a turn, small steps
+    spin = tmp_path / "spin.csv"
+    np.savetxt(spin, np.column_stack([t, 0 * t, 0 * t, 3 * math.pi * t / 10]), delimiter=",", header="t,x,y,theta",
+               comments="", fmt="%.17g")
+    assert load_reference(spin).pose[-1, 2] == pytest.approx(6 * math.pi)
+
+
 @pytest.mark.parametrize("controller", ["pure-pursuit", "stanley"])
 @pytest.mark.parametrize("name", ["diff-drive", "forklift", "swerve-4"])
 def test_geometric_trackers_converge_onto_the_path(controller, name):

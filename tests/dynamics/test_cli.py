@@ -94,6 +94,16 @@ def test_simulate_out_writes_steering_as_headings(capsys, tmp_path):
     np.testing.assert_allclose(heading, table[:, header.index("steer.heading")], atol=1e-8)
 
 
+def test_a_heading_column_beyond_a_turn_is_refused(capsys, tmp_path):
+    """A heading of 90 (degrees meant) was read as 90 rad and steered to 2.035 rad (exit 0)."""
+    path = tmp_path / "tau.csv"
+    path.write_text("time,right_drive.spin,left_drive.spin,steer.heading\n0,300,300,0.5\n3,300,300,90\n")
+    code, out, err = run(capsys, "simulate", "forklift", "--torques", str(path))
+    assert code == 2 and out == ""
+    assert err.strip() == (f"wmrkit: error: {path}:3: column 'steer.heading': a heading is read in radians, and 90 "
+                           "rad is more than a turn; degrees? 90 deg = 1.5708 rad")
+
+
 def test_simulate_torque_file(capsys, tmp_path):
     path = tmp_path / "tau.csv"
     path.write_text("time,left_drive.spin,right_drive.spin\n0,100,100\n1,100,100\n")

@@ -92,12 +92,24 @@ def reference_from_samples(name: str, t: np.ndarray, pose: np.ndarray) -> Refere
     if np.any(np.diff(t) <= 0):
         k = int(np.argmax(np.diff(t) <= 0))
         raise ReferenceError(f"{name}: times must increase (sample {k + 1}: {t[k + 1]} after {t[k]})")
+    _check_radians(name, pose[:, 2])
     pose[:, 2] = np.unwrap(pose[:, 2])
     # second-order differences at the ends too: first-order ones put a false curvature jump at the first and last
     # samples of a reference that starts or ends turning
     vel = np.gradient(pose, t, axis=0, edge_order=2)
     acc = np.gradient(vel, t, axis=0, edge_order=2)
     return Reference(name, readonly(t), readonly(pose), readonly(vel), readonly(acc))
+
+
+def _check_radians(name: str, theta: np.ndarray) -> None:
+    """Headings are radians: wrapped ones stay within a turn, unwrapped ones move less than half a turn a sample.
+    Beyond a turn with larger jumps they are degrees (or nothing a robot can follow): refused."""
+    jumps = np.abs(np.diff(theta))
+    if np.abs(theta).max() > 2 * math.pi and jumps.max() > math.pi:
+        k = int(np.argmax(jumps)) + 1
+        raise ReferenceError(f"{name}: sample {k + 1}: theta {theta[k]:g} rad, {jumps[k - 1]:g} rad from the sample "
+                             "before: headings are radians and go beyond a turn only when unwrapped (less than half "
+                             f"a turn a sample); degrees? {theta[k]:g} deg = {math.radians(theta[k]):.6g} rad")
 
 
 def load_reference(path: str | os.PathLike[str]) -> Reference:

@@ -192,6 +192,15 @@ def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequenc
     return kp, kd
 
 
+def _check_radians(source: str, column: str, headings: np.ndarray) -> None:
+    """A heading column [rad] stays within a turn, as a bare angle anywhere else (``units.parse_quantity``)."""
+    beyond = np.flatnonzero(np.abs(headings) > 2 * math.pi)
+    if beyond.size:
+        h = headings[beyond[0]]
+        raise WmrkitError(f"{source}:{beyond[0] + 2}: column '{column}': a heading is read in radians, and {h:g} rad "
+                          f"is more than a turn; degrees? {h:g} deg = {math.radians(h):.6g} rad")
+
+
 def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     """:class:`Inputs` from a torque CSV (module docstring); errors name the file, the line and the column."""
     source = str(path)
@@ -226,6 +235,8 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     torques, headings = {}, {}
     for j, name in enumerate(header[1:], start=1):
         wheel, _, joint = name.partition(".")
+        if joint == "heading":
+            _check_radians(source, name, values[:, j])
         try:
             if joint == "heading":
                 headings[model.steer_columns[model.robot.steer_names.index(wheel)]] = values[:, j]
