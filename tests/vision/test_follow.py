@@ -141,3 +141,17 @@ def test_refused_setups():
 def test_an_omnidirectional_robot_follows_without_turning():
     run = follow_line(catalog.load("omni-3"), CAMERA, gain=0.3, duration=6)
     assert np.all(np.diff(run.lateral) < 0) and np.allclose(run.pose[:, 2], 0.0, atol=1e-9)
+
+
+def test_a_camera_too_noisy_to_see_the_line_is_an_error_with_its_reason(capsys):
+    """'--image-noise 1e300' ran 40 periods steering to lines found in noise (final h 40 cm, exit 0)."""
+    from pathlib import Path
+
+    from wmrkit.cli.main import main
+
+    camera = str(Path(__file__).resolve().parents[2] / "docs" / "figures" / "vision" / "follower-camera.yaml")
+    assert main(["follow-line", "line-follower", "--camera", camera, "--image-noise", "40"]) == 2
+    err = capsys.readouterr().err
+    assert "follow-line: the camera does not see the line at the start pose: image: too noisy" in err
+    assert main(["follow-line", "line-follower", "--camera", camera, "--image-noise", "1e300"]) == 2
+    assert "image noise must be in [0, 255] grey levels" in capsys.readouterr().err

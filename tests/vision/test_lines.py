@@ -153,3 +153,24 @@ def test_runs_of_a_random_mask_match_a_loop():
             else:
                 c += 1
     assert list(zip(rows.tolist(), first.tolist(), middle.tolist(), length.tolist(), strict=True)) == expected
+
+
+@pytest.mark.parametrize("noise", [20.0, 40.0, 255.0])
+def test_an_image_too_noisy_for_the_threshold_is_refused_not_read_as_lines(noise):
+    """Image noise of 20 grey levels defeats Otsu's threshold of a thin line: 40 % of the pixels become of
+    interest and Hough found a line in them wherever the speckle peaked (the follower steered to it, exit 0)."""
+    cam = Camera(150, math.radians(60), 0.3, 320, 240)
+    scene = Scene(ns=(0,), width=0.02)
+    assert len(extract_lines(render(cam, (0, 0.3, 0), scene, noise=12.0, seed=1))) == 1  # below: found
+    with pytest.raises(WmrkitError, match=r"image: too noisy to find lines, \d+ runs of pixels of interest a row"):
+        extract_lines(render(cam, (0, 0.3, 0), scene, noise=noise, seed=1))
+    with pytest.raises(WmrkitError, match="too noisy"):
+        locate_image(cam, render(cam, (0, 0.3, 0), scene, noise=noise, seed=1))
+
+
+def test_weeds_and_crop_rows_are_not_speckle():
+    """The densest scenes of these tests (five crop rows with 100 weeds; 5 runs a row at most in the median)."""
+    cam = Camera(545, math.radians(76), 1.42, 640, 480)
+    scene = Scene(ns=(-2, -1, 0, 1, 2), spacing=0.6, width=0.25, style="crops")
+    img = render(cam, (0.0, -0.05, 0.01), scene, noise=6.0, blur=1.0, clutter=100, seed=1)
+    assert len(extract_lines(img, n_lines=5)) >= 3

@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 
 from ..errors import WmrkitError
 from ..robot import Robot
-from .camera import Camera, distort
+from .camera import Camera, CameraError, distort
 from .follow import LineFollowing
 from .lines import DetectedLine, extract_lines
 
@@ -34,13 +34,20 @@ def draw_camera_view(ax, camera: Camera, image: np.ndarray, lines: tuple[Detecte
     ax.set_yticks([])
 
 
+def _found_lines(camera: Camera, image: np.ndarray, n_lines: int) -> tuple:
+    """The lines :func:`.lines.extract_lines` finds in `image`, none where it finds only noise (drawn as it is)."""
+    try:
+        return extract_lines(image, n_lines=n_lines, k1=camera.k1, focal_px=camera.focal_px)
+    except CameraError:
+        return ()
+
+
 def save_detection_figure(camera: Camera, image: np.ndarray, path: str | os.PathLike[str], *,
                           n_lines: int = 1, title: str = "") -> None:
     """A PNG/SVG of `image` with the lines :func:`.lines.extract_lines` finds in it."""
     fig = Figure(figsize=(camera.width / 100, camera.rows / 100 + (0.3 if title else 0)), dpi=100)
     ax = fig.add_axes((0, 0, 1, 1 if not title else camera.rows / (camera.rows + 30)))
-    draw_camera_view(ax, camera, image, extract_lines(image, n_lines=n_lines, k1=camera.k1,
-                                                      focal_px=camera.focal_px))
+    draw_camera_view(ax, camera, image, _found_lines(camera, image, n_lines))
     if title:
         fig.suptitle(title, fontsize=9)
     fig.savefig(path)
@@ -83,7 +90,7 @@ def save_animation(run: LineFollowing, robot: Robot, camera: Camera, path: str |
     def frame(k: int):
         cam_ax.clear()
         img = run.images[k]
-        draw_camera_view(cam_ax, camera, img, extract_lines(img, n_lines=1, k1=camera.k1, focal_px=camera.focal_px))
+        draw_camera_view(cam_ax, camera, img, _found_lines(camera, img, 1))
         cam_ax.set_title("camera", fontsize=9)
         path_line.set_data(pose[:k + 1, 0], pose[:k + 1, 1])
         c, s = math.cos(pose[k, 2]), math.sin(pose[k, 2])

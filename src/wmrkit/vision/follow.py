@@ -217,6 +217,7 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     lost = np.zeros(n_steps, dtype=bool)
     images: list[np.ndarray] = []
     beta = robot.beta
+    why: list[str] = []  # why the last image gave no positioning
 
     def position(p: np.ndarray) -> tuple[float, float] | None:
         if not from_image:
@@ -227,13 +228,14 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
             images.append(img)
         try:
             fix = locate_image(camera, img, spacing=scene.spacing, ns=scene.ns, z_p=z_p)
-        except WmrkitError:
+        except WmrkitError as err:
+            why[:] = [str(err)]
             return None
         return (fix.psi + rng.uniform(-noise[1], noise[1]), fix.h + rng.uniform(-noise[0], noise[0]))
 
     last = position(pose[0])  # the image taken before starting
     if last is None:
-        raise WmrkitError("follow-line: the camera does not see the line at the start pose")
+        raise WmrkitError(f"follow-line: the camera does not see the line at the start pose: {why[0]}")
     for k in range(n_steps):
         psi, h = last
         measured[k] = psi, h

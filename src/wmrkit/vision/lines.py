@@ -210,6 +210,23 @@ def _fit_lines(runs: np.ndarray, lines: list[tuple[float, float]], max_band: flo
     return fits
 
 
+#: Most runs of pixels of interest per image row (median over the rows that have any), per 32 px of width, and at
+#: least: references (painted lines, crop rows, with weeds) make one or two per reference crossing a row (measured:
+#: 1-5 in the tests' scenes); binarised noise makes one every 4 px (an image too noisy for the threshold).
+SPECKLE_RUNS_PER_32_PX, SPECKLE_MIN_RUNS = 1.0, 8.0
+
+
+def _check_not_speckle(run_row: np.ndarray, rows: int, width: int) -> None:
+    """Refuse pixels of interest that are noise, not references: Hough finds lines in any dense speckle (image
+    noise of 20 grey levels defeats the threshold of a thin line; a follower then steered to random lines)."""
+    per_row = np.bincount(run_row, minlength=rows)
+    per_row = per_row[per_row > 0]
+    limit = max(SPECKLE_MIN_RUNS, SPECKLE_RUNS_PER_32_PX * width / 32)
+    if per_row.size and np.median(per_row) > limit:
+        raise CameraError(f"image: too noisy to find lines, {np.median(per_row):g} runs of pixels of interest a row "
+                          f"(median; references make a few, at most {limit:g}): reduce the image noise")
+
+
 def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Every run of mask pixels along a row: ``(row, first column, middle column, length)``.
 
@@ -245,6 +262,7 @@ def extract_lines(image: ArrayLike, *, n_lines: int = 1, mode: str = "threshold"
     rows, width = binary.shape
     scale = hough_scale if hough_scale is not None else (0.5 if width > 400 else 1.0)
     run_row, run_first, run_mid, run_len = _runs(binary)
+    _check_not_speckle(run_row, rows, width)
     if mode == "threshold":  # wide references vote as thin lines: the middle pixel of each run
         voters = np.zeros_like(binary)
         voters[run_row, np.floor(run_mid).astype(np.intp)] = 255

@@ -8,7 +8,6 @@ Options add Gaussian noise, blur and clutter (bright blobs lying on the ground).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +23,8 @@ GROUND, PAINT = 70.0, 215.0
 #: Largest blur sigma [px] (wider blurs a camera image to a uniform grey) and most clutter blobs per image (each
 #: costs a pass over the image).
 MAX_BLUR, MAX_CLUTTER = 50.0, 100
+#: Largest image noise: a standard deviation of the whole grey range.
+MAX_NOISE = 255.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -76,9 +77,9 @@ def render(camera: Camera, pose_line_robot: ArrayLike, scene: Scene, *, z_p: flo
     Gaussian noise [grey levels]; `blur`: Gaussian blur sigma [px]; `clutter`: number of bright blobs scattered
     on the ground in view (drawn anew for each image); `seed` makes noise and clutter reproducible.
     """
-    if not (math.isfinite(noise) and noise >= 0 and math.isfinite(blur) and 0 <= blur <= MAX_BLUR):
-        raise CameraError(f"render: image noise must be finite and >= 0 and blur in [0, {MAX_BLUR:g}] px, got "
-                          f"{noise:g}, {blur:g}")
+    if not (0 <= noise <= MAX_NOISE and 0 <= blur <= MAX_BLUR):  # NaN fails both
+        raise CameraError(f"render: image noise must be in [0, {MAX_NOISE:g}] grey levels and blur in [0, "
+                          f"{MAX_BLUR:g}] px, got {noise:g}, {blur:g}")
     if not (isinstance(clutter, int | np.integer) and 0 <= clutter <= MAX_CLUTTER):
         raise CameraError(f"render: clutter must be an integer in [0, {MAX_CLUTTER}] blobs, got {clutter!r}")
     rng = np.random.default_rng(seed)
