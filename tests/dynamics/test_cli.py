@@ -39,6 +39,17 @@ def test_tyre_friction_coefficients_are_the_forces_over_the_load(capsys):
     assert code == 0 and data["Fx"] < 0 and data["mu_long"] is None and data["mu_lat"] is None  # not defined
 
 
+@pytest.mark.parametrize(("args", "message"), [
+    (["--load", "1e300", "--slip-ratio", "0.1"], "--load: at most 1e+07 N"),  # printed Fx = -6.8e299 N, exit 0
+    (["--load", "3000", "--speed", "1e300"], "--speed: must be in (0, 1000] m/s, got 1e+300"),
+    (["--load", "3000", "--slip-angle", "90deg"], "--slip-angle: must be in (-pi/2, pi/2) rad"),
+    (["--load", "3000", "--slip-ratio", "2.5"], "--slip-ratio: must be in (-1, 2], got 2.5")])
+def test_tyre_refusals_name_the_option(capsys, args, message):
+    """One line naming the option (it was one line naming the three slip inputs together)."""
+    code, out, err = run(capsys, "tyre", "pacejka", *args)
+    assert code == 2 and out == "" and err.strip().startswith(f"wmrkit: error: {message}")
+
+
 def test_tyre_text(capsys):
     code, out, _ = run(capsys, "tyre", "dugoff", "--load", "8000", "--slip-ratio", "0.01", "--param", "cs=80000")
     assert code == 0 and "Fx (longitudinal) = -808.081 N" in out and "Fy (lateral)      = 0 N" in out

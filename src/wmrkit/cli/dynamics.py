@@ -29,7 +29,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("model", metavar="MODEL", choices=list(TYRES), help=f"one of: {', '.join(TYRES)}")
     p.add_argument("--load", required=True, metavar="FZ", help="normal load [N]")
     p.add_argument("--slip-ratio", default="0", metavar="S",
-                   help="longitudinal slip ratio (7.31), > -1; positive: the contact slides forward (braking)")
+                   help="longitudinal slip ratio (7.31), in (-1, 2]; positive: the contact slides forward (braking)")
     p.add_argument("--slip-angle", default="0", metavar="A",
                    help="slip angle (7.35): radians, or degrees with 'deg'; positive: the contact slides left")
     p.add_argument("--speed", default="2", metavar="V", help="wheel speed [m/s] (pacejka's coefficients use it)")
@@ -57,16 +57,22 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 
 def run_tyre(args: argparse.Namespace) -> int:
     """Print the forces (and plot the curves)."""
-    from ..dynamics.tyres import Tyre
+    from ..dynamics.tyres import MAX_LOAD, Tyre
 
     check_plot_path(args.plot)
     params = {k: parse_value(v, "number", f"--param {k}") for k, v in parse_assignments(args.param, "--param").items()}
     tyre = Tyre.of(args.model, params)
     load = _positive(parse_value(args.load, "number", "--load"), "--load", zero=True)
+    if load > MAX_LOAD:
+        raise WmrkitError(f"--load: at most {MAX_LOAD:g} N (a thousand tonnes on one tyre), got {load:g} N")
     s = parse_value(args.slip_ratio, "number", "--slip-ratio")
     a = parse_value(args.slip_angle, "angle", "--slip-angle")
     speed = _positive(parse_value(args.speed, "number", "--speed"), "--speed")
-    f = tyre.forces_at_slip(load, s, a, speed)
+    try:
+        f = tyre.forces_at_slip(load, s, a, speed)
+    except WmrkitError as err:  # "slip ratio: ..." -> "--slip-ratio: ..."
+        field, _, problem = str(err).partition(":")
+        raise WmrkitError(f"--{field.replace(' ', '-')}:{problem}") from None
     fx, fy = float(f.longitudinal) + 0.0, float(f.lateral) + 0.0  # no "-0"
     if not (math.isfinite(fx) and math.isfinite(fy)):
         raise WmrkitError("the model gives no finite force at these inputs")

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import UnknownNameError, WmrkitError
+from ..limits import MAX_SPEED
 
 TINY = 1e-300
 
@@ -221,6 +222,8 @@ def tyre_kind(name: str) -> TyreKind:
 POSITIVE_PARAMS = ("mu", "mu_lat", "mu_long", "eps", "mu_scale")
 #: Largest tyre parameter (a stiffness of 1e12 N is rigid; beyond it the forces overflow).
 MAX_PARAM = 1e12
+#: Largest normal load on one tyre [N] (``wmrkit tyre --load``): a thousand tonnes.
+MAX_LOAD = 1e7
 
 
 def param_problem(name: str, value: float) -> str:
@@ -301,7 +304,11 @@ def slip_velocities(s: ArrayLike, alpha: ArrayLike, speed: ArrayLike) -> tuple[n
     (braking) ``v_roll = v (s - 1)``; for ``-1 < s < 0`` (driving) ``v_roll = -v / (1 + s)``.
     """
     s, alpha, v = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (s, alpha, speed)))
-    if np.any(s <= -1) or np.any(s > 2) or np.any(np.abs(alpha) >= np.pi / 2) or np.any(v <= 0):
-        raise WmrkitError("slip ratio must be in (-1, 2], slip angle in (-pi/2, pi/2) rad and speed > 0")
+    checks = (("slip ratio", s, (s > -1) & (s <= 2), "in (-1, 2]"),
+              ("slip angle", alpha, np.abs(alpha) < np.pi / 2, "in (-pi/2, pi/2) rad (-90 to 90 deg)"),
+              ("speed", v, (v > 0) & (v <= MAX_SPEED), f"in (0, {MAX_SPEED:g}] m/s"))
+    for name, values, ok, allowed in checks:
+        if not np.all(ok):
+            raise WmrkitError(f"{name}: must be {allowed}, got {values[~ok].flat[0]:g}")
     v_roll = np.where(s >= 0, v * (s - 1), -v / (1 + np.maximum(s, -0.999999)))
     return v * np.tan(alpha), v + v_roll, v, v_roll
