@@ -93,6 +93,20 @@ def test_cli_track_discrete_warns_and_plots(tmp_path, capsys):
     assert "10 T" in captured.err and "tracking error" in captured.out and png.stat().st_size > 1000
 
 
+@pytest.mark.parametrize(("controller", "option", "python"), [("pure-pursuit", "--lookahead", "lookahead"),
+                                                               ("stanley", "--stanley-gain", "stanley_gain")])
+def test_cli_geometric_tracker_options_are_the_python_ones(capsys, controller, option, python):
+    """They were not on the command line, and --gain, which these trackers ignore, changed nothing."""
+    ref, errors = builtin_reference("circle"), []
+    for value in (0.4, 2.5):
+        assert main(["track", "diff-drive", "--reference", "circle", "--controller", controller, option, str(value),
+                     "--json"]) == 0
+        errors.append(json.loads(capsys.readouterr().out)["summary"]["rms_error"])
+        want = track(catalog.load("diff-drive"), ref, controller=controller, **{python: value}).summary()
+        assert errors[-1] == pytest.approx(want["rms_error"], rel=1e-9)
+    assert abs(errors[0] - errors[1]) > 1e-3 * max(errors)  # the option acts
+
+
 def test_cli_feasibility_json(capsys):
     assert main(["feasibility", "forklift", "--reference", "square", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
@@ -108,6 +122,15 @@ def test_cli_feasibility_json(capsys):
     (["feasibility", "skid-steer-4", "--reference", "line"], "degenerate"),
     (["track", "forklift", "--reference", "missing.csv"], "no such file"),
     (["track", "diff-drive", "--reference", "line", "--dynamics"], "no mass properties"),
+    (["track", "diff-drive", "--reference", "circle", "--controller", "pure-pursuit", "--gain", "3"],
+     "--gain applies to --controller p or pi or point, not pure-pursuit (it would be ignored)"),
+    (["track", "diff-drive", "--reference", "circle", "--controller", "stanley", "--gate", "1"], "--gate applies"),
+    (["track", "diff-drive", "--reference", "circle", "--lookahead", "1"], "--lookahead applies to --controller "
+                                                                           "pure-pursuit, not p"),
+    (["track", "diff-drive", "--reference", "circle", "--controller", "pure-pursuit", "--stanley-gain", "2"],
+     "--stanley-gain applies to --controller stanley"),
+    (["track", "diff-drive", "--reference", "circle", "--controller", "pure-pursuit", "--lookahead", "0"],
+     "--lookahead: expected a positive number"),
 ])
 def test_cli_errors_exit_2_with_one_line(argv, message, capsys):
     assert main(argv) == 2

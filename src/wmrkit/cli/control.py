@@ -21,8 +21,12 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    help="initial pose: x, y [m], theta (radians, or degrees with 'deg'); default on the reference")
     p.add_argument("--controller", default="p", choices=("p", "pi", "point", "pure-pursuit", "stanley"),
                    help="p: P + feedforward (8.2); pi: PI + feedforward (8.3); point: (8.1); or a geometric tracker")
-    p.add_argument("--gain", default="1", metavar="A", help="pole a [1/s] of the position loop (default 1)")
-    p.add_argument("--gate", metavar="D", help="apply the feedforward only within D [m] of the reference (8.53)")
+    p.add_argument("--gain", metavar="A", help="p, pi, point: pole a [1/s] of the position loop (default 1)")
+    p.add_argument("--gate", metavar="D", help="p, pi, point: apply the feedforward only within D [m] of the "
+                                               "reference (8.53)")
+    p.add_argument("--lookahead", metavar="L", help="pure-pursuit: lookahead distance along the path [m] "
+                                                    "(default 1)")
+    p.add_argument("--stanley-gain", metavar="K", help="stanley: cross-track gain [1/s] (default 1)")
     p.add_argument("--period", metavar="T", help="sample period [s]; without it the loop is continuous")
     p.add_argument("--delay", type=int, default=0, metavar="N", help="measurement delay in samples (with --period)")
     p.add_argument("--duration", metavar="S", help="seconds to simulate (default: the reference's length)")
@@ -78,6 +82,18 @@ def _positive(text: str, what: str, kind: str = "number") -> float:
     return value
 
 
+#: The options of each controller (``track``): any other controller would ignore them, so they are refused there.
+CONTROLLER_OPTIONS = {"--gain": ("p", "pi", "point"), "--gate": ("p", "pi", "point"),
+                      "--lookahead": ("pure-pursuit",), "--stanley-gain": ("stanley",)}
+
+
+def _check_controller_options(args: argparse.Namespace) -> None:
+    for option, controllers in CONTROLLER_OPTIONS.items():
+        if getattr(args, option[2:].replace("-", "_")) is not None and args.controller not in controllers:
+            raise WmrkitError(f"{option} applies to --controller {' or '.join(controllers)}, not "
+                              f"{args.controller} (it would be ignored)")
+
+
 def run_track(args: argparse.Namespace) -> int:
     """Simulate, then print a summary (or the time series as JSON); warnings on stderr."""
     from ..control.laws import SamplingWarning
@@ -88,7 +104,10 @@ def run_track(args: argparse.Namespace) -> int:
     if args.start:
         start = [parse_value(args.start[0], "length", "--from X"), parse_value(args.start[1], "length", "--from Y"),
                  parse_value(args.start[2], "angle", "--from THETA")]
-    gain = parse_value(args.gain, "number", "--gain")
+    _check_controller_options(args)
+    gain = 1.0 if args.gain is None else parse_value(args.gain, "number", "--gain")
+    lookahead = 1.0 if args.lookahead is None else _positive(args.lookahead, "--lookahead", "length")
+    stanley_gain = 1.0 if args.stanley_gain is None else parse_value(args.stanley_gain, "number", "--stanley-gain")
     period = None if args.period is None else _positive(args.period, "--period")
     duration = None if args.duration is None else _positive(args.duration, "--duration")
     gate = None if args.gate is None else _positive(args.gate, "--gate", "length")
@@ -104,6 +123,7 @@ def run_track(args: argparse.Namespace) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", SamplingWarning)
         run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
+                    lookahead=lookahead, stanley_gain=stanley_gain,
                     period=period, delay=args.delay, duration=duration, policy=args.steering, dynamics=args.dynamics,
                     slip_model=args.slip_model, feedback=args.feedback, weights=weights, noise=noise, ramp=args.ramp,
                     progress=sys.stderr.isatty() and not args.json)
