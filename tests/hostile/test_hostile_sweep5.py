@@ -156,6 +156,9 @@ def test_calibrate_refuses_a_broken_reference_trajectory(tum, expected, tmp_path
     (["--method", "wls", "--mu-default", "1,"], "expected two numbers"),
     (["--mu", "front_left=2,1"], "--mu applies to --method wls, not to --method exact"),  # ignored before
     (["--kf-noise", "1", "1", "1"], "--kf-noise applies to --method fk1 or fk2"),  # ignored before
+    (["--method", "exact", "--scheme", "euler"], "--scheme applies to --method wls, fk1 or fk2"),  # ignored before
+    (["--crowley", "1", "1", "1"], "--crowley applies with --covariance"),  # ignored before
+    (["--method", "fk2", "--crowley", "1", "1", "1"], "--crowley applies with --covariance"),  # ignored before
 ])
 def test_odometry_estimator_options_are_used_or_refused(option, expected, tmp_path, capsys):
     assert expected in _refused(["odometry", "skid-steer-4", _skid_log(tmp_path), "--quiet", *option], capsys)

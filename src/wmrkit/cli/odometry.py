@@ -50,7 +50,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    help="least-squares weight of a wheel's no-slip equations (default 1; repeat)")
     p.add_argument("--covariance", action="store_true", help="propagate Crowley's pose covariance (003 eq. 17)")
     p.add_argument("--crowley", nargs=3, type=float, metavar=("K_D", "K_DTHETA", "K_THETA"),
-                   default=(0.001, 0.003, 0.001), help="Crowley's coefficients (default 0.001 0.003 0.001)")
+                   help="with --covariance: Crowley's coefficients (default 0.001 0.003 0.001)")
     g = p.add_argument_group("CSV logs")
     g.add_argument("--time-column", default="time", help="name of the time column (default: time)")
     g.add_argument("--time-unit", choices=tuple(TIME_UNITS), help="unit of the time column (default: the header's "
@@ -87,8 +87,15 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Parse the options into a log format, run :func:`wmrkit.odometry.files.odometry_file`, print the summary."""
     robot = load_robot(args.robot)
+    scheme_given = args.scheme is not None
     settings = resolve_method(args)  # --method, --scheme: the options, else the description's odometry block
     check_estimator_options(args)
+    if scheme_given and args.method not in ESTIMATOR_METHODS:
+        raise WmrkitError(f"--scheme applies to --method wls, fk1 or fk2 (their integration); --method {args.method} "
+                          "is a scheme itself (it would be ignored)")
+    if args.crowley is not None and not args.covariance:
+        raise WmrkitError("--crowley applies with --covariance (it would be ignored)")
+    args.crowley = args.crowley or (0.001, 0.003, 0.001)
     check_chunk_size(args.chunk_size, WmrkitError, "--chunk-size")
     if not all(math.isfinite(k) and k >= 0 for k in args.crowley):
         raise WmrkitError(f"--crowley: coefficients must be finite and >= 0, got {' '.join(map(str, args.crowley))}")
