@@ -9,19 +9,24 @@ import pytest
 from wmrkit.cli.main import main
 
 
-def _json(capsys, argv):
-    assert main(argv) == 0
+def _json(capsys, argv, code=0):
+    assert main(argv) == code
     return json.loads(capsys.readouterr().out)
 
 
 def test_batch_odometry(capsys, fleet_dir, tmp_path):
+    """One of the six logs fails: the others are done and written, and the exit code is 1 (it was 0, so a
+    pipeline could not tell a partial batch from a complete one)."""
     out = tmp_path / "r.parquet"
     data = _json(capsys, ["batch", "odometry", "diff-drive", str(fleet_dir), "--workers", "0", "--closed",
-                          "--out", str(out), "--trajectories", str(tmp_path), "--json"])
+                          "--out", str(out), "--trajectories", str(tmp_path), "--json"], code=1)
     assert data["logs"] == 6 and data["failed"] == 1 and out.exists()
     assert all(r["closure_error"] < 0.1 for r in data["rows"] if not r["error"])
-    assert main(["batch", "odometry", "diff-drive", str(fleet_dir), "--workers", "0", "--out", str(out)]) == 0
+    assert main(["batch", "odometry", "diff-drive", str(fleet_dir), "--workers", "0", "--out", str(out)]) == 1
     assert "5 from an earlier run" in capsys.readouterr().out
+    data = _json(capsys, ["batch", "odometry", "diff-drive", str(fleet_dir / "run*.csv"), "--workers", "0",
+                          "--json"])  # without the broken log: exit 0
+    assert data["logs"] == 5 and data["failed"] == 0
 
 
 def test_batch_calibrate_and_montecarlo(capsys, calibration_data, tmp_path):

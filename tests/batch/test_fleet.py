@@ -91,3 +91,28 @@ def test_expand_logs_and_bags(fleet_dir, diff, tmp_path):
         batch_odometry(diff, [fleet_dir], out=tmp_path / "nope" / "r.parquet")
     with pytest.raises(BatchError, match="no such folder"):
         batch_odometry(diff, [fleet_dir], trajectories=tmp_path / "nope")
+
+
+def test_each_log_is_read_as_its_header_says(fleet_dir, diff, tmp_path):
+    """A log whose header gives its units ('time [ms]', 'left.spin [rad/s]'), as 'wmrkit odometry' reads it: batch
+    odometry failed on it ("missing column 'time' (did you mean 'time [s]'?)"), and so did the README's
+    example on the forklift log the example script writes. Fleet calibration reads it the same way."""
+    from wmrkit.batch.calibrate import load_run
+    from wmrkit.odometry.logs import LogFormat, write_csv
+
+    log = load_csv(fleet_dir / "run0.csv", ("left.spin", "right.spin"))
+    units = tmp_path / "units.csv"
+    rates = np.gradient(log.positions, log.time, axis=0)  # velocities, integrated by the trapezoidal rule
+    write_csv(units, ("time [ms]", "left.spin [rad/s]", "right.spin [rad/s]"), np.column_stack([1e3 * log.time, rates]))
+    velocity = tmp_path / "velocity.csv"
+    write_csv(velocity, ("time", "left.spin", "right.spin"), np.column_stack([log.time, rates]))
+    plain = batch_odometry(diff, [velocity], fmt=LogFormat(spin="velocity")).rows[0]
+    (row,) = batch_odometry(diff, [units]).rows
+    assert row["error"] is None
+    assert (row["x"], row["y"], row["theta"]) == pytest.approx((plain["x"], plain["y"], plain["theta"]), abs=1e-9)
+    (row,) = batch_odometry(diff, [units], header={"time_unit": "s"}).rows  # an option against the header
+    assert "the header says --time-unit ms, the option says s" in row["error"]
+    run = load_run(diff, str(units), closed=True)
+    want = load_csv(velocity, ("left.spin", "right.spin"), LogFormat(spin="velocity"))
+    np.testing.assert_allclose(run.log.time, want.time, atol=1e-12)
+    np.testing.assert_allclose(run.log.positions, want.positions, atol=1e-9)

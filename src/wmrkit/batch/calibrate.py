@@ -351,8 +351,11 @@ def default_parameters(robot: Robot, *, closed: bool) -> list[Parameter]:
 def load_run(robot: Robot, path: str, *, reference: str | os.PathLike[str] | None = None, closed: bool = False,
              options: Mapping[str, Any] | None = None) -> CalibrationRun:
     """A :class:`CalibrationRun` from a log file: with `reference` (a TUM or trajectory-CSV file) its poses at
-    the log's samples with equal times (within 1 us); with `closed`, the final pose is the start (origin)."""
+    the log's samples with equal times (within 1 us); with `closed`, the final pose is the start (origin).
+    `options`: ``sensed``; ``topic`` and ``joint_names`` (bags); ``fmt`` (a CSV layout), else ``header`` (settings
+    of :func:`~wmrkit.odometry.header.header_format`: each CSV log is read as its header says)."""
     from ..odometry.files import is_bag
+    from ..odometry.header import header_format
     from ..odometry.logs import LogError, concatenate, load_csv
     from ..odometry.model import odometry_model
     from ..odometry.trajectories import read_trajectory_csv, read_tum
@@ -365,8 +368,8 @@ def load_run(robot: Robot, path: str, *, reference: str | os.PathLike[str] | Non
         log = concatenate(list(read_joint_states(path, joints, topic=options.get("topic", "/joint_states"),
                                                  names=options.get("joint_names"), robot=robot)))
     else:
-        fmt = options.get("fmt")
-        log = load_csv(path, joints, fmt, robot=robot) if fmt is not None else load_csv(path, joints, robot=robot)
+        fmt = options.get("fmt") or header_format(path, robot.name, joints, **options.get("header", {}))
+        log = load_csv(path, joints, fmt, robot=robot)
     if closed:
         return CalibrationRun.closed_path(log)
     if reference is None:

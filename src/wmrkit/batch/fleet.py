@@ -54,6 +54,7 @@ class LogJob:
     slip_warning: float = 0.01
     options: Mapping[str, Any] = field(default_factory=dict)  # more keyword arguments of odometry_file
     model: Any = None  # the odometry model, built once per batch (else per log, from options' sensed/weights)
+    header: Mapping[str, Any] | None = None  # without options["fmt"]: a CSV log's format from its header and these
 
 
 @dataclass(frozen=True)
@@ -94,7 +95,9 @@ def expand_logs(patterns: Sequence[str | os.PathLike[str]]) -> list[str]:
 
 def process_log(job: LogJob) -> dict[str, Any]:
     """Odometry of one log to its summary row; never raises (an error becomes the row's ``error``)."""
-    from ..odometry.files import odometry_file
+    from ..odometry.files import is_bag, odometry_file
+    from ..odometry.header import header_format
+    from ..odometry.model import odometry_model
 
     row: dict[str, Any] = {name: None for name, _ in SUMMARY_SCHEMA}
     row.update(log=job.path, robot=job.robot.name, method=job.method, trajectory=job.trajectory)
@@ -102,8 +105,11 @@ def process_log(job: LogJob) -> dict[str, Any]:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=job.model,
-                              **dict(job.options))
+            options = dict(job.options)
+            if job.header is not None and not is_bag(job.path):  # each log says its units (odometry's rule)
+                joints = (job.model or odometry_model(job.robot, options.get("sensed"))).joints
+                options["fmt"] = header_format(job.path, job.robot.name, joints, **job.header)
+            s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=job.model, **options)
         except Exception as err:
             row.update(error=_message(err), trajectory=None, seconds=time.perf_counter() - t0)
             return row
@@ -125,14 +131,16 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
                    method: str = "exact", out: str | os.PathLike[str] | None = None,
                    trajectories: str | os.PathLike[str] | None = None, trajectory_format: str = "tum",
                    closed: bool = False, resume: bool = True, progress: bool = False, slip_warning: float = 0.01,
-                   fmt: LogFormat | None = None, topic: str = "/joint_states",
-                   joint_names: Mapping[str, str] | None = None, sensed: Sequence[str] | None = None,
-                   weights: Mapping[str, float] | None = None) -> FleetResult:
+                   fmt: LogFormat | None = None, header: Mapping[str, Any] | None = None,
+                   topic: str = "/joint_states", joint_names: Mapping[str, str] | None = None,
+                   sensed: Sequence[str] | None = None, weights: Mapping[str, float] | None = None) -> FleetResult:
     """Odometry of every log in `logs` (files, globs, folders; :func:`expand_logs`) on `runner` (default: a
     serial engine); the table is written to `out` (Parquet) and each trajectory to `trajectories`/``NAME.EXT``.
 
     `closed`: every run ends at its start (the closure error is reported). `fmt` (CSV layout), `topic` and
-    `joint_names` (bags), `sensed` and `weights` go to :func:`~wmrkit.odometry.files.odometry_file`.
+    `joint_names` (bags), `sensed` and `weights` go to :func:`~wmrkit.odometry.files.odometry_file`. Without
+    `fmt`, each CSV log is read as its header says (units in brackets, :func:`~wmrkit.odometry.header.header_format`
+    with the settings `header`, e.g. ``{"time_unit": "ms"}``), as ``wmrkit odometry`` reads one.
     With `resume`, rows of `out` (and of its part files) without error are kept and their logs skipped.
     """
     from ..odometry.integrators import check_method
@@ -143,6 +151,9 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     options = {"topic": topic, "joint_names": joint_names}
     if fmt is not None:
         options["fmt"] = fmt
+        if header:
+            raise BatchError("batch odometry: give fmt (a whole CSV layout) or header settings, not both")
+    header = None if fmt is not None else dict(header or {})
     paths = expand_logs(logs)
     if out is not None and not Path(out).absolute().parent.is_dir():
         raise BatchError(f"--out {os.fspath(out)}: the folder {Path(out).absolute().parent} does not exist")
@@ -152,7 +163,8 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
         raise BatchError(f"trajectory format must be csv or tum, got '{trajectory_format}'")
     targets = _trajectory_names(paths, trajectories, trajectory_format)
     done = _done(out, robot, method, targets) if resume and out is not None else {}
-    jobs = [LogJob(p, robot, method, targets[p], closed, slip_warning, options, model) for p in paths if p not in done]
+    jobs = [LogJob(p, robot, method, targets[p], closed, slip_warning, options, model, header)
+            for p in paths if p not in done]
     sink = RowSink(out, SUMMARY_SCHEMA)
     rows: dict[str, Mapping[str, Any]] = dict(done)
     own = runner is None

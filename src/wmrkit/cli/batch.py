@@ -101,7 +101,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 def _log_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("logs")
     g.add_argument("--time-column", default="time", help="name of the CSV time column (default: time)")
-    g.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), default="s", help="unit of the time column")
+    g.add_argument("--time-unit", choices=("s", "ms", "us", "ns"),
+                   help="unit of the time column (default: the header's, 'time [ms]', else s)")
     g.add_argument("--column", action="append", metavar="JOINT=COLUMN", default=[], help="column of a joint (repeat)")
     g.add_argument("--sensed", action="append", metavar="WHEEL.JOINT", help="use only these sensed joints (repeat)")
     g.add_argument("--topic", default="/joint_states", help="JointState topic of bags (default: /joint_states)")
@@ -109,15 +110,11 @@ def _log_options(p: argparse.ArgumentParser) -> None:
 
 
 def _options(args: argparse.Namespace) -> dict:
-    from ..odometry.logs import LogFormat
-
-    fmt = LogFormat(time_column=args.time_column, time_unit=args.time_unit,
-                    columns=tuple(parse_assignments(args.column, "--column").items()))
-    out = {"sensed": args.sensed, "topic": args.topic,
-           "joint_names": parse_assignments(args.joint_name, "--joint-name") or None}
-    if fmt != LogFormat():
-        out["fmt"] = fmt
-    return out
+    """Log reading options: each CSV log's header units, with these settings over them (as ``wmrkit odometry``)."""
+    return {"sensed": args.sensed, "topic": args.topic,
+            "joint_names": parse_assignments(args.joint_name, "--joint-name") or None,
+            "header": {"time_column": args.time_column, "time_unit": args.time_unit,
+                       "columns": parse_assignments(args.column, "--column")}}
 
 
 def _runner(args: argparse.Namespace):
@@ -131,7 +128,8 @@ def _progress(args: argparse.Namespace) -> bool:
 
 
 def run_odometry(args: argparse.Namespace) -> int:
-    """Batch odometry; prints the number of logs done, skipped and failed (and each failure)."""
+    """Batch odometry; prints the number of logs done, skipped and failed (and each failure). Exit code 1 when a
+    log failed (the others are done and written)."""
     from ..batch.fleet import batch_odometry
 
     robot = load_robot(args.robot)
@@ -142,7 +140,7 @@ def run_odometry(args: argparse.Namespace) -> int:
                                 **_options(args))
     if args.json:
         print_json(result.to_dict() | {"rows": [dict(r) for r in result.rows]})
-        return 0
+        return 1 if result.failed else 0
     print(f"{len(result.rows)} logs: {len(result.rows) - result.failed} done ({result.skipped} from an earlier run), "
           f"{result.failed} failed" + (f"; table {args.out}" if args.out else ""))
     for r in result.rows:
@@ -151,7 +149,7 @@ def run_odometry(args: argparse.Namespace) -> int:
         elif not args.out:
             print(f"  {r['log']}: x {r['x']:.4f} m, y {r['y']:.4f} m, theta {r['theta']:.4f} rad, "
                   f"path {r['path_length']:.4g} m")
-    return 0
+    return 1 if result.failed else 0  # a pipeline must tell a batch with failed logs from a complete one
 
 
 def run_calibrate(args: argparse.Namespace) -> int:

@@ -6,14 +6,12 @@ import argparse
 import math
 import sys
 from dataclasses import replace
-from pathlib import Path
 
 from ..errors import WmrkitError
 from ..limits import check_chunk_size
 from ..odometry.covariance import CrowleyNoise
-from ..odometry.encoders import encoders_for
 from ..odometry.files import odometry_file
-from ..odometry.header import HeaderUnits, merge_option, read_header_units
+from ..odometry.header import header_format
 from ..odometry.integrators import METHODS
 from ..odometry.logs import TIME_UNITS, LogFormat
 from ..odometry.model import odometry_model
@@ -100,30 +98,18 @@ def run(args: argparse.Namespace) -> int:
     if not all(math.isfinite(k) and k >= 0 for k in args.crowley):
         raise WmrkitError(f"--crowley: coefficients must be finite and >= 0, got {' '.join(map(str, args.crowley))}")
     joints = odometry_model(robot, args.sensed).joints
-    units = read_header_units(args.log) if Path(args.log).is_file() else HeaderUnits(())
-    spin = merge_option("--spin", args.spin, units.spin, "angle", args.log)
-    steer = merge_option("--steer", args.steer, units.steer, "angle", args.log)
-    convention = merge_option("--steer-convention", args.steer_convention, units.steer_convention, "heading",
-                              args.log)
-    time_unit = merge_option("--time-unit", args.time_unit, units.time_unit, "s", args.log)
-    bits = merge_option("--counter-bits", args.counter_bits, units.bits, None, args.log)
-    signed = args.signed_counter or units.signed
-    counted = [j for j in joints if (steer if j.endswith(".steer") else spin) == "counts"]
     options = {"--cpr": args.cpr is not None, "--gear": args.gear is not None,
                "--counter-bits": args.counter_bits is not None, "--signed-counter": args.signed_counter}
+    steer_res = None if args.steer_resolution is None else parse_angle(args.steer_resolution, "--steer-resolution")
+    fmt = header_format(args.log, robot.name, joints, time_column=args.time_column, time_unit=args.time_unit,
+                        columns=parse_assignments(args.column, "--column"), spin=args.spin, steer=args.steer,
+                        steer_convention=args.steer_convention, counter_bits=args.counter_bits,
+                        signed=args.signed_counter, cpr=args.cpr, gear=args.gear, steer_resolution=steer_res,
+                        heading_column=args.heading_column, gyro_column=args.gyro_column, max_gap=args.max_gap)
     given = [o for o, v in options.items() if v]
-    if given and not any(j.endswith(".spin") for j in counted):  # it would be ignored silently
+    if given and not any(j.endswith(".spin") for j, _ in fmt.encoders):  # it would be ignored silently
         raise WmrkitError(f"{given[0]} applies to spin columns of encoder counts (--spin counts, or a header "
                           "'WHEEL.spin [counts]')")
-    steer_res = None if args.steer_resolution is None else parse_angle(args.steer_resolution, "--steer-resolution")
-    encoders = encoders_for(robot.name, counted, counts_per_rev=args.cpr, gear_ratio=args.gear,
-                            bits=bits, signed=signed, steer_resolution=steer_res)
-    renamed = {plain: written for plain, written in units.columns}  # 'left.spin [counts]' read as left.spin
-    columns = {j: renamed[j] for j in joints if j in renamed} | parse_assignments(args.column, "--column")
-    fmt = LogFormat(time_column=renamed.get(args.time_column, args.time_column), time_unit=time_unit,
-                    columns=tuple(columns.items()), spin=spin, steer=steer, encoders=encoders,
-                    heading_column=args.heading_column, gyro_column=args.gyro_column, max_gap=args.max_gap,
-                    steer_convention=convention)
     pose0 = [parse_value(args.pose[0], "length", "--pose X"), parse_value(args.pose[1], "length", "--pose Y"),
              parse_angle(args.pose[2], "--pose")]
     slip_model = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None

@@ -13,11 +13,17 @@ by an older wmrkit version, read as such; ``[deg:heading]`` says the default exp
 
 from __future__ import annotations
 
+import os
 import re
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import WmrkitError
+
+if TYPE_CHECKING:
+    from .logs import LogFormat
 
 #: Units a joint column may declare, and the log-format mode each means.
 SPIN_UNITS = {"rad": "angle", "rad/s": "velocity", "counts": "counts"}
@@ -120,3 +126,33 @@ def merge_option(name: str, given: object | None, declared: object | None, defau
         raise HeaderError(f"{source}: the header says {name} {declared}, the option says {given}; drop the option "
                           "or fix the header")
     return declared
+
+
+def header_format(path: str | os.PathLike[str], robot_name: str, joints: Sequence[str], *, time_column: str = "time",
+                  time_unit: str | None = None, columns: Mapping[str, str] | None = None, spin: str | None = None,
+                  steer: str | None = None, steer_convention: str | None = None, counter_bits: int | None = None,
+                  signed: bool = False, cpr: float | None = None, gear: float | None = None,
+                  steer_resolution: float | None = None, heading_column: str | None = None,
+                  gyro_column: str | None = None, max_gap: float | None = None) -> LogFormat:
+    """The :class:`~.logs.LogFormat` of the CSV log at `path` for `joints` of robot `robot_name`: the settings given
+    (None: not given; named as the ``wmrkit odometry`` options) merged with the units its header declares
+    (:func:`merge_option`: a setting and a header that disagree are an error), else the defaults. Joints read as
+    counts get the given encoder settings over the catalog's (:func:`~.encoders.encoders_for`)."""
+    from .encoders import encoders_for
+    from .logs import LogFormat
+
+    source = os.fspath(path)
+    units = read_header_units(path) if Path(path).is_file() else HeaderUnits(())
+    spin = merge_option("--spin", spin, units.spin, "angle", source)
+    steer = merge_option("--steer", steer, units.steer, "angle", source)
+    convention = merge_option("--steer-convention", steer_convention, units.steer_convention, "heading", source)
+    unit = merge_option("--time-unit", time_unit, units.time_unit, "s", source)
+    bits = merge_option("--counter-bits", counter_bits, units.bits, None, source)
+    counted = [j for j in joints if (steer if j.endswith(".steer") else spin) == "counts"]
+    encoders = encoders_for(robot_name, counted, counts_per_rev=cpr, gear_ratio=gear, bits=bits,
+                            signed=signed or units.signed, steer_resolution=steer_resolution)
+    renamed = dict(units.columns)  # 'left.spin [counts]' read as left.spin
+    named = {j: renamed[j] for j in joints if j in renamed} | dict(columns or {})
+    return LogFormat(time_column=renamed.get(time_column, time_column), time_unit=unit, columns=tuple(named.items()),
+                     spin=spin, steer=steer, encoders=encoders, heading_column=heading_column,
+                     gyro_column=gyro_column, max_gap=max_gap, steer_convention=convention)
