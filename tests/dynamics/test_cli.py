@@ -121,3 +121,22 @@ def test_simulate_torque_file(capsys, tmp_path):
     code, out, err = run(capsys, "simulate", "forklift", "--torques", str(path), "--tyre", "dugoff", "--json")
     assert code == 0, err
     assert json.loads(out)["final_twist"][0] > 0.05  # positive spin torque drives the truck forward
+
+
+def test_json_errors_about_a_file_give_its_place(capsys, tmp_path):
+    """Errors from torque files, references and logs named their file only in the message: the JSON's file, line
+    and field were null (a description's were filled in)."""
+    from wmrkit.cli.main import main
+
+    torques = tmp_path / "tau.csv"
+    torques.write_text("time,right_drive.spin,left_drive.spin,steer.heading\n0,300,300,0.5\n3,300,300,90\n")
+    assert main(["simulate", "forklift", "--torques", str(torques), "--json"]) == 2
+    data = json.loads(capsys.readouterr().err)
+    assert (data["file"], data["line"], data["field"]) == (str(torques), 3, "steer.heading")
+    assert data["error"].startswith("a heading is read in radians")
+    missing = str(tmp_path / "none.csv")
+    assert main(["odometry", "forklift", missing, "--json"]) == 2
+    data = json.loads(capsys.readouterr().err)
+    assert (data["file"], data["line"], data["field"], data["error"]) == (missing, None, None, "no such file")
+    assert main(["ik", "swerve-4", "--twist", "1", "0", "--json"]) == 2  # not about a file: no place
+    assert json.loads(capsys.readouterr().err)["file"] is None

@@ -5,9 +5,11 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import os
 import re
 import sys
 import threading
+from collections.abc import Sequence
 from typing import NoReturn
 
 from ..errors import DescriptionError, WmrkitError
@@ -79,14 +81,14 @@ def main(argv: list[str] | None = None) -> int:
         check_outputs(args)
         return int(args.run(args) or 0)
     except WmrkitError as err:
-        report_error(err, as_json)
+        report_error(err, as_json, argv)
         return 2
     except BrokenPipeError:  # e.g. `wmrkit robots | head` (an OSError: caught first)
         return 0
     except OSError as err:
         if err.filename is None:  # not about a file: a bug, with its traceback
             raise
-        report_error(WmrkitError(f"{err.filename}: {err.strerror or err}"), as_json)  # e.g. a full disk
+        report_error(WmrkitError(f"{err.filename}: {err.strerror or err}"), as_json, argv)  # e.g. a full disk
         return 2
     finally:
         done.set()
@@ -109,11 +111,12 @@ def _compile_notice(done: threading.Event, poll: float = 0.25) -> None:
             return
 
 
-def report_error(err: WmrkitError, as_json: bool) -> None:
+def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> None:
     """One line on stderr: ``wmrkit: error: ...``, or under ``--json`` a JSON object with the error's place.
 
     JSON: ``{"error": message, "file": ..., "wheel": ..., "field": ...}``; the place keys are null when the
-    error has no such place.
+    error has no such place. A message about a file of the command line (`argv`), ``FILE[:LINE]: [column
+    'NAME': ]...`` (logs, torque files, references, trajectories), gives ``file``, ``line`` and ``field``.
     """
     if not as_json:
         if isinstance(err, UsageError):
@@ -128,7 +131,24 @@ def report_error(err: WmrkitError, as_json: bool) -> None:
             data["wheel"] = err.wheel if err.wheel is not None else loc[1]
             loc = loc[2:]
         data["field"] = ".".join(str(p) for p in loc) or None
+    else:
+        data |= _file_place(data["error"], argv)
     print(json.dumps(data), file=sys.stderr)
+
+
+def _file_place(message: str, argv: Sequence[str]) -> dict:
+    """``file``, ``line`` and ``field`` of a message that starts with a file given in `argv` (a path: a name with a
+    dot or a slash, or one that exists; the longest first)."""
+    files = (a for a in argv if ("." in a or "/" in a or os.path.exists(a)) and message.startswith(f"{a}:"))
+    for name in sorted(files, key=len, reverse=True):
+        rest = message[len(name) + 1:]
+        place = re.match(r"(\d+):", rest)
+        line = int(place.group(1)) if place else None
+        rest = rest[place.end():] if place else rest
+        column = re.match(r" column '([^']*)':", rest)
+        rest = rest[column.end():] if column else rest
+        return {"error": rest.strip(), "file": name, "line": line, "field": column.group(1) if column else None}
+    return {}
 
 
 #: Longest error message printed [characters]; longer ones (quoting huge user text) are cut.
