@@ -38,6 +38,15 @@ def test_text_output_and_exact_check(capsys):
     assert "feasible: 2 manoeuvres" in out and "collision-free, ends inside the slot" in out
 
 
+def test_one_manoeuvre_is_singular(capsys, tmp_path):
+    """A narrow slot entered in one reverse manoeuvre printed '1 manoeuvres, ... 1 direction changes'."""
+    f = tmp_path / "one.yaml"
+    f.write_text("vehicle: {a1: 150 cm, b1: 50 cm, c1: 140 cm, h1: 105 cm, d1: 50 cm, phi_max: 46 deg}\n"
+                 "space: {H: 400 cm, J: 150 cm, MS: 20 cm, dx2: 70 cm, final_gap: 30 cm}\n")
+    code, out, _ = run(capsys, str(f))
+    assert code == 0 and "feasible: 1 manoeuvre, " in out and ", 1 direction change, " in out
+
+
 def test_infeasible_slot_says_why_and_the_shortest_slot(capsys, tmp_path):
     f = tmp_path / "short.yaml"
     f.write_text("vehicle: {a1: 150 cm, b1: 50 cm, c1: 140 cm, h1: 105 cm, d1: 50 cm, phi_max: 46 deg}\n"

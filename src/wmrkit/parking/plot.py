@@ -79,7 +79,8 @@ def plot_plan(plan: ParkingPlan, execution: Execution | None = None) -> Figure:
         ax.legend(loc="upper left", fontsize=8)
     if plan.segments:
         draw_car(ax, v, np.array(plan.final_pose), 0.0, color="#2ca02c", alpha=0.5, fill=True)
-    verdict = f"{plan.maneuvers} manoeuvres" if plan.feasible else f"infeasible: {plan.reason[:70]}"
+    plural = "" if plan.maneuvers == 1 else "s"
+    verdict = f"{plan.maneuvers} manoeuvre{plural}" if plan.feasible else f"infeasible: {plan.reason[:70]}"
     ax.set_title(f"H = {sp.H:.3g} m, J = {sp.J:.3g} m, car {v.length:.3g} x {v.c1:.3g} m: {verdict}", fontsize=9)
     _frame(ax, plan)
     fig.tight_layout()

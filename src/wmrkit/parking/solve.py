@@ -87,6 +87,10 @@ def solve(problem: ParkingProblem, *, check: bool = False, search: bool = True, 
     return Solution(problem, plan, 1e3 * sorted(times)[len(times) // 2], shortest, report)
 
 
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
 def describe(solution: Solution) -> str:
     """The text ``wmrkit park`` prints without ``--json``."""
     p, sp, v = solution.plan, solution.problem.space, solution.problem.vehicle
@@ -94,8 +98,9 @@ def describe(solution: Solution) -> str:
              f"(length ratio {length_ratio(v, sp):.1f} %)"]
     lines += [f"warning: {w}" for w in p.warnings]
     if p.feasible:
-        lines.append(f"feasible: {p.maneuvers} manoeuvres, final gap to the curb {p.final_gap * 100:.1f} cm, "
-                     f"path {path_length(p.segments):.2f} m, {direction_changes(p.segments)} direction changes, "
+        changes = direction_changes(p.segments)
+        lines.append(f"feasible: {_count(p.maneuvers, 'manoeuvre')}, final gap to the curb {p.final_gap * 100:.1f} "
+                     f"cm, path {path_length(p.segments):.2f} m, {_count(changes, 'direction change')}, "
                      f"planned in {solution.time_ms:.3f} ms")
         lines.append(f"approach point: dx1 = {p.dx1:.4g} m from the parked cars' side, pass {p.dy3:.4g} m past "
                      "the front one")
