@@ -66,6 +66,14 @@ def test_headings_in_degrees_are_refused_and_unwrapped_radians_kept(tmp_path):
     assert load_reference(spin).pose[-1, 2] == pytest.approx(6 * math.pi)
 
 
+def test_a_reference_faster_than_any_robot_is_refused(tmp_path):
+    """Times in ns read as s: 'track' said the start was too far ('start closer ... within 0 m')."""
+    fast = tmp_path / "fast.csv"
+    fast.write_text("t,x,y,theta\n0,0,0,0\n1e-12,1,0,0\n2e-12,2,0,0\n")
+    with pytest.raises(ReferenceError, match=r"samples 1-2 move at 1e\+12 m/s, beyond 1000 m/s"):
+        load_reference(fast)
+
+
 @pytest.mark.parametrize("controller", ["pure-pursuit", "stanley"])
 @pytest.mark.parametrize("name", ["diff-drive", "forklift", "swerve-4"])
 def test_geometric_trackers_converge_onto_the_path(controller, name):

@@ -18,7 +18,7 @@ import numpy as np
 
 from .._shapes import readonly
 from ..errors import UnknownNameError, WmrkitError
-from ..limits import MAX_COORDINATE, check_table_size
+from ..limits import MAX_COORDINATE, MAX_SPEED, check_table_size
 
 __all__ = ["BUILTIN", "Reference", "ReferenceError", "builtin_reference", "load_reference", "reference_from_samples",
            "resolve_reference"]
@@ -96,6 +96,11 @@ def reference_from_samples(name: str, t: np.ndarray, pose: np.ndarray) -> Refere
     pose[:, 2] = np.unwrap(pose[:, 2])
     # second-order differences at the ends too: first-order ones put a false curvature jump at the first and last
     # samples of a reference that starts or ends turning
+    step = np.hypot(*np.diff(pose[:, :2], axis=0).T) / np.diff(t)
+    if step.max() > MAX_SPEED:  # a wrong time unit (ms, ns read as s) or positions: nothing a robot follows
+        k = int(np.argmax(step))
+        raise ReferenceError(f"{name}: samples {k + 1}-{k + 2} move at {step[k]:.3g} m/s, beyond {MAX_SPEED:g} m/s "
+                             "(times are seconds, positions metres)")
     vel = np.gradient(pose, t, axis=0, edge_order=2)
     acc = np.gradient(vel, t, axis=0, edge_order=2)
     return Reference(name, readonly(t), readonly(pose), readonly(vel), readonly(acc))
