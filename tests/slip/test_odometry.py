@@ -173,3 +173,21 @@ def test_a_noise_spread_beyond_double_precision_is_refused():
     KalmanNoise(1.0, 1.0 / MAX_SPREAD, 1.0)  # the widest spread accepted
     with pytest.raises(WmrkitError, match=r"front \(longitudinal\) \(1e-07\) and process \(1\)"):
         KalmanNoise(1.0, 1.0, 1.0, (("front", 1.0, 1e-7),))
+
+
+def test_a_filter_lagging_its_measurements_is_not_called_a_contradiction(tmp_path, capsys):
+    """Right wheel and steering only: the sensors cannot contradict each other (no redundancy), but FK2's slip
+    indicator, the rows' residual at the filtered twist, holds the filter's lag where the motion changes; the
+    warning said "the sensed joints contradict each other", listing slips of 1e-17 m. The no-slip model's slips
+    decide for the filters."""
+    robot = catalog.load("forklift")
+    profile = TwistProfile.from_segments([(2.0, 0.5, 0.0, 0.0), (2.0, 1.5, 0.0, 0.6), (2.0, 0.3, 0.0, -0.5)])
+    path = tmp_path / "log.csv"
+    write_log(path, simulate(robot, profile.about((-1.0, 0.0)), 50.0).log, robot)
+    args = ["odometry", "forklift", str(path), "--sensed", "right_drive.spin", "--sensed", "steer.steer", "--json"]
+    assert main([*args, "--method", "fk2"]) == 0
+    out, err = capsys.readouterr()
+    data = json.loads(out)
+    motion = data["distance"] / (data["samples"] - 1)
+    assert data["rms_slip"] > 0.02 * motion  # the filter's indicator: above the tolerance
+    assert "contradict" not in err and data["consistent"] is True

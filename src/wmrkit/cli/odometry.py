@@ -7,6 +7,8 @@ import math
 import sys
 from dataclasses import replace
 
+import numpy as np
+
 from ..errors import WmrkitError
 from ..limits import check_chunk_size
 from ..odometry.covariance import CrowleyNoise
@@ -123,7 +125,8 @@ def run(args: argparse.Namespace) -> int:
                  for w, v in parse_assignments(args.weight, "--weight").items()})
     if slip_model is not None:
         summary = replace(summary, method=f"{args.method} ({args.scheme})")
-    consistent = _check_consistency(summary, lambda: _slipping(robot, args.log, joints, fmt, args.sensed))
+    consistent = _check_consistency(summary, lambda: _wheel_slips(robot, args.log, fmt, args.sensed),
+                                    filtered=args.method in ("fk1", "fk2"))
     print_json(summary.to_dict() | {"consistent": consistent}) if args.json else print(format_summary(summary))
     return 0
 
@@ -133,39 +136,41 @@ def run(args: argparse.Namespace) -> int:
 LOG_SLIP_RTOL = 0.02
 
 
-def _check_consistency(s: OdometrySummary, slipping) -> bool:
+def _check_consistency(s: OdometrySummary, wheel_slips, *, filtered: bool = False) -> bool:
     """Warn (one line on stderr) when the sensors contradict each other beyond the tolerance, naming the wheels
-    that slip most (`slipping()`); say whether they agree. A slip indicator as large as the motion itself means
-    units, signs or the description are wrong."""
+    that slip most (`wheel_slips()`, RMS per wheel of the no-slip model); say whether they agree. A slip indicator
+    as large as the motion itself means units, signs or the description are wrong. A Kalman filter's indicator
+    (`filtered`) also holds its lag behind the measurements, so there the no-slip model's slips decide."""
     motion = s.distance / max(s.samples - 1, 1)
-    if s.rms_slip <= LOG_SLIP_RTOL * motion + 1e-9:
+    tolerance = LOG_SLIP_RTOL * motion + 1e-9
+    if s.rms_slip <= tolerance:
+        return True
+    slips = wheel_slips()
+    rms = float(np.sqrt(sum(v * v for v in slips.values())))
+    if filtered and rms <= tolerance:
         return True
     what = ("larger than the motion itself: check the columns' units (counts? degrees?), signs and the robot "
             "description" if s.rms_slip > motion else "beyond measurement noise: wheels slip, or units or signs "
             "are wrong")
-    wheels = slipping()
-    named = f" (slip per wheel: {wheels})" if wheels else ""
+    named = ", ".join(f"{name} {value:.3g} m" for name, value in sorted(slips.items(), key=lambda kv: -kv[1]))
+    named = f" (slip per wheel: {named})" if named else ""
     print(f"wmrkit: warning: the sensed joints contradict each other: slip indicator rms {s.rms_slip:.3g} m per "
           f"interval (max {s.max_slip:.3g} m) against {motion:.3g} m of motion per interval{named}, {what}",
           file=sys.stderr)
     return False
 
 
-def _slipping(robot, log: str, joints, fmt: LogFormat, sensed) -> str:
-    """The wheels' RMS slip over the first samples of a CSV log, largest first ("" for a bag)."""
+def _wheel_slips(robot, log: str, fmt: LogFormat, sensed) -> dict[str, float]:
+    """The wheels' RMS slip [m per interval] over the first samples of a CSV log ({} for a bag)."""
     from ..odometry.files import is_bag
     from ..odometry.logs import read_csv
     from ..odometry.model import wheel_slip
 
     if is_bag(log):
-        return ""
+        return {}
     model = odometry_model(robot, sensed)
     first = next(iter(read_csv(log, model.joints, fmt, robot=robot, chunk_size=20_000)))
-    slips = sorted(wheel_slip(model, first.positions).items(), key=lambda kv: -kv[1])
-    return ", ".join(f"{name} {value:.3g} m" for name, value in slips)
-
-
-
+    return wheel_slip(model, first.positions)
 
 
 def format_summary(s: OdometrySummary) -> str:
