@@ -90,7 +90,7 @@ def test_odometry_refuses_a_broken_bag_with_one_line_naming_it(path, capsys):
     assert path.name in _refused(["odometry", "diff-drive", str(path), "--quiet"], capsys)
 
 
-@pytest.mark.parametrize("option", [["--covariance", "--crowley", "nan", "1", "1"], ["--crowley", "nan", "1", "1"],
+@pytest.mark.parametrize("option", [["--covariance", "--crowley", "nan", "1", "1"],  # without --covariance: refused
                                     ["--covariance", "--crowley", "1", "-1", "1"],
                                     ["--covariance", "--crowley", "1", "1", "inf"]])
 def test_noise_coefficients_must_be_finite_and_non_negative(option, tmp_path, capsys):
