@@ -22,7 +22,8 @@ def test_ik_json_has_the_documented_shape(capsys):
     code, out, err = run(capsys, "ik", "swerve-4", "--twist", "1", "0.5", "0.2", "--json")
     assert code == 0 and err == ""
     data = json.loads(out)
-    assert set(data) == {"wheels", "slip", "feasible"} and data["feasible"] is True
+    assert set(data) == {"wheels", "slip", "out_of_range", "feasible"} and data["feasible"] is True
+    assert data["out_of_range"] == []
     robot = catalog.load("swerve-4")
     assert list(data["wheels"]) == list(robot.wheel_names)
     for name, (x, y) in zip(robot.wheel_names, (w.position for w in robot.wheels), strict=True):
@@ -140,3 +141,20 @@ def test_rates_beyond_any_robot_are_refused_not_printed_as_inf(capsys, argv):
     """Issue 9: finite input whose result overflows gets one line and exit 2, never inf in the output."""
     code, out, err = run(capsys, *argv)
     assert code == 2 and out == "" and "beyond 1e+06" in err and "inf" not in err.replace("infeasible", "")
+
+
+def test_ik_outside_a_steer_range_is_not_feasible(capsys):
+    """The car's front wheels steer within +-40 deg: a turn that needs 46.5 deg was printed 'feasible: yes'."""
+    from wmrkit.kinematics.wheel_ik import wheel_commands
+
+    robot = catalog.load("ackermann")
+    code, out, err = run(capsys, "ik", "ackermann", "--twist", "1", "0", "0.3", "--json")
+    data = json.loads(out)
+    assert code == 0 and data["feasible"] is False and data["out_of_range"] == ["front_left"]
+    assert math.degrees(data["wheels"]["front_left"]["heading"]) == pytest.approx(46.5433, abs=1e-4)
+    assert "wheel 'front_left' would steer to heading 46.5433 deg, outside its steer_range [-40, 40] deg" in err
+    code, out, err = run(capsys, "ik", "ackermann", "--twist", "1", "0", "0.3")
+    assert "feasible: NO (a wheel cannot steer there)" in out and "slips" not in err
+    batch = wheel_commands(robot, [[1, 0, 0.1], [1, 0, 0.3], [1, 0.5, 0.1]])
+    assert batch.feasible.tolist() == [True, False, False]  # the last: a fixed wheel slips
+    assert batch.in_range[:, robot.wheel_names.index("front_left")].tolist() == [True, False, True]

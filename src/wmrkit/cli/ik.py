@@ -49,11 +49,8 @@ def run_ik(args: argparse.Namespace) -> int:
     robot = steered_robot(args.robot, args.steer)
     commands = wheel_commands(robot, args.twist)
     _check_finite("ik", commands.rates, commands.slip)
-    if not commands.feasible:
-        worst = int(np.argmax(np.abs(commands.slip)))
-        print(f"wmrkit: warning: twist not feasible for robot '{robot.name}': wheel '{robot.wheel_names[worst]}' "
-              f"slips sideways at {commands.slip[worst]:+.6g} m/s (fixed wheels allow no lateral motion)",
-              file=sys.stderr)
+    for why in _infeasible(robot, commands):
+        print(f"wmrkit: warning: twist not feasible for robot '{robot.name}': {why}", file=sys.stderr)
     print_json(commands.to_dict()) if args.json else print(format_commands(robot, commands))
     return 0
 
@@ -117,8 +114,24 @@ def format_commands(robot: Robot, commands: WheelCommands) -> str:
         heading = math.degrees(entry.get("heading", math.nan))
         lines.append(f"{w.name:<14}{w.type:<14}{_num(heading):>14}{_num(entry['spin']):>14}"
                      f"{_num(entry['steer_rate']):>12}{_num(data['slip'][w.name]):>12}  {other}".rstrip())
-    lines.append("feasible: " + ("yes" if data["feasible"] else "NO (a fixed wheel would slip sideways)"))
+    reasons = [why.split(":")[0] for why in _infeasible(robot, commands)]
+    lines.append("feasible: " + ("yes" if data["feasible"] else f"NO ({'; '.join(reasons)})"))
     return "\n".join(lines)
+
+
+def _infeasible(robot, commands: WheelCommands) -> list[str]:
+    """Why one twist's commands are not feasible: a fixed wheel that slips sideways, steered wheels whose heading
+    is outside their steer_range (each ``"reason: detail"``)."""
+    out = []
+    if np.any(np.abs(commands.slip) > 1e-9):
+        worst = int(np.argmax(np.abs(commands.slip)))
+        out.append(f"a fixed wheel would slip sideways: wheel '{robot.wheel_names[worst]}' slips at "
+                   f"{commands.slip[worst]:+.6g} m/s (fixed wheels allow no lateral motion)")
+    for i in np.flatnonzero(~commands.in_range):
+        lo, hi = (math.degrees(a) for a in robot.wheels[i].steer_range)
+        out.append(f"a wheel cannot steer there: wheel '{robot.wheel_names[i]}' would steer to heading "
+                   f"{math.degrees(commands.heading[i]):.6g} deg, outside its steer_range [{lo:g}, {hi:g}] deg")
+    return out
 
 
 def _num(x: float) -> str:

@@ -119,8 +119,8 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
         raise WmrkitError(f"robot '{robot.name}' has no actuated joint: no servo would drive it (it would not "
                           "move); list the motors in its wheels' 'actuated' field")
     cmd = wheel_commands(robot, twists, slip_tol=SLIP_TOL)
-    if not allow_slip and not cmd.feasible.all():
-        k = int(np.argmin(cmd.feasible))
+    if not allow_slip and not (np.abs(cmd.slip) <= SLIP_TOL).all():  # a heading outside steer_range: the servo
+        k = int(np.argmin((np.abs(cmd.slip) <= SLIP_TOL).all(axis=-1)))  # holds the wheel at the range's end
         w = int(np.argmax(np.abs(cmd.slip[k])))
         raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion for "
                           f"'{robot.name}': fixed wheel '{robot.wheel_names[w]}' would slip sideways at "

@@ -60,6 +60,7 @@ class Plan:
     wheel_names: tuple[str, ...]
     rate_names: tuple[str, ...]
     wheel_delta: np.ndarray  # (N,) each wheel's delta: heading = steer + delta - pi/2
+    steer_range: np.ndarray | None  # (2, N) heading ranges (lo, hi), +-inf where none; None: no wheel has one
 
 
 @functools.lru_cache(maxsize=256)
@@ -129,6 +130,8 @@ def plan(robot: Robot) -> Plan:
         spin_select=selector(spin_col), steer_rate_select=selector(steer_rate_col),
         wheel_names=robot.wheel_names, rate_names=robot.rate_names,
         wheel_delta=readonly(np.array([w.delta for w in robot.wheels], dtype=float)),
+        steer_range=readonly(np.array([w.steer_range or (-np.inf, np.inf) for w in robot.wheels], dtype=float).T)
+        if any(w.steer_range for w in robot.wheels) else None,
     )
 
 

@@ -43,7 +43,8 @@ class Realtime:
 
     - ``ik(vx, vy, omega, heading, rates_out, heading_out) -> bool``: per-wheel IK of one twist. `heading`
       ``(n_steer,)`` the current headings [rad]; writes the joint rates ``(n_rates,)`` (``robot.rate_names``) and
-      the new headings; returns whether the twist is feasible (no fixed wheel slips beyond 1e-9 m/s).
+      the new headings; returns whether the twist is feasible (no fixed wheel slips beyond 1e-9 m/s, every heading
+      within its wheel's ``steer_range``).
     - ``fk(rates, heading, twist_out)``: the twist ``(3,)`` from the sensed joint rates ``(n_a,)`` (``rate_joints``)
       by the least squares (4.11), at headings ``(n_steer_sensed,)`` of ``steer_joints`` (ignored when constant).
     - ``odometry_step(pose, previous, positions, heading_mid)``: one exact SE(2) step; `pose` ``(3,)`` is updated
@@ -105,6 +106,10 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
     n_e = len(e_beta)
     delta = np.array([w.delta for w in robot.wheels if w.kind.steers], dtype=float)
     two_pi = 2.0 * math.pi
+    ranged = np.array([w.steer_range is not None for w in robot.wheels if w.kind.steers], dtype=np.bool_)
+    lo = np.array([(w.steer_range or (0.0, 0.0))[0] for w in robot.wheels if w.kind.steers], dtype=float)
+    width = np.array([np.subtract(*(w.steer_range or (0.0, 0.0))[::-1]) for w in robot.wheels if w.kind.steers],
+                     dtype=float)
 
     @numba.njit(cache=False)
     def wrap(a):
@@ -149,6 +154,10 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
                 feasible = False
         for k in range(n_steer):
             beta[k] = wrap(beta[k] + delta[k] - HALF_PI)
+            if ranged[k]:  # wheels.heading_in_range: counter-clockwise from lo, within the width
+                off = (beta[k] - lo[k] + 1e-12) % two_pi - 1e-12
+                if off > width[k] + 1e-12:
+                    feasible = False
         return feasible
 
     return ik

@@ -20,7 +20,7 @@ from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from ..units import UnitError, parse_quantity
-from ..wheels import heading_from_beta
+from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
 from ._ik_fast import wrap_angle
 from .linalg import matrix_rank, solve_assigned
@@ -42,7 +42,10 @@ class WheelCommands:
       relative to the body); NaN where the twist alone does not define it (steerable) or there is no joint.
     - ``rates`` ``(..., n_rates)``: every joint rate in ``robot.rate_names`` order (rollers, ``spin1``/``spin2``).
     - ``slip`` ``(..., N)`` [m/s]: lateral slip (3.11) row 0 / (8.14) left at each fixed wheel, 0 elsewhere.
-    - ``feasible`` ``(...)`` bool: every ``|slip| <= slip_tol``.
+    - ``feasible`` ``(...)`` bool: every ``|slip| <= slip_tol`` and every heading within its wheel's ``steer_range``.
+    - ``in_range`` ``(..., N)`` bool: the wheel's heading lies in its ``steer_range`` (True for wheels without one,
+      and for those that do not steer). The root of (8.9) is the one closest to the current heading; when it is
+      outside the range the twist is not feasible for the robot (its steering cannot reach it).
     - ``beta`` ``(..., n_steer)`` [rad]: the steering configuration the commands hold at (``steer_names`` order).
     - ``heading`` ``(..., N)`` [rad] in ``(-pi, pi]``: the users' steering angle, each wheel's rolling direction
       (0 = straight ahead, +x), ``steer + delta - pi/2`` (:func:`wmrkit.wheels.heading_from_beta`); NaN for wheels
@@ -61,6 +64,7 @@ class WheelCommands:
     beta: np.ndarray
     held: np.ndarray
     heading: np.ndarray
+    in_range: np.ndarray
 
     def velocity(self, twist_robot: ArrayLike) -> np.ndarray:
         """The velocity vector ``(twist; rates)`` of ``Robot.velocity_names``. ``(..., 3) -> (..., 3 + n_rates)``."""
@@ -71,8 +75,8 @@ class WheelCommands:
         """One twist's commands as plain data (the ``wmrkit ik --json`` output); NaN stays NaN (JSON: null).
 
         ``{"wheels": {name: {"heading", "spin", "steer_rate", other joint rates...}}, "slip": {name: m/s},
-        "feasible": bool}``: ``heading`` [rad] only for steered wheels (0 = rolling straight ahead). Only for a
-        single twist (batch shape ``()``).
+        "out_of_range": [names of wheels outside their steer_range], "feasible": bool}``: ``heading`` [rad] only
+        for steered wheels (0 = rolling straight ahead). Only for a single twist (batch shape ``()``).
         """
         if self.feasible.shape != ():
             raise ShapeError(f"to_dict: expected one twist (batch shape ()), got batch shape {self.feasible.shape}")
@@ -86,6 +90,7 @@ class WheelCommands:
                     entry[joint] = value
             wheels[name] = entry
         return {"wheels": wheels, "slip": dict(zip(self.wheel_names, self.slip.tolist(), strict=True)),
+                "out_of_range": [n for n, ok in zip(self.wheel_names, self.in_range.tolist(), strict=True) if not ok],
                 "feasible": bool(self.feasible)}
 
 
@@ -132,6 +137,22 @@ def wheel_commands(
         slip = np.zeros((*batch, n))
         slip[..., p.fixed_wheels] = twist @ p.fixed_lateral
         feasible = np.all(np.abs(slip) <= slip_tol, axis=-1)
+    steer = _steer_columns(p, config, batch, n)
+    heading = heading_from_beta(steer, p.wheel_delta)
+    if p.steer_range is None:
+        in_range = np.broadcast_to(True, (*batch, n))
+    else:  # a wheel that does not steer (NaN heading) has no range
+        in_range = heading_in_range(np.nan_to_num(heading), *p.steer_range)
+        feasible = feasible & np.all(in_range, axis=-1)
+    return WheelCommands(
+        wheel_names=p.wheel_names, rate_names=p.rate_names, steer=_ro(steer), spin=_ro(spin),
+        steer_rate=_ro(_columns(rates, p.steer_rate_select, batch, n)), rates=_ro(rates), slip=_ro(slip),
+        feasible=_ro(feasible), beta=_ro(config), held=_ro(held), heading=_ro(heading), in_range=_ro(in_range),
+    )
+
+
+def _steer_columns(p: _ik_fast.Plan, config: np.ndarray, batch: tuple[int, ...], n: int) -> np.ndarray:
+    """The steering angles β ``(..., n_steer)`` as ``(..., N)`` columns, NaN for wheels that do not steer."""
     if p.n_steer == n:
         steer = config
     elif p.n_steer == 0:
@@ -139,12 +160,7 @@ def wheel_commands(
     else:
         steer = np.full((*batch, n), np.nan)
         steer[..., p.steer_wheels] = config
-    return WheelCommands(
-        wheel_names=p.wheel_names, rate_names=p.rate_names,
-        steer=_ro(steer), spin=_ro(spin), steer_rate=_ro(_columns(rates, p.steer_rate_select, batch, n)),
-        rates=_ro(rates), slip=_ro(slip), feasible=_ro(feasible), beta=_ro(config), held=_ro(held),
-        heading=_ro(heading_from_beta(steer, p.wheel_delta)),
-    )
+    return steer
 
 
 def _general(
