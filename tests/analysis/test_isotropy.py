@@ -353,3 +353,16 @@ def test_a_large_condition_number_is_a_number_not_infinite(length, kappa):
     reference = condition_number(isotropy_matrix(omni, None, default_joints(omni), ("vx", "vy", "omega"),
                                                  length=length))
     assert float(twist_condition_number(omni, length=length)) == pytest.approx(float(reference), rel=1e-9)
+
+
+@pytest.mark.parametrize(("name", "joints"), [("mecanum-4", ("front_left.spin",)),
+                                              ("mecanum-4", ("front_left.spin", "front_right.spin")),
+                                              ("diff-drive", ("left.spin",))])
+def test_fewer_joints_than_the_mobility_cannot_tell_the_motions_apart(name, joints):
+    """Two Mecanum spins for three degrees of freedom gave kappa = 1 ("isotropic") at D = 372 m: the SVD of a 2 x 3
+    map has two singular values, and they were equal. The Gram route of large batches said inf already."""
+    robot = catalog.load(name)
+    assert np.isinf(twist_condition_number(robot, joints=joints)).all()
+    many = np.tile(robot.beta, (5000, 1))  # beyond the SVD route's batch size
+    assert np.isinf(twist_condition_number(robot, many, joints=joints)).all()
+    assert np.isinf(condition_number(np.ones((4, 2, 3)))).all() and condition_number(np.eye(3)[:, :2]) == 1

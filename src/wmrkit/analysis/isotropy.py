@@ -41,11 +41,14 @@ LENGTH_RANGE = (1e-3, 1e3)
 
 def condition_number(h: ArrayLike) -> np.ndarray:
     """``kappa = sigma_max / sigma_min`` of eq. (5.28); ``inf`` where H is singular. ``(..., f, f') -> (...)``,
-    finite entries, ``f, f' >= 1``."""
+    finite entries, ``f, f' >= 1``. H maps the `f'` inputs (twist coordinates) to the `f` outputs (joint rates):
+    with fewer outputs than inputs some inputs give no output (``inf``)."""
     h = np.asarray(h, dtype=float)
     if h.ndim < 2 or 0 in h.shape[-2:] or not np.all(np.isfinite(h)):
         raise ShapeError(f"condition_number: expected matrices (..., f, f') with f, f' >= 1 and finite entries, got "
                          f"shape {h.shape}" + ("" if np.all(np.isfinite(h)) else " with entries that are not finite"))
+    if h.shape[-2] < h.shape[-1]:  # f joints cannot tell f' > f motions apart (the SVD would give f values)
+        return np.full(h.shape[:-2], np.inf)
     s = np.linalg.svd(h, compute_uv=False)
     with np.errstate(divide="ignore"):
         return np.where(s[..., -1] > 1e-13 * s[..., 0], s[..., 0] / np.where(s[..., -1] > 0, s[..., -1], 1.0), np.inf)
