@@ -64,3 +64,15 @@ def test_plot(diff, square, tmp_path):
     res = monte_carlo(diff, square, 20, seed=0)
     plot_monte_carlo(res, tmp_path / "mc.png")
     assert (tmp_path / "mc.png").stat().st_size > 1000
+
+
+def test_a_robot_that_senses_nothing_is_one_line_exit_2(tmp_path, capsys):
+    """It ended in numpy's 'need at least one array to concatenate' (a traceback, exit 1)."""
+    from wmrkit.cli.main import main
+
+    robot = tmp_path / "blind.yaml"
+    robot.write_text("name: blind\nwheels:\n"
+                     "  - {name: l, type: fixed, position: [0, 0.2], heading: 0, r: 0.1, actuated: [spin]}\n"
+                     "  - {name: r, type: fixed, position: [0, -0.2], heading: 0, r: 0.1, actuated: [spin]}\n")
+    assert main(["batch", "montecarlo", str(robot), "--path", "arc", "-n", "5", "--workers", "0"]) == 2
+    assert "sensed: robot 'blind' senses no joint" in capsys.readouterr().err

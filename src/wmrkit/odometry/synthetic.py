@@ -215,6 +215,9 @@ def _check_arguments(robot: Robot, sensed: tuple[str, ...], pose0: ArrayLike, sp
                      steer_noise: float, slips: Sequence[Slip], oversample: int, seed: int) -> None:
     """Refuse, by name, the arguments of :func:`simulate` that would give NaN poses, a silently noiseless run
     (a negative noise) or a numpy exception (a negative seed, a joint that does not exist)."""
+    if not sensed:
+        raise WmrkitError(f"sensed: robot '{robot.name}' senses no joint, so a log of it would be empty (list the "
+                          "encoders in its wheels' 'sensed' field)")
     for joint in sensed:
         wheel, _, kind = joint.partition(".")
         if joint not in robot.rate_names and not (kind == "steer" and robot.wheel(wheel).kind.steers):
