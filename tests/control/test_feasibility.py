@@ -81,6 +81,9 @@ def test_sampled_file_reference_gives_the_same_violations():
     sampled = reference_from_samples("square.csv", sq.t, sq.pose)
     got = feasibility(catalog.load("forklift"), sampled)
     assert [round(v.t, 1) for v in got.violations] == [round(b, 1) for b in sq.breaks]
+    # the central differences split each corner over two steps, each half of it: the jump is their sum (it was
+    # reported as 0.785, half the corner)
+    assert all(v.size == pytest.approx(np.pi / 2, abs=1e-6) for v in got.violations)
     assert feasibility(catalog.load("forklift"), reference_from_samples("c", REFS["circle"].t,
                                                                         REFS["circle"].pose)).feasible
 

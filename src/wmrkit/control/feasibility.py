@@ -166,13 +166,21 @@ def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float) -> list[tupl
     size[np.any(np.isnan(d), axis=-1)] = 0.0
     typical = np.median(size) if len(size) else 0.0
     hit = np.flatnonzero(size > max(floor, factor * typical))
-    out: list[tuple[int, float]] = []
+    events: list[list[int]] = []  # [first step, last step, step of the largest]
     for k in hit:  # a jump spread over consecutive samples (finite differences) is one event
-        if out and k - out[-1][0] <= 2:
-            if size[k] > out[-1][1]:
-                out[-1] = (out[-1][0], float(size[k]))
-            continue
-        out.append((int(k), float(size[k])))
+        if events and k - events[-1][1] <= 2:
+            events[-1][1] = int(k)
+            if size[k] > size[events[-1][2]]:
+                events[-1][2] = int(k)
+        else:
+            events.append([int(k), int(k), int(k)])
+    out = []
+    for first, last, top in events:  # its size: the whole change across it (a sampled corner splits in halves)
+        total = x[last + 1] - x[first]
+        if angle:
+            total = wrap_angle(total)
+        whole = float(np.sqrt(np.nansum(total * total)))
+        out.append((first, whole if np.all(np.isfinite(total)) else float(size[top])))
     return out
 
 
