@@ -116,3 +116,18 @@ def test_camera_file_round_trip_and_errors(tmp_path):
     (tmp_path / "twice.yaml").write_text("focal_px: 300\ntilt: 0.8\nheight: 0.2\ntilt: 0.9\n")
     with pytest.raises(CameraError, match=r"twice.yaml:4: tilt: field 'tilt' given twice"):  # not the last one kept
         Camera.from_file(tmp_path / "twice.yaml")
+
+
+def test_camera_files_read_numbers_and_units_as_descriptions_do(tmp_path):
+    """'k1: 1e-7' is a string to YAML 1.1 and was refused ("expected a number, got '1e-7'"); units are read as in
+    robot descriptions, and a bare tilt beyond a turn (degrees meant) is refused."""
+    from wmrkit.vision.camera import Camera, CameraError
+
+    path = tmp_path / "cam.yaml"
+    path.write_text("focal_px: 1.5e2\ntilt: 60 deg\nheight: 30 cm\nwidth: 320\nrows: 240\nk1: 1e-7\n")
+    cam = Camera.from_file(path)
+    assert (cam.focal_px, cam.height, cam.k1) == (150.0, pytest.approx(0.3), 1e-7)
+    assert cam.tilt == pytest.approx(math.radians(60))
+    path.write_text("focal_px: 150\ntilt: 60\nheight: 0.3\n")
+    with pytest.raises(CameraError, match="tilt: a bare angle is read in radians, and 60 rad is more than a turn"):
+        Camera.from_file(path)

@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors
 from ..documents import read_document, read_file
 from ..errors import DescriptionError, WmrkitError
+from ..units import UnitError, parse_quantity
 
 __all__ = ["Camera", "CameraError", "camera_coordinates", "distort", "extrinsics", "ground_from_image",
            "project", "rotation", "undistort"]
@@ -40,6 +41,10 @@ class CameraError(WmrkitError, ValueError):
 
 #: Largest image side [px]: the synthetic camera holds several float arrays of the image's size.
 MAX_PIXELS = 4096
+
+
+#: The unit kind of each camera field (:func:`wmrkit.units.parse_quantity`); the others are plain numbers.
+_FIELD_KINDS = {"tilt": "angle", "height": "length"}
 
 
 @dataclass(frozen=True, slots=True)
@@ -88,12 +93,14 @@ class Camera:
         if missing:
             raise CameraError(f"{source}: missing field '{missing[0]}'")
         values: dict[str, Any] = {}
-        for name, value in data.items():
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise CameraError(f"{source}: {name}: expected a number, got {value!r}")
-            if name in ("width", "rows") and not float(value).is_integer():
+        for name, value in data.items():  # units as in descriptions: '60 deg', '30 cm', '1e-7' (YAML 1.1 reads a str)
+            try:
+                number = parse_quantity(value, _FIELD_KINDS.get(name, "number"))
+            except UnitError as err:
+                raise CameraError(f"{source}: {name}: {err}") from None
+            if name in ("width", "rows") and not number.is_integer():
                 raise CameraError(f"{source}: {name}: expected a whole number of pixels, got {value!r}")
-            values[name] = int(value) if name in ("width", "rows") else float(value)
+            values[name] = int(number) if name in ("width", "rows") else number
         try:
             return cls(**values)
         except CameraError as err:
