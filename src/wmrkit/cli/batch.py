@@ -196,11 +196,14 @@ def run_montecarlo(args: argparse.Namespace) -> int:
     check_plot_path(args.plot)
     if (args.log is None) == (args.path is None):
         raise WmrkitError("give a LOG or --path NAME (one of the two)")
-    if args.log is not None:
-        from ..odometry.logs import load_csv
-        from ..odometry.model import odometry_model
+    from ..odometry.model import odometry_model
 
-        log = load_csv(args.log, odometry_model(robot).joints, robot=robot)
+    model = odometry_model(robot)
+    if args.log is not None:  # read as its header says, as 'wmrkit odometry' reads it
+        from ..odometry.header import header_format
+        from ..odometry.logs import load_csv
+
+        log = load_csv(args.log, model.joints, header_format(args.log, robot.name, model.joints), robot=robot)
     else:
         if not args.rate > 0:
             raise WmrkitError(f"--rate must be > 0 Hz, got {args.rate}")
@@ -211,6 +214,11 @@ def run_montecarlo(args: argparse.Namespace) -> int:
                              method=args.method, seed=args.seed, runner=runner, progress=_progress(args))
     if args.plot:
         plot_monte_carlo(result, args.plot)
+    castors = [j for j in model.rate_joints if j in model.steer_joints]
+    if castors:  # their noisy angles are both increments and configuration
+        print(f"wmrkit: warning: the analytic covariance (003, first order) leaves out the configuration error that "
+              f"the noise of the castor angles {', '.join(castors)} builds up: trust the Monte Carlo spread",
+              file=sys.stderr)
     if args.json:
         print_json(result.to_dict())
         return 0
