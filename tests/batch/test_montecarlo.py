@@ -80,11 +80,15 @@ def test_plot(diff, square, tmp_path):
 
 def test_a_robot_that_senses_nothing_is_one_line_exit_2(tmp_path, capsys):
     """It ended in numpy's 'need at least one array to concatenate' (a traceback, exit 1)."""
+    from wmrkit import Robot
     from wmrkit.cli.main import main
+    from wmrkit.errors import WmrkitError
 
     robot = tmp_path / "blind.yaml"
     robot.write_text("name: blind\nwheels:\n"
                      "  - {name: l, type: fixed, position: [0, 0.2], heading: 0, r: 0.1, actuated: [spin]}\n"
                      "  - {name: r, type: fixed, position: [0, -0.2], heading: 0, r: 0.1, actuated: [spin]}\n")
     assert main(["batch", "montecarlo", str(robot), "--path", "arc", "-n", "5", "--workers", "0"]) == 2
-    assert "sensed: robot 'blind' senses no joint" in capsys.readouterr().err
+    assert "the sensed joints of robot 'blind' (none) do not determine its motion" in capsys.readouterr().err
+    with pytest.raises(WmrkitError, match="sensed: robot 'blind' senses no joint"):  # the synthetic log itself
+        path_log(Robot.from_file(robot), "arc")
