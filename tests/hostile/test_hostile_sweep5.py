@@ -202,9 +202,9 @@ def test_tyre_parameters_follow_the_description_rules(option, expected, capsys):
 
 
 def test_tyre_overflow_is_one_line_without_warnings(capsys):
-    # numpy's two-line RuntimeWarning came before the error
-    assert "no finite force" in _refused(["tyre", "pacejka", "--load", "1000", "--slip-ratio", "0.1", "--speed",
-                                          "1e308"], capsys)
+    # numpy's two-line RuntimeWarning came before the error ("no finite force"); the speed is now bounded first
+    assert "--speed: must be in (0, 1000] m/s" in _refused(["tyre", "pacejka", "--load", "1000", "--slip-ratio",
+                                                            "0.1", "--speed", "1e308"], capsys)
 
 
 @pytest.mark.parametrize("option, expected", [
@@ -238,7 +238,9 @@ def test_analyze_resolution_is_bounded(capsys):
 
 
 @pytest.mark.parametrize("option, expected", [
-    (["--vary", "wheels[0].alpha=30deg:90deg:1000000000"], "N must be in [1, 1000000]"),  # a hang
+    (["--vary", "wheels[0].alpha=30deg:90deg:1000000000"], "N must be a whole number of points in [1, 1000000]"),
+    (["--vary", "wheels[0].l=0.1:0.2:nan"], "got 'nan'"),  # "invalid literal for int() with base 10"
+    (["--vary", "wheels[0].alpha=0:720deg:3"], "an angle beyond one turn"),  # "write '12.5664 deg'"
     (["--vary", "wheels[1].alpha=0:1:10000", "--vary", "wheels[0].alpha=0:1:10000"], "the first two --vary axes"),
     (["--vary", "wheels[0].l=0.1:0.3:3", "--vary", "wheels[0].l=0.2:0.4:3"], "move the same field"),  # overwritten
     (["--vary", "wheels[0].l=0.1:0.3:3", "--length", "1e308"], "--length: 1e+308 m is outside"),  # kappa inf

@@ -86,11 +86,15 @@ def parse_vary(text: str, robot: Robot) -> Axis:
     try:
         kind = kinds.pop()
         start, stop = (parse_quantity(p.strip(), kind) for p in parts[:2])
-        n = int(parts[2])
-    except (UnitError, ValueError) as err:
+    except UnitError as err:
         raise BatchError(f"--vary {text}: {err}") from None
+    n = int(parts[2]) if parts[2].strip().isdigit() else 0
     if not 1 <= n <= MAX_POINTS:
-        raise BatchError(f"--vary {text}: N must be in [1, {MAX_POINTS}]")
+        raise BatchError(f"--vary {text}: N must be a whole number of points in [1, {MAX_POINTS}], got "
+                         f"{parts[2].strip()!r}")
+    if kind == "angle" and max(abs(start), abs(stop)) > 2 * math.pi * (1 + 1e-12):
+        raise BatchError(f"--vary {text}: an angle beyond one turn repeats a geometry of the sweep; sweep within "
+                         "-360 deg to 360 deg")
     return Axis(lhs.strip(), tuple(targets), np.linspace(start, stop, n))
 
 

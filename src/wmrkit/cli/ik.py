@@ -71,7 +71,8 @@ def run_fk(args: argparse.Namespace) -> int:
         print(f"wmrkit: warning: these rates do not determine the twist of robot '{robot.name}'; "
               "printing the minimum-norm one", file=sys.stderr)
     if not fk.consistent:
-        worst = ", ".join(f"{n} {fk.wheel_slip[robot.wheel_names.index(n)]:.3g} m/s" for n in fk.slipping)
+        names = fk.slipping or [robot.wheel_names[i] for i in np.argsort(-fk.wheel_slip) if fk.wheel_slip[i] > 0]
+        worst = ", ".join(f"{n} {fk.wheel_slip[robot.wheel_names.index(n)]:.3g} m/s" for n in names)
         print(f"wmrkit: warning: the rates contradict each other: the wheels slip ({worst}; residual "
               f"{fk.residual:.3g} m/s > tolerance {fk.tolerance:.3g} m/s); check units, signs and --steer headings",
               file=sys.stderr)
