@@ -104,6 +104,7 @@ def test_bad_twist_is_a_usage_error(capsys):
     assert main(["ik", "swerve-4", "--twist", "1", "0", "inf", "--json"]) == 2
     data = json.loads(capsys.readouterr().err)
     assert "argument --twist" in data["error"] and data["file"] is None
+    assert set(data) == {"error", "file", "wheel", "field", "line"}  # every error has the five keys ("line" lacked)
 
 
 def test_fk_textbook_ackermann_angles_are_consistent(capsys):

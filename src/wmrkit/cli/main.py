@@ -114,7 +114,7 @@ def _compile_notice(done: threading.Event, poll: float = 0.25) -> None:
 def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> None:
     """One line on stderr: ``wmrkit: error: ...``, or under ``--json`` a JSON object with the error's place.
 
-    JSON: ``{"error": message, "file": ..., "wheel": ..., "field": ...}``; the place keys are null when the
+    JSON: ``{"error": message, "file": ..., "wheel": ..., "field": ..., "line": ...}``; the place keys are null when the
     error has no such place. A message about a file of the command line (`argv`), ``FILE[:LINE]: [column
     'NAME': ]...`` (logs, torque files, references, trajectories), gives ``file``, ``line`` and ``field``.
     """
@@ -123,7 +123,7 @@ def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> N
             print(err.usage, end="", file=sys.stderr)
         print(f"wmrkit: error: {one_line(str(err))}", file=sys.stderr)
         return
-    data = {"error": one_line(str(err)), "file": None, "wheel": None, "field": None}
+    data = {"error": one_line(str(err)), "file": None, "wheel": None, "field": None, "line": None}
     if isinstance(err, DescriptionError):
         loc = err.loc
         data["error"], data["file"], data["line"] = one_line(err.message), err.source, err.line
