@@ -74,6 +74,15 @@ def test_a_reference_faster_than_any_robot_is_refused(tmp_path):
         load_reference(fast)
 
 
+def test_speed_and_size_are_refused_with_a_file_reference(tmp_path, capsys):
+    """They were ignored: a file's samples give its speed and size."""
+    path = tmp_path / "ref.csv"
+    path.write_text("t,x,y,theta\n0,0,0,0\n1,1,0,0\n2,2,0,0\n")
+    for command in ("feasibility", "track"):
+        assert main([command, "diff-drive", "--reference", str(path), "--speed", "3"]) == 2
+        assert "--speed and --size apply to a built-in reference" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("controller", ["pure-pursuit", "stanley"])
 @pytest.mark.parametrize("name", ["diff-drive", "forklift", "swerve-4"])
 def test_geometric_trackers_converge_onto_the_path(controller, name):

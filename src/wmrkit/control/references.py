@@ -274,5 +274,8 @@ def resolve_reference(spec: str, *, speed: float | None = None, size: float | No
     if spec in BUILTIN:
         return builtin_reference(spec, speed=speed, size=size)
     if Path(spec).suffix or Path(spec).exists():
+        if speed is not None or size is not None:  # a file's samples fix both: they would be ignored
+            raise ReferenceError(f"{spec}: --speed and --size apply to a built-in reference; a file's samples give "
+                                 "its speed and size")
         return load_reference(spec)
     return builtin_reference(spec)  # raises with a suggestion
