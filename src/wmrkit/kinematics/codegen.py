@@ -79,7 +79,8 @@ class _Plan:
         if int(matrix_rank(a[..., self.unknown_cols]).max()) < len(self.unknown_cols):
             names = ", ".join(self.robot.velocity_names[j] for j in self.unknown_cols)
             raise SingularError(f"robot '{self.robot.name}': the sensed rates ({', '.join(self.sensed)}) do not "
-                                f"determine ({names}); sense more joints or pass sensed=")
+                                f"determine ({names}); sense more joints (the wheels' 'sensed' field of the "
+                                "description, or sensed= in Python)")
 
     def forward_exprs(self) -> tuple[list[sp.Expr], list[sp.Expr]]:
         """Entries of ``A_na`` (row-major) and of ``b = -A_s q_s``."""
