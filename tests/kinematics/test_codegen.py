@@ -100,30 +100,32 @@ def test_python_module_equals_numeric_model(name, tmp_path):
     assert mod.SENSED_NAMES == sensed and mod.FREE_STEER_NAMES == free
     assert mod.RATE_NAMES == tuple(n for n in robot.rate_names if n not in free)
     beta, twist, q_s, s = inputs(robot, sensed)
+    heading = robot.heading_of_beta(beta)  # the generated code takes headings (it took the thesis's beta)
     rates, twist_fw, slip = numeric(robot, sensed, beta, twist, q_s, s)
-    np.testing.assert_allclose(mod.constraint_matrix(beta), robot.constraint_matrix(beta), atol=1e-12)
-    np.testing.assert_allclose(_inverse(mod, twist, s, beta), rates, rtol=1e-9, atol=1e-9)
-    got_twist, got_slip = mod.forward_with_residual(q_s, beta)
+    np.testing.assert_allclose(mod.constraint_matrix(heading), robot.constraint_matrix(beta), atol=1e-12)
+    np.testing.assert_allclose(_inverse(mod, twist, s, heading), rates, rtol=1e-9, atol=1e-9)
+    got_twist, got_slip = mod.forward_with_residual(q_s, heading)
     np.testing.assert_allclose(got_twist, twist_fw, rtol=1e-8, atol=1e-9)
     np.testing.assert_allclose(got_slip, slip, rtol=1e-8, atol=1e-9)
     # batches broadcast: one configuration for many twists, and (2, 3) leading axes
-    np.testing.assert_allclose(_inverse(mod, twist, s, beta[0]), numeric(robot, sensed, beta[0], twist, q_s, s)[0],
+    np.testing.assert_allclose(_inverse(mod, twist, s, heading[0]), numeric(robot, sensed, beta[0], twist, q_s, s)[0],
                                rtol=1e-9, atol=1e-9)
-    assert mod.forward(q_s.reshape(2, 3, -1), beta.reshape(2, 3, -1)).shape == (2, 3, 3)
+    assert mod.forward(q_s.reshape(2, 3, -1), heading.reshape(2, 3, -1)).shape == (2, 3, 3)
+    np.testing.assert_allclose(mod.HEADING_DESCRIBED, robot.heading, atol=1e-15)
 
 
 def test_python_module_consistent_rates_give_the_twist_without_slip(tmp_path):
     """Rates of a no-slip motion (the inverse of an assignable twist) come back as that twist, residual 0."""
     robot = ROBOTS["diff-castor"]
     mod = load_module(write_code(robot, "python", tmp_path)[0])
-    beta = np.array([0.7])
+    heading = np.array([0.7])
     twist = np.array([0.3, 0.0, -0.4])  # vy = 0: the fixed wheels' lateral constraint
-    rates = mod.inverse(twist, beta)
-    got, slip = mod.forward_with_residual(rates[:2], beta)
+    rates = mod.inverse(twist, heading)
+    got, slip = mod.forward_with_residual(rates[:2], heading)
     np.testing.assert_allclose(got, twist, atol=1e-12)
     assert slip == pytest.approx(0, abs=1e-12)
     with pytest.raises(ValueError, match=r"twist: expected shape \(\.\.\., 3\)"):
-        mod.inverse([1.0, 2.0], beta)
+        mod.inverse([1.0, 2.0], heading)
 
 
 GCC = shutil.which("gcc")
@@ -151,12 +153,13 @@ def test_c_code_equals_numeric_model(name, tmp_path):
     lib, ident = compile_c(robot, tmp_path)
     sensed = sensed_rates(robot)
     beta, twist, q_s, s = inputs(robot, sensed, seed=1)
+    heading = robot.heading_of_beta(beta)  # the generated code takes headings
     rates, twist_fw, slip = numeric(robot, sensed, beta, twist, q_s, s)
     forward = getattr(lib, f"{ident}_forward")
     forward.restype = ctypes.c_int
     n_rows, n_vel = robot.constraint_matrix().shape
     for k in range(N):
-        b = beta[k] if beta.shape[1] else None
+        b = heading[k] if beta.shape[1] else None
         a_out, out, tw = np.zeros(n_rows * n_vel), np.zeros(rates.shape[-1]), np.zeros(3)
         res = ctypes.c_double(-1.0)
         getattr(lib, f"{ident}_constraint")(_ptr(b) if b is not None else None, _ptr(a_out))
@@ -220,7 +223,8 @@ def test_cli_symbolic_and_codegen_end_to_end(capsys, tmp_path):
     mod = load_module(tmp_path / "forklift_kinematics.py")
     robot = catalog.load("forklift")
     # straight ahead (steer axle along +y): vx = r phi for both drive wheels, the steered wheel rolls as fast
-    np.testing.assert_allclose(mod.inverse([0.46, 0, 0], robot.beta), [2.0, 2.0, 2.0], atol=1e-12)
+    np.testing.assert_allclose(mod.inverse([0.46, 0, 0], [0.0]), [2.0, 2.0, 2.0], atol=1e-12)  # heading 0
+    np.testing.assert_allclose(mod.inverse([0.46, 0, 0], robot.heading), [2.0, 2.0, 2.0], atol=1e-12)
     assert main(["kinematics", "forklift", "--codegen", "python", str(tmp_path / "forklift_kinematics.py")]) == 2
 
 
@@ -233,7 +237,7 @@ def test_a_double_wheel_turns_on_the_spot_by_rolling_its_sub_wheels_apart(tmp_pa
         {"name": "back", "type": "fixed", "position": [-0.2, 0], "beta": "90 deg", "r": 0.05, "sensed": ["spin"]}])
     mod = load_module(write_code(double, "python", tmp_path)[0])
     assert mod.FREE_STEER_NAMES == ("unit.steer",) and "unit.steer" not in mod.RATE_NAMES
-    rates = dict(zip(mod.RATE_NAMES, mod.inverse([0.0, 0.0, 0.0], [0.7], [0.4]), strict=True))
+    rates = dict(zip(mod.RATE_NAMES, mod.inverse([0.0, 0.0, 0.0], [0.7], [0.4 - math.pi / 2]), strict=True))
     assert rates["unit.spin1"] == pytest.approx(-0.1 * 0.7 / 0.05) and rates["unit.spin2"] == pytest.approx(0.7 * 2)
     assert rates["back.spin"] == pytest.approx(0.0, abs=1e-15)
     with pytest.raises(ValueError, match=r"steer_rate: expected shape \(\.\.\., 1\)"):
@@ -250,6 +254,6 @@ def test_a_double_wheel_turns_on_the_spot_by_rolling_its_sub_wheels_apart(tmp_pa
     assert solved["omega"] == pytest.approx(0.3 * math.tan(heading) / 0.4) and solved["vy"] == pytest.approx(
         0.2 * solved["omega"])
     twist = [0.3, solved["vy"], solved["omega"]]
-    expected = dict(zip(mod.RATE_NAMES, mod.inverse(twist, [0.7], [0.4]), strict=True))
+    expected = dict(zip(mod.RATE_NAMES, mod.inverse(twist, [0.7], double.heading_of_beta([0.4])), strict=True))
     for name, value in expected.items():
         assert solved[name] == pytest.approx(value, rel=1e-12, abs=1e-12)

@@ -1,11 +1,13 @@
 """Code generation: a robot's kinematic models as dependency-free C99 or numpy code (from the symbolic models).
 
-``inverse(twist, beta) -> wheel rates`` is the closed form of :func:`~wmrkit.kinematics.symbolic.symbolic_model`
+``inverse(twist, heading) -> wheel rates`` is the closed form of :func:`~wmrkit.kinematics.symbolic.symbolic_model`
 with the twist assigned (4.11): exact when the twist is assignable, else least squares per wheel, as a
-controller needs it. ``forward(sensed, beta) -> twist`` solves the no-slip equations for the twist and every
+controller needs it. ``forward(sensed, heading) -> twist`` solves the no-slip equations for the twist and every
 unsensed rate by least squares (4.11): the generated C carries a small Householder-QR routine (no closed form
 to blow up), the generated Python calls ``numpy.linalg.pinv``; the residual ``|A q|`` [m/s] is the slip (4.16).
 Both are printed from the same symbolic constraint matrix (3.22), with common-subexpression elimination.
+The steering inputs are headings (0 = rolling straight ahead, counter-clockwise positive), what encoders and
+controllers use; the generated code turns each into the thesis's angle, ``beta = heading + pi/2 - delta``.
 """
 
 from __future__ import annotations
@@ -54,6 +56,8 @@ class _Plan:
     def __init__(self, robot: Robot, sensed: Sequence[str] | None) -> None:
         self.robot, self.name = robot, identifier(robot.name)
         self.beta = tuple(sp.Symbol(f"b{i}", real=True) for i in range(len(robot.steer_names)))
+        # beta = heading + offset (Robot.beta_of_heading; the offset is beta at heading 0, pi/2 - delta)
+        self.offsets = tuple(float(b) for b in robot.beta_of_heading(np.zeros(len(self.beta))))
         self.twist = tuple(sp.Symbol(n, real=True) for n in TWIST_NAMES)
         self.sensed = tuple(sensed) if sensed is not None else sensed_rates(robot)
         for n in self.sensed:
@@ -203,15 +207,16 @@ def _c_unpack(plan: _Plan, sensed: bool = False, twist: bool = False) -> str:
     if sensed:
         lines += [f"    const double q{i} = sensed[{i}]; /* {_c_comment(n)} */" for i, n in enumerate(plan.sensed)]
         names += [f"q{i}" for i in range(len(plan.sensed))]
-    lines += [f"    const double b{i} = beta[{i}]; /* {_c_comment(n)} */" for i, n in enumerate(plan.robot.steer_names)]
-    names += [f"b{i}" for i in range(len(plan.beta))] or ["beta"]
+    lines += [f"    const double b{i} = heading[{i}] + {off!r}; /* {_c_comment(n)}: beta = heading + pi/2 - delta */"
+              for i, (n, off) in enumerate(zip(plan.robot.steer_names, plan.offsets, strict=True))]
+    names += [f"b{i}" for i in range(len(plan.beta))] or ["heading"]
     lines.append("    " + " ".join(f"(void){n};" for n in names))
     return "\n".join(lines)
 
 
 def _c_files(plan: _Plan) -> list[tuple[str, str]]:
     r, n, p = plan.robot, plan.name, plan.name.upper()
-    beta_param = f"const double beta[{p}_N_STEER]" if plan.beta else "const double *beta"
+    beta_param = f"const double heading[{p}_N_STEER]" if plan.beta else "const double *heading"
     sizes = {"N_STEER": len(plan.beta), "N_RATES": len(plan.rates), "N_SENSED": len(plan.sensed),
              "N_ROWS": plan.a.rows, "N_VEL": plan.a.cols, "N_UNKNOWN": len(plan.unknown_cols)}
     steer_param = ""
@@ -232,18 +237,19 @@ def _c_files(plan: _Plan) -> list[tuple[str, str]]:
         " *   twist[3]  = (vx [m/s], vy [m/s], omega [rad/s]), body twist in the robot frame",
         *([_c_list(f" *   steer_rate[{p}_N_FREE_STEER] = steering rates of the double wheels [rad/s] (an input: "
                    "no twist determines them)", plan.free_steer)] if plan.free_steer else []),
-        _c_list(f" *   beta[{p}_N_STEER] = steering angles [rad]", r.steer_names),
+        _c_list(f" *   heading[{p}_N_STEER] = steering headings [rad], 0 = rolling straight ahead, counter-clockwise "
+                "positive", r.steer_names),
         _c_list(f" *   rates[{p}_N_RATES] = wheel joint rates [rad/s]", plan.rates),
         _c_list(f" *   sensed[{p}_N_SENSED] = sensed joint rates [rad/s]", plan.sensed),
         _c_list(f" *   a[{p}_N_ROWS * {p}_N_VEL] = slip matrix A (3.22), row-major, slip = A q; columns",
                 r.velocity_names),
         " *",
-        f" * {n}_constraint: A(beta), two rows per contact point (along and across the roller axis).",
+        f" * {n}_constraint: A (3.22) at the headings, two rows per contact point (along and across the roller axis).",
         f" * {n}_inverse: wheel rates for a twist{' and steering rates' if plan.free_steer else ''} "
         f"({'exact' if plan.inverse_exact else 'least squares per wheel'},"
         " thesis 4.11).",
         f" * {n}_forward: least-squares twist from the sensed rates (4.11); *residual = |A q| [m/s], the slip",
-        " *   (may be NULL). Returns 0, or -1 if the sensed rates do not determine the twist at this beta.",
+        " *   (may be NULL). Returns 0, or -1 if the sensed rates do not determine the twist at these headings.",
         " */",
         f"#ifndef {p}_KINEMATICS_H", f"#define {p}_KINEMATICS_H", "",
         *[f"#define {p}_{k} {v}" for k, v in sizes.items()], "",
@@ -292,7 +298,7 @@ def _py_body(exprs: list[sp.Expr], targets: list[str]) -> str:
 
 def _python_file(plan: _Plan) -> list[tuple[str, str]]:
     r = plan.robot
-    unpack = "\n".join(f"    b{i} = beta[..., {i}]  # {n}" for i, n in enumerate(r.steer_names))
+    unpack = "\n".join(f"    b{i} = beta[..., {i}]  # {n}" for i, n in enumerate(r.steer_names))  # from _beta
     a_targets = [f"out[..., {i}, {j}]" for i in range(plan.a.rows) for j in range(plan.a.cols)]
     inputs, k = plan.twist + plan.steer_rate, 3 + len(plan.free_steer)
     m = sp.Matrix(plan.inverse).jacobian(sp.Matrix(inputs))
@@ -302,7 +308,7 @@ def _python_file(plan: _Plan) -> list[tuple[str, str]]:
         steer_doc = (f"\n- ``steer_rate``: ``(..., {len(plan.free_steer)})`` steering rates of the double wheels "
                      "[rad/s], order ``FREE_STEER_NAMES``\n  (an input of the inverse model: no twist determines "
                      "them);")
-        inverse_def = f'''def inverse(twist, steer_rate, beta=None):
+        inverse_def = f'''def inverse(twist, steer_rate, heading=None):
     """Wheel rates [rad/s] for body twists and double-wheel steering rates:
     ``(..., 3), (..., {len(plan.free_steer)}), (..., {len(plan.beta)}) -> (..., {m.rows})``.
     """
@@ -311,20 +317,21 @@ def _python_file(plan: _Plan) -> list[tuple[str, str]]:
     shape = numpy.broadcast_shapes(twist.shape[:-1], steer_rate.shape[:-1])
     inputs = numpy.concatenate([numpy.broadcast_to(twist, shape + (3,)),
                                 numpy.broadcast_to(steer_rate, shape + ({len(plan.free_steer)},))], axis=-1)
-    return (inverse_matrix(beta) @ inputs[..., None])[..., 0]'''
+    return (inverse_matrix(heading) @ inputs[..., None])[..., 0]'''
     else:
         steer_doc = ""
-        inverse_def = f'''def inverse(twist, beta=None):
+        inverse_def = f'''def inverse(twist, heading=None):
     """Wheel rates [rad/s] for body twists: ``(..., 3), (..., {len(plan.beta)}) -> (..., {m.rows})``."""
     twist = _vectors(twist, 3, "twist")
-    return (inverse_matrix(beta) @ twist[..., None])[..., 0]'''
+    return (inverse_matrix(heading) @ twist[..., None])[..., 0]'''
     text = f'''"""No-slip kinematic models of robot {json.dumps(r.name)} (thesis ch. 4), generated by wmrkit.
 
 Do not edit; regenerate with ``wmrkit kinematics ROBOT --codegen python DIR``. Needs only numpy. SI units,
 robot frame x forward, y left. Arrays take leading batch axes, which broadcast:
 
 - ``twist``: ``(..., 3)`` = (vx [m/s], vy [m/s], omega [rad/s]) in the robot frame;{steer_doc}
-- ``beta``: ``(..., {len(plan.beta)})`` steering angles [rad], order ``STEER_NAMES`` (None: as described);
+- ``heading``: ``(..., {len(plan.beta)})`` steering headings [rad], 0 = rolling straight ahead, counter-clockwise
+  positive, order ``STEER_NAMES`` (None: as described);
 - wheel rates: ``(..., {len(plan.rates)})`` [rad/s], order ``RATE_NAMES``;
 - ``sensed``: ``(..., {len(plan.sensed)})`` [rad/s], order ``SENSED_NAMES``.
 """
@@ -336,16 +343,17 @@ RATE_NAMES = {tuple(plan.rates)!r}
 SENSED_NAMES = {tuple(plan.sensed)!r}
 FREE_STEER_NAMES = {tuple(plan.free_steer)!r}
 VELOCITY_NAMES = {tuple(r.velocity_names)!r}
-BETA_DESCRIBED = {tuple(float(b) for b in r.beta)!r}
+HEADING_DESCRIBED = {tuple(float(h) for h in r.heading)!r}
+_BETA_OFFSET = {tuple(plan.offsets)!r}  # the thesis's beta = heading + pi/2 - delta
 _SENSED_COLUMNS = {list(plan.sensed_cols)!r}
 _UNKNOWN_COLUMNS = {list(plan.unknown_cols)!r}
 
 
-def _beta(beta):
-    beta = numpy.asarray(BETA_DESCRIBED if beta is None else beta, dtype=float)
-    if beta.shape[-1:] != ({len(plan.beta)},):
-        raise ValueError(f"beta: expected shape (..., {len(plan.beta)}), got {{beta.shape}}")
-    return beta
+def _beta(heading):
+    heading = numpy.asarray(HEADING_DESCRIBED if heading is None else heading, dtype=float)
+    if heading.shape[-1:] != ({len(plan.beta)},):
+        raise ValueError(f"heading: expected shape (..., {len(plan.beta)}), got {{heading.shape}}")
+    return heading + numpy.asarray(_BETA_OFFSET)
 
 
 def _vectors(x, n, name):
@@ -355,24 +363,24 @@ def _vectors(x, n, name):
     return x
 
 
-def constraint_matrix(beta=None):
+def constraint_matrix(heading=None):
     """Slip matrix A (3.22), roller frame, columns VELOCITY_NAMES.
 
     ``(..., {len(plan.beta)}) -> (..., {plan.a.rows}, {plan.a.cols})``.
     """
-    beta = _beta(beta)
+    beta = _beta(heading)
 {unpack}
     out = numpy.zeros(beta.shape[:-1] + ({plan.a.rows}, {plan.a.cols}))
 {_py_body(list(plan.a), a_targets)}
     return out
 
 
-def inverse_matrix(beta=None):
+def inverse_matrix(heading=None):
     """``rates = M @ {inputs_doc}`` ({"exact" if plan.inverse_exact else "least squares per wheel"}, 4.11).
 
     ``(..., {len(plan.beta)}) -> (..., {m.rows}, {k})``.
     """
-    beta = _beta(beta)
+    beta = _beta(heading)
 {unpack}
     out = numpy.zeros(beta.shape[:-1] + ({m.rows}, {k}))
 {_py_body(list(m), m_targets)}
@@ -382,13 +390,13 @@ def inverse_matrix(beta=None):
 {inverse_def}
 
 
-def forward_with_residual(sensed, beta=None):
+def forward_with_residual(sensed, heading=None):
     """Least-squares twist (4.11) and slip residual ``|A q|`` [m/s].
 
     ``(..., {len(plan.sensed)}) -> (..., 3), (...)``.
     """
     sensed = _vectors(sensed, {len(plan.sensed)}, "sensed")
-    a = constraint_matrix(beta)
+    a = constraint_matrix(heading)
     a_na = a[..., _UNKNOWN_COLUMNS]
     rhs = -(a[..., _SENSED_COLUMNS] @ sensed[..., None])
     x = numpy.linalg.pinv(a_na) @ rhs
@@ -396,8 +404,8 @@ def forward_with_residual(sensed, beta=None):
     return x[..., :3, 0], residual
 
 
-def forward(sensed, beta=None):
+def forward(sensed, heading=None):
     """Least-squares body twist from sensed rates (4.11): ``(..., {len(plan.sensed)}) -> (..., 3)``."""
-    return forward_with_residual(sensed, beta)[0]
+    return forward_with_residual(sensed, heading)[0]
 '''
     return [(f"{plan.name}_kinematics.py", text)]
