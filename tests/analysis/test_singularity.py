@@ -210,3 +210,23 @@ def test_a_subnormal_angle_gives_the_answer_of_zero_without_a_warning():
         warnings.simplefilter("error")
         tiny = analyze(car(2.225073858507e-311)).to_dict()
     assert tiny["singular"] == analyze(car(0.0)).to_dict()["singular"]
+
+
+def test_the_actuated_singular_set_says_it_leaves_a_coupling_out(capsys):
+    """The forklift's drive spins are one differential: at the steering wheel's 90 deg heading the motion (a turn
+    about the drive axle's middle) is driven by no actuator, which the actuation line says, while the singular-set
+    search, each joint on its own, says 'never'. The line now says what it leaves out (the sensed one has no
+    coupling to leave out)."""
+    import json
+
+    from wmrkit.cli.main import main
+
+    assert main(["analyze", "forklift", "--steer", "steer=90deg"]) == 0
+    out = capsys.readouterr().out
+    assert "actuation: insufficient" in out
+    assert ("singular (actuated: right_drive.spin, left_drive.spin; each joint on its own: the differential of "
+            "right_drive.spin + left_drive.spin is left out of this search (see actuation))") in out
+    assert "singular (sensed: right_drive.spin, left_drive.spin): " in out
+    assert main(["analyze", "forklift", "--json"]) == 0
+    notes = {k: v["note"] for k, v in json.loads(capsys.readouterr().out)["singular"].items()}
+    assert notes["sensed"] is None and "differential" in notes["actuated"]

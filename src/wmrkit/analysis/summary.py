@@ -57,7 +57,9 @@ class Analysis:
             "sensing": {k: self.sensing[k] for k in ("sufficient", "verdict")},
             "condition_number": self.condition_number, "characteristic_length": self.characteristic_length,
             "condition_joints": list(self.joints), "natural_length": self.natural,
-            "singular": {k: _singular_dict(s, self.robot) for k, s in self.singular.items()},
+            "singular": {k: _singular_dict(s, self.robot) | {"note": uncoupled_note(s, self.robot) or None
+                                                             if k == "actuated" else None}
+                         for k, s in self.singular.items()},
         }
 
     def format_text(self) -> str:
@@ -80,7 +82,8 @@ class Analysis:
             lines.append(f"  condition number {kappa} at the {how} D = "
                          f"{self.characteristic_length:.4g} m, joints {', '.join(self.joints) or '-'}")
         for key, s in self.singular.items():
-            lines.append(f"  singular ({key}: {', '.join(s.assigned) or '-'}): {describe_singular(s, r)}")
+            note = f"; {uncoupled_note(s, r)}" if key == "actuated" and uncoupled_note(s, r) else ""
+            lines.append(f"  singular ({key}: {', '.join(s.assigned) or '-'}{note}): {describe_singular(s, r)}")
         return "\n".join(lines)
 
 
@@ -98,6 +101,16 @@ def actuation_words(actuation: dict[str, Any]) -> str:
             "(mechanical couplings go in the description's 'couplings')")
 
 
+def uncoupled_note(s: SingularSet, robot: Robot) -> str:
+    """What the singular-set search (ch. 6, each assigned joint on its own) leaves out: the mechanical couplings
+    that tie assigned joints into one channel (a differential). "" when none does."""
+    tied = [f"{c.kind} of {' + '.join(c.joints)}" for c in robot.couplings
+            if c.rates and sum(j in s.assigned for j in c.joints) > 1]
+    if not tied:
+        return ""
+    return f"each joint on its own: the {', '.join(tied)} is left out of this search (see actuation)"
+
+
 def _singular_dict(s: SingularSet, robot: Robot) -> dict[str, Any]:
     """JSON of a singular set: ``configurations`` as the thesis's β of `variables`, ``headings`` the same angles
     as the wheels' headings (0 = rolling straight ahead)."""
@@ -105,7 +118,8 @@ def _singular_dict(s: SingularSet, robot: Robot) -> dict[str, Any]:
     configs = s.configurations[:24]
     return {"assigned": list(s.assigned), "variables": list(s.variables), "always": s.always, "never": s.never,
             "exact": s.exact, "count": len(s.configurations), "configurations": configs.tolist(),
-            "headings": heading_from_beta(configs, delta).tolist(), "reasons": list(s.reasons)}
+            "headings": heading_from_beta(configs, delta).tolist(), "reasons": list(s.reasons),
+            "note": None}
 
 
 def describe_singular(s: SingularSet, robot: Robot | None = None, *, limit: int = 6) -> str:
