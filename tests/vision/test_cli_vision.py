@@ -69,6 +69,10 @@ def test_calibrate_from_measurements(capsys):
     code, out, _ = run(["vision", "calibrate", "--x1", "71.2357", "--x2", "49.0727", "--rows", "60",
                         "--half-separation", "0.035", "--row-distance", "0.10221"], capsys)
     assert code == 0 and "tilt = " in out and "height = 0.134" in out
+    # rows +-60 px and x1 = 71 px lie outside a 100 x 100 px image: refused (it wrote a camera file)
+    code, out, err = run(["vision", "calibrate", "--x1", "71.2357", "--x2", "49.0727", "--rows", "60",
+                          "--half-separation", "0.035", "--row-distance", "0.10221", "--size", "100", "100"], capsys)
+    assert code == 2 and "A must be below 50 px and x1, x2 below 50 px" in err
 
 
 def test_follow_line_json_and_animation(tmp_path, capsys):

@@ -135,8 +135,12 @@ def run_calibrate(args: argparse.Namespace) -> int:
     if by_points:
         if args.x1 is None or args.x2 is None:
             raise WmrkitError("calibrate: --x1 and --x2 go together")
-        cal = calibrate(args.x1, args.x2, args.rows, xw, yw)
         width, rows = args.size or (640, 480)
+        if not (args.rows < rows / 2 and max(args.x1, args.x2) < width / 2):  # inside the image, as from IMAGE
+            raise WmrkitError(f"calibrate: rows A ({args.rows:g} px) and x1, x2 ({args.x1:g}, {args.x2:g} px) are "
+                              f"measured from the centre of a {width} x {rows} px image (--size): A must be below "
+                              f"{rows / 2:g} px and x1, x2 below {width / 2:g} px")
+        cal = calibrate(args.x1, args.x2, args.rows, xw, yw)
     else:
         if args.size is not None:  # it would be ignored
             raise WmrkitError("calibrate: --size applies to --x1/--x2 (the camera file of an image has its size)")
