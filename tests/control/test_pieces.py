@@ -70,7 +70,8 @@ def test_point_twist_gives_the_point_its_velocity_and_no_slip(name, vx, vy, th):
                      math.sin(th) * twist[0] + math.cos(th) * twist[1], twist[2]])
     vel = (point_pose(cp, pose + h * rate) - point_pose(cp, pose - h * rate))[:2] / (2 * h)
     np.testing.assert_allclose(vel, [vx, vy], atol=1e-5)
-    assert bool(wheel_commands(robot, twist).feasible) or cp.skid
+    assert np.all(np.abs(wheel_commands(robot, twist).slip) <= 1e-9) or cp.skid  # (the steering may be beyond
+    # its range: the car's +-40 deg rack cannot strafe its point, which is what the twist asks; not this test's)
 
 
 def test_castor_angle_is_fed_back_and_trails():

@@ -113,6 +113,26 @@ def test_swerve_inverse_with_optimize_matches_closest_angle_policy():
             assert abs(wrap_angle(ours.steer[i, k] - (state.angle.radians() + math.pi / 2))) < 1e-10  # thesis β
 
 
+@pytest.mark.parametrize("twist", [(0.0, 1.0, 0.0), (0.0, -1.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 0.0, 1.0)])
+def test_swerve_ties_are_broken_as_wpilibs_optimize(twist):
+    """From heading 0, strafing left asks for +-90 deg, both 90 deg away: WPILib keeps +90 rolling forward; the IK
+    took -90 rolling backward (the same motion, the other root). The compiled single-call IK agrees."""
+    from wmrkit.kinematics.realtime import realtime
+
+    swerve = _swerve()
+    ours = wheel_commands(swerve, twist, heading=np.zeros(4))
+    rt = realtime(swerve)
+    rates, heading = np.zeros(4), np.zeros(4)
+    rt.ik(*twist, np.zeros(4), rates, heading)
+    for k, state in enumerate(kin.SwerveDrive4Kinematics(*_translations()).toSwerveModuleStates(
+            kin.ChassisSpeeds(*twist))):
+        state.optimize(geo.Rotation2d(0.0))
+        assert ours.spin[k] * R == pytest.approx(state.speed, rel=1e-10, abs=1e-12)
+        assert abs(wrap_angle(ours.heading[k] - state.angle.radians())) < 1e-10
+        assert rates[k] * R == pytest.approx(state.speed, rel=1e-10, abs=1e-12)
+        assert abs(wrap_angle(heading[k] - state.angle.radians())) < 1e-10
+
+
 def test_swerve_forward_matches_to_chassis_speeds():
     swerve = _swerve()
     peer = kin.SwerveDrive4Kinematics(*_translations())

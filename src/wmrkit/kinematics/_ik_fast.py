@@ -215,7 +215,9 @@ def _steer_block(
     sign = minus_ux * sin_cur
     np.multiply(uy, cos_cur, out=tmp)
     sign += tmp
-    np.copysign(1.0, sign, out=sign)  # a tie (exactly 90 deg away, +-0) goes either way, consistently
+    tie = np.abs(sign) <= 1e-12 * speed  # both roots 90 deg away: the one rolling forward, as WPILib's optimize
+    np.copysign(1.0, sign, out=sign)
+    sign[tie] = -1.0  # the spin is -speed sign / r
     minus_ux *= sign
     minus_ux += 0.0  # -0.0 -> +0.0: atan2 then returns +pi, never -pi, for a wheel rolling straight back
     uy *= sign

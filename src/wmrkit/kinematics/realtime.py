@@ -132,7 +132,8 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             minus_ux = sy[i] * w - vx
             uy = sx[i] * w + vy
             speed = math.sqrt(minus_ux * minus_ux + uy * uy)
-            sign = math.copysign(1.0, minus_ux * math.sin(beta[k]) + uy * math.cos(beta[k]))
+            along = minus_ux * math.sin(beta[k]) + uy * math.cos(beta[k])
+            sign = -1.0 if abs(along) <= 1e-12 * speed else math.copysign(1.0, along)  # a tie: rolling forward
             moving = speed > speed_tol
             if moving:
                 beta[k] = math.atan2(minus_ux * sign + 0.0, uy * sign)
