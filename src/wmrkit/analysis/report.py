@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import html
 import itertools
+import math
 import os
 from pathlib import Path
 
@@ -114,7 +115,9 @@ def _summary_table(a: Analysis) -> str:
     if c.mobility <= 1:
         rows.append(("isotropy (5.28)", f"does not apply (m = {c.mobility}: no two motions to balance)"))
     else:
-        rows += [("condition number κ (5.28)", f"{a.condition_number:.4g} for ({', '.join(a.joints)})"),
+        kappa = (f"{a.condition_number:.4g}" if math.isfinite(a.condition_number)
+                 else "infinite (these joints do not determine the twist)")
+        rows += [("condition number κ (5.28)", f"{kappa} for ({', '.join(a.joints)})"),
                  ("characteristic length D",
                   f"{a.characteristic_length:.4g} m ({'natural' if a.natural else 'given'})")]
     for key, s in a.singular.items():
