@@ -311,7 +311,7 @@ def test_vision_calibrate_out_and_sizes(tmp_path, capsys):
             "--row-distance", "20cm"]
     assert "is a folder" in _refused([*argv, "--out", str(tmp_path)], capsys)  # IsADirectoryError
     # a 1e8 x 1e8 camera was written, and follow-line then tried to render its images
-    assert "width: out of range" in _refused([*argv, "--size", "100000000", "100", "--out", str(tmp_path / "c.yaml")],
+    assert "width: out of range" in _refused([*argv, "--size", "100000000", "480", "--out", str(tmp_path / "c.yaml")],
                                              capsys)
     assert "cos(tilt) = inf" in _refused([*argv, "--half-separation", "1e308"], capsys)  # after numpy's warnings
 
