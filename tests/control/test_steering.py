@@ -42,6 +42,15 @@ def test_choice_is_a_root_and_within_range(h, s, cur, lo, width):
         assert off <= width + 1e-9 or off >= 2 * math.pi - 1e-9
 
 
+@pytest.mark.parametrize(("h", "s"), [(math.pi / 2, 2.0), (math.pi / 2, -2.0), (-math.pi / 2, 2.0),
+                                      (-math.pi / 2, -2.0)])
+def test_closest_breaks_a_tie_by_rolling_forward(h, s):
+    """Both roots 90 deg from the current heading: the one whose spin is >= 0, as the IK and WPILib's optimize (it
+    took the first root given, whichever way it rolled)."""
+    c = choose_steering([h], [s], [0.0], ranges=[[-math.pi, math.pi]])
+    assert c.spin[0] == abs(s) and abs(_wrapped(c.heading[0] - (h if s > 0 else h + math.pi))) < 1e-12
+
+
 @given(h=angles, s=st.floats(-5, 5))
 def test_quadrant_policies(h, s):
     four = choose_steering([h], [s], [0.0], policy="4-quadrant")

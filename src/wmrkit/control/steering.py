@@ -99,8 +99,9 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
         pref0 = s0 >= 0
     elif policy == "2-quadrant":
         pref0 = (h0 > -math.pi / 2 + 1e-12) & (h0 <= math.pi / 2 + 1e-12)
-    else:
-        pref0 = np.abs(wrap_angle(h0 - cur)) <= np.abs(wrap_angle(h1 - cur))
+    else:  # a tie (both 90 deg away): the root rolling forward, as the IK and WPILib's optimize
+        d0, d1 = np.abs(wrap_angle(h0 - cur)), np.abs(wrap_angle(h1 - cur))
+        pref0 = (d0 < d1 - 1e-12) | ((np.abs(d0 - d1) <= 1e-12) & (s0 >= 0))
     if ranges is None:
         ok0 = ok1 = np.ones(h0.shape, dtype=bool)
         lo = hi = None
