@@ -57,9 +57,7 @@ class Analysis:
             "sensing": {k: self.sensing[k] for k in ("sufficient", "verdict")},
             "condition_number": self.condition_number, "characteristic_length": self.characteristic_length,
             "condition_joints": list(self.joints), "natural_length": self.natural,
-            "singular": {k: _singular_dict(s, self.robot) | {"note": uncoupled_note(s, self.robot) or None
-                                                             if k == "actuated" else None}
-                         for k, s in self.singular.items()},
+            "singular": {k: _singular_dict(s, self.robot, self._note(k, s)) for k, s in self.singular.items()},
         }
 
     def format_text(self) -> str:
@@ -82,9 +80,14 @@ class Analysis:
             lines.append(f"  condition number {kappa} at the {how} D = "
                          f"{self.characteristic_length:.4g} m, joints {', '.join(self.joints) or '-'}")
         for key, s in self.singular.items():
-            note = f"; {uncoupled_note(s, r)}" if key == "actuated" and uncoupled_note(s, r) else ""
-            lines.append(f"  singular ({key}: {', '.join(s.assigned) or '-'}{note}): {describe_singular(s, r)}")
+            note = self._note(key, s)
+            lines.append(f"  singular ({key}: {', '.join(s.assigned) or '-'}{f'; {note}' if note else ''}): "
+                         f"{describe_singular(s, r)}")
         return "\n".join(lines)
+
+    def _note(self, key: str, s: SingularSet) -> str | None:
+        """What the actuated singular set leaves out (:func:`uncoupled_note`); None for the sensed one."""
+        return (uncoupled_note(s, self.robot) or None) if key == "actuated" else None
 
 
 def _yes(flag: bool, yes: str, no: str) -> str:
@@ -111,15 +114,14 @@ def uncoupled_note(s: SingularSet, robot: Robot) -> str:
     return f"each joint on its own: the {', '.join(tied)} is left out of this search (see actuation)"
 
 
-def _singular_dict(s: SingularSet, robot: Robot) -> dict[str, Any]:
+def _singular_dict(s: SingularSet, robot: Robot, note: str | None = None) -> dict[str, Any]:
     """JSON of a singular set: ``configurations`` as the thesis's β of `variables`, ``headings`` the same angles
     as the wheels' headings (0 = rolling straight ahead)."""
     delta = np.array([robot.wheel(v).delta for v in s.variables], dtype=float)
     configs = s.configurations[:24]
     return {"assigned": list(s.assigned), "variables": list(s.variables), "always": s.always, "never": s.never,
             "exact": s.exact, "count": len(s.configurations), "configurations": configs.tolist(),
-            "headings": heading_from_beta(configs, delta).tolist(), "reasons": list(s.reasons),
-            "note": None}
+            "headings": heading_from_beta(configs, delta).tolist(), "reasons": list(s.reasons), "note": note}
 
 
 def describe_singular(s: SingularSet, robot: Robot | None = None, *, limit: int = 6) -> str:

@@ -109,7 +109,7 @@ def _determined(jac: np.ndarray) -> bool:
 def _refit(problem: CalibrationProblem) -> np.ndarray:
     """A bootstrap replicate: the fit over `problem`'s runs, in one process; NaN where they do not determine the
     parameters (a resample of closed squares that all turn the same way), which the fit would report as a value."""
-    fit = solve(problem.residuals, len(problem.parameters), jacobian=problem.jacobian)
+    fit = problem.solve()
     return fit.x if _determined(fit.jac) else np.full(len(problem.parameters), np.nan)
 
 

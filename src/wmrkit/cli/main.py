@@ -139,16 +139,13 @@ def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> N
 def _file_place(message: str, argv: Sequence[str]) -> dict:
     """``file``, ``line`` and ``field`` of a message that starts with a file given in `argv` (a path: a name with a
     dot or a slash, or one that exists; the longest first)."""
-    files = (a for a in argv if ("." in a or "/" in a or os.path.exists(a)) and message.startswith(f"{a}:"))
-    for name in sorted(files, key=len, reverse=True):
-        rest = message[len(name) + 1:]
-        place = re.match(r"(\d+):", rest)
-        line = int(place.group(1)) if place else None
-        rest = rest[place.end():] if place else rest
-        column = re.match(r" column '([^']*)':", rest)
-        rest = rest[column.end():] if column else rest
-        return {"error": rest.strip(), "file": name, "line": line, "field": column.group(1) if column else None}
-    return {}
+    name = max((a for a in argv if ("." in a or "/" in a or os.path.exists(a)) and message.startswith(f"{a}:")),
+               key=len, default=None)
+    if name is None:
+        return {}
+    place = re.match(r"(?:(\d+):)?(?: column '([^']*)':)?(.*)", message[len(name) + 1:], flags=re.S)
+    line, column, rest = place.groups()
+    return {"error": rest.strip(), "file": name, "line": int(line) if line else None, "field": column}
 
 
 #: Longest error message printed [characters]; longer ones (quoting huge user text) are cut.

@@ -19,6 +19,7 @@ import numpy as np
 from .._shapes import readonly
 from ..errors import UnknownNameError, WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_table_size
+from ..units import BARE_ANGLE_LIMIT
 
 __all__ = ["BUILTIN", "Reference", "ReferenceError", "builtin_reference", "load_reference", "reference_from_samples",
            "resolve_reference"]
@@ -110,7 +111,7 @@ def _check_radians(name: str, theta: np.ndarray) -> None:
     """Headings are radians: wrapped ones stay within a turn, unwrapped ones move less than half a turn a sample.
     Beyond a turn with larger jumps they are degrees (or nothing a robot can follow): refused."""
     jumps = np.abs(np.diff(theta))
-    if np.abs(theta).max() > 2 * math.pi and jumps.max() > math.pi:
+    if np.abs(theta).max() > BARE_ANGLE_LIMIT and jumps.max() > math.pi:
         k = int(np.argmax(jumps)) + 1
         raise ReferenceError(f"{name}: sample {k + 1}: theta {theta[k]:g} rad, {jumps[k - 1]:g} rad from the sample "
                              "before: headings are radians and go beyond a turn only when unwrapped (less than half "

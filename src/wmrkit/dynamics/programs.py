@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike
 from .._shapes import readonly
 from ..errors import WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, check_table_size
+from ..units import BARE_ANGLE_LIMIT
 from .model import DynamicModel
 from .simulate import Inputs, _knots, joint_column
 
@@ -119,8 +120,9 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
         raise WmrkitError(f"robot '{robot.name}' has no actuated joint: no servo would drive it (it would not "
                           "move); list the motors in its wheels' 'actuated' field")
     cmd = wheel_commands(robot, twists, slip_tol=SLIP_TOL)
-    if not allow_slip and not (np.abs(cmd.slip) <= SLIP_TOL).all():  # a heading outside steer_range: the servo
-        k = int(np.argmin((np.abs(cmd.slip) <= SLIP_TOL).all(axis=-1)))  # holds the wheel at the range's end
+    rolls = np.all(np.abs(cmd.slip) <= SLIP_TOL, axis=-1)  # not cmd.feasible: a heading outside the steer_range
+    if not allow_slip and not rolls.all():  # is held at the range's end by its servo
+        k = int(np.argmin(rolls))
         w = int(np.argmax(np.abs(cmd.slip[k])))
         raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion for "
                           f"'{robot.name}': fixed wheel '{robot.wheel_names[w]}' would slip sideways at "
@@ -194,7 +196,7 @@ def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequenc
 
 def _check_radians(source: str, column: str, headings: np.ndarray) -> None:
     """A heading column [rad] stays within a turn, as a bare angle anywhere else (``units.parse_quantity``)."""
-    beyond = np.flatnonzero(np.abs(headings) > 2 * math.pi)
+    beyond = np.flatnonzero(np.abs(headings) > BARE_ANGLE_LIMIT)
     if beyond.size:
         h = headings[beyond[0]]
         raise WmrkitError(f"{source}:{beyond[0] + 2}: column '{column}': a heading is read in radians, and {h:g} rad "

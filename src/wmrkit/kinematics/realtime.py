@@ -106,10 +106,10 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
     n_e = len(e_beta)
     delta = np.array([w.delta for w in robot.wheels if w.kind.steers], dtype=float)
     two_pi = 2.0 * math.pi
-    ranged = np.array([w.steer_range is not None for w in robot.wheels if w.kind.steers], dtype=np.bool_)
-    lo = np.array([(w.steer_range or (0.0, 0.0))[0] for w in robot.wheels if w.kind.steers], dtype=float)
-    width = np.array([np.subtract(*(w.steer_range or (0.0, 0.0))[::-1]) for w in robot.wheels if w.kind.steers],
-                     dtype=float)
+    ranges = (p.steer_range[:, p.steer_wheels] if p.steer_range is not None
+              else np.array([[-np.inf], [np.inf]]).repeat(n_steer, axis=1))
+    ranged = np.isfinite(ranges).all(axis=0)  # (n_steer,): the wheels with a steer_range (heading lo, hi)
+    lo, width = np.where(ranged, ranges[0], 0.0), np.where(ranged, ranges[1] - ranges[0], 0.0)
 
     @numba.njit(cache=False)
     def wrap(a):

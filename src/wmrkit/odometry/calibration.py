@@ -154,7 +154,11 @@ class CalibrationProblem:
 
     def fit(self) -> np.ndarray:
         """The least-squares parameters ``(n,)`` (:func:`solve`), in this process."""
-        return solve(self.residuals, len(self.parameters), jacobian=self.jacobian).x
+        return self.solve().x
+
+    def solve(self):
+        """The least-squares fit (:func:`solve`), in this process: a ``scipy.optimize.OptimizeResult``."""
+        return solve(self.residuals, len(self.parameters), jacobian=self.jacobian)
 
     def values(self, p: ArrayLike) -> tuple[tuple[str, float, float], ...]:
         """``(name, nominal, value at p)`` per wheel field of every parameter [m or rad]."""
