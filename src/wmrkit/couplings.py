@@ -34,6 +34,22 @@ class Coupling:
         """The coupling acts on joint rates (columns of the Jacobian form), not on steering angles."""
         return self.kind != "linkage"
 
+    @property
+    def channel_name(self) -> str:
+        """The name of the one actuator or sensor it makes of its joints: ``differential(a.spin, b.spin)``."""
+        return f"{self.kind}({', '.join(self.joints)})"
+
+
+def channel_names(couplings: tuple[Coupling, ...], joints: tuple[str, ...]) -> tuple[str, ...]:
+    """`joints` with those of each rate coupling replaced, once, by its channel (in the order of `joints`)."""
+    out: list[str] = []
+    for j in joints:
+        c = next((c for c in couplings if c.rates and j in c.joints), None)
+        name = j if c is None else c.channel_name
+        if name not in out:
+            out.append(name)
+    return tuple(out)
+
 
 def coupled_columns(
     couplings: tuple[Coupling, ...], names: tuple[str, ...], selected: tuple[int, ...]
@@ -74,7 +90,7 @@ def coupled_columns(
         elif c not in emitted:
             emitted.add(c)
             sel.append(channel[c])
-            sel_names.append(f"{c.kind}({', '.join(c.joints)})")
+            sel_names.append(c.channel_name)
     rest = [eye[i] for i in range(n) if i not in owner and i not in selected]
     rest += [channel[c] for c in channel if c not in emitted]
     rest += [v for c in channel if c.kind == "differential" for v in across[c]]

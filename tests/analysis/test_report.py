@@ -31,6 +31,9 @@ def test_report_for_every_catalog_robot(name, tmp_path):
     else:
         assert f"Type {c.type} of the thesis" in text and f"m = {c.mobility}, d = {c.steerability}" in text
     assert "Singular configurations" in text and "Isotropy" in text
+    for c in robot.couplings:  # the actuated model's channels, as analyze searches it
+        if c.rates and all(j in robot.actuated for j in c.joints):
+            assert f"<td>({c.channel_name}): " in text
 
 
 def test_json_output_has_the_keys_of_the_issue(capsys):

@@ -212,21 +212,89 @@ def test_a_subnormal_angle_gives_the_answer_of_zero_without_a_warning():
     assert tiny["singular"] == analyze(car(0.0)).to_dict()["singular"]
 
 
-def test_the_actuated_singular_set_says_it_leaves_a_coupling_out(capsys):
-    """The forklift's drive spins are one differential: at the steering wheel's 90 deg heading the motion (a turn
-    about the drive axle's middle) is driven by no actuator, which the actuation line says, while the singular-set
-    search, each joint on its own, says 'never'. The line now says what it leaves out (the sensed one has no
-    coupling to leave out)."""
+def test_the_forklift_differential_cannot_drive_a_turn_about_the_drive_axle_middle(capsys):
+    """The forklift's drive spins are one differential. At the steering wheel's +-90 deg heading the robot's only
+    motion turns about the middle of the drive axle: the wheels spin opposite, the differential's input stands
+    still, and its one motor drives nothing ('actuation: insufficient' there). The actuated singular set, searched
+    through the coupling, is exactly those two headings (it said 'never' with each joint on its own); the sensed
+    set keeps each joint on its own (two encoders read the turn) and stays 'never'."""
     import json
 
     from wmrkit.cli.main import main
 
+    r = catalog.load("forklift")
+    drives = ("right_drive.spin", "left_drive.spin")
+    s = singular_set(r, drives, coupled=True)
+    assert s.exact and not s.always and s.coupled
+    assert sorted(np.degrees(r.heading_of_beta(s.configurations)).ravel().round(9)) == [-90.0, 90.0]
+    assert singular_set(r, drives).never  # each joint on its own
+    # Independent: the slip matrix at +-90 deg has a motion with both drive rates opposite (their mean zero)
+    for h in (math.pi / 2, -math.pi / 2):
+        a = r.constraint_matrix(heading=[h])
+        motion = np.linalg.svd(a)[2][-1]
+        assert np.allclose(a @ motion, 0, atol=1e-12) and abs(motion[2]) > 0.1  # a turn
+        i, j = (r.velocity_index(n) for n in drives)
+        assert motion[i] == pytest.approx(-motion[j]) and abs(motion[i]) > 0.1
     assert main(["analyze", "forklift", "--steer", "steer=90deg"]) == 0
     out = capsys.readouterr().out
     assert "actuation: insufficient" in out
-    assert ("singular (actuated: right_drive.spin, left_drive.spin; each joint on its own: the differential of "
-            "right_drive.spin + left_drive.spin is left out of this search (see actuation))") in out
-    assert "singular (sensed: right_drive.spin, left_drive.spin): " in out
+    assert ("singular (actuated: differential(right_drive.spin, left_drive.spin)): at heading steer = 90.00, "
+            "-90.00 deg") in out
+    assert "singular (sensed: right_drive.spin, left_drive.spin): never" in out
     assert main(["analyze", "forklift", "--json"]) == 0
-    notes = {k: v["note"] for k, v in json.loads(capsys.readouterr().out)["singular"].items()}
-    assert notes["sensed"] is None and "differential" in notes["actuated"]
+    sing = json.loads(capsys.readouterr().out)["singular"]
+    assert sing["actuated"]["channels"] == ["differential(right_drive.spin, left_drive.spin)"]
+    assert sorted(np.round(np.degrees(sing["actuated"]["headings"]), 9).ravel()) == [-90.0, 90.0]
+    assert sing["sensed"]["channels"] == list(drives) and sing["sensed"]["never"]
+
+
+def test_a_car_with_a_rear_differential_is_singular_turning_about_the_rear_axle_middle():
+    """The Ackermann template drives its rear wheels through a differential: among coordinated steerings its
+    actuated model breaks down only with the ICR at the rear axle's middle (the origin), where the rear wheels
+    spin opposite."""
+    from wmrkit.analysis.coordinated import coordinated_singular_set
+    from wmrkit.analysis.icr import icr
+
+    r = catalog.load("ackermann")
+    s = coordinated_singular_set(r, ("rear_left.spin", "rear_right.spin"), coupled=True)
+    assert len(s.configurations) == 1 and s.coupled
+    point = icr(r, s.configurations[0]).point
+    assert np.allclose(point, 0.0, atol=1e-7)
+    assert coordinated_singular_set(r, ("rear_left.spin", "rear_right.spin")).never
+
+
+@st.composite
+def coupled_cases(draw):
+    """A random robot with random rate couplings (differentials and gear trains over its joint rates)."""
+    import dataclasses
+
+    from wmrkit.couplings import Coupling
+
+    r = draw(robots(max_wheels=4))
+    rates = list(r.rate_names)
+    assume(len(rates) >= 2)
+    order = draw(st.permutations(rates))
+    couplings, k = [], 0
+    while k + 2 <= len(order) and draw(st.booleans()) | (k == 0):
+        size = draw(st.integers(2, min(3, len(order) - k)))
+        ratios = tuple(draw(st.sampled_from([0.5, 1.0, -1.0, 2.0, 1 / 3])) for _ in range(size))
+        couplings.append(Coupling(draw(st.sampled_from(["differential", "gear"])), tuple(order[k:k + size]), ratios))
+        k += size
+    r = dataclasses.replace(r, couplings=tuple(couplings))
+    assigned = tuple(draw(st.lists(st.sampled_from(r.velocity_names), unique=True, max_size=4)))
+    rng = np.random.default_rng(draw(st.integers(0, 2**16)))
+    beta = (rng.uniform(-np.pi, np.pi, len(r.steer_names)) if draw(st.booleans())
+            else steer_to_icr(r, rng.normal(size=3)))
+    return r, assigned, beta
+
+
+@settings(max_examples=200)
+@given(coupled_cases())
+def test_coupled_line_test_equals_coupled_rank_test_on_random_robots(case):
+    """The lines eliminated through the couplings (several wheels together) against the rank test written in the
+    coupled variables (coupled_columns' free directions), which shares no code with the elimination."""
+    r, assigned, beta = case
+    line = {bool(is_singular(r, beta, assigned, rtol=SINGULAR_RTOL * f, coupled=True)) for f in (1e-2, 1e2)}
+    rank = {bool(is_singular_rank(r, beta, assigned, coupled=True)) for _ in (0,)}
+    assume(len(line) == 1)
+    assert line == rank

@@ -115,11 +115,16 @@ def test_parse_vary_units_and_errors():
 def test_kappa_metrics_are_refused_for_robots_of_mobility_1(name):
     """Types 4 and 5 have kappa 1 wherever they can move (§5.5.4-5.5.5): a swerve drive's random configurations are
     never coordinated, so 'sweep swerve-4 --vary ...' printed 'kappa_mean nan' for every design, exit 0. The
-    singularity margin still sweeps, finite."""
+    singularity margin still sweeps, finite, where no coupling ties the actuated joints (the car's and the
+    forklift's differentials join wheels, which the per-wheel kernel cannot: refused, as analyze searches them)."""
     robot = catalog.load(name)
     axes = [parse_vary("wheels[0].l=0.3:0.5:2" if name != "forklift" else "wheels[0].l=0.8:1.2:2", robot)]
     for metric in ("kappa_mean", "kappa_max", "inv_kappa_mean"):
         with pytest.raises(BatchError, match=r"has mobility 1.*--metric singular_margin"):
             build_spec(robot, axes, metric)
-    spec = build_spec(robot, axes, "singular_margin", configs=8)
-    assert np.all(np.isfinite(evaluate(np.arange(2), spec)))
+    if name == "swerve-4":
+        spec = build_spec(robot, axes, "singular_margin", configs=8)
+        assert np.all(np.isfinite(evaluate(np.arange(2), spec)))
+    else:  # driven through a differential: the per-wheel kernel would give the margin of separate joints
+        with pytest.raises(BatchError, match=r"are one differential.*not of this robot's actuated model"):
+            build_spec(robot, axes, "singular_margin", configs=8)

@@ -9,6 +9,8 @@ parameterised by the ICR itself, a point of the projective plane allowed by the 
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy.optimize import minimize
 
@@ -42,25 +44,29 @@ def _on_axle(robot: Robot, t: np.ndarray) -> np.ndarray:
     return np.stack([c * d * ly + s * size * lx, -c * d * lx + s * size * ly, c], axis=-1)
 
 
-def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolution: int = 90) -> SingularSet:
+def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolution: int = 90,
+                             coupled: bool = False) -> SingularSet:
     """Singular configurations among the coordinated ones (all axles through one ICR) of `robot`.
 
     One parameter (a fixed axle): minima of the singularity distance along the axle, refined to machine
     precision. Two (no fixed wheel): refined minima along each grid row of ICR directions, points on the
     singular curves. ``configurations`` are steering configurations over all of ``robot.steer_names``.
+    `coupled`: through the robot's rate couplings (:func:`wmrkit.analysis.lines.constraint_lines`).
     """
-    cl = constraint_lines(robot, assigned)
+    cl = constraint_lines(robot, assigned, coupled=coupled)
     names = robot.steer_names
     empty = np.zeros((0, len(names)))
+    distance = functools.partial(singularity_distance, robot, assigned=cl.assigned, coupled=cl.coupled)
+    singular = functools.partial(is_singular, robot, assigned=cl.assigned, coupled=cl.coupled)
     if cl.internal or len(cl.labels) < 3:
         return SingularSet(cl.assigned, names, True, empty, True, ("fewer assigned velocities than the mobility",),
-                           coordinated=True)
+                           coordinated=True, coupled=cl.coupled)
     grid, dims = admissible_icrs(robot, resolution)
     grid_beta = steer_to_icr(robot, grid)
-    dist = singularity_distance(robot, grid_beta, cl.assigned)
-    if np.all(is_singular(robot, grid_beta, cl.assigned)):
+    dist = distance(grid_beta)
+    if np.all(singular(grid_beta)):
         return SingularSet(cl.assigned, names, True, empty, dims == 1, ("singular at every coordinated steering",),
-                           coordinated=True)
+                           coordinated=True, coupled=cl.coupled)
     rows = dist.reshape(-1, resolution) if dims == 2 else dist[None]
     size, step = robot_size(robot), (np.pi if dims == 1 else 2 * np.pi) / resolution
     thetas = np.linspace(0.0, np.pi / 2, resolution // 4 + 1)
@@ -75,25 +81,25 @@ def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolut
     is_min = (rows <= np.roll(rows, 1, axis=1)) & (rows <= np.roll(rows, -1, axis=1)) & (rows < 0.2)
     r_idx, i_idx = np.nonzero(is_min)
     x0 = start + i_idx * step
-    x = _golden_batch(lambda x: singularity_distance(robot, steer_to_icr(robot, icr_of(r_idx, x)), cl.assigned),
+    x = _golden_batch(lambda x: distance(steer_to_icr(robot, icr_of(r_idx, x))),
                       x0 - 2 * step, x0 + 2 * step)
     betas = steer_to_icr(robot, icr_of(r_idx, x)).reshape(-1, len(names))
-    sing = is_singular(robot, betas, cl.assigned) if len(betas) else np.zeros(0, bool)
+    sing = singular(betas) if len(betas) else np.zeros(0, bool)
     found = list(betas[sing])
     if dims == 2 and not found and len(betas):  # an isolated singular ICR (e.g. at a wheel): minimise in 2-D
-        d = singularity_distance(robot, betas, cl.assigned)
+        d = distance(betas)
         seen: list[np.ndarray] = []
         for k in np.argsort(d)[:6]:
             def g(p):
                 h = np.array([size * np.sin(p[0]) * np.cos(p[1]), size * np.sin(p[0]) * np.sin(p[1]), np.cos(p[0])])
-                return float(singularity_distance(robot, steer_to_icr(robot, h), cl.assigned))
+                return float(distance(steer_to_icr(robot, h)))
 
             res = minimize(g, [thetas[r_idx[k]], x[k]], method="Nelder-Mead",
                            options={"xatol": 1e-12, "fatol": 1e-15, "maxiter": 600})
             t, ph = res.x
             h = np.array([size * np.sin(t) * np.cos(ph), size * np.sin(t) * np.sin(ph), np.cos(t)])
             beta = steer_to_icr(robot, h)
-            if is_singular(robot, beta, cl.assigned) and not any(np.linalg.norm(np.cross(h, e)) < 1e-7 for e in seen):
+            if singular(beta) and not any(np.linalg.norm(np.cross(h, e)) < 1e-7 for e in seen):
                 seen.append(h)
                 found.append(beta)
     out = np.array(found).reshape(-1, len(names))
@@ -104,7 +110,7 @@ def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolut
                 keep.append(i)
         out = out[keep]
     where = tuple(icr(robot, b).describe() for b in out[:8])
-    return SingularSet(cl.assigned, names, False, out, dims == 1, where, coordinated=True)
+    return SingularSet(cl.assigned, names, False, out, dims == 1, where, coordinated=True, coupled=cl.coupled)
 
 
 def _golden_batch(f, a: np.ndarray, b: np.ndarray, iterations: int = 70) -> np.ndarray:

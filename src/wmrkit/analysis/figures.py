@@ -223,7 +223,7 @@ def singular_figure(robot: Robot, s: SingularSet, title: str) -> Figure | None:
     ax = fig.add_subplot(1, 2 if two else 1, 1)
     draw_robot(robot, ax, beta=beta, labels=False)
     size = robot_size(robot)
-    cl = constraint_lines(robot, s.assigned)
+    cl = constraint_lines(robot, s.assigned, coupled=s.coupled)
     lines = cl.lines(beta)
     for k, (lam, label) in enumerate(zip(lines, cl.labels, strict=True)):
         _draw_line(ax, lam, color=LINE_COLORS[k % len(LINE_COLORS)], linewidth=1.4, label=label, zorder=4)

@@ -20,8 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
+from scipy.linalg import block_diag
 
 from .._shapes import as_vectors, readonly
+from ..couplings import Coupling, coupled_columns
 from ..kinematics.linalg import rref
 from ..robot import TWIST_NAMES, Robot, element_table
 
@@ -81,8 +83,9 @@ class ConstraintLines:
     """Compiled constraint lines of a robot for one set of assigned velocities (eqs. 6.15-6.17).
 
     ``labels[i]`` names line i ("axle of f1", "plane of o3", "X axis (vx assigned)"...); ``wheels[i]`` its wheel
-    ("" for a vehicle velocity). ``internal`` lists wheels whose unassigned joint rates are not fixed by the twist
-    (e.g. a double wheel with none of its joints assigned): a model with them is always undetermined.
+    ("" for a vehicle velocity, "a + b" for a line through a coupling). ``internal`` lists wheels whose unassigned
+    joint rates are not fixed by the twist (e.g. a double wheel with none of its joints assigned): a model with
+    them is always undetermined.
     """
 
     robot: Robot
@@ -92,6 +95,7 @@ class ConstraintLines:
     internal: tuple[str, ...]
     coefficients: np.ndarray  # (n_lines, 2 n_elements): combination of the element rows
     constant: np.ndarray  # (n_lines, 3): rows added for vehicle velocities
+    coupled: bool = False  # the rate couplings held (constraint_lines(coupled=True) on a robot that has some)
 
     def lines(self, beta: ArrayLike | None = None) -> np.ndarray:
         """The lines at steering configuration `beta`: ``(..., n_steer) -> (..., n_lines, 3)`` (6.18), normalised."""
@@ -103,46 +107,64 @@ class ConstraintLines:
     def steered(self) -> tuple[bool, ...]:
         """Whether each line moves with the steering configuration (it belongs to a wheel that steers)."""
         steer = set(self.robot.steer_names)
-        return tuple(w in steer for w in self.wheels)
+        return tuple(not steer.isdisjoint(w.split(" + ")) for w in self.wheels)
+
+    @property
+    def wheel_names(self) -> frozenset[str]:
+        """The wheels whose slip rows enter some line."""
+        return frozenset(n for w in self.wheels if w for n in w.split(" + "))
 
 
-def constraint_lines(robot: Robot, assigned: tuple[str, ...] = ()) -> ConstraintLines:
+def constraint_lines(robot: Robot, assigned: tuple[str, ...] = (), *, coupled: bool = False) -> ConstraintLines:
     """The lines G of (6.15)-(6.17) for `assigned` velocities (names from ``robot.velocity_names``).
 
     With nothing assigned these are the motion constraints K_r* of (5.2)-(5.9): the ICR lies on every line.
     A model with the assigned velocities is singular iff the lines are concurrent or parallel (rank < 3, 6.17),
     or some wheel in ``internal`` has undetermined rates.
+
+    `coupled`: the robot's rate couplings (``wmrkit.couplings``) hold: an assigned joint of a differential assigns
+    its channel (the weighted sum of its joints' rates) and leaves the rates across it free; a gear train turns
+    its joints together. The free rates of the coupled wheels are then eliminated together, so a line may combine
+    the rows of several wheels (the actuated model of a robot driven through a differential).
     """
     for name in assigned:
         robot.velocity_index(name)
-    return _compile(robot, tuple(sorted(set(assigned), key=robot.velocity_names.index)))
+    coupled = coupled and any(c.rates for c in robot.couplings)
+    return _compile(robot, tuple(sorted(set(assigned), key=robot.velocity_names.index)), coupled)
 
 
 @functools.lru_cache(maxsize=512)
-def _compile(robot: Robot, assigned: tuple[str, ...]) -> ConstraintLines:
+def _compile(robot: Robot, assigned: tuple[str, ...], coupled: bool = False) -> ConstraintLines:
     rng = np.random.default_rng(0)
     probe = element_rows(robot, rng.uniform(-np.pi, np.pi, (3, len(robot.steer_names))))  # (3, 2E, 3)
     coefficients, labels, wheels, internal = [], [], [], []
     n_rows = probe.shape[-2]
-    start = 0
-    for w in robot.wheels:
-        rows = 2 * len(w.elements())
-        w_block = _rate_block(w)  # (rows, n_rates) constant
-        free = [j for j, n in enumerate(w.rate_names) if n not in assigned]
-        sub = w_block[:, free]
-        u, s, _ = np.linalg.svd(sub) if sub.size else (np.eye(rows), np.zeros(0), None)
+    starts = np.cumsum([0] + [2 * len(w.elements()) for w in robot.wheels])
+    for block, couplings in _blocks(robot, coupled):
+        members = [robot.wheels[i] for i in block]
+        rows = np.concatenate([np.arange(starts[i], starts[i + 1]) for i in block])
+        w_block = block_diag(*[_rate_block(w) for w in members])  # (rows, n_rates) constant
+        names = tuple(n for w in members for n in w.rate_names)
+        selected = tuple(j for j, n in enumerate(names) if n in assigned)
+        if couplings:
+            sub = w_block @ coupled_columns(couplings, names, selected)[2]
+        else:
+            sub = w_block[:, [j for j in range(len(names)) if j not in selected]]
+        u, s, _ = np.linalg.svd(sub) if sub.size else (np.eye(len(rows)), np.zeros(0), None)
         rank = int(np.sum(s > 1e-12 * max(1.0, s.max(initial=0.0))))
-        if rank < len(free):
-            internal.append(w.name)
+        if rank < sub.shape[1]:
+            internal.append(" + ".join(w.name for w in members))
         for n in _clean(u[:, rank:].T):
             full = np.zeros(n_rows)
-            full[start:start + rows] = n
+            full[rows] = n
             if np.abs(np.einsum("k,bkc->bc", full, probe)).max() < 1e-12:
                 continue  # a combination that cancels identically (e.g. the shared axle of a double castor)
+            parts = {i: full[starts[i]:starts[i + 1]] for i in block}
+            on = [i for i in block if np.abs(parts[i]).max() > 1e-12]
             coefficients.append(full)
-            labels.append(f"{_label(w, n)} of {w.name}")
-            wheels.append(w.name)
-        start += rows
+            wheels.append(" + ".join(robot.wheels[i].name for i in on))
+            labels.append(f"{_label(robot.wheels[on[0]], parts[on[0]])} of {wheels[-1]}" if len(on) == 1 else
+                          f"line of {wheels[-1]} (through the {' and '.join(c.kind for c in couplings)})")
     constant = [np.zeros(3)] * len(coefficients)
     for name in assigned:
         if name in TWIST_NAMES:
@@ -152,8 +174,30 @@ def _compile(robot: Robot, assigned: tuple[str, ...]) -> ConstraintLines:
             wheels.append("")
     return ConstraintLines(
         robot, assigned, tuple(labels), tuple(wheels), tuple(internal),
-        readonly(np.array(coefficients).reshape(-1, n_rows)), readonly(np.array(constant).reshape(-1, 3)),
+        readonly(np.array(coefficients).reshape(-1, n_rows)), readonly(np.array(constant).reshape(-1, 3)), coupled,
     )
+
+
+def _blocks(robot: Robot, coupled: bool) -> list[tuple[tuple[int, ...], tuple[Coupling, ...]]]:
+    """The wheels whose free rates are eliminated together, with the rate couplings that tie them: every wheel on
+    its own, or (`coupled`) the wheels joined by rate couplings as one block."""
+    group = list(range(len(robot.wheels)))  # union-find over wheel indices
+    index = {w.name: i for i, w in enumerate(robot.wheels)}
+    ties = [c for c in robot.couplings if c.rates] if coupled else []
+
+    def root(i: int) -> int:
+        while group[i] != i:
+            i = group[i]
+        return i
+
+    for c in ties:
+        first, *others = (index[j.partition(".")[0]] for j in c.joints)
+        for o in others:
+            group[root(o)] = root(first)
+    out: dict[int, list[int]] = {}
+    for i in range(len(robot.wheels)):
+        out.setdefault(root(i), []).append(i)
+    return [(tuple(b), tuple(c for c in ties if index[c.joints[0].partition(".")[0]] in b)) for b in out.values()]
 
 
 def _rate_block(w) -> np.ndarray:

@@ -18,7 +18,7 @@ from .coordinated import coordinated_singular_set
 from .figures import condition_figure, length_figure, motions_figure, robot_figure, singular_figure
 from .lines import constraint_lines
 from .singularity import singular_set
-from .summary import Analysis, actuation_words, describe_singular
+from .summary import Analysis, actuation_words, assigned_names, describe_singular
 
 _CSS = """
 body { font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; color: #222; line-height: 1.45 }
@@ -121,7 +121,8 @@ def _summary_table(a: Analysis) -> str:
                  ("characteristic length D",
                   f"{a.characteristic_length:.4g} m ({'natural' if a.natural else 'given'})")]
     for key, s in a.singular.items():
-        rows.append((f"singular {key} model", f"({', '.join(s.assigned) or '-'}): {describe_singular(s, a.robot)}"))
+        rows.append((f"singular {key} model",
+                     f"({', '.join(assigned_names(s, a.robot)) or '-'}): {describe_singular(s, a.robot)}"))
     rows += [("special configuration", s.description) for s in c.special]
     body = "".join(f"<tr><th>{_e(k)}</th><td>{_e(v)}</td></tr>" for k, v in rows)
     return f"<table>{body}</table>"
@@ -159,7 +160,7 @@ def _singular_section(a: Analysis, out: Path, resolution: int, dpi: float | None
             "(thesis ch. 6).")
     body = ""
     for key, s in a.singular.items():
-        fig = singular_figure(r, s, f"{key} ({', '.join(s.assigned)})")
+        fig = singular_figure(r, s, f"{key} ({', '.join(assigned_names(s, r))})")
         if fig is not None:
             body += _save(dpi, fig, out, f"singular_{key}.png")
     body += _assignable_table(a, resolution)

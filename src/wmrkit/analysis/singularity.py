@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
+from ..couplings import coupled_columns
 from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import matrix_rank, nondimensional
 from ..kinematics.models import configuration
@@ -34,28 +35,37 @@ SINGULAR_RTOL = 1e-8
 
 
 def is_singular_rank(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], *,
-                     heading: ArrayLike | None = None) -> np.ndarray:
+                     heading: ArrayLike | None = None, coupled: bool = False) -> np.ndarray:
     """Rank test (6.12): ``rank A_na < k - |assigned|``. ``(..., n_steer) -> (...)`` bool.
 
     `assigned` are names from ``robot.velocity_names`` (twist components and wheel joint rates). Steering: `beta`
-    (thesis, None: as described) or `heading` (0 = rolling forward).
+    (thesis, None: as described) or `heading` (0 = rolling forward). `coupled`: the robot's rate couplings hold
+    (:func:`wmrkit.couplings.coupled_columns`): ``A_na`` is the slip matrix in the free variables, the twist
+    components not assigned and the free rate combinations ``T_rest``.
     """
     cols = [robot.velocity_index(n) for n in assigned]
     a = nondimensional(robot).constraint_matrix(beta, heading=heading)  # kinematics.linalg's tolerances
+    if coupled:
+        rates = robot.rate_names
+        rest = coupled_columns(robot.couplings, rates, tuple(rates.index(n) for n in assigned if n in rates))[2]
+        twist = [j for j in range(3) if j not in cols]
+        free = np.concatenate([a[..., twist], a[..., 3:] @ rest], axis=-1)
+        return matrix_rank(free) < free.shape[-1]
     free = [j for j in range(a.shape[-1]) if j not in cols]
     return matrix_rank(a[..., free]) < len(free)
 
 
 def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], *,
-                rtol: float = SINGULAR_RTOL, heading: ArrayLike | None = None) -> np.ndarray:
+                rtol: float = SINGULAR_RTOL, heading: ArrayLike | None = None, coupled: bool = False) -> np.ndarray:
     """Line test (6.17)-(6.20): the constraint lines G are concurrent or parallel. ``(..., n_steer) -> (...)`` bool.
 
     Also True when a wheel has joint rates the assigned set leaves undetermined (e.g. a double wheel with none of
     its joints assigned). Equals :func:`is_singular_rank` away from numerical ties. Uses an SVD per configuration
     (accurate to machine precision); :func:`singularity_distance` is the fast measure for maps. Steering: `beta`
-    (thesis, None: as described) or `heading` (0 = rolling forward).
+    (thesis, None: as described) or `heading` (0 = rolling forward). `coupled`: through the robot's rate couplings
+    (:func:`wmrkit.analysis.lines.constraint_lines`).
     """
-    cl = constraint_lines(robot, assigned)
+    cl = constraint_lines(robot, assigned, coupled=coupled)
     beta = configuration(robot, beta, heading)
     if cl.internal or len(cl.labels) < 3:
         return np.ones(beta.shape[:-1], bool)
@@ -65,14 +75,16 @@ def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...],
 
 
 def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], *,
-                         length: float | None = None, heading: ArrayLike | None = None) -> np.ndarray:
+                         length: float | None = None, heading: ArrayLike | None = None,
+                         coupled: bool = False) -> np.ndarray:
     """Distance to singularity: ``sigma_min / sigma_max`` of the lines G (6.17), rows scaled to unit norm.
 
     ``(..., n_steer) -> (...)`` in [0, 1]; 0 exactly at singular configurations. The ``d_lambda`` column is
     divided by `length` [m] (default: the robot's size, :func:`robot_size`) so the measure has no units.
-    Steering: `beta` (thesis, None: as described) or `heading` (0 = rolling forward).
+    Steering: `beta` (thesis, None: as described) or `heading` (0 = rolling forward). `coupled`: through the
+    robot's rate couplings.
     """
-    cl = constraint_lines(robot, assigned)
+    cl = constraint_lines(robot, assigned, coupled=coupled)
     beta = configuration(robot, beta, heading)
     if cl.internal or len(cl.labels) < 3:
         return np.zeros(beta.shape[:-1])
@@ -109,7 +121,8 @@ class SingularSet:
     ``exact`` (zero or one variable), points on the singular curves/surfaces sampled on a grid otherwise.
     ``reasons`` explains an ``always``. ``coordinated``: only configurations with all steered axles through one
     ICR were searched (:func:`wmrkit.analysis.coordinated.coordinated_singular_set`); ``reasons`` then describes
-    the singular ICRs.
+    the singular ICRs. ``coupled``: the robot's rate couplings held (an assigned joint of a differential assigns
+    its channel), as for the actuated model.
     """
 
     assigned: tuple[str, ...]
@@ -119,6 +132,7 @@ class SingularSet:
     exact: bool
     reasons: tuple[str, ...] = ()
     coordinated: bool = False
+    coupled: bool = False
 
     @property
     def never(self) -> bool:
@@ -127,18 +141,19 @@ class SingularSet:
 
 
 def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[str, ...] | None = None,
-                 resolution: int = 180, max_samples: int = 20000) -> SingularSet:
+                 resolution: int = 180, max_samples: int = 20000, coupled: bool = False) -> SingularSet:
     """The singular configurations of the model with `assigned` velocities (§6.3-6.5).
 
     `variables`: steering wheels to vary (default: those whose lines enter G, since the others do not matter);
     the rest stay at their described angles. With more than one variable, all but the last are sampled on a
     grid of `resolution` points per turn (fewer if the grid would exceed `max_samples` points) and the last is
-    solved exactly.
+    solved exactly. `coupled`: through the robot's rate couplings (the actuated model of a robot with a
+    differential: :func:`wmrkit.analysis.lines.constraint_lines`).
     """
-    cl = constraint_lines(robot, assigned)
+    cl = constraint_lines(robot, assigned, coupled=coupled)
     steer = robot.steer_names
     if variables is None:
-        variables = tuple(n for n in steer if n in set(cl.wheels))
+        variables = tuple(n for n in steer if n in cl.wheel_names)
     for v in variables:
         if v not in steer:
             raise UnknownNameError(f"robot '{robot.name}' has no steering wheel '{v}' (steering: {', '.join(steer)})")
@@ -147,14 +162,14 @@ def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[st
     empty = np.zeros((0, len(variables)))
     if cl.internal:
         why = tuple(f"the joint rates of {w} are not determined by the assigned velocities" for w in cl.internal)
-        return SingularSet(cl.assigned, variables, True, empty, True, why)
+        return SingularSet(cl.assigned, variables, True, empty, True, why, coupled=cl.coupled)
     if len(cl.labels) < 3:
         why = (f"only {len(cl.labels)} constraint line(s): fewer assigned velocities than the mobility",)
-        return SingularSet(cl.assigned, variables, True, empty, True, why)
+        return SingularSet(cl.assigned, variables, True, empty, True, why, coupled=cl.coupled)
     if not variables:
-        sing = bool(is_singular(robot, base, cl.assigned))
+        sing = bool(is_singular(robot, base, cl.assigned, coupled=cl.coupled))
         why = ("the lines " + ", ".join(cl.labels) + " are concurrent or parallel",) if sing else ()
-        return SingularSet(cl.assigned, variables, sing, empty, True, why)
+        return SingularSet(cl.assigned, variables, sing, empty, True, why, coupled=cl.coupled)
     per_axis = resolution if len(idx) <= 2 else min(resolution, int(max_samples ** (1 / (len(idx) - 1))))
     grid = np.linspace(-np.pi, np.pi, per_axis, endpoint=False)
     if per_axis < 4:  # too many variables for a grid (numpy has 32 axes at most): a seeded random sample
@@ -167,7 +182,8 @@ def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[st
     roots, always = _roots_last(cl, configs, idx[-1])
     if always.all():
         return SingularSet(cl.assigned, variables, True, empty, len(idx) == 1,
-                           ("the lines " + ", ".join(cl.labels) + " are always concurrent or parallel",))
+                           ("the lines " + ", ".join(cl.labels) + " are always concurrent or parallel",),
+                           coupled=cl.coupled)
     found = [np.zeros((0, len(idx)))]
     for i, rs in enumerate(roots):
         values = grid if always[i] else rs  # a whole line of the last angle is singular: sample it
@@ -180,7 +196,7 @@ def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[st
     found_arr = np.concatenate(found)
     if len(found_arr):
         found_arr = found_arr[np.lexsort(found_arr.T[::-1])]
-    return SingularSet(cl.assigned, variables, False, found_arr, len(idx) == 1)
+    return SingularSet(cl.assigned, variables, False, found_arr, len(idx) == 1, coupled=cl.coupled)
 
 
 def _isolated(cl, base: np.ndarray, idx: list[int], per_axis: int, count: int = 8) -> np.ndarray:
@@ -189,7 +205,7 @@ def _isolated(cl, base: np.ndarray, idx: list[int], per_axis: int, count: int = 
     mesh = np.stack(np.meshgrid(*([axis] * len(idx)), indexing="ij"), axis=-1)
     beta = np.broadcast_to(base, (*mesh.shape[:-1], len(base))).copy()
     beta[..., idx] = mesh
-    dist = singularity_distance(cl.robot, beta, cl.assigned)
+    dist = singularity_distance(cl.robot, beta, cl.assigned, coupled=cl.coupled)
     is_min = dist < 0.2
     for ax in range(len(idx)):
         is_min &= (dist <= np.roll(dist, 1, ax)) & (dist <= np.roll(dist, -1, ax))
@@ -199,7 +215,7 @@ def _isolated(cl, base: np.ndarray, idx: list[int], per_axis: int, count: int = 
     def f(x):
         b = base.copy()
         b[idx] = x
-        return float(singularity_distance(cl.robot, b, cl.assigned))
+        return float(singularity_distance(cl.robot, b, cl.assigned, coupled=cl.coupled))
 
     out: list[np.ndarray] = []
     for s in starts:

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from ..couplings import channel_names
 from ..errors import WmrkitError
 from ..kinematics.actuation import actuation_analysis
 from ..kinematics.sensing import sensing_analysis
@@ -57,7 +58,7 @@ class Analysis:
             "sensing": {k: self.sensing[k] for k in ("sufficient", "verdict")},
             "condition_number": self.condition_number, "characteristic_length": self.characteristic_length,
             "condition_joints": list(self.joints), "natural_length": self.natural,
-            "singular": {k: _singular_dict(s, self.robot, self._note(k, s)) for k, s in self.singular.items()},
+            "singular": {k: _singular_dict(s, self.robot) for k, s in self.singular.items()},
         }
 
     def format_text(self) -> str:
@@ -80,14 +81,8 @@ class Analysis:
             lines.append(f"  condition number {kappa} at the {how} D = "
                          f"{self.characteristic_length:.4g} m, joints {', '.join(self.joints) or '-'}")
         for key, s in self.singular.items():
-            note = self._note(key, s)
-            lines.append(f"  singular ({key}: {', '.join(s.assigned) or '-'}{f'; {note}' if note else ''}): "
-                         f"{describe_singular(s, r)}")
+            lines.append(f"  singular ({key}: {', '.join(assigned_names(s, r)) or '-'}): {describe_singular(s, r)}")
         return "\n".join(lines)
-
-    def _note(self, key: str, s: SingularSet) -> str | None:
-        """What the actuated singular set leaves out (:func:`uncoupled_note`); None for the sensed one."""
-        return (uncoupled_note(s, self.robot) or None) if key == "actuated" else None
 
 
 def _yes(flag: bool, yes: str, no: str) -> str:
@@ -104,24 +99,20 @@ def actuation_words(actuation: dict[str, Any]) -> str:
             "(mechanical couplings go in the description's 'couplings')")
 
 
-def uncoupled_note(s: SingularSet, robot: Robot) -> str:
-    """What the singular-set search (ch. 6, each assigned joint on its own) leaves out: the mechanical couplings
-    that tie assigned joints into one channel (a differential). "" when none does."""
-    tied = [f"{c.kind} of {' + '.join(c.joints)}" for c in robot.couplings
-            if c.rates and sum(j in s.assigned for j in c.joints) > 1]
-    if not tied:
-        return ""
-    return f"each joint on its own: the {', '.join(tied)} is left out of this search (see actuation)"
+def assigned_names(s: SingularSet, robot: Robot) -> tuple[str, ...]:
+    """The velocities a singular set assigns, each rate coupling's joints as its channel when it holds them."""
+    return channel_names(robot.couplings, s.assigned) if s.coupled else s.assigned
 
 
-def _singular_dict(s: SingularSet, robot: Robot, note: str | None = None) -> dict[str, Any]:
+def _singular_dict(s: SingularSet, robot: Robot) -> dict[str, Any]:
     """JSON of a singular set: ``configurations`` as the thesis's β of `variables`, ``headings`` the same angles
     as the wheels' headings (0 = rolling straight ahead)."""
     delta = np.array([robot.wheel(v).delta for v in s.variables], dtype=float)
     configs = s.configurations[:24]
     return {"assigned": list(s.assigned), "variables": list(s.variables), "always": s.always, "never": s.never,
             "exact": s.exact, "count": len(s.configurations), "configurations": configs.tolist(),
-            "headings": heading_from_beta(configs, delta).tolist(), "reasons": list(s.reasons), "note": note}
+            "headings": heading_from_beta(configs, delta).tolist(), "reasons": list(s.reasons),
+            "channels": list(assigned_names(s, robot))}
 
 
 def describe_singular(s: SingularSet, robot: Robot | None = None, *, limit: int = 6) -> str:
@@ -155,12 +146,13 @@ def model_rates(robot: Robot, joints: tuple[str, ...]) -> tuple[str, ...]:
 
 
 def model_singular_set(robot: Robot, assigned: tuple[str, ...], cls: Classification,
-                       resolution: int) -> SingularSet:
+                       resolution: int, *, coupled: bool = False) -> SingularSet:
     """Singular set of a model: over admissible (coordinated) configurations when the steering must be coordinated
-    (:mod:`.coordinated`), else over the whole steering space (:func:`.singularity.singular_set`)."""
+    (:mod:`.coordinated`), else over the whole steering space (:func:`.singularity.singular_set`). `coupled`:
+    through the robot's rate couplings (the actuated model: a differential is one actuator)."""
     if cls.coordinated:
-        return coordinated_singular_set(robot, assigned, resolution=resolution)
-    return singular_set(robot, assigned, resolution=resolution, max_samples=resolution * 8)
+        return coordinated_singular_set(robot, assigned, resolution=resolution, coupled=coupled)
+    return singular_set(robot, assigned, resolution=resolution, max_samples=resolution * 8, coupled=coupled)
 
 
 def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) -> Analysis:
@@ -178,7 +170,7 @@ def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) 
     else:
         d, kappa = float(length), float(twist_condition_number(robot, joints=joints, length=length))
     act, sen = actuation_analysis(robot), sensing_analysis(robot)
-    singular = {key: model_singular_set(robot, model_rates(robot, names), cls, resolution)
+    singular = {key: model_singular_set(robot, model_rates(robot, names), cls, resolution, coupled=key == "actuated")
                 for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed))}
     return Analysis(
         robot, cls, int(instantaneous_mobility(robot)), icr(robot),

@@ -189,6 +189,12 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
                          "configuration it can move in and undefined elsewhere (isotropy does not apply to types 4 "
                          "and 5, §5.5.4-5.5.5), so a --metric of kappa compares nothing; sweep --metric "
                          "singular_margin")
+    tied = [c for c in robot.couplings if c.rates and sum(j in joints for j in c.joints) > 1]
+    if metric == "singular_margin" and tied:
+        raise BatchError(f"robot '{robot.name}': its actuated joints {', '.join(tied[0].joints)} are one "
+                         f"{tied[0].kind}; the sweep's kernel takes each wheel on its own, and a line through the "
+                         f"coupling joins wheels: its singular_margin would be that of separate joints, not of this "
+                         f"robot's actuated model (use 'wmrkit analyze' on the designs)")
     cl = constraint_lines(robot, joints)
     if metric == "singular_margin" and (cl.internal or len(cl.labels) < 3):
         raise BatchError(f"robot '{robot.name}': its actuated model is singular everywhere (fewer than 3 lines)")

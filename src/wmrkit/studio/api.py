@@ -30,7 +30,7 @@ from ..analysis.isotropy import (
 )
 from ..analysis.optimize import isotropic_configurations
 from ..analysis.singularity import robot_size, singularity_distance
-from ..analysis.summary import describe_singular, model_rates, model_singular_set
+from ..analysis.summary import assigned_names, describe_singular, model_rates, model_singular_set
 from ..description import COMMON_WHEEL_FIELDS, robot_from_dict, robot_to_dict
 from ..errors import DescriptionError, WmrkitError
 from ..kinematics.actuation import actuation_analysis
@@ -142,7 +142,7 @@ def live_summary(robot: Robot) -> dict[str, Any]:
     here = {}
     for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed)):
         assigned = model_rates(robot, names)
-        dist = float(singularity_distance(robot, None, assigned))
+        dist = float(singularity_distance(robot, None, assigned, coupled=key == "actuated"))
         here[key] = {"assigned": list(assigned), "distance": dist, "singular": dist < 1e-8,
                      "near": dist < NEAR_SINGULAR}
     return {
@@ -187,11 +187,12 @@ def configurations(request: Any) -> dict[str, Any]:
     cls = classify(robot)
     out: dict[str, Any] = {"singular": {}}
     for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed)):
-        s = model_singular_set(robot, model_rates(robot, names), cls, 90)
+        s = model_singular_set(robot, model_rates(robot, names), cls, 90, coupled=key == "actuated")
         headings = [[float(heading_from_beta(v, robot.wheel(n).delta)) for n, v in zip(s.variables, row,
                                                                                         strict=True)]
                     for row in s.configurations[:24].tolist()]
-        out["singular"][key] = {"assigned": list(s.assigned), "variables": list(s.variables), "always": s.always,
+        out["singular"][key] = {"assigned": list(s.assigned), "channels": list(assigned_names(s, robot)),
+                                "variables": list(s.variables), "always": s.always,
                                 "never": s.never, "exact": s.exact, "count": len(s.configurations),
                                 "headings": headings, "reasons": list(s.reasons), "text": describe_singular(s)}
     # The library's search refines each grid minimum at its own natural length: quick for m = 2 or one steering
