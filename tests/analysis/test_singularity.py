@@ -298,3 +298,18 @@ def test_coupled_line_test_equals_coupled_rank_test_on_random_robots(case):
     rank = {bool(is_singular_rank(r, beta, assigned, coupled=True)) for _ in (0,)}
     assume(len(line) == 1)
     assert line == rank
+
+
+def test_a_line_through_a_coupling_may_vanish():
+    """Two steerable wheels at one point, their spins geared together: the line 'plane of w0 - plane of w1' is
+    zero where they point the same way. It is no constraint there (the tests divided by its zero norm: NaN, and an
+    SVD that did not converge); with the two axle lines left the model is singular, as the rank test says."""
+    from wmrkit.couplings import Coupling
+    from wmrkit.robot import Robot
+    from wmrkit.wheels import Wheel
+
+    w = [Wheel(name=n, type="steerable", l=0.0, alpha=0.0, beta=0.0, r=0.5) for n in ("w0", "w1")]
+    r = Robot(name="r", wheels=tuple(w), couplings=(Coupling("gear", ("w0.spin", "w1.spin"), (0.5, 0.5)),))
+    b = np.array([-0.81, -0.81])
+    assert is_singular(r, b, (), coupled=True) and is_singular_rank(r, b, (), coupled=True)
+    assert singularity_distance(r, b, (), coupled=True) == 0.0

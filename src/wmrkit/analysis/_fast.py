@@ -112,12 +112,13 @@ def columns_m2(rates: np.ndarray, lines: np.ndarray) -> tuple[np.ndarray, np.nda
 def distance_cm(lines: np.ndarray, length: float) -> np.ndarray:
     """``sigma_min / sigma_max`` of the lines ``(L, 3, N)`` with d scaled by 1/length and unit rows, (6.17)."""
     g = lines * np.array([1.0, 1.0, 1.0 / length])[None, :, None]
-    g = g / np.sqrt(np.einsum("lcn,lcn->ln", g, g))[:, None, :]
+    norm = np.sqrt(np.einsum("lcn,lcn->ln", g, g))
+    g = g / np.where(norm > 0, norm, 1.0)[:, None, :]  # a line through a coupling can vanish at some configurations
     if g.shape[-1] <= FEW:  # SVD: accurate to eps (the Gram route bottoms out at sqrt(eps))
         sv = np.linalg.svd(np.moveaxis(g, -1, 0), compute_uv=False)
-        return sv[:, 2] / sv[:, 0]
+        return sv[:, 2] / np.where(sv[:, 0] > 0, sv[:, 0], 1.0)
     small, _, large = eigvalsh3_entries(*gram3(g))
-    return np.sqrt(np.maximum(small, 0.0) / large)
+    return np.sqrt(np.maximum(small, 0.0) / np.where(large > 0, large, 1.0))
 
 
 def _eig3(entries: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -70,8 +70,9 @@ def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...],
     if cl.internal or len(cl.labels) < 3:
         return np.ones(beta.shape[:-1], bool)
     g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / robot_size(robot)])
-    sv = np.linalg.svd(g / np.linalg.norm(g, axis=-1, keepdims=True), compute_uv=False)
-    return sv[..., 2] < rtol * sv[..., 0]
+    norm = np.linalg.norm(g, axis=-1, keepdims=True)  # a line through a coupling can vanish at some configurations
+    sv = np.linalg.svd(g / np.where(norm > 0, norm, 1.0), compute_uv=False)
+    return sv[..., 2] <= rtol * sv[..., 0]
 
 
 def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], *,
