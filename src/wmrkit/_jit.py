@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numba
 import numpy as np
+from numba.extending import overload
 
 #: Array elements a kernel may process as plain Python, over the whole process, before it is compiled. Set the
 #: environment variable ``WMRKIT_INTERPRET_BUDGET`` (0: always compile) to change it.
@@ -106,3 +107,15 @@ def drop_stale_cache(kernels: Sequence[str], helpers: Sequence[str] = ()) -> Non
         os.replace(scratch, stamp)  # atomic: processes starting together read a whole stamp or none
     except OSError:  # a read-only installation: numba compiles in memory anyway
         pass
+
+
+def float64_vector(a) -> bool:
+    """In compiled code: whether `a` is a 1-D float64 array, decided when the caller is compiled (a kernel writing
+    its results into an integer or float32 array would truncate or round them silently)."""
+    return isinstance(a, np.ndarray) and a.dtype == np.float64 and a.ndim == 1
+
+
+@overload(float64_vector)
+def _float64_vector(a):
+    answer = isinstance(a, numba.types.Array) and a.dtype == numba.types.float64 and a.ndim == 1
+    return lambda a: answer

@@ -78,3 +78,62 @@ def test_odometry_steps_equal_the_batched_odometry(name):
     for k in range(1, len(log)):
         rt.odometry_step(pose, previous, log.positions[k], np.empty(0))
     np.testing.assert_allclose(pose, ref.poses[-1], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["swerve-4", "forklift", "diff-drive"])
+def test_wrong_arrays_and_non_finite_input_are_refused_not_written_past(name):
+    """The kernels write into caller-owned arrays: arrays shorter than the robot's were written past their ends (a
+    neighbour's memory overwritten, once a glibc abort), an integer array truncated the rates, and a NaN twist gave
+    'feasible' with zero rates. Each is refused with the shapes the robot needs, and the neighbour is untouched."""
+    robot = catalog.load(name)
+    rt = realtime(robot)
+    n, ns = len(robot.rate_names), len(robot.steer_names)
+    guard = np.full(2 * n + 2 * ns + 4, 7.0)
+    short_rates, short_heading = guard[:max(n - 1, 0)], guard[n:n + max(ns - 1, 0)]
+    ok = np.zeros(ns), np.empty(n), np.empty(ns)
+    cases = [((1.0, 0.5, 0.3, np.zeros(ns), short_rates, ok[2]), "ik: heading and heading_out must be float64"),
+             ((1.0, 0.5, 0.3, np.zeros(ns), np.empty(n, dtype=int), ok[2]), "rates_out one of shape"),
+             ((np.nan, 0.0, 0.0, *ok), r"ik: the twist \(vx, vy, omega\) must be finite"),
+             ((1e300, 0.0, 0.0, *ok), r"each at most 1e\+06"),
+             ((1.0, 0.0, 0.0, np.zeros(ns + 1), ok[1], ok[2]), "heading and heading_out")]
+    if ns:
+        cases += [((1.0, 0.5, 0.3, np.zeros(ns), ok[1], short_heading), "heading and heading_out"),
+                  ((1.0, 0.0, 0.0, np.full(ns, np.inf), ok[1], ok[2]), "ik: the headings must be finite")]
+    for args, message in cases:
+        with pytest.raises(ValueError, match=message):
+            rt.ik(*args)
+    assert (guard == 7.0).all()
+    na, nsj = len(rt.rate_joints), len(rt.steer_joints)
+    with pytest.raises(ValueError, match=r"fk: rates must have shape"):
+        rt.fk(np.ones(na + 1), np.zeros(nsj), np.empty(3))
+    with pytest.raises(ValueError, match=r"twist_out be a float64 array of shape \(3,\)"):
+        rt.fk(np.ones(na), np.zeros(nsj), np.empty(3, dtype=np.float32))
+    with pytest.raises(ValueError, match="fk: the rates must be finite"):
+        rt.fk(np.full(na, np.nan), np.zeros(nsj), np.empty(3))
+    pose, previous = np.zeros(3), np.zeros(na)
+    with pytest.raises(ValueError, match=r"odometry_step: pose must be a float64 array of shape \(3,\)"):
+        rt.odometry_step(guard[:2], previous, np.ones(na), np.zeros(nsj))
+    with pytest.raises(ValueError, match="odometry_step: pose must be"):
+        rt.odometry_step(pose, np.zeros(na, dtype=int), np.ones(na), np.zeros(nsj))
+    with pytest.raises(ValueError, match="odometry_step: the pose and the joint positions must be finite"):
+        rt.odometry_step(pose, previous, np.full(na, np.inf), np.zeros(nsj))
+    assert (pose == 0).all() and (previous == 0).all() and (guard == 7.0).all()
+    if nsj:
+        with pytest.raises(ValueError, match=r"fk: the headings must be a finite array of shape \(\d+,\)"):
+            rt.fk(np.ones(na), np.full(nsj, np.nan), np.empty(3))
+
+
+def test_the_control_tick_refuses_non_finite_poses_and_wrong_twist_arrays():
+    """control_tick wrote a NaN twist and said 'feasible' for a NaN pose."""
+    from wmrkit.control.tick import control_tick
+
+    robot = catalog.load("diff-drive")
+    tick = control_tick(robot).tick
+    n, ns = len(robot.rate_names), len(robot.steer_names)
+    hd, rates, out = np.zeros(ns), np.empty(n), np.empty(ns)
+    twist = np.empty(3)
+    assert tick(0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.5, 0.0, 0.0, hd, twist, rates, out)
+    with pytest.raises(ValueError, match="tick: the pose, the reference and its velocity must be finite"):
+        tick(np.nan, 0.0, 0.0, 1.0, 0.0, 0.0, 0.5, 0.0, 0.0, hd, twist, rates, out)
+    with pytest.raises(ValueError, match=r"tick: twist_out must be a float64 array of shape \(3,\)"):
+        tick(0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.5, 0.0, 0.0, hd, np.empty(2), rates, out)

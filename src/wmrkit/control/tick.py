@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..limits import MAX_COORDINATE
 from ..robot import Robot
 from .laws import PositionLaw
 from .points import ControlError, ControlPoint, control_point
@@ -99,11 +100,21 @@ def _tick_kernel(ik, law_twist):
     """The tick: `law_twist` (:func:`scalar_law`) compiled around the robot's IK kernel `ik`."""
     import numba
 
+    from .._jit import float64_vector
+
     law = numba.njit(inline="always")(law_twist)
+    shapes = "tick: twist_out must be a float64 array of shape (3,)"
+    big = MAX_COORDINATE
+    bad = f"tick: the pose, the reference and its velocity must be finite, each at most {big:g} in size"
 
     @numba.njit(cache=False)
     def tick(x, y, theta, x_ref, y_ref, theta_ref, vx_ref, vy_ref, omega_ref, heading, twist_out, rates_out,
              heading_out):
+        if not (float64_vector(twist_out) and twist_out.shape[0] == 3):
+            raise ValueError(shapes)
+        if not (abs(x) <= big and abs(y) <= big and abs(theta) <= big and abs(x_ref) <= big and abs(y_ref) <= big
+                and abs(theta_ref) <= big and abs(vx_ref) <= big and abs(vy_ref) <= big and abs(omega_ref) <= big):
+            raise ValueError(bad)  # NaN included
         vx, vy, w, _, _, _ = law(x, y, theta, x_ref, y_ref, theta_ref, vx_ref, vy_ref, omega_ref, 0.0, 0.0, 0.0)
         twist_out[0], twist_out[1], twist_out[2] = vx, vy, w
         return ik(vx, vy, w, heading, rates_out, heading_out)

@@ -25,8 +25,9 @@ from typing import Any
 import numba
 import numpy as np
 
-from .._jit import drop_stale_cache
+from .._jit import drop_stale_cache, float64_vector
 from ..errors import WmrkitError
+from ..limits import MAX_QUERY_RATE
 from ..odometry import _kernels
 from ..odometry._kernels import _cos_sin, _sinc
 from ..robot import Robot
@@ -110,6 +111,11 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
               else np.array([[-np.inf], [np.inf]]).repeat(n_steer, axis=1))
     ranged = np.isfinite(ranges).all(axis=0)  # (n_steer,): the wheels with a steer_range (heading lo, hi)
     lo, width = np.where(ranged, ranges[0], 0.0), np.where(ranged, ranges[1] - ranges[0], 0.0)
+    shapes = (f"ik: heading and heading_out must be float64 arrays of shape ({n_steer},) (robot.steer_names) and "
+              f"rates_out one of shape ({n_rates},) (robot.rate_names)")
+    limit = MAX_QUERY_RATE
+    too_big = f"ik: the twist (vx, vy, omega) must be finite, each at most {limit:g} in size"
+    bad_heading = "ik: the headings must be finite [rad]"
 
     @numba.njit(cache=False)
     def wrap(a):
@@ -122,6 +128,14 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
 
     @numba.njit(cache=False)
     def ik(vx, vy, w, heading, rates_out, heading_out):
+        if not (float64_vector(rates_out) and float64_vector(heading_out) and heading.shape[0] == n_steer
+                and heading_out.shape[0] == n_steer and rates_out.shape[0] == n_rates):
+            raise ValueError(shapes)  # written past their ends otherwise
+        if not (abs(vx) <= limit and abs(vy) <= limit and abs(w) <= limit):  # NaN included
+            raise ValueError(too_big)
+        for k in range(n_steer):
+            if not math.isfinite(heading[k]):
+                raise ValueError(bad_heading)
         beta = heading_out  # the thesis's angles while computing, headings on return: nothing is allocated
         for k in range(n_steer):
             beta[k] = wrap(heading[k] - delta[k] + HALF_PI)
@@ -166,9 +180,17 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
 
 def _constant_fk(twist_map: np.ndarray):
     n_a = twist_map.shape[1]
+    shapes = f"fk: rates must have shape ({n_a},) (rate_joints) and twist_out be a float64 array of shape (3,)"
+    bad = f"fk: the rates must be finite, each at most {MAX_QUERY_RATE:g} in size [rad/s]"
+    limit = MAX_QUERY_RATE
 
     @numba.njit(cache=False)
     def fk(rates, heading, twist_out):
+        if not (float64_vector(twist_out) and twist_out.shape[0] == 3 and rates.shape[0] == n_a):
+            raise ValueError(shapes)
+        for j in range(n_a):
+            if not abs(rates[j]) <= limit:
+                raise ValueError(bad)
         for r in range(3):
             acc = 0.0
             for j in range(n_a):
@@ -179,8 +201,21 @@ def _constant_fk(twist_map: np.ndarray):
 
 
 def _constant_step(twist_map: np.ndarray):
+    n_a = twist_map.shape[1]
+    shapes = (f"odometry_step: pose must be a float64 array of shape (3,), previous one of shape ({n_a},) "
+              f"(rate_joints) and positions of shape ({n_a},)")
+    bad = "odometry_step: the pose and the joint positions must be finite"
+
     @numba.njit(cache=False)
     def step(pose, previous, positions, heading_mid):
+        if not (float64_vector(pose) and float64_vector(previous) and pose.shape[0] == 3
+                and previous.shape[0] == n_a and positions.shape[0] == n_a):
+            raise ValueError(shapes)
+        for j in range(n_a):
+            if not (math.isfinite(positions[j]) and math.isfinite(previous[j])):
+                raise ValueError(bad)
+        if not (math.isfinite(pose[0]) and math.isfinite(pose[1]) and math.isfinite(pose[2])):
+            raise ValueError(bad)
         _step(pose, previous, positions, twist_map)
 
     return step
@@ -210,14 +245,31 @@ def _steering_fk_and_step(model):
     robot = model.robot
     delta = np.array([robot.wheel(j.partition(".")[0]).delta for j in model.steer_joints], dtype=float)
 
-    def twist_map(heading) -> np.ndarray:
-        s, _ = model.matrices(np.asarray(heading, dtype=float) - delta + HALF_PI)
+    n_a, n_s = len(model.rate_joints), len(delta)
+
+    def twist_map(heading, name: str) -> np.ndarray:
+        heading = np.asarray(heading, dtype=float)
+        if heading.shape != (n_s,) or not np.isfinite(heading).all():
+            raise ValueError(f"{name}: the headings must be a finite array of shape ({n_s},) [rad] (steer_joints)")
+        s, _ = model.matrices(heading - delta + HALF_PI)
         return np.ascontiguousarray(s[:3])
 
     def fk(rates, heading, twist_out):
-        twist_out[:] = twist_map(heading) @ np.asarray(rates, dtype=float)
+        rates = np.asarray(rates, dtype=float)
+        if rates.shape != (n_a,) or not float64_vector(twist_out) or np.shape(twist_out) != (3,):
+            raise ValueError(f"fk: rates must have shape ({n_a},) (rate_joints) and twist_out be a float64 array "
+                             "of shape (3,)")
+        if not (np.abs(rates) <= MAX_QUERY_RATE).all():
+            raise ValueError(f"fk: the rates must be finite, each at most {MAX_QUERY_RATE:g} in size [rad/s]")
+        twist_out[:] = twist_map(heading, "fk") @ rates
 
     def step(pose, previous, positions, heading_mid):
-        _step(pose, previous, positions, twist_map(heading_mid))
+        if not (float64_vector(pose) and float64_vector(previous) and np.shape(pose) == (3,)
+                and np.shape(previous) == (n_a,) and np.shape(positions) == (n_a,)):
+            raise ValueError(f"odometry_step: pose must be a float64 array of shape (3,), previous one of shape "
+                             f"({n_a},) (rate_joints) and positions of shape ({n_a},)")
+        if not (np.isfinite(pose).all() and np.isfinite(previous).all() and np.isfinite(positions).all()):
+            raise ValueError("odometry_step: the pose and the joint positions must be finite")
+        _step(pose, previous, np.asarray(positions, dtype=float), twist_map(heading_mid, "odometry_step"))
 
     return fk, step
