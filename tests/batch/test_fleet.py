@@ -89,8 +89,21 @@ def test_expand_logs_and_bags(fleet_dir, diff, tmp_path):
         expand_logs([tmp_path / "missing.csv"])
     with pytest.raises(BatchError, match="does not exist"):
         batch_odometry(diff, [fleet_dir], out=tmp_path / "nope" / "r.parquet")
-    with pytest.raises(BatchError, match="no such folder"):
-        batch_odometry(diff, [fleet_dir], trajectories=tmp_path / "nope")
+    (tmp_path / "a-file").write_text("")
+    with pytest.raises(BatchError, match="a-file: cannot make the folder"):
+        batch_odometry(diff, [fleet_dir], trajectories=tmp_path / "a-file")
+
+
+def test_the_trajectories_folder_is_made_when_missing(fleet_dir, diff, tmp_path, capsys):
+    """docs/batch.md's command with '--trajectories traj/' failed 'no such folder' (after starting the cluster),
+    while every other output folder of the CLI (analyze --report) is made with its parents."""
+    from wmrkit.cli.main import main
+
+    res = batch_odometry(diff, [fleet_dir / "run0.csv"], trajectories=tmp_path / "made" / "here")
+    assert res.failed == 0 and (tmp_path / "made" / "here" / "run0.tum").is_file()
+    assert main(["batch", "odometry", "diff-drive", str(fleet_dir / "run1.csv"), "--workers", "0",
+                 "--trajectories", str(tmp_path / "traj")]) == 0
+    assert (tmp_path / "traj" / "run1.tum").is_file()
 
 
 def test_each_log_is_read_as_its_header_says(fleet_dir, diff, tmp_path):

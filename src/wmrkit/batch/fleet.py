@@ -135,7 +135,8 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
                    topic: str = "/joint_states", joint_names: Mapping[str, str] | None = None,
                    sensed: Sequence[str] | None = None, weights: Mapping[str, float] | None = None) -> FleetResult:
     """Odometry of every log in `logs` (files, globs, folders; :func:`expand_logs`) on `runner` (default: a
-    serial engine); the table is written to `out` (Parquet) and each trajectory to `trajectories`/``NAME.EXT``.
+    serial engine); the table is written to `out` (Parquet) and each trajectory to `trajectories`/``NAME.EXT`` (the
+    folder made when missing).
 
     `closed`: every run ends at its start (the closure error is reported). `fmt` (CSV layout), `topic` and
     `joint_names` (bags), `sensed` and `weights` go to :func:`~wmrkit.odometry.files.odometry_file`. Without
@@ -157,8 +158,12 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     paths = expand_logs(logs)
     if out is not None and not Path(out).absolute().parent.is_dir():
         raise BatchError(f"--out {os.fspath(out)}: the folder {Path(out).absolute().parent} does not exist")
-    if trajectories is not None and not Path(trajectories).is_dir():
-        raise BatchError(f"--trajectories {os.fspath(trajectories)}: no such folder")
+    if trajectories is not None:  # made with its parents when missing, as every output folder of the CLI
+        try:
+            Path(trajectories).mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise BatchError(f"--trajectories {os.fspath(trajectories)}: cannot make the folder "
+                             f"({err.strerror or err})") from None
     if trajectory_format not in ("csv", "tum"):
         raise BatchError(f"trajectory format must be csv or tum, got '{trajectory_format}'")
     targets = _trajectory_names(paths, trajectories, trajectory_format)
