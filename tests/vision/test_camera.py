@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wmrkit.errors import WmrkitError
@@ -16,6 +16,7 @@ from wmrkit.vision.camera import (
     camera_coordinates,
     distort,
     extrinsics,
+    fold_radius,
     ground_from_image,
     project,
     rotation,
@@ -97,7 +98,122 @@ def test_ground_from_image_inverts_projection(xu, yu):
 @given(st.floats(-300, 300), st.floats(-240, 240), st.floats(-0.2, 0.2))
 def test_undistort_inverts_distort(x, y, k1):
     d = distort([x, y], k1, 400.0)
-    np.testing.assert_allclose(undistort(d, k1, 400.0, iterations=40), [x, y], atol=1e-6)
+    np.testing.assert_allclose(undistort(d, k1, 400.0), [x, y], atol=1e-9)
+
+
+def test_undistort_is_exact_for_the_audits_points():
+    """The fixed-point iteration stopped after 8 steps without converging: k1 = -0.5 gave (295.8, 217.0) for
+    (300, 220), k1 = 0.5 (300.10, 220.08); k1 = -0.7 gave (251.7, 184.6), but (300, 220) lies beyond that model's
+    fold (r = 372 px > f / sqrt(2.1) = 345 px): distort now says so (NaN) and no camera of that image is accepted."""
+    for k1 in (-0.5, 0.5, 0.9):
+        np.testing.assert_allclose(undistort(distort([[300.0, 220.0]], k1, 500.0), k1, 500.0), [[300.0, 220.0]],
+                                   atol=1e-9)
+    assert np.all(np.isnan(distort([[300.0, 220.0]], -0.7, 500.0)))
+    with pytest.raises(CameraError, match=r"camera: k1: -0.7 folds the distortion model over inside the 640 x 480 "
+                                          r"image .* k1 must be > -0.2315 for this image"):
+        Camera(500.0, 0.5, 1.0, k1=-0.7)
+
+
+def _grid(width: int, rows: int, step: int = 7) -> np.ndarray:
+    """Image points [px from the centre] every `step` px and on the image's edges and corners."""
+    xs = np.unique(np.r_[np.arange(-width / 2, width / 2, step), width / 2])
+    ys = np.unique(np.r_[np.arange(-rows / 2, rows / 2, step), rows / 2])
+    return np.stack(np.meshgrid(xs, ys), -1).reshape(-1, 2)
+
+
+@pytest.mark.parametrize("k1", np.r_[np.linspace(-0.999, 0.999, 25), -1e-9, 1e-9, 1e-12])
+def test_undistort_round_trips_over_the_whole_image_across_the_accepted_k1(k1):
+    """Every image point (pixel edges included) of cameras with k1 across (-1, 1): the exact inverse, checked
+    against the forward model both ways. For k1 < 0 the focal length puts the image's corners at 98 % of the
+    fold radius (near the hardest camera accepted) and at 30 %."""
+    width, rows = 640, 480
+    corner = math.hypot(width, rows) / 2
+    focals = [500.0, 2000.0] if k1 >= 0 else [corner * 1.5 * math.sqrt(-3 * k1) / c for c in (0.98, 0.3)]
+    for f in focals:
+        cam = Camera(f, 0.8, 0.5, width, rows, float(k1))  # accepted
+        d = _grid(width, rows)
+        u = undistort(d, cam.k1, f)
+        np.testing.assert_allclose(distort(u, cam.k1, f), d, atol=1e-9)
+        # the physical root: |u| below the fold, growing with |d| along each ray
+        assert np.all(np.hypot(*u.T) <= fold_radius(cam.k1, f)[0] * (1 + 1e-12))
+        np.testing.assert_allclose(undistort(distort(u, cam.k1, f), cam.k1, f), u, atol=1e-8)
+        ray = np.linspace(0, 1, 200)[:, None] * d[np.argmax(np.hypot(*d.T))]
+        assert np.all(np.diff(np.hypot(*undistort(ray, cam.k1, f).T)) > 0)
+
+
+@settings(max_examples=300)
+@given(st.floats(-0.999, 0.999), st.floats(50, 3000), st.integers(8, 1024), st.integers(8, 1024),
+       st.floats(-0.5, 0.5), st.floats(-0.5, 0.5))
+def test_undistort_inverts_distort_on_every_accepted_camera(k1, f, width, rows, a, b):
+    try:
+        cam = Camera(f, 0.8, 0.5, width, rows, k1)
+    except CameraError as err:  # refused only where the model folds over inside the image
+        assert "folds the distortion model over" in str(err)
+        assert math.hypot(width, rows) / 2 >= fold_radius(k1, f)[1]
+        return
+    p = np.array([a * width, b * rows])  # a point of the image
+    u = undistort(p, cam.k1, f)
+    np.testing.assert_allclose(distort(u, cam.k1, f), p, atol=1e-9)
+    np.testing.assert_allclose(undistort(distort(u, cam.k1, f), cam.k1, f), u, atol=1e-8)
+
+
+def test_undistort_refuses_points_beyond_the_fold_and_distort_does_not_fold_back():
+    r_u, r_d = fold_radius(-0.3, 400.0)
+    assert (r_u, r_d) == (pytest.approx(400 / 0.9**0.5), pytest.approx(2 / 3 * 400 / 0.9**0.5))
+    assert fold_radius(0.3, 400.0) == (math.inf, math.inf)
+    # the fold itself, where dr_u/dr_d is infinite: round-off eps in r_d moves r_u by sqrt(eps), not eps
+    np.testing.assert_allclose(undistort([r_d, 0.0], -0.3, 400.0), [r_u, 0.0], rtol=2 * np.finfo(float).eps ** 0.5)
+    with pytest.raises(CameraError, match=r"undistort: xy_d: 1 point\(s\) \(0, 290\) px lie beyond 281.1 px"):
+        undistort([[0.0, 10.0], [0.0, 290.0]], -0.3, 400.0)
+    # beyond the fold the model would image points where nearer points are: NaN, not a second image
+    d = distort([[r_u * 0.999, 0.0], [r_u * 1.5, 0.0]], -0.3, 400.0)
+    assert np.isfinite(d[0]).all() and np.isnan(d[1]).all()
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    (lambda: distort([1.0, 2.0], math.nan, 400.0), "distort: k1: expected a finite number, got nan"),
+    (lambda: undistort([1.0, 2.0], 0.1, 0.0), r"undistort: focal_px: expected a finite number > 0, got 0.0"),
+    (lambda: undistort([1.0, 2.0], 0.1, -400.0), r"undistort: focal_px: expected a finite number > 0, got -400.0"),
+    (lambda: fold_radius(-0.1, math.inf), r"fold_radius: focal_px: expected a finite number > 0, got inf"),
+])
+def test_the_distortion_functions_refuse_their_inputs_by_name(call, message):
+    with pytest.raises(CameraError, match=message):
+        call()
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    ((500.0, 0.5, 1.0, "640"), r"camera: width: expected a whole number of pixels \(an integer\), got '640'"),
+    ((500.0, 0.5, 1.0, 640.5), r"camera: width: expected a whole number of pixels \(an integer\), got 640.5"),
+    ((500.0, 0.5, 1.0, 640, 480.0), r"camera: rows: expected a whole number of pixels \(an integer\), got 480.0"),
+    ((500.0, 0.5, 1.0, True), r"camera: width: expected a whole number of pixels \(an integer\), got True"),
+    (("500", 0.5, 1.0), r"camera: focal_px: expected a number, got '500'"),
+    ((500.0, None, 1.0), r"camera: tilt: expected a number, got None"),
+    ((500.0, 0.5, 1.0, 640, 480, "0.1"), r"camera: k1: expected a number, got '0.1'"),
+    ((math.inf, 0.5, 1.0), r"camera: focal_px: out of range, got inf"),
+    ((-500.0, 0.5, 1.0), r"camera: focal_px: out of range, got -500.0"),
+    ((500.0, 0.5, math.nan), r"camera: height: out of range, got nan"),
+])
+def test_camera_fields_are_checked_by_name(args, message):
+    """Camera(500., .5, 1., "640") raised a bare TypeError and width=640.5 was accepted."""
+    with pytest.raises(CameraError, match=message):
+        Camera(*args)
+
+
+def test_camera_numbers_are_stored_as_python_numbers(tmp_path):
+    cam = Camera(np.float64(400.0), np.float32(0.75), 1, np.int64(320), np.int32(240))
+    assert [type(v) for v in cam.to_dict().values()] == [float, float, float, int, int, float]
+    cam.to_file(tmp_path / "cam.yaml")  # numpy scalars are not YAML
+    assert Camera.from_file(tmp_path / "cam.yaml") == cam
+
+
+@pytest.mark.parametrize("focal", [0.0, -400.0, math.nan, math.inf, [400.0, 0.0]])
+def test_project_and_ground_from_image_refuse_a_focal_length_that_is_not_positive(focal):
+    """focal_px = 0 put every point at the image centre, a negative one mirrored the image."""
+    psi, t = extrinsics([0.0, 0.0, 0.0], Camera(400.0, 0.8, 0.5))
+    with pytest.raises(CameraError, match=r"^project: focal_px: expected finite numbers > 0 \[px\], got "):
+        project([0.0, 2.0, 0.0], psi, 0.8, t, focal)
+    with pytest.raises(CameraError, match=r"^ground_from_image: focal_px: expected finite numbers > 0"):
+        ground_from_image([0.0, 10.0], psi, 0.8, t, focal)
 
 
 def test_camera_file_round_trip_and_errors(tmp_path):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -136,6 +137,22 @@ def test_refused_setups():
         follow_line(ROBOT, CAMERA, gain=2.0)
     with pytest.raises(WmrkitError, match="does not see the line"):
         follow_line(ROBOT, CAMERA, start=(0.0, 5.0, 0.0))
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    ((math.nan, 0.1, 0.3, 0.1), "psi: expected a finite number, got nan"),
+    ((0.0, math.inf, 0.3, 0.1), "h: expected a finite number, got inf"),
+    ((0.0, 0.1, 0.0, 0.1), "gain: expected a finite number > 0, got 0.0"),
+    ((0.0, 0.1, math.nan, 0.1), "gain: expected a finite number > 0, got nan"),
+    ((0.0, 0.1, 0.3, math.inf), "speed: expected a finite number > 0, got inf"),
+    ((0.0, 0.1, 0.3, 0.0), "speed: expected a finite number > 0, got 0.0"),
+    ((0.0, 0.1, 0.3, 2e3), "speed: 2000 m/s is faster than 1000 m/s"),
+    ((0.0, "0.1", 0.3, 0.1), "h: expected a finite number, got '0.1'"),
+])
+def test_line_following_twist_refuses_its_inputs_by_name(args, message):
+    """NaN psi or h and speed = inf gave a twist of NaN; gain = 0 a law without correction."""
+    with pytest.raises(WmrkitError, match=f"^line_following_twist: {re.escape(message)}$"):
+        line_following_twist(ROBOT, *args)
 
 
 def test_an_omnidirectional_robot_follows_without_turning():

@@ -61,6 +61,17 @@ def test_distorted_stripes_are_found_and_straightened_with_k1():
     assert abs(ignorant.h - POSE[1]) > 5 * abs(fix.h - POSE[1])  # the bent stripes are still found
 
 
+def test_a_distortion_that_folds_over_inside_the_image_is_refused():
+    """k1 = -0.5 with f = 325.7 px folds over 230 px from the centre, inside the 640 x 480 image: the pixels beyond
+    have no undistorted position (the fixed-point iteration gave some without converging)."""
+    img = render(CAMERA, POSE, SCENE)
+    with pytest.raises(WmrkitError, match=r"^extract_lines: k1: -0.5 folds the distortion model over inside the "
+                                          r"640 x 480 image \(focal 325.7 px\)"):
+        extract_lines(img, n_lines=3, k1=-0.5, focal_px=325.7)
+    with pytest.raises(WmrkitError, match=r"^extract_lines: k1: expected a finite number, got nan"):
+        extract_lines(img, n_lines=3, k1=math.nan, focal_px=325.7)
+
+
 def test_wide_stripe_gives_its_axis_not_a_diagonal():
     """A wide painted band (the mean cell of §9.2.1.C): the axis, not a line from corner to corner."""
     cam = Camera(300, math.radians(55), 0.3, 320, 240)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -106,6 +107,27 @@ def test_distorted_points_are_undistorted_with_the_camera_k1():
     uv = project(np.array([[0.0, 1.0, 0], [0.0, 2.5, 0]]), psi, cam.tilt, t, cam.focal_px)
     fix = locate_points(cam, [(0, distort(uv, cam.k1, cam.focal_px))])
     assert fix.h == pytest.approx(0.05, abs=1e-9) and fix.psi == pytest.approx(-0.1, abs=1e-9)
+
+
+def test_points_beyond_the_fold_of_the_lens_model_are_refused_by_line():
+    """Points may lie outside the image (up to its size); with k1 < 0 they can lie beyond the fold of the radial
+    model, where no undistorted point exists: the fixed-point iteration returned one that did not converge."""
+    cam = Camera(400.0, 1.0, 0.5, 320, 240, k1=-0.3)  # folds over 281.1 px from the centre
+    with pytest.raises(CameraError, match=r"^points: lines\[1\]: 1 point\(s\) \(300, 200\) px lie beyond 281.1 px"):
+        locate_points(cam, [(0, [[1.0, -50.0], [3.0, 50.0]]), (1, [[300.0, 200.0], [40.0, 50.0]])], spacing=0.5)
+
+
+@pytest.mark.parametrize(("points", "n", "message"), [
+    ([[math.nan, 40.0], [-5.0, 80.0]], 0, "points_u: expected finite image coordinates [px], got nan"),
+    ([[10.0, 40.0], [-5.0, math.inf]], 0, "points_u: expected finite image coordinates [px], got inf"),
+    ([[10.0, 40.0], [-5.0, 80.0]], math.nan, "n: expected finite line indices, got nan"),
+])
+def test_line_position_refuses_points_that_are_not_finite(points, n, message):
+    """NaN points gave psi = h = NaN without a word."""
+    from wmrkit.errors import ShapeError
+
+    with pytest.raises(ShapeError, match=f"^{re.escape(message)}$"):
+        line_position(points, n, focal_px=500.0, tilt=0.3, height=0.5, spacing=0.1)
 
 
 def test_points_file_and_its_errors(tmp_path):

@@ -12,12 +12,15 @@ Frames (thesis Figs. 9.2-9.4):
 
 The camera is mounted on the robot looking straight ahead, its lens at height `height` and ``z_p`` from the
 tracked point P (the robot origin) along the optical axis: the lens is ``z_p sin(tilt)`` behind P horizontally.
-Lens distortion (option) is one radial term: ``x_d = x_u (1 + k1 r^2)``, ``r^2 = (x_u^2 + y_u^2) / f^2``.
+Lens distortion (option) is one radial term: ``x_d = x_u (1 + k1 r^2)``, ``r^2 = (x_u^2 + y_u^2) / f^2``. Its
+inverse is a cubic in r, solved in closed form (:func:`undistort`); with ``k1 < 0`` the model folds over at
+``r = 1 / sqrt(-3 k1)`` (:func:`fold_radius`), and a camera whose image reaches the fold is refused.
 """
 
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
@@ -31,8 +34,8 @@ from ..documents import read_document, read_file
 from ..errors import DescriptionError, WmrkitError
 from ..units import UnitError, parse_quantity
 
-__all__ = ["Camera", "CameraError", "camera_coordinates", "distort", "extrinsics", "ground_from_image",
-           "project", "rotation", "undistort"]
+__all__ = ["Camera", "CameraError", "camera_coordinates", "check_lens_image", "distort", "extrinsics", "fold_radius",
+           "ground_from_image", "project", "rotation", "undistort"]
 
 
 class CameraError(WmrkitError, ValueError):
@@ -64,12 +67,23 @@ class Camera:
     k1: float = 0.0
 
     def __post_init__(self) -> None:
+        for name in ("focal_px", "tilt", "height", "width", "rows", "k1"):
+            value = getattr(self, name)
+            if name in ("width", "rows"):
+                if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+                    raise CameraError(f"camera: {name}: expected a whole number of pixels (an integer), got {value!r}")
+                object.__setattr__(self, name, int(value))
+            else:
+                if isinstance(value, bool) or not isinstance(value, numbers.Real):
+                    raise CameraError(f"camera: {name}: expected a number, got {value!r}")
+                object.__setattr__(self, name, float(value))
         checks = {"focal_px": self.focal_px > 0, "tilt": 0 < self.tilt < math.pi / 2, "height": self.height > 0,
                   "width": 8 <= self.width <= MAX_PIXELS, "rows": 8 <= self.rows <= MAX_PIXELS, "k1": abs(self.k1) < 1}
         for name, ok in checks.items():
             value = getattr(self, name)
             if not ok or not math.isfinite(value):
                 raise CameraError(f"camera: {name}: out of range, got {value}")
+        check_lens_image(self.k1, self.focal_px, self.width, self.rows, "camera")
 
     @property
     def centre(self) -> tuple[float, float]:
@@ -152,15 +166,29 @@ def camera_coordinates(points_w: ArrayLike, psi: ArrayLike, tilt: ArrayLike, t: 
     return (rotation(psi, tilt) @ p[..., None])[..., 0] + as_vectors(t, 3, "t")
 
 
+def _focal(focal_px: ArrayLike, where: str) -> np.ndarray:
+    """`focal_px` as a float array, or :class:`CameraError` naming it unless every value is finite and > 0 (f = 0
+    put every point at the centre, f < 0 mirrored the image)."""
+    try:
+        f = np.asarray(focal_px, dtype=float)
+    except (TypeError, ValueError):
+        raise CameraError(f"{where}: focal_px: expected numbers, got {focal_px!r}") from None
+    bad = ~((f > 0) & (f < math.inf))  # NaN included
+    if bad.any():
+        raise CameraError(f"{where}: focal_px: expected finite numbers > 0 [px], got {float(f[bad].flat[0])}")
+    return f
+
+
 def project(points_w: ArrayLike, psi: ArrayLike, tilt: ArrayLike, t: ArrayLike, focal_px: ArrayLike) -> np.ndarray:
     """Image coordinates ``(x_u, y_u)`` [px] of ground-frame points, eqs. (9.1) and (9.4) with R'.
 
-    ``(..., 3) -> (..., 2)``. Points behind the camera (``z_c <= 0``) give NaN.
+    ``(..., 3) -> (..., 2)``. Points behind the camera (``z_c <= 0``) give NaN; `focal_px` must be finite and > 0.
     """
+    f = _focal(focal_px, "project")
     c = camera_coordinates(points_w, psi, tilt, t)
     zc = c[..., 2:3]
     safe = np.where(zc > 0, zc, np.nan)
-    return np.asarray(focal_px, dtype=float)[..., None] * c[..., :2] / safe
+    return f[..., None] * c[..., :2] / safe
 
 
 def extrinsics(pose_line_robot: ArrayLike, camera: Camera, z_p: ArrayLike = 0.0) -> tuple[np.ndarray, np.ndarray]:
@@ -182,12 +210,13 @@ def ground_from_image(xy_u: ArrayLike, psi: ArrayLike, tilt: ArrayLike, t: Array
                       focal_px: ArrayLike) -> np.ndarray:
     """Ground points ``(x_w, y_w)`` seen at undistorted image points: eq. (9.4) inverted on ``z_w = 0``.
 
-    ``(..., 2) -> (..., 2)``. Rays that do not meet the ground ahead (above the horizon) give NaN.
+    ``(..., 2) -> (..., 2)``. Rays that do not meet the ground ahead (above the horizon) give NaN; `focal_px` must
+    be finite and > 0.
     """
+    f = _focal(focal_px, "ground_from_image")
     xy = as_vectors(xy_u, 2, "xy_u")
     r = rotation(psi, tilt)
-    ray_c = np.concatenate([xy, np.broadcast_to(np.asarray(focal_px, dtype=float)[..., None], xy[..., :1].shape)],
-                           -1)
+    ray_c = np.concatenate([xy, np.broadcast_to(f[..., None], xy[..., :1].shape)], -1)
     ray_w = (np.swapaxes(r, -1, -2) @ ray_c[..., None])[..., 0]
     lens_w = -(np.swapaxes(r, -1, -2) @ as_vectors(t, 3, "t")[..., None])[..., 0]
     down = -ray_w[..., 2]
@@ -195,25 +224,90 @@ def ground_from_image(xy_u: ArrayLike, psi: ArrayLike, tilt: ArrayLike, t: Array
     return lens_w[..., :2] + s[..., None] * ray_w[..., :2]
 
 
+def _lens(k1: float, focal_px: float, where: str) -> tuple[float, float]:
+    """`k1` and `focal_px` as floats, or :class:`CameraError` naming the one that is not finite (or f <= 0)."""
+    try:
+        k, f = float(k1), float(focal_px)
+    except (TypeError, ValueError):
+        raise CameraError(f"{where}: k1 and focal_px must be numbers, got {k1!r}, {focal_px!r}") from None
+    if not math.isfinite(k):
+        raise CameraError(f"{where}: k1: expected a finite number, got {k}")
+    if not 0 < f < math.inf:
+        raise CameraError(f"{where}: focal_px: expected a finite number > 0, got {f}")
+    return k, f
+
+
+def fold_radius(k1: float, focal_px: float) -> tuple[float, float]:
+    """Where the radial model folds over: ``(r_u, r_d)`` [px] from the image centre.
+
+    ``r_d = r_u (1 + k1 r_u^2 / f^2)`` grows with r_u up to ``r_u = f / sqrt(-3 k1)`` when ``k1 < 0``, where it
+    reaches ``r_d = 2/3 r_u``; farther points would be imaged nearer the centre again (the model, not a lens).
+    Both are ``inf`` for ``k1 >= 0`` (always invertible).
+    """
+    return _fold(*_lens(k1, focal_px, "fold_radius"))
+
+
+def _fold(k1: float, f: float) -> tuple[float, float]:
+    if k1 >= 0:
+        return math.inf, math.inf
+    r_u = f / math.sqrt(-3 * k1)
+    return r_u, 2 * r_u / 3
+
+
+def check_lens_image(k1: float, focal_px: float, width: int, rows: int, where: str) -> None:
+    """Refuse (:class:`CameraError` naming `k1`) a distortion that folds over inside a ``width x rows`` image:
+    its corners (pixel edges, ``hypot(width, rows) / 2`` from the centre) must be nearer than :func:`fold_radius`'s
+    ``r_d``, so that every pixel has one undistorted position."""
+    k1, focal_px = _lens(k1, focal_px, where)
+    _, r_d = _fold(k1, focal_px)
+    corner = math.hypot(width, rows) / 2
+    if not corner < r_d:
+        least = -4 * focal_px**2 / (27 * corner**2)  # k1 at which r_d reaches the corner
+        raise CameraError(f"{where}: k1: {k1:g} folds the distortion model over inside the {width} x {rows} image "
+                          f"(focal {focal_px:g} px): it is invertible out to {r_d:.1f} px from the centre, the "
+                          f"corners are {corner:.1f} px away; k1 must be > {least:.4g} for this image")
+
+
 def distort(xy_u: ArrayLike, k1: float, focal_px: float) -> np.ndarray:
-    """Radial distortion ``x_d = x_u (1 + k1 r^2)``, ``r^2 = |x_u|^2 / f^2``. ``(..., 2) -> (..., 2)``."""
+    """Radial distortion of the image points of (9.1)-(9.2) (wmrkit extension): ``x_d = x_u (1 + k1 r^2)``,
+    ``r^2 = |x_u|^2 / f^2``. ``(..., 2) -> (..., 2)``.
+
+    Points beyond the fold of a ``k1 < 0`` model (``|x_u| > f / sqrt(-3 k1)``, :func:`fold_radius`) give NaN: the
+    model would image them where nearer points are, a lens does not.
+    """
     xy = as_vectors(xy_u, 2, "xy_u")
+    k1, f = _lens(k1, focal_px, "distort")
     if k1 == 0:
         return xy
-    r2 = np.sum(xy * xy, axis=-1, keepdims=True) / focal_px**2
-    return xy * (1 + k1 * r2)
+    r2 = np.sum(xy * xy, axis=-1, keepdims=True) / f**2
+    out = xy * (1 + k1 * r2)
+    return np.where(-3 * k1 * r2 > 1, np.nan, out) if k1 < 0 else out
 
 
-def undistort(xy_d: ArrayLike, k1: float, focal_px: float, *, iterations: int = 8) -> np.ndarray:
-    """Inverse of :func:`distort` by fixed-point iteration (converges for ``|k1 r^2| < 1/3``).
+def undistort(xy_d: ArrayLike, k1: float, focal_px: float) -> np.ndarray:
+    """Inverse of :func:`distort`, exact: the cubic ``k1 r^3 + r - r_d = 0`` (radii over f) in closed form.
 
-    ``(..., 2) -> (..., 2)``.
+    ``(..., 2) -> (..., 2)``. With ``s = sqrt(3 |k1|)`` and ``u = 3 s r_d / 2``, the physical root (the one on the
+    increasing branch, ``r -> r_d`` as ``k1 -> 0``) is ``r = (2 / s) sinh(asinh(u) / 3)`` for ``k1 > 0`` (the only
+    real root) and ``r = (2 / s) sin(asin(u) / 3)`` for ``k1 < 0``. A ``k1 < 0`` model reaches no farther than
+    :func:`fold_radius`'s ``r_d`` (``u = 1``): points beyond it have no undistorted position, :class:`CameraError`
+    names them.
     """
     xy_d = as_vectors(xy_d, 2, "xy_d")
+    k1, f = _lens(k1, focal_px, "undistort")
     if k1 == 0:
         return xy_d
-    xy = xy_d
-    for _ in range(iterations):
-        r2 = np.sum(xy * xy, axis=-1, keepdims=True) / focal_px**2
-        xy = xy_d / (1 + k1 * r2)
-    return xy
+    s = math.sqrt(3 * abs(k1))
+    u = 1.5 * s * np.hypot(xy_d[..., 0], xy_d[..., 1]) / f
+    if k1 > 0:
+        r = (2 / s) * np.sinh(np.arcsinh(u) / 3)
+    else:
+        beyond = u > 1 + 1e-12  # round-off of a point distorted exactly at the fold is let through
+        if beyond.any():
+            bad = xy_d[beyond]
+            shown = ", ".join(f"({x:.6g}, {y:.6g})" for x, y in bad[:3]) + (" ..." if len(bad) > 3 else "")
+            raise CameraError(f"undistort: xy_d: {len(bad)} point(s) {shown} px lie beyond {2 * f / (3 * s):.1f} px "
+                              f"from the centre, where the model with k1 = {k1:g} folds over: they have no "
+                              "undistorted position")
+        r = (2 / s) * np.sin(np.arcsin(np.minimum(u, 1.0)) / 3)
+    return xy_d / (1 + k1 * r * r)[..., None]

@@ -17,6 +17,8 @@ of (9.26) (:func:`line_following_law`), the twist the one the robot's fixed whee
 
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -77,8 +79,17 @@ def line_following_twist(robot: Robot, psi: float, h: float, gain: float, speed:
     ``-> (3,)``. The pose in the line frame L is ``(?, h, -psi)`` (9.25); the law's world velocity of P is
     ``(speed, -gain h)`` (lateral error ``exp(-gain t)``; the printed ``-a_x h`` is in the thesis's X-right frame
     and has the wrong sign there); :func:`wmrkit.control.points.twist_for_velocity` turns it into the twist the
-    robot's fixed wheels admit, with P the robot origin.
+    robot's fixed wheels admit, with P the robot origin. `psi` [rad] and `h` [m] must be finite, `gain` [1/s] and
+    `speed` [m/s] finite and > 0 (at most ``limits.MAX_SPEED``), else :class:`WmrkitError` names the argument.
     """
+    for name, value, low in (("psi", psi, -math.inf), ("h", h, -math.inf), ("gain", gain, 0.0),
+                             ("speed", speed, 0.0)):
+        if isinstance(value, bool | str) or not isinstance(value, numbers.Real | np.ndarray) or np.ndim(value) \
+                or not low < float(value) < math.inf:
+            need = "a finite number" if low < 0 else "a finite number > 0"
+            raise WmrkitError(f"line_following_twist: {name}: expected {need}, got {value!r}")
+    if speed > MAX_SPEED:
+        raise WmrkitError(f"line_following_twist: speed: {speed:g} m/s is faster than {MAX_SPEED:g} m/s")
     pose = np.array([0.0, h, -psi])
     v_world = law_velocity(line_following_law(gain), np.zeros(3), np.array([speed, 0.0, 0.0]), pose, np.zeros(3))
     return twist_for_velocity(control_point(robot, (0.0, 0.0)), pose, v_world)

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import WmrkitError
-from .camera import CameraError, undistort
+from .camera import CameraError, check_lens_image, undistort
 
 __all__ = ["DetectedLine", "cv2_module", "extract_lines", "interest_mask"]
 
@@ -251,7 +251,8 @@ def extract_lines(image: ArrayLike, *, n_lines: int = 1, mode: str = "threshold"
 
     `max_angle` [rad]: the largest angle from the image's vertical searched; `min_votes`: Hough threshold
     (default a fifth of the shorter image side); `min_separation_px`: peaks closer than this (and 3 deg) are
-    one line; `k1`, `focal_px`: the lens distortion undone before the fit (module docstring);
+    one line; `k1`, `focal_px`: the lens distortion undone before the fit (module docstring; refused where the
+    model folds over inside the image, :func:`.camera.check_lens_image`);
     `hough_scale`: the Hough transform runs on the mask resized by this factor (default 0.5 for images wider
     than 400 px, else 1); `mask`: a precomputed :func:`interest_mask`.
     """
@@ -260,6 +261,9 @@ def extract_lines(image: ArrayLike, *, n_lines: int = 1, mode: str = "threshold"
         raise CameraError(f"n_lines must be >= 1, got {n_lines}")
     binary = interest_mask(image, mode) if mask is None else mask
     rows, width = binary.shape
+    f = focal_px if focal_px is not None else float(max(rows, width))
+    if k1 != 0:  # every pixel must have one undistorted position (camera.check_lens_image)
+        check_lens_image(k1, f, width, rows, "extract_lines")
     scale = hough_scale if hough_scale is not None else (0.5 if width > 400 else 1.0)
     run_row, run_first, run_mid, run_len = _runs(binary)
     _check_not_speckle(run_row, rows, width)
@@ -288,7 +292,6 @@ def extract_lines(image: ArrayLike, *, n_lines: int = 1, mode: str = "threshold"
     runs = np.stack([run_first[whole] - 0.5 - cx, run_first[whole] + run_len[whole] - 0.5 - cx,
                      run_row[whole] - cy], -1).astype(float)
     if k1 != 0:  # fit on the undistorted runs: distortion bends the stripes, the ground lines are straight
-        f = focal_px if focal_px is not None else float(max(rows, width))
         fits = _fit_lines(runs, [(x0, s) for x0, s, _ in lines], max_band_px)
         rough = [(fit[0], fit[1]) if fit else (x0, s) for fit, (x0, s, _) in zip(fits, lines, strict=True)]
         ends = undistort(np.stack([runs[:, [0, 2]], runs[:, [1, 2]]], 1), k1, f)  # (M, 2 ends, 2)

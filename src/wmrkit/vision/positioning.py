@@ -34,11 +34,17 @@ def line_position(points_u: ArrayLike, n: ArrayLike, *, focal_px: float, tilt: f
     at ``x_w = n * spacing`` [m]; `height` v [m]; `tilt` phi [rad]; `z_p` [m] from the lens to P along the optical
     axis. ``psi`` [rad] is the yaw of the camera relative to the line (the robot's heading is ``-psi``, (9.25)),
     ``h`` [m] the signed distance from P to the followed line, positive when P is left of it (``h = -x_w(P)``).
-    Points on one image row (``y_u1 = y_u2``) give NaN.
+    Points on one image row (``y_u1 = y_u2``) give NaN; non-finite points or `n` are refused (:class:`ShapeError`).
     """
     p = np.asarray(points_u, dtype=float)
     if p.shape[-2:] != (2, 2):
         raise ShapeError(f"points_u: expected shape (..., 2, 2), got {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise ShapeError("points_u: expected finite image coordinates [px], got "
+                         f"{float(p[~np.isfinite(p)].flat[0])}")
+    n_arr = np.asarray(n, dtype=float)
+    if not np.all(np.isfinite(n_arr)):
+        raise ShapeError(f"n: expected finite line indices, got {float(n_arr[~np.isfinite(n_arr)].flat[0])}")
     for name, value in (("focal_px", focal_px), ("height", height)):
         if not 0 < value < math.inf:  # NaN included
             raise ShapeError(f"{name}: expected a finite number > 0, got {value}")
@@ -49,7 +55,7 @@ def line_position(points_u: ArrayLike, n: ArrayLike, *, focal_px: float, tilt: f
     dy = y1 - y2
     safe = np.where(dy != 0, dy, np.nan)
     psi = np.arctan(cf * (x1 - x2) / safe + (sf / focal_px) * (y2 * x1 - y1 * x2) / safe)
-    t_x = (height / (focal_px * cf)) * (y1 * x2 - y2 * x1) / safe - np.asarray(n, dtype=float) * spacing / np.cos(psi)
+    t_x = (height / (focal_px * cf)) * (y1 * x2 - y2 * x1) / safe - n_arr * spacing / np.cos(psi)
     h = math.tan(tilt) * (height - z_p * cf) * np.sin(psi) + t_x * np.cos(psi)
     return psi, t_x, h
 
@@ -85,7 +91,8 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
                   z_p: float = 0.0) -> Positioning:
     """Position from ``(n, [[x_u1, y_u1], [x_u2, y_u2]])`` per line (pixels from the image centre, y down).
 
-    Points are taken as measured on the camera's (possibly distorted) image and undistorted with ``camera.k1``.
+    Points are taken as measured on the camera's (possibly distorted) image and undistorted with ``camera.k1``
+    (exactly, :func:`.camera.undistort`; points beyond the fold of a ``k1 < 0`` model are refused).
     A line with ``n != 0`` needs `spacing` d > 0 [m]. The mean psi is taken on the circle.
     """
     from .camera import undistort
@@ -108,7 +115,10 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
                               f"{camera.rows} image (pixels from its centre)")
         if any(n == other for other, _ in lines[:i]):  # two lines said to be the same one would be averaged
             raise CameraError(f"points: lines[{i}].n: line n = {n} given twice")
-        und = undistort(pts, camera.k1, camera.focal_px)
+        try:  # points outside the image may lie beyond the fold of a k1 < 0 model
+            und = undistort(pts, camera.k1, camera.focal_px)
+        except CameraError as err:
+            raise CameraError(f"points: lines[{i}]: {str(err).removeprefix('undistort: xy_d: ')}") from None
         psi, _, h = line_position(und, n, focal_px=camera.focal_px, tilt=camera.tilt, height=camera.height,
                                   spacing=spacing, z_p=z_p)
         fixes.append(LineFix(int(n), (tuple(pts[0].tolist()), tuple(pts[1].tolist())), float(psi), float(h)))
