@@ -139,9 +139,11 @@ def test_fk_contradicting_rates_warn_and_say_so_in_json(capsys):
     ["fk", "forklift", "--spin", "right_drive=1e308", "--spin", "left_drive=-1e308"],
 ])
 def test_rates_beyond_any_robot_are_refused_not_printed_as_inf(capsys, argv):
-    """Issue 9: finite input whose result overflows gets one line and exit 2, never inf in the output."""
+    """Issue 9: finite input whose result overflows gets one line and exit 2, never inf in the output (ik's --twist
+    printed argparse's usage line first: a value out of range is not a mistake of syntax)."""
     code, out, err = run(capsys, *argv)
     assert code == 2 and out == "" and "beyond 1e+06" in err and "inf" not in err.replace("infeasible", "")
+    assert err.count("\n") == 1 and err.startswith("wmrkit: error: ")
 
 
 def test_ik_outside_a_steer_range_is_not_feasible(capsys):

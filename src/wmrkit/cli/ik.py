@@ -90,9 +90,9 @@ def _finite(text: str) -> float:
         value = parse_quantity(text, "number")
     except UnitError as err:
         raise argparse.ArgumentTypeError(str(err)) from None
-    if abs(value) > MAX_QUERY_RATE:
-        raise argparse.ArgumentTypeError(f"{text}: beyond {MAX_QUERY_RATE:g} (m/s or rad/s), no wheeled robot moves so "
-                                         "fast")
+    if abs(value) > MAX_QUERY_RATE:  # a value out of range, not a mistake in the command's syntax: no usage line
+        raise WmrkitError(f"ik: --twist {text}: beyond {MAX_QUERY_RATE:g} (m/s or rad/s), no wheeled robot moves "
+                          "so fast")
     return value
 
 
