@@ -15,7 +15,7 @@ from wmrkit.odometry.covariance import CrowleyNoise, JointNoise, propagate_covar
 from wmrkit.odometry.integrators import METHODS, integrate_increments, step
 from wmrkit.odometry.model import odometry_model
 from wmrkit.odometry.pipeline import odometry
-from wmrkit.odometry.synthetic import TwistProfile, simulate
+from wmrkit.odometry.synthetic import TwistProfile, simulate, square_path
 
 
 @pytest.mark.parametrize(("dd", "dth", "var_d", "var_th", "sd_th_deg"), [
@@ -142,5 +142,30 @@ def test_joint_noise_covariance_matches_simulated_encoder_noise():
 def test_shape_errors():
     with pytest.raises(WmrkitError, match="expected shapes"):
         propagate_covariance(np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3, 3)))
-    with pytest.raises(WmrkitError, match=r"initial: expected shape \(3, 3\)"):
+    with pytest.raises(WmrkitError, match=r"initial: expected a finite \(3, 3\) matrix"):
         propagate_covariance(np.zeros((4, 3)), np.zeros((3, 3)), np.zeros((3, 3, 3)), initial=np.eye(2))
+
+
+def test_noise_and_covariances_that_cannot_be_are_refused_by_name():
+    """A negative noise coefficient or initial covariance gave negative variances, and an asymmetric initial
+    covariance was averaged into a symmetric one, silently."""
+    from wmrkit.odometry.covariance import NoiseError
+
+    with pytest.raises(NoiseError, match=r"CrowleyNoise\.k_d: a noise coefficient must be finite and >= 0, got -1"):
+        CrowleyNoise(-1, 1, 1)
+    with pytest.raises(NoiseError, match=r"JointNoise\.per_sample: a noise coefficient"):
+        JointNoise(0.1, float("nan"))
+    poses, inc = np.zeros((4, 3)), np.zeros((3, 3))
+    q = np.tile(np.eye(3), (3, 1, 1))
+    with pytest.raises(NoiseError, match="initial: a covariance must be positive semi-definite"):
+        propagate_covariance(poses, inc, q, initial=-np.eye(3))
+    with pytest.raises(NoiseError, match="increment_covariance: every matrix must be finite and symmetric"):
+        propagate_covariance(poses, inc, -q)
+    robot = catalog.load("diff-drive")
+    log = simulate(robot, square_path(1.0), 50.0).log
+    with pytest.raises(NoiseError, match="initial_covariance: a covariance must be positive semi-definite"):
+        odometry(robot, log, noise=CrowleyNoise(), initial_covariance=-np.eye(3))
+    with pytest.raises(NoiseError, match="initial_covariance: a covariance is symmetric"):
+        odometry(robot, log, noise=CrowleyNoise(), initial_covariance=[[1, 5, 0], [0, 1, 0], [0, 0, 1]])
+    assert np.isfinite(odometry(robot, log, noise=CrowleyNoise(), initial_covariance=np.eye(3) * 1e-4)
+                       .covariance).all()

@@ -122,3 +122,18 @@ def test_standard_update_is_the_batch_estimate_and_the_printed_one_is_not():
     printed = kalman_filter(kalman_model(forklift_at_axle(), "fk2", noise, thesis_double_q=True), log, x0=x0, p0=p0)
     assert not np.allclose(printed.covariance, cov_last, atol=1e-3)
     assert np.all(np.linalg.eigvalsh(printed.covariance - cov_last) > 0)
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    ({"p0": -np.eye(3)}, "p0: a covariance must be positive definite, its least eigenvalue is -1"),
+    ({"p0": np.zeros((3, 3))}, "p0: a covariance must be positive definite"),
+    ({"p0": [[1.0, 5.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]}, "p0: a covariance is symmetric"),
+    ({"p0": np.full((3, 3), np.nan)}, r"p0: expected a finite \(3, 3\) matrix"),
+    ({"x0": [np.nan, 0.0, 0.0]}, r"x0: expected a twist \(vx, vy, omega\), finite"),
+    ({"x0": [0.0, 0.0]}, r"x0: expected a twist"),  # a bare reshape error
+])
+def test_the_filter_refuses_a_start_that_is_not_a_twist_and_a_covariance(options, message):
+    """p0 = -I (or NaN, or x0 NaN) gave every twist, increment and covariance NaN, without an error."""
+    model = kalman_model(forklift_at_axle(), "fk2", fk2_noise(0.5, 0.1, 0.1, 0.1))
+    with pytest.raises(ValueError, match=message):
+        kalman_filter(model, forklift_log([2.0] * 3, [1.9] * 3, [0.0] * 3), **options)

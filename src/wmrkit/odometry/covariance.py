@@ -14,7 +14,8 @@ loop; positions are taken relative to the first pose to keep the sums well condi
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -34,6 +35,9 @@ class CrowleyNoise:
     k_d: float = 0.001
     k_dtheta: float = 0.003
     k_theta: float = 0.001
+
+    def __post_init__(self) -> None:
+        _check_coefficients(self)
 
     def input_covariance(self, delta_d: ArrayLike, delta_theta: ArrayLike) -> np.ndarray:
         """Covariance of ``U = (dD, dtheta)``, 003 eqs. (15)-(17): ``(...), (...) -> (..., 2, 2)``."""
@@ -72,6 +76,9 @@ class JointNoise:
     per_rad: float = 0.0
     per_sample: float = 0.0
 
+    def __post_init__(self) -> None:
+        _check_coefficients(self)
+
     def increment_covariance(self, twist_map: ArrayLike, rate_increments: ArrayLike) -> np.ndarray:
         """Covariance of body increments, ``S_t diag(sigma^2) S_t^T`` (first order in the ranks solution (4.11)).
 
@@ -81,6 +88,38 @@ class JointNoise:
         s = np.asarray(twist_map, dtype=float)
         var = self.per_rad * np.abs(np.asarray(rate_increments, dtype=float)) + self.per_sample
         return (s * var[..., None, :]) @ np.swapaxes(s, -1, -2)
+
+
+class NoiseError(WmrkitError, ValueError):
+    """A noise coefficient or a covariance that cannot be one: negative, not finite, not symmetric positive
+    semi-definite. The message names the argument."""
+
+
+def _check_coefficients(noise) -> None:
+    """Every coefficient of a noise model finite and >= 0 (a negative variance gave negative covariances)."""
+    for f in fields(noise):
+        value = getattr(noise, f.name)
+        if not (isinstance(value, int | float | np.floating) and not isinstance(value, bool)
+                and math.isfinite(value) and value >= 0):
+            raise NoiseError(f"{type(noise).__name__}.{f.name}: a noise coefficient must be finite and >= 0, "
+                             f"got {value!r}")
+
+
+def check_covariance(c: ArrayLike, what: str, *, definite: bool = False) -> np.ndarray:
+    """`c` ``(3, 3)`` as floats, or :class:`NoiseError` naming `what` unless it is finite, symmetric (to 1e-9 of
+    its largest entry; not averaged: an asymmetric matrix is a mistake) and positive semi-definite (`definite`:
+    positive definite)."""
+    c = np.asarray(c, dtype=float)
+    if c.shape != (3, 3) or not np.isfinite(c).all():
+        raise NoiseError(f"{what}: expected a finite (3, 3) matrix, got shape {c.shape}")
+    scale = float(np.abs(c).max())
+    if np.abs(c - c.T).max() > 1e-9 * scale:
+        raise NoiseError(f"{what}: a covariance is symmetric, got {c.tolist()}")
+    low = float(np.linalg.eigvalsh(c)[0])
+    if low < -1e-12 * scale or (definite and not low > 1e-12 * scale):
+        raise NoiseError(f"{what}: a covariance must be positive {'definite' if definite else 'semi-definite'}, "
+                         f"its least eigenvalue is {low:.6g}")
+    return c
 
 
 def step_jacobians(pose_world_robot: ArrayLike, increment_robot: ArrayLike,
@@ -131,9 +170,10 @@ def propagate_covariance(poses_world_robot: ArrayLike, increments_robot: ArrayLi
     if poses.shape != (n + 1, 3) or inc.shape != (n, 3) or q.shape != (n, 3, 3):
         raise WmrkitError(f"propagate_covariance: expected shapes (N + 1, 3), (N, 3), (N, 3, 3); got {poses.shape}, "
                           f"{inc.shape}, {q.shape}")
-    p0 = np.zeros((3, 3)) if initial is None else np.asarray(initial, dtype=float)
-    if p0.shape != (3, 3):
-        raise WmrkitError(f"initial: expected shape (3, 3), got {p0.shape}")
+    p0 = np.zeros((3, 3)) if initial is None else check_covariance(initial, "initial")
+    if not (np.isfinite(q).all() and (np.diagonal(q, axis1=-2, axis2=-1) >= 0).all()
+            and np.abs(q - np.swapaxes(q, -1, -2)).max(initial=0.0) <= 1e-9 * np.abs(q).max(initial=0.0)):
+        raise NoiseError("increment_covariance: every matrix must be finite and symmetric, with variances >= 0")
     _, g = step_jacobians(poses[:-1], inc, method)
     c = np.concatenate([p0[None], g @ q @ np.swapaxes(g, -1, -2)])  # C_0 = P_0, C_k = G Q G^T
     rel = poses[:, :2] - poses[0, :2]

@@ -24,7 +24,7 @@ from ..errors import WmrkitError
 from ..limits import MAX_COORDINATE, check_chunk_size
 from ..robot import Robot
 from ..units import MAX_ANGLE, MAX_TURNS
-from .covariance import CrowleyNoise, JointNoise, propagate_covariance
+from .covariance import CrowleyNoise, JointNoise, check_covariance, propagate_covariance
 from .integrators import HEADING_FRACTION, Method, check_method
 from .logs import JointLog, LogError, check_time
 from .model import ModelIncrements, OdometryModel, kernel_maps, odometry_model, wrap_angle
@@ -293,9 +293,7 @@ def _check_inputs(pose: np.ndarray, noise: Noise | None, initial_covariance: Arr
                 raise LogError(f"{type(noise).__name__}.{name}: a noise coefficient must be finite and >= 0, "
                                f"got {value!r}")
     if initial_covariance is not None:
-        c = np.asarray(initial_covariance, dtype=float)
-        if c.shape != (3, 3) or not np.isfinite(c).all():
-            raise LogError(f"initial_covariance: expected a finite (3, 3) matrix, got shape {c.shape}")
+        check_covariance(initial_covariance, "initial_covariance")
 
 
 def _overflow(chunk: JointLog, values: np.ndarray, what: str = "pose") -> None:

@@ -22,7 +22,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import WmrkitError
+from ..errors import ShapeError, WmrkitError
+from ..limits import MAX_QUERY_RATE
+from ..odometry.covariance import check_covariance
 from ..odometry.integrators import HEADING_FRACTION, Method, check_method
 from ..odometry.logs import JointLog
 from ..odometry.model import ConfigurationMaps, OdometryModel, cached_maps, odometry_model, wrap_angle
@@ -209,8 +211,12 @@ def _run(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike 
         x0 = np.linalg.lstsq(c / model.sigma[:, None], -(aa @ rate0) / model.sigma, rcond=None)[0]
     # The kernel runs on the covariance over the process variance (Q = I, R / k13^2): the twists depend on those
     # ratios alone, and a covariance of k13^2 = 1e200 would overflow in the 3x3 inverses (cubes of its entries).
-    p_start = np.eye(3) if p0 is None else np.asarray(p0, dtype=float) / model.process
-    filt = np.concatenate([np.asarray(x0, dtype=float).reshape(3), p_start[[0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]])
+    p_start = np.eye(3) if p0 is None else check_covariance(p0, "p0", definite=True) / model.process
+    x0 = np.asarray(x0, dtype=float)
+    if x0.shape != (3,) or not (np.abs(x0) <= MAX_QUERY_RATE).all():
+        raise ShapeError(f"x0: expected a twist (vx, vy, omega), finite and each at most {MAX_QUERY_RATE:g}, got "
+                         f"{x0.tolist()}")
+    filt = np.concatenate([x0, p_start[[0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]])
     slip = np.empty(len(t) - 1)
     missing = np.empty((len(t) - 1, len(steer_cols)))
     start = 0
