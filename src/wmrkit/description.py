@@ -34,7 +34,7 @@ from .limits import (  # noqa: F401  (the limits are part of the description for
 )
 from .robot import Robot
 from .units import BARE_ANGLE_LIMIT
-from .wheels import GEOMETRY_FIELDS, KINDS, Wheel, beta_from_heading
+from .wheels import GEOMETRY_FIELDS, KINDS, Wheel, beta_from_heading, geometry_problem
 
 #: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
 WHEEL_TYPES = (*KINDS, "mecanum")
@@ -168,8 +168,6 @@ def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc) -> Wheel:
     elif "l" in item or "alpha" in item:
         values["l"] = check.quantity(check.require(item, "l", loc), "length", (*loc, "l"))
         values["alpha"] = check.quantity(check.require(item, "alpha", loc), "angle", (*loc, "alpha"))
-        if values["l"] < 0:
-            check.fail(f"must be >= 0 (the direction is alpha), got {values['l']} m", (*loc, "l"))
     else:
         check.fail("missing the wheel's place: 'position: [x, y]' or 'l' and 'alpha'", loc)
     for key, default in kind.optional.items():
@@ -245,19 +243,9 @@ def _mecanum_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc) ->
 
 
 def _check_geometry(type_name: str, v: dict[str, float], check: FieldReader, loc: Loc) -> None:
-    for key in ("r", "r_r", "b"):
-        if key in v and v[key] <= 0:
-            check.fail(f"must be > 0, got {v[key]} m", (*loc, key))
-    if type_name in ("castor", "double_castor") and v["d"] == 0:
-        other = "steerable" if type_name == "castor" else "double"
-        check.fail(f"a {type_name} needs an offset d != 0 (with d = 0 it is a '{other}' wheel)", (*loc, "d"))
-    if type_name == "castor" and abs(math.cos(v["delta"])) < 1e-9:
-        check.fail("a castor with delta = +-90 deg has its axle along the arm and cannot steer itself "
-                   "(det J_c = -r d cos(delta) = 0, eq. 3.19)", (*loc, "delta"))
-    if type_name == "swedish" and abs(math.sin(v["gamma"])) < 1e-9:
-        check.fail("a Swedish wheel with gamma = 0 (or 180 deg) has rollers parallel to the axle and does not "
-                   "roll (det J_s = r r_r sin(gamma) = 0, eq. 3.19); omni: 90 deg, Mecanum: 45 deg",
-                   (*loc, "gamma"))
+    problem = geometry_problem(type_name, v)
+    if problem is not None:
+        check.fail(problem[1], (*loc, problem[0]))
 
 
 # ---- serialisation ---------------------------------------------------------------------------------------

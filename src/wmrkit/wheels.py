@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._shapes import as_angles
-from .errors import UnknownNameError
+from .errors import UnknownNameError, WmrkitError
 
 if TYPE_CHECKING:
     from .dynamics.tyres import Tyre
@@ -70,6 +70,34 @@ GEOMETRY_FIELDS: dict[str, str] = {
 }
 
 
+class WheelError(WmrkitError, ValueError):
+    """A wheel built in Python (not read from a description) that the wheel model cannot use; names the field."""
+
+
+def geometry_problem(type_name: str, v: dict[str, float], *, degenerate: bool = True) -> tuple[str, str] | None:
+    """The first geometric field of a wheel of `type_name` (values `v`, SI) that the model cannot use, with why;
+    None when all can be used. Descriptions and :class:`Wheel` ask the same question; a :class:`Wheel` built in
+    Python may be degenerate (`degenerate=False`: a castor without offset, Swedish rollers along the axle; their
+    slip rows (3.12)/(3.13) exist, their Jacobians (3.19) are singular), a description may not."""
+    if v.get("l", 0.0) < 0:
+        return "l", f"must be >= 0 (the direction is alpha), got {v['l']} m"
+    for key in ("r", "r_r", "b"):
+        if key in v and v[key] <= 0:
+            return key, f"must be > 0, got {v[key]} m"
+    if not degenerate:
+        return None
+    if type_name in ("castor", "double_castor") and v["d"] == 0:
+        other = "steerable" if type_name == "castor" else "double"
+        return "d", f"a {type_name} needs an offset d != 0 (with d = 0 it is a '{other}' wheel)"
+    if type_name == "castor" and abs(math.cos(v["delta"])) < 1e-9:
+        return "delta", ("a castor with delta = +-90 deg has its axle along the arm and cannot steer itself "
+                         "(det J_c = -r d cos(delta) = 0, eq. 3.19)")
+    if type_name == "swedish" and abs(math.sin(v["gamma"])) < 1e-9:
+        return "gamma", ("a Swedish wheel with gamma = 0 (or 180 deg) has rollers parallel to the axle and does not "
+                         "roll (det J_s = r r_r sin(gamma) = 0, eq. 3.19); omni: 90 deg, Mecanum: 45 deg")
+    return None
+
+
 @dataclass(frozen=True, slots=True)
 class Wheel:
     """One wheel (or wheel unit) of a robot. A frozen value in SI units (m, rad).
@@ -104,6 +132,22 @@ class Wheel:
     # steering range (wmrkit.control, thesis §8.4.1/§8.6.3): (min, max) HEADING [rad] the steering joint reaches,
     # e.g. (-pi/2, pi/2) for the forklift; None: unlimited
     steer_range: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        kind = KINDS.get(self.type)
+        if kind is None:
+            raise WheelError(f"wheel '{self.name}': unknown type {self.type!r} (types: {', '.join(KINDS)})")
+        values = {key: getattr(self, key) for key in ("l", "alpha", *kind.required, *kind.optional)}
+        for key, value in values.items():
+            try:
+                finite = math.isfinite(value)
+            except TypeError:
+                finite = False
+            if not finite:
+                raise WheelError(f"wheel '{self.name}': {key}: expected a finite number, got {value!r}")
+        problem = geometry_problem(self.type, values, degenerate=False)
+        if problem is not None:
+            raise WheelError(f"wheel '{self.name}': {problem[0]}: {problem[1]}")
 
     @property
     def kind(self) -> WheelKind:

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
+from ..errors import ShapeError
 from ..kinematics.linalg import characteristic_length, matrix_rank
 from ..kinematics.models import configuration
 from ..robot import Robot
@@ -29,9 +30,20 @@ def icr_of_twist(twist_robot: ArrayLike) -> np.ndarray:
 
 def twist_of_icr(icr_h: ArrayLike) -> np.ndarray:
     """A unit twist about the homogeneous ICR ``(x, y, w)``: ``(y, -x, w)`` normalised. ``(..., 3) -> (..., 3)``."""
-    h = as_vectors(icr_h, 3, "icr_h")
+    h = _homogeneous(icr_h)
     t = np.stack([h[..., 1], -h[..., 0], h[..., 2]], axis=-1)
     return t / np.linalg.norm(t, axis=-1, keepdims=True)
+
+
+def _homogeneous(icr_h: ArrayLike) -> np.ndarray:
+    """`icr_h` ``(..., 3)``, or :class:`ShapeError` unless every point is finite and not ``(0, 0, 0)`` (no point:
+    it gave NaN twists, and steering left at the described angles)."""
+    h = as_vectors(icr_h, 3, "icr_h")
+    bad = ~(np.isfinite(h).all(axis=-1) & (np.abs(h).max(axis=-1, initial=0.0) > 0))
+    if bad.any():
+        raise ShapeError(f"icr_h: expected finite homogeneous points (x, y, w), not all zero, got "
+                         f"{h[bad][0].tolist()}")
+    return h
 
 
 def to_cartesian(icr_h: ArrayLike) -> np.ndarray:
@@ -113,7 +125,7 @@ def steer_to_icr(robot: Robot, icr_h: ArrayLike) -> np.ndarray:
     axle); castors and wheels at the ICR keep their described angle. This is the coordination (Ackermann, swerve)
     that lets a robot with several steered wheels move (§5.3, consequence 3 of 5.12).
     """
-    h = as_vectors(icr_h, 3, "icr_h")
+    h = _homogeneous(icr_h)
     beta = np.broadcast_to(robot.beta, (*h.shape[:-1], len(robot.steer_names))).copy()
     cl = constraint_lines(robot)
     aimed = {w for w in cl.wheels if w in robot.steer_names}

@@ -24,6 +24,7 @@ from scipy.linalg import block_diag
 
 from .._shapes import as_vectors, readonly
 from ..couplings import Coupling, coupled_columns
+from ..errors import ShapeError
 from ..kinematics.linalg import rref
 from ..robot import TWIST_NAMES, Robot, element_table
 
@@ -44,7 +45,10 @@ def line_through(point: ArrayLike, direction: ArrayLike) -> np.ndarray:
     ``(..., 2), (..., 2) -> (..., 3)``; the direction is normalised, lengths in m.
     """
     p, u = as_vectors(point, 2, "point"), as_vectors(direction, 2, "direction")
-    u = u / np.linalg.norm(u, axis=-1, keepdims=True)
+    norm = np.linalg.norm(u, axis=-1, keepdims=True)
+    if not ((norm > 0).all() and np.isfinite(norm).all() and np.isfinite(p).all()):
+        raise ShapeError("line_through: expected a finite point and a finite direction that is not (0, 0)")
+    u = u / norm
     return np.concatenate([u, (p[..., 0] * u[..., 1] - p[..., 1] * u[..., 0])[..., None]], axis=-1)
 
 

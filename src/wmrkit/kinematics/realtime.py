@@ -32,6 +32,7 @@ from ..odometry import _kernels
 from ..odometry._kernels import _cos_sin, _sinc
 from ..robot import Robot
 from . import _ik_fast
+from .wheel_ik import check_tolerances
 
 drop_stale_cache([__file__], [_kernels.__file__])
 
@@ -68,6 +69,7 @@ def realtime(robot: Robot, sensed: tuple[str, ...] | None = None, *, speed_tol: 
     as for the odometry model."""
     from ..odometry.model import odometry_model
 
+    check_tolerances(speed_tol, slip_tol)
     p = _ik_fast.plan(robot)
     ik = _ik_kernel(p, robot, speed_tol, slip_tol)
     try:

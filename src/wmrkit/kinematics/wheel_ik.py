@@ -8,6 +8,7 @@ explains them and the slip they leave. ``docs/wheel-ik.md`` states the policies 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -94,6 +95,17 @@ class WheelCommands:
                 "feasible": bool(self.feasible)}
 
 
+def check_tolerances(speed_tol: float, slip_tol: float) -> None:
+    """Both tolerances finite numbers >= 0 [m/s] (a negative or NaN slip_tol called every twist infeasible)."""
+    for name, value in (("speed_tol", speed_tol), ("slip_tol", slip_tol)):
+        try:
+            ok = math.isfinite(value) and value >= 0
+        except TypeError:
+            ok = False
+        if not ok:
+            raise ShapeError(f"{name}: expected a finite tolerance >= 0 [m/s], got {value!r}")
+
+
 def wheel_commands(
     robot: Robot, twist_robot: ArrayLike, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None,
     speed_tol: float = 1e-12, slip_tol: float = 1e-9,
@@ -112,6 +124,7 @@ def wheel_commands(
     - fixed: spin (8.12) at its constant angle, and the lateral slip (8.14) the twist leaves: ``feasible`` is
       False when any exceeds `slip_tol` [m/s] (e.g. ``v_y != 0`` for a differential drive).
     """
+    check_tolerances(speed_tol, slip_tol)
     p = _ik_fast.plan(robot)
     twist = as_vectors(twist_robot, 3, "twist_robot")
     if not (np.abs(twist) <= MAX_QUERY_RATE).all():  # NaN included

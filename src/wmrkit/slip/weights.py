@@ -39,17 +39,23 @@ class SlipWeights:
     mu: tuple[tuple[str, float, float], ...] = ()
     default: tuple[float, float] = (1.0, 1.0)
 
+    def __post_init__(self) -> None:
+        """Every coefficient a finite number > 0 (zero or NaN weights gave a zero or NaN twist)."""
+        for name, lat, lon in (*self.mu, ("default", *self.default)):
+            for what, v in (("lateral", lat), ("longitudinal", lon)):
+                try:
+                    ok = math.isfinite(v) and v > 0
+                except TypeError:
+                    ok = False
+                if not ok:
+                    raise SlipWeightError(f"friction coefficient of wheel '{name}' ({what}) must be a finite "
+                                          f"number > 0, got {v!r}")
+
     @classmethod
     def of(cls, mu: Mapping[str, tuple[float, float]], default: tuple[float, float] = (1.0, 1.0)) -> SlipWeights:
         """From a mapping ``{wheel: (mu_lateral, mu_longitudinal)}``."""
-        out = cls(tuple((str(k), float(v[0]), float(v[1])) for k, v in mu.items()),
-                  (float(default[0]), float(default[1])))
-        for name, lat, lon in (*out.mu, ("default", *out.default)):
-            for what, v in (("lateral", lat), ("longitudinal", lon)):
-                if not (math.isfinite(v) and v > 0):
-                    raise SlipWeightError(f"friction coefficient of wheel '{name}' ({what}) must be a finite "
-                                          f"number > 0, got {v}")
-        return out
+        return cls(tuple((str(k), float(v[0]), float(v[1])) for k, v in mu.items()),
+                   (float(default[0]), float(default[1])))
 
     @classmethod
     def uniform(cls, lateral: float = 1.0, longitudinal: float = 1.0) -> SlipWeights:

@@ -1,0 +1,74 @@
+"""Values built in Python, not read from a file, are checked as the description reader checks them (audit of the
+Python API, session 14): each of these gave NaN, zero or a wrong verdict without an error."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog, wheel_commands
+from wmrkit.analysis.icr import steer_to_icr, twist_of_icr
+from wmrkit.analysis.lines import line_through
+from wmrkit.kinematics.realtime import realtime
+from wmrkit.slip.weights import SlipWeights
+from wmrkit.wheels import Wheel, WheelError
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    ({"r": 0.0}, "wheel 'left': r: must be > 0, got 0.0 m"),  # spins NaN
+    ({"r": math.nan}, "wheel 'left': r: expected a finite number, got nan"),
+    ({"r": -1.0}, "wheel 'left': r: must be > 0, got -1.0 m"),
+    ({"l": -0.5}, r"wheel 'left': l: must be >= 0 \(the direction is alpha\)"),
+    ({"beta": "90 deg"}, "wheel 'left': beta: expected a finite number, got '90 deg'"),
+    ({"type": "nonsense"}, "wheel 'left': unknown type 'nonsense' \\(types: fixed, steerable"),
+])
+def test_a_wheel_the_model_cannot_use_is_refused_by_field(change, message):
+    wheel = catalog.load("diff-drive").wheel("left")
+    with pytest.raises(WheelError, match=message):
+        dataclasses.replace(wheel, **change)
+
+
+def test_a_wheel_built_in_python_may_be_degenerate_but_not_meaningless():
+    """A castor without offset has slip rows (3.12) (a degenerate one: the description refuses it, naming d); a
+    Swedish wheel's roller radius must still be > 0."""
+    Wheel(name="c", type="castor", l=1.0, alpha=0.0, beta=0.0, r=0.1, d=0.0)
+    with pytest.raises(WheelError, match=r"wheel 's': r_r: must be > 0, got 0\.0 m"):
+        Wheel(name="s", type="swedish", l=1.0, alpha=0.0, beta=0.0, r=0.1, r_r=0.0, gamma=0.5)
+
+
+@pytest.mark.parametrize("default", [(0.0, 0.0), (math.nan, 1.0), (1.0, -2.0)])
+def test_slip_weights_built_directly_are_checked_as_slip_weights_of(default):
+    """SlipWeights(mu=(), default=(0, 0)) gave a zero twist from WLS, (nan, 1) a NaN one."""
+    with pytest.raises(ValueError, match=r"friction coefficient of wheel 'default' \((lateral|longitudinal)\) must"):
+        SlipWeights((), default)
+
+
+@pytest.mark.parametrize("tolerances", [{"slip_tol": -1.0}, {"slip_tol": math.nan}, {"speed_tol": math.inf}])
+def test_ik_tolerances_are_finite_and_not_negative(tolerances):
+    """slip_tol = -1 or NaN called a feasible twist infeasible."""
+    dd = catalog.load("diff-drive")
+    name = next(iter(tolerances))
+    with pytest.raises(ValueError, match=f"{name}: expected a finite tolerance >= 0"):
+        wheel_commands(dd, [1.0, 0.0, 0.0], **tolerances)
+    with pytest.raises(ValueError, match=f"{name}: expected a finite tolerance >= 0"):
+        realtime(dd, **tolerances)
+    assert wheel_commands(dd, [1.0, 0.0, 0.0]).feasible
+
+
+@pytest.mark.parametrize("icr", [[math.nan, 0.0, 1.0], [math.inf, 0.0, 1.0], [0.0, 0.0, 0.0]])
+def test_an_icr_that_is_no_point_is_refused(icr):
+    """steer_to_icr returned the described angles for these, twist_of_icr NaN."""
+    sw = catalog.load("swerve-4")
+    with pytest.raises(ValueError, match=r"icr_h: expected finite homogeneous points \(x, y, w\), not all zero"):
+        steer_to_icr(sw, icr)
+    with pytest.raises(ValueError, match="icr_h: expected finite homogeneous points"):
+        twist_of_icr(icr)
+    assert np.isfinite(steer_to_icr(sw, [0.0, 1.0, 0.0])).all()
+
+
+def test_a_line_needs_a_direction():
+    with pytest.raises(ValueError, match=r"line_through: expected a finite point and a finite direction"):
+        line_through([0.0, 0.0], [0.0, 0.0])
