@@ -238,24 +238,78 @@ def test_cli_slip_weights_and_closure_warnings(skid_runs, diff, tmp_path, capsys
     assert main(["batch", "calibrate", "skid-steer-4", str(tmp_path / "s*.csv"), "--reference", str(tmp_path / "ref"),
                  "--slip", "--workers", "0"]) == 0
     assert f"WLS mu_lateral / mu_longitudinal  {direct.ratio:.6g}" in capsys.readouterr().out
-    # closed squares cut short: the fit runs, and says why it cannot be trusted
+    # closed squares cut short (two each way: the interval needs every run's removal to leave both directions): the
+    # fit runs, and says why it cannot be trusted
     true = apply_parameters(diff, [("left.r", "-right.r"), ("left.l", "right.l")], [0.01, 0.03])
-    for i in range(2):
-        write_log(tmp_path / f"sq{i}.csv", simulate(true, square_path(1.5, clockwise=i == 1), 10.0))
+    for i in range(4):
+        write_log(tmp_path / f"sq{i}.csv", simulate(true, square_path(1.5, clockwise=i % 2 == 1), 10.0))
     assert main(["batch", "calibrate", "diff-drive", str(tmp_path / "sq*.csv"), "--closed", "--workers", "0"]) == 0
     err = capsys.readouterr().err
-    assert err.count("wmrkit: warning:") == 2 and "sq1.csv" in err and "ends while the wheels still turn" in err
+    assert err.count("wmrkit: warning:") == 4 and "sq1.csv" in err and "ends while the wheels still turn" in err
 
 
-def test_jacobian_interval_needs_each_run_removable(diff):
+@pytest.mark.parametrize("noise", [0.0, 1e-5])
+def test_jacobian_interval_needs_each_run_removable(diff, noise):
     """One clockwise and one counter-clockwise square: without either, the ratio and the track are confounded
-    (rank-1 Jacobian), so the leave-one-run-out interval does not exist and the error says what to add."""
+    (rank-1 Jacobian), so the leave-one-run-out interval does not exist and the error says what to add. With
+    encoder noise the rank is not 1 to round-off (the noise breaks it), and it gave an interval."""
     params = [("left.r", "-right.r"), ("left.l", "right.l")]
     true = apply_parameters(diff, params, [0.01, 0.03])
-    runs = [CalibrationRun.closed_path(simulate(true, square_path(1.5, clockwise=cw, pause=0.3), 10.0).log)
-            for cw in (False, True)]
-    with pytest.raises(BatchError, match="two in each direction"):
+    runs = [CalibrationRun.closed_path(simulate(true, square_path(1.5, clockwise=cw, pause=0.3), 10.0,
+                                                spin_noise_per_rad=noise, seed=3).log) for cw in (False, True)]
+    with pytest.raises(BatchError, match=r"without run 1 the other runs cannot tell .* two in each direction"):
         fleet_calibrate(diff, runs, params)
+
+
+def _squares(true, ways, noise, pause=0.5):
+    return [CalibrationRun.closed_path(simulate(true, square_path(1.5, clockwise=cw, pause=pause), 10.0,
+                                                spin_noise_per_rad=noise, seed=i).log) for i, cw in enumerate(ways)]
+
+
+@pytest.mark.parametrize("noise", [0.0, 1e-5])
+@pytest.mark.parametrize("ci", ["jacobian", "bootstrap"])
+def test_closed_squares_all_turning_one_way_are_refused(diff, ci, noise):
+    """The audit's fleet: three squares one way gave left.r 0.0079 m, right.r 0.142 m and a 1.34 m track (with
+    noise; without, a zero-width interval around a wrong value), exit status 0. No pause: a turn ends between two
+    samples, and the odometry's discretisation leaves the noise-free Jacobian a weakest singular value 5e-6 of the
+    largest (cond(J'J) 4e10, under the old limit of 1e14)."""
+    params = default_parameters(diff, closed=True)
+    true = apply_parameters(diff, params, [0.01, 0.03])
+    with pytest.raises(BatchError, match=r"cannot tell these parameters apart: .*all turn counter-clockwise"):
+        fleet_calibrate(diff, _squares(true, [False] * 3, noise, pause=0.0), params, ci=ci, n_boot=8)
+
+
+def test_bootstrap_drops_the_noisy_resamples_that_turn_one_way(diff):
+    """The audit's bootstrap: six noisy squares, three each way. The resamples of squares that all turn one way
+    (5 of 64 with seed 0) were kept: 95 % intervals [-2.08, 0.47] of the ratio and [+3 %, +1000 %] of the track,
+    about 0.0102 and 0.031. Now exactly those are dropped and counted, and the interval is about the jacobian one."""
+    params = default_parameters(diff, closed=True)
+    true = apply_parameters(diff, params, [0.01, 0.03])
+    ways = [False] * 3 + [True] * 3
+    runs = _squares(true, ways, 1e-5)
+    rng = np.random.default_rng(0)
+    one_way = sum(len({ways[i] for i in rng.integers(0, 6, 6)}) == 1 for _ in range(64))
+    assert one_way == 5
+    boot = fleet_calibrate(diff, runs, params, ci="bootstrap", n_boot=64, seed=0)
+    assert f"bootstrap: {one_way} of 64 replicates dropped" in " ".join(boot.warnings)
+    jac = fleet_calibrate(diff, runs, params)
+    np.testing.assert_allclose(boot.estimate, jac.estimate, rtol=1e-12)
+    for p, (lo, hi), (a, b) in zip(boot.estimate, boot.interval, jac.interval, strict=True):
+        assert lo < p < hi and 0.2 < (hi - lo) / (b - a) < 5
+
+
+def test_cli_refuses_closed_squares_that_all_turn_one_way(diff, tmp_path, capsys):
+    from batch_params import write_log
+
+    from wmrkit.cli.main import main
+
+    params = default_parameters(diff, closed=True)
+    true = apply_parameters(diff, params, [0.01, 0.03])
+    for i, run in enumerate(_squares(true, [False] * 3, 1e-5)):
+        write_log(tmp_path / f"run{i}.csv", run)
+    assert main(["batch", "calibrate", "diff-drive", str(tmp_path / "run*.csv"), "--closed", "--workers", "0"]) == 2
+    err = capsys.readouterr().err
+    assert "cannot tell these parameters apart" in err and "the 3 closed runs all turn counter-clockwise" in err
 
 
 def test_bootstrap_drops_replicates_that_do_not_determine_the_parameters(diff):

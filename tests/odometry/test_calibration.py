@@ -105,6 +105,52 @@ def test_one_direction_alone_does_not_determine_ratio_and_track(clockwise):
     assert both[1] > 0.1 * both[0]
 
 
+@pytest.mark.parametrize("noise", [0.0, 1e-5])
+@pytest.mark.parametrize("clockwise", [False, True])
+def test_equal_closed_squares_all_turning_one_way_are_refused(clockwise, noise):
+    """The audit's case: three counter-clockwise squares gave left.r = -0.026 m and a 1.5 m track, no warning
+    (with noise the fit slides along the valley until a radius crosses zero; without, it stops anywhere on it)."""
+    nominal = catalog.load("diff-drive")
+    true = apply_parameters(nominal, RATIO_TRACK, [0.01, 0.03])
+    runs = [CalibrationRun.closed_path(simulate(true, square_path(1.5, clockwise=clockwise, pause=0.3), 10.0,
+                                                spin_noise_per_rad=noise, seed=i).log) for i in range(3)]
+    way = "clockwise" if clockwise else "counter-clockwise"
+    with pytest.raises(WmrkitError, match=f"cannot tell these parameters apart: .*the 3 closed runs all turn {way}"):
+        calibrate(nominal, runs, RATIO_TRACK)
+
+
+def test_closed_squares_of_different_sizes_turning_one_way_are_accepted():
+    """Not a turning-direction rule: the heading drift of unequal radii grows with the side and the turn error of
+    the track does not, so one-way squares of several sizes determine both (a decision on the data, not the
+    shape)."""
+    nominal = catalog.load("diff-drive")
+    true = apply_parameters(nominal, RATIO_TRACK, [0.01, 0.03])
+    runs = [CalibrationRun.closed_path(simulate(true, square_path(1.0 + 0.2 * i, pause=0.5), 10.0,
+                                                spin_noise_per_rad=1e-5, seed=i).log) for i in range(5)]
+    fit = calibrate(nominal, runs, RATIO_TRACK)
+    assert fit.value("left.r") / 0.075 - 1 == pytest.approx(0.01, abs=1e-3)
+    assert fit.value("left.l") / 0.2 - 1 == pytest.approx(0.03, abs=2e-3)
+
+
+def test_undetermined_is_decided_on_relative_changes_of_the_fitted_values():
+    """The scales make a unit step a relative change of the fitted value (the smaller of 1 +- p for a ratio); a
+    length through zero, a direction the runs do not see and one the residuals leave loose are each named."""
+    nominal = catalog.load("diff-drive")
+    params = (*RATIO_TRACK, "left.alpha")
+    runs = _closed_squares(apply_parameters(nominal, RATIO_TRACK, [0.01, 0.03]), pause=0.3)
+    both = CalibrationProblem(nominal, tuple(RATIO_TRACK), tuple(runs))
+    np.testing.assert_allclose(CalibrationProblem(nominal, params, tuple(runs)).scales([0.5, -0.2, 3.0]),
+                               [0.5, 0.8, 1.0])
+    p = np.array([0.01, 0.03])
+    jac, r = both.jacobian(p), both.residuals(p)
+    assert both.undetermined(p, jac, r) is None
+    assert "left.r = -0.0075 m" in both.undetermined([-1.1, 0.03], jac, r)
+    one = both.with_runs(runs[:1])
+    assert one.undetermined(p, one.jacobian(p), one.residuals(p)).startswith("they do not move the poses along")
+    loose = both.undetermined(p, jac, r + 2.0)  # closure errors of 2 m: the weaker direction is known to +-20 %
+    assert "a standard error of" in loose and "(at most 10%)" in loose
+
+
 def test_problem_residuals_and_solver_are_what_calibrate_uses():
     """The shared pieces (also used by the fleet fit): residuals are zero at the true parameters, and the solver
     from the nominal robot lands there."""

@@ -95,22 +95,17 @@ def _jacobian_of(args: tuple[CalibrationProblem, np.ndarray, np.ndarray]) -> np.
     return problem.jacobian(p, r)
 
 
-#: Condition number of ``J^T J`` above which the runs cannot tell the parameters apart.
-MAX_CONDITION = 1e14
 #: Least fraction of bootstrap replicates that must determine the parameters (the others are dropped and counted).
 MIN_DETERMINED = 0.5
 
 
-def _determined(jac: np.ndarray) -> bool:
-    """Whether a least-squares Jacobian ``(R, n)`` determines all `n` parameters."""
-    return bool(np.linalg.cond(jac.T @ jac) <= MAX_CONDITION)
-
-
 def _refit(problem: CalibrationProblem) -> np.ndarray:
     """A bootstrap replicate: the fit over `problem`'s runs, in one process; NaN where they do not determine the
-    parameters (a resample of closed squares that all turn the same way), which the fit would report as a value."""
+    parameters (:meth:`~wmrkit.odometry.calibration.CalibrationProblem.undetermined`: e.g. a resample of equal
+    closed squares that all turn the same way), which the fit would report as a value."""
     fit = problem.solve()
-    return fit.x if _determined(fit.jac) else np.full(len(problem.parameters), np.nan)
+    undetermined = problem.undetermined(fit.x, fit.jac, fit.fun)
+    return fit.x if undetermined is None else np.full(len(problem.parameters), np.nan)
 
 
 #: Most bootstrap replicates (each refits every run): percentile intervals settle within a few thousand.
@@ -171,12 +166,13 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
         if m <= n:
             raise BatchError(f"calibrate: {m} residuals cannot fix {n} parameters with an interval; add runs")
         fit = solve(residuals, n, jacobian=jacobian)
-        if not _determined(fit.jac):
-            raise BatchError("calibrate: the runs cannot tell these parameters apart (singular Jacobian); add runs "
-                             "of other shapes or fit fewer parameters")
+        reason = problem.undetermined(fit.x, fit.jac, fit.fun)
+        if reason is not None:
+            raise BatchError(f"calibrate: the runs cannot tell these parameters apart: {reason}{problem.hint()}; add "
+                             f"runs of other shapes or fit fewer parameters")
         notes = ()
         if ci == "jacobian":
-            lo, hi = _sandwich_interval(fit, problem.sizes(), level)
+            lo, hi = _sandwich_interval(problem, fit, level)
         else:
             rng = np.random.default_rng(seed)
             picks = [rng.integers(0, len(runs), len(runs)) for _ in range(n_boot)]
@@ -216,14 +212,16 @@ def _t_quantile(level: float, dof: int) -> float:
     return float(stats.t.isf((1.0 - level) / 2, dof))
 
 
-def _sandwich_interval(fit, sizes: Sequence[int], level: float) -> tuple[np.ndarray, np.ndarray]:
+def _sandwich_interval(problem: CalibrationProblem, fit, level: float) -> tuple[np.ndarray, np.ndarray]:
     """Interval from the least-squares Jacobian with the run-clustered ("sandwich") covariance in its jackknife
     form (CR3): ``(G-1)/G sum_g d_g d_g^T`` with ``d_g = (J^T J - J_g^T J_g)^-1 J_g^T r_g``, the linearised change
     of the estimate when run ``g`` is left out. The errors along one trajectory accumulate (they are correlated),
     runs are independent; Student's t with ``G - 1`` degrees of freedom. The plain clustered form ``(J^T J)^-1
     (sum_g J_g^T r_g r_g^T J_g) (J^T J)^-1 G/(G-1)`` (CR1) covered a track error in only 84-87 % of 200 fleets of
-    6-8 runs at 95 %; this one covers 92-97 % (tested)."""
+    6-8 runs at 95 %; this one covers 92-97 % (tested). Every run's removal must leave the parameters determined
+    (:meth:`~wmrkit.odometry.calibration.CalibrationProblem.undetermined` on the other runs' rows at the fit)."""
 
+    sizes = problem.sizes()
     g = len(sizes)
     if g < 2:
         raise BatchError("calibrate: a confidence interval needs at least two runs")
@@ -231,11 +229,13 @@ def _sandwich_interval(fit, sizes: Sequence[int], level: float) -> tuple[np.ndar
     change = []
     for k, (a, b) in enumerate(zip(np.cumsum([0, *sizes[:-1]]), np.cumsum(sizes), strict=True)):
         jg = fit.jac[a:b]
-        rest = jtj - jg.T @ jg
-        if np.linalg.cond(rest) > MAX_CONDITION:
-            raise BatchError(f"calibrate: without run {k + 1} the other runs cannot tell these parameters apart, so "
-                             f"the interval cannot be estimated; add runs (closed squares: two in each direction)")
-        change.append(np.linalg.solve(rest, jg.T @ fit.fun[a:b]))
+        others = np.r_[0:a, b:fit.fun.size]
+        reason = problem.undetermined(fit.x, fit.jac[others], fit.fun[others])
+        if reason is not None:
+            raise BatchError(f"calibrate: without run {k + 1} the other runs cannot tell these parameters apart "
+                             f"({reason}), so the interval cannot be estimated; add runs (closed squares: two in "
+                             f"each direction)")
+        change.append(np.linalg.solve(jtj - jg.T @ jg, jg.T @ fit.fun[a:b]))
     change = np.array(change)
     cov = change.T @ change * (g - 1) / g
     half = _t_quantile(level, g - 1) * np.sqrt(np.diag(cov))

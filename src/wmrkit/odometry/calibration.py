@@ -24,6 +24,14 @@ never reached and biases the fit (a +3 % track came out +2.74 %); such runs get 
 (:meth:`CalibrationRun.warning`). One implementation serves one log and a fleet: :class:`CalibrationProblem`
 holds the residuals, :func:`solve` the least squares; :mod:`wmrkit.batch.calibrate` maps the same residuals
 over many logs on an engine.
+
+Runs that cannot tell the parameters apart have an arbitrary fit (equal closed squares all driven one way: the
+radius ratio and the track only move their net turn, and the solver slides along that valley to e.g. a left
+radius of -0.026 m). :meth:`CalibrationProblem.undetermined` decides at the fit, on the Jacobian with each column
+scaled to a relative change of the fitted value (1 rad for angles): a direction is not determined when its
+singular value is under :data:`RANK_TOL` of the largest (noise-free runs), or when the residuals leave it a
+standard error over :data:`MAX_STANDARD_ERROR` (noisy runs, where the noise itself breaks the degeneracy). Such
+fits are refused.
 """
 
 from __future__ import annotations
@@ -44,6 +52,16 @@ from .pipeline import odometry
 
 Parameter = str | tuple[str, ...]
 _STEP = float(np.sqrt(np.finfo(float).eps))  # relative forward-difference step of the Jacobian
+
+#: Least ratio of the weakest to the largest singular value of the scaled Jacobian (module docstring): below it
+#: a direction is at the level of the sampled odometry's discretisation and of the forward differences (noise-free
+#: equal squares driven one way: up to 5e-6; runs that determine the parameters: 0.01-0.2).
+RANK_TOL = 1e-4
+#: Largest standard error of a fit along any direction, in relative changes of the fitted lengths or in rad
+#: (the residuals' RMS over the singular value). Equal closed squares driven one way with encoder noise: 0.15 or
+#: more in 180 synthetic fleets of 1-6 squares (the noise sets the fit along the valley); both ways, with
+#: residuals of 0.05-0.09 m: under 0.01; one way in five sizes: 0.03.
+MAX_STANDARD_ERROR = 0.1
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
@@ -170,6 +188,56 @@ class CalibrationProblem:
         """The runs' warnings (:meth:`CalibrationRun.warning`)."""
         return tuple(w for w in (run.warning() for run in self.runs) if w is not None)
 
+    def scales(self, p: ArrayLike) -> np.ndarray:
+        """``(n,)``: the change of each parameter that is a unit relative change of its fitted value at `p`: the
+        smallest ``|1 +- p|`` of its lengths, 1 (rad) for angles."""
+        p = np.asarray(p, dtype=float)
+        return np.array([min([1.0] * any(GEOMETRY_FIELDS[f] == "angle" for _, f, _ in group)
+                             + [abs(1.0 + sign * v) for _, f, sign in group if GEOMETRY_FIELDS[f] == "length"])
+                         for group, v in zip(_groups(self.robot, self.parameters), p.tolist(), strict=True)])
+
+    def undetermined(self, p: ArrayLike, jac: ArrayLike, r: ArrayLike) -> str | None:
+        """Why the runs do not determine the parameters at the fit `p` (``jac``, ``r``: the Jacobian and the
+        residuals there), or ``None`` (module docstring): a length scaled through zero; else, on the Jacobian scaled
+        by :meth:`scales`, the weakest direction's singular value under :data:`RANK_TOL` of the largest, or its
+        standard error (residual RMS with ``R - n`` degrees of freedom over that singular value) over
+        :data:`MAX_STANDARD_ERROR`."""
+        p, jac, r = np.asarray(p, dtype=float), np.asarray(jac, dtype=float), np.asarray(r, dtype=float)
+        for name, nominal, value in self.values(p):
+            if GEOMETRY_FIELDS[name.partition(".")[2]] == "length" and value / nominal <= 0:
+                return f"the fit gives {name} = {value:.3g} m (nominal {nominal:.3g} m), a length through zero"
+        _, sv, vt = np.linalg.svd(jac * self.scales(p), full_matrices=False)
+        if not sv[-1] > RANK_TOL * sv[0]:  # also all zero, or NaN
+            return f"they do not move the poses along {self._direction(vt[-1])}"
+        dof = r.size - len(self.parameters)
+        se = float(np.linalg.norm(r) / np.sqrt(dof) / sv[-1]) if dof > 0 else 0.0
+        if se > MAX_STANDARD_ERROR:
+            return (f"their residuals leave {self._direction(vt[-1])} a standard error of {se:.0%} "
+                    f"(at most {MAX_STANDARD_ERROR:.0%})")
+        return None
+
+    def _direction(self, v: np.ndarray) -> str:
+        """A direction `v` ``(n,)`` of parameter space in words: one parameter, or a combination."""
+        names = [",".join((g,) if isinstance(g, str) else g) for g in self.parameters]
+        if np.max(np.abs(v)) > 0.99:
+            return names[int(np.argmax(np.abs(v)))]
+        v = v * np.sign(v[np.argmax(np.abs(v))])
+        return "the combination " + " ".join(f"{c:+.2f} ({n})" for c, n in zip(v, names, strict=True) if abs(c) >= 0.05)
+
+    def hint(self) -> str:
+        """For closed runs that all turn one way (net heading of the nominal odometry), a clause saying so and what
+        to add; else ``""``."""
+        if not self.runs or not all(run.closed for run in self.runs):
+            return ""
+        model = odometry_model(self.robot, self.sensed, weights=self.weights)
+        headings = [np.unwrap(odometry(model, run.log, method=self.method).poses[:, 2]) for run in self.runs]
+        turns = [h[-1] - h[0] for h in headings]
+        if all(t > np.pi for t in turns) or all(t < -np.pi for t in turns):
+            way = "counter-clockwise" if turns[0] > 0 else "clockwise"
+            return (f"; the {len(turns)} closed runs all turn {way} (closed squares: drive them both ways, two or more "
+                    f"in each direction)")
+        return ""
+
 
 def solve(residuals: Callable[[np.ndarray], np.ndarray], n: int, x0: ArrayLike | None = None,
           jacobian: Callable[[np.ndarray, np.ndarray | None], np.ndarray] | None = None):
@@ -234,7 +302,8 @@ def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence
 
     Residuals per referenced sample: ``x``, ``y`` error [m] and ``heading_weight`` [m/rad] times the wrapped
     heading error (:meth:`CalibrationProblem.residuals`). Needs at least as many residuals as parameters, and
-    parameters the runs can tell apart. `sensed` and `weights` choose the model as in
+    parameters the runs can tell apart (else an error says which direction they leave undetermined:
+    :meth:`CalibrationProblem.undetermined`). `sensed` and `weights` choose the model as in
     :func:`~.model.odometry_model`; `run_weights` as in :class:`CalibrationProblem`.
     """
     if not runs:
@@ -246,6 +315,10 @@ def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence
     if r0.size < len(groups):
         raise WmrkitError(f"calibrate: {r0.size} residuals cannot fix {len(groups)} parameters; add runs or references")
     fit = solve(problem.residuals, len(groups), jacobian=problem.jacobian)
+    reason = problem.undetermined(fit.x, fit.jac, fit.fun)
+    if reason is not None:
+        raise WmrkitError(f"calibrate: the runs cannot tell these parameters apart: {reason}{problem.hint()}; add "
+                          f"runs of other shapes or fit fewer parameters")
     return Calibration(apply_parameters(robot, parameters, fit.x), problem.values(fit.x), rms(r0), rms(fit.fun),
                        bool(fit.success), problem.warnings())
 
