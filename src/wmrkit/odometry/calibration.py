@@ -36,6 +36,7 @@ fits are refused.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
@@ -44,7 +45,7 @@ from numpy.typing import ArrayLike
 
 from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
-from ..wheels import GEOMETRY_FIELDS
+from ..wheels import GEOMETRY_FIELDS, Wheel
 from .integrators import Method
 from .logs import JointLog
 from .model import odometry_model, wrap_angle
@@ -291,8 +292,17 @@ def apply_parameters(robot: Robot, parameters: Sequence[Parameter], p: ArrayLike
         for wheel, fld, sign in group:
             w, v = wheels[wheel], sign * value
             old = getattr(w, fld)
-            wheels[wheel] = replace(w, **{fld: old * (1.0 + v) if GEOMETRY_FIELDS[fld] == "length" else old + v})
+            wheels[wheel] = _trial(w, fld, old * (1.0 + v) if GEOMETRY_FIELDS[fld] == "length" else old + v)
     return replace(robot, wheels=tuple(wheels[w.name] for w in robot.wheels))
+
+
+def _trial(wheel: Wheel, field: str, value: float) -> Wheel:
+    """`wheel` with `field` set to `value`, unchecked: the solver's trial values may take a length through zero,
+    which :class:`~wmrkit.wheels.Wheel` refuses; a fit that ends there is refused by
+    :meth:`CalibrationProblem.undetermined`, naming the length."""
+    out = copy.copy(wheel)
+    object.__setattr__(out, field, value)
+    return out
 
 
 def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence[Parameter], *,
