@@ -1,5 +1,6 @@
-"""Values built in Python, not read from a file, are checked as the description reader checks them (audit of the
-Python API, session 14): each of these gave NaN, zero or a wrong verdict without an error."""
+"""Python doors checked as the files and the command line are (audit of the Python API, session 14): values built in
+Python, arrays that are not finite, sizes without bound. Each of these gave NaN, zero, a wrong verdict or an unbounded
+allocation without an error."""
 
 from __future__ import annotations
 
@@ -72,3 +73,28 @@ def test_an_icr_that_is_no_point_is_refused(icr):
 def test_a_line_needs_a_direction():
     with pytest.raises(ValueError, match=r"line_through: expected a finite point and a finite direction"):
         line_through([0.0, 0.0], [0.0, 0.0])
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    (lambda i: i.integrate_exact([0.0, 0.0, 0.0], [math.nan, 0.0, 0.0], 1.0), "twist_robot: expected finite numbers"),
+    (lambda i: i.integrate_rk2([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], math.inf), "dt: expected finite numbers, got inf"),
+    (lambda i: i.step([math.nan, 0.0, 0.0], [0.1, 0.0, 0.0]), "pose_world_robot: expected finite numbers"),
+    (lambda i: i.integrate_increments([0.0, 0.0, 0.0], [[0.1, math.inf, 0.0]]), "increments_robot: expected finite"),
+    (lambda i: i.integrate_increments([0.0, 0.0, 0.0], [[0.1, 0.0, 0.0]], heading_world=[0.0, math.nan]),
+     "heading_world: expected finite numbers"),
+])
+def test_the_integrators_refuse_what_is_not_finite(call, message):
+    """integrate_exact([0, 0, 0], [nan, 0, 0], 1) gave [nan, nan, 0]: a NaN pose, silently."""
+    from wmrkit.odometry import integrators
+
+    with pytest.raises(ValueError, match=message):
+        call(integrators)
+
+
+def test_a_synthetic_run_bounds_its_fine_steps():
+    """oversample=10**9 tried to allocate 15 TiB."""
+    from wmrkit.errors import WmrkitError
+    from wmrkit.odometry.synthetic import simulate, square_path
+
+    with pytest.raises(WmrkitError, match=r"oversample 1000000000 at 100 Hz .* at most 1e\+08 fine steps"):
+        simulate(catalog.load("diff-drive"), square_path(1.0), 100.0, oversample=10**9)

@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
-from ..errors import WmrkitError
+from ..errors import ShapeError, WmrkitError
 
 Method = Literal["exact", "rk2", "euler", "paper002"]
 #: Integration schemes, best first.
@@ -89,14 +89,21 @@ def step(pose_world_robot: ArrayLike, increment_robot: ArrayLike, method: Method
     of :data:`METHODS` (module docstring).
     """
     check_method(method)
-    pose = as_vectors(pose_world_robot, 3, "pose_world_robot")
-    inc = as_vectors(increment_robot, 3, "increment_robot")
+    pose = _finite(as_vectors(pose_world_robot, 3, "pose_world_robot"), "pose_world_robot")
+    inc = _finite(as_vectors(increment_robot, 3, "increment_robot"), "increment_robot")
     return compose_columns(pose, inc[..., 0, None], inc[..., 1, None], inc[..., 2, None], method)[..., 0, :]
 
 
+def _finite(values: np.ndarray, name: str) -> np.ndarray:
+    """`values`, or :class:`ShapeError` naming `name` when any is NaN or infinite (it went through as NaN poses)."""
+    if not np.isfinite(values).all():
+        raise ShapeError(f"{name}: expected finite numbers, got {values[~np.isfinite(values)].flat[0]}")
+    return values
+
+
 def _twist_step(pose_world_robot: ArrayLike, twist_robot: ArrayLike, dt: ArrayLike, method: Method) -> np.ndarray:
-    twist = as_vectors(twist_robot, 3, "twist_robot")
-    return step(pose_world_robot, twist * np.asarray(dt, dtype=float)[..., None], method)
+    twist = _finite(as_vectors(twist_robot, 3, "twist_robot"), "twist_robot")
+    return step(pose_world_robot, twist * _finite(np.asarray(dt, dtype=float), "dt")[..., None], method)
 
 
 def integrate_exact(pose_world_robot: ArrayLike, twist_robot: ArrayLike, dt: ArrayLike) -> np.ndarray:
@@ -153,6 +160,9 @@ def integrate_increments(
     inc = np.asarray(increments_robot, dtype=float)
     if inc.ndim < 2 or inc.shape[-1] != 3:
         raise WmrkitError(f"increments_robot: expected shape (..., N, 3), got {inc.shape}")
+    _finite(pose0, "pose_world_robot"), _finite(inc, "increments_robot")
+    if heading_world is not None:
+        _finite(np.asarray(heading_world, dtype=float), "heading_world")
     return compose_columns(pose0, inc[..., 0], inc[..., 1], inc[..., 2], method, heading_world=heading_world)
 
 

@@ -128,6 +128,8 @@ class SyntheticRun:
 
 #: Most samples of a synthetic log (each is a row of every joint array, fine-stepped `oversample` times).
 MAX_SAMPLES = 10**7
+#: Most fine steps (sample periods times `oversample`): each holds a few rows of every joint, about 1 kB.
+MAX_FINE_STEPS = 10**8
 
 
 def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLike = (0.0, 0.0, 0.0),
@@ -146,6 +148,9 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     if not (1e-6 <= rate and profile.duration * rate <= MAX_SAMPLES):
         raise WmrkitError(f"rate {rate:g} Hz over the profile's {profile.duration:g} s: need a rate >= 1e-06 Hz and "
                           f"at most {MAX_SAMPLES} sample periods")
+    if profile.duration * rate * oversample > MAX_FINE_STEPS:  # the fine arrays: 15 TiB at oversample = 1e9
+        raise WmrkitError(f"oversample {oversample} at {rate:g} Hz over {profile.duration:g} s: at most "
+                          f"{MAX_FINE_STEPS:.0e} fine steps (sample periods times oversample)")
     n = math.ceil(profile.duration * rate - 1e-9) + 1  # the whole profile: a log never stops short of its end
     t_samples = np.arange(n) / rate
     if t_samples[-1] > profile.duration:  # the robot rests from the profile's end to the last sample
