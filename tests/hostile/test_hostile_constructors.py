@@ -98,3 +98,24 @@ def test_a_synthetic_run_bounds_its_fine_steps():
 
     with pytest.raises(WmrkitError, match=r"oversample 1000000000 at 100 Hz .* at most 1e\+08 fine steps"):
         simulate(catalog.load("diff-drive"), square_path(1.0), 100.0, oversample=10**9)
+
+
+def test_small_python_doors_say_what_is_wrong():
+    """closure_error said 'the path neither moves nor turns' of a NaN pose; j_model of no samples gave NaN with a
+    RuntimeWarning; a JointLog of lists failed later with 'list' object has no attribute; Vehicle refused
+    np.int64(1) as 'not a finite number'."""
+    from wmrkit.errors import WmrkitError
+    from wmrkit.odometry.logs import JointLog
+    from wmrkit.parking.problem import load_problem
+    from wmrkit.slip import closure_error, j_model
+
+    with pytest.raises(WmrkitError, match="closure_error: poses must be finite, pose 1 is not"):
+        closure_error(np.array([[0.0, 0.0, 0.0], [math.nan, 0.0, 0.0]]))
+    with pytest.raises(WmrkitError, match="j_model: expected at least one sample"):
+        j_model(np.zeros((0, 3)), np.zeros((0, 3)))
+    log = JointLog([0, 1], ("a",), [[0], [1]])
+    assert isinstance(log.time, np.ndarray) and log.positions.dtype == float and len(log.select(("a",))) == 2
+    vehicle = load_problem("thesis-9.1").vehicle
+    assert dataclasses.replace(vehicle, track=np.int64(1)).track == 1.0
+    with pytest.raises(WmrkitError, match=r"vehicle\.track: must be a finite number, got True"):
+        dataclasses.replace(vehicle, track=True)

@@ -74,6 +74,13 @@ class JointLog:
     first_index: int = 0
 
     def __post_init__(self) -> None:
+        for name in ("time", "positions", "heading_world"):  # lists given in Python: the methods need arrays
+            value = getattr(self, name)
+            if value is not None and not isinstance(value, np.ndarray):
+                try:
+                    object.__setattr__(self, name, np.asarray(value, dtype=float))
+                except (TypeError, ValueError):
+                    raise LogError(f"{self.source}: {name}: expected numbers, got {type(value).__name__}") from None
         n = len(self.time)
         if np.ndim(self.time) != 1 or np.shape(self.positions) != (n, len(self.joints)):
             raise LogError(f"{self.source}: expected time (N,) and positions (N, {len(self.joints)}), got "

@@ -10,6 +10,7 @@ Corners are numbered as in Fig. 9.20, relative to the ICR of the arc being drive
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 from ..errors import WmrkitError
@@ -35,8 +36,9 @@ class Vehicle:
     def __post_init__(self) -> None:
         for name in ("a1", "b1", "c1", "h1", "track", "phi_max"):
             value = getattr(self, name)
-            if not (isinstance(value, int | float) and math.isfinite(value)):
+            if isinstance(value, bool) or not (isinstance(value, numbers.Real) and math.isfinite(value)):
                 raise WmrkitError(f"vehicle.{name}: must be a finite number, got {value!r}")
+            object.__setattr__(self, name, float(value))  # numpy scalars (np.int64(3)) were refused
         for name in ("a1", "c1", "h1"):
             if getattr(self, name) <= 0:
                 raise WmrkitError(f"vehicle.{name}: must be > 0, got {getattr(self, name)} m")
@@ -88,8 +90,9 @@ class Space:
     def __post_init__(self) -> None:
         for name in ("H", "J", "MS", "dx2", "final_gap"):
             value = getattr(self, name)
-            if not (isinstance(value, int | float) and math.isfinite(value)):
+            if isinstance(value, bool) or not (isinstance(value, numbers.Real) and math.isfinite(value)):
                 raise WmrkitError(f"space.{name}: must be a finite number, got {value!r}")
+            object.__setattr__(self, name, float(value))
         for name in ("H", "J", "final_gap"):
             if getattr(self, name) <= 0:
                 raise WmrkitError(f"space.{name}: must be > 0, got {getattr(self, name)} m")

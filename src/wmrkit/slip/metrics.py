@@ -20,6 +20,8 @@ def j_model(twist_reference: ArrayLike, twist_model: ArrayLike) -> float:
     ref, mod = np.asarray(twist_reference, dtype=float), np.asarray(twist_model, dtype=float)
     if ref.shape != mod.shape or ref.ndim != 2 or ref.shape[1] != 3:
         raise WmrkitError(f"j_model: expected two (N, 3) twist arrays, got {ref.shape} and {mod.shape}")
+    if not len(ref) or not (np.isfinite(ref).all() and np.isfinite(mod).all()):
+        raise WmrkitError(f"j_model: expected at least one sample, every twist finite, got {len(ref)} samples")
     return float(np.mean(np.abs(ref - mod)))
 
 
@@ -33,6 +35,9 @@ def closure_error(poses: ArrayLike, truth_final: ArrayLike | None = None) -> tup
     p = as_vectors(poses, 3, "poses")
     if p.ndim != 2 or len(p) < 2:
         raise WmrkitError(f"closure_error: poses must be a path of at least 2 poses (N, 3), got shape {p.shape}")
+    if not np.isfinite(p).all():  # it said 'the path neither moves nor turns'
+        raise WmrkitError(f"closure_error: poses must be finite, pose {int(np.argmin(np.isfinite(p).all(axis=1)))} "
+                          "is not")
     goal = p[0] if truth_final is None else as_vectors(truth_final, 3, "truth_final").reshape(3)
     steps = np.diff(p, axis=0)
     distance = float(np.sum(np.hypot(steps[:, 0], steps[:, 1])))
