@@ -119,3 +119,17 @@ def test_small_python_doors_say_what_is_wrong():
     assert dataclasses.replace(vehicle, track=np.int64(1)).track == 1.0
     with pytest.raises(WmrkitError, match=r"vehicle\.track: must be a finite number, got True"):
         dataclasses.replace(vehicle, track=True)
+
+
+def test_batch_shapes_and_chunk_sizes_are_named():
+    """numpy's 'shape mismatch: objects cannot be broadcast' for wheel_commands; a bare TypeError for chunk=2.5."""
+    from wmrkit.batch.engine import BatchError
+    from wmrkit.batch.sweep import sweep
+    from wmrkit.batch.sweep_kernel import parse_vary
+
+    with pytest.raises(ValueError, match=r"twist_robot \(3, 3\) and the steering \(2, 4\): their batch shapes"):
+        wheel_commands(catalog.load("swerve-4"), np.ones((3, 3)), heading=np.zeros((2, 4)))
+    robot = catalog.load("omni-3")
+    axes = [parse_vary("wheels[0].l=0.2:0.3:2", robot)]
+    with pytest.raises(BatchError, match=r"chunk: expected an integer >= 1, got 2\.5"):
+        sweep(robot, axes, chunk=2.5)

@@ -60,8 +60,9 @@ def sweep(robot: Robot, axes: Sequence[Axis], metric: str = "kappa_mean", *, run
     natural length of each design); `configs` steering configurations per design for steered robots."""
     if metric not in METRICS:
         raise BatchError(f"unknown metric '{metric}' (metrics: {', '.join(METRICS)})")
-    if chunk < 1 or top < 1:
-        raise BatchError("chunk and top must be >= 1")
+    for name, value in (("chunk", chunk), ("top", top)):
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+            raise BatchError(f"{name}: expected an integer >= 1, got {value!r}")
     t0 = time.perf_counter()
     axes = tuple(axes)
     spec = build_spec(robot, list(axes), metric, length=length, configs=configs, seed=seed)

@@ -132,7 +132,11 @@ def wheel_commands(
                          f"rad/s; beyond, the wheel rates overflow), got {_first_bad(twist)}")
     beta = robot.steering(beta, heading)
     current = robot.beta if beta is None else beta
-    batch = np.broadcast_shapes(twist.shape[:-1], current.shape[:-1])
+    try:
+        batch = np.broadcast_shapes(twist.shape[:-1], current.shape[:-1])
+    except ValueError:
+        raise ShapeError(f"twist_robot {twist.shape} and the steering {current.shape}: their batch shapes (all but "
+                         "the last axis) do not broadcast") from None
     n = p.n_wheels
     if p.only_steerable:  # swerve-like: the angles are the configuration, the spins the rates
         config, rates, held = _ik_fast.steer_to_twist(p, twist, current, speed_tol)
