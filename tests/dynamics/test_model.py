@@ -200,3 +200,13 @@ def test_contacts_on_one_line_are_refused(keep):
     data["wheels"] = [w for w in data["wheels"] if w["name"] in keep]
     with pytest.raises(WmrkitError, match=rf"contacts of its wheels \({', '.join(keep)}\) lie on one line"):
         DynamicModel.of(Robot.from_dict(data))
+
+
+def test_the_slip_matrix_stays_batched_while_the_other_methods_take_one_state():
+    model = DynamicModel.of(tricycle(0.4))
+    beta = np.array([[0.4], [-0.2]])
+    batch = model.slip_matrix(beta)
+    assert batch.shape == (2, 6, model.n)
+    np.testing.assert_array_equal(batch[1], model.slip_matrix(beta[1]))
+    with pytest.raises(WmrkitError, match=r"^beta: expected shape \(1,\), one state at a time, got \(2, 1\)"):
+        model.mass_matrix(beta)  # a numba TypingError before

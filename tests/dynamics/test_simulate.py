@@ -11,7 +11,7 @@ from dynamics_robots import castor_robot, double_unit_robot, tricycle
 from wmrkit import catalog
 from wmrkit.dynamics.model import DynamicModel
 from wmrkit.dynamics.programs import PATHS, feasible_twists, path_program, read_torques, twist_program
-from wmrkit.dynamics.simulate import Inputs, simulate
+from wmrkit.dynamics.simulate import METHODS, Inputs, simulate
 from wmrkit.dynamics.tyres import Tyre
 from wmrkit.errors import WmrkitError
 
@@ -213,3 +213,12 @@ def test_a_wheel_that_lifts_off_stops_the_run_where_the_load_reaches_zero():
     gentle = twist_program(model, [0.0, 2.0], [(1.0, 0.0, 0.0), (0.0, 0.0, 0.0)])
     sim = simulate(model, gentle, 2.5, initial_twist=(1.0, 0.0, 0.0))
     assert sim.loads.min() > 0.5 * model.normal_loads().min()
+
+
+def test_a_record_step_beyond_the_run_records_its_start_with_every_method(forklift):
+    # the adaptive method raised AttributeError ('list' object has no attribute 'T'): LSODA over (0, 0)
+    inputs = Inputs.torques_only(forklift, [0.0], {})
+    runs = [simulate(forklift, inputs, 1.0, method=method, record_step=5.0) for method in METHODS]
+    for sim in runs:
+        assert sim.t.tolist() == [0.0]
+        np.testing.assert_array_equal(sim.loads, runs[0].loads)

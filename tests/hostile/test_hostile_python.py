@@ -6,6 +6,7 @@ the argument."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -15,6 +16,9 @@ import wmrkit.analysis
 import wmrkit.slip
 from wmrkit import catalog, direct_model, forward_kinematics, inverse_model, mobility, wheel_commands
 from wmrkit.analysis import icr, is_singular, singularity_distance
+from wmrkit.dynamics.model import DynamicModel
+from wmrkit.dynamics.simulate import Inputs, Stepper, advance, simulate
+from wmrkit.dynamics.tyres import Tyre
 from wmrkit.errors import ShapeError, WmrkitError
 
 
@@ -287,3 +291,116 @@ def test_condition_number_refuses_what_is_not_a_finite_matrix(h):
 
     with pytest.raises(WmrkitError, match=r"^condition_number: expected matrices"):
         condition_number(h)
+
+
+def _forklift_model():
+    return DynamicModel.of(catalog.load("forklift"))  # n = 7: vx, vy, omega, two drives, steer.spin, steer.steer
+
+
+def _inputs(**fields):
+    """Inputs of the forklift (K = 2 times), standstill torques, with `fields` replaced."""
+    k, n = len(fields.get("time", (0.0, 1.0))), 7
+    values = {"time": np.array([0.0, 1.0]), "torques": np.zeros((k, n)), "rate_reference": np.zeros((k, n)),
+              "rate_gain": np.zeros(n), "torque_limit": np.full(n, np.inf), "heading_reference": np.zeros((k, 1)),
+              "steer_kp": np.zeros(1), "steer_kd": np.zeros(1)}
+    return Inputs(**{**values, **{key: np.asarray(v, dtype=float) for key, v in fields.items()}})
+
+
+def _simulate(inputs=None, duration=1.0, **options):
+    return simulate(_forklift_model(), _inputs() if inputs is None else inputs, duration, **options)
+
+
+def _body(**fields):
+    return replace(catalog.load("forklift").body, **fields)
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    # inputs of another robot's width (n = 3, one steering joint) made the kernels read out of bounds: numbers that
+    # changed from run to run
+    (lambda: _simulate(_inputs(time=[0.0, 1.0], torques=np.zeros((2, 3)), rate_reference=np.zeros((2, 3)),
+                               rate_gain=np.zeros(3), torque_limit=np.full(3, np.inf))),
+     r"^torques: expected 7 columns for robot 'forklift' \(n = 7 velocities of model.names, n_steer = 1\), got "
+     r"shape \(2, 3\)"),
+    (lambda: _inputs(time=[1.0, 0.0]), r"^time: input times must be at least one, finite and strictly increasing, "
+                                       r"got \[1.0, 0.0\]"),  # ran, holding the inputs of t = 0
+    (lambda: _inputs(time=[]), r"^time: input times must be at least one"),  # numpy's reshape error
+    (lambda: _inputs(rate_gain=[-1.0] * 7), r"^rate_gain: expected finite numbers >= 0, got -1.0"),  # ran
+    (lambda: _inputs(steer_kd=[np.nan]), r"^steer_kd: expected finite numbers >= 0, got nan"),
+    (lambda: _inputs(torque_limit=[np.nan] * 7), r"^torque_limit: expected numbers >= 0 \(inf: no limit\), got nan"),
+    (lambda: _inputs(torques=np.full((2, 7), np.inf)), r"^torques: expected finite numbers, got inf"),
+    (lambda: _inputs(heading_reference=np.zeros((3, 1))), r"^heading_reference: expected shape \(K, n_steer\) "
+                                                          r"with K = 2 rows, one per time, got \(3, 1\)"),
+    (lambda: _inputs(steer_kp=np.zeros(2)), r"^steer_kp: expected shape \(1,\)"),
+    # numpy's 'operands could not be broadcast together'
+    (lambda: Inputs.torques_only(
+        _forklift_model(), [0.0, 1.0], {"right_drive.spin": [1.0, 2.0, 3.0]}),
+     r"^torques\['right_drive.spin'\]: expected one value or 2, one per time, got shape \(3,\)"),
+    # the Python doors did not bound the work as the CLI does: 7 TiB of records, an endless loop, 38 s of LSODA
+    (lambda: _simulate(duration=1e6, step=1e-6), r"^duration 1e\+06 s at step 1e-06 s: more than 5e\+07 integration"),
+    (lambda: _simulate(duration=1e3, method="adaptive", record_step=1e-9),
+     r"^record_step: 1e-09 s over 1000 s is more than 5e\+07 samples"),
+    (lambda: _simulate(method="adaptive", rtol=np.nan), r"^rtol: expected a relative tolerance in \(0, 1\), got nan"),
+    (lambda: _simulate(record_step=-0.1), r"^record_step: expected a finite number > 0"),  # IndexError
+    (lambda: _simulate(record_step=np.nan), r"^record_step: expected a finite number > 0"),  # NaN to integer
+    (lambda: Stepper(_forklift_model()).advance(
+        _inputs(), 1e9), r"^duration must be >= 0 and at most 5e\+07 steps of 0.001 s, got 1000000000.0"),
+    (lambda: advance(
+        _forklift_model(), np.zeros(14), _inputs(), np.inf), r"^duration must be >= 0 and at most 5e\+07 steps"),
+    # impossible loads: a wheel pulled down, negative or NaN loads, LinAlgError
+    (lambda: wmrkit.slip.normal_loads(catalog.load("forklift"), accel_cm=(0.0, 30.0)),
+     r"^normal_loads: contact 'left_drive' lifts off the ground: its load would be -5.016e\+04 N < 0 \(body.com "
+     r"\[-1.45, 0.0\] m, accel_cm \[0.0, 30.0\] m/s\^2\)"),
+    (lambda: wmrkit.slip.normal_loads(catalog.load("forklift"), accel_cm=[(0.0, 0.0), (0.0, -30.0)]),
+     r"^normal_loads: contact 'right_drive' lifts off the ground: its load would be .* sample \(1,\)\)"),
+    (lambda: wmrkit.slip.normal_loads(catalog.load("forklift"), body=_body(com=(10.0, 0.0))),
+     r"^normal_loads: contact 'steer' lifts off the ground: its load would be -1.998e\+05 N"),
+    (lambda: wmrkit.slip.normal_loads(catalog.load("forklift"), body=_body(mass=-5.0)),
+     r"^body.mass: expected a finite number > 0 kg, got -5.0"),
+    (lambda: wmrkit.slip.normal_loads(catalog.load("forklift"), body=_body(mass=np.nan)), r"^body.mass: expected"),
+    (lambda: wmrkit.slip.normal_loads(catalog.load("forklift"), body=_body(com=(np.nan, 0.0))),
+     r"^body.com: expected two lengths within 1000 m, got \(nan, 0.0\)"),
+    (lambda: wmrkit.slip.mqe(catalog.load("forklift"), ["right_drive.spin", "left_drive.spin"], [1.0, 1.0],
+                             wmrkit.slip.tyre_friction(catalog.load("forklift")), body=_body(com_height=-1.0)),
+     r"^body.com_height: expected a length in \[0, 1000\] m"),
+    (lambda: DynamicModel.of(
+        replace(catalog.load("forklift"), body=_body(mass=np.nan))),
+     r"^robot 'forklift': body.mass: expected a finite number > 0 kg, got nan"),  # a model of NaN loads
+    # DynamicModel: zero forces from NaN or negative loads, loads of 0 or NaN, numba typing errors on batches, NaN
+    (lambda: _forklift_model().contact_forces(None, np.ones(7), [np.nan] * 3), r"^loads: expected finite numbers"),
+    (lambda: _forklift_model().contact_forces(None, np.ones(7), [-1000.0] * 3),
+     r"^loads: expected normal loads >= 0 N, got \[-1000.0, -1000.0, -1000.0\]"),
+    (lambda: DynamicModel.of(catalog.load("forklift"),
+                                                                                gravity=-9.8),
+     r"^gravity: expected a finite number > 0 m/s\^2, got -9.8"),
+    (lambda: DynamicModel.of(catalog.load("forklift"),
+                                                                                gravity=np.nan), r"^gravity: "),
+    (lambda: _forklift_model().mass_matrix([[0.1], [0.2]]), r"^beta: expected shape \(1,\), one state at a time"),
+    (lambda: _forklift_model().normal_loads(None, np.ones((2, 7))), r"^nu: expected shape \(7,\), one state at a "),
+    (lambda: _forklift_model().contact_forces(None, np.ones((2, 7))), r"^nu: expected shape \(7,\), one state"),
+    (lambda: _forklift_model().accelerations(None, np.ones((2, 7))), r"^nu: expected shape \(7,\), one state"),
+    (lambda: _forklift_model().accelerations(None, np.ones(7), forces=np.ones((2, 3))),  # read as (3, 2)
+     r"^forces: expected shape \(3, 2\), one state at a time, got \(2, 3\)"),
+    (lambda: _forklift_model().velocity([[1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]), r"^twist: expected shape \(3,\), one "),
+    (lambda: _forklift_model().kinetic_energy(None, [np.nan] * 7), r"^nu: expected finite numbers"),
+    (lambda: _forklift_model().normal_loads(None, [np.nan] * 7), r"^nu: expected finite numbers"),
+    (lambda: _forklift_model().accelerations(None, np.ones(7), [np.nan] * 7), r"^torques: expected finite numbers"),
+    # tyre forces from a load < 0 pushed with the slip; NaN and infinite loads gave NaN, finite or infinite forces
+    (lambda: Tyre.of("coulomb").forces_at_slip(-1000, 0.1, 0.05),
+     r"^fz: expected normal loads in \[0, 1e\+07\] N, got -1000"),
+    (lambda: Tyre.of("pacejka").forces_at_slip(np.nan, 0.1, 0.0),
+     r"^fz: expected normal loads in \[0, 1e\+07\] N, got nan"),
+    (lambda: Tyre.of("dugoff").forces_at_slip(np.inf, 0.1, 0.0),
+     r"^fz: expected normal loads in \[0, 1e\+07\] N, got inf"),
+    (lambda: Tyre.of("pacejka").forces(
+        [1000.0, 1000.0], [0.0, np.nan], 0.0, 1.0, -1.0), r"^v_lat: expected finite velocities \[m/s\], got nan"),
+])
+def test_the_dynamics_doors_refuse_by_name(call, message):
+    """From the audit of the Python dynamics API (simulator inputs and work, normal loads, the model's methods,
+    tyres): out-of-bounds reads, unbounded work, impossible loads and forces, numpy and numba errors."""
+    with pytest.raises(WmrkitError, match=message):
+        call()
+
+
+def test_a_dynamic_model_refuses_a_tyre_that_is_not_one_by_name():
+    with pytest.raises(TypeError, match=r"^tyre: expected a Tyre, a tyre model's name or None, got int"):
+        DynamicModel.of(catalog.load("forklift"), tyre=3)  # type: ignore[arg-type]  # AttributeError before

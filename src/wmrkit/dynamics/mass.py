@@ -18,6 +18,7 @@ The functions here are called from :mod:`wmrkit.description` with its located-er
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -39,6 +40,20 @@ class Body:
     inertia: float  # z-inertia about the centre of mass
     com: tuple[float, float] = (0.0, 0.0)  # centre of mass (x, y) in R
     com_height: float = 0.0  # height of the centre of mass above the ground (load transfer, 7.64)
+
+
+def body_problem(body: Body) -> str:
+    """Why `body` cannot be a robot's mass properties (a phrase for a one-line error naming the field), or ``""``:
+    what a description's ``body`` section allows (:func:`body_from_dict`)."""
+    if not 0 < body.mass < math.inf:  # NaN included
+        return f"body.mass: expected a finite number > 0 kg, got {body.mass}"
+    if not 0 < body.inertia < math.inf:
+        return f"body.inertia: expected a finite number > 0 kg m^2, got {body.inertia}"
+    if len(body.com) != 2 or not all(abs(c) <= MAX_SIZE for c in body.com):
+        return f"body.com: expected two lengths within {MAX_SIZE:g} m, got {tuple(body.com)}"
+    if not 0 <= body.com_height <= MAX_SIZE:
+        return f"body.com_height: expected a length in [0, {MAX_SIZE:g}] m, got {body.com_height}"
+    return ""
 
 
 def body_from_dict(data: Mapping[str, Any], check: Any) -> Body | None:

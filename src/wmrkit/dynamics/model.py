@@ -20,16 +20,17 @@ the wheel centre (7.18)-(7.20), exact (no (7.21) approximation, ``docs/errata.md
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, readonly
-from ..errors import WmrkitError
+from .._shapes import as_angles, readonly
+from ..errors import ShapeError, WmrkitError
 from ..robot import Robot, element_table
-from .mass import CASTOR_TYPES, Body
+from .mass import CASTOR_TYPES, Body, body_problem
 from .tyres import Tyre
 
 GRAVITY = 9.81
@@ -41,7 +42,8 @@ class DynamicModel:
 
     ``names`` (n,): the generalized velocities; ``contacts`` (E,): one name per contact point (``wheel`` or
     ``wheel.1``/``wheel.2`` for double wheels); ``steer_columns`` (n_steer,): column of each steering rate;
-    ``tyres`` (E,): the tyre of each contact; ``gravity`` [m/s^2].
+    ``tyres`` (E,): the tyre of each contact; ``gravity`` [m/s^2]. The methods take one state at a time (finite
+    numbers; only :meth:`slip_matrix` is batched).
     """
 
     robot: Robot
@@ -61,6 +63,10 @@ class DynamicModel:
         """
         if isinstance(tyre, str):
             tyre = Tyre.of(tyre)
+        elif not (tyre is None or isinstance(tyre, Tyre)):
+            raise TypeError(f"tyre: expected a Tyre, a tyre model's name or None, got {type(tyre).__name__}")
+        if not 0 < float(gravity) < math.inf:  # NaN included
+            raise WmrkitError(f"gravity: expected a finite number > 0 m/s^2, got {gravity}")
         return _build(robot, tyre, float(gravity))
 
     @property
@@ -82,14 +88,14 @@ class DynamicModel:
     def velocity(self, twist: ArrayLike, rates: ArrayLike | None = None) -> np.ndarray:
         """A velocity vector ``(n,)`` from a twist and the other velocities (default 0)."""
         nu = np.zeros(self.n)
-        nu[:3] = as_vectors(twist, 3, "twist")
+        nu[:3] = _one(twist, 3, "twist")
         if rates is not None:
-            nu[3:] = as_vectors(rates, self.n - 3, "rates")
+            nu[3:] = _one(rates, self.n - 3, "rates")
         return nu
 
     def slip_matrix(self, beta: ArrayLike | None = None) -> np.ndarray:
-        """``A (2E, n)``: :meth:`Robot.constraint_matrix` (frame Ē), zero columns for steerable steering rates."""
-        a = self.robot.constraint_matrix(self._beta(beta))
+        """``A (..., 2E, n)``: :meth:`Robot.constraint_matrix` (frame Ē), zero columns for steerable steering rates."""
+        a = self.robot.constraint_matrix(beta)  # batched (..., n_steer) as the robot's
         return readonly(np.concatenate([a, np.zeros((*a.shape[:-1], self.n - a.shape[-1]))], axis=-1))
 
     def mass_matrix(self, beta: ArrayLike | None = None) -> np.ndarray:
@@ -102,7 +108,7 @@ class DynamicModel:
 
     def kinetic_energy(self, beta: ArrayLike | None, nu: ArrayLike) -> float:
         """``T = nu' M nu / 2`` [J] (7.17)."""
-        nu = as_vectors(nu, self.n, "nu")
+        nu = _one(nu, self.n, "nu")
         return float(0.5 * nu @ self.mass_matrix(beta) @ nu)
 
     def normal_loads(self, beta: ArrayLike | None = None, nu: ArrayLike | None = None,
@@ -116,8 +122,8 @@ class DynamicModel:
         from ._kernels import normal_loads
 
         out = np.zeros(len(self.contacts))
-        nu = np.zeros(self.n) if nu is None else np.array(as_vectors(nu, self.n, "nu"))
-        acc = np.zeros(self.n) if acceleration is None else np.array(as_vectors(acceleration, self.n, "acceleration"))
+        nu = np.zeros(self.n) if nu is None else _one(nu, self.n, "nu")
+        acc = np.zeros(self.n) if acceleration is None else _one(acceleration, self.n, "acceleration")
         normal_loads(self._beta(beta), nu, acc, self.pack, out)
         return readonly(out)
 
@@ -125,9 +131,14 @@ class DynamicModel:
         """Tyre forces ``(E, 2)`` [N] (lateral, longitudinal; frame Ē) at velocities `nu` (default: static loads)."""
         from ._kernels import contact_forces
 
-        nu = np.array(as_vectors(nu, self.n, "nu"))  # writable copies: one compiled signature
-        loads = self.normal_loads(beta) if loads is None else as_vectors(loads, len(self.contacts), "loads")
+        nu = _one(nu, self.n, "nu")
         e = len(self.contacts)
+        if loads is None:
+            loads = self.normal_loads(beta)
+        else:
+            loads = _one(loads, e, "loads")
+            if not (loads >= 0).all():
+                raise WmrkitError(f"loads: expected normal loads >= 0 N, got {loads.tolist()}")
         f, g, vw = np.zeros((e, 2)), np.zeros((e, 2, 2)), np.zeros(e)
         contact_forces(np.array(self.slip_matrix(beta)), nu, self.pack, np.array(loads, dtype=float),
                        f, g, vw, False)
@@ -135,14 +146,16 @@ class DynamicModel:
 
     def accelerations(self, beta: ArrayLike | None, nu: ArrayLike, torques: ArrayLike | None = None,
                       forces: ArrayLike | None = None) -> np.ndarray:
-        """``d nu / dt`` ``(n,)`` from the equations of motion, for given contact `forces` ``(E, 2)`` (default: the
-        tyres at static loads) and generalized `torques` ``(n,)`` (default 0)."""
+        """``d nu / dt`` ``(n,)`` from the equations of motion, for given contact `forces` ``(E, 2)`` or flat
+        ``(2E,)`` (default: the tyres at static loads) and generalized `torques` ``(n,)`` (default 0)."""
         from ._kernels import bias, mass_matrix
 
         beta = self._beta(beta)
-        nu = np.array(as_vectors(nu, self.n, "nu"))  # writable copies: one compiled signature
+        nu = _one(nu, self.n, "nu")
+        e = len(self.contacts)
         f = self.contact_forces(beta, nu) if forces is None else np.asarray(forces, dtype=float)
-        tau = np.zeros(self.n) if torques is None else as_vectors(torques, self.n, "torques")
+        f = _one(f.reshape(e, 2) if f.shape == (2 * e,) else f, e, "forces", 2)
+        tau = np.zeros(self.n) if torques is None else _one(torques, self.n, "torques")
         m, dm = np.zeros((self.n, self.n)), np.zeros((len(self.steer_columns), self.n, self.n))
         mass_matrix(beta, self.pack, self.n, m, dm)
         b = np.zeros(self.n)
@@ -180,7 +193,20 @@ class DynamicModel:
     def _beta(self, beta: ArrayLike | None) -> np.ndarray:
         if beta is None:
             return np.array(self.robot.beta, dtype=float)
-        return np.array(as_vectors(beta, len(self.steer_columns), "beta"), dtype=float)
+        return _one(as_angles(beta, len(self.steer_columns), "beta"), len(self.steer_columns), "beta")
+
+
+def _one(x: ArrayLike, size: int, name: str, columns: int | None = None) -> np.ndarray:
+    """`x` as a writable float array (one compiled signature) of shape ``(size,)`` (or ``(size, columns)``) with
+    finite entries; :class:`ShapeError` (the model's methods take one state at a time) or :class:`WmrkitError`
+    naming `name` otherwise."""
+    a = np.array(x, dtype=float)
+    shape = (size,) if columns is None else (size, columns)
+    if a.shape != shape:
+        raise ShapeError(f"{name}: expected shape {shape}, one state at a time, got {a.shape}")
+    if not np.isfinite(a).all():
+        raise WmrkitError(f"{name}: expected finite numbers, got {a.tolist()}")
+    return a
 
 
 @functools.lru_cache(maxsize=64)
@@ -189,6 +215,9 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
     if body is None:
         raise WmrkitError(f"robot '{robot.name}' has no mass properties: add a 'body: {{mass, inertia, com, "
                           "com_height}' section to its description (docs/dynamics.md)")
+    problem = body_problem(body)
+    if problem:
+        raise WmrkitError(f"robot '{robot.name}': {problem}")
     t = element_table(robot)
     names = list(robot.velocity_names)
     steer_cols = []
@@ -240,10 +269,7 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
     static = np.zeros(n_el)
     normal_loads(np.array(robot.beta, dtype=float), np.zeros(n), np.zeros(n), pack, static)
     pack = (*pack, (static > 0).astype(float))  # 15: the contacts loaded at rest (lift-off: _integrate.assemble)
-    contacts = []
-    for w in robot.wheels:
-        k = len(w.elements())
-        contacts.extend([w.name] if k == 1 else [f"{w.name}.{j + 1}" for j in range(k)])
+    contacts = contact_names(robot)
     spread = np.linalg.svd(geo, compute_uv=False)
     if len(spread) < 3 or spread[2] <= 1e-9 * spread[0]:  # (7.64) has no solution: a pitch moment would be left
         raise WmrkitError(f"robot '{robot.name}': the contacts of its wheels ({', '.join(contacts)}) lie on one "
@@ -256,6 +282,15 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
                           f"by its wheels: at rest the normal loads (7.64) would pull {', '.join(unloaded)} down "
                           "(negative), so the robot tips over; move body.com inside the wheels' contacts")
     return DynamicModel(robot, tuple(names), tuple(contacts), tuple(steer_cols), tyres_e, gravity, pack)
+
+
+def contact_names(robot: Robot) -> list[str]:
+    """One name per contact point (``wheel``; ``wheel.1``, ``wheel.2`` for the contacts of a double wheel)."""
+    names = []
+    for w in robot.wheels:
+        k = len(w.elements())
+        names.extend([w.name] if k == 1 else [f"{w.name}.{j + 1}" for j in range(k)])
+    return names
 
 
 def _differentials(robot: Robot, names: list[str]) -> tuple[np.ndarray, np.ndarray]:

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
-from ..errors import WmrkitError
+from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
@@ -37,6 +37,8 @@ class Inputs:
     ``tau += gain (reference - rate)``, saturated at ``torque_limit (n,)``; ``heading_reference (K, n_steer)``
     [rad, headings: 0 = rolling straight ahead] with ``steer_kp``, ``steer_kd (n_steer,)``: steering servos,
     saturated smoothly at ``steer_limit (n_steer,)`` [N m] (``limit tanh(pd / limit)``; default and inf: none).
+    Checked when made (shapes that agree, times strictly increasing, finite values, gains and limits >= 0); a
+    simulator checks the widths against its model.
     """
 
     time: np.ndarray
@@ -49,13 +51,20 @@ class Inputs:
     steer_kd: np.ndarray
     steer_limit: np.ndarray | None = None
 
+    def __post_init__(self) -> None:
+        _check_inputs(self)  # once, where the inputs are made; a simulator checks their widths against its model
+
     @classmethod
     def torques_only(cls, model: DynamicModel, time: ArrayLike, torques: dict[str, ArrayLike]) -> Inputs:
         """Pure torque inputs: `torques` maps actuated joints (``wheel.spin``, ``wheel.steer``) to values (K,)."""
         t = _knots(time)
         tau = np.zeros((len(t), model.n))
         for name, values in torques.items():
-            tau[:, joint_column(model, name)] = np.broadcast_to(np.asarray(values, dtype=float), t.shape)
+            column, values = joint_column(model, name), np.asarray(values, dtype=float)
+            if values.shape not in ((), (1,), t.shape):
+                raise ShapeError(f"torques['{name}']: expected one value or {len(t)}, one per time, got shape "
+                                 f"{values.shape}")
+            tau[:, column] = values
         s = len(model.steer_columns)
         return cls(*(readonly(a) for a in (t, tau, np.zeros_like(tau), np.zeros(model.n), np.full(model.n, np.inf),
                                             np.zeros((len(t), s)), np.zeros(s), np.zeros(s))))
@@ -142,7 +151,8 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     The initial velocities roll without slip at `initial_twist` (wheel IK, §8.4) with the steering at its IK
     headings (or as described when the twist is 0). `record_step` [s] (default `step`, at least 1 ms for
     ``"adaptive"``) sets the output sampling; `progress` shows a tqdm bar (default: runs of 500 000 steps or more);
-    `jac_every`: steps between refreshes of the tyre Jacobian of the semi-implicit method (1: every step).
+    `jac_every`: steps between refreshes of the tyre Jacobian of the semi-implicit method (1: every step);
+    `rtol` in (0, 1): the adaptive method's relative tolerance. At most :data:`MAX_STEPS` fixed steps and samples.
 
     A wheel loaded at rest whose normal load falls to 0 lifts off; the planar model cannot follow it (it clips the
     load and keeps the wheel down), so the run stops with a :class:`WmrkitError` naming the contact and the time,
@@ -153,9 +163,17 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
         raise WmrkitError(f"unknown method '{method}' (methods: {', '.join(METHODS)})")
     if not (math.isfinite(duration) and duration > 0 and math.isfinite(step) and 0 < step <= duration):
         raise WmrkitError(f"duration and step must be finite with 0 < step <= duration, got {duration}, {step}")
+    if method != "adaptive" and duration / step > MAX_STEPS:
+        raise WmrkitError(f"duration {duration:g} s at step {step:g} s: more than {MAX_STEPS:.0e} integration steps")
+    if record_step is not None and not 0 < record_step < math.inf:  # NaN included
+        raise WmrkitError(f"record_step: expected a finite number > 0 [s] (None: the step), got {record_step}")
+    record = record_step or (max(step, 1e-3) if method == "adaptive" else step)
+    if duration / record > MAX_STEPS:
+        raise WmrkitError(f"record_step: {record:g} s over {duration:g} s is more than {MAX_STEPS:.0e} samples")
+    if not 0 < rtol < 1:
+        raise WmrkitError(f"rtol: expected a relative tolerance in (0, 1), got {rtol}")
     s0 = initial_state(model, initial_twist, initial_pose)
     inp = _compiled_inputs(model, inputs)
-    record = record_step or (max(step, 1e-3) if method == "adaptive" else step)
     every = max(1, round(record / step))
     if method == "adaptive":
         rec, info = _adaptive(model, s0, inp, duration, record, rtol, allow_lift_off)
@@ -235,17 +253,18 @@ class Stepper:
         return self._k * self.step
 
     def advance(self, inputs: Inputs | None, duration: float) -> np.ndarray:
-        """Integrate ``round(duration / step)`` steps with `inputs` (time axis: the simulation time; None: the
-        last ones); changes :attr:`state` in place and returns it."""
+        """Integrate ``round(duration / step)`` steps (at most :data:`MAX_STEPS`) with `inputs` (time axis: the
+        simulation time; None: the last ones); changes :attr:`state` in place and returns it."""
         from ._integrate import run
 
         if inputs is not None:
             self._inputs = _compiled_inputs(self.model, inputs)
         if self._inputs is None:
             raise WmrkitError("advance: no inputs given yet")
-        n_steps = round(duration / self.step) if math.isfinite(duration) and duration >= 0 else -1
-        if n_steps < 0:
-            raise WmrkitError(f"duration must be finite and >= 0, got {duration}")
+        if not 0 <= duration / self.step <= MAX_STEPS:  # NaN and infinities included
+            raise WmrkitError(f"duration must be >= 0 and at most {MAX_STEPS:.0e} steps of {self.step:g} s, got "
+                              f"{duration}")
+        n_steps = round(duration / self.step)
         run(self.state, self._k, self.step, n_steps, 1 << 62, self._method, self.jac_every, self._acc,
             self.model.pack, self._inputs, self._w, self._rec, 0, self._phase)
         self._k += n_steps
@@ -325,19 +344,54 @@ def initial_state(model: DynamicModel, twist: ArrayLike = (0, 0, 0), pose: Array
 
 
 def _knots(time: ArrayLike) -> np.ndarray:
-    t = np.atleast_1d(np.asarray(time, dtype=float))
-    if t.ndim != 1 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
-        raise WmrkitError("input times must be finite and strictly increasing")
+    t = np.atleast_1d(np.asarray(time, dtype=float))  # strictly increasing with finite ends: finite
+    if t.ndim != 1 or not len(t) or not (math.isfinite(t[0]) and math.isfinite(t[-1]) and (t[1:] > t[:-1]).all()):
+        raise WmrkitError(f"time: input times must be at least one, finite and strictly increasing, got "
+                          f"{t.tolist() if t.size <= 6 else f'shape {t.shape}'}")
     return t
 
 
+#: The fields of :class:`Inputs` after ``time``, in the kernels' order, and the values each one may hold.
+_INPUT_FIELDS = (("torques", "finite numbers"), ("rate_reference", "finite numbers"),
+                 ("rate_gain", "finite numbers >= 0"), ("torque_limit", "numbers >= 0 (inf: no limit)"),
+                 ("heading_reference", "finite numbers"), ("steer_kp", "finite numbers >= 0"),
+                 ("steer_kd", "finite numbers >= 0"))
+
+
+def _check_inputs(inputs: Inputs) -> None:
+    """Raise :class:`WmrkitError` naming the field of `inputs` whose shape does not agree with the others (K times,
+    n velocities, n_steer steering joints) or whose values make no sense (times not strictly increasing, values not
+    finite, gains or limits below 0); the model's sizes are checked by :func:`_compiled_inputs`."""
+    k = len(_knots(inputs.time))
+    arrays = [np.asarray(getattr(inputs, name), dtype=float) for name, _ in _INPUT_FIELDS]
+    for j, size in ((0, "n"), (4, "n_steer")):
+        if arrays[j].ndim != 2 or len(arrays[j]) != k:
+            raise ShapeError(f"{_INPUT_FIELDS[j][0]}: expected shape (K, {size}) with K = {k} rows, one per time, "
+                             f"got {arrays[j].shape}")
+    n, s = arrays[0].shape[1], arrays[4].shape[1]
+    for (name, want), a, shape in zip(_INPUT_FIELDS, arrays, ((k, n), (k, n), (n,), (n,), (k, s), (s,), (s,)),
+                                      strict=True):
+        if a.shape != shape:
+            raise ShapeError(f"{name}: expected shape {shape} ({n} velocities as torques, {s} steering joints as "
+                             f"heading_reference), got {a.shape}")
+        bad = ~(a >= 0) if name == "torque_limit" else ~np.isfinite(a) | (a < 0 if ">=" in want else False)
+        if bad.any():
+            raise WmrkitError(f"{name}: expected {want}, got {float(a[bad].flat[0])!r}")
+
+
 def _compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
-    beta_ref = np.asarray(model.robot.beta_of_heading(inputs.heading_reference), dtype=float) \
-        if len(model.steer_columns) else np.zeros((len(inputs.time), 0))
-    return tuple(np.array(a, dtype=float, order="C") for a in (  # writable copies: one compiled signature
-        inputs.time, inputs.torques, inputs.rate_reference, inputs.rate_gain, inputs.torque_limit,
-        beta_ref.reshape(len(inputs.time), -1), inputs.steer_kp, inputs.steer_kd,
-        _steer_limits(model, inputs.steer_limit)))
+    """The kernels' inputs (writable C copies: one compiled signature); :class:`ShapeError` naming the field of
+    `inputs` whose width does not fit `model` (the kernels would read out of bounds)."""
+    arrays = [np.array(getattr(inputs, name), dtype=float, order="C") for name, _ in _INPUT_FIELDS]
+    n, s = model.n, len(model.steer_columns)
+    for (name, _), a, width in zip(_INPUT_FIELDS, arrays, (n, n, n, n, s, s, s), strict=True):
+        if a.shape[-1] != width:
+            raise ShapeError(f"{name}: expected {width} columns for robot '{model.robot.name}' (n = {n} velocities "
+                             f"of model.names, n_steer = {s}), got shape {a.shape}")
+    tau, rref, gain, limit, href, kp, kd = arrays
+    beta_ref = np.array(model.robot.beta_of_heading(href), dtype=float, order="C") if s else href
+    return (np.array(np.atleast_1d(inputs.time), dtype=float), tau, rref, gain, limit, beta_ref, kp, kd,
+            _steer_limits(model, inputs.steer_limit))
 
 
 def _steer_limits(model: DynamicModel, limit: ArrayLike | None) -> np.ndarray:
@@ -396,21 +450,24 @@ def _adaptive(model, s0, inp, duration, record, rtol, allow_lift_off):
     w = work_arrays(model.n, len(model.contacts), len(model.steer_columns))
     acc = np.zeros(model.n)
     t_eval = np.arange(0.0, duration + record / 2, record)
-    try:
-        sol = solve_ivp(lambda t, s: derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w),
-                        (0.0, t_eval[-1]), s0, method="LSODA", t_eval=t_eval, rtol=rtol, atol=rtol * 1e-3)
-    except ZeroDivisionError:  # the compiled kernels raise it where the state has overflowed
-        raise WmrkitError("the adaptive integration diverged (the state overflowed)") from None
-    if not sol.success:
-        raise WmrkitError(f"the adaptive integration failed: {sol.message}")
-    rec = _records(model, len(sol.t))
+    ts, ys, evaluations = t_eval, s0[:, None], 0  # one sample (record > 2 duration): t = 0, as the fixed steps
+    if len(t_eval) > 1:
+        try:
+            sol = solve_ivp(lambda t, s: derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w),
+                            (0.0, t_eval[-1]), s0, method="LSODA", t_eval=t_eval, rtol=rtol, atol=rtol * 1e-3)
+        except ZeroDivisionError:  # the compiled kernels raise it where the state has overflowed
+            raise WmrkitError("the adaptive integration diverged (the state overflowed)") from None
+        if not sol.success:
+            raise WmrkitError(f"the adaptive integration failed: {sol.message}")
+        ts, ys, evaluations = sol.t, sol.y, int(sol.nfev)
+    rec = _records(model, len(ts))
     w[16][:] = 0.0  # lift-off judged on the accepted states only (not on the solver's trial evaluations)
-    for i, (t, s) in enumerate(zip(sol.t, sol.y.T, strict=True)):
+    for i, (t, s) in enumerate(zip(ts, ys.T, strict=True)):
         derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w)
         observe(t, np.ascontiguousarray(s), acc, model.pack, inp, w, rec, i)
     if not allow_lift_off:
         check_lift_off(model, w)
-    return rec, {"evaluations": int(sol.nfev)}
+    return rec, {"evaluations": evaluations}
 
 
 def _result(model: DynamicModel, rec: tuple, method: str, step: float, info: dict) -> Simulation:

@@ -280,7 +280,20 @@ class Tyre:
 
     def forces(self, fz: ArrayLike, v_lat: ArrayLike, v_long: ArrayLike, v_wheel: ArrayLike,
                v_roll: ArrayLike) -> TyreForces:
-        """Contact forces from slip velocities [m/s] and the normal load `fz` [N]; all broadcast."""
+        """Contact forces from slip velocities [m/s] (finite) and the normal load `fz` [N] (in ``[0, MAX_LOAD]``);
+        all broadcast."""
+        fz, *slips = (np.asarray(a, dtype=float) for a in (fz, v_lat, v_long, v_wheel, v_roll))
+        bad = ~((fz >= 0) & (fz <= MAX_LOAD))  # NaN included
+        if bad.any():
+            raise WmrkitError(f"fz: expected normal loads in [0, {MAX_LOAD:g}] N, got {fz[bad].flat[0]:g}")
+        for name, v in zip(("v_lat", "v_long", "v_wheel", "v_roll"), slips, strict=True):
+            if not np.isfinite(v).all():
+                raise WmrkitError(f"{name}: expected finite velocities [m/s], got {v[~np.isfinite(v)].flat[0]:g}")
+        return self._forces(fz, *slips)
+
+    def _forces(self, fz: ArrayLike, v_lat: ArrayLike, v_long: ArrayLike, v_wheel: ArrayLike,
+                v_roll: ArrayLike) -> TyreForces:
+        """:meth:`forces` without the checks of its arguments (the slip models' inner loops)."""
         p = self.vector()
         args = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (fz, v_lat, v_long, v_wheel, v_roll)))
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # callers check the forces are finite

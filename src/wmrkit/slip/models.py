@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..dynamics.mass import Body
+from ..dynamics.mass import Body, body_problem
 from ..errors import WmrkitError
 from ..kinematics.linalg import solve_assigned
 from ..limits import MAX_QUERY_RATE
@@ -71,7 +71,7 @@ class TyreFriction:
         out = np.empty(np.broadcast_shapes(v_slip.shape, v_body.shape))
         for tyre, ix in self.groups:  # the contacts of one tyre model in one vectorised call
             v_wheel, v_long = v_body[..., ix, 1], v_slip[..., ix, 1]
-            f = tyre.forces(loads[..., ix], v_slip[..., ix, 0], v_long, v_wheel, v_long - v_wheel)
+            f = tyre._forces(loads[..., ix], v_slip[..., ix, 0], v_long, v_wheel, v_long - v_wheel)  # unchecked
             out[..., ix, 0], out[..., ix, 1] = f.lateral, f.longitudinal
         return out
 
@@ -196,7 +196,17 @@ def normal_loads(robot: Robot, body: Body | None = None, accel_cm: ArrayLike = (
     h = body.com_height
     rhs = np.stack(np.broadcast_arrays(np.full(a.shape[:-1], body.mass * g), -h * body.mass * a[..., 0],
                                        -h * body.mass * a[..., 1]), axis=-1)
-    return (_load_map(robot, body, beta) @ rhs[..., None])[..., 0]
+    loads = (_load_map(robot, body, beta) @ rhs[..., None])[..., 0]
+    lifted = loads < -1e-9 * body.mass * g  # below 0 beyond round-off
+    if lifted.any():
+        from ..dynamics.model import contact_names
+
+        at = np.unravel_index(int(np.argmax(lifted)), loads.shape)
+        where = f"accel_cm {a.tolist()} m/s^2" if loads.ndim == 1 else f"sample {tuple(int(i) for i in at[:-1])}"
+        raise WmrkitError(f"normal_loads: contact '{contact_names(robot)[at[-1]]}' lifts off the ground: its load "
+                          f"would be {loads[at]:.4g} N < 0 (body.com {list(body.com)} m, {where}); (7.64) holds only "
+                          "while every wheel is on the ground")
+    return loads
 
 
 def _load_map(robot: Robot, body: Body, beta: ArrayLike | None) -> np.ndarray:
@@ -210,6 +220,9 @@ def _body(robot: Robot, body: Body | None) -> Body:
     body = robot.body if body is None else body
     if body is None:
         raise WmrkitError(f"robot '{robot.name}' has no mass properties ('body:' in its description)")
+    problem = body_problem(body)
+    if problem:
+        raise WmrkitError(problem)
     return body
 
 
