@@ -138,6 +138,8 @@ class Wheel:
         if kind is None:
             raise WheelError(f"wheel '{self.name}': unknown type {self.type!r} (types: {', '.join(KINDS)})")
         values = {key: getattr(self, key) for key in ("l", "alpha", *kind.required, *kind.optional)}
+        if any(hasattr(v, "free_symbols") for v in values.values()):
+            return  # symbolic parameters (SymPy, wmrkit.kinematics.symbolic): no numbers to check
         for key, value in values.items():
             try:
                 finite = math.isfinite(value)

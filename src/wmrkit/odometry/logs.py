@@ -75,12 +75,8 @@ class JointLog:
 
     def __post_init__(self) -> None:
         for name in ("time", "positions", "heading_world"):  # lists given in Python: the methods need arrays
-            value = getattr(self, name)
-            if value is not None and not isinstance(value, np.ndarray):
-                try:
-                    object.__setattr__(self, name, np.asarray(value, dtype=float))
-                except (TypeError, ValueError):
-                    raise LogError(f"{self.source}: {name}: expected numbers, got {type(value).__name__}") from None
+            if (value := getattr(self, name)) is not None and not isinstance(value, np.ndarray):
+                object.__setattr__(self, name, np.asarray(value, dtype=float))
         n = len(self.time)
         if np.ndim(self.time) != 1 or np.shape(self.positions) != (n, len(self.joints)):
             raise LogError(f"{self.source}: expected time (N,) and positions (N, {len(self.joints)}), got "
