@@ -84,3 +84,55 @@ def test_best_configurations_of_a_type3_robot_are_local_minima():
                 b = beta.copy()
                 b[j] += step
                 assert natural_length(r, b)[1] >= k0 - 1e-9
+
+
+def _castor_ring(n: int):
+    """One driven steerable wheel and `n` driven castors on a ring: m = 2 with n + 1 steering variables."""
+    from wmrkit.description import robot_from_dict
+
+    wheels = [{"name": "s", "type": "steerable", "position": [0.3, 0.0], "beta": math.pi / 2, "r": 0.05,
+               "actuated": ["spin", "steer"]}]
+    for i in range(n):
+        a = 2 * math.pi * (i + 0.5) / n
+        wheels.append({"name": f"c{i}", "type": "castor", "position": [0.3 * math.cos(a), 0.3 * math.sin(a)],
+                       "beta": 0.1 * i, "d": 0.04, "r": 0.03, "actuated": "spin"})
+    return robot_from_dict({"name": "ring", "wheels": wheels})
+
+
+def test_best_configurations_grid_is_bounded(monkeypatch):
+    """9 steering variables: 4 points per axis would be 262144 > max_samples, so a seeded sample of max_samples
+    configurations replaces the grid (the grid took 12 s at 9 variables, 860 MB at 11, 32 TiB at 21)."""
+    from wmrkit.analysis import optimize
+
+    real, sizes = optimize._grid_kappa, []
+
+    def spy(model, beta, length):
+        sizes.append(int(np.prod(beta.shape[:-1])))
+        assert sizes[-1] <= 2000, f"{sizes[-1]} configurations evaluated at once"
+        return real(model, beta, length)
+
+    monkeypatch.setattr(optimize, "_grid_kappa", spy)
+    r = _castor_ring(8)
+    found = best_configurations(r, max_samples=2000, count=2, length=0.3)
+    assert sizes == [2000] and 1 <= len(found) <= 2
+    assert all(np.isfinite(c.condition_number) and c.condition_number >= 1 for c in found)
+    assert found == best_configurations(r, max_samples=2000, count=2, length=0.3)  # seeded: reproducible
+
+
+def test_best_configurations_beyond_numpy_axes(monkeypatch):
+    """40 steering variables: no 40-axis grid (numpy allows 32: a 500 RuntimeError in the studio before)."""
+    from scipy.optimize import OptimizeResult
+
+    from wmrkit.analysis import optimize
+
+    monkeypatch.setattr(optimize, "minimize", lambda f, x0, **kw: OptimizeResult(x=np.asarray(x0)))  # fast
+    found = best_configurations(_castor_ring(39), max_samples=500, count=1, length=0.3)
+    assert len(found) == 1 and len(found[0].beta) == 40
+
+
+@pytest.mark.parametrize("bad", [{"max_samples": 0}, {"resolution": 2.5}, {"count": True}])
+def test_best_configurations_bad_limits(bad):
+    from wmrkit import WmrkitError
+
+    with pytest.raises(WmrkitError, match=next(iter(bad))):
+        best_configurations(catalog.load("thesis-steer-castor"), **bad)

@@ -263,6 +263,38 @@ def test_configurations(client):
     assert all(c["condition_number"] == pytest.approx(1.0) for c in diff["isotropic"])
 
 
+def castor_ring(n: int) -> dict:
+    """m = 2: one driven steerable wheel and `n` castors, every castor a steering variable of the search."""
+    wheels = [{"name": "s", "type": "steerable", "position": [0.3, 0], "heading": 0, "r": 0.05,
+               "actuated": ["spin", "steer"], "sensed": ["spin", "steer"]}]
+    for i in range(n):
+        a = 2 * math.pi * (i + 0.5) / n
+        wheels.append({"name": f"c{i}", "type": "castor", "position": [0.3 * math.cos(a), 0.3 * math.sin(a)],
+                       "heading": 0.1 * i, "d": 0.04, "r": 0.03, "actuated": ["spin"], "sensed": ["spin", "steer"]})
+    return {"name": "ring", "wheels": wheels}
+
+
+@pytest.mark.parametrize("n", [5, 40])
+def test_configurations_bounded_for_many_steering_wheels(client, n):
+    """m = 2 with many castors: the isotropic search is skipped with a note (it took 36 s and 860 MB at 10
+    castors, 500 MemoryError at 20, 500 RuntimeError 'up to 32 dimensions' at 60)."""
+    import time
+
+    from wmrkit.studio.api import MAX_ISOTROPIC_STEERING
+
+    t0 = time.perf_counter()
+    r = client.post("/api/configurations", json={"description": castor_ring(n)})
+    assert r.status_code == 200, r.json()
+    data = r.json()
+    assert data["isotropic_searched"] is False and data["isotropic"] == []
+    assert f"{n + 1} steering wheels" in data["isotropic_note"] and str(MAX_ISOTROPIC_STEERING) in data[
+        "isotropic_note"]
+    assert data["singular"]["actuated"]["variables"]  # the singular sets are still given
+    assert time.perf_counter() - t0 < 30
+    few = client.post("/api/configurations", json={"description": castor_ring(MAX_ISOTROPIC_STEERING - 1)}).json()
+    assert few["isotropic_searched"] is True and few["isotropic_note"] is None
+
+
 # ---- files ----------------------------------------------------------------------------------------------------
 def test_meta_and_catalog(client):
     meta = client.get("/api/meta").json()

@@ -41,9 +41,15 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
 
     kappa is :func:`~wmrkit.analysis.isotropy.twist_condition_number` for `joints`, at `length` or at each
     configuration's natural length. A grid (`resolution` per turn, at most `max_samples` points) finds the
-    basins; the best `count` are refined to machine precision. `variables` default to the steering wheels that
-    change kappa (those with an axle constraint or among the joints).
+    basins; the best `count` are refined to machine precision (Nelder-Mead, at most 200 evaluations per variable
+    and start). When even 4 points per axis would exceed `max_samples` (many steering variables), a seeded
+    random sample of `max_samples` configurations replaces the grid and its best `count` points start the
+    refinement: memory and time stay bounded (the sample may miss narrow basins). `variables` default to the
+    steering wheels that change kappa (those with an axle constraint or among the joints).
     """
+    for value, what in ((resolution, "resolution"), (max_samples, "max_samples"), (count, "count")):
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+            raise WmrkitError(f"{what} must be an integer >= 1, got {value!r}")
     model = twist_model(robot, joints)
     steer = robot.steer_names
     if variables is None:
@@ -66,20 +72,27 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
     if not idx:
         d, k = natural_length(robot, joints=model.joints) if length is None else (length, score(np.zeros(0)))
         return (Conditioning(tuple(robot.beta.tolist()), d, k),)
-    per_axis = resolution if len(idx) == 1 else max(4, min(resolution, int(max_samples ** (1 / len(idx)))))
-    axis = np.linspace(-np.pi, np.pi, per_axis, endpoint=False)
-    mesh = np.stack(np.meshgrid(*([axis] * len(idx)), indexing="ij"), axis=-1)  # (n, ..., n, v)
-    values = _grid_kappa(model, full(mesh), length)
-    finite = np.where(np.isfinite(values), values, np.inf)
-    is_min = np.ones(values.shape, bool)
-    for ax in range(len(idx)):
-        is_min &= (finite <= np.roll(finite, 1, ax)) & (finite <= np.roll(finite, -1, ax))
-    starts = np.argwhere(is_min & np.isfinite(values))
-    starts = starts[np.argsort(finite[tuple(starts.T)])][:count]
-    step = 2 * np.pi / per_axis
+    per_axis = min(resolution, _grid_points(max_samples, len(idx)))
+    if len(idx) == 1:
+        per_axis = resolution
+    step = 2 * np.pi / max(per_axis, 4)
+    if per_axis >= 4:
+        axis = np.linspace(-np.pi, np.pi, per_axis, endpoint=False)
+        mesh = np.stack(np.meshgrid(*([axis] * len(idx)), indexing="ij"), axis=-1)  # (n, ..., n, v)
+        values = _grid_kappa(model, full(mesh), length)
+        finite = np.where(np.isfinite(values), values, np.inf)
+        is_min = np.ones(values.shape, bool)
+        for ax in range(len(idx)):
+            is_min &= (finite <= np.roll(finite, 1, ax)) & (finite <= np.roll(finite, -1, ax))
+        starts = np.argwhere(is_min & np.isfinite(values))
+        x0s = axis[starts[np.argsort(finite[tuple(starts.T)])][:count]]
+    else:  # too many variables for a grid (4 per axis > max_samples; numpy has 32 axes at most): a seeded sample
+        sample = np.random.default_rng(0).uniform(-np.pi, np.pi, (max_samples, len(idx)))
+        values = _grid_kappa(model, full(sample), length)
+        order = np.argsort(np.where(np.isfinite(values), values, np.inf))
+        x0s = sample[order[np.isfinite(values[order])][:count]]
     found: list[tuple[np.ndarray, float]] = []
-    for s in starts:
-        x0 = axis[s]
+    for x0 in x0s:
         if len(idx) == 1:
             x = np.array([golden_section(lambda t: score(np.array([t])), x0[0] - step, x0[0] + step)])
         else:
@@ -95,11 +108,25 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
     return tuple(out)
 
 
+def _grid_points(max_samples: int, n: int) -> int:
+    """The largest k with k ** n <= max_samples (exact integer arithmetic; float roots round either way)."""
+    k = max(1, round(max_samples ** (1 / n)))
+    while k ** n > max_samples:
+        k -= 1
+    while (k + 1) ** n <= max_samples:
+        k += 1
+    return k
+
+
 def isotropic_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None,
                              variables: tuple[str, ...] | None = None, resolution: int = 72,
-                             tol: float = 1e-6) -> tuple[Conditioning, ...]:
-    """Configurations where the model is isotropic, kappa = 1 at its natural length (5.29); may be empty."""
-    best = best_configurations(robot, joints=joints, variables=variables, resolution=resolution, count=16)
+                             max_samples: int = 20000, tol: float = 1e-6) -> tuple[Conditioning, ...]:
+    """Configurations where the model is isotropic, kappa = 1 at its natural length (5.29); may be empty.
+
+    The search of :func:`best_configurations` (16 starts; grid or seeded sample of at most `max_samples`).
+    """
+    best = best_configurations(robot, joints=joints, variables=variables, resolution=resolution,
+                               max_samples=max_samples, count=16)
     return tuple(c for c in best if c.condition_number < 1 + tol)
 
 

@@ -46,6 +46,9 @@ from ..wheels import KINDS, beta_from_heading, heading_from_beta
 NEAR_SINGULAR = 0.05
 #: Largest κ-map grid per axis and largest trajectory sample count a request may ask for.
 MAX_RESOLUTION = 181
+#: Most steering wheels for which /api/configurations searches the isotropic configurations (about 2 s at 4 on
+#: the 2-core machine; the search grows with every steering angle): beyond, not searched, with a note.
+MAX_ISOTROPIC_STEERING = 4
 SOURCE = "studio"
 #: The description format reads ``heading:`` itself (else :func:`headings_to_beta` converts it).
 NATIVE_HEADING = "heading" in COMMON_WHEEL_FIELDS
@@ -196,10 +199,24 @@ def configurations(request: Any) -> dict[str, Any]:
                                 "never": s.never, "exact": s.exact, "count": len(s.configurations),
                                 "headings": headings, "reasons": list(s.reasons), "text": describe_singular(s)}
     # The library's search refines each grid minimum at its own natural length: quick for m = 2 or one steering
-    # angle, but tens of seconds for m = 3 with several (a 1-D length search inside Nelder-Mead): not searched.
-    searched = bool(robot.steer_names) and cls.mobility > 1 and (cls.mobility == 2 or len(robot.steer_names) == 1)
+    # angle, but tens of seconds for m = 3 with several (a 1-D length search inside Nelder-Mead), and growing
+    # with every steering angle for m = 2: not searched then, with a note saying why.
+    n_steer = len(robot.steer_names)
+    if not n_steer:
+        note = "the robot does not steer: its condition number is the one above"
+    elif cls.mobility <= 1:
+        note = f"m = {cls.mobility}: no two motions to balance"
+    elif cls.mobility != 2 and n_steer > 1:
+        note = f"not searched for m = {cls.mobility} with {n_steer} steering wheels (see the κ map)"
+    elif n_steer > MAX_ISOTROPIC_STEERING:
+        note = (f"not searched: {n_steer} steering wheels, the studio searches up to {MAX_ISOTROPIC_STEERING} "
+                "(see the κ map; wmrkit.analysis.isotropic_configurations searches any number)")
+    else:
+        note = None
+    searched = note is None
     iso = isotropic_configurations(robot) if searched else ()
     out["isotropic_searched"] = searched
+    out["isotropic_note"] = note
     out["isotropic"] = [{"heading": _headings(robot, c.beta), "length": c.length,
                          "condition_number": c.condition_number} for c in iso]
     return out

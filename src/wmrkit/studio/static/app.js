@@ -430,7 +430,7 @@ function renderAnalysis() {
   if (c) {
     setCell("a-singular", Object.entries(c.singular).map(([k, s]) => `${k}: ${esc(s.text.replace(/-?\d+\.\d+/g, (m) => m))}` +
       (s.headings.length ? `<br><span class="hint">headings ${s.headings.slice(0, 4).map((h) => "(" + h.map((v) => fmt(deg(v), 4)).join(", ") + ")").join(" ")} deg</span>` : "")).join("<br>"), c.singular);
-    setCell("a-isotropic", !c.isotropic_searched ? '<span class="hint">not searched (see the κ map)</span>'
+    setCell("a-isotropic", !c.isotropic_searched ? `<span class="hint">${esc(c.isotropic_note || "not searched (see the κ map)")}</span>`
       : c.isotropic.length ? c.isotropic.slice(0, 4).map((i) => "(" + i.heading.map((v) => fmt(deg(v), 4)).join(", ") + ") deg").join(", ")
         : "none", c.isotropic);
   }
