@@ -42,7 +42,7 @@ wheels:
     r_r: 0.01
 """
 TYPES = ", ".join((*KINDS, "mecanum"))
-LENGTHS = "m, mm, cm, dm, km, in, ft"
+LENGTHS = "m, mm, cm, dm, km, um, \u00b5m, in, ft"
 
 # (find, replace with, expected 1-based line, expected message after "file:line: "); BASE's lines counted by hand
 BAD = {

@@ -64,7 +64,7 @@ def test_angles_within_a_turn_or_with_a_unit_are_read(value):
     ("90 mm", "angle", "'90 mm' is a length, expected an angle"),
     ("5 deg", "length", "'5 deg' is an angle, expected a length"),
     ("1 m", "number", "'1 m' is a length, expected a number"),
-    ("3 furlong", "length", "unknown unit 'furlong' in '3 furlong' (accepted: m, mm, cm, dm, km, in, ft)"),
+    ("3 furlong", "length", "unknown unit 'furlong' in '3 furlong' (accepted: m, mm, cm, dm, km, um, \u00b5m, in, ft)"),
     ("3 x", "number", "unknown unit 'x' in '3 x' (accepted: none (a plain number))"),
     ("pi/2", "angle", "cannot read 'pi/2' as an angle (write e.g. '1.57' or '90 deg')"),
     ("90 deg deg", "angle", "cannot read '90 deg deg' as an angle (write e.g. '1.57' or '90 deg')"),
@@ -96,3 +96,9 @@ def test_anything_else_is_a_unit_error_or_a_finite_float(value, kind):
         assert len(str(err).splitlines()) <= 1
     else:
         assert isinstance(out, float) and math.isfinite(out)
+
+
+@pytest.mark.parametrize("text", ["5 um", "5um", "5 \u00b5m", "5 \u03bcm"])
+def test_micrometres_are_read(text):
+    """The envelope's message says '1 um to 1 km': 'um' (and the micro sign, either code point) is a unit."""
+    assert parse_quantity(text, "length") == pytest.approx(5e-6, rel=1e-12)

@@ -76,7 +76,8 @@ def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None
             check.fail(f"duplicate wheel name '{wheel.name}'", ("wheels", i, "name"))
         names.add(wheel.name)
         wheels.append(wheel)
-    _check_envelope(wheels, check)
+    _check_envelope(wheels, check, {i for i, item in enumerate(wheels_data) if isinstance(item, Mapping)
+                                    and "position" in item})
     couplings = _couplings_from_dict(data.get("couplings", []), wheels, check)
     odometry = None
     if "odometry" in data or any(isinstance(w, Mapping) and "slip" in w for w in wheels_data):

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import os
 import re
+from collections.abc import Collection
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -100,10 +101,23 @@ def _check_text_fields(name: str, notes: str, check: Any) -> None:
                        f"{char!a}", (key,))
 
 
-def _check_envelope(wheels: list[Wheel], check: Any) -> None:
+def _check_envelope(wheels: list[Wheel], check: Any, positioned: Collection[int] = ()) -> None:
     """The physical envelope wmrkit's numbers are valid in (docs/limits.md): the robot's size (its largest length)
     from 1 um to 1 km, radii and offsets not below MIN_RATIO of it (rank decisions are made relative to the size),
-    Swedish rollers and castor axles at least ANGLE_MARGIN away from the angles where the wheel degenerates."""
+    Swedish rollers and castor axles at least ANGLE_MARGIN away from the angles where the wheel degenerates.
+
+    `positioned`: indices of the wheels described by ``position: [x, y]`` rather than ``l``/``alpha``; a distance
+    out of range is then reported at the coordinate the user gave (``position[0]`` or ``position[1]``)."""
+
+    def where(i: int, key: str) -> tuple:
+        if key != "l" or i not in positioned:
+            return ("wheels", i, key)
+        x, y = wheels[i].position
+        return ("wheels", i, "position", int(abs(y) > abs(x)))
+
+    def what(size: float, i: int, key: str) -> str:
+        return f"{size:g} m" if key != "l" or i not in positioned else f"{size:g} m from the robot's origin"
+
     lengths = []
     for i, w in enumerate(wheels):
         if len(w.name) > MAX_NAME:
@@ -112,11 +126,11 @@ def _check_envelope(wheels: list[Wheel], check: Any) -> None:
         lengths += [(abs(getattr(w, k)), i, k) for k in given]
     size, i, key = max(lengths)
     if not size <= MAX_SIZE:
-        check.fail(f"{size:g} m: longer than {MAX_SIZE:g} m, outside the lengths wmrkit handles (1 um to 1 km)",
-                   ("wheels", i, key))
+        check.fail(f"{what(size, i, key)}: longer than {MAX_SIZE:g} m, outside the lengths wmrkit handles "
+                   "(1 um to 1 km)", where(i, key))
     if size < MIN_SIZE:
         check.fail(f"the robot's size ({size:g} m, its largest length) is below {MIN_SIZE:g} m (1 um)",
-                   ("wheels", i, key))
+                   where(i, key))
     for value, i, key in lengths:
         if key != "l" and value < MIN_RATIO * size:
             check.fail(f"{value:g} m is less than {MIN_RATIO:g} of the robot's size ({size:g} m, its largest "

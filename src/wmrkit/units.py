@@ -14,7 +14,8 @@ Kind = Literal["length", "angle", "number"]
 
 #: Factor to SI for every unit accepted, by kind.
 UNITS: dict[str, dict[str, float]] = {
-    "length": {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "dm": 0.1, "km": 1e3, "in": 0.0254, "ft": 0.3048},
+    "length": {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "dm": 0.1, "km": 1e3, "um": 1e-6, "\u00b5m": 1e-6, "in": 0.0254,
+               "ft": 0.3048},
     "angle": {"rad": 1.0, "mrad": 1e-3, "deg": math.pi / 180, "°": math.pi / 180, "turn": 2 * math.pi},
     "number": {},
 }
@@ -79,6 +80,7 @@ def _plain(number: float) -> str:
 def _factor(unit: str, kind: Kind, text: str) -> float:
     if not unit:
         return 1.0
+    unit = unit.replace("\u03bc", "\u00b5")  # Greek mu (μm) as the micro sign (µm)
     if unit in UNITS[kind]:
         return UNITS[kind][unit]
     for other, table in UNITS.items():

@@ -114,6 +114,27 @@ def test_invalid_field_has_cli_message(client, edit, field):
         assert body["message"] == err.value.message and body["error"] == str(err.value)
 
 
+@pytest.mark.parametrize(("index", "value"), [(1, "2 km"), (0, "-2 km")])
+def test_position_out_of_range_names_the_coordinate(client, index, value):
+    """y = '2 km' was reported as 'wheels[0].l: 2000 m' (the page marked x): the coordinate typed is named."""
+    d = desc("diff-drive")
+    w = d["wheels"][0]
+    del w["l"], w["alpha"]
+    w["position"] = [0.0, 0.2]
+    w["position"][index] = value
+    body = client.post("/api/analyze", json={"description": d}).json()
+    assert body["field"] == f"wheels[0].position[{index}]"
+    assert "from the robot's origin: longer than 1000 m" in body["message"]
+
+
+def test_l_out_of_range_keeps_the_cli_message():
+    d = {"name": "x", "wheels": [{"name": "a", "type": "fixed", "l": "2 km", "alpha": 0, "beta": 0, "r": 0.1}]}
+    with pytest.raises(DescriptionError) as err:
+        robot_from_dict(d)
+    assert err.value.loc == ("wheels", 0, "l")
+    assert err.value.message == "2000 m: longer than 1000 m, outside the lengths wmrkit handles (1 um to 1 km)"
+
+
 @pytest.mark.parametrize("body", [
     [1, 2], {"description": 3}, {"nothing": 1}, {"description": {"name": "x", "wheels": []}},
     {"description": {"name": "x", "wheels": [{"name": "a"}]}},
@@ -261,6 +282,19 @@ def test_configurations(client):
     diff = client.post("/api/configurations", json={"description": desc("diff-drive")}).json()
     assert diff["isotropic_searched"] and diff["isotropic"]
     assert all(c["condition_number"] == pytest.approx(1.0) for c in diff["isotropic"])
+
+
+def test_singular_text_in_headings(client):
+    """The page shows headings like the CLI ('at beta front = -180.00, 0.00 deg' before: the thesis's beta)."""
+    from wmrkit.analysis.classification import classify
+    from wmrkit.analysis.summary import describe_singular, model_rates, model_singular_set
+
+    robot = catalog.load("bicycle")
+    data = client.post("/api/configurations", json={"description": robot.to_dict()}).json()
+    for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed)):
+        s = model_singular_set(robot, model_rates(robot, names), classify(robot), 90, coupled=key == "actuated")
+        assert data["singular"][key]["text"] == describe_singular(s, robot)
+        assert data["singular"][key]["text"] == "at heading front = 90.00, -90.00 deg"  # as `wmrkit analyze bicycle`
 
 
 def castor_ring(n: int) -> dict:

@@ -197,7 +197,8 @@ def configurations(request: Any) -> dict[str, Any]:
         out["singular"][key] = {"assigned": list(s.assigned), "channels": list(assigned_names(s, robot)),
                                 "variables": list(s.variables), "always": s.always,
                                 "never": s.never, "exact": s.exact, "count": len(s.configurations),
-                                "headings": headings, "reasons": list(s.reasons), "text": describe_singular(s)}
+                                "headings": headings, "reasons": list(s.reasons),
+                                "text": describe_singular(s, robot)}
     # The library's search refines each grid minimum at its own natural length: quick for m = 2 or one steering
     # angle, but tens of seconds for m = 3 with several (a 1-D length search inside Nelder-Mead), and growing
     # with every steering angle for m = 2: not searched then, with a note saying why.
