@@ -384,6 +384,59 @@ def test_path_traversal_refused(tmp_path, client, path):
     assert not (tmp_path.parent / "evil.yaml").exists()
 
 
+def test_save_does_not_replace_without_overwrite(tmp_path, client):
+    """A non-robot YAML with comments was silently replaced: now 409 unless the request says overwrite."""
+    other = tmp_path / "notes.yaml"
+    other.write_text("# my notes\nshopping: [milk]\n")
+    r = client.post("/api/save", json={"path": "notes.yaml", "description": desc("diff-drive")})
+    assert r.status_code == 409 and r.json()["exists"] is True and "notes.yaml" in r.json()["error"]
+    assert other.read_text() == "# my notes\nshopping: [milk]\n"
+    bad = client.post("/api/save", json={"path": "notes.yaml", "description": desc("diff-drive"), "overwrite": "yes"})
+    assert bad.status_code == 400 and "overwrite" in bad.json()["error"]
+    r = client.post("/api/save", json={"path": "notes.yaml", "description": desc("diff-drive"), "overwrite": True})
+    assert r.status_code == 200 and Robot.from_file(other) == catalog.load("diff-drive")
+
+
+@pytest.mark.parametrize(("path", "status", "words"), [
+    (".hidden/r.yaml", 403, "hidden"), (".r.yaml", 403, "hidden"), ("sub/.git/r.yaml", 403, "hidden"),
+    (" r.yaml", 400, "space"), ("r .yaml", 200, None), ("sub /r.yaml", 400, "space"), ("r\x01.yaml", 400, "control"),
+    ("r\n.yaml", 400, "control"), ("r\x85.yaml", 400, "control"),
+])
+def test_save_refuses_hidden_and_odd_names(tmp_path, client, path, status, words):
+    (tmp_path / ".hidden").mkdir()
+    (tmp_path / "sub" / ".git").mkdir(parents=True)
+    (tmp_path / "sub ").mkdir()
+    r = client.post("/api/save", json={"path": path, "description": desc("diff-drive")})
+    assert r.status_code == status, r.json()
+    if words:
+        assert words in r.json()["error"]
+        assert not any(p.is_file() for p in tmp_path.rglob("*"))
+
+
+def test_file_system_errors_are_4xx(tmp_path, client):
+    """A folder named like a description, and names too long for the file system, answered 500 (OSError)."""
+    (tmp_path / "dir.yaml").mkdir()
+    r = client.post("/api/save", json={"path": "dir.yaml", "description": desc("diff-drive"), "overwrite": True})
+    assert r.status_code == 400 and "folder" in r.json()["error"]
+    assert client.post("/api/open", json={"path": "dir.yaml"}).status_code == 400
+    for path in ("a" * 300 + ".yaml", "d/" * 400 + "r.yaml", "x" * 2000 + ".yaml"):
+        for endpoint in ("/api/open", "/api/save"):
+            r = client.post(endpoint, json={"path": path, "description": desc("diff-drive")})
+            assert r.status_code == 400 and len(r.json()["error"]) < 200, (endpoint, path[:20], r.json())
+    (tmp_path / "loop.yaml").symlink_to(tmp_path / "loop.yaml")  # ELOOP
+    for endpoint in ("/api/open", "/api/save"):
+        r = client.post(endpoint, json={"path": "loop.yaml", "description": desc("diff-drive"), "overwrite": True})
+        assert 400 <= r.status_code < 500, (endpoint, r.json())
+
+
+def test_security_headers(client):
+    for r in (client.get("/"), client.get("/static/app.js"), client.get("/api/meta"),
+              client.post("/api/analyze", json={"description": 3})):
+        assert r.headers["x-frame-options"] == "DENY"
+        assert "frame-ancestors 'none'" in r.headers["content-security-policy"]
+        assert "default-src 'self'" in r.headers["content-security-policy"]
+
+
 def test_symlink_out_of_root_refused(tmp_path):
     root = tmp_path / "root"
     root.mkdir()

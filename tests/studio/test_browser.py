@@ -91,7 +91,7 @@ def page(server):
         errors: list[str] = []
         pg.on("pageerror", lambda e: errors.append(str(e)))
         pg.goto(url)
-        pg.wait_for_function("window.studioStats && window.studioStats.rendered > 0")
+        pg.wait_for_function("() => window.studioStats && window.studioStats.rendered > 0")
         pg.errors = errors
         yield pg
         context.close()
@@ -100,7 +100,7 @@ def page(server):
 
 def settle(pg) -> None:
     """Wait until no edit is in flight and the debounced requests have answered."""
-    idle = "!S.inflight && !S.pending && S.driving === 0"
+    idle = "() => !S.inflight && !S.pending && S.driving === 0"  # a function: a string would need eval (CSP)
     pg.wait_for_function(idle)
     pg.wait_for_timeout(700)
     pg.wait_for_function(idle)
@@ -227,7 +227,7 @@ def test_open_drag_retype_drive_save(page, server):
     # save, then open the saved file: the same robot, the same file Robot.to_file writes
     pg.fill("#save-path", "designed.yaml")
     pg.click("#save")
-    pg.wait_for_function("document.getElementById('status').textContent.startsWith('saved')")
+    pg.wait_for_function("() => document.getElementById('status').textContent.startsWith('saved')")
     saved = Robot.from_file(root / "designed.yaml")
     assert saved == robot
     saved.to_file(root / "expected.yaml")
@@ -307,7 +307,7 @@ def test_drag_latency_eight_wheels(page, server):
         for i in range(8)]})
     robot.to_file(root / "ring8.yaml")
     pg.evaluate("fetch('/api/files').then((r) => r.json()).then((d) => fillFiles(d.files))")
-    pg.wait_for_function("[...document.getElementById('files').options].some((o) => o.value === 'ring8.yaml')")
+    pg.wait_for_function("() => [...document.getElementById('files').options].some((o) => o.value === 'ring8.yaml')")
     pg.select_option("#files", "ring8.yaml")
     pg.click("#open")
     settle(pg)

@@ -26,6 +26,16 @@ from . import api, files
 MAX_BODY = 1_000_000
 #: Host names of this machine: the ``Host`` headers a studio on a loopback interface answers.
 LOCAL_HOSTS = ["127.0.0.1", "localhost", "::1", "[::1]"]
+#: Sent with every answer: no other site may frame the page (clickjacking), and the page loads and runs only the
+#: studio's own files (it needs nothing else: no CDN, no inline script or style).
+SECURITY_HEADERS = {
+    "X-Frame-Options": "DENY",
+    "Content-Security-Policy": "default-src 'self'; script-src 'self'; style-src 'self'; img-src 'self' data:; "
+                               "connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'none'; "
+                               "frame-ancestors 'none'",
+    "X-Content-Type-Options": "nosniff",
+    "Referrer-Policy": "no-referrer",
+}
 
 log = logging.getLogger("wmrkit.studio")
 
@@ -61,6 +71,7 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
     require_starlette()
     from starlette.applications import Starlette
     from starlette.concurrency import run_in_threadpool
+    from starlette.middleware import Middleware
     from starlette.responses import FileResponse, JSONResponse, Response
     from starlette.routing import Mount, Route
     from starlette.staticfiles import StaticFiles
@@ -84,6 +95,8 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
                 return respond({"error": str(err)}, err.status)
             except files.ForbiddenPathError as err:
                 return respond({"error": str(err)}, 403)
+            except files.FileExistsStudioError as err:
+                return respond({"error": str(err), "exists": True}, 409)
             except DescriptionError as err:
                 return respond({"error": str(err), "message": err.message, "loc": list(err.loc),
                                 "field": _field_name(err.loc)}, 422)
@@ -119,13 +132,35 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
         Route("/api/kappa", endpoint(api.kappa_map, thread=True), methods=["POST"]),
         Mount("/static", app=StaticFiles(directory=str(static)), name="static"),
     ]
-    middleware = []
+    middleware = [Middleware(_SecurityHeaders)]
     if allowed_hosts is not None:
-        from starlette.middleware import Middleware
         from starlette.middleware.trustedhost import TrustedHostMiddleware
 
         middleware.append(Middleware(TrustedHostMiddleware, allowed_hosts=allowed_hosts))
     return Starlette(routes=routes, middleware=middleware)
+
+
+class _SecurityHeaders:
+    """ASGI middleware adding :data:`SECURITY_HEADERS` to every HTTP answer (static files and errors included)."""
+
+    def __init__(self, app) -> None:
+        self.app = app
+
+    async def __call__(self, scope, receive, send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+
+        async def with_headers(message) -> None:
+            if message["type"] == "http.response.start":
+                headers = list(message.get("headers", []))
+                present = {k.lower() for k, _ in headers}
+                headers += [(k.lower().encode(), v.encode()) for k, v in SECURITY_HEADERS.items()
+                            if k.lower().encode() not in present]
+                message = {**message, "headers": headers}
+            await send(message)
+
+        await self.app(scope, receive, with_headers)
 
 
 async def _read_json(request) -> Any:

@@ -541,7 +541,11 @@ async function openRobot() {
 }
 async function saveRobot() {
   const path = $("save-path").value.trim();
-  const r = await call("/api/save", { path, description: S.desc });
+  let r = await call("/api/save", { path, description: S.desc });
+  if (r.status === 409 && r.data.exists) {  // the file exists: replace it only when the user says so
+    if (!window.confirm(`${path} exists in the studio's folder. Replace it?`)) { $("status").textContent = "not saved"; return; }
+    r = await call("/api/save", { path, description: S.desc, overwrite: true });
+  }
   if (!r.ok) { showError(r.data); return; }
   showError(null);
   $("status").textContent = `saved ${r.data.path}`;
