@@ -332,3 +332,232 @@ def test_drag_latency_eight_wheels(page, server):
           f"(max {max(edits):.1f}); server median {np.median(server_ms):.2f} ms")
     assert np.median(edits) < 1000
     assert not pg.errors
+
+
+# ---- regressions ----------------------------------------------------------------------------------------------
+def edit(pg, field: str, value: str) -> None:
+    pg.fill(f'#wheel-fields [data-field="{field}"]', value)
+    pg.press(f'#wheel-fields [data-field="{field}"]', "Enter")
+    settle(pg)
+
+
+def test_late_slow_answers_do_not_overwrite_newer_ones(page):
+    """/api/configurations and /api/kappa of an older robot answered late replaced the newer robot's."""
+    pg = page
+    open_catalog(pg, "diff-drive")
+    pg.evaluate("""() => {
+        window.realFetch = window.realFetch || window.fetch;
+        window.slowSent = { configurations: 0, kappa: 0 };
+        window.fetch = async (url, init) => {
+            const key = String(url).includes('/api/configurations') ? 'configurations'
+                : String(url).includes('/api/kappa') ? 'kappa' : null;
+            const first = key && window.slowSent[key]++ === 0;
+            const r = await window.realFetch(url, init);
+            if (first) await new Promise((ok) => setTimeout(ok, 2500));  // the first answer comes late
+            return r;
+        };
+    }""")
+    try:
+        pg.evaluate("refresh()")  # diff-drive again: its slow requests are the delayed ones
+        pg.wait_for_function("() => window.slowSent.configurations >= 1 && window.slowSent.kappa >= 1")
+        pg.select_option("#catalog", "thesis-steer-castor")
+        pg.click("#open")
+        settle(pg)
+        pg.wait_for_timeout(3000)  # the late answers have come by now
+        settle(pg)
+        robot = catalog.load("thesis-steer-castor")
+        assert pg.evaluate("S.configs.singular.actuated.variables") == [
+            n for n in robot.steer_names if n in pg.evaluate("S.configs.singular.actuated.variables")]
+        assert len(pg.evaluate("S.configs.singular.actuated.variables")) > 1  # diff-drive's has one (the castor)
+        assert pg.evaluate("S.kappa.wheels") == list(robot.steer_names[:2])
+    finally:
+        pg.evaluate("window.fetch = window.realFetch")
+    assert not pg.errors
+
+
+def test_delete_after_undo_deletes_nothing(page):
+    """After an undo S.selected named a wheel that no longer existed; Delete removed the last wheel."""
+    pg = page
+    open_catalog(pg, "diff-drive")
+    pg.click("#add")
+    settle(pg)
+    pg.click("#undo")
+    settle(pg)
+    assert pg.evaluate("S.selected") is None
+    pg.click("#delete")
+    settle(pg)
+    assert [w.name for w in page_robot(pg).wheels] == ["left", "right", "caster"]
+    pg.click('[data-wheel="left"]')
+    edit(pg, "name", "lefty")
+    pg.click("#undo")
+    settle(pg)
+    pg.click("#delete")
+    settle(pg)
+    assert [w.name for w in page_robot(pg).wheels] == ["left", "right", "caster"]
+    assert not pg.errors
+
+
+def drive_ok(pg) -> None:
+    assert pg.evaluate("S.drive !== null"), "drive stopped answering"
+    assert pg.locator("#commands tr[data-wheel]").count() == len(page_robot(pg).wheels)
+
+
+def test_drive_recovers_after_steering_wheel_renamed_retyped_deleted(page):
+    """S.heading kept old wheel names: every /api/drive answered 400 ('... is not a steering wheel')."""
+    pg = page
+    open_catalog(pg, "swerve-4")
+    pg.click("#plan", position={"x": 5, "y": 5})
+    for key in ("w", "w", "q"):
+        pg.keyboard.press(key)
+    settle(pg)
+    assert "front_left" in pg.evaluate("S.heading")
+    pg.click('[data-wheel="front_left"]')
+    edit(pg, "name", "fl")
+    drive_ok(pg)
+    assert "fl" in pg.evaluate("S.heading") and "front_left" not in pg.evaluate("S.heading")
+    pg.select_option('#wheel-fields [data-field="type"]', "fixed")
+    settle(pg)
+    drive_ok(pg)
+    pg.click('[data-wheel="rear_left"]')
+    pg.click("#delete")
+    settle(pg)
+    drive_ok(pg)
+    pg.keyboard.press(" ")
+    settle(pg)
+    assert not pg.errors
+
+
+def test_couplings_follow_renamed_deleted_retyped_wheels(page):
+    """ackermann: rear_left to double answered "couplings[0].joints[0]: no joint 'rear_left.spin'"."""
+    pg = page
+    open_catalog(pg, "ackermann")
+    pg.click('[data-wheel="front_left"]')
+    edit(pg, "name", "fl")
+    assert pg.evaluate("S.error") is None
+    assert page_robot(pg).couplings[1].joints == ("fl.steer", "front_right.steer")
+    pg.click('[data-wheel="rear_left"]')
+    pg.select_option('#wheel-fields [data-field="type"]', "double")
+    settle(pg)
+    assert pg.evaluate("S.error") is None
+    assert [c.kind for c in page_robot(pg).couplings] == ["linkage"]  # the differential lost a joint: one left
+    pg.click('[data-wheel="front_right"]')
+    pg.click("#delete")
+    settle(pg)
+    assert pg.evaluate("S.error") is None and page_robot(pg).couplings == ()
+    assert "couplings" not in pg.evaluate("S.desc")
+    assert not pg.errors
+
+
+def test_errors_marked_on_their_own_field_naming_the_wheel(page):
+    pg = page
+    open_catalog(pg, "diff-drive")
+    pg.click('[data-wheel="left"]')
+    edit(pg, "name", "1left")  # not a wheel name: the wheel's name input, not the robot's
+    assert pg.locator('#wheel-fields [data-field="name"].invalid').count() == 1
+    assert pg.locator("#robot-name.invalid").count() == 0
+    assert pg.inner_text('#wheel-fields [data-msg="name"]') != ""
+    assert pg.inner_text('#robot-panel [data-msg="name"]') == ""
+    pg.click("#undo")
+    settle(pg)
+    pg.fill("#robot-name", "")
+    pg.press("#robot-name", "Enter")
+    settle(pg)
+    pg.click('[data-wheel="left"]')
+    assert pg.locator("#robot-name.invalid").count() == 1
+    assert pg.locator('#wheel-fields [data-field="name"].invalid').count() == 0
+    pg.click("#undo")
+    settle(pg)
+    pg.click('[data-wheel="right"]')
+    edit(pg, "y", "2 km")  # reported as wheels[1].l before: the x field was marked
+    assert pg.locator('#wheel-fields [data-field="y"].invalid').count() == 1
+    assert pg.locator('#wheel-fields [data-field="x"].invalid').count() == 0
+    assert pg.inner_text("#error").startswith("wheel 'right', position[1]: 2000 m from the robot's origin")
+    pg.click("#undo")
+    settle(pg)
+    edit(pg, "r", "0")
+    assert pg.inner_text("#error").startswith("wheel 'right', r: must be > 0")  # 'studio: wheels[1].r' before
+    pg.click("#undo")
+    settle(pg)
+    assert pg.locator(".invalid").count() == 0
+    assert not pg.errors
+
+
+def test_save_asks_before_replacing(page, server):
+    pg = page
+    _, root = server
+    open_catalog(pg, "omni-3")
+    (root / "keep.yaml").write_text("# not a robot\nanswer: 42\n")
+    pg.fill("#save-path", "keep.yaml")
+    asked = []
+
+    def dismiss(d):
+        asked.append(d.message)
+        d.dismiss()
+
+    pg.once("dialog", dismiss)
+    pg.click("#save")
+    pg.wait_for_function("() => document.getElementById('status').textContent === 'not saved'")
+    assert asked and "keep.yaml" in asked[0]
+    assert (root / "keep.yaml").read_text() == "# not a robot\nanswer: 42\n"
+    pg.once("dialog", lambda d: d.accept())
+    pg.click("#save")
+    pg.wait_for_function("() => document.getElementById('status').textContent.startsWith('saved')")
+    assert Robot.from_file(root / "keep.yaml") == catalog.load("omni-3")
+    assert not pg.errors
+
+
+def test_click_without_drag_keeps_redo(page):
+    """Clicking a wheel pushed an undo step and cleared Redo before any drag happened."""
+    pg = page
+    open_catalog(pg, "diff-drive")
+    pg.click('[data-wheel="left"]')
+    edit(pg, "r", "60 mm")
+    pg.click("#undo")
+    settle(pg)
+    undo, redo = pg.evaluate("S.undo.length"), pg.evaluate("S.redo.length")
+    assert redo == 1
+    pg.click('[data-wheel="right"]')
+    settle(pg)
+    assert pg.evaluate("S.selected") == "right"
+    assert (pg.evaluate("S.undo.length"), pg.evaluate("S.redo.length")) == (undo, redo)
+    pg.click("#redo")
+    settle(pg)
+    assert page_robot(pg).wheel("left").r == pytest.approx(0.06)
+    assert not pg.errors
+
+
+def test_modified_keys_do_not_drive(page):
+    """Ctrl+A, Ctrl+D, Ctrl+S, Alt+W nudged the twist."""
+    pg = page
+    open_catalog(pg, "omni-3")
+    pg.click("#plan", position={"x": 5, "y": 5})
+    pg.keyboard.press(" ")
+    for key in ("Control+a", "Control+d", "Control+s", "Alt+w", "Meta+q"):
+        pg.keyboard.press(key)
+    settle(pg)
+    assert pg.evaluate("S.twist") == [0, 0, 0]
+    pg.keyboard.press("w")
+    settle(pg)
+    assert pg.evaluate("S.twist") == pytest.approx([0.1, 0, 0])
+    pg.keyboard.press(" ")
+    settle(pg)
+    assert not pg.errors
+
+
+def test_handle_heading_is_a_clean_value(page):
+    """A heading turned with the handle was rounded to 1e-4 rad and shown as 90.0002 deg."""
+    pg = page
+    open_catalog(pg, "thesis-steer-castor")
+    pg.click('[data-wheel="o1"]')
+    handle = pg.locator('[data-handle="o1"]').bounding_box()
+    hx, hy = handle["x"] + handle["width"] / 2, handle["y"] + handle["height"] / 2
+    pg.mouse.move(hx, hy)
+    pg.mouse.down()
+    pg.mouse.move(hx + 30, hy - 50, steps=4)
+    pg.mouse.up()
+    settle(pg)
+    heading = pg.evaluate("S.desc.wheels.find((w) => w.name === 'o1').heading")
+    value = float(heading.removesuffix(" deg"))
+    assert heading.endswith(" deg") and round(value, 2) == value
+    assert pg.input_value('#wheel-fields [data-field="heading"]') == heading
+    assert not pg.errors

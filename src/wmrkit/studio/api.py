@@ -121,7 +121,7 @@ def geometry(robot: Robot) -> dict[str, Any]:
 def kinds() -> dict[str, Any]:
     """The wheel types: fields (required, optional with defaults), joints, whether they steer, a summary."""
     return {k.name: {"required": list(k.required), "optional": dict(k.optional), "joints": list(k.joints),
-                     "steers": k.steers, "summary": k.summary} for k in KINDS.values()}
+                     "rates": list(k.rates), "steers": k.steers, "summary": k.summary} for k in KINDS.values()}
 
 
 # ---- analysis ----------------------------------------------------------------------------------------------

@@ -47,15 +47,66 @@ function commit(mutate, { push = true } = {}) {
   if (JSON.stringify(next) === before) return;
   if (push) { S.undo.push(before); S.redo = []; }
   S.desc = next;
+  afterChange();
   refresh();
 }
-function undo() { if (S.undo.length) { S.redo.push(JSON.stringify(S.desc)); S.desc = JSON.parse(S.undo.pop()); refresh(); } }
-function redo() { if (S.redo.length) { S.undo.push(JSON.stringify(S.desc)); S.desc = JSON.parse(S.redo.pop()); refresh(); } }
-function wheelIndex(name) { return S.desc.wheels.findIndex((w) => w.name === name); }
+function restore(text) {  // undo, redo: the selection and the driven headings may name wheels that are gone
+  S.desc = JSON.parse(text);
+  afterChange();
+  renderWheelPanel();
+  refresh();
+}
+function afterChange() {
+  if (S.selected !== null && wheelIndex(S.selected) < 0) S.selected = null;
+  S.heading = steeringHeadings(S.heading);
+}
+function undo() { if (S.undo.length) { S.redo.push(JSON.stringify(S.desc)); restore(S.undo.pop()); } }
+function redo() { if (S.redo.length) { S.undo.push(JSON.stringify(S.desc)); restore(S.redo.pop()); } }
+function wheelIndex(name) { return Array.isArray(S.desc.wheels) ? S.desc.wheels.findIndex((w) => w.name === name) : -1; }
+function steeringHeadings(heading) {  // the driven headings of wheels that still steer (a wheel renamed, retyped
+  const out = {};                     // or deleted while driving is dropped: /api/drive refuses unknown names)
+  const wheels = Array.isArray(S.desc.wheels) ? S.desc.wheels : [];
+  for (const [name, h] of Object.entries(heading || {})) {
+    const w = wheels.find((x) => x && x.name === name), kind = w && S.meta.kinds[w.type];
+    if (kind && kind.steers) out[name] = h;
+  }
+  return out;
+}
+// Couplings name joints 'wheel.joint': renaming a wheel rewrites them; deleting it, or a type without the joint
+// (or where it changes role: a linkage couples steering angles, the others rates), drops the joint from its
+// coupling, and the coupling when fewer than two joints remain.
+function rewriteCouplings(d, name, { rename = null, type = undefined } = {}) {
+  if (!Array.isArray(d.couplings)) return;
+  const kind = type === undefined ? undefined : type === null ? null : S.meta.kinds[type];
+  d.couplings = d.couplings.filter((c) => {
+    if (!c || !Array.isArray(c.joints)) return true;
+    const ratios = Array.isArray(c.ratios) && c.ratios.length === c.joints.length ? [...c.ratios] : null;
+    const joints = [], kept = [];
+    let touched = false;
+    c.joints.forEach((j, i) => {
+      const [wheel, ...rest] = typeof j === "string" ? j.split(".") : [null];
+      const part = rest.join(".");
+      if (wheel !== name) { joints.push(j); kept.push(i); return; }
+      touched = true;
+      if (rename !== null) { joints.push(`${rename}.${part}`); kept.push(i); return; }
+      if (kind === undefined) { joints.push(j); kept.push(i); return; }
+      const angle = kind && part === "steer" && !(kind.rates || []).includes("steer");
+      if (kind && kind.joints.includes(part) && angle === (c.kind === "linkage")) { joints.push(j); kept.push(i); }
+    });
+    if (!touched) return true;
+    if (joints.length < 2) return false;
+    c.joints = joints;
+    if (ratios) c.ratios = kept.map((i) => ratios[i]);
+    return true;
+  });
+  if (!d.couplings.length) delete d.couplings;
+}
 function geometryOf(name) { return S.geometry && S.geometry.wheels.find((w) => w.name === name); }
 
 function setPlace(w, x, y) { delete w.l; delete w.alpha; w.position = [x, y]; }
 function setHeading(w, h) { delete w.beta; w.heading = h; }
+// A heading picked with the mouse [rad], in whole hundredths of a degree: "90 deg", not 90.0002 deg (1e-4 rad).
+function cleanHeading(rad) { return `${Math.round(deg(rad) * 100) / 100} deg`; }
 
 // ---- analysis on every edit -----------------------------------------------------------------------------------
 function refresh() {
@@ -85,20 +136,39 @@ async function send() {
 const timers = {};
 function later(key, fn, ms) { clearTimeout(timers[key]); timers[key] = setTimeout(fn, ms); }
 
-async function loadConfigurations() {
-  const r = await call("/api/configurations", { description: S.desc });
-  S.configs = r.ok ? r.data : null;
-  renderAnalysis();
+// The slow answers (/api/configurations, /api/kappa): one request of each in flight, the latest edit waiting
+// (requests do not pile up in the server's threads), and an answer older than the latest request is dropped.
+const slow = { configs: { seq: 0, busy: false, again: false }, kappa: { seq: 0, busy: false, again: false } };
+async function loadSlow(key, request, show) {
+  const q = slow[key];
+  if (q.busy) { q.again = true; return; }
+  q.busy = true; q.again = false;
+  const seq = ++q.seq;
+  let r;
+  try { r = await request(); } finally { q.busy = false; }
+  if (q.again) { loadSlow(key, request, show); return; }  // a newer edit came meanwhile: its answer replaces this
+  if (seq !== q.seq || r === undefined) return;
+  show(r);
 }
-async function loadKappa() {
-  if (!S.analysis || Object.keys(S.analysis.steering).length === 0) { S.kappa = null; renderKappa(); return; }
-  const r = await call("/api/kappa", { description: S.desc, resolution: 72 });
-  S.kappa = r.ok ? r.data : null;
-  renderKappa();
+function loadConfigurations() {
+  return loadSlow("configs", () => call("/api/configurations", { description: S.desc }), (r) => {
+    S.configs = r.ok ? r.data : null;
+    renderAnalysis();
+  });
+}
+function loadKappa() {
+  return loadSlow("kappa", async () => {
+    if (!S.analysis || Object.keys(S.analysis.steering).length === 0) return { ok: false, data: null };
+    return call("/api/kappa", { description: S.desc, resolution: 72 });
+  }, (r) => {
+    S.kappa = r.ok ? r.data : null;
+    renderKappa();
+  });
 }
 async function driveNow() {
   const seq = ++S.driveSeq;
   S.driving += 1;
+  S.heading = steeringHeadings(S.heading);
   const r = await call("/api/drive", { description: S.desc, twist: S.twist, heading: S.heading })
     .finally(() => { S.driving -= 1; });
   if (seq !== S.driveSeq) return;  // a newer twist or edit was sent meanwhile
@@ -115,22 +185,34 @@ function showError(err) {
   S.error = err;
   const box = $("error");
   if (!err) { box.hidden = true; return; }
-  box.hidden = false; box.textContent = err.error;
-  if (err.loc && err.loc[0] === "wheels" && typeof err.loc[1] === "number" && S.desc.wheels[err.loc[1]]) {
-    const name = S.desc.wheels[err.loc[1]].name;
-    if (S.selected !== name && typeof name === "string") { S.selected = name; renderWheelPanel(); }
-  }
+  box.hidden = false; box.textContent = errorText(err);
+  const w = errorWheel(err);
+  if (w && S.selected !== w.name) { S.selected = w.name; renderWheelPanel(); }
   markField();
+}
+function errorWheel(err) {  // the wheel an error is about (loc wheels[i]...), when it has a name
+  const i = err && err.loc && err.loc[0] === "wheels" && typeof err.loc[1] === "number" ? err.loc[1] : -1;
+  const w = i >= 0 && S.desc && Array.isArray(S.desc.wheels) ? S.desc.wheels[i] : null;
+  return w && typeof w.name === "string" && w.name ? w : null;
+}
+function errorText(err) {  // the library's message, the wheel named rather than numbered: wheel 'right', r: ...
+  const w = errorWheel(err);
+  if (!w || err.message === undefined) return err.error;
+  const rest = err.loc.slice(2).map((p) => (typeof p === "number" ? `[${p}]` : `.${p}`)).join("").replace(/^\./, "");
+  return `wheel '${w.name}'${rest ? `, ${rest}` : ""}: ${err.message}`;
 }
 function markField() {
   const err = S.error;
-  if (!err || !err.loc) return;
-  let key = err.loc.length >= 3 && err.loc[0] === "wheels" ? err.loc[2] : err.loc[0];
+  if (!err || !err.loc || !err.loc.length) return;
+  const onWheel = err.loc[0] === "wheels" && err.loc.length >= 3;
+  if (err.loc[0] === "wheels" && !onWheel) return;  // about the list or a whole wheel: the box says it
+  const scope = onWheel ? $("wheel-fields") : $("robot-panel");  // 'name' is a field of both panels
+  let key = onWheel ? err.loc[2] : err.loc[0];
   if (key === "position" || key === "l" || key === "alpha") key = err.loc[3] === 1 ? "y" : "x";
   if (key === "beta") key = "heading";
-  const input = document.querySelector(`[data-field="${key}"]`) || document.querySelector(`[data-loc="${key}"]`);
+  const input = scope.querySelector(`[data-field="${key}"]`) || scope.querySelector(`[data-loc="${key}"]`);
   if (input) input.classList.add("invalid");
-  const msg = document.querySelector(`[data-msg="${key}"]`);
+  const msg = scope.querySelector(`[data-msg="${key}"]`);
   if (msg) msg.textContent = err.message;
 }
 
@@ -191,9 +273,15 @@ function renderWheelPanel() {
 }
 function editField(field, text) {
   const name = S.selected;
+  if (name === null || wheelIndex(name) < 0) return;
   commit((d) => {
     const w = d.wheels[wheelIndex(name)];
-    if (field === "name") { w.name = text; S.selected = text; return; }
+    if (field === "name") {
+      w.name = text; S.selected = text;
+      rewriteCouplings(d, name, { rename: text });
+      if (name in S.heading && text !== name) { S.heading[text] = S.heading[name]; delete S.heading[name]; }
+      return;
+    }
     if (field === "x" || field === "y") {
       const g = geometryOf(name), pos = Array.isArray(w.position) ? [...w.position] : (g ? [...g.joint] : [0, 0]);
       pos[field === "x" ? 0 : 1] = text; setPlace(w, pos[0], pos[1]); return;
@@ -204,6 +292,7 @@ function editField(field, text) {
 }
 function changeType(type) {
   const name = S.selected, kind = S.meta.kinds[type];
+  if (name === null || wheelIndex(name) < 0 || !kind) return;
   commit((d) => {
     const i = wheelIndex(name), old = d.wheels[i], g = geometryOf(name);
     const w = { name: old.name, type };
@@ -218,6 +307,7 @@ function changeType(type) {
       if (keep.length) w[group] = keep;
     }
     d.wheels[i] = w;
+    rewriteCouplings(d, name, { type });
   });
 }
 function addWheel() {
@@ -235,9 +325,12 @@ function addWheel() {
   S.selected = name; renderWheelPanel();
 }
 function deleteWheel() {
-  if (S.selected === null) return;
   const name = S.selected;
-  commit((d) => { d.wheels.splice(wheelIndex(name), 1); });
+  if (name === null || wheelIndex(name) < 0) { S.selected = null; renderWheelPanel(); return; }
+  commit((d) => {
+    d.wheels.splice(d.wheels.findIndex((w) => w.name === name), 1);
+    rewriteCouplings(d, name, { type: null });
+  });
   S.selected = null; renderWheelPanel();
 }
 
@@ -381,8 +474,8 @@ function onPointerDown(ev) {
   const name = handle ? handle.dataset.handle : wheel.dataset.wheel;
   if (S.selected !== name) { S.selected = name; renderWheelPanel(); drawPlan(); }
   const g = geometryOf(name), start = svgPoint(ev);
-  S.dragging = { name, rotate: !!handle, offset: [g.joint[0] - start[0], g.joint[1] - start[1]], joint: g.joint };
-  S.undo.push(JSON.stringify(S.desc)); S.redo = [];
+  S.dragging = { name, rotate: !!handle, offset: [g.joint[0] - start[0], g.joint[1] - start[1]], joint: g.joint,
+    before: JSON.stringify(S.desc), pushed: false };  // one undo step, pushed when the drag first moves
   $("plan").setPointerCapture(ev.pointerId);
   ev.preventDefault();
 }
@@ -390,16 +483,17 @@ function onPointerMove(ev) {
   const d = S.dragging;
   if (!d) return;
   const p = svgPoint(ev), round = (v) => Math.round(v * 1e4) / 1e4;
+  if (wheelIndex(d.name) < 0) return;
   commit((desc) => {
     const w = desc.wheels[wheelIndex(d.name)];
-    if (d.rotate) setHeading(w, round(Math.atan2(p[1] - d.joint[1], p[0] - d.joint[0])));
+    if (d.rotate) setHeading(w, cleanHeading(Math.atan2(p[1] - d.joint[1], p[0] - d.joint[0])));
     else setPlace(w, round(p[0] + d.offset[0]), round(p[1] + d.offset[1]));
   }, { push: false });
+  if (!d.pushed && JSON.stringify(S.desc) !== d.before) { d.pushed = true; S.undo.push(d.before); S.redo = []; }
 }
 function onPointerUp() {
   if (!S.dragging) return;
   S.dragging = null;
-  if (S.undo.length && S.undo[S.undo.length - 1] === JSON.stringify(S.desc)) S.undo.pop();
   renderWheelPanel(); drawPlan();
 }
 
@@ -525,8 +619,9 @@ function kappaClick(ev) {
   const P = 30, W = c.width - P - 4, H = c.height - P - 4;
   const h0 = ((ev.clientX - r.left) * sx - P) / W * 2 * Math.PI - Math.PI, h1 = (4 + H - (ev.clientY - r.top) * sy) / H * 2 * Math.PI - Math.PI;
   commit((d) => {
-    setHeading(d.wheels[wheelIndex(k.wheels[0])], Math.round(h0 * 1e4) / 1e4);
-    if (k.wheels.length > 1) setHeading(d.wheels[wheelIndex(k.wheels[1])], Math.round(h1 * 1e4) / 1e4);
+    const i0 = d.wheels.findIndex((w) => w.name === k.wheels[0]), i1 = d.wheels.findIndex((w) => w.name === k.wheels[1]);
+    if (i0 >= 0) setHeading(d.wheels[i0], cleanHeading(h0));
+    if (k.wheels.length > 1 && i1 >= 0) setHeading(d.wheels[i1], cleanHeading(h1));
   });
   S.heading = {};
 }
@@ -600,8 +695,9 @@ async function main() {
   window.addEventListener("resize", () => { S.view = null; drawPlan(); });
   document.addEventListener("keydown", (e) => {
     if (e.target.closest("input, select")) return;
-    if ((e.ctrlKey || e.metaKey) && e.key === "z") { undo(); e.preventDefault(); return; }
-    if ((e.ctrlKey || e.metaKey) && e.key === "y") { redo(); e.preventDefault(); return; }
+    if ((e.ctrlKey || e.metaKey) && !e.altKey && e.key.toLowerCase() === "z") { undo(); e.preventDefault(); return; }
+    if ((e.ctrlKey || e.metaKey) && !e.altKey && e.key.toLowerCase() === "y") { redo(); e.preventDefault(); return; }
+    if (e.ctrlKey || e.metaKey || e.altKey) return;  // the browser's shortcuts (Ctrl+A, Ctrl+S, ...): not the twist
     const steps = { w: [0.1, 0, 0], s: [-0.1, 0, 0], a: [0, 0.1, 0], d: [0, -0.1, 0], q: [0, 0, 0.2], e: [0, 0, -0.2] };
     const k = e.key.toLowerCase();
     if (k in steps) setTwist(S.twist.map((v, i) => Math.max(-2, Math.min(2, v + steps[k][i]))));
