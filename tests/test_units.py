@@ -13,7 +13,8 @@ from wmrkit.units import UNITS, UnitError, si_unit
 
 # Factors to SI written out independently of units.py.
 FACTORS = {
-    "length": {"m": 1.0, "mm": 0.001, "cm": 0.01, "dm": 0.1, "km": 1000.0, "in": 0.0254, "ft": 0.3048},
+    "length": {"m": 1.0, "mm": 0.001, "cm": 0.01, "dm": 0.1, "km": 1000.0, "um": 1e-6, "\u00b5m": 1e-6, "in": 0.0254,
+               "ft": 0.3048},
     "angle": {"rad": 1.0, "mrad": 0.001, "deg": math.pi / 180, "°": math.pi / 180, "turn": 2 * math.pi},
 }
 

@@ -67,7 +67,7 @@ def _diff_drive(**left) -> dict:
 
 @pytest.mark.parametrize(("changes", "field", "reason"), [
     ({"r": 1e308}, "r", "longer than 1000 m"),
-    ({"position": [1e308, 1e308]}, "l", "longer than 1000 m"),
+    ({"position": [1e308, 1e308]}, r"position\[0\]", "longer than 1000 m"),  # the coordinate typed
     ({"r": 0.2 * MIN_RATIO * 0.99}, "r", "less than 0.0001 of the robot's size"),  # size 0.2 m: the positions
     ({"r": 1e-320}, "r", "less than 0.0001 of the robot's size"),
 ])
