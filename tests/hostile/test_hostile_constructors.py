@@ -133,3 +133,20 @@ def test_batch_shapes_and_chunk_sizes_are_named():
     axes = [parse_vary("wheels[0].l=0.2:0.3:2", robot)]
     with pytest.raises(BatchError, match=r"chunk: expected an integer >= 1, got 2\.5"):
         sweep(robot, axes, chunk=2.5)
+
+
+def test_encoders_and_references_refuse_what_is_not_finite():
+    """An incremental encoder quantised a NaN angle to -9223372036854775808 counts, silently; an absolute encoder
+    read NaN counts as a NaN angle; a reference sampled at a NaN time gave a NaN pose."""
+    from wmrkit.control.references import builtin_reference
+    from wmrkit.odometry.encoders import AbsoluteEncoder, EncoderError, IncrementalEncoder
+
+    with pytest.raises(EncoderError, match="angle: expected finite angles"):
+        IncrementalEncoder(8290).quantize([0.1, math.nan])
+    with pytest.raises(EncoderError, match="angle: expected finite angles"):
+        AbsoluteEncoder(0.0246).quantize([math.inf])
+    with pytest.raises(EncoderError, match="counts: expected finite readings"):
+        AbsoluteEncoder(0.0246).angle([math.nan])
+    assert IncrementalEncoder(8290).quantize([1.0]).tolist() == [math.floor(8290 / (2 * math.pi))]
+    with pytest.raises(ValueError, match="sample times must be finite"):
+        builtin_reference("circle").sample(np.array([0.0, math.nan]))

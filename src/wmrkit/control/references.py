@@ -75,6 +75,8 @@ class Reference:
     def sample(self, t: np.ndarray) -> np.ndarray:
         """Poses at times `t` ``(m,) -> (m, 3)`` (linear interpolation, held after the end)."""
         t = np.asarray(t, dtype=float)
+        if not np.isfinite(t).all():
+            raise ReferenceError(f"{self.name}: sample times must be finite")
         return np.stack([np.interp(t, self.t, self.pose[:, j]) for j in range(3)], axis=-1)
 
 

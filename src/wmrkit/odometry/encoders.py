@@ -88,7 +88,7 @@ class IncrementalEncoder:
 
     def quantize(self, angle: ArrayLike) -> np.ndarray:
         """Counts an ideal encoder reports at wheel angle `angle` [rad] (floor, cumulative, no wrap). ``(...)``."""
-        return np.floor(np.asarray(angle, dtype=float) / self.radians_per_count).astype(np.int64)
+        return np.floor(_counts_of(angle, self.radians_per_count)).astype(np.int64)
 
     def wrap(self, counts: ArrayLike) -> np.ndarray:
         """Cumulative counts as the fixed-width counter shows them (identity without ``bits``). ``(...)``."""
@@ -119,11 +119,15 @@ class AbsoluteEncoder:
 
     def angle(self, counts: ArrayLike) -> np.ndarray:
         """Angles [rad] of raw readings `counts`. ``(...) -> (...)``."""
-        return self.offset + self.sign * np.asarray(counts, dtype=float) * self.resolution
+        c = np.asarray(counts, dtype=float)
+        if not np.isfinite(c).all():
+            raise EncoderError("counts: expected finite readings")
+        return self.offset + self.sign * c * self.resolution
 
     def quantize(self, angle: ArrayLike) -> np.ndarray:
         """The reading (nearest count) of an ideal encoder at `angle` [rad]. ``(...) -> (...)`` int."""
-        return np.rint(self.sign * (np.asarray(angle, dtype=float) - self.offset) / self.resolution).astype(np.int64)
+        return np.rint(self.sign * _counts_of(np.asarray(angle, dtype=float) - self.offset, self.resolution)
+                       ).astype(np.int64)
 
     def round(self, angle: ArrayLike) -> np.ndarray:
         """`angle` [rad] rounded to what this encoder can report. ``(...) -> (...)``."""
@@ -131,6 +135,15 @@ class AbsoluteEncoder:
 
 
 Encoder = IncrementalEncoder | AbsoluteEncoder
+
+
+def _counts_of(angle: ArrayLike, per_count: float) -> np.ndarray:
+    """``angle / per_count`` as counts, or :class:`EncoderError` when an angle is not finite or the count would not
+    fit an int64 (NaN became -9223372036854775808 counts, silently)."""
+    c = np.asarray(angle, dtype=float) / per_count
+    if not (np.abs(c) < 2.0**62).all():
+        raise EncoderError(f"angle: expected finite angles within {2.0**62 * per_count:.3g} rad of the encoder's zero")
+    return c
 
 #: Encoders of catalog robots, by robot then joint (thesis §7.5.1: 8290 pulses/rev, 1.4118 deg = 360/255 deg).
 #: The forklift's steering encoder reads 0 when steered straight ahead, the general rule of steering encoders
