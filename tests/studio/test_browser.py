@@ -348,12 +348,16 @@ def test_late_slow_answers_do_not_overwrite_newer_ones(page):
     pg.evaluate("""() => {
         window.realFetch = window.realFetch || window.fetch;
         window.slowSent = { configurations: 0, kappa: 0 };
+        window.slowDone = { configurations: false, kappa: false };
         window.fetch = async (url, init) => {
             const key = String(url).includes('/api/configurations') ? 'configurations'
                 : String(url).includes('/api/kappa') ? 'kappa' : null;
             const first = key && window.slowSent[key]++ === 0;
             const r = await window.realFetch(url, init);
-            if (first) await new Promise((ok) => setTimeout(ok, 2500));  // the first answer comes late
+            if (first) {  // the first answer comes late
+                await new Promise((ok) => setTimeout(ok, 2500));
+                window.slowDone[key] = true;
+            }
             return r;
         };
     }""")
@@ -363,7 +367,12 @@ def test_late_slow_answers_do_not_overwrite_newer_ones(page):
         pg.select_option("#catalog", "thesis-steer-castor")
         pg.click("#open")
         settle(pg)
-        pg.wait_for_timeout(3000)  # the late answers have come by now
+        # The late answers have come, and the newer robot's are shown (on a loaded machine its search takes
+        # seconds: a fixed wait was not enough). Before the fix the late diff-drive answers stayed: a timeout.
+        pg.wait_for_function("""() => window.slowDone.configurations && window.slowDone.kappa && S.configs
+            && S.configs.singular.actuated.variables.length > 1 && S.kappa && S.kappa.wheels.length === 2""",
+                             timeout=60_000)
+        pg.wait_for_timeout(500)
         settle(pg)
         robot = catalog.load("thesis-steer-castor")
         assert pg.evaluate("S.configs.singular.actuated.variables") == [
