@@ -2,10 +2,20 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
 from .errors import ShapeError
+
+
+def finite_number(value: object) -> bool:
+    """Whether `value` is one finite real number (Python, NumPy scalar); False for NaN, infinities, text, None."""
+    try:
+        return math.isfinite(value)  # type: ignore[arg-type]
+    except TypeError:
+        return False
 
 
 def as_vectors(x: ArrayLike, n: int, name: str) -> np.ndarray:

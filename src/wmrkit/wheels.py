@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._shapes import as_angles
+from ._shapes import as_angles, finite_number
 from .errors import UnknownNameError, WmrkitError
 
 if TYPE_CHECKING:
@@ -141,11 +141,7 @@ class Wheel:
         if any(hasattr(v, "free_symbols") for v in values.values()):
             return  # symbolic parameters (SymPy, wmrkit.kinematics.symbolic): no numbers to check
         for key, value in values.items():
-            try:
-                finite = math.isfinite(value)
-            except TypeError:
-                finite = False
-            if not finite:
+            if not finite_number(value):
                 raise WheelError(f"wheel '{self.name}': {key}: expected a finite number, got {value!r}")
         problem = geometry_problem(self.type, values, degenerate=False)
         if problem is not None:

@@ -8,7 +8,6 @@ explains them and the slip they leave. ``docs/wheel-ik.md`` states the policies 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -16,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, readonly
+from .._shapes import as_vectors, finite_number, readonly
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
@@ -98,11 +97,7 @@ class WheelCommands:
 def check_tolerances(speed_tol: float, slip_tol: float) -> None:
     """Both tolerances finite numbers >= 0 [m/s] (a negative or NaN slip_tol called every twist infeasible)."""
     for name, value in (("speed_tol", speed_tol), ("slip_tol", slip_tol)):
-        try:
-            ok = math.isfinite(value) and value >= 0
-        except TypeError:
-            ok = False
-        if not ok:
+        if not (finite_number(value) and value >= 0):
             raise ShapeError(f"{name}: expected a finite tolerance >= 0 [m/s], got {value!r}")
 
 

@@ -174,6 +174,13 @@ def propagate_covariance(poses_world_robot: ArrayLike, increments_robot: ArrayLi
     if not (np.isfinite(q).all() and (np.diagonal(q, axis1=-2, axis2=-1) >= 0).all()
             and np.abs(q - np.swapaxes(q, -1, -2)).max(initial=0.0) <= 1e-9 * np.abs(q).max(initial=0.0)):
         raise NoiseError("increment_covariance: every matrix must be finite and symmetric, with variances >= 0")
+    return propagate_checked(poses, inc, q, method, p0)
+
+
+def propagate_checked(poses: np.ndarray, inc: np.ndarray, q: np.ndarray, method: Method,
+                      p0: np.ndarray) -> np.ndarray:
+    """:func:`propagate_covariance` on arrays already checked (the pipeline's own, chunk after chunk: its
+    overflows are located where they happen, not refused as input)."""
     _, g = step_jacobians(poses[:-1], inc, method)
     c = np.concatenate([p0[None], g @ q @ np.swapaxes(g, -1, -2)])  # C_0 = P_0, C_k = G Q G^T
     rel = poses[:, :2] - poses[0, :2]

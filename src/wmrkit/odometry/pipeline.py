@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -24,7 +24,7 @@ from ..errors import WmrkitError
 from ..limits import MAX_COORDINATE, check_chunk_size
 from ..robot import Robot
 from ..units import MAX_ANGLE, MAX_TURNS
-from .covariance import CrowleyNoise, JointNoise, check_covariance, propagate_covariance
+from .covariance import CrowleyNoise, JointNoise, check_covariance, propagate_checked
 from .integrators import HEADING_FRACTION, Method, check_method
 from .logs import JointLog, LogError, check_time
 from .model import ModelIncrements, OdometryModel, kernel_maps, odometry_model, wrap_angle
@@ -135,7 +135,7 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
             steps = np.stack([dx, dy, dth if heading is None else np.diff(heading)], axis=-1)
             q = _increment_covariance(noise, inc, steps)
             with np.errstate(over="ignore", invalid="ignore"):  # an overflow is reported below, located
-                covs = propagate_covariance(np.vstack([pose[None], poses]), steps, q, method, initial=cov)
+                covs = propagate_checked(np.vstack([pose[None], poses]), steps, q, method, cov)
             cov = covs[-1]
             if not np.isfinite(cov).all():
                 _overflow(chunk, covs.reshape(n, 9), "covariance")
@@ -282,16 +282,12 @@ def _validate(chunk: JointLog, prev: JointLog | None, *, positions: bool = True)
 
 
 def _check_inputs(pose: np.ndarray, noise: Noise | None, initial_covariance: ArrayLike | None) -> None:
-    """Refuse a non-finite start pose, noise coefficients that are not finite and >= 0, a bad initial covariance."""
+    """Refuse a non-finite start pose and a bad initial covariance (noise models check their coefficients when
+    made)."""
     if not np.isfinite(pose).all():
         raise LogError(f"pose0: must be finite, got {pose.tolist()}")
     if np.abs(pose[:2]).max() > MAX_COORDINATE:
         raise LogError(f"pose0: a position beyond {MAX_COORDINATE:g} m, got {pose[:2].tolist()}")
-    if noise is not None:
-        for name, value in ((f.name, getattr(noise, f.name)) for f in fields(noise)):
-            if not (isinstance(value, int | float | np.floating) and math.isfinite(value) and value >= 0):
-                raise LogError(f"{type(noise).__name__}.{name}: a noise coefficient must be finite and >= 0, "
-                               f"got {value!r}")
     if initial_covariance is not None:
         check_covariance(initial_covariance, "initial_covariance")
 

@@ -9,12 +9,12 @@ scales each row by ``sqrt(mu)``. Only ratios matter (the WLS solution is invaria
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .._shapes import finite_number
 from ..errors import WmrkitError
 from ..odometry.model import OdometryModel, frozen, odometry_model, solution_maps
 from ..robot import Robot
@@ -43,11 +43,7 @@ class SlipWeights:
         """Every coefficient a finite number > 0 (zero or NaN weights gave a zero or NaN twist)."""
         for name, lat, lon in (*self.mu, ("default", *self.default)):
             for what, v in (("lateral", lat), ("longitudinal", lon)):
-                try:
-                    ok = math.isfinite(v) and v > 0
-                except TypeError:
-                    ok = False
-                if not ok:
+                if not (finite_number(v) and v > 0):
                     raise SlipWeightError(f"friction coefficient of wheel '{name}' ({what}) must be a finite "
                                           f"number > 0, got {v!r}")
 
