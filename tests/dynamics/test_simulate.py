@@ -222,3 +222,32 @@ def test_a_record_step_beyond_the_run_records_its_start_with_every_method(forkli
     for sim in runs:
         assert sim.t.tolist() == [0.0]
         np.testing.assert_array_equal(sim.loads, runs[0].loads)
+
+
+def test_recorded_samples_are_bounded_in_memory_and_the_refusal_names_a_step_that_fits(forklift):
+    """5e7 steps recorded at every step were allowed: 16 GB of samples for the forklift (40 numbers a sample)."""
+    from wmrkit.dynamics import simulate as module
+
+    inputs = Inputs.torques_only(forklift, [0.0], {})
+    capacity = module.record_capacity(forklift)
+    assert capacity == module.MAX_RECORD_VALUES // (3 * forklift.n + 6 * len(forklift.contacts) + 1)
+    for method in METHODS:  # refused before integrating: no time is spent on a run that cannot be kept
+        with pytest.raises(WmrkitError, match=r"records \d+ samples, more than the \d+ of robot 'forklift'"):
+            simulate(forklift, inputs, 49_000.0, step=1e-3, record_step=1e-3, method=method)
+    every = module.recordable_step(forklift, 49_000.0, 1e-3, 1e-3)
+    steps = round(every / 1e-3)  # the least whole number of steps that fits
+    assert 49_000_000 // steps + 1 <= capacity < 49_000_000 // (steps - 1) + 1
+    assert module.recordable_step(forklift, 10.0, 1e-3, 0.01) == 0.01  # short runs keep what was asked
+
+
+def test_cli_simulate_records_within_the_memory_bound(capsys, tmp_path, monkeypatch):
+    """The CLI picks a record step that fits (here a bound of 100 samples) instead of failing or exhausting memory."""
+    import json
+
+    from wmrkit.cli.main import main
+    from wmrkit.dynamics import simulate as module
+
+    monkeypatch.setattr(module, "MAX_RECORD_VALUES", 100 * 40)
+    assert main(["simulate", "forklift", "--path", "straight", "--duration", "3", "--json"]) == 0
+    samples = json.loads(capsys.readouterr().out)["samples"]
+    assert 50 < samples <= 100  # at 0.01 s, 301 samples

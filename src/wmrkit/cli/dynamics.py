@@ -97,7 +97,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     """Simulate, print a summary, write and plot on request."""
     from ..dynamics.model import DynamicModel
     from ..dynamics.programs import path_program, read_torques
-    from ..dynamics.simulate import MAX_STEPS, simulate
+    from ..dynamics.simulate import MAX_STEPS, recordable_step, simulate
 
     model = DynamicModel.of(load_robot(args.robot), args.tyre)
     check_plot_path(args.plot)
@@ -118,7 +118,8 @@ def run_simulate(args: argparse.Namespace) -> int:
     twist = [0.0, 0.0, 0.0] if args.initial_twist is None else [
         parse_value(v, "number", "--initial-twist") for v in args.initial_twist]
     sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
-                   record_step=max(step, 0.01), progress=False if args.json else None)
+                   record_step=recordable_step(model, duration, step, max(step, 0.01)),
+                   progress=False if args.json else None)
     if args.out:
         _write(sim, args.out)
     if args.plot:

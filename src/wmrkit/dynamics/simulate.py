@@ -141,6 +141,19 @@ def joint_column(model: DynamicModel, name: str) -> int:
 #: steps a second, so under a minute.
 MAX_STEPS = 50_000_000
 
+#: Most numbers a simulation records (1 GiB of float64); a sample holds ``3 n + 6 e + 1``, 40 for the forklift.
+MAX_RECORD_VALUES = 1 << 27
+
+
+def record_capacity(model: DynamicModel) -> int:
+    """Most samples a simulation of `model` records (:data:`MAX_RECORD_VALUES` over the numbers in a sample)."""
+    return MAX_RECORD_VALUES // (3 * model.n + 6 * len(model.contacts) + 1)
+
+
+def recordable_step(model: DynamicModel, duration: float, step: float, wanted: float) -> float:
+    """The least record step >= `wanted` [s] keeping a run of `duration` within :func:`record_capacity`."""
+    return max(wanted, step * math.ceil(duration / step / (record_capacity(model) - 2)))
+
 
 def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, step: float = 1e-3,
              method: Method = "semi-implicit", tyre: Tyre | str | None = None, initial_twist: ArrayLike = (0, 0, 0),
@@ -152,7 +165,8 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     headings (or as described when the twist is 0). `record_step` [s] (default `step`, at least 1 ms for
     ``"adaptive"``) sets the output sampling; `progress` shows a tqdm bar (default: runs of 500 000 steps or more);
     `jac_every`: steps between refreshes of the tyre Jacobian of the semi-implicit method (1: every step);
-    `rtol` in (0, 1): the adaptive method's relative tolerance. At most :data:`MAX_STEPS` fixed steps and samples.
+    `rtol` in (0, 1): the adaptive method's relative tolerance. At most :data:`MAX_STEPS` fixed steps and samples,
+    and at most :func:`record_capacity` samples (1 GiB).
 
     A wheel loaded at rest whose normal load falls to 0 lifts off; the planar model cannot follow it (it clips the
     load and keeps the wheel down), so the run stops with a :class:`WmrkitError` naming the contact and the time,
@@ -170,11 +184,16 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     record = record_step or (max(step, 1e-3) if method == "adaptive" else step)
     if duration / record > MAX_STEPS:
         raise WmrkitError(f"record_step: {record:g} s over {duration:g} s is more than {MAX_STEPS:.0e} samples")
+    every = max(1, round(record / step))
+    samples = math.floor(duration / record + 0.5) + 1 if method == "adaptive" else round(duration / step) // every + 1
+    if samples > record_capacity(model):
+        raise WmrkitError(f"record_step: {record:g} s over {duration:g} s records {samples} samples, more than the "
+                          f"{record_capacity(model)} of robot '{model.robot.name}' that fit in 1 GiB "
+                          f"(MAX_RECORD_VALUES); record every {recordable_step(model, duration, step, step):g} s")
     if not 0 < rtol < 1:
         raise WmrkitError(f"rtol: expected a relative tolerance in (0, 1), got {rtol}")
     s0 = initial_state(model, initial_twist, initial_pose)
     inp = _compiled_inputs(model, inputs)
-    every = max(1, round(record / step))
     if method == "adaptive":
         rec, info = _adaptive(model, s0, inp, duration, record, rtol, allow_lift_off)
     else:
