@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -10,6 +12,7 @@ from slip_helpers import L3, L12, R, forklift_at_axle, thesis_twist_to_rep
 
 from wmrkit import catalog
 from wmrkit.dynamics.mass import Body
+from wmrkit.errors import WmrkitError
 from wmrkit.slip.models import LinearFriction, mcd, mqe, normal_loads, wls
 from wmrkit.slip.weights import SlipWeightError, SlipWeights
 
@@ -228,3 +231,19 @@ def test_normal_loads_equal_the_dynamic_model_s_on_a_castor_robot():
         w["inertia"] = {"spin": 0.01, **({"steer": 0.002} if w["type"] == "castor" else {})}
     robot = Robot.from_dict(d)
     assert normal_loads(robot) == pytest.approx(DynamicModel.of(robot).normal_loads(), rel=1e-9)
+
+
+def test_a_friction_law_that_does_not_fit_the_robot_is_refused_by_name():
+    """A LinearFriction of the wrong length gave numpy's broadcast error; NaN or negative coefficients gave a twist."""
+    robot = catalog.load("skid-steer-4")
+    rates = [1.0, 1.0, 1.0, 1.0]
+    for mu, match in (((1.0,) * 4, "2 pairs of coefficients for 4 contacts"), ((1.0, math.nan) * 4, "finite"),
+                      ((-1.0, 1.0) * 4, "> 0"), ((), "a .lateral, longitudinal. pair")):
+        with pytest.raises(WmrkitError, match=match):
+            mcd(robot, robot.actuated, rates, LinearFriction(mu))
+    with pytest.raises(WmrkitError, match=r"shape \(4, 2\), one pair per contact, got shape \(2, 2\)"):
+        mqe(robot, robot.actuated, rates, lambda slip, v, loads: -slip[:2])
+    with pytest.raises(WmrkitError, match="non-finite"):
+        mcd(robot, robot.actuated, rates, lambda slip, v, loads: slip * math.inf)
+    good = mcd(robot, robot.actuated, rates, LinearFriction((1.0,) * 8))
+    assert good.converged.all()

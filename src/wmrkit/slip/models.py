@@ -45,6 +45,14 @@ class LinearFriction:
 
     mu: tuple[float, ...]  # (2 E,) per row of the slip matrix, lateral then longitudinal per contact
 
+    def __post_init__(self) -> None:
+        """Pairs of finite coefficients > 0 (as :class:`SlipWeights`: a NaN or negative one gave a wrong twist)."""
+        mu = np.asarray(self.mu, dtype=float)
+        if mu.ndim != 1 or mu.size == 0 or mu.size % 2:
+            raise WmrkitError(f"LinearFriction: expected a (lateral, longitudinal) pair per contact, got {self.mu!r}")
+        if not (np.isfinite(mu) & (mu > 0)).all():
+            raise WmrkitError(f"LinearFriction: every coefficient must be a finite number > 0, got {self.mu!r}")
+
     @classmethod
     def from_weights(cls, robot: Robot, weights: SlipWeights) -> LinearFriction:
         """The law whose coefficients are `weights`."""
@@ -279,6 +287,8 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
                 out[:3] -= inertial
             return out
 
+        if i == 0:
+            _check_law(friction, slip_shape=(n_e, 2), loads=static if quasi_static is None else None)
         scale = max(1.0, float(np.max(np.abs(equations(q0[i][free])))))
         sol = root(lambda z, s=scale: equations(z) / s, q0[i][free], method="hybr", tol=tol * 1e-3)
         q = np.empty(k)
@@ -296,6 +306,21 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
     body_v = (a_b[..., :3] @ q_out[..., :3, None])[..., 0]
     forces = friction(slip.reshape(*batch, n_e, 2), body_v.reshape(*batch, n_e, 2), f_n).reshape(*batch, 2 * n_e)
     return SlipSolution(q_out, slip, forces, res.reshape(batch), ok.reshape(batch))
+
+
+def _check_law(friction: FrictionLaw, slip_shape: tuple[int, int], loads: np.ndarray | None) -> None:
+    """Refuse a friction law that does not give one finite (lateral, longitudinal) force per contact."""
+    if isinstance(friction, LinearFriction) and len(friction.mu) != 2 * slip_shape[0]:
+        raise WmrkitError(f"LinearFriction: {len(friction.mu) // 2} pairs of coefficients for {slip_shape[0]} "
+                          "contacts (one (lateral, longitudinal) pair per contact)")
+    probe = np.full(slip_shape, 0.1)
+    try:
+        f = np.asarray(friction(probe, probe, np.ones(slip_shape[0]) if loads is None else loads), dtype=float)
+    except (ValueError, TypeError, IndexError) as err:
+        raise WmrkitError(f"friction law: fails on {slip_shape[0]} contacts ({err})") from None
+    if f.shape != slip_shape or not np.isfinite(f).all():
+        raise WmrkitError(f"friction law: expected finite forces of shape {slip_shape}, one pair per contact, got "
+                          f"shape {f.shape}" + ("" if f.shape != slip_shape else " with non-finite values"))
 
 
 def _centripetal(quasi: tuple[Body, float], load_map: np.ndarray,
