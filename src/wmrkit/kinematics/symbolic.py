@@ -20,14 +20,22 @@ from typing import Literal
 
 import sympy as sp
 
-from ..errors import SingularError, UnknownNameError
+from ..errors import SingularError, UnknownNameError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
 from ..wheels import GEOMETRY_FIELDS
-from ._exact_linalg import agrees, numeric, random_points, solve_exactly
+from ._exact_linalg import _components, agrees, numeric, random_points, solve_exactly
 from ._symbolic_matrix import AssignmentError, constraint, exact_number, geometry_fields
 from .linalg import matrix_rank
 
 Geometry = Literal["numeric", "symbolic"] | Mapping[str, sp.Expr]
+
+#: Steering angles one least-squares closed form (4.11) may couple by default: its derivation grows about fourfold
+#: per angle (castors: 3 take seconds, 4 about 20 s, 5 a minute and a half, 6 several minutes, 12 hours).
+MAX_LSQ_ANGLES = 4
+
+
+class ClosedFormTooLargeError(WmrkitError, ValueError):
+    """A least-squares closed form that couples more steering angles than allowed (it would take too long)."""
 
 
 # ---- symbols ---------------------------------------------------------------------------------------------
@@ -144,6 +152,7 @@ def symbolic_model(
     beta: Sequence[sp.Expr | float] | None = None,
     *,
     geometry: Geometry = "numeric",
+    max_lsq_angles: int = MAX_LSQ_ANGLES,
 ) -> SymbolicModel:
     """Closed-form solution of ``A q = 0`` for the velocities not in `assigned`, thesis (4.5)/(4.9)-(4.11).
 
@@ -151,18 +160,23 @@ def symbolic_model(
     exactly (the ranks / null-space method). With more assigned velocities than the mobility m (the extended
     solution of §4.5) it is the least-squares solution ``-(A_na^T A_na)^-1 A_na^T A_a`` (4.11)/(4.82), as long
     as ``A_na`` keeps full column rank; otherwise :class:`SingularError`. Ranks are generic: evaluated at random
-    values of every symbol. `beta`, `geometry`: as in :func:`symbolic_constraint_matrix`.
+    values of every symbol. `beta`, `geometry`: as in :func:`symbolic_constraint_matrix`. A least-squares form
+    whose unknowns couple more than `max_lsq_angles` steering symbols (:data:`MAX_LSQ_ANGLES`) is refused at once
+    with :class:`ClosedFormTooLargeError` (the derivation grows about fourfold per angle).
     """
     names = tuple(assigned)
     for n in names:
         robot.velocity_index(n)
         if names.count(n) > 1:
             raise AssignmentError(f"assigned: velocity '{n}' listed twice")
-    return _solve(robot, names, _steering_values(robot, beta), _geometry_key(robot, geometry))
+    if isinstance(max_lsq_angles, bool) or not isinstance(max_lsq_angles, int) or max_lsq_angles < 0:
+        raise AssignmentError(f"max_lsq_angles: expected a whole number >= 0, got {max_lsq_angles!r}")
+    return _solve(robot, names, _steering_values(robot, beta), _geometry_key(robot, geometry), max_lsq_angles)
 
 
 @functools.lru_cache(maxsize=128)
-def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], geometry: tuple) -> SymbolicModel:
+def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], geometry: tuple,
+           max_lsq_angles: int) -> SymbolicModel:
     a = constraint(robot, beta, geometry)
     a_idx = [robot.velocity_index(n) for n in assigned]
     na_idx = [j for j in range(a.cols) if j not in a_idx]
@@ -177,6 +191,12 @@ def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], g
             f"({', '.join(solved)}): rank A_na = {rank_na} < {len(na_idx)} unknowns (mobility m = {a.cols - rank})"
         )
     exact = rank_na == rank
+    coupled = [] if exact else _coupled_angles(a, na_idx, beta)
+    if len(coupled) > max_lsq_angles:
+        raise ClosedFormTooLargeError(
+            f"robot '{robot.name}': the least-squares closed form for ({', '.join(assigned) or 'nothing'}) couples "
+            f"{len(coupled)} steering angles ({', '.join(coupled)}), more than max_lsq_angles = {max_lsq_angles}: "
+            "it would take minutes to hours; use the numeric models ('wmrkit kinematics') or the generated code")
     try:
         m, residual = solve_exactly(a, na_idx, a_idx, exact, values[0])
         ok = agrees(m, a, na_idx, a_idx, points[1])
@@ -189,6 +209,14 @@ def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], g
         matrix=sp.ImmutableMatrix(m), residual=sp.ImmutableMatrix(residual),
         exact=exact, steering=beta, rank=rank, mobility=a.cols - rank,
     )
+
+
+def _coupled_angles(a: sp.MatrixBase, na_idx: list[int], beta: tuple[sp.Expr, ...]) -> list[str]:
+    """Names of the steering symbols in the rows of the largest block of unknowns solved together (the cost of
+    its least-squares closed form)."""
+    steering = set().union(*(b.free_symbols for b in beta))
+    blocks = [set().union(*(a.row(i).free_symbols for i in rows)) & steering for rows, _ in _components(a[:, na_idx])]
+    return sorted(s.name for s in max(blocks, key=len, default=set()))
 
 
 # ---- default assignments and printing --------------------------------------------------------------------
@@ -214,7 +242,7 @@ def twist_assignment(robot: Robot) -> tuple[str, ...]:
         try:
             if symbolic_model(robot, subset + free).exact:
                 return subset + free
-        except SingularError:
+        except (SingularError, ClosedFormTooLargeError):  # not exact: the next subset
             continue
     return TWIST_NAMES + free
 
@@ -240,6 +268,9 @@ def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, late
             model = symbolic_model(robot, names)
         except SingularError as err:
             lines.append(f"{comment}  not determined: {err}")
+            continue
+        except ClosedFormTooLargeError as err:
+            lines.append(f"{comment}  not derived: {err}")
             continue
         if model.exact:
             how = f"exact (4.5)/(4.11): assignable set, generic rank A = {model.rank}, mobility m = {model.mobility}"

@@ -1,0 +1,64 @@
+"""Bounded time of the closed forms (wmrkit.kinematics.symbolic): a least-squares form that couples many steering
+angles is refused at once, and ``kinematics --symbolic`` says so instead of computing for hours."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import pytest
+import yaml
+
+from wmrkit import Robot
+from wmrkit.cli.main import main
+from wmrkit.kinematics.symbolic import (
+    MAX_LSQ_ANGLES,
+    AssignmentError,
+    ClosedFormTooLargeError,
+    format_symbolic,
+    sensed_rates,
+    symbolic_model,
+    twist_assignment,
+)
+
+
+def castors(n: int) -> dict:
+    """`n` castors on a circle, every joint sensed (by default): the direct model is least squares over n angles."""
+    return {"name": f"castors{n}", "wheels": [
+        {"name": f"w{i}", "type": "castor", "d": 0.03, "r": 0.05,
+         "position": [round(0.5 * math.cos(2 * math.pi * i / n) + 0.01 * i, 4),
+                      round(0.5 * math.sin(2 * math.pi * i / n), 4)]} for i in range(n)]}
+
+
+def test_a_least_squares_form_over_many_angles_is_refused_at_once():
+    """Six castors: the least-squares direct model couples six steering angles; its derivation took several minutes
+    (twelve castors: hours), now ClosedFormTooLargeError names them at once. The exact inverse model is still
+    derived (one angle per wheel)."""
+    robot = Robot.from_dict(castors(6))
+    start = time.perf_counter()
+    with pytest.raises(ClosedFormTooLargeError, match=r"couples 6 steering angles \(beta_w0, beta_w1, beta_w2, "
+                                                      r"beta_w3, beta_w4, beta_w5\), more than max_lsq_angles = 4"):
+        symbolic_model(robot, sensed_rates(robot))
+    assert time.perf_counter() - start < 10
+    assert twist_assignment(robot) == ("vx", "vy", "omega")
+    assert symbolic_model(robot, ("vx", "vy", "omega")).exact
+    assert MAX_LSQ_ANGLES == 4
+
+
+def test_the_limit_is_a_keyword():
+    robot = Robot.from_dict(castors(3))
+    with pytest.raises(ClosedFormTooLargeError, match="couples 3 steering angles"):
+        symbolic_model(robot, sensed_rates(robot), max_lsq_angles=2)
+    with pytest.raises(AssignmentError, match="max_lsq_angles: expected a whole number >= 0, got -1"):
+        symbolic_model(robot, sensed_rates(robot), max_lsq_angles=-1)
+
+
+def test_format_and_cli_print_why_a_model_is_not_derived(tmp_path, capsys):
+    data = castors(6)
+    text = format_symbolic(Robot.from_dict(data))
+    assert "  not derived: robot 'castors6': the least-squares closed form" in text
+    assert "inverse model, assigned: vx, vy, omega" in text and "w0.spin = " in text
+    path = tmp_path / "castors6.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["kinematics", str(path), "--symbolic"]) == 0
+    assert "not derived: robot 'castors6'" in capsys.readouterr().out
