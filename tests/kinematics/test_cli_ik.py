@@ -71,7 +71,8 @@ def test_fk_json_and_text(capsys):
     code, out, err = run(capsys, "fk", "diff-drive", "--spin", "left=10", "--spin", "right.spin=12", "--json")
     assert code == 0 and err == ""
     data = json.loads(out)
-    assert set(data) == {"twist", "residual", "consistent", "slipping"} and data["consistent"] is True
+    assert set(data) == {"twist", "determined", "residual", "consistent", "slipping"} and data["consistent"] is True
+    assert data["determined"] is True
     r, half_track = 0.075, 0.20
     np.testing.assert_allclose(data["twist"], [r * 11, 0.0, r * 2 / (2 * half_track)], atol=1e-12)
     assert data["residual"] < 1e-12
@@ -80,6 +81,17 @@ def test_fk_json_and_text(capsys):
     assert "contradict" in err  # one module turned to 100 deg, the others straight: no common ICR, they slip
     code, out, err = run(capsys, "fk", "diff-drive", "--spin", "left=3")
     assert code == 0 and "do not determine the twist" in err and err.count("\n") == 1
+    # under --json the output says so too (it had only the text warning: a program read a minimum-norm twist)
+    code, out, err = run(capsys, "fk", "diff-drive", "--spin", "left=3", "--json")
+    assert code == 0 and json.loads(out)["determined"] is False and "do not determine the twist" in err
+
+
+def test_ik_text_names_each_reason_once(capsys):
+    """Both front wheels of the car out of their steer_range: 'NO (a wheel cannot steer there; a wheel cannot steer
+    there)' repeated the reason per wheel (the warnings on stderr name the wheels)."""
+    code, out, err = run(capsys, "ik", "ackermann", "--twist", "1", "0", "1")
+    assert code == 0 and out.splitlines()[-1] == "feasible: NO (a wheel cannot steer there)"
+    assert "wheel 'front_left'" in err and "wheel 'front_right'" in err
 
 
 @pytest.mark.parametrize(("argv", "message"), [

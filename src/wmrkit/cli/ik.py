@@ -66,8 +66,8 @@ def run_fk(args: argparse.Namespace) -> int:
                               "fast")
     fk = forward_kinematics_check(robot, rates)
     _check_finite("fk", fk.twist, fk.residual)
-    twist = fk.twist
-    if not twist_is_determined(robot, list(rates)):
+    twist, determined = fk.twist, bool(twist_is_determined(robot, list(rates)))
+    if not determined:
         print(f"wmrkit: warning: these rates do not determine the twist of robot '{robot.name}'; "
               "printing the minimum-norm one", file=sys.stderr)
     if not fk.consistent:
@@ -77,8 +77,8 @@ def run_fk(args: argparse.Namespace) -> int:
               f"{fk.residual:.3g} m/s > tolerance {fk.tolerance:.3g} m/s); check units, signs and --steer headings",
               file=sys.stderr)
     if args.json:
-        print_json({"twist": twist.tolist(), "residual": fk.residual, "consistent": fk.consistent,
-                    "slipping": list(fk.slipping)})
+        print_json({"twist": twist.tolist(), "determined": determined, "residual": fk.residual,
+                    "consistent": fk.consistent, "slipping": list(fk.slipping)})
     else:
         print(f"twist (robot frame): vx = {twist[0]:.6g} m/s, vy = {twist[1]:.6g} m/s, omega = {twist[2]:.6g} rad/s")
         print(f"residual (slip norm): {fk.residual:.3g} m/s ({'consistent' if fk.consistent else 'INCONSISTENT'})")
@@ -115,7 +115,7 @@ def format_commands(robot: Robot, commands: WheelCommands) -> str:
         heading = math.degrees(entry.get("heading", math.nan))
         lines.append(f"{w.name:<14}{w.type:<14}{_num(heading):>14}{_num(entry['spin']):>14}"
                      f"{_num(entry['steer_rate']):>12}{_num(data['slip'][w.name]):>12}  {other}".rstrip())
-    reasons = [why.split(":")[0] for why in _infeasible(robot, commands)]
+    reasons = dict.fromkeys(why.split(":")[0] for why in _infeasible(robot, commands))  # each reason once
     lines.append("feasible: " + ("yes" if data["feasible"] else f"NO ({'; '.join(reasons)})"))
     return "\n".join(lines)
 
