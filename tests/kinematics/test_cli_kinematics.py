@@ -117,3 +117,15 @@ def test_a_robot_that_cannot_move(capsys, tmp_path):
     out = capsys.readouterr().out
     assert "mobility m = 0" in out and "cannot move (m = 0)" in out
     assert run_json(capsys, ["kinematics", str(path)])["assignable_sets"] == [[]]
+
+
+def test_an_unknown_codegen_language_is_refused_before_the_work(capsys, monkeypatch, tmp_path):
+    """The language was checked after the chapter-4 summary (and --symbolic): tens of seconds on a large robot."""
+    import wmrkit.cli.kinematics as command
+
+    def never(robot):
+        raise AssertionError("the summary ran before the language was checked")
+
+    monkeypatch.setattr(command, "kinematics_summary", never)
+    assert main(["kinematics", "forklift", "--symbolic", "--codegen", "rust", str(tmp_path)]) == 2
+    assert "--codegen: language must be one of c, python, got 'rust'" in capsys.readouterr().err

@@ -33,6 +33,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print the chapter-4 summary; --symbolic and --codegen add closed forms and generated files."""
+    if args.codegen and args.codegen[0] not in CODEGEN_LANGUAGES:  # before the work, not after it
+        raise WmrkitError(f"--codegen: language must be one of {', '.join(CODEGEN_LANGUAGES)}, got '{args.codegen[0]}'")
     robot = steered_robot(args.robot, args.steer)
     summary = kinematics_summary(robot)
     if args.symbolic:
@@ -41,8 +43,6 @@ def run(args: argparse.Namespace) -> int:
         summary["symbolic"] = format_symbolic(robot)
     if args.codegen:
         lang, directory = args.codegen
-        if lang not in CODEGEN_LANGUAGES:
-            raise WmrkitError(f"--codegen: language must be one of {', '.join(CODEGEN_LANGUAGES)}, got '{lang}'")
         from ..kinematics.codegen import write_code
 
         summary["generated"] = [str(p) for p in write_code(robot, lang, directory)]
