@@ -34,8 +34,8 @@ def _robot(name: str, steered: str, castor: str = "caster") -> Robot:
         Wheel(castor, "castor", 0.3, math.pi, 0.0, 0.03, d=0.04)))
 
 
-def _gcc_errors(source: Path) -> str:
-    out = subprocess.run([GCC, "-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", "-c", "-o", "/dev/null",
+def _gcc_errors(source: Path, *flags: str) -> str:
+    out = subprocess.run([GCC, "-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", *flags, "-c", "-o", "/dev/null",
                           str(source)], capture_output=True, text=True)
     return out.stderr
 
@@ -104,3 +104,11 @@ def test_cli_refuses_to_overwrite_with_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "forklift_kinematics.h: exists and is not wmrkit's code" in err
     assert (tmp_path / "forklift_kinematics.h").read_text() == "/* mine */\n"
+
+
+@pytest.mark.skipif(GCC is None, reason="gcc not installed")
+def test_c_compiles_under_the_warnings_embedded_projects_use(tmp_path):
+    """-Wdouble-promotion refused `status == 0 ? x[i] : NAN` (NAN is a float) in every generated forward model."""
+    _, source = write_code(catalog.load("swerve-4"), "c", tmp_path)
+    assert _gcc_errors(source, "-Wshadow", "-Wconversion", "-Wdouble-promotion", "-Wfloat-equal", "-Wcast-qual",
+                       "-Wstrict-prototypes", "-Wmissing-prototypes", "-Wundef") == ""

@@ -298,7 +298,7 @@ def _c_files(plan: _Plan) -> list[tuple[str, str]]:
         f"    /* unknowns x: {_c_comment(', '.join(r.velocity_names[j] for j in plan.unknown_cols))} */",
         _c_body(plan, a_na + b, fw_targets),
         f"    const int status = lstsq({p}_N_ROWS, {na}, a, b, x, residual);",
-        "    for (int i = 0; i < 3; ++i) twist[i] = status == 0 ? x[i] : NAN;",
+        "    for (int i = 0; i < 3; ++i) twist[i] = status == 0 ? x[i] : (double)NAN;",
         "    if (status != 0 && residual) *residual = NAN;",
         "    return status;", "}", "",
     ])
