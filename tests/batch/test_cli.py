@@ -22,8 +22,9 @@ def test_batch_odometry(capsys, fleet_dir, tmp_path):
                           "--out", str(out), "--trajectories", str(tmp_path), "--json"], code=1)
     assert data["logs"] == 6 and data["failed"] == 1 and out.exists()
     assert all(r["closure_error"] < 0.1 for r in data["rows"] if not r["error"])
-    assert main(["batch", "odometry", "diff-drive", str(fleet_dir), "--workers", "0", "--out", str(out)]) == 1
-    assert "5 from an earlier run" in capsys.readouterr().out
+    assert main(["batch", "odometry", "diff-drive", str(fleet_dir), "--workers", "0", "--closed", "--out",
+                 str(out)]) == 1
+    assert "5 from an earlier run" in capsys.readouterr().out  # the same settings (with --closed): rows reused
     data = _json(capsys, ["batch", "odometry", "diff-drive", str(fleet_dir / "run*.csv"), "--workers", "0",
                           "--json"])  # without the broken log: exit 0
     assert data["logs"] == 5 and data["failed"] == 0

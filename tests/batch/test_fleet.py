@@ -129,3 +129,64 @@ def test_each_log_is_read_as_its_header_says(fleet_dir, diff, tmp_path):
     want = load_csv(velocity, ("left.spin", "right.spin"), LogFormat(spin="velocity"))
     np.testing.assert_allclose(run.log.time, want.time, atol=1e-12)
     np.testing.assert_allclose(run.log.positions, want.positions, atol=1e-9)
+
+
+def test_a_rerun_with_other_settings_redoes_the_logs(fleet_dir, diff, tmp_path):
+    """Rows were reused on the robot's name and the method alone: a rerun with a calibrated robot of the same name
+    returned the old geometry's poses, and one with closed=True rows without a closure error."""
+    from wmrkit.odometry.calibration import apply_parameters
+
+    out, logs = tmp_path / "res.parquet", [fleet_dir / "run0.csv", fleet_dir / "run1.csv"]
+    batch_odometry(diff, logs, out=out)
+    bigger = apply_parameters(diff, ["left.r", "right.r"], [0.05, 0.05])
+    assert bigger.name == diff.name
+    res = batch_odometry(bigger, logs, out=out)
+    want = odometry(bigger, load_csv(logs[0], ("left.spin", "right.spin"))).poses[-1]
+    assert res.skipped == 0 and (res.rows[0]["x"], res.rows[0]["y"]) == pytest.approx(tuple(want[:2]), abs=1e-12)
+    closed = batch_odometry(bigger, logs, out=out, closed=True)
+    assert closed.skipped == 0 and all(r["closure_error"] is not None for r in closed.rows)
+    assert batch_odometry(bigger, logs, out=out, closed=True).skipped == 2
+    stat = os.stat(logs[1])  # a log recorded again under the same name is redone
+    os.utime(logs[1], ns=(stat.st_atime_ns, stat.st_mtime_ns + 10**9))
+    assert batch_odometry(bigger, logs, out=out, closed=True).skipped == 1
+
+
+def test_an_output_file_of_another_kind_is_refused(fleet_dir, diff, tmp_path):
+    """A sweep's table given as --out was replaced without a word; one whose columns have other types failed
+    with pyarrow's traceback (ArrowInvalid)."""
+    pa = pytest.importorskip("pyarrow")
+    other = tmp_path / "sweep.parquet"
+    pq.write_table(pa.table({"index": [0, 1], "metric": [1.0, 2.0]}), other)
+    for resume in (True, False):
+        with pytest.raises(BatchError, match=r"sweep.parquet: not a table of this command \(no column 'log'"):
+            batch_odometry(diff, [fleet_dir / "run0.csv"], out=other, resume=resume)
+    assert pq.read_table(other).column_names == ["index", "metric"]
+    typed = tmp_path / "typed.parquet"
+    pq.write_table(pa.table({"log": [str(fleet_dir / "run0.csv")], "robot": ["diff-drive"], "method": ["exact"],
+                             "x": ["oops"], "error": pa.array([None], pa.string()),
+                             "trajectory": pa.array([None], pa.string())}), typed)
+    with pytest.raises(BatchError, match=r"typed\.parquet: column 'x' is string, expected double"):
+        batch_odometry(diff, [fleet_dir / "run0.csv"], out=typed)
+
+
+def test_an_empty_folder_and_a_log_given_twice(fleet_dir, diff, tmp_path):
+    """A folder without logs gave '0 logs: 0 done' and exit 0; one log under two spellings ran twice, both runs
+    writing the same trajectory file."""
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(BatchError, match="empty: no logs in the folder"):
+        expand_logs([tmp_path / "empty"])
+    with pytest.raises(BatchError, match="no logs given"):
+        batch_odometry(diff, [])
+    twice = [str(fleet_dir / "run0.csv"), os.path.join(str(fleet_dir), ".", "run0.csv")]
+    assert expand_logs(twice) == twice[:1]
+    res = batch_odometry(diff, twice, trajectories=tmp_path / "traj")
+    assert len(res.rows) == 1 and res.failed == 0
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux's /proc (a folder no one can write into)")
+def test_a_table_that_cannot_be_written_is_named():
+    """pyarrow's error carries no file name, so the command ended in a traceback (sweep --out)."""
+    from wmrkit.batch.parquet import write_rows
+
+    with pytest.raises(BatchError, match=r"/proc/x\.parquet: cannot write the table"):
+        write_rows("/proc/x.parquet", [{"log": "a"}], [("log", "string")])

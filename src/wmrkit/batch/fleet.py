@@ -28,7 +28,7 @@ import numpy as np
 from ..odometry.logs import LogFormat
 from ..robot import Robot
 from .engine import BatchError, Engine, TaskFailure, engine
-from .parquet import RowSink, read_rows
+from .parquet import RowSink, check_table, read_rows
 
 #: Columns of the batch-odometry table (name, type); lengths in m, angles in rad, times in s.
 SUMMARY_SCHEMA = (
@@ -37,7 +37,10 @@ SUMMARY_SCHEMA = (
     ("path_length", "float64"), ("rotation", "float64"), ("closure_error", "float64"),
     ("closure_heading", "float64"), ("max_slip", "float64"), ("rms_slip", "float64"), ("max_dt", "float64"),
     ("warnings", "string"), ("error", "string"), ("trajectory", "string"), ("seconds", "float64"),
+    ("settings", "string"),
 )
+#: Columns a table must have to be a batch-odometry table at all (an older one lacks some others: it is redone).
+KEY_COLUMNS = ("log", "robot", "method", "error", "trajectory")
 #: Suffixes of single-file logs found in a folder (CSV joint logs, ROS 2 bag files).
 LOG_SUFFIXES = (".csv", ".db3", ".mcap")
 
@@ -85,12 +88,19 @@ def expand_logs(patterns: Sequence[str | os.PathLike[str]]) -> list[str]:
             if not p.exists():
                 raise BatchError(f"{m}: no such file or folder")
             if p.is_dir() and not (p / "metadata.yaml").exists():
-                out.extend(os.fspath(c) for c in sorted(p.iterdir())
-                           if (c.is_file() and c.suffix.lower() in LOG_SUFFIXES)
-                           or (c.is_dir() and (c / "metadata.yaml").exists()))
+                found = [os.fspath(c) for c in sorted(p.iterdir())
+                         if (c.is_file() and c.suffix.lower() in LOG_SUFFIXES)
+                         or (c.is_dir() and (c / "metadata.yaml").exists())]
+                if not found:  # else an empty batch "succeeded" with exit 0
+                    raise BatchError(f"{m}: no logs in the folder (CSV, .db3 or .mcap files, or ROS 2 bag folders)")
+                out.extend(found)
             else:
                 out.append(m)
-    return list(dict.fromkeys(out))
+    # one log given twice (logs/a.csv and ./logs/a.csv) is run once: twice, both runs wrote one trajectory file
+    first: dict[str, str] = {}
+    for m in out:
+        first.setdefault(os.path.normcase(os.path.abspath(m)), m)
+    return list(first.values())
 
 
 def process_log(job: LogJob) -> dict[str, Any]:
@@ -156,6 +166,8 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
             raise BatchError("batch odometry: give fmt (a whole CSV layout) or header settings, not both")
     header = None if fmt is not None else dict(header or {})
     paths = expand_logs(logs)
+    if not paths:
+        raise BatchError("batch odometry: no logs given")
     if out is not None and not Path(out).absolute().parent.is_dir():
         raise BatchError(f"--out {os.fspath(out)}: the folder {Path(out).absolute().parent} does not exist")
     if trajectories is not None:  # made with its parents when missing, as every output folder of the CLI
@@ -167,7 +179,11 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     if trajectory_format not in ("csv", "tum"):
         raise BatchError(f"trajectory format must be csv or tum, got '{trajectory_format}'")
     targets = _trajectory_names(paths, trajectories, trajectory_format)
-    done = _done(out, robot, method, targets) if resume and out is not None else {}
+    batch = _fingerprint(robot, method, closed, slip_warning, options, header, sensed, weights)
+    settings = {p: _fingerprint(batch, _stat(p)) for p in paths}
+    # an existing --out must be a table of this command (it is replaced at the end), even without resuming
+    current = check_table(out, SUMMARY_SCHEMA, KEY_COLUMNS) if out is not None and Path(out).is_file() else True
+    done = _done(out, robot, method, targets, settings) if resume and out is not None and current else {}
     jobs = [LogJob(p, robot, method, targets[p], closed, slip_warning, options, model, header)
             for p in paths if p not in done]
     sink = RowSink(out, SUMMARY_SCHEMA)
@@ -180,6 +196,7 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
             if isinstance(row, TaskFailure):  # the worker died more often than the scheduler allows
                 row = {name: None for name, _ in SUMMARY_SCHEMA} | {"log": jobs[index].path, "robot": robot.name,
                                                                      "method": method, "error": str(row)}
+            row = dict(row) | {"settings": settings[row["log"]]}
             rows[row["log"]] = row
             sink.add(row)
     finally:
@@ -191,12 +208,17 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     return FleetResult(ordered, len(done), sum(1 for r in ordered if r["error"]))
 
 
-def _done(out, robot: Robot, method: str, targets: Mapping[str, str | None]) -> dict[str, Mapping[str, Any]]:
-    """Rows of an earlier run that need no redoing: same log, robot and method, no error, trajectory present."""
+def _done(out, robot: Robot, method: str, targets: Mapping[str, str | None],
+          settings: Mapping[str, str]) -> dict[str, Mapping[str, Any]]:
+    """Rows of an earlier run that need no redoing: same log, robot and method, made with the same settings
+    (robot description, options, log file: ``settings``), no error, trajectory present."""
     keep: dict[str, Mapping[str, Any]] = {}
     for row in read_rows(out):
         p = row.get("log")
         if p not in targets or row.get("robot") != robot.name or row.get("method") != method:
+            continue
+        if row.get("settings") != settings[p]:  # another geometry of the same name, --closed, --sensed, a new log
+            keep.pop(p, None)
             continue
         want = targets[p]
         if row.get("error") or (want is not None and (row.get("trajectory") != want or not Path(want).exists())):
@@ -204,6 +226,30 @@ def _done(out, robot: Robot, method: str, targets: Mapping[str, str | None]) -> 
             continue
         keep[p] = row
     return keep
+
+
+def _fingerprint(*parts: Any) -> str:
+    """A short digest of `parts` (their ``repr``; mappings sorted by key)."""
+    def canonical(x: Any) -> Any:
+        if isinstance(x, Mapping):
+            return sorted((str(k), canonical(v)) for k, v in x.items())
+        if isinstance(x, Robot):
+            from ..description import robot_to_dict
+
+            return canonical(robot_to_dict(x))
+        if isinstance(x, list | tuple):
+            return [canonical(v) for v in x]
+        return x
+
+    return hashlib.sha1(repr(canonical(list(parts))).encode()).hexdigest()[:16]
+
+
+def _stat(path: str) -> tuple:
+    """Size and modification time of a log file, or of every file of a bag folder (a changed log is redone)."""
+    p = Path(path)
+    files = sorted(f for f in p.rglob("*") if f.is_file()) if p.is_dir() else [p]
+    return tuple((os.fspath(f.relative_to(p)) if p.is_dir() else "", f.stat().st_size, f.stat().st_mtime_ns)
+                 for f in files)
 
 
 def _trajectory_names(paths: Sequence[str], folder, fmt: str) -> dict[str, str | None]:

@@ -37,8 +37,33 @@ def write_rows(path: str | os.PathLike[str], rows: Sequence[Mapping[str, Any]], 
     if path.parent and not path.parent.exists():
         raise BatchError(f"{path}: the folder {path.parent} does not exist")
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    pq.write_table(table, tmp)
-    os.replace(tmp, path)
+    try:
+        pq.write_table(table, tmp)
+        os.replace(tmp, path)
+    except OSError as err:  # pyarrow's errors carry no file name: the command would end in a traceback
+        raise BatchError(f"{path}: cannot write the table ({' '.join(str(err.strerror or err).split())})") from None
+
+
+def check_table(path: str | os.PathLike[str], schema: Schema, keys: Sequence[str]) -> bool:
+    """Refuse a Parquet file at `path` that is not a table of `schema` (a table of another command, which the
+    batch would overwrite, or columns of other types, on which it would fail); True when it has every column of
+    `schema` (its rows can be resumed), False when it lacks some but has the `keys` (an older table: redone)."""
+    pq = need_extra("pyarrow.parquet")
+    try:
+        found = pq.read_schema(path)
+    except Exception as err:
+        raise BatchError(f"{path}: not a readable Parquet table ({' '.join(str(err).split())})") from None
+    want = _schema(schema)
+    missing = [k for k in keys if k not in found.names]
+    if missing:
+        raise BatchError(f"{path}: not a table of this command (no column '{missing[0]}'; columns: "
+                         f"{', '.join(found.names[:6])}{', ...' if len(found.names) > 6 else ''}); remove it or "
+                         "choose another output file")
+    for name in found.names:
+        if name in want.names and not found.field(name).type.equals(want.field(name).type):
+            raise BatchError(f"{path}: column '{name}' is {found.field(name).type}, expected "
+                             f"{want.field(name).type}; remove it or choose another output file")
+    return all(name in found.names for name in want.names)
 
 
 def read_rows(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
