@@ -85,3 +85,10 @@ def test_montecarlo_refuses_a_built_in_path_the_robot_cannot_steer(capsys):
     err = capsys.readouterr().err
     assert "wheel 'front_left' would steer to heading" in err and "steer_range [-40, 40] deg" in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_sweep_text_gives_the_units_of_the_best_designs(capsys):
+    """The best designs were printed as 'wheels[0].alpha = 1.0472' (radians, though --vary was given in deg)."""
+    assert main(["sweep", "omni-3", "--vary", "wheels[0].alpha=30deg:90deg:3", "--vary", "wheels.back.l=0.15:0.25:3",
+                 "--workers", "0", "--top", "1"]) == 0
+    assert "wheels[0].alpha = 1.0472 rad, wheels.back.l = 0.2 m" in capsys.readouterr().out

@@ -128,3 +128,58 @@ def test_kappa_metrics_are_refused_for_robots_of_mobility_1(name):
     else:  # driven through a differential: the per-wheel kernel would give the margin of separate joints
         with pytest.raises(BatchError, match=r"are one differential.*not of this robot's actuated model"):
             build_spec(robot, axes, "singular_margin", configs=8)
+
+
+def test_refusals_come_before_the_per_wheel_tables(monkeypatch):
+    """A robot the metric cannot rate was refused after one rebuild per swept value (a 3000-point axis of a swerve
+    drive: 35 s, hours at the 10^6 points allowed)."""
+    import wmrkit.batch.sweep_kernel as kernel
+
+    def no_rebuild(*args, **kwargs):
+        raise AssertionError("a robot was rebuilt before the refusal")
+
+    monkeypatch.setattr(kernel, "variant", no_rebuild)
+    for name, metric, msg in [("swerve-4", "kappa_mean", "has mobility 1"),
+                              ("forklift", "singular_margin", "are one differential")]:
+        robot = catalog.load(name)
+        with pytest.raises(BatchError, match=msg):
+            build_spec(robot, [parse_vary("wheels[0].l=0.8:1.2:1000", robot)], metric)
+
+
+def test_a_chunk_holds_a_bounded_number_of_configurations(monkeypatch):
+    """A chunk evaluates designs x configurations at once (about 0.5 kB each): 4096 designs of --configs 10000
+    needed 22 GB. Fewer designs go into a chunk when there are many configurations; the values do not change."""
+    driver = sys.modules["wmrkit.batch.sweep"]  # the module (wmrkit.batch.sweep is also the function's name)
+    robot = catalog.load("thesis-steer-castor")
+    axes = [parse_vary("wheels.o1.l=0:0.4:10", robot)]
+    want = sweep(robot, axes, "inv_kappa_mean", configs=16, length=0.4, chunk=4, top=10)
+    monkeypatch.setattr(driver, "MAX_CHUNK_COLUMNS", 64)  # 4 designs of 16 configurations
+    res = sweep(robot, axes, "inv_kappa_mean", configs=16, length=0.4, top=10)
+    assert res.chunks == 3 and res.best == want.best
+
+
+def test_the_plot_names_units_and_survives_a_sweep_without_a_finite_value(tmp_path):
+    """Every design singular: a log colour scale of no data raised ValueError after the whole sweep. The axes were
+    labelled without units (radians and metres, whatever units --vary was given in)."""
+    import matplotlib
+
+    robot = catalog.load("thesis-steer-castor")
+    axes = [parse_vary("wheels.c2.alpha=0:0:1", robot), parse_vary("wheels.o1.l=0.5:0.5:1", robot)]
+    singular = sweep(robot, axes, configs=8)
+    assert singular.best[0]["kappa_mean"] == math.inf
+    with matplotlib.rc_context({"svg.fonttype": "none"}):  # text stays text in the SVG
+        plot_sweep(singular, tmp_path / "none.svg")
+        plot_sweep(sweep(robot, [parse_vary("wheels.c2.alpha=90deg:180deg:3", robot)], configs=8, top=1),
+                   tmp_path / "one.svg")
+    text = (tmp_path / "none.svg").read_text()
+    assert "no finite kappa_mean" in text and "wheels.c2.alpha [rad]" in text and "wheels.o1.l [m]" in text
+    assert "wheels.c2.alpha [rad]" in (tmp_path / "one.svg").read_text()
+    assert [a["unit"] for a in singular.to_dict()["axes"]] == ["rad", "m"]
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="needs Linux's /proc (no one can write into it)")
+def test_an_output_that_cannot_be_written_is_named():
+    """pyarrow's error carries no file name: 'sweep --out' into an unwritable folder ended in a traceback."""
+    robot = catalog.load("omni-3")
+    with pytest.raises(BatchError, match=r"/proc/s\.parquet: cannot write the table"):
+        sweep(robot, [parse_vary("wheels[0].l=0.1:0.2:2", robot)], out="/proc/s.parquet")

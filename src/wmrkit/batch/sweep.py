@@ -24,6 +24,9 @@ from ..robot import Robot
 from .engine import BatchError, Engine, engine, need_extra
 from .sweep_kernel import METRICS, Axis, build_spec, evaluate
 
+#: Most designs x steering configurations evaluated in one chunk (4096 x 128, the documented example; the chunk is
+#: made smaller for more configurations): a chunk's memory is about 0.5 kB per pair.
+MAX_CHUNK_COLUMNS = 2**19
 #: Whether a metric is better when smaller.
 LOWER_IS_BETTER = {"kappa_mean": True, "kappa_max": True, "inv_kappa_mean": False, "singular_margin": False}
 
@@ -48,7 +51,7 @@ class SweepResult:
         return {"robot": self.robot, "metric": self.metric, "designs": self.total, "chunks": self.chunks,
                 "seconds": self.seconds,
                 "axes": [{"field": a.label, "start": float(a.values[0]), "stop": float(a.values[-1]),
-                          "n": len(a.values)} for a in self.axes],
+                          "n": len(a.values), "unit": a.unit} for a in self.axes],
                 "best": [{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in b.items()}
                          for b in self.best]}
 
@@ -65,8 +68,11 @@ def sweep(robot: Robot, axes: Sequence[Axis], metric: str = "kappa_mean", *, run
             raise BatchError(f"{name}: expected an integer >= 1, got {value!r}")
     t0 = time.perf_counter()
     axes = tuple(axes)
-    spec = build_spec(robot, list(axes), metric, length=length, configs=configs, seed=seed)
-    total = int(np.prod(spec.shape))
+    spec = build_spec(robot, list(axes), metric, length=length, configs=configs, seed=seed, progress=progress)
+    total = math.prod(spec.shape)
+    # a chunk evaluates designs x configurations at once (about 0.5 kB each): 4096 designs of 10^4 configurations
+    # took 22 GB; fewer designs per chunk keep it within MAX_CHUNK_COLUMNS
+    chunk = min(chunk, max(1, MAX_CHUNK_COLUMNS // len(spec.configs)))
     lower = LOWER_IS_BETTER[metric]
     grid = np.full(spec.shape[:2], np.inf if lower else -np.inf)
     best = np.zeros((0, 3))  # rows (index, metric, length)
@@ -99,9 +105,10 @@ def sweep(robot: Robot, axes: Sequence[Axis], metric: str = "kappa_mean", *, run
                        time.perf_counter() - t0)
 
 
-def _blocks(total: int, chunk: int, spec) -> tuple[list[int], Sequence | None]:
-    """Chunk starts and, with Dask, the chunks of the flat design index as a lazy sequence of delayed values."""
-    starts = list(range(0, total, chunk))
+def _blocks(total: int, chunk: int, spec) -> tuple[range, Sequence | None]:
+    """Chunk starts (a range: 10^9 designs in chunks of one made a list of 10^9 numbers before any work) and, with
+    Dask, the chunks of the flat design index as a lazy sequence of delayed values."""
+    starts = range(0, total, chunk)
     try:
         da = need_extra("dask.array")
     except BatchError:
@@ -151,7 +158,11 @@ class _Writer:
         self.schema = pa.schema([("index", pa.int64()), *((n, pa.float64()) for n in names), ("metric", pa.float64()),
                                  ("length", pa.float64())])
         self.tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
-        self._w = pq.ParquetWriter(self.tmp, self.schema)
+        try:
+            self._w = pq.ParquetWriter(self.tmp, self.schema)
+        except OSError as err:  # pyarrow's error carries no file name: the command ended in a traceback
+            raise BatchError(f"{self.path}: cannot write the table ({' '.join(str(err.strerror or err).split())})") \
+                from None
 
     def write(self, index: np.ndarray, shape: tuple[int, ...], values: np.ndarray) -> None:
         sub = np.unravel_index(index, shape)
@@ -174,11 +185,22 @@ def plot_sweep(result: SweepResult, path: str | os.PathLike[str]) -> None:
     a0 = result.axes[0]
     fig, ax = plt.subplots(figsize=(6, 4.5))
     best = result.best[0] if result.best else None
-    if len(result.axes) == 1:
+    if best is not None and not math.isfinite(best[result.metric]):
+        best = None  # nothing to mark
+    label = lambda a: f"{a.label} [{a.unit}]"  # noqa: E731 - values in SI, as typed into --vary after the units
+    with np.errstate(all="ignore"):  # kappa >= 1 spanning decades: a log scale (not over a few per cent of one)
+        log = result.metric in ("kappa_mean", "kappa_max") and np.nanmin(g, initial=np.inf) > 0 \
+            and np.nanmax(g, initial=0.0) > 10 * np.nanmin(g, initial=np.inf)
+    if np.isnan(g).all():  # every design singular or immobile: a log colour scale of no data raised ValueError
+        ax.text(0.5, 0.5, f"no finite {result.metric}: every design is singular\nat a configuration sampled, or "
+                "cannot move", ha="center", va="center", transform=ax.transAxes)
+        ax.set_xlabel(label(a0) if len(result.axes) == 1 else label(result.axes[1]))
+        ax.set_ylabel(result.metric if len(result.axes) == 1 else label(a0))
+    elif len(result.axes) == 1:
         ax.plot(a0.values, g, "-o", ms=3)
-        if result.metric in ("kappa_mean", "kappa_max"):
+        if log:
             ax.set_yscale("log")
-        ax.set_xlabel(a0.label)
+        ax.set_xlabel(label(a0))
         ax.set_ylabel(result.metric)
         if best is not None:
             ax.plot(best[a0.label], best[result.metric], "r*", ms=14, label="best")
@@ -186,13 +208,11 @@ def plot_sweep(result: SweepResult, path: str | os.PathLike[str]) -> None:
         a1 = result.axes[1]
         from matplotlib.colors import LogNorm
 
-        # kappa >= 1 spans decades: a log scale
-        log = result.metric in ("kappa_mean", "kappa_max") and np.nanmin(g, initial=np.inf) > 0
         mesh = ax.pcolormesh(a1.values, a0.values, g, shading="nearest", cmap="viridis_r" if log else "viridis",
                              norm=LogNorm() if log else None)
         fig.colorbar(mesh, ax=ax, label=result.metric + (" (best over other axes)" if len(result.axes) > 2 else ""))
-        ax.set_xlabel(a1.label)
-        ax.set_ylabel(a0.label)
+        ax.set_xlabel(label(a1))
+        ax.set_ylabel(label(a0))
         if best is not None:
             ax.plot(best[a1.label], best[a0.label], "r*", ms=14, label="best")
     if best is not None:

@@ -56,6 +56,11 @@ class Axis:
     targets: tuple[tuple[int, str], ...]
     values: np.ndarray
 
+    @property
+    def unit(self) -> str:
+        """Unit of the values: ``"rad"`` for the angle fields, ``"m"`` for the lengths."""
+        return "rad" if GEOMETRY_FIELDS[self.targets[0][1]] == "angle" else "m"
+
 
 def parse_vary(text: str, robot: Robot) -> Axis:
     """An :class:`Axis` from ``FIELD[,FIELD...]=START:STOP:N`` (values with units, e.g. ``30deg``, ``250mm``)."""
@@ -130,10 +135,13 @@ class SweepSpec:
 
 
 def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | None = None, configs: int = 64,
-               seed: int = 0) -> SweepSpec:
-    """Compile the per-wheel tables of a sweep (module docstring)."""
+               seed: int = 0, progress: bool = False) -> SweepSpec:
+    """Compile the per-wheel tables of a sweep (module docstring); a tqdm bar counts the robots rebuilt when
+    `progress` (about 8 ms each: a 10^6-point axis is a few hours)."""
+    from tqdm import tqdm
+
     from ..analysis.classification import classify
-    from ..analysis.isotropy import default_joints, twist_model
+    from ..analysis.isotropy import default_joints
     from ..analysis.lines import constraint_lines, line_parameters
     from ..analysis.singularity import robot_size
 
@@ -153,36 +161,8 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
         raise BatchError(f"{' x '.join(map(str, shape))} designs: at most {MAX_DESIGNS:.0e} designs, and "
                          f"{MAX_MAP:.0e} over the first two --vary axes (the map kept in memory)")
     joints = default_joints(robot)
-    p0 = line_parameters(robot)
-    row_wheel = np.repeat(p0.element_wheel, 2)
-    n_steer = len(robot.steer_names)
-    rng = np.random.default_rng(seed)
-    beta = rng.uniform(-np.pi, np.pi, (configs, n_steer)) if n_steer else np.zeros((1, 0))
-    tables, wheel_axes = [], []
-    for w in range(len(robot.wheels)):
-        mine = tuple(k for k, ax in enumerate(axes) if any(i == w for i, _ in ax.targets))
-        wheel_axes.append(mine)
-        el, rows = p0.element_wheel == w, row_wheel == w
-        cols: dict[str, list] = {k: [] for k in ("theta", "lc", "ls", "lsn", "dc", "ds", "beta", "l", "rates", "lines",
-                                                 "sing")}
-        for combo in itertools.product(*(range(len(axes[k].values)) for k in mine)):
-            assign = {t: axes[k].values[c] for k, c in zip(mine, combo, strict=True)
-                      for t in axes[k].targets if t[0] == w}
-            r = variant(robot, assign) if assign else robot
-            p = line_parameters(r)
-            for key, arr in (("theta", p.theta_offset), ("lc", p.l_c_alpha), ("ls", p.l_s_alpha),
-                             ("lsn", p.l_s_alpha_neg), ("dc", p.d_c), ("ds", p.d_s)):
-                cols[key].append(arr[el])
-            cols["beta"].append(p.beta_described[w])
-            cols["l"].append(r.wheels[w].l)
-            cols["rates"].append(twist_model(r, joints).coefficients[:, rows])
-            cols["lines"].append(_wheel_lines(constraint_lines(r), r, w, rows))
-            cols["sing"].append(_wheel_lines(constraint_lines(r, joints), r, w, rows))
-        shapes = {k: {np.shape(v) for v in vs} for k, vs in cols.items()}
-        if any(len(s) > 1 for s in shapes.values()):
-            raise BatchError(f"the swept values change the structure of wheel '{robot.wheels[w].name}' (e.g. a castor "
-                             "offset through 0): sweep a range on one side")
-        tables.append({k: np.asarray(v, dtype=float) for k, v in cols.items()})
+    # the refusals that depend on the robot alone come before the tables (one rebuild per value: a 3000-point
+    # axis of a swerve drive took 35 s to be refused)
     mobility = classify(robot).mobility
     if metric != "singular_margin" and mobility < 2:
         raise BatchError(f"robot '{robot.name}' has mobility {mobility}: its condition number is 1 at every "
@@ -198,8 +178,46 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
     cl = constraint_lines(robot, joints)
     if metric == "singular_margin" and (cl.internal or len(cl.labels) < 3):
         raise BatchError(f"robot '{robot.name}': its actuated model is singular everywhere (fewer than 3 lines)")
+    p0 = line_parameters(robot)
+    n_steer = len(robot.steer_names)
+    rng = np.random.default_rng(seed)
+    beta = rng.uniform(-np.pi, np.pi, (configs, n_steer)) if n_steer else np.zeros((1, 0))
+    wheel_axes = [tuple(k for k, ax in enumerate(axes) if any(i == w for i, _ in ax.targets))
+                  for w in range(len(robot.wheels))]
+    with tqdm(total=sum(math.prod(shape[k] for k in mine) for mine in wheel_axes), desc="robots", unit="robot",
+              disable=not progress, leave=False) as bar:
+        tables = [_wheel_table(robot, axes, w, mine, joints, p0, bar) for w, mine in enumerate(wheel_axes)]
     return SweepSpec(tuple(len(a.values) for a in axes), metric, mobility, length, beta,
                      p0.steer_wheels, p0.element_wheel, tuple(wheel_axes), tuple(tables), robot_size(robot))
+
+
+def _wheel_table(robot: Robot, axes: list[Axis], w: int, mine: tuple[int, ...], joints, p0, bar) -> dict:
+    """Wheel `w`'s table: per combination of the values of its axes `mine`, its slip-row parameters and blocks."""
+    from ..analysis.isotropy import twist_model
+    from ..analysis.lines import constraint_lines, line_parameters
+
+    el, rows = p0.element_wheel == w, np.repeat(p0.element_wheel, 2) == w
+    cols: dict[str, list] = {k: [] for k in ("theta", "lc", "ls", "lsn", "dc", "ds", "beta", "l", "rates", "lines",
+                                             "sing")}
+    for combo in itertools.product(*(range(len(axes[k].values)) for k in mine)):
+        assign = {t: axes[k].values[c] for k, c in zip(mine, combo, strict=True)
+                  for t in axes[k].targets if t[0] == w}
+        r = variant(robot, assign) if assign else robot
+        p = line_parameters(r)
+        for key, arr in (("theta", p.theta_offset), ("lc", p.l_c_alpha), ("ls", p.l_s_alpha),
+                         ("lsn", p.l_s_alpha_neg), ("dc", p.d_c), ("ds", p.d_s)):
+            cols[key].append(arr[el])
+        cols["beta"].append(p.beta_described[w])
+        cols["l"].append(r.wheels[w].l)
+        cols["rates"].append(twist_model(r, joints).coefficients[:, rows])
+        cols["lines"].append(_wheel_lines(constraint_lines(r), r, w, rows))
+        cols["sing"].append(_wheel_lines(constraint_lines(r, joints), r, w, rows))
+        bar.update(1)
+    shapes = {k: {np.shape(v) for v in vs} for k, vs in cols.items()}
+    if any(len(s) > 1 for s in shapes.values()):
+        raise BatchError(f"the swept values change the structure of wheel '{robot.wheels[w].name}' (e.g. a castor "
+                         "offset through 0): sweep a range on one side")
+    return {k: np.asarray(v, dtype=float) for k, v in cols.items()}
 
 
 def _wheel_lines(cl, robot: Robot, w: int, rows: np.ndarray) -> np.ndarray:

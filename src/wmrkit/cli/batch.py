@@ -250,7 +250,7 @@ def run_sweep(args: argparse.Namespace) -> int:
         return 0
     print(f"robot {robot.name}: {args.metric} over {result.total:,} designs in {result.seconds:.3g} s")
     for b in result.best:
-        fields = ", ".join(f"{a.label} = {b[a.label]:.6g}" for a in axes)
+        fields = ", ".join(f"{a.label} = {b[a.label]:.6g} {a.unit}" for a in axes)
         value = b[args.metric]
         shown = (f"{value:.6g}" if math.isfinite(value) else "infinite (singular at a configuration sampled)"
                  if value == math.inf else "undefined (it cannot move at any configuration sampled)")
