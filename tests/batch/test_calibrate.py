@@ -340,3 +340,11 @@ def test_bootstrap_refuses_when_most_replicates_do_not_determine_the_parameters(
         fleet_calibrate(diff, runs, params, ci="bootstrap", n_boot=40, seed=0)
     with pytest.raises(BatchError, match="cannot tell these parameters apart"):  # the fit itself, either interval
         fleet_calibrate(diff, runs[:1], params, ci="bootstrap", n_boot=40)
+
+
+def test_a_log_the_slip_fit_refuses_is_named(diff, fleet_dir):
+    """A differential drive's squares do not determine the WLS ratio: the error said 'task 0 failed: ...', which
+    log of the fleet it was not."""
+    runs = load_runs(diff, [str(fleet_dir / "run0.csv"), str(fleet_dir / "run1.csv")], closed=True)
+    with pytest.raises(BatchError, match=r"^\S*run0\.csv: the log does not determine the WLS ratio"):
+        fleet_slip_calibrate(diff, runs)

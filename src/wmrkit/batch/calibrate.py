@@ -43,7 +43,7 @@ from ..odometry.calibration import (
     solve,
 )
 from ..robot import Robot
-from .engine import BatchError, Engine, engine
+from .engine import BatchError, Engine, TaskFailure, engine
 
 
 @dataclass(frozen=True)
@@ -321,10 +321,13 @@ def fleet_slip_calibrate(robot: Robot, runs: Sequence[CalibrationRun], *, runner
     runner = engine(workers=0) if runner is None else runner
     try:
         per_run = runner.map(_slip_of, [(robot, run, method, heading_weight) for run in runs], progress=progress,
-                             desc="slip")
+                             desc="slip", errors="return")
     finally:
         if own:
             runner.close()
+    for run, value in zip(runs, per_run, strict=True):
+        if isinstance(value, TaskFailure):  # named by its log (the message said 'task 0 failed')
+            raise BatchError(f"{run.log.source}: {value}")
     logs = np.log(np.array(per_run, dtype=float))  # (G, 2)
     g = len(per_run)
     half = _t_quantile(level, g - 1) * logs.std(axis=0, ddof=1) / np.sqrt(g)
