@@ -92,3 +92,15 @@ def test_a_robot_that_senses_nothing_is_one_line_exit_2(tmp_path, capsys):
     assert "the sensed joints of robot 'blind' (none) do not determine its motion" in capsys.readouterr().err
     with pytest.raises(WmrkitError, match="sensed: robot 'blind' senses no joint"):  # the synthetic log itself
         path_log(Robot.from_file(robot), "arc")
+
+
+def test_run_and_block_counts_must_be_whole_numbers(diff):
+    """block=0 raised range()'s ValueError, a negative block numpy's 'need at least one array to concatenate',
+    and runs=2.5 a TypeError: none of them said which argument was wrong."""
+    log = path_log(diff, "arc", 5.0)
+    for block in (0, -3, 2.5, True):
+        with pytest.raises(BatchError, match="block: expected a whole number of runs >= 1"):
+            monte_carlo(diff, log, 10, block=block)
+    with pytest.raises(BatchError, match="at least 2 runs and at most"):
+        monte_carlo(diff, log, 2.5)
+    assert monte_carlo(diff, log, np.int64(3), block=2).poses.shape == (3, 3)

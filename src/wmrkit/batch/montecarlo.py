@@ -147,8 +147,11 @@ def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4
     from ..odometry.covariance import JointNoise
     from ..odometry.pipeline import odometry
 
-    if not 2 <= runs <= MAX_RUNS:
-        raise BatchError(f"Monte Carlo needs at least 2 runs and at most {MAX_RUNS}, got {runs}")
+    whole = lambda n: isinstance(n, int | np.integer) and not isinstance(n, bool)  # noqa: E731
+    if not whole(runs) or not 2 <= runs <= MAX_RUNS:
+        raise BatchError(f"Monte Carlo needs at least 2 runs and at most {MAX_RUNS}, got {runs!r}")
+    if not whole(block) or block < 1:  # 0 raised range()'s ValueError, a negative one 'need at least one array'
+        raise BatchError(f"block: expected a whole number of runs >= 1, got {block!r}")
     if not (0 <= per_rad <= 1 and 0 <= resolution <= math.pi and 0 <= slip_std <= 1):
         raise BatchError(f"noise must be in [0, 1] (per rad), resolution in [0, pi] rad and slip in [0, 1] (the "
                          f"standard deviation of a slip ratio), got {per_rad:g}, {resolution:g}, {slip_std:g}")
