@@ -125,3 +125,26 @@ def test_the_docs_figure_script_draws_the_wheel_parameters(tmp_path):
     fig = module.wheel_parameters_figure()
     fig.savefig(tmp_path / "w.svg")
     assert b"<svg" in (tmp_path / "w.svg").read_bytes()[:2000]
+
+
+@pytest.mark.skipif(importlib.util.find_spec("PIL") is None, reason="the GIF writer needs Pillow")
+def test_the_line_following_animation_has_bounded_frames_and_an_increasing_plan_axis(tmp_path, monkeypatch):
+    """Every camera image was a frame (about 0.25 s and 1.5 MB each until written: 400 took 106 s and 640 MB, and
+    follow-line allows 10^4). The plan view ran from the start's x to the end's: a run along -x (started at 180
+    deg) had an inverted x axis with the robot out of view."""
+    from PIL import Image
+
+    import wmrkit.vision.animation as animation
+    from wmrkit.vision.camera import Camera
+    from wmrkit.vision.follow import follow_line
+
+    root = Path(__file__).resolve().parents[1]
+    camera = Camera.from_file(root / "docs" / "figures" / "vision" / "follower-camera.yaml")
+    robot = catalog.load("line-follower")
+    run = follow_line(robot, camera, duration=5.0, start=(0.0, 0.05, np.pi), keep_images=True)
+    monkeypatch.setattr(animation, "MAX_FRAMES", 4)
+    animation.save_animation(run, robot, camera, tmp_path / "run.gif")
+    assert len(run.images) == 11 and Image.open(tmp_path / "run.gif").n_frames == 4
+    backward = np.array([[0.0, 0.05, np.pi], [-1.0, 0.02, np.pi], [-2.0, 0.0, np.pi]])
+    (x0, x1), (y0, y1) = animation._plan_limits(backward)
+    assert x0 < -2.0 and x1 > 0.0 and y0 < 0.0 < 0.05 < y1
