@@ -92,3 +92,14 @@ def test_sweep_text_gives_the_units_of_the_best_designs(capsys):
     assert main(["sweep", "omni-3", "--vary", "wheels[0].alpha=30deg:90deg:3", "--vary", "wheels.back.l=0.15:0.25:3",
                  "--workers", "0", "--top", "1"]) == 0
     assert "wheels[0].alpha = 1.0472 rad, wheels.back.l = 0.2 m" in capsys.readouterr().out
+
+
+def test_batch_odometry_text_shows_the_warnings_of_the_logs(capsys, fleet_dir, tmp_path):
+    """A log of one sample (no motion) or with slip above the threshold was flagged only in the table's 'warnings'
+    column: the text output, without --out, showed it nowhere."""
+    one = tmp_path / "one.csv"
+    one.write_text("time,left.spin,right.spin\n0,0,0\n")
+    assert main(["batch", "odometry", "diff-drive", str(one), str(fleet_dir / "run0.csv"), "--workers", "0"]) == 0
+    out, err = capsys.readouterr()
+    assert "2 logs: 2 done" in out
+    assert err.strip().splitlines() == [f"wmrkit: warning: {one}: a single sample: no motion"]

@@ -144,11 +144,14 @@ def run_odometry(args: argparse.Namespace) -> int:
     print(f"{len(result.rows)} logs: {len(result.rows) - result.failed} done ({result.skipped} from an earlier run), "
           f"{result.failed} failed" + (f"; table {args.out}" if args.out else ""))
     for r in result.rows:
-        if r["error"]:
-            print(f"  failed: {r['error']}")
+        if r["error"]:  # a worker that died more often than allowed: its message does not name the log
+            print(f"  failed: {r['error'] if r['error'].startswith(r['log']) else r['log'] + ': ' + r['error']}")
         elif not args.out:
             print(f"  {r['log']}: x {r['x']:.4f} m, y {r['y']:.4f} m, theta {r['theta']:.4f} rad, "
                   f"path {r['path_length']:.4g} m")
+    for r in result.rows:  # they were only in the table's 'warnings' column (or nowhere, without --out)
+        if r["warnings"] and not r["error"]:
+            print(f"wmrkit: warning: {r['log']}: {r['warnings']}", file=sys.stderr)
     return 1 if result.failed else 0  # a pipeline must tell a batch with failed logs from a complete one
 
 
