@@ -57,3 +57,11 @@ def test_chunk_spans_cover_the_items_in_shrinking_tasks(n, chunk, workers):
         assert b - a <= max(chunk // 8, 1, -(-(n - a) // (4 * workers)))
     if n >= 16 * chunk * workers:  # a large batch is mostly full tasks: few round trips
         assert len(spans) <= n / chunk + 8 * 4 * workers
+
+
+def test_a_worker_count_must_be_a_whole_number():
+    """engine(workers=2.5) reached Dask's TypeError, and workers=True started a LocalCluster that failed ('Nanny
+    failed to start') instead of naming the argument."""
+    for workers in (2.5, True, "2"):
+        with pytest.raises(BatchError, match="--workers must be in"):
+            engine(workers=workers)

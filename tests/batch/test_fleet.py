@@ -190,3 +190,11 @@ def test_a_table_that_cannot_be_written_is_named():
 
     with pytest.raises(BatchError, match=r"/proc/x\.parquet: cannot write the table"):
         write_rows("/proc/x.parquet", [{"log": "a"}], [("log", "string")])
+
+
+def test_the_slip_threshold_must_be_a_length(fleet_dir, diff):
+    """slip_warning=nan never warned, and -1 flagged every log ('slip indicator up to 0 m per interval (threshold
+    -1 m)')."""
+    for bad in (float("nan"), -1.0, math.inf):
+        with pytest.raises(BatchError, match="slip_warning must be a finite length >= 0 m"):
+            batch_odometry(diff, [fleet_dir / "run0.csv"], slip_warning=bad)

@@ -183,3 +183,16 @@ def test_an_output_that_cannot_be_written_is_named():
     robot = catalog.load("omni-3")
     with pytest.raises(BatchError, match=r"/proc/s\.parquet: cannot write the table"):
         sweep(robot, [parse_vary("wheels[0].l=0.1:0.2:2", robot)], out="/proc/s.parquet")
+
+
+def test_configuration_counts_and_seeds_must_be_whole_numbers():
+    """configs=2.5 and configs=True swept silently (numpy took them as a size), seed=-1 and seed=2.5 reached
+    numpy's ValueError and TypeError."""
+    robot = catalog.load("omni-3")
+    axes = [parse_vary("wheels[0].l=0.1:0.2:2", robot)]
+    for configs in (2.5, True):
+        with pytest.raises(BatchError, match=r"--configs must be in \[1, 10000\] \(a whole number\)"):
+            sweep(robot, axes, configs=configs)
+    for seed in (-1, 2.5):
+        with pytest.raises(BatchError, match="seed must be an integer >= 0"):
+            sweep(robot, axes, seed=seed)

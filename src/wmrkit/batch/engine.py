@@ -21,6 +21,7 @@ import os
 import sys
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
+from numbers import Integral
 from typing import Any, Literal
 
 from ..errors import WmrkitError
@@ -267,7 +268,8 @@ def engine(scheduler: str | Any | None = None, workers: int | None = None, *, re
     CPU count, at most :data:`WORKERS_PER_CPU` per CPU), one thread each. Without Dask installed and no scheduler:
     serial, with one line on stderr."""
     cpus = os.cpu_count() or 1
-    if workers is not None and not 0 <= workers <= WORKERS_PER_CPU * cpus:
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, Integral)  # True: a cluster of
+                                or not 0 <= workers <= WORKERS_PER_CPU * cpus):           # 'True' workers failed
         raise BatchError(f"--workers must be in [0, {WORKERS_PER_CPU * cpus}] ({WORKERS_PER_CPU} per CPU of this "
                          f"machine; a larger fleet needs a cluster: --scheduler), got {workers}")
     if scheduler is None and workers == 0:

@@ -158,6 +158,8 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     from ..odometry.model import odometry_model
 
     check_method(method)  # type: ignore[arg-type]
+    if not (isinstance(slip_warning, int | float) and math.isfinite(slip_warning) and slip_warning >= 0):
+        raise BatchError(f"slip_warning must be a finite length >= 0 m, got {slip_warning!r}")  # NaN: never warned
     model = odometry_model(robot, sensed, weights=weights)  # once: the same for every log (a bad --sensed fails here)
     options = {"topic": topic, "joint_names": joint_names}
     if fmt is not None:

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..limits import check_length
+from ..limits import check_length, check_seed
 from ..robot import Robot
 from ..wheels import GEOMETRY_FIELDS
 from .engine import BatchError
@@ -151,8 +151,9 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
         raise BatchError("a sweep needs at least one --vary")
     if length is not None:
         check_length(length, BatchError, "--length")
-    if not 1 <= configs <= MAX_CONFIGS:
-        raise BatchError(f"--configs must be in [1, {MAX_CONFIGS}], got {configs}")
+    if isinstance(configs, bool) or not isinstance(configs, int | np.integer) or not 1 <= configs <= MAX_CONFIGS:
+        raise BatchError(f"--configs must be in [1, {MAX_CONFIGS}] (a whole number), got {configs!r}")
+    check_seed(seed, BatchError)  # -1 and 2.5 reached numpy's ValueError and TypeError
     targets = [t for a in axes for t in a.targets]
     if len(set(targets)) != len(targets):
         raise BatchError("two --vary axes move the same field (one would overwrite the other)")
