@@ -348,3 +348,9 @@ def test_a_log_the_slip_fit_refuses_is_named(diff, fleet_dir):
     runs = load_runs(diff, [str(fleet_dir / "run0.csv"), str(fleet_dir / "run1.csv")], closed=True)
     with pytest.raises(BatchError, match=r"^\S*run0\.csv: the log does not determine the WLS ratio"):
         fleet_slip_calibrate(diff, runs)
+
+
+def test_reading_the_logs_shows_progress(diff, fleet_dir, capsys):
+    """Fleet calibration read its logs (weeks of them, on the engine) with no progress bar (the bootstrap had one)."""
+    runs = load_runs(diff, [str(fleet_dir / "run0.csv"), str(fleet_dir / "run1.csv")], closed=True, progress=True)
+    assert len(runs) == 2 and "logs: 0%| | 0/2" in " ".join(capsys.readouterr().err.split())

@@ -407,9 +407,9 @@ def _load(args: tuple) -> CalibrationRun:
 
 
 def load_runs(robot: Robot, paths: Sequence[str], *, reference_dir: str | os.PathLike[str] | None = None,
-              closed: bool = False, runner: Engine | None = None,
-              options: Mapping[str, Any] | None = None) -> list[CalibrationRun]:
-    """Runs of many logs, read on the engine (the first bad log raises its error)."""
+              closed: bool = False, runner: Engine | None = None, options: Mapping[str, Any] | None = None,
+              progress: bool = False) -> list[CalibrationRun]:
+    """Runs of many logs, read on the engine (the first bad log raises its error; a tqdm bar with `progress`)."""
     if (reference_dir is None) == (not closed):
         raise BatchError("give reference trajectories (a folder) or closed paths, one of the two")
     refs = [None if closed else find_reference(p, reference_dir) for p in paths]
@@ -417,7 +417,7 @@ def load_runs(robot: Robot, paths: Sequence[str], *, reference_dir: str | os.Pat
     runner = engine(workers=0) if runner is None else runner
     try:
         out = runner.map(_load, [(robot, p, r, closed, dict(options or {})) for p, r in zip(paths, refs, strict=True)],
-                         errors="return")
+                         errors="return", progress=progress, desc="logs")
     finally:
         if own:
             runner.close()

@@ -166,7 +166,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
     check_bootstrap(args.bootstrap, "--bootstrap")
     with _runner(args) as runner:
         runs = load_runs(robot, expand_logs(args.logs), reference_dir=args.reference, closed=args.closed,
-                         runner=runner, options=_options(args))
+                         runner=runner, options=_options(args), progress=_progress(args))
         if args.slip:
             from ..batch.calibrate import fleet_slip_calibrate
 
