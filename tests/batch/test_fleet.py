@@ -198,3 +198,12 @@ def test_the_slip_threshold_must_be_a_length(fleet_dir, diff):
     for bad in (float("nan"), -1.0, math.inf):
         with pytest.raises(BatchError, match="slip_warning must be a finite length >= 0 m"):
             batch_odometry(diff, [fleet_dir / "run0.csv"], slip_warning=bad)
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs named pipes")
+def test_a_named_pipe_is_refused_not_waited_on(diff, tmp_path):
+    """A FIFO given as a log: its reader waited for a writer forever (the batch hung, serially or on a worker)."""
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    with pytest.raises(BatchError, match=r"pipe\.csv: not a regular file or folder"):
+        batch_odometry(diff, [fifo])

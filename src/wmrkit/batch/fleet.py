@@ -87,6 +87,8 @@ def expand_logs(patterns: Sequence[str | os.PathLike[str]]) -> list[str]:
             p = Path(m)
             if not p.exists():
                 raise BatchError(f"{m}: no such file or folder")
+            if not (p.is_file() or p.is_dir()):  # a FIFO: reading it waited for a writer forever
+                raise BatchError(f"{m}: not a regular file or folder (a FIFO, socket or device)")
             if p.is_dir() and not (p / "metadata.yaml").exists():
                 found = [os.fspath(c) for c in sorted(p.iterdir())
                          if (c.is_file() and c.suffix.lower() in LOG_SUFFIXES)
