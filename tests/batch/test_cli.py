@@ -103,3 +103,13 @@ def test_batch_odometry_text_shows_the_warnings_of_the_logs(capsys, fleet_dir, t
     out, err = capsys.readouterr()
     assert "2 logs: 2 done" in out
     assert err.strip().splitlines() == [f"wmrkit: warning: {one}: a single sample: no motion"]
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="needs named pipes")
+def test_montecarlo_refuses_a_log_that_is_not_a_file(capsys, tmp_path):
+    """A FIFO given as the Monte Carlo log was read forever (the command hung)."""
+    import os
+
+    os.mkfifo(tmp_path / "pipe.csv")
+    assert main(["batch", "montecarlo", "diff-drive", str(tmp_path / "pipe.csv"), "-n", "2", "--workers", "0"]) == 2
+    assert "pipe.csv: not a regular file" in capsys.readouterr().err

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from pathlib import Path
 
 from ..errors import WmrkitError
 from ._common import (
@@ -202,6 +203,8 @@ def run_montecarlo(args: argparse.Namespace) -> int:
     from ..odometry.model import odometry_model
 
     model = odometry_model(robot)
+    if args.log is not None and Path(args.log).exists() and not Path(args.log).is_file():  # a FIFO: read forever
+        raise WmrkitError(f"{args.log}: not a regular file (a folder, FIFO or device); LOG is a CSV log")
     if args.log is not None:  # read as its header says, as 'wmrkit odometry' reads it
         from ..odometry.header import header_format
         from ..odometry.logs import load_csv
