@@ -173,3 +173,19 @@ def test_a_long_trajectory_is_thinned_before_it_is_drawn(tmp_path, monkeypatch):
     np.testing.assert_array_equal(line[:, 0], poses[0, :2])
     np.testing.assert_array_equal(line[:, -1], poses[-1, :2])
     assert (tmp_path / "long.png").read_bytes().startswith(HEADERS[".png"])
+
+
+def test_a_detection_figure_checks_its_file_type(tmp_path):
+    """save_detection_figure raised matplotlib's ValueError for 'x.txt' and wrote 'x.png' when given 'x'."""
+    from wmrkit.vision.animation import save_detection_figure
+    from wmrkit.vision.camera import Camera
+
+    figures = Path(__file__).resolve().parents[1] / "docs" / "figures"
+    camera = Camera.from_file(figures / "vision" / "follower-camera.yaml")
+    image = np.zeros((camera.rows, camera.width), dtype=np.uint8)
+    for name in ("x.txt", "x"):
+        with pytest.raises(PlotError, match="cannot draw to"):
+            save_detection_figure(camera, image, tmp_path / name)
+    assert not (tmp_path / "x.png").exists()
+    save_detection_figure(camera, image, tmp_path / "ok.png")
+    assert (tmp_path / "ok.png").read_bytes().startswith(HEADERS[".png"])

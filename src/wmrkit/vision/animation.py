@@ -11,6 +11,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..errors import WmrkitError
+from ..plotting.files import check_figure_path
 from ..robot import Robot
 from .camera import Camera, CameraError, distort
 from .follow import LineFollowing
@@ -44,7 +45,8 @@ def _found_lines(camera: Camera, image: np.ndarray, n_lines: int) -> tuple:
 
 def save_detection_figure(camera: Camera, image: np.ndarray, path: str | os.PathLike[str], *,
                           n_lines: int = 1, title: str = "") -> None:
-    """A PNG/SVG of `image` with the lines :func:`.lines.extract_lines` finds in it."""
+    """A PNG/SVG/PDF of `image` with the lines :func:`.lines.extract_lines` finds in it."""
+    check_figure_path(path)  # 'x.txt' raised matplotlib's ValueError, and 'x' wrote x.png
     fig = Figure(figsize=(camera.width / 100, camera.rows / 100 + (0.3 if title else 0)), dpi=100)
     ax = fig.add_axes((0, 0, 1, 1 if not title else camera.rows / (camera.rows + 30)))
     draw_camera_view(ax, camera, image, _found_lines(camera, image, n_lines))
