@@ -189,3 +189,16 @@ def test_a_detection_figure_checks_its_file_type(tmp_path):
     assert not (tmp_path / "x.png").exists()
     save_detection_figure(camera, image, tmp_path / "ok.png")
     assert (tmp_path / "ok.png").read_bytes().startswith(HEADERS[".png"])
+
+
+def test_many_configurations_are_thinned_and_an_empty_heading_batch_is_named():
+    """Each configuration drawn costs about 10 ms (1000 took 9 s; a batch of 10^5 about 15 min): at most
+    MAX_CONFIGURATIONS are drawn, first and last included. An empty batch given as heading= was reported as 'beta:'."""
+    from wmrkit.plotting.robot import MAX_CONFIGURATIONS
+
+    robot = catalog.load("swerve-4")
+    headings = np.linspace(-1.0, 1.0, 1000)[:, None].repeat(4, axis=1)
+    ax = draw_robot(robot, heading=headings)
+    assert len(_wheel_patches(ax)) == 4 * MAX_CONFIGURATIONS
+    with pytest.raises(ShapeError, match=r"^heading: no configuration to draw"):
+        draw_robot(robot, heading=np.zeros((0, 4)))
