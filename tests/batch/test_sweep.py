@@ -196,3 +196,11 @@ def test_configuration_counts_and_seeds_must_be_whole_numbers():
     for seed in (-1, 2.5):
         with pytest.raises(BatchError, match="seed must be an integer >= 0"):
             sweep(robot, axes, seed=seed)
+
+
+def test_a_length_with_the_singular_margin_is_refused():
+    """--length is D of the condition number; the margin scales by each design's size, so a --length given with it
+    was ignored without a word (rule 8)."""
+    robot = catalog.load("omni-3")
+    with pytest.raises(BatchError, match="--length sets D of the kappa metrics"):
+        sweep(robot, [parse_vary("wheels[0].l=0.1:0.2:2", robot)], "singular_margin", length=0.3)

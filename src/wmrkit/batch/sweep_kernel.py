@@ -151,6 +151,8 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
         raise BatchError("a sweep needs at least one --vary")
     if length is not None:
         check_length(length, BatchError, "--length")
+        if metric == "singular_margin":  # its length is the robot's size: a --length was ignored without a word
+            raise BatchError("--length sets D of the kappa metrics; singular_margin scales by each design's size")
     if isinstance(configs, bool) or not isinstance(configs, int | np.integer) or not 1 <= configs <= MAX_CONFIGS:
         raise BatchError(f"--configs must be in [1, {MAX_CONFIGS}] (a whole number), got {configs!r}")
     check_seed(seed, BatchError)  # -1 and 2.5 reached numpy's ValueError and TypeError
