@@ -113,3 +113,13 @@ def test_montecarlo_refuses_a_log_that_is_not_a_file(capsys, tmp_path):
     os.mkfifo(tmp_path / "pipe.csv")
     assert main(["batch", "montecarlo", "diff-drive", str(tmp_path / "pipe.csv"), "-n", "2", "--workers", "0"]) == 2
     assert "pipe.csv: not a regular file" in capsys.readouterr().err
+
+
+def test_montecarlo_refuses_a_rate_with_a_log(capsys, fleet_dir):
+    """--rate is the sample rate of a built-in path: given with a LOG it was ignored without a word (rule 8)."""
+    assert main(["batch", "montecarlo", "diff-drive", str(fleet_dir / "run0.csv"), "--rate", "50", "-n", "2",
+                 "--workers", "0"]) == 2
+    assert "--rate sets the sample rate of a built-in --path" in capsys.readouterr().err
+    assert main(["batch", "montecarlo", "diff-drive", "--path", "arc", "--rate", "5", "-n", "2", "--workers", "0",
+                 "--json"]) == 0
+    assert '"samples": 51' in capsys.readouterr().out

@@ -76,7 +76,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    help="random-walk variance per radian of joint travel (default 1e-4)")
     p.add_argument("--resolution", metavar="ANGLE", default="0", help="encoder resolution [rad or deg] (default 0)")
     p.add_argument("--slip", type=float, default=0.0, metavar="STD", help="std of a run's wheel slip ratio")
-    p.add_argument("--rate", type=float, default=20.0, help="sample rate of a built-in path [Hz] (default 20)")
+    p.add_argument("--rate", type=float, help="sample rate of a built-in path [Hz] (default 20)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
     p.add_argument("--plot", metavar="FILE", help="final positions with both 95 %% ellipses")
@@ -203,6 +203,8 @@ def run_montecarlo(args: argparse.Namespace) -> int:
     from ..odometry.model import odometry_model
 
     model = odometry_model(robot)
+    if args.log is not None and args.rate is not None:  # the log's own times are used: it was ignored silently
+        raise WmrkitError("--rate sets the sample rate of a built-in --path; a LOG keeps its own times")
     if args.log is not None and Path(args.log).exists() and not Path(args.log).is_file():  # a FIFO: read forever
         raise WmrkitError(f"{args.log}: not a regular file (a folder, FIFO or device); LOG is a CSV log")
     if args.log is not None:  # read as its header says, as 'wmrkit odometry' reads it
@@ -211,9 +213,10 @@ def run_montecarlo(args: argparse.Namespace) -> int:
 
         log = load_csv(args.log, model.joints, header_format(args.log, robot.name, model.joints), robot=robot)
     else:
-        if not args.rate > 0:
-            raise WmrkitError(f"--rate must be > 0 Hz, got {args.rate}")
-        log = path_log(robot, args.path, args.rate)
+        rate = 20.0 if args.rate is None else args.rate
+        if not rate > 0:
+            raise WmrkitError(f"--rate must be > 0 Hz, got {rate}")
+        log = path_log(robot, args.path, rate)
     with _runner(args) as runner:
         result = monte_carlo(robot, log, args.runs, per_rad=args.noise,
                              resolution=parse_angle(args.resolution, "--resolution"), slip_std=args.slip,
