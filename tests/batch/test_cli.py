@@ -123,3 +123,16 @@ def test_montecarlo_refuses_a_rate_with_a_log(capsys, fleet_dir):
     assert main(["batch", "montecarlo", "diff-drive", "--path", "arc", "--rate", "5", "-n", "2", "--workers", "0",
                  "--json"]) == 0
     assert '"samples": 51' in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("extra", "message"), [
+    (["--bootstrap", "500"], "--bootstrap is the number of replicates of --ci bootstrap"),
+    (["--ci", "jacobian", "--bootstrap", "500"], "--bootstrap is the number of replicates of --ci bootstrap"),
+    (["--slip", "--param", "left.r"], "--param is for the geometry fit; --slip fits slip weights"),
+    (["--slip", "--ci", "bootstrap"], "--ci is for the geometry fit; --slip fits slip weights"),
+])
+def test_calibrate_refuses_options_it_would_ignore(capsys, calibration_data, extra, message):
+    """--bootstrap without --ci bootstrap, and --param or --ci with --slip, were ignored without a word (rule 8)."""
+    assert main(["batch", "calibrate", "diff-drive", str(calibration_data / "c0.csv"), "--closed", "--workers", "0",
+                 *extra]) == 2
+    assert message in capsys.readouterr().err

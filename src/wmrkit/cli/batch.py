@@ -58,9 +58,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--param", action="append", metavar="FIELDS", default=[],
                    help="a parameter: WHEEL.FIELD names moved together, comma-separated, '-' to oppose (repeat; "
                         "default: spin wheels' radii (their ratio with --closed) and the track)")
-    p.add_argument("--ci", choices=("jacobian", "bootstrap"), default="jacobian", help="interval method")
+    p.add_argument("--ci", choices=("jacobian", "bootstrap"), help="interval method (default jacobian)")
     p.add_argument("--level", type=float, default=0.95, help="confidence level (default 0.95)")
-    p.add_argument("--bootstrap", type=int, default=200, metavar="B", help="bootstrap replicates (default 200)")
+    p.add_argument("--bootstrap", type=int, metavar="B", help="bootstrap replicates of --ci bootstrap (default 200)")
     p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
     p.add_argument("--slip", action="store_true", help="fit the slip weights (WLS ratio, effective track) instead")
     _log_options(p)
@@ -162,6 +162,11 @@ def run_calibrate(args: argparse.Namespace) -> int:
     from ..batch.fleet import expand_logs
 
     robot = load_robot(args.robot)
+    if args.slip and (args.param or args.ci):  # the slip fit has its own two parameters and interval: ignored
+        raise WmrkitError(f"{'--param' if args.param else '--ci'} is for the geometry fit; --slip fits slip weights")
+    if args.bootstrap is not None and args.ci != "bootstrap":
+        raise WmrkitError("--bootstrap is the number of replicates of --ci bootstrap")
+    args.ci, args.bootstrap = args.ci or "jacobian", 200 if args.bootstrap is None else args.bootstrap
     params = ([tuple(n.strip() for n in p.split(",") if n.strip()) for p in args.param] if args.param
               else [] if args.slip else default_parameters(robot, closed=args.closed))
     check_bootstrap(args.bootstrap, "--bootstrap")
