@@ -207,3 +207,12 @@ def test_a_named_pipe_is_refused_not_waited_on(diff, tmp_path):
     os.mkfifo(fifo)
     with pytest.raises(BatchError, match=r"pipe\.csv: not a regular file or folder"):
         batch_odometry(diff, [fifo])
+
+
+def test_an_output_that_is_a_folder_is_refused_before_the_work(fleet_dir, diff, tmp_path, monkeypatch):
+    """batch_odometry(out=FOLDER) ran every log and then failed to write the table ('Is a directory')."""
+    import wmrkit.batch.fleet as fleet
+
+    monkeypatch.setattr(fleet, "process_log", lambda job: pytest.fail("a log was processed"))
+    with pytest.raises(BatchError, match="a folder, not a file"):
+        batch_odometry(diff, [fleet_dir / "run0.csv"], out=tmp_path)

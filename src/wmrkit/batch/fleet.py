@@ -174,6 +174,8 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
         raise BatchError("batch odometry: no logs given")
     if out is not None and not Path(out).absolute().parent.is_dir():
         raise BatchError(f"--out {os.fspath(out)}: the folder {Path(out).absolute().parent} does not exist")
+    if out is not None and Path(out).is_dir():  # else refused only when the table is written, after the work
+        raise BatchError(f"--out {os.fspath(out)}: a folder, not a file")
     if trajectories is not None:  # made with its parents when missing, as every output folder of the CLI
         try:
             Path(trajectories).mkdir(parents=True, exist_ok=True)
