@@ -219,3 +219,29 @@ def test_weights_too_far_apart_are_refused(capsys, tmp_path, weight):
     close = odometry_model(catalog.load("forklift"), weights={"steer": 1e6})  # at the limit: still the motion
     assert np.hypot(*odometry(close, run.log).final_pose[:2]) == pytest.approx(np.hypot(*run.truth[-1, :2]),
                                                                                abs=1e-6)
+
+
+def test_a_byte_order_mark_is_not_part_of_the_first_column(capsys, diff_csv, tmp_path):
+    """Spreadsheet exports start with a UTF-8 byte-order mark: the log was refused ('no time column')."""
+    bom = tmp_path / "bom.csv"
+    with open(diff_csv, encoding="utf-8") as f:
+        bom.write_text("\ufeff" + f.read(), encoding="utf-8")
+    plain = _json(capsys, ["odometry", "diff-drive", diff_csv, "--json"])
+    marked = _json(capsys, ["odometry", "diff-drive", str(bom), "--json"])
+    assert marked["pose"] == plain["pose"] and marked["samples"] == plain["samples"]
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="needs named pipes")
+def test_a_named_pipe_is_refused_not_waited_on(tmp_path):
+    """A FIFO given as the log: the reader waited for a writer forever (run in a child, with a time limit)."""
+    import os
+    import subprocess
+    import sys
+
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    out = subprocess.run([sys.executable, "-m", "wmrkit", "odometry", "diff-drive", str(fifo), "--json"],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 2 and out.stdout == ""
+    error = json.loads(out.stderr)  # one line, the file named
+    assert error["file"].endswith("pipe.csv") and error["error"].startswith("not a regular file")

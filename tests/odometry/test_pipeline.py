@@ -140,9 +140,22 @@ def test_decimator_keeps_a_bounded_evenly_spaced_subset():
 
         dec(Trajectory(t, np.column_stack([t, t, t]), np.zeros(len(t))))
     time, poses = dec.result()
-    assert len(time) <= 100 and time[0] == 0
-    assert np.all(np.diff(time) == dec.stride)
+    assert len(time) <= 101 and time[0] == 0
+    assert np.all(np.diff(time[:-1]) == dec.stride)
+    assert time[-1] == n - 1 and 0 < time[-1] - time[-2] <= dec.stride  # the stream's end is kept (plots mark it)
     np.testing.assert_array_equal(poses[:, 0], time)
+
+
+def test_decimator_keeps_the_last_pose_once():
+    from wmrkit.odometry.trajectories import Trajectory
+
+    for n in (1, 7, 8, 9, 1000):
+        dec = Decimator(max_points=4)
+        t = np.arange(n, dtype=float)
+        dec(Trajectory(t, np.column_stack([t, t, t]), np.zeros(n)))
+        dec(Trajectory(t[:0], np.zeros((0, 3)), np.zeros(0)))  # an empty chunk changes nothing
+        time, _ = dec.result()
+        assert time[-1] == n - 1 and np.all(np.diff(time) > 0)
 
 
 def test_memory_stays_bounded_for_long_streams(monkeypatch):

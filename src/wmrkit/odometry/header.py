@@ -60,7 +60,7 @@ class HeaderUnits:
 def read_header_units(path: str | Path, *, max_chars: int = 1 << 16, delimiter: str = ",") -> HeaderUnits:
     """The units of a CSV log's header line (bounded read); an unreadable file says nothing here."""
     try:
-        with open(path, encoding="utf-8", errors="replace", newline="") as f:
+        with open(path, encoding="utf-8-sig", errors="replace", newline="") as f:
             line = f.readline(max_chars)
     except (OSError, IsADirectoryError):
         return HeaderUnits(())

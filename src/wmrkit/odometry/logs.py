@@ -309,8 +309,10 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
     source = os.fspath(path)
     wheels = robot.wheel_names if robot is not None and not wheels else wheels
     decoder = Decoder(joints, fmt, source, robot)
-    try:
-        f = open(source, encoding="utf-8", errors="surrogateescape", newline="")  # bad bytes found per chunk
+    if os.path.exists(source) and not os.path.isfile(source):  # a FIFO waited for a writer forever
+        raise LogError(f"{source}: not a regular file (a folder, FIFO, socket or device)")
+    try:  # utf-8-sig: a byte-order mark (spreadsheet exports) is not part of the first column's name
+        f = open(source, encoding="utf-8-sig", errors="surrogateescape", newline="")  # bad bytes found per chunk
     except OSError as err:
         raise LogError(f"{source}: cannot open: {err.strerror}") from None
     try:

@@ -178,17 +178,20 @@ def join(parts: Sequence[Trajectory]) -> Trajectory:
 
 
 class Decimator:
-    """A sink keeping at most about `max_points` poses of a stream (every k-th, k doubling as needed)."""
+    """A sink keeping at most about `max_points` poses of a stream (every k-th, k doubling as needed), and the last."""
 
     def __init__(self, max_points: int = 100_000) -> None:
         self.max_points, self.stride, self._seen = max_points, 1, 0
         self._time: list[np.ndarray] = []
         self._poses: list[np.ndarray] = []
+        self._last: tuple[np.ndarray, np.ndarray] | None = None
 
     def __call__(self, chunk: Trajectory) -> None:
         """Take the poses of `chunk` that fall on the stride."""
         idx = np.flatnonzero((np.arange(self._seen, self._seen + len(chunk)) % self.stride) == 0)
         self._seen += len(chunk)
+        if len(chunk):
+            self._last = (chunk.time[-1:], chunk.poses[-1:])
         self._time.append(chunk.time[idx])
         self._poses.append(chunk.poses[idx])
         if sum(map(len, self._time)) > self.max_points:
@@ -197,8 +200,10 @@ class Decimator:
             self._time, self._poses, self.stride = [t[keep]], [p[keep]], self.stride * 2
 
     def result(self) -> tuple[np.ndarray, np.ndarray]:
-        """Times ``(M,)`` and poses ``(M, 3)`` kept."""
-        return np.concatenate(self._time), np.concatenate(self._poses)
+        """Times ``(M,)`` and poses ``(M, 3)`` kept, the stream's last pose included (the end a plot marks)."""
+        last = [] if self._last is None or (self._seen - 1) % self.stride == 0 else [self._last]
+        return (np.concatenate([*self._time, *(t for t, _ in last)]),
+                np.concatenate([*self._poses, *(p for _, p in last)]))
 
 
 def _compose_chunk(model: OdometryModel, positions: np.ndarray, before: np.ndarray, inc: ModelIncrements | None,
