@@ -58,7 +58,7 @@ def test_open_loop_execution_follows_the_plan_exactly(car, slot):
 def test_ackermann_wheels_steer_to_their_own_angles_and_any_origin_works():
     """A catalog car (two front wheels): each front wheel's heading is atan(h1 / (rho -+ track/2)) (Ackermann),
     and moving the robot's origin off the rear axle changes nothing for P_f."""
-    text = ("vehicle: {robot: ackermann, a1: 3.6 m, b1: 1.0 m, c1: 1.8 m, phi_max: 35 deg}\n"
+    text = ("vehicle: {robot: ackermann, a1: 3.6 m, b1: 1.0 m, c1: 1.8 m, phi_max: 34 deg}\n"
             "space: {H: 7 m, J: 2.3 m, MS: 0.25 m, dx2: 1.4 m, final_gap: 0.1 m}\n")
     problem = problem_from_text(text, source="car.yaml")
     plan = plan_parking(problem.vehicle, problem.space)

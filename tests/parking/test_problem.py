@@ -43,7 +43,7 @@ def test_builtin_names():
 
 def test_car_like_robot_gives_wheelbase_and_track(tmp_path):
     text = """\
-vehicle: {robot: ackermann, a1: 3.6 m, b1: 1.0 m, c1: 1.8 m, phi_max: 35 deg}
+vehicle: {robot: ackermann, a1: 3.6 m, b1: 1.0 m, c1: 1.8 m, phi_max: 34 deg}
 space: {H: 7 m, J: 2.3 m, MS: 0.25 m, dx2: 1.4 m, final_gap: 0.1 m}
 """
     p = problem_from_text(text, source="car.yaml")
@@ -74,7 +74,7 @@ space: {H: 7 m, J: 2.3 m, MS: 0.25 m, dx2: 1.4 m, final_gap: 0.1 m}
      r"is behind the front axle \(h1 = 1\.05 m\)"),
     (TABLE_91.replace("d1: 0.5", "d1: 1.5"), r"^x\.yaml:6: vehicle\.d1: the rear wheels \(1\.5 m apart\) stand "
      r"outside"),
-    ("vehicle: {robot: ackermann, a1: 3.6 m, b1: 1.0 m, c1: 1.5 m, phi_max: 35 deg}\n",
+    ("vehicle: {robot: ackermann, a1: 3.6 m, b1: 1.0 m, c1: 1.5 m, phi_max: 34 deg}\n",
      r"^x\.yaml:1: vehicle\.c1: the rear wheels \(1\.55 m apart\) stand outside the body's width \(c1 = 1\.5 m\)"),
     (TABLE_91.replace("H: 3.35", "H: 40 cm"), r"^x\.yaml:8: space\.MS: the margins at both ends \(0\.4 m\) leave "
      r"nothing of the slot's length H = 0\.4 m"),  # a ZeroDivisionError traceback in the length ratio (9.37) before

@@ -130,10 +130,8 @@ def execute_plan(plan: ParkingPlan, robot: Robot | None = None, *, v_max: float 
     """
     if not plan.feasible:
         raise WmrkitError(f"the plan is not feasible ({plan.reason}): nothing to execute")
-    from .problem import car_axles
-
     robot = vehicle_robot(plan.vehicle) if robot is None else robot
-    car_axles(robot)  # refuses robots that are not car-like
+    _check_steering(plan, robot)  # refuses robots that are not car-like, or cannot steer the plan
     offset = _rear_axle_midpoint(robot)
     t, ref, dist, seg = timed_reference(plan.segments, v_max=v_max, a_max=a_max, steer_rate=steer_rate, dt=dt)
     kappa = np.array([s.curvature for s in plan.segments])[seg]
@@ -151,6 +149,21 @@ def execute_plan(plan: ParkingPlan, robot: Robot | None = None, *, v_max: float 
     deviation = np.hypot(pose[:, 0] - ref[:, 0], pose[:, 1] - ref[:, 1])
     return Execution(robot, mode, readonly(t), readonly(ref), readonly(pose), readonly(steering),
                      readonly(headings), readonly(seg), readonly(deviation))
+
+
+def _check_steering(plan: ParkingPlan, robot: Robot) -> None:
+    """Refuse a `robot` that is not car-like (:func:`.problem.car_axles`), or whose wheels' ``steer_range`` does not
+    reach the plan's tightest turn (open loop they were turned beyond it, closed loop the car left the path)."""
+    from .problem import car_axles, curvature_limit
+
+    h1 = car_axles(robot)[0]
+    kappa = max((abs(s.curvature) for s in plan.segments), default=0.0)
+    limit = curvature_limit(robot)
+    if kappa > limit * (1 + 1e-9):
+        raise WmrkitError(f"the plan steers to {math.degrees(math.atan(h1 * kappa)):.4g} deg; robot '{robot.name}' "
+                          f"steers at most {math.floor(math.degrees(math.atan(h1 * limit)) * 100) / 100:.2f} deg "
+                          f"within its wheels' steer_range (radius {1 / kappa:.4g} m planned, {1 / limit:.4g} m "
+                          "reachable): plan with that phi_max")
 
 
 def _rear_axle_midpoint(robot: Robot) -> np.ndarray:

@@ -21,6 +21,7 @@ from ..catalog import resolve as resolve_robot
 from ..documents import FieldReader, read_document, read_file
 from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
+from ..wheels import Wheel, heading_from_beta, heading_in_range
 from .geometry import Space, Vehicle, no_free_length, wheels_outside
 
 VEHICLE_FIELDS = ("a1", "b1", "c1", "h1", "d1", "phi_max")
@@ -125,11 +126,35 @@ def _vehicle(check: FieldReader, data: Any, base: Path | None) -> tuple[Vehicle,
             check.fail(f"must be >= 0, got {v[name]} m", ("vehicle", name) if name in data else ("vehicle",))
     if not 0 < v["phi_max"] < math.pi / 2:
         check.fail(f"must be in (0, 90) deg, got {math.degrees(v['phi_max']):.6g} deg", ("vehicle", "phi_max"))
+    beyond = None if robot is None else _beyond_steer_range(robot, v["phi_max"])
+    if beyond is not None:
+        check.fail(beyond, ("vehicle", "phi_max"))
     problem = wheels_outside(v["a1"], v["c1"], v["h1"], v["d1"])
     if problem is not None:
         check.fail(problem[1], ("vehicle", problem[0] if problem[0] in data else "c1"))  # d1 of a robot
     vehicle = Vehicle(a1=v["a1"], b1=v["b1"], c1=v["c1"], h1=v["h1"], track=v["d1"], phi_max=v["phi_max"])
     return vehicle, robot
+
+
+def _beyond_steer_range(robot: Robot, phi_max: float) -> str | None:
+    """Why `phi_max` [rad] turns `robot`'s steerable wheels beyond their ``steer_range``, or None."""
+    limit = steering_limit(robot)
+    if phi_max <= limit + 1e-12:
+        return None
+    h1 = car_axles(robot)[0]
+    kappa = math.tan(phi_max) / h1
+    rear, front, _ = _axles(robot)
+    rx, ry = (sum(p[0] for p in rear) / len(rear), sum(p[1] for p in rear) / len(rear))
+    worst = ""
+    for w, (x, y) in zip([w for w in robot.wheels if w.type == "steerable"], front, strict=True):
+        if w.steer_range is not None:
+            for k in (kappa, -kappa):
+                h = math.atan2((x - rx) * k, 1 - (y - ry) * k)
+                if not (heading_in_range(h, *w.steer_range) or heading_in_range(h + math.pi, *w.steer_range)):
+                    lo, hi = (math.degrees(a) for a in w.steer_range)
+                    worst = worst or f"wheel '{w.name}' to {math.degrees(h):.4g} deg, range [{lo:g}, {hi:g}] deg"
+    return (f"{math.degrees(phi_max):.4g} deg turns the front wheels of robot '{robot.name}' beyond their "
+            f"steer_range ({worst}): at most {math.floor(math.degrees(limit) * 100) / 100:.2f} deg with this robot")
 
 
 def _space(check: FieldReader, data: Any) -> Space:
@@ -151,23 +176,79 @@ def car_axles(robot: Robot) -> tuple[float, float]:
     """Wheelbase ``h1`` and rear track ``d1`` of a car-like robot [m] (Fig. 9.19; Ackermann-equivalent wheel).
 
     The fixed wheels form the rear axle (P_f their midpoint), the steerable wheels the front one; ``h1`` is the
-    distance between the two axles' midpoints. Raises :class:`WmrkitError` for robots that are not car-like.
+    distance between the two axles' midpoints. The car drives along the robot's +x (its fixed wheels roll along x,
+    the steering axle lies ahead of P_f on the x axis through it). Raises :class:`WmrkitError` for robots that are
+    not such cars (a rear-steered forklift, the thesis's Y-forward tricycle).
     """
+    rear, front, fixed = _axles(robot)
+    tol = 1e-9 * max(1.0, *(abs(c) for p in (*rear, *front) for c in p))
+    for w in fixed:
+        heading = float(heading_from_beta(w.beta, w.delta))
+        if abs(math.sin(heading)) > 1e-9:
+            raise WmrkitError(f"robot '{robot.name}' does not drive along its x axis: fixed wheel '{w.name}' rolls at "
+                              f"heading {math.degrees(heading):.4g} deg; the planner's car drives forward along +x "
+                              "(x forward, y left), its fixed wheels rolling at heading 0")
+    if len(rear) == 2 and abs(rear[0][0] - rear[1][0]) > tol:
+        raise WmrkitError(f"robot '{robot.name}': its fixed wheels are not on one axle (x = {rear[0][0]:.6g} and "
+                          f"{rear[1][0]:.6g} m): a car has one rear axle")
+    rx, ry = (sum(p[0] for p in rear) / len(rear), sum(p[1] for p in rear) / len(rear))
+    fx, fy = (sum(p[0] for p in front) / len(front), sum(p[1] for p in front) / len(front))
+    track = math.dist(rear[0], rear[1]) if len(rear) == 2 else 0.0
+    wheelbase = fx - rx
+    if wheelbase <= tol:
+        where = (f"{-wheelbase:.4g} m behind its fixed axle (rear-steered)" if wheelbase < -tol
+                 else "on its fixed axle (no wheelbase)")
+        raise WmrkitError(f"robot '{robot.name}': its steerable wheels are {where}; the planner's car (Fig. 9.19) "
+                          "steers with wheels ahead of its rear axle along +x")
+    if abs(fy - ry) > tol:
+        raise WmrkitError(f"robot '{robot.name}': its steerable wheels' midpoint is {fy - ry:.4g} m to the side of "
+                          "the rear axle's: the planner's equivalent steering wheel lies on the car's centre line")
+    return wheelbase, track
+
+
+def _axles(robot: Robot) -> tuple[list[tuple[float, float]], list[tuple[float, float]], list[Wheel]]:
+    """Positions of the fixed and the steerable wheels [m, robot frame], and the fixed wheels; or the error of a
+    robot that is not car-like."""
     fixed = [w for w in robot.wheels if w.type == "fixed"]
     steer = [w for w in robot.wheels if w.type == "steerable"]
     if not 1 <= len(fixed) <= 2 or not steer or len(fixed) + len(steer) != len(robot.wheels):
         raise WmrkitError(f"robot '{robot.name}' is not car-like (one rear axle of fixed wheels and steerable "
                           f"front wheels; it has {', '.join(w.type for w in robot.wheels)})")
 
-    def xy(w) -> tuple[float, float]:
+    def xy(w: Wheel) -> tuple[float, float]:
         return w.l * math.cos(w.alpha), w.l * math.sin(w.alpha)
 
-    rear = [xy(w) for w in fixed]
-    front = [xy(w) for w in steer]
+    return [xy(w) for w in fixed], [xy(w) for w in steer], fixed
+
+
+def curvature_limit(robot: Robot) -> float:
+    """Largest path curvature of P_f [1/m] the car-like `robot`'s steerable wheels reach within their
+    ``steer_range`` (either root of (8.9): a wheel may also roll reversed), turning either way; inf without ranges.
+
+    For curvature ``kappa`` (ICR on the rear axle at ``1/kappa`` to the left of P_f) a wheel at ``(u, v)`` from P_f
+    rolls at heading ``atan2(u kappa, 1 - v kappa)``, monotone in ``kappa``: it reaches a range end ``h`` at
+    ``kappa = sin h / (u cos h + v sin h)`` (never when that denominator is not positive).
+    """
+    rear, front, _ = _axles(robot)
+    car_axles(robot)
     rx, ry = (sum(p[0] for p in rear) / len(rear), sum(p[1] for p in rear) / len(rear))
-    fx, fy = (sum(p[0] for p in front) / len(front), sum(p[1] for p in front) / len(front))
-    track = math.dist(rear[0], rear[1]) if len(rear) == 2 else 0.0
-    wheelbase = math.hypot(fx - rx, fy - ry)
-    if wheelbase <= 0:
-        raise WmrkitError(f"robot '{robot.name}': the steerable wheels sit on the rear axle (no wheelbase)")
-    return wheelbase, track
+    limit = math.inf
+    for w, (x, y) in zip([w for w in robot.wheels if w.type == "steerable"], front, strict=True):
+        if w.steer_range is None or w.steer_range[1] - w.steer_range[0] >= math.pi:  # one root always fits
+            continue
+        lo, hi = w.steer_range
+        shift = next((s for s in (0.0, -math.pi, math.pi, -2 * math.pi, 2 * math.pi) if lo + s <= 0 <= hi + s), None)
+        if shift is None:  # it cannot roll straight ahead
+            return 0.0
+        u, v = x - rx, y - ry
+        for end in (lo + shift, hi + shift):
+            den = u * math.cos(end) + v * math.sin(end)
+            if den > 0:
+                limit = min(limit, abs(math.sin(end) / den))
+    return limit
+
+
+def steering_limit(robot: Robot) -> float:
+    """Largest equivalent steering angle ``phi`` [rad] (9.27) the car-like `robot` reaches within its wheels'
+    ``steer_range``: ``atan(h1 kappa)`` at :func:`curvature_limit`; ``pi/2`` without ranges."""
+    return math.atan(car_axles(robot)[0] * curvature_limit(robot))
