@@ -159,3 +159,22 @@ def test_cli_track_through_the_dynamics(capsys):
     assert main(["track", "forklift", "--reference", "line", "--dynamics", "--duration", "2", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["period"] == 0.02 and len(data["t"]) == 101 and data["summary"]["max_error"] < 0.05  # starts at rest
+
+
+@pytest.mark.parametrize("t0", [100.0, -5.0, 1.6e9])
+def test_a_file_whose_times_do_not_start_at_zero_is_tracked_from_its_first_sample(tmp_path, t0, capsys):
+    """TUM files carry absolute (Unix) times: the loop ran from t = 0 against a reference held at its first pose
+    before its start (t0 > 0: rms 0.48 m, final 0.5 m = v/a behind) or already at its end (t0 < 0: 2 m off)."""
+    t = np.arange(0.0, 20.001, 0.1)
+    rows = [f"{ti + t0!r} {0.5 * ti!r} 0 0 0 0 0 1" for ti in t.tolist()]
+    (tmp_path / "abs.tum").write_text("\n".join(rows) + "\n")
+    (tmp_path / "rel.tum").write_text("\n".join(f"{ti!r} {0.5 * ti!r} 0 0 0 0 0 1" for ti in t.tolist()) + "\n")
+    robot = catalog.load("mecanum-4")
+    absolute, relative = (track(robot, load_reference(tmp_path / f), initial_pose=[0, 0.3, 0])
+                          for f in ("abs.tum", "rel.tum"))
+    np.testing.assert_allclose(absolute.t, relative.t, atol=1e-6)
+    np.testing.assert_allclose(absolute.error, relative.error, atol=1e-5)  # times of 1.6e9 s: 2e-7 s apart
+    assert absolute.error[-1] < 1e-5  # 0.5 m (v / a) behind before
+    assert main(["track", "mecanum-4", "--reference", str(tmp_path / "abs.tum"), "--from", "0", "0.3", "0",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["summary"]["final_error"] < 1e-5

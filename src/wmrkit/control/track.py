@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from ..slip.kalman import KalmanNoise
     from ..slip.weights import SlipWeights
 
-__all__ = ["CONTROLLERS", "TrackingRun", "initial_pose_on", "track"]
+__all__ = ["CONTROLLERS", "TrackingRun", "from_first_sample", "initial_pose_on", "track"]
 
 #: Controllers: the thesis's laws (8.1)-(8.3) and the two geometric trackers users use.
 CONTROLLERS = ("p", "pi", "point", "pure-pursuit", "stanley")
@@ -130,6 +130,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
           noise: KalmanNoise | None = None, ramp: bool = False, progress: bool = False) -> TrackingRun:
     """Track `reference` with `robot` (thesis ch. 8): closed loop, continuous (``period`` None) or discrete.
 
+    The run's time 0 is the reference's first sample (:func:`from_first_sample`: TUM files carry Unix times).
+
     `controller`: ``"p"`` (8.2), ``"pi"`` (8.3), ``"point"`` (8.1), ``"pure-pursuit"``, ``"stanley"``. `gain`: the
     pole ``a`` [1/s] of every coordinate; `integral_gain` ``b`` [1/s^2] of ``"pi"`` (default ``a^2/4``, critically
     damped); `gate` [m]: feedforward gate (8.53). `initial_pose` ``(3,)`` default: on the reference
@@ -152,6 +154,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     if period is None and delay and not dynamics:
         raise ControlError("delay: a measurement delay in samples needs a sample period (--period)")
     cp = control_point(robot, point)
+    if reference.t[0] != 0.0:  # absolute (TUM: Unix) times: the run's clock starts at the first sample
+        reference = from_first_sample(reference)
     duration = reference.duration if duration is None else float(duration)
     _check_timing(duration, 0.02 if dynamics and period is None else period, output_dt)
     pose0 = initial_pose_on(cp, reference) if initial_pose is None else as_vectors(initial_pose, 3, "initial_pose")
@@ -300,6 +304,15 @@ def _check_dynamic_work(duration: float, period: float, slipping: bool) -> None:
     if slipping and duration / period > MAX_SLIP_PERIODS:
         raise ControlError(f"duration {duration:g} s at a period of {period:g} s: more than {MAX_SLIP_PERIODS} control "
                            "periods with slip-model commands or feedback (each solves the slip model)")
+
+
+def from_first_sample(reference: Reference) -> Reference:
+    """`reference` with its times (and breaks) counted from its first sample [s]: what :func:`track` follows (the
+    loop starts at t = 0; a reference starting later was held at its first pose, one already over at its last)."""
+    from dataclasses import replace
+
+    t0 = float(reference.t[0])
+    return replace(reference, t=readonly(reference.t - t0), breaks=tuple(b - t0 for b in reference.breaks))
 
 
 def _full_point(cp: ControlPoint, p: np.ndarray) -> ControlPoint:
