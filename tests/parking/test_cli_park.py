@@ -116,3 +116,16 @@ def test_check_reads_the_executed_path_too(capsys):
     assert out.count("collision-free") == 2
     code, out, _ = run(capsys, "thesis-9.1", "--check")  # no execution asked: the plan alone
     assert "executed" not in out
+
+
+def test_a_plan_too_long_for_the_closed_loop_is_refused_in_parking_terms(capsys, tmp_path):
+    """A pass 1000 m out (the largest length a problem takes) makes a 2.6 km plan, 86 min to drive: the closed loop
+    refused it with track's advice (--duration, --speed, --size, --period), none of which park has."""
+    f = tmp_path / "far.yaml"
+    f.write_text("vehicle: {a1: 1.5, b1: 0.5, c1: 1.4, h1: 1.05, d1: 0.5, phi_max: 46 deg}\n"
+                 "space: {H: 3.35, J: 2.0, MS: 0.2, dx2: 1000, final_gap: 0.07}\n")
+    code, _, err = run(capsys, str(f), "--controller", "p", "--animate", str(tmp_path / "far.gif"))
+    assert code == 2 and err.count("\n") == 1
+    assert "controller 'p': the plan takes 5163 s to drive" in err and "open loop" in err
+    assert not any(option in err for option in ("--duration", "--speed", "--size", "--period"))
+    assert not (tmp_path / "far.gif").exists()

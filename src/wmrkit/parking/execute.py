@@ -213,8 +213,13 @@ def _open_loop(robot, offset, pose0, t, dist, seg, kappa, direction):
 def _closed_loop(robot, offset, t, ref, controller, gain):
     """Track the steering axle's midpoint (a point off the fixed axle, as §8.6 controls) with wmrkit.control."""
     from ..control.references import reference_from_samples
-    from ..control.track import track
+    from ..control.track import MAX_CONTINUOUS_SAMPLES, track
 
+    output_dt = float(t[1] - t[0])
+    if t[-1] / output_dt > MAX_CONTINUOUS_SAMPLES:  # track's own refusal named its options (--duration, ...)
+        raise WmrkitError(f"controller '{controller}': the plan takes {t[-1]:.0f} s to drive; the closed loop "
+                          f"simulates at most {MAX_CONTINUOUS_SAMPLES * output_dt:.0f} s: execute it open loop "
+                          "(no controller), or plan a shorter pass (dx2)")
     front = np.mean([[w.l * math.cos(w.alpha), w.l * math.sin(w.alpha)] for w in robot.wheels
                      if w.type == "steerable"], axis=0)
     point = front - offset  # in P_f's frame (the robot frame translated to P_f)
@@ -223,7 +228,7 @@ def _closed_loop(robot, offset, t, ref, controller, gain):
                               ref[:, 2]])
     reference = reference_from_samples("parking plan", t, target)
     run = track(robot, reference, controller=controller, gain=gain, point=tuple(front),
-                initial_pose=_origin_pose(ref[0], offset), output_dt=float(t[1] - t[0]))
+                initial_pose=_origin_pose(ref[0], offset), output_dt=output_dt)
     pose = np.stack([np.interp(t, run.t, run.pose[:, j]) for j in range(3)], axis=-1)
     heading = np.stack([np.interp(t, run.t, run.heading[:, j]) for j in range(run.heading.shape[1])], axis=-1)
     return _pf_pose(pose, offset), heading
