@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import math
+from dataclasses import asdict
 
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from parking_cases import CAR_91, CAR_92, arc_poses, corners_world
+from parking_cases import CAR_91, CAR_92, SLOT_91, arc_poses, corners_world
 
+from wmrkit.errors import WmrkitError
 from wmrkit.parking.geometry import (
     Space,
     Vehicle,
@@ -116,3 +118,9 @@ def test_blackburn_bound_against_a_numeric_sweep(vehicle):
     resolution = 2 * math.hypot(vehicle.a1, rho + vehicle.c1) * (theta[1] - theta[0])  # corner travel per sample
     assert vehicle.b1 + gap == pytest.approx(blackburn_min_length(vehicle), abs=resolution)
     assert vehicle.b1 + gap <= blackburn_min_length(vehicle) + 1e-12  # samples can only miss the extreme
+
+
+def test_space_refuses_a_negative_dx2_as_a_problem_file_does():
+    """Space(dx2=-1) was planned (a pass at c1/2 + MS, with a warning) where a problem file refuses it."""
+    with pytest.raises(WmrkitError, match=r"space\.dx2: must be >= 0, got -1\.0 m"):
+        Space(**{**asdict(SLOT_91), "dx2": -1.0})

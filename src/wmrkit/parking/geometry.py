@@ -96,8 +96,9 @@ class Space:
         for name in ("H", "J", "final_gap"):
             if getattr(self, name) <= 0:
                 raise WmrkitError(f"space.{name}: must be > 0, got {getattr(self, name)} m")
-        if self.MS < 0:
-            raise WmrkitError(f"space.MS: must be >= 0, got {self.MS} m")
+        for name in ("MS", "dx2"):  # a problem file refused a negative dx2; Space took it
+            if getattr(self, name) < 0:
+                raise WmrkitError(f"space.{name}: must be >= 0, got {getattr(self, name)} m")
         problem = no_free_length(self.H, self.MS)
         if problem is not None:
             raise WmrkitError(f"space.MS: {problem}")
