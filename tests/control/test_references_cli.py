@@ -178,3 +178,14 @@ def test_a_file_whose_times_do_not_start_at_zero_is_tracked_from_its_first_sampl
     assert main(["track", "mecanum-4", "--reference", str(tmp_path / "abs.tum"), "--from", "0", "0.3", "0",
                  "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["summary"]["final_error"] < 1e-5
+
+
+@pytest.mark.filterwarnings("error")  # pytest captures warnings: make them fail here
+def test_times_whose_differences_overflow_give_one_error_line(tmp_path, capsys):
+    """Times 1e300 s apart: numpy's three overflow RuntimeWarnings (file and line of its gradient) came on stderr
+    before the error line."""
+    f = tmp_path / "huge.csv"
+    f.write_text("t,x,y,theta\n0,0,0,0\n1,1,0,0\n1e300,2,0,0\n")
+    assert main(["track", "diff-drive", "--reference", str(f)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "RuntimeWarning" not in err

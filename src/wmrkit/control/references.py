@@ -104,8 +104,13 @@ def reference_from_samples(name: str, t: np.ndarray, pose: np.ndarray) -> Refere
         k = int(np.argmax(step))
         raise ReferenceError(f"{name}: samples {k + 1}-{k + 2} move at {step[k]:.3g} m/s, beyond {MAX_SPEED:g} m/s "
                              "(times are seconds, positions metres)")
-    vel = np.gradient(pose, t, axis=0, edge_order=2)
-    acc = np.gradient(vel, t, axis=0, edge_order=2)
+    with np.errstate(over="ignore", invalid="ignore"):  # numpy's warnings on stderr: refused below instead
+        vel = np.gradient(pose, t, axis=0, edge_order=2)
+        acc = np.gradient(vel, t, axis=0, edge_order=2)
+    if not (np.isfinite(vel).all() and np.isfinite(acc).all()):  # samples 1e-300 s apart: an acceleration of inf
+        k = int(np.argmax(~(np.isfinite(vel).all(axis=1) & np.isfinite(acc).all(axis=1))))
+        raise ReferenceError(f"{name}: sample {k + 1}: the velocity or acceleration by finite differences overflows "
+                             "(samples too close in time, or too far apart: times are seconds)")
     return Reference(name, readonly(t), readonly(pose), readonly(vel), readonly(acc))
 
 
