@@ -172,3 +172,14 @@ def test_a_camera_too_noisy_to_see_the_line_is_an_error_with_its_reason(capsys):
     assert "follow-line: the camera does not see the line at the start pose: image: too noisy" in err
     assert main(["follow-line", "line-follower", "--camera", camera, "--image-noise", "1e300"]) == 2
     assert "image noise must be in [0, 255] grey levels" in capsys.readouterr().err
+
+
+def test_a_robot_started_facing_back_follows_the_line_the_other_way_and_psi_stays_wrapped():
+    """Started at theta = 3 rad the robot follows the line towards -x (the camera cannot tell the line's
+    direction); the summary printed psi = -180.77 deg, outside (-180, 180]: now 179.23 deg."""
+    run = follow_line(ROBOT, CAMERA, start=(0.0, 0.3, 3.0))
+    assert run.failure() is None and abs(run.lateral[-1]) < 0.005 and run.pose[-1, 0] < -1.0
+    out = run.to_dict()
+    assert out["final_psi"] == pytest.approx(math.remainder(-run.pose[-1, 2], 2 * math.pi), abs=1e-12)
+    assert -math.pi < out["final_psi"] <= math.pi
+    assert all(-math.pi < s["psi"] <= math.pi for s in out["samples"])

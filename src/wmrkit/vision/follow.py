@@ -33,6 +33,7 @@ from ..kinematics.wheel_ik import forward_kinematics, wheel_commands
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_seed
 from ..odometry.integrators import integrate_exact
 from ..robot import Robot
+from ..wheels import wrap_angle
 from .camera import Camera, extrinsics
 from .lines import extract_lines
 from .positioning import Positioning, locate_points
@@ -149,14 +150,14 @@ class LineFollowing:
                 "from the line)")
 
     def to_dict(self) -> dict[str, Any]:
-        """Summary and samples (the ``wmrkit follow-line --json`` output)."""
+        """Summary and samples (the ``wmrkit follow-line --json`` output); psi [rad] wrapped to (-pi, pi]."""
         h = self.lateral
         return {
             "robot": self.robot_name, "gain": self.gain, "speed": self.speed, "period": self.period,
-            "final_h": float(h[-1]), "final_psi": float(-self.pose[-1, 2]),
+            "final_h": float(h[-1]), "final_psi": float(wrap_angle(-self.pose[-1, 2])),
             "overshoot": float(max(0.0, -np.min(h * np.sign(h[0])))) if h[0] != 0 else 0.0,
             "settling_time_95": self.settling_time(), "lost_images": int(np.count_nonzero(self.lost)),
-            "samples": [{"t": float(t), "x": float(p[0]), "h": float(p[1]), "psi": float(-p[2])}
+            "samples": [{"t": float(t), "x": float(p[0]), "h": float(p[1]), "psi": float(wrap_angle(-p[2]))}
                         for t, p in zip(self.time, self.pose, strict=True)],
             "wheel_rates": {n: self.rates[:, i].tolist() for i, n in enumerate(self.rate_names)},
         }
