@@ -148,6 +148,9 @@ def test_cli_feasibility_json(capsys):
      "--stanley-gain applies to --controller stanley"),
     (["track", "diff-drive", "--reference", "circle", "--controller", "pure-pursuit", "--lookahead", "0"],
      "--lookahead: expected a positive number"),
+    # 377 periods measured 10^8 samples late: an open loop printed as a tracking result, exit 0
+    (["track", "diff-drive", "--reference", "circle", "--period", "0.1", "--delay", "100000000"],
+     "delay: 100000000 samples of 0.1 s reach past the run (37.69 s): the loop would never see a measurement"),
 ])
 def test_cli_errors_exit_2_with_one_line(argv, message, capsys):
     assert main(argv) == 2

@@ -157,7 +157,11 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     if reference.t[0] != 0.0:  # absolute (TUM: Unix) times: the run's clock starts at the first sample
         reference = from_first_sample(reference)
     duration = reference.duration if duration is None else float(duration)
-    _check_timing(duration, 0.02 if dynamics and period is None else period, output_dt)
+    sampled = 0.02 if dynamics and period is None else period
+    _check_timing(duration, sampled, output_dt)
+    if sampled is not None and isinstance(delay, int) and delay > 0 and delay * sampled >= duration:
+        raise ControlError(f"delay: {delay} samples of {sampled:g} s reach past the run ({duration:g} s): the loop "
+                           "would never see a measurement (open loop)")
     pose0 = initial_pose_on(cp, reference) if initial_pose is None else as_vectors(initial_pose, 3, "initial_pose")
     if not (np.abs(pose0) <= MAX_COORDINATE).all() or pose0.ndim != 1:  # NaN included
         raise ControlError(f"initial_pose: expected one pose (x, y, theta), finite and within {MAX_COORDINATE:g}, "
