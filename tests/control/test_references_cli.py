@@ -192,3 +192,22 @@ def test_times_whose_differences_overflow_give_one_error_line(tmp_path, capsys):
     assert main(["track", "diff-drive", "--reference", str(f)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "RuntimeWarning" not in err
+
+
+def test_an_animation_that_is_not_a_gif_is_refused_before_the_run(tmp_path, monkeypatch, capsys):
+    """--animate run.png wrote a single still PNG and exited 0."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["track", "diff-drive", "--reference", "line", "--duration", "2", "--animate", "run.png"]) == 2
+    out = capsys.readouterr()
+    assert out.out == "" and out.err.count("\n") == 1 and "run.png: the animation is written as .gif" in out.err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_animate_run_refuses_a_file_that_is_not_a_gif(tmp_path):
+    from wmrkit.control.plots import animate_run
+    from wmrkit.errors import WmrkitError
+
+    run = track(catalog.load("diff-drive"), builtin_reference("line", duration=2.0))
+    with pytest.raises(WmrkitError, match=r"run\.png: the animation is written as a GIF"):
+        animate_run(run, tmp_path / "run.png")
+    assert not (tmp_path / "run.png").exists()

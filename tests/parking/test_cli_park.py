@@ -129,3 +129,12 @@ def test_a_plan_too_long_for_the_closed_loop_is_refused_in_parking_terms(capsys,
     assert "controller 'p': the plan takes 5163 s to drive" in err and "open loop" in err
     assert not any(option in err for option in ("--duration", "--speed", "--size", "--period"))
     assert not (tmp_path / "far.gif").exists()
+
+
+@pytest.mark.parametrize("argv", [["--plot", "x.txt"], ["--animate", "x.mp4"], ["--json", "--animate", "x.png"]])
+def test_output_files_it_cannot_write_are_refused_before_the_answer(capsys, tmp_path, monkeypatch, argv):
+    """The whole answer (text, or JSON on stdout) was printed, then the error, exit 2."""
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(capsys, "thesis-9.1", *argv)
+    assert code == 2 and out == "" and err.count("\n") == 1 and argv[-1] in err
+    assert list(tmp_path.iterdir()) == []

@@ -175,3 +175,17 @@ def test_locate_refuses_a_spacing_it_would_ignore(capsys):
     code, _, err = run(["vision", "locate", str(FIGURES / "three-lines.png"), "--camera",
                         str(FIGURES / "thesis-camera.yaml"), "--spacing", "3.5cm", "--lines", "1"], capsys)
     assert code == 2 and "--spacing applies to 2 or 3 lines" in err
+
+
+def test_follow_line_refuses_an_animation_it_cannot_write_before_the_run(tmp_path, capsys, monkeypatch):
+    """--animate run.png was refused only after the whole simulated run (40 images rendered and located)."""
+    from wmrkit.vision import follow as follow_module
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the run started")
+
+    monkeypatch.setattr(follow_module, "follow_line", no_run)
+    Camera(150.0, math.radians(60), 0.3, 160, 120).to_file(tmp_path / "cam.yaml")
+    code, out, err = run(["follow-line", "line-follower", "--camera", str(tmp_path / "cam.yaml"), "--animate",
+                          str(tmp_path / "run.png")], capsys)
+    assert code == 2 and out == "" and "run.png: the animation is written as .gif" in err

@@ -6,9 +6,10 @@ import argparse
 import math
 import sys
 import warnings
+from pathlib import Path
 
 from ..errors import WmrkitError
-from ._common import add_json_flag, add_robot_argument, load_robot, parse_value, print_json
+from ._common import add_json_flag, add_robot_argument, check_plot_path, load_robot, parse_value, print_json
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -94,11 +95,20 @@ def _check_controller_options(args: argparse.Namespace) -> None:
                               f"{args.controller} (it would be ignored)")
 
 
+def check_animation_path(path: str | None, suffixes: tuple[str, ...] = (".gif",)) -> None:
+    """Refuse, before the work it shows, an ``--animate`` file whose extension is not one of `suffixes` (a
+    ``.png`` was written as a single still frame, exit 0; a ``.mp4`` refused after the answer was printed)."""
+    if path is not None and Path(path).suffix.lower() not in suffixes:
+        raise WmrkitError(f"--animate {path}: the animation is written as {' or '.join(suffixes)}")
+
+
 def run_track(args: argparse.Namespace) -> int:
     """Simulate, then print a summary (or the time series as JSON); warnings on stderr."""
     from ..control.laws import SamplingWarning
     from ..control.track import track
 
+    check_plot_path(args.plot)
+    check_animation_path(args.animate)
     robot, reference = load_robot(args.robot), _reference(args)
     start = None
     if args.start:
@@ -161,6 +171,7 @@ def run_feasibility(args: argparse.Namespace) -> int:
     """Print the Table 8.1 requirement and every violation with its remedy."""
     from ..control.feasibility import feasibility
 
+    check_plot_path(args.plot)
     robot, reference = load_robot(args.robot), _reference(args)
     result = feasibility(robot, reference, args.framework)
     if args.plot:

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 
 from ..errors import WmrkitError
-from ._common import add_json_flag, print_json
+from ._common import add_json_flag, check_plot_path, print_json
+from .control import check_animation_path
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -36,6 +37,8 @@ def run(args: argparse.Namespace) -> int:
 
     if not 2 <= args.frames <= MAX_FRAMES:  # below 2 was raised to 2 silently; thousands took minutes
         raise WmrkitError(f"--frames: expected 2 to {MAX_FRAMES} animation frames, got {args.frames}")
+    check_plot_path(args.plot)  # before the answer is printed
+    check_animation_path(args.animate, (".gif", ".html"))
     solution = solve(load_problem(args.problem), check=args.check)
     execution = executed = None
     if args.animate or (args.check and args.controller and solution.plan.feasible):

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..errors import WmrkitError
 from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_value, print_json
+from .control import check_animation_path
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -162,6 +163,7 @@ def run_follow(args: argparse.Namespace) -> int:
     from ..vision.follow import follow_line
     from ..vision.render import Scene
 
+    check_animation_path(args.animate)  # before the run
     robot, camera = load_robot(args.robot), _camera(args.camera)
     noise = (0.0, 0.0) if not args.noise else (parse_value(args.noise[0], "length", "--noise H"),
                                                 parse_angle(args.noise[1], "--noise PSI"))

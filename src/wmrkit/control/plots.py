@@ -68,9 +68,11 @@ def plot_run(run: TrackingRun, path: str | os.PathLike[str]) -> None:
 
 
 def animate_run(run: TrackingRun, path: str | os.PathLike[str], *, frames: int = 80) -> None:
-    """A GIF of the robot (outline and wheels at their headings) following the reference."""
+    """A GIF of the robot (outline and wheels at their headings) following the reference (`path` ends in .gif)."""
     from matplotlib.animation import FuncAnimation, PillowWriter
 
+    if os.path.splitext(os.fspath(path))[1].lower() != ".gif":  # x.png was written as one still frame
+        raise WmrkitError(f"{os.fspath(path)}: the animation is written as a GIF (.gif)")
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(5, 5))
     idx = np.linspace(0, len(run.t) - 1, min(frames, len(run.t))).astype(int)
