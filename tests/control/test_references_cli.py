@@ -91,6 +91,19 @@ def test_geometric_trackers_converge_onto_the_path(controller, name):
     assert run.cross_track[0] > 0.3 and run.cross_track[-1] < 0.01
 
 
+@pytest.mark.parametrize("name", ["diff-drive", "mecanum-4"])
+def test_pure_pursuit_turns_round_to_a_path_that_runs_behind_it(name):
+    """A reference reversing along -x with heading 0 puts the goal point straight behind: kappa = 2 y_g / L^2 ~ 0
+    drove the robot straight away (final error 8.3 m on a 5 m reference; cross-track growing without bound)."""
+    from wmrkit.control.references import reference_from_samples
+
+    t = np.arange(0.0, 40.001, 0.1)
+    ref = reference_from_samples("reverse", t, np.column_stack([-0.5 * t, 0 * t, 0 * t]))
+    run = track(catalog.load(name), ref, controller="pure-pursuit", initial_pose=[0.0, 0.2, 0.0])
+    assert run.cross_track[run.t > 25].max() < 0.01
+    assert run.tracked[-1, 0] < -15.0  # along the path, towards -x
+
+
 def test_cli_track_json(capsys):
     assert main(["track", "forklift", "--reference", "circle", "--from", "0", "0.5", "0deg", "--duration", "4",
                  "--json"]) == 0

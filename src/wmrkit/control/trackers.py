@@ -4,7 +4,8 @@ Both steer a point of the robot onto the reference *path* at the reference's spe
 
 - **pure pursuit** (Coulter 1992): the axle point ``A`` (the foot of the fixed axle, the origin without fixed wheels)
   drives on the arc through a goal point ``lookahead`` metres further along the path: curvature
-  ``kappa = 2 y_g / L_d^2``;
+  ``kappa = 2 y_g / L_d^2``; a goal behind ``A`` (``x_g <= 0``) turns it round on the circle of diameter ``L_d``
+  (``kappa = +-2 / L_d``, towards the goal's side, left when straight behind);
 - **Stanley** (Thrun et al. 2006): a front point ``F`` at ``wheelbase`` ahead of ``A``; steering
   ``delta = psi_e - atan(k e / (v + eps))`` with the heading error ``psi_e`` and the signed cross-track error ``e`` of
   ``F`` (positive left), curvature ``tan(delta) / wheelbase``.
@@ -137,7 +138,12 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0)
         c, s = math.cos(psi), math.sin(psi)
         x_g, y_g = c * d[0] + s * d[1], -s * d[0] + c * d[1]
         dist2 = x_g * x_g + y_g * y_g
-        kappa = 2.0 * y_g / dist2 if dist2 > 1e-12 else 0.0
+        if dist2 <= 1e-12:
+            kappa = 0.0
+        elif x_g > 0:
+            kappa = 2.0 * y_g / dist2
+        else:  # goal behind (the path runs against the robot): 2 y_g / L^2 ~ 0 drove straight away; turn round
+            kappa = math.copysign(2.0 / math.sqrt(dist2), y_g)
         v = _speed(reference, t)
         return _twist_at_origin(cp, v, v * kappa), np.zeros(3)
 
