@@ -13,14 +13,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wmrkit.cli.main import main
+from wmrkit.cli.main import COMPILE_NOTICE, main
 from wmrkit.control.points import ControlError
 
 CAMERA = str(Path(__file__).parents[2] / "docs" / "figures" / "vision" / "follower-camera.yaml")
 #: Seconds one refused command may take: a refusal is immediate, and the hangs it replaced ran for over a minute (a wide
 #: margin for a loaded machine).
 FAST = 30.0
-COMPILING = "wmrkit: compiling numerical kernels for this machine (first run only; cached for the next runs)...\n"
+COMPILING = COMPILE_NOTICE + "\n"
 
 
 def _refused(argv: list[str], capsys) -> str:
@@ -342,9 +342,15 @@ def test_a_continuous_loop_stops_within_its_computing_time_and_names_a_wheel_hel
     # 'track ackermann --reference figure-eight --gain 3' ran 6 minutes before 'too stiff': the law asks for turns
     # tighter than the +-40 deg rack allows, and a front wheel held at an end of its range switches ends where the
     # heading asked of it passes 90 deg. Now at most MAX_CONTINUOUS_SECONDS of computing (lowered here), and the
-    # refusal says where it got and which wheel is held.
+    # refusal says where it got and which wheel is held. The loop's clock is a fake one advancing 0.5 s a reading
+    # (one reading every 1000 evaluations): on a loaded machine 2 s of real computing stopped it before any wheel
+    # was held, and the message had no wheel to name.
+    import types
+
     from wmrkit.control import loop
 
+    readings = iter(range(1, 10**6))
+    monkeypatch.setattr(loop, "time", types.SimpleNamespace(monotonic=lambda: 0.5 * next(readings)))
     monkeypatch.setattr(loop, "MAX_CONTINUOUS_SECONDS", 2.0)
     start = time.monotonic()
     message = _refused(["track", "ackermann", "--reference", "figure-eight", "--gain", "3"], capsys)

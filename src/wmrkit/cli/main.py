@@ -96,6 +96,8 @@ def main(argv: list[str] | None = None) -> int:
 
 #: Seconds of uninterrupted kernel compilation after which the command says why it is quiet.
 COMPILE_NOTICE_AFTER = 2.0
+#: The line it prints on stderr (before an answer or an error line).
+COMPILE_NOTICE = "wmrkit: compiling numerical kernels for this machine (first run only; cached for the next runs)..."
 
 
 def _compile_notice(done: threading.Event, poll: float = 0.25) -> None:
@@ -106,8 +108,7 @@ def _compile_notice(done: threading.Event, poll: float = 0.25) -> None:
     while not done.wait(poll):
         busy = busy + poll if _compiling() else 0.0
         if busy >= COMPILE_NOTICE_AFTER:
-            print("wmrkit: compiling numerical kernels for this machine (first run only; cached for the next runs)...",
-                  file=sys.stderr, flush=True)
+            print(COMPILE_NOTICE, file=sys.stderr, flush=True)
             return
 
 
