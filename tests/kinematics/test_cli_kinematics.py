@@ -129,3 +129,14 @@ def test_an_unknown_codegen_language_is_refused_before_the_work(capsys, monkeypa
     monkeypatch.setattr(command, "kinematics_summary", never)
     assert main(["kinematics", "forklift", "--symbolic", "--codegen", "rust", str(tmp_path)]) == 2
     assert "--codegen: language must be one of c, python, got 'rust'" in capsys.readouterr().err
+
+
+def test_a_json_error_about_a_file_in_the_output_folder_names_that_file(capsys, tmp_path):
+    """--codegen c DIR over a user's file: the JSON error had "file": null (the message names DIR/FILE, argv DIR)."""
+    (tmp_path / "diff_drive_kinematics.c").write_text("int main(void) { return 0; }\n")
+    assert main(["kinematics", "diff-drive", "--codegen", "c", str(tmp_path), "--json"]) == 2
+    error = json.loads(capsys.readouterr().err)
+    assert error["file"] == f"{tmp_path}/diff_drive_kinematics.c"
+    assert error["error"].startswith("exists and is not wmrkit's code for robot 'diff-drive'")
+    assert main(["kinematics", "diff-drive", "--codegen", "c", f"{tmp_path}/", "--json"]) == 2  # a trailing slash
+    assert json.loads(capsys.readouterr().err)["file"] == f"{tmp_path}/diff_drive_kinematics.c"

@@ -139,9 +139,13 @@ def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> N
 
 def _file_place(message: str, argv: Sequence[str]) -> dict:
     """``file``, ``line`` and ``field`` of a message that starts with a file given in `argv` (a path: a name with a
-    dot or a slash, or one that exists; the longest first)."""
-    name = max((a for a in argv if ("." in a or "/" in a or os.path.exists(a)) and message.startswith(f"{a}:")),
-               key=len, default=None)
+    dot or a slash, or one that exists; the longest first), or with a file inside a folder given there (the files
+    a command writes into its output folder)."""
+    paths = [a for a in argv if "." in a or "/" in a or os.path.exists(a)]
+    name = max((a for a in paths if message.startswith(f"{a}:")), key=len, default=None)
+    if name is None:
+        inside = (re.match(re.escape(a.rstrip("/")) + r"/[^:\n]+(?=:)", message) for a in paths if a.strip("/"))
+        name = max((m.group(0) for m in inside if m), key=len, default=None)
     if name is None:
         return {}
     place = re.match(r"(?:(\d+):)?(?: column '([^']*)':)?(.*)", message[len(name) + 1:], flags=re.S)
