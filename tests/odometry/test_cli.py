@@ -245,3 +245,22 @@ def test_a_named_pipe_is_refused_not_waited_on(tmp_path):
     assert out.returncode == 2 and out.stdout == ""
     error = json.loads(out.stderr)  # one line, the file named
     assert error["file"].endswith("pipe.csv") and error["error"].startswith("not a regular file")
+
+
+@pytest.mark.parametrize("alias", ["same", "dot", "link"])
+@pytest.mark.parametrize("fmt", ["csv", "tum"])
+def test_an_output_that_is_the_log_is_refused_and_the_log_kept(capsys, diff_csv, tmp_path, monkeypatch, alias, fmt):
+    """``--out log.csv`` opened the log for writing before reading it: the log was emptied (then 'empty file')."""
+    import os
+    from pathlib import Path
+
+    log = Path(diff_csv)
+    before = log.read_bytes()
+    monkeypatch.chdir(log.parent)
+    if alias == "link":
+        os.symlink(log.name, "link.csv")
+    given = {"same": str(log), "dot": f"./{log.name}", "link": "link.csv"}[alias]
+    assert main(["odometry", "diff-drive", str(log), "--out", given, "--format", fmt]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "the output file is the log itself" in err, err
+    assert log.read_bytes() == before

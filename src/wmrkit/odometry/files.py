@@ -40,6 +40,22 @@ def out_format_of(path: str | os.PathLike[str]) -> OutFormat:
     return "csv" if suffix == ".csv" else "tum" if suffix in (".tum", ".txt") else "bag"
 
 
+def _same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
+    """Whether `a` and `b` name one file (links and relative paths resolved; `b` need not exist)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return os.path.realpath(a) == os.path.realpath(b)
+
+
+def _check_not_the_log(log_path: str | os.PathLike[str], outputs: Mapping[str, object]) -> None:
+    """Refuse an output that is the log itself: opening it for writing would empty the log before it is read."""
+    for what, path in outputs.items():
+        if path is not None and _same_file(log_path, path):  # type: ignore[arg-type]
+            raise LogError(f"{os.fspath(log_path)}: the {what} file is the log itself (writing it would destroy the "
+                           "log); choose another file")
+
+
 def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFormat = DEFAULT_FORMAT,
                   method: Method = "exact", pose0: ArrayLike = (0.0, 0.0, 0.0), sensed: Sequence[str] | None = None,
                   noise: Noise | None = None, out: str | os.PathLike[str] | None = None,
@@ -66,6 +82,7 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
         raise LogError(f"{os.fspath(log_path)}: CSV options (columns, counts, heading...) do not apply to a bag")
     total, unit = ((bag_message_count(log_path, topic), "msg") if bag
                    else (os.path.getsize(log_path), "B"))
+    _check_not_the_log(log_path, {"output": out, "plot": plot})
     out_fmt = None if out is None else (out_format or out_format_of(out))
     if out_fmt not in (None, "csv", "tum", "bag"):
         raise LogError(f"unknown output format '{out_fmt}' (formats: csv, tum, bag)")
