@@ -264,3 +264,30 @@ def test_an_output_that_is_the_log_is_refused_and_the_log_kept(capsys, diff_csv,
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "the output file is the log itself" in err, err
     assert log.read_bytes() == before
+
+
+@pytest.mark.parametrize(("header", "args"), [
+    ("time [s],left.spin,right.spin,latency [ms]", []),  # the time was read in ms: every step 1000 times shorter
+    ("time,left.spin,right.spin,battery [V]", []),  # refused: 'unknown unit V (time units ...)'
+    ("time,left.spin,right.spin,imu.yaw [deg]", []),  # refused: 'unknown unit deg (for a spin joint ...)'
+    ("time,enc_l [rad],enc_r [rad]", ["--column", "left.spin=enc_l", "--column", "right.spin=enc_r"]),  # refused
+])
+def test_units_of_columns_that_are_not_the_logs_do_not_change_the_reading(capsys, tmp_path, header, args):
+    plain = tmp_path / "plain.csv"
+    rows = "0,0,0{x}\n0.5,1,2{x}\n1,2,4{x}\n"
+    plain.write_text("time,left.spin,right.spin\n" + rows.format(x=""))
+    path = tmp_path / "units.csv"
+    path.write_text(header + "\n" + rows.format(x=",5" if header.count(",") == 3 else ""))
+    want = _json(capsys, ["odometry", "diff-drive", str(plain), "--json"])
+    got = _json(capsys, ["odometry", "diff-drive", str(path), "--json", *args])
+    assert (got["pose"], got["max_dt"]) == (want["pose"], want["max_dt"])
+
+
+def test_a_heading_column_with_its_unit(capsys, tmp_path):
+    """``--heading-column yaw`` on a header ``yaw [rad]`` was refused ('time units'); ``[deg]`` is refused, named."""
+    path = tmp_path / "yaw.csv"
+    path.write_text("time,left.spin,right.spin,yaw [rad]\n0,0,0,0\n1,1,1,0.5\n")
+    assert _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--heading-column", "yaw"])["pose"][2] == 0.5
+    path.write_text("time,left.spin,right.spin,yaw [deg]\n0,0,0,0\n1,1,1,0.5\n")
+    assert main(["odometry", "diff-drive", str(path), "--heading-column", "yaw"]) == 2
+    assert "column 'yaw': unit 'deg'; a heading column is read in rad" in capsys.readouterr().err

@@ -47,3 +47,22 @@ def test_options_and_header_must_agree():
     assert merge_option("--spin", None, None, "angle", "f") == "angle"
     with pytest.raises(HeaderError, match="the header says --spin counts, the option says angle"):
         merge_option("--spin", "angle", "counts", "angle", "f")
+
+
+def test_only_the_time_column_gives_the_time_unit():
+    """``time [s]`` next to ``latency [ms]``: the log's time was read in milliseconds (steps 1000 times short)."""
+    assert parse_header_units(["time [s]", "a.spin", "latency [ms]"]).time_unit == "s"
+    assert parse_header_units(["time", "a.spin", "latency [ms]"]).time_unit is None
+    assert parse_header_units(["stamp [us]", "time [ms]"], time_column="stamp").time_unit == "us"
+
+
+def test_units_of_other_columns_are_ignored_and_roles_are_read():
+    """Columns that are not the log's (``battery [V]``, ``imu.yaw [deg]``) were refused for their units; renamed
+    joint columns (``--column left.spin=enc_l``) and the heading columns had theirs read as time units."""
+    u = parse_header_units(["time", "a.spin [rad]", "battery [V]", "imu.yaw [deg]"])
+    assert (u.spin, u.time_unit) == ("angle", None)
+    u = parse_header_units(["time", "enc_l [counts:u16]", "yaw [rad]", "w [rad/s]"],
+                           roles={"enc_l": "spin", "yaw": "heading", "w": "gyro"})
+    assert (u.spin, u.bits, dict(u.columns)["yaw"]) == ("counts", 16, "yaw [rad]")
+    with pytest.raises(HeaderError, match="column 'yaw': unit 'deg'; a heading column is read in rad"):
+        parse_header_units(["time", "yaw [deg]"], source="log.csv", roles={"yaw": "heading"})

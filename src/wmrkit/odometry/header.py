@@ -31,6 +31,8 @@ STEER_UNITS = {"rad": "angle", "deg": "degrees", "counts": "counts"}
 #: Conventions a steering unit may name after a colon (``deg:beta``).
 STEER_CONVENTIONS = ("heading", "beta")
 TIME_UNITS = ("s", "ms", "us", "ns")
+#: The one unit the external heading columns are read in (``LogFormat.heading_column``, ``gyro_column``).
+EXTERNAL_UNITS = {"heading": "rad", "gyro": "rad/s"}
 
 _NAME = re.compile(r"^\s*([^\[\]]*?)\s*\[\s*([^\[\]]+?)\s*\]\s*$")
 _COUNTER = re.compile(r"^counts:([us])(\d{1,2})$")
@@ -57,34 +59,50 @@ class HeaderUnits:
         return bool(self.columns)
 
 
-def read_header_units(path: str | Path, *, max_chars: int = 1 << 16, delimiter: str = ",") -> HeaderUnits:
-    """The units of a CSV log's header line (bounded read); an unreadable file says nothing here."""
+def read_header_units(path: str | Path, *, max_chars: int = 1 << 16, delimiter: str = ",", time_column: str = "time",
+                      roles: Mapping[str, str] | None = None) -> HeaderUnits:
+    """The units of a CSV log's header line (bounded read; :func:`parse_header_units`); an unreadable file says
+    nothing here."""
     try:
         with open(path, encoding="utf-8-sig", errors="replace", newline="") as f:
             line = f.readline(max_chars)
     except (OSError, IsADirectoryError):
         return HeaderUnits(())
-    return parse_header_units(line.strip("\r\n").split(delimiter), source=str(path))
+    return parse_header_units(line.strip("\r\n").split(delimiter), source=str(path), time_column=time_column,
+                              roles=roles)
 
 
-def parse_header_units(names: list[str], *, source: str = "<log>") -> HeaderUnits:
-    """Parse ``name [unit]`` header entries (see the module docstring)."""
+def parse_header_units(names: list[str], *, source: str = "<log>", time_column: str = "time",
+                       roles: Mapping[str, str] | None = None) -> HeaderUnits:
+    """Parse ``name [unit]`` header entries (see the module docstring).
+
+    The time unit is the unit of `time_column` only; joint units are those of ``WHEEL.spin``/``WHEEL.steer``
+    columns and of the columns `roles` names (plain column name -> ``"spin"``, ``"steer"``, or ``"heading"`` [rad]
+    and ``"gyro"`` [rad/s], the external heading columns). The units of other columns (a battery voltage, a
+    latency in ms) are not the log's and are ignored."""
     columns, modes, bits, signed, time_unit = [], {"spin": set(), "steer": set()}, set(), set(), None
-    conventions = set()
+    conventions, roles = set(), dict(roles or {})
     for written in names:
         match = _NAME.match(written)
         if match is None:
             continue
         plain, unit = match.group(1), match.group(2)
         columns.append((plain, written))
-        joint = plain.rpartition(".")[2]
-        if "." not in plain:  # time or another plain column
+        joint = plain.rpartition(".")[2] if "." in plain else None
+        kind = roles.get(plain, joint if joint in ("spin", "steer") else None)
+        if plain == time_column:
             if unit not in TIME_UNITS:
                 raise HeaderError(f"{source}:1: column '{plain}': unknown unit '{unit}' (time units: "
                                   f"{', '.join(TIME_UNITS)})")
             time_unit = unit
             continue
-        kind = "steer" if joint == "steer" else "spin"
+        if kind in EXTERNAL_UNITS:
+            if unit != EXTERNAL_UNITS[kind]:
+                raise HeaderError(f"{source}:1: column '{plain}': unit '{unit}'; a {kind} column is read in "
+                                  f"{EXTERNAL_UNITS[kind]}")
+            continue
+        if kind is None:  # not a column of the log's joints: its unit is not ours to read
+            continue
         table = STEER_UNITS if kind == "steer" else SPIN_UNITS
         base, colon, convention = unit.rpartition(":")
         if colon and convention in STEER_CONVENTIONS:
@@ -142,7 +160,10 @@ def header_format(path: str | os.PathLike[str], robot_name: str, joints: Sequenc
     from .logs import LogFormat
 
     source = os.fspath(path)
-    units = read_header_units(path) if Path(path).is_file() else HeaderUnits(())
+    roles = {c: j.rpartition(".")[2] for j, c in (columns or {}).items()}
+    roles |= {c: kind for c, kind in ((heading_column, "heading"), (gyro_column, "gyro")) if c is not None}
+    units = (read_header_units(path, time_column=time_column, roles=roles) if Path(path).is_file()
+             else HeaderUnits(()))
     spin = merge_option("--spin", spin, units.spin, "angle", source)
     steer = merge_option("--steer", steer, units.steer, "angle", source)
     convention = merge_option("--steer-convention", steer_convention, units.steer_convention, "heading", source)
@@ -152,7 +173,9 @@ def header_format(path: str | os.PathLike[str], robot_name: str, joints: Sequenc
     encoders = encoders_for(robot_name, counted, counts_per_rev=cpr, gear_ratio=gear, bits=bits,
                             signed=signed or units.signed, steer_resolution=steer_resolution)
     renamed = dict(units.columns)  # 'left.spin [counts]' read as left.spin
-    named = {j: renamed[j] for j in joints if j in renamed} | dict(columns or {})
+    named = {j: renamed[j] for j in joints if j in renamed} | {j: renamed.get(c, c) for j, c in (columns or {}).items()}
     return LogFormat(time_column=renamed.get(time_column, time_column), time_unit=unit, columns=tuple(named.items()),
-                     spin=spin, steer=steer, encoders=encoders, heading_column=heading_column,
-                     gyro_column=gyro_column, max_gap=max_gap, steer_convention=convention)
+                     spin=spin, steer=steer, encoders=encoders,
+                     heading_column=None if heading_column is None else renamed.get(heading_column, heading_column),
+                     gyro_column=None if gyro_column is None else renamed.get(gyro_column, gyro_column),
+                     max_gap=max_gap, steer_convention=convention)
