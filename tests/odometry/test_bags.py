@@ -97,3 +97,20 @@ def test_bad_bags(mecanum_bag, tmp_path):
         list(read_joint_states(partial, run.log.joints))
     with pytest.raises(LogError, match="already exists"):
         write_joint_states(partial, log)
+
+
+@pytest.mark.parametrize("start", [3e9, -1.0, 1e300])
+def test_times_a_ros_stamp_cannot_hold_are_refused_by_name(tmp_path, start):
+    """A log's time beyond 2^31 s (a ms log read as s, an epoch in ms) raised struct.error from rosbags' int32
+    seconds, 1e300 s an OverflowError: tracebacks. Negative stamps were written (ROS 2 refuses them)."""
+    from wmrkit.cli.main import main
+    from wmrkit.odometry.trajectories import Trajectory
+
+    path = tmp_path / "log.csv"
+    path.write_text(f"time,left.spin,right.spin\n{start!r},0,0\n{start * (1 + 1e-9) + 1!r},1,1\n")
+    assert main(["odometry", "diff-drive", str(path), "--out", str(tmp_path / "odom")]) == 2
+    with pytest.raises(LogError, match=r"is no ROS 2 time stamp \(0 to 2\^31 s"):
+        with OdometryBagWriter(tmp_path / "o") as w:
+            w.write(Trajectory(np.array([start]), np.zeros((1, 3)), np.zeros(1)))
+    with pytest.raises(LogError, match=r"js: time .* is no ROS 2 time stamp"):
+        write_joint_states(tmp_path / "js", JointLog(np.array([start]), ("left.spin",), np.zeros((1, 1))))

@@ -36,6 +36,9 @@ JOINT_STATE = "sensor_msgs/msg/JointState"
 ODOMETRY = "nav_msgs/msg/Odometry"
 
 
+#: First time [s] past what a ROS 2 stamp holds (``builtin_interfaces/msg/Time``: int32 seconds, never negative).
+MAX_STAMP = 2.0 ** 31
+
 #: Largest ``metadata.yaml`` read [bytes]; ``ros2 bag`` writes a few kilobytes.
 MAX_METADATA = 1 << 20
 
@@ -104,6 +107,14 @@ def _typestore():
     from rosbags.typesys import Stores, get_typestore
 
     return get_typestore(Stores.ROS2_HUMBLE)
+
+
+def _check_stamps(path: str, time: np.ndarray) -> None:
+    """Refuse times [s] a ROS 2 stamp cannot hold (outside [0, :data:`MAX_STAMP`)), naming the bag `path`."""
+    bad = np.flatnonzero(~((time >= 0) & (time < MAX_STAMP)))
+    if bad.size:
+        raise LogError(f"{path}: time {float(time[bad[0]])!r} s is no ROS 2 time stamp (0 to 2^31 s, "
+                       "builtin_interfaces/Time's int32 seconds): is the log's time unit right (--time-unit)?")
 
 
 def _stamp(t: float):
@@ -197,6 +208,7 @@ def write_joint_states(path: str | os.PathLike[str], log: JointLog, *, robot: Ro
     Steering positions are written as headings, converted with `robot` (required when the log steers)."""
     ts = _typestore()
     rename = dict(names or {})
+    _check_stamps(os.fspath(path), log.time)
     positions = log.heading_positions(robot)
     header_t, state_t = ts.types["std_msgs/msg/Header"], ts.types[JOINT_STATE]
     with _writer(path) as writer:
@@ -212,6 +224,7 @@ def write_joint_states(path: str | os.PathLike[str], log: JointLog, *, robot: Ro
 class OdometryBagWriter:
     """Writes trajectory chunks as ``nav_msgs/msg/Odometry`` to a new bag (context manager).
 
+    Times must lie in [0, :data:`MAX_STAMP`) s (a ROS 2 stamp), else :class:`LogError`.
     Pose covariance: the ``(x, y, theta)`` covariance at rows/columns 0, 1, 5 of the 6x6 ROS matrix (z, roll,
     pitch left 0: planar motion). Twist: the constant body twist ``(vx, vy, omega)`` that moves the robot from the
     pose before to each pose in its interval (the SE(2) logarithm of the step; 0 at the first).
@@ -220,6 +233,7 @@ class OdometryBagWriter:
     def __init__(self, path: str | os.PathLike[str], *, topic: str = "/odom", frame_id: str = "odom",
                  child_frame_id: str = "base_link") -> None:
         self._ts = _typestore()
+        self.path = os.fspath(path)
         self._ctx = _writer(path)
         self._writer = self._ctx.__enter__()
         self._conn = self._writer.add_connection(topic, ODOMETRY, typestore=self._ts)
@@ -229,6 +243,7 @@ class OdometryBagWriter:
     def write(self, chunk: Trajectory) -> None:
         """Append one Odometry message per pose of `chunk`."""
         t = self._ts.types
+        _check_stamps(self.path, chunk.time)
         prev_t = chunk.time[:1] if self._last is None else np.array([self._last[0]])
         prev_p = chunk.poses[:1] if self._last is None else self._last[1][None]
         times, poses = np.concatenate([prev_t, chunk.time]), np.vstack([prev_p, chunk.poses])
