@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -213,3 +214,35 @@ def test_trajectory_files_round_trip(tmp_path):
     np.testing.assert_allclose(np.diff(poses[:, 2]), np.diff(np.unwrap(traj.poses[:, 2])), atol=1e-10)
     with pytest.raises(LogError, match="unknown trajectory format 'kitti'"):
         TrajectoryWriter(tmp_path / "t.x", "kitti")
+
+
+@pytest.mark.parametrize("chunk_size", [1, 3, 1 << 16])
+def test_an_endless_line_is_refused_without_reading_it_whole(tmp_path, chunk_size):
+    """A log whose tail is one 'line' of NUL bytes (a logger's preallocated block after a power loss) or digits was
+    read whole into memory (200 MB: 1.3 GB resident) before any check; now rows are read in bounded pieces."""
+    import tracemalloc
+
+    from wmrkit.odometry._text import MAX_LINE
+
+    path = tmp_path / "tail.csv"
+    with open(path, "wb") as f:
+        f.write(b"time,left.spin,right.spin\n0,0,0\n0.1,1,1\n")
+        f.write(b"\0" * (64 << 20))
+    tracemalloc.start()
+    try:
+        with pytest.raises(LogError, match=rf"tail\.csv:4: a line longer than {MAX_LINE} characters"):
+            list(read_csv(path, ("left.spin", "right.spin"), chunk_size=chunk_size))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 100 << 20  # the pieces held before the check (64 MiB of pieces at most), never the whole tail
+
+
+@pytest.mark.parametrize("sep", [";", "\t", "|"])
+def test_another_delimiter_is_named(tmp_path, sep):
+    """A semicolon-separated log was refused as "column 'time;left.spin;right.spin' names no wheel of the robot"."""
+    path = tmp_path / "sep.csv"
+    path.write_text(sep.join(("time", "left.spin", "right.spin")) + "\n" + sep.join("000") + "\n")
+    message = rf"sep\.csv:1: one column .*: fields separated by {re.escape(repr(sep))}, not ','"
+    with pytest.raises(LogError, match=message):
+        list(read_csv(path, ("left.spin", "right.spin"), robot=catalog.load("diff-drive")))

@@ -22,9 +22,7 @@ see (a truncated last line that still ends in a newline and holds plausible numb
 from __future__ import annotations
 
 import difflib
-import itertools
 import os
-import re
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
@@ -33,6 +31,7 @@ import numpy as np
 
 from ..errors import WmrkitError
 from ..limits import check_chunk_size
+from ._text import check_lines, encoded, read_lines
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
 from .steering import CONVENTIONS, check_robot, check_steer_range, convert_steering
 
@@ -319,7 +318,7 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
         header_line = f.readline(MAX_HEADER + 1)
         if len(header_line) > MAX_HEADER:
             raise LogError(f"{source}:1: the header line is longer than {MAX_HEADER} characters: not a CSV log")
-        _encoded([header_line], source, 1)
+        encoded([header_line], source, 1)
         if not header_line.strip():
             raise LogError(f"{source}:1: empty file or no header line")
         header = [h.strip() for h in header_line.strip("\r\n").split(fmt.delimiter)]
@@ -328,10 +327,10 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
             progress(len(header_line.encode()))
         line, index = 2, 0
         while True:
-            lines = list(itertools.islice(f, chunk_size))
+            lines = read_lines(f, chunk_size, source, line)
             if not lines:
                 break
-            keep = _check_lines(lines, fmt.delimiter, len(header), source, line)
+            keep = check_lines(lines, fmt.delimiter, len(header), source, line)
             rows = lines if keep is None else [ln for ln, k in zip(lines, keep, strict=True) if k]
             raw = _parse(rows, usecols, fmt.delimiter, source, line, lines, len(header))
             if raw.size:
@@ -387,6 +386,10 @@ def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: S
             raise LogError(f"{source}:1: column '{name}' appears twice")
         seen.add(name)
     renamed = {c for _, c in fmt.columns}
+    other = [d for d in ",;\t|" if d != fmt.delimiter and d in header[0]] if len(header) == 1 else []
+    if other:
+        raise LogError(f"{source}:1: one column {_short(header[0])}: fields separated by {other[0]!r}, not "
+                       f"{fmt.delimiter!r}")
     for name in header:
         wheel, dot, joint = name.rpartition(".")
         if dot and joint in ("spin", "steer") and wheels and wheel not in wheels and name not in renamed:
@@ -407,7 +410,7 @@ def _parse(rows: list[str], usecols: list[int], delimiter: str, source: str, lin
         return np.zeros((0, len(usecols)))
     try:
         return np.loadtxt(rows, delimiter=delimiter, usecols=usecols, ndmin=2, comments=None, dtype=float)
-    except ValueError:  # field counts are already checked (_check_lines): a field is not a number
+    except ValueError:  # field counts are already checked (check_lines): a field is not a number
         pass
     for k, ln in enumerate(lines):  # error path: find the first bad line
         if not ln.strip():
@@ -422,59 +425,6 @@ def _parse(rows: list[str], usecols: list[int], delimiter: str, source: str, lin
                 raise LogError(f"{source}:{line + k}: field {c + 1}: cannot read {_short(fields[c].strip())} as a "
                                "number") from None
     raise LogError(f"{source}:{line}: cannot read the rows that start here")  # pragma: no cover
-
-
-_CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")  # all but tab, newline, carriage return
-
-
-def _encoded(lines: list[str], source: str, line: int) -> tuple[np.ndarray, np.ndarray]:
-    """`lines` joined as UTF-8 bytes ``(B,)`` uint8, and where the newlines are; refuses bytes that are not UTF-8
-    (read as lone surrogates) and control characters other than tab and line ends, naming the line. Vectorised."""
-    text = "".join(lines)
-    try:
-        b = np.frombuffer(text.encode("utf-8"), dtype=np.uint8)
-    except UnicodeEncodeError as err:
-        where = line + text.count("\n", 0, err.start)
-        raise LogError(f"{source}:{where}: bytes that are not UTF-8 text (a binary file, or another encoding?)"
-                       ) from None
-    newlines = np.flatnonzero(b == 10)
-    if np.count_nonzero(b < 32) != len(newlines) or np.count_nonzero(b == 127):  # else only newlines: fine
-        bad = _CONTROL.search(text)
-        if bad is not None:
-            where = line + text.count("\n", 0, bad.start())
-            raise LogError(f"{source}:{where}: control character {bad.group()!r} in a text log (a binary file?)")
-    return b, newlines
-
-
-def _check_lines(lines: list[str], delimiter: str, width: int, source: str, line: int) -> np.ndarray | None:
-    """Check every line of a chunk at once (vectorised over the bytes): text, field count, line end.
-
-    Returns which lines hold data (None: all of them); blank lines are skipped. A last line without its line end
-    (only the file's last line can lack one) is reported: the file was probably cut while being written.
-    """
-    b, ends = _encoded(lines, source, line)
-    if not lines[-1].endswith("\n"):
-        ends = np.append(ends, len(b) - 1)
-    if len(ends) == len(lines):
-        counts = np.diff(np.searchsorted(np.flatnonzero(b == ord(delimiter)), ends), prepend=0)
-        suspects = np.flatnonzero(counts != width - 1)
-    else:  # lines ending in a lone carriage return: count per line
-        suspects = np.array([k for k, ln in enumerate(lines) if ln.count(delimiter) != width - 1], dtype=int)
-    if width == 1:
-        suspects = np.arange(len(lines))
-    data_lines = None
-    for k in suspects.tolist():  # blank lines, or the first bad one
-        if not lines[k].strip():
-            data_lines = np.ones(len(lines), dtype=bool) if data_lines is None else data_lines
-            data_lines[k] = False
-        elif lines[k].count(delimiter) != width - 1:
-            raise LogError(f"{source}:{line + k}: expected {width} fields, got {lines[k].count(delimiter) + 1} "
-                           f"(the header has {width})")
-    last = len(lines) - 1
-    if (data_lines is None or data_lines[last]) and not lines[last].endswith(("\n", "\r")):
-        raise LogError(f"{source}:{line + last}: the last line has no line end: the file looks truncated "
-                       "(end a complete line with a newline)")
-    return data_lines
 
 
 def _check_finite(log: JointLog, raw: np.ndarray) -> None:
