@@ -291,3 +291,11 @@ def test_a_heading_column_with_its_unit(capsys, tmp_path):
     path.write_text("time,left.spin,right.spin,yaw [deg]\n0,0,0,0\n1,1,1,0.5\n")
     assert main(["odometry", "diff-drive", str(path), "--heading-column", "yaw"]) == 2
     assert "column 'yaw': unit 'deg'; a heading column is read in rad" in capsys.readouterr().err
+
+
+def test_an_output_that_is_the_plot_is_refused(capsys, diff_csv, tmp_path):
+    """``--out p.png --format csv --plot p.png``: the plot replaced the trajectory and the run reported success."""
+    same = str(tmp_path / "p.png")
+    assert main(["odometry", "diff-drive", diff_csv, "--out", same, "--format", "csv", "--plot", same]) == 2
+    assert "the output and the plot are one file" in capsys.readouterr().err
+    assert not (tmp_path / "p.png").exists()

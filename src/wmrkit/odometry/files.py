@@ -83,6 +83,9 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
     total, unit = ((bag_message_count(log_path, topic), "msg") if bag
                    else (os.path.getsize(log_path), "B"))
     _check_not_the_log(log_path, {"output": out, "plot": plot})
+    if out is not None and plot is not None and _same_file(out, plot):
+        raise LogError(f"{os.fspath(out)}: the output and the plot are one file (the plot would replace the "
+                       "trajectory); choose two files")
     out_fmt = None if out is None else (out_format or out_format_of(out))
     if out_fmt not in (None, "csv", "tum", "bag"):
         raise LogError(f"unknown output format '{out_fmt}' (formats: csv, tum, bag)")
