@@ -180,3 +180,24 @@ def test_a_slip_weights_file_giving_a_field_twice_is_refused(capsys, tmp_path):
                  str(path)]) == 2
     err = capsys.readouterr().err
     assert "w.json:2: weights.default: field 'default' given twice" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("text,field,message", [
+    ('{"weights": {"default": [true, 1]}}', "weights.default.0", "expected a finite number > 0, got true"),
+    ('{"weights": {"default": ["2", 1]}}', "weights.default.0", 'expected a finite number > 0, got "2"'),
+    ('{"weights": {"default": [NaN, 1]}}', "weights.default.0", "expected a finite number > 0, got NaN"),
+    ('{"weights": {"default": [1, 1], "wheels": {"nose": [1, 1]}}}', "weights.wheels.nose",
+     "robot 'skid-steer-4' has no wheel 'nose' (wheels: front_left, front_right, rear_left, rear_right)"),
+    ('{"weights": {"default": [1, 1], "wheel": {"front_left": [1, 2]}}}', "weights",
+     "unknown field 'wheel' (fields: default, wheels)"),
+])
+def test_a_slip_weights_file_is_checked_by_field(capsys, tmp_path, text, field, message):
+    """A weights file's true or "2" was read as 1 or 2, a misspelt 'wheel' key was ignored (the default applied
+    to every wheel), and NaN, negative or unknown-wheel errors did not name the file: now each is refused with the
+    file and the field."""
+    path = tmp_path / "w.json"
+    path.write_text(text)
+    assert main(["odometry", "skid-steer-4", str(tmp_path / "log.csv"), "--method", "wls", "--slip-weights",
+                 str(path), "--json"]) == 2
+    data = json.loads(capsys.readouterr().err)
+    assert (data["file"], data["field"], data["error"]) == (str(path), field, message)

@@ -56,29 +56,67 @@ def resolve_method(args: argparse.Namespace):
     return settings
 
 
-def weights_from_args(args: argparse.Namespace, settings=None):
+def weights_from_args(args: argparse.Namespace, settings=None, robot: Robot | None = None):
     """The WLS friction coefficients: the description's (`settings`), replaced by a ``--slip-weights`` file, then
-    ``--mu-default`` and ``--mu`` options."""
+    ``--mu-default`` and ``--mu`` options. With `robot`, a file naming a wheel it lacks is refused by place."""
     from ..slip.weights import SlipWeights
 
     base = settings.weights() if settings is not None else SlipWeights()
     mu: dict[str, tuple[float, float]] = {n: (a, b) for n, a, b in base.mu}
     default = base.default
     if args.slip_weights:
-        data = _read_json(args.slip_weights)
-        w = data.get("weights", data) if isinstance(data, dict) else None
-        try:
-            lat, lon = (float(v) for v in w["default"])
-            default = (lat, lon)
-            mu = {str(k): (float(a), float(b)) for k, (a, b) in w.get("wheels", {}).items()}
-        except (TypeError, KeyError, ValueError, AttributeError):
-            raise WmrkitError(f"{args.slip_weights}: expected {{\"weights\": {{\"default\": [LAT, LONG], "
-                              "\"wheels\": {NAME: [LAT, LONG]}}} (the output of 'wmrkit calibrate --json')") from None
+        default, mu = _weights_file(args.slip_weights, robot)
     if args.mu_default is not None:
         default = _pair(args.mu_default, "--mu-default")
     for name, value in parse_assignments(args.mu, "--mu").items():
         mu[name] = _pair(value, f"--mu {name}")
     return SlipWeights.of(mu, default)
+
+
+#: The layout of a ``--slip-weights`` file (what ``wmrkit calibrate --json`` writes under ``weights``).
+WEIGHTS_LAYOUT = '{"weights": {"default": [LAT, LONG], "wheels": {NAME: [LAT, LONG]}}}'
+
+
+def _weights_file(path: str, robot: Robot | None) -> tuple[tuple[float, float], dict[str, tuple[float, float]]]:
+    """``(default, {wheel: (lat, long)})`` of a ``--slip-weights`` file; errors name the file and the field."""
+    from ..errors import DescriptionError
+
+    def fail(message: str, loc: tuple[str | int, ...]) -> None:
+        raise DescriptionError(message, source=path, loc=loc)
+
+    data = _read_json(path)
+    w = data.get("weights", data) if isinstance(data, dict) else None
+    loc: tuple[str | int, ...] = ("weights",) if isinstance(data, dict) and "weights" in data else ()
+    if not isinstance(w, dict) or "default" not in w:
+        fail(f"expected {WEIGHTS_LAYOUT} (the output of 'wmrkit calibrate --json')", loc)
+    unknown = [k for k in w if k not in ("default", "wheels")]
+    if unknown:
+        fail(f"unknown field '{unknown[0]}' (fields: default, wheels)", loc)
+    wheels = w.get("wheels", {})
+    if not isinstance(wheels, dict):
+        fail("must be a mapping {NAME: [LAT, LONG]}", (*loc, "wheels"))
+    if robot is not None:
+        lacking = next((n for n in wheels if n not in robot.wheel_names), None)
+        if lacking is not None:
+            fail(f"robot '{robot.name}' has no wheel '{lacking}' (wheels: {', '.join(robot.wheel_names)})",
+                 (*loc, "wheels", lacking))
+
+    def pair(value: object, at: tuple[str | int, ...]) -> tuple[float, float]:
+        if not isinstance(value, list) or len(value) != 2:
+            fail("expected two friction coefficients [LAT, LONG]", at)
+        for j, v in enumerate(value):  # type: ignore[arg-type]
+            if isinstance(v, bool) or not isinstance(v, int | float) or not (math.isfinite(v) and v > 0):
+                fail(f"expected a finite number > 0, got {json_text(v)}", (*at, j))
+        return float(value[0]), float(value[1])  # type: ignore[index]
+
+    return pair(w["default"], (*loc, "default")), {str(k): pair(v, (*loc, "wheels", k)) for k, v in wheels.items()}
+
+
+def json_text(value: object) -> str:
+    """`value` as JSON writes it (``true``, ``"1"``, ``NaN``), for an error message."""
+    import json
+
+    return json.dumps(value)
 
 
 def check_estimator_options(args: argparse.Namespace) -> None:
@@ -109,7 +147,7 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
     wheels = {n: (a, b) for n, a, b in (described.wheels if described else ())}
     wheels |= {n: _pair(v, f"--kf-wheel {n}") for n, v in parse_assignments(args.kf_wheel, "--kf-wheel").items()}
     noise = noise_from_options(k[0], k[1], k[2], wheels) if args.method != "wls" else None
-    weights = weights_from_args(args, settings) if args.method == "wls" else None
+    weights = weights_from_args(args, settings, robot) if args.method == "wls" else None
     return estimator(robot, args.method, sensed=args.sensed, weights=weights, noise=noise,
                      thesis_double_q=args.thesis_double_q)
 
