@@ -201,3 +201,20 @@ def test_a_slip_weights_file_is_checked_by_field(capsys, tmp_path, text, field, 
                  str(path), "--json"]) == 2
     data = json.loads(capsys.readouterr().err)
     assert (data["file"], data["field"], data["error"]) == (str(path), field, message)
+
+
+@pytest.mark.parametrize("odometry,wheel_slip,loc", [
+    ({"slip": {"lateral": 1e-20, "longitudinal": 1}}, None, ("odometry", "slip", "lateral")),
+    (None, {"lateral": 1e-13, "longitudinal": 1}, ("wheels", 1, "slip", "lateral")),
+    ({"slip": {"lateral": 1e13, "longitudinal": 1e13}}, {"lateral": 1, "longitudinal": 1},
+     ("wheels", 1, "slip", "lateral")),
+])
+def test_friction_coefficients_too_far_apart_are_refused_where_the_description_gives_them(odometry, wheel_slip, loc):
+    """Coefficients more than 1e12 apart loaded, and `wmrkit odometry ROBOT LOG` then failed without the file or
+    the field (SlipWeights.row_mu); the noises were already checked this way."""
+    text = yaml.safe_dump(_skid(odometry, wheel_slip), sort_keys=False)
+    with pytest.raises(DescriptionError) as err:
+        robot_from_text(text, source="robot.yaml")
+    assert err.value.loc == loc and "differ by more than a factor 1e+12" in err.value.message
+    within = _skid({"slip": {"lateral": 1e-11, "longitudinal": 1}}, {"lateral": 1, "longitudinal": 1})
+    robot_from_text(yaml.safe_dump(within, sort_keys=False), source="robot.yaml")  # 1e11 apart: accepted

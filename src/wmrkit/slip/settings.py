@@ -93,12 +93,42 @@ def settings_from_dict(data: Mapping[str, Any], check: Any) -> OdometrySettings:
             wheel_noise.append((name, *_pair(item["slip"]["noise"], check, (*where, "noise"), ())))
             noise_at.append((*where, "noise"))
     settings = OdometrySettings(method, scheme, slip, tuple(wheel_slip), noise, tuple(wheel_noise))  # type: ignore[arg-type]
+    _check_slip_spread(data, settings, check)
     if noise_at:
         try:
             settings.kalman_noise()  # the spread of the noises (KalmanNoise), refused where the file gives them
         except WmrkitError as err:
             check.fail(str(err), noise_at[0])
     return settings
+
+
+def _check_slip_spread(data: Mapping[str, Any], settings: OdometrySettings, check: Any) -> None:
+    """Refuse, at the place that gives it, a friction coefficient more than ``MAX_RATIO`` from another that applies
+    to the same robot (``SlipWeights.row_mu`` refused it only when odometry ran, without the file)."""
+    from .weights import MAX_RATIO
+
+    wheels = list(data.get("wheels", []))
+    used: list[tuple[float, tuple]] = []
+    if settings.slip is not None and any(not isinstance(w, Mapping) or "slip" not in w for w in wheels):
+        used += [(v, ("odometry", "slip", k)) for v, k in zip(settings.slip, ("lateral", "longitudinal"), strict=True)]
+    elif settings.slip is None and len(settings.wheel_slip) < len(wheels):
+        used += [(1.0, ())]  # the wheels without slip get the unit default
+    at = [i for i, w in enumerate(wheels) if isinstance(w, Mapping) and "slip" in w]
+    for i, (_, lat, lon) in zip(at, settings.wheel_slip, strict=True):
+        used += [(lat, ("wheels", i, "slip", "lateral")), (lon, ("wheels", i, "slip", "longitudinal"))]
+    if not used:
+        return
+    lo, hi = min(used, key=lambda u: u[0]), max(used, key=lambda u: u[0])
+    if hi[0] > MAX_RATIO * lo[0]:
+        here, other = (lo, hi) if lo[1] else (hi, lo)
+        where = _place(other[1]) if other[1] else "the default of the wheels without slip"
+        check.fail(f"{here[0]:g} and {other[0]:g} ({where}) differ by more than a factor {MAX_RATIO:g}: the weighted "
+                   "least squares would lose the smaller rows to round-off (only ratios matter)", here[1])
+
+
+def _place(loc: tuple) -> str:
+    """``("wheels", 0, "slip", "lateral")`` -> ``wheels[0].slip.lateral``."""
+    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in loc).lstrip(".")
 
 
 def settings_to_dict(settings: OdometrySettings) -> dict[str, Any]:
