@@ -140,3 +140,23 @@ def test_json_errors_about_a_file_give_its_place(capsys, tmp_path):
     assert (data["file"], data["line"], data["field"], data["error"]) == (missing, None, None, "no such file")
     assert main(["ik", "swerve-4", "--twist", "1", "0", "--json"]) == 2  # not about a file: no place
     assert json.loads(capsys.readouterr().err)["file"] is None
+
+
+def test_a_heading_column_of_a_wheel_that_does_not_steer_names_it(capsys, tmp_path):
+    """'right_drive.heading' (a fixed wheel) was refused as "tuple.index(x): x not in tuple"."""
+    path = tmp_path / "tau.csv"
+    path.write_text("time,right_drive.spin,right_drive.heading\n0,300,0.1\n1,300,0.1\n")
+    code, out, err = run(capsys, "simulate", "forklift", "--torques", str(path))
+    assert code == 2 and out == ""
+    assert err.strip() == (f"wmrkit: error: {path}:1: column 'right_drive.heading': robot 'forklift' has no steered "
+                           "wheel 'right_drive' (a heading column is a steering reference; steered wheels: steer)")
+
+
+def test_a_torque_file_with_a_byte_order_mark_is_read(capsys, tmp_path):
+    """A spreadsheet's UTF-8 export starts with a byte-order mark: the file was refused as having no 'time' header
+    (joint logs already read it)."""
+    path = tmp_path / "tau.csv"
+    path.write_bytes(b"\xef\xbb\xbftime,left_drive.spin,right_drive.spin\n0,100,100\n1,100,100\n")
+    code, out, err = run(capsys, "simulate", "forklift", "--torques", str(path), "--json")
+    assert code == 0, err
+    assert json.loads(out)["final_twist"][0] > 0.05

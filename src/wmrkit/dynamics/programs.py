@@ -208,7 +208,7 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     source = str(path)
     check_table_size(path, WmrkitError, "torque file")
     try:
-        with open(path, newline="", encoding="utf-8") as fh:
+        with open(path, newline="", encoding="utf-8-sig") as fh:  # a byte-order mark is not part of 'time'
             rows = list(csv.reader(fh))
     except (OSError, UnicodeDecodeError) as err:
         raise WmrkitError(f"{source}: cannot read the file ({err.__class__.__name__})") from None
@@ -241,7 +241,11 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
             _check_radians(source, name, values[:, j])
         try:
             if joint == "heading":
-                headings[model.steer_columns[model.robot.steer_names.index(wheel)]] = values[:, j]
+                steered = model.robot.steer_names
+                if wheel not in steered:
+                    raise WmrkitError(f"robot '{model.robot.name}' has no steered wheel '{wheel}' (a heading column "
+                                      f"is a steering reference; steered wheels: {', '.join(steered) or 'none'})")
+                headings[model.steer_columns[steered.index(wheel)]] = values[:, j]
             else:
                 torques[name] = values[:, j]
                 joint_column(model, name)
