@@ -204,3 +204,17 @@ def test_pacejka_shifts_fade_out_at_standstill():
     assert t.forces(FZ, 0.0, 0.0, 0.0, 0.0) == (0.0, 0.0)
     moving = t.forces(FZ, 0.0, 0.0, 2.0, -2.0)
     assert moving.longitudinal < -100 and moving.lateral < -10  # rolling resistance and lateral bias at 2 m/s
+
+
+def test_forces_at_slip_refuses_a_speed_below_the_regularisation_speed(capsys):
+    """`wmrkit tyre dugoff --slip-ratio 0.01 --speed 0.001` printed slip ratio 0.01 with the force of s = 0.001
+    (80 N instead of 808: below eps = 0.01 m/s the model divides the slip by eps); now it is refused."""
+    from wmrkit.cli.main import main
+
+    dugoff = Tyre.of("dugoff", {"mu": 100.0})
+    assert -dugoff.forces_at_slip(1000.0, 0.01, 0.0, 0.01).longitudinal == pytest.approx(80000 * 0.01 / 0.99)
+    for tyre in (dugoff, Tyre.of("pacejka")):
+        with pytest.raises(WmrkitError, match=r"speed: must be at least the .* tyre's eps = 0.01 m/s, got 0.001"):
+            tyre.forces_at_slip(1000.0, 0.01, 0.0, [2.0, 0.001])
+    assert main(["tyre", "dugoff", "--load", "1000", "--slip-ratio", "0.01", "--speed", "0.001"]) == 2
+    assert capsys.readouterr().err.startswith("wmrkit: error: --speed: must be at least the dugoff tyre's eps")

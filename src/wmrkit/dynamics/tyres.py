@@ -304,9 +304,16 @@ class Tyre:
                        speed: ArrayLike = 2.0) -> TyreForces:
         """Contact forces at a slip ratio, a slip angle [rad] and a wheel speed [m/s] (> 0), all broadcast.
 
-        The slip velocities are rebuilt exactly (see :func:`slip_velocities`) and passed to :meth:`forces`.
+        The slip velocities are rebuilt exactly (see :func:`slip_velocities`) and passed to :meth:`forces`. A model
+        with a regularisation speed ``eps`` (dugoff, pacejka) refuses a `speed` below it: there it divides the slip
+        by ``eps`` instead of the speed, and the forces would be those of a smaller slip than the one asked.
         """
         v_lat, v_long, v_wheel, v_roll = slip_velocities(slip_ratio, slip_angle, speed)
+        eps = self.as_dict().get("eps")
+        if eps is not None and np.any(v_wheel < eps):
+            raise WmrkitError(f"speed: must be at least the {self.model} tyre's eps = {eps:g} m/s, got "
+                              f"{v_wheel[v_wheel < eps].flat[0]:g} (below eps the model divides the slip by eps, not "
+                              "by the speed: the forces would be those of a smaller slip ratio and angle)")
         return self.forces(fz, v_lat, v_long, v_wheel, v_roll)
 
 
