@@ -109,6 +109,17 @@ def test_torque_file(tmp_path, forklift):
     assert read_torques(forklift, path).torques[0, forklift.names.index("left_drive.spin")] == 9
 
 
+def test_a_heading_column_for_a_passive_castor_is_refused(tmp_path):
+    """'caster.heading' gave the castor, whose steering no motor drives, a PD servo (kp 37 N m/rad) that steered
+    it; torque columns on joints that are not actuated were already refused."""
+    model = DynamicModel.of(castor_robot())
+    path = tmp_path / "tau.csv"
+    path.write_text("time,left.spin,caster.heading\n0,1,0.1\n1,1,0.1\n")
+    with pytest.raises(WmrkitError, match=r"^.*tau.csv:1: column 'caster.heading': the steering of wheel 'caster' is "
+                                          r"not actuated .* \(actuated: left.spin, right.spin\)$"):
+        read_torques(model, path)
+
+
 def test_bad_arguments_are_errors(forklift):
     inputs = Inputs.torques_only(forklift, [0.0], {})
     with pytest.raises(WmrkitError):

@@ -2,7 +2,8 @@
 
 A torque file is a CSV with a header ``time,<wheel>.<joint>,...``: times [s] strictly increasing from at most 0,
 torques [N m] on actuated joints (``spin``, ``spin1``/``spin2``, ``steer``), linear between rows, the last row held;
-a ``<wheel>.heading`` column [rad] is a steering-servo reference instead (the users' heading, 0 = straight ahead).
+a ``<wheel>.heading`` column [rad] is a steering-servo reference instead (the users' heading, 0 = straight ahead;
+actuated steering only: a castor steers passively).
 
 A built-in program (:func:`path_program`) is a schedule of body twists; each actuated wheel follows the no-slip
 rate of its twist (wheel IK, §8.4) through a saturated rate servo and each actuated steering the IK heading
@@ -245,7 +246,12 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
                 if wheel not in steered:
                     raise WmrkitError(f"robot '{model.robot.name}' has no steered wheel '{wheel}' (a heading column "
                                       f"is a steering reference; steered wheels: {', '.join(steered) or 'none'})")
-                headings[model.steer_columns[steered.index(wheel)]] = values[:, j]
+                column = model.steer_columns[steered.index(wheel)]
+                if not model.is_actuated(column):
+                    raise WmrkitError(f"the steering of wheel '{wheel}' is not actuated (it steers passively, as the "
+                                      f"tyres turn it): no servo can follow a heading (actuated: "
+                                      f"{', '.join(model.robot.actuated) or 'none'})")
+                headings[column] = values[:, j]
             else:
                 torques[name] = values[:, j]
                 joint_column(model, name)
