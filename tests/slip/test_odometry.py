@@ -86,7 +86,9 @@ def test_cli_refuses_bad_estimator_options(tmp_path, capsys, forklift_run):
     path = tmp_path / "log.csv"
     write_log(path, log, catalog.load("forklift"))
     for extra, message in ((["--method", "wls", "--mu", "steer=0,1"], "> 0"),
-                           (["--method", "wls", "--mu", "nope=1,1"], "lacks"),
+                           (["--method", "wls", "--mu", "nope=1,1"], "--mu nope: robot 'forklift' has no wheel"),
+                           (["--method", "fk2", "--kf-wheel", "nope=1,1"],
+                            "--kf-wheel nope: robot 'forklift' has no wheel"),  # the option was not named
                            (["--method", "fk2", "--kf-noise", "1", "-1", "1"], "[1e-150, 1e+150]"),
                            (["--method", "fk2", "--kf-noise", "1e308", "1", "1"], "process: must be"),
                            (["--method", "fk2", "--kf-noise", "1", "1e-30", "1"], "differ by more than"),

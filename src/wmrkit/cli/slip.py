@@ -69,8 +69,16 @@ def weights_from_args(args: argparse.Namespace, settings=None, robot: Robot | No
     if args.mu_default is not None:
         default = _pair(args.mu_default, "--mu-default")
     for name, value in parse_assignments(args.mu, "--mu").items():
+        _check_wheel(robot, name, "--mu")
         mu[name] = _pair(value, f"--mu {name}")
     return SlipWeights.of(mu, default)
+
+
+def _check_wheel(robot: Robot | None, name: str, option: str) -> None:
+    """Refuse `option` ``NAME=...`` for a wheel `robot` lacks, naming the option."""
+    if robot is not None and name not in robot.wheel_names:
+        raise WmrkitError(f"{option} {name}: robot '{robot.name}' has no wheel '{name}' (wheels: "
+                          f"{', '.join(robot.wheel_names)})")
 
 
 #: The layout of a ``--slip-weights`` file (what ``wmrkit calibrate --json`` writes under ``weights``).
@@ -145,7 +153,9 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
     k = args.kf_noise or (described and (described.process, described.lateral, described.longitudinal)) \
         or (1.0, 1.0, 1.0)
     wheels = {n: (a, b) for n, a, b in (described.wheels if described else ())}
-    wheels |= {n: _pair(v, f"--kf-wheel {n}") for n, v in parse_assignments(args.kf_wheel, "--kf-wheel").items()}
+    for n, v in parse_assignments(args.kf_wheel, "--kf-wheel").items():
+        _check_wheel(robot, n, "--kf-wheel")
+        wheels[n] = _pair(v, f"--kf-wheel {n}")
     noise = noise_from_options(k[0], k[1], k[2], wheels) if args.method != "wls" else None
     weights = weights_from_args(args, settings, robot) if args.method == "wls" else None
     return estimator(robot, args.method, sensed=args.sensed, weights=weights, noise=noise,
