@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wmrkit import catalog
+from wmrkit import Robot, catalog
 from wmrkit.cli.main import main
 
 BROKEN = {
@@ -145,3 +145,24 @@ def test_a_negative_value_with_a_unit_is_a_value_not_an_option(value, expected, 
     out = json.loads(capsys.readouterr().out)
     assert out["slip_angle"] == pytest.approx(expected, rel=1e-15)
     assert out["Fy"] > 0  # a negative slip angle: the force of the ground pushes to +y (independent of the parse)
+
+
+@pytest.mark.parametrize("name", catalog.names())
+def test_show_json_reads_back_as_the_same_robot(name, tmp_path, capsys):
+    """docs/catalog.md: copy `wmrkit show NAME --json` and change the numbers. The copy was refused with
+    "unknown field 'velocity_names'" (the derived names show adds)."""
+    assert main(["show", name, "--json"]) == 0
+    path = tmp_path / "copy.json"
+    path.write_text(capsys.readouterr().out, encoding="utf-8")
+    assert Robot.from_file(path) == catalog.load(name)
+
+
+def test_show_json_copy_with_stale_derived_names_is_refused(tmp_path, capsys):
+    assert main(["show", "diff-drive", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    data["wheels"][0]["name"] = "port"  # renamed, but velocity_names still says left.spin
+    path = tmp_path / "copy.json"
+    path.write_text(json.dumps(data), encoding="utf-8")
+    assert main(["show", str(path)]) == 2
+    line = capsys.readouterr().err.strip()
+    assert "copy.json" in line and "velocity_names: derived from the wheels" in line and "port.spin" in line

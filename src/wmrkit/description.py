@@ -40,6 +40,10 @@ from .wheels import GEOMETRY_FIELDS, KINDS, Wheel, beta_from_heading, geometry_p
 WHEEL_TYPES = (*KINDS, "mecanum")
 
 TOP_FIELDS = ("name", "wheels", "notes", "couplings", "body", "odometry")  # odometry: wmrkit.slip.settings
+#: Names derived from the wheels that ``wmrkit show --json`` adds (``cli.robots.summary``); a description copied
+#: from it may keep them, and each must then equal what the wheels give (:func:`_check_derived`).
+DERIVED_FIELDS = {"velocity_names": "velocity_names", "steer_names": "steer_names", "actuated_joints": "actuated",
+                  "sensed_joints": "sensed"}
 COMMON_WHEEL_FIELDS = ("name", "type", "position", "l", "alpha", "actuated", "sensed", "heading",
                        "inertia", "mass", "tyre",  # these three: wmrkit.dynamics.mass
                        "steer_range",  # _steer_range_from_dict
@@ -59,7 +63,7 @@ def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None
     check = FieldReader(source, line_of or (lambda loc: None))
     if not isinstance(data, Mapping):
         check.fail("a robot description is a mapping with the fields 'name' and 'wheels'", ())
-    check.reject_unknown(data, TOP_FIELDS, ())
+    check.reject_unknown(data, TOP_FIELDS + tuple(DERIVED_FIELDS), ())
     name = check.text(data, "name", ())
     notes = check.text(data, "notes", (), required=False)
     _check_text_fields(name, notes, check)
@@ -84,8 +88,21 @@ def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None
         from .slip.settings import settings_from_dict
 
         odometry = settings_from_dict(data, check)
-    return Robot(name=name, wheels=tuple(wheels), notes=notes, couplings=couplings,
-                 body=mass.body_from_dict(data, check), odometry=odometry)
+    robot = Robot(name=name, wheels=tuple(wheels), notes=notes, couplings=couplings,
+                  body=mass.body_from_dict(data, check), odometry=odometry)
+    _check_derived(data, robot, check)
+    return robot
+
+
+def _check_derived(data: Mapping[str, Any], robot: Robot, check: FieldReader) -> None:
+    """The derived names of ``wmrkit show --json`` (:data:`DERIVED_FIELDS`), when present, equal the robot's: they
+    are read back, never used, so a copy whose wheels were edited is refused instead of silently contradicted."""
+    for key, attribute in DERIVED_FIELDS.items():
+        if key in data:
+            expected = list(getattr(robot, attribute))
+            if data[key] != expected:
+                check.fail(f"derived from the wheels (wmrkit show --json writes it), so it must be {expected}, got "
+                           f"{data[key]!r}: correct it or delete it", (key,))
 
 
 def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) -> tuple[Coupling, ...]:
