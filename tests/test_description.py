@@ -457,3 +457,12 @@ def test_a_steered_wheel_given_no_angle_rolls_straight_ahead(item):
     wheel = robot.wheels[0]
     axle = wheel.beta + wheel.delta  # the axle of the rolling wheel (3.12): perpendicular to straight ahead
     assert (np.cos(axle), np.sin(axle)) == pytest.approx((0.0, 1.0), abs=1e-15)
+
+
+@pytest.mark.parametrize("text", ["\u0663", "\uff11", "0.\u0665 m", "\u0661\u0662 deg", "1e\u0663"])
+def test_digits_other_than_ascii_are_not_read_as_numbers(text):
+    """float() reads '٣' (Arabic-Indic three) as 3 and '１' (fullwidth one) as 1, and the quantity grammar's \\d
+    let them through: 'r: ٣' gave a 3 m wheel. The grammar is ASCII digits only."""
+    with pytest.raises(DescriptionError, match=r"wheels\[0\]\.r: "):
+        robot_from_text(f"name: x\nwheels:\n  - {{name: a, type: fixed, position: [0, 0.2], heading: 0, "
+                        f"r: '{text}'}}\n", source=SRC)

@@ -20,7 +20,8 @@ UNITS: dict[str, dict[str, float]] = {
     "number": {},
 }
 _SI = {"length": "m", "angle": "rad", "number": ""}
-_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([^\s\d.+-][^\s]*)?\s*$")
+#: ASCII digits only: ``\d`` also matched '٣' and '１', which float() read as 3 and 1.
+_QUANTITY = re.compile(r"^\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*([^\s0-9.+-][^\s]*)?\s*$")
 
 
 class UnitError(ValueError):
