@@ -7,7 +7,7 @@ import re
 
 import pytest
 
-from wmrkit import catalog
+from wmrkit import Robot, catalog
 from wmrkit.analysis.classification import classify
 from wmrkit.analysis.isotropy import natural_length
 from wmrkit.analysis.report import write_report
@@ -105,3 +105,25 @@ def test_user_errors_exit_2_with_one_line(argv, message, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1
+
+
+ONE_WHEEL = "name: one\nwheels:\n" \
+            "  - {name: left, type: fixed, position: [0, 0.2], heading: 0, r: 0.05, actuated: spin}\n"
+
+
+def test_no_natural_length_where_every_length_leaves_the_twist_undetermined(tmp_path, capsys):
+    """One driven wheel, m = 2: kappa is infinite at every D, yet analyze printed "at the natural length D = 0.2 m"
+    (the robot size natural_length falls back to) and the JSON and report gave that D as natural."""
+    path = tmp_path / "one.yaml"
+    path.write_text(ONE_WHEEL, encoding="utf-8")
+    assert main(["analyze", str(path)]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if "condition number" in x)
+    assert line == "  condition number infinite (these joints do not determine the twist), joints left.spin"
+    assert main(["analyze", str(path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["condition_number"] is None and out["characteristic_length"] is None
+    assert main(["analyze", str(path), "--length", "300 mm"]) == 0  # a given length is still reported
+    assert "infinite (these joints do not determine the twist) at the given length D = 0.3 m" in capsys.readouterr().out
+    text = write_report(analyze(Robot.from_file(path), resolution=12), tmp_path / "r", resolution=12,
+                        dpi=30).read_text(encoding="utf-8")
+    assert "characteristic length D" not in text and "infinite (these joints do not determine the twist)" in text

@@ -117,9 +117,10 @@ def _summary_table(a: Analysis) -> str:
     else:
         kappa = (f"{a.condition_number:.4g}" if math.isfinite(a.condition_number)
                  else "infinite (these joints do not determine the twist)")
-        rows += [("condition number κ (5.28)", f"{kappa} for ({', '.join(a.joints)})"),
-                 ("characteristic length D",
-                  f"{a.characteristic_length:.4g} m ({'natural' if a.natural else 'given'})")]
+        rows.append(("condition number κ (5.28)", f"{kappa} for ({', '.join(a.joints)})"))
+        if a.has_length:
+            rows.append(("characteristic length D",
+                         f"{a.characteristic_length:.4g} m ({'natural' if a.natural else 'given'})"))
     for key, s in a.singular.items():
         rows.append((f"singular {key} model",
                      f"({', '.join(assigned_names(s, a.robot)) or '-'}): {describe_singular(s, a.robot)}"))

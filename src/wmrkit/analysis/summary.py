@@ -56,10 +56,25 @@ class Analysis:
             "icr": self.icr.describe(),
             "actuation": {k: self.actuation[k] for k in ("consistent", "sufficient", "verdict")},
             "sensing": {k: self.sensing[k] for k in ("sufficient", "verdict")},
-            "condition_number": self.condition_number, "characteristic_length": self.characteristic_length,
+            "condition_number": self.condition_number,
+            "characteristic_length": self.characteristic_length if self.has_length else None,
             "condition_joints": list(self.joints), "natural_length": self.natural,
             "singular": {k: _singular_dict(s, self.robot) for k, s in self.singular.items()},
         }
+
+    @property
+    def has_length(self) -> bool:
+        """A length goes with the condition number: given, or natural where some length makes kappa finite (where
+        none does, :func:`.natural_length` falls back to the robot size, which minimises nothing)."""
+        return not self.natural or bool(np.isfinite(self.condition_number))
+
+    def condition_words(self) -> str:
+        """The condition number and its length in words (the text summary and the report)."""
+        if not np.isfinite(self.condition_number):
+            kappa = "infinite (these joints do not determine the twist)"
+            return f"{kappa} at the given length D = {self.characteristic_length:.4g} m" if self.has_length else kappa
+        how = "natural length" if self.natural else "given length"
+        return f"{self.condition_number:.4g} at the {how} D = {self.characteristic_length:.4g} m"
 
     def format_text(self) -> str:
         """A concise terminal summary."""
@@ -72,14 +87,10 @@ class Analysis:
         lines.append(f"  actuation: {actuation_words(self.actuation)} ({', '.join(r.actuated) or 'nothing declared'})")
         lines.append(f"  sensing: {_yes(self.sensing['sufficient'], 'sufficient', 'insufficient')} "
                      f"({', '.join(r.sensed) or 'nothing declared'})")
-        how = "natural length" if self.natural else "given length"
         if c.mobility <= 1:
             lines.append(f"  isotropy: does not apply (m = {c.mobility}: no two motions to balance)")
         else:
-            kappa = (f"{self.condition_number:.4g}" if np.isfinite(self.condition_number) else
-                     "infinite (these joints do not determine the twist)")
-            lines.append(f"  condition number {kappa} at the {how} D = "
-                         f"{self.characteristic_length:.4g} m, joints {', '.join(self.joints) or '-'}")
+            lines.append(f"  condition number {self.condition_words()}, joints {', '.join(self.joints) or '-'}")
         for key, s in self.singular.items():
             lines.append(f"  singular ({key}: {', '.join(assigned_names(s, r)) or '-'}): {describe_singular(s, r)}")
         return "\n".join(lines)
