@@ -200,3 +200,24 @@ def test_axle_rows_not_the_first_row_of_5_3():
     assert np.allclose(first_row, 0.0)
     got = classify(catalog.load("diff-drive"))
     assert got.type == 2 and got.fixed_rank == 1
+
+
+@pytest.mark.parametrize("angle", [0.0, 30.0, 90.0, 135.0])
+def test_special_configuration_is_told_in_headings(angle):
+    """The text said "(at 0.0 deg, mod 180 deg)" for the direction of the line, which wmrkit's steering door reads
+    as a heading: steering both wheels to heading 0 there drives along the line, with m = 1. It now names the
+    headings, and steering the wheels to them gives the special m."""
+    a, c = math.radians(angle), (math.cos(math.radians(angle)), math.sin(math.radians(angle)))
+    r = robot("pair", {"name": "o1", "type": "steerable", "position": [0.5 * c[0], 0.5 * c[1]], "r": 0.1},
+              {"name": "o2", "type": "steerable", "position": [-0.5 * c[0], -0.5 * c[1]], "r": 0.1},
+              {"name": "s3", "type": "swedish", "position": [-c[1], c[0]], "beta": 0.2, "gamma": 90 * DEG, "r": 0.1,
+               "r_r": 0.02})
+    (special,) = classify(r).special
+    words = special.description.split("headings ")[1]
+    h1, h2 = (math.radians(float(x)) for x in words.removesuffix(" deg)").split(" or "))
+    assert abs(math.remainder(h1 - a, math.pi)) == pytest.approx(math.pi / 2)
+    assert abs(math.remainder(h2 - h1 - math.pi, 2 * math.pi)) < 1e-9
+    assert all(-180 < math.degrees(h) <= 180 for h in (h1, h2))
+    for h in (h1, h2):
+        assert instantaneous_mobility(r, heading=[h, h]) == special.mobility == 2
+    assert instantaneous_mobility(r, heading=[a, a]) == 1

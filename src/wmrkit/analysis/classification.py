@@ -163,6 +163,12 @@ def _pinned(robot: Robot, cl, fixed_rows: list[int], steered: list[str], rf: int
     return out
 
 
+def _deg(x: float) -> str:
+    """`x` [deg] with one decimal, never "-0.0"."""
+    text = f"{x:.1f}"
+    return "0.0" if text == "-0.0" else text
+
+
 def _special(robot: Robot, steered: list[str], rf: int, m: int) -> tuple[SpecialConfiguration, ...]:
     """Configurations where m rises above the generic value: all steered axles on one line (digest §2.3)."""
     if rf != 0 or len(steered) < 2:
@@ -176,6 +182,9 @@ def _special(robot: Robot, steered: list[str], rf: int, m: int) -> tuple[Special
     if m_here <= m:
         return ()
     names = ", ".join(steered)
-    text = (f"m = {m_here} when the axles of {names} all lie on the line through their centres "
-            f"(at {np.degrees(np.arctan2(direction[1], direction[0])) % 180:.1f} deg, mod 180 deg)")
+    line = float(np.degrees(np.arctan2(direction[1], direction[0]))) % 180  # the wheels roll across it
+    heading = line - 90  # in [-90, 90), and the heading 180 deg away in [90, 180] or (-180, -90]
+    text = (f"m = {m_here} when the axles of {names} all lie on the line through their centres (the line at "
+            f"{_deg(line)} deg: headings {_deg(heading)} or {_deg(heading + 180 if heading <= 0 else heading - 180)} "
+            "deg)")
     return (SpecialConfiguration(tuple(float(b) for b in beta), m_here, text),)
