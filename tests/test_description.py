@@ -466,3 +466,13 @@ def test_digits_other_than_ascii_are_not_read_as_numbers(text):
     with pytest.raises(DescriptionError, match=r"wheels\[0\]\.r: "):
         robot_from_text(f"name: x\nwheels:\n  - {{name: a, type: fixed, position: [0, 0.2], heading: 0, "
                         f"r: '{text}'}}\n", source=SRC)
+
+
+@pytest.mark.parametrize(("kind", "extra"), [("steerable", ""), ("fixed", ""), ("castor", ", d: 0.05, delta: 30 deg")])
+def test_a_heading_whose_beta_passes_the_angle_limit_is_located(kind, extra):
+    """'heading: 1e6 turn' passed the quantity check (at most 1e6 turns) and its beta = heading + 90 deg did not:
+    the error came later as "beta: angles must be finite numbers of at most 1e+06 turns [rad], got 6283186.87...",
+    with no file, wheel or field."""
+    with pytest.raises(DescriptionError, match=r"^robots/test\.yaml:3: wheels\[0\]\.heading: .*1e\+06 turns"):
+        robot_from_text(f"name: x\nwheels:\n  - {{name: a, type: {kind}, position: [0.3, 0.2], heading: 1e6 turn, "
+                        f"r: 0.1{extra}}}\n", source=SRC)

@@ -33,7 +33,7 @@ from .limits import (  # noqa: F401  (the limits are part of the description for
     _check_text_fields,
 )
 from .robot import Robot
-from .units import BARE_ANGLE_LIMIT
+from .units import BARE_ANGLE_LIMIT, MAX_ANGLE, MAX_TURNS
 from .wheels import GEOMETRY_FIELDS, KINDS, Wheel, beta_from_heading, geometry_problem
 
 #: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
@@ -234,6 +234,9 @@ def _read_heading(item: Mapping[str, Any], values: dict[str, float], check: Fiel
                    "angle, heading + 90 deg), not both", (*loc, "heading"))
     heading = check.quantity(item["heading"], "angle", (*loc, "heading"))
     values["beta"] = float(beta_from_heading(heading, values.get("delta", 0.0)))
+    if abs(values["beta"]) > MAX_ANGLE:  # a heading of 1e6 turns passed, and its beta failed later, unlocated
+        check.fail(f"{item['heading']!r} is more than {MAX_TURNS:g} turns as the thesis's beta (heading - delta + "
+                   "90 deg): no angle to steer by", (*loc, "heading"))
 
 
 def _mecanum_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc) -> Wheel:
