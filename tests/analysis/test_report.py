@@ -11,7 +11,7 @@ from wmrkit import Robot, catalog
 from wmrkit.analysis.classification import classify
 from wmrkit.analysis.isotropy import natural_length
 from wmrkit.analysis.report import write_report
-from wmrkit.analysis.summary import analyze
+from wmrkit.analysis.summary import analyze, describe_singular
 from wmrkit.cli.main import main
 
 
@@ -127,3 +127,14 @@ def test_no_natural_length_where_every_length_leaves_the_twist_undetermined(tmp_
     text = write_report(analyze(Robot.from_file(path), resolution=12), tmp_path / "r", resolution=12,
                         dpi=30).read_text(encoding="utf-8")
     assert "characteristic length D" not in text and "infinite (these joints do not determine the twist)" in text
+
+
+def test_the_table_of_every_assigned_set_repeats_the_summary_for_the_analysed_sets(tmp_path):
+    """thesis-two-steer-castor's page said "(o1.spin): on curves over (o1, o2), 180 sampled points" in the summary
+    and "o1.spin | on curves over (o1, o2), 44 sampled points" in the table below: the table searched again at a
+    quarter of the resolution. The analysed sets are now shown as analysed."""
+    result = analyze(catalog.load("thesis-two-steer-castor"), resolution=48)
+    s = result.singular["actuated"]
+    assert s.assigned == ("o1.spin",) and not s.exact and not s.coupled
+    text = write_report(result, tmp_path, resolution=48, dpi=30).read_text(encoding="utf-8")
+    assert f"<tr><td>o1.spin</td><td>{describe_singular(s, result.robot, limit=4)}</td></tr>" in text

@@ -180,10 +180,12 @@ def _assignable_table(a: Analysis, resolution: int, limit: int = 36) -> str:
         note = f"<p class='small'>{len(sets)} sets; the first {limit} are shown.</p>"
         sets = sets[:limit]
     small = max(12, resolution // 4)
+    done = {frozenset(s.assigned): s for s in a.singular.values() if not s.coupled}  # as the summary rows say
     rows = []
     for q_a in sets:
-        s = (coordinated_singular_set(r, q_a, resolution=small) if a.classification.coordinated
-             else singular_set(r, q_a, resolution=small, max_samples=small * 4))
+        s = done.get(frozenset(q_a)) or (
+            coordinated_singular_set(r, q_a, resolution=small) if a.classification.coordinated
+            else singular_set(r, q_a, resolution=small, max_samples=small * 4))
         rows.append(f"<tr><td>{_e(', '.join(q_a))}</td><td>{_e(describe_singular(s, r, limit=4))}</td></tr>")
     return (f"<h3>Every choice of {m} assigned velocit{'y' if m == 1 else 'ies'} (m = {m})</h3>{note}"
             f"<table><tr><th>assigned</th><th>singular</th></tr>{''.join(rows)}</table>")
