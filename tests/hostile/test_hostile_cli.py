@@ -155,3 +155,31 @@ def test_a_robot_of_many_castors_gets_a_bounded_answer(tmp_path):
 def test_a_yaml_bomb_in_a_bag_s_metadata_is_refused_in_bounded_memory():
     result = _run(["odometry", "diff-drive", str(HERE / "bags" / "yaml-bomb"), "--quiet"], timeout=30)
     assert result.returncode == 2 and result.stderr.count("\n") == 1 and "YAML anchors" in result.stderr
+
+
+def _laughs(levels: int = 9) -> str:
+    """A YAML "billion laughs" list: 9 aliases of the level below, `levels` deep (9**9 items once expanded)."""
+    expr, prev = '&a ["x", "x", "x", "x", "x", "x", "x", "x", "x"]', "a"
+    for anchor in "bcdefghijk"[:levels - 1]:
+        expr, prev = f"&{anchor} [{expr}, " + ", ".join([f"*{prev}"] * 8) + "]", anchor
+    return expr
+
+
+@pytest.mark.parametrize("field", ["name", "notes", "wheel name", "wheel type", "coupling kind", "velocity_names"])
+def test_an_alias_bomb_where_text_is_expected_is_refused_quickly(field, tmp_path):
+    """A billion-laughs list given as a name, a type or a coupling kind: the error quoted the value with repr(),
+    expanding its 4e8 items, and the command ran out of time and memory instead of refusing it."""
+    bomb = _laughs()
+    wheel = {"name": "a", "type": "fixed"} | ({"name": bomb} if field == "wheel name" else {}) | (
+        {"type": bomb} if field == "wheel type" else {})
+    text = ("name: " + (bomb if field == "name" else "x") + "\n" + (f"notes: {bomb}\n" if field == "notes" else "")
+            + (f"velocity_names: {bomb}\n" if field == "velocity_names" else "")
+            + f"wheels:\n  - {{name: {wheel['name']}, type: {wheel['type']}, position: [0, 0.2], heading: 0, "
+            "r: 0.05}\n"
+            + (f"couplings:\n  - {{kind: {bomb}, joints: [a.spin, b.spin]}}\n" if field == "coupling kind" else ""))
+    path = tmp_path / "bomb.yaml"
+    path.write_text(text)
+    result = _run(["show", str(path)], timeout=30)
+    assert result.returncode == 2 and result.stdout == "", result.stderr[-300:]
+    (line,) = result.stderr.splitlines()
+    assert line.startswith(f"wmrkit: error: {path}:") and len(line) < 400 and result.elapsed < 10, line
