@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
+import pytest
 from hypothesis import HealthCheck, settings
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -15,3 +17,14 @@ sys.path[1:1] = [str(p) for p in sorted(Path(__file__).parent.iterdir()) if p.is
 # CPUs are shared: no per-example deadline; sizes are kept small in the tests themselves.
 settings.register_profile("wmrkit", deadline=None, suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile("wmrkit")
+
+
+@pytest.fixture(autouse=True)
+def _no_compile_notice(request, monkeypatch):
+    """In-process CLI runs print their answer alone: the notice that numba is compiling (a cold kernel cache, as in a
+    fresh clone, or a kernel's source just changed) added a line to stderr in whichever test compiled first. Modules
+    with ``KEEP_COMPILE_NOTICE = True`` keep it (they time refusals and strip it); tests of it set their own delay."""
+    if not getattr(request.module, "KEEP_COMPILE_NOTICE", False):
+        import wmrkit.cli.main as cli
+
+        monkeypatch.setattr(cli, "COMPILE_NOTICE_AFTER", math.inf)

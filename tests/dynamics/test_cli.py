@@ -105,14 +105,21 @@ def test_simulate_out_writes_steering_as_headings(capsys, tmp_path):
     np.testing.assert_allclose(heading, table[:, header.index("steer.heading")], atol=1e-8)
 
 
-def test_a_heading_column_beyond_a_turn_is_refused(capsys, tmp_path):
-    """A heading of 90 (degrees meant) was read as 90 rad and steered to 2.035 rad (exit 0)."""
+@pytest.mark.parametrize("text, place, message", [
+    # a heading of 90 (degrees meant) was read as 90 rad and steered to 2.035 rad (exit 0)
+    ("time,right_drive.spin,left_drive.spin,steer.heading\n0,300,300,0.5\n3,300,300,90\n", "3: column "
+     "'steer.heading'", "a heading is read in radians, and 90 rad is more than a turn; degrees? 90 deg = 1.5708 rad"),
+    # 'right_drive.heading' (a fixed wheel) was refused as "tuple.index(x): x not in tuple"
+    ("time,right_drive.spin,right_drive.heading\n0,300,0.1\n1,300,0.1\n", "1: column 'right_drive.heading'",
+     "robot 'forklift' has no steered wheel 'right_drive' (a heading column is a steering reference; steered "
+     "wheels: steer)"),
+], ids=["heading beyond a turn", "heading of a fixed wheel"])
+def test_a_bad_heading_column_is_refused_at_its_place(capsys, tmp_path, text, place, message):
     path = tmp_path / "tau.csv"
-    path.write_text("time,right_drive.spin,left_drive.spin,steer.heading\n0,300,300,0.5\n3,300,300,90\n")
+    path.write_text(text)
     code, out, err = run(capsys, "simulate", "forklift", "--torques", str(path))
     assert code == 2 and out == ""
-    assert err.strip() == (f"wmrkit: error: {path}:3: column 'steer.heading': a heading is read in radians, and 90 "
-                           "rad is more than a turn; degrees? 90 deg = 1.5708 rad")
+    assert err.strip() == f"wmrkit: error: {path}:{place}: {message}"
 
 
 def test_simulate_torque_file(capsys, tmp_path):
@@ -140,16 +147,6 @@ def test_json_errors_about_a_file_give_its_place(capsys, tmp_path):
     assert (data["file"], data["line"], data["field"], data["error"]) == (missing, None, None, "no such file")
     assert main(["ik", "swerve-4", "--twist", "1", "0", "--json"]) == 2  # not about a file: no place
     assert json.loads(capsys.readouterr().err)["file"] is None
-
-
-def test_a_heading_column_of_a_wheel_that_does_not_steer_names_it(capsys, tmp_path):
-    """'right_drive.heading' (a fixed wheel) was refused as "tuple.index(x): x not in tuple"."""
-    path = tmp_path / "tau.csv"
-    path.write_text("time,right_drive.spin,right_drive.heading\n0,300,0.1\n1,300,0.1\n")
-    code, out, err = run(capsys, "simulate", "forklift", "--torques", str(path))
-    assert code == 2 and out == ""
-    assert err.strip() == (f"wmrkit: error: {path}:1: column 'right_drive.heading': robot 'forklift' has no steered "
-                           "wheel 'right_drive' (a heading column is a steering reference; steered wheels: steer)")
 
 
 def test_a_torque_file_with_a_byte_order_mark_is_read(capsys, tmp_path):
