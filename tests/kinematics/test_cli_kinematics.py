@@ -140,3 +140,11 @@ def test_a_json_error_about_a_file_in_the_output_folder_names_that_file(capsys, 
     assert error["error"].startswith("exists and is not wmrkit's code for robot 'diff-drive'")
     assert main(["kinematics", "diff-drive", "--codegen", "c", f"{tmp_path}/", "--json"]) == 2  # a trailing slash
     assert json.loads(capsys.readouterr().err)["file"] == f"{tmp_path}/diff_drive_kinematics.c"
+
+
+def test_a_steer_heading_beyond_the_angle_limit_names_the_option(capsys):
+    """--steer steer=1e6turn gave 'beta: angles must be ... at most 1e+06 turns', naming neither option nor wheel."""
+    assert main(["kinematics", "forklift", "--steer", "steer=1e6turn"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wmrkit: error: --steer steer=1e6turn: ") and "1e+06 turns" in err
+    assert err.count("\n") == 1

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import catalog
-from ..errors import WmrkitError
+from ..errors import ShapeError, WmrkitError
 from ..robot import Robot
 from ..units import Kind, UnitError, parse_quantity
 
@@ -138,5 +138,13 @@ def add_steer_option(parser: argparse.ArgumentParser, text: str = "heading of a 
 
 def steered_robot(spec: str, steer: list[str] | None) -> Robot:
     """The robot named by a ROBOT argument, at the headings of its ``--steer`` options (0 = straight ahead)."""
+    from .._shapes import as_angles
+
     pairs = parse_assignments(steer, "--steer")
-    return load_robot(spec).with_steering({n: parse_angle(v, f"--steer {n}") for n, v in pairs.items()})
+    robot = load_robot(spec).with_steering({n: parse_angle(v, f"--steer {n}") for n, v in pairs.items()})
+    for name, value in pairs.items():  # a heading whose beta passes the angle limit (1e6 turns) failed unlocated later
+        try:
+            as_angles([robot.wheel(name).beta], 1, "beta")
+        except ShapeError as err:
+            raise WmrkitError(f"--steer {name}={value}: {err}") from None
+    return robot
