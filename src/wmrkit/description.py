@@ -10,7 +10,6 @@ import json
 import math
 import os
 import re
-import reprlib
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -18,7 +17,7 @@ from typing import Any
 import yaml
 
 from .couplings import COUPLING_KINDS, Coupling
-from .documents import FieldReader, LineOf, Loc, hint, read_document, read_file
+from .documents import FieldReader, LineOf, Loc, hint, read_document, read_file, short_repr
 from .dynamics import mass
 from .limits import (  # noqa: F401  (the limits are part of the description format)
     ANGLE_MARGIN,
@@ -65,8 +64,8 @@ def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None
     if not isinstance(data, Mapping):
         check.fail("a robot description is a mapping with the fields 'name' and 'wheels'", ())
     check.reject_unknown(data, TOP_FIELDS + tuple(DERIVED_FIELDS), ())
-    name = _text(check, data, "name", ())
-    notes = _text(check, data, "notes", (), required=False)
+    name = check.text(data, "name", ())
+    notes = check.text(data, "notes", (), required=False)
     _check_text_fields(name, notes, check)
     wheels_data = check.require(data, "wheels", ())
     if not isinstance(wheels_data, list) or not wheels_data:
@@ -103,21 +102,7 @@ def _check_derived(data: Mapping[str, Any], robot: Robot, check: FieldReader) ->
             expected = list(getattr(robot, attribute))
             if data[key] != expected:
                 check.fail(f"derived from the wheels (wmrkit show --json writes it), so it must be {expected}, got "
-                           f"{_SHORT.repr(data[key])}: correct it or delete it", (key,))
-
-
-#: Bounded repr of a value in an error: an aliased YAML "billion laughs" list (9 aliases, 9 deep) given as a name
-#: was written out whole, 4e8 items, and the error never came.
-_SHORT = reprlib.Repr()
-_SHORT.maxstring = _SHORT.maxother = 80
-_SHORT.maxlevel, _SHORT.maxlist, _SHORT.maxdict = 2, 4, 4
-
-
-def _text(check: FieldReader, data: Mapping[str, Any], key: str, loc: Loc, *, required: bool = True) -> str:
-    """:meth:`FieldReader.text`, with a value that is not a string quoted in bounded form (:data:`_SHORT`)."""
-    if key in data and not isinstance(data[key], str):
-        check.fail(f"must be a non-empty string, got {_SHORT.repr(data[key])}", (*loc, key))
-    return check.text(data, key, loc, required=required)
+                           f"{short_repr(data[key])}: correct it or delete it", (key,))
 
 
 def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) -> tuple[Coupling, ...]:
@@ -132,7 +117,7 @@ def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) ->
         if not isinstance(item, Mapping):
             check.fail("a coupling is a mapping {kind, joints, ratios}", loc)
         check.reject_unknown(item, ("kind", "joints", "ratios"), loc)
-        kind = _text(check, item, "kind", loc)
+        kind = check.text(item, "kind", loc)
         if kind not in COUPLING_KINDS:
             check.fail(f"unknown coupling kind '{kind}'{hint(kind, COUPLING_KINDS)} (kinds: "
                        f"{', '.join(COUPLING_KINDS)})", (*loc, "kind"))
@@ -170,14 +155,14 @@ def _joint_names(wheels: list[Wheel]) -> list[str]:
 def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc) -> Wheel:
     if not isinstance(item, Mapping):
         check.fail("a wheel is a mapping with at least 'name', 'type' and its geometry", loc)
-    type_name = _text(check, item, "type", loc)
+    type_name = check.text(item, "type", loc)
     if type_name == "mecanum":
         return _mecanum_from_dict(item, check, loc)
     if type_name not in KINDS:
         check.fail(f"unknown wheel type '{type_name}'{hint(type_name, WHEEL_TYPES)} (types: {', '.join(WHEEL_TYPES)})",
                    (*loc, "type"))
     kind = KINDS[type_name]
-    name = _text(check, item, "name", loc)
+    name = check.text(item, "name", loc)
     if len(loc) == 2 and isinstance(loc[1], int):
         check.wheels[loc[1]:] = [name]
     if not WHEEL_NAME.fullmatch(name):

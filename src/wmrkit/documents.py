@@ -10,6 +10,7 @@ from __future__ import annotations
 import difflib
 import json
 import os
+import reprlib
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -21,12 +22,23 @@ from .limits import _check_size
 from .units import UnitError, parse_quantity
 
 __all__ = ["FieldReader", "LineOf", "Loc", "compose", "hint", "line_finder", "parse_document", "read_document",
-           "read_file"]
+           "read_file", "short_repr"]
 
 #: A field's location: keys and list indices from the document's root.
 Loc = tuple[str | int, ...]
 #: Maps a location to its 1-based line, or None.
 LineOf = Callable[[Loc], int | None]
+
+#: Bounded repr of a value quoted in an error: an aliased YAML "billion laughs" list (9 aliases, 9 deep) given as a
+#: name was written out whole, 4e8 items, and the error never came.
+_SHORT = reprlib.Repr()
+_SHORT.maxstring = _SHORT.maxother = 80
+_SHORT.maxlevel, _SHORT.maxlist, _SHORT.maxdict = 2, 4, 4
+
+
+def short_repr(value: Any) -> str:
+    """`value`'s repr for an error message, bounded (:data:`_SHORT`) whatever its size or depth."""
+    return _SHORT.repr(value)
 
 
 def read_file(path: str | os.PathLike[str], what: str = "description") -> str:
@@ -83,7 +95,7 @@ class FieldReader:
             return ""
         value = self.require(data, key, loc)
         if not isinstance(value, str) or (required and not value.strip()):
-            self.fail(f"must be a non-empty string, got {value!r}", (*loc, key))
+            self.fail(f"must be a non-empty string, got {short_repr(value)}", (*loc, key))
         return value
 
     def quantity(self, value: Any, kind: str, loc: Loc) -> float:

@@ -22,6 +22,11 @@ class UnknownNameError(WmrkitError, LookupError):
 _ONE_LINE = str.maketrans({c: repr(c)[1:-1] for c in "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"})
 
 
+def field_path(loc: tuple[str | int, ...]) -> str:
+    """A field's location as written in errors: ``("wheels", 0, "r")`` -> ``wheels[0].r``."""
+    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in loc).lstrip(".")
+
+
 class DescriptionError(WmrkitError, ValueError):
     """A robot description is wrong at a known place: file, wheel, field.
 
@@ -37,7 +42,7 @@ class DescriptionError(WmrkitError, ValueError):
 
     def _format(self) -> str:
         where = self.source if self.line is None else f"{self.source}:{self.line}"
-        path = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in self.loc).lstrip(".")
+        path = field_path(self.loc)
         text = f"{where}: {path}: {self.message}" if path else f"{where}: {self.message}"
         return text.translate(_ONE_LINE)  # names and values quoted from a file may hold line breaks
 

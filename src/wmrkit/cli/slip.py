@@ -4,6 +4,7 @@ and the options of the slip-aware estimators of ``wmrkit odometry --method wls|f
 from __future__ import annotations
 
 import argparse
+import json
 import math
 from pathlib import Path
 
@@ -114,17 +115,10 @@ def _weights_file(path: str, robot: Robot | None) -> tuple[tuple[float, float], 
             fail("expected two friction coefficients [LAT, LONG]", at)
         for j, v in enumerate(value):  # type: ignore[arg-type]
             if isinstance(v, bool) or not isinstance(v, int | float) or not (math.isfinite(v) and v > 0):
-                fail(f"expected a finite number > 0, got {json_text(v)}", (*at, j))
+                fail(f"expected a finite number > 0, got {json.dumps(v)}", (*at, j))
         return float(value[0]), float(value[1])  # type: ignore[index]
 
     return pair(w["default"], (*loc, "default")), {str(k): pair(v, (*loc, "wheels", k)) for k, v in wheels.items()}
-
-
-def json_text(value: object) -> str:
-    """`value` as JSON writes it (``true``, ``"1"``, ``NaN``), for an error message."""
-    import json
-
-    return json.dumps(value)
 
 
 def check_estimator_options(args: argparse.Namespace) -> None:

@@ -16,6 +16,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon, Rectangle
 
 from ..errors import WmrkitError
+from ..plotting.files import spread_indices
 from .execute import Execution, execute_plan
 from .geometry import Space, Vehicle, footprint
 from .path import sample_poses
@@ -109,7 +110,7 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
     if suffix not in (".gif", ".html"):
         raise WmrkitError(f"{path}: the animation is written as .gif or .html")
     run = execute_plan(plan) if execution is None else execution
-    frames = np.unique(np.linspace(0, len(run.t) - 1, min(max_frames, len(run.t))).round().astype(int))
+    frames = spread_indices(len(run.t), max_frames)
     fig = Figure(figsize=(8, 4.6))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()

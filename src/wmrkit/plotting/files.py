@@ -1,8 +1,11 @@
-"""Figure files: the formats wmrkit draws to, chosen by the file's extension, checked before the drawing."""
+"""Figure files: the formats wmrkit draws to, chosen by the file's extension, checked before the drawing; and which
+items of a long sequence a figure or an animation draws."""
 
 from __future__ import annotations
 
 import os
+
+import numpy as np
 
 from ..errors import WmrkitError
 
@@ -23,3 +26,9 @@ def check_figure_path(path: str | os.PathLike[str], what: str = "") -> None:
     if suffix not in FORMATS:
         raise PlotError(f"{what + ' ' if what else ''}{name}: cannot draw to '{suffix or 'no extension'}' (plot files "
                         f"are {', '.join(FORMATS)})")
+
+
+def spread_indices(n: int, most: int) -> np.ndarray:
+    """Indices of at most `most` of `n` items, spread evenly, the first and the last included (the frames of an
+    animation, the configurations drawn over each other)."""
+    return np.unique(np.linspace(0, n - 1, min(n, most)).round().astype(int))

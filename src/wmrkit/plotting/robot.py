@@ -26,7 +26,7 @@ from .._shapes import as_vectors
 from ..errors import ShapeError
 from ..robot import Robot
 from ..wheels import Wheel
-from .files import PlotError, check_figure_path
+from .files import PlotError, check_figure_path, spread_indices
 
 DRIVEN = "#f28e2b"  # actuated spin: orange wheel
 PASSIVE = "#e6e6e6"  # passive wheel: light grey
@@ -80,7 +80,7 @@ def _configurations(robot: Robot, beta: ArrayLike | None, what: str = "beta") ->
     if b.size == 0:
         raise ShapeError(f"{what}: no configuration to draw, got shape {b.shape}")
     b = b.reshape(-1, n)
-    return b[np.unique(np.linspace(0, len(b) - 1, min(len(b), MAX_CONFIGURATIONS)).round().astype(int))]
+    return b[spread_indices(len(b), MAX_CONFIGURATIONS)]
 
 
 def _wheel_betas(robot: Robot, config: np.ndarray) -> list[float]:

@@ -25,7 +25,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import WmrkitError
+from ..errors import WmrkitError, field_path
 
 #: The values of ``odometry.method``: the no-slip model's integration schemes, then the slip-aware estimators.
 METHODS = ("exact", "rk2", "euler", "paper002", "wls", "fk1", "fk2")
@@ -121,14 +121,9 @@ def _check_slip_spread(data: Mapping[str, Any], settings: OdometrySettings, chec
     lo, hi = min(used, key=lambda u: u[0]), max(used, key=lambda u: u[0])
     if hi[0] > MAX_RATIO * lo[0]:
         here, other = (lo, hi) if lo[1] else (hi, lo)
-        where = _place(other[1]) if other[1] else "the default of the wheels without slip"
+        where = field_path(other[1]) if other[1] else "the default of the wheels without slip"
         check.fail(f"{here[0]:g} and {other[0]:g} ({where}) differ by more than a factor {MAX_RATIO:g}: the weighted "
                    "least squares would lose the smaller rows to round-off (only ratios matter)", here[1])
-
-
-def _place(loc: tuple) -> str:
-    """``("wheels", 0, "slip", "lateral")`` -> ``wheels[0].slip.lateral``."""
-    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in loc).lstrip(".")
 
 
 def settings_to_dict(settings: OdometrySettings) -> dict[str, Any]:

@@ -11,7 +11,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..errors import WmrkitError
-from ..plotting.files import check_figure_path
+from ..plotting.files import check_figure_path, spread_indices
 from ..robot import Robot
 from .camera import Camera, CameraError, distort
 from .follow import LineFollowing
@@ -118,6 +118,6 @@ def save_animation(run: LineFollowing, robot: Robot, camera: Camera, path: str |
         return body, path_line
 
     n = len(run.images)
-    frames = np.unique(np.linspace(0, n - 1, min(n, MAX_FRAMES)).round().astype(int)).tolist()
+    frames = spread_indices(n, MAX_FRAMES).tolist()
     anim = FuncAnimation(fig, frame, frames=frames, blit=False)
     anim.save(str(path), writer=PillowWriter(fps=fps))
