@@ -37,9 +37,20 @@ def run_json(capsys, argv: list[str]) -> dict:
     return json.loads(capsys.readouterr().out)
 
 
+def test_a_drive_unit_s_mobility_says_which_motions_are_the_body_s(capsys):
+    """m = 2 (4.3) counts the unit turning on the spot under a still body; analyze's m (5.13) is 1: both named."""
+    assert main(["kinematics", "agv-drive-unit"]) == 0
+    line = capsys.readouterr().out.splitlines()[1]
+    assert line.strip() == ("mobility m = 2 (4.3): 1 of the body (G, 4.22; the classification's m) and 1 of the joints "
+                            "with the body at rest")
+    data = run_json(capsys, ["kinematics", "agv-drive-unit"])
+    assert (data["mobility"], data["vehicle_dof"]) == (2, 1)
+
+
 def test_json_summary_of_the_tricycle(capsys, tricycle_file):
     data = run_json(capsys, ["kinematics", tricycle_file])
     assert data["mobility"] == 1 and data["generic_mobility"] == 1 and data["extended_dof"] == 2
+    assert data["vehicle_dof"] == 1
     assert data["assignable_sets"] == [["vy"], ["omega"], ["w1.spin"], ["w2.spin"], ["w3.spin"]]
     assert data["lost_here"] == []
     direct = data["direct_model"]

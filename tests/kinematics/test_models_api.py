@@ -73,6 +73,28 @@ def test_mobility_oracles_of_part_d(wheels, m):
     assert all(len(s) == m for s in assignable_sets(robot))
 
 
+@pytest.mark.parametrize("name", ["agv-drive-unit", "diff-drive", "forklift", "thesis-omni-castor", "mecanum-4",
+                                  "thesis-two-steer-castor"])
+def test_vehicle_dof_is_the_rank_of_the_twist_rows_of_a_null_space_basis(name):
+    """Independent: scipy's null space B of A (4.2), rank of its (vx, vy, omega) rows; and at generic steering the
+    classification's m (5.13). The drive unit turns on the spot under a still body: m = 2, one of them the body's."""
+    from scipy.linalg import null_space
+
+    from wmrkit import catalog
+    from wmrkit.analysis import classify
+    from wmrkit.kinematics.linalg import nondimensional
+    from wmrkit.kinematics.trees import vehicle_dof
+
+    robot = catalog.load(name)
+    beta = np.random.default_rng(4).uniform(-3, 3, size=(5, len(robot.steer_names)))
+    for b in beta:
+        basis = null_space(nondimensional(robot).constraint_matrix(b))
+        assert int(vehicle_dof(robot, b)) == np.linalg.matrix_rank(basis[:3], tol=1e-9)
+    assert int(vehicle_dof(robot, beta).max()) == classify(robot).mobility
+    if name == "agv-drive-unit":
+        assert int(mobility(robot)) == 2 and int(vehicle_dof(robot)) == 1
+
+
 @pytest.mark.parametrize("batch", BATCHES, ids=str)
 def test_batch_equals_loop(batch):
     robot = bicycle()

@@ -21,6 +21,7 @@ from .models import (
     mobility,
 )
 from .sensing import minimal_sensor_sets, sensing_analysis
+from .trees import vehicle_dof
 
 
 def _model(build, robot: Robot) -> dict[str, Any]:
@@ -48,6 +49,7 @@ def kinematics_summary(robot: Robot) -> dict[str, Any]:
         "beta": dict(zip(robot.steer_names, robot.beta.tolist(), strict=True)),  # the thesis's angles [rad]
         "velocity_names": list(robot.velocity_names),
         "mobility": int(mobility(robot)),
+        "vehicle_dof": int(vehicle_dof(robot)),  # G (4.22): of the m above, motions of the body
         "generic_mobility": generic_mobility(robot),
         "extended_dof": extended_dof(robot),
         "assignable_sets": [list(s) for s in here],
@@ -106,6 +108,10 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
     m, generic = summary["mobility"], summary["generic_mobility"]
     mobility = (f"  mobility m = {m}" if m == generic else
                 f"  mobility m = {m} at this steering (m = {generic} at generic steering: a special configuration)")
+    self_motions = m - summary["vehicle_dof"]
+    if self_motions > 0:
+        mobility += (f" (4.3): {summary['vehicle_dof']} of the body (G, 4.22; the classification's m) and "
+                     f"{self_motions} of the joints with the body at rest")
     extra = summary["extended_dof"] - m
     lines = [f"robot {summary['robot']} ({steer or 'no steering'})", mobility]
     if extra > 0:

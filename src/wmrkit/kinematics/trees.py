@@ -173,7 +173,8 @@ def independent_wheel_rates(robot: Robot, beta: ArrayLike | None = None) -> np.n
 def vehicle_dof(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
     """G of eq. (4.22): ``3 - rank(Delta(J) I_bar)``, three minus the independent motion constraints.
 
-    ``(..., n_steer) -> (...)`` int. Equal to the mobility m (4.75).
+    ``(..., n_steer) -> (...)`` int: the twist degrees of freedom. Equal to the mobility m (4.75), except for
+    double wheels, whose steering turns without moving the body: ``m - G`` such self-motions (docs/kinematics.md).
     """
     i_bar, j = nondimensional(robot).jacobian_form(beta)
     return 3 - matrix_rank(delta_projector(j) @ i_bar)
