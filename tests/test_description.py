@@ -14,6 +14,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from wmrkit import KINDS, DescriptionError, Robot, Wheel
+from wmrkit.cli.main import main
 from wmrkit.description import robot_from_text
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "description-format.md"
@@ -158,6 +159,24 @@ def test_malformed_json_and_json_nan():
             robot_from_text(text.replace("NaN", bad), source="bot.json", fmt="json")
     with pytest.raises(DescriptionError, match=r"^bot\.json:\d+: wheels\[0\]\.r: field 'r' given twice$"):
         robot_from_text(text.replace('"r": NaN', '"r": 0.1, "r": 0.2'), source="bot.json", fmt="json")
+
+
+@pytest.mark.parametrize("fmt", ["json", "yaml"])
+def test_a_field_given_twice_names_its_wheel_like_every_other_wheel_error(fmt, tmp_path, capsys):
+    """The JSON error's `wheel` is the wheel's name (as for a wrong value), not its index in the list."""
+    data = yaml.safe_load(BASE)
+    text = json.dumps(data, indent=1) if fmt == "json" else BASE
+    name = data["wheels"][0]["name"]
+    twice = text.replace('"r": 0.1', '"r": 0.1, "r": 0.2', 1) if fmt == "json" else \
+        text.replace("    r: 0.1\n", "    r: 0.1\n    r: 0.2\n", 1)
+    assert twice != text
+    with pytest.raises(DescriptionError) as err:
+        robot_from_text(twice, source=f"bot.{fmt}", fmt=fmt)
+    assert err.value.wheel == name and err.value.loc == ("wheels", 0, "r")
+    path = tmp_path / f"bot.{fmt}"
+    path.write_text(twice)
+    assert main(["show", str(path), "--json"]) == 2
+    assert json.loads(capsys.readouterr().err)["wheel"] == name
 
 
 def test_unreadable_files(tmp_path):

@@ -218,11 +218,19 @@ def _reject_duplicate_keys(root: yaml.Node | None, source: str) -> None:
                 if isinstance(k, yaml.ScalarNode) and k.value != "<<":
                     if k.value in keys:
                         raise DescriptionError(f"field '{k.value}' given twice", source=source, loc=(*loc, k.value),
-                                               line=k.start_mark.line + 1)
+                                               line=k.start_mark.line + 1, wheel=_wheel_name(node, loc))
                     keys.add(k.value)
                 stack.append((v, (*loc, k.value) if isinstance(k, yaml.ScalarNode) else loc))
         elif isinstance(node, yaml.SequenceNode):
             stack.extend((v, (*loc, i)) for i, v in enumerate(node.value))
+
+
+def _wheel_name(node: yaml.MappingNode, loc: Loc) -> str | None:
+    """The name of the wheel the mapping `node` at `loc` describes (``wheels[i]``), when it gives one."""
+    if len(loc) != 2 or loc[0] != "wheels":
+        return None
+    return next((v.value for k, v in node.value if isinstance(k, yaml.ScalarNode) and k.value == "name"
+                 and isinstance(v, yaml.ScalarNode)), None)
 
 
 def line_finder(root: yaml.Node | None) -> LineOf:
