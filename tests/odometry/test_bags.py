@@ -114,3 +114,16 @@ def test_times_a_ros_stamp_cannot_hold_are_refused_by_name(tmp_path, start):
             w.write(Trajectory(np.array([start]), np.zeros((1, 3)), np.zeros(1)))
     with pytest.raises(LogError, match=r"js: time .* is no ROS 2 time stamp"):
         write_joint_states(tmp_path / "js", JointLog(np.array([start]), ("left.spin",), np.zeros((1, 1))))
+
+
+@pytest.mark.parametrize("name", ["odom", "odom.csv", "odom.tum"])
+def test_a_run_that_fails_leaves_no_partial_output(tmp_path, name):
+    """A log broken half way (NaN at row 60) is refused, and the trajectory file or bag begun is removed: a partial
+    output (the bag's metadata, a CSV header) would read as the run's result."""
+    log = tmp_path / "log.csv"
+    rows = [f"{0.01 * i},{0.1 * i if i != 60 else 'nan'},{0.1 * i}" for i in range(100)]
+    log.write_text("time,left.spin,right.spin\n" + "\n".join(rows) + "\n")
+    out = tmp_path / name
+    with pytest.raises(LogError, match=r"left\.spin: value nan"):
+        odometry_file(catalog.load("diff-drive"), log, out=out, chunk_size=16)  # chunks before row 60 written
+    assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["log.csv"]

@@ -2,14 +2,16 @@
 
 Inputs: CSV logs (:mod:`.logs`) or ROS 2 bags (a bag directory, or a ``.db3``/``.mcap`` file; :mod:`.bags`).
 Outputs chosen by ``out_format`` or the extension of ``out``: ``.csv`` (time, pose, slip, covariance), ``.tum``
-or ``.txt`` (TUM), anything else a new ROS 2 bag of ``nav_msgs/msg/Odometry``. A plot keeps a decimated copy of
-the trajectory, so memory stays bounded for any log length. Steering joints in either file are headings (0 =
-rolling straight ahead; :mod:`.steering`), converted to β with `robot`'s wheels by the readers.
+or ``.txt`` (TUM), anything else a new ROS 2 bag of ``nav_msgs/msg/Odometry``; a run that fails removes the output
+it began. A plot keeps a decimated copy of the trajectory, so memory stays bounded for any log length. Steering
+joints in either file are headings (0 = rolling straight ahead; :mod:`.steering`), converted to β with `robot`'s
+wheels by the readers.
 """
 
 from __future__ import annotations
 
 import os
+import shutil
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Literal
@@ -46,6 +48,14 @@ def _same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
         return os.path.samefile(a, b)
     except OSError:
         return os.path.realpath(a) == os.path.realpath(b)
+
+
+def _remove(path: str | os.PathLike[str]) -> None:
+    """Delete an output file, or a bag (a directory), that this run created."""
+    if Path(path).is_dir():
+        shutil.rmtree(path, ignore_errors=True)
+    else:
+        Path(path).unlink(missing_ok=True)
 
 
 def _check_not_the_log(log_path: str | os.PathLike[str], outputs: Mapping[str, object]) -> None:
@@ -105,13 +115,17 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
         decimated = Decimator() if plot is not None else None
         if decimated is not None:
             sinks.append(decimated)
+        done = False
         try:
             summary = (run_odometry(model, chunks, method=method, pose0=pose0, noise=noise, sinks=sinks)
                        if isinstance(model, OdometryModel) else model.run(chunks, method=method, pose0=pose0,
                                                                           sinks=sinks))
+            done = True
         finally:
             if writer is not None:
                 writer.close()
+                if not done:  # a failed run leaves no partial trajectory that would read as its result
+                    _remove(out)
     if decimated is not None:
         from .plot import save_trajectory_plot
 
