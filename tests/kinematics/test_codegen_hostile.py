@@ -69,6 +69,15 @@ def test_files_are_checked_before_any_is_written(tmp_path):
     assert not (tmp_path / "forklift_kinematics.h").exists()
 
 
+@pytest.mark.parametrize("lang", ["c", "python"])
+def test_a_name_too_long_for_a_file_name_is_refused_before_writing(tmp_path, lang):
+    """A 300-character robot name (Python allows it; descriptions stop at 64) failed with OSError 'File name too
+    long'; the refusal now says why, and nothing is written."""
+    with pytest.raises(CodegenError, match=r"would have 3\d\d bytes, file systems allow 255; give the robot a shorter"):
+        write_code(_robot("r" * 300, "front"), lang, tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_users_file_or_another_robots_code_is_never_overwritten(tmp_path):
     """Existing files were overwritten silently: a user's own file, or the code of another robot whose name gives
     the same identifier ('diff drive' and 'diff-drive'). Regenerating the same robot's code still overwrites it."""
