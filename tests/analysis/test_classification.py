@@ -119,6 +119,29 @@ def test_icr_sets():
     stuck = robot("s", _fixed("a", 1, 0, 0.0), _fixed("b", 0, 1, math.pi / 2), _fixed("c", 1, 1, 0.7))
     assert icr(stuck).kind == "none"
     assert "translation" in icr(tricycle(beta3=0.0)).describe()
+    assert icr(stuck).consistent is None  # fixed axles that miss: no steering can mend it
+
+
+@pytest.mark.parametrize(("outer", "hint"), [(23.4429, True), (24.0, True), (25.0, False), (30.0, False)])
+def test_nearly_meeting_steered_axles_give_the_headings_at_which_they_meet(outer, hint):
+    """An Ackermann car steered 30 deg inside has no ICR unless the outside wheel is at atan(L / (L / tan 30 deg +
+    track)) = 23.44289865 deg (closed form): headings rounded to 0.0001 deg gave "cannot move" and no more. When the
+    steered wheels miss one point by at most 0.5 deg, the headings at which the axles meet come with it; they keep
+    the rear axle (fixed) and turn about one point on it."""
+    car = catalog.load("ackermann")
+    exact = math.degrees(math.atan(2.7 / (2.7 / math.tan(math.radians(30)) + 1.55)))
+    assert icr(car, heading=np.radians([30.0, exact])).kind == "point"
+    got = icr(car, heading=np.radians([30.0, outer]))
+    assert got.kind == "none" and (got.consistent is not None) == hint
+    if hint:
+        headings = np.array([h for _, h in got.consistent])
+        meet = icr(car, heading=headings)
+        assert meet.kind == "point" and abs(meet.point[0]) < 1e-9  # on the rear axle
+        inner, outer_aimed = np.degrees(headings)
+        assert math.degrees(math.atan(2.7 / (2.7 / math.tan(math.radians(inner)) + 1.55))) == pytest.approx(
+            outer_aimed, abs=1e-9)  # the closed form holds at the aimed headings
+        assert max(abs(inner - 30.0), abs(outer_aimed - outer)) == pytest.approx(math.degrees(got.miss[1]))
+        assert got.describe().startswith("no ICR: the robot cannot move without slipping; its steered axles miss")
 
 
 # ---- random robots: the classification agrees with the rank of the constraint matrix -------------------------

@@ -9,10 +9,12 @@ The thesis's closed form (5.21) swaps x and y (errata, docs/errata.md); the null
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
+from scipy.linalg import null_space
 
 from .._shapes import as_vectors
 from ..errors import ShapeError
@@ -65,6 +67,10 @@ class ICRSet:
     point: tuple[float, float] | None = None
     direction: tuple[float, float] | None = None
     line: tuple[float, float, float] | None = None
+    # "none" whose steered axles miss one point by at most ROUNDING: the headings [rad] at which they meet, and the
+    # wheel that misses most with its miss [rad] (rounded headings, not a robot that cannot move)
+    consistent: tuple[tuple[str, float], ...] | None = None
+    miss: tuple[str, float] | None = None
 
     def describe(self) -> str:
         """One line for people, e.g. ``ICR at (0.000, -2.747) m``."""
@@ -78,7 +84,16 @@ class ICRSet:
             return f"ICR anywhere on the line through ({f(d * ly)}, {f(-d * lx)}) m along ({f(lx)}, {f(ly)})"
         if self.kind == "plane":
             return "ICR anywhere in the plane (no wheel axle constrains it)"
-        return "no ICR: the robot cannot move without slipping"
+        text = "no ICR: the robot cannot move without slipping"
+        if self.consistent is None:
+            return text
+        aimed = ", ".join(f"{name} {math.degrees(h):.10g} deg" for name, h in self.consistent)
+        return (f"{text}; its steered axles miss one point by {math.degrees(self.miss[1]):.2g} deg at most "
+                f"({self.miss[0]}): rounded headings? They meet at headings {aimed}")
+
+
+#: Largest heading error [rad] :func:`icr` reads as rounding of consistent headings (0.5 deg).
+ROUNDING = math.radians(0.5)
 
 
 def format_coordinate(x: float) -> str:
@@ -92,11 +107,11 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
     thesis's `beta` or the users' `heading` (default the described one)."""
     beta = configuration(robot, beta, heading)
     g = constraint_lines(robot).lines(beta)
-    rank = int(matrix_rank(g * [1.0, 1.0, 1.0 / characteristic_length(robot)])) if len(g) else 0  # nondimensional
+    rank = _rank(robot, g)
     if rank == 0:
         return ICRSet("plane")
     if rank == 3:
-        return ICRSet("none")
+        return _nearly_consistent(robot, beta, g)
     if rank == 1:
         row = g[np.argmax(np.linalg.norm(g, axis=-1))]
         return ICRSet("line", line=tuple(float(v) for v in row))
@@ -105,6 +120,29 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
         n = np.hypot(x, y) * (1.0 if y > 1e-12 or (abs(y) <= 1e-12 and x < 0) else -1.0)  # either sign: +x first
         return ICRSet("infinity", direction=(float(y / n), float(-x / n)))
     return ICRSet("point", point=(float(x / w), float(y / w)))
+
+
+def _rank(robot: Robot, lines: np.ndarray) -> int:
+    """Rank of the constraint lines, nondimensional (0: no line)."""
+    return int(matrix_rank(lines * [1.0, 1.0, 1.0 / characteristic_length(robot)])) if len(lines) else 0
+
+
+def _nearly_consistent(robot: Robot, beta: np.ndarray, lines: np.ndarray) -> ICRSet:
+    """"none", with the headings that make the axles meet when re-aiming the steered wheels at the nearest common
+    point moves none of them by more than :data:`ROUNDING` (e.g. Ackermann headings given to 0.001 deg)."""
+    steered = np.array([w in robot.steer_names for w in constraint_lines(robot).wheels], dtype=bool)
+    fixed = null_space(lines[~steered]) if (~steered).any() else np.eye(3)  # points on every fixed axle
+    if not steered.any() or fixed.shape[1] == 0:
+        return ICRSet("none")
+    v = fixed @ np.linalg.svd(lines[steered] @ fixed)[2][-1]  # of those, the nearest to the steered axles
+    aimed = steer_to_icr(robot, np.array([-v[1], v[0], v[2]]))  # as common_point maps a line-space vector
+    miss = np.abs(np.angle(np.exp(1j * (aimed - beta))))
+    worst = int(np.argmax(miss))
+    if miss[worst] > ROUNDING or _rank(robot, constraint_lines(robot).lines(aimed)) == 3:
+        return ICRSet("none")
+    headings = robot.heading_of_beta(aimed)
+    return ICRSet("none", consistent=tuple(zip(robot.steer_names, headings.tolist(), strict=True)),
+                  miss=(robot.steer_names[worst], float(miss[worst])))
 
 
 def icr_points(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None) -> np.ndarray:
