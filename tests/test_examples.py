@@ -4,11 +4,13 @@ tests/odometry/test_examples.py."""
 
 from __future__ import annotations
 
+import math
 import re
 import runpy
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -36,6 +38,17 @@ def test_slip_skid_steer(tmp_path, monkeypatch, capsys):
     for no_slip, track, wls, gap in rows.values():
         assert wls < no_slip / 2.5 and wls == pytest.approx(track, abs=1e-4) and gap < 1e-6
     assert len(list(tmp_path.glob("skid-*.png"))) == 3
+
+
+def test_track_forklift(tmp_path, monkeypatch, capsys):
+    scope, out = run_example("track_forklift.py", tmp_path, monkeypatch, capsys)
+    run, pi, dyn, a = scope["run"], scope["pi"], scope["dyn"], scope["GAIN"]
+    e0 = math.hypot(0.0, 0.5)
+    assert run.error[0] == pytest.approx(e0)  # recomputed here, not read from the example
+    assert np.max(np.abs(run.error - e0 * np.exp(-a * run.t))) < 2e-7  # docs/control.md: to 2e-7 m
+    assert np.max(np.abs(pi.error - np.abs(e0 * (1 - a * pi.t / 2) * np.exp(-a * pi.t / 2)))) < 2e-7
+    assert dyn.error[-1] < 5e-3 and np.max(dyn.error[dyn.t >= 10]) < 5e-3  # docs: about 1.3 mm of tyre slip
+    assert "P law:  error 0.50 m" in out and (tmp_path / "track-dynamics.png").exists()
 
 
 @pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.py")), ids=lambda p: p.name)
