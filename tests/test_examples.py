@@ -51,6 +51,25 @@ def test_track_forklift(tmp_path, monkeypatch, capsys):
     assert "P law:  error 0.50 m" in out and (tmp_path / "track-dynamics.png").exists()
 
 
+def test_park_car(tmp_path, monkeypatch, capsys):
+    pytest.importorskip("shapely")
+    scope, out = run_example("park_car.py", tmp_path, monkeypatch, capsys)
+    lines = out.splitlines()
+    assert re.findall(r"slot: (\d+) manoeuvres", out) == ["2", "4"]  # Tables 9.1 and 9.2
+    assert sum("parked corners inside the slot: True" in line for line in lines) == 2
+    asked = [float(x) for x in re.findall(r"asked: below (\S+) cm", out)]
+    gaps = [numbers(line.split("from the corners")[1])[0] for line in lines if "from the corners" in line]
+    assert asked == [7, 17] and len(gaps) == 2  # Tables 9.1 and 9.2
+    assert all(0 < gap < limit for gap, limit in zip(gaps, asked, strict=True))
+    assert gaps == [float(x) for x in re.findall(r"final gap to the curb (\S+) cm", out)]  # the planner's own
+    assert sum(line.endswith("collision-free True") for line in lines) == 2
+    driven, plan = scope["driven"], scope["plan"]  # thesis-9.1 with the P law
+    assert driven.deviation.max() < 0.02  # docs/parking.md: within 2 cm
+    assert np.hypot(*(driven.pose[-1, :2] - np.array(plan.final_pose[:2]))) < 0.01
+    assert "shortest slot that works: 2.642 m" in out  # docs/parking.md
+    assert len(list(tmp_path.glob("park-*.png"))) == 2
+
+
 @pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.py")), ids=lambda p: p.name)
 def test_every_example_has_a_docstring_that_says_how_to_run_it(path):
     text = path.read_text()
