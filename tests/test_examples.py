@@ -70,6 +70,24 @@ def test_park_car(tmp_path, monkeypatch, capsys):
     assert len(list(tmp_path.glob("park-*.png"))) == 2
 
 
+def test_follow_line(tmp_path, monkeypatch, capsys):
+    pytest.importorskip("cv2")
+    scope, out = run_example("follow_line.py", tmp_path, monkeypatch, capsys)
+    runs = [line for line in out.splitlines() if line.startswith("line-follower")]
+    assert len(runs) == 2
+    for line, overshoots in zip(runs, (False, True), strict=True):
+        assert "images lost 0" in line
+        final = float(line.split("->")[1].split(" cm")[0])
+        overshoot = float(line.split("overshoot ")[1].split(" cm")[0])
+        agree = float(line.split("give h within ")[1].split(" mm")[0])
+        # a one-period delay: real roots of z^2 - z + aT for aT <= 1/4 (a = 0.3), complex for a = 0.8
+        assert abs(final) < 0.5 and (overshoot > 1.0 if overshoots else overshoot == 0.0) and agree < 1.0
+    h, recursion = scope["h"], np.array(scope["recursion"])
+    assert np.max(np.abs(h - recursion)) < 5e-4  # the camera path against the exact delayed recursion
+    assert abs(h[0]) == pytest.approx(0.3) and abs(h[-1]) < 1e-3
+    assert (tmp_path / "follow-line-first-image.png").exists()
+
+
 @pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.py")), ids=lambda p: p.name)
 def test_every_example_has_a_docstring_that_says_how_to_run_it(path):
     text = path.read_text()
