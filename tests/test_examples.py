@@ -88,6 +88,20 @@ def test_follow_line(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "follow-line-first-image.png").exists()
 
 
+def test_design_sweep(tmp_path, monkeypatch, capsys):
+    scope, out = run_example("design_sweep.py", tmp_path, monkeypatch, capsys)
+    best = scope["result"].best[0]
+    assert best[scope["ALPHA"]] == pytest.approx(math.radians(60)) and best[scope["BACK_L"]] == pytest.approx(0.2)
+    assert best["kappa_mean"] == pytest.approx(1.0, abs=1e-6)  # the symmetric kiwi drive is isotropic
+    assert best["length"] == pytest.approx(math.sqrt(2) * 0.2, rel=1e-6)  # D = sqrt(2) L (docs/analysis.md)
+    rebuilt = [line for line in out.splitlines() if line.strip().startswith("rebuilt")]
+    assert len(rebuilt) == 4
+    for line in rebuilt:
+        assert abs(numbers(line.split("the sweep's:")[1])[0]) < 1e-6
+    assert numbers(rebuilt[-1].split("kappa")[1])[0] > 1.5  # the worst design of the grid
+    assert (tmp_path / "sweep-omni-3.png").exists()
+
+
 @pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.py")), ids=lambda p: p.name)
 def test_every_example_has_a_docstring_that_says_how_to_run_it(path):
     text = path.read_text()
