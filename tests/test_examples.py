@@ -107,3 +107,13 @@ def test_every_example_has_a_docstring_that_says_how_to_run_it(path):
     text = path.read_text()
     assert text.startswith('"""') and f"python examples/{path.name}" in text
     assert len(text.splitlines()) <= 90
+
+
+def test_the_readme_lists_every_example_with_a_command_that_runs_it():
+    """The README's Examples block: one `python examples/NAME.py [DIR]` per example (each is run by the tests above
+    or by tests/odometry/test_examples.py with such an argument)."""
+    readme = (EXAMPLES.parent / "README.md").read_text()
+    block = readme.split("## Examples", 1)[1].split("```", 2)[1]
+    commands = [re.sub(r"\s+#.*$", "", line).split() for line in block.splitlines() if line.strip()]
+    assert all(words[0] == "python" and len(words) <= 3 for words in commands)
+    assert sorted(words[1] for words in commands) == sorted(f"examples/{p.name}" for p in EXAMPLES.glob("*.py"))
