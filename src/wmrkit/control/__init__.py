@@ -10,6 +10,7 @@ from .feasibility import COLUMNS, Feasibility, Requirement, Violation, feasibili
 from .forklift import ForkliftIK, forklift_ik, forklift_real_loops, from_thesis_pose, with_steer_range
 from .laws import PositionLaw, SamplingWarning, check_sampling, law_velocity
 from .loop import Plant, law_controller, simulate
+from .plots import animate_run, plot_feasibility, plot_run
 from .points import ControlError, ControlPoint, control_point, point_pose, twist_for_velocity
 from .references import (
     BUILTIN,
@@ -63,6 +64,7 @@ __all__ = [
     "TrackingRun",
     "Violation",
     "ackermann_twist",
+    "animate_run",
     "builtin_reference",
     "check_sampling",
     "choose_steering",
@@ -79,6 +81,8 @@ __all__ = [
     "law_controller",
     "law_velocity",
     "load_reference",
+    "plot_feasibility",
+    "plot_run",
     "point_pose",
     "pure_pursuit",
     "reference_from_samples",
