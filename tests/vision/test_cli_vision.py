@@ -189,3 +189,14 @@ def test_follow_line_refuses_an_animation_it_cannot_write_before_the_run(tmp_pat
     code, out, err = run(["follow-line", "line-follower", "--camera", str(tmp_path / "cam.yaml"), "--animate",
                           str(tmp_path / "run.png")], capsys)
     assert code == 2 and out == "" and "run.png: the animation is written as .gif" in err
+
+
+def test_calibrate_refuses_to_write_the_camera_file_over_its_image(tmp_path, capsys):
+    # --out equal to IMAGE replaced the calibration image by the camera file's YAML, exit 0
+    image = tmp_path / "cal.png"
+    image.write_bytes((FIGURES / "calibration.png").read_bytes())
+    before = image.read_bytes()
+    code, out, err = run(["vision", "calibrate", str(image), "--rows", "60", "--half-separation", "3.5cm",
+                          "--row-distance", "10.22cm", "--out", str(tmp_path / "." / "cal.png")], capsys)
+    assert code == 2 and out == "" and "is the input IMAGE" in err and len(err.strip().splitlines()) == 1
+    assert image.read_bytes() == before
