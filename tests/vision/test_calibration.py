@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -103,3 +104,13 @@ def test_calibration_refuses_what_is_no_calibration():
     blank = np.full((240, 320), 70, np.uint8)
     with pytest.raises(CameraError, match="two stripes"):
         calibrate_image(blank, 60.0, 0.035, 0.2)
+
+
+@pytest.mark.parametrize("x1, x2, rows_a, x_w, y_w, height", [
+    (60, 59.9999999, 60, 0.035, 0.1022, "3.06e+07"),  # stripes that look parallel: focal 7.7e10 px, exit 0
+    (60, 30, 1e-300, 0.035, 1e-300, "2.333e-303"),  # printed 'focal = 0.00 px, height = 0.00000 m'
+    (60, 30, 60, 1e300, 1e301, "3.816e+300"),
+])
+def test_calibration_refuses_an_impossible_camera_height(x1, x2, rows_a, x_w, y_w, height):
+    with pytest.raises(CameraError, match=rf"camera height of {re.escape(height)} m, outside the lengths"):
+        calibrate(x1, x2, rows_a, x_w, y_w)

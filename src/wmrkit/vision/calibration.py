@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..limits import MAX_SIZE, MIN_SIZE
 from .camera import Camera, CameraError
 
 __all__ = ["Calibration", "calibrate", "calibrate_image", "calibration_kernel"]
@@ -67,7 +68,7 @@ def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_d
     """Calibrate from image measurements (x1, x2, A) [px] and ground ones (x_w, y_w) [m], (9.18)-(9.24).
 
     Raises :class:`CameraError` naming the measurement when they describe no camera (``x1 <= x2``, a tilt
-    whose cosine is not in (0, 1)).
+    whose cosine is not in (0, 1), a height outside ``[MIN_SIZE, MAX_SIZE]`` of :mod:`wmrkit.limits`).
     """
     for name, value in (("x1", x1), ("x2", x2), ("rows A", rows_a), ("half-separation", half_separation),
                         ("row distance", row_distance)):
@@ -81,6 +82,10 @@ def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_d
     if not math.isfinite(tilt):
         raise CameraError(f"calibration: the measurements give cos(tilt) = {c:.4g}, not in (0, 1): check the "
                           f"half-separation and row distance")
+    if not MIN_SIZE <= height <= MAX_SIZE:  # x1 close to x2 (stripes that look parallel), or lengths far off
+        raise CameraError(f"calibration: the measurements give a camera height of {height:.4g} m, outside the "
+                          f"lengths wmrkit handles ({MIN_SIZE:g} to {MAX_SIZE:g} m): check x1 and x2 (nearly equal "
+                          "when the stripes look parallel), rows A and the half-separation")
     return Calibration(tilt, focal, height, float(x1), float(x2), float(rows_a), float(half_separation),
                        float(row_distance))
 
