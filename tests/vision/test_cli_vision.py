@@ -200,3 +200,10 @@ def test_calibrate_refuses_to_write_the_camera_file_over_its_image(tmp_path, cap
                           "--row-distance", "10.22cm", "--out", str(tmp_path / "." / "cal.png")], capsys)
     assert code == 2 and out == "" and "is the input IMAGE" in err and len(err.strip().splitlines()) == 1
     assert image.read_bytes() == before
+
+
+def test_locate_refuses_a_negative_spacing_instead_of_ignoring_it(capsys):
+    # --spacing -3.5cm located from one line (n = 0), as without --spacing, exit 0
+    code, out, err = run(["vision", "locate", str(FIGURES / "three-lines.png"), "--camera",
+                          str(FIGURES / "thesis-camera.yaml"), "--spacing", "-3.5cm"], capsys)
+    assert code == 2 and out == "" and "spacing: expected a length in [0, 1000] m" in err

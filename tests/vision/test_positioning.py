@@ -154,3 +154,15 @@ def test_points_file_and_its_errors(tmp_path):
         locate_points(cam, [(0, [[0, 10], [1, 10]])])
     with pytest.raises(CameraError, match="must be -1, 0 or 1"):
         locate_points(cam, [(2, [[0, -10], [1, 10]])], spacing=0.1)
+
+
+@pytest.mark.parametrize(("spacing", "z_p", "message"), [
+    (-0.035, 0.0, "spacing: expected a length in [0, 1000] m (0: one line), got -0.035"),
+    (math.nan, 0.0, "spacing: expected a length in [0, 1000] m (0: one line), got nan"),
+    (1e300, 0.0, "spacing: expected a length in [0, 1000] m (0: one line), got 1e+300"),
+    (0.0, 1e300, "z_p: expected a length in [-1000, 1000] m, got 1e+300"),
+])
+def test_locate_points_refuses_a_spacing_or_z_p_out_of_range(spacing, z_p, message):
+    """A negative spacing was read as none (one line, silently); z_p = 1e300 printed h = 4e299 m."""
+    with pytest.raises(CameraError, match=f"^{re.escape(message)}$"):
+        locate_points(Camera(300, 1.0, 0.3), [(0, [[0, -10], [1, 10]])], spacing=spacing, z_p=z_p)

@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
 from ..errors import ShapeError
+from ..limits import MAX_SIZE
 from .camera import Camera, CameraError, read_located
 
 __all__ = ["SPACING_TOLERANCE", "LineFix", "Positioning", "check_spacing", "line_position", "locate_points",
@@ -93,12 +94,17 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
 
     Points are taken as measured on the camera's (possibly distorted) image and undistorted with ``camera.k1``
     (exactly, :func:`.camera.undistort`; points beyond the fold of a ``k1 < 0`` model are refused).
-    A line with ``n != 0`` needs `spacing` d > 0 [m]. The mean psi is taken on the circle.
+    A line with ``n != 0`` needs `spacing` d > 0 [m]; `spacing` and ``|z_p|`` are at most ``limits.MAX_SIZE``.
+    The mean psi is taken on the circle.
     """
     from .camera import undistort
 
     if not lines:
         raise CameraError("points: no lines given")
+    if not 0 <= spacing <= MAX_SIZE:  # NaN included; a negative spacing was read as none (one line), silently
+        raise CameraError(f"spacing: expected a length in [0, {MAX_SIZE:g}] m (0: one line), got {spacing:g}")
+    if not abs(z_p) <= MAX_SIZE:
+        raise CameraError(f"z_p: expected a length in [-{MAX_SIZE:g}, {MAX_SIZE:g}] m, got {z_p:g}")
     fixes = []
     for i, (n, pts) in enumerate(lines):
         pts = np.asarray(pts, dtype=float)
