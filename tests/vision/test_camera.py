@@ -192,6 +192,11 @@ def test_the_distortion_functions_refuse_their_inputs_by_name(call, message):
     ((math.inf, 0.5, 1.0), r"camera: focal_px: out of range, got inf"),
     ((-500.0, 0.5, 1.0), r"camera: focal_px: out of range, got -500.0"),
     ((500.0, 0.5, math.nan), r"camera: height: out of range, got nan"),
+    # a height of 1e308 m was accepted: locate printed a NaN spacing and a numpy warning
+    ((500.0, 0.5, 1e308), r"^camera: height: out of range, got 1e\+308 \(expected a length in \(0, 1000\] m\)$"),
+    # the range was not said, nor the value in degrees of a tilt given as '100 deg'
+    ((500.0, math.radians(100), 1.0), r"^camera: tilt: out of range, got 1.745\d* rad \(100 deg\) \(expected an "
+                                      r"angle in \(0, 90 deg\) from the vertical\)$"),
 ])
 def test_camera_fields_are_checked_by_name(args, message):
     """Camera(500., .5, 1., "640") raised a bare TypeError and width=640.5 was accepted."""

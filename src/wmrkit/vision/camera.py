@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors
 from ..documents import read_document, read_file
 from ..errors import DescriptionError, WmrkitError
+from ..limits import MAX_SIZE
 from ..units import UnitError, parse_quantity
 
 __all__ = ["Camera", "CameraError", "camera_coordinates", "check_lens_image", "distort", "extrinsics", "fold_radius",
@@ -55,7 +56,8 @@ class Camera:
     """A calibrated camera looking at the ground (§9.2.1.D-E). Frozen.
 
     - ``focal_px`` f [px] (9.1)-(9.2) with unit pixel size; ``tilt`` phi [rad], from the vertical (9.3);
-    - ``height`` v [m], of the lens above the ground (9.7); ``width``, ``rows``: image size [px];
+    - ``height`` v [m], of the lens above the ground (9.7), at most ``limits.MAX_SIZE``; ``width``, ``rows``:
+      image size [px];
     - ``k1``: radial distortion coefficient (0: an ideal pinhole).
     """
 
@@ -77,12 +79,17 @@ class Camera:
                 if isinstance(value, bool) or not isinstance(value, numbers.Real):
                     raise CameraError(f"camera: {name}: expected a number, got {value!r}")
                 object.__setattr__(self, name, float(value))
-        checks = {"focal_px": self.focal_px > 0, "tilt": 0 < self.tilt < math.pi / 2, "height": self.height > 0,
-                  "width": 8 <= self.width <= MAX_PIXELS, "rows": 8 <= self.rows <= MAX_PIXELS, "k1": abs(self.k1) < 1}
-        for name, ok in checks.items():
+        checks = {"focal_px": (self.focal_px > 0, "a finite number > 0 [px]"),
+                  "tilt": (0 < self.tilt < math.pi / 2, "an angle in (0, 90 deg) from the vertical"),
+                  "height": (0 < self.height <= MAX_SIZE, f"a length in (0, {MAX_SIZE:g}] m"),
+                  "width": (8 <= self.width <= MAX_PIXELS, f"[8, {MAX_PIXELS}] px"),
+                  "rows": (8 <= self.rows <= MAX_PIXELS, f"[8, {MAX_PIXELS}] px"),
+                  "k1": (abs(self.k1) < 1, "a finite number in (-1, 1)")}
+        for name, (ok, expected) in checks.items():
             value = getattr(self, name)
             if not ok or not math.isfinite(value):
-                raise CameraError(f"camera: {name}: out of range, got {value}")
+                shown = f"{value} rad ({math.degrees(value):.4g} deg)" if name == "tilt" else f"{value}"
+                raise CameraError(f"camera: {name}: out of range, got {shown} (expected {expected})")
         check_lens_image(self.k1, self.focal_px, self.width, self.rows, "camera")
 
     @property
