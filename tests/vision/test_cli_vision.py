@@ -207,3 +207,11 @@ def test_locate_refuses_a_negative_spacing_instead_of_ignoring_it(capsys):
     code, out, err = run(["vision", "locate", str(FIGURES / "three-lines.png"), "--camera",
                           str(FIGURES / "thesis-camera.yaml"), "--spacing", "-3.5cm"], capsys)
     assert code == 2 and out == "" and "spacing: expected a length in [0, 1000] m" in err
+
+
+@pytest.mark.parametrize("lines", ["2", "3"])
+def test_locate_lines_without_spacing_names_the_options(lines, capsys):
+    # the error named 'points: lines[0]', which an IMAGE does not have
+    code, out, err = run(["vision", "locate", str(FIGURES / "three-lines.png"), "--camera",
+                          str(FIGURES / "thesis-camera.yaml"), "--lines", lines], capsys)
+    assert code == 2 and out == "" and f"locate: --lines {lines} needs --spacing D > 0" in err

@@ -109,6 +109,8 @@ def run_locate(args: argparse.Namespace) -> int:
             raise WmrkitError(f"--lines must be 1, 2 or 3, got {args.lines}")
         if args.lines == 1 and spacing > 0:  # one line (n = 0) does not use it: it would be ignored
             raise WmrkitError("locate: --spacing applies to 2 or 3 lines, not to --lines 1")
+        if args.lines in (2, 3) and not spacing > 0:  # it failed after the extraction, naming 'points: lines[0]'
+            raise WmrkitError(f"locate: --lines {args.lines} needs --spacing D > 0, the distance between the lines")
         ns = layouts[args.lines] if args.lines else None
         image = read_image(args.image)
         if image.shape != (camera.rows, camera.width):
