@@ -215,3 +215,57 @@ def test_locate_lines_without_spacing_names_the_options(lines, capsys):
     code, out, err = run(["vision", "locate", str(FIGURES / "three-lines.png"), "--camera",
                           str(FIGURES / "thesis-camera.yaml"), "--lines", lines], capsys)
     assert code == 2 and out == "" and f"locate: --lines {lines} needs --spacing D > 0" in err
+
+
+def _png_header_only(path, width, rows):
+    """A PNG whose header says `width` x `rows` px (its data is a few bytes: a decompression bomb's header)."""
+    import struct
+    import zlib
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, rows, 8, 0, 0, 0, 0))
+                     + chunk(b"IDAT", zlib.compress(b"\0" * 100)) + chunk(b"IEND", b""))
+
+
+@pytest.mark.parametrize("command", [["locate", "--camera", str(FIGURES / "thesis-camera.yaml")],
+                                     ["calibrate", "--rows", "60", "--half-separation", "3.5cm",
+                                      "--row-distance", "10cm"]])
+def test_images_larger_than_wmrkit_handles_are_refused_in_one_line(tmp_path, capsys, command):
+    # a 40000 x 40000 px header made OpenCV raise past its decoding limit: a cv2.error traceback
+    _png_header_only(tmp_path / "huge.png", 40000, 40000)
+    # a 5000 x 5000 px image was read (and calibrated: 25 M pixels, the camera file then refused its width)
+    cv2.imwrite(str(tmp_path / "big.png"), np.zeros((5000, 20), np.uint8))
+    for name in ("huge.png", "big.png"):
+        code, out, err = run(["vision", command[0], str(tmp_path / name), *command[1:]], capsys)
+        assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+        assert f"{name}: larger than the 4096 px a side wmrkit handles" in err
+
+
+def test_a_large_image_is_refused_from_its_header_before_decoding(tmp_path):
+    """The CLI process sets OpenCV's decoding limits to 4096 px a side before importing it: a 12000 x 12000 px
+    PNG of 140 kB (144 MB decoded; a 30000 px one took 1.8 GB and 5 s) is refused without being decoded."""
+    import struct
+    import subprocess
+    import sys
+    import zlib
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+    side, packer = 12000, zlib.compressobj(1)
+    row = bytes(side + 1)
+    data = b"".join(packer.compress(row) for _ in range(side)) + packer.flush()
+    (tmp_path / "big.png").write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", side, side, 8, 0,
+                                                                                        0, 0, 0))
+                                       + chunk(b"IDAT", data) + chunk(b"IEND", b""))
+    script = ("import resource, sys\nfrom wmrkit.cli.vision import read_image\nfrom wmrkit.errors import WmrkitError\n"
+              "try:\n    read_image(sys.argv[1])\nexcept WmrkitError as err:\n    print(err)\n"
+              "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)")
+    env = {k: v for k, v in __import__("os").environ.items() if not k.startswith("OPENCV_IO_MAX_IMAGE")}
+    done = subprocess.run([sys.executable, "-c", script, str(tmp_path / "big.png")], capture_output=True, text=True,
+                          env=env, timeout=60)
+    assert "big.png: larger than the 4096 px a side" in done.stdout
+    peak_kb = done.stdout.splitlines()[-1]
+    assert int(peak_kb) < 200_000  # about 100 MB: Python, NumPy and OpenCV; decoding would add 144 MB

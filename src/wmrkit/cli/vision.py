@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -79,14 +80,28 @@ def _camera(path: str):
 
 
 def read_image(path: str) -> np.ndarray:
-    """A grey image from a file, or a WmrkitError naming it."""
+    """A grey image from a file, or a WmrkitError naming it. Images larger than the camera's ``MAX_PIXELS`` a
+    side are refused: from their header when this process has not imported OpenCV yet (its decoding limits are
+    read then), else once read."""
+    from ..vision.camera import MAX_PIXELS
+
+    for side in ("WIDTH", "HEIGHT"):  # a small file may decode to gigabytes (a PNG of 30000 x 30000 px: 1.8 GB)
+        os.environ.setdefault(f"OPENCV_IO_MAX_IMAGE_{side}", str(MAX_PIXELS))
     from ..vision.lines import cv2_module
 
     if not Path(path).is_file():
         raise WmrkitError(f"{path}: no such image file")
-    img = cv2_module().imread(path, 0)
+    too_large = f"{path}: larger than the {MAX_PIXELS} px a side wmrkit handles (docs/limits.md)"
+    cv2 = cv2_module()
+    try:
+        img = cv2.imread(path, 0)
+    except cv2.error as err:  # beyond OpenCV's decoding limits (it raised a traceback), or a broken file
+        raise WmrkitError(too_large if "CV_IO_MAX_IMAGE" in str(err) else f"{path}: not an image OpenCV can read "
+                          f"({str(err).strip().splitlines()[-1]})") from None
     if img is None:
         raise WmrkitError(f"{path}: not an image OpenCV can read")
+    if max(img.shape) > MAX_PIXELS:
+        raise WmrkitError(too_large)
     return img
 
 
