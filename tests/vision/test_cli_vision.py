@@ -243,6 +243,7 @@ def test_images_larger_than_wmrkit_handles_are_refused_in_one_line(tmp_path, cap
         assert f"{name}: larger than the 4096 px a side wmrkit handles" in err
 
 
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="reads the peak memory from /proc")
 def test_a_large_image_is_refused_from_its_header_before_decoding(tmp_path):
     """The CLI process sets OpenCV's decoding limits to 4096 px a side before importing it: a 12000 x 12000 px
     PNG of 140 kB (144 MB decoded; a 30000 px one took 1.8 GB and 5 s) is refused without being decoded."""
@@ -260,12 +261,21 @@ def test_a_large_image_is_refused_from_its_header_before_decoding(tmp_path):
     (tmp_path / "big.png").write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", side, side, 8, 0,
                                                                                         0, 0, 0))
                                        + chunk(b"IDAT", data) + chunk(b"IEND", b""))
-    script = ("import resource, sys\nfrom wmrkit.cli.vision import read_image\nfrom wmrkit.errors import WmrkitError\n"
-              "try:\n    read_image(sys.argv[1])\nexcept WmrkitError as err:\n    print(err)\n"
-              "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)")
+    script = ("import sys\nfrom wmrkit.cli.vision import read_image\nfrom wmrkit.errors import WmrkitError\n"
+              "try:\n    read_image(sys.argv[1])\nexcept WmrkitError as err:\n    print(err)\n"  # this process's peak:
+              "print(open('/proc/self/status').read().split('VmHWM:')[1].split()[0])")  # ru_maxrss has the parent's
     env = {k: v for k, v in __import__("os").environ.items() if not k.startswith("OPENCV_IO_MAX_IMAGE")}
     done = subprocess.run([sys.executable, "-c", script, str(tmp_path / "big.png")], capture_output=True, text=True,
                           env=env, timeout=60)
     assert "big.png: larger than the 4096 px a side" in done.stdout
     peak_kb = done.stdout.splitlines()[-1]
     assert int(peak_kb) < 200_000  # about 100 MB: Python, NumPy and OpenCV; decoding would add 144 MB
+
+
+def test_a_broken_image_file_gives_one_line(tmp_path, capfd):
+    # a PNG signature without its header printed OpenCV's own '[ERROR:0@...] ... readHeader' line before wmrkit's
+    (tmp_path / "broken.png").write_bytes(b"\x89PNG\r\n\x1a\n")
+    code = main(["vision", "locate", str(tmp_path / "broken.png"), "--camera", str(FIGURES / "thesis-camera.yaml")])
+    out, err = capfd.readouterr()
+    assert code == 2 and out == "" and err.strip().splitlines() == [
+        f"wmrkit: error: {tmp_path / 'broken.png'}: not an image OpenCV can read"]

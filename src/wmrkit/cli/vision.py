@@ -93,11 +93,15 @@ def read_image(path: str) -> np.ndarray:
         raise WmrkitError(f"{path}: no such image file")
     too_large = f"{path}: larger than the {MAX_PIXELS} px a side wmrkit handles (docs/limits.md)"
     cv2 = cv2_module()
+    level = cv2.utils.logging.getLogLevel()
+    cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)  # a broken file printed OpenCV's own line
     try:
         img = cv2.imread(path, 0)
     except cv2.error as err:  # beyond OpenCV's decoding limits (it raised a traceback), or a broken file
         raise WmrkitError(too_large if "CV_IO_MAX_IMAGE" in str(err) else f"{path}: not an image OpenCV can read "
                           f"({str(err).strip().splitlines()[-1]})") from None
+    finally:
+        cv2.utils.logging.setLogLevel(level)
     if img is None:
         raise WmrkitError(f"{path}: not an image OpenCV can read")
     if max(img.shape) > MAX_PIXELS:
