@@ -114,3 +114,13 @@ def test_calibration_refuses_what_is_no_calibration():
 def test_calibration_refuses_an_impossible_camera_height(x1, x2, rows_a, x_w, y_w, height):
     with pytest.raises(CameraError, match=rf"camera height of {re.escape(height)} m, outside the lengths"):
         calibrate(x1, x2, rows_a, x_w, y_w)
+
+
+@pytest.mark.parametrize("third", [-0.02, 0.01])
+def test_calibration_image_with_a_third_stripe_is_refused(third):
+    """The two strongest lines were taken: with a third stripe at -2 cm the camera came out 37.6 deg, 251 px,
+    12.96 cm (truth 45 deg, 325.7 px, 13.4 cm), exit 0; at +1 cm 'cos(tilt) = 1.98'."""
+    cam = Camera(325.7, math.radians(45), 0.134, 320, 240)
+    image = render(cam, [0, 0, 0], Scene(ns=(), extra=(-0.035, 0.035, third), width=0.008))
+    with pytest.raises(CameraError, match=r"^calibration: the image shows more than two stripes \(lines at x = "):
+        calibrate_image(image, 60.0, 0.035, 0.10221)

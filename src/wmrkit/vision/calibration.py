@@ -96,7 +96,8 @@ def calibrate_image(image: ArrayLike, rows_a: float, half_separation: float, row
     """Calibrate from an image of two parallel stripes in the calibration pose (9.12), §9.2.1.E.
 
     The two stripes are extracted (:func:`wmrkit.vision.lines.extract_lines`), their half-distances on rows
-    ``+-A`` [px] measured; `k1` with `focal_guess` undistorts the points when the distortion is known. The
+    ``+-A`` [px] measured (an image showing a third stripe is refused); `k1` with `focal_guess` undistorts the
+    points when the distortion is known. The
     stripes' vanishing point must lie on the image's vertical centre line (``psi = 0``) within
     `max_vanishing_px`, else :class:`CameraError` says to turn the camera.
     """
@@ -105,9 +106,13 @@ def calibrate_image(image: ArrayLike, rows_a: float, half_separation: float, row
     img = np.asarray(image)
     if not 0 < rows_a < img.shape[0] / 2:
         raise CameraError(f"calibration: rows A must be in (0, {img.shape[0] / 2:g}) px, got {rows_a:g}")
-    lines = extract_lines(img, n_lines=2, mode=mode, k1=k1, focal_px=focal_guess or float(max(img.shape[:2])))
+    lines = extract_lines(img, n_lines=3, mode=mode, k1=k1, focal_px=focal_guess or float(max(img.shape[:2])))
     if len(lines) < 2:
         raise CameraError("calibration: the image does not show two stripes")
+    if len(lines) > 2:  # the two strongest were taken, whichever pair they were: a wrong camera, or cos(tilt) > 1
+        raise CameraError(f"calibration: the image shows more than two stripes (lines at x = "
+                          f"{', '.join(f'{ln.x0:.0f}' for ln in lines)} px on the centre row): the calibration pose "
+                          "needs exactly two")
     left, right = sorted(lines, key=lambda ln: ln.x_at(0.0))
     near = (right.x_at(rows_a) - left.x_at(rows_a)) / 2
     far = (right.x_at(-rows_a) - left.x_at(-rows_a)) / 2
