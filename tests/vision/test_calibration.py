@@ -124,3 +124,12 @@ def test_calibration_image_with_a_third_stripe_is_refused(third):
     image = render(cam, [0, 0, 0], Scene(ns=(), extra=(-0.035, 0.035, third), width=0.008))
     with pytest.raises(CameraError, match=r"^calibration: the image shows more than two stripes \(lines at x = "):
         calibrate_image(image, 60.0, 0.035, 0.10221)
+
+
+def test_calibration_image_refuses_rows_too_close_to_measure_the_convergence():
+    """Rows +-0.01 px gave tilt 89.99 deg, focal 2.8e6 px, height 0.19 m, exit 0 (x1 - x2 = 0.004 px)."""
+    cam = Camera(325.7, math.radians(45), 0.134, 320, 240)
+    image = render(cam, [0, 0, 0], Scene(ns=(), extra=(-0.035, 0.035), width=0.008))
+    with pytest.raises(CameraError, match=r"differ by less than 1 px, too little to measure: .* \(A = 0.01 px\)$"):
+        calibrate_image(image, 0.01, 0.035, 0.10221)
+    assert calibrate_image(image, 5.0, 0.035, 0.00823).tilt == pytest.approx(math.radians(45), abs=1e-3)  # 1.8 px

@@ -23,6 +23,10 @@ from .camera import Camera, CameraError
 
 __all__ = ["Calibration", "calibrate", "calibrate_image", "calibration_kernel"]
 
+#: Least difference x1 - x2 [px] calibrate_image accepts: below a pixel, the convergence of the stripes between rows
+#: +-A is not measured (rows +-0.01 px of the docs' image gave a tilt of 89.99 deg and a focal length of 2.8e6 px).
+MIN_CONVERGENCE_PX = 1.0
+
 
 def calibration_kernel(x1: ArrayLike, x2: ArrayLike, rows_a: ArrayLike, half_separation: ArrayLike,
                        row_distance: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -121,4 +125,8 @@ def calibrate_image(image: ArrayLike, rows_a: float, half_separation: float, row
         where = "at infinity" if vanish is None else f"at x = {vanish[0]:.1f} px"
         raise CameraError(f"calibration: not the calibration pose (psi = 0): the stripes meet {where}, not on the "
                           f"image's centre line; turn the camera until they do (tolerance {max_vanishing_px:g} px)")
+    if near - far < MIN_CONVERGENCE_PX:  # rows +-A so close that the stripes' convergence is below a pixel
+        raise CameraError(f"calibration: the stripes' half-distances on rows +-A ({near:.4g} and {far:.4g} px) differ "
+                          f"by less than {MIN_CONVERGENCE_PX:g} px, too little to measure: take rows A farther from "
+                          f"the centre (A = {rows_a:g} px)")
     return calibrate(near, far, rows_a, half_separation, row_distance)
