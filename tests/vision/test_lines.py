@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import builtins
 import math
+import re
 
 import numpy as np
 import pytest
 
 from wmrkit.errors import WmrkitError
 from wmrkit.vision import lines as lines_module
-from wmrkit.vision.camera import Camera, extrinsics, project
+from wmrkit.vision.camera import Camera, CameraError, extrinsics, project
 from wmrkit.vision.follow import locate_image
 from wmrkit.vision.lines import extract_lines, interest_mask
 from wmrkit.vision.render import Scene, render
@@ -185,3 +186,14 @@ def test_weeds_and_crop_rows_are_not_speckle():
     scene = Scene(ns=(-2, -1, 0, 1, 2), spacing=0.6, width=0.25, style="crops")
     img = render(cam, (0.0, -0.05, 0.01), scene, noise=6.0, blur=1.0, clutter=100, seed=1)
     assert len(extract_lines(img, n_lines=5)) >= 3
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [
+    ({"ns": (-1, 0, 1), "spacing": math.nan}, "scene: spacing must be in [0, 1000] m, got nan"),
+    ({"ns": (-1, 0, 1), "spacing": -0.5}, "scene: spacing must be in [0, 1000] m, got -0.5"),
+    ({"ns": (), "extra": (0.1, math.inf)}, "scene: extra stripes must lie within 1000 m of the line, got (0.1, inf)"),
+])
+def test_scene_refuses_stripe_positions_that_are_not_lengths(kwargs, message):
+    """A NaN spacing rendered the image with a numpy 'invalid value' warning, the stripes nowhere."""
+    with pytest.raises(CameraError, match=f"^{re.escape(message)}$"):
+        Scene(**kwargs)

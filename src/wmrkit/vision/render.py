@@ -29,7 +29,8 @@ MAX_NOISE = 255.0
 
 @dataclass(frozen=True, slots=True)
 class Scene:
-    """Parallel lines on the ground at ``x_w = n * spacing`` (9.8), ``n`` in `ns`; `width` [m] of each.
+    """Parallel lines on the ground at ``x_w = n * spacing`` (9.8), ``n`` in `ns`; `width` [m] of each; `spacing`
+    in ``[0, limits.MAX_SIZE]`` m.
 
     ``style="paint"``: uniform painted stripes; ``"crops"``: rows of plants whose width and density vary along
     the row (chufa field, Fig. 9.10), on textured soil. `extra` lists further lateral positions x_w [m] of
@@ -47,6 +48,10 @@ class Scene:
             raise CameraError(f"scene: style must be 'paint' or 'crops', got {self.style!r}")
         if not 0 < self.width <= MAX_SIZE:
             raise CameraError(f"scene: width must be in (0, {MAX_SIZE:g}] m, got {self.width}")
+        if not 0 <= self.spacing <= MAX_SIZE:  # NaN included: it rendered garbage with a numpy warning
+            raise CameraError(f"scene: spacing must be in [0, {MAX_SIZE:g}] m, got {self.spacing}")
+        if not all(abs(x) <= MAX_SIZE for x in self.extra):
+            raise CameraError(f"scene: extra stripes must lie within {MAX_SIZE:g} m of the line, got {self.extra}")
 
     @property
     def offsets(self) -> np.ndarray:
