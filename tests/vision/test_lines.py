@@ -197,3 +197,13 @@ def test_scene_refuses_stripe_positions_that_are_not_lengths(kwargs, message):
     """A NaN spacing rendered the image with a numpy 'invalid value' warning, the stripes nowhere."""
     with pytest.raises(CameraError, match=f"^{re.escape(message)}$"):
         Scene(**kwargs)
+
+
+@pytest.mark.parametrize(("image", "message"), [
+    (np.full((60, 80), np.nan), "image: expected finite grey levels, got float64 values that are not finite"),
+    (np.full((60, 80), "a"), "image: expected finite grey levels, got <U1 values"),
+])
+def test_images_of_grey_levels_that_are_not_numbers_are_refused(image, message):
+    """NaN grey levels were cast to 0 with a numpy warning (no line found); text raised a numpy UFuncTypeError."""
+    with pytest.raises(CameraError, match=f"^{re.escape(message)}$"):
+        extract_lines(image)

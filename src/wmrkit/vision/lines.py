@@ -78,6 +78,9 @@ def interest_mask(image: ArrayLike, mode: str = "threshold", *, min_contrast: fl
     if img.ndim != 2 or img.size == 0:
         raise CameraError(f"image: expected a grey or BGR image, got shape {img.shape}")
     if img.dtype != np.uint8:
+        if not np.issubdtype(img.dtype, np.number) or not np.all(np.isfinite(img)):  # NaN became 0 with a warning
+            raise CameraError(f"image: expected finite grey levels, got {img.dtype} values"
+                              + ("" if not np.issubdtype(img.dtype, np.number) else " that are not finite"))
         img = np.clip(img, 0, 255).astype(np.uint8)
     lo, hi, _, _ = cv2.minMaxLoc(img)
     if hi - lo < min_contrast:  # a blank image has no pixels of interest
