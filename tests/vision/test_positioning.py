@@ -142,6 +142,9 @@ def test_points_file_and_its_errors(tmp_path):
         "field.json": ('{"lines": [{"n": 0, "pts": [[1, 2], [3, 4]]}]}', r"lines\[0\]: expected the fields"),
         "n.json": ('{"lines": [{"n": "x", "points": [[1, 2], [3, 4]]}]}', r"lines\[0\].n"),
         "pts.json": ('{"lines": [{"n": 0, "points": [[1, 2]]}]}', r"lines\[0\].points"),
+        # an unknown top-level field was ignored
+        "extra.json": ('{"lines": [{"n": 0, "points": [[1, -50], [3, 50]]}], "spacing": 0.6}',
+                       r"extra.json: unknown field 'spacing' \(the only field is 'lines'\)$"),
     }
     for name, (text, message) in cases.items():
         (tmp_path / name).write_text(text)

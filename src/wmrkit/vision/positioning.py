@@ -164,6 +164,8 @@ def read_points(path: str | Path) -> list[tuple[int, np.ndarray]]:
     data = read_located(path, "points file", "json")
     if not isinstance(data, dict) or not isinstance(data.get("lines"), list) or not data["lines"]:
         raise CameraError(f"{path}: expected {{\"lines\": [{{\"n\": ..., \"points\": [[xu, yu], [xu, yu]]}}]}}")
+    if set(data) != {"lines"}:  # a misspelt or extra field was ignored
+        raise CameraError(f"{path}: unknown field '{sorted(set(data) - {'lines'})[0]}' (the only field is 'lines')")
     out = []
     for i, line in enumerate(data["lines"]):
         if not isinstance(line, dict) or set(line) - {"n", "points"} or "points" not in line:
