@@ -5,6 +5,7 @@ from __future__ import annotations
 import builtins
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,6 +17,7 @@ from wmrkit.vision.follow import locate_image
 from wmrkit.vision.lines import extract_lines, interest_mask
 from wmrkit.vision.render import Scene, render
 
+FIGURES = Path(__file__).parents[2] / "docs" / "figures" / "vision"
 CAMERA = Camera(325.7, math.radians(45), 0.134, 640, 480)
 SCENE = Scene(ns=(-1, 0, 1), spacing=0.035, width=0.008)
 POSE = (0.0, -0.058, math.radians(10))
@@ -207,3 +209,29 @@ def test_images_of_grey_levels_that_are_not_numbers_are_refused(image, message):
     """NaN grey levels were cast to 0 with a numpy warning (no line found); text raised a numpy UFuncTypeError."""
     with pytest.raises(CameraError, match=f"^{re.escape(message)}$"):
         extract_lines(image)
+
+
+@pytest.mark.parametrize(("image", "camera", "spacing", "psi_deg", "h"), [
+    ("three-lines.png", Camera(325.7, math.radians(45), 0.134, 320, 240), 0.035, -35.43, -0.0583),
+    ("crop-rows.png", Camera(545.0, math.radians(76), 1.42, 640, 480), 0.60, -0.57, -0.05),
+])
+def test_gradient_mode_locates_the_docs_images(image, camera, spacing, psi_deg, h):
+    """--mode gradient said 'found 2 line(s), expected 3' on both: asked for two more lines than expected, spurious
+    peaks 2 px from a contour (or crossing the stripe) took its rows and its fit failed."""
+    import cv2
+
+    img = cv2.imread(str(FIGURES / image), 0)
+    fix = locate_image(camera, img, spacing=spacing, mode="gradient")
+    assert math.degrees(fix.psi) == pytest.approx(psi_deg, abs=0.05) and fix.h == pytest.approx(h, abs=0.002)
+
+
+def test_gradient_mode_pairs_the_two_contours_of_one_reference():
+    """Contours were paired in turn: asked for one line, the three-line image gave one at x0 = 77 px, between
+    two stripes (a contour of each), where there is none."""
+    import cv2
+
+    img = cv2.imread(str(FIGURES / "three-lines.png"), 0)
+    truth = [ln.x0 for ln in extract_lines(img, n_lines=3)]
+    for n in (1, 2, 3, 4, 5):
+        for line in extract_lines(img, n_lines=n, mode="gradient"):
+            assert min(abs(line.x0 - x) for x in truth) < 1.0

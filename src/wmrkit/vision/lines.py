@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import WmrkitError
-from .camera import CameraError, check_lens_image, undistort
+from .camera import CameraError, check_lens_image, distort, undistort
 
 __all__ = ["DetectedLine", "cv2_module", "extract_lines", "interest_mask"]
 
@@ -64,6 +64,21 @@ class DetectedLine:
         return self.x_at(y), y
 
 
+def _grey(image: ArrayLike) -> np.ndarray:
+    """A grey or BGR image as a 2-D uint8 grey image, or :class:`CameraError` naming what it is not."""
+    img = np.asarray(image)
+    if img.ndim == 3 and img.shape[2] == 3:
+        img = cv2_module().cvtColor(img, cv2_module().COLOR_BGR2GRAY)
+    if img.ndim != 2 or img.size == 0:
+        raise CameraError(f"image: expected a grey or BGR image, got shape {img.shape}")
+    if img.dtype != np.uint8:
+        if not np.issubdtype(img.dtype, np.number) or not np.all(np.isfinite(img)):  # NaN became 0 with a warning
+            raise CameraError(f"image: expected finite grey levels, got {img.dtype} values"
+                              + ("" if not np.issubdtype(img.dtype, np.number) else " that are not finite"))
+        img = np.clip(img, 0, 255).astype(np.uint8)
+    return img
+
+
 def interest_mask(image: ArrayLike, mode: str = "threshold", *, min_contrast: float = 20.0) -> np.ndarray:
     """Binary uint8 mask (255 = of interest) of a grey or BGR image, steps 1-2 of §9.2.1.C.
 
@@ -72,16 +87,7 @@ def interest_mask(image: ArrayLike, mode: str = "threshold", *, min_contrast: fl
     cv2 = cv2_module()
     if mode not in ("threshold", "gradient"):
         raise CameraError(f"mode must be 'threshold' or 'gradient', got {mode!r}")
-    img = np.asarray(image)
-    if img.ndim == 3 and img.shape[2] == 3:
-        img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
-    if img.ndim != 2 or img.size == 0:
-        raise CameraError(f"image: expected a grey or BGR image, got shape {img.shape}")
-    if img.dtype != np.uint8:
-        if not np.issubdtype(img.dtype, np.number) or not np.all(np.isfinite(img)):  # NaN became 0 with a warning
-            raise CameraError(f"image: expected finite grey levels, got {img.dtype} values"
-                              + ("" if not np.issubdtype(img.dtype, np.number) else " that are not finite"))
-        img = np.clip(img, 0, 255).astype(np.uint8)
+    img = _grey(image)
     lo, hi, _, _ = cv2.minMaxLoc(img)
     if hi - lo < min_contrast:  # a blank image has no pixels of interest
         return np.zeros(img.shape, np.uint8)
@@ -90,6 +96,25 @@ def interest_mask(image: ArrayLike, mode: str = "threshold", *, min_contrast: fl
         return mask
     median = float(np.median(img))
     return cv2.Canny(cv2.GaussianBlur(img, (5, 5), 1.0), max(10.0, 0.66 * median), max(30.0, 1.33 * median))
+
+
+def _bright_side(grey: np.ndarray, line: DetectedLine, k1: float, focal_px: float, offset: float = 2.0) -> float:
+    """Mean grey level `offset` px right of `line` minus left of it, over the image's lower half: > 0 on the left
+    contour of a bright reference, < 0 on its right one (``mode="gradient"``: Canny's edges have no sign)."""
+    rows, width = grey.shape
+    cx, cy = (width - 1) / 2, (rows - 1) / 2
+    ys = np.arange(0.0, cy, 2.0)
+    pts = np.stack([line.x_at(ys), ys], -1)  # undistorted, as fitted: back to the image's pixels
+    pts = distort(pts, k1, focal_px) + np.array([cx, cy])
+    ok = np.all(np.isfinite(pts), axis=1)
+    x, y = pts[ok, 0], pts[ok, 1]
+    ok[ok] = (x >= offset) & (x <= width - 1 - offset) & (y >= 0) & (y <= rows - 1)
+    if not ok.any():
+        return 0.0
+    r = np.rint(pts[ok, 1]).astype(np.intp)
+    right = grey[r, np.rint(pts[ok, 0] + offset).astype(np.intp)].astype(float)
+    left = grey[r, np.rint(pts[ok, 0] - offset).astype(np.intp)].astype(float)
+    return float(np.mean(right - left))
 
 
 def _run_around(row: np.ndarray, x: float, search: float) -> tuple[float, float] | None:
@@ -149,8 +174,17 @@ def _peaks(cells: np.ndarray, votes: np.ndarray, mask: np.ndarray, n_lines: int,
     return out
 
 
+#: Least grey-level step [grey levels] across a contour line (``mode="gradient"``, :func:`_bright_side`): real
+#: contours of the test scenes show 55-140; a fit drawn onto a reference's axis (fewer lines asked than in view) ~1.
+CONTOUR_CONTRAST = 10.0
+#: Contour lines (``mode="gradient"``) nearer than this [px] on the near rows are one line: the fit leaves out rows
+#: where two lines are nearer (``_fit_lines``' `min_gap`), so a second peak there, a contour's duplicate or a line
+#: crossing the stripe from one contour to the other, took the real contour's rows and its fit failed.
+GRADIENT_MIN_GAP_PX = 8.0
+
+
 def _fit_lines(runs: np.ndarray, lines: list[tuple[float, float]], max_band: float,
-               min_gap: float = 8.0, passes: int = 4) -> list[tuple[float, float, int] | None]:
+               min_gap: float = GRADIENT_MIN_GAP_PX, passes: int = 4) -> list[tuple[float, float, int] | None]:
     """Least-squares ``x = x0 + slope y`` of each line over its own pixels, `passes` passes.
 
     `runs` ``(M, 3)``: ``(x_left, x_right, y)`` [px] of the runs of mask pixels along the rows (pixel edges).
@@ -289,7 +323,7 @@ def extract_lines(image: ArrayLike, *, n_lines: int = 1, mode: str = "threshold"
     # transposed image: y_p cos(theta) + x_p sin(theta) = rho  ->  x = (rho - (y + cy) cos) / sin - cx
     rho, sin_t, cos_t = cells[:, 0] / scale, np.sin(cells[:, 1]), np.cos(cells[:, 1])
     lines_xs = np.stack([(rho - cy * cos_t) / sin_t - cx, -cos_t / sin_t], -1)
-    sep = float(min_separation_px if mode == "threshold" else 2)
+    sep = float(min_separation_px if mode == "threshold" else GRADIENT_MIN_GAP_PX)
     lines = _peaks(lines_xs, cells[:, 2], binary, n_lines * (1 if mode == "threshold" else 2), 0.7, sep)
     whole = (run_first > 0) & (run_first + run_len < width)  # runs cut by the image border are off-centre
     runs = np.stack([run_first[whole] - 0.5 - cx, run_first[whole] + run_len[whole] - 0.5 - cx,
@@ -305,6 +339,17 @@ def extract_lines(image: ArrayLike, *, n_lines: int = 1, mode: str = "threshold"
     result = sorted((DetectedLine(fit[0], fit[1], v, fit[2]) for fit, (_, _, v) in zip(fits, lines, strict=True)
                      if fit), key=lambda ln: ln.x0)
     if mode == "gradient":  # the two contour lines of each reference: their middle line (§9.2.1.C, step 1)
+        # a left contour (brighter on its right) then a right one: taken in turn, contours of two neighbouring
+        # references made a line between them where there is none
+        grey = _grey(image)
+        side = [_bright_side(grey, ln, k1, f) for ln in result]
+        pairs, i = [], 0
+        while i + 1 < len(result):
+            if side[i] > CONTOUR_CONTRAST and side[i + 1] < -CONTOUR_CONTRAST:
+                pairs.append((result[i], result[i + 1]))
+                i += 2
+            else:
+                i += 1
         result = [DetectedLine((a.x0 + b.x0) / 2, (a.slope + b.slope) / 2, min(a.votes, b.votes),
-                               a.n_pixels + b.n_pixels) for a, b in zip(result[::2], result[1::2], strict=False)]
+                               a.n_pixels + b.n_pixels) for a, b in pairs]
     return tuple(result)
