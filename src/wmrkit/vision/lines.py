@@ -328,6 +328,13 @@ def extract_lines(image: ArrayLike, *, n_lines: int = 1, mode: str = "threshold"
     whole = (run_first > 0) & (run_first + run_len < width)  # runs cut by the image border are off-centre
     runs = np.stack([run_first[whole] - 0.5 - cx, run_first[whole] + run_len[whole] - 0.5 - cx,
                      run_row[whole] - cy], -1).astype(float)
+    if mode == "gradient":  # strongest first, a contour peak is kept if every kept line still fits with it: a
+        # spurious peak near a contour (a diagonal across the stripe, a line sharing its far end) took its rows
+        kept: list[tuple[float, float, int]] = []
+        for peak in lines:
+            if all(_fit_lines(runs, [(x0, s) for x0, s, _ in (*kept, peak)], max_band_px, passes=2)):
+                kept.append(peak)
+        lines = kept
     if k1 != 0:  # fit on the undistorted runs: distortion bends the stripes, the ground lines are straight
         fits = _fit_lines(runs, [(x0, s) for x0, s, _ in lines], max_band_px)
         rough = [(fit[0], fit[1]) if fit else (x0, s) for fit, (x0, s, _) in zip(fits, lines, strict=True)]
