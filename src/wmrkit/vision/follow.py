@@ -49,12 +49,12 @@ def locate_image(camera: Camera, image: ArrayLike, *, spacing: float = 0.0, ns: 
 
     `ns`: the index n (9.8) of each line expected, left to right in the image; default ``(0,)`` without
     `spacing`, ``(-1, 0, 1)`` with it (crop rows); ``(-1, 1)`` is a road's two lines. Of the lines found (up to
-    two more than expected), the neighbouring ones centred on the image's near row are used. The points are
-    taken on rows ``+-rows_a`` [px] (default a quarter of the image height). Raises :class:`WmrkitError` when
-    fewer lines than expected are found.
+    four more than expected: the chufa camera sees five crop rows), the neighbouring ones centred on the image's
+    near row are used. The points are taken on rows ``+-rows_a`` [px] (default a quarter of the image height).
+    Raises :class:`WmrkitError` when fewer lines than expected are found.
     """
     ns = ns if ns is not None else ((-1, 0, 1) if spacing > 0 else (0,))
-    found = extract_lines(image, n_lines=len(ns) + 2, mode=mode, k1=camera.k1, focal_px=camera.focal_px)
+    found = extract_lines(image, n_lines=len(ns) + 4, mode=mode, k1=camera.k1, focal_px=camera.focal_px)
     if len(found) < len(ns):
         raise WmrkitError(f"image: found {len(found)} line(s), expected {len(ns)}")
     a = rows_a if rows_a is not None else camera.rows / 4
