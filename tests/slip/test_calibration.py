@@ -116,3 +116,16 @@ def test_a_run_without_turning_determines_no_slip_parameter(tmp_path, capsys):
     write_trajectory(ref, Trajectory(run.log.time, run.truth, np.zeros(len(run.log))), fmt="tum")
     assert main(["calibrate", "skid-steer-4", str(log), "--reference", str(ref)]) == 2
     assert "does not determine" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["omni-3", "diff-drive"])
+def test_a_turning_log_without_slip_determines_no_ratio(name):
+    """A turning run without slip: every weighting gives the same odometry. The finite-difference slope of the fit
+    (round-off, 1e-13 m over a step of 1e-6) passed the test on omni-3 and its start guess, ratio 1, was reported
+    as a calibration; diff-drive's refusal asked for a run that turns. Now both are refused, saying the log turns."""
+    from wmrkit.odometry.synthetic import TwistProfile, simulate
+
+    robot = catalog.load(name)
+    run = simulate(robot, TwistProfile.from_segments([(3.0, 0.5, 0.0, 0.3), (3.0, 0.5, 0.0, -0.3)]), 50.0)
+    with pytest.raises(WmrkitError, match=r"does not determine the WLS ratio.*the log turns: no slip in it"):
+        calibrate_slip(robot, run.log, (run.log.time, run.truth))

@@ -95,6 +95,9 @@ def effective_track_model(robot: Robot, multiplier: float):
 #: A slip parameter is determined by a log when changing it tenfold moves the odometry by more than this fraction of
 #: the run's extent (a straight run moves it by 0: the fit returned its start guess, 10^0.1 for the track).
 IDENTIFIED = 1e-6
+#: A reference that turns through more than this [rad] is a run that turns (for the message when a parameter is not
+#: determined).
+TURNING = 0.1
 
 
 def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, ArrayLike], *, method: Method = "exact",
@@ -124,16 +127,23 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
         err[:, 2] = heading_weight * wrap_angle(err[:, 2])
         return err.ravel()
 
-    fit_k = least_squares(lambda p: residuals(poses_of(wls_model(robot, SlipWeights.uniform(10.0 ** p[0], 1.0)))),
+    models = {"WLS ratio": lambda p: wls_model(robot, SlipWeights.uniform(10.0 ** p, 1.0)),
+              "effective track": lambda p: effective_track_model(robot, 10.0 ** p)}
+    fit_k = least_squares(lambda p: residuals(poses_of(models["WLS ratio"](p[0]))),
                           [0.0], bounds=([-6.0], [6.0]), x_scale=[1.0], diff_step=[1e-6])
-    fit_m = least_squares(lambda p: residuals(poses_of(effective_track_model(robot, 10.0 ** p[0]))),
+    fit_m = least_squares(lambda p: residuals(poses_of(models["effective track"](p[0]))),
                           [0.1], bounds=([-2.0], [2.0]), x_scale=[0.1], diff_step=[1e-6])
     scale = max(1.0, float(np.ptp(ref[:, :2], axis=0).max()))  # the run's extent [m]
+    turns = float(np.ptp(ref[:, 2])) > TURNING
     for fit, what in ((fit_k, "WLS ratio"), (fit_m, "effective track")):
-        if not np.max(np.abs(fit.jac)) > IDENTIFIED * scale:  # the start guess would be reported as a fit
+        at = residuals(poses_of(models[what](fit.x[0])))
+        moved = max(float(np.max(np.abs(residuals(poses_of(models[what](fit.x[0] + s))) - at))) for s in (-1, 1))
+        if not moved > IDENTIFIED * scale:  # the start guess would be reported as a fit
+            reason = (f"the log turns: no slip in it, or robot '{robot.name}' whose wheels make its odometry "
+                      f"independent of the {what}") if turns else "a run without turning?"
             raise WmrkitError(f"the log does not determine the {what}: the odometry moves less than "
-                              f"{IDENTIFIED * scale:.2g} m when it changes tenfold (a run without turning?); "
-                              "calibrate on a log that turns")
+                              f"{IDENTIFIED * scale:.2g} m when it changes tenfold ({reason}); "
+                              "calibrate on a log that turns" + (" and slips" if turns else ""))
         if np.any(fit.active_mask != 0):
             raise WmrkitError(f"the {what} ran to the bound of its search ({_BOUNDS[what]}): the log and the "
                               "reference disagree; check that they record the same run on the same clock")
