@@ -129,3 +129,28 @@ def test_a_turning_log_without_slip_determines_no_ratio(name):
     run = simulate(robot, TwistProfile.from_segments([(3.0, 0.5, 0.0, 0.3), (3.0, 0.5, 0.0, -0.3)]), 50.0)
     with pytest.raises(WmrkitError, match=r"does not determine the WLS ratio.*the log turns: no slip in it"):
         calibrate_slip(robot, run.log, (run.log.time, run.truth))
+
+
+@pytest.mark.parametrize("scale", [1000.0, 0.01])
+def test_a_reference_in_other_units_is_refused(tmp_path, capsys, husky_run, scale):
+    """A reference in millimetres (or hectometres) was fitted as well as it could be (a 12 m run: ratio 1.6, RMS
+    error 5 km) and the block to paste into the description printed. Now refused by distance travelled, naming the
+    file."""
+    log = husky_run.log
+    with pytest.raises(WmrkitError, match=r"^reference: the reference travels .*more than a factor 2 apart"):
+        calibrate_slip(catalog.load("skid-steer-4"), log, (log.time, husky_run.truth * [scale, scale, 1.0]))
+    log_path, ref_path = tmp_path / "log.csv", tmp_path / "ref.tum"
+    write_csv(log_path, ("time", *log.joints), np.column_stack([log.time, log.positions]))
+    write_trajectory(ref_path, Trajectory(log.time, husky_run.truth * [scale, scale, 1.0], np.zeros(len(log))), "tum")
+    assert main(["calibrate", "skid-steer-4", str(log_path), "--reference", str(ref_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"wmrkit: error: {ref_path}: the reference travels") and err.count("\n") == 1
+
+
+def test_the_distance_check_ignores_reference_noise(husky_run):
+    """Noise on the reference adds up sample by sample; by chords 1 s apart it does not: 10 cm of noise at 20 Hz
+    makes this 9.9 m run 37 m long sample by sample (refused), 9.95 m by chords."""
+    log, robot = husky_run.log, catalog.load("skid-steer-4")
+    noisy = husky_run.truth + np.random.default_rng(0).normal(0.0, [0.1, 0.1, 0.0], husky_run.truth.shape)
+    assert calibrate_slip(robot, log, (log.time, noisy)).ratio == pytest.approx(
+        calibrate_slip(robot, log, (log.time, husky_run.truth)).ratio, rel=0.2)

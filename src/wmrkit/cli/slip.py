@@ -195,7 +195,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
         raise
     except ValueError as err:
         raise WmrkitError(f"{args.reference}: not a TUM trajectory ({err})") from None
-    result = calibrate_slip(robot, log, ref, method=args.scheme)
+    result = calibrate_slip(robot, log, ref, method=args.scheme, source=args.reference)
     if args.json:
         print_json(result.to_dict())
     else:

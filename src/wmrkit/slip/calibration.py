@@ -98,16 +98,23 @@ IDENTIFIED = 1e-6
 #: A reference that turns through more than this [rad] is a run that turns (for the message when a parameter is not
 #: determined).
 TURNING = 0.1
+#: The reference and the log's no-slip odometry may travel distances at most this factor apart (and differ by at
+#: least ``MIN_DISAGREEMENT`` m before that is refused): beyond it they are not the same run, or not in the same
+#: units (a reference in millimetres travels 1000 times farther). Slip changes the distance travelled by far less.
+MAX_SCALE = 2.0
+MIN_DISAGREEMENT = 1.0
 
 
 def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, ArrayLike], *, method: Method = "exact",
-                   heading_weight: float = 1.0) -> SlipCalibration:
+                   heading_weight: float = 1.0, source: str = "reference") -> SlipCalibration:
     """Fit the WLS ratio and the effective track of `robot` to `reference` ``(times (M,), poses (M, 3))`` (TUM).
 
     The odometry is placed so that it passes through the reference's first pose at the reference's first time (a
     reference may start after the log), and interpolated linearly at the reference's times within the log's span.
     A fit that runs to a bound of its search (ratio 1e-6 or 1e6, multiplier 0.01 or 100) is refused: the log and
-    the reference then disagree (another run, another time base).
+    the reference then disagree (another run, another time base), and so is a reference that travels more than
+    ``MAX_SCALE`` times farther or less far than the no-slip odometry (another run, other units). `source` names the
+    reference in errors.
     """
     from scipy.optimize import least_squares
 
@@ -116,7 +123,7 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
     t = np.asarray(log.time, dtype=float)
     inside = (t_ref >= t[0] - 1e-9) & (t_ref <= t[-1] + 1e-9)
     if inside.sum() < 2:
-        raise WmrkitError("reference: fewer than two poses within the log's time span")
+        raise WmrkitError(f"{source}: fewer than two poses within the log's time span")
     t_ref, ref = t_ref[inside], ref[inside]
 
     def poses_of(model) -> np.ndarray:
@@ -127,6 +134,11 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
         err[:, 2] = heading_weight * wrap_angle(err[:, 2])
         return err.ravel()
 
+    travelled = _path_length(t_ref, ref[:, :2]), _path_length(t_ref, poses_of(wls_model(robot))[:, :2])
+    if abs(travelled[0] - travelled[1]) > max(MIN_DISAGREEMENT, (MAX_SCALE - 1) * min(travelled)):
+        raise WmrkitError(f"{source}: the reference travels {travelled[0]:.4g} m where the log's odometry travels "
+                          f"{travelled[1]:.4g} m (more than a factor {MAX_SCALE:g} apart): the log and the reference "
+                          "disagree; check that they record the same run, in metres and seconds")
     models = {"WLS ratio": lambda p: wls_model(robot, SlipWeights.uniform(10.0 ** p, 1.0)),
               "effective track": lambda p: effective_track_model(robot, 10.0 ** p)}
     fit_k = least_squares(lambda p: residuals(poses_of(models["WLS ratio"](p[0]))),
@@ -169,6 +181,13 @@ def _anchored(poses: np.ndarray, start: np.ndarray) -> np.ndarray:
     d = poses[:, :2] - poses[0, :2]
     return np.column_stack([start[0] + c * d[:, 0] - s * d[:, 1], start[1] + s * d[:, 0] + c * d[:, 1],
                             poses[:, 2] + turn])
+
+
+def _path_length(t: np.ndarray, xy: np.ndarray) -> float:
+    """Distance [m] travelled along `xy` ``(N, 2)`` at times `t`, by chords at least 1 s apart (so that the noise of a
+    motion-capture reference does not add up over a long run)."""
+    keep = np.unique(np.append(np.searchsorted(t, np.arange(t[0], t[-1], 1.0)), len(t) - 1))
+    return float(np.hypot(*np.diff(xy[keep], axis=0).T).sum())
 
 
 def _interp(t_new: np.ndarray, t: np.ndarray, poses: np.ndarray) -> np.ndarray:
