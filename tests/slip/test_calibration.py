@@ -154,3 +154,18 @@ def test_the_distance_check_ignores_reference_noise(husky_run):
     noisy = husky_run.truth + np.random.default_rng(0).normal(0.0, [0.1, 0.1, 0.0], husky_run.truth.shape)
     assert calibrate_slip(robot, log, (log.time, noisy)).ratio == pytest.approx(
         calibrate_slip(robot, log, (log.time, husky_run.truth)).ratio, rel=0.2)
+
+
+@pytest.mark.parametrize(("reference", "weight", "message"), [
+    (lambda t, p: (t, p[:-5]), 1.0, r"expected times \(M,\) and poses \(M, 3\)"),
+    (lambda t, p: (t, np.where(np.arange(len(t))[:, None] == 50, np.nan, p)), 1.0, "pose 51: .* finite"),
+    (lambda t, p: (t[::-1], p[::-1]), 1.0, "pose 2: time .* does not increase"),
+    (lambda t, p: (t, p), math.nan, "heading_weight"),
+    (lambda t, p: (t, p), -1.0, "heading_weight"),
+])
+def test_calibrate_slip_checks_its_arguments(husky_run, reference, weight, message):
+    """calibrate_slip from Python: a reference of another length raised IndexError, NaN poses or a NaN heading
+    weight scipy's ValueError; unsorted times were taken. Now each is a WmrkitError naming what is wrong."""
+    log = husky_run.log
+    with pytest.raises(WmrkitError, match=message):
+        calibrate_slip(catalog.load("skid-steer-4"), log, reference(log.time, husky_run.truth), heading_weight=weight)

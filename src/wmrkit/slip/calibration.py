@@ -118,8 +118,18 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
     """
     from scipy.optimize import least_squares
 
+    if not (math.isfinite(heading_weight) and heading_weight >= 0):
+        raise WmrkitError(f"heading_weight: expected a finite number >= 0 [m/rad], got {heading_weight!r}")
     t_ref, ref = (np.asarray(a, dtype=float) for a in reference)
-    ref = ref.reshape(-1, 3)
+    if t_ref.ndim != 1 or ref.shape != (len(t_ref), 3):
+        raise WmrkitError(f"{source}: expected times (M,) and poses (M, 3), got shapes {t_ref.shape} and {ref.shape}")
+    if not (np.isfinite(t_ref).all() and np.isfinite(ref).all()):
+        k = int(np.argmin(np.isfinite(np.column_stack([t_ref, ref])).all(axis=1)))
+        raise WmrkitError(f"{source}: pose {k + 1}: times and poses must be finite numbers")
+    if np.any(np.diff(t_ref) <= 0):
+        k = int(np.argmax(np.diff(t_ref) <= 0))
+        raise WmrkitError(f"{source}: pose {k + 2}: time {float(t_ref[k + 1])!r} s does not increase (after "
+                          f"{float(t_ref[k])!r} s)")
     t = np.asarray(log.time, dtype=float)
     inside = (t_ref >= t[0] - 1e-9) & (t_ref <= t[-1] + 1e-9)
     if inside.sum() < 2:
