@@ -132,3 +132,19 @@ def test_an_angular_acceleration_jump_breaks_the_dynamic_framework_of_steered_ro
     rate = np.diff(np.unwrap(heading)) / 0.01
     k = int(np.searchsorted(t, 5.0))
     assert np.abs(rate[k - 100:k - 1]).max() < 1e-9 and np.abs(rate[k + 1:k + 10]).min() > 0.05
+
+
+def test_a_reference_mostly_at_rest_has_no_jump_where_it_moves_smoothly():
+    """A smooth move of 1 m (speed 0 -> 1 -> 0 m/s over 2 s) in 22 s at rest: the median step of the whole reference
+    was 0, so every moving step above the 1 mm floor was a 'position jump' (0.987 m, 'no vehicle can follow it').
+    The typical step is now the median of the steps around each one; a real jump after a rest is still found."""
+    t = np.arange(0.0, 22.0, 0.01)
+    s = np.clip((t - 10) / 2, 0, 1)
+    x = s - np.sin(2 * np.pi * s) / (2 * np.pi)
+    smooth = reference_from_samples("move.csv", t, np.column_stack([x, 0 * t, 0 * t]))
+    for name in ("omni-3", "diff-drive", "ackermann"):
+        for framework in ("kinematic", "dynamic"):
+            assert feasibility(catalog.load(name), smooth, framework).feasible, (name, framework)
+    jump = reference_from_samples("jump.csv", t, np.column_stack([np.where(t >= 10, 1.0, 0.0), 0 * t, 0 * t]))
+    got = feasibility(catalog.load("omni-3"), jump).violations
+    assert [(v.signal, round(v.t, 2), round(v.size, 6)) for v in got] == [("position", 10.0, 1.0)]

@@ -8,7 +8,8 @@ rates jump; the *dynamic* one needs them continuous, so every condition goes one
 
 Signals of the reference, sampled: position, tangent angle ``chi`` (8.29) and its rate ``omega_g`` (8.31),
 curvature ``kappa`` (8.33) and its rate, heading ``theta``, velocity and acceleration. A sample-to-sample change
-larger than ``jump_factor`` times the typical one and than an absolute floor is a discontinuity.
+larger than ``jump_factor`` times the typical one where it is (the median of its block of 21 steps, or of a
+neighbouring block when larger) and than an absolute floor is a discontinuity.
 """
 
 from __future__ import annotations
@@ -157,6 +158,10 @@ _FLOOR = {"position": 1e-3, "theta": 0.02, "velocity": 0.02, "omega": 0.02, "acc
           "chi_rate": 0.02, "kappa": 0.02, "kappa_rate": 0.02}
 
 
+#: Steps in a block: a step's typical size is the median of its block or of a neighbouring one, whichever is larger.
+BLOCK = 21
+
+
 def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float) -> list[tuple[int, float]]:
     x = x.reshape(len(x), -1)
     d = np.diff(x, axis=0)
@@ -164,8 +169,12 @@ def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float) -> list[tupl
         d = wrap_angle(d)
     size = np.sqrt(np.nansum(d * d, axis=-1))
     size[np.any(np.isnan(d), axis=-1)] = 0.0
-    typical = np.median(size) if len(size) else 0.0
-    hit = np.flatnonzero(size > max(floor, factor * typical))
+    # the typical step where each one is: the median of its block of steps, or of a neighbouring block when larger
+    # (a global median is 0 for a reference mostly at rest, and its every moving step was a jump)
+    n = len(size)
+    blocks = np.median(np.pad(size, (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK), axis=1) if n else size
+    near = np.maximum(blocks, np.maximum(np.r_[blocks[:1], blocks[:-1]], np.r_[blocks[1:], blocks[-1:]]))
+    hit = np.flatnonzero(size > np.maximum(floor, factor * np.repeat(near, BLOCK)[:n]))
     events: list[list[int]] = []  # [first step, last step, step of the largest]
     for k in hit:  # a jump spread over consecutive samples (finite differences) is one event
         if events and k - events[-1][1] <= 2:
@@ -188,7 +197,8 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
                 point: tuple[float, float] | None = None, jump_factor: float = 20.0) -> Feasibility:
     """Check `reference` against the Table 8.1 cell of `robot` (§8.5): every discontinuity and its remedy.
 
-    A jump is a step of a signal larger than `jump_factor` (> 1) times its median step (and than a floor)."""
+    A jump is a step of a signal larger than `jump_factor` (> 1) times the typical step where it is (the median of
+    its block of ``BLOCK`` steps, or of a neighbouring block when larger) and than a floor."""
     if not 1 < jump_factor < math.inf:  # NaN included: at 0 or NaN every step above the floor was a jump
         raise ControlError(f"jump_factor: expected a finite number > 1 (times the median step), got {jump_factor}")
     req = requirement(robot, framework, point=point)
