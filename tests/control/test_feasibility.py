@@ -148,3 +148,12 @@ def test_a_reference_mostly_at_rest_has_no_jump_where_it_moves_smoothly():
     jump = reference_from_samples("jump.csv", t, np.column_stack([np.where(t >= 10, 1.0, 0.0), 0 * t, 0 * t]))
     got = feasibility(catalog.load("omni-3"), jump).violations
     assert [(v.signal, round(v.t, 2), round(v.size, 6)) for v in got] == [("position", 10.0, 1.0)]
+
+
+def test_a_spike_is_reported_with_its_size():
+    """A sampled position jump is a velocity spike, up and back down: the whole change across it is 0, and the
+    dynamic framework of a type 1 robot reported a 'velocity jump' of size 0.0. Its size is now the spike's."""
+    t = np.arange(0.0, 20.0, 0.01)
+    jump = reference_from_samples("jump.csv", t, np.column_stack([np.where(t >= 10, 1.0, 0.0), 0 * t, 0 * t]))
+    got = feasibility(catalog.load("omni-3"), jump, "dynamic").violations
+    assert [v.signal for v in got] == ["velocity"] and got[0].size == pytest.approx(50.0)  # 1 m over 2 x 0.01 s

@@ -184,12 +184,12 @@ def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float) -> list[tupl
         else:
             events.append([int(k), int(k), int(k)])
     out = []
-    for first, last, top in events:  # its size: the whole change across it (a sampled corner splits in halves)
-        total = x[last + 1] - x[first]
+    for first, last, top in events:  # its size: the whole change across it (a sampled corner splits in halves),
+        total = x[last + 1] - x[first]  # or its largest step when that is larger (a spike: up, then back down)
         if angle:
             total = wrap_angle(total)
         whole = float(np.sqrt(np.nansum(total * total)))
-        out.append((first, whole if np.all(np.isfinite(total)) else float(size[top])))
+        out.append((first, max(whole, float(size[top])) if np.all(np.isfinite(total)) else float(size[top])))
     return out
 
 
