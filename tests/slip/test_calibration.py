@@ -169,3 +169,14 @@ def test_calibrate_slip_checks_its_arguments(husky_run, reference, weight, messa
     log = husky_run.log
     with pytest.raises(WmrkitError, match=message):
         calibrate_slip(catalog.load("skid-steer-4"), log, reference(log.time, husky_run.truth), heading_weight=weight)
+
+
+def test_a_run_that_turns_more_than_half_a_turn_on_the_spot():
+    """Turning on the spot for 2.5 rad: the heading error was wrapped, so the fit had a minimum every turn and the
+    effective track stopped in a wrong one (multiplier 0.96, final heading 94 deg off, a position error of 1e-13 m
+    on a run without translation). Headings are compared unwrapped: m = 1 + k, both exact."""
+    robot = catalog.load("skid-steer-4")
+    run = wheel_speed_run(robot, [(5.0, [-5, 5, -5, 5])], 50.0)
+    cal = calibrate_slip(robot, run.log, (run.log.time, run.truth))
+    assert cal.ratio == pytest.approx(3.0, rel=1e-6) and cal.multiplier == pytest.approx(4.0, rel=1e-6)
+    assert all(h < 1e-9 for name, _, h in cal.final if name != "no_slip")

@@ -1,7 +1,7 @@
 """Calibration of slip models from a log with a reference trajectory (skid steering and other over-constrained robots).
 
 Two one-parameter models are fitted to the same run, by least squares of the position and heading errors at the
-reference's samples (heading in metres of arc at ``heading_weight`` m/rad):
+reference's samples (heading unwrapped, in metres of arc at ``heading_weight`` m/rad):
 
 - **WLS** (7.52): the ratio ``k = mu_lateral / mu_longitudinal`` of every wheel's friction coefficients (7.59);
   ``k = 1`` is today's unweighted least squares, ``k -> 0`` ignores the lateral rows.
@@ -134,14 +134,15 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
     inside = (t_ref >= t[0] - 1e-9) & (t_ref <= t[-1] + 1e-9)
     if inside.sum() < 2:
         raise WmrkitError(f"{source}: fewer than two poses within the log's time span")
-    t_ref, ref = t_ref[inside], ref[inside]
+    t_ref, ref = t_ref[inside], ref[inside].copy()
+    ref[:, 2] = np.unwrap(ref[:, 2])  # compared unwrapped: a wrapped error has a minimum every turn
 
     def poses_of(model) -> np.ndarray:
         return _anchored(_interp(t_ref, t, odometry(model, log, method=method).poses), ref[0])
 
     def residuals(poses: np.ndarray) -> np.ndarray:
         err = poses - ref
-        err[:, 2] = heading_weight * wrap_angle(err[:, 2])
+        err[:, 2] *= heading_weight
         return err.ravel()
 
     travelled = _path_length(t_ref, ref[:, :2]), _path_length(t_ref, poses_of(wls_model(robot))[:, :2])
