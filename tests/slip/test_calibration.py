@@ -180,3 +180,13 @@ def test_a_run_that_turns_more_than_half_a_turn_on_the_spot():
     cal = calibrate_slip(robot, run.log, (run.log.time, run.truth))
     assert cal.ratio == pytest.approx(3.0, rel=1e-6) and cal.multiplier == pytest.approx(4.0, rel=1e-6)
     assert all(h < 1e-9 for name, _, h in cal.final if name != "no_slip")
+
+
+def test_a_reference_on_another_clock_names_both_spans(husky_run):
+    """A reference stamped in epoch seconds against a log from 0: the refusal gives both time spans."""
+    log = husky_run.log
+    with pytest.raises(WmrkitError, match=r"time span \(0 to 10 s; the reference spans 1.7e\+09 to 1.70000001e\+09 s\)"
+                                          r": another clock"):
+        calibrate_slip(catalog.load("skid-steer-4"), log, (log.time + 1.7e9, husky_run.truth))
+    with pytest.raises(WmrkitError, match=r"time span \(0 to 10 s\)"):
+        calibrate_slip(catalog.load("skid-steer-4"), log, (np.zeros(0), np.zeros((0, 3))))

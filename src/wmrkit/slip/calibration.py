@@ -133,7 +133,9 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
     t = np.asarray(log.time, dtype=float)
     inside = (t_ref >= t[0] - 1e-9) & (t_ref <= t[-1] + 1e-9)
     if inside.sum() < 2:
-        raise WmrkitError(f"{source}: fewer than two poses within the log's time span")
+        spans = f"; the reference spans {t_ref[0]:.9g} to {t_ref[-1]:.9g} s" if len(t_ref) else ""
+        raise WmrkitError(f"{source}: fewer than two poses within the log's time span ({t[0]:.9g} to {t[-1]:.9g} s"
+                          f"{spans}): another clock or time unit?")
     t_ref, ref = t_ref[inside], ref[inside].copy()
     ref[:, 2] = np.unwrap(ref[:, 2])  # compared unwrapped: a wrapped error has a minimum every turn
 
