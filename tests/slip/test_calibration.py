@@ -15,6 +15,7 @@ from wmrkit.odometry.logs import write_csv
 from wmrkit.odometry.pipeline import odometry
 from wmrkit.odometry.trajectories import Trajectory, write_trajectory
 from wmrkit.slip.calibration import calibrate_slip, effective_track_model
+from wmrkit.slip.skid import skid_comparison
 from wmrkit.slip.synthetic import wheel_speed_run
 from wmrkit.slip.weights import SlipWeights, wls_model
 
@@ -190,3 +191,18 @@ def test_a_reference_on_another_clock_names_both_spans(husky_run):
         calibrate_slip(catalog.load("skid-steer-4"), log, (log.time + 1.7e9, husky_run.truth))
     with pytest.raises(WmrkitError, match=r"time span \(0 to 10 s\)"):
         calibrate_slip(catalog.load("skid-steer-4"), log, (np.zeros(0), np.zeros((0, 3))))
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    (lambda r: wheel_speed_run(r, SEGMENTS, math.nan), "rate nan Hz"),
+    (lambda r: wheel_speed_run(r, SEGMENTS, -5.0), "rate -5 Hz"),
+    (lambda r: wheel_speed_run(r, SEGMENTS, 1e9), "at most 10000000 sample periods"),
+    (lambda r: wheel_speed_run(r, [(math.inf, [1, 1, 1, 1])], 20.0), "finite durations"),
+    (lambda r: skid_comparison(r, source="qs"), "source must be 'md' or 'quasi-static'"),
+    (lambda r: skid_comparison(r, rate=0.0), "rate must be a finite number > 0"),
+])
+def test_simulated_runs_check_their_arguments(call, message):
+    """A NaN rate raised numpy's ValueError, a negative one IndexError, 1e9 Hz MemoryError (97 GiB), an unknown
+    source ran the dynamic model, rate 0 divided by zero: each is now a WmrkitError."""
+    with pytest.raises(WmrkitError, match=message):
+        call(catalog.load("skid-steer-4"))

@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike
 from ..errors import WmrkitError
 from ..odometry.integrators import integrate_increments
 from ..odometry.logs import JointLog
+from ..odometry.synthetic import MAX_SAMPLES
 from ..robot import Robot
 from .models import mcd, mqe, normal_loads, tyre_friction
 
@@ -46,8 +47,13 @@ def wheel_speed_run(robot: Robot, segments: Sequence[tuple[float, Sequence[float
     law = tyre_friction(robot)
     durations = np.array([float(d) for d, _ in segments])
     rates = np.array([list(r) for _, r in segments], dtype=float).reshape(len(segments), -1)
-    if rates.shape[1] != len(joints) or np.any(durations <= 0):
-        raise WmrkitError(f"segments: need durations > 0 and {len(joints)} rates each ({', '.join(joints)})")
+    if rates.shape[1] != len(joints) or not np.all((durations > 0) & np.isfinite(durations)) \
+            or not np.isfinite(rates).all():
+        raise WmrkitError(f"segments: need finite durations > 0 and {len(joints)} finite rates each "
+                          f"({', '.join(joints)})")
+    if not (1e-6 <= rate and durations.sum() * rate <= MAX_SAMPLES):  # NaN too: it failed in numpy, 1e9 Hz in memory
+        raise WmrkitError(f"rate {rate:g} Hz over the segments' {durations.sum():g} s: need a rate >= 1e-06 Hz and "
+                          f"at most {MAX_SAMPLES} sample periods")
     if model == "mqe":
         sol = mqe(robot, joints, rates, law, beta)
     else:
