@@ -12,6 +12,7 @@ from wmrkit import catalog
 from wmrkit.cli.main import main
 from wmrkit.errors import WmrkitError
 from wmrkit.odometry.logs import write_csv
+from wmrkit.odometry.model import wrap_angle
 from wmrkit.odometry.pipeline import odometry
 from wmrkit.odometry.trajectories import Trajectory, write_trajectory
 from wmrkit.slip.calibration import calibrate_slip, effective_track_model
@@ -157,6 +158,15 @@ def test_the_distance_check_ignores_reference_noise(husky_run):
         calibrate_slip(robot, log, (log.time, husky_run.truth)).ratio, rel=0.2)
 
 
+def test_a_sparse_reference_is_not_judged_by_distance():
+    """Reference poses many seconds apart (a run's start and end, as batch calibrate passes for a closed path) are
+    chords that say nothing of the distance travelled: 1.8 m against 0.33 m was refused. Now left alone."""
+    robot = catalog.load("skid-steer-4")
+    run = wheel_speed_run(robot, [(2.0, [10] * 4), (5.5, [6, 14, 6, 14]), (2.0, [10] * 4)], 20.0)
+    at = [0, len(run.log) - 1]
+    assert 0.6 < calibrate_slip(robot, run.log, (run.log.time[at], run.truth[at])).ratio < 0.95
+
+
 @pytest.mark.parametrize(("reference", "weight", "message"), [
     (lambda t, p: (t, p[:-5]), 1.0, r"expected times \(M,\) and poses \(M, 3\)"),
     (lambda t, p: (t, np.where(np.arange(len(t))[:, None] == 50, np.nan, p)), 1.0, "pose 51: .* finite"),
@@ -181,6 +191,14 @@ def test_a_run_that_turns_more_than_half_a_turn_on_the_spot():
     cal = calibrate_slip(robot, run.log, (run.log.time, run.truth))
     assert cal.ratio == pytest.approx(3.0, rel=1e-6) and cal.multiplier == pytest.approx(4.0, rel=1e-6)
     assert all(h < 1e-9 for name, _, h in cal.final if name != "no_slip")
+    # the error is unwrapped along the samples, not the reference: wrapped headings sampled more than half a turn
+    # apart (a run's start and end poses) still fit
+    run = wheel_speed_run(robot, [(5.5, [6, 14, 6, 14])], 20.0)
+    at = [0, len(run.log) - 1]
+    ref = run.truth[at].copy()
+    ref[:, 2] = wrap_angle(ref[:, 2])
+    cal = calibrate_slip(robot, run.log, (run.log.time[at], ref))
+    assert 0.6 < cal.ratio < 0.95 and cal.multiplier == pytest.approx(1 + cal.ratio, rel=1e-3)
 
 
 def test_a_reference_on_another_clock_names_both_spans(husky_run):
@@ -206,3 +224,4 @@ def test_simulated_runs_check_their_arguments(call, message):
     source ran the dynamic model, rate 0 divided by zero: each is now a WmrkitError."""
     with pytest.raises(WmrkitError, match=message):
         call(catalog.load("skid-steer-4"))
+

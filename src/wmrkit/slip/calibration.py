@@ -1,7 +1,7 @@
 """Calibration of slip models from a log with a reference trajectory (skid steering and other over-constrained robots).
 
 Two one-parameter models are fitted to the same run, by least squares of the position and heading errors at the
-reference's samples (heading unwrapped, in metres of arc at ``heading_weight`` m/rad):
+reference's samples (heading error unwrapped along them, in metres of arc at ``heading_weight`` m/rad):
 
 - **WLS** (7.52): the ratio ``k = mu_lateral / mu_longitudinal`` of every wheel's friction coefficients (7.59);
   ``k = 1`` is today's unweighted least squares, ``k -> 0`` ignores the lateral rows.
@@ -136,15 +136,14 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
         spans = f"; the reference spans {t_ref[0]:.9g} to {t_ref[-1]:.9g} s" if len(t_ref) else ""
         raise WmrkitError(f"{source}: fewer than two poses within the log's time span ({t[0]:.9g} to {t[-1]:.9g} s"
                           f"{spans}): another clock or time unit?")
-    t_ref, ref = t_ref[inside], ref[inside].copy()
-    ref[:, 2] = np.unwrap(ref[:, 2])  # compared unwrapped: a wrapped error has a minimum every turn
+    t_ref, ref = t_ref[inside], ref[inside]
 
     def poses_of(model) -> np.ndarray:
         return _anchored(_interp(t_ref, t, odometry(model, log, method=method).poses), ref[0])
 
     def residuals(poses: np.ndarray) -> np.ndarray:
         err = poses - ref
-        err[:, 2] *= heading_weight
+        err[:, 2] = heading_weight * np.unwrap(err[:, 2])  # 0 at the start; wrapped, it had a minimum every turn
         return err.ravel()
 
     travelled = _path_length(t_ref, ref[:, :2]), _path_length(t_ref, poses_of(wls_model(robot))[:, :2])
@@ -198,9 +197,11 @@ def _anchored(poses: np.ndarray, start: np.ndarray) -> np.ndarray:
 
 def _path_length(t: np.ndarray, xy: np.ndarray) -> float:
     """Distance [m] travelled along `xy` ``(N, 2)`` at times `t`, by chords at least 1 s apart (so that the noise of a
-    motion-capture reference does not add up over a long run)."""
+    motion-capture reference does not add up over a long run) and at most 2 s (a chord across a longer gap, such as
+    a closed path's start and end poses, says nothing of the distance travelled)."""
     keep = np.unique(np.append(np.searchsorted(t, np.arange(t[0], t[-1], 1.0)), len(t) - 1))
-    return float(np.hypot(*np.diff(xy[keep], axis=0).T).sum())
+    chords = np.hypot(*np.diff(xy[keep], axis=0).T)
+    return float(chords[np.diff(t[keep]) <= 2.0].sum())
 
 
 def _interp(t_new: np.ndarray, t: np.ndarray, poses: np.ndarray) -> np.ndarray:
