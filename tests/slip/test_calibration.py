@@ -225,3 +225,13 @@ def test_simulated_runs_check_their_arguments(call, message):
     with pytest.raises(WmrkitError, match=message):
         call(catalog.load("skid-steer-4"))
 
+
+
+def test_a_log_of_one_sample_is_refused_as_such(husky_run):
+    """A one-row log was refused as 'fewer than two poses within the log's time span (0 to 0 s): another clock?'."""
+    from wmrkit.odometry.logs import JointLog
+
+    log = husky_run.log
+    one = JointLog(log.time[:1], log.joints, log.positions[:1], source="one.csv")
+    with pytest.raises(WmrkitError, match=r"^one\.csv: 1 sample\(s\): a log to calibrate on needs a run"):
+        calibrate_slip(catalog.load("skid-steer-4"), one, (log.time, husky_run.truth))

@@ -131,6 +131,8 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
         raise WmrkitError(f"{source}: pose {k + 2}: time {float(t_ref[k + 1])!r} s does not increase (after "
                           f"{float(t_ref[k])!r} s)")
     t = np.asarray(log.time, dtype=float)
+    if len(t) < 2:  # "another clock?" misled
+        raise WmrkitError(f"{log.source}: {len(t)} sample(s): a log to calibrate on needs a run of two or more")
     inside = (t_ref >= t[0] - 1e-9) & (t_ref <= t[-1] + 1e-9)
     if inside.sum() < 2:
         spans = f"; the reference spans {t_ref[0]:.9g} to {t_ref[-1]:.9g} s" if len(t_ref) else ""
