@@ -50,6 +50,29 @@ def test_tyre_refusals_name_the_option(capsys, args, message):
     assert code == 2 and out == "" and err.strip().startswith(f"wmrkit: error: {message}")
 
 
+@pytest.mark.parametrize(("model", "speed", "warned"), [("pacejka", "18", False), ("pacejka", "30", True),
+                                                      ("dugoff", "30", False)])
+def test_pacejka_beyond_its_fitted_speeds_is_evaluated_with_a_warning(capsys, model, speed, warned):
+    """Appendix 7.A1 fits the coefficients to wheel speeds of 1-18 m/s (its peak reaches 0 at 381 m/s, and speeds
+    to 1e3 m/s are accepted): beyond 18 m/s the forces come with a warning, on stderr and in the JSON."""
+    code, out, err = run(capsys, "tyre", model, "--load", "3000", "--slip-ratio", "0.1", "--speed", speed, "--json")
+    assert code == 0 and bool(json.loads(out)["warnings"]) == warned
+    assert (err == "") != warned and ("fits its coefficients to wheel speeds up to 18 m/s" in err) == warned
+
+
+@pytest.mark.parametrize(("tyre", "warned"), [("pacejka", True), ("dugoff", False)])
+def test_simulate_warns_when_pacejka_tyres_run_beyond_their_fitted_speeds(capsys, tmp_path, tyre, warned):
+    torques = tmp_path / "zero.csv"
+    torques.write_text("time,front_left.spin,front_right.spin,rear_left.spin,rear_right.spin\n0,0,0,0,0\n"
+                       "0.1,0,0,0,0\n")
+    code, out, err = run(capsys, "simulate", "skid-steer-4", "--torques", str(torques), "--initial-twist", "20", "0",
+                         "0", "--duration", "0.02", "--tyre", tyre, "--json")
+    assert code == 0 and bool(json.loads(out)["warnings"]) == warned and ("pacejka tyre at 2" in err) == warned
+    code, out, err = run(capsys, "simulate", "skid-steer-4", "--torques", str(torques), "--initial-twist", "5", "0",
+                         "0", "--duration", "0.02", "--tyre", "pacejka", "--json")
+    assert code == 0 and json.loads(out)["warnings"] == [] and err == ""
+
+
 def test_tyre_text(capsys):
     code, out, _ = run(capsys, "tyre", "dugoff", "--load", "8000", "--slip-ratio", "0.01", "--param", "cs=80000")
     assert code == 0 and "Fx (longitudinal) = -808.081 N" in out and "Fy (lateral)      = 0 N" in out

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -57,7 +58,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 
 def run_tyre(args: argparse.Namespace) -> int:
     """Print the forces (and plot the curves)."""
-    from ..dynamics.tyres import MAX_LOAD, Tyre
+    from ..dynamics.tyres import MAX_LOAD, Tyre, beyond_fit
 
     check_plot_path(args.plot)
     params = {k: parse_value(v, "number", f"--param {k}") for k, v in parse_assignments(args.param, "--param").items()}
@@ -82,9 +83,13 @@ def run_tyre(args: argparse.Namespace) -> int:
                           f"forces ({fx:.6g} N, {fy:.6g} N) overflow (its forces do not scale with the load)")
     if args.plot:
         _plot_tyre(tyre, load, s, a, speed, args.plot)
+    warning = beyond_fit(tyre.model, speed)
+    if warning:
+        print(f"wmrkit: warning: {warning}", file=sys.stderr)
     if args.json:
         print_json({"model": tyre.model, "params": tyre.as_dict(), "load": load, "slip_ratio": s, "slip_angle": a,
-                    "speed": speed, "Fx": fx, "Fy": fy, "mu_long": mu_long, "mu_lat": mu_lat})
+                    "speed": speed, "Fx": fx, "Fy": fy, "mu_long": mu_long, "mu_lat": mu_lat,
+                    "warnings": [warning] if warning else []})
     else:
         print(f"{tyre.model} tyre, load {load:g} N, slip ratio {s:g}, slip angle {a:g} rad, wheel speed {speed:g} m/s")
         print(f"Fx (longitudinal) = {fx:.6g} N")
@@ -126,16 +131,30 @@ def run_simulate(args: argparse.Namespace) -> int:
         _plot_simulation(sim, model.robot.name, args.plot)
     pose, tw = sim.pose[-1], sim.twist[-1]
     travelled = float(np.sum(np.hypot(*np.diff(sim.pose[:, :2], axis=0).T)))
+    warnings = _tyre_warnings(model, sim.twist)
+    for warning in warnings:
+        print(f"wmrkit: warning: {warning}", file=sys.stderr)
     if args.json:
         print_json({"robot": model.robot.name, "method": sim.method, "step": step, "duration": duration,
                     "samples": len(sim.t), "final_pose": pose.tolist(), "final_twist": tw.tolist(),
-                    "distance": travelled, "max_slip": float(np.abs(sim.slip).max()), "out": args.out})
+                    "distance": travelled, "max_slip": float(np.abs(sim.slip).max()), "out": args.out,
+                    "warnings": warnings})
     else:
         print(f"{model.robot.name}: {duration:g} s simulated ({sim.method}, step {step:g} s), {len(sim.t)} samples")
         print(f"final pose: x = {pose[0]:.6g} m, y = {pose[1]:.6g} m, theta = {pose[2]:.6g} rad")
         print(f"final twist: vx = {tw[0]:.6g} m/s, vy = {tw[1]:.6g} m/s, omega = {tw[2]:.6g} rad/s")
         print(f"distance travelled: {travelled:.6g} m; largest slip speed {np.abs(sim.slip).max():.3g} m/s")
     return 0
+
+
+def _tyre_warnings(model, twist: np.ndarray) -> list[str]:
+    """Warnings for tyres used beyond their fitted speeds: the fastest speed of a wheel's mounting point over the
+    recorded twists (the tyres see their rolling components, at most that)."""
+    from ..dynamics.tyres import beyond_fit
+
+    x, y = np.array([w.position for w in model.robot.wheels]).T
+    fastest = float(np.max(np.hypot(twist[:, :1] - twist[:, 2:] * y, twist[:, 1:2] + twist[:, 2:] * x)))
+    return sorted({w for w in (beyond_fit(t.model, fastest) for t in model.tyres) if w})
 
 
 def _positive(x: float, what: str, *, zero: bool = False) -> float:

@@ -224,6 +224,18 @@ POSITIVE_PARAMS = ("mu", "mu_lat", "mu_long", "eps", "mu_scale")
 MAX_PARAM = 1e12
 #: Largest normal load on one tyre [N] (``wmrkit tyre --load``): a thousand tonnes.
 MAX_LOAD = 1e7
+#: Highest wheel speed [m/s] of the curves appendix 7.A1 fits (Figs. 7.25-7.26: 1-18 m/s longitudinal, 1-9 m/s
+#: lateral; a light-motorcycle tyre, Lu & Shih 2005). Beyond it the speed-dependent coefficients extrapolate, and
+#: lose their meaning: the longitudinal peak 0.8 - 0.0021 v reaches 0 at 381 m/s. Evaluated there with a warning.
+PACEJKA_FITTED_SPEED = 18.0
+
+
+def beyond_fit(model: str, speed: float) -> str | None:
+    """A warning when `model` ("pacejka") is used at a wheel `speed` [m/s] beyond :data:`PACEJKA_FITTED_SPEED`."""
+    if model != "pacejka" or not speed > PACEJKA_FITTED_SPEED:
+        return None
+    return (f"the pacejka tyre at {speed:.4g} m/s: appendix 7.A1 fits its coefficients to wheel speeds up to "
+            f"{PACEJKA_FITTED_SPEED:g} m/s; beyond, they extrapolate (the peak force reaches 0 at 381 m/s)")
 
 
 def param_problem(name: str, value: float) -> str:
