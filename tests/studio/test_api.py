@@ -429,6 +429,13 @@ def test_file_system_errors_are_4xx(tmp_path, client):
         assert 400 <= r.status_code < 500, (endpoint, r.json())
 
 
+def test_save_refuses_a_named_pipe(tmp_path, client):
+    """Saving over a named pipe waited for a reader for ever (and, on the event loop, held every request)."""
+    os.mkfifo(tmp_path / "pipe.yaml")
+    r = client.post("/api/save", json={"path": "pipe.yaml", "description": desc("diff-drive"), "overwrite": True})
+    assert r.status_code == 400 and "not a regular file" in r.json()["error"]
+
+
 def test_security_headers(client):
     for r in (client.get("/"), client.get("/static/app.js"), client.get("/api/meta"),
               client.post("/api/analyze", json={"description": 3})):

@@ -132,6 +132,8 @@ def save_robot(root: Path, request: Any) -> dict[str, Any]:
             raise StudioError(f"path: the folder of '{shown}' does not exist")
         if path.is_dir():
             raise StudioError(f"path: '{shown}' is a folder, not a file")
+        if path.exists() and not path.is_file():  # a named pipe: writing waited for a reader, holding the server
+            raise StudioError(f"path: '{shown}' is not a regular file")
         if path.exists() and not overwrite:
             raise FileExistsStudioError(f"path: '{shown}' exists; replace it (overwrite) or choose another name")
         robot.to_file(path)
