@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import socket
 import subprocess
 import sys
 import time
@@ -26,6 +27,20 @@ def test_unknown_robot_exits_2(capsys):
 def test_bad_port_exits_2(capsys):
     assert main(["studio", "diff-drive", "--port", "70000", "--no-browser"]) == 2
     assert "--port" in capsys.readouterr().err
+
+
+def test_port_in_use_and_bad_host_are_one_line(capsys):
+    """uvicorn logged 'ERROR: [Errno 98] ...' and exited with code 3 (and warned about a bad host as reachable)."""
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        assert main(["studio", "diff-drive", "--port", str(port), "--no-browser"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"127.0.0.1:{port}" in err and "--port 0" in err, err
+    assert main(["studio", "diff-drive", "--host", "no such host!", "--port", "0", "--no-browser"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--host" in err and "no such host!" in err, err
 
 
 def test_server_process_serves_the_file(tmp_path):

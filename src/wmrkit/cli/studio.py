@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import errno
 import ipaddress
+import socket
 import sys
 import threading
 import webbrowser
@@ -40,6 +42,12 @@ def run_studio(args: argparse.Namespace) -> int:
     robot = catalog.resolve(args.robot)
     if not 0 <= args.port <= 65535:
         raise WmrkitError(f"--port: from 0 to 65535, got {args.port}")
+    shown = f"[{args.host}]" if ":" in args.host else args.host
+    try:
+        sock = _listen(args.host, args.port)
+    except OSError as err:  # uvicorn logged its own 'ERROR:' line and exited with code 3
+        hint = " (try --port 0 for a free one)" if err.errno == errno.EADDRINUSE else ""
+        raise WmrkitError(f"--host/--port: cannot listen on {shown}:{args.port}: {err.strerror or err}{hint}") from None
     app = create_app(root, robot, robot_spec=spec, allowed_hosts=LOCAL_HOSTS if _loopback(args.host) else None)
     from ..studio import api
 
@@ -48,7 +56,6 @@ def run_studio(args: argparse.Namespace) -> int:
 
     config = uvicorn.Config(app, host=args.host, port=args.port, log_level="warning")
     server = uvicorn.Server(config)
-    shown = f"[{args.host}]" if ":" in args.host else args.host
     if not _loopback(args.host):
         print(f"wmrkit: warning: listening on {args.host}: other machines can reach the studio and its folder",
               file=sys.stderr)
@@ -66,14 +73,28 @@ def run_studio(args: argparse.Namespace) -> int:
 
     threading.Thread(target=announce, daemon=True).start()
     try:
-        server.run()
-    except OSError as err:
-        raise WmrkitError(f"cannot listen on {args.host}:{args.port}: {err.strerror or err}") from None
+        server.run(sockets=[sock])
     except KeyboardInterrupt:
         pass
     if not server.started:
-        raise WmrkitError(f"cannot listen on {args.host}:{args.port} (in use? try --port 0)")
+        raise WmrkitError(f"the server on {shown}:{args.port} did not start")
     return 0
+
+
+def _listen(host: str, port: int) -> socket.socket:
+    """A socket listening on `host`:`port`, bound here so that a port in use or an unknown host is one line.
+    A name with IPv4 and IPv6 addresses (``localhost``) listens on its first IPv4 one."""
+    found = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    family, _, _, _, address = min(found, key=lambda a: a[0] != socket.AF_INET)
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as uvicorn: restart at once on the same port
+        sock.bind(address)
+        sock.listen()
+    except OSError:
+        sock.close()
+        raise
+    return sock
 
 
 def _loopback(host: str) -> bool:
