@@ -258,7 +258,8 @@ def kappa_map(request: Any) -> dict[str, Any]:
 
 # ---- driving -----------------------------------------------------------------------------------------------
 def drive(request: Any) -> dict[str, Any]:
-    """Per-wheel commands for ``twist`` (vx [m/s], vy [m/s], omega [rad/s]) from the current ``heading`` mapping.
+    """Per-wheel commands for ``twist`` (vx [m/s], vy [m/s], omega [rad/s]) from the current ``heading`` mapping
+    (steering wheel -> heading, radians or a string with a unit, ``"30 deg"``).
 
     Per wheel: heading [rad] and spin [rad/s] (§8.4), the rolling speed ``r * spin`` [m/s] for the arrows, the
     lateral slip of fixed wheels; ``feasible`` and the residual ``|A q_dot|`` [m/s] of the no-slip equations
@@ -276,8 +277,11 @@ def drive(request: Any) -> dict[str, Any]:
         raise StudioError(f"heading: '{unknown[0]}' is not a steering wheel of '{robot.name}' "
                           f"(steering: {', '.join(robot.steer_names) or 'none'})")
     current = robot.heading.copy()
-    for name, value in steering.items():
-        current[robot.steer_names.index(name)] = _numbers([value], f"heading.{name}", 1)[0]
+    for name, value in steering.items():  # an angle: "30 deg" accepted, a bare number beyond a turn refused
+        try:
+            current[robot.steer_names.index(name)] = parse_quantity(value, "angle")
+        except UnitError as err:
+            raise StudioError(f"heading.{name}: {err}") from None
     beta = robot.beta_of_heading(current)
     c = wheel_commands(robot, twist, beta)
     now_heading = robot.heading_of_beta(c.beta)
