@@ -160,6 +160,16 @@ def test_malformed_requests(client):
     assert client.post("/api/meta", json={}).status_code == 405  # meta is read-only
 
 
+def test_key_given_twice_is_refused(client):
+    """The last of two keys was taken silently (description files refuse it: 'field 'r' given twice')."""
+    text = json.dumps({"description": desc("diff-drive")}).replace('"r": 0.075', '"r": 0.075, "r": 0.1', 1)
+    r = client.post("/api/analyze", content=text.encode(), headers={"content-type": "application/json"})
+    assert r.status_code == 400 and "'r' given twice" in r.json()["error"], r.json()
+    many = "{" + ", ".join(f'"k{i}": 0' for i in range(60000)) + ', "k0": 1}'  # found in linear time
+    r = client.post("/api/analyze", content=many.encode(), headers={"content-type": "application/json"})
+    assert r.status_code == 400 and "'k0' given twice" in r.json()["error"]
+
+
 def test_server_survives_after_bad_input(client):
     for _ in range(3):
         client.post("/api/drive", json={"description": desc("diff-drive"), "twist": ["a", None, {}]})

@@ -164,7 +164,8 @@ class _SecurityHeaders:
 
 
 async def _read_json(request) -> Any:
-    """The request's JSON body, refusing other content types, bodies over MAX_BODY and malformed JSON."""
+    """The request's JSON body, refusing other content types, bodies over MAX_BODY, malformed JSON and a key given
+    twice in one object."""
     kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
     if kind != "application/json":
         raise _HTTPError(415, "send JSON (Content-Type: application/json)")
@@ -178,13 +179,23 @@ async def _read_json(request) -> Any:
             raise _HTTPError(413, f"request too large (limit {MAX_BODY} bytes)")
         chunks.append(chunk)
     try:
-        return json.loads(b"".join(chunks).decode("utf-8"), parse_constant=_no_constant)
+        return json.loads(b"".join(chunks).decode("utf-8"), parse_constant=_no_constant, object_pairs_hook=_no_twice)
     except (ValueError, RecursionError) as err:
         raise _HTTPError(400, f"malformed JSON: {str(err).splitlines()[0][:200]}") from None
 
 
 def _no_constant(name: str) -> Any:
     raise ValueError(f"{name} is not a number JSON allows")
+
+
+def _no_twice(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object whose keys are all different (as description files: the last of two was taken silently)."""
+    out = dict(pairs)
+    if len(out) != len(pairs):
+        seen: set[str] = set()
+        twice = next(k for k, _ in pairs if k in seen or seen.add(k))
+        raise ValueError(f"field {twice[:80]!r} given twice")
+    return out
 
 
 def _field_name(loc: tuple) -> str:
