@@ -170,6 +170,26 @@ def test_key_given_twice_is_refused(client):
     assert r.status_code == 400 and "'k0' given twice" in r.json()["error"]
 
 
+@pytest.mark.parametrize("endpoint, body", [
+    ("/api/drive", {"twist": [1, 0, 0], "sample": 500}), ("/api/kappa", {"resoluton": 24}),
+    ("/api/analyze", {"heading": {}}), ("/api/configurations", {"wheels": ["caster"]}),
+    ("/api/save", {"path": "a.yaml", "overwrit": True}), ("/api/drive", {"twist": [1, 0, 0], "heading": 0}),
+    ("/api/drive", {"twist": [1, 0, 0], "heading": None}), ("/api/kappa", {"wheels": ""}),
+    ("/api/kappa", {"wheels": []}),
+])
+def test_unknown_or_mistyped_request_fields_are_refused(client, endpoint, body):
+    """A misspelt field was ignored (the default taken), and so was a heading or wheels of 0, '' or []."""
+    r = client.post(endpoint, json={"description": desc("diff-drive"), **body})
+    assert r.status_code == 400, r.json()
+    word = next(iter(k for k in body if k not in ("twist", "path")))
+    assert word in r.json()["error"], r.json()
+
+
+def test_open_takes_catalog_or_path(client):
+    r = client.post("/api/open", json={"catalog": "diff-drive", "path": "mine.yaml"})
+    assert r.status_code == 400 and "not both" in r.json()["error"]
+
+
 def test_server_survives_after_bad_input(client):
     for _ in range(3):
         client.post("/api/drive", json={"description": desc("diff-drive"), "twist": ["a", None, {}]})

@@ -131,6 +131,7 @@ def analyze_live(request: Any) -> dict[str, Any]:
     The same numbers as :func:`wmrkit.analysis.analyze` (its ``to_dict`` keys), minus the singular sets over
     the steering space (:func:`configurations`), plus ``singular_here`` and the drawing's ``geometry``.
     """
+    check_fields(request, "description")
     robot = robot_of(request)
     return {"robot": robot.name, "description": description_of(robot), "geometry": geometry(robot),
             "analysis": live_summary(robot)}
@@ -186,6 +187,7 @@ def configurations(request: Any) -> dict[str, Any]:
 
     Slower than :func:`analyze_live` for robots with several steering angles; the page asks after an edit settles.
     """
+    check_fields(request, "description")
     robot = robot_of(request)
     cls = classify(robot)
     out: dict[str, Any] = {"singular": {}}
@@ -230,11 +232,12 @@ def kappa_map(request: Any) -> dict[str, Any]:
     ``resolution`` (points per turn). κ at the natural length of the described configuration; null where the
     robot cannot move (uncoordinated steering) or the model is singular (κ infinite).
     """
+    check_fields(request, "description", "wheels", "resolution")
     robot = robot_of(request)
     steer = robot.steer_names
     if not steer:
         raise StudioError(f"robot '{robot.name}' does not steer: no κ map over steering angles")
-    names = request.get("wheels") or list(steer[:2])
+    names = request.get("wheels", list(steer[:2]))
     if (not isinstance(names, list) or not 1 <= len(names) <= 2 or any(n not in steer for n in names)
             or len(set(names)) != len(names)):  # a wheel twice: its second angle overwrote the first axis
         raise StudioError(f"wheels: one or two different steering wheels of {', '.join(steer)}")
@@ -265,11 +268,12 @@ def drive(request: Any) -> dict[str, Any]:
     lateral slip of fixed wheels; ``feasible`` and the residual ``|A q_dot|`` [m/s] of the no-slip equations
     (3.22); the ICR of the twist; and the poses of the robot holding the twist for ``duration`` s (exact SE(2)).
     """
+    check_fields(request, "description", "twist", "heading", "duration", "samples")
     robot = robot_of(request)
     twist = np.array(_numbers(request.get("twist"), "twist", 3))
     if np.abs(twist).max() > MAX_QUERY_RATE:
         raise StudioError(f"twist: beyond {MAX_QUERY_RATE:g} (m/s or rad/s), no wheeled robot moves so fast")
-    steering = request.get("heading") or {}
+    steering = request.get("heading", {})
     if not isinstance(steering, Mapping):
         raise StudioError("heading: a mapping {steering wheel: heading [rad]}")
     unknown = [n for n in steering if n not in robot.steer_names]
@@ -325,6 +329,15 @@ def _headings(robot: Robot, beta: Any) -> list[float]:
 def _finite(x: float) -> float | None:
     x = float(x)
     return x if math.isfinite(x) else None
+
+
+def check_fields(request: Any, *fields: str) -> None:
+    """Refuse a field of the request that the endpoint does not read (a typo, ``"sample"``, was ignored)."""
+    if not isinstance(request, Mapping):
+        raise StudioError("the request body must be a JSON object")
+    unknown = [k for k in request if k not in fields]
+    if unknown:
+        raise StudioError(f"unknown field {unknown[0][:80]!r} (this request takes {', '.join(fields)})")
 
 
 def _field(request: Any, key: str, kind: type) -> Any:

@@ -19,7 +19,7 @@ from .. import catalog
 from ..description import robot_from_text
 from ..documents import read_file
 from ..errors import WmrkitError
-from .api import StudioError, description_of, robot_of
+from .api import StudioError, check_fields, description_of, robot_of
 
 SUFFIXES = (".yaml", ".yml", ".json")
 #: At most this many files are listed, at most this deep below the root.
@@ -100,6 +100,9 @@ def open_robot(root: Path, request: Any) -> dict[str, Any]:
     """``{"path": ...}`` (a file in `root`) or ``{"catalog": name}`` -> its description (SI) and source text."""
     if not isinstance(request, Mapping):
         raise StudioError("the request body must be a JSON object")
+    check_fields(request, "catalog", "path")
+    if "catalog" in request and "path" in request:
+        raise StudioError("give either 'catalog' or 'path', not both")
     if "catalog" in request:
         name = request["catalog"]
         if not isinstance(name, str):
@@ -120,6 +123,7 @@ def open_robot(root: Path, request: Any) -> dict[str, Any]:
 def save_robot(root: Path, request: Any) -> dict[str, Any]:
     """``{"path", "description", "overwrite"?}``: validate, write with :meth:`Robot.to_file`, return the text
     written. An existing file is replaced only with ``"overwrite": true`` (else :class:`FileExistsStudioError`)."""
+    check_fields(request, "path", "description", "overwrite")
     robot = robot_of(request)
     path = safe_path(root, request.get("path"))
     overwrite = request.get("overwrite", False)
