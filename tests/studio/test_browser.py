@@ -384,6 +384,31 @@ def test_late_slow_answers_do_not_overwrite_newer_ones(page):
     assert not pg.errors
 
 
+def test_configurations_of_an_earlier_robot_are_not_shown(page):
+    """While a robot's configurations were searched (seconds for some m = 3 robots), the page showed the previous
+    robot's singular and isotropic configurations next to the new analysis (e.g. 'm = 1: no two motions')."""
+    pg = page
+    open_catalog(pg, "diff-drive")
+    pg.wait_for_function("() => S.configs && S.configsText === S.analysedText")
+    old = pg.inner_text("#a-singular")
+    pg.evaluate("""() => {
+        window.realFetch = window.realFetch || window.fetch;
+        window.fetch = async (url, init) => {
+            const r = await window.realFetch(url, init);
+            if (String(url).includes('/api/configurations')) await new Promise((ok) => setTimeout(ok, 3000));
+            return r;
+        };
+    }""")
+    try:
+        open_catalog(pg, "thesis-steer-castor")
+        assert pg.inner_text("#a-singular") == pg.inner_text("#a-isotropic") == "computing…", old
+        pg.wait_for_function("() => S.configsText === S.analysedText", timeout=60_000)
+        assert pg.inner_text("#a-singular") not in ("computing…", old)
+    finally:
+        pg.evaluate("window.fetch = window.realFetch")
+    assert not pg.errors
+
+
 def test_delete_after_undo_deletes_nothing(page):
     """After an undo S.selected named a wheel that no longer existed; Delete removed the last wheel."""
     pg = page

@@ -8,6 +8,7 @@ const LENGTHS = new Set(["d", "r", "r_r", "b"]);
 const ANGLES = new Set(["delta", "gamma"]);
 const S = {
   meta: null, desc: null, geometry: null, analysis: null, drive: null, kappa: null, configs: null,
+  analysedText: "", configsText: null,  // the descriptions (JSON) the analysis and the configurations are about
   selected: null, undo: [], redo: [], twist: [0, 0, 0], heading: {}, path: "",
   inflight: false, pending: false, driving: 0, driveSeq: 0, editTime: 0, seq: 0, anim: null, view: null,
 };
@@ -116,11 +117,11 @@ function refresh() {
 }
 async function send() {
   S.inflight = true; S.pending = false;
-  const t0 = S.editTime, seq = ++S.seq, desc = S.desc;
+  const t0 = S.editTime, seq = ++S.seq, desc = S.desc, text = JSON.stringify(desc);
   const r = await call("/api/analyze", { description: desc });
   S.inflight = false;
   if (r.ok) {
-    S.geometry = r.data.geometry; S.analysis = r.data.analysis; S.valid = desc;
+    S.geometry = r.data.geometry; S.analysis = r.data.analysis; S.valid = desc; S.analysedText = text;
     showError(null);
   } else {
     showError(r.data);
@@ -151,8 +152,10 @@ async function loadSlow(key, request, show) {
   show(r);
 }
 function loadConfigurations() {
-  return loadSlow("configs", () => call("/api/configurations", { description: S.desc }), (r) => {
-    S.configs = r.ok ? r.data : null;
+  let text;  // the description asked about
+  const request = () => { text = JSON.stringify(S.desc); return call("/api/configurations", { description: S.desc }); };
+  return loadSlow("configs", request, (r) => {
+    S.configs = r.ok ? r.data : null; S.configsText = text;
     renderAnalysis();
   });
 }
@@ -520,8 +523,12 @@ function renderAnalysis() {
   const here = Object.entries(a.singular_here).map(([k, s]) => `${k}: ` + (s.singular ? '<span class="bad">singular</span>'
     : s.near ? `<span class="warn">near (distance ${fmt(s.distance, 3)})</span>` : `no (distance ${fmt(s.distance, 3)})`));
   setCell("a-singular-here", here.join("<br>"), a.singular_here);
-  const c = S.configs;
-  if (c) {
+  // The configurations of an earlier robot are not shown next to this one's analysis (a search may take seconds).
+  const c = S.configsText === S.analysedText ? S.configs : undefined;
+  if (!c) {
+    const note = `<span class="hint">${c === undefined ? "computing…" : "not available"}</span>`;
+    setCell("a-singular", note, null); setCell("a-isotropic", note, null);
+  } else {
     setCell("a-singular", Object.entries(c.singular).map(([k, s]) => `${k}: ${esc(s.text.replace(/-?\d+\.\d+/g, (m) => m))}` +
       (s.headings.length ? `<br><span class="hint">headings ${s.headings.slice(0, 4).map((h) => "(" + h.map((v) => fmt(deg(v), 4)).join(", ") + ")").join(" ")} deg</span>` : "")).join("<br>"), c.singular);
     setCell("a-isotropic", !c.isotropic_searched ? `<span class="hint">${esc(c.isotropic_note || "not searched (see the κ map)")}</span>`
