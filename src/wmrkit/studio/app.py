@@ -122,8 +122,8 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
     routes = [
         Route("/", index),
         Route("/favicon.ico", lambda request: Response(status_code=204)),
-        Route("/api/meta", endpoint(meta, body=False)),
-        Route("/api/files", endpoint(lambda _: {"files": files.list_files(root)}, body=False)),
+        Route("/api/meta", endpoint(meta, body=False, thread=True)),
+        Route("/api/files", endpoint(lambda _: {"files": files.list_files(root)}, body=False, thread=True)),
         Route("/api/open", endpoint(lambda p: files.open_robot(root, p)), methods=["POST"]),
         Route("/api/save", endpoint(lambda p: files.save_robot(root, p)), methods=["POST"]),
         Route("/api/analyze", endpoint(api.analyze_live), methods=["POST"]),
