@@ -443,7 +443,7 @@ def test_save_does_not_replace_without_overwrite(tmp_path, client):
 @pytest.mark.parametrize(("path", "status", "words"), [
     (".hidden/r.yaml", 403, "hidden"), (".r.yaml", 403, "hidden"), ("sub/.git/r.yaml", 403, "hidden"),
     (" r.yaml", 400, "space"), ("r .yaml", 200, None), ("sub /r.yaml", 400, "space"), ("r\x01.yaml", 400, "control"),
-    ("r\n.yaml", 400, "control"), ("r\x85.yaml", 400, "control"),
+    ("r\n.yaml", 400, "control"), ("r\x85.yaml", 400, "control")
 ])
 def test_save_refuses_hidden_and_odd_names(tmp_path, client, path, status, words):
     (tmp_path / ".hidden").mkdir()
@@ -513,6 +513,14 @@ def test_symlink_out_of_root_refused(tmp_path):
     assert c.post("/api/save", json={"path": "link.yaml", "description": desc("omni-3")}).status_code == 403
     assert Robot.from_file(outside) == catalog.load("diff-drive")
     assert "link.yaml" not in c.get("/api/files").json()["files"]
+
+
+@pytest.mark.parametrize("endpoint", ["/api/open", "/api/save"])
+def test_path_with_a_lone_surrogate_is_refused(client, endpoint):
+    """JSON may hold "\\ud800", which no file name encodes: a 500 UnicodeEncodeError before."""
+    body = json.dumps({"path": "r\ud800.yaml", **({"description": desc("diff-drive")} if "save" in endpoint else {})})
+    r = client.post(endpoint, content=body.encode(), headers={"content-type": "application/json"})
+    assert r.status_code == 400 and "surrogate" in r.json()["error"], r.json()
 
 
 def test_open_missing_and_invalid_file(tmp_path, client):

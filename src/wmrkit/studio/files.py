@@ -1,11 +1,11 @@
 """Description files of the studio: list, open and save, only inside the directory the studio was started for.
 
 A path from the page is relative to that root; absolute paths, ``..`` that leaves it, symbolic links that point
-out of it, hidden files and folders (a part starting with ``.``), names with control characters or leading or
-trailing spaces, names over :data:`MAX_NAME` characters and other extensions than ``.yaml``/``.yml``/``.json``
-are refused. Saving writes exactly what :meth:`wmrkit.Robot.to_file` writes, so ``wmrkit show`` reads the same
-robot back; it replaces an existing file only when the request says ``"overwrite": true`` (else
-:class:`FileExistsStudioError`, answered 409, and the page asks the user).
+out of it, hidden files and folders (a part starting with ``.``), names with control characters, lone surrogates
+or leading or trailing spaces, names over :data:`MAX_NAME` characters and other extensions than
+``.yaml``/``.yml``/``.json`` are refused. Saving writes exactly what :meth:`wmrkit.Robot.to_file` writes, so
+``wmrkit show`` reads the same robot back; it replaces an existing file only when the request says
+``"overwrite": true`` (else :class:`FileExistsStudioError`, answered 409, and the page asks the user).
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ MAX_ENTRIES = 20_000
 #: Longest path the page may give, and longest part of it (file systems allow 255 bytes per name) [characters].
 MAX_PATH, MAX_NAME = 1000, 200
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
+_SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 class ForbiddenPathError(WmrkitError, PermissionError):
@@ -49,6 +50,8 @@ def safe_path(root: Path, relative: Any) -> Path:
     shown = _shown(relative)
     if _CONTROL.search(relative):
         raise StudioError(f"path: {shown!r} holds a control character")
+    if _SURROGATE.search(relative):  # JSON's "\ud800": no file name encodes it (a 500 UnicodeEncodeError before)
+        raise StudioError(f"path: {shown!r} holds a lone surrogate, not a character")
     if len(relative) > MAX_PATH:
         raise StudioError(f"path: {len(relative)} characters, at most {MAX_PATH}")
     candidate = Path(relative)
