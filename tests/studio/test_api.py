@@ -523,6 +523,19 @@ def test_path_with_a_lone_surrogate_is_refused(client, endpoint):
     assert r.status_code == 400 and "surrogate" in r.json()["error"], r.json()
 
 
+@pytest.mark.parametrize("edit", [
+    lambda b: b["description"]["wheels"][0].update(type="\ud800"), lambda b: b["description"]["wheels"][0].update(
+        actuated=["\ud800"]), lambda b: b.update(twist=[0, 0, 0], heading={"\ud800": 1}),
+])
+def test_a_lone_surrogate_quoted_in_a_message_is_answered(client, edit):
+    """Messages quoting a lone surrogate of the request failed to encode as UTF-8: a plain-text 500."""
+    body = {"description": desc("diff-drive")}
+    edit(body)
+    r = client.post("/api/drive" if "twist" in body else "/api/analyze", content=json.dumps(body).encode(),
+                    headers={"content-type": "application/json"})
+    assert 400 <= r.status_code < 500 and "\ud800" in r.json()["error"], r.text
+
+
 def test_open_missing_and_invalid_file(tmp_path, client):
     assert client.post("/api/open", json={"path": "none.yaml"}).status_code == 400
     (tmp_path / "bad.yaml").write_text("name: x\nwheels:\n  - {name: a, type: fixed, l: 1, alpha: 0, beta: 0, r: -1}\n")

@@ -72,7 +72,7 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
     from starlette.applications import Starlette
     from starlette.concurrency import run_in_threadpool
     from starlette.middleware import Middleware
-    from starlette.responses import FileResponse, JSONResponse, Response
+    from starlette.responses import FileResponse, Response
     from starlette.routing import Mount, Route
     from starlette.staticfiles import StaticFiles
 
@@ -81,7 +81,10 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
     static = static_dir()
 
     def respond(data: Any, status: int = 200) -> Response:
-        return JSONResponse(_finite(data), status_code=status)
+        # ASCII JSON: a lone surrogate of the request ("\ud800"), quoted by a message, stays an escape (JSONResponse
+        # wrote UTF-8, which cannot encode it: a plain-text 500 outside the handlers).
+        body = json.dumps(_finite(data), ensure_ascii=True, allow_nan=False, separators=(",", ":"))
+        return Response(body, status_code=status, media_type="application/json")
 
     def endpoint(fn: Callable[[Any], Any], *, body: bool = True, thread: bool = False):
         """`thread`: run in a worker thread, so that a slow answer does not hold up the live analysis."""
