@@ -228,6 +228,15 @@ def test_drive_flags_infeasible_twist(client):
     assert max(abs(w["slip"]) for w in data["wheels"].values()) == pytest.approx(0.3)
 
 
+def test_drive_says_why_a_twist_is_infeasible(client):
+    """An Ackermann turn beyond the rack was only 'infeasible' (the page: 'the wheels would slip', residual 5e-16)."""
+    turn = client.post("/api/drive", json={"description": desc("ackermann"), "twist": [1, 0, 0.5]}).json()
+    assert turn["feasible"] is False and turn["slips"] is False and turn["residual"] < 1e-12
+    assert turn["out_of_range"] == ["front_left", "front_right"]
+    side = client.post("/api/drive", json={"description": desc("diff-drive"), "twist": [0, 1, 0]}).json()
+    assert side["feasible"] is False and side["slips"] is True and side["out_of_range"] == []
+
+
 def test_drive_icr_and_trajectory(client):
     twist = [0.5, 0.1, 0.25]
     data = client.post("/api/drive", json={"description": desc("omni-3"), "twist": twist,

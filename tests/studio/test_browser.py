@@ -285,6 +285,7 @@ def test_drive_coordinated_robot(page):
         assert abs(math.remainder(float(cell.get_attribute("data-value")) - h, 2 * math.pi)) < 1e-9
         assert abs(h) > 0.05  # turned towards the ICR, to the left
     assert shown(pg, "d-feasible") is c.feasible.item() is False  # 66 and 44 deg: beyond the +-40 deg rack
+    assert pg.inner_text("#d-feasible") == "infeasible: front_left, front_right beyond the steering range"  # not 'slip'
     assert "ICR at (0.000, 2.000) m" in pg.inner_text("#d-icr")
     pg.evaluate("document.querySelector('aside').scrollTop = 0")
     screenshot(pg, "drive.png")

@@ -265,8 +265,9 @@ def drive(request: Any) -> dict[str, Any]:
     (steering wheel -> heading, radians or a string with a unit, ``"30 deg"``).
 
     Per wheel: heading [rad] and spin [rad/s] (§8.4), the rolling speed ``r * spin`` [m/s] for the arrows, the
-    lateral slip of fixed wheels; ``feasible`` and the residual ``|A q_dot|`` [m/s] of the no-slip equations
-    (3.22); the ICR of the twist; and the poses of the robot holding the twist for ``duration`` s (exact SE(2)).
+    lateral slip of fixed wheels; ``feasible``, why not (``slips``: the residual ``|A q_dot|`` [m/s] of the no-slip
+    equations (3.22) is not zero; ``out_of_range``: the wheels whose heading is beyond their ``steer_range``); the
+    ICR of the twist; and the poses of the robot holding the twist for ``duration`` s (exact SE(2)).
     """
     check_fields(request, "description", "twist", "heading", "duration", "samples")
     robot = robot_of(request)
@@ -297,6 +298,8 @@ def drive(request: Any) -> dict[str, Any]:
         wheels[w.name] = {"heading": h, "spin": _finite(spin), "speed": _finite(spin * w.r),
                           "steer_rate": _finite(float(c.steer_rate[i])), "slip": float(c.slip[i])}
     scale = max(1.0, float(np.abs(twist[:2]).sum() + abs(twist[2]) * robot_size(robot)))
+    slips = not residual <= 1e-9 * scale
+    out_of_range = [w.name for w, ok in zip(robot.wheels, c.in_range.tolist(), strict=True) if not ok]
     duration = float(_numbers([request.get("duration", 4.0)], "duration", 1)[0])
     samples = _integer(request.get("samples", 120), "samples", 2, 2000)
     if not 0 < duration <= 600:
@@ -305,7 +308,8 @@ def drive(request: Any) -> dict[str, Any]:
     poses = integrate_exact(np.zeros(3), twist, t)
     return {"twist": twist.tolist(), "wheels": wheels, "heading": dict(zip(robot.steer_names, now_heading.tolist(),
                                                                            strict=True)),
-            "feasible": bool(c.feasible) and residual <= 1e-9 * scale, "residual": residual,
+            "feasible": bool(c.feasible) and not slips, "slips": slips, "out_of_range": out_of_range,
+            "residual": residual,
             "icr": twist_icr(twist), "times": t.tolist(), "poses": poses.tolist()}
 
 

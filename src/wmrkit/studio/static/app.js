@@ -549,8 +549,11 @@ function setTwist(t, { fromSliders = false } = {}) {
 function renderDrive() {
   const d = S.drive, tab = $("commands");
   if (!d) { $("d-feasible").textContent = ""; tab.innerHTML = ""; return; }
+  const why = [];  // an Ackermann turn beyond the rack was 'the wheels would slip (residual 4.9e-16 m/s)'
+  if (d.out_of_range.length) why.push(`${d.out_of_range.join(", ")} beyond the steering range`);
+  if (d.slips || !why.length) why.push(`the wheels would slip (residual ${fmt(d.residual, 3)} m/s)`);
   $("d-feasible").innerHTML = d.feasible ? '<span class="good">feasible: no wheel slips</span>'
-    : `<span class="bad">infeasible: the wheels would slip (residual ${fmt(d.residual, 3)} m/s)</span>`;
+    : `<span class="bad">infeasible: ${esc(why.join("; "))}</span>`;
   $("d-feasible").dataset.value = JSON.stringify(d.feasible);
   $("d-icr").textContent = d.icr.text;
   tab.innerHTML = "<tr><th>wheel</th><th>heading [deg]</th><th>spin [rad/s]</th><th>slip [m/s]</th></tr>";
