@@ -18,7 +18,7 @@ from typing import Any
 import yaml
 
 from .errors import DescriptionError
-from .limits import _check_size
+from .limits import _check_size, regular_file_problem
 from .units import UnitError, parse_quantity
 
 __all__ = ["FieldReader", "LineOf", "Loc", "compose", "hint", "line_finder", "parse_document", "read_document",
@@ -45,6 +45,9 @@ def read_file(path: str | os.PathLike[str], what: str = "description") -> str:
     """The UTF-8 text of the document file `path` (a `what`), at most :data:`wmrkit.limits.MAX_FILE_SIZE` bytes;
     a :class:`DescriptionError` naming the file and the reason when it cannot be read."""
     path = Path(path)
+    problem = regular_file_problem(path, what)
+    if problem:
+        raise DescriptionError(problem, source=str(path))
     try:
         _check_size(path.stat().st_size, "bytes", str(path), what)
         return path.read_text(encoding="utf-8")

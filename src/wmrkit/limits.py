@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import stat
 from collections.abc import Collection
 from typing import TYPE_CHECKING, Any
 
@@ -69,12 +70,30 @@ def check_chunk_size(chunk_size: object, error: type[Exception], what: str = "ch
         raise error(f"{what} must be in [1, {MAX_CHUNK}] samples (it bounds the memory), got {chunk_size}")
 
 
+def regular_file_problem(path: str | os.PathLike[str], what: str) -> str | None:
+    """Why `path` is no file to read (a `what`): a folder, or not a regular file (a FIFO waits for a writer
+    forever, a device such as /dev/zero never ends); None when it is one or cannot be examined (left to its
+    reader)."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):  # ValueError: a NUL in the name
+        return None
+    if stat.S_ISREG(mode):
+        return None
+    kind = "a folder" if stat.S_ISDIR(mode) else "not a regular file (a FIFO, socket or device)"
+    return f"{kind}; a {what} is a file"
+
+
 def check_table_size(path: str | os.PathLike[str], error: type[Exception], what: str) -> None:
-    """Raise `error` naming `path` when the file (a `what`, read whole) is larger than :data:`MAX_TABLE_SIZE`;
-    a file that cannot be examined is left to its reader."""
+    """Raise `error` naming `path` when it is not a regular file (:func:`regular_file_problem`) or when the file (a
+    `what`, read whole) is larger than :data:`MAX_TABLE_SIZE`; a file that cannot be examined is left to its
+    reader."""
+    problem = regular_file_problem(path, what)
+    if problem:
+        raise error(f"{os.fspath(path)}: {problem}")
     try:
         size = os.stat(path).st_size
-    except OSError:
+    except (OSError, ValueError):
         return
     if size > MAX_TABLE_SIZE:
         raise error(f"{os.fspath(path)}: {size} bytes: a {what} is read whole and may hold at most "

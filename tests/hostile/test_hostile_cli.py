@@ -183,3 +183,32 @@ def test_an_alias_bomb_where_text_is_expected_is_refused_quickly(field, tmp_path
     assert result.returncode == 2 and result.stdout == "", result.stderr[-300:]
     (line,) = result.stderr.splitlines()
     assert line.startswith(f"wmrkit: error: {path}:") and len(line) < 400 and result.elapsed < 10, line
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="needs named pipes")
+def test_named_pipes_and_devices_given_as_input_files_are_refused_not_read(tmp_path):
+    """A FIFO given as a description, reference, torque file, parking problem, camera file, slip-weights file or
+    trajectory waited for a writer forever (the open blocks), and /dev/zero as a description never ended; each is one
+    line naming the file, exit 2. The commands run in one child process with a time limit."""
+    import os
+
+    pipe = tmp_path / "pipe.yaml"
+    os.mkfifo(pipe)
+    log = _ok_log(tmp_path)
+    commands = [["show", str(pipe)], ["show", "/dev/zero"], ["track", "diff-drive", "--reference", str(pipe)],
+                ["feasibility", "diff-drive", "--reference", str(pipe)],
+                ["simulate", "skid-steer-4", "--torques", str(pipe)], ["park", str(pipe)],
+                ["follow-line", "line-follower", "--camera", str(pipe)],
+                ["odometry", "diff-drive", log, "--method", "wls", "--slip-weights", str(pipe)],
+                ["calibrate", "diff-drive", log, "--reference", str(pipe)]]
+    script = ("import json, sys\nfrom wmrkit.cli.main import main\nfor argv in json.loads(sys.argv[1]):\n"
+              "    print(main(argv), flush=True)\n")
+    out = subprocess.run([sys.executable, "-c", script, json.dumps(commands)], capture_output=True, text=True,
+                         timeout=300)
+    assert out.stdout.split() == ["2"] * len(commands), out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == len(commands)
+    for line, argv in zip(lines, commands, strict=True):
+        named = "/dev/zero" if "/dev/zero" in argv else str(pipe)
+        assert line.startswith(f"wmrkit: error: {named}: not a regular file") or (
+            argv[0] == "calibrate" and line == f"wmrkit: error: {named}: not a file"), (argv, line)

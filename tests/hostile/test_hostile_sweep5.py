@@ -130,7 +130,8 @@ def test_reference_files_are_read_row_by_row(text, expected, tmp_path, capsys):
 
 def test_a_directory_as_reference_is_refused(tmp_path, capsys):
     for command in ("track", "feasibility"):  # IsADirectoryError traceback before
-        assert "cannot read the reference" in _refused([command, "diff-drive", "--reference", str(tmp_path)], capsys)
+        assert f"{tmp_path}: a folder; a reference is a file" in _refused([command, "diff-drive", "--reference",
+                                                                         str(tmp_path)], capsys)
 
 
 def _skid_log(tmp_path: Path, n: int = 50) -> str:

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import WmrkitError
+from ..limits import regular_file_problem
 
 if TYPE_CHECKING:
     from .logs import LogFormat
@@ -63,6 +64,8 @@ def read_header_units(path: str | Path, *, max_chars: int = 1 << 16, delimiter: 
                       roles: Mapping[str, str] | None = None) -> HeaderUnits:
     """The units of a CSV log's header line (bounded read; :func:`parse_header_units`); an unreadable file says
     nothing here."""
+    if regular_file_problem(path, "log"):  # a FIFO's open waits for a writer: its reader refuses it
+        return HeaderUnits(())
     try:
         with open(path, encoding="utf-8-sig", errors="replace", newline="") as f:
             line = f.readline(max_chars)

@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from ..errors import WmrkitError
-from ..limits import check_chunk_size
+from ..limits import check_chunk_size, regular_file_problem
 from ._text import check_lines, encoded, read_lines
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
 from .steering import CONVENTIONS, check_robot, check_steer_range, convert_steering
@@ -308,8 +308,9 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
     source = os.fspath(path)
     wheels = robot.wheel_names if robot is not None and not wheels else wheels
     decoder = Decoder(joints, fmt, source, robot)
-    if os.path.exists(source) and not os.path.isfile(source):  # a FIFO waited for a writer forever
-        raise LogError(f"{source}: not a regular file (a folder, FIFO, socket or device)")
+    problem = regular_file_problem(source, "log")  # a FIFO waited for a writer forever
+    if problem:
+        raise LogError(f"{source}: {problem}")
     try:  # utf-8-sig: a byte-order mark (spreadsheet exports) is not part of the first column's name
         f = open(source, encoding="utf-8-sig", errors="surrogateescape", newline="")  # bad bytes found per chunk
     except OSError as err:

@@ -160,6 +160,7 @@ def _check_finite(path: str | os.PathLike[str], values: np.ndarray, what: str) -
 
 def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
     """A trajectory CSV written by :class:`TrajectoryWriter` (covariance restored when present)."""
+    check_table_size(path, LogError, "trajectory")  # before opening: a FIFO's open waits for a writer
     try:
         with open(path, encoding="utf-8") as f:
             header = f.readline().strip().split(",")
