@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from wmrkit import catalog
 from wmrkit.control.feasibility import COLUMNS, feasibility, requirement, signals
 from wmrkit.control.points import ControlError
-from wmrkit.control.references import builtin_reference, reference_from_samples
+from wmrkit.control.references import builtin_reference, load_reference, reference_from_samples
 from wmrkit.control.track import track
 
 T1, T2_OFF, T2_ON = "type 1", "type 2, off axle", "type 2, on axle"
@@ -157,3 +159,97 @@ def test_a_spike_is_reported_with_its_size():
     jump = reference_from_samples("jump.csv", t, np.column_stack([np.where(t >= 10, 1.0, 0.0), 0 * t, 0 * t]))
     got = feasibility(catalog.load("omni-3"), jump, "dynamic").violations
     assert [v.signal for v in got] == ["velocity"] and got[0].size == pytest.approx(50.0)  # 1 m over 2 x 0.01 s
+
+
+def _from_rest(t, ramp=4.0, v=1.0):
+    """Arc length of a start from rest: speed v (1 - cos(pi t / ramp)) / 2 up to `ramp` [s], then v."""
+    return np.where(t < ramp, 0.5 * v * (t - ramp / np.pi * np.sin(np.pi * t / ramp)), 0.5 * v * ramp + v * (t - ramp))
+
+
+def _line_arc(s, line=5.0, radius=3.0):
+    th = np.clip(s - line, 0, None) / radius
+    return np.column_stack([np.where(s < line, s, line + radius * np.sin(th)),
+                            np.where(s < line, 0, radius * (1 - np.cos(th))), th])
+
+
+def test_a_sampled_circle_starting_from_rest_has_no_jump(tmp_path):
+    """A 3 m circle whose speed ramps up smoothly from rest, as a CSV file: the finite-difference curvature near
+    rest (0 to 1.6 1/m for 1/3) and the backward tangent of the first sample were reported as a curvature jump,
+    a curvature-rate jump and a tangent-angle jump of pi (audit of ch. 8). Curvature is judged where it is defined."""
+    t = np.arange(0.0, 20.0, 0.01)
+    th = _from_rest(t) / 3.0
+    path = tmp_path / "circle.csv"
+    rows = "".join(f"{a:.6f},{x:.9f},{y:.9f},{c:.9f}\n" for a, x, y, c in
+                   zip(t, 3 * np.sin(th), 3 * (1 - np.cos(th)), th, strict=True))
+    path.write_text("t,x,y,theta\n" + rows)
+    ref = load_reference(path)
+    for name in ("ackermann", "forklift", "diff-drive"):
+        for framework in ("kinematic", "dynamic"):
+            assert feasibility(catalog.load(name), ref, framework).feasible, (name, framework)
+    kappa = signals(ref)["kappa"]
+    assert np.nanmax(np.abs(kappa - 1 / 3)) < 0.01 and np.isfinite(kappa[100:]).all()  # 1e-9 m file precision
+
+
+def test_real_jumps_after_a_start_from_rest_are_found_where_they_are():
+    """Starting from rest (as above), a line into an arc of 3 m (at s = 5 m, t = 7 s), a corner, a teleport: each
+    is found at its time with its size, and nothing at the start."""
+    t = np.arange(0.0, 15.0, 0.01)
+    s = _from_rest(t)
+    car, forklift = catalog.load("ackermann"), catalog.load("forklift")
+    arc = reference_from_samples("line-arc.csv", t, _line_arc(s))
+    got = [(v.signal, v.t, v.size) for v in feasibility(car, arc).violations]
+    assert [g[0] for g in got] == ["kappa"] and got[0][1] == pytest.approx(7.0, abs=0.02)
+    assert got[0][2] == pytest.approx(1 / 3, rel=0.02)
+    got = feasibility(car, arc, "dynamic").violations
+    assert [v.signal for v in got] == ["kappa_rate", "kappa"] and all(abs(v.t - 7.0) < 0.03 for v in got)
+    got = feasibility(forklift, arc, "dynamic").violations
+    assert [v.signal for v in got] == ["chi_rate"] and got[0].size == pytest.approx(1 / 3, rel=0.02)
+    corner = reference_from_samples("corner.csv", t, np.column_stack(
+        [np.minimum(s, 5.0), np.clip(s - 5.0, 0, None), np.where(s < 5, 0, np.pi / 2)]))
+    for robot in (car, forklift):
+        got = feasibility(robot, corner).violations
+        assert [(v.signal, round(v.t, 2), round(v.size, 6)) for v in got] == [("chi", 7.0, round(np.pi / 2, 6))]
+    pose = _line_arc(s)
+    pose[:, 0] += np.where(t >= 8, 0.5, 0.0)
+    got = feasibility(car, reference_from_samples("teleport.csv", t, pose)).violations
+    found = [(v.signal, round(v.t, 2)) for v in got]
+    assert found[0] == ("kappa", 6.99) and ("position", 8.0) in found
+    # and the tangent on either side of the jump (finite differences across it), as before
+    assert all(s == "chi" and abs(t - 8.0) < 0.05 for s, t in found[1:] if s != "position")
+
+
+def test_a_stop_and_turn_in_place_is_a_tangent_jump_for_a_car_only():
+    """Along +x to rest at 6 s, a quarter turn in place, then along +y from 8 s. A car cannot turn at rest: its
+    tangent jumps by pi/2 across the stop (it was not found: the tangent is undefined at rest). A vehicle that can
+    re-orient at rest (Table 8.1's remedy: a diff drive, a forklift's steered wheel) follows it."""
+    t = np.arange(0.0, 15.0, 0.01)
+
+    def move(t0):  # from rest to rest over 6 s, 3 m
+        u = np.clip((t - t0) / 6, 0, 1)
+        return 3 * (u - np.sin(2 * np.pi * u) / (2 * np.pi))
+
+    ref = reference_from_samples("stop-turn.csv", t, np.column_stack(
+        [move(0), move(8), np.pi / 2 * np.clip((t - 6) / 2, 0, 1)]))
+    for framework in ("kinematic", "dynamic"):
+        got = feasibility(catalog.load("ackermann"), ref, framework).violations
+        assert [v.signal for v in got] == ["chi"] and got[0].size == pytest.approx(np.pi / 2, abs=1e-6)
+        assert 6.0 <= got[0].t <= 8.5  # reported when the tangent is defined again after the stop
+        for name in ("diff-drive", "forklift"):
+            assert feasibility(catalog.load(name), ref, framework).feasible
+    straight = reference_from_samples("stop-go.csv", t, np.column_stack([move(0) + move(8), 0 * t, 0 * t]))
+    assert feasibility(catalog.load("ackermann"), straight, "dynamic").feasible
+
+
+@settings(max_examples=40)
+@given(st.floats(0.5, 8.0), st.floats(0.2, 2.0), st.floats(-0.5, 0.5), st.floats(-0.3, 0.3), st.floats(0.5, 4.0))
+def test_smooth_paths_from_rest_have_no_jump(ramp, speed, amplitude, bend, period):
+    """Random smooth paths y = amplitude sin(x / period) + bend x^2, driven along x from rest (speed ramping up as
+    above, for `ramp` s, to `speed`), sampled at 100 Hz: a car follows them, in both frameworks."""
+    t = np.arange(0.0, 12.0, 0.01)
+    x = _from_rest(t, ramp, speed)
+    slope = amplitude / period * np.cos(x / period) + 2 * bend * x
+    ref = reference_from_samples("smooth.csv", t, np.column_stack(
+        [x, amplitude * np.sin(x / period) + bend * x**2, np.arctan(slope)]))
+    for framework in ("kinematic", "dynamic"):
+        got = feasibility(catalog.load("ackermann"), ref, framework).violations
+        assert not got, [(v.signal, v.t, v.size) for v in got]

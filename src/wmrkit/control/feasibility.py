@@ -10,6 +10,13 @@ Signals of the reference, sampled: position, tangent angle ``chi`` (8.29) and it
 curvature ``kappa`` (8.33) and its rate, heading ``theta``, velocity and acceleration. A sample-to-sample change
 larger than ``jump_factor`` times the typical one where it is (the median of its block of 21 steps, or of a
 neighbouring block when larger) and than an absolute floor is a discontinuity.
+
+``kappa`` and the rates are not judged where the reference rests or starts or stops (its speed changes by more
+than 5 % in a sample step), ``chi`` at rest and where the speed changes by more than itself in a step: there they
+come from a velocity near zero (finite differences of positions that hardly move, for a file). A jump across such
+samples is still found, as the change from the last sample before to the first after, where it is reported; across
+a rest only for a car's tangent (R on the fixed axle of a type 4 cannot turn at rest; any other vehicle re-orients
+there, the remedy of Table 8.1).
 """
 
 from __future__ import annotations
@@ -136,21 +143,31 @@ def _on_axle(robot: Robot, p: np.ndarray) -> bool:
     return False
 
 
-def signals(reference: Reference, *, speed_tol: float = 1e-6) -> dict[str, np.ndarray]:
-    """The sampled signals of `reference` ``(n,)`` each (NaN where undefined: ``chi`` and ``kappa`` at rest)."""
+def signals(reference: Reference, *, speed_tol: float = 1e-6, slow: float = 0.05) -> dict[str, np.ndarray]:
+    """The sampled signals of `reference` ``(n,)`` each, and ``at_rest`` ``(n,)`` (speed at most `speed_tol`).
+
+    ``chi`` and its rate, ``kappa`` and its rate are NaN at rest, where they are undefined, and the last three
+    where the speed changes by more than `slow` (5 %) of itself in one sample step (``dt |v . a| / |v|^2``), ``chi``
+    where by more than itself: a reference starting or stopping, where they come from ``v`` and ``a`` near zero
+    and, for a sampled reference, from finite differences of positions that hardly move (a 3 m circle from rest at
+    100 Hz had a curvature of 0 to 1.6 1/m over its first 0.15 s, and a tangent pointing backwards at its first
+    sample). A constant-speed reference, or
+    one with exact derivatives at a steady speed, has none of them undefined."""
     p, v, a = reference.pose, reference.velocity, reference.acceleration
     speed = np.hypot(v[:, 0], v[:, 1])
-    moving = speed > speed_tol
-    with np.errstate(invalid="ignore", divide="ignore"):
-        chi = np.where(moving, np.arctan2(v[:, 1], v[:, 0]), np.nan)
-        cross = v[:, 0] * a[:, 1] - v[:, 1] * a[:, 0]
-        kappa = np.where(moving, cross / speed**3, np.nan)
-        chi_rate = np.where(moving, cross / speed**2, np.nan)
     t = reference.t
+    at_rest = ~(speed > speed_tol)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        change = np.gradient(t) * np.abs(v[:, 0] * a[:, 0] + v[:, 1] * a[:, 1])  # of the speed in a step
+        steady = ~at_rest & (change <= slow * speed**2)
+        chi = np.where(~at_rest & (change <= speed**2), np.arctan2(v[:, 1], v[:, 0]), np.nan)
+        cross = v[:, 0] * a[:, 1] - v[:, 1] * a[:, 0]
+        kappa = np.where(steady, cross / speed**3, np.nan)
+        chi_rate = np.where(steady, cross / speed**2, np.nan)
     return {"position": p[:, :2], "theta": p[:, 2], "velocity": v[:, :2], "omega": v[:, 2], "acceleration": a[:, :2],
             "omega_rate": a[:, 2],
             "chi": chi, "chi_rate": chi_rate, "kappa": kappa,
-            "kappa_rate": np.gradient(np.nan_to_num(kappa), t) * (t[1] - t[0])}
+            "kappa_rate": np.gradient(kappa, t) * (t[1] - t[0]), "at_rest": at_rest}
 
 
 _FLOOR = {"position": 1e-3, "theta": 0.02, "velocity": 0.02, "omega": 0.02, "acceleration": 0.05, "omega_rate": 0.05,
@@ -162,13 +179,28 @@ _FLOOR = {"position": 1e-3, "theta": 0.02, "velocity": 0.02, "omega": 0.02, "acc
 BLOCK = 21
 
 
-def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float) -> list[tuple[int, float]]:
+def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float,
+           at_rest: np.ndarray | None = None, across_rest: bool = False) -> list[tuple[int, float]]:
     x = x.reshape(len(x), -1)
+    cut = None
+    if at_rest is not None and np.isnan(x).any():
+        # undefined samples (NaN) are bridged: the step into the first defined sample after them is the change since
+        # the last defined one (a jump while starting or stopping is still found), unless the reference rests
+        # between them (there the signal is undefined, and a vehicle at rest may re-orient, the remedy) and
+        # `across_rest` is False
+        n = len(x)
+        last = np.maximum.accumulate(np.where(np.isnan(x).any(axis=-1), -1, np.arange(n)))
+        rests = np.cumsum(at_rest)
+        cut = (last[:-1] < 0) | ((rests[1:] - rests[np.maximum(last[:-1], 0)] > 0) & (not across_rest))
+        x = x[np.maximum(last, 0)]
+        x[last < 0] = np.nan
     d = np.diff(x, axis=0)
     if angle:
         d = wrap_angle(d)
     size = np.sqrt(np.nansum(d * d, axis=-1))
     size[np.any(np.isnan(d), axis=-1)] = 0.0
+    if cut is not None:
+        size[cut] = 0.0
     # the typical step where each one is: the median of its block of steps, or of a neighbouring block when larger
     # (a global median is 0 for a reference mostly at rest, and its every moving step was a jump)
     n = len(size)
@@ -209,7 +241,9 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
         if name == "kappa_rate":
             x = x / (reference.t[1] - reference.t[0])
         floor = _FLOOR[name]
-        for k, size in _jumps(x, name in ("theta", "chi"), floor, jump_factor):
+        # a car (R on the fixed axle of a type 4) cannot turn at rest: its tangent is compared across a stop
+        across = name == "chi" and req.column == "type 4, on axle"
+        for k, size in _jumps(x, name in ("theta", "chi"), floor, jump_factor, sig["at_rest"], across):
             t = float(reference.t[k + 1])
             if any(v.t == t and v.signal in ("chi", "position") for v in found) and name != "position":
                 continue  # already reported by a lower-order signal at the same instant
