@@ -18,7 +18,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._shapes import finite_number
+from .errors import UnknownNameError, WmrkitError
+from .limits import MAX_COUPLING_RATIO, MIN_COUPLING_RATIO, MIN_RATIO
+
 COUPLING_KINDS = ("differential", "gear", "linkage")
+
+
+class CouplingError(WmrkitError, ValueError):
+    """A coupling built in Python that no description would give (``docs/description-format.md``, Couplings)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -28,6 +36,19 @@ class Coupling:
     kind: str
     joints: tuple[str, ...]
     ratios: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        name = f"coupling {self.kind}({', '.join(map(str, self.joints))})"
+        if self.kind not in COUPLING_KINDS:
+            raise CouplingError(f"{name}: unknown kind (kinds: {', '.join(COUPLING_KINDS)})")
+        if len(self.joints) < 2 or len(set(self.joints)) != len(self.joints) or len(self.ratios) != len(self.joints):
+            raise CouplingError(f"{name}: expected two or more distinct joints and one ratio per joint")
+        if not all(finite_number(k) and MIN_COUPLING_RATIO <= abs(k) <= MAX_COUPLING_RATIO for k in self.ratios):
+            raise CouplingError(f"{name}: ratios {self.ratios}: each must be of magnitude {MIN_COUPLING_RATIO:g} to "
+                                f"{MAX_COUPLING_RATIO:g} (docs/limits.md)")
+        if max(map(abs, self.ratios)) > min(map(abs, self.ratios)) / MIN_RATIO:
+            raise CouplingError(f"{name}: the largest ratio is more than {1 / MIN_RATIO:g} times the smallest "
+                                "(docs/limits.md)")
 
     @property
     def rates(self) -> bool:
@@ -67,6 +88,10 @@ def coupled_columns(
     owner: dict[int, Coupling] = {}
     for c in couplings:
         if c.rates:
+            missing = [j for j in c.joints if j not in names]
+            if missing:
+                rates = ", ".join(n for n in names if not n.startswith("omega@"))
+                raise UnknownNameError(f"{c.channel_name}: no joint rate {missing[0]} (rates: {rates})")
             owner.update({names.index(j): c for j in c.joints})
     channel: dict[Coupling, np.ndarray] = {}
     across: dict[Coupling, list[np.ndarray]] = {}

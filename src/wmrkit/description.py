@@ -21,11 +21,13 @@ from .documents import FieldReader, LineOf, Loc, hint, read_document, read_file,
 from .dynamics import mass
 from .limits import (  # noqa: F401  (the limits are part of the description format)
     ANGLE_MARGIN,
+    MAX_COUPLING_RATIO,
     MAX_FILE_SIZE,
     MAX_NAME,
     MAX_NOTES,
     MAX_SIZE,
     MAX_WHEELS,
+    MIN_COUPLING_RATIO,
     MIN_RATIO,
     MIN_SIZE,
     _check_envelope,
@@ -144,6 +146,14 @@ def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) ->
         ratios = tuple(check.quantity(v, "number", (*loc, "ratios", j)) for j, v in enumerate(raw))
         if any(r == 0 for r in ratios):
             check.fail("ratios must be non-zero (a joint with ratio 0 is not coupled)", (*loc, "ratios"))
+        sizes = [abs(r) for r in ratios]
+        for j, size in enumerate(sizes):
+            if not MIN_COUPLING_RATIO <= size <= MAX_COUPLING_RATIO:
+                check.fail(f"{ratios[j]:g}: outside the ratios wmrkit handles ({MIN_COUPLING_RATIO:g} to "
+                           f"{MAX_COUPLING_RATIO:g} in magnitude, docs/limits.md)", (*loc, "ratios", j))
+        if max(sizes) > min(sizes) / MIN_RATIO:
+            check.fail(f"the largest ratio is more than {1 / MIN_RATIO:g} times the smallest: rank decisions would "
+                       "lose the smaller to round-off (docs/limits.md)", (*loc, "ratios"))
         out.append(Coupling(kind, tuple(joints), ratios))
     return tuple(out)
 

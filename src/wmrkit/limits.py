@@ -43,6 +43,9 @@ MAX_NAME, MAX_NOTES = 64, 4096
 MIN_SIZE, MAX_SIZE = 1e-6, 1e3
 #: Radii, roller radii, castor offsets and half-widths are at least MIN_RATIO times the robot's size.
 MIN_RATIO = 1e-4
+#: A coupling's ratios: each of magnitude in [MIN_COUPLING_RATIO, MAX_COUPLING_RATIO], the largest at most
+#: 1 / MIN_RATIO times the smallest (rank decisions would lose the smaller to round-off).
+MIN_COUPLING_RATIO, MAX_COUPLING_RATIO = 1e-6, 1e6
 #: Swedish gamma at least this far from 0 and 180 deg; castor delta at least this far from +-90 deg [rad].
 ANGLE_MARGIN = math.radians(1.0)
 
