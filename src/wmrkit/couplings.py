@@ -9,7 +9,8 @@ one actuator or sensor per coupling instead of one per joint, and no longer repo
   differential: the mean of the two wheel rates with ratios 1/2, 1/2); the other combinations stay free.
 - ``gear``: the joints turn together, rigidly, ``q_j = ratio_j * u`` (a chain, a gear train, a synchro drive).
 - ``linkage``: steering joints moved by one mechanism (an Ackermann linkage); the angles are a configuration, so
-  the coupling says that actuating (or sensing) one of them sets them all.
+  the coupling says that actuating one of them sets them all. Sensing stays per angle (the linkage's geometry is
+  not modelled: its ratios are not used), as it does per joint under the other kinds.
 """
 
 from __future__ import annotations
