@@ -50,3 +50,26 @@ def test_a_python_coupling_is_checked_like_a_described_one():
                                 couplings=(Coupling("gear", ("right_drive.spin", "rear.spin"), (1.0, 1.0)),))
     with pytest.raises(UnknownNameError, match=r"no joint rate rear\.spin"):
         actuation_analysis(robot)
+
+
+def car_with(couplings: list[dict]) -> Robot:
+    return Robot.from_dict({"name": "car", "wheels": [
+        {"name": "a", "type": "fixed", "position": [0, 0.3], "heading": 0, "r": 0.1, "actuated": ["spin"]},
+        {"name": "b", "type": "fixed", "position": [0, -0.3], "heading": 0, "r": 0.1, "actuated": ["spin"]},
+        {"name": "c", "type": "castor", "position": [-0.5, 0], "beta": "90 deg", "d": 0.05, "r": 0.05},
+        {"name": "s", "type": "steerable", "position": [0.5, 0], "heading": 0, "r": 0.05, "actuated": ["steer"]}],
+        "couplings": couplings})
+
+
+@pytest.mark.parametrize(("coupling", "m"), [
+    ({"kind": "gear", "joints": ["a.spin", "b.spin"], "ratios": [1, 1]}, 1),  # a chain along one side: rolls
+    ({"kind": "gear", "joints": ["a.spin", "b.spin"], "ratios": [1, -1]}, 0),  # wheels of one axle counter-rotate
+    ({"kind": "gear", "joints": ["c.steer", "c.spin"]}, 0),  # rolling straight, the castor does not swivel
+    ({"kind": "differential", "joints": ["a.spin", "b.spin"]}, 1),
+], ids=["chain", "locked-axle", "locked-castor", "differential"])
+def test_the_actuation_mobility_is_that_of_the_coupled_mechanism(coupling, m):
+    """The car rolls straight only (m = 1); a gear that forbids that locks it. Before, the verdict said
+    "over-actuated: more actuated rates than degrees of freedom (1 actuated rate, m = 1)" of a locked car."""
+    analysis = actuation_analysis(car_with([coupling]))
+    assert int(analysis.mobility) == m and f"m = {m})" in str(analysis.verdict)
+    assert str(analysis.leaf) == ("determined" if m else "overdetermined")

@@ -125,7 +125,7 @@ class ActuationAnalysis:
     actuated: tuple[str, ...]  # actuated columns of the Jacobian form (wheel rates)
     steering: tuple[str, ...]  # steerable wheels whose steering joint is actuated
     steering_missing: tuple[str, ...]  # steerable wheels whose steering is not actuated
-    mobility: np.ndarray  # (...) int, m = G
+    mobility: np.ndarray  # (...) int, m (3.22) with the gear couplings held: the motions the mechanism allows
     tree: TreeVerdict
     inverse_matrix: np.ndarray  # (..., n_u, 3), (4.26)
 
@@ -196,7 +196,7 @@ def actuation_analysis(
     i_bar, j_u, j_nu, channels = coupled_split(robot, columns, beta)
     steering = linked_steering(robot.couplings, steering)
     unit = nondimensional(robot)  # rank decisions: the tolerance policy of .linalg
-    a = unit.constraint_matrix(beta)
+    a = coupled_constraints(unit, beta)
     i_bar1, j_u1, j_nu1, _ = coupled_split(unit, columns, beta)
     return ActuationAnalysis(
         robot.name, channels, steering, steering_split(robot, steering),
@@ -204,6 +204,18 @@ def actuation_analysis(
         eliminated_tree(i_bar1, j_u1, j_nu1),
         readonly(partitioned_solution(j_u, j_nu) @ i_bar),
     )
+
+
+def coupled_constraints(robot: Robot, beta: np.ndarray) -> np.ndarray:
+    """The no-slip constraint matrix (3.22) with one more row per direction a ``gear`` coupling holds at zero (its
+    joints turn together): its null space is the motions the mechanism allows, ``(..., 3E + n_g, 3 + n_w)``."""
+    a = robot.constraint_matrix(beta)
+    if not any(c.kind == "gear" for c in robot.couplings):
+        return a
+    drop = coupled_columns(robot.couplings, jacobian_names(robot), ())[3]
+    rows = np.zeros((drop.shape[1], a.shape[-1]))
+    rows[:, 3:] = drop[: a.shape[-1] - 3].T  # jacobian_names: the wheel rates first, as after the twist in (3.22)
+    return np.concatenate([a, np.broadcast_to(rows, (*a.shape[:-2], *rows.shape))], axis=-2)
 
 
 def subset_trees(robot: Robot, beta: np.ndarray, size: int) -> tuple[list[tuple[int, ...]], TreeVerdict | None]:
