@@ -6,11 +6,16 @@ import dataclasses
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
 
+from strategies import wheels
 from wmrkit import Robot, UnknownNameError, catalog
 from wmrkit.couplings import Coupling, CouplingError
 from wmrkit.errors import DescriptionError
-from wmrkit.kinematics.actuation import actuation_analysis
+from wmrkit.kinematics.actuation import actuation_analysis, actuation_tree
+from wmrkit.kinematics.linalg import matrix_rank, nondimensional
+from wmrkit.kinematics.sensing import sensing_analysis, sensing_tree
 
 
 def forklift_with(ratios: list[float], kind: str = "differential") -> dict:
@@ -73,3 +78,86 @@ def test_the_actuation_mobility_is_that_of_the_coupled_mechanism(coupling, m):
     analysis = actuation_analysis(car_with([coupling]))
     assert int(analysis.mobility) == m and f"m = {m})" in str(analysis.verdict)
     assert str(analysis.leaf) == ("determined" if m else "overdetermined")
+
+
+@pytest.mark.parametrize("name", ["agv-drive-unit", "forklift", "ackermann", "diff-drive", "swerve-4"])
+def test_the_tree_functions_give_the_verdicts_of_the_analyses(name):
+    """``actuation_tree`` classified the thesis's least-squares equation (4.28) without the couplings: the AGV's
+    drive unit, the forklift's differential and the car's were 'overdetermined' there and 'determined' in
+    ``actuation_analysis``, ``kinematics`` and ``analyze`` (docs/errata.md, (4.28))."""
+    robot = catalog.load(name)
+    assert str(actuation_tree(robot).leaf) == str(actuation_analysis(robot).leaf)
+    assert str(sensing_tree(robot).leaf) == str(sensing_analysis(robot).leaf)
+    forklift = catalog.load("forklift")  # commands are one rate per channel: the differential's carrier rate
+    carrier = actuation_analysis(forklift).inverse([1.0, 0.0, 0.0])
+    assert str(actuation_tree(forklift, q_dot_u=carrier).leaf) == "determined"
+
+
+TYPES = ["fixed", "steerable", "castor", "swedish", "ball", "orthogonal", "double", "double_castor"]
+
+
+@st.composite
+def coupled_robots(draw) -> Robot:
+    """1-4 random wheels, up to two rate couplings over random joints (passive ones included), random ratios."""
+    types = draw(st.lists(st.sampled_from(TYPES), min_size=1, max_size=4))
+    ws = tuple(draw(wheels(t, name=f"w{i}")) for i, t in enumerate(types))
+    rates = [n for n in Robot("r", ws).rate_names if not n.endswith(".roller")]
+    couplings, used = [], set()
+    for _ in range(draw(st.integers(0, 2))):
+        free = [r for r in rates if r not in used]
+        if len(free) < 2:
+            break
+        joints = draw(st.lists(st.sampled_from(free), min_size=2, max_size=min(4, len(free)), unique=True))
+        used |= set(joints)
+        ratios = tuple(draw(st.sampled_from([-1.0, 1.0])) * 10 ** draw(st.floats(-2, 2)) for _ in joints)
+        couplings.append(Coupling(draw(st.sampled_from(["differential", "gear"])), tuple(joints), ratios))
+    return Robot("r", ws, couplings=tuple(couplings))
+
+
+def _coupled_tree(robot: Robot) -> tuple[int, str]:
+    """Independent of the Jacobian form: the no-slip equations (3.22) plus a row per direction a gear forbids;
+    each actuated channel a functional of the velocities (a differential ``k . q``, a gear ``u`` of
+    ``q = k u``, a joint alone its rate). Consistent: the channels take any values on the allowed motions;
+    determined: the allowed motions with the channels at rest do not move the body."""
+    a, names = robot.constraint_matrix(), robot.velocity_names
+    rows, funcs, seen = [a], [], set()
+    for c in robot.couplings:
+        k, idx = np.array(c.ratios), [names.index(j) for j in c.joints]
+        if c.kind == "gear":
+            across = np.zeros((len(k) - 1, a.shape[1]))
+            across[:, idx] = np.linalg.svd(k[None, :])[2][1:]
+            rows.append(across)
+    for j in robot.actuated:
+        c = next((c for c in robot.couplings if j in c.joints), None)
+        if c in seen or j not in names:
+            continue
+        f = np.zeros(a.shape[1])
+        if c is None:
+            f[names.index(j)] = 1.0
+        else:
+            seen.add(c)
+            k = np.array(c.ratios)
+            f[[names.index(x) for x in c.joints]] = k if c.kind == "differential" else k / (k @ k)
+        funcs.append(f)
+    _, s, vt = np.linalg.svd(np.vstack(rows))
+    allowed = vt[int(np.sum(s > 1e-9 * max(1.0, s.max()))):].T
+    on = np.array(funcs, dtype=float).reshape(len(funcs), a.shape[1]) @ allowed
+    consistent = matrix_rank(on) == len(funcs)
+    _, s2, vt2 = np.linalg.svd(on) if on.size else (None, np.zeros(0), np.eye(allowed.shape[1]))
+    at_rest = allowed @ vt2[int(np.sum(s2 > 1e-9 * max(1.0, s2.max(initial=0.0)))):].T
+    determined = bool(np.abs(at_rest[:3]).max(initial=0.0) < 1e-7)
+    leaf = {(True, True): "determined", (False, True): "overdetermined", (True, False): "indeterminate",
+            (False, False): "underdetermined"}[consistent, determined]
+    return allowed.shape[1], leaf
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(coupled_robots())
+def test_coupled_verdicts_and_mobility_agree_with_the_no_slip_equations(robot):
+    unit = nondimensional(robot)
+    s = np.linalg.svd(unit.constraint_matrix(), compute_uv=False)
+    assume(not np.any((s > 1e-12) & (s < 1e-4)))  # a generic configuration: ranks are clear
+    m, leaf = _coupled_tree(unit)
+    analysis = actuation_analysis(robot)
+    assert (int(analysis.mobility), str(analysis.leaf)) == (m, leaf)
+    assert str(actuation_tree(robot).leaf) == leaf

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, readonly
 from ..couplings import coupled_columns, linked_steering
 from ..robot import Robot
-from .linalg import matrix_rank, nondimensional
+from .linalg import delta_projector, matrix_rank, nondimensional
 from .models import configuration
 from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_prefilter, search_sets
 from .trees import (
@@ -100,10 +100,14 @@ def actuation_tree(
     ``determined``: consistent actuation (sufficient, no conflict possible); ``overdetermined``: possible
     conflict, and with commands ``q_dot_u`` ``(..., n_u)`` ``consistent`` (actuator coupling respected) or
     ``inconsistent`` (the wheels fight and slip); ``indeterminate``/``underdetermined``/``incompatible``:
-    insufficient actuators.
+    insufficient actuators. The tree of :func:`actuation_analysis`: the unselected rates eliminated exactly
+    (:func:`.trees.eliminated_tree`), the robot's couplings held, and ``q_dot_u`` one rate per actuated channel
+    (``ActuationAnalysis.actuated``).
     """
-    i_u, j_u = actuation_equation(nondimensional(robot), actuated, beta)  # rates are angular: same units
-    return classify_system(i_u, j_u, q_dot_u)
+    columns, _ = select_columns(robot, robot.actuated if actuated is None else actuated, "actuated")
+    i_bar, j_u, j_nu, _ = coupled_split(nondimensional(robot), columns, beta)  # rates are angular: same units
+    delta = delta_projector(j_nu)
+    return classify_system(delta @ i_bar, delta @ j_u, q_dot_u)
 
 
 _ACTUATION_TEXT = {

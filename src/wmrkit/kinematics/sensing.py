@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, readonly
 from ..robot import TWIST_NAMES, Robot
 from .actuation import minimal_set_search, split_jacobian, steering_split, verdict_texts
-from .linalg import matrix_rank, nondimensional
+from .linalg import delta_projector, matrix_rank, nondimensional
 from .models import configuration
 from .search import SetList
 from .trees import (
@@ -87,8 +87,9 @@ def sensing_tree(
     (redundant sensors, slip detectable), and with readings ``q_dot_s`` ``(..., n_s)`` ``consistent`` (no slip
     nor noise) or ``inconsistent``; the other leaves: insufficient sensors.
     """
-    i_s, j_s = sensing_equation(nondimensional(robot), sensed, beta)  # rates are angular: same units
-    return classify_system(i_s, j_s, q_dot_s)
+    _, _, i_bar, j_s, j_ns = _split(nondimensional(robot), sensed, beta)  # rates are angular: same units
+    delta = delta_projector(j_ns)  # the unsensed rates eliminated exactly, as in sensing_analysis
+    return classify_system(delta @ i_bar, delta @ j_s, q_dot_s)
 
 
 _SENSING_TEXT = {
