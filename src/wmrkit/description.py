@@ -137,7 +137,8 @@ def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) ->
                            f"{kind} couples {'steering angles (kind: linkage)' if kind == 'linkage' else 'rates'}",
                            (*loc, "joints", j))
             if joint in used:
-                check.fail(f"joint '{joint}' is in two couplings", (*loc, "joints", j))
+                where = "twice in this coupling" if joint in joints[:j] else "in two couplings"
+                check.fail(f"joint '{joint}' is {where}", (*loc, "joints", j))
             used.add(joint)
         default = [1.0 / len(joints)] * len(joints) if kind == "differential" else [1.0] * len(joints)
         raw = item.get("ratios", default)

@@ -161,3 +161,12 @@ def test_coupled_verdicts_and_mobility_agree_with_the_no_slip_equations(robot):
     analysis = actuation_analysis(robot)
     assert (int(analysis.mobility), str(analysis.leaf)) == (m, leaf)
     assert str(actuation_tree(robot).leaf) == leaf
+
+
+def test_a_joint_repeated_in_one_coupling_is_named_as_such():
+    """Before: "joint 'right_drive.spin' is in two couplings" of a description with one coupling."""
+    data = catalog.load("forklift").to_dict()
+    data["couplings"] = [{"kind": "differential", "joints": ["right_drive.spin", "right_drive.spin"]}]
+    with pytest.raises(DescriptionError, match=r"couplings\[0\]\.joints\[1\]: joint 'right_drive\.spin' is twice in "
+                                               "this coupling"):
+        Robot.from_dict(data)
