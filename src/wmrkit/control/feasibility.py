@@ -225,6 +225,20 @@ def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float,
     return out
 
 
+#: Samples on each side of a curvature-rate jump over which the change must persist. ``kappa_rate`` is a third finite
+#: difference of the positions: a kink of the speed profile (a jerk step, e.g. where a short ramp from rest ends)
+#: rings over about four samples (+0.04 then back, on a 2 m curve after a 0.5 s ramp at 100 Hz) with no step in the
+#: curvature rate itself, while a true step persists.
+PERSIST = 4
+
+
+def _persists(x: np.ndarray, k: int, floor: float) -> bool:
+    """Whether the jump of step `k` (from sample k to k + 1) is still larger than `floor` between the samples
+    :data:`PERSIST` before and after it (undefined there: kept)."""
+    before, after = x[max(k - PERSIST, 0)], x[min(k + 1 + PERSIST, len(x) - 1)]
+    return not (np.isfinite(before) and np.isfinite(after)) or abs(float(after - before)) > floor
+
+
 def feasibility(robot: Robot, reference: Reference, framework: Literal["kinematic", "dynamic"] = "kinematic", *,
                 point: tuple[float, float] | None = None, jump_factor: float = 20.0) -> Feasibility:
     """Check `reference` against the Table 8.1 cell of `robot` (§8.5): every discontinuity and its remedy.
@@ -244,6 +258,8 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
         # a car (R on the fixed axle of a type 4) cannot turn at rest: its tangent is compared across a stop
         across = name == "chi" and req.column == "type 4, on axle"
         for k, size in _jumps(x, name in ("theta", "chi"), floor, jump_factor, sig["at_rest"], across):
+            if name == "kappa_rate" and not _persists(x, k, floor):
+                continue  # ringing of a third finite difference, not a step of the curvature rate
             t = float(reference.t[k + 1])
             if any(v.t == t and v.signal in ("chi", "position") for v in found) and name != "position":
                 continue  # already reported by a lower-order signal at the same instant
