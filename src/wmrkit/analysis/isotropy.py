@@ -173,7 +173,7 @@ def _kappa(model: TwistModel, beta: np.ndarray, length: float) -> np.ndarray:
     out = np.empty(len(flat))
     p, cl = line_parameters(model.robot), constraint_lines(model.robot)
     for s in range(0, len(flat), _fast.CHUNK):
-        rows = _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
+        rows = _element_rows_one(p, flat[0]) if len(flat) == 1 else _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
         lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
         out[s:s + _fast.CHUNK] = _fast.kappa_cm(model.mobility, _fast.combine(model.coefficients, rows), lines,
                                                 float(length))
@@ -202,25 +202,62 @@ def natural_length(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple
     beta = configuration(robot, beta, heading)
     if beta.ndim != 1:
         raise UnknownNameError("natural_length takes one configuration (shape (n_steer,))")
-    size = robot_size(robot)
+    return _natural_length(model, beta, robot_size(robot))
+
+
+def _natural_length(model: TwistModel, beta: np.ndarray, size: float) -> tuple[float, float]:
+    """:func:`natural_length` at one checked configuration ``(n_steer,)``, the element rows computed once (the
+    values of :func:`_kappa`); for m = 3 the search grid of lengths is one batched SVD."""
+    p, cl = line_parameters(model.robot), constraint_lines(model.robot)
+    rows = _element_rows_one(p, beta)
+    lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
+    rates = _fast.combine(model.coefficients, rows)
     if model.mobility == 2:
-        rows = _fast.element_rows_cm(line_parameters(robot), beta[None])
-        cl = constraint_lines(robot)
-        lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
-        a, b, ok = _fast.columns_m2(_fast.combine(model.coefficients, rows), lines)
+        a, b, ok = _fast.columns_m2(rates, lines)
         v, w = float(np.linalg.norm(a)), float(np.linalg.norm(b))
         length = w / v if ok[0] and v > 0 and w > 0 else size
-        return length, float(_kappa(model, beta, length))
-    if model.mobility == 3:
-        return _minimise_length(lambda d: float(_kappa(model, beta, d)), size)
-    return size, float(_kappa(model, beta, size))
+        if not ok[0]:  # kappa_cm's value, with these columns
+            return length, np.nan
+        return length, float(condition_number(np.stack([a[:, 0], b[:, 0] / length], axis=-1)))
+    if model.mobility == 3:  # kappa_cm's SVD route for one configuration, without its batch bookkeeping
+        h = rates[:, :, 0]
+
+        def many(lengths: np.ndarray) -> np.ndarray:
+            scale = np.ones((len(lengths), 3))
+            scale[:, 2] = 1.0 / lengths
+            return condition_number(h * scale[:, None, :])
+
+        def one(length: float) -> float:  # condition_number's value and threshold, on one (J, 3) matrix
+            if h.shape[0] < 3:
+                return np.inf
+            sv = np.linalg.svd(h * np.array([1.0, 1.0, 1.0 / length]), compute_uv=False)
+            return float(sv[0] / sv[-1]) if sv[-1] > 1e-13 * sv[0] else np.inf
+
+        return _minimise_length(one, size, many)
+    return size, float(_fast.kappa_cm(model.mobility, rates, lines, float(size))[0])
 
 
-def _minimise_length(kappa, size: float) -> tuple[float, float]:
-    """Minimise ``kappa(D)`` over D in LENGTH_RANGE * size (log scale); ties go to `size`."""
+def _element_rows_one(p, beta: np.ndarray) -> np.ndarray:
+    """``_fast.element_rows_cm(p, beta[None])`` for one configuration ``(n_steer,)``, vectorised over the
+    elements instead of the configurations (the same values): ``(2E, 3, 1)``."""
+    wheel_beta = np.array(p.beta_described, dtype=float)
+    wheel_beta[p.steer_wheels] = beta
+    theta = wheel_beta[p.element_wheel] + p.theta_offset
+    c, s = np.cos(theta), np.sin(theta)
+    out = np.empty((len(theta), 2, 3))
+    out[:, 0, 0], out[:, 0, 1] = c, s
+    out[:, 0, 2] = p.l_s_alpha_neg * c + p.l_c_alpha * s - p.d_c
+    out[:, 1, 0], out[:, 1, 1] = -s, c
+    out[:, 1, 2] = p.l_c_alpha * c + p.l_s_alpha * s + p.d_s
+    return out.reshape(-1, 3, 1)
+
+
+def _minimise_length(kappa, size: float, many=None) -> tuple[float, float]:
+    """Minimise ``kappa(D)`` over D in LENGTH_RANGE * size (log scale); ties go to `size`. `many`, if given, is
+    `kappa` over an array of lengths at once (the same values)."""
     lo, hi = np.log(LENGTH_RANGE[0] * size), np.log(LENGTH_RANGE[1] * size)
     grid = np.linspace(lo, hi, 121)
-    values = np.array([kappa(np.exp(x)) for x in grid])
+    values = many(np.exp(grid)) if many is not None else np.array([kappa(np.exp(x)) for x in grid])
     k_size = kappa(size)
     finite = np.isfinite(values)
     if not finite.any():

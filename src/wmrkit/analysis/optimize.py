@@ -20,7 +20,7 @@ from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
 from . import _fast
 from ._sym import eigvalsh2_entries
-from .isotropy import _kappa, golden_section, kappa_function, natural_length, twist_model
+from .isotropy import _kappa, _natural_length, golden_section, kappa_function, natural_length, twist_model
 from .lines import constraint_lines, line_parameters
 from .singularity import robot_size
 
@@ -60,14 +60,18 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
             raise UnknownNameError(f"robot '{robot.name}' has no steering wheel '{v}' (steering: {', '.join(steer)})")
     idx = [steer.index(v) for v in variables]
 
+    described = robot.beta
+
     def full(x: np.ndarray) -> np.ndarray:
-        b = np.broadcast_to(robot.beta, (*np.shape(x)[:-1], len(steer))).copy()
+        b = np.broadcast_to(described, (*np.shape(x)[:-1], len(steer))).copy()
         b[..., idx] = x
         return b
 
+    size = robot_size(robot)
+
     def score(x: np.ndarray) -> float:
         b = full(np.asarray(x, dtype=float))
-        return natural_length(robot, b, joints=model.joints)[1] if length is None else float(_kappa(model, b, length))
+        return _natural_length(model, b, size)[1] if length is None else float(_kappa(model, b, length))
 
     if not idx:
         d, k = natural_length(robot, joints=model.joints) if length is None else (length, score(np.zeros(0)))
@@ -103,7 +107,7 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
     out = []
     for x, k in sorted(found, key=lambda t: t[1]):
         b = full(x)
-        d = natural_length(robot, b, joints=model.joints)[0] if length is None else length
+        d = _natural_length(model, b, size)[0] if length is None else length
         out.append(Conditioning(tuple(float(v) for v in b), float(d), float(k)))
     return tuple(out)
 
@@ -150,8 +154,15 @@ def _grid_kappa(model, beta: np.ndarray, length: float | None) -> np.ndarray:
                                              np.einsum("jn,jn->n", b, b))
             out[s:s + _fast.CHUNK] = np.where(ok, _fast.ratio(small, large), np.nan)
         return out.reshape(beta.shape[:-1])
+    if model.mobility != 3:  # kappa does not depend on D
+        return _kappa(model, beta, size)
     lengths = size * np.logspace(-2, 2, 33)
-    return np.min(np.stack([_kappa(model, beta, d) for d in lengths]), axis=0)
+    flat = beta.reshape(-1, beta.shape[-1])
+    out = np.empty(len(flat))
+    for s in range(0, len(flat), _fast.CHUNK):  # _kappa's chunks, the rows computed once for all the lengths
+        kappa = kappa_function(model, flat[s:s + _fast.CHUNK])
+        out[s:s + _fast.CHUNK] = np.min(np.stack([kappa(d) for d in lengths]), axis=0)
+    return out.reshape(beta.shape[:-1])
 
 
 @dataclass(frozen=True, eq=False)
