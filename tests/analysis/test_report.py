@@ -63,6 +63,17 @@ def test_couplings_decide_the_actuation_verdict(capsys):
     assert "over-actuated" in line and "coordinated" in line and "inconsistent" not in line
 
 
+def test_analyze_names_a_differential_as_one_actuator_as_kinematics_does(capsys):
+    """analyze listed the differential's two joints as actuators beside a verdict counting them as one, while its
+    own singular line and `kinematics` named the channel."""
+    assert main(["analyze", "forklift"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    channel = "differential(right_drive.spin, left_drive.spin)"
+    actuation = next(x for x in lines if x.strip().startswith("actuation:"))
+    assert actuation.endswith(f"({channel}, steer.steer)")
+    assert any(x.strip().startswith(f"singular (actuated: {channel})") for x in lines)
+
+
 def test_json_condition_number_at_the_natural_or_given_length(capsys):
     assert main(["analyze", "thesis-omni-swedish", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)

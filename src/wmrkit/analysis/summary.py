@@ -84,7 +84,8 @@ class Analysis:
             lines.append(f"  at the described steering: m = {self.instantaneous_mobility}")
         lines += [f"  {s.description}" for s in c.special]
         lines.append(f"  {self.icr.describe()}")
-        lines.append(f"  actuation: {actuation_words(self.actuation)} ({', '.join(r.actuated) or 'nothing declared'})")
+        actuators = channel_names(r.couplings, r.actuated)  # a differential's joints are one actuator
+        lines.append(f"  actuation: {actuation_words(self.actuation)} ({', '.join(actuators) or 'nothing declared'})")
         lines.append(f"  sensing: {_yes(self.sensing['sufficient'], 'sufficient', 'insufficient')} "
                      f"({', '.join(r.sensed) or 'nothing declared'})")
         if c.mobility <= 1:
