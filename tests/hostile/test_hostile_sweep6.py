@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import json
 from pathlib import Path
 
 import numpy as np
@@ -113,7 +114,24 @@ def test_a_write_that_fails_midway_is_one_line_naming_the_file(monkeypatch, tmp_
     for argv in (["show", "forklift"], ["park", "thesis-9.1"]):  # a message of its own, the one of main()
         path = str(tmp_path / "drawing.png")
         message = _one_line([*argv, "--plot", path], capsys)
-        assert message.startswith(f"wmrkit: error: {path}: ") and "No space left on device" in message
+        named = path if argv[0] == "show" else f"--plot {path}"  # main() names the option too
+        assert message.startswith(f"wmrkit: error: {named}: ") and "No space left on device" in message
+
+
+def test_a_report_folder_that_cannot_be_made_late_names_the_option(monkeypatch, tmp_path, capsys):
+    """mkdir failing after the checks (as root, /proc passes the permission check) named the folder alone; the text
+    names the option too, the JSON keeps the file."""
+    import os
+
+    def refuse(name, *args, **kwargs):
+        raise OSError(errno.ENOENT, "No such file or directory", str(name))
+
+    monkeypatch.setattr(os, "makedirs", refuse)
+    folder = str(tmp_path / "figures")
+    argv = ["slip-study", "skid-steer-4", "--source", "quasi-static", "--report", folder]
+    assert _one_line(argv, capsys).startswith(f"wmrkit: error: --report {folder}")
+    assert main([*argv, "--json"]) == 2
+    assert json.loads(capsys.readouterr().err)["file"].startswith(folder)
 
 
 @pytest.mark.parametrize("twist", [["10", "2", "1e308"], ["10", "1e6", "0"], ["0", "0", "1000.1"]])

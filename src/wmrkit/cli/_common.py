@@ -88,6 +88,19 @@ def check_outputs(args: argparse.Namespace) -> None:
             raise WmrkitError(f"{what} {path}: {problem}")
 
 
+def output_option(args: argparse.Namespace | None, filename: str | os.PathLike[str]) -> str:
+    """``"--report "`` when `filename` is an output option's path or inside its folder (else ``""``), to name the
+    option in an error about that file."""
+    target = Path(os.fspath(filename)).absolute()
+    for dest in OUTPUT_FILES + OUTPUT_FOLDERS:
+        path = getattr(args, dest, None)
+        if isinstance(path, str) and path.strip():
+            given = Path(path).absolute()
+            if target == given or (dest in OUTPUT_FOLDERS and given in target.parents):
+                return f"--{dest} "
+    return ""
+
+
 def output_problem(path: str, folder: bool) -> str | None:
     """Why `path` cannot be written as a file (or, with `folder`, as a folder made with its parents), or None."""
     if not path.strip():

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from typing import NoReturn
 
 from ..errors import DescriptionError, WmrkitError
-from ._common import check_blank, check_outputs
+from ._common import check_blank, check_outputs, output_option
 
 #: Each command and the module of ``wmrkit.cli`` that registers it (``add_parsers``), in ``--help`` order.
 COMMANDS = {
@@ -74,6 +74,7 @@ def main(argv: list[str] | None = None) -> int:
     done = threading.Event()
     if not as_json:
         threading.Thread(target=_compile_notice, args=(done,), daemon=True).start()
+    args = None
     try:
         parser = build_parser(command)
         args = parser.parse_args(argv)
@@ -88,7 +89,9 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as err:
         if err.filename is None:  # not about a file: a bug, with its traceback
             raise
-        report_error(WmrkitError(f"{err.filename}: {err.strerror or err}"), as_json, argv)  # e.g. a full disk
+        # a write that fails late (a full disk, mkdir in /proc as root): the text names the option, the JSON the file
+        option = "" if as_json else output_option(args, err.filename)
+        report_error(WmrkitError(f"{option}{err.filename}: {err.strerror or err}"), as_json, argv)
         return 2
     finally:
         done.set()
