@@ -160,13 +160,13 @@ def test_best_configurations_m3_agree_with_the_batched_kernel(case):
     r, kw = {"two-wheel": (_swedish_castor(), {}), "spins-only": (_swedish_castor(("spin",)), {}),
              "omni-castor": (catalog.load("thesis-omni-castor"), {"resolution": 12, "count": 1})}[case]
     found = best_configurations(r, **kw)
+    if case == "spins-only":  # fewer driven joints than m: the twist is never determined; 8 'best' at inf before
+        assert found == ()
+        return
     assert found
     for c in found:
         beta = np.asarray(c.beta)[None]
         here = float(condition_map(r, beta, length=c.length)[0])
-        if case == "spins-only":  # fewer driven joints than m: the twist is never determined
-            assert c.condition_number == math.inf and here == math.inf
-            continue
         assert c.condition_number == pytest.approx(here, rel=1e-9)
         for f in (0.99, 1.01):
             assert float(condition_map(r, beta, length=c.length * f)[0]) >= here * (1 - 1e-9)

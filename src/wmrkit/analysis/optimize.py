@@ -45,7 +45,8 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
     and start). When even 4 points per axis would exceed `max_samples` (many steering variables), a seeded
     random sample of `max_samples` configurations replaces the grid and its best `count` points start the
     refinement: memory and time stay bounded (the sample may miss narrow basins). `variables` default to the
-    steering wheels that change kappa (those with an axle constraint or among the joints).
+    steering wheels that change kappa (those with an axle constraint or among the joints). Only configurations
+    where kappa is finite are returned: none when the joints determine the twist nowhere (fewer joints than m).
     """
     for value, what in ((resolution, "resolution"), (max_samples, "max_samples"), (count, "count")):
         if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
@@ -106,6 +107,8 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
             found.append((x, score(x)))
     out = []
     for x, k in sorted(found, key=lambda t: t[1]):
+        if not np.isfinite(k):  # the twist is undetermined there (the grid's fast kernel gave a huge finite value)
+            continue
         b = full(x)
         d = _natural_length(model, b, size)[0] if length is None else length
         out.append(Conditioning(tuple(float(v) for v in b), float(d), float(k)))
