@@ -170,3 +170,20 @@ def test_a_joint_repeated_in_one_coupling_is_named_as_such():
     with pytest.raises(DescriptionError, match=r"couplings\[0\]\.joints\[1\]: joint 'right_drive\.spin' is twice in "
                                                "this coupling"):
         Robot.from_dict(data)
+
+
+def test_one_joint_of_a_coupling_listed_as_actuated_actuates_the_mechanism():
+    """A coupling is one actuator (docs/description-format.md): the car with only rear_left.spin listed gets the
+    verdict of the car with both, and its actuators are named by the channel."""
+    from wmrkit import Robot, catalog
+    from wmrkit.kinematics import actuation_analysis
+
+    car = catalog.load("ackermann")
+    data = car.to_dict()
+    right = next(w for w in data["wheels"] if w["name"] == "rear_right")
+    right["actuated"] = [j for j in right["actuated"] if j != "spin"]
+    one = Robot.from_dict(data)
+    assert "rear_right.spin" not in one.actuated and "rear_left.spin" in one.actuated
+    both, single = actuation_analysis(car).as_dict(), actuation_analysis(one).as_dict()
+    assert single["verdict"] == both["verdict"] and single["consistent"] and single["sufficient"]
+    assert single["actuated"] == both["actuated"] == ["differential(rear_left.spin, rear_right.spin)"]
