@@ -14,7 +14,8 @@ neighbouring block when larger) and than an absolute floor is a discontinuity.
 ``kappa`` and the rates are not judged where the reference rests or starts or stops (its speed changes by more
 than 5 % in a sample step), ``chi`` at rest and where the speed changes by more than itself in a step: there they
 come from a velocity near zero (finite differences of positions that hardly move, for a file). A jump across such
-samples is still found, as the change from the last sample before to the first after, where it is reported; across
+samples is still found, as the change from the last sample before to the first after (compared with as many
+typical steps as it spans), where it is reported; across
 a rest only for a car's tangent (R on the fixed axle of a type 4 cannot turn at rest; any other vehicle re-orients
 there, the remedy of Table 8.1).
 """
@@ -182,7 +183,8 @@ BLOCK = 21
 def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float,
            at_rest: np.ndarray | None = None, across_rest: bool = False) -> list[tuple[int, float]]:
     x = x.reshape(len(x), -1)
-    cut = None
+    cut = held = None
+    span = 1  # sample steps each step covers: more for one bridged over undefined samples
     if at_rest is not None and np.isnan(x).any():
         # undefined samples (NaN) are bridged: the step into the first defined sample after them is the change since
         # the last defined one (a jump while starting or stopping is still found), unless the reference rests
@@ -192,6 +194,8 @@ def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float,
         last = np.maximum.accumulate(np.where(np.isnan(x).any(axis=-1), -1, np.arange(n)))
         rests = np.cumsum(at_rest)
         cut = (last[:-1] < 0) | ((rests[1:] - rests[np.maximum(last[:-1], 0)] > 0) & (not across_rest))
+        span = np.arange(1, n) - np.maximum(last[:-1], 0)
+        held = last[1:] < np.arange(1, n)  # steps into an undefined sample: no step of the signal
         x = x[np.maximum(last, 0)]
         x[last < 0] = np.nan
     d = np.diff(x, axis=0)
@@ -204,9 +208,19 @@ def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float,
     # the typical step where each one is: the median of its block of steps, or of a neighbouring block when larger
     # (a global median is 0 for a reference mostly at rest, and its every moving step was a jump)
     n = len(size)
-    blocks = np.median(np.pad(size, (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK), axis=1) if n else size
+    if held is None:
+        blocks = np.median(np.pad(size, (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK), axis=1) if n else size
+    else:  # of the steps of the signal (per sample step for a bridged one), not of the 0s held over undefined ones
+        typical = np.pad(np.where(held, np.nan, size / span), (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK)
+        count = (~np.isnan(typical)).sum(axis=1)
+        typical = np.sort(typical, axis=1)  # NaN last
+        rows = np.arange(len(typical))
+        mid = 0.5 * (typical[rows, np.maximum(count - 1, 0) // 2] + typical[rows, count // 2 - (count == 0)])
+        blocks = np.where(count > 0, mid, 0.0)
     near = np.maximum(blocks, np.maximum(np.r_[blocks[:1], blocks[:-1]], np.r_[blocks[1:], blocks[-1:]]))
-    hit = np.flatnonzero(size > np.maximum(floor, factor * np.repeat(near, BLOCK)[:n]))
+    # a step bridged over k undefined samples is the change of k steps: compared with k typical ones (at 10 Hz, a
+    # smooth curvature changing by 0.09 over 6 samples whose speed changed too fast to judge them was a 'jump')
+    hit = np.flatnonzero(size > np.maximum(floor, factor * span * np.repeat(near, BLOCK)[:n]))
     events: list[list[int]] = []  # [first step, last step, step of the largest]
     for k in hit:  # a jump spread over consecutive samples (finite differences) is one event
         if events and k - events[-1][1] <= 2:
