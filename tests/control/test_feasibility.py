@@ -285,3 +285,27 @@ def test_sparse_real_curvature_jump_is_still_found():
                       ).violations
     assert [v.signal for v in got] == ["kappa"] and got[0].t == pytest.approx(7.0, abs=0.15)
     assert got[0].size == pytest.approx(1 / 3, rel=0.05)
+
+
+def test_a_densely_sampled_reference_is_judged_above_rounding():
+    """A 3 m circle at 1 m/s sampled every 3 us (positions 3 um apart; a whole lap, 6.3 M samples, reported
+    the same): the rounding of positions and times made curvature-rate 'jumps' of 3 1/(m s) near 0.016 s for a car
+    in the dynamic framework. The curvature signals are judged every few samples, where rounding is small; a real
+    curvature-rate step (a line into a clothoid, kappa = 20 u at u m into it) is found with its size."""
+    from scipy.special import fresnel
+
+    t = np.arange(0.0, 0.3, 3e-6)
+    th = t / 3.0
+    car = catalog.load("ackermann")
+    circle = reference_from_samples("circle.csv", t, np.column_stack([3 * np.sin(th), 3 * (1 - np.cos(th)), th]))
+    assert feasibility(car, circle, "dynamic").feasible
+    u = np.clip(t - 0.15, 0, None)  # 1 m/s, the clothoid from 0.15 m: heading 10 u^2
+    sin, cos = fresnel(u * np.sqrt(20 / np.pi))
+    c = np.sqrt(np.pi / 20)
+    clothoid = reference_from_samples("clothoid.csv", t, np.column_stack([np.minimum(t, 0.15) + c * cos, c * sin,
+                                                                         10 * u**2]))
+    assert feasibility(car, clothoid).feasible
+    got = feasibility(car, clothoid, "dynamic").violations
+    # (its end, inside the clothoid, is another matter: the one-sided curvature rate of the last samples, 20 -> 10)
+    assert [(v.signal, round(v.t, 3)) for v in got if v.t < 0.29] == [("kappa_rate", 0.15)]
+    assert got[0].size == pytest.approx(20.0, rel=0.02)

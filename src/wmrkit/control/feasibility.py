@@ -33,7 +33,7 @@ from ..limits import MAX_SIZE
 from ..robot import Robot
 from ..wheels import wrap_angle
 from .points import ControlError, control_point
-from .references import Reference
+from .references import Reference, reference_from_samples
 
 __all__ = ["COLUMNS", "Feasibility", "Requirement", "Violation", "feasibility", "requirement"]
 
@@ -263,23 +263,60 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
         raise ControlError(f"jump_factor: expected a finite number > 1 (times the median step), got {jump_factor}")
     req = requirement(robot, framework, point=point)
     sig = signals(reference)
+    dense = _curvature_reference(reference) if set(req.signals) & set(_CURVATURE) else None
+    dense_sig = None if dense is None else signals(dense)
     found: list[Violation] = []
     for name in req.signals:
-        x = sig[name]
+        ref, s = (dense, dense_sig) if dense is not None and name in _CURVATURE else (reference, sig)
+        x = s[name]
         if name == "kappa_rate":
-            x = x / (reference.t[1] - reference.t[0])
+            x = x / (ref.t[1] - ref.t[0])
         floor = _FLOOR[name]
         # a car (R on the fixed axle of a type 4) cannot turn at rest: its tangent is compared across a stop
         across = name == "chi" and req.column == "type 4, on axle"
-        for k, size in _jumps(x, name in ("theta", "chi"), floor, jump_factor, sig["at_rest"], across):
+        for k, size in _jumps(x, name in ("theta", "chi"), floor, jump_factor, s["at_rest"], across):
             if name == "kappa_rate" and not _persists(x, k, floor):
                 continue  # ringing of a third finite difference, not a step of the curvature rate
-            t = float(reference.t[k + 1])
+            t = float(ref.t[k + 1])
             if any(v.t == t and v.signal in ("chi", "position") for v in found) and name != "position":
                 continue  # already reported by a lower-order signal at the same instant
             found.append(Violation(t, name, KINDS[name], size, _remedy(req, name)))
     found.sort(key=lambda v: v.t)
     return Feasibility(req, tuple(found))
+
+
+#: Signals from the normal acceleration (second differences of the positions, for a file), and the curvature rate
+#: (a third), judged at a spacing where the rounding of the positions and times does not dominate them.
+_CURVATURE = ("chi_rate", "kappa", "kappa_rate")
+#: Rounding noise [1/(m s)] allowed in the curvature rate: 1/200 of its jump floor.
+_RATE_NOISE = 1e-4
+
+
+def _curvature_reference(reference: Reference) -> Reference | None:
+    """The reference every few samples, re-differentiated, for the curvature signals when it is so dense that
+    rounding dominates them; None when it is not.
+
+    The second difference of positions rounded to ``eps L`` (``L`` their size, plus the distance covered in the
+    rounding of the times) over a step ``h`` errs by about ``4 eps L / h^2``, its curvature by that over ``v^2`` and
+    the curvature rate by that over ``h``: the step is the smallest multiple of the sample spacing that keeps the rate
+    within :data:`_RATE_NOISE` at the typical moving speed ``v`` (a 3 m circle at 1 m/s sampled every 3 us had
+    curvature-rate 'jumps' of 3 1/(m s) from rounding alone; it is judged every 0.6 ms, 200 samples)."""
+    t, p = reference.t, reference.pose
+    n = len(t)
+    spacing = (t[-1] - t[0]) / (n - 1)
+    speed = np.hypot(*reference.velocity[:: max(1, n // 10_000), :2].T)
+    moving = speed[speed > 1e-6]
+    if not len(moving):
+        return None
+    v = float(np.median(moving))
+    size = float(np.abs(p[:, :2]).max()) + v * float(np.abs(t).max())
+    h = (4 * np.finfo(float).eps * size / (v * v * _RATE_NOISE)) ** (1 / 3)
+    step = int(min(math.ceil(h / spacing), (n - 1) // 4))
+    if step <= 1:
+        return None
+    # the heading plays no part in these signals (and every few samples a spinning one may turn by more than half a
+    # turn, which a file is refused for)
+    return reference_from_samples(reference.name, t[::step], np.column_stack([p[::step, :2], np.zeros(len(t[::step]))]))
 
 
 def _remedy(req: Requirement, signal: str) -> str:
