@@ -245,11 +245,19 @@ def test_a_stop_and_turn_in_place_is_a_tangent_jump_for_a_car_only():
 def test_smooth_paths_from_rest_have_no_jump(ramp, speed, amplitude, bend, period):
     """Random smooth paths y = amplitude sin(x / period) + bend x^2, driven along x from rest (speed ramping up as
     above, for `ramp` s, to `speed`), sampled at 100 Hz: a car follows them, in both frameworks."""
-    t = np.arange(0.0, 12.0, 0.01)
+    _assert_a_car_follows(_smooth_path(0.01, ramp, speed, amplitude, bend, period))
+
+
+def _smooth_path(dt, ramp, speed, amplitude, bend, period):
+    """y = amplitude sin(x / period) + bend x^2 driven along x from rest, sampled every `dt` [s] for 12 s."""
+    t = np.arange(0.0, 12.0, dt)
     x = _from_rest(t, ramp, speed)
     slope = amplitude / period * np.cos(x / period) + 2 * bend * x
-    ref = reference_from_samples("smooth.csv", t, np.column_stack(
+    return reference_from_samples("smooth.csv", t, np.column_stack(
         [x, amplitude * np.sin(x / period) + bend * x**2, np.arctan(slope)]))
+
+
+def _assert_a_car_follows(ref):
     for framework in ("kinematic", "dynamic"):
         got = feasibility(catalog.load("ackermann"), ref, framework).violations
         assert not got, [(v.signal, v.t, v.size) for v in got]
@@ -267,15 +275,7 @@ def test_sparse_smooth_paths_from_rest_have_no_curvature_jump(case):
     (steep parts, not only the start) the curvature is not judged, and the change across those samples (0.09 1/m over
     6 samples, 1.2 over 3 on a tight wiggle) was compared with one typical step, and the median of the steps counted
     the held samples as steps of 0 (6 of 120 random paths were reported). It is compared with as many typical steps."""
-    ramp, speed, amplitude, bend, period = case
-    t = np.arange(0.0, 12.0, 0.1)
-    x = _from_rest(t, ramp, speed)
-    slope = amplitude / period * np.cos(x / period) + 2 * bend * x
-    ref = reference_from_samples("sparse.csv", t, np.column_stack(
-        [x, amplitude * np.sin(x / period) + bend * x**2, np.arctan(slope)]))
-    for framework in ("kinematic", "dynamic"):
-        got = feasibility(catalog.load("ackermann"), ref, framework).violations
-        assert not got, [(v.signal, v.t, v.size) for v in got]
+    _assert_a_car_follows(_smooth_path(0.1, *case))
 
 
 def test_sparse_real_curvature_jump_is_still_found():
