@@ -32,7 +32,7 @@ from ..kinematics.models import configuration
 from ..robot import Robot
 from . import _fast
 from .classification import classify
-from .lines import _rate_block, constraint_lines, element_rows, line_parameters
+from .lines import _rate_block, constraint_lines, element_rows, line_parameters, rows_at
 from .singularity import check_positive_length, robot_size
 
 #: Search interval of the natural length, in robot sizes (see :func:`natural_length`).
@@ -238,18 +238,11 @@ def _natural_length(model: TwistModel, beta: np.ndarray, size: float) -> tuple[f
 
 
 def _element_rows_one(p, beta: np.ndarray) -> np.ndarray:
-    """``_fast.element_rows_cm(p, beta[None])`` for one configuration ``(n_steer,)``, vectorised over the
-    elements instead of the configurations (the same values): ``(2E, 3, 1)``."""
+    """``_fast.element_rows_cm(p, beta[None])`` for one configuration ``(n_steer,)``: ``(2E, 3, 1)``, from
+    :func:`.lines.rows_at` (vectorised over the elements instead of the configurations)."""
     wheel_beta = np.array(p.beta_described, dtype=float)
     wheel_beta[p.steer_wheels] = beta
-    theta = wheel_beta[p.element_wheel] + p.theta_offset
-    c, s = np.cos(theta), np.sin(theta)
-    out = np.empty((len(theta), 2, 3))
-    out[:, 0, 0], out[:, 0, 1] = c, s
-    out[:, 0, 2] = p.l_s_alpha_neg * c + p.l_c_alpha * s - p.d_c
-    out[:, 1, 0], out[:, 1, 1] = -s, c
-    out[:, 1, 2] = p.l_c_alpha * c + p.l_s_alpha * s + p.d_s
-    return out.reshape(-1, 3, 1)
+    return rows_at(p, wheel_beta)[..., None]
 
 
 def _minimise_length(kappa, size: float, many=None) -> tuple[float, float]:

@@ -246,11 +246,15 @@ def element_rows(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
     """
     p = line_parameters(robot)
     if beta is None:
-        wheel_beta = p.beta_described
-    else:
-        beta = as_vectors(beta, len(robot.steer_names), "beta")
-        wheel_beta = np.broadcast_to(p.beta_described, (*beta.shape[:-1], len(p.beta_described))).copy()
-        wheel_beta[..., p.steer_wheels] = beta
+        return rows_at(p, p.beta_described)
+    beta = as_vectors(beta, len(robot.steer_names), "beta")
+    wheel_beta = np.broadcast_to(p.beta_described, (*beta.shape[:-1], len(p.beta_described))).copy()
+    wheel_beta[..., p.steer_wheels] = beta
+    return rows_at(p, wheel_beta)
+
+
+def rows_at(p: LineParameters, wheel_beta: np.ndarray) -> np.ndarray:
+    """:func:`element_rows` from the angle β of every wheel ``(..., n_wheels)`` -> ``(..., 2 n_elements, 3)``."""
     theta = wheel_beta[..., p.element_wheel] + p.theta_offset
     c, s = np.cos(theta), np.sin(theta)
     out = np.empty((*theta.shape[:-1], theta.shape[-1], 2, 3))

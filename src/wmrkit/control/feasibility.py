@@ -213,7 +213,7 @@ def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float,
     else:  # of the steps of the signal (per sample step for a bridged one), not of the 0s held over undefined ones
         typical = np.pad(np.where(held, np.nan, size / span), (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK)
         count = (~np.isnan(typical)).sum(axis=1)
-        typical = np.sort(typical, axis=1)  # NaN last
+        typical = np.sort(typical, axis=1)  # NaN last; np.nanmedian gives the same, 7x slower on rows of 21
         rows = np.arange(len(typical))
         mid = 0.5 * (typical[rows, np.maximum(count - 1, 0) // 2] + typical[rows, count // 2 - (count == 0)])
         blocks = np.where(count > 0, mid, 0.0)

@@ -69,7 +69,7 @@ def read_header_units(path: str | Path, *, max_chars: int = 1 << 16, delimiter: 
     try:
         with open(path, encoding="utf-8-sig", errors="replace", newline="") as f:
             line = f.readline(max_chars)
-    except (OSError, IsADirectoryError):
+    except OSError:
         return HeaderUnits(())
     return parse_header_units(line.strip("\r\n").split(delimiter), source=str(path), time_column=time_column,
                               roles=roles)
@@ -165,8 +165,7 @@ def header_format(path: str | os.PathLike[str], robot_name: str, joints: Sequenc
     source = os.fspath(path)
     roles = {c: j.rpartition(".")[2] for j, c in (columns or {}).items()}
     roles |= {c: kind for c, kind in ((heading_column, "heading"), (gyro_column, "gyro")) if c is not None}
-    units = (read_header_units(path, time_column=time_column, roles=roles) if Path(path).is_file()
-             else HeaderUnits(()))
+    units = read_header_units(path, time_column=time_column, roles=roles)  # nothing from a missing file
     spin = merge_option("--spin", spin, units.spin, "angle", source)
     steer = merge_option("--steer", steer, units.steer, "angle", source)
     convention = merge_option("--steer-convention", steer_convention, units.steer_convention, "heading", source)

@@ -162,7 +162,7 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
     scale = max(1.0, float(np.ptp(ref[:, :2], axis=0).max()))  # the run's extent [m]
     turns = float(np.ptp(ref[:, 2])) > TURNING
     for fit, what in ((fit_k, "WLS ratio"), (fit_m, "effective track")):
-        at = residuals(poses_of(models[what](fit.x[0])))
+        at = fit.fun  # the residuals at the fit
         moved = max(float(np.max(np.abs(residuals(poses_of(models[what](fit.x[0] + s))) - at))) for s in (-1, 1))
         if not moved > IDENTIFIED * scale:  # the start guess would be reported as a fit
             reason = (f"the log turns: no slip in it, or robot '{robot.name}' whose wheels make its odometry "
