@@ -113,6 +113,14 @@ def test_wrapping_counter_and_sensed_subset(capsys, tmp_path, diff_run):
     assert np.hypot(*(np.array(out["pose"][:2]) - diff_run.truth[-1, :2])) < 0.01
 
 
+@pytest.mark.parametrize("width", ["u64", "s64"])
+def test_a_64_bit_counter_header_is_read(capsys, tmp_path, width):
+    path = tmp_path / "c.csv"  # the header's widths are 8 to 64 bits; 64 was refused without the file or column
+    path.write_text(f"time,left.spin [counts:{width}],right.spin [counts:{width}]\n0,0,0\n1,1000,1000\n")
+    out = _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--cpr", "1000"])
+    assert out["pose"] == pytest.approx([2 * math.pi * 0.075, 0.0, 0.0], abs=1e-12)
+
+
 def test_gyro_heading(capsys, tmp_path, diff_run):
     gyro = np.gradient(diff_run.truth[:, 2], diff_run.log.time)
     path = tmp_path / "g.csv"

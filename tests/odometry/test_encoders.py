@@ -48,7 +48,7 @@ def test_wrap_around_of_fixed_width_counters(bits, signed):
     np.testing.assert_array_equal(enc.count_increments(shown), steps)
 
 
-@given(st.integers(2, 62), st.booleans(), st.lists(st.integers(-(1 << 60), 1 << 60), min_size=2, max_size=30))
+@given(st.integers(2, 63), st.booleans(), st.lists(st.integers(-(1 << 60), 1 << 60), min_size=2, max_size=30))
 def test_unwrap_recovers_any_steps_below_half_the_range(bits, signed, raw):
     half = 1 << (bits - 1)
     steps = np.array([s % half - half // 2 if bits > 1 else 0 for s in raw], dtype=np.int64)
@@ -69,8 +69,20 @@ def test_bad_counts_are_refused_with_the_column_name():
         IncrementalEncoder(100).count_increments(np.array([0.0, 2.0**54]))
 
 
+def test_64_bit_counters_of_the_header_widths():
+    # a header's 'counts:u64' / 'counts:s64' (widths 8 to 64) was refused: "bits must be between 2 and 62"
+    signed = IncrementalEncoder(counts_per_rev=100, bits=64, signed=True)
+    np.testing.assert_array_equal(signed.count_increments(np.array([(1 << 63) - 2, -(1 << 63) + 3])), [5])
+    np.testing.assert_array_equal(signed.wrap(np.array([-5, 7])), [-5, 7])
+    unsigned = IncrementalEncoder(counts_per_rev=100, bits=64)
+    np.testing.assert_array_equal(unsigned.count_increments(np.array([0.0, 5.0, 2.0])), [5, -3])
+    with pytest.raises(EncoderError, match="outside the 63-bit unsigned counter range"):
+        IncrementalEncoder(counts_per_rev=100, bits=63).count_increments(np.array([-1, 0]))
+
+
 @pytest.mark.parametrize("kwargs", [dict(counts_per_rev=0), dict(counts_per_rev=10, gear_ratio=-1),
-                                    dict(counts_per_rev=10, bits=1), dict(counts_per_rev=10, sign=2)])
+                                    dict(counts_per_rev=10, bits=1), dict(counts_per_rev=10, bits=65),
+                                    dict(counts_per_rev=10, sign=2)])
 def test_bad_incremental_settings(kwargs):
     with pytest.raises(EncoderError):
         IncrementalEncoder(**kwargs)

@@ -48,8 +48,8 @@ class IncrementalEncoder:
             raise EncoderError(f"counts_per_rev must be > 0, got {self.counts_per_rev}")
         if not self.gear_ratio > 0 or not math.isfinite(self.gear_ratio):
             raise EncoderError(f"gear_ratio must be > 0, got {self.gear_ratio}")
-        if self.bits is not None and not 2 <= self.bits <= 62:
-            raise EncoderError(f"bits must be between 2 and 62, got {self.bits}")
+        if self.bits is not None and not 2 <= self.bits <= 64:
+            raise EncoderError(f"bits must be between 2 and 64, got {self.bits}")
         if self.counts_per_rev * self.gear_ratio > MAX_COUNTS_PER_REV:  # a count below round-off, or 0 rad
             raise EncoderError(f"counts_per_rev x gear_ratio = {self.counts_per_rev * self.gear_ratio:g} counts per "
                                f"wheel revolution: at most {MAX_COUNTS_PER_REV:g}")
@@ -79,8 +79,8 @@ class IncrementalEncoder:
             bad = c.min() if c.min() < low else c.max()
             raise EncoderError(f"{name}: count {bad} outside the {self.bits}-bit "
                                f"{'signed' if self.signed else 'unsigned'} counter range [{low}, {low + span})")
-        d = np.diff(c, axis=0)
-        return (d + (span >> 1)) % span - (span >> 1)
+        shift = 64 - self.bits  # int64 differences wrap modulo 2**64; the shifts take them modulo 2**bits
+        return (np.diff(c, axis=0) << shift) >> shift
 
     def angle_increments(self, counts: ArrayLike, *, name: str = "counts") -> np.ndarray:
         """Wheel angle increments [rad] between consecutive samples. ``(N, ...) -> (N - 1, ...)``."""
@@ -95,9 +95,13 @@ class IncrementalEncoder:
         c = np.asarray(counts, dtype=np.int64)
         if self.bits is None:
             return c
-        span = 1 << self.bits
-        low = -(span >> 1) if self.signed else 0
-        return (c - low) % span + low
+        shift = 64 - self.bits
+        shown = (c << shift) >> shift  # the signed counter's reading
+        if self.signed:
+            return shown
+        if self.bits == 64 and (c < 0).any():
+            raise EncoderError("counts: a 64-bit unsigned counter's readings of negative counts exceed int64")
+        return shown & ((1 << self.bits) - 1) if self.bits < 64 else c
 
 
 @dataclass(frozen=True, slots=True)
