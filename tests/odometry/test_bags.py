@@ -7,6 +7,7 @@ import pytest
 
 from wmrkit import catalog
 from wmrkit.odometry.bags import (
+    JOINT_STATE,
     OdometryBagWriter,
     bag_message_count,
     read_joint_states,
@@ -127,3 +128,48 @@ def test_a_run_that_fails_leaves_no_partial_output(tmp_path, name):
     with pytest.raises(LogError, match=r"left\.spin: value nan"):
         odometry_file(catalog.load("diff-drive"), log, out=out, chunk_size=16)  # chunks before row 60 written
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["log.csv"]
+
+
+def test_header_stamps_going_backwards_are_named_as_such(tmp_path):
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    state, header, stamp = (ts.types[t] for t in (JOINT_STATE, "std_msgs/msg/Header", "builtin_interfaces/msg/Time"))
+    with Writer(tmp_path / "js", version=8) as w:  # received in order, stamped 1 s, 2 s, 1.5 s
+        conn = w.add_connection("/joint_states", JOINT_STATE, typestore=ts)
+        for k, (sec, nsec) in enumerate([(1, 0), (2, 0), (1, 500_000_000)]):
+            msg = state(header=header(stamp=stamp(sec=sec, nanosec=nsec), frame_id=""),
+                        name=["left.spin", "right.spin"], position=np.full(2, float(k)),
+                        velocity=np.zeros(0), effort=np.zeros(0))
+            w.write(conn, (k + 1) * 10**9, ts.serialize_cdr(msg, JOINT_STATE))
+    for chunk_size in (1, 10):  # was: "turns 1 rad in -0.5 s (-2 rad/s > 10000 rad/s): an implausible jump"
+        with pytest.raises(LogError, match=r"sample 2: time 1.5 s goes backwards"):
+            list(read_joint_states(tmp_path / "js", ("left.spin", "right.spin"), chunk_size=chunk_size))
+
+
+@pytest.mark.parametrize(("time", "left", "message"), [
+    ([0.0, 1.0, 1.0], [0.0, 1.0, 2.0], r"sample 2: time 1.0 s repeats the previous sample"),  # was: "in 0 s"
+    ([0.0, 1.0, 2.0], [0.0, np.nan, 2.0], r"sample 1: left.spin: value nan is not a finite number"),
+])
+def test_bad_stamps_and_positions_of_a_bag_are_named_as_such(tmp_path, time, left, message):
+    path = tmp_path / "js"
+    write_joint_states(path, JointLog(np.array(time), ("left.spin", "right.spin"),
+                                      np.column_stack([left, [0.0, 1.0, 2.0]])))
+    for chunk_size in (1, 10):
+        with pytest.raises(LogError, match=message):
+            list(read_joint_states(path, ("left.spin", "right.spin"), chunk_size=chunk_size))
+
+
+def test_a_joint_named_twice_in_a_message_is_refused(tmp_path):
+    path = tmp_path / "js"  # the last of the two positions was used silently
+    write_joint_states(path, JointLog(np.array([0.0, 1.0]), ("left.spin", "right.spin"), np.array([[0, 0], [1, 2.0]])),
+                       names={"right.spin": "left.spin"})
+    with pytest.raises(LogError, match=r"message 0: left.spin is named twice \(left.spin, left.spin\)"):
+        list(read_joint_states(path, ("left.spin", "right.spin")))
+    with pytest.raises(LogError, match=r"message 0: right.spin is named twice \(wheel_l, wheel_r\)"):
+        write_joint_states(tmp_path / "js2", JointLog(np.array([0.0, 1.0]), ("left.spin", "right.spin"),
+                                                      np.array([[0, 0], [1, 2.0]])),
+                           names={"left.spin": "wheel_l", "right.spin": "wheel_r"})
+        list(read_joint_states(tmp_path / "js2", ("left.spin", "right.spin"),
+                               names={"wheel_l": "right.spin", "wheel_r": "right.spin"}))

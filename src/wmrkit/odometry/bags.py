@@ -5,8 +5,8 @@ ros2_control's joint state broadcaster publishes them: a steering joint reads 0 
 ahead), converted to the thesis's β of :class:`~.logs.JointLog` with the robot's wheels (:mod:`.steering`); the
 writer converts back. Joint names are the robot's ``WHEEL.spin`` / ``WHEEL.steer`` unless
 ``names`` maps ROS names onto them. Messages naming none of the needed joints (other publishers on the topic)
-are skipped; a message naming some but not all is an error. Time is the header stamp (the bag's receive time
-when the stamp is zero).
+are skipped; a message naming some but not all, or one of them twice, is an error. Time is the header stamp (the
+bag's receive time when the stamp is zero), strictly increasing.
 
 ``rosbags`` is the optional extra ``bags``, imported on first use. A bag that cannot be read (no metadata, an
 unknown version, a file that is no SQLite or MCAP store, metadata larger than :data:`MAX_METADATA` or using
@@ -25,7 +25,8 @@ import numpy as np
 
 from ..errors import WmrkitError
 from .integrators import sinc
-from .logs import MAX_RATE, JointLog, LogError, check_jumps
+from .logs import MAX_RATE, JointLog, LogError, check_jumps, check_time
+from .pipeline import check_finite
 from .steering import check_robot, check_steer_range, convert_steering
 
 if TYPE_CHECKING:
@@ -163,6 +164,12 @@ def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, ro
         for stamp_ns, msg in _messages(reader, conns, f"{source}: {topic}", JOINT_STATE, ts):
             got = {rename.get(n, n): k for k, n in enumerate(msg.name)}
             have = [j for j in joints if j in got]
+            if len(got) < len(msg.name):  # a joint named twice: which position is it?
+                named = [rename.get(n, n) for n in msg.name]
+                twice = [j for j in have if named.count(j) > 1]
+                if twice:
+                    raise LogError(f"{source}: {topic} message {index}: {twice[0]} is named twice "
+                                   f"({', '.join(n for n in msg.name if rename.get(n, n) == twice[0])})")
             if progress is not None:
                 progress(1)
             if not have:
@@ -195,6 +202,8 @@ def _chunk(times: list[float], joints: Sequence[str], rows: list, source: str, f
     raw = np.array(rows, dtype=float).reshape(len(times), len(joints))
     log = JointLog(np.array(times), tuple(joints), raw, None, source, None, first)
     t = log.time if last is None else np.concatenate([[last[0]], log.time])
+    check_finite(log)  # named as such, not as a jump of nan rad
+    check_time(log, log.time, None if last is None else last[0], None)  # a repeated stamp, not a jump in 0 s
     check_jumps(log, raw, None if last is None else last[1], t, max_rate)
     check_steer_range(robot, joints, raw, log.where)
     yield JointLog(log.time, log.joints, convert_steering(robot, joints, raw, to="beta", source=source), None,
