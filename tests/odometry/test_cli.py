@@ -144,6 +144,12 @@ def test_gyro_heading(capsys, tmp_path, diff_run):
     ("ok", ["--chunk-size", "0"], r"--chunk-size must be in \[1, 4194304\] samples"),
     ("ok", ["--weight", "left=-1"], r"weight of wheel 'left' must be a finite number > 0"),
     ("missing", [], r"no such file"),
+    # one encoder read for two wheels, a joint misspelt: were read as a straight line / ignored
+    ("ok", ["--column", "right.spin=left.spin"], r"x\.csv:1: column 'left\.spin' is read for both left\.spin and "
+                                                  r"right\.spin"),
+    ("ok", ["--column", "left.spin=time"], r"x\.csv:1: column 'time' is read for both time and left\.spin"),
+    ("ok", ["--heading-column", "right.spin"], r"column 'right\.spin' is read for both right\.spin and heading"),
+    ("ok", ["--column", "lfet.spin=left.spin"], r"a column is given for 'lfet\.spin', no joint of the robot"),
 ])
 def test_bad_input_exits_2_with_one_line(capsys, tmp_path, setup, args, message):
     path = tmp_path / "x.csv"

@@ -395,8 +395,20 @@ def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: S
         wheel, dot, joint = name.rpartition(".")
         if dot and joint in ("spin", "steer") and wheels and wheel not in wheels and name not in renamed:
             raise LogError(f"{source}:1: column '{name}' names no wheel of the robot (wheels: {', '.join(wheels)})")
-    wanted = [fmt.time_column, *(fmt.column_of(j) for j in joints)]
-    wanted += [c for c in (fmt.heading_column, fmt.gyro_column) if c is not None]
+    for joint, _ in fmt.columns:  # a misspelt joint's column would be ignored
+        wheel, _, kind = joint.rpartition(".")
+        if wheels and (kind not in ("spin", "steer") or wheel not in wheels):
+            raise LogError(f"{source}: a column is given for '{joint}', no joint of the robot (joints WHEEL.spin, "
+                           f"WHEEL.steer; wheels: {', '.join(wheels)})")
+    wanted, roles = [fmt.time_column, *(fmt.column_of(j) for j in joints)], ["time", *joints]
+    for role, name in (("heading", fmt.heading_column), ("gyro", fmt.gyro_column)):
+        if name is not None:
+            wanted.append(name)
+            roles.append(role)
+    for k, name in enumerate(wanted):  # one column read twice: two encoders were read from one
+        if name in wanted[:k]:
+            raise LogError(f"{source}:1: column '{name}' is read for both {roles[wanted.index(name)]} and "
+                           f"{roles[k]}")
     for name in wanted:
         if name not in header:
             close = difflib.get_close_matches(name, header, n=1)
