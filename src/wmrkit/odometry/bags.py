@@ -150,6 +150,12 @@ def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, ro
     """
     source, rename = os.fspath(path), dict(names or {})
     check_robot(joints, robot, source)
+    wheels = [w.name for w in robot.wheels] if robot is not None else []
+    for ros, joint in rename.items():  # a misspelt joint's name would be ignored
+        wheel, _, kind = joint.rpartition(".")
+        if joint not in joints and (kind not in ("spin", "steer") or (wheels and wheel not in wheels)):
+            raise LogError(f"{source}: ROS joint '{ros}' is mapped to '{joint}', no joint of the robot (joints "
+                           f"WHEEL.spin, WHEEL.steer{'; wheels: ' + ', '.join(wheels) if wheels else ''})")
     reader = _open(source)
     ts = _typestore()
     try:
