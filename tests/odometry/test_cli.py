@@ -150,6 +150,12 @@ def test_gyro_heading(capsys, tmp_path, diff_run):
     ("ok", ["--column", "left.spin=time"], r"x\.csv:1: column 'time' is read for both time and left\.spin"),
     ("ok", ["--heading-column", "right.spin"], r"column 'right\.spin' is read for both right\.spin and heading"),
     ("ok", ["--column", "lfet.spin=left.spin"], r"a column is given for 'lfet\.spin', no joint of the robot"),
+    # a steering resolution for a log without steering counts was ignored; encoder settings named their fields
+    ("ok", ["--steer-resolution", "1.4118 deg"], r"--steer-resolution applies to steer columns of encoder counts"),
+    ("ok", ["--spin", "counts", "--cpr", "0"], r"--cpr must be a finite number > 0, got 0"),
+    ("ok", ["--spin", "counts", "--cpr", "100", "--gear", "-2"], r"--gear must be a finite number > 0, got -2"),
+    ("ok", ["--spin", "counts", "--cpr", "100", "--counter-bits", "65"], r"--counter-bits must be between 2 and 64"),
+    ("ok", ["--max-gap", "-1"], r"--max-gap must be > 0 s, got -1"),
 ])
 def test_bad_input_exits_2_with_one_line(capsys, tmp_path, setup, args, message):
     path = tmp_path / "x.csv"

@@ -103,6 +103,13 @@ def run(args: argparse.Namespace) -> int:
     options = {"--cpr": args.cpr is not None, "--gear": args.gear is not None,
                "--counter-bits": args.counter_bits is not None, "--signed-counter": args.signed_counter}
     steer_res = None if args.steer_resolution is None else parse_angle(args.steer_resolution, "--steer-resolution")
+    for option, value in (("--cpr", args.cpr), ("--gear", args.gear), ("--steer-resolution", steer_res)):
+        if value is not None and not (math.isfinite(value) and value > 0):  # the library's messages name its fields
+            raise WmrkitError(f"{option} must be a finite number > 0, got {value:g}")
+    if args.max_gap is not None and not args.max_gap > 0:
+        raise WmrkitError(f"--max-gap must be > 0 s, got {args.max_gap:g}")
+    if args.counter_bits is not None and not 2 <= args.counter_bits <= 64:
+        raise WmrkitError(f"--counter-bits must be between 2 and 64, got {args.counter_bits}")
     fmt = header_format(args.log, robot.name, joints, time_column=args.time_column, time_unit=args.time_unit,
                         columns=parse_assignments(args.column, "--column"), spin=args.spin, steer=args.steer,
                         steer_convention=args.steer_convention, counter_bits=args.counter_bits,
@@ -112,6 +119,9 @@ def run(args: argparse.Namespace) -> int:
     if given and not any(j.endswith(".spin") for j, _ in fmt.encoders):  # it would be ignored silently
         raise WmrkitError(f"{given[0]} applies to spin columns of encoder counts (--spin counts, or a header "
                           "'WHEEL.spin [counts]')")
+    if steer_res is not None and not any(j.endswith(".steer") for j, _ in fmt.encoders):  # ignored as well
+        raise WmrkitError("--steer-resolution applies to steer columns of encoder counts (--steer counts, or a header "
+                          "'WHEEL.steer [counts]')")
     pose0 = [parse_value(args.pose[0], "length", "--pose X"), parse_value(args.pose[1], "length", "--pose Y"),
              parse_angle(args.pose[2], "--pose")]
     slip_model = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None
