@@ -197,6 +197,20 @@ def test_bad_in_memory_logs_are_refused():
         odometry(robot, log, chunk_size=2)
 
 
+@pytest.mark.parametrize("noise", [None, CrowleyNoise()])
+def test_a_pose_beyond_the_handled_range_is_refused_not_printed(noise):
+    robot = catalog.load("diff-drive")  # finite but no pose: theta 1.9e149 rad was printed as a result
+    log = JointLog(np.array([0.0, 1.0, 2.0, 3.0]), ("left.spin", "right.spin"),
+                   np.array([[0, 0], [1, 1], [1e150, 2e150], [1e150, 2e150]]))
+    for chunk_size in (1, 10):
+        with pytest.raises(LogError, match=r"sample 2: the pose .* is beyond 1e\+09 m or 1e\+06 turns"):
+            odometry(robot, log, chunk_size=chunk_size, noise=noise)
+    with pytest.raises(LogError, match=r"sample 1: the pose .* is beyond 1e\+09 m"):  # from a start near the limit
+        odometry(robot, log.slice(0, 2), pose0=(1e9 - 0.01, 0, 0))
+    np.testing.assert_allclose(odometry(robot, log.slice(0, 2), pose0=(1e9 - 0.1, 0, 0)).final_pose,
+                               [1e9 - 0.025, 0, 0], atol=1e-6)
+
+
 def test_castor_robot_from_its_castors_converges_at_second_order():
     """Three sensed castors (thesis type-1 robot): the steering angles change continuously, the model takes them
     at mid-interval, so the error falls like the square of the sample period."""

@@ -93,6 +93,7 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
     prev: JointLog | None = None
     heading0 = 0.0
     stats = _Stats()
+    reach, turn = MAX_COORDINATE - np.abs(pose[:2]).max(), MAX_ANGLE - abs(pose[2])  # path and rotation in bounds
     row = 0  # index of the chunk's first sample in `out`
     for raw in chunks:
         chunk = raw if raw.joints == model.joints else raw.select(model.joints)
@@ -129,6 +130,9 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
             check_finite(chunk)
         if not (all(map(math.isfinite, sums)) and np.isfinite(poses[-1]).all()):
             _overflow(chunk, poses)
+        if (stats.dist + sums[0] > reach or stats.rot + sums[1] > turn  # cheap bounds of the poses; then scan them
+                or abs(poses[-1, 2]) > MAX_ANGLE):
+            _beyond(chunk, poses)
         covs = None
         if cov is not None:
             dx, dy, dth = (np.zeros(n) if c is None else c for c in (inc.column(0), inc.column(1), inc.column(2)))
@@ -303,6 +307,16 @@ def _overflow(chunk: JointLog, values: np.ndarray, what: str = "pose") -> None:
     i = int(np.argmax(bad)) if bad.any() else len(values) - 1
     raise LogError(f"{chunk.where(i)}: the {what} overflows here (values too large for floating point: an "
                    "implausible log)")
+
+
+def _beyond(chunk: JointLog, poses: np.ndarray) -> None:
+    """Name the first row of `chunk` whose pose is beyond :data:`MAX_COORDINATE` or :data:`MAX_ANGLE` (finite, but
+    no pose: a heading of 1e149 rad has no direction), if any."""
+    bad = (np.abs(poses[:, :2]) > MAX_COORDINATE).any(axis=1) | (np.abs(poses[:, 2]) > MAX_ANGLE)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise LogError(f"{chunk.where(i)}: the pose {poses[i].tolist()} is beyond {MAX_COORDINATE:g} m or "
+                       f"{MAX_TURNS:g} turns here: an implausible log (a unit or time column misread?)")
 
 
 def check_finite(log: JointLog) -> None:
