@@ -121,6 +121,14 @@ def test_a_64_bit_counter_header_is_read(capsys, tmp_path, width):
     assert out["pose"] == pytest.approx([2 * math.pi * 0.075, 0.0, 0.0], abs=1e-12)
 
 
+def test_an_angle_in_a_steering_counts_column_is_refused(capsys, tmp_path):
+    path = tmp_path / "f.csv"  # degrees written to the forklift's counts column were read as 1.4118-deg counts
+    path.write_text("time,right_drive.spin [counts],left_drive.spin [counts],steer.steer [counts]\n"
+                    "0,0,0,-25.17\n1,1000,1000,-25.17\n")
+    assert main(["odometry", "forklift", str(path)]) == 2
+    assert "column 'steer.steer [counts]': counts must be whole numbers, got -25.17" in capsys.readouterr().err
+
+
 def test_gyro_heading(capsys, tmp_path, diff_run):
     gyro = np.gradient(diff_run.truth[:, 2], diff_run.log.time)
     path = tmp_path / "g.csv"

@@ -88,6 +88,13 @@ def test_bad_incremental_settings(kwargs):
         IncrementalEncoder(**kwargs)
 
 
+def test_fractional_absolute_counts_are_refused():
+    enc = AbsoluteEncoder(resolution=math.radians(1.4118))  # -25.17 (degrees in a counts column) was read as counts
+    with pytest.raises(EncoderError, match=r"steer: counts must be whole numbers, got -25\.17 \(an angle in degrees"):
+        enc.angle(np.array([-25.0, -25.17]), name="steer")
+    assert enc.angle(np.array([-25.0]))[0] == pytest.approx(math.radians(-25 * 1.4118), rel=1e-15)
+
+
 def test_quantize_is_the_floor_of_the_count():
     enc = IncrementalEncoder(counts_per_rev=8290)
     res = 2 * math.pi / 8290

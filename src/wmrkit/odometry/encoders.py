@@ -121,11 +121,15 @@ class AbsoluteEncoder:
         if self.sign not in (1, -1):
             raise EncoderError(f"sign must be +1 or -1, got {self.sign}")
 
-    def angle(self, counts: ArrayLike) -> np.ndarray:
-        """Angles [rad] of raw readings `counts`. ``(...) -> (...)``."""
+    def angle(self, counts: ArrayLike, *, name: str = "counts") -> np.ndarray:
+        """Angles [rad] of raw readings `counts` (whole numbers, else :class:`EncoderError` naming `name`).
+        ``(...) -> (...)``."""
         c = np.asarray(counts, dtype=float)
         if not np.isfinite(c).all():
-            raise EncoderError("counts: expected finite readings")
+            raise EncoderError(f"{name}: expected finite readings")
+        if (c != np.round(c)).any():  # an angle written to a counts column
+            raise EncoderError(f"{name}: counts must be whole numbers, got {float(c[c != np.round(c)][0])!r} "
+                               "(an angle in degrees or radians?)")
         return self.offset + self.sign * c * self.resolution
 
     def quantize(self, angle: ArrayLike) -> np.ndarray:

@@ -237,10 +237,11 @@ class Decoder:
         if kind == "velocity":
             return (0.0 if prev is None else prev) + _cumtrapz(col, t, start=prev is None)
         enc = self.fmt.encoder_of(joint, self.source)
+        name = f"{probe.source}: column '{self.fmt.column_of(joint)}'"
         try:
             if isinstance(enc, AbsoluteEncoder):
-                return enc.angle(new)
-            steps = enc.angle_increments(col, name=f"{probe.source}: column '{self.fmt.column_of(joint)}'")
+                return enc.angle(new, name=name)
+            steps = enc.angle_increments(col, name=name)
         except EncoderError as err:
             raise LogError(str(err)) from None
         start = np.zeros(1) if prev is None else np.full(1, prev)
