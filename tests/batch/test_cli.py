@@ -136,3 +136,16 @@ def test_calibrate_refuses_options_it_would_ignore(capsys, calibration_data, ext
     assert main(["batch", "calibrate", "diff-drive", str(calibration_data / "c0.csv"), "--closed", "--workers", "0",
                  *extra]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_sweep_refuses_to_write_its_table_over_the_robot_description(capsys, tmp_path):
+    """'sweep robot.json --out robot.json' replaced the description with the Parquet table (exit 0)."""
+    from wmrkit import catalog
+    from wmrkit.description import robot_to_dict
+
+    robot = tmp_path / "robot.json"
+    robot.write_text(json.dumps(robot_to_dict(catalog.load("omni-3"))))
+    before = robot.read_text()
+    assert main(["sweep", str(robot), "--vary", "wheels[0].l=0.1:0.2:2", "--workers", "0", "--out", str(robot)]) == 2
+    assert "is the ROBOT description" in capsys.readouterr().err
+    assert robot.read_text() == before
