@@ -354,3 +354,13 @@ def test_reading_the_logs_shows_progress(diff, fleet_dir, capsys):
     """Fleet calibration read its logs (weeks of them, on the engine) with no progress bar (the bootstrap had one)."""
     runs = load_runs(diff, [str(fleet_dir / "run0.csv"), str(fleet_dir / "run1.csv")], closed=True, progress=True)
     assert len(runs) == 2 and "logs: 0%| | 0/2" in " ".join(capsys.readouterr().err.split())
+
+
+@pytest.mark.parametrize("params", [[("left.r", "left.r")], [("left.r", "right.r"), "right.r"]])
+def test_a_field_given_twice_is_refused(diff, runs, params):
+    """'--param left.r,left.r' scaled left.r by (1 + p)^2 and listed it twice with p, the half of its change; a
+    field in two groups was blamed on the runs ('cannot tell these parameters apart: add runs')."""
+    from wmrkit.errors import WmrkitError
+
+    with pytest.raises(WmrkitError, match=r"parameter '(left|right)\.r': given twice"):
+        fleet_calibrate(diff, runs, params)

@@ -365,6 +365,8 @@ def _groups(robot: Robot, parameters: Sequence[Parameter]) -> list[list[tuple[st
                                        f"(fields: {', '.join(allowed)})")
             if GEOMETRY_FIELDS[fld] == "length" and getattr(w, fld) == 0:
                 raise WmrkitError(f"parameter '{name}': its nominal value is 0, so it cannot be scaled")
+            if any((wheel, fld) == (g[0], g[1]) for g in (*group, *(g for gs in groups for g in gs))):
+                raise WmrkitError(f"parameter '{name}': given twice (a field moved twice is scaled twice)")
             group.append((wheel, fld, sign))
         if not group:
             raise WmrkitError("calibrate: an empty parameter group")
