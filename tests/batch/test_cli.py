@@ -149,3 +149,13 @@ def test_sweep_refuses_to_write_its_table_over_the_robot_description(capsys, tmp
     assert main(["sweep", str(robot), "--vary", "wheels[0].l=0.1:0.2:2", "--workers", "0", "--out", str(robot)]) == 2
     assert "is the ROBOT description" in capsys.readouterr().err
     assert robot.read_text() == before
+
+
+def test_batch_odometry_refuses_a_trajectory_format_without_trajectories(capsys, fleet_dir, tmp_path):
+    """--trajectory-format csv without --trajectories wrote no trajectory and said nothing (rule 8)."""
+    assert main(["batch", "odometry", "diff-drive", str(fleet_dir / "run0.csv"), "--workers", "0",
+                 "--trajectory-format", "csv"]) == 2
+    assert "--trajectory-format is the format of the --trajectories files" in capsys.readouterr().err
+    assert main(["batch", "odometry", "diff-drive", str(fleet_dir / "run0.csv"), "--workers", "0",
+                 "--trajectory-format", "csv", "--trajectories", str(tmp_path)]) == 0
+    assert (tmp_path / "run0.csv").exists()

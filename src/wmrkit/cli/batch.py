@@ -42,7 +42,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
     p.add_argument("--out", metavar="FILE", help="summary table (Parquet); a rerun skips the logs done")
     p.add_argument("--trajectories", metavar="DIR", help="write each log's trajectory to DIR/NAME.tum")
-    p.add_argument("--trajectory-format", choices=("tum", "csv"), default="tum", help="trajectory files (default tum)")
+    p.add_argument("--trajectory-format", choices=("tum", "csv"), help="trajectory files (default tum)")
     p.add_argument("--closed", action="store_true", help="every run ends at its start: report the closure error")
     p.add_argument("--no-resume", action="store_true", help="redo every log even if --out has it")
     _log_options(p)
@@ -134,9 +134,11 @@ def run_odometry(args: argparse.Namespace) -> int:
     from ..batch.fleet import batch_odometry
 
     robot = load_robot(args.robot)
+    if args.trajectory_format is not None and args.trajectories is None:  # no trajectory written: it was ignored
+        raise WmrkitError("--trajectory-format is the format of the --trajectories files; give --trajectories DIR")
     with _runner(args) as runner:
         result = batch_odometry(robot, args.logs, runner=runner, method=args.method, out=args.out,
-                                trajectories=args.trajectories, trajectory_format=args.trajectory_format,
+                                trajectories=args.trajectories, trajectory_format=args.trajectory_format or "tum",
                                 closed=args.closed, resume=not args.no_resume, progress=_progress(args),
                                 **_options(args))
     if args.json:
