@@ -27,6 +27,9 @@ from .sweep_kernel import METRICS, Axis, build_spec, evaluate
 #: Most designs x steering configurations evaluated in one chunk (4096 x 128, the documented example; the chunk is
 #: made smaller for more configurations): a chunk's memory is about 0.5 kB per pair.
 MAX_CHUNK_COLUMNS = 2**19
+#: Most best designs kept and reported (``top``): they are kept in memory and sorted at every chunk, so a larger
+#: `top` made the memory grow with the number of designs (about 2 kB each); every design goes to ``out``.
+MAX_TOP = 10**4
 #: Whether a metric is better when smaller.
 LOWER_IS_BETTER = {"kappa_mean": True, "kappa_max": True, "inv_kappa_mean": False, "singular_margin": False}
 
@@ -66,6 +69,8 @@ def sweep(robot: Robot, axes: Sequence[Axis], metric: str = "kappa_mean", *, run
     for name, value in (("chunk", chunk), ("top", top)):
         if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
             raise BatchError(f"{name}: expected an integer >= 1, got {value!r}")
+    if top > MAX_TOP:
+        raise BatchError(f"--top {top}: at most {MAX_TOP} best designs (every design is in the --out table)")
     t0 = time.perf_counter()
     axes = tuple(axes)
     spec = build_spec(robot, list(axes), metric, length=length, configs=configs, seed=seed, progress=progress)

@@ -92,7 +92,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--length", metavar="D", help="characteristic length [m] (default: each design's natural one)")
     p.add_argument("--configs", type=int, default=64, help="steering configurations per design (default 64)")
     p.add_argument("--chunk", type=int, default=4096, help="designs per chunk (default 4096)")
-    p.add_argument("--top", type=int, default=10, help="best designs reported (default 10)")
+    p.add_argument("--top", type=int, default=10, help="best designs reported (default 10, at most 10000)")
     p.add_argument("--out", metavar="FILE", help="every design and its metric (Parquet)")
     p.add_argument("--plot", metavar="FILE", help="the metric over the first one or two axes")
     _engine_options(p)
