@@ -212,3 +212,17 @@ def test_the_number_of_best_designs_is_bounded():
     robot = catalog.load("omni-3")
     with pytest.raises(BatchError, match=r"--top 1000000000: at most 10000 best designs"):
         sweep(robot, [parse_vary("wheels[0].l=0.1:0.2:2", robot)], top=10**9)
+
+
+def test_the_table_says_which_metric_it_holds_and_the_units(tmp_path):
+    """The Parquet table had a column 'metric' but did not say which (kappa_mean is better low, inv_kappa_mean
+    high) nor the robot, nor that an angle axis is in rad though --vary was given in deg."""
+    pq = pytest.importorskip("pyarrow.parquet")
+    robot = catalog.load("omni-3")
+    axes = [parse_vary("wheels[0].alpha=30deg:90deg:2", robot), parse_vary("wheels[1].l=0.1:0.2:2", robot)]
+    sweep(robot, axes, "inv_kappa_mean", out=tmp_path / "s.parquet")
+    schema = pq.read_schema(tmp_path / "s.parquet")
+    assert {k.decode(): v.decode() for k, v in schema.metadata.items()} == {
+        "robot": "omni-3", "metric": "inv_kappa_mean", "better": "higher"}
+    units = {f.name: f.metadata[b"unit"].decode() for f in schema if f.metadata}
+    assert units == {"wheels[0].alpha": "rad", "wheels[1].l": "m", "metric": "1", "length": "m"}

@@ -81,7 +81,7 @@ def sweep(robot: Robot, axes: Sequence[Axis], metric: str = "kappa_mean", *, run
     lower = LOWER_IS_BETTER[metric]
     grid = np.full(spec.shape[:2], np.inf if lower else -np.inf)
     best = np.zeros((0, 3))  # rows (index, metric, length)
-    writer = _Writer(out, axes) if out is not None else None
+    writer = _Writer(out, axes, robot.name, metric) if out is not None else None
     own = runner is None
     runner = engine(workers=0) if runner is None else runner
     try:
@@ -148,9 +148,10 @@ def _keep_best(rows: np.ndarray, top: int, lower: bool) -> np.ndarray:
 
 
 class _Writer:
-    """Streams chunks of the sweep to Parquet (a temporary file renamed into place at the end)."""
+    """Streams chunks of the sweep to Parquet (a temporary file renamed into place at the end). The schema's
+    metadata names the ``robot`` and the ``metric`` (the column is ``metric``), each field's its ``unit``."""
 
-    def __init__(self, path: str | os.PathLike[str], axes: Sequence[Axis]) -> None:
+    def __init__(self, path: str | os.PathLike[str], axes: Sequence[Axis], robot: str, metric: str) -> None:
         pa, pq = need_extra("pyarrow"), need_extra("pyarrow.parquet")
         self.path, self.axes, self._pa = Path(path), axes, pa
         if not self.path.parent.exists():
@@ -160,8 +161,12 @@ class _Writer:
         names = [a.label for a in axes]
         if len(set(names)) != len(names):
             raise BatchError("two --vary axes have the same fields")
-        self.schema = pa.schema([("index", pa.int64()), *((n, pa.float64()) for n in names), ("metric", pa.float64()),
-                                 ("length", pa.float64())])
+        self.schema = pa.schema([pa.field("index", pa.int64()),
+                                 *(pa.field(a.label, pa.float64(), metadata={"unit": a.unit}) for a in axes),
+                                 pa.field("metric", pa.float64(), metadata={"unit": "1"}),  # every metric is a ratio
+                                 pa.field("length", pa.float64(), metadata={"unit": "m"})],
+                                metadata={"robot": robot, "metric": metric,
+                                          "better": "lower" if LOWER_IS_BETTER[metric] else "higher"})
         self.tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
         try:
             self._w = pq.ParquetWriter(self.tmp, self.schema)
