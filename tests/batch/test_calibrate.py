@@ -364,3 +364,32 @@ def test_a_field_given_twice_is_refused(diff, runs, params):
 
     with pytest.raises(WmrkitError, match=r"parameter '(left|right)\.r': given twice"):
         fleet_calibrate(diff, runs, params)
+
+
+def test_the_default_parameters_are_those_of_the_sensed_joints(tmp_path, capsys):
+    """With --sensed, the default parameters were still every spin-sensed wheel's radius: a Mecanum robot read from
+    three of its four encoders was refused ('they do not move the poses along rear_right.r')."""
+    import json
+
+    from batch_params import write_log
+
+    from wmrkit.cli.main import main
+    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+
+    robot = catalog.load("mecanum-4")
+    sensed = ["front_left.spin", "front_right.spin", "rear_left.spin"]
+    assert default_parameters(robot, closed=False, sensed=sensed) == [
+        "front_left.r", "front_right.r", "rear_left.r", ("front_left.l", "front_right.l", "rear_left.l")]
+    (tmp_path / "ref").mkdir()
+    rng = np.random.default_rng(1)
+    for i in range(3):
+        segs = [(2.0, 0.3, rng.uniform(-0.3, 0.3), rng.uniform(-0.6, 0.6)) for _ in range(3)]
+        run = simulate(robot, TwistProfile.from_segments(segs), 10.0, spin_noise_per_rad=1e-5, seed=i)
+        write_log(tmp_path / f"m{i}.csv", run)
+        write_trajectory(tmp_path / "ref" / f"m{i}.tum", Trajectory(run.log.time, run.truth, np.zeros(len(run.log)),
+                                                                    None), "tum")
+    argv = ["batch", "calibrate", "mecanum-4", str(tmp_path / "m*.csv"), "--reference", str(tmp_path / "ref"),
+            "--workers", "0", "--json"]
+    assert main([*argv, *(a for s in sensed for a in ("--sensed", s))]) == 0
+    fields = [v["field"] for v in json.loads(capsys.readouterr().out)["values"]]
+    assert fields == ["front_left.r", "front_right.r", "rear_left.r", "front_left.l", "front_right.l", "rear_left.l"]

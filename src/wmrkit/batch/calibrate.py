@@ -337,11 +337,11 @@ def fleet_slip_calibrate(robot: Robot, runs: Sequence[CalibrationRun], *, runner
                                 (float(lo[1]), float(hi[1])), tuple((float(k), float(m)) for k, m in per_run), level)
 
 
-def default_parameters(robot: Robot, *, closed: bool) -> list[Parameter]:
-    """Radii of the wheels with a sensed spin and the common scale of the wheel placement (``l``: the track of
-    a differential drive); with only closed paths, the radius *ratio* of two such wheels instead of both radii
-    (a closed path returns to its start at any scale)."""
-    spun = [j.partition(".")[0] for j in robot.sensed if j.endswith(".spin")]
+def default_parameters(robot: Robot, *, closed: bool, sensed: Sequence[str] | None = None) -> list[Parameter]:
+    """Radii of the wheels with a sensed spin (among `sensed`, default the robot's sensed joints) and the common
+    scale of the wheel placement (``l``: the track of a differential drive); with only closed paths, the radius
+    *ratio* of two such wheels instead of both radii (a closed path returns to its start at any scale)."""
+    spun = [j.partition(".")[0] for j in (sensed or robot.sensed) if j.endswith(".spin")]
     placed = tuple(f"{w.name}.l" for w in robot.wheels if w.l > 0 and w.name in spun)
     if closed:
         if len(spun) != 2:

@@ -170,7 +170,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
         raise WmrkitError("--bootstrap is the number of replicates of --ci bootstrap")
     args.ci, args.bootstrap = args.ci or "jacobian", 200 if args.bootstrap is None else args.bootstrap
     params = ([tuple(n.strip() for n in p.split(",") if n.strip()) for p in args.param] if args.param
-              else [] if args.slip else default_parameters(robot, closed=args.closed))
+              else [] if args.slip else default_parameters(robot, closed=args.closed, sensed=args.sensed))
     check_bootstrap(args.bootstrap, "--bootstrap")
     with _runner(args) as runner:
         runs = load_runs(robot, expand_logs(args.logs), reference_dir=args.reference, closed=args.closed,
