@@ -130,6 +130,8 @@ def test_montecarlo_refuses_a_rate_with_a_log(capsys, fleet_dir):
     (["--ci", "jacobian", "--bootstrap", "500"], "--bootstrap is the number of replicates of --ci bootstrap"),
     (["--slip", "--param", "left.r"], "--param is for the geometry fit; --slip fits slip weights"),
     (["--slip", "--ci", "bootstrap"], "--ci is for the geometry fit; --slip fits slip weights"),
+    # the slip fit read the logs with the --sensed joints and then wanted every sensed joint ('no samples of joint')
+    (["--slip", "--sensed", "left.spin"], "--sensed is for the geometry fit; --slip fits slip weights"),
 ])
 def test_calibrate_refuses_options_it_would_ignore(capsys, calibration_data, extra, message):
     """--bootstrap without --ci bootstrap, and --param or --ci with --slip, were ignored without a word (rule 8)."""

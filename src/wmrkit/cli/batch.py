@@ -164,8 +164,9 @@ def run_calibrate(args: argparse.Namespace) -> int:
     from ..batch.fleet import expand_logs
 
     robot = load_robot(args.robot)
-    if args.slip and (args.param or args.ci):  # the slip fit has its own two parameters and interval: ignored
-        raise WmrkitError(f"{'--param' if args.param else '--ci'} is for the geometry fit; --slip fits slip weights")
+    if args.slip and (args.param or args.ci or args.sensed):  # the slip fit has its own two parameters and interval,
+        given = "--param" if args.param else "--ci" if args.ci else "--sensed"  # and takes every sensed joint
+        raise WmrkitError(f"{given} is for the geometry fit; --slip fits slip weights")
     if args.bootstrap is not None and args.ci != "bootstrap":
         raise WmrkitError("--bootstrap is the number of replicates of --ci bootstrap")
     args.ci, args.bootstrap = args.ci or "jacobian", 200 if args.bootstrap is None else args.bootstrap
