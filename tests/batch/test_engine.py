@@ -65,3 +65,11 @@ def test_a_worker_count_must_be_a_whole_number():
     for workers in (2.5, True, "2"):
         with pytest.raises(BatchError, match="--workers must be in"):
             engine(workers=workers)
+
+
+def test_a_worker_count_with_a_scheduler_is_refused():
+    """--scheduler ADDRESS --workers 2 (or 0: serial) connected to the scheduler and ignored the count without a
+    word (rule 8)."""
+    for workers in (0, 2):
+        with pytest.raises(BatchError, match="--workers sets the size of the embedded cluster"):
+            engine("tcp://127.0.0.1:1", workers)

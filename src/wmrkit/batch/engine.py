@@ -268,6 +268,8 @@ def engine(scheduler: str | Any | None = None, workers: int | None = None, *, re
     CPU count, at most :data:`WORKERS_PER_CPU` per CPU), one thread each. Without Dask installed and no scheduler:
     serial, with one line on stderr."""
     cpus = os.cpu_count() or 1
+    if scheduler is not None and workers is not None:  # the scheduler's cluster has its own workers: ignored
+        raise BatchError("--workers sets the size of the embedded cluster; a --scheduler's cluster has its own workers")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, Integral)  # True: a cluster of
                                 or not 0 <= workers <= WORKERS_PER_CPU * cpus):           # 'True' workers failed
         raise BatchError(f"--workers must be in [0, {WORKERS_PER_CPU * cpus}] ({WORKERS_PER_CPU} per CPU of this "
