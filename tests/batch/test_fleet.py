@@ -216,3 +216,14 @@ def test_an_output_that_is_a_folder_is_refused_before_the_work(fleet_dir, diff, 
     monkeypatch.setattr(fleet, "process_log", lambda job: pytest.fail("a log was processed"))
     with pytest.raises(BatchError, match="a folder, not a file"):
         batch_odometry(diff, [fleet_dir / "run0.csv"], out=tmp_path)
+
+
+
+def test_a_file_in_the_place_of_the_parts_folder_is_refused_before_the_work(fleet_dir, diff, tmp_path, monkeypatch):
+    """A file named OUT.parts made the batch run every log and then fail ('OUT.parts: File exists'): the work lost."""
+    import wmrkit.batch.fleet as fleet
+
+    (tmp_path / "r.parquet.parts").write_text("")
+    monkeypatch.setattr(fleet, "process_log", lambda job: pytest.fail("a log was processed"))
+    with pytest.raises(BatchError, match=r"r\.parquet\.parts is a file; the batch keeps its part files"):
+        batch_odometry(diff, [fleet_dir / "run0.csv"], out=tmp_path / "r.parquet")

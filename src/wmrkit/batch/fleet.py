@@ -28,7 +28,7 @@ import numpy as np
 from ..odometry.logs import LogFormat
 from ..robot import Robot
 from .engine import BatchError, Engine, TaskFailure, engine
-from .parquet import RowSink, check_table, read_rows
+from .parquet import RowSink, check_table, parts_dir, read_rows
 
 #: Columns of the batch-odometry table (name, type); lengths in m, angles in rad, times in s.
 SUMMARY_SCHEMA = (
@@ -176,6 +176,9 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
         raise BatchError(f"--out {os.fspath(out)}: the folder {Path(out).absolute().parent} does not exist")
     if out is not None and Path(out).is_dir():  # else refused only when the table is written, after the work
         raise BatchError(f"--out {os.fspath(out)}: a folder, not a file")
+    if out is not None and parts_dir(out).exists() and not parts_dir(out).is_dir():  # else it failed after the work
+        raise BatchError(f"--out {os.fspath(out)}: {parts_dir(out)} is a file; the batch keeps its part files (resume "
+                         "points) in a folder of that name")
     if trajectories is not None:  # made with its parents when missing, as every output folder of the CLI
         try:
             Path(trajectories).mkdir(parents=True, exist_ok=True)
