@@ -100,7 +100,8 @@ def test_parse_vary_units_and_errors():
     for bad, msg in [("wheels.nope.l=0:1:2", "no wheel 'nope'"), ("wheels[9].l=0:1:2", "out of range"),
                      ("wheels[0].colour=0:1:2", "not a geometry field"), ("wheels[0].l=0:1", "START:STOP:N"),
                      ("wheels[0].l,wheels[1].alpha=0:1:2", "share a unit"), ("wheels[0].l=0:1:0", "N must be"),
-                     ("wheels[0].l=0:1kg:3", "wheels"), ("robot.l=0:1:2", "is not wheels")]:
+                     ("wheels[0].l=0:1kg:3", "wheels"), ("robot.l=0:1:2", "is not wheels"),
+                     ("wheels[0].l=0:1:\u00b2", "N must be")]:  # a superscript two: int()'s ValueError (traceback)
         with pytest.raises(BatchError, match=msg):
             parse_vary(bad, robot)
     with pytest.raises(BatchError, match="--vary"):  # a value the description refuses

@@ -93,7 +93,7 @@ def parse_vary(text: str, robot: Robot) -> Axis:
         start, stop = (parse_quantity(p.strip(), kind) for p in parts[:2])
     except UnitError as err:
         raise BatchError(f"--vary {text}: {err}") from None
-    n = int(parts[2]) if parts[2].strip().isdigit() else 0
+    n = int(parts[2]) if parts[2].strip().isdecimal() else 0  # isdigit() took "²", which int() refuses
     if not 1 <= n <= MAX_POINTS:
         raise BatchError(f"--vary {text}: N must be a whole number of points in [1, {MAX_POINTS}], got "
                          f"{parts[2].strip()!r}")
