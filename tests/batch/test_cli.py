@@ -161,3 +161,11 @@ def test_batch_odometry_refuses_a_trajectory_format_without_trajectories(capsys,
     assert main(["batch", "odometry", "diff-drive", str(fleet_dir / "run0.csv"), "--workers", "0",
                  "--trajectory-format", "csv", "--trajectories", str(tmp_path)]) == 0
     assert (tmp_path / "run0.csv").exists()
+
+
+
+def test_sweep_refuses_one_file_for_the_table_and_the_plot(capsys, tmp_path):
+    """'--out s.png --plot s.png' wrote the table, then the picture over it (exit 0, the table lost)."""
+    assert main(["sweep", "omni-3", "--vary", "wheels[0].l=0.1:0.2:2", "--workers", "0", "--out",
+                 str(tmp_path / "s.png"), "--plot", str(tmp_path / "s.png")]) == 2
+    assert "is the --plot file too" in capsys.readouterr().err and not (tmp_path / "s.png").exists()
