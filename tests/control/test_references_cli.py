@@ -104,6 +104,21 @@ def test_pure_pursuit_turns_round_to_a_path_that_runs_behind_it(name):
     assert run.tracked[-1, 0] < -15.0  # along the path, towards -x
 
 
+def test_pure_pursuit_goal_past_the_path_end_lies_on_its_tangent():
+    """The goal point was held at the path's end: a robot that reached it before the reference's time ended circled
+    it on ever tighter turns (``2 / L_d``, ``L_d -> 0``): a 2 m line from 0.5 m ahead was 'too stiff to integrate'
+    after 34 s, and the circle from 0.3 m off (the docs' comparison) after 2 min."""
+    from wmrkit.control.points import control_point
+    from wmrkit.control.trackers import pure_pursuit
+
+    robot, ref = catalog.load("diff-drive"), builtin_reference("line", duration=4.0)  # 2 m along +x
+    control = pure_pursuit(control_point(robot), ref, 1.0)
+    twist, _ = control(1.0, np.array([2.01, 0.0, 0.0]), np.zeros(3))  # 1 cm past the end, heading along the path
+    assert twist[2] == pytest.approx(0.0) and twist[0] == pytest.approx(0.5)
+    run = track(robot, ref, controller="pure-pursuit", initial_pose=[0.5, 0.0, 0.0])
+    assert np.abs(run.twist[:, 2]).max() < 1e-9 and run.pose[-1, 0] == pytest.approx(2.5, abs=1e-3)
+
+
 def test_cli_track_json(capsys):
     assert main(["track", "forklift", "--reference", "circle", "--from", "0", "0.5", "0deg", "--duration", "4",
                  "--json"]) == 0

@@ -3,9 +3,9 @@
 Both steer a point of the robot onto the reference *path* at the reference's speed (they do not correct timing):
 
 - **pure pursuit** (Coulter 1992): the axle point ``A`` (the foot of the fixed axle, the origin without fixed wheels)
-  drives on the arc through a goal point ``lookahead`` metres further along the path: curvature
-  ``kappa = 2 y_g / L_d^2``; a goal behind ``A`` (``x_g <= 0``) turns it round on the circle of diameter ``L_d``
-  (``kappa = +-2 / L_d``, towards the goal's side, left when straight behind);
+  drives on the arc through a goal point ``lookahead`` metres further along the path (past its end: on its final
+  tangent): curvature ``kappa = 2 y_g / L_d^2``; a goal behind ``A`` (``x_g <= 0``) turns it round on the circle of
+  diameter ``L_d`` (``kappa = +-2 / L_d``, towards the goal's side, left when straight behind);
 - **Stanley** (Thrun et al. 2006): a front point ``F`` at ``wheelbase`` ahead of ``A``; steering
   ``delta = psi_e - atan(k e / (v + eps))`` with the heading error ``psi_e`` and the signed cross-track error ``e`` of
   ``F`` (positive left), curvature ``tan(delta) / wheelbase``.
@@ -68,7 +68,12 @@ class PathIndex:
         return float(s_), chi, e
 
     def point_at(self, s: float) -> np.ndarray:
-        """Path point at arc length `s` [m] (clamped to the ends)."""
+        """Path point at arc length `s` [m] (clamped to the start; beyond the end, on the end's tangent: a goal held
+        at the end point let a robot that reached it first circle it on ever tighter turns, ``2 / L_d``)."""
+        beyond = s - self.s[-1]
+        if beyond > 0:
+            chi = self.tangent(len(self.xy) - 1)
+            return self.xy[-1] + beyond * np.array([math.cos(chi), math.sin(chi)])
         return np.array([np.interp(s, self.s, self.xy[:, 0]), np.interp(s, self.s, self.xy[:, 1])])
 
     def tangent(self, i: int) -> float:
