@@ -78,9 +78,11 @@ space: {H: 7 m, J: 2.3 m, MS: 0.25 m, dx2: 1.4 m, final_gap: 0.1 m}
      r"^x\.yaml:1: vehicle\.c1: the rear wheels \(1\.55 m apart\) stand outside the body's width \(c1 = 1\.5 m\)"),
     (TABLE_91.replace("H: 3.35", "H: 40 cm"), r"^x\.yaml:8: space\.MS: the margins at both ends \(0\.4 m\) leave "
      r"nothing of the slot's length H = 0\.4 m"),  # a ZeroDivisionError traceback in the length ratio (9.37) before
+    (TABLE_91.replace("final_gap: 7 cm", "final_gap: 7"), r"^x\.yaml:8: space\.final_gap: the gap to the curb \(7 m\) "
+     r"must be less than the slot's width J = 2 m"),  # 7 m: 'feasible: 1 manoeuvre, final gap 7.6 cm' before
 ], ids=["missing", "angle-as-length", "phi-90", "negative", "typo", "zero-width", "unknown-top", "twice",
         "not-car-like", "not-mapping", "list", "python-tag", "no-eval", "front-axle-outside", "track-outside",
-        "robot-track-outside", "no-free-length"])
+        "robot-track-outside", "no-free-length", "gap-wider-than-slot"])
 def test_bad_input_gives_one_located_line(text, message):
     with pytest.raises(DescriptionError, match=message) as info:
         problem_from_text(text, source="x.yaml")

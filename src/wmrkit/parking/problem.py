@@ -169,6 +169,9 @@ def _space(check: FieldReader, data: Any) -> Space:
     problem = no_free_length(s["H"], s["MS"])
     if problem is not None:
         check.fail(problem, ("space", "MS"))
+    if s["final_gap"] >= s["J"]:  # 'final_gap: 7' (metres, not cm) stopped the plan after its first manoeuvre
+        check.fail(f"the gap to the curb ({s['final_gap']:g} m) must be less than the slot's width J = {s['J']:g} m "
+                   "(a plain number is metres: write e.g. '7 cm')", ("space", "final_gap"))
     return Space(**s)
 
 
