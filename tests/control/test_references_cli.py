@@ -53,6 +53,13 @@ def test_files_tum_and_csv(tmp_path):
         builtin_reference("circel")
 
 
+def test_csv_with_a_byte_order_mark_is_read(tmp_path):
+    """A spreadsheet's 'CSV UTF-8' starts with a BOM: 'expected the columns t,x,y,theta, got \\ufefft,x,y,theta'."""
+    path = tmp_path / "bom.csv"
+    path.write_bytes(b"\xef\xbb\xbft,x,y,theta\n0,0,0,0\n1,1,0,0\n2,2,0,0\n")
+    np.testing.assert_allclose(load_reference(path).pose[:, 0], [0.0, 1.0, 2.0])
+
+
 def test_headings_in_degrees_are_refused_and_unwrapped_radians_kept(tmp_path):
     """'t,x,y,theta' with theta 90 was read as 90 rad and followed as 2.035 rad (exit 0)."""
     deg = tmp_path / "deg.csv"

@@ -135,7 +135,7 @@ def load_reference(path: str | os.PathLike[str]) -> Reference:
         with open(path, encoding="utf-8") as f:
             first = f.readline()
         if "," in first:
-            with open(path, encoding="utf-8", newline="") as f:
+            with open(path, encoding="utf-8-sig", newline="") as f:  # -sig: a spreadsheet's byte-order mark
                 rows = list(csv.reader(f))
             header = [h.strip().lower() for h in rows[0]]
             if header[:1] == ["time"]:
