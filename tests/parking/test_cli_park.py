@@ -101,6 +101,17 @@ def test_animation_executed_through_the_tracker(capsys, tmp_path):
     assert code == 2 and "invalid choice" in err
 
 
+@pytest.mark.parametrize(("argv", "message"), [
+    (["--controller", "p"], "--controller p drives the plan for --animate or --check (it would be ignored)"),
+    (["--controller", "pi", "--plot", "x.png"], "--controller pi drives the plan for --animate or --check"),
+    (["--frames", "10"], "--frames applies to --animate (it would be ignored)"),
+])
+def test_options_of_the_executed_plan_need_animate_or_check(capsys, argv, message):
+    """'park thesis-9.1 --controller p' printed the plan, exit 0, and drove nothing."""
+    code, out, err = run(capsys, "thesis-9.1", *argv)
+    assert code == 2 and out == "" and message in err
+
+
 def test_check_reads_the_executed_path_too(capsys):
     """--check with --controller also checks the path the closed loop drove: example 1's plan only touches the
     front car (zero lateral clearance), and a tracker a fraction of a millimetre off clips it; example 2 stays

@@ -16,7 +16,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    "name: thesis-9.1, thesis-9.2")
     p.add_argument("--plot", metavar="FILE", help="draw the plan (.png, .svg or .pdf)")
     p.add_argument("--animate", metavar="FILE", help="animate the executed plan (.gif or .html)")
-    p.add_argument("--frames", type=int, default=200, metavar="N", help="at most N animation frames (default 200)")
+    p.add_argument("--frames", type=int, metavar="N", help="at most N animation frames (default 200)")
     p.add_argument("--controller", choices=("p", "pi"), default=None,
                    help="execute closed loop with the thesis's law (8.2)/(8.3) for --animate and --check (default: "
                    "open loop)")
@@ -35,8 +35,15 @@ def run(args: argparse.Namespace) -> int:
     from ..parking.problem import load_problem
     from ..parking.solve import check_dict, describe, describe_check, solve
 
-    if not 2 <= args.frames <= MAX_FRAMES:  # below 2 was raised to 2 silently; thousands took minutes
-        raise WmrkitError(f"--frames: expected 2 to {MAX_FRAMES} animation frames, got {args.frames}")
+    # options of the executed plan without --animate or --check were ignored (exit 0): refused, as track's
+    if args.frames is not None and not args.animate:
+        raise WmrkitError("--frames applies to --animate (it would be ignored)")
+    if args.controller is not None and not (args.animate or args.check):
+        raise WmrkitError(f"--controller {args.controller} drives the plan for --animate or --check (it would be "
+                          "ignored)")
+    frames = 200 if args.frames is None else args.frames
+    if not 2 <= frames <= MAX_FRAMES:  # below 2 was raised to 2 silently; thousands took minutes
+        raise WmrkitError(f"--frames: expected 2 to {MAX_FRAMES} animation frames, got {frames}")
     check_plot_path(args.plot)  # before the answer is printed
     check_animation_path(args.animate, (".gif", ".html"))
     solution = solve(load_problem(args.problem), check=args.check)
@@ -65,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
         from ..parking import plot
 
         if args.animate:
-            plot.animate_plan(solution.plan, args.animate, execution, max_frames=max(2, args.frames))
+            plot.animate_plan(solution.plan, args.animate, execution, max_frames=frames)
         if args.plot:
             plot.save_plan_figure(solution.plan, args.plot, execution)
     return 0
