@@ -60,6 +60,13 @@ def test_csv_with_a_byte_order_mark_is_read(tmp_path):
     np.testing.assert_allclose(load_reference(path).pose[:, 0], [0.0, 1.0, 2.0])
 
 
+def test_a_lap_too_short_or_too_long_names_speed_and_size():
+    """'--speed 1e4' said 'duration/dt gives 1 samples': neither option a user gives."""
+    with pytest.raises(ReferenceError, match=r"^reference 'circle' at 10000 m/s, size 3 m: 0\.001885 s \(one lap at "
+                                             r"this speed and size\) sampled every 0\.01 s gives 1 samples"):
+        builtin_reference("circle", speed=1e4)
+
+
 def test_headings_in_degrees_are_refused_and_unwrapped_radians_kept(tmp_path):
     """'t,x,y,theta' with theta 90 was read as 90 rad and followed as 2.035 rad (exit 0)."""
     deg = tmp_path / "deg.csv"

@@ -269,7 +269,9 @@ def builtin_reference(name: str, *, speed: float | None = None, size: float | No
             raise ReferenceError(f"reference '{name}': {what} must be a positive number, got {value}")
     n = math.floor(dur / dt + 1e-9) + 1
     if n < 3 or n > 10_000_000:
-        raise ReferenceError(f"reference '{name}': duration/dt gives {n} samples (3 to 10^7 allowed)")
+        lap = " (one lap at this speed and size)" if duration is None else ""
+        raise ReferenceError(f"reference '{name}' at {v:g} m/s, size {size:g} m: {dur:.4g} s{lap} sampled every "
+                             f"{dt:g} s gives {n} samples (3 to 10^7 allowed)")
     t = np.arange(n) * dt
     pose, vel, acc, breaks = fn(t, v, size)
     return Reference(name, readonly(t), readonly(np.ascontiguousarray(pose, dtype=float)),
