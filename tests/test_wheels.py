@@ -404,3 +404,16 @@ def test_errata_chapter_3_cites_existing_tests():
     for path, name in cited:
         source = (Path(__file__).resolve().parent / path).read_text()
         assert re.search(rf"^def {name}\(", source, flags=re.M), (path, name)
+
+
+@pytest.mark.parametrize(("joints", "message"), [
+    ("spin", r"expected a tuple of joint names \(spin\), got 'spin'"),  # Robot.actuated read 'left.s', 'left.p', ...
+    (("steer",), r"no joint 'steer' on a fixed wheel \(joints: spin\)"),  # a fixed wheel 'actuated' in steering
+    (("spin", "spin"), r"joint 'spin' listed twice"),
+])
+@pytest.mark.parametrize("field", ["actuated", "sensed"])
+def test_a_wheel_built_in_python_names_joints_of_its_type(field, joints, message):
+    from wmrkit.wheels import WheelError
+
+    with pytest.raises(WheelError, match=rf"^wheel 'left': {field}: {message}$"):
+        Wheel("left", "fixed", l=0.2, alpha=math.pi / 2, beta=math.pi / 2, r=0.1, **{field: joints})

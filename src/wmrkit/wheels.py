@@ -137,6 +137,10 @@ class Wheel:
         kind = KINDS.get(self.type)
         if kind is None:
             raise WheelError(f"wheel '{self.name}': unknown type {self.type!r} (types: {', '.join(KINDS)})")
+        for key in ("actuated", "sensed"):  # a string here was read letter by letter: 'left.s', 'left.p', ...
+            problem = _joints_problem(getattr(self, key), kind)
+            if problem is not None:
+                raise WheelError(f"wheel '{self.name}': {key}: {problem}")
         values = {key: getattr(self, key) for key in ("l", "alpha", *kind.required, *kind.optional)}
         if any(hasattr(v, "free_symbols") for v in values.values()):
             return  # symbolic parameters (SymPy, wmrkit.kinematics.symbolic): no numbers to check
@@ -183,6 +187,18 @@ class Wheel:
     def elements(self) -> tuple[Element, ...]:
         """The contact elements this wheel expands into (see module docstring)."""
         return _ELEMENTS[self.type](self)
+
+
+def _joints_problem(joints: object, kind: WheelKind) -> str | None:
+    """Why `joints` (a wheel's ``actuated`` or ``sensed``) is no tuple of distinct joints of `kind`; None if it is."""
+    if not isinstance(joints, tuple) or not all(isinstance(j, str) for j in joints):
+        return f"expected a tuple of joint names ({', '.join(kind.joints)}), got {joints!r}"
+    for i, joint in enumerate(joints):
+        if joint not in kind.joints:
+            return f"no joint '{joint}' on a {kind.name} wheel (joints: {', '.join(kind.joints)})"
+        if joint in joints[:i]:
+            return f"joint '{joint}' listed twice"
+    return None
 
 
 class Element(NamedTuple):
