@@ -186,3 +186,19 @@ def test_castor_heading_follows_its_axle():
     w = c.wheels[0]
     assert np.degrees(w.beta) == pytest.approx(30 - 20 + 90)
     assert np.degrees(w.heading) == pytest.approx(30)
+
+
+def test_a_robot_built_in_python_has_wheels_with_distinct_names():
+    """Robot() took two wheels named 'left' (velocity names 'left.spin' twice, a to_dict that did not load back)
+    and no wheels at all (constraint_matrix: 'cannot reshape array of size 0')."""
+    from wmrkit.wheels import WheelError
+
+    r = catalog.load("diff-drive")
+    with pytest.raises(WheelError, match=r"^robot 'diff-drive': wheels\[1\]: duplicate wheel name 'left'$"):
+        dataclasses.replace(r, wheels=(r.wheels[0], dataclasses.replace(r.wheels[1], name="left")))
+    with pytest.raises(WheelError, match=r"^robot 'diff-drive': wheels: expected a non-empty tuple of Wheel"):
+        dataclasses.replace(r, wheels=())
+    with pytest.raises(WheelError, match=r"^robot 'diff-drive': wheels: expected a non-empty tuple of Wheel"):
+        dataclasses.replace(r, wheels=list(r.wheels))
+    with pytest.raises(WheelError, match=r"^robot 'diff-drive': wheels\[0\]: expected a Wheel, got dict$"):
+        dataclasses.replace(r, wheels=({"name": "left"},))

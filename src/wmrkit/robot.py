@@ -20,7 +20,7 @@ from ._shapes import as_angles, as_vectors, readonly
 from .couplings import Coupling
 from .dynamics.mass import Body
 from .errors import ShapeError, UnknownNameError
-from .wheels import Wheel, generic_wheel_jacobian, rotate_rows_to_robot
+from .wheels import Wheel, WheelError, generic_wheel_jacobian, rotate_rows_to_robot
 
 if TYPE_CHECKING:
     from .slip.settings import OdometrySettings
@@ -41,6 +41,7 @@ class Robot:
     _hash: int = field(default=0, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        _check_wheels(self)
         # Hashed once: derived arrays are cached per robot (keyed by it) and looked up on every batched call.
         object.__setattr__(self, "_hash", hash((self.name, self.wheels, self.notes, self.couplings, self.body,
                                                    self.odometry)))
@@ -249,6 +250,22 @@ class Robot:
         from .description import save_robot_file
 
         save_robot_file(self, path)
+
+
+def _check_wheels(robot: Robot) -> None:
+    """A robot built in Python has wheels as a description has them: a non-empty tuple of :class:`Wheel` with
+    distinct names (two wheels named 'left' gave the velocity 'left.spin' twice)."""
+    wheels = robot.wheels
+    if not isinstance(wheels, tuple) or not wheels:
+        raise WheelError(f"robot '{robot.name}': wheels: expected a non-empty tuple of Wheel, got "
+                         f"{'()' if wheels == () else type(wheels).__name__}")
+    names: set[str] = set()
+    for i, wheel in enumerate(wheels):
+        if not isinstance(wheel, Wheel):
+            raise WheelError(f"robot '{robot.name}': wheels[{i}]: expected a Wheel, got {type(wheel).__name__}")
+        if wheel.name in names:
+            raise WheelError(f"robot '{robot.name}': wheels[{i}]: duplicate wheel name '{wheel.name}'")
+        names.add(wheel.name)
 
 
 @functools.lru_cache(maxsize=256)
