@@ -71,6 +71,10 @@ def test_angles_within_a_turn_or_with_a_unit_are_read(value):
     ("90 deg deg", "angle", "cannot read '90 deg deg' as an angle (write e.g. '1.57' or '90 deg')"),
     ("", "length", "cannot read '' as a length (write e.g. '0.25' or '250 mm')"),
     ("nan", "length", "cannot read 'nan' as a length (write e.g. '0.25' or '250 mm')"),
+    ("\u221230 deg", "angle", "cannot read '\u221230 deg' as an angle (write e.g. '1.57' or '90 deg'): "
+     "'\\u2212' (MINUS SIGN) is no ASCII character"),  # a minus copied from a PDF looked like the example it refused
+    ("\uff13 mm", "length", "cannot read '\uff13 mm' as a length (write e.g. '0.25' or '250 mm'): '\\uff13' "
+     "(FULLWIDTH DIGIT THREE) is no ASCII character"),
     (float("nan"), "length", "must be finite, got nan"),
     (float("-inf"), "angle", "must be finite, got -inf"),
     ("1e999 m", "length", "must be finite, got '1e999 m'"),

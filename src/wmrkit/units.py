@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import re
+import unicodedata
 from typing import Literal
 
 Kind = Literal["length", "angle", "number"]
@@ -46,7 +47,7 @@ def parse_quantity(value: object, kind: Kind) -> float:
     elif isinstance(value, str):
         match = _QUANTITY.match(value)
         if match is None:
-            raise UnitError(f"cannot read {value!r} as {_a(kind)} (write e.g. {_example(kind)})")
+            raise UnitError(f"cannot read {value!r} as {_a(kind)} (write e.g. {_example(kind)}){_foreign(value)}")
         number, unit = float(match.group(1)), match.group(2) or ""
         factor = _factor(unit, kind, value)
     else:
@@ -72,6 +73,13 @@ MAX_ANGLE = 2 * math.pi * MAX_TURNS
 
 def _bare(value: object) -> bool:
     return not isinstance(value, str) or _QUANTITY.match(value).group(2) in (None, "")  # type: ignore[union-attr]
+
+
+def _foreign(text: str) -> str:
+    """The first character of `text` that is no ASCII nor a unit's symbol, named: a minus sign copied from a PDF
+    (U+2212) or a full-width digit looks like the example the message gives; '' when there is none."""
+    char = next((c for c in text if not c.isascii() and not c.isspace() and c not in "\u00b0\u00b5\u03bc"), None)
+    return "" if char is None else f": {char!a} ({unicodedata.name(char, 'no name')}) is no ASCII character"
 
 
 def _plain(number: float) -> str:
