@@ -188,6 +188,18 @@ def test_unreadable_files(tmp_path):
         Robot.from_file(bad)
 
 
+
+@pytest.mark.parametrize("suffix", [".json", ".yaml"])
+def test_a_file_saved_with_a_byte_order_mark_loads(suffix, tmp_path):
+    """Windows editors start UTF-8 files with a BOM: YAML skipped it, JSON answered "Unexpected UTF-8 BOM (decode
+    using utf-8-sig)", advice for Python programmers."""
+    robot = robot_from_text(BASE, source=SRC)
+    path = tmp_path / f"bot{suffix}"
+    robot.to_file(path)
+    path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    assert Robot.from_file(path) == robot
+
+
 # ---- the documented format ----------------------------------------------------------------------------------------
 def _doc_blocks(lang: str) -> list[str]:
     return re.findall(rf"^```{lang}\n(.*?)^```", DOC.read_text(), flags=re.S | re.M)

@@ -42,15 +42,16 @@ def short_repr(value: Any) -> str:
 
 
 def read_file(path: str | os.PathLike[str], what: str = "description") -> str:
-    """The UTF-8 text of the document file `path` (a `what`), at most :data:`wmrkit.limits.MAX_FILE_SIZE` bytes;
-    a :class:`DescriptionError` naming the file and the reason when it cannot be read."""
+    """The UTF-8 text of the document file `path` (a `what`), at most :data:`wmrkit.limits.MAX_FILE_SIZE` bytes,
+    without the byte order mark Windows editors write (``json`` refused it); a :class:`DescriptionError` naming the
+    file and the reason when it cannot be read."""
     path = Path(path)
     problem = regular_file_problem(path, what)
     if problem:
         raise DescriptionError(problem, source=str(path))
     try:
         _check_size(path.stat().st_size, "bytes", str(path), what)
-        return path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as err:
         reason = getattr(err, "strerror", None) or err  # UnicodeDecodeError has no strerror
         raise DescriptionError(f"cannot read the file ({err.__class__.__name__}: {reason})",
