@@ -292,3 +292,16 @@ def test_docs_list_every_robot_with_its_drawing():
         assert f"| `{name}` |" in text, name
         assert f'<img src="figures/catalog/{name}.png"' in text, name
         assert (docs / "figures" / "catalog" / f"{name}.png").read_bytes().startswith(b"\x89PNG")
+
+
+def test_a_folder_named_like_a_catalog_robot_does_not_hide_it(tmp_path, monkeypatch):
+    """A folder 'forklift/' of logs in the working folder made every 'wmrkit ... forklift' answer "forklift: a
+    folder; a description is a file"; a file of that name is still a description, as documented."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "forklift").mkdir()
+    assert catalog.resolve("forklift") == catalog.load("forklift")
+    (tmp_path / "logs").mkdir()
+    with pytest.raises(ValueError, match=r"^logs: a folder; a description is a file$"):
+        catalog.resolve("logs")
+    (tmp_path / "bicycle").write_text(catalog.source_text("diff-drive"), encoding="utf-8")
+    assert catalog.resolve("bicycle") == catalog.load("diff-drive")

@@ -35,9 +35,10 @@ def source_text(name: str) -> str:
 
 
 def resolve(spec: str) -> Robot:
-    """A robot from a command-line argument: a description file path if one exists, else a catalog name."""
+    """A robot from a command-line argument: a description file path if one exists, else a catalog name (also when
+    a folder of that name exists: a folder 'forklift/' of logs hid the catalog's forklift)."""
     path = Path(spec)
-    if path.suffix.lower() in (".yaml", ".yml", ".json") or path.exists():
+    if path.suffix.lower() in (".yaml", ".yml", ".json") or (path.exists() and not (path.is_dir() and spec in names())):
         if not path.exists():
             raise UnknownNameError(f"{spec}: no such file")
         return Robot.from_file(path)
