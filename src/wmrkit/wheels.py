@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 
 from ._shapes import as_angles, finite_number
 from .errors import UnknownNameError, WmrkitError
+from .units import MAX_ANGLE, MAX_TURNS
 
 if TYPE_CHECKING:
     from .dynamics.tyres import Tyre
@@ -145,8 +146,11 @@ class Wheel:
         if any(hasattr(v, "free_symbols") for v in values.values()):
             return  # symbolic parameters (SymPy, wmrkit.kinematics.symbolic): no numbers to check
         for key, value in values.items():
-            if not finite_number(value):
+            if isinstance(value, bool) or not finite_number(value):
                 raise WheelError(f"wheel '{self.name}': {key}: expected a finite number, got {value!r}")
+            if GEOMETRY_FIELDS[key] == "angle" and abs(value) > MAX_ANGLE:  # as descriptions and with_beta refuse
+                raise WheelError(f"wheel '{self.name}': {key}: expected an angle of at most {MAX_TURNS:g} turns [rad], "
+                                 f"got {value!r}")
         problem = geometry_problem(self.type, values, degenerate=False)
         if problem is not None:
             raise WheelError(f"wheel '{self.name}': {problem[0]}: {problem[1]}")

@@ -25,6 +25,10 @@ from wmrkit.wheels import Wheel, WheelError
     ({"l": -0.5}, r"wheel 'left': l: must be >= 0 \(the direction is alpha\)"),
     ({"beta": "90 deg"}, "wheel 'left': beta: expected a finite number, got '90 deg'"),
     ({"type": "nonsense"}, "wheel 'left': unknown type 'nonsense' \\(types: fixed, steerable"),
+    # heading 0 printed for sin/cos of round-off, and a to_file that from_file refused ('1e+300 rad' is more than ...)
+    ({"beta": 1e300}, r"wheel 'left': beta: expected an angle of at most 1e\+06 turns \[rad\], got 1e\+300"),
+    ({"alpha": -1e7}, r"wheel 'left': alpha: expected an angle of at most 1e\+06 turns \[rad\], got -10000000\.0"),
+    ({"l": True}, r"wheel 'left': l: expected a finite number, got True"),  # read as 1 m
 ])
 def test_a_wheel_the_model_cannot_use_is_refused_by_field(change, message):
     wheel = catalog.load("diff-drive").wheel("left")
