@@ -142,6 +142,8 @@ class Wheel:
             problem = _joints_problem(getattr(self, key), kind)
             if problem is not None:
                 raise WheelError(f"wheel '{self.name}': {key}: {problem}")
+        if self.steer_range is not None:
+            _check_steer_range(self, kind)
         values = {key: getattr(self, key) for key in ("l", "alpha", *kind.required, *kind.optional)}
         if any(hasattr(v, "free_symbols") for v in values.values()):
             return  # symbolic parameters (SymPy, wmrkit.kinematics.symbolic): no numbers to check
@@ -191,6 +193,19 @@ class Wheel:
     def elements(self) -> tuple[Element, ...]:
         """The contact elements this wheel expands into (see module docstring)."""
         return _ELEMENTS[self.type](self)
+
+
+def _check_steer_range(wheel: Wheel, kind: WheelKind) -> None:
+    """``steer_range`` as a description has it (``description._steer_range_from_dict``): on a wheel that steers, a
+    tuple ``(min, max)`` of headings [rad], min < max within one turn."""
+    lo_hi = wheel.steer_range
+    where = f"wheel '{wheel.name}': steer_range"
+    if not kind.steers:
+        raise WheelError(f"{where}: a {kind.name} wheel does not steer")
+    if not (isinstance(lo_hi, tuple) and len(lo_hi) == 2 and all(finite_number(v) for v in lo_hi)
+            and -2 * math.pi <= lo_hi[0] < lo_hi[1] <= 2 * math.pi and lo_hi[1] - lo_hi[0] <= 2 * math.pi):
+        raise WheelError(f"{where}: must be a tuple (min, max) of headings, min < max within one turn [rad], got "
+                         f"{lo_hi!r}")
 
 
 def _joints_problem(joints: object, kind: WheelKind) -> str | None:

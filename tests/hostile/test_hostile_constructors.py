@@ -29,11 +29,22 @@ from wmrkit.wheels import Wheel, WheelError
     ({"beta": 1e300}, r"wheel 'left': beta: expected an angle of at most 1e\+06 turns \[rad\], got 1e\+300"),
     ({"alpha": -1e7}, r"wheel 'left': alpha: expected an angle of at most 1e\+06 turns \[rad\], got -10000000\.0"),
     ({"l": True}, r"wheel 'left': l: expected a finite number, got True"),  # read as 1 m
+    # every heading out of range (ik: never feasible), and a to_dict that from_dict refused
+    ({"steer_range": (0.5, -0.5)}, r"wheel 'left': steer_range: a fixed wheel does not steer"),
 ])
 def test_a_wheel_the_model_cannot_use_is_refused_by_field(change, message):
     wheel = catalog.load("diff-drive").wheel("left")
     with pytest.raises(WheelError, match=message):
         dataclasses.replace(wheel, **change)
+
+
+@pytest.mark.parametrize("steer_range", [(0.5, -0.5), (-7.0, 0.0), (0.0, math.nan), [-1.0, 1.0], (-1.0,)])
+def test_a_steering_range_built_in_python_is_checked_as_in_a_description(steer_range):
+    """(0.5, -0.5) put every heading out of range (ik: never feasible) and gave a to_dict that from_dict refused."""
+    wheel = catalog.load("ackermann").wheel("front_left")
+    with pytest.raises(WheelError, match=r"^wheel 'front_left': steer_range: must be a tuple \(min, max\) of headings, "
+                                         r"min < max within one turn \[rad\], got "):
+        dataclasses.replace(wheel, steer_range=steer_range)
 
 
 def test_a_wheel_built_in_python_may_be_degenerate_but_not_meaningless():
