@@ -161,6 +161,18 @@ def test_malformed_json_and_json_nan():
         robot_from_text(text.replace('"r": NaN', '"r": 0.1, "r": 0.2'), source="bot.json", fmt="json")
 
 
+
+@pytest.mark.parametrize(("text", "message"), [
+    ('{"name": ' + "[" * 100000 + "]" * 100000 + "}", "malformed JSON: nesting too deep"),
+    ('{"name": "x", "wheels": [{"r": ' + "1" * 5000 + "}]}", "malformed JSON: a number of more than 4300 digits"),
+])
+def test_json_beyond_the_parser_s_limits_is_refused_in_the_user_s_terms(text, message):
+    """The JSON door answered with Python's words: 'maximum recursion depth exceeded while decoding a JSON array from
+    a unicode string', '... use sys.set_int_max_str_digits() to increase the limit' (YAML: 'nesting too deep')."""
+    with pytest.raises(DescriptionError) as err:
+        robot_from_text(text, source="bot.json", fmt="json")
+    assert str(err.value) == f"bot.json: {message}"
+
 @pytest.mark.parametrize("fmt", ["json", "yaml"])
 def test_a_field_given_twice_names_its_wheel_like_every_other_wheel_error(fmt, tmp_path, capsys):
     """The JSON error's `wheel` is the wheel's name (as for a wrong value), not its index in the list."""

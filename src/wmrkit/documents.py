@@ -11,6 +11,7 @@ import difflib
 import json
 import os
 import reprlib
+import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -151,8 +152,12 @@ def parse_document(text: str, source: str, fmt: str) -> tuple[yaml.Node | None, 
         except json.JSONDecodeError as err:
             raise DescriptionError(f"malformed JSON: {err.msg} (column {err.colno})", source=source,
                                    line=err.lineno) from None
-        except (ValueError, RecursionError) as err:  # integers of > 4300 digits, nesting too deep
-            raise DescriptionError(f"malformed JSON: {str(err).splitlines()[0]}", source=source) from None
+        except RecursionError:
+            raise DescriptionError("malformed JSON: nesting too deep", source=source) from None
+        except ValueError as err:  # integers of > 4300 digits (Python's words: "use sys.set_int_max_str_digits()")
+            what = (f"a number of more than {sys.get_int_max_str_digits()} digits" if "integer string" in str(err)
+                    else str(err).splitlines()[0])
+            raise DescriptionError(f"malformed JSON: {what}", source=source) from None
     try:
         loader = _SafeLoader(text)  # the reader already rejects some characters
         try:
