@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 
+from wmrkit import catalog
 from wmrkit.cli.main import main
 from wmrkit.dynamics.tyres import Tyre
 
@@ -180,3 +181,17 @@ def test_a_torque_file_with_a_byte_order_mark_is_read(capsys, tmp_path):
     code, out, err = run(capsys, "simulate", "forklift", "--torques", str(path), "--json")
     assert code == 0, err
     assert json.loads(out)["final_twist"][0] > 0.05
+
+
+def test_simulate_refuses_to_write_over_its_torque_file_or_description(capsys, tmp_path):
+    torques = tmp_path / "torques.csv"
+    text = "time,right_drive.spin,left_drive.spin\n0,100,100\n0.1,100,100\n"
+    torques.write_text(text)
+    code, out, err = run(capsys, "simulate", "forklift", "--torques", str(torques), "--out", str(torques))
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1 and "is the torque file" in err
+    assert torques.read_text() == text  # the run wrote its samples over it before
+    description = tmp_path / "forklift.yaml"
+    catalog.load("forklift").to_file(description)
+    text = description.read_text()
+    code, out, err = run(capsys, "simulate", str(description), "--path", "straight", "--out", str(description))
+    assert code == 2 and out == "" and "is the robot description" in err and description.read_text() == text
