@@ -195,3 +195,16 @@ def test_simulate_refuses_to_write_over_its_torque_file_or_description(capsys, t
     text = description.read_text()
     code, out, err = run(capsys, "simulate", str(description), "--path", "straight", "--out", str(description))
     assert code == 2 and out == "" and "is the robot description" in err and description.read_text() == text
+
+
+def test_simulate_refuses_an_initial_twist_that_does_not_roll(capsys, tmp_path):
+    """The start rolls without slip: (1, 0, 0.1) for the forklift (origin at the fork tips, axle 1 m behind) left its
+    drive wheels slipping sideways at 0.1 m/s from t = 0, silently."""
+    torques = tmp_path / "zero.csv"
+    torques.write_text("time,right_drive.spin\n0,0\n")
+    argv = ["simulate", "forklift", "--torques", str(torques), "--duration", "0.05", "--json", "--initial-twist"]
+    code, out, err = run(capsys, *argv, "1", "0", "0.1")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "'left_drive' would slip sideways at 0.1 m/s" in err and "VY = 0.1 m/s" in err
+    code, out, err = run(capsys, *argv, "1", "0.1", "0.1")  # the rolling one
+    assert code == 0 and json.loads(out)["max_slip"] < 0.01

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import WmrkitError
+from ..limits import MAX_SPEED
 from ._common import (
     add_json_flag,
     add_robot_argument,
@@ -49,7 +50,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--step", default="0.001", metavar="DT", help="integration step [s] (default 0.001)")
     p.add_argument("--method", default="semi-implicit", choices=["semi-implicit", "rk4", "adaptive"])
     p.add_argument("--speed", default="2", metavar="V", help="speed of a --path program [m/s] (default 2)")
-    p.add_argument("--initial-twist", nargs=3, metavar=("VX", "VY", "OMEGA"), help="initial twist (rolling)")
+    p.add_argument("--initial-twist", nargs=3, metavar=("VX", "VY", "OMEGA"),
+                   help="initial twist [m/s, m/s, rad/s], rolling without slip (a twist at which a fixed wheel "
+                        "would slip sideways is refused)")
     p.add_argument("--out", metavar="FILE", help="write the samples: .csv (one row per sample) or .json")
     p.add_argument("--plot", metavar="FILE", help="plot the path and the twist (png/svg/pdf)")
     add_json_flag(p)
@@ -123,6 +126,7 @@ def run_simulate(args: argparse.Namespace) -> int:
                           f"{MAX_STEPS:.0e} steps")
     twist = [0.0, 0.0, 0.0] if args.initial_twist is None else [
         parse_value(v, "number", "--initial-twist") for v in args.initial_twist]
+    _check_rolling(model, twist)
     sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
                    record_step=recordable_step(model, duration, step, max(step, 0.01)),
                    progress=False if args.json else None)
@@ -146,6 +150,26 @@ def run_simulate(args: argparse.Namespace) -> int:
         print(f"final twist: vx = {tw[0]:.6g} m/s, vy = {tw[1]:.6g} m/s, omega = {tw[2]:.6g} rad/s")
         print(f"distance travelled: {travelled:.6g} m; largest slip speed {np.abs(sim.slip).max():.3g} m/s")
     return 0
+
+
+def _check_rolling(model, twist: list[float]) -> None:
+    """Refuse an ``--initial-twist`` at which a fixed wheel would slip sideways: the start rolls without slip (the
+    forklift, whose origin is at the fork tips, turns with ``vy = -omega x_axle``; a skid steer cannot turn so)."""
+    from ..dynamics.programs import SLIP_TOL, feasible_twists
+    from ..kinematics.wheel_ik import wheel_commands
+
+    if not np.all(np.abs(twist) <= MAX_SPEED):  # left to initial_state's message
+        return
+    slip = np.abs(wheel_commands(model.robot, twist).slip)
+    if slip.max() <= SLIP_TOL:
+        return
+    w = int(np.argmax(slip))
+    rolling = feasible_twists(model, [twist])[0]
+    hint = (f"with this VX and OMEGA it rolls at VY = {rolling[1]:.6g} m/s"
+            if np.abs(wheel_commands(model.robot, rolling).slip).max() <= SLIP_TOL else "no VY makes it roll")
+    raise WmrkitError(f"--initial-twist {' '.join(f'{v:g}' for v in twist)}: fixed wheel "
+                      f"'{model.robot.wheel_names[w]}' would slip sideways at {slip[w]:.3g} m/s, and the simulation "
+                      f"starts rolling without slip ({hint})")
 
 
 def _check_not_an_input(args: argparse.Namespace) -> None:
