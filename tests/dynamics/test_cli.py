@@ -208,3 +208,13 @@ def test_simulate_refuses_an_initial_twist_that_does_not_roll(capsys, tmp_path):
     assert "'left_drive' would slip sideways at 0.1 m/s" in err and "VY = 0.1 m/s" in err
     code, out, err = run(capsys, *argv, "1", "0.1", "0.1")  # the rolling one
     assert code == 0 and json.loads(out)["max_slip"] < 0.01
+
+
+@pytest.mark.parametrize("extra", [[], ["--feedback", "wls"]])
+def test_track_through_the_dynamics_refuses_a_period_of_a_fraction_of_a_step(capsys, extra):
+    """The loop advances the dynamics by whole 1 ms steps: a period of 1.5 ms ran 2 ms of dynamics per period of the
+    law, so the robot ran ahead of its reference (0.1 m rms along the figure eight in 2 s), silently."""
+    code, out, err = run(capsys, "track", "forklift", "--reference", "figure-eight", "--dynamics", "--duration", "2",
+                         "--period", "0.0015", *extra)
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "whole number of dynamics steps of 0.001 s, got 0.0015" in err

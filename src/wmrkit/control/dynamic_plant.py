@@ -47,8 +47,9 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
     from ..dynamics.programs import twist_program
     from ..dynamics.simulate import Stepper
     from ..kinematics.realtime import realtime
-    if not (math.isfinite(period) and period >= step > 0):
-        raise ControlError(f"period: expected a control period >= the dynamics step {step} s, got {period}")
+    if not (math.isfinite(period) and period >= step > 0 and abs(period / step - round(period / step)) <= 1e-6):
+        raise ControlError(f"period: expected a control period of a whole number of dynamics steps of {step} s, "
+                           f"got {period}")  # 0.0015 s ran 2 ms of dynamics per 1.5 ms of the law's time
     if feedback not in ("pose", "odometry"):
         raise ControlError(f"feedback must be 'pose' or 'odometry', got {feedback!r}")
     check_delay(delay)

@@ -66,8 +66,9 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     from ..dynamics.simulate import Stepper
     from ..kinematics.wheel_ik import wheel_commands
 
-    if not (math.isfinite(period) and period >= step > 0):
-        raise ControlError(f"period: expected a control period >= the dynamics step {step} s, got {period}")
+    if not (math.isfinite(period) and period >= step > 0 and abs(period / step - round(period / step)) <= 1e-6):
+        raise ControlError(f"period: expected a control period of a whole number of dynamics steps of {step} s, "
+                           f"got {period}")  # 0.0015 s ran 2 ms of dynamics per 1.5 ms of the law's time
     if slip_model not in SLIP_MODELS:
         raise ControlError(f"slip model must be one of {', '.join(SLIP_MODELS)}, got '{slip_model}'")
     if feedback not in FEEDBACK:
