@@ -218,3 +218,13 @@ def test_track_through_the_dynamics_refuses_a_period_of_a_fraction_of_a_step(cap
                          "--period", "0.0015", *extra)
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
     assert "whole number of dynamics steps of 0.001 s, got 0.0015" in err
+
+
+def test_simulate_says_when_its_final_pose_is(capsys):
+    """Samples are recorded every 0.01 s: a run of 1.015 s printed the pose at 1.01 s as its final pose, unsaid."""
+    argv = ["simulate", "forklift", "--path", "straight", "--duration", "1.015"]
+    code, out, _ = run(capsys, *argv, "--json")
+    data = json.loads(out)
+    assert code == 0 and data["final_time"] == pytest.approx(1.01) and data["duration"] == 1.015
+    code, out, _ = run(capsys, *argv)
+    assert code == 0 and "final pose (t = 1.01 s): x = " in out
