@@ -228,3 +228,14 @@ def test_simulate_says_when_its_final_pose_is(capsys):
     assert code == 0 and data["final_time"] == pytest.approx(1.01) and data["duration"] == 1.015
     code, out, _ = run(capsys, *argv)
     assert code == 0 and "final pose (t = 1.01 s): x = " in out
+
+
+def test_tyre_takes_the_discontinuous_coulomb_law(capsys):
+    """docs/dynamics.md: coulomb's `k = inf` is the discontinuous law, and --param follows the descriptions' rules;
+    --param k=inf was refused ("cannot read 'inf' as a number")."""
+    code, out, err = run(capsys, "tyre", "coulomb", "--load", "3000", "--slip-ratio", "0.1", "--param", "k=inf",
+                         "--json")
+    assert code == 0, err
+    assert json.loads(out)["Fx"] == pytest.approx(-0.8 * 3000)  # mu_long Fz, whatever the slip
+    code, _, err = run(capsys, "tyre", "dugoff", "--load", "3000", "--param", "mu=inf")
+    assert code == 2 and "--param mu" in err  # only coulomb's k may be infinite

@@ -64,7 +64,8 @@ def run_tyre(args: argparse.Namespace) -> int:
     from ..dynamics.tyres import MAX_LOAD, Tyre, beyond_fit
 
     check_plot_path(args.plot)
-    params = {k: parse_value(v, "number", f"--param {k}") for k, v in parse_assignments(args.param, "--param").items()}
+    params = {k: math.inf if k == "k" and v.strip().lower() in ("inf", "+inf", "infinity") else  # discontinuous
+              parse_value(v, "number", f"--param {k}") for k, v in parse_assignments(args.param, "--param").items()}
     tyre = Tyre.of(args.model, params)
     load = _positive(parse_value(args.load, "number", "--load"), "--load", zero=True)
     if load > MAX_LOAD:
