@@ -166,3 +166,27 @@ def test_show_json_copy_with_stale_derived_names_is_refused(tmp_path, capsys):
     assert main(["show", str(path)]) == 2
     line = capsys.readouterr().err.strip()
     assert "copy.json" in line and "velocity_names: derived from the wheels" in line and "port.spin" in line
+
+
+@pytest.mark.parametrize("args", [
+    ["show", "{robot}", "--plot", "{robot}"],  # the description was replaced by the drawing (exit 0)
+    ["odometry", "diff-drive", "{log}", "--out", "{log}"],
+    ["odometry", "diff-drive", "{log}", "--out", "{dir}/./{log_name}"],  # the same file by another name
+    ["odometry", "diff-drive", "{log}", "--out", "{dir}/p.svg", "--plot", "{dir}/p.svg"],  # two outputs in one file
+    ["kinematics", "{robot}", "--codegen", "c", "{dir}/gen", "--json"],  # an output folder is not compared: runs
+])
+def test_an_output_that_is_an_input_or_another_output_is_refused(args, tmp_path, capsys):
+    """Before any work, one line naming both; the input is left as it was."""
+    robot, log = tmp_path / "q.png", tmp_path / "run.csv"
+    robot.write_text(json.dumps(catalog.load("diff-drive").to_dict()))
+    log.write_text("time,left.spin,right.spin\n0,0,0\n1,1,1\n")
+    before = robot.read_text(), log.read_text()
+    names = {"robot": robot, "log": log, "dir": tmp_path, "log_name": log.name}
+    code = main([a.format(**names) for a in args])
+    err = capsys.readouterr().err
+    if "--codegen" in args:
+        assert code == 0, err
+        return
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "is also " in err, err
+    assert "(the output would replace it)" in err and (robot.read_text(), log.read_text()) == before
+    assert not (tmp_path / "p.svg").exists()

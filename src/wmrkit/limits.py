@@ -87,6 +87,17 @@ def regular_file_problem(path: str | os.PathLike[str], what: str) -> str | None:
     return f"{kind}; a {what} is a file"
 
 
+def same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
+    """Whether `a` and `b` name one file (links and relative paths resolved; they need not exist). A name the system
+    cannot look up (a NUL in it) is no file."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return os.path.realpath(a) == os.path.realpath(b)
+    except ValueError:
+        return False
+
+
 def check_table_size(path: str | os.PathLike[str], error: type[Exception], what: str) -> None:
     """Raise `error` naming `path` when it is not a regular file (:func:`regular_file_problem`) or when the file (a
     `what`, read whole) is larger than :data:`MAX_TABLE_SIZE`; a file that cannot be examined is left to its

@@ -149,7 +149,7 @@ def test_sweep_refuses_to_write_its_table_over_the_robot_description(capsys, tmp
     robot.write_text(json.dumps(robot_to_dict(catalog.load("omni-3"))))
     before = robot.read_text()
     assert main(["sweep", str(robot), "--vary", "wheels[0].l=0.1:0.2:2", "--workers", "0", "--out", str(robot)]) == 2
-    assert "is the ROBOT description" in capsys.readouterr().err
+    assert "is also ROBOT" in capsys.readouterr().err
     assert robot.read_text() == before
 
 
@@ -168,4 +168,4 @@ def test_sweep_refuses_one_file_for_the_table_and_the_plot(capsys, tmp_path):
     """'--out s.png --plot s.png' wrote the table, then the picture over it (exit 0, the table lost)."""
     assert main(["sweep", "omni-3", "--vary", "wheels[0].l=0.1:0.2:2", "--workers", "0", "--out",
                  str(tmp_path / "s.png"), "--plot", str(tmp_path / "s.png")]) == 2
-    assert "is the --plot file too" in capsys.readouterr().err and not (tmp_path / "s.png").exists()
+    assert "is also --plot" in capsys.readouterr().err and not (tmp_path / "s.png").exists()

@@ -188,13 +188,13 @@ def test_simulate_refuses_to_write_over_its_torque_file_or_description(capsys, t
     text = "time,right_drive.spin,left_drive.spin\n0,100,100\n0.1,100,100\n"
     torques.write_text(text)
     code, out, err = run(capsys, "simulate", "forklift", "--torques", str(torques), "--out", str(torques))
-    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1 and "is the torque file" in err
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1 and "is also --torques" in err
     assert torques.read_text() == text  # the run wrote its samples over it before
     description = tmp_path / "forklift.yaml"
     catalog.load("forklift").to_file(description)
     text = description.read_text()
     code, out, err = run(capsys, "simulate", str(description), "--path", "straight", "--out", str(description))
-    assert code == 2 and out == "" and "is the robot description" in err and description.read_text() == text
+    assert code == 2 and out == "" and "is also ROBOT" in err and description.read_text() == text
 
 
 def test_simulate_refuses_an_initial_twist_that_does_not_roll(capsys, tmp_path):

@@ -277,7 +277,7 @@ def test_monte_carlo_options_are_checked(option, expected, capsys):
 
 def test_odometry_encoder_options_apply_to_counts_only(tmp_path, capsys):
     log = _skid_log(tmp_path)
-    for option in (["--gear", "0"], ["--cpr", "100"]):  # ignored silently when no column holds counts
+    for option in (["--gear", "2"], ["--cpr", "100"]):  # ignored silently when no column holds counts
         assert "applies to spin columns of encoder counts" in _refused(["odometry", "skid-steer-4", log, "--quiet",
                                                                         *option], capsys)
     counts = _write(tmp_path / "counts.csv", "time,front_left.spin,front_right.spin,rear_left.spin,rear_right.spin\n"

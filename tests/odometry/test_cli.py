@@ -290,7 +290,7 @@ def test_an_output_that_is_the_log_is_refused_and_the_log_kept(capsys, diff_csv,
     given = {"same": str(log), "dot": f"./{log.name}", "link": "link.csv"}[alias]
     assert main(["odometry", "diff-drive", str(log), "--out", given, "--format", fmt]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "the output file is the log itself" in err, err
+    assert err.count("\n") == 1 and "--out " in err and "is also LOG (the output would replace it)" in err, err
     assert log.read_bytes() == before
 
 
@@ -325,5 +325,5 @@ def test_an_output_that_is_the_plot_is_refused(capsys, diff_csv, tmp_path):
     """``--out p.png --format csv --plot p.png``: the plot replaced the trajectory and the run reported success."""
     same = str(tmp_path / "p.png")
     assert main(["odometry", "diff-drive", diff_csv, "--out", same, "--format", "csv", "--plot", same]) == 2
-    assert "the output and the plot are one file" in capsys.readouterr().err
+    assert "is also --plot (the output would replace it)" in capsys.readouterr().err
     assert not (tmp_path / "p.png").exists()

@@ -198,7 +198,7 @@ def test_calibrate_refuses_to_write_the_camera_file_over_its_image(tmp_path, cap
     before = image.read_bytes()
     code, out, err = run(["vision", "calibrate", str(image), "--rows", "60", "--half-separation", "3.5cm",
                           "--row-distance", "10.22cm", "--out", str(tmp_path / "." / "cal.png")], capsys)
-    assert code == 2 and out == "" and "is the input IMAGE" in err and len(err.strip().splitlines()) == 1
+    assert code == 2 and out == "" and "is also IMAGE" in err and len(err.strip().splitlines()) == 1
     assert image.read_bytes() == before
 
 

@@ -11,6 +11,7 @@ from typing import Any
 
 from .. import catalog
 from ..errors import ShapeError, WmrkitError
+from ..limits import same_file
 from ..robot import Robot
 from ..units import Kind, UnitError, parse_quantity
 
@@ -59,33 +60,48 @@ def check_plot_path(path: str | None, what: str = "--plot") -> None:
 OUTPUT_FILES, OUTPUT_FOLDERS = ("out", "plot", "animate"), ("report", "trajectories")
 
 
-def check_blank(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
-    """Refuse, before any work, an argument given as empty text (a file or a robot named ''), naming it: read as a
-    path, '' would be the current folder."""
+def named_values(parser: argparse.ArgumentParser, args: argparse.Namespace):
+    """``(name, dest, value)`` of every argument of the chosen (sub)command, the name as the user sees it
+    (``--out``, ``ROBOT``), lists flattened."""
     for action in parser._actions:
         if isinstance(action, argparse._SubParsersAction):
             chosen = action.choices.get(getattr(args, action.dest, None))
             if chosen is not None:
-                check_blank(chosen, args)
+                yield from named_values(chosen, args)
             continue
         value = getattr(args, action.dest, None)
-        values = [v for x in (value if isinstance(value, list) else [value])
-                  for v in (x if isinstance(x, list) else [x])]
-        if any(isinstance(v, str) and not v.strip() for v in values):
-            metavar = " ".join(action.metavar) if isinstance(action.metavar, tuple) else action.metavar
-            raise WmrkitError(f"{'/'.join(action.option_strings) or metavar or action.dest.upper()}: empty value")
+        metavar = " ".join(action.metavar) if isinstance(action.metavar, tuple) else action.metavar
+        name = "/".join(action.option_strings) or metavar or action.dest.upper()
+        for v in (value if isinstance(value, list) else [value]):
+            for x in (v if isinstance(v, list) else [v]):
+                yield name, action.dest, x
 
 
-def check_outputs(args: argparse.Namespace) -> None:
+def check_blank(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse, before any work, an argument given as empty text (a file or a robot named ''), naming it: read as a
+    path, '' would be the current folder."""
+    for name, _, value in named_values(parser, args):
+        if isinstance(value, str) and not value.strip():
+            raise WmrkitError(f"{name}: empty value")
+
+
+def check_outputs(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
     """Refuse, before any work, an output the command could not write: a file whose folder is missing or not
-    writable, or that is a folder; a folder that is a file, or whose nearest existing parent is not writable."""
-    given = [(f"--{dest}", getattr(args, dest, None), dest in OUTPUT_FOLDERS) for dest in OUTPUT_FILES + OUTPUT_FOLDERS]
+    writable, or that is a folder; a folder that is a file, or whose nearest existing parent is not writable; a file
+    that is one of the command's input files or another of its outputs (it would replace it)."""
+    given = [(dest, getattr(args, dest, None), dest in OUTPUT_FOLDERS) for dest in OUTPUT_FILES + OUTPUT_FOLDERS]
     if getattr(args, "codegen", None):
-        given.append(("--codegen", args.codegen[1], True))
-    for what, path, folder in given:
+        given.append(("codegen", args.codegen[1], True))
+    outputs = {dest for dest, path, _ in given if path is not None}
+    others = [(name, dest, value) for name, dest, value in named_values(parser, args) if isinstance(value, str)]
+    for dest, path, folder in given:
         problem = None if path is None else output_problem(path, folder)
         if problem:
-            raise WmrkitError(f"{what} {path}: {problem}")
+            raise WmrkitError(f"--{dest} {path}: {problem}")
+        for name, other, value in ([] if path is None or folder else others):
+            # another output, or an input file (an existing one: ROBOT may name the catalog)
+            if other != dest and (other in outputs or Path(value).is_file()) and same_file(path, value):
+                raise WmrkitError(f"--{dest} {path}: is also {name} (the output would replace it)")
 
 
 def output_option(args: argparse.Namespace | None, filename: str | os.PathLike[str]) -> str:

@@ -253,10 +253,6 @@ def run_sweep(args: argparse.Namespace) -> int:
 
     robot = load_robot(args.robot)
     check_plot_path(args.plot)
-    if args.out is not None and Path(args.robot).is_file() and Path(args.out).resolve() == Path(args.robot).resolve():
-        raise WmrkitError(f"--out {args.out}: is the ROBOT description (the table would replace it)")
-    if args.out is not None and args.plot is not None and Path(args.out).resolve() == Path(args.plot).resolve():
-        raise WmrkitError(f"--out {args.out}: is the --plot file too (the picture would replace the table)")
     axes = [parse_vary(v, robot) for v in args.vary]
     length = None if args.length is None else parse_value(args.length, "length", "--length")
     if args.configs < 1:

@@ -110,7 +110,6 @@ def run_simulate(args: argparse.Namespace) -> int:
 
     model = DynamicModel.of(load_robot(args.robot), args.tyre)
     check_plot_path(args.plot)
-    _check_not_an_input(args)
     speed = _positive(parse_value(args.speed, "number", "--speed"), "--speed")
     if args.path:
         inputs, duration = path_program(model, args.path, speed=speed)
@@ -171,17 +170,6 @@ def _check_rolling(model, twist: list[float]) -> None:
     raise WmrkitError(f"--initial-twist {' '.join(f'{v:g}' for v in twist)}: fixed wheel "
                       f"'{model.robot.wheel_names[w]}' would slip sideways at {slip[w]:.3g} m/s, and the simulation "
                       f"starts rolling without slip ({hint})")
-
-
-def _check_not_an_input(args: argparse.Namespace) -> None:
-    """Refuse an ``--out`` that is an input (the torque file, the description file): the samples would replace it.
-    (``--plot`` cannot be one: it must be a .png, .svg or .pdf.)"""
-    from ..odometry.files import _same_file
-
-    inputs = {"torque file": args.torques, "robot description": args.robot if Path(args.robot).is_file() else None}
-    for what, path in inputs.items():
-        if args.out is not None and path is not None and _same_file(path, args.out):
-            raise WmrkitError(f"--out {args.out}: is the {what} (the samples would replace it); choose another file")
 
 
 def _tyre_warnings(model, twist: np.ndarray) -> list[str]:

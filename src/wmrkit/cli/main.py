@@ -79,7 +79,7 @@ def main(argv: list[str] | None = None) -> int:
         parser = build_parser(command)
         args = parser.parse_args(argv)
         check_blank(parser, args)
-        check_outputs(args)
+        check_outputs(parser, args)
         return int(args.run(args) or 0)
     except WmrkitError as err:
         report_error(err, as_json, argv)

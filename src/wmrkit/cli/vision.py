@@ -154,8 +154,6 @@ def run_calibrate(args: argparse.Namespace) -> int:
     by_points = args.x1 is not None or args.x2 is not None
     if by_points == (args.image is not None):
         raise WmrkitError("calibrate: give either IMAGE or both --x1 and --x2")
-    if args.out and args.image and Path(args.out).resolve() == Path(args.image).resolve():
-        raise WmrkitError(f"--out {args.out}: is the input IMAGE (the camera file would replace it)")
     if by_points:
         if args.x1 is None or args.x2 is None:
             raise WmrkitError("calibrate: --x1 and --x2 go together")

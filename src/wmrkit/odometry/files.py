@@ -18,6 +18,7 @@ from typing import Literal
 
 from numpy.typing import ArrayLike
 
+from ..limits import same_file
 from ..robot import Robot
 from .bags import OdometryBagWriter, bag_message_count, read_joint_states
 from .integrators import Method, check_method
@@ -42,14 +43,6 @@ def out_format_of(path: str | os.PathLike[str]) -> OutFormat:
     return "csv" if suffix == ".csv" else "tum" if suffix in (".tum", ".txt") else "bag"
 
 
-def _same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
-    """Whether `a` and `b` name one file (links and relative paths resolved; `b` need not exist)."""
-    try:
-        return os.path.samefile(a, b)
-    except OSError:
-        return os.path.realpath(a) == os.path.realpath(b)
-
-
 def _remove(path: str | os.PathLike[str]) -> None:
     """Delete an output file, or a bag (a directory), that this run created."""
     if Path(path).is_dir():
@@ -61,7 +54,7 @@ def _remove(path: str | os.PathLike[str]) -> None:
 def _check_not_the_log(log_path: str | os.PathLike[str], outputs: Mapping[str, object]) -> None:
     """Refuse an output that is the log itself: opening it for writing would empty the log before it is read."""
     for what, path in outputs.items():
-        if path is not None and _same_file(log_path, path):  # type: ignore[arg-type]
+        if path is not None and same_file(log_path, path):  # type: ignore[arg-type]
             raise LogError(f"{os.fspath(log_path)}: the {what} file is the log itself (writing it would destroy the "
                            "log); choose another file")
 
@@ -93,7 +86,7 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
     total, unit = ((bag_message_count(log_path, topic), "msg") if bag
                    else (os.path.getsize(log_path), "B"))
     _check_not_the_log(log_path, {"output": out, "plot": plot})
-    if out is not None and plot is not None and _same_file(out, plot):
+    if out is not None and plot is not None and same_file(out, plot):
         raise LogError(f"{os.fspath(out)}: the output and the plot are one file (the plot would replace the "
                        "trajectory); choose two files")
     out_fmt = None if out is None else (out_format or out_format_of(out))
