@@ -173,3 +173,28 @@ def test_ik_outside_a_steer_range_is_not_feasible(capsys):
     batch = wheel_commands(robot, [[1, 0, 0.1], [1, 0, 0.3], [1, 0.5, 0.1]])
     assert batch.feasible.tolist() == [True, False, False]  # the last: a fixed wheel slips
     assert batch.in_range[:, robot.wheel_names.index("front_left")].tolist() == [True, False, True]
+
+
+def test_ik_takes_the_other_root_when_only_it_is_within_the_steer_range(tmp_path, capsys):
+    """Modules limited to +-90 deg at heading 80 deg, asked to roll towards 100 deg: the closest root (100 deg) is
+    outside the range but the other (-80 deg, spinning backwards) is inside. It was 'feasible: NO (a wheel cannot
+    steer there)' for a twist the robot can follow."""
+    from wmrkit import Robot
+    from wmrkit.kinematics.wheel_ik import wheel_commands
+
+    wheels = "\n".join(f"  - {{name: {n}, type: steerable, position: [{x}, {y}], heading: 80 deg, r: 0.05, "
+                       f"steer_range: [-90 deg, 90 deg]}}" for n, x, y in (("a", 0.3, 0.3), ("b", -0.3, -0.3)))
+    path = tmp_path / "limited.yaml"
+    path.write_text(f"name: limited\nwheels:\n{wheels}\n")
+    twist = [math.cos(math.radians(100)), math.sin(math.radians(100)), 0.0]
+    code, out, err = run(capsys, "ik", str(path), "--twist", *map(str, twist), "--json")
+    data = json.loads(out)
+    assert code == 0 and data["feasible"] is True and data["out_of_range"] == [] and err == ""
+    for entry in data["wheels"].values():
+        assert math.degrees(entry["heading"]) == pytest.approx(-80.0) and entry["spin"] == pytest.approx(-20.0)
+    robot = Robot.from_file(path)
+    c = wheel_commands(robot, [twist, [-t for t in twist], [0.0, 1.0, 0.0]], heading=[[80.0 * math.pi / 180] * 2] * 3)
+    assert c.feasible.tolist() == [True, True, True]
+    np.testing.assert_allclose(np.degrees(c.heading[:, 0]), [-80.0, -80.0, 90.0], atol=1e-9)
+    np.testing.assert_allclose(c.spin[:, 0], [-20.0, 20.0, 20.0], atol=1e-9)
+    assert np.abs(robot.slip_velocity(c.velocity([twist, [-t for t in twist], [0.0, 1.0, 0.0]]), c.beta)).max() < 1e-12

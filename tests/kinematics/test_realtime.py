@@ -39,6 +39,23 @@ def test_ik_equals_the_batched_ik(name):
     _same_ik(robot, rt, np.zeros(3), robot.heading)  # zero twist: angles held, spins 0
 
 
+def test_ik_takes_the_root_within_the_steer_range_as_the_batched_ik():
+    """Modules limited to +-90 deg at 80 deg asked for 100 deg: the other root (-80 deg, spin negated) is within
+    the range and is taken, as by wheel_commands; it was the closest root, reported infeasible."""
+    from wmrkit import Robot, Wheel
+
+    robot = Robot("limited", tuple(Wheel(n, "steerable", 0.4, a, 0.0, 0.05, steer_range=(-np.pi / 2, np.pi / 2))
+                                   for n, a in (("a", 0.8), ("b", -2.3))))
+    rt = realtime(robot)
+    rates, out = np.empty(2), np.empty(2)
+    twist = (np.cos(np.radians(100)), np.sin(np.radians(100)), 0.0)
+    assert rt.ik(*twist, np.radians([80.0, 80.0]), rates, out)
+    np.testing.assert_allclose(np.degrees(out), [-80.0, -80.0]), np.testing.assert_allclose(rates, [-20.0, -20.0])
+    rng = np.random.default_rng(3)
+    for _ in range(100):
+        _same_ik(robot, rt, rng.uniform(-1, 1, 3), rng.uniform(-np.pi / 2, np.pi / 2, 2))
+
+
 @settings(max_examples=25)
 @given(robot=robots(max_wheels=3), data=st.data())
 def test_ik_equals_the_batched_ik_on_random_robots(robot, data):

@@ -6,7 +6,8 @@ A robot's wheels fall into three groups, each solved for a whole batch of twists
   (rolling row of (3.11); (8.27)/(8.28) for rollers) and a fixed wheel's lateral row (8.14) gives its slip.
 - *steered by the twist*: steerable (centred orientable) and double wheels. The angle zeroing the lateral slip is
   (8.9), ``atan2(-u_x, u_y)`` with ``u`` the velocity of the steering axis; of it and its opposite the one closest to
-  the current angle is kept, and the spin follows from (8.12) with the matching sign.
+  the current angle is kept (the other one when only it is within the wheel's ``steer_range``), and the spin
+  follows from (8.12) with the matching sign.
 - *at the current angle*: castors, double castors (and the sub-wheels of a double wheel once its angle is chosen):
   the element rows (3.10) at that angle give the steering rate (8.24) and the spins (8.25).
 """
@@ -21,7 +22,7 @@ import numpy as np
 
 from .._shapes import readonly
 from ..robot import Robot
-from ..wheels import generic_slip_rows, wrap_angle
+from ..wheels import generic_slip_rows, heading_in_range, wrap_angle
 
 TWO_PI = 2.0 * math.pi
 CONSTANT_TYPES = ("fixed", "swedish", "ball", "orthogonal")
@@ -193,7 +194,21 @@ def steer_to_twist(
         kept = np.broadcast_to(wrap_angle(cur), beta.shape)
         beta[held] = kept[held]
         spin[held[p.steered_spin_of]] = 0.0
+    if p.steer_range is not None:
+        _prefer_in_range(p, beta, spin, held)
     return (beta.T.reshape(*batch, n_o), spin.T.reshape(*batch, n_s), held.T.reshape(*batch, n_o))
+
+
+def _prefer_in_range(p: Plan, beta: np.ndarray, spin: np.ndarray, held: np.ndarray) -> None:
+    """Where the closest root's heading is outside its wheel's ``steer_range`` and the other root's is inside,
+    take the other root (``beta + pi``, spin negated): the wheel can follow the twist. In place, ``(n_o, m)``."""
+    wheels = p.steer_wheels[p.steered_beta]
+    lo, hi = p.steer_range[:, wheels][..., None]  # (n_o, 1) each; +-inf: no range
+    heading = beta + (p.wheel_delta[wheels] - 0.5 * math.pi)[:, None]
+    flip = ~held & ~heading_in_range(heading, lo, hi) & heading_in_range(heading + math.pi, lo, hi)
+    if flip.any():
+        beta[flip] = wrap_angle(beta[flip] + math.pi)
+        spin[flip[p.steered_spin_of]] *= -1.0
 
 
 def _steer_block(

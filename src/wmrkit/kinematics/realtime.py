@@ -129,6 +129,11 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
         return y
 
     @numba.njit(cache=False)
+    def in_range(h, k):  # wheels.heading_in_range of heading h: counter-clockwise from lo, within the width
+        off = (h - lo[k] + 1e-12) % two_pi - 1e-12
+        return off <= width[k] + 1e-12
+
+    @numba.njit(cache=False)
     def ik(vx, vy, w, heading, rates_out, heading_out):
         if not (float64_vector(rates_out) and float64_vector(heading_out) and heading.shape[0] == n_steer
                 and heading_out.shape[0] == n_steer and rates_out.shape[0] == n_rates):
@@ -153,6 +158,10 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             moving = speed > speed_tol
             if moving:
                 beta[k] = math.atan2(minus_ux * sign + 0.0, uy * sign)
+                h = beta[k] + (delta[k] - HALF_PI)
+                if ranged[k] and not in_range(h, k) and in_range(h + math.pi, k):
+                    beta[k] = wrap(beta[k] + math.pi)  # the other root is within the steer_range: take it
+                    sign = -sign
             if spin_col[i] >= 0:
                 rates_out[spin_col[i]] = -speed * sign * inv_r[i] if moving else 0.0
         for e in range(n_e):  # castor-like elements at the (new) angle: rows (3.10), (8.24), (8.25)
@@ -171,10 +180,8 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
                 feasible = False
         for k in range(n_steer):
             beta[k] = wrap(beta[k] + delta[k] - HALF_PI)
-            if ranged[k]:  # wheels.heading_in_range: counter-clockwise from lo, within the width
-                off = (beta[k] - lo[k] + 1e-12) % two_pi - 1e-12
-                if off > width[k] + 1e-12:
-                    feasible = False
+            if ranged[k] and not in_range(beta[k], k):
+                feasible = False
         return feasible
 
     return ik

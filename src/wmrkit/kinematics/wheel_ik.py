@@ -44,8 +44,8 @@ class WheelCommands:
     - ``slip`` ``(..., N)`` [m/s]: lateral slip (3.11) row 0 / (8.14) left at each fixed wheel, 0 elsewhere.
     - ``feasible`` ``(...)`` bool: every ``|slip| <= slip_tol`` and every heading within its wheel's ``steer_range``.
     - ``in_range`` ``(..., N)`` bool: the wheel's heading lies in its ``steer_range`` (True for wheels without one,
-      and for those that do not steer). The root of (8.9) is the one closest to the current heading; when it is
-      outside the range the twist is not feasible for the robot (its steering cannot reach it).
+      and for those that do not steer). The root of (8.9) is the one closest to the current heading unless only
+      the other lies within the range; when neither does the twist is not feasible (the steering cannot reach it).
     - ``beta`` ``(..., n_steer)`` [rad]: the steering configuration the commands hold at (``steer_names`` order).
     - ``heading`` ``(..., N)`` [rad] in ``(-pi, pi]``: the users' steering angle, each wheel's rolling direction
       (0 = straight ahead, +x), ``steer + delta - pi/2`` (:func:`wmrkit.wheels.heading_from_beta`); NaN for wheels
@@ -112,7 +112,8 @@ def wheel_commands(
     `beta` or the users' `heading` (``robot.steer_names`` order; default the described ones).
 
     - steerable / double wheels: angle (8.9) of the two solutions ``b`` and ``b + pi`` closest to the current
-      angle (the spin sign flips rather than the wheel turning half round), spin (8.12) with that sign; where the
+      angle (the spin sign flips rather than the wheel turning half round), or the other one when only it is within
+      the wheel's ``steer_range``, spin (8.12) with that sign; where the
       steering axis moves slower than `speed_tol` [m/s] the angle is undefined: current angle kept, spin 0.
     - castor: steering rate (8.24) and spin (8.25) at the current angle; double castor likewise (3.31)-(3.36).
     - Swedish, ball, orthogonal: spin (8.27) and roller rate (8.28, with the roller radius r_r).
