@@ -56,6 +56,18 @@ def test_ik_takes_the_root_within_the_steer_range_as_the_batched_ik():
         _same_ik(robot, rt, rng.uniform(-1, 1, 3), rng.uniform(-np.pi / 2, np.pi / 2, 2))
 
 
+@pytest.mark.parametrize("name", ["diff-drive", "swerve-4"])
+def test_odometry_step_that_overflows_is_refused_and_writes_nothing(name):
+    """Joint positions of 1e308 and -1e308 are finite, their difference is not: the pose became NaN."""
+    rt = realtime(catalog.load(name))
+    n = len(rt.rate_joints)
+    pose, previous = np.array([1.0, 2.0, 0.5]), np.zeros(n)
+    positions = np.where(np.arange(n) % 2, -1e308, 1e308)
+    with pytest.raises(ValueError, match="overflows"):
+        rt.odometry_step(pose, previous, positions, np.zeros(len(rt.steer_joints)))
+    assert pose.tolist() == [1.0, 2.0, 0.5] and previous.tolist() == [0.0] * n
+
+
 @settings(max_examples=25)
 @given(robot=robots(max_wheels=3), data=st.data())
 def test_ik_equals_the_batched_ik_on_random_robots(robot, data):

@@ -37,6 +37,8 @@ from .wheel_ik import check_tolerances
 drop_stale_cache([__file__], [_kernels.__file__])
 
 HALF_PI = 0.5 * math.pi
+OVERFLOW = ("odometry_step: the step overflows (joint positions too far from the previous ones); the pose and "
+            "previous are unchanged")
 
 
 @dataclass(frozen=True, eq=False)
@@ -214,6 +216,7 @@ def _constant_step(twist_map: np.ndarray):
     shapes = (f"odometry_step: pose must be a float64 array of shape (3,), previous one of shape ({n_a},) "
               f"(rate_joints) and positions of shape ({n_a},)")
     bad = "odometry_step: the pose and the joint positions must be finite"
+    overflow = OVERFLOW
 
     @numba.njit(cache=False)
     def step(pose, previous, positions, heading_mid):
@@ -225,7 +228,8 @@ def _constant_step(twist_map: np.ndarray):
                 raise ValueError(bad)
         if not (math.isfinite(pose[0]) and math.isfinite(pose[1]) and math.isfinite(pose[2])):
             raise ValueError(bad)
-        _step(pose, previous, positions, twist_map)
+        if not _step(pose, previous, positions, twist_map):
+            raise ValueError(overflow)
 
     return step
 
@@ -233,20 +237,24 @@ def _constant_step(twist_map: np.ndarray):
 @numba.njit(cache=True)
 def _step(pose, previous, positions, twist_map):
     """One exact SE(2) step (paper 003 (21)-(25)): body increments ``twist_map @ dq``, chord ``sinc(h)`` along the
-    mid heading, with the odometry kernels' own sine and cosine (the batched path's numbers)."""
+    mid heading, with the odometry kernels' own sine and cosine (the batched path's numbers). Returns False, and
+    writes nothing, when the new pose would not be finite (positions too far apart to subtract)."""
     d0 = d1 = d2 = 0.0
     for j in range(positions.shape[0]):
         dq = positions[j] - previous[j]
-        previous[j] = positions[j]
         d0 += twist_map[0, j] * dq
         d1 += twist_map[1, j] * dq
         d2 += twist_map[2, j] * dq
     h = 0.5 * d2
     f = _sinc(h)
     c, s = _cos_sin(pose[2] + h)
-    pose[0] += f * (c * d0 - s * d1)
-    pose[1] += f * (s * d0 + c * d1)
-    pose[2] += d2
+    x, y, theta = pose[0] + f * (c * d0 - s * d1), pose[1] + f * (s * d0 + c * d1), pose[2] + d2
+    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(theta)):
+        return False
+    for j in range(positions.shape[0]):
+        previous[j] = positions[j]
+    pose[0], pose[1], pose[2] = x, y, theta
+    return True
 
 
 def _steering_fk_and_step(model):
@@ -279,6 +287,7 @@ def _steering_fk_and_step(model):
                              f"({n_a},) (rate_joints) and positions of shape ({n_a},)")
         if not (np.isfinite(pose).all() and np.isfinite(previous).all() and np.isfinite(positions).all()):
             raise ValueError("odometry_step: the pose and the joint positions must be finite")
-        _step(pose, previous, np.asarray(positions, dtype=float), twist_map(heading_mid, "odometry_step"))
+        if not _step(pose, previous, np.asarray(positions, dtype=float), twist_map(heading_mid, "odometry_step")):
+            raise ValueError(OVERFLOW)
 
     return fk, step
