@@ -84,3 +84,23 @@ def test_without_steerable_wheels_the_guess_is_returned():
 def test_shapes_are_checked():
     with pytest.raises(ShapeError, match=r"q_assigned: expected shape \(\.\.\., 2\)"):
         extended_solution(bicycle(), ["vx", "vy"], [1.0])
+
+
+@pytest.mark.parametrize("q", [[np.nan, 1.0], [1.0, np.inf], [1e300, -1e300], [2e6, 0.0]])
+def test_assigned_values_must_be_finite_and_bounded(q):
+    """NaN gave a NaN slip, 1e300 an infinite one, and solve_steering returned the guess as a 'root' of 1e300."""
+    robot = car_with_castor()
+    with pytest.raises(ShapeError, match=r"q_assigned: (rl|rr)\.spin: expected finite numbers within 1e\+06"):
+        extended_solution(robot, ["rl.spin", "rr.spin"], q)
+    with pytest.raises(ShapeError, match=r"q_assigned: (rl|rr)\.spin: expected finite numbers within 1e\+06"):
+        solve_steering(robot, ["rl.spin", "rr.spin"], q)
+
+
+def test_starts_iterations_and_names_are_checked():
+    with pytest.raises(ShapeError, match="starts >= 1 and iterations >= 0"):
+        solve_steering(bicycle(), ["vx", "vy", "omega"], [1.0, 0.0, 0.0], starts=0)
+    with pytest.raises(ShapeError, match="starts >= 1 and iterations >= 0"):
+        solve_steering(bicycle(), ["vx", "vy", "omega"], [1.0, 0.0, 0.0], iterations=-1)
+    with pytest.raises(ShapeError, match="at least one velocity name"):  # was numpy's 'cannot reshape' ValueError
+        solve_steering(bicycle(), [], np.zeros(0))
+

@@ -18,7 +18,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
-from ..errors import SingularError
+from ..errors import ShapeError, SingularError
+from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from .linalg import solve_assigned
 from .models import configuration, describe_configuration, generic_mobility, velocity_indices
@@ -78,12 +79,26 @@ def extended_solution(
     steering angles of :func:`solve_steering`. ``heading`` (0 = rolling forward) instead of ``beta``: the same.
     """
     beta = configuration(robot, beta, heading)
-    idx = velocity_indices(robot, assigned)
-    q = as_vectors(q_assigned, len(idx), "q_assigned")
+    idx, q = _assigned(robot, assigned, q_assigned)
     q_dot, residual = solve_assigned(robot.constraint_matrix(beta), idx, q)
     beta = np.broadcast_to(beta, (*q_dot.shape[:-1], beta.shape[-1]))
     return ExtendedSolution(robot.name, robot.velocity_names, tuple(assigned), readonly(np.array(beta)),
                             readonly(q_dot), readonly(residual))
+
+
+def _assigned(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """Columns of the assigned velocities and their values ``(..., n_a)``, finite and within ``MAX_QUERY_RATE``
+    (NaN gave a NaN slip, 1e300 an infinite one, and solve_steering returned the guess as a root)."""
+    if len(assigned) == 0:
+        raise ShapeError(f"assigned: expected at least one velocity name of robot '{robot.name}', got none")
+    idx = velocity_indices(robot, assigned)
+    q = as_vectors(q_assigned, len(idx), "q_assigned")
+    bad = ~(np.abs(q) <= MAX_QUERY_RATE).reshape(-1, len(idx))  # NaN included
+    if bad.any():
+        i, j = (int(x) for x in np.argwhere(bad)[0])
+        raise ShapeError(f"q_assigned: {assigned[j]}: expected finite numbers within {MAX_QUERY_RATE:g} (rad/s or "
+                         f"m/s), got {float(q.reshape(-1, len(idx))[i, j])}")
+    return idx, q
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:
@@ -99,13 +114,17 @@ def solve_steering(
     Finds roots of the residual of (4.11) over the angles of the centred steerable wheels (the others, and
     castor angles, stay at `beta_guess`) by Levenberg-Marquardt from `beta_guess` (the thesis needs beta to vary
     continuously, so the nearby root is wanted); where that fails, from a grid of ``starts`` angles per wheel,
-    keeping the root closest to the guess. ``q_assigned``: ``(..., n_a)``; ``beta_guess``: ``(..., n_steer)``
-    or None (described). Returns ``(..., n_steer)`` [rad], steerable angles wrapped to [-pi, pi). Raises
+    keeping the root closest to the guess. ``q_assigned``: ``(..., n_a)``, finite, within ``MAX_QUERY_RATE``;
+    ``beta_guess``: ``(..., n_steer)`` or None (described). Returns ``(..., n_steer)`` [rad], steerable angles
+    wrapped to [-pi, pi). Raises
     :class:`~wmrkit.errors.SingularError` where no angle makes the assignment slip-free.
     """
+    if not (isinstance(starts, int | np.integer) and starts >= 1 and isinstance(iterations, int | np.integer)
+            and iterations >= 0):
+        raise ShapeError(f"solve_steering: expected starts >= 1 and iterations >= 0 (integers), got {starts!r} and "
+                         f"{iterations!r}")
     guess = configuration(robot, beta_guess)
-    idx = velocity_indices(robot, assigned)
-    q = as_vectors(q_assigned, len(idx), "q_assigned")
+    idx, q = _assigned(robot, assigned, q_assigned)
     batch = np.broadcast_shapes(q.shape[:-1], guess.shape[:-1])
     guess = np.broadcast_to(guess, (*batch, guess.shape[-1])).reshape(-1, guess.shape[-1])
     q = np.broadcast_to(q, (*batch, q.shape[-1])).reshape(-1, q.shape[-1])
