@@ -104,3 +104,22 @@ def test_starts_iterations_and_names_are_checked():
     with pytest.raises(ShapeError, match="at least one velocity name"):  # was numpy's 'cannot reshape' ValueError
         solve_steering(bicycle(), [], np.zeros(0))
 
+
+def test_the_grid_of_starts_is_bounded(monkeypatch):
+    """8 starts on 6 steered wheels are 262,144 starts per problem (minutes and gigabytes where no root exists):
+    at most MAX_STARTS, a seeded sample of the grid, and the problems in chunks."""
+    from wmrkit.kinematics import extended
+
+    robot = Robot("six", tuple(Wheel(f"w{i}", "steerable", 0.5, i * math.pi / 3, HALF_PI, 0.05) for i in range(6)))
+    monkeypatch.setattr(extended, "MAX_STARTS", 16, raising=False)
+    lm, sizes = extended._levenberg_marquardt, []
+
+    def counted(f, x, iterations, tol):
+        sizes.append(x.shape[0] * x.shape[1])
+        assert sizes[-1] <= 4 * 16, "too many starts at once"
+        return lm(f, x, 5, tol)
+
+    monkeypatch.setattr(extended, "_levenberg_marquardt", counted)
+    with pytest.raises(SingularError, match="no steering angles make"):  # the spin contradicts the twist
+        solve_steering(robot, ["vx", "vy", "omega", "w0.spin"], [[1.0, 0.0, 0.0, 100.0]] * 5)
+    assert sizes[0] == 5 and len(sizes) == 1 + 2  # the guesses, then 5 problems x 16 starts in chunks of 4
