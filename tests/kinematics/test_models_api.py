@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from wmrkit import Robot, ShapeError, SingularError, UnknownNameError, Wheel, WmrkitError
+from wmrkit import Robot, ShapeError, SingularError, UnknownNameError, Wheel, WmrkitError, catalog
 from wmrkit.kinematics.models import (
     assignable_sets,
     direct_model,
@@ -169,3 +169,12 @@ def test_a_robot_that_cannot_move_has_the_empty_model():
     model = kinematic_model(robot, [])
     assert model.matrix.shape == (6, 0)
     np.testing.assert_array_equal(model.velocities(np.zeros(0)), np.zeros(6))
+
+
+@pytest.mark.parametrize("q", [[np.nan], [np.inf], [1e308], [[1.0], [-2e6]]])
+def test_assigned_values_must_be_finite_and_bounded(q):
+    """solve and velocities gave NaN for NaN and numbers near overflow (9e306) for 1e308, silently."""
+    model = kinematic_model(catalog.load("thesis-tricycle-ch4"), ["o3.spin"])
+    for method in (model.solve, model.velocities):
+        with pytest.raises(ShapeError, match=r"q_assigned: o3\.spin: expected finite numbers within 1e\+06"):
+            method(q)

@@ -19,7 +19,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
-from ..errors import SingularError, WmrkitError
+from ..errors import ShapeError, SingularError, WmrkitError
+from ..limits import MAX_QUERY_RATE
 from ..robot import TWIST_NAMES, Robot
 from .linalg import matrix_rank, nondimensional, velocity_scale
 from .nullspace import null_space_assignable, null_space_solution, rref_solution
@@ -55,8 +56,14 @@ class KinematicModel:
         return "inverse" if all(twist) else "direct" if not any(twist) else "mixed"
 
     def solve(self, q_assigned: ArrayLike) -> np.ndarray:
-        """The solved velocities for assigned ones: ``(..., n_assigned) -> (..., n_solved)``."""
+        """The solved velocities for assigned ones: ``(..., n_assigned) -> (..., n_solved)``. The assigned values
+        must be finite and within ``MAX_QUERY_RATE`` (m/s, rad/s): NaN and 1e308 gave NaN and overflowing rates."""
         q = as_vectors(q_assigned, len(self.assigned), "q_assigned")
+        bad = ~(np.abs(q) <= MAX_QUERY_RATE)  # NaN included
+        if bad.any():
+            where = tuple(int(x) for x in np.argwhere(bad)[0])
+            raise ShapeError(f"q_assigned: {self.assigned[where[-1]]}: expected finite numbers within "
+                             f"{MAX_QUERY_RATE:g} (rad/s or m/s), got {float(q[where])}")
         return (self.matrix @ q[..., None])[..., 0]
 
     def velocities(self, q_assigned: ArrayLike) -> np.ndarray:
