@@ -216,3 +216,17 @@ def test_a_drive_unit_driven_by_its_two_wheels():
         {"name": "trailer", "type": "double_castor", "position": [-0.3, 0], "beta": "90 deg", "d": 0.1, "b": 0.05,
          "r": 0.04}]})
     assert str(actuation_analysis(trailer).tree.leaf) == "indeterminate"
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, 1e308, -2e6])
+def test_the_analyses_solutions_refuse_values_that_are_not_finite_or_beyond_1e6(bad):
+    """ActuationAnalysis.inverse, SensingAnalysis.twist and .direct gave NaN, -inf or 1e306 silently."""
+    from wmrkit import ShapeError, catalog
+
+    robot = catalog.load("thesis-tricycle-ch4")
+    with pytest.raises(ShapeError, match=r"twist_robot: vy: expected finite numbers within 1e\+06"):
+        actuation_analysis(robot).inverse([[0.0, 0.0, 0.0], [0.0, bad, 0.0]])
+    sensing = sensing_analysis(robot)
+    for method in (sensing.twist, sensing.direct):
+        with pytest.raises(ShapeError, match=r"q_dot_s: f2\.spin: expected finite numbers within 1e\+06"):
+            method([1.0, bad])

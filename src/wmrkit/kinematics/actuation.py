@@ -19,9 +19,9 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..couplings import coupled_columns, linked_steering
-from ..robot import Robot
+from ..robot import TWIST_NAMES, Robot
 from .linalg import delta_projector, matrix_rank, nondimensional
-from .models import configuration
+from .models import bounded, configuration
 from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_prefilter, search_sets
 from .trees import (
     TreeVerdict,
@@ -156,7 +156,7 @@ class ActuationAnalysis:
 
     def inverse(self, twist_robot: ArrayLike) -> np.ndarray:
         """Actuated rates for a (feasible) body twist, (4.26): ``(..., 3) -> (..., n_u)`` [rad/s, m/s]."""
-        t = as_vectors(twist_robot, 3, "twist_robot")
+        t = bounded(as_vectors(twist_robot, 3, "twist_robot"), TWIST_NAMES, "twist_robot")
         return (self.inverse_matrix @ t[..., None])[..., 0]
 
     def as_dict(self) -> dict[str, Any]:

@@ -19,10 +19,9 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..errors import ShapeError, SingularError
-from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from .linalg import solve_assigned
-from .models import configuration, describe_configuration, generic_mobility, velocity_indices
+from .models import bounded, configuration, describe_configuration, generic_mobility, velocity_indices
 
 #: Most grid starts per problem of :func:`solve_steering` (its default 8 per wheel on 4 steered wheels); beyond,
 #: a seeded sample of the grid. Each start costs about 7 ms when no root exists (4096: 27 s for a swerve-4).
@@ -95,13 +94,7 @@ def _assigned(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike) -> t
     if len(assigned) == 0:
         raise ShapeError(f"assigned: expected at least one velocity name of robot '{robot.name}', got none")
     idx = velocity_indices(robot, assigned)
-    q = as_vectors(q_assigned, len(idx), "q_assigned")
-    bad = ~(np.abs(q) <= MAX_QUERY_RATE).reshape(-1, len(idx))  # NaN included
-    if bad.any():
-        i, j = (int(x) for x in np.argwhere(bad)[0])
-        raise ShapeError(f"q_assigned: {assigned[j]}: expected finite numbers within {MAX_QUERY_RATE:g} (rad/s or "
-                         f"m/s), got {float(q.reshape(-1, len(idx))[i, j])}")
-    return idx, q
+    return idx, bounded(as_vectors(q_assigned, len(idx), "q_assigned"), assigned, "q_assigned")
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:

@@ -58,12 +58,7 @@ class KinematicModel:
     def solve(self, q_assigned: ArrayLike) -> np.ndarray:
         """The solved velocities for assigned ones: ``(..., n_assigned) -> (..., n_solved)``. The assigned values
         must be finite and within ``MAX_QUERY_RATE`` (m/s, rad/s): NaN and 1e308 gave NaN and overflowing rates."""
-        q = as_vectors(q_assigned, len(self.assigned), "q_assigned")
-        bad = ~(np.abs(q) <= MAX_QUERY_RATE)  # NaN included
-        if bad.any():
-            where = tuple(int(x) for x in np.argwhere(bad)[0])
-            raise ShapeError(f"q_assigned: {self.assigned[where[-1]]}: expected finite numbers within "
-                             f"{MAX_QUERY_RATE:g} (rad/s or m/s), got {float(q[where])}")
+        q = bounded(as_vectors(q_assigned, len(self.assigned), "q_assigned"), self.assigned, "q_assigned")
         return (self.matrix @ q[..., None])[..., 0]
 
     def velocities(self, q_assigned: ArrayLike) -> np.ndarray:
@@ -105,6 +100,17 @@ def mobility(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike 
     """Degree of mobility ``m = k - rank A`` (4.3): ``(..., n_steer) -> (...)`` int (β or `heading`)."""
     a = nondimensional(robot).constraint_matrix(configuration(robot, beta, heading))
     return a.shape[-1] - matrix_rank(a)
+
+
+def bounded(q: np.ndarray, names: Sequence[str], argument: str) -> np.ndarray:
+    """`q` ``(..., len(names))`` itself, or :class:`ShapeError` naming `argument` and the velocity of the first value
+    that is not a finite number within ``MAX_QUERY_RATE`` (m/s, rad/s): the models' products gave NaN or overflowed."""
+    bad = ~(np.abs(q) <= MAX_QUERY_RATE)  # NaN included
+    if bad.any():
+        where = tuple(int(x) for x in np.argwhere(bad)[0])
+        raise ShapeError(f"{argument}: {names[where[-1]]}: expected finite numbers within {MAX_QUERY_RATE:g} (rad/s "
+                         f"or m/s), got {float(q[where])}")
+    return q
 
 
 def velocity_indices(robot: Robot, names: Sequence[str]) -> np.ndarray:

@@ -19,7 +19,7 @@ from .._shapes import as_vectors, readonly
 from ..robot import TWIST_NAMES, Robot
 from .actuation import minimal_set_search, split_jacobian, steering_split, verdict_texts
 from .linalg import delta_projector, matrix_rank, nondimensional
-from .models import configuration
+from .models import bounded, configuration
 from .search import SetList
 from .trees import (
     TreeVerdict,
@@ -138,7 +138,7 @@ class SensingAnalysis:
 
     def twist(self, q_dot_s: ArrayLike) -> np.ndarray:
         """The body twist from sensed rates, (4.32): ``(..., n_s) -> (..., 3)`` [m/s, rad/s]."""
-        q = as_vectors(q_dot_s, len(self.sensed), "q_dot_s")
+        q = bounded(as_vectors(q_dot_s, len(self.sensed), "q_dot_s"), self.sensed, "q_dot_s")
         return (self.direct_matrix @ q[..., None])[..., 0]
 
     def direct(self, q_dot_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
@@ -147,7 +147,7 @@ class SensingAnalysis:
         The residual is ``I_ns (twist; q_dot_ns) - J_s q_dot_s``: zero without slip or noise, the slip
         indicator otherwise (when ``slip_detectable``).
         """
-        q = as_vectors(q_dot_s, len(self.sensed), "q_dot_s")[..., None]
+        q = bounded(as_vectors(q_dot_s, len(self.sensed), "q_dot_s"), self.sensed, "q_dot_s")[..., None]
         return (self.full_matrix @ q)[..., :3, 0], (self.residual_matrix @ q)[..., 0]
 
     def as_dict(self) -> dict[str, Any]:
