@@ -10,6 +10,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text()
 
@@ -43,3 +45,16 @@ def test_every_command_of_what_you_get_exits_0(tmp_path):
         if out.returncode != 0:
             failed.append(f"{command}: exit {out.returncode}: {out.stderr.strip()[-300:]}")
     assert failed == []
+
+
+def test_a_wheel_written_as_the_readme_writes_it_without_its_heading_is_told_heading(tmp_path):
+    """The README writes wheels with `position` and `heading`; forgetting the heading was reported as a missing
+    'beta', a field that file never used."""
+    from wmrkit import DescriptionError, Robot
+
+    path = tmp_path / "rover.yaml"
+    path.write_text("name: rover\nwheels:\n  - {name: left, type: fixed, position: [0, 0.3], r: 0.1}\n")
+    with pytest.raises(DescriptionError) as err:
+        Robot.from_file(path)
+    assert str(err.value).endswith("rover.yaml:3: wheels[0]: missing field 'heading' (rolling direction, "
+                                   "0 = straight ahead; or the thesis's 'beta')")

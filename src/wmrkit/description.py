@@ -204,6 +204,8 @@ def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc) -> Wheel:
     for key in kind.required:
         if key == "beta" and "heading" in item:
             continue
+        if key == "beta" and "beta" not in item:  # files are written with heading (README): name it, not only beta
+            check.fail("missing field 'heading' (rolling direction, 0 = straight ahead; or the thesis's 'beta')", loc)
         values[key] = check.quantity(check.require(item, key, loc), GEOMETRY_FIELDS[key], (*loc, key))
     _read_heading(item, values, check, loc, "beta" in kind.optional)
     _check_geometry(type_name, values, check, loc)
