@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from doc_examples import ROOT, check_command_examples, command_examples
@@ -16,3 +18,21 @@ def test_the_pages_with_command_examples_are_found():
 @pytest.mark.parametrize("page", PAGES)
 def test_command_examples_print_what_the_page_shows(page, tmp_path, capsys):
     assert check_command_examples(page, tmp_path, capsys) > 0
+
+
+def test_control_one_call_example_summary_is_what_its_comment_says(tmp_path, monkeypatch):
+    """docs/control.md's first example: the numbers of its `run.summary()` comment are the run's (`~` an order of
+    magnitude, within a factor 3). Its final error read ~1e-11 while the run ends at 2e-9."""
+    block = re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "control.md").read_text(), flags=re.S)[0]
+    comment = re.search(r"run\.summary\(\)\s+# \{(.*)\}", block)[1]
+    monkeypatch.chdir(tmp_path)  # the example writes track.png
+    scope: dict = {}
+    exec(compile(block, "docs/control.md", "exec"), scope)  # our own documentation, not user text
+    summary = scope["run"].summary()
+    shown = dict(re.findall(r"'(\w+)': (~?[-+]?\d[-+.\deE]*)", comment))
+    assert set(shown) == {"max_error", "final_error"}
+    for key, value in shown.items():
+        if value.startswith("~"):
+            assert float(value[1:]) / 3 <= summary[key] <= 3 * float(value[1:]), (key, summary[key])
+        else:
+            assert summary[key] == pytest.approx(float(value), rel=1e-3), (key, summary[key])
