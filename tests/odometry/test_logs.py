@@ -111,6 +111,8 @@ def test_heading_and_gyro_columns(tmp_path):
      r"x\.csv:1: column 'rigth\.spin' names no wheel of the robot \(wheels: left, right, caster\)"),
     ("time,left.spin,right_spin", ["0,0,0"], LogFormat(),
      r"x\.csv:1: missing column 'right\.spin' \(did you mean 'right_spin'\?\)"),
+    ("time,left.spin", ["0,0"], LogFormat(),  # not 'did you mean left.spin', read for the left wheel
+     r"x\.csv:1: missing column 'right\.spin' \(columns: 'time, left\.spin'\)"),
     ("t,left.spin,right.spin", ["0,0,0"], LogFormat(), r"x\.csv:1: missing column 'time'"),
     ("time,left.spin,right.spin,left.spin", ["0,0,0,0"], LogFormat(), r"x\.csv:1: column 'left\.spin' appears twice"),
     ("time,left.spin,right.spin", [], LogFormat(), r"x\.csv: no samples after the header"),

@@ -412,7 +412,8 @@ def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: S
                            f"{roles[k]}")
     for name in wanted:
         if name not in header:
-            close = difflib.get_close_matches(name, header, n=1)
+            unread = [h for h in header if h not in wanted]  # not a column read for another joint
+            close = difflib.get_close_matches(name, unread, n=1)
             hint = f" (did you mean '{close[0]}'?)" if close else ""
             raise LogError(f"{source}:1: missing column '{name}'{hint} (columns: {_short(', '.join(header), 200)})")
     return [header.index(n) for n in wanted]
