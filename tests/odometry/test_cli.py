@@ -327,3 +327,14 @@ def test_an_output_that_is_the_plot_is_refused(capsys, diff_csv, tmp_path):
     assert main(["odometry", "diff-drive", diff_csv, "--out", same, "--format", "csv", "--plot", same]) == 2
     assert "is also --plot (the output would replace it)" in capsys.readouterr().err
     assert not (tmp_path / "p.png").exists()
+
+
+def test_json_error_about_a_log_row_names_its_joint(capsys, tmp_path):
+    """limits.md: an error about a log gives its column as `field`; a row's value error ('x.csv:3: left.spin: value
+    nan ...') left it null."""
+    log = tmp_path / "nan.csv"
+    log.write_text("time,left.spin,right.spin\n0,0,0\n0.1,nan,1\n")
+    assert main(["odometry", "diff-drive", str(log), "--json"]) == 2
+    data = json.loads(capsys.readouterr().err)
+    assert (data["file"], data["line"], data["field"]) == (str(log), 3, "left.spin"), data
+    assert data["error"].startswith("value nan is not a finite number")

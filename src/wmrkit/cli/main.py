@@ -120,7 +120,8 @@ def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> N
 
     JSON: ``{"error": message, "file": ..., "wheel": ..., "field": ..., "line": ...}``; the place keys are null when the
     error has no such place. A message about a file of the command line (`argv`), ``FILE[:LINE]: [column
-    'NAME': ]...`` (logs, torque files, references, trajectories), gives ``file``, ``line`` and ``field``.
+    'NAME': |WHEEL.spin: |WHEEL.steer: ]...`` (logs, torque files, references, trajectories), gives ``file``, ``line``
+    and ``field``.
     """
     if not as_json:
         if isinstance(err, UsageError):
@@ -151,9 +152,11 @@ def _file_place(message: str, argv: Sequence[str]) -> dict:
         name = max((m.group(0) for m in inside if m), key=len, default=None)
     if name is None:
         return {}
-    place = re.match(r"(?:(\d+):)?(?: column '([^']*)':)?(.*)", message[len(name) + 1:], flags=re.S)
-    line, column, rest = place.groups()
-    return {"error": rest.strip(), "file": name, "line": int(line) if line else None, "field": column}
+    # the column as "column 'NAME':" or, in a log's row errors, as the joint "WHEEL.spin:" / "WHEEL.steer:"
+    place = re.match(r"(?:(\d+):)?(?: column '([^']*)':| ([^\s:']+\.(?:spin|steer)):)?(.*)", message[len(name) + 1:],
+                     flags=re.S)
+    line, column, joint, rest = place.groups()
+    return {"error": rest.strip(), "file": name, "line": int(line) if line else None, "field": column or joint}
 
 
 #: Longest error message printed [characters]; longer ones (quoting huge user text) are cut.
