@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -18,9 +19,13 @@ def finite_number(value: object) -> bool:
         return False
 
 
-def as_vectors(x: ArrayLike, n: int, name: str) -> np.ndarray:
-    """Return `x` as a float array of shape ``(..., n)``, or raise :class:`ShapeError` naming `name`."""
-    a = np.asarray(x, dtype=float)
+def as_vectors(x: ArrayLike, n: int, name: str, *, angles: bool = False) -> np.ndarray:
+    """Return `x` as a float array of shape ``(..., n)``, or raise :class:`ShapeError` naming `name`.
+
+    Real numbers only (Python or NumPy, any precision): text, booleans, complex numbers, mappings and ragged
+    nested lists are refused, since the Python API reads no units (``"30 deg"``, or ``"30"`` as 30 rad).
+    """
+    a = x if isinstance(x, np.ndarray) and x.dtype == float else _real_array(x, name, angles)
     if a.shape[-1:] != (n,):
         raise ShapeError(f"{name}: expected shape (..., {n}), got {a.shape}")
     return a
@@ -31,12 +36,47 @@ def as_angles(x: ArrayLike, n: int, name: str) -> np.ndarray:
     angles beyond :data:`wmrkit.units.MAX_ANGLE` (1e6 turns), whose sine and cosine are round-off."""
     from .units import MAX_ANGLE, MAX_TURNS
 
-    a = as_vectors(x, n, name)
+    a = as_vectors(x, n, name, angles=True)
     bad = ~(np.abs(a) <= MAX_ANGLE)  # NaN included
     if bad.any():
         value = float(a[np.unravel_index(int(np.argmax(bad)), a.shape)])
         raise ShapeError(f"{name}: angles must be finite numbers of at most {MAX_TURNS:g} turns [rad], got {value!r}")
     return a
+
+
+#: What an array of each refused dtype kind holds, for :func:`_real_array`'s message.
+_REFUSED_KINDS = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "bytes", "M": "dates", "m": "durations"}
+
+
+def _real_array(x: object, name: str, angles: bool) -> np.ndarray:
+    """`x` as a float array, or :class:`ShapeError` naming `name` and saying what it got."""
+    if isinstance(x, str | Mapping):
+        got = f"the text {x!r}" if isinstance(x, str) else \
+            f"a {type(x).__name__} (a mapping: pass the values as an array, in the order the function documents)"
+    else:
+        try:
+            a = np.asarray(x)
+            if a.dtype.kind in "fiu":
+                return a.astype(float, copy=False)
+            if a.dtype.kind == "O":
+                return a.astype(float)  # Fraction, Decimal; None reads as NaN, which the callers' checks refuse
+            got = _REFUSED_KINDS.get(a.dtype.kind, f"values of type {a.dtype}")
+            if a.dtype.kind == "U":
+                got = f"the text {str(next((v for v in a.flat if not _number(v)), a.flat[0]))!r}"
+        except (TypeError, ValueError, OverflowError):  # a ragged nested list, an element that is no number
+            got = f"a {type(x).__name__} of values that are no numbers, or of rows of different lengths"
+    unit = "radians (e.g. math.radians(30))" if angles else "SI units (m, rad, m/s, rad/s)"
+    if got.startswith("the text"):
+        raise ShapeError(f"{name}: got {got}, but the Python API reads no units: pass real numbers in {unit}")
+    raise ShapeError(f"{name}: expected real numbers in {unit}, got {got}")
+
+
+def _number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def readonly(a: np.ndarray) -> np.ndarray:

@@ -1,0 +1,58 @@
+"""Values users pass to the Python API: every wrong one is one WmrkitError naming the argument and saying what was
+expected, never numpy's own message ("could not convert string to float"), a Python TypeError or a silent guess.
+The Python API reads no units: a string is refused, with the advice to pass radians."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from wmrkit import ShapeError, WmrkitError, catalog, inverse_model, wheel_commands
+
+SWERVE = catalog.load("swerve-4")
+STEER = np.array([0.1, -0.2, 0.3, 0.0])
+
+
+@pytest.mark.parametrize(("call", "match"), [
+    (lambda: SWERVE.with_beta("30 deg"), r"^beta: got the text '30 deg', but the Python API reads no units: pass "
+                                         r"real numbers in radians \(e\.g\. math\.radians\(30\)\)$"),
+    (lambda: SWERVE.with_beta(["30 deg"] * 4), r"^beta: got the text '30 deg'.*math\.radians"),
+    (lambda: SWERVE.with_beta(["0.5", "0.5", "0.5", "30"]), r"^beta: got the text '0\.5'.*no units"),  # not 30 rad
+    (lambda: SWERVE.constraint_matrix(heading=[0.0, 0.1, "1 deg", 0.2]), r"^heading: got the text '1 deg'"),
+    (lambda: SWERVE.with_steering({"front_left": "30 deg"}), r"^front_left: heading: got the text '30 deg'.*radians"),
+    (lambda: wheel_commands(SWERVE, "1 m/s"), r"^twist_robot: got the text '1 m/s'.*SI units"),
+    (lambda: inverse_model(SWERVE, heading=["30 deg"] * 4), r"^heading: got the text '30 deg'"),
+    (lambda: SWERVE.with_beta([True, False, True, False]), r"^beta: expected real numbers in radians.*got booleans$"),
+    (lambda: SWERVE.with_steering({"front_left": True}), r"^front_left: heading: expected real numbers.*booleans$"),
+    (lambda: SWERVE.with_beta([1j] * 4), r"^beta: expected real numbers.*got complex numbers$"),
+    (lambda: SWERVE.constraint_matrix(heading={"front_left": 0.3}), r"^heading: expected real numbers.*got a dict "
+                                                                     r"\(a mapping: pass the values as an array"),
+    (lambda: SWERVE.with_beta([[0.1] * 4, [0.1] * 3]), r"^beta: expected real numbers.*rows of different lengths$"),
+    (lambda: wheel_commands(SWERVE, [1.0, 0.0, 0.0], beta=[None, 0.0, "a", 0.0]), r"^beta: expected real numbers"),
+])
+def test_values_that_are_no_real_numbers_are_refused_naming_the_argument(call, match):
+    with pytest.raises(ShapeError, match=match):
+        call()
+
+
+def test_numbers_of_any_real_type_are_taken():
+    as_float = SWERVE.constraint_matrix(STEER)
+    for value in (STEER.tolist(), tuple(STEER)):
+        np.testing.assert_array_equal(SWERVE.constraint_matrix(value), as_float)
+    single = STEER.astype(np.float32)
+    np.testing.assert_array_equal(SWERVE.constraint_matrix(single), SWERVE.constraint_matrix(single.astype(float)))
+    np.testing.assert_array_equal(SWERVE.constraint_matrix([Fraction(1, 10), -0.2, 0.3, 0]), as_float)
+    np.testing.assert_array_equal(SWERVE.constraint_matrix(np.array([0, 1, 2, 3], dtype=np.int64)),
+                                  SWERVE.constraint_matrix([0.0, 1.0, 2.0, 3.0]))
+    turned = SWERVE.with_steering({"front_left": np.float32(0.5), "rear_left": np.int64(1)})
+    assert turned.heading[0] == pytest.approx(0.5) and turned.heading[2] == 1.0
+    assert isinstance(turned.wheel("front_left").beta, float)
+
+
+def test_every_refusal_is_one_line_and_a_wmrkit_error():
+    for bad in ("30 deg", ["a"] * 4, {"x": 1}, [1j] * 4, [True] * 4, [[1.0], [1.0, 2.0]], object()):
+        with pytest.raises(WmrkitError) as err:
+            SWERVE.constraint_matrix(bad)
+        assert "\n" not in str(err.value) and str(err.value).startswith("beta: ")
