@@ -56,3 +56,20 @@ def test_every_refusal_is_one_line_and_a_wmrkit_error():
         with pytest.raises(WmrkitError) as err:
             SWERVE.constraint_matrix(bad)
         assert "\n" not in str(err.value) and str(err.value).startswith("beta: ")
+
+
+@pytest.mark.parametrize(("call", "match"), [
+    (lambda: SWERVE.with_steering("front_left"), r"^headings: expected a mapping \{wheel name: angle \[rad\]\} such "
+                                                 r"as \{'front_left': 0\.5\}, got str 'front_left'$"),
+    (lambda: SWERVE.with_steering(["front_left"]), r"^headings: expected a mapping .*, got list \['front_left'\]$"),
+    (lambda: SWERVE.with_beta_angles(("front_left", 0.3)), r"^angles: expected a mapping"),
+    (lambda: SWERVE.with_steering({"front_left": np.array([0.3, 0.2])}),
+     r"^headings: front_left: expected one angle \[rad\], got ndarray"),
+    (lambda: SWERVE.with_beta_angles({"rear_right": [0.3]}), r"^angles: rear_right: expected one angle \[rad\]"),
+])
+def test_with_steering_takes_a_mapping_of_single_angles(call, match):
+    """A wheel's name alone was read letter by letter ("no wheel 'f'"); an array value gave "expected shape (..., 1),
+    got (1, 2)"."""
+    with pytest.raises(ShapeError, match=match):
+        call()
+    assert SWERVE.with_steering({"front_left": np.array(0.25)}).heading[0] == 0.25  # a 0-d array is one angle

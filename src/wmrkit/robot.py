@@ -162,19 +162,26 @@ class Robot:
 
         The users' convention (WPILib, ROS 2); :meth:`with_beta_angles` takes the thesis's β instead.
         """
-        self._check_steers(headings)
+        self._check_steers(headings, "headings")
         return replace(self, wheels=tuple(w.with_heading(headings[w.name]) if w.name in headings else w
                                           for w in self.wheels))
 
     def with_beta_angles(self, angles: Mapping[str, float]) -> Robot:
         """The same robot with the named wheels at the thesis's steering angles β [rad]."""
-        self._check_steers(angles)
+        self._check_steers(angles, "angles")
         return replace(self, wheels=tuple(w.with_beta(angles[w.name]) if w.name in angles else w for w in self.wheels))
 
-    def _check_steers(self, names: Mapping[str, float]) -> None:
-        for name in names:
+    def _check_steers(self, names: Mapping[str, float], argument: str) -> None:
+        if not isinstance(names, Mapping):  # a wheel's name was read letter by letter: "no wheel 'f'"
+            raise ShapeError(f"{argument}: expected a mapping {{wheel name: angle [rad]}} such as "
+                             f"{{'{self.steer_names[0] if self.steer_names else 'wheel'}': 0.5}}, got "
+                             f"{type(names).__name__} {names!r:.60}")
+        for name, value in names.items():
             if self.wheel(name).kind.steers is False:
                 raise UnknownNameError(f"wheel '{name}' of robot '{self.name}' does not steer")
+            if isinstance(value, list | tuple) or (isinstance(value, np.ndarray) and value.ndim > 0):
+                raise ShapeError(f"{argument}: {name}: expected one angle [rad], got {type(value).__name__} "
+                                 f"{value!r:.60}")
 
     # ---- composite equations -----------------------------------------------------------------------------
     def constraint_matrix(
