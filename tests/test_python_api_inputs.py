@@ -73,3 +73,22 @@ def test_with_steering_takes_a_mapping_of_single_angles(call, match):
     with pytest.raises(ShapeError, match=match):
         call()
     assert SWERVE.with_steering({"front_left": np.array(0.25)}).heading[0] == 0.25  # a 0-d array is one angle
+
+
+def test_slip_velocity_refuses_rates_that_are_not_finite_and_batches_that_do_not_broadcast():
+    """NaN gave NaN slips; a q_dot batch of 3 against a steering batch of 2 gave numpy's 'operands could not be
+    broadcast together with remapped shapes'."""
+    k = len(SWERVE.velocity_names)
+    with pytest.raises(ShapeError, match=r"^q_dot: vy: expected finite numbers within 1e\+06"):
+        SWERVE.slip_velocity([0.0, np.nan] + [0.0] * (k - 2))
+    with pytest.raises(ShapeError, match=r"^q_dot: front_left\.spin: expected finite numbers"):
+        SWERVE.slip_velocity([0.0] * 3 + [1e300] + [0.0] * (k - 4))
+    with pytest.raises(ShapeError, match=rf"^q_dot \(3, {k}\) and the steering \(2, 4\): their batch shapes \(all "
+                                         r"but the last axis\) do not broadcast$"):
+        SWERVE.slip_velocity(np.zeros((3, k)), np.zeros((2, 4)))
+    # the rates of a rolling twist leave no slip, and heading= is the same steering as its beta
+    commands = wheel_commands(SWERVE, [0.4, 0.3, 0.5])
+    q_dot = np.concatenate([[0.4, 0.3, 0.5], commands.rates])
+    np.testing.assert_allclose(SWERVE.slip_velocity(q_dot, commands.beta), 0.0, atol=1e-12)
+    np.testing.assert_allclose(SWERVE.slip_velocity(q_dot, heading=commands.heading), 0.0, atol=1e-12)
+    assert SWERVE.slip_velocity(np.zeros((2, 1, k)), np.zeros((3, 4))).shape == (2, 3, 8)

@@ -210,10 +210,21 @@ class Robot:
             a = rotate_rows_to_robot(a, beta_e + t.delta + t.gamma)
         return a.reshape(*a.shape[:-3], 2 * t.n_elements, 3 + t.n_rates)
 
-    def slip_velocity(self, q_dot: ArrayLike, beta: ArrayLike | None = None) -> np.ndarray:
-        """Slip of every contact along its roller axes, ``A @ q_dot`` (3.22). ``(..., k) -> (..., 2 n_contacts)``."""
-        q_dot = as_vectors(q_dot, 3 + element_table(self).n_rates, "q_dot")
-        return (self.constraint_matrix(beta) @ q_dot[..., None])[..., 0]
+    def slip_velocity(self, q_dot: ArrayLike, beta: ArrayLike | None = None, *,
+                      heading: ArrayLike | None = None) -> np.ndarray:
+        """Slip of every contact along its roller axes, ``A @ q_dot`` (3.22). ``(..., k) -> (..., 2 n_contacts)``;
+        `q_dot` finite within 1e6 (m/s, rad/s), its batch shape broadcast with the steering's."""
+        from .kinematics.models import bounded
+
+        q_dot = bounded(as_vectors(q_dot, 3 + element_table(self).n_rates, "q_dot"), self.velocity_names, "q_dot")
+        steering = self.steering(beta, heading)
+        shape = (len(self.steer_names),) if steering is None else steering.shape
+        try:
+            np.broadcast_shapes(q_dot.shape[:-1], shape[:-1])
+        except ValueError:
+            raise ShapeError(f"q_dot {q_dot.shape} and the steering {shape}: their batch shapes (all but the last "
+                             "axis) do not broadcast") from None
+        return (self.constraint_matrix(steering) @ q_dot[..., None])[..., 0]
 
     def jacobian_form(self, beta: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The composite Jacobian form (3.20): ``I_bar @ twist_robot = J @ q_dot_w``.
