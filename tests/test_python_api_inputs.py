@@ -92,3 +92,16 @@ def test_slip_velocity_refuses_rates_that_are_not_finite_and_batches_that_do_not
     np.testing.assert_allclose(SWERVE.slip_velocity(q_dot, commands.beta), 0.0, atol=1e-12)
     np.testing.assert_allclose(SWERVE.slip_velocity(q_dot, heading=commands.heading), 0.0, atol=1e-12)
     assert SWERVE.slip_velocity(np.zeros((2, 1, k)), np.zeros((3, 4))).shape == (2, 3, 8)
+
+
+def test_jacobian_form_checks_its_steering_and_takes_heading():
+    """NaN or 1e300 rad as beta gave a Jacobian of NaN and round-off without a word."""
+    for bad in (np.nan, 1e300):
+        with pytest.raises(ShapeError, match=r"^beta: angles must be finite numbers of at most 1e\+06 turns"):
+            SWERVE.jacobian_form([0.0, bad, 0.0, 0.0])
+    twist = np.array([0.4, 0.3, 0.5])
+    commands = wheel_commands(SWERVE, twist)
+    i_bar, j = SWERVE.jacobian_form(heading=commands.heading)
+    np.testing.assert_array_equal(j, SWERVE.jacobian_form(commands.beta)[1])
+    q_dot_w = np.concatenate([commands.rates, [twist[2]] * len(SWERVE.wheels)])  # (3.20): one omega per contact
+    np.testing.assert_allclose(i_bar @ twist, j @ q_dot_w, atol=1e-12)

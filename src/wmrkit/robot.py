@@ -226,15 +226,17 @@ class Robot:
                              "axis) do not broadcast") from None
         return (self.constraint_matrix(steering) @ q_dot[..., None])[..., 0]
 
-    def jacobian_form(self, beta: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def jacobian_form(self, beta: ArrayLike | None = None, *,
+                      heading: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The composite Jacobian form (3.20): ``I_bar @ twist_robot = J @ q_dot_w``.
 
         Returns ``(I_bar, J)`` of shapes ``(3 E, 3)`` and ``(..., 3 E, n_rates + E)``; ``q_dot_w`` is the
         wheel rates (as in ``rate_names``) followed by one copy of ``omega`` per contact (3.17)-(3.19).
-        For one-element wheels J is block diagonal with the blocks (3.19).
+        For one-element wheels J is block diagonal with the blocks (3.19). The steering configuration is the
+        thesis's `beta` or the users' `heading` (see :meth:`steering`); default the described one.
         """
         t = element_table(self)
-        beta_e = element_beta(self, beta)
+        beta_e = element_beta(self, self.steering(beta, heading))
         jac = generic_wheel_jacobian(beta_e, t.l, t.alpha, t.d, t.delta, t.gamma, t.r, t.r_r)  # (..., E, 3, 4)
         j_rates = jac[..., :3] @ t.rate_map  # (..., E, 3, n_rates)
         j_omega = jac[..., 3:] * np.eye(t.n_elements)[:, None, :]  # (..., E, 3, E)
