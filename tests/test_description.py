@@ -519,3 +519,30 @@ def test_a_heading_whose_beta_passes_the_angle_limit_is_located(kind, extra):
     with pytest.raises(DescriptionError, match=r"^robots/test\.yaml:3: wheels\[0\]\.heading: .*1e\+06 turns"):
         robot_from_text(f"name: x\nwheels:\n  - {{name: a, type: {kind}, position: [0.3, 0.2], heading: 1e6 turn, "
                         f"r: 0.1{extra}}}\n", source=SRC)
+
+
+def test_numpy_numbers_in_a_description_mapping_are_numbers():
+    """A mapping built with NumPy (a design sweep's values) was refused: 'position[0]: expected a length, got
+    float32'. NumPy's reals of any precision are read as Python's are; its booleans stay refused."""
+    from wmrkit import catalog
+
+    forklift = catalog.load("forklift")
+
+    def numpy_numbers(x, kind):
+        if isinstance(x, dict):
+            return {k: numpy_numbers(v, kind) for k, v in x.items()}
+        if isinstance(x, list):
+            return [numpy_numbers(v, kind) for v in x]
+        return kind(x) if isinstance(x, int | float) and not isinstance(x, bool) else x
+
+    assert Robot.from_dict(numpy_numbers(forklift.to_dict(), np.float64)) == forklift
+    single = Robot.from_dict(numpy_numbers(forklift.to_dict(), np.float32))
+    assert single.wheels[0].r == float(np.float32(forklift.wheels[0].r))
+    assert all(type(w.l) is float and type(w.r) is float for w in single.wheels)
+    data = {"name": "a", "wheels": [
+        {"name": "l", "type": "fixed", "position": [np.int64(0), np.float32(0.25)], "heading": np.int8(0), "r": 0.1},
+        {"name": "r", "type": "fixed", "position": [0, -0.25], "heading": 0, "r": np.float16(0.125)}]}
+    assert Robot.from_dict(data).wheel("l").l == 0.25 and Robot.from_dict(data).wheel("r").r == 0.125
+    data["wheels"][0]["r"] = np.bool_(True)
+    with pytest.raises(DescriptionError, match=r"^<dict>: wheels\[0\]\.r: expected a length, got bool"):
+        Robot.from_dict(data)

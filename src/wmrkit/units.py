@@ -7,6 +7,7 @@ small fixed grammar (number, optional space, unit); nothing is ever evaluated.
 from __future__ import annotations
 
 import math
+import numbers
 import re
 import unicodedata
 from typing import Literal
@@ -32,14 +33,15 @@ class UnitError(ValueError):
 def parse_quantity(value: object, kind: Kind) -> float:
     """Return `value` in SI units (m or rad) as a finite float.
 
-    Accepts ints, floats and strings such as ``"90 deg"``, ``"250 mm"``, ``"-0.5rad"``, ``"1e-3"``.
+    Accepts real numbers (Python's, NumPy's of any precision) and strings such as ``"90 deg"``, ``"250 mm"``,
+    ``"-0.5rad"``, ``"1e-3"``.
     Raises :class:`UnitError` for booleans, NaN, infinities, unknown units and units of the wrong kind, and for
     a bare angle (no unit, so radians) beyond a turn, ``|angle| > 2 pi``: almost surely degrees written bare; and
     for an angle beyond :data:`MAX_TURNS` turns in any unit.
     """
     if isinstance(value, bool):
         raise UnitError(f"expected {_a(kind)}, got a boolean")
-    if isinstance(value, int | float):
+    if isinstance(value, numbers.Real):  # int, float, and NumPy's float32, int64, ... (not its bool_)
         try:
             number, factor = float(value), 1.0
         except OverflowError:
