@@ -546,3 +546,17 @@ def test_numpy_numbers_in_a_description_mapping_are_numbers():
     data["wheels"][0]["r"] = np.bool_(True)
     with pytest.raises(DescriptionError, match=r"^<dict>: wheels\[0\]\.r: expected a length, got bool"):
         Robot.from_dict(data)
+
+
+@pytest.mark.parametrize("suffix", [".yaml", ".json"])
+def test_a_robot_built_with_numpy_numbers_saves_and_loads(suffix, tmp_path):
+    """Wheel(..., r=np.float32(0.1)) is a valid wheel, but saving it raised yaml's RepresenterError ('cannot
+    represent an object') or json's TypeError ('Object of type float32 is not JSON serializable')."""
+    robot = Robot("np", (
+        Wheel("l", "fixed", l=np.float32(0.25), alpha=np.float64(math.pi / 2), beta=np.float32(0.0), r=np.float32(0.1)),
+        Wheel("c", "castor", l=np.int64(1), alpha=math.pi, beta=0.0, r=0.05, d=np.float16(0.125),
+              steer_range=(np.float32(-1.5), np.float32(1.5))),
+    ))
+    path = tmp_path / f"np{suffix}"
+    robot.to_file(path)
+    assert Robot.from_file(path) == robot

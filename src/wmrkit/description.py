@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 import os
 import re
 from collections.abc import Mapping
@@ -305,10 +306,10 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
 
 def _wheel_to_dict(w: Wheel) -> dict[str, Any]:
     kind = w.kind
-    out: dict[str, Any] = {"name": w.name, "type": w.type, "l": w.l, "alpha": w.alpha}
+    out: dict[str, Any] = {"name": w.name, "type": w.type, "l": _plain(w.l), "alpha": _plain(w.alpha)}
     for key in GEOMETRY_FIELDS:
         if key in kind.required or key in kind.optional:
-            out[key] = getattr(w, key)
+            out[key] = _plain(getattr(w, key))
     for key, value in out.items():  # a bare angle beyond a turn reads as degrees written bare: keep the unit
         if GEOMETRY_FIELDS.get(key) == "angle" and abs(value) > BARE_ANGLE_LIMIT:
             out[key] = f"{value!r} rad"
@@ -317,8 +318,14 @@ def _wheel_to_dict(w: Wheel) -> dict[str, Any]:
     if w.sensed:
         out["sensed"] = list(w.sensed)
     if w.steer_range is not None:
-        out["steer_range"] = list(w.steer_range)
+        out["steer_range"] = [_plain(v) for v in w.steer_range]
     return out | mass.wheel_dynamics_to_dict(w)
+
+
+def _plain(value: Any) -> Any:
+    """A NumPy number of a wheel built in Python (``Wheel(..., r=np.float32(0.1))``) as a Python float, which YAML
+    and JSON can write; other values as they are."""
+    return float(value) if isinstance(value, numbers.Real) and type(value) not in (int, float) else value
 
 
 def load_robot_file(path: str | os.PathLike[str]) -> Robot:
