@@ -105,3 +105,21 @@ def test_jacobian_form_checks_its_steering_and_takes_heading():
     np.testing.assert_array_equal(j, SWERVE.jacobian_form(commands.beta)[1])
     q_dot_w = np.concatenate([commands.rates, [twist[2]] * len(SWERVE.wheels)])  # (3.20): one omega per contact
     np.testing.assert_allclose(i_bar @ twist, j @ q_dot_w, atol=1e-12)
+
+
+@pytest.mark.parametrize(("rates", "match"), [
+    (np.zeros(2), r"^rates: expected a mapping \{joint name: rate\} such as \{'left\.spin': 10\.0\}, got ndarray$"),
+    (["left.spin", "right.spin"], r"^rates: expected a mapping .*, got list$"),
+    ({"left.spin": {"a": 1}, "right.spin": 1.0}, r"^rates: left\.spin: expected real numbers in SI units"),
+    ({"left.spin": True, "right.spin": 1.0}, r"^rates: left\.spin: expected real numbers .*got booleans$"),
+])
+def test_forward_kinematics_takes_a_mapping_of_numbers(rates, match):
+    """An array raised "argument of type 'numpy.float64' is not iterable", a list "'list' object has no attribute
+    'items'", a dict value a bare TypeError; True was read as 1 rad/s."""
+    from wmrkit import forward_kinematics
+
+    robot = catalog.load("diff-drive")
+    with pytest.raises(ShapeError, match=match):
+        forward_kinematics(robot, rates)
+    twist, residual = forward_kinematics(robot, {"left.spin": np.float32(10.0), "right.spin": np.int64(10)})
+    assert twist[0] == pytest.approx(10.0 * robot.wheel("left").r) and residual < 1e-12

@@ -31,6 +31,11 @@ def as_vectors(x: ArrayLike, n: int, name: str, *, angles: bool = False) -> np.n
     return a
 
 
+def as_reals(x: ArrayLike, name: str) -> np.ndarray:
+    """Return `x` as a float array of any shape, refusing what :func:`as_vectors` refuses (text, booleans, ...)."""
+    return x if isinstance(x, np.ndarray) and x.dtype == float else _real_array(x, name, False)
+
+
 def as_angles(x: ArrayLike, n: int, name: str) -> np.ndarray:
     """:func:`as_vectors` for angles [rad]: also raise :class:`ShapeError` naming `name` for NaN, infinities and
     angles beyond :data:`wmrkit.units.MAX_ANGLE` (1e6 turns), whose sine and cosine are round-off."""

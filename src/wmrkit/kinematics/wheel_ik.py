@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, finite_number, readonly
+from .._shapes import as_reals, as_vectors, finite_number, readonly
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
@@ -234,8 +234,11 @@ def forward_kinematics(
     left by the assignment, 0 when the rates are consistent (the slip indicator of (4.11)/(4.82)). When the
     given rates do not determine the twist the minimum-norm one is returned: check :func:`twist_is_determined`.
     """
+    if not isinstance(rates, Mapping):  # an array was read as names ("numpy.float64 is not iterable")
+        raise ShapeError(f"rates: expected a mapping {{joint name: rate}} such as {{'{robot.rate_names[0]}': 10.0}}, "
+                         f"got {type(rates).__name__}")
     columns = _assigned_columns(robot, list(rates))
-    given = {k: np.asarray(_rate_value(k, v), dtype=float) for k, v in rates.items()}
+    given = {k: as_reals(_rate_value(k, v), f"rates: {k}") for k, v in rates.items()}
     try:
         values = np.broadcast_arrays(*given.values())
     except ValueError:
