@@ -123,3 +123,29 @@ def test_forward_kinematics_takes_a_mapping_of_numbers(rates, match):
         forward_kinematics(robot, rates)
     twist, residual = forward_kinematics(robot, {"left.spin": np.float32(10.0), "right.spin": np.int64(10)})
     assert twist[0] == pytest.approx(10.0 * robot.wheel("left").r) and residual < 1e-12
+
+
+def test_values_whose_batch_does_not_broadcast_with_the_steering_batch_are_named():
+    """numpy's 'operands could not be broadcast together with remapped shapes' named neither argument."""
+    from wmrkit import actuation_analysis, forward_kinematics, kinematic_model, sensing_analysis
+    from wmrkit.kinematics import extended_solution
+
+    diff = catalog.load("diff-drive")
+    two = np.array([[0.1], [0.2]])  # two steering configurations of the castor
+    spins = ["left.spin", "right.spin"]
+    message = r"^{} \(3, {}\) and the steering configurations \(2,\): their batch shapes \(all but the last axis\) " \
+              r"do not broadcast$"
+    calls = [
+        (lambda: kinematic_model(diff, spins, heading=two).solve(np.zeros((3, 2))), "q_assigned", 2),
+        (lambda: kinematic_model(diff, spins, heading=two).velocities(np.zeros((3, 2))), "q_assigned", 2),
+        (lambda: extended_solution(diff, spins, np.zeros((3, 2)), heading=two), "q_assigned", 2),
+        (lambda: forward_kinematics(diff, {"left.spin": np.zeros(3), "right.spin": 1.0}, heading=two), "rates", 2),
+        (lambda: actuation_analysis(SWERVE, heading=[STEER, STEER]).inverse(np.zeros((3, 3))), "twist_robot", 3),
+        (lambda: sensing_analysis(SWERVE, heading=[STEER, STEER]).twist(np.zeros((3, 4))), "q_dot_s", 4),
+        (lambda: sensing_analysis(SWERVE, heading=[STEER, STEER]).direct(np.zeros((3, 4))), "q_dot_s", 4),
+    ]
+    for call, name, n in calls:
+        with pytest.raises(ShapeError, match=message.format(name, n)):
+            call()
+    # batches that broadcast still do: (3, 1) values against 2 configurations
+    assert kinematic_model(diff, spins, heading=two).solve(np.zeros((3, 1, 2))).shape == (3, 2, 5)

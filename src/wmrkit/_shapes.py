@@ -49,6 +49,16 @@ def as_angles(x: ArrayLike, n: int, name: str) -> np.ndarray:
     return a
 
 
+def matvec(m: np.ndarray, v: np.ndarray, name: str) -> np.ndarray:
+    """``m @ v`` over leading batch axes, ``(..., r, n), (..., n) -> (..., r)``, or :class:`ShapeError` naming `name`
+    when the two batch shapes do not broadcast (numpy's message named neither)."""
+    try:
+        return (m @ v[..., None])[..., 0]
+    except ValueError:
+        raise ShapeError(f"{name} {v.shape} and the steering configurations {m.shape[:-2]}: their batch shapes (all "
+                         "but the last axis) do not broadcast") from None
+
+
 #: What an array of each refused dtype kind holds, for :func:`_real_array`'s message.
 _REFUSED_KINDS = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "bytes", "M": "dates", "m": "durations"}
 

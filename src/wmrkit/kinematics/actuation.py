@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, readonly
+from .._shapes import as_vectors, matvec, readonly
 from ..couplings import coupled_columns, linked_steering
 from ..robot import TWIST_NAMES, Robot
 from .linalg import delta_projector, matrix_rank, nondimensional
@@ -157,7 +157,7 @@ class ActuationAnalysis:
     def inverse(self, twist_robot: ArrayLike) -> np.ndarray:
         """Actuated rates for a (feasible) body twist, (4.26): ``(..., 3) -> (..., n_u)`` [rad/s, m/s]."""
         t = bounded(as_vectors(twist_robot, 3, "twist_robot"), TWIST_NAMES, "twist_robot")
-        return (self.inverse_matrix @ t[..., None])[..., 0]
+        return matvec(self.inverse_matrix, t, "twist_robot")
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready summary (lists and plain values)."""

@@ -20,6 +20,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.linalg import lapack
 
+from .._shapes import matvec
+
 if TYPE_CHECKING:
     from ..robot import Robot
 
@@ -94,14 +96,16 @@ def delta_projector(m: ArrayLike) -> np.ndarray:
     return m @ np.linalg.pinv(m) - eye
 
 
-def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike,
+                   name: str = "q_assigned") -> tuple[np.ndarray, np.ndarray]:
     """Ranks-method solution (4.9)-(4.11): the velocities not assigned, by least squares, and the residual.
 
     ``a``: ``(..., R, k)`` slip matrix (3.22); ``assigned``: column indices (n_a,); ``q_assigned``:
     ``(..., n_a)``. Returns ``(q_dot, residual)``: the full velocity vector ``(..., k)`` (assigned entries
     copied in) and ``a @ q_dot`` ``(..., R)``, zero when the assignment is consistent with no slip; its norm is
     the slip indicator of (4.11)/(4.82). Uses the pseudo-inverse, so a non-assignable set returns the
-    minimum-norm solution rather than failing: check assignability with ``matrix_rank`` (4.10).
+    minimum-norm solution rather than failing: check assignability with ``matrix_rank`` (4.10). `name` names
+    ``q_assigned`` when its batch shape does not broadcast with ``a``'s.
     """
     a = np.asarray(a, dtype=float)
     assigned = np.asarray(assigned, dtype=int)
@@ -115,7 +119,7 @@ def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike) -> 
         # solution, ~1.7x faster (an empty batch takes the general path: LAPACK refuses zero right-hand sides)
         q_na = _min_norm_lstsq(a_na, rhs).T.reshape(*q_assigned.shape[:-1], len(free))
     else:
-        rhs = -(a_a @ q_assigned[..., None])
+        rhs = -matvec(a_a, q_assigned, name)[..., None]
         q_na = (np.linalg.pinv(a_na) @ rhs)[..., 0]
     batch = np.broadcast_shapes(q_na.shape[:-1], q_assigned.shape[:-1])
     q = np.empty((*batch, a.shape[-1]))

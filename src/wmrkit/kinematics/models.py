@@ -18,7 +18,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, readonly
+from .._shapes import as_vectors, matvec, readonly
 from ..errors import ShapeError, SingularError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..robot import TWIST_NAMES, Robot
@@ -59,7 +59,7 @@ class KinematicModel:
         """The solved velocities for assigned ones: ``(..., n_assigned) -> (..., n_solved)``. The assigned values
         must be finite and within ``MAX_QUERY_RATE`` (m/s, rad/s): NaN and 1e308 gave NaN and overflowing rates."""
         q = bounded(as_vectors(q_assigned, len(self.assigned), "q_assigned"), self.assigned, "q_assigned")
-        return (self.matrix @ q[..., None])[..., 0]
+        return matvec(self.matrix, q, "q_assigned")
 
     def velocities(self, q_assigned: ArrayLike) -> np.ndarray:
         """The whole velocity vector ``q_dot`` (robot order): ``(..., n_assigned) -> (..., k)``; ``A q_dot = 0``."""

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, readonly
+from .._shapes import as_vectors, matvec, readonly
 from ..robot import TWIST_NAMES, Robot
 from .actuation import minimal_set_search, split_jacobian, steering_split, verdict_texts
 from .linalg import delta_projector, matrix_rank, nondimensional
@@ -139,7 +139,7 @@ class SensingAnalysis:
     def twist(self, q_dot_s: ArrayLike) -> np.ndarray:
         """The body twist from sensed rates, (4.32): ``(..., n_s) -> (..., 3)`` [m/s, rad/s]."""
         q = bounded(as_vectors(q_dot_s, len(self.sensed), "q_dot_s"), self.sensed, "q_dot_s")
-        return (self.direct_matrix @ q[..., None])[..., 0]
+        return matvec(self.direct_matrix, q, "q_dot_s")
 
     def direct(self, q_dot_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Twist and residual from sensed rates, (4.31): ``(..., n_s) -> ((..., 3), (..., 3E))``.
@@ -147,8 +147,8 @@ class SensingAnalysis:
         The residual is ``I_ns (twist; q_dot_ns) - J_s q_dot_s``: zero without slip or noise, the slip
         indicator otherwise (when ``slip_detectable``).
         """
-        q = bounded(as_vectors(q_dot_s, len(self.sensed), "q_dot_s"), self.sensed, "q_dot_s")[..., None]
-        return (self.full_matrix @ q)[..., :3, 0], (self.residual_matrix @ q)[..., 0]
+        q = bounded(as_vectors(q_dot_s, len(self.sensed), "q_dot_s"), self.sensed, "q_dot_s")
+        return matvec(self.full_matrix, q, "q_dot_s")[..., :3], matvec(self.residual_matrix, q, "q_dot_s")
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready summary (lists and plain values)."""

@@ -246,7 +246,7 @@ def forward_kinematics(
         raise ShapeError(f"rates: the rates' shapes do not broadcast together: {shapes}") from None
     q_assigned = np.stack(values, axis=-1)
     _check_finite_rates(list(given), q_assigned)
-    q_dot, slip = solve_assigned(robot.constraint_matrix(beta, heading=heading), columns, q_assigned)
+    q_dot, slip = solve_assigned(robot.constraint_matrix(beta, heading=heading), columns, q_assigned, "rates")
     return readonly(q_dot[..., :3]), readonly(np.linalg.norm(slip, axis=-1))
 
 
