@@ -149,3 +149,17 @@ def test_values_whose_batch_does_not_broadcast_with_the_steering_batch_are_named
             call()
     # batches that broadcast still do: (3, 1) values against 2 configurations
     assert kinematic_model(diff, spins, heading=two).solve(np.zeros((3, 1, 2))).shape == (3, 2, 5)
+
+
+@pytest.mark.parametrize("bad", ["30 deg", np.nan, 1e300, [0.1, "x"]])
+def test_one_wheel_s_jacobian_and_slip_rows_check_beta(bad):
+    """wheel_jacobian and wheel_slip_rows gave "could not convert string to float", or NaN and round-off."""
+    from wmrkit import wheel_jacobian, wheel_slip_rows
+
+    wheel = SWERVE.wheel("front_left")
+    for call in (wheel_jacobian, wheel_slip_rows):
+        with pytest.raises(ShapeError, match=r"^front_left: beta: "):
+            call(wheel, bad)
+    assert wheel_jacobian(wheel, [0.1, 0.2]).shape == (2, 3, 2)
+    single = np.float32(0.5)
+    np.testing.assert_array_equal(wheel_slip_rows(wheel, single), wheel_slip_rows(wheel, float(single)))

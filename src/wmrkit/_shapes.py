@@ -49,6 +49,12 @@ def as_angles(x: ArrayLike, n: int, name: str) -> np.ndarray:
     return a
 
 
+def as_angle_array(x: ArrayLike, name: str) -> np.ndarray:
+    """Angles of any shape ``(...)`` [rad], refused as :func:`as_angles` refuses them."""
+    a = x if isinstance(x, np.ndarray) and x.dtype == float else _real_array(x, name, True)
+    return as_angles(a[..., None], 1, name)[..., 0]
+
+
 def matvec(m: np.ndarray, v: np.ndarray, name: str) -> np.ndarray:
     """``m @ v`` over leading batch axes, ``(..., r, n), (..., n) -> (..., r)``, or :class:`ShapeError` naming `name`
     when the two batch shapes do not broadcast (numpy's message named neither)."""

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._shapes import as_angles, finite_number
+from ._shapes import as_angle_array, as_angles, finite_number
 from .errors import UnknownNameError, WmrkitError
 from .units import MAX_ANGLE, MAX_TURNS
 
@@ -387,7 +387,7 @@ def wheel_slip_rows(wheel: Wheel, beta: ArrayLike | None = None) -> np.ndarray:
 
     ``(...) -> (..., 2 * n_elements, 3 + n_rates)``; `beta` defaults to the wheel's own.
     """
-    beta = np.asarray(wheel.beta if beta is None else beta, dtype=float)
+    beta = np.asarray(wheel.beta if beta is None else as_angle_array(beta, f"{wheel.name}: beta"), dtype=float)
     blocks = []
     for e in wheel.elements():
         g = generic_slip_rows(beta + e.beta_offset, e.l, e.alpha, e.d, e.delta, e.gamma, e.r, e.r_r)
@@ -409,7 +409,7 @@ def wheel_jacobian(wheel: Wheel, beta: ArrayLike | None = None) -> np.ndarray:
             "use Robot.jacobian_form"
         )
     e = elements[0]
-    beta = np.asarray(wheel.beta if beta is None else beta, dtype=float)
+    beta = np.asarray(wheel.beta if beta is None else as_angle_array(beta, f"{wheel.name}: beta"), dtype=float)
     j = generic_wheel_jacobian(beta + e.beta_offset, e.l, e.alpha, e.d, e.delta, e.gamma, e.r, e.r_r)
     return np.concatenate([j[..., :3] @ np.asarray(e.rate_map, dtype=float), j[..., 3:]], -1)
 
