@@ -32,6 +32,24 @@ def test_semi_implicit_and_rk4_agree_with_the_adaptive_solution():
         assert np.allclose(sim.twist, ref.twist, atol=tol), method
 
 
+def test_dugoff_at_low_speed_the_energy_the_semi_implicit_step_adds_vanishes_with_the_step():
+    """Dugoff's law dissipates (test_tyres), but its slope at zero slip, cs / speed, is steep at low speed: the
+    semi-implicit step overshoots across zero slip and adds energy (docs/dynamics.md: measured sizes)."""
+    model = DynamicModel.of(catalog.load("skid-steer-4"))  # Dugoff tyres, no torque
+    inputs = Inputs.torques_only(model, [0.0, 1.0], {})
+
+    def gain(**kw):  # largest rise of the kinetic energy over the run, relative to the initial one
+        sim = simulate(model, inputs, 0.5, initial_twist=[0.028, 0.017, 0.025], record_step=1e-3, **kw)
+        assert np.all(sim.friction_power() <= 1e-9)  # every sample dissipates: the gain is the integrator's
+        states = np.column_stack([sim.pose, sim.joint_positions, sim.twist, sim.joint_rates])
+        e = np.array([model.kinetic_energy(s[list(model.steer_columns)], s[model.n:]) for s in states])
+        return (np.maximum.accumulate(e[::-1])[::-1] - e).max() / e[0]
+
+    gains = [gain(step=step) for step in (1e-3, 2.5e-4, 6.25e-5)]
+    assert gains[1] <= gains[0] / 8 and gains[2] <= 1e-12
+    assert gain(method="adaptive", rtol=1e-7) <= 1e-12
+
+
 def test_forklift_pacejka_friction_never_adds_energy_and_the_truck_follows_its_program(forklift):
     model = DynamicModel.of(catalog.load("forklift"), Tyre.of("pacejka", {"shifts": 0.0}))
     inputs, duration = path_program(model, "turn", speed=2.0)

@@ -71,6 +71,28 @@ def test_friction_never_adds_energy(model, v_lat, v_long, v_wheel):
     assert f.lateral * v_lat + f.longitudinal * v_long <= 1e-9
 
 
+@pytest.mark.parametrize("params", [{}, {"eps": 1e-6}, {"eps": 1.0}, {"cs": 1e12, "calpha": 1e3, "mu": 0.1},
+                                    {"cs": 0.0}, {"calpha": 0.0}])
+def test_dugoff_opposes_each_slip_component_down_to_standstill_and_in_reverse(params):
+    """Dense grid: speeds from 1e-9 to 100 m/s (log-uniform, both signs, zeros), rolling and near-rolling wheels,
+    the eps band included; each force component opposes its own slip and |F| <= mu Fz."""
+    rng = np.random.default_rng(7)
+    n = 200_000
+
+    def sample(scale):
+        x = np.exp(rng.uniform(math.log(1e-9), math.log(scale), n)) * rng.choice([-1.0, 1.0], n)
+        return np.where(rng.random(n) < 0.02, 0.0, x)
+
+    tyre = Tyre.of("dugoff", params)
+    for scale in (1e-2, 1.0, 100.0):
+        v_lat, v_wheel = sample(scale), sample(scale)
+        v_roll = np.where(rng.random(n) < 0.5, -v_wheel * (1 + sample(0.1)), sample(scale))  # near rolling
+        fz = rng.uniform(0, 1e5, n)
+        f = tyre.forces(fz, v_lat, v_wheel + v_roll, v_wheel, v_roll)
+        assert np.all(f.lateral * v_lat <= 0) and np.all(f.longitudinal * (v_wheel + v_roll) <= 0)
+        assert np.all(np.hypot(f.lateral, f.longitudinal) <= tyre.as_dict()["mu"] * fz * (1 + 1e-12))
+
+
 @pytest.mark.parametrize("model", ["linear", "coulomb", "dugoff", "pacejka"])
 @settings(max_examples=40, deadline=None)
 @given(v_lat=slips, v_long=slips, v_wheel=speeds)
