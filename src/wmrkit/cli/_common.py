@@ -167,13 +167,13 @@ def add_steer_option(parser: argparse.ArgumentParser, text: str = "heading of a 
 
 def steered_robot(spec: str, steer: list[str] | None) -> Robot:
     """The robot named by a ROBOT argument, at the headings of its ``--steer`` options (0 = straight ahead)."""
-    from .._shapes import as_angles
+    from ..wheels import WheelError
 
-    pairs = parse_assignments(steer, "--steer")
-    robot = load_robot(spec).with_steering({n: parse_angle(v, f"--steer {n}") for n, v in pairs.items()})
-    for name, value in pairs.items():  # a heading whose beta passes the angle limit (1e6 turns) failed unlocated later
+    robot = load_robot(spec)
+    for name, value in parse_assignments(steer, "--steer").items():
+        heading = parse_angle(value, f"--steer {name}")
         try:
-            as_angles([robot.wheel(name).beta], 1, "beta")
-        except ShapeError as err:
+            robot = robot.with_steering({name: heading})
+        except (ShapeError, WheelError) as err:  # e.g. a beta beyond the angle limit (1e6 turns): name the option
             raise WmrkitError(f"--steer {name}={value}: {err}") from None
     return robot
