@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import importlib
+
 import numpy as np
 import pytest
 
-from wmrkit import catalog
+from wmrkit import Robot, catalog
 from wmrkit.analysis.coordinated import coordinated_singular_set
-from wmrkit.analysis.icr import icr
+from wmrkit.analysis.icr import icr, steer_to_icr
 from wmrkit.analysis.singularity import is_singular_rank
+
+icr_module = importlib.import_module("wmrkit.analysis.icr")  # the package exports the function icr too
 
 
 def _icr_points(robot, s):
@@ -51,3 +55,26 @@ def test_swerve_spin_singular_when_turning_about_the_wheel():
         else:
             assert got.kind == "infinity" and got.direction[0] == pytest.approx(0.0, abs=1e-7)
     assert coordinated_singular_set(r, tuple(r.rate_names), resolution=24).never  # all four spins: never
+
+
+def _steered_circle(n):
+    """n independently steered wheels on a 0.5 m circle (a swerve robot with many modules)."""
+    wheels = [{"name": f"w{i}", "type": "steerable", "r": 0.05, "actuated": ["spin", "steer"],
+               "sensed": ["spin", "steer"],
+               "position": [0.5 * np.cos(2 * np.pi * i / n), 0.5 * np.sin(2 * np.pi * i / n)]} for i in range(n)]
+    return Robot.from_dict({"name": f"steered{n}", "wheels": wheels})
+
+
+def test_steer_to_icr_builds_the_wheel_rows_once(monkeypatch):
+    """steer_to_icr evaluated every wheel's element rows once per wheel and call (64 x 64 rows for one ICR of a
+    64-wheel robot; the report's searches call it thousands of times): now once per robot, every wheel at once."""
+    r = _steered_circle(64)
+    calls = []
+    real = icr_module.element_rows
+    monkeypatch.setattr(icr_module, "element_rows", lambda *a, **k: calls.append(1) or real(*a, **k))
+    h = np.array([0.2, -0.1, 1.0])
+    beta = steer_to_icr(r, h)
+    for _ in range(3):
+        np.testing.assert_array_equal(steer_to_icr(r, h), beta)
+    assert len(calls) <= 1
+    np.testing.assert_allclose(icr(r, beta).point, h[:2], atol=1e-12)  # every axle through the ICR

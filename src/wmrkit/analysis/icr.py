@@ -9,6 +9,7 @@ The thesis's closed form (5.21) swaps x and y (errata, docs/errata.md); the null
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -165,24 +166,34 @@ def steer_to_icr(robot: Robot, icr_h: ArrayLike) -> np.ndarray:
     """
     h = _homogeneous(icr_h)
     beta = np.broadcast_to(robot.beta, (*h.shape[:-1], len(robot.steer_names))).copy()
-    cl = constraint_lines(robot)
-    aimed = {w for w in cl.wheels if w in robot.steer_names}
-    for j, name in enumerate(robot.steer_names):
-        if name not in aimed:
-            continue
-        w = robot.wheel(name)
-        cx, cy = w.position
-        dx, dy = h[..., 0] - h[..., 2] * cx, h[..., 1] - h[..., 2] * cy
-        ok = np.hypot(dx, dy) > 1e-12 * np.maximum(np.abs(h).max(axis=-1), 1e-300)
-        axle = np.arctan2(dy, dx) + _axle_offset(robot, name)
-        branch = axle + np.pi * np.round((w.beta - axle) / np.pi)
-        beta[..., j] = np.where(ok, branch, w.beta)
+    j, cx, cy, offset, described = _aimed_axles(robot)
+    if not len(j):
+        return beta
+    dx, dy = h[..., :1] - h[..., 2:] * cx, h[..., 1:2] - h[..., 2:] * cy  # (..., n_aimed), every wheel at once
+    ok = np.hypot(dx, dy) > 1e-12 * np.maximum(np.abs(h).max(axis=-1), 1e-300)[..., None]
+    axle = np.arctan2(dy, dx) + offset
+    branch = axle + np.pi * np.round((described - axle) / np.pi)
+    beta[..., j] = np.where(ok, branch, described)
     return beta
 
 
-def _axle_offset(robot: Robot, name: str) -> float:
-    """Steering angle minus the direction of the wheel's axle line (0 for steerable and double wheels)."""
+@functools.lru_cache(maxsize=512)
+def _aimed_axles(robot: Robot) -> tuple[np.ndarray, ...]:
+    """The steering wheels with an axle line (cached per robot): their indices in ``robot.steer_names``, mount
+    points x and y [m], :func:`_axle_offset` and described beta, one array each."""
+    aimed = set(constraint_lines(robot).wheels)
+    j = [k for k, name in enumerate(robot.steer_names) if name in aimed]
     probe = element_rows(robot, robot.beta)
+    wheels = [robot.wheel(robot.steer_names[k]) for k in j]
+    return (np.array(j, dtype=int), np.array([w.position[0] for w in wheels], dtype=float),
+            np.array([w.position[1] for w in wheels], dtype=float),
+            np.array([_axle_offset(robot, w.name, probe) for w in wheels], dtype=float),
+            np.array([w.beta for w in wheels], dtype=float))
+
+
+def _axle_offset(robot: Robot, name: str, probe: np.ndarray | None = None) -> float:
+    """Steering angle minus the direction of the wheel's axle line (0 for steerable and double wheels)."""
+    probe = element_rows(robot, robot.beta) if probe is None else probe
     cl = constraint_lines(robot)
     i = cl.wheels.index(name)
     lam = np.einsum("k,kc->c", cl.coefficients[i], probe)
