@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from wmrkit import Robot, catalog
+from wmrkit.analysis import _fast, coordinated
 from wmrkit.analysis.coordinated import coordinated_singular_set
 from wmrkit.analysis.icr import icr, steer_to_icr
 from wmrkit.analysis.singularity import is_singular_rank
@@ -78,3 +79,26 @@ def test_steer_to_icr_builds_the_wheel_rows_once(monkeypatch):
         np.testing.assert_array_equal(steer_to_icr(r, h), beta)
     assert len(calls) <= 1
     np.testing.assert_allclose(icr(r, beta).point, h[:2], atol=1e-12)  # every axle through the ICR
+
+
+def test_search_is_chunked_and_its_fallback_budgeted(monkeypatch):
+    """A robot of many steered wheels: the ICR grid went to steer_to_icr and the line SVDs whole ((resolution/4 + 1)
+    x resolution ICRs times the wheels: 6.7 GB at resolution 1440 for 64 wheels), and when no grid row met the
+    singular ICR (at the wheel whose spin is assigned) six 2-D searches ran to the end, ~200 evaluations each,
+    though all found the same point (727 s for the report of 64 wheels). Now CHUNK ICRs at once, the searches stop
+    on a point already found, and share MAX_EVALUATIONS."""
+    r = _steered_circle(8)
+    largest, searches = [0], []
+    real_steer, real_minimize = coordinated.steer_to_icr, coordinated.minimize
+    monkeypatch.setattr(coordinated, "steer_to_icr",
+                        lambda robot, h: largest.__setitem__(0, max(largest[0], np.size(h) // 3))
+                        or real_steer(robot, h))
+    monkeypatch.setattr(coordinated, "minimize",
+                        lambda *a, **k: searches.append(real_minimize(*a, **k)) or searches[-1])
+    for resolution in (360, 22):  # the report's grid (a quarter of the default), where no row meets the wheel
+        searches.clear()
+        s = coordinated_singular_set(r, ("w0.spin",), resolution=resolution)
+        (point,) = _icr_points(r, s)
+        np.testing.assert_allclose(point, r.wheel("w0").position, atol=1e-9)  # turning about the wheel
+    assert 0 < largest[0] <= _fast.CHUNK < 91 * 360
+    assert len(searches) == 2 and sum(res.nfev for res in searches) <= coordinated.MAX_EVALUATIONS

@@ -20,20 +20,15 @@ def element_rows_cm(p, beta: np.ndarray) -> np.ndarray:
     """Slip-row twist columns ``(2E, 3, N)`` for configurations `beta` ``(N, n_steer)``; `p`: line_parameters."""
     n = beta.shape[0]
     n_el = len(p.element_wheel)
+    wheel_beta = np.repeat(np.asarray(p.beta_described, dtype=float)[:, None], n, axis=1)  # (N_wheels, N)
+    wheel_beta[p.steer_wheels] = beta.T
+    theta = wheel_beta[p.element_wheel] + p.theta_offset[:, None]  # every element at once: (E, N)
+    c, s = np.cos(theta), np.sin(theta)
     out = np.empty((n_el, 2, 3, n))
-    steer_of_wheel = {w: j for j, w in enumerate(p.steer_wheels.tolist())}
-    for e in range(n_el):
-        w = int(p.element_wheel[e])
-        if w in steer_of_wheel:
-            theta = beta[:, steer_of_wheel[w]] + p.theta_offset[e]
-            c, s = np.cos(theta), np.sin(theta)
-        else:
-            theta = p.beta_described[w] + p.theta_offset[e]
-            c, s = np.full(n, np.cos(theta)), np.full(n, np.sin(theta))
-        out[e, 0, 0], out[e, 0, 1] = c, s
-        out[e, 0, 2] = p.l_s_alpha_neg[e] * c + p.l_c_alpha[e] * s - p.d_c[e]
-        out[e, 1, 0], out[e, 1, 1] = -s, c
-        out[e, 1, 2] = p.l_c_alpha[e] * c + p.l_s_alpha[e] * s + p.d_s[e]
+    out[:, 0, 0], out[:, 0, 1] = c, s
+    out[:, 0, 2] = p.l_s_alpha_neg[:, None] * c + p.l_c_alpha[:, None] * s - p.d_c[:, None]
+    out[:, 1, 0], out[:, 1, 1] = -s, c
+    out[:, 1, 2] = p.l_c_alpha[:, None] * c + p.l_s_alpha[:, None] * s + p.d_s[:, None]
     return out.reshape(2 * n_el, 3, n)
 
 

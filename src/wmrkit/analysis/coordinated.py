@@ -15,10 +15,15 @@ import numpy as np
 from scipy.optimize import minimize
 
 from ..robot import Robot
+from . import _fast
 from .classification import classify
 from .icr import icr, steer_to_icr
-from .lines import constraint_lines
-from .singularity import SingularSet, is_singular, robot_size, singularity_distance
+from .lines import constraint_lines, line_parameters
+from .singularity import SingularSet, is_singular, robot_size
+
+#: Evaluations of the singularity distance shared by the 2-D searches for isolated singular ICRs of one singular
+#: set (up to 6 starts, about 200 evaluations each; they stop when one returns to a point already found).
+MAX_EVALUATIONS = 1200
 
 
 def admissible_icrs(robot: Robot, resolution: int) -> tuple[np.ndarray, int]:
@@ -56,15 +61,24 @@ def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolut
     cl = constraint_lines(robot, assigned, coupled=coupled)
     names = robot.steer_names
     empty = np.zeros((0, len(names)))
-    distance = functools.partial(singularity_distance, robot, assigned=cl.assigned, coupled=cl.coupled)
     singular = functools.partial(is_singular, robot, assigned=cl.assigned, coupled=cl.coupled)
     if cl.internal or len(cl.labels) < 3:
         return SingularSet(cl.assigned, names, True, empty, True, ("fewer assigned velocities than the mobility",),
                            coordinated=True, coupled=cl.coupled)
+    params, length = line_parameters(robot), float(robot_size(robot))
+
+    def distance(h: np.ndarray) -> np.ndarray:  # singularity_distance at the ICRs h (n, 3), CHUNK of them at once
+        h = h.reshape(-1, 3)
+        out = np.empty(len(h))
+        for s in range(0, len(h), _fast.CHUNK):
+            rows = _fast.element_rows_cm(params, steer_to_icr(robot, h[s:s + _fast.CHUNK]))
+            out[s:s + _fast.CHUNK] = _fast.distance_cm(_fast.combine(cl.coefficients, rows, cl.constant), length)
+        return out
+
     grid, dims = admissible_icrs(robot, resolution)
-    grid_beta = steer_to_icr(robot, grid)
-    dist = distance(grid_beta)
-    if np.all(singular(grid_beta)):
+    dist = distance(grid)
+    if all(np.all(singular(steer_to_icr(robot, grid[s:s + _fast.CHUNK])))
+           for s in range(0, len(grid), _fast.CHUNK)):
         return SingularSet(cl.assigned, names, True, empty, dims == 1, ("singular at every coordinated steering",),
                            coordinated=True, coupled=cl.coupled)
     rows = dist.reshape(-1, resolution) if dims == 2 else dist[None]
@@ -81,27 +95,35 @@ def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolut
     is_min = (rows <= np.roll(rows, 1, axis=1)) & (rows <= np.roll(rows, -1, axis=1)) & (rows < 0.2)
     r_idx, i_idx = np.nonzero(is_min)
     x0 = start + i_idx * step
-    x = _golden_batch(lambda x: distance(steer_to_icr(robot, icr_of(r_idx, x))),
-                      x0 - 2 * step, x0 + 2 * step)
-    betas = steer_to_icr(robot, icr_of(r_idx, x)).reshape(-1, len(names))
-    sing = singular(betas) if len(betas) else np.zeros(0, bool)
-    found = list(betas[sing])
-    if dims == 2 and not found and len(betas):  # an isolated singular ICR (e.g. at a wheel): minimise in 2-D
-        d = distance(betas)
+    x = _golden_batch(lambda x: distance(icr_of(r_idx, x)), x0 - 2 * step, x0 + 2 * step)
+    minima = icr_of(r_idx, x)
+    sing = np.concatenate([np.zeros(0, bool)] + [singular(steer_to_icr(robot, minima[s:s + _fast.CHUNK]))
+                                                 for s in range(0, len(minima), _fast.CHUNK)])
+    found = list(steer_to_icr(robot, minima[sing]).reshape(-1, len(names)))
+    if dims == 2 and not found and len(minima):  # an isolated singular ICR (e.g. at a wheel): minimise in 2-D
+        d = distance(minima)
         seen: list[np.ndarray] = []
+        budget = MAX_EVALUATIONS
         for k in np.argsort(d)[:6]:
+            if budget <= 0:
+                break
+
             def g(p):
                 h = np.array([size * np.sin(p[0]) * np.cos(p[1]), size * np.sin(p[0]) * np.sin(p[1]), np.cos(p[0])])
-                return float(distance(steer_to_icr(robot, h)))
+                return float(distance(h)[0])
 
             res = minimize(g, [thetas[r_idx[k]], x[k]], method="Nelder-Mead",
-                           options={"xatol": 1e-12, "fatol": 1e-15, "maxiter": 600})
+                           options={"xatol": 1e-12, "fatol": 1e-15, "maxiter": 600, "maxfev": budget})
+            budget -= res.nfev
             t, ph = res.x
             h = np.array([size * np.sin(t) * np.cos(ph), size * np.sin(t) * np.sin(ph), np.cos(t)])
             beta = steer_to_icr(robot, h)
-            if singular(beta) and not any(np.linalg.norm(np.cross(h, e)) < 1e-7 for e in seen):
-                seen.append(h)
-                found.append(beta)
+            if not singular(beta):
+                continue
+            if any(np.linalg.norm(np.cross(h, e)) < 1e-7 for e in seen):
+                break  # back to a point already found: the next (worse) starts are in its basin too
+            seen.append(h)
+            found.append(beta)
     out = np.array(found).reshape(-1, len(names))
     if len(out) > 1:
         keep = [0]

@@ -165,8 +165,8 @@ def steer_to_icr(robot: Robot, icr_h: ArrayLike) -> np.ndarray:
     that lets a robot with several steered wheels move (§5.3, consequence 3 of 5.12).
     """
     h = _homogeneous(icr_h)
-    beta = np.broadcast_to(robot.beta, (*h.shape[:-1], len(robot.steer_names))).copy()
-    j, cx, cy, offset, described = _aimed_axles(robot)
+    steering, j, cx, cy, offset, described = _aimed_axles(robot)
+    beta = np.broadcast_to(steering, (*h.shape[:-1], len(steering))).copy()
     if not len(j):
         return beta
     dx, dy = h[..., :1] - h[..., 2:] * cx, h[..., 1:2] - h[..., 2:] * cy  # (..., n_aimed), every wheel at once
@@ -179,13 +179,13 @@ def steer_to_icr(robot: Robot, icr_h: ArrayLike) -> np.ndarray:
 
 @functools.lru_cache(maxsize=512)
 def _aimed_axles(robot: Robot) -> tuple[np.ndarray, ...]:
-    """The steering wheels with an axle line (cached per robot): their indices in ``robot.steer_names``, mount
-    points x and y [m], :func:`_axle_offset` and described beta, one array each."""
+    """``robot.beta``, then the steering wheels with an axle line (cached per robot): their indices in
+    ``robot.steer_names``, mount points x and y [m], :func:`_axle_offset` and described beta, one array each."""
     aimed = set(constraint_lines(robot).wheels)
     j = [k for k, name in enumerate(robot.steer_names) if name in aimed]
     probe = element_rows(robot, robot.beta)
     wheels = [robot.wheel(robot.steer_names[k]) for k in j]
-    return (np.array(j, dtype=int), np.array([w.position[0] for w in wheels], dtype=float),
+    return (robot.beta, np.array(j, dtype=int), np.array([w.position[0] for w in wheels], dtype=float),
             np.array([w.position[1] for w in wheels], dtype=float),
             np.array([_axle_offset(robot, w.name, probe) for w in wheels], dtype=float),
             np.array([w.beta for w in wheels], dtype=float))
