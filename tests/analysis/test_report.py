@@ -8,6 +8,7 @@ import re
 import pytest
 
 from wmrkit import Robot, catalog
+from wmrkit.analysis import report
 from wmrkit.analysis.classification import classify
 from wmrkit.analysis.isotropy import natural_length
 from wmrkit.analysis.report import write_report
@@ -149,3 +150,18 @@ def test_the_table_of_every_assigned_set_repeats_the_summary_for_the_analysed_se
     assert s.assigned == ("o1.spin",) and not s.exact and not s.coupled
     text = write_report(result, tmp_path, resolution=48, dpi=30).read_text(encoding="utf-8")
     assert f"<tr><td>o1.spin</td><td>{describe_singular(s, result.robot, limit=4)}</td></tr>" in text
+
+
+def test_the_table_of_every_assigned_set_has_a_bounded_grid(monkeypatch):
+    """The table searched each of its up to 36 sets at a quarter of --resolution: at 1440, a 360-point grid per
+    set, 150 s for a robot of 64 steered wheels (the singular sets above it are searched at --resolution)."""
+    asked = []
+
+    def recorder(real):
+        return lambda robot, q_a, **k: asked.append(k["resolution"]) or real(robot, q_a, **{**k, "resolution": 12})
+
+    monkeypatch.setattr(report, "coordinated_singular_set", recorder(report.coordinated_singular_set))
+    monkeypatch.setattr(report, "singular_set", recorder(report.singular_set))
+    for name in ("swerve-4", "thesis-steer-castor"):
+        report._assignable_table(analyze(catalog.load(name), resolution=12), 1440)
+    assert asked and max(asked) == 90  # report.TABLE_RESOLUTION

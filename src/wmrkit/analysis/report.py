@@ -31,6 +31,11 @@ img { max-width: 100%; border: 1px solid #ddd; margin: 0.4em 0 } .small { color:
 """
 
 
+#: Grid points per turn of the table of every assigned set (a quarter of the report's resolution, at most this):
+#: up to 36 singular sets, each costing grid size x wheels (150 s for 64 steered wheels at resolution 1440).
+TABLE_RESOLUTION = 90
+
+
 class ReportError(WmrkitError, OSError):
     """The report directory cannot be written."""
 
@@ -179,7 +184,7 @@ def _assignable_table(a: Analysis, resolution: int, limit: int = 36) -> str:
     if len(sets) > limit:
         note = f"<p class='small'>{len(sets)} sets; the first {limit} are shown.</p>"
         sets = sets[:limit]
-    small = max(12, resolution // 4)
+    small = min(max(12, resolution // 4), TABLE_RESOLUTION)
     done = {frozenset(s.assigned): s for s in a.singular.values() if not s.coupled}  # as the summary rows say
     rows = []
     for q_a in sets:
