@@ -77,8 +77,8 @@ def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolut
 
     grid, dims = admissible_icrs(robot, resolution)
     dist = distance(grid)
-    if all(np.all(singular(steer_to_icr(robot, grid[s:s + _fast.CHUNK])))
-           for s in range(0, len(grid), _fast.CHUNK)):
+    if not (dist > 1e-3).any() and all(np.all(singular(steer_to_icr(robot, grid[s:s + _fast.CHUNK])))
+                                       for s in range(0, len(grid), _fast.CHUNK)):  # far from 1e-8: regular
         return SingularSet(cl.assigned, names, True, empty, dims == 1, ("singular at every coordinated steering",),
                            coordinated=True, coupled=cl.coupled)
     rows = dist.reshape(-1, resolution) if dims == 2 else dist[None]
