@@ -85,8 +85,8 @@ def test_search_is_chunked_and_its_fallback_budgeted(monkeypatch):
     """A robot of many steered wheels: the ICR grid went to steer_to_icr and the line SVDs whole ((resolution/4 + 1)
     x resolution ICRs times the wheels: 6.7 GB at resolution 1440 for 64 wheels), and when no grid row met the
     singular ICR (at the wheel whose spin is assigned) six 2-D searches ran to the end, ~200 evaluations each,
-    though all found the same point (727 s for the report of 64 wheels). Now CHUNK ICRs at once, the searches stop
-    on a point already found, and share MAX_EVALUATIONS."""
+    though all found the same point (727 s for the report of 64 wheels). Now CHUNK ICRs at once, and the searches
+    share MAX_EVALUATIONS."""
     r = _steered_circle(8)
     largest, searches = [0], []
     real_steer, real_minimize = coordinated.steer_to_icr, coordinated.minimize
@@ -101,4 +101,4 @@ def test_search_is_chunked_and_its_fallback_budgeted(monkeypatch):
         (point,) = _icr_points(r, s)
         np.testing.assert_allclose(point, r.wheel("w0").position, atol=1e-9)  # turning about the wheel
     assert 0 < largest[0] <= _fast.CHUNK < 91 * 360
-    assert len(searches) == 2 and sum(res.nfev for res in searches) <= coordinated.MAX_EVALUATIONS
+    assert 0 < len(searches) <= 6 and sum(res.nfev for res in searches) <= coordinated.MAX_EVALUATIONS

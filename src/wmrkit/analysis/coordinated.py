@@ -22,7 +22,7 @@ from .lines import constraint_lines, line_parameters
 from .singularity import SingularSet, is_singular, robot_size
 
 #: Evaluations of the singularity distance shared by the 2-D searches for isolated singular ICRs of one singular
-#: set (up to 6 starts, about 200 evaluations each; they stop when one returns to a point already found).
+#: set (up to 6 starts, about 200 evaluations each; the starts left when it is spent are not searched).
 MAX_EVALUATIONS = 1200
 
 
@@ -118,12 +118,9 @@ def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolut
             t, ph = res.x
             h = np.array([size * np.sin(t) * np.cos(ph), size * np.sin(t) * np.sin(ph), np.cos(t)])
             beta = steer_to_icr(robot, h)
-            if not singular(beta):
-                continue
-            if any(np.linalg.norm(np.cross(h, e)) < 1e-7 for e in seen):
-                break  # back to a point already found: the next (worse) starts are in its basin too
-            seen.append(h)
-            found.append(beta)
+            if singular(beta) and not any(np.linalg.norm(np.cross(h, e)) < 1e-7 for e in seen):
+                seen.append(h)
+                found.append(beta)
     out = np.array(found).reshape(-1, len(names))
     if len(out) > 1:
         keep = [0]
