@@ -79,10 +79,15 @@ def test_slip_velocity_refuses_rates_that_are_not_finite_and_batches_that_do_not
     """NaN gave NaN slips; a q_dot batch of 3 against a steering batch of 2 gave numpy's 'operands could not be
     broadcast together with remapped shapes'."""
     k = len(SWERVE.velocity_names)
-    with pytest.raises(ShapeError, match=r"^q_dot: vy: expected finite numbers within 1e\+06"):
+    with pytest.raises(ShapeError, match=r"^q_dot: vy: expected finite numbers, got nan"):
         SWERVE.slip_velocity([0.0, np.nan] + [0.0] * (k - 2))
     with pytest.raises(ShapeError, match=r"^q_dot: front_left\.spin: expected finite numbers"):
-        SWERVE.slip_velocity([0.0] * 3 + [1e300] + [0.0] * (k - 4))
+        SWERVE.slip_velocity([0.0] * 3 + [np.inf] + [0.0] * (k - 4))
+    # the rates of a twist within the query limit (1e6 m/s) pass 1e6 rad/s: they are taken (the studio's drive)
+    fast = wheel_commands(SWERVE, [1e6, 0.0, -1e6])
+    assert np.isfinite(SWERVE.slip_velocity(np.concatenate([[1e6, 0.0, -1e6], fast.rates]), fast.beta)).all()
+    with pytest.raises(ShapeError, match=r"^q_dot: the slip overflows"):
+        SWERVE.slip_velocity([1.7e308] * 3 + [-1.7e308] * (k - 3))
     with pytest.raises(ShapeError, match=rf"^q_dot \(3, {k}\) and the steering \(2, 4\): their batch shapes \(all "
                                          r"but the last axis\) do not broadcast$"):
         SWERVE.slip_velocity(np.zeros((3, k)), np.zeros((2, 4)))

@@ -8,6 +8,7 @@ The steering configuration ``beta`` is ordered as ``Robot.steer_names``: one ang
 from __future__ import annotations
 
 import functools
+import math
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
@@ -213,10 +214,12 @@ class Robot:
     def slip_velocity(self, q_dot: ArrayLike, beta: ArrayLike | None = None, *,
                       heading: ArrayLike | None = None) -> np.ndarray:
         """Slip of every contact along its roller axes, ``A @ q_dot`` (3.22). ``(..., k) -> (..., 2 n_contacts)``;
-        `q_dot` finite within 1e6 (m/s, rad/s), its batch shape broadcast with the steering's."""
+        `q_dot` finite (the rates of a twist within the query limit, 1e6 m/s, may pass 1e6 rad/s), its batch shape
+        broadcast with the steering's."""
         from .kinematics.models import bounded
 
-        q_dot = bounded(as_vectors(q_dot, 3 + element_table(self).n_rates, "q_dot"), self.velocity_names, "q_dot")
+        q_dot = bounded(as_vectors(q_dot, 3 + element_table(self).n_rates, "q_dot"), self.velocity_names, "q_dot",
+                        limit=math.inf)
         steering = self.steering(beta, heading)
         shape = (len(self.steer_names),) if steering is None else steering.shape
         try:
@@ -224,7 +227,11 @@ class Robot:
         except ValueError:
             raise ShapeError(f"q_dot {q_dot.shape} and the steering {shape}: their batch shapes (all but the last "
                              "axis) do not broadcast") from None
-        return (self.constraint_matrix(steering) @ q_dot[..., None])[..., 0]
+        with np.errstate(over="ignore", invalid="ignore"):  # finite rates near the largest float: refused below
+            slip = (self.constraint_matrix(steering) @ q_dot[..., None])[..., 0]
+        if not np.isfinite(slip).all():
+            raise ShapeError("q_dot: the slip overflows (rates near the largest float)")
+        return slip
 
     def jacobian_form(self, beta: ArrayLike | None = None, *,
                       heading: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:

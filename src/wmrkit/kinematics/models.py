@@ -102,14 +102,15 @@ def mobility(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike 
     return a.shape[-1] - matrix_rank(a)
 
 
-def bounded(q: np.ndarray, names: Sequence[str], argument: str) -> np.ndarray:
+def bounded(q: np.ndarray, names: Sequence[str], argument: str, limit: float = MAX_QUERY_RATE) -> np.ndarray:
     """`q` ``(..., len(names))`` itself, or :class:`ShapeError` naming `argument` and the velocity of the first value
-    that is not a finite number within ``MAX_QUERY_RATE`` (m/s, rad/s): the models' products gave NaN or overflowed."""
-    bad = ~(np.abs(q) <= MAX_QUERY_RATE)  # NaN included
+    that is not a finite number within `limit` (default ``MAX_QUERY_RATE``, m/s, rad/s; ``math.inf``: any finite
+    number): the models' products gave NaN or overflowed."""
+    bad = ~np.isfinite(q) | (np.abs(q) > limit)
     if bad.any():
         where = tuple(int(x) for x in np.argwhere(bad)[0])
-        raise ShapeError(f"{argument}: {names[where[-1]]}: expected finite numbers within {MAX_QUERY_RATE:g} (rad/s "
-                         f"or m/s), got {float(q[where])}")
+        within = f" within {limit:g} (rad/s or m/s)" if math.isfinite(limit) else ""
+        raise ShapeError(f"{argument}: {names[where[-1]]}: expected finite numbers{within}, got {float(q[where])}")
     return q
 
 
