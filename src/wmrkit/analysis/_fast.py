@@ -16,19 +16,29 @@ CHUNK = 4096  # configurations per chunk: the working set stays in cache
 FEW = 64  # configurations up to which LAPACK's SVD is used (accurate to eps) instead of closed-form Gram eigenvalues
 
 
+def _columns(x) -> np.ndarray:
+    """Per-wheel or per-element values ``(K,)`` as a column ``(K, 1)``, or ``(K, N)`` (one per configuration) as they
+    are."""
+    a = np.asarray(x, dtype=float)
+    return a[:, None] if a.ndim == 1 else a
+
+
 def element_rows_cm(p, beta: np.ndarray) -> np.ndarray:
-    """Slip-row twist columns ``(2E, 3, N)`` for configurations `beta` ``(N, n_steer)``; `p`: line_parameters."""
+    """Slip-row twist columns ``(2E, 3, N)`` for configurations `beta` ``(N, n_steer)``; `p`: line_parameters, its
+    per-wheel and per-element values one each ``(W,)``/``(E,)`` or one per configuration ``(W, N)``/``(E, N)`` (the
+    sweep's designs)."""
     n = beta.shape[0]
     n_el = len(p.element_wheel)
-    wheel_beta = np.repeat(np.asarray(p.beta_described, dtype=float)[:, None], n, axis=1)  # (N_wheels, N)
+    wheel_beta = np.broadcast_to(_columns(p.beta_described), (len(p.beta_described), n)).copy()  # (W, N)
     wheel_beta[p.steer_wheels] = beta.T
-    theta = wheel_beta[p.element_wheel] + p.theta_offset[:, None]  # every element at once: (E, N)
+    theta = wheel_beta[p.element_wheel] + _columns(p.theta_offset)  # every element at once: (E, N)
     c, s = np.cos(theta), np.sin(theta)
+    lc, ls, lsn, dc, ds = map(_columns, (p.l_c_alpha, p.l_s_alpha, p.l_s_alpha_neg, p.d_c, p.d_s))
     out = np.empty((n_el, 2, 3, n))
     out[:, 0, 0], out[:, 0, 1] = c, s
-    out[:, 0, 2] = p.l_s_alpha_neg[:, None] * c + p.l_c_alpha[:, None] * s - p.d_c[:, None]
+    out[:, 0, 2] = lsn * c + lc * s - dc
     out[:, 1, 0], out[:, 1, 1] = -s, c
-    out[:, 1, 2] = p.l_c_alpha[:, None] * c + p.l_s_alpha[:, None] * s + p.d_s[:, None]
+    out[:, 1, 2] = lc * c + ls * s + ds
     return out.reshape(2 * n_el, 3, n)
 
 
