@@ -61,24 +61,22 @@ def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolut
     cl = constraint_lines(robot, assigned, coupled=coupled)
     names = robot.steer_names
     empty = np.zeros((0, len(names)))
-    singular = functools.partial(is_singular, robot, assigned=cl.assigned, coupled=cl.coupled)
     if cl.internal or len(cl.labels) < 3:
         return SingularSet(cl.assigned, names, True, empty, True, ("fewer assigned velocities than the mobility",),
                            coordinated=True, coupled=cl.coupled)
     params, length = line_parameters(robot), float(robot_size(robot))
 
-    def distance(h: np.ndarray) -> np.ndarray:  # singularity_distance at the ICRs h (n, 3), CHUNK of them at once
-        h = h.reshape(-1, 3)
-        out = np.empty(len(h))
-        for s in range(0, len(h), _fast.CHUNK):
-            rows = _fast.element_rows_cm(params, steer_to_icr(robot, h[s:s + _fast.CHUNK]))
-            out[s:s + _fast.CHUNK] = _fast.distance_cm(_fast.combine(cl.coefficients, rows, cl.constant), length)
-        return out
+    def distance_at(beta: np.ndarray) -> np.ndarray:
+        """singularity_distance's kernel without its per-call checks (the 2-D searches ask for one ICR at a time)."""
+        rows = _fast.element_rows_cm(params, beta)
+        return _fast.distance_cm(_fast.combine(cl.coefficients, rows, cl.constant), length)
 
+    distance = functools.partial(_at_icrs, robot, distance_at, float)
+    singular = functools.partial(_at_icrs, robot, functools.partial(is_singular, robot, assigned=cl.assigned,
+                                                                    coupled=cl.coupled), bool)
     grid, dims = admissible_icrs(robot, resolution)
     dist = distance(grid)
-    if not (dist > 1e-3).any() and all(np.all(singular(steer_to_icr(robot, grid[s:s + _fast.CHUNK])))
-                                       for s in range(0, len(grid), _fast.CHUNK)):  # far from 1e-8: regular
+    if not (dist > 1e-3).any() and singular(grid).all():  # a distance far from 1e-8: regular there
         return SingularSet(cl.assigned, names, True, empty, dims == 1, ("singular at every coordinated steering",),
                            coordinated=True, coupled=cl.coupled)
     rows = dist.reshape(-1, resolution) if dims == 2 else dist[None]
@@ -97,9 +95,7 @@ def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolut
     x0 = start + i_idx * step
     x = _golden_batch(lambda x: distance(icr_of(r_idx, x)), x0 - 2 * step, x0 + 2 * step)
     minima = icr_of(r_idx, x)
-    sing = np.concatenate([np.zeros(0, bool)] + [singular(steer_to_icr(robot, minima[s:s + _fast.CHUNK]))
-                                                 for s in range(0, len(minima), _fast.CHUNK)])
-    found = list(steer_to_icr(robot, minima[sing]).reshape(-1, len(names)))
+    found = list(steer_to_icr(robot, minima[singular(minima)]).reshape(-1, len(names)))
     if dims == 2 and not found and len(minima):  # an isolated singular ICR (e.g. at a wheel): minimise in 2-D
         d = distance(minima)
         seen: list[np.ndarray] = []
@@ -117,10 +113,9 @@ def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolut
             budget -= res.nfev
             t, ph = res.x
             h = np.array([size * np.sin(t) * np.cos(ph), size * np.sin(t) * np.sin(ph), np.cos(t)])
-            beta = steer_to_icr(robot, h)
-            if singular(beta) and not any(np.linalg.norm(np.cross(h, e)) < 1e-7 for e in seen):
+            if singular(h)[0] and not any(np.linalg.norm(np.cross(h, e)) < 1e-7 for e in seen):
                 seen.append(h)
-                found.append(beta)
+                found.append(steer_to_icr(robot, h))
     out = np.array(found).reshape(-1, len(names))
     if len(out) > 1:
         keep = [0]
@@ -130,6 +125,16 @@ def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolut
         out = out[keep]
     where = tuple(icr(robot, b).describe() for b in out[:8])
     return SingularSet(cl.assigned, names, False, out, dims == 1, where, coordinated=True, coupled=cl.coupled)
+
+
+def _at_icrs(robot: Robot, measure, dtype: type, h: np.ndarray) -> np.ndarray:
+    """`measure` of the steering aimed at the ICRs `h` ``(..., 3)`` -> ``(n,)``, :data:`_fast.CHUNK` ICRs at a time
+    (the steering of a whole grid of many wheels at once took gigabytes)."""
+    h = h.reshape(-1, 3)
+    out = np.empty(len(h), dtype)
+    for s in range(0, len(h), _fast.CHUNK):
+        out[s:s + _fast.CHUNK] = measure(steer_to_icr(robot, h[s:s + _fast.CHUNK]))
+    return out
 
 
 def _golden_batch(f, a: np.ndarray, b: np.ndarray, iterations: int = 70) -> np.ndarray:
