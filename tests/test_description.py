@@ -560,3 +560,19 @@ def test_a_robot_built_with_numpy_numbers_saves_and_loads(suffix, tmp_path):
     path = tmp_path / f"np{suffix}"
     robot.to_file(path)
     assert Robot.from_file(path) == robot
+
+
+@pytest.mark.parametrize(("field", "value"), [("heading", "60 deg"), ("heading", "-140 deg"), ("beta", "150 deg")])
+def test_described_heading_outside_its_steer_range_is_refused(tmp_path, field, value):
+    """The heading a description gives is a steering angle: one its own steer_range cannot reach is inconsistent
+    data (odometry refuses such logged headings), named by line and field, not loaded."""
+    path = tmp_path / "r.yaml"
+    path.write_text("name: r\nwheels:\n"
+                    f"  - {{name: a, type: steerable, position: [1, 0], {field}: {value}, r: 0.1, "
+                    "steer_range: [-40 deg, 40 deg]}\n"
+                    "  - {name: b, type: fixed, position: [0, 0.5], heading: 0, r: 0.1}\n")
+    with pytest.raises(DescriptionError, match=rf"r\.yaml:3: wheels\[0\]\.{field}: .* deg is outside the wheel's "
+                                               r"steer_range \[-40, 40\] deg"):
+        Robot.from_file(path)
+    path.write_text(path.read_text().replace(value, "-40 deg" if field == "heading" else "130 deg"))  # at the end
+    assert Robot.from_file(path).wheel("a").heading == pytest.approx(math.radians(-40 if field == "heading" else 40))

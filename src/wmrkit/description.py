@@ -37,7 +37,15 @@ from .limits import (  # noqa: F401  (the limits are part of the description for
 )
 from .robot import Robot
 from .units import BARE_ANGLE_LIMIT, MAX_ANGLE, MAX_TURNS
-from .wheels import GEOMETRY_FIELDS, KINDS, Wheel, beta_from_heading, geometry_problem
+from .wheels import (
+    GEOMETRY_FIELDS,
+    KINDS,
+    Wheel,
+    beta_from_heading,
+    geometry_problem,
+    heading_from_beta,
+    heading_in_range,
+)
 
 #: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
 WHEEL_TYPES = (*KINDS, "mecanum")
@@ -212,9 +220,14 @@ def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc) -> Wheel:
     _check_geometry(type_name, values, check, loc)
     actuated = check.joints(item, "actuated", kind.joints, loc)
     sensed = check.joints(item, "sensed", kind.joints, loc)
+    steer_range = _steer_range_from_dict(item, check, loc, kind.steers)
+    heading = None if steer_range is None else float(heading_from_beta(values["beta"], values.get("delta", 0.0)))
+    if heading is not None and not heading_in_range(heading, *steer_range):  # a steering angle it cannot reach
+        lo, hi = (math.degrees(a) for a in steer_range)
+        check.fail(f"{math.degrees(heading):.6g} deg is outside the wheel's steer_range [{lo:.6g}, {hi:.6g}] deg (the "
+                   "heading described is a steering angle too)", (*loc, "beta" if "beta" in item else "heading"))
     return Wheel(name=name, type=type_name, actuated=actuated, sensed=sensed, **values,
-                 **mass.wheel_dynamics_from_dict(item, check, loc, type_name),
-                 steer_range=_steer_range_from_dict(item, check, loc, kind.steers))
+                 **mass.wheel_dynamics_from_dict(item, check, loc, type_name), steer_range=steer_range)
 
 
 def _steer_range_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc,
