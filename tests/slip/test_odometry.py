@@ -89,9 +89,14 @@ def test_cli_refuses_bad_estimator_options(tmp_path, capsys, forklift_run):
                            (["--method", "wls", "--mu", "nope=1,1"], "--mu nope: robot 'forklift' has no wheel"),
                            (["--method", "fk2", "--kf-wheel", "nope=1,1"],
                             "--kf-wheel nope: robot 'forklift' has no wheel"),  # the option was not named
-                           (["--method", "fk2", "--kf-noise", "1", "-1", "1"], "[1e-150, 1e+150]"),
-                           (["--method", "fk2", "--kf-noise", "1e308", "1", "1"], "process: must be"),
-                           (["--method", "fk2", "--kf-noise", "1", "1e-30", "1"], "differ by more than"),
+                           (["--method", "fk2", "--kf-noise", "1", "-1", "1"], "--kf-noise: Kalman noise lateral: "
+                                                                                "must be a finite number in [1e-150"),
+                           (["--method", "fk2", "--kf-noise", "1e308", "1", "1"], "--kf-noise: Kalman noise process: "
+                                                                                  "must be"),
+                           (["--method", "fk2", "--kf-noise", "1", "1e-30", "1"], "--kf-noise: Kalman noise lateral "
+                                                                                 "(1e-30) and process (1) differ by"),
+                           (["--method", "fk2", "--kf-wheel", "steer=1e9,1"], "--kf-wheel: Kalman noise process (1) "
+                                                                              "and steer (lateral) (1e+09) differ by"),
                            (["--method", "wls", "--mu", "steer=abc"], "two numbers"),
                            (["--method", "fk1", "--covariance"], "not available")):
         assert main(["odometry", "forklift", str(path), *extra]) == 2

@@ -150,7 +150,11 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
     for n, v in parse_assignments(args.kf_wheel, "--kf-wheel").items():
         _check_wheel(robot, n, "--kf-wheel")
         wheels[n] = _pair(v, f"--kf-wheel {n}")
-    noise = noise_from_options(k[0], k[1], k[2], wheels) if args.method != "wls" else None
+    try:
+        noise = noise_from_options(k[0], k[1], k[2], wheels) if args.method != "wls" else None
+    except WmrkitError as e:  # the description's noise was checked when it was read: an option is at fault
+        given = [o for o, v in (("--kf-noise", args.kf_noise), ("--kf-wheel", args.kf_wheel)) if v]
+        raise WmrkitError(f"{' with '.join(given)}: {e}") from None
     weights = weights_from_args(args, settings, robot) if args.method == "wls" else None
     return estimator(robot, args.method, sensed=args.sensed, weights=weights, noise=noise,
                      thesis_double_q=args.thesis_double_q)
