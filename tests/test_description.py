@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from wmrkit import KINDS, DescriptionError, Robot, Wheel
 from wmrkit.cli.main import main
 from wmrkit.description import robot_from_text
+from wmrkit.wheels import WheelError
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "description-format.md"
 SRC = "robots/test.yaml"
@@ -554,7 +555,7 @@ def test_a_robot_built_with_numpy_numbers_saves_and_loads(suffix, tmp_path):
     represent an object') or json's TypeError ('Object of type float32 is not JSON serializable')."""
     robot = Robot("np", (
         Wheel("l", "fixed", l=np.float32(0.25), alpha=np.float64(math.pi / 2), beta=np.float32(0.0), r=np.float32(0.1)),
-        Wheel("c", "castor", l=np.int64(1), alpha=math.pi, beta=0.0, r=0.05, d=np.float16(0.125),
+        Wheel("c", "castor", l=np.int64(1), alpha=math.pi, beta=np.float32(1.5), r=0.05, d=np.float16(0.125),
               steer_range=(np.float32(-1.5), np.float32(1.5))),
     ))
     path = tmp_path / f"np{suffix}"
@@ -575,4 +576,39 @@ def test_described_heading_outside_its_steer_range_is_refused(tmp_path, field, v
                                                r"steer_range \[-40, 40\] deg"):
         Robot.from_file(path)
     path.write_text(path.read_text().replace(value, "-40 deg" if field == "heading" else "130 deg"))  # at the end
-    assert Robot.from_file(path).wheel("a").heading == pytest.approx(math.radians(-40 if field == "heading" else 40))
+    robot = Robot.from_file(path)
+    assert robot.wheel("a").heading == pytest.approx(math.radians(-40 if field == "heading" else 40))
+    with pytest.raises(WheelError, match=r"^wheel 'a': heading: 45 deg is outside the wheel's steer_range \[-40, 40\]"):
+        robot.with_steering({"a": math.radians(45)})  # in Python too: a saved robot always loads back
+
+
+@pytest.mark.parametrize("name", ["ackermann", "mecanum-4", "swerve-4", "forklift", "skid-steer-4", "agv-drive-unit"])
+def test_robots_are_saved_as_their_users_wrote_them(name, capsys):
+    """to_dict (and show --json, and every saved file) writes a wheel's place as ``position`` and its angle as
+    ``heading``, the numbers of the catalog file (read independently from its text), a Mecanum wheel as ``type:
+    mecanum``: not the thesis's l, alpha, beta that a user would have to convert back. Still exact."""
+    from wmrkit import catalog
+    from wmrkit.units import parse_quantity
+
+    robot = catalog.load(name)
+    written = robot.to_dict()
+    source = yaml.safe_load(catalog.source_text(name))["wheels"]
+    for got, typed in zip(written["wheels"], source, strict=True):
+        assert got["type"] == typed["type"]
+        assert got["position"] == [parse_quantity(v, "length") for v in typed["position"]]
+        assert got["heading"] == parse_quantity(typed.get("heading", 0), "angle")
+        assert not {"l", "alpha", "beta"} & set(got)
+    assert Robot.from_dict(written) == robot
+    assert main(["show", name, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["wheels"] == json.loads(json.dumps(written["wheels"]))
+
+
+def test_a_parameter_no_users_number_gives_back_is_saved_as_the_thesis_wrote_it():
+    """beta = 20 deg has finer bits than any heading near -70 deg (heading = beta - 90 deg) can carry: the wheel keeps
+    'beta' (exact), its place still 'position'."""
+    robot = Robot.from_dict({"name": "r", "wheels": [
+        {"name": "o", "type": "steerable", "l": 0.5, "alpha": "90 deg", "beta": "20 deg", "r": 0.1}]})
+    (wheel,) = robot.to_dict()["wheels"]
+    assert wheel["beta"] == math.radians(20) and "heading" not in wheel
+    assert wheel["position"] == [0.0, 0.5] and "l" not in wheel
+    assert Robot.from_dict(robot.to_dict()) == robot

@@ -11,14 +11,14 @@ import math
 import numbers
 import os
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
 import yaml
 
 from .couplings import COUPLING_KINDS, Coupling
-from .documents import FieldReader, LineOf, Loc, hint, read_document, read_file, short_repr
+from .documents import DescriptionError, FieldReader, LineOf, Loc, hint, read_document, read_file, short_repr
 from .dynamics import mass
 from .limits import (  # noqa: F401  (the limits are part of the description format)
     ANGLE_MARGIN,
@@ -44,7 +44,7 @@ from .wheels import (
     beta_from_heading,
     geometry_problem,
     heading_from_beta,
-    heading_in_range,
+    heading_range_problem,
 )
 
 #: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
@@ -221,11 +221,10 @@ def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc) -> Wheel:
     actuated = check.joints(item, "actuated", kind.joints, loc)
     sensed = check.joints(item, "sensed", kind.joints, loc)
     steer_range = _steer_range_from_dict(item, check, loc, kind.steers)
-    heading = None if steer_range is None else float(heading_from_beta(values["beta"], values.get("delta", 0.0)))
-    if heading is not None and not heading_in_range(heading, *steer_range):  # a steering angle it cannot reach
-        lo, hi = (math.degrees(a) for a in steer_range)
-        check.fail(f"{math.degrees(heading):.6g} deg is outside the wheel's steer_range [{lo:.6g}, {hi:.6g}] deg (the "
-                   "heading described is a steering angle too)", (*loc, "beta" if "beta" in item else "heading"))
+    problem = steer_range and heading_range_problem(heading_from_beta(values["beta"], values.get("delta", 0.0)),
+                                                    steer_range)
+    if problem:  # located here; Wheel refuses it too
+        check.fail(problem, (*loc, "beta" if "beta" in item else "heading"))
     return Wheel(name=name, type=type_name, actuated=actuated, sensed=sensed, **values,
                  **mass.wheel_dynamics_from_dict(item, check, loc, type_name), steer_range=steer_range)
 
@@ -298,7 +297,8 @@ def _check_geometry(type_name: str, v: dict[str, float], check: FieldReader, loc
 
 # ---- serialisation ---------------------------------------------------------------------------------------
 def robot_to_dict(robot: Robot) -> dict[str, Any]:
-    """The description mapping of `robot` in SI numbers; ``robot_from_dict(robot_to_dict(r)) == r``."""
+    """The description mapping of `robot` in SI numbers and radians, its wheels as users write them where that is
+    exact (:func:`_wheel_to_dict`); ``robot_from_dict(robot_to_dict(r)) == r``."""
     out: dict[str, Any] = {"name": robot.name}
     if robot.notes:
         out["notes"] = robot.notes
@@ -318,6 +318,52 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
 
 
 def _wheel_to_dict(w: Wheel) -> dict[str, Any]:
+    """The wheel as users write it where that reads back to exactly this wheel (:func:`_users_form`), else in the
+    thesis's parameters."""
+    thesis = _thesis_form(w)
+    users = _users_form(w, thesis)
+    return users if _reads_back(users) == w else thesis
+
+
+def _users_form(w: Wheel, thesis: dict[str, Any]) -> dict[str, Any]:
+    """`thesis` (the wheel's fields in the thesis's parameters) with ``position: [x, y]`` for ``l``, ``alpha`` and
+    ``heading`` [rad] (0 = straight ahead) for ``beta``, each rounded to the fewest decimals that give back the exact
+    parameters (a wheel read from ``position: [0.25, -0.3]`` is written so); a Swedish wheel with the rollers of
+    ``type: mecanum`` as one. A parameter that no such number gives back stays as it is."""
+    position = _fewest_digits(w.position, w.l, lambda x, y: math.hypot(x, y) == w.l and math.atan2(y, x) == w.alpha)
+    heading = _fewest_digits((w.heading,), math.pi, lambda h: float(beta_from_heading(h, w.delta)) == w.beta)
+    out = {"name": w.name, "type": w.type}
+    out |= {"l": thesis["l"], "alpha": thesis["alpha"]} if position is None else {"position": list(position)}
+    out |= {"beta": thesis["beta"]} if heading is None else {"heading": heading[0]}
+    out |= {k: v for k, v in thesis.items() if k not in out and k not in ("l", "alpha", "beta")}
+    if w.type == "swedish":  # type: mecanum takes gamma from the quadrant, r_r = r / 4 by default
+        mecanum = {k: v for k, v in out.items() if k != "gamma" and (k != "r_r" or v != w.r / 4)} | {"type": "mecanum"}
+        if _reads_back(mecanum) == w:
+            return mecanum
+    return out
+
+
+def _fewest_digits(values: tuple[float, ...], scale: float,
+                   exact: Callable[..., bool]) -> tuple[float, ...] | None:
+    """`values` rounded to the fewest decimals (1 to 18 significant digits of `scale`) for which ``exact(*values)``
+    holds, or None."""
+    top = math.floor(math.log10(scale)) if 0 < scale < math.inf else 0
+    for digits in range(1, 19):
+        candidate = tuple(round(float(v), digits - 1 - top) + 0.0 for v in values)  # + 0.0: no -0.0 written
+        if exact(*candidate):
+            return candidate
+    return None
+
+
+def _reads_back(item: dict[str, Any]) -> Wheel | None:
+    """The wheel that `item` describes, as a description reads it; None if it does not read."""
+    try:
+        return _wheel_from_dict(item, FieldReader("<written>", lambda loc: None), ("wheels", 0))
+    except DescriptionError:
+        return None
+
+
+def _thesis_form(w: Wheel) -> dict[str, Any]:
     kind = w.kind
     out: dict[str, Any] = {"name": w.name, "type": w.type, "l": _plain(w.l), "alpha": _plain(w.alpha)}
     for key in GEOMETRY_FIELDS:

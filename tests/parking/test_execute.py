@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 
 import numpy as np
@@ -75,8 +74,7 @@ def test_ackermann_wheels_steer_to_their_own_angles_and_any_origin_works():
     np.testing.assert_allclose(run.wheel_headings[turning, names.index("front_right")], right, atol=1e-9)
     data = problem.robot.to_dict()
     for w in data["wheels"]:  # origin 1 m ahead of the rear axle
-        x, y = w["l"] * math.cos(w["alpha"]) - 1.0, w["l"] * math.sin(w["alpha"])
-        w["l"], w["alpha"] = math.hypot(x, y), math.atan2(y, x)
+        w["position"][0] -= 1.0
     moved = execute_plan(plan, Robot.from_dict(data))
     np.testing.assert_allclose(moved.pose, run.pose, atol=1e-9)
 
