@@ -305,3 +305,20 @@ def test_a_folder_named_like_a_catalog_robot_does_not_hide_it(tmp_path, monkeypa
         catalog.resolve("logs")
     (tmp_path / "bicycle").write_text(catalog.source_text("diff-drive"), encoding="utf-8")
     assert catalog.resolve("bicycle") == catalog.load("diff-drive")
+
+
+def test_a_name_of_the_wrong_type_is_a_clear_type_error(tmp_path, monkeypatch):
+    """catalog.load(None) or load(Path('forklift')) answered "'NoneType' object is not iterable" from difflib, and
+    resolve(Path('forklift')) "unsupported operand type(s) for +"; a path-like names a robot like its str."""
+    for bad in (None, 3, ["forklift"], b"forklift", Path("forklift")):
+        with pytest.raises(TypeError, match=r"^a catalog robot's name is a str, got "):
+            catalog.load(bad)
+        with pytest.raises(TypeError, match=r"^a catalog robot's name is a str, got "):
+            catalog.source_text(bad)
+    for bad in (None, 3, ["forklift"], b"forklift"):
+        with pytest.raises(TypeError, match=r"^a robot is a catalog name or a description file's path, got "):
+            catalog.resolve(bad)
+    monkeypatch.chdir(tmp_path)
+    assert catalog.resolve(Path("forklift")) == catalog.load("forklift")
+    (tmp_path / "mine.yaml").write_text(catalog.source_text("bicycle"), encoding="utf-8")
+    assert catalog.resolve(tmp_path / "mine.yaml") == catalog.load("bicycle")

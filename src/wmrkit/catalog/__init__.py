@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import difflib
 import functools
+import os
 from importlib import resources
 from pathlib import Path
 
@@ -17,9 +18,15 @@ def names() -> tuple[str, ...]:
     return tuple(sorted(p.name[:-5] for p in resources.files(__name__).iterdir() if p.name.endswith(".yaml")))
 
 
-@functools.cache
 def load(name: str) -> Robot:
     """The catalog robot `name`, or :class:`UnknownNameError` with a suggestion."""
+    if not isinstance(name, str):
+        raise TypeError(f"a catalog robot's name is a str, got {type(name).__name__} (a file: Robot.from_file)")
+    return _load(name)
+
+
+@functools.cache
+def _load(name: str) -> Robot:
     if name not in names():
         close = difflib.get_close_matches(name, names(), n=1)
         hint = f" (did you mean '{close[0]}'?)" if close else ""
@@ -34,9 +41,13 @@ def source_text(name: str) -> str:
     return resources.files(__name__).joinpath(f"{name}.yaml").read_text(encoding="utf-8")
 
 
-def resolve(spec: str) -> Robot:
+def resolve(spec: str | os.PathLike[str]) -> Robot:
     """A robot from a command-line argument: a description file path if one exists, else a catalog name (also when
     a folder of that name exists: a folder 'forklift/' of logs hid the catalog's forklift)."""
+    if isinstance(spec, os.PathLike):
+        spec = os.fspath(spec)
+    if not isinstance(spec, str):
+        raise TypeError(f"a robot is a catalog name or a description file's path, got {type(spec).__name__}")
     path = Path(spec)
     if path.suffix.lower() in (".yaml", ".yml", ".json") or (path.exists() and not (path.is_dir() and spec in names())):
         if not path.exists():
