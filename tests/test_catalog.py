@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from wmrkit import Robot, catalog
+from wmrkit.analysis import classify
 from wmrkit.kinematics.linalg import matrix_rank, solve_assigned
 
 NAMES = catalog.names()
@@ -17,7 +19,8 @@ THESIS = [n for n in NAMES if n.startswith("thesis-")]
 
 #: Degree of mobility m = k - rank A at the described configuration. Thesis vehicles: Table 5.1 (types 1-5)
 #: and (4.79); templates: a skid steer is degenerate (two parallel fixed axles, (5.11)), a swerve or Ackermann
-#: robot with its axles through one ICR has m = 1 (the steering adds non-instantaneous DOF).
+#: robot with its axles through one ICR has m = 1 (the steering adds non-instantaneous DOF); the AGV's double wheel
+#: adds its free turntable (3.29) to the body's 1.
 MOBILITY = {
     "thesis-omni-swedish": 3, "thesis-omni-castor": 3,
     "thesis-diff-swedish": 2, "thesis-diff-castor": 2,
@@ -25,7 +28,7 @@ MOBILITY = {
     "thesis-tricycle": 1, "thesis-tricycle-ch4": 1, "thesis-bicycle-swedish": 1, "thesis-bicycle-castor": 1,
     "thesis-two-steer-swedish": 1, "thesis-two-steer-castor": 1,
     "diff-drive": 2, "line-follower": 2, "skid-steer-4": 1, "mecanum-4": 3, "omni-3": 3, "omni-4": 3,
-    "swerve-4": 1, "ackermann": 1, "bicycle": 1, "forklift": 1,
+    "swerve-4": 1, "ackermann": 1, "bicycle": 1, "forklift": 1, "agv-drive-unit": 2,
 }
 
 
@@ -35,7 +38,8 @@ def mobility(robot: Robot, beta=None) -> np.ndarray:
 
 
 def test_catalog_lists_every_robot_of_the_brief():
-    assert set(MOBILITY) <= set(NAMES)
+    """...and every catalog robot has its degree of mobility checked (agv-drive-unit's was not)."""
+    assert set(MOBILITY) == set(NAMES)
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -292,6 +296,19 @@ def test_docs_list_every_robot_with_its_drawing():
         assert f"| `{name}` |" in text, name
         assert f'<img src="figures/catalog/{name}.png"' in text, name
         assert (docs / "figures" / "catalog" / f"{name}.png").read_bytes().startswith(b"\x89PNG")
+
+
+def test_docs_table_gives_each_robot_its_degree_of_mobility():
+    """The m column of docs/catalog.md is the body's mobility (the classification's, `wmrkit analyze`); where
+    k - rank A (`wmrkit kinematics`) is larger, the row says so: agv-drive-unit's read 1 while k - rank A = 2."""
+    text = (Path(__file__).resolve().parents[1] / "docs" / "catalog.md").read_text(encoding="utf-8")
+    rows = {m[1]: m[2] for m in re.finditer(r"^\| `([^`]+)` \|[^|]*\|[^|]*\| ([^|]+) \| <img", text, re.M)}
+    assert set(rows) == set(NAMES)
+    for name, cell in rows.items():
+        body = classify(catalog.load(name)).mobility
+        assert cell.split()[0] == str(body), name
+        if MOBILITY[name] != body:
+            assert f"({MOBILITY[name]} with the" in cell, name
 
 
 def test_a_folder_named_like_a_catalog_robot_does_not_hide_it(tmp_path, monkeypatch):
