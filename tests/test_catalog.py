@@ -12,6 +12,7 @@ import pytest
 
 from wmrkit import Robot, catalog
 from wmrkit.analysis import classify
+from wmrkit.errors import UnknownNameError
 from wmrkit.kinematics.linalg import matrix_rank, solve_assigned
 
 NAMES = catalog.names()
@@ -339,3 +340,16 @@ def test_a_name_of_the_wrong_type_is_a_clear_type_error(tmp_path, monkeypatch):
     assert catalog.resolve(Path("forklift")) == catalog.load("forklift")
     (tmp_path / "mine.yaml").write_text(catalog.source_text("bicycle"), encoding="utf-8")
     assert catalog.resolve(tmp_path / "mine.yaml") == catalog.load("bicycle")
+
+
+def test_unknown_names_point_to_the_catalog_robot(tmp_path, monkeypatch):
+    """'FORKLIFT' got no suggestion (difflib is case-sensitive) and 'forklift.yaml', the catalog file's name, only
+    "no such file"."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(UnknownNameError, match=r"^no robot 'FORKLIFT' in the catalog \(did you mean 'forklift'\?\)"):
+        catalog.resolve("FORKLIFT")
+    with pytest.raises(UnknownNameError, match=r"^forklift.yaml: no such file \(the catalog's robot is 'forklift', "
+                                         r"without '.yaml'\)$"):
+        catalog.resolve("forklift.yaml")
+    with pytest.raises(UnknownNameError, match=r"^robot.yaml: no such file$"):
+        catalog.resolve("robot.yaml")

@@ -28,7 +28,7 @@ def load(name: str) -> Robot:
 @functools.cache
 def _load(name: str) -> Robot:
     if name not in names():
-        close = difflib.get_close_matches(name, names(), n=1)
+        close = difflib.get_close_matches(name.lower(), names(), n=1)  # 'FORKLIFT' had no suggestion
         hint = f" (did you mean '{close[0]}'?)" if close else ""
         raise UnknownNameError(f"no robot '{name}' in the catalog{hint}; 'wmrkit robots' lists them")
     text = resources.files(__name__).joinpath(f"{name}.yaml").read_text(encoding="utf-8")
@@ -51,7 +51,8 @@ def resolve(spec: str | os.PathLike[str]) -> Robot:
     path = Path(spec)
     if path.suffix.lower() in (".yaml", ".yml", ".json") or (path.exists() and not (path.is_dir() and spec in names())):
         if not path.exists():
-            raise UnknownNameError(f"{spec}: no such file")
+            hint = f" (the catalog's robot is '{path.stem}', without '{path.suffix}')" if path.stem in names() else ""
+            raise UnknownNameError(f"{spec}: no such file{hint}")
         return Robot.from_file(path)
     if spec not in names():
         files = [p for p in (Path(spec + ext) for ext in (".yaml", ".yml", ".json")) if p.is_file()]
