@@ -43,8 +43,6 @@ from .wheels import (
     Wheel,
     beta_from_heading,
     geometry_problem,
-    heading_from_beta,
-    heading_range_problem,
 )
 
 #: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
@@ -220,13 +218,9 @@ def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc) -> Wheel:
     _check_geometry(type_name, values, check, loc)
     actuated = check.joints(item, "actuated", kind.joints, loc)
     sensed = check.joints(item, "sensed", kind.joints, loc)
-    steer_range = _steer_range_from_dict(item, check, loc, kind.steers)
-    problem = steer_range and heading_range_problem(heading_from_beta(values["beta"], values.get("delta", 0.0)),
-                                                    steer_range)
-    if problem:  # located here; Wheel refuses it too
-        check.fail(problem, (*loc, "beta" if "beta" in item else "heading"))
     return Wheel(name=name, type=type_name, actuated=actuated, sensed=sensed, **values,
-                 **mass.wheel_dynamics_from_dict(item, check, loc, type_name), steer_range=steer_range)
+                 **mass.wheel_dynamics_from_dict(item, check, loc, type_name),
+                 steer_range=_steer_range_from_dict(item, check, loc, kind.steers))
 
 
 def _steer_range_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc,

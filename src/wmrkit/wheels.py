@@ -156,9 +156,6 @@ class Wheel:
         problem = geometry_problem(self.type, values, degenerate=False)
         if problem is not None:
             raise WheelError(f"wheel '{self.name}': {problem[0]}: {problem[1]}")
-        problem = self.steer_range and heading_range_problem(self.heading, self.steer_range)
-        if problem:
-            raise WheelError(f"wheel '{self.name}': heading: {problem}")
 
     @property
     def kind(self) -> WheelKind:
@@ -294,15 +291,6 @@ def heading_in_range(heading: ArrayLike, lo: ArrayLike, hi: ArrayLike, tol: floa
     lo_, width = np.where(full, 0.0, lo), np.where(full, 0.0, hi - lo)
     off = np.mod(h - lo_ + tol, 2 * np.pi) - tol  # how far past lo, counter-clockwise, in [-tol, 2 pi - tol)
     return full | (off <= width + tol)
-
-
-def heading_range_problem(heading: float, steer_range: tuple[float, float]) -> str | None:
-    """Why a wheel's `heading` [rad] is not one its `steer_range` reaches (a steering angle beyond the joint's
-    limits: odometry refuses such logged headings, controllers never command them); None if it is."""
-    if heading_in_range(heading, *steer_range):
-        return None
-    lo, hi = (math.degrees(a) for a in steer_range)
-    return f"{math.degrees(float(heading)):.6g} deg is outside the wheel's steer_range [{lo:.6g}, {hi:.6g}] deg"
 
 
 def heading_from_beta(beta: ArrayLike, delta: ArrayLike = 0.0) -> np.ndarray:

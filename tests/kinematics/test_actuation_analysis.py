@@ -143,11 +143,12 @@ def test_427_a_square_jacobian_with_nothing_selected_is_inverted():
 ONE_CONTACT = ["fixed", "steerable", "castor", "swedish", "ball", "orthogonal"]
 
 
-@settings(max_examples=20)
-@given(st.lists(st.sampled_from(ONE_CONTACT), min_size=1, max_size=3).flatmap(
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.sampled_from([*ONE_CONTACT, "double", "double_castor"]), min_size=1, max_size=3).flatmap(
     lambda types: st.tuples(*[wheels(t, name=f"w{i}") for i, t in enumerate(types)])))
 def test_minimal_actuator_sets_are_the_assignable_wheel_rate_sets(ws):
-    """B.3.8: consistent actuation with G = m rates <=> the rates are an assignable set (4.10)."""
+    """B.3.8: consistent actuation with m rates <=> the rates are an assignable set (4.10). With a double wheel
+    (G < m, 4.69) too: the sets of G rates that drive the body and leave the unit's turntable free were listed."""
     robot = Robot("r", tuple(ws))
     a = robot.constraint_matrix()
     m = int(mobility(robot))
@@ -161,7 +162,9 @@ def test_minimal_actuator_sets_are_the_assignable_wheel_rate_sets(ws):
             expected.append(subset)
     steer = tuple(f"{w.name}.steer" for w in robot.wheels if w.type == "steerable")
     found = minimal_actuator_sets(robot)
-    assert [s[: len(s) - len(steer)] for s in found] == (expected if m else [])
+    listed, expected = [s[: len(s) - len(steer)] for s in found], expected if m else []
+    assert listed == (expected if found.complete else expected[:len(listed)])  # the first MAX_MINIMAL_SETS
+    assert found.complete == (len(listed) == len(expected))
 
 
 def _tree_from_constraints(robot: Robot, joints) -> tuple[bool, bool]:
@@ -210,6 +213,12 @@ def test_a_drive_unit_driven_by_its_two_wheels():
 
     agv = catalog.load("agv-drive-unit")
     assert str(actuation_analysis(agv).tree.leaf) == "determined"
+    assert actuation_analysis(agv).sufficient and actuation_analysis(agv).undriven == 0
+    rear = actuation_analysis(agv, actuated=["rear_left.spin"])  # drives the body; the unit turns freely on the spot
+    assert str(rear.tree.leaf) == "determined" and rear.undriven == 1 and not rear.sufficient
+    assert str(rear.verdict).startswith("insufficient actuators: the actuated rates drive the body, but a motion")
+    assert ("rear_left.spin",) not in minimal_actuator_sets(agv)
+    assert ("unit.spin1", "unit.spin2") in minimal_actuator_sets(agv)
     trailer = Robot.from_dict({"name": "unit-and-trailer", "wheels": [
         {"name": "drive", "type": "double", "position": [0.3, 0], "heading": 0, "b": 0.06, "r": 0.08,
          "actuated": ["spin1", "spin2"]},

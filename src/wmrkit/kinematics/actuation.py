@@ -31,7 +31,6 @@ from .trees import (
     partitioned_solution,
     reduced_equation,
     select_columns,
-    vehicle_dof,
 )
 
 
@@ -115,6 +114,11 @@ _ACTUATION_TEXT = {
     "overdetermined": "over-actuated: more actuated rates than degrees of freedom, so the actuators must be "
                       "coordinated (or mechanically coupled: 'couplings' in the description) or they fight and "
                       "the wheels slip",
+    "body only": "insufficient actuators: the actuated rates drive the body, but a motion of the joints with the "
+                 "body at rest (a double wheel turning on the spot, 4.69) is not actuated",
+    "overdetermined, body only": "over-actuated and insufficient: more actuated rates than the body's degrees of "
+                                 "freedom, which they may fight over, while a motion of the joints with the body at "
+                                 "rest (a double wheel turning on the spot, 4.69) is not actuated",
     "indeterminate": "insufficient actuators: some degrees of freedom are not actuated",
     "underdetermined": "insufficient and conflicting actuators: some degrees of freedom are not actuated and "
                        "the actuated rates can fight",
@@ -132,11 +136,13 @@ class ActuationAnalysis:
     mobility: np.ndarray  # (...) int, m (3.22) with the gear couplings held: the motions the mechanism allows
     tree: TreeVerdict
     inverse_matrix: np.ndarray  # (..., n_u, 3), (4.26)
+    undriven: np.ndarray  # (...) int, motions with every actuated rate at rest (:func:`undriven_motions`)
 
     @property
     def sufficient(self) -> np.ndarray:
-        """``rank I_u = 3``: every feasible motion is reached by the actuators (sufficient actuators)."""
-        return self.tree.rank_a == 3
+        """``rank I_u = 3`` and no motion left with every actuated rate at rest (a double wheel's turntable, 4.69):
+        every feasible motion is reached by the actuators (sufficient actuators)."""
+        return (self.tree.rank_a == 3) & (self.undriven == 0)
 
     @property
     def consistent(self) -> np.ndarray:
@@ -150,9 +156,13 @@ class ActuationAnalysis:
 
     @property
     def verdict(self) -> np.ndarray:
-        """One sentence per configuration: the tree's verdict, the counts, and missing steering actuators."""
-        return verdict_texts(self.leaf, _ACTUATION_TEXT, len(self.actuated), self.mobility,
-                         self.steering_missing, "actuated")
+        """One sentence per configuration: the tree's verdict, the counts, and missing steering actuators; a body
+        driven while a joint motion is not (a double wheel's free turntable) is not called consistent."""
+        free = {"determined": "body only", "overdetermined": "overdetermined, body only"}
+        leaf = np.where(self.undriven > 0, np.vectorize(lambda lf: free.get(lf, lf), otypes=[object])(self.leaf),
+                        self.leaf)
+        return verdict_texts(leaf, _ACTUATION_TEXT, len(self.actuated), self.mobility, self.steering_missing,
+                             "actuated")
 
     def inverse(self, twist_robot: ArrayLike) -> np.ndarray:
         """Actuated rates for a (feasible) body twist, (4.26): ``(..., 3) -> (..., n_u)`` [rad/s, m/s]."""
@@ -165,7 +175,8 @@ class ActuationAnalysis:
             "actuated": list(self.actuated), "steering_actuated": list(self.steering),
             "steering_not_actuated": list(self.steering_missing), "mobility": self.mobility.tolist(),
             "leaf": self.leaf.tolist(), "sufficient": self.sufficient.tolist(),
-            "consistent": self.consistent.tolist(), "verdict": self.verdict.tolist(),
+            "consistent": self.consistent.tolist(), "undriven_motions": self.undriven.tolist(),
+            "verdict": self.verdict.tolist(),
             "inverse_matrix": self.inverse_matrix.tolist(),
         }
 
@@ -207,7 +218,17 @@ def actuation_analysis(
         readonly(np.asarray(a.shape[-1] - matrix_rank(a))),
         eliminated_tree(i_bar1, j_u1, j_nu1),
         readonly(partitioned_solution(j_u, j_nu) @ i_bar),
+        readonly(undriven_motions(i_bar1, j_nu1)),
     )
+
+
+def undriven_motions(i_bar: np.ndarray, j_rest: np.ndarray) -> np.ndarray:
+    """How many independent motions the mechanism has with every selected rate at rest: the nullity of ``[I_bar,
+    J_rest]`` (the Jacobian form (3.20) without the selected columns, couplings held). Zero when the selected rates
+    drive everything; a double wheel whose steering turns with the body at rest (4.69: G < m) leaves one where the
+    tree (4.28), which looks at the body alone, says determined. ``(3E, 3), (..., 3E, n) -> (...)`` int."""
+    both = np.concatenate([np.broadcast_to(i_bar, (*j_rest.shape[:-1], 3)), j_rest], axis=-1)
+    return both.shape[-1] - matrix_rank(both)
 
 
 def coupled_constraints(robot: Robot, beta: np.ndarray) -> np.ndarray:
@@ -239,13 +260,18 @@ def selectable_rates(robot: Robot) -> list[int]:
     return [i for i, n in enumerate(robot.rate_names) if not n.endswith(".roller")]
 
 
-def minimal_set_search(robot: Robot, beta: np.ndarray, size: int, wanted: str, what: str) -> SetList:
+def minimal_set_search(robot: Robot, beta: np.ndarray, size: int, wanted: str, what: str, *,
+                       drive_all: bool = False) -> SetList:
     """The sets of `size` selectable rates whose tree (4.28)/(4.34) is `wanted` with rank 3 at every
-    configuration: a bounded search (:mod:`.search`) pruned by the null-space test when ``size`` is the mobility
-    (then the rates must be an assignable set of the direct model), listing at most MAX_MINIMAL_SETS."""
+    configuration (and, `drive_all`, no motion left with them at rest: :func:`undriven_motions`): a bounded search
+    (:mod:`.search`) pruned by the null-space test when ``size`` is the mobility (then the rates must be an
+    assignable set of the direct model), listing at most MAX_MINIMAL_SETS."""
     def exact(sel: np.ndarray) -> np.ndarray:
         tree = trees_of(robot, beta, sel)
-        return ((tree.leaf == wanted) & (tree.rank_a == 3)).reshape(len(sel), -1).all(axis=1)
+        ok = (tree.leaf == wanted) & (tree.rank_a == 3)
+        if drive_all:
+            ok &= undriven_motions(*_rest_of(robot, beta, sel)) == 0
+        return ok.reshape(len(sel), -1).all(axis=1)
 
     a = nondimensional(robot).constraint_matrix(beta)
     m = np.unique(a.shape[-1] - matrix_rank(a))
@@ -258,28 +284,37 @@ def minimal_set_search(robot: Robot, beta: np.ndarray, size: int, wanted: str, w
 
 def trees_of(robot: Robot, beta: np.ndarray, sel: np.ndarray) -> TreeVerdict:
     """The trees (4.28)/(4.34) of the sets of rate columns `sel` ``(S, size)``: leaves ``(S, ...)``."""
+    i_bar, j = nondimensional(robot).jacobian_form(beta)
+    j_sel = np.moveaxis(j[..., sel], -2, 0)  # (..., 3E, S, size) -> (S, ..., 3E, size)
+    return eliminated_tree(i_bar, j_sel, _rest_of(robot, beta, sel)[1])
+
+
+def _rest_of(robot: Robot, beta: np.ndarray, sel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(I_bar, J_rest)`` of the nondimensional Jacobian form without the columns `sel` ``(S, size)``:
+    ``(3E, 3), (S, ..., 3E, n_w - size)``."""
     n_w = len(jacobian_names(robot))
     i_bar, j = nondimensional(robot).jacobian_form(beta)
     rest = np.array([[c for c in range(n_w) if c not in s] for s in sel.tolist()], dtype=int).reshape(
         len(sel), n_w - sel.shape[1])
-    j_sel = np.moveaxis(j[..., sel], -2, 0)  # (..., 3E, S, size) -> (S, ..., 3E, size)
-    j_rest = np.moveaxis(j[..., rest], -2, 0)
-    return eliminated_tree(i_bar, j_sel, j_rest)
+    return i_bar, np.moveaxis(j[..., rest], -2, 0)
 
 
 def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None, *,
                           heading: ArrayLike | None = None) -> tuple[tuple[str, ...], ...]:
     """The smallest actuator choices with consistent actuation (Fig. 4.4 ``determined``) at every configuration.
 
-    Each set has G (= m, B.3.8) wheel rates, followed by the ``steer`` joints of the centred steerable wheels,
-    which the thesis requires actuated. Empty when no choice of wheel rates works (e.g. m = 0). Steering: `beta`
-    (thesis) or `heading` (0 = rolling forward), default as described.
+    Each set has m (B.3.8) wheel rates, followed by the ``steer`` joints of the centred steerable wheels, which the
+    thesis requires actuated. m = G, the body's degrees of freedom, except with a double wheel, whose steering
+    turns with the body at rest (4.69): one more rate must drive it (:func:`undriven_motions`). Empty when no
+    choice of wheel rates works (e.g. m = 0). Steering: `beta` (thesis) or `heading` (0 = rolling forward),
+    default as described.
     """
     beta = configuration(robot, beta, heading)
-    m = np.unique(vehicle_dof(robot, beta))  # G = m unless a double wheel adds a self-motion (4.69)
+    a = nondimensional(robot).constraint_matrix(beta)
+    m = np.unique(a.shape[-1] - matrix_rank(a))
     if len(m) != 1 or m[0] == 0:
-        return ()
-    found = minimal_set_search(robot, beta, int(m[0]), "determined", "minimal actuator sets")
+        return SetList()
+    found = minimal_set_search(robot, beta, int(m[0]), "determined", "minimal actuator sets", drive_all=True)
     steer = tuple(f"{w}.steer" for w in steering_split(robot, ()))
     names = jacobian_names(robot)
     return SetList([tuple(names[c] for c in s) + steer for s in found], found.complete, found.note)

@@ -202,7 +202,7 @@ def minimal_sensor_sets(
     beta = configuration(robot, beta, heading)
     m = np.unique(vehicle_dof(robot, beta))  # G = m unless a double wheel adds a self-motion (4.69)
     if len(m) != 1 or m[0] == 0:
-        return ()
+        return SetList()
     names, steer = jacobian_names(robot), tuple(f"{w}.steer" for w in steering_split(robot, ()))
     wanted = "overdetermined" if detect_slip else "determined"
     sizes = range(int(m[0]) + 1, len(robot.rate_names) + 1) if detect_slip else (int(m[0]),)
