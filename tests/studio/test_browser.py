@@ -7,6 +7,7 @@ recorded (``window.studioStats``) and printed, not asserted tightly: the machine
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import shutil
@@ -595,4 +596,27 @@ def test_handle_heading_is_a_clean_value(page):
     value = float(heading.removesuffix(" deg"))
     assert heading.endswith(" deg") and round(value, 2) == value
     assert pg.input_value('#wheel-fields [data-field="heading"]') == heading
+    assert not pg.errors
+
+
+def test_open_invalid_file_names_the_file_not_the_current_robot(page, server):
+    """Opening an invalid file named the wheel at the same index of the robot on screen (and selected it, marking
+    its field): 'wheel 'right', r: must be > 0' for the file's wheel 'b'; the error names the file and its wheel."""
+    pg = page
+    _, root = server
+    open_catalog(pg, "diff-drive")
+    bad = catalog.load("omni-3").to_dict()
+    bad["wheels"][1]["r"] = -0.003
+    (root / "bad.json").write_text(json.dumps(bad))
+    pg.evaluate("call('/api/files').then((f) => fillFiles(f.data.files))")
+    pg.wait_for_function("() => [...document.getElementById('files').options].some((o) => o.value === 'bad.json')")
+    pg.click('[data-wheel="left"]')
+    pg.select_option("#files", "bad.json")
+    pg.click("#open")
+    pg.wait_for_function("() => !document.getElementById('error').hidden")
+    text = pg.inner_text("#error")
+    assert "bad.json" in text and "wheels[1].r" in text and "right" not in text, text
+    assert pg.evaluate("S.selected") == "left"
+    assert pg.locator(".invalid").count() == 0
+    assert page_robot(pg) == catalog.load("diff-drive")
     assert not pg.errors

@@ -641,7 +641,8 @@ async function openRobot() {
   const file = $("files").value;
   if (!file && !$("catalog").value) return;
   const r = await call("/api/open", file ? { path: file } : { catalog: $("catalog").value });
-  if (!r.ok) { showError(r.data); return; }
+  // The error is about the file's wheels, not the robot on screen: its message (naming the file), no field marked.
+  if (!r.ok) { showError({ error: r.data.error }); return; }
   load(r.data.description, file || `${r.data.description.name}.yaml`);
 }
 async function saveRobot() {
