@@ -275,14 +275,15 @@ def test_drive_bad_input(client, body):
 
 
 def test_drive_heading_is_an_angle(client):
-    """'30 deg' was refused ('is an angle, expected a number'); 1e300 failed unlocated; 7 (rad, bare) passed."""
+    """'30 deg' was refused ('is an angle, expected a number'); 1e300 failed unlocated; 7 (rad, bare) passed;
+    '1e6 turn' (a heading within the limit, its beta = heading + 90 deg beyond) was 'beta: angles must be ...'."""
     body = {"description": desc("swerve-4"), "twist": [0, 0, 0]}
     deg = client.post("/api/drive", json={**body, "heading": {"front_left": "30 deg"}})
     rad = client.post("/api/drive", json={**body, "heading": {"front_left": math.radians(30)}})
     assert deg.status_code == 200, deg.json()
     assert deg.json()["heading"]["front_left"] == pytest.approx(math.radians(30), abs=1e-12)
     assert deg.json() == rad.json()
-    for value in (7.0, 1e300, "2e6 turn", "30 parsecs"):
+    for value in (7.0, 1e300, "2e6 turn", "1e6 turn", "30 parsecs"):
         r = client.post("/api/drive", json={**body, "heading": {"front_left": value}})
         assert r.status_code == 400 and r.json()["error"].startswith("heading.front_left: "), (value, r.json())
 

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .._shapes import as_angles
 from ..analysis.classification import classify, instantaneous_mobility
 from ..analysis.icr import ICRSet, icr, icr_of_twist
 from ..analysis.isotropy import (
@@ -32,7 +33,7 @@ from ..analysis.optimize import isotropic_configurations
 from ..analysis.singularity import robot_size, singularity_distance
 from ..analysis.summary import assigned_names, describe_singular, model_rates, model_singular_set
 from ..description import COMMON_WHEEL_FIELDS, robot_from_dict, robot_to_dict
-from ..errors import DescriptionError, WmrkitError
+from ..errors import DescriptionError, ShapeError, WmrkitError
 from ..kinematics.actuation import actuation_analysis
 from ..kinematics.sensing import sensing_analysis
 from ..kinematics.wheel_ik import wheel_commands
@@ -285,7 +286,8 @@ def drive(request: Any) -> dict[str, Any]:
     for name, value in steering.items():  # an angle: "30 deg" accepted, a bare number beyond a turn refused
         try:
             current[robot.steer_names.index(name)] = parse_quantity(value, "angle")
-        except UnitError as err:
+            as_angles(robot.beta_of_heading(current), len(current), "beta")  # beta = heading + 90 deg - delta too
+        except (UnitError, ShapeError) as err:
             raise StudioError(f"heading.{name}: {err}") from None
     beta = robot.beta_of_heading(current)
     c = wheel_commands(robot, twist, beta)
