@@ -288,6 +288,13 @@ def test_drive_heading_is_an_angle(client):
         assert r.status_code == 400 and r.json()["error"].startswith("heading.front_left: "), (value, r.json())
 
 
+def test_drive_unknown_heading_wheel_is_quoted_short(client):
+    """A 10,000-character unknown wheel name was quoted whole in the message."""
+    body = {"description": desc("swerve-4"), "twist": [0, 0, 0], "heading": {"x" * 10_000: 0}}
+    r = client.post("/api/drive", json=body)
+    assert r.status_code == 400 and len(r.json()["error"]) < 300, r.json()
+
+
 def test_drive_takes_twists_up_to_the_query_limit(client):
     for twist, status in (([1e6, 0, -1e6], 200), ([0.5, 1.0, 1e308], 400), ([0, -1.1e6, 0], 400)):
         r = client.post("/api/drive", json={"description": desc("omni-3"), "twist": twist})  # 1e308: a 500 before

@@ -280,7 +280,7 @@ def drive(request: Any) -> dict[str, Any]:
         raise StudioError("heading: a mapping {steering wheel: heading [rad]}")
     unknown = [n for n in steering if n not in robot.steer_names]
     if unknown:
-        raise StudioError(f"heading: '{unknown[0]}' is not a steering wheel of '{robot.name}' "
+        raise StudioError(f"heading: '{unknown[0][:80]}' is not a steering wheel of '{robot.name}' "
                           f"(steering: {', '.join(robot.steer_names) or 'none'})")
     current = robot.heading.copy()
     for name, value in steering.items():  # an angle: "30 deg" accepted, a bare number beyond a turn refused
