@@ -58,6 +58,16 @@ def test_analyze_equals_library(client, name):
             assert live[key] == pytest.approx(full[key], rel=1e-9)
 
 
+def test_no_natural_length_where_kappa_is_infinite(client):
+    """A swerve with one wheel turned cannot move: kappa is infinite at every length, and the page showed
+    'D = 0.396 m' (natural_length's fallback, the robot size, minimising nothing) where `wmrkit analyze` gives none."""
+    robot = catalog.load("swerve-4").with_steering({"front_left": math.radians(30)})
+    live = client.post("/api/analyze", json={"description": robot.to_dict()}).json()["analysis"]
+    full = analyze(robot).to_dict()
+    assert full["characteristic_length"] is None and not math.isfinite(full["condition_number"])
+    assert live["condition_number"] is None and live["characteristic_length"] is None
+
+
 def test_analyze_headings_and_geometry(client):
     robot = catalog.load("ackermann")
     data = client.post("/api/analyze", json={"description": robot.to_dict()}).json()

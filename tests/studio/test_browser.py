@@ -620,3 +620,16 @@ def test_open_invalid_file_names_the_file_not_the_current_robot(page, server):
     assert pg.locator(".invalid").count() == 0
     assert page_robot(pg) == catalog.load("diff-drive")
     assert not pg.errors
+
+
+def test_infinite_condition_number_has_no_length(page):
+    """A swerve with one wheel turned cannot move: 'κ = – at D = 0.396 m' was shown (no length minimises κ)."""
+    pg = page
+    open_catalog(pg, "swerve-4")
+    pg.click('[data-wheel="front_left"]')
+    edit(pg, "heading", "30 deg")
+    assert shown(pg, "a-kappa") == [None, None]
+    assert pg.inner_text("#a-kappa").startswith("κ infinite"), pg.inner_text("#a-kappa")
+    pg.click("#undo")
+    settle(pg)
+    assert not pg.errors

@@ -518,7 +518,8 @@ function renderAnalysis() {
   const verdict = (v, ok) => `<span class="${ok ? "good" : "warn"}">${esc(v.verdict)}</span> <span class="hint">(${esc(v.joints.join(", ") || "nothing declared")})</span>`;
   setCell("a-actuation", verdict(a.actuation, a.actuation.consistent && a.actuation.sufficient), a.actuation);
   setCell("a-sensing", verdict(a.sensing, a.sensing.sufficient), a.sensing);
-  setCell("a-kappa", `κ = ${fmt(a.condition_number, 6)} at D = ${fmt(a.characteristic_length, 4)} m ` +
+  setCell("a-kappa", (a.condition_number === null ? "κ infinite (these joints do not determine the twist) "
+    : `κ = ${fmt(a.condition_number, 6)} at D = ${fmt(a.characteristic_length, 4)} m `) +
     `<span class="hint">(${esc(a.condition_joints.join(", "))})</span>`, [a.condition_number, a.characteristic_length]);
   const here = Object.entries(a.singular_here).map(([k, s]) => `${k}: ` + (s.singular ? '<span class="bad">singular</span>'
     : s.near ? `<span class="warn">near (distance ${fmt(s.distance, 3)})</span>` : `no (distance ${fmt(s.distance, 3)})`));
