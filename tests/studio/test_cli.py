@@ -66,3 +66,26 @@ def test_server_process_serves_the_file(tmp_path):
     finally:
         proc.terminate()
         proc.wait(10)
+
+
+def test_a_linked_file_is_opened_and_saved_where_it_is(tmp_path, monkeypatch):
+    """`wmrkit studio robots/current.yaml`, a link to designs/v3.yaml: the studio served designs/ but offered to
+    save as 'current.yaml' there, a new file beside the one the user opened."""
+    from wmrkit.cli import studio as cli_studio
+    from wmrkit.studio import app as studio_app
+
+    (tmp_path / "designs").mkdir()
+    (tmp_path / "robots").mkdir()
+    catalog.load("omni-3").to_file(tmp_path / "designs" / "v3.yaml")
+    (tmp_path / "robots" / "current.yaml").symlink_to(tmp_path / "designs" / "v3.yaml")
+    seen = {}
+
+    def create_app(root, robot, *, robot_spec=None, allowed_hosts=None):
+        seen.update(root=root, spec=robot_spec)
+        raise KeyboardInterrupt  # stop before serving
+
+    monkeypatch.setattr(studio_app, "create_app", create_app)
+    monkeypatch.setattr(cli_studio, "_listen", lambda host, port: None)
+    with pytest.raises(KeyboardInterrupt):
+        main(["studio", str(tmp_path / "robots" / "current.yaml"), "--port", "0", "--no-browser"])
+    assert seen == {"root": (tmp_path / "designs").resolve(), "spec": "v3.yaml"}

@@ -35,8 +35,8 @@ def run_studio(args: argparse.Namespace) -> int:
     spec = args.robot
     path = Path(spec)
     if path.suffix.lower() in (".yaml", ".yml", ".json") or path.exists():
-        root = path.resolve().parent
-        spec = path.name
+        target = path.resolve()  # a symbolic link: the file it names, in the folder served (opened and saved there)
+        root, spec = target.parent, target.name
     else:
         root = Path.cwd()
     robot = catalog.resolve(args.robot)
