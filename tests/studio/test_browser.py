@@ -633,3 +633,32 @@ def test_infinite_condition_number_has_no_length(page):
     pg.click("#undo")
     settle(pg)
     assert not pg.errors
+
+
+def test_started_with_a_yml_file_saves_to_it(page):
+    """`wmrkit studio mine.yml`: the save field said 'omni-3.yaml' (only .yaml and .json were taken as files), so
+    Save wrote another file than the one opened."""
+    import uvicorn
+
+    root = Path(tempfile.mkdtemp(prefix="wmrkit-studio-yml-"))
+    catalog.load("omni-3").to_file(root / "Mine.YML")
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    app = create_app(root, Robot.from_file(root / "Mine.YML"), robot_spec="Mine.YML", allowed_hosts=LOCAL_HOSTS)
+    srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+    thread = threading.Thread(target=srv.run, daemon=True)
+    thread.start()
+    pg = page.context.new_page()
+    try:
+        deadline = time.monotonic() + 20
+        while not srv.started and time.monotonic() < deadline:
+            time.sleep(0.05)
+        pg.goto(f"http://127.0.0.1:{port}/")
+        pg.wait_for_function("() => window.studioStats && window.studioStats.rendered > 0")
+        assert pg.input_value("#save-path") == "Mine.YML"
+    finally:
+        pg.close()
+        srv.should_exit = True
+        thread.join(10)
+        shutil.rmtree(root, ignore_errors=True)

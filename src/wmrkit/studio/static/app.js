@@ -717,7 +717,7 @@ async function main() {
     else if (k === "delete") deleteWheel();
   });
   setTwist([0, 0, 0]);
-  load(S.meta.start.description, S.meta.start.spec.endsWith(".yaml") || S.meta.start.spec.endsWith(".json")
+  load(S.meta.start.description, /\.(ya?ml|json)$/i.test(S.meta.start.spec)  // a file: .yaml, .yml, .json (files.py)
     ? S.meta.start.spec : `${S.meta.start.description.name}.yaml`);
 }
 main();
