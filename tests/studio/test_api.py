@@ -232,6 +232,27 @@ def test_drive_matches_wheel_commands(client, name):
     assert data["feasible"] == (slip < 1e-9 and bool(c.feasible))
 
 
+DOUBLE = {"name": "dbl", "wheels": [
+    {"name": "L", "type": "fixed", "position": [0, 0.2], "heading": 0, "r": 0.05, "actuated": ["spin"]},
+    {"name": "R", "type": "fixed", "position": [0, -0.2], "heading": 0, "r": 0.05, "actuated": ["spin"]},
+    {"name": "D", "type": "double_castor", "position": [-0.4, 0], "heading": 0, "d": 0.05, "b": 0.03, "r": 0.03},
+    {"name": "E", "type": "double", "position": [0.4, 0], "heading": 0, "b": 0.03, "r": 0.03}]}
+
+
+@pytest.mark.parametrize("description", [DOUBLE, desc("mecanum-4")], ids=["double", "mecanum-4"])
+def test_drive_gives_every_joint_rate_as_wmrkit_ik(client, description):
+    """A double wheel's motors turn at spin1 and spin2 and a Swedish wheel's rollers at 'roller' (`wmrkit ik
+    --json` gives them); the studio gave only the mean spin."""
+    twist = [0.5, 0.0 if description is DOUBLE else 0.2, 0.3]
+    data = client.post("/api/drive", json={"description": description, "twist": twist}).json()
+    cli = wheel_commands(robot_from_dict(description), twist).to_dict()["wheels"]
+    for name, want in cli.items():
+        got = {k: v for k, v in data["wheels"][name].items() if k not in ("speed", "slip")}
+        assert got.keys() == want.keys() | {"heading"}
+        for k, v in want.items():
+            assert got[k] == (None if math.isnan(v) else pytest.approx(v, abs=1e-12)), (name, k)
+
+
 def test_drive_flags_infeasible_twist(client):
     data = client.post("/api/drive", json={"description": desc("diff-drive"), "twist": [0, 0.3, 0]}).json()
     assert data["feasible"] is False and data["residual"] > 0.1

@@ -662,3 +662,20 @@ def test_started_with_a_yml_file_saves_to_it(page):
         srv.should_exit = True
         thread.join(10)
         shutil.rmtree(root, ignore_errors=True)
+
+
+def test_drive_table_shows_roller_rates(page):
+    """The table gave a Swedish wheel's spin only; its rollers' rates (as `wmrkit ik`) follow it now."""
+    pg = page
+    open_catalog(pg, "mecanum-4")
+    pg.click("#plan", position={"x": 5, "y": 5})
+    for key in ("w", "w", "a"):
+        pg.keyboard.press(key)
+    settle(pg)
+    robot, twist = page_robot(pg), pg.evaluate("S.twist")
+    want = wheel_commands(robot, twist).to_dict()["wheels"]["front_left"]["roller"]
+    cell = pg.inner_text('#commands tr[data-wheel="front_left"] td:nth-child(3)')
+    assert f"roller {float(f'{want:.4g}'):g}" in cell, (cell, want)
+    pg.keyboard.press(" ")
+    settle(pg)
+    assert not pg.errors

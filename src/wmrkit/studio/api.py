@@ -267,9 +267,10 @@ def drive(request: Any) -> dict[str, Any]:
     (steering wheel -> heading, radians or a string with a unit, ``"30 deg"``).
 
     Per wheel: heading [rad] and spin [rad/s] (§8.4), the rolling speed ``r * spin`` [m/s] for the arrows, the
-    lateral slip of fixed wheels; ``feasible``, why not (``slips``: the residual ``|A q_dot|`` [m/s] of the no-slip
-    equations (3.22) is not zero; ``out_of_range``: the wheels whose heading is beyond their ``steer_range``); the
-    ICR of the twist; and the poses of the robot holding the twist for ``duration`` s (exact SE(2)).
+    lateral slip of fixed wheels, its other joint rates (``spin1``/``spin2`` of double wheels, ``roller``) [rad/s];
+    ``feasible``, why not (``slips``: the residual ``|A q_dot|`` [m/s] of the no-slip equations (3.22) is not zero;
+    ``out_of_range``: the wheels whose heading is beyond their ``steer_range``); the ICR of the twist; and the poses
+    of the robot holding the twist for ``duration`` s (exact SE(2)).
     """
     check_fields(request, "description", "twist", "heading", "duration", "samples")
     robot = robot_of(request)
@@ -295,11 +296,13 @@ def drive(request: Any) -> dict[str, Any]:
     now_heading = robot.heading_of_beta(c.beta)
     residual = float(np.linalg.norm(robot.slip_velocity(c.velocity(twist), c.beta)))
     wheels = {}
+    joints = c.to_dict()["wheels"]  # the other joint rates (spin1, spin2, roller), as `wmrkit ik --json`
     for i, w in enumerate(robot.wheels):
         h = float(now_heading[robot.steer_names.index(w.name)]) if w.kind.steers else float(w.heading)
         spin = float(c.spin[i])
         wheels[w.name] = {"heading": h, "spin": _finite(spin), "speed": _finite(spin * w.r),
                           "steer_rate": _finite(float(c.steer_rate[i])), "slip": float(c.slip[i])}
+        wheels[w.name] |= {k: _finite(v) for k, v in joints[w.name].items() if k not in wheels[w.name]}
     scale = max(1.0, float(np.abs(twist[:2]).sum() + abs(twist[2]) * robot_size(robot)))
     slips = not residual <= 1e-9 * scale
     out_of_range = [w.name for w, ok in zip(robot.wheels, c.in_range.tolist(), strict=True) if not ok]

@@ -560,8 +560,10 @@ function renderDrive() {
   tab.innerHTML = "<tr><th>wheel</th><th>heading [deg]</th><th>spin [rad/s]</th><th>slip [m/s]</th></tr>";
   for (const [name, c] of Object.entries(d.wheels)) {
     const tr = document.createElement("tr"); tr.dataset.wheel = name;
+    const joints = Object.entries(c).filter(([k]) => !["heading", "spin", "speed", "steer_rate", "slip"].includes(k))
+      .map(([k, v]) => `${esc(k)} ${fmt(v, 4)}`);  // a double wheel's spin1, spin2 (spin: their mean), rollers
     tr.innerHTML = `<td>${esc(name)}</td><td data-value="${c.heading}">${fmt(deg(c.heading), 4)}</td>` +
-      `<td data-value="${c.spin}">${fmt(c.spin, 4)}</td><td class="${Math.abs(c.slip) > 1e-9 ? "bad" : ""}">${fmt(c.slip, 3)}</td>`;
+      `<td data-value="${c.spin}">${fmt(c.spin, 4)}${joints.length ? ` <span class="hint">(${joints.join(", ")})</span>` : ""}</td><td class="${Math.abs(c.slip) > 1e-9 ? "bad" : ""}">${fmt(c.slip, 3)}</td>`;
     tab.appendChild(tr);
   }
 }
