@@ -542,6 +542,18 @@ def test_listing_looks_at_a_bounded_number_of_entries(tmp_path, client, monkeypa
     assert client.get("/api/files").json()["files"] == ["logs/zz.yaml", "robot.yaml"]
 
 
+def test_listing_shows_only_files_that_open(tmp_path, client):
+    """Names /api/open refuses (control character, leading space, undecodable bytes, over 200 characters, or in
+    such a folder) were listed: the page offered files that answered 400."""
+    names = [b"a\nb.yaml", b" lead.yaml", b"\xff.yaml", b"x" * 210 + b".yaml", b"ok.yaml", b"tab\tdir/in.yaml"]
+    (tmp_path / "tab\tdir").mkdir()
+    for name in names:
+        catalog.load("omni-3").to_file(Path(os.fsdecode(os.path.join(bytes(tmp_path), name))))
+    listed = client.get("/api/files").json()["files"]
+    assert listed == ["ok.yaml"], listed
+    assert all(client.post("/api/open", json={"path": f}).status_code == 200 for f in listed)
+
+
 def test_security_headers(client):
     for r in (client.get("/"), client.get("/static/app.js"), client.get("/api/meta"),
               client.post("/api/analyze", json={"description": 3})):

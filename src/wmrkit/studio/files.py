@@ -84,8 +84,8 @@ def _shown(relative: str) -> str:
 
 
 def list_files(root: Path) -> list[str]:
-    """Description files below `root` (relative POSIX paths, sorted; hidden folders skipped), looking at no more
-    than :data:`MAX_ENTRIES` folder entries, shallow folders first."""
+    """Description files below `root` (relative POSIX paths, sorted; hidden folders and names :func:`safe_path`
+    refuses skipped), looking at no more than :data:`MAX_ENTRIES` folder entries, shallow folders first."""
     root = root.resolve()
     found: list[str] = []
     queue = deque([(root, 0)])
@@ -99,7 +99,7 @@ def list_files(root: Path) -> list[str]:
             continue
         budget -= len(entries)
         for e in entries:
-            if e.name.startswith("."):
+            if e.name.startswith(".") or not _plain_name(e.name):  # hidden, or a name safe_path refuses
                 continue
             p = Path(e.path)
             try:
@@ -110,6 +110,12 @@ def list_files(root: Path) -> list[str]:
             except OSError:
                 continue
     return sorted(found)[:MAX_FILES]
+
+
+def _plain_name(name: str) -> bool:
+    """A file or folder name :func:`safe_path` takes (so that every file listed opens)."""
+    return (len(name) <= MAX_NAME and name == name.strip() and not _CONTROL.search(name)
+            and not _SURROGATE.search(name))
 
 
 def open_robot(root: Path, request: Any) -> dict[str, Any]:
