@@ -139,6 +139,22 @@ def test_refused_setups():
         follow_line(ROBOT, CAMERA, start=(0.0, 5.0, 0.0))
 
 
+def test_a_run_renders_a_bounded_number_of_pixels(monkeypatch):
+    """A 4096 x 4096 camera took 10 s and 1.9 GB an image: 10^4 periods of it ran for a day."""
+    from wmrkit.vision import follow as follow_module
+
+    def no_render(*args, **kwargs):
+        raise AssertionError("rendered before the run was refused")
+
+    monkeypatch.setattr(follow_module, "render", no_render)
+    big = Camera(1920.0, math.radians(60), 0.3, 4096, 4096)
+    with pytest.raises(WmrkitError, match=re.escape("follow-line: 60 periods of 4096 x 4096 px images are more "
+                                                     "than the 7.68e+08 pixels a run renders")):
+        follow_line(ROBOT, big, duration=30)
+    run = follow_line(ROBOT, big, duration=30, from_image=False)  # no image rendered: not counted
+    assert len(run.time) == 61
+
+
 @pytest.mark.parametrize(("args", "message"), [
     ((math.nan, 0.1, 0.3, 0.1), "psi: expected a finite number, got nan"),
     ((0.0, math.inf, 0.3, 0.1), "h: expected a finite number, got inf"),

@@ -177,6 +177,10 @@ def view_width(camera: Camera, rows_a: float | None = None) -> float:
 
 #: Most control periods of a run: each renders and processes one image (about 10 ms).
 MAX_PERIODS = 10**4
+#: Most pixels rendered over a run (periods x image pixels): MAX_PERIODS images of the docs' follower camera
+#: (320 x 240 px). Rendering costs about 0.5 us a pixel: a 4096 x 4096 camera took 10 s and 1.9 GB an image, so
+#: 10^4 periods of it ran for a day (and ``keep_images`` held 170 GB).
+MAX_RUN_PIXELS = MAX_PERIODS * 320 * 240
 
 
 def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float = 0.1, period: float = 0.5,
@@ -200,6 +204,10 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     if not duration / period <= MAX_PERIODS:
         raise WmrkitError(f"follow-line: duration {duration:g} s at a period of {period:g} s is more than "
                           f"{MAX_PERIODS} periods (one image each)")
+    if from_image and round(duration / period) * camera.width * camera.rows > MAX_RUN_PIXELS:
+        raise WmrkitError(f"follow-line: {round(duration / period)} periods of {camera.width} x {camera.rows} px "
+                          f"images are more than the {MAX_RUN_PIXELS:.3g} pixels a run renders (docs/limits.md): "
+                          "shorten the duration, lengthen the period or use a smaller camera image")
     if not (all(np.isfinite(noise)) and 0 <= noise[0] <= MAX_COORDINATE and 0 <= noise[1] <= np.pi):
         raise WmrkitError(f"follow-line: noise bounds must be h in [0, {MAX_COORDINATE:g}] m and psi in [0, pi] "
                           f"rad, got {noise[0]:g} m, {noise[1]:g} rad")
