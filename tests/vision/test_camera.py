@@ -14,6 +14,7 @@ from wmrkit.vision.camera import (
     Camera,
     CameraError,
     camera_coordinates,
+    check_lens_image,
     distort,
     extrinsics,
     fold_radius,
@@ -129,16 +130,18 @@ def test_undistort_round_trips_over_the_whole_image_across_the_accepted_k1(k1):
     width, rows = 640, 480
     corner = math.hypot(width, rows) / 2
     focals = [500.0, 2000.0] if k1 >= 0 else [corner * 1.5 * math.sqrt(-3 * k1) / c for c in (0.98, 0.3)]
+    k1 = float(k1)
     for f in focals:
-        cam = Camera(f, 0.8, 0.5, width, rows, float(k1))  # accepted
+        # accepted by the lens check (a Camera's; for k1 = -1e-9 these focal lengths are below its MIN_FOCAL_PX)
+        check_lens_image(k1, f, width, rows, "test")
         d = _grid(width, rows)
-        u = undistort(d, cam.k1, f)
-        np.testing.assert_allclose(distort(u, cam.k1, f), d, atol=1e-9)
+        u = undistort(d, k1, f)
+        np.testing.assert_allclose(distort(u, k1, f), d, atol=1e-9)
         # the physical root: |u| below the fold, growing with |d| along each ray
-        assert np.all(np.hypot(*u.T) <= fold_radius(cam.k1, f)[0] * (1 + 1e-12))
-        np.testing.assert_allclose(undistort(distort(u, cam.k1, f), cam.k1, f), u, atol=1e-8)
+        assert np.all(np.hypot(*u.T) <= fold_radius(k1, f)[0] * (1 + 1e-12))
+        np.testing.assert_allclose(undistort(distort(u, k1, f), k1, f), u, atol=1e-8)
         ray = np.linspace(0, 1, 200)[:, None] * d[np.argmax(np.hypot(*d.T))]
-        assert np.all(np.diff(np.hypot(*undistort(ray, cam.k1, f).T)) > 0)
+        assert np.all(np.diff(np.hypot(*undistort(ray, k1, f).T)) > 0)
 
 
 @settings(max_examples=300)
@@ -191,6 +194,8 @@ def test_the_distortion_functions_refuse_their_inputs_by_name(call, message):
     ((500.0, 0.5, 1.0, 640, 480, "0.1"), r"camera: k1: expected a number, got '0.1'"),
     ((math.inf, 0.5, 1.0), r"camera: focal_px: out of range, got inf"),
     ((-500.0, 0.5, 1.0), r"camera: focal_px: out of range, got -500.0"),
+    # 'focal_px: 1e-300' was accepted: locate printed a line 2.3e284 m away
+    ((1e-300, 0.5, 1.0), r"^camera: focal_px: out of range, got 1e-300 \(expected a finite number >= 1 \[px\]\)$"),
     ((500.0, 0.5, math.nan), r"camera: height: out of range, got nan"),
     # a height of 1e308 m was accepted: locate printed a NaN spacing and a numpy warning
     ((500.0, 0.5, 1e308), r"^camera: height: out of range, got 1e\+308 \(expected a length in \(0, 1000\] m\)$"),
