@@ -135,6 +135,10 @@ def test_a_lost_image_keeps_the_previous_positioning(monkeypatch):
 def test_refused_setups():
     with pytest.raises(WmrkitError, match="unstable"):
         follow_line(ROBOT, CAMERA, gain=2.0)
+    with pytest.raises(WmrkitError, match=re.escape("follow-line: gain 0.3 1/s times the start's distance to the "
+                                                    "line and the noise bound on h (0.3 + 1e+09 m) commands up to "
+                                                    "3e+08 m/s across the line, faster than 1000 m/s")):
+        follow_line(ROBOT, CAMERA, noise=(1e9, 0.0))  # it failed in twist_robot, naming neither
     with pytest.raises(WmrkitError, match="does not see the line"):
         follow_line(ROBOT, CAMERA, start=(0.0, 5.0, 0.0))
 
@@ -164,6 +168,8 @@ def test_a_run_renders_a_bounded_number_of_pixels(monkeypatch):
     ((0.0, 0.1, 0.3, 0.0), "speed: expected a finite number > 0, got 0.0"),
     ((0.0, 0.1, 0.3, 2e3), "speed: 2000 m/s is faster than 1000 m/s"),
     ((0.0, "0.1", 0.3, 0.1), "h: expected a finite number, got '0.1'"),
+    # 'follow-line --noise 1e9 0' answered "twist_robot: expected finite speeds ... within 1e+06", naming no option
+    ((0.0, 1e4, 0.3, 0.1), "gain * h: 0.3 1/s x 10000 m commands 3000 m/s across the line, faster than 1000 m/s"),
 ])
 def test_line_following_twist_refuses_its_inputs_by_name(args, message):
     """NaN psi or h and speed = inf gave a twist of NaN; gain = 0 a law without correction."""

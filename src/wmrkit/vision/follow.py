@@ -81,7 +81,8 @@ def line_following_twist(robot: Robot, psi: float, h: float, gain: float, speed:
     ``(speed, -gain h)`` (lateral error ``exp(-gain t)``; the printed ``-a_x h`` is in the thesis's X-right frame
     and has the wrong sign there); :func:`wmrkit.control.points.twist_for_velocity` turns it into the twist the
     robot's fixed wheels admit, with P the robot origin. `psi` [rad] and `h` [m] must be finite, `gain` [1/s] and
-    `speed` [m/s] finite and > 0 (at most ``limits.MAX_SPEED``), else :class:`WmrkitError` names the argument.
+    `speed` [m/s] finite and > 0 (at most ``limits.MAX_SPEED``, as ``gain * |h|``), else :class:`WmrkitError` names
+    the argument.
     """
     for name, value, low in (("psi", psi, -math.inf), ("h", h, -math.inf), ("gain", gain, 0.0),
                              ("speed", speed, 0.0)):
@@ -91,6 +92,9 @@ def line_following_twist(robot: Robot, psi: float, h: float, gain: float, speed:
             raise WmrkitError(f"line_following_twist: {name}: expected {need}, got {value!r}")
     if speed > MAX_SPEED:
         raise WmrkitError(f"line_following_twist: speed: {speed:g} m/s is faster than {MAX_SPEED:g} m/s")
+    if gain * abs(h) > MAX_SPEED:  # the twist's or the wheel rates' bound refused it, naming neither
+        raise WmrkitError(f"line_following_twist: gain * h: {gain:g} 1/s x {h:g} m commands {gain * abs(h):g} m/s "
+                          f"across the line, faster than {MAX_SPEED:g} m/s")
     pose = np.array([0.0, h, -psi])
     v_world = law_velocity(line_following_law(gain), np.zeros(3), np.array([speed, 0.0, 0.0]), pose, np.zeros(3))
     return twist_for_velocity(control_point(robot, (0.0, 0.0)), pose, v_world)
@@ -232,6 +236,10 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     if not np.all(np.abs(pose[0, :2]) <= MAX_COORDINATE):
         raise WmrkitError(f"follow-line: start position ({pose[0, 0]:g}, {pose[0, 1]:g}) m is beyond "
                           f"{MAX_COORDINATE:g} m")
+    if gain * (abs(pose[0, 1]) + noise[0]) > MAX_SPEED:  # the first command: |h| up to the start's plus the noise
+        raise WmrkitError(f"follow-line: gain {gain:g} 1/s times the start's distance to the line and the noise bound "
+                          f"on h ({abs(pose[0, 1]):g} + {noise[0]:g} m) commands up to "
+                          f"{gain * (abs(pose[0, 1]) + noise[0]):g} m/s across the line, faster than {MAX_SPEED:g} m/s")
     measured = np.empty((n_steps, 2))
     twists, rates, steers = np.empty((n_steps, 3)), np.empty((n_steps, len(robot.rate_names))), []
     lost = np.zeros(n_steps, dtype=bool)
