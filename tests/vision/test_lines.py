@@ -126,6 +126,15 @@ def test_road_with_two_lines_and_no_centre_line():
     assert fix.h == pytest.approx(0.3, abs=0.005)
 
 
+def test_a_camera_whose_horizon_is_below_the_far_row_locates_from_rows_that_see_the_ground():
+    """Tilt 85 deg: the horizon is row -47.7 px, above the far row -120 px would see no ground (points there are
+    refused): the far point is taken halfway to the horizon, on the same image line."""
+    cam = Camera(545.0, math.radians(85), 1.42, 640, 480)
+    fix = locate_image(cam, render(cam, (0.0, -0.2, -0.1), Scene(width=0.05)))
+    assert fix.psi == pytest.approx(0.1, abs=1e-3) and fix.h == pytest.approx(-0.2, abs=1e-3)
+    assert fix.lines[0].points[0][1] == pytest.approx(-545.0 / math.tan(math.radians(85)) / 2)
+
+
 def test_blank_image_has_no_lines_and_bad_input_is_refused():
     assert extract_lines(np.full((120, 160), 90, np.uint8)) == ()
     with pytest.raises(WmrkitError, match="expected a grey or BGR image"):

@@ -117,6 +117,17 @@ def test_points_beyond_the_fold_of_the_lens_model_are_refused_by_line():
         locate_points(cam, [(0, [[1.0, -50.0], [3.0, 50.0]]), (1, [[300.0, 200.0], [40.0, 50.0]])], spacing=0.5)
 
 
+def test_points_above_the_horizon_are_refused_by_line():
+    """The chufa camera's horizon is row -135.9 px: points on row -200 see no ground, and a line through them was
+    positioned 13.3 m away at psi = 89 deg, exit 0."""
+    with pytest.raises(CameraError, match=re.escape("points: lines[0]: a point [[300.0, -200.0], [-300.0, -199.0]] "
+                                                    "lies above the horizon (row y_u = -135.9 px")):
+        locate_points(CHUFA_CAMERA, [(0, [[300.0, -200.0], [-300.0, -199.0]])])
+    with pytest.raises(CameraError, match=r"^points: lines\[0\]: a point .* lies above the horizon"):
+        locate_points(CHUFA_CAMERA, [(0, [[4.0, -135.9], [-2.0, 93.0]])])  # 0.02 px above it
+    locate_points(CHUFA_CAMERA, [(0, [[4.0, -135.8], [-2.0, 93.0]])])  # just below it: accepted
+
+
 @pytest.mark.parametrize(("points", "n", "message"), [
     ([[math.nan, 40.0], [-5.0, 80.0]], 0, "points_u: expected finite image coordinates [px], got nan"),
     ([[10.0, 40.0], [-5.0, math.inf]], 0, "points_u: expected finite image coordinates [px], got inf"),

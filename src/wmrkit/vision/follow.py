@@ -50,7 +50,8 @@ def locate_image(camera: Camera, image: ArrayLike, *, spacing: float = 0.0, ns: 
     `ns`: the index n (9.8) of each line expected, left to right in the image; default ``(0,)`` without
     `spacing`, ``(-1, 0, 1)`` with it (crop rows); ``(-1, 1)`` is a road's two lines. Of the lines found (up to
     four more than expected: the chufa camera sees five crop rows), the neighbouring ones centred on the image's
-    near row are used. The points are taken on rows ``+-rows_a`` [px] (default a quarter of the image height).
+    near row are used. The points are taken on rows ``+-rows_a`` [px] (default a quarter of the image height;
+    the far one halfway to the horizon when ``-rows_a`` is above it).
     Raises :class:`WmrkitError` when fewer lines than expected are found.
     """
     ns = ns if ns is not None else ((-1, 0, 1) if spacing > 0 else (0,))
@@ -62,10 +63,11 @@ def locate_image(camera: Camera, image: ArrayLike, *, spacing: float = 0.0, ns: 
     start = min(range(len(found) - len(ns) + 1),
                 key=lambda i: abs(sum(ln.x_at(a) for ln in found[i:i + len(ns)])))
     lines = found[start:start + len(ns)]
-    a = rows_a if rows_a is not None else camera.rows / 4
+    horizon = camera.focal_px / math.tan(camera.tilt)  # rows above -horizon see no ground: the far point is taken
+    far = a if a < horizon else horizon / 2  # below it (any two points of a line give the same position)
     undistorted = replace(camera, k1=0.0)  # the extracted lines are already undistorted
-    return locate_points(undistorted, [(n, ln.points(a)) for n, ln in zip(ns, lines, strict=True)],
-                         spacing=spacing, z_p=z_p)
+    return locate_points(undistorted, [(n, np.array([[ln.x_at(-far), -far], [ln.x_at(a), a]]))
+                                       for n, ln in zip(ns, lines, strict=True)], spacing=spacing, z_p=z_p)
 
 
 def line_following_law(gain: float) -> PositionLaw:

@@ -93,7 +93,8 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
     """Position from ``(n, [[x_u1, y_u1], [x_u2, y_u2]])`` per line (pixels from the image centre, y down).
 
     Points are taken as measured on the camera's (possibly distorted) image and undistorted with ``camera.k1``
-    (exactly, :func:`.camera.undistort`; points beyond the fold of a ``k1 < 0`` model are refused).
+    (exactly, :func:`.camera.undistort`; points beyond the fold of a ``k1 < 0`` model are refused, and so are
+    points at or above the horizon, row ``y_u = -f / tan(tilt)``, where no ground is seen).
     A line with ``n != 0`` needs `spacing` d > 0 [m]; `spacing` and ``|z_p|`` are at most ``limits.MAX_SIZE``.
     The mean psi is taken on the circle.
     """
@@ -105,6 +106,7 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
         raise CameraError(f"spacing: expected a length in [0, {MAX_SIZE:g}] m (0: one line), got {spacing:g}")
     if not abs(z_p) <= MAX_SIZE:
         raise CameraError(f"z_p: expected a length in [-{MAX_SIZE:g}, {MAX_SIZE:g}] m, got {z_p:g}")
+    horizon = -camera.focal_px / math.tan(camera.tilt)  # image row of the horizon [px, y down]
     fixes = []
     for i, (n, pts) in enumerate(lines):
         pts = np.asarray(pts, dtype=float)
@@ -125,6 +127,9 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
             und = undistort(pts, camera.k1, camera.focal_px)
         except CameraError as err:
             raise CameraError(f"points: lines[{i}]: {str(err).removeprefix('undistort: xy_d: ')}") from None
+        if not np.all(und[:, 1] > horizon):  # no ground there: a line through it gave a distance of metres, exit 0
+            raise CameraError(f"points: lines[{i}]: a point {pts.tolist()} lies above the horizon (row y_u = "
+                              f"{horizon:.1f} px for this camera's tilt and focal length), where no ground is seen")
         psi, _, h = line_position(und, n, focal_px=camera.focal_px, tilt=camera.tilt, height=camera.height,
                                   spacing=spacing, z_p=z_p)
         fixes.append(LineFix(int(n), (tuple(pts[0].tolist()), tuple(pts[1].tolist())), float(psi), float(h)))
