@@ -279,3 +279,17 @@ def test_a_broken_image_file_gives_one_line(tmp_path, capfd):
     out, err = capfd.readouterr()
     assert code == 2 and out == "" and err.strip().splitlines() == [
         f"wmrkit: error: {tmp_path / 'broken.png'}: not an image OpenCV can read"]
+
+
+def test_errors_about_an_image_or_a_points_file_name_it(tmp_path, capsys):
+    """'image: found 0 line(s), expected 1' and 'points: lines[0]: ...' named neither the IMAGE nor the file."""
+    cv2.imwrite(str(tmp_path / "black.png"), np.zeros((240, 320), np.uint8))
+    code, _, err = run(["vision", "locate", str(tmp_path / "black.png"), "--camera",
+                        str(FIGURES / "thesis-camera.yaml"), "--json"], capsys)
+    assert code == 2 and json.loads(err) == {"error": "found 0 line(s), expected 1",
+                                             "file": str(tmp_path / "black.png"), "wheel": None, "field": None,
+                                             "line": None}
+    (tmp_path / "p.json").write_text('{"lines": [{"n": 0, "points": [[300, -200], [-300, -199]]}]}')
+    code, _, err = run(["vision", "locate", "--points", str(tmp_path / "p.json"), "--camera",
+                        str(FIGURES / "chufa-camera.yaml")], capsys)
+    assert code == 2 and err.startswith(f"wmrkit: error: {tmp_path / 'p.json'}: lines[0]: a point ")

@@ -6,6 +6,8 @@ from __future__ import annotations
 import argparse
 import math
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -109,6 +111,17 @@ def read_image(path: str) -> np.ndarray:
     return img
 
 
+@contextmanager
+def _naming(path: str, prefix: str) -> Iterator[None]:
+    """Errors about the file's content (messages starting with `prefix`, e.g. "image: found 0 line(s)") name it."""
+    try:
+        yield
+    except WmrkitError as err:
+        if not str(err).startswith(prefix):
+            raise
+        raise WmrkitError(f"{path}: {str(err).removeprefix(prefix)}") from None
+
+
 def run_locate(args: argparse.Namespace) -> int:
     """``wmrkit vision locate``."""
     from ..vision.follow import locate_image
@@ -121,7 +134,8 @@ def run_locate(args: argparse.Namespace) -> int:
         for option, value in (("--lines", args.lines), ("--mode", args.mode)):
             if value is not None:  # it would be ignored
                 raise WmrkitError(f"locate: {option} applies to an IMAGE, not to --points")
-        fix = locate_points(camera, read_points(args.points), spacing=spacing, z_p=z_p)
+        with _naming(args.points, "points: "):
+            fix = locate_points(camera, read_points(args.points), spacing=spacing, z_p=z_p)
     else:
         layouts = {1: (0,), 2: (-1, 1), 3: (-1, 0, 1)}
         if args.lines is not None and args.lines not in layouts:
@@ -135,7 +149,8 @@ def run_locate(args: argparse.Namespace) -> int:
         if image.shape != (camera.rows, camera.width):
             raise WmrkitError(f"{args.image}: {image.shape[1]} x {image.shape[0]} px, the camera file says "
                               f"{camera.width} x {camera.rows}")
-        fix = locate_image(camera, image, spacing=spacing, ns=ns, z_p=z_p, mode=args.mode or "threshold")
+        with _naming(args.image, "image: "):
+            fix = locate_image(camera, image, spacing=spacing, ns=ns, z_p=z_p, mode=args.mode or "threshold")
     if args.json:
         print_json(fix.to_dict())
     else:
