@@ -293,3 +293,13 @@ def test_errors_about_an_image_or_a_points_file_name_it(tmp_path, capsys):
     code, _, err = run(["vision", "locate", "--points", str(tmp_path / "p.json"), "--camera",
                         str(FIGURES / "chufa-camera.yaml")], capsys)
     assert code == 2 and err.startswith(f"wmrkit: error: {tmp_path / 'p.json'}: lines[0]: a point ")
+
+
+def test_calibrate_an_image_of_one_row_gives_one_line(tmp_path, capsys):
+    """OpenCV's resize raised on it: a traceback."""
+    row = np.full((1, 1000), 70, np.uint8)
+    row[0, 100:110] = row[0, 800:810] = 220
+    cv2.imwrite(str(tmp_path / "row.png"), row)
+    code, _, err = run(["vision", "calibrate", str(tmp_path / "row.png"), "--rows", "0.4", "--half-separation", "1",
+                        "--row-distance", "1"], capsys)
+    assert code == 2 and err == f"wmrkit: error: {tmp_path / 'row.png'}: 1000 x 1 px, smaller than 8 px a side\n"

@@ -135,6 +135,20 @@ def test_a_camera_whose_horizon_is_below_the_far_row_locates_from_rows_that_see_
     assert fix.lines[0].points[0][1] == pytest.approx(-545.0 / math.tan(math.radians(85)) / 2)
 
 
+@pytest.mark.parametrize(("image", "options", "message"), [
+    # OpenCV's resize raised on a row wider than 400 px ('vision calibrate' printed its traceback)
+    (np.tile(np.r_[np.full(100, 70), np.full(10, 220)], 10)[None].astype(np.uint8), {},
+     "image: 1100 x 1 px, smaller than 8 px a side"),
+    (np.zeros((240, 320), np.uint8), {"hough_scale": 0.0}, "extract_lines: hough_scale: expected a factor in (0, 1]"),
+    (np.zeros((240, 320), np.uint8), {"hough_scale": 100.0}, "extract_lines: hough_scale: expected a factor"),
+    (np.zeros((240, 320), np.uint8), {"max_angle": math.nan}, "extract_lines: max_angle: expected an angle in"),
+    (np.zeros((240, 320), np.uint8), {"n_lines": 2.5}, "n_lines must be an integer >= 1, got 2.5"),
+])
+def test_extract_lines_refuses_what_opencv_failed_on(image, options, message):
+    with pytest.raises(CameraError, match=re.escape(message)):
+        extract_lines(image, **options)
+
+
 def test_blank_image_has_no_lines_and_bad_input_is_refused():
     assert extract_lines(np.full((120, 160), 90, np.uint8)) == ()
     with pytest.raises(WmrkitError, match="expected a grey or BGR image"):

@@ -182,7 +182,8 @@ def run_calibrate(args: argparse.Namespace) -> int:
         if args.size is not None:  # it would be ignored
             raise WmrkitError("calibrate: --size applies to --x1/--x2 (the camera file of an image has its size)")
         image = read_image(args.image)
-        cal = calibrate_image(image, args.rows, xw, yw)
+        with _naming(args.image, "image: "):
+            cal = calibrate_image(image, args.rows, xw, yw)
         rows, width = image.shape
     if args.out:
         cal.camera(width=width, rows=rows).to_file(args.out)

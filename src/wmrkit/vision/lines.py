@@ -286,22 +286,30 @@ def extract_lines(image: ArrayLike, *, n_lines: int = 1, mode: str = "threshold"
                   mask: np.ndarray | None = None) -> tuple[DetectedLine, ...]:
     """Up to `n_lines` lines of a grey/BGR `image` (§9.2.1.C), sorted left to right; fewer if the image has fewer.
 
-    `max_angle` [rad]: the largest angle from the image's vertical searched; `min_votes`: Hough threshold
+    `image`: at least 8 px a side; `max_angle` [rad]: the largest angle from the image's vertical searched, in
+    ``(0, pi/2]``; `min_votes`: Hough threshold
     (default a fifth of the shorter image side); `min_separation_px`: peaks closer than this (and 3 deg) are
     one line; `k1`, `focal_px`: the lens distortion undone before the fit (module docstring; refused where the
     model folds over inside the image, :func:`.camera.check_lens_image`);
-    `hough_scale`: the Hough transform runs on the mask resized by this factor (default 0.5 for images wider
-    than 400 px, else 1); `mask`: a precomputed :func:`interest_mask`.
+    `hough_scale`: the Hough transform runs on the mask resized by this factor in ``(0, 1]`` (default 0.5 for
+    images wider than 400 px, else 1); `mask`: a precomputed :func:`interest_mask`.
     """
     cv2 = cv2_module()
-    if n_lines < 1:
-        raise CameraError(f"n_lines must be >= 1, got {n_lines}")
+    if isinstance(n_lines, bool) or not isinstance(n_lines, int | np.integer) or n_lines < 1:
+        raise CameraError(f"n_lines must be an integer >= 1, got {n_lines!r}")
+    if not 0 < max_angle <= math.pi / 2:  # NaN included: OpenCV raised its own error
+        raise CameraError(f"extract_lines: max_angle: expected an angle in (0, pi/2] rad, got {max_angle}")
     binary = interest_mask(image, mode) if mask is None else mask
     rows, width = binary.shape
+    if min(rows, width) < 8:  # a camera's least side; OpenCV's resize raised on one row wider than 400 px
+        raise CameraError(f"image: {width} x {rows} px, smaller than 8 px a side")
     f = focal_px if focal_px is not None else float(max(rows, width))
     if k1 != 0:  # every pixel must have one undistorted position (camera.check_lens_image)
         check_lens_image(k1, f, width, rows, "extract_lines")
     scale = hough_scale if hough_scale is not None else (0.5 if width > 400 else 1.0)
+    if not (0 < scale <= 1 and min(rows, width) * scale >= 1):  # > 1: slower, not finer (100 took 9 s)
+        raise CameraError(f"extract_lines: hough_scale: expected a factor in (0, 1] that leaves at least a pixel of "
+                          f"the {width} x {rows} px image, got {scale}")
     run_row, run_first, run_mid, run_len = _runs(binary)
     _check_not_speckle(run_row, rows, width)
     if mode == "threshold":  # wide references vote as thin lines: the middle pixel of each run
