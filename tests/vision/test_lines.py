@@ -149,6 +149,15 @@ def test_extract_lines_refuses_what_opencv_failed_on(image, options, message):
         extract_lines(image, **options)
 
 
+def test_locate_image_refuses_an_image_that_is_not_the_camera_size():
+    """A 420 x 340 px image (the camera's 320 x 240 padded) was positioned about the wrong centre: h = -1.5 mm,
+    psi = 0.5 deg for a robot 0.1 m left of the line at psi = -5.7 deg, no error."""
+    cam = Camera(150.0, math.radians(60), 0.3, 320, 240)
+    img = render(cam, (0.0, 0.1, 0.1), Scene())
+    with pytest.raises(CameraError, match=r"^image: 420 x 340 px, the camera's is 320 x 240$"):
+        locate_image(cam, np.pad(img, 50))
+
+
 def test_blank_image_has_no_lines_and_bad_input_is_refused():
     assert extract_lines(np.full((120, 160), 90, np.uint8)) == ()
     with pytest.raises(WmrkitError, match="expected a grey or BGR image"):

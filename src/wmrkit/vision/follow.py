@@ -34,7 +34,7 @@ from ..limits import MAX_COORDINATE, MAX_SPEED, check_seed
 from ..odometry.integrators import integrate_exact
 from ..robot import Robot
 from ..wheels import wrap_angle
-from .camera import Camera, extrinsics
+from .camera import Camera, CameraError, extrinsics
 from .lines import extract_lines
 from .positioning import Positioning, locate_points
 from .render import Scene, render
@@ -52,9 +52,13 @@ def locate_image(camera: Camera, image: ArrayLike, *, spacing: float = 0.0, ns: 
     four more than expected: the chufa camera sees five crop rows), the neighbouring ones centred on the image's
     near row are used. The points are taken on rows ``+-rows_a`` [px] (default a quarter of the image height;
     the far one halfway to the horizon when ``-rows_a`` is above it).
-    Raises :class:`WmrkitError` when fewer lines than expected are found.
+    Raises :class:`WmrkitError` when fewer lines than expected are found, or the image is not the camera's size.
     """
     ns = ns if ns is not None else ((-1, 0, 1) if spacing > 0 else (0,))
+    shape = np.shape(image)[:2]
+    if shape != (camera.rows, camera.width):  # the camera model's centre and rows: another image was misread
+        raise CameraError(f"image: {' x '.join(map(str, shape[::-1]))} px, the camera's is {camera.width} x "
+                          f"{camera.rows}")
     found = extract_lines(image, n_lines=len(ns) + 4, mode=mode, k1=camera.k1, focal_px=camera.focal_px)
     if len(found) < len(ns):
         raise WmrkitError(f"image: found {len(found)} line(s), expected {len(ns)}")
