@@ -222,6 +222,14 @@ def test_weeds_and_crop_rows_are_not_speckle():
     assert len(extract_lines(img, n_lines=5)) >= 3
 
 
+@pytest.mark.parametrize(("pose", "z_p"), [((0.0, math.nan, 0.0), 0.0), ((0.0, 0.1, math.inf), 0.0),
+                                           ((0.0, 0.1, 0.0), math.nan)])
+def test_render_refuses_a_pose_that_is_not_finite(pose, z_p):
+    """It rendered a blank image (ground only), which reads as 'no line in view'."""
+    with pytest.raises(CameraError, match=r"^render: pose and z_p must be finite"):
+        render(CAMERA, pose, Scene(), z_p=z_p)
+
+
 @pytest.mark.parametrize(("kwargs", "message"), [
     ({"ns": (-1, 0, 1), "spacing": math.nan}, "scene: spacing must be in [0, 1000] m, got nan"),
     ({"ns": (-1, 0, 1), "spacing": -0.5}, "scene: spacing must be in [0, 1000] m, got -0.5"),

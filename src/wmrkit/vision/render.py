@@ -87,6 +87,8 @@ def render(camera: Camera, pose_line_robot: ArrayLike, scene: Scene, *, z_p: flo
                           f"{MAX_BLUR:g}] px, got {noise:g}, {blur:g}")
     if not (isinstance(clutter, int | np.integer) and 0 <= clutter <= MAX_CLUTTER):
         raise CameraError(f"render: clutter must be an integer in [0, {MAX_CLUTTER}] blobs, got {clutter!r}")
+    if not (np.all(np.isfinite(np.asarray(pose_line_robot, dtype=float))) and np.isfinite(z_p)):  # NaN: a blank image
+        raise CameraError(f"render: pose and z_p must be finite, got {pose_line_robot!r}, {z_p!r}")
     rng = np.random.default_rng(seed)
     psi, t = extrinsics(pose_line_robot, camera, z_p)
     ground = ground_from_image(_pixel_grid(camera), psi, camera.tilt, t, camera.focal_px)
