@@ -132,6 +132,14 @@ def test_a_lost_image_keeps_the_previous_positioning(monkeypatch):
     assert abs(run.lateral[-1]) < abs(run.lateral[0])
 
 
+def test_the_run_ends_within_its_duration():
+    """Periods were rounded: 20.3 s ran 20.5 s, and 0.1 s at T = 0.5 s ran no period, its start printed as a result."""
+    assert follow_line(ROBOT, CAMERA, duration=20.3, from_image=False).time[-1] == 20.0
+    assert follow_line(ROBOT, CAMERA, duration=0.5 * 3, period=0.5, from_image=False).time[-1] == 1.5
+    with pytest.raises(WmrkitError, match=re.escape("follow-line: duration 0.1 s is shorter than one period (0.5 s)")):
+        follow_line(ROBOT, CAMERA, duration=0.1)
+
+
 def test_refused_setups():
     with pytest.raises(WmrkitError, match="unstable"):
         follow_line(ROBOT, CAMERA, gain=2.0)

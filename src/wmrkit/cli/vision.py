@@ -58,7 +58,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     f.add_argument("--gain", type=float, default=0.3, metavar="A", help="lateral gain a_x [1/s] (default 0.3)")
     f.add_argument("--speed", default="0.1", metavar="V", help="following speed [m/s] (default 0.1)")
     f.add_argument("--period", type=float, default=0.5, metavar="T", help="control period = image time [s]")
-    f.add_argument("--duration", type=float, default=20.0, metavar="S", help="simulated time [s] (default 20)")
+    f.add_argument("--duration", type=float, default=20.0, metavar="S", help="simulated time [s]: the whole periods "
+                   "within it (default 20)")
     f.add_argument("--start", nargs=2, default=("0.3", "0"), metavar=("H", "THETA"),
                    help="start: distance to the line [m, left positive] and heading [rad, or 'deg'] (default "
                         "0.3 0: the thesis's p(0) = (-0.3 m, 0, 0))")

@@ -200,7 +200,8 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
                 from_image: bool = True) -> LineFollowing:
     """Simulate the vision line follower of §9.2.3 (module docstring).
 
-    `gain` a_x [1/s]; `speed` v_follow [m/s]; `period` T [s]; `start`: pose of P ``(x, y, theta)`` in the line
+    `gain` a_x [1/s]; `speed` v_follow [m/s]; `period` T [s]; `duration` [s]: the whole periods within it (at
+    least one); `start`: pose of P ``(x, y, theta)`` in the line
     frame L (the thesis's p(0) = (-0.3 m, 0, 0) with its X to the right is ``y = +0.3``); `scene`: default one
     painted line 2 cm wide; `noise`: bounds (h [m], psi [rad]) of uniform noise added to each positioning;
     `image_noise`, `blur`, `clutter`: options of the synthetic camera. ``from_image=False`` skips the camera and
@@ -214,8 +215,11 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     if not duration / period <= MAX_PERIODS:
         raise WmrkitError(f"follow-line: duration {duration:g} s at a period of {period:g} s is more than "
                           f"{MAX_PERIODS} periods (one image each)")
-    if from_image and round(duration / period) * camera.width * camera.rows > MAX_RUN_PIXELS:
-        raise WmrkitError(f"follow-line: {round(duration / period)} periods of {camera.width} x {camera.rows} px "
+    n_steps = math.floor(duration / period + 1e-9)  # whole periods within the duration (rounding ran past it)
+    if n_steps < 1:  # no period: the start was printed as the result
+        raise WmrkitError(f"follow-line: duration {duration:g} s is shorter than one period ({period:g} s)")
+    if from_image and n_steps * camera.width * camera.rows > MAX_RUN_PIXELS:
+        raise WmrkitError(f"follow-line: {n_steps} periods of {camera.width} x {camera.rows} px "
                           f"images are more than the {MAX_RUN_PIXELS:.3g} pixels a run renders (docs/limits.md): "
                           "shorten the duration, lengthen the period or use a smaller camera image")
     if not (all(np.isfinite(noise)) and 0 <= noise[0] <= MAX_COORDINATE and 0 <= noise[1] <= np.pi):
@@ -236,7 +240,6 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     actuated = [n for n in robot.rate_names if n.endswith(".spin") and n in robot.actuated] or \
         [n for n in robot.rate_names if n.endswith(".spin")]
     rng = np.random.default_rng(seed)
-    n_steps = round(duration / period)
     pose = np.empty((n_steps + 1, 3))
     pose[0] = as_vectors(start, 3, "start")
     if not np.all(np.abs(pose[0, :2]) <= MAX_COORDINATE):
