@@ -303,3 +303,9 @@ def test_calibrate_an_image_of_one_row_gives_one_line(tmp_path, capsys):
     code, _, err = run(["vision", "calibrate", str(tmp_path / "row.png"), "--rows", "0.4", "--half-separation", "1",
                         "--row-distance", "1"], capsys)
     assert code == 2 and err == f"wmrkit: error: {tmp_path / 'row.png'}: 1000 x 1 px, smaller than 8 px a side\n"
+
+
+def test_an_image_that_is_a_folder_is_called_one(tmp_path, capsys):
+    """'no such image file' was said of a folder that exists."""
+    code, _, err = run(["vision", "locate", str(tmp_path), "--camera", str(FIGURES / "thesis-camera.yaml")], capsys)
+    assert code == 2 and err == f"wmrkit: error: {tmp_path}: a folder; an image is a file\n"

@@ -92,6 +92,8 @@ def read_image(path: str) -> np.ndarray:
         os.environ.setdefault(f"OPENCV_IO_MAX_IMAGE_{side}", str(MAX_PIXELS))
     from ..vision.lines import cv2_module
 
+    if Path(path).is_dir():  # it said 'no such image file' of a folder that exists
+        raise WmrkitError(f"{path}: a folder; an image is a file")
     if not Path(path).is_file():
         raise WmrkitError(f"{path}: no such image file")
     too_large = f"{path}: larger than the {MAX_PIXELS} px a side wmrkit handles (docs/limits.md)"
