@@ -165,6 +165,7 @@ def test_minimal_actuator_sets_are_the_assignable_wheel_rate_sets(ws):
     listed, expected = [s[: len(s) - len(steer)] for s in found], expected if m else []
     assert listed == (expected if found.complete else expected[:len(listed)])  # the first MAX_MINIMAL_SETS
     assert found.complete == (len(listed) == len(expected))
+    assert minimal_sensor_sets(robot) == found  # basic sensing with m rates: the same criterion (B.3.8)
 
 
 def _tree_from_constraints(robot: Robot, joints) -> tuple[bool, bool]:
@@ -219,6 +220,9 @@ def test_a_drive_unit_driven_by_its_two_wheels():
     assert str(rear.verdict).startswith("insufficient actuators: the actuated rates drive the body, but a motion")
     assert ("rear_left.spin",) not in minimal_actuator_sets(agv)
     assert ("unit.spin1", "unit.spin2") in minimal_actuator_sets(agv)
+    rear = sensing_analysis(agv, sensed=["rear_left.spin"])  # the body's twist, but the unit's turn is unknown
+    assert str(rear.tree.leaf) == "determined" and rear.unsensed == 1 and not rear.sufficient
+    assert ("rear_left.spin",) not in minimal_sensor_sets(agv)
     trailer = Robot.from_dict({"name": "unit-and-trailer", "wheels": [
         {"name": "drive", "type": "double", "position": [0.3, 0], "heading": 0, "b": 0.06, "r": 0.08,
          "actuated": ["spin1", "spin2"]},

@@ -31,6 +31,7 @@ from .trees import (
     partitioned_solution,
     reduced_equation,
     select_columns,
+    undriven_motions,
 )
 
 
@@ -158,11 +159,8 @@ class ActuationAnalysis:
     def verdict(self) -> np.ndarray:
         """One sentence per configuration: the tree's verdict, the counts, and missing steering actuators; a body
         driven while a joint motion is not (a double wheel's free turntable) is not called consistent."""
-        free = {"determined": "body only", "overdetermined": "overdetermined, body only"}
-        leaf = np.where(self.undriven > 0, np.vectorize(lambda lf: free.get(lf, lf), otypes=[object])(self.leaf),
-                        self.leaf)
-        return verdict_texts(leaf, _ACTUATION_TEXT, len(self.actuated), self.mobility, self.steering_missing,
-                             "actuated")
+        return verdict_texts(body_only(self.leaf, self.undriven), _ACTUATION_TEXT, len(self.actuated), self.mobility,
+                             self.steering_missing, "actuated")
 
     def inverse(self, twist_robot: ArrayLike) -> np.ndarray:
         """Actuated rates for a (feasible) body twist, (4.26): ``(..., 3) -> (..., n_u)`` [rad/s, m/s]."""
@@ -179,6 +177,13 @@ class ActuationAnalysis:
             "verdict": self.verdict.tolist(),
             "inverse_matrix": self.inverse_matrix.tolist(),
         }
+
+
+def body_only(leaf: np.ndarray, free: np.ndarray) -> np.ndarray:
+    """The leaves of a tree ``(...)``, ``determined`` and ``overdetermined`` marked ``body only`` where `free`
+    ``(...)`` motions of the joints are left with the selected rates at rest: the trees look at the body alone."""
+    marked = {"determined": "body only", "overdetermined": "overdetermined, body only"}
+    return np.where(free > 0, np.vectorize(lambda lf: marked.get(lf, lf), otypes=[object])(leaf), leaf)
 
 
 def verdict_texts(leaf: np.ndarray, texts: dict[str, str], n: int, m: np.ndarray,
@@ -220,15 +225,6 @@ def actuation_analysis(
         readonly(partitioned_solution(j_u, j_nu) @ i_bar),
         readonly(undriven_motions(i_bar1, j_nu1)),
     )
-
-
-def undriven_motions(i_bar: np.ndarray, j_rest: np.ndarray) -> np.ndarray:
-    """How many independent motions the mechanism has with every selected rate at rest: the nullity of ``[I_bar,
-    J_rest]`` (the Jacobian form (3.20) without the selected columns, couplings held). Zero when the selected rates
-    drive everything; a double wheel whose steering turns with the body at rest (4.69: G < m) leaves one where the
-    tree (4.28), which looks at the body alone, says determined. ``(3E, 3), (..., 3E, n) -> (...)`` int."""
-    both = np.concatenate([np.broadcast_to(i_bar, (*j_rest.shape[:-1], 3)), j_rest], axis=-1)
-    return both.shape[-1] - matrix_rank(both)
 
 
 def coupled_constraints(robot: Robot, beta: np.ndarray) -> np.ndarray:

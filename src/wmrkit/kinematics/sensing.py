@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, matvec, readonly
 from ..robot import TWIST_NAMES, Robot
-from .actuation import minimal_set_search, split_jacobian, steering_split, verdict_texts
+from .actuation import body_only, minimal_set_search, split_jacobian, steering_split, verdict_texts
 from .linalg import delta_projector, matrix_rank, nondimensional
 from .models import bounded, configuration
 from .search import SetList
@@ -29,7 +29,7 @@ from .trees import (
     partitioned_solution,
     reduced_equation,
     select_columns,
-    vehicle_dof,
+    undriven_motions,
 )
 
 
@@ -98,6 +98,11 @@ _SENSING_TEXT = {
     "indeterminate": "insufficient sensors: some degrees of freedom are not sensed",
     "underdetermined": "insufficient and redundant sensors: some degrees of freedom are not sensed and some "
                        "sensors sense the same ones",
+    "body only": "insufficient sensors: the sensed rates give the body's twist, but not a motion of the joints with "
+                 "the body at rest (a double wheel turning on the spot, 4.69), so the next configuration is unknown",
+    "overdetermined, body only": "insufficient and redundant sensors: redundant for the body's twist, but a motion "
+                                 "of the joints with the body at rest (a double wheel turning on the spot, 4.69) is "
+                                 "not sensed",
 }
 
 
@@ -115,11 +120,13 @@ class SensingAnalysis:
     full_matrix: np.ndarray  # (..., 3 + n_ns, n_s), (4.31)
     full_names: tuple[str, ...]  # rows of full_matrix: vx, vy, omega, then the non-sensed velocities
     residual_matrix: np.ndarray  # (..., 3E, n_s): least-squares error of (4.31) per sensed rate
+    unsensed: np.ndarray  # (...) int, motions with every sensed rate at rest (.trees.undriven_motions)
 
     @property
     def sufficient(self) -> np.ndarray:
-        """``rank I_s = 3``: the sensed rates determine the twist (sufficient sensors)."""
-        return self.tree.rank_a == 3
+        """``rank I_s = 3`` and no motion left with every sensed rate at rest (a double wheel's turntable, 4.69):
+        the sensed rates determine the twist and how the configuration changes (sufficient sensors)."""
+        return (self.tree.rank_a == 3) & (self.unsensed == 0)
 
     @property
     def slip_detectable(self) -> np.ndarray:
@@ -134,7 +141,8 @@ class SensingAnalysis:
     @property
     def verdict(self) -> np.ndarray:
         """One sentence per configuration: the tree's verdict, the counts, and missing steering sensors."""
-        return verdict_texts(self.leaf, _SENSING_TEXT, len(self.sensed), self.mobility, self.steering_missing, "sensed")
+        return verdict_texts(body_only(self.leaf, self.unsensed), _SENSING_TEXT, len(self.sensed), self.mobility,
+                             self.steering_missing, "sensed")
 
     def twist(self, q_dot_s: ArrayLike) -> np.ndarray:
         """The body twist from sensed rates, (4.32): ``(..., n_s) -> (..., 3)`` [m/s, rad/s]."""
@@ -156,7 +164,8 @@ class SensingAnalysis:
             "sensed": list(self.sensed), "steering_sensed": list(self.steering),
             "steering_not_sensed": list(self.steering_missing), "mobility": self.mobility.tolist(),
             "leaf": self.leaf.tolist(), "sufficient": self.sufficient.tolist(),
-            "slip_detectable": self.slip_detectable.tolist(), "verdict": self.verdict.tolist(),
+            "slip_detectable": self.slip_detectable.tolist(), "unsensed_motions": self.unsensed.tolist(),
+            "verdict": self.verdict.tolist(),
             "direct_matrix": self.direct_matrix.tolist(),
         }
 
@@ -186,6 +195,7 @@ def sensing_analysis(
         readonly(partitioned_solution(i_bar, j_ns) @ j_s), readonly(full),
         TWIST_NAMES + tuple(n for c, n in enumerate(names) if c not in columns),
         readonly(i_ns @ full - j_s),
+        readonly(undriven_motions(i_bar1, j_ns1)),
     )
 
 
@@ -194,20 +204,22 @@ def minimal_sensor_sets(
 ) -> tuple[tuple[str, ...], ...]:
     """The smallest sensor choices that determine the twist at every configuration (Fig. 4.5).
 
-    ``detect_slip=False``: basic sensing (``determined``), G (= m) rates each; ``True``: the smallest sets with
+    ``detect_slip=False``: basic sensing (``determined``), m rates each (G, the body's degrees of freedom, plus
+    one per double wheel, whose turn on the spot (4.69) must be sensed too); ``True``: the smallest sets with
     sufficient *redundant* sensors (``overdetermined``, slip detectable). Each set lists the wheel rates, then
     the ``steer`` joints of the centred steerable wheels (their angle must be sensed, 4.33). Steering: `beta`
     (thesis) or `heading` (0 = rolling forward), default as described.
     """
     beta = configuration(robot, beta, heading)
-    m = np.unique(vehicle_dof(robot, beta))  # G = m unless a double wheel adds a self-motion (4.69)
+    a = nondimensional(robot).constraint_matrix(beta)
+    m = np.unique(a.shape[-1] - matrix_rank(a))
     if len(m) != 1 or m[0] == 0:
         return SetList()
     names, steer = jacobian_names(robot), tuple(f"{w}.steer" for w in steering_split(robot, ()))
     wanted = "overdetermined" if detect_slip else "determined"
     sizes = range(int(m[0]) + 1, len(robot.rate_names) + 1) if detect_slip else (int(m[0]),)
     for size in sizes:  # bounded searches (.search), pruned by the null-space test at size m
-        found = minimal_set_search(robot, beta, size, wanted, "minimal sensor sets")
+        found = minimal_set_search(robot, beta, size, wanted, "minimal sensor sets", drive_all=True)
         if found or not found.complete:
             return SetList([tuple(names[c] for c in s) + steer for s in found], found.complete, found.note)
     return SetList()

@@ -183,6 +183,18 @@ def vehicle_dof(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
 # ---- split of the wheel velocities: actuated/sensed and the rest (§4.4.3-4.4.6) ---------------------------
 
 
+def undriven_motions(i_bar: np.ndarray, j_rest: np.ndarray) -> np.ndarray:
+    """How many independent motions the mechanism has with every selected rate at rest: the nullity of ``[I_bar,
+    J_rest]`` (the Jacobian form (3.20) without the selected columns, couplings held). Zero when the selected rates
+    drive (or sense) everything; a double wheel whose steering turns with the body at rest (4.69: G < m) leaves one
+    where the trees (4.28)/(4.34), which look at the body alone, say determined. ``(3E, 3), (..., 3E, n) -> (...)``
+    int."""
+    both = np.concatenate([np.broadcast_to(i_bar, (*j_rest.shape[:-1], 3)), j_rest], axis=-1)
+    return both.shape[-1] - matrix_rank(both)
+
+
+
+
 def partitioned_solution(j_sel: ArrayLike, j_rest: ArrayLike) -> np.ndarray:
     """The selected part of the least-squares solution of ``y = J_sel q_sel + J_rest q_rest`` (4.25)-(4.26).
 
