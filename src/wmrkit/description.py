@@ -290,14 +290,15 @@ def _check_geometry(type_name: str, v: dict[str, float], check: FieldReader, loc
 
 
 # ---- serialisation ---------------------------------------------------------------------------------------
-def robot_to_dict(robot: Robot) -> dict[str, Any]:
+def robot_to_dict(robot: Robot, *, thesis: bool = False) -> dict[str, Any]:
     """The description mapping of `robot` in SI numbers and radians, its wheels as users write them where that is
-    exact (:func:`_wheel_to_dict`); ``robot_from_dict(robot_to_dict(r)) == r``."""
+    exact (:func:`_wheel_to_dict`), or with `thesis` in the thesis's parameters (``l``, ``alpha``, ``beta``, the
+    fields ``wmrkit batch sweep --vary`` sets); ``robot_from_dict(robot_to_dict(r)) == r`` either way."""
     out: dict[str, Any] = {"name": robot.name}
     if robot.notes:
         out["notes"] = robot.notes
     out |= mass.body_to_dict(robot.body)
-    out["wheels"] = [_wheel_to_dict(w) for w in robot.wheels]
+    out["wheels"] = [_thesis_form(w) if thesis else _wheel_to_dict(w) for w in robot.wheels]
     if robot.odometry is not None:
         from .slip.settings import settings_to_dict
 

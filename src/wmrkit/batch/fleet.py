@@ -245,7 +245,7 @@ def _fingerprint(*parts: Any) -> str:
         if isinstance(x, Robot):
             from ..description import robot_to_dict
 
-            return canonical(robot_to_dict(x))
+            return canonical(robot_to_dict(x, thesis=True))
         if isinstance(x, list | tuple):
             return [canonical(v) for v in x]
         return x

@@ -108,7 +108,7 @@ def variant(robot: Robot, assignments: dict[tuple[int, str], float], *, where: s
     from ..description import robot_from_dict, robot_to_dict
     from ..errors import WmrkitError
 
-    data = copy.deepcopy(robot_to_dict(robot))
+    data = copy.deepcopy(robot_to_dict(robot, thesis=True))  # --vary sets the thesis's fields
     for (i, fld), value in assignments.items():
         data["wheels"][i][fld] = float(value)
     try:
