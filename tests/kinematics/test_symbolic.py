@@ -93,6 +93,18 @@ def test_symbolic_geometry_evaluates_to_the_numeric_matrix(robot):
                                rtol=0, atol=1e-12)
 
 
+def test_symbolic_geometry_gives_every_field_its_own_symbol():
+    """A Swedish wheel 'a' and a wheel 'r_a': the roller radius of one and the radius of the other were both the
+    symbol r_r_a, one parameter in the closed forms (their numbers substituted into one symbol, the other lost)."""
+    robot = Robot("two", (Wheel("a", "swedish", 0.3, 0.0, 0.0, 0.05, gamma=0.7, r_r=0.01),
+                          Wheel("r_a", "fixed", 0.3, math.pi, 0.0, 0.08)))
+    g = geometry_symbols(robot)
+    assert len(set(g.values())) == len(g) and g["r_a.r"].name == "r_r_a" and g["a.r_r"].name == "rr_a"
+    values = {sym: getattr(robot.wheel(key.split(".")[0]), key.split(".")[1]) for key, sym in g.items()}
+    a = symbolic_constraint_matrix(robot, geometry="symbolic").xreplace(values)
+    np.testing.assert_allclose(np.array(a.evalf(), dtype=float), robot.constraint_matrix(), rtol=0, atol=1e-12)
+
+
 def test_catalog_forklift_entries_are_exact():
     """Positions [-1, +-0.45], [-2.35, 0] and r = 0.23 appear as exact rationals (3.11), beta 90 deg as pi/2."""
     from wmrkit import catalog

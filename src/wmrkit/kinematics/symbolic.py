@@ -50,12 +50,17 @@ def velocity_symbols(robot: Robot) -> tuple[sp.Symbol, ...]:
 
 
 def geometry_symbols(robot: Robot) -> dict[str, sp.Symbol]:
-    """``{"wheel.field": symbol}`` for every geometric field of every wheel: ``l_<wheel>``, ``alpha_<wheel>``..."""
-    out = {}
+    """``{"wheel.field": symbol}`` for every geometric field of every wheel: ``l_<wheel>``, ``alpha_<wheel>``...
+
+    A roller radius is ``r_r_<wheel>``, or ``rr_<wheel>`` where a wheel named ``r_<wheel>`` gives its radius that
+    name (equal names would be one sympy symbol: two parameters merged into one).
+    """
+    names, out = {w.name for w in robot.wheels}, {}
     for w in robot.wheels:
         for f in geometry_fields(w):
             assumptions = {"positive": True} if f in ("r", "r_r", "b") else {"real": True}
-            out[f"{w.name}.{f}"] = sp.Symbol(f"{f}_{w.name}", **assumptions)
+            prefix = "rr" if f == "r_r" and f"r_{w.name}" in names else f
+            out[f"{w.name}.{f}"] = sp.Symbol(f"{prefix}_{w.name}", **assumptions)
     return out
 
 
