@@ -206,6 +206,8 @@ def test_identifiers_and_errors(tmp_path):
     assert identifier("double") == "double_"
     with pytest.raises(CodegenError, match="lang: expected 'c' or 'python', got 'rust'"):
         write_code(ROBOTS["forklift"], "rust", tmp_path)
+    with pytest.raises(CodegenError, match=r"sensed: expected a sequence of names, got the string 'steer\.spin'"):
+        write_code(ROBOTS["forklift"], "python", tmp_path, sensed="steer.spin")  # said "no velocity 's'"
     with pytest.raises(CodegenError, match="'vx' is a body velocity"):
         write_code(ROBOTS["forklift"], "python", tmp_path, sensed=["vx"])
     with pytest.raises(SingularError, match=r"the sensed rates \(fl.spin, fr.spin\) do not determine"):

@@ -367,6 +367,8 @@ def test_errors_name_the_culprit():
         tri(["vz"])
     with pytest.raises(AssignmentError, match="'vy' listed twice"):
         tri(["vy", "vy"])
+    with pytest.raises(AssignmentError, match="expected a sequence of names, got the string 'vy'"):  # was 'v'
+        tri("vy")
     with pytest.raises(UnknownNameError, match="wheel 'w1' \\(fixed\\) has no geometric field 'd'"):
         symbolic_model(TRICYCLE, ["vy"], geometry={"w1.d": l12})
     with pytest.raises(AssignmentError, match="strings are never parsed"):

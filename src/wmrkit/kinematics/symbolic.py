@@ -169,6 +169,8 @@ def symbolic_model(
     whose unknowns couple more than `max_lsq_angles` steering symbols (:data:`MAX_LSQ_ANGLES`) is refused at once
     with :class:`ClosedFormTooLargeError` (the derivation grows about fourfold per angle).
     """
+    if isinstance(assigned, str):  # tuple("vx") would read ('v', 'x')
+        raise AssignmentError(f"assigned: expected a sequence of names, got the string '{assigned}'")
     names = tuple(assigned)
     for n in names:
         robot.velocity_index(n)
