@@ -186,6 +186,12 @@ def test_c_forward_reports_a_singular_configuration(tmp_path):
     assert np.isnan(tw).all() and math.isnan(res.value)
     assert forward(_ptr(np.ones(3)), _ptr(np.array([0.0, 1.0, 2.0])), _ptr(tw), None) == 0
     assert np.isfinite(tw).all()
+    # a NaN or inf sensor value or heading: -1 and NaN, not 0 with a NaN twist a controller would take as valid
+    for sensed, heading in [([1.0, math.nan, 1.0], [0.0, 1.0, 2.0]), ([1.0, math.inf, 1.0], [0.0, 1.0, 2.0]),
+                            ([1.0, 1.0, 1.0], [0.0, math.nan, 2.0]), ([1.0, 1.0, 1.0], [0.0, math.inf, 2.0])]:
+        tw[:] = 0.0
+        assert forward(_ptr(np.array(sensed)), _ptr(np.array(heading)), _ptr(tw), ctypes.byref(res)) == -1
+        assert np.isnan(tw).all() and math.isnan(res.value)
 
 
 def test_names_that_are_no_identifiers_or_break_comments(tmp_path):
