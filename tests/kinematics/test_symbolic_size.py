@@ -62,3 +62,29 @@ def test_format_and_cli_print_why_a_model_is_not_derived(tmp_path, capsys):
     path.write_text(yaml.safe_dump(data))
     assert main(["kinematics", str(path), "--symbolic"]) == 0
     assert "not derived: robot 'castors6'" in capsys.readouterr().out
+
+
+def test_five_omni_wheels_give_their_direct_model_in_seconds():
+    """Five omni wheels at 72 deg (sensed spins): sin(2 pi/5) came in as the nested root sqrt(5/8 + sqrt(5)/8),
+    which no polynomial generator covers, so the least-squares direct model fell back to sympy expressions and
+    `kinematics --symbolic` ran for minutes (stopped at 2 min). Nested roots are now floats taken exactly, as sin
+    and cos of an angle that is no simple multiple of pi; the form still equals numeric least squares (4.11)."""
+    import numpy as np
+    import sympy as sp
+
+    from wmrkit.kinematics.linalg import solve_assigned
+    from wmrkit.kinematics.symbolic import symbolic_constraint_matrix
+
+    robot = Robot.from_dict({"name": "omni5", "wheels": [
+        {"name": f"o{i}", "type": "swedish", "l": 0.2, "alpha": f"{72 * i} deg", "beta": f"{72 * i} deg",
+         "gamma": "90 deg", "r": 0.05, "r_r": 0.01, "sensed": ["spin"]} for i in range(5)]})
+    nested = [p for p in symbolic_constraint_matrix(robot).atoms(sp.Pow) if not p.base.is_Rational]
+    assert not nested, nested
+    start = time.perf_counter()
+    model = symbolic_model(robot, sensed_rates(robot))
+    assert time.perf_counter() - start < 20
+    cols = [robot.velocity_index(n) for n in model.assigned]
+    q = np.random.default_rng(0).normal(size=len(cols))
+    expected = solve_assigned(robot.constraint_matrix(), cols, q)[0]
+    got = np.array(model.matrix.evalf(), dtype=float) @ q
+    np.testing.assert_allclose(got, expected[[robot.velocity_index(n) for n in model.solved]], rtol=1e-9, atol=1e-12)

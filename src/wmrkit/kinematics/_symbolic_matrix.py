@@ -142,11 +142,15 @@ def _constants(e: sp.Expr) -> sp.Expr:
     """sin/cos of a number that is no simple multiple of pi (a fixed axle at 0.3 rad) -> its float, exactly.
 
     ``cos(pi/18)`` stays; ``cos(3/10)`` would be one more variable of the rational-function field for nothing.
+    A nested root (``sin(2 pi/5) = sqrt(5/8 + sqrt(5)/8)``) becomes its float too: no generator covers it.
     """
     table = {}
     for atom in e.atoms(sp.sin, sp.cos):
         arg = atom.args[0]
         if not arg.free_symbols and not (arg / sp.pi).is_Rational:
+            table[atom] = exact_number(float(atom), "length")
+    for atom in e.atoms(sp.Pow):  # a nested root (sin(2 pi/5)): no generator, the algebra would fall back to EX
+        if not atom.free_symbols and atom.exp.is_Rational and not atom.base.is_Rational:
             table[atom] = exact_number(float(atom), "length")
     return e.xreplace(table) if table else e
 
