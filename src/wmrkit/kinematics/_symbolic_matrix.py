@@ -139,15 +139,15 @@ def _place(l: float, alpha: float, given: dict[str, sp.Expr]) -> tuple[sp.Expr, 
 
 
 def _constants(e: sp.Expr) -> sp.Expr:
-    """sin/cos of a number that is no simple multiple of pi (a fixed axle at 0.3 rad) -> its float, exactly.
+    """sin/cos of a number that sympy leaves unevaluated (a fixed axle at 0.3 rad or 52 deg) -> its float, exactly.
 
-    ``cos(pi/18)`` stays; ``cos(3/10)`` would be one more variable of the rational-function field for nothing.
+    ``sin(pi/6) = 1/2`` and ``cos(pi/4) = sqrt(2)/2`` are exact already; ``cos(3/10)`` or ``cos(13 pi/45)`` would
+    be two more variables of the rational-function field each (eight Swedish wheels at odd angles: minutes).
     A nested root (``sin(2 pi/5) = sqrt(5/8 + sqrt(5)/8)``) becomes its float too: no generator covers it.
     """
     table = {}
     for atom in e.atoms(sp.sin, sp.cos):
-        arg = atom.args[0]
-        if not arg.free_symbols and not (arg / sp.pi).is_Rational:
+        if not atom.args[0].free_symbols:
             table[atom] = exact_number(float(atom), "length")
     for atom in e.atoms(sp.Pow):  # a nested root (sin(2 pi/5)): no generator, the algebra would fall back to EX
         if not atom.free_symbols and atom.exp.is_Rational and not atom.base.is_Rational:
