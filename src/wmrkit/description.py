@@ -184,8 +184,8 @@ def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc) -> Wheel:
     if len(loc) == 2 and isinstance(loc[1], int):
         check.wheels[loc[1]:] = [name]
     if not WHEEL_NAME.fullmatch(name):
-        check.fail(f"wheel names are letters, digits, '_' and '-' (they name velocities 'wheel.joint'), got {name!r}",
-                   (*loc, "name"))
+        check.fail("wheel names are ASCII letters, digits, '_' and '-', starting with a letter or '_' (they name "
+                   f"velocities 'wheel.joint'), got {name!r}", (*loc, "name"))
     allowed = COMMON_WHEEL_FIELDS + kind.required + tuple(kind.optional)
     for key in item:
         if key not in allowed and key in ALL_WHEEL_FIELDS:
