@@ -347,6 +347,9 @@ def test_431_needs_the_transposed_product_and_sufficient_sensors():
     i_ns = np.concatenate([i_bar, -j[:, [2, 3, 4, 5]]], axis=1)  # sensors phi1, phi2
     assert i_ns.shape == (9, 7) and matrix_rank(i_ns @ i_ns.T) == 7 < 9
     assert matrix_rank(i_ns.T @ i_ns) == 7
+    # wmrkit's (4.31) is the least-squares solution with (I_ns^T I_ns)^-1 (the printed order cannot be inverted)
+    expected = np.linalg.solve(i_ns.T @ i_ns, i_ns.T @ j[:, [0, 1]])
+    np.testing.assert_allclose(sensed_full_matrix(TRI, ["w1.spin", "w2.spin"]), expected, atol=1e-12)
     none_sensed = np.concatenate([i_bar, -j], axis=1)
     assert none_sensed.shape == (9, 9) and matrix_rank(none_sensed) == 8
     assert not bool(sensing_analysis(TRI, sensed=[]).sufficient)
