@@ -104,6 +104,10 @@ def test_fig_6_4_differential_with_swedish_design_conditions(seed):
     b3 = brentq(lambda b: l12 * c(b) - l3 * c(b - a3), *_bracket(lambda b: l12 * c(b) - l3 * c(b - a3)))
     assert is_singular(differential(l12=l12, l3=l3, alpha3=a3, beta3=b3), None, ("f1.spin", "s3.spin"))
     assert not is_singular(differential(l12=l12, l3=l3, alpha3=a3, beta3=b3 + 0.3), None, ("f1.spin", "s3.spin"))
+    # (phi_s3, omega), not drawn (errata "Fig. 6.4 omits the omega-assigned sets"): singular iff cos(beta3) = 0
+    for b3 in (np.pi / 2, -np.pi / 2):
+        assert is_singular(differential(l12=l12, l3=l3, alpha3=a3, beta3=b3), None, ("s3.spin", "omega"))
+    assert not is_singular(differential(l12=l12, l3=l3, alpha3=a3, beta3=np.pi / 2 + 0.3), None, ("s3.spin", "omega"))
 
 
 def _bracket(f):
