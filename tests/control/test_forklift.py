@@ -8,7 +8,7 @@ import warnings
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from wmrkit import catalog
@@ -32,6 +32,8 @@ def _thesis_rows(beta3):
 
 @settings(max_examples=60, deadline=None)
 @given(vx=st.floats(-2, 2), vy=st.floats(-2, 2), theta=st.floats(-math.pi, math.pi), quadrants=st.sampled_from([2, 4]))
+@example(vx=1.0, vy=0.0, theta=0.0, quadrants=2)  # R v_y = 0: sign(R v_y) of (8.51) undefined (docs/errata.md)
+@example(vx=-1.0, vy=0.0, theta=0.0, quadrants=2)
 def test_ik_zeroes_the_wheel_equations(vx, vy, theta, quadrants):
     """Both rows of (3.11) vanish for every wheel at the IK's omega, spins and beta3 (4- and 2-quadrant)."""
     c, s = math.cos(theta), math.sin(theta)
