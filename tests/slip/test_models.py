@@ -30,9 +30,9 @@ def closed_form(u1, u2, beta3, k11, k12):
                      dl - (c * L3 * cb / (2 * b * L12**2)) * g / den], axis=-1)
 
 
-def matrix_form(u1, u2, beta3, k11, k12):
+def matrix_form(u1, u2, beta3, k11, k12, mx=1.0):
     """(7.65)-(7.66) literally: A_mu_na, A_mu_a and one 3x3 inverse (thesis frame, phi_dot = -u / r)."""
-    mx, my, m3 = 1.0, k11, k12
+    my, m3 = k11 * mx, k12 * mx
     cb, sb = np.cos(beta3), np.sin(beta3)
     ana = np.array([[np.sqrt(2 * mx), 0, 0], [0, np.sqrt(my), np.sqrt(my) * L12], [0, np.sqrt(my), -np.sqrt(my) * L12],
                     [np.sqrt(m3) * cb, np.sqrt(m3) * sb, np.sqrt(m3) * L3 * cb]])
@@ -41,23 +41,26 @@ def matrix_form(u1, u2, beta3, k11, k12):
     return -np.linalg.solve(ana.T @ ana, ana.T @ aa @ phi)
 
 
-def forklift_wls(u1, u2, beta3, k11, k12):
+def forklift_wls(u1, u2, beta3, k11, k12, mx=1.0):
     robot = forklift_at_axle()
-    w = SlipWeights.of({"right_drive": (1.0, k11), "left_drive": (1.0, k11), "steer": (k12, 1.0)})
+    w = SlipWeights.of({"right_drive": (mx, k11 * mx), "left_drive": (mx, k11 * mx), "steer": (k12 * mx, mx)})
     # thesis beta3 (axle angle, 0 = straight) is the catalog's beta (axle +90 deg: straight) minus 90 deg;
     # the spin of the steered wheel is free, so the axle's sign does not matter
     return wls(robot, SPINS, np.stack([u1, u2], -1) / R, np.asarray(beta3)[..., None] + np.pi / 2, w)
 
 
 @settings(max_examples=60, deadline=None)
-@given(st.floats(-5, 5), st.floats(-5, 5), st.floats(-1.5, 1.5), st.floats(-3, 2), st.floats(-3, 2))
-def test_general_wls_is_the_forklift_closed_form(u1, u2, beta3, lk11, lk12):
-    """(7.65)-(7.67) as a test of the general solver: the same twist for any speeds, steering and weights."""
+@given(st.floats(-5, 5), st.floats(-5, 5), st.floats(-1.5, 1.5), st.floats(-3, 2), st.floats(-3, 2),
+       st.sampled_from([1.0, 0.05, 20.0]))
+def test_general_wls_is_the_forklift_closed_form(u1, u2, beta3, lk11, lk12, mx):
+    """(7.65)-(7.67) as a test of the general solver: the same twist for any speeds, steering and weights. The
+    scale mu_x12 = mx != 1 tells the merged row sqrt(2 mu_x12) from the printed sqrt(2) mu_x12 (docs/errata.md)."""
     k11, k12 = 10.0**lk11, 10.0**lk12
-    got = forklift_wls(u1, u2, beta3, k11, k12).twist
+    got = forklift_wls(u1, u2, beta3, k11, k12, mx).twist
     want = thesis_twist_to_rep(closed_form(u1, u2, beta3, k11, k12))
     assert np.allclose(got, want, atol=1e-9 * (1 + abs(u1) + abs(u2)))
-    assert np.allclose(thesis_twist_to_rep(matrix_form(u1, u2, beta3, k11, k12)), want, atol=1e-9 * (1 + abs(u1)))
+    assert np.allclose(thesis_twist_to_rep(matrix_form(u1, u2, beta3, k11, k12, mx)), want,
+                       atol=1e-9 * (1 + abs(u1)))
 
 
 def test_spec_oracles_and_consistent_inputs():
