@@ -74,6 +74,16 @@ def test_gated_feedforward_switches_off_beyond_the_gate():
     np.testing.assert_allclose(far, [0.6, 0, 0])
 
 
+@pytest.mark.parametrize(("gate", "final"), [(0.15, 0.2), (0.25, 0.0)])
+def test_a_gate_below_v_over_a_never_switches_the_feedforward_on(gate, final):
+    """(8.53) qualified (docs/errata.md): closed, the gate leaves the point-to-point lag v / a = 0.2 m; a gate d_max
+    below it is never reached and the error stays there, one above it lets the feedforward take the error to 0."""
+    run = track(catalog.load("mecanum-4"), builtin_reference("line", speed=0.4), controller="p", gain=2.0, gate=gate,
+                duration=8.0, initial_pose=[0.0, 1.0, 0.0])
+    assert run.error[0] == pytest.approx(1.0)
+    assert run.error[-1] == pytest.approx(final, abs=1e-5)
+
+
 def _lateral(a, period, n=40, delay=1):
     robot = catalog.load("mecanum-4")
     ref = builtin_reference("line", duration=n * period + 1)
