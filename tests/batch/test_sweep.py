@@ -227,3 +227,17 @@ def test_the_table_says_which_metric_it_holds_and_the_units(tmp_path):
         "robot": "omni-3", "metric": "inv_kappa_mean", "better": "higher"}
     units = {f.name: f.metadata[b"unit"].decode() for f in schema if f.metadata}
     assert units == {"wheels[0].alpha": "rad", "wheels[1].l": "m", "metric": "1", "length": "m"}
+
+
+def test_heading_is_swept_as_users_write_it():
+    """--vary wheels.X.heading (0 = straight ahead) moves the same designs as the thesis's beta 90 deg higher, and
+    cannot be swept with that wheel's beta."""
+    robot = catalog.load("thesis-omni-swedish")
+    by_heading = sweep(robot, [parse_vary("wheels[0].heading=-60deg:30deg:4", robot)], "inv_kappa_mean", top=4)
+    by_beta = sweep(robot, [parse_vary("wheels[0].beta=30deg:120deg:4", robot)], "inv_kappa_mean", top=4)
+    assert [b["inv_kappa_mean"] for b in by_heading.best] == pytest.approx(
+        [b["inv_kappa_mean"] for b in by_beta.best], rel=1e-12)
+    assert parse_vary("wheels[0].heading=-60deg:30deg:4", robot).unit == "rad"
+    with pytest.raises(BatchError, match="move the same field"):
+        build_spec(robot, [parse_vary("wheels[0].heading=0:1:2", robot), parse_vary("wheels[0].beta=0:1:2", robot)],
+                   "inv_kappa_mean")

@@ -1,8 +1,8 @@
 """Design sweeps, the kernel: an isotropy or singularity metric over the cartesian product of description fields.
 
-``--vary wheels.front_left.l=0.2:0.4:21`` (or ``wheels[0].alpha=30deg:60deg:7``; several targets joined by
-commas move together) gives an axis; the product of the axes is flattened and cut into chunks, a Dask array
-``map_blocks`` over the flat indices; each chunk is evaluated vectorised. Metrics (thesis ch. 5-6):
+``--vary wheels.front_left.l=0.2:0.4:21`` (or ``wheels[0].alpha=30deg:60deg:7``, ``wheels.left.heading=...``;
+several targets joined by commas move together) gives an axis; the product of the axes is flattened and cut into
+chunks, a Dask array ``map_blocks`` over the flat indices; each chunk is evaluated vectorised. Metrics (thesis ch. 5-6):
 
 - ``kappa_mean`` / ``kappa_max``: the condition number (5.28) of the actuated joint rates over the admissible
   twists (:func:`wmrkit.analysis.isotropy.twist_condition_number`), mean / max over steering configurations
@@ -48,6 +48,11 @@ _TARGET = re.compile(r"^wheels(?:\.([A-Za-z_][A-Za-z0-9_-]*)|\[(\d+)\])\.([a-z_]
 MAX_POINTS, MAX_DESIGNS, MAX_MAP, MAX_CONFIGS = 10**6, 10**9, 10**7, 10**4
 
 
+#: The fields a --vary may move: the description's geometry fields, and ``heading`` (the users' steering angle,
+#: 0 = straight ahead) in place of the thesis's ``beta``.
+VARY_FIELDS = {**GEOMETRY_FIELDS, "heading": "angle"}
+
+
 @dataclass(frozen=True, eq=False)  # eq=False: array field
 class Axis:
     """One swept quantity: ``targets`` ``((wheel index, field), ...)`` moved together through ``values`` (SI)."""
@@ -59,7 +64,7 @@ class Axis:
     @property
     def unit(self) -> str:
         """Unit of the values: ``"rad"`` for the angle fields, ``"m"`` for the lengths."""
-        return "rad" if GEOMETRY_FIELDS[self.targets[0][1]] == "angle" else "m"
+        return "rad" if VARY_FIELDS[self.targets[0][1]] == "angle" else "m"
 
 
 def parse_vary(text: str, robot: Robot) -> Axis:
@@ -82,10 +87,10 @@ def parse_vary(text: str, robot: Robot) -> Axis:
         i = names.index(name) if name is not None else int(index)
         if i >= len(names):
             raise BatchError(f"--vary {text}: wheel index {i} out of range (the robot has {len(names)} wheels)")
-        if fld not in GEOMETRY_FIELDS:
-            raise BatchError(f"--vary {text}: '{fld}' is not a geometry field ({', '.join(GEOMETRY_FIELDS)})")
+        if fld not in VARY_FIELDS:
+            raise BatchError(f"--vary {text}: '{fld}' is not a geometry field ({', '.join(VARY_FIELDS)})")
         targets.append((i, fld))
-        kinds.add(GEOMETRY_FIELDS[fld])
+        kinds.add(VARY_FIELDS[fld])
     if len(kinds) != 1:
         raise BatchError(f"--vary {text}: fields moved together must share a unit (lengths or angles)")
     try:
@@ -108,8 +113,10 @@ def variant(robot: Robot, assignments: dict[tuple[int, str], float], *, where: s
     from ..description import robot_from_dict, robot_to_dict
     from ..errors import WmrkitError
 
-    data = copy.deepcopy(robot_to_dict(robot, thesis=True))  # --vary sets the thesis's fields
+    data = copy.deepcopy(robot_to_dict(robot, thesis=True))  # --vary sets the thesis's fields, or heading for beta
     for (i, fld), value in assignments.items():
+        if fld == "heading":
+            data["wheels"][i].pop("beta", None)
         data["wheels"][i][fld] = float(value)
     try:
         return robot_from_dict(data, source=where)
@@ -157,8 +164,9 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
         raise BatchError(f"--configs must be in [1, {MAX_CONFIGS}] (a whole number), got {configs!r}")
     check_seed(seed, BatchError)  # -1 and 2.5 reached numpy's ValueError and TypeError
     targets = [t for a in axes for t in a.targets]
-    if len(set(targets)) != len(targets):
-        raise BatchError("two --vary axes move the same field (one would overwrite the other)")
+    if len(set(targets)) != len(targets) or any((i, "beta") in targets for i, f in targets if f == "heading"):
+        raise BatchError("two --vary axes move the same field (one would overwrite the other; heading is beta - 90 "
+                         "deg)")
     shape = [len(a.values) for a in axes]
     if math.prod(shape[:2]) > MAX_MAP or math.prod(shape) > MAX_DESIGNS:
         raise BatchError(f"{' x '.join(map(str, shape))} designs: at most {MAX_DESIGNS:.0e} designs, and "

@@ -86,7 +86,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = commands.add_parser("sweep", help="a design metric over a product of description fields (Dask)")
     add_robot_argument(p)
     p.add_argument("--vary", action="append", required=True, metavar="FIELD=START:STOP:N",
-                   help="wheels.NAME.FIELD or wheels[I].FIELD (comma-join fields moved together); units allowed")
+                   help="wheels.NAME.FIELD or wheels[I].FIELD: a geometry field of the description or heading "
+                        "(0 = straight ahead); comma-join fields moved together; units allowed")
     p.add_argument("--metric", choices=("kappa_mean", "kappa_max", "inv_kappa_mean", "singular_margin"),
                    default="kappa_mean", help="design metric (default kappa_mean; see docs/batch.md)")
     p.add_argument("--length", metavar="D", help="characteristic length [m] (default: each design's natural one)")
