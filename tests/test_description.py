@@ -593,3 +593,7 @@ def test_a_parameter_no_users_number_gives_back_is_saved_as_the_thesis_wrote_it(
     assert wheel["beta"] == math.radians(20) and "heading" not in wheel
     assert wheel["position"] == [0.0, 0.5] and "l" not in wheel
     assert Robot.from_dict(robot.to_dict()) == robot
+    import sympy
+
+    symbolic = Robot("s", (Wheel("a", "fixed", l=sympy.Symbol("l"), alpha=0.0, beta=0.0, r=0.1),))
+    assert symbolic.to_dict()["wheels"][0]["l"] == sympy.Symbol("l")  # no numbers to round: as they are

@@ -316,6 +316,8 @@ def _wheel_to_dict(w: Wheel) -> dict[str, Any]:
     """The wheel as users write it where that reads back to exactly this wheel (:func:`_users_form`), else in the
     thesis's parameters."""
     thesis = _thesis_form(w)
+    if any(hasattr(getattr(w, k), "free_symbols") for k in ("l", "alpha", "beta", "delta")):
+        return thesis  # symbolic parameters (wmrkit.kinematics.symbolic): no numbers to round
     users = _users_form(w, thesis)
     return users if _reads_back(users) == w else thesis
 
