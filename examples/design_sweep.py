@@ -44,7 +44,7 @@ plot_sweep(result, out_dir / "sweep-omni-3.png")
 
 def design(alpha: float, back_l: float) -> Robot:
     """omni-3 with wheel 0 at angle alpha (its beta too) and the back wheel at distance back_l, from its description."""
-    data = omni.to_dict()
+    data = omni.to_dict(thesis=True)  # the thesis's l, alpha, beta, which the sweep varies
     data["wheels"][0].update(alpha=alpha, beta=alpha)
     next(w for w in data["wheels"] if w["name"] == "back")["l"] = back_l
     return Robot.from_dict(data, source="design")

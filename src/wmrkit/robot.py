@@ -259,11 +259,12 @@ class Robot:
 
         return robot_from_dict(data, source=source)
 
-    def to_dict(self) -> dict[str, Any]:
-        """The description mapping; ``Robot.from_dict(r.to_dict()) == r``."""
+    def to_dict(self, *, thesis: bool = False) -> dict[str, Any]:
+        """The description mapping, wheels as users write them (``position``, ``heading``) where exact, or with
+        `thesis` in the thesis's ``l``, ``alpha``, ``beta``; ``Robot.from_dict(r.to_dict()) == r``."""
         from .description import robot_to_dict
 
-        return robot_to_dict(self)
+        return robot_to_dict(self, thesis=thesis)
 
     @classmethod
     def from_file(cls, path: str | os.PathLike[str]) -> Robot:
