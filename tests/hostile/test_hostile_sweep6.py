@@ -266,3 +266,23 @@ def test_an_empty_argument_is_refused_by_name(argv, name, capsys):
 def test_an_empty_output_name_is_refused_by_name(argv, capsys):
     option = _option(argv)
     assert _one_line([*argv, ""], capsys) == f"wmrkit: error: {option}: empty value\n"
+
+
+@pytest.mark.parametrize(("robot", "vary", "field", "value"), [
+    ("omni-3", "wheels.back.l=150mm:250mm:3", "l", 0.25),  # the fuzzer's ground and docs/batch.md's sweep
+    ("omni-3", "wheels[0].alpha,wheels[0].beta=30deg:90deg:3", "beta", np.pi / 2),
+    ("mecanum-4", "wheels[0].gamma=30deg:60deg:3", "gamma", np.pi / 3),
+])
+def test_a_sweep_varies_wheels_saved_in_the_users_form(robot, vary, field, value):
+    """Descriptions are saved with position, heading and type mecanum: a sweep of l, alpha, beta or gamma set the
+    thesis's field beside them and every design was refused ("give either 'position' or 'l' and 'alpha'")."""
+    from wmrkit.batch.sweep_kernel import parse_vary, variant
+
+    base = catalog.load(robot)
+    axis = parse_vary(vary, base)
+    design = variant(base, {t: axis.values[-1] for t in axis.targets})
+    i = axis.targets[0][0]
+    assert getattr(design.wheels[i], field) == pytest.approx(value)
+    for j, w in enumerate(base.wheels):
+        if j != i:
+            assert design.wheels[j] == w
