@@ -207,6 +207,9 @@ def test_a_negative_delay_is_refused_by_every_loop(loop, capsys):
      "more than 50000 control periods with slip-model commands"),
     (["track", "skid-steer-4", "--reference", "circle", "--dynamics", "--period", "0.1", "--duration", "60000"],
      "more than 5e+07 integration steps"),
+    # 285,665 samples: 940 MB and 8 s; 1e5 Hz raised numpy's MemoryError after a minute (3.6 GiB for one array)
+    (["batch", "montecarlo", "diff-drive", "--path", "square", "-n", "2", "--workers", "0", "--rate", "10000"],
+     "a run at most 134217728 (1 GiB): a rate of at most 9035 Hz"),
 ])
 def test_options_that_ran_unbounded_or_were_ignored_are_refused(argv, expected, capsys):
     assert expected in _one_line(argv, capsys)
@@ -286,3 +289,17 @@ def test_a_sweep_varies_wheels_saved_in_the_users_form(robot, vary, field, value
     for j, w in enumerate(base.wheels):
         if j != i:
             assert design.wheels[j] == w
+
+
+def test_a_synthetic_run_holds_at_most_a_gib_of_fine_arrays():
+    """simulate's fine arrays grew with rate x duration x the robot's size: 1e7 samples (its documented limit) of the
+    diff-drive would have taken 27 GB. The bound is in numbers, so a larger robot gets a lower rate."""
+    from wmrkit.odometry.synthetic import MAX_FINE_VALUES, TwistProfile, fine_step_values, simulate
+
+    profile = TwistProfile(np.array([0.01]), np.array([[0.5, 0.0, 0.0]]))
+    for name in ("diff-drive", "swerve-4"):
+        robot = catalog.load(name)
+        top = MAX_FINE_VALUES / (fine_step_values(robot) * 8 * 0.01)
+        assert len(simulate(robot, profile, 0.01 * top).log) > 100  # just inside: 'batch montecarlo --rate 9000'
+        with pytest.raises(WmrkitError, match=rf"'{name}' holds up to \d+ numbers a fine step .* a rate of at most"):
+            simulate(robot, profile, 1.01 * top)

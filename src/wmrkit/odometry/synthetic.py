@@ -130,6 +130,15 @@ class SyntheticRun:
 MAX_SAMPLES = 10**7
 #: Most fine steps (sample periods times `oversample`): each holds a few rows of every joint, about 1 kB.
 MAX_FINE_STEPS = 10**8
+#: Most numbers in the fine arrays of a run (2^27, 1 GiB): a fine step holds the solution and residual maps of its
+#: configuration and its increments, at most :func:`fine_step_values` numbers (1.1e6 samples of the diff-drive took
+#: 3.1 GB and 30 s, 1e7 samples would have taken 27 GB).
+MAX_FINE_VALUES = 1 << 27
+
+
+def fine_step_values(robot: Robot) -> int:
+    """An upper bound of the numbers one fine step of `robot` holds in :func:`simulate` (:data:`MAX_FINE_VALUES`)."""
+    return (len(robot.steer_names) + 4) * (len(robot.velocity_names) + 2 * len(robot.wheels))
 
 
 def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLike = (0.0, 0.0, 0.0),
@@ -151,6 +160,11 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     if profile.duration * rate * oversample > MAX_FINE_STEPS:  # the fine arrays: 15 TiB at oversample = 1e9
         raise WmrkitError(f"oversample {oversample} at {rate:g} Hz over {profile.duration:g} s: at most "
                           f"{MAX_FINE_STEPS:.0e} fine steps (sample periods times oversample)")
+    values = fine_step_values(robot) * oversample * profile.duration
+    if rate * values > MAX_FINE_VALUES:
+        raise WmrkitError(f"rate {rate:g} Hz over the profile's {profile.duration:g} s: robot '{robot.name}' holds up "
+                          f"to {fine_step_values(robot)} numbers a fine step ({oversample} a sample), a run at most "
+                          f"{MAX_FINE_VALUES} (1 GiB): a rate of at most {MAX_FINE_VALUES / values:.4g} Hz")
     n = math.ceil(profile.duration * rate - 1e-9) + 1  # the whole profile: a log never stops short of its end
     t_samples = np.arange(n) / rate
     if t_samples[-1] > profile.duration:  # the robot rests from the profile's end to the last sample
