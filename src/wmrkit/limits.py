@@ -25,8 +25,8 @@ MAX_FILE_SIZE = 1 << 18
 #: Largest coordinate of a position in a trajectory or reference file [m] (beyond it differences of positions lose
 #: their precision and squares overflow).
 MAX_COORDINATE = 1e9
-#: Largest file read whole into memory [bytes]: trajectories (TUM, CSV), references, torque files. Joint logs are
-#: read in chunks and have no such limit.
+#: Largest file read whole into memory [bytes]: trajectories (TUM, CSV), references, torque files, the log of a Monte
+#: Carlo study. The joint logs of odometry are read in chunks and have no such limit.
 MAX_TABLE_SIZE = 1 << 26
 #: Most samples of a joint log read at once (``chunk_size``): the chunks bound the memory of a log of any length.
 MAX_CHUNK = 1 << 22

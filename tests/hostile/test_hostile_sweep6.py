@@ -303,3 +303,24 @@ def test_a_synthetic_run_holds_at_most_a_gib_of_fine_arrays():
         assert len(simulate(robot, profile, 0.01 * top).log) > 100  # just inside: 'batch montecarlo --rate 9000'
         with pytest.raises(WmrkitError, match=rf"'{name}' holds up to \d+ numbers a fine step .* a rate of at most"):
             simulate(robot, profile, 1.01 * top)
+
+
+def test_a_monte_carlo_study_is_bounded_in_memory_and_work():
+    """A LOG of 3e6 samples took 850 MB for two runs, and 10^6 runs of it would have run for days."""
+    from wmrkit.batch.engine import BatchError
+    from wmrkit.batch.montecarlo import MAX_LOG_VALUES, MAX_RUNS, MAX_WORK, monte_carlo
+    from wmrkit.odometry.logs import JointLog
+
+    robot = catalog.load("diff-drive")
+
+    def log(n):
+        t = np.arange(n) * 0.01
+        return JointLog(t, ("left.spin", "right.spin"), np.column_stack([t, 1.001 * t]))
+
+    n = MAX_LOG_VALUES // 5 + 1
+    with pytest.raises(BatchError, match=rf"log: {n} samples of 2 joints: a Monte Carlo log holds at most"):
+        monte_carlo(robot, log(n), 2)
+    n = int(MAX_WORK // (5 * MAX_RUNS)) + 1
+    with pytest.raises(BatchError, match=rf"runs: {MAX_RUNS} runs of {n} samples .* at most 999500 runs of this log"):
+        monte_carlo(robot, log(n), MAX_RUNS)
+    assert monte_carlo(robot, log(n), 3).runs == 3

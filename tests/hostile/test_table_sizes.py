@@ -1,5 +1,6 @@
-"""Files read whole (trajectories, references, torque files) are refused above ``limits.MAX_TABLE_SIZE`` bytes,
-naming the file, before they are read: bounded memory (joint logs stream and have no such limit)."""
+"""Files read whole (trajectories, references, torque files, a Monte Carlo LOG) are refused above
+``limits.MAX_TABLE_SIZE`` bytes, naming the file, before they are read: bounded memory (the joint logs of odometry
+stream and have no such limit)."""
 
 from __future__ import annotations
 
@@ -56,7 +57,8 @@ def test_files_at_the_limit_are_read_and_larger_ones_refused(files, monkeypatch)
 
 @pytest.mark.parametrize("argv", [["simulate", "forklift", "--torques", "{torques}"],
                                   ["track", "diff-drive", "--reference", "{tum}"],
-                                  ["calibrate", "skid-steer-4", "{log}", "--reference", "{tum}"]])
+                                  ["calibrate", "skid-steer-4", "{log}", "--reference", "{tum}"],
+                                  ["batch", "montecarlo", "skid-steer-4", "{log}", "-n", "2", "--workers", "0"]])
 def test_the_commands_refuse_them_in_one_line(files, monkeypatch, argv):
     monkeypatch.setattr(limits, "MAX_TABLE_SIZE", 10)
     err = io.StringIO()

@@ -138,6 +138,12 @@ def path_log(robot: Robot, name: str, rate: float = 20.0) -> JointLog:
 
 #: Most runs of one Monte Carlo study (each integrates the whole log once).
 MAX_RUNS = 10**6
+#: Most numbers in the log, samples x (joints + 3): each run holds a few arrays of its size (a log of 3e6 samples of
+#: two joints took 850 MB for two runs).
+MAX_LOG_VALUES = 1 << 23
+#: Most numbers integrated by a study, runs x samples x (joints + 3), about 3e7 a second on one core: 5 min (10^6
+#: runs of a log of 1.7e6 samples would have run for days).
+MAX_WORK = 1e10
 
 
 def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4, resolution: float = 0.0,
@@ -156,6 +162,14 @@ def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4
         raise BatchError(f"noise must be in [0, 1] (per rad), resolution in [0, pi] rad and slip in [0, 1] (the "
                          f"standard deviation of a slip ratio), got {per_rad:g}, {resolution:g}, {slip_std:g}")
     check_seed(seed, BatchError)
+    values = len(log) * (len(log.joints) + 3)
+    if values > MAX_LOG_VALUES:
+        raise BatchError(f"log: {len(log)} samples of {len(log.joints)} joints: a Monte Carlo log holds at most "
+                         f"{MAX_LOG_VALUES} numbers, samples x (joints + 3) (docs/limits.md); decimate or cut it")
+    if runs * values > MAX_WORK:
+        raise BatchError(f"runs: {runs} runs of {len(log)} samples of {len(log.joints)} joints: a study integrates at "
+                         f"most {MAX_WORK:g} numbers, runs x samples x (joints + 3), about 5 min on one core: at most "
+                         f"{int(MAX_WORK // values)} runs of this log")
     nominal = odometry(robot, log, method=method, noise=JointNoise(per_rad, resolution**2 / 6))
     sizes = [min(block, runs - s) for s in range(0, runs, block)]
     seeds = np.random.SeedSequence(seed).spawn(len(sizes))

@@ -217,9 +217,11 @@ def run_montecarlo(args: argparse.Namespace) -> int:
     if args.log is not None and Path(args.log).exists() and not Path(args.log).is_file():  # a FIFO: read forever
         raise WmrkitError(f"{args.log}: not a regular file (a folder, FIFO or device); LOG is a CSV log")
     if args.log is not None:  # read as its header says, as 'wmrkit odometry' reads it
+        from ..limits import check_table_size
         from ..odometry.header import header_format
         from ..odometry.logs import load_csv
 
+        check_table_size(args.log, WmrkitError, "Monte Carlo log")  # read whole, before monte_carlo's bounds
         log = load_csv(args.log, model.joints, header_format(args.log, robot.name, model.joints), robot=robot)
     else:
         rate = 20.0 if args.rate is None else args.rate
