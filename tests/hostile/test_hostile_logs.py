@@ -144,3 +144,18 @@ def test_reading_a_bag_without_the_bags_extra_names_the_extra(monkeypatch, tmp_p
         bag_message_count(tmp_path, "/joint_states")
     with pytest.raises(WmrkitError, match=r"pip install 'wmrkit\[bags\]'"):
         list(read_joint_states(tmp_path, JOINTS))
+
+
+@pytest.mark.parametrize("chunk_size", [2, 64])
+def test_max_gap_names_the_first_gap(tmp_path, chunk_size):
+    """The largest step was named: a 1 s gap at line 4 was reported at a later, longer one (and, of equal steps, at
+    whichever rounding made longest)."""
+    from wmrkit.odometry.logs import LogFormat
+
+    rows = _valid_log(12).splitlines(keepends=True)
+    times = [0.0, 0.05, 1.05, 1.1, 1.15, 4.15, 4.2, 4.25, 4.3, 4.35, 4.4]
+    text = rows[0] + "".join(f"{t!r}," + r.split(",", 1)[1] for t, r in zip(times, rows[1:], strict=False))
+    path = tmp_path / "gaps.csv"
+    path.write_text(text)
+    with pytest.raises(WmrkitError, match=r"gaps\.csv:4: time step of 1 s exceeds max_gap = 0\.5 s"):
+        odometry_file(ROBOT, path, fmt=LogFormat(max_gap=0.5), chunk_size=chunk_size)

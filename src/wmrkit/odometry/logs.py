@@ -261,8 +261,9 @@ def check_time(log: JointLog, time: np.ndarray, previous: float | None, max_gap:
         what = "repeats the previous sample (a zero time step)" if dt[bad[0]] == 0 else "goes backwards"
         raise LogError(f"{log.where(i)}: time {float(time[i])!r} s {what}; time must increase strictly")
     if max_gap is not None and dt.size and dt.max() > max_gap:
-        i = int(np.argmax(dt)) + 1 - shift
-        raise LogError(f"{log.where(i)}: time step of {dt.max():.6g} s exceeds max_gap = {max_gap:g} s (a gap)")
+        k = int(np.argmax(dt > max_gap))  # the first gap (the largest was named: of equal steps, a rounding's)
+        raise LogError(f"{log.where(k + 1 - shift)}: time step of {dt[k]:.6g} s exceeds max_gap = {max_gap:g} s "
+                       "(a gap)")
 
 
 def check_jumps(log: JointLog, positions: np.ndarray, previous: np.ndarray | None, time: np.ndarray,
