@@ -169,3 +169,21 @@ def test_noise_and_covariances_that_cannot_be_are_refused_by_name():
         odometry(robot, log, noise=CrowleyNoise(), initial_covariance=[[1, 5, 0], [0, 1, 0], [0, 0, 1]])
     assert np.isfinite(odometry(robot, log, noise=CrowleyNoise(), initial_covariance=np.eye(3) * 1e-4)
                        .covariance).all()
+
+
+def test_non_finite_poses_and_increments_are_refused_by_name():
+    """NaN or infinite poses or increments went through as NaN covariances (step() refused them already)."""
+    poses, inc = np.zeros((3, 3)), np.full((2, 3), 0.1)
+    q = np.tile(np.eye(3) * 1e-3, (2, 1, 1))
+    bad_poses, bad_inc = poses.copy(), inc.copy()
+    bad_poses[1, 0], bad_inc[0, 2] = np.nan, np.inf
+    with pytest.raises(WmrkitError, match="poses_world_robot: expected finite numbers, got nan"):
+        propagate_covariance(bad_poses, inc, q)
+    with pytest.raises(WmrkitError, match="increments_robot: expected finite numbers, got inf"):
+        propagate_covariance(poses, bad_inc, q)
+    with pytest.raises(WmrkitError, match="pose_world_robot: expected finite numbers"):
+        step_jacobians([0.0, 0.0, np.nan], [1.0, 0.0, 0.0])
+    with pytest.raises(WmrkitError, match="increments_robot: expected finite numbers"):
+        CrowleyNoise().increment_covariance([np.nan, 0.0, 0.0])
+    with pytest.raises(WmrkitError, match="delta_d: expected finite numbers"):
+        CrowleyNoise().input_covariance(np.nan, 0.0)

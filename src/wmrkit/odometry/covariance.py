@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
 from ..errors import WmrkitError
-from .integrators import HEADING_FRACTION, Method, check_method, sinc, sinc_derivative
+from .integrators import HEADING_FRACTION, Method, _finite, check_method, sinc, sinc_derivative
 
 
 @dataclass(frozen=True, slots=True)
@@ -41,7 +41,8 @@ class CrowleyNoise:
 
     def input_covariance(self, delta_d: ArrayLike, delta_theta: ArrayLike) -> np.ndarray:
         """Covariance of ``U = (dD, dtheta)``, 003 eqs. (15)-(17): ``(...), (...) -> (..., 2, 2)``."""
-        dd, dth = np.broadcast_arrays(np.abs(np.asarray(delta_d, float)), np.abs(np.asarray(delta_theta, float)))
+        dd, dth = np.broadcast_arrays(np.abs(_finite(np.asarray(delta_d, float), "delta_d")),
+                                      np.abs(_finite(np.asarray(delta_theta, float), "delta_theta")))
         q = np.zeros((*dd.shape, 2, 2))
         q[..., 0, 0] = self.k_d * dd
         q[..., 1, 1] = self.k_dtheta * dd + self.k_theta * dth
@@ -54,7 +55,7 @@ class CrowleyNoise:
         length of the body displacement), ``K_Dtheta |dD| + K_theta |dtheta|`` on the heading, no cross terms.
         For a differential drive (``dy = 0``) this is exactly (17) on ``(dD, dtheta)``.
         """
-        inc = as_vectors(increments_robot, 3, "increments_robot")
+        inc = _finite(as_vectors(increments_robot, 3, "increments_robot"), "increments_robot")
         dd = np.hypot(inc[..., 0], inc[..., 1])
         safe = np.where(dd > 0, dd, 1.0)
         u = inc[..., :2] / safe[..., None]
@@ -131,8 +132,13 @@ def step_jacobians(pose_world_robot: ArrayLike, increment_robot: ArrayLike,
     take columns 0 and 2 of ``J_pose_increment``.
     """
     check_method(method)
-    pose = as_vectors(pose_world_robot, 3, "pose_world_robot")
-    inc = as_vectors(increment_robot, 3, "increment_robot")
+    pose = _finite(as_vectors(pose_world_robot, 3, "pose_world_robot"), "pose_world_robot")
+    inc = _finite(as_vectors(increment_robot, 3, "increment_robot"), "increment_robot")
+    return _step_jacobians(pose, inc, method)
+
+
+def _step_jacobians(pose: np.ndarray, inc: np.ndarray, method: Method) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`step_jacobians` on arrays already checked."""
     batch = np.broadcast_shapes(pose.shape[:-1], inc.shape[:-1])
     frac, dth = HEADING_FRACTION[method], inc[..., 2]
     head = pose[..., 2] + frac * dth
@@ -170,6 +176,7 @@ def propagate_covariance(poses_world_robot: ArrayLike, increments_robot: ArrayLi
     if poses.shape != (n + 1, 3) or inc.shape != (n, 3) or q.shape != (n, 3, 3):
         raise WmrkitError(f"propagate_covariance: expected shapes (N + 1, 3), (N, 3), (N, 3, 3); got {poses.shape}, "
                           f"{inc.shape}, {q.shape}")
+    _finite(poses, "poses_world_robot"), _finite(inc, "increments_robot")
     p0 = np.zeros((3, 3)) if initial is None else check_covariance(initial, "initial")
     if not (np.isfinite(q).all() and (np.diagonal(q, axis1=-2, axis2=-1) >= 0).all()
             and np.abs(q - np.swapaxes(q, -1, -2)).max(initial=0.0) <= 1e-9 * np.abs(q).max(initial=0.0)):
@@ -181,7 +188,7 @@ def propagate_checked(poses: np.ndarray, inc: np.ndarray, q: np.ndarray, method:
                       p0: np.ndarray) -> np.ndarray:
     """:func:`propagate_covariance` on arrays already checked (the pipeline's own, chunk after chunk: its
     overflows are located where they happen, not refused as input)."""
-    _, g = step_jacobians(poses[:-1], inc, method)
+    _, g = _step_jacobians(poses[:-1], inc, method)
     c = np.concatenate([p0[None], g @ q @ np.swapaxes(g, -1, -2)])  # C_0 = P_0, C_k = G Q G^T
     rel = poses[:, :2] - poses[0, :2]
     b = np.stack([-rel[:, 1], rel[:, 0]], axis=-1)  # J p_k, 2-D part of (-y, x, 0)
