@@ -171,6 +171,16 @@ def test_noise_and_covariances_that_cannot_be_are_refused_by_name():
                        .covariance).all()
 
 
+def test_initial_covariance_without_noise_is_refused():
+    """odometry(..., initial_covariance=P0) without a noise model returned no covariance, P0 silently ignored."""
+    from wmrkit.odometry.covariance import NoiseError
+
+    robot = catalog.load("diff-drive")
+    log = simulate(robot, square_path(1.0), 10.0).log
+    with pytest.raises(NoiseError, match="initial_covariance: needs a noise model"):
+        odometry(robot, log, initial_covariance=np.eye(3) * 1e-4)
+
+
 def test_non_finite_poses_and_increments_are_refused_by_name():
     """NaN or infinite poses or increments went through as NaN covariances (step() refused them already)."""
     poses, inc = np.zeros((3, 3)), np.full((2, 3), 0.1)

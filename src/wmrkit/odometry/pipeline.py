@@ -24,7 +24,7 @@ from ..errors import WmrkitError
 from ..limits import MAX_COORDINATE, check_chunk_size
 from ..robot import Robot
 from ..units import MAX_ANGLE, MAX_TURNS
-from .covariance import CrowleyNoise, JointNoise, check_covariance, propagate_checked
+from .covariance import CrowleyNoise, JointNoise, NoiseError, check_covariance, propagate_checked
 from .integrators import HEADING_FRACTION, Method, check_method
 from .logs import JointLog, LogError, check_time
 from .model import ModelIncrements, OdometryModel, kernel_maps, odometry_model, wrap_angle
@@ -291,13 +291,16 @@ def _validate(chunk: JointLog, prev: JointLog | None, *, positions: bool = True)
 
 
 def _check_inputs(pose: np.ndarray, noise: Noise | None, initial_covariance: ArrayLike | None) -> None:
-    """Refuse a non-finite start pose and a bad initial covariance (noise models check their coefficients when
-    made)."""
+    """Refuse a non-finite start pose and a bad initial covariance, or one without a noise model (noise models
+    check their coefficients when made)."""
     if not np.isfinite(pose).all():
         raise LogError(f"pose0: must be finite, got {pose.tolist()}")
     if np.abs(pose[:2]).max() > MAX_COORDINATE:
         raise LogError(f"pose0: a position beyond {MAX_COORDINATE:g} m, got {pose[:2].tolist()}")
     if initial_covariance is not None:
+        if noise is None:
+            raise NoiseError("initial_covariance: needs a noise model (noise=...); without one no covariance is "
+                             "propagated and it would be ignored")
         check_covariance(initial_covariance, "initial_covariance")
 
 
