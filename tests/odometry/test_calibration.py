@@ -252,6 +252,27 @@ def test_calibration_errors():
         apply_parameters(catalog.load("bicycle"), ["rear.l"], [0.1])  # the rear wheel is at the origin
 
 
+def test_references_samples_and_heading_weight_that_cannot_be_are_refused_by_name():
+    """A NaN reference or heading weight reached the solver ("Residuals are not finite in the initial point"),
+    an `at` past the log an IndexError, too few `at` a broadcasting error, and negative `at` counted from the end."""
+    robot = catalog.load("diff-drive")
+    run = simulate(robot, square_path(1.0), 10.0)
+    bad = run.truth.copy()
+    bad[5, 0] = np.nan
+    with pytest.raises(WmrkitError, match=r"CalibrationRun\.reference: expected finite poses .* NaN or infinite"):
+        CalibrationRun(run.log, bad)
+    with pytest.raises(WmrkitError, match=r"CalibrationRun\.reference: expected finite poses \(M, 3\), got shape"):
+        CalibrationRun(run.log, run.truth[:, :2])
+    three = run.truth[-3:]
+    for at in ([10**6, 1, 2], [-1, -2, -3], [1, 2], [0.5, 1.5, 2.5]):
+        with pytest.raises(WmrkitError, match=r"CalibrationRun\.at: expected 3 sample indices"):
+            CalibrationRun(run.log, three, np.array(at))
+    good = CalibrationRun(run.log, run.truth)
+    for weight in (float("nan"), -1.0):
+        with pytest.raises(WmrkitError, match="heading_weight must be finite and >= 0"):
+            calibrate(robot, [good], ["left.r"], heading_weight=weight)
+
+
 def test_calibration_section_of_the_odometry_page_runs():
     """The Python example of docs/odometry.md's calibration section prints what its comments say."""
     import contextlib

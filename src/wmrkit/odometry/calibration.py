@@ -80,6 +80,22 @@ class CalibrationRun:
     pose0: tuple[float, float, float] | None = None
     closed: bool = False
 
+    def __post_init__(self) -> None:
+        """Refuse references that are not finite poses ``(M, 3)`` and samples ``at`` that are not indices of the
+        log, one per reference pose (they reached the solver as NaN residuals or numpy index errors)."""
+        ref = np.asarray(self.reference, dtype=float)
+        shaped = ref.ndim in (1, 2) and ref.size > 0 and ref.shape[-1] == 3
+        if not (shaped and np.isfinite(ref).all()):
+            raise WmrkitError(f"CalibrationRun.reference: expected finite poses (M, 3), got shape {ref.shape}"
+                              + (" with NaN or infinite values" if shaped else ""))
+        if self.at is not None:
+            at = np.asarray(self.at).reshape(-1)
+            n = len(self.log)
+            if (at.shape != (ref.size // 3,) or not np.issubdtype(at.dtype, np.integer)
+                    or not ((at >= 0) & (at < n)).all()):
+                raise WmrkitError(f"CalibrationRun.at: expected {ref.size // 3} sample indices (one per reference "
+                                  f"pose), integers in [0, {n}), got {at.tolist()}")
+
     @classmethod
     def closed_path(cls, log: JointLog) -> CalibrationRun:
         """A run that ends where it started: the last sample's pose is the start pose, the origin."""
@@ -318,6 +334,8 @@ def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence
     """
     if not runs:
         raise WmrkitError("calibrate: no runs")
+    if not (np.isfinite(heading_weight) and heading_weight >= 0):
+        raise WmrkitError(f"calibrate: heading_weight must be finite and >= 0 [m/rad], got {heading_weight!r}")
     groups = _groups(robot, parameters)
     problem = CalibrationProblem(robot, tuple(parameters), tuple(runs), method, heading_weight,
                                  None if sensed is None else tuple(sensed), weights, run_weights)
