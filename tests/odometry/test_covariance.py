@@ -181,6 +181,17 @@ def test_initial_covariance_without_noise_is_refused():
         odometry(robot, log, initial_covariance=np.eye(3) * 1e-4)
 
 
+@pytest.mark.parametrize("noise", [CrowleyNoise, "crowley", (0.001, 0.003, 0.001)])
+def test_a_noise_that_is_no_noise_model_is_refused(noise):
+    """The class instead of an instance failed with a misleading shape error, a string with an AttributeError."""
+    from wmrkit.odometry.covariance import NoiseError
+
+    robot = catalog.load("diff-drive")
+    log = simulate(robot, square_path(1.0), 10.0).log
+    with pytest.raises(NoiseError, match="noise: expected a CrowleyNoise or JointNoise instance"):
+        odometry(robot, log, noise=noise)
+
+
 def test_non_finite_poses_and_increments_are_refused_by_name():
     """NaN or infinite poses or increments went through as NaN covariances (step() refused them already)."""
     poses, inc = np.zeros((3, 3)), np.full((2, 3), 0.1)

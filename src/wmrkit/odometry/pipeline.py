@@ -291,12 +291,14 @@ def _validate(chunk: JointLog, prev: JointLog | None, *, positions: bool = True)
 
 
 def _check_inputs(pose: np.ndarray, noise: Noise | None, initial_covariance: ArrayLike | None) -> None:
-    """Refuse a non-finite start pose and a bad initial covariance, or one without a noise model (noise models
-    check their coefficients when made)."""
+    """Refuse a non-finite start pose, a noise that is no noise model, and a bad initial covariance or one without
+    a noise model (noise models check their coefficients when made)."""
     if not np.isfinite(pose).all():
         raise LogError(f"pose0: must be finite, got {pose.tolist()}")
     if np.abs(pose[:2]).max() > MAX_COORDINATE:
         raise LogError(f"pose0: a position beyond {MAX_COORDINATE:g} m, got {pose[:2].tolist()}")
+    if noise is not None and not isinstance(noise, CrowleyNoise | JointNoise):
+        raise NoiseError(f"noise: expected a CrowleyNoise or JointNoise instance, got {noise!r}")
     if initial_covariance is not None:
         if noise is None:
             raise NoiseError("initial_covariance: needs a noise model (noise=...); without one no covariance is "
