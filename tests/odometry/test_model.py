@@ -217,6 +217,16 @@ def test_sensing_errors_name_the_problem():
         odometry_model(catalog.load("forklift")).increments(np.zeros((3, 2)))
 
 
+def test_one_sensed_joint_as_a_string_and_weights_that_are_not_numbers():
+    """sensed="left.spin" was split into letters ("no wheel 'l'"), a weight "1" failed with a TypeError."""
+    diff = catalog.load("diff-drive")
+    with pytest.raises(SensingError, match=r"the sensed joints of robot 'diff-drive' \(left\.spin\) do not determine"):
+        odometry_model(diff, "left.spin")
+    for bad in ("1", None, True):
+        with pytest.raises(SensingError, match=f"weight of wheel 'left' must be a finite number > 0, got {bad}"):
+            odometry_model(diff, weights={"left": bad})
+
+
 def test_row_weights_give_the_weighted_least_squares():
     """Against numpy's lstsq on the weighted rows (an independent solver): min || W A q || with dq assigned."""
     robot = catalog.load("forklift")

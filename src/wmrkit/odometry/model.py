@@ -321,19 +321,19 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
                    weights: Mapping[str, float] | None = None) -> OdometryModel:
     """The sensed direct model of `robot` over samples (ranks method, eqs. (4.9)-(4.11); module docstring).
 
-    `sensed`: joints ``wheel.joint`` the log provides (default ``robot.sensed``). `weights`: wheel name -> weight
-    > 0 of its constraint rows in the least squares (default 1): how much that wheel's no-slip equations are
-    trusted, the weighting idea of the thesis's WLS estimator (§7.4.4). A small weight on the forklift's steered
-    wheel, whose angle is coarsely quantised, gives nearly the drive wheels' differential odometry while its
-    residual still reports the disagreement. The residual is always the unweighted ``A dq``. Raises
-    :class:`SensingError` when the joints cannot give the motion, :class:`UnknownNameError` for a name the robot
-    lacks.
+    `sensed`: joints ``wheel.joint`` the log provides (default ``robot.sensed``; one string is one joint).
+    `weights`: wheel name -> weight > 0 of its constraint rows in the least squares (default 1): how much that
+    wheel's no-slip equations are trusted, the weighting idea of the thesis's WLS estimator (§7.4.4). A small
+    weight on the forklift's steered wheel, whose angle is coarsely quantised, gives nearly the drive wheels'
+    differential odometry while its residual still reports the disagreement. The residual is always the
+    unweighted ``A dq``. Raises :class:`SensingError` when the joints cannot give the motion,
+    :class:`UnknownNameError` for a name the robot lacks.
     """
-    sensed = tuple(robot.sensed if sensed is None else sensed)
+    sensed = tuple(robot.sensed if sensed is None else (sensed,) if isinstance(sensed, str) else sensed)
     weights = dict(weights or {})
     for name, w in weights.items():
         robot.wheel(name)
-        if not (w > 0 and np.isfinite(w)):
+        if not (isinstance(w, int | float | np.number) and not isinstance(w, bool) and w > 0 and np.isfinite(w)):
             raise SensingError(f"weight of wheel '{name}' must be a finite number > 0, got {w}")
     for name in sensed:
         wheel_name, _, joint = name.partition(".")
