@@ -217,6 +217,19 @@ def test_sensing_errors_name_the_problem():
         odometry_model(catalog.load("forklift")).increments(np.zeros((3, 2)))
 
 
+def test_non_finite_joint_data_is_refused_by_name():
+    """NaN or infinite joint increments, positions or steering angles gave NaN body increments silently."""
+    diff, fork = odometry_model(catalog.load("diff-drive")), odometry_model(catalog.load("forklift"))
+    with pytest.raises(WmrkitError, match="rate_increments: expected finite numbers, got nan"):
+        diff.increments(np.array([[np.nan, 1.0]]))
+    with pytest.raises(WmrkitError, match="positions: expected finite numbers, got inf"):
+        diff.from_positions(np.array([[0.0, 0.0], [np.inf, 1.0]]))
+    with pytest.raises(WmrkitError, match="previous: expected finite numbers"):
+        diff.from_positions(np.array([[0.0, 0.0]]), previous=[np.nan, 0.0])
+    with pytest.raises(WmrkitError, match="beta_mid: expected finite numbers"):
+        fork.increments(np.zeros((1, len(fork.rate_joints))), np.full((1, len(fork.steer_joints)), np.nan))
+
+
 def test_one_sensed_joint_as_a_string_and_weights_that_are_not_numbers():
     """sensed="left.spin" was split into letters ("no wheel 'l'"), a weight "1" failed with a TypeError."""
     diff = catalog.load("diff-drive")

@@ -29,6 +29,7 @@ from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import matrix_rank, solve_assigned
 from ..robot import Robot
 from ..wheels import heading_from_beta
+from .integrators import _finite
 
 #: Steering configurations whose maps a model keeps; a chunk with more new ones (continuous steering) starts afresh.
 CACHE_SIZE = 1 << 14
@@ -224,6 +225,7 @@ class OdometryModel:
         dq = np.asarray(rate_increments, dtype=float)
         if dq.ndim != 2 or dq.shape[1] != len(self.rate_joints):
             raise WmrkitError(f"rate_increments: expected shape (N, {len(self.rate_joints)}), got {dq.shape}")
+        _finite(dq, "rate_increments")
         if self.constant:
             return ModelIncrements(dq, self.joint_names, self.solution, self.residual_map)
         s, rm, index = self._solve_by_configuration(dq, beta_mid)
@@ -239,6 +241,9 @@ class OdometryModel:
         p = np.asarray(positions, dtype=float)
         if p.ndim != 2 or p.shape[1] != len(self.joints):
             raise WmrkitError(f"positions: expected shape (N + 1, {len(self.joints)}), got {p.shape}")
+        _finite(p, "positions")
+        if previous is not None:
+            _finite(np.asarray(previous, dtype=float), "previous")
         if previous is None:
             d = np.diff(p, axis=0)
         else:
@@ -309,6 +314,7 @@ class OdometryModel:
         beta = np.asarray(beta_mid, dtype=float)
         if beta.shape != (dq.shape[0], len(self.steer_joints)):
             raise WmrkitError(f"beta_mid: expected shape ({dq.shape[0]}, {len(self.steer_joints)}), got {beta.shape}")
+        _finite(beta, "beta_mid")
         configs, index = configurations(beta)
         maps, bad = self.configuration_maps(configs)
         if len(bad):
