@@ -129,6 +129,18 @@ def test_quarter_circle_end_point_errors_of_a6(n, paper, midpoint):
     assert err["exact"] < 1e-14
 
 
+@pytest.mark.parametrize("n", [8, 100])
+def test_whole_circles_of_equal_steps_close_with_every_scheme_on_a_wrong_circle(n):
+    """A.6: equal steps at evenly spaced headings sum to zero, so every scheme returns to its start; only exact
+    stays on the circle (R = 0.6 m: the half-way pose is (0, 1.2)), so loop closure is no accuracy test."""
+    inc = np.tile([0.6 * 2 * math.pi / n, 0.0, 2 * math.pi / n], (n, 1))
+    for method in METHODS:
+        poses = integrate_increments([0, 0, 0], inc, method)
+        np.testing.assert_allclose(poses[-1], [0.0, 0.0, 2 * math.pi], atol=1e-13)
+        off = np.hypot(*(poses[n // 2 - 1, :2] - [0.0, 1.2]))
+        assert off < 1e-13 if method == "exact" else off > {"rk2": 0.5 / n**2}.get(method, 0.5 / n)  # 2nd, 1st order
+
+
 def test_measured_convergence_orders():
     """Time-varying twist; increments are the exact integrals of the twist over each step (what encoders
     measure); reference by an independent adaptive ODE solver. Orders: Euler and (15) first, RK2 and the
