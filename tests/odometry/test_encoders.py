@@ -82,10 +82,16 @@ def test_64_bit_counters_of_the_header_widths():
 
 @pytest.mark.parametrize("kwargs", [dict(counts_per_rev=0), dict(counts_per_rev=10, gear_ratio=-1),
                                     dict(counts_per_rev=10, bits=1), dict(counts_per_rev=10, bits=65),
-                                    dict(counts_per_rev=10, sign=2)])
+                                    dict(counts_per_rev=10, sign=2), dict(counts_per_rev=10, bits=2.5)])
 def test_bad_incremental_settings(kwargs):
-    with pytest.raises(EncoderError):
+    with pytest.raises(EncoderError):  # bits=2.5 wrapped counts modulo 2**2.5
         IncrementalEncoder(**kwargs)
+
+
+@pytest.mark.parametrize("offset", [math.nan, math.inf])
+def test_absolute_encoder_offset_must_be_finite(offset):
+    with pytest.raises(EncoderError, match="offset must be a finite angle"):  # gave NaN / infinite angles
+        AbsoluteEncoder(resolution=0.01, offset=offset)
 
 
 def test_fractional_absolute_counts_are_refused():

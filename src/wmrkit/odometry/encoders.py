@@ -48,8 +48,8 @@ class IncrementalEncoder:
             raise EncoderError(f"counts_per_rev must be > 0, got {self.counts_per_rev}")
         if not self.gear_ratio > 0 or not math.isfinite(self.gear_ratio):
             raise EncoderError(f"gear_ratio must be > 0, got {self.gear_ratio}")
-        if self.bits is not None and not 2 <= self.bits <= 64:
-            raise EncoderError(f"bits must be between 2 and 64, got {self.bits}")
+        if self.bits is not None and not (isinstance(self.bits, int | np.integer) and 2 <= self.bits <= 64):
+            raise EncoderError(f"bits must be a whole number between 2 and 64, got {self.bits}")
         if self.counts_per_rev * self.gear_ratio > MAX_COUNTS_PER_REV:  # a count below round-off, or 0 rad
             raise EncoderError(f"counts_per_rev x gear_ratio = {self.counts_per_rev * self.gear_ratio:g} counts per "
                                f"wheel revolution: at most {MAX_COUNTS_PER_REV:g}")
@@ -118,6 +118,8 @@ class AbsoluteEncoder:
     def __post_init__(self) -> None:
         if not self.resolution > 0 or not math.isfinite(self.resolution):
             raise EncoderError(f"resolution must be > 0, got {self.resolution}")
+        if not math.isfinite(self.offset):
+            raise EncoderError(f"offset must be a finite angle [rad], got {self.offset}")
         if self.sign not in (1, -1):
             raise EncoderError(f"sign must be +1 or -1, got {self.sign}")
 
