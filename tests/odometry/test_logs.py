@@ -194,6 +194,20 @@ def test_trajectory_files_with_non_finite_values_are_refused_at_their_pose(tmp_p
         read_trajectory_csv(csv)
 
 
+@pytest.mark.parametrize(("text", "message"), [
+    ("time,x,y,theta,slip\n0,1,2\n1,2,3\n", "3 values per row under a header of 5 columns"),  # was IndexError
+    ("time,x,y,theta,slip\n0\n1\n", "1 values per row under a header of 5 columns"),  # was a numpy ValueError
+    ("time,x,y,theta,slip,cov_xx,cov_xy\n0,1,2,0,0,1,0\n", r":1: expected the columns time,x,y,theta,slip \(and"),
+])
+def test_trajectory_csv_with_other_columns_is_refused_by_name(tmp_path, text, message):
+    """A reference trajectory CSV (batch calibrate) with missing columns failed with numpy errors; a partial
+    covariance was dropped silently."""
+    csv = tmp_path / "t.csv"
+    csv.write_text(text)
+    with pytest.raises(LogError, match=r"t\.csv" + ("" if message.startswith(":") else ": ") + message):
+        read_trajectory_csv(csv)
+
+
 def test_trajectory_files_round_trip(tmp_path):
     rng = np.random.default_rng(0)
     n = 30

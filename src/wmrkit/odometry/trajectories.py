@@ -167,13 +167,16 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
     except (OSError, UnicodeDecodeError) as err:
         raise LogError(f"{os.fspath(path)}: cannot read the trajectory ({getattr(err, 'strerror', None) or err})") \
             from None
+    if header[:5] != ["time", "x", "y", "theta", "slip"] or header[5:] not in ([], list(COV_COLUMNS)):
+        raise LogError(f"{os.fspath(path)}:1: expected the columns time,x,y,theta,slip (and the covariance's "
+                       f"{','.join(COV_COLUMNS)}), got {','.join(header)}")
     data = _load_table(path, delimiter=",", skiprows=1)
+    if data.shape[1] != len(header):
+        raise LogError(f"{os.fspath(path)}: {data.shape[1]} values per row under a header of {len(header)} columns")
     _check_samples(path, data[:, 0], data[:, 1:3])
-    if header[:5] != ["time", "x", "y", "theta", "slip"]:
-        raise LogError(f"{os.fspath(path)}:1: expected the columns time,x,y,theta,slip, got {','.join(header)}")
     _check_finite(path, data[:, 3:], "theta, slip and the covariance")
     cov = None
-    if len(header) == 11:
+    if len(header) > 5:
         cov = np.zeros((len(data), 3, 3))
         cov[:, _TRIU[0], _TRIU[1]] = data[:, 5:]
         cov = cov + np.swapaxes(np.triu(cov, 1), -1, -2)
