@@ -161,6 +161,10 @@ def test_noise_and_covariances_that_cannot_be_are_refused_by_name():
         propagate_covariance(poses, inc, q, initial=-np.eye(3))
     with pytest.raises(NoiseError, match="increment_covariance: every matrix must be finite and symmetric"):
         propagate_covariance(poses, inc, -q)
+    indefinite = q.copy()
+    indefinite[1, 0, 1] = indefinite[1, 1, 0] = 2.0  # variances >= 0, but eigenvalue -1: gave negative variances
+    with pytest.raises(NoiseError, match="increment_covariance: matrix 1 is not positive semi-definite"):
+        propagate_covariance(poses, inc, indefinite)
     robot = catalog.load("diff-drive")
     log = simulate(robot, square_path(1.0), 50.0).log
     with pytest.raises(NoiseError, match="initial_covariance: a covariance must be positive semi-definite"):

@@ -178,9 +178,15 @@ def propagate_covariance(poses_world_robot: ArrayLike, increments_robot: ArrayLi
                           f"{inc.shape}, {q.shape}")
     _finite(poses, "poses_world_robot"), _finite(inc, "increments_robot")
     p0 = np.zeros((3, 3)) if initial is None else check_covariance(initial, "initial")
+    scale = np.abs(q).max(initial=0.0)
     if not (np.isfinite(q).all() and (np.diagonal(q, axis1=-2, axis2=-1) >= 0).all()
-            and np.abs(q - np.swapaxes(q, -1, -2)).max(initial=0.0) <= 1e-9 * np.abs(q).max(initial=0.0)):
+            and np.abs(q - np.swapaxes(q, -1, -2)).max(initial=0.0) <= 1e-9 * scale):
         raise NoiseError("increment_covariance: every matrix must be finite and symmetric, with variances >= 0")
+    low = np.linalg.eigvalsh(q)[:, 0] if n else np.zeros(0)
+    if (low < -1e-12 * scale).any():
+        k = int(np.argmax(low < -1e-12 * scale))
+        raise NoiseError(f"increment_covariance: matrix {k} is not positive semi-definite (least eigenvalue "
+                         f"{low[k]:.6g}): a covariance cannot be")
     return propagate_checked(poses, inc, q, method, p0)
 
 
