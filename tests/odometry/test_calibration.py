@@ -233,6 +233,10 @@ def test_square_path_error_is_the_larger_centroid_distance():
     ccw = [[0.0, -0.3], [0.0, -0.1], [0.0, -0.2]]  # centroid (0, -0.2)... and 0.2 again
     assert square_path_error(cw, ccw) == pytest.approx(0.2)
     assert square_path_error([[0.3, 0.4]], [[0.0, 0.1]]) == pytest.approx(0.5)
+    assert square_path_error([0.3, 0.4], [0.0, 0.1]) == pytest.approx(0.5)  # one run each
+    for bad in ([], [[np.nan, 0.0]], [[1.0, 2.0, 3.0]], [[1.0, 2.0, 3.0, 4.0]]):  # NaN, NaN, ValueError, two runs
+        with pytest.raises(WmrkitError, match=r"errors_cw: expected the finite return-position errors \(n, 2\)"):
+            square_path_error(bad, ccw)
 
 
 def test_calibration_errors():

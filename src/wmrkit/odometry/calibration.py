@@ -363,9 +363,19 @@ def square_path_error(errors_cw: ArrayLike, errors_ccw: ArrayLike) -> float:
 
     ``(n, 2), (m, 2) -> float``: final minus start position of each run.
     """
-    cw = np.asarray(errors_cw, dtype=float).reshape(-1, 2)
-    ccw = np.asarray(errors_ccw, dtype=float).reshape(-1, 2)
+    cw, ccw = _return_errors(errors_cw, "errors_cw"), _return_errors(errors_ccw, "errors_ccw")
     return float(max(np.hypot(*cw.mean(axis=0)), np.hypot(*ccw.mean(axis=0))))
+
+
+def _return_errors(errors: ArrayLike, name: str) -> np.ndarray:
+    """`errors` as ``(n, 2)`` with ``n >= 1``, finite, or :class:`WmrkitError` naming `name` (an empty list gave
+    NaN, three columns were read as pairs)."""
+    e = np.asarray(errors, dtype=float)
+    e = e[None] if e.ndim == 1 else e
+    if e.ndim != 2 or e.shape[1] != 2 or len(e) == 0 or not np.isfinite(e).all():
+        raise WmrkitError(f"{name}: expected the finite return-position errors (n, 2) of one or more runs, got "
+                          f"shape {np.shape(errors)}" + (" with NaN or infinite values" if e.size else ""))
+    return e
 
 
 def _groups(robot: Robot, parameters: Sequence[Parameter]) -> list[list[tuple[str, str, float]]]:
