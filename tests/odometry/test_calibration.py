@@ -275,8 +275,8 @@ def test_references_samples_and_heading_weight_that_cannot_be_are_refused_by_nam
     for weight in (float("nan"), -1.0):
         with pytest.raises(WmrkitError, match="heading_weight must be finite and >= 0"):
             calibrate(robot, [good], ["left.r"], heading_weight=weight)
-    with pytest.raises(WmrkitError, match=r"sensed joints of robot 'diff-drive' \(left\.spin\) do not determine"):
-        calibrate(robot, [good], ["left.r"], sensed="left.spin")  # one joint, not the letters l, e, f, t, ...
+    with pytest.raises(WmrkitError, match=r"sensed: expected a sequence of 'wheel.joint' names, got the string"):
+        calibrate(robot, [good], ["left.r"], sensed="left.spin")  # not the letters l, e, f, t, ...
 
 
 def test_calibration_section_of_the_odometry_page_runs():

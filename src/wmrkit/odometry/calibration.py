@@ -336,10 +336,11 @@ def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence
         raise WmrkitError("calibrate: no runs")
     if not (np.isfinite(heading_weight) and heading_weight >= 0):
         raise WmrkitError(f"calibrate: heading_weight must be finite and >= 0 [m/rad], got {heading_weight!r}")
+    if isinstance(sensed, str):  # tuple("left.spin") would read ('l', 'e', ...)
+        raise WmrkitError(f"calibrate: sensed: expected a sequence of 'wheel.joint' names, got the string '{sensed}'")
     groups = _groups(robot, parameters)
     problem = CalibrationProblem(robot, tuple(parameters), tuple(runs), method, heading_weight,
-                                 None if sensed is None else (sensed,) if isinstance(sensed, str) else tuple(sensed),
-                                 weights, run_weights)
+                                 None if sensed is None else tuple(sensed), weights, run_weights)
     r0 = problem.residuals(np.zeros(len(groups)))
     if r0.size < len(groups):
         raise WmrkitError(f"calibrate: {r0.size} residuals cannot fix {len(groups)} parameters; add runs or references")

@@ -327,7 +327,7 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
                    weights: Mapping[str, float] | None = None) -> OdometryModel:
     """The sensed direct model of `robot` over samples (ranks method, eqs. (4.9)-(4.11); module docstring).
 
-    `sensed`: joints ``wheel.joint`` the log provides (default ``robot.sensed``; one string is one joint).
+    `sensed`: joints ``wheel.joint`` the log provides (default ``robot.sensed``; a sequence, not one string).
     `weights`: wheel name -> weight > 0 of its constraint rows in the least squares (default 1): how much that
     wheel's no-slip equations are trusted, the weighting idea of the thesis's WLS estimator (§7.4.4). A small
     weight on the forklift's steered wheel, whose angle is coarsely quantised, gives nearly the drive wheels'
@@ -335,7 +335,9 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
     unweighted ``A dq``. Raises :class:`SensingError` when the joints cannot give the motion,
     :class:`UnknownNameError` for a name the robot lacks.
     """
-    sensed = tuple(robot.sensed if sensed is None else (sensed,) if isinstance(sensed, str) else sensed)
+    if isinstance(sensed, str):  # tuple("left.spin") would read ('l', 'e', ...); as trees.select_columns
+        raise SensingError(f"sensed: expected a sequence of 'wheel.joint' names, got the string '{sensed}'")
+    sensed = tuple(robot.sensed if sensed is None else sensed)
     weights = dict(weights or {})
     for name, w in weights.items():
         robot.wheel(name)
