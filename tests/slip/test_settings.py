@@ -218,3 +218,19 @@ def test_friction_coefficients_too_far_apart_are_refused_where_the_description_g
     assert err.value.loc == loc and "differ by more than a factor 1e+12" in err.value.message
     within = _skid({"slip": {"lateral": 1e-11, "longitudinal": 1}}, {"lateral": 1, "longitudinal": 1})
     robot_from_text(yaml.safe_dump(within, sort_keys=False), source="robot.yaml")  # 1e11 apart: accepted
+
+
+@pytest.mark.parametrize("options,where", [
+    (["--slip-weights", "{w}"], "--slip-weights {w}: "),
+    (["--mu", "front_right=1e-13,1"], "--mu front_right and the default 1,1: "),
+    (["--slip-weights", "{w}", "--mu-default", "1e13,1e13"], "--slip-weights {w} and --mu-default: "),
+])
+def test_friction_coefficients_too_far_apart_are_refused_naming_the_options_or_file(capsys, tmp_path, options, where):
+    """Coefficients more than 1e12 apart from a --slip-weights file or --mu options were refused without the file
+    or the option (SlipWeights.row_mu, when odometry ran)."""
+    w = tmp_path / "w.json"
+    w.write_text('{"weights": {"default": [1, 1], "wheels": {"front_left": [1e-13, 1]}}}')
+    args = [a.format(w=w) for a in options]
+    assert main(["odometry", "skid-steer-4", str(tmp_path / "log.csv"), "--method", "wls", *args, "--json"]) == 2
+    error = json.loads(capsys.readouterr().err)["error"]
+    assert error.startswith(where.format(w=w)) and "differ by more than a factor 1e+12" in error

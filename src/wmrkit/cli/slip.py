@@ -65,14 +65,36 @@ def weights_from_args(args: argparse.Namespace, settings=None, robot: Robot | No
     base = settings.weights() if settings is not None else SlipWeights()
     mu: dict[str, tuple[float, float]] = {n: (a, b) for n, a, b in base.mu}
     default = base.default
+    described = settings is not None and settings.slip is not None  # where each coefficient comes from (below)
+    given = "the description's odometry.slip" if described else "the default 1,1"
+    origin = {n: f"the description's wheels.{n}.slip" for n in mu}
     if args.slip_weights:
         default, mu = _weights_file(args.slip_weights, robot)
+        given, origin = f"--slip-weights {args.slip_weights}", {n: f"--slip-weights {args.slip_weights}" for n in mu}
     if args.mu_default is not None:
-        default = _pair(args.mu_default, "--mu-default")
+        default, given = _pair(args.mu_default, "--mu-default"), "--mu-default"
     for name, value in parse_assignments(args.mu, "--mu").items():
         _check_wheel(robot, name, "--mu")
-        mu[name] = _pair(value, f"--mu {name}")
-    return SlipWeights.of(mu, default)
+        mu[name], origin[name] = _pair(value, f"--mu {name}"), f"--mu {name}"
+    weights = SlipWeights.of(mu, default)
+    if robot is not None:
+        _check_spread(robot, weights, {w.name: origin.get(w.name, given) for w in robot.wheels})
+    return weights
+
+
+def _check_spread(robot: Robot, weights, origin: dict[str, str]) -> None:
+    """Refuse coefficients more than ``MAX_RATIO`` apart naming the options or file that gave them
+    (``SlipWeights.row_mu`` refused them only when odometry ran, without saying where they came from)."""
+    from ..slip.weights import MAX_RATIO
+
+    used = [(v, w.name, what) for w in robot.wheels
+            for v, what in zip(weights.of_wheel(w.name), ("lateral", "longitudinal"), strict=True)]
+    lo, hi = min(used), max(used)
+    if hi[0] > MAX_RATIO * lo[0]:
+        where = " and ".join(dict.fromkeys((origin[lo[1]], origin[hi[1]])))
+        raise WmrkitError(f"{where}: friction coefficients of wheel {lo[1]} ({lo[2]}) ({lo[0]:g}) and {hi[1]} "
+                          f"({hi[2]}) ({hi[0]:g}) differ by more than a factor {MAX_RATIO:g}: the weighted least "
+                          "squares would lose the smaller rows to round-off (only ratios matter)")
 
 
 def _check_wheel(robot: Robot | None, name: str, option: str) -> None:
