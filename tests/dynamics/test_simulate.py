@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -30,6 +31,20 @@ def test_semi_implicit_and_rk4_agree_with_the_adaptive_solution():
         assert np.allclose(sim.t, ref.t)
         assert np.allclose(sim.pose, ref.pose, atol=tol), method
         assert np.allclose(sim.twist, ref.twist, atol=tol), method
+
+
+def test_an_adaptive_run_is_bounded_in_evaluations(monkeypatch):
+    """The adaptive method had no bound on its work: the forklift's 3 s turn takes 1e6 evaluations (14 s), so a
+    long --duration ran for hours, and a discontinuous Coulomb law (k = inf) did not finish 0.05 s in 3 min."""
+    import wmrkit.dynamics.simulate as sim_module
+
+    model = DynamicModel.of(castor_robot({"model": "dugoff", "cs": 800, "calpha": 600}))
+    inputs = Inputs.torques_only(model, [0.0, 1.0], {"left.spin": [0.1, 0.1], "right.spin": [0.3, 0.3]})
+    used = simulate(model, inputs, 0.2, method="adaptive", initial_twist=[0.4, 0, 0]).info["evaluations"]
+    monkeypatch.setattr(sim_module, "MAX_EVALUATIONS", used // 2)
+    with pytest.raises(WmrkitError, match=re.escape(f"more than {used // 2:.0e} evaluations of the model by t = ")
+                       + r"\S+ s of 0.2 s .* use the semi-implicit method"):
+        simulate(model, inputs, 0.2, method="adaptive", initial_twist=[0.4, 0, 0])
 
 
 def test_dugoff_at_low_speed_the_energy_the_semi_implicit_step_adds_vanishes_with_the_step():

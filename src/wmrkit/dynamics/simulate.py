@@ -461,6 +461,15 @@ def _fixed(model, s0, inp, duration, step, every, method, progress, jac_every, a
     return tuple(r[:i] for r in rec), {"steps": n_steps}
 
 
+#: Most evaluations of the model an adaptive run makes (LSODA, 10-15 us each: about 2 min; the forklift's 22 s
+#: rectangle takes about 7e6): without it a long run, or a discontinuous tyre law, integrated for hours.
+MAX_EVALUATIONS = 10_000_000
+
+
+class _OverBudget(Exception):
+    """Raised by the adaptive run's right-hand side beyond :data:`MAX_EVALUATIONS` (args: the time reached)."""
+
+
 def _adaptive(model, s0, inp, duration, record, rtol, allow_lift_off):
     from scipy.integrate import solve_ivp
 
@@ -471,11 +480,22 @@ def _adaptive(model, s0, inp, duration, record, rtol, allow_lift_off):
     t_eval = np.arange(0.0, duration + record / 2, record)
     ts, ys, evaluations = t_eval, s0[:, None], 0  # one sample (record > 2 duration): t = 0, as the fixed steps
     if len(t_eval) > 1:
+        calls = [0]
+
+        def rhs(t, s):
+            calls[0] += 1
+            if calls[0] > MAX_EVALUATIONS:
+                raise _OverBudget(t)
+            return derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w)
+
         try:
-            sol = solve_ivp(lambda t, s: derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w),
-                            (0.0, t_eval[-1]), s0, method="LSODA", t_eval=t_eval, rtol=rtol, atol=rtol * 1e-3)
+            sol = solve_ivp(rhs, (0.0, t_eval[-1]), s0, method="LSODA", t_eval=t_eval, rtol=rtol, atol=rtol * 1e-3)
         except ZeroDivisionError:  # the compiled kernels raise it where the state has overflowed
             raise WmrkitError("the adaptive integration diverged (the state overflowed)") from None
+        except _OverBudget as e:
+            raise WmrkitError(f"the adaptive integration needed more than {MAX_EVALUATIONS:.0e} evaluations of the "
+                              f"model by t = {e.args[0]:.6g} s of {duration:g} s (stiff or discontinuous tyres, or a "
+                              "long run); use the semi-implicit method or a shorter duration") from None
         if not sol.success:
             raise WmrkitError(f"the adaptive integration failed: {sol.message}")
         ts, ys, evaluations = sol.t, sol.y, int(sol.nfev)
