@@ -36,7 +36,7 @@ def test_semi_implicit_and_rk4_agree_with_the_adaptive_solution():
 def test_an_adaptive_run_is_bounded_in_evaluations(monkeypatch):
     """The adaptive method had no bound on its work: the forklift's 3 s turn takes 1e6 evaluations (14 s), so a
     long --duration ran for hours, and a discontinuous Coulomb law (k = inf) did not finish 0.05 s in 3 min."""
-    import wmrkit.dynamics.simulate as sim_module
+    import wmrkit.dynamics.runs as sim_module
 
     model = DynamicModel.of(castor_robot({"model": "dugoff", "cs": 800, "calpha": 600}))
     inputs = Inputs.torques_only(model, [0.0, 1.0], {"left.spin": [0.1, 0.1], "right.spin": [0.3, 0.3]})

@@ -54,7 +54,7 @@ def assemble(t, s, acc, pack, inp, jac, w):
 
     ``w = (a, m, dm, fz, f, g, vw, tau, kdiag, rhs, beta, beta_rate, rate_ref, beta_ref, mat, filled, lift)``
     (``lift``: 1, the time and the contact of the first lift-off, see
-    :func:`wmrkit.dynamics.simulate.check_lift_off`):
+    :func:`wmrkit.dynamics.runs.check_lift_off`):
     ``rhs = tau + A' F + bias`` so that
     ``m nu' = rhs``; ``kdiag`` holds the servo terms of ``d rhs / d nu``.
     """

@@ -22,6 +22,7 @@ from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .model import DynamicModel
+from .runs import LiftOffError, adaptive_run, check_lift_off, fixed_run, records  # noqa: F401  (LiftOffError: API)
 from .tyres import Tyre
 
 Method = Literal["semi-implicit", "rk4", "adaptive"]
@@ -195,32 +196,11 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     s0 = initial_state(model, initial_twist, initial_pose)
     inp = _compiled_inputs(model, inputs)
     if method == "adaptive":
-        rec, info = _adaptive(model, s0, inp, duration, record, rtol, allow_lift_off)
+        rec, info = adaptive_run(model, s0, inp, duration, record, rtol, allow_lift_off)
     else:
-        rec, info = _fixed(model, s0, inp, duration, step, every, 0 if method == "semi-implicit" else 1, progress,
+        rec, info = fixed_run(model, s0, inp, duration, step, every, 0 if method == "semi-implicit" else 1, progress,
                            jac_every, allow_lift_off)
     return _result(model, rec, method, step, info)
-
-
-class LiftOffError(WmrkitError):
-    """A wheel loaded at rest lost its load: the run stops there (:func:`check_lift_off`). ``what`` states it
-    (contact, time, load at rest); the message adds what to change, which a caller may replace."""
-
-    def __init__(self, what: str, advice: str = "use smaller torques or speeds") -> None:
-        self.what, self.advice = what, advice
-        super().__init__(f"{what}; {advice}")
-
-
-def check_lift_off(model: DynamicModel, w: tuple) -> None:
-    """Refuse a run in which a wheel loaded at rest lost its load (lifts off), as the integrator's work arrays `w`
-    recorded it: the planar model clips the load at 0 and keeps the wheel down, so the motion that follows is not
-    physical (with friction)."""
-    lift = w[16]
-    if lift[0]:
-        e = int(lift[2])
-        raise LiftOffError(f"contact '{model.contacts[e]}' lifts off the ground at t = {lift[1]:.6g} s (normal load "
-                           f"0; {model.normal_loads()[e]:.4g} N at rest): the planar model keeps every wheel on the "
-                           "ground, so the motion would not be physical")
 
 
 class Stepper:
@@ -262,7 +242,7 @@ class Stepper:
         self._phase = self._k  # the tyre Jacobian is refreshed at the first step, then every jac_every steps
         self._acc = np.zeros(n)
         self._w = work_arrays(n, len(self.model.contacts), len(self.model.steer_columns))
-        self._rec = _records(self.model, 0)
+        self._rec = records(self.model, 0)
         self._inputs: tuple | None = None
         self._delta = np.array([w.delta for w in self.model.robot.wheels if w.kind.steers], dtype=float)
 
@@ -422,91 +402,6 @@ def _steer_limits(model: DynamicModel, limit: ArrayLike | None) -> np.ndarray:
         raise WmrkitError(f"steer_limit: expected {len(model.steer_columns)} torques > 0 N m (inf: none), got "
                           f"{limit.tolist()}")
     return np.where(np.isinf(limit), 0.0, limit)
-
-
-def _records(model: DynamicModel, n_rec: int) -> tuple:
-    e = len(model.contacts)
-    return (np.zeros(n_rec), np.zeros((n_rec, 2 * model.n)), np.zeros((n_rec, e, 2)), np.zeros((n_rec, e)),
-            np.zeros((n_rec, e, 2)), np.zeros((n_rec, e)), np.zeros((n_rec, model.n)))
-
-
-def _fixed(model, s0, inp, duration, step, every, method, progress, jac_every, allow_lift_off):
-    from ._integrate import observe, run, work_arrays
-
-    n_steps = round(duration / step)
-    rec = _records(model, n_steps // every + 1)
-    w = work_arrays(model.n, len(model.contacts), len(model.steer_columns))
-    s, acc = s0.copy(), np.zeros(model.n)
-    observe(0.0, s, acc, model.pack, inp, w, rec, 0)
-    i, done = 1, 0
-    chunk = max(every, (n_steps // 200) // every * every) if n_steps >= 500_000 or progress else n_steps
-    bar = None
-    if progress or (progress is None and n_steps >= 500_000):
-        from tqdm import tqdm
-
-        bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
-    while done < n_steps:
-        k = min(chunk, n_steps - done)
-        i = run(s, done, step, k, every, method, jac_every, acc, model.pack, inp, w, rec, i)
-        done += k
-        if bar is not None:
-            bar.update(k)
-        if not np.all(np.isfinite(s)):
-            raise WmrkitError(f"the simulation diverged before t = {done * step:.6g} s; use a smaller --step (or "
-                              "smaller torques or speeds)")
-        if not allow_lift_off:
-            check_lift_off(model, w)
-    if bar is not None:
-        bar.close()
-    return tuple(r[:i] for r in rec), {"steps": n_steps}
-
-
-#: Most evaluations of the model an adaptive run makes (LSODA, 10-15 us each: about 2 min; the forklift's 22 s
-#: rectangle takes about 7e6): without it a long run, or a discontinuous tyre law, integrated for hours.
-MAX_EVALUATIONS = 10_000_000
-
-
-class _OverBudget(Exception):
-    """Raised by the adaptive run's right-hand side beyond :data:`MAX_EVALUATIONS` (args: the time reached)."""
-
-
-def _adaptive(model, s0, inp, duration, record, rtol, allow_lift_off):
-    from scipy.integrate import solve_ivp
-
-    from ._integrate import derivative, observe, work_arrays
-
-    w = work_arrays(model.n, len(model.contacts), len(model.steer_columns))
-    acc = np.zeros(model.n)
-    t_eval = np.arange(0.0, duration + record / 2, record)
-    ts, ys, evaluations = t_eval, s0[:, None], 0  # one sample (record > 2 duration): t = 0, as the fixed steps
-    if len(t_eval) > 1:
-        calls = [0]
-
-        def rhs(t, s):
-            calls[0] += 1
-            if calls[0] > MAX_EVALUATIONS:
-                raise _OverBudget(t)
-            return derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w)
-
-        try:
-            sol = solve_ivp(rhs, (0.0, t_eval[-1]), s0, method="LSODA", t_eval=t_eval, rtol=rtol, atol=rtol * 1e-3)
-        except ZeroDivisionError:  # the compiled kernels raise it where the state has overflowed
-            raise WmrkitError("the adaptive integration diverged (the state overflowed)") from None
-        except _OverBudget as e:
-            raise WmrkitError(f"the adaptive integration needed more than {MAX_EVALUATIONS:.0e} evaluations of the "
-                              f"model by t = {e.args[0]:.6g} s of {duration:g} s (stiff or discontinuous tyres, or a "
-                              "long run); use the semi-implicit method or a shorter duration") from None
-        if not sol.success:
-            raise WmrkitError(f"the adaptive integration failed: {sol.message}")
-        ts, ys, evaluations = sol.t, sol.y, int(sol.nfev)
-    rec = _records(model, len(ts))
-    w[16][:] = 0.0  # lift-off judged on the accepted states only (not on the solver's trial evaluations)
-    for i, (t, s) in enumerate(zip(ts, ys.T, strict=True)):
-        derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w)
-        observe(t, np.ascontiguousarray(s), acc, model.pack, inp, w, rec, i)
-    if not allow_lift_off:
-        check_lift_off(model, w)
-    return rec, {"evaluations": evaluations}
 
 
 def _result(model: DynamicModel, rec: tuple, method: str, step: float, info: dict) -> Simulation:

@@ -1,0 +1,122 @@
+"""The runs of :func:`~wmrkit.dynamics.simulate.simulate`: fixed-step (compiled, chunked, a ``tqdm`` bar on long
+runs) and adaptive (scipy's LSODA, at most :data:`MAX_EVALUATIONS` evaluations), their records, and the lift-off
+check both make."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import WmrkitError
+from .model import DynamicModel
+
+
+class LiftOffError(WmrkitError):
+    """A wheel loaded at rest lost its load: the run stops there (:func:`check_lift_off`). ``what`` states it
+    (contact, time, load at rest); the message adds what to change, which a caller may replace."""
+
+    def __init__(self, what: str, advice: str = "use smaller torques or speeds") -> None:
+        self.what, self.advice = what, advice
+        super().__init__(f"{what}; {advice}")
+
+
+def check_lift_off(model: DynamicModel, w: tuple) -> None:
+    """Refuse a run in which a wheel loaded at rest lost its load (lifts off), as the integrator's work arrays `w`
+    recorded it: the planar model clips the load at 0 and keeps the wheel down, so the motion that follows is not
+    physical (with friction)."""
+    lift = w[16]
+    if lift[0]:
+        e = int(lift[2])
+        raise LiftOffError(f"contact '{model.contacts[e]}' lifts off the ground at t = {lift[1]:.6g} s (normal load "
+                           f"0; {model.normal_loads()[e]:.4g} N at rest): the planar model keeps every wheel on the "
+                           "ground, so the motion would not be physical")
+
+
+def records(model: DynamicModel, n_rec: int) -> tuple:
+    """Zeroed record arrays of `n_rec` samples: time, state, contact forces, loads, slip velocities and speeds,
+    joint torques (:func:`._integrate.observe` fills them)."""
+    e = len(model.contacts)
+    return (np.zeros(n_rec), np.zeros((n_rec, 2 * model.n)), np.zeros((n_rec, e, 2)), np.zeros((n_rec, e)),
+            np.zeros((n_rec, e, 2)), np.zeros((n_rec, e)), np.zeros((n_rec, model.n)))
+
+
+def fixed_run(model, s0, inp, duration, step, every, method, progress, jac_every, allow_lift_off):
+    """`duration` [s] from state `s0` in compiled fixed steps (`method` 0: semi-implicit, 1: rk4), recording every
+    `every` steps, in chunks (a ``tqdm`` bar on long runs); ``(records, info)``."""
+    from ._integrate import observe, run, work_arrays
+
+    n_steps = round(duration / step)
+    rec = records(model, n_steps // every + 1)
+    w = work_arrays(model.n, len(model.contacts), len(model.steer_columns))
+    s, acc = s0.copy(), np.zeros(model.n)
+    observe(0.0, s, acc, model.pack, inp, w, rec, 0)
+    i, done = 1, 0
+    chunk = max(every, (n_steps // 200) // every * every) if n_steps >= 500_000 or progress else n_steps
+    bar = None
+    if progress or (progress is None and n_steps >= 500_000):
+        from tqdm import tqdm
+
+        bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
+    while done < n_steps:
+        k = min(chunk, n_steps - done)
+        i = run(s, done, step, k, every, method, jac_every, acc, model.pack, inp, w, rec, i)
+        done += k
+        if bar is not None:
+            bar.update(k)
+        if not np.all(np.isfinite(s)):
+            raise WmrkitError(f"the simulation diverged before t = {done * step:.6g} s; use a smaller --step (or "
+                              "smaller torques or speeds)")
+        if not allow_lift_off:
+            check_lift_off(model, w)
+    if bar is not None:
+        bar.close()
+    return tuple(r[:i] for r in rec), {"steps": n_steps}
+
+
+#: Most evaluations of the model an adaptive run makes (LSODA, 10-15 us each: about 2 min; the forklift's 22 s
+#: rectangle takes about 7e6): without it a long run, or a discontinuous tyre law, integrated for hours.
+MAX_EVALUATIONS = 10_000_000
+
+
+class _OverBudget(Exception):
+    """Raised by the adaptive run's right-hand side beyond :data:`MAX_EVALUATIONS` (args: the time reached)."""
+
+
+def adaptive_run(model, s0, inp, duration, record, rtol, allow_lift_off):
+    """`duration` [s] from state `s0` with scipy's LSODA at `rtol`, recorded every `record` s, at most
+    :data:`MAX_EVALUATIONS` evaluations of the model; ``(records, info)``."""
+    from scipy.integrate import solve_ivp
+
+    from ._integrate import derivative, observe, work_arrays
+
+    w = work_arrays(model.n, len(model.contacts), len(model.steer_columns))
+    acc = np.zeros(model.n)
+    t_eval = np.arange(0.0, duration + record / 2, record)
+    ts, ys, evaluations = t_eval, s0[:, None], 0  # one sample (record > 2 duration): t = 0, as the fixed steps
+    if len(t_eval) > 1:
+        calls = [0]
+
+        def rhs(t, s):
+            calls[0] += 1
+            if calls[0] > MAX_EVALUATIONS:
+                raise _OverBudget(t)
+            return derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w)
+
+        try:
+            sol = solve_ivp(rhs, (0.0, t_eval[-1]), s0, method="LSODA", t_eval=t_eval, rtol=rtol, atol=rtol * 1e-3)
+        except ZeroDivisionError:  # the compiled kernels raise it where the state has overflowed
+            raise WmrkitError("the adaptive integration diverged (the state overflowed)") from None
+        except _OverBudget as e:
+            raise WmrkitError(f"the adaptive integration needed more than {MAX_EVALUATIONS:.0e} evaluations of the "
+                              f"model by t = {e.args[0]:.6g} s of {duration:g} s (stiff or discontinuous tyres, or a "
+                              "long run); use the semi-implicit method or a shorter duration") from None
+        if not sol.success:
+            raise WmrkitError(f"the adaptive integration failed: {sol.message}")
+        ts, ys, evaluations = sol.t, sol.y, int(sol.nfev)
+    rec = records(model, len(ts))
+    w[16][:] = 0.0  # lift-off judged on the accepted states only (not on the solver's trial evaluations)
+    for i, (t, s) in enumerate(zip(ts, ys.T, strict=True)):
+        derivative(t, np.ascontiguousarray(s), acc, model.pack, inp, w)
+        observe(t, np.ascontiguousarray(s), acc, model.pack, inp, w, rec, i)
+    if not allow_lift_off:
+        check_lift_off(model, w)
+    return rec, {"evaluations": evaluations}
