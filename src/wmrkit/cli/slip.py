@@ -83,18 +83,16 @@ def weights_from_args(args: argparse.Namespace, settings=None, robot: Robot | No
 
 
 def _check_spread(robot: Robot, weights, origin: dict[str, str]) -> None:
-    """Refuse coefficients more than ``MAX_RATIO`` apart naming the options or file that gave them
-    (``SlipWeights.row_mu`` refused them only when odometry ran, without saying where they came from)."""
-    from ..slip.weights import MAX_RATIO
+    """Refuse coefficients too far apart (``SlipWeights.row_mu``, which refused them only when odometry ran) now,
+    naming the options or file that gave them."""
+    from ..slip.weights import SlipWeightError
 
-    used = [(v, w.name, what) for w in robot.wheels
-            for v, what in zip(weights.of_wheel(w.name), ("lateral", "longitudinal"), strict=True)]
-    lo, hi = min(used), max(used)
-    if hi[0] > MAX_RATIO * lo[0]:
-        where = " and ".join(dict.fromkeys((origin[lo[1]], origin[hi[1]])))
-        raise WmrkitError(f"{where}: friction coefficients of wheel {lo[1]} ({lo[2]}) ({lo[0]:g}) and {hi[1]} "
-                          f"({hi[2]}) ({hi[0]:g}) differ by more than a factor {MAX_RATIO:g}: the weighted least "
-                          "squares would lose the smaller rows to round-off (only ratios matter)")
+    try:
+        weights.row_mu(robot)
+    except SlipWeightError as err:
+        if not err.wheels:
+            raise
+        raise WmrkitError(f"{' and '.join(dict.fromkeys(origin[w] for w in err.wheels))}: {err}") from None
 
 
 def _check_wheel(robot: Robot | None, name: str, option: str) -> None:

@@ -21,7 +21,7 @@ from .._shapes import as_vectors, matvec, readonly
 from ..couplings import coupled_columns, linked_steering
 from ..robot import TWIST_NAMES, Robot
 from .linalg import delta_projector, matrix_rank, nondimensional
-from .models import bounded, configuration
+from .models import bounded, configuration, mobility
 from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_prefilter, search_sets
 from .trees import (
     TreeVerdict,
@@ -263,10 +263,11 @@ def minimal_set_search(robot: Robot, beta: np.ndarray, size: int, wanted: str, w
     (:mod:`.search`) pruned by the null-space test when ``size`` is the mobility (then the rates must be an
     assignable set of the direct model), listing at most MAX_MINIMAL_SETS."""
     def exact(sel: np.ndarray) -> np.ndarray:
-        tree = trees_of(robot, beta, sel)
+        i_bar, j_sel, j_rest = _split_sets(robot, beta, sel)
+        tree = eliminated_tree(i_bar, j_sel, j_rest)
         ok = (tree.leaf == wanted) & (tree.rank_a == 3)
         if drive_all:
-            ok &= undriven_motions(*_rest_of(robot, beta, sel)) == 0
+            ok &= undriven_motions(i_bar, j_rest) == 0
         return ok.reshape(len(sel), -1).all(axis=1)
 
     a = nondimensional(robot).constraint_matrix(beta)
@@ -280,19 +281,17 @@ def minimal_set_search(robot: Robot, beta: np.ndarray, size: int, wanted: str, w
 
 def trees_of(robot: Robot, beta: np.ndarray, sel: np.ndarray) -> TreeVerdict:
     """The trees (4.28)/(4.34) of the sets of rate columns `sel` ``(S, size)``: leaves ``(S, ...)``."""
-    i_bar, j = nondimensional(robot).jacobian_form(beta)
-    j_sel = np.moveaxis(j[..., sel], -2, 0)  # (..., 3E, S, size) -> (S, ..., 3E, size)
-    return eliminated_tree(i_bar, j_sel, _rest_of(robot, beta, sel)[1])
+    return eliminated_tree(*_split_sets(robot, beta, sel))
 
 
-def _rest_of(robot: Robot, beta: np.ndarray, sel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(I_bar, J_rest)`` of the nondimensional Jacobian form without the columns `sel` ``(S, size)``:
-    ``(3E, 3), (S, ..., 3E, n_w - size)``."""
+def _split_sets(robot: Robot, beta: np.ndarray, sel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(I_bar, J_sel, J_rest)`` of the nondimensional Jacobian form split by each set of columns `sel`
+    ``(S, size)``: ``(3E, 3), (S, ..., 3E, size), (S, ..., 3E, n_w - size)``."""
     n_w = len(jacobian_names(robot))
     i_bar, j = nondimensional(robot).jacobian_form(beta)
     rest = np.array([[c for c in range(n_w) if c not in s] for s in sel.tolist()], dtype=int).reshape(
         len(sel), n_w - sel.shape[1])
-    return i_bar, np.moveaxis(j[..., rest], -2, 0)
+    return i_bar, np.moveaxis(j[..., sel], -2, 0), np.moveaxis(j[..., rest], -2, 0)  # (..., 3E, S, k) -> (S, ...)
 
 
 def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None, *,
@@ -306,8 +305,7 @@ def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None, *,
     default as described.
     """
     beta = configuration(robot, beta, heading)
-    a = nondimensional(robot).constraint_matrix(beta)
-    m = np.unique(a.shape[-1] - matrix_rank(a))
+    m = np.unique(mobility(robot, beta))
     if len(m) != 1 or m[0] == 0:
         return SetList()
     found = minimal_set_search(robot, beta, int(m[0]), "determined", "minimal actuator sets", drive_all=True)

@@ -19,7 +19,7 @@ from .._shapes import as_vectors, matvec, readonly
 from ..robot import TWIST_NAMES, Robot
 from .actuation import body_only, minimal_set_search, split_jacobian, steering_split, verdict_texts
 from .linalg import delta_projector, matrix_rank, nondimensional
-from .models import bounded, configuration
+from .models import bounded, configuration, mobility
 from .search import SetList
 from .trees import (
     TreeVerdict,
@@ -211,8 +211,7 @@ def minimal_sensor_sets(
     (thesis) or `heading` (0 = rolling forward), default as described.
     """
     beta = configuration(robot, beta, heading)
-    a = nondimensional(robot).constraint_matrix(beta)
-    m = np.unique(a.shape[-1] - matrix_rank(a))
+    m = np.unique(mobility(robot, beta))
     if len(m) != 1 or m[0] == 0:
         return SetList()
     names, steer = jacobian_names(robot), tuple(f"{w}.steer" for w in steering_split(robot, ()))

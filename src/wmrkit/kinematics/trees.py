@@ -193,8 +193,6 @@ def undriven_motions(i_bar: np.ndarray, j_rest: np.ndarray) -> np.ndarray:
     return both.shape[-1] - matrix_rank(both)
 
 
-
-
 def partitioned_solution(j_sel: ArrayLike, j_rest: ArrayLike) -> np.ndarray:
     """The selected part of the least-squares solution of ``y = J_sel q_sel + J_rest q_rest`` (4.25)-(4.26).
 

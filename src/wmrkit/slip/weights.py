@@ -25,7 +25,10 @@ MAX_RATIO = 1e12
 
 
 class SlipWeightError(WmrkitError, ValueError):
-    """A friction coefficient that is not a finite number > 0, or names a wheel the robot lacks."""
+    """A friction coefficient that is not a finite number > 0, or names a wheel the robot lacks; ``wheels``: the
+    two wheels of coefficients too far apart (:meth:`SlipWeights.row_mu`), else empty."""
+
+    wheels: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -77,16 +80,19 @@ class SlipWeights:
             if n not in names:
                 raise SlipWeightError(f"friction coefficients given for wheel '{n}', which robot '{robot.name}' "
                                       f"lacks (wheels: {', '.join(robot.wheel_names)})")
-        out, rows = [], []
+        out, rows, wheels = [], [], []
         for w in robot.wheels:
             out += list(self.of_wheel(w.name)) * len(w.elements())
             rows += [f"{w.name} (lateral)", f"{w.name} (longitudinal)"] * len(w.elements())
+            wheels += [w.name] * (2 * len(w.elements()))
         mu = np.array(out, dtype=float)
         if mu.size and mu.max() > MAX_RATIO * mu.min():
             lo, hi = int(np.argmin(mu)), int(np.argmax(mu))
-            raise SlipWeightError(f"friction coefficients of wheel {rows[lo]} ({mu[lo]:g}) and {rows[hi]} "
+            err = SlipWeightError(f"friction coefficients of wheel {rows[lo]} ({mu[lo]:g}) and {rows[hi]} "
                                   f"({mu[hi]:g}) differ by more than a factor {MAX_RATIO:g}: the weighted least "
                                   "squares would lose the smaller rows to round-off (only ratios matter)")
+            err.wheels = (wheels[lo], wheels[hi])
+            raise err
         return mu
 
 
