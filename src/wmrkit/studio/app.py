@@ -87,7 +87,9 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
         return Response(body, status_code=status, media_type="application/json")
 
     def endpoint(fn: Callable[[Any], Any], *, body: bool = True, thread: bool = False):
-        """`thread`: run in a worker thread, so that a slow answer does not hold up the live analysis."""
+        """`thread`: run in a worker thread, so that a slow answer does not hold up the other requests (the live
+        analysis of a 64-wheel robot takes over a second). Open and save stay on the event loop: a save checks that
+        its file does not exist and writes it in one step, with no other request in between."""
 
         async def handle(request) -> Response:
             t0 = time.perf_counter()
@@ -129,9 +131,9 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
         Route("/api/files", endpoint(lambda _: {"files": files.list_files(root)}, body=False, thread=True)),
         Route("/api/open", endpoint(lambda p: files.open_robot(root, p)), methods=["POST"]),
         Route("/api/save", endpoint(lambda p: files.save_robot(root, p)), methods=["POST"]),
-        Route("/api/analyze", endpoint(api.analyze_live), methods=["POST"]),
+        Route("/api/analyze", endpoint(api.analyze_live, thread=True), methods=["POST"]),
         Route("/api/configurations", endpoint(api.configurations, thread=True), methods=["POST"]),
-        Route("/api/drive", endpoint(api.drive), methods=["POST"]),
+        Route("/api/drive", endpoint(api.drive, thread=True), methods=["POST"]),
         Route("/api/kappa", endpoint(api.kappa_map, thread=True), methods=["POST"]),
         Mount("/static", app=StaticFiles(directory=str(static)), name="static"),
     ]
