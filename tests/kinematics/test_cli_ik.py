@@ -198,3 +198,13 @@ def test_ik_takes_the_other_root_when_only_it_is_within_the_steer_range(tmp_path
     np.testing.assert_allclose(np.degrees(c.heading[:, 0]), [-80.0, -80.0, 90.0], atol=1e-9)
     np.testing.assert_allclose(c.spin[:, 0], [-20.0, 20.0, 20.0], atol=1e-9)
     assert np.abs(robot.slip_velocity(c.velocity([twist, [-t for t in twist], [0.0, 1.0, 0.0]]), c.beta)).max() < 1e-12
+
+
+def test_text_prints_rounding_noise_as_zero(capsys):
+    """The tables printed 0 for rounding noise but the twist line and the 'other rates' column did not:
+    'vy = 1.92296e-16 m/s' for a differential drive and 'roller -1.77636e-14' for a Mecanum wheel driving
+    straight. Below 1e-12 (m/s, rad/s) every printed number is 0, as in the tables; JSON keeps the raw floats."""
+    code, out, _ = run(capsys, "fk", "diff-drive", "--spin", "left=10", "--spin", "right=12")
+    assert code == 0 and "vy = 0 m/s" in out and "e-1" not in out.splitlines()[0]
+    code, out, _ = run(capsys, "ik", "mecanum-4", "--twist", "1", "0", "0")
+    assert code == 0 and out.count("roller 0\n") == 4 and "e-1" not in out

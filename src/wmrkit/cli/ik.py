@@ -80,7 +80,8 @@ def run_fk(args: argparse.Namespace) -> int:
         print_json({"twist": twist.tolist(), "determined": determined, "residual": fk.residual,
                     "consistent": fk.consistent, "slipping": list(fk.slipping)})
     else:
-        print(f"twist (robot frame): vx = {twist[0]:.6g} m/s, vy = {twist[1]:.6g} m/s, omega = {twist[2]:.6g} rad/s")
+        vx, vy, omega = (_num(v) for v in twist)
+        print(f"twist (robot frame): vx = {vx} m/s, vy = {vy} m/s, omega = {omega} rad/s")
         print(f"residual (slip norm): {fk.residual:.3g} m/s ({'consistent' if fk.consistent else 'INCONSISTENT'})")
     return 0
 
@@ -111,7 +112,7 @@ def format_commands(robot: Robot, commands: WheelCommands) -> str:
              f"{'slip [m/s]':>12}  other rates [rad/s]"]
     for w in robot.wheels:
         entry = data["wheels"][w.name]
-        other = ", ".join(f"{k} {v:.6g}" for k, v in entry.items() if k not in ("heading", "spin", "steer_rate"))
+        other = ", ".join(f"{k} {_num(v)}" for k, v in entry.items() if k not in ("heading", "spin", "steer_rate"))
         heading = math.degrees(entry.get("heading", math.nan))
         lines.append(f"{w.name:<14}{w.type:<14}{_num(heading):>14}{_num(entry['spin']):>14}"
                      f"{_num(entry['steer_rate']):>12}{_num(data['slip'][w.name]):>12}  {other}".rstrip())
