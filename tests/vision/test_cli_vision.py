@@ -309,3 +309,17 @@ def test_an_image_that_is_a_folder_is_called_one(tmp_path, capsys):
     """'no such image file' was said of a folder that exists."""
     code, _, err = run(["vision", "locate", str(tmp_path), "--camera", str(FIGURES / "thesis-camera.yaml")], capsys)
     assert code == 2 and err == f"wmrkit: error: {tmp_path}: a folder; an image is a file\n"
+
+
+def test_follow_line_started_on_the_line_has_no_settling_time(tmp_path, capsys):
+    """Started on the line (h = 0) the 5 % band of the start's distance is empty, so rounding noise of 1e-16 m
+    made the summary say '95 % settling not reached within the run' and 'final h = -0.00 cm'."""
+    Camera(150.0, math.radians(60), 0.3, 160, 120).to_file(tmp_path / "cam.yaml")
+    argv = ["follow-line", "line-follower", "--camera", str(tmp_path / "cam.yaml"), "--duration", "3"]
+    code, out, _ = run([*argv, "--start", "0", "0"], capsys)
+    assert code == 0 and "95 % settling undefined (the run starts on the line)" in out
+    assert "final h = 0.00 cm, psi = 0.00 deg" in out and "-0.00" not in out
+    code, out, _ = run([*argv, "--start", "0", "0", "--json"], capsys)
+    assert json.loads(out)["settling_time_95"] is None
+    code, out, _ = run([*argv, "--start", "0.1", "0"], capsys)  # off the line: a settling time or 'not reached'
+    assert code == 0 and "undefined" not in out

@@ -224,10 +224,16 @@ def run_follow(args: argparse.Namespace) -> int:
     if args.json:
         print_json(summary)
     else:
+        settling = ("undefined (the run starts on the line)" if run.started_on_line
+                    else "not reached within the run" if summary["settling_time_95"] is None
+                    else f"{summary['settling_time_95']:.1f} s")
         print(f"robot {robot.name}: a = {run.gain:g} 1/s, T = {run.period:g} s, {len(run.time) - 1} periods; "
-              f"final h = {summary['final_h'] * 100:.2f} cm, psi = {math.degrees(summary['final_psi']):.2f} deg, "
-              f"overshoot {summary['overshoot'] * 100:.2f} cm, 95 % settling "
-              + ("not reached within the run" if summary['settling_time_95'] is None
-                 else f"{summary['settling_time_95']:.1f} s")
+              f"final h = {_fixed(summary['final_h'] * 100)} cm, psi = {_fixed(math.degrees(summary['final_psi']))} "
+              f"deg, overshoot {_fixed(summary['overshoot'] * 100)} cm, 95 % settling {settling}"
               + (f"; animation {args.animate}" if args.animate else ""))
     return 0
+
+
+def _fixed(x: float) -> str:
+    """Two decimals, without the sign of a value that rounds to zero ("0.00", not "-0.00")."""
+    return f"{round(x, 2) + 0.0:.2f}"

@@ -140,12 +140,21 @@ class LineFollowing:
 
     def settling_time(self, fraction: float = 0.95) -> float | None:
         """First time [s] after which |h| stays within ``(1 - fraction)`` of its initial value; None when the last
-        sample is still outside (not settled within the run: the end of the run is no settling time)."""
+        sample is still outside (not settled within the run: the end of the run is no settling time) or when the
+        run starts on the line (h = 0: no band to settle in, see :meth:`started_on_line`)."""
         h = np.abs(self.lateral)
+        if self.started_on_line:
+            return None
         outside = np.flatnonzero(h > (1 - fraction) * h[0])
         if outside.size and outside[-1] == len(h) - 1:
             return None
         return float(self.time[outside[-1] + 1]) if outside.size else 0.0
+
+    @property
+    def started_on_line(self) -> bool:
+        """Whether the run starts with P on the line (h = 0), where a settling time relative to the start's
+        distance is not defined."""
+        return bool(self.lateral[0] == 0.0)
 
     def failure(self) -> str | None:
         """Why the run is not a line following, or None: the line was lost in some images (the command then used
