@@ -88,10 +88,11 @@ def test_montecarlo_refuses_a_built_in_path_the_robot_cannot_steer(capsys):
 
 
 def test_sweep_text_gives_the_units_of_the_best_designs(capsys):
-    """The best designs were printed as 'wheels[0].alpha = 1.0472' (radians, though --vary was given in deg)."""
+    """The best designs were printed as 'wheels[0].alpha = 1.0472' (no unit), then in radians though --vary was
+    given in deg."""
     assert main(["sweep", "omni-3", "--vary", "wheels[0].alpha=30deg:90deg:3", "--vary", "wheels.back.l=0.15:0.25:3",
                  "--workers", "0", "--top", "1"]) == 0
-    assert "wheels[0].alpha = 1.0472 rad, wheels.back.l = 0.2 m" in capsys.readouterr().out
+    assert "wheels[0].alpha = 60 deg, wheels.back.l = 0.2 m" in capsys.readouterr().out
 
 
 def test_batch_odometry_text_shows_the_warnings_of_the_logs(capsys, fleet_dir, tmp_path):

@@ -59,8 +59,11 @@ def test_sweep_driver_best_designs_parquet_and_chunks(tmp_path):
             parse_vary("wheels[1].l=0.1:0.3:5", robot), parse_vary("wheels[2].l=150mm:250mm:3", robot)]
     res = sweep(robot, axes, "kappa_mean", chunk=16, out=tmp_path / "s.parquet", top=4)
     brute = evaluate(np.arange(105), build_spec(robot, axes, "kappa_mean"))[:, 0]
-    order = np.lexsort((np.arange(105), brute))[:4]
-    assert [b["index"] for b in res.best] == order.tolist()
+    # the best four, by value: designs 53 and 55 tie (mirror images) up to round-off, which depends on the chunk's
+    # path and the CPU's LAPACK kernels, so the order among ties is not checked
+    np.testing.assert_allclose([b["kappa_mean"] for b in res.best], np.sort(brute)[:4], rtol=1e-12)
+    np.testing.assert_allclose([brute[b["index"]] for b in res.best], np.sort(brute)[:4], rtol=1e-12)
+    assert len({b["index"] for b in res.best}) == 4
     assert res.best[0]["kappa_mean"] == pytest.approx(1.0, abs=1e-9)  # the symmetric kiwi drive is isotropic
     assert res.best[0]["wheels[0].alpha,wheels[0].beta"] == pytest.approx(math.radians(60))
     assert res.best[0]["wheels[1].l"] == pytest.approx(0.2)
@@ -70,7 +73,8 @@ def test_sweep_driver_best_designs_parquet_and_chunks(tmp_path):
     np.testing.assert_allclose(np.array(table["metric"])[np.argsort(table["index"])], brute, rtol=1e-12)
     np.testing.assert_allclose(res.grid, brute.reshape(7, 5, 3).min(axis=2), rtol=1e-12)
     other = sweep(robot, axes, "kappa_mean", chunk=1000, top=4)
-    assert [b["index"] for b in other.best] == [b["index"] for b in res.best]
+    np.testing.assert_allclose([b["kappa_mean"] for b in other.best], [b["kappa_mean"] for b in res.best],
+                               rtol=1e-12)
     margin = sweep(robot, axes, "singular_margin", top=2)
     assert margin.best[0]["singular_margin"] == pytest.approx(np.max(evaluate(
         np.arange(105), build_spec(robot, axes, "singular_margin"))[:, 0]))
@@ -173,8 +177,8 @@ def test_the_plot_names_units_and_survives_a_sweep_without_a_finite_value(tmp_pa
         plot_sweep(sweep(robot, [parse_vary("wheels.c2.alpha=90deg:180deg:3", robot)], configs=8, top=1),
                    tmp_path / "one.svg")
     text = (tmp_path / "none.svg").read_text()
-    assert "no finite kappa_mean" in text and "wheels.c2.alpha [rad]" in text and "wheels.o1.l [m]" in text
-    assert "wheels.c2.alpha [rad]" in (tmp_path / "one.svg").read_text()
+    assert "no finite kappa_mean" in text and "wheels.c2.alpha [deg]" in text and "wheels.o1.l [m]" in text
+    assert "wheels.c2.alpha [deg]" in (tmp_path / "one.svg").read_text()  # people read degrees, as typed
     assert [a["unit"] for a in singular.to_dict()["axes"]] == ["rad", "m"]
 
 
@@ -241,3 +245,40 @@ def test_heading_is_swept_as_users_write_it():
     with pytest.raises(BatchError, match="move the same field"):
         build_spec(robot, [parse_vary("wheels[0].heading=0:1:2", robot), parse_vary("wheels[0].beta=0:1:2", robot)],
                    "inv_kappa_mean")
+
+
+def test_position_is_swept_as_users_write_it(capsys):
+    """--vary wheels.X.x / .y move the wheel's position [x, y] (the users' form; only the thesis's polar l, alpha
+    could be swept): each design equals the robot described by hand with that position."""
+    from wmrkit.analysis.isotropy import natural_length
+    from wmrkit.description import robot_from_dict
+
+    robot = catalog.load("omni-3")
+    axes = [parse_vary("wheels[0].x=100mm:300mm:3", robot), parse_vary("wheels[0].y=-0.1:0.1:2", robot)]
+    assert [a.unit for a in axes] == ["m", "m"]
+    result = sweep(robot, axes, top=6, configs=8)
+    assert len(result.best) == 6
+    for b in result.best:
+        data = robot.to_dict()
+        data["wheels"][0]["position"] = [b["wheels[0].x"], b["wheels[0].y"]]
+        _, kappa = natural_length(robot_from_dict(data))
+        assert b["kappa_mean"] == pytest.approx(kappa, rel=1e-9)
+    for other in ("l", "alpha"):
+        with pytest.raises(BatchError, match="move the same field"):
+            build_spec(robot, [axes[0], parse_vary(f"wheels[0].{other}=0.1:0.2:2", robot)], "kappa_mean")
+
+
+def test_the_table_prints_angles_in_degrees(capsys):
+    """'--vary ...heading=-30deg:30deg:5' printed 'heading = -0.523599 rad': the table people read shows degrees
+    (JSON and Parquet keep radians, SI)."""
+    import json
+
+    from wmrkit.cli.main import main
+
+    argv = ["sweep", "omni-3", "--vary", "wheels[0].heading=-30deg:30deg:3", "--workers", "0", "--quiet"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "wheels[0].heading = -30 deg" in out and "wheels[0].heading = 30 deg" in out and "rad" not in out
+    assert main([*argv, "--json"]) == 0
+    axis = json.loads(capsys.readouterr().out)["axes"][0]
+    assert axis["unit"] == "rad" and axis["start"] == pytest.approx(-math.pi / 6)

@@ -197,7 +197,7 @@ def plot_sweep(result: SweepResult, path: str | os.PathLike[str]) -> None:
     best = result.best[0] if result.best else None
     if best is not None and not math.isfinite(best[result.metric]):
         best = None  # nothing to mark
-    label = lambda a: f"{a.label} [{a.unit}]"  # noqa: E731 - values in SI, as typed into --vary after the units
+    label = lambda a: f"{a.label} [{a.shown_unit}]"  # noqa: E731 - angles in degrees, as typed into --vary
     with np.errstate(all="ignore"):  # kappa >= 1 spanning decades: a log scale (not over a few per cent of one)
         log = result.metric in ("kappa_mean", "kappa_max") and np.nanmin(g, initial=np.inf) > 0 \
             and np.nanmax(g, initial=0.0) > 10 * np.nanmin(g, initial=np.inf)
@@ -207,24 +207,25 @@ def plot_sweep(result: SweepResult, path: str | os.PathLike[str]) -> None:
         ax.set_xlabel(label(a0) if len(result.axes) == 1 else label(result.axes[1]))
         ax.set_ylabel(result.metric if len(result.axes) == 1 else label(a0))
     elif len(result.axes) == 1:
-        ax.plot(a0.values, g, "-o", ms=3)
+        ax.plot(a0.shown(a0.values), g, "-o", ms=3)
         if log:
             ax.set_yscale("log")
         ax.set_xlabel(label(a0))
         ax.set_ylabel(result.metric)
         if best is not None:
-            ax.plot(best[a0.label], best[result.metric], "r*", ms=14, label="best")
+            ax.plot(a0.shown(best[a0.label]), best[result.metric], "r*", ms=14, label="best")
     else:
         a1 = result.axes[1]
         from matplotlib.colors import LogNorm
 
-        mesh = ax.pcolormesh(a1.values, a0.values, g, shading="nearest", cmap="viridis_r" if log else "viridis",
+        mesh = ax.pcolormesh(a1.shown(a1.values), a0.shown(a0.values), g, shading="nearest",
+                             cmap="viridis_r" if log else "viridis",
                              norm=LogNorm() if log else None)
         fig.colorbar(mesh, ax=ax, label=result.metric + (" (best over other axes)" if len(result.axes) > 2 else ""))
         ax.set_xlabel(label(a1))
         ax.set_ylabel(label(a0))
         if best is not None:
-            ax.plot(best[a1.label], best[a0.label], "r*", ms=14, label="best")
+            ax.plot(a1.shown(best[a1.label]), a0.shown(best[a0.label]), "r*", ms=14, label="best")
     if best is not None:
         ax.legend(loc="best", fontsize=8)
     ax.set_title(f"{result.robot}: {result.metric} over {result.total:,} designs")

@@ -48,9 +48,10 @@ _TARGET = re.compile(r"^wheels(?:\.([A-Za-z_][A-Za-z0-9_-]*)|\[(\d+)\])\.([a-z_]
 MAX_POINTS, MAX_DESIGNS, MAX_MAP, MAX_CONFIGS = 10**6, 10**9, 10**7, 10**4
 
 
-#: The fields a --vary may move: the description's geometry fields, and ``heading`` (the users' steering angle,
-#: 0 = straight ahead) in place of the thesis's ``beta``.
-VARY_FIELDS = {**GEOMETRY_FIELDS, "heading": "angle"}
+#: The fields a --vary may move: the description's geometry fields, ``heading`` (the users' steering angle,
+#: 0 = straight ahead) in place of the thesis's ``beta``, and ``x``, ``y`` (the wheel's ``position`` [m]) in place
+#: of the thesis's polar ``l``, ``alpha``.
+VARY_FIELDS = {**GEOMETRY_FIELDS, "heading": "angle", "x": "length", "y": "length"}
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: array field
@@ -65,6 +66,15 @@ class Axis:
     def unit(self) -> str:
         """Unit of the values: ``"rad"`` for the angle fields, ``"m"`` for the lengths."""
         return "rad" if VARY_FIELDS[self.targets[0][1]] == "angle" else "m"
+
+    @property
+    def shown_unit(self) -> str:
+        """Unit in which the values are shown to people (the table printed, the plot): ``"deg"`` or ``"m"``."""
+        return "deg" if self.unit == "rad" else "m"
+
+    def shown(self, values: Any) -> Any:
+        """`values` (SI) in :attr:`shown_unit`: angles in degrees, as typed into ``--vary``."""
+        return np.degrees(values) if self.unit == "rad" else values
 
 
 def parse_vary(text: str, robot: Robot) -> Axis:
@@ -115,9 +125,16 @@ def variant(robot: Robot, assignments: dict[tuple[int, str], float], *, where: s
 
     data = copy.deepcopy(robot_to_dict(robot, thesis=True))  # --vary sets the thesis's fields, or heading for beta
     for (i, fld), value in assignments.items():
+        wheel = data["wheels"][i]
+        if fld in ("x", "y"):
+            if "position" not in wheel:
+                l, alpha = wheel.pop("l"), wheel.pop("alpha")
+                wheel["position"] = [l * math.cos(alpha), l * math.sin(alpha)]
+            wheel["position"][fld == "y"] = float(value)
+            continue
         if fld == "heading":
-            data["wheels"][i].pop("beta", None)
-        data["wheels"][i][fld] = float(value)
+            wheel.pop("beta", None)
+        wheel[fld] = float(value)
     try:
         return robot_from_dict(data, source=where)
     except WmrkitError as err:
@@ -164,9 +181,10 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
         raise BatchError(f"--configs must be in [1, {MAX_CONFIGS}] (a whole number), got {configs!r}")
     check_seed(seed, BatchError)  # -1 and 2.5 reached numpy's ValueError and TypeError
     targets = [t for a in axes for t in a.targets]
-    if len(set(targets)) != len(targets) or any((i, "beta") in targets for i, f in targets if f == "heading"):
+    if len(set(targets)) != len(targets) or any((i, "beta") in targets for i, f in targets if f == "heading") \
+            or any((i, f) in targets for i, g in targets if g in ("x", "y") for f in ("l", "alpha")):
         raise BatchError("two --vary axes move the same field (one would overwrite the other; heading is beta - 90 "
-                         "deg)")
+                         "deg, and x, y place the wheel that l, alpha place)")
     shape = [len(a.values) for a in axes]
     if math.prod(shape[:2]) > MAX_MAP or math.prod(shape) > MAX_DESIGNS:
         raise BatchError(f"{' x '.join(map(str, shape))} designs: at most {MAX_DESIGNS:.0e} designs, and "

@@ -86,8 +86,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = commands.add_parser("sweep", help="a design metric over a product of description fields (Dask)")
     add_robot_argument(p)
     p.add_argument("--vary", action="append", required=True, metavar="FIELD=START:STOP:N",
-                   help="wheels.NAME.FIELD or wheels[I].FIELD: a geometry field of the description or heading "
-                        "(0 = straight ahead); comma-join fields moved together; units allowed")
+                   help="wheels.NAME.FIELD or wheels[I].FIELD: a geometry field of the description, heading "
+                        "(0 = straight ahead) or x, y (the position); comma-join fields moved together; units allowed")
     p.add_argument("--metric", choices=("kappa_mean", "kappa_max", "inv_kappa_mean", "singular_margin"),
                    default="kappa_mean", help="design metric (default kappa_mean; see docs/batch.md)")
     p.add_argument("--length", metavar="D", help="characteristic length [m] (default: each design's natural one)")
@@ -270,7 +270,7 @@ def run_sweep(args: argparse.Namespace) -> int:
         return 0
     print(f"robot {robot.name}: {args.metric} over {result.total:,} designs in {result.seconds:.3g} s")
     for b in result.best:
-        fields = ", ".join(f"{a.label} = {b[a.label]:.6g} {a.unit}" for a in axes)
+        fields = ", ".join(f"{a.label} = {a.shown(b[a.label]):.6g} {a.shown_unit}" for a in axes)
         value = b[args.metric]
         shown = (f"{value:.6g}" if math.isfinite(value) else "infinite (singular at a configuration sampled)"
                  if value == math.inf else "undefined (it cannot move at any configuration sampled)")
