@@ -235,3 +235,20 @@ def test_a_log_of_one_sample_is_refused_as_such(husky_run):
     one = JointLog(log.time[:1], log.joints, log.positions[:1], source="one.csv")
     with pytest.raises(WmrkitError, match=r"^one\.csv: 1 sample\(s\): a log to calibrate on needs a run"):
         calibrate_slip(catalog.load("skid-steer-4"), one, (log.time, husky_run.truth))
+
+
+def test_cli_calibrate_reads_the_log_header_units(tmp_path, capsys, husky_run):
+    """A log whose header says milliseconds ('time [ms]', 'WHEEL.spin [rad]'), read as 'wmrkit odometry' reads it,
+    gives the fit of the same log in seconds (it was refused: missing column 'time')."""
+    log = husky_run.log
+    plain, units, ref = tmp_path / "log.csv", tmp_path / "log_ms.csv", tmp_path / "ref.tum"
+    write_csv(plain, ("time", *log.joints), np.column_stack([log.time, log.positions]))
+    write_csv(units, ("time [ms]", *(f"{j} [rad]" for j in log.joints)),
+              np.column_stack([log.time * 1000, log.positions]))
+    write_trajectory(ref, Trajectory(log.time, husky_run.truth, np.zeros(len(log))), "tum")
+    fits = []
+    for path in (plain, units):
+        assert main(["calibrate", "skid-steer-4", str(path), "--reference", str(ref), "--json"]) == 0
+        fits.append(json.loads(capsys.readouterr().out))
+    for key in ("ratio", "wheel_separation_multiplier"):  # times / 1000 differ in the last bits: the fit's tolerance
+        assert fits[1][key] == pytest.approx(fits[0][key], rel=1e-7)

@@ -192,7 +192,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = commands.add_parser("calibrate", help="calibrate slip weights and the effective track from a log with a "
                                               "reference trajectory (skid steering)")
     add_robot_argument(p)
-    p.add_argument("log", metavar="LOG", help="CSV joint log (time, WHEEL.spin ... cumulative angles [rad])")
+    p.add_argument("log", metavar="LOG", help="CSV joint log (time, WHEEL.spin ... cumulative angles), read as its "
+                                             "header says ('time [ms]'; default s and rad), as 'wmrkit odometry'")
     p.add_argument("--reference", required=True, metavar="TRAJ.tum", help="reference trajectory (TUM) of the run")
     p.add_argument("--scheme", choices=("exact", "rk2", "euler", "paper002"), default="exact",
                    help="integration scheme (default: exact)")
@@ -203,6 +204,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 
 def run_calibrate(args: argparse.Namespace) -> int:
     """Fit the WLS lateral/longitudinal ratio and the effective track; print both and their errors."""
+    from ..odometry.header import header_format
     from ..odometry.logs import load_csv
     from ..odometry.model import odometry_model
     from ..odometry.trajectories import read_tum
@@ -210,7 +212,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
 
     robot = load_robot(args.robot)
     joints = odometry_model(robot).joints
-    log = load_csv(args.log, joints, robot=robot)
+    log = load_csv(args.log, joints, header_format(args.log, robot.name, joints), robot=robot)  # as odometry reads it
     if not Path(args.reference).is_file():
         raise WmrkitError(f"{args.reference}: {'not a file' if Path(args.reference).exists() else 'no such file'}")
     try:
