@@ -147,6 +147,13 @@ def test_errors(diff, runs, calibration_data, tmp_path):
         fleet_calibrate(diff, runs[:1], PARAMS)
 
 
+def test_a_bootstrap_interval_needs_two_runs(diff, runs):
+    """Every resample of one run is that run: the bootstrap printed the fit as its own 95 % interval, of zero width
+    whatever the noise (exit 0), where the Jacobian interval refuses."""
+    with pytest.raises(BatchError, match="at least two runs"):
+        fleet_calibrate(diff, runs[:1], PARAMS, ci="bootstrap", n_boot=5)
+
+
 SKID_SEGMENTS = [(3.0, [8, 12, 8, 12]), (2.0, [10, 10, 10, 10]), (3.0, [12, 8, 12, 8]), (2.0, [6, 14, 6, 14])]
 
 

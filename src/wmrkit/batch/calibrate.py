@@ -170,6 +170,8 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
         if reason is not None:
             raise BatchError(f"calibrate: the runs cannot tell these parameters apart: {reason}{problem.hint()}; add "
                              f"runs of other shapes or fit fewer parameters")
+        if len(runs) < 2:  # every bootstrap resample of one run is that run: a zero-width interval whatever the noise
+            raise BatchError("calibrate: a confidence interval needs at least two runs")
         notes = ()
         if ci == "jacobian":
             lo, hi = _sandwich_interval(problem, fit, level)
@@ -223,8 +225,6 @@ def _sandwich_interval(problem: CalibrationProblem, fit, level: float) -> tuple[
 
     sizes = problem.sizes()
     g = len(sizes)
-    if g < 2:
-        raise BatchError("calibrate: a confidence interval needs at least two runs")
     jtj = fit.jac.T @ fit.jac
     change = []
     for k, (a, b) in enumerate(zip(np.cumsum([0, *sizes[:-1]]), np.cumsum(sizes), strict=True)):
