@@ -354,7 +354,8 @@ def default_parameters(robot: Robot, *, closed: bool, sensed: Sequence[str] | No
 def load_run(robot: Robot, path: str, *, reference: str | os.PathLike[str] | None = None, closed: bool = False,
              options: Mapping[str, Any] | None = None) -> CalibrationRun:
     """A :class:`CalibrationRun` from a log file: with `reference` (a TUM or trajectory-CSV file) its poses at
-    the log's samples with equal times (within 1 us); with `closed`, the final pose is the start (origin).
+    the log's samples with equal times (within 1 us), the run starting at the first of them (in the reference's
+    frame); with `closed`, the final pose is the start (origin).
     `options`: ``sensed``; ``topic`` and ``joint_names`` (bags); ``fmt`` (a CSV layout), else ``header`` (settings
     of :func:`~wmrkit.odometry.header.header_format`: each CSV log is read as its header says)."""
     from ..odometry.files import is_bag
@@ -389,7 +390,13 @@ def load_run(robot: Robot, path: str, *, reference: str | os.PathLike[str] | Non
     bad = np.abs(log.time[near] - t) > 1e-6
     if bad.any():
         raise LogError(f"{ref}: reference time {float(t[np.flatnonzero(bad)[0]])!r} s is not a sample time of {path}")
-    return CalibrationRun(log, poses, near)
+    if len(near) < 2:  # its only pose is where the run starts: nothing to fit
+        raise LogError(f"{ref}: {len(near)} pose: a reference needs two or more poses within the log")
+    # the run starts at the first reference pose: a reference may start after the log, in its own frame (motion
+    # capture), and the log's start pose is then unknown (taken as the origin, it biased the fit), as in
+    # wmrkit.slip.calibration.calibrate_slip
+    first = int(near.min())
+    return CalibrationRun(log.slice(first, len(log)), poses, near - first)
 
 
 def find_reference(log_path: str, folder: str | os.PathLike[str]) -> str:
