@@ -43,6 +43,10 @@ def test_rows_match_the_in_memory_pipeline(fleet_dir, diff, tmp_path):
     table = pq.read_table(out)
     assert table.schema.names == [n for n, _ in SUMMARY_SCHEMA] and table.num_rows == 6
     assert not parts_dir(out).exists()
+    units = {f.name: (f.metadata or {}).get(b"unit", b"").decode() for f in table.schema}  # as the sweep's table
+    assert {k: units[k] for k in ("x", "theta", "duration", "path_length", "closure_heading", "max_slip")} == {
+        "x": "m", "theta": "rad", "duration": "s", "path_length": "m", "closure_heading": "rad", "max_slip": "m"}
+    assert units["log"] == "" and units["samples"] == ""
 
 
 def test_rerun_resumes_and_retries_failures(fleet_dir, diff, tmp_path):

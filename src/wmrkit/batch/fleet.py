@@ -30,14 +30,14 @@ from ..robot import Robot
 from .engine import BatchError, Engine, TaskFailure, engine
 from .parquet import RowSink, check_table, parts_dir, read_rows
 
-#: Columns of the batch-odometry table (name, type); lengths in m, angles in rad, times in s.
+#: Columns of the batch-odometry table (name, type and unit, :data:`.parquet.Schema`).
 SUMMARY_SCHEMA = (
     ("log", "string"), ("robot", "string"), ("method", "string"), ("samples", "int64"),
-    ("start_time", "float64"), ("duration", "float64"), ("x", "float64"), ("y", "float64"), ("theta", "float64"),
-    ("path_length", "float64"), ("rotation", "float64"), ("closure_error", "float64"),
-    ("closure_heading", "float64"), ("max_slip", "float64"), ("rms_slip", "float64"), ("max_dt", "float64"),
-    ("warnings", "string"), ("error", "string"), ("trajectory", "string"), ("seconds", "float64"),
-    ("settings", "string"),
+    ("start_time", "float64 s"), ("duration", "float64 s"), ("x", "float64 m"), ("y", "float64 m"),
+    ("theta", "float64 rad"), ("path_length", "float64 m"), ("rotation", "float64 rad"),
+    ("closure_error", "float64 m"), ("closure_heading", "float64 rad"), ("max_slip", "float64 m"),
+    ("rms_slip", "float64 m"), ("max_dt", "float64 s"), ("warnings", "string"), ("error", "string"),
+    ("trajectory", "string"), ("seconds", "float64 s"), ("settings", "string"),
 )
 #: Columns a table must have to be a batch-odometry table at all (an older one lacks some others: it is redone).
 KEY_COLUMNS = ("log", "robot", "method", "error", "trajectory")

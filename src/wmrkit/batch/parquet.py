@@ -17,14 +17,19 @@ from typing import Any
 
 from .engine import BatchError, need_extra
 
-#: Column types accepted in :data:`Schema`: pyarrow type names.
+#: Columns ``(name, type)``: pyarrow type names, with an optional unit after a space (``"float64 m"``), written
+#: as the field's ``unit`` metadata (as the sweep's table).
 Schema = Sequence[tuple[str, str]]
 
 
 def _schema(schema: Schema):
     pa = need_extra("pyarrow")
     types = {"string": pa.string(), "float64": pa.float64(), "int64": pa.int64(), "bool": pa.bool_()}
-    return pa.schema([(name, types[kind]) for name, kind in schema])
+    fields = []
+    for name, kind in schema:
+        kind, _, unit = kind.partition(" ")
+        fields.append(pa.field(name, types[kind], metadata={"unit": unit} if unit else None))
+    return pa.schema(fields)
 
 
 def write_rows(path: str | os.PathLike[str], rows: Sequence[Mapping[str, Any]], schema: Schema) -> None:
