@@ -170,3 +170,13 @@ def test_sweep_refuses_one_file_for_the_table_and_the_plot(capsys, tmp_path):
     assert main(["sweep", "omni-3", "--vary", "wheels[0].l=0.1:0.2:2", "--workers", "0", "--out",
                  str(tmp_path / "s.png"), "--plot", str(tmp_path / "s.png")]) == 2
     assert "is also --plot" in capsys.readouterr().err and not (tmp_path / "s.png").exists()
+
+
+def test_a_bad_log_of_a_glob_is_the_json_error_s_file(capsys, fleet_dir):
+    """The docs' 'logs/*.csv': the failing log is the JSON error's file and line (they were null: the message's
+    file was not a word of the command line, only the pattern that matched it)."""
+    assert main(["batch", "calibrate", "diff-drive", str(fleet_dir / "*.csv"), "--closed", "--workers", "0",
+                 "--json"]) == 2
+    data = json.loads(capsys.readouterr().err)
+    assert data["file"] == str(fleet_dir / "broken.csv") and data["line"] == 4
+    assert data["error"].startswith("time ") and "broken.csv" not in data["error"]

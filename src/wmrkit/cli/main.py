@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import fnmatch
+import glob
 import importlib
 import json
 import os
@@ -143,13 +145,17 @@ def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> N
 
 def _file_place(message: str, argv: Sequence[str]) -> dict:
     """``file``, ``line`` and ``field`` of a message that starts with a file given in `argv` (a path: a name with a
-    dot or a slash, or one that exists; the longest first), or with a file inside a folder given there (the files
-    a command writes into its output folder)."""
+    dot or a slash, or one that exists; the longest first), with a file inside a folder given there (the files
+    a command writes into its output folder), or with a file that a glob pattern given there matches."""
     paths = [a for a in argv if "." in a or "/" in a or os.path.exists(a)]
     name = max((a for a in paths if message.startswith(f"{a}:")), key=len, default=None)
     if name is None:
         inside = (re.match(re.escape(a.rstrip("/")) + r"/[^:\n]+(?=:)", message) for a in paths if a.strip("/"))
         name = max((m.group(0) for m in inside if m), key=len, default=None)
+    if name is None:  # a file that a pattern of the command line matched ('logs/*.csv' of the batch commands)
+        first = re.match(r"[^:\n]+(?=:)", message)
+        if first and any(glob.has_magic(a) and fnmatch.fnmatchcase(first.group(0), a) for a in argv):
+            name = first.group(0)
     if name is None:
         return {}
     # the column as "column 'NAME':" or, in a log's row errors, as the joint "WHEEL.spin:" / "WHEEL.steer:"
