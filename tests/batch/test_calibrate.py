@@ -423,3 +423,21 @@ def test_the_default_parameters_are_those_of_the_sensed_joints(tmp_path, capsys)
     assert main([*argv, *(a for s in sensed for a in ("--sensed", s))]) == 0
     fields = [v["field"] for v in json.loads(capsys.readouterr().out)["values"]]
     assert fields == ["front_left.r", "front_right.r", "rear_left.r", "front_left.l", "front_right.l", "rear_left.l"]
+
+
+def test_a_fit_that_did_not_converge_is_flagged(diff, runs, monkeypatch):
+    """A Levenberg-Marquardt fit stopped by its evaluation limit came out as any other, with only the JSON's
+    'success': false (the text output and the warnings said nothing)."""
+    import wmrkit.batch.calibrate as module
+    from wmrkit.odometry.calibration import solve
+
+    assert fleet_calibrate(diff, runs, PARAMS).warnings == ()
+
+    def stopped(*args, **kwargs):
+        fit = solve(*args, **kwargs)
+        fit.success, fit.message = False, "The maximum number of function evaluations is exceeded."
+        return fit
+
+    monkeypatch.setattr(module, "solve", stopped)
+    fit = fleet_calibrate(diff, runs, PARAMS)
+    assert not fit.success and any("did not converge" in w and "evaluations" in w for w in fit.warnings)

@@ -172,7 +172,8 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
                              f"runs of other shapes or fit fewer parameters")
         if len(runs) < 2:  # every bootstrap resample of one run is that run: a zero-width interval whatever the noise
             raise BatchError("calibrate: a confidence interval needs at least two runs")
-        notes = ()
+        notes = () if fit.success else (f"the fit did not converge ({' '.join(str(fit.message).split())}): the "
+                                        "values are where it stopped",)
         if ci == "jacobian":
             lo, hi = _sandwich_interval(problem, fit, level)
         else:
@@ -187,8 +188,8 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
                                  "cannot tell these parameters apart; add runs (closed squares: two or more in each "
                                  "direction) or use --ci jacobian")
             if dropped:
-                notes = (f"bootstrap: {dropped} of {n_boot} replicates dropped, their resampled runs cannot tell "
-                         "the parameters apart (the interval is over the others)",)
+                notes += (f"bootstrap: {dropped} of {n_boot} replicates dropped, their resampled runs cannot tell "
+                          "the parameters apart (the interval is over the others)",)
             lo, hi = np.quantile(kept, 0.5 - level / 2, axis=0), np.quantile(kept, 0.5 + level / 2, axis=0)
     finally:
         if own:
