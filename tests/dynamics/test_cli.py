@@ -146,6 +146,16 @@ def test_a_bad_heading_column_is_refused_at_its_place(capsys, tmp_path, text, pl
     assert err.strip() == f"wmrkit: error: {path}:{place}: {message}"
 
 
+def test_simulate_refuses_speed_without_a_path_program(capsys, tmp_path):
+    """--speed sets a --path program's speed; with --torques it was ignored (exit 0), though docs/limits.md said no."""
+    path = tmp_path / "tau.csv"
+    path.write_text("time,left_drive.spin,right_drive.spin\n0,100,100\n1,100,100\n")
+    code, out, err = run(capsys, "simulate", "forklift", "--torques", str(path), "--speed", "3", "--json")
+    assert code == 2 and out == ""
+    message = "--speed applies to --path (the speed of a built-in program; it would be ignored)"
+    assert json.loads(err)["error"] == message
+
+
 def test_simulate_torque_file(capsys, tmp_path):
     path = tmp_path / "tau.csv"
     path.write_text("time,left_drive.spin,right_drive.spin\n0,100,100\n1,100,100\n")

@@ -49,7 +49,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--duration", metavar="S", help="simulated time [s] (default: the program's or the file's)")
     p.add_argument("--step", default="0.001", metavar="DT", help="integration step [s] (default 0.001)")
     p.add_argument("--method", default="semi-implicit", choices=["semi-implicit", "rk4", "adaptive"])
-    p.add_argument("--speed", default="2", metavar="V", help="speed of a --path program [m/s] (default 2)")
+    p.add_argument("--speed", metavar="V", help="speed of a --path program [m/s] (default 2)")
     p.add_argument("--initial-twist", nargs=3, metavar=("VX", "VY", "OMEGA"),
                    help="initial twist [m/s, m/s, rad/s], rolling without slip (a twist at which a fixed wheel "
                         "would slip sideways is refused)")
@@ -110,7 +110,9 @@ def run_simulate(args: argparse.Namespace) -> int:
 
     model = DynamicModel.of(load_robot(args.robot), args.tyre)
     check_plot_path(args.plot)
-    speed = _positive(parse_value(args.speed, "number", "--speed"), "--speed")
+    if args.speed is not None and not args.path:  # it sets a program's speed: with --torques it would be ignored
+        raise WmrkitError("--speed applies to --path (the speed of a built-in program; it would be ignored)")
+    speed = _positive(parse_value("2" if args.speed is None else args.speed, "number", "--speed"), "--speed")
     if args.path:
         inputs, duration = path_program(model, args.path, speed=speed)
     else:
