@@ -156,6 +156,15 @@ def test_simulate_refuses_speed_without_a_path_program(capsys, tmp_path):
     assert json.loads(err)["error"] == message
 
 
+@pytest.mark.parametrize("name", ["run.png", "run.yaml", "run"])
+def test_simulate_out_is_csv_or_json(capsys, tmp_path, name):
+    """An --out neither .csv nor .json got CSV text under its name (a 'run.png' that no viewer opens), exit 0."""
+    out_file = tmp_path / name
+    code, out, err = run(capsys, "simulate", "forklift", "--path", "straight", "--out", str(out_file))
+    assert code == 2 and out == "" and not out_file.exists()
+    assert err.strip() == f"wmrkit: error: --out {out_file}: the samples are written as .csv or .json"
+
+
 def test_simulate_torque_file(capsys, tmp_path):
     path = tmp_path / "tau.csv"
     path.write_text("time,left_drive.spin,right_drive.spin\n0,100,100\n1,100,100\n")

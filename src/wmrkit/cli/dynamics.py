@@ -108,6 +108,8 @@ def run_simulate(args: argparse.Namespace) -> int:
     from ..dynamics.programs import path_program, read_torques
     from ..dynamics.simulate import MAX_STEPS, recordable_step, simulate
 
+    if args.out is not None and Path(args.out).suffix.lower() not in (".csv", ".json"):  # not CSV under another name
+        raise WmrkitError(f"--out {args.out}: the samples are written as .csv or .json")
     model = DynamicModel.of(load_robot(args.robot), args.tyre)
     check_plot_path(args.plot)
     if args.speed is not None and not args.path:  # it sets a program's speed: with --torques it would be ignored
