@@ -140,19 +140,20 @@ def run_simulate(args: argparse.Namespace) -> int:
         _plot_simulation(sim, model.robot.name, args.plot)
     pose, tw, end = sim.pose[-1], sim.twist[-1], float(sim.t[-1])  # the last sample: the record step's multiple
     travelled = float(np.sum(np.hypot(*np.diff(sim.pose[:, :2], axis=0).T)))
+    max_slip = float(np.hypot(sim.slip[..., 0], sim.slip[..., 1]).max())  # a contact's slip speed, not a component
     warnings = _tyre_warnings(model, sim.twist)
     for warning in warnings:
         print(f"wmrkit: warning: {warning}", file=sys.stderr)
     if args.json:
         print_json({"robot": model.robot.name, "method": sim.method, "step": step, "duration": duration,
                     "samples": len(sim.t), "final_time": end, "final_pose": pose.tolist(), "final_twist": tw.tolist(),
-                    "distance": travelled, "max_slip": float(np.abs(sim.slip).max()), "out": args.out,
+                    "distance": travelled, "max_slip": max_slip, "out": args.out,
                     "warnings": warnings})
     else:
         print(f"{model.robot.name}: {duration:g} s simulated ({sim.method}, step {step:g} s), {len(sim.t)} samples")
         print(f"final pose (t = {end:g} s): x = {pose[0]:.6g} m, y = {pose[1]:.6g} m, theta = {pose[2]:.6g} rad")
         print(f"final twist (t = {end:g} s): vx = {tw[0]:.6g} m/s, vy = {tw[1]:.6g} m/s, omega = {tw[2]:.6g} rad/s")
-        print(f"distance travelled: {travelled:.6g} m; largest slip speed {np.abs(sim.slip).max():.3g} m/s")
+        print(f"distance travelled: {travelled:.6g} m; largest slip speed {max_slip:.3g} m/s")
     return 0
 
 
