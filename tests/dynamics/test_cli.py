@@ -196,6 +196,25 @@ def test_simulate_refuses_a_duration_that_is_not_whole_steps(capsys, tmp_path, e
                            f"{extra[-1]} s steps: the run would end at t = {end} s; give a step that divides it")
 
 
+def test_simulate_out_forces_are_in_the_contact_frame(capsys, tmp_path):
+    """docs/dynamics.md: f_long is positive backwards (frame Ē): on a straight run the momentum's change is the
+    impulse of -sum(f_long)."""
+    torques, out_file = tmp_path / "tau.csv", tmp_path / "run.csv"
+    torques.write_text("time,left_drive.spin,right_drive.spin\n0,100,100\n1,100,100\n")
+    code, _, err = run(capsys, "simulate", "forklift", "--torques", str(torques), "--tyre", "dugoff", "--method",
+                       "adaptive", "--out", str(out_file))
+    assert code == 0, err
+    header = out_file.read_text().splitlines()[0].split(",")
+    table = np.loadtxt(out_file, delimiter=",", skiprows=1)
+    column = {name: table[:, k] for k, name in enumerate(header)}
+    wheels = ("right_drive", "left_drive", "steer")
+    f_long = sum(column[f"{w}.f_long"] for w in wheels)
+    assert np.all(column["right_drive.f_long"][1:] < 0) and np.all(column["vx"][1:] > 0)  # driving forward
+    impulse = np.concatenate([[0], np.cumsum(np.diff(column["time"]) * (f_long[1:] + f_long[:-1]) / 2)])
+    # from 0.1 s: the first samples, 10 ms apart, miss the forces rising within the first step
+    np.testing.assert_allclose(2500 * (column["vx"] - column["vx"][10])[20:], -(impulse - impulse[10])[20:], rtol=1e-3)
+
+
 def test_simulate_torque_file(capsys, tmp_path):
     path = tmp_path / "tau.csv"
     path.write_text("time,left_drive.spin,right_drive.spin\n0,100,100\n1,100,100\n")
