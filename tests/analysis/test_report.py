@@ -165,3 +165,27 @@ def test_the_table_of_every_assigned_set_has_a_bounded_grid(monkeypatch):
     for name in ("swerve-4", "thesis-steer-castor"):
         report._assignable_table(analyze(catalog.load(name), resolution=12), 1440)
     assert asked and max(asked) == 90  # report.TABLE_RESOLUTION
+
+
+
+@pytest.mark.parametrize(("name", "figure"), [("forklift", "singular"), ("ackermann", "singular"),
+                                              ("thesis-steer-castor", "length")])
+def test_report_figures_keep_every_axis_label_inside(name, figure):
+    """The forklift's and the car's singular pictures lost the left of their 'y [m]' label, the kappa(D) curve of
+    thesis-steer-castor half of 'condition number κ': the labels reached past the figure's left edge, which the
+    PNG cuts off. Every axis label and title now lies inside the figure."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from wmrkit.analysis.figures import length_figure, singular_figure
+
+    robot = catalog.load(name)
+    result = analyze(robot, resolution=12)
+    fig = (singular_figure(robot, result.singular["actuated"], "actuated") if figure == "singular"
+           else length_figure(robot, result.joints))
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    for ax in fig.axes:
+        for text in (ax.xaxis.label, ax.yaxis.label, ax.title):
+            box = text.get_window_extent(canvas.get_renderer())
+            assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1, text.get_text()
+            assert fig.bbox.y0 <= box.y0 and box.y1 <= fig.bbox.y1, text.get_text()

@@ -128,7 +128,7 @@ def motions_figure(robot: Robot, cls: Classification) -> Figure | None:
     size = robot_size(robot)
     n = len(samples)
     cols = 2 if n > 1 else 1
-    fig = Figure(figsize=(5 * cols, 4.6 * math.ceil(n / cols)), dpi=90)
+    fig = Figure(figsize=(5 * cols, 4.6 * math.ceil(n / cols)), dpi=90, layout="constrained")
     for k, h in enumerate(samples):
         ax = fig.add_subplot(math.ceil(n / cols), cols, k + 1)
         beta = steer_to_icr(robot, h) if robot.steer_names else robot.beta
@@ -146,7 +146,6 @@ def motions_figure(robot: Robot, cls: Classification) -> Figure | None:
                           if n in set(constraint_lines(robot).wheels))
         what += f"; {far}" if far and abs(h[2]) > 1e-12 else ""
         ax.set_title(what + (f"\nheadings: {steer}" if steer else ""), fontsize=9)
-    fig.subplots_adjust(left=0.08, right=0.97, bottom=0.06, top=0.93, wspace=0.3, hspace=0.35)
     return fig
 
 
@@ -157,7 +156,7 @@ def length_figure(robot: Robot, joints: tuple[str, ...]) -> Figure | None:
     kappa = np.array([float(twist_condition_number(robot, joints=joints, length=d)) for d in lengths])
     if not np.isfinite(kappa).any() or np.nanmax(kappa) - np.nanmin(kappa) < 1e-9:
         return None
-    fig = Figure(figsize=(6, 3.6), dpi=100)
+    fig = Figure(figsize=(6, 3.6), dpi=100, layout="constrained")
     ax = fig.add_subplot()
     ax.loglog(lengths, kappa, color="#1f77b4")
     ax.plot([d0], [k0], "o", color=ICR_COLOR)
@@ -166,7 +165,6 @@ def length_figure(robot: Robot, joints: tuple[str, ...]) -> Figure | None:
     ax.set_ylabel("condition number κ")
     ax.set_title(f"κ of ({', '.join(joints)}) ← (v, D·ω)", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
-    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.15, top=0.9)
     return fig
 
 
@@ -177,7 +175,7 @@ def condition_figure(robot: Robot, joints: tuple[str, ...], length: float, varia
         return None
     idx = [robot.steer_names.index(v) for v in variables[:2]]
     axis = np.linspace(-np.pi, np.pi, resolution + 1)  # headings
-    fig = Figure(figsize=(6.4, 4.4), dpi=100)
+    fig = Figure(figsize=(6.4, 4.4), dpi=100, layout="constrained")
     ax = fig.add_subplot()
     if len(idx) == 1:
         heading = np.broadcast_to(robot.heading, (len(axis), len(robot.beta))).copy()
@@ -205,7 +203,6 @@ def condition_figure(robot: Robot, joints: tuple[str, ...], length: float, varia
         ax.set_ylabel(f"heading of {variables[1]} [deg]")
         ax.legend(loc="upper right", fontsize=8)
     ax.set_title(f"κ of ({', '.join(joints)}) at D = {length:.3g} m", fontsize=10)
-    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.13, top=0.9)
     return fig
 
 
@@ -219,7 +216,7 @@ def singular_figure(robot: Robot, s: SingularSet, title: str) -> Figure | None:
         gap = np.abs(np.angle(np.exp(1j * (s.configurations - beta[idx])))).sum(axis=1)
         beta[idx] = s.configurations[int(np.argmin(gap))]
     two = len(s.variables) == 2 and len(s.configurations) > 1
-    fig = Figure(figsize=(11 if two else 6.5, 5.6), dpi=90)
+    fig = Figure(figsize=(11 if two else 6.5, 5.6), dpi=90, layout="constrained")
     ax = fig.add_subplot(1, 2 if two else 1, 1)
     draw_robot(robot, ax, beta=beta, labels=False)
     size = robot_size(robot)
@@ -249,5 +246,4 @@ def singular_figure(robot: Robot, s: SingularSet, title: str) -> Figure | None:
         ax2.legend(loc="upper right", fontsize=8)
         ax2.set_title("singular configurations", fontsize=9)
         ax2.grid(True, alpha=0.3)
-    fig.subplots_adjust(left=0.08, right=0.97, bottom=0.1, top=0.92, wspace=0.25)
     return fig
