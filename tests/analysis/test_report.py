@@ -45,7 +45,7 @@ def test_json_output_has_the_keys_of_the_issue(capsys):
     assert out["actuation"]["consistent"] is True  # two driven wheels, one motor: the catalog declares the differential
     assert out["actuation"]["sufficient"] is True and out["sensing"]["sufficient"] is True
     assert out["condition_number"] == pytest.approx(1.0)
-    assert out["characteristic_length"] > 0
+    assert out["characteristic_length"] is None  # m = 1: kappa = 1 at every length, none to choose
 
 
 def test_couplings_decide_the_actuation_verdict(capsys):
@@ -189,3 +189,17 @@ def test_report_figures_keep_every_axis_label_inside(name, figure):
             box = text.get_window_extent(canvas.get_renderer())
             assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1, text.get_text()
             assert fig.bbox.y0 <= box.y0 and box.y1 <= fig.bbox.y1, text.get_text()
+
+
+@pytest.mark.parametrize("name", ["ackermann", "thesis-tricycle", "swerve-4"])
+def test_no_natural_length_where_isotropy_does_not_apply(name, capsys):
+    """m = 1: kappa is 1 at every length, yet `analyze --json` gave the robot size (natural_length's fallback,
+    2.06 m for the car) as `characteristic_length` with `natural_length: true`, while the text and the report say
+    isotropy does not apply. No length is reported now unless one is given."""
+    assert main(["analyze", name, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mobility"] == 1 and out["condition_number"] == pytest.approx(1.0)
+    assert out["characteristic_length"] is None
+    assert main(["analyze", name, "--json", "--length", "300 mm"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["characteristic_length"] == pytest.approx(0.3) and out["natural_length"] is False

@@ -64,9 +64,10 @@ class Analysis:
 
     @property
     def has_length(self) -> bool:
-        """A length goes with the condition number: given, or natural where some length makes kappa finite (where
-        none does, :func:`.natural_length` falls back to the robot size, which minimises nothing)."""
-        return not self.natural or bool(np.isfinite(self.condition_number))
+        """A length goes with the condition number: given, or natural where some length makes kappa finite and
+        kappa depends on it (m >= 2). Elsewhere :func:`.natural_length` falls back to the robot size, which
+        minimises nothing."""
+        return not self.natural or (self.classification.mobility >= 2 and bool(np.isfinite(self.condition_number)))
 
     def condition_words(self) -> str:
         """The condition number and its length in words (the text summary and the report)."""

@@ -519,7 +519,8 @@ function renderAnalysis() {
   setCell("a-actuation", verdict(a.actuation, a.actuation.consistent && a.actuation.sufficient), a.actuation);
   setCell("a-sensing", verdict(a.sensing, a.sensing.sufficient), a.sensing);
   setCell("a-kappa", (a.condition_number === null ? "κ infinite (these joints do not determine the twist) "
-    : `κ = ${fmt(a.condition_number, 6)} at D = ${fmt(a.characteristic_length, 4)} m `) +
+    : `κ = ${fmt(a.condition_number, 6)} ` + (a.characteristic_length === null ? ""
+      : `at D = ${fmt(a.characteristic_length, 4)} m `)) +
     `<span class="hint">(${esc(a.condition_joints.join(", "))})</span>`, [a.condition_number, a.characteristic_length]);
   const here = Object.entries(a.singular_here).map(([k, s]) => `${k}: ` + (s.singular ? '<span class="bad">singular</span>'
     : s.near ? `<span class="warn">near (distance ${fmt(s.distance, 3)})</span>` : `no (distance ${fmt(s.distance, 3)})`));
