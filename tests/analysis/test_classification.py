@@ -244,3 +244,15 @@ def test_special_configuration_is_told_in_headings(angle):
     for h in (h1, h2):
         assert instantaneous_mobility(r, heading=[h, h]) == special.mobility == 2
     assert instantaneous_mobility(r, heading=[a, a]) == 1
+
+
+def test_fighting_fixed_wheels_are_named_in_description_order():
+    """The reason listed the fixed wheels in alphabetical order: w0, w1, w10, w11, ..., w2 for a ring of wheels
+    w0..w11; it now names them as the description lists them."""
+    ring = [{"name": f"w{i}", "type": "fixed", "r": 0.05, "heading": 0.0,
+             "position": [0.5 * math.cos(2 * math.pi * i / 12), 0.5 * math.sin(2 * math.pi * i / 12)]}
+            for i in range(12)]
+    robot = Robot.from_dict({"name": "ring", "wheels": ring})
+    c = classify(robot)
+    assert c.degenerate and c.reasons[0].startswith(
+        "fixed wheels " + ", ".join(f"w{i}" for i in range(12)) + " have different axles")

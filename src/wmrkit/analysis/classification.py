@@ -109,7 +109,7 @@ def classify(robot: Robot, *, samples: int = 8, seed: int = 0) -> Classification
     rf = int(matrix_rank(g_fixed)) if fixed_rows else 0
     reasons: list[str] = []
     if rf >= 2:
-        names = sorted({cl.wheels[i] for i in fixed_rows})
+        names = sorted({cl.wheels[i] for i in fixed_rows}, key=robot.wheel_names.index)
         reasons.append(f"fixed wheels {', '.join(names)} have different axles: they fight (5.11)")
     rng = np.random.default_rng(seed)
     admissible = _admissible_configurations(robot, g_fixed, rf, samples, rng)
