@@ -137,12 +137,29 @@ def test_simulate_out_writes_steering_as_headings(capsys, tmp_path):
         assert run(capsys, "simulate", "forklift", "--torques", str(torques), "--out", str(out))[0] == 0
     header = csv_out.read_text().splitlines()[0].split(",")
     table = np.loadtxt(csv_out, delimiter=",", skiprows=1)
-    assert "steer.heading" in header and "steer.steer.position" not in header
-    assert "right_drive.spin.position" in header and "steer.steer.rate" in header
-    assert np.abs(table[:, header.index("steer.heading")]).max() < 1e-3  # straight ahead (beta: pi/2)
+    assert "steer.steer [rad]" in header  # the heading, as a joint log's steering column
+    assert "right_drive.spin [rad]" in header and "steer.steer.rate [rad/s]" in header
+    assert np.abs(table[:, header.index("steer.steer [rad]")]).max() < 1e-3  # straight ahead (beta: pi/2)
     data = json.loads(json_out.read_text())
     heading = np.array(data["joint_positions"])[:, data["positions"].index("steer.heading")]
-    np.testing.assert_allclose(heading, table[:, header.index("steer.heading")], atol=1e-8)
+    np.testing.assert_allclose(heading, table[:, header.index("steer.steer [rad]")], atol=1e-8)
+
+
+@pytest.mark.parametrize(("robot", "path"), [("skid-steer-4", "turn"), ("forklift", "turn")])
+def test_simulate_out_is_a_joint_log_that_odometry_reads(capsys, tmp_path, robot, path):
+    """simulate --out wrote 'front_left.spin.position' and 'steer.heading' without units: 'wmrkit odometry' on it
+    said "missing column 'front_left.spin' (did you mean 'front_left.spin.rate'?)", and following the hint read the
+    rates as angles (x = 2.0 m for a run that ended at 16.6 m). The CSV is now a joint log with units in its
+    header: odometry reads it as written, and on the slip-free forklift turn ends near the simulated pose."""
+    out, traj = tmp_path / "run.csv", tmp_path / "odo.tum"
+    assert run(capsys, "simulate", robot, "--path", path, "--out", str(out))[0] == 0
+    table = np.loadtxt(out, delimiter=",", skiprows=1)
+    code, _, err = run(capsys, "odometry", robot, str(out), "--out", str(traj))
+    assert code == 0, err
+    end = np.loadtxt(traj)[-1]
+    assert end[0] == pytest.approx(table[-1, 0])
+    if robot == "forklift":  # little slip: the wheels' odometry is close to the simulated pose
+        assert np.hypot(end[1] - table[-1, 1], end[2] - table[-1, 2]) < 0.05 * np.hypot(table[-1, 1], table[-1, 2])
 
 
 @pytest.mark.parametrize("text, place, message", [
@@ -206,7 +223,7 @@ def test_simulate_out_forces_are_in_the_contact_frame(capsys, tmp_path):
     assert code == 0, err
     header = out_file.read_text().splitlines()[0].split(",")
     table = np.loadtxt(out_file, delimiter=",", skiprows=1)
-    column = {name: table[:, k] for k, name in enumerate(header)}
+    column = {name.partition(" [")[0]: table[:, k] for k, name in enumerate(header)}
     wheels = ("right_drive", "left_drive", "steer")
     f_long = sum(column[f"{w}.f_long"] for w in wheels)
     assert np.all(column["right_drive.f_long"][1:] < 0) and np.all(column["vx"][1:] > 0)  # driving forward

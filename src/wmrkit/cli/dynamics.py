@@ -207,10 +207,13 @@ def _write(sim, out: str) -> None:
             path.write_text(json.dumps(sim.to_dict()) + "\n", encoding="utf-8")
             return
         position_names, positions = sim.joint_table()
-        cols = ["time", "x", "y", "theta", "vx", "vy", "omega",
-                *(n if n.endswith(".heading") else f"{n}.position" for n in position_names),
-                *(f"{j}.rate" for j in sim.joint_names), *(f"{c}.{k}" for c in sim.contacts for k in
-                                                           ("f_lat", "f_long", "load"))]
+        # a joint log as `wmrkit odometry` and `calibrate` read it: units in the header, a steered wheel's heading
+        # as its 'WHEEL.steer' column, every other column's name not a joint's (x, WHEEL.spin.rate, ...)
+        cols = ["time [s]", "x [m]", "y [m]", "theta [rad]", "vx [m/s]", "vy [m/s]", "omega [rad/s]",
+                *(f"{n.removesuffix('.heading')}.steer [rad]" if n.endswith(".heading") else f"{n} [rad]"
+                  for n in position_names),
+                *(f"{j}.rate [rad/s]" for j in sim.joint_names),
+                *(f"{c}.{k} [N]" for c in sim.contacts for k in ("f_lat", "f_long", "load"))]
         data = np.column_stack([sim.t, sim.pose, sim.twist, positions, sim.joint_rates,
                                 np.concatenate([sim.forces, sim.loads[..., None]], axis=-1).reshape(len(sim.t), -1)])
         np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.9g")
