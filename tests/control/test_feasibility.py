@@ -309,3 +309,25 @@ def test_a_densely_sampled_reference_is_judged_above_rounding():
     # (its end, inside the clothoid, is another matter: the one-sided curvature rate of the last samples, 20 -> 10)
     assert [(v.signal, round(v.t, 3)) for v in got if v.t < 0.29] == [("kappa_rate", 0.15)]
     assert got[0].size == pytest.approx(20.0, rel=0.02)
+
+
+@pytest.mark.parametrize("name", ["diff-drive", "forklift", "ackermann", "line-follower", "thesis-steer-castor"])
+def test_a_speed_step_breaks_the_dynamic_framework_of_every_vehicle(name):
+    """Along +x at 0.5 m/s, then 1 m/s from t = 5 s: the tangent, its rate and the curvature stay continuous, but the
+    drive wheels' spins jump with the speed (below, from the no-slip IK), which the dynamic framework forbids (wheel
+    rates continuous, §8.5). A diff drive, forklift or car (types 2 on the axle and 4) was reported feasible:
+    Table 8.1 states their condition on chi only, by (8.34) 'chi C1 => v_a C0', which a speed step on a line
+    contradicts. The kinematic framework lets the rates jump: feasible there."""
+    from wmrkit.kinematics.wheel_ik import wheel_commands
+
+    t = np.arange(0.0, 10.0, 0.01)
+    x = np.where(t < 5, 0.5 * t, 2.5 + (t - 5))
+    ref = reference_from_samples("speed-step.csv", t, np.column_stack([x, 0 * t, 0 * t]))
+    robot = catalog.load(name)
+    spins = [np.asarray(wheel_commands(robot, [v, 0.0, 0.0]).spin) for v in (0.5, 1.0)]
+    assert np.abs(spins[1] - spins[0]).max() > 1.0  # the wheels' rates jump (rad/s)
+    assert feasibility(robot, ref, "kinematic").feasible
+    got = feasibility(robot, ref, "dynamic").violations
+    assert [v.signal for v in got] == ["velocity"]
+    assert got[0].t == pytest.approx(5.0, abs=0.02) and got[0].size == pytest.approx(0.5, rel=1e-6)
+    assert "re-orient" not in got[0].remedy  # nothing turns: the speed steps

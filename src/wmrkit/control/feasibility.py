@@ -40,13 +40,16 @@ __all__ = ["COLUMNS", "Feasibility", "Requirement", "Violation", "feasibility", 
 _VEHICLE = "stop and re-orient the vehicle"
 _WHEEL = "stop and re-orient the orientable wheel"
 _WHEELS = "stop and re-orient the orientable wheels"
-#: Table 8.1: column -> (pose references, kinematic signals, dynamic signals, remedy, footnote).
+#: Table 8.1: column -> (pose references, kinematic signals, dynamic signals, remedy, footnote). The dynamic
+#: framework of every column also needs the velocity continuous: the drive wheels' rates are proportional to the
+#: speed, and the table's conditions on chi alone rest on (8.34) 'chi C1 => v_a C0', which a speed step on a line
+#: (chi constant) contradicts.
 COLUMNS: dict[str, tuple[int, tuple[str, ...], tuple[str, ...], str]] = {
     "type 1": (3, ("position", "theta"), ("velocity", "omega"), "the reference must be continuous"),
     "type 2, off axle": (2, ("position",), ("velocity",), "the reference must be continuous"),
-    "type 2, on axle": (2, ("position", "chi"), ("position", "chi", "chi_rate"), _VEHICLE),
-    "type 4, off axle": (2, ("position", "chi"), ("position", "chi", "chi_rate"), _WHEEL),
-    "type 4, on axle": (2, ("position", "chi", "kappa"), ("position", "chi", "kappa", "kappa_rate"),
+    "type 2, on axle": (2, ("position", "chi"), ("position", "chi", "velocity", "chi_rate"), _VEHICLE),
+    "type 4, off axle": (2, ("position", "chi"), ("position", "chi", "velocity", "chi_rate"), _WHEEL),
+    "type 4, on axle": (2, ("position", "chi", "kappa"), ("position", "chi", "velocity", "kappa", "kappa_rate"),
                         _WHEEL + " (both tangent and curvature jump: the vehicle, re-orienting the wheel twice)"),
     "types 3 and 5, l_o != 0": (3, ("position", "theta", "velocity", "omega"),
                                 ("position", "theta", "velocity", "omega", "acceleration", "omega_rate"), _WHEELS),
@@ -328,4 +331,6 @@ def _remedy(req: Requirement, signal: str) -> str:
         return _WHEEL
     if req.column.startswith("type 1") or req.column.startswith("type 2, off"):
         return "an error appears that the position loop then removes (kinematics allows no jump here)"
+    if signal == "velocity" and req.framework == "dynamic" and "l_o != 0" not in req.column:
+        return "the speed steps (the wheels' rates would jump): an error appears that the position loop then removes"
     return req.remedy
