@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from wmrkit import catalog
-from wmrkit.control.laws import PositionLaw, SamplingWarning, check_sampling, law_velocity
+from wmrkit.control.laws import PositionLaw, SamplingWarning, check_sampling, law_velocity, sampled_root
 from wmrkit.control.loop import law_controller, simulate
 from wmrkit.control.points import ControlError, control_point, point_pose
 from wmrkit.control.references import builtin_reference
@@ -126,6 +126,57 @@ def test_sampling_rule_warns():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert check_sampling(PositionLaw.uniform("p", 0.2), 0.5)
+
+
+@pytest.mark.parametrize(("a", "b", "period", "delay"), [(15.0, 0.0, 0.1, 0), (25.0, 0.0, 0.1, 0), (5.0, 0.0, 0.1, 3),
+                                                      (3.0, 0.0, 0.1, 3), (0.2, 5.0, 0.5, 0), (1.0, 2.0, 0.5, 1)])
+def test_sampled_root_is_the_slowest_mode_of_the_simulated_loop(a, b, period, delay):
+    """sampled_root (a polynomial root) against the sampled loop itself (mecanum, lateral error, P or PI law),
+    written here as a state recursion: x = (e_k, ..., e_{k-d}, I_k), e_{k+1} = e_k - T (a e_{k-d} + b I_k),
+    I_{k+1} = I_k + T e_{k-d}. The simulation follows it exactly, and the root's modulus is the matrix's spectral
+    radius: without delay e_{k+1} = (1 - a T) e_k (a T = 1.5: a decaying oscillation; 2.5: grows 1.5 a sample)."""
+    robot, n = catalog.load("mecanum-4"), 24
+    ref = builtin_reference("line", duration=n * period + 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SamplingWarning)
+        out = simulate(robot, law_controller(control_point(robot), PositionLaw.uniform("pi" if b else "p", a, b), ref),
+                       np.array([0.0, 0.3, 0.0]), n * period, period=period, delay=delay)
+    m = np.zeros((delay + 2, delay + 2))
+    m[0, 0], m[0, -1] = 1.0, -b * period
+    m[0, delay] -= a * period
+    m[1:delay + 1, :delay] += np.eye(delay)
+    m[-1, delay], m[-1, -1] = period, 1.0
+    x, e = np.r_[np.full(delay + 1, -0.3), 0.0], []
+    for _ in range(n + 1):
+        e.append(x[0])
+        x = m @ x
+    np.testing.assert_allclose(-out["pose"][:, 1], e, atol=1e-9 * max(1.0, np.abs(e).max()))
+    if b == 0:  # the integral then feeds nothing back: its mode (z = 1) is not the error's
+        m = m[:-1, :-1]
+    assert abs(sampled_root(a, b, period, delay)) == pytest.approx(max(abs(np.linalg.eigvals(m))), rel=1e-6)
+    if b == 0 and delay == 0:
+        assert sampled_root(a, b, period, delay) == pytest.approx(1 - a * period)
+
+
+def test_sampling_warning_says_when_the_sampled_loop_diverges():
+    """The warning said 'expect oscillation; unstable with a one-sample delay once a T > 1' for every fast pole: a
+    loop without delay at a T = 2.5 (unstable: its error grows 1.5 times a sample) or with 3 samples of delay at
+    a T = 0.5 (unstable from 0.445) printed its diverging run with that warning; without delay at a T = 0.4 it
+    promised an oscillation that a first-order recursion never has. A PI law with a large integral gain diverges
+    sampled whatever 1/a (b T^2 = 1.25 here), and was not warned of."""
+    def message(law, period, delay=0):
+        with pytest.warns(SamplingWarning) as caught:
+            assert not check_sampling(law, period, delay=delay)
+        return str(caught[0].message)
+
+    assert "unstable" in message(PositionLaw.uniform("p", 25.0), 0.1) and "1.5 times" in message(
+        PositionLaw.uniform("p", 25.0), 0.1)
+    assert "unstable with a delay of 3 samples" in message(PositionLaw.uniform("p", 5.0), 0.1, 3)
+    assert "oscillation" not in message(PositionLaw.uniform("p", 0.8), 0.5)
+    assert "expect oscillation; unstable from a T = 1 with a delay of 1 sample" in message(
+        PositionLaw.uniform("p", 0.8), 0.5, 1)
+    assert "unstable" in message(PositionLaw.uniform("pi", 0.2, 5.0), 0.5)
+    assert abs(sampled_root(0.2, 5.0, 0.5)) > 1
 
 
 def test_bad_options_raise_located_errors():

@@ -22,9 +22,9 @@ from typing import Literal
 import numpy as np
 
 from ..wheels import wrap_angle
-from .points import ControlError
+from .points import ControlError, check_delay
 
-__all__ = ["KINDS", "PositionLaw", "SamplingWarning", "check_sampling", "law_velocity"]
+__all__ = ["KINDS", "PositionLaw", "SamplingWarning", "check_sampling", "law_velocity", "sampled_root"]
 
 KINDS = ("point", "p", "pi")
 
@@ -84,12 +84,41 @@ def law_velocity(law: PositionLaw, pose_ref: np.ndarray, velocity_ref: np.ndarra
     return out
 
 
-def check_sampling(law: PositionLaw, period: float, *, factor: float = 10.0, stacklevel: int = 2) -> bool:
-    """Whether ``1/a >= factor * T`` for every pole (§8.3); warns :class:`SamplingWarning` when not."""
+def sampled_root(a: float, b: float, period: float, delay: int = 0) -> complex:
+    """The slowest root of the sampled error recursion of one coordinate (commands held for `period` ``T``, the pose
+    measured `delay` samples late): ``e_{k+1} = e_k - T (a e_{k-d} + b I_k)``, ``I_{k+1} = I_k + T e_{k-d}``, whose
+    characteristic polynomial is ``z^d (z - 1)^2 + a T (z - 1) + b T^2`` (``b = 0``: ``z^{d+1} - z^d + a T``,
+    stable while ``a T < 2 sin(pi / (2 (2 d + 1)))``: 2 without delay, 1 with one sample). The loop oscillates when
+    this root is complex or negative and diverges when its modulus reaches 1."""
+    if b == 0:
+        poly = np.zeros(delay + 2)
+        poly[:2] = 1.0, -1.0
+        poly[-1] += a * period
+    else:
+        poly = np.polyadd(np.r_[1.0, -2.0, 1.0, np.zeros(delay)], [a * period, b * period * period - a * period])
+    return complex(max(np.roots(poly), key=abs))
+
+
+def check_sampling(law: PositionLaw, period: float, *, delay: int = 0, factor: float = 10.0,
+                   stacklevel: int = 2) -> bool:
+    """Whether ``1/a >= factor * T`` for every pole (§8.3) and the sampled loop is stable (:func:`sampled_root`,
+    with `delay` samples); warns :class:`SamplingWarning` when not, saying whether the loop oscillates or diverges."""
+    check_delay(delay)
     fastest = max(law.a)
     ok = fastest == 0 or 1.0 / fastest >= factor * period * (1 - 1e-12)
+    b = law.b if law.kind == "pi" else (0.0, 0.0, 0.0)
+    root = max((sampled_root(ai, bi, period, delay) for ai, bi in zip(law.a, b, strict=True)), key=abs)
+    samples = f"{delay} sample{'' if delay == 1 else 's'}"
+    rule = "" if ok else f"1/a = {1 / fastest:.3g} s < {factor:g} T = {factor * period:.3g} s (thesis §8.3): "
+    if abs(root) >= 1 - 1e-12:
+        warnings.warn(f"discrete loop: {rule}unstable with a delay of {samples}: the error grows by "
+                      f"{abs(root):.4g} times a sample; lower the gains or the period", SamplingWarning,
+                      stacklevel=stacklevel)
+        return False
     if not ok:
-        warnings.warn(f"discrete loop: 1/a = {1 / fastest:.3g} s < {factor:g} T = {factor * period:.3g} s "
-                      f"(thesis §8.3): expect oscillation; unstable with a one-sample delay once a T > 1",
-                      SamplingWarning, stacklevel=stacklevel)
+        shape = ("expect oscillation" if abs(root.imag) > 1e-12 or root.real < 0 else
+                 "the sampled response departs from the continuous design")
+        bound = (f"; unstable from a T = {2 * math.sin(math.pi / (2 * (2 * delay + 1))):.3g} with a delay of "
+                 f"{samples}" if law.kind != "pi" else "")
+        warnings.warn(f"discrete loop: {rule}{shape}{bound}", SamplingWarning, stacklevel=stacklevel)
     return ok

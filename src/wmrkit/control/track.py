@@ -169,8 +169,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     if controller in ("p", "pi", "point"):
         b = gain * gain / 4 if integral_gain is None else integral_gain
         law = PositionLaw.uniform(controller, gain, b if controller == "pi" else 0.0, gate)  # type: ignore[arg-type]
-        if period is not None:
-            check_sampling(law, period, stacklevel=3)
+        if sampled is not None:
+            check_sampling(law, sampled, delay=delay, stacklevel=3)
         if dynamics:  # the same law in scalar arithmetic: the dynamic loop's per-period cost (issue 11)
             from .dynamic_plant import fast_law_controller
 
