@@ -197,3 +197,21 @@ def test_skid_steer_is_controlled_with_slip_reported():
     assert run.error.max() < 1e-6
     assert not np.all(run.commands.feasible)
     assert math.isfinite(run.summary()["rms_error"])
+
+
+def test_a_long_sampled_loop_is_refused_before_it_runs():
+    """A sampled loop of 1e6 periods passed the sample limit and ran for about an hour (a diff drive at 0.02 s: four
+    evaluations of an RK4 step for its castor each period). It is refused before the first period; a run within
+    the bound still goes."""
+    from wmrkit.control.loop import MAX_SAMPLED_EVALUATIONS
+
+    def never(t, pose, integral):
+        raise AssertionError("the loop ran")
+
+    diff = catalog.load("diff-drive")
+    with pytest.raises(ControlError, match=f"more than {MAX_SAMPLED_EVALUATIONS} evaluations"):
+        simulate(diff, never, np.zeros(3), 19_999.0, period=0.02)
+    with pytest.raises(ControlError, match="evaluations"):  # the exact step of the ideal plant: one a period
+        simulate(catalog.load("mecanum-4"), never, np.zeros(3), (MAX_SAMPLED_EVALUATIONS + 1) * 0.01, period=0.01)
+    run = track(diff, builtin_reference("line"), period=0.02, duration=2.0)
+    assert run.error.max() < 1e-6

@@ -62,6 +62,10 @@ def check_diverged(twist: np.ndarray, t: float) -> None:
 #: takes thousands), and at most this many seconds of computing (each evaluation costs 0.2 to 1 ms: the
 #: evaluation budget alone let a car with its steering at the ends of its range run for 6 minutes).
 MAX_EVALUATIONS, EVALUATIONS_PER_SECOND, MAX_CONTINUOUS_SECONDS = 20_000, 2_000, 120.0
+#: Most evaluations of a sampled loop: one a period for the ideal plant's exact step, one plus four per RK4 substep
+#: otherwise (castors, low-level loops). Each costs 0.5 to 1 ms (law, wheel IK, record), so 1e6 periods of a diff
+#: drive at 0.02 s (its RK4 step for the castor) ran for about an hour.
+MAX_SAMPLED_EVALUATIONS = 100_000
 
 
 def _too_stiff(controller: TwistController, sim: _Sim, t: float, x: np.ndarray, duration: float, evaluations: int,
@@ -295,6 +299,12 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
         integral = np.zeros(3)
         exact = plant.loops is None and not sim.passive.any()  # the ideal plant's exact SE(2) step
         subs = 1 if exact else max(1, math.ceil(period / 0.02))
+        work = n if exact else n * (1 + 4 * subs)
+        if work > MAX_SAMPLED_EVALUATIONS:
+            raise ControlError(f"duration {duration:g} s at a period of {period:g} s: {n} periods"
+                               f"{'' if exact else f' of {subs} RK4 substep(s) (castors or low-level loops)'}, more "
+                               f"than {MAX_SAMPLED_EVALUATIONS} evaluations of the loop (about 2 min of computing); "
+                               "give a shorter --duration or a longer --period")
         for k in range(n):
             t = k * period
             measured = history[max(0, k - delay)]
