@@ -298,13 +298,15 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
         x, history, records = x0.copy(), [x0[:3].copy()], []
         integral = np.zeros(3)
         exact = plant.loops is None and not sim.passive.any()  # the ideal plant's exact SE(2) step
-        subs = 1 if exact else max(1, math.ceil(period / 0.02))
+        step = 0.02 if plant.loops is None else min(0.02, plant.loops.time_scale)  # RK4 is stable within a few
+        subs = 1 if exact else max(1, math.ceil(min(period / step, 1e18)))  # time scales of the fastest loop
         work = n if exact else n * (1 + 4 * subs)
         if work > MAX_SAMPLED_EVALUATIONS:
-            raise ControlError(f"duration {duration:g} s at a period of {period:g} s: {n} periods"
-                               f"{'' if exact else f' of {subs} RK4 substep(s) (castors or low-level loops)'}, more "
-                               f"than {MAX_SAMPLED_EVALUATIONS} evaluations of the loop (about 2 min of computing); "
-                               "give a shorter --duration or a longer --period")
+            steps = "" if exact else (f" of {subs:.3g} RK4 substep(s) (castors, or low-level loops: each at most the "
+                                      f"fastest loop's time scale, {step:.3g} s)")
+            raise ControlError(f"duration {duration:g} s at a period of {period:g} s: {n} periods{steps}, more than "
+                               f"{MAX_SAMPLED_EVALUATIONS} evaluations of the loop (about 2 min of computing); give a "
+                               "shorter --duration or a longer --period")
         for k in range(n):
             t = k * period
             measured = history[max(0, k - delay)]
