@@ -86,8 +86,12 @@ def reference_from_samples(name: str, t: np.ndarray, pose: np.ndarray) -> Refere
     pose = np.asarray(pose, dtype=float).copy()
     if t.ndim != 1 or pose.shape != (len(t), 3) or len(t) < 3:
         raise ReferenceError(f"{name}: expected at least 3 samples of (t, x, y, theta), got {pose.shape}")
-    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(pose))):
-        raise ReferenceError(f"{name}: times and poses must be finite numbers")
+    bad = ~np.isfinite(np.column_stack([t, pose]))
+    if bad.any():
+        k, c = (int(i) for i in np.argwhere(bad)[0])
+        value = float(t[k] if c == 0 else pose[k, c - 1])
+        raise ReferenceError(f"{name}: sample {k + 1}: {('t', 'x', 'y', 'theta')[c]} {value!r} is not a finite "
+                             "number (times and poses must be)")
     if np.abs(pose[:, :2]).max() > MAX_COORDINATE:
         k = int(np.argmax(np.abs(pose[:, :2]).max(axis=1)))
         raise ReferenceError(f"{name}: sample {k + 1}: position ({pose[k, 0]:g}, {pose[k, 1]:g}) m is beyond "
