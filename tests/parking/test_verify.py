@@ -40,6 +40,40 @@ def test_the_check_sees_a_collision():
     assert report.colliding.tolist() == [False, True] and report.what == "curb"
 
 
+def test_a_check_in_chunks_sees_what_one_pass_sees(monkeypatch):
+    """The check tests its poses CHUNK at a time (memory bounded): a shifted path that hits the front car (the
+    hits in the middle of the path) gives the same per-pose answers, obstacle and clearance in chunks of 7 as in
+    one; the rear car is hit by a path shifted back."""
+    from wmrkit.parking import verify
+
+    plan = plan_parking(CAR_91, SLOT_91)
+    for dx, first in ((0.3, "front"), (-1.0, "rear")):
+        shifted = [Segment(s.phase, s.maneuver, s.direction, s.curvature, s.length, s.steering,
+                           (s.start[0] + dx, *s.start[1:]), (s.end[0] + dx, *s.end[1:])) for s in plan.segments]
+        whole = check_plan(CAR_91, SLOT_91, shifted)
+        monkeypatch.setattr(verify, "CHUNK", 7)
+        chunked = check_plan(CAR_91, SLOT_91, shifted)
+        monkeypatch.undo()
+        assert whole.what == chunked.what == first and 0 < chunked.n_collisions < len(chunked.poses)
+        assert np.array_equal(whole.colliding, chunked.colliding)
+        assert (whole.min_clearance, whole.inside) == (chunked.min_clearance, chunked.inside)
+
+
+def test_too_many_poses_are_refused_before_they_are_made():
+    """At most MAX_CHECK_POSES poses: eleven 100 m stretches sampled every 0.1 mm of corner motion would be 1.1e7
+    (2.2e6 with the cap of sample_poses per segment)."""
+    from wmrkit.errors import WmrkitError
+    from wmrkit.parking.verify import MAX_CHECK_POSES, densify
+
+    segs = [Segment(1, 0, 1, 0.0, 100.0, 0.0, (100.0 * k, 5.0, 0.0), (100.0 * (k + 1), 5.0, 0.0)) for k in range(11)]
+    with pytest.raises(WmrkitError, match=f"would test 2.2e\\+06 poses .*at most {MAX_CHECK_POSES}"):
+        check_plan(CAR_91, SLOT_91, segs, corner_step=1e-4)
+    with pytest.raises(WmrkitError, match=f"at most {MAX_CHECK_POSES}"):
+        check_poses(CAR_91, SLOT_91, np.zeros((MAX_CHECK_POSES + 1, 3)))
+    with pytest.raises(WmrkitError, match=f"at most {MAX_CHECK_POSES}"):
+        densify(CAR_91, np.array([[-1000.0, 5.0, 0.0], [0.0, 5.0, 0.0]]), corner_step=1e-4)
+
+
 def test_touching_is_not_a_collision():
     """Example 1 drives with the car's side on the obstacles' line (dx2 = c1/2): clearance 0, no overlap."""
     report = check_plan(CAR_91, SLOT_91, plan_parking(CAR_91, SLOT_91).segments)

@@ -74,10 +74,16 @@ def sample_poses(segments: tuple[Segment, ...] | list[Segment], step: float = 0.
     """
     chunks = []
     for k, seg in enumerate(segments):
-        n = min(max(1, math.ceil(seg.length / step)), MAX_SAMPLES)
+        n = sample_count(seg.length, step)
         s = np.linspace(0.0, seg.length, n + 1)[(1 if k else 0):]
         chunks.append(integrate_exact(np.array(seg.start), np.array(seg.twist), s))
     return np.concatenate(chunks) if chunks else np.zeros((0, 3))
+
+
+def sample_count(length: float, step: float) -> int:
+    """Number of steps :func:`sample_poses` cuts a segment `length` [m] long into: at most `step` [m] each, at most
+    :data:`MAX_SAMPLES`."""
+    return min(max(1, math.ceil(length / step)), MAX_SAMPLES)
 
 
 def path_length(segments: tuple[Segment, ...] | list[Segment]) -> float:

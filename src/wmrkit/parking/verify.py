@@ -17,7 +17,13 @@ import numpy as np
 from ..errors import WmrkitError
 from ..wheels import wrap_angle
 from .geometry import Space, Vehicle, footprint
-from .path import Segment, sample_poses
+from .path import Segment, sample_count, sample_poses
+
+#: Most poses one check tests (about 25 us each here: under a minute). A longer path (a pass of hundreds of
+#: metres, a car hundreds of metres long) is refused before anything is allocated: 1e7 poses took over 4 GB.
+MAX_CHECK_POSES = 2_000_000
+#: Poses tested at a time (their shapely polygons take about 1 kB each).
+CHUNK = 50_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,10 +87,12 @@ def dense_poses(vehicle: Vehicle, segments: tuple[Segment, ...] | list[Segment],
                 corner_step: float = 0.002) -> np.ndarray:
     """P_f's poses along the path with no body corner moving more than `corner_step` [m] between samples."""
     reach = _corner_reach(vehicle)
+    steps = [corner_step / (1 + reach * abs(seg.curvature)) for seg in segments]  # corner speed / P_f speed
+    _check_count(1 + sum(sample_count(seg.length, step) for seg, step in zip(segments, steps, strict=True)),
+                 corner_step)
     chunks = []
-    for k, seg in enumerate(segments):
-        factor = 1 + reach * abs(seg.curvature)  # corner speed / P_f speed
-        chunk = sample_poses([seg], corner_step / factor)
+    for k, (seg, step) in enumerate(zip(segments, steps, strict=True)):
+        chunk = sample_poses([seg], step)
         chunks.append(chunk if k == 0 else chunk[1:])
     return np.concatenate(chunks) if chunks else np.zeros((0, 3))
 
@@ -99,10 +107,20 @@ def densify(vehicle: Vehicle, poses: np.ndarray, corner_step: float = 0.002) -> 
     step = np.diff(poses, axis=0)
     step[:, 2] = wrap_angle(step[:, 2])  # the short way round
     moved = np.hypot(step[:, 0], step[:, 1]) + _corner_reach(vehicle) * np.abs(step[:, 2])  # a corner's bound
-    parts = np.maximum(1, np.ceil(moved / corner_step)).astype(int)
+    parts = np.maximum(1, np.ceil(moved / corner_step))
+    _check_count(1 + float(parts.sum()), corner_step)
+    parts = parts.astype(int)
     k = np.repeat(np.arange(len(step)), parts)
     frac = (np.arange(len(k)) - np.repeat(np.cumsum(parts) - parts, parts)) / np.repeat(parts, parts)
     return np.concatenate([poses[k] + frac[:, None] * step[k], poses[-1:]])
+
+
+def _check_count(n: float, corner_step: float | None = None) -> None:
+    """Refuse a check of more than :data:`MAX_CHECK_POSES` poses, before they are made."""
+    if n > MAX_CHECK_POSES:
+        spacing = "" if corner_step is None else f" (no corner moving more than {corner_step * 1e3:g} mm between them)"
+        raise WmrkitError(f"the exact check would test {n:.3g} poses{spacing}, at most {MAX_CHECK_POSES}: the path "
+                          "is too long to check; plan a shorter one (a pass nearer the parked cars, a smaller car)")
 
 
 def check_plan(vehicle: Vehicle, space: Space, segments: tuple[Segment, ...] | list[Segment], *,
@@ -115,18 +133,21 @@ def check_poses(vehicle: Vehicle, space: Space, poses: np.ndarray, *, tol: float
     """Check P_f's `poses` ``(N, 3)`` (any planner's, sampled densely by the caller) against the scene."""
     shapely = shapely_module()
     poses = np.asarray(poses, dtype=float).reshape(-1, 3)
-    cars = footprints(vehicle, poses)
+    _check_count(len(poses))
+    obstacles = {name: (ob, ob.buffer(-tol, join_style="mitre")) for name, ob in scene(space).items()}
     colliding = np.zeros(len(poses), dtype=bool)
-    what, clearance = "", math.inf
-    for name, obstacle in scene(space).items():
-        core = obstacle.buffer(-tol, join_style="mitre")
-        hit = shapely.intersects(cars, core)
-        if hit.any() and not what:
-            what = name
-        colliding |= hit
-        clearance = min(clearance, float(np.min(shapely.distance(cars, obstacle))) if len(poses) else math.inf)
+    hit_any = dict.fromkeys(obstacles, False)
+    clearance = math.inf
+    for lo in range(0, len(poses), CHUNK):  # bounded memory: CHUNK polygons at a time
+        cars = footprints(vehicle, poses[lo:lo + CHUNK])
+        for name, (obstacle, core) in obstacles.items():
+            hit = shapely.intersects(cars, core)
+            hit_any[name] |= bool(hit.any())
+            colliding[lo:lo + CHUNK] |= hit
+            clearance = min(clearance, float(np.min(shapely.distance(cars, obstacle))))
+    what = next((name for name, hit in hit_any.items() if hit), "")  # the first obstacle of the scene hit
     inside = False
     if len(poses):
         slot = shapely.box(-space.H, -space.J, 0.0, 0.0).buffer(tol, join_style="mitre")
-        inside = bool(shapely.within(cars[-1], slot))
+        inside = bool(shapely.within(footprints(vehicle, poses[-1:])[0], slot))
     return CollisionReport(poses, colliding, what, clearance, inside)
