@@ -124,3 +124,14 @@ def test_space_refuses_a_negative_dx2_as_a_problem_file_does():
     """Space(dx2=-1) was planned (a pass at c1/2 + MS, with a warning) where a problem file refuses it."""
     with pytest.raises(WmrkitError, match=r"space\.dx2: must be >= 0, got -1\.0 m"):
         Space(**{**asdict(SLOT_91), "dx2": -1.0})
+
+
+def test_space_refuses_a_gap_to_the_curb_of_the_slots_width_as_a_problem_file_does():
+    """Space(final_gap=7) (7 m, meant 7 cm) was planned: the planner stopped after its first manoeuvre, whatever gap
+    it left (7.6 cm for example 1), where a problem file refuses it."""
+    with pytest.raises(WmrkitError, match=r"space\.final_gap: the gap to the curb \(7 m\) must be less than the "
+                                          r"slot's width J = 2 m"):
+        Space(**{**asdict(SLOT_91), "final_gap": 7.0})
+    with pytest.raises(WmrkitError, match=r"space\.final_gap: .* J = 2 m"):
+        Space(**{**asdict(SLOT_91), "final_gap": 2.0})
+    assert Space(**{**asdict(SLOT_91), "final_gap": 1.99}).final_gap == 1.99

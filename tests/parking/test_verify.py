@@ -92,7 +92,7 @@ def problems(draw):
     H = draw(st.floats(length + 2 * ms - 0.3, 2.5 * length + 2 * ms + 1.0))
     J = draw(st.floats(c1 - 0.2, c1 + 1.5))
     dx2 = draw(st.floats(c1 / 2 - 0.3, c1 / 2 + 1.5))
-    gap = draw(st.floats(0.02, 0.3))
+    gap = draw(st.floats(0.02, min(0.3, 0.9 * J)))  # a gap less than the width (Space refuses one wider)
     return Vehicle(a1, b1, c1, h1, 0.5, phi), Space(max(H, 0.1), max(J, 0.1), ms, max(dx2, 0.0), gap)
 
 
@@ -117,7 +117,7 @@ def test_planner_never_loops_and_feasible_plans_are_exactly_collision_free(probl
                          ids=["9.1", "9.2", "car"])
 def test_one_manoeuvre_slots_are_not_shorter_than_blackburns_bound(car):
     """The shortest slot the planner enters in one manoeuvre (no margin) is at least the closed-form bound."""
-    slot = Space(H=10.0, J=car.c1 + 2.0, MS=0.0, dx2=car.c1 / 2 + 0.5, final_gap=5.0)
+    slot = Space(H=10.0, J=car.c1 + 2.0, MS=0.0, dx2=car.c1 / 2 + 0.5, final_gap=2.1)  # any gap in the slot is < 2
     h = shortest_slot(car, slot, step=0.02, span=8.0, max_maneuvers=1)
     assert h is not None
     bound = blackburn_min_length(car)

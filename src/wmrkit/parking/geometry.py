@@ -102,6 +102,9 @@ class Space:
         problem = no_free_length(self.H, self.MS)
         if problem is not None:
             raise WmrkitError(f"space.MS: {problem}")
+        problem = gap_too_wide(self.final_gap, self.J)
+        if problem is not None:
+            raise WmrkitError(f"space.final_gap: {problem}")
 
     @property
     def effective_length(self) -> float:
@@ -116,6 +119,15 @@ def no_free_length(H: float, MS: float) -> str | None:
         return None
     return (f"the margins at both ends ({2 * MS:g} m) leave nothing of the slot's length H = {H:g} m "
             "(H - 2 MS must be > 0)")
+
+
+def gap_too_wide(final_gap: float, J: float) -> str | None:
+    """Why a desired gap to the curb `final_gap` is not less than the slot's width `J` (any pose in the slot has a
+    smaller one: the planner stopped after its first manoeuvre, whatever gap it left), or None."""
+    if final_gap < J:
+        return None
+    return (f"the gap to the curb ({final_gap:g} m) must be less than the slot's width J = {J:g} m (a plain number "
+            "is metres: write e.g. '7 cm')")
 
 
 def turning_radius(h1: float, phi: float) -> float:

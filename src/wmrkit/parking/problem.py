@@ -22,7 +22,7 @@ from ..documents import FieldReader, read_document, read_file
 from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
 from ..wheels import Wheel, heading_from_beta, heading_in_range
-from .geometry import Space, Vehicle, no_free_length, wheels_outside
+from .geometry import Space, Vehicle, gap_too_wide, no_free_length, wheels_outside
 
 VEHICLE_FIELDS = ("a1", "b1", "c1", "h1", "d1", "phi_max")
 ROBOT_VEHICLE_FIELDS = ("robot", "a1", "b1", "c1", "phi_max")
@@ -169,9 +169,9 @@ def _space(check: FieldReader, data: Any) -> Space:
     problem = no_free_length(s["H"], s["MS"])
     if problem is not None:
         check.fail(problem, ("space", "MS"))
-    if s["final_gap"] >= s["J"]:  # 'final_gap: 7' (metres, not cm) stopped the plan after its first manoeuvre
-        check.fail(f"the gap to the curb ({s['final_gap']:g} m) must be less than the slot's width J = {s['J']:g} m "
-                   "(a plain number is metres: write e.g. '7 cm')", ("space", "final_gap"))
+    problem = gap_too_wide(s["final_gap"], s["J"])  # 'final_gap: 7' (metres, not cm)
+    if problem is not None:
+        check.fail(problem, ("space", "final_gap"))
     return Space(**s)
 
 
