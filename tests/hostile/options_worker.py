@@ -77,7 +77,8 @@ def serve() -> None:
             code, escaped = 98, traceback.format_exc()[-1500:]
         text = out.getvalue()
         answer = {"code": code, "out": text[-2000:], "err": err.getvalue()[-2000:], "escaped": escaped,
-                  "json": _strict_json(text) if code == 0 and "--json" in argv else None, "nulls": sorted(set(nulls))}
+                  "json": _strict_json(text) if code in (0, 1) and "--json" in argv else None,
+                  "nulls": sorted(set(nulls))}
         sys.__stdout__.write(json.dumps(answer) + "\n")
         sys.__stdout__.flush()
 

@@ -53,7 +53,8 @@ def test_infeasible_slot_says_why_and_the_shortest_slot(capsys, tmp_path):
                  "space: {H: 230 cm, J: 200 cm, MS: 20 cm, dx2: 90 cm, final_gap: 7 cm}\n")
     code, out, _ = run(capsys, str(f), "--json")
     data = json.loads(out)
-    assert code == 0 and data["feasible"] is False and "too short" in data["reason"]
+    # the answer is printed, exit 1: 'park ... && next' went on (exit 0) as if the car had parked
+    assert code == 1 and data["feasible"] is False and "too short" in data["reason"]
     assert 2.4 < data["shortest_H"] < 3.35
     assert data["approach"]["dx1"] is None and data["final_gap"] is None  # not defined: documented nulls, not NaN
     code, out, _ = run(capsys, str(f))
@@ -115,10 +116,11 @@ def test_options_of_the_executed_plan_need_animate_or_check(capsys, argv, messag
 def test_check_reads_the_executed_path_too(capsys):
     """--check with --controller also checks the path the closed loop drove: example 1's plan only touches the
     front car (zero lateral clearance), and a tracker a fraction of a millimetre off clips it; example 2 stays
-    clear. Said in the text and in JSON (``executed_check``), exit 0: a collision is an answer."""
+    clear. Said in the text and in JSON (``executed_check``); a collision is an answer, exit 1 (it was 0, so a
+    script went on as if the car had parked)."""
     code, out, _ = run(capsys, "thesis-9.1", "--check", "--controller", "p", "--json")
     data = json.loads(out)
-    assert code == 0 and data["check"]["collision_free"] is True
+    assert code == 1 and data["check"]["collision_free"] is True
     executed = data["executed_check"]
     assert executed["mode"] == "p" and executed["collision_free"] is False and executed["first_hit"] == "front"
     assert executed["colliding_poses"] > 0 and executed["inside_slot"] is True

@@ -75,4 +75,12 @@ def run(args: argparse.Namespace) -> int:
             plot.animate_plan(solution.plan, args.animate, execution, max_frames=frames)
         if args.plot:
             plot.save_plan_figure(solution.plan, args.plot, execution)
-    return 0
+    return 0 if parked(solution, executed) else 1
+
+
+def parked(solution, executed=None) -> bool:
+    """Whether the answer is yes: a plan, and every check asked for collision-free and ending inside the slot. The
+    command exits 1 otherwise (its answer printed all the same; 2 is kept for bad input), so that a script's
+    ``wmrkit park ... && next`` does not go on as if the car had parked."""
+    checks = [c for c in (solution.check, executed) if c is not None]
+    return bool(solution.plan.feasible and all(c.collision_free and c.inside for c in checks))
