@@ -250,3 +250,15 @@ def test_a_friction_law_that_does_not_fit_the_robot_is_refused_by_name():
         mcd(robot, robot.actuated, rates, lambda slip, v, loads: slip * math.inf)
     good = mcd(robot, robot.actuated, rates, LinearFriction((1.0,) * 8))
     assert good.converged.all()
+
+
+@pytest.mark.parametrize("model", [wls, mcd, mqe])
+def test_a_lone_name_for_the_assigned_velocities_is_refused_as_a_string(model):
+    """``wls(robot, "front_left.spin", ...)`` read the name as its letters: 'expected distinct velocity names, got
+    ['f', 'r', 'o', ...]' (the diff drive's 'left.spin': "has no velocity 'l'"); it is refused naming the string, as
+    ``odometry_model`` refuses a lone `sensed` name."""
+    robot = catalog.load("skid-steer-4")
+    law = () if model is wls else (LinearFriction((1.0,) * 8),)
+    with pytest.raises(WmrkitError, match=r"expected a sequence of velocity names, got the string 'front_left\.spin'"):
+        model(robot, "front_left.spin", [1.0], *law)
+    assert model(robot, ("front_left.spin",), [1.0], *law).converged.all()  # a sequence of one name is fine

@@ -124,6 +124,8 @@ def assigned_columns(robot: Robot, assigned: Sequence[str]) -> np.ndarray:
 def _assigned(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Columns and values ``(..., n_a)`` of the assigned velocities; :class:`WmrkitError` naming `q_assigned` when
     its last axis is not one value per name or a value is not a finite number within ``MAX_QUERY_RATE``."""
+    if isinstance(assigned, str):  # tuple("left.spin") would read ('l', 'e', ...)
+        raise WmrkitError(f"assigned: expected a sequence of velocity names, got the string '{assigned}'")
     if not assigned or len(set(assigned)) != len(assigned):
         raise WmrkitError(f"assigned: expected distinct velocity names, at least one, got {list(assigned)}")
     cols = assigned_columns(robot, assigned)
