@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from wmrkit.cli.main import main
+from wmrkit.errors import WmrkitError
 from wmrkit.odometry.integrators import integrate_increments
 from wmrkit.slip.metrics import closure_error, j_closure, j_model
 
@@ -29,6 +30,18 @@ def test_closure_index_of_a_circle_with_a_known_defect():
     exact = np.vstack([[0, 0, 0], integrate_increments([0, 0, 0], inc * [1, 1, 2 * np.pi / (2 * np.pi + 0.1)])])
     assert closure_error(exact)[0] < 1e-12 and pos > 0.01
     assert j_closure([poses, exact]) == pytest.approx((pos + head + sum(closure_error(exact))) / 4)
+
+
+def test_closure_index_of_a_path_that_does_not_turn_or_move_says_which():
+    """A straight run (open, against its true end) and a turn on the spot leave one term of (7.80) undefined: the
+    message said 'the path neither moves nor turns' for both."""
+    straight = np.column_stack([np.linspace(0, 5, 11), np.zeros(11), np.zeros(11)])
+    with pytest.raises(WmrkitError, match=r"does not turn \(rotation 0 rad\)"):
+        closure_error(straight, [5.1, 0.0, 0.0])
+    with pytest.raises(WmrkitError, match=r"does not move \(distance 0 m\)"):
+        closure_error(np.column_stack([np.zeros(11), np.zeros(11), np.linspace(0, 6, 11)]))
+    with pytest.raises(WmrkitError, match="neither moves nor turns"):
+        closure_error(np.zeros((3, 3)))
 
 
 @pytest.fixture(scope="module")

@@ -42,8 +42,11 @@ def closure_error(poses: ArrayLike, truth_final: ArrayLike | None = None) -> tup
     steps = np.diff(p, axis=0)
     distance = float(np.sum(np.hypot(steps[:, 0], steps[:, 1])))
     rotation = float(np.sum(np.abs(wrap_angle(steps[:, 2]))))
-    if distance <= 0 or rotation <= 0:
-        raise WmrkitError("closure_error: the path neither moves nor turns")
+    if distance <= 0 or rotation <= 0:  # each term of (7.80) divides by one of them
+        what = "neither moves nor turns" if distance <= 0 and rotation <= 0 else \
+            "does not move (distance 0 m)" if distance <= 0 else "does not turn (rotation 0 rad)"
+        raise WmrkitError(f"closure_error: the path {what}: (7.80) divides the position error by the distance "
+                          "travelled and the heading error by the rotation")
     pos = float(np.hypot(*(p[-1, :2] - goal[:2])))
     head = float(abs(wrap_angle(p[-1, 2] - goal[2])))
     return pos / distance, head / rotation
