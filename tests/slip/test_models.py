@@ -262,3 +262,34 @@ def test_a_lone_name_for_the_assigned_velocities_is_refused_as_a_string(model):
     with pytest.raises(WmrkitError, match=r"expected a sequence of velocity names, got the string 'front_left\.spin'"):
         model(robot, "front_left.spin", [1.0], *law)
     assert model(robot, ("front_left.spin",), [1.0], *law).converged.all()  # a sequence of one name is fine
+
+
+@pytest.mark.parametrize("free_spin", [False, True])
+def test_mcd_with_a_twist_component_assigned_gives_the_tyres_the_body_velocity(free_spin):
+    """Assigning omega with the spins (an inverse use, §7.4.3) raised an IndexError when fewer than three velocities
+    were left free, and otherwise solved with the contacts' body velocities set to 0, so that the tyre laws took
+    every slip as a skid of a wheel at rest (slip angles of 90 deg): vx came out wrong. Here the force balance is
+    solved independently with scipy on the robot's own slip rows and tyres."""
+    from scipy.optimize import root
+
+    from wmrkit.slip.models import tyre_friction
+
+    robot = catalog.load("skid-steer-4")
+    law, loads = tyre_friction(robot), normal_loads(robot)
+    spins = robot.sensed[:3] if free_spin else robot.sensed
+    q_a = np.array([0.5, 8.0, 12.0, 8.0, 12.0][: 1 + len(spins)])
+    sol = mcd(robot, ("omega", *spins), q_a, law, loads=loads)
+    a = robot.constraint_matrix()
+    cols = [robot.velocity_index(n) for n in ("omega", *spins)]
+    free = [c for c in range(a.shape[1]) if c not in cols and c in (0, 1, *map(robot.velocity_index, robot.sensed))]
+
+    def balance(z):
+        q = np.zeros(a.shape[1])
+        q[cols], q[free] = q_a, z
+        return a[:, free].T @ law((a @ q).reshape(4, 2), (a[:, :3] @ q[:3]).reshape(4, 2), loads).reshape(-1)
+
+    want = root(balance, [1.0, 0.0, 12.0][: len(free)], tol=1e-14).x
+    assert np.abs(balance(want)).max() < 1e-9
+    assert sol.converged
+    np.testing.assert_allclose(sol.q_dot[free], want, atol=1e-9)
+    assert 0.9 < sol.twist[0] < 1.0  # the wheels' mean rolling speed is 1 m/s: some is lost to the skid

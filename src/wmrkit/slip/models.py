@@ -245,6 +245,9 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
         raise WmrkitError(f"g: expected a finite gravity > 0 m/s^2, got {quasi_static[1]}")
 
     cols, q_a = _assigned(robot, assigned, q_assigned)
+    if quasi_static is not None and np.isin(cols, (0, 1, 2)).any():
+        raise WmrkitError("MQE needs the body twist unassigned (the vehicle velocities are its unknowns), got "
+                          f"assigned {list(assigned)}")
     a_all = robot.constraint_matrix(beta)
     batch = np.broadcast_shapes(q_a.shape[:-1], a_all.shape[:-2])
     a_all = np.broadcast_to(a_all, (*batch, *a_all.shape[-2:])).reshape(-1, *a_all.shape[-2:])
@@ -273,11 +276,15 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
         a_na, fixed = a[:, free], a[:, cols] @ q_a[i]
         body_part = a[:, :3]
         load_map = None if load_maps is None else load_maps[i] if load_maps.ndim == 3 else load_maps
+        known = np.zeros(k)
+        known[cols] = q_a[i]
 
-        def equations(z, a_na=a_na, fixed=fixed, body_part=body_part, load_map=load_map):
+        def equations(z, a_na=a_na, fixed=fixed, body_part=body_part, load_map=load_map, known=known):
             slip = a_na @ z + fixed
-            twist = z[:3] if free[2] == 2 else None
-            v_body = body_part @ (twist if twist is not None else np.zeros(3))
+            q = known.copy()
+            q[free] = z
+            twist = q[:3]  # assigned components included: the contacts' body velocities of the tyre laws
+            v_body = body_part @ twist
             if quasi_static is None:
                 f_n = static
                 inertial = 0.0
@@ -326,12 +333,10 @@ def _check_law(friction: FrictionLaw, slip_shape: tuple[int, int], loads: np.nda
 
 
 def _centripetal(quasi: tuple[Body, float], load_map: np.ndarray,
-                 twist: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+                 twist: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Loads (:func:`normal_loads` through its `load_map`) and the inertial wrench ``(M a_cm, c x M a_cm)`` about the
     origin of uniform curvilinear motion."""
     body, g = quasi
-    if twist is None:
-        raise WmrkitError("MQE needs the body twist unassigned (the vehicle velocities are its unknowns)")
     cx, cy = body.com
     vx, vy, w = twist
     v_cm = np.array([vx - w * cy, vy + w * cx])
