@@ -153,6 +153,13 @@ def test_bad_weights_are_refused():
         SlipWeights.of({"a": (0.0, 1.0)})
     with pytest.raises(SlipWeightError, match="lacks"):
         SlipWeights.of({"nope": (1.0, 1.0)}).row_mu(catalog.load("diff-drive"))
+    # a string was read as its characters ("12": (1, 2)) and a third value dropped; a lone number raised a TypeError
+    for value in ("12", (1.0, 2.0, 3.0), (1.0,), 5.0, ("a", 1.0), None):
+        with pytest.raises(SlipWeightError, match=r"wheel 'left': expected a pair of numbers \(lateral, longitudinal"):
+            SlipWeights.of({"left": value})  # type: ignore[dict-item]
+        with pytest.raises(SlipWeightError, match="wheel 'default': expected a pair of numbers"):
+            SlipWeights.of({}, value)  # type: ignore[arg-type]
+    assert SlipWeights.of({"left": np.array([1.0, 2.0])}, [3, 4]) == SlipWeights((("left", 1.0, 2.0),), (3.0, 4.0))
 
 
 def test_mqe_from_a_start_with_round_off_zeros_converges():

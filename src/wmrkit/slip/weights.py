@@ -9,7 +9,7 @@ scales each row by ``sqrt(mu)``. Only ratios matter (the WLS solution is invaria
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -53,8 +53,7 @@ class SlipWeights:
     @classmethod
     def of(cls, mu: Mapping[str, tuple[float, float]], default: tuple[float, float] = (1.0, 1.0)) -> SlipWeights:
         """From a mapping ``{wheel: (mu_lateral, mu_longitudinal)}``."""
-        return cls(tuple((str(k), float(v[0]), float(v[1])) for k, v in mu.items()),
-                   (float(default[0]), float(default[1])))
+        return cls(tuple((str(k), *_pair(str(k), v)) for k, v in mu.items()), _pair("default", default))
 
     @classmethod
     def uniform(cls, lateral: float = 1.0, longitudinal: float = 1.0) -> SlipWeights:
@@ -94,6 +93,18 @@ class SlipWeights:
             err.wheels = (wheels[lo], wheels[hi])
             raise err
         return mu
+
+
+def _pair(name: str, value: object) -> tuple[float, float]:
+    """``(lateral, longitudinal)`` of wheel `name`; a string or a sequence of another length is refused (``"12"``
+    read as (1, 2), a third value dropped)."""
+    try:
+        if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray) or len(value) != 2:
+            raise TypeError
+        return float(value[0]), float(value[1])  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise SlipWeightError(f"friction coefficients of wheel '{name}': expected a pair of numbers (lateral, "
+                              f"longitudinal), got {value!r}") from None
 
 
 def wls_model(robot: Robot, weights: SlipWeights | None = None, sensed=None) -> OdometryModel:
