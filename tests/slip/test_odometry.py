@@ -182,6 +182,18 @@ def test_a_noise_spread_beyond_double_precision_is_refused():
         KalmanNoise(1.0, 1.0, 1.0, (("front", 1.0, 1e-7),))
 
 
+
+def test_a_noise_that_is_not_a_number_is_refused_by_name():
+    """Text raised numpy's 'ufunc isfinite not supported' TypeError, naming nothing."""
+    from wmrkit.errors import WmrkitError
+    from wmrkit.slip.kalman import KalmanNoise
+
+    with pytest.raises(WmrkitError, match="Kalman noise process: must be a finite number"):
+        KalmanNoise("1", 1.0, 1.0)  # type: ignore[arg-type]
+    with pytest.raises(WmrkitError, match=r"Kalman noise front \(lateral\): must be a finite number"):
+        KalmanNoise(1.0, 1.0, 1.0, (("front", None, 1.0),))  # type: ignore[arg-type]
+
+
 def test_a_filter_lagging_its_measurements_is_not_called_a_contradiction(tmp_path, capsys):
     """Right wheel and steering only: the sensors cannot contradict each other (no redundancy), but FK2's slip
     indicator, the rows' residual at the filtered twist, holds the filter's lag where the motion changes; the

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._shapes import finite_number
 from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..odometry.covariance import check_covariance
@@ -55,7 +56,7 @@ class KalmanNoise:
                  *((f"{w} ({d})", x) for w, a, b in self.wheels for d, x in (("lateral", a), ("longitudinal", b))))
         lo, hi = NOISE_RANGE
         for name, v in named:
-            if not (np.isfinite(v) and lo <= v <= hi):
+            if not (finite_number(v) and lo <= v <= hi):  # text raised numpy's TypeError
                 raise WmrkitError(f"Kalman noise {name}: must be a finite number in [{lo:g}, {hi:g}], got {v}")
         (small, a), (large, b) = min(named, key=lambda nv: nv[1]), max(named, key=lambda nv: nv[1])
         if b > MAX_SPREAD * a:
