@@ -300,3 +300,16 @@ def test_mcd_with_a_twist_component_assigned_gives_the_tyres_the_body_velocity(f
     assert sol.converged
     np.testing.assert_allclose(sol.q_dot[free], want, atol=1e-9)
     assert 0.9 < sol.twist[0] < 1.0  # the wheels' mean rolling speed is 1 m/s: some is lost to the skid
+
+
+def test_a_start_of_one_sample_serves_a_batch_and_a_start_of_another_batch_is_refused():
+    """A `start` whose batch differed from the inputs' raised an IndexError from inside the per-sample loop."""
+    robot = catalog.load("skid-steer-4")
+    law = LinearFriction((1.0,) * 8)
+    rates = np.array([[1.0, 2.0, 1.0, 2.0], [2.0, 1.0, 2.0, 1.0], [1.0, 1.0, 1.0, 1.0]])
+    want = mcd(robot, robot.sensed, rates, law)
+    one = mcd(robot, robot.sensed, rates, law, start=wls(robot, robot.sensed, rates[:1]))
+    assert one.converged.all()
+    np.testing.assert_allclose(one.q_dot, want.q_dot, atol=1e-9)
+    with pytest.raises(WmrkitError, match=r"start: expected velocities of shape \(3, 7\)"):
+        mcd(robot, robot.sensed, rates, law, start=wls(robot, robot.sensed, rates[:2]))

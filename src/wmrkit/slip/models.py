@@ -258,7 +258,11 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
     n_s = len(robot.steer_names)
     betas = (None if beta is None or n_s == 0
              else np.broadcast_to(np.asarray(beta, float), (*batch, n_s)).reshape(-1, n_s))
-    q0 = (wls(robot, assigned, q_a, betas) if start is None else start).q_dot.reshape(-1, k)
+    q0 = wls(robot, assigned, q_a, betas).q_dot if start is None else np.asarray(start.q_dot, dtype=float)
+    if q0.shape[-1:] != (k,) or q0.size // k not in (1, len(q_a)):  # one for every sample, or one per sample
+        raise WmrkitError(f"start: expected velocities of shape {(*batch, k)} (one solution per sample, or one for "
+                          f"all), got {q0.shape}")
+    q0 = np.broadcast_to(q0.reshape(-1, k), (len(q_a), k))
     # scipy's hybr differences each unknown with a step relative to its size: a start of 1e-17 (round-off of an
     # exact 0) gives it a useless Jacobian column and it stalls (skid steer, tests/slip/test_models.py)
     q0 = np.where(np.abs(q0) < 1e-9 * np.maximum(1.0, np.abs(q0).max(axis=-1, keepdims=True)), 0.0, q0)
