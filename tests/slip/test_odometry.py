@@ -210,3 +210,34 @@ def test_a_filter_lagging_its_measurements_is_not_called_a_contradiction(tmp_pat
     motion = data["distance"] / (data["samples"] - 1)
     assert data["rms_slip"] > 0.02 * motion  # the filter's indicator: above the tolerance
     assert "contradict" not in err and "the sensed joints themselves agree" in err
+
+
+def test_fk1_warns_where_its_rows_do_not_fix_the_twist(tmp_path, capsys):
+    """The forklift turning on the spot with its steered wheel at heading 90 deg: FK1's kept rows (the steered
+    wheel's and the drive wheels' rolling rows, (7.69)) lose the sideways speed there, so FK1 ended at (0, 0),
+    exit 0 and "consistent", where the robot went to (-0.61, -0.92) m (FK2 and WLS: exact). Now a warning names the
+    heading; driving straight, none. The condition number is checked against an SVD of the rows done here."""
+    from wmrkit.analysis.singularity import robot_size
+    from wmrkit.slip.kalman import ILL_CONDITIONED, kalman_model
+
+    t = np.arange(0, 5.0001, 0.01)
+    header = "time [s],right_drive.spin [rad],left_drive.spin [rad],steer.steer [deg]\n"
+    for name, left, heading, warned in (("spin", -2.0, 90, True), ("straight", 2.0, 0, False)):
+        path = tmp_path / f"{name}.csv"
+        path.write_text(header + "".join(f"{a:.4f},{2 * a:.6f},{left * a:.6f},{heading}\n" for a in t))
+        for method in ("fk1", "fk2"):
+            assert main(["odometry", "forklift", str(path), "--method", method, "--json"]) == 0
+            err = capsys.readouterr().err
+            said = f"wmrkit: warning: {method}: at a steering heading of the log (steer 90 deg)" in err
+            assert said == (warned and method == "fk1"), (name, method, err)
+            assert not said or ("rows do not fix the twist" in err and err.count("\n") == 1)
+    robot = catalog.load("forklift")
+    model = kalman_model(robot, "fk1")
+    for heading, ill in ((0.0, False), (np.radians(89.5), True)):
+        beta = np.array([[heading + np.pi / 2]])
+        model.configuration_maps(beta)
+        c = robot.constraint_matrix(beta)[0][model.rows, :3] / model.sigma[:, None]
+        c[:, 2] *= robot_size(robot)
+        s = np.linalg.svd(c, compute_uv=False)
+        assert model.worst_conditioning[0] == pytest.approx(s[0] / s[-1], rel=1e-9)
+        assert (model.worst_conditioning[0] > ILL_CONDITIONED) == ill

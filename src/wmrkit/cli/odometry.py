@@ -135,10 +135,31 @@ def run(args: argparse.Namespace) -> int:
                  for w, v in parse_assignments(args.weight, "--weight").items()})
     if slip_model is not None:
         summary = replace(summary, method=f"{args.method} ({args.scheme})")
+    if args.method in ("fk1", "fk2"):
+        _warn_ill_conditioned(args.method, slip_model.model)
     consistent = _check_consistency(summary, lambda: _wheel_slips(robot, args.log, fmt, args.sensed),
                                     filtered=args.method if args.method in ("fk1", "fk2") else None)
     print_json(summary.to_dict() | {"consistent": consistent}) if args.json else print(format_summary(summary))
     return 0
+
+
+def _warn_ill_conditioned(name: str, model) -> None:
+    """Warn (one line on stderr) when, at a steering configuration of the log, the filter's kept rows barely fixed
+    the twist (:attr:`~wmrkit.slip.kalman.KalmanModel.worst_conditioning`): its answer there is its prediction."""
+    from ..slip.kalman import ILL_CONDITIONED
+
+    worst = model.worst_conditioning
+    if worst is None or worst[0] <= ILL_CONDITIONED:
+        return
+    om = model.odometry
+    beta = dict(zip((om.robot.steer_names[i] for i in om.steer_index), worst[1], strict=True))
+    heading = om.robot.with_beta_angles(beta).heading
+    where = ", ".join(f"{n} {math.degrees(heading[om.robot.steer_names.index(n)]):.4g} deg" for n in beta)
+    fix = ("do not fix the twist" if math.isinf(worst[0]) else
+           f"barely fix the twist (condition number {worst[0]:.3g} > {ILL_CONDITIONED:g})")
+    print(f"wmrkit: warning: {name}: at a steering heading of the log ({where}) its measurement rows {fix}: there the "
+          f"filter carries its prediction and the trajectory can be far off"
+          f"{'; use --method fk2 or wls' if name == 'fk1' else ''}", file=sys.stderr)
 
 
 #: Slip tolerance of a log: an RMS slip indicator above this fraction of the mean motion per interval means the

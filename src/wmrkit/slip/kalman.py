@@ -95,6 +95,8 @@ class KalmanModel:
     thesis_double_q: bool = False
     # matrices per steering configuration met so far; not an init field, so dataclasses.replace starts a new one
     _cache: dict = field(init=False, default_factory=dict, compare=False, repr=False)
+    # the worst-conditioned configuration met so far: {"condition": kappa, "config": (s,) angles}
+    _worst: dict = field(init=False, default_factory=dict, compare=False, repr=False)
 
     def matrices(self, beta_full: np.ndarray) -> tuple[np.ndarray, ...]:
         """``(H, M, C, A_a)`` per configuration ``(U, n_steer) -> (U, 3, 3), (U, 3, n_a), (U, m, 3), (U, m, n_a)``,
@@ -125,10 +127,40 @@ class KalmanModel:
             full[:, om.steer_index] = new
             h, mm, c, aa = self.matrices(full)
             slip = np.linalg.qr(np.concatenate([c, aa], axis=-1), mode="r")  # |[C, A_a] z| = |T z|, fewer rows
+            self._note_conditioning(c, new)
             return np.ones(len(new), dtype=bool), (h, mm, c, aa, slip)
 
         shapes = ((3, 3), (3, n_a), (m, 3), (m, n_a), (min(m, 3 + n_a), 3 + n_a))
         return cached_maps(self._cache, configs, shapes, compute)[0]
+
+
+    def _note_conditioning(self, c: np.ndarray, configs: np.ndarray) -> None:
+        """Keep the worst condition number of the kept rows ``C`` ``(U, m, 3)`` (weighted by their noise, omega's
+        column times the robot's size: dimensionless) over the configurations `configs` ``(U, s)``."""
+        from ..analysis.singularity import robot_size
+
+        weighted = c / self.sigma[:, None]
+        weighted[..., 2] *= robot_size(self.odometry.robot)
+        s = np.linalg.svd(weighted, compute_uv=False)
+        with np.errstate(divide="ignore"):
+            kappa = np.where(s[..., -1] > 1e-12 * s[..., 0], s[..., 0] / s[..., -1], np.inf)
+        k = int(np.argmax(kappa))
+        if len(kappa) and kappa[k] > self._worst.get("condition", 0.0):
+            self._worst.update(condition=float(kappa[k]), config=tuple(float(a) for a in configs[k]))
+
+    @property
+    def worst_conditioning(self) -> tuple[float, tuple[float, ...]] | None:
+        """The largest condition number with which the kept rows fixed the twist at a steering configuration met so
+        far, and that configuration (sensed steering angles, thesis beta [rad]); None before any. Where it is large
+        (:data:`ILL_CONDITIONED`) the measurements barely fix a direction of the twist and the filter carries its
+        prediction there: FK1 near a forklift heading of +-90 deg, where its kept rows lose the sideways speed."""
+        return (self._worst["condition"], self._worst["config"]) if self._worst else None
+
+
+#: Condition number above which a filter's kept rows are said not to fix the twist (``wmrkit odometry`` warns):
+#: 6 times that of the forklift's FK1 rows driving straight (16; its FK2 rows: 6.5), reached within about 1 deg of a
+#: heading of +-90 deg there.
+ILL_CONDITIONED = 100.0
 
 
 def kalman_model(robot: Robot, kind: str = "fk2", noise: KalmanNoise | None = None,
