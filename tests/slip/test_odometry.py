@@ -241,3 +241,16 @@ def test_fk1_warns_where_its_rows_do_not_fix_the_twist(tmp_path, capsys):
         s = np.linalg.svd(c, compute_uv=False)
         assert model.worst_conditioning[0] == pytest.approx(s[0] / s[-1], rel=1e-9)
         assert (model.worst_conditioning[0] > ILL_CONDITIONED) == ill
+
+
+def test_coefficients_of_a_wheel_without_rows_are_refused(tmp_path, capsys):
+    """With only the forklift's drive spins sensed the steered wheel has no row in the model (its rows hold its
+    unsensed spin), so '--mu steer=1,2' weighed nothing and was ignored silently (exit 0)."""
+    path = tmp_path / "drive.csv"
+    path.write_text("time [s],right_drive.spin [rad],left_drive.spin [rad]\n0,0,0\n1,1,1\n2,2,2\n")
+    argv = ["odometry", "forklift", str(path), "--method", "wls", "--sensed", "right_drive.spin", "--sensed",
+            "left_drive.spin"]
+    assert main([*argv, "--mu", "steer=1,2"]) == 2
+    err = capsys.readouterr().err
+    assert "--mu steer: wheel 'steer' has no no-slip rows" in err and err.count("\n") == 1
+    assert main([*argv, "--mu", "right_drive=1,2"]) == 0  # a wheel with rows: used

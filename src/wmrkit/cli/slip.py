@@ -176,8 +176,17 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
         given = [o for o, v in (("--kf-noise", args.kf_noise), ("--kf-wheel", args.kf_wheel)) if v]
         raise WmrkitError(f"{' with '.join(given)}: {e}") from None
     weights = weights_from_args(args, settings, robot) if args.method == "wls" else None
-    return estimator(robot, args.method, sensed=args.sensed, weights=weights, noise=noise,
-                     thesis_double_q=args.thesis_double_q)
+    chosen = estimator(robot, args.method, sensed=args.sensed, weights=weights, noise=noise,
+                       thesis_double_q=args.thesis_double_q)
+    rows = chosen.rows if args.method == "wls" else chosen.model.rows
+    used = {robot.wheel_names[robot.row_wheels[r]] for r in rows}
+    option = "--mu" if args.method == "wls" else "--kf-wheel"
+    for name in parse_assignments(args.mu if args.method == "wls" else args.kf_wheel, option):
+        if name not in used:  # its coefficients would weigh no row: ignored silently
+            raise WmrkitError(f"{option} {name}: wheel '{name}' has no no-slip rows in the {args.method} model of the "
+                              f"sensed joints (its rows hold rates that are not sensed); its coefficients would be "
+                              f"ignored (wheels with rows: {', '.join(n for n in robot.wheel_names if n in used)})")
+    return chosen
 
 
 def _read_json(path: str):
