@@ -107,3 +107,29 @@ def test_anything_else_is_a_unit_error_or_a_finite_float(value, kind):
 def test_micrometres_are_read(text):
     """The envelope's message says '1 um to 1 km': 'um' (and the micro sign, either code point) is a unit."""
     assert parse_quantity(text, "length") == pytest.approx(5e-6, rel=1e-12)
+
+
+# Exact decimal factors of the units that have one, written out independently of units.py.
+DECIMAL_FACTORS = {"mm": "0.001", "cm": "0.01", "dm": "0.1", "km": "1000", "um": "0.000001", "\u00b5m": "0.000001",
+                   "\u03bcm": "0.000001", "in": "0.0254", "ft": "0.3048", "mrad": "0.001"}
+
+
+@pytest.mark.parametrize("unit", sorted(DECIMAL_FACTORS))
+def test_decimal_units_give_the_float_nearest_the_quantity_written(unit):
+    """'9 mm' is 0.009, the float nearest 9/1000 (as '0.009' is), not 9 * 1e-3 = 0.009000000000000001: one reading in
+    seven of a whole number of millimetres was an ulp off, and `wmrkit show --json` wrote 'r: 3 dm' back as
+    0.30000000000000004. Fraction -> float rounds once, to the nearest."""
+    from fractions import Fraction
+
+    kind = "angle" if unit == "mrad" else "length"
+    for text in [*(str(n) for n in range(1, 1001)), "0.1", "2.5", "12.7", "1e3", "-7", "3.3e-2"]:
+        assert parse_quantity(f"{text} {unit}", kind) == float(Fraction(text) * Fraction(DECIMAL_FACTORS[unit])), text
+
+
+@given(st.decimals(allow_nan=False, allow_infinity=False, places=6, min_value=-10**6, max_value=10**6),
+       st.sampled_from(sorted(DECIMAL_FACTORS)))
+def test_any_decimal_with_a_decimal_unit_is_read_exactly(number, unit):
+    from fractions import Fraction
+
+    kind = "angle" if unit == "mrad" else "length"
+    assert parse_quantity(f"{number}{unit}", kind) == float(Fraction(number) * Fraction(DECIMAL_FACTORS[unit]))

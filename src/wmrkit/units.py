@@ -6,6 +6,7 @@ small fixed grammar (number, optional space, unit); nothing is ever evaluated.
 
 from __future__ import annotations
 
+import decimal
 import math
 import numbers
 import re
@@ -22,6 +23,13 @@ UNITS: dict[str, dict[str, float]] = {
     "number": {},
 }
 _SI = {"length": "m", "angle": "rad", "number": ""}
+#: The units whose factor is a decimal number, exactly: a quantity in them is read as the decimal it is ("9 mm" is
+#: 0.009, the float nearest 9e-3), not as the product of two rounded floats (9 * 1e-3 = 0.009000000000000001).
+_DECIMAL = {unit: decimal.Decimal(factor) for unit, factor in (
+    ("mm", "1e-3"), ("cm", "1e-2"), ("dm", "0.1"), ("km", "1e3"), ("um", "1e-6"), ("\u00b5m", "1e-6"), ("in", "0.0254"),
+    ("ft", "0.3048"), ("mrad", "1e-3"))}
+#: Enough digits for any number a description holds; no traps: an overflow gives inf, refused as not finite.
+_CONTEXT = decimal.Context(prec=10_000, Emax=decimal.MAX_EMAX, Emin=decimal.MIN_EMIN, traps=[])
 #: ASCII digits only: ``\d`` also matched '٣' and '１', which float() read as 3 and 1.
 _QUANTITY = re.compile(r"^\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*([^\s0-9.+-][^\s]*)?\s*$")
 
@@ -43,26 +51,28 @@ def parse_quantity(value: object, kind: Kind) -> float:
         raise UnitError(f"expected {_a(kind)}, got a boolean")
     if isinstance(value, numbers.Real):  # int, float, and NumPy's float32, int64, ... (not its bool_)
         try:
-            number, factor = float(value), 1.0
+            number = si = float(value)
         except OverflowError:
             raise UnitError(f"expected {_a(kind)}, got an integer too large for a float") from None
     elif isinstance(value, str):
         match = _QUANTITY.match(value)
         if match is None:
             raise UnitError(f"cannot read {value!r} as {_a(kind)} (write e.g. {_example(kind)}){_foreign(value)}")
-        number, unit = float(match.group(1)), match.group(2) or ""
+        number, unit = float(match.group(1)), (match.group(2) or "").replace("\u03bc", "\u00b5")  # μm as µm
         factor = _factor(unit, kind, value)
+        exact = _DECIMAL.get(unit) if number and math.isfinite(number) else None  # '1e99999 mm': inf, refused below
+        si = number * factor if exact is None else float(_CONTEXT.multiply(decimal.Decimal(match.group(1)), exact))
     else:
         raise UnitError(f"expected {_a(kind)}, got {type(value).__name__}")
-    if not math.isfinite(number * factor):  # "1e308 km" overflows only in SI
+    if not math.isfinite(si):  # "1e308 km" overflows only in SI
         raise UnitError(f"must be finite, got {value!r}")
-    if kind == "angle" and abs(number * factor) > MAX_ANGLE:
+    if kind == "angle" and abs(si) > MAX_ANGLE:
         raise UnitError(f"{value!r} is more than {MAX_TURNS:g} turns: no angle to steer, turn or roll by (its sine and "
                         "cosine would be round-off)")
     if kind == "angle" and _bare(value) and abs(number) > BARE_ANGLE_LIMIT:
         raise UnitError(f"a bare angle is read in radians, and {_plain(number)} rad is more than a turn: "
                         f"write '{_plain(number)} deg' for degrees (or '{_plain(number)} rad' if you mean it)")
-    return number * factor
+    return si
 
 
 #: A bare angle (no unit: radians) beyond this is refused as probably degrees [rad].
@@ -91,7 +101,6 @@ def _plain(number: float) -> str:
 def _factor(unit: str, kind: Kind, text: str) -> float:
     if not unit:
         return 1.0
-    unit = unit.replace("\u03bc", "\u00b5")  # Greek mu (μm) as the micro sign (µm)
     if unit in UNITS[kind]:
         return UNITS[kind][unit]
     for other, table in UNITS.items():
