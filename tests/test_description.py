@@ -597,3 +597,16 @@ def test_a_parameter_no_users_number_gives_back_is_saved_as_the_thesis_wrote_it(
 
     symbolic = Robot("s", (Wheel("a", "fixed", l=sympy.Symbol("l"), alpha=0.0, beta=0.0, r=0.1),))
     assert symbolic.to_dict()["wheels"][0]["l"] == sympy.Symbol("l")  # no numbers to round: as they are
+
+
+@pytest.mark.parametrize(("position", "written"), [
+    ([0, 0.30000000000000004], [0.0, 0.30000000000000004]), ([-0.1 - 0.2, 0], [-0.30000000000000004, 0.0]),
+    ([0, "9 mm"], [0.0, 0.009]), (["0.5 in", "-3 dm"], [0.0127, -0.3]),
+])
+def test_a_position_is_saved_with_the_fewest_decimals_of_each_coordinate(position, written):
+    """Both coordinates were rounded to the same number of decimals: the 0 of [0, 0.30000000000000004] came out as
+    2e-17 (the cosine of alpha = 90 deg, times l), and [0, 9 mm] as [1e-18, 0.009000000000000001]."""
+    robot = Robot.from_dict({"name": "r", "wheels": [{"name": "w", "type": "fixed", "position": position, "heading": 0,
+                                                      "r": 0.1}]})
+    assert robot.to_dict()["wheels"][0]["position"] == written
+    assert Robot.from_dict(robot.to_dict()) == robot

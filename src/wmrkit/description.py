@@ -6,6 +6,7 @@ only; user text is never evaluated. Every error names the file, the line where k
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import numbers
@@ -342,13 +343,17 @@ def _users_form(w: Wheel, thesis: dict[str, Any]) -> dict[str, Any]:
 
 def _fewest_digits(values: tuple[float, ...], scale: float,
                    exact: Callable[..., bool]) -> tuple[float, ...] | None:
-    """`values` rounded to the fewest decimals (1 to 18 significant digits of `scale`) for which ``exact(*values)``
-    holds, or None."""
+    """`values` rounded to the fewest decimals (1 to 18 significant digits of `scale`, each value its own: the x of
+    ``position: [0, 0.30000000000000004]`` is 0, not 2e-17) for which ``exact(*values)`` holds, or None."""
     top = math.floor(math.log10(scale)) if 0 < scale < math.inf else 0
-    for digits in range(1, 19):
-        candidate = tuple(round(float(v), digits - 1 - top) + 0.0 for v in values)  # + 0.0: no -0.0 written
-        if exact(*candidate):
-            return candidate
+    rounded = [[round(float(value), n - 1 - top) + 0.0 for n in range(1, 19)]  # + 0.0: no -0.0 written
+               for value in values]  # rounded[i][n - 1]: values[i] to n digits
+    for most in range(1, 19):
+        counts = (c for c in itertools.product(range(1, most + 1), repeat=len(values)) if max(c) == most)
+        for digits in sorted(counts, key=sum):
+            candidate = tuple(r[n - 1] for r, n in zip(rounded, digits, strict=True))
+            if exact(*candidate):
+                return candidate
     return None
 
 
