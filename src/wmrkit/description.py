@@ -65,6 +65,9 @@ ALL_WHEEL_FIELDS = COMMON_WHEEL_FIELDS + tuple(f for f in GEOMETRY_FIELDS if f n
 MECANUM_GAMMA = math.pi / 4
 
 WHEEL_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
+#: ulps around a heading computed back from beta and delta where the writer looks for the heading that gave them
+#: (``beta = heading - delta + 90 deg`` and back round twice each way: castors with delta != 0 came out an ulp off).
+HEADING_SPREAD = 4
 
 
 
@@ -329,7 +332,13 @@ def _users_form(w: Wheel, thesis: dict[str, Any]) -> dict[str, Any]:
     parameters (a wheel read from ``position: [0.25, -0.3]`` is written so); a Swedish wheel with the rollers of
     ``type: mecanum`` as one. A parameter that no such number gives back stays as it is."""
     position = _fewest_digits(w.position, w.l, lambda x, y: math.hypot(x, y) == w.l and math.atan2(y, x) == w.alpha)
-    heading = _fewest_digits((w.heading,), math.pi, lambda h: float(beta_from_heading(h, w.delta)) == w.beta)
+
+    def gives_beta(h: float) -> bool:  # within a turn: a bare angle beyond reads as degrees
+        return abs(h) <= BARE_ANGLE_LIMIT and float(beta_from_heading(h, w.delta)) == w.beta
+
+    # the heading in (-180, 180] deg, else as written beyond it (-180 deg, a steer_range's 200 deg, ...)
+    heading = (_fewest_digits((w.heading,), math.pi, gives_beta, HEADING_SPREAD)
+               or _fewest_digits((w.beta + w.delta - math.pi / 2,), math.pi, gives_beta, HEADING_SPREAD))
     out = {"name": w.name, "type": w.type}
     out |= {"l": thesis["l"], "alpha": thesis["alpha"]} if position is None else {"position": list(position)}
     out |= {"beta": thesis["beta"]} if heading is None else {"heading": heading[0]}
@@ -341,20 +350,31 @@ def _users_form(w: Wheel, thesis: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _fewest_digits(values: tuple[float, ...], scale: float,
-                   exact: Callable[..., bool]) -> tuple[float, ...] | None:
+def _fewest_digits(values: tuple[float, ...], scale: float, exact: Callable[..., bool],
+                   spread: int = 0) -> tuple[float, ...] | None:
     """`values` rounded to the fewest decimals (1 to 18 significant digits of `scale`, each value its own: the x of
-    ``position: [0, 0.30000000000000004]`` is 0, not 2e-17) for which ``exact(*values)`` holds, or None."""
+    ``position: [0, 0.30000000000000004]`` is 0, not 2e-17) for which ``exact(*values)`` holds, or None. With
+    `spread`, the floats up to `spread` ulps from each value are rounded too: a number computed back from the
+    wheel's parameters may be a few ulps off the one that gave them."""
     top = math.floor(math.log10(scale)) if 0 < scale < math.inf else 0
-    rounded = [[round(float(value), n - 1 - top) + 0.0 for n in range(1, 19)]  # + 0.0: no -0.0 written
-               for value in values]  # rounded[i][n - 1]: values[i] to n digits
+    rounded = [[dict.fromkeys(round(v, n - 1 - top) + 0.0 for v in _floats_near(float(value), spread))  # no -0.0
+                for n in range(1, 19)] for value in values]  # rounded[i][n - 1]: values[i] to n digits
     for most in range(1, 19):
         counts = (c for c in itertools.product(range(1, most + 1), repeat=len(values)) if max(c) == most)
         for digits in sorted(counts, key=sum):
-            candidate = tuple(r[n - 1] for r, n in zip(rounded, digits, strict=True))
-            if exact(*candidate):
-                return candidate
+            for candidate in itertools.product(*(r[n - 1] for r, n in zip(rounded, digits, strict=True))):
+                if exact(*candidate):
+                    return candidate
     return None
+
+
+def _floats_near(value: float, spread: int) -> list[float]:
+    """`value` and the floats up to `spread` ulps either side of it."""
+    out, up, down = [value], value, value
+    for _ in range(spread):
+        up, down = math.nextafter(up, math.inf), math.nextafter(down, -math.inf)
+        out += [up, down]
+    return out
 
 
 def _reads_back(item: dict[str, Any]) -> Wheel | None:
