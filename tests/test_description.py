@@ -631,3 +631,18 @@ def test_a_position_is_saved_with_the_fewest_decimals_of_each_coordinate(positio
                                                       "r": 0.1}]})
     assert robot.to_dict()["wheels"][0]["position"] == written
     assert Robot.from_dict(robot.to_dict()) == robot
+
+
+@pytest.mark.parametrize(("extra", "field", "message"), [
+    ({"d": 0.1}, "d", "field 'd' does not apply to a mecanum wheel"),
+    ({"actuated": ["steer"]}, "actuated[0]", "no joint 'steer' on a mecanum wheel (joints: spin)"),
+    ({"steer_range": ["-90 deg", "90 deg"]}, "steer_range", "a mecanum wheel does not steer"),
+])
+def test_errors_on_a_mecanum_wheel_name_the_type_written(extra, field, message):
+    """A ``type: mecanum`` wheel is read as a Swedish one, and its errors said 'a swedish wheel', a type the file
+    does not hold."""
+    with pytest.raises(DescriptionError) as err:
+        Robot.from_dict({"name": "r", "wheels": [{"name": "fl", "type": "mecanum", "position": [0.2, 0.15], "r": 0.05,
+                                                  **extra}]})
+    assert f"wheels[0].{field}: {message}" in str(err.value)
+    assert "swedish" not in str(err.value)

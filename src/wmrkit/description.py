@@ -174,16 +174,19 @@ def _joint_names(wheels: list[Wheel]) -> list[str]:
     return [f"{w.name}.{j}" for w in wheels for j in w.kind.joints]
 
 
-def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc) -> Wheel:
+def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc, kind_name: str | None = None) -> Wheel:
+    """The wheel `item`; `kind_name`: the wheel kind of its type (``swedish`` for ``type: mecanum``, which the
+    messages keep saying)."""
     if not isinstance(item, Mapping):
         check.fail("a wheel is a mapping with at least 'name', 'type' and its geometry", loc)
     type_name = check.text(item, "type", loc)
-    if type_name == "mecanum":
+    if type_name == "mecanum" and kind_name is None:
         return _mecanum_from_dict(item, check, loc)
-    if type_name not in KINDS:
+    if type_name not in KINDS and kind_name is None:
         check.fail(f"unknown wheel type '{type_name}'{hint(type_name, WHEEL_TYPES)} (types: {', '.join(WHEEL_TYPES)})",
                    (*loc, "type"))
-    kind = KINDS[type_name]
+    kind_name = kind_name or type_name
+    kind = KINDS[kind_name]
     name = check.text(item, "name", loc)
     if len(loc) == 2 and isinstance(loc[1], int):
         check.wheels[loc[1]:] = [name]
@@ -219,11 +222,11 @@ def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc) -> Wheel:
             check.fail("missing field 'heading' (rolling direction, 0 = straight ahead; or the thesis's 'beta')", loc)
         values[key] = check.quantity(check.require(item, key, loc), GEOMETRY_FIELDS[key], (*loc, key))
     _read_heading(item, values, check, loc, "beta" in kind.optional)
-    _check_geometry(type_name, values, check, loc)
+    _check_geometry(kind_name, values, check, loc)
     actuated = check.joints(item, "actuated", kind.joints, loc)
     sensed = check.joints(item, "sensed", kind.joints, loc)
-    return Wheel(name=name, type=type_name, actuated=actuated, sensed=sensed, **values,
-                 **mass.wheel_dynamics_from_dict(item, check, loc, type_name),
+    return Wheel(name=name, type=kind_name, actuated=actuated, sensed=sensed, **values,
+                 **mass.wheel_dynamics_from_dict(item, check, loc, kind_name),
                  steer_range=_steer_range_from_dict(item, check, loc, kind.steers))
 
 
@@ -271,11 +274,10 @@ def _mecanum_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc) ->
     ``MecanumDriveKinematics`` and ROS 2's ``mecanum_drive_controller``. ``gamma`` overrides it.
     """
     data = {k: v for k, v in item.items()}
-    data["type"] = "swedish"
     if "beta" not in data and "heading" not in data:
         data["heading"] = 0.0
     if "gamma" not in data:
-        probe = _wheel_from_dict({**data, "gamma": MECANUM_GAMMA, "r_r": data.get("r_r", 1.0)}, check, loc)
+        probe = _wheel_from_dict({**data, "gamma": MECANUM_GAMMA, "r_r": data.get("r_r", 1.0)}, check, loc, "swedish")
         x, y = probe.position
         if abs(x * y) <= 1e-12 * max(probe.l * probe.l, 1e-300):  # l * l: inf, never OverflowError
             check.fail("a mecanum wheel on an axis of the robot frame has no quadrant to take its roller angle "
@@ -284,7 +286,7 @@ def _mecanum_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc) ->
     if "r_r" not in data:
         r = check.quantity(check.require(item, "r", loc), "length", (*loc, "r"))
         data["r_r"] = r / 4
-    return _wheel_from_dict(data, check, loc)
+    return _wheel_from_dict(data, check, loc, "swedish")
 
 
 def _check_geometry(type_name: str, v: dict[str, float], check: FieldReader, loc: Loc) -> None:
