@@ -646,3 +646,14 @@ def test_errors_on_a_mecanum_wheel_name_the_type_written(extra, field, message):
                                                   **extra}]})
     assert f"wheels[0].{field}: {message}" in str(err.value)
     assert "swedish" not in str(err.value)
+
+
+@pytest.mark.parametrize("item", [{"name": "front", "type": "fixd"}, {"name": "front", "r": 0.1},
+                                  {"name": "front", "type": 3}])
+def test_an_error_in_a_wheel_s_type_names_the_wheel(item, tmp_path, capsys):
+    """The type was read before the name: a misspelt or missing type gave the JSON error "wheel": 0, every later
+    field "wheel": "front"."""
+    path = tmp_path / "r.yaml"
+    path.write_text(yaml.safe_dump({"name": "r", "wheels": [item]}))
+    assert main(["show", str(path), "--json"]) == 2
+    assert json.loads(capsys.readouterr().err)["wheel"] == "front"

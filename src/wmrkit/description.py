@@ -179,6 +179,12 @@ def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc, kind_name: str | N
     messages keep saying)."""
     if not isinstance(item, Mapping):
         check.fail("a wheel is a mapping with at least 'name', 'type' and its geometry", loc)
+    name = check.text(item, "name", loc)  # first: every later error names the wheel
+    if len(loc) == 2 and isinstance(loc[1], int):
+        check.wheels[loc[1]:] = [name]
+    if not WHEEL_NAME.fullmatch(name):
+        check.fail("wheel names are ASCII letters, digits, '_' and '-', starting with a letter or '_' (they name "
+                   f"velocities 'wheel.joint'), got {name!r}", (*loc, "name"))
     type_name = check.text(item, "type", loc)
     if type_name == "mecanum" and kind_name is None:
         return _mecanum_from_dict(item, check, loc)
@@ -187,12 +193,6 @@ def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc, kind_name: str | N
                    (*loc, "type"))
     kind_name = kind_name or type_name
     kind = KINDS[kind_name]
-    name = check.text(item, "name", loc)
-    if len(loc) == 2 and isinstance(loc[1], int):
-        check.wheels[loc[1]:] = [name]
-    if not WHEEL_NAME.fullmatch(name):
-        check.fail("wheel names are ASCII letters, digits, '_' and '-', starting with a letter or '_' (they name "
-                   f"velocities 'wheel.joint'), got {name!r}", (*loc, "name"))
     allowed = COMMON_WHEEL_FIELDS + kind.required + tuple(kind.optional)
     for key in item:
         if key not in allowed and key in ALL_WHEEL_FIELDS:
