@@ -657,3 +657,17 @@ def test_an_error_in_a_wheel_s_type_names_the_wheel(item, tmp_path, capsys):
     path.write_text(yaml.safe_dump({"name": "r", "wheels": [item]}))
     assert main(["show", str(path), "--json"]) == 2
     assert json.loads(capsys.readouterr().err)["wheel"] == "front"
+
+
+@pytest.mark.parametrize(("written", "read_as"), [("010", "8"), ("-010", "-8"), ("1:30", "90"), ("1:30.5", "90.5")])
+def test_numbers_yaml_1_1_reads_otherwise_than_they_look_are_refused(written, read_as):
+    """PyYAML follows YAML 1.1: 'position: [010, 0]' put the wheel 8 m ahead (octal), 'r: 1:30' made a 90 m wheel
+    (base 60), without a word. JSON refuses both; YAML 1.2 reads 010 as 10. Now a located error says what YAML read."""
+    text = f"name: r\nwheels:\n  - {{name: w, type: fixed, position: [{written}, 0.2], r: 0.1, heading: 0}}\n"
+    with pytest.raises(DescriptionError) as err:
+        robot_from_text(text, source="r.yaml")
+    assert str(err.value).startswith("r.yaml:3: malformed YAML: ")
+    assert f"YAML 1.1 reads it as {read_as}, not as it looks" in str(err.value)
+    for plain in ("0", "00", "007", "08", "1_0", "0.5", "00.5", "'010'"):  # read as they look: kept
+        text = f"name: r\nwheels:\n  - {{name: w, type: fixed, position: [{plain}, 0.2], r: 0.1, heading: 0}}\n"
+        assert robot_from_text(text, source="r.yaml").wheels[0].position[1] == pytest.approx(0.2)

@@ -204,6 +204,21 @@ class _SafeLoader(yaml.SafeLoader):
             ) from None
 
 
+def _plain_number(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> int | float:
+    """A YAML int or float, refused (a located error) where YAML 1.1 reads it otherwise than it looks: ``010`` as
+    the octal 8, ``1:30`` as the sexagesimal 90 (JSON refuses both, YAML 1.2 reads 010 as 10)."""
+    number = (yaml.SafeLoader.construct_yaml_int if node.tag.endswith(":int") else
+              yaml.SafeLoader.construct_yaml_float)(loader, node)
+    digits = node.value.lstrip("+-").replace("_", "")
+    if ":" in digits or (digits.isdigit() and int(digits) != abs(number)):
+        raise ValueError(f"YAML 1.1 reads it as {number!r}, not as it looks: write {number!r} if you mean it")
+    return number
+
+
+_SafeLoader.add_constructor("tag:yaml.org,2002:int", _plain_number)
+_SafeLoader.add_constructor("tag:yaml.org,2002:float", _plain_number)
+
+
 def compose(text: str) -> yaml.Node | None:
     """The YAML node tree of `text` (JSON is YAML enough for this), or None."""
     try:
