@@ -359,14 +359,20 @@ def _fewest_digits(values: tuple[float, ...], scale: float, exact: Callable[...,
     `spread`, the floats up to `spread` ulps from each value are rounded too: a number computed back from the
     wheel's parameters may be a few ulps off the one that gave them."""
     top = math.floor(math.log10(scale)) if 0 < scale < math.inf else 0
-    rounded = [[dict.fromkeys(round(v, n - 1 - top) + 0.0 for v in _floats_near(float(value), spread))  # no -0.0
-                for n in range(1, 19)] for value in values]  # rounded[i][n - 1]: values[i] to n digits
-    for most in range(1, 19):
-        counts = (c for c in itertools.product(range(1, most + 1), repeat=len(values)) if max(c) == most)
-        for digits in sorted(counts, key=sum):
-            for candidate in itertools.product(*(r[n - 1] for r, n in zip(rounded, digits, strict=True))):
-                if exact(*candidate):
-                    return candidate
+    # a number farther than 64 ulps of `scale` from its value changes a parameter of that size by more than its
+    # float spacing: it cannot be exact, and is not tried (each `exact` call costs; a 64-wheel robot has 128 numbers)
+    near = 64 * math.ulp(scale) if 0 < scale < math.inf else math.inf
+    rounded = [[[c for c in dict.fromkeys(round(v, n - 1 - top) + 0.0 for v in _floats_near(float(value), spread))
+                 if abs(c - value) <= near] for n in range(1, 19)]  # rounded[i][n - 1]: values[i] to n digits
+               for value in values]  # (+ 0.0: no -0.0)
+    usable = [[n for n in range(1, 19) if r[n - 1]] for r in rounded]  # digit counts with a candidate left
+    if not all(usable):
+        return None
+    # fewest digits first: the largest count, then their sum, then in order
+    for digits in sorted(itertools.product(*usable), key=lambda c: (max(c), sum(c), c)):
+        for candidate in itertools.product(*(r[n - 1] for r, n in zip(rounded, digits, strict=True))):
+            if exact(*candidate):
+                return candidate
     return None
 
 
