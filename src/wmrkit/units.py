@@ -24,10 +24,10 @@ UNITS: dict[str, dict[str, float]] = {
 }
 _SI = {"length": "m", "angle": "rad", "number": ""}
 #: The units whose factor is a decimal number, exactly: a quantity in them is read as the decimal it is ("9 mm" is
-#: 0.009, the float nearest 9e-3), not as the product of two rounded floats (9 * 1e-3 = 0.009000000000000001).
-_DECIMAL = {unit: decimal.Decimal(factor) for unit, factor in (
-    ("mm", "1e-3"), ("cm", "1e-2"), ("dm", "0.1"), ("km", "1e3"), ("um", "1e-6"), ("\u00b5m", "1e-6"), ("in", "0.0254"),
-    ("ft", "0.3048"), ("mrad", "1e-3"))}
+#: 0.009, the float nearest 9e-3), not as the product of two rounded floats (9 * 1e-3 = 0.009000000000000001):
+#: every unit of UNITS but the ones of pi, its factor as the decimal it was written as (repr gives it back).
+_DECIMAL = {unit: decimal.Decimal(repr(factor)) for unit, factor in (*UNITS["length"].items(), *UNITS["angle"].items())
+            if unit not in ("m", "rad", "deg", "°", "turn")}
 #: Enough digits for any number a description holds; no traps: an overflow gives inf, refused as not finite.
 _CONTEXT = decimal.Context(prec=10_000, Emax=decimal.MAX_EMAX, Emin=decimal.MIN_EMIN, traps=[])
 #: ASCII digits only: ``\d`` also matched '٣' and '１', which float() read as 3 and 1.

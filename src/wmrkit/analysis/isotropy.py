@@ -189,6 +189,13 @@ def kappa_function(model: TwistModel, beta: np.ndarray):
     return lambda length: _fast.kappa_cm(model.mobility, rates, lines, float(length))
 
 
+def length_applies(mobility: int, kappa: float) -> bool:
+    """Whether a natural length goes with a condition number `kappa` of a robot of `mobility` m: where kappa is
+    finite and depends on the length (m >= 2). Elsewhere :func:`natural_length` falls back to the robot size, which
+    minimises nothing."""
+    return mobility >= 2 and bool(np.isfinite(kappa))
+
+
 def natural_length(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple[str, ...] | None = None,
                    heading: ArrayLike | None = None) -> tuple[float, float]:
     """The characteristic length minimising :func:`twist_condition_number` at one configuration: ``(D [m], kappa)``.

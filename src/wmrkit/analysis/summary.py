@@ -23,7 +23,7 @@ from ..wheels import heading_from_beta
 from .classification import Classification, classify, instantaneous_mobility
 from .coordinated import coordinated_singular_set
 from .icr import ICRSet, icr
-from .isotropy import default_joints, natural_length, twist_condition_number
+from .isotropy import default_joints, length_applies, natural_length, twist_condition_number
 from .singularity import SingularSet, singular_set
 
 
@@ -64,10 +64,8 @@ class Analysis:
 
     @property
     def has_length(self) -> bool:
-        """A length goes with the condition number: given, or natural where some length makes kappa finite and
-        kappa depends on it (m >= 2). Elsewhere :func:`.natural_length` falls back to the robot size, which
-        minimises nothing."""
-        return not self.natural or (self.classification.mobility >= 2 and bool(np.isfinite(self.condition_number)))
+        """A length goes with the condition number: given, or natural where it applies (:func:`.length_applies`)."""
+        return not self.natural or length_applies(self.classification.mobility, self.condition_number)
 
     def condition_words(self) -> str:
         """The condition number and its length in words (the text summary and the report)."""

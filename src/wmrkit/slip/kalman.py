@@ -133,19 +133,19 @@ class KalmanModel:
         shapes = ((3, 3), (3, n_a), (m, 3), (m, n_a), (min(m, 3 + n_a), 3 + n_a))
         return cached_maps(self._cache, configs, shapes, compute)[0]
 
-
     def _note_conditioning(self, c: np.ndarray, configs: np.ndarray) -> None:
         """Keep the worst condition number of the kept rows ``C`` ``(U, m, 3)`` (weighted by their noise, omega's
         column times the robot's size: dimensionless) over the configurations `configs` ``(U, s)``."""
+        from ..analysis.isotropy import condition_number
         from ..analysis.singularity import robot_size
 
+        if not len(configs):
+            return
         weighted = c / self.sigma[:, None]
         weighted[..., 2] *= robot_size(self.odometry.robot)
-        s = np.linalg.svd(weighted, compute_uv=False)
-        with np.errstate(divide="ignore"):
-            kappa = np.where(s[..., -1] > 1e-12 * s[..., 0], s[..., 0] / s[..., -1], np.inf)
+        kappa = condition_number(weighted)
         k = int(np.argmax(kappa))
-        if len(kappa) and kappa[k] > self._worst.get("condition", 0.0):
+        if kappa[k] > self._worst.get("condition", 0.0):
             self._worst.update(condition=float(kappa[k]), config=tuple(float(a) for a in configs[k]))
 
     @property

@@ -26,6 +26,7 @@ from ..analysis.isotropy import (
     condition_map,
     default_joints,
     kappa_function,
+    length_applies,
     natural_length,
     twist_model,
 )
@@ -161,10 +162,8 @@ def live_summary(robot: Robot) -> dict[str, Any]:
                       "verdict": str(act.verdict), "joints": list(robot.actuated)},
         "sensing": {"sufficient": bool(np.all(sen.sufficient)), "verdict": str(sen.verdict),
                     "joints": list(robot.sensed)},
-        # no length where kappa is infinite at every one or does not depend on it (m = 1): natural_length's
-        # fallback, the size, minimises nothing
         "condition_number": _finite(kappa),
-        "characteristic_length": _finite(length) if math.isfinite(kappa) and cls.mobility >= 2 else None,
+        "characteristic_length": _finite(length) if length_applies(cls.mobility, kappa) else None,
         "condition_joints": list(joints), "natural_length": True,
         "steering": dict(zip(robot.steer_names, robot.heading.tolist(), strict=True)),
         "singular_here": here,
