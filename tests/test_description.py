@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -13,9 +14,10 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 
-from wmrkit import KINDS, DescriptionError, Robot, Wheel
+from wmrkit import KINDS, DescriptionError, Robot, Wheel, catalog
 from wmrkit.cli.main import main
 from wmrkit.description import robot_from_text
+from wmrkit.dynamics.mass import Body
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "description-format.md"
 SRC = "robots/test.yaml"
@@ -671,3 +673,17 @@ def test_numbers_yaml_1_1_reads_otherwise_than_they_look_are_refused(written, re
     for plain in ("0", "00", "007", "08", "1_0", "0.5", "00.5", "'010'"):  # read as they look: kept
         text = f"name: r\nwheels:\n  - {{name: w, type: fixed, position: [{plain}, 0.2], r: 0.1, heading: 0}}\n"
         assert robot_from_text(text, source="r.yaml").wheels[0].position[1] == pytest.approx(0.2)
+
+
+@pytest.mark.parametrize("change", [
+    lambda r: replace(r, body=Body(-1.0, 1.0)),  # a negative mass
+    lambda r: replace(r, wheels=(replace(r.wheels[0], r=1e-9), *r.wheels[1:])),  # a radius lost in the rank tests
+])
+def test_to_file_refuses_a_robot_its_file_would_not_load_as(change, tmp_path):
+    # a robot built in Python that a description refuses was written, and the file failed only when read back
+    robot = change(catalog.load("diff-drive"))
+    for name in ("a.yaml", "a.json"):
+        with pytest.raises(DescriptionError, match=rf"robot 'diff-drive' is not written to .*{name}: it would not "
+                                                   r"load back: (body\.mass|wheels\[0\]\.r): "):
+            robot.to_file(tmp_path / name)
+        assert not (tmp_path / name).exists()

@@ -434,9 +434,16 @@ def robot_from_text(text: str, *, source: str, fmt: str = "yaml") -> Robot:
 
 
 def save_robot_file(robot: Robot, path: str | os.PathLike[str]) -> None:
-    """Write `robot` as YAML or JSON (by the file's extension)."""
+    """Write `robot` as YAML or JSON (by the file's extension); a robot built in Python that a description refuses
+    (a negative mass, a radius too small for the rank tests) raises :class:`DescriptionError` and nothing is
+    written: the file would not load back."""
     path = Path(path)
     data = robot_to_dict(robot)
+    try:
+        robot_from_dict(data, source=str(path))
+    except DescriptionError as err:
+        raise DescriptionError(err.message, source=f"robot '{robot.name}' is not written to {path}: it would not "
+                               "load back", loc=err.loc, wheel=err.wheel) from None
     if path.suffix.lower() == ".json":
         path.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
     else:
