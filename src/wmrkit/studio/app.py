@@ -88,8 +88,9 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
 
     def endpoint(fn: Callable[[Any], Any], *, body: bool = True, thread: bool = False):
         """`thread`: run in a worker thread, so that a slow answer does not hold up the other requests (the live
-        analysis of a 64-wheel robot takes over a second). Open and save stay on the event loop: a save checks that
-        its file does not exist and writes it in one step, with no other request in between."""
+        analysis of a 64-wheel robot takes over a second; opening a 256 KiB YAML file, seconds). Save stays on the
+        event loop: it checks that its file does not exist and writes it in one step, with no other request in
+        between."""
 
         async def handle(request) -> Response:
             t0 = time.perf_counter()
@@ -129,7 +130,7 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
         Route("/favicon.ico", lambda request: Response(status_code=204)),
         Route("/api/meta", endpoint(meta, body=False, thread=True)),
         Route("/api/files", endpoint(lambda _: {"files": files.list_files(root)}, body=False, thread=True)),
-        Route("/api/open", endpoint(lambda p: files.open_robot(root, p)), methods=["POST"]),
+        Route("/api/open", endpoint(lambda p: files.open_robot(root, p), thread=True), methods=["POST"]),
         Route("/api/save", endpoint(lambda p: files.save_robot(root, p)), methods=["POST"]),
         Route("/api/analyze", endpoint(api.analyze_live, thread=True), methods=["POST"]),
         Route("/api/configurations", endpoint(api.configurations, thread=True), methods=["POST"]),
