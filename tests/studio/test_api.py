@@ -171,6 +171,17 @@ def test_malformed_requests(client):
     assert client.post("/api/meta", json={}).status_code == 405  # meta is read-only
 
 
+def test_wrong_method_and_unknown_route_answer_json(client):
+    """A wrong method or an unknown endpoint answered Starlette's plain text ('Method Not Allowed'), where every
+    other mistake is a JSON {"error": message} (docs/studio.md)."""
+    for r, status in ((client.get("/api/analyze"), 405), (client.put("/api/save"), 405),
+                      (client.post("/api/meta", json={}), 405), (client.get("/api/analyse"), 404),
+                      (client.get("/static/none.js"), 404)):
+        assert r.status_code == status and r.headers["content-type"] == "application/json", r.text
+        assert r.json()["error"], r.text
+    assert client.get("/api/analyze").headers["allow"] == "POST"
+
+
 def test_key_given_twice_is_refused(client):
     """The last of two keys was taken silently (description files refuse it: 'field 'r' given twice')."""
     text = json.dumps({"description": desc("diff-drive")}).replace('"r": 0.075', '"r": 0.075, "r": 0.1', 1)

@@ -71,6 +71,7 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
     require_starlette()
     from starlette.applications import Starlette
     from starlette.concurrency import run_in_threadpool
+    from starlette.exceptions import HTTPException
     from starlette.middleware import Middleware
     from starlette.responses import FileResponse, Response
     from starlette.routing import Mount, Route
@@ -122,6 +123,11 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
                 "files": files.list_files(root), "start": {"spec": robot_spec or start.name,
                                                            "description": api.description_of(start)}}
 
+    async def http_error(request, err: HTTPException) -> Response:  # 404, 405: JSON as every other mistake
+        response = respond({"error": f"{err.detail}: {request.method} {request.url.path[:200]}"}, err.status_code)
+        response.headers.update(err.headers or {})  # a 405's Allow
+        return response
+
     async def index(request) -> Response:
         return FileResponse(static / "index.html", headers={"Cache-Control": "no-store"})
 
@@ -143,7 +149,7 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
         from starlette.middleware.trustedhost import TrustedHostMiddleware
 
         middleware.append(Middleware(TrustedHostMiddleware, allowed_hosts=allowed_hosts))
-    return Starlette(routes=routes, middleware=middleware)
+    return Starlette(routes=routes, middleware=middleware, exception_handlers={HTTPException: http_error})
 
 
 class _SecurityHeaders:
