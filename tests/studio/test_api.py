@@ -18,7 +18,7 @@ from starlette.testclient import TestClient
 
 from wmrkit import Robot, catalog
 from wmrkit.analysis.summary import analyze
-from wmrkit.description import robot_from_dict
+from wmrkit.description import ALL_WHEEL_FIELDS, WHEEL_TYPES, robot_from_dict
 from wmrkit.errors import DescriptionError
 from wmrkit.kinematics.wheel_ik import wheel_commands
 from wmrkit.studio.api import NATIVE_HEADING
@@ -436,6 +436,10 @@ def test_configurations_bounded_for_many_steering_wheels(client, n):
 def test_meta_and_catalog(client):
     meta = client.get("/api/meta").json()
     assert set(meta["catalog"]) == set(catalog.names()) and "castor" in meta["kinds"]
+    # every type a description may use, 'mecanum' (which to_dict writes) included: the page's fields follow it
+    assert list(meta["kinds"]) == list(WHEEL_TYPES)
+    for name, kind in meta["kinds"].items():
+        assert set(kind["required"]) | set(kind["optional"]) <= set(ALL_WHEEL_FIELDS), name
     r = client.post("/api/open", json={"catalog": "swerve-4"})
     assert Robot.from_dict(r.json()["description"]) == catalog.load("swerve-4")
     assert client.post("/api/open", json={"catalog": "swerv-4"}).status_code == 400

@@ -682,3 +682,28 @@ def test_drive_table_shows_roller_rates(page):
     pg.keyboard.press(" ")
     settle(pg)
     assert not pg.errors
+
+
+def test_mecanum_wheel_fields_are_editable(page):
+    """A 'type: mecanum' wheel (mecanum-4's, as to_dict writes them) had no kind in the page: its panel showed
+    no r, r_r or gamma and no actuated/sensed boxes, so neither its radius nor its joints could be edited."""
+    pg = page
+    open_catalog(pg, "mecanum-4")
+    pg.click('[data-wheel="front_left"]')
+    assert pg.input_value('#wheel-fields [data-field="r"]') == "76.2 mm"
+    assert pg.input_value('#wheel-fields [data-field="r_r"]') == "12.5 mm"
+    assert pg.input_value('#wheel-fields [data-field="gamma"]') == ""  # absent: from the quadrant, +-45 deg
+    assert pg.locator('#wheel-fields [data-field="actuated.spin"]').is_checked()
+    edit(pg, "r", "80 mm")
+    pg.uncheck('#wheel-fields [data-field="sensed.spin"]')
+    settle(pg)
+    wheel = page_robot(pg).wheel("front_left")
+    assert wheel.r == pytest.approx(0.08) and wheel.r_r == pytest.approx(0.0125) and wheel.sensed == ()
+    assert wheel.gamma == pytest.approx(math.pi / 4)
+    assert pg.evaluate("S.desc.wheels[0].type") == "mecanum"
+    pg.select_option("#new-type", "mecanum")  # placed off the axes: its rollers' angle comes from its quadrant
+    pg.click("#add")
+    settle(pg)
+    assert pg.evaluate("document.getElementById('error').hidden"), pg.inner_text("#error")
+    assert page_robot(pg).wheels[-1].type == "swedish"
+    assert not pg.errors

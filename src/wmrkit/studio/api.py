@@ -121,9 +121,15 @@ def geometry(robot: Robot) -> dict[str, Any]:
 
 
 def kinds() -> dict[str, Any]:
-    """The wheel types: fields (required, optional with defaults), joints, whether they steer, a summary."""
-    return {k.name: {"required": list(k.required), "optional": dict(k.optional), "joints": list(k.joints),
-                     "rates": list(k.rates), "steers": k.steers, "summary": k.summary} for k in KINDS.values()}
+    """The wheel types a description may use: fields (required, optional with defaults), joints, whether they
+    steer, a summary. ``mecanum`` is a Swedish wheel whose ``gamma`` (from its quadrant) and ``r_r`` (``r / 4``)
+    are optional without a fixed default (null)."""
+    out = {k.name: {"required": list(k.required), "optional": dict(k.optional), "joints": list(k.joints),
+                    "rates": list(k.rates), "steers": k.steers, "summary": k.summary} for k in KINDS.values()}
+    out["mecanum"] = out["swedish"] | {
+        "required": ["r"], "optional": {"gamma": None, "r_r": None},
+        "summary": "Swedish wheel of the standard X layout: gamma +-45 deg from its quadrant, r_r = r / 4 unless given"}
+    return out
 
 
 # ---- analysis ----------------------------------------------------------------------------------------------

@@ -34,7 +34,7 @@ function fmt(x, digits = 4) {
   return Number(x.toPrecision(digits)).toString();
 }
 function shown(value, field) {  // a description value as the user sees it: numbers (SI) in mm / deg
-  if (typeof value !== "number") return value === undefined ? "" : String(value);
+  if (typeof value !== "number") return value === undefined || value === null ? "" : String(value);
   if (LENGTHS.has(field) || field === "x" || field === "y") return `${fmt(value * 1000, 6)} mm`;
   if (ANGLES.has(field) || field === "heading") return `${fmt(deg(value), 6)} deg`;
   return String(value);
@@ -319,7 +319,8 @@ function addWheel() {
   do { name = `w${++n}`; } while (wheelIndex(name) >= 0);
   const size = S.geometry ? S.geometry.size : 0.3;
   commit((d) => {
-    const w = { name, type, position: [0, 0.6 * size], heading: 0, r: 0.05 };
+    // a mecanum wheel takes its rollers' angle from its quadrant: not on an axis
+    const w = { name, type, position: [type === "mecanum" ? 0.6 * size : 0, 0.6 * size], heading: 0, r: 0.05 };
     if (kind.required.includes("d")) w.d = 0.04;
     if (kind.required.includes("b")) w.b = 0.08;
     if (kind.required.includes("gamma")) { w.gamma = "90 deg"; w.r_r = "10 mm"; }
