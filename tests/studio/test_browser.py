@@ -707,3 +707,32 @@ def test_mecanum_wheel_fields_are_editable(page):
     assert pg.evaluate("document.getElementById('error').hidden"), pg.inner_text("#error")
     assert page_robot(pg).wheels[-1].type == "swedish"
     assert not pg.errors
+
+
+def test_duplicate_name_keeps_the_renamed_wheel_selected(page):
+    """Renaming 'right' to 'left' (a duplicate: an error) selected the first wheel of that name, the other one:
+    its fields were shown, and typing 'right' back renamed the original left wheel, swapping the two names
+    without an error."""
+    pg = page
+    open_catalog(pg, "diff-drive")
+    pg.click('[data-wheel="right"]')
+    edit(pg, "name", "left")
+    assert "duplicate wheel name 'left'" in pg.inner_text("#error")
+    assert pg.input_value('#wheel-fields [data-field="y"]') == "-200 mm"  # the renamed wheel's panel
+    edit(pg, "name", "right")
+    assert pg.evaluate("document.getElementById('error').hidden")
+    robot = page_robot(pg)
+    assert robot.wheel("left").position[1] == pytest.approx(0.2)
+    assert robot.wheel("right").position[1] == pytest.approx(-0.2)
+    pg.click("#undo")
+    settle(pg)
+    pg.click("#undo")
+    settle(pg)
+    assert [w.name for w in page_robot(pg).wheels] == ["left", "right", "caster"]
+    open_catalog(pg, "ackermann")  # the couplings keep their joints through the duplicate and back
+    pg.click('[data-wheel="rear_right"]')
+    edit(pg, "name", "rear_left")
+    edit(pg, "name", "rear_right")
+    assert pg.evaluate("document.getElementById('error').hidden"), pg.inner_text("#error")
+    assert pg.evaluate("S.desc.couplings") == catalog.load("ackermann").to_dict()["couplings"]
+    assert not pg.errors

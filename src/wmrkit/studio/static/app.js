@@ -9,7 +9,7 @@ const ANGLES = new Set(["delta", "gamma"]);
 const S = {
   meta: null, desc: null, geometry: null, analysis: null, drive: null, kappa: null, configs: null,
   analysedText: "", configsText: null,  // the descriptions (JSON) the analysis and the configurations are about
-  selected: null, undo: [], redo: [], twist: [0, 0, 0], heading: {}, path: "",
+  selected: null, selIndex: -1, undo: [], redo: [], twist: [0, 0, 0], heading: {}, path: "",
   inflight: false, pending: false, driving: 0, driveSeq: 0, editTime: 0, seq: 0, anim: null, view: null,
 };
 // Timings for the docs and the browser test: round trip edit -> numbers shown [ms], server time [ms].
@@ -58,12 +58,20 @@ function restore(text) {  // undo, redo: the selection and the driven headings m
   refresh();
 }
 function afterChange() {
-  if (S.selected !== null && wheelIndex(S.selected) < 0) S.selected = null;
+  if (S.selected !== null && selectedIndex() < 0) S.selected = null;
   S.heading = steeringHeadings(S.heading);
 }
 function undo() { if (S.undo.length) { S.redo.push(JSON.stringify(S.desc)); restore(S.undo.pop()); } }
 function redo() { if (S.redo.length) { S.undo.push(JSON.stringify(S.desc)); restore(S.redo.pop()); } }
 function wheelIndex(name) { return Array.isArray(S.desc.wheels) ? S.desc.wheels.findIndex((w) => w.name === name) : -1; }
+// The selected wheel is known by its name and its index: while two wheels share the name (a duplicate being
+// fixed), the index tells which one (by name alone the other wheel was edited, and the names swapped silently).
+function select(name, i = wheelIndex(name)) { S.selected = name; S.selIndex = i; }
+function selectedIndex() {
+  if (S.selected === null || !Array.isArray(S.desc.wheels)) return -1;
+  const w = S.desc.wheels[S.selIndex];
+  return w && w.name === S.selected ? S.selIndex : wheelIndex(S.selected);
+}
 function steeringHeadings(heading) {  // the driven headings of wheels that still steer (a wheel renamed, retyped
   const out = {};                     // or deleted while driving is dropped: /api/drive refuses unknown names)
   const wheels = Array.isArray(S.desc.wheels) ? S.desc.wheels : [];
@@ -189,8 +197,8 @@ function showError(err) {
   const box = $("error");
   if (!err) { box.hidden = true; return; }
   box.hidden = false; box.textContent = errorText(err);
-  const w = errorWheel(err);
-  if (w && S.selected !== w.name) { S.selected = w.name; renderWheelPanel(); }
+  const w = errorWheel(err), i = w ? err.loc[1] : -1;
+  if (w && selectedIndex() !== i) { select(w.name, i); renderWheelPanel(); }
   markField();
 }
 function errorWheel(err) {  // the wheel an error is about (loc wheels[i]...), when it has a name
@@ -222,7 +230,7 @@ function markField() {
 // ---- side panel: the selected wheel ---------------------------------------------------------------------------
 function renderWheelPanel() {
   const box = $("wheel-fields");
-  const i = S.selected === null ? -1 : wheelIndex(S.selected);
+  const i = selectedIndex();
   $("wheel-title").textContent = i < 0 ? "" : S.selected;
   if (i < 0) { box.innerHTML = '<p class="hint">click a wheel</p>'; return; }
   const w = S.desc.wheels[i], g = geometryOf(w.name), kind = S.meta.kinds[w.type];
@@ -262,7 +270,7 @@ function renderWheelPanel() {
       const box2 = document.createElement("input"); box2.type = "checkbox"; box2.checked = have.has(j);
       box2.dataset.field = `${group}.${j}`;
       box2.addEventListener("change", () => commit((d) => {
-        const ww = d.wheels[wheelIndex(w.name)];
+        const ww = d.wheels[i];
         const set = new Set(typeof ww[group] === "string" ? [ww[group]] : (ww[group] || []));
         if (box2.checked) set.add(j); else set.delete(j);
         ww[group] = kind.joints.filter((x) => set.has(x));
@@ -275,12 +283,15 @@ function renderWheelPanel() {
   markField();
 }
 function editField(field, text) {
-  const name = S.selected;
-  if (name === null || wheelIndex(name) < 0) return;
+  const name = S.selected, i = selectedIndex();
+  if (i < 0) return;
   commit((d) => {
-    const w = d.wheels[wheelIndex(name)];
+    const w = d.wheels[i];
     if (field === "name") {
-      w.name = text; S.selected = text;
+      // the joints and driven heading follow the wheel, unless either name is another wheel's (a duplicate)
+      const shared = d.wheels.some((x, k) => k !== i && x && (x.name === name || x.name === text));
+      w.name = text; select(text, i);
+      if (shared) return;
       rewriteCouplings(d, name, { rename: text });
       if (name in S.heading && text !== name) { S.heading[text] = S.heading[name]; delete S.heading[name]; }
       return;
@@ -294,10 +305,10 @@ function editField(field, text) {
   });
 }
 function changeType(type) {
-  const name = S.selected, kind = S.meta.kinds[type];
-  if (name === null || wheelIndex(name) < 0 || !kind) return;
+  const name = S.selected, i = selectedIndex(), kind = S.meta.kinds[type];
+  if (i < 0 || !kind) return;
   commit((d) => {
-    const i = wheelIndex(name), old = d.wheels[i], g = geometryOf(name);
+    const old = d.wheels[i], g = geometryOf(name);
     const w = { name: old.name, type };
     setPlace(w, ...(Array.isArray(old.position) ? old.position : (g ? g.joint : [0, 0])));
     w.heading = "heading" in old ? old.heading : (g ? g.heading : 0);
@@ -326,13 +337,13 @@ function addWheel() {
     if (kind.required.includes("gamma")) { w.gamma = "90 deg"; w.r_r = "10 mm"; }
     d.wheels.push(w);
   });
-  S.selected = name; renderWheelPanel();
+  select(name); renderWheelPanel();
 }
 function deleteWheel() {
-  const name = S.selected;
-  if (name === null || wheelIndex(name) < 0) { S.selected = null; renderWheelPanel(); return; }
+  const name = S.selected, i = selectedIndex();
+  if (i < 0) { S.selected = null; renderWheelPanel(); return; }
   commit((d) => {
-    d.wheels.splice(d.wheels.findIndex((w) => w.name === name), 1);
+    d.wheels.splice(i, 1);
     rewriteCouplings(d, name, { type: null });
   });
   S.selected = null; renderWheelPanel();
@@ -476,7 +487,7 @@ function onPointerDown(ev) {
   const handle = ev.target.closest("[data-handle]"), wheel = ev.target.closest("[data-wheel]");
   if (!handle && !wheel) return;
   const name = handle ? handle.dataset.handle : wheel.dataset.wheel;
-  if (S.selected !== name) { S.selected = name; renderWheelPanel(); drawPlan(); }
+  if (S.selected !== name) { select(name); renderWheelPanel(); drawPlan(); }
   const g = geometryOf(name), start = svgPoint(ev);
   S.dragging = { name, rotate: !!handle, offset: [g.joint[0] - start[0], g.joint[1] - start[1]], joint: g.joint,
     before: JSON.stringify(S.desc), pushed: false };  // one undo step, pushed when the drag first moves
