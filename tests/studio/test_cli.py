@@ -89,3 +89,28 @@ def test_a_linked_file_is_opened_and_saved_where_it_is(tmp_path, monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         main(["studio", str(tmp_path / "robots" / "current.yaml"), "--port", "0", "--no-browser"])
     assert seen == {"root": (tmp_path / "designs").resolve(), "spec": "v3.yaml"}
+
+
+def test_a_loopback_host_answers_at_its_own_address(tmp_path, monkeypatch):
+    """`--host 127.0.0.2` (a loopback address) printed and opened http://127.0.0.2:PORT/, which answered 400
+    'Invalid host header': only the Host names 127.0.0.1, localhost and ::1 were answered."""
+    pytest.importorskip("httpx2")
+    from starlette.testclient import TestClient
+
+    from wmrkit.cli import studio as cli_studio
+    from wmrkit.studio import app as studio_app
+
+    real_create_app, seen = studio_app.create_app, {}
+
+    def create_app(root, robot, *, robot_spec=None, allowed_hosts=None):
+        seen["hosts"] = allowed_hosts
+        raise KeyboardInterrupt  # stop before serving
+
+    monkeypatch.setattr(studio_app, "create_app", create_app)
+    monkeypatch.setattr(cli_studio, "_listen", lambda host, port: None)
+    with pytest.raises(KeyboardInterrupt):
+        main(["studio", "diff-drive", "--host", "127.0.0.2", "--port", "0", "--no-browser"])
+    app = real_create_app(tmp_path, allowed_hosts=seen["hosts"])
+    assert TestClient(app, base_url="http://127.0.0.2:8765").get("/api/meta").status_code == 200
+    assert TestClient(app, base_url="http://localhost:8765").get("/api/meta").status_code == 200
+    assert TestClient(app, base_url="http://evil.example").get("/api/meta").status_code == 400

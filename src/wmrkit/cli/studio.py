@@ -48,7 +48,9 @@ def run_studio(args: argparse.Namespace) -> int:
     except OSError as err:  # uvicorn logged its own 'ERROR:' line and exited with code 3
         hint = " (try --port 0 for a free one)" if err.errno == errno.EADDRINUSE else ""
         raise WmrkitError(f"--host/--port: cannot listen on {shown}:{args.port}: {err.strerror or err}{hint}") from None
-    app = create_app(root, robot, robot_spec=spec, allowed_hosts=LOCAL_HOSTS if _loopback(args.host) else None)
+    # on a loopback interface, only this machine's names and the address listened on (127.0.0.2 is one too)
+    local = [*LOCAL_HOSTS, args.host] if _loopback(args.host) else None
+    app = create_app(root, robot, robot_spec=spec, allowed_hosts=local)
     from ..studio import api
 
     api.analyze_live({"description": robot.to_dict()})  # warm the imports and compiled kernels before serving
