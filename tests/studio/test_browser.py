@@ -736,3 +736,36 @@ def test_duplicate_name_keeps_the_renamed_wheel_selected(page):
     assert pg.evaluate("document.getElementById('error').hidden"), pg.inner_text("#error")
     assert pg.evaluate("S.desc.couplings") == catalog.load("ackermann").to_dict()["couplings"]
     assert not pg.errors
+
+
+def test_typed_heading_is_drawn_after_driving(page):
+    """After a twist turned the swerve wheels (vy: 90 deg) and Stop, a heading typed in a wheel's field was not
+    drawn: the drive kept the heading the last twist left (the table and the drawing said 90 deg, the field 0)."""
+    pg = page
+    open_catalog(pg, "swerve-4")
+    pg.click("#plan", position={"x": 5, "y": 5})
+    for key in ("a", "a"):
+        pg.keyboard.press(key)
+    settle(pg)
+    pg.keyboard.press(" ")
+    settle(pg)
+    cell = '#commands tr[data-wheel="front_left"] td:nth-child(2)'
+    assert float(pg.get_attribute(cell, "data-value")) == pytest.approx(math.pi / 2)
+    pg.click('[data-wheel="front_left"]')
+    edit(pg, "heading", "10 deg")
+    assert float(pg.get_attribute(cell, "data-value")) == pytest.approx(math.radians(10))
+    assert float(pg.get_attribute('#commands tr[data-wheel="front_right"] td:nth-child(2)', "data-value")) \
+        == pytest.approx(math.pi / 2)  # the others stay where the twist put them
+    pg.click('[data-wheel="front_right"]')  # the same with the handle
+    settle(pg)
+    handle = pg.locator('[data-handle="front_right"]').bounding_box()
+    hx, hy = handle["x"] + handle["width"] / 2, handle["y"] + handle["height"] / 2
+    pg.mouse.move(hx, hy)
+    pg.mouse.down()
+    pg.mouse.move(hx + 10, hy - 40, steps=4)
+    pg.mouse.up()
+    settle(pg)
+    typed = pg.evaluate("S.desc.wheels.find((w) => w.name === 'front_right').heading")
+    assert float(pg.get_attribute('#commands tr[data-wheel="front_right"] td:nth-child(2)', "data-value")) \
+        == pytest.approx(math.radians(float(typed.removesuffix(" deg"))))
+    assert not pg.errors

@@ -300,7 +300,7 @@ function editField(field, text) {
       const g = geometryOf(name), pos = Array.isArray(w.position) ? [...w.position] : (g ? [...g.joint] : [0, 0]);
       pos[field === "x" ? 0 : 1] = text; setPlace(w, pos[0], pos[1]); return;
     }
-    if (field === "heading") { setHeading(w, text); return; }
+    if (field === "heading") { setHeading(w, text); delete S.heading[name]; return; }  // drawn as typed
     if (text === "") delete w[field]; else w[field] = text;
   });
 }
@@ -501,7 +501,10 @@ function onPointerMove(ev) {
   if (wheelIndex(d.name) < 0) return;
   commit((desc) => {
     const w = desc.wheels[wheelIndex(d.name)];
-    if (d.rotate) setHeading(w, cleanHeading(Math.atan2(p[1] - d.joint[1], p[0] - d.joint[0])));
+    if (d.rotate) {  // the wheel is drawn where the handle turns it, not at the heading a twist left
+      setHeading(w, cleanHeading(Math.atan2(p[1] - d.joint[1], p[0] - d.joint[0])));
+      delete S.heading[d.name];
+    }
     else setPlace(w, round(p[0] + d.offset[0]), round(p[1] + d.offset[1]));
   }, { push: false });
   if (!d.pushed && JSON.stringify(S.desc) !== d.before) { d.pushed = true; S.undo.push(d.before); S.redo = []; }
