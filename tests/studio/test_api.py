@@ -21,7 +21,6 @@ from wmrkit.analysis.summary import analyze
 from wmrkit.description import ALL_WHEEL_FIELDS, WHEEL_TYPES, robot_from_dict
 from wmrkit.errors import DescriptionError
 from wmrkit.kinematics.wheel_ik import wheel_commands
-from wmrkit.studio.api import NATIVE_HEADING
 from wmrkit.studio.app import MAX_BODY, create_app
 
 STEERING = ("ackermann", "swerve-4", "diff-drive", "thesis-steer-castor", "thesis-two-steer-swedish")
@@ -119,10 +118,9 @@ def test_invalid_field_has_cli_message(client, edit, field):
     assert r.status_code == 422
     body = r.json()
     assert body["field"] == field
-    if edit[0] != "heading" or NATIVE_HEADING:  # the library's own validation, the same text as the CLI's
-        with pytest.raises(DescriptionError) as err:
-            robot_from_dict(d, source="studio")
-        assert body["message"] == err.value.message and body["error"] == str(err.value)
+    with pytest.raises(DescriptionError) as err:  # the library's own validation, the same text as the CLI's
+        robot_from_dict(d, source="studio")
+    assert body["message"] == err.value.message and body["error"] == str(err.value)
 
 
 @pytest.mark.parametrize(("index", "value"), [(1, "2 km"), (0, "-2 km")])

@@ -43,7 +43,6 @@ from wmrkit import Robot, catalog  # noqa: E402
 from wmrkit.analysis.summary import analyze  # noqa: E402
 from wmrkit.description import robot_from_dict  # noqa: E402
 from wmrkit.kinematics.wheel_ik import wheel_commands  # noqa: E402
-from wmrkit.studio.api import headings_to_beta  # noqa: E402
 from wmrkit.studio.app import LOCAL_HOSTS, create_app  # noqa: E402
 
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -108,7 +107,7 @@ def settle(pg) -> None:
 
 
 def page_robot(pg) -> Robot:
-    return robot_from_dict(headings_to_beta(pg.evaluate("S.desc")))
+    return robot_from_dict(pg.evaluate("S.desc"))
 
 
 def shown(pg, cell: str):

@@ -33,8 +33,8 @@ from ..analysis.isotropy import (
 from ..analysis.optimize import isotropic_configurations
 from ..analysis.singularity import robot_size, singularity_distance
 from ..analysis.summary import assigned_names, describe_singular, model_rates, model_singular_set
-from ..description import COMMON_WHEEL_FIELDS, robot_from_dict, robot_to_dict
-from ..errors import DescriptionError, ShapeError, WmrkitError
+from ..description import robot_from_dict, robot_to_dict
+from ..errors import ShapeError, WmrkitError
 from ..kinematics.actuation import actuation_analysis
 from ..kinematics.sensing import sensing_analysis
 from ..kinematics.wheel_ik import wheel_commands
@@ -42,7 +42,7 @@ from ..limits import MAX_QUERY_RATE
 from ..odometry.integrators import integrate_exact
 from ..robot import Robot
 from ..units import UnitError, parse_quantity
-from ..wheels import KINDS, beta_from_heading, heading_from_beta
+from ..wheels import KINDS, heading_from_beta
 
 #: Distance to singularity (``sigma_min / sigma_max`` of the constraint lines, 6.17) below which the page warns.
 NEAR_SINGULAR = 0.05
@@ -52,8 +52,6 @@ MAX_RESOLUTION = 181
 #: the 2-core machine; the search grows with every steering angle): beyond, not searched, with a note.
 MAX_ISOTROPIC_STEERING = 4
 SOURCE = "studio"
-#: The description format reads ``heading:`` itself (else :func:`headings_to_beta` converts it).
-NATIVE_HEADING = "heading" in COMMON_WHEEL_FIELDS
 
 
 class StudioError(WmrkitError, ValueError):
@@ -62,39 +60,9 @@ class StudioError(WmrkitError, ValueError):
 
 # ---- descriptions ------------------------------------------------------------------------------------------
 def robot_of(request: Any) -> Robot:
-    """The :class:`Robot` of ``request["description"]`` (headings accepted in place of ``beta``)."""
+    """The :class:`Robot` of ``request["description"]`` (the description format reads ``heading`` or ``beta``)."""
     data = _field(request, "description", Mapping)
-    return robot_from_dict(headings_to_beta(data), source=SOURCE)
-
-
-def headings_to_beta(data: Mapping[str, Any]) -> dict[str, Any]:
-    """A copy of description `data` where each wheel's ``heading`` became the thesis's ``beta`` (radians).
-
-    When the description format itself reads ``heading:`` (:mod:`wmrkit.description`), `data` is passed on as it
-    is, so that every message is the library's own.
-    """
-    out = dict(data)
-    wheels = data.get("wheels")
-    if not isinstance(wheels, list) or NATIVE_HEADING:
-        return out
-    out["wheels"] = []
-    for i, item in enumerate(wheels):
-        if isinstance(item, Mapping) and "heading" in item:
-            item = dict(item)
-            if "beta" in item:
-                raise DescriptionError("give either 'beta' or 'heading', not both", source=SOURCE,
-                                       loc=("wheels", i, "heading"))
-            try:
-                heading = parse_quantity(item.pop("heading"), "angle")
-            except UnitError as err:
-                raise DescriptionError(str(err), source=SOURCE, loc=("wheels", i, "heading")) from None
-            try:
-                delta = parse_quantity(item.get("delta", 0.0), "angle")
-            except UnitError:
-                delta = 0.0  # robot_from_dict reports the bad delta at its own field
-            item["beta"] = float(beta_from_heading(heading, delta))
-        out["wheels"].append(item)
-    return out
+    return robot_from_dict(data, source=SOURCE)
 
 
 def description_of(robot: Robot) -> dict[str, Any]:
