@@ -768,3 +768,29 @@ def test_typed_heading_is_drawn_after_driving(page):
     assert float(pg.get_attribute('#commands tr[data-wheel="front_right"] td:nth-child(2)', "data-value")) \
         == pytest.approx(math.radians(float(typed.removesuffix(" deg"))))
     assert not pg.errors
+
+
+def test_kappa_map_cell_steers_to_the_heading_it_shows(page):
+    """The κ map painted κ(h_i) over the cell from h_i to h_i + 5 deg, while its axis, cross and clicks put h_i at
+    the cell's left edge: a click in the middle of a cell steered half a cell (2.5 deg) past the heading whose κ
+    the cell shows."""
+    pg = page
+    open_catalog(pg, "thesis-steer-castor")
+    axis, wheels = pg.evaluate("[S.kappa.axis, S.kappa.wheels]")
+    pg.locator("#kappa").scroll_into_view_if_needed()
+    rect = pg.evaluate("(() => { const c = document.getElementById('kappa'), r = c.getBoundingClientRect(); "
+                       "return [r.left, r.top, c.width / r.width, c.height / r.height, c.width, c.height]; })()")
+    left, top, sx, sy, width, height = rect
+    n, margin = len(axis), 30  # the map's left and bottom margin in renderKappa (4 px right and top)
+    w, h = width - margin - 4, height - margin - 4
+    i, j = 10, 50  # cell (i, j) shows kappa at (axis[i], axis[j]): image column i, row n - 1 - j from the top
+    # mouse events land on whole CSS pixels: click the one nearest the cell's centre, expect the heading there
+    cx, cy = round(left + (margin + (i + 0.5) * w / n) / sx), round(top + (4 + (n - 0.5 - j) * h / n) / sy)
+    want = (axis[i] + ((cx - left) * sx - margin - (i + 0.5) * w / n) / w * 2 * math.pi,
+            axis[j] - ((cy - top) * sy - 4 - (n - 0.5 - j) * h / n) / h * 2 * math.pi)
+    pg.mouse.click(cx, cy)
+    settle(pg)
+    robot = page_robot(pg)
+    for name, heading in zip(wheels, want, strict=True):  # to the hundredth of a degree the page keeps
+        assert abs(math.remainder(robot.wheel(name).heading - heading, 2 * math.pi)) < math.radians(0.006), name
+    assert not pg.errors

@@ -629,10 +629,10 @@ function renderKappa() {
     x.imageSmoothingEnabled = false; x.drawImage(tmp, P, 4, W, H);
   } else {
     x.strokeStyle = "#1565c0"; x.beginPath();
-    vals.forEach((v, i) => { if (v === null) return; const px = P + i / n * W, py = 4 + H - (v / hi) * H; i ? x.lineTo(px, py) : x.moveTo(px, py); });
+    vals.forEach((v, i) => { if (v === null) return; const px = P + (i + 0.5) / n * W, py = 4 + H - (v / hi) * H; i ? x.lineTo(px, py) : x.moveTo(px, py); });
     x.stroke();
   }
-  const toPx = (h) => P + ((h + Math.PI) / (2 * Math.PI)) * W, toPy = (h) => 4 + H - ((h + Math.PI) / (2 * Math.PI)) * H;
+  const toPx = (h) => P + kappaFraction(h, n) * W, toPy = (h) => 4 + H - kappaFraction(h, n) * H;
   x.strokeStyle = "#fff"; x.lineWidth = 2;
   const cx = toPx(k.current[0]), cy = k.current.length > 1 ? toPy(k.current[1]) : 4 + H / 2;
   x.beginPath(); x.moveTo(cx - 7, cy); x.lineTo(cx + 7, cy); x.moveTo(cx, cy - 7); x.lineTo(cx, cy + 7); x.stroke();
@@ -642,11 +642,15 @@ function renderKappa() {
   $("k-note").textContent = `log10 κ from 0 (isotropic, yellow at ${fmt(hi, 2)}) ; grey: the robot cannot move or the model is singular; ` +
     (k.best ? `best κ = ${fmt(k.best.kappa, 4)}` : "") + ". Click to steer there.";
 }
+// Cell i of the map shows κ at axis[i] = -π + 2π i / n and spans [i, i + 1) / n of the axis: headings are placed at
+// cell centres (h = axis[i] at (i + 0.5) / n), by the cross and by clicks alike.
+function kappaFraction(h, n) { return (((h + Math.PI) / (2 * Math.PI) + 0.5 / n) % 1 + 1) % 1; }
+function kappaHeading(fraction, n) { const a = (fraction - 0.5 / n) * 2 * Math.PI - Math.PI; return Math.atan2(Math.sin(a), Math.cos(a)); }
 function kappaClick(ev) {
   const k = S.kappa; if (!k) return;
   const c = $("kappa"), r = c.getBoundingClientRect(), sx = c.width / r.width, sy = c.height / r.height;
-  const P = 30, W = c.width - P - 4, H = c.height - P - 4;
-  const h0 = ((ev.clientX - r.left) * sx - P) / W * 2 * Math.PI - Math.PI, h1 = (4 + H - (ev.clientY - r.top) * sy) / H * 2 * Math.PI - Math.PI;
+  const P = 30, W = c.width - P - 4, H = c.height - P - 4, n = k.axis.length;
+  const h0 = kappaHeading(((ev.clientX - r.left) * sx - P) / W, n), h1 = kappaHeading((4 + H - (ev.clientY - r.top) * sy) / H, n);
   commit((d) => {
     const i0 = d.wheels.findIndex((w) => w.name === k.wheels[0]), i1 = d.wheels.findIndex((w) => w.name === k.wheels[1]);
     if (i0 >= 0) setHeading(d.wheels[i0], cleanHeading(h0));
