@@ -380,6 +380,7 @@ def test_configurations(client):
         for beta, heading in zip(full[key]["configurations"], data["singular"][key]["headings"], strict=False):
             deltas = [robot.wheel(n).delta for n in full[key]["variables"]]
             assert all(angle_close(b + dl - math.pi / 2, h) for b, dl, h in zip(beta, deltas, heading, strict=True))
+        assert {k: v for k, v in data["singular"][key].items() if k != "text"} == full[key]  # analyze --json's
     diff = client.post("/api/configurations", json={"description": desc("diff-drive")}).json()
     assert diff["isotropic_searched"] and diff["isotropic"]
     assert all(c["condition_number"] == pytest.approx(1.0) for c in diff["isotropic"])

@@ -59,7 +59,7 @@ class Analysis:
             "condition_number": self.condition_number,
             "characteristic_length": self.characteristic_length if self.has_length else None,
             "condition_joints": list(self.joints), "natural_length": self.natural,
-            "singular": {k: _singular_dict(s, self.robot) for k, s in self.singular.items()},
+            "singular": {k: singular_dict(s, self.robot) for k, s in self.singular.items()},
         }
 
     @property
@@ -115,7 +115,7 @@ def assigned_names(s: SingularSet, robot: Robot) -> tuple[str, ...]:
     return channel_names(robot.couplings, s.assigned) if s.coupled else s.assigned
 
 
-def _singular_dict(s: SingularSet, robot: Robot) -> dict[str, Any]:
+def singular_dict(s: SingularSet, robot: Robot) -> dict[str, Any]:
     """JSON of a singular set: ``configurations`` as the thesis's β of `variables`, ``headings`` the same angles
     as the wheels' headings (0 = rolling straight ahead)."""
     delta = np.array([robot.wheel(v).delta for v in s.variables], dtype=float)

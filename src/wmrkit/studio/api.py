@@ -32,7 +32,7 @@ from ..analysis.isotropy import (
 )
 from ..analysis.optimize import isotropic_configurations
 from ..analysis.singularity import robot_size, singularity_distance
-from ..analysis.summary import assigned_names, describe_singular, model_rates, model_singular_set
+from ..analysis.summary import describe_singular, model_rates, model_singular_set, singular_dict
 from ..description import robot_from_dict, robot_to_dict
 from ..errors import ShapeError, WmrkitError
 from ..kinematics.actuation import actuation_analysis
@@ -42,7 +42,7 @@ from ..limits import MAX_QUERY_RATE
 from ..odometry.integrators import integrate_exact
 from ..robot import Robot
 from ..units import UnitError, parse_quantity
-from ..wheels import KINDS, heading_from_beta
+from ..wheels import KINDS
 
 #: Distance to singularity (``sigma_min / sigma_max`` of the constraint lines, 6.17) below which the page warns.
 NEAR_SINGULAR = 0.05
@@ -170,14 +170,7 @@ def configurations(request: Any) -> dict[str, Any]:
     out: dict[str, Any] = {"singular": {}}
     for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed)):
         s = model_singular_set(robot, model_rates(robot, names), cls, 90, coupled=key == "actuated")
-        headings = [[float(heading_from_beta(v, robot.wheel(n).delta)) for n, v in zip(s.variables, row,
-                                                                                        strict=True)]
-                    for row in s.configurations[:24].tolist()]
-        out["singular"][key] = {"assigned": list(s.assigned), "channels": list(assigned_names(s, robot)),
-                                "variables": list(s.variables), "always": s.always,
-                                "never": s.never, "exact": s.exact, "count": len(s.configurations),
-                                "headings": headings, "reasons": list(s.reasons),
-                                "text": describe_singular(s, robot)}
+        out["singular"][key] = singular_dict(s, robot) | {"text": describe_singular(s, robot)}  # as analyze --json
     # The library's search refines each grid minimum at its own natural length: quick for m = 2 or one steering
     # angle, but tens of seconds for m = 3 with several (a 1-D length search inside Nelder-Mead), and growing
     # with every steering angle for m = 2: not searched then, with a note saying why.
