@@ -794,3 +794,22 @@ def test_kappa_map_cell_steers_to_the_heading_it_shows(page):
     for name, heading in zip(wheels, want, strict=True):  # to the hundredth of a degree the page keeps
         assert abs(math.remainder(robot.wheel(name).heading - heading, 2 * math.pi)) < math.radians(0.006), name
     assert not pg.errors
+
+
+def test_a_bare_number_is_in_the_unit_its_field_shows(page):
+    """The fields show x, y, r in mm and headings in deg, but a bare number typed there was read as the description
+    format reads it: '300' in x (shown '200 mm') put the wheel 300 m away, '5' in a heading shown in deg was 5 rad."""
+    pg = page
+    open_catalog(pg, "swerve-4")
+    pg.click('[data-wheel="front_left"]')
+    settle(pg)
+    edit(pg, "x", "300")
+    edit(pg, "r", "50.5")
+    edit(pg, "heading", "5")
+    wheel = page_robot(pg).wheel("front_left")
+    assert wheel.position[0] == pytest.approx(0.3, abs=1e-12)
+    assert wheel.r == pytest.approx(0.0505, abs=1e-12)
+    assert wheel.heading == pytest.approx(math.radians(5), abs=1e-12)
+    edit(pg, "y", "0.25 m")  # a number with a unit is read as written
+    assert page_robot(pg).wheel("front_left").position[1] == pytest.approx(0.25, abs=1e-12)
+    assert pg.locator(".invalid").count() == 0 and not pg.errors

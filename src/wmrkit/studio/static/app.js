@@ -33,11 +33,22 @@ function fmt(x, digits = 4) {
   if (Math.abs(x) < 5e-13) x = 0;
   return Number(x.toPrecision(digits)).toString();
 }
+function shownUnit(field) {  // the unit a field shows its value in: mm for lengths, deg for angles, else none
+  if (LENGTHS.has(field) || field === "x" || field === "y") return "mm";
+  if (ANGLES.has(field) || field === "heading") return "deg";
+  return "";
+}
 function shown(value, field) {  // a description value as the user sees it: numbers (SI) in mm / deg
   if (typeof value !== "number") return value === undefined || value === null ? "" : String(value);
-  if (LENGTHS.has(field) || field === "x" || field === "y") return `${fmt(value * 1000, 6)} mm`;
-  if (ANGLES.has(field) || field === "heading") return `${fmt(deg(value), 6)} deg`;
+  const unit = shownUnit(field);
+  if (unit === "mm") return `${fmt(value * 1000, 6)} mm`;
+  if (unit === "deg") return `${fmt(deg(value), 6)} deg`;
   return String(value);
+}
+const BARE_NUMBER = /^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/;
+function typed(field, text) {  // a bare number typed in a field shown in mm or deg is in that unit, as displayed
+  const unit = shownUnit(field);
+  return unit && BARE_NUMBER.test(text) ? `${text} ${unit}` : text;
 }
 
 // ---- editing, undo/redo ---------------------------------------------------------------------------------------
@@ -239,7 +250,7 @@ function renderWheelPanel() {
     const l = document.createElement("label"); l.className = "row"; l.textContent = label;
     const input = document.createElement("input");
     input.dataset.field = field; input.value = value; input.title = title;
-    input.addEventListener("change", () => editField(field, input.value.trim()));
+    input.addEventListener("change", () => editField(field, typed(field, input.value.trim())));
     l.appendChild(input); box.appendChild(l);
     const m = document.createElement("div"); m.className = "msg"; m.dataset.msg = field; box.appendChild(m);
   };
