@@ -133,3 +133,11 @@ def test_calibration_image_refuses_rows_too_close_to_measure_the_convergence():
     with pytest.raises(CameraError, match=r"differ by less than 1 px, too little to measure: .* \(A = 0.01 px\)$"):
         calibrate_image(image, 0.01, 0.035, 0.10221)
     assert calibrate_image(image, 5.0, 0.035, 0.00823).tilt == pytest.approx(math.radians(45), abs=1e-3)  # 1.8 px
+
+
+def test_calibration_of_underflowing_measurements_is_refused_not_a_traceback():
+    # x1 * x2 underflows to 0: the cos(tilt) of the message divided by zero (ZeroDivisionError, a traceback);
+    # (9.18) is A (x_w / y_w) (x1 + x2) / (x1 x2) = 1e-300 (0.035 / 0.1022) 1.1e301 = 3.767
+    with pytest.raises(CameraError, match=r"cos\(tilt\) = 3.767, not in \(0, 1\)"):
+        calibrate(1e-300, 1e-301, 1e-300, 0.035, 0.1022)
+

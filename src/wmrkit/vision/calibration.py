@@ -37,7 +37,7 @@ def calibration_kernel(x1: ArrayLike, x2: ArrayLike, rows_a: ArrayLike, half_sep
     """
     x1, x2, a = (np.asarray(v, dtype=float) for v in (x1, x2, rows_a))
     xw, yw = np.asarray(half_separation, dtype=float), np.asarray(row_distance, dtype=float)
-    cos_tilt = a * (xw / yw) * (x1 + x2) / (x1 * x2)
+    cos_tilt = a * (xw / yw) * (1 / x1 + 1 / x2)  # (x1 + x2) / (x1 x2), without the product (it can underflow)
     tilt = np.arccos(np.where((cos_tilt > 0) & (cos_tilt < 1), cos_tilt, np.nan))
     focal = np.tan(tilt) * a * (x1 + x2) / (x1 - x2)
     height = 2 * xw * np.sin(tilt) * a / (x1 - x2)
@@ -82,7 +82,7 @@ def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_d
         raise CameraError(f"calibration: x1 (near row +A, {x1:g} px) must exceed x2 (far row -A, {x2:g} px)")
     with np.errstate(over="ignore", invalid="ignore"):  # an overflow gives NaN, refused below
         tilt, focal, height = (float(v) for v in calibration_kernel(x1, x2, rows_a, half_separation, row_distance))
-        c = rows_a * (half_separation / row_distance) * (x1 + x2) / (x1 * x2)
+        c = rows_a * (half_separation / row_distance) * (1 / x1 + 1 / x2)  # (x1 + x2) / (x1 x2): x1 x2 underflowed
     if not math.isfinite(tilt):
         raise CameraError(f"calibration: the measurements give cos(tilt) = {c:.4g}, not in (0, 1): check the "
                           f"half-separation and row distance")
