@@ -141,3 +141,13 @@ def test_calibration_of_underflowing_measurements_is_refused_not_a_traceback():
     with pytest.raises(CameraError, match=r"cos\(tilt\) = 3.767, not in \(0, 1\)"):
         calibrate(1e-300, 1e-301, 1e-300, 0.035, 0.1022)
 
+
+
+@pytest.mark.parametrize("x1, x2, rows_a", [(0.002, 0.001, 0.001), (2e-5, 1e-5, 1e-5)])
+def test_calibration_refuses_a_focal_length_no_camera_has(x1, x2, rows_a):
+    # (9.21) gave f = 0.005 px, printed with exit 0 (without --out; with it the camera file named only focal_px)
+    _, focal, height = calibration_kernel(x1, x2, rows_a, 0.035, 0.1022)
+    assert focal < 1 and 1e-6 <= height <= 1e3  # the height check let it through
+    with pytest.raises(CameraError, match=rf"^calibration: the measurements give a focal length of {focal:.4g} px, "
+                                          r"below 1 px"):
+        calibrate(x1, x2, rows_a, 0.035, 0.1022)

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..limits import MAX_SIZE, MIN_SIZE
-from .camera import Camera, CameraError
+from .camera import MIN_FOCAL_PX, Camera, CameraError
 
 __all__ = ["Calibration", "calibrate", "calibrate_image", "calibration_kernel"]
 
@@ -72,7 +72,8 @@ def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_d
     """Calibrate from image measurements (x1, x2, A) [px] and ground ones (x_w, y_w) [m], (9.18)-(9.24).
 
     Raises :class:`CameraError` naming the measurement when they describe no camera (``x1 <= x2``, a tilt
-    whose cosine is not in (0, 1), a height outside ``[MIN_SIZE, MAX_SIZE]`` of :mod:`wmrkit.limits`).
+    whose cosine is not in (0, 1), a height outside ``[MIN_SIZE, MAX_SIZE]`` of :mod:`wmrkit.limits`, a focal length
+    below :data:`.camera.MIN_FOCAL_PX`).
     """
     for name, value in (("x1", x1), ("x2", x2), ("rows A", rows_a), ("half-separation", half_separation),
                         ("row distance", row_distance)):
@@ -90,6 +91,10 @@ def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_d
         raise CameraError(f"calibration: the measurements give a camera height of {height:.4g} m, outside the "
                           f"lengths wmrkit handles ({MIN_SIZE:g} to {MAX_SIZE:g} m): check x1 and x2 (nearly equal "
                           "when the stripes look parallel), rows A and the half-separation")
+    if not focal >= MIN_FOCAL_PX:  # rows A of a fraction of a pixel: printed 'focal = 0.01 px', exit 0
+        raise CameraError(f"calibration: the measurements give a focal length of {focal:.4g} px, below "
+                          f"{MIN_FOCAL_PX:g} px (no camera: see vision.camera.MIN_FOCAL_PX): check rows A, x1 and x2 "
+                          "(pixels from the image's centre)")
     return Calibration(tilt, focal, height, float(x1), float(x2), float(rows_a), float(half_separation),
                        float(row_distance))
 
