@@ -213,3 +213,12 @@ def test_a_robot_started_facing_back_follows_the_line_the_other_way_and_psi_stay
     assert out["final_psi"] == pytest.approx(math.remainder(-run.pose[-1, 2], 2 * math.pi), abs=1e-12)
     assert -math.pi < out["final_psi"] <= math.pi
     assert all(-math.pi < s["psi"] <= math.pi for s in out["samples"])
+
+
+@pytest.mark.parametrize("name", ["diff-drive", "thesis-tricycle", "ackermann"])
+def test_a_robot_whose_origin_is_on_its_fixed_axle_is_refused_with_what_to_do(name):
+    # it failed at the first command with control's 'choose a point ahead of the axle', which follow-line has no
+    # option for: P is the robot's origin (9.25)
+    with pytest.raises(WmrkitError, match=rf"^follow-line: robot '{name}': its origin, the point P .* lies on its "
+                                          r"fixed axle.*describe the robot with its origin ahead of the axle"):
+        follow_line(catalog.load(name), CAMERA, duration=1)

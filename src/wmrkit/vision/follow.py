@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..control.laws import PositionLaw, law_velocity
-from ..control.points import control_point, twist_for_velocity
+from ..control.points import ControlError, control_point, twist_for_velocity
 from ..errors import WmrkitError
 from ..kinematics.wheel_ik import forward_kinematics, wheel_commands
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_seed
@@ -246,6 +246,15 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
                           f"camera sees across its image on the row where the line is measured ({view:.4g} m at "
                           f"row +{camera.rows / 4:g} px, looking straight along the line): the line's edges "
                           "are out of view")
+    try:  # P, the point positioned (9.25) and steered (9.26), is the robot's origin
+        control_point(robot, (0.0, 0.0))
+    except ControlError as err:  # its advice, "choose a point ahead of the axle", has no option here
+        if "fixed axle" not in str(err):
+            raise
+        raise WmrkitError(f"follow-line: robot '{robot.name}': its origin, the point P the camera positions and the "
+                          "command steers (9.25)-(9.26), lies on its fixed axle, where its velocity across the line "
+                          "cannot be commanded; describe the robot with its origin ahead of the axle (the "
+                          "line-follower's is 0.39 m ahead)") from None
     actuated = [n for n in robot.rate_names if n.endswith(".spin") and n in robot.actuated] or \
         [n for n in robot.rate_names if n.endswith(".spin")]
     rng = np.random.default_rng(seed)
