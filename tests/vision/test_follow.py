@@ -222,3 +222,10 @@ def test_a_robot_whose_origin_is_on_its_fixed_axle_is_refused_with_what_to_do(na
     with pytest.raises(WmrkitError, match=rf"^follow-line: robot '{name}': its origin, the point P .* lies on its "
                                           r"fixed axle.*describe the robot with its origin ahead of the axle"):
         follow_line(catalog.load(name), CAMERA, duration=1)
+
+
+@pytest.mark.parametrize("z_p", [1e4, -2e3, math.nan, math.inf])
+def test_a_z_p_out_of_range_is_named_not_read_as_a_line_not_seen(z_p):
+    # 1e4 said "the camera does not see the line at the start pose: z_p: expected a length in [-1000, 1000] m"
+    with pytest.raises(WmrkitError, match=r"^follow-line: z_p \(--z-p\): expected a length in \[-1000, 1000\] m"):
+        follow_line(ROBOT, CAMERA, z_p=z_p, duration=1)

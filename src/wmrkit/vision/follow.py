@@ -30,7 +30,7 @@ from ..control.laws import PositionLaw, law_velocity
 from ..control.points import ControlError, control_point, twist_for_velocity
 from ..errors import WmrkitError
 from ..kinematics.wheel_ik import forward_kinematics, wheel_commands
-from ..limits import MAX_COORDINATE, MAX_SPEED, check_seed
+from ..limits import MAX_COORDINATE, MAX_SIZE, MAX_SPEED, check_seed
 from ..odometry.integrators import integrate_exact
 from ..robot import Robot
 from ..wheels import wrap_angle
@@ -213,6 +213,7 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     least one); `start`: pose of P ``(x, y, theta)`` in the line
     frame L (the thesis's p(0) = (-0.3 m, 0, 0) with its X to the right is ``y = +0.3``); `scene`: default one
     painted line 2 cm wide; `noise`: bounds (h [m], psi [rad]) of uniform noise added to each positioning;
+    `z_p` [m]: from the lens to P along the optical axis, within ``limits.MAX_SIZE``;
     `image_noise`, `blur`, `clutter`: options of the synthetic camera. ``from_image=False`` skips the camera and
     measures the exact (psi, h) of the pose (what the thesis's simulation did), for comparison.
     """
@@ -234,6 +235,9 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     if not (all(np.isfinite(noise)) and 0 <= noise[0] <= MAX_COORDINATE and 0 <= noise[1] <= np.pi):
         raise WmrkitError(f"follow-line: noise bounds must be h in [0, {MAX_COORDINATE:g}] m and psi in [0, pi] "
                           f"rad, got {noise[0]:g} m, {noise[1]:g} rad")
+    if not abs(z_p) <= MAX_SIZE:  # NaN included; it was refused in the first image: 'the camera does not see the line'
+        raise WmrkitError(f"follow-line: z_p (--z-p): expected a length in [-{MAX_SIZE:g}, {MAX_SIZE:g}] m, "
+                          f"got {z_p:g}")
     noise = (abs(float(noise[0])), abs(float(noise[1])))  # -0.0 is a bound of 0 (numpy's uniform refuses it)
     check_seed(seed, WmrkitError, "follow-line: seed")
     if gain * period >= 1:
