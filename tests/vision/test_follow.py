@@ -229,3 +229,15 @@ def test_a_z_p_out_of_range_is_named_not_read_as_a_line_not_seen(z_p):
     # 1e4 said "the camera does not see the line at the start pose: z_p: expected a length in [-1000, 1000] m"
     with pytest.raises(WmrkitError, match=r"^follow-line: z_p \(--z-p\): expected a length in \[-1000, 1000\] m"):
         follow_line(ROBOT, CAMERA, z_p=z_p, duration=1)
+
+
+@pytest.mark.parametrize("kwargs, named", [
+    ({"gain": math.nan}, "gain (--gain): expected a finite number > 0 [1/s], got nan"),
+    ({"period": 0.0}, "period (--period): expected a finite number > 0 [s], got 0"),
+    ({"duration": math.inf}, "duration (--duration): expected a finite number > 0 [s], got inf"),
+    ({"speed": -0.1}, "speed (--speed): expected a finite number > 0 [m/s], got -0.1"),
+])
+def test_a_bad_loop_setting_is_named(kwargs, named):
+    # "follow-line: gain, period, duration and speed must be finite numbers > 0" named none of the four
+    with pytest.raises(WmrkitError, match=rf"^follow-line: {re.escape(named)}$"):
+        follow_line(ROBOT, CAMERA, **kwargs)

@@ -217,9 +217,10 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     `image_noise`, `blur`, `clutter`: options of the synthetic camera. ``from_image=False`` skips the camera and
     measures the exact (psi, h) of the pose (what the thesis's simulation did), for comparison.
     """
-    if not all(np.isfinite([gain, period, duration, speed])) or not (gain > 0 and period > 0 and duration > 0
-                                                                      and speed > 0):
-        raise WmrkitError("follow-line: gain, period, duration and speed must be finite numbers > 0")
+    for name, value, unit in (("gain", gain, "1/s"), ("period", period, "s"), ("duration", duration, "s"),
+                              ("speed", speed, "m/s")):
+        if not 0 < value < math.inf:  # NaN included
+            raise WmrkitError(f"follow-line: {name} (--{name}): expected a finite number > 0 [{unit}], got {value:g}")
     if speed > MAX_SPEED:
         raise WmrkitError(f"follow-line: speed {speed:g} m/s is faster than {MAX_SPEED:g} m/s")
     if not duration / period <= MAX_PERIODS:
