@@ -299,3 +299,18 @@ def test_gradient_mode_finds_every_reference_when_asked_for_more_lines():
         found = extract_lines(img, n_lines=7, mode="gradient")
         assert len(found) == count
         assert max(abs(a.x0 - b) for a, b in zip(found, truth, strict=True)) < 1.5
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    # each found no line in an image of one painted line, silently (the band or separation of no pixel)
+    ({"max_band_px": -1.0}, "extract_lines: max_band_px: expected a finite number > 0 [px], got -1"),
+    ({"max_band_px": math.nan}, "extract_lines: max_band_px: expected a finite number > 0 [px], got nan"),
+    ({"min_separation_px": -5}, "extract_lines: min_separation_px: expected a finite number > 0 [px], got -5"),
+    ({"min_votes": -5}, "extract_lines: min_votes: expected an integer >= 1, got -5"),
+])
+def test_extract_lines_refuses_settings_that_would_find_no_line(options, message):
+    cam = Camera(150.0, math.radians(60), 0.3, 320, 240)
+    image = render(cam, (0.0, 0.05, 0.2), Scene())
+    assert len(extract_lines(image)) == 1
+    with pytest.raises(CameraError, match=f"^{re.escape(message)}$"):
+        extract_lines(image, **options)

@@ -287,10 +287,10 @@ def extract_lines(image: ArrayLike, *, n_lines: int = 1, mode: str = "threshold"
     """Up to `n_lines` lines of a grey/BGR `image` (§9.2.1.C), sorted left to right; fewer if the image has fewer.
 
     `image`: at least 8 px a side; `max_angle` [rad]: the largest angle from the image's vertical searched, in
-    ``(0, pi/2]``; `min_votes`: Hough threshold
-    (default a fifth of the shorter image side); `min_separation_px`: peaks closer than this (and 3 deg) are
-    one line; `k1`, `focal_px`: the lens distortion undone before the fit (module docstring; refused where the
-    model folds over inside the image, :func:`.camera.check_lens_image`);
+    ``(0, pi/2]``; `min_votes`: Hough threshold, an integer >= 1 (default a fifth of the shorter image side);
+    `min_separation_px` (> 0): peaks closer than this (and 3 deg) are one line; `max_band_px` (> 0): the widest
+    band of pixels fitted around a line; `k1`, `focal_px`: the lens distortion undone before the fit (module
+    docstring; refused where the model folds over inside the image, :func:`.camera.check_lens_image`);
     `hough_scale`: the Hough transform runs on the mask resized by this factor in ``(0, 1]`` (default 0.5 for
     images wider than 400 px, else 1); `mask`: a precomputed :func:`interest_mask`.
     """
@@ -299,6 +299,12 @@ def extract_lines(image: ArrayLike, *, n_lines: int = 1, mode: str = "threshold"
         raise CameraError(f"n_lines must be an integer >= 1, got {n_lines!r}")
     if not 0 < max_angle <= math.pi / 2:  # NaN included: OpenCV raised its own error
         raise CameraError(f"extract_lines: max_angle: expected an angle in (0, pi/2] rad, got {max_angle}")
+    for name, value in (("max_band_px", max_band_px), ("min_separation_px", min_separation_px)):
+        if not 0 < value < math.inf:  # NaN included: a band or separation of no pixel found no line, silently
+            raise CameraError(f"extract_lines: {name}: expected a finite number > 0 [px], got {value:g}")
+    if min_votes is not None and (isinstance(min_votes, bool) or not isinstance(min_votes, int | np.integer)
+                                  or min_votes < 1):
+        raise CameraError(f"extract_lines: min_votes: expected an integer >= 1, got {min_votes!r}")
     binary = interest_mask(image, mode) if mask is None else mask
     rows, width = binary.shape
     if min(rows, width) < 8:  # a camera's least side; OpenCV's resize raised on one row wider than 400 px
