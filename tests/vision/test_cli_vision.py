@@ -323,3 +323,15 @@ def test_follow_line_started_on_the_line_has_no_settling_time(tmp_path, capsys):
     assert json.loads(out)["settling_time_95"] is None
     code, out, _ = run([*argv, "--start", "0.1", "0"], capsys)  # off the line: a settling time or 'not reached'
     assert code == 0 and "undefined" not in out
+
+
+def test_locate_prints_no_negative_zero(tmp_path, capsys):
+    """A line straight ahead through P printed 'line n = +0: psi = -0.000 deg' (round-off of -1e-17 rad)."""
+    camera = Camera(150.0, math.radians(60), 0.3, 320, 240)
+    camera.to_file(tmp_path / "camera.yaml")
+    cv2.imwrite(str(tmp_path / "ahead.png"), render(camera, (0.0, 0.0, 0.0), Scene(ns=(-1, 0, 1), spacing=0.2)))
+    assert main(["vision", "locate", str(tmp_path / "ahead.png"), "--camera", str(tmp_path / "camera.yaml"),
+                 "--spacing", "0.2"]) == 0
+    out = capsys.readouterr().out
+    assert "psi = 0.000000 rad (0.000 deg), h = 0.00000 m" in out and "n = +0: psi = 0.000 deg" in out
+    assert "-0.000 " not in out

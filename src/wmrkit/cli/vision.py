@@ -157,9 +157,9 @@ def run_locate(args: argparse.Namespace) -> int:
     if args.json:
         print_json(fix.to_dict())
     else:
-        print(f"psi = {fix.psi:.6f} rad ({math.degrees(fix.psi):.3f} deg), h = {fix.h:.5f} m")
+        print(f"psi = {_fixed(fix.psi, 6)} rad ({_fixed(math.degrees(fix.psi), 3)} deg), h = {_fixed(fix.h, 5)} m")
         for line in fix.lines:
-            print(f"  line n = {line.n:+d}: psi = {math.degrees(line.psi):.3f} deg, h = {line.h:.5f} m")
+            print(f"  line n = {line.n:+d}: psi = {_fixed(math.degrees(line.psi), 3)} deg, h = {_fixed(line.h, 5)} m")
     return 0
 
 
@@ -234,6 +234,6 @@ def run_follow(args: argparse.Namespace) -> int:
     return 0
 
 
-def _fixed(x: float) -> str:
-    """Two decimals, without the sign of a value that rounds to zero ("0.00", not "-0.00")."""
-    return f"{round(x, 2) + 0.0:.2f}"
+def _fixed(x: float, digits: int = 2) -> str:
+    """`digits` decimals, without the sign of a value that rounds to zero ("0.00", not "-0.00")."""
+    return f"{round(x, digits) + 0.0:.{digits}f}"
