@@ -69,8 +69,13 @@ def _pixel_grid(camera: Camera) -> np.ndarray:
 
 
 def _coverage(dist: np.ndarray, half: np.ndarray | float, footprint: np.ndarray) -> np.ndarray:
-    """Fraction of a pixel of ground size `footprint` covered by a stripe of half-width `half` at `dist`."""
-    return np.clip(0.5 + (half - np.abs(dist)) / footprint, 0.0, 1.0)
+    """Fraction of a pixel of ground size `footprint` covered by a stripe of half-width `half` at `dist`: the overlap
+    of ``[|dist| - footprint / 2, |dist| + footprint / 2]`` with ``[-half, half]``, over the footprint. (Its edge alone,
+    ``0.5 + (half - |dist|) / footprint``, painted half of a pixel a stripe thinner than it crossed at its centre,
+    whatever the stripe's width.)"""
+    d = np.abs(dist)
+    overlap = np.minimum(d + footprint / 2, half) - np.maximum(d - footprint / 2, -half)
+    return np.clip(overlap / footprint, 0.0, 1.0)
 
 
 def render(camera: Camera, pose_line_robot: ArrayLike, scene: Scene, *, z_p: float = 0.0, noise: float = 0.0,
