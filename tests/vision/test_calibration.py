@@ -151,3 +151,16 @@ def test_calibration_refuses_a_focal_length_no_camera_has(x1, x2, rows_a):
     with pytest.raises(CameraError, match=rf"^calibration: the measurements give a focal length of {focal:.4g} px, "
                                           r"below 1 px"):
         calibrate(x1, x2, rows_a, 0.035, 0.1022)
+
+
+def test_calibration_image_refuses_a_far_row_beyond_the_vanishing_point_naming_rows_a():
+    # the stripes cross at their vanishing point (row -f / tan(tilt), the horizon): on row -A above it their
+    # half-distance is negative, and 'vision calibrate IMAGE --rows 100' said "x2 must be > 0", an option of the
+    # other mode
+    cam = Camera(325.7, math.radians(75), 0.134, 320, 240)
+    horizon = cam.focal_px / math.tan(cam.tilt)  # 87.3 px above the centre
+    image = render(cam, [0, 0, 0], Scene(ns=(), extra=(-0.035, 0.035), width=0.008))
+    with pytest.raises(CameraError, match=r"^calibration: rows A \(100 px\): row -A is above where the stripes "
+                                          r"meet \(row -87\.\d px\), take A below 87\.\d px$"):
+        calibrate_image(image, 100.0, 0.035, 0.1)
+    assert horizon == pytest.approx(87.3, abs=0.05)

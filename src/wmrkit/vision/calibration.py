@@ -130,6 +130,9 @@ def calibrate_image(image: ArrayLike, rows_a: float, half_separation: float, row
         where = "at infinity" if vanish is None else f"at x = {vanish[0]:.1f} px"
         raise CameraError(f"calibration: not the calibration pose (psi = 0): the stripes meet {where}, not on the "
                           f"image's centre line; turn the camera until they do (tolerance {max_vanishing_px:g} px)")
+    if not -rows_a > vanish[1]:  # beyond where the stripes cross, their half-distance is negative (x2 < 0)
+        raise CameraError(f"calibration: rows A ({rows_a:g} px): row -A is above where the stripes meet (row "
+                          f"{vanish[1]:.1f} px), take A below {-vanish[1]:.1f} px")
     if near - far < MIN_CONVERGENCE_PX:  # rows +-A so close that the stripes' convergence is below a pixel
         raise CameraError(f"calibration: the stripes' half-distances on rows +-A ({near:.4g} and {far:.4g} px) differ "
                           f"by less than {MIN_CONVERGENCE_PX:g} px, too little to measure: take rows A farther from "
