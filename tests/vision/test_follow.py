@@ -241,3 +241,13 @@ def test_a_bad_loop_setting_is_named(kwargs, named):
     # "follow-line: gain, period, duration and speed must be finite numbers > 0" named none of the four
     with pytest.raises(WmrkitError, match=rf"^follow-line: {re.escape(named)}$"):
         follow_line(ROBOT, CAMERA, **kwargs)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"noise": (0.1,)}, "noise: expected shape (..., 2), got (1,)"),  # IndexError: tuple index out of range
+    ({"start": (0.0, 0.3, math.nan)}, "follow-line: start: expected a finite pose (x, y, theta), got (0, 0.3, nan)"),
+])
+def test_follow_line_names_a_bad_noise_or_start(kwargs, message):
+    # a NaN start was refused by render, as 'render: pose and z_p must be finite'
+    with pytest.raises(WmrkitError, match=f"^{re.escape(message)}$"):
+        follow_line(ROBOT, CAMERA, duration=1, **kwargs)

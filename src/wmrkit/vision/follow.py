@@ -233,6 +233,7 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
         raise WmrkitError(f"follow-line: {n_steps} periods of {camera.width} x {camera.rows} px "
                           f"images are more than the {MAX_RUN_PIXELS:.3g} pixels a run renders (docs/limits.md): "
                           "shorten the duration, lengthen the period or use a smaller camera image")
+    noise = tuple(as_vectors(noise, 2, "noise"))  # (0.1,) raised IndexError
     if not (all(np.isfinite(noise)) and 0 <= noise[0] <= MAX_COORDINATE and 0 <= noise[1] <= np.pi):
         raise WmrkitError(f"follow-line: noise bounds must be h in [0, {MAX_COORDINATE:g}] m and psi in [0, pi] "
                           f"rad, got {noise[0]:g} m, {noise[1]:g} rad")
@@ -265,6 +266,9 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     rng = np.random.default_rng(seed)
     pose = np.empty((n_steps + 1, 3))
     pose[0] = as_vectors(start, 3, "start")
+    if not np.all(np.isfinite(pose[0])):  # render refused it, naming 'pose and z_p'
+        raise WmrkitError(f"follow-line: start: expected a finite pose (x, y, theta), got "
+                          f"({', '.join(f'{v:g}' for v in pose[0])})")
     if not np.all(np.abs(pose[0, :2]) <= MAX_COORDINATE):
         raise WmrkitError(f"follow-line: start position ({pose[0, 0]:g}, {pose[0, 1]:g}) m is beyond "
                           f"{MAX_COORDINATE:g} m")
