@@ -178,6 +178,16 @@ def test_bad_input_exits_2_with_one_line(capsys, tmp_path, setup, args, message)
     assert __import__("re").search(message, err), err
 
 
+def test_a_field_that_is_no_number_is_located_by_its_column_under_json(capsys, tmp_path):
+    """An empty or non-numeric cell was named "field 3", so --json gave "field": null; the column is named now."""
+    path = tmp_path / "x.csv"
+    path.write_text("time,left.spin,right.spin [rad]\n0,0,0\n0.05,1,\n")
+    assert main(["odometry", "diff-drive", str(path), "--json"]) == 2
+    err = json.loads(capsys.readouterr().err)
+    assert (err["file"], err["line"], err["field"]) == (str(path), 3, "right.spin [rad]")
+    assert err["error"] == "cannot read '' as a number (field 3)"
+
+
 def test_usage_errors_exit_2(capsys, diff_csv):
     assert main(["odometry", "diff-drive", diff_csv, "--method", "rk4"]) == 2  # usage errors: exit 2, no traceback
     assert "argument --method: invalid choice: 'rk4'" in capsys.readouterr().err

@@ -335,7 +335,7 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
                 break
             keep = check_lines(lines, fmt.delimiter, len(header), source, line)
             rows = lines if keep is None else [ln for ln, k in zip(lines, keep, strict=True) if k]
-            raw = _parse(rows, usecols, fmt.delimiter, source, line, lines, len(header))
+            raw = _parse(rows, usecols, fmt.delimiter, source, line, lines, header)
             if raw.size:
                 yield decoder.decode(raw, line if len(rows) == len(lines) else None, index)
             if progress is not None:
@@ -421,7 +421,9 @@ def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: S
 
 
 def _parse(rows: list[str], usecols: list[int], delimiter: str, source: str, line: int, lines: list[str],
-           width: int) -> np.ndarray:
+           header: list[str]) -> np.ndarray:
+    """The numbers of the columns `usecols` of `rows` ``(R, len(usecols))``; a field that is not a number is refused
+    naming its line and its column as the header writes it."""
     if not rows:
         return np.zeros((0, len(usecols)))
     try:
@@ -432,14 +434,14 @@ def _parse(rows: list[str], usecols: list[int], delimiter: str, source: str, lin
         if not ln.strip():
             continue
         fields = ln.strip("\r\n").split(delimiter)
-        if len(fields) != width:
-            raise LogError(f"{source}:{line + k}: expected {width} fields, got {len(fields)}")
+        if len(fields) != len(header):
+            raise LogError(f"{source}:{line + k}: expected {len(header)} fields, got {len(fields)}")
         for c in usecols:
             try:
                 float(fields[c])
             except ValueError:
-                raise LogError(f"{source}:{line + k}: field {c + 1}: cannot read {_short(fields[c].strip())} as a "
-                               "number") from None
+                raise LogError(f"{source}:{line + k}: column '{header[c]}': cannot read {_short(fields[c].strip())} "
+                               f"as a number (field {c + 1})") from None
     raise LogError(f"{source}:{line}: cannot read the rows that start here")  # pragma: no cover
 
 
