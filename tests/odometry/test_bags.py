@@ -178,5 +178,6 @@ def test_a_joint_named_twice_in_a_message_is_refused(tmp_path):
 def test_a_ros_name_mapped_to_no_joint_of_the_robot_is_refused(mecanum_bag):
     robot, run, path = mecanum_bag  # a misspelt target was ignored silently
     names = {v: k for k, v in ROS_NAMES.items()} | {"x_joint": "front_lfet.spin"}
-    with pytest.raises(LogError, match=r"ROS joint 'x_joint' is mapped to 'front_lfet\.spin', no joint of the robot"):
+    with pytest.raises(LogError, match=r"ROS joint 'x_joint' is mapped to 'front_lfet\.spin', no joint of the "
+                                         r"robot \(did you mean 'front_left\.spin'\?\)"):
         list(read_joint_states(path, run.log.joints, robot=robot, names=names))

@@ -110,7 +110,14 @@ def test_heading_and_gyro_columns(tmp_path):
     ("time,left.spin,right.spin", ["0,0,0", "0.1,abc,1"], LogFormat(),
      r"x\.csv:3: column 'left\.spin': cannot read 'abc'"),
     ("time,left.spin,rigth.spin", ["0,0,0"], LogFormat(),
-     r"x\.csv:1: column 'rigth\.spin' names no wheel of the robot \(wheels: left, right, caster\)"),
+     r"x\.csv:1: column 'rigth\.spin' names no wheel of the robot \(did you mean 'right\.spin'\?\) \(wheels: left, "
+     r"right, caster\)"),
+    ("time,lefft.spin,right.spin", ["0,0,0"], LogFormat(),  # a misspelt wheel got no hint
+     r"x\.csv:1: column 'lefft\.spin' names no wheel of the robot \(did you mean 'left\.spin'\?\) \(wheels: "),
+    ("time,front_left.spin,left.spin,right.spin", ["0,0,0,0"], LogFormat(),  # another robot's log: no hint
+     r"x\.csv:1: column 'front_left\.spin' names no wheel of the robot \(wheels: "),
+    ("time,left.spin,right.spin", ["0,0,0"], LogFormat(columns=(("left.spn", "left.spin"),)),
+     r"x\.csv: a column is given for 'left\.spn', no joint of the robot \(did you mean 'left\.spin'\?\)"),
     ("time,left.spin,right_spin", ["0,0,0"], LogFormat(),
      r"x\.csv:1: missing column 'right\.spin' \(did you mean 'right_spin'\?\)"),
     ("time,left.spin", ["0,0"], LogFormat(),  # not 'did you mean left.spin', read for the left wheel

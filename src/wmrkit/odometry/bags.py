@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import WmrkitError
 from .integrators import sinc
-from .logs import MAX_RATE, JointLog, LogError, check_jumps, check_time
+from .logs import MAX_RATE, JointLog, LogError, check_jumps, check_time, did_you_mean
 from .pipeline import check_finite
 from .steering import check_robot, check_steer_range, convert_steering
 
@@ -154,8 +154,9 @@ def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, ro
     for ros, joint in rename.items():  # a misspelt joint's name would be ignored
         wheel, _, kind = joint.rpartition(".")
         if joint not in joints and (kind not in ("spin", "steer") or (wheels and wheel not in wheels)):
-            raise LogError(f"{source}: ROS joint '{ros}' is mapped to '{joint}', no joint of the robot (joints "
-                           f"WHEEL.spin, WHEEL.steer{'; wheels: ' + ', '.join(wheels) if wheels else ''})")
+            raise LogError(f"{source}: ROS joint '{ros}' is mapped to '{joint}', no joint of the robot"
+                           f"{did_you_mean(joint, wheels)} (joints WHEEL.spin, WHEEL.steer"
+                           f"{'; wheels: ' + ', '.join(wheels) if wheels else ''})")
     reader = _open(source)
     ts = _typestore()
     try:

@@ -396,12 +396,14 @@ def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: S
     for name in header:
         wheel, dot, joint = name.rpartition(".")
         if dot and joint in ("spin", "steer") and wheels and wheel not in wheels and name not in renamed:
-            raise LogError(f"{source}:1: column '{name}' names no wheel of the robot (wheels: {', '.join(wheels)})")
+            raise LogError(f"{source}:1: column '{name}' names no wheel of the robot"
+                           f"{did_you_mean(name, wheels, header)} (wheels: {', '.join(wheels)})")
     for joint, _ in fmt.columns:  # a misspelt joint's column would be ignored
         wheel, _, kind = joint.rpartition(".")
         if wheels and (kind not in ("spin", "steer") or wheel not in wheels):
-            raise LogError(f"{source}: a column is given for '{joint}', no joint of the robot (joints WHEEL.spin, "
-                           f"WHEEL.steer; wheels: {', '.join(wheels)})")
+            raise LogError(f"{source}: a column is given for '{joint}', no joint of the robot"
+                           f"{did_you_mean(joint, wheels)} (joints WHEEL.spin, WHEEL.steer; wheels: "
+                           f"{', '.join(wheels)})")
     wanted, roles = [fmt.time_column, *(fmt.column_of(j) for j in joints)], ["time", *joints]
     for role, name in (("heading", fmt.heading_column), ("gyro", fmt.gyro_column)):
         if name is not None:
@@ -457,6 +459,17 @@ def _cumtrapz(rate: np.ndarray, t: np.ndarray, *, start: bool) -> np.ndarray:
     """Trapezoidal running integral of `rate` over `t`; includes the leading 0 when `start`."""
     steps = np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(t))
     return np.concatenate([[0.0], steps]) if start else steps
+
+
+def did_you_mean(joint: str, wheels: Sequence[str], taken: Sequence[str] = ()) -> str:
+    """`` (did you mean 'WHEEL.KIND'?)`` for a misspelt joint name `joint` (``lefft.spin``, ``left.spn``), or ``""``
+    when no joint of `wheels` but those `taken` (columns of their own) is that close: a log of another robot
+    (``front_left.spin`` on a differential drive) gets no hint that would point at the wrong fix."""
+    kind = joint.rpartition(".")[2]
+    kinds = (kind,) if kind in ("spin", "steer") else ("spin", "steer")
+    names = [f"{w}.{k}" for w in wheels for k in kinds if f"{w}.{k}" not in taken]
+    close = difflib.get_close_matches(joint, names, n=1, cutoff=0.85)
+    return f" (did you mean '{close[0]}'?)" if close else ""
 
 
 def _short(text: str, limit: int = 40) -> str:
