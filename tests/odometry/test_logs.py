@@ -148,6 +148,36 @@ def test_errors_in_later_chunks_name_the_right_line(tmp_path):
         list(read_csv(path, JOINTS, chunk_size=8))
 
 
+@pytest.mark.parametrize("chunk", [1, 8, 1 << 16])
+@pytest.mark.parametrize(("bad", "message"), [
+    ("70000", r"column 'right\.spin': count 70000 outside the 16-bit unsigned counter range"),
+    ("12.5", r"column 'right\.spin': counts must be whole numbers, got 12\.5"),
+    ("1e300", r"column 'right\.spin': counts beyond 2\*\*53"),
+])
+def test_bad_counts_name_their_line(tmp_path, chunk, bad, message):
+    """Counts outside the counter, fractional or beyond 2**53 were refused naming the column but not the line."""
+    rows = [f"{0.1 * k!r},{k},{k}" for k in range(50)]
+    rows[37] = f"3.7,37,{bad}"
+    path = _write(tmp_path / "x.csv", "time,left.spin,right.spin", rows)
+    enc = IncrementalEncoder(100, bits=16)
+    fmt = LogFormat(spin="counts", encoders=(("left.spin", enc), ("right.spin", enc)))
+    with pytest.raises(LogError, match=r"x\.csv:39: " + message):
+        list(read_csv(path, JOINTS, fmt, chunk_size=chunk))
+
+
+def test_bad_steering_counts_name_their_line(tmp_path):
+    robot = catalog.load("forklift")
+    joints = ("right_drive.spin", "left_drive.spin", "steer.steer")
+    rows = [f"{0.1 * k!r},{k},{k},0" for k in range(20)]
+    rows[11] = "1.1,11,11,2.5"  # an angle in a counts column
+    path = _write(tmp_path / "f.csv", "time," + ",".join(joints), rows)
+    fmt = LogFormat(spin="counts", steer="counts", encoders=tuple(catalog_encoders("forklift").items()))
+    for chunk in (3, 1 << 16):
+        with pytest.raises(LogError, match=r"f\.csv:13: column 'steer\.steer': counts must be whole numbers, got "
+                                           r"2\.5"):
+            list(read_csv(path, joints, fmt, robot=robot, chunk_size=chunk))
+
+
 def test_missing_and_empty_files(tmp_path):
     with pytest.raises(LogError, match=r"nope\.csv: cannot open"):
         load_csv(tmp_path / "nope.csv", JOINTS)

@@ -20,7 +20,19 @@ from ..errors import UnknownNameError, WmrkitError
 
 
 class EncoderError(WmrkitError, ValueError):
-    """Encoder settings or counts that cannot be right (zero resolution, counts outside the counter's range)."""
+    """Encoder settings or counts that cannot be right (zero resolution, counts outside the counter's range).
+
+    ``index``: for bad counts, the sample (index along the first axis of the readings) of the first one, which
+    a log reader turns into the line (None for settings)."""
+
+    def __init__(self, message: str, index: int | None = None) -> None:
+        super().__init__(message)
+        self.index = index
+
+
+def _first(bad: np.ndarray) -> int:
+    """The sample (first-axis index) of the first True of `bad`."""
+    return int(np.argwhere(bad)[0][0])
 
 
 #: Most counts per wheel revolution (counts per revolution x gear ratio): 2^53, where counts stop being exact.
@@ -76,9 +88,10 @@ class IncrementalEncoder:
         span = 1 << self.bits
         low = -(span >> 1) if self.signed else 0
         if c.size and (c.min() < low or c.max() >= low + span):
-            bad = c.min() if c.min() < low else c.max()
+            k = _first((c < low) | (c >= low + span))
+            bad = c[k][(c[k] < low) | (c[k] >= low + span)].reshape(-1)[0]
             raise EncoderError(f"{name}: count {bad} outside the {self.bits}-bit "
-                               f"{'signed' if self.signed else 'unsigned'} counter range [{low}, {low + span})")
+                               f"{'signed' if self.signed else 'unsigned'} counter range [{low}, {low + span})", k)
         shift = 64 - self.bits  # int64 differences wrap modulo 2**64; the shifts take them modulo 2**bits
         return (np.diff(c, axis=0) << shift) >> shift
 
@@ -128,10 +141,10 @@ class AbsoluteEncoder:
         ``(...) -> (...)``."""
         c = np.asarray(counts, dtype=float)
         if not np.isfinite(c).all():
-            raise EncoderError(f"{name}: expected finite readings")
+            raise EncoderError(f"{name}: expected finite readings", _first(~np.isfinite(c)))
         if (c != np.round(c)).any():  # an angle written to a counts column
             raise EncoderError(f"{name}: counts must be whole numbers, got {float(c[c != np.round(c)][0])!r} "
-                               "(an angle in degrees or radians?)")
+                               "(an angle in degrees or radians?)", _first(c != np.round(c)))
         return self.offset + self.sign * c * self.resolution
 
     def quantize(self, angle: ArrayLike) -> np.ndarray:
@@ -179,11 +192,13 @@ def _as_integer(c: np.ndarray, name: str) -> np.ndarray:
     """Float counts (as read from text) to int64, refusing fractions, NaN and values beyond 2**53."""
     c = np.asarray(c, dtype=float)
     if not np.all(np.isfinite(c)):
-        raise EncoderError(f"{name}: counts must be finite")
+        raise EncoderError(f"{name}: counts must be finite", _first(~np.isfinite(c)))
     if np.any(np.abs(c) > 2.0**53):
-        raise EncoderError(f"{name}: counts beyond 2**53 cannot be represented exactly (counter overflow?)")
+        raise EncoderError(f"{name}: counts beyond 2**53 cannot be represented exactly (counter overflow?)",
+                           _first(np.abs(c) > 2.0**53))
     if np.any(c != np.round(c)):
-        raise EncoderError(f"{name}: counts must be whole numbers")
+        raise EncoderError(f"{name}: counts must be whole numbers, got {float(c[c != np.round(c)][0])!r}",
+                           _first(c != np.round(c)))
     return c.astype(np.int64)
 
 

@@ -237,13 +237,15 @@ class Decoder:
         if kind == "velocity":
             return (0.0 if prev is None else prev) + _cumtrapz(col, t, start=prev is None)
         enc = self.fmt.encoder_of(joint, self.source)
-        name = f"{probe.source}: column '{self.fmt.column_of(joint)}'"
+        name = f"column '{self.fmt.column_of(joint)}'"
+        absolute = isinstance(enc, AbsoluteEncoder)
         try:
-            if isinstance(enc, AbsoluteEncoder):
+            if absolute:
                 return enc.angle(new, name=name)
             steps = enc.angle_increments(col, name=name)
-        except EncoderError as err:
-            raise LogError(str(err)) from None
+        except EncoderError as err:  # its index counts the readings given; `col` has the previous chunk's last first
+            row = None if err.index is None else err.index - (0 if absolute else len(col) - len(new))
+            raise LogError(f"{probe.source if row is None else probe.where(row)}: {err}") from None
         start = np.zeros(1) if prev is None else np.full(1, prev)
         out = start[0] + np.cumsum(steps)
         return np.concatenate([start, out]) if prev is None else out
