@@ -164,6 +164,9 @@ def test_gyro_heading(capsys, tmp_path, diff_run):
     ("ok", ["--spin", "counts", "--cpr", "100", "--gear", "-2"], r"--gear must be a finite number > 0, got -2"),
     ("ok", ["--spin", "counts", "--cpr", "100", "--counter-bits", "65"], r"--counter-bits must be between 2 and 64"),
     ("ok", ["--max-gap", "-1"], r"--max-gap must be > 0 s, got -1"),
+    # bag options on a CSV log were ignored (CSV options on a bag were refused)
+    ("ok", ["--joint-name", "wheel_l=left.spin"], r"--joint-name applies to ROS 2 bags; LOG .*x\.csv is read as a CSV"),
+    ("ok", ["--topic", "/wheels"], r"--topic applies to ROS 2 bags"),
 ])
 def test_bad_input_exits_2_with_one_line(capsys, tmp_path, setup, args, message):
     path = tmp_path / "x.csv"

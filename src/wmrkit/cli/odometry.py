@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from dataclasses import replace
 
@@ -12,7 +13,7 @@ import numpy as np
 from ..errors import WmrkitError
 from ..limits import check_chunk_size
 from ..odometry.covariance import CrowleyNoise
-from ..odometry.files import odometry_file
+from ..odometry.files import is_bag, odometry_file
 from ..odometry.header import header_format
 from ..odometry.integrators import METHODS
 from ..odometry.logs import TIME_UNITS, LogFormat
@@ -106,6 +107,9 @@ def run(args: argparse.Namespace) -> int:
     for option, value in (("--cpr", args.cpr), ("--gear", args.gear), ("--steer-resolution", steer_res)):
         if value is not None and not (math.isfinite(value) and value > 0):  # the library's messages name its fields
             raise WmrkitError(f"{option} must be a finite number > 0, got {value:g}")
+    if os.path.isfile(args.log) and not is_bag(args.log) and (args.joint_name or args.topic != "/joint_states"):
+        raise WmrkitError(f"{'--joint-name' if args.joint_name else '--topic'} applies to ROS 2 bags; LOG {args.log} "
+                          "is read as a CSV log (it would be ignored; a CSV's columns are renamed by --column)")
     if args.max_gap is not None and not args.max_gap > 0:
         raise WmrkitError(f"--max-gap must be > 0 s, got {args.max_gap:g}")
     if args.counter_bits is not None and not 2 <= args.counter_bits <= 64:
@@ -198,7 +202,6 @@ def _check_consistency(s: OdometrySummary, wheel_slips, *, filtered: str | None 
 
 def _wheel_slips(robot, log: str, fmt: LogFormat, sensed) -> dict[str, float]:
     """The wheels' RMS slip [m per interval] over the first samples of a CSV log ({} for a bag)."""
-    from ..odometry.files import is_bag
     from ..odometry.logs import read_csv
     from ..odometry.model import wheel_slip
 
