@@ -14,9 +14,10 @@ from hypothesis import strategies as st
 
 from wmrkit import catalog
 from wmrkit.cli.main import main
+from wmrkit.errors import ShapeError
 from wmrkit.odometry.encoders import AbsoluteEncoder, IncrementalEncoder, catalog_encoders
 from wmrkit.odometry.files import odometry_file
-from wmrkit.odometry.logs import JointLog, LogFormat, load_csv, write_csv, write_log
+from wmrkit.odometry.logs import JointLog, LogError, LogFormat, load_csv, write_csv, write_log
 from wmrkit.odometry.model import odometry_model
 from wmrkit.odometry.pipeline import odometry
 from wmrkit.odometry.steering import SteeringError
@@ -302,3 +303,25 @@ def test_the_car_template_refuses_its_steering_logged_in_degrees(capsys, tmp_pat
     err = capsys.readouterr().err.strip()
     assert err.endswith("degrees read as radians? (CSV logs: --steer degrees)") and f"{log}:3: front_" in err
     assert main(["odometry", "ackermann", str(log), "--steer", "degrees"]) == 0
+
+
+@pytest.mark.parametrize(("joints", "positions", "error", "message"), [
+    # a 1-D or 3-D array raised numpy's IndexError / broadcast ValueError from the conversion
+    (("front_left.spin", "front_left.steer"), np.zeros(3), LogError, r"expected time \(N,\) and positions \(N, 2\), "
+                                                                       r"got \(3,\) and \(3,\)"),
+    (("front_left.spin", "front_left.steer"), np.zeros((3, 2, 1)), LogError, r"positions \(N, 2\), got .* \(3, 2, 1\)"),
+    # a lone string was read as one joint per letter ("positions (N, 16)")
+    ("front_left.steer", np.zeros((3, 1)), LogError, r"joints: expected a sequence of joint names, got the string "
+                                                      r"'front_left\.steer'"),
+    (("front_left.spin", "front_left.steer"), [["0", "0"]] * 3, ShapeError, r"positions: got the text '0'"),
+])
+def test_joint_data_of_the_wrong_shape_or_kind_is_refused_by_name(joints, positions, error, message):
+    with pytest.raises(error, match=message):
+        JointLog.from_headings(SWERVE, np.arange(3.0), joints, positions)
+
+
+def test_a_joint_log_holds_float_arrays_and_refuses_a_lone_joint_name():
+    log = JointLog(np.arange(3), ("left.spin",), np.arange(3)[:, None])  # integers: converted
+    assert log.time.dtype == float and log.positions.dtype == float
+    with pytest.raises(LogError, match=r"got the string 'left\.spin'"):
+        JointLog(np.arange(3.0), "left.spin", np.zeros((3, 1)))

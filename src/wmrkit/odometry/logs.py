@@ -24,11 +24,12 @@ from __future__ import annotations
 import difflib
 import os
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
+from .._shapes import as_reals
 from ..errors import WmrkitError
 from ..limits import check_chunk_size, regular_file_problem
 from ._text import check_lines, encoded, read_lines
@@ -73,9 +74,13 @@ class JointLog:
     first_index: int = 0
 
     def __post_init__(self) -> None:
-        for name in ("time", "positions", "heading_world"):  # lists given in Python: the methods need arrays
-            if (value := getattr(self, name)) is not None and not isinstance(value, np.ndarray):
-                object.__setattr__(self, name, np.asarray(value, dtype=float))
+        if isinstance(self.joints, str):  # tuple("left.spin") read nine joints 'l', 'e', ...
+            raise LogError(f"{self.source}: joints: expected a sequence of joint names, got the string "
+                           f"'{self.joints}'")
+        for name in ("time", "positions", "heading_world"):  # lists given in Python: the methods need float arrays
+            if (value := getattr(self, name)) is not None and not (isinstance(value, np.ndarray)
+                                                                   and value.dtype == float):
+                object.__setattr__(self, name, as_reals(value, f"{self.source}: {name}"))
         n = len(self.time)
         if np.ndim(self.time) != 1 or np.shape(self.positions) != (n, len(self.joints)):
             raise LogError(f"{self.source}: expected time (N,) and positions (N, {len(self.joints)}), got "
@@ -91,10 +96,9 @@ class JointLog:
                       heading_world: np.ndarray | None = None, source: str = "<log>") -> JointLog:
         """A log from joint data whose steering columns are headings (0 = rolling straight ahead, CCW; ROS 2
         ``JointState``, WPILib), converted to β with `robot`'s wheels (:func:`.steering.convert_steering`)."""
-        positions = np.asarray(positions, dtype=float)
-        check_steer_range(robot, joints, positions, lambda i: f"{source}: sample {i}")
-        pos = convert_steering(robot, joints, positions, to="beta", source=source)
-        return cls(np.asarray(time, dtype=float), tuple(joints), pos, heading_world, source)
+        log = cls(time, joints if isinstance(joints, str) else tuple(joints), positions, heading_world, source)
+        check_steer_range(robot, log.joints, log.positions, log.where)  # shapes checked: the headings as given
+        return replace(log, positions=convert_steering(robot, log.joints, log.positions, to="beta", source=source))
 
     def heading_positions(self, robot: Robot) -> np.ndarray:
         """``positions`` ``(N, n)`` with the steering columns as headings [rad] (what files hold; in (-pi, pi] at
