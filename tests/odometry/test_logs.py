@@ -301,3 +301,25 @@ def test_another_delimiter_is_named(tmp_path, sep):
     message = rf"sep\.csv:1: one column .*: fields separated by {re.escape(repr(sep))}, not ','"
     with pytest.raises(LogError, match=message):
         list(read_csv(path, ("left.spin", "right.spin"), robot=catalog.load("diff-drive")))
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    # a lone pair raised "too many values to unpack"; a dict the same (its keys were unpacked)
+    (lambda: LogFormat(columns=("left.spin", "enc_l")), r"LogFormat\.columns: expected \(joint, column\) pairs"),
+    (lambda: LogFormat(encoders=("left.spin", IncrementalEncoder(100))), r"LogFormat\.encoders: expected \(joint, "),
+    (lambda: LogFormat(encoders=(("left.spin", 1024),)), r"LogFormat\.encoders: expected \(joint, encoder\) pairs"),
+    (lambda: LogFormat(max_gap="1"), r"LogFormat\.max_gap: expected a number or None, got '1'"),  # was a TypeError
+    # a lone joint name was read as one joint per letter: "missing column 'l'"
+    (lambda: load_csv(__file__, "left.spin"), r"joints: expected a sequence of joint names, got the string "
+                                              r"'left\.spin'"),
+])
+def test_a_log_format_and_joints_of_the_wrong_kind_are_refused_by_name(call, message):
+    with pytest.raises(LogError, match=message):
+        call()
+
+
+def test_a_log_format_takes_its_pairs_as_a_mapping(tmp_path):
+    path = _write(tmp_path / "x.csv", "time,enc_l,enc_r", ["0,0,0", "0.1,1,2"])
+    log = load_csv(path, JOINTS, LogFormat(columns={"left.spin": "enc_l", "right.spin": "enc_r"}))
+    np.testing.assert_array_equal(log.positions, [[0, 0], [1, 2]])
+    assert LogFormat(columns={"left.spin": "enc_l"}) == LogFormat(columns=(("left.spin", "enc_l"),))

@@ -1,14 +1,17 @@
 """The text of a CSV log, checked line by line in chunks (vectorised over the bytes): what :mod:`.logs` parses.
 
 Rows are read in bounded pieces (:data:`MAX_LINE`), so a file whose tail is one endless "line" (a logger's
-preallocated block of NUL bytes after a power loss, a binary file) costs no more memory than a chunk.
+preallocated block of NUL bytes after a power loss, a binary file) costs no more memory than a chunk. The text
+of the readers' messages too: a field quoted short, a did-you-mean for a misspelt joint.
 """
 
 from __future__ import annotations
 
+import difflib
 import functools
 import itertools
 import re
+from collections.abc import Sequence
 from typing import IO
 
 import numpy as np
@@ -92,3 +95,19 @@ def check_lines(lines: list[str], delimiter: str, width: int, source: str, line:
         raise _error(f"{source}:{line + last}: the last line has no line end: the file looks truncated "
                        "(end a complete line with a newline)")
     return data_lines
+
+
+def did_you_mean(joint: str, wheels: Sequence[str], taken: Sequence[str] = ()) -> str:
+    """`` (did you mean 'WHEEL.KIND'?)`` for a misspelt joint name `joint` (``lefft.spin``, ``left.spn``), or ``""``
+    when no joint of `wheels` but those `taken` (columns of their own) is that close: a log of another robot
+    (``front_left.spin`` on a differential drive) gets no hint that would point at the wrong fix."""
+    kind = joint.rpartition(".")[2]
+    kinds = (kind,) if kind in ("spin", "steer") else ("spin", "steer")
+    names = [f"{w}.{k}" for w in wheels for k in kinds if f"{w}.{k}" not in taken]
+    close = difflib.get_close_matches(joint, names, n=1, cutoff=0.85)
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+def short(text: str, limit: int = 40) -> str:
+    """`text` quoted for a message, cut to about `limit` characters."""
+    return repr(text) if len(text) <= limit else repr(text[:limit]) + f"... ({len(text)} characters)"

@@ -24,8 +24,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WmrkitError
+from ._text import did_you_mean
 from .integrators import sinc
-from .logs import MAX_RATE, JointLog, LogError, check_jumps, check_time, did_you_mean
+from .logs import MAX_RATE, JointLog, LogError, check_jumps, check_time, joint_names
 from .pipeline import check_finite
 from .steering import check_robot, check_steer_range, convert_steering
 
@@ -149,6 +150,7 @@ def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, ro
     (:func:`.logs.check_jumps`).
     """
     source, rename = os.fspath(path), dict(names or {})
+    joints = joint_names(joints, source)
     check_robot(joints, robot, source)
     wheels = [w.name for w in robot.wheels] if robot is not None else []
     for ros, joint in rename.items():  # a misspelt joint's name would be ignored

@@ -22,8 +22,9 @@ see (a truncated last line that still ends in a newline and holds plausible numb
 from __future__ import annotations
 
 import difflib
+import numbers
 import os
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Literal
 
@@ -32,7 +33,7 @@ import numpy as np
 from .._shapes import as_reals
 from ..errors import WmrkitError
 from ..limits import check_chunk_size, regular_file_problem
-from ._text import check_lines, encoded, read_lines
+from ._text import check_lines, did_you_mean, encoded, read_lines, short
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
 from .steering import CONVENTIONS, check_robot, check_steer_range, convert_steering
 
@@ -74,9 +75,7 @@ class JointLog:
     first_index: int = 0
 
     def __post_init__(self) -> None:
-        if isinstance(self.joints, str):  # tuple("left.spin") read nine joints 'l', 'e', ...
-            raise LogError(f"{self.source}: joints: expected a sequence of joint names, got the string "
-                           f"'{self.joints}'")
+        joint_names(self.joints, self.source)  # tuple("left.spin") read nine joints 'l', 'e', ...
         for name in ("time", "positions", "heading_world"):  # lists given in Python: the methods need float arrays
             if (value := getattr(self, name)) is not None and not (isinstance(value, np.ndarray)
                                                                    and value.dtype == float):
@@ -157,6 +156,19 @@ class LogFormat:
     steer_convention: Literal["heading", "beta"] = "heading"
 
     def __post_init__(self) -> None:
+        for name, kind, example in (("columns", str, "'enc_l'"),
+                                    ("encoders", Encoder, "IncrementalEncoder(1024)")):
+            value = getattr(self, name)
+            pairs = tuple(value.items()) if isinstance(value, Mapping) else value  # a dict reads as its pairs
+            if isinstance(pairs, str) or not all(isinstance(p, tuple | list) and len(p) == 2 and isinstance(p[0], str)
+                                                 and isinstance(p[1], kind) for p in pairs):
+                raise LogError(f"LogFormat.{name}: expected (joint, {name[:-1]}) pairs, e.g. (('left.spin', "
+                               f"{example}),), got {value!r}")
+            object.__setattr__(self, name, tuple(tuple(p) for p in pairs))
+        for name in ("max_gap", "max_rate"):
+            value = getattr(self, name)
+            if value is not None and not (isinstance(value, numbers.Real) and not isinstance(value, bool)):
+                raise LogError(f"LogFormat.{name}: expected a number or None, got {value!r}")
         if self.time_unit not in TIME_UNITS:
             raise LogError(f"unknown time unit '{self.time_unit}' (units: {', '.join(TIME_UNITS)})")
         if self.spin not in ("angle", "counts", "velocity") or self.steer not in ("angle", "degrees", "counts"):
@@ -197,7 +209,7 @@ class Decoder:
     """
 
     def __init__(self, joints: Sequence[str], fmt: LogFormat, source: str, robot: Robot | None = None) -> None:
-        self.joints, self.fmt, self.source, self.robot = tuple(joints), fmt, source, robot
+        self.joints, self.fmt, self.source, self.robot = joint_names(joints, source), fmt, source, robot
         if fmt.steer_convention == "heading":
             check_robot(self.joints, robot, source)
         self._last: np.ndarray | None = None  # last raw row (time, joints, heading)
@@ -253,6 +265,13 @@ class Decoder:
         start = np.zeros(1) if prev is None else np.full(1, prev)
         out = start[0] + np.cumsum(steps)
         return np.concatenate([start, out]) if prev is None else out
+
+
+def joint_names(joints: Sequence[str], source: str) -> tuple[str, ...]:
+    """`joints` as a tuple; a lone string (``"left.spin"``, read as one joint per letter) is a :class:`LogError`."""
+    if isinstance(joints, str):
+        raise LogError(f"{source}: joints: expected a sequence of joint names, got the string '{joints}'")
+    return tuple(joints)
 
 
 def check_time(log: JointLog, time: np.ndarray, previous: float | None, max_gap: float | None) -> None:
@@ -397,7 +416,7 @@ def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: S
     renamed = {c for _, c in fmt.columns}
     other = [d for d in ",;\t|" if d != fmt.delimiter and d in header[0]] if len(header) == 1 else []
     if other:
-        raise LogError(f"{source}:1: one column {_short(header[0])}: fields separated by {other[0]!r}, not "
+        raise LogError(f"{source}:1: one column {short(header[0])}: fields separated by {other[0]!r}, not "
                        f"{fmt.delimiter!r}")
     for name in header:
         wheel, dot, joint = name.rpartition(".")
@@ -424,7 +443,7 @@ def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: S
             unread = [h for h in header if h not in wanted]  # not a column read for another joint
             close = difflib.get_close_matches(name, unread, n=1)
             hint = f" (did you mean '{close[0]}'?)" if close else ""
-            raise LogError(f"{source}:1: missing column '{name}'{hint} (columns: {_short(', '.join(header), 200)})")
+            raise LogError(f"{source}:1: missing column '{name}'{hint} (columns: {short(', '.join(header), 200)})")
     return [header.index(n) for n in wanted]
 
 
@@ -448,7 +467,7 @@ def _parse(rows: list[str], usecols: list[int], delimiter: str, source: str, lin
             try:
                 float(fields[c])
             except ValueError:
-                raise LogError(f"{source}:{line + k}: column '{header[c]}': cannot read {_short(fields[c].strip())} "
+                raise LogError(f"{source}:{line + k}: column '{header[c]}': cannot read {short(fields[c].strip())} "
                                f"as a number (field {c + 1})") from None
     raise LogError(f"{source}:{line}: cannot read the rows that start here")  # pragma: no cover
 
@@ -465,22 +484,6 @@ def _cumtrapz(rate: np.ndarray, t: np.ndarray, *, start: bool) -> np.ndarray:
     """Trapezoidal running integral of `rate` over `t`; includes the leading 0 when `start`."""
     steps = np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(t))
     return np.concatenate([[0.0], steps]) if start else steps
-
-
-def did_you_mean(joint: str, wheels: Sequence[str], taken: Sequence[str] = ()) -> str:
-    """`` (did you mean 'WHEEL.KIND'?)`` for a misspelt joint name `joint` (``lefft.spin``, ``left.spn``), or ``""``
-    when no joint of `wheels` but those `taken` (columns of their own) is that close: a log of another robot
-    (``front_left.spin`` on a differential drive) gets no hint that would point at the wrong fix."""
-    kind = joint.rpartition(".")[2]
-    kinds = (kind,) if kind in ("spin", "steer") else ("spin", "steer")
-    names = [f"{w}.{k}" for w in wheels for k in kinds if f"{w}.{k}" not in taken]
-    close = difflib.get_close_matches(joint, names, n=1, cutoff=0.85)
-    return f" (did you mean '{close[0]}'?)" if close else ""
-
-
-def _short(text: str, limit: int = 40) -> str:
-    """`text` quoted for a message, cut to about `limit` characters."""
-    return repr(text) if len(text) <= limit else repr(text[:limit]) + f"... ({len(text)} characters)"
 
 
 def _quoted(names: Sequence[str]) -> str:
