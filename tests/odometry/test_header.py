@@ -66,3 +66,26 @@ def test_units_of_other_columns_are_ignored_and_roles_are_read():
     assert (u.spin, u.bits, dict(u.columns)["yaw"]) == ("counts", 16, "yaw [rad]")
     with pytest.raises(HeaderError, match="column 'yaw': unit 'deg'; a heading column is read in rad"):
         parse_header_units(["time", "yaw [deg]"], source="log.csv", roles={"yaw": "heading"})
+
+
+def _format(tmp_path, header, **options):
+    from wmrkit.odometry.header import header_format
+
+    path = tmp_path / "x.csv"
+    path.write_text(header + "\n0,0,0\n")
+    return header_format(path, "diff-drive", ("left.spin", "right.spin"), **options)
+
+
+def test_a_column_named_with_its_unit_keeps_the_unit(tmp_path):
+    """--time-column 'time [ms]' (the name as the header and the missing-column hint write it) read milliseconds
+    as seconds, and --column left.spin='enc_l [rad/s]' velocities as angles: the unit was not the column's."""
+    fmt = _format(tmp_path, "time [ms],left.spin,right.spin", time_column="time [ms]")
+    assert (fmt.time_column, fmt.time_unit) == ("time [ms]", "ms")
+    fmt = _format(tmp_path, "time,enc_l [rad/s],enc_r [rad/s]",
+                  columns={"left.spin": "enc_l [rad/s]", "right.spin": "enc_r [rad/s]"})
+    assert fmt.spin == "velocity" and dict(fmt.columns) == {"left.spin": "enc_l [rad/s]", "right.spin": "enc_r [rad/s]"}
+    fmt = _format(tmp_path, "time,position[0],position[1]",  # brackets that hold no unit are part of the name
+                  columns={"left.spin": "position[0]", "right.spin": "position[1]"})
+    assert fmt.spin == "angle" and dict(fmt.columns) == {"left.spin": "position[0]", "right.spin": "position[1]"}
+    with pytest.raises(HeaderError, match=r"x\.csv:1: no column 'time \[s\]' \(the header names it 'time \[ms\]'\)"):
+        _format(tmp_path, "time [ms],left.spin,right.spin", time_column="time [s]")

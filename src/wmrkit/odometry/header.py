@@ -138,6 +138,19 @@ def parse_header_units(names: list[str], *, source: str = "<log>", time_column: 
                        next(iter(bits), None), next(iter(signed), False), next(iter(conventions), None))
 
 
+def _plain(name: str) -> str:
+    """A column name without the unit it may carry (``'time [ms]'`` -> ``'time'``); a name whose brackets hold no
+    unit (``'position[0]'``, an exported array) is a name."""
+    match = _NAME.match(name)
+    if match is None:
+        return name
+    unit = match.group(2)
+    base, _, convention = unit.rpartition(":")
+    unit = base if convention in STEER_CONVENTIONS else unit
+    known = (*TIME_UNITS, *SPIN_UNITS, *STEER_UNITS, *EXTERNAL_UNITS.values())
+    return match.group(1) if unit in known or _COUNTER.match(unit) else name
+
+
 def merge_option(name: str, given: object | None, declared: object | None, default: object, source: str) -> object:
     """An option's value: the header's when the option was not given; the option's when the header is silent;
     an error when both are given and disagree."""
@@ -163,9 +176,17 @@ def header_format(path: str | os.PathLike[str], robot_name: str, joints: Sequenc
     from .logs import LogFormat
 
     source = os.fspath(path)
-    roles = {c: j.rpartition(".")[2] for j, c in (columns or {}).items()}
+    given = {"time": time_column, "heading": heading_column, "gyro": gyro_column} | dict(columns or {})
+    plain = {k: None if c is None else _plain(c) for k, c in given.items()}  # 'time [ms]' names the column 'time'
+    time_column, heading_column, gyro_column = plain["time"], plain["heading"], plain["gyro"]
+    columns = {j: plain[j] for j in columns or {}}
+    roles = {c: j.rpartition(".")[2] for j, c in columns.items()}
     roles |= {c: kind for c, kind in ((heading_column, "heading"), (gyro_column, "gyro")) if c is not None}
     units = read_header_units(path, time_column=time_column, roles=roles)  # nothing from a missing file
+    for key, name in given.items():  # a unit typed with a name that the header writes otherwise: a missing column
+        if name is not None and name != plain[key] and dict(units.columns).get(plain[key]) != name:
+            raise HeaderError(f"{source}:1: no column '{name}' (the header names it "
+                              f"'{dict(units.columns).get(plain[key], plain[key])}')")
     spin = merge_option("--spin", spin, units.spin, "angle", source)
     steer = merge_option("--steer", steer, units.steer, "angle", source)
     convention = merge_option("--steer-convention", steer_convention, units.steer_convention, "heading", source)
