@@ -104,6 +104,11 @@ def test_heading_and_gyro_columns(tmp_path):
      r"x\.csv:4: time 0\.1 s goes backwards"),
     ("time,left.spin,right.spin", ["0,0,0", "0.1,nan,1"], LogFormat(),
      r"x\.csv:3: left\.spin: value nan is not a finite number"),
+    # the gyro's column was called 'heading', and neither it nor the time's was named as a column (--json: no field)
+    ("time,left.spin,right.spin,gz", ["0,0,0,0", "0.1,1,1,nan"], LogFormat(gyro_column="gz"),
+     r"x\.csv:3: column 'gz': value nan is not a finite number"),
+    ("stamp,left.spin,right.spin", ["0,0,0", "inf,1,1"], LogFormat(time_column="stamp"),
+     r"x\.csv:3: column 'stamp': value inf is not a finite number"),
     ("time,left.spin,right.spin", ["0,0,0", "0.1,,1"], LogFormat(),
      r"x\.csv:3: column 'left\.spin': cannot read '' as a number \(field 2\)"),
     ("time,left.spin,right.spin", ["0,0,0", "0.1,1"], LogFormat(), r"x\.csv:3: expected 3 fields, got 2"),

@@ -220,7 +220,7 @@ class Decoder:
         """Rows ``(time, joint columns..., [heading or gyro])`` in file units to a validated chunk."""
         fmt, n_j = self.fmt, len(self.joints)
         probe = JointLog(raw[:, 0], self.joints, raw[:, 1:1 + n_j], None, self.source, first_line, first_index)
-        _check_finite(probe, raw)
+        _check_finite(probe, raw, fmt)
         scale = TIME_UNITS[fmt.time_unit]
         time = raw[:, 0] * scale
         check_time(probe, time, None if self._last is None else self._last[0] * scale, fmt.max_gap)
@@ -472,11 +472,14 @@ def _parse(rows: list[str], usecols: list[int], delimiter: str, source: str, lin
     raise LogError(f"{source}:{line}: cannot read the rows that start here")  # pragma: no cover
 
 
-def _check_finite(log: JointLog, raw: np.ndarray) -> None:
+def _check_finite(log: JointLog, raw: np.ndarray, fmt: LogFormat) -> None:
+    """Refuse a value of `raw` (time, joints, external heading) that is not finite, naming its row and its joint or
+    column (the gyro's as the gyro's: it was called 'heading')."""
     bad = ~np.isfinite(raw)
     if bad.any():
         i, c = (int(x) for x in np.argwhere(bad)[0])
-        name = "time" if c == 0 else log.joints[c - 1] if c <= len(log.joints) else "heading"
+        name = (f"column '{fmt.time_column}'" if c == 0 else log.joints[c - 1] if c <= len(log.joints)
+                else f"column '{fmt.heading_column or fmt.gyro_column}'")
         raise LogError(f"{log.where(i)}: {name}: value {float(raw[i, c])!r} is not a finite number")
 
 
