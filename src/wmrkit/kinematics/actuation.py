@@ -22,7 +22,7 @@ from ..couplings import coupled_columns, linked_steering
 from ..robot import TWIST_NAMES, Robot
 from .linalg import delta_projector, matrix_rank, nondimensional
 from .models import bounded, configuration, mobility
-from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_prefilter, search_sets
+from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
 from .trees import (
     TreeVerdict,
     classify_system,
@@ -275,7 +275,8 @@ def minimal_set_search(robot: Robot, beta: np.ndarray, size: int, wanted: str, w
     prefilter = null_space_prefilter(a, size, offset=3) if len(m) == 1 and m[0] == size else None
     sets, complete, note = search_sets(selectable_rates(robot), size, exact, prefilter=prefilter,
                                        limit=MAX_MINIMAL_SETS, max_exact=exact_budget(
-                                           nondimensional(robot).jacobian_form(beta)[1].shape, 4), what=what)
+                                           nondimensional(robot).jacobian_form(beta)[1].shape, 4),
+                                       walk_cost=null_space_cost(a.shape, size), what=what)
     return SetList(sets, complete, note)
 
 

@@ -25,7 +25,7 @@ from ..robot import TWIST_NAMES, Robot
 from .linalg import matrix_rank, nondimensional, velocity_scale
 from .nullspace import null_space_assignable, null_space_solution, rref_solution
 from .ranks import ranks_assignable, ranks_solution
-from .search import SetList, exact_budget, null_space_prefilter, search_sets
+from .search import SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
 
 Method = Literal["ranks", "nullspace", "rref"]
 
@@ -149,7 +149,8 @@ def _sets_at(robot: Robot, a: np.ndarray, method: Method) -> tuple[tuple[str, ..
         return SetList()
     sets, complete, note = search_sets(  # bounded, pruned by the null-space test (.search)
         range(a.shape[-1]), int(m[0]), lambda s: _assignable(a, s, method).reshape(len(s), -1).all(axis=1),
-        prefilter=null_space_prefilter(a, int(m[0])), max_exact=exact_budget(a.shape, 2), what="assignable sets")
+        prefilter=null_space_prefilter(a, int(m[0])), max_exact=exact_budget(a.shape, 2),
+        walk_cost=null_space_cost(a.shape, int(m[0])), what="assignable sets")
     names = robot.velocity_names
     return SetList([tuple(names[i] for i in s) for s in sets], complete, note)
 
@@ -191,7 +192,8 @@ def generically_assignable_sets(robot: Robot) -> tuple[tuple[str, ...], ...]:
     sets, complete, note = search_sets(  # bounded, pruned by the null-space test (.search)
         range(a.shape[-1]), m, lambda s: (ranks_assignable(a, s) & generic).any(axis=1),
         prefilter=lambda s: np.any([t(s) for t in tests], axis=0) if tests else np.zeros(len(s), dtype=bool),
-        max_exact=exact_budget(a.shape, 2), what="generically assignable sets")
+        max_exact=exact_budget(a.shape, 2), walk_cost=len(tests) * null_space_cost(a.shape[1:], m),
+        what="generically assignable sets")
     names = robot.velocity_names
     return SetList([tuple(names[i] for i in s) for s in sets], complete, note)
 
@@ -252,7 +254,8 @@ def _first_assignable(robot: Robot, a: np.ndarray, candidates: Sequence[str], m:
     names = robot.velocity_names
     columns = [names.index(n) for n in candidates]
     found, _, _ = search_sets(columns, m, lambda s: ranks_assignable(a, s).reshape(len(s), -1).all(axis=1),
-                              prefilter=null_space_prefilter(a, m), limit=1, max_exact=exact_budget(a.shape, 2))
+                              prefilter=null_space_prefilter(a, m), limit=1, max_exact=exact_budget(a.shape, 2),
+                              walk_cost=null_space_cost(a.shape, m))
     return tuple(names[i] for i in found[0]) if found else None
 
 

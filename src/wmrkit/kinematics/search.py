@@ -3,7 +3,9 @@
 The number of candidate sets grows as ``C(n, m)``: 6,545 for 16 castors, 341,376 for 64. A search here walks the
 candidates in lexicographic order, in batches, through a cheap *necessary* test (the null-space test (4.5): the
 rows ``B_a`` of a null-space basis invertible, a batch of ``m x m`` matrices), then confirms the survivors with
-the exact test of the caller, and stops after ``limit`` sets found or :data:`MAX_CANDIDATES` candidates walked.
+the exact test of the caller, and stops after ``limit`` sets found, :data:`MAX_CANDIDATES` candidates walked or
+:data:`WALK_WORK` spent in the prefilter (each candidate costs an SVD of ``m x m`` per configuration: with the
+self-motions of double wheels ``m`` grows with the wheel count, and 8 of them walked a million 9 x 9 candidates).
 The result is a :class:`SetList`: a tuple of sets that says whether it is complete. A tqdm bar shows a long walk
 (on a terminal only). Costs against the wheel count are in ``docs/limits.md``.
 """
@@ -25,6 +27,9 @@ MAX_CANDIDATES = 2_000_000
 #: Work of the exact tests of one search, in units of ``rows * columns**2`` of the matrices decomposed (SVD,
 #: pseudo-inverse): about 5 s on the reference machine of ``docs/limits.md``; a search stops when it is spent.
 EXACT_WORK = 1e8
+#: Work of the prefilter of one search, in units of ``m**3`` per candidate and configuration (the SVD of ``B_a``):
+#: about 2 s on the reference machine of ``docs/limits.md``; the walk stops when it is spent.
+WALK_WORK = 5e7
 #: Candidates tested at once (prefilter), and exact tests at once.
 BATCH, EXACT_BATCH = 8192, 64
 #: Searches of more candidates than this are pruned by the prefilter.
@@ -66,6 +71,12 @@ def null_space_prefilter(a: np.ndarray, m: int, offset: int = 0) -> Test:
     return test
 
 
+def null_space_cost(shape: Sequence[int], m: int) -> float:
+    """Work of :func:`null_space_prefilter` per candidate on matrices of `shape` ``(..., R, k)`` (units of
+    :data:`WALK_WORK`): an ``m x m`` SVD per configuration."""
+    return max(m, 1) ** 3 * max(math.prod(shape[:-2]), 1)
+
+
 def exact_budget(shape: Sequence[int], per_test: int = 1) -> int:
     """How many exact tests of matrices of `shape` ``(..., R, k)`` fit in :data:`EXACT_WORK` (at least 4);
     `per_test`: decompositions per test."""
@@ -75,13 +86,14 @@ def exact_budget(shape: Sequence[int], per_test: int = 1) -> int:
 
 
 def search_sets(columns: Sequence[int], size: int, exact: Test, *, prefilter: Test | None = None,
-                limit: int = MAX_SETS, max_exact: int | None = None,
+                limit: int = MAX_SETS, max_exact: int | None = None, walk_cost: float = 0.0,
                 what: str = "sets") -> tuple[list[tuple[int, ...]], bool, str]:
     """Sets of `size` of `columns` passing `exact`, lexicographic, at most `limit` of them.
 
     `exact` and `prefilter` map candidates ``(S, size)`` int to ``(S,)`` bool; `prefilter` must be a necessary
     condition of `exact` (it only prunes). At most `max_exact` candidates reach `exact` (None: no bound; see
-    :func:`exact_budget`). Returns ``(sets, complete, note)``.
+    :func:`exact_budget`), and at most :data:`WALK_WORK` / `walk_cost` go through `prefilter` (`walk_cost`: its
+    work per candidate, :func:`null_space_cost`). Returns ``(sets, complete, note)``.
     """
     total = math.comb(len(columns), size)
     candidates = itertools.combinations(columns, size)
@@ -91,10 +103,13 @@ def search_sets(columns: Sequence[int], size: int, exact: Test, *, prefilter: Te
 
     if total <= PRUNE_FROM:  # small searches: the exact test alone, as it always was
         prefilter = None
+    max_walk = MAX_CANDIDATES
+    if prefilter is not None and walk_cost > 0:
+        max_walk = min(MAX_CANDIDATES, max(1, int(WALK_WORK / walk_cost)))
     with tqdm(total=total, disable=None if total > PROGRESS_FROM else True, leave=False, unit="set",
               desc=f"searching {what}") as bar:
         while True:
-            chunk = list(itertools.islice(candidates, BATCH))
+            chunk = list(itertools.islice(candidates, min(BATCH, max_walk)))
             if not chunk:
                 return found, True, ""
             batch = np.array(chunk, dtype=int).reshape(len(chunk), size)
@@ -113,6 +128,6 @@ def search_sets(columns: Sequence[int], size: int, exact: Test, *, prefilter: Te
                 start += len(part)
                 if len(found) > limit:
                     return found[:limit], False, f"more than {limit} {what} (the first {limit} listed)"
-            if walked >= MAX_CANDIDATES and walked < total:
+            if walked >= max_walk and walked < total:
                 return found, False, (f"search stopped after {walked} of {total} candidate {what} "
                                       "(docs/limits.md)")
