@@ -102,3 +102,27 @@ def test_a_robot_of_double_wheels_is_searched_within_the_walk_budget(monkeypatch
     monkeypatch.setattr(models, "null_space_prefilter", counting)
     sets = generically_assignable_sets(robot)
     assert not sets.complete and "search stopped after" in sets.note
+
+
+def test_a_search_stopped_before_a_set_is_found_does_not_claim_there_is_none(monkeypatch):
+    """With the walk's budget spent before any set was found, the default direct model of 8 double wheels said
+    'no set of 9 wheel rates can be assigned', a false claim (the search had seen 73,728 of 1.3 million sets)."""
+    import pytest
+
+    from wmrkit.errors import SingularError
+    from wmrkit.kinematics import direct_model, inverse_model, search
+
+    robot = _castors(4)  # assignable sets exist
+    assert direct_model(robot).assigned and inverse_model(robot).assigned
+    monkeypatch.setattr(search, "PRUNE_FROM", 0)
+    monkeypatch.setattr(search, "MAX_CANDIDATES", 1)  # the walk stops after one candidate, which the prefilter drops
+    monkeypatch.setattr(search, "BATCH", 1)
+
+    def nothing(a, m, offset=0):
+        return lambda sets: np.zeros(len(sets), bool)
+
+    from wmrkit.kinematics import models
+    monkeypatch.setattr(models, "null_space_prefilter", nothing)
+    with pytest.raises(SingularError, match=r"no set of \d+ wheel rates was found assignable at .* before the search "
+                                            r"stopped after 1 of \d+ candidate sets \(docs/limits\.md\); name the"):
+        direct_model(robot)

@@ -250,13 +250,25 @@ def _dimensional(robot: Robot, matrix: np.ndarray, assigned: np.ndarray) -> np.n
     return matrix * scale[assigned] / scale[solved][:, None]
 
 
-def _first_assignable(robot: Robot, a: np.ndarray, candidates: Sequence[str], m: int) -> tuple[str, ...] | None:
+def _first_assignable(robot: Robot, a: np.ndarray, candidates: Sequence[str], m: int) -> tuple[tuple[str, ...] |
+                                                                                          None, str]:
+    """The first assignable set of `m` of `candidates` (None if none was found) and, when the bounded search
+    stopped before its end, its note (else ``""``)."""
     names = robot.velocity_names
     columns = [names.index(n) for n in candidates]
-    found, _, _ = search_sets(columns, m, lambda s: ranks_assignable(a, s).reshape(len(s), -1).all(axis=1),
+    found, complete, note = search_sets(columns, m, lambda s: ranks_assignable(a, s).reshape(len(s), -1).all(axis=1),
                               prefilter=null_space_prefilter(a, m), limit=1, max_exact=exact_budget(a.shape, 2),
                               walk_cost=null_space_cost(a.shape, m))
-    return tuple(names[i] for i in found[0]) if found else None
+    return (tuple(names[i] for i in found[0]) if found else None), "" if complete else note
+
+
+def _none_assignable(robot: Robot, what: str, beta: np.ndarray, note: str) -> SingularError:
+    """No set of `what` can be assigned at `beta`, or, when the search stopped early (`note`), none was found."""
+    where = describe_configuration(robot, beta)
+    if not note:
+        return SingularError(f"robot '{robot.name}': no {what} can be assigned at {where}")
+    return SingularError(f"robot '{robot.name}': no {what} was found assignable at {where} before the {note}; name "
+                         "the velocities to assign")
 
 
 def direct_model(
@@ -275,10 +287,12 @@ def direct_model(
     m = int(np.max(a.shape[-1] - matrix_rank(a)))
     usable = [n for n in robot.rate_names if not n.endswith(".roller")]
     sensed = [n for n in usable if n in robot.sensed]
-    choice = _first_assignable(robot, a, sensed, m) or _first_assignable(robot, a, usable, m)
+    choice, note = _first_assignable(robot, a, sensed, m)
     if choice is None:
-        raise SingularError(f"robot '{robot.name}': no set of {m} wheel rates can be assigned at "
-                            f"{describe_configuration(robot, beta)}")
+        choice, other = _first_assignable(robot, a, usable, m)
+        note = other or note
+    if choice is None:
+        raise _none_assignable(robot, f"set of {m} wheel rates", beta, note)
     return kinematic_model(robot, choice, beta)
 
 
@@ -301,10 +315,10 @@ def inverse_model(
         fixed = [robot.velocity_index(n) for n in free]
         choice = next((c + free for c in itertools.combinations(TWIST_NAMES, m) if 0 < m <= 3 and ranks_assignable(
             a, [[robot.velocity_index(n) for n in c] + fixed]).all()), None)
+        note = ""
     else:
-        choice = _first_assignable(robot, a, TWIST_NAMES, m)
+        choice, note = _first_assignable(robot, a, TWIST_NAMES, m)
     if choice is None:
         also = f" with {', '.join(free)}" if free else ""
-        raise SingularError(f"robot '{robot.name}': no {m} of (vx, vy, omega){also} can be assigned at "
-                            f"{describe_configuration(robot, beta)}")
+        raise _none_assignable(robot, f"{m} of (vx, vy, omega){also}", beta, note)
     return kinematic_model(robot, choice, beta)
