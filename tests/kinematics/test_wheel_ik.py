@@ -15,7 +15,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from strategies import robots
-from wmrkit import Robot, ShapeError, catalog
+from wmrkit import Robot, ShapeError, SingularError, Wheel, catalog
 from wmrkit.kinematics import _ik_fast
 from wmrkit.kinematics.wheel_ik import forward_kinematics, twist_is_determined, wheel_commands, wrap_angle
 
@@ -369,3 +369,17 @@ def test_forward_kinematics_check_judges_rates_from_the_ik():
             wrong[first] += 5.0 + 0.5 * abs(wrong[first])
             bad = forward_kinematics_check(robot, wrong, heading=heading)
             assert not bad.consistent and first in bad.slipping
+
+
+@pytest.mark.parametrize(("wheel", "field"), [
+    (Wheel("c", "castor", l=0.3, alpha=0.0, beta=math.pi / 2, r=0.05, d=0.0), "d"),  # no offset: steerable
+    (Wheel("c", "castor", l=0.3, alpha=0.0, beta=math.pi / 2, r=0.05, d=0.05, delta=math.pi / 2), "delta"),
+    (Wheel("c", "swedish", l=0.3, alpha=0.0, beta=math.pi / 2, r=0.05, r_r=0.01, gamma=0.0), "gamma"),
+])
+def test_a_degenerate_wheel_built_in_python_has_no_wheel_commands(wheel, field):
+    """Python may build the degenerate wheels a description refuses; their rates are not determined by the twist,
+    and wheel_commands answered NaN, inf or 1.6e17 rad/s spins and steering rates, 'feasible'."""
+    robot = Robot("r", (wheel, *(w for w in catalog.load("diff-drive").wheels if w.type == "fixed")))
+    with pytest.raises(SingularError, match=rf"robot 'r': wheel 'c': {field}: .* no twist determines its rates, so "
+                                            r"it has no wheel commands \(8\.4\)"):
+        wheel_commands(robot, [0.5, 0.0, 0.2])

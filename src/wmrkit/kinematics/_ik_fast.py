@@ -21,8 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._shapes import readonly
+from ..errors import SingularError
 from ..robot import Robot
-from ..wheels import generic_slip_rows, heading_in_range, wrap_angle
+from ..wheels import generic_slip_rows, geometry_problem, heading_in_range, wrap_angle
 
 TWO_PI = 2.0 * math.pi
 CONSTANT_TYPES = ("fixed", "swedish", "ball", "orthogonal")
@@ -66,7 +67,14 @@ class Plan:
 
 @functools.lru_cache(maxsize=256)
 def plan(robot: Robot) -> Plan:
-    """The IK arrays of `robot` (built once per robot)."""
+    """The IK arrays of `robot` (built once per robot); :class:`SingularError` for a degenerate wheel built in Python
+    (a castor without offset, Swedish rollers along the axle: :func:`~wmrkit.wheels.geometry_problem`), whose
+    steering or spin rate no twist determines (it gave inf and NaN rates, called feasible)."""
+    for w in robot.wheels:
+        problem = geometry_problem(w.type, {k: getattr(w, k) for k in ("l", *w.kind.required, *w.kind.optional)})
+        if problem is not None:
+            raise SingularError(f"robot '{robot.name}': wheel '{w.name}': {problem[0]}: {problem[1]}: no twist "
+                                "determines its rates, so it has no wheel commands (8.4)")
     n = len(robot.wheels)
     steer_names = robot.steer_names
     col = {name: i for i, name in enumerate(robot.rate_names)}
