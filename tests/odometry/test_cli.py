@@ -351,3 +351,19 @@ def test_json_error_about_a_log_row_names_its_joint(capsys, tmp_path):
     data = json.loads(capsys.readouterr().err)
     assert (data["file"], data["line"], data["field"]) == (str(log), 3, "left.spin"), data
     assert data["error"].startswith("value nan is not a finite number")
+
+
+def test_a_heading_column_in_degrees_without_its_unit_is_refused(capsys, tmp_path):
+    """A yaw logged in degrees under a bare name was read as radians (theta 213 rad where the wheels said 3.75,
+    exit 0): beyond one turn, a bare heading is refused as probably degrees (the rule of descriptions); an
+    unwrapped heading in rad beyond a turn passes when its header writes the unit."""
+    rows = "".join(f"{k},{k},{k},{6.0 * k}\n" for k in range(4))  # 0, 6, 12, 18: degrees
+    path = tmp_path / "yaw.csv"
+    path.write_text("time,left.spin,right.spin,yaw\n" + rows)
+    assert main(["odometry", "diff-drive", str(path), "--json", "--heading-column", "yaw"]) == 2
+    got = json.loads(capsys.readouterr().err)
+    assert (got["file"], got["line"], got["field"]) == (str(path), 4, "yaw"), got
+    assert got["error"].startswith("12 is beyond one turn as radians, probably degrees")
+    path.write_text("time,left.spin,right.spin,yaw [rad]\n" + rows)
+    assert _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--heading-column", "yaw"])["pose"][2] \
+        == pytest.approx(math.remainder(18, 2 * math.pi), abs=1e-12)  # the pose's heading is wrapped

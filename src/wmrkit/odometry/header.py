@@ -20,6 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ..errors import WmrkitError
 from ..limits import regular_file_problem
 
@@ -149,6 +151,22 @@ def _plain(name: str) -> str:
     unit = base if convention in STEER_CONVENTIONS else unit
     known = (*TIME_UNITS, *SPIN_UNITS, *STEER_UNITS, *EXTERNAL_UNITS.values())
     return match.group(1) if unit in known or _COUNTER.match(unit) else name
+
+
+def bare_heading_problem(column: str, heading: Sequence[float]) -> tuple[int, str] | None:
+    """``(row, message)`` for a heading column whose name writes no unit (``yaw``, not ``yaw [rad]``) holding a
+    value beyond one turn, else None: read as radians, a yaw logged in degrees gave theta = 213 rad with exit 0. The
+    rule of bare angles in descriptions (:data:`~wmrkit.units.BARE_ANGLE_LIMIT`); an unwrapped heading in rad
+    writes its unit in the header."""
+    from ..units import BARE_ANGLE_LIMIT
+
+    beyond = np.flatnonzero(np.abs(np.asarray(heading, dtype=float)) > BARE_ANGLE_LIMIT)
+    if _NAME.match(column) is not None or not beyond.size:
+        return None
+    i = int(beyond[0])
+    return i, (f"column '{column}': {float(heading[i]):g} is beyond one turn as radians, probably degrees: a heading "
+               f"column is read in rad (convert it; an unwrapped heading in rad writes its unit in the header: "
+               f"'{column} [rad]')")
 
 
 def merge_option(name: str, given: object | None, declared: object | None, default: object, source: str) -> object:

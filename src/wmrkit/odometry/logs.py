@@ -35,6 +35,7 @@ from ..errors import WmrkitError
 from ..limits import check_chunk_size, regular_file_problem
 from ._text import check_lines, did_you_mean, encoded, read_lines, short
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
+from .header import bare_heading_problem
 from .steering import CONVENTIONS, check_robot, check_steer_range, convert_steering
 
 if TYPE_CHECKING:
@@ -221,6 +222,8 @@ class Decoder:
         fmt, n_j = self.fmt, len(self.joints)
         probe = JointLog(raw[:, 0], self.joints, raw[:, 1:1 + n_j], None, self.source, first_line, first_index)
         _check_finite(probe, raw, fmt)
+        if fmt.heading_column is not None and (problem := bare_heading_problem(fmt.heading_column, raw[:, -1])):
+            raise LogError(f"{probe.where(problem[0])}: {problem[1]}")
         scale = TIME_UNITS[fmt.time_unit]
         time = raw[:, 0] * scale
         check_time(probe, time, None if self._last is None else self._last[0] * scale, fmt.max_gap)
