@@ -60,3 +60,21 @@ def test_every_command_line_option_is_named_in_the_documentation():
 
     walk(build_parser(), "")
     assert missing == []
+
+
+def test_no_command_of_the_documentation_has_an_unquoted_glob():
+    """A command as the pages write it runs as pasted into any shell: `wheels[0].alpha` unquoted is a glob, which
+    zsh (macOS's shell) refuses ('no matches found') and bash replaces by a file of that pattern if one exists;
+    `'logs/*.csv'` is quoted for wmrkit to expand. batch.md's sweep wrote `--vary wheels[0].alpha,...` bare."""
+    unquoted = []
+    for page in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        inside = False
+        for number, line in enumerate(page.read_text().splitlines(), 1):
+            if line.startswith("```"):
+                inside = not inside
+            command = line.strip().removeprefix("$ ")
+            if inside and command.startswith(("wmrkit ", "python ", "pip ")):
+                words = re.sub(r"'[^']*'|\"[^\"]*\"", "''", re.split(r"\s+#\s", command)[0])
+                if re.search(r"[*?]|\w\[", words):  # '[--from X Y THETA]' is a synopsis, not a word
+                    unquoted.append(f"{page.name}:{number}: {command}")
+    assert unquoted == []

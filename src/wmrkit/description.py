@@ -299,7 +299,7 @@ def _check_geometry(type_name: str, v: dict[str, float], check: FieldReader, loc
 def robot_to_dict(robot: Robot, *, thesis: bool = False) -> dict[str, Any]:
     """The description mapping of `robot` in SI numbers and radians, its wheels as users write them where that is
     exact (:func:`_wheel_to_dict`), or with `thesis` in the thesis's parameters (``l``, ``alpha``, ``beta``, the
-    fields ``wmrkit batch sweep --vary`` sets); ``robot_from_dict(robot_to_dict(r)) == r`` either way."""
+    fields ``wmrkit sweep --vary`` sets); ``robot_from_dict(robot_to_dict(r)) == r`` either way."""
     out: dict[str, Any] = {"name": robot.name}
     if robot.notes:
         out["notes"] = robot.notes
