@@ -75,9 +75,10 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--noise", type=float, default=1e-4, metavar="RAD2_PER_RAD",
                    help="random-walk variance per radian of joint travel (default 1e-4)")
     p.add_argument("--resolution", metavar="ANGLE", default="0", help="encoder resolution [rad or deg] (default 0)")
-    p.add_argument("--slip", type=float, default=0.0, metavar="STD", help="std of a run's wheel slip ratio")
+    p.add_argument("--slip", type=float, default=0.0, metavar="STD",
+                   help="std of a run's wheel slip ratio (default 0: no slip)")
     p.add_argument("--rate", type=float, help="sample rate of a built-in path [Hz] (default 20)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="random seed of the runs (default 0)")
     p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
     p.add_argument("--plot", metavar="FILE", help="final positions with both 95 %% ellipses")
     _engine_options(p)

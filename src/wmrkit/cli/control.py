@@ -21,7 +21,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--from", dest="start", nargs=3, metavar=("X", "Y", "THETA"),
                    help="initial pose: x, y [m], theta (radians, or degrees with 'deg'); default on the reference")
     p.add_argument("--controller", default="p", choices=("p", "pi", "point", "pure-pursuit", "stanley"),
-                   help="p: P + feedforward (8.2); pi: PI + feedforward (8.3); point: (8.1); or a geometric tracker")
+                   help="p: P + feedforward (8.2), the default; pi: PI + feedforward (8.3); point: (8.1); or a "
+                        "geometric tracker")
     p.add_argument("--gain", metavar="A", help="p, pi, point: pole a [1/s] of the position loop (default 1)")
     p.add_argument("--gate", metavar="D", help="p, pi, point: apply the feedforward only within D [m] of the "
                                                "reference (8.53)")
@@ -29,19 +30,22 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                                                     "(default 1)")
     p.add_argument("--stanley-gain", metavar="K", help="stanley: cross-track gain [1/s] (default 1)")
     p.add_argument("--period", metavar="T", help="sample period [s]; without it the loop is continuous")
-    p.add_argument("--delay", type=int, default=0, metavar="N", help="measurement delay in samples (with --period)")
+    p.add_argument("--delay", type=int, default=0, metavar="N",
+                   help="measurement delay in samples (with --period; default 0)")
     p.add_argument("--duration", metavar="S", help="seconds to simulate (default: the reference's length)")
     p.add_argument("--steering", default="closest", choices=("closest", "4-quadrant", "2-quadrant"),
-                   help="which of the two steering solutions (8.9) a wheel takes (within its steer_range)")
+                   help="which of the two steering solutions (8.9) a wheel takes (within its steer_range; default "
+                        "closest)")
     p.add_argument("--dynamics", action="store_true",
                    help="close the loop through the chapter-7 dynamics with tyres (needs mass properties; "
                         "period default 0.02 s)")
     p.add_argument("--slip-model", default="none", choices=("none", "mqe", "mcd"),
                    help="with --dynamics: wheel commands from the inverse slip model (thesis future work 4) instead "
-                        "of the no-slip IK")
+                        "of the no-slip IK (default none: the no-slip IK)")
     p.add_argument("--feedback", default="pose", choices=("pose", "odometry", "wls", "fk2", "mqe"),
                    help="with --dynamics: what the controller measures: the true pose, no-slip odometry, WLS, the "
-                        "FK2 filter (weights and noise from the description), or the MQE slip model as odometry")
+                        "FK2 filter (weights and noise from the description), or the MQE slip model as odometry "
+                        "(default pose)")
     p.add_argument("--ramp", action="store_true",
                    help="with --dynamics: reach each period's wheel commands linearly over the period (first-order "
                         "hold) instead of holding them")
@@ -55,7 +59,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     add_robot_argument(p)
     _reference_options(p)
     p.add_argument("--framework", default="kinematic", choices=("kinematic", "dynamic"),
-                   help="kinematic: wheel rates may jump; dynamic: they must be continuous (§8.5)")
+                   help="kinematic (default): wheel rates may jump; dynamic: they must be continuous (§8.5)")
     p.add_argument("--plot", metavar="FILE", help="save a plot of the reference with its violations")
     add_json_flag(p)
     p.set_defaults(run=run_feasibility)

@@ -31,10 +31,13 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("model", metavar="MODEL", choices=list(TYRES), help=f"one of: {', '.join(TYRES)}")
     p.add_argument("--load", required=True, metavar="FZ", help="normal load [N]")
     p.add_argument("--slip-ratio", default="0", metavar="S",
-                   help="longitudinal slip ratio (7.31), in (-1, 2]; positive: the contact slides forward (braking)")
+                   help="longitudinal slip ratio (7.31), in (-1, 2]; positive: the contact slides forward (braking) "
+                        "(default 0)")
     p.add_argument("--slip-angle", default="0", metavar="A",
-                   help="slip angle (7.35): radians, or degrees with 'deg'; positive: the contact slides left")
-    p.add_argument("--speed", default="2", metavar="V", help="wheel speed [m/s] (pacejka's coefficients use it)")
+                   help="slip angle (7.35): radians, or degrees with 'deg'; positive: the contact slides left "
+                        "(default 0)")
+    p.add_argument("--speed", default="2", metavar="V",
+                   help="wheel speed [m/s] (pacejka's coefficients use it; default 2)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a model parameter (repeat)")
     p.add_argument("--plot", metavar="FILE", help="plot the curves against slip ratio and slip angle (png/svg/pdf)")
     add_json_flag(p)
@@ -48,7 +51,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--tyre", choices=list(TYRES), help="tyre model for every wheel (default: each wheel's own)")
     p.add_argument("--duration", metavar="S", help="simulated time [s] (default: the program's or the file's)")
     p.add_argument("--step", default="0.001", metavar="DT", help="integration step [s] (default 0.001)")
-    p.add_argument("--method", default="semi-implicit", choices=["semi-implicit", "rk4", "adaptive"])
+    p.add_argument("--method", default="semi-implicit", choices=["semi-implicit", "rk4", "adaptive"],
+                   help="integrator: semi-implicit Euler (default; stable with stiff tyres at 1 ms), rk4 (fixed "
+                        "step, non-stiff tyres only: docs/dynamics.md) or adaptive (LSODA)")
     p.add_argument("--speed", metavar="V", help="speed of a --path program [m/s] (default 2)")
     p.add_argument("--initial-twist", nargs=3, metavar=("VX", "VY", "OMEGA"),
                    help="initial twist [m/s, m/s, rad/s], rolling without slip (a twist at which a fixed wheel "

@@ -78,7 +78,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     g.add_argument("--topic", default="/joint_states", help="JointState topic (default: /joint_states)")
     g.add_argument("--joint-name", action="append", metavar="ROS=JOINT", default=[],
                    help="map a ROS joint name to a robot joint WHEEL.spin/WHEEL.steer (repeat)")
-    p.add_argument("--chunk-size", type=int, default=1 << 16, help="samples per chunk (memory bound)")
+    p.add_argument("--chunk-size", type=int, default=1 << 16, help="samples per chunk (memory bound; default 65536)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_estimator_options(p)
     add_json_flag(p)

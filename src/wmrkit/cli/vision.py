@@ -28,10 +28,12 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     src.add_argument("--points", metavar="FILE", help='JSON {"lines": [{"n": -1|0|1, "points": '
                      '[[xu, yu], [xu, yu]]}]} [px from the centre, y down]')
     loc.add_argument("--camera", required=True, metavar="FILE", help="camera file (what 'calibrate --out' writes)")
-    loc.add_argument("--spacing", default="0", metavar="D", help="distance between parallel lines [m, or 'cm']")
+    loc.add_argument("--spacing", default="0", metavar="D",
+                     help="distance between parallel lines [m, or 'cm'] (default 0: one line)")
     loc.add_argument("--lines", type=int, metavar="N", help="lines in the image: 1 (default without --spacing), "
                      "2 (road: n = -1, 1) or 3 (crops: n = -1, 0, 1, default with --spacing)")
-    loc.add_argument("--z-p", default="0", metavar="Z", help="distance from the lens to P along the axis [m]")
+    loc.add_argument("--z-p", default="0", metavar="Z",
+                     help="distance from the lens to P along the axis [m] (default 0)")
     loc.add_argument("--mode", choices=("threshold", "gradient"),
                      help="pixels of interest: the reference (threshold, default) or its contour (gradient)")
     add_json_flag(loc)
@@ -57,7 +59,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     f.add_argument("--camera", required=True, metavar="FILE", help="camera file of the robot's camera")
     f.add_argument("--gain", type=float, default=0.3, metavar="A", help="lateral gain a_x [1/s] (default 0.3)")
     f.add_argument("--speed", default="0.1", metavar="V", help="following speed [m/s] (default 0.1)")
-    f.add_argument("--period", type=float, default=0.5, metavar="T", help="control period = image time [s]")
+    f.add_argument("--period", type=float, default=0.5, metavar="T",
+                   help="control period = image time [s] (default 0.5)")
     f.add_argument("--duration", type=float, default=20.0, metavar="S", help="simulated time [s]: the whole periods "
                    "within it (default 20)")
     f.add_argument("--start", nargs=2, default=("0.3", "0"), metavar=("H", "THETA"),
@@ -65,12 +68,13 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                         "0.3 0: the thesis's p(0) = (-0.3 m, 0, 0))")
     f.add_argument("--noise", nargs=2, metavar=("H", "PSI"), help="bounds of uniform noise on h [m] and psi [rad, "
                    "or 'deg'] (the thesis's example 2: 0.02 3deg)")
-    f.add_argument("--image-noise", type=float, default=0.0, metavar="SIGMA", help="image noise [grey levels]")
-    f.add_argument("--blur", type=float, default=0.0, metavar="SIGMA", help="image blur [px]")
-    f.add_argument("--clutter", type=int, default=0, metavar="N", help="bright blobs on the ground")
+    f.add_argument("--image-noise", type=float, default=0.0, metavar="SIGMA",
+                   help="image noise [grey levels] (default 0)")
+    f.add_argument("--blur", type=float, default=0.0, metavar="SIGMA", help="image blur [px] (default 0)")
+    f.add_argument("--clutter", type=int, default=0, metavar="N", help="bright blobs on the ground (default 0)")
     f.add_argument("--line-width", default="0.02", metavar="W", help="painted line width [m] (default 0.02)")
-    f.add_argument("--z-p", default="0", metavar="Z", help="distance from the lens to P along the axis [m]")
-    f.add_argument("--seed", type=int, default=0, help="random seed (noise, clutter)")
+    f.add_argument("--z-p", default="0", metavar="Z", help="distance from the lens to P along the axis [m] (default 0)")
+    f.add_argument("--seed", type=int, default=0, help="random seed (noise, clutter; default 0)")
     f.add_argument("--animate", metavar="FILE", help="write a GIF: camera view beside the plan view")
     add_json_flag(f)
     f.set_defaults(run=run_follow)
