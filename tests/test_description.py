@@ -687,3 +687,15 @@ def test_to_file_refuses_a_robot_its_file_would_not_load_as(change, tmp_path):
                                                    r"load back: (body\.mass|wheels\[0\]\.r): "):
             robot.to_file(tmp_path / name)
         assert not (tmp_path / name).exists()
+
+
+def test_conventions_md_says_how_a_file_is_written(tmp_path):
+    """docs/conventions.md's examples of what `Robot.to_file` writes are what it writes: the page said a β of 7.57
+    rad from `heading: 6` was written `"7.57... rad"`, while that wheel is written `heading: 6.0`."""
+    text = (Path(__file__).resolve().parents[1] / "docs" / "conventions.md").read_text()
+    examples = re.findall(r"`heading: ([^`]+)` is written\s+`(\w+): ([^`]+)`", text)
+    assert len(examples) == 2
+    for heading, key, written in examples:
+        wheel = {"name": "w", "type": "steerable", "position": [1, 0], "heading": heading, "r": 0.1}
+        Robot.from_dict({"name": "r", "wheels": [wheel]}).to_file(tmp_path / "r.yaml")
+        assert f"  {key}: {written}\n" in (tmp_path / "r.yaml").read_text()
