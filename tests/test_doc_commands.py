@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import pytest
 
@@ -78,3 +79,31 @@ def test_no_command_of_the_documentation_has_an_unquoted_glob():
                 if re.search(r"[*?]|\w\[", words):  # '[--from X Y THETA]' is a synopsis, not a word
                     unquoted.append(f"{page.name}:{number}: {command}")
     assert unquoted == []
+
+
+def _anchors(page: Path) -> set[str]:
+    """GitHub's anchors of a page's headings: lower case, punctuation dropped, spaces as hyphens."""
+    return {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-")
+            for h in re.findall(r"^#+ (.*)$", page.read_text(), flags=re.M)}
+
+
+def test_every_file_and_link_the_documentation_names_exists():
+    """What README.md and docs/ point a reader to is in the repository: relative links (and their #anchors), paths
+    written in backticks (from the root, the page or the package: `slip/skid.py`) and `tests/...py::test_name`
+    citations. Paths of the examples' outputs and placeholders (`DIR/NAME.tum`) are not files; the thesis digests
+    (`spec/...`) and the style guide (`shared/STYLE.md`) are cited sources of the project, not in the repository."""
+    outside = ("logs/", "refs/", "out/", "report/", "traj/", "squares/", "spec/", "shared/")
+    missing = []
+    for page in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        text = page.read_text()
+        for target, anchor in re.findall(r"\]\(([^)#:\s]+)(#[\w-]+)?\)", text):
+            path = page.parent / target
+            if not path.exists() or (anchor and path.suffix == ".md" and anchor[1:] not in _anchors(path)):
+                missing.append(f"{page.name}: link {target}{anchor}")
+        for path, name in re.findall(r"`((?:[\w.-]+/)+[\w.-]+\.\w+)(?:::(\w+))?`", text):
+            found = [p for p in (ROOT / path, page.parent / path, ROOT / "src" / "wmrkit" / path) if p.exists()]
+            if not found and not path.startswith(outside) and not path.split("/")[0].isupper():
+                missing.append(f"{page.name}: {path}")
+            elif name and not re.search(rf"^def {name}\b", found[0].read_text(), flags=re.M):
+                missing.append(f"{page.name}: {path}::{name}")
+    assert missing == []
