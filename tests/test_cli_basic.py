@@ -216,3 +216,27 @@ def test_every_option_has_help_and_says_its_default():
 
     walk(build_parser(), "")
     assert silent == []
+
+
+def test_options_choosing_an_integration_scheme_explain_every_choice():
+    """`--method`/`--scheme` offered `paper002` (and `slip-study --source` `md`) with no word of what they are: the
+    paper's number in the project's bibliography. Every such option now names each of its choices in its help."""
+    import argparse
+    import re
+
+    from wmrkit.cli.main import build_parser
+
+    unexplained = []
+
+    def walk(parser: argparse.ArgumentParser, command: str) -> None:
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    walk(sub, f"{command} {name}".strip())
+            elif action.choices and {"paper002", "md"} & set(action.choices):
+                for choice in action.choices:
+                    if not re.search(rf"(?<![\w-]){re.escape(choice)}(?![\w-])", action.help or ""):
+                        unexplained.append(f"{command} {action.option_strings[-1]} {choice}")
+
+    walk(build_parser(), "")
+    assert unexplained == []

@@ -15,6 +15,10 @@ from ..limits import same_file
 from ..robot import Robot
 from ..units import Kind, UnitError, parse_quantity
 
+#: The integration schemes (docs/odometry.md), named once for every option that takes one.
+SCHEMES_HELP = ("exact (SE(2) arcs), rk2 (midpoint), euler (heading at the step's start) or paper002 (at its end, "
+                "Tello-Cristiany et al. (15))")
+
 
 def add_robot_argument(parser: argparse.ArgumentParser) -> None:
     """The ROBOT positional: a catalog name or a description file."""

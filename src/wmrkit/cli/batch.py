@@ -9,6 +9,7 @@ from pathlib import Path
 
 from ..errors import WmrkitError
 from ._common import (
+    SCHEMES_HELP,
     add_json_flag,
     add_robot_argument,
     check_plot_path,
@@ -39,7 +40,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = sub.add_parser("odometry", help="odometry of many logs in parallel, one summary row per log (Parquet)")
     add_robot_argument(p)
     p.add_argument("logs", nargs="+", metavar="LOG", help="CSV logs, ROS 2 bags, globs or folders")
-    p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
+    p.add_argument("--method", choices=METHODS, default="exact",
+                   help=f"integration scheme: {SCHEMES_HELP} (default: exact)")
     p.add_argument("--out", metavar="FILE", help="summary table (Parquet); a rerun skips the logs done")
     p.add_argument("--trajectories", metavar="DIR", help="write each log's trajectory to DIR/NAME.tum")
     p.add_argument("--trajectory-format", choices=("tum", "csv"), help="trajectory files (default tum)")
@@ -61,7 +63,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--ci", choices=("jacobian", "bootstrap"), help="interval method (default jacobian)")
     p.add_argument("--level", type=float, default=0.95, help="confidence level (default 0.95)")
     p.add_argument("--bootstrap", type=int, metavar="B", help="bootstrap replicates of --ci bootstrap (default 200)")
-    p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
+    p.add_argument("--method", choices=METHODS, default="exact",
+                   help=f"integration scheme: {SCHEMES_HELP} (default: exact)")
     p.add_argument("--slip", action="store_true", help="fit the slip weights (WLS ratio, effective track) instead")
     _log_options(p)
     _engine_options(p)
@@ -79,7 +82,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    help="std of a run's wheel slip ratio (default 0: no slip)")
     p.add_argument("--rate", type=float, help="sample rate of a built-in path [Hz] (default 20)")
     p.add_argument("--seed", type=int, default=0, help="random seed of the runs (default 0)")
-    p.add_argument("--method", choices=METHODS, default="exact", help="integration scheme (default: exact)")
+    p.add_argument("--method", choices=METHODS, default="exact",
+                   help=f"integration scheme: {SCHEMES_HELP} (default: exact)")
     p.add_argument("--plot", metavar="FILE", help="final positions with both 95 %% ellipses")
     _engine_options(p)
     p.set_defaults(run=run_montecarlo)

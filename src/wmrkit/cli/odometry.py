@@ -20,6 +20,7 @@ from ..odometry.logs import TIME_UNITS, LogFormat
 from ..odometry.model import odometry_model
 from ..odometry.pipeline import OdometrySummary
 from ._common import (
+    SCHEMES_HELP,
     add_json_flag,
     add_robot_argument,
     load_robot,
@@ -37,9 +38,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     add_robot_argument(p)
     p.add_argument("log", metavar="LOG", help="CSV log (time, WHEEL.spin, WHEEL.steer columns) or ROS 2 bag")
     p.add_argument("--method", choices=(*METHODS, *ESTIMATOR_METHODS),
-                   help="integration scheme of the no-slip model, or a slip-aware estimator: wls (weighted least "
-                        "squares), fk1, fk2 (Kalman filters), see docs/slip.md (default: the description's "
-                        "odometry.method, else exact)")
+                   help=f"integration scheme of the no-slip model, {SCHEMES_HELP}; or a slip-aware estimator: wls "
+                        "(weighted least squares), fk1, fk2 (Kalman filters), see docs/slip.md (default: the "
+                        "description's odometry.method, else exact)")
     p.add_argument("--out", metavar="FILE", help="trajectory output: .csv, .tum/.txt (TUM), else a new ROS 2 bag")
     p.add_argument("--format", dest="out_format", choices=("csv", "tum", "bag"), help="output format (default: "
                    "from the --out extension)")
@@ -49,7 +50,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--sensed", action="append", metavar="WHEEL.JOINT", help="use only these sensed joints (repeat)")
     p.add_argument("--weight", action="append", metavar="WHEEL=W", default=[],
                    help="least-squares weight of a wheel's no-slip equations (default 1; repeat)")
-    p.add_argument("--covariance", action="store_true", help="propagate Crowley's pose covariance (003 eq. 17)")
+    p.add_argument("--covariance", action="store_true",
+                   help="propagate the pose covariance of Crowley's error model (Bermudez, paper 003 (17): "
+                        "docs/odometry.md)")
     p.add_argument("--crowley", nargs=3, type=float, metavar=("K_D", "K_DTHETA", "K_THETA"),
                    help="with --covariance: Crowley's coefficients (default 0.001 0.003 0.001)")
     g = p.add_argument_group("CSV logs")

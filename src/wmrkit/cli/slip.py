@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ..errors import WmrkitError
 from ..robot import Robot
-from ._common import add_json_flag, add_robot_argument, load_robot, parse_assignments, print_json
+from ._common import SCHEMES_HELP, add_json_flag, add_robot_argument, load_robot, parse_assignments, print_json
 
 ESTIMATOR_METHODS = ("wls", "fk1", "fk2")
 
@@ -19,16 +19,16 @@ def add_estimator_options(p: argparse.ArgumentParser) -> None:
     """Options of ``odometry --method wls|fk1|fk2``."""
     g = p.add_argument_group("slip-aware estimators (--method wls|fk1|fk2, thesis §7.4-7.5)")
     g.add_argument("--scheme", choices=("exact", "rk2", "euler", "paper002"),
-                   help="integration scheme of the estimated twists (default: the description's odometry.scheme, "
-                        "else exact)")
+                   help=f"integration scheme of the estimated twists: {SCHEMES_HELP} (default: the description's "
+                        "odometry.scheme, else exact)")
     g.add_argument("--mu", action="append", metavar="WHEEL=LAT,LONG", default=[],
                    help="WLS: friction coefficients of a wheel, lateral and longitudinal (only ratios matter; "
                         "default 1,1; repeat)")
     g.add_argument("--mu-default", metavar="LAT,LONG", help="WLS: coefficients of the wheels not named by --mu")
     g.add_argument("--slip-weights", metavar="FILE", help="WLS: coefficients from 'wmrkit calibrate --json' output")
     g.add_argument("--kf-noise", nargs=3, type=float, metavar=("PROCESS", "LAT", "LONG"),
-                   help="FK1/FK2: process noise k13 [m/s per sample] and the lateral / longitudinal row noise "
-                        "[m/s] (default 1 1 1)")
+                   help="FK1/FK2: process noise (the thesis's k13, (7.68)) [m/s per sample] and the lateral / "
+                        "longitudinal row noise [m/s] (default 1 1 1)")
     g.add_argument("--kf-wheel", action="append", metavar="WHEEL=LAT,LONG", default=[],
                    help="FK1/FK2: row noise of one wheel (repeat)")
     g.add_argument("--thesis-double-q", action="store_true",
@@ -205,7 +205,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                                              "header says ('time [ms]'; default s and rad), as 'wmrkit odometry'")
     p.add_argument("--reference", required=True, metavar="TRAJ.tum", help="reference trajectory (TUM) of the run")
     p.add_argument("--scheme", choices=("exact", "rk2", "euler", "paper002"), default="exact",
-                   help="integration scheme (default: exact)")
+                   help=f"integration scheme: {SCHEMES_HELP} (default: exact)")
     add_json_flag(p)
     p.set_defaults(run=run_calibrate)
     add_study_parser(commands)
@@ -250,7 +250,7 @@ def add_study_parser(commands: argparse._SubParsersAction) -> None:
                    help="forklift: drive wheels through the open differential of one traction motor (default, the "
                         "forklift's drivetrain) or each through its own rate servo")
     p.add_argument("--source", choices=("md", "quasi-static"),
-                   help="skid-steer-4: motion from the dynamic model (default) or the quasi-static slip model")
+                   help="skid-steer-4: motion from the dynamic model (md, default) or the quasi-static slip model")
     add_json_flag(p)
     p.set_defaults(run=run_study)
 

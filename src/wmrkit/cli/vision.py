@@ -33,7 +33,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     loc.add_argument("--lines", type=int, metavar="N", help="lines in the image: 1 (default without --spacing), "
                      "2 (road: n = -1, 1) or 3 (crops: n = -1, 0, 1, default with --spacing)")
     loc.add_argument("--z-p", default="0", metavar="Z",
-                     help="distance from the lens to P along the axis [m] (default 0)")
+                     help="distance along the optical axis from the lens to P, the tracked point (the robot's "
+                          "origin) [m] (default 0: P below the lens)")
     loc.add_argument("--mode", choices=("threshold", "gradient"),
                      help="pixels of interest: the reference (threshold, default) or its contour (gradient)")
     add_json_flag(loc)
@@ -73,7 +74,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     f.add_argument("--blur", type=float, default=0.0, metavar="SIGMA", help="image blur [px] (default 0)")
     f.add_argument("--clutter", type=int, default=0, metavar="N", help="bright blobs on the ground (default 0)")
     f.add_argument("--line-width", default="0.02", metavar="W", help="painted line width [m] (default 0.02)")
-    f.add_argument("--z-p", default="0", metavar="Z", help="distance from the lens to P along the axis [m] (default 0)")
+    f.add_argument("--z-p", default="0", metavar="Z",
+                   help="distance along the optical axis from the lens to P, the tracked point (the robot's "
+                        "origin) [m] (default 0: P below the lens)")
     f.add_argument("--seed", type=int, default=0, help="random seed (noise, clutter; default 0)")
     f.add_argument("--animate", metavar="FILE", help="write a GIF: camera view beside the plan view")
     add_json_flag(f)
