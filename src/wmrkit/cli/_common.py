@@ -162,11 +162,12 @@ def parse_assignments(items: list[str] | None, what: str) -> dict[str, str]:
     return out
 
 
-def add_steer_option(parser: argparse.ArgumentParser, text: str = "heading of a steered wheel") -> None:
-    """``--steer NAME=ANGLE`` (repeatable): the wheel's heading, radians or degrees with ``deg``."""
+def add_steer_option(parser: argparse.ArgumentParser, text: str = "heading of a steered wheel", note: str = "") -> None:
+    """``--steer NAME=ANGLE`` (repeatable): the wheel's heading, radians or degrees with ``deg``; `note` ends the
+    help."""
     parser.add_argument("--steer", action="append", metavar="NAME=ANGLE", default=[],
                         help=f"{text}: its rolling direction, 0 = straight ahead, counter-clockwise positive; "
-                             "radians, or degrees with 'deg' (repeatable)")
+                             f"radians, or degrees with 'deg' (repeatable){note}")
 
 
 def steered_robot(spec: str, steer: list[str] | None) -> Robot:

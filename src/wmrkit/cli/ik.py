@@ -30,7 +30,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     add_robot_argument(p)
     p.add_argument("--twist", nargs=3, type=_finite, required=True, metavar=("VX", "VY", "OMEGA"),
                    help="body twist: vx, vy [m/s], omega [rad/s] (x forward, y left)")
-    add_steer_option(p, "current heading of a steered wheel (default: as described); the closest solution is kept")
+    add_steer_option(p, "current heading of a steered wheel (default: as described)",
+                     "; a steerable wheel keeps, of its two solutions (h, spin) and (h + 180 deg, -spin), the one "
+                     "closest to it; a castor's is the angle it is at")
     add_json_flag(p)
     p.set_defaults(run=run_ik)
 
