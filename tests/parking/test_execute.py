@@ -114,3 +114,35 @@ def test_open_loop_execution_passes_the_exact_check():
         run = execute_plan(plan_parking(car, slot), dt=0.02)
         report = check_poses(car, slot, run.pose)
         assert report.collision_free and report.inside
+
+
+def test_a_long_open_loop_execution_is_driven_in_bounded_memory():
+    """The open loop's batched inverse and forward kinematics took about 2 KB a sample at once (a 9.8 km plan,
+    394,511 samples: 870 MB); solved in chunks, the run keeps well under 1 KB a sample and drives the same path."""
+    import tracemalloc
+
+    plan = plan_parking(CAR_91, SLOT_91)
+    tracemalloc.start()
+    try:
+        run = execute_plan(plan, dt=0.0004)  # 73,371 samples
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert len(run.t) > 70_000 and peak < 1000 * len(run.t)
+    assert run.deviation.max() < 1e-9
+    np.testing.assert_allclose(run.pose[-1], plan.final_pose, atol=1e-9)
+    np.testing.assert_allclose(run.wheel_headings[:, 0], run.steering, atol=1e-9)
+
+
+def test_an_execution_of_too_many_samples_is_refused_before_it_is_sampled():
+    """A 57 km plan (91 manoeuvres of a 500 m car) was sampled into 2.3e6 poses and its execution took over 3.2 GB
+    (a MemoryError traceback under a 4 GB limit, from 'park --animate'); refused, naming the drive's duration."""
+    from wmrkit.parking.execute import MAX_SAMPLES
+
+    plan = plan_parking(CAR_91, SLOT_91)  # 29.35 s of driving
+    dt = 29.0 / MAX_SAMPLES  # 506,000 samples
+    with pytest.raises(WmrkitError, match=f"the plan takes 29 s to drive: executing it samples at most {MAX_SAMPLES}"):
+        timed_reference(plan.segments, dt=dt)
+    with pytest.raises(WmrkitError, match="at most 500000 poses"):
+        execute_plan(plan, dt=dt)
+    assert len(timed_reference(plan.segments, dt=29.4 / MAX_SAMPLES)[0]) == 499_106  # within the bound

@@ -26,6 +26,12 @@ from .planner import ParkingPlan
 
 #: Wheel radius of the vehicle built from the planner's parameters (the thesis gives none) [m].
 WHEEL_RADIUS = 0.3
+#: Samples of the open loop's kinematics solved at once (its batched inverse and forward kinematics take about
+#: 2 KB a sample: a 9.8 km plan, 394,511 samples, took 870 MB at once, 280 MB in chunks).
+CHUNK = 10_000
+#: Most samples of an executed plan (about 400 bytes each while it is driven: 200 MB; a 57 km plan, 2.3e6
+#: samples, took over 3.2 GB and ended in a MemoryError traceback under a 4 GB limit).
+MAX_SAMPLES = 500_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -101,6 +107,11 @@ def timed_reference(segments: tuple[Segment, ...] | list[Segment], *, v_max: flo
     """
     if not (v_max > 0 and a_max > 0 and steer_rate > 0 and dt > 0):
         raise WmrkitError("v_max, a_max, steer_rate and dt must be > 0")
+    durations = [abs(seg.steering - steer) / steer_rate + trapezoid_duration(seg.length, v_max, a_max)
+                 for seg, steer in zip(segments, [0.0, *(s.steering for s in segments)], strict=False)]
+    if sum(max(1, math.ceil(d / dt)) for d in durations) + 1 > MAX_SAMPLES:
+        raise WmrkitError(f"the plan takes {sum(durations):.0f} s to drive: executing it samples at most "
+                          f"{MAX_SAMPLES} poses ({MAX_SAMPLES * dt:.0f} s at {dt:g} s, docs/limits.md)")
     ts, poses, dists, segs = [], [], [], []
     t0, steer = 0.0, 0.0
     for k, seg in enumerate(segments):
@@ -198,16 +209,20 @@ def _open_loop(robot, offset, pose0, t, dist, seg, kappa, direction):
     speed = np.divide(step, dt, out=np.zeros_like(step), where=dt > 0)
     twist_pf = np.column_stack([direction * speed, np.zeros_like(speed), direction * speed * kappa])
     unit = np.column_stack([direction, np.zeros_like(speed), direction * kappa])  # steering set at rest too
-    commands = wheel_commands(robot, _origin_twist(unit, offset))
-    moving = wheel_commands(robot, _origin_twist(twist_pf, offset), commands.beta)
     names = [f"{w.name}.spin" for w in robot.wheels if "spin" in w.actuated]
     idx = [robot.rate_names.index(n) for n in names]
-    rates = {n: moving.rates[:, i] for n, i in zip(names, idx, strict=True)}
-    twist, _ = forward_kinematics(robot, rates, commands.beta)
+    twist = np.empty_like(twist_pf)
+    beta = np.empty((len(t), len(robot.steer_names)))
+    for part in (slice(k, k + CHUNK) for k in range(0, len(t), CHUNK)):  # bounded memory: ~2 KB a sample at once
+        commands = wheel_commands(robot, _origin_twist(unit[part], offset))
+        moving = wheel_commands(robot, _origin_twist(twist_pf[part], offset), commands.beta)
+        rates = {n: moving.rates[:, i] for n, i in zip(names, idx, strict=True)}
+        twist[part] = forward_kinematics(robot, rates, commands.beta)[0]
+        beta[part] = commands.beta
     origin0 = _origin_pose(pose0, offset)
     increments = twist * dt[:, None]
     origin = np.vstack([origin0, integrate_increments(origin0, increments[1:])])
-    return _pf_pose(origin, offset), np.asarray(robot.heading_of_beta(commands.beta))
+    return _pf_pose(origin, offset), np.asarray(robot.heading_of_beta(beta))
 
 
 def _closed_loop(robot, offset, t, ref, controller, gain):
