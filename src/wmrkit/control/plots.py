@@ -69,7 +69,7 @@ def plot_run(run: TrackingRun, path: str | os.PathLike[str]) -> None:
 
 def animate_run(run: TrackingRun, path: str | os.PathLike[str], *, frames: int = 80) -> None:
     """A GIF of the robot (outline and wheels at their headings) following the reference (`path` ends in .gif)."""
-    from matplotlib.animation import FuncAnimation, PillowWriter
+    from ..plotting.files import save_gif
 
     if os.path.splitext(os.fspath(path))[1].lower() != ".gif":  # x.png was written as one still frame
         raise WmrkitError(f"{os.fspath(path)}: the animation is written as a GIF (.gif)")
@@ -104,9 +104,8 @@ def animate_run(run: TrackingRun, path: str | os.PathLike[str], *, frames: int =
         ax.set_title(f"{robot.name}, {run.controller}: t = {run.t[i]:.1f} s", fontsize=9)
         return []
 
-    anim = FuncAnimation(fig, frame, frames=len(idx), blit=False)
     try:
-        anim.save(path, writer=PillowWriter(fps=12))
+        save_gif(fig, frame, range(len(idx)), path, fps=12)
     except (OSError, ValueError) as err:
         raise WmrkitError(f"{path}: cannot save the animation ({err})") from None
     finally:

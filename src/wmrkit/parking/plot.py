@@ -16,13 +16,16 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon, Rectangle
 
 from ..errors import WmrkitError
-from ..plotting.files import spread_indices
+from ..plotting.files import save_gif, spread_indices
 from .execute import Execution, execute_plan
 from .geometry import Space, Vehicle, footprint
 from .path import sample_poses
 from .planner import ParkingPlan
 
 FORWARD, BACKWARD = "#1f77b4", "#d62728"
+#: Most samples of the trail an animation draws, spread evenly (every sample of a plan driven in under 10 min; each
+#: frame drew every sample up to it: 800 frames of a 9.8 km plan, 394,511 samples, ran over 6 min).
+MAX_TRAIL = 12_000
 
 
 def car_outline(vehicle: Vehicle, pose: np.ndarray) -> np.ndarray:
@@ -103,7 +106,7 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
     The car drives P_f's executed poses with its steering wheel turned to the commanded heading; the trail is
     coloured by direction. Returns the number of frames (at most `max_frames`, evenly spaced in time).
     """
-    from matplotlib.animation import FuncAnimation, PillowWriter
+    from matplotlib.animation import FuncAnimation
 
     path = Path(path)
     suffix = path.suffix.lower()
@@ -111,6 +114,7 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
         raise WmrkitError(f"{path}: the animation is written as .gif or .html")
     run = execute_plan(plan) if execution is None else execution
     frames = spread_indices(len(run.t), max_frames)
+    dots = spread_indices(len(run.t), MAX_TRAIL)  # the trail's samples (all of a short run)
     fig = Figure(figsize=(8, 4.6))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
@@ -129,7 +133,7 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
         i = frames[k]
         artists.extend(draw_car(ax, plan.vehicle, run.pose[i], float(run.steering[i]), color="#2ca02c",
                                 alpha=0.8, fill=True))
-        upto = slice(0, i + 1)
+        upto = dots[:np.searchsorted(dots, i, side="right")]
         fwd = direction[upto] > 0
         trail_f.set_data(run.pose[upto][fwd, 0], run.pose[upto][fwd, 1])
         trail_b.set_data(run.pose[upto][~fwd, 0], run.pose[upto][~fwd, 1])
@@ -138,10 +142,10 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
                        f"steering {math.degrees(run.steering[i]):+5.1f} deg")
         return [*artists, trail_f, trail_b, title]
 
-    anim = FuncAnimation(fig, update, frames=len(frames), interval=1000 / fps, blit=False)
     if suffix == ".gif":
-        anim.save(path, writer=PillowWriter(fps=fps), dpi=80)
+        save_gif(fig, update, range(len(frames)), path, fps=fps, dpi=80)
     else:
+        anim = FuncAnimation(fig, update, frames=len(frames), interval=1000 / fps, blit=False)
         path.write_text(anim.to_jshtml(fps=fps), encoding="utf-8")
     return len(frames)
 

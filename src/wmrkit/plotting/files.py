@@ -1,9 +1,10 @@
-"""Figure files: the formats wmrkit draws to, chosen by the file's extension, checked before the drawing; and which
-items of a long sequence a figure or an animation draws."""
+"""Figure files: the formats wmrkit draws to, chosen by the file's extension, checked before the drawing; which
+items of a long sequence a figure or an animation draws; animations written as GIFs."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable, Iterable
 
 import numpy as np
 
@@ -32,3 +33,25 @@ def spread_indices(n: int, most: int) -> np.ndarray:
     """Indices of at most `most` of `n` items, spread evenly, the first and the last included (the frames of an
     animation, the configurations drawn over each other)."""
     return np.unique(np.linspace(0, n - 1, min(n, most)).round().astype(int))
+
+
+def save_gif(fig, draw: Callable[[int], object], frames: Iterable[int], path: str | os.PathLike[str], *,
+             fps: float, dpi: float | None = None) -> None:
+    """Write a GIF of `fig`, calling ``draw(k)`` for each item of `frames` before rendering it (Agg, off-screen).
+
+    Each frame is rendered once and kept as a palette image (1 byte a pixel), as GIF stores it: matplotlib's
+    ``FuncAnimation.save`` with ``PillowWriter`` rendered every frame twice and kept it as RGBA until the end
+    (800 frames of 640 x 368 px: 4 min and 840 MB on the shared 2-core machine)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image
+
+    if dpi is not None:
+        fig.set_dpi(dpi)
+    canvas = FigureCanvasAgg(fig)
+    images = []
+    for k in frames:
+        draw(k)
+        canvas.draw()
+        rgba = Image.fromarray(np.asarray(canvas.buffer_rgba()))
+        images.append(rgba.convert("RGB").convert("P", palette=Image.Palette.ADAPTIVE))
+    images[0].save(os.fspath(path), save_all=True, append_images=images[1:], duration=int(1000 / fps), loop=0)

@@ -11,7 +11,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..errors import WmrkitError
-from ..plotting.files import check_figure_path, spread_indices
+from ..plotting.files import check_figure_path, save_gif, spread_indices
 from ..robot import Robot
 from .camera import Camera, CameraError, distort
 from .follow import LineFollowing
@@ -82,8 +82,6 @@ def save_animation(run: LineFollowing, robot: Robot, camera: Camera, path: str |
                    fps: float = 4.0) -> None:
     """A GIF of `run` (made with ``keep_images=True``): camera view (left) beside the plan view (right); at most
     :data:`MAX_FRAMES` frames, evenly spread over the run (the last one included)."""
-    from matplotlib.animation import FuncAnimation, PillowWriter
-
     if run.images is None:
         raise WmrkitError("animation: the run kept no camera images (follow_line(..., keep_images=True))")
     if Path(path).suffix.lower() != ".gif":
@@ -119,5 +117,4 @@ def save_animation(run: LineFollowing, robot: Robot, camera: Camera, path: str |
 
     n = len(run.images)
     frames = spread_indices(n, MAX_FRAMES).tolist()
-    anim = FuncAnimation(fig, frame, frames=frames, blit=False)
-    anim.save(str(path), writer=PillowWriter(fps=fps))
+    save_gif(fig, frame, frames, path, fps=fps)
