@@ -64,7 +64,7 @@ def test_cli_show_plot(tmp_path, capsys):
     assert main(["show", "thesis-omni-castor", "--plot", str(out)]) == 0
     assert out.read_bytes().startswith(HEADERS[".png"])
     assert main(["show", "diff-drive", "--plot", str(tmp_path / "x.gif")]) == 2
-    assert "cannot draw to '.gif'" in capsys.readouterr().err
+    assert f"--plot {tmp_path / 'x.gif'}: cannot draw to '.gif'" in capsys.readouterr().err  # the option named
 
 
 @pytest.mark.parametrize("robot", [SPECIALS, catalog.load("thesis-steer-castor"), catalog.load("mecanum-4")],

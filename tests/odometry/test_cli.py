@@ -367,3 +367,10 @@ def test_a_heading_column_in_degrees_without_its_unit_is_refused(capsys, tmp_pat
     path.write_text("time,left.spin,right.spin,yaw [rad]\n" + rows)
     assert _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--heading-column", "yaw"])["pose"][2] \
         == pytest.approx(math.remainder(18, 2 * math.pi), abs=1e-12)  # the pose's heading is wrapped
+
+
+def test_a_plot_file_wmrkit_cannot_draw_names_the_option(capsys, diff_csv, tmp_path):
+    """'p.txt: cannot draw to ...' named no option (other commands say '--plot p.txt: ...'); checked before the run."""
+    assert main(["odometry", "diff-drive", diff_csv, "--plot", str(tmp_path / "p.txt")]) == 2
+    assert capsys.readouterr().err == (f"wmrkit: error: --plot {tmp_path / 'p.txt'}: cannot draw to '.txt' (plot "
+                                       "files are .png, .svg, .pdf)\n")

@@ -23,6 +23,7 @@ from ._common import (
     SCHEMES_HELP,
     add_json_flag,
     add_robot_argument,
+    check_plot_path,
     load_robot,
     parse_angle,
     parse_assignments,
@@ -129,6 +130,7 @@ def run(args: argparse.Namespace) -> int:
     if steer_res is not None and not any(j.endswith(".steer") for j, _ in fmt.encoders):  # ignored as well
         raise WmrkitError("--steer-resolution applies to steer columns of encoder counts (--steer counts, or a header "
                           "'WHEEL.steer [counts]')")
+    check_plot_path(args.plot)
     pose0 = [parse_value(args.pose[0], "length", "--pose X"), parse_value(args.pose[1], "length", "--pose Y"),
              parse_angle(args.pose[2], "--pose")]
     slip_model = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None

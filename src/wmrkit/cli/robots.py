@@ -7,7 +7,7 @@ import math
 
 from .. import catalog
 from ..robot import Robot
-from ._common import add_json_flag, add_robot_argument, load_robot, print_json
+from ._common import add_json_flag, add_robot_argument, check_plot_path, load_robot, print_json
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -38,6 +38,7 @@ def run_robots(args: argparse.Namespace) -> int:
 def run_show(args: argparse.Namespace) -> int:
     """Print a robot's summary; draw it with --plot."""
     robot = load_robot(args.robot)
+    check_plot_path(args.plot)
     if args.plot:
         from ..plotting.robot import save_robot_figure
 
