@@ -194,6 +194,26 @@ def test_c_forward_reports_a_singular_configuration(tmp_path):
         assert np.isnan(tw).all() and math.isnan(res.value)
 
 
+def test_python_forward_reports_a_singular_configuration_as_the_c_does(tmp_path):
+    """Three castors sensing their spins, axles parallel: the sensed rates do not determine the twist. The generated
+    Python returned pinv's minimum-norm guess (0.03, 0, 0) with residual 0 (no slip), where the C returns -1 and NaN,
+    and a NaN heading raised numpy's 'SVD did not converge'. Now NaN twist and residual, row by row in a batch."""
+    robot = _robot("castors", [
+        {"name": f"c{i}", "type": "castor", "l": 0.3, "alpha": f"{a} deg", "d": 0.05, "r": 0.03, "sensed": ["spin"]}
+        for i, a in enumerate((0, 120, 240))])
+    mod = load_module(write_code(robot, "python", tmp_path)[0])
+    headings = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 2.0], [0.0, math.nan, 2.0], [0.0, 1.0, 2.0]])
+    sensed = np.array([[1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [1.0, math.inf, 1.0]])
+    twist, slip = mod.forward_with_residual(sensed, headings)
+    assert np.isnan(twist[[0, 2, 3]]).all() and np.isnan(slip[[0, 2, 3]]).all()
+    beta = robot.beta_of_heading(headings[1])  # the determined row: the numeric model (4.11)
+    expected, residual = solve_assigned(robot.constraint_matrix(beta), [robot.velocity_index(n) for n in
+                                                                          sensed_rates(robot)], sensed[1])
+    np.testing.assert_allclose(twist[1], expected[:3], rtol=1e-9, atol=1e-12)
+    assert slip[1] == pytest.approx(np.linalg.norm(residual), abs=1e-12)
+    assert np.isnan(mod.forward([1.0, 1.0, 1.0], [0.0, 0.0, 0.0])).all()
+
+
 def test_names_that_are_no_identifiers_or_break_comments(tmp_path):
     """Robot and wheel names end up in identifiers, C comments and Python docstrings: none may break the code."""
     robot = Robot('3 wheels */ /* """ \\', (  # built directly: description files allow only plain wheel names

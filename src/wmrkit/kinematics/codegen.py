@@ -438,15 +438,22 @@ def inverse_matrix(heading=None):
 def forward_with_residual(sensed, heading=None):
     """Least-squares twist (4.11) and slip residual ``|A q|`` [m/s].
 
-    ``(..., {len(plan.sensed)}) -> (..., 3), (...)``.
+    ``(..., {len(plan.sensed)}) -> (..., 3), (...)``. Both are NaN where the sensed rates do not determine the twist
+    at those headings (the smallest singular value of the unknowns' columns <= 1e-9 rows max(1, max|A_ij|)) or an
+    input is not finite, as the C code's -1.
     """
     sensed = _vectors(sensed, {len(plan.sensed)}, "sensed")
     a = constraint_matrix(heading)
+    finite = numpy.isfinite(a).all(axis=(-2, -1)) & numpy.isfinite(sensed).all(axis=-1)
+    a = numpy.where(finite[..., None, None], a, 0.0)
+    sensed = numpy.where(finite[..., None], sensed, 0.0)
     a_na = a[..., _UNKNOWN_COLUMNS]
     rhs = -(a[..., _SENSED_COLUMNS] @ sensed[..., None])
     x = numpy.linalg.pinv(a_na) @ rhs
     residual = numpy.linalg.norm((a_na @ x - rhs)[..., 0], axis=-1)
-    return x[..., :3, 0], residual
+    tol = 1e-9 * a_na.shape[-2] * numpy.maximum(numpy.abs(a_na).max(axis=(-2, -1)), 1.0)
+    ok = finite & (numpy.linalg.svd(a_na, compute_uv=False)[..., -1] > tol)
+    return numpy.where(ok[..., None], x[..., :3, 0], numpy.nan), numpy.where(ok, residual, numpy.nan)
 
 
 def forward(sensed, heading=None):
