@@ -356,6 +356,22 @@ def test_format_symbolic_says_when_a_set_does_not_determine_the_rest():
     assert "model, assigned: vx" in text and "not determined" in text and "rank A_na = 4 < 5" in text
 
 
+def test_format_symbolic_says_how_beta_relates_to_the_heading():
+    """The closed forms are in the thesis's beta, while every other line of the CLI speaks headings (a forklift going
+    straight is heading 0, beta pi/2): the header printed 'steering [rad]: beta_steer' alone, so a user put the
+    heading in. It now gives each wheel's beta = heading + pi/2 - delta, checked against Robot.beta_of_heading."""
+    robot = Robot.from_dict({"name": "castor", "wheels": [
+        {"name": "left", "type": "fixed", "position": [0, 0.2], "beta": "90 deg", "r": 0.05, "sensed": ["spin"]},
+        {"name": "right", "type": "fixed", "position": [0, -0.2], "beta": "90 deg", "r": 0.05, "sensed": ["spin"]},
+        {"name": "c", "type": "castor", "position": [-0.3, 0], "d": 0.04, "delta": "10 deg", "r": 0.03},
+        {"name": "s", "type": "steerable", "position": [0.3, 0], "r": 0.03}]})
+    header = format_symbolic(robot).splitlines()[2]
+    assert "beta_c = heading_c + 4*pi/9, beta_s = heading_s + pi/2" in header
+    np.testing.assert_allclose(robot.beta_of_heading([0.0, 0.0]), [4 * math.pi / 9, math.pi / 2])
+    assert "heading 0 = rolling straight ahead" in header
+    assert "steering [rad]: none;" in format_symbolic(replace(robot, wheels=robot.wheels[:2]))
+
+
 def test_default_assignments():
     assert sensed_rates(DIFF) == ("left.spin", "right.spin")
     assert twist_assignment(DIFF) == ("vx", "omega")

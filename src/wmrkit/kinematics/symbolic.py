@@ -24,7 +24,7 @@ from ..errors import SingularError, UnknownNameError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
 from ..wheels import GEOMETRY_FIELDS
 from ._exact_linalg import _components, agrees, numeric, random_points, solve_exactly
-from ._symbolic_matrix import AssignmentError, constraint, exact_number, geometry_fields
+from ._symbolic_matrix import AssignmentError, _nice_number, constraint, exact_number, geometry_fields
 from .linalg import matrix_rank
 
 Geometry = Literal["numeric", "symbolic"] | Mapping[str, sp.Expr]
@@ -266,8 +266,7 @@ def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, late
     comment = "% " if latex else ""
     lines = [f"{comment}{robot.name}: no-slip kinematic models in closed form (thesis ch. 4)",
              f"{comment}  velocities: {', '.join(robot.velocity_names)}",
-             f"{comment}  steering [rad]: {', '.join(map(str, steering_symbols(robot))) or 'none'}; "
-             "geometry: the robot's numbers, exact (m, rad)"]
+             f"{comment}  steering [rad]: {_steering_note(robot)}; geometry: the robot's numbers, exact (m, rad)"]
     for title, names in sets:
         lines.append("")
         lines.append(f"{comment}{title}, assigned: {', '.join(names) or 'nothing'}")
@@ -288,6 +287,21 @@ def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, late
         lines += _latex_block(model) if latex else [f"    {n} = {_linear_form(model, i)}" for i, n in
                                                     enumerate(model.solved)]
     return "\n".join(lines)
+
+
+def _steering_note(robot: Robot) -> str:
+    """``beta_<wheel> = heading_<wheel> + offset`` per steering wheel: the thesis's angle of the closed forms in
+    terms of the users' heading (``beta = heading + pi/2 - delta``, :meth:`Robot.beta_of_heading`)."""
+    if not robot.steer_names:
+        return "none"
+    offsets = robot.beta_of_heading([0.0] * len(robot.steer_names)).tolist()
+    terms = []
+    for beta, name, offset in zip(steering_symbols(robot), robot.steer_names, offsets, strict=True):
+        exact = _nice_number(offset, "angle")
+        heading = sp.Symbol(f"heading_{name}") + (sp.Float(offset, 15) if exact is None else exact)
+        terms.append(f"{beta} = {sp.sstr(heading)}")
+    return (", ".join(terms) + " (the thesis's axle angle; heading 0 = rolling straight ahead, counter-clockwise "
+            "positive)")
 
 
 def _linear_form(model: SymbolicModel, i: int, names: Mapping[str, str] | None = None) -> str:
