@@ -393,6 +393,21 @@ def test_errors_name_the_culprit():
         symbolic_model(TRICYCLE, ["vy"], [0.1, 0.2])
 
 
+@pytest.mark.parametrize("angle", [1e20, 1e300, -7e6, 10**400, math.nan, math.inf, sp.nan, sp.oo, sp.zoo,
+                                   sp.Float(1e20)])
+def test_steering_numbers_beyond_a_million_turns_or_not_finite_are_refused(angle):
+    """beta = 1e20 or 1e300 (no angle: its sine is round-off) was made exact and gave SingularError 'assigning (vy)
+    does not determine (...)', a false claim about the robot; sympy's nan and zoo raised numpy's 'SVD did not
+    converge', oo a TypeError, 10**400 an OverflowError. Now the Python API's rule for angles (as_angles: finite, at
+    most 1e6 turns), one AssignmentError naming beta and the wheel."""
+    with pytest.raises(AssignmentError, match=r"beta\[0\] \(w3\): .*at most 1e\+06 turns"):
+        symbolic_model(TRICYCLE, ["vy"], [angle])
+    with pytest.raises(AssignmentError, match=r"beta\[0\] \(w3\)"):
+        symbolic_constraint_matrix(TRICYCLE, [angle])
+    m = symbolic_model(TRICYCLE, ["vy"], [sp.pi / 3 + 2 * sp.pi * 10**5])  # within: as sin(pi/3), cos(pi/3)
+    assert m.matrix == symbolic_model(TRICYCLE, ["vy"], [sp.pi / 3]).matrix
+
+
 def test_a_double_castor_is_exact_in_closed_form():
     """(3.31) with ``cos(skew) = d / arm``, ``sin(skew) = b / arm``: the entries are plain fractions of the
     description's numbers. Its hypot/atan2 were floats made exact, so `kinematics --symbolic` printed

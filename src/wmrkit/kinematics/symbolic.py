@@ -22,6 +22,7 @@ import sympy as sp
 
 from ..errors import SingularError, UnknownNameError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
+from ..units import MAX_ANGLE, MAX_TURNS
 from ..wheels import GEOMETRY_FIELDS
 from ._exact_linalg import _components, agrees, numeric, random_points, solve_exactly
 from ._symbolic_matrix import AssignmentError, _nice_number, constraint, exact_number, geometry_fields
@@ -92,10 +93,22 @@ def _steering_values(robot: Robot, beta: Sequence[sp.Expr | float] | None) -> tu
     if len(values) != len(robot.steer_names):
         raise AssignmentError(f"beta: expected {len(robot.steer_names)} steering angles "
                               f"({', '.join(robot.steer_names) or 'none'}), got {len(values)}")
-    for v in values:
+    for i, (v, name) in enumerate(zip(values, robot.steer_names, strict=True)):
         if not isinstance(v, sp.Basic | int | float):
             raise AssignmentError(f"beta: expected sympy expressions or numbers, got {type(v).__name__}")
+        if not (isinstance(v, sp.Basic) and v.free_symbols) and not _within_turns(v):
+            raise AssignmentError(f"beta[{i}] ({name}): angles must be finite numbers of at most {MAX_TURNS:g} turns "
+                                  f"[rad] (their sine is round-off beyond), got {v!r:.40}")
     return tuple(v if isinstance(v, sp.Basic) else exact_number(v, "angle") for v in values)
+
+
+def _within_turns(v: sp.Expr | float) -> bool:
+    """A number (sympy's too) that is finite and at most MAX_TURNS turns, as :func:`wmrkit._shapes.as_angles` asks."""
+    try:
+        x = complex(v)
+    except (TypeError, OverflowError):  # zoo, oo, 10**400
+        return False
+    return x.imag == 0 and abs(x.real) <= MAX_ANGLE
 
 
 def symbolic_constraint_matrix(
