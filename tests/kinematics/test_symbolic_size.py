@@ -7,6 +7,7 @@ import math
 import time
 
 import pytest
+import sympy as sp
 import yaml
 
 from wmrkit import Robot
@@ -108,3 +109,24 @@ def _assert_direct_model_is_least_squares(robot: Robot) -> None:
     expected = solve_assigned(robot.constraint_matrix(), cols, q)[0]
     got = np.array(model.matrix.evalf(), dtype=float) @ q
     np.testing.assert_allclose(got, expected[[robot.velocity_index(n) for n in model.solved]], rtol=1e-9, atol=1e-12)
+
+
+def test_the_relations_are_converted_once_per_ring(monkeypatch):
+    """Each entry of a closed form is reduced modulo sin^2 + cos^2 = 1 of every angle; the relations were rebuilt as
+    polynomials for every entry (6,720 entries x 33 relations for 32 double wheels: 221,760 conversions, most of the
+    time; 64 double wheels' `kinematics --codegen` did not finish in 400 s). Now once per polynomial ring. The
+    model is the same: its rates at rest, unit turning at s, are the sub-wheels' -+b s / r (3.24)."""
+    from sympy.polys.rings import PolyRing
+
+    n = 6
+    robot = Robot.from_dict({"name": "doubles", "wheels": [
+        {"name": f"u{i}", "type": "double", "b": 0.05, "r": 0.1, "alpha": 2 * math.pi * i / n, "l": 0.5}
+        for i in range(n)]})
+    calls = []
+    original = PolyRing.from_expr
+    monkeypatch.setattr(PolyRing, "from_expr", lambda ring, expr: calls.append(expr) or original(ring, expr))
+    model = symbolic_model(robot, ("vx", "vy", "omega", *robot.free_steering))
+    assert 0 < len(calls) <= 2 * n  # the 2 n relations s^2 + c^2 - 1, once (before: 2,268)
+    rates = model.matrix[:, 3:]  # the steering rates' columns, at rest
+    k = model.solved.index("u0.spin1")
+    assert rates[k, 0] == sp.Rational(-1, 2) and rates[k + 1, 0] == sp.Rational(1, 2)  # -+b/r = -+0.05/0.1

@@ -32,6 +32,7 @@ class _Generators:
         self.forward: dict[sp.Expr, sp.Symbol] = {}
         self.back: dict[sp.Symbol, sp.Expr] = {}
         self.relations: list[sp.Expr] = []
+        self._bases: dict = {}
         for k, arg in enumerate(sorted({a.args[0] for a in atoms}, key=sp.default_sort_key)):
             s, c = sp.Dummy(f"a{k}"), sp.Dummy(f"b{k}")  # sin before cos: reducing gives s^2 -> 1 - c^2
             self.forward.update({sp.sin(arg): s, sp.cos(arg): c})
@@ -42,6 +43,13 @@ class _Generators:
             self.forward[root], self.back[g] = g, root
             self.relations.append(g**2 - root.base)
 
+    def _basis(self, ring) -> list:
+        """The relations as polynomials of `ring`, built once per ring: rebuilding them for every entry (a
+        conversion per relation, 221,760 for 32 double wheels) took most of the time of a large closed form."""
+        if ring not in self._bases:
+            self._bases[ring] = [ring.from_expr(r) for r in self.relations if r.free_symbols <= set(ring.symbols)]
+        return self._bases[ring]
+
     def domain_matrix(self, m: sp.MatrixBase) -> DomainMatrix:
         """`m` over a ring of polynomials in the generators (and the other symbols), or numbers (QQ, EX)."""
         return DomainMatrix.from_list_sympy(*m.shape, sp.Matrix(m).xreplace(self.forward).tolist())
@@ -51,8 +59,7 @@ class _Generators:
         ring = _poly_ring(domain)
         if ring is None:
             return sp.factor_terms(sp.cancel(domain.to_sympy(num) / domain.to_sympy(den))).xreplace(self.back)
-        basis = [ring.from_expr(r) for r in self.relations if r.free_symbols <= set(ring.symbols)]
-        num, den = num.rem(basis), den.rem(basis)
+        num, den = num.rem(self._basis(ring)), den.rem(self._basis(ring))
         if not den:
             raise ZeroDivisionError("a pivot vanished on sin^2 + cos^2 = 1")
         num, den = num.cancel(den)
