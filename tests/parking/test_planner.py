@@ -16,6 +16,10 @@ from wmrkit.parking.geometry import arcs_through, corner_distance
 from wmrkit.parking.planner import approach_point, first_reach, pass_end
 from wmrkit.parking.problem import load_problem
 
+#: Seconds past which a plan is taken to hang (the printed loops never end); a plan takes about 1 ms, which
+#: benchmarks/bench_parking.py measures: no test is timed against a target.
+HANG = 10.0
+
 
 def test_table_9_1_gives_two_manoeuvres():
     plan = plan_parking(CAR_91, SLOT_91)
@@ -116,7 +120,7 @@ def test_errata_algorithm_4_literal_loop_never_ends_and_is_bounded_here():
     t0 = time.perf_counter()
     assert pass_end(v, dx1, offset) is None
     plan = plan_parking(v, replace(SLOT_91, dx2=offset))
-    assert time.perf_counter() - t0 < 0.5
+    assert time.perf_counter() - t0 < HANG  # the printed loop never ends
     assert plan.feasible and plan.maneuvers == 2 and c1_half_clear(plan)
 
 
@@ -152,13 +156,6 @@ def test_algorithm_5_root_touches_the_curb_exactly():
     assert second.rho > corner_distance(CAR_91, 0.0, 2)  # far larger than the minimum radius
 
 
-def test_planning_is_fast():
-    t0 = time.perf_counter()
-    for _ in range(200):
-        plan_parking(CAR_92, SLOT_92)
-    assert (time.perf_counter() - t0) / 200 < 2e-3  # generous: the benchmark measures the target
-
-
 def test_units_rounding_does_not_change_the_plan():
     """"70 cm" and "140 cm" / 2 differ in floating point (0.7 vs 0.7000000000000001): same plan, no warning."""
     wide = replace(CAR_91, c1=1.4000000000000001)
@@ -172,9 +169,9 @@ def test_huge_but_finite_inputs_return_quickly():
     """Python callers are not limited to 1 km: every loop and search stays bounded."""
     t0 = time.perf_counter()
     plan = plan_parking(CAR_91, replace(SLOT_91, H=1e9, dx2=1e6))
-    assert time.perf_counter() - t0 < 0.5 and not plan.feasible
+    assert time.perf_counter() - t0 < HANG and not plan.feasible
     assert shortest_slot(replace(CAR_91, a1=1e4), replace(SLOT_91, J=1.3)) is None
-    assert time.perf_counter() - t0 < 5.0
+    assert time.perf_counter() - t0 < 2 * HANG
 
 
 @pytest.mark.parametrize(("search", "options", "message"), [

@@ -102,7 +102,7 @@ def test_planner_never_loops_and_feasible_plans_are_exactly_collision_free(probl
     vehicle, space = problem
     t0 = time.perf_counter()
     plan = plan_parking(vehicle, space, max_maneuvers=40)
-    assert time.perf_counter() - t0 < 1.0  # bounded: no hang on any input
+    assert time.perf_counter() - t0 < 10.0  # bounded: no hang on any input (a plan takes about 1 ms; no timing)
     if not plan.feasible:
         assert plan.reason and plan.maneuvers == 0
         return
