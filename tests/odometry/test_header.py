@@ -89,3 +89,13 @@ def test_a_column_named_with_its_unit_keeps_the_unit(tmp_path):
     assert fmt.spin == "angle" and dict(fmt.columns) == {"left.spin": "position[0]", "right.spin": "position[1]"}
     with pytest.raises(HeaderError, match=r"x\.csv:1: no column 'time \[s\]' \(the header names it 'time \[ms\]'\)"):
         _format(tmp_path, "time [ms],left.spin,right.spin", time_column="time [s]")
+
+
+def test_a_column_named_with_a_unit_wmrkit_does_not_read_is_refused(tmp_path):
+    """--time-column 'time [min]' read the minutes as seconds, exit 0: the unknown unit was taken as part of the
+    name, so the header's reader (which refuses 'min' without the option) never saw it as the time's unit."""
+    with pytest.raises(HeaderError, match=r"x\.csv:1: column 'time': unknown unit 'min' \(time units: s, ms, us, ns\)"):
+        _format(tmp_path, "time [min],left.spin,right.spin", time_column="time [min]")
+    with pytest.raises(HeaderError, match=r"column 'enc_l': unknown unit 'deg/s' \(for a spin joint: rad, rad/s"):
+        _format(tmp_path, "time,enc_l [deg/s],enc_r [deg/s]",
+                columns={"left.spin": "enc_l [deg/s]", "right.spin": "enc_r [deg/s]"})

@@ -39,6 +39,8 @@ EXTERNAL_UNITS = {"heading": "rad", "gyro": "rad/s"}
 
 _NAME = re.compile(r"^\s*([^\[\]]*?)\s*\[\s*([^\[\]]+?)\s*\]\s*$")
 _COUNTER = re.compile(r"^counts:([us])(\d{1,2})$")
+#: What a unit in brackets looks like (``ms``, ``rad/s``, ``counts:u16``, ``deg:heading``, ``min``), unlike an index.
+_UNIT_WORD = re.compile(r"^[A-Za-z][A-Za-z0-9/:^*._-]*$")
 
 
 class HeaderError(WmrkitError, ValueError):
@@ -141,16 +143,11 @@ def parse_header_units(names: list[str], *, source: str = "<log>", time_column: 
 
 
 def _plain(name: str) -> str:
-    """A column name without the unit it may carry (``'time [ms]'`` -> ``'time'``); a name whose brackets hold no
-    unit (``'position[0]'``, an exported array) is a name."""
+    """A column name without the unit it may carry (``'time [ms]'`` -> ``'time'``, ``'time [min]'`` -> ``'time'``,
+    whose unit the header's reader then refuses by name); a name whose brackets hold no unit word (``'position[0]'``,
+    an exported array) is a name."""
     match = _NAME.match(name)
-    if match is None:
-        return name
-    unit = match.group(2)
-    base, _, convention = unit.rpartition(":")
-    unit = base if convention in STEER_CONVENTIONS else unit
-    known = (*TIME_UNITS, *SPIN_UNITS, *STEER_UNITS, *EXTERNAL_UNITS.values())
-    return match.group(1) if unit in known or _COUNTER.match(unit) else name
+    return match.group(1) if match is not None and _UNIT_WORD.match(match.group(2)) else name
 
 
 def bare_heading_problem(column: str, heading: Sequence[float]) -> tuple[int, str] | None:
