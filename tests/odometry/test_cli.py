@@ -374,3 +374,13 @@ def test_a_plot_file_wmrkit_cannot_draw_names_the_option(capsys, diff_csv, tmp_p
     assert main(["odometry", "diff-drive", diff_csv, "--plot", str(tmp_path / "p.txt")]) == 2
     assert capsys.readouterr().err == (f"wmrkit: error: --plot {tmp_path / 'p.txt'}: cannot draw to '.txt' (plot "
                                        "files are .png, .svg, .pdf)\n")
+
+
+def test_json_error_about_a_missing_column_names_it(capsys, tmp_path):
+    """'x.csv:1: missing column 'right.spin' (columns: ...)' gave "field": null in --json."""
+    log = tmp_path / "one.csv"
+    log.write_text("time,left.spin\n0,0\n1,1\n")
+    assert main(["odometry", "diff-drive", str(log), "--json"]) == 2
+    data = json.loads(capsys.readouterr().err)
+    assert (data["file"], data["line"], data["field"]) == (str(log), 1, "right.spin"), data
+    assert data["error"].startswith("missing column 'right.spin'")

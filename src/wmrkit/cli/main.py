@@ -162,7 +162,9 @@ def _file_place(message: str, argv: Sequence[str]) -> dict:
     place = re.match(r"(?:(\d+):)?(?: column '([^']*)':| ([^\s:']+\.(?:spin|steer)):)?(.*)", message[len(name) + 1:],
                      flags=re.S)
     line, column, joint, rest = place.groups()
-    return {"error": rest.strip(), "file": name, "line": int(line) if line else None, "field": column or joint}
+    missing = re.match(r"\s*missing column '([^']*)'", rest)  # "x.csv:1: missing column 'right.spin' (columns: ...)"
+    return {"error": rest.strip(), "file": name, "line": int(line) if line else None,
+            "field": column or joint or (missing.group(1) if missing else None)}
 
 
 #: Longest error message printed [characters]; longer ones (quoting huge user text) are cut.
