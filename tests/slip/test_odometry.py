@@ -254,3 +254,13 @@ def test_coefficients_of_a_wheel_without_rows_are_refused(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--mu steer: wheel 'steer' has no no-slip rows" in err and err.count("\n") == 1
     assert main([*argv, "--mu", "right_drive=1,2"]) == 0  # a wheel with rows: used
+
+
+@pytest.mark.parametrize(("method", "instead"), [("wls", "--mu"), ("fk1", "--kf-wheel"), ("fk2", "--kf-wheel")])
+def test_weight_with_a_slip_aware_method_names_that_methods_option(method, instead, tmp_path, capsys):
+    """'--method fk2 --weight left=2' said 'with --method wls use --mu', an option fk2 refuses."""
+    log = tmp_path / "d.csv"
+    log.write_text("time,left.spin,right.spin\n0,0,0\n1,1,1.2\n")
+    assert main(["odometry", "diff-drive", str(log), "--method", method, "--weight", "left=2"]) == 2
+    assert capsys.readouterr().err == (f"wmrkit: error: --weight applies to the kinematic methods; with --method "
+                                       f"{method} use {instead} WHEEL=LAT,LONG\n")

@@ -160,7 +160,8 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
     from ..slip.kalman import noise_from_options
 
     if args.weight:
-        raise WmrkitError("--weight applies to the kinematic methods; with --method wls use --mu WHEEL=LAT,LONG")
+        other = "--mu WHEEL=LAT,LONG" if args.method == "wls" else "--kf-wheel WHEEL=LAT,LONG"
+        raise WmrkitError(f"--weight applies to the kinematic methods; with --method {args.method} use {other}")
     if args.covariance:
         raise WmrkitError(f"--covariance is not available with --method {args.method} (kinematic methods only)")
     described = settings.kalman_noise() if settings is not None else None
