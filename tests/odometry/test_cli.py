@@ -384,3 +384,11 @@ def test_json_error_about_a_missing_column_names_it(capsys, tmp_path):
     data = json.loads(capsys.readouterr().err)
     assert (data["file"], data["line"], data["field"]) == (str(log), 1, "right.spin"), data
     assert data["error"].startswith("missing column 'right.spin'")
+
+
+def test_a_start_pose_too_far_names_the_option(capsys, tmp_path):
+    """'--pose 1e10 0 0' was refused as 'pose0: ...', the Python argument's name, not the option's."""
+    log = tmp_path / "d.csv"
+    log.write_text("time,left.spin,right.spin\n0,0,0\n1,1,1.2\n")
+    assert main(["odometry", "diff-drive", str(log), "--pose", "1e10", "0", "0"]) == 2
+    assert capsys.readouterr().err.startswith("wmrkit: error: --pose: a position beyond 1e+09 m, got [10000000000.0")

@@ -18,7 +18,7 @@ from ..odometry.header import header_format
 from ..odometry.integrators import METHODS
 from ..odometry.logs import TIME_UNITS, LogFormat
 from ..odometry.model import odometry_model
-from ..odometry.pipeline import OdometrySummary
+from ..odometry.pipeline import OdometrySummary, check_start_pose
 from ._common import (
     SCHEMES_HELP,
     add_json_flag,
@@ -133,6 +133,7 @@ def run(args: argparse.Namespace) -> int:
     check_plot_path(args.plot)
     pose0 = [parse_value(args.pose[0], "length", "--pose X"), parse_value(args.pose[1], "length", "--pose Y"),
              parse_angle(args.pose[2], "--pose")]
+    check_start_pose(np.array(pose0), "--pose")
     slip_model = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None
     summary = odometry_file(
         robot, args.log, fmt=fmt, method=args.scheme if slip_model is not None else args.method, pose0=pose0,

@@ -290,13 +290,19 @@ def _validate(chunk: JointLog, prev: JointLog | None, *, positions: bool = True)
     return largest
 
 
+def check_start_pose(pose: np.ndarray, name: str = "pose0") -> None:
+    """Refuse a start pose ``(3,)`` that is not finite or lies beyond :data:`MAX_COORDINATE`, naming it `name` (the
+    CLI's ``--pose``)."""
+    if not np.isfinite(pose).all():
+        raise LogError(f"{name}: must be finite, got {pose.tolist()}")
+    if np.abs(pose[:2]).max() > MAX_COORDINATE:
+        raise LogError(f"{name}: a position beyond {MAX_COORDINATE:g} m, got {pose[:2].tolist()}")
+
+
 def _check_inputs(pose: np.ndarray, noise: Noise | None, initial_covariance: ArrayLike | None) -> None:
     """Refuse a non-finite start pose, a noise that is no noise model, and a bad initial covariance or one without
     a noise model (noise models check their coefficients when made)."""
-    if not np.isfinite(pose).all():
-        raise LogError(f"pose0: must be finite, got {pose.tolist()}")
-    if np.abs(pose[:2]).max() > MAX_COORDINATE:
-        raise LogError(f"pose0: a position beyond {MAX_COORDINATE:g} m, got {pose[:2].tolist()}")
+    check_start_pose(pose)
     if noise is not None and not isinstance(noise, CrowleyNoise | JointNoise):
         raise NoiseError(f"noise: expected a CrowleyNoise or JointNoise instance, got {noise!r}")
     if initial_covariance is not None:
