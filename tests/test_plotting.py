@@ -202,3 +202,22 @@ def test_many_configurations_are_thinned_and_an_empty_heading_batch_is_named():
     assert len(_wheel_patches(ax)) == 4 * MAX_CONFIGURATIONS
     with pytest.raises(ShapeError, match=r"^heading: no configuration to draw"):
         draw_robot(robot, heading=np.zeros((0, 4)))
+
+
+def test_an_animation_body_does_not_cross_itself():
+    """track --animate filled the wheels' mount points in description order: front_left, rear_right, front_right,
+    rear_left drew a bow-tie. The footprint (shared with follow-line's animation) orders them around the body."""
+    shapely = pytest.importorskip("shapely.geometry")
+    from wmrkit.plotting.robot import footprint
+
+    corners = {"front_left": (0.5, 0.3), "rear_right": (-0.5, -0.3), "front_right": (0.5, -0.3),
+               "rear_left": (-0.5, 0.3)}
+    robot = Robot.from_dict({"name": "x", "wheels": [
+        {"name": n, "type": "swedish", "position": list(p), "heading": 0, "r": 0.05, "r_r": 0.01, "gamma": "45 deg"}
+        for n, p in corners.items()]})
+    described = shapely.Polygon([w.position for w in robot.wheels])
+    assert not described.is_valid  # the bow-tie
+    body = shapely.Polygon(footprint(robot))
+    assert body.is_valid and body.area == pytest.approx(0.6, abs=1e-12)
+    with_origin = footprint(robot, origin=True)
+    assert len(with_origin) == 5 and shapely.Polygon(with_origin).is_valid

@@ -70,6 +70,7 @@ def plot_run(run: TrackingRun, path: str | os.PathLike[str]) -> None:
 def animate_run(run: TrackingRun, path: str | os.PathLike[str], *, frames: int = 80) -> None:
     """A GIF of the robot (outline and wheels at their headings) following the reference (`path` ends in .gif)."""
     from ..plotting.files import save_gif
+    from ..plotting.robot import footprint
 
     if os.path.splitext(os.fspath(path))[1].lower() != ".gif":  # x.png was written as one still frame
         raise WmrkitError(f"{os.fspath(path)}: the animation is written as a GIF (.gif)")
@@ -81,6 +82,7 @@ def animate_run(run: TrackingRun, path: str | os.PathLike[str], *, frames: int =
     centre = pts.min(axis=0) + np.ptp(pts, axis=0) / 2
     robot = run.robot
     mounts = np.array([w.position for w in robot.wheels] + [(0.0, 0.0)])
+    body = footprint(robot)
     steer = robot.steer_names
     fixed_heading = {w.name: w.heading for w in robot.wheels}
 
@@ -92,7 +94,7 @@ def animate_run(run: TrackingRun, path: str | os.PathLike[str], *, frames: int =
         x, y, th = run.pose[i]
         c, s = math.cos(th), math.sin(th)
         world = np.column_stack([x + c * mounts[:, 0] - s * mounts[:, 1], y + s * mounts[:, 0] + c * mounts[:, 1]])
-        ax.fill(world[:-1, 0], world[:-1, 1], color="#c9d6e3", alpha=0.6)
+        ax.fill(x + c * body[:, 0] - s * body[:, 1], y + s * body[:, 0] + c * body[:, 1], color="#c9d6e3", alpha=0.6)
         for j, w in enumerate(robot.wheels):
             h = th + (run.heading[i, steer.index(w.name)] if w.name in steer else fixed_heading[w.name])
             d = max(w.r, 0.05) * np.array([math.cos(h), math.sin(h)])

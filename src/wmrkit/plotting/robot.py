@@ -96,6 +96,15 @@ def _size(robot: Robot, elements: list[list[ElementGeometry]]) -> float:
     return max(extent, 4 * r_max)
 
 
+def footprint(robot: Robot, *, origin: bool = False) -> np.ndarray:
+    """Outline of the robot's body in its frame [m] for an animation: the wheels' mount points (and the origin,
+    the tracked point, with `origin`) in order of angle about their centroid, so that its polygon does not cross
+    itself (in description order a four-wheel robot drew a bow-tie). ``(k, 2)``."""
+    pts = np.array([w.position for w in robot.wheels] + ([(0.0, 0.0)] if origin else []))
+    centre = pts.mean(axis=0)
+    return pts[np.argsort(np.arctan2(pts[:, 1] - centre[1], pts[:, 0] - centre[0]))]
+
+
 def _rounded_hull(points: np.ndarray, pad: float) -> np.ndarray:
     """Convex hull of discs of radius `pad` around `points`, as a closed polygon ``(n, 2)``."""
     t = np.linspace(0, 2 * np.pi, 48, endpoint=False)

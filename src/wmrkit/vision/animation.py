@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 
 from ..errors import WmrkitError
 from ..plotting.files import check_figure_path, save_gif, spread_indices
+from ..plotting.robot import footprint
 from ..robot import Robot
 from .camera import Camera, CameraError, distort
 from .follow import LineFollowing
@@ -55,15 +56,6 @@ def save_detection_figure(camera: Camera, image: np.ndarray, path: str | os.Path
     fig.savefig(path)
 
 
-def _footprint(robot: Robot) -> np.ndarray:
-    """Outline of the robot in its frame [m]: the wheels' mount points and the tracked point P."""
-    pts = [(w.l * math.cos(w.alpha), w.l * math.sin(w.alpha)) for w in robot.wheels] + [(0.0, 0.0)]
-    pts = np.array(pts)
-    centre = pts.mean(axis=0)
-    angle = np.arctan2(pts[:, 1] - centre[1], pts[:, 0] - centre[0])
-    return pts[np.argsort(angle)]
-
-
 #: Most frames of a GIF: a longer run shows every k-th image (a frame costs about 0.25 s and 1.5 MB until the GIF
 #: is written: 400 frames took 106 s and 640 MB, and follow-line allows 10^4 periods).
 MAX_FRAMES = 200
@@ -89,7 +81,7 @@ def save_animation(run: LineFollowing, robot: Robot, camera: Camera, path: str |
     fig = Figure(figsize=(9, 3.6), dpi=80)
     cam_ax, plan_ax = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
     pose = run.pose
-    outline = _footprint(robot)
+    outline = footprint(robot, origin=True)  # the mount points and the tracked point P
     plan_ax.axhline(0.0, color="#222222", linewidth=2, label="line")
     xlim, ylim = _plan_limits(pose)
     plan_ax.set_xlim(*xlim)
