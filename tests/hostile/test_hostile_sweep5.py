@@ -290,7 +290,7 @@ def test_odometry_encoder_options_apply_to_counts_only(tmp_path, capsys):
 def test_odometry_start_pose_and_covariance_overflow(tmp_path, capsys):
     log = _skid_log(tmp_path, 200)
     # --pose 1e308 0 0 printed a 309-digit x
-    assert "pose0: a position beyond 1e+09 m" in _refused(["odometry", "skid-steer-4", log, "--quiet", "--pose",
+    assert "--pose: a position beyond 1e+09 m" in _refused(["odometry", "skid-steer-4", log, "--quiet", "--pose",
                                                            "1e308", "0", "0"], capsys)
     # numpy's RuntimeWarning (two lines) came before the located error
     assert "the covariance overflows here" in _refused(["odometry", "skid-steer-4", log, "--quiet", "--covariance",
