@@ -6,13 +6,13 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq
 from thesis_vehicles import DEG, omni_castor, omni_swedish, robot
 
 from strategies import robots
-from wmrkit import UnknownNameError, catalog
+from wmrkit import Robot, UnknownNameError, Wheel, catalog
 from wmrkit.analysis.icr import steer_to_icr
 from wmrkit.analysis.lines import constraint_lines, line_through
 from wmrkit.analysis.singularity import (
@@ -288,8 +288,24 @@ def coupled_cases(draw):
     return r, assigned, beta
 
 
+def _coincident_castors_geared():
+    """Found by a random draw: four wheels at the origin, two identical double castors geared to a double wheel's
+    steering. Where the castors are both at beta = 0 their rows cancel in the gear's line, whose round-off was
+    normalised into a spurious unit line: the line test said 'not singular' while the body can rotate in place."""
+    from wmrkit.couplings import Coupling
+
+    def wheel(name, kind, **k):
+        return Wheel(name, kind, l=0.0, alpha=0.0, beta=0.0, r=0.5, **k)
+
+    robot = Robot("r", (wheel("w0", "double_castor", d=0.5, b=0.5), wheel("w1", "fixed"),
+                        wheel("w2", "double", b=0.5), wheel("w3", "double_castor", d=0.5, b=0.5)),
+                  couplings=(Coupling("gear", ("w3.spin1", "w0.spin1", "w2.steer"), (0.5, 0.5, 0.5)),))
+    return robot, (), np.array([0.0, -0.81011685, 0.0])
+
+
 @settings(max_examples=200)
 @given(coupled_cases())
+@example(_coincident_castors_geared())
 def test_coupled_line_test_equals_coupled_rank_test_on_random_robots(case):
     """The lines eliminated through the couplings (several wheels together) against the rank test written in the
     coupled variables (coupled_columns' free directions), which shares no code with the elimination."""

@@ -104,7 +104,11 @@ class ConstraintLines:
     def lines(self, beta: ArrayLike | None = None) -> np.ndarray:
         """The lines at steering configuration `beta`: ``(..., n_steer) -> (..., n_lines, 3)`` (6.18), normalised."""
         rows = element_rows(self.robot, beta)
-        lam = np.einsum("lk,...kc->...lc", self.coefficients, rows) + self.constant
+        lam = np.einsum("lk,...kc->...lc", self.coefficients, rows)
+        # A line through a coupling vanishes where its wheels' rows cancel (two identical castors at one angle): its
+        # round-off, normalised, was a spurious unit line. Zero it when it is round-off of the terms that formed it.
+        terms = np.einsum("lk,...kc->...lc", np.abs(self.coefficients), np.abs(rows)).max(axis=-1, keepdims=True)
+        lam = np.where(np.abs(lam).max(axis=-1, keepdims=True) <= 1e-12 * terms, 0.0, lam) + self.constant
         return normalize_lines(lam)
 
     @property
