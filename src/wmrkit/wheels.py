@@ -144,7 +144,7 @@ class Wheel:
                 raise WheelError(f"wheel '{self.name}': {key}: {problem}")
         if self.steer_range is not None:
             _check_steer_range(self, kind)
-        values = {key: getattr(self, key) for key in ("l", "alpha", *kind.required, *kind.optional)}
+        values = self.geometry()
         if any(hasattr(v, "free_symbols") for v in values.values()):
             return  # symbolic parameters (SymPy, wmrkit.kinematics.symbolic): no numbers to check
         for key, value in values.items():
@@ -161,6 +161,12 @@ class Wheel:
     def kind(self) -> WheelKind:
         """The :class:`WheelKind` of this wheel's type."""
         return KINDS[self.type]
+
+    def geometry(self) -> dict[str, float]:
+        """The geometric fields of this wheel's type by name (``l``, ``alpha`` and the type's own), as
+        :func:`geometry_problem` takes them."""
+        kind = self.kind
+        return {key: getattr(self, key) for key in ("l", "alpha", *kind.required, *kind.optional)}
 
     @property
     def position(self) -> tuple[float, float]:

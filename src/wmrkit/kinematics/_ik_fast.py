@@ -71,7 +71,7 @@ def plan(robot: Robot) -> Plan:
     (a castor without offset, Swedish rollers along the axle: :func:`~wmrkit.wheels.geometry_problem`), whose
     steering or spin rate no twist determines (it gave inf and NaN rates, called feasible)."""
     for w in robot.wheels:
-        problem = geometry_problem(w.type, {k: getattr(w, k) for k in ("l", *w.kind.required, *w.kind.optional)})
+        problem = geometry_problem(w.type, w.geometry())
         if problem is not None:
             raise SingularError(f"robot '{robot.name}': wheel '{w.name}': {problem[0]}: {problem[1]}: no twist "
                                 "determines its rates, so it has no wheel commands (8.4)")

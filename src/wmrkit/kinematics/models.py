@@ -250,15 +250,16 @@ def _dimensional(robot: Robot, matrix: np.ndarray, assigned: np.ndarray) -> np.n
     return matrix * scale[assigned] / scale[solved][:, None]
 
 
-def _first_assignable(robot: Robot, a: np.ndarray, candidates: Sequence[str], m: int) -> tuple[tuple[str, ...] |
-                                                                                          None, str]:
+def _first_assignable(robot: Robot, a: np.ndarray, candidates: Sequence[str],
+                      m: int) -> tuple[tuple[str, ...] | None, str]:
     """The first assignable set of `m` of `candidates` (None if none was found) and, when the bounded search
     stopped before its end, its note (else ``""``)."""
     names = robot.velocity_names
     columns = [names.index(n) for n in candidates]
-    found, complete, note = search_sets(columns, m, lambda s: ranks_assignable(a, s).reshape(len(s), -1).all(axis=1),
-                              prefilter=null_space_prefilter(a, m), limit=1, max_exact=exact_budget(a.shape, 2),
-                              walk_cost=null_space_cost(a.shape, m))
+    found, complete, note = search_sets(
+        columns, m, lambda s: ranks_assignable(a, s).reshape(len(s), -1).all(axis=1),
+        prefilter=null_space_prefilter(a, m), limit=1, max_exact=exact_budget(a.shape, 2),
+        walk_cost=null_space_cost(a.shape, m))
     return (tuple(names[i] for i in found[0]) if found else None), "" if complete else note
 
 

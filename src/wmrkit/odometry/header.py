@@ -158,7 +158,7 @@ def bare_heading_problem(column: str, heading: Sequence[float]) -> tuple[int, st
     from ..units import BARE_ANGLE_LIMIT
 
     beyond = np.flatnonzero(np.abs(np.asarray(heading, dtype=float)) > BARE_ANGLE_LIMIT)
-    if _NAME.match(column) is not None or not beyond.size:
+    if _plain(column) != column or not beyond.size:  # the header writes the column's unit
         return None
     i = int(beyond[0])
     return i, (f"column '{column}': {float(heading[i]):g} is beyond one turn as radians, probably degrees: a heading "
