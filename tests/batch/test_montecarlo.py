@@ -121,3 +121,70 @@ def test_the_plot_draws_a_bounded_number_of_runs(tmp_path, monkeypatch):
     plot_monte_carlo(MonteCarloResult("r", len(poses), 100, poses, np.zeros(3), cov, cov, 1e-4, 0.0, 0.0),
                      str(tmp_path / "mc.png"))
     assert drawn == [len(poses[::5])] and drawn[0] <= MAX_POINTS_DRAWN
+
+
+@pytest.mark.parametrize("name", ["diff-drive", "swerve-4", "thesis-omni-castor", "agv-drive-unit"])
+def test_final_poses_are_the_odometry_of_each_run(name):
+    """The Monte Carlo runs are integrated by final_poses, one compiled pass per run: each final pose is that of
+    odometry() over the run's log, bit for bit, for every scheme, on fixed, steered (the steering exact) and castor
+    and double-wheel robots (the configuration perturbed: new maps every run)."""
+    from wmrkit import catalog
+    from wmrkit.odometry.integrators import METHODS
+    from wmrkit.odometry.logs import JointLog
+    from wmrkit.odometry.model import odometry_model
+    from wmrkit.odometry.pipeline import final_poses, odometry
+
+    robot = catalog.load(name)
+    model = odometry_model(robot)
+    log = path_log(robot, "square", 5.0).select(model.joints)
+    rng = np.random.default_rng(7)
+    runs = log.positions + np.cumsum(rng.normal(scale=1e-3, size=(3, *log.positions.shape)), axis=1)
+    for method in METHODS:
+        expected = [odometry(model, JointLog(log.time, log.joints, q), method=method).poses[-1] for q in runs]
+        np.testing.assert_array_equal(final_poses(model, log, runs, method=method), expected)
+
+
+def test_final_poses_refuse_a_bad_run_by_its_row():
+    from wmrkit import catalog
+    from wmrkit.odometry.logs import LogError
+    from wmrkit.odometry.model import odometry_model
+    from wmrkit.odometry.pipeline import final_poses
+
+    for name in ("diff-drive", "swerve-4"):
+        robot = catalog.load(name)
+        model = odometry_model(robot)
+        log = path_log(robot, "arc", 5.0).select(model.joints)
+        runs = np.stack([log.positions] * 2)
+        runs[1, 7, 0] = np.nan
+        with pytest.raises(LogError, match=rf"\(run 1\): sample 7: {model.joints[0]}: value nan is not a finite"):
+            final_poses(model, log, runs)
+        with pytest.raises(LogError, match=r"positions: expected \(runs, 51, "):
+            final_poses(model, log, runs[:, :-1])
+
+
+def test_a_study_is_bounded_by_its_work_per_worker():
+    """1e6 runs of the diff-drive's square without workers (the documented bound on runs) did not answer within
+    the option fuzzer's 200 s on a loaded machine (about 260 us a run): the bound counts each run's fixed cost and
+    a castor robot's new configurations (14 ms a run of the square: 10^6 runs of it would have taken 4 hours), and
+    grows with the workers."""
+    from types import SimpleNamespace
+
+    from wmrkit import catalog
+    from wmrkit.batch.montecarlo import MAX_RUNS, MAX_WORK, RUN_COST, study_cost
+    from wmrkit.odometry.model import odometry_model
+
+    diff = catalog.load("diff-drive")
+    square = path_log(diff, "square")
+    one = len(square) * 5 + RUN_COST
+    with pytest.raises(BatchError, match=rf"runs: at most {int(MAX_WORK // one)} runs of this log \(573 samples of 2 "
+                                         r"joints\) on 1 worker, got 1000000: .*more workers \(--workers"):
+        monte_carlo(diff, square, MAX_RUNS)
+    castor = catalog.load("thesis-omni-castor")
+    log = path_log(castor, "square")
+    cost = study_cost(odometry_model(castor), log, 1)
+    assert cost > 100 * one  # its new configurations each run
+    for workers in (1, 2):
+        with pytest.raises(BatchError, match=rf"at most {int(workers * MAX_WORK // cost)} runs .* on {workers} worker"):
+            monte_carlo(castor, log, 10**4, runner=None if workers == 1 else SimpleNamespace(workers=workers))
+    swerve = catalog.load("swerve-4")
+    assert study_cost(odometry_model(swerve), path_log(swerve, "square"), 1) < 3 * one

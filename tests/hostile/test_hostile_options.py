@@ -33,8 +33,8 @@ from wmrkit.odometry.synthetic import simulate, square_path
 HERE = Path(__file__).parent
 SECONDS = float(os.environ.get("WMRKIT_FUZZ_SECONDS", "45"))
 SEED = int(os.environ.get("WMRKIT_FUZZ_SEED", "20261125"))
-#: Seconds after which a case counts as a hang: the slowest case within the documented limits here, 1e6 Monte
-#: Carlo runs without Dask (``batch montecarlo -n 1000000 --workers 0``), takes about 100 s.
+#: Seconds after which a case counts as a hang: the slowest cases within the documented limits here, a Monte Carlo
+#: study of the most work one worker takes (``batch.montecarlo.MAX_WORK``), take about 45-60 s on one core.
 HANG = 200.0
 VALUES = ["nan", "inf", "-inf", "1e308", "-1e308", "0", "-0", "-1", "1e-308", "5e-324", "1e20", "-1e20",
           "99999999999999999999999", "", " ", "abc", "1e400", "1e308deg", "nan deg", "0.5", "2", "1000000", "1e9",

@@ -308,7 +308,7 @@ def test_a_synthetic_run_holds_at_most_a_gib_of_fine_arrays():
 def test_a_monte_carlo_study_is_bounded_in_memory_and_work():
     """A LOG of 3e6 samples took 850 MB for two runs, and 10^6 runs of it would have run for days."""
     from wmrkit.batch.engine import BatchError
-    from wmrkit.batch.montecarlo import MAX_LOG_VALUES, MAX_RUNS, MAX_WORK, monte_carlo
+    from wmrkit.batch.montecarlo import MAX_LOG_VALUES, MAX_RUNS, MAX_WORK, RUN_COST, monte_carlo
     from wmrkit.odometry.logs import JointLog
 
     robot = catalog.load("diff-drive")
@@ -320,7 +320,10 @@ def test_a_monte_carlo_study_is_bounded_in_memory_and_work():
     n = MAX_LOG_VALUES // 5 + 1
     with pytest.raises(BatchError, match=rf"log: {n} samples of 2 joints: a Monte Carlo log holds at most"):
         monte_carlo(robot, log(n), 2)
-    n = int(MAX_WORK // (5 * MAX_RUNS)) + 1
-    with pytest.raises(BatchError, match=rf"runs: {MAX_RUNS} runs of {n} samples .* at most 999500 runs of this log"):
+    n = int((MAX_WORK / MAX_RUNS - RUN_COST) // 5) + 1  # the shortest log of which MAX_RUNS runs are too many
+    most = int(MAX_WORK // (5 * n + RUN_COST))
+    assert most < MAX_RUNS
+    with pytest.raises(BatchError, match=rf"runs: at most {most} runs of this log \({n} samples of 2 joints\) on 1 "
+                                         rf"worker, got {MAX_RUNS}: .* more workers \(--workers, --scheduler\)"):
         monte_carlo(robot, log(n), MAX_RUNS)
     assert monte_carlo(robot, log(n), 3).runs == 3

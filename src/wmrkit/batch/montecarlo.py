@@ -1,8 +1,9 @@
 """Monte Carlo odometry: sensor errors sampled N times over one log, against the analytic covariance of paper 003.
 
 The log (a file, or a built-in path driven by :func:`wmrkit.odometry.synthetic.simulate`) is taken as the truth.
-Each Monte Carlo run perturbs its joint increments as a sensor would and integrates them with
-:func:`wmrkit.odometry.pipeline.odometry`:
+Each Monte Carlo run perturbs its joint increments as a sensor would and integrates them as
+:func:`wmrkit.odometry.pipeline.odometry` does (:func:`~wmrkit.odometry.pipeline.final_poses`, one compiled pass a
+run):
 
 - random-walk noise on every sensed joint rate's increment (wheel spins, rollers), variance ``per_rad |dq|`` (the
   model of :class:`~wmrkit.odometry.covariance.JointNoise`);
@@ -33,6 +34,7 @@ import numpy as np
 from .._shapes import readonly
 from ..limits import check_seed
 from ..odometry.logs import JointLog
+from ..odometry.model import OdometryModel, odometry_model
 from ..robot import Robot
 from .engine import BatchError, Engine, engine
 
@@ -102,29 +104,38 @@ class _Block:
     method: str
 
 
+#: Numbers of perturbed joint positions generated at once, runs x samples x joints (2 MiB: they stay in cache).
+BATCH_VALUES = 1 << 18
+
+
 def run_block(block: _Block) -> np.ndarray:
-    """Final poses ``(runs, 3)`` of one block of perturbed runs (module docstring)."""
-    from ..odometry.model import odometry_model
-    from ..odometry.pipeline import odometry
+    """Final poses ``(runs, 3)`` of one block of perturbed runs (module docstring), generated about
+    :data:`BATCH_VALUES` numbers at a time and integrated by :func:`~wmrkit.odometry.pipeline.final_poses`."""
+    from ..odometry.pipeline import final_poses
 
     model = odometry_model(block.robot)
     log = block.log.select(model.joints)
     rng = np.random.default_rng(block.seed)
     spin = np.array([j.endswith(".spin") for j in log.joints])
-    rate = np.isin(log.joints, model.rate_joints)  # the steering angles are the configuration: not perturbed
-    dq = np.diff(log.positions, axis=0)
-    out = np.empty((block.runs, 3))
-    for k in range(block.runs):
-        inc = dq * np.where(spin, 1.0 + block.slip_std * rng.standard_normal(len(spin)), 1.0)
+    rate = np.flatnonzero(np.isin(log.joints, model.rate_joints))  # steering angles are the configuration: exact
+    travel = log.positions - log.positions[0]
+    walk = np.sqrt(block.per_rad * np.abs(np.diff(log.positions[:, rate], axis=0)))
+    per = max(1, BATCH_VALUES // log.positions.size)
+    poses = []
+    for start in range(0, block.runs, per):
+        runs = min(per, block.runs - start)
+        if block.slip_std > 0:  # each spin turns 1 + s times its rolling angle over the run
+            q = travel * np.where(spin, 1.0 + block.slip_std * rng.standard_normal((runs, 1, len(spin))), 1.0)
+        else:
+            q = np.repeat(travel[None], runs, axis=0)
         if block.per_rad > 0:
-            inc = inc + rate * rng.standard_normal(dq.shape) * np.sqrt(block.per_rad * np.abs(dq))
-        q = log.positions[0] + np.vstack([np.zeros((1, dq.shape[1])), np.cumsum(inc, axis=0)])
+            q[:, 1:, rate] += np.cumsum(rng.standard_normal((runs, *walk.shape)) * walk, axis=1)
+        q += log.positions[0]
         if block.resolution > 0:
-            grid = np.floor(q / block.resolution + rng.random(q.shape[1])) * block.resolution
-            q = np.where(rate, grid, q)
-        run = JointLog(log.time, log.joints, q, None, log.source)
-        out[k] = odometry(model, run, method=block.method).poses[-1]
-    return out
+            grid = np.floor(q[..., rate] / block.resolution + rng.random((runs, 1, len(rate)))) * block.resolution
+            q[..., rate] = grid
+        poses.append(final_poses(model, log, q, method=block.method))
+    return np.concatenate(poses)
 
 
 def path_log(robot: Robot, name: str, rate: float = 20.0) -> JointLog:
@@ -136,18 +147,32 @@ def path_log(robot: Robot, name: str, rate: float = 20.0) -> JointLog:
     return simulate(robot, PATHS[name](), rate).log
 
 
-#: Most runs of one Monte Carlo study (each integrates the whole log once).
+#: Most runs of one Monte Carlo study.
 MAX_RUNS = 10**6
 #: Most numbers in the log, samples x (joints + 3): each run holds a few arrays of its size (a log of 3e6 samples of
 #: two joints took 850 MB for two runs).
 MAX_LOG_VALUES = 1 << 23
-#: Most numbers integrated by a study, runs x samples x (joints + 3), about 3e7 a second on one core: 5 min (10^6
-#: runs of a log of 1.7e6 samples would have run for days).
-MAX_WORK = 1e10
+#: Most work of a study per worker, in numbers integrated: runs x (samples x (joints + 3) + :data:`RUN_COST` +
+#: samples x :data:`CONFIGURATION_COST` where a perturbed joint is also the configuration). Integration runs at
+#: 15-35 ns a number on one core (diff-drive to swerve-4, squares), so at most about 30-70 s a worker.
+MAX_WORK = 2e9
+#: A run's fixed cost in numbers integrated (about 20 us: the random draws' set-up, the checks, the kernel's call).
+RUN_COST = 1000
+#: A sample's extra cost in numbers integrated when its configuration is perturbed (a castor's angle, a double
+#: wheel's steering: both a sensed rate and the configuration): every run meets new configurations, whose maps are
+#: computed (about 4-25 us a sample, thesis-omni-castor the slowest).
+CONFIGURATION_COST = 2000
+
+
+def study_cost(model: OdometryModel, log: JointLog, runs: int) -> float:
+    """The work of `runs` runs of `log` (:data:`MAX_WORK`'s units)."""
+    moving = set(model.steer_joints) & set(model.rate_joints)
+    per_sample = len(log.joints) + 3 + (CONFIGURATION_COST if moving else 0)
+    return runs * (len(log) * per_sample + RUN_COST)
 
 
 def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4, resolution: float = 0.0,
-                slip_std: float = 0.0, method: str = "exact", seed: int = 0, block: int = 64,
+                slip_std: float = 0.0, method: str = "exact", seed: int = 0, block: int = 256,
                 runner: Engine | None = None, progress: bool = False) -> MonteCarloResult:
     """`runs` perturbed copies of `log` integrated on `runner` (module docstring), blocks of `block` runs."""
     from ..odometry.covariance import JointNoise
@@ -166,11 +191,14 @@ def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4
     if values > MAX_LOG_VALUES:
         raise BatchError(f"log: {len(log)} samples of {len(log.joints)} joints: a Monte Carlo log holds at most "
                          f"{MAX_LOG_VALUES} numbers, samples x (joints + 3) (docs/limits.md); decimate or cut it")
-    if runs * values > MAX_WORK:
-        raise BatchError(f"runs: {runs} runs of {len(log)} samples of {len(log.joints)} joints: a study integrates at "
-                         f"most {MAX_WORK:g} numbers, runs x samples x (joints + 3), about 5 min on one core: at most "
-                         f"{int(MAX_WORK // values)} runs of this log")
-    nominal = odometry(robot, log, method=method, noise=JointNoise(per_rad, resolution**2 / 6))
+    model = odometry_model(robot)
+    workers = 1 if runner is None else runner.workers
+    if study_cost(model, log, runs) > MAX_WORK * workers:
+        most = int(MAX_WORK * workers // study_cost(model, log, 1))
+        raise BatchError(f"runs: at most {most} runs of this log ({len(log)} samples of {len(log.joints)} joints) "
+                         f"on {workers} worker{'s' * (workers > 1)}, got {runs}: a study does about a minute of work "
+                         f"per worker (docs/limits.md); more workers (--workers, --scheduler) take more runs")
+    nominal = odometry(model, log, method=method, noise=JointNoise(per_rad, resolution**2 / 6))
     sizes = [min(block, runs - s) for s in range(0, runs, block)]
     seeds = np.random.SeedSequence(seed).spawn(len(sizes))
     blocks = [_Block(robot, log, n, s, per_rad, resolution, slip_std, method)
