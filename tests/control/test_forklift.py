@@ -65,6 +65,15 @@ def test_ik_digest_oracles():
     assert (float(four.phi1), float(four.phi2)) == pytest.approx((2.2753, 2.0413), abs=1e-4)
 
 
+def test_ik_of_large_velocities_does_not_overflow(recwarn):
+    """|phi3| was sqrt((k R v_x)^2 + R v_y^2) / r: squares of 1e200 overflowed to inf (a RuntimeWarning, seen in
+    the README's pytest) where the magnitude is finite."""
+    ik = forklift_ik([3e200, 4e200], 0.0)
+    k = (2.35 - 1.0) / 1.0
+    assert float(ik.phi3) == pytest.approx(-math.hypot(k * 3e200, 4e200) / 0.23, rel=1e-15)
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
 @settings(max_examples=40, deadline=None)
 @given(vx=st.floats(-2, 2), vy=st.floats(-2, 2), theta=st.floats(-math.pi, math.pi))
 def test_ik_equals_the_generic_per_wheel_ik_on_the_catalog_truck(vx, vy, theta):

@@ -50,7 +50,7 @@ def forklift_ik(velocity_world: ArrayLike, theta: ArrayLike, *, l12: float = 0.4
     phi1 = -(rvy - (l12 / e) * rvx) / r
     phi2 = -(rvy + (l12 / e) * rvx) / r
     k = (l3 - e) / e
-    mag = np.sqrt((k * rvx) ** 2 + rvy**2) / r
+    mag = np.hypot(k * rvx, rvy) / r  # no overflow of the squares for large velocities
     if quadrants == 4:
         beta3, phi3 = np.arctan2(k * rvx, rvy), -mag  # (8.49) in four quadrants, (8.50)
     elif quadrants == 2:
