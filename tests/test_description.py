@@ -689,6 +689,35 @@ def test_to_file_refuses_a_robot_its_file_would_not_load_as(change, tmp_path):
         assert not (tmp_path / name).exists()
 
 
+def test_to_file_that_fails_midway_leaves_the_old_file_whole(tmp_path, monkeypatch):
+    """The description was written in place: a write that failed half-way (a full disk) left half a file where the
+    robot was, which the studio's Save over an existing file would also do. Now it is written beside it and moved
+    onto it in one step; the failed write leaves the old file as it was (permissions too) and no scratch file."""
+    import os
+
+    old = tmp_path / "r.yaml"
+    catalog.load("diff-drive").to_file(old)
+    os.chmod(old, 0o600)
+    before = old.read_text()
+    write_text = Path.write_text
+
+    def full_disk(self, text, **kw):
+        write_text(self, text[: len(text) // 2], **kw)
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(Path, "write_text", full_disk)
+    with pytest.raises(OSError, match="No space left"):
+        catalog.load("omni-3").to_file(old)
+    monkeypatch.undo()
+    assert old.read_text() == before and sorted(os.listdir(tmp_path)) == ["r.yaml"]
+    catalog.load("omni-3").to_file(old)
+    assert Robot.from_file(old).name == "omni-3" and old.stat().st_mode & 0o777 == 0o600
+    link = tmp_path / "link.yaml"
+    link.symlink_to(old)
+    catalog.load("swerve-4").to_file(link)  # through a link: the file it points to is replaced, the link kept
+    assert link.is_symlink() and Robot.from_file(old).name == "swerve-4"
+
+
 def test_conventions_md_says_how_a_file_is_written(tmp_path):
     """docs/conventions.md's examples of what `Robot.to_file` writes are what it writes: the page said a β of 7.57
     rad from `heading: 6` was written `"7.57... rad"`, while that wheel is written `heading: 6.0`."""

@@ -18,6 +18,7 @@ from typing import Any
 
 import yaml
 
+from ._atomic import atomic_path
 from .couplings import COUPLING_KINDS, Coupling
 from .documents import DescriptionError, FieldReader, LineOf, Loc, hint, read_document, read_file, short_repr
 from .dynamics import mass
@@ -444,7 +445,7 @@ def save_robot_file(robot: Robot, path: str | os.PathLike[str]) -> None:
     except DescriptionError as err:
         raise DescriptionError(err.message, source=f"robot '{robot.name}' is not written to {path}: it would not "
                                "load back", loc=err.loc, wheel=err.wheel) from None
-    if path.suffix.lower() == ".json":
-        path.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
-    else:
-        path.write_text(yaml.safe_dump(data, sort_keys=False, allow_unicode=True), encoding="utf-8")
+    text = (json.dumps(data, indent=2) + "\n" if path.suffix.lower() == ".json"
+            else yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
+    with atomic_path(path) as scratch:  # a failed write leaves the old description whole
+        scratch.write_text(text, encoding="utf-8")

@@ -15,6 +15,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from .._atomic import atomic_path
 from .engine import BatchError, need_extra
 
 #: Columns ``(name, type)``: pyarrow type names, with an optional unit after a space (``"float64 m"``), written
@@ -41,10 +42,9 @@ def write_rows(path: str | os.PathLike[str], rows: Sequence[Mapping[str, Any]], 
     path = Path(path)
     if path.parent and not path.parent.exists():
         raise BatchError(f"{path}: the folder {path.parent} does not exist")
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
-        pq.write_table(table, tmp)
-        os.replace(tmp, path)
+        with atomic_path(path) as tmp:
+            pq.write_table(table, tmp)
     except OSError as err:  # pyarrow's errors carry no file name: the command would end in a traceback
         raise BatchError(f"{path}: cannot write the table ({' '.join(str(err.strerror or err).split())})") from None
 
