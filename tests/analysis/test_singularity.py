@@ -329,3 +329,14 @@ def test_a_line_through_a_coupling_may_vanish():
     b = np.array([-0.81, -0.81])
     assert is_singular(r, b, (), coupled=True) and is_singular_rank(r, b, (), coupled=True)
     assert singularity_distance(r, b, (), coupled=True) == 0.0
+
+
+@pytest.mark.parametrize("copies", [1, 100])  # one configuration (SVD) and a map (the Gram route beyond 64)
+def test_singularity_distance_drops_a_coupled_line_that_is_round_off(copies):
+    """The map kernel forms the lines through a coupling itself: at the @example's configuration the gear's line is
+    round-off (4e-16) of its wheels' rows, which it normalised into a spurious unit line (distance 0.39 where the
+    line test and the rank test (6.12) say singular). It is zero there, as ConstraintLines.lines makes it."""
+    robot, assigned, beta = _coincident_castors_geared()
+    assert is_singular(robot, beta, assigned, coupled=True) and is_singular_rank(robot, beta, assigned, coupled=True)
+    dist = singularity_distance(robot, np.tile(beta, (copies, 1)), assigned, coupled=True)
+    assert np.all(dist < 1e-8)

@@ -42,12 +42,28 @@ def element_rows_cm(p, beta: np.ndarray) -> np.ndarray:
     return out.reshape(2 * n_el, 3, n)
 
 
-def combine(coefficients: np.ndarray, rows: np.ndarray, constant: np.ndarray | None = None) -> np.ndarray:
-    """``coefficients (L, 2E) @ rows (2E, 3, N) (+ constant (L, 3))`` -> ``(L, 3, N)``."""
-    out = (coefficients @ rows.reshape(rows.shape[0], -1)).reshape(coefficients.shape[0], 3, rows.shape[-1])
-    if constant is not None:
-        out += constant[:, :, None]
-    return out
+def combine(coefficients: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """``coefficients (L, 2E) @ rows (2E, 3, N)`` -> ``(L, 3, N)``."""
+    return (coefficients @ rows.reshape(rows.shape[0], -1)).reshape(coefficients.shape[0], 3, rows.shape[-1])
+
+
+def cancel_roundoff(lam: np.ndarray, terms: np.ndarray, axis: int) -> np.ndarray:
+    """Zero the lines `lam` (components on `axis`) that are round-off (1e-12) of the `terms` ``|coefficients| @
+    |rows|`` that formed them: a line through a coupling vanishes where its wheels' rows cancel (two identical castors
+    at one angle), and its round-off, normalised, was a spurious unit line (6.17)."""
+    small = np.abs(lam).max(axis=axis, keepdims=True) <= 1e-12 * terms.max(axis=axis, keepdims=True)
+    return np.where(small, 0.0, lam)
+
+
+def combine_lines(cl, rows: np.ndarray) -> np.ndarray:
+    """The constraint lines of `cl` (:class:`.lines.ConstraintLines`) at `rows` ``(2E, 3, N)`` -> ``(L, 3, N)``, not
+    normalised; a line that is round-off is zeroed (:func:`cancel_roundoff`) as ``cl.lines`` does. Only a line
+    through a coupling can be (a wheel's own line keeps the length of its direction as it steers), so the check
+    runs only for those."""
+    lam = combine(cl.coefficients, rows)
+    if cl.coupled:
+        lam = cancel_roundoff(lam, combine(np.abs(cl.coefficients), np.abs(rows)), axis=1)
+    return lam + cl.constant[:, :, None]
 
 
 def normalize_cm(lines: np.ndarray) -> np.ndarray:

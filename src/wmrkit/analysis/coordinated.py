@@ -69,7 +69,7 @@ def coordinated_singular_set(robot: Robot, assigned: tuple[str, ...], *, resolut
     def distance_at(beta: np.ndarray) -> np.ndarray:
         """singularity_distance's kernel without its per-call checks (the 2-D searches ask for one ICR at a time)."""
         rows = _fast.element_rows_cm(params, beta)
-        return _fast.distance_cm(_fast.combine(cl.coefficients, rows, cl.constant), length)
+        return _fast.distance_cm(_fast.combine_lines(cl, rows), length)
 
     distance = functools.partial(_at_icrs, robot, distance_at, float)
     singular = functools.partial(_at_icrs, robot, functools.partial(is_singular, robot, assigned=cl.assigned,

@@ -174,7 +174,7 @@ def _kappa(model: TwistModel, beta: np.ndarray, length: float) -> np.ndarray:
     p, cl = line_parameters(model.robot), constraint_lines(model.robot)
     for s in range(0, len(flat), _fast.CHUNK):
         rows = _element_rows_one(p, flat[0]) if len(flat) == 1 else _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
-        lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
+        lines = _fast.normalize_cm(_fast.combine_lines(cl, rows))
         out[s:s + _fast.CHUNK] = _fast.kappa_cm(model.mobility, _fast.combine(model.coefficients, rows), lines,
                                                 float(length))
     return out.reshape(beta.shape[:-1])
@@ -184,7 +184,7 @@ def kappa_function(model: TwistModel, beta: np.ndarray):
     """``length -> kappa (N,)`` at configurations `beta` ``(N, n_steer)`` (one chunk), rows computed once."""
     p, cl = line_parameters(model.robot), constraint_lines(model.robot)
     rows = _fast.element_rows_cm(p, beta)
-    lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
+    lines = _fast.normalize_cm(_fast.combine_lines(cl, rows))
     rates = _fast.combine(model.coefficients, rows)
     return lambda length: _fast.kappa_cm(model.mobility, rates, lines, float(length))
 
@@ -217,7 +217,7 @@ def _natural_length(model: TwistModel, beta: np.ndarray, size: float) -> tuple[f
     values of :func:`_kappa`); for m = 3 the search grid of lengths is one batched SVD."""
     p, cl = line_parameters(model.robot), constraint_lines(model.robot)
     rows = _element_rows_one(p, beta)
-    lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
+    lines = _fast.normalize_cm(_fast.combine_lines(cl, rows))
     rates = _fast.combine(model.coefficients, rows)
     if model.mobility == 2:
         a, b, ok = _fast.columns_m2(rates, lines)

@@ -27,6 +27,7 @@ from ..couplings import Coupling, coupled_columns
 from ..errors import ShapeError
 from ..kinematics.linalg import rref
 from ..robot import TWIST_NAMES, Robot, element_table
+from ._fast import cancel_roundoff
 
 #: Rows added for assigned vehicle velocities (rules 5-6 of §6.3): the X axis, the Y axis, the line at infinity.
 TWIST_LINES = {"vx": (1.0, 0.0, 0.0), "vy": (0.0, 1.0, 0.0), "omega": (0.0, 0.0, 1.0)}
@@ -105,11 +106,8 @@ class ConstraintLines:
         """The lines at steering configuration `beta`: ``(..., n_steer) -> (..., n_lines, 3)`` (6.18), normalised."""
         rows = element_rows(self.robot, beta)
         lam = np.einsum("lk,...kc->...lc", self.coefficients, rows)
-        # A line through a coupling vanishes where its wheels' rows cancel (two identical castors at one angle): its
-        # round-off, normalised, was a spurious unit line. Zero it when it is round-off of the terms that formed it.
-        terms = np.einsum("lk,...kc->...lc", np.abs(self.coefficients), np.abs(rows)).max(axis=-1, keepdims=True)
-        lam = np.where(np.abs(lam).max(axis=-1, keepdims=True) <= 1e-12 * terms, 0.0, lam) + self.constant
-        return normalize_lines(lam)
+        terms = np.einsum("lk,...kc->...lc", np.abs(self.coefficients), np.abs(rows))
+        return normalize_lines(cancel_roundoff(lam, terms, axis=-1) + self.constant)
 
     @property
     def steered(self) -> tuple[bool, ...]:

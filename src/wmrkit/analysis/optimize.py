@@ -148,7 +148,7 @@ def _grid_kappa(model, beta: np.ndarray, length: float | None) -> np.ndarray:
         out = np.empty(len(flat))
         for s in range(0, len(flat), _fast.CHUNK):
             rows = _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
-            lines = _fast.normalize_cm(_fast.combine(cl.coefficients, rows, cl.constant))
+            lines = _fast.normalize_cm(_fast.combine_lines(cl, rows))
             rates = _fast.combine(model.coefficients, rows)
             a, b, ok = _fast.columns_m2(rates, lines)
             na, nb = np.linalg.norm(a, axis=0), np.linalg.norm(b, axis=0)

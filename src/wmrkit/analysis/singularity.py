@@ -96,7 +96,7 @@ def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[s
     p, length = line_parameters(robot), float(robot_size(robot) if length is None else length)
     for s in range(0, len(flat), _fast.CHUNK):
         rows = _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
-        out[s:s + _fast.CHUNK] = _fast.distance_cm(_fast.combine(cl.coefficients, rows, cl.constant), length)
+        out[s:s + _fast.CHUNK] = _fast.distance_cm(_fast.combine_lines(cl, rows), length)
     return out.reshape(beta.shape[:-1])
 
 
