@@ -119,7 +119,8 @@ class SingularSet:
 
     ``always``: singular at every configuration; otherwise ``configurations`` ``(n, len(variables))`` [rad] lists
     singular configurations (the other steering angles at their described values): all of them when
-    ``exact`` (zero or one variable), points on the singular curves/surfaces sampled on a grid otherwise.
+    ``exact`` (zero or one variable), points on the singular curves/surfaces sampled on a grid otherwise, and the
+    described configuration when it is singular (a sample misses a set of high codimension).
     ``reasons`` explains an ``always``. ``coordinated``: only configurations with all steered axles through one
     ICR were searched (:func:`wmrkit.analysis.coordinated.coordinated_singular_set`); ``reasons`` then describes
     the singular ICRs. ``coupled``: the robot's rate couplings held (an assigned joint of a differential assigns
@@ -195,6 +196,10 @@ def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[st
         # the curve sampling (searched on a grid: not with a random sample)
         found.append(_isolated(cl, base, idx, per_axis))
     found_arr = np.concatenate(found)
+    described = base[idx]  # a sample misses a set of high codimension (castors at rest all pointing one way)
+    if (len(idx) >= 2 and not np.any(np.all(np.abs(found_arr - described) < 1e-9, axis=1))
+            and is_singular(robot, base, cl.assigned, coupled=cl.coupled)):
+        found_arr = np.concatenate([found_arr, described[None]])
     if len(found_arr):
         found_arr = found_arr[np.lexsort(found_arr.T[::-1])]
     return SingularSet(cl.assigned, variables, False, found_arr, len(idx) == 1, coupled=cl.coupled)
