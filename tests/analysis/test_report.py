@@ -203,3 +203,29 @@ def test_no_natural_length_where_isotropy_does_not_apply(name, capsys):
     assert main(["analyze", name, "--json", "--length", "300 mm"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["characteristic_length"] == pytest.approx(0.3) and out["natural_length"] is False
+
+
+@pytest.mark.parametrize("resolution", [0, 7, 1441, 10**6, -5, 2.5, "90"])
+def test_the_python_doors_bound_the_resolution_as_analyze_resolution_does(resolution, tmp_path):
+    """analyze(resolution=0) said the actuated model of thesis-steer-castor is 'always' singular (an empty search
+    reads as all-singular), 10**6 ran without end, -5 and 2.5 raised numpy's ValueError / TypeError; the CLI refused
+    them all. analyze and write_report now apply --resolution's rule, 8 to 1440 points a turn."""
+    from wmrkit.errors import WmrkitError
+
+    robot = catalog.load("thesis-steer-castor")
+    with pytest.raises(WmrkitError, match="resolution"):
+        analyze(robot, resolution=resolution)
+    with pytest.raises(WmrkitError, match="resolution"):
+        write_report(analyze(robot), tmp_path, resolution=resolution)
+    assert not (tmp_path / "index.html").exists()
+
+
+def test_singular_set_refuses_an_empty_search():
+    """singular_set(resolution=0, max_samples=0) searched nothing and called the model always singular."""
+    from wmrkit.analysis.singularity import singular_set
+    from wmrkit.errors import WmrkitError
+
+    robot = catalog.load("thesis-steer-castor")
+    for bad in ({"resolution": 0, "max_samples": 0}, {"max_samples": 0}, {"resolution": 2.5}, {"resolution": -1}):
+        with pytest.raises(WmrkitError):
+            singular_set(robot, ("o1.spin", "c2.spin"), **bad)

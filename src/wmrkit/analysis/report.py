@@ -18,7 +18,7 @@ from .coordinated import coordinated_singular_set
 from .figures import condition_figure, length_figure, motions_figure, robot_figure, singular_figure
 from .lines import constraint_lines
 from .singularity import singular_set
-from .summary import Analysis, actuation_words, assigned_names, describe_singular
+from .summary import Analysis, actuation_words, assigned_names, check_resolution, describe_singular
 
 _CSS = """
 body { font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; color: #222; line-height: 1.45 }
@@ -44,8 +44,10 @@ def write_report(analysis: Analysis, directory: str | os.PathLike[str], *, resol
                  dpi: float | None = None) -> Path:
     """Write ``index.html`` and its images into `directory` (created if needed); return the page's path.
 
-    `resolution`: grid points per turn of the maps and singular sets; `dpi`: image resolution (default ~100).
+    `resolution`: grid points per turn of the maps and singular sets (:func:`.summary.check_resolution`, as
+    ``--resolution``); `dpi`: image resolution (default ~100).
     """
+    check_resolution(resolution)
     out = Path(directory)
     try:
         out.mkdir(parents=True, exist_ok=True)

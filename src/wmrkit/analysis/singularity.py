@@ -16,6 +16,7 @@ the exact singular angles; with more, the last angle is solved exactly on a grid
 from __future__ import annotations
 
 import itertools
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -152,6 +153,9 @@ def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[st
     solved exactly. `coupled`: through the robot's rate couplings (the actuated model of a robot with a
     differential: :func:`wmrkit.analysis.lines.constraint_lines`).
     """
+    for key, value in (("resolution", resolution), ("max_samples", max_samples)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:  # none: 'always'
+            raise WmrkitError(f"singular_set: {key} must be a whole number >= 1, got {value!r}")
     cl = constraint_lines(robot, assigned, coupled=coupled)
     steer = robot.steer_names
     if variables is None:

@@ -8,6 +8,7 @@ model at the natural length (§5.4) and where the actuated and sensed models are
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any
 
@@ -166,12 +167,28 @@ def model_singular_set(robot: Robot, assigned: tuple[str, ...], cls: Classificat
     return singular_set(robot, assigned, resolution=resolution, max_samples=resolution * 8, coupled=coupled)
 
 
+#: Grid points per turn of a steering angle for analyze and its report (``--resolution``): the maps' cost grows with
+#: the square of the finest (1440: about 5 s for a swerve drive).
+MIN_RESOLUTION, MAX_RESOLUTION = 8, 1440
+
+
+def check_resolution(resolution: int, name: str = "resolution") -> None:
+    """Raise :class:`WmrkitError` unless `resolution` is a whole number of grid points per turn from
+    :data:`MIN_RESOLUTION` to :data:`MAX_RESOLUTION` (`name`: the option or keyword, for the message)."""
+    if (isinstance(resolution, bool) or not isinstance(resolution, numbers.Integral)
+            or not MIN_RESOLUTION <= resolution <= MAX_RESOLUTION):
+        raise WmrkitError(f"{name}: need {MIN_RESOLUTION} to {MAX_RESOLUTION} points per turn (a quarter degree), "
+                          f"got {resolution!r}")
+
+
 def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) -> Analysis:
     """Analyse `robot` at its described configuration (see the module docstring).
 
     `length` [m]: characteristic length of the condition number (default: the natural one). `resolution`:
-    grid points per turn for singular sets over two or more steering angles.
+    grid points per turn for singular sets over two or more steering angles (:func:`check_resolution`, as
+    ``--resolution``).
     """
+    check_resolution(resolution)
     cls = classify(robot)
     joints = default_joints(robot)
     if length is not None:  # as analyze --length: at 1e-9 m the twist read as undetermined

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..analysis.summary import analyze
+from ..analysis.summary import analyze, check_resolution
 from ..errors import WmrkitError
 from ..limits import check_length
 from ._common import (
@@ -32,16 +32,10 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
-#: Finest --resolution: the maps' cost grows with its square (1440: about 5 s for a swerve drive).
-MAX_RESOLUTION = 1440
-
-
 def run(args: argparse.Namespace) -> int:
     """Print the analysis; write the report with --report."""
     robot = steered_robot(args.robot, args.steer)
-    if not 8 <= args.resolution <= MAX_RESOLUTION:
-        raise WmrkitError(f"--resolution: need 8 to {MAX_RESOLUTION} points per turn (a quarter degree), got "
-                          f"{args.resolution}")
+    check_resolution(args.resolution, "--resolution")
     result = analyze(robot, length=_length(args.length), resolution=args.resolution)
     if args.report:
         from ..analysis.report import write_report
