@@ -58,10 +58,17 @@ def as_angle_array(x: ArrayLike, name: str) -> np.ndarray:
 def matvec(m: np.ndarray, v: np.ndarray, name: str) -> np.ndarray:
     """``m @ v`` over leading batch axes, ``(..., r, n), (..., n) -> (..., r)``, or :class:`ShapeError` naming `name`
     when the two batch shapes do not broadcast (numpy's message named neither)."""
+    batch_shape(v.shape, m.shape[:-2], name)
+    return (m @ v[..., None])[..., 0]
+
+
+def batch_shape(shape: tuple[int, ...], steering_batch: tuple[int, ...], name: str) -> tuple[int, ...]:
+    """The batch shape of `name` ``(..., n)`` (its `shape`) broadcast with the steering configurations' batch, or
+    :class:`ShapeError` naming both (numpy's message named neither)."""
     try:
-        return (m @ v[..., None])[..., 0]
+        return np.broadcast_shapes(shape[:-1], steering_batch)
     except ValueError:
-        raise ShapeError(f"{name} {v.shape} and the steering configurations {m.shape[:-2]}: their batch shapes (all "
+        raise ShapeError(f"{name} {shape} and the steering configurations {steering_batch}: their batch shapes (all "
                          "but the last axis) do not broadcast") from None
 
 

@@ -313,3 +313,21 @@ def test_a_start_of_one_sample_serves_a_batch_and_a_start_of_another_batch_is_re
     np.testing.assert_allclose(one.q_dot, want.q_dot, atol=1e-9)
     with pytest.raises(WmrkitError, match=r"start: expected velocities of shape \(3, 7\)"):
         mcd(robot, robot.sensed, rates, law, start=wls(robot, robot.sensed, rates[:2]))
+
+
+@pytest.mark.parametrize("model", ["wls", "mcd", "mqe", "normal_loads"])
+def test_inputs_and_steering_of_batches_that_do_not_broadcast_are_refused_naming_both(model):
+    """Four samples of rates (or accelerations) against three steering angles: mcd, mqe and normal_loads raised
+    numpy's 'shape mismatch: objects cannot be broadcast' (naming neither argument); wls named both."""
+    from wmrkit.errors import ShapeError
+    from wmrkit.slip.models import tyre_friction
+
+    fk = catalog.load("forklift")
+    heading = np.zeros((3, 1))
+    calls = {"wls": lambda: wls(fk, SPINS, np.ones((4, 2)), heading=heading),
+             "mcd": lambda: mcd(fk, SPINS, np.ones((4, 2)), tyre_friction(fk), heading=heading),
+             "mqe": lambda: mqe(fk, SPINS, np.ones((4, 2)), tyre_friction(fk), heading=heading),
+             "normal_loads": lambda: normal_loads(fk, accel_cm=np.zeros((4, 2)), heading=heading)}
+    name = "accel_cm" if model == "normal_loads" else "q_assigned"
+    with pytest.raises(ShapeError, match=rf"{name} \(4, 2\) and the steering configurations \(3,\).*do not broadcast"):
+        calls[model]()

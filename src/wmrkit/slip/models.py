@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._shapes import batch_shape
 from ..dynamics.mass import Body, body_problem
 from ..errors import WmrkitError
 from ..kinematics.linalg import solve_assigned
@@ -206,7 +207,9 @@ def normal_loads(robot: Robot, body: Body | None = None, accel_cm: ArrayLike = (
     h = body.com_height
     rhs = np.stack(np.broadcast_arrays(np.full(a.shape[:-1], body.mass * g), -h * body.mass * a[..., 0],
                                        -h * body.mass * a[..., 1]), axis=-1)
-    loads = (_load_map(robot, body, beta) @ rhs[..., None])[..., 0]
+    load_map = _load_map(robot, body, beta)
+    batch_shape(a.shape, load_map.shape[:-2], "accel_cm")  # numpy's message named neither
+    loads = (load_map @ rhs[..., None])[..., 0]
     lifted = loads < -1e-9 * body.mass * g  # below 0 beyond round-off
     if lifted.any():
         from ..dynamics.model import contact_names
@@ -249,7 +252,7 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
         raise WmrkitError("MQE needs the body twist unassigned (the vehicle velocities are its unknowns), got "
                           f"assigned {list(assigned)}")
     a_all = robot.constraint_matrix(beta)
-    batch = np.broadcast_shapes(q_a.shape[:-1], a_all.shape[:-2])
+    batch = batch_shape(q_a.shape, a_all.shape[:-2], "q_assigned")
     a_all = np.broadcast_to(a_all, (*batch, *a_all.shape[-2:])).reshape(-1, *a_all.shape[-2:])
     q_a = np.broadcast_to(q_a, (*batch, len(cols))).reshape(-1, len(cols))
     k = a_all.shape[-1]
