@@ -331,3 +331,35 @@ def test_inputs_and_steering_of_batches_that_do_not_broadcast_are_refused_naming
     name = "accel_cm" if model == "normal_loads" else "q_assigned"
     with pytest.raises(ShapeError, match=rf"{name} \(4, 2\) and the steering configurations \(3,\).*do not broadcast"):
         calls[model]()
+
+
+@pytest.mark.parametrize(("law", "power_law"), [(lambda n: np.ones_like(n), True), (lambda n: n**2, True),
+                                                (lambda n: n**3, True), (lambda n: 1 + n, False),
+                                                (lambda n: n + n**2, False)])
+def test_mcd_minimises_the_dissipation_only_for_power_law_friction(law, power_law):
+    """The block counter-example (7.4)-(7.8): force balance (MCD) is a stationary point of the dissipated power
+    ``sum |v| f(|v|)`` exactly when ``f + |v| f' = k f`` (f = 1, |v|^2, |v|^3), not for f = 1 + |v| or |v| + |v|^2.
+    The gradient is taken by central differences of the dissipation, independently of the model's equations; an
+    asymmetric skid steer (four different wheel speeds) so that the slips differ in size."""
+    robot = catalog.load("skid-steer-4")
+    rates = np.array([2.0, 7.0, 5.0, 9.0])
+
+    def friction(v, v_body, loads):
+        n = np.linalg.norm(v, axis=-1, keepdims=True)
+        return -law(n) * v / np.maximum(n, 1e-300)
+
+    sol = mcd(robot, robot.sensed, rates, friction)
+    assert sol.converged
+    a = robot.constraint_matrix()
+    assert robot.velocity_names[3:] == robot.sensed  # q_dot = (twist, rates)
+
+    def dissipation(twist):
+        v = np.linalg.norm((a @ np.concatenate([twist, rates])).reshape(-1, 2), axis=1)
+        return float(np.sum(v * law(v)))
+
+    h = 1e-6
+    grad = np.array([dissipation(sol.twist + h * e) - dissipation(sol.twist - h * e) for e in np.eye(3)]) / (2 * h)
+    if power_law:
+        assert np.abs(grad).max() < 1e-7
+    else:
+        assert np.abs(grad).max() > 1e-3
