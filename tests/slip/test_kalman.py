@@ -6,8 +6,10 @@ import numpy as np
 import pytest
 from slip_helpers import L3, L12, R, forklift_at_axle, thesis_twist_to_rep
 
+from wmrkit import catalog
+from wmrkit.errors import WmrkitError
 from wmrkit.odometry.logs import JointLog
-from wmrkit.slip.kalman import KalmanNoise, fk1_noise, fk2_noise, kalman_filter, kalman_model
+from wmrkit.slip.kalman import KalmanNoise, fk1_noise, fk2_noise, kalman_filter, kalman_model, kalman_odometry
 from wmrkit.slip.models import wls
 from wmrkit.slip.weights import SlipWeights
 
@@ -137,3 +139,26 @@ def test_the_filter_refuses_a_start_that_is_not_a_twist_and_a_covariance(options
     model = kalman_model(forklift_at_axle(), "fk2", fk2_noise(0.5, 0.1, 0.1, 0.1))
     with pytest.raises(ValueError, match=message):
         kalman_filter(model, forklift_log([2.0] * 3, [1.9] * 3, [0.0] * 3), **options)
+
+
+@pytest.mark.parametrize(("time", "spin", "call", "message"), [
+    ([0.0, 0.1, 0.1, 0.2], [0.0, 0.1, 0.2, 0.3], "filter", r"sample 2: time 0.1 s repeats"),
+    ([0.0, 0.1, 0.05, 0.2], [0.0, 0.1, 0.2, 0.3], "odometry", r"sample 2: time 0.05 s goes backwards"),
+    ([0.0, 0.1, 0.2, 0.3], [0.0, 0.1, np.nan, 0.3], "odometry", r"sample 2: right_drive.spin: value nan"),
+    ([0.0, 0.1, 0.2, 0.3], [0.0, 0.1, 0.2, 0.3], {"pose0": [0.0, 0.0, np.nan]}, r"pose0: must be finite"),
+    ([0.0, 0.1, 0.2, 0.3], [0.0, 0.1, 0.2, 0.3], {"pose0": [0.0, 0.0]}, r"pose0: expected shape .*got \(2,\)"),
+    ([0.0, 0.1, 0.2, 0.3], [0.0, 0.1, 0.2, 0.3], {"pose0": [1e300, 0.0, 0.0]}, r"pose0: a position beyond"),
+])
+def test_the_filter_refuses_a_log_or_start_pose_that_odometry_refuses(time, spin, call, message):
+    """kalman_filter and kalman_odometry (Python) gave NaN twists and poses for a repeated time or a NaN reading,
+    wrong numbers for time going backwards and a NaN path for a NaN start pose (a (2,) pose: numpy's broadcast error),
+    where odometry() and the CLI refuse them."""
+    model = kalman_model(catalog.load("forklift"), "fk2")
+    spin = np.array(spin)
+    log = JointLog(np.array(time), ("right_drive.spin", "left_drive.spin", "steer.steer"),
+                   np.column_stack([spin, spin, np.full(4, np.pi / 2)]))
+    with pytest.raises(WmrkitError, match=message):
+        if call == "filter":
+            kalman_filter(model, log)
+        else:
+            kalman_odometry(model, log, **({} if call == "odometry" else call))

@@ -84,10 +84,8 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
     `out`, a trajectory of preallocated arrays as long as the whole log, is filled in place (no copies).
     """
     check_method(method)
-    pose = as_vectors(pose0, 3, "pose0").copy()
-    if pose.shape != (3,):
-        raise LogError(f"pose0: expected one pose (3,), got {pose.shape}")
-    _check_inputs(pose, noise, initial_covariance)
+    pose = start_pose(pose0)
+    _check_inputs(noise, initial_covariance)
     cov = None if noise is None else (np.zeros((3, 3)) if initial_covariance is None
                                       else np.array(initial_covariance, dtype=float))
     prev: JointLog | None = None
@@ -328,10 +326,18 @@ def check_start_pose(pose: np.ndarray, name: str = "pose0") -> None:
         raise LogError(f"{name}: a position beyond {MAX_COORDINATE:g} m, got {pose[:2].tolist()}")
 
 
-def _check_inputs(pose: np.ndarray, noise: Noise | None, initial_covariance: ArrayLike | None) -> None:
-    """Refuse a non-finite start pose, a noise that is no noise model, and a bad initial covariance or one without
-    a noise model (noise models check their coefficients when made)."""
+def start_pose(pose0: ArrayLike) -> np.ndarray:
+    """`pose0` as one pose ``(3,)`` (a copy), refused as :func:`check_start_pose` refuses it."""
+    pose = as_vectors(pose0, 3, "pose0").copy()
+    if pose.shape != (3,):
+        raise LogError(f"pose0: expected one pose (3,), got {pose.shape}")
     check_start_pose(pose)
+    return pose
+
+
+def _check_inputs(noise: Noise | None, initial_covariance: ArrayLike | None) -> None:
+    """Refuse a noise that is no noise model, and a bad initial covariance or one without a noise model (noise
+    models check their coefficients when made)."""
     if noise is not None and not isinstance(noise, CrowleyNoise | JointNoise):
         raise NoiseError(f"noise: expected a CrowleyNoise or JointNoise instance, got {noise!r}")
     if initial_covariance is not None:

@@ -18,12 +18,12 @@ from numpy.typing import ArrayLike
 
 from ..errors import WmrkitError
 from ..odometry.integrators import Method, check_method, integrate_increments
-from ..odometry.logs import JointLog, LogError, check_time
+from ..odometry.logs import JointLog, LogError
 from ..odometry.model import OdometryModel
-from ..odometry.pipeline import OdometrySummary, check_finite
+from ..odometry.pipeline import OdometrySummary, start_pose
 from ..odometry.trajectories import Trajectory
 from ..robot import Robot
-from .kalman import FILTERS, KalmanModel, KalmanNoise, kalman_filter, kalman_model
+from .kalman import FILTERS, KalmanModel, KalmanNoise, _filter, check_log, kalman_model
 from .weights import SlipWeights, wls_model
 
 ESTIMATORS = ("wls", *FILTERS)
@@ -50,7 +50,7 @@ class KalmanEstimator:
             sinks: Sequence[Callable[[Trajectory], object]] = ()) -> OdometrySummary:
         """Filter and integrate every chunk; each sink gets each :class:`Trajectory` chunk."""
         check_method(method)
-        pose = np.array(pose0, dtype=float).reshape(3)
+        pose = start_pose(pose0)
         prev: JointLog | None = None
         x = p = None
         n_total, t0, t1, dist, rot, max_slip, sq, max_dt = 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -58,10 +58,7 @@ class KalmanEstimator:
             chunk = raw if raw.joints == self.joints else raw.select(self.joints)
             if len(chunk) == 0:
                 continue
-            if chunk.heading_world is not None:
-                raise WmrkitError(f"{self.name} filters the wheels' twist; an external heading (heading or gyro "
-                                  "column) is not used by it: drop that option or use --method wls")
-            _check(chunk, None if prev is None else float(prev.time[-1]))
+            check_log(chunk, None if prev is None else float(prev.time[-1]), self.name)
             if prev is None:
                 t0 = float(chunk.time[0])
                 first = Trajectory(chunk.time[:1], pose[None].copy(), np.zeros(1))
@@ -72,7 +69,7 @@ class KalmanEstimator:
                 chunk = JointLog(np.concatenate([prev.time[-1:], chunk.time]), chunk.joints,
                                  np.vstack([prev.positions[-1:], chunk.positions]), source=chunk.source)
             if len(chunk) >= 2:
-                run = kalman_filter(self.model, chunk, x0=x, p0=p)
+                run = _filter(self.model, chunk, x, p)
                 x, p = run.twist[-1], run.covariance
                 poses = integrate_increments(pose, run.increments, method)
                 for sink in sinks:
@@ -102,9 +99,3 @@ def estimator(robot: Robot, name: str, *, sensed: Sequence[str] | None = None, w
     if name in FILTERS:
         return KalmanEstimator(kalman_model(robot, name, noise, sensed, thesis_double_q=thesis_double_q), name)
     raise WmrkitError(f"estimator must be one of {', '.join(ESTIMATORS)}, got '{name}'")
-
-
-def _check(chunk: JointLog, previous: float | None) -> None:
-    """Refuse non-finite values and time that does not increase (the message names the row), as the pipeline."""
-    check_finite(chunk)
-    check_time(chunk, np.asarray(chunk.time, dtype=float), previous, None)

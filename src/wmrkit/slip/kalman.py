@@ -27,8 +27,9 @@ from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..odometry.covariance import check_covariance
 from ..odometry.integrators import HEADING_FRACTION, Method, check_method
-from ..odometry.logs import JointLog
+from ..odometry.logs import JointLog, check_time
 from ..odometry.model import ConfigurationMaps, OdometryModel, cached_maps, odometry_model, wrap_angle
+from ..odometry.pipeline import check_finite, start_pose
 from ..odometry.trajectories import Trajectory
 from ..robot import Robot
 
@@ -215,6 +216,12 @@ def kalman_filter(model: KalmanModel, log: JointLog, *, x0: ArrayLike | None = N
     `x0` defaults to the least-squares twist of the first interval, `p0` to Q (the spec's choice; the thesis
     gives neither). Rates are the increments over each interval divided by its duration.
     """
+    check_log(_selected(model, log))
+    return _filter(model, log, x0, p0)
+
+
+def _filter(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike | None) -> KalmanRun:
+    """:func:`kalman_filter` on a log already checked (:func:`check_log`)."""
     t = np.asarray(log.time, dtype=float)
     increments = np.empty((max(len(t) - 1, 0), 3))
     slip, filt = _run(model, log, x0, p0, increments, np.empty((0, 3)), np.zeros(7), "exact")
@@ -230,7 +237,7 @@ def _run(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike 
     from . import _kalman_kernel
 
     om = model.odometry
-    chunk = log if log.joints == om.joints else log.select(om.joints)
+    chunk = _selected(model, log)
     p = np.asarray(chunk.positions, dtype=float)
     t = np.asarray(chunk.time, dtype=float)
     if len(t) < 2:
@@ -271,7 +278,8 @@ def kalman_odometry(model: KalmanModel, log: JointLog, *, method: Method = "exac
     """Poses from the filtered twists (one per sample, the first `pose0`), composed with `method` in the same
     pass as the filter; `x0`, `p0` as in :func:`kalman_filter`."""
     check_method(method)
-    pose0 = np.asarray(pose0, dtype=float)
+    pose0 = start_pose(pose0)
+    check_log(_selected(model, log))
     n = len(log)
     poses = np.empty((n, 3))
     poses[0] = pose0
@@ -279,6 +287,24 @@ def kalman_odometry(model: KalmanModel, log: JointLog, *, method: Method = "exac
     slip[0] = 0.0
     slip[1:] = _run(model, log, x0, p0, np.empty((0, 3)), poses[1:], np.concatenate([pose0, np.zeros(4)]), method)[0]
     return Trajectory(np.asarray(log.time, dtype=float), poses, slip)
+
+
+def check_log(log: JointLog, previous: float | None = None, name: str = "the filter") -> None:
+    """Refuse what the filters cannot use, as the odometry pipeline refuses it: an external heading (``heading`` or
+    gyro column: not used), values that are not finite numbers, time that does not increase (from `previous`, the
+    last time before); :class:`~wmrkit.odometry.logs.LogError` naming the sample. `name`: the filter's, for the
+    messages."""
+    if log.heading_world is not None:
+        raise WmrkitError(f"{name} filters the wheels' twist; an external heading (heading or gyro column) is not used "
+                          "by it: drop that option or use --method wls")
+    check_finite(log)
+    check_time(log, np.asarray(log.time, dtype=float), previous, None)
+
+
+def _selected(model: KalmanModel, log: JointLog) -> JointLog:
+    """`log` with the columns of the filter's joints."""
+    joints = model.odometry.joints
+    return log if log.joints == joints else log.select(joints)
 
 
 def noise_from_options(process: float, lateral: float, longitudinal: float,
