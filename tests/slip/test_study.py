@@ -44,6 +44,18 @@ def test_closure_index_of_a_path_that_does_not_turn_or_move_says_which():
         closure_error(np.zeros((3, 3)))
 
 
+def test_closure_index_refuses_a_true_final_pose_that_is_not_finite_and_finals_of_another_count():
+    """closure_error(poses, [1, 2, nan]) returned (0.32, nan), and j_closure with fewer true final poses than runs
+    raised zip()'s 'argument 2 is shorter than argument 1'."""
+    n = 100
+    inc = np.tile([2 * np.pi / n, 0.0, 2 * np.pi / n], (n, 1))
+    poses = np.vstack([[0, 0, 0], integrate_increments([0, 0, 0], inc)])
+    with pytest.raises(WmrkitError, match=r"truth_final: must be finite, got \[1.0, 2.0, nan\]"):
+        closure_error(poses, [1.0, 2.0, np.nan])
+    with pytest.raises(WmrkitError, match="j_closure: 2 runs and 1 true final poses"):
+        j_closure([poses, poses], [poses[-1]])
+
+
 @pytest.fixture(scope="module")
 def study(tmp_path_factory):
     import contextlib

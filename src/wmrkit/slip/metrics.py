@@ -39,6 +39,8 @@ def closure_error(poses: ArrayLike, truth_final: ArrayLike | None = None) -> tup
         raise WmrkitError(f"closure_error: poses must be finite, pose {int(np.argmin(np.isfinite(p).all(axis=1)))} "
                           "is not")
     goal = p[0] if truth_final is None else as_vectors(truth_final, 3, "truth_final").reshape(3)
+    if not np.isfinite(goal).all():  # the heading term was nan
+        raise WmrkitError(f"closure_error: truth_final: must be finite, got {goal.tolist()}")
     steps = np.diff(p, axis=0)
     distance = float(np.sum(np.hypot(steps[:, 0], steps[:, 1])))
     rotation = float(np.sum(np.abs(wrap_angle(steps[:, 2]))))
@@ -55,7 +57,10 @@ def closure_error(poses: ArrayLike, truth_final: ArrayLike | None = None) -> tup
 def j_closure(runs: Sequence[ArrayLike], truth_finals: Sequence[ArrayLike] | None = None) -> float:
     """(7.80): ``1/(2 N_e) sum (position error / distance + heading error / rotation)`` over runs (closed, or
     against `truth_finals` as in :func:`closure_error`)."""
+    runs = list(runs)
     if not runs:
         raise WmrkitError("j_closure: no runs")
     finals = [None] * len(runs) if truth_finals is None else list(truth_finals)
+    if len(finals) != len(runs):  # zip() said 'argument 2 is shorter than argument 1'
+        raise WmrkitError(f"j_closure: {len(runs)} runs and {len(finals)} true final poses: expected one per run")
     return float(sum(sum(closure_error(p, f)) for p, f in zip(runs, finals, strict=True)) / (2 * len(runs)))
