@@ -75,6 +75,24 @@ def test_the_robot_value_keeps_its_settings_through_dict_and_file(tmp_path):
     assert plain.odometry is None and plain != robot and "odometry" not in plain.to_dict()
 
 
+def test_a_wheel_s_kalman_noise_without_friction_coefficients_is_read_and_written_back():
+    """Robot.to_dict() wrote a wheel's own Kalman noise without coefficients of its own as ``slip: {noise: ...}``,
+    which the reader refused ("wheels[2].slip: missing field 'lateral'"): such a robot could not be read back, and a
+    description could not give one wheel's FK noise alone. That wheel keeps the default coefficients."""
+    from dataclasses import replace
+
+    from wmrkit.robot import Robot
+
+    fork = replace(catalog.load("forklift"),
+                   odometry=OdometrySettings(method="fk2", slip=(2.0, 1.0), wheel_noise=(("steer", 0.28, 1.0),)))
+    back = Robot.from_dict(fork.to_dict())
+    assert back == fork and back.odometry.weights().of_wheel("steer") == (2.0, 1.0)
+    assert back.odometry.kalman_noise().of_wheel("steer") == (0.28, 1.0)
+    with pytest.raises(DescriptionError, match=r"wheels\[1\]\.slip: missing field 'longitudinal'"):
+        robot_from_text(yaml.safe_dump(_skid(None, {"lateral": 2, "noise": {"lateral": 1, "longitudinal": 1}})),
+                        source="robot.yaml")
+
+
 @pytest.mark.parametrize(("odometry", "wheel_slip", "message"), [
     ({"method": "wsl"}, None, "odometry.method: must be one of exact, rk2, euler, paper002, wls, fk1, fk2, got 'wsl'"),
     ({"slip": {"lateral": 1}}, None, "odometry.slip: missing field 'longitudinal'"),

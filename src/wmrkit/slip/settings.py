@@ -88,7 +88,8 @@ def settings_from_dict(data: Mapping[str, Any], check: Any) -> OdometrySettings:
             continue
         where = ("wheels", i, "slip")
         name = str(item.get("name"))
-        wheel_slip.append((name, *_pair(item["slip"], check, where, ("noise",))))
+        if _has_coefficients(item):  # else {noise: ...} alone: the wheel's Kalman noise, the default coefficients
+            wheel_slip.append((name, *_pair(item["slip"], check, where, ("noise",))))
         if "noise" in item["slip"]:
             wheel_noise.append((name, *_pair(item["slip"]["noise"], check, (*where, "noise"), ())))
             noise_at.append((*where, "noise"))
@@ -109,11 +110,11 @@ def _check_slip_spread(data: Mapping[str, Any], settings: OdometrySettings, chec
 
     wheels = list(data.get("wheels", []))
     used: list[tuple[float, tuple]] = []
-    if settings.slip is not None and any(not isinstance(w, Mapping) or "slip" not in w for w in wheels):
+    if settings.slip is not None and not all(_has_coefficients(w) for w in wheels):
         used += [(v, ("odometry", "slip", k)) for v, k in zip(settings.slip, ("lateral", "longitudinal"), strict=True)]
     elif settings.slip is None and len(settings.wheel_slip) < len(wheels):
         used += [(1.0, ())]  # the wheels without slip get the unit default
-    at = [i for i, w in enumerate(wheels) if isinstance(w, Mapping) and "slip" in w]
+    at = [i for i, w in enumerate(wheels) if _has_coefficients(w)]
     for i, (_, lat, lon) in zip(at, settings.wheel_slip, strict=True):
         used += [(lat, ("wheels", i, "slip", "lateral")), (lon, ("wheels", i, "slip", "longitudinal"))]
     if not used:
@@ -124,6 +125,14 @@ def _check_slip_spread(data: Mapping[str, Any], settings: OdometrySettings, chec
         where = field_path(other[1]) if other[1] else "the default of the wheels without slip"
         check.fail(f"{here[0]:g} and {other[0]:g} ({where}) differ by more than a factor {MAX_RATIO:g}: the weighted "
                    "least squares would lose the smaller rows to round-off (only ratios matter)", here[1])
+
+
+def _has_coefficients(wheel: Any) -> bool:
+    """Whether a wheel's description gives its own friction coefficients: a ``slip`` other than ``{noise: ...}``
+    alone (a wheel's Kalman noise with the default coefficients)."""
+    if not isinstance(wheel, Mapping) or "slip" not in wheel:
+        return False
+    return not (isinstance(wheel["slip"], Mapping) and set(wheel["slip"]) == {"noise"})
 
 
 def settings_to_dict(settings: OdometrySettings) -> dict[str, Any]:
