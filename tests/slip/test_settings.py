@@ -184,6 +184,19 @@ def test_cli_reports_description_errors(tmp_path, capsys, husky_files):
     assert err.count("\n") == 1
 
 
+def test_a_described_method_the_robot_cannot_run_is_refused_naming_the_description(tmp_path, capsys, husky_files):
+    """'odometry: {method: fk1}' on a skid steer (FK1 leaves out the fixed wheels' lateral rows) was refused with
+    'fk1: the sensed rows ... use fk2' and no word of where fk1 came from: the user had typed no --method."""
+    d, _ = husky_files
+    robot = _write(tmp_path, _skid({"method": "fk1"}))
+    assert main(["odometry", str(robot), str(d / "log.csv")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"wmrkit: error: {robot}: odometry.method fk1 (--method overrides it): fk1: the sensed rows")
+    assert err.count("\n") == 1
+    assert main(["odometry", str(robot), str(d / "log.csv"), "--method", "fk1"]) == 2
+    assert capsys.readouterr().err.startswith("wmrkit: error: fk1: the sensed rows")
+
+
 def test_weights_of_settings_are_slip_weights():
     s = OdometrySettings(slip=(2.0, 1.0), wheel_slip=(("a", 1.0, 3.0),))
     assert s.weights() == SlipWeights.of({"a": (1.0, 3.0)}, (2.0, 1.0))

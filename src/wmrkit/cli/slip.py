@@ -52,6 +52,7 @@ def resolve_method(args: argparse.Namespace):
     from ..slip.settings import odometry_settings
 
     settings = odometry_settings(args.robot)
+    args.method_described = args.method is None and settings.method is not None  # named in its errors
     args.method = args.method or settings.method or "exact"
     args.scheme = args.scheme or settings.scheme or "exact"
     return settings
@@ -177,8 +178,13 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
         given = [o for o, v in (("--kf-noise", args.kf_noise), ("--kf-wheel", args.kf_wheel)) if v]
         raise WmrkitError(f"{' with '.join(given)}: {e}") from None
     weights = weights_from_args(args, settings, robot) if args.method == "wls" else None
-    chosen = estimator(robot, args.method, sensed=args.sensed, weights=weights, noise=noise,
-                       thesis_double_q=args.thesis_double_q)
+    try:
+        chosen = estimator(robot, args.method, sensed=args.sensed, weights=weights, noise=noise,
+                           thesis_double_q=args.thesis_double_q)
+    except WmrkitError as err:  # a method the user did not type: say where it came from
+        if not getattr(args, "method_described", False):
+            raise
+        raise WmrkitError(f"{args.robot}: odometry.method {args.method} (--method overrides it): {err}") from None
     rows = chosen.rows if args.method == "wls" else chosen.model.rows
     used = {robot.wheel_names[robot.row_wheels[r]] for r in rows}
     option = "--mu" if args.method == "wls" else "--kf-wheel"
