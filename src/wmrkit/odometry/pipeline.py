@@ -98,7 +98,7 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
         if len(chunk) == 0:
             continue
         if prev is None:
-            _validate(chunk, None)
+            check_chunk(chunk, None)
             heading0 = 0.0 if chunk.heading_world is None else float(chunk.heading_world[0]) - pose[2]
             stats.start(chunk.time[0])
             first = Trajectory(chunk.time[:1], pose[None].copy(), np.zeros(1), None if cov is None else cov[None])
@@ -114,7 +114,7 @@ def run_odometry(model: OdometryModel, chunks: Iterable[JointLog], *, method: Me
         # path length is then finite exactly when the positions are (checked below: one read of them). Steering
         # angles are checked first: the configuration lookup needs numbers.
         fused = cov is None
-        max_dt = _validate(chunk, prev, positions=not (fused and model.constant))
+        max_dt = check_chunk(chunk, prev, positions=not (fused and model.constant))
         inc = None if fused else model.from_positions(chunk.positions, previous=prev.positions[-1])
         heading = None
         if chunk.heading_world is not None:
@@ -183,8 +183,8 @@ def final_poses(model: OdometryModel, log: JointLog, positions: np.ndarray, *,
     if positions.shape[1:] != log.positions.shape or n < 2:
         raise LogError(f"positions: expected (runs, {n}, {len(log.joints)}) of a log of at least 2 samples, got "
                        f"{positions.shape}")
-    _validate(log.slice(0, 1), None, positions=False)
-    _validate(log.slice(1, n), log.slice(0, 1), positions=False)
+    check_chunk(log.slice(0, 1), None, positions=False)
+    check_chunk(log.slice(1, n), log.slice(0, 1), positions=False)
     steer = _steer_columns(log)
     poses, slip, out, origin = np.empty((n - 1, 3)), np.zeros(n - 1), np.empty((runs, 3)), np.zeros(3)
     for k in range(runs):
@@ -297,7 +297,7 @@ def _fill(out: Trajectory, chunk: Trajectory, row: int) -> None:
         out.covariance[row:stop] = chunk.covariance
 
 
-def _validate(chunk: JointLog, prev: JointLog | None, *, positions: bool = True) -> float:
+def check_chunk(chunk: JointLog, prev: JointLog | None, *, positions: bool = True) -> float:
     """Refuse non-finite values and time that does not increase; the longest time step (from `prev`'s last
     sample, 0 without steps). `positions=False` leaves the joint positions to the caller."""
     from . import _kernels  # numba loads on first use

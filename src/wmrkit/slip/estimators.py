@@ -58,7 +58,7 @@ class KalmanEstimator:
             chunk = raw if raw.joints == self.joints else raw.select(self.joints)
             if len(chunk) == 0:
                 continue
-            check_log(chunk, None if prev is None else float(prev.time[-1]), self.name)
+            check_log(chunk, prev, self.name)
             if prev is None:
                 t0 = float(chunk.time[0])
                 first = Trajectory(chunk.time[:1], pose[None].copy(), np.zeros(1))

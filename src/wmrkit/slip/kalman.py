@@ -27,9 +27,9 @@ from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..odometry.covariance import check_covariance
 from ..odometry.integrators import HEADING_FRACTION, Method, check_method
-from ..odometry.logs import JointLog, check_time
+from ..odometry.logs import JointLog
 from ..odometry.model import ConfigurationMaps, OdometryModel, cached_maps, odometry_model, wrap_angle
-from ..odometry.pipeline import check_finite, start_pose
+from ..odometry.pipeline import check_chunk, start_pose
 from ..odometry.trajectories import Trajectory
 from ..robot import Robot
 
@@ -289,16 +289,15 @@ def kalman_odometry(model: KalmanModel, log: JointLog, *, method: Method = "exac
     return Trajectory(np.asarray(log.time, dtype=float), poses, slip)
 
 
-def check_log(log: JointLog, previous: float | None = None, name: str = "the filter") -> None:
-    """Refuse what the filters cannot use, as the odometry pipeline refuses it: an external heading (``heading`` or
-    gyro column: not used), values that are not finite numbers, time that does not increase (from `previous`, the
-    last time before); :class:`~wmrkit.odometry.logs.LogError` naming the sample. `name`: the filter's, for the
-    messages."""
+def check_log(log: JointLog, previous: JointLog | None = None, name: str = "the filter") -> None:
+    """Refuse what the filters cannot use, as the odometry pipeline refuses it (:func:`~wmrkit.odometry.pipeline.
+    check_chunk`, a compiled pass unless a value is bad): an external heading (``heading`` or gyro column: not
+    used), values that are not finite numbers, time that does not increase (from `previous`, the chunk before);
+    :class:`~wmrkit.odometry.logs.LogError` naming the sample. `name`: the filter's, for the messages."""
     if log.heading_world is not None:
         raise WmrkitError(f"{name} filters the wheels' twist; an external heading (heading or gyro column) is not used "
                           "by it: drop that option or use --method wls")
-    check_finite(log)
-    check_time(log, np.asarray(log.time, dtype=float), previous, None)
+    check_chunk(log, previous)
 
 
 def _selected(model: KalmanModel, log: JointLog) -> JointLog:
