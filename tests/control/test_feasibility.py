@@ -331,3 +331,32 @@ def test_a_speed_step_breaks_the_dynamic_framework_of_every_vehicle(name):
     assert [v.signal for v in got] == ["velocity"]
     assert got[0].t == pytest.approx(5.0, abs=0.02) and got[0].size == pytest.approx(0.5, rel=1e-6)
     assert "re-orient" not in got[0].remedy  # nothing turns: the speed steps
+
+
+def test_a_reversal_of_the_direction_of_travel_is_no_tangent_jump():
+    """(8.29) defines the tangent as arctan(dy/dx): a cusp (the reference slows to a stop between two samples and
+    comes back) leaves it continuous, and each vehicle follows one without a jump of its wheels: a diff drive or a
+    car drives back (the car keeps its steering on a curve: (8.41) divides by the signed speed), a forklift's or a
+    single steered wheel's 2-quadrant root keeps its angle and its spin changes sign. Every such reversal was a
+    'tangent-angle jump' of pi (the car's on a curve also a curvature jump of twice the curvature)."""
+    t = np.arange(0.0, 20.0, 0.01)
+    s = np.sin(0.5 * t)  # back and forth, the speed through 0 between samples at 3.14, 9.42, 15.71 s
+    line = reference_from_samples("back-forth.csv", t, np.column_stack([s, 0 * t, 0 * t]))
+    curve = reference_from_samples("curve-back-forth.csv", t, np.column_stack([s, s * s / 4, 0 * t]))
+    for name in ("diff-drive", "forklift", "ackermann", "thesis-steer-castor"):
+        for ref in (line, curve):
+            for framework in ("kinematic", "dynamic"):
+                got = feasibility(catalog.load(name), ref, framework).violations
+                assert not got, (name, ref.name, framework, [(v.signal, v.t, v.size) for v in got])
+    # the signed curvature of the parabola y = x^2 / 4 against the vehicle: 1/2 at its vertex, each way through
+    kappa = signals(curve)["kappa"]
+    vertex = np.flatnonzero(np.abs(s) < 0.005)
+    assert np.allclose(kappa[vertex], 0.5, atol=1e-3)
+    # an instant reversal on a line is followed in the kinematic framework (the wheels' rates jump); the dynamic
+    # one needs the speed continuous: a velocity jump of 1 m/s, not a tangent jump
+    x = np.where(t < 10, 0.5 * t, 10 - 0.5 * t)
+    instant = reference_from_samples("instant.csv", t, np.column_stack([x, 0 * t, 0 * t]))
+    robot = catalog.load("diff-drive")
+    assert feasibility(robot, instant).feasible
+    got = feasibility(robot, instant, "dynamic").violations
+    assert [v.signal for v in got] == ["velocity"] and got[0].size == pytest.approx(1.0, rel=0.01)

@@ -166,12 +166,27 @@ def signals(reference: Reference, *, speed_tol: float = 1e-6, slow: float = 0.05
         steady = ~at_rest & (change <= slow * speed**2)
         chi = np.where(~at_rest & (change <= speed**2), np.arctan2(v[:, 1], v[:, 0]), np.nan)
         cross = v[:, 0] * a[:, 1] - v[:, 1] * a[:, 0]
-        kappa = np.where(steady, cross / speed**3, np.nan)
+        kappa = np.where(steady, cross / speed**3, np.nan) * _travel_sign(chi)
         chi_rate = np.where(steady, cross / speed**2, np.nan)
     return {"position": p[:, :2], "theta": p[:, 2], "velocity": v[:, :2], "omega": v[:, 2], "acceleration": a[:, :2],
             "omega_rate": a[:, 2],
             "chi": chi, "chi_rate": chi_rate, "kappa": kappa,
             "kappa_rate": np.gradient(kappa, t) * (t[1] - t[0]), "at_rest": at_rest}
+
+
+def _travel_sign(chi: np.ndarray) -> np.ndarray:
+    """+1, then -1 after each reversal of the direction of travel (the tangent ``atan2`` turning by more than a
+    quarter turn between defined samples), so that the curvature is the path's, signed against the vehicle and not
+    against its direction of travel: (8.41) divides by the signed speed. A car reversing along a curve keeps its
+    steering; ``omega_g / v_a`` of (8.33) flipped sign there."""
+    defined = np.flatnonzero(np.isfinite(chi))
+    sign = np.ones(len(chi))
+    if len(defined) > 1:
+        flips = np.abs(wrap_angle(np.diff(chi[defined]))) > math.pi / 2
+        sign[defined[1:]] = np.where(np.cumsum(flips) % 2, -1.0, 1.0)
+        sign[: defined[0]] = 1.0
+        sign = sign[np.maximum.accumulate(np.where(np.isfinite(chi), np.arange(len(chi)), 0))]
+    return sign
 
 
 _FLOOR = {"position": 1e-3, "theta": 0.02, "velocity": 0.02, "omega": 0.02, "acceleration": 0.05, "omega_rate": 0.05,
@@ -183,7 +198,7 @@ _FLOOR = {"position": 1e-3, "theta": 0.02, "velocity": 0.02, "omega": 0.02, "acc
 BLOCK = 21
 
 
-def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float,
+def _jumps(x: np.ndarray, turn: float | None, floor: float, factor: float,
            at_rest: np.ndarray | None = None, across_rest: bool = False) -> list[tuple[int, float]]:
     x = x.reshape(len(x), -1)
     cut = held = None
@@ -202,8 +217,8 @@ def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float,
         x = x[np.maximum(last, 0)]
         x[last < 0] = np.nan
     d = np.diff(x, axis=0)
-    if angle:
-        d = wrap_angle(d)
+    if turn:
+        d = _wrap(d, turn)
     size = np.sqrt(np.nansum(d * d, axis=-1))
     size[np.any(np.isnan(d), axis=-1)] = 0.0
     if cut is not None:
@@ -235,11 +250,23 @@ def _jumps(x: np.ndarray, angle: bool, floor: float, factor: float,
     out = []
     for first, last, top in events:  # its size: the whole change across it (a sampled corner splits in halves),
         total = x[last + 1] - x[first]  # or its largest step when that is larger (a spike: up, then back down)
-        if angle:
-            total = wrap_angle(total)
+        if turn:
+            total = _wrap(total, turn)
         whole = float(np.sqrt(np.nansum(total * total)))
         out.append((first, max(whole, float(size[top])) if np.all(np.isfinite(total)) else float(size[top])))
     return out
+
+
+#: Period of the angle signals: a heading's turn, and half a turn for the tangent, which (8.29) defines as
+#: ``arctan(dy/dx)``: a reversal of the direction of travel (a cusp) leaves it continuous, and every vehicle of the
+#: table follows one without a jump of its wheels (a 2-quadrant root of (8.9) keeps the steering, the spins change
+#: sign). It was compared over a whole turn, so a smooth back-and-forth was a tangent-angle jump of pi.
+_TURN = {"theta": 2 * math.pi, "chi": math.pi}
+
+
+def _wrap(d: np.ndarray, turn: float) -> np.ndarray:
+    """Angle differences wrapped to ``(-turn / 2, turn / 2]``."""
+    return wrap_angle(d * (2 * math.pi / turn)) * (turn / (2 * math.pi))
 
 
 #: Samples on each side of a curvature-rate jump over which the change must persist. ``kappa_rate`` is a third finite
@@ -277,7 +304,7 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
         floor = _FLOOR[name]
         # a car (R on the fixed axle of a type 4) cannot turn at rest: its tangent is compared across a stop
         across = name == "chi" and req.column == "type 4, on axle"
-        for k, size in _jumps(x, name in ("theta", "chi"), floor, jump_factor, s["at_rest"], across):
+        for k, size in _jumps(x, _TURN.get(name), floor, jump_factor, s["at_rest"], across):
             if name == "kappa_rate" and not _persists(x, k, floor):
                 continue  # ringing of a third finite difference, not a step of the curvature rate
             t = float(ref.t[k + 1])
