@@ -108,7 +108,7 @@ def check_animation_path(path: str | None, suffixes: tuple[str, ...] = (".gif",)
 
 def run_track(args: argparse.Namespace) -> int:
     """Simulate, then print a summary (or the time series as JSON); warnings on stderr."""
-    from ..control.laws import SamplingWarning
+    from ..control.laws import GateWarning, SamplingWarning
     from ..control.track import track
 
     check_plot_path(args.plot)
@@ -136,13 +136,14 @@ def run_track(args: argparse.Namespace) -> int:
         weights, noise = settings.weights(), settings.kalman_noise()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", SamplingWarning)
+        warnings.simplefilter("always", GateWarning)
         run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
                     lookahead=lookahead, stanley_gain=stanley_gain,
                     period=period, delay=args.delay, duration=duration, policy=args.steering, dynamics=args.dynamics,
                     slip_model=args.slip_model, feedback=args.feedback, weights=weights, noise=noise, ramp=args.ramp,
                     progress=sys.stderr.isatty() and not args.json)
     for w in caught:
-        if issubclass(w.category, SamplingWarning):
+        if issubclass(w.category, (SamplingWarning, GateWarning)):
             print(f"wmrkit: warning: {w.message}", file=sys.stderr)
     for v in run.range_violations():
         lo, hi = (math.degrees(a) for a in robot.wheel(v["wheel"]).steer_range)

@@ -8,7 +8,7 @@ from .actuators import ActuatorLoop, LowLevelLoops
 from .dynamic_plant import simulate_dynamics
 from .feasibility import COLUMNS, Feasibility, Requirement, Violation, feasibility, requirement
 from .forklift import ForkliftIK, forklift_ik, forklift_real_loops, from_thesis_pose, with_steer_range
-from .laws import PositionLaw, SamplingWarning, check_sampling, law_velocity, sampled_root
+from .laws import GateWarning, PositionLaw, SamplingWarning, check_gate, check_sampling, law_velocity, sampled_root
 from .loop import Plant, law_controller, simulate
 from .plots import animate_run, plot_feasibility, plot_run
 from .points import ControlError, ControlPoint, control_point, point_pose, twist_for_velocity
@@ -50,6 +50,7 @@ __all__ = [
     "ControlTick",
     "Feasibility",
     "ForkliftIK",
+    "GateWarning",
     "LowLevelLoops",
     "Plant",
     "PositionLaw",
@@ -66,6 +67,7 @@ __all__ = [
     "ackermann_twist",
     "animate_run",
     "builtin_reference",
+    "check_gate",
     "check_sampling",
     "choose_steering",
     "control_point",

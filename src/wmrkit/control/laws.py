@@ -24,13 +24,18 @@ import numpy as np
 from ..wheels import wrap_angle
 from .points import ControlError, check_delay
 
-__all__ = ["KINDS", "PositionLaw", "SamplingWarning", "check_sampling", "law_velocity", "sampled_root"]
+__all__ = ["KINDS", "GateWarning", "PositionLaw", "SamplingWarning", "check_gate", "check_sampling", "law_velocity",
+           "sampled_root"]
 
 KINDS = ("point", "p", "pi")
 
 
 class SamplingWarning(UserWarning):
     """The discrete loop breaks the rule 1/a >= 10 T (§8.3, §9.2.2)."""
+
+
+class GateWarning(UserWarning):
+    """The feedforward gate (8.53) is below the point-to-point lag ``v / a``: once open it never closes again."""
 
 
 @dataclass(frozen=True)
@@ -122,3 +127,35 @@ def check_sampling(law: PositionLaw, period: float, *, delay: int = 0, factor: f
                  f"{samples}" if law.kind != "pi" else "")
         warnings.warn(f"discrete loop: {rule}{shape}{bound}", SamplingWarning, stacklevel=stacklevel)
     return ok
+
+
+def check_gate(law: PositionLaw, velocity: np.ndarray, *, stacklevel: int = 2) -> bool:
+    """Whether the feedforward gate ``d_max`` (8.53) of `law` exceeds the point-to-point lag ``|(v_x / a_x, v_y /
+    a_y)|`` of the reference `velocity` ``(n, 2+)`` [m/s] (world frame) wherever it moves; warns
+    :class:`GateWarning` when not. Beyond the gate the law is (8.1), whose error on a ramp tends to ``v / a``: an
+    error that once exceeds a smaller gate (a start off the reference, a corner) settles at ``v / a`` instead of 0
+    (docs/errata.md, (8.53)). No gate, or a law other than ``"p"``: True (``"point"`` has no feedforward to gate;
+    ``"pi"``'s integral removes a ramp's error without it)."""
+    if law.gate is None or law.kind != "p":
+        return True
+    v = np.asarray(velocity, dtype=float)[:, :2]
+    moving = np.hypot(v[:, 0], v[:, 1]) > 0
+    if not moving.any():
+        return True
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lags = np.hypot(*(v[moving] / np.asarray(law.a[:2])).T)
+    k = int(np.argmax(lags))
+    lag = float(lags[k])
+    if lag < law.gate:
+        return True
+    speed = float(np.hypot(*v[moving][k]))
+    if not math.isfinite(lag):  # a = 0: no feedback to bring the error back within the gate
+        warnings.warn(f"feedforward gate {law.gate:g} m (8.53) with a pole a = 0: once the error exceeds the gate "
+                      f"nothing moves the robot (the reference moves at up to {speed:.4g} m/s); give a gain > 0",
+                      GateWarning, stacklevel=stacklevel)
+        return False
+    warnings.warn(f"feedforward gate {law.gate:g} m (8.53) is below the point-to-point lag v / a = {lag:.4g} m "
+                  f"(reference speed {speed:.4g} m/s, a = {min(law.a[:2]):g} 1/s): once the error exceeds the gate "
+                  "the feedforward stays off and the error settles at v / a instead of 0 (docs/errata.md, (8.53)); "
+                  f"give a gate above {lag:.4g} m or a larger gain", GateWarning, stacklevel=stacklevel)
+    return False

@@ -16,7 +16,7 @@ from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .actuators import LowLevelLoops
-from .laws import PositionLaw, check_sampling
+from .laws import PositionLaw, check_gate, check_sampling
 from .loop import Plant, law_controller, simulate
 from .points import ControlError, ControlPoint, control_point, point_pose
 from .references import Reference
@@ -171,6 +171,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         law = PositionLaw.uniform(controller, gain, b if controller == "pi" else 0.0, gate)  # type: ignore[arg-type]
         if sampled is not None:
             check_sampling(law, sampled, delay=delay, stacklevel=3)
+        check_gate(law, reference.velocity, stacklevel=3)
         if dynamics:  # the same law in scalar arithmetic: the dynamic loop's per-period cost (issue 11)
             from .dynamic_plant import fast_law_controller
 
