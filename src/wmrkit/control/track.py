@@ -18,7 +18,7 @@ from ..wheels import heading_from_beta
 from .actuators import LowLevelLoops
 from .laws import PositionLaw, check_gate, check_sampling
 from .loop import Plant, law_controller, simulate
-from .points import ControlError, ControlPoint, control_point, point_pose
+from .points import ControlError, ControlPoint, check_delay, control_point, point_pose
 from .references import Reference
 from .trackers import PathIndex, default_wheelbase, pure_pursuit, stanley
 
@@ -159,7 +159,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     duration = reference.duration if duration is None else float(duration)
     sampled = 0.02 if dynamics and period is None else period
     _check_timing(duration, sampled, output_dt)
-    if sampled is not None and isinstance(delay, int) and delay > 0 and delay * sampled >= duration:
+    check_delay(delay)
+    if sampled is not None and delay > 0 and delay * sampled >= duration:
         raise ControlError(f"delay: {delay} samples of {sampled:g} s reach past the run ({duration:g} s): the loop "
                            "would never see a measurement (open loop)")
     pose0 = initial_pose_on(cp, reference) if initial_pose is None else as_vectors(initial_pose, 3, "initial_pose")
