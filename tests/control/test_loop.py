@@ -250,3 +250,11 @@ def test_a_numpy_integer_delay_past_the_run_is_refused():
     for delay in (100, np.int64(100)):
         with pytest.raises(ControlError, match="reach past the run"):
             track(catalog.load("mecanum-4"), builtin_reference("line"), period=0.1, delay=delay, duration=5.0)
+
+
+def test_the_point_to_point_law_has_no_feedforward_to_gate():
+    """(8.1) has no feedforward: a gate on it was ignored (the run equal to the ungated one, exit 0)."""
+    with pytest.raises(ControlError, match="no feedforward to gate"):
+        PositionLaw.uniform("point", 1.0, gate=0.5)
+    with pytest.raises(ControlError, match="no feedforward to gate"):
+        track(catalog.load("mecanum-4"), builtin_reference("line"), controller="point", gate=0.5, duration=1.0)

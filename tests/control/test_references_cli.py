@@ -195,6 +195,9 @@ def test_cli_feasibility_json(capsys):
     (["track", "diff-drive", "--reference", "circle", "--controller", "pure-pursuit", "--gain", "3"],
      "--gain applies to --controller p or pi or point, not pure-pursuit (it would be ignored)"),
     (["track", "diff-drive", "--reference", "circle", "--controller", "stanley", "--gate", "1"], "--gate applies"),
+    # the point-to-point law (8.1) has no feedforward: the gate was ignored, exit 0
+    (["track", "diff-drive", "--reference", "circle", "--controller", "point", "--gate", "1"],
+     "--gate applies to --controller p or pi, not point (it would be ignored)"),
     (["track", "diff-drive", "--reference", "circle", "--lookahead", "1"], "--lookahead applies to --controller "
                                                                            "pure-pursuit, not p"),
     (["track", "diff-drive", "--reference", "circle", "--controller", "pure-pursuit", "--stanley-gain", "2"],

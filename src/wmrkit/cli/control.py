@@ -24,7 +24,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    help="p: P + feedforward (8.2), the default; pi: PI + feedforward (8.3); point: (8.1); or a "
                         "geometric tracker")
     p.add_argument("--gain", metavar="A", help="p, pi, point: pole a [1/s] of the position loop (default 1)")
-    p.add_argument("--gate", metavar="D", help="p, pi, point: apply the feedforward only within D [m] of the "
+    p.add_argument("--gate", metavar="D", help="p, pi: apply the feedforward only within D [m] of the "
                                                "reference (8.53)")
     p.add_argument("--lookahead", metavar="L", help="pure-pursuit: lookahead distance along the path [m] "
                                                     "(default 1)")
@@ -88,7 +88,7 @@ def _positive(text: str, what: str, kind: str = "number") -> float:
 
 
 #: The options of each controller (``track``): any other controller would ignore them, so they are refused there.
-CONTROLLER_OPTIONS = {"--gain": ("p", "pi", "point"), "--gate": ("p", "pi", "point"),
+CONTROLLER_OPTIONS = {"--gain": ("p", "pi", "point"), "--gate": ("p", "pi"),
                       "--lookahead": ("pure-pursuit",), "--stanley-gain": ("stanley",)}
 
 

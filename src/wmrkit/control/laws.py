@@ -56,6 +56,9 @@ class PositionLaw:
                 raise ControlError(f"gain {name}: expected three finite numbers >= 0, got {gains}")
         if self.gate is not None and not (self.gate > 0 and math.isfinite(self.gate)):
             raise ControlError(f"feedforward gate: expected a distance > 0 m, got {self.gate}")
+        if self.gate is not None and self.kind == "point":
+            raise ControlError("feedforward gate: the point-to-point law (8.1) has no feedforward to gate (it would be "
+                               "ignored); use the p or pi law")
 
     @classmethod
     def uniform(cls, kind: Literal["point", "p", "pi"] = "p", a: float = 1.0, b: float = 0.0,
