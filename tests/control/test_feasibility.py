@@ -360,3 +360,23 @@ def test_a_reversal_of_the_direction_of_travel_is_no_tangent_jump():
     assert feasibility(robot, instant).feasible
     got = feasibility(robot, instant, "dynamic").violations
     assert [v.signal for v in got] == ["velocity"] and got[0].size == pytest.approx(1.0, rel=0.01)
+
+
+def test_a_gap_in_the_samples_is_no_jump():
+    """A 3 m circle at 0.5 m/s logged at 100 Hz with 0.5 s of samples missing (a dropped stretch of a log): each
+    step is compared with the typical step over as long a time, and the gap is no jump (it was a 'position jump' of
+    0.26 m, which no vehicle can follow, for every robot; in the dynamic framework a velocity jump of 0.042)."""
+    t = np.arange(0.0, 20.0, 0.01)
+    t = t[(t < 8.0) | (t >= 8.5)]
+    th = t / 6
+    gap = reference_from_samples("gap.csv", t, np.column_stack([3 * np.sin(th), 3 * (1 - np.cos(th)), th]))
+    for name in ("mecanum-4", "line-follower", "diff-drive", "forklift", "ackermann", "swerve-4"):
+        for framework in ("kinematic", "dynamic"):
+            got = feasibility(catalog.load(name), gap, framework).violations
+            assert not got, (name, framework, [(v.signal, v.t, v.size) for v in got])
+    # a teleport inside the gap is still found, with its size, when the gap cannot explain it: more than jump_factor
+    # (20) times the 0.25 m the reference moves in 0.5 s (a 2 m one is 4 m/s of motion the file did not sample)
+    pose = np.column_stack([3 * np.sin(th), 3 * (1 - np.cos(th)), th])
+    pose[t >= 8.5, 1] += 10.0
+    got = feasibility(catalog.load("mecanum-4"), reference_from_samples("gap-jump.csv", t, pose)).violations
+    assert [(v.signal, v.t) for v in got][:1] == [("position", 8.5)] and got[0].size > 10.0

@@ -198,11 +198,15 @@ _FLOOR = {"position": 1e-3, "theta": 0.02, "velocity": 0.02, "omega": 0.02, "acc
 BLOCK = 21
 
 
-def _jumps(x: np.ndarray, turn: float | None, floor: float, factor: float,
+def _jumps(x: np.ndarray, t: np.ndarray, turn: float | None, floor: float, factor: float,
            at_rest: np.ndarray | None = None, across_rest: bool = False) -> list[tuple[int, float]]:
     x = x.reshape(len(x), -1)
     cut = held = None
-    span = 1  # sample steps each step covers: more for one bridged over undefined samples
+    # typical sample steps each step covers: its time over the median sample spacing (more for one bridged over
+    # undefined samples, or across a gap in a file's samples: a smooth circle with 0.5 s of samples missing was a
+    # 'position jump' of 0.26 m)
+    spacing = float(np.median(np.diff(t)))
+    span = np.diff(t) / spacing
     if at_rest is not None and np.isnan(x).any():
         # undefined samples (NaN) are bridged: the step into the first defined sample after them is the change since
         # the last defined one (a jump while starting or stopping is still found), unless the reference rests
@@ -212,7 +216,7 @@ def _jumps(x: np.ndarray, turn: float | None, floor: float, factor: float,
         last = np.maximum.accumulate(np.where(np.isnan(x).any(axis=-1), -1, np.arange(n)))
         rests = np.cumsum(at_rest)
         cut = (last[:-1] < 0) | ((rests[1:] - rests[np.maximum(last[:-1], 0)] > 0) & (not across_rest))
-        span = np.arange(1, n) - np.maximum(last[:-1], 0)
+        span = (t[1:] - t[np.maximum(last[:-1], 0)]) / spacing
         held = last[1:] < np.arange(1, n)  # steps into an undefined sample: no step of the signal
         x = x[np.maximum(last, 0)]
         x[last < 0] = np.nan
@@ -227,7 +231,7 @@ def _jumps(x: np.ndarray, turn: float | None, floor: float, factor: float,
     # (a global median is 0 for a reference mostly at rest, and its every moving step was a jump)
     n = len(size)
     if held is None:
-        blocks = np.median(np.pad(size, (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK), axis=1) if n else size
+        blocks = np.median(np.pad(size / span, (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK), axis=1) if n else size
     else:  # of the steps of the signal (per sample step for a bridged one), not of the 0s held over undefined ones
         typical = np.pad(np.where(held, np.nan, size / span), (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK)
         count = (~np.isnan(typical)).sum(axis=1)
@@ -304,7 +308,7 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
         floor = _FLOOR[name]
         # a car (R on the fixed axle of a type 4) cannot turn at rest: its tangent is compared across a stop
         across = name == "chi" and req.column == "type 4, on axle"
-        for k, size in _jumps(x, _TURN.get(name), floor, jump_factor, s["at_rest"], across):
+        for k, size in _jumps(x, ref.t, _TURN.get(name), floor, jump_factor, s["at_rest"], across):
             if name == "kappa_rate" and not _persists(x, k, floor):
                 continue  # ringing of a third finite difference, not a step of the curvature rate
             t = float(ref.t[k + 1])
