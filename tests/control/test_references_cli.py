@@ -195,6 +195,10 @@ def test_cli_feasibility_json(capsys):
     (["track", "diff-drive", "--reference", "circle", "--controller", "pure-pursuit", "--gain", "3"],
      "--gain applies to --controller p or pi or point, not pure-pursuit (it would be ignored)"),
     (["track", "diff-drive", "--reference", "circle", "--controller", "stanley", "--gate", "1"], "--gate applies"),
+    # a negative gain was named as the Python keyword ('gain: expected a pole a >= 0'), not as the option
+    (["track", "diff-drive", "--reference", "circle", "--gain", "-1"], "--gain: expected a gain >= 0 [1/s], got -1"),
+    (["track", "diff-drive", "--reference", "circle", "--controller", "stanley", "--stanley-gain", "-2"],
+     "--stanley-gain: expected a gain >= 0 [1/s], got -2"),
     # the point-to-point law (8.1) has no feedforward: the gate was ignored, exit 0
     (["track", "diff-drive", "--reference", "circle", "--controller", "point", "--gate", "1"],
      "--gate applies to --controller p or pi, not point (it would be ignored)"),

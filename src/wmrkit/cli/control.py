@@ -87,6 +87,15 @@ def _positive(text: str, what: str, kind: str = "number") -> float:
     return value
 
 
+def _non_negative(text: str, what: str) -> float:
+    """A gain [1/s] >= 0 (0: no feedback), named by its option when refused (it was named 'gain' or 'stanley
+    gain', as the Python keyword)."""
+    value = parse_value(text, "number", what)
+    if not 0 <= value < float("inf"):
+        raise WmrkitError(f"{what}: expected a gain >= 0 [1/s], got {text}")
+    return value
+
+
 #: The options of each controller (``track``): any other controller would ignore them, so they are refused there.
 CONTROLLER_OPTIONS = {"--gain": ("p", "pi", "point"), "--gate": ("p", "pi"),
                       "--lookahead": ("pure-pursuit",), "--stanley-gain": ("stanley",)}
@@ -119,9 +128,9 @@ def run_track(args: argparse.Namespace) -> int:
         start = [parse_value(args.start[0], "length", "--from X"), parse_value(args.start[1], "length", "--from Y"),
                  parse_value(args.start[2], "angle", "--from THETA")]
     _check_controller_options(args)
-    gain = 1.0 if args.gain is None else parse_value(args.gain, "number", "--gain")
+    gain = 1.0 if args.gain is None else _non_negative(args.gain, "--gain")
     lookahead = 1.0 if args.lookahead is None else _positive(args.lookahead, "--lookahead", "length")
-    stanley_gain = 1.0 if args.stanley_gain is None else parse_value(args.stanley_gain, "number", "--stanley-gain")
+    stanley_gain = 1.0 if args.stanley_gain is None else _non_negative(args.stanley_gain, "--stanley-gain")
     period = None if args.period is None else _positive(args.period, "--period")
     duration = None if args.duration is None else _positive(args.duration, "--duration")
     gate = None if args.gate is None else _positive(args.gate, "--gate", "length")
