@@ -165,3 +165,23 @@ def test_densified_poses_move_no_corner_more_than_the_step(seed, step):
     assert np.hypot(np.diff(x, axis=0), np.diff(y, axis=0)).max() <= step * (1 + 1e-9)
     kept = [int(np.flatnonzero(np.all(np.isclose(dense, p, rtol=0, atol=1e-12), axis=1))[0]) for p in poses]
     assert kept == sorted(kept) and kept[0] == 0 and kept[-1] == len(dense) - 1
+
+
+@pytest.mark.parametrize("poses", [np.zeros((6, 2)), np.zeros((3, 4)), np.zeros((2, 2, 3)),
+                                   [[-1.7, -1.245, math.nan]], [[0.0, 0.0, "30 deg"]]])
+def test_pose_arrays_other_than_n_by_3_finite_are_refused(poses):
+    """(6, 2) positions were reshaped into four poses mixing x, y and theta (a wrong answer), NaN raised a GEOS
+    traceback, (3, 4) numpy's reshape error."""
+    from wmrkit.errors import ShapeError
+    from wmrkit.parking.verify import densify
+
+    with pytest.raises(ShapeError, match="poses"):
+        check_poses(CAR_91, SLOT_91, poses)
+    with pytest.raises(ShapeError, match="poses"):
+        densify(CAR_91, poses)
+
+
+def test_one_pose_is_one_row():
+    final = plan_parking(CAR_91, SLOT_91).final_pose
+    report = check_poses(CAR_91, SLOT_91, np.array(final))
+    assert report.poses.shape == (1, 3) and report.collision_free and report.inside

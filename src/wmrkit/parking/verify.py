@@ -14,7 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import WmrkitError
+from .._shapes import as_vectors
+from ..errors import ShapeError, WmrkitError
 from ..wheels import wrap_angle
 from .geometry import Space, Vehicle, footprint
 from .path import Segment, sample_count, sample_poses
@@ -101,7 +102,7 @@ def densify(vehicle: Vehicle, poses: np.ndarray, corner_step: float = 0.002) -> 
     """P_f's `poses` ``(N, 3)`` (an executed path) with poses interpolated linearly between neighbours so that no
     body corner moves more than `corner_step` [m] between samples. Between samples the motion is taken as the
     chord: within ``ds^2 kappa / 8`` of the arc (0.06 mm for 2.5 cm steps on a 1.4 m radius)."""
-    poses = np.asarray(poses, dtype=float).reshape(-1, 3)
+    poses = _pose_rows(poses)
     if len(poses) < 2:
         return poses
     step = np.diff(poses, axis=0)
@@ -113,6 +114,19 @@ def densify(vehicle: Vehicle, poses: np.ndarray, corner_step: float = 0.002) -> 
     k = np.repeat(np.arange(len(step)), parts)
     frac = (np.arange(len(k)) - np.repeat(np.cumsum(parts) - parts, parts)) / np.repeat(parts, parts)
     return np.concatenate([poses[k] + frac[:, None] * step[k], poses[-1:]])
+
+
+def _pose_rows(poses: np.ndarray) -> np.ndarray:
+    """`poses` as finite ``(N, 3)`` rows ``(x, y, theta)`` (one pose ``(3,)`` is one row), or :class:`ShapeError`:
+    ``(N, 2)`` positions were reshaped into other poses (six points read as four poses mixing x, y and theta),
+    and NaN raised a GEOS traceback."""
+    rows = as_vectors(poses, 3, "poses")
+    rows = rows[None] if rows.ndim == 1 else rows
+    if rows.ndim != 2:
+        raise ShapeError(f"poses: expected shape (N, 3), rows (x, y, theta) of P_f, got {rows.shape}")
+    if not np.isfinite(rows).all():
+        raise ShapeError(f"poses: row {int(np.argmax(~np.isfinite(rows).all(axis=1)))} is not finite")
+    return rows
 
 
 def _check_count(n: float, corner_step: float | None = None) -> None:
@@ -132,7 +146,7 @@ def check_plan(vehicle: Vehicle, space: Space, segments: tuple[Segment, ...] | l
 def check_poses(vehicle: Vehicle, space: Space, poses: np.ndarray, *, tol: float = 1e-7) -> CollisionReport:
     """Check P_f's `poses` ``(N, 3)`` (any planner's, sampled densely by the caller) against the scene."""
     shapely = shapely_module()
-    poses = np.asarray(poses, dtype=float).reshape(-1, 3)
+    poses = _pose_rows(poses)
     _check_count(len(poses))
     obstacles = {name: (ob, ob.buffer(-tol, join_style="mitre")) for name, ob in scene(space).items()}
     colliding = np.zeros(len(poses), dtype=bool)
