@@ -165,3 +165,19 @@ def test_an_exact_check_too_big_is_refused_before_it_allocates(capsys, tmp_path)
     code, out, err = run(capsys, str(f), "--check", "--json")
     assert code == 2 and out == "" and err.count("\n") == 1
     assert "poses" in json.loads(err)["error"] and "at most 2000000" in err
+
+
+@pytest.mark.parametrize("json_flag", [[], ["--json"]])
+def test_an_impossible_slot_with_animate_is_the_answer_exit_1(capsys, tmp_path, json_flag):
+    """An impossible slot with --animate exited 2 (bad input) with 'the plan is not feasible (...): nothing to
+    execute', without the answer (the reason, the shortest slot) that it prints, exit 1, without --animate."""
+    f = tmp_path / "short.yaml"
+    f.write_text("vehicle: {a1: 150 cm, b1: 50 cm, c1: 140 cm, h1: 105 cm, d1: 50 cm, phi_max: 46 deg}\n"
+                 "space: {H: 230 cm, J: 200 cm, MS: 20 cm, dx2: 90 cm, final_gap: 7 cm}\n")
+    gif = tmp_path / "a.gif"
+    code, out, err = run(capsys, str(f), "--animate", str(gif), "--check", "--controller", "p", *json_flag)
+    assert code == 1 and not gif.exists() and "no animation" in err
+    if json_flag:
+        assert json.loads(out)["feasible"] is False
+    else:
+        assert "infeasible: the slot is too short" in out and "shortest slot that works" in out

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from ..errors import WmrkitError
 from ._common import add_json_flag, check_plot_path, print_json
@@ -48,8 +49,8 @@ def run(args: argparse.Namespace) -> int:
     check_animation_path(args.animate, (".gif", ".html"))
     solution = solve(load_problem(args.problem), check=args.check)
     execution = executed = None
-    if args.animate or (args.check and args.controller and solution.plan.feasible):
-        from ..parking.execute import execute_plan  # refuses an infeasible plan (exit 2, the reason)
+    if solution.plan.feasible and (args.animate or (args.check and args.controller)):
+        from ..parking.execute import execute_plan
 
         execution = execute_plan(solution.plan, solution.problem.robot, controller=args.controller)
         if args.check:
@@ -71,8 +72,10 @@ def run(args: argparse.Namespace) -> int:
     if args.animate or args.plot:
         from ..parking import plot
 
-        if args.animate:
+        if args.animate and execution is not None:
             plot.animate_plan(solution.plan, args.animate, execution, max_frames=frames)
+        elif args.animate:  # an impossible slot is an answer (exit 1), not bad input (it exited 2, unprinted)
+            print(f"wmrkit: note: no plan, so no animation: {args.animate} not written", file=sys.stderr)
         if args.plot:
             plot.save_plan_figure(solution.plan, args.plot, execution)
     return 0 if parked(solution, executed) else 1
