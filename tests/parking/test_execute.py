@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import replace
 
 import numpy as np
@@ -169,3 +170,20 @@ def test_a_gif_renders_each_frame_once_and_draws_a_bounded_trail(tmp_path, monke
     assert max(drawn) <= MAX_TRAIL < len(run.t) and sum(drawn[-2:]) == MAX_TRAIL  # the last frame: the whole trail
     with Image.open(tmp_path / "a.gif") as gif:
         assert gif.n_frames == 5 and gif.size == (640, 368)
+
+
+@pytest.mark.parametrize("dt", [0.05, 0.3])
+def test_open_loop_keeps_the_distance_driven_at_a_segments_first_sample(dt):
+    """Where the steering wait between two segments is shorter than dt (none at all when the steering does not
+    change: the reverse S into the first manoeuvre of a car passing beyond its approach point), the first sample
+    of the new segment is already under way; the open loop dropped that distance (0.6 mm per stop at dt = 0.05 s,
+    1 cm at 0.3 s) and ended off the plan."""
+    text = ("vehicle: {robot: ackermann, a1: 3.6 m, b1: 1.0 m, c1: 1.8 m, phi_max: 30 deg}\n"
+            "space: {H: 6 m, J: 2.2 m, MS: 0.2 m, dx2: 1.2 m, final_gap: 10 cm}\n")
+    problem = problem_from_text(text, source="car.yaml")
+    plan = plan_parking(problem.vehicle, problem.space)
+    assert any(a.steering == b.steering for a, b in itertools.pairwise(plan.segments))  # the case at stake
+    for robot in (None, problem.robot):
+        run = execute_plan(plan, robot, dt=dt)
+        assert run.deviation.max() < 1e-9
+        np.testing.assert_allclose(run.pose[-1], plan.final_pose, atol=1e-9)

@@ -204,7 +204,10 @@ def _origin_pose(pose_pf: np.ndarray, offset: np.ndarray) -> np.ndarray:
 
 def _open_loop(robot, offset, pose0, t, dist, seg, kappa, direction):
     step = np.diff(dist, prepend=dist[0])
-    step[np.r_[True, seg[1:] != seg[:-1]]] = 0.0  # a new segment starts at rest at its start pose
+    # a segment's first sample follows the previous segment's end, its start: the car has driven dist from there
+    # (more than 0 when the steering wait is shorter than dt; setting it to 0 lost 0.6 mm a stop at dt = 0.05 s)
+    new = np.r_[False, seg[1:] != seg[:-1]]
+    step[new] = dist[new]
     dt = np.diff(t, prepend=t[0])
     speed = np.divide(step, dt, out=np.zeros_like(step), where=dt > 0)
     twist_pf = np.column_stack([direction * speed, np.zeros_like(speed), direction * speed * kappa])
