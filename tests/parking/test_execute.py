@@ -142,7 +142,8 @@ def test_an_execution_of_too_many_samples_is_refused_before_it_is_sampled():
 
     plan = plan_parking(CAR_91, SLOT_91)  # 29.35 s of driving
     dt = 29.0 / MAX_SAMPLES  # 506,000 samples
-    with pytest.raises(WmrkitError, match=f"the plan takes 29 s to drive: executing it samples at most {MAX_SAMPLES}"):
+    message = f"the plan takes 29.35 s to drive: executing it samples at most {MAX_SAMPLES}"
+    with pytest.raises(WmrkitError, match=message):
         timed_reference(plan.segments, dt=dt)
     with pytest.raises(WmrkitError, match="at most 500000 poses"):
         execute_plan(plan, dt=dt)
@@ -187,3 +188,13 @@ def test_open_loop_keeps_the_distance_driven_at_a_segments_first_sample(dt):
         run = execute_plan(plan, robot, dt=dt)
         assert run.deviation.max() < 1e-9
         np.testing.assert_allclose(run.pose[-1], plan.final_pose, atol=1e-9)
+
+
+@pytest.mark.parametrize(("option", "value"), [("a_max", np.inf), ("dt", np.inf), ("v_max", np.nan),
+                                               ("steer_rate", 0.0), ("v_max", True), ("dt", "0.05")])
+def test_execution_options_are_finite_positive_numbers_named(option, value):
+    """a_max = inf raised 'dt: expected finite numbers, got nan' (another option's name) after RuntimeWarnings;
+    dt = inf drove one sample a segment; v_max = True was read as 1 m/s."""
+    plan = plan_parking(CAR_91, SLOT_91)
+    with pytest.raises(WmrkitError, match=rf"^{option}: must be a finite number > 0"):
+        execute_plan(plan, **{option: value})

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._shapes import readonly
+from .._shapes import finite_number, readonly
 from ..errors import WmrkitError
 from ..kinematics.wheel_ik import forward_kinematics, wheel_commands
 from ..odometry.integrators import integrate_exact, integrate_increments
@@ -105,12 +105,14 @@ def timed_reference(segments: tuple[Segment, ...] | list[Segment], *, v_max: flo
     ``distance`` ``(n,)`` [m] is the distance along the current segment; ``segment`` ``(n,)`` its index. Speeds
     [m/s], accelerations [m/s^2], steering rate [rad/s] are positive.
     """
-    if not (v_max > 0 and a_max > 0 and steer_rate > 0 and dt > 0):
-        raise WmrkitError("v_max, a_max, steer_rate and dt must be > 0")
+    for name, value in (("v_max", v_max), ("a_max", a_max), ("steer_rate", steer_rate), ("dt", dt)):
+        # a_max = inf raised "dt: expected finite numbers, got nan"; dt = inf gave one sample a segment; True was 1
+        if isinstance(value, bool) or not (finite_number(value) and value > 0):
+            raise WmrkitError(f"{name}: must be a finite number > 0, got {value!r}")
     durations = [abs(seg.steering - steer) / steer_rate + trapezoid_duration(seg.length, v_max, a_max)
                  for seg, steer in zip(segments, [0.0, *(s.steering for s in segments)], strict=False)]
     if sum(max(1, math.ceil(d / dt)) for d in durations) + 1 > MAX_SAMPLES:
-        raise WmrkitError(f"the plan takes {sum(durations):.0f} s to drive: executing it samples at most "
+        raise WmrkitError(f"the plan takes {sum(durations):.4g} s to drive: executing it samples at most "
                           f"{MAX_SAMPLES} poses ({MAX_SAMPLES * dt:.0f} s at {dt:g} s, docs/limits.md)")
     ts, poses, dists, segs = [], [], [], []
     t0, steer = 0.0, 0.0
