@@ -198,3 +198,16 @@ def test_execution_options_are_finite_positive_numbers_named(option, value):
     plan = plan_parking(CAR_91, SLOT_91)
     with pytest.raises(WmrkitError, match=rf"^{option}: must be a finite number > 0"):
         execute_plan(plan, **{option: value})
+
+
+@pytest.mark.parametrize(("option", "value"), [("max_frames", 10**9), ("max_frames", 1), ("max_frames", 2.5),
+                                               ("fps", 0), ("fps", True)])
+def test_animation_options_are_bounded_integers_refused_before_the_work(tmp_path, option, value):
+    """animate_plan(max_frames=10**9) drew every executed sample (up to 500,000 frames: hours; the CLI's --frames
+    stops at 800), 2.5 raised a TypeError, fps=0 a ZeroDivisionError once every frame was rendered."""
+    from wmrkit.parking.plot import animate_plan
+
+    plan = plan_parking(CAR_91, SLOT_91)
+    with pytest.raises(WmrkitError, match=rf"^{option}: expected an integer from"):
+        animate_plan(plan, tmp_path / "a.gif", **{option: value})
+    assert not (tmp_path / "a.gif").exists()

@@ -27,10 +27,6 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
-#: Most frames of an animation (matplotlib embeds at most 20 MB in an HTML page).
-MAX_FRAMES = 800
-
-
 def run(args: argparse.Namespace) -> int:
     """Plan, execute and check on request, print (text or JSON), draw and animate on request."""
     from ..parking.problem import load_problem
@@ -43,8 +39,11 @@ def run(args: argparse.Namespace) -> int:
         raise WmrkitError(f"--controller {args.controller} drives the plan for --animate or --check (it would be "
                           "ignored)")
     frames = 200 if args.frames is None else args.frames
-    if not 2 <= frames <= MAX_FRAMES:  # below 2 was raised to 2 silently; thousands took minutes
-        raise WmrkitError(f"--frames: expected 2 to {MAX_FRAMES} animation frames, got {frames}")
+    if args.animate:
+        from ..parking.plot import MAX_FRAMES  # (matplotlib: imported only to animate)
+
+        if not 2 <= frames <= MAX_FRAMES:  # below 2 was raised to 2 silently; thousands took minutes
+            raise WmrkitError(f"--frames: expected 2 to {MAX_FRAMES} animation frames, got {frames}")
     check_plot_path(args.plot)  # before the answer is printed
     check_animation_path(args.animate, (".gif", ".html"))
     solution = solve(load_problem(args.problem), check=args.check)

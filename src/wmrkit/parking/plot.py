@@ -6,6 +6,7 @@ matplotlib's object API (no pyplot, no GUI backend). World frame of :mod:`wmrkit
 from __future__ import annotations
 
 import math
+import numbers
 import os
 from pathlib import Path
 
@@ -26,6 +27,8 @@ FORWARD, BACKWARD = "#1f77b4", "#d62728"
 #: Most samples of the trail an animation draws, spread evenly (every sample of a plan driven in under 10 min; each
 #: frame drew every sample up to it: 800 frames of a 9.8 km plan, 394,511 samples, ran over 6 min).
 MAX_TRAIL = 12_000
+#: Most frames of an animation (matplotlib embeds at most 20 MB in an HTML page; a GIF frame is about 0.25 MB).
+MAX_FRAMES = 800
 
 
 def car_outline(vehicle: Vehicle, pose: np.ndarray) -> np.ndarray:
@@ -104,7 +107,8 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
     """Write an animation of the executed plan: ``.gif`` (PillowWriter) or ``.html`` (``to_jshtml``).
 
     The car drives P_f's executed poses with its steering wheel turned to the commanded heading; the trail is
-    coloured by direction. Returns the number of frames (at most `max_frames`, evenly spaced in time).
+    coloured by direction. Returns the number of frames (at most `max_frames`, 2 to :data:`MAX_FRAMES`, evenly
+    spaced in time); `fps` frames a second, 1 to 100.
     """
     from matplotlib.animation import FuncAnimation
 
@@ -112,6 +116,11 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
     suffix = path.suffix.lower()
     if suffix not in (".gif", ".html"):
         raise WmrkitError(f"{path}: the animation is written as .gif or .html")
+    # max_frames = 10**9 drew every executed sample (up to 500,000 frames: hours), 2.5 raised a TypeError; fps = 0
+    # a ZeroDivisionError once the whole animation was rendered
+    for name, value, lo, hi in (("max_frames", max_frames, 2, MAX_FRAMES), ("fps", fps, 1, 100)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not lo <= value <= hi:
+            raise WmrkitError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
     run = execute_plan(plan) if execution is None else execution
     frames = spread_indices(len(run.t), max_frames)
     dots = spread_indices(len(run.t), MAX_TRAIL)  # the trail's samples (all of a short run)
