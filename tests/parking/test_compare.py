@@ -36,3 +36,16 @@ def test_the_check_passes_reeds_shepp_on_the_open_road():
     poses = np.array([w.pose_2d_tuple for w in path.waypoints()])
     report = check_poses(CAR_91, SLOT_91, poses)
     assert report.collision_free and report.min_clearance > 0.5
+
+
+@pytest.mark.parametrize(("option", "value", "message"), [
+    ("step", 0.0, "step: must be a finite length > 0 m"), ("step", -1.0, "step: must be a finite length > 0 m"),
+    ("step", math.nan, "step: must be a finite length > 0 m"), ("repeat", 0, "repeat: must be an integer >= 1"),
+    ("step", 1e-7, "the exact check would test 3.13e\\+07 poses")])
+def test_compare_refuses_its_options_by_name(option, value, message):
+    """step = 0 raised OverflowError, -1 IndexError, NaN ValueError (from rsplan), 1e-7 m made 3e7 Reeds-Shepp
+    poses (gigabytes) before the check refused them; repeat = 0 gave NaN times."""
+    from wmrkit.errors import WmrkitError
+
+    with pytest.raises(WmrkitError, match=f"^{message}"):
+        compare(CAR_91, SLOT_91, **{option: value})

@@ -9,6 +9,7 @@ whether it is usable. Both are timed the same way (median of repeated calls).
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from dataclasses import dataclass
 
@@ -18,7 +19,7 @@ from ..errors import WmrkitError
 from .geometry import Space, Vehicle
 from .path import direction_changes, path_length
 from .planner import plan_parking
-from .verify import check_plan, check_poses
+from .verify import check_count, check_plan, check_poses
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,7 +56,14 @@ def rsplan_module():
 
 
 def compare(vehicle: Vehicle, space: Space, *, repeat: int = 5, step: float = 0.005) -> tuple[Outcome, Outcome]:
-    """``(thesis, reeds_shepp)`` outcomes on one slot. `step` [m]: spacing of the Reeds-Shepp poses checked."""
+    """``(thesis, reeds_shepp)`` outcomes on one slot. `step` [m]: spacing of the Reeds-Shepp poses checked (at
+    most :data:`.verify.MAX_CHECK_POSES` of them); `repeat` (an integer >= 1) runs of each planner timed."""
+    # step = 0 raised OverflowError, -1 IndexError, NaN ValueError, 1e-7 made 3e7 poses before the check's bound;
+    # repeat = 0 timed nothing and gave NaN times
+    if not 0 < step < math.inf:
+        raise WmrkitError(f"step: must be a finite length > 0 m, got {step!r}")
+    if isinstance(repeat, bool) or not isinstance(repeat, numbers.Integral) or repeat < 1:
+        raise WmrkitError(f"repeat: must be an integer >= 1, got {repeat!r}")
     rs = rsplan_module()
     plan = plan_parking(vehicle, space)
     ours_ms = _median_ms(lambda: plan_parking(vehicle, space), repeat)
@@ -79,6 +87,7 @@ def compare(vehicle: Vehicle, space: Space, *, repeat: int = 5, step: float = 0.
 
     rs_ms = _median_ms(solve, repeat)
     path = solve()
+    check_count(1 + path.total_length / step)  # its waypoints are made on demand: count them first
     poses = np.array([w.pose_2d_tuple for w in path.waypoints()])
     report = check_poses(vehicle, space, poses)
     theirs = Outcome("Reeds-Shepp (rsplan)", True, report.collision_free and report.inside,

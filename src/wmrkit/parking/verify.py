@@ -89,7 +89,7 @@ def dense_poses(vehicle: Vehicle, segments: tuple[Segment, ...] | list[Segment],
     """P_f's poses along the path with no body corner moving more than `corner_step` [m] between samples."""
     reach = _corner_reach(vehicle)
     steps = [corner_step / (1 + reach * abs(seg.curvature)) for seg in segments]  # corner speed / P_f speed
-    _check_count(1 + sum(sample_count(seg.length, step) for seg, step in zip(segments, steps, strict=True)),
+    check_count(1 + sum(sample_count(seg.length, step) for seg, step in zip(segments, steps, strict=True)),
                  corner_step)
     chunks = []
     for k, (seg, step) in enumerate(zip(segments, steps, strict=True)):
@@ -109,7 +109,7 @@ def densify(vehicle: Vehicle, poses: np.ndarray, corner_step: float = 0.002) -> 
     step[:, 2] = wrap_angle(step[:, 2])  # the short way round
     moved = np.hypot(step[:, 0], step[:, 1]) + _corner_reach(vehicle) * np.abs(step[:, 2])  # a corner's bound
     parts = np.maximum(1, np.ceil(moved / corner_step))
-    _check_count(1 + float(parts.sum()), corner_step)
+    check_count(1 + float(parts.sum()), corner_step)
     parts = parts.astype(int)
     k = np.repeat(np.arange(len(step)), parts)
     frac = (np.arange(len(k)) - np.repeat(np.cumsum(parts) - parts, parts)) / np.repeat(parts, parts)
@@ -129,7 +129,7 @@ def _pose_rows(poses: np.ndarray) -> np.ndarray:
     return rows
 
 
-def _check_count(n: float, corner_step: float | None = None) -> None:
+def check_count(n: float, corner_step: float | None = None) -> None:
     """Refuse a check of more than :data:`MAX_CHECK_POSES` poses, before they are made."""
     if n > MAX_CHECK_POSES:
         spacing = "" if corner_step is None else f" (no corner moving more than {corner_step * 1e3:g} mm between them)"
@@ -147,7 +147,7 @@ def check_poses(vehicle: Vehicle, space: Space, poses: np.ndarray, *, tol: float
     """Check P_f's `poses` ``(N, 3)`` (any planner's, sampled densely by the caller) against the scene."""
     shapely = shapely_module()
     poses = _pose_rows(poses)
-    _check_count(len(poses))
+    check_count(len(poses))
     obstacles = {name: (ob, ob.buffer(-tol, join_style="mitre")) for name, ob in scene(space).items()}
     colliding = np.zeros(len(poses), dtype=bool)
     hit_any = dict.fromkeys(obstacles, False)
