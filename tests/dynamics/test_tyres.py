@@ -209,6 +209,27 @@ def test_tyre_values_and_errors():
         Tyre.of("michelin")
 
 
+def test_the_constructor_is_of_with_the_defaults_and_the_checks():
+    """``Tyre("dugoff")``, the dataclass's own constructor, made a tyre with every parameter 0 (``params=()``): no
+    force at any slip (``Tyre()`` too: 0 N where pacejka gives 486 N), and ``simulate`` with it stopped on a
+    ZeroDivisionError. It now completes the model's defaults and checks the values as :meth:`Tyre.of` does."""
+    for model in TYRES:
+        assert Tyre(model) == Tyre.of(model)
+    assert Tyre() == Tyre.of("pacejka")
+    assert Tyre("dugoff", (("mu", 0.5),)) == Tyre.of("dugoff", {"mu": 0.5})
+    assert Tyre("dugoff", {"mu": 0.5}).params == Tyre.of("dugoff", {"mu": 0.5}).params
+    f = Tyre("pacejka").forces(1000, 0.1, 0.1, 2.0, -1.9)
+    assert f == Tyre.of("pacejka").forces(1000, 0.1, 0.1, 2.0, -1.9) and f.longitudinal < -400
+    for params, message in (((("cs", -1.0),), "tyre parameter cs: must be >= 0"),
+                            ((("mu", math.nan),), "tyre parameter mu must be finite"),
+                            ((("cz", 1.0),), "no parameter 'cz'"),
+                            ((("mu", 0.5), ("mu", 0.6)), "parameter 'mu' given twice")):
+        with pytest.raises(WmrkitError, match=message):
+            Tyre("dugoff", params)
+    with pytest.raises(UnknownNameError, match="unknown tyre model"):
+        Tyre("michelin")
+
+
 def test_errata_7_31_slip_ratio_follows_the_slip_velocity():
     """(7.31) writes s = (phi_dot r - v) / max(...) but calls the numerator v_slip, which ch. 3 defines as
     v + r phi_dot (forward rolling has r phi_dot = -v). wmrkit: s = v_slip / max(|r phi_dot|, |v|), so the force

@@ -258,14 +258,18 @@ class Tyre:
     model: str = "pacejka"
     params: tuple[tuple[str, float], ...] = ()  # every parameter of the model, in the model's order
 
-    @classmethod
-    def of(cls, model: str, params: Mapping[str, float] | None = None) -> Tyre:
-        """A tyre of `model`; parameters not given take the model's defaults; unknown names raise."""
-        kind = tyre_kind(model)
-        params = dict(params or {})
+    def __post_init__(self) -> None:
+        """Complete the parameters given (pairs or a mapping) with the model's defaults, in its order, and check
+        them: ``Tyre(model, params)`` is :meth:`of` (``Tyre("dugoff")`` had every parameter 0, and no force)."""
+        kind = tyre_kind(self.model)
+        pairs = list(self.params.items() if isinstance(self.params, Mapping) else self.params)
+        params = dict(pairs)
+        if len(params) < len(pairs):
+            twice = next(n for j, (n, _) in enumerate(pairs) if n in (m for m, _ in pairs[:j]))
+            raise WmrkitError(f"tyre parameter '{twice}' given twice")
         unknown = [n for n in params if n not in kind.defaults]
         if unknown:
-            raise UnknownNameError(f"tyre model '{model}' has no parameter '{unknown[0]}' "
+            raise UnknownNameError(f"tyre model '{self.model}' has no parameter '{unknown[0]}' "
                                    f"(parameters: {', '.join(kind.defaults)})")
         for n, v in params.items():
             if not (math.isfinite(float(v)) or (n == "k" and v == math.inf)):  # k = inf: discontinuous Coulomb
@@ -273,7 +277,12 @@ class Tyre:
             problem = param_problem(n, float(v))
             if problem:
                 raise WmrkitError(f"tyre parameter {n}: {problem}")
-        return cls(model, tuple((n, float(params.get(n, d))) for n, d, _ in kind.params))
+        object.__setattr__(self, "params", tuple((n, float(params.get(n, d))) for n, d, _ in kind.params))
+
+    @classmethod
+    def of(cls, model: str, params: Mapping[str, float] | None = None) -> Tyre:
+        """A tyre of `model`; parameters not given take the model's defaults; unknown names raise."""
+        return cls(model, tuple(dict(params or {}).items()))
 
     @property
     def kind(self) -> TyreKind:
