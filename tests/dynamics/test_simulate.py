@@ -268,6 +268,20 @@ def test_a_record_step_beyond_the_run_records_its_start_with_every_method(forkli
         np.testing.assert_array_equal(sim.loads, runs[0].loads)
 
 
+@pytest.mark.parametrize("duration, record, last", [(0.05, 0.03, 0.03), (0.1, 0.03, 0.09), (0.09, 0.03, 0.09)])
+def test_an_adaptive_run_records_as_the_fixed_steps_and_stops_at_its_duration(forklift, duration, record, last):
+    """The adaptive method sampled ``round(duration / record_step)`` record steps: asked for 0.05 s recorded every
+    0.03 s it integrated to 0.06 s, past the duration ('wmrkit simulate --method adaptive --duration 0.05 --step
+    0.03' printed '0.05 s simulated' above a final pose at t = 0.06 s). Like the fixed steps, it records the
+    multiples of the record step within the duration."""
+    inputs = Inputs.torques_only(forklift, [0.0], {})
+    for method in METHODS:
+        sim = simulate(forklift, inputs, duration, method=method, step=0.01, record_step=record,
+                       initial_twist=[0.4, 0, 0])
+        assert sim.t[-1] == pytest.approx(last) and sim.t[-1] <= duration, method
+        assert np.allclose(np.diff(sim.t), record)
+
+
 def test_recorded_samples_are_bounded_in_memory_and_the_refusal_names_a_step_that_fits(forklift):
     """5e7 steps recorded at every step were allowed: 16 GB of samples for the forklift (40 numbers a sample)."""
     from wmrkit.dynamics import simulate as module

@@ -4,6 +4,8 @@ check both make."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import WmrkitError
@@ -81,6 +83,12 @@ class _OverBudget(Exception):
     """Raised by the adaptive run's right-hand side beyond :data:`MAX_EVALUATIONS` (args: the time reached)."""
 
 
+def adaptive_samples(duration: float, record: float) -> int:
+    """Samples of an adaptive run: the multiples of `record` within `duration` (as the fixed steps record them;
+    rounding to the nearest one integrated up to half a record step past the duration)."""
+    return math.floor(duration / record * (1 + 1e-12)) + 1
+
+
 def adaptive_run(model, s0, inp, duration, record, rtol, allow_lift_off):
     """`duration` [s] from state `s0` with scipy's LSODA at `rtol`, recorded every `record` s, at most
     :data:`MAX_EVALUATIONS` evaluations of the model; ``(records, info)``."""
@@ -90,8 +98,8 @@ def adaptive_run(model, s0, inp, duration, record, rtol, allow_lift_off):
 
     w = work_arrays(model.n, len(model.contacts), len(model.steer_columns))
     acc = np.zeros(model.n)
-    t_eval = np.arange(0.0, duration + record / 2, record)
-    ts, ys, evaluations = t_eval, s0[:, None], 0  # one sample (record > 2 duration): t = 0, as the fixed steps
+    t_eval = record * np.arange(adaptive_samples(duration, record))  # the multiples within the duration
+    ts, ys, evaluations = t_eval, s0[:, None], 0  # one sample (record > duration): t = 0, as the fixed steps
     if len(t_eval) > 1:
         calls = [0]
 

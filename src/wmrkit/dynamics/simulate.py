@@ -22,7 +22,7 @@ from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .model import DynamicModel
-from .runs import LiftOffError, adaptive_run, check_lift_off, fixed_run, records  # noqa: F401  (LiftOffError: API)
+from .runs import LiftOffError, adaptive_run, adaptive_samples, check_lift_off, fixed_run, records  # noqa: F401  (LiftOffError: API)
 from .tyres import Tyre
 
 Method = Literal["semi-implicit", "rk4", "adaptive"]
@@ -186,7 +186,7 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     if duration / record > MAX_STEPS:
         raise WmrkitError(f"record_step: {record:g} s over {duration:g} s is more than {MAX_STEPS:.0e} samples")
     every = max(1, round(record / step))
-    samples = math.floor(duration / record + 0.5) + 1 if method == "adaptive" else round(duration / step) // every + 1
+    samples = adaptive_samples(duration, record) if method == "adaptive" else round(duration / step) // every + 1
     if samples > record_capacity(model):
         raise WmrkitError(f"record_step: {record:g} s over {duration:g} s records {samples} samples, more than the "
                           f"{record_capacity(model)} of robot '{model.robot.name}' that fit in 1 GiB "
