@@ -316,6 +316,17 @@ def test_simulate_says_when_its_final_pose_is(capsys):
     assert code == 0 and "final pose (t = 1.01 s): x = " in out
 
 
+@pytest.mark.parametrize("method", ["semi-implicit", "adaptive"])
+def test_a_run_shorter_than_the_record_step_still_records_its_end(capsys, method):
+    """The command records every 0.01 s: a run of 4 ms printed '0.004 s simulated', 1 sample, and the start (t = 0,
+    the robot at rest) as its final pose and twist. The record step is now at most the duration."""
+    argv = ["simulate", "forklift", "--path", "straight", "--duration", "0.004", "--method", method, "--json"]
+    code, out, _ = run(capsys, *argv)
+    data = json.loads(out)
+    assert code == 0 and data["samples"] == 2 and data["final_time"] == pytest.approx(0.004)
+    assert data["final_twist"][0] > 0  # the ramp has started
+
+
 def test_tyre_takes_the_discontinuous_coulomb_law(capsys):
     """docs/dynamics.md: coulomb's `k = inf` is the discontinuous law, and --param follows the descriptions' rules;
     --param k=inf was refused ("cannot read 'inf' as a number")."""

@@ -142,7 +142,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         parse_value(v, "number", "--initial-twist") for v in args.initial_twist]
     _check_rolling(model, twist)
     sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
-                   record_step=recordable_step(model, duration, step, max(step, 0.01)),
+                   record_step=recordable_step(model, duration, step, max(step, min(0.01, duration))),
                    progress=False if args.json else None)
     if args.out:
         _write(sim, args.out)
