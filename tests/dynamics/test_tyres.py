@@ -230,6 +230,18 @@ def test_the_constructor_is_of_with_the_defaults_and_the_checks():
         Tyre("michelin")
 
 
+def test_arguments_that_do_not_broadcast_are_named():
+    """numpy's 'shape mismatch: objects cannot be broadcast to a single shape' named no argument."""
+    from wmrkit.errors import ShapeError
+
+    tyre = Tyre.of("dugoff")
+    with pytest.raises(ShapeError, match=r"not broadcast together: slip_ratio \(2,\), slip_angle \(3,\), speed \(\)"):
+        tyre.forces_at_slip(FZ, [0.1, 0.2], [0.1, 0.2, 0.3], 2.0)
+    with pytest.raises(ShapeError, match=r"fz \(2,\), v_lat \(3,\), v_long \(\)"):
+        tyre.forces([FZ, FZ], [0.0, 0.1, 0.2], 0.0, 2.0, -2.0)
+    assert tyre.forces_at_slip(np.full((2, 1), FZ), [0.1, 0.2, 0.3], 0.0).longitudinal.shape == (2, 3)
+
+
 def test_errata_7_31_slip_ratio_follows_the_slip_velocity():
     """(7.31) writes s = (phi_dot r - v) / max(...) but calls the numerator v_slip, which ch. 3 defines as
     v + r phi_dot (forward rolling has r phi_dot = -v). wmrkit: s = v_slip / max(|r phi_dot|, |v|), so the force

@@ -25,7 +25,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import UnknownNameError, WmrkitError
+from ..errors import ShapeError, UnknownNameError, WmrkitError
 from ..limits import MAX_SPEED
 
 TINY = 1e-300
@@ -303,7 +303,7 @@ class Tyre:
                v_roll: ArrayLike) -> TyreForces:
         """Contact forces from slip velocities [m/s] (finite) and the normal load `fz` [N] (in ``[0, MAX_LOAD]``);
         all broadcast."""
-        fz, *slips = (np.asarray(a, dtype=float) for a in (fz, v_lat, v_long, v_wheel, v_roll))
+        fz, *slips = _broadcast(fz=fz, v_lat=v_lat, v_long=v_long, v_wheel=v_wheel, v_roll=v_roll)
         bad = ~((fz >= 0) & (fz <= MAX_LOAD))  # NaN included
         if bad.any():
             raise WmrkitError(f"fz: expected normal loads in [0, {MAX_LOAD:g}] N, got {fz[bad].flat[0]:g}")
@@ -344,7 +344,7 @@ def slip_velocities(s: ArrayLike, alpha: ArrayLike, speed: ArrayLike) -> tuple[n
     Inverse of :func:`slip_ratio` / :func:`slip_angle`: ``(v_lat, v_long, v_wheel, v_roll)``. For ``s >= 0``
     (braking) ``v_roll = v (s - 1)``; for ``-1 < s < 0`` (driving) ``v_roll = -v / (1 + s)``.
     """
-    s, alpha, v = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (s, alpha, speed)))
+    s, alpha, v = _broadcast(slip_ratio=s, slip_angle=alpha, speed=speed)
     checks = (("slip ratio", s, (s > -1) & (s <= 2), "in (-1, 2]"),
               ("slip angle", alpha, np.abs(alpha) < np.pi / 2, "in (-pi/2, pi/2) rad (-90 to 90 deg)"),
               ("speed", v, (v > 0) & (v <= MAX_SPEED), f"in (0, {MAX_SPEED:g}] m/s"))
@@ -353,3 +353,13 @@ def slip_velocities(s: ArrayLike, alpha: ArrayLike, speed: ArrayLike) -> tuple[n
             raise WmrkitError(f"{name}: must be {allowed}, got {values[~ok].flat[0]:g}")
     v_roll = np.where(s >= 0, v * (s - 1), -v / (1 + np.maximum(s, -0.999999)))
     return v * np.tan(alpha), v + v_roll, v, v_roll
+
+
+def _broadcast(**arrays: ArrayLike) -> list[np.ndarray]:
+    """The arrays as floats broadcast together, or :class:`ShapeError` naming each one's shape."""
+    values = [np.asarray(a, dtype=float) for a in arrays.values()]
+    try:
+        return list(np.broadcast_arrays(*values))
+    except ValueError:
+        shapes = ", ".join(f"{name} {a.shape}" for name, a in zip(arrays, values, strict=True))
+        raise ShapeError(f"the arguments do not broadcast together: {shapes}") from None
