@@ -10,6 +10,19 @@ import numpy as np
 import pytest
 
 from wmrkit import ShapeError, WmrkitError, catalog, inverse_model, wheel_commands
+from wmrkit.analysis import (
+    best_configurations,
+    is_singular,
+    isotropy_length,
+    isotropy_matrix,
+    natural_length,
+    singular_set,
+)
+from wmrkit.analysis.coordinated import coordinated_singular_set
+from wmrkit.kinematics import extended_solution, twist_is_determined
+from wmrkit.kinematics.realtime import realtime
+from wmrkit.odometry import odometry_model
+from wmrkit.odometry.encoders import encoders_for
 
 SWERVE = catalog.load("swerve-4")
 STEER = np.array([0.1, -0.2, 0.3, 0.0])
@@ -168,3 +181,39 @@ def test_one_wheel_s_jacobian_and_slip_rows_check_beta(bad):
     assert wheel_jacobian(wheel, [0.1, 0.2]).shape == (2, 3, 2)
     single = np.float32(0.5)
     np.testing.assert_array_equal(wheel_slip_rows(wheel, single), wheel_slip_rows(wheel, float(single)))
+
+
+
+ACKERMANN = catalog.load("ackermann")
+
+
+@pytest.mark.parametrize(("argument", "call"), [
+    ("assigned", lambda n: singular_set(ACKERMANN, n)),
+    ("assigned", lambda n: is_singular(ACKERMANN, None, n)),
+    ("assigned", lambda n: coordinated_singular_set(ACKERMANN, n)),
+    ("variables", lambda n: singular_set(ACKERMANN, ("vx", "vy", "omega"), variables="front_left")),
+    ("variables", lambda n: best_configurations(ACKERMANN, variables="front_left")),
+    ("joints", lambda n: best_configurations(ACKERMANN, joints=n)),
+    ("joints", lambda n: natural_length(ACKERMANN, joints=n)),
+    ("assigned", lambda n: isotropy_matrix(ACKERMANN, None, n, ("vx",))),
+    ("selected", lambda n: isotropy_length(ACKERMANN, None, ("rear_left.spin",), "vx")),
+    ("sensed", lambda n: realtime(ACKERMANN, n)),
+    ("names", lambda n: twist_is_determined(ACKERMANN, n)),
+    ("names", lambda n: extended_solution(ACKERMANN, ("vx", "omega"), [1.0, 0.1]).values(n)),
+    ("joints", lambda n: encoders_for("ackermann", n)),
+    ("assigned velocities", lambda n: inverse_model(ACKERMANN, n)),
+    ("sensed", lambda n: odometry_model(ACKERMANN, n)),
+])
+def test_a_lone_name_where_names_are_expected_is_refused_as_a_string(argument, call):
+    """A lone string was iterated letter by letter ("no velocity 'r'"), and realtime's sensed=string built a model
+    without FK or odometry; every door now reads names through _shapes.as_names."""
+    with pytest.raises(WmrkitError, match=rf"^{argument}: expected a sequence of [a-z' .]*names, got the string '"):
+        call("rear_left.spin")
+
+
+def test_names_that_are_no_strings_are_refused():
+    with pytest.raises(WmrkitError, match=r"^assigned: expected a sequence of velocity names, got \(1, 2\)$"):
+        singular_set(ACKERMANN, (1, 2))
+    with pytest.raises(WmrkitError, match=r"^assigned: expected a sequence of velocity names, got 3$"):
+        singular_set(ACKERMANN, 3)
+    assert singular_set(ACKERMANN, ["vx", "omega"]).assigned == ("vx", "omega")  # a list still does

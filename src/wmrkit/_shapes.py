@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -53,6 +53,21 @@ def as_angle_array(x: ArrayLike, name: str) -> np.ndarray:
     """Angles of any shape ``(...)`` [rad], refused as :func:`as_angles` refuses them."""
     a = x if isinstance(x, np.ndarray) and x.dtype == float else _real_array(x, name, True)
     return as_angles(a[..., None], 1, name)[..., 0]
+
+
+def as_names(names: object, argument: str, what: str = "names", error: type[Exception] = ShapeError) -> tuple[str, ...]:
+    """`names` (joints, velocities, wheels) as a tuple of strings, or `error` naming `argument`.
+
+    The one door for every sequence of names the Python API takes: a lone string is refused, since iterating it
+    reads one name per letter (``"o1.spin"`` gave "no velocity 'o'"), as is anything that is not an iterable of
+    strings. `what` says what the names are, for the message (``"'wheel.joint' names"``).
+    """
+    if isinstance(names, str):
+        raise error(f"{argument}: expected a sequence of {what}, got the string '{names}'")
+    items = tuple(names) if isinstance(names, Iterable) and not isinstance(names, Mapping) else None
+    if items is None or not all(isinstance(n, str) for n in items):
+        raise error(f"{argument}: expected a sequence of {what}, got {names!r}")
+    return items
 
 
 def matvec(m: np.ndarray, v: np.ndarray, name: str) -> np.ndarray:

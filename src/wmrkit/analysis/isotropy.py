@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import readonly
+from .._shapes import as_names, readonly
 from ..errors import ShapeError, UnknownNameError
 from ..kinematics.models import configuration
 from ..robot import Robot
@@ -65,6 +65,8 @@ def isotropy_matrix(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, .
     """
     check_positive_length(length)
     beta = robot.steering(beta, heading)
+    assigned, selected = (as_names(v, k, "velocity names", UnknownNameError)
+                          for k, v in (("assigned", assigned), ("selected", selected)))
     if len(assigned) != len(selected) or set(assigned) & set(selected):
         raise UnknownNameError(f"isotropy_matrix: need as many selected as assigned velocities, disjoint; got "
                                f"{list(assigned)} and {list(selected)}")
@@ -89,6 +91,8 @@ def isotropy_length(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, .
     Without omega among the velocities there is no D to choose: returns ``(nan, kappa)``.
     """
     beta = robot.steering(beta, heading)
+    assigned, selected = (as_names(v, k, "velocity names", UnknownNameError)
+                          for k, v in (("assigned", assigned), ("selected", selected)))
     if "omega" not in assigned + selected:
         return float("nan"), float(condition_number(isotropy_matrix(robot, beta, assigned, selected)))
     return _minimise_length(lambda d: float(condition_number(isotropy_matrix(robot, beta, assigned, selected,
@@ -126,7 +130,8 @@ class TwistModel:
 
 def twist_model(robot: Robot, joints: tuple[str, ...] | None = None) -> TwistModel:
     """The :class:`TwistModel` of `robot` for `joints` (names from ``robot.rate_names``; default actuated)."""
-    joints = default_joints(robot) if joints is None else tuple(joints)
+    joints = default_joints(robot) if joints is None else as_names(joints, "joints", "joint rate names",
+                                                                   UnknownNameError)
     for n in joints:
         if n not in robot.rate_names:
             raise UnknownNameError(f"robot '{robot.name}' has no joint rate '{n}' "

@@ -22,9 +22,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.linalg import block_diag
 
-from .._shapes import as_vectors, readonly
+from .._shapes import as_names, as_vectors, readonly
 from ..couplings import Coupling, coupled_columns
-from ..errors import ShapeError
+from ..errors import ShapeError, UnknownNameError
 from ..kinematics.linalg import rref
 from ..robot import TWIST_NAMES, Robot, element_table
 from ._fast import cancel_roundoff
@@ -133,6 +133,7 @@ def constraint_lines(robot: Robot, assigned: tuple[str, ...] = (), *, coupled: b
     its joints together. The free rates of the coupled wheels are then eliminated together, so a line may combine
     the rows of several wheels (the actuated model of a robot driven through a differential).
     """
+    assigned = as_names(assigned, "assigned", "velocity names", UnknownNameError)
     for name in assigned:
         robot.velocity_index(name)
     coupled = coupled and any(c.rates for c in robot.couplings)

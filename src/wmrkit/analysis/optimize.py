@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
+from .._shapes import as_names
 from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
 from . import _fast
@@ -56,6 +57,7 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
     if variables is None:
         used = set(constraint_lines(robot).wheels) | {n.split(".")[0] for n in model.joints}
         variables = tuple(n for n in steer if n in used)
+    variables = as_names(variables, "variables", "steering wheel names", UnknownNameError)
     for v in variables:
         if v not in steer:
             raise UnknownNameError(f"robot '{robot.name}' has no steering wheel '{v}' (steering: {', '.join(steer)})")

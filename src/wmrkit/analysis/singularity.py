@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
+from .._shapes import as_names
 from ..couplings import coupled_columns
 from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import matrix_rank, nondimensional
@@ -160,6 +161,7 @@ def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[st
     steer = robot.steer_names
     if variables is None:
         variables = tuple(n for n in steer if n in cl.wheel_names)
+    variables = as_names(variables, "variables", "steering wheel names", UnknownNameError)
     for v in variables:
         if v not in steer:
             raise UnknownNameError(f"robot '{robot.name}' has no steering wheel '{v}' (steering: {', '.join(steer)})")

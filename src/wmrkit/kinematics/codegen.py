@@ -26,6 +26,7 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 
+from .._shapes import as_names
 from ..errors import SingularError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
 from .linalg import matrix_rank
@@ -63,9 +64,7 @@ class _Plan:
         # beta = heading + offset (Robot.beta_of_heading; the offset is beta at heading 0, pi/2 - delta)
         self.offsets = tuple(float(b) for b in robot.beta_of_heading(np.zeros(len(self.beta))))
         self.twist = tuple(sp.Symbol(n, real=True) for n in TWIST_NAMES)
-        if isinstance(sensed, str):  # tuple("left.spin") would read ('l', 'e', ...)
-            raise CodegenError(f"sensed: expected a sequence of names, got the string '{sensed}'")
-        self.sensed = tuple(sensed) if sensed is not None else sensed_rates(robot)
+        self.sensed = as_names(sensed, "sensed", error=CodegenError) if sensed is not None else sensed_rates(robot)
         for n in self.sensed:
             if robot.velocity_index(n) < 3:
                 raise CodegenError(f"sensed: '{n}' is a body velocity; sensed inputs are wheel joint rates")

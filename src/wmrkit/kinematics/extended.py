@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, readonly
-from ..errors import ShapeError, SingularError
+from .._shapes import as_names, as_vectors, readonly
+from ..errors import ShapeError, SingularError, UnknownNameError
 from ..robot import Robot
 from .linalg import solve_assigned
 from .models import bounded, configuration, describe_configuration, generic_mobility, velocity_indices
@@ -57,6 +57,10 @@ class ExtendedSolution:
 
     def values(self, names: Sequence[str]) -> np.ndarray:
         """The entries of ``q_dot`` named `names`: ``(..., len(names))``."""
+        names = as_names(names, "names", "velocity names", UnknownNameError)
+        unknown = [n for n in names if n not in self.velocity_names]
+        if unknown:
+            raise UnknownNameError(f"no velocity '{unknown[0]}' (velocities: {', '.join(self.velocity_names)})")
         return self.q_dot[..., [self.velocity_names.index(n) for n in names]]
 
     def as_dict(self) -> dict[str, Any]:

@@ -18,7 +18,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, matvec, readonly
+from .._shapes import as_names, as_vectors, matvec, readonly
 from ..errors import ShapeError, SingularError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..robot import TWIST_NAMES, Robot
@@ -116,8 +116,7 @@ def bounded(q: np.ndarray, names: Sequence[str], argument: str, limit: float = M
 
 def velocity_indices(robot: Robot, names: Sequence[str]) -> np.ndarray:
     """Columns of ``A`` (3.22) of the velocities `names` ``(n,)``; unknown or repeated names raise."""
-    if isinstance(names, str):
-        raise WmrkitError(f"assigned velocities: expected a sequence of names, got the string '{names}'")
+    names = as_names(names, "assigned velocities", error=WmrkitError)
     if len(set(names)) != len(names):
         raise WmrkitError(f"assigned velocities: repeated name in {tuple(names)}")
     return np.array([robot.velocity_index(n) for n in names], dtype=int).reshape(len(names))

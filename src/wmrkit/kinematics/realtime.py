@@ -26,7 +26,8 @@ import numba
 import numpy as np
 
 from .._jit import drop_stale_cache, float64_vector
-from ..errors import WmrkitError
+from .._shapes import as_names
+from ..errors import SelectionError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..odometry import _kernels
 from ..odometry._kernels import _cos_sin, _sinc
@@ -72,6 +73,8 @@ def realtime(robot: Robot, sensed: tuple[str, ...] | None = None, *, speed_tol: 
     from ..odometry.model import odometry_model
 
     check_tolerances(speed_tol, slip_tol)
+    if sensed is not None:  # a wrong argument is refused here, not kept as the FK's refusal (a lone string was)
+        sensed = as_names(sensed, "sensed", "'wheel.joint' names", SelectionError)
     p = _ik_fast.plan(robot)
     ik = _ik_kernel(p, robot, speed_tol, slip_tol)
     try:

@@ -20,6 +20,7 @@ from typing import Literal
 
 import sympy as sp
 
+from .._shapes import as_names
 from ..errors import SingularError, UnknownNameError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
 from ..units import MAX_ANGLE, MAX_TURNS
@@ -182,9 +183,7 @@ def symbolic_model(
     whose unknowns couple more than `max_lsq_angles` steering symbols (:data:`MAX_LSQ_ANGLES`) is refused at once
     with :class:`ClosedFormTooLargeError` (the derivation grows about fourfold per angle).
     """
-    if isinstance(assigned, str):  # tuple("vx") would read ('v', 'x')
-        raise AssignmentError(f"assigned: expected a sequence of names, got the string '{assigned}'")
-    names = tuple(assigned)
+    names = as_names(assigned, "assigned", error=AssignmentError)
     for n in names:
         robot.velocity_index(n)
         if names.count(n) > 1:

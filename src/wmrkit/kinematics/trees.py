@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import readonly
+from .._shapes import as_names, readonly
 from ..errors import SelectionError, UnknownNameError
 from ..robot import TWIST_NAMES, Robot
 from .linalg import delta_projector, matrix_rank, nondimensional, velocity_scale
@@ -238,8 +238,7 @@ def select_columns(robot: Robot, joints: Sequence[str], role: str) -> tuple[tupl
     steerable wheels whose ``steer`` joint is listed (a configuration joint: it sets beta, not a column).
     Refuses ``omega`` and the twist (no physical joint, §4.4.3) and roller rates (not accessible, §3.3.3).
     """
-    if isinstance(joints, str):
-        raise SelectionError(f"{role} joints: expected a sequence of 'wheel.joint' names, got the string '{joints}'")
+    joints = as_names(joints, f"{role} joints", "'wheel.joint' names", SelectionError)
     names, columns, steering = jacobian_names(robot), [], []
     for joint in joints:
         if joint in TWIST_NAMES or joint.startswith("omega@"):

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_reals, as_vectors, finite_number, readonly
+from .._shapes import as_names, as_reals, as_vectors, finite_number, readonly
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
@@ -305,7 +305,7 @@ def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: 
     True iff ``rank(A_na) = n_twist_free + rank(A_rest)`` (4.10): ``A_na`` the columns not assigned, ``A_rest``
     those of the unknown joint rates, ``n_twist_free`` the twist components not assigned.
     """
-    columns = _assigned_columns(robot, list(names))
+    columns = _assigned_columns(robot, list(as_names(names, "names", "joint rate names", UnknownNameError)))
     a = robot.constraint_matrix(beta, heading=heading)
     free = np.setdiff1d(np.arange(a.shape[-1]), columns)
     rest = free[free >= 3]

@@ -43,6 +43,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._shapes import as_names
 from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
 from ..wheels import GEOMETRY_FIELDS, Wheel
@@ -336,8 +337,8 @@ def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence
         raise WmrkitError("calibrate: no runs")
     if not (np.isfinite(heading_weight) and heading_weight >= 0):
         raise WmrkitError(f"calibrate: heading_weight must be finite and >= 0 [m/rad], got {heading_weight!r}")
-    if isinstance(sensed, str):  # tuple("left.spin") would read ('l', 'e', ...)
-        raise WmrkitError(f"calibrate: sensed: expected a sequence of 'wheel.joint' names, got the string '{sensed}'")
+    if sensed is not None:
+        sensed = as_names(sensed, "calibrate: sensed", "'wheel.joint' names", WmrkitError)
     groups = _groups(robot, parameters)
     problem = CalibrationProblem(robot, tuple(parameters), tuple(runs), method, heading_weight,
                                  None if sensed is None else tuple(sensed), weights, run_weights)

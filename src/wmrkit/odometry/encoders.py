@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._shapes import as_names
 from ..errors import UnknownNameError, WmrkitError
 
 
@@ -215,7 +216,7 @@ def encoders_for(robot_name: str, joints: Sequence[str], *, counts_per_rev: floa
     """
     known = CATALOG_ENCODERS.get(robot_name, {})
     out = []
-    for joint in joints:
+    for joint in as_names(joints, "joints", "joint names", EncoderError):
         if joint.endswith(".steer"):
             enc = AbsoluteEncoder(steer_resolution) if steer_resolution is not None else known.get(joint)
         elif counts_per_rev is not None:

@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
-from .._shapes import as_reals
+from .._shapes import as_names, as_reals
 from ..errors import WmrkitError
 from ..limits import check_chunk_size, regular_file_problem
 from ._text import check_lines, did_you_mean, encoded, read_lines, short
@@ -272,9 +272,7 @@ class Decoder:
 
 def joint_names(joints: Sequence[str], source: str) -> tuple[str, ...]:
     """`joints` as a tuple; a lone string (``"left.spin"``, read as one joint per letter) is a :class:`LogError`."""
-    if isinstance(joints, str):
-        raise LogError(f"{source}: joints: expected a sequence of joint names, got the string '{joints}'")
-    return tuple(joints)
+    return as_names(joints, f"{source}: joints", "joint names", LogError)
 
 
 def check_time(log: JointLog, time: np.ndarray, previous: float | None, max_gap: float | None) -> None:

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import readonly
+from .._shapes import as_names, readonly
 from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import matrix_rank, solve_assigned
 from ..robot import Robot
@@ -335,9 +335,7 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
     unweighted ``A dq``. Raises :class:`SensingError` when the joints cannot give the motion,
     :class:`UnknownNameError` for a name the robot lacks.
     """
-    if isinstance(sensed, str):  # tuple("left.spin") would read ('l', 'e', ...); as trees.select_columns
-        raise SensingError(f"sensed: expected a sequence of 'wheel.joint' names, got the string '{sensed}'")
-    sensed = tuple(robot.sensed if sensed is None else sensed)
+    sensed = robot.sensed if sensed is None else as_names(sensed, "sensed", "'wheel.joint' names", SensingError)
     weights = dict(weights or {})
     for name, w in weights.items():
         robot.wheel(name)

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import batch_shape
+from .._shapes import as_names, batch_shape
 from ..dynamics.mass import Body, body_problem
 from ..errors import WmrkitError
 from ..kinematics.linalg import solve_assigned
@@ -125,8 +125,7 @@ def assigned_columns(robot: Robot, assigned: Sequence[str]) -> np.ndarray:
 def _assigned(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Columns and values ``(..., n_a)`` of the assigned velocities; :class:`WmrkitError` naming `q_assigned` when
     its last axis is not one value per name or a value is not a finite number within ``MAX_QUERY_RATE``."""
-    if isinstance(assigned, str):  # tuple("left.spin") would read ('l', 'e', ...)
-        raise WmrkitError(f"assigned: expected a sequence of velocity names, got the string '{assigned}'")
+    assigned = as_names(assigned, "assigned", "velocity names", WmrkitError)
     if not assigned or len(set(assigned)) != len(assigned):
         raise WmrkitError(f"assigned: expected distinct velocity names, at least one, got {list(assigned)}")
     cols = assigned_columns(robot, assigned)
