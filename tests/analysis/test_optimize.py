@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 from thesis_vehicles import DEG, differential, robot
 
-from wmrkit import UnknownNameError, catalog
+from wmrkit import Robot, UnknownNameError, catalog
+from wmrkit.analysis.isotropy import natural_length
 from wmrkit.analysis.optimize import best_configurations, optimize_geometry
 
 
@@ -73,8 +74,6 @@ def test_best_configurations_of_a_type3_robot_are_local_minima():
     assert 1 <= len(found) <= 3
     ks = [c.condition_number for c in found]
     assert ks == sorted(ks)
-    from wmrkit.analysis.isotropy import natural_length
-
     for c in found:
         beta = np.array(c.beta)
         k0 = natural_length(r, beta)[1]
@@ -193,3 +192,19 @@ def test_best_two_wheel_configuration_against_brute_force():
     fine = np.stack([condition_map(r, beta, length=d) for d in lengths])
     assert best.condition_number <= fine.min() * (1 + 1e-9)
     assert fine.min() == pytest.approx(best.condition_number, rel=1e-5)
+
+
+def test_conditioning_gives_the_configuration_as_headings_too():
+    """Conditioning.beta is the thesis's angle; .heading (added beside it) is the users' angle by the robot's own
+    conversion, so that a configuration found can be passed back as heading=."""
+    data = catalog.load("thesis-steer-castor").to_dict()
+    data["wheels"][1]["delta"] = 0.3  # a castor whose heading and beta differ by more than pi/2
+    r = Robot.from_dict(data)
+    found = best_configurations(r, resolution=36, count=2)
+    for c in found:
+        assert c.heading == tuple(r.heading_of_beta(np.array(c.beta)).tolist())
+        back = r.beta_of_heading(c.heading) - np.array(c.beta)
+        assert np.allclose(np.angle(np.exp(1j * back)), 0.0, atol=1e-12)
+        assert natural_length(r, heading=c.heading) == pytest.approx(natural_length(r, np.array(c.beta)), rel=1e-9)
+    (still,) = best_configurations(catalog.load("thesis-omni-swedish"))
+    assert still.heading == still.beta == ()

@@ -28,11 +28,16 @@ from .singularity import robot_size
 
 @dataclass(frozen=True)
 class Conditioning:
-    """A steering configuration ``beta`` ``(n_steer,)`` [rad], its length D [m] and condition number (5.28)."""
+    """A steering configuration ``beta`` ``(n_steer,)`` [rad], its length D [m] and condition number (5.28).
+
+    ``heading`` is the same configuration as the users' angles (rolling directions, 0 = straight ahead), by the
+    robot's own conversion :meth:`~wmrkit.robot.Robot.heading_of_beta`; ``beta`` is the thesis's.
+    """
 
     beta: tuple[float, ...]
     length: float
     condition_number: float
+    heading: tuple[float, ...]
 
 
 def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, length: float | None = None,
@@ -78,7 +83,7 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
 
     if not idx:
         d, k = natural_length(robot, joints=model.joints) if length is None else (length, score(np.zeros(0)))
-        return (Conditioning(tuple(robot.beta.tolist()), d, k),)
+        return (Conditioning(tuple(robot.beta.tolist()), d, k, tuple(robot.heading.tolist())),)
     per_axis = min(resolution, _grid_points(max_samples, len(idx)))
     if len(idx) == 1:
         per_axis = resolution
@@ -113,7 +118,8 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
             continue
         b = full(x)
         d = _natural_length(model, b, size)[0] if length is None else length
-        out.append(Conditioning(tuple(float(v) for v in b), float(d), float(k)))
+        out.append(Conditioning(tuple(float(v) for v in b), float(d), float(k),
+                                tuple(robot.heading_of_beta(b).tolist())))
     return tuple(out)
 
 
