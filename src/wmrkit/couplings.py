@@ -15,13 +15,19 @@ one actuator or sensor per coupling instead of one per joint, and no longer repo
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ._shapes import finite_number
+from ._shapes import as_names, finite_number
 from .errors import UnknownNameError, WmrkitError
 from .limits import MAX_COUPLING_RATIO, MIN_COUPLING_RATIO, MIN_RATIO
+
+if TYPE_CHECKING:
+    from .robot import Robot
+    from .wheels import Wheel
 
 COUPLING_KINDS = ("differential", "gear", "linkage")
 
@@ -39,7 +45,11 @@ class Coupling:
     ratios: tuple[float, ...]
 
     def __post_init__(self) -> None:
-        name = f"coupling {self.kind}({', '.join(map(str, self.joints))})"
+        joints = as_names(self.joints, f"coupling {self.kind}: joints", "'wheel.joint' names", CouplingError)
+        object.__setattr__(self, "joints", joints)  # lists, as a description has them, kept as tuples (hashed)
+        if isinstance(self.ratios, list | np.ndarray):
+            object.__setattr__(self, "ratios", tuple(self.ratios))
+        name = f"coupling {self.kind}({', '.join(joints)})"
         if self.kind not in COUPLING_KINDS:
             raise CouplingError(f"{name}: unknown kind (kinds: {', '.join(COUPLING_KINDS)})")
         if len(self.joints) < 2 or len(set(self.joints)) != len(self.joints) or len(self.ratios) != len(self.joints):
@@ -60,6 +70,39 @@ class Coupling:
     def channel_name(self) -> str:
         """The name of the one actuator or sensor it makes of its joints: ``differential(a.spin, b.spin)``."""
         return f"{self.kind}({', '.join(self.joints)})"
+
+
+def joint_problem(kind: str, joint: str, wheels: Mapping[str, Wheel],
+                  did_you_mean: Callable[[], str] = lambda: "") -> str | None:
+    """Why `joint` (``wheel.joint``) cannot be in a coupling of `kind` on a robot whose `wheels` are given by name,
+    or None: the robot has the joint, a steering angle in a linkage and a joint rate in the other kinds."""
+    wheel, _, part = joint.partition(".")
+    w = wheels.get(wheel)
+    if w is None or part not in w.kind.joints:
+        return f"no joint '{joint}' on this robot{did_you_mean()}"
+    steer_angle = part == "steer" and "steer" not in w.kind.rates
+    if steer_angle != (kind == "linkage"):
+        return (f"'{joint}' is {'a steering angle' if steer_angle else 'a joint rate'}: a {kind} couples "
+                f"{'steering angles (kind: linkage)' if kind == 'linkage' else 'rates'}")
+    return None
+
+
+def check_couplings(robot: Robot) -> None:
+    """A robot built in Python couples joints as a description does (``description._couplings_from_dict``): a
+    tuple of :class:`Coupling` whose joints the robot has, each in one coupling at most; else :class:`CouplingError`
+    naming it (a linkage of a joint the robot lacks was ignored without a word)."""
+    couplings = robot.couplings
+    if not isinstance(couplings, tuple) or not all(isinstance(c, Coupling) for c in couplings):
+        raise CouplingError(f"robot '{robot.name}': couplings: expected a tuple of Coupling, got {couplings!r:.80}")
+    wheels = {w.name: w for w in robot.wheels}
+    used: set[str] = set()
+    for i, c in enumerate(couplings):
+        for joint in c.joints:
+            problem = joint_problem(c.kind, joint, wheels) or (f"joint '{joint}' is in two couplings"
+                                                                if joint in used else None)
+            if problem is not None:
+                raise CouplingError(f"robot '{robot.name}': couplings[{i}] {c.channel_name}: {problem}")
+            used.add(joint)
 
 
 def channel_names(couplings: tuple[Coupling, ...], joints: tuple[str, ...]) -> tuple[str, ...]:

@@ -19,7 +19,7 @@ from typing import Any
 import yaml
 
 from ._atomic import atomic_path
-from .couplings import COUPLING_KINDS, Coupling
+from .couplings import COUPLING_KINDS, Coupling, joint_problem
 from .documents import DescriptionError, FieldReader, LineOf, Loc, hint, read_document, read_file, short_repr
 from .dynamics import mass
 from .limits import (  # noqa: F401  (the limits are part of the description format)
@@ -139,15 +139,9 @@ def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) ->
         if not isinstance(joints, list) or len(joints) < 2 or not all(isinstance(j, str) for j in joints):
             check.fail("must be a list of two or more joint names 'wheel.joint'", (*loc, "joints"))
         for j, joint in enumerate(joints):
-            wheel, _, part = joint.partition(".")
-            w = by_name.get(wheel)
-            if w is None or part not in w.kind.joints:
-                check.fail(f"no joint '{joint}' on this robot{hint(joint, _joint_names(wheels))}", (*loc, "joints", j))
-            steer_angle = part == "steer" and "steer" not in w.kind.rates
-            if steer_angle != (kind == "linkage"):
-                check.fail(f"'{joint}' is {'a steering angle' if steer_angle else 'a joint rate'}: a "
-                           f"{kind} couples {'steering angles (kind: linkage)' if kind == 'linkage' else 'rates'}",
-                           (*loc, "joints", j))
+            problem = joint_problem(kind, joint, by_name, lambda joint=joint: hint(joint, _joint_names(wheels)))
+            if problem is not None:
+                check.fail(problem, (*loc, "joints", j))
             if joint in used:
                 where = "twice in this coupling" if joint in joints[:j] else "in two couplings"
                 check.fail(f"joint '{joint}' is {where}", (*loc, "joints", j))

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._shapes import as_angles, as_vectors, readonly
-from .couplings import Coupling
+from .couplings import Coupling, check_couplings
 from .dynamics.mass import Body
 from .errors import ShapeError, UnknownNameError
 from .wheels import Wheel, WheelError, generic_wheel_jacobian, rotate_rows_to_robot
@@ -43,6 +43,7 @@ class Robot:
 
     def __post_init__(self) -> None:
         _check_wheels(self)
+        check_couplings(self)
         # Hashed once: derived arrays are cached per robot (keyed by it) and looked up on every batched call.
         object.__setattr__(self, "_hash", hash((self.name, self.wheels, self.notes, self.couplings, self.body,
                                                    self.odometry)))

@@ -271,7 +271,8 @@ def coupled_cases(draw):
     from wmrkit.couplings import Coupling
 
     r = draw(robots(max_wheels=4))
-    rates = list(r.rate_names)
+    # the rates a coupling may hold, as in a description: not a roller's (no joint to couple: Robot refuses it)
+    rates = [n for n in r.rate_names if n.partition(".")[2] in r.wheel(n.partition(".")[0]).kind.joints]
     assume(len(rates) >= 2)
     order = draw(st.permutations(rates))
     couplings, k = [], 0

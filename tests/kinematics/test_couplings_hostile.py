@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from strategies import wheels
-from wmrkit import Robot, UnknownNameError, catalog
+from wmrkit import Robot, catalog
 from wmrkit.couplings import Coupling, CouplingError
 from wmrkit.errors import DescriptionError
 from wmrkit.kinematics.actuation import actuation_analysis, actuation_tree
@@ -51,10 +51,35 @@ def test_a_python_coupling_is_checked_like_a_described_one():
         Coupling("chain", ("a.spin", "b.spin"), (1.0, 1.0))
     with pytest.raises(CouplingError, match="magnitude"):
         Coupling("gear", ("a.spin", "b.spin"), (float("nan"), 1.0))
-    robot = dataclasses.replace(catalog.load("forklift"),
-                                couplings=(Coupling("gear", ("right_drive.spin", "rear.spin"), (1.0, 1.0)),))
-    with pytest.raises(UnknownNameError, match=r"no joint rate rear\.spin"):
-        actuation_analysis(robot)
+    forklift = catalog.load("forklift")
+    with pytest.raises(CouplingError, match=r"^robot 'forklift': couplings\[0\] gear\(right_drive\.spin, rear\.spin\): "
+                                            r"no joint 'rear\.spin' on this robot$"):
+        dataclasses.replace(forklift, couplings=(Coupling("gear", ("right_drive.spin", "rear.spin"), (1.0, 1.0)),))
+
+
+@pytest.mark.parametrize(("couplings", "match"), [
+    # a linkage of a joint the robot lacks was ignored: the analyses answered as if the robot had no linkage
+    ((Coupling("linkage", ("nope.steer", "front_left.steer"), (1.0, 1.0)),), r"no joint 'nope\.steer' on this robot"),
+    ((Coupling("linkage", ("rear_left.spin", "rear_right.spin"), (1.0, 1.0)),),
+     r"'rear_left\.spin' is a joint rate: a linkage couples steering angles"),
+    ((Coupling("gear", ("front_left.steer", "front_right.steer"), (1.0, 1.0)),), r"'front_left\.steer' is a steering"),
+    ((Coupling("gear", ("rear_left.spin", "rear_right.spin"), (1.0, 1.0)),
+      Coupling("differential", ("rear_right.spin", "front_left.spin"), (0.5, 0.5))),
+     r"couplings\[1\] .*: joint 'rear_right\.spin' is in two couplings"),
+    ("differential", r"couplings: expected a tuple of Coupling, got 'differential'"),  # was read letter by letter
+    ([], r"couplings: expected a tuple of Coupling, got \[\]"),  # TypeError: unhashable type: 'list'
+])
+def test_a_python_robot_s_couplings_are_checked_like_a_description_s(couplings, match):
+    with pytest.raises(CouplingError, match=r"^robot 'ackermann': (couplings\[0\] [^:]*: )?" + match):
+        dataclasses.replace(catalog.load("ackermann"), couplings=couplings)
+
+
+def test_a_coupling_reads_its_joints_as_names():
+    with pytest.raises(CouplingError, match=r"^coupling linkage: joints: expected a sequence of 'wheel\.joint' names, "
+                                            r"got the string 'front_left\.steer'$"):  # was linkage(f, r, o, n, ...)
+        Coupling("linkage", "front_left.steer", (1.0,))
+    listed = Coupling("gear", ["a.spin", "b.spin"], [1.0, 2.0])  # lists, as a description has them
+    assert listed == Coupling("gear", ("a.spin", "b.spin"), (1.0, 2.0)) and hash(listed)
 
 
 def car_with(couplings: list[dict]) -> Robot:
