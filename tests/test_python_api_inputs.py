@@ -217,3 +217,15 @@ def test_names_that_are_no_strings_are_refused():
     with pytest.raises(WmrkitError, match=r"^assigned: expected a sequence of velocity names, got 3$"):
         singular_set(ACKERMANN, 3)
     assert singular_set(ACKERMANN, ["vx", "omega"]).assigned == ("vx", "omega")  # a list still does
+
+
+@pytest.mark.parametrize(("change", "match"), [
+    ({"name": 5}, r"^robot 5: name: expected a text, got int$"),  # was built, and to_file refused it
+    ({"notes": ["a"]}, r"^robot 'ackermann': notes: expected a text, got list$"),  # TypeError: unhashable type
+    ({"body": {"mass": 10.0}}, r"^robot 'ackermann': body: expected a wmrkit\.dynamics\.mass\.Body or None, got dict$"),
+])
+def test_a_robot_s_name_notes_and_body_are_checked(change, match):
+    import dataclasses
+
+    with pytest.raises(WmrkitError, match=match):
+        dataclasses.replace(ACKERMANN, **change)

@@ -283,7 +283,15 @@ class Robot:
 
 def _check_wheels(robot: Robot) -> None:
     """A robot built in Python has wheels as a description has them: a non-empty tuple of :class:`Wheel` with
-    distinct names (two wheels named 'left' gave the velocity 'left.spin' twice)."""
+    distinct names (two wheels named 'left' gave the velocity 'left.spin' twice); a text name and notes and a
+    :class:`Body` or None (a dict raised TypeError 'unhashable type', a name 5 was taken)."""
+    for key, expected, ok in (("name", "a text", isinstance(robot.name, str)),
+                              ("notes", "a text", isinstance(robot.notes, str)),
+                              ("body", "a wmrkit.dynamics.mass.Body or None",
+                               robot.body is None or isinstance(robot.body, Body))):
+        if not ok:
+            got = type(getattr(robot, key)).__name__
+            raise WheelError(f"robot {robot.name!r:.40}: {key}: expected {expected}, got {got}")
     wheels = robot.wheels
     if not isinstance(wheels, tuple) or not wheels:
         raise WheelError(f"robot '{robot.name}': wheels: expected a non-empty tuple of Wheel, got "
