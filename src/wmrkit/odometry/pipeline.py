@@ -178,6 +178,9 @@ def final_poses(model: OdometryModel, log: JointLog, positions: np.ndarray, *,
     ``(R, N, n)`` (joints in ``model.joints`` order) in place of the log's own: many runs of one log (Monte Carlo)
     without the per-call work of :func:`odometry` (one compiled pass per run, the time checked once)."""
     check_method(method)
+    if log.heading_world is not None:  # odometry() would take theta from it; the runs here have none
+        raise LogError(f"{log.source}: an external heading (heading_world) is not used by final_poses; give the log "
+                       "without it")
     log = log if log.joints == model.joints else log.select(model.joints)
     runs, n = positions.shape[0], len(log)
     if positions.shape[1:] != log.positions.shape or n < 2:
