@@ -204,3 +204,35 @@ def test_a_log_with_an_external_heading_is_refused(diff, square):
         monte_carlo(diff, log, 10)
     with pytest.raises(LogError, match=r"imu\.csv: an external heading"):
         final_poses(odometry_model(diff), log, square.positions[None])
+
+
+def test_the_work_bound_counts_a_steered_robots_run():
+    """A run's fixed cost is not the same for every robot: about 20 us for a fixed configuration, about 100 us
+    for a steered robot (its configuration maps looked up each run), 1.5-2.6 ms where the perturbed joints are
+    the configuration (each run's new configurations are added to the maps the model keeps). Counted as 1000
+    for all, short logs let one worker take 1e6 runs of swerve-4 (about 100 s) and 284,616 runs of
+    thesis-omni-castor (about 10 min: 20,000 took 36 s) instead of the documented minute."""
+    from wmrkit import catalog
+    from wmrkit.batch.montecarlo import (
+        CONFIGURATION_COST,
+        CONFIGURATION_RUN_COST,
+        MAX_RUNS,
+        MAX_WORK,
+        RUN_COST,
+        STEERED_RUN_COST,
+        study_cost,
+    )
+    from wmrkit.odometry.model import odometry_model
+
+    assert RUN_COST < STEERED_RUN_COST < CONFIGURATION_RUN_COST
+    for name, per_sample, per_run in (("diff-drive", 5, RUN_COST), ("swerve-4", 11, STEERED_RUN_COST),
+                                      ("thesis-omni-castor", 9 + CONFIGURATION_COST, CONFIGURATION_RUN_COST)):
+        robot = catalog.load(name)
+        log = path_log(robot, "square", 0.05)  # 3 samples
+        assert study_cost(odometry_model(robot), log, 7) == 7 * (3 * per_sample + per_run)
+    swerve = catalog.load("swerve-4")
+    with pytest.raises(BatchError, match=rf"at most {int(MAX_WORK // (33 + STEERED_RUN_COST))} runs of this log"):
+        monte_carlo(swerve, path_log(swerve, "square", 0.05), MAX_RUNS)
+    castor = catalog.load("thesis-omni-castor")
+    with pytest.raises(BatchError, match=r"at most \d+ runs of this log \(3 samples of 6 joints\)"):
+        monte_carlo(castor, path_log(castor, "square", 0.05), 10**5)

@@ -152,12 +152,20 @@ MAX_RUNS = 10**6
 #: Most numbers in the log, samples x (joints + 3): each run holds a few arrays of its size (a log of 3e6 samples of
 #: two joints took 850 MB for two runs).
 MAX_LOG_VALUES = 1 << 23
-#: Most work of a study per worker, in numbers integrated: runs x (samples x (joints + 3) + :data:`RUN_COST` +
-#: samples x :data:`CONFIGURATION_COST` where a perturbed joint is also the configuration). Integration runs at
-#: 15-35 ns a number on one core (diff-drive to swerve-4, squares), so at most about 30-70 s a worker.
+#: Most work of a study per worker, in numbers integrated: runs x (samples x (joints + 3) + a run's fixed cost
+#: (:data:`RUN_COST`, :data:`STEERED_RUN_COST`, :data:`CONFIGURATION_RUN_COST`) + samples x
+#: :data:`CONFIGURATION_COST` where a perturbed joint is also the configuration). Integration runs at 15-35 ns a
+#: number on one core (diff-drive to swerve-4, squares), so at most about 30-70 s a worker.
 MAX_WORK = 2e9
 #: A run's fixed cost in numbers integrated (about 20 us: the random draws' set-up, the checks, the kernel's call).
 RUN_COST = 1000
+#: A steered robot's run's fixed cost (about 100 us: its configuration maps are looked up each run; 1e6 runs of
+#: a 3-sample log of swerve-4, counted at :data:`RUN_COST`, took about 100 s).
+STEERED_RUN_COST = 5000
+#: A run's fixed cost where a perturbed joint is the configuration (1.5-2.6 ms: each run's new configurations are
+#: added to the maps the model keeps; counted at :data:`RUN_COST`, 284,616 runs of a 3-sample log of
+#: thesis-omni-castor were allowed, about 10 min).
+CONFIGURATION_RUN_COST = 100_000
 #: A sample's extra cost in numbers integrated when its configuration is perturbed (a castor's angle, a double
 #: wheel's steering: both a sensed rate and the configuration): every run meets new configurations, whose maps are
 #: computed (about 4-25 us a sample, thesis-omni-castor the slowest).
@@ -168,7 +176,8 @@ def study_cost(model: OdometryModel, log: JointLog, runs: int) -> float:
     """The work of `runs` runs of `log` (:data:`MAX_WORK`'s units)."""
     moving = set(model.steer_joints) & set(model.rate_joints)
     per_sample = len(log.joints) + 3 + (CONFIGURATION_COST if moving else 0)
-    return runs * (len(log) * per_sample + RUN_COST)
+    per_run = CONFIGURATION_RUN_COST if moving else RUN_COST if model.constant else STEERED_RUN_COST
+    return runs * (len(log) * per_sample + per_run)
 
 
 def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4, resolution: float = 0.0,
