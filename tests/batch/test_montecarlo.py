@@ -236,3 +236,19 @@ def test_the_work_bound_counts_a_steered_robots_run():
     castor = catalog.load("thesis-omni-castor")
     with pytest.raises(BatchError, match=r"at most \d+ runs of this log \(3 samples of 6 joints\)"):
         monte_carlo(castor, path_log(castor, "square", 0.05), 10**5)
+
+
+def test_a_log_of_one_sample_is_refused_by_name(diff, tmp_path, capsys):
+    """A LOG of one sample has no motion to perturb: it was integrated, then every block failed with the kernel's
+    'task 0 failed: positions: expected (runs, 1, 2) of a log of at least 2 samples, got (256, 1, 2)', naming
+    neither the log nor the option."""
+    import json
+
+    from wmrkit.cli.main import main
+
+    log = tmp_path / "one.csv"
+    log.write_text("time,left.spin,right.spin\n0,0,0\n")
+    assert main(["batch", "montecarlo", "diff-drive", str(log), "--workers", "0", "--json"]) == 2
+    err = json.loads(capsys.readouterr().err)
+    assert err["file"] == str(log) and "1 sample" in err["error"] and "at least 2" in err["error"]
+    assert "task" not in err["error"]

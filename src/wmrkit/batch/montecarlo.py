@@ -196,6 +196,9 @@ def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4
         raise BatchError(f"noise must be in [0, 1] (per rad), resolution in [0, pi] rad and slip in [0, 1] (the "
                          f"standard deviation of a slip ratio), got {per_rad:g}, {resolution:g}, {slip_std:g}")
     check_seed(seed, BatchError)
+    if len(log) < 2:  # no motion to perturb (every run failed in the kernel, naming neither log nor option)
+        raise BatchError(f"{log.source}: {len(log)} sample{'s' * (len(log) != 1)}: a Monte Carlo study needs a log of "
+                         "at least 2 samples")
     if log.heading_world is not None:  # the runs would integrate without it, the nominal pose with it
         raise BatchError(f"{log.source}: an external heading (heading_world) is not sampled by the Monte Carlo "
                          "runs, which perturb the joints only; give the log without it")
