@@ -252,3 +252,14 @@ def test_a_log_of_one_sample_is_refused_by_name(diff, tmp_path, capsys):
     err = json.loads(capsys.readouterr().err)
     assert err["file"] == str(log) and "1 sample" in err["error"] and "at least 2" in err["error"]
     assert "task" not in err["error"]
+
+
+def test_final_poses_take_positions_as_any_array_like(diff, square):
+    """A list of runs (as JointLog takes its positions) raised AttributeError: 'list' object has no attribute
+    'shape'; now read as floats, as odometry() reads the same numbers."""
+    from wmrkit.odometry.model import odometry_model
+    from wmrkit.odometry.pipeline import final_poses, odometry
+
+    model = odometry_model(diff)
+    got = final_poses(model, square, [square.positions.tolist()])
+    np.testing.assert_array_equal(got, [odometry(model, square).poses[-1]])

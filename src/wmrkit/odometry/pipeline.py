@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors
+from .._shapes import as_reals, as_vectors
 from ..errors import WmrkitError
 from ..limits import MAX_COORDINATE, check_chunk_size
 from ..robot import Robot
@@ -182,10 +182,12 @@ def final_poses(model: OdometryModel, log: JointLog, positions: np.ndarray, *,
         raise LogError(f"{log.source}: an external heading (heading_world) is not used by final_poses; give the log "
                        "without it")
     log = log if log.joints == model.joints else log.select(model.joints)
-    runs, n = positions.shape[0], len(log)
-    if positions.shape[1:] != log.positions.shape or n < 2:
+    positions = as_reals(positions, "positions")  # a list of runs, as JointLog takes its positions
+    n = len(log)
+    if positions.ndim != 3 or positions.shape[1:] != log.positions.shape or n < 2:
         raise LogError(f"positions: expected (runs, {n}, {len(log.joints)}) of a log of at least 2 samples, got "
                        f"{positions.shape}")
+    runs = positions.shape[0]
     check_chunk(log.slice(0, 1), None, positions=False)
     check_chunk(log.slice(1, n), log.slice(0, 1), positions=False)
     steer = _steer_columns(log)
