@@ -441,3 +441,17 @@ def test_a_fit_that_did_not_converge_is_flagged(diff, runs, monkeypatch):
     monkeypatch.setattr(module, "solve", stopped)
     fit = fleet_calibrate(diff, runs, PARAMS)
     assert not fit.success and any("did not converge" in w and "evaluations" in w for w in fit.warnings)
+
+
+def test_two_logs_of_one_name_are_refused_their_one_reference(diff, calibration_data, tmp_path):
+    """References are found by the log's name (DIR/NAME.tum): robot1/c0.csv and robot2/c0.csv, as a fleet's
+    folders hold them, both took c0.tum, and a log of another run whose times were the same was fitted against it
+    without a word (exit 0)."""
+    import shutil
+
+    for folder, source in (("robot1", "c0.csv"), ("robot2", "c1.csv")):
+        (tmp_path / folder).mkdir()
+        shutil.copy(calibration_data / source, tmp_path / folder / "c0.csv")
+    logs = [str(tmp_path / "robot1" / "c0.csv"), str(tmp_path / "robot2" / "c0.csv")]
+    with pytest.raises(BatchError, match=r"robot2/c0\.csv: its reference .*c0\.tum is also that of .*robot1/c0\.csv"):
+        load_runs(diff, logs, reference_dir=calibration_data / "ref")

@@ -421,6 +421,11 @@ def load_runs(robot: Robot, paths: Sequence[str], *, reference_dir: str | os.Pat
     if (reference_dir is None) == (not closed):
         raise BatchError("give reference trajectories (a folder) or closed paths, one of the two")
     refs = [None if closed else find_reference(p, reference_dir) for p in paths]
+    owner: dict[str, str] = {}  # a reference is one run's truth: two logs of one name (robot1/run.csv, robot2/...)
+    for p, r in zip(paths, refs, strict=True):
+        if r is not None and owner.setdefault(os.path.realpath(r), p) != p:
+            raise BatchError(f"{p}: its reference {r} is also that of {owner[os.path.realpath(r)]} (a log's reference "
+                             "is DIR/NAME.tum by the log's name): give the logs names of their own")
     own = runner is None
     runner = engine(workers=0) if runner is None else runner
     try:
