@@ -455,3 +455,19 @@ def test_two_logs_of_one_name_are_refused_their_one_reference(diff, calibration_
     logs = [str(tmp_path / "robot1" / "c0.csv"), str(tmp_path / "robot2" / "c0.csv")]
     with pytest.raises(BatchError, match=r"robot2/c0\.csv: its reference .*c0\.tum is also that of .*robot1/c0\.csv"):
         load_runs(diff, logs, reference_dir=calibration_data / "ref")
+
+
+def test_sensed_joints_that_cannot_work_are_refused_before_the_logs(diff, calibration_data, capsys):
+    """'batch calibrate --sensed left.spin' (or a wheel the robot lacks) was blamed on the first log, with the
+    exception's class in the message ('c0.csv: SensingError: ...'), as if the log were wrong; 'odometry' and 'batch
+    odometry' name the sensed joints alone."""
+    import json
+
+    from wmrkit.cli.main import main
+
+    for sensed, words in (("left.spin", "do not determine its motion"), ("nosuch.spin", "has no wheel 'nosuch'")):
+        argv = ["batch", "calibrate", "diff-drive", str(calibration_data / "*.csv"), "--reference",
+                str(calibration_data / "ref"), "--sensed", sensed, "--workers", "0", "--json"]
+        assert main(argv) == 2
+        err = json.loads(capsys.readouterr().err)
+        assert words in err["error"] and "Error:" not in err["error"] and err["file"] is None, err

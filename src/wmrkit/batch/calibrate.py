@@ -418,8 +418,11 @@ def load_runs(robot: Robot, paths: Sequence[str], *, reference_dir: str | os.Pat
               closed: bool = False, runner: Engine | None = None, options: Mapping[str, Any] | None = None,
               progress: bool = False) -> list[CalibrationRun]:
     """Runs of many logs, read on the engine (the first bad log raises its error; a tqdm bar with `progress`)."""
+    from ..odometry.model import odometry_model
+
     if (reference_dir is None) == (not closed):
         raise BatchError("give reference trajectories (a folder) or closed paths, one of the two")
+    odometry_model(robot, (options or {}).get("sensed"))  # sensed joints that cannot work: theirs, not the 1st log's
     refs = [None if closed else find_reference(p, reference_dir) for p in paths]
     owner: dict[str, str] = {}  # a reference is one run's truth: two logs of one name (robot1/run.csv, robot2/...)
     for p, r in zip(paths, refs, strict=True):
