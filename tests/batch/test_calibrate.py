@@ -471,3 +471,20 @@ def test_sensed_joints_that_cannot_work_are_refused_before_the_logs(diff, calibr
         assert main(argv) == 2
         err = json.loads(capsys.readouterr().err)
         assert words in err["error"] and "Error:" not in err["error"] and err["file"] is None, err
+
+
+def test_a_log_refused_by_its_header_is_named_as_the_file(diff, tmp_path, capsys):
+    """A wmrkit error of a log other than LogError (a header's unknown unit: HeaderError) came back from the
+    engine as 'HeaderError: run0.csv:1: ...', so --json's file was null and the class name was in the line."""
+    import json
+
+    from wmrkit.cli.main import main
+
+    (tmp_path / "run0.csv").write_text("time [min],left.spin,right.spin\n0,0,0\n1,1,1\n")
+    (tmp_path / "run0.tum").write_text("0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n")
+    argv = ["batch", "calibrate", "diff-drive", str(tmp_path / "run0.csv"), "--reference", str(tmp_path),
+            "--workers", "0", "--json"]
+    assert main(argv) == 2
+    err = json.loads(capsys.readouterr().err)
+    assert err["file"] == str(tmp_path / "run0.csv") and err["line"] == 1, err
+    assert "unknown unit 'min'" in err["error"] and "HeaderError" not in err["error"], err

@@ -63,14 +63,15 @@ def need_extra(module: str) -> Any:
 
 @dataclass(frozen=True, slots=True)
 class TaskFailure:
-    """A task that raised: its position in the input, the exception's type name and one-line message."""
+    """A task that raised: its position in the input, the exception's type name (``WmrkitError`` for every error of
+    wmrkit's, whose messages stand alone) and one-line message."""
 
     index: int
     kind: str
     message: str
 
     def __str__(self) -> str:
-        return f"{self.kind}: {self.message}" if self.kind not in ("LogError", "WmrkitError") else self.message
+        return f"{self.kind}: {self.message}" if self.kind != "WmrkitError" else self.message
 
 
 def _call(fn: Callable[[Any], Any], index: int, item: Any) -> tuple[int, bool, Any]:
@@ -78,8 +79,9 @@ def _call(fn: Callable[[Any], Any], index: int, item: Any) -> tuple[int, bool, A
     stop the batch, and the error travels back as plain strings (any exception pickles that way)."""
     try:
         return index, True, fn(item)
-    except Exception as err:
-        return index, False, (type(err).__name__, " ".join(str(err).split()) or repr(err))
+    except Exception as err:  # wmrkit's own errors are one-line messages: no class name in front (HeaderError: ...)
+        kind = "WmrkitError" if isinstance(err, WmrkitError) else type(err).__name__
+        return index, False, (kind, " ".join(str(err).split()) or repr(err))
 
 
 class Engine:
