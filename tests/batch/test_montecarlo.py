@@ -263,3 +263,12 @@ def test_final_poses_take_positions_as_any_array_like(diff, square):
     model = odometry_model(diff)
     got = final_poses(model, square, [square.positions.tolist()])
     np.testing.assert_array_equal(got, [odometry(model, square).poses[-1]])
+
+
+@pytest.mark.parametrize("keyword", ["per_rad", "resolution", "slip_std"])
+@pytest.mark.parametrize("value", ["1e-4", "2 deg", None, True])
+def test_noise_keywords_must_be_numbers(diff, square, keyword, value):
+    """Text or None raised TypeError ('<=' not supported between instances of 'int' and 'str') from the range
+    check; True was read as 1."""
+    with pytest.raises(BatchError, match=rf"{keyword}: expected a number .* got {value!r}"):
+        monte_carlo(diff, square, 4, **{keyword: value})

@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from numbers import Real
 
 import numpy as np
 
@@ -192,6 +193,10 @@ def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4
         raise BatchError(f"Monte Carlo needs at least 2 runs and at most {MAX_RUNS}, got {runs!r}")
     if not whole(block) or block < 1:  # 0 raised range()'s ValueError, a negative one 'need at least one array'
         raise BatchError(f"block: expected a whole number of runs >= 1, got {block!r}")
+    for name, value in (("per_rad", per_rad), ("resolution", resolution), ("slip_std", slip_std)):
+        if isinstance(value, bool) or not isinstance(value, Real):  # text: the range check raised TypeError
+            raise BatchError(f"{name}: expected a number (rad^2/rad, rad, a ratio; the Python API reads no units), "
+                             f"got {value!r}")
     if not (0 <= per_rad <= 1 and 0 <= resolution <= math.pi and 0 <= slip_std <= 1):
         raise BatchError(f"noise must be in [0, 1] (per rad), resolution in [0, pi] rad and slip in [0, 1] (the "
                          f"standard deviation of a slip ratio), got {per_rad:g}, {resolution:g}, {slip_std:g}")
