@@ -488,3 +488,37 @@ def test_a_log_refused_by_its_header_is_named_as_the_file(diff, tmp_path, capsys
     err = json.loads(capsys.readouterr().err)
     assert err["file"] == str(tmp_path / "run0.csv") and err["line"] == 1, err
     assert "unknown unit 'min'" in err["error"] and "HeaderError" not in err["error"], err
+
+
+@pytest.mark.parametrize(("keywords", "words"), [
+    ({"level": "0.95"}, "confidence level must be in"),
+    ({"level": None}, "confidence level must be in"),
+    ({"heading_weight": "1"}, "heading_weight must be finite and >= 0"),
+    ({"heading_weight": -1.0}, "heading_weight must be finite and >= 0"),
+    ({"heading_weight": float("nan")}, "heading_weight must be finite and >= 0"),
+    ({"sensed": "left.spin"}, "sensed: expected a sequence"),
+    ({"method": "bogus"}, "unknown integration method 'bogus'"),
+])
+def test_fleet_keywords_are_checked_as_the_single_fit_checks_them(diff, runs, keywords, words):
+    """fleet_calibrate did not check what calibrate checks: level '0.95' or None raised TypeError, heading_weight
+    '1' failed in a task (UFuncTypeError), NaN in SciPy ('Residuals are not finite in the initial point'), -1 was
+    fitted, and an unknown method came back as 'task 0 failed: ...'."""
+    from wmrkit.errors import WmrkitError
+
+    with pytest.raises(WmrkitError, match=words) as err:
+        fleet_calibrate(diff, runs, PARAMS, **keywords)
+    assert "task" not in str(err.value)
+    if "sensed" not in keywords:
+        with pytest.raises(WmrkitError, match=words):
+            fleet_slip_calibrate(diff, runs, **keywords)
+
+
+def test_a_lone_string_of_parameters_is_refused(diff, runs):
+    """fleet_calibrate(robot, runs, 'left.r') (and calibrate's) read the parameters 'l', 'e', 'f', ... and said
+    \"robot 'diff-drive' has no wheel 'l'\"."""
+    from wmrkit.errors import WmrkitError
+
+    for fit in (fleet_calibrate, calibrate):
+        with pytest.raises(WmrkitError, match=r"parameters: expected a sequence of parameters, got the string "
+                                              r"'left\.r' \(write \['left\.r'\]\)"):
+            fit(diff, runs, "left.r")

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from .._shapes import finite_number
 from ..limits import check_seed
 from ..odometry.calibration import (
     CalibrationProblem,
@@ -39,9 +40,11 @@ from ..odometry.calibration import (
     Parameter,
     RunWeights,
     apply_parameters,
+    check_options,
     rms,
     solve,
 )
+from ..odometry.integrators import check_method
 from ..robot import Robot
 from .engine import BatchError, Engine, TaskFailure, engine
 
@@ -132,8 +135,10 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
     if ci == "bootstrap":
         check_bootstrap(n_boot)
         check_seed(seed, BatchError)
+    sensed = check_options(heading_weight, sensed)  # as wmrkit.odometry.calibrate checks them, before any work
+    check_method(method)
+    apply_parameters(robot, parameters, np.zeros(len(parameters)))  # names checked here, in the caller's process
     params = tuple(parameters)
-    apply_parameters(robot, params, np.zeros(len(params)))  # names checked here, in the caller's process
     problem = CalibrationProblem(robot, params, tuple(runs), method, heading_weight,
                                  None if sensed is None else tuple(sensed), weights, run_weights)
     own = runner is None
@@ -204,7 +209,7 @@ MAX_LEVEL = 0.9999
 
 def check_level(level: float) -> None:
     """Refuse a confidence level outside ``(0, MAX_LEVEL]``."""
-    if not 0 < level <= MAX_LEVEL:
+    if isinstance(level, bool) or not (finite_number(level) and 0 < level <= MAX_LEVEL):
         raise BatchError(f"confidence level must be in (0, {MAX_LEVEL:g}], got {level!r}")
 
 
@@ -318,6 +323,8 @@ def fleet_slip_calibrate(robot: Robot, runs: Sequence[CalibrationRun], *, runner
     if len(runs) < 2:
         raise BatchError("calibrate: slip weights with an interval need at least two runs")
     check_level(level)
+    check_options(heading_weight, None)
+    check_method(method)
     own = runner is None
     runner = engine(workers=0) if runner is None else runner
     try:

@@ -43,7 +43,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_names
+from .._shapes import as_names, finite_number
 from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
 from ..wheels import GEOMETRY_FIELDS, Wheel
@@ -322,6 +322,14 @@ def _trial(wheel: Wheel, field: str, value: float) -> Wheel:
     return out
 
 
+def check_options(heading_weight: float, sensed: Sequence[str] | None) -> tuple[str, ...] | None:
+    """Refuse a `heading_weight` that is not a finite number >= 0 [m/rad] and `sensed` that is not a sequence of
+    names (one string read one name per letter); `sensed` as a tuple."""
+    if isinstance(heading_weight, bool) or not (finite_number(heading_weight) and heading_weight >= 0):
+        raise WmrkitError(f"calibrate: heading_weight must be finite and >= 0 [m/rad], got {heading_weight!r}")
+    return None if sensed is None else as_names(sensed, "calibrate: sensed", "'wheel.joint' names", WmrkitError)
+
+
 def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence[Parameter], *,
               method: Method = "exact", heading_weight: float = 1.0, sensed: Sequence[str] | None = None,
               weights: Mapping[str, float] | None = None, run_weights: RunWeights | None = None) -> Calibration:
@@ -335,10 +343,7 @@ def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence
     """
     if not runs:
         raise WmrkitError("calibrate: no runs")
-    if not (np.isfinite(heading_weight) and heading_weight >= 0):
-        raise WmrkitError(f"calibrate: heading_weight must be finite and >= 0 [m/rad], got {heading_weight!r}")
-    if sensed is not None:
-        sensed = as_names(sensed, "calibrate: sensed", "'wheel.joint' names", WmrkitError)
+    sensed = check_options(heading_weight, sensed)
     groups = _groups(robot, parameters)
     problem = CalibrationProblem(robot, tuple(parameters), tuple(runs), method, heading_weight,
                                  None if sensed is None else tuple(sensed), weights, run_weights)
@@ -381,6 +386,9 @@ def _return_errors(errors: ArrayLike, name: str) -> np.ndarray:
 
 
 def _groups(robot: Robot, parameters: Sequence[Parameter]) -> list[list[tuple[str, str, float]]]:
+    if isinstance(parameters, str):  # 'left.r' read as the parameters 'l', 'e', ...: "robot has no wheel 'l'"
+        raise WmrkitError(f"calibrate: parameters: expected a sequence of parameters, got the string '{parameters}' "
+                          f"(write ['{parameters}'])")
     groups = []
     for param in parameters:
         names = (param,) if isinstance(param, str) else tuple(param)
