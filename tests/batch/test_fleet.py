@@ -231,3 +231,19 @@ def test_a_file_in_the_place_of_the_parts_folder_is_refused_before_the_work(flee
     monkeypatch.setattr(fleet, "process_log", lambda job: pytest.fail("a log was processed"))
     with pytest.raises(BatchError, match=r"r\.parquet\.parts is a file; the batch keeps its part files"):
         batch_odometry(diff, [fleet_dir / "run0.csv"], out=tmp_path / "r.parquet")
+
+
+def test_one_path_where_a_sequence_is_expected_is_refused(diff, fleet_dir, calibration_data):
+    """batch_odometry(robot, 'logs/') read the logs 'l', 'o', 'g', ... ('l: no such file or folder'), a Path
+    raised TypeError ('PosixPath' object is not iterable), and load_runs(robot, 'run.csv', ...) looked for the
+    reference l.tum."""
+    from pathlib import Path
+
+    from wmrkit.batch.calibrate import load_runs
+
+    for logs in (str(fleet_dir), Path(fleet_dir)):
+        with pytest.raises(BatchError, match=r"logs: expected a sequence of files, globs or folders, got the single "
+                                             rf"path '{fleet_dir}' \(write \['{fleet_dir}'\]\)"):
+            batch_odometry(diff, logs)
+    with pytest.raises(BatchError, match=r"paths: expected a sequence .* single path '.*c0\.csv'"):
+        load_runs(diff, str(calibration_data / "c0.csv"), reference_dir=calibration_data / "ref")

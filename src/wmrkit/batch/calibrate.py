@@ -426,7 +426,9 @@ def load_runs(robot: Robot, paths: Sequence[str], *, reference_dir: str | os.Pat
               progress: bool = False) -> list[CalibrationRun]:
     """Runs of many logs, read on the engine (the first bad log raises its error; a tqdm bar with `progress`)."""
     from ..odometry.model import odometry_model
+    from .fleet import check_paths
 
+    check_paths(paths, "paths")
     if (reference_dir is None) == (not closed):
         raise BatchError("give reference trajectories (a folder) or closed paths, one of the two")
     odometry_model(robot, (options or {}).get("sensed"))  # sensed joints that cannot work: theirs, not the 1st log's

@@ -75,9 +75,18 @@ class FleetResult:
                 "errors": {r["log"]: r["error"] for r in self.rows if r["error"]}}
 
 
+def check_paths(paths: object, what: str = "logs") -> None:
+    """Refuse one path given where a sequence of them is expected: a string was read as the paths of its
+    characters ('l: no such file or folder'), a :class:`~pathlib.Path` raised TypeError."""
+    if isinstance(paths, str | os.PathLike):
+        raise BatchError(f"{what}: expected a sequence of files, globs or folders, got the single path "
+                         f"'{os.fspath(paths)}' (write ['{os.fspath(paths)}'])")
+
+
 def expand_logs(patterns: Sequence[str | os.PathLike[str]]) -> list[str]:
     """Log paths from files, globs and folders (in order, each once). A folder holding a ROS 2 bag
     (``metadata.yaml``) is one log; another folder gives its CSV/bag files and bag sub-folders, sorted."""
+    check_paths(patterns)
     out: list[str] = []
     for pattern in map(os.fspath, patterns):
         matches = sorted(glob.glob(pattern)) if glob.has_magic(pattern) else [pattern]
