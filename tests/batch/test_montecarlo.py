@@ -162,7 +162,7 @@ def test_final_poses_refuse_a_bad_run_by_its_row():
             final_poses(model, log, runs[:, :-1])
 
 
-def test_a_study_is_bounded_by_its_work_per_worker():
+def test_a_study_is_bounded_by_its_work_per_worker(monkeypatch):
     """1e6 runs of the diff-drive's square without workers (the documented bound on runs) did not answer within
     the option fuzzer's 200 s on a loaded machine (about 260 us a run): the bound counts each run's fixed cost and
     a castor robot's new configurations (14 ms a run of the square: 10^6 runs of it would have taken 4 hours), and
@@ -185,7 +185,12 @@ def test_a_study_is_bounded_by_its_work_per_worker():
     assert cost > 100 * one  # its new configurations each run
     for workers in (1, 2):
         with pytest.raises(BatchError, match=rf"at most {int(workers * MAX_WORK // cost)} runs .* on {workers} worker"):
-            monte_carlo(castor, log, 10**4, runner=None if workers == 1 else SimpleNamespace(workers=workers))
+            monte_carlo(castor, log, 10**4, runner=None if workers == 1 else SimpleNamespace(workers=workers,
+                                                                                              mode="remote"))
+    # --workers allows 4 a CPU: 8 embedded workers on 2 CPUs were granted 8 minutes of work, about 4 on the clock
+    monkeypatch.setattr("os.cpu_count", lambda: 2)
+    with pytest.raises(BatchError, match=rf"at most {int(2 * MAX_WORK // cost)} runs .* on 2 workers.* one a CPU"):
+        monte_carlo(castor, log, 10**4, runner=SimpleNamespace(workers=8, mode="local"))
     swerve = catalog.load("swerve-4")
     assert study_cost(odometry_model(swerve), path_log(swerve, "square"), 1) < 3 * one
 

@@ -26,6 +26,7 @@ on the engine or the number of workers.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from numbers import Real
@@ -213,11 +214,14 @@ def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4
                          f"{MAX_LOG_VALUES} numbers, samples x (joints + 3) (docs/limits.md); decimate or cut it")
     model = odometry_model(robot)
     workers = 1 if runner is None else runner.workers
+    if runner is not None and runner.mode == "local":  # the embedded cluster's workers share this machine's CPUs
+        workers = min(workers, os.cpu_count() or 1)
     if study_cost(model, log, runs) > MAX_WORK * workers:
         most = int(MAX_WORK * workers // study_cost(model, log, 1))
         raise BatchError(f"runs: at most {most} runs of this log ({len(log)} samples of {len(log.joints)} joints) "
                          f"on {workers} worker{'s' * (workers > 1)}, got {runs}: a study does about a minute of work "
-                         f"per worker (docs/limits.md); more workers (--workers, --scheduler) take more runs")
+                         f"per worker, and an embedded cluster counts at most one a CPU (docs/limits.md); more "
+                         f"workers (--workers up to the CPUs, --scheduler) take more runs")
     nominal = odometry(model, log, method=method, noise=JointNoise(per_rad, resolution**2 / 6))
     sizes = [min(block, runs - s) for s in range(0, runs, block)]
     seeds = np.random.SeedSequence(seed).spawn(len(sizes))
