@@ -324,6 +324,7 @@ def test_a_monte_carlo_study_is_bounded_in_memory_and_work():
     most = int(MAX_WORK // (5 * n + RUN_COST))
     assert most < MAX_RUNS
     with pytest.raises(BatchError, match=rf"runs: at most {most} runs of this log \({n} samples of 2 joints\) on 1 "
-                                         rf"worker, got {MAX_RUNS}: .* more workers \(--workers, --scheduler\)"):
+                                         rf"worker, got {MAX_RUNS}: .* more workers \(--workers up to the CPUs, "
+                                         r"--scheduler\)"):
         monte_carlo(robot, log(n), MAX_RUNS)
     assert monte_carlo(robot, log(n), 3).runs == 3
