@@ -72,6 +72,11 @@ def test_ik_of_large_velocities_does_not_overflow(recwarn):
     k = (2.35 - 1.0) / 1.0
     assert float(ik.phi3) == pytest.approx(-math.hypot(k * 3e200, 4e200) / 0.23, rel=1e-15)
     assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+    # 2-quadrant beta3 = arctan(k R v_x / R v_y) (8.51): a tiny R v_y overflowed the quotient with a RuntimeWarning
+    # (a random draw of test_ik_zeroes_the_wheel_equations in the README's pytest); arctan(inf) is the right 90 deg
+    ik = forklift_ik([1.0, 1e-310], 0.0, quadrants=2)
+    assert float(ik.beta3) == math.pi / 2
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
 
 
 @settings(max_examples=40, deadline=None)

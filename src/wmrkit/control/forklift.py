@@ -54,7 +54,7 @@ def forklift_ik(velocity_world: ArrayLike, theta: ArrayLike, *, l12: float = 0.4
     if quadrants == 4:
         beta3, phi3 = np.arctan2(k * rvx, rvy), -mag  # (8.49) in four quadrants, (8.50)
     elif quadrants == 2:
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # a quotient beyond 1e308: arctan(+-inf)
             beta3 = np.where(rvy == 0, np.copysign(math.pi / 2, k * rvx), np.arctan(k * rvx / rvy))
         beta3 = np.where(beta3 <= -math.pi / 2, beta3 + math.pi, beta3)
         # (8.51) = -sign(R v_y) * mag; written as the rolling row (8.11) at beta3, which also holds at R v_y = 0
