@@ -199,44 +199,29 @@ def test_every_option_has_help_and_says_its_default():
     --framework`, among others, left their defaults unsaid."""
     import argparse
 
-    from wmrkit.cli.main import build_parser
+    from cli_options import options
 
     silent = []
-
-    def walk(parser: argparse.ArgumentParser, command: str) -> None:
-        for action in parser._actions:
-            if isinstance(action, argparse._SubParsersAction):
-                for name, sub in action.choices.items():
-                    walk(sub, f"{command} {name}".strip())
-            elif action.option_strings and not isinstance(action, argparse._HelpAction | argparse._VersionAction):
-                takes_value = action.nargs != 0 and not action.required
-                default = not (action.default is None or action.default is False or action.default == [])
-                if not action.help or (takes_value and default and "default" not in action.help):
-                    silent.append(f"{command} {action.option_strings[-1]} (default {action.default!r})")
-
-    walk(build_parser(), "")
+    for words, action in options():
+        if not isinstance(action, argparse._HelpAction | argparse._VersionAction):
+            takes_value = action.nargs != 0 and not action.required
+            default = not (action.default is None or action.default is False or action.default == [])
+            if not action.help or (takes_value and default and "default" not in action.help):
+                silent.append(f"{' '.join(words)} {action.option_strings[-1]} (default {action.default!r})")
     assert silent == []
 
 
 def test_options_choosing_an_integration_scheme_explain_every_choice():
     """`--method`/`--scheme` offered `paper002` (and `slip-study --source` `md`) with no word of what they are: the
     paper's number in the project's bibliography. Every such option now names each of its choices in its help."""
-    import argparse
     import re
 
-    from wmrkit.cli.main import build_parser
+    from cli_options import options
 
     unexplained = []
-
-    def walk(parser: argparse.ArgumentParser, command: str) -> None:
-        for action in parser._actions:
-            if isinstance(action, argparse._SubParsersAction):
-                for name, sub in action.choices.items():
-                    walk(sub, f"{command} {name}".strip())
-            elif action.choices and {"paper002", "md"} & set(action.choices):
-                for choice in action.choices:
-                    if not re.search(rf"(?<![\w-]){re.escape(choice)}(?![\w-])", action.help or ""):
-                        unexplained.append(f"{command} {action.option_strings[-1]} {choice}")
-
-    walk(build_parser(), "")
+    for words, action in options():
+        if action.choices and {"paper002", "md"} & set(action.choices):
+            for choice in action.choices:
+                if not re.search(rf"(?<![\w-]){re.escape(choice)}(?![\w-])", action.help or ""):
+                    unexplained.append(f"{' '.join(words)} {action.option_strings[-1]} {choice}")
     assert unexplained == []

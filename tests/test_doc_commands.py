@@ -45,21 +45,14 @@ def test_every_command_line_option_is_named_in_the_documentation():
     `follow-line --blur/--clutter` were in --help only."""
     import argparse
 
-    from wmrkit.cli.main import build_parser
+    from cli_options import options
 
     text = "\n".join(p.read_text() for p in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))])
     missing = []
-
-    def walk(parser: argparse.ArgumentParser, command: str) -> None:
-        for action in parser._actions:
-            if isinstance(action, argparse._SubParsersAction):
-                for name, sub in action.choices.items():
-                    walk(sub, f"{command} {name}".strip())
-            elif command and action.option_strings and not isinstance(action, argparse._HelpAction):
-                if not any(re.search(re.escape(o) + r"(?![\w-])", text) for o in action.option_strings):
-                    missing.append(f"{command} {'/'.join(action.option_strings)}")
-
-    walk(build_parser(), "")
+    for words, action in options():
+        if words and not isinstance(action, argparse._HelpAction):
+            if not any(re.search(re.escape(o) + r"(?![\w-])", text) for o in action.option_strings):
+                missing.append(f"{' '.join(words)} {'/'.join(action.option_strings)}")
     assert missing == []
 
 

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cli_options import options
 from wmrkit import catalog
 from wmrkit.cli._common import OUTPUT_FILES, OUTPUT_FOLDERS
 from wmrkit.cli.main import build_parser, main
@@ -48,14 +49,11 @@ VISION = Path(__file__).parents[2] / "docs" / "figures" / "vision"
 FOLDER_OPTIONS = {f"--{d}" for d in OUTPUT_FOLDERS} | {"--codegen"}
 
 
-def _commands(parser: argparse.ArgumentParser, prefix: tuple[str, ...] = ()):
+def _commands(parser: argparse.ArgumentParser):
     """Every (command words, option string) of the parser whose option names a file or folder written."""
-    for action in parser._actions:
-        if isinstance(action, argparse._SubParsersAction):
-            for name, sub in action.choices.items():
-                yield from _commands(sub, (*prefix, name))
-        elif action.option_strings and (action.dest in OUTPUT_FILES + OUTPUT_FOLDERS or action.dest == "codegen"):
-            yield prefix, action.option_strings[-1]
+    for words, action in options(parser):
+        if action.dest in OUTPUT_FILES + OUTPUT_FOLDERS or action.dest == "codegen":
+            yield words, action.option_strings[-1]
 
 
 def _option(argv: list[str]) -> str:
