@@ -192,16 +192,17 @@ def final_poses(model: OdometryModel, log: JointLog, positions: np.ndarray, *,
     check_chunk(log.slice(1, n), log.slice(0, 1), positions=False)
     steer = _steer_columns(log)
     poses, slip, out, origin = np.empty((n - 1, 3)), np.zeros(n - 1), np.empty((runs, 3)), np.zeros(3)
-    for k in range(runs):
+    run = lambda k: JointLog(log.time, log.joints, positions[k], None, f"{log.source} (run {k})")  # noqa: E731
+    for k in range(runs):  # the slow paths name the first bad value, as run_odometry's
         q = positions[k]
-        ok = model.constant or bool(np.isfinite(q.sum()) and np.abs(q[:, steer]).max(initial=0.0) <= MAX_ANGLE)
-        sums = (math.nan,) if not ok else _compose_chunk(model, q[1:], q[0], None, origin, None, method, poses, slip)
+        if not (model.constant or (np.isfinite(q.sum()) and np.abs(q[:, steer]).max(initial=0.0) <= MAX_ANGLE)):
+            check_finite(run(k))  # the configuration lookup needs numbers
+        sums = _compose_chunk(model, q[1:], q[0], None, origin, None, method, poses, slip)
         if not (all(map(math.isfinite, sums)) and np.isfinite(poses[-1]).all()):
-            run = JointLog(log.time, log.joints, q, None, f"{log.source} (run {k})")
-            check_finite(run)
-            _overflow(run.slice(1, n), poses)
+            check_finite(run(k))
+            _overflow(run(k).slice(1, n), poses)
         if sums[0] > MAX_COORDINATE or sums[1] > MAX_ANGLE or abs(poses[-1, 2]) > MAX_ANGLE:  # cheap bounds first
-            _beyond(JointLog(log.time, log.joints, q, None, f"{log.source} (run {k})").slice(1, n), poses)
+            _beyond(run(k).slice(1, n), poses)
         out[k] = poses[-1]
     return out
 
