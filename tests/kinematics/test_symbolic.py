@@ -425,3 +425,46 @@ def test_a_double_castor_is_exact_in_closed_form():
                                    rtol=0, atol=1e-12)
     model = symbolic_model(robot, ("drive.steer", "drive.spin1", "drive.spin2"))
     assert model.exact and "0000000" not in str(model.matrix)
+
+
+def test_steering_given_as_headings_as_every_function_takes_it():
+    """symbolic_constraint_matrix and symbolic_model took the thesis's beta only, while every other function taking a
+    steering configuration takes ``heading=`` too (docs/conventions.md): a user's heading 0 (the forklift driving
+    straight) went in as beta = 0, where the forklift's inverse model for vx raises SingularError. ``heading=``
+    now gives ``beta = heading + pi/2 - delta`` exactly, checked against Robot.constraint_matrix(heading=) for a
+    castor with delta = 10 deg, with the robot's numbers and with its delta as a symbol."""
+    robot = Robot.from_dict({"name": "castor", "wheels": [
+        {"name": "left", "type": "fixed", "position": [0, 0.2], "beta": "90 deg", "r": 0.05, "sensed": ["spin"]},
+        {"name": "right", "type": "fixed", "position": [0, -0.2], "beta": "90 deg", "r": 0.05, "sensed": ["spin"]},
+        {"name": "c", "type": "castor", "position": [-0.3, 0], "d": 0.04, "delta": "10 deg", "r": 0.03},
+        {"name": "s", "type": "steerable", "position": [0.3, 0], "r": 0.03}]})
+    heading = np.array([0.7, -2.9])
+    expected = robot.constraint_matrix(heading=heading)
+    numeric_geometry = symbolic_constraint_matrix(robot, heading=heading)  # a numpy array, as numeric code gives
+    np.testing.assert_allclose(np.array(numeric_geometry.evalf(), dtype=float), expected, rtol=0, atol=1e-12)
+    symbols = geometry_symbols(robot)
+    values = {symbols[k]: getattr(robot.wheel(k.split(".")[0]), k.split(".")[1]) for k in symbols}
+    general = symbolic_constraint_matrix(robot, heading=list(heading), geometry="symbolic")
+    assert symbols["c.delta"] in general.free_symbols
+    np.testing.assert_allclose(np.array(general.xreplace(values).evalf(), dtype=float), expected, rtol=0, atol=1e-12)
+    h = sp.Symbol("h", real=True)
+    fork = Robot.from_dict({"name": "rear steer", "wheels": [
+        {"name": "right", "type": "fixed", "position": [0, -0.45], "beta": "90 deg", "r": 0.2},
+        {"name": "left", "type": "fixed", "position": [0, 0.45], "beta": "90 deg", "r": 0.2},
+        {"name": "steer", "type": "steerable", "position": [-1.5, 0], "r": 0.1}]})
+    with pytest.raises(SingularError):
+        symbolic_model(fork, ["vx"], [0.0])  # beta = 0: the steered axle along x, no forward motion
+    straight = symbolic_model(fork, ["vx"], heading=[0.0])
+    assert straight.exact and list(straight.matrix) == [0, 0, 5, 5, 10]  # vy, omega, then the spins vx / r
+    turning = symbolic_model(fork, ["vx"], heading=[h])  # rear steering left turns the robot right: -tan(h) / 1.5
+    assert sp.simplify(turning.matrix[1] + sp.tan(h) / sp.Rational(3, 2)) == 0
+    numpy_int = symbolic_model(fork, ["vx"], heading=[np.int64(1)])  # refused as 'int64' before
+    assert numpy_int.matrix == symbolic_model(fork, ["vx"], heading=[1.0]).matrix
+    with pytest.raises(AssignmentError, match=r"as beta .* or heading .*, not both"):
+        symbolic_model(fork, ["vx"], [1.0], heading=[0.0])
+    with pytest.raises(AssignmentError, match=r"heading: expected 1 steering angles .*got float 0\.0"):
+        symbolic_model(fork, ["vx"], heading=0.0)
+    with pytest.raises(AssignmentError, match="beta: expected sympy expressions or numbers, got bool"):
+        symbolic_model(fork, ["vx"], [True])
+    with pytest.raises(AssignmentError, match=r"heading\[0\] \(steer\): .*at most 1e\+06 turns"):
+        symbolic_constraint_matrix(fork, heading=[math.nan])

@@ -14,10 +14,12 @@ from __future__ import annotations
 
 import functools
 import itertools
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
+import numpy as np
 import sympy as sp
 
 from .._shapes import as_names
@@ -87,20 +89,37 @@ def _geometry_table(robot: Robot, geometry: Geometry) -> dict[str, sp.Expr]:
     return table
 
 
-def _steering_values(robot: Robot, beta: Sequence[sp.Expr | float] | None) -> tuple[sp.Expr, ...]:
-    if beta is None:
-        return steering_symbols(robot)
-    values = tuple(beta)
-    if len(values) != len(robot.steer_names):
-        raise AssignmentError(f"beta: expected {len(robot.steer_names)} steering angles "
-                              f"({', '.join(robot.steer_names) or 'none'}), got {len(values)}")
+def _steering_values(robot: Robot, beta: Sequence[sp.Expr | float] | None, heading: Sequence[sp.Expr | float] | None,
+                     geometry: tuple[tuple[str, sp.Expr], ...]) -> tuple[sp.Expr, ...]:
+    """The thesis's beta per steering wheel: `beta` as given, or from the users' `heading` (0 = rolling straight
+    ahead), ``beta = heading + pi/2 - delta`` (:func:`wmrkit.wheels.beta_from_heading`) with delta exact, or the
+    wheel's delta symbol of `geometry`; symbols ``beta_<wheel>`` when neither is given."""
+    if heading is None:
+        return steering_symbols(robot) if beta is None else _angle_values(robot, beta, "beta")
+    if beta is not None:
+        raise AssignmentError("give the steering configuration as beta (thesis) or heading (rolling direction), "
+                              "not both")
+    table = dict(geometry)
+    wheels = [robot.wheel(n) for n in robot.steer_names]
+    delta = [table.get(f"{w.name}.delta", exact_number(w.delta, "angle")) for w in wheels]
+    return tuple(h + sp.pi / 2 - d for h, d in zip(_angle_values(robot, heading, "heading"), delta, strict=True))
+
+
+def _angle_values(robot: Robot, angles: Sequence[sp.Expr | float], what: str) -> tuple[sp.Expr, ...]:
+    """One angle per steering wheel (sympy expressions or real numbers, numpy's too), numbers made exact."""
+    listed = (isinstance(angles, Sequence) and not isinstance(angles, str)) or np.ndim(angles) == 1
+    values = tuple(angles) if listed else None
+    if values is None or len(values) != len(robot.steer_names):
+        got = f"{len(values)}" if values is not None else f"{type(angles).__name__} {angles!r:.40}"
+        raise AssignmentError(f"{what}: expected {len(robot.steer_names)} steering angles "
+                              f"({', '.join(robot.steer_names) or 'none'}), got {got}")
     for i, (v, name) in enumerate(zip(values, robot.steer_names, strict=True)):
-        if not isinstance(v, sp.Basic | int | float):
-            raise AssignmentError(f"beta: expected sympy expressions or numbers, got {type(v).__name__}")
+        if isinstance(v, bool | np.bool_) or not isinstance(v, sp.Basic | numbers.Real):
+            raise AssignmentError(f"{what}: expected sympy expressions or numbers, got {type(v).__name__}")
         if not (isinstance(v, sp.Basic) and v.free_symbols) and not _within_turns(v):
-            raise AssignmentError(f"beta[{i}] ({name}): angles must be finite numbers of at most {MAX_TURNS:g} turns "
-                                  f"[rad] (their sine is round-off beyond), got {v!r:.40}")
-    return tuple(v if isinstance(v, sp.Basic) else exact_number(v, "angle") for v in values)
+            raise AssignmentError(f"{what}[{i}] ({name}): angles must be finite numbers of at most {MAX_TURNS:g} "
+                                  f"turns [rad] (their sine is round-off beyond), got {v!r:.40}")
+    return tuple(v if isinstance(v, sp.Basic) else exact_number(float(v), "angle") for v in values)
 
 
 def _within_turns(v: sp.Expr | float) -> bool:
@@ -113,16 +132,20 @@ def _within_turns(v: sp.Expr | float) -> bool:
 
 
 def symbolic_constraint_matrix(
-    robot: Robot, beta: Sequence[sp.Expr | float] | None = None, *, geometry: Geometry = "numeric"
+    robot: Robot, beta: Sequence[sp.Expr | float] | None = None, *, geometry: Geometry = "numeric",
+    heading: Sequence[sp.Expr | float] | None = None,
 ) -> sp.ImmutableMatrix:
     """The slip matrix ``A`` of eq. (3.22) in closed form, roller frame (3.6); columns ``robot.velocity_names``.
 
     ``(2 * n_contacts, 3 + n_rates)``, the same matrix as :meth:`wmrkit.Robot.constraint_matrix` (built from the
     same kernel). `beta`: one angle per ``robot.steer_names`` (symbols ``beta_<wheel>`` by default; numbers are
-    made exact). `geometry`: ``"numeric"`` (the robot's numbers, exact), ``"symbolic"`` (every field a symbol,
-    see :func:`geometry_symbols`) or a mapping ``{"wheel.field": expression}`` for chosen fields only.
+    made exact), or `heading`: the users' steering angles (0 = rolling straight ahead), turned into
+    ``beta = heading + pi/2 - delta``. `geometry`: ``"numeric"`` (the robot's numbers, exact), ``"symbolic"``
+    (every field a symbol, see :func:`geometry_symbols`) or a mapping ``{"wheel.field": expression}`` for chosen
+    fields only.
     """
-    return constraint(robot, _steering_values(robot, beta), _geometry_key(robot, geometry))
+    key = _geometry_key(robot, geometry)
+    return constraint(robot, _steering_values(robot, beta, heading, key), key)
 
 
 def _geometry_key(robot: Robot, geometry: Geometry) -> tuple[tuple[str, sp.Expr], ...]:
@@ -172,6 +195,7 @@ def symbolic_model(
     *,
     geometry: Geometry = "numeric",
     max_lsq_angles: int = MAX_LSQ_ANGLES,
+    heading: Sequence[sp.Expr | float] | None = None,
 ) -> SymbolicModel:
     """Closed-form solution of ``A q = 0`` for the velocities not in `assigned`, thesis (4.5)/(4.9)-(4.11).
 
@@ -179,9 +203,9 @@ def symbolic_model(
     exactly (the ranks / null-space method). With more assigned velocities than the mobility m (the extended
     solution of §4.5) it is the least-squares solution ``-(A_na^T A_na)^-1 A_na^T A_a`` (4.11)/(4.82), as long
     as ``A_na`` keeps full column rank; otherwise :class:`SingularError`. Ranks are generic: evaluated at random
-    values of every symbol. `beta`, `geometry`: as in :func:`symbolic_constraint_matrix`. A least-squares form
-    whose unknowns couple more than `max_lsq_angles` steering symbols (:data:`MAX_LSQ_ANGLES`) is refused at once
-    with :class:`ClosedFormTooLargeError` (the derivation grows about fourfold per angle).
+    values of every symbol. `beta`, `heading`, `geometry`: as in :func:`symbolic_constraint_matrix`. A
+    least-squares form whose unknowns couple more than `max_lsq_angles` steering symbols (:data:`MAX_LSQ_ANGLES`)
+    is refused at once with :class:`ClosedFormTooLargeError` (the derivation grows about fourfold per angle).
     """
     names = as_names(assigned, "assigned", error=AssignmentError)
     for n in names:
@@ -190,7 +214,8 @@ def symbolic_model(
             raise AssignmentError(f"assigned: velocity '{n}' listed twice")
     if isinstance(max_lsq_angles, bool) or not isinstance(max_lsq_angles, int) or max_lsq_angles < 0:
         raise AssignmentError(f"max_lsq_angles: expected a whole number >= 0, got {max_lsq_angles!r}")
-    return _solve(robot, names, _steering_values(robot, beta), _geometry_key(robot, geometry), max_lsq_angles)
+    key = _geometry_key(robot, geometry)
+    return _solve(robot, names, _steering_values(robot, beta, heading, key), key, max_lsq_angles)
 
 
 @functools.lru_cache(maxsize=128)
