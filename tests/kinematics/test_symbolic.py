@@ -6,6 +6,7 @@ exactly against numeric least squares, and the tricycle tables (4.80)-(4.84) aga
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -468,3 +469,30 @@ def test_steering_given_as_headings_as_every_function_takes_it():
         symbolic_model(fork, ["vx"], [True])
     with pytest.raises(AssignmentError, match=r"heading\[0\] \(steer\): .*at most 1e\+06 turns"):
         symbolic_constraint_matrix(fork, heading=[math.nan])
+
+
+def test_latex_escapes_names_that_latex_would_read_as_markup():
+    """A wheel built in Python may have any name (descriptions allow identifiers only). In the LaTeX block 'l%'
+    commented out the rest of its row (terms dropped without a word), 'r&#' added an alignment column and a '#'
+    LaTeX refuses, and a name with a line break ended its '%' comment line. Now every special character is
+    escaped: each row has exactly its one alignment '&', no bare '%', balanced braces, and only comments,
+    'aligned' and rows as lines."""
+    robot = Robot("a\nb", (Wheel("l%", "fixed", 0.2, math.pi / 2, 0.0, 0.05, sensed=("spin",)),
+                           Wheel("r&#", "fixed", 0.2, -math.pi / 2, 0.0, 0.05, sensed=("spin",)),
+                           Wheel("c~^{x}\\$_\n", "castor", 0.3, math.pi, 0.0, 0.03, d=0.04)))
+    text = format_symbolic(robot, latex=True)
+    bare = re.compile(r"(?<!\\)[%&#$^~]")  # a special character without its backslash (\hat{}, \sim{} are escapes)
+    rows = [line for line in text.splitlines() if line.startswith("  ")]
+    assert len(rows) == 5 + 6, text  # direct (two spins sensed): 5 solved; inverse (vy assigned): 6
+    for row in rows:
+        left, _, right = row.partition(" &= ")
+        assert not bare.search(left + right), row
+        depth = 0
+        for ch in re.sub(r"\\[{}]", "", row):
+            depth += {"{": 1, "}": -1}.get(ch, 0)
+            assert depth >= 0, row
+        assert depth == 0, row
+    assert r"\dot{\varphi}_{\mathrm{l\%}}" in text and r"\dot{\varphi}_{\mathrm{r\&\#}}" in text
+    assert r"\dot{\beta}_{\mathrm{c\sim{}\hat{}\{x\}\backslash{}\$\_\backslash{}n}}" in text
+    for line in text.splitlines():
+        assert line.startswith(("% ", "  ", r"\begin{aligned}", r"\end{aligned}")) or not line, line

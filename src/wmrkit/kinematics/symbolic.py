@@ -323,6 +323,8 @@ def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, late
         lines.append(f"{comment}  {how}")
         lines += _latex_block(model) if latex else [f"    {n} = {_linear_form(model, i)}" for i, n in
                                                     enumerate(model.solved)]
+    if latex:  # a Python-built name with a line break would end its comment line
+        lines = [printable(line) if line.startswith(comment) else line for line in lines]
     return "\n".join(lines)
 
 
@@ -356,15 +358,32 @@ def _linear_form(model: SymbolicModel, i: int, names: Mapping[str, str] | None =
     return " + ".join(parts).replace("+ -", "- ")
 
 
+#: LaTeX's special characters in a name, as math-mode text (a Python-built wheel may be called 'l%' or 'a&b': '%'
+#: commented the rest of the row out, '&' added an alignment column)
+_LATEX_SPECIAL = {"\\": r"\backslash{}", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&", "#": r"\#", "%": r"\%",
+                  "_": r"\_", "^": r"\hat{}", "~": r"\sim{}"}
+
+
+def printable(text: str) -> str:
+    """`text` on one printable line: line breaks, control and format characters and lone surrogates escaped as in a
+    Python string (``"a\\nb"``), so that a name can neither end a comment nor break the encoding."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+def _latex_text(text: str) -> str:
+    """`text` inside ``\\mathrm{}``: printable, LaTeX's special characters escaped."""
+    return "".join(_LATEX_SPECIAL.get(c, c) for c in printable(text))
+
+
 def latex_name(name: str) -> str:
     """LaTeX for a velocity or steering name: ``vx -> v_x``, ``left.spin -> \\dot{\\varphi}_{\\mathrm{left}}``."""
     twist = {"vx": "v_x", "vy": "v_y", "omega": r"\omega"}
     if name in twist:
         return twist[name]
     if name.startswith("beta_"):
-        return r"\beta_{\mathrm{" + name[5:].replace("_", r"\_") + "}}"
-    wheel, _, joint = name.partition(".")
-    wheel = r"\mathrm{" + wheel.replace("_", r"\_") + "}"
+        return r"\beta_{\mathrm{" + _latex_text(name[5:]) + "}}"
+    wheel, _, joint = name.rpartition(".")
+    wheel = r"\mathrm{" + _latex_text(wheel) + "}"
     if joint == "steer":
         return rf"\dot{{\beta}}_{{{wheel}}}"
     sub = {"roller": "r,", "spin": ""}.get(joint, f"{joint[4:]},")  # spin1 -> phi_{1,wheel}
