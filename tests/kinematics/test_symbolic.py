@@ -15,7 +15,7 @@ import sympy as sp
 from hypothesis import given, settings
 
 from strategies import robots
-from wmrkit import Robot, SingularError, UnknownNameError, Wheel
+from wmrkit import Robot, SingularError, UnknownNameError, Wheel, catalog
 from wmrkit.kinematics.linalg import solve_assigned
 from wmrkit.kinematics.symbolic import (
     AssignmentError,
@@ -38,6 +38,7 @@ TRICYCLE = Robot("tricycle", (  # table C.1; the numbers are those of the oracle
     Wheel("w2", "fixed", 0.5, math.pi, 0.0, 0.1, sensed=("spin",)),
     Wheel("w3", "steerable", 1.2, -math.pi / 2, 0.4, 0.1),
 ))
+TRICYCLE_CATALOG = catalog.load("thesis-tricycle")
 GEOMETRY = {"w1.l": l12, "w2.l": l12, "w3.l": l3, "w1.r": r, "w2.r": r, "w3.r": r}
 NUMBERS = {r: 0.1, l12: 0.5, l3: 1.2}
 
@@ -496,3 +497,24 @@ def test_latex_escapes_names_that_latex_would_read_as_markup():
     assert r"\dot{\beta}_{\mathrm{c\sim{}\hat{}\{x\}\backslash{}\$\_\backslash{}n}}" in text
     for line in text.splitlines():
         assert line.startswith(("% ", "  ", r"\begin{aligned}", r"\end{aligned}")) or not line, line
+
+
+@pytest.mark.parametrize(("field", "value", "message"), [
+    ("f1.l", math.nan, "expected a finite number"), ("f1.r", sp.nan, "expected a finite number"),
+    ("f1.r", sp.zoo, "expected a finite number"), ("o3.r", math.inf, "expected a finite number"),
+    ("f1.r", 0.0, "r: must be > 0"), ("f1.r", -0.1, "r: must be > 0"), ("f1.l", -0.5, "l: must be >= 0"),
+    ("f1.alpha", 1e300, "at most 1e\\+06 turns"), ("f1.r", True, "got bool"),
+])
+def test_geometry_numbers_follow_the_wheels_rules(field, value, message):
+    """Numbers given for geometric fields were taken as they came: NaN raised 'cannot make nan exact' (no field
+    named), sympy's nan numpy's LinAlgError 'SVD did not converge', r = 0 or l = 1e300 a SingularError, a false claim
+    about the robot, alpha = 1e300 (no angle) was accepted. Now the rules of Wheel, naming the entry."""
+    with pytest.raises(AssignmentError, match=rf"geometry\['{field}'\]: .*{message}"):
+        symbolic_model(TRICYCLE_CATALOG, ["vy"], geometry={field: value})
+
+
+def test_geometry_numbers_that_pass_keep_their_exact_value():
+    """Checked numbers stay as given: a sympy surd is not replaced by its float (numpy floats are made exact)."""
+    root = symbolic_constraint_matrix(TRICYCLE_CATALOG, geometry={"f1.r": sp.sqrt(2) / 20, "f2.r": np.float64(0.2)})
+    assert any(entry.has(sp.sqrt(2)) for entry in root)
+    assert sp.Rational(1, 5) in root.atoms(sp.Rational)

@@ -14,9 +14,10 @@ from __future__ import annotations
 
 import functools
 import itertools
+import math
 import numbers
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -26,7 +27,7 @@ from .._shapes import as_names
 from ..errors import SingularError, UnknownNameError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
 from ..units import MAX_ANGLE, MAX_TURNS
-from ..wheels import GEOMETRY_FIELDS
+from ..wheels import GEOMETRY_FIELDS, Wheel, WheelError
 from ._exact_linalg import _components, agrees, numeric, random_points, solve_exactly
 from ._symbolic_matrix import AssignmentError, _nice_number, constraint, exact_number, geometry_fields
 from .linalg import matrix_rank
@@ -82,11 +83,29 @@ def _geometry_table(robot: Robot, geometry: Geometry) -> dict[str, sp.Expr]:
         if field not in geometry_fields(wheel):
             raise UnknownNameError(f"geometry: wheel '{wheel_name}' ({wheel.type}) has no geometric field "
                                    f"'{field}' (fields: {', '.join(geometry_fields(wheel))})")
-        if not isinstance(value, sp.Basic | int | float):
+        if isinstance(value, bool | np.bool_) or not isinstance(value, sp.Basic | numbers.Real):
             raise AssignmentError(f"geometry['{key}']: expected a sympy expression or a number, got "
                                   f"{type(value).__name__} (strings are never parsed)")
-        table[key] = value if isinstance(value, sp.Basic) else exact_number(value, GEOMETRY_FIELDS[field])
+        if isinstance(value, sp.Basic) and value.free_symbols:
+            table[key] = value
+            continue
+        _check_number(wheel, field, value, f"geometry['{key}']")
+        table[key] = value if isinstance(value, sp.Basic) else exact_number(float(value), GEOMETRY_FIELDS[field])
     return table
+
+
+def _check_number(wheel: Wheel, field: str, value: sp.Expr | float, what: str) -> None:
+    """A number for a wheel's geometric field passes the rules of :class:`Wheel` (finite, angles of at most
+    MAX_TURNS turns, radii > 0, l >= 0): NaN raised numpy's 'SVD did not converge', r = 0 a SingularError about
+    the robot."""
+    try:
+        x = complex(value)
+    except (TypeError, OverflowError):  # sympy's zoo, oo, 10**400
+        x = complex(math.nan)
+    try:
+        replace(wheel, **{field: x.real if x.imag == 0 else math.nan})
+    except WheelError as err:
+        raise AssignmentError(f"{what}: {err}") from None
 
 
 def _steering_values(robot: Robot, beta: Sequence[sp.Expr | float] | None, heading: Sequence[sp.Expr | float] | None,
