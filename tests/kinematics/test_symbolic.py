@@ -518,3 +518,12 @@ def test_geometry_numbers_that_pass_keep_their_exact_value():
     root = symbolic_constraint_matrix(TRICYCLE_CATALOG, geometry={"f1.r": sp.sqrt(2) / 20, "f2.r": np.float64(0.2)})
     assert any(entry.has(sp.sqrt(2)) for entry in root)
     assert sp.Rational(1, 5) in root.atoms(sp.Rational)
+
+
+def test_format_symbolic_refuses_a_lone_string_as_symbolic_model_does():
+    """format_symbolic(robot, "vx") read the string letter by letter: "no velocity 'v'"; a number raised TypeError."""
+    with pytest.raises(AssignmentError, match=r"expected a sequence of .*names, got the string 'vy'"):
+        format_symbolic(TRICYCLE, "vy")
+    with pytest.raises(AssignmentError, match="assigned"):
+        format_symbolic(TRICYCLE, 5)
+    assert "model, assigned: vy" in format_symbolic(TRICYCLE, ("vy",))

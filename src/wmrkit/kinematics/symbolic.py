@@ -317,7 +317,7 @@ def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, late
     ``beta_<wheel>`` [rad], geometry exact from the robot's numbers), or LaTeX ``aligned`` blocks. Each model
     says whether it is exact (4.5)/(4.11) or least squares (4.11)/(4.82), whose residual ``A q`` is slip.
     """
-    sets = [("model", tuple(assigned))] if assigned is not None else [
+    sets = [("model", as_names(assigned, "assigned", error=AssignmentError))] if assigned is not None else [
         ("direct model (sensed)", sensed_rates(robot)), ("inverse model", twist_assignment(robot))]
     comment = "% " if latex else ""
     lines = [f"{comment}{robot.name}: no-slip kinematic models in closed form (thesis ch. 4)",
