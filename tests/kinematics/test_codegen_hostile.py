@@ -121,3 +121,13 @@ def test_c_compiles_under_the_warnings_embedded_projects_use(tmp_path):
     _, source = write_code(catalog.load("swerve-4"), "c", tmp_path)
     assert _gcc_errors(source, "-Wshadow", "-Wconversion", "-Wdouble-promotion", "-Wfloat-equal", "-Wcast-qual",
                        "-Wstrict-prototypes", "-Wmissing-prototypes", "-Wundef") == ""
+
+
+def test_a_micro_robot_is_not_refused(tmp_path):
+    """The sensed-rates check ran on the raw matrix: a 1 um robot with a 1 nm castor (within docs/limits.md) was
+    refused, 'the sensed rates (left.spin, right.spin) do not determine ...'. Now on the nondimensional robot."""
+    robot = Robot.from_dict({"name": "micro", "wheels": [
+        {"name": "left", "type": "fixed", "position": [0, 0.4e-6], "heading": 0, "r": 1e-7, "sensed": ["spin"]},
+        {"name": "right", "type": "fixed", "position": [0, -0.4e-6], "heading": 0, "r": 1e-7, "sensed": ["spin"]},
+        {"name": "caster", "type": "castor", "position": [-1e-6, 0], "d": 1e-7, "r": 1e-9}]})
+    assert [p.name for p in write_code(robot, "python", tmp_path)] == ["micro_kinematics.py"]

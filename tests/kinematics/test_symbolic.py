@@ -16,7 +16,7 @@ from hypothesis import given, settings
 
 from strategies import robots
 from wmrkit import Robot, SingularError, UnknownNameError, Wheel, catalog
-from wmrkit.kinematics.linalg import solve_assigned
+from wmrkit.kinematics.linalg import solve_assigned, velocity_scale
 from wmrkit.kinematics.symbolic import (
     AssignmentError,
     exact_number,
@@ -527,3 +527,27 @@ def test_format_symbolic_refuses_a_lone_string_as_symbolic_model_does():
     with pytest.raises(AssignmentError, match="assigned"):
         format_symbolic(TRICYCLE, 5)
     assert "model, assigned: vy" in format_symbolic(TRICYCLE, ("vy",))
+
+
+MICRO = Robot.from_dict({"name": "micro", "wheels": [  # 1 um across, a castor of 1 nm: within docs/limits.md
+    {"name": "left", "type": "fixed", "position": [0, 0.4e-6], "heading": 0, "r": 1e-7, "sensed": ["spin"]},
+    {"name": "right", "type": "fixed", "position": [0, -0.4e-6], "heading": 0, "r": 1e-7, "sensed": ["spin"]},
+    {"name": "caster", "type": "castor", "position": [-1e-6, 0], "d": 1e-7, "r": 1e-9}]})
+
+
+@pytest.mark.parametrize("assigned", [("left.spin", "right.spin"), ("vx", "omega"), ("vx", "vy", "omega")])
+def test_a_micro_robot_has_its_closed_forms(assigned):
+    """Ranks were taken on the raw matrix, whose castor-spin column (r = 1 nm) fell below the rank tolerance: every
+    model of this 1 um robot raised SingularError 'rank A_na = 4 < 5' (its mobility is 2, as the numeric models
+    say), and write_code refused it. Columns are now equilibrated for the rank decisions; the closed form equals
+    numeric least squares (4.11)."""
+    model = symbolic_model(MICRO, assigned)
+    assert model.mobility == 2 and model.exact == (len(assigned) == 2)
+    a_idx = [MICRO.velocity_index(n) for n in assigned]
+    scale = velocity_scale(MICRO)  # compared as nondimensional velocities (vx / L, rad/s), of order 1
+    for beta in np.random.default_rng(3).uniform(-math.pi, math.pi, (3, 1)):
+        q_a = np.random.default_rng(4).normal(size=len(assigned)) / scale[a_idx]
+        expected = np.delete(solve_assigned(MICRO.constraint_matrix(beta), a_idx, q_a)[0] * scale, a_idx)
+        m = np.array(model.matrix.xreplace({model.steering[0]: sp.Float(beta[0])}).evalf(), dtype=float)
+        got = (m @ q_a) * np.delete(scale, a_idx)
+        np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-12 * np.abs(expected).max())

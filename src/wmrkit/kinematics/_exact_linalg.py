@@ -81,6 +81,14 @@ def numeric(m: sp.MatrixBase, point: dict[sp.Symbol, sp.Float]) -> np.ndarray:
     return np.array(sp.Matrix(m).xreplace(point).evalf(), dtype=float).reshape(m.shape)
 
 
+def equilibrated(values: np.ndarray) -> np.ndarray:
+    """`values` with each non-zero column divided by its largest entry: ranks and independent rows are decided on
+    columns of order 1 whatever the units (m/s of vx, m of a radius), as on the nondimensional robot of the numeric
+    models (``linalg.nondimensional``). Raw, a 1 um robot's castor of radius 1 nm fell below the rank tolerance."""
+    size = np.abs(values).max(axis=-2, keepdims=True)
+    return values / np.where(size > 0, size, 1.0)
+
+
 def random_points(m: sp.MatrixBase, n: int = 2) -> list[dict[sp.Symbol, sp.Float]]:
     rng = np.random.default_rng(20240607)
     symbols = sorted(m.free_symbols, key=sp.default_sort_key)

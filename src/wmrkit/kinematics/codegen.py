@@ -29,7 +29,7 @@ from sympy.printing.numpy import NumPyPrinter
 from .._shapes import as_names
 from ..errors import SingularError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
-from .linalg import matrix_rank
+from .linalg import matrix_rank, nondimensional
 from .symbolic import printable, sensed_rates, symbolic_constraint_matrix, symbolic_model
 
 C_KEYWORDS = frozenset(
@@ -83,8 +83,9 @@ class _Plan:
         self.inverse = [e for e in model.matrix * sp.Matrix(self.twist + self.steer_rate)]
 
     def _check_forward(self) -> None:
-        rng = np.random.default_rng(7)
-        a = self.robot.constraint_matrix(rng.uniform(-math.pi, math.pi, (3, len(self.robot.steer_names))))
+        beta = np.random.default_rng(7).uniform(-math.pi, math.pi, (3, len(self.robot.steer_names)))
+        # on the nondimensional robot, as the numeric models decide ranks: raw, a 1 um robot's 1 nm castor was lost
+        a = nondimensional(self.robot).constraint_matrix(beta)
         if int(matrix_rank(a[..., self.unknown_cols]).max()) < len(self.unknown_cols):
             names = ", ".join(self.robot.velocity_names[j] for j in self.unknown_cols)
             raise SingularError(f"robot '{self.robot.name}': the sensed rates ({', '.join(self.sensed)}) do not "

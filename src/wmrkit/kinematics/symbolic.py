@@ -28,7 +28,7 @@ from ..errors import SingularError, UnknownNameError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
 from ..units import MAX_ANGLE, MAX_TURNS
 from ..wheels import GEOMETRY_FIELDS, Wheel, WheelError
-from ._exact_linalg import _components, agrees, numeric, random_points, solve_exactly
+from ._exact_linalg import _components, agrees, equilibrated, numeric, random_points, solve_exactly
 from ._symbolic_matrix import AssignmentError, _nice_number, constraint, exact_number, geometry_fields
 from .linalg import matrix_rank
 
@@ -244,7 +244,7 @@ def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], g
     a_idx = [robot.velocity_index(n) for n in assigned]
     na_idx = [j for j in range(a.cols) if j not in a_idx]
     points = random_points(a)
-    values = [numeric(a, p) for p in points]
+    values = [equilibrated(numeric(a, p)) for p in points]  # ranks of columns of order 1 (units, tiny robots)
     rank = max(int(matrix_rank(v)) for v in values)
     rank_na = max(int(matrix_rank(v[:, na_idx])) for v in values)
     solved = tuple(robot.velocity_names[j] for j in na_idx)
