@@ -285,3 +285,42 @@ def test_a_double_wheel_turns_on_the_spot_by_rolling_its_sub_wheels_apart(tmp_pa
     expected = dict(zip(mod.RATE_NAMES, mod.inverse(twist, [0.7], double.heading_of_beta([0.4])), strict=True))
     for name, value in expected.items():
         assert solved[name] == pytest.approx(value, rel=1e-12, abs=1e-12)
+
+
+MICRO = _robot("micro", [  # 1 um across, a castor of 1 nm: within docs/limits.md
+    {"name": "left", "type": "fixed", "position": [0, 0.4e-6], "heading": 0, "r": 1e-7, "sensed": ["spin"]},
+    {"name": "right", "type": "fixed", "position": [0, -0.4e-6], "heading": 0, "r": 1e-7, "sensed": ["spin"]},
+    {"name": "caster", "type": "castor", "position": [-1e-6, 0], "d": 1e-7, "r": 1e-9}])
+
+
+def _micro_reference():
+    """Rates of a no-slip motion of the micro robot (1 um/s, 0.5 rad/s) at three castor headings, and its twist."""
+    heading = np.array([[0.3], [-2.0], [3.1]])
+    twist = np.array([1e-6, 0.0, 0.5])
+    a = MICRO.constraint_matrix(heading=heading)
+    rates = solve_assigned(a, [0, 1, 2], np.broadcast_to(twist, (3, 3)))[0][..., 3:5]  # left, right spins
+    return heading, twist, rates
+
+
+def test_python_forward_of_a_micro_robot(tmp_path):
+    """The generated forward's rank test was absolute (smallest singular value <= 1e-9 rows max(1, max|A_ij|)): the
+    castor-spin column of a 1 um robot with a 1 nm castor (entries 1e-9) fell below it, and every twist came out
+    NaN, 'not determined'. The columns are now scaled to norm 1 first, whatever their units."""
+    mod = load_module(write_code(MICRO, "python", tmp_path)[0])
+    heading, twist, rates = _micro_reference()
+    got, slip = mod.forward_with_residual(rates, heading)
+    np.testing.assert_allclose(got, np.broadcast_to(twist, (3, 3)), rtol=1e-8, atol=1e-18)
+    assert (slip < 1e-18).all()  # m/s: the rates are those of a motion without slip
+
+
+@pytest.mark.skipif(GCC is None, reason="gcc not installed")
+def test_c_forward_of_a_micro_robot(tmp_path):
+    """The C lstsq refused a column whose remaining norm was <= 1e-9 m max(1, max|A_ij|): -1 (not determined) for
+    every heading of the micro robot. Now relative to the column's own norm."""
+    lib, ident = compile_c(MICRO, tmp_path)
+    heading, twist, rates = _micro_reference()
+    for k in range(3):
+        tw, res = np.zeros(3), ctypes.c_double(-1.0)
+        assert getattr(lib, f"{ident}_forward")(_ptr(rates[k]), _ptr(heading[k]), _ptr(tw), ctypes.byref(res)) == 0
+        np.testing.assert_allclose(tw, twist, rtol=1e-8, atol=1e-18)
+        assert res.value < 1e-18

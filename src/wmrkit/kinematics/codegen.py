@@ -178,17 +178,15 @@ def _cse(exprs: list[sp.Expr], printer: C99CodePrinter | NumPyPrinter) -> tuple[
 # ---- C ---------------------------------------------------------------------------------------------------
 _C_LSTSQ = """\
 /* min |A x - b| by Householder QR; A: m x n row-major (m >= n), A and b are overwritten.
- * Returns 0, or -1 if A is rank deficient (a column norm <= 1e-9 m max|A_ij|, then x is not set).
- * *residual (if not NULL) = |A x - b|. */
+ * Returns 0, or -1 if A is rank deficient (what is left of a column once the previous ones are projected out is
+ * <= 1e-9 m times its norm, whatever its units: then x is not set). *residual (if not NULL) = |A x - b|. */
 static int lstsq(int m, int n, double *a, double *b, double *x, double *residual)
 {
-    double scale = 1.0;
-    for (int i = 0; i < m * n; ++i) scale = fmax(scale, fabs(a[i]));
-    const double tol = 1e-9 * m * scale;
     for (int k = 0; k < n; ++k) {
-        double norm = 0.0;
+        double norm = 0.0, column = 0.0; /* the reflections keep the column's norm: rows < k hold its R part */
         for (int i = k; i < m; ++i) norm = hypot(norm, a[i * n + k]);
-        if (norm <= tol) return -1;
+        for (int i = 0; i < k; ++i) column = hypot(column, a[i * n + k]);
+        if (norm <= 1e-9 * m * hypot(column, norm)) return -1;
         const double alpha = a[k * n + k] > 0.0 ? -norm : norm;
         a[k * n + k] -= alpha; /* column k below the diagonal is now v = x - alpha e_k */
         double vv = 0.0;
@@ -433,8 +431,8 @@ def forward_with_residual(sensed, heading=None):
     """Least-squares twist (4.11) and slip residual ``|A q|`` [m/s].
 
     ``(..., {len(plan.sensed)}) -> (..., 3), (...)``. Both are NaN where the sensed rates do not determine the twist
-    at those headings (the smallest singular value of the unknowns' columns <= 1e-9 rows max(1, max|A_ij|)) or an
-    input is not finite, as the C code's -1.
+    at those headings (the smallest singular value of the unknowns' columns, each scaled to norm 1 whatever its
+    units, <= 1e-9 rows) or an input is not finite, as the C code's -1.
     """
     sensed = _vectors(sensed, {len(plan.sensed)}, "sensed")
     a = constraint_matrix(heading)
@@ -443,10 +441,11 @@ def forward_with_residual(sensed, heading=None):
     sensed = numpy.where(finite[..., None], sensed, 0.0)
     a_na = a[..., _UNKNOWN_COLUMNS]
     rhs = -(a[..., _SENSED_COLUMNS] @ sensed[..., None])
-    x = numpy.linalg.pinv(a_na) @ rhs
+    norms = numpy.linalg.norm(a_na, axis=-2, keepdims=True)  # columns of norm 1: m/s and m alike
+    unit = a_na / numpy.where(norms > 0, norms, 1.0)
+    x = (numpy.linalg.pinv(unit) @ rhs) / numpy.where(norms > 0, norms, 1.0).swapaxes(-1, -2)
     residual = numpy.linalg.norm((a_na @ x - rhs)[..., 0], axis=-1)
-    tol = 1e-9 * a_na.shape[-2] * numpy.maximum(numpy.abs(a_na).max(axis=(-2, -1)), 1.0)
-    ok = finite & (numpy.linalg.svd(a_na, compute_uv=False)[..., -1] > tol)
+    ok = finite & (numpy.linalg.svd(unit, compute_uv=False)[..., -1] > 1e-9 * a_na.shape[-2])
     return numpy.where(ok[..., None], x[..., :3, 0], numpy.nan), numpy.where(ok, residual, numpy.nan)
 
 
