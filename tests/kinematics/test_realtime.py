@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from circle import circular_gap
 from strategies import robots
-from wmrkit import catalog, forward_kinematics, wheel_commands
+from wmrkit import ShapeError, catalog, forward_kinematics, wheel_commands
 from wmrkit.kinematics.realtime import realtime
 from wmrkit.odometry.model import odometry_model
 from wmrkit.odometry.pipeline import odometry
@@ -166,3 +166,20 @@ def test_the_control_tick_refuses_non_finite_poses_and_wrong_twist_arrays():
         tick(np.nan, 0.0, 0.0, 1.0, 0.0, 0.0, 0.5, 0.0, 0.0, hd, twist, rates, out)
     with pytest.raises(ValueError, match=r"tick: twist_out must be a float64 array of shape \(3,\)"):
         tick(0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.5, 0.0, 0.0, hd, np.empty(2), rates, out)
+
+
+@pytest.mark.parametrize("heading", [1e7, -1e17, 1e300])
+def test_headings_beyond_a_million_turns_are_refused_as_by_the_batched_ik(heading):
+    """wheel_commands refuses a heading beyond 1e6 turns (its sine and cosine are round-off); the compiled IK took
+    it and answered 'feasible' with headings of pi or 0 depending on the rounding, and the steering FK with a twist."""
+    robot = catalog.load("swerve-4")
+    with pytest.raises(ShapeError, match="at most 1e\\+06 turns"):
+        wheel_commands(robot, [1.0, 0.0, 0.0], heading=np.full(4, heading))
+    rt = realtime(robot)
+    rates, out = np.full(4, 7.0), np.full(4, 7.0)
+    with pytest.raises(ValueError, match="ik: the headings must be finite, at most 1e\\+06 turns"):
+        rt.ik(1.0, 0.0, 0.0, np.full(4, heading), rates, out)
+    assert (rates == 7.0).all() and (out == 7.0).all()
+    with pytest.raises(ValueError, match="fk: the headings must be a finite array of shape \\(4,\\), at most 1e\\+06"):
+        rt.fk(np.ones(len(rt.rate_joints)), np.full(len(rt.steer_joints), heading), np.empty(3))
+    rt.ik(1.0, 0.0, 0.0, np.full(4, 2 * np.pi * 1e6), rates, out)  # the bound itself is an angle

@@ -32,6 +32,7 @@ from ..limits import MAX_QUERY_RATE
 from ..odometry import _kernels
 from ..odometry._kernels import _cos_sin, _sinc
 from ..robot import Robot
+from ..units import MAX_ANGLE, MAX_TURNS
 from . import _ik_fast
 from .wheel_ik import check_tolerances
 
@@ -122,7 +123,8 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
               f"rates_out one of shape ({n_rates},) (robot.rate_names)")
     limit = MAX_QUERY_RATE
     too_big = f"ik: the twist (vx, vy, omega) must be finite, each at most {limit:g} in size"
-    bad_heading = "ik: the headings must be finite [rad]"
+    bad_heading = f"ik: the headings must be finite, at most {MAX_TURNS:g} turns [rad]"
+    max_angle = MAX_ANGLE  # wheel_commands' bound (as_angles): beyond, the wrapped angle is round-off
 
     @numba.njit(cache=False)
     def wrap(a):
@@ -146,7 +148,7 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
         if not (abs(vx) <= limit and abs(vy) <= limit and abs(w) <= limit):  # NaN included
             raise ValueError(too_big)
         for k in range(n_steer):
-            if not math.isfinite(heading[k]):
+            if not abs(heading[k]) <= max_angle:  # NaN included
                 raise ValueError(bad_heading)
         beta = heading_out  # the thesis's angles while computing, headings on return: nothing is allocated
         for k in range(n_steer):
@@ -269,8 +271,9 @@ def _steering_fk_and_step(model):
 
     def twist_map(heading, name: str) -> np.ndarray:
         heading = np.asarray(heading, dtype=float)
-        if heading.shape != (n_s,) or not np.isfinite(heading).all():
-            raise ValueError(f"{name}: the headings must be a finite array of shape ({n_s},) [rad] (steer_joints)")
+        if heading.shape != (n_s,) or not (np.abs(heading) <= MAX_ANGLE).all():  # NaN included
+            raise ValueError(f"{name}: the headings must be a finite array of shape ({n_s},), at most {MAX_TURNS:g} "
+                             "turns [rad] (steer_joints)")
         s, _ = model.matrices(heading - delta + HALF_PI)
         return np.ascontiguousarray(s[:3])
 
