@@ -12,7 +12,7 @@ import pytest
 
 from wmrkit import analysis, catalog, kinematics, slip
 from wmrkit.control.slip_control import slip_commands, slip_inverse
-from wmrkit.kinematics.extended import extended_solution
+from wmrkit.kinematics.extended import extended_solution, no_slip_extended_solution, solve_steering
 from wmrkit.kinematics.wheel_ik import twist_is_determined
 
 
@@ -39,6 +39,11 @@ CALLS = {
     "minimal_sensor_sets": (ROBOT, HEADING, lambda **s: kinematics.minimal_sensor_sets(ROBOT, **s)),
     "twist_is_determined": (ROBOT, HEADING, lambda **s: twist_is_determined(ROBOT, list(SPINS), **s)),
     "extended_solution": (ROBOT, HEADING, lambda **s: extended_solution(ROBOT, SPINS, [10.0, 11.0], **s).q_dot),
+    # the guess: the castors' angles are kept, the steered wheel's root is the one closest to it
+    "solve_steering": (ROBOT, HEADING, lambda **s: solve_steering(ROBOT, ("vx", *SPINS), [0.2, 10.0, 11.0],
+                                                                  *_beta(s), **s)),
+    "no_slip_extended_solution": (ROBOT, HEADING, lambda **s: no_slip_extended_solution(
+        ROBOT, ("vx", *SPINS), [0.2, 10.0, 11.0], *_beta(s), **s).q_dot),
     "condition_map": (ROBOT, HEADING, lambda **s: analysis.condition_map(ROBOT, **s)),
     "icr_points": (ROBOT, HEADING, lambda **s: analysis.icr_points(ROBOT, **s)),
     "instantaneous_mobility": (ROBOT, HEADING, lambda **s: analysis.instantaneous_mobility(ROBOT, **s)),

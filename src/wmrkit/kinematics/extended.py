@@ -107,7 +107,7 @@ def _wrap(x: np.ndarray) -> np.ndarray:
 
 def solve_steering(
     robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta_guess: ArrayLike | None = None,
-    *, starts: int = 8, iterations: int = 60,
+    *, heading: ArrayLike | None = None, starts: int = 8, iterations: int = 60,
 ) -> np.ndarray:
     """Steering angles making an over-assigned set slip-free, the conditions (4.83) in general form.
 
@@ -116,15 +116,15 @@ def solve_steering(
     continuously, so the nearby root is wanted); where that fails, from a grid of ``starts`` angles per wheel,
     keeping the root closest to the guess (at most :data:`MAX_STARTS` starts per problem: beyond, a seeded sample
     of the grid). ``q_assigned``: ``(..., n_a)``, finite, within ``MAX_QUERY_RATE``; ``beta_guess``:
-    ``(..., n_steer)`` or None (described). Returns ``(..., n_steer)`` [rad], steerable angles wrapped to
-    [-pi, pi). Raises
+    ``(..., n_steer)`` or None (described), or the guess as the users' ``heading`` (0 = rolling forward). Returns
+    the thesis's β ``(..., n_steer)`` [rad], steerable angles wrapped to [-pi, pi). Raises
     :class:`~wmrkit.errors.SingularError` where no angle makes the assignment slip-free.
     """
     if not (isinstance(starts, int | np.integer) and starts >= 1 and isinstance(iterations, int | np.integer)
             and iterations >= 0):
         raise ShapeError(f"solve_steering: expected starts >= 1 and iterations >= 0 (integers), got {starts!r} and "
                          f"{iterations!r}")
-    guess = configuration(robot, beta_guess)
+    guess = configuration(robot, beta_guess, heading)
     idx, q = _assigned(robot, assigned, q_assigned)
     batch = np.broadcast_shapes(q.shape[:-1], guess.shape[:-1])
     guess = np.broadcast_to(guess, (*batch, guess.shape[-1])).reshape(-1, guess.shape[-1])
@@ -205,11 +205,13 @@ def _levenberg_marquardt(f, x: np.ndarray, iterations: int, tol: np.ndarray) -> 
 
 
 def no_slip_extended_solution(
-    robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta_guess: ArrayLike | None = None
+    robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta_guess: ArrayLike | None = None, *,
+    heading: ArrayLike | None = None,
 ) -> ExtendedSolution:
     """The slip-free extended solution (4.84): (4.82) at the steering angles of :func:`solve_steering`.
 
-    ``(..., n_a), (..., n_steer) -> ExtendedSolution`` whose ``beta`` holds the angles to steer to.
+    ``(..., n_a), (..., n_steer) -> ExtendedSolution`` whose ``beta`` holds the angles to steer to (the thesis's β);
+    the guess as `beta_guess` or as the users' `heading`.
     """
-    beta = solve_steering(robot, assigned, q_assigned, beta_guess)
+    beta = solve_steering(robot, assigned, q_assigned, beta_guess, heading=heading)
     return extended_solution(robot, assigned, q_assigned, beta)
