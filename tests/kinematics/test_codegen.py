@@ -240,6 +240,19 @@ def test_identifiers_and_errors(tmp_path):
         write_code(ROBOTS["mecanum"], "python", tmp_path, sensed=["fl.spin", "fr.spin"])
 
 
+def test_the_refusal_names_the_rates_left_free_not_every_unknown(tmp_path):
+    """A differential drive's two wheel spins fix the twist; a double wheel beside them can still turn on the spot
+    (3.29), which the generated forward model (every unsensed rate solved) cannot tell. The refusal listed every
+    unknown, (vx, vy, omega, unit.steer, ...), a false claim about the twist; now the three rates left free."""
+    robot = _robot("dd-double", [
+        {"name": "left", "type": "fixed", "position": [0, 0.2], "heading": 0, "r": 0.075, "sensed": ["spin"]},
+        {"name": "right", "type": "fixed", "position": [0, -0.2], "heading": 0, "r": 0.075, "sensed": ["spin"]},
+        {"name": "unit", "type": "double", "position": [0.5, 0], "heading": 0, "b": 0.05, "r": 0.05}])
+    with pytest.raises(SingularError, match=r"do not determine \(unit\.steer, unit\.spin1, unit\.spin2\);"):
+        write_code(robot, "python", tmp_path)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_cli_symbolic_and_codegen_end_to_end(capsys, tmp_path):
     """`wmrkit kinematics forklift --symbolic --codegen python DIR`: closed forms printed, a working module written."""
     from wmrkit.cli.main import main

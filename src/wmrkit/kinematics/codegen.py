@@ -86,8 +86,12 @@ class _Plan:
         beta = np.random.default_rng(7).uniform(-math.pi, math.pi, (3, len(self.robot.steer_names)))
         # on the nondimensional robot, as the numeric models decide ranks: raw, a 1 um robot's 1 nm castor was lost
         a = nondimensional(self.robot).constraint_matrix(beta)
-        if int(matrix_rank(a[..., self.unknown_cols]).max()) < len(self.unknown_cols):
-            names = ", ".join(self.robot.velocity_names[j] for j in self.unknown_cols)
+        a_na = a[..., self.unknown_cols]
+        ranks = matrix_rank(a_na)
+        if int(ranks.max()) < len(self.unknown_cols):  # name the rates the null space moves, not every unknown
+            k = int(np.argmax(ranks))
+            free = np.abs(np.linalg.svd(a_na[k])[2][int(ranks[k]):]).max(axis=0) > 1e-9
+            names = ", ".join(self.robot.velocity_names[j] for j, f in zip(self.unknown_cols, free, strict=True) if f)
             raise SingularError(f"robot '{self.robot.name}': the sensed rates ({', '.join(self.sensed)}) do not "
                                 f"determine ({names}); sense more joints (the wheels' 'sensed' field of the "
                                 "description, or sensed= in Python)")
