@@ -176,8 +176,22 @@ def test_mobility_and_rank_of_the_tricycle_479():
 
 
 def test_vx_cannot_be_assigned():
-    with pytest.raises(SingularError, match=r"assigning \(vx\) does not determine"):
+    with pytest.raises(SingularError, match=r"assigning \(vx\) does not determine \(vy, omega, w1\.spin, w2\.spin, "
+                                            r"w3\.spin\)"):
         tri(["vx"])
+
+
+def test_the_refusal_names_the_velocities_left_free_not_every_unknown():
+    """The two spins of a differential drive fix its twist; an unsensed double wheel beside them can still turn on
+    the spot (3.29). The message listed every unknown, (vx, vy, omega, unit.steer, ...), a false claim about the
+    twist ('kinematics --symbolic' printed it as the direct model's 'not determined' line)."""
+    robot = Robot.from_dict({"name": "dd-double", "wheels": [
+        {"name": "left", "type": "fixed", "position": [0, 0.2], "heading": 0, "r": 0.075},
+        {"name": "right", "type": "fixed", "position": [0, -0.2], "heading": 0, "r": 0.075},
+        {"name": "unit", "type": "double", "position": [0.5, 0], "heading": 0, "b": 0.05, "r": 0.05}]})
+    with pytest.raises(SingularError, match=r"\(left\.spin, right\.spin\) does not determine \(unit\.steer, "
+                                            r"unit\.spin1, unit\.spin2\): rank A_na = 5 < 6"):
+        symbolic_model(robot, ["left.spin", "right.spin"])
 
 
 # ---- the tricycle tables (4.80)/(4.81), digest C.5 (corrected) --------------------------------------------

@@ -29,7 +29,7 @@ from sympy.printing.numpy import NumPyPrinter
 from .._shapes import as_names
 from ..errors import SingularError, WmrkitError
 from ..robot import TWIST_NAMES, Robot
-from .linalg import matrix_rank, nondimensional
+from .linalg import free_columns, matrix_rank, nondimensional
 from .symbolic import printable, sensed_rates, symbolic_constraint_matrix, symbolic_model
 
 C_KEYWORDS = frozenset(
@@ -88,9 +88,8 @@ class _Plan:
         a = nondimensional(self.robot).constraint_matrix(beta)
         a_na = a[..., self.unknown_cols]
         ranks = matrix_rank(a_na)
-        if int(ranks.max()) < len(self.unknown_cols):  # name the rates the null space moves, not every unknown
-            k = int(np.argmax(ranks))
-            free = np.abs(np.linalg.svd(a_na[k])[2][int(ranks[k]):]).max(axis=0) > 1e-9
+        if int(ranks.max()) < len(self.unknown_cols):  # name the rates left free, not every unknown
+            free = free_columns(a_na[int(np.argmax(ranks))])
             names = ", ".join(self.robot.velocity_names[j] for j, f in zip(self.unknown_cols, free, strict=True) if f)
             raise SingularError(f"robot '{self.robot.name}': the sensed rates ({', '.join(self.sensed)}) do not "
                                 f"determine ({names}); sense more joints (the wheels' 'sensed' field of the "

@@ -43,6 +43,17 @@ def matrix_rank(m: ArrayLike, *, rtol: float = RANK_RTOL) -> np.ndarray:
     return np.sum(s > rtol * max(m.shape[-2:]) * scale, axis=-1)
 
 
+def free_columns(m: ArrayLike, *, rtol: float = RANK_RTOL) -> np.ndarray:
+    """Which columns of one matrix ``(r, c)`` its null space moves, ``(c,)`` bool: the unknowns that ``m x = b``
+    leaves undetermined (all False at full column rank). Rank as :func:`matrix_rank` decides it."""
+    m = np.asarray(m, dtype=float)
+    rank = int(matrix_rank(m, rtol=rtol))
+    if rank == m.shape[-1]:
+        return np.zeros(m.shape[-1], dtype=bool)
+    null = np.linalg.svd(m)[2][rank:]
+    return np.abs(null).max(axis=0) > 1e-9
+
+
 #: Wheel fields that are lengths [m] (scaled by :func:`nondimensional`).
 LENGTH_FIELDS = ("l", "d", "r", "r_r", "b")
 

@@ -30,7 +30,7 @@ from ..units import MAX_ANGLE, MAX_TURNS
 from ..wheels import GEOMETRY_FIELDS, Wheel, WheelError
 from ._exact_linalg import _components, agrees, equilibrated, numeric, random_points, solve_exactly
 from ._symbolic_matrix import AssignmentError, _nice_number, constraint, exact_number, geometry_fields
-from .linalg import matrix_rank
+from .linalg import free_columns, matrix_rank
 
 Geometry = Literal["numeric", "symbolic"] | Mapping[str, sp.Expr]
 
@@ -246,12 +246,15 @@ def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], g
     points = random_points(a)
     values = [equilibrated(numeric(a, p)) for p in points]  # ranks of columns of order 1 (units, tiny robots)
     rank = max(int(matrix_rank(v)) for v in values)
-    rank_na = max(int(matrix_rank(v[:, na_idx])) for v in values)
+    ranks_na = [int(matrix_rank(v[:, na_idx])) for v in values]
+    rank_na = max(ranks_na)
     solved = tuple(robot.velocity_names[j] for j in na_idx)
-    if rank_na < len(na_idx):
+    if rank_na < len(na_idx):  # name the velocities left free, not every unknown
+        free = free_columns(values[ranks_na.index(rank_na)][:, na_idx])
         raise SingularError(
             f"robot '{robot.name}': assigning ({', '.join(assigned) or 'nothing'}) does not determine "
-            f"({', '.join(solved)}): rank A_na = {rank_na} < {len(na_idx)} unknowns (mobility m = {a.cols - rank})"
+            f"({', '.join(n for n, f in zip(solved, free, strict=True) if f)}): rank A_na = {rank_na} < "
+            f"{len(na_idx)} unknowns (mobility m = {a.cols - rank})"
         )
     exact = rank_na == rank
     coupled = [] if exact else _coupled_angles(a, na_idx, beta)
