@@ -182,7 +182,8 @@ def _cse(exprs: list[sp.Expr], printer: C99CodePrinter | NumPyPrinter) -> tuple[
 _C_LSTSQ = """\
 /* min |A x - b| by Householder QR; A: m x n row-major (m >= n), A and b are overwritten.
  * Returns 0, or -1 if A is rank deficient (what is left of a column once the previous ones are projected out is
- * <= 1e-9 * m (the rows) times its norm, whatever its units: then x is not set). *residual (if not NULL) = |A x - b|. */
+ * <= 1e-9 * m (the rows) times its norm, whatever its units: then x is not set).
+ * *residual (if not NULL) = |A x - b|. */
 static int lstsq(int m, int n, double *a, double *b, double *x, double *residual)
 {
     for (int k = 0; k < n; ++k) {
