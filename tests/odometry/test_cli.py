@@ -386,6 +386,20 @@ def test_json_error_about_a_missing_column_names_it(capsys, tmp_path):
     assert data["error"].startswith("missing column 'right.spin'")
 
 
+@pytest.mark.parametrize(("header", "option"), [("left.spin [counts:u16],right.spin [counts:u16]", "--cpr"),
+                                                ("left.spin,right.spin", "--cpr")])
+def test_counts_without_encoder_data_name_the_file_column_and_option(capsys, tmp_path, header, option):
+    """A counts log of a robot without catalog encoders said "joint 'left.spin' of robot 'diff-drive': no encoder
+    data; give the counts per revolution": no file, no column (--json "file": null, "field": null), no option."""
+    log = tmp_path / "c.csv"
+    log.write_text(f"time,{header}\n0,0,0\n1,10,10\n")
+    extra = [] if "counts" in header else ["--spin", "counts"]
+    assert main(["odometry", "diff-drive", str(log), "--json", *extra]) == 2
+    data = json.loads(capsys.readouterr().err)
+    assert (data["file"], data["line"], data["field"]) == (str(log), 1, "left.spin"), data
+    assert option in data["error"]
+
+
 def test_a_start_pose_too_far_names_the_option(capsys, tmp_path):
     """'--pose 1e10 0 0' was refused as 'pose0: ...', the Python argument's name, not the option's."""
     log = tmp_path / "d.csv"

@@ -24,11 +24,12 @@ class EncoderError(WmrkitError, ValueError):
     """Encoder settings or counts that cannot be right (zero resolution, counts outside the counter's range).
 
     ``index``: for bad counts, the sample (index along the first axis of the readings) of the first one, which
-    a log reader turns into the line (None for settings)."""
+    a log reader turns into the line (None for settings); ``joint``: the joint that has no encoder data, if that
+    is the error (the log readers name its column)."""
 
-    def __init__(self, message: str, index: int | None = None) -> None:
+    def __init__(self, message: str, index: int | None = None, joint: str | None = None) -> None:
         super().__init__(message)
-        self.index = index
+        self.index, self.joint = index, joint
 
 
 def _first(bad: np.ndarray) -> int:
@@ -228,7 +229,9 @@ def encoders_for(robot_name: str, joints: Sequence[str], *, counts_per_rev: floa
                                          enc.bits if bits is None else bits, signed if bits is not None else enc.signed,
                                          enc.sign)
         if enc is None:
-            what = "steering resolution" if joint.endswith(".steer") else "counts per revolution"
-            raise EncoderError(f"joint '{joint}' of robot '{robot_name}': no encoder data; give the {what}")
+            what = ("steering resolution (steer_resolution; --steer-resolution)" if joint.endswith(".steer") else
+                    "counts per revolution (counts_per_rev; --cpr)")
+            raise EncoderError(f"joint '{joint}' of robot '{robot_name}': no encoder data; give the {what}",
+                               joint=joint)
         out.append((joint, enc))
     return tuple(out)

@@ -187,7 +187,7 @@ def header_format(path: str | os.PathLike[str], robot_name: str, joints: Sequenc
     (None: not given; named as the ``wmrkit odometry`` options) merged with the units its header declares
     (:func:`merge_option`: a setting and a header that disagree are an error), else the defaults. Joints read as
     counts get the given encoder settings over the catalog's (:func:`~.encoders.encoders_for`)."""
-    from .encoders import encoders_for
+    from .encoders import EncoderError, encoders_for
     from .logs import LogFormat
 
     source = os.fspath(path)
@@ -208,9 +208,14 @@ def header_format(path: str | os.PathLike[str], robot_name: str, joints: Sequenc
     unit = merge_option("--time-unit", time_unit, units.time_unit, "s", source)
     bits = merge_option("--counter-bits", counter_bits, units.bits, None, source)
     counted = [j for j in joints if (steer if j.endswith(".steer") else spin) == "counts"]
-    encoders = encoders_for(robot_name, counted, counts_per_rev=cpr, gear_ratio=gear, bits=bits,
-                            signed=signed or units.signed, steer_resolution=steer_resolution)
     renamed = dict(units.columns)  # 'left.spin [counts]' read as left.spin
+    try:
+        encoders = encoders_for(robot_name, counted, counts_per_rev=cpr, gear_ratio=gear, bits=bits,
+                                signed=signed or units.signed, steer_resolution=steer_resolution)
+    except EncoderError as e:  # name the file and the column (the --json "field"), as the log's other errors do
+        if e.joint is None:
+            raise
+        raise HeaderError(f"{source}:1: column '{(columns or {}).get(e.joint, e.joint)}': {e}") from None
     named = {j: renamed[j] for j in joints if j in renamed} | {j: renamed.get(c, c) for j, c in (columns or {}).items()}
     return LogFormat(time_column=renamed.get(time_column, time_column), time_unit=unit, columns=tuple(named.items()),
                      spin=spin, steer=steer, encoders=encoders,
