@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_names
+from .._shapes import as_names, finite_number
 from ..errors import UnknownNameError, WmrkitError
 
 
@@ -58,10 +58,10 @@ class IncrementalEncoder:
     sign: int = 1
 
     def __post_init__(self) -> None:
-        if not self.counts_per_rev > 0 or not math.isfinite(self.counts_per_rev):
-            raise EncoderError(f"counts_per_rev must be > 0, got {self.counts_per_rev}")
-        if not self.gear_ratio > 0 or not math.isfinite(self.gear_ratio):
-            raise EncoderError(f"gear_ratio must be > 0, got {self.gear_ratio}")
+        for name in ("counts_per_rev", "gear_ratio"):  # text raised a TypeError comparing it, True was 1
+            value = getattr(self, name)
+            if isinstance(value, bool) or not (finite_number(value) and value > 0):
+                raise EncoderError(f"{name} must be a finite number > 0, got {value!r}")
         if self.bits is not None and not (isinstance(self.bits, int | np.integer) and 2 <= self.bits <= 64):
             raise EncoderError(f"bits must be a whole number between 2 and 64, got {self.bits}")
         if self.counts_per_rev * self.gear_ratio > MAX_COUNTS_PER_REV:  # a count below round-off, or 0 rad
@@ -131,10 +131,10 @@ class AbsoluteEncoder:
     sign: int = 1
 
     def __post_init__(self) -> None:
-        if not self.resolution > 0 or not math.isfinite(self.resolution):
-            raise EncoderError(f"resolution must be > 0, got {self.resolution}")
-        if not math.isfinite(self.offset):
-            raise EncoderError(f"offset must be a finite angle [rad], got {self.offset}")
+        if isinstance(self.resolution, bool) or not (finite_number(self.resolution) and self.resolution > 0):
+            raise EncoderError(f"resolution must be a finite number > 0 [rad], got {self.resolution!r}")
+        if isinstance(self.offset, bool) or not finite_number(self.offset):
+            raise EncoderError(f"offset must be a finite angle [rad], got {self.offset!r}")
         if self.sign not in (1, -1):
             raise EncoderError(f"sign must be +1 or -1, got {self.sign}")
 

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._shapes import as_reals, finite_number
 from ..errors import WmrkitError
 from ..kinematics.linalg import solve_assigned
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_seed
@@ -55,8 +56,11 @@ class TwistProfile:
 
     @classmethod
     def from_segments(cls, segments: Sequence[tuple[float, float, float, float]]) -> TwistProfile:
-        """From ``(duration, vx, vy, omega)`` rows."""
-        a = np.asarray(segments, dtype=float).reshape(-1, 4)
+        """From ``(duration, vx, vy, omega)`` rows (one row alone is one segment)."""
+        a = as_reals(segments, "profile: segments")
+        a = a.reshape(-1, 4) if a.ndim == 1 and a.size in (0, 4) else a
+        if a.ndim != 2 or a.shape[1] != 4:  # a row of 3 or 5 values was numpy's reshape error, 8 values two rows
+            raise WmrkitError(f"profile: expected (duration, vx, vy, omega) rows, got shape {a.shape}")
         return cls(a[:, 0], a[:, 1:])
 
     @property
@@ -92,10 +96,10 @@ def square_path(side: float, *, speed: float = 0.5, turn_rate: float = 0.5, cloc
     optional stop of `pause` [s] between segments (time for steered wheels to turn). Counter-clockwise unless
     `clockwise` (the two runs of the classic square-path benchmark)."""
     for name, value in (("side", side), ("speed", speed), ("turn_rate", turn_rate)):
-        if not 0 < value < math.inf:
-            raise WmrkitError(f"square_path: {name} must be a finite number > 0, got {value}")
-    if not 0 <= pause < math.inf:
-        raise WmrkitError(f"square_path: pause must be a finite number >= 0 s, got {pause}")
+        if isinstance(value, bool) or not (finite_number(value) and value > 0):
+            raise WmrkitError(f"square_path: {name} must be a finite number > 0, got {value!r}")
+    if isinstance(pause, bool) or not (finite_number(pause) and pause >= 0):
+        raise WmrkitError(f"square_path: pause must be a finite number >= 0 s, got {pause!r}")
     w = -turn_rate if clockwise else turn_rate
     seg = [(side / speed, speed, 0.0, 0.0), (math.pi / 2 / turn_rate, 0.0, 0.0, w)]
     if pause > 0:
@@ -154,6 +158,8 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     """
     sensed = tuple(robot.sensed if sensed is None else sensed)
     _check_arguments(robot, sensed, pose0, spin_noise_per_rad, steer_noise, slips, oversample, seed)
+    if isinstance(rate, bool) or not finite_number(rate):
+        raise WmrkitError(f"rate: expected a finite number [Hz], got {rate!r}")
     if not (1e-6 <= rate and profile.duration * rate <= MAX_SAMPLES):
         raise WmrkitError(f"rate {rate:g} Hz over the profile's {profile.duration:g} s: need a rate >= 1e-06 Hz and "
                           f"at most {MAX_SAMPLES} sample periods")
@@ -246,8 +252,8 @@ def _check_arguments(robot: Robot, sensed: tuple[str, ...], pose0: ArrayLike, sp
     if pose.shape != (3,) or not (np.abs(pose) <= MAX_COORDINATE).all():
         raise WmrkitError(f"pose0: expected (x, y, theta), finite and within {MAX_COORDINATE:g}, got {pose.tolist()}")
     for name, value in (("spin_noise_per_rad", spin_noise_per_rad), ("steer_noise", steer_noise)):
-        if not 0 <= value < math.inf:
-            raise WmrkitError(f"{name}: a noise must be a finite number >= 0, got {value}")
+        if isinstance(value, bool) or not (finite_number(value) and value >= 0):
+            raise WmrkitError(f"{name}: a noise must be a finite number >= 0, got {value!r}")
     if isinstance(oversample, bool) or not isinstance(oversample, int | np.integer) or oversample < 1:
         raise WmrkitError(f"oversample: expected an integer >= 1 (fine steps per sample), got {oversample!r}")
     check_seed(seed, WmrkitError)
