@@ -10,9 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wmrkit import catalog
-from wmrkit.errors import WmrkitError
+from wmrkit.errors import ShapeError, WmrkitError
 from wmrkit.odometry.covariance import CrowleyNoise, JointNoise, propagate_covariance, step_jacobians
-from wmrkit.odometry.integrators import METHODS, integrate_increments, step
+from wmrkit.odometry.integrators import METHODS, integrate_exact, integrate_increments, step
 from wmrkit.odometry.model import odometry_model
 from wmrkit.odometry.pipeline import odometry
 from wmrkit.odometry.synthetic import TwistProfile, simulate, square_path
@@ -212,3 +212,20 @@ def test_non_finite_poses_and_increments_are_refused_by_name():
         CrowleyNoise().increment_covariance([np.nan, 0.0, 0.0])
     with pytest.raises(WmrkitError, match="delta_d: expected finite numbers"):
         CrowleyNoise().input_covariance(np.nan, 0.0)
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    # numpy's "shape mismatch: objects cannot be broadcast to a single shape" named neither argument
+    (lambda: step(np.zeros((4, 3)), np.ones((5, 3))), r"^pose_world_robot \(4, 3\) and increment_robot \(5, 3\): "
+                                                      r"their batch shapes"),
+    (lambda: step_jacobians(np.zeros((4, 3)), np.ones((5, 3))), r"^pose_world_robot \(4, 3\) and increment_robot"),
+    (lambda: CrowleyNoise().input_covariance([1.0, 2.0], [1.0, 2.0, 3.0]), r"^delta_d \(2,\) and delta_theta \(3,\)"),
+    (lambda: integrate_exact([0, 0, 0], [[1.0, 0, 1.0]] * 3, [0.1, 0.2]), r"^twist_robot \(3, 3\) and dt \(2, 1\)"),
+    # text was read as a number: integrate_exact(..., '0.1') stepped 0.1 s
+    (lambda: integrate_exact([0, 0, 0], [1.0, 0, 1.0], "0.1"), r"^dt: got the text '0\.1'"),
+    (lambda: CrowleyNoise().input_covariance("1", 0.5), r"^delta_d: got the text '1'"),
+])
+def test_steps_refuse_batches_that_do_not_broadcast_and_text_by_name(call, message):
+    with pytest.raises(ShapeError, match=message):
+        call()
+

@@ -20,9 +20,9 @@ from dataclasses import dataclass, fields
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors
-from ..errors import WmrkitError
-from .integrators import HEADING_FRACTION, Method, _finite, check_method, sinc, sinc_derivative
+from .._shapes import as_reals, as_vectors
+from ..errors import ShapeError, WmrkitError
+from .integrators import HEADING_FRACTION, Method, _finite, check_batches, check_method, sinc, sinc_derivative
 
 
 @dataclass(frozen=True, slots=True)
@@ -41,8 +41,12 @@ class CrowleyNoise:
 
     def input_covariance(self, delta_d: ArrayLike, delta_theta: ArrayLike) -> np.ndarray:
         """Covariance of ``U = (dD, dtheta)``, 003 eqs. (15)-(17): ``(...), (...) -> (..., 2, 2)``."""
-        dd, dth = np.broadcast_arrays(np.abs(_finite(np.asarray(delta_d, float), "delta_d")),
-                                      np.abs(_finite(np.asarray(delta_theta, float), "delta_theta")))
+        dd, dth = (np.abs(_finite(as_reals(v, name), name)) for v, name in ((delta_d, "delta_d"),
+                                                                             (delta_theta, "delta_theta")))
+        try:
+            dd, dth = np.broadcast_arrays(dd, dth)
+        except ValueError:  # numpy's 'shape mismatch' named neither
+            raise ShapeError(f"delta_d {dd.shape} and delta_theta {dth.shape}: their shapes do not broadcast") from None
         q = np.zeros((*dd.shape, 2, 2))
         q[..., 0, 0] = self.k_d * dd
         q[..., 1, 1] = self.k_dtheta * dd + self.k_theta * dth
@@ -134,6 +138,7 @@ def step_jacobians(pose_world_robot: ArrayLike, increment_robot: ArrayLike,
     check_method(method)
     pose = _finite(as_vectors(pose_world_robot, 3, "pose_world_robot"), "pose_world_robot")
     inc = _finite(as_vectors(increment_robot, 3, "increment_robot"), "increment_robot")
+    check_batches(pose, "pose_world_robot", inc, "increment_robot")
     return _step_jacobians(pose, inc, method)
 
 

@@ -32,7 +32,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors
+from .._shapes import as_reals, as_vectors
 from ..errors import ShapeError, WmrkitError
 
 Method = Literal["exact", "rk2", "euler", "paper002"]
@@ -91,6 +91,7 @@ def step(pose_world_robot: ArrayLike, increment_robot: ArrayLike, method: Method
     check_method(method)
     pose = _finite(as_vectors(pose_world_robot, 3, "pose_world_robot"), "pose_world_robot")
     inc = _finite(as_vectors(increment_robot, 3, "increment_robot"), "increment_robot")
+    check_batches(pose, "pose_world_robot", inc, "increment_robot")
     return compose_columns(pose, inc[..., 0, None], inc[..., 1, None], inc[..., 2, None], method)[..., 0, :]
 
 
@@ -101,9 +102,21 @@ def _finite(values: np.ndarray, name: str) -> np.ndarray:
     return values
 
 
+def check_batches(a: np.ndarray, a_name: str, b: np.ndarray, b_name: str) -> None:
+    """Refuse arrays ``(..., 3)`` whose batch shapes (all but the last axis) do not broadcast, naming both (numpy's
+    'shape mismatch' named neither)."""
+    try:
+        np.broadcast_shapes(a.shape[:-1], b.shape[:-1])
+    except ValueError:
+        raise ShapeError(f"{a_name} {a.shape} and {b_name} {b.shape}: their batch shapes (all but the last axis) do "
+                         "not broadcast") from None
+
+
 def _twist_step(pose_world_robot: ArrayLike, twist_robot: ArrayLike, dt: ArrayLike, method: Method) -> np.ndarray:
     twist = _finite(as_vectors(twist_robot, 3, "twist_robot"), "twist_robot")
-    return step(pose_world_robot, twist * _finite(np.asarray(dt, dtype=float), "dt")[..., None], method)
+    dt = _finite(as_reals(dt, "dt"), "dt")[..., None]  # text ('0.1') was read as a number
+    check_batches(twist, "twist_robot", dt, "dt")
+    return step(pose_world_robot, twist * dt, method)
 
 
 def integrate_exact(pose_world_robot: ArrayLike, twist_robot: ArrayLike, dt: ArrayLike) -> np.ndarray:
