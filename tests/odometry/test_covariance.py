@@ -229,3 +229,25 @@ def test_steps_refuse_batches_that_do_not_broadcast_and_text_by_name(call, messa
     with pytest.raises(ShapeError, match=message):
         call()
 
+
+def test_first_order_covariance_matches_a_monte_carlo_of_the_steps():
+    """Independent check of propagate_covariance: small Crowley noise drawn on every body increment of a curving,
+    sideways-drifting path, each run integrated step by step; the sample covariance of the final poses (2e4 runs,
+    fixed seed: 0.9 % of the largest entry off at most) equals the first-order propagation for every scheme. (The
+    schemes' covariances differ by 2.5 % here, the accumulated heading noise dominating: this checks the
+    propagation, the Jacobians of each scheme are checked against central differences above.)"""
+    rng = np.random.default_rng(7)
+    n, runs, scale = 40, 20_000, 0.01  # noise scaled down: first order is exact to O(scale^2)
+    inc = np.column_stack([np.full(n, 0.05), np.full(n, 0.01), np.linspace(0.02, 0.08, n)])
+    q = CrowleyNoise(1e-4, 3e-4, 1e-4).increment_covariance(inc)
+    w, v = np.linalg.eigh(q)
+    root = v * np.sqrt(np.clip(w, 0.0, None))[:, None, :]
+    pose0 = np.array([0.3, -0.2, 0.7])
+    drawn = inc + scale * (root @ rng.standard_normal((runs, n, 3, 1)))[..., 0]
+    for method in METHODS:
+        poses = np.vstack([pose0, integrate_increments(pose0, inc, method)])
+        expected = propagate_covariance(poses, inc, q, method)[-1]
+        x = np.tile(pose0, (runs, 1))
+        for k in range(n):  # step by step, not through the compiled composition
+            x = step(x, drawn[:, k], method)
+        np.testing.assert_allclose(np.cov(x.T) / scale**2, expected, atol=0.02 * np.abs(expected).max())
