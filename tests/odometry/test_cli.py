@@ -167,6 +167,10 @@ def test_gyro_heading(capsys, tmp_path, diff_run):
     # bag options on a CSV log were ignored (CSV options on a bag were refused)
     ("ok", ["--joint-name", "wheel_l=left.spin"], r"--joint-name applies to ROS 2 bags; LOG .*x\.csv is read as a CSV"),
     ("ok", ["--topic", "/wheels"], r"--topic applies to ROS 2 bags"),
+    # steering options on a robot that reads no steering were ignored (exit 0): a log of another robot?
+    ("ok", ["--steer", "degrees"], r"--steer applies to steering columns; robot 'diff-drive' reads none \(sensed: "
+                                   r"left\.spin, right\.spin\)"),
+    ("ok", ["--steer-convention", "beta"], r"--steer-convention applies to steering columns"),
 ])
 def test_bad_input_exits_2_with_one_line(capsys, tmp_path, setup, args, message):
     path = tmp_path / "x.csv"

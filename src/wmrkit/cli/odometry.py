@@ -105,6 +105,10 @@ def run(args: argparse.Namespace) -> int:
     if not all(math.isfinite(k) and k >= 0 for k in args.crowley):
         raise WmrkitError(f"--crowley: coefficients must be finite and >= 0, got {' '.join(map(str, args.crowley))}")
     joints = odometry_model(robot, args.sensed).joints
+    steer_option = "--steer" if args.steer else "--steer-convention" if args.steer_convention else None
+    if steer_option and not any(j.endswith(".steer") for j in joints):  # it would be ignored silently
+        raise WmrkitError(f"{steer_option} applies to steering columns; robot '{robot.name}' reads none (sensed: "
+                          f"{', '.join(joints)}): another robot's log?")
     options = {"--cpr": args.cpr is not None, "--gear": args.gear is not None,
                "--counter-bits": args.counter_bits is not None, "--signed-counter": args.signed_counter}
     steer_res = None if args.steer_resolution is None else parse_angle(args.steer_resolution, "--steer-resolution")
