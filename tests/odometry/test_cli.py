@@ -138,6 +138,25 @@ def test_gyro_heading(capsys, tmp_path, diff_run):
     assert out["pose"][2] == pytest.approx(diff_run.truth[-1, 2], abs=0.01)
 
 
+@pytest.mark.parametrize(("column", "values", "agrees"), [
+    ("gz", lambda w: w, True), ("yaw", lambda y: y, True),
+    ("gz", np.degrees, False),  # a gyro in deg/s read as rad/s: theta 57 times the truth, "consistent": true
+    ("yaw", lambda y: -y, False),  # a clockwise (NED) yaw: the mirror path
+    ("gz", lambda w: 1.3 * w, True),  # a skid steer's wheels turn more than the robot: not a contradiction
+])
+def test_an_external_heading_that_contradicts_the_wheels_warns(capsys, tmp_path, diff_run, column, values, agrees):
+    truth = diff_run.truth[:, 2]
+    data = values(np.gradient(truth, diff_run.log.time) if column == "gz" else truth)
+    path = tmp_path / "h.csv"
+    write_csv(path, ("time", "left.spin", "right.spin", column), np.column_stack([diff_run.log.time,
+                                                                                  diff_run.log.positions, data]))
+    option = "--gyro-column" if column == "gz" else "--heading-column"
+    assert main(["odometry", "diff-drive", str(path), "--json", option, column]) == 0
+    out = capsys.readouterr()
+    assert json.loads(out.out)["consistent"] is agrees
+    assert ("external heading (column '" + column + "')" in out.err) is not agrees, out.err
+
+
 @pytest.mark.parametrize(("setup", "args", "message"), [
     ("nan", [], r"x\.csv:4: right\.spin: value nan is not a finite number"),
     ("repeat", [], r"x\.csv:4: time 0\.05 s repeats the previous sample \(a zero time step\)"),

@@ -153,6 +153,8 @@ def run(args: argparse.Namespace) -> int:
         _warn_ill_conditioned(args.method, slip_model.model)
     consistent = _check_consistency(summary, lambda: _wheel_slips(robot, args.log, fmt, args.sensed),
                                     filtered=args.method if args.method in ("fk1", "fk2") else None)
+    if fmt.heading_column or fmt.gyro_column:
+        consistent = _check_heading(robot, args.log, fmt, args.sensed) and consistent
     print_json(summary.to_dict() | {"consistent": consistent}) if args.json else print(format_summary(summary))
     return 0
 
@@ -207,6 +209,38 @@ def _check_consistency(s: OdometrySummary, wheel_slips, *, filtered: str | None 
     print(f"wmrkit: warning: the sensed joints contradict each other: slip indicator rms {s.rms_slip:.3g} m per "
           f"interval (max {s.max_slip:.3g} m) against {motion:.3g} m of motion per interval{named}, {what}",
           file=sys.stderr)
+    return False
+
+
+#: An external heading (heading or gyro column) contradicts the wheels when its turns over the first samples differ
+#: from theirs by more than this fraction of the larger, interval by interval: a gyro in deg/s read as rad/s, a
+#: clockwise (NED) yaw (a skid steer's wheels, which turn more than the robot, stay well within it).
+HEADING_RTOL = 0.5
+#: Least turning [rad] of the wheels or the external heading over the first samples for that comparison.
+HEADING_MIN_TURN = 0.1
+
+
+def _check_heading(robot, log: str, fmt: LogFormat, sensed) -> bool:
+    """Warn (one line on stderr) when the external heading's turns contradict the wheels' over the first samples of
+    a CSV log (:data:`HEADING_RTOL`); return whether they did not. Its changes replace the wheels' dtheta, so a
+    heading in other units or of the other sign gave a wrong trajectory with "consistent": true."""
+    from ..odometry.logs import read_csv
+
+    if is_bag(log):
+        return True
+    model = odometry_model(robot, sensed)
+    first = next(iter(read_csv(log, model.joints, fmt, robot=robot, chunk_size=20_000)))
+    wheels = model.from_positions(first.positions).column(2)
+    external = np.diff(first.heading_world)
+    wheels = np.zeros_like(external) if wheels is None else wheels
+    scale = float(np.maximum(np.abs(wheels), np.abs(external)).sum())
+    off = float(np.abs(external - wheels).sum())
+    if scale < HEADING_MIN_TURN or off <= HEADING_RTOL * scale:
+        return True
+    column = fmt.heading_column or fmt.gyro_column
+    print(f"wmrkit: warning: the external heading (column '{column}') turns {external.sum():.4g} rad over the first "
+          f"{len(first)} samples where the wheels turn {wheels.sum():.4g} rad ({off:.3g} rad apart interval by "
+          f"interval): its units (deg? deg/s?) or its sign (clockwise?) are probably wrong", file=sys.stderr)
     return False
 
 
