@@ -225,3 +225,15 @@ def test_options_choosing_an_integration_scheme_explain_every_choice():
                 if not re.search(rf"(?<![\w-]){re.escape(choice)}(?![\w-])", action.help or ""):
                     unexplained.append(f"{' '.join(words)} {action.option_strings[-1]} {choice}")
     assert unexplained == []
+
+
+def test_odometry_options_a_description_may_default_say_so():
+    """A description's `odometry:` block (method, scheme, slip, noise) and a wheel's `slip:` give the defaults of
+    `wmrkit odometry`'s options (docs/description-format.md): `--kf-noise` said '(default 1 1 1)' and `--mu`
+    'default 1,1' while a described noise or friction coefficient was used in their place; `--mu-default` and
+    `--kf-wheel` said nothing of their defaults."""
+    from cli_options import options
+
+    described = ("--method", "--scheme", "--mu", "--mu-default", "--kf-noise", "--kf-wheel")
+    helps = {a.option_strings[-1]: a.help for words, a in options() if words == ("odometry",)}
+    assert [o for o in described if "description" not in helps[o]] == []

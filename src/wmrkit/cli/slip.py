@@ -23,14 +23,17 @@ def add_estimator_options(p: argparse.ArgumentParser) -> None:
                         "odometry.scheme, else exact)")
     g.add_argument("--mu", action="append", metavar="WHEEL=LAT,LONG", default=[],
                    help="WLS: friction coefficients of a wheel, lateral and longitudinal (only ratios matter; "
-                        "default 1,1; repeat)")
-    g.add_argument("--mu-default", metavar="LAT,LONG", help="WLS: coefficients of the wheels not named by --mu")
+                        "default: the wheel's slip in the description, else 1,1; repeat)")
+    g.add_argument("--mu-default", metavar="LAT,LONG",
+                   help="WLS: coefficients of the wheels not named by --mu (default: the description's "
+                        "odometry.slip, else 1,1)")
     g.add_argument("--slip-weights", metavar="FILE", help="WLS: coefficients from 'wmrkit calibrate --json' output")
     g.add_argument("--kf-noise", nargs=3, type=float, metavar=("PROCESS", "LAT", "LONG"),
                    help="FK1/FK2: process noise (the thesis's k13, (7.68)) [m/s per sample] and the lateral / "
-                        "longitudinal row noise [m/s] (default 1 1 1)")
+                        "longitudinal row noise [m/s] (default: the description's odometry.noise, else 1 1 1)")
     g.add_argument("--kf-wheel", action="append", metavar="WHEEL=LAT,LONG", default=[],
-                   help="FK1/FK2: row noise of one wheel (repeat)")
+                   help="FK1/FK2: row noise of one wheel (default: the wheel's slip.noise in the description, "
+                        "else --kf-noise's; repeat)")
     g.add_argument("--thesis-double-q", action="store_true",
                    help="FK1/FK2: add Q again after the update, as (7.75) is printed (see docs/errata.md)")
 
