@@ -100,3 +100,28 @@ def test_every_file_and_link_the_documentation_names_exists():
             elif name and not re.search(rf"^def {name}\b", found[0].read_text(), flags=re.M):
                 missing.append(f"{page.name}: {path}::{name}")
     assert missing == []
+
+
+def test_signatures_the_documentation_writes_with_beta_name_heading_too():
+    """A signature of the pages (`mobility(robot, beta=None)` in a code block, or in backticks) of a function that
+    takes the users' `heading=` writes it: docs/kinematics.md and docs/wheel-ik.md gave every function with the
+    thesis's `beta=None` only, the axle angle, 90 deg off the heading a reader of the conventions page passes."""
+    import importlib
+    import inspect
+    import pkgutil
+
+    import wmrkit
+
+    functions = {}
+    for info in pkgutil.walk_packages(wmrkit.__path__, "wmrkit."):
+        if info.name.split(".")[1] in ("kinematics", "analysis"):
+            module = importlib.import_module(info.name)
+            functions |= {n: f for n, f in vars(module).items() if inspect.isfunction(f)}
+    unsaid = []
+    for page in sorted((ROOT / "docs").glob("*.md")):
+        for number, line in enumerate(page.read_text().splitlines(), 1):
+            for name, args in re.findall(r"\b(\w+)\((robot\b[^()]*\bbeta=None[^()]*)\)", line):
+                if name in functions and "heading" in inspect.signature(functions[name]).parameters \
+                        and "heading=" not in args:
+                    unsaid.append(f"{page.name}:{number}: {name}")
+    assert unsaid == []
