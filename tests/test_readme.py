@@ -58,3 +58,20 @@ def test_a_wheel_written_as_the_readme_writes_it_without_its_heading_is_told_hea
         Robot.from_file(path)
     assert str(err.value).endswith("rover.yaml:3: wheels[0]: missing field 'heading' (rolling direction, "
                                    "0 = straight ahead; or the thesis's 'beta')")
+
+
+def test_the_described_robot_is_rated_as_the_readme_says(tmp_path, capsys):
+    """'Describing a robot': its YAML, saved as tricycle.yaml, is what the sentence after it says: 'wmrkit analyze
+    tricycle.yaml rates it a type-4 vehicle (m = 1, d = 1) with sufficient, consistent actuators'."""
+    import json
+
+    from wmrkit.cli.main import main
+
+    section = README.split("## Describing a robot", 1)[1]
+    (tmp_path / "tricycle.yaml").write_text(re.findall(r"```yaml\n(.*?)```", section, flags=re.S)[0])
+    assert "`wmrkit analyze tricycle.yaml` rates it a type-4 vehicle (m = 1, d = 1) with sufficient, consistent" \
+           in " ".join(section.split())
+    assert main(["analyze", str(tmp_path / "tricycle.yaml"), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert (report["type"], report["mobility"], report["steerability"]) == (4, 1, 1)
+    assert report["actuation"]["sufficient"] and report["actuation"]["consistent"]
