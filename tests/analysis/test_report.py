@@ -220,6 +220,18 @@ def test_the_python_doors_bound_the_resolution_as_analyze_resolution_does(resolu
     assert not (tmp_path / "index.html").exists()
 
 
+@pytest.mark.parametrize("dpi", [0, -5, float("nan"), float("inf"), 5, 601, 10**5, "100", True])
+def test_write_report_refuses_a_resolution_of_images_it_cannot_draw(dpi, tmp_path):
+    """write_report(dpi=) was passed to matplotlib unchecked: -5 and NaN raised its ValueError after robot.png was
+    written, 0 drew at the default silently, 3000 drew a 28500 x 19500 px robot picture (2 GB, killed); a
+    number from MIN_DPI to MAX_DPI or None is taken, anything else refused before the report folder is made."""
+    from wmrkit.errors import WmrkitError
+
+    with pytest.raises(WmrkitError, match="dpi"):
+        write_report(analyze(catalog.load("diff-drive"), resolution=12), tmp_path / "r", resolution=12, dpi=dpi)
+    assert not (tmp_path / "r").exists()
+
+
 def test_singular_set_refuses_an_empty_search():
     """singular_set(resolution=0, max_samples=0) searched nothing and called the model always singular."""
     from wmrkit.analysis.singularity import singular_set

@@ -10,6 +10,7 @@ from __future__ import annotations
 import html
 import itertools
 import math
+import numbers
 import os
 from pathlib import Path
 
@@ -34,6 +35,9 @@ img { max-width: 100%; border: 1px solid #ddd; margin: 0.4em 0 } .small { color:
 #: Grid points per turn of the table of every assigned set (a quarter of the report's resolution, at most this):
 #: up to 36 singular sets, each costing grid size x wheels (150 s for 64 steered wheels at resolution 1440).
 TABLE_RESOLUTION = 90
+#: Image resolutions ``write_report(dpi=)`` takes [dots per inch]: below 20 matplotlib's fonts fail (5 raised a
+#: FreeType error); at 600 the largest picture (9.5 x 6.5 in) is 5700 x 3900 px (3000 drew 2 GB and was killed).
+MIN_DPI, MAX_DPI = 20, 600
 
 
 class ReportError(WmrkitError, OSError):
@@ -45,9 +49,13 @@ def write_report(analysis: Analysis, directory: str | os.PathLike[str], *, resol
     """Write ``index.html`` and its images into `directory` (created if needed); return the page's path.
 
     `resolution`: grid points per turn of the maps and singular sets (:func:`.summary.check_resolution`, as
-    ``--resolution``); `dpi`: image resolution (default ~100).
+    ``--resolution``); `dpi`: image resolution, :data:`MIN_DPI` to :data:`MAX_DPI` (default ~100).
     """
     check_resolution(resolution)
+    # matplotlib took any dpi: 0 drew at the default silently, -5 and NaN raised its ValueError, 10**5 bad_alloc
+    if dpi is not None and (isinstance(dpi, bool) or not isinstance(dpi, numbers.Real)
+                            or not MIN_DPI <= dpi <= MAX_DPI):  # NaN included
+        raise WmrkitError(f"dpi: expected {MIN_DPI} to {MAX_DPI} dots per inch or None, got {dpi!r}")
     out = Path(directory)
     try:
         out.mkdir(parents=True, exist_ok=True)
