@@ -271,3 +271,21 @@ def test_animate_run_refuses_a_file_that_is_not_a_gif(tmp_path):
     with pytest.raises(WmrkitError, match=r"run\.png: the animation is written as a GIF"):
         animate_run(run, tmp_path / "run.png")
     assert not (tmp_path / "run.png").exists()
+
+
+def test_every_frame_of_the_tracking_animation_labels_its_axes_in_metres(tmp_path, monkeypatch):
+    """animate_run cleared its axes for each frame and drew the plan without axis labels: x and y in no unit."""
+    import wmrkit.plotting.files as files
+    from wmrkit.control.plots import animate_run
+
+    labels = []
+
+    def spy(fig, draw, frames, path, **kwargs):
+        for k in frames:
+            draw(k)
+            labels.append((fig.axes[0].get_xlabel(), fig.axes[0].get_ylabel()))
+
+    monkeypatch.setattr(files, "save_gif", spy)
+    animate_run(track(catalog.load("diff-drive"), builtin_reference("line", duration=2.0)), tmp_path / "r.gif",
+                frames=3)
+    assert labels == [("x [m]", "y [m]")] * 3

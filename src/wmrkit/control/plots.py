@@ -103,6 +103,8 @@ def animate_run(run: TrackingRun, path: str | os.PathLike[str], *, frames: int =
         ax.set_xlim(centre[0] - span / 2, centre[0] + span / 2)
         ax.set_ylim(centre[1] - span / 2, centre[1] + span / 2)
         ax.set_aspect("equal")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
         ax.set_title(f"{robot.name}, {run.controller}: t = {run.t[i]:.1f} s", fontsize=9)
         return []
 
