@@ -289,3 +289,17 @@ def test_every_frame_of_the_tracking_animation_labels_its_axes_in_metres(tmp_pat
     animate_run(track(catalog.load("diff-drive"), builtin_reference("line", duration=2.0)), tmp_path / "r.gif",
                 frames=3)
     assert labels == [("x [m]", "y [m]")] * 3
+
+
+@pytest.mark.parametrize("frames", [0, 1, -3, 2.5, True, 10**6])
+def test_animate_run_takes_a_bounded_number_of_frames(tmp_path, frames):
+    """animate_run(frames=) was unchecked: 0 raised an IndexError, -3 numpy's ValueError, 2.5 a TypeError, and
+    10**6 drew every sample of the run as a frame (track allows 10^6 samples; a frame is about 0.25 MB until the GIF
+    is written). Now 2 to 800 frames, as park --animate."""
+    from wmrkit.control.plots import animate_run
+    from wmrkit.errors import WmrkitError
+
+    run = track(catalog.load("diff-drive"), builtin_reference("line", duration=2.0))
+    with pytest.raises(WmrkitError, match=r"^frames: expected an integer from 2 to 800"):
+        animate_run(run, tmp_path / "run.gif", frames=frames)
+    assert not (tmp_path / "run.gif").exists()

@@ -67,16 +67,23 @@ def plot_run(run: TrackingRun, path: str | os.PathLike[str]) -> None:
     _save(fig, path)
 
 
+#: Most frames of a tracking animation, as park --animate's (:data:`wmrkit.parking.plot.MAX_FRAMES`): each is kept,
+#: about 0.25 MB, until the GIF is written, and a run has up to 10^6 samples.
+MAX_FRAMES = 800
+
+
 def animate_run(run: TrackingRun, path: str | os.PathLike[str], *, frames: int = 80) -> None:
-    """A GIF of the robot (outline and wheels at their headings) following the reference (`path` ends in .gif)."""
-    from ..plotting.files import save_gif
+    """A GIF of the robot (outline and wheels at their headings) following the reference (`path` ends in .gif);
+    `frames`: at most that many, 2 to :data:`MAX_FRAMES`, evenly spread over the run."""
+    from ..plotting.files import check_count, save_gif, spread_indices
     from ..plotting.robot import footprint
 
     if os.path.splitext(os.fspath(path))[1].lower() != ".gif":  # x.png was written as one still frame
         raise WmrkitError(f"{os.fspath(path)}: the animation is written as a GIF (.gif)")
+    check_count("frames", frames, 2, MAX_FRAMES)  # 0 raised an IndexError; 10**6 drew every sample of the run
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(5, 5))
-    idx = np.linspace(0, len(run.t) - 1, min(frames, len(run.t))).astype(int)
+    idx = spread_indices(len(run.t), frames)
     pts = np.vstack([run.reference[:, :2], run.pose[:, :2]])
     span = float(np.ptp(pts, axis=0).max()) + 2.0
     centre = pts.min(axis=0) + np.ptp(pts, axis=0) / 2

@@ -6,7 +6,6 @@ matplotlib's object API (no pyplot, no GUI backend). World frame of :mod:`wmrkit
 from __future__ import annotations
 
 import math
-import numbers
 import os
 from pathlib import Path
 
@@ -17,7 +16,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon, Rectangle
 
 from ..errors import WmrkitError
-from ..plotting.files import save_gif, spread_indices
+from ..plotting.files import check_count, save_gif, spread_indices
 from .execute import Execution, execute_plan
 from .geometry import Space, Vehicle, footprint
 from .path import sample_poses
@@ -118,9 +117,8 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
         raise WmrkitError(f"{path}: the animation is written as .gif or .html")
     # max_frames = 10**9 drew every executed sample (up to 500,000 frames: hours), 2.5 raised a TypeError; fps = 0
     # a ZeroDivisionError once the whole animation was rendered
-    for name, value, lo, hi in (("max_frames", max_frames, 2, MAX_FRAMES), ("fps", fps, 1, 100)):
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not lo <= value <= hi:
-            raise WmrkitError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
+    check_count("max_frames", max_frames, 2, MAX_FRAMES)
+    check_count("fps", fps, 1, 100)
     run = execute_plan(plan) if execution is None else execution
     frames = spread_indices(len(run.t), max_frames)
     dots = spread_indices(len(run.t), MAX_TRAIL)  # the trail's samples (all of a short run)

@@ -3,6 +3,7 @@ items of a long sequence a figure or an animation draws; animations written as G
 
 from __future__ import annotations
 
+import numbers
 import os
 from collections.abc import Callable, Iterable
 
@@ -27,6 +28,13 @@ def check_figure_path(path: str | os.PathLike[str], what: str = "") -> None:
     if suffix not in FORMATS:
         raise PlotError(f"{what + ' ' if what else ''}{name}: cannot draw to '{suffix or 'no extension'}' (plot files "
                         f"are {', '.join(FORMATS)})")
+
+
+def check_count(name: str, value: object, lo: int, hi: int) -> None:
+    """Raise :class:`PlotError` naming `name` unless `value` is an integer from `lo` to `hi` (an animation's
+    frames, its frames a second), before the work that draws."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not lo <= value <= hi:
+        raise PlotError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
 
 
 def spread_indices(n: int, most: int) -> np.ndarray:
