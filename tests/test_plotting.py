@@ -221,3 +221,17 @@ def test_an_animation_body_does_not_cross_itself():
     assert body.is_valid and body.area == pytest.approx(0.6, abs=1e-12)
     with_origin = footprint(robot, origin=True)
     assert len(with_origin) == 5 and shapely.Polygon(with_origin).is_valid
+
+
+@pytest.mark.parametrize("poses", [[[0.0, 0.0, 0.0], [float("nan"), 1.0, 0.0], [2.0, 2.0, 0.0]],
+                                   [[0.0, 0.0, 0.0], [float("inf"), 1.0, 0.0]], np.zeros((0, 3)), np.zeros(3),
+                                   np.zeros((4, 2)), [[0, 0, 0], [1, "a", 0]]])
+def test_a_trajectory_plot_refuses_a_path_it_cannot_draw_naming_it(tmp_path, poses):
+    """save_trajectory_plot drew a path with a NaN or an infinite pose as a broken line (or none) and wrote the
+    file; an empty path raised an IndexError, a flat (3,) one 'too many indices', a text value numpy's ValueError."""
+    from wmrkit.errors import WmrkitError
+    from wmrkit.odometry.plot import save_trajectory_plot
+
+    with pytest.raises(WmrkitError, match=r"^odometry \(diff-drive\): "):
+        save_trajectory_plot(tmp_path / "p.png", {"ok": np.zeros((2, 3)), "odometry (diff-drive)": poses})
+    assert list(tmp_path.iterdir()) == []
