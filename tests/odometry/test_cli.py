@@ -142,7 +142,9 @@ def test_gyro_heading(capsys, tmp_path, diff_run):
     ("gz", lambda w: w, True), ("yaw", lambda y: y, True),
     ("gz", np.degrees, False),  # a gyro in deg/s read as rad/s: theta 57 times the truth, "consistent": true
     ("yaw", lambda y: -y, False),  # a clockwise (NED) yaw: the mirror path
-    ("gz", lambda w: 1.3 * w, True),  # a skid steer's wheels turn more than the robot: not a contradiction
+    ("gz", lambda w: 1.3 * w, True),
+    ("gz", lambda w: w / 3, True),  # a skid steer's wheels turn up to 2-3 times the robot: not a contradiction
+    ("yaw", lambda y: y / 3, True),
 ])
 def test_an_external_heading_that_contradicts_the_wheels_warns(capsys, tmp_path, diff_run, column, values, agrees):
     truth = diff_run.truth[:, 2]

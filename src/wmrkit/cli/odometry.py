@@ -213,9 +213,10 @@ def _check_consistency(s: OdometrySummary, wheel_slips, *, filtered: str | None 
 
 
 #: An external heading (heading or gyro column) contradicts the wheels when its turns over the first samples differ
-#: from theirs by more than this fraction of the larger, interval by interval: a gyro in deg/s read as rad/s, a
-#: clockwise (NED) yaw (a skid steer's wheels, which turn more than the robot, stay well within it).
-HEADING_RTOL = 0.5
+#: from theirs by more than this fraction of the larger, interval by interval. Turns k times apart (same sign) are
+#: 1 - 1/k apart: a gyro in deg/s read as rad/s is 0.98 apart, a clockwise (NED) yaw 1 or more; a skid steer, whose
+#: wheels turn up to 2-3 times the robot (ROS's wheel_separation_multiplier 1.5-2), is 0.67 apart at the most.
+HEADING_RTOL = 0.8
 #: Least turning [rad] of the wheels or the external heading over the first samples for that comparison.
 HEADING_MIN_TURN = 0.1
 
