@@ -74,6 +74,18 @@ def test_plot_and_animation_files(capsys, tmp_path):
     assert code == 0 and "<script" in html.read_text()
 
 
+def test_an_html_animation_keeps_every_frame(capsys, tmp_path):
+    """Past matplotlib's embedding limit (rcParams, 20 MB: about 500 frames of a plan) to_jshtml dropped the rest of
+    the frames with a log message, and park said it wrote them all; a small limit shows it on a short run."""
+    import matplotlib
+
+    html = tmp_path / "a.html"
+    with matplotlib.rc_context({"animation.embed_limit": 0.05}):
+        code, out, _ = run(capsys, "thesis-9.2", "--animate", str(html), "--frames", "6")
+    assert code == 0
+    assert html.read_text().count("data:image/png;base64") == 6
+
+
 @pytest.mark.parametrize(("argv", "message"), [
     (["nope.yaml"], "nope.yaml: cannot read the file"),
     (["thesis-9.9"], "no parking problem 'thesis-9.9'"),

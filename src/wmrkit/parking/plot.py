@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon, Rectangle
 
 from ..errors import WmrkitError
-from ..plotting.files import check_count, save_gif, spread_indices
+from ..plotting.files import check_count, save_gif, save_html, spread_indices
 from .execute import Execution, execute_plan
 from .geometry import Space, Vehicle, footprint
 from .path import sample_poses
@@ -103,14 +103,13 @@ def save_plan_figure(plan: ParkingPlan, path: str | os.PathLike[str], execution:
 
 def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Execution | None = None, *,
                  fps: int = 20, max_frames: int = 400) -> int:
-    """Write an animation of the executed plan: ``.gif`` (PillowWriter) or ``.html`` (``to_jshtml``).
+    """Write an animation of the executed plan: ``.gif`` or ``.html`` (a page with a player; ``save_gif``,
+    ``save_html``).
 
     The car drives P_f's executed poses with its steering wheel turned to the commanded heading; the trail is
     coloured by direction. Returns the number of frames (at most `max_frames`, 2 to :data:`MAX_FRAMES`, evenly
     spaced in time); `fps` frames a second, 1 to 100.
     """
-    from matplotlib.animation import FuncAnimation
-
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in (".gif", ".html"):
@@ -149,11 +148,8 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
                        f"steering {math.degrees(run.steering[i]):+5.1f} deg")
         return [*artists, trail_f, trail_b, title]
 
-    if suffix == ".gif":
-        save_gif(fig, update, range(len(frames)), path, fps=fps, dpi=80)
-    else:
-        anim = FuncAnimation(fig, update, frames=len(frames), interval=1000 / fps, blit=False)
-        path.write_text(anim.to_jshtml(fps=fps), encoding="utf-8")
+    save = save_gif if suffix == ".gif" else save_html
+    save(fig, update, range(len(frames)), path, fps=fps, dpi=80)
     return len(frames)
 
 
