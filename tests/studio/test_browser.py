@@ -813,3 +813,23 @@ def test_a_bare_number_is_in_the_unit_its_field_shows(page):
     edit(pg, "y", "0.25 m")  # a number with a unit is read as written
     assert page_robot(pg).wheel("front_left").position[1] == pytest.approx(0.25, abs=1e-12)
     assert pg.locator(".invalid").count() == 0 and not pg.errors
+
+
+def test_keys_stay_within_the_sliders(page):
+    """W pressed 15 times set vx = 1.5 m/s while the vx slider (+-1) showed 1; moving the vy slider then sent vx = 1."""
+    pg = page
+    open_catalog(pg, "omni-3")
+    pg.click("#plan", position={"x": 5, "y": 5})
+    pg.keyboard.press(" ")
+    for key in ["w"] * 15 + ["a"] * 15 + ["q"] * 15:
+        pg.keyboard.press(key)
+    settle(pg)
+    assert pg.evaluate("S.twist") == pytest.approx([1, 1, 2])
+    assert [float(pg.evaluate(f"document.getElementById('{k}').value")) for k in ("vx", "vy", "omega")] == [1, 1, 2]
+    pg.fill("#vy", "0.5")
+    pg.dispatch_event("#vy", "input")
+    settle(pg)
+    assert pg.evaluate("S.twist") == pytest.approx([1, 0.5, 2])
+    pg.keyboard.press(" ")
+    settle(pg)
+    assert not pg.errors

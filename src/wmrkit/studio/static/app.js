@@ -745,7 +745,10 @@ async function main() {
     if (e.ctrlKey || e.metaKey || e.altKey) return;  // the browser's shortcuts (Ctrl+A, Ctrl+S, ...): not the twist
     const steps = { w: [0.1, 0, 0], s: [-0.1, 0, 0], a: [0, 0.1, 0], d: [0, -0.1, 0], q: [0, 0, 0.2], e: [0, 0, -0.2] };
     const k = e.key.toLowerCase();
-    if (k in steps) setTwist(S.twist.map((v, i) => Math.max(-2, Math.min(2, v + steps[k][i]))));
+    // within the sliders' own range (vx, vy +-1 m/s, ω +-2 rad/s): a key took vx to 2 while its slider showed 1,
+    // and moving another slider then set vx back to 1 silently
+    const range = (i) => $(["vx", "vy", "omega"][i]);
+    if (k in steps) setTwist(S.twist.map((v, i) => Math.max(+range(i).min, Math.min(+range(i).max, v + steps[k][i]))));
     else if (k === " ") { setTwist([0, 0, 0]); e.preventDefault(); }
     else if (k === "delete") deleteWheel();
   });
