@@ -833,3 +833,23 @@ def test_keys_stay_within_the_sliders(page):
     pg.keyboard.press(" ")
     settle(pg)
     assert not pg.errors
+
+
+def test_edits_resume_after_the_server_did_not_answer(page):
+    """A request that got no answer (the server stopped, fetch failed) left the analysis 'in flight' for good: no
+    error shown, and every later edit waited behind it, even once the server answered again."""
+    pg = page
+    open_catalog(pg, "diff-drive")
+    settle(pg)
+    pg.route("**/api/analyze", lambda route: route.abort())
+    pg.fill("#robot-name", "unanswered")
+    pg.dispatch_event("#robot-name", "change")
+    pg.wait_for_function("() => !document.getElementById('error').hidden")
+    assert "no answer from the studio server" in pg.text_content("#error")
+    pg.unroute("**/api/analyze")
+    pg.fill("#robot-name", "answered")
+    pg.dispatch_event("#robot-name", "change")
+    settle(pg)
+    assert json.loads(pg.evaluate("S.analysedText"))["name"] == "answered"
+    assert pg.evaluate("document.getElementById('error').hidden")
+    assert not pg.errors  # before: 'Failed to fetch', uncaught

@@ -19,7 +19,12 @@ window.studioStats = { edits: [], server: [], rendered: 0 };
 async function call(path, body) {
   const init = body === undefined ? {} : {
     method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) };
-  const r = await fetch(path, init);
+  let r;
+  try { r = await fetch(path, init); } catch {  // no answer at all (the server stopped): an error, not a request
+    // left in flight for good (every later edit waited behind it, even after the server was back)
+    return { ok: false, status: 0, data: { error: `no answer from the studio server (${path}): is it running?` },
+      server: null };
+  }
   const data = await r.json().catch(() => ({ error: `HTTP ${r.status}` }));
   const timing = (r.headers.get("Server-Timing") || "").match(/dur=([\d.]+)/);
   return { ok: r.ok, status: r.status, data, server: timing ? parseFloat(timing[1]) : null };
