@@ -71,7 +71,6 @@ def test_server_process_serves_the_file(tmp_path):
 def test_a_linked_file_is_opened_and_saved_where_it_is(tmp_path, monkeypatch):
     """`wmrkit studio robots/current.yaml`, a link to designs/v3.yaml: the studio served designs/ but offered to
     save as 'current.yaml' there, a new file beside the one the user opened."""
-    from wmrkit.cli import studio as cli_studio
     from wmrkit.studio import app as studio_app
 
     (tmp_path / "designs").mkdir()
@@ -85,7 +84,6 @@ def test_a_linked_file_is_opened_and_saved_where_it_is(tmp_path, monkeypatch):
         raise KeyboardInterrupt  # stop before serving
 
     monkeypatch.setattr(studio_app, "create_app", create_app)
-    monkeypatch.setattr(cli_studio, "_listen", lambda host, port: None)
     with pytest.raises(KeyboardInterrupt):
         main(["studio", str(tmp_path / "robots" / "current.yaml"), "--port", "0", "--no-browser"])
     assert seen == {"root": (tmp_path / "designs").resolve(), "spec": "v3.yaml"}
@@ -97,7 +95,6 @@ def test_a_loopback_host_answers_at_its_own_address(tmp_path, monkeypatch):
     pytest.importorskip("httpx2")
     from starlette.testclient import TestClient
 
-    from wmrkit.cli import studio as cli_studio
     from wmrkit.studio import app as studio_app
 
     real_create_app, seen = studio_app.create_app, {}
@@ -107,10 +104,42 @@ def test_a_loopback_host_answers_at_its_own_address(tmp_path, monkeypatch):
         raise KeyboardInterrupt  # stop before serving
 
     monkeypatch.setattr(studio_app, "create_app", create_app)
-    monkeypatch.setattr(cli_studio, "_listen", lambda host, port: None)
     with pytest.raises(KeyboardInterrupt):
         main(["studio", "diff-drive", "--host", "127.0.0.2", "--port", "0", "--no-browser"])
     app = real_create_app(tmp_path, allowed_hosts=seen["hosts"])
     assert TestClient(app, base_url="http://127.0.0.2:8765").get("/api/meta").status_code == 200
     assert TestClient(app, base_url="http://localhost:8765").get("/api/meta").status_code == 200
     assert TestClient(app, base_url="http://evil.example").get("/api/meta").status_code == 400
+
+
+
+@pytest.mark.parametrize("host", ["127.1", "127.0.0.1"])
+def test_loopback_is_known_by_the_address_listened_on(tmp_path, monkeypatch, capsys, host):
+    """`--host 127.1` listens on 127.0.0.1, but was taken for another machine's address: a false warning that other
+    machines could reach the studio, and every Host header answered (no protection against DNS rebinding)."""
+    pytest.importorskip("httpx2")
+    import uvicorn
+    from starlette.testclient import TestClient
+
+    from wmrkit.studio import app as studio_app
+
+    real_create_app, seen = studio_app.create_app, {}
+
+    def create_app(root, robot, *, robot_spec=None, allowed_hosts=None):
+        seen["app"] = real_create_app(tmp_path, robot, allowed_hosts=allowed_hosts)
+        return seen["app"]
+
+    class Server:  # serves nothing: closes the socket the command bound
+        def __init__(self, config):
+            self.started, self.should_exit, self.servers = True, True, []
+
+        def run(self, sockets):
+            for sock in sockets:
+                sock.close()
+
+    monkeypatch.setattr(studio_app, "create_app", create_app)
+    monkeypatch.setattr(uvicorn, "Server", Server)
+    assert main(["studio", "diff-drive", "--host", host, "--port", "0", "--no-browser"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    assert TestClient(seen["app"], base_url="http://127.0.0.1:8765").get("/api/meta").status_code == 200
+    assert TestClient(seen["app"], base_url="http://evil.example").get("/api/meta").status_code == 400

@@ -48,8 +48,11 @@ def run_studio(args: argparse.Namespace) -> int:
     except OSError as err:  # uvicorn logged its own 'ERROR:' line and exited with code 3
         hint = " (try --port 0 for a free one)" if err.errno == errno.EADDRINUSE else ""
         raise WmrkitError(f"--host/--port: cannot listen on {shown}:{args.port}: {err.strerror or err}{hint}") from None
-    # on a loopback interface, only this machine's names and the address listened on (127.0.0.2 is one too)
-    local = [*LOCAL_HOSTS, args.host] if _loopback(args.host) else None
+    # on a loopback interface, only this machine's names and the address listened on (127.0.0.2 is one too);
+    # loopback or not by the address bound, not by how --host spells it (127.1 was taken for another machine's)
+    bound = sock.getsockname()[0]
+    loopback = _loopback(bound)
+    local = [*LOCAL_HOSTS, args.host, bound] if loopback else None
     app = create_app(root, robot, robot_spec=spec, allowed_hosts=local)
     from ..studio import api
 
@@ -58,7 +61,7 @@ def run_studio(args: argparse.Namespace) -> int:
 
     config = uvicorn.Config(app, host=args.host, port=args.port, log_level="warning")
     server = uvicorn.Server(config)
-    if not _loopback(args.host):
+    if not loopback:
         print(f"wmrkit: warning: listening on {args.host}: other machines can reach the studio and its folder",
               file=sys.stderr)
 
