@@ -57,6 +57,34 @@ def test_analyze_equals_library(client, name):
             assert live[key] == pytest.approx(full[key], rel=1e-9)
 
 
+
+@pytest.mark.parametrize("name", ["forklift", "thesis-steer-castor", "thesis-two-steer-swedish", "swerve-4"])
+def test_singular_here_is_the_line_test(client, name):
+    """'singular here' is the library's line test (is_singular, 6.17-6.20), at the described steering and at the
+    singular configurations the library finds."""
+    from wmrkit.analysis.singularity import is_singular
+    from wmrkit.analysis.summary import model_rates
+
+    sets = client.post("/api/configurations", json={"description": desc(name)}).json()["singular"]
+    configs = [{}] + [dict(zip(s["variables"], h, strict=True)) for s in sets.values() for h in s["headings"][:3]]
+    verdicts = set()
+    for headings in configs:
+        d = desc(name)
+        for w in d["wheels"]:
+            if w["name"] in headings:
+                w.pop("beta", None)
+                w["heading"] = headings[w["name"]]
+        r = client.post("/api/analyze", json={"description": d})
+        if r.status_code != 200:  # a heading beyond a wheel's steering range
+            continue
+        robot = robot_from_dict(d)
+        for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed)):
+            want = bool(is_singular(robot, None, model_rates(robot, names), coupled=key == "actuated"))
+            assert r.json()["analysis"]["singular_here"][key]["singular"] == want, (headings, key)
+            verdicts.add(want)
+    assert verdicts == {True, False} or name == "swerve-4"
+
+
 def test_no_natural_length_where_kappa_is_infinite(client):
     """A swerve with one wheel turned cannot move: kappa is infinite at every length, and the page showed
     'D = 0.396 m' (natural_length's fallback, the robot size, minimising nothing) where `wmrkit analyze` gives none."""

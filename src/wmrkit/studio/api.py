@@ -31,7 +31,7 @@ from ..analysis.isotropy import (
     twist_model,
 )
 from ..analysis.optimize import isotropic_configurations
-from ..analysis.singularity import robot_size, singularity_distance
+from ..analysis.singularity import SINGULAR_RTOL, robot_size, singularity_distance
 from ..analysis.summary import describe_singular, model_rates, model_singular_set, singular_dict
 from ..description import robot_from_dict, robot_to_dict
 from ..errors import ShapeError, WmrkitError
@@ -123,7 +123,8 @@ def live_summary(robot: Robot) -> dict[str, Any]:
     for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed)):
         assigned = model_rates(robot, names)
         dist = float(singularity_distance(robot, None, assigned, coupled=key == "actuated"))
-        here[key] = {"assigned": list(assigned), "distance": dist, "singular": dist < 1e-8,
+        # singular: the line test's own threshold (is_singular), sigma_min <= SINGULAR_RTOL sigma_max
+        here[key] = {"assigned": list(assigned), "distance": dist, "singular": dist <= SINGULAR_RTOL,
                      "near": dist < NEAR_SINGULAR}
     return {
         "mobility": cls.mobility, "steerability": cls.steerability, "type": cls.type, "type_name": cls.name,
