@@ -853,3 +853,28 @@ def test_edits_resume_after_the_server_did_not_answer(page):
     assert json.loads(pg.evaluate("S.analysedText"))["name"] == "answered"
     assert pg.evaluate("document.getElementById('error').hidden")
     assert not pg.errors  # before: 'Failed to fetch', uncaught
+
+
+def test_the_list_chosen_last_is_opened(page, server):
+    """With a file chosen in the file list, choosing a catalog robot and Open opened the file again: the file list
+    took precedence, so the catalog choice was ignored with no word. Choosing in one list clears the other."""
+    pg = page
+    _, root = server
+    catalog.load("omni-3").to_file(root / "mine.yaml")
+    pg.evaluate("call('/api/files').then((f) => fillFiles(f.data.files))")
+    pg.wait_for_function("() => [...document.getElementById('files').options].some((o) => o.value === 'mine.yaml')")
+    pg.select_option("#files", "mine.yaml")
+    pg.click("#open")
+    settle(pg)
+    assert page_robot(pg).name == "omni-3"
+    pg.select_option("#catalog", "swerve-4")
+    assert pg.evaluate("document.getElementById('files').value") == ""
+    pg.click("#open")
+    settle(pg)
+    assert page_robot(pg).name == "swerve-4"
+    pg.select_option("#files", "mine.yaml")
+    assert pg.evaluate("document.getElementById('catalog').value") == ""
+    pg.click("#open")
+    settle(pg)
+    assert page_robot(pg).name == "omni-3"
+    assert not pg.errors

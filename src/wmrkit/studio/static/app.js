@@ -720,10 +720,14 @@ async function main() {
   const m = await call("/api/meta");
   S.meta = m.data;
   const fromCatalog = S.meta.catalog.includes(S.meta.start.spec);
-  $("catalog").add(new Option("(choose)", "", false, !fromCatalog));
+  $("catalog").add(new Option("(choose)", "", false, !fromCatalog));  // always: choosing a file clears it
   for (const n of S.meta.catalog) $("catalog").add(new Option(n, n, false, n === S.meta.start.spec));
   for (const t of Object.keys(S.meta.kinds)) $("new-type").add(new Option(t, t));
   fillFiles(S.meta.files);
+  // Open opens what was chosen last: choosing in one list clears the other (a file chosen before took precedence,
+  // and a catalog robot chosen after it was ignored)
+  $("catalog").addEventListener("change", () => { if ($("catalog").value) $("files").value = ""; });
+  $("files").addEventListener("change", () => { if ($("files").value) $("catalog").value = ""; });
   $("open").onclick = openRobot; $("save").onclick = saveRobot;
   $("undo").onclick = undo; $("redo").onclick = redo;
   $("add").onclick = addWheel; $("delete").onclick = deleteWheel;
