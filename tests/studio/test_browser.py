@@ -878,3 +878,25 @@ def test_the_list_chosen_last_is_opened(page, server):
     settle(pg)
     assert page_robot(pg).name == "omni-3"
     assert not pg.errors
+
+
+def test_stopping_after_a_turn_beyond_the_rack_is_feasible(page):
+    """Ackermann: a twist that needs the front wheels beyond their +-40 deg rack (flagged infeasible) left them
+    there: after Stop the page drew them at 66 and 44 deg and said 'infeasible: ... beyond the steering range' for
+    the robot at rest. The wheels stay at the last headings they could reach."""
+    pg = page
+    open_catalog(pg, "ackermann")
+    pg.click("#plan", position={"x": 5, "y": 5})
+    for key in (" ", "w", "w", "w", "w", "q"):
+        pg.keyboard.press(key)
+    settle(pg)
+    assert shown(pg, "d-feasible") is False
+    pg.keyboard.press(" ")
+    settle(pg)
+    assert pg.evaluate("S.twist") == [0, 0, 0]
+    assert shown(pg, "d-feasible") is True, pg.inner_text("#d-feasible")
+    rack = math.radians(40)
+    for name in ("front_left", "front_right"):
+        cell = pg.locator(f'#commands tr[data-wheel="{name}"] td').nth(1)
+        assert abs(float(cell.get_attribute("data-value"))) <= rack + 1e-12
+    assert not pg.errors

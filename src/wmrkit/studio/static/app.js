@@ -201,7 +201,11 @@ async function driveNow() {
   if (seq !== S.driveSeq) return;  // a newer twist or edit was sent meanwhile
   if (!r.ok) { S.drive = null; renderDrive(); return; }
   S.drive = r.data;
-  if (S.twist.some((v) => v !== 0)) S.heading = r.data.heading;  // the wheels stay where the last twist put them
+  // the wheels stay where the last twist put them, except beyond their steering range (the twist was infeasible:
+  // kept there, a robot at rest was drawn past its rack and called infeasible after Stop)
+  if (S.twist.some((v) => v !== 0)) {
+    for (const [name, h] of Object.entries(r.data.heading)) if (!r.data.out_of_range.includes(name)) S.heading[name] = h;
+  }
   renderDrive(); drawPlan();
 }
 
