@@ -251,3 +251,19 @@ def test_follow_line_names_a_bad_noise_or_start(kwargs, message):
     # a NaN start was refused by render, as 'render: pose and z_p must be finite'
     with pytest.raises(WmrkitError, match=f"^{re.escape(message)}$"):
         follow_line(ROBOT, CAMERA, duration=1, **kwargs)
+
+
+def test_the_json_of_a_steered_robot_gives_its_steering_headings():
+    """The forklift's wheel commands are its drive rates and its steering: --json gave only 'wheel_rates'
+    (steer.spin among them), not the steering heading the rear wheel was turned to. Each heading is checked
+    against the direction of the steered wheel's velocity under the twist the run produced (v + omega x r)."""
+    robot = catalog.load("forklift")
+    camera = Camera(272.5, math.radians(60), 1.42, 320, 240)
+    run = follow_line(robot, camera, speed=0.5, start=(0.0, 1.0, 0.0), duration=5)
+    steering = run.to_dict()["steering"]
+    assert list(steering) == ["steer"]
+    x, y = robot.wheel("steer").position
+    for heading, (vx, vy, omega) in zip(steering["steer"], run.twist, strict=True):
+        assert heading == pytest.approx(math.atan2(vy + omega * x, vx - omega * y), abs=1e-9)
+    assert math.degrees(steering["steer"][0]) == pytest.approx(39.0, abs=0.1)  # (0.5, -0.3 + 0.3 * 2.35) m/s
+    assert follow_line(ROBOT, CAMERA, duration=1).to_dict()["steering"] == {}

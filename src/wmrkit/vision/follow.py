@@ -169,7 +169,8 @@ class LineFollowing:
                 "from the line)")
 
     def to_dict(self) -> dict[str, Any]:
-        """Summary and samples (the ``wmrkit follow-line --json`` output); psi [rad] wrapped to (-pi, pi]."""
+        """Summary and samples (the ``wmrkit follow-line --json`` output); psi [rad] wrapped to (-pi, pi]; the wheel
+        commands of each period: ``wheel_rates`` [rad/s] and ``steering`` headings [rad] of the steered wheels."""
         h = self.lateral
         return {
             "robot": self.robot_name, "gain": self.gain, "speed": self.speed, "period": self.period,
@@ -179,6 +180,7 @@ class LineFollowing:
             "samples": [{"t": float(t), "x": float(p[0]), "h": float(p[1]), "psi": float(wrap_angle(-p[2]))}
                         for t, p in zip(self.time, self.pose, strict=True)],
             "wheel_rates": {n: self.rates[:, i].tolist() for i, n in enumerate(self.rate_names)},
+            "steering": {n: self.steer[:, i].tolist() for i, n in enumerate(self.steer_names)},
         }
 
 
