@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import re
 
@@ -202,6 +203,25 @@ def test_a_camera_too_noisy_to_see_the_line_is_an_error_with_its_reason(capsys):
     assert "follow-line: the camera does not see the line at the start pose: image: too noisy" in err
     assert main(["follow-line", "line-follower", "--camera", camera, "--image-noise", "1e300"]) == 2
     assert "image noise must be in [0, 255] grey levels" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("option, named", [
+    (["--image-noise", "nan"], "image_noise (--image-noise): image noise must be in [0, 255] grey levels"),
+    (["--image-noise", "-1"], "image_noise (--image-noise): image noise must be in [0, 255] grey levels"),
+    (["--blur", "60"], "blur (--blur): expected a blur in [0, 50] px (a Gaussian sigma), got 60"),
+    (["--clutter", "1000"], "clutter (--clutter): clutter must be an integer in [0, 100] blobs, got 1000"),
+])
+def test_a_bad_synthetic_camera_option_is_named_as_the_option(option, named, capsys):
+    """They were refused by the synthetic camera in the first image, naming no option ('render: image noise must
+    be in [0, 255] grey levels and blur in [0, 50] px, got nan, 0' for --image-noise nan), under --json too."""
+    from pathlib import Path
+
+    from wmrkit.cli.main import main
+
+    camera = str(Path(__file__).resolve().parents[2] / "docs" / "figures" / "vision" / "follower-camera.yaml")
+    assert main(["follow-line", "line-follower", "--camera", camera, "--json", *option]) == 2
+    out = capsys.readouterr()
+    assert json.loads(out.err)["error"].startswith(f"follow-line: {named}") and out.out == ""
 
 
 def test_a_robot_started_facing_back_follows_the_line_the_other_way_and_psi_stays_wrapped():

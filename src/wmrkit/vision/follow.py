@@ -37,7 +37,7 @@ from ..wheels import wrap_angle
 from .camera import Camera, CameraError, extrinsics
 from .lines import extract_lines
 from .positioning import Positioning, locate_points
-from .render import Scene, render
+from .render import MAX_BLUR, MAX_CLUTTER, MAX_NOISE, Scene, render
 
 __all__ = ["LineFollowing", "follow_line", "line_following_law", "line_following_twist", "locate_image",
            "thesis_initial_commands", "view_width"]
@@ -242,6 +242,16 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     if not abs(z_p) <= MAX_SIZE:  # NaN included; it was refused in the first image: 'the camera does not see the line'
         raise WmrkitError(f"follow-line: z_p (--z-p): expected a length in [-{MAX_SIZE:g}, {MAX_SIZE:g}] m, "
                           f"got {z_p:g}")
+    if not 0 <= image_noise <= MAX_NOISE:  # NaN included; the synthetic camera's options, named as options (render
+        # refused them in the first image, naming no option)
+        raise WmrkitError(f"follow-line: image_noise (--image-noise): image noise must be in [0, {MAX_NOISE:g}] grey "
+                          f"levels (a standard deviation), got {image_noise:g}")
+    if not 0 <= blur <= MAX_BLUR:
+        raise WmrkitError(f"follow-line: blur (--blur): expected a blur in [0, {MAX_BLUR:g}] px (a Gaussian sigma), "
+                          f"got {blur:g}")
+    if isinstance(clutter, bool) or not isinstance(clutter, int | np.integer) or not 0 <= clutter <= MAX_CLUTTER:
+        raise WmrkitError(f"follow-line: clutter (--clutter): clutter must be an integer in [0, {MAX_CLUTTER}] blobs, "
+                          f"got {clutter!r}")
     noise = (abs(float(noise[0])), abs(float(noise[1])))  # -0.0 is a bound of 0 (numpy's uniform refuses it)
     check_seed(seed, WmrkitError, "follow-line: seed")
     if gain * period >= 1:
