@@ -251,6 +251,37 @@ def test_images_of_grey_levels_that_are_not_numbers_are_refused(image, message):
         extract_lines(image)
 
 
+def _one_stripe() -> np.ndarray:
+    img = np.full((60, 80), 60.0)
+    img[:, 38:42] = 200.0
+    return img
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.int64, np.float32, np.uint16, np.int16])
+def test_colour_images_of_any_number_type_with_levels_0_255_are_read_as_grey_ones(dtype):
+    """A BGR image of float64 or int64 levels (numpy's defaults) raised OpenCV's cv2.error from its colour
+    conversion, which takes 8-bit images only: a traceback from the Python API."""
+    grey = _one_stripe()
+    expected = extract_lines(grey.astype(np.uint8))
+    assert len(expected) == 1 and expected[0].x0 == pytest.approx(0.0, abs=1e-9)
+    assert extract_lines(np.stack([grey] * 3, -1).astype(dtype)) == expected
+    assert extract_lines(grey.astype(dtype)) == expected
+
+
+@pytest.mark.parametrize(("image", "message"), [
+    (_one_stripe().astype(np.uint16) * 4, "image: uint16 grey levels from 240 to 800, outside 0-255: give 8-bit "
+                                          "levels (a 16-bit image divided by 257)"),
+    (_one_stripe() - 100, "image: float64 grey levels from -40 to 100, outside 0-255"),
+    (_one_stripe() / 255, "image: float64 grey levels from 0.235294 to 0.784314: wmrkit reads levels 0-255 "
+                          "(multiply an image of levels in [0, 1] by 255)"),
+])
+def test_grey_levels_outside_0_255_are_refused_not_clipped(image, message):
+    """They were clipped to 0-255: a 16-bit image of ground 240 and paint 800 became all white and a float image
+    of levels in [0, 1] all black, both read as showing no line ('found 0 line(s)'), with no word on why."""
+    with pytest.raises(CameraError, match=f"^{re.escape(message)}"):
+        extract_lines(image)
+
+
 @pytest.mark.parametrize(("image", "camera", "spacing", "psi_deg", "h"), [
     ("three-lines.png", Camera(325.7, math.radians(45), 0.134, 320, 240), 0.035, -35.43, -0.0583),
     ("crop-rows.png", Camera(545.0, math.radians(76), 1.42, 640, 480), 0.60, -0.57, -0.05),

@@ -65,17 +65,28 @@ class DetectedLine:
 
 
 def _grey(image: ArrayLike) -> np.ndarray:
-    """A grey or BGR image as a 2-D uint8 grey image, or :class:`CameraError` naming what it is not."""
+    """A grey or BGR image of 0-255 levels as a 2-D uint8 grey image, or :class:`CameraError` naming what it is not.
+
+    Levels of another type are taken as they are, not rescaled: levels outside 0-255 (a 16-bit image) and a
+    float image of levels within [0, 1] are refused (clipped, the first read as white, the second as black).
+    """
     img = np.asarray(image)
-    if img.ndim == 3 and img.shape[2] == 3:
-        img = cv2_module().cvtColor(img, cv2_module().COLOR_BGR2GRAY)
-    if img.ndim != 2 or img.size == 0:
+    if not (img.ndim == 2 or (img.ndim == 3 and img.shape[2] == 3)) or img.size == 0:
         raise CameraError(f"image: expected a grey or BGR image, got shape {img.shape}")
     if img.dtype != np.uint8:
         if not np.issubdtype(img.dtype, np.number) or not np.all(np.isfinite(img)):  # NaN became 0 with a warning
             raise CameraError(f"image: expected finite grey levels, got {img.dtype} values"
                               + ("" if not np.issubdtype(img.dtype, np.number) else " that are not finite"))
-        img = np.clip(img, 0, 255).astype(np.uint8)
+        lo, hi = float(img.min()), float(img.max())
+        if lo < 0 or hi > 255:
+            raise CameraError(f"image: {img.dtype} grey levels from {lo:g} to {hi:g}, outside 0-255: give 8-bit levels "
+                              "(a 16-bit image divided by 257)")
+        if np.issubdtype(img.dtype, np.floating) and lo < hi <= 1:
+            raise CameraError(f"image: {img.dtype} grey levels from {lo:g} to {hi:g}: wmrkit reads levels 0-255 "
+                              "(multiply an image of levels in [0, 1] by 255)")
+        img = img.astype(np.uint8)  # BGR conversion (OpenCV) takes 8-bit images only
+    if img.ndim == 3:
+        img = cv2_module().cvtColor(np.ascontiguousarray(img), cv2_module().COLOR_BGR2GRAY)
     return img
 
 
