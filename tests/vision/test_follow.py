@@ -287,3 +287,13 @@ def test_the_json_of_a_steered_robot_gives_its_steering_headings():
         assert heading == pytest.approx(math.atan2(vy + omega * x, vx - omega * y), abs=1e-9)
     assert math.degrees(steering["steer"][0]) == pytest.approx(39.0, abs=0.1)  # (0.5, -0.3 + 0.3 * 2.35) m/s
     assert follow_line(ROBOT, CAMERA, duration=1).to_dict()["steering"] == {}
+
+
+@pytest.mark.parametrize("noise", [(0.02, 3.0), (0.02, math.pi / 2), (0.02, math.pi)])
+def test_a_heading_noise_beyond_what_an_image_can_give_is_refused(noise):
+    """'--noise 0.02 3' (3 rad, meant as the thesis's 3 deg) ran with noise of +-172 deg on a heading that (9.10)
+    gives within +-90 deg, and printed 'final h = 27.51 cm, psi = 40.60 deg, ... settling not reached', exit 0."""
+    with pytest.raises(WmrkitError, match=r"^follow-line: noise \(--noise H PSI\): noise bounds must be .* psi in "
+                                          r"\[0, 90\) deg .* write e\.g\. '3deg'\), got 0\.02 m"):
+        follow_line(ROBOT, CAMERA, noise=noise, duration=1)
+    assert follow_line(ROBOT, CAMERA, noise=(0.02, math.radians(89)), duration=1).failure() is None

@@ -214,7 +214,8 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     `gain` a_x [1/s]; `speed` v_follow [m/s]; `period` T [s]; `duration` [s]: the whole periods within it (at
     least one); `start`: pose of P ``(x, y, theta)`` in the line
     frame L (the thesis's p(0) = (-0.3 m, 0, 0) with its X to the right is ``y = +0.3``); `scene`: default one
-    painted line 2 cm wide; `noise`: bounds (h [m], psi [rad]) of uniform noise added to each positioning;
+    painted line 2 cm wide; `noise`: bounds (h [m], psi [rad, below pi/2]) of uniform noise added to each
+    positioning;
     `z_p` [m]: from the lens to P along the optical axis, within ``limits.MAX_SIZE``;
     `image_noise`, `blur`, `clutter`: options of the synthetic camera. ``from_image=False`` skips the camera and
     measures the exact (psi, h) of the pose (what the thesis's simulation did), for comparison.
@@ -236,9 +237,13 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
                           f"images are more than the {MAX_RUN_PIXELS:.3g} pixels a run renders (docs/limits.md): "
                           "shorten the duration, lengthen the period or use a smaller camera image")
     noise = tuple(as_vectors(noise, 2, "noise"))  # (0.1,) raised IndexError
-    if not (all(np.isfinite(noise)) and 0 <= noise[0] <= MAX_COORDINATE and 0 <= noise[1] <= np.pi):
-        raise WmrkitError(f"follow-line: noise bounds must be h in [0, {MAX_COORDINATE:g}] m and psi in [0, pi] "
-                          f"rad, got {noise[0]:g} m, {noise[1]:g} rad")
+    if not (all(np.isfinite(noise)) and 0 <= noise[0] <= MAX_COORDINATE and 0 <= noise[1] < np.pi / 2):
+        # psi positioned from an image lies within +-90 deg (9.10): '--noise 0.02 3' (3 rad, meant as 3 deg) ran
+        # with the heading's noise beyond it, and printed a run that never settled, exit 0
+        raise WmrkitError(f"follow-line: noise (--noise H PSI): noise bounds must be h in [0, {MAX_COORDINATE:g}] m "
+                          f"and psi in [0, 90) deg (a heading positioned from an image lies within +-90 deg; a bare "
+                          f"PSI is in radians, write e.g. '3deg'), got {noise[0]:g} m, {noise[1]:g} rad "
+                          f"({math.degrees(noise[1]):.4g} deg)")
     if not abs(z_p) <= MAX_SIZE:  # NaN included; it was refused in the first image: 'the camera does not see the line'
         raise WmrkitError(f"follow-line: z_p (--z-p): expected a length in [-{MAX_SIZE:g}, {MAX_SIZE:g}] m, "
                           f"got {z_p:g}")
