@@ -75,6 +75,22 @@ def test_calibrate_from_measurements(capsys):
     assert code == 2 and "A must be below 50 px and x1, x2 below 50 px" in err
 
 
+@pytest.mark.parametrize(("x1", "x2", "size", "message"), [
+    ("71.2357", "49.0727", ["0", "0"], "calibrate: --size: the image is 0 x 0 px, expected 8 to 4096 px a side"),
+    ("71.2357", "49.0727", ["100000", "480"], "calibrate: --size: the image is 100000 x 480 px, expected 8 to 4096"),
+    ("nan", "49.0727", [], "calibration: x1 must be > 0, got nan"),
+    ("71.2357", "nan", [], "calibration: x2 must be > 0, got nan"),
+])
+def test_calibrate_names_a_bad_size_or_measurement(x1, x2, size, message, tmp_path, capsys):
+    """'--size 0 0' said 'A must be below 0 px and x1, x2 below 0 px', '--size 100000 480' was refused after the
+    calibration as 'camera: width: out of range', and '--x1 nan' said x1 must be below 320 px."""
+    argv = ["vision", "calibrate", "--x1", x1, "--x2", x2, "--rows", "60", "--half-separation", "0.035",
+            "--row-distance", "0.10221", "--out", str(tmp_path / "camera.yaml"), "--json"]
+    code, out, err = run(argv + (["--size", *size] if size else []), capsys)
+    assert code == 2 and out == "" and json.loads(err)["error"].startswith(message)
+    assert not (tmp_path / "camera.yaml").exists()
+
+
 def test_follow_line_json_and_animation(tmp_path, capsys):
     Camera(150.0, math.radians(60), 0.3, 160, 120).to_file(tmp_path / "cam.yaml")
     gif = tmp_path / "run.gif"

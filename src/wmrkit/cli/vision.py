@@ -173,6 +173,7 @@ def run_locate(args: argparse.Namespace) -> int:
 def run_calibrate(args: argparse.Namespace) -> int:
     """``wmrkit vision calibrate``."""
     from ..vision.calibration import calibrate, calibrate_image
+    from ..vision.camera import MAX_PIXELS
 
     xw = parse_value(args.half_separation, "length", "--half-separation")
     yw = parse_value(args.row_distance, "length", "--row-distance")
@@ -183,7 +184,12 @@ def run_calibrate(args: argparse.Namespace) -> int:
         if args.x1 is None or args.x2 is None:
             raise WmrkitError("calibrate: --x1 and --x2 go together")
         width, rows = args.size or (640, 480)
-        if not (args.rows < rows / 2 and max(args.x1, args.x2) < width / 2):  # inside the image, as from IMAGE
+        if not 8 <= min(width, rows) <= max(width, rows) <= MAX_PIXELS:  # 0 0 asked for A below 0 px; 1e5 px was
+            # refused after the calibration as the camera's 'width'
+            raise WmrkitError(f"calibrate: --size: the image is {width} x {rows} px, expected 8 to {MAX_PIXELS} px a "
+                              "side (a camera's)")
+        if args.rows >= rows / 2 or max(args.x1, args.x2) >= width / 2:  # inside the image, as from IMAGE (NaN: named
+            # by calibrate)
             raise WmrkitError(f"calibrate: rows A ({args.rows:g} px) and x1, x2 ({args.x1:g}, {args.x2:g} px) are "
                               f"measured from the centre of a {width} x {rows} px image (--size): A must be below "
                               f"{rows / 2:g} px and x1, x2 below {width / 2:g} px")
