@@ -297,3 +297,17 @@ def test_a_heading_noise_beyond_what_an_image_can_give_is_refused(noise):
                                           r"\[0, 90\) deg .* write e\.g\. '3deg'\), got 0\.02 m"):
         follow_line(ROBOT, CAMERA, noise=noise, duration=1)
     assert follow_line(ROBOT, CAMERA, noise=(0.02, math.radians(89)), duration=1).failure() is None
+
+
+def test_the_kept_images_are_the_views_from_the_poses_beside_them():
+    """images[k] was the view from pose[k - 1] (the start's image twice, then each one period late), so the
+    animation drew each camera view beside the next period's plan view and h: frame 1 showed the view from
+    h = 30 cm beside 'h = +25.2 cm', frame 2 the view from 25.2 cm beside 'h = +19.9 cm'."""
+    from wmrkit.vision.render import Scene, render
+
+    run = follow_line(ROBOT, CAMERA, duration=2, keep_images=True)
+    assert len(run.images) == len(run.pose) == 5
+    for image, pose in zip(run.images, run.pose, strict=True):
+        assert np.array_equal(image, render(CAMERA, pose, Scene(ns=(0,), width=0.02)))
+    plain = follow_line(ROBOT, CAMERA, duration=2)
+    assert np.array_equal(plain.pose, run.pose) and np.array_equal(plain.measured, run.measured)

@@ -115,7 +115,7 @@ class LineFollowing:
     - ``twist`` ``(K, 3)``: the twist the wheels produced; ``rates`` ``(K, n_rates)`` [rad/s] the wheel commands
       (``rate_names``); ``steer`` ``(K, n_steer)`` [rad] steering headings of ``steer_names`` (0 = ahead);
     - ``lost`` ``(K,)`` bool: no line found in that image (the previous positioning was kept);
-    - ``images``: the camera images, one per period, when asked for.
+    - ``images``: when asked for, the camera image seen at each pose ``(K + 1)``: ``images[k]`` at ``pose[k]``.
     """
 
     robot_name: str
@@ -300,12 +300,15 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     beta = robot.beta
     why: list[str] = []  # why the last image gave no positioning
 
-    def position(p: np.ndarray) -> tuple[float, float] | None:
+    def view(p: np.ndarray) -> np.ndarray:
+        return render(camera, p, scene, z_p=z_p, noise=image_noise, blur=blur, clutter=clutter,
+                      seed=int(rng.integers(1 << 31)))
+
+    def position(p: np.ndarray, keep: bool) -> tuple[float, float] | None:
         if not from_image:
             return (-p[2] + rng.uniform(-noise[1], noise[1]), p[1] + rng.uniform(-noise[0], noise[0]))
-        img = render(camera, p, scene, z_p=z_p, noise=image_noise, blur=blur, clutter=clutter,
-                     seed=int(rng.integers(1 << 31)))
-        if keep_images:
+        img = view(p)
+        if keep_images and keep:  # one image per pose, the one seen there
             images.append(img)
         try:
             fix = locate_image(camera, img, spacing=scene.spacing, ns=scene.ns, z_p=z_p)
@@ -314,7 +317,7 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
             return None
         return (fix.psi + rng.uniform(-noise[1], noise[1]), fix.h + rng.uniform(-noise[0], noise[0]))
 
-    last = position(pose[0])  # the image taken before starting
+    last = position(pose[0], True)  # the image taken before starting
     if last is None:
         raise WmrkitError(f"follow-line: the camera does not see the line at the start pose: {why[0]}")
     for k in range(n_steps):
@@ -326,10 +329,12 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
         twist, _ = forward_kinematics(robot, {n: cmd.rates[names.index(n)] for n in actuated}, beta)
         twists[k], rates[k] = twist, cmd.rates
         steers.append(robot.heading_of_beta(beta))
-        new = position(pose[k])  # processed during this period, used in the next one
+        new = position(pose[k], k > 0)  # processed during this period, used in the next one (pose[0]'s is kept)
         lost[k] = new is None
         last = new if new is not None else last
         pose[k + 1] = integrate_exact(pose[k], twist, period)
+    if keep_images and from_image:  # what the camera sees at the end (the animation's last frame)
+        images.append(view(pose[-1]))
     time = np.arange(n_steps + 1) * period
     steer = np.array(steers).reshape(n_steps, len(robot.steer_names))
     return LineFollowing(robot.name, tuple(robot.rate_names), tuple(robot.steer_names), gain, speed, period,
