@@ -222,6 +222,16 @@ def test_weeds_and_crop_rows_are_not_speckle():
     assert len(extract_lines(img, n_lines=5)) >= 3
 
 
+@pytest.mark.parametrize(("pose", "z_p", "shapes"), [([[0.0, 0.1, 0.0], [1.0, 0.1, 0.0]], 0.0, "(2, 3) and ()"),
+                                                     ((0.0, 0.1, 0.0), np.array([0.0, 0.1]), "(3,) and (2,)")])
+def test_render_makes_one_image_of_one_pose(pose, z_p, shapes):
+    """Two poses, or two z_p, raised numpy's ValueError (operands could not be broadcast; truth value of an array
+    is ambiguous) from deep in the camera model."""
+    with pytest.raises(CameraError, match=rf"^render: one pose \(x, y, theta\) and one z_p make an image, got "
+                                          rf"shapes {re.escape(shapes)}$"):
+        render(CAMERA, pose, Scene(), z_p=z_p)
+
+
 @pytest.mark.parametrize(("pose", "z_p"), [((0.0, math.nan, 0.0), 0.0), ((0.0, 0.1, math.inf), 0.0),
                                            ((0.0, 0.1, 0.0), math.nan)])
 def test_render_refuses_a_pose_that_is_not_finite(pose, z_p):

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._shapes import as_vectors
 from ..limits import MAX_SIZE
 from .camera import Camera, CameraError, extrinsics, ground_from_image, undistort
 
@@ -92,10 +93,14 @@ def render(camera: Camera, pose_line_robot: ArrayLike, scene: Scene, *, z_p: flo
                           f"{MAX_BLUR:g}] px, got {noise:g}, {blur:g}")
     if not (isinstance(clutter, int | np.integer) and 0 <= clutter <= MAX_CLUTTER):
         raise CameraError(f"render: clutter must be an integer in [0, {MAX_CLUTTER}] blobs, got {clutter!r}")
-    if not (np.all(np.isfinite(np.asarray(pose_line_robot, dtype=float))) and np.isfinite(z_p)):  # NaN: a blank image
+    pose = as_vectors(pose_line_robot, 3, "render: pose_line_robot")
+    if pose.shape != (3,) or np.ndim(z_p):  # one image: (2, 3) poses or an array z_p raised numpy's ValueError
+        raise CameraError(f"render: one pose (x, y, theta) and one z_p make an image, got shapes {pose.shape} and "
+                          f"{np.shape(z_p)}")
+    if not (np.all(np.isfinite(pose)) and np.isfinite(z_p)):  # NaN: a blank image
         raise CameraError(f"render: pose and z_p must be finite, got {pose_line_robot!r}, {z_p!r}")
     rng = np.random.default_rng(seed)
-    psi, t = extrinsics(pose_line_robot, camera, z_p)
+    psi, t = extrinsics(pose, camera, z_p)
     ground = ground_from_image(_pixel_grid(camera), psi, camera.tilt, t, camera.focal_px)
     xw, yw = ground[..., 0], ground[..., 1]
     visible = np.isfinite(xw)
