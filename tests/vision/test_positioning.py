@@ -168,6 +168,9 @@ def test_points_file_and_its_errors(tmp_path):
         locate_points(cam, [(0, [[0, 10], [1, 10]])])
     with pytest.raises(CameraError, match="must be -1, 0 or 1"):
         locate_points(cam, [(2, [[0, -10], [1, 10]])], spacing=0.1)
+    # True (== 1) was positioned as line n = +1, as a points file's "n": true is refused
+    with pytest.raises(CameraError, match=r"^points: lines\[0\]\.n: must be -1, 0 or 1, got True$"):
+        locate_points(cam, [(True, [[0, -10], [1, 10]])], spacing=0.1)
 
 
 @pytest.mark.parametrize(("spacing", "z_p", "message"), [

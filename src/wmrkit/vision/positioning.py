@@ -112,7 +112,7 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
         pts = np.asarray(pts, dtype=float)
         if pts.shape != (2, 2) or not np.all(np.isfinite(pts)):
             raise CameraError(f"points: lines[{i}]: expected two finite points [[xu, yu], [xu, yu]]")
-        if n not in (-1, 0, 1):
+        if isinstance(n, bool) or n not in (-1, 0, 1):  # True == 1: read as the line right of the followed one
             raise CameraError(f"points: lines[{i}].n: must be -1, 0 or 1, got {n!r}")
         if n != 0 and not spacing > 0:
             raise CameraError(f"points: lines[{i}]: n = {n} needs the line spacing (--spacing D > 0)")
