@@ -81,7 +81,7 @@ def test_an_html_animation_keeps_every_frame(capsys, tmp_path):
 
     html = tmp_path / "a.html"
     with matplotlib.rc_context({"animation.embed_limit": 0.05}):
-        code, out, _ = run(capsys, "thesis-9.2", "--animate", str(html), "--frames", "6")
+        code, _, _ = run(capsys, "thesis-9.2", "--animate", str(html), "--frames", "6")
     assert code == 0
     assert html.read_text().count("data:image/png;base64") == 6
 
