@@ -30,6 +30,32 @@ def test_batch_odometry(capsys, fleet_dir, tmp_path):
     assert data["logs"] == 5 and data["failed"] == 0
 
 
+@pytest.mark.parametrize(("described", "given", "method"), [
+    ("rk2", [], "rk2"), ("euler", ["--method", "exact"], "exact"), ("wls", ["--method", "rk2"], "rk2"),
+    ("wls", [], None),
+])
+def test_batch_odometry_runs_the_described_method(capsys, fleet_dir, tmp_path, described, given, method):
+    """A description's odometry.method was ignored (exact ran, where 'wmrkit odometry' ran the described rk2); a
+    slip-aware one, which batch odometry does not run, is refused by name unless --method says which to run."""
+    import yaml
+
+    from wmrkit import catalog
+
+    data = catalog.load("diff-drive").to_dict() | {"odometry": {"method": described}}
+    robot = tmp_path / "r.yaml"
+    robot.write_text(yaml.safe_dump(data))
+    argv = ["batch", "odometry", str(robot), str(fleet_dir / "run0.csv"), "--workers", "0", "--json", *given]
+    if method is None:
+        assert main(argv) == 2
+        error = json.loads(capsys.readouterr().err)["error"]
+        assert "odometry.method is wls, which batch odometry does not run" in error
+        return
+    rows = _json(capsys, argv)["rows"]
+    assert [r["method"] for r in rows] == [method] and not rows[0]["error"]
+    single = _json(capsys, ["odometry", str(robot), str(fleet_dir / "run0.csv"), "--json", "--method", method])
+    assert [rows[0]["x"], rows[0]["y"], rows[0]["theta"]] == pytest.approx(single["pose"], abs=1e-12)
+
+
 def test_batch_calibrate_and_montecarlo(capsys, calibration_data, tmp_path):
     data = _json(capsys, ["batch", "calibrate", "diff-drive", str(calibration_data / "*.csv"), "--reference",
                           str(calibration_data / "ref"), "--workers", "0", "--json"])

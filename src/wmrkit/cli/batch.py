@@ -40,8 +40,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = sub.add_parser("odometry", help="odometry of many logs in parallel, one summary row per log (Parquet)")
     add_robot_argument(p)
     p.add_argument("logs", nargs="+", metavar="LOG", help="CSV logs, ROS 2 bags, globs or folders")
-    p.add_argument("--method", choices=METHODS, default="exact",
-                   help=f"integration scheme: {SCHEMES_HELP} (default: exact)")
+    p.add_argument("--method", choices=METHODS,
+                   help=f"integration scheme: {SCHEMES_HELP} (default: the description's odometry.method, as for "
+                        "'wmrkit odometry', else exact)")
     p.add_argument("--out", metavar="FILE", help="summary table (Parquet); a rerun skips the logs done")
     p.add_argument("--trajectories", metavar="DIR", help="write each log's trajectory to DIR/NAME.tum")
     p.add_argument("--trajectory-format", choices=("tum", "csv"), help="trajectory files (default tum)")
@@ -134,12 +135,27 @@ def _progress(args: argparse.Namespace) -> bool:
     return not args.quiet and not args.json and sys.stderr.isatty()
 
 
+def _described_method(robot) -> str:
+    """The description's ``odometry.method`` where ``batch odometry`` runs it (a no-slip scheme), else ``exact``
+    when it names none; a slip-aware estimator is refused: the rows would be the no-slip model's, which the
+    description says the robot needs more than (``wmrkit odometry`` runs it)."""
+    from ..odometry.integrators import METHODS
+
+    method = robot.odometry.method if robot.odometry is not None else None
+    if method is not None and method not in METHODS:
+        raise WmrkitError(f"robot '{robot.name}': its description's odometry.method is {method}, which batch odometry "
+                          f"does not run ('wmrkit odometry' does, one log at a time); give --method "
+                          f"{'|'.join(METHODS)} for the no-slip model")
+    return method or "exact"
+
+
 def run_odometry(args: argparse.Namespace) -> int:
     """Batch odometry; prints the number of logs done, skipped and failed (and each failure). Exit code 1 when a
     log failed (the others are done and written)."""
     from ..batch.fleet import batch_odometry
 
     robot = load_robot(args.robot)
+    args.method = args.method or _described_method(robot)
     if args.trajectory_format is not None and args.trajectories is None:  # no trajectory written: it was ignored
         raise WmrkitError("--trajectory-format is the format of the --trajectories files; give --trajectories DIR")
     with _runner(args) as runner:
