@@ -336,3 +336,29 @@ def test_tyre_takes_the_discontinuous_coulomb_law(capsys):
     assert json.loads(out)["Fx"] == pytest.approx(-0.8 * 3000)  # mu_long Fz, whatever the slip
     code, _, err = run(capsys, "tyre", "dugoff", "--load", "3000", "--param", "mu=inf")
     assert code == 2 and "--param mu" in err  # only coulomb's k may be infinite
+
+
+@pytest.mark.parametrize("argv", [
+    ("tyre", "pacejka", "--load", "3000", "--slip-ratio", "0.1", "--slip-angle", "0.05"),
+    ("simulate", "skid-steer-4", "--path", "turn", "--duration", "0.5"),
+])
+def test_plots_label_every_axis_and_close_on_a_failed_write(capsys, monkeypatch, tmp_path, argv):
+    """The right-hand panels (forces against slip angle, the twist against time) had no y label, their units in
+    the legend only; a write that failed left the figure open in the process."""
+    import matplotlib.pyplot as plt
+
+    from wmrkit.cli import dynamics as cli_dynamics
+    from wmrkit.errors import WmrkitError
+
+    seen = []
+
+    def failing(fig, out):
+        seen.append([(ax.get_xlabel(), ax.get_ylabel()) for ax in fig.axes])
+        raise WmrkitError(f"--plot {out}: cannot write (disk full)")
+
+    monkeypatch.setattr(cli_dynamics, "_savefig", failing)
+    before = set(plt.get_fignums())
+    code, _, err = run(capsys, *argv, "--plot", str(tmp_path / "p.png"))
+    assert code == 2 and "disk full" in err
+    assert seen and all(x and "[" in y for x, y in seen[0]), seen
+    assert set(plt.get_fignums()) == before

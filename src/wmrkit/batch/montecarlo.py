@@ -275,5 +275,7 @@ def plot_monte_carlo(result: MonteCarloResult, path: str) -> None:
     ax.set_title(f"{result.robot}: final pose, Monte Carlo vs analytic")
     ax.legend(fontsize=8, loc="upper right")
     fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    try:
+        fig.savefig(path)
+    finally:  # a failed write leaves no open figure behind
+        plt.close(fig)

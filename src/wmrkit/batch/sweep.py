@@ -230,5 +230,7 @@ def plot_sweep(result: SweepResult, path: str | os.PathLike[str]) -> None:
         ax.legend(loc="best", fontsize=8)
     ax.set_title(f"{result.robot}: {result.metric} over {result.total:,} designs")
     fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    try:
+        fig.savefig(path)
+    finally:  # a failed write leaves no open figure behind
+        plt.close(fig)

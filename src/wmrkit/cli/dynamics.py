@@ -248,14 +248,16 @@ def _plot_tyre(tyre, load: float, s: float, a: float, speed: float, out: str) ->
     ax1.set(xlabel="slip ratio", ylabel="force [N]", title=f"slip angle {a:g} rad")
     ax2.plot(aa, f2.lateral, label="Fy (lateral)")
     ax2.plot(aa, f2.longitudinal, label="Fx (longitudinal)")
-    ax2.set(xlabel="slip angle [rad]", title=f"slip ratio {s:g}")
+    ax2.set(xlabel="slip angle [rad]", ylabel="force [N]", title=f"slip ratio {s:g}")
     for ax in (ax1, ax2):
         ax.grid(True)
         ax.legend()
     fig.suptitle(f"{tyre.model} tyre, load {load:g} N, wheel speed {speed:g} m/s")
     fig.tight_layout()
-    _savefig(fig, out)
-    plt.close(fig)
+    try:
+        _savefig(fig, out)
+    finally:  # a failed write leaves no open figure behind (a long-lived process calls this many times)
+        plt.close(fig)
 
 
 def _plot_simulation(sim, name: str, out: str) -> None:
@@ -269,10 +271,12 @@ def _plot_simulation(sim, name: str, out: str) -> None:
     ax1.set(xlabel="x [m]", ylabel="y [m]", title=f"{name}: path", aspect="equal")
     for k, label in enumerate(("vx [m/s]", "vy [m/s]", "omega [rad/s]")):
         ax2.plot(sim.t, sim.twist[:, k], label=label)
-    ax2.set(xlabel="time [s]", title="twist (robot frame)")
+    ax2.set(xlabel="time [s]", ylabel="vx, vy [m/s]; omega [rad/s]", title="twist (robot frame)")
     for ax in (ax1, ax2):
         ax.grid(True)
     ax2.legend()
     fig.tight_layout()
-    _savefig(fig, out)
-    plt.close(fig)
+    try:
+        _savefig(fig, out)
+    finally:
+        plt.close(fig)
