@@ -115,6 +115,20 @@ def test_chufa_crop_rows_synthetic():
         assert weeds.h == pytest.approx(pose[1], abs=0.025)
 
 
+@pytest.mark.parametrize("turn_deg", [5.0, 10.0, 15.5, -15.5, 20.0])
+@pytest.mark.parametrize("h", [0.009, 0.2, -0.25, 0.29])
+def test_a_turned_robot_between_crop_rows_follows_the_nearest(turn_deg, h):
+    """The lines centred in the image were taken as rows -1, 0, 1: turned 5 deg at 20 cm from its row, the robot was
+    placed at -40 cm (one row over, 0.6 m apart), and would steer to the next row. Identical rows: the followed one
+    is the one P is nearest (|h| <= spacing / 2); checked against the pose rendered."""
+    cam = Camera(545, math.radians(76), 1.42, 640, 480)
+    scene = Scene(ns=(-2, -1, 0, 1, 2), spacing=0.6, width=0.25, style="crops")
+    fix = locate_image(cam, render(cam, (0.0, h, math.radians(turn_deg)), scene, noise=6.0, blur=1.0, seed=1),
+                       spacing=0.6)
+    assert fix.h == pytest.approx(h, abs=0.005)
+    assert fix.psi == pytest.approx(-math.radians(turn_deg), abs=math.radians(0.05))
+
+
 def test_road_with_two_lines_and_no_centre_line():
     """Fig. 9.5 (a): a road's two lines at n = -1 and +1, the followed centre line not painted."""
     cam = Camera(400, math.radians(70), 1.2, 640, 480)

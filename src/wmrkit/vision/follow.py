@@ -50,7 +50,8 @@ def locate_image(camera: Camera, image: ArrayLike, *, spacing: float = 0.0, ns: 
     `ns`: the index n (9.8) of each line expected, left to right in the image; default ``(0,)`` without
     `spacing`, ``(-1, 0, 1)`` with it (crop rows); ``(-1, 1)`` is a road's two lines. Of the lines found (up to
     four more than expected: the chufa camera sees five crop rows), the neighbouring ones centred on the image's
-    near row are used. The points are taken on rows ``+-rows_a`` [px] (default a quarter of the image height;
+    near row are used; with a `spacing`, those that put P nearest the followed line (identical rows: the robot
+    follows the nearest). The points are taken on rows ``+-rows_a`` [px] (default a quarter of the image height;
     the far one halfway to the horizon when ``-rows_a`` is above it).
     Raises :class:`WmrkitError` when fewer lines than expected are found, or the image is not the camera's size.
     """
@@ -63,15 +64,28 @@ def locate_image(camera: Camera, image: ArrayLike, *, spacing: float = 0.0, ns: 
     if len(found) < len(ns):
         raise WmrkitError(f"image: found {len(found)} line(s), expected {len(ns)}")
     a = rows_a if rows_a is not None else camera.rows / 4
-    # the len(ns) neighbouring lines around the image's centre on the near row +A (more rows may be in view)
-    start = min(range(len(found) - len(ns) + 1),
-                key=lambda i: abs(sum(ln.x_at(a) for ln in found[i:i + len(ns)])))
-    lines = found[start:start + len(ns)]
     horizon = camera.focal_px / math.tan(camera.tilt)  # rows above -horizon see no ground: the far point is taken
     far = a if a < horizon else horizon / 2  # below it (any two points of a line give the same position)
     undistorted = replace(camera, k1=0.0)  # the extracted lines are already undistorted
-    return locate_points(undistorted, [(n, np.array([[ln.x_at(-far), -far], [ln.x_at(a), a]]))
-                                       for n, ln in zip(ns, lines, strict=True)], spacing=spacing, z_p=z_p)
+
+    def located(start: int) -> Positioning:
+        return locate_points(undistorted, [(n, np.array([[ln.x_at(-far), -far], [ln.x_at(a), a]]))
+                                           for n, ln in zip(ns, found[start:start + len(ns)], strict=True)],
+                             spacing=spacing, z_p=z_p)
+
+    # the len(ns) neighbouring lines around the image's centre on the near row +A (more rows may be in view)
+    starts = sorted(range(len(found) - len(ns) + 1), key=lambda i: abs(sum(ln.x_at(a) for ln in found[i:i + len(ns)])))
+    if spacing == 0 or len(starts) == 1:
+        return located(starts[0])
+    # identical rows: the group P is nearest the followed one of (|h| <= spacing / 2). The image's centre was one row
+    # over for a robot turned 5 deg at 0.2 m from its row (h = -0.4 m: it steered to the next row)
+    fixes = []
+    for start in starts:
+        try:
+            fixes.append(located(start))
+        except WmrkitError:  # a group with a stray line (not spaced as given): not the followed one
+            continue
+    return min(fixes, key=lambda f: abs(f.h)) if fixes else located(starts[0])
 
 
 def line_following_law(gain: float) -> PositionLaw:
