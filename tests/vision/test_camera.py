@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -224,6 +225,18 @@ def test_project_and_ground_from_image_refuse_a_focal_length_that_is_not_positiv
         project([0.0, 2.0, 0.0], psi, 0.8, t, focal)
     with pytest.raises(CameraError, match=r"^ground_from_image: focal_px: expected finite numbers > 0"):
         ground_from_image([0.0, 10.0], psi, 0.8, t, focal)
+
+
+def test_a_camera_file_is_written_as_its_extension_says(tmp_path):
+    """'--out cam.json' wrote YAML (not JSON) and '--out cam.png' YAML into a picture's name."""
+    cam = Camera(325.7, math.radians(45), 0.134, 320, 240, 0.05)
+    cam.to_file(tmp_path / "cam.json")
+    assert json.loads((tmp_path / "cam.json").read_text()) == cam.to_dict()
+    assert Camera.from_file(tmp_path / "cam.json") == cam
+    for name in ("cam.png", "cam"):
+        with pytest.raises(CameraError, match=rf"{name}: a camera file is .yaml, .yml or .json"):
+            cam.to_file(tmp_path / name)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cam.json"]
 
 
 def test_camera_file_round_trip_and_errors(tmp_path):

@@ -51,7 +51,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                      help="real distance along the stripes between the points seen on rows +A and -A [m]")
     cal.add_argument("--size", nargs=2, type=int, metavar=("W", "H"),
                      help="image size for the camera file with --x1/--x2 (default 640 480)")
-    cal.add_argument("--out", metavar="FILE", help="write the camera file (YAML)")
+    cal.add_argument("--out", metavar="FILE", help="write the camera file (.yaml/.yml; .json for JSON)")
     add_json_flag(cal)
     cal.set_defaults(run=run_calibrate)
 

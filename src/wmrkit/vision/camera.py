@@ -19,6 +19,7 @@ inverse is a cubic in r, solved in closed form (:func:`undistort`); with ``k1 < 
 
 from __future__ import annotations
 
+import json
 import math
 import numbers
 from dataclasses import asdict, dataclass, fields
@@ -29,6 +30,7 @@ import numpy as np
 import yaml
 from numpy.typing import ArrayLike
 
+from .._atomic import atomic_path
 from .._shapes import as_vectors
 from ..documents import read_document, read_file
 from ..errors import DescriptionError, WmrkitError
@@ -139,9 +141,17 @@ class Camera:
         return cls.from_dict(read_located(path, "camera file", "yaml"), source=str(path))
 
     def to_file(self, path: str | Path) -> None:
-        """Write the camera file (YAML, plain SI numbers)."""
+        """Write the camera file, plain SI numbers: JSON for a ``.json`` file, else YAML (``.yaml``, ``.yml``; other
+        extensions are refused: ``--out camera.png`` wrote YAML into a picture's name), replacing it in one step."""
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix not in (".yaml", ".yml", ".json"):
+            raise CameraError(f"{path}: a camera file is .yaml, .yml or .json, not '{suffix or 'no extension'}'")
+        data = self.to_dict()
+        text = json.dumps(data, indent=2) + "\n" if suffix == ".json" else yaml.safe_dump(data, sort_keys=False)
         try:
-            Path(path).write_text(yaml.safe_dump(self.to_dict(), sort_keys=False))
+            with atomic_path(path) as scratch:
+                scratch.write_text(text, encoding="utf-8")
         except OSError as err:
             raise CameraError(f"{path}: cannot write the camera file ({err.strerror or err})") from None
 
