@@ -256,6 +256,8 @@ def test_a_z_p_out_of_range_is_named_not_read_as_a_line_not_seen(z_p):
     ({"period": 0.0}, "period (--period): expected a finite number > 0 [s], got 0"),
     ({"duration": math.inf}, "duration (--duration): expected a finite number > 0 [s], got inf"),
     ({"speed": -0.1}, "speed (--speed): expected a finite number > 0 [m/s], got -0.1"),
+    ({"gain": "0.3"}, "gain (--gain): expected a finite number > 0 [1/s], got '0.3'"),  # a bare TypeError
+    ({"speed": True}, "speed (--speed): expected a finite number > 0 [m/s], got True"),  # taken as 1 m/s
 ])
 def test_a_bad_loop_setting_is_named(kwargs, named):
     # "follow-line: gain, period, duration and speed must be finite numbers > 0" named none of the four

@@ -236,8 +236,10 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     """
     for name, value, unit in (("gain", gain, "1/s"), ("period", period, "s"), ("duration", duration, "s"),
                               ("speed", speed, "m/s")):
-        if not 0 < value < math.inf:  # NaN included
-            raise WmrkitError(f"follow-line: {name} (--{name}): expected a finite number > 0 [{unit}], got {value:g}")
+        number = isinstance(value, numbers.Real) and not isinstance(value, bool)  # "0.3" raised a bare TypeError
+        if not (number and 0 < value < math.inf):  # NaN included
+            got = f"{value:g}" if number else repr(value)
+            raise WmrkitError(f"follow-line: {name} (--{name}): expected a finite number > 0 [{unit}], got {got}")
     if speed > MAX_SPEED:
         raise WmrkitError(f"follow-line: speed {speed:g} m/s is faster than {MAX_SPEED:g} m/s")
     if not duration / period <= MAX_PERIODS:
