@@ -314,8 +314,9 @@ def test_vision_calibrate_out_and_sizes(tmp_path, capsys):
             "--row-distance", "20cm"]
     assert "is a folder" in _refused([*argv, "--out", str(tmp_path)], capsys)  # IsADirectoryError
     # a 1e8 x 1e8 camera was written, and follow-line then tried to render its images
-    assert "width: out of range" in _refused([*argv, "--size", "100000000", "480", "--out", str(tmp_path / "c.yaml")],
-                                             capsys)
+    assert "--size: the image is 100000000 x 480 px, expected 8 to 4096 px a side" in _refused(
+        [*argv, "--size", "100000000", "480", "--out", str(tmp_path / "c.yaml")], capsys)
+    assert not (tmp_path / "c.yaml").exists()
     assert "cos(tilt) = inf" in _refused([*argv, "--half-separation", "1e308"], capsys)  # after numpy's warnings
 
 
