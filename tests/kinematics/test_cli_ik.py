@@ -208,3 +208,22 @@ def test_text_prints_rounding_noise_as_zero(capsys):
     assert code == 0 and "vy = 0 m/s" in out and "e-1" not in out.splitlines()[0]
     code, out, _ = run(capsys, "ik", "mecanum-4", "--twist", "1", "0", "0")
     assert code == 0 and out.count("roller 0\n") == 4 and "e-1" not in out
+
+
+def test_ik_and_show_tables_keep_long_wheel_names_apart_from_their_type(capsys, tmp_path):
+    # ROS 2 names its joints 'front_left_wheel_joint': a name of 14 characters or more ran into the type column
+    # ('front_left_wheel_jointswedish'), in ik's and show's tables alike
+    path = tmp_path / "ros.yaml"
+    names = ("front_left_wheel_joint", "front_right_wheel_joint", "rear_right_wheel_joint", "rl")
+    places = ((0.2, 0.15), (0.2, -0.15), (-0.2, -0.15), (-0.2, 0.15))
+    wheels = ", ".join(f"{{name: {n}, type: mecanum, position: [{x}, {y}], r: 0.05, actuated: spin}}"
+                       for n, (x, y) in zip(names, places, strict=True))
+    path.write_text(f"name: ros-mecanum\nwheels: [{wheels}]\n")
+    for argv in (("ik", str(path), "--twist", "0.3", "0.2", "0.5"), ("show", str(path))):
+        code, out, _ = run(capsys, *argv)
+        rows = [line.split() for line in out.splitlines() if line.split() and line.split()[0] in names]
+        assert code == 0 and [r[0] for r in rows] == list(names) and {r[1] for r in rows} == {"swedish"}
+        header = next(line for line in out.splitlines() if line.split()[:2] == ["wheel", "type"])
+        for line in out.splitlines():  # the columns line up: each row's type starts under the header's
+            if line.split() and line.split()[0] in names:
+                assert line.index(" swedish") + 1 == header.index("type")

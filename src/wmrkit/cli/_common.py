@@ -35,6 +35,12 @@ def load_robot(spec: str) -> Robot:
     return catalog.resolve(spec)
 
 
+def wheel_column_width(robot: Robot, least: int = 14) -> int:
+    """Width of a table's wheel-name column: `least`, or the longest name and two spaces (ROS 2's
+    'front_left_wheel_joint' ran into the next column)."""
+    return max(least, max(len(w.name) for w in robot.wheels) + 2)
+
+
 def print_json(data: Any) -> None:
     """Print `data` as JSON (NaN and infinities become null: JSON has none)."""
     print(json.dumps(_finite(data), indent=2))

@@ -7,7 +7,7 @@ import math
 
 from .. import catalog
 from ..robot import Robot
-from ._common import add_json_flag, add_robot_argument, check_plot_path, load_robot, print_json
+from ._common import add_json_flag, add_robot_argument, check_plot_path, load_robot, print_json, wheel_column_width
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -66,7 +66,8 @@ def summary(robot: Robot) -> dict:
 def format_summary(robot: Robot) -> str:
     """Human-readable summary: one line per wheel in the robot frame (x forward, y left)."""
     lines = [f"robot {robot.name}: {len(robot.wheels)} wheels" + (f"  ({robot.notes})" if robot.notes else "")]
-    header = f"  {'wheel':<14}{'type':<14}{'x [m]':>10}{'y [m]':>10}{'heading':>10}{'r [m]':>10}"
+    width = wheel_column_width(robot)
+    header = f"  {'wheel':<{width}}{'type':<14}{'x [m]':>10}{'y [m]':>10}{'heading':>10}{'r [m]':>10}"
     lines.append(header + "  joints (A actuated, S sensed)")
     for w in robot.wheels:
         x, y = w.position
@@ -77,7 +78,7 @@ def format_summary(robot: Robot) -> str:
         extra = {"castor": f"  d={_g(w.d)} delta={_g(math.degrees(w.delta))}deg",
                  "double_castor": f"  d={_g(w.d)} b={_g(w.b)}", "double": f"  b={_g(w.b)}",
                  "swedish": f"  gamma={_g(math.degrees(w.gamma))}deg r_r={_g(w.r_r)}"}.get(w.type, "")
-        row = (f"  {w.name:<14}{w.type:<14}{_g(_zero(x)):>10}{_g(_zero(y)):>10}"
+        row = (f"  {w.name:<{width}}{w.type:<14}{_g(_zero(x)):>10}{_g(_zero(y)):>10}"
                f"{_g(_zero(math.degrees(w.heading))) + '°':>10}{_g(w.r):>10}")
         lines.append(f"{row}  {joints}{extra}")
     lines.append("  heading: the wheel's rolling direction, 0° = straight ahead (+x), counter-clockwise positive")
