@@ -10,6 +10,7 @@ import pytest
 
 from wmrkit import catalog
 from wmrkit.cli.main import main
+from wmrkit.kinematics.wheel_ik import wheel_commands
 from wmrkit.odometry.encoders import IncrementalEncoder, catalog_encoders
 from wmrkit.odometry.logs import write_csv
 from wmrkit.odometry.pipeline import odometry
@@ -350,13 +351,40 @@ def test_units_of_columns_that_are_not_the_logs_do_not_change_the_reading(capsys
 
 
 def test_a_heading_column_with_its_unit(capsys, tmp_path):
-    """``--heading-column yaw`` on a header ``yaw [rad]`` was refused ('time units'); ``[deg]`` is refused, named."""
+    """``--heading-column yaw`` on a header ``yaw [rad]`` was refused ('time units'); a unit other than rad and deg
+    is refused, named."""
     path = tmp_path / "yaw.csv"
     path.write_text("time,left.spin,right.spin,yaw [rad]\n0,0,0,0\n1,1,1,0.5\n")
     assert _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--heading-column", "yaw"])["pose"][2] == 0.5
-    path.write_text("time,left.spin,right.spin,yaw [deg]\n0,0,0,0\n1,1,1,0.5\n")
+    path.write_text("time,left.spin,right.spin,yaw [grad]\n0,0,0,0\n1,1,1,0.5\n")
     assert main(["odometry", "diff-drive", str(path), "--heading-column", "yaw"]) == 2
-    assert "column 'yaw': unit 'deg'; a heading column is read in rad" in capsys.readouterr().err
+    assert "column 'yaw': unknown unit 'grad' (for a heading column: rad, deg)" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("header", "option", "values"), [
+    ("yaw [deg]", "--heading-column", lambda t: np.degrees(0.5 * t)),   # WPILib's gyro angle, in degrees
+    ("gz [deg/s]", "--gyro-column", lambda t: np.full_like(t, np.degrees(0.5))),
+    ("yaw [rad]", "--heading-column", lambda t: 0.5 * t),
+    ("gz [rad/s]", "--gyro-column", lambda t: np.full_like(t, 0.5)),
+])
+def test_a_heading_or_gyro_column_in_degrees_is_read_as_its_header_says(capsys, tmp_path, header, option, values):
+    """A gyro logged in degrees (WPILib's ``getAngle()``, deg/s rates) was refused ('a heading column is read in
+    rad') with no way to read it but converting the file; the header's ``[deg]`` / ``[deg/s]`` now reads it. Swerve
+    modules driving the body twist (1 m/s at 30 deg, 0.5 rad/s), the gyro agreeing: the pose is the arc of speed
+    1 m/s at the world angle 0.5 t + 30 deg, integrated here by its closed form."""
+    c = np.radians(30)
+    swerve, t = catalog.load("swerve-4"), np.linspace(0.0, 2.0, 201)
+    commands = wheel_commands(swerve, [np.cos(c), np.sin(c), 0.5])  # constant headings and spins
+    joints = [f"{w}.spin,{w}.steer [deg]" for w in swerve.wheel_names]
+    rows = [f"{a:.6f}," + ",".join(f"{s * a:.12f},{np.degrees(h):.12f}" for s, h in
+                                   zip(commands.spin, commands.heading, strict=True)) + f",{v:.12f}"
+            for a, v in zip(t, values(t), strict=True)]
+    path = tmp_path / "gyro.csv"
+    path.write_text(f"time,{','.join(joints)},{header}\n" + "\n".join(rows) + "\n")
+    out = _json(capsys, ["odometry", "swerve-4", str(path), "--json", option, header.split()[0]])
+    want = [(np.sin(1 + c) - np.sin(c)) / 0.5, (np.cos(c) - np.cos(1 + c)) / 0.5, 1.0]  # x = int cos(0.5 t + c)
+    np.testing.assert_allclose(out["pose"], want, atol=1e-8)
+    assert out["consistent"] is True
 
 
 def test_an_output_that_is_the_plot_is_refused(capsys, diff_csv, tmp_path):

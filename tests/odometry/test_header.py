@@ -64,8 +64,11 @@ def test_units_of_other_columns_are_ignored_and_roles_are_read():
     u = parse_header_units(["time", "enc_l [counts:u16]", "yaw [rad]", "w [rad/s]"],
                            roles={"enc_l": "spin", "yaw": "heading", "w": "gyro"})
     assert (u.spin, u.bits, dict(u.columns)["yaw"]) == ("counts", 16, "yaw [rad]")
-    with pytest.raises(HeaderError, match="column 'yaw': unit 'deg'; a heading column is read in rad"):
-        parse_header_units(["time", "yaw [deg]"], source="log.csv", roles={"yaw": "heading"})
+    assert not u.external_degrees
+    assert parse_header_units(["time", "yaw [deg]"], roles={"yaw": "heading"}).external_degrees
+    assert parse_header_units(["time", "gz [deg/s]"], roles={"gz": "gyro"}).external_degrees
+    with pytest.raises(HeaderError, match=r"column 'yaw': unknown unit 'deg/s' \(for a heading column: rad, deg\)"):
+        parse_header_units(["time", "yaw [deg/s]"], source="log.csv", roles={"yaw": "heading"})
 
 
 def _format(tmp_path, header, **options):

@@ -75,8 +75,10 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     g.add_argument("--counter-bits", type=int, help="width of a wrapping hardware counter (default: the header's)")
     g.add_argument("--signed-counter", action="store_true", help="the counter is signed")
     g.add_argument("--steer-resolution", metavar="ANGLE", help="steering encoder resolution [rad, or 'deg']")
-    g.add_argument("--heading-column", help="absolute heading column [rad] used instead of the wheels' heading")
-    g.add_argument("--gyro-column", help="yaw-rate column [rad/s] integrated instead of the wheels' heading")
+    g.add_argument("--heading-column", help="absolute heading column used instead of the wheels' heading: rad, or "
+                   "deg when its header says so ('yaw [deg]')")
+    g.add_argument("--gyro-column", help="yaw-rate column integrated instead of the wheels' heading: rad/s, or deg/s "
+                   "when its header says so ('gz [deg/s]')")
     g.add_argument("--max-gap", type=float, metavar="SECONDS", help="refuse time steps longer than this")
     g = p.add_argument_group("ROS 2 bags")
     g.add_argument("--topic", default="/joint_states", help="JointState topic (default: /joint_states)")
@@ -238,10 +240,11 @@ def _check_heading(robot, log: str, fmt: LogFormat, sensed) -> bool:
     off = float(np.abs(external - wheels).sum())
     if scale < HEADING_MIN_TURN or off <= HEADING_RTOL * scale:
         return True
-    column = fmt.heading_column or fmt.gyro_column
+    column, unit = (fmt.heading_column, "deg") if fmt.heading_column else (fmt.gyro_column, "deg/s")
     print(f"wmrkit: warning: the external heading (column '{column}') turns {external.sum():.4g} rad over the first "
           f"{len(first)} samples where the wheels turn {wheels.sum():.4g} rad ({off:.3g} rad apart interval by "
-          f"interval): its units (deg? deg/s?) or its sign (clockwise?) are probably wrong", file=sys.stderr)
+          f"interval): its units (deg or deg/s? write them in the header: '{column} [{unit}]') or its sign "
+          f"(clockwise?) are probably wrong", file=sys.stderr)
     return False
 
 

@@ -34,8 +34,9 @@ STEER_UNITS = {"rad": "angle", "deg": "degrees", "counts": "counts"}
 #: Conventions a steering unit may name after a colon (``deg:beta``).
 STEER_CONVENTIONS = ("heading", "beta")
 TIME_UNITS = ("s", "ms", "us", "ns")
-#: The one unit the external heading columns are read in (``LogFormat.heading_column``, ``gyro_column``).
-EXTERNAL_UNITS = {"heading": "rad", "gyro": "rad/s"}
+#: The units the external heading columns may declare (``LogFormat.heading_column``, ``gyro_column``); without one
+#: they are read in the first (a WPILib gyro's angle is in degrees: ``yaw [deg]``, ``gz [deg/s]``).
+EXTERNAL_UNITS = {"heading": ("rad", "deg"), "gyro": ("rad/s", "deg/s")}
 
 _NAME = re.compile(r"^\s*([^\[\]]*?)\s*\[\s*([^\[\]]+?)\s*\]\s*$")
 _COUNTER = re.compile(r"^counts:([us])(\d{1,2})$")
@@ -58,6 +59,7 @@ class HeaderUnits:
     bits: int | None = None
     signed: bool = False
     steer_convention: str | None = None
+    external_degrees: bool = False  # the heading or gyro column is in deg (deg/s)
 
     @property
     def declared(self) -> bool:
@@ -84,11 +86,11 @@ def parse_header_units(names: list[str], *, source: str = "<log>", time_column: 
     """Parse ``name [unit]`` header entries (see the module docstring).
 
     The time unit is the unit of `time_column` only; joint units are those of ``WHEEL.spin``/``WHEEL.steer``
-    columns and of the columns `roles` names (plain column name -> ``"spin"``, ``"steer"``, or ``"heading"`` [rad]
-    and ``"gyro"`` [rad/s], the external heading columns). The units of other columns (a battery voltage, a
-    latency in ms) are not the log's and are ignored."""
+    columns and of the columns `roles` names (plain column name -> ``"spin"``, ``"steer"``, or ``"heading"`` [rad
+    or deg] and ``"gyro"`` [rad/s or deg/s], the external heading columns). The units of other columns (a battery
+    voltage, a latency in ms) are not the log's and are ignored."""
     columns, modes, bits, signed, time_unit = [], {"spin": set(), "steer": set()}, set(), set(), None
-    conventions, roles = set(), dict(roles or {})
+    conventions, roles, external_degrees = set(), dict(roles or {}), False
     for written in names:
         match = _NAME.match(written)
         if match is None:
@@ -104,9 +106,10 @@ def parse_header_units(names: list[str], *, source: str = "<log>", time_column: 
             time_unit = unit
             continue
         if kind in EXTERNAL_UNITS:
-            if unit != EXTERNAL_UNITS[kind]:
-                raise HeaderError(f"{source}:1: column '{plain}': unit '{unit}'; a {kind} column is read in "
-                                  f"{EXTERNAL_UNITS[kind]}")
+            if unit not in EXTERNAL_UNITS[kind]:
+                raise HeaderError(f"{source}:1: column '{plain}': unknown unit '{unit}' (for a {kind} column: "
+                                  f"{', '.join(EXTERNAL_UNITS[kind])})")
+            external_degrees = unit.startswith("deg")
             continue
         if kind is None:  # not a column of the log's joints: its unit is not ours to read
             continue
@@ -139,7 +142,8 @@ def parse_header_units(names: list[str], *, source: str = "<log>", time_column: 
     if len(conventions) > 1:
         raise HeaderError(f"{source}:1: the steer columns mix conventions (heading, beta); one per log")
     return HeaderUnits(tuple(columns), time_unit, next(iter(modes["spin"]), None), next(iter(modes["steer"]), None),
-                       next(iter(bits), None), next(iter(signed), False), next(iter(conventions), None))
+                       next(iter(bits), None), next(iter(signed), False), next(iter(conventions), None),
+                       external_degrees)
 
 
 def _plain(name: str) -> str:
@@ -162,8 +166,8 @@ def bare_heading_problem(column: str, heading: Sequence[float]) -> tuple[int, st
         return None
     i = int(beyond[0])
     return i, (f"column '{column}': {float(heading[i]):g} is beyond one turn as radians, probably degrees: a heading "
-               f"column is read in rad (convert it; an unwrapped heading in rad writes its unit in the header: "
-               f"'{column} [rad]')")
+               f"column without a unit is read in rad (write its unit in the header: '{column} [deg]' for degrees, "
+               f"'{column} [rad]' for an unwrapped heading in rad)")
 
 
 def merge_option(name: str, given: object | None, declared: object | None, default: object, source: str) -> object:
@@ -221,4 +225,4 @@ def header_format(path: str | os.PathLike[str], robot_name: str, joints: Sequenc
                      spin=spin, steer=steer, encoders=encoders,
                      heading_column=None if heading_column is None else renamed.get(heading_column, heading_column),
                      gyro_column=None if gyro_column is None else renamed.get(gyro_column, gyro_column),
-                     max_gap=max_gap, steer_convention=convention)
+                     max_gap=max_gap, steer_convention=convention, external_degrees=units.external_degrees)

@@ -138,7 +138,8 @@ class LogFormat:
     ``steer_convention``: ``"heading"`` (0 = rolling straight ahead, the default) or ``"beta"`` (the thesis's
     angle, files of older wmrkit versions; header ``[deg:beta]``). ``encoders``: ``(joint,
     encoder)`` pairs for counts. ``heading_column``: absolute heading [rad] (IMU yaw; unwrapped here) replacing
-    the wheels' heading; ``gyro_column``: yaw rate [rad/s] instead (integrated from 0). ``max_gap``: longest
+    the wheels' heading; ``gyro_column``: yaw rate [rad/s] instead (integrated from 0); ``external_degrees``: that
+    column is in deg (deg/s; a header's ``[deg]``, ``[deg/s]``). ``max_gap``: longest
     time step accepted [s] (None: any). ``time_unit``: one of :data:`TIME_UNITS`. ``max_rate``: largest
     plausible spin rate [rad/s] between two samples (None: any); a faster step is refused as an encoder jump.
     """
@@ -155,6 +156,7 @@ class LogFormat:
     delimiter: str = ","
     max_rate: float | None = MAX_RATE
     steer_convention: Literal["heading", "beta"] = "heading"
+    external_degrees: bool = False
 
     def __post_init__(self) -> None:
         for name, kind, example in (("columns", str, "'enc_l'"),
@@ -179,6 +181,8 @@ class LogFormat:
             raise LogError(f"steer_convention must be heading or beta, got {self.steer_convention!r}")
         if self.heading_column is not None and self.gyro_column is not None:
             raise LogError("give a heading column or a gyro column, not both")
+        if not isinstance(self.external_degrees, bool):
+            raise LogError(f"LogFormat.external_degrees: expected True or False, got {self.external_degrees!r}")
         if self.max_gap is not None and not self.max_gap > 0:
             raise LogError(f"max_gap must be > 0 s, got {self.max_gap}")
         if self.max_rate is not None and not self.max_rate > 0:
@@ -234,12 +238,12 @@ class Decoder:
             prev = None if self._positions is None else self._positions[j]
             pos[:, j] = self._decode_joint(joint, ext[:, 1 + j], ext_time, prev, probe)
         check_jumps(probe, pos, self._positions, ext_time, fmt.max_rate)
-        heading = None
+        heading, external = None, np.radians(ext[:, -1]) if fmt.external_degrees else ext[:, -1]
         if fmt.heading_column is not None:
-            u = np.unwrap(ext[:, -1])
+            u = np.unwrap(external)
             heading = u if self._last is None else self._heading + (u[1:] - u[0])
         elif fmt.gyro_column is not None:
-            heading = self._heading + _cumtrapz(ext[:, -1], ext_time, start=self._last is None)
+            heading = self._heading + _cumtrapz(external, ext_time, start=self._last is None)
         if heading is not None:
             self._heading = heading[-1]
         self._last, self._positions = raw[-1].copy(), pos[-1].copy()  # as read: counts and rates continue from it
