@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from wmrkit import Robot, wheel_commands
+from wmrkit.analysis.summary import analyze
 
 CORNERS = {"fl": (0.3, 0.25), "fr": (0.3, -0.25), "rl": (-0.3, 0.25), "rr": (-0.3, -0.25)}
 MR_GAMMA = {"fl": -45.0, "fr": 45.0, "rl": 45.0, "rr": -45.0}  # Modern Robotics' mecanum robot (Fig. 13.5)
@@ -73,3 +74,20 @@ def test_modern_robotics_gamma_is_the_thesis_gamma_minus_90_deg(gamma_mr):
     thesis = _robot([{"name": n, "type": "swedish", "position": list(p), "heading": 0, "r": R, "r_r": 0.01,
                       "gamma": f"{gamma_mr + 90.0} deg"} for n, p in CORNERS.items()])
     np.testing.assert_allclose(wheel_commands(thesis, twist).spin, want, atol=1e-9)
+
+
+@pytest.mark.parametrize(("lx", "ly"), [(0.2, 0.15), (0.25, 0.1), (0.175, 0.175)])
+def test_ros2_mecanum_drive_controller_wheel_speeds(lx, ly):
+    """docs/conventions.md: ROS 2's mecanum_drive_controller commands (vx -+ vy -+ (lx + ly) omega) / r, in its
+    order front-left, front-right, rear-right, rear-left; wmrkit's spins of a `type: mecanum` robot at (+-lx, +-ly)
+    are those, for any split of the sum 0.35 m."""
+    r, k = 0.05, lx + ly
+    names = {"front_left_wheel_joint": (lx, ly), "front_right_wheel_joint": (lx, -ly),
+             "rear_right_wheel_joint": (-lx, -ly), "rear_left_wheel_joint": (-lx, ly)}
+    robot = _robot([{"name": n, "type": "mecanum", "position": list(p), "r": r} for n, p in names.items()])
+    rng = np.random.default_rng(7)
+    for vx, vy, w in rng.uniform(-1, 1, (20, 3)):
+        ros = np.array([vx - vy - k * w, vx + vy + k * w, vx - vy + k * w, vx + vy - k * w]) / r
+        np.testing.assert_allclose(wheel_commands(robot, [vx, vy, w]).spin, ros, rtol=1e-12, atol=1e-12)
+    iso = analyze(robot).to_dict()  # the sum is the natural length: kappa 1 there
+    assert iso["characteristic_length"] == pytest.approx(k, rel=1e-9) and iso["condition_number"] == pytest.approx(1)
