@@ -100,6 +100,20 @@ def test_bad_bags(mecanum_bag, tmp_path):
         write_joint_states(partial, log)
 
 
+def test_a_bag_of_unmapped_ros_names_is_refused_with_the_names_it_holds(mecanum_bag, capsys):
+    """A ROS 2 user's bag (fl_wheel_joint, ...) read without --joint-name said only that no message names
+    front_left.spin, ...: not which names the bag holds, nor how to map them."""
+    from wmrkit.cli.main import main
+
+    _, run, path = mecanum_bag
+    ros = ", ".join(ROS_NAMES[j] for j in run.log.joints)
+    with pytest.raises(LogError, match=f"; its messages name {ros}: map them onto the robot's joints with "
+                                       r"--joint-name ROS=WHEEL\.spin \(names= in Python\)"):
+        list(read_joint_states(path, run.log.joints))
+    assert main(["odometry", "mecanum-4", str(path)]) == 2
+    assert "its messages name fl_wheel_joint" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("start", [3e9, -1.0, 1e300])
 def test_times_a_ros_stamp_cannot_hold_are_refused_by_name(tmp_path, start):
     """A log's time beyond 2^31 s (a ms log read as s, an epoch in ms) raised struct.error from rosbags' int32

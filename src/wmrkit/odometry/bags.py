@@ -35,6 +35,8 @@ if TYPE_CHECKING:
 from .trajectories import Trajectory, quaternion_z, yaw_of_quaternion
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
+#: How many of the names a bag's messages give an error quotes when none names the robot's joints.
+MAX_SEEN_NAMES = 16
 ODOMETRY = "nav_msgs/msg/Odometry"
 
 
@@ -170,6 +172,7 @@ def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, ro
             raise LogError(f"{source}: topic '{topic}' carries {conns[0].msgtype}, not {JOINT_STATE}")
         times, rows, index, first = [], [], 0, 0
         last: tuple[float, np.ndarray] | None = None
+        seen: dict[str, None] = {}  # names of skipped messages, for the error when none names the joints
         for stamp_ns, msg in _messages(reader, conns, f"{source}: {topic}", JOINT_STATE, ts):
             got = {rename.get(n, n): k for k, n in enumerate(msg.name)}
             have = [j for j in joints if j in got]
@@ -182,6 +185,8 @@ def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, ro
             if progress is not None:
                 progress(1)
             if not have:
+                if len(seen) < MAX_SEEN_NAMES:
+                    seen.update(dict.fromkeys(msg.name[:MAX_SEEN_NAMES]))
                 continue
             if len(have) != len(joints):
                 missing = [j for j in joints if j not in got]
@@ -199,7 +204,10 @@ def read_joint_states(path: str | os.PathLike[str], joints: Sequence[str], *, ro
         if times:
             yield from _chunk(times, joints, rows, f"{source}: {topic}", first, last, max_rate, robot)
         if index == 0:
-            raise LogError(f"{source}: no JointState message on '{topic}' names the joints {', '.join(joints)}")
+            names_seen = list(seen)[:MAX_SEEN_NAMES]
+            raise LogError(f"{source}: no JointState message on '{topic}' names the joints {', '.join(joints)}"
+                           + (f"; its messages name {', '.join(names_seen)}: map them onto the robot's joints with "
+                              f"--joint-name ROS=WHEEL.spin (names= in Python)" if names_seen else ""))
     finally:
         reader.close()
 
