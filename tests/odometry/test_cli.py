@@ -10,6 +10,7 @@ import pytest
 
 from wmrkit import catalog
 from wmrkit.cli.main import main
+from wmrkit.errors import WmrkitError
 from wmrkit.kinematics.wheel_ik import wheel_commands
 from wmrkit.odometry.encoders import IncrementalEncoder, catalog_encoders
 from wmrkit.odometry.logs import write_csv
@@ -459,3 +460,28 @@ def test_a_start_pose_too_far_names_the_option(capsys, tmp_path):
     log.write_text("time,left.spin,right.spin\n0,0,0\n1,1,1.2\n")
     assert main(["odometry", "diff-drive", str(log), "--pose", "1e10", "0", "0"]) == 2
     assert capsys.readouterr().err.startswith("wmrkit: error: --pose: a position beyond 1e+09 m, got [10000000000.0")
+
+
+@pytest.mark.parametrize("unit", ["m", "m/s"])
+def test_spin_columns_of_wheel_travel_in_metres_are_divided_by_the_radius(capsys, tmp_path, unit):
+    """WPILib's swerve odometry takes module positions in metres (SwerveModulePosition.distanceMeters): such a log,
+    'front_left.spin [m]', was refused ('unknown unit 'm''). The header's m (m/s) now reads the wheel's travel
+    (speed), divided by its radius. The modules drive the body twist (1 m/s at 30 deg, 0.5 rad/s): the pose is the
+    closed-form arc, as the same log in rad gives."""
+    from wmrkit.odometry.logs import LogFormat, load_csv
+
+    c = np.radians(30)
+    swerve, t = catalog.load("swerve-4"), np.linspace(0.0, 2.0, 201)
+    commands = wheel_commands(swerve, [np.cos(c), np.sin(c), 0.5])
+    speed = commands.spin * 0.0508  # m/s along each module's heading
+    joints = [f"{w}.spin [{unit}],{w}.steer [deg]" for w in swerve.wheel_names]
+    rows = [f"{a:.6f}," + ",".join(f"{v * a if unit == 'm' else v:.12f},{np.degrees(h):.12f}"
+                                   for v, h in zip(speed, commands.heading, strict=True)) for a in t]
+    path = tmp_path / "modules.csv"
+    path.write_text(f"time,{','.join(joints)}\n" + "\n".join(rows) + "\n")
+    out = _json(capsys, ["odometry", "swerve-4", str(path), "--json"])
+    want = [(np.sin(1 + c) - np.sin(c)) / 0.5, (np.cos(c) - np.cos(1 + c)) / 0.5, 1.0]
+    np.testing.assert_allclose(out["pose"], want, atol=1e-8)
+    assert out["consistent"] is True and out["distance"] == pytest.approx(2.0, rel=1e-9)
+    with pytest.raises(WmrkitError, match=r"spin columns in m or m/s .* need the robot's wheel radii: pass robot="):
+        load_csv(path, ["front_left.spin"], LogFormat(spin="distance" if unit == "m" else "speed"))

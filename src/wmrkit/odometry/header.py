@@ -1,7 +1,8 @@
 """Units written in a CSV log's header: a log says what its columns hold (``docs/odometry.md``).
 
 A column name may carry its unit in brackets: ``time [ms]``, ``left.spin [rad]``, ``left.spin [rad/s]``,
-``left.spin [counts]``, ``left.spin [counts:u16]`` (an incremental encoder on an unsigned 16-bit counter that wraps;
+``left.spin [counts]``, ``left.spin [m]`` or ``[m/s]`` (the wheel's travel or speed, divided by its radius),
+``left.spin [counts:u16]`` (an incremental encoder on an unsigned 16-bit counter that wraps;
 ``s16`` signed, any width from 8 to 64 bits), ``steer.steer [rad]``, ``steer.steer [deg]``, ``steer.steer [counts]``.
 A log written this way needs no ``--spin``/``--steer``/``--counter-bits`` options, and an option that contradicts
 the header is an error rather than a silent misreading.
@@ -26,10 +27,13 @@ from ..errors import WmrkitError
 from ..limits import regular_file_problem
 
 if TYPE_CHECKING:
+    from ..robot import Robot
     from .logs import LogFormat
 
 #: Units a joint column may declare, and the log-format mode each means.
-SPIN_UNITS = {"rad": "angle", "rad/s": "velocity", "counts": "counts"}
+SPIN_UNITS = {"rad": "angle", "rad/s": "velocity", "counts": "counts", "m": "distance", "m/s": "speed"}
+#: The spin modes of :class:`~.logs.LogFormat` (``--spin`` takes the first three; a header's m, m/s the others).
+SPIN_MODES = ("angle", "counts", "velocity", "distance", "speed")
 STEER_UNITS = {"rad": "angle", "deg": "degrees", "counts": "counts"}
 #: Conventions a steering unit may name after a colon (``deg:beta``).
 STEER_CONVENTIONS = ("heading", "beta")
@@ -144,6 +148,18 @@ def parse_header_units(names: list[str], *, source: str = "<log>", time_column: 
     return HeaderUnits(tuple(columns), time_unit, next(iter(modes["spin"]), None), next(iter(modes["steer"]), None),
                        next(iter(bits), None), next(iter(signed), False), next(iter(conventions), None),
                        external_degrees)
+
+
+def travel_radii(joints: Sequence[str], spin: str, robot: Robot | None, source: str) -> np.ndarray | None:
+    """What divides each joint's column into radians: its wheel's radius for spin joints logged as the wheel's
+    travel [m] or speed [m/s] (WPILib's ``SwerveModulePosition.distanceMeters``), 1 for steering; None for other
+    spin modes. Those need the robot (:class:`HeaderError`)."""
+    if spin not in ("distance", "speed"):
+        return None
+    if robot is None:
+        raise HeaderError(f"{source}: spin columns in m or m/s (the wheels' travel) need the robot's wheel radii: "
+                          "pass robot=")
+    return np.array([1.0 if j.endswith(".steer") else robot.wheel(j.rpartition(".")[0]).r for j in joints])
 
 
 def _plain(name: str) -> str:

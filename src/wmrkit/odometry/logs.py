@@ -35,7 +35,7 @@ from ..errors import WmrkitError
 from ..limits import check_chunk_size, regular_file_problem
 from ._text import check_lines, did_you_mean, encoded, read_lines, short
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
-from .header import bare_heading_problem
+from .header import SPIN_MODES, bare_heading_problem, travel_radii
 from .steering import CONVENTIONS, check_robot, check_steer_range, convert_steering
 
 if TYPE_CHECKING:
@@ -132,14 +132,14 @@ class JointLog:
 class LogFormat:
     """How joints are stored in a CSV log; the defaults read ``time`` [s] and ``WHEEL.spin``/``WHEEL.steer`` [rad].
 
-    ``columns``: ``(joint, column)`` pairs renaming columns. ``spin``: ``"angle"`` (cumulative, rad),
-    ``"counts"`` (incremental encoder, see ``encoders``) or ``"velocity"`` (rad/s, integrated by the trapezoidal
-    rule). ``steer``: ``"angle"`` (rad), ``"degrees"`` or ``"counts"`` (absolute encoder readings).
-    ``steer_convention``: ``"heading"`` (0 = rolling straight ahead, the default) or ``"beta"`` (the thesis's
-    angle, files of older wmrkit versions; header ``[deg:beta]``). ``encoders``: ``(joint,
-    encoder)`` pairs for counts. ``heading_column``: absolute heading [rad] (IMU yaw; unwrapped here) replacing
-    the wheels' heading; ``gyro_column``: yaw rate [rad/s] instead (integrated from 0); ``external_degrees``: that
-    column is in deg (deg/s; a header's ``[deg]``, ``[deg/s]``). ``max_gap``: longest
+    ``columns``: ``(joint, column)`` pairs renaming columns. ``spin``: ``"angle"`` (cumulative, rad), ``"counts"``
+    (incremental encoder, see ``encoders``), ``"velocity"`` (rad/s, integrated by the trapezoidal rule), ``"distance"``
+    or ``"speed"`` (the wheel's travel [m] or speed [m/s], divided by its radius; the robot is needed). ``steer``:
+    ``"angle"`` (rad), ``"degrees"`` or ``"counts"`` (absolute encoder readings). ``steer_convention``: ``"heading"``
+    (0 = rolling straight ahead, the default) or ``"beta"`` (the thesis's angle, files of older wmrkit versions;
+    header ``[deg:beta]``). ``encoders``: ``(joint, encoder)`` pairs for counts. ``heading_column``: absolute heading
+    [rad] (IMU yaw; unwrapped here) replacing the wheels' heading; ``gyro_column``: yaw rate [rad/s] instead
+    (integrated from 0); ``external_degrees``: that column is in deg (deg/s; a header's ``[deg]``). ``max_gap``: longest
     time step accepted [s] (None: any). ``time_unit``: one of :data:`TIME_UNITS`. ``max_rate``: largest
     plausible spin rate [rad/s] between two samples (None: any); a faster step is refused as an encoder jump.
     """
@@ -147,7 +147,7 @@ class LogFormat:
     time_column: str = "time"
     time_unit: str = "s"
     columns: tuple[tuple[str, str], ...] = ()
-    spin: Literal["angle", "counts", "velocity"] = "angle"
+    spin: Literal["angle", "counts", "velocity", "distance", "speed"] = "angle"
     steer: Literal["angle", "degrees", "counts"] = "angle"
     encoders: tuple[tuple[str, Encoder], ...] = field(default=())
     heading_column: str | None = None
@@ -174,8 +174,8 @@ class LogFormat:
                 raise LogError(f"LogFormat.{name}: expected a number or None, got {value!r}")
         if self.time_unit not in TIME_UNITS:
             raise LogError(f"unknown time unit '{self.time_unit}' (units: {', '.join(TIME_UNITS)})")
-        if self.spin not in ("angle", "counts", "velocity") or self.steer not in ("angle", "degrees", "counts"):
-            raise LogError(f"spin must be angle, counts or velocity and steer angle, degrees or counts; got "
+        if self.spin not in SPIN_MODES or self.steer not in ("angle", "degrees", "counts"):
+            raise LogError(f"spin must be one of {', '.join(SPIN_MODES)} and steer angle, degrees or counts; got "
                            f"{self.spin}, {self.steer}")
         if self.steer_convention not in CONVENTIONS:
             raise LogError(f"steer_convention must be heading or beta, got {self.steer_convention!r}")
@@ -217,6 +217,7 @@ class Decoder:
         self.joints, self.fmt, self.source, self.robot = joint_names(joints, source), fmt, source, robot
         if fmt.steer_convention == "heading":
             check_robot(self.joints, robot, source)
+        self._radii = travel_radii(self.joints, fmt.spin, robot, source)  # spins in m, m/s: divided into rad
         self._last: np.ndarray | None = None  # last raw row (time, joints, heading)
         self._positions: np.ndarray | None = None  # last decoded positions
         self._heading = 0.0
@@ -232,6 +233,7 @@ class Decoder:
         time = raw[:, 0] * scale
         check_time(probe, time, None if self._last is None else self._last[0] * scale, fmt.max_gap)
         ext = raw if self._last is None else np.vstack([self._last[None], raw])
+        ext = ext if self._radii is None else np.hstack([ext[:, :1], ext[:, 1:1 + n_j] / self._radii, ext[:, 1 + n_j:]])
         ext_time = ext[:, 0] * scale
         pos = np.empty((len(raw), n_j))
         for j, joint in enumerate(self.joints):
@@ -255,9 +257,9 @@ class Decoder:
     def _decode_joint(self, joint: str, col: np.ndarray, t: np.ndarray, prev: float | None, probe: JointLog):
         kind = self.fmt.steer if joint.endswith(".steer") else self.fmt.spin
         new = col if prev is None else col[1:]
-        if kind in ("angle", "degrees"):
+        if kind in ("angle", "degrees", "distance"):  # travel in m: divided by the radius in decode
             return np.radians(new) if kind == "degrees" else new
-        if kind == "velocity":
+        if kind in ("velocity", "speed"):
             return (0.0 if prev is None else prev) + _cumtrapz(col, t, start=prev is None)
         enc = self.fmt.encoder_of(joint, self.source)
         name = f"column '{self.fmt.column_of(joint)}'"
