@@ -151,3 +151,22 @@ def test_swerve_forward_matches_to_chassis_speeds():
     fk, residual = forward_kinematics(swerve, dict(zip(NAMES, speeds / R, strict=True)), heading=angles)
     np.testing.assert_allclose(fk, twist, rtol=1e-12)
     assert residual < 1e-12
+
+
+def test_field_relative_speeds_as_the_docs_rotate_them():
+    """docs/wheel-ik.md, 'Coming from WPILib': the field-relative twist rotated by -theta as written there equals
+    ChassisSpeeds.fromFieldRelativeSpeeds, and wmrkit's swerve IK of it WPILib's module states (speed = spin * r)."""
+    swerve = Robot.from_dict({"name": "sw", "wheels": [
+        {"name": n, "type": "steerable", "position": list(p), "r": R} for n, p in zip(NAMES, CORNERS, strict=True)]})
+    swerve_kin = kin.SwerveDrive4Kinematics(*_translations())
+    rng = np.random.default_rng(11)
+    for (vx_f, vy_f, omega), theta in zip(_twists(50, 5), rng.uniform(-4, 4, 50), strict=True):
+        vx = math.cos(theta) * vx_f + math.sin(theta) * vy_f  # the docs' formula
+        vy = -math.sin(theta) * vx_f + math.cos(theta) * vy_f
+        speeds = kin.ChassisSpeeds.fromFieldRelativeSpeeds(vx_f, vy_f, omega, geo.Rotation2d(theta))
+        np.testing.assert_allclose([vx, vy, omega], [speeds.vx, speeds.vy, speeds.omega], rtol=1e-12, atol=1e-12)
+        c = wheel_commands(swerve, [vx, vy, omega], heading=np.zeros(4))
+        for k, state in enumerate(swerve_kin.toSwerveModuleStates(speeds)):
+            wpi = state.speed * np.array([math.cos(state.angle.radians()), math.sin(state.angle.radians())])
+            ours = c.spin[k] * R * np.array([math.cos(c.heading[k]), math.sin(c.heading[k])])
+            np.testing.assert_allclose(ours, wpi, atol=1e-12)
