@@ -188,6 +188,30 @@ def test_reverse_motion_is_mirrored():
     assert t.forces(FZ, 0, 0, 2.0, -2.0).longitudinal < 0 < t.forces(FZ, 0, 0, -2.0, 2.0).longitudinal
 
 
+@pytest.mark.parametrize(("v", "k9y", "k7y", "k10y", "k9x", "k7x", "k10x"), [
+    (1, 8.2229, 0.7979, 0.9517, 3.2909, 1.1083, -2.7581), (2, 8.9448, 0.7958, 0.9334, 5.0329, 1.0067, -1.7942),
+    (5, 11.7698, 0.7895, 0.8808, 9.9275, 0.8444, -1.8970), (9, 15.6399, 0.7811, 0.8044, 14.5500, 0.7749, -3.1124),
+    (18, 23.3937, 0.7622, 0.6044, 19.7725, 0.7512, -3.1249)])
+def test_pacejka_tyre_is_the_pacejka_package_at_the_spec_coefficients(v, k9y, k7y, k10y, k9x, k7x, k10x):
+    """The whole pacejka tyre (Tyre.forces_at_slip, shifts off, pure slips) against the pacejka package built from
+    the digest's coefficients at each speed (§9.5, 4 decimals; k8 = 1.57 and 1.2 from (7.82)-(7.83)): every
+    point of both curves, the peak, the fall beyond it (k10) and the sign. The package's force has its slip's sign;
+    wmrkit's is the ground's force on the wheel, against the slip (docs/conventions.md): F = -package(s)."""
+    pacejka = pytest.importorskip("pacejka")
+    tyre = Tyre.of("pacejka", {"shifts": 0.0})
+    s = np.linspace(-0.9, 0.9, 181)
+    alpha = np.linspace(-1.5, 1.5, 181)  # radians, within (-pi/2, pi/2)
+    long_peer = pacejka.Tire.from_constants("long", k7y, b_x=k9y, c_x=1.57, e_x=k10y)
+    lat_peer = pacejka.Tire.from_constants("lat", k7x, b_x=1.0, c_x=1.0, e_x=0.0, b_y=k9x, c_y=1.2, e_y=k10x)
+    fx = long_peer.calculate_forces(FZ, 0.0, s, friction_circle=False, alpha_unit="rad")[1]
+    fy = lat_peer.calculate_forces(FZ, alpha, 0.0, friction_circle=False, alpha_unit="rad")[0]
+    ours_long = tyre.forces_at_slip(FZ, s, 0.0, float(v)).longitudinal
+    ours_lat = tyre.forces_at_slip(FZ, 0.0, alpha, float(v)).lateral
+    np.testing.assert_allclose(ours_long, -fx, rtol=0, atol=2e-4 * FZ)  # the table's 4 decimals
+    np.testing.assert_allclose(ours_lat, -fy, rtol=0, atol=2e-4 * FZ)
+    assert ours_long[-1] < 0 < ours_long[0] and ours_lat[-1] < 0 < ours_lat[0]
+
+
 def test_magic_formula_agrees_with_the_pacejka_package():
     pacejka = pytest.importorskip("pacejka")
     b, c, e, mu = 11.0, 1.5, 0.3, 0.9
