@@ -25,6 +25,32 @@ def test_same_start_same_goal_and_the_exact_check_decides(car, slot):
     assert math.isfinite(rs.time_ms) and math.isfinite(ours.time_ms)
 
 
+@pytest.mark.parametrize(("car", "slot"), [(CAR_91, SLOT_91), (CAR_92, SLOT_92)], ids=["9.1", "9.2"])
+def test_reeds_shepp_joins_the_plans_ends_at_the_cars_radius(car, slot):
+    """The comparison's Reeds-Shepp path is rsplan's between the thesis plan's ends (the end of the detection pass,
+    the final pose) at the car's minimum radius h1 / tan(phi_max) (9.27), typed here from the car's table: its
+    length is that path's, its poses start and end there and turn no tighter than that radius, nor does the
+    thesis's path; the test above (RS never longer) would pass a radius too small."""
+    import numpy as np
+    import rsplan.planner
+
+    from wmrkit.parking.planner import plan_parking
+
+    rho = car.h1 / math.tan(car.phi_max)
+    plan = plan_parking(car, slot)
+    moving = [s for s in plan.segments if s.phase >= 2]
+    assert max(abs(s.curvature) for s in moving) <= 1 / rho + 1e-12
+    _, rs = compare(car, slot, repeat=1)
+    start, goal = moving[0].start, plan.final_pose
+    path = rsplan.planner.path(tuple(start), tuple(goal), rho, 0.0, 0.005)
+    assert rs.length == pytest.approx(path.total_length, rel=1e-12)
+    poses = np.array([w.pose_2d_tuple for w in path.waypoints()])
+    np.testing.assert_allclose(poses[[0, -1]], [start, goal], atol=1e-9)
+    step = np.hypot(*np.diff(poses[:, :2], axis=0).T)
+    turn = np.abs(np.diff(np.unwrap(poses[:, 2])))
+    assert (turn[step > 1e-6] / step[step > 1e-6]).max() == pytest.approx(1 / rho, rel=1e-4)  # tight slot: at it
+
+
 def test_the_check_passes_reeds_shepp_on_the_open_road():
     """Not biased: a Reeds-Shepp lane change on the road, away from the slot, has no colliding pose."""
     import numpy as np
