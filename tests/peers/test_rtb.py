@@ -74,3 +74,36 @@ def test_diffsteer_and_unicycle():
         assert ik.feasible
         np.testing.assert_allclose(ik.spin * R, [v - omega * track / 2, v + omega * track / 2], rtol=1e-10,
                                    atol=1e-12)
+
+
+def test_catalog_car_and_bicycle_are_the_toolboxs_bicycle():
+    """The catalog's templates as users take them: `bicycle` (rear wheel at the origin) sensing its rear spin and
+    front heading equals RTB's Bicycle at steer gamma = heading; the `ackermann` car (origin at the rear axle)
+    driven at RTB's Bicycle rate steers its front wheels to the textbook Ackermann angles
+    atan(L omega / (v -+ omega w)) (w = half the track, + left) and spins its rear ones at (v -+ omega w) / r."""
+    from wmrkit import catalog
+
+    bike, car = catalog.load("bicycle"), catalog.load("ackermann")
+    length, r_bike = bike.wheel("front").position[0], bike.wheel("rear").r
+    wheelbase, half = car.wheel("front_left").position
+    r_car = car.wheel("rear_left").r
+    rng = np.random.default_rng(2)
+    for _ in range(40):
+        v, gamma, theta = rng.uniform(0.2, 3.0) * rng.choice([-1, 1]), rng.uniform(-1.2, 1.2), rng.uniform(-3, 3)
+        expected = _to_robot(rtb.Bicycle(L=length, steer_max=1.5).deriv([0, 0, theta], [v, gamma], limits=False),
+                             theta)
+        fk, residual = forward_kinematics(bike, {"rear": v / r_bike}, heading=[gamma])
+        np.testing.assert_allclose(fk, expected, rtol=1e-10, atol=1e-12)
+        assert residual < 1e-12
+        gamma = gamma * 0.5  # within the car's +-40 deg rack on both sides
+        twist = _to_robot(rtb.Bicycle(L=wheelbase, steer_max=1.5).deriv([0, 0, theta], [v, gamma], limits=False),
+                          theta)
+        ik = wheel_commands(car, twist)
+        assert ik.feasible
+        omega = twist[2]
+        names = [w.name for w in car.wheels]
+        heading = dict(zip(names, ik.heading, strict=True))
+        for side, sign in (("left", 1), ("right", -1)):
+            want = math.atan(wheelbase * omega / (v - sign * omega * half))
+            assert heading[f"front_{side}"] == pytest.approx(want, abs=1e-12)
+            assert ik.spin[names.index(f"rear_{side}")] * r_car == pytest.approx(v - sign * omega * half, abs=1e-12)
