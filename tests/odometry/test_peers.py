@@ -175,3 +175,27 @@ def test_swerve_log_in_module_angles_matches_wpilib_odometry(tmp_path, capsys):
     from wmrkit.odometry.trajectories import read_trajectory_csv
 
     np.testing.assert_allclose(read_trajectory_csv(tmp_path / "path.csv").poses, want, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("ratio", [1.0, 0.8])
+def test_skid_steer_odometry_is_wpilibs_differential_drive_at_the_effective_track(tmp_path, ratio):
+    """A four-wheel skid steer (wheels at (+-a, +-b)) read by wmrkit's least squares (ratio 1) or WLS with
+    mu_lateral / mu_longitudinal = k is WPILib's (and ROS diff_drive_controller's) differential drive whose track is
+    the wheels' 2 b times wheel_separation_multiplier m = 1 + k (a / b)^2 (docs/slip.md): on the square catalog
+    robot, no-slip odometry turns half as much as the geometric track says (m = 2), pose by pose."""
+    from wmrkit.odometry.logs import load_csv
+    from wmrkit.slip.weights import SlipWeights, wls_model
+
+    robot = catalog.load("skid-steer-4")
+    names = ("front_left", "front_right", "rear_left", "rear_right")
+    a, b = robot.wheel("front_left").position
+    rng = np.random.default_rng(5)
+    time = np.arange(401) * 0.02
+    sides = np.cumsum(np.vstack([[0, 0], rng.normal([0.008, 0.012], 0.004, (400, 2))]), axis=0)  # left, right [m]
+    _csv(tmp_path / "skid.csv", names, time, sides[:, [0, 1, 0, 1]] / robot.wheel("front_left").r)
+    peer = kin.DifferentialDriveKinematics(2 * b * (1 + ratio * (a / b) ** 2))
+    want = _wpilib_poses(peer.toTwist2d(*map(float, d)) for d in np.diff(sides, axis=0))
+    model = wls_model(robot, SlipWeights.uniform(ratio, 1.0)) if ratio != 1.0 else odometry_model(robot)
+    got = odometry(model, load_csv(tmp_path / "skid.csv", model.joints, robot=robot)).poses
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+    assert abs(want[-1, 2]) > 1.0  # it turned
