@@ -116,6 +116,18 @@ def test_skew_free_matches_wpilib():
     got = discretize_twist([1.0, 0.3, 2.0], 0.02)
     want = kin.ChassisSpeeds.discretize(kin.ChassisSpeeds(1.0, 0.3, 2.0), 0.02)
     np.testing.assert_allclose(got, [want.vx, want.vy, want.omega], atol=1e-12)
+    rng = np.random.default_rng(8)
+    for twist, dt in zip(rng.normal(size=(200, 3)) * [1.0, 1.0, 3.0], rng.uniform(0.005, 0.5, 200), strict=True):
+        if abs(twist[2] * dt) < 3.0:  # within half a turn a period (below)
+            want = kin.ChassisSpeeds.discretize(kin.ChassisSpeeds(*twist), float(dt))
+            # WPILib's Pose2d.log divides by cos(dtheta) - 1: about 1e-16 / dtheta^2 relative at small turns
+            np.testing.assert_allclose(discretize_twist(twist, dt), [want.vx, want.vy, want.omega], rtol=1e-8,
+                                       atol=1e-12)
+    # beyond half a turn a period WPILib wraps the period's turn into (-pi, pi] (another omega); wmrkit keeps it
+    want = kin.ChassisSpeeds.discretize(kin.ChassisSpeeds(0.5, 0.2, 3.0), 2.0)
+    assert want.omega == pytest.approx(3.0 - math.pi, abs=1e-12) and discretize_twist([0.5, 0.2, 3.0], 2.0)[2] == 3.0
+    end = integrate_exact([0.0, 0.0, 0.0], discretize_twist([0.5, 0.2, 3.0], 2.0), 2.0)
+    np.testing.assert_allclose(end, [1.0, 0.4, 6.0], atol=1e-12)
 
 
 def test_skew_free_discrete_loop_removes_the_drift_of_translating_while_rotating():
