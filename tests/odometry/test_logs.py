@@ -328,3 +328,22 @@ def test_a_log_format_takes_its_pairs_as_a_mapping(tmp_path):
     log = load_csv(path, JOINTS, LogFormat(columns={"left.spin": "enc_l", "right.spin": "enc_r"}))
     np.testing.assert_array_equal(log.positions, [[0, 0], [1, 2]])
     assert LogFormat(columns={"left.spin": "enc_l"}) == LogFormat(columns=(("left.spin", "enc_l"),))
+
+
+def test_a_header_with_units_read_without_its_format_names_header_format(tmp_path):
+    """A log with units in its header (as docs/odometry.md asks, as 'wmrkit simulate --out' writes) given to
+    load_csv with the default format said "missing column 'time' (did you mean 'time [s]'?)": no argument can follow
+    that hint (the joints are not named with units). The message names header_format, and following it reads the
+    log as 'wmrkit odometry' does."""
+    from wmrkit.odometry.header import header_format
+
+    robot = catalog.load("diff-drive")
+    path = tmp_path / "units.csv"
+    write_csv(path, ("time [ms]", "left.spin [rad]", "right.spin [rad]"), np.array([[0, 0, 0], [100, 1, 2.0]]))
+    with pytest.raises(LogError, match=r"units\.csv:1: missing column 'time': the header gives its unit \('time "
+                                       r"\[ms\]'\); read the units it declares with fmt=header_format\(path, "):
+        load_csv(path, ("left.spin", "right.spin"), robot=robot)
+    log = load_csv(path, ("left.spin", "right.spin"), header_format(path, robot.name, ("left.spin", "right.spin")),
+                   robot=robot)
+    np.testing.assert_allclose(log.time, [0.0, 0.1])
+    np.testing.assert_allclose(log.positions, [[0, 0], [1, 2]])

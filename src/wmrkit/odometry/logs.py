@@ -448,6 +448,11 @@ def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: S
     for name in wanted:
         if name not in header:
             unread = [h for h in header if h not in wanted]  # not a column read for another joint
+            unit = next((h for h in unread if h.startswith(f"{name} [") and h.endswith("]")), None)
+            if unit is not None:  # 'did you mean 'time [s]'?' named nothing a caller could pass
+                raise LogError(f"{source}:1: missing column '{name}': the header gives its unit ('{unit}'); read the "
+                               "units it declares with fmt=header_format(path, robot.name, joints) "
+                               "(wmrkit.odometry.header), as 'wmrkit odometry' does")
             close = difflib.get_close_matches(name, unread, n=1)
             hint = f" (did you mean '{close[0]}'?)" if close else ""
             raise LogError(f"{source}:1: missing column '{name}'{hint} (columns: {short(', '.join(header), 200)})")
