@@ -2,7 +2,8 @@
 
 Rows are read in bounded pieces (:data:`MAX_LINE`), so a file whose tail is one endless "line" (a logger's
 preallocated block of NUL bytes after a power loss, a binary file) costs no more memory than a chunk. The text
-of the readers' messages too: a field quoted short, a did-you-mean for a misspelt joint.
+of the readers' messages too: a field quoted short, a did-you-mean for a misspelt joint; and the rows' numbers
+(:func:`parse_rows`).
 """
 
 from __future__ import annotations
@@ -111,3 +112,28 @@ def did_you_mean(joint: str, wheels: Sequence[str], taken: Sequence[str] = ()) -
 def short(text: str, limit: int = 40) -> str:
     """`text` quoted for a message, cut to about `limit` characters."""
     return repr(text) if len(text) <= limit else repr(text[:limit]) + f"... ({len(text)} characters)"
+
+
+def parse_rows(rows: list[str], usecols: list[int], delimiter: str, source: str, line: int, lines: list[str],
+               header: list[str]) -> np.ndarray:
+    """The numbers of the columns `usecols` of `rows` ``(R, len(usecols))``; a field that is not a number is refused
+    naming its line and its column as the header writes it."""
+    if not rows:
+        return np.zeros((0, len(usecols)))
+    try:
+        return np.loadtxt(rows, delimiter=delimiter, usecols=usecols, ndmin=2, comments=None, dtype=float)
+    except ValueError:  # field counts are already checked (check_lines): a field is not a number
+        pass
+    for k, ln in enumerate(lines):  # error path: find the first bad line
+        if not ln.strip():
+            continue
+        fields = ln.strip("\r\n").split(delimiter)
+        if len(fields) != len(header):
+            raise _error(f"{source}:{line + k}: expected {len(header)} fields, got {len(fields)}")
+        for c in usecols:
+            try:
+                float(fields[c])
+            except ValueError:
+                raise _error(f"{source}:{line + k}: column '{header[c]}': cannot read {short(fields[c].strip())} "
+                             f"as a number (field {c + 1})") from None
+    raise _error(f"{source}:{line}: cannot read the rows that start here")  # pragma: no cover

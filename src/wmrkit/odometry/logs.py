@@ -33,7 +33,7 @@ import numpy as np
 from .._shapes import as_names, as_reals
 from ..errors import WmrkitError
 from ..limits import check_chunk_size, regular_file_problem
-from ._text import check_lines, did_you_mean, encoded, read_lines, short
+from ._text import check_lines, did_you_mean, encoded, parse_rows, read_lines, short
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
 from .header import SPIN_MODES, bare_heading_problem, travel_radii
 from .steering import CONVENTIONS, check_robot, check_steer_range, convert_steering
@@ -367,7 +367,7 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
                 break
             keep = check_lines(lines, fmt.delimiter, len(header), source, line)
             rows = lines if keep is None else [ln for ln, k in zip(lines, keep, strict=True) if k]
-            raw = _parse(rows, usecols, fmt.delimiter, source, line, lines, header)
+            raw = parse_rows(rows, usecols, fmt.delimiter, source, line, lines, header)
             if raw.size:
                 yield decoder.decode(raw, line if len(rows) == len(lines) else None, index)
             if progress is not None:
@@ -457,31 +457,6 @@ def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: S
             hint = f" (did you mean '{close[0]}'?)" if close else ""
             raise LogError(f"{source}:1: missing column '{name}'{hint} (columns: {short(', '.join(header), 200)})")
     return [header.index(n) for n in wanted]
-
-
-def _parse(rows: list[str], usecols: list[int], delimiter: str, source: str, line: int, lines: list[str],
-           header: list[str]) -> np.ndarray:
-    """The numbers of the columns `usecols` of `rows` ``(R, len(usecols))``; a field that is not a number is refused
-    naming its line and its column as the header writes it."""
-    if not rows:
-        return np.zeros((0, len(usecols)))
-    try:
-        return np.loadtxt(rows, delimiter=delimiter, usecols=usecols, ndmin=2, comments=None, dtype=float)
-    except ValueError:  # field counts are already checked (check_lines): a field is not a number
-        pass
-    for k, ln in enumerate(lines):  # error path: find the first bad line
-        if not ln.strip():
-            continue
-        fields = ln.strip("\r\n").split(delimiter)
-        if len(fields) != len(header):
-            raise LogError(f"{source}:{line + k}: expected {len(header)} fields, got {len(fields)}")
-        for c in usecols:
-            try:
-                float(fields[c])
-            except ValueError:
-                raise LogError(f"{source}:{line + k}: column '{header[c]}': cannot read {short(fields[c].strip())} "
-                               f"as a number (field {c + 1})") from None
-    raise LogError(f"{source}:{line}: cannot read the rows that start here")  # pragma: no cover
 
 
 def _check_finite(log: JointLog, raw: np.ndarray, fmt: LogFormat) -> None:
