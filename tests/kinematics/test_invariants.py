@@ -1,0 +1,144 @@
+"""Invariants over random robots (tests/strategies.py): what must hold for ANY valid robot.
+
+Each transformed robot is built here field by field from the thesis's geometry (3.8), independently of the library:
+
+- frame change: the reference point moved to c and the frame turned by phi. A wheel at p sits at R(-phi)(p - c) with
+  its angles turned by -phi; the twist at the new point is v' = R(-phi)(v + omega z x c), omega' = omega; every
+  joint rate is unchanged and every heading turns by -phi.
+- mirror in y (x, y) -> (x, -y): directions theta -> -theta. A wheel keeps its spin sign if its rolling direction
+  (heading = beta + delta - 90 deg) is mirrored, so beta' = pi - beta, delta' = -delta, gamma' = -gamma (the roller's
+  axis line mirrored), d' = d; a double unit's axle then points the other way, so spin1 and spin2 swap. The twist
+  (vx, vy, omega) -> (vx, -vy, -omega). A joint rate is a pseudovector w u about its axis u: mirrored it is
+  -M(w u) = w (-M u), and the mirrored wheel's spin and roller axes are -M u, so those rates keep their sign; the
+  steering axis z is kept (M z = z), so steering rates change sign. Ball and orthogonal wheels have gamma = 90 deg
+  by type, not -90 deg: their roller axis keeps its line but points the other way, so their roller rate changes sign.
+- scale: every length times k: (vx, vy, omega) -> (k vx, k vy, omega) with the same joint rates.
+- wheel order: the per-wheel results permute with the wheels, the twist does not change.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+from strategies import robots
+from wmrkit import Robot, forward_kinematics, wheel_commands
+from wmrkit.kinematics.linalg import LENGTH_FIELDS
+from wmrkit.kinematics.wheel_ik import twist_is_determined
+
+_twists = st.lists(st.floats(-2, 2), min_size=3, max_size=3).map(np.array)
+
+
+def _wrap(a):
+    """Angles into (-pi, pi]."""
+    return np.pi - np.mod(np.pi - np.asarray(a), 2 * np.pi)
+
+
+def _moved(robot: Robot, c, phi: float) -> Robot:
+    """`robot` described from a frame at `c` (old frame) turned by `phi`."""
+    rot = np.array([[math.cos(phi), math.sin(phi)], [-math.sin(phi), math.cos(phi)]])  # R(-phi)
+    wheels = []
+    for w in robot.wheels:
+        x, y = rot @ (np.array([w.l * math.cos(w.alpha), w.l * math.sin(w.alpha)]) - c)
+        wheels.append(replace(w, l=math.hypot(x, y), alpha=math.atan2(y, x), beta=float(_wrap(w.beta - phi))))
+    return replace(robot, wheels=tuple(wheels))
+
+
+def _mirrored(robot: Robot) -> Robot:
+    return replace(robot, wheels=tuple(replace(w, alpha=-w.alpha, beta=float(_wrap(math.pi - w.beta)), delta=-w.delta,
+                                               gamma=-w.gamma) for w in robot.wheels))
+
+
+def _rates(robot: Robot, commands) -> dict[str, float]:
+    return dict(zip(robot.rate_names, commands.rates.tolist(), strict=True))
+
+
+def _defined(commands) -> bool:
+    """No angle held (undefined: a policy, not a solution) and every heading clear of the +-pi wrap."""
+    return not commands.held.any() and not (np.abs(np.abs(commands.heading[np.isfinite(commands.heading)])
+                                                   - np.pi) < 1e-6).any()
+
+
+def _scale(robot: Robot, twist) -> float:
+    return 1.0 + float(np.abs(twist).sum()) * (1 + max(w.l + abs(w.d) + w.b for w in robot.wheels))
+
+
+@settings(max_examples=60)
+@given(robot=robots(max_wheels=4), twist=_twists, c=st.lists(st.floats(-1, 1), min_size=2, max_size=2).map(np.array),
+       phi=st.floats(-math.pi, math.pi))
+def test_moving_the_reference_frame_transforms_the_twist_and_keeps_the_joint_rates(robot, twist, c, phi):
+    moved = _moved(robot, c, phi)
+    assume(all(w.l > 1e-3 or w.type in ("fixed", "swedish", "ball", "orthogonal") for w in moved.wheels))
+    rot = np.array([[math.cos(phi), math.sin(phi)], [-math.sin(phi), math.cos(phi)]])
+    v = rot @ (twist[:2] + twist[2] * np.array([-c[1], c[0]]))
+    twist2 = np.array([*v, twist[2]])
+    a, b = wheel_commands(robot, twist), wheel_commands(moved, twist2)
+    assume(_defined(a) and _defined(b))
+    tol = 1e-9 * _scale(robot, twist)
+    np.testing.assert_allclose(b.rates, a.rates, atol=tol)
+    np.testing.assert_allclose(b.slip, a.slip, atol=tol)
+    np.testing.assert_array_equal(b.feasible, a.feasible)
+    steered = np.isfinite(a.heading)
+    np.testing.assert_array_equal(np.isfinite(b.heading), steered)
+    np.testing.assert_allclose(_wrap(b.heading[steered] - a.heading[steered] + phi), 0.0, atol=1e-9)
+    # fk: the same joint rates give the moved twist back
+    got, res = forward_kinematics(robot, _rates(robot, a), a.beta)
+    got2, res2 = forward_kinematics(moved, _rates(moved, b), b.beta)
+    np.testing.assert_allclose(res2, res, atol=1e-7 * _scale(robot, twist))
+    if not twist_is_determined(robot, list(robot.rate_names), a.beta):
+        return  # the minimum-norm twist of underdetermined rates depends on the frame
+    v_got = rot @ (got[:2] + got[2] * np.array([-c[1], c[0]]))
+    np.testing.assert_allclose(got2, [*v_got, got[2]], atol=1e-6 * _scale(robot, twist))
+
+
+@settings(max_examples=60)
+@given(robot=robots(max_wheels=4), twist=_twists)
+def test_a_robot_mirrored_in_y_mirrors_the_twist_and_keeps_the_spins(robot, twist):
+    mirror = _mirrored(robot)
+    m_twist = twist * np.array([1.0, -1.0, -1.0])
+    a, b = wheel_commands(robot, twist), wheel_commands(mirror, m_twist)
+    assume(_defined(a) and _defined(b))
+    tol = 1e-9 * _scale(robot, twist)
+    ra, rb = _rates(robot, a), _rates(mirror, b)
+    for name, value in ra.items():
+        wheel, _, joint = name.partition(".")
+        other = {"spin1": "spin2", "spin2": "spin1"}.get(joint, joint)
+        fixed_gamma = joint == "roller" and robot.wheel(wheel).type != "swedish"  # gamma = 90 deg, not -90 deg
+        expected = -value if joint == "steer" or fixed_gamma else value
+        assert math.isclose(rb[f"{wheel}.{other}"], expected, abs_tol=tol), (name, rb, ra)
+    np.testing.assert_allclose(np.abs(b.slip), np.abs(a.slip), atol=tol)
+    np.testing.assert_array_equal(b.feasible, a.feasible)
+    steered = np.isfinite(a.heading)
+    np.testing.assert_allclose(_wrap(b.heading[steered] + a.heading[steered]), 0.0, atol=1e-9)
+    got, _ = forward_kinematics(robot, ra, a.beta)
+    got2, _ = forward_kinematics(mirror, rb, b.beta)
+    np.testing.assert_allclose(got2, got * np.array([1.0, -1.0, -1.0]), atol=1e-6 * _scale(robot, twist))
+
+
+@settings(max_examples=40)
+@given(robot=robots(max_wheels=4), twist=_twists, k=st.floats(1e-3, 1e3))
+def test_every_length_times_k_scales_the_linear_velocities_and_keeps_the_joint_rates(robot, twist, k):
+    scaled = replace(robot, wheels=tuple(replace(w, **{f: getattr(w, f) * k for f in LENGTH_FIELDS})
+                                         for w in robot.wheels))
+    a, b = wheel_commands(robot, twist), wheel_commands(scaled, twist * np.array([k, k, 1.0]))
+    assume(_defined(a) and _defined(b))
+    np.testing.assert_allclose(b.rates, a.rates, atol=1e-9 * _scale(robot, twist))
+    np.testing.assert_allclose(b.slip, a.slip * k, atol=1e-9 * k * _scale(robot, twist))
+    np.testing.assert_allclose(b.heading, a.heading, atol=1e-9)
+    np.testing.assert_array_equal(b.feasible, a.feasible)
+
+
+@settings(max_examples=40)
+@given(robot=robots(max_wheels=4), twist=_twists, data=st.data())
+def test_reordering_the_wheels_permutes_the_results_and_nothing_else(robot, twist, data):
+    order = data.draw(st.permutations(range(len(robot.wheels))))
+    shuffled = replace(robot, wheels=tuple(robot.wheels[i] for i in order))
+    a, b = wheel_commands(robot, twist), wheel_commands(shuffled, twist)
+    for field in ("spin", "steer_rate", "slip", "heading", "held", "in_range"):
+        np.testing.assert_array_equal(getattr(b, field), getattr(a, field)[list(order)], err_msg=field)
+    assert _rates(shuffled, b) == _rates(robot, a)
+    assert bool(b.feasible) == bool(a.feasible)
