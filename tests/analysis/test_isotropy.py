@@ -10,7 +10,7 @@ from scipy.optimize import brentq
 from thesis_vehicles import DEG, differential, omni_castor, omni_swedish, type3
 
 from circle import assert_same_angles
-from wmrkit import UnknownNameError, catalog
+from wmrkit import Robot, UnknownNameError, Wheel, catalog, wheel_commands
 from wmrkit.analysis.isotropy import (
     condition_map,
     condition_number,
@@ -22,6 +22,7 @@ from wmrkit.analysis.isotropy import (
     twist_model,
 )
 from wmrkit.analysis.optimize import best_configurations, isotropic_configurations
+from wmrkit.analysis.singularity import robot_size
 
 
 def _roots(f, lo=-np.pi, hi=np.pi, n=2880):
@@ -366,3 +367,21 @@ def test_fewer_joints_than_the_mobility_cannot_tell_the_motions_apart(name, join
     many = np.tile(robot.beta, (5000, 1))  # beyond the SVD route's batch size
     assert np.isinf(twist_condition_number(robot, many, joints=joints)).all()
     assert np.isinf(condition_number(np.ones((4, 2, 3)))).all() and condition_number(np.eye(3)[:, :2]) == 1
+
+
+@pytest.mark.parametrize("k", [1.0, 0.01, 3.0])
+def test_joints_blind_to_rotation_have_no_natural_length(k):
+    """A type-2 robot whose spins do not see omega: a fixed wheel and a double castor, both mounted at the origin (the
+    castor's steering takes the rotation). kappa is infinite at every length, but the m = 2 closed form D = |h_omega|
+    / |h_v| took |h_omega|'s round-off: 'condition number 1.084 at the natural length D = 1.613e-18 m' (wmrkit
+    analyze), 1.213 at D = 2.2e-20 m for the same robot at a hundredth of its size."""
+    robot = Robot(name="blind", wheels=(
+        Wheel(name="c", type="double_castor", l=0.0, alpha=0.0, beta=0.0, r=0.01 * k, d=-0.47 * k, b=0.01 * k),
+        Wheel(name="f", type="fixed", l=0.0, alpha=0.0, beta=0.0, r=0.01 * k)))
+    joints = default_joints(robot)
+    assert joints == ("c.spin1", "c.spin2", "f.spin")
+    spins = wheel_commands(robot, [0.0, 0.0, 1.0]).velocity([0.0, 0.0, 1.0])  # turning on the spot moves no spin
+    np.testing.assert_allclose([spins[robot.velocity_index(j)] for j in joints], 0.0, atol=1e-12)
+    length, kappa = natural_length(robot)
+    assert np.isinf(kappa) and length == robot_size(robot)
+    assert np.isinf(twist_condition_number(robot, length=length))

@@ -227,7 +227,9 @@ def _natural_length(model: TwistModel, beta: np.ndarray, size: float) -> tuple[f
     if model.mobility == 2:
         a, b, ok = _fast.columns_m2(rates, lines)
         v, w = float(np.linalg.norm(a)), float(np.linalg.norm(b))
-        length = w / v if ok[0] and v > 0 and w > 0 else size
+        # joints blind to omega (|h_omega| round-off of 0 at the robot's size, below condition_number's threshold):
+        # kappa is infinite at every D, as at the size; w / v was a length of 1e-18 m with a kappa of round-off
+        length = w / v if ok[0] and v > 0 and w > 1e-13 * v * size else size
         if not ok[0]:  # kappa_cm's value, with these columns
             return length, np.nan
         return length, float(condition_number(np.stack([a[:, 0], b[:, 0] / length], axis=-1)))
