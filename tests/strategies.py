@@ -1,4 +1,5 @@
-"""Hypothesis strategies for random regular wheels and robots (``from strategies import wheels, robots``).
+"""Hypothesis strategies for random regular wheels and robots (``from strategies import wheels, robots``), and the
+transformed robots of the invariance tests (:func:`moved`, :func:`mirrored`, :func:`scaled`), built field by field.
 
 The test root is put on ``sys.path`` by ``tests/conftest.py``, so every test folder can import this module.
 """
@@ -6,6 +7,7 @@ The test root is put on ``sys.path`` by ``tests/conftest.py``, so every test fol
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from hypothesis import strategies as st
 
@@ -43,3 +45,37 @@ def robots(draw, max_wheels: int = 4) -> Robot:
     n = draw(st.integers(1, max_wheels))
     return Robot(name=draw(st.sampled_from(["r", "rover", "test-bot"])),
                  wheels=tuple(draw(wheels(name=f"w{i}")) for i in range(n)))
+
+
+def moved(robot: Robot, c: tuple[float, float], phi: float) -> Robot:
+    """`robot` described from a frame at `c` (in its frame) turned by `phi`: a wheel at p sits at R(-phi)(p - c) with
+    its angles turned by -phi (3.8); a twist becomes R(-phi)(v + omega z x c), omega (:func:`moved_twist`)."""
+    cos, sin = math.cos(phi), math.sin(phi)
+    wheels = []
+    for w in robot.wheels:
+        x, y = w.l * math.cos(w.alpha) - c[0], w.l * math.sin(w.alpha) - c[1]
+        x, y = cos * x + sin * y, -sin * x + cos * y
+        beta = math.remainder(w.beta - phi, math.tau)
+        wheels.append(replace(w, l=math.hypot(x, y), alpha=math.atan2(y, x), beta=beta))
+    return replace(robot, wheels=tuple(wheels))
+
+
+def moved_twist(twist, c: tuple[float, float], phi: float) -> tuple[float, float, float]:
+    """The twist ``(vx, vy, omega)`` of the robot's origin as the twist of the frame of :func:`moved`."""
+    vx, vy, w = (float(v) for v in twist)
+    vx, vy = vx - w * c[1], vy + w * c[0]
+    return (math.cos(phi) * vx + math.sin(phi) * vy, -math.sin(phi) * vx + math.cos(phi) * vy, w)
+
+
+def mirrored(robot: Robot) -> Robot:
+    """`robot` mirrored in y, each wheel rolling along its mirrored direction with the same spin sign (heading ->
+    -heading), so beta -> pi - beta, delta -> -delta, gamma -> -gamma (the roller's axis line mirrored), d kept; a
+    double unit's axle then points the other way (spin1 and spin2 swap sides); a twist becomes (vx, -vy, -omega)."""
+    return replace(robot, wheels=tuple(replace(w, alpha=-w.alpha, beta=math.remainder(math.pi - w.beta, math.tau),
+                                               delta=-w.delta, gamma=-w.gamma) for w in robot.wheels))
+
+
+def scaled(robot: Robot, k: float) -> Robot:
+    """`robot` with every length (l, r, r_r, d, b) times `k`."""
+    return replace(robot, wheels=tuple(replace(w, l=w.l * k, r=w.r * k, r_r=w.r_r * k, d=w.d * k, b=w.b * k)
+                                       for w in robot.wheels))

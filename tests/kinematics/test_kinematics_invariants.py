@@ -1,6 +1,7 @@
 """Invariants over random robots (tests/strategies.py): what must hold for ANY valid robot.
 
-Each transformed robot is built here field by field from the thesis's geometry (3.8), independently of the library:
+Each transformed robot is built field by field from the thesis's geometry (3.8), independently of the library
+(tests/strategies.py: moved, mirrored, scaled):
 
 - frame change: the reference point moved to c and the frame turned by phi. A wheel at p sits at R(-phi)(p - c) with
   its angles turned by -phi; the twist at the new point is v' = R(-phi)(v + omega z x c), omega' = omega; every
@@ -25,9 +26,8 @@ import numpy as np
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from strategies import robots
+from strategies import mirrored, moved, moved_twist, robots, scaled
 from wmrkit import Robot, forward_kinematics, wheel_commands
-from wmrkit.kinematics.linalg import LENGTH_FIELDS
 from wmrkit.kinematics.wheel_ik import twist_is_determined
 
 _twists = st.lists(st.floats(-2, 2), min_size=3, max_size=3).map(np.array)
@@ -36,21 +36,6 @@ _twists = st.lists(st.floats(-2, 2), min_size=3, max_size=3).map(np.array)
 def _wrap(a):
     """Angles into (-pi, pi]."""
     return np.pi - np.mod(np.pi - np.asarray(a), 2 * np.pi)
-
-
-def _moved(robot: Robot, c, phi: float) -> Robot:
-    """`robot` described from a frame at `c` (old frame) turned by `phi`."""
-    rot = np.array([[math.cos(phi), math.sin(phi)], [-math.sin(phi), math.cos(phi)]])  # R(-phi)
-    wheels = []
-    for w in robot.wheels:
-        x, y = rot @ (np.array([w.l * math.cos(w.alpha), w.l * math.sin(w.alpha)]) - c)
-        wheels.append(replace(w, l=math.hypot(x, y), alpha=math.atan2(y, x), beta=float(_wrap(w.beta - phi))))
-    return replace(robot, wheels=tuple(wheels))
-
-
-def _mirrored(robot: Robot) -> Robot:
-    return replace(robot, wheels=tuple(replace(w, alpha=-w.alpha, beta=float(_wrap(math.pi - w.beta)), delta=-w.delta,
-                                               gamma=-w.gamma) for w in robot.wheels))
 
 
 def _rates(robot: Robot, commands) -> dict[str, float]:
@@ -71,12 +56,8 @@ def _scale(robot: Robot, twist) -> float:
 @given(robot=robots(max_wheels=4), twist=_twists, c=st.lists(st.floats(-1, 1), min_size=2, max_size=2).map(np.array),
        phi=st.floats(-math.pi, math.pi))
 def test_moving_the_reference_frame_transforms_the_twist_and_keeps_the_joint_rates(robot, twist, c, phi):
-    moved = _moved(robot, c, phi)
-    assume(all(w.l > 1e-3 or w.type in ("fixed", "swedish", "ball", "orthogonal") for w in moved.wheels))
-    rot = np.array([[math.cos(phi), math.sin(phi)], [-math.sin(phi), math.cos(phi)]])
-    v = rot @ (twist[:2] + twist[2] * np.array([-c[1], c[0]]))
-    twist2 = np.array([*v, twist[2]])
-    a, b = wheel_commands(robot, twist), wheel_commands(moved, twist2)
+    other = moved(robot, c, phi)
+    a, b = wheel_commands(robot, twist), wheel_commands(other, moved_twist(twist, c, phi))
     assume(_defined(a) and _defined(b))
     tol = 1e-9 * _scale(robot, twist)
     np.testing.assert_allclose(b.rates, a.rates, atol=tol)
@@ -87,18 +68,17 @@ def test_moving_the_reference_frame_transforms_the_twist_and_keeps_the_joint_rat
     np.testing.assert_allclose(_wrap(b.heading[steered] - a.heading[steered] + phi), 0.0, atol=1e-9)
     # fk: the same joint rates give the moved twist back
     got, res = forward_kinematics(robot, _rates(robot, a), a.beta)
-    got2, res2 = forward_kinematics(moved, _rates(moved, b), b.beta)
+    got2, res2 = forward_kinematics(other, _rates(other, b), b.beta)
     np.testing.assert_allclose(res2, res, atol=1e-7 * _scale(robot, twist))
     if not twist_is_determined(robot, list(robot.rate_names), a.beta):
         return  # the minimum-norm twist of underdetermined rates depends on the frame
-    v_got = rot @ (got[:2] + got[2] * np.array([-c[1], c[0]]))
-    np.testing.assert_allclose(got2, [*v_got, got[2]], atol=1e-6 * _scale(robot, twist))
+    np.testing.assert_allclose(got2, moved_twist(got, c, phi), atol=1e-6 * _scale(robot, twist))
 
 
 @settings(max_examples=60)
 @given(robot=robots(max_wheels=4), twist=_twists)
 def test_a_robot_mirrored_in_y_mirrors_the_twist_and_keeps_the_spins(robot, twist):
-    mirror = _mirrored(robot)
+    mirror = mirrored(robot)
     m_twist = twist * np.array([1.0, -1.0, -1.0])
     a, b = wheel_commands(robot, twist), wheel_commands(mirror, m_twist)
     assume(_defined(a) and _defined(b))
@@ -122,9 +102,7 @@ def test_a_robot_mirrored_in_y_mirrors_the_twist_and_keeps_the_spins(robot, twis
 @settings(max_examples=40)
 @given(robot=robots(max_wheels=4), twist=_twists, k=st.floats(1e-3, 1e3))
 def test_every_length_times_k_scales_the_linear_velocities_and_keeps_the_joint_rates(robot, twist, k):
-    scaled = replace(robot, wheels=tuple(replace(w, **{f: getattr(w, f) * k for f in LENGTH_FIELDS})
-                                         for w in robot.wheels))
-    a, b = wheel_commands(robot, twist), wheel_commands(scaled, twist * np.array([k, k, 1.0]))
+    a, b = wheel_commands(robot, twist), wheel_commands(scaled(robot, k), twist * np.array([k, k, 1.0]))
     assume(_defined(a) and _defined(b))
     np.testing.assert_allclose(b.rates, a.rates, atol=1e-9 * _scale(robot, twist))
     np.testing.assert_allclose(b.slip, a.slip * k, atol=1e-9 * k * _scale(robot, twist))

@@ -1,0 +1,65 @@
+"""Analysis invariants over random robots (tests/strategies.py: moved, mirrored, scaled, built field by field):
+the twist condition number at a length D (5.28) and the natural length do not depend on how the robot frame is
+turned, on a mirror image (with spin1/spin2 swapped), on the wheel order, and scale as D with the robot (kappa
+unchanged with D times k); the ICR (5.9)-(5.10) is a point of the plane: it moves with the frame, is mirrored
+with the robot and scales with it."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from strategies import mirrored, moved, robots, scaled
+from wmrkit.analysis.icr import icr
+from wmrkit.analysis.isotropy import default_joints, natural_length, twist_condition_number
+
+
+def _same(a, b, rtol):
+    """Equal to `rtol`, infinities and NaN at the same places."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    np.testing.assert_array_equal(np.isinf(a), np.isinf(b))
+    np.testing.assert_array_equal(np.isnan(a), np.isnan(b))
+    np.testing.assert_allclose(a[np.isfinite(a)], b[np.isfinite(b)], rtol=rtol, atol=1e-9)
+
+
+@settings(max_examples=40)
+@given(robot=robots(max_wheels=4), phi=st.floats(-3, 3), k=st.floats(0.01, 100), length=st.floats(0.05, 2),
+       data=st.data())
+def test_kappa_and_the_natural_length_ignore_frame_turns_mirrors_and_order_and_scale_with_the_robot(
+        robot, phi, k, length, data):
+    joints = default_joints(robot)
+    swapped = tuple(j.replace("spin1", "#").replace("spin2", "spin1").replace("#", "spin2") for j in joints)
+    order = data.draw(st.permutations(range(len(robot.wheels))))
+    kappa = twist_condition_number(robot, joints=joints, length=length)
+    d, kappa_d = natural_length(robot, joints=joints)
+    for other, js, factor in ((moved(robot, (0.0, 0.0), phi), joints, 1.0), (mirrored(robot), swapped, 1.0),
+                              (replace(robot, wheels=tuple(robot.wheels[i] for i in order)), joints, 1.0),
+                              (scaled(robot, k), joints, k)):
+        _same(twist_condition_number(other, joints=js, length=length * factor), kappa, 1e-6)
+        d2, kappa_d2 = natural_length(other, joints=js)
+        _same(kappa_d2, kappa_d, 1e-4)
+        if math.isfinite(kappa_d):  # where kappa is infinite every D is as bad: no length to compare
+            assert math.isclose(d2, d * factor, rel_tol=1e-3)
+
+
+@settings(max_examples=80)
+@given(robot=robots(max_wheels=4), c=st.tuples(st.floats(-1, 1), st.floats(-1, 1)), phi=st.floats(-3, 3),
+       k=st.floats(0.01, 100))
+def test_the_icr_moves_with_the_frame_is_mirrored_and_scales_with_the_robot(robot, c, phi, k):
+    rot = np.array([[math.cos(phi), math.sin(phi)], [-math.sin(phi), math.cos(phi)]])
+    here = icr(robot)
+    for other, point, direction in (
+            (moved(robot, c, phi), lambda p: rot @ (p - c), lambda d: rot @ d),
+            (mirrored(robot), lambda p: p * [1, -1], lambda d: d * [1, -1]),
+            (scaled(robot, k), lambda p: p * k, lambda d: d)):
+        there = icr(other)
+        assert there.kind == here.kind
+        if here.kind == "point":
+            np.testing.assert_allclose(there.point, point(np.array(here.point)), rtol=1e-6, atol=1e-6 * (1 + k))
+        if here.kind == "infinity":  # a direction up to its sign
+            expected = direction(np.array(here.direction))
+            assert min(np.abs(np.array(there.direction) - s * expected).max() for s in (1, -1)) < 1e-6
