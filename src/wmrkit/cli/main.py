@@ -72,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run ``wmrkit`` with `argv`; return the exit code (0 ok, 2 user error)."""
     argv = sys.argv[1:] if argv is None else argv
     command = next((a for a in argv if not a.startswith("-")), None)
-    as_json = "--json" in argv
+    as_json = wants_json(argv)
     done = threading.Event()
     if not as_json:
         threading.Thread(target=_compile_notice, args=(done,), daemon=True).start()
@@ -80,6 +80,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         parser = build_parser(command)
         args = parser.parse_args(argv)
+        as_json = bool(getattr(args, "json", False))  # as parsed: '--js' is --json too
         check_blank(parser, args)
         check_outputs(parser, args)
         return int(args.run(args) or 0)
@@ -97,6 +98,13 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     finally:
         done.set()
+
+
+def wants_json(argv: Sequence[str]) -> bool:
+    """Whether `argv` asks for ``--json``, before it is parsed (for the compile notice and an error of the parsing):
+    the option or an abbreviation of it that argparse takes for it ('--js'; '--j', where it is ambiguous, too)."""
+    words = argv[:argv.index("--")] if "--" in argv else argv
+    return any(len(w) >= 3 and "--json".startswith(w) for w in words)
 
 
 #: Seconds of uninterrupted kernel compilation after which the command says why it is quiet.

@@ -1,0 +1,39 @@
+"""One CLI, one contract: every command (walked from the parser tree, ``tests/cli_options.py``) answers a command line
+it cannot parse as every other error: exit code 2 and one line, a JSON object of one shape under ``--json`` (however
+the option is spelt), and nothing on stdout."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from cli_options import options
+from wmrkit.cli.main import main
+
+#: Every command's words (``('batch', 'odometry')``) and whether it offers --json.
+COMMANDS = {cmd: any(a.dest == "json" for c, a in options() if c == cmd) for cmd, a in options() if a.dest == "help"}
+LEAVES = sorted(cmd for cmd in COMMANDS if cmd and not any(c[:len(cmd)] == cmd and c != cmd for c in COMMANDS))
+#: The keys of every error object (docs/limits.md).
+ERROR_KEYS = ["error", "file", "wheel", "field", "line"]
+
+
+def test_the_walk_finds_every_command():
+    assert len(LEAVES) >= 20 and ("batch", "montecarlo") in LEAVES and ("vision", "locate") in LEAVES
+    assert [cmd for cmd in LEAVES if not COMMANDS[cmd]] == [("studio",)]  # a server: no answer to print
+
+
+@pytest.mark.parametrize("spelling", ["--json", "--js"])
+@pytest.mark.parametrize("command", [cmd for cmd in LEAVES if COMMANDS[cmd]], ids=" ".join)
+def test_a_usage_error_under_json_is_one_error_object(command, spelling, capsys):
+    """'--js' is --json to argparse (an abbreviation): the answer was JSON but an error was a text line."""
+    assert main([*command, spelling, "--no-such-option"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and len(err.splitlines()) == 1, err
+    error = json.loads(err)
+    assert list(error) == ERROR_KEYS and error["error"], error
+
+
+def test_an_abbreviated_json_answers_its_error_in_json(capsys):
+    assert main(["show", "no-such-robot", "--js"]) == 2
+    assert json.loads(capsys.readouterr().err)["error"].startswith("no robot 'no-such-robot'")
