@@ -31,7 +31,32 @@ def test_a_usage_error_under_json_is_one_error_object(command, spelling, capsys)
     out, err = capsys.readouterr()
     assert out == "" and len(err.splitlines()) == 1, err
     error = json.loads(err)
-    assert list(error) == ERROR_KEYS and error["error"], error
+    assert list(error) == ERROR_KEYS and error["error"].startswith(f"{' '.join(command)}: "), error
+
+
+@pytest.mark.parametrize("command", LEAVES, ids=" ".join)
+def test_a_usage_error_is_the_usage_and_one_error_line(command, capsys):
+    """The command's usage: an unknown option was answered with wmrkit's ('usage: wmrkit [-h] [--version] COMMAND
+    ...') and a message naming no command."""
+    assert main([*command, "--no-such-option"]) == 2
+    out, err = capsys.readouterr()
+    lines = err.splitlines()
+    assert out == "" and lines[0].startswith(f"usage: wmrkit {' '.join(command)}"), err
+    assert [ln for ln in lines if ln.startswith("wmrkit: error: ")] == [lines[-1]] and "Traceback" not in err
+
+
+@pytest.mark.parametrize("argv", [
+    ["robots"], ["ik", "diff-drive", "--twist", "1", "0", "0"], ["studio", "--port", "0"],
+    ["batch", "montecarlo", "diff-drive", "--path", "square"], ["vision", "locate", "x.png", "--camera", "c.yaml"],
+    ["odometry", "diff-drive", "log.csv", "extra.csv"]])
+def test_an_unknown_argument_is_named_with_the_command_and_its_usage(argv, capsys):
+    """Not wmrkit's usage and a bare 'unrecognized arguments' (the commands' other usage errors name them)."""
+    command = [w for w in argv if w in {"batch", "montecarlo", "vision", "locate"}] or argv[:1]
+    unknown = "extra.csv" if argv[0] == "odometry" else "--bogus"
+    assert main([*argv, "--bogus"] if unknown == "--bogus" else argv) == 2
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0].startswith(f"usage: wmrkit {' '.join(command)} ")
+    assert lines[-1] == f"wmrkit: error: {' '.join(command)}: unrecognized arguments: {unknown}"
 
 
 def test_an_abbreviated_json_answers_its_error_in_json(capsys):

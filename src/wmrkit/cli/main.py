@@ -79,7 +79,9 @@ def main(argv: list[str] | None = None) -> int:
     args = None
     try:
         parser = build_parser(command)
-        args = parser.parse_args(argv)
+        args, unknown = parser.parse_known_args(argv)
+        if unknown:  # argparse's parse_args says so with wmrkit's usage; the command's own names the command
+            chosen_parser(parser, args).error(f"unrecognized arguments: {' '.join(unknown)}")
         as_json = bool(getattr(args, "json", False))  # as parsed: '--js' is --json too
         check_blank(parser, args)
         check_outputs(parser, args)
@@ -98,6 +100,14 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     finally:
         done.set()
+
+
+def chosen_parser(parser: argparse.ArgumentParser, args: argparse.Namespace) -> argparse.ArgumentParser:
+    """The parser of the (sub)command that `args` chose ('batch odometry': batch's odometry parser)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction) and getattr(args, action.dest, None) in action.choices:
+            return chosen_parser(action.choices[getattr(args, action.dest)], args)
+    return parser
 
 
 def wants_json(argv: Sequence[str]) -> bool:
