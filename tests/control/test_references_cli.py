@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -303,3 +304,19 @@ def test_animate_run_takes_a_bounded_number_of_frames(tmp_path, frames):
     with pytest.raises(WmrkitError, match=r"^frames: expected an integer from 2 to 800"):
         animate_run(run, tmp_path / "run.gif", frames=frames)
     assert not (tmp_path / "run.gif").exists()
+
+
+def test_a_size_for_the_line_is_refused_and_help_gives_each_shapes_default(capsys):
+    """'track ... --reference line --size 5' ran the same line as without it (its shape has no size), exit 0; the
+    option's help gave no default ('(radius, side...)'). The defaults it states are the shapes' (BUILTIN)."""
+    with pytest.raises(ReferenceError, match=r"^reference 'line' has no size .* applies to circle, figure-eight"):
+        builtin_reference("line", size=5.0)
+    assert main(["track", "diff-drive", "--reference", "line", "--size", "5", "--duration", "1"]) == 2
+    assert "reference 'line' has no size" in capsys.readouterr().err
+    assert builtin_reference("line", speed=2.0).pose[-1, 0] == pytest.approx(40.0)  # 20 s at 2 m/s, as before
+    for command in ("track", "feasibility"):
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        text = " ".join(capsys.readouterr().out.split())
+        stated = dict(re.findall(r"([a-z-]+) (?:radius|half width|side|leg) \((?:default )?([\d.]+)\)", text))
+        assert stated == {n: f"{s0:g}" for n, (_, _, s0, _) in BUILTIN.items() if n != "line"}, stated

@@ -69,7 +69,9 @@ def _reference_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--reference", required=True, metavar="FILE|NAME",
                    help="line, circle, figure-eight, square, arc-line, corner; or a TUM / CSV (t,x,y,theta) file")
     p.add_argument("--speed", metavar="V", help="speed of a built-in reference [m/s] (default 0.5)")
-    p.add_argument("--size", metavar="L", help="size of a built-in reference [m] (radius, side...)")
+    p.add_argument("--size", metavar="L", help="size of a built-in reference [m]: circle radius (default 3), "
+                                               "figure-eight half width (6), square side (6), arc-line radius (1.5), "
+                                               "corner leg (3); a line has none")
 
 
 def _reference(args: argparse.Namespace):

@@ -254,7 +254,8 @@ def builtin_reference(name: str, *, speed: float | None = None, size: float | No
     """A built-in reference by name (:data:`BUILTIN`), sampled every `dt` [s], with exact derivatives.
 
     `speed` [m/s] along the path, `size` [m] (circle radius, square side, figure-eight half width, arc radius,
-    leg length of ``corner``), `duration` [s] (default: one lap); defaults per shape in :data:`BUILTIN`.
+    leg length of ``corner``; ``line`` has none, and refuses one), `duration` [s] (default: one lap); defaults
+    per shape in :data:`BUILTIN`.
     """
     if name not in BUILTIN:
         import difflib
@@ -262,6 +263,9 @@ def builtin_reference(name: str, *, speed: float | None = None, size: float | No
         close = difflib.get_close_matches(name, BUILTIN, n=1)
         hint = f" (did you mean '{close[0]}'?)" if close else ""
         raise UnknownNameError(f"no built-in reference '{name}'{hint} (built-in: {', '.join(BUILTIN)}; or a file)")
+    if name == "line" and size is not None:  # its shape has no size: it would be ignored
+        raise ReferenceError("reference 'line' has no size (the x axis, followed at the speed for 20 s); a size "
+                             f"applies to {', '.join(n for n in BUILTIN if n != 'line')}")
     fn, v0, s0, d0 = BUILTIN[name]
     v, size = (v0 if speed is None else speed), (s0 if size is None else size)
     for what, value in (("speed", v), ("size", size), ("dt", dt)):
