@@ -62,3 +62,19 @@ def test_an_unknown_argument_is_named_with_the_command_and_its_usage(argv, capsy
 def test_an_abbreviated_json_answers_its_error_in_json(capsys):
     assert main(["show", "no-such-robot", "--js"]) == 2
     assert json.loads(capsys.readouterr().err)["error"].startswith("no robot 'no-such-robot'")
+
+
+#: A complete command line of each command with a --seed (the walk below finds them all).
+SEEDED = {("batch", "montecarlo"): ["diff-drive", "--path", "square"], ("slip-study",): ["forklift"],
+          ("follow-line",): ["line-follower", "--camera", "docs/figures/vision/follower-camera.yaml"]}
+
+
+@pytest.mark.parametrize("value", ["-1", "1e3", "x"])
+def test_every_seed_option_takes_one_rule_and_names_itself(value, capsys):
+    """--seed -1 was refused after the parsing as 'seed must be an integer >= 0, got -1' (batch montecarlo,
+    slip-study) or 'follow-line: seed must ...', naming no option, while '1e3' was argparse's 'invalid int value'."""
+    assert sorted(cmd for cmd, a in options() if "--seed" in a.option_strings) == sorted(SEEDED)
+    for command, rest in SEEDED.items():
+        assert main([*command, *rest, "--seed", value]) == 2
+        assert capsys.readouterr().err.splitlines()[-1] == (
+            f"wmrkit: error: {' '.join(command)}: argument --seed: expected a whole number >= 0, got '{value}'")

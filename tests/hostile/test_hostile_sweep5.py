@@ -213,7 +213,6 @@ def test_tyre_overflow_is_one_line_without_warnings(capsys):
 @pytest.mark.parametrize("option, expected", [
     (["--noise", "-1", "0"], "noise bounds"),  # numpy ValueError traceback
     (["--noise", "1e308", "0"], "noise bounds"),  # OverflowError traceback
-    (["--seed", "-1"], "seed must be an integer >= 0"),  # ValueError traceback
     (["--clutter", "-1"], "clutter must be an integer in [0, 100]"),  # ValueError traceback
     (["--clutter", "1000000000"], "clutter must be an integer in [0, 100]"),  # a hang
     (["--blur", "1e308"], "blur in [0, 50] px"),  # cv2.error traceback
@@ -268,7 +267,6 @@ def test_sweep_out_and_plot_paths_are_checked_first(tmp_path, capsys):
     (["--slip", "1000"], "slip in [0, 1]"),  # a slip ratio's std of 1000: theta -537 rad, exit 0
     (["--rate", "1e308"], "at most 10000000 sample periods"),  # OverflowError traceback
     (["--rate", "1e-320"], "a rate >= 1e-06 Hz"),  # ValueError traceback
-    (["--seed", "-1"], "seed must be an integer >= 0"),  # ValueError traceback
 ])
 def test_monte_carlo_options_are_checked(option, expected, capsys):
     argv = ["batch", "montecarlo", "diff-drive", "--path", "square", "-n", "4", "--workers", "0", *option]

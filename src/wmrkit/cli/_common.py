@@ -142,6 +142,17 @@ def output_problem(path: str, folder: bool) -> str | None:
     return None
 
 
+def seed(text: str) -> int:
+    """``--seed``: a whole number >= 0, what numpy's generators take (every command's, one rule and one message)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got '{text}'")
+    return value
+
+
 def parse_value(text: str, kind: Kind, what: str) -> float:
     """A number from the command line (SI, or with a unit such as ``deg``, ``mm``); errors name the option."""
     try:

@@ -18,6 +18,7 @@ from ._common import (
     parse_assignments,
     parse_value,
     print_json,
+    seed,
 )
 
 
@@ -82,7 +83,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--slip", type=float, default=0.0, metavar="STD",
                    help="std of a run's wheel slip ratio (default 0: no slip)")
     p.add_argument("--rate", type=float, help="sample rate of a built-in path [Hz] (default 20)")
-    p.add_argument("--seed", type=int, default=0, help="random seed of the runs (default 0)")
+    p.add_argument("--seed", type=seed, default=0, help="random seed of the runs (default 0)")
     p.add_argument("--method", choices=METHODS, default="exact",
                    help=f"integration scheme: {SCHEMES_HELP} (default: exact)")
     p.add_argument("--plot", metavar="FILE", help="final positions with both 95 %% ellipses")

@@ -10,7 +10,15 @@ from pathlib import Path
 
 from ..errors import WmrkitError
 from ..robot import Robot
-from ._common import SCHEMES_HELP, add_json_flag, add_robot_argument, load_robot, parse_assignments, print_json
+from ._common import (
+    SCHEMES_HELP,
+    add_json_flag,
+    add_robot_argument,
+    load_robot,
+    parse_assignments,
+    print_json,
+    seed,
+)
 
 ESTIMATOR_METHODS = ("wls", "fk1", "fk2")
 
@@ -255,7 +263,7 @@ def add_study_parser(commands: argparse._SubParsersAction) -> None:
     p.add_argument("study", choices=("forklift", "skid-steer-4"), help="which study")
     p.add_argument("--report", metavar="DIR", help="write the figures into DIR")
     p.add_argument("--quick", action="store_true", help="forklift: fewer sweep points and shorter runs (a smoke run)")
-    p.add_argument("--seed", type=int, help="forklift: seed of the experiments' speeds and encoder phases (default 0)")
+    p.add_argument("--seed", type=seed, help="forklift: seed of the experiments' speeds and encoder phases (default 0)")
     p.add_argument("--drive", choices=("differential", "servo"),
                    help="forklift: drive wheels through the open differential of one traction motor (default, the "
                         "forklift's drivetrain) or each through its own rate servo")

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import WmrkitError
-from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_value, print_json
+from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_value, print_json, seed
 from .control import check_animation_path
 
 
@@ -77,7 +77,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     f.add_argument("--z-p", default="0", metavar="Z",
                    help="distance along the optical axis from the lens to P, the tracked point (the robot's "
                         "origin) [m] (default 0: P below the lens)")
-    f.add_argument("--seed", type=int, default=0, help="random seed (noise, clutter; default 0)")
+    f.add_argument("--seed", type=seed, default=0, help="random seed (noise, clutter; default 0)")
     f.add_argument("--animate", metavar="FILE", help="write a GIF: camera view beside the plan view")
     add_json_flag(f)
     f.set_defaults(run=run_follow)
