@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -227,3 +228,11 @@ def test_ik_and_show_tables_keep_long_wheel_names_apart_from_their_type(capsys, 
         for line in out.splitlines():  # the columns line up: each row's type starts under the header's
             if line.split() and line.split()[0] in names:
                 assert line.index(" swedish") + 1 == header.index("type")
+
+
+def test_every_number_column_of_the_ik_table_names_its_unit(capsys):
+    """'steer rate' was the one column of numbers without its unit (rad/s), beside 'spin [rad/s]' and 'slip [m/s]'."""
+    assert main(["ik", "diff-drive", "--twist", "1", "0.2", "0.5"]) == 0
+    header = capsys.readouterr().out.splitlines()[0]
+    columns = re.split(r"\s{2,}", header.strip())
+    assert columns[:2] == ["wheel", "type"] and all(re.search(r"\[[^]]+\]$", c) for c in columns[2:]), columns

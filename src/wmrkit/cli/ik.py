@@ -111,14 +111,14 @@ def _check_finite(what: str, *arrays) -> None:
 def format_commands(robot: Robot, commands: WheelCommands) -> str:
     """Human-readable table of one twist's wheel commands: heading in degrees (0 = rolling straight ahead)."""
     data, width = commands.to_dict(), wheel_column_width(robot)
-    lines = [f"{'wheel':<{width}}{'type':<14}{'heading [deg]':>14}{'spin [rad/s]':>14}{'steer rate':>12}"
+    lines = [f"{'wheel':<{width}}{'type':<14}{'heading [deg]':>14}{'spin [rad/s]':>14}{'steer rate [rad/s]':>20}"
              f"{'slip [m/s]':>12}  other rates [rad/s]"]
     for w in robot.wheels:
         entry = data["wheels"][w.name]
         other = ", ".join(f"{k} {_num(v)}" for k, v in entry.items() if k not in ("heading", "spin", "steer_rate"))
         heading = math.degrees(entry.get("heading", math.nan))
         lines.append(f"{w.name:<{width}}{w.type:<14}{_num(heading):>14}{_num(entry['spin']):>14}"
-                     f"{_num(entry['steer_rate']):>12}{_num(data['slip'][w.name]):>12}  {other}".rstrip())
+                     f"{_num(entry['steer_rate']):>20}{_num(data['slip'][w.name]):>12}  {other}".rstrip())
     reasons = dict.fromkeys(why.split(":")[0] for why in _infeasible(robot, commands))  # each reason once
     lines.append("feasible: " + ("yes" if data["feasible"] else f"NO ({'; '.join(reasons)})"))
     return "\n".join(lines)
