@@ -7,7 +7,6 @@ only; user text is never evaluated. Every error names the file, the line where k
 from __future__ import annotations
 
 import itertools
-import json
 import math
 import numbers
 import os
@@ -16,11 +15,18 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-import yaml
-
-from ._atomic import atomic_path
 from .couplings import COUPLING_KINDS, Coupling, joint_problem
-from .documents import DescriptionError, FieldReader, LineOf, Loc, hint, read_document, read_file, short_repr
+from .documents import (
+    DescriptionError,
+    FieldReader,
+    LineOf,
+    Loc,
+    hint,
+    read_document,
+    read_file,
+    short_repr,
+    write_document,
+)
 from .dynamics import mass
 from .limits import (  # noqa: F401  (the limits are part of the description format)
     ANGLE_MARGIN,
@@ -439,7 +445,4 @@ def save_robot_file(robot: Robot, path: str | os.PathLike[str]) -> None:
     except DescriptionError as err:
         raise DescriptionError(err.message, source=f"robot '{robot.name}' is not written to {path}: it would not "
                                "load back", loc=err.loc, wheel=err.wheel) from None
-    text = (json.dumps(data, indent=2) + "\n" if path.suffix.lower() == ".json"
-            else yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
-    with atomic_path(path) as scratch:  # a failed write leaves the old description whole
-        scratch.write_text(text, encoding="utf-8")
+    write_document(path, data)  # in one step: a failed write leaves the old description whole

@@ -18,6 +18,7 @@ from typing import Any
 
 import yaml
 
+from ._atomic import atomic_path
 from .errors import DescriptionError
 from .limits import _check_size, regular_file_problem
 from .units import UnitError, parse_quantity
@@ -57,6 +58,16 @@ def read_file(path: str | os.PathLike[str], what: str = "description") -> str:
         reason = getattr(err, "strerror", None) or err  # UnicodeDecodeError has no strerror
         raise DescriptionError(f"cannot read the file ({err.__class__.__name__}: {reason})",
                                source=str(path)) from None
+
+
+def write_document(path: str | os.PathLike[str], data: Any) -> None:
+    """Write `data` to `path` as JSON (a ``.json`` name) or YAML (any other), replacing the file in one step
+    (:func:`wmrkit._atomic.atomic_path`: a failed write leaves the old file whole); what :func:`read_document`
+    reads back."""
+    text = (json.dumps(data, indent=2) + "\n" if Path(path).suffix.lower() == ".json"
+            else yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
+    with atomic_path(path) as scratch:
+        scratch.write_text(text, encoding="utf-8")
 
 
 def read_document(text: str, source: str, fmt: str = "yaml") -> tuple[Any, LineOf]:

@@ -228,12 +228,9 @@ def _check_heading(robot, log: str, fmt: LogFormat, sensed) -> bool:
     """Warn (one line on stderr) when the external heading's turns contradict the wheels' over the first samples of
     a CSV log (:data:`HEADING_RTOL`); return whether they did not. Its changes replace the wheels' dtheta, so a
     heading in other units or of the other sign gave a wrong trajectory with "consistent": true."""
-    from ..odometry.logs import read_csv
-
     if is_bag(log):
         return True
-    model = odometry_model(robot, sensed)
-    first = next(iter(read_csv(log, model.joints, fmt, robot=robot, chunk_size=20_000)))
+    model, first = _first_samples(robot, log, fmt, sensed)
     wheels = model.from_positions(first.positions).column(2)
     external = np.diff(first.heading_world)
     wheels = np.zeros_like(external) if wheels is None else wheels
@@ -251,14 +248,24 @@ def _check_heading(robot, log: str, fmt: LogFormat, sensed) -> bool:
 
 def _wheel_slips(robot, log: str, fmt: LogFormat, sensed) -> dict[str, float]:
     """The wheels' RMS slip [m per interval] over the first samples of a CSV log ({} for a bag)."""
-    from ..odometry.logs import read_csv
     from ..odometry.model import wheel_slip
 
     if is_bag(log):
         return {}
-    model = odometry_model(robot, sensed)
-    first = next(iter(read_csv(log, model.joints, fmt, robot=robot, chunk_size=20_000)))
+    model, first = _first_samples(robot, log, fmt, sensed)
     return wheel_slip(model, first.positions)
+
+
+#: Samples of a CSV log the diagnostics read (the per-wheel slip, the external heading against the wheels).
+FIRST_SAMPLES = 20_000
+
+
+def _first_samples(robot, log: str, fmt: LogFormat, sensed):
+    """The no-slip model and the first :data:`FIRST_SAMPLES` samples of a CSV log, for the diagnostics."""
+    from ..odometry.logs import read_csv
+
+    model = odometry_model(robot, sensed)
+    return model, next(iter(read_csv(log, model.joints, fmt, robot=robot, chunk_size=FIRST_SAMPLES)))
 
 
 def format_summary(s: OdometrySummary) -> str:

@@ -19,7 +19,6 @@ inverse is a cubic in r, solved in closed form (:func:`undistort`); with ``k1 < 
 
 from __future__ import annotations
 
-import json
 import math
 import numbers
 from dataclasses import asdict, dataclass, fields
@@ -27,12 +26,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from numpy.typing import ArrayLike
 
-from .._atomic import atomic_path
 from .._shapes import as_vectors
-from ..documents import read_document, read_file
+from ..documents import read_document, read_file, write_document
 from ..errors import DescriptionError, WmrkitError
 from ..limits import MAX_SIZE
 from ..units import UnitError, parse_quantity
@@ -147,11 +144,8 @@ class Camera:
         suffix = path.suffix.lower()
         if suffix not in (".yaml", ".yml", ".json"):
             raise CameraError(f"{path}: a camera file is .yaml, .yml or .json, not '{suffix or 'no extension'}'")
-        data = self.to_dict()
-        text = json.dumps(data, indent=2) + "\n" if suffix == ".json" else yaml.safe_dump(data, sort_keys=False)
         try:
-            with atomic_path(path) as scratch:
-                scratch.write_text(text, encoding="utf-8")
+            write_document(path, self.to_dict())
         except OSError as err:
             raise CameraError(f"{path}: cannot write the camera file ({err.strerror or err})") from None
 
