@@ -1,11 +1,13 @@
-"""The kinematic loop of §8.2 (Fig. 8.1), closed in continuous time (scipy ``solve_ivp``) or at a sample period.
+"""The kinematic loop of §8.2 (Fig. 8.1), closed in continuous time (scipy's RK45) or at a sample period.
 
 Each instant: position control (a :class:`~wmrkit.control.laws.PositionLaw`, or a geometric tracker) gives the
 velocity to impose; :func:`~wmrkit.control.points.twist_for_velocity` turns it into an admissible body twist;
 :func:`~wmrkit.kinematics.wheel_ik.wheel_commands` gives every wheel's command at the current steering (castor
 angles fed back, §8.4.3); the steering policy and ranges pick the roots (:mod:`.steering`). The plant is ideal
 (the robot moves with the commanded twist, unless a wheel is held at the end of its steering range: then with the
-least-squares twist (4.11) of the actuated wheels' commanded rates at the steering reached) or goes through
+least-squares twist (4.11) of the actuated wheels' commanded rates at the steering reached; a held wheel changes
+ends only when the other end serves the asked heading better by ``HOLD_MARGIN``, an event the continuous loop
+locates) or goes through
 low-level loops (:mod:`.actuators`), the twist then being the least-squares one of the joints' actual rates at the
 actual steering. Each record says which steered wheels were within their range (``in_range``). The pose is measured
 exactly, optionally ``delay`` samples late (discrete loop).
@@ -25,6 +27,7 @@ import numpy as np
 from ..kinematics.wheel_ik import WheelCommands, forward_kinematics, wheel_commands
 from ..limits import MAX_QUERY_RATE, MAX_SPEED
 from ..robot import Robot
+from ..wheels import wrap_angle
 from .actuators import LowLevelLoops
 from .laws import PositionLaw, law_velocity, pose_error
 from .points import ControlError, ControlPoint, check_delay, point_pose, twist_for_velocity
@@ -67,6 +70,12 @@ MAX_EVALUATIONS, EVALUATIONS_PER_SECOND, MAX_CONTINUOUS_SECONDS = 20_000, 2_000,
 #: drive at 0.02 s (its RK4 step for the castor) ran for about an hour.
 MAX_SAMPLED_EVALUATIONS = 100_000
 
+#: A steered wheel of the ideal plant held at an end of its steering range stays there unless the other end serves
+#: the heading asked of it better by more than this [rad] (:func:`~.steering.choose_steering` ``hold_margin``).
+HOLD_MARGIN = math.radians(2.0)
+#: Bisections locating the instant a held wheel changes ends in the continuous loop (to 2**-40 of a step).
+SWITCH_BISECTIONS = 40
+
 
 def _too_stiff(controller: TwistController, sim: _Sim, t: float, x: np.ndarray, duration: float, evaluations: int,
                seconds: float) -> ControlError:
@@ -75,8 +84,7 @@ def _too_stiff(controller: TwistController, sim: _Sim, t: float, x: np.ndarray, 
     beta = x[6:6 + len(sim.passive)]
     held = [sim.robot.steer_names[k] for k in np.flatnonzero(~sim.realised(twist, beta)[1])]
     why = (f"; wheel '{held[0]}' is held at an end of its steer_range (the law asks for turns sharper than the robot "
-           "can make; where the heading asked of it passes 90 deg the wheel switches ends, a jump the integrator "
-           "cannot step over)" if held else "")
+           "can make)" if held else "")
     return ControlError(f"the closed loop is too stiff to integrate over {duration:g} s: it reached t = {t:.4g} s "
                         f"after {evaluations} evaluations and {seconds:.0f} s of computing (commanded speed "
                         f"{math.hypot(*twist[:2]):.3g} m/s){why}; start closer to the reference, lower the gain, or "
@@ -146,9 +154,11 @@ class _Sim:
             spins = [j for j in robot.rate_names if j.endswith(_SPINS)]
         self.drive = tuple(spins)
         self.n_loop = 0 if loops is None else loops.size
+        self.hold_margin = HOLD_MARGIN  # the continuous loop holds ends within a step (inf) and switches at events
 
-    def commands(self, twist: np.ndarray, beta: np.ndarray) -> _Commands:
-        """Wheel commands at steering `beta`, with the policy and ranges applied to the steered wheels."""
+    def commands(self, twist: np.ndarray, beta: np.ndarray, hold_margin: float | None = None) -> _Commands:
+        """Wheel commands at steering `beta`, with the policy and ranges applied to the steered wheels; a wheel held
+        at an end changes ends past `hold_margin` (default ``self.hold_margin``)."""
         c = wheel_commands(self.robot, twist, beta)
         target, rates = np.array(c.beta), np.array(c.rates)
         fits = np.ones(len(target), dtype=bool)
@@ -156,7 +166,8 @@ class _Sim:
             steered = ~self.passive
             heading = target - math.pi / 2 + self.delta
             ch = choose_steering(heading, np.asarray(c.spin)[self.wheel_of_steer], beta - math.pi / 2 + self.delta,
-                                 policy=self.plant.policy, ranges=self.ranges)
+                                 policy=self.plant.policy, ranges=self.ranges,
+                                 hold_margin=self.hold_margin if hold_margin is None else hold_margin)
             target = np.where(steered, np.asarray(ch.heading) + math.pi / 2 - self.delta, target)
             reverse_spins(rates, self.spin_columns, np.asarray(ch.reversed) & steered)
             fits = np.asarray(ch.in_range) | self.passive
@@ -213,8 +224,8 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
              breaks: tuple[float, ...] = ()) -> dict[str, np.ndarray]:
     """Close the loop of `robot` under `controller` from `initial_pose` for `duration` [s].
 
-    Continuous time (``period`` None; ``solve_ivp`` RK45 with `rtol`/`atol`, sampled every `output_dt`) or discrete
-    (commands held for `period` [s], pose measured `delay` samples late, ``skew_free`` applies
+    Continuous time (``period`` None; RK45 with `rtol`/`atol`, sampled every `output_dt`: :func:`_integrate`) or
+    discrete (commands held for `period` [s], pose measured `delay` samples late, ``skew_free`` applies
     :func:`discretize_twist` to the held twist). Returns arrays: ``t (n,)``, ``pose (n, 3)``, ``twist (n, 3)``
     (commanded), ``beta (n, n_steer)`` (actual steering), ``target (n, n_steer)`` (commanded steering).
     ``breaks``: times where the reference is discontinuous; the continuous integration restarts there.
@@ -260,13 +271,10 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
         return np.concatenate([dpose, de if held is None else np.zeros(3), dbeta, dls])
 
     if period is None:
-        from scipy.integrate import solve_ivp
-
         t_out = np.arange(0.0, duration + 1e-9, output_dt)
         if t_out[-1] < duration - 1e-9 or len(t_out) == 1:  # the last sample at the end of the run
             t_out = np.append(t_out, duration)
         edges = [0.0, *sorted(b for b in breaks if 0 < b < t_out[-1]), float(t_out[-1])]
-        ts, xs, x = [], [], x0
         allowed = int(MAX_EVALUATIONS + EVALUATIONS_PER_SECOND * duration)
         budget, start = [allowed], time.monotonic()
 
@@ -276,20 +284,9 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
                 raise _too_stiff(controller, sim, t, x, duration, allowed - budget[0], time.monotonic() - start)
             return rhs(t, x)
 
-        for lo, hi in itertools.pairwise(edges):  # restart at the reference's known corners
-            last = hi == edges[-1]
-            keep = t_out[(t_out >= lo) & ((t_out <= hi) if last else (t_out < hi))]
-            sol = solve_ivp(counted, (lo, hi), x, t_eval=keep, rtol=rtol, atol=atol, max_step=0.25,
-                            dense_output=True)
-            if not sol.success:
-                raise ControlError(f"the closed loop could not be integrated: {sol.message}")
-            ts.extend(sol.t)
-            xs.extend(sol.y.T)
-            x = sol.sol(hi)
-        records, prev = [], beta0
-        for t, x in zip(ts, xs, strict=True):
-            records.append(_record(controller, sim, t, x, split, prev))
-            prev = records[-1]["beta"]
+        sim.hold_margin = math.inf  # within a step; _given_steering switches ends as events
+        records = _integrate(counted, x0, t_out, edges, lambda t, x: _record(controller, sim, t, x, split),
+                             lambda t, x: _given_steering(controller, sim, t, x, split), rtol, atol)
     else:
         if not (math.isfinite(period) and period > 0):
             raise ControlError(f"period: expected a positive number of seconds, got {period}")
@@ -345,11 +342,81 @@ def _advance(rhs, x: np.ndarray, t: float, period: float, subs: int, held: tuple
     return x
 
 
-def _record(controller, sim: _Sim, t: float, x: np.ndarray, split, prev: np.ndarray) -> dict:
-    pose, integral, _, _ = split(x)
+def _integrate(fun, x0: np.ndarray, t_out: np.ndarray, edges: list[float], record, given, rtol: float,
+               atol: float) -> list[dict]:
+    """The continuous loop: RK45 (scipy's, as ``solve_ivp``) step by step, restarted at the `edges`; `record(t, x)`
+    at each of `t_out`. The steered wheels' entries of the state are constant within a step: the steering last
+    given, from which the roots and ends are chosen (:func:`~.steering.choose_steering` ``current``), as the sampled
+    loop keeps each period's angle. After each step they take the steering just given, ``given(t, x)`` (an array,
+    and whether a held wheel changes ends there, past ``HOLD_MARGIN``); within a step a held wheel stays at its end,
+    and where it changes ends the instant is located (bisection on the step's interpolant) and the integration
+    restarts there: the hysteresis makes the switch an event, not a discontinuity the integrator chatters on."""
+    from scipy.integrate import RK45
+
+    records, x = [], x0
+    for lo, hi in itertools.pairwise(edges):  # restart at the reference's known corners
+        last = hi == edges[-1]
+        keep = list(t_out[(t_out >= lo) & ((t_out <= hi) if last else (t_out < hi))])
+        t0 = lo
+        while True:
+            if keep and keep[0] == t0:
+                records.append(record(t0, x))
+                keep.pop(0)
+            solver = RK45(fun, t0, x, hi, rtol=rtol, atol=atol, max_step=0.25)
+            switched = None
+            while solver.status == "running" and switched is None:
+                message = solver.step()
+                if solver.status == "failed":
+                    raise ControlError(f"the closed loop could not be integrated: {message}")
+                t_end, y = solver.t, solver.y
+                dense = solver.dense_output()
+                new, switch = given(t_end, y)
+                if switch:  # the first instant of the step where a held wheel changes ends
+                    a, b = solver.t_old, t_end
+                    for _ in range(SWITCH_BISECTIONS):
+                        mid = 0.5 * (a + b)
+                        if given(mid, dense(mid))[1]:
+                            b = mid
+                        else:
+                            a = mid
+                    t_end, y = b, dense(b)
+                    new = given(b, y)[0]
+                    switched = b
+                while keep and keep[0] <= t_end:
+                    records.append(record(keep[0], dense(keep.pop(0))))
+                y = y.copy()
+                y[6:] = new
+                if switched is None and solver.status == "running" and not np.array_equal(y, solver.y):
+                    solver.y, solver.f = y, fun(t_end, y)  # the derivative there follows the steering given
+            x = y if switched is not None else solver.y
+            if switched is None or switched >= hi:
+                break
+            t0 = switched
+    return records
+
+
+def _given_steering(controller, sim: _Sim, t: float, x: np.ndarray, split) -> tuple[np.ndarray, bool]:
+    """``x[6:]`` with the steered wheels' angles replaced by those the commands at `(t, x)` give them (a held wheel
+    changing ends past ``HOLD_MARGIN``), and whether a held wheel changes ends."""
+    pose, integral, beta, _ = split(x)
+    twist, _ = controller(t, pose, integral)
+    out = x[6:].copy()
+    steered = ~sim.passive
+    if not steered.any():
+        return out, False
+    target = sim.commands(twist, beta, HOLD_MARGIN).target
+    out[:len(beta)][steered] = target[steered]
+    if not sim.limited:
+        return out, False
+    held = sim.commands(twist, beta).target  # within a step: held wheels stay at their ends
+    return out, bool(np.any(np.abs(wrap_angle(target - held))[steered] > 1e-9))
+
+
+def _record(controller, sim: _Sim, t: float, x: np.ndarray, split) -> dict:
+    pose, integral, beta, _ = split(x)
     twist, _ = controller(t, pose, integral)
     check_diverged(twist, t)
-    return _record_held(sim, t, x, split, twist, prev)
+    return _record_held(sim, t, x, split, twist, beta)
 
 
 def _record_held(sim: _Sim, t: float, x: np.ndarray, split, twist: np.ndarray, prev: np.ndarray) -> dict:

@@ -83,15 +83,20 @@ def check_policy(policy: str) -> None:
 
 
 def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, policy: str = "closest",
-                    ranges: ArrayLike | None = None) -> SteeringChoice:
+                    ranges: ArrayLike | None = None, hold_margin: float = 0.0) -> SteeringChoice:
     """Pick, per wheel, the root of (8.9) allowed by `policy` and the heading range.
 
     `heading`, `spin`: one root and its spin ``(..., n)``; the other root is ``heading + pi`` with ``-spin``.
     `current` ``(..., n)``: current headings (for ``"closest"`` and for ties). `ranges` ``(n, 2)`` heading ranges.
     When neither root fits, the wheel is held at the end of its range nearest to either root, with that root's spin
     (a car asked for 70 deg left by a +-40 deg rack turns 40 deg left, not 40 deg right with its wheel reversed).
+    `hold_margin` [rad]: a wheel held at an end (`current` there) stays there unless the other end is nearer by more
+    than this (hysteresis: a heading asked back and forth across the tie, 90 deg for a +-40 deg rack, does not swap
+    ends at each crossing).
     """
     check_policy(policy)
+    if isinstance(hold_margin, bool) or not isinstance(hold_margin, int | float) or not hold_margin >= 0:
+        raise ControlError(f"hold_margin: expected an angle >= 0 [rad] (inf: never change ends), got {hold_margin!r}")
     h0, s0, cur = _finite({"heading": heading, "spin": spin, "current": current})
     h0 = wrap_angle(h0)
     h1, s1 = wrap_angle(h0 + math.pi), -s0
@@ -116,7 +121,11 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
         with np.errstate(invalid="ignore"):
             end0, miss0 = _nearest_end(h0, lo, hi)
             end1, miss1 = _nearest_end(h1, lo, hi)
-        near0 = (miss0 < miss1) | ((miss0 == miss1) & pref0)
+            near0 = (miss0 < miss1) | ((miss0 == miss1) & pref0)
+            if hold_margin > 0:  # within the margin of a tie, the end the wheel is held at
+                at0 = np.abs(wrap_angle(cur - end0)) <= 1e-9
+                at1 = np.abs(wrap_angle(cur - end1)) <= 1e-9
+                near0 = np.where((np.abs(miss0 - miss1) <= hold_margin) & (at0 != at1), at0, near0)
         h = np.where(fits, h, np.where(near0, end0, end1))
         take0 = np.where(fits, take0, near0)
     s = np.where(take0, s0, s1)
