@@ -374,6 +374,8 @@ def test_the_dynamics_refuse_a_steered_wheel_nothing_steers():
     (lambda: ackermann_twist(1.0, math.inf), "curvature: expected finite numbers, got inf"),  # was [1, nan, inf]
     (lambda: discretize_twist([1.0, 0.0, 1.0], math.nan), "dt = nan"),  # was NaN
     (lambda: discretize_twist([1.0, 0.0, 1.0], -0.1), "dt = -0.1"),
+    (lambda: discretize_twist([1.0, 0.0, 20 * math.pi], 0.1), r"omega dt = 6\.28319 rad is \(nearly\) a whole"),
+    (lambda: discretize_twist([[0.0, 0.0, 0.0], [0.0, 1.0, -40 * math.pi]], 0.1), r"omega dt = -12\.5664 rad"),
 ])
 def test_the_steering_helpers_refuse_what_they_cannot_use_by_name(call, message):
     """Found by the audit of the Python doors: numpy's broadcast errors, or NaN results, before."""

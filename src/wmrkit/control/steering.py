@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
+from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from ..wheels import heading_in_range, wrap_angle
 from .points import ControlError
@@ -225,7 +226,11 @@ def discretize_twist(twist_robot: ArrayLike, dt: float) -> np.ndarray:
     """Second-order (skew-free) discretisation: the constant body twist that, held for `dt`, ends at the pose
     ``(vx dt, vy dt, omega dt)`` of the body frame: the SE(2) logarithm of that pose over `dt` (WPILib
     ``ChassisSpeeds.discretize``, #5349/#7332). Inverse of :func:`wmrkit.odometry.integrate_exact`'s chord form:
-    ``(vx, vy)' = Rot(-h) (vx, vy) / sinc(h)`` with ``h = omega dt / 2``. ``(..., 3) -> (..., 3)``."""
+    ``(vx, vy)' = Rot(-h) (vx, vy) / sinc(h)`` with ``h = omega dt / 2``. ``(..., 3) -> (..., 3)``.
+
+    Refused where the result would exceed ``limits.MAX_QUERY_RATE``: a period turning (nearly) a whole number of
+    turns ends where it started, so no constant twist with that omega moves it along the step (``sinc(h) = 0``;
+    ``omega dt = 2 pi`` gave ``vx = -2.6e16`` m/s)."""
     from ..odometry.integrators import sinc
 
     t = as_vectors(twist_robot, 3, "twist_robot")
@@ -235,4 +240,10 @@ def discretize_twist(twist_robot: ArrayLike, dt: float) -> np.ndarray:
     c, s, k = np.cos(h), np.sin(h), 1.0 / sinc(h)
     vx = k * (c * t[..., 0] + s * t[..., 1])
     vy = k * (-s * t[..., 0] + c * t[..., 1])
-    return np.stack([vx, vy, t[..., 2]], axis=-1)
+    out = np.stack([vx, vy, t[..., 2]], axis=-1)
+    if not (np.abs(out) <= MAX_QUERY_RATE).all():  # inf and NaN included
+        worst = np.unravel_index(np.argmin(np.abs(sinc(h))), h.shape)
+        raise ControlError(f"discretize_twist: omega dt = {2 * float(h[worst]):.6g} rad is (nearly) a whole number of "
+                           f"turns per period, where no constant twist reaches the step (the discretised twist would "
+                           f"exceed {MAX_QUERY_RATE:g} m/s); give a shorter period")
+    return out
