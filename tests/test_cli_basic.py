@@ -237,3 +237,19 @@ def test_odometry_options_a_description_may_default_say_so():
     described = ("--method", "--scheme", "--mu", "--mu-default", "--kf-noise", "--kf-wheel")
     helps = {a.option_strings[-1]: a.help for words, a in options() if words == ("odometry",)}
     assert [o for o in described if "description" not in helps[o]] == []
+
+
+def test_show_and_ik_name_a_mecanum_wheel_as_its_description_does(tmp_path, capsys):
+    """`type: mecanum` (a Swedish wheel with the standard rollers of its quadrant) was shown as 'swedish' by the
+    `show` and `ik` tables, while `show --json` wrote 'mecanum'; a Swedish wheel with other rollers stays 'swedish'."""
+    assert main(["show", "mecanum-4"]) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[2:6]]
+    assert [r[1] for r in rows] == ["mecanum"] * 4
+    assert main(["ik", "mecanum-4", "--twist", "0.5", "0.3", "0"]) == 0
+    assert [line.split()[1] for line in capsys.readouterr().out.splitlines()[1:5]] == ["mecanum"] * 4
+    odd = tmp_path / "odd.yaml"
+    odd.write_text("name: odd\nwheels:\n"
+                   "  - {name: a, type: swedish, position: [0.2, 0.2], heading: 0, r: 0.05, gamma: 30 deg, r_r: 0.01}\n"
+                   "  - {name: b, type: mecanum, position: [-0.2, -0.2], r: 0.05}\n")
+    assert main(["show", str(odd)]) == 0
+    assert [line.split()[1] for line in capsys.readouterr().out.splitlines()[2:4]] == ["swedish", "mecanum"]

@@ -319,6 +319,12 @@ def robot_to_dict(robot: Robot, *, thesis: bool = False) -> dict[str, Any]:
     return out
 
 
+def described_type(w: Wheel) -> str:
+    """The wheel's type as a description would write it: ``mecanum`` for a Swedish wheel with the rollers of
+    ``type: mecanum`` (the standard X layout of WPILib and ROS 2, from its quadrant), else its kind."""
+    return _wheel_to_dict(w)["type"] if w.type == "swedish" else w.type
+
+
 def _wheel_to_dict(w: Wheel) -> dict[str, Any]:
     """The wheel as users write it where that reads back to exactly this wheel (:func:`_users_form`), else in the
     thesis's parameters."""

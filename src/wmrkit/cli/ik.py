@@ -8,6 +8,7 @@ import sys
 
 import numpy as np
 
+from ..description import described_type
 from ..errors import WmrkitError
 from ..kinematics.wheel_ik import WheelCommands, forward_kinematics_check, twist_is_determined, wheel_commands
 from ..limits import MAX_QUERY_RATE
@@ -117,7 +118,7 @@ def format_commands(robot: Robot, commands: WheelCommands) -> str:
         entry = data["wheels"][w.name]
         other = ", ".join(f"{k} {_num(v)}" for k, v in entry.items() if k not in ("heading", "spin", "steer_rate"))
         heading = math.degrees(entry.get("heading", math.nan))
-        lines.append(f"{w.name:<{width}}{w.type:<14}{_num(heading):>14}{_num(entry['spin']):>14}"
+        lines.append(f"{w.name:<{width}}{described_type(w):<14}{_num(heading):>14}{_num(entry['spin']):>14}"
                      f"{_num(entry['steer_rate']):>20}{_num(data['slip'][w.name]):>12}  {other}".rstrip())
     reasons = dict.fromkeys(why.split(":")[0] for why in _infeasible(robot, commands))  # each reason once
     lines.append("feasible: " + ("yes" if data["feasible"] else f"NO ({'; '.join(reasons)})"))

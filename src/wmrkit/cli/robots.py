@@ -6,6 +6,7 @@ import argparse
 import math
 
 from .. import catalog
+from ..description import described_type
 from ..robot import Robot
 from ._common import add_json_flag, add_robot_argument, check_plot_path, load_robot, print_json, wheel_column_width
 
@@ -78,7 +79,7 @@ def format_summary(robot: Robot) -> str:
         extra = {"castor": f"  d={_g(w.d)} delta={_g(math.degrees(w.delta))}deg",
                  "double_castor": f"  d={_g(w.d)} b={_g(w.b)}", "double": f"  b={_g(w.b)}",
                  "swedish": f"  gamma={_g(math.degrees(w.gamma))}deg r_r={_g(w.r_r)}"}.get(w.type, "")
-        row = (f"  {w.name:<{width}}{w.type:<14}{_g(_zero(x)):>10}{_g(_zero(y)):>10}"
+        row = (f"  {w.name:<{width}}{described_type(w):<14}{_g(_zero(x)):>10}{_g(_zero(y)):>10}"
                f"{_g(_zero(math.degrees(w.heading))) + '°':>10}{_g(w.r):>10}")
         lines.append(f"{row}  {joints}{extra}")
     lines.append("  heading: the wheel's rolling direction, 0° = straight ahead (+x), counter-clockwise positive")
