@@ -398,12 +398,12 @@ def _integrate(fun, x0: np.ndarray, t_out: np.ndarray, edges: list[float], recor
 def _given_steering(controller, sim: _Sim, t: float, x: np.ndarray, split) -> tuple[np.ndarray, bool]:
     """``x[6:]`` with the steered wheels' angles replaced by those the commands at `(t, x)` give them (a held wheel
     changing ends past ``HOLD_MARGIN``), and whether a held wheel changes ends."""
-    pose, integral, beta, _ = split(x)
-    twist, _ = controller(t, pose, integral)
     out = x[6:].copy()
     steered = ~sim.passive
     if not steered.any():
         return out, False
+    pose, integral, beta, _ = split(x)
+    twist, _ = controller(t, pose, integral)
     target = sim.commands(twist, beta, HOLD_MARGIN).target
     out[:len(beta)][steered] = target[steered]
     if not sim.limited:
