@@ -23,7 +23,8 @@ def test_ik_json_has_the_documented_shape(capsys):
     code, out, err = run(capsys, "ik", "swerve-4", "--twist", "1", "0.5", "0.2", "--json")
     assert code == 0 and err == ""
     data = json.loads(out)
-    assert set(data) == {"wheels", "slip", "out_of_range", "feasible"} and data["feasible"] is True
+    assert set(data) == {"wheels", "slip", "out_of_range", "feasible", "warnings"} and data["feasible"] is True
+    assert data["warnings"] == []
     assert data["out_of_range"] == []
     robot = catalog.load("swerve-4")
     assert list(data["wheels"]) == list(robot.wheel_names)
@@ -72,7 +73,8 @@ def test_fk_json_and_text(capsys):
     code, out, err = run(capsys, "fk", "diff-drive", "--spin", "left=10", "--spin", "right.spin=12", "--json")
     assert code == 0 and err == ""
     data = json.loads(out)
-    assert set(data) == {"twist", "determined", "residual", "consistent", "slipping"} and data["consistent"] is True
+    assert set(data) == {"twist", "determined", "residual", "consistent", "slipping", "warnings"}
+    assert data["consistent"] is True and data["warnings"] == []
     assert data["determined"] is True
     r, half_track = 0.075, 0.20
     np.testing.assert_allclose(data["twist"], [r * 11, 0.0, r * 2 / (2 * half_track)], atol=1e-12)

@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
+import sys
+from collections.abc import Iterator
+from contextvars import ContextVar
 from pathlib import Path
 from typing import Any
 
@@ -41,8 +45,35 @@ def wheel_column_width(robot: Robot, least: int = 14) -> int:
     return max(least, max(len(w.name) for w in robot.wheels) + 2)
 
 
-def print_json(data: Any) -> None:
-    """Print `data` as JSON (NaN and infinities become null: JSON has none)."""
+#: The warnings the running command has said (:func:`collecting_warnings`), for its JSON answer.
+_SAID: ContextVar[list[str] | None] = ContextVar("wmrkit_cli_warnings", default=None)
+
+
+@contextlib.contextmanager
+def collecting_warnings() -> Iterator[list[str]]:
+    """Collect the :func:`warn` calls of one command run (``wmrkit.cli.main.main`` wraps each run in it)."""
+    said: list[str] = []
+    token = _SAID.set(said)
+    try:
+        yield said
+    finally:
+        _SAID.reset(token)
+
+
+def warn(message: str) -> None:
+    """A warning: one line ``wmrkit: warning: MESSAGE`` on stderr for people, and MESSAGE in the ``"warnings"``
+    list of the command's JSON answer (:func:`print_json` with ``warnings=True``) for scripts."""
+    print(f"wmrkit: warning: {message}", file=sys.stderr)
+    said = _SAID.get()
+    if said is not None:
+        said.append(message)
+
+
+def print_json(data: Any, *, warnings: bool = False) -> None:
+    """Print `data` as JSON (NaN and infinities become null: JSON has none). With `warnings` (the commands that can
+    warn), the mapping gets a top-level ``"warnings"``: the messages of :func:`warn` in this run, [] when none."""
+    if warnings:
+        data = {**data, "warnings": list(_SAID.get() or [])}
     print(json.dumps(_finite(data), indent=2))
 
 

@@ -19,6 +19,7 @@ from ._common import (
     parse_value,
     print_json,
     seed,
+    warn,
 )
 
 
@@ -164,8 +165,11 @@ def run_odometry(args: argparse.Namespace) -> int:
                                 trajectories=args.trajectories, trajectory_format=args.trajectory_format or "tum",
                                 closed=args.closed, resume=not args.no_resume, progress=_progress(args),
                                 **_options(args))
+    for r in result.rows:  # they were only in the table's 'warnings' column (or nowhere, without --out)
+        if r["warnings"] and not r["error"]:
+            warn(f"{r['log']}: {r['warnings']}")
     if args.json:
-        print_json(result.to_dict() | {"rows": [dict(r) for r in result.rows]})
+        print_json(result.to_dict() | {"rows": [dict(r) for r in result.rows]}, warnings=True)
         return 1 if result.failed else 0
     print(f"{len(result.rows)} logs: {len(result.rows) - result.failed} done ({result.skipped} from an earlier run), "
           f"{result.failed} failed" + (f"; table {args.out}" if args.out else ""))
@@ -175,9 +179,6 @@ def run_odometry(args: argparse.Namespace) -> int:
         elif not args.out:
             print(f"  {r['log']}: x {r['x']:.4f} m, y {r['y']:.4f} m, theta {r['theta']:.4f} rad, "
                   f"path {r['path_length']:.4g} m")
-    for r in result.rows:  # they were only in the table's 'warnings' column (or nowhere, without --out)
-        if r["warnings"] and not r["error"]:
-            print(f"wmrkit: warning: {r['log']}: {r['warnings']}", file=sys.stderr)
     return 1 if result.failed else 0  # a pipeline must tell a batch with failed logs from a complete one
 
 
@@ -208,8 +209,10 @@ def run_calibrate(args: argparse.Namespace) -> int:
             result = fleet_calibrate(robot, runs, params, runner=runner, ci=args.ci, level=args.level,
                                      n_boot=args.bootstrap, method=args.method, sensed=args.sensed,
                                      progress=_progress(args))
+    for warning in () if args.slip else result.warnings:  # the slip fit has none
+        warn(warning)
     if args.json:
-        print_json(result.to_dict())
+        print_json(result.to_dict(), warnings=True)
         return 0
     if args.slip:
         print(result.format())
@@ -218,8 +221,6 @@ def run_calibrate(args: argparse.Namespace) -> int:
           f"{result.rms_after:.4g}; {result.level:.0%} intervals ({result.ci})")
     for name, nominal, value, lo, hi in result.values:
         print(f"  {name:<24} {nominal:.6g} -> {value:.6g}  [{lo:.6g}, {hi:.6g}]")
-    for warning in result.warnings:
-        print(f"wmrkit: warning: {warning}", file=sys.stderr)
     return 0
 
 
@@ -258,11 +259,10 @@ def run_montecarlo(args: argparse.Namespace) -> int:
         plot_monte_carlo(result, args.plot)
     castors = [j for j in model.rate_joints if j in model.steer_joints]
     if castors:  # their noisy angles are both increments and configuration
-        print(f"wmrkit: warning: the analytic covariance (003, first order) leaves out the configuration error that "
-              f"the noise of the castor angles {', '.join(castors)} builds up: trust the Monte Carlo spread",
-              file=sys.stderr)
+        warn(f"the analytic covariance (003, first order) leaves out the configuration error that the noise of the "
+             f"castor angles {', '.join(castors)} builds up: trust the Monte Carlo spread")
     if args.json:
-        print_json(result.to_dict())
+        print_json(result.to_dict(), warnings=True)
         return 0
     d = result.to_dict()
     print(f"robot {robot.name}: {result.runs} runs over {result.samples} samples")

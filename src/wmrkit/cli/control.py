@@ -9,7 +9,7 @@ import warnings
 from pathlib import Path
 
 from ..errors import WmrkitError
-from ._common import add_json_flag, add_robot_argument, check_plot_path, load_robot, parse_value, print_json
+from ._common import add_json_flag, add_robot_argument, check_plot_path, load_robot, parse_value, print_json, warn
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -118,7 +118,7 @@ def check_animation_path(path: str | None, suffixes: tuple[str, ...] = (".gif",)
 
 
 def run_track(args: argparse.Namespace) -> int:
-    """Simulate, then print a summary (or the time series as JSON); warnings on stderr."""
+    """Simulate, then print a summary (or the time series as JSON); warnings on stderr (and in the JSON)."""
     from ..control.laws import GateWarning, SamplingWarning
     from ..control.track import track
 
@@ -155,13 +155,12 @@ def run_track(args: argparse.Namespace) -> int:
                     progress=sys.stderr.isatty() and not args.json)
     for w in caught:
         if issubclass(w.category, (SamplingWarning, GateWarning)):
-            print(f"wmrkit: warning: {w.message}", file=sys.stderr)
+            warn(str(w.message))
     for v in run.range_violations():
         lo, hi = (math.degrees(a) for a in robot.wheel(v["wheel"]).steer_range)
-        print(f"wmrkit: warning: wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg for "
-              f"{v['seconds']:.3g} s (t = {v['from']:.4g} to {v['to']:.4g} s) and was held at its end: the robot "
-              "cannot follow this reference there (its wheels scrub; the tracking errors are the result)",
-              file=sys.stderr)
+        warn(f"wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg for {v['seconds']:.3g} s "
+             f"(t = {v['from']:.4g} to {v['to']:.4g} s) and was held at its end: the robot cannot follow this "
+             "reference there (its wheels scrub; the tracking errors are the result)")
     if args.plot or args.animate:
         from ..control.plots import animate_run, plot_run
 
@@ -170,7 +169,7 @@ def run_track(args: argparse.Namespace) -> int:
         if args.animate:
             animate_run(run, args.animate)
     if args.json:
-        print_json(run.to_dict())
+        print_json(run.to_dict(), warnings=True)
     else:
         s = run.summary()
         print(f"robot {robot.name}, reference {reference.name}, controller {args.controller}, "

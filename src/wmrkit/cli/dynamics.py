@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +18,7 @@ from ._common import (
     parse_assignments,
     parse_value,
     print_json,
+    warn,
 )
 
 
@@ -94,11 +94,10 @@ def run_tyre(args: argparse.Namespace) -> int:
         _plot_tyre(tyre, load, s, a, speed, args.plot)
     warning = beyond_fit(tyre.model, speed)
     if warning:
-        print(f"wmrkit: warning: {warning}", file=sys.stderr)
+        warn(warning)
     if args.json:
         print_json({"model": tyre.model, "params": tyre.as_dict(), "load": load, "slip_ratio": s, "slip_angle": a,
-                    "speed": speed, "Fx": fx, "Fy": fy, "mu_long": mu_long, "mu_lat": mu_lat,
-                    "warnings": [warning] if warning else []})
+                    "speed": speed, "Fx": fx, "Fy": fy, "mu_long": mu_long, "mu_lat": mu_lat}, warnings=True)
     else:
         print(f"{tyre.model} tyre, load {load:g} N, slip ratio {s:g}, slip angle {a:g} rad, wheel speed {speed:g} m/s")
         print(f"Fx (longitudinal) = {fx:.6g} N")
@@ -151,14 +150,12 @@ def run_simulate(args: argparse.Namespace) -> int:
     pose, tw, end = sim.pose[-1], sim.twist[-1], float(sim.t[-1])  # the last sample: the record step's multiple
     travelled = float(np.sum(np.hypot(*np.diff(sim.pose[:, :2], axis=0).T)))
     max_slip = float(np.hypot(sim.slip[..., 0], sim.slip[..., 1]).max())  # a contact's slip speed, not a component
-    warnings = _tyre_warnings(model, sim.twist)
-    for warning in warnings:
-        print(f"wmrkit: warning: {warning}", file=sys.stderr)
+    for warning in _tyre_warnings(model, sim.twist):
+        warn(warning)
     if args.json:
         print_json({"robot": model.robot.name, "method": sim.method, "step": step, "duration": duration,
                     "samples": len(sim.t), "final_time": end, "final_pose": pose.tolist(), "final_twist": tw.tolist(),
-                    "distance": travelled, "max_slip": max_slip, "out": args.out,
-                    "warnings": warnings})
+                    "distance": travelled, "max_slip": max_slip, "out": args.out}, warnings=True)
     else:
         print(f"{model.robot.name}: {duration:g} s simulated ({sim.method}, step {step:g} s), {len(sim.t)} samples")
         print(f"final pose (t = {end:g} s): x = {pose[0]:.6g} m, y = {pose[1]:.6g} m, theta = {pose[2]:.6g} rad")

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 
 import numpy as np
 
@@ -22,6 +21,7 @@ from ._common import (
     parse_value,
     print_json,
     steered_robot,
+    warn,
     wheel_column_width,
 )
 
@@ -49,18 +49,18 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 
 
 def run_ik(args: argparse.Namespace) -> int:
-    """Print the per-wheel commands; warn on stderr when the twist makes a fixed wheel slip."""
+    """Print the per-wheel commands; warn when the twist makes a fixed wheel slip or a wheel steer out of range."""
     robot = steered_robot(args.robot, args.steer)
     commands = wheel_commands(robot, args.twist)
     _check_finite("ik", commands.rates, commands.slip)
     for why in _infeasible(robot, commands):
-        print(f"wmrkit: warning: twist not feasible for robot '{robot.name}': {why}", file=sys.stderr)
-    print_json(commands.to_dict()) if args.json else print(format_commands(robot, commands))
+        warn(f"twist not feasible for robot '{robot.name}': {why}")
+    print_json(commands.to_dict(), warnings=True) if args.json else print(format_commands(robot, commands))
     return 0
 
 
 def run_fk(args: argparse.Namespace) -> int:
-    """Print the twist and the slip residual; warn on stderr when the rates do not fix the twist."""
+    """Print the twist and the slip residual; warn when the rates do not fix the twist or contradict each other."""
     robot = steered_robot(args.robot, args.steer)
     given = parse_assignments(args.spin, "--spin")
     rates = {name: parse_value(value, "number", f"--spin {name}") for name, value in given.items()}
@@ -72,17 +72,15 @@ def run_fk(args: argparse.Namespace) -> int:
     _check_finite("fk", fk.twist, fk.residual)
     twist, determined = fk.twist, bool(twist_is_determined(robot, list(rates)))
     if not determined:
-        print(f"wmrkit: warning: these rates do not determine the twist of robot '{robot.name}'; "
-              "printing the minimum-norm one", file=sys.stderr)
+        warn(f"these rates do not determine the twist of robot '{robot.name}'; printing the minimum-norm one")
     if not fk.consistent:
         names = fk.slipping or [robot.wheel_names[i] for i in np.argsort(-fk.wheel_slip) if fk.wheel_slip[i] > 0]
         worst = ", ".join(f"{n} {fk.wheel_slip[robot.wheel_names.index(n)]:.3g} m/s" for n in names)
-        print(f"wmrkit: warning: the rates contradict each other: the wheels slip ({worst}; residual "
-              f"{fk.residual:.3g} m/s > tolerance {fk.tolerance:.3g} m/s); check units, signs and --steer headings",
-              file=sys.stderr)
+        warn(f"the rates contradict each other: the wheels slip ({worst}; residual {fk.residual:.3g} m/s > "
+             f"tolerance {fk.tolerance:.3g} m/s); check units, signs and --steer headings")
     if args.json:
         print_json({"twist": twist.tolist(), "determined": determined, "residual": fk.residual,
-                    "consistent": fk.consistent, "slipping": list(fk.slipping)})
+                    "consistent": fk.consistent, "slipping": list(fk.slipping)}, warnings=True)
     else:
         vx, vy, omega = (_num(v) for v in twist)
         print(f"twist (robot frame): vx = {vx} m/s, vy = {vy} m/s, omega = {omega} rad/s")

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from typing import NoReturn
 
 from ..errors import DescriptionError, WmrkitError
-from ._common import check_blank, check_outputs, output_option
+from ._common import check_blank, check_outputs, collecting_warnings, output_option
 
 #: Each command and the module of ``wmrkit.cli`` that registers it (``add_parsers``), in ``--help`` order.
 COMMANDS = {
@@ -85,7 +85,8 @@ def main(argv: list[str] | None = None) -> int:
         as_json = bool(getattr(args, "json", False))  # as parsed: '--js' is --json too
         check_blank(parser, args)
         check_outputs(parser, args)
-        return int(args.run(args) or 0)
+        with collecting_warnings():
+            return int(args.run(args) or 0)
     except WmrkitError as err:
         report_error(err, as_json, argv)
         return 2

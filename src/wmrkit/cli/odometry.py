@@ -29,6 +29,7 @@ from ._common import (
     parse_assignments,
     parse_value,
     print_json,
+    warn,
 )
 from .slip import ESTIMATOR_METHODS, add_estimator_options, check_estimator_options, estimator_from_args, resolve_method
 
@@ -158,12 +159,15 @@ def run(args: argparse.Namespace) -> int:
                                     filtered=args.method if args.method in ("fk1", "fk2") else None)
     if fmt.heading_column or fmt.gyro_column:
         consistent = _check_heading(robot, args.log, fmt, args.sensed) and consistent
-    print_json(summary.to_dict() | {"consistent": consistent}) if args.json else print(format_summary(summary))
+    if args.json:
+        print_json(summary.to_dict() | {"consistent": consistent}, warnings=True)
+    else:
+        print(format_summary(summary))
     return 0
 
 
 def _warn_ill_conditioned(name: str, model) -> None:
-    """Warn (one line on stderr) when, at a steering configuration of the log, the filter's kept rows barely fixed
+    """Warn (:func:`._common.warn`) when, at a steering configuration of the log, the filter's kept rows barely fixed
     the twist (:attr:`~wmrkit.slip.kalman.KalmanModel.worst_conditioning`): its answer there is its prediction."""
     from ..slip.kalman import ILL_CONDITIONED
 
@@ -176,9 +180,8 @@ def _warn_ill_conditioned(name: str, model) -> None:
     where = ", ".join(f"{n} {math.degrees(heading[om.robot.steer_names.index(n)]):.4g} deg" for n in beta)
     fix = ("do not fix the twist" if math.isinf(worst[0]) else
            f"barely fix the twist (condition number {worst[0]:.3g} > {ILL_CONDITIONED:g})")
-    print(f"wmrkit: warning: {name}: at a steering heading of the log ({where}) its measurement rows {fix}: there the "
-          f"filter carries its prediction and the trajectory can be far off"
-          f"{'; use --method fk2 or wls' if name == 'fk1' else ''}", file=sys.stderr)
+    warn(f"{name}: at a steering heading of the log ({where}) its measurement rows {fix}: there the filter carries "
+         f"its prediction and the trajectory can be far off{'; use --method fk2 or wls' if name == 'fk1' else ''}")
 
 
 #: Slip tolerance of a log: an RMS slip indicator above this fraction of the mean motion per interval means the
@@ -187,7 +190,7 @@ LOG_SLIP_RTOL = 0.02
 
 
 def _check_consistency(s: OdometrySummary, wheel_slips, *, filtered: str | None = None) -> bool:
-    """Warn (one line on stderr) when the slip indicator exceeds the tolerance, naming the wheels that slip most
+    """Warn (:func:`._common.warn`) when the slip indicator exceeds the tolerance, naming the wheels that slip most
     (`wheel_slips()`, RMS per wheel of the no-slip model); return whether it did not. A slip indicator as large as
     the motion itself means units, signs or the description are wrong. A Kalman filter's indicator (`filtered`:
     its name) is its residual, which also holds its lag behind the measurements: where the no-slip model's own
@@ -199,19 +202,18 @@ def _check_consistency(s: OdometrySummary, wheel_slips, *, filtered: str | None 
         return True
     slips = wheel_slips()
     if filtered and float(np.sqrt(sum(v * v for v in slips.values()))) <= tolerance:
-        print(f"wmrkit: warning: the {filtered} filter's residual (slip indicator rms {s.rms_slip:.3g} m per "
-              f"interval, max {s.max_slip:.3g} m, against {motion:.3g} m of motion) shows a log that changes faster "
-              "than its process noise allows: a glitch in a reading, slip, or a process noise too small "
-              "(--kf-noise); the sensed joints themselves agree", file=sys.stderr)
+        warn(f"the {filtered} filter's residual (slip indicator rms {s.rms_slip:.3g} m per interval, max "
+             f"{s.max_slip:.3g} m, against {motion:.3g} m of motion) shows a log that changes faster than its process "
+             "noise allows: a glitch in a reading, slip, or a process noise too small (--kf-noise); the sensed "
+             "joints themselves agree")
         return False
     what = ("larger than the motion itself: check the columns' units (counts? degrees?), signs and the robot "
             "description" if s.rms_slip > motion else "beyond measurement noise: wheels slip, or units or signs "
             "are wrong")
     named = ", ".join(f"{name} {value:.3g} m" for name, value in sorted(slips.items(), key=lambda kv: -kv[1]))
     named = f" (slip per wheel: {named})" if named else ""
-    print(f"wmrkit: warning: the sensed joints contradict each other: slip indicator rms {s.rms_slip:.3g} m per "
-          f"interval (max {s.max_slip:.3g} m) against {motion:.3g} m of motion per interval{named}, {what}",
-          file=sys.stderr)
+    warn(f"the sensed joints contradict each other: slip indicator rms {s.rms_slip:.3g} m per interval (max "
+         f"{s.max_slip:.3g} m) against {motion:.3g} m of motion per interval{named}, {what}")
     return False
 
 
@@ -225,7 +227,7 @@ HEADING_MIN_TURN = 0.1
 
 
 def _check_heading(robot, log: str, fmt: LogFormat, sensed) -> bool:
-    """Warn (one line on stderr) when the external heading's turns contradict the wheels' over the first samples of
+    """Warn (:func:`._common.warn`) when the external heading's turns contradict the wheels' over the first samples of
     a CSV log (:data:`HEADING_RTOL`); return whether they did not. Its changes replace the wheels' dtheta, so a
     heading in other units or of the other sign gave a wrong trajectory with "consistent": true."""
     if is_bag(log):
@@ -239,10 +241,9 @@ def _check_heading(robot, log: str, fmt: LogFormat, sensed) -> bool:
     if scale < HEADING_MIN_TURN or off <= HEADING_RTOL * scale:
         return True
     column, unit = (fmt.heading_column, "deg") if fmt.heading_column else (fmt.gyro_column, "deg/s")
-    print(f"wmrkit: warning: the external heading (column '{column}') turns {external.sum():.4g} rad over the first "
-          f"{len(first)} samples where the wheels turn {wheels.sum():.4g} rad ({off:.3g} rad apart interval by "
-          f"interval): its units (deg or deg/s? write them in the header: '{column} [{unit}]') or its sign "
-          f"(clockwise?) are probably wrong", file=sys.stderr)
+    warn(f"the external heading (column '{column}') turns {external.sum():.4g} rad over the first {len(first)} samples "
+         f"where the wheels turn {wheels.sum():.4g} rad ({off:.3g} rad apart interval by interval): its units (deg or "
+         f"deg/s? write them in the header: '{column} [{unit}]') or its sign (clockwise?) are probably wrong")
     return False
 
 

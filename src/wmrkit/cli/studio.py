@@ -6,12 +6,12 @@ import argparse
 import errno
 import ipaddress
 import socket
-import sys
 import threading
 import webbrowser
 from pathlib import Path
 
 from ..errors import WmrkitError
+from ._common import warn
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -62,8 +62,7 @@ def run_studio(args: argparse.Namespace) -> int:
     config = uvicorn.Config(app, host=args.host, port=args.port, log_level="warning")
     server = uvicorn.Server(config)
     if not loopback:
-        print(f"wmrkit: warning: listening on {args.host}: other machines can reach the studio and its folder",
-              file=sys.stderr)
+        warn(f"listening on {args.host}: other machines can reach the studio and its folder")
 
     def announce() -> None:
         while not server.started:
