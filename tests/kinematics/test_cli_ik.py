@@ -225,11 +225,11 @@ def test_ik_and_show_tables_keep_long_wheel_names_apart_from_their_type(capsys, 
     for argv in (("ik", str(path), "--twist", "0.3", "0.2", "0.5"), ("show", str(path))):
         code, out, _ = run(capsys, *argv)
         rows = [line.split() for line in out.splitlines() if line.split() and line.split()[0] in names]
-        assert code == 0 and [r[0] for r in rows] == list(names) and {r[1] for r in rows} == {"swedish"}
+        assert code == 0 and [r[0] for r in rows] == list(names) and {r[1] for r in rows} == {"mecanum"}
         header = next(line for line in out.splitlines() if line.split()[:2] == ["wheel", "type"])
         for line in out.splitlines():  # the columns line up: each row's type starts under the header's
             if line.split() and line.split()[0] in names:
-                assert line.index(" swedish") + 1 == header.index("type")
+                assert line.index(" mecanum") + 1 == header.index("type")
 
 
 def test_every_number_column_of_the_ik_table_names_its_unit(capsys):
