@@ -15,7 +15,7 @@ in any log file, and :func:`~.logs.write_log` writes the log with headings.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,7 +26,7 @@ from ..errors import WmrkitError
 from ..kinematics.linalg import solve_assigned
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_seed
 from ..robot import Robot
-from ..wheels import heading_in_range, wheel_slip_rows
+from ..wheels import Wheel, heading_in_range, slip_row_entries
 from .encoders import AbsoluteEncoder, Encoder, IncrementalEncoder
 from .integrators import integrate_increments
 from .logs import JointLog
@@ -320,9 +320,28 @@ def _nodes_from_intervals(b: np.ndarray, fine: np.ndarray, default: float) -> np
     return np.interp(fine, fine[ok], nodes[ok])
 
 
-def _castor_angles(wheel, profile: TwistProfile, fine: np.ndarray) -> np.ndarray:
+def _slip_rows_at(wheel: Wheel) -> Callable[[float], np.ndarray]:
+    """``b -> wheel_slip_rows(wheel, b)`` (3.6), (3.11)-(3.13), bit for bit, for one angle ``b`` [rad]: the same
+    entries (:func:`~wmrkit.wheels.slip_row_entries`) and products, without wheel_slip_rows's checks, element
+    expansion and broadcasting on every call (the castor ODE's right side calls it some 30 times a sample; they
+    took two thirds of ``simulate`` of a robot with castors)."""
+    parts = [(np.array(e[:2] + e[3:8], dtype=float), e.beta_offset, np.asarray(e.rate_map, dtype=float))
+             for e in wheel.elements()]
+
+    def rows(b: float) -> np.ndarray:
+        blocks = []
+        for (l, alpha, d, delta, gamma, r, r_r), offset, rate_map in parts:
+            g = np.array(slip_row_entries(b + offset, l, alpha, d, delta, gamma, r, r_r))
+            blocks.append(np.concatenate([g[:, :3], g[:, 3:] @ rate_map], -1))
+        return np.concatenate(blocks)
+
+    return rows
+
+
+def _castor_angles(wheel: Wheel, profile: TwistProfile, fine: np.ndarray) -> np.ndarray:
     from scipy.integrate import solve_ivp
 
+    slip_rows = _slip_rows_at(wheel)
     beta = np.empty(len(fine))
     beta[0] = wheel.beta
     bounds = profile.boundaries
@@ -334,7 +353,7 @@ def _castor_angles(wheel, profile: TwistProfile, fine: np.ndarray) -> np.ndarray
         tw = profile.twists[s]
 
         def rhs(_t, b, tw=tw):
-            rows = wheel_slip_rows(wheel, b[0])  # (2E, 3 + n_rates): steer rate is the first rate column
+            rows = slip_rows(b[0])  # (2E, 3 + n_rates): steer rate is the first rate column
             rates = np.linalg.lstsq(rows[:, 3:], -rows[:, :3] @ tw, rcond=None)[0]
             return [rates[0]]
 
