@@ -557,7 +557,7 @@ def test_a_robot_built_with_numpy_numbers_saves_and_loads(suffix, tmp_path):
     represent an object') or json's TypeError ('Object of type float32 is not JSON serializable')."""
     robot = Robot("np", (
         Wheel("l", "fixed", l=np.float32(0.25), alpha=np.float64(math.pi / 2), beta=np.float32(0.0), r=np.float32(0.1)),
-        Wheel("c", "castor", l=np.int64(1), alpha=math.pi, beta=0.0, r=0.05, d=np.float16(0.125),
+        Wheel("c", "castor", l=np.int64(1), alpha=math.pi, beta=np.float64(math.pi / 2), r=0.05, d=np.float16(0.125),
               steer_range=(np.float32(-1.5), np.float32(1.5))),
     ))
     path = tmp_path / f"np{suffix}"
@@ -728,3 +728,33 @@ def test_conventions_md_says_how_a_file_is_written(tmp_path):
         wheel = {"name": "w", "type": "steerable", "position": [1, 0], "heading": heading, "r": 0.1}
         Robot.from_dict({"name": "r", "wheels": [wheel]}).to_file(tmp_path / "r.yaml")
         assert f"  {key}: {written}\n" in (tmp_path / "r.yaml").read_text()
+
+
+@pytest.mark.parametrize(("extra", "field", "written"), [
+    ({"heading": "50 deg"}, "heading", "heading 50 deg"),
+    ({"heading": -0.8}, "heading", "heading -45.8366 deg"),
+    ({"beta": "150 deg"}, "beta", "heading 60 deg"),
+    ({}, "steer_range", "heading 0 deg (no heading given: straight ahead)"),
+])
+def test_a_heading_outside_the_wheel_s_own_steer_range_is_refused(extra, field, written, tmp_path, capsys):
+    """A steered wheel described at a heading its steering cannot reach loaded silently (the robot then started
+    out of its own range: controllers held it at an end, odometry refused its logs). Now one line naming the file,
+    the wheel and the field; a heading within the range, or at an end, loads."""
+    wheel = {"name": "front", "type": "steerable", "position": [0.5, 0], "r": 0.1,
+             "steer_range": ["10 deg", "40 deg"]}
+    path = tmp_path / "bot.yaml"
+    text = yaml.safe_dump({"name": "bot", "wheels": [{**wheel, **extra}]}, sort_keys=False)
+    path.write_text(text)
+    assert main(["show", str(path), "--json"]) == 2
+    error = json.loads(capsys.readouterr().err)
+    line = _line_of(text, f"{field}:")
+    assert (error["file"], error["wheel"], error["field"], error["line"]) == (str(path), "front", field, line)
+    assert error["error"] == f"{written} is outside the wheel's steer_range [10, 40] deg"
+    for inside in ("10 deg", "25 deg", "40 deg", "-335 deg"):  # -335 deg is 25 deg a turn away
+        robot = Robot.from_dict({"name": "bot", "wheels": [{**wheel, "heading": inside}]})
+        assert Robot.from_dict(robot.to_dict()) == robot
+    across = {**wheel, "steer_range": ["170 deg", "190 deg"]}  # a range across 180 deg
+    assert Robot.from_dict({"name": "bot", "wheels": [{**across, "heading": "-175 deg"}]}).wheels[0].heading == \
+        pytest.approx(math.radians(-175))
+    with pytest.raises(DescriptionError, match=r"wheels\[0\]\.heading: heading 160 deg is outside"):
+        Robot.from_dict({"name": "bot", "wheels": [{**across, "heading": "160 deg"}]})

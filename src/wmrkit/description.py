@@ -51,6 +51,8 @@ from .wheels import (
     Wheel,
     beta_from_heading,
     geometry_problem,
+    heading_from_beta,
+    heading_in_range,
 )
 
 #: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
@@ -226,9 +228,25 @@ def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc, kind_name: str | N
     _check_geometry(kind_name, values, check, loc)
     actuated = check.joints(item, "actuated", kind.joints, loc)
     sensed = check.joints(item, "sensed", kind.joints, loc)
+    steer_range = _steer_range_from_dict(item, check, loc, kind.steers)
+    if steer_range is not None:
+        _check_heading_in_range(item, values, steer_range, check, loc)
     return Wheel(name=name, type=kind_name, actuated=actuated, sensed=sensed, **values,
-                 **mass.wheel_dynamics_from_dict(item, check, loc, kind_name),
-                 steer_range=_steer_range_from_dict(item, check, loc, kind.steers))
+                 **mass.wheel_dynamics_from_dict(item, check, loc, kind_name), steer_range=steer_range)
+
+
+def _check_heading_in_range(item: Mapping[str, Any], values: dict[str, float], steer_range: tuple[float, float],
+                            check: FieldReader, loc: Loc) -> None:
+    """A steered wheel described at a heading its own ``steer_range`` does not reach is refused: the robot would
+    start where its steering cannot be (controllers hold it at an end, odometry refuses its logs)."""
+    heading = float(heading_from_beta(values["beta"], values.get("delta", 0.0)))
+    if bool(heading_in_range(heading, *steer_range)):
+        return
+    field = next((key for key in ("heading", "beta") if key in item), "steer_range")
+    given = "" if field != "steer_range" else " (no heading given: straight ahead)"
+    lo, hi = (f"{math.degrees(v):g}" for v in steer_range)
+    check.fail(f"heading {math.degrees(heading):g} deg{given} is outside the wheel's steer_range [{lo}, {hi}] deg",
+               (*loc, field))
 
 
 def _steer_range_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc,
