@@ -485,3 +485,32 @@ def test_spin_columns_of_wheel_travel_in_metres_are_divided_by_the_radius(capsys
     assert out["consistent"] is True and out["distance"] == pytest.approx(2.0, rel=1e-9)
     with pytest.raises(WmrkitError, match=r"spin columns in m or m/s .* need the robot's wheel radii: pass robot="):
         load_csv(path, ["front_left.spin"], LogFormat(spin="distance" if unit == "m" else "speed"))
+
+
+@pytest.mark.parametrize(("unit", "per_rad", "rate"), [
+    ("deg", 180 / np.pi, False), ("deg/s", 180 / np.pi, True), ("rev", 0.5 / np.pi, False),
+    ("rev/s", 0.5 / np.pi, True), ("turn", 0.5 / np.pi, False), ("rpm", 30 / np.pi, True),
+])
+def test_spin_columns_in_degrees_or_turns_are_converted(capsys, tmp_path, unit, per_rad, rate):
+    """A wheel angle logged in degrees or turns ('left.spin [deg]', an encoder's 'rev', a motor's 'rpm') was refused
+    ("unknown unit 'deg' (for a spin joint: rad, ...)"), while the same header's steering in [deg] was read; the
+    user had to rewrite the file. The header's unit now converts the column into radians (rad/s), in the CLI and
+    in Python through header_format. A differential drive driving the arc (0.4 m/s, 0.5 rad/s) for 2 s: the pose
+    is the closed-form arc, as the same log in rad gives; a header mixing deg and rad is refused."""
+    from wmrkit.odometry.header import header_format
+    from wmrkit.odometry.logs import load_csv
+
+    diff, t = catalog.load("diff-drive"), np.linspace(0.0, 2.0, 201)
+    spins = wheel_commands(diff, [0.4, 0.0, 0.5]).spin[:2]  # rad/s, left then right (then the castor)
+    rows = [f"{a:.6f}," + ",".join(f"{(w if rate else w * a) * per_rad:.12f}" for w in spins) for a in t]
+    path = tmp_path / "spin.csv"
+    path.write_text(f"time,left.spin [{unit}],right.spin [{unit}]\n" + "\n".join(rows) + "\n")
+    out = _json(capsys, ["odometry", "diff-drive", str(path), "--json"])
+    np.testing.assert_allclose(out["pose"], [np.sin(1.0) / 0.5 * 0.4, (1 - np.cos(1.0)) / 0.5 * 0.4, 1.0],
+                               atol=1e-8)
+    log = load_csv(path, ["left.spin", "right.spin"], header_format(path, "diff-drive", ["left.spin", "right.spin"]),
+                   robot=diff)
+    np.testing.assert_allclose(log.positions[-1], spins * 2.0, rtol=1e-9)
+    path.write_text(f"time,left.spin [{unit}],right.spin [rad{'/s' if rate else ''}]\n0,0,0\n")
+    assert main(["odometry", "diff-drive", str(path)]) == 2
+    assert "the spin columns mix units" in capsys.readouterr().err

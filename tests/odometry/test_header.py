@@ -25,7 +25,8 @@ def test_steering_units_and_conventions():
 
 
 @pytest.mark.parametrize(("names", "message"), [
-    (["a.spin [deg]"], "unknown unit 'deg'"),
+    (["a.spin [grad]"], "unknown unit 'grad'"),
+    (["a.spin [deg]", "b.spin [rev]"], r"the spin columns mix units \(deg, rev\)"),
     (["a.spin [rad]", "b.spin [counts]"], "mix units"),
     (["a.spin [counts:u16]", "b.spin [counts:u32]"], "mix widths"),
     (["a.spin [counts:u99]"], "counter width 99"),
@@ -99,6 +100,6 @@ def test_a_column_named_with_a_unit_wmrkit_does_not_read_is_refused(tmp_path):
     name, so the header's reader (which refuses 'min' without the option) never saw it as the time's unit."""
     with pytest.raises(HeaderError, match=r"x\.csv:1: column 'time': unknown unit 'min' \(time units: s, ms, us, ns\)"):
         _format(tmp_path, "time [min],left.spin,right.spin", time_column="time [min]")
-    with pytest.raises(HeaderError, match=r"column 'enc_l': unknown unit 'deg/s' \(for a spin joint: rad, rad/s"):
-        _format(tmp_path, "time,enc_l [deg/s],enc_r [deg/s]",
-                columns={"left.spin": "enc_l [deg/s]", "right.spin": "enc_r [deg/s]"})
+    with pytest.raises(HeaderError, match=r"column 'enc_l': unknown unit 'grad/s' \(for a spin joint: rad, rad/s"):
+        _format(tmp_path, "time,enc_l [grad/s],enc_r [grad/s]",
+                columns={"left.spin": "enc_l [grad/s]", "right.spin": "enc_r [grad/s]"})

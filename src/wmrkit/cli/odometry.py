@@ -65,7 +65,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     g.add_argument("--spin", choices=("angle", "counts", "velocity"),
                    help="spin columns: cumulative angle [rad], encoder counts, or velocity [rad/s] (default: the "
                         "header's units, e.g. 'left.spin [counts:u16]', or the wheel's travel 'left.spin [m]' or "
-                        "speed '[m/s]'; else angle)")
+                        "speed '[m/s]', 'left.spin [deg]', '[rpm]'; else angle)")
     g.add_argument("--steer", choices=("angle", "degrees", "counts"),
                    help="steer columns: angle [rad], degrees or counts (default: the header's units, else angle)")
     g.add_argument("--steer-convention", choices=("heading", "beta"),

@@ -2,6 +2,7 @@
 
 A column name may carry its unit in brackets: ``time [ms]``, ``left.spin [rad]``, ``left.spin [rad/s]``,
 ``left.spin [counts]``, ``left.spin [m]`` or ``[m/s]`` (the wheel's travel or speed, divided by its radius),
+``left.spin [deg]``, ``[deg/s]``, ``[rev]`` (``[turn]``), ``[rev/s]`` (``[turn/s]``), ``[rpm]`` (read in rad, rad/s),
 ``left.spin [counts:u16]`` (an incremental encoder on an unsigned 16-bit counter that wraps;
 ``s16`` signed, any width from 8 to 64 bits), ``steer.steer [rad]``, ``steer.steer [deg]``, ``steer.steer [counts]``.
 A log written this way needs no ``--spin``/``--steer``/``--counter-bits`` options, and an option that contradicts
@@ -14,6 +15,7 @@ by an older wmrkit version, read as such; ``[deg:heading]`` says the default exp
 
 from __future__ import annotations
 
+import math
 import os
 import re
 from collections.abc import Mapping, Sequence
@@ -31,7 +33,12 @@ if TYPE_CHECKING:
     from .logs import LogFormat
 
 #: Units a joint column may declare, and the log-format mode each means.
-SPIN_UNITS = {"rad": "angle", "rad/s": "velocity", "counts": "counts", "m": "distance", "m/s": "speed"}
+SPIN_UNITS = {"rad": "angle", "rad/s": "velocity", "counts": "counts", "m": "distance", "m/s": "speed",
+              "deg": "angle", "deg/s": "velocity", "rev": "angle", "rev/s": "velocity", "turn": "angle",
+              "turn/s": "velocity", "rpm": "velocity"}
+#: Radians (rad/s) in one unit of the spin units that are not rad (:attr:`~.logs.LogFormat.spin_scale`).
+SPIN_SCALES = {"deg": math.pi / 180, "deg/s": math.pi / 180, "rev": 2 * math.pi, "rev/s": 2 * math.pi,
+               "turn": 2 * math.pi, "turn/s": 2 * math.pi, "rpm": math.pi / 30}
 #: The spin modes of :class:`~.logs.LogFormat` (``--spin`` takes the first three; a header's m, m/s the others).
 SPIN_MODES = ("angle", "counts", "velocity", "distance", "speed")
 STEER_UNITS = {"rad": "angle", "deg": "degrees", "counts": "counts"}
@@ -64,6 +71,7 @@ class HeaderUnits:
     signed: bool = False
     steer_convention: str | None = None
     external_degrees: bool = False  # the heading or gyro column is in deg (deg/s)
+    spin_scale: float = 1.0  # radians in one unit of the spin columns (deg, rev, rpm: SPIN_SCALES)
 
     @property
     def declared(self) -> bool:
@@ -94,7 +102,7 @@ def parse_header_units(names: list[str], *, source: str = "<log>", time_column: 
     or deg] and ``"gyro"`` [rad/s or deg/s], the external heading columns). The units of other columns (a battery
     voltage, a latency in ms) are not the log's and are ignored."""
     columns, modes, bits, signed, time_unit = [], {"spin": set(), "steer": set()}, set(), set(), None
-    conventions, roles, external_degrees = set(), dict(roles or {}), False
+    conventions, roles, external_degrees, spin_units = set(), dict(roles or {}), False, set()
     for written in names:
         match = _NAME.match(written)
         if match is None:
@@ -138,24 +146,31 @@ def parse_header_units(names: list[str], *, source: str = "<log>", time_column: 
             raise HeaderError(f"{source}:1: column '{plain}': unknown unit '{unit}' (for a {kind} joint: "
                               f"{', '.join(table)}; {extra}, ...)")
         modes[kind].add(table[unit])
+        if kind == "spin":
+            spin_units.add(unit)
     for kind, found in modes.items():
         if len(found) > 1:
             raise HeaderError(f"{source}:1: the {kind} columns mix units ({', '.join(sorted(found))}); one per log")
+    if len({SPIN_SCALES.get(u, 1.0) for u in spin_units}) > 1:  # rad and deg: both angles, not one scale
+        raise HeaderError(f"{source}:1: the spin columns mix units ({', '.join(sorted(spin_units))}); one per log")
     if len(bits) > 1 or len(signed) > 1:
         raise HeaderError(f"{source}:1: the counter columns mix widths or signedness; one counter per log")
     if len(conventions) > 1:
         raise HeaderError(f"{source}:1: the steer columns mix conventions (heading, beta); one per log")
     return HeaderUnits(tuple(columns), time_unit, next(iter(modes["spin"]), None), next(iter(modes["steer"]), None),
                        next(iter(bits), None), next(iter(signed), False), next(iter(conventions), None),
-                       external_degrees)
+                       external_degrees, SPIN_SCALES.get(next(iter(spin_units), "rad"), 1.0))
 
 
-def travel_radii(joints: Sequence[str], spin: str, robot: Robot | None, source: str) -> np.ndarray | None:
+def travel_radii(joints: Sequence[str], spin: str, robot: Robot | None, source: str,
+                 spin_scale: float = 1.0) -> np.ndarray | None:
     """What divides each joint's column into radians: its wheel's radius for spin joints logged as the wheel's
-    travel [m] or speed [m/s] (WPILib's ``SwerveModulePosition.distanceMeters``), 1 for steering; None for other
-    spin modes. Those need the robot (:class:`HeaderError`)."""
+    travel [m] or speed [m/s] (WPILib's ``SwerveModulePosition.distanceMeters``), ``1 / spin_scale`` for spins in
+    another angle unit (deg, rev), 1 for steering; None when nothing is divided. Travel needs the robot
+    (:class:`HeaderError`)."""
     if spin not in ("distance", "speed"):
-        return None
+        return None if spin_scale == 1.0 else np.array([1.0 if j.endswith(".steer") else 1.0 / spin_scale
+                                                        for j in joints])
     if robot is None:
         raise HeaderError(f"{source}: spin columns in m or m/s (the wheels' travel) need the robot's wheel radii: "
                           "pass robot=")
@@ -241,4 +256,5 @@ def header_format(path: str | os.PathLike[str], robot_name: str, joints: Sequenc
                      spin=spin, steer=steer, encoders=encoders,
                      heading_column=None if heading_column is None else renamed.get(heading_column, heading_column),
                      gyro_column=None if gyro_column is None else renamed.get(gyro_column, gyro_column),
-                     max_gap=max_gap, steer_convention=convention, external_degrees=units.external_degrees)
+                     max_gap=max_gap, steer_convention=convention, external_degrees=units.external_degrees,
+                     spin_scale=units.spin_scale)

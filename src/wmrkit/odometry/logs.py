@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
-from .._shapes import as_names, as_reals
+from .._shapes import as_names, as_reals, finite_number
 from ..errors import WmrkitError
 from ..limits import check_chunk_size, regular_file_problem
 from ._text import check_lines, did_you_mean, encoded, parse_rows, read_lines, short
@@ -139,7 +139,8 @@ class LogFormat:
     (0 = rolling straight ahead, the default) or ``"beta"`` (the thesis's angle, files of older wmrkit versions;
     header ``[deg:beta]``). ``encoders``: ``(joint, encoder)`` pairs for counts. ``heading_column``: absolute heading
     [rad] (IMU yaw; unwrapped here) replacing the wheels' heading; ``gyro_column``: yaw rate [rad/s] instead
-    (integrated from 0); ``external_degrees``: that column is in deg (deg/s; a header's ``[deg]``). ``max_gap``: longest
+    (integrated from 0); ``external_degrees``: that column is in deg (deg/s; a header's ``[deg]``). ``spin_scale``:
+    radians in one unit of the spin columns in angle or velocity mode (pi/180 for a header's deg). ``max_gap``: longest
     time step accepted [s] (None: any). ``time_unit``: one of :data:`TIME_UNITS`. ``max_rate``: largest
     plausible spin rate [rad/s] between two samples (None: any); a faster step is refused as an encoder jump.
     """
@@ -157,6 +158,7 @@ class LogFormat:
     max_rate: float | None = MAX_RATE
     steer_convention: Literal["heading", "beta"] = "heading"
     external_degrees: bool = False
+    spin_scale: float = 1.0
 
     def __post_init__(self) -> None:
         for name, kind, example in (("columns", str, "'enc_l'"),
@@ -183,6 +185,11 @@ class LogFormat:
             raise LogError("give a heading column or a gyro column, not both")
         if not isinstance(self.external_degrees, bool):
             raise LogError(f"LogFormat.external_degrees: expected True or False, got {self.external_degrees!r}")
+        scale = self.spin_scale
+        if (isinstance(scale, bool) or not (finite_number(scale) and scale > 0)
+                or (scale != 1 and self.spin not in ("angle", "velocity"))):
+            raise LogError(f"LogFormat.spin_scale: a number > 0 for spins in angle or velocity mode, got "
+                           f"{self.spin_scale!r} ({self.spin})")
         if self.max_gap is not None and not self.max_gap > 0:
             raise LogError(f"max_gap must be > 0 s, got {self.max_gap}")
         if self.max_rate is not None and not self.max_rate > 0:
@@ -217,7 +224,7 @@ class Decoder:
         self.joints, self.fmt, self.source, self.robot = joint_names(joints, source), fmt, source, robot
         if fmt.steer_convention == "heading":
             check_robot(self.joints, robot, source)
-        self._radii = travel_radii(self.joints, fmt.spin, robot, source)  # spins in m, m/s: divided into rad
+        self._radii = travel_radii(self.joints, fmt.spin, robot, source, fmt.spin_scale)  # m, m/s, deg: into rad
         self._last: np.ndarray | None = None  # last raw row (time, joints, heading)
         self._positions: np.ndarray | None = None  # last decoded positions
         self._heading = 0.0
