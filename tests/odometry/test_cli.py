@@ -514,3 +514,21 @@ def test_spin_columns_in_degrees_or_turns_are_converted(capsys, tmp_path, unit, 
     path.write_text(f"time,left.spin [{unit}],right.spin [rad{'/s' if rate else ''}]\n0,0,0\n")
     assert main(["odometry", "diff-drive", str(path)]) == 2
     assert "the spin columns mix units" in capsys.readouterr().err
+
+
+def test_a_header_with_quoted_column_names_reads_as_without_quotes(capsys, tmp_path):
+    """A spreadsheet's export quotes its header ('"time [s]","left.spin [deg]"'): it was refused with 'missing
+    column 'time' (columns: '"time [s]", ...')', the quotes read as part of the names. The header line is read as
+    CSV (quotes removed, a quoted delimiter kept in its name), in the CLI and load_csv, with its units."""
+    from wmrkit.odometry.header import header_format
+    from wmrkit.odometry.logs import load_csv
+
+    rows = "0,0,0,5\n0.5,57.3,114.6,5\n1,114.6,229.2,5\n"
+    plain, quoted = tmp_path / "plain.csv", tmp_path / "quoted.csv"
+    plain.write_text("time [s],left.spin [deg],right.spin [deg],volts\n" + rows)
+    quoted.write_text('"time [s]", "left.spin [deg]","right.spin [deg]","battery, volts"\n' + rows)
+    want = _json(capsys, ["odometry", "diff-drive", str(plain), "--json"])
+    assert _json(capsys, ["odometry", "diff-drive", str(quoted), "--json"])["pose"] == want["pose"]
+    joints = ["left.spin", "right.spin"]
+    log = load_csv(quoted, joints, header_format(quoted, "diff-drive", joints), robot=catalog.load("diff-drive"))
+    np.testing.assert_allclose(log.positions[-1], np.radians([114.6, 229.2]), rtol=1e-12)

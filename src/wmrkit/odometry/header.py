@@ -15,6 +15,7 @@ by an older wmrkit version, read as such; ``[deg:heading]`` says the default exp
 
 from __future__ import annotations
 
+import csv
 import math
 import os
 import re
@@ -89,8 +90,15 @@ def read_header_units(path: str | Path, *, max_chars: int = 1 << 16, delimiter: 
             line = f.readline(max_chars)
     except OSError:
         return HeaderUnits(())
-    return parse_header_units(line.strip("\r\n").split(delimiter), source=str(path), time_column=time_column,
+    return parse_header_units(header_names(line, delimiter), source=str(path), time_column=time_column,
                               roles=roles)
+
+
+def header_names(line: str, delimiter: str = ",") -> list[str]:
+    """The column names of a header line, read as CSV: a spreadsheet's quotes (``"time [s]"``) are not part of the
+    names, and a quoted delimiter is (``"battery, volts"``); spaces around a name are dropped."""
+    return [name.strip() for name in next(csv.reader([line.strip("\r\n")], delimiter=delimiter,
+                                                     skipinitialspace=True), [""])]
 
 
 def parse_header_units(names: list[str], *, source: str = "<log>", time_column: str = "time",

@@ -35,7 +35,7 @@ from ..errors import WmrkitError
 from ..limits import check_chunk_size, regular_file_problem
 from ._text import check_lines, did_you_mean, encoded, parse_rows, read_lines, short
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
-from .header import SPIN_MODES, bare_heading_problem, travel_radii
+from .header import SPIN_MODES, bare_heading_problem, header_names, travel_radii
 from .steering import CONVENTIONS, check_robot, check_steer_range, convert_steering
 
 if TYPE_CHECKING:
@@ -363,7 +363,7 @@ def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat
         encoded([header_line], source, 1)
         if not header_line.strip():
             raise LogError(f"{source}:1: empty file or no header line")
-        header = [h.strip() for h in header_line.strip("\r\n").split(fmt.delimiter)]
+        header = header_names(header_line, fmt.delimiter)  # quotes of a spreadsheet's export removed
         usecols = _columns(header, joints, fmt, wheels, source)
         if progress is not None:
             progress(len(header_line.encode()))
