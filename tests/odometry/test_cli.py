@@ -532,3 +532,38 @@ def test_a_header_with_quoted_column_names_reads_as_without_quotes(capsys, tmp_p
     joints = ["left.spin", "right.spin"]
     log = load_csv(quoted, joints, header_format(quoted, "diff-drive", joints), robot=catalog.load("diff-drive"))
     np.testing.assert_allclose(log.positions[-1], np.radians([114.6, 229.2]), rtol=1e-12)
+
+
+GEARED = """name: geared
+wheels:
+  - {name: left, type: fixed, position: [0, 0.2], heading: 0, r: 0.1, actuated: [spin], sensed: [spin]}
+  - {name: right, type: fixed, position: [0, -0.2], heading: 0, r: 0.1, sensed: [spin]}
+couplings:
+  - {kind: gear, joints: [left.spin, right.spin], ratios: [1, RATIO]}
+"""
+
+
+@pytest.mark.parametrize(("ratio", "right", "agrees"), [
+    (1, 2.0, False),  # the gear turns both spins together; the log turns the right one twice as fast
+    (2, 2.0, True),  # the gear's ratio 2: as logged
+    (-1, -1.0, True),  # a gear reversing the right wheel (the robot turns on the spot)
+    (-1, 1.0, False),  # ... logged turning the same way
+    (1, 1.03, True),  # 3 % apart: backlash, encoder noise
+])
+def test_a_log_that_breaks_a_gear_coupling_warns_and_says_inconsistent(capsys, tmp_path, ratio, right, agrees):
+    """A description's gear says its joints turn together (q_j = ratio_j * u); a log whose geared spins did not
+    (right = 2 x left on a 1:1 gear: another robot's log, or a wrong description) was integrated as a turn, exit 0,
+    "consistent": true, slip indicator 0 (two sensed spins determine a differential drive's twist: nothing else
+    compared them). Now a warning names the coupling and how far apart its joints turn, and "consistent" is false."""
+    robot = tmp_path / "geared.yaml"
+    robot.write_text(GEARED.replace("RATIO", str(ratio)))
+    log = tmp_path / "g.csv"
+    log.write_text("time,left.spin,right.spin\n" + "".join(f"{t},{t},{t * right}\n" for t in range(5)))
+    assert main(["odometry", str(robot), str(log), "--json"]) == 0
+    out = capsys.readouterr()
+    assert json.loads(out.out)["consistent"] is agrees
+    if agrees:
+        assert out.err == ""
+    else:
+        assert out.err.count("\n") == 1 and out.err.startswith(
+            f"wmrkit: warning: the joints of gear(left.spin, right.spin) (ratios 1, {ratio:g}) do not turn together")

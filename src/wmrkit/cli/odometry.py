@@ -159,6 +159,7 @@ def run(args: argparse.Namespace) -> int:
                                     filtered=args.method if args.method in ("fk1", "fk2") else None)
     if fmt.heading_column or fmt.gyro_column:
         consistent = _check_heading(robot, args.log, fmt, args.sensed) and consistent
+    consistent = _check_gears(robot, args.log, fmt, args.sensed) and consistent
     if args.json:
         print_json(summary.to_dict() | {"consistent": consistent}, warnings=True)
     else:
@@ -245,6 +246,41 @@ def _check_heading(robot, log: str, fmt: LogFormat, sensed) -> bool:
          f"where the wheels turn {wheels.sum():.4g} rad ({off:.3g} rad apart interval by interval): its units (deg or "
          f"deg/s? write them in the header: '{column} [{unit}]') or its sign (clockwise?) are probably wrong")
     return False
+
+
+#: A gear coupling's joints (q_j = ratio_j * u) contradict it when their u_j differ, interval by interval over the
+#: first samples, by more than this fraction of the largest (backlash and encoder noise stay well within it).
+GEAR_RTOL = 0.1
+#: Least turning [rad] of a gear's u over the first samples for that comparison.
+GEAR_MIN_TURN = 0.1
+
+
+def _check_gears(robot, log: str, fmt: LogFormat, sensed) -> bool:
+    """Warn (one line on stderr per gear) when the logged joints of a description's ``gear`` coupling do not turn
+    together at its ratios over the first samples of a CSV log (:data:`GEAR_RTOL`); return whether they all did.
+    Odometry reads each joint on its own: a log breaking the gear (another robot's, or a wrong description) was
+    integrated as a turn with "consistent": true."""
+    gears = [c for c in robot.couplings if c.kind == "gear"]
+    if not gears or is_bag(log):
+        return True
+    model, first = _first_samples(robot, log, fmt, sensed)
+    steps = np.diff(first.positions, axis=0)
+    agrees = True
+    for gear in gears:
+        read = [(model.joints.index(j), k) for j, k in zip(gear.joints, gear.ratios, strict=True) if j in model.joints]
+        if len(read) < 2:
+            continue
+        u = np.column_stack([steps[:, i] / k for i, k in read])  # (N - 1, joints): the gear's input by each joint
+        scale = float(np.abs(u).max(axis=1).sum())
+        off = float((u.max(axis=1) - u.min(axis=1)).sum())
+        if scale < GEAR_MIN_TURN or off <= GEAR_RTOL * scale:
+            continue
+        agrees = False
+        turns = ", ".join(f"{model.joints[i]} {steps[:, i].sum():.4g} rad" for i, _ in read)
+        warn(f"the joints of {gear.channel_name} (ratios {', '.join(f'{k:g}' for k in gear.ratios)}) do not turn "
+             f"together over the first {len(first)} samples ({turns}; {off / scale:.0%} apart interval by interval): "
+             "the log is not of this robot, or its description's gear is wrong")
+    return agrees
 
 
 def _wheel_slips(robot, log: str, fmt: LogFormat, sensed) -> dict[str, float]:
