@@ -23,8 +23,8 @@ def test_ik_json_has_the_documented_shape(capsys):
     code, out, err = run(capsys, "ik", "swerve-4", "--twist", "1", "0.5", "0.2", "--json")
     assert code == 0 and err == ""
     data = json.loads(out)
-    assert set(data) == {"wheels", "slip", "out_of_range", "feasible", "warnings"} and data["feasible"] is True
-    assert data["warnings"] == []
+    assert set(data) == {"wheels", "slip", "out_of_range", "out_of_gear", "feasible", "warnings"}
+    assert data["feasible"] is True and data["warnings"] == []
     assert data["out_of_range"] == []
     robot = catalog.load("swerve-4")
     assert list(data["wheels"]) == list(robot.wheel_names)

@@ -124,13 +124,19 @@ def format_commands(robot: Robot, commands: WheelCommands) -> str:
 
 
 def _infeasible(robot, commands: WheelCommands) -> list[str]:
-    """Why one twist's commands are not feasible: a fixed wheel that slips sideways, steered wheels whose heading
-    is outside their steer_range (each ``"reason: detail"``)."""
+    """Why one twist's commands are not feasible: a fixed wheel that slips sideways, a gear coupling whose joints
+    would turn out of its ratios, steered wheels whose heading is outside their steer_range (each
+    ``"reason: detail"``)."""
     out = []
     if np.any(np.abs(commands.slip) > 1e-9):
         worst = int(np.argmax(np.abs(commands.slip)))
         out.append(f"a fixed wheel would slip sideways: wheel '{robot.wheel_names[worst]}' slips at "
                    f"{commands.slip[worst]:+.6g} m/s (fixed wheels allow no lateral motion)")
+    for c, ok in zip(robot.couplings, commands.in_gear.tolist(), strict=True):
+        if not ok:
+            asked = ", ".join(f"{j} {_num(commands.rates[robot.rate_names.index(j)])}" for j in c.joints)
+            out.append(f"a gear coupling cannot turn its joints so: {c.channel_name} turns them in the ratios "
+                       f"{', '.join(f'{k:g}' for k in c.ratios)}, the twist needs {asked} rad/s")
     for i in np.flatnonzero(~commands.in_range):
         lo, hi = (math.degrees(a) for a in robot.wheels[i].steer_range)
         out.append(f"a wheel cannot steer there: wheel '{robot.wheel_names[i]}' would steer to heading "

@@ -34,7 +34,7 @@ from ..odometry._kernels import _cos_sin, _sinc
 from ..robot import Robot
 from ..units import MAX_ANGLE, MAX_TURNS
 from . import _ik_fast
-from .wheel_ik import check_tolerances
+from .wheel_ik import GEAR_RTOL, check_tolerances
 
 drop_stale_cache([__file__], [_kernels.__file__])
 
@@ -50,7 +50,7 @@ class Realtime:
     - ``ik(vx, vy, omega, heading, rates_out, heading_out) -> bool``: per-wheel IK of one twist. `heading`
       ``(n_steer,)`` the current headings [rad]; writes the joint rates ``(n_rates,)`` (``robot.rate_names``) and
       the new headings; returns whether the twist is feasible (no fixed wheel slips beyond 1e-9 m/s, every heading
-      within its wheel's ``steer_range``).
+      within its wheel's ``steer_range``, every gear coupling's rates in its ratios), as ``wheel_commands``.
     - ``fk(rates, heading, twist_out)``: the twist ``(3,)`` from the sensed joint rates ``(n_a,)`` (``rate_joints``)
       by the least squares (4.11), at headings ``(n_steer_sensed,)`` of ``steer_joints`` (ignored when constant).
     - ``odometry_step(pose, previous, positions, heading_mid)``: one exact SE(2) step; `pose` ``(3,)`` is updated
@@ -125,6 +125,11 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
     too_big = f"ik: the twist (vx, vy, omega) must be finite, each at most {limit:g} in size"
     bad_heading = f"ik: the headings must be finite, at most {MAX_TURNS:g} turns [rad]"
     max_angle = MAX_ANGLE  # wheel_commands' bound (as_angles): beyond, the wrapped angle is round-off
+    gears = [c for c in robot.couplings if c.kind == "gear"]  # wheel_commands' in_gear, flattened
+    gear_cols = np.array([robot.rate_names.index(j) for c in gears for j in c.joints], dtype=np.int64)
+    gear_k = np.array([k for c in gears for k in c.ratios], dtype=float)
+    gear_start = np.cumsum([0] + [len(c.joints) for c in gears]).astype(np.int64)
+    n_gears, gear_rtol = len(gears), GEAR_RTOL
 
     @numba.njit(cache=False)
     def wrap(a):
@@ -189,6 +194,17 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             beta[k] = wrap(beta[k] + delta[k] - HALF_PI)
             if ranged[k] and not in_range(beta[k], k):
                 feasible = False
+        largest = 0.0
+        for j in range(n_rates):
+            largest = max(largest, abs(rates_out[j]))
+        for g in range(n_gears):  # a gear turns its joints as q_j = k_j u (wheel_ik.gear_error)
+            kq, kk = 0.0, 0.0
+            for t in range(gear_start[g], gear_start[g + 1]):
+                kq += gear_k[t] * rates_out[gear_cols[t]]
+                kk += gear_k[t] * gear_k[t]
+            for t in range(gear_start[g], gear_start[g + 1]):
+                if abs(rates_out[gear_cols[t]] - gear_k[t] * (kq / kk)) > gear_rtol * largest:
+                    feasible = False
         return feasible
 
     return ik

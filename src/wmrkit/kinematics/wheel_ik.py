@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_names, as_reals, as_vectors, finite_number, readonly
+from ..couplings import Coupling
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
@@ -25,8 +26,12 @@ from . import _ik_fast
 from ._ik_fast import wrap_angle
 from .linalg import matrix_rank, solve_assigned
 
-__all__ = ["WheelCommands", "forward_kinematics", "resolve_rate_name", "twist_is_determined", "wheel_commands",
-           "wrap_angle"]
+__all__ = ["WheelCommands", "forward_kinematics", "gear_error", "resolve_rate_name", "twist_is_determined",
+           "wheel_commands", "wrap_angle"]
+
+#: A gear coupling's rates are in its ratios when they depart from them by at most this fraction of the largest
+#: joint rate of the command (round-off of the rates (8.12)-(8.28) is ~1e-16 of it).
+GEAR_RTOL = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -42,7 +47,8 @@ class WheelCommands:
       relative to the body); NaN where the twist alone does not define it (steerable) or there is no joint.
     - ``rates`` ``(..., n_rates)``: every joint rate in ``robot.rate_names`` order (rollers, ``spin1``/``spin2``).
     - ``slip`` ``(..., N)`` [m/s]: lateral slip (3.11) row 0 / (8.14) left at each fixed wheel, 0 elsewhere.
-    - ``feasible`` ``(...)`` bool: every ``|slip| <= slip_tol`` and every heading within its wheel's ``steer_range``.
+    - ``feasible`` ``(...)`` bool: every ``|slip| <= slip_tol``, every heading within its wheel's ``steer_range``
+      and every gear coupling's rates in its ratios (``in_gear``).
     - ``in_range`` ``(..., N)`` bool: the wheel's heading lies in its ``steer_range`` (True for wheels without one,
       and for those that do not steer). The root of (8.9) is the one closest to the current heading unless only
       the other lies within the range; when neither does the twist is not feasible (the steering cannot reach it).
@@ -51,6 +57,9 @@ class WheelCommands:
       (0 = straight ahead, +x), ``steer + delta - pi/2`` (:func:`wmrkit.wheels.heading_from_beta`); NaN for wheels
       that do not steer. ``steer`` is the same angle in the thesis's convention (β, the axle).
     - ``held`` ``(..., N)`` bool: the steering axis does not move, the angle is undefined and was kept.
+    - ``in_gear`` ``(..., n_couplings)`` bool, one per ``robot.couplings``: a ``gear``'s joint rates are
+      ``ratio_j * u`` for one ``u`` (:func:`gear_error` within ``GEAR_RTOL`` of the largest rate); True for the
+      other kinds (a differential leaves the rates' difference free; a linkage's geometry is not modelled).
     """
 
     wheel_names: tuple[str, ...]
@@ -65,6 +74,8 @@ class WheelCommands:
     held: np.ndarray
     heading: np.ndarray
     in_range: np.ndarray
+    in_gear: np.ndarray
+    couplings: tuple[Coupling, ...] = ()
 
     def velocity(self, twist_robot: ArrayLike) -> np.ndarray:
         """The velocity vector ``(twist; rates)`` of ``Robot.velocity_names``. ``(..., 3) -> (..., 3 + n_rates)``."""
@@ -75,7 +86,8 @@ class WheelCommands:
         """One twist's commands as plain data (the ``wmrkit ik --json`` output); NaN stays NaN (JSON: null).
 
         ``{"wheels": {name: {"heading", "spin", "steer_rate", other joint rates...}}, "slip": {name: m/s},
-        "out_of_range": [names of wheels outside their steer_range], "feasible": bool}``: ``heading`` [rad] only
+        "out_of_range": [names of wheels outside their steer_range], "out_of_gear": [channel names of the gear
+        couplings the rates break], "feasible": bool}``: ``heading`` [rad] only
         for steered wheels (0 = rolling straight ahead). Only for a single twist (batch shape ``()``).
         """
         if self.feasible.shape != ():
@@ -91,6 +103,8 @@ class WheelCommands:
             wheels[name] = entry
         return {"wheels": wheels, "slip": dict(zip(self.wheel_names, self.slip.tolist(), strict=True)),
                 "out_of_range": [n for n, ok in zip(self.wheel_names, self.in_range.tolist(), strict=True) if not ok],
+                "out_of_gear": [c.channel_name for c, ok in zip(self.couplings, self.in_gear.tolist(), strict=True)
+                                if not ok],
                 "feasible": bool(self.feasible)}
 
 
@@ -119,6 +133,8 @@ def wheel_commands(
     - Swedish, ball, orthogonal: spin (8.27) and roller rate (8.28, with the roller radius r_r).
     - fixed: spin (8.12) at its constant angle, and the lateral slip (8.14) the twist leaves: ``feasible`` is
       False when any exceeds `slip_tol` [m/s] (e.g. ``v_y != 0`` for a differential drive).
+    - a ``gear`` coupling (``robot.couplings``) whose joints the twist asks to turn out of its ratios (a solid rear
+      axle asked to turn) makes it False too: ``in_gear``.
     """
     check_tolerances(speed_tol, slip_tol)
     p = _ik_fast.plan(robot)
@@ -157,11 +173,28 @@ def wheel_commands(
     else:  # a wheel that does not steer (NaN heading) has no range
         in_range = heading_in_range(np.nan_to_num(heading), *p.steer_range)
         feasible = feasible & np.all(in_range, axis=-1)
+    in_gear = np.ones((*batch, len(robot.couplings)), dtype=bool)
+    for i, c in enumerate(robot.couplings):
+        if c.kind == "gear":
+            in_gear[..., i] = gear_error(c, p.rate_names, rates) <= GEAR_RTOL * np.abs(rates).max(axis=-1)
+    feasible = feasible & np.all(in_gear, axis=-1)
     return WheelCommands(
         wheel_names=p.wheel_names, rate_names=p.rate_names, steer=_ro(steer), spin=_ro(spin),
         steer_rate=_ro(_columns(rates, p.steer_rate_select, batch, n)), rates=_ro(rates), slip=_ro(slip),
         feasible=_ro(feasible), beta=_ro(config), held=_ro(held), heading=_ro(heading), in_range=_ro(in_range),
+        in_gear=_ro(in_gear), couplings=robot.couplings,
     )
+
+
+def gear_error(coupling: Coupling, rate_names: tuple[str, ...], rates: np.ndarray) -> np.ndarray:
+    """How far joint `rates` ``(..., n_rates)`` (`rate_names` order) are from turning together as a ``gear``
+    coupling turns them, ``q_j = ratio_j * u`` (``docs/description-format.md``): the largest ``|q_j - ratio_j u|``
+    at the least-squares ``u = k.q / k.k`` [rad/s], ``(...)``; 0 for the other kinds, which impose no rate."""
+    if coupling.kind != "gear":
+        return np.zeros(rates.shape[:-1])
+    q = rates[..., [rate_names.index(j) for j in coupling.joints]]
+    k = np.array(coupling.ratios, dtype=float)
+    return np.max(np.abs(q - (q @ k / (k @ k))[..., None] * k), axis=-1)
 
 
 def _steer_columns(p: _ik_fast.Plan, config: np.ndarray, batch: tuple[int, ...], n: int) -> np.ndarray:

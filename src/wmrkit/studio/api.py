@@ -265,7 +265,8 @@ def drive(request: Any) -> dict[str, Any]:
     now_heading = robot.heading_of_beta(c.beta)
     residual = float(np.linalg.norm(robot.slip_velocity(c.velocity(twist), c.beta)))
     wheels = {}
-    joints = c.to_dict()["wheels"]  # the other joint rates (spin1, spin2, roller), as `wmrkit ik --json`
+    data = c.to_dict()
+    joints = data["wheels"]  # the other joint rates (spin1, spin2, roller), as `wmrkit ik --json`
     for i, w in enumerate(robot.wheels):
         h = float(now_heading[robot.steer_names.index(w.name)]) if w.kind.steers else float(w.heading)
         spin = float(c.spin[i])
@@ -284,6 +285,7 @@ def drive(request: Any) -> dict[str, Any]:
     return {"twist": twist.tolist(), "wheels": wheels, "heading": dict(zip(robot.steer_names, now_heading.tolist(),
                                                                            strict=True)),
             "feasible": bool(c.feasible) and not slips, "slips": slips, "out_of_range": out_of_range,
+            "out_of_gear": data["out_of_gear"],
             "residual": residual,
             "icr": twist_icr(twist), "times": t.tolist(), "poses": poses.tolist()}
 

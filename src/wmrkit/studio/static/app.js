@@ -588,6 +588,7 @@ function renderDrive() {
   if (!d) { $("d-feasible").textContent = ""; tab.innerHTML = ""; return; }
   const why = [];  // an Ackermann turn beyond the rack was 'the wheels would slip (residual 4.9e-16 m/s)'
   if (d.out_of_range.length) why.push(`${d.out_of_range.join(", ")} beyond the steering range`);
+  if (d.out_of_gear.length) why.push(`${d.out_of_gear.join(", ")} cannot turn its joints so`);
   if (d.slips || !why.length) why.push(`the wheels would slip (residual ${fmt(d.residual, 3)} m/s)`);
   $("d-feasible").innerHTML = d.feasible ? '<span class="good">feasible: no wheel slips</span>'
     : `<span class="bad">infeasible: ${esc(why.join("; "))}</span>`;
