@@ -161,6 +161,11 @@ def run_track(args: argparse.Namespace) -> int:
         warn(f"wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg for {v['seconds']:.3g} s "
              f"(t = {v['from']:.4g} to {v['to']:.4g} s) and was held at its end: the robot cannot follow this "
              "reference there (its wheels scrub; the tracking errors are the result)")
+    for c, ok in zip(robot.couplings, run.commands.in_gear.all(axis=0).tolist(), strict=True):
+        if not ok:  # the plants drive each joint on its own (docs/description-format.md, Couplings)
+            warn(f"the commands turn the joints of {c.channel_name} out of its ratios (ratios "
+                 f"{', '.join(f'{k:g}' for k in c.ratios)}); the simulation does not model gear couplings, so the "
+                 "real robot cannot drive this run")
     if args.plot or args.animate:
         from ..control.plots import animate_run, plot_run
 
@@ -189,6 +194,10 @@ def run_feasibility(args: argparse.Namespace) -> int:
     check_plot_path(args.plot)
     robot, reference = load_robot(args.robot), _reference(args)
     result = feasibility(robot, reference, args.framework)
+    for c in robot.couplings:
+        if c.kind == "gear":  # Table 8.1 classifies the wheels' geometry only
+            print(f"wmrkit: warning: {c.channel_name} is not considered: Table 8.1 judges the wheels alone; check "
+                  "the reference's twists with 'wmrkit ik' (a gear may forbid them)", file=sys.stderr)
     if args.plot:
         from ..control.plots import plot_feasibility
 

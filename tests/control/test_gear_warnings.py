@@ -1,0 +1,37 @@
+"""track and feasibility say that they do not model a gear coupling (``couplings:``) when it matters: both
+answered a solid-axle car's circle without a word (feasible; tracked as if its rear wheels turned apart)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from wmrkit import catalog
+from wmrkit.cli.main import main
+from wmrkit.couplings import Coupling
+
+GEAR = "gear(rear_left.spin, rear_right.spin)"
+
+
+def kart(tmp_path, ratios=(1.0, 1.0)):
+    car = catalog.load("ackermann")
+    car = dataclasses.replace(car, couplings=(car.couplings[1], Coupling("gear", GEAR[5:-1].split(", "), ratios)))
+    path = tmp_path / "kart.yaml"
+    car.to_file(path)
+    return str(path)
+
+
+def test_feasibility_says_a_gear_is_not_considered(tmp_path, capsys):
+    assert main(["feasibility", kart(tmp_path), "--reference", "circle"]) == 0
+    out, err = capsys.readouterr()
+    assert "feasible: yes" in out and f"wmrkit: warning: {GEAR} is not considered: Table 8.1 judges" in err
+    assert main(["feasibility", "ackermann", "--reference", "circle"]) == 0
+    assert capsys.readouterr().err == ""  # a differential forbids no twist
+
+
+def test_track_warns_when_its_commands_break_a_gear(tmp_path, capsys):
+    path = kart(tmp_path)
+    assert main(["track", path, "--reference", "circle", "--duration", "3"]) == 0
+    err = capsys.readouterr().err
+    assert f"the commands turn the joints of {GEAR} out of its ratios (ratios 1, 1)" in err
+    assert main(["track", path, "--reference", "line", "--duration", "3"]) == 0  # straight: the axle turns as one
+    assert "out of its ratios" not in capsys.readouterr().err
