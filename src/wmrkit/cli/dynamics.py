@@ -150,7 +150,9 @@ def run_simulate(args: argparse.Namespace) -> int:
     pose, tw, end = sim.pose[-1], sim.twist[-1], float(sim.t[-1])  # the last sample: the record step's multiple
     travelled = float(np.sum(np.hypot(*np.diff(sim.pose[:, :2], axis=0).T)))
     max_slip = float(np.hypot(sim.slip[..., 0], sim.slip[..., 1]).max())  # a contact's slip speed, not a component
-    for warning in _tyre_warnings(model, sim.twist):
+    for warning in _tyre_warnings(model, sim.twist) + [
+            f"{c.channel_name} is not modelled: each of its joints is driven on its own (docs/description-format.md, "
+            "Couplings)" for c in model.robot.couplings if c.kind == "gear"]:
         warn(warning)
     if args.json:
         print_json({"robot": model.robot.name, "method": sim.method, "step": step, "duration": duration,
