@@ -123,3 +123,15 @@ def test_realtime_ik_says_the_same(joints, ratios):
         assert feasible == bool(ref.feasible)
         seen.add(feasible)
     assert seen == {True, False}
+
+
+def test_closed_forms_say_a_gear_is_not_used(capsys, tmp_path):
+    """kinematics --symbolic / --codegen write the uncoupled wheels' models; with a gear they said nothing."""
+    path = tmp_path / "geared.yaml"
+    geared("diff-drive", ("left.spin", "right.spin"), (1.0, 1.0)).to_file(path)
+    code, _, err = run(capsys, "kinematics", str(path), "--symbolic")
+    assert code == 0 and "wmrkit: warning: gear(left.spin, right.spin) is not used by the closed forms" in err
+    code, _, err = run(capsys, "kinematics", str(path))
+    assert code == 0 and err == ""
+    code, _, err = run(capsys, "kinematics", "forklift", "--symbolic")  # a differential: nothing to say
+    assert code == 0 and err == ""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from ..errors import WmrkitError
 from ..kinematics.summary import format_kinematics_summary, kinematics_summary
@@ -37,6 +38,10 @@ def run(args: argparse.Namespace) -> int:
         raise WmrkitError(f"--codegen: language must be one of {', '.join(CODEGEN_LANGUAGES)}, got '{args.codegen[0]}'")
     robot = steered_robot(args.robot, args.steer)
     summary = kinematics_summary(robot)
+    for c in robot.couplings if args.symbolic or args.codegen else ():
+        if c.kind == "gear":  # the closed forms are the uncoupled wheels' (docs/description-format.md, Couplings)
+            print(f"wmrkit: warning: {c.channel_name} is not used by the closed forms or the generated code: an "
+                  "inverse model may give rates it forbids (check a twist with 'wmrkit ik')", file=sys.stderr)
     if args.symbolic:
         from ..kinematics.symbolic import format_symbolic
 
