@@ -16,8 +16,8 @@ from wmrkit.cli.main import main
 #: Every command offering --json, as its words.
 JSON_COMMANDS = {cmd for cmd, action in options() if action.dest == "json"}
 #: The commands that cannot warn (their JSON has no "warnings"); a new command is put here or in CASES.
-SILENT = {("robots",), ("show",), ("kinematics",), ("analyze",), ("sweep",), ("calibrate",), ("slip-study",),
-          ("vision", "locate"), ("vision", "calibrate"), ("follow-line",), ("feasibility",)}
+SILENT = {("robots",), ("show",), ("analyze",), ("sweep",), ("calibrate",), ("slip-study",),
+          ("vision", "locate"), ("vision", "calibrate"), ("follow-line",)}
 PREFIX = "wmrkit: warning: "
 
 
@@ -25,14 +25,20 @@ PREFIX = "wmrkit: warning: "
 def files(tmp_path_factory):
     """Logs for odometry (a yaw column that turns where the wheels do not, and one that agrees), batch odometry (a
     log of one sample) and batch calibrate (closed squares, and the same cut short before their last turn ends),
-    zero torques for simulate."""
+    zero torques for simulate, a car with a solid rear axle (a gear coupling)."""
+    import dataclasses
+
     from wmrkit import catalog
     from wmrkit.batch.calibrate import default_parameters
+    from wmrkit.couplings import Coupling
     from wmrkit.odometry.calibration import apply_parameters
     from wmrkit.odometry.logs import write_csv
     from wmrkit.odometry.synthetic import simulate, square_path
 
     d = tmp_path_factory.mktemp("warnings")
+    car = catalog.load("ackermann")  # a solid rear axle: its spins on a gear, which some commands do not model
+    dataclasses.replace(car, couplings=(Coupling("gear", ("rear_left.spin", "rear_right.spin"), (1.0, 1.0)),)
+                        ).to_file(d / "kart.yaml")
     t = np.arange(21) * 0.1
     for name, yaw in (("turning-yaw.csv", 0.5 * t), ("yaw.csv", 0 * t)):
         write_csv(d / name, ("time", "left.spin", "right.spin", "yaw"), np.column_stack([t, 10 * t, 10 * t, yaw]))
@@ -63,6 +69,8 @@ CASES = {
                     "pacejka", "simulate skid-steer-4 --torques {d}/zero.csv --initial-twist 5 0 0 --duration 0.02 "
                     "--tyre pacejka"),
     ("park",): ("park thesis-9.2", "park thesis-9.1"),
+    ("kinematics",): ("kinematics {d}/kart.yaml --symbolic", "kinematics ackermann --symbolic"),
+    ("feasibility",): ("feasibility {d}/kart.yaml --reference circle", "feasibility ackermann --reference circle"),
     ("batch", "odometry"): ("batch odometry diff-drive {d}/one.csv {d}/yaw.csv --workers 0",
                             "batch odometry diff-drive {d}/yaw.csv --workers 0"),
     ("batch", "calibrate"): ("batch calibrate diff-drive {d}/short --closed --workers 0",

@@ -196,14 +196,14 @@ def run_feasibility(args: argparse.Namespace) -> int:
     result = feasibility(robot, reference, args.framework)
     for c in robot.couplings:
         if c.kind == "gear":  # Table 8.1 classifies the wheels' geometry only
-            print(f"wmrkit: warning: {c.channel_name} is not considered: Table 8.1 judges the wheels alone; check "
-                  "the reference's twists with 'wmrkit ik' (a gear may forbid them)", file=sys.stderr)
+            warn(f"{c.channel_name} is not considered: Table 8.1 judges the wheels alone; check the reference's "
+                 "twists with 'wmrkit ik' (a gear may forbid them)")
     if args.plot:
         from ..control.plots import plot_feasibility
 
         plot_feasibility(result, reference, args.plot)
     if args.json:
-        print_json(result.to_dict())
+        print_json(result.to_dict(), warnings=True)
         return 0
     r = result.requirement
     print(f"robot {robot.name}: Table 8.1 column '{r.column}', {r.references} pose references; "

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 from ..errors import WmrkitError
 from ..kinematics.summary import format_kinematics_summary, kinematics_summary
@@ -13,6 +12,7 @@ from ._common import (
     add_steer_option,
     print_json,
     steered_robot,
+    warn,
 )
 
 CODEGEN_LANGUAGES = ("c", "python")
@@ -40,8 +40,8 @@ def run(args: argparse.Namespace) -> int:
     summary = kinematics_summary(robot)
     for c in robot.couplings if args.symbolic or args.codegen else ():
         if c.kind == "gear":  # the closed forms are the uncoupled wheels' (docs/description-format.md, Couplings)
-            print(f"wmrkit: warning: {c.channel_name} is not used by the closed forms or the generated code: an "
-                  "inverse model may give rates it forbids (check a twist with 'wmrkit ik')", file=sys.stderr)
+            warn(f"{c.channel_name} is not used by the closed forms or the generated code: an inverse model may give "
+                 "rates it forbids (check a twist with 'wmrkit ik')")
     if args.symbolic:
         from ..kinematics.symbolic import format_symbolic
 
@@ -52,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
 
         summary["generated"] = [str(p) for p in write_code(robot, lang, directory)]
     if args.json:
-        print_json(summary)
+        print_json(summary, warnings=True)
         return 0
     print(format_kinematics_summary(summary, limit=None if args.all else 12))
     if args.symbolic:
