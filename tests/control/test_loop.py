@@ -258,3 +258,14 @@ def test_the_point_to_point_law_has_no_feedforward_to_gate():
         PositionLaw.uniform("point", 1.0, gate=0.5)
     with pytest.raises(ControlError, match="no feedforward to gate"):
         track(catalog.load("mecanum-4"), builtin_reference("line"), controller="point", gate=0.5, duration=1.0)
+
+
+@pytest.mark.parametrize("name", ["mecanum-4", "diff-drive", "ackermann"])
+def test_a_run_started_on_the_reference_ends_on_it(name):
+    """Started on the line (x = 0.5 t for 20 s), the ideal loop's point is at x = 0.5 t exactly, the last sample
+    included: the reference's velocity at its last sample is its own (0.5 m/s), rest only after. It was rest at the
+    last sample already, so the integrator's last step saw the feedforward drop at t = 20 s and the summary's final
+    error was 1.2e-6 to 1.8e-6 m (max_error too), all earlier samples 0."""
+    run = track(catalog.load(name), builtin_reference("line"))
+    np.testing.assert_allclose(run.tracked[:, 0], 0.5 * run.t, rtol=0, atol=1e-9)
+    assert run.summary()["final_error"] < 1e-9

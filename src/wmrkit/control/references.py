@@ -52,9 +52,10 @@ class Reference:
 
     def at(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """``(pose (3,), velocity (3,))`` at time `t`: cubic Hermite between samples (pose from pose and velocity,
-        velocity from velocity and acceleration; exact to ``O(dt^4)``); after the end the last pose at rest."""
+        velocity from velocity and acceleration; exact to ``O(dt^4)``); after the end the last pose at rest (at the
+        last sample its own velocity: a run ends there, and its last step must not see the reference stop)."""
         ts = self.t
-        if t >= ts[-1]:
+        if t > ts[-1]:
             return self.pose[-1].copy(), np.zeros(3)
         k = min(max(int(np.searchsorted(ts, t, side="right")) - 1, 0), len(ts) - 2)
         h = ts[k + 1] - ts[k]
