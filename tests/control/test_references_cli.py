@@ -320,3 +320,14 @@ def test_a_size_for_the_line_is_refused_and_help_gives_each_shapes_default(capsy
         text = " ".join(capsys.readouterr().out.split())
         stated = dict(re.findall(r"([a-z-]+) (?:radius|half width|side|leg) \((?:default )?([\d.]+)\)", text))
         assert stated == {n: f"{s0:g}" for n, (_, _, s0, _) in BUILTIN.items() if n != "line"}, stated
+
+
+@pytest.mark.parametrize("options, advice", [(["--duration", "1e9"], "give a shorter duration (--duration)"),
+                                             (["--period", "1e-4", "--duration", "1000"],
+                                              "give a shorter duration (--duration) or a longer period (--period)")])
+def test_a_run_of_too_many_samples_is_refused_saying_what_to_do(options, advice, capsys):
+    """'duration 1e+09 s at an output step of 0.05 s: more than 1000000 samples' said what was wrong, not what to
+    change (the continuous loop's own bound, 2000 s, says it)."""
+    assert main(["track", "diff-drive", "--reference", "circle", *options]) == 2
+    err = capsys.readouterr().err
+    assert "more than 1000000 samples" in err and advice in err and len(err.strip().splitlines()) == 1

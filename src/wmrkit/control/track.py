@@ -260,7 +260,8 @@ def _check_timing(duration: float, period: float | None, output_dt: float) -> No
     step = output_dt if period is None else period
     if not (math.isfinite(step) and step > 0) or duration / step > MAX_SAMPLES:
         raise ControlError(f"duration {duration:g} s at {'a period' if period else 'an output step'} of {step:g} s: "
-                           f"more than {MAX_SAMPLES} samples")
+                           f"more than {MAX_SAMPLES} samples; give a shorter duration (--duration)"
+                           f"{' or a longer period (--period)' if period else ''}")
 
 
 #: Most output samples of a continuous kinematic loop (2000 s at the 0.05 s output step): each costs about 1.7 ms
