@@ -331,3 +331,16 @@ def test_a_run_of_too_many_samples_is_refused_saying_what_to_do(options, advice,
     assert main(["track", "diff-drive", "--reference", "circle", *options]) == 2
     err = capsys.readouterr().err
     assert "more than 1000000 samples" in err and advice in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("controller", ["pure-pursuit", "stanley"])
+@pytest.mark.parametrize("name", ["diff-drive", "ackermann", "forklift", "omni-3"])
+def test_geometric_trackers_start_with_their_point_on_the_reference(controller, name):
+    """Without a start the robot is placed with the *tracked* point on the reference's first pose. It was placed
+    with the thesis law's control point there, so pure pursuit, which tracks the axle point, followed the line a
+    constant 0.25 m behind (the diff drive; 2.81 m for the car) and reported that as its tracking error from a start
+    'on the reference'; Stanley's front point was 0.11 m behind on the car. On the line both are then exact."""
+    robot, ref = catalog.load(name), builtin_reference("line")
+    run = track(robot, ref, controller=controller)
+    np.testing.assert_allclose(run.tracked[0, :2], ref.pose[0, :2], atol=1e-12)
+    assert run.summary()["max_error"] < 1e-6

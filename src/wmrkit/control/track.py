@@ -132,14 +132,14 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
 
     The run's time 0 is the reference's first sample (:func:`from_first_sample`: TUM files carry Unix times).
 
-    `controller`: ``"p"`` (8.2), ``"pi"`` (8.3), ``"point"`` (8.1), ``"pure-pursuit"``, ``"stanley"``. `gain`: the
-    pole ``a`` [1/s] of every coordinate; `integral_gain` ``b`` [1/s^2] of ``"pi"`` (default ``a^2/4``, critically
-    damped); `gate` [m]: feedforward gate (8.53). `initial_pose` ``(3,)`` default: on the reference
-    (:func:`initial_pose_on`). `delay` in samples (discrete only). `point` ``(2,)`` [m]: controlled point of a
-    reduced-mobility robot (:func:`control_point`). `loops`: low-level actuator loops; `policy`: steering root
-    (:mod:`.steering`). `skew_free`: second-order discretisation of the held twist. Geometric trackers:
-    `lookahead` [m] (pure pursuit), `stanley_gain` [1/s]. `dynamics`: the plant is the chapter-7 dynamic model with
-    tyres (`tyre`: traction model name, default as described), driven by servos each period
+    `controller`: ``"p"`` (8.2), ``"pi"`` (8.3), ``"point"`` (8.1), ``"pure-pursuit"``, ``"stanley"``. `gain`: the pole
+    ``a`` [1/s] of every coordinate; `integral_gain` ``b`` [1/s^2] of ``"pi"`` (default ``a^2/4``, critically damped);
+    `gate` [m]: feedforward gate (8.53). `initial_pose` ``(3,)`` default: the tracked point on the reference
+    (:func:`initial_pose_on`; the geometric trackers' own point). `delay` in samples (discrete only). `point` ``(2,)``
+    [m]: controlled point of a reduced-mobility robot (:func:`control_point`). `loops`: low-level actuator loops;
+    `policy`: steering root (:mod:`.steering`). `skew_free`: second-order discretisation of the held twist. Geometric
+    trackers: `lookahead` [m] (pure pursuit), `stanley_gain` [1/s]. `dynamics`: the plant is the chapter-7 dynamic model
+    with tyres (`tyre`: traction model name, default as described), driven by servos each period
     (:func:`.dynamic_plant.simulate_dynamics`; period default 0.02 s); with it, `feedback="odometry"` measures the
     pose by odometry from the sensed joints (``TrackingRun.estimate``) instead of exactly, ``"wls"`` by WLS odometry
     with friction coefficients `weights`, ``"fk2"`` by the Kalman filter FK2 with `noise`; `slip_model` ``"mqe"`` or
@@ -186,6 +186,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         ctrl = stanley(cp, reference, stanley_gain, length)
         tracked_point = cp.axle_point + length * np.array([math.cos(cp.forward), math.sin(cp.forward)])
     geometric = controller in ("pure-pursuit", "stanley")  # switching goal points: a looser tolerance
+    if initial_pose is None and geometric:  # the tracker's own point starts on the reference, not the law's
+        pose0 = initial_pose_on(_full_point(cp, tracked_point), reference)
     if dynamics:
         from .dynamic_plant import simulate_dynamics
 
