@@ -344,3 +344,15 @@ def test_geometric_trackers_start_with_their_point_on_the_reference(controller, 
     run = track(robot, ref, controller=controller)
     np.testing.assert_allclose(run.tracked[0, :2], ref.pose[0, :2], atol=1e-12)
     assert run.summary()["max_error"] < 1e-6
+
+
+def test_track_warns_when_the_wheels_must_slip_to_follow(capsys):
+    """The skid steer turns only by scrubbing its fixed wheels sideways: the kinematic loop moves it as commanded
+    and printed an error of 4e-11 m on the circle with no word on it (the IK's slip was in Python only). Now a
+    warning names the slipping wheels and the times; a diff drive on the same circle gets none."""
+    assert main(["track", "skid-steer-4", "--reference", "circle", "--duration", "3"]) == 0
+    err = capsys.readouterr().err
+    assert "must slip sideways" in err and "front_left" in err and "to 3 s)" in err
+    assert len(err.strip().splitlines()) == 1
+    assert main(["track", "diff-drive", "--reference", "circle", "--duration", "3"]) == 0
+    assert capsys.readouterr().err == ""

@@ -166,6 +166,12 @@ def run_track(args: argparse.Namespace) -> int:
             warn(f"the commands turn the joints of {c.channel_name} out of its ratios (ratios "
                  f"{', '.join(f'{k:g}' for k in c.ratios)}); the simulation does not model gear couplings, so the "
                  "real robot cannot drive this run")
+    slipping = [] if args.dynamics else run.slip_violations()  # the dynamics' tyres do slip, and show it
+    if slipping:
+        warn(f"wheel{'s' if len(slipping) > 1 else ''} {', '.join(repr(v['wheel']) for v in slipping)} must slip "
+             f"sideways to move as commanded (t = {min(v['from'] for v in slipping):.4g} to "
+             f"{max(v['to'] for v in slipping):.4g} s): the kinematic loop moved the robot as commanded, so its errors "
+             "do not show the scrubbing (--dynamics simulates it with tyres)")
     if args.plot or args.animate:
         from ..control.plots import animate_run, plot_run
 

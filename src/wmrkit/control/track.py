@@ -32,6 +32,10 @@ __all__ = ["CONTROLLERS", "TrackingRun", "from_first_sample", "initial_pose_on",
 CONTROLLERS = ("p", "pi", "point", "pure-pursuit", "stanley")
 
 
+#: Lateral slip [m/s] of a fixed wheel's commands beyond which a run reports it (:meth:`TrackingRun.slip_violations`).
+SLIP_TOL = 1e-6
+
+
 @dataclass(frozen=True, eq=False)
 class TrackingRun:
     """A closed-loop run (frozen; arrays read-only; eq=False: array fields). ``n`` samples:
@@ -72,12 +76,23 @@ class TrackingRun:
     def range_violations(self) -> list[dict[str, Any]]:
         """Per steered wheel held at the end of its range: ``{"wheel", "from", "to", "seconds"}`` ([s]: first and
         last sample, and the time spent beyond the range, counted in samples)."""
-        if self.beyond_range is None or not self.beyond_range.any():
+        if self.beyond_range is None:
+            return []
+        return self._intervals(self.robot.steer_names, self.beyond_range)
+
+    def slip_violations(self, tol: float = SLIP_TOL) -> list[dict[str, Any]]:
+        """Per fixed wheel whose commands leave a lateral slip (8.14) beyond `tol` [m/s] (a skid steer turning: the
+        wheels must scrub to move as commanded, which the kinematic plant does not show): listed as by
+        :meth:`range_violations`."""
+        return self._intervals(self.robot.wheel_names, np.abs(np.asarray(self.commands.slip)) > tol)
+
+    def _intervals(self, names: tuple[str, ...], hits: np.ndarray) -> list[dict[str, Any]]:
+        if not hits.any():
             return []
         dt = np.diff(self.t, append=self.t[-1] + (self.t[-1] - self.t[-2] if len(self.t) > 1 else 0.0))
         out = []
-        for k, name in enumerate(self.robot.steer_names):
-            hit = self.beyond_range[:, k]
+        for k, name in enumerate(names):
+            hit = hits[:, k]
             if hit.any():
                 idx = np.flatnonzero(hit)
                 out.append({"wheel": name, "from": float(self.t[idx[0]]), "to": float(self.t[idx[-1]]),
