@@ -195,7 +195,7 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             if ranged[k] and not in_range(beta[k], k):
                 feasible = False
         largest = 0.0
-        for j in range(n_rates):
+        for j in range(n_rates if n_gears else 0):  # robots without gears skip this (the one-call path's cost)
             largest = max(largest, abs(rates_out[j]))
         for g in range(n_gears):  # a gear turns its joints as q_j = k_j u (wheel_ik.gear_error)
             kq, kk = 0.0, 0.0
