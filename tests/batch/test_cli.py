@@ -61,6 +61,9 @@ def test_batch_calibrate_and_montecarlo(capsys, calibration_data, tmp_path):
                           str(calibration_data / "ref"), "--workers", "0", "--json"])
     assert [v["field"] for v in data["values"]] == ["left.r", "right.r", "left.l", "right.l"]
     assert all(v["low"] < v["fitted"] < v["high"] for v in data["values"])
+    assert data["inconsistent"] is False and data["warnings"] == []  # eight runs of one robot agree
+    assert [r["file"].rsplit("/", 1)[-1] for r in data["per_run"]] == [f"c{i}.csv" for i in range(8)]
+    assert all(0 < r["residual_ratio"] < 30 for r in data["per_run"])
     assert main(["batch", "calibrate", "diff-drive", str(calibration_data / "c*.csv"), "--closed", "--workers", "0",
                  "--param", "left.r,-right.r"]) == 0
     assert "left.r" in capsys.readouterr().out
@@ -206,3 +209,34 @@ def test_a_bad_log_of_a_glob_is_the_json_error_s_file(capsys, fleet_dir):
     data = json.loads(capsys.readouterr().err)
     assert data["file"] == str(fleet_dir / "broken.csv") and data["line"] == 4
     assert data["error"].startswith("time ") and "broken.csv" not in data["error"]
+
+
+def test_batch_calibrate_names_a_run_of_another_robot(capsys, tmp_path):
+    """Eight runs, one of a robot whose left radius is +6 % (the others +1 %): the fit averaged it in with no
+    warning; now a warning names its file, on stderr and in the JSON, and each run's ratio is listed."""
+    import numpy as np
+    from batch_params import PARAMS, TRUE_P, write_log
+
+    from wmrkit import catalog
+    from wmrkit.odometry.calibration import apply_parameters
+    from wmrkit.odometry.synthetic import TwistProfile, simulate
+    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+
+    diff, rng = catalog.load("diff-drive"), np.random.default_rng(2003)
+    (tmp_path / "ref").mkdir()
+    for i in range(8):
+        true = apply_parameters(diff, PARAMS, [0.06 if i == 3 else TRUE_P[0], *TRUE_P[1:]])
+        segs = [(2.0, 0.3 + 0.1 * rng.random(), 0.0, rng.uniform(-0.6, 0.6)) for _ in range(3)]
+        run = simulate(true, TwistProfile.from_segments(segs), 10.0, spin_noise_per_rad=1e-5, seed=i)
+        write_log(tmp_path / f"r{i}.csv", run)
+        write_trajectory(tmp_path / "ref" / f"r{i}.tum", Trajectory(run.log.time, run.truth, np.zeros(len(run.log)),
+                                                                    None), "tum")
+    argv = ["batch", "calibrate", "diff-drive", str(tmp_path / "r*.csv"), "--reference", str(tmp_path / "ref"),
+            "--workers", "0"]
+    data = _json(capsys, [*argv, "--json"])
+    assert data["inconsistent"] is True and len(data["warnings"]) == 1
+    assert data["warnings"][0].startswith(f"{tmp_path / 'r3.csv'}: disagrees with the other runs")
+    ratios = [r["residual_ratio"] for r in data["per_run"]]
+    assert data["per_run"][3]["file"] == str(tmp_path / "r3.csv") and ratios[3] > 30
+    assert main(argv) == 0
+    assert f"wmrkit: warning: {tmp_path / 'r3.csv'}: disagrees" in capsys.readouterr().err

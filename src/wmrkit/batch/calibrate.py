@@ -46,6 +46,7 @@ from ..odometry.calibration import (
 )
 from ..odometry.integrators import check_method
 from ..robot import Robot
+from .consistency import ROUNDOFF, run_consistency, travel
 from .engine import BatchError, Engine, TaskFailure, engine
 
 
@@ -54,7 +55,10 @@ class FleetCalibration:
     """A fleet fit: the calibrated ``robot``; per parameter ``estimate`` ``p`` and its ``interval`` ``(low,
     high)``; per wheel field ``values``: ``(name, nominal, fitted, low, high)`` [m or rad] at confidence
     ``level``; residual RMS before and after; ``runs``, ``residuals`` counts; ``ci`` the interval method;
-    ``warnings``: runs whose data do not fit the method (e.g. a closed path cut short)."""
+    ``warnings``: runs whose data do not fit the method (e.g. a closed path cut short) or disagree with the others;
+    ``logs``: the runs' files; ``residual_ratios``: each run's RMS at the other runs' fit over that at its own
+    (``None`` with fewer than 4 runs) and ``inconsistent``: the largest over
+    :data:`~wmrkit.batch.consistency.MAX_RATIO` (:mod:`wmrkit.batch.consistency`; ``None`` when not judged)."""
 
     robot: Robot
     parameters: tuple[tuple[str, ...], ...]
@@ -69,6 +73,9 @@ class FleetCalibration:
     level: float
     success: bool
     warnings: tuple[str, ...] = ()
+    logs: tuple[str, ...] = ()
+    residual_ratios: tuple[float | None, ...] = ()
+    inconsistent: bool | None = None
 
     def value(self, name: str) -> tuple[float, float, float]:
         """``(fitted, low, high)`` of the wheel field `name`."""
@@ -81,7 +88,9 @@ class FleetCalibration:
         """JSON-ready mapping."""
         return {"robot": self.robot.name, "ci": self.ci, "level": self.level, "runs": self.runs,
                 "residuals": self.residuals, "rms_before": self.rms_before, "rms_after": self.rms_after,
-                "success": self.success, "warnings": list(self.warnings),
+                "success": self.success, "warnings": list(self.warnings), "inconsistent": self.inconsistent,
+                "per_run": [{"file": f, "residual_ratio": q} for f, q in zip(self.logs, self.residual_ratios,
+                                                                             strict=True)],
                 "parameters": [{"group": list(g), "p": p, "low": lo, "high": hi}
                                for g, p, (lo, hi) in zip(self.parameters, self.estimate, self.interval, strict=True)],
                 "values": [{"field": n, "nominal": a, "fitted": v, "low": lo, "high": hi}
@@ -260,10 +269,15 @@ def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float,
             a, b = (next(v for n, _, v in end if n == name) for end in ends)
             values.append((name, nominal, fitted, min(a, b), max(a, b)))
     groups = tuple((g,) if isinstance(g, str) else tuple(g) for g in params)
+    sources = [run.log.source for run in problem.runs]  # runs made in Python share '<log>' or '<synthetic>'
+    logs = tuple(s if sources.count(s) == 1 else f"run {k + 1} ({s})" for k, s in enumerate(sources))
+    judged = run_consistency(fit.jac, fit.fun, problem.sizes(),
+                             [ROUNDOFF * max(travel(robot, run), 1.0) for run in problem.runs], logs)
     return FleetCalibration(apply_parameters(robot, params, fit.x), groups, tuple(map(float, fit.x)),
                             tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True)), tuple(values),
                             rms(r0), rms(fit.fun), len(problem.runs), int(r0.size), ci, level, bool(fit.success),
-                            problem.warnings() + notes)
+                            problem.warnings() + notes + ((judged.message,) if judged.message else ()), logs,
+                            judged.ratios, judged.inconsistent)
 
 
 @dataclass(frozen=True)
