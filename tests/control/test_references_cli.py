@@ -164,6 +164,21 @@ def test_cli_track_discrete_warns_and_plots(tmp_path, capsys):
     assert "10 T" in captured.err and "tracking error" in captured.out and png.stat().st_size > 1000
 
 
+@pytest.mark.parametrize("extra", [(), ("--json",)])
+def test_a_diverged_sampled_loop_says_the_sampling_warning_that_foretold_it(capsys, extra):
+    """The sampling warning ('unstable with a delay of 2 samples: the error grows by 1.298 times a sample') was
+    dropped when the loop then diverged: the error escaped before the warnings were said. It is now in the one line
+    of the error (text or JSON)."""
+    assert main(["track", "diff-drive", "--reference", "line", "--period", "0.05", "--delay", "2", "--gain", "30",
+                 *extra]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1
+    message = json.loads(err)["error"] if extra else err
+    assert re.search(r"the closed loop diverged at t = .*lower the gain or the period \(discrete loop: 1/a = "
+                     r"0\.0333 s < 10 T = 0\.5 s .*unstable with a delay of 2 samples: the error grows by 1\.298 "
+                     r"times a sample", message), message
+
+
 @pytest.mark.parametrize(("controller", "option", "python"), [("pure-pursuit", "--lookahead", "lookahead"),
                                                                ("stanley", "--stanley-gain", "stanley_gain")])
 def test_cli_geometric_tracker_options_are_the_python_ones(capsys, controller, option, python):

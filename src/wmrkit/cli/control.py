@@ -148,11 +148,17 @@ def run_track(args: argparse.Namespace) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", SamplingWarning)
         warnings.simplefilter("always", GateWarning)
-        run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
-                    lookahead=lookahead, stanley_gain=stanley_gain,
-                    period=period, delay=args.delay, duration=duration, policy=args.steering, dynamics=args.dynamics,
-                    slip_model=args.slip_model, feedback=args.feedback, weights=weights, noise=noise, ramp=args.ramp,
-                    progress=sys.stderr.isatty() and not args.json)
+        try:
+            run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
+                        lookahead=lookahead, stanley_gain=stanley_gain, period=period, delay=args.delay,
+                        duration=duration, policy=args.steering, dynamics=args.dynamics, slip_model=args.slip_model,
+                        feedback=args.feedback, weights=weights, noise=noise, ramp=args.ramp,
+                        progress=sys.stderr.isatty() and not args.json)
+        except WmrkitError as err:  # the sampling warning that foretold it, in the one line of the error
+            foretold = [str(w.message) for w in caught if issubclass(w.category, SamplingWarning)]
+            if not foretold:
+                raise
+            raise type(err)(f"{err} ({'; '.join(foretold)})") from None
     for w in caught:
         if issubclass(w.category, (SamplingWarning, GateWarning)):
             warn(str(w.message))
