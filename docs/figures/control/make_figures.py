@@ -67,10 +67,11 @@ def table() -> list[str]:
         for ref_name in ("circle", "figure-eight", "square"):
             ref = builtin_reference(ref_name, size=scale * {"circle": 3, "figure-eight": 6, "square": 6}[ref_name])
             for controller in ("p", "pure-pursuit", "stanley"):
-                from wmrkit.control import control_point, initial_pose_on
-
-                pose0 = initial_pose_on(control_point(robot), ref) + np.array([0.0, 0.3, 0.0])
-                run = track(robot, ref, controller=controller, initial_pose=pose0, output_dt=0.05)
+                # each controller's own tracked point 0.3 m off the reference's start (track's default start puts
+                # that point on it: the thesis law's control point, pure pursuit's axle point, Stanley's front point)
+                on = track(robot, ref, controller=controller, duration=0.05).pose[0]
+                run = track(robot, ref, controller=controller, initial_pose=on + np.array([0.0, 0.3, 0.0]),
+                            output_dt=0.05)
                 s, late = run.summary(), run.summary(settle=5.0)
                 rows.append(f"| {name} | {ref_name} | {controller} | {1e3 * s['rms_cross_track']:.1f} | "
                             f"{1e3 * late['max_cross_track']:.1f} | {1e3 * s['rms_error']:.1f} |")
