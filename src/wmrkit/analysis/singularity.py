@@ -110,9 +110,14 @@ def check_positive_length(length: float) -> None:
         raise WmrkitError(f"length: must be a finite number > 0 m, got {length}")
 
 
+#: Least :func:`robot_size` [m] (docs/limits.md: below it the default lengths are not scale-free).
+SIZE_FLOOR = 1e-3
+
+
 def robot_size(robot: Robot) -> float:
-    """RMS distance of the wheels' mount points from the robot origin [m] (at least 1 mm): a default length."""
-    return max(float(np.sqrt(np.mean([w.l**2 for w in robot.wheels]))), 1e-3)
+    """RMS distance of the wheels' mount points from the robot origin [m] (at least :data:`SIZE_FLOOR`): a default
+    length."""
+    return max(float(np.sqrt(np.mean([w.l**2 for w in robot.wheels]))), SIZE_FLOOR)
 
 
 @dataclass(frozen=True, eq=False)
