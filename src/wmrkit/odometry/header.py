@@ -16,7 +16,6 @@ by an older wmrkit version, read as such; ``[deg:heading]`` says the default exp
 from __future__ import annotations
 
 import csv
-import math
 import os
 import re
 from collections.abc import Mapping, Sequence
@@ -28,6 +27,7 @@ import numpy as np
 
 from ..errors import WmrkitError
 from ..limits import regular_file_problem
+from ..units import UNITS
 
 if TYPE_CHECKING:
     from ..robot import Robot
@@ -37,9 +37,10 @@ if TYPE_CHECKING:
 SPIN_UNITS = {"rad": "angle", "rad/s": "velocity", "counts": "counts", "m": "distance", "m/s": "speed",
               "deg": "angle", "deg/s": "velocity", "rev": "angle", "rev/s": "velocity", "turn": "angle",
               "turn/s": "velocity", "rpm": "velocity"}
-#: Radians (rad/s) in one unit of the spin units that are not rad (:attr:`~.logs.LogFormat.spin_scale`).
-SPIN_SCALES = {"deg": math.pi / 180, "deg/s": math.pi / 180, "rev": 2 * math.pi, "rev/s": 2 * math.pi,
-               "turn": 2 * math.pi, "turn/s": 2 * math.pi, "rpm": math.pi / 30}
+#: Radians (rad/s) in one unit of the spin units that are not rad (:attr:`~.logs.LogFormat.spin_scale`), from the
+#: description's angle units (:data:`wmrkit.units.UNITS`).
+SPIN_SCALES = {"deg": UNITS["angle"]["deg"], "rev": UNITS["angle"]["turn"], "turn": UNITS["angle"]["turn"]}
+SPIN_SCALES |= {f"{unit}/s": k for unit, k in SPIN_SCALES.items()} | {"rpm": UNITS["angle"]["turn"] / 60}
 #: The spin modes of :class:`~.logs.LogFormat` (``--spin`` takes the first three; a header's m, m/s the others).
 SPIN_MODES = ("angle", "counts", "velocity", "distance", "speed")
 STEER_UNITS = {"rad": "angle", "deg": "degrees", "counts": "counts"}
