@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from thesis_vehicles import DEG, bicycle, differential, omni_castor, omni_swedish, robot, tricycle, type3, type5
 
 from strategies import wheels
-from wmrkit import Robot, catalog
+from wmrkit import Robot, Wheel, catalog
 from wmrkit.analysis.classification import TABLE_5_1, classify, instantaneous_mobility
 from wmrkit.analysis.icr import icr
 from wmrkit.kinematics.linalg import matrix_rank
@@ -120,6 +120,26 @@ def test_icr_sets():
     assert icr(stuck).kind == "none"
     assert "translation" in icr(tricycle(beta3=0.0)).describe()
     assert icr(stuck).consistent is None  # fixed axles that miss: no steering can mend it
+
+
+@pytest.mark.parametrize("phi", [0.0, 0.5, 1.0, -2.0])
+def test_axles_parallel_within_rounding_do_not_meet_far_away(phi):
+    """Two fixed wheels turned alike, 6e-8 m apart along x (hypothesis's example): their axles are parallel, so the
+    robot translates. Turning the frame by `phi` leaves their directions equal only to rounding, which made them
+    meet 5e8 m to one side in one frame and 6e8 m to the other in the next. Within rounding of the condition of
+    the two axles, the ICR is at infinity, along the wheels, in every frame; a genuine meeting 1e4 sizes away is
+    still a point."""
+    rolling = (-math.sin(1.0 - phi), math.cos(1.0 - phi))  # the axles' direction is beta, 1 - phi when turned
+
+    def turned(name, x, beta=1.0):  # a fixed wheel at (x, 0) of the original frame, in the turned frame
+        return Wheel(name, "fixed", l=abs(x), alpha=math.atan2(-math.sin(phi) * x, math.cos(phi) * x),
+                     beta=beta - phi, r=0.5)
+
+    got = icr(Robot("r", (turned("w0", 0.0), turned("w1", 5.960464477539063e-08))))
+    assert got.kind == "infinity"
+    assert min(np.abs(np.array(got.direction) - sign * np.array(rolling)).max() for sign in (1, -1)) < 1e-9
+    apart = Robot("r", (turned("w0", 0.0), turned("w1", 1.0, beta=1.0 + 1e-4)))  # axles 1e-4 rad apart: 8.4e3 m
+    assert icr(apart).kind == "point" and 1e3 < math.hypot(*icr(apart).point) < 1e5
 
 
 @pytest.mark.parametrize(("outer", "hint"), [(23.4429, True), (24.0, True), (25.0, False), (30.0, False)])
