@@ -14,8 +14,13 @@ sys.path.insert(0, str(Path(__file__).parent))
 # --import-mode=importlib pytest does not put a test's folder on sys.path, so every test folder goes on it here.
 sys.path[1:1] = [str(p) for p in sorted(Path(__file__).parent.iterdir()) if p.is_dir() and not p.name.startswith("_")]
 
-# CPUs are shared: no per-example deadline; sizes are kept small in the tests themselves.
-settings.register_profile("wmrkit", deadline=None, suppress_health_check=[HealthCheck.too_slow])
+# CPUs are shared: no per-example deadline; sizes are kept small in the tests themselves. The default profile is
+# derandomized (the README's `pytest` draws the examples CI draws: a fresh clone fails on a change, never on a draw);
+# `pytest --hypothesis-profile=explore` draws new examples on every run, for finding new failures while developing.
+settings.register_profile("wmrkit", deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True,
+                          database=None, print_blob=True)
+settings.register_profile("explore", deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=False,
+                          print_blob=True)
 settings.load_profile("wmrkit")
 
 
