@@ -108,6 +108,10 @@ def test_closed_paths_fit_the_radius_ratio(diff, tmp_path):
     # a closed run's final pose (3 numbers) against 2 parameters leaves its own fit 1 residual: no ratio (one
     # square's came out 303, a false alarm)
     assert res.inconsistent is None and res.residual_ratios == (None,) * 4
+    # ... and it says so (a run of another robot is averaged in unseen), in Python and the JSON
+    from wmrkit.batch.consistency import CLOSED
+
+    assert res.not_judged == CLOSED and res.to_dict()["not_judged"] == CLOSED
     for k, truth in enumerate([0.01, 0.03]):
         lo, hi = res.interval[k]
         assert lo <= truth <= hi and abs(res.estimate[k] - truth) < 2e-3
@@ -234,6 +238,10 @@ def test_fleet_slip_weights_from_closed_paths_and_errors(skid_runs):
     truth_end = [CalibrationRun(r.log, r.truth[-1:], pose0=tuple(r.truth[0])) for r in sims[:3]]
     res = fleet_slip_calibrate(robot, truth_end)
     assert len(res.per_run) == 3 and res.ratio_interval[0] <= res.ratio <= res.ratio_interval[1]
+    # the runs are not checked against each other, and that is said (text and JSON)
+    from wmrkit.batch.consistency import SLIP_NOT_JUDGED
+
+    assert res.to_dict()["not_judged"] == SLIP_NOT_JUDGED and f"not judged: {SLIP_NOT_JUDGED}" in res.format()
     with pytest.raises(BatchError, match="at least two runs"):
         fleet_slip_calibrate(robot, truth_end[:1])
     with pytest.raises(BatchError, match="confidence level"):
@@ -578,7 +586,12 @@ def test_runs_that_agree_are_not_flagged_a_false_alarm_study(diff):
 
 
 def test_three_runs_are_too_few_to_judge(diff):
+    from wmrkit.batch.consistency import FEW_RUNS
+
     res = fleet_calibrate(diff, _fleet(diff, 5, n=3, bad=0), PARAMS)
     assert res.inconsistent is None and res.residual_ratios == (None,) * 3
     data = res.to_dict()
     assert data["inconsistent"] is None and [r["residual_ratio"] for r in data["per_run"]] == [None] * 3
+    assert res.not_judged == data["not_judged"] == FEW_RUNS  # said, not only a null
+    judged = fleet_calibrate(diff, _fleet(diff, 5, n=4), PARAMS)
+    assert judged.inconsistent is False and judged.not_judged is None and judged.to_dict()["not_judged"] is None

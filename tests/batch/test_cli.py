@@ -66,7 +66,12 @@ def test_batch_calibrate_and_montecarlo(capsys, calibration_data, tmp_path):
     assert all(0 < r["residual_ratio"] < 30 for r in data["per_run"])
     assert main(["batch", "calibrate", "diff-drive", str(calibration_data / "c*.csv"), "--closed", "--workers", "0",
                  "--param", "left.r,-right.r"]) == 0
-    assert "left.r" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "left.r" in out
+    # closed paths are not checked against each other: said, not only a null in the JSON
+    from wmrkit.batch.consistency import CLOSED
+
+    assert f"  not judged: {CLOSED}" in out and data["not_judged"] is None
     plot = tmp_path / "mc.png"
     data = _json(capsys, ["batch", "montecarlo", "diff-drive", "--path", "arc", "-n", "30", "--workers", "0",
                           "--resolution", "0.5deg", "--plot", str(plot), "--json"])

@@ -46,7 +46,7 @@ from ..odometry.calibration import (
 )
 from ..odometry.integrators import check_method
 from ..robot import Robot
-from .consistency import ROUNDOFF, run_consistency, travel
+from .consistency import ROUNDOFF, SLIP_NOT_JUDGED, run_consistency, travel
 from .engine import BatchError, Engine, TaskFailure, engine
 
 
@@ -58,7 +58,8 @@ class FleetCalibration:
     ``warnings``: runs whose data do not fit the method (e.g. a closed path cut short) or disagree with the others;
     ``logs``: the runs' files; ``residual_ratios``: each run's RMS at the other runs' fit over that at its own
     (``None`` with fewer than 4 runs) and ``inconsistent``: the largest over
-    :data:`~wmrkit.batch.consistency.MAX_RATIO` (:mod:`wmrkit.batch.consistency`; ``None`` when not judged)."""
+    :data:`~wmrkit.batch.consistency.MAX_RATIO` (:mod:`wmrkit.batch.consistency`; ``None`` when not judged, and
+    ``not_judged`` says why: fewer than 4 runs, or only closed paths)."""
 
     robot: Robot
     parameters: tuple[tuple[str, ...], ...]
@@ -76,6 +77,7 @@ class FleetCalibration:
     logs: tuple[str, ...] = ()
     residual_ratios: tuple[float | None, ...] = ()
     inconsistent: bool | None = None
+    not_judged: str | None = None
 
     def value(self, name: str) -> tuple[float, float, float]:
         """``(fitted, low, high)`` of the wheel field `name`."""
@@ -89,6 +91,7 @@ class FleetCalibration:
         return {"robot": self.robot.name, "ci": self.ci, "level": self.level, "runs": self.runs,
                 "residuals": self.residuals, "rms_before": self.rms_before, "rms_after": self.rms_after,
                 "success": self.success, "warnings": list(self.warnings), "inconsistent": self.inconsistent,
+                "not_judged": self.not_judged,
                 "per_run": [{"file": f, "residual_ratio": q} for f, q in zip(self.logs, self.residual_ratios,
                                                                              strict=True)],
                 "parameters": [{"group": list(g), "p": p, "low": lo, "high": hi}
@@ -277,14 +280,16 @@ def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float,
                             tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True)), tuple(values),
                             rms(r0), rms(fit.fun), len(problem.runs), int(r0.size), ci, level, bool(fit.success),
                             problem.warnings() + notes + ((judged.message,) if judged.message else ()), logs,
-                            judged.ratios, judged.inconsistent)
+                            judged.ratios, judged.inconsistent, judged.not_judged)
 
 
 @dataclass(frozen=True)
 class FleetSlipCalibration:
     """Slip weights of a fleet: the WLS friction ratio ``mu_lateral / mu_longitudinal`` and the effective-track
     multiplier, each the geometric mean over the runs with its interval at ``level`` (Student's t over the runs'
-    log values: run-to-run variation, e.g. floors and loads); ``per_run``: ``(ratio, multiplier)`` of each run."""
+    log values: run-to-run variation, e.g. floors and loads); ``per_run``: ``(ratio, multiplier)`` of each run;
+    ``not_judged``: the runs are not checked against each other (why:
+    :data:`~wmrkit.batch.consistency.SLIP_NOT_JUDGED`)."""
 
     robot: str
     ratio: float
@@ -293,6 +298,7 @@ class FleetSlipCalibration:
     multiplier_interval: tuple[float, float]
     per_run: tuple[tuple[float, float], ...]
     level: float
+    not_judged: str = SLIP_NOT_JUDGED
 
     @property
     def weights(self):
@@ -307,13 +313,15 @@ class FleetSlipCalibration:
                 f"  WLS mu_lateral / mu_longitudinal  {self.ratio:.6g}  [{self.ratio_interval[0]:.6g}, "
                 f"{self.ratio_interval[1]:.6g}]\n"
                 f"  effective track multiplier        {self.multiplier:.6g}  [{self.multiplier_interval[0]:.6g}, "
-                f"{self.multiplier_interval[1]:.6g}]")
+                f"{self.multiplier_interval[1]:.6g}]\n"
+                f"  not judged: {self.not_judged}")
 
     def to_dict(self) -> dict:
         """JSON-ready; ``weights`` is what ``wmrkit odometry --slip-weights FILE`` reads."""
         return {"robot": self.robot, "weights": self.weights.to_dict(), "level": self.level, "runs": len(self.per_run),
                 "ratio": self.ratio, "ratio_interval": list(self.ratio_interval),
                 "wheel_separation_multiplier": self.multiplier, "multiplier_interval": list(self.multiplier_interval),
+                "not_judged": self.not_judged,
                 "per_run": [{"ratio": k, "wheel_separation_multiplier": m} for k, m in self.per_run]}
 
 

@@ -43,6 +43,23 @@ MIN_RUNS = 4
 #: three numbers, against two parameters) its own fit is near exact by chance and the ratio noise's (303 for a
 #: good closed square of four); a chi with 6 degrees of freedom is seldom near zero.
 MIN_DOF = 6
+#: Why a fleet is not judged (said by ``batch calibrate``'s text and JSON, ``not_judged``): too few runs.
+FEW_RUNS = (f"fewer than {MIN_RUNS} runs: the runs are not checked against each other (with 2 or 3, a run of "
+            "another robot cannot be told from the others), a run that disagrees is averaged in unseen")
+#: ... and every run a closed path (or as short): its own noise cannot be measured from its one residual beyond the
+#: parameters, which the ratio's denominator needs. A closed run does carry information against the others' pooled
+#: noise (4 squares, one of a robot with a 10 % larger left radius: 96 by refits, agreeing runs at most 3), but to
+#: first order only 20 (the fit's curvature swamps the noise), and with two squares each way the odd run's partner
+#: in direction scored 123: not done.
+CLOSED = ("no run has 6 residuals beyond its own parameters (closed paths: a final pose): the runs are not checked "
+          "against each other, a run of another robot is averaged in unseen; a fleet with reference trajectories "
+          "is checked")
+#: Why ``batch calibrate --slip`` does not judge its runs: the residual ratio is one of noise, and a slip fit's own
+#: residuals are the slip model's error. Simulated skid-steer fleets (quasi-static slip, 6 runs): agreeing runs up to
+#: 1.6 in 4 fleets, a run of a robot with twice the tyres' cornering stiffness (its friction ratio 1.59 against
+#: 0.77) 6 to 10, one with a 10 % larger wheel radius 1 to 7 (6 fleets); no threshold like MAX_RATIO separates them.
+SLIP_NOT_JUDGED = ("the runs are not checked against each other (a slip fit's residuals are its model's error, not "
+                   "noise): compare the per-run values; a run of another robot or floor is averaged in")
 #: Runs tried as the one that disagrees (the largest ratios; each try costs one pass over all runs' n x n blocks).
 CANDIDATES = 10
 
@@ -51,11 +68,13 @@ CANDIDATES = 10
 class Consistency:
     """``ratios``: per run, or ``None`` (fewer than :data:`MIN_RUNS` runs, or fewer than :data:`MIN_DOF`
     residuals beyond its own parameters: closed paths); ``inconsistent``: the largest over
-    :data:`MAX_RATIO` (``None`` when not judged); ``message``: the warning that names the run, or ``None``."""
+    :data:`MAX_RATIO` (``None`` when not judged); ``message``: the warning that names the run, or ``None``;
+    ``not_judged``: why no run was judged (:data:`FEW_RUNS`, :data:`CLOSED`), or ``None``."""
 
     ratios: tuple[float | None, ...]
     inconsistent: bool | None
     message: str | None = None
+    not_judged: str | None = None
 
 
 def travel(robot: Robot, run: CalibrationRun) -> float:
@@ -85,7 +104,7 @@ def run_consistency(jac: np.ndarray, res: np.ndarray, sizes: Sequence[int], floo
     its own fit [m]; `names`: how the warning names it), the flag and its message (module docstring)."""
     g = len(sizes)
     if g < MIN_RUNS:
-        return Consistency((None,) * g, None)
+        return Consistency((None,) * g, None, not_judged=FEW_RUNS)
     ends = np.cumsum(sizes)
     blocks = [(jac[e - s:e], res[e - s:e]) for s, e in zip(sizes, ends, strict=True)]
     a = np.array([j.T @ j for j, _ in blocks])
@@ -100,7 +119,7 @@ def run_consistency(jac: np.ndarray, res: np.ndarray, sizes: Sequence[int], floo
     ratios, d = _ratios(a, b, c, own, everyone, np.zeros(a.shape[1]))
     judged = tuple(None if np.isnan(q) else float(q) for q in ratios)
     if np.isnan(ratios).all():
-        return Consistency(judged, None)
+        return Consistency(judged, None, not_judged=CLOSED)
     worst = int(np.nanargmax(ratios))
     if ratios[worst] <= MAX_RATIO:
         return Consistency(judged, False)

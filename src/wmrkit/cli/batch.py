@@ -221,6 +221,8 @@ def run_calibrate(args: argparse.Namespace) -> int:
           f"{result.rms_after:.4g}; {result.level:.0%} intervals ({result.ci})")
     for name, nominal, value, lo, hi in result.values:
         print(f"  {name:<24} {nominal:.6g} -> {value:.6g}  [{lo:.6g}, {hi:.6g}]")
+    if result.not_judged:
+        print(f"  not judged: {result.not_judged}")
     return 0
 
 
