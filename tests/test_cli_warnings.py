@@ -56,13 +56,15 @@ def files(tmp_path_factory):
     return d
 
 
-#: Each command that can warn: a command line that warns and one that does not ({d}: the files' folder).
+#: Each command that can warn: a command line that warns (or several, each warning its own way) and one that does not
+#: ({d}: the files' folder).
 CASES = {
     ("ik",): ("ik diff-drive --twist 1 0.2 0", "ik diff-drive --twist 1 0 0.5"),
     ("fk",): ("fk diff-drive --spin left=10", "fk diff-drive --spin left=10 --spin right=12"),
     ("odometry",): ("odometry diff-drive {d}/turning-yaw.csv --heading-column yaw",
                     "odometry diff-drive {d}/yaw.csv --heading-column yaw"),
-    ("track",): ("track mecanum-4 --reference line --period 0.5 --delay 1 --gain 0.8 --duration 2",
+    ("track",): (("track mecanum-4 --reference line --period 0.5 --delay 1 --gain 0.8 --duration 2",
+                  "track forklift --reference square --duration 13"),  # a corner: Table 8.1's stop and re-orient
                  "track mecanum-4 --reference line --duration 2"),
     ("tyre",): ("tyre pacejka --load 3000 --slip-ratio 0.1 --speed 30", "tyre pacejka --load 3000 --slip-ratio 0.1"),
     ("simulate",): ("simulate skid-steer-4 --torques {d}/zero.csv --initial-twist 20 0 0 --duration 0.02 --tyre "
@@ -96,14 +98,15 @@ def _said(text: str, prefix: str = PREFIX) -> list[str]:
 
 @pytest.mark.parametrize("command", sorted(CASES), ids=" ".join)
 def test_the_json_lists_the_warnings_that_stderr_says(command, files, capsys):
-    warns, quiet = CASES[command]
-    out, err = _run(capsys, warns, files, "--json")
-    text_out, text_err = _run(capsys, warns, files)
-    # park writes its plan's warnings in its text answer ('warning: ...'), the others on stderr
-    said = _said(text_out, "warning: ") if command == ("park",) else _said(text_err)
-    assert said and json.loads(out)["warnings"] == said
-    if command != ("park",):
-        assert _said(err) == said  # on stderr under --json too, for people
+    warnings, quiet = CASES[command]
+    for warns in (warnings,) if isinstance(warnings, str) else warnings:
+        out, err = _run(capsys, warns, files, "--json")
+        text_out, text_err = _run(capsys, warns, files)
+        # park writes its plan's warnings in its text answer ('warning: ...'), the others on stderr
+        said = _said(text_out, "warning: ") if command == ("park",) else _said(text_err)
+        assert said and json.loads(out)["warnings"] == said
+        if command != ("park",):
+            assert _said(err) == said  # on stderr under --json too, for people
     out, err = _run(capsys, quiet, files, "--json")
     assert json.loads(out)["warnings"] == [] and PREFIX not in err
 

@@ -178,6 +178,16 @@ def run_track(args: argparse.Namespace) -> int:
              f"sideways to move as commanded (t = {min(v['from'] for v in slipping):.4g} to "
              f"{max(v['to'] for v in slipping):.4g} s): the kinematic loop moved the robot as commanded, so its errors "
              "do not show the scrubbing (--dynamics simulates it with tyres)")
+    verdict = run.feasibility  # Table 8.1 for the tracked point: a line per remedy and times, feasibility's words
+    broken: dict[tuple[str, tuple[float, ...]], list[str]] = {}
+    for kind, remedy in dict.fromkeys((v.kind, v.remedy) for v in verdict.violations) if verdict else ():
+        times = tuple(v.t for v in verdict.violations if (v.kind, v.remedy) == (kind, remedy))
+        broken.setdefault((remedy, times), []).append(kind)
+    for (remedy, times), kinds in broken.items():
+        more = f" and {len(times) - 5} more times" if len(times) > 5 else ""
+        warn(f"the robot cannot follow this reference with zero error (Table 8.1, column "
+             f"'{verdict.requirement.column}' for the tracked point, {verdict.requirement.framework} framework): "
+             f"{' and '.join(kinds)} at t = {', '.join(f'{t:.4g}' for t in times[:5])} s{more}: {remedy}")
     if args.plot or args.animate:
         from ..control.plots import animate_run, plot_run
 

@@ -4,8 +4,8 @@ prints, and what a planner, e.g. the parking application, calls to execute a pla
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -16,6 +16,7 @@ from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .actuators import LowLevelLoops
+from .feasibility import BLOCK, Feasibility, feasibility
 from .laws import PositionLaw, check_gate, check_sampling
 from .loop import Plant, law_controller, simulate
 from .points import ControlError, ControlPoint, check_delay, control_point, point_pose
@@ -52,7 +53,10 @@ class TrackingRun:
       inverse slip model, :mod:`.slip_control`); ``feedback``: what the controller measured (:mod:`.slip_loop`);
     - ``beyond_range`` ``(n, n_steer)`` bool: where a steered wheel was asked for a heading outside its
       ``steer_range`` and held at the end of it (the robot then moves with the least-squares twist of its drive
-      wheels: it cannot follow as commanded); :meth:`range_violations` lists them per wheel.
+      wheels: it cannot follow as commanded); :meth:`range_violations` lists them per wheel;
+    - ``feasibility``: the reference judged by Table 8.1 (§8.5, :func:`.feasibility.feasibility`) for the tracked
+      point, in the kinematic framework (the dynamic one through the dynamics), its violations up to the run's end;
+      None for a robot Table 8.1 does not apply to (degenerate: the skid steer).
     """
 
     robot: Robot
@@ -72,6 +76,7 @@ class TrackingRun:
     slip_model: str = "none"
     feedback: str = "pose"
     beyond_range: np.ndarray | None = None
+    feasibility: Feasibility | None = None
 
     def range_violations(self) -> list[dict[str, Any]]:
         """Per steered wheel held at the end of its range: ``{"wheel", "from", "to", "seconds"}`` ([s]: first and
@@ -123,6 +128,7 @@ class TrackingRun:
         if self.slip_model != "none" or self.feedback != "pose":
             out["slip_model"], out["feedback"] = self.slip_model, self.feedback
         out["beyond_steer_range"] = self.range_violations()
+        out["feasibility"] = None if self.feasibility is None else self.feasibility.to_dict()
         return out
 
 
@@ -261,7 +267,25 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                        readonly(error), readonly(cross), readonly(out["twist"]), readonly(np.asarray(heading)),
                        commands, period, delay, readonly(out["estimate"]) if "estimate" in out and
                        feedback != "pose" else None, slip_model, feedback,
-                       readonly(~out["in_range"]) if "in_range" in out else None)
+                       readonly(~out["in_range"]) if "in_range" in out else None,
+                       _feasibility(robot, reference, tracked_point, "dynamic" if dynamics else "kinematic", t[-1]))
+
+
+def _feasibility(robot: Robot, reference: Reference, point: np.ndarray,
+                 framework: Literal["kinematic", "dynamic"], end: float) -> Feasibility | None:
+    """Table 8.1's verdict on `reference` for `robot` tracked at `point` ``(2,)`` [m, robot frame], its violations
+    up to `end` [s]; None for a degenerate robot (no column of the table)."""
+    from ..analysis.classification import classify
+
+    if classify(robot).type is None:
+        return None
+    # the run's part, and a margin to judge its end: a 10 s run (4.2 s) of an 8.8e6-sample circle judged it all in 3.9 s
+    stop = int(np.searchsorted(reference.t, end, side="right")) + 2 * BLOCK
+    if stop < len(reference.t):
+        reference = replace(reference, t=reference.t[:stop], pose=reference.pose[:stop],
+                            velocity=reference.velocity[:stop], acceleration=reference.acceleration[:stop])
+    found = feasibility(robot, reference, framework, point=(float(point[0]), float(point[1])))
+    return Feasibility(found.requirement, tuple(v for v in found.violations if v.t <= end))
 
 
 #: Most samples of a run (control periods, or output samples of a continuous loop): each costs a control law
@@ -333,13 +357,9 @@ def _check_dynamic_work(duration: float, period: float, slipping: bool) -> None:
 def from_first_sample(reference: Reference) -> Reference:
     """`reference` with its times (and breaks) counted from its first sample [s]: what :func:`track` follows (the
     loop starts at t = 0; a reference starting later was held at its first pose, one already over at its last)."""
-    from dataclasses import replace
-
     t0 = float(reference.t[0])
     return replace(reference, t=readonly(reference.t - t0), breaks=tuple(b - t0 for b in reference.breaks))
 
 
 def _full_point(cp: ControlPoint, p: np.ndarray) -> ControlPoint:
-    from dataclasses import replace
-
     return replace(cp, point=readonly(np.asarray(p, dtype=float).copy()))

@@ -1,0 +1,120 @@
+"""track judges its reference by Table 8.1 (§8.5) for the point it tracks: the bicycle and the forklift tracked the
+square to 1e-7 m in the ideal plant, turning their steered wheel instantly at the corners, and 'wmrkit track' said
+nothing of the tangent jumps that Table 8.1 says they cannot follow (the real vehicle stops and re-orients the wheel).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.analysis.classification import classify
+from wmrkit.cli.main import main
+from wmrkit.control.feasibility import feasibility
+from wmrkit.control.points import control_point
+from wmrkit.control.references import builtin_reference
+from wmrkit.control.track import track
+from wmrkit.control.trackers import default_wheelbase
+
+WARNING = "wmrkit: warning: the robot cannot follow this reference with zero error (Table 8.1, column "
+
+
+def _warned(err: str) -> list[str]:
+    return [line for line in err.splitlines() if line.startswith(WARNING)]
+
+
+@pytest.mark.parametrize("robot", ["bicycle", "forklift"])
+def test_track_warns_at_the_corners_of_the_square_for_a_steered_vehicle(robot, capsys):
+    assert main(["track", robot, "--reference", "square"]) == 0
+    out, err = capsys.readouterr()
+    assert float(out.split("tracking error [m]: rms ")[1].split(",")[0]) < 1e-6  # the ideal plant follows it
+    assert _warned(err) == [f"{WARNING}'type 4, off axle' for the tracked point, kinematic framework): tangent-angle "
+                            "jump (chi not C0) at t = 12, 24, 36 s: stop and re-orient the orientable wheel"]
+    assert main(["track", robot, "--reference", "square", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    verdict = data["feasibility"]
+    assert not verdict["feasible"] and verdict["column"] == "type 4, off axle" and verdict["framework"] == "kinematic"
+    # the corners of a 6 m square at 0.5 m/s, and the tangent turning a quarter turn at each
+    assert [(v["t"], v["signal"]) for v in verdict["violations"]] == [(12.0, "chi"), (24.0, "chi"), (36.0, "chi")]
+    assert all(v["size"] == pytest.approx(math.pi / 2) for v in verdict["violations"])
+    assert [w for w in data["warnings"] if w.startswith(WARNING[len("wmrkit: warning: "):])] == \
+        [w.removeprefix("wmrkit: warning: ") for w in _warned(err)]
+
+
+def test_the_verdict_is_for_the_point_the_controller_tracks(capsys):
+    """The p law tracks a point ahead of the diff drive's axle (Table 8.1: x, y continuous, the square is followed),
+    pure pursuit the axle's midpoint (the tangent must be continuous: the vehicle stops and turns at a corner)."""
+    assert main(["track", "diff-drive", "--reference", "square", "--duration", "13"]) == 0
+    assert _warned(capsys.readouterr().err) == []
+    assert main(["track", "diff-drive", "--reference", "square", "--duration", "13", "--controller",
+                 "pure-pursuit"]) == 0
+    assert _warned(capsys.readouterr().err) == [
+        f"{WARNING}'type 2, on axle' for the tracked point, kinematic framework): tangent-angle jump (chi not C0) at "
+        "t = 12 s: stop and re-orient the vehicle"]
+    # the bicycle's axle point must have a continuous curvature: the arc-line's steps where the arc meets the line
+    bicycle, arc_line = catalog.load("bicycle"), builtin_reference("arc-line")
+    assert track(bicycle, arc_line).feasibility.feasible
+    run = track(bicycle, arc_line, controller="pure-pursuit")
+    assert run.feasibility.requirement.column == "type 4, on axle"
+    assert [(v.signal, round(v.t, 2)) for v in run.feasibility.violations] == [("kappa", 9.43)]
+    assert run.to_dict()["feasibility"] == run.feasibility.to_dict()
+
+
+def test_only_the_violations_within_the_run_are_reported(capsys):
+    forklift, square = catalog.load("forklift"), builtin_reference("square")
+    assert track(forklift, square, duration=10).feasibility.feasible
+    assert [v.t for v in track(forklift, square, duration=25).feasibility.violations] == [12.0, 24.0]
+    # the reference is judged up to the run's end (with a margin): a corner at the last sample is still one
+    assert [v.t for v in track(forklift, square, duration=12).feasibility.violations] == [12.0]
+
+
+def test_a_reference_from_a_file_is_judged_in_the_run_s_time(tmp_path, capsys):
+    """TUM times are Unix times; the run and its warning count from the first sample, as the run's t."""
+    path = tmp_path / "corner.txt"
+    rows = []
+    for k in range(400):
+        x, y, th = (0.025 * k, 0.0, 0.0) if k < 200 else (5.0, 0.025 * (k - 200), math.pi / 2)
+        rows.append(f"{1.7e9 + 0.05 * k:.3f} {x} {y} 0 0 0 {math.sin(th / 2)} {math.cos(th / 2)}")
+    path.write_text("\n".join(rows) + "\n")
+    assert main(["track", "bicycle", "--reference", str(path)]) == 0
+    assert _warned(capsys.readouterr().err) == [
+        f"{WARNING}'type 4, off axle' for the tracked point, kinematic framework): tangent-angle jump (chi not C0) at "
+        "t = 10 s: stop and re-orient the orientable wheel"]
+
+
+def test_a_degenerate_robot_has_no_verdict(capsys):
+    run = track(catalog.load("skid-steer-4"), builtin_reference("line"), duration=2)
+    assert run.feasibility is None and run.to_dict()["feasibility"] is None
+
+
+def test_through_the_dynamics_the_dynamic_framework_judges(capsys):
+    """The arc-line's turn rate steps where the arc meets the line: the kinematic framework lets the forklift's
+    steering jump there, the dynamic one (wheel rates continuous) does not."""
+    forklift, arc_line = catalog.load("forklift"), builtin_reference("arc-line")
+    assert track(forklift, arc_line, duration=10).feasibility.feasible
+    assert main(["track", "forklift", "--reference", "arc-line", "--dynamics", "--duration", "10"]) == 0
+    assert _warned(capsys.readouterr().err) == [
+        f"{WARNING}'type 4, off axle' for the tracked point, dynamic framework): turn-rate jump (chi not C1) at "
+        "t = 9.43 s: stop and re-orient the orientable wheel"]
+
+
+def test_smooth_references_are_followed_by_every_catalog_robot_at_every_tracked_point():
+    """Not noisy: the circle, the line and the figure-eight have a continuous pose, velocity, acceleration, tangent,
+    curvature and their rates, so no column of Table 8.1 refuses them, in either framework, at the point of any
+    controller (the law's, pure pursuit's axle point, Stanley's front point), which track judges as here."""
+    references = [builtin_reference(name) for name in ("line", "circle", "figure-eight")]
+    for name in catalog.names():
+        robot = catalog.load(name)
+        if classify(robot).type is None:
+            continue
+        cp = control_point(robot)
+        front = cp.axle_point + default_wheelbase(cp) * np.array([math.cos(cp.forward), math.sin(cp.forward)])
+        for point in (cp.point, cp.axle_point, front):
+            for framework in ("kinematic", "dynamic"):
+                for reference in references:
+                    verdict = feasibility(robot, reference, framework, point=tuple(point))  # as track judges
+                    assert verdict.feasible, (name, point, framework, reference.name, verdict.violations)
