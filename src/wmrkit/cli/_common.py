@@ -69,11 +69,16 @@ def warn(message: str) -> None:
         said.append(message)
 
 
+def said() -> list[str]:
+    """The messages of :func:`warn` in this command run so far ([] outside a run)."""
+    return list(_SAID.get() or [])
+
+
 def print_json(data: Any, *, warnings: bool = False) -> None:
     """Print `data` as JSON (NaN and infinities become null: JSON has none). With `warnings` (the commands that can
     warn), the mapping gets a top-level ``"warnings"``: the messages of :func:`warn` in this run, [] when none."""
     if warnings:
-        data = {**data, "warnings": list(_SAID.get() or [])}
+        data = {**data, "warnings": said()}
     print(json.dumps(_finite(data), indent=2))
 
 

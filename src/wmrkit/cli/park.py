@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 from ..errors import WmrkitError
-from ._common import add_json_flag, check_plot_path, print_json
+from ._common import add_json_flag, check_plot_path, print_json, said, warn
 from .control import check_animation_path
 
 
@@ -57,11 +56,13 @@ def run(args: argparse.Namespace) -> int:
 
             vehicle, space = solution.problem.vehicle, solution.problem.space
             executed = check_poses(vehicle, space, densify(vehicle, execution.pose))
+    if args.animate and execution is None:  # an impossible slot is an answer (exit 1), not bad input
+        warn(f"no plan, so no animation: {args.animate} not written")
     if args.json:
         out = solution.to_dict()
         if executed is not None:
             out["executed_check"] = {"mode": execution.mode, **check_dict(executed)}
-        print_json(out)
+        print_json({**out, "warnings": [*out["warnings"], *said()]})  # the plan's, then the command's
     else:
         print(describe(solution))
         if executed is not None:
@@ -73,8 +74,6 @@ def run(args: argparse.Namespace) -> int:
 
         if args.animate and execution is not None:
             plot.animate_plan(solution.plan, args.animate, execution, max_frames=frames)
-        elif args.animate:  # an impossible slot is an answer (exit 1), not bad input (it exited 2, unprinted)
-            print(f"wmrkit: note: no plan, so no animation: {args.animate} not written", file=sys.stderr)
         if args.plot:
             plot.save_plan_figure(solution.plan, args.plot, execution)
     return 0 if parked(solution, executed) else 1
