@@ -87,7 +87,7 @@ CASES = {
 
 
 #: The exit code of a case that warns when it is not 0: an answer that is no (docs/limits.md, Exit codes).
-NO = {"park {d}/short.yaml --animate {d}/no.gif": 1}
+NO = {"ik diff-drive --twist 1 0.2 0": 1, "park {d}/short.yaml --animate {d}/no.gif": 1}
 
 
 def test_every_command_with_json_is_one_that_can_warn_or_one_that_cannot():

@@ -194,7 +194,7 @@ def test_cli_geometric_tracker_options_are_the_python_ones(capsys, controller, o
 
 
 def test_cli_feasibility_json(capsys):
-    assert main(["feasibility", "forklift", "--reference", "square", "--json"]) == 0
+    assert main(["feasibility", "forklift", "--reference", "square", "--json"]) == 1  # an answer that is no
     data = json.loads(capsys.readouterr().out)
     assert data["feasible"] is False and {"t", "kind", "remedy"} <= set(data["violations"][0])
     assert main(["feasibility", "mecanum-4", "--reference", "circle", "--framework", "dynamic", "--json"]) == 0

@@ -44,7 +44,7 @@ def test_ik_json_of_other_wheel_types_adds_their_joints(capsys):
 
 def test_ik_warns_about_an_infeasible_twist(capsys):
     code, out, err = run(capsys, "ik", "diff-drive", "--twist", "1", "0.2", "0.5")
-    assert code == 0
+    assert code == 1  # an answer that is no (docs/limits.md, Exit codes)
     assert err.startswith("wmrkit: warning: twist not feasible for robot 'diff-drive'") and err.count("\n") == 1
     assert "feasible: NO" in out and "left" in out and "caster" in out
     code, out, err = run(capsys, "ik", "diff-drive", "--twist", "1", "0", "0.5", "--json")
@@ -93,7 +93,7 @@ def test_ik_text_names_each_reason_once(capsys):
     """Both front wheels of the car out of their steer_range: 'NO (a wheel cannot steer there; a wheel cannot steer
     there)' repeated the reason per wheel (the warnings on stderr name the wheels)."""
     code, out, err = run(capsys, "ik", "ackermann", "--twist", "1", "0", "1")
-    assert code == 0 and out.splitlines()[-1] == "feasible: NO (a wheel cannot steer there)"
+    assert code == 1 and out.splitlines()[-1] == "feasible: NO (a wheel cannot steer there)"
     assert "wheel 'front_left'" in err and "wheel 'front_right'" in err
 
 
@@ -168,7 +168,7 @@ def test_ik_outside_a_steer_range_is_not_feasible(capsys):
     robot = catalog.load("ackermann")
     code, out, err = run(capsys, "ik", "ackermann", "--twist", "1", "0", "0.3", "--json")
     data = json.loads(out)
-    assert code == 0 and data["feasible"] is False and data["out_of_range"] == ["front_left"]
+    assert code == 1 and data["feasible"] is False and data["out_of_range"] == ["front_left"]
     assert math.degrees(data["wheels"]["front_left"]["heading"]) == pytest.approx(46.5433, abs=1e-4)
     assert "wheel 'front_left' would steer to heading 46.5433 deg, outside its steer_range [-40, 40] deg" in err
     code, out, err = run(capsys, "ik", "ackermann", "--twist", "1", "0", "0.3")
@@ -234,7 +234,7 @@ def test_ik_and_show_tables_keep_long_wheel_names_apart_from_their_type(capsys, 
 
 def test_every_number_column_of_the_ik_table_names_its_unit(capsys):
     """'steer rate' was the one column of numbers without its unit (rad/s), beside 'spin [rad/s]' and 'slip [m/s]'."""
-    assert main(["ik", "diff-drive", "--twist", "1", "0.2", "0.5"]) == 0
+    assert main(["ik", "diff-drive", "--twist", "1", "0.2", "0.5"]) == 1  # not feasible: an answer that is no
     header = capsys.readouterr().out.splitlines()[0]
     columns = re.split(r"\s{2,}", header.strip())
     assert columns[:2] == ["wheel", "type"] and all(re.search(r"\[[^]]+\]$", c) for c in columns[2:]), columns

@@ -87,7 +87,7 @@ def test_ik_names_the_gear_and_the_rates(capsys, tmp_path):
     path = tmp_path / "kart.yaml"
     car.to_file(path)
     code, out, err = run(capsys, "ik", str(path), "--twist", "1", "0", "0.2")
-    assert code == 0 and "feasible: NO (a gear coupling cannot turn its joints so)" in out
+    assert code == 1 and "feasible: NO (a gear coupling cannot turn its joints so)" in out
     assert ("a gear coupling cannot turn its joints so: gear(rear_left.spin, rear_right.spin) turns them in the "
             "ratios 1, 1, the twist needs rear_left.spin 2.56061, rear_right.spin 3.5 rad/s") in err
     code, out, err = run(capsys, "ik", str(path), "--twist", "1", "0", "0.2", "--json")

@@ -210,7 +210,8 @@ def run_track(args: argparse.Namespace) -> int:
 
 
 def run_feasibility(args: argparse.Namespace) -> int:
-    """Print the Table 8.1 requirement and every violation with its remedy."""
+    """Print the Table 8.1 requirement and every violation with its remedy; exit 1 when there is one (the answer is
+    no)."""
     from ..control.feasibility import feasibility
 
     check_plot_path(args.plot)
@@ -226,11 +227,11 @@ def run_feasibility(args: argparse.Namespace) -> int:
         plot_feasibility(result, reference, args.plot)
     if args.json:
         print_json(result.to_dict(), warnings=True)
-        return 0
+        return 0 if result.feasible else 1  # an answer that is no (docs/limits.md, Exit codes)
     r = result.requirement
     print(f"robot {robot.name}: Table 8.1 column '{r.column}', {r.references} pose references; "
           f"{r.framework} framework needs continuous: {', '.join(r.signals)}")
     print("feasible: yes" if result.feasible else f"feasible: NO ({len(result.violations)} violation(s))")
     for v in result.violations:
         print(f"  t = {v.t:8.3f} s  {v.kind}, jump {v.size:.3g}: {v.remedy}")
-    return 0
+    return 0 if result.feasible else 1

@@ -49,14 +49,15 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 
 
 def run_ik(args: argparse.Namespace) -> int:
-    """Print the per-wheel commands; warn when the twist makes a fixed wheel slip or a wheel steer out of range."""
+    """Print the per-wheel commands; warn when the twist makes a fixed wheel slip or a wheel steer out of range, and
+    exit 1 then (the answer is no: the commands printed do not give the twist)."""
     robot = steered_robot(args.robot, args.steer)
     commands = wheel_commands(robot, args.twist)
     _check_finite("ik", commands.rates, commands.slip)
     for why in _infeasible(robot, commands):
         warn(f"twist not feasible for robot '{robot.name}': {why}")
     print_json(commands.to_dict(), warnings=True) if args.json else print(format_commands(robot, commands))
-    return 0
+    return 0 if commands.feasible else 1  # an answer that is no (docs/limits.md, Exit codes)
 
 
 def run_fk(args: argparse.Namespace) -> int:

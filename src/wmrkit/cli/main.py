@@ -1,4 +1,5 @@
-"""Entry point of the ``wmrkit`` command. User mistakes print one line and exit 2; bugs keep their traceback."""
+"""Entry point of the ``wmrkit`` command. An answer exits 0, or 1 when it is no (docs/limits.md, Exit codes); user
+mistakes print one line and exit 2; bugs keep their traceback."""
 
 from __future__ import annotations
 
@@ -69,7 +70,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run ``wmrkit`` with `argv`; return the exit code (0 ok, 2 user error)."""
+    """Run ``wmrkit`` with `argv`; return the exit code (0 an answer, 1 an answer that is no, 2 no answer)."""
     argv = sys.argv[1:] if argv is None else argv
     command = next((a for a in argv if not a.startswith("-")), None)
     as_json = wants_json(argv)
