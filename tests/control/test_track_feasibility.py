@@ -64,6 +64,21 @@ def test_the_verdict_is_for_the_point_the_controller_tracks(capsys):
     assert run.to_dict()["feasibility"] == run.feasibility.to_dict()
 
 
+def test_feasibility_judges_the_point_given_as_track_judges_the_point_it_tracks(capsys):
+    """'wmrkit feasibility' judged R only: the bicycle's arc-line was 'feasible: NO' there (R on the rear axle: the
+    curvature must be continuous) while 'track bicycle' with the p law, tracking a point ahead, was right to say
+    nothing. ``--point X Y`` judges any point; the verdict is track's for the same point."""
+    bicycle, arc_line = catalog.load("bicycle"), builtin_reference("arc-line")
+    tracked = track(bicycle, arc_line).feasibility
+    x, y = control_point(bicycle).point
+    assert main(["feasibility", "bicycle", "--reference", "arc-line", "--point", str(x), str(y), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out) == {**tracked.to_dict(), "warnings": []}
+    assert main(["feasibility", "bicycle", "--reference", "arc-line", "--point", "0", "0"]) == 1  # R, as before
+    assert "kappa not C0" in capsys.readouterr().out
+    assert main(["feasibility", "bicycle", "--reference", "arc-line", "--point", "1e300", "0"]) == 2
+    assert "point: expected (x, y), finite" in capsys.readouterr().err
+
+
 def test_only_the_violations_within_the_run_are_reported(capsys):
     forklift, square = catalog.load("forklift"), builtin_reference("square")
     assert track(forklift, square, duration=10).feasibility.feasible

@@ -60,6 +60,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     _reference_options(p)
     p.add_argument("--framework", default="kinematic", choices=("kinematic", "dynamic"),
                    help="kinematic (default): wheel rates may jump; dynamic: they must be continuous (§8.5)")
+    p.add_argument("--point", nargs=2, metavar=("X", "Y"),
+                   help="the tracked point [m, robot frame] (default the robot origin R, as Table 8.1; 'wmrkit track' "
+                        "judges the point its controller tracks)")
     p.add_argument("--plot", metavar="FILE", help="save a plot of the reference with its violations")
     add_json_flag(p)
     p.set_defaults(run=run_feasibility)
@@ -216,7 +219,9 @@ def run_feasibility(args: argparse.Namespace) -> int:
 
     check_plot_path(args.plot)
     robot, reference = load_robot(args.robot), _reference(args)
-    result = feasibility(robot, reference, args.framework)
+    point = None if args.point is None else (parse_value(args.point[0], "length", "--point X"),
+                                              parse_value(args.point[1], "length", "--point Y"))
+    result = feasibility(robot, reference, args.framework, point=point)
     for c in robot.couplings:
         if c.kind == "gear":  # Table 8.1 classifies the wheels' geometry only
             warn(f"{c.channel_name} is not considered: Table 8.1 judges the wheels alone; check the reference's "
