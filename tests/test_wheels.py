@@ -21,6 +21,7 @@ from scipy.linalg import null_space
 from strategies import wheels
 from wmrkit import KINDS, Robot, ShapeError, Wheel, generic_slip_rows, wheel_jacobian, wheel_slip_rows
 from wmrkit.errors import UnknownNameError
+from wmrkit.wheels import wrap_angle
 
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -417,3 +418,16 @@ def test_a_wheel_built_in_python_names_joints_of_its_type(field, joints, message
 
     with pytest.raises(WheelError, match=rf"^wheel 'left': {field}: {message}$"):
         Wheel("left", "fixed", l=0.2, alpha=math.pi / 2, beta=math.pi / 2, r=0.1, **{field: joints})
+
+
+def test_wrap_angle_is_the_round_formula_bit_for_bit():
+    # np.rint (the loop's hot path) in place of np.round must change no bit: halves, turns, huge and tiny angles
+    rng = np.random.default_rng(5)
+    a = np.concatenate([rng.uniform(-20, 20, 10_000), rng.normal(0, 1e6, 1000), 10.0 ** rng.uniform(-300, 300, 1000),
+                        np.arange(-41, 42) * math.pi, np.arange(-41, 42) * 2 * math.pi, [0.0, -0.0, 5e-324, 1e308]])
+    a = np.concatenate([a, -a, np.nextafter(a, np.inf), np.nextafter(a, -np.inf)])
+    y = a - 2 * math.pi * np.round(a / (2 * math.pi))
+    expected = np.where(y <= -math.pi, y + 2 * math.pi, np.where(y > math.pi, y - 2 * math.pi, y))
+    got = wrap_angle(a)
+    assert np.array_equal(got.view(np.int64), expected.view(np.int64))
+    assert wrap_angle(3 * math.pi).shape == () and float(wrap_angle(3 * math.pi)) == math.pi

@@ -285,7 +285,7 @@ _ELEMENTS = {
 def wrap_angle(angle: ArrayLike) -> np.ndarray:
     """Angles wrapped to ``(-pi, pi]`` [rad]; exact (no rounding) for angles already in range. ``(...) -> (...)``."""
     a = np.asarray(angle, dtype=float)
-    y = a - 2 * math.pi * np.round(a / (2 * math.pi))
+    y = a - 2 * math.pi * np.rint(a / (2 * math.pi))  # np.round's own ufunc (halves to even), without its wrapper
     return np.where(y <= -math.pi, y + 2 * math.pi, np.where(y > math.pi, y - 2 * math.pi, y))
 
 
