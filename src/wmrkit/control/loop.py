@@ -24,7 +24,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..kinematics.wheel_ik import WheelCommands, forward_kinematics, wheel_commands
+from ..kinematics.wheel_ik import checked_rates, forward_kinematics
 from ..limits import MAX_QUERY_RATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import wrap_angle
@@ -32,7 +32,7 @@ from .actuators import LowLevelLoops
 from .laws import PositionLaw, law_velocity, pose_error
 from .points import ControlError, ControlPoint, check_delay, point_pose, twist_for_velocity
 from .references import Reference
-from .steering import choose_steering, discretize_twist, reverse_spins, spin_columns, steer_ranges, unit_spin
+from .steering import checked_steering, discretize_twist, reverse_spins, spin_columns, steer_ranges, unit_spin
 
 _SPINS = (".spin", ".spin1", ".spin2")  # the joints that drive a wheel
 
@@ -107,11 +107,10 @@ def law_controller(cp: ControlPoint, law: PositionLaw, reference: Reference) -> 
 
 
 class _Commands(NamedTuple):
-    """One evaluation of the wheel commands: the IK, the steering targets (thesis beta), the joint rates
+    """One evaluation of the wheel commands: the steering targets (thesis beta), the joint rates
     (``robot.rate_names``) and the spins of the steered wheels for the chosen roots, and whether each steered
     wheel's target lies within its range."""
 
-    ik: WheelCommands
     target: np.ndarray
     rates: np.ndarray
     spin: np.ndarray
@@ -137,6 +136,9 @@ class _Sim:
         self.delta = np.array([robot.wheel(n).delta for n in names], dtype=float)
         self.ranges, self.spin_columns = steer_ranges(robot), spin_columns(robot)
         self.wheel_of_steer = np.array([robot.wheel_names.index(n) for n in names], dtype=int)
+        self.castor_rate_columns = np.array([robot.rate_names.index(f"{n}.steer") for n, p in zip(names, self.passive,
+                                                                                                    strict=True) if p],
+                                            dtype=int)  # the castors' steering rates (8.24) in the IK's rates
         loops = plant.loops
         self.joints = () if loops is None else loops.joints
         for j in self.joints:
@@ -156,23 +158,26 @@ class _Sim:
         self.n_loop = 0 if loops is None else loops.size
         self.hold_margin = HOLD_MARGIN  # the continuous loop holds ends within a step (inf) and switches at events
 
-    def commands(self, twist: np.ndarray, beta: np.ndarray, hold_margin: float | None = None) -> _Commands:
+    def commands(self, twist: np.ndarray, beta: np.ndarray, hold_margin: float | None = None,
+                 ik: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> _Commands:
         """Wheel commands at steering `beta`, with the policy and ranges applied to the steered wheels; a wheel held
-        at an end changes ends past `hold_margin` (default ``self.hold_margin``)."""
-        c = wheel_commands(self.robot, twist, beta)
-        target, rates = np.array(c.beta), np.array(c.rates)
+        at an end changes ends past `hold_margin` (default ``self.hold_margin``). `ik`: the IK's rates, steering and
+        spins at `(twist, beta)` (:func:`checked_rates`), when already computed."""
+        rates, target, spin_all = checked_rates(self.robot, twist, beta) if ik is None else ik
+        target, rates = np.array(target), np.array(rates)
         fits = np.ones(len(target), dtype=bool)
         if len(target) and (self.plant.policy != "closest" or self.limited):
             steered = ~self.passive
             heading = target - math.pi / 2 + self.delta
-            ch = choose_steering(heading, np.asarray(c.spin)[self.wheel_of_steer], beta - math.pi / 2 + self.delta,
-                                 policy=self.plant.policy, ranges=self.ranges,
-                                 hold_margin=self.hold_margin if hold_margin is None else hold_margin)
-            target = np.where(steered, np.asarray(ch.heading) + math.pi / 2 - self.delta, target)
-            reverse_spins(rates, self.spin_columns, np.asarray(ch.reversed) & steered)
-            fits = np.asarray(ch.in_range) | self.passive
-        spin = np.where(self.passive, np.asarray(c.spin)[self.wheel_of_steer], unit_spin(rates, self.spin_columns))
-        return _Commands(c, target, rates, spin, fits)
+            margin = self.hold_margin if hold_margin is None else hold_margin
+            chosen, _, in_range, reverse = checked_steering(heading, spin_all[self.wheel_of_steer],
+                                                            beta - math.pi / 2 + self.delta, self.plant.policy,
+                                                            self.ranges, margin)
+            target = np.where(steered, chosen + math.pi / 2 - self.delta, target)
+            reverse_spins(rates, self.spin_columns, reverse & steered)
+            fits = in_range | self.passive
+        spin = np.where(self.passive, spin_all[self.wheel_of_steer], unit_spin(rates, self.spin_columns))
+        return _Commands(target, rates, spin, fits)
 
     def realised(self, twist: np.ndarray, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The ideal plant's twist and which steered wheels fit their ranges: the commanded twist, or, when a wheel
@@ -265,8 +270,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
                           math.sin(th) * moving[0] + math.cos(th) * moving[1], moving[2]])
         dbeta = np.zeros(n_s)
         if sim.passive.any():  # castors turn by themselves (8.24): integrate at the actual twist
-            cc = wheel_commands(robot, moving, actual_beta)
-            dbeta[sim.passive] = np.asarray(cc.steer_rate)[sim.wheel_of_steer[sim.passive]]
+            dbeta[sim.passive] = checked_rates(robot, moving, actual_beta)[0][sim.castor_rate_columns]
         dls = ls[:0] if plant.loops is None else plant.loops.derivative(ls, sim.joint_commands(cmd))
         return np.concatenate([dpose, de if held is None else np.zeros(3), dbeta, dls])
 
@@ -404,11 +408,12 @@ def _given_steering(controller, sim: _Sim, t: float, x: np.ndarray, split) -> tu
         return out, False
     pose, integral, beta, _ = split(x)
     twist, _ = controller(t, pose, integral)
-    target = sim.commands(twist, beta, HOLD_MARGIN).target
+    ik = checked_rates(sim.robot, twist, beta)
+    target = sim.commands(twist, beta, HOLD_MARGIN, ik).target
     out[:len(beta)][steered] = target[steered]
     if not sim.limited:
         return out, False
-    held = sim.commands(twist, beta).target  # within a step: held wheels stay at their ends
+    held = sim.commands(twist, beta, ik=ik).target  # within a step: held wheels stay at their ends
     return out, bool(np.any(np.abs(wrap_angle(target - held))[steered] > 1e-9))
 
 

@@ -99,6 +99,15 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
     if isinstance(hold_margin, bool) or not isinstance(hold_margin, int | float) or not hold_margin >= 0:
         raise ControlError(f"hold_margin: expected an angle >= 0 [rad] (inf: never change ends), got {hold_margin!r}")
     h0, s0, cur = _finite({"heading": heading, "spin": spin, "current": current})
+    r = None if ranges is None else np.asarray(ranges, dtype=float)
+    h, s, fits, reverse = checked_steering(h0, s0, cur, policy, r, hold_margin)
+    return SteeringChoice(readonly(h), readonly(s), readonly(fits), readonly(reverse))
+
+
+def checked_steering(h0: np.ndarray, s0: np.ndarray, cur: np.ndarray, policy: str, r: np.ndarray | None,
+                     hold_margin: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`choose_steering` of arguments it has checked (float arrays of one shape, a policy, a margin), as
+    ``(heading, spin, in_range, reversed)``: for a loop calling it thousands of times (the continuous loop)."""
     h0 = wrap_angle(h0)
     h1, s1 = wrap_angle(h0 + math.pi), -s0
     if policy == "4-quadrant":
@@ -108,11 +117,10 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
     else:  # a tie (both 90 deg away): the root rolling forward, as the IK and WPILib's optimize
         d0, d1 = np.abs(wrap_angle(h0 - cur)), np.abs(wrap_angle(h1 - cur))
         pref0 = (d0 < d1 - 1e-12) | ((np.abs(d0 - d1) <= 1e-12) & (s0 >= 0))
-    if ranges is None:
+    if r is None:
         ok0 = ok1 = np.ones(h0.shape, dtype=bool)
         lo = hi = None
     else:
-        r = np.asarray(ranges, dtype=float)
         lo, hi = r[..., 0], r[..., 1]
         ok0, ok1 = heading_in_range(h0, lo, hi), heading_in_range(h1, lo, hi)
     take0 = np.where(ok0 & ok1, pref0, ok0)
@@ -130,8 +138,7 @@ def choose_steering(heading: ArrayLike, spin: ArrayLike, current: ArrayLike, *, 
         h = np.where(fits, h, np.where(near0, end0, end1))
         take0 = np.where(fits, take0, near0)
     s = np.where(take0, s0, s1)
-    return SteeringChoice(readonly(np.asarray(h)), readonly(np.asarray(s)), readonly(np.asarray(fits)),
-                          readonly(~np.asarray(take0)))
+    return np.asarray(h), np.asarray(s), np.asarray(fits), ~np.asarray(take0)
 
 
 def spin_columns(robot: Robot) -> np.ndarray:

@@ -20,7 +20,7 @@ from ..couplings import Coupling
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
-from ..units import UnitError, parse_quantity
+from ..units import MAX_ANGLE, UnitError, parse_quantity
 from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
 from ._ik_fast import wrap_angle
@@ -32,6 +32,8 @@ __all__ = ["WheelCommands", "forward_kinematics", "gear_error", "resolve_rate_na
 #: A gear coupling's rates are in its ratios when they depart from them by at most this fraction of the largest
 #: joint rate of the command (round-off of the rates (8.12)-(8.28) is ~1e-16 of it).
 GEAR_RTOL = 1e-9
+#: :func:`wheel_commands`' default ``speed_tol`` [m/s]: a steering axis slower than this holds its angle.
+SPEED_TOL = 1e-12
 
 
 @dataclass(frozen=True, eq=False)
@@ -117,7 +119,7 @@ def check_tolerances(speed_tol: float, slip_tol: float) -> None:
 
 def wheel_commands(
     robot: Robot, twist_robot: ArrayLike, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None,
-    speed_tol: float = 1e-12, slip_tol: float = 1e-9,
+    speed_tol: float = SPEED_TOL, slip_tol: float = 1e-9,
 ) -> WheelCommands:
     """Per-wheel inverse kinematics of the thesis §8.4 for a batch of body twists.
 
@@ -150,15 +152,7 @@ def wheel_commands(
         raise ShapeError(f"twist_robot {twist.shape} and the steering {current.shape}: their batch shapes (all but "
                          "the last axis) do not broadcast") from None
     n = p.n_wheels
-    if p.only_steerable:  # swerve-like: the angles are the configuration, the spins the rates
-        config, rates, held = _ik_fast.steer_to_twist(p, twist, current, speed_tol)
-    else:
-        rates, config, held = _general(p, twist, current, batch, speed_tol)
-    spin = _columns(rates, p.spin_select, batch, n)
-    doubles = p.spin2_col >= 0
-    if doubles.any():
-        spin = spin.copy()  # may be a view of rates
-        spin[..., doubles] = 0.5 * (spin[..., doubles] + rates[..., p.spin2_col[doubles]])
+    rates, config, held, spin = _rates(p, twist, current, batch, speed_tol)
     if len(p.fixed_wheels) == 0:
         slip = np.broadcast_to(0.0, (*batch, n))
         feasible = np.broadcast_to(True, batch)
@@ -184,6 +178,33 @@ def wheel_commands(
         feasible=_ro(feasible), beta=_ro(config), held=_ro(held), heading=_ro(heading), in_range=_ro(in_range),
         in_gear=_ro(in_gear), couplings=robot.couplings,
     )
+
+
+def _rates(p: _ik_fast.Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...],
+           speed_tol: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The joint rates, steering configuration, held flags and spins ``(..., N)`` of :func:`wheel_commands`."""
+    if p.only_steerable:  # swerve-like: the angles are the configuration, the spins the rates
+        config, rates, held = _ik_fast.steer_to_twist(p, twist, current, speed_tol)
+    else:
+        rates, config, held = _general(p, twist, current, batch, speed_tol)
+    spin = _columns(rates, p.spin_select, batch, p.n_wheels)
+    doubles = p.spin2_col >= 0
+    if doubles.any():
+        spin = spin.copy()  # may be a view of rates
+        spin[..., doubles] = 0.5 * (spin[..., doubles] + rates[..., p.spin2_col[doubles]])
+    return rates, config, held, spin
+
+
+def checked_rates(robot: Robot, twist: np.ndarray, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`wheel_commands`' ``rates``, ``beta`` and ``spin`` for one twist ``(3,)`` at steering `beta`
+    ``(n_steer,)`` (float arrays), the same numbers without its other outputs (slip, headings, ranges, gears) and
+    the checks of its arguments' types and shapes: for a loop calling it thousands of times (the continuous
+    control loop). A twist or an angle that :func:`wheel_commands` refuses is refused by it (same error)."""
+    if not ((np.abs(twist) <= MAX_QUERY_RATE).all() and (np.abs(beta) <= MAX_ANGLE).all()):  # NaN included
+        c = wheel_commands(robot, twist, beta)  # raises; kept should its bounds ever differ
+        return c.rates, c.beta, c.spin
+    rates, config, _, spin = _rates(_ik_fast.plan(robot), twist, beta, (), SPEED_TOL)
+    return rates, config, spin
 
 
 def gear_error(coupling: Coupling, rate_names: tuple[str, ...], rates: np.ndarray) -> np.ndarray:
