@@ -24,6 +24,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..kinematics.linalg import solve_assigned
 from ..kinematics.wheel_ik import checked_rates, forward_kinematics
 from ..limits import MAX_QUERY_RATE, MAX_SPEED
 from ..robot import Robot
@@ -155,6 +156,7 @@ class _Sim:
         if self.limited and not spins:  # no actuator described: every wheel spins as the IK commands it
             spins = [j for j in robot.rate_names if j.endswith(_SPINS)]
         self.drive = tuple(spins)
+        self.drive_columns = np.array([robot.velocity_names.index(j) for j in spins], dtype=int)
         self.n_loop = 0 if loops is None else loops.size
         self.hold_margin = HOLD_MARGIN  # the continuous loop holds ends within a step (inf) and switches at events
 
@@ -191,12 +193,13 @@ class _Sim:
         return self.least_squares_twist(cmd, cmd.target, {}), cmd.fits
 
     def least_squares_twist(self, cmd: _Commands, beta: np.ndarray, actual: dict[str, float]) -> np.ndarray:
-        """Twist (4.11) of the drive joints' rates (`actual` where given, else commanded) at steering `beta`."""
-        rates = {}
-        for j in self.drive:
-            rates[j] = actual[j] if j in actual else float(cmd.rates[self.robot.rate_names.index(j)])  # chosen roots
-        twist, _ = forward_kinematics(self.robot, rates, beta)
-        return np.asarray(twist)
+        """Twist (4.11) of the drive joints' rates (`actual` where given, else commanded) at steering `beta`:
+        :func:`forward_kinematics`' numbers, its columns found once a run."""
+        q = np.array([actual[j] if j in actual else float(cmd.rates[c - 3])  # chosen roots
+                      for j, c in zip(self.drive, self.drive_columns, strict=True)])
+        if not (np.abs(q) <= MAX_QUERY_RATE).all():  # NaN included: refused by it, naming the rate
+            return np.asarray(forward_kinematics(self.robot, dict(zip(self.drive, q.tolist(), strict=True)), beta)[0])
+        return solve_assigned(self.robot.constraint_matrix(beta), self.drive_columns, q)[0][:3]
 
     def joint_commands(self, cmd: _Commands) -> np.ndarray:
         out = np.zeros(len(self.joints))
