@@ -1,0 +1,88 @@
+"""The continuous control loop (``wmrkit track`` without ``--period``): the cost of one evaluation, and whole runs.
+
+- one evaluation's wheel commands, ``_Sim.commands`` (the IK and the steering choice with the loop's checked
+  arguments, :func:`~wmrkit.kinematics.wheel_ik.checked_rates` and :func:`~wmrkit.control.steering.checked_steering`)
+  against the general path measured in the same run, ``wheel_commands`` + ``choose_steering`` on the same twist and
+  steering (what the loop called before), for the car (its front wheels at their stops) and a swerve-4;
+- the least-squares twist (4.11) of the car's rear spins, held at its stops (``_Sim.least_squares_twist``), against
+  ``forward_kinematics`` on the same rates;
+- whole runs with the defaults (the car on the circle and the figure-eight, a diff drive and its castor on the circle,
+  swerve-4 on the square, thesis-steer-castor's castors): wall time against the reference's duration.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from wmrkit import catalog
+from wmrkit.control import builtin_reference, track
+from wmrkit.control.loop import Plant, _Sim
+from wmrkit.control.steering import choose_steering
+from wmrkit.kinematics.wheel_ik import forward_kinematics, wheel_commands
+
+from ._harness import Result, best_time
+
+
+def _evaluations(name: str, n: int) -> Result:
+    robot = catalog.load(name)
+    sim = _Sim(robot, Plant())
+    twist, beta = np.array([0.5, 0.0, 1.0]), np.array(robot.beta, dtype=float)  # the car: beyond its stops
+
+    def lean():
+        for _ in range(n):
+            sim.commands(twist, beta)
+
+    def general():
+        for _ in range(n):
+            c = wheel_commands(robot, twist, beta)
+            choose_steering(np.asarray(c.beta) - math.pi / 2 + sim.delta, np.asarray(c.spin)[sim.wheel_of_steer],
+                            beta - math.pi / 2 + sim.delta, policy="closest", ranges=sim.ranges,
+                            hold_margin=sim.hold_margin)
+
+    return Result(f"{name}: one evaluation's wheel commands", n, best_time(lean),
+                  "wheel_commands + choose_steering", best_time(general))
+
+
+def _least_squares(n: int) -> Result:
+    robot = catalog.load("ackermann")
+    sim = _Sim(robot, Plant())
+    beta = np.array(robot.beta, dtype=float) + 0.1
+    cmd = sim.commands(np.array([0.5, 0.0, 1.0]), beta)
+    rates = {j: float(cmd.rates[robot.rate_names.index(j)]) for j in sim.drive}
+
+    def lean():
+        for _ in range(n):
+            sim.least_squares_twist(cmd, beta, {})
+
+    def general():
+        for _ in range(n):
+            forward_kinematics(robot, rates, beta)
+
+    return Result("ackermann: least-squares twist of the held car", n, best_time(lean), "forward_kinematics",
+                  best_time(general))
+
+
+def run(quick: bool) -> list[Result]:
+    """Per-evaluation costs against the general path, and whole continuous runs against real time."""
+    n = 200 if quick else 2000
+    out = [_evaluations("ackermann", n), _evaluations("swerve-4", n), _least_squares(n)]
+    runs = [("ackermann", "circle"), ("diff-drive", "circle"), ("swerve-4", "square")]
+    if not quick:
+        runs += [("ackermann", "figure-eight"), ("thesis-steer-castor", "circle")]
+    for robot, name in runs:
+        reference = builtin_reference(name)
+        t0 = time.perf_counter()
+        result = track(catalog.load(robot), reference)
+        wall = time.perf_counter() - t0
+        duration = float(result.t[-1])
+        out.append(Result(f"track {robot} {name} (continuous, defaults)", len(result.t), wall, "real time", duration,
+                          target=f"{duration / wall:.0f}x faster than real time"))
+    return out
+
+
+if __name__ == "__main__":
+    for r in run(quick=True):
+        print(r.line())
