@@ -78,8 +78,8 @@ def run(quick: bool) -> list[Result]:
         result = track(catalog.load(robot), reference)
         wall = time.perf_counter() - t0
         duration = float(result.t[-1])
-        out.append(Result(f"track {robot} {name} (continuous, defaults)", len(result.t), wall, "real time", duration,
-                          target=f"{duration / wall:.0f}x faster than real time"))
+        # the ratio is how many times faster than real time; no target is stated for it
+        out.append(Result(f"track {robot} {name} (continuous, defaults)", len(result.t), wall, "real time", duration))
     return out
 
 
