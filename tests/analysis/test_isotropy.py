@@ -385,3 +385,21 @@ def test_joints_blind_to_rotation_have_no_natural_length(k):
     length, kappa = natural_length(robot)
     assert np.isinf(kappa) and length == robot_size(robot)
     assert np.isinf(twist_condition_number(robot, length=length))
+
+
+@pytest.mark.parametrize("k", [1.0, 4.0, 8.0, 100.0])
+def test_the_natural_length_of_a_robot_mounted_at_its_origin_scales_with_it(k):
+    """A double castor mounted at the origin (0.5 m offset, half-separation and radius) is sized 1 mm
+    (robot_size's floor: no mount point away from the origin) at any scale, and the natural length was searched up
+    to 1 m only: scaled by 4 its D was that bound, 1 m, with kappa 1.966 instead of the minimum 1.932 at 0.289 * 4 m
+    (hypothesis found it). The search now reaches 1000 times the robot's largest length. Independent: kappa scanned
+    on a fine grid of lengths."""
+    wheel = Wheel("w0", "double_castor", l=0.0, alpha=0.0, beta=0.0, r=0.5 * k, d=-0.5 * k, b=0.5 * k,
+                  actuated=("steer", "spin1", "spin2"))
+    robot = Robot("r", (wheel,))
+    joints = default_joints(robot)
+    d, kappa = natural_length(robot, joints=joints)
+    scan = np.array([twist_condition_number(robot, joints=joints, length=x) for x in np.geomspace(0.01, 100, 4001) * k])
+    assert scan.min() * (1 - 1e-3) <= kappa <= scan.min()  # at the minimum, between the scan's lengths
+    assert math.isclose(d / k, 0.5 / math.sqrt(3), rel_tol=1e-6)  # where the scan's minimum lies, below
+    assert math.isclose(np.geomspace(0.01, 100, 4001)[scan.argmin()], 0.5 / math.sqrt(3), rel_tol=5e-3)

@@ -96,8 +96,6 @@ class ICRSet:
 #: Largest heading error [rad] :func:`icr` reads as rounding of consistent headings (0.5 deg).
 ROUNDING = math.radians(0.5)
 
-#: An ICR farther than this many robot sizes is at infinity (a translation; beyond any physical meaning).
-FAR = 1e9
 #: Rounding of the common point's ``w`` (nondimensional, unit vector) per unit condition number of two axles: an
 #: ICR whose ``w`` is below it times ``s_1 / s_2`` is the intersection of axles parallel within rounding, not a point.
 ROUNDING_W = 1e3 * np.finfo(float).eps
@@ -125,7 +123,9 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
     size = characteristic_length(robot)
     _, s, vt = np.linalg.svd(g * [1.0, 1.0, 1.0 / size])  # nondimensional: lengths in robot sizes
     x, y, w = -vt[-1, 1], vt[-1, 0], vt[-1, 2]  # the common point as common_point maps it, in robot sizes
-    if abs(w) * FAR <= math.hypot(x, y) or abs(w) <= ROUNDING_W * s[0] / s[1]:
+    # no distance beyond which a point is "at infinity": the robot size depends on the frame's origin, so the
+    # same axles would meet in one frame and not in another (1.25e9 sizes away: steering 1e-10 rad)
+    if abs(w) <= ROUNDING_W * s[0] / s[1]:
         n = np.hypot(x, y) * (1.0 if y > 1e-12 or (abs(y) <= 1e-12 and x < 0) else -1.0)  # either sign: +x first
         return ICRSet("infinity", direction=(float(y / n), float(-x / n)))
     return ICRSet("point", point=(float(size * x / w), float(size * y / w)))

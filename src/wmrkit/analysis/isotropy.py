@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_names, readonly
 from ..errors import ShapeError, UnknownNameError
+from ..kinematics.linalg import characteristic_length
 from ..kinematics.models import configuration
 from ..robot import Robot
 from . import _fast
@@ -35,7 +36,8 @@ from .classification import classify
 from .lines import _rate_block, constraint_lines, element_rows, line_parameters, rows_at
 from .singularity import check_positive_length, robot_size
 
-#: Search interval of the natural length, in robot sizes (see :func:`natural_length`).
+#: Search interval of the natural length, in robot sizes (see :func:`natural_length`); its top is at least
+#: ``LENGTH_RANGE[1]`` times the robot's largest length (:func:`~wmrkit.kinematics.linalg.characteristic_length`).
 LENGTH_RANGE = (1e-3, 1e3)
 
 
@@ -96,7 +98,8 @@ def isotropy_length(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, .
     if "omega" not in assigned + selected:
         return float("nan"), float(condition_number(isotropy_matrix(robot, beta, assigned, selected)))
     return _minimise_length(lambda d: float(condition_number(isotropy_matrix(robot, beta, assigned, selected,
-                                                                             length=d))), robot_size(robot))
+                                                                             length=d))), robot_size(robot),
+                            largest=characteristic_length(robot))
 
 
 def default_joints(robot: Robot) -> tuple[str, ...]:
@@ -247,7 +250,7 @@ def _natural_length(model: TwistModel, beta: np.ndarray, size: float) -> tuple[f
             sv = np.linalg.svd(h * np.array([1.0, 1.0, 1.0 / length]), compute_uv=False)
             return float(sv[0] / sv[-1]) if sv[-1] > 1e-13 * sv[0] else np.inf
 
-        return _minimise_length(one, size, many)
+        return _minimise_length(one, size, many, largest=characteristic_length(model.robot))
     return size, float(_fast.kappa_cm(model.mobility, rates, lines, float(size))[0])
 
 
@@ -259,10 +262,13 @@ def _element_rows_one(p, beta: np.ndarray) -> np.ndarray:
     return rows_at(p, wheel_beta)[..., None]
 
 
-def _minimise_length(kappa, size: float, many=None) -> tuple[float, float]:
-    """Minimise ``kappa(D)`` over D in LENGTH_RANGE * size (log scale); ties go to `size`. `many`, if given, is
-    `kappa` over an array of lengths at once (the same values)."""
-    lo, hi = np.log(LENGTH_RANGE[0] * size), np.log(LENGTH_RANGE[1] * size)
+def _minimise_length(kappa, size: float, many=None, *, largest: float = 0.0) -> tuple[float, float]:
+    """Minimise ``kappa(D)`` over D from ``LENGTH_RANGE[0] * size`` to ``LENGTH_RANGE[1]`` times the larger of
+    `size` and the robot's `largest` length (log scale); ties go to `size`. `many`, if given, is `kappa` over an
+    array of lengths at once (the same values). A robot whose wheels are all mounted at its origin is sized
+    1 mm (:func:`.singularity.robot_size`'s floor) whatever its castor offsets and radii: searched up to 1 m
+    only, a double castor of 0.5 m offset and radius, natural length 0.29 m, scaled by 4 was given 1 m."""
+    lo, hi = np.log(LENGTH_RANGE[0] * size), np.log(LENGTH_RANGE[1] * max(size, largest))
     grid = np.linspace(lo, hi, 121)
     values = many(np.exp(grid)) if many is not None else np.array([kappa(np.exp(x)) for x in grid])
     k_size = kappa(size)
