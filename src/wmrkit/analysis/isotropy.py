@@ -98,8 +98,7 @@ def isotropy_length(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, .
     if "omega" not in assigned + selected:
         return float("nan"), float(condition_number(isotropy_matrix(robot, beta, assigned, selected)))
     return _minimise_length(lambda d: float(condition_number(isotropy_matrix(robot, beta, assigned, selected,
-                                                                             length=d))), robot_size(robot),
-                            largest=characteristic_length(robot))
+                                                                             length=d))), robot)
 
 
 def default_joints(robot: Robot) -> tuple[str, ...]:
@@ -250,7 +249,7 @@ def _natural_length(model: TwistModel, beta: np.ndarray, size: float) -> tuple[f
             sv = np.linalg.svd(h * np.array([1.0, 1.0, 1.0 / length]), compute_uv=False)
             return float(sv[0] / sv[-1]) if sv[-1] > 1e-13 * sv[0] else np.inf
 
-        return _minimise_length(one, size, many, largest=characteristic_length(model.robot))
+        return _minimise_length(one, model.robot, many)
     return size, float(_fast.kappa_cm(model.mobility, rates, lines, float(size))[0])
 
 
@@ -262,13 +261,14 @@ def _element_rows_one(p, beta: np.ndarray) -> np.ndarray:
     return rows_at(p, wheel_beta)[..., None]
 
 
-def _minimise_length(kappa, size: float, many=None, *, largest: float = 0.0) -> tuple[float, float]:
-    """Minimise ``kappa(D)`` over D from ``LENGTH_RANGE[0] * size`` to ``LENGTH_RANGE[1]`` times the larger of
-    `size` and the robot's `largest` length (log scale); ties go to `size`. `many`, if given, is `kappa` over an
-    array of lengths at once (the same values). A robot whose wheels are all mounted at its origin is sized
-    1 mm (:func:`.singularity.robot_size`'s floor) whatever its castor offsets and radii: searched up to 1 m
-    only, a double castor of 0.5 m offset and radius, natural length 0.29 m, scaled by 4 was given 1 m."""
-    lo, hi = np.log(LENGTH_RANGE[0] * size), np.log(LENGTH_RANGE[1] * max(size, largest))
+def _minimise_length(kappa, robot: Robot, many=None) -> tuple[float, float]:
+    """Minimise ``kappa(D)`` over D from ``LENGTH_RANGE[0]`` times `robot`'s size (:func:`.singularity.robot_size`)
+    to ``LENGTH_RANGE[1]`` times the larger of its size and its largest length (log scale); ties go to the size.
+    `many`, if given, is `kappa` over an array of lengths at once (the same values). A robot whose wheels are all
+    mounted at its origin is sized 1 mm (robot_size's floor) whatever its castor offsets and radii: searched up to
+    1 m only, a double castor of 0.5 m offset and radius, natural length 0.29 m, scaled by 4 was given 1 m."""
+    size = robot_size(robot)
+    lo, hi = np.log(LENGTH_RANGE[0] * size), np.log(LENGTH_RANGE[1] * max(size, characteristic_length(robot)))
     grid = np.linspace(lo, hi, 121)
     values = many(np.exp(grid)) if many is not None else np.array([kappa(np.exp(x)) for x in grid])
     k_size = kappa(size)

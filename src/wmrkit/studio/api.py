@@ -36,7 +36,6 @@ from ..analysis.summary import describe_singular, model_rates, model_singular_se
 from ..description import robot_from_dict, robot_to_dict
 from ..errors import ShapeError, WmrkitError
 from ..kinematics.actuation import actuation_analysis
-from ..kinematics.linalg import characteristic_length
 from ..kinematics.sensing import sensing_analysis
 from ..kinematics.wheel_ik import wheel_commands
 from ..limits import MAX_QUERY_RATE
@@ -153,7 +152,7 @@ def live_natural_length(robot: Robot, joints: tuple[str, ...]) -> tuple[float, f
     if model.mobility != 3:
         return natural_length(robot, joints=joints)
     kappa = kappa_function(model, robot.beta[None])
-    return _minimise_length(lambda d: float(kappa(d)[0]), robot_size(robot), largest=characteristic_length(robot))
+    return _minimise_length(lambda d: float(kappa(d)[0]), robot)
 
 
 def icr_dict(s: ICRSet) -> dict[str, Any]:
