@@ -16,15 +16,16 @@ from hypothesis import strategies as st
 from strategies import mirrored, moved, robots, scaled
 from wmrkit.analysis.icr import icr
 from wmrkit.analysis.isotropy import default_joints, natural_length, twist_condition_number
-from wmrkit.analysis.singularity import SIZE_FLOOR, robot_size
 
 
 def _same(a, b, rtol):
-    """Equal to `rtol`, infinities and NaN at the same places."""
+    """Condition numbers equal to `rtol`, infinities and NaN at the same places. A computed kappa is itself known
+    only to about kappa * eps (the least singular value to eps times the largest): 5e-6 at a kappa of 6e10."""
     a, b = np.asarray(a, float), np.asarray(b, float)
     np.testing.assert_array_equal(np.isinf(a), np.isinf(b))
     np.testing.assert_array_equal(np.isnan(a), np.isnan(b))
-    np.testing.assert_allclose(a[np.isfinite(a)], b[np.isfinite(b)], rtol=rtol, atol=1e-9)
+    a, b = a[np.isfinite(a)], b[np.isfinite(b)]
+    np.testing.assert_allclose(a, b, rtol=rtol + 10 * np.finfo(float).eps * np.max(b, initial=0.0), atol=1e-9)
 
 
 @settings(max_examples=40)
@@ -43,9 +44,7 @@ def test_kappa_and_the_natural_length_ignore_frame_turns_mirrors_and_order_and_s
         _same(twist_condition_number(other, joints=js, length=length * factor), kappa, 1e-6)
         d2, kappa_d2 = natural_length(other, joints=js)
         _same(kappa_d2, kappa_d, 1e-4)
-        # where kappa is infinite every D is as bad: no length to compare; where robot_size is at its documented
-        # 1 mm floor (docs/limits.md: not scale-free below a millimetre) a D that is the size does not scale
-        if math.isfinite(kappa_d) and SIZE_FLOOR not in (robot_size(robot), robot_size(other)):
+        if math.isfinite(kappa_d):  # where kappa is infinite every D is as bad: no length to compare
             assert math.isclose(d2, d * factor, rel_tol=1e-3)
 
 

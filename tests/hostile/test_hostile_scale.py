@@ -1,6 +1,7 @@
 """Issue 9: rank decisions are scale-aware. The same robot at any size of the envelope (1 um to 1 km) has the same
 mobility, assignable sets, minimal actuator sets, actuation and sensing verdicts and vehicle type; its models
-solve the no-slip equations of the scaled robot. And what lies outside the envelope is refused by the loader."""
+solve the no-slip equations of the scaled robot; its default lengths (robot size, natural length) scale with it.
+And what lies outside the envelope is refused by the loader."""
 
 from __future__ import annotations
 
@@ -14,6 +15,8 @@ from hypothesis import strategies as st
 
 from strategies import robots
 from wmrkit.analysis.classification import classify
+from wmrkit.analysis.isotropy import default_joints, natural_length
+from wmrkit.analysis.singularity import robot_size, singularity_distance
 from wmrkit.description import ANGLE_MARGIN, MAX_SIZE, MIN_RATIO, MIN_SIZE, robot_from_dict, robot_to_dict
 from wmrkit.errors import DescriptionError
 from wmrkit.kinematics import actuation_analysis, assignable_sets, minimal_actuator_sets, mobility, sensing_analysis
@@ -92,3 +95,24 @@ def test_the_envelope_s_edges_are_accepted_and_just_beyond_refused():
     tiny["wheels"][1].update(position=[0, -0.9 * MIN_SIZE], r=0.5 * MIN_SIZE)
     with pytest.raises(DescriptionError, match=r"below 1e-06 m"):
         robot_from_dict(tiny)
+
+
+@settings(max_examples=25)
+@given(robot=robots(max_wheels=3), exponent=st.sampled_from([math.log10(MIN_SIZE), math.log10(MAX_SIZE)]),
+       beta=st.lists(st.floats(-3, 3), min_size=3, max_size=3))
+def test_the_default_lengths_scale_with_the_robot_at_the_ends_of_the_envelope(robot, exponent, beta):
+    """robot_size, the natural length and the distance to singularity at 1 um and 1 km are those at the robot's
+    size (a robot of 1 um was sized 1 mm, a floor, so its lines were weighed at 1000 of its sizes)."""
+    factor = 10.0**exponent / _size(robot)
+    scaled = _scaled(robot, factor)
+    assert robot_size(scaled) == pytest.approx(robot_size(robot) * factor, rel=1e-9)
+    config = np.array(beta[:len(robot.beta)])
+    assigned = default_joints(robot)
+    np.testing.assert_allclose(singularity_distance(scaled, config, assigned),
+                               singularity_distance(robot, config, assigned), rtol=1e-6, atol=1e-9)
+    d, kappa = natural_length(robot, config)
+    d_scaled, kappa_scaled = natural_length(scaled, config)
+    assert np.isinf(kappa_scaled) == np.isinf(kappa) and np.isnan(kappa_scaled) == np.isnan(kappa)
+    if np.isfinite(kappa):
+        assert kappa_scaled == pytest.approx(kappa, rel=1e-4)
+        assert d_scaled == pytest.approx(d * factor, rel=1e-3)

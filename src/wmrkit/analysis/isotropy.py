@@ -36,7 +36,7 @@ from .classification import classify
 from .lines import _rate_block, constraint_lines, element_rows, line_parameters, rows_at
 from .singularity import check_positive_length, robot_size
 
-#: Search interval of the natural length, in robot sizes (see :func:`natural_length`); its top is at least
+#: Search interval of the natural length (see :func:`natural_length`): from ``LENGTH_RANGE[0]`` robot sizes to
 #: ``LENGTH_RANGE[1]`` times the robot's largest length (:func:`~wmrkit.kinematics.linalg.characteristic_length`).
 LENGTH_RANGE = (1e-3, 1e3)
 
@@ -178,22 +178,18 @@ def _kappa(model: TwistModel, beta: np.ndarray, length: float) -> np.ndarray:
     """Condition numbers at configurations `beta` ``(..., n_steer) -> (...)``, in cache-sized chunks."""
     flat = beta.reshape(int(np.prod(beta.shape[:-1])), beta.shape[-1])
     out = np.empty(len(flat))
-    p, cl = line_parameters(model.robot), constraint_lines(model.robot)
+    p = line_parameters(model.robot)
     for s in range(0, len(flat), _fast.CHUNK):
         rows = _element_rows_one(p, flat[0]) if len(flat) == 1 else _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
-        lines = _fast.normalize_cm(_fast.combine_lines(cl, rows))
-        out[s:s + _fast.CHUNK] = _fast.kappa_cm(model.mobility, _fast.combine(model.coefficients, rows), lines,
-                                                float(length))
+        rates, lines, unit = _in_robot_lengths(model, rows)
+        out[s:s + _fast.CHUNK] = _fast.kappa_cm(model.mobility, rates, lines, float(length) / unit)
     return out.reshape(beta.shape[:-1])
 
 
 def kappa_function(model: TwistModel, beta: np.ndarray):
     """``length -> kappa (N,)`` at configurations `beta` ``(N, n_steer)`` (one chunk), rows computed once."""
-    p, cl = line_parameters(model.robot), constraint_lines(model.robot)
-    rows = _fast.element_rows_cm(p, beta)
-    lines = _fast.normalize_cm(_fast.combine_lines(cl, rows))
-    rates = _fast.combine(model.coefficients, rows)
-    return lambda length: _fast.kappa_cm(model.mobility, rates, lines, float(length))
+    rates, lines, unit = _in_robot_lengths(model, _fast.element_rows_cm(line_parameters(model.robot), beta))
+    return lambda length: _fast.kappa_cm(model.mobility, rates, lines, float(length) / unit)
 
 
 def length_applies(mobility: int, kappa: float) -> bool:
@@ -222,35 +218,56 @@ def natural_length(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple
 def _natural_length(model: TwistModel, beta: np.ndarray, size: float) -> tuple[float, float]:
     """:func:`natural_length` at one checked configuration ``(n_steer,)``, the element rows computed once (the
     values of :func:`_kappa`); for m = 3 the search grid of lengths is one batched SVD."""
-    p, cl = line_parameters(model.robot), constraint_lines(model.robot)
-    rows = _element_rows_one(p, beta)
-    lines = _fast.normalize_cm(_fast.combine_lines(cl, rows))
-    rates = _fast.combine(model.coefficients, rows)
+    p = line_parameters(model.robot)
+    rates, lines, unit = _in_robot_lengths(model, _element_rows_one(p, beta))
     if model.mobility == 2:
         a, b, ok = _fast.columns_m2(rates, lines)
         v, w = float(np.linalg.norm(a)), float(np.linalg.norm(b))
-        # joints blind to omega (|h_omega| round-off of 0 at the robot's size, below condition_number's threshold):
-        # kappa is infinite at every D, as at the size; w / v was a length of 1e-18 m with a kappa of round-off
-        length = w / v if ok[0] and v > 0 and w > 1e-13 * v * size else size
         if not ok[0]:  # kappa_cm's value, with these columns
-            return length, np.nan
-        return length, float(condition_number(np.stack([a[:, 0], b[:, 0] / length], axis=-1)))
+            return size, np.nan
+        if _blind(v, w):  # w / v was a length of 1e-18 m (or 7e15 m) with a kappa of round-off
+            return size, np.inf
+        length = w / v
+        return length * unit, float(condition_number(np.stack([a[:, 0], b[:, 0] / length], axis=-1)))
     if model.mobility == 3:  # kappa_cm's SVD route for one configuration, without its batch bookkeeping
         h = rates[:, :, 0]
+        if _blind(float(np.linalg.norm(h[:, :2])), float(np.linalg.norm(h[:, 2]))):
+            return size, np.inf  # the search found a kappa of 1e11 where the omega column's round-off met D = 1e-6 m
 
         def many(lengths: np.ndarray) -> np.ndarray:
             scale = np.ones((len(lengths), 3))
-            scale[:, 2] = 1.0 / lengths
+            scale[:, 2] = unit / lengths
             return condition_number(h * scale[:, None, :])
 
         def one(length: float) -> float:  # condition_number's value and threshold, on one (J, 3) matrix
             if h.shape[0] < 3:
                 return np.inf
-            sv = np.linalg.svd(h * np.array([1.0, 1.0, 1.0 / length]), compute_uv=False)
+            sv = np.linalg.svd(h * np.array([1.0, 1.0, unit / length]), compute_uv=False)
             return float(sv[0] / sv[-1]) if sv[-1] > 1e-13 * sv[0] else np.inf
 
         return _minimise_length(one, model.robot, many)
-    return size, float(_fast.kappa_cm(model.mobility, rates, lines, float(size))[0])
+    return size, float(_fast.kappa_cm(model.mobility, rates, lines, size / unit)[0])
+
+
+def _in_robot_lengths(model: TwistModel, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """The joint rates ``(J, 3, N)`` and normalised axle lines ``(R, 3, N)`` at element `rows` in the robot's
+    largest length ``L`` (:func:`~wmrkit.kinematics.linalg.characteristic_length`), and ``L`` [m]: the twist's
+    lengths and the lines' ``d`` divided by L (rates per unit speed times L), as
+    :func:`~wmrkit.kinematics.linalg.nondimensional` makes the rank decisions. Every threshold of :mod:`._fast`
+    is then relative: a robot of 1 um had its axles "one line" within 1e-6 m, all of them. Condition numbers are
+    unchanged; a length D of the robot is ``D / L`` here."""
+    unit = characteristic_length(model.robot)
+    scale = np.array([unit, unit, 1.0])[None, :, None]
+    lines = _fast.combine_lines(constraint_lines(model.robot), rows) * np.array([1.0, 1.0, 1.0 / unit])[None, :, None]
+    return _fast.combine(model.coefficients, rows) * scale, _fast.normalize_cm(lines), unit
+
+
+def _blind(v: float, w: float) -> bool:
+    """Whether joints whose rates have norm `v` per unit speed and `w` per unit turn rate, in the robot's largest
+    length (:func:`_in_robot_lengths`), are blind to the translation or to the turn rate: kappa is then infinite at
+    every D (one below 1e-13 of the other is round-off of 0; two steering rates blind to the speed once gave a
+    natural length of 7e15 m)."""
+    return not (v > 1e-13 * w and w > 1e-13 * v)
 
 
 def _element_rows_one(p, beta: np.ndarray) -> np.ndarray:
@@ -263,12 +280,11 @@ def _element_rows_one(p, beta: np.ndarray) -> np.ndarray:
 
 def _minimise_length(kappa, robot: Robot, many=None) -> tuple[float, float]:
     """Minimise ``kappa(D)`` over D from ``LENGTH_RANGE[0]`` times `robot`'s size (:func:`.singularity.robot_size`)
-    to ``LENGTH_RANGE[1]`` times the larger of its size and its largest length (log scale); ties go to the size.
-    `many`, if given, is `kappa` over an array of lengths at once (the same values). A robot whose wheels are all
-    mounted at its origin is sized 1 mm (robot_size's floor) whatever its castor offsets and radii: searched up to
-    1 m only, a double castor of 0.5 m offset and radius, natural length 0.29 m, scaled by 4 was given 1 m."""
+    to ``LENGTH_RANGE[1]`` times its largest length (log scale); ties go to the size. `many`, if given, is `kappa`
+    over an array of lengths at once (the same values). The top is not 1000 sizes: a double castor of 0.5 m offset
+    and radius mounted at the origin, natural length 0.29 m, once sized 1 mm, was searched up to 1 m only."""
     size = robot_size(robot)
-    lo, hi = np.log(LENGTH_RANGE[0] * size), np.log(LENGTH_RANGE[1] * max(size, characteristic_length(robot)))
+    lo, hi = np.log(LENGTH_RANGE[0] * size), np.log(LENGTH_RANGE[1] * characteristic_length(robot))
     grid = np.linspace(lo, hi, 121)
     values = many(np.exp(grid)) if many is not None else np.array([kappa(np.exp(x)) for x in grid])
     k_size = kappa(size)

@@ -25,7 +25,7 @@ from scipy.linalg import block_diag
 from .._shapes import as_names, as_vectors, readonly
 from ..couplings import Coupling, coupled_columns
 from ..errors import ShapeError, UnknownNameError
-from ..kinematics.linalg import rref
+from ..kinematics.linalg import nondimensional, rref
 from ..robot import TWIST_NAMES, Robot, element_table
 from ._fast import cancel_roundoff
 
@@ -142,13 +142,16 @@ def constraint_lines(robot: Robot, assigned: tuple[str, ...] = (), *, coupled: b
 
 @functools.lru_cache(maxsize=512)
 def _compile(robot: Robot, assigned: tuple[str, ...], coupled: bool = False) -> ConstraintLines:
+    # decided on the robot in its largest length (the rate blocks' null spaces are the same, the thresholds
+    # relative): a double castor scaled by 39 kept a combination that cancels identically as a line of round-off
+    unit = nondimensional(robot)
     rng = np.random.default_rng(0)
-    probe = element_rows(robot, rng.uniform(-np.pi, np.pi, (3, len(robot.steer_names))))  # (3, 2E, 3)
+    probe = element_rows(unit, rng.uniform(-np.pi, np.pi, (3, len(robot.steer_names))))  # (3, 2E, 3)
     coefficients, labels, wheels, internal = [], [], [], []
     n_rows = probe.shape[-2]
     starts = np.cumsum([0] + [2 * len(w.elements()) for w in robot.wheels])
     for block, couplings in _blocks(robot, coupled):
-        members = [robot.wheels[i] for i in block]
+        members = [unit.wheels[i] for i in block]
         rows = np.concatenate([np.arange(starts[i], starts[i + 1]) for i in block])
         w_block = block_diag(*[_rate_block(w) for w in members])  # (rows, n_rates) constant
         names = tuple(n for w in members for n in w.rate_names)
