@@ -26,3 +26,20 @@ def write_log(path, run) -> str:
     """The run's log as a default-format CSV; the path as a string."""
     write_csv(path, ("time", *run.log.joints), np.column_stack([run.log.time, run.log.positions]))
     return str(path)
+
+
+def closed_fleet(diff, seed, odd=None, runs=6, noise=1e-5):
+    """Closed squares of 1-2.5 m, both ways, encoder noise `noise` per rad, of a robot at radius ratio +1 % and track
+    +3 %; run 0 of one at `odd` ``(ratio, track)`` instead."""
+    from wmrkit.batch.calibrate import default_parameters
+    from wmrkit.odometry.calibration import CalibrationRun, apply_parameters
+    from wmrkit.odometry.synthetic import simulate, square_path
+
+    params = default_parameters(diff, closed=True)
+    rng = np.random.default_rng(seed)
+    robots = [apply_parameters(diff, params, odd if k == 0 and odd else [0.01, 0.03]) for k in range(runs)]
+    return params, [CalibrationRun.closed_path(simulate(r, square_path(rng.uniform(1.0, 2.5), clockwise=k % 2 == 1,
+                                                                        pause=0.5), 10.0, spin_noise_per_rad=noise,
+                                                        seed=int(rng.integers(1 << 30))).log)
+                    for k, r in enumerate(robots)]
+

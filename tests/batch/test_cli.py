@@ -56,7 +56,7 @@ def test_batch_odometry_runs_the_described_method(capsys, fleet_dir, tmp_path, d
     assert [rows[0]["x"], rows[0]["y"], rows[0]["theta"]] == pytest.approx(single["pose"], abs=1e-12)
 
 
-def test_batch_calibrate_and_montecarlo(capsys, calibration_data, tmp_path):
+def test_batch_calibrate_and_montecarlo(capsys, calibration_data, fleet_dir, tmp_path):
     data = _json(capsys, ["batch", "calibrate", "diff-drive", str(calibration_data / "*.csv"), "--reference",
                           str(calibration_data / "ref"), "--workers", "0", "--json"])
     assert [v["field"] for v in data["values"]] == ["left.r", "right.r", "left.l", "right.l"]
@@ -67,11 +67,12 @@ def test_batch_calibrate_and_montecarlo(capsys, calibration_data, tmp_path):
     assert main(["batch", "calibrate", "diff-drive", str(calibration_data / "c*.csv"), "--closed", "--workers", "0",
                  "--param", "left.r,-right.r"]) == 0
     out = capsys.readouterr().out
-    assert "left.r" in out
-    # closed paths are not checked against each other: said, not only a null in the JSON
+    assert "left.r" in out and "not judged" not in out  # eight closed runs are judged (consistency.judge)
+    # fewer than 6 closed runs are not checked against each other: said, not only a null in the JSON
     from wmrkit.batch.consistency import CLOSED
 
-    assert f"  not judged: {CLOSED}" in out and data["not_judged"] is None
+    assert main(["batch", "calibrate", "diff-drive", str(fleet_dir / "run*.csv"), "--closed", "--workers", "0"]) == 0
+    assert f"  not judged: {CLOSED}" in capsys.readouterr().out and data["not_judged"] is None
     plot = tmp_path / "mc.png"
     data = _json(capsys, ["batch", "montecarlo", "diff-drive", "--path", "arc", "-n", "30", "--workers", "0",
                           "--resolution", "0.5deg", "--plot", str(plot), "--json"])
@@ -245,3 +246,23 @@ def test_batch_calibrate_names_a_run_of_another_robot(capsys, tmp_path):
     assert data["per_run"][3]["file"] == str(tmp_path / "r3.csv") and ratios[3] > 30
     assert main(argv) == 0
     assert f"wmrkit: warning: {tmp_path / 'r3.csv'}: disagrees" in capsys.readouterr().err
+
+
+def test_batch_calibrate_names_a_closed_run_of_another_robot(capsys, diff, tmp_path):
+    """Six closed squares, one of a robot with a 5 % larger left radius: exit 0 with "inconsistent": null and no
+    word before; now one warning names its file (stderr, and the JSON's warnings), its score in per_run."""
+    from batch_params import closed_fleet, write_log
+
+    _, runs = closed_fleet(diff, 1, [0.06, 0.03])
+    for k, run in enumerate(runs):
+        write_log(tmp_path / f"sq{k}.csv", run)
+    args = ["batch", "calibrate", "diff-drive", str(tmp_path / "sq*.csv"), "--closed", "--workers", "0"]
+    assert main(args) == 0
+    out, err = capsys.readouterr()
+    assert err.count("wmrkit: warning:") == 1 and "sq0.csv: disagrees with the other runs (closed-path score" in err
+    assert "not judged" not in out
+    data = _json(capsys, [*args, "--json"])
+    assert data["inconsistent"] is True and data["not_judged"] is None
+    assert [r["file"].rsplit("/", 1)[-1] for r in data["per_run"]] == [f"sq{k}.csv" for k in range(6)]
+    assert data["per_run"][0]["residual_ratio"] > 40 > max(r["residual_ratio"] for r in data["per_run"][1:])
+    assert any("sq0.csv: disagrees" in w for w in data["warnings"])

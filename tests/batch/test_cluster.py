@@ -77,6 +77,7 @@ def test_sweep_montecarlo_calibration_identical(engines, diff, calibration_data)
         np.testing.assert_array_equal(m.poses, m0.poses)
         c = fleet_calibrate(diff, runs, params, runner=runner)
         assert c.values == c0.values and c.interval == c0.interval
+        assert c.residual_ratios == c0.residual_ratios and c.warnings == c0.warnings
         assert load_runs(diff, [str(calibration_data / "c0.csv")], reference_dir=calibration_data / "ref",
                          runner=runner)[0].reference.tolist() == runs[0].reference.tolist()
 
@@ -124,3 +125,16 @@ def test_cli_on_the_remote_scheduler(cluster, fleet_dir, capsys):
     assert main([*argv, "--workers", "0"]) == 1
     serial = json.loads(capsys.readouterr().out)
     assert _strip(remote["rows"]) == _strip(serial["rows"]) and remote["failed"] == 1
+
+
+def test_closed_path_fleet_judged_identically(engines, diff):
+    """Six closed squares, one of another robot: the closed-path scores (a refit on the engine) are those of the
+    serial engine, bit for bit, and name the same run."""
+    from batch_params import closed_fleet
+
+    params, runs = closed_fleet(diff, 1, [0.06, 0.03])
+    c0 = fleet_calibrate(diff, runs, params)
+    assert c0.inconsistent is True
+    for name, runner in engines.items():
+        c = fleet_calibrate(diff, runs, params, runner=runner)
+        assert c.residual_ratios == c0.residual_ratios and c.warnings == c0.warnings, name

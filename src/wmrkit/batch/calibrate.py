@@ -46,7 +46,7 @@ from ..odometry.calibration import (
 )
 from ..odometry.integrators import check_method
 from ..robot import Robot
-from .consistency import ROUNDOFF, SLIP_NOT_JUDGED, run_consistency, travel
+from .consistency import SLIP_NOT_JUDGED, Consistency, judge, names
 from .engine import BatchError, Engine, TaskFailure, engine
 
 
@@ -57,9 +57,10 @@ class FleetCalibration:
     ``level``; residual RMS before and after; ``runs``, ``residuals`` counts; ``ci`` the interval method;
     ``warnings``: runs whose data do not fit the method (e.g. a closed path cut short) or disagree with the others;
     ``logs``: the runs' files; ``residual_ratios``: each run's RMS at the other runs' fit over that at its own
-    (``None`` with fewer than 4 runs) and ``inconsistent``: the largest over
-    :data:`~wmrkit.batch.consistency.MAX_RATIO` (:mod:`wmrkit.batch.consistency`; ``None`` when not judged, and
-    ``not_judged`` says why: fewer than 4 runs, or only closed paths)."""
+    (``None`` with fewer than 4 runs), for a fleet of closed paths over the other runs' RMS there (their closed-path
+    score) and ``inconsistent``: the largest over :data:`~wmrkit.batch.consistency.MAX_RATIO` (closed paths:
+    :data:`~wmrkit.batch.consistency.MAX_CLOSED_SCORE`; :mod:`wmrkit.batch.consistency`; ``None`` when not judged,
+    and ``not_judged`` says why: fewer than 4 runs, or fewer than 6 closed paths)."""
 
     robot: Robot
     parameters: tuple[tuple[str, ...], ...]
@@ -121,6 +122,15 @@ def _refit(problem: CalibrationProblem) -> np.ndarray:
     fit = problem.solve()
     undetermined = problem.undetermined(fit.x, fit.jac, fit.fun)
     return fit.x if undetermined is None else np.full(len(problem.parameters), np.nan)
+
+
+def _refit_without(args: tuple[CalibrationProblem, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The fit of `problem`'s runs but the last from `x0`, in one process, and every run's residuals there
+    (:func:`~wmrkit.batch.consistency.judge`)."""
+    problem, x0 = args
+    others = problem.with_runs(problem.runs[:-1])
+    x = solve(others.residuals, len(problem.parameters), x0, others.jacobian).x
+    return x, problem.residuals(x)
 
 
 #: Most bootstrap replicates (each refits every run): percentile intervals settle within a few thousand.
@@ -208,10 +218,11 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
                 notes += (f"bootstrap: {dropped} of {n_boot} replicates dropped, their resampled runs cannot tell "
                           "the parameters apart (the interval is over the others)",)
             lo, hi = np.quantile(kept, 0.5 - level / 2, axis=0), np.quantile(kept, 0.5 + level / 2, axis=0)
+        judged = judge(problem, fit, jacobian, lambda tasks: runner.map(_refit_without, tasks))
     finally:
         if own:
             runner.close()
-    return _result(problem, fit, lo, hi, r0, ci, level, notes)
+    return _result(problem, fit, lo, hi, r0, ci, level, judged, notes)
 
 
 #: Highest confidence level: beyond it Student's quantile with the few degrees of freedom of a fleet is astronomic (1
@@ -260,7 +271,7 @@ def _sandwich_interval(problem: CalibrationProblem, fit, level: float) -> tuple[
     return fit.x - half, fit.x + half
 
 
-def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float,
+def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float, judged: Consistency,
             notes: tuple[str, ...] = ()) -> FleetCalibration:
     robot, params = problem.robot, problem.parameters
     values = []
@@ -272,10 +283,7 @@ def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float,
             a, b = (next(v for n, _, v in end if n == name) for end in ends)
             values.append((name, nominal, fitted, min(a, b), max(a, b)))
     groups = tuple((g,) if isinstance(g, str) else tuple(g) for g in params)
-    sources = [run.log.source for run in problem.runs]  # runs made in Python share '<log>' or '<synthetic>'
-    logs = tuple(s if sources.count(s) == 1 else f"run {k + 1} ({s})" for k, s in enumerate(sources))
-    judged = run_consistency(fit.jac, fit.fun, problem.sizes(),
-                             [ROUNDOFF * max(travel(robot, run), 1.0) for run in problem.runs], logs)
+    logs = names(problem)
     return FleetCalibration(apply_parameters(robot, params, fit.x), groups, tuple(map(float, fit.x)),
                             tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True)), tuple(values),
                             rms(r0), rms(fit.fun), len(problem.runs), int(r0.size), ci, level, bool(fit.success),
