@@ -133,3 +133,44 @@ def test_smooth_references_are_followed_by_every_catalog_robot_at_every_tracked_
                 for reference in references:
                     verdict = feasibility(robot, reference, framework, point=tuple(point))  # as track judges
                     assert verdict.feasible, (name, point, framework, reference.name, verdict.violations)
+
+
+def _light_diff_drive(path, com_height: float) -> str:
+    """A 20 kg differential drive with mass properties (the dynamics), its centre of mass `com_height` up."""
+    tyre = "tyre: {model: dugoff, cs: 2000, calpha: 1500, mu: 0.8}"
+    path.write_text(
+        f"name: dd-mass\nbody: {{mass: 20, inertia: 0.5, com: [-0.05, 0], com_height: {com_height}}}\nwheels:\n"
+        f"  - {{name: left, type: fixed, position: [0, 0.2], heading: 0, r: 0.075, actuated: [spin], "
+        f"inertia: {{spin: 0.01}}, {tyre}}}\n"
+        f"  - {{name: right, type: fixed, position: [0, -0.2], heading: 0, r: 0.075, actuated: [spin], "
+        f"inertia: {{spin: 0.01}}, {tyre}}}\n"
+        f"  - {{name: caster, type: castor, position: [-0.25, 0], heading: 0, d: 0.04, r: 0.025, "
+        f"inertia: {{spin: 0.001, steer: 0.001}}, {tyre}}}\n")
+    return str(path)
+
+
+def _slow_line(path) -> str:
+    """0.1 m/s along x for 1 s (101 samples), then the reference ends."""
+    path.write_text("t,x,y,theta\n" + "".join(f"{0.01 * k:.2f},{0.001 * k:.4f},0,0\n" for k in range(101)))
+    return str(path)
+
+
+def test_a_run_past_the_reference_s_end_judges_the_stop_there(tmp_path, capsys):
+    """Past its end the reference holds its last pose at rest, so a longer --duration stops the robot there: a speed
+    step to 0. The dynamic framework (wheel rates continuous) forbids it in every column of Table 8.1; the kinematic
+    one lets the rates jump, and no wheel must re-orient for a stop nothing follows, so it stays silent."""
+    robot, line = _light_diff_drive(tmp_path / "dd.yaml", 0.005), _slow_line(tmp_path / "line.csv")
+    assert main(["track", robot, "--reference", line, "--dynamics", "--duration", "1.5"]) == 0
+    assert _warned(capsys.readouterr().err) == [
+        f"{WARNING}'type 2, off axle' for the tracked point, dynamic framework): velocity jump (p_ref not C1) at "
+        "t = 1 s (the reference's end: the run went on past it, where the reference stops, holding its last pose): "
+        "an error appears that the position loop then removes (kinematics allows no jump here)"]
+    assert main(["track", robot, "--reference", line, "--dynamics", "--duration", "1.5", "--json"]) == 0
+    verdict = json.loads(capsys.readouterr().out)["feasibility"]
+    assert [(v["t"], v["signal"], v["size"]) for v in verdict["violations"]] == [(1.0, "velocity", pytest.approx(0.1))]
+    assert main(["track", robot, "--reference", line, "--dynamics"]) == 0  # the run ends with the reference
+    assert _warned(capsys.readouterr().err) == []
+    for name in ("swerve-4", "diff-drive", "bicycle"):  # kinematic: no column forbids the stop
+        run = track(catalog.load(name), builtin_reference("circle"), duration=40)
+        assert run.feasibility.feasible and np.ptp(run.reference[-30:], axis=0).max() == 0  # held at rest: a stop
+

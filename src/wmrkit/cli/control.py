@@ -7,9 +7,13 @@ import math
 import sys
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import WmrkitError
 from ._common import add_json_flag, add_robot_argument, check_plot_path, load_robot, parse_value, print_json, warn
+
+if TYPE_CHECKING:
+    from ..control.feasibility import Feasibility
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -181,16 +185,7 @@ def run_track(args: argparse.Namespace) -> int:
              f"sideways to move as commanded (t = {min(v['from'] for v in slipping):.4g} to "
              f"{max(v['to'] for v in slipping):.4g} s): the kinematic loop moved the robot as commanded, so its errors "
              "do not show the scrubbing (--dynamics simulates it with tyres)")
-    verdict = run.feasibility  # Table 8.1 for the tracked point: a line per remedy and times, feasibility's words
-    broken: dict[tuple[str, tuple[float, ...]], list[str]] = {}
-    for kind, remedy in dict.fromkeys((v.kind, v.remedy) for v in verdict.violations) if verdict else ():
-        times = tuple(v.t for v in verdict.violations if (v.kind, v.remedy) == (kind, remedy))
-        broken.setdefault((remedy, times), []).append(kind)
-    for (remedy, times), kinds in broken.items():
-        more = f" and {len(times) - 5} more times" if len(times) > 5 else ""
-        warn(f"the robot cannot follow this reference with zero error (Table 8.1, column "
-             f"'{verdict.requirement.column}' for the tracked point, {verdict.requirement.framework} framework): "
-             f"{' and '.join(kinds)} at t = {', '.join(f'{t:.4g}' for t in times[:5])} s{more}: {remedy}")
+    warn_infeasible(run.feasibility, reference.duration if run.t[-1] > reference.duration else None)
     if args.plot or args.animate:
         from ..control.plots import animate_run, plot_run
 
@@ -210,6 +205,23 @@ def run_track(args: argparse.Namespace) -> int:
         print(f"tracking error [m]: rms {s['rms_error']:.4g}, max {s['max_error']:.4g}, final {s['final_error']:.4g}")
         print(f"cross-track error [m]: rms {s['rms_cross_track']:.4g}, max {s['max_cross_track']:.4g}")
     return 0
+
+
+def warn_infeasible(verdict: Feasibility | None, end: float | None = None) -> None:
+    """Warn where Table 8.1 says the robot cannot follow the reference it tracked (`verdict`: a run's
+    ``feasibility``), a line per remedy and set of times, in feasibility's words; `end` [s]: where the reference
+    ended before the run did (it then holds its last pose at rest: the stop is judged as any jump)."""
+    broken: dict[tuple[str, tuple[float, ...]], list[str]] = {}
+    for kind, remedy in dict.fromkeys((v.kind, v.remedy) for v in verdict.violations) if verdict else ():
+        times = tuple(v.t for v in verdict.violations if (v.kind, v.remedy) == (kind, remedy))
+        broken.setdefault((remedy, times), []).append(kind)
+    for (remedy, times), kinds in broken.items():
+        more = f" and {len(times) - 5} more times" if len(times) > 5 else ""
+        stop = (f" ({'' if len(times) == 1 else f't = {end:.4g} s: '}the reference's end: the run went on past it, "
+                "where the reference stops, holding its last pose)" if end in times else "")
+        warn(f"the robot cannot follow this reference with zero error (Table 8.1, column "
+             f"'{verdict.requirement.column}' for the tracked point, {verdict.requirement.framework} framework): "
+             f"{' and '.join(kinds)} at t = {', '.join(f'{t:.4g}' for t in times[:5])} s{more}{stop}: {remedy}")
 
 
 def run_feasibility(args: argparse.Namespace) -> int:

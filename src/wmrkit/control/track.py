@@ -281,11 +281,30 @@ def _feasibility(robot: Robot, reference: Reference, point: np.ndarray,
         return None
     # the run's part, and a margin to judge its end: a 10 s run (4.2 s) of an 8.8e6-sample circle judged it all in 3.9 s
     stop = int(np.searchsorted(reference.t, end, side="right")) + 2 * BLOCK
+    last = float(reference.t[-1])
     if stop < len(reference.t):
         reference = replace(reference, t=reference.t[:stop], pose=reference.pose[:stop],
                             velocity=reference.velocity[:stop], acceleration=reference.acceleration[:stop])
+    elif end > last and framework == "dynamic":  # past its end the reference holds its last pose at rest
+        # the speed steps to 0 there: the wheel rates jump, which the dynamic framework forbids in every column; the
+        # kinematic one lets them jump, and no wheel must re-orient for a stop that nothing follows (types 3 and 5
+        # need p_ref C1 for the wheels' headings, which (8.10) gives from p_ref's velocity: undefined at rest)
+        reference = held_at_rest(reference, 2 * BLOCK)
     found = feasibility(robot, reference, framework, point=(float(point[0]), float(point[1])))
-    return Feasibility(found.requirement, tuple(v for v in found.violations if v.t <= end))
+    stopped = float(reference.t[-2 * BLOCK]) if end > last and framework == "dynamic" else math.nan  # first at rest
+    found_all = (replace(v, t=last) if v.t == stopped else v for v in found.violations)  # the stop: at the end
+    return Feasibility(found.requirement, tuple(v for v in found_all if v.t <= end))
+
+
+def held_at_rest(reference: Reference, samples: int) -> Reference:
+    """`reference` and `samples` more samples, at its sample spacing, at rest at its last pose: what the loop
+    follows past its end (:meth:`Reference.at`), its speed stepping to 0 after the last sample (Table 8.1 judges
+    that step as any other)."""
+    t = reference.t[-1] + (reference.t[-1] - reference.t[-2]) * np.arange(1, samples + 1)
+    rest = np.zeros((samples, 3))
+    return replace(reference, t=np.r_[reference.t, t], pose=np.vstack([reference.pose, rest + reference.pose[-1]]),
+                   velocity=np.vstack([reference.velocity, rest]),
+                   acceleration=np.vstack([reference.acceleration, rest]))
 
 
 #: Most samples of a run (control periods, or output samples of a continuous loop): each costs a control law
