@@ -174,3 +174,27 @@ def test_a_run_past_the_reference_s_end_judges_the_stop_there(tmp_path, capsys):
         run = track(catalog.load(name), builtin_reference("circle"), duration=40)
         assert run.feasibility.feasible and np.ptp(run.reference[-30:], axis=0).max() == 0  # held at rest: a stop
 
+
+
+def test_a_run_that_stops_names_the_table_8_1_jump_before_it(tmp_path, capsys):
+    """The robot tips over at the reference's end (its stop) through the dynamics, and an unstable sampled loop
+    diverges after the square's first corner: the error line names that jump, as Table 8.1 judged it."""
+    robot, line = _light_diff_drive(tmp_path / "dd.yaml", 0.1), _slow_line(tmp_path / "line.csv")
+    stop = ("before it, at t = 1 s (the reference's end, where it stops), Table 8.1 (column 'type 2, off axle' for "
+            "the tracked point, dynamic framework) found a jump the robot cannot follow: velocity jump (p_ref not C1)")
+    assert main(["track", robot, "--reference", line, "--dynamics", "--duration", "1.5"]) == 2
+    err = capsys.readouterr().err
+    lifted = float(err.split("lifts off the ground at t = ")[1].split(" s")[0])
+    assert 1.0 < lifted < 1.1 and stop in err and len(err.strip().splitlines()) == 1
+    assert main(["track", robot, "--reference", line, "--dynamics", "--duration", "1.5", "--json"]) == 2
+    assert stop in json.loads(capsys.readouterr().err)["error"]
+    square = ["track", "omni-3", "--reference", "square", "--period", "0.5", "--gain", "10", "--duration", "30"]
+    assert main(square) == 2
+    err = capsys.readouterr().err
+    assert "the closed loop diverged at t = 17.5 s" in err and (
+        "before it, at t = 12 s, Table 8.1 (column 'type 1' for the tracked point, kinematic framework) found a jump "
+        "the robot cannot follow: heading jump (theta_ref not C0)") in err
+    assert main(["track", "diff-drive", "--reference", "circle", "--duration", "2", "--gain", "1e308", "--period",
+                 "0.1"]) == 2  # no jump before it: nothing named
+    err = capsys.readouterr().err
+    assert "diverged" in err and "Table 8.1" not in err

@@ -31,7 +31,7 @@ from ..robot import Robot
 from ..wheels import wrap_angle
 from .actuators import LowLevelLoops
 from .laws import PositionLaw, law_velocity, pose_error
-from .points import ControlError, ControlPoint, check_delay, point_pose, twist_for_velocity
+from .points import ControlError, ControlPoint, StoppedRun, check_delay, point_pose, twist_for_velocity
 from .references import Reference
 from .steering import checked_steering, discretize_twist, reverse_spins, spin_columns, steer_ranges, unit_spin
 
@@ -47,18 +47,18 @@ def check_command(twist: np.ndarray, t: float) -> None:
     """Refuse a law's twist beyond ``limits.MAX_SPEED`` (m/s, rad/s) at `t`: a loop through the dynamics has
     diverged (the plant would be driven far outside any robot's envelope, slowly and meaninglessly)."""
     if not np.all(np.abs(twist) <= MAX_SPEED):  # NaN included
-        raise ControlError(f"the loop diverged: at t = {t:.6g} s the law commands the twist "
-                           f"{tuple(float(v) for v in twist)}, beyond {MAX_SPEED:g} m/s or rad/s; lower the gain or "
-                           "the period")
+        raise StoppedRun(f"the loop diverged: at t = {t:.6g} s the law commands the twist "
+                         f"{tuple(float(v) for v in twist)}, beyond {MAX_SPEED:g} m/s or rad/s; lower the gain or "
+                         "the period", t)
 
 
 def check_diverged(twist: np.ndarray, t: float) -> None:
     """Refuse a law's twist beyond ``limits.MAX_QUERY_RATE`` at `t` in a kinematic loop: no wheel command is defined
     there (:func:`wheel_commands` refuses it), the loop has diverged."""
     if not np.all(np.abs(twist) <= MAX_QUERY_RATE):  # NaN included
-        raise ControlError(f"the closed loop diverged at t = {t:.6g} s: the law commands the twist "
-                           f"{tuple(float(v) for v in twist)}, beyond {MAX_QUERY_RATE:g} m/s or rad/s; lower the gain "
-                           "or the period")
+        raise StoppedRun(f"the closed loop diverged at t = {t:.6g} s: the law commands the twist "
+                         f"{tuple(float(v) for v in twist)}, beyond {MAX_QUERY_RATE:g} m/s or rad/s; lower the gain "
+                         "or the period", t)
 
 
 #: Evaluations of the continuous loop allowed: a base plus this many per simulated second (the examples take

@@ -24,11 +24,20 @@ from ..limits import MAX_SIZE
 from ..robot import Robot
 from ..wheels import heading_from_beta
 
-__all__ = ["ControlError", "ControlPoint", "control_point", "point_pose", "twist_for_velocity"]
+__all__ = ["ControlError", "ControlPoint", "StoppedRun", "control_point", "point_pose", "twist_for_velocity"]
 
 
 class ControlError(WmrkitError, ValueError):
     """A robot, reference or option the controller cannot use (one line, names the cause)."""
+
+
+class StoppedRun(ControlError):
+    """A closed loop that stopped at time ``t`` [s] (it diverged, or a wheel lifted off): :func:`.track.track`
+    names the Table 8.1 jump of the reference before it, if any."""
+
+    def __init__(self, message: str, t: float = math.nan) -> None:
+        self.t = t
+        super().__init__(message)
 
 
 def check_delay(delay: int) -> None:

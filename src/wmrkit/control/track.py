@@ -19,7 +19,7 @@ from .actuators import LowLevelLoops
 from .feasibility import BLOCK, Feasibility, feasibility
 from .laws import PositionLaw, check_gate, check_sampling
 from .loop import Plant, law_controller, simulate
-from .points import ControlError, ControlPoint, check_delay, control_point, point_pose
+from .points import ControlError, ControlPoint, StoppedRun, check_delay, control_point, point_pose
 from .references import Reference
 from .trackers import PathIndex, default_wheelbase, pure_pursuit, stanley
 
@@ -231,10 +231,13 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                 out = simulate_dynamics(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
                                         feedback=feedback, step=DYNAMICS_STEP, policy=policy)
         except LiftOffError as err:
-            raise ControlError(f"{err.what}; the servos follow each period's command with up to the grip's torque, "
-                               "so a step in the command (a corner of the reference, a start off it) can tip the "
-                               "robot: give a smoother reference, a lower speed or gain, or start on the "
-                               "reference") from None
+            raise _stopped(StoppedRun(
+                f"{err.what}; the servos follow each period's command with up to the grip's torque, so a step in the "
+                "command (a corner of the reference, a start off it) can tip the robot: give a smoother reference, a "
+                "lower speed or gain, or start on the reference", err.t), robot, reference, tracked_point,
+                "dynamic") from None
+        except StoppedRun as err:
+            raise _stopped(err, robot, reference, tracked_point, "dynamic") from None
     elif feedback != "pose" or slip_model != "none" or ramp:
         what = (f"feedback='{feedback}'" if feedback != "pose" else f"slip_model='{slip_model}'"
                 if slip_model != "none" else "ramp=True")
@@ -243,14 +246,18 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         if period is None:
             _check_continuous_work(cp, reference, pose0, duration, output_dt,
                                    gain if controller in ("p", "pi", "point") else None)
-        out = simulate(robot, ctrl, pose0, duration, period=period, delay=delay, plant=Plant(loops, policy),
-                       output_dt=output_dt, skew_free=skew_free, breaks=reference.breaks,
-                       rtol=1e-5 if geometric else 1e-8, atol=1e-7 if geometric else 1e-10)
+        try:
+            out = simulate(robot, ctrl, pose0, duration, period=period, delay=delay, plant=Plant(loops, policy),
+                           output_dt=output_dt, skew_free=skew_free, breaks=reference.breaks,
+                           rtol=1e-5 if geometric else 1e-8, atol=1e-7 if geometric else 1e-10)
+        except StoppedRun as err:
+            raise _stopped(err, robot, reference, tracked_point, "kinematic") from None
     t, pose = out["t"], out["pose"]
     if not (np.all(np.isfinite(pose)) and np.all(np.abs(pose[:, :2]) <= MAX_COORDINATE)):
         k = int(np.argmax(~(np.isfinite(pose).all(axis=1) & (np.abs(pose[:, :2]) <= MAX_COORDINATE).all(axis=1))))
-        raise ControlError(f"the closed loop diverged at t = {t[k]:.6g} s (the pose leaves {MAX_COORDINATE:g} m): "
-                           "lower the gain, or shorten the period")
+        raise _stopped(StoppedRun(f"the closed loop diverged at t = {t[k]:.6g} s (the pose leaves "
+                                  f"{MAX_COORDINATE:g} m): lower the gain, or shorten the period", float(t[k])),
+                       robot, reference, tracked_point, "dynamic" if dynamics else "kinematic")
     tcp = _full_point(cp, tracked_point)
     tracked = point_pose(tcp, pose)
     ref = reference.sample(t)
@@ -269,6 +276,21 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                        feedback != "pose" else None, slip_model, feedback,
                        readonly(~out["in_range"]) if "in_range" in out else None,
                        _feasibility(robot, reference, tracked_point, "dynamic" if dynamics else "kinematic", t[-1]))
+
+
+def _stopped(err: StoppedRun, robot: Robot, reference: Reference, point: np.ndarray,
+             framework: Literal["kinematic", "dynamic"]) -> StoppedRun:
+    """`err`, naming the last jump of `reference` at or before the run stopped that Table 8.1 says the robot
+    tracked at `point` cannot follow (the likely cause: a step of the commands), if there is one."""
+    verdict = _feasibility(robot, reference, point, framework, err.t)
+    if verdict is None or verdict.feasible:
+        return err
+    last = verdict.violations[-1].t
+    jumps = [v for v in verdict.violations if v.t == last]
+    end = " (the reference's end, where it stops)" if last == reference.t[-1] else ""
+    return StoppedRun(f"{err}; before it, at t = {last:.4g} s{end}, Table 8.1 (column '{verdict.requirement.column}' "
+                      f"for the tracked point, {framework} framework) found a jump the robot cannot follow: "
+                      f"{' and '.join(v.kind for v in jumps)}: {jumps[0].remedy}", err.t)
 
 
 def _feasibility(robot: Robot, reference: Reference, point: np.ndarray,

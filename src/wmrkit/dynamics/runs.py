@@ -14,10 +14,10 @@ from .model import DynamicModel
 
 class LiftOffError(WmrkitError):
     """A wheel loaded at rest lost its load: the run stops there (:func:`check_lift_off`). ``what`` states it
-    (contact, time, load at rest); the message adds what to change, which a caller may replace."""
+    (contact, time, load at rest), ``t`` its time [s]; the message adds what to change, which a caller may replace."""
 
-    def __init__(self, what: str, advice: str = "use smaller torques or speeds") -> None:
-        self.what, self.advice = what, advice
+    def __init__(self, what: str, advice: str = "use smaller torques or speeds", t: float = math.nan) -> None:
+        self.what, self.advice, self.t = what, advice, t
         super().__init__(f"{what}; {advice}")
 
 
@@ -30,7 +30,7 @@ def check_lift_off(model: DynamicModel, w: tuple) -> None:
         e = int(lift[2])
         raise LiftOffError(f"contact '{model.contacts[e]}' lifts off the ground at t = {lift[1]:.6g} s (normal load "
                            f"0; {model.normal_loads()[e]:.4g} N at rest): the planar model keeps every wheel on the "
-                           "ground, so the motion would not be physical")
+                           "ground, so the motion would not be physical", t=float(lift[1]))
 
 
 def records(model: DynamicModel, n_rec: int) -> tuple:
