@@ -245,7 +245,7 @@ def test_a_hold_margin_that_is_not_an_angle_is_refused(bad):
 
 
 def test_the_continuous_loop_steps_over_a_wheel_changing_ends(monkeypatch):
-    """`wmrkit track ackermann --reference circle`, the defaults: the 3 m circle asks a front wheel for more than its
+    """`wmrkit track ackermann --reference circle --size 3`: the 3 m circle asks a front wheel for more than its
     +-40 deg and, at times, for a heading near 90 deg, where the two ends tie. Without memory the wheel swapped ends
     at every crossing and the continuous loop spent its 2 min of computing (95,000 evaluations) to reach t = 17 s
     of 38 and answer "too stiff". Now the held wheel changes ends past HOLD_MARGIN, located as an event: about 1,700

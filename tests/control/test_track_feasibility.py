@@ -198,3 +198,31 @@ def test_a_run_that_stops_names_the_table_8_1_jump_before_it(tmp_path, capsys):
                  "0.1"]) == 2  # no jump before it: nothing named
     err = capsys.readouterr().err
     assert "diverged" in err and "Table 8.1" not in err
+
+
+def _radius(capsys) -> float:
+    """The reference circle's radius from its sample at t = 1 s: (x^2 + y^2) / (2 y) for a circle through the
+    origin tangent to x."""
+    data = json.loads(capsys.readouterr().out)
+    k = data["t"].index(1.0)
+    x, y = data["reference"][k][:2]
+    return (x * x + y * y) / (2 * y)
+
+
+def test_the_default_circle_of_track_is_one_the_robot_can_drive(capsys):
+    """The catalog car steers +-40 deg (its rear axle turns on 3.99 m at least): 'wmrkit track ackermann --reference
+    circle' on the 3 m circle held both front wheels at their stops for 30 s and missed by 1.25 m. Its default
+    circle is now 1.5 times that radius, rounded up to a metre (6 m); robots without a minimum turning radius keep
+    the 3 m circle, and an explicit --size is kept as given."""
+    assert main(["track", "ackermann", "--reference", "circle"]) == 0
+    out, err = capsys.readouterr()
+    assert err == "" and "reference circle of radius 6 m (at least 1.5 times the robot's minimum turning radius, " \
+                         "3.993 m)" in out
+    assert float(out.split("tracking error [m]: rms ")[1].split(",")[0]) < 1e-6
+    assert main(["track", "ackermann", "--reference", "circle", "--duration", "2", "--json"]) == 0
+    assert _radius(capsys) == pytest.approx(6.0, rel=1e-6)
+    assert main(["track", "diff-drive", "--reference", "circle", "--duration", "2", "--json"]) == 0
+    assert _radius(capsys) == pytest.approx(3.0, rel=1e-6)
+    assert main(["track", "ackermann", "--reference", "circle", "--size", "3", "--duration", "8", "--json"]) == 0
+    out = capsys.readouterr().out
+    assert "front_left" in {v["wheel"] for v in json.loads(out)["beyond_steer_range"]}

@@ -81,12 +81,33 @@ def _reference_options(p: argparse.ArgumentParser) -> None:
                                                "corner leg (3); a line has none")
 
 
-def _reference(args: argparse.Namespace):
-    from ..control.references import resolve_reference
+#: ``track``'s default circle for a robot with a minimum turning radius (a car's steering stops): its radius is at
+#: least this many times that radius (rounded up to a metre), so the default run is one the robot can drive.
+CIRCLE_MARGIN = 1.5
+
+
+def _reference(args: argparse.Namespace, robot=None):
+    """The ``--reference`` (with ``--speed``, ``--size``); for `robot`'s ``track``, a circle without ``--size`` is
+    the built-in 3 m one, or :data:`CIRCLE_MARGIN` times the robot's minimum turning radius when that is larger."""
+    from ..control.references import BUILTIN, resolve_reference
 
     speed = None if args.speed is None else _positive(args.speed, "--speed", "number")
     size = None if args.size is None else _positive(args.size, "--size", "length")
+    if size is None and robot is not None and args.reference == "circle":
+        size = max(BUILTIN["circle"][2], math.ceil(CIRCLE_MARGIN * min_turning_radius(robot)))
     return resolve_reference(args.reference, speed=speed, size=size)
+
+
+def min_turning_radius(robot) -> float:
+    """The radius [m] of the tightest circle the rear axle's midpoint of a car-like `robot` drives within its
+    steering wheels' ``steer_range`` (:func:`wmrkit.parking.problem.curvature_limit`); 0 for any other robot, or
+    one whose ranges do not limit it."""
+    from ..parking.problem import curvature_limit
+
+    try:
+        return 1.0 / curvature_limit(robot)
+    except (WmrkitError, ZeroDivisionError):  # not car-like; or it cannot roll straight ahead
+        return 0.0
 
 
 def _positive(text: str, what: str, kind: str = "number") -> float:
@@ -131,7 +152,8 @@ def run_track(args: argparse.Namespace) -> int:
 
     check_plot_path(args.plot)
     check_animation_path(args.animate)
-    robot, reference = load_robot(args.robot), _reference(args)
+    robot = load_robot(args.robot)
+    reference = _reference(args, robot)
     start = None
     if args.start:
         start = [parse_value(args.start[0], "length", "--from X"), parse_value(args.start[1], "length", "--from Y"),
@@ -197,7 +219,10 @@ def run_track(args: argparse.Namespace) -> int:
         print_json(run.to_dict(), warnings=True)
     else:
         s = run.summary()
-        print(f"robot {robot.name}, reference {reference.name}, controller {args.controller}, "
+        raised = args.reference == "circle" and args.size is None and min_turning_radius(robot) > 0
+        circle = (f" of radius {reference.pose[:, 1].max() / 2:.4g} m (at least {CIRCLE_MARGIN:g} times the robot's "
+                  f"minimum turning radius, {min_turning_radius(robot):.4g} m)" if raised else "")
+        print(f"robot {robot.name}, reference {reference.name}{circle}, controller {args.controller}, "
               f"{'continuous' if run.period is None else f'period {run.period:g} s, delay {args.delay}'}"
               f"{', through the dynamics' if args.dynamics else ''}"
               f"{f', {args.slip_model.upper()} commands' if args.slip_model != 'none' else ''}"
