@@ -380,3 +380,27 @@ def test_a_gap_in_the_samples_is_no_jump():
     pose[t >= 8.5, 1] += 10.0
     got = feasibility(catalog.load("mecanum-4"), reference_from_samples("gap-jump.csv", t, pose)).violations
     assert [(v.signal, v.t) for v in got][:1] == [("position", 8.5)] and got[0].size > 10.0
+
+
+def test_a_sampled_reference_coming_to_rest_on_a_curve_has_no_jump_at_its_end():
+    """A file's velocity at its last sample is a one-sided finite difference: on a 2 m arc decelerating to rest at
+    0.5 m/s^2 it was 1.2e-5 m/s across the path, square to the acceleration, so its tangent was defined there and a
+    quarter turn off: a 'tangent-angle jump' at the end for the bicycle and the diff drive (R on the axle), and for
+    every parking plan (each ends so). The same motion from exact derivatives has none; the sampled one must agree."""
+    from wmrkit.control.references import Reference
+
+    t = np.arange(0, 4.0001, 0.05)
+    s = np.where(t < 3, 0.5 * t, 1.5 + 0.5 * (t - 3) - 0.25 * (t - 3) ** 2)
+    ds, dds = np.where(t < 3, 0.5, 0.5 - 0.5 * (t - 3)), np.where(t < 3, 0.0, -0.5)
+    radius = 2.0
+    phi = s / radius
+    pose = np.column_stack([radius * np.sin(phi), radius * (1 - np.cos(phi)), phi])
+    velocity = np.column_stack([ds * np.cos(phi), ds * np.sin(phi), ds / radius])
+    acceleration = np.column_stack([dds * np.cos(phi) - ds**2 / radius * np.sin(phi),
+                                    dds * np.sin(phi) + ds**2 / radius * np.cos(phi), dds / radius])
+    exact = Reference("arc", t, pose, velocity, acceleration)
+    sampled = reference_from_samples("arc.csv", t, pose)
+    for name in ("bicycle", "diff-drive", "swerve-4", "forklift"):
+        robot = catalog.load(name)
+        assert feasibility(robot, exact).feasible
+        assert feasibility(robot, sampled).violations == ()

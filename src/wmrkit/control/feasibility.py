@@ -163,6 +163,11 @@ def signals(reference: Reference, *, speed_tol: float = 1e-6, slow: float = 0.05
     at_rest = ~(speed > speed_tol)
     with np.errstate(invalid="ignore", divide="ignore"):
         change = np.gradient(t) * np.abs(v[:, 0] * a[:, 0] + v[:, 1] * a[:, 1])  # of the speed in a step
+        # (times the speed), or to a neighbouring sample when larger: a file's finite differences at its last sample,
+        # where it comes to rest, give a velocity of 1e-5 m/s across the path, square to its acceleration, whose
+        # tangent was a 'tangent-angle jump' of a quarter turn
+        change = np.maximum(change, speed * np.maximum(np.abs(np.diff(speed, prepend=speed[:1])),
+                                                       np.abs(np.diff(speed, append=speed[-1:]))))
         steady = ~at_rest & (change <= slow * speed**2)
         chi = np.where(~at_rest & (change <= speed**2), np.arctan2(v[:, 1], v[:, 0]), np.nan)
         cross = v[:, 0] * a[:, 1] - v[:, 1] * a[:, 0]
