@@ -193,3 +193,37 @@ def test_an_impossible_slot_with_animate_is_the_answer_exit_1(capsys, tmp_path, 
         assert json.loads(out)["feasible"] is False
     else:
         assert "infeasible: the slot is too short" in out and "shortest slot that works" in out
+
+
+def test_park_shows_table_8_1_s_verdict_on_the_timed_plan(capsys, monkeypatch):
+    """The plan, timed as it is driven (a trapezoid a segment, the steering turned at rest), judged by Table 8.1 at
+    the steering axle's midpoint (the point the closed loop tracks), through track's code: text line, JSON
+    'feasibility', a warning when not feasible. Its arcs meet at rest, so the car follows them; before the signals'
+    fix the plans' last sample was a false 'tangent-angle jump' (thesis-9.1 at 29.35 s)."""
+    from wmrkit.control.feasibility import Violation
+    from wmrkit.parking import execute
+
+    for name in ("thesis-9.1", "thesis-9.2"):
+        assert main(["park", name]) == 0
+        out, err = capsys.readouterr()
+        assert "Table 8.1 (column 'type 4, off axle' for the steering axle's midpoint, kinematic framework): " \
+               "feasible: yes" in out.splitlines() and err == ""
+        assert main(["park", name, "--json"]) == 0
+        data = json.loads(capsys.readouterr().out)
+        assert data["feasibility"]["feasible"] and data["feasibility"]["column"] == "type 4, off axle"
+    judged = execute.plan_feasibility
+
+    def corner(plan, robot=None):  # a plan Table 8.1 refuses: the warning and the line say so, the answer stands
+        verdict = judged(plan, robot)
+        jump = Violation(3.0, "chi", "tangent-angle jump (chi not C0)", 1.0, "stop and re-orient the orientable wheel")
+        return type(verdict)(verdict.requirement, (jump,))
+
+    monkeypatch.setattr(execute, "plan_feasibility", corner)
+    assert main(["park", "thesis-9.1"]) == 0
+    out, err = capsys.readouterr()
+    assert "feasible: NO (1 violation(s))" in out and err.startswith(
+        "wmrkit: warning: the robot cannot follow this reference with zero error (Table 8.1, column 'type 4, off axle' "
+        "for the tracked point, kinematic framework): tangent-angle jump (chi not C0) at t = 3 s: stop and re-orient")
+    assert main(["park", "thesis-9.1", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert not data["feasibility"]["feasible"] and data["warnings"][0].startswith("the robot cannot follow")

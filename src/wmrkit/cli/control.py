@@ -232,6 +232,13 @@ def run_track(args: argparse.Namespace) -> int:
     return 0
 
 
+def verdict_line(verdict: Feasibility, point: str = "the tracked point") -> str:
+    """One line: Table 8.1's column for `point`, the framework, and whether the reference can be followed."""
+    r = verdict.requirement
+    return (f"Table 8.1 (column '{r.column}' for {point}, {r.framework} framework): feasible: "
+            f"{'yes' if verdict.feasible else f'NO ({len(verdict.violations)} violation(s))'}")
+
+
 def warn_infeasible(verdict: Feasibility | None, end: float | None = None) -> None:
     """Warn where Table 8.1 says the robot cannot follow the reference it tracked (`verdict`: a run's
     ``feasibility``), a line per remedy and set of times, in feasibility's words; `end` [s]: where the reference

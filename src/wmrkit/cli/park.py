@@ -6,7 +6,7 @@ import argparse
 
 from ..errors import WmrkitError
 from ._common import add_json_flag, check_plot_path, print_json, said, warn
-from .control import check_animation_path
+from .control import check_animation_path, verdict_line, warn_infeasible
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -56,15 +56,24 @@ def run(args: argparse.Namespace) -> int:
 
             vehicle, space = solution.problem.vehicle, solution.problem.space
             executed = check_poses(vehicle, space, densify(vehicle, execution.pose))
+    verdict = None
+    if solution.plan.feasible:  # Table 8.1 on the timed plan, at the point the closed loop tracks, as track judges
+        from ..parking.execute import plan_feasibility
+
+        verdict = plan_feasibility(solution.plan, solution.problem.robot)
+        warn_infeasible(verdict)
     if args.animate and execution is None:  # an impossible slot is an answer (exit 1), not bad input
         warn(f"no plan, so no animation: {args.animate} not written")
     if args.json:
         out = solution.to_dict()
         if executed is not None:
             out["executed_check"] = {"mode": execution.mode, **check_dict(executed)}
+        out["feasibility"] = None if verdict is None else verdict.to_dict()
         print_json({**out, "warnings": [*out["warnings"], *said()]})  # the plan's, then the command's
     else:
         print(describe(solution))
+        if verdict is not None:
+            print(verdict_line(verdict, "the steering axle's midpoint"))
         if executed is not None:
             law = execution.mode.upper()
             mode = "open loop" if execution.mode == "open-loop" else f"closed loop with the {law} law"

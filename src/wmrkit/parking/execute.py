@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -23,6 +24,9 @@ from ..robot import Robot
 from .geometry import Vehicle
 from .path import Segment
 from .planner import ParkingPlan
+
+if TYPE_CHECKING:
+    from ..control.feasibility import Feasibility
 
 #: Wheel radius of the vehicle built from the planner's parameters (the thesis gives none) [m].
 WHEEL_RADIUS = 0.3
@@ -232,7 +236,6 @@ def _open_loop(robot, offset, pose0, t, dist, seg, kappa, direction):
 
 def _closed_loop(robot, offset, t, ref, controller, gain):
     """Track the steering axle's midpoint (a point off the fixed axle, as §8.6 controls) with wmrkit.control."""
-    from ..control.references import reference_from_samples
     from ..control.track import MAX_CONTINUOUS_SAMPLES, track
 
     output_dt = float(t[1] - t[0])
@@ -240,15 +243,38 @@ def _closed_loop(robot, offset, t, ref, controller, gain):
         raise WmrkitError(f"controller '{controller}': the plan takes {t[-1]:.0f} s to drive; the closed loop "
                           f"simulates at most {MAX_CONTINUOUS_SAMPLES * output_dt:.0f} s: execute it open loop "
                           "(no controller), or plan a shorter pass (dx2)")
+    reference, front = _steering_axle_reference(robot, offset, t, ref)
+    run = track(robot, reference, controller=controller, gain=gain, point=tuple(front),
+                initial_pose=_origin_pose(ref[0], offset), output_dt=output_dt)
+    pose = np.stack([np.interp(t, run.t, run.pose[:, j]) for j in range(3)], axis=-1)
+    heading = np.stack([np.interp(t, run.t, run.heading[:, j]) for j in range(run.heading.shape[1])], axis=-1)
+    return _pf_pose(pose, offset), heading
+
+
+def _steering_axle_reference(robot: Robot, offset: np.ndarray, t: np.ndarray, ref: np.ndarray):
+    """``(reference, point)``: the timed path of the steering axle's midpoint, `point` ``(2,)`` [m, robot frame],
+    when P_f (at `offset` from the robot origin) follows `ref` ``(n, 3)`` at `t` (what the closed loop tracks)."""
+    from ..control.references import reference_from_samples
+
     front = np.mean([[w.l * math.cos(w.alpha), w.l * math.sin(w.alpha)] for w in robot.wheels
                      if w.type == "steerable"], axis=0)
     point = front - offset  # in P_f's frame (the robot frame translated to P_f)
     c, s = np.cos(ref[:, 2]), np.sin(ref[:, 2])
     target = np.column_stack([ref[:, 0] + c * point[0] - s * point[1], ref[:, 1] + s * point[0] + c * point[1],
                               ref[:, 2]])
-    reference = reference_from_samples("parking plan", t, target)
-    run = track(robot, reference, controller=controller, gain=gain, point=tuple(front),
-                initial_pose=_origin_pose(ref[0], offset), output_dt=output_dt)
-    pose = np.stack([np.interp(t, run.t, run.pose[:, j]) for j in range(3)], axis=-1)
-    heading = np.stack([np.interp(t, run.t, run.heading[:, j]) for j in range(run.heading.shape[1])], axis=-1)
-    return _pf_pose(pose, offset), heading
+    return reference_from_samples("parking plan", t, target), front
+
+
+def plan_feasibility(plan: ParkingPlan, robot: Robot | None = None, *, v_max: float = 0.5, a_max: float = 0.5,
+                     steer_rate: float = 0.5, dt: float = 0.05) -> Feasibility:
+    """Table 8.1's verdict (§8.5, kinematic framework) on `plan` timed as :func:`execute_plan` drives it (its
+    ``v_max``, ``a_max``, ``steer_rate``, ``dt``), for `robot` (default :func:`vehicle_robot`) tracked at its
+    steering axle's midpoint, as the closed loop tracks it: the same verdict as that run's ``feasibility``."""
+    from ..control.feasibility import feasibility
+
+    if not plan.feasible:
+        raise WmrkitError(f"the plan is not feasible ({plan.reason}): nothing to judge")
+    robot = vehicle_robot(plan.vehicle) if robot is None else robot
+    t, ref, _, _ = timed_reference(plan.segments, v_max=v_max, a_max=a_max, steer_rate=steer_rate, dt=dt)
+    reference, front = _steering_axle_reference(robot, _rear_axle_midpoint(robot), t, ref)
+    return feasibility(robot, reference, point=(float(front[0]), float(front[1])))
