@@ -150,10 +150,11 @@ def test_cli_track_json(capsys):
                  "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert {"t", "pose", "reference", "wheels", "summary"} <= set(data)
+    assert "error" not in data  # the key of a failure (docs/limits.md, JSON answers): the series is tracking_error
     assert len(data["pose"][0]) == 3 and len(data["reference"][0]) == 3 and len(data["t"]) == len(data["pose"])
     assert data["wheels"]["right_drive"]["heading"] is None
     assert len(data["wheels"]["steer"]["heading"]) == len(data["t"])
-    assert data["error"][0] == pytest.approx(0.5) and data["error"][-1] < 0.5 * math.exp(-3.5)
+    assert data["tracking_error"][0] == pytest.approx(0.5) and data["tracking_error"][-1] < 0.5 * math.exp(-3.5)
 
 
 def test_cli_track_discrete_warns_and_plots(tmp_path, capsys):

@@ -112,7 +112,7 @@ def test_cli_track_with_the_slip_model(capsys):
     assert code == 0
     d = json.loads(capsys.readouterr().out)
     assert d["slip_model"] == "mqe" and d["feedback"] == "mqe"
-    assert len(d["error"]) == len(d["t"]) == len(d["estimate"]) == 21
+    assert len(d["tracking_error"]) == len(d["t"]) == len(d["estimate"]) == 21
     assert d["summary"]["rms_error"] < 0.1
     assert main(["track", "skid-steer-4", "--reference", "circle", "--slip-model", "mqe"]) == 2
     assert "needs --dynamics" in capsys.readouterr().err

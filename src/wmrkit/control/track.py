@@ -113,8 +113,9 @@ class TrackingRun:
                 "max_cross_track": float(c.max())}
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready: ``t``, ``pose`` and ``reference`` as ``(x, y, theta)`` rows, per-wheel ``heading`` (steering,
-        null for wheels that do not steer) and ``spin`` series, errors and the summary."""
+        """JSON-ready: ``t``, ``pose`` and ``reference`` as ``(x, y, theta)`` rows, ``tracking_error`` (the
+        tracked point's distance from the reference, :attr:`error`; never ``error``, the key of a failure), per-wheel
+        ``heading`` (steering, null for wheels that do not steer) and ``spin`` series and the summary."""
         wheels: dict[str, dict[str, Any]] = {}
         steer = self.robot.steer_names
         for i, name in enumerate(self.robot.wheel_names):
@@ -122,7 +123,7 @@ class TrackingRun:
             wheels[name] = {"heading": h, "spin": np.asarray(self.commands.spin[:, i]).tolist()}
         out = {"robot": self.robot.name, "controller": self.controller, "period": self.period, "delay": self.delay,
                "t": self.t.tolist(), "pose": self.pose.tolist(), "reference": self.reference.tolist(),
-               "error": self.error.tolist(), "wheels": wheels, "summary": self.summary()}
+               "tracking_error": self.error.tolist(), "wheels": wheels, "summary": self.summary()}
         if self.estimate is not None:
             out["estimate"] = self.estimate.tolist()
         if self.slip_model != "none" or self.feedback != "pose":
