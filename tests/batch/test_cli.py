@@ -20,7 +20,7 @@ def test_batch_odometry(capsys, fleet_dir, tmp_path):
     out = tmp_path / "r.parquet"
     data = _json(capsys, ["batch", "odometry", "diff-drive", str(fleet_dir), "--workers", "0", "--closed",
                           "--out", str(out), "--trajectories", str(tmp_path), "--json"], code=1)
-    assert data["logs"] == 6 and data["failed"] == 1 and out.exists()
+    assert data["robot"] == "diff-drive" and data["logs"] == 6 and data["failed"] == 1 and out.exists()
     assert all(r["closure_error"] < 0.1 for r in data["rows"] if not r["error"])
     assert main(["batch", "odometry", "diff-drive", str(fleet_dir), "--workers", "0", "--closed", "--out",
                  str(out)]) == 1

@@ -72,7 +72,7 @@ def test_feasibility_judges_the_point_given_as_track_judges_the_point_it_tracks(
     tracked = track(bicycle, arc_line).feasibility
     x, y = control_point(bicycle).point
     assert main(["feasibility", "bicycle", "--reference", "arc-line", "--point", str(x), str(y), "--json"]) == 0
-    assert json.loads(capsys.readouterr().out) == {**tracked.to_dict(), "warnings": []}
+    assert json.loads(capsys.readouterr().out) == {"robot": "bicycle", **tracked.to_dict(), "warnings": []}
     assert main(["feasibility", "bicycle", "--reference", "arc-line", "--point", "0", "0"]) == 1  # R, as before
     assert "kappa not C0" in capsys.readouterr().out
     assert main(["feasibility", "bicycle", "--reference", "arc-line", "--point", "1e300", "0"]) == 2

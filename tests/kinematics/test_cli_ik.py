@@ -23,7 +23,8 @@ def test_ik_json_has_the_documented_shape(capsys):
     code, out, err = run(capsys, "ik", "swerve-4", "--twist", "1", "0.5", "0.2", "--json")
     assert code == 0 and err == ""
     data = json.loads(out)
-    assert set(data) == {"wheels", "slip", "out_of_range", "out_of_gear", "feasible", "warnings"}
+    assert set(data) == {"robot", "wheels", "slip", "out_of_range", "out_of_gear", "feasible", "warnings"}
+    assert data["robot"] == "swerve-4"
     assert data["feasible"] is True and data["warnings"] == []
     assert data["out_of_range"] == []
     robot = catalog.load("swerve-4")
@@ -73,7 +74,8 @@ def test_fk_json_and_text(capsys):
     code, out, err = run(capsys, "fk", "diff-drive", "--spin", "left=10", "--spin", "right.spin=12", "--json")
     assert code == 0 and err == ""
     data = json.loads(out)
-    assert set(data) == {"twist", "determined", "residual", "consistent", "slipping", "warnings"}
+    assert set(data) == {"robot", "twist", "determined", "residual", "consistent", "slipping", "warnings"}
+    assert data["robot"] == "diff-drive"
     assert data["consistent"] is True and data["warnings"] == []
     assert data["determined"] is True
     r, half_track = 0.075, 0.20

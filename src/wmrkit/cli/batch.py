@@ -169,7 +169,7 @@ def run_odometry(args: argparse.Namespace) -> int:
         if r["warnings"] and not r["error"]:
             warn(f"{r['log']}: {r['warnings']}")
     if args.json:
-        print_json(result.to_dict() | {"rows": [dict(r) for r in result.rows]}, warnings=True)
+        print_json({"robot": robot.name, **result.to_dict(), "rows": [dict(r) for r in result.rows]}, warnings=True)
         return 1 if result.failed else 0
     print(f"{len(result.rows)} logs: {len(result.rows) - result.failed} done ({result.skipped} from an earlier run), "
           f"{result.failed} failed" + (f"; table {args.out}" if args.out else ""))

@@ -275,7 +275,7 @@ def run_feasibility(args: argparse.Namespace) -> int:
 
         plot_feasibility(result, reference, args.plot)
     if args.json:
-        print_json(result.to_dict(), warnings=True)
+        print_json({"robot": robot.name, **result.to_dict()}, warnings=True)
         return 0 if result.feasible else 1  # an answer that is no (docs/limits.md, Exit codes)
     r = result.requirement
     print(f"robot {robot.name}: Table 8.1 column '{r.column}', {r.references} pose references; "

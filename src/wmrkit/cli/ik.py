@@ -56,7 +56,10 @@ def run_ik(args: argparse.Namespace) -> int:
     _check_finite("ik", commands.rates, commands.slip)
     for why in _infeasible(robot, commands):
         warn(f"twist not feasible for robot '{robot.name}': {why}")
-    print_json(commands.to_dict(), warnings=True) if args.json else print(format_commands(robot, commands))
+    if args.json:
+        print_json({"robot": robot.name, **commands.to_dict()}, warnings=True)
+    else:
+        print(format_commands(robot, commands))
     return 0 if commands.feasible else 1  # an answer that is no (docs/limits.md, Exit codes)
 
 
@@ -80,7 +83,7 @@ def run_fk(args: argparse.Namespace) -> int:
         warn(f"the rates contradict each other: the wheels slip ({worst}; residual {fk.residual:.3g} m/s > "
              f"tolerance {fk.tolerance:.3g} m/s); check units, signs and --steer headings")
     if args.json:
-        print_json({"twist": twist.tolist(), "determined": determined, "residual": fk.residual,
+        print_json({"robot": robot.name, "twist": twist.tolist(), "determined": determined, "residual": fk.residual,
                     "consistent": fk.consistent, "slipping": list(fk.slipping)}, warnings=True)
     else:
         vx, vy, omega = (_num(v) for v in twist)
