@@ -53,7 +53,7 @@ def test_batch_odometry_runs_the_described_method(capsys, fleet_dir, tmp_path, d
     rows = _json(capsys, argv)["rows"]
     assert [r["method"] for r in rows] == [method] and not rows[0]["error"]
     single = _json(capsys, ["odometry", str(robot), str(fleet_dir / "run0.csv"), "--json", "--method", method])
-    assert [rows[0]["x"], rows[0]["y"], rows[0]["theta"]] == pytest.approx(single["pose"], abs=1e-12)
+    assert [rows[0]["x"], rows[0]["y"], rows[0]["theta"]] == pytest.approx(single["final_pose"], abs=1e-12)
 
 
 def test_batch_calibrate_and_montecarlo(capsys, calibration_data, fleet_dir, tmp_path):

@@ -26,14 +26,14 @@ def _json(capsys, argv):
 
 def test_json_prints_the_final_pose(capsys, diff_csv, diff_run):
     out = _json(capsys, ["odometry", "diff-drive", diff_csv, "--json"])
-    np.testing.assert_allclose(out["pose"], diff_run.truth[-1], atol=1e-9)
+    np.testing.assert_allclose(out["final_pose"], diff_run.truth[-1], atol=1e-9)
     assert out["samples"] == len(diff_run.log) and out["method"] == "exact"
 
 
 @pytest.mark.parametrize("method", ["exact", "rk2", "euler", "paper002"])
 def test_methods_rank_as_expected(capsys, diff_csv, diff_run, method):
     out = _json(capsys, ["odometry", "diff-drive", diff_csv, "--json", "--method", method])
-    err = np.hypot(*(np.array(out["pose"][:2]) - diff_run.truth[-1, :2]))
+    err = np.hypot(*(np.array(out["final_pose"][:2]) - diff_run.truth[-1, :2]))
     assert err < {"exact": 1e-9, "rk2": 1e-4, "euler": 0.05, "paper002": 0.05}[method]
 
 
@@ -43,9 +43,9 @@ def test_text_summary_and_start_pose(capsys, diff_csv):
     assert "robot diff-drive, method exact" in text and "final std:" in text
     out = _json(capsys, ["odometry", "diff-drive", diff_csv, "--json", "--pose", "1 m", "200 mm", "0.5"])
     base = _json(capsys, ["odometry", "diff-drive", diff_csv, "--json"])
-    x, y, th = base["pose"]
+    x, y, th = base["final_pose"]
     c, s = math.cos(0.5), math.sin(0.5)
-    np.testing.assert_allclose(out["pose"], [1 + c * x - s * y, 0.2 + s * x + c * y, th + 0.5], atol=1e-12)
+    np.testing.assert_allclose(out["final_pose"], [1 + c * x - s * y, 0.2 + s * x + c * y, th + 0.5], atol=1e-12)
 
 
 def test_outputs_csv_tum_bag_and_plot(capsys, tmp_path, diff_csv, diff_run):
@@ -81,20 +81,20 @@ def test_forklift_counts_log_uses_the_catalog_encoders(capsys, tmp_path):
     # what the library gives on the decoded angles (counts relative to the first sample)
     log = run.log
     log = type(log)(log.time, log.joints, log.positions - np.array([*log.positions[0, :2], 0.0]))
-    np.testing.assert_allclose(out["pose"], odometry(robot, log).final_pose, atol=1e-9)
+    np.testing.assert_allclose(out["final_pose"], odometry(robot, log).final_pose, atol=1e-9)
     # 8 m driven; steering quantised to 1.4 deg makes the least-squares blend turn a little: within 2 %
-    assert np.hypot(*(np.array(out["pose"][:2]) - run.truth[-1, :2])) < 0.16
+    assert np.hypot(*(np.array(out["final_pose"][:2]) - run.truth[-1, :2])) < 0.16
     # the same with explicit settings: --cpr and --steer-resolution
     out2 = _json(capsys, ["odometry", "forklift", str(path), "--json", "--spin", "counts", "--steer", "counts",
                           "--time-column", "stamp", "--cpr", "8290", "--steer-resolution", "1.4118 deg",
                           "--column", "right_drive.spin=enc_r", "--column", "left_drive.spin=enc_l",
                           "--column", "steer.steer=steer_raw"])
-    assert out2["pose"] == out["pose"]  # one rule: every steering encoder reads 0 straight ahead, catalog or not
+    assert out2["final_pose"] == out["final_pose"]  # one rule: every steering encoder reads 0 straight ahead
     out3 = _json(capsys, ["odometry", "forklift", str(path), "--json", "--spin", "counts", "--steer", "counts",
                           "--time-column", "stamp", "--weight", "steer=0.01", "--column", "right_drive.spin=enc_r",
                           "--column", "left_drive.spin=enc_l", "--column", "steer.steer=steer_raw"])
-    err3 = np.hypot(*(np.array(out3["pose"][:2]) - run.truth[-1, :2]))
-    assert err3 < 0.2 * np.hypot(*(np.array(out["pose"][:2]) - run.truth[-1, :2]))  # trusting the steering less
+    err3 = np.hypot(*(np.array(out3["final_pose"][:2]) - run.truth[-1, :2]))
+    assert err3 < 0.2 * np.hypot(*(np.array(out["final_pose"][:2]) - run.truth[-1, :2]))  # trusting the steering less
     # --gear with the catalog's counts per revolution: 2 encoder turns per wheel turn halve every spin angle (it was
     # ignored without --cpr: the same pose, exit 0)
     columns = ["--column", "right_drive.spin=enc_r", "--column", "left_drive.spin=enc_l", "--column",
@@ -112,7 +112,7 @@ def test_wrapping_counter_and_sensed_subset(capsys, tmp_path, diff_run):
     write_csv(path, ("time", "left.spin", "right.spin"), np.column_stack([diff_run.log.time, *counts]), fmt="%.10g")
     out = _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--spin", "counts", "--cpr", "1024",
                          "--counter-bits", "12"])
-    assert np.hypot(*(np.array(out["pose"][:2]) - diff_run.truth[-1, :2])) < 0.01
+    assert np.hypot(*(np.array(out["final_pose"][:2]) - diff_run.truth[-1, :2])) < 0.01
 
 
 @pytest.mark.parametrize("width", ["u64", "s64"])
@@ -120,7 +120,7 @@ def test_a_64_bit_counter_header_is_read(capsys, tmp_path, width):
     path = tmp_path / "c.csv"  # the header's widths are 8 to 64 bits; 64 was refused without the file or column
     path.write_text(f"time,left.spin [counts:{width}],right.spin [counts:{width}]\n0,0,0\n1,1000,1000\n")
     out = _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--cpr", "1000"])
-    assert out["pose"] == pytest.approx([2 * math.pi * 0.075, 0.0, 0.0], abs=1e-12)
+    assert out["final_pose"] == pytest.approx([2 * math.pi * 0.075, 0.0, 0.0], abs=1e-12)
 
 
 def test_an_angle_in_a_steering_counts_column_is_refused(capsys, tmp_path):
@@ -137,7 +137,7 @@ def test_gyro_heading(capsys, tmp_path, diff_run):
     write_csv(path, ("time", "left.spin", "right.spin", "gz"),
               np.column_stack([diff_run.log.time, diff_run.log.positions, gyro]))
     out = _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--gyro-column", "gz"])
-    assert out["pose"][2] == pytest.approx(diff_run.truth[-1, 2], abs=0.01)
+    assert out["final_pose"][2] == pytest.approx(diff_run.truth[-1, 2], abs=0.01)
 
 
 @pytest.mark.parametrize(("column", "values", "agrees"), [
@@ -250,7 +250,7 @@ def test_units_in_the_header_need_no_options_and_contradicting_options_are_refus
     plain = json.loads(capsys.readouterr().out)
     assert main(["odometry", "forklift", log, "--spin", "counts", "--steer", "counts", "--counter-bits", "16",
                  "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["pose"] == plain["pose"] and plain["consistent"] is True
+    assert json.loads(capsys.readouterr().out)["final_pose"] == plain["final_pose"] and plain["consistent"] is True
     assert 20 < plain["distance"] < 30  # the example's 24 m drive, not 85.9 km of counts read as radians
     assert main(["odometry", "forklift", log, "--spin", "angle"]) == 2
     assert "the header says --spin counts, the option says angle" in capsys.readouterr().err
@@ -296,7 +296,7 @@ def test_a_byte_order_mark_is_not_part_of_the_first_column(capsys, diff_csv, tmp
         bom.write_text("\ufeff" + f.read(), encoding="utf-8")
     plain = _json(capsys, ["odometry", "diff-drive", diff_csv, "--json"])
     marked = _json(capsys, ["odometry", "diff-drive", str(bom), "--json"])
-    assert marked["pose"] == plain["pose"] and marked["samples"] == plain["samples"]
+    assert marked["final_pose"] == plain["final_pose"] and marked["samples"] == plain["samples"]
 
 
 @pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="needs named pipes")
@@ -348,7 +348,7 @@ def test_units_of_columns_that_are_not_the_logs_do_not_change_the_reading(capsys
     path.write_text(header + "\n" + rows.format(x=",5" if header.count(",") == 3 else ""))
     want = _json(capsys, ["odometry", "diff-drive", str(plain), "--json"])
     got = _json(capsys, ["odometry", "diff-drive", str(path), "--json", *args])
-    assert (got["pose"], got["max_dt"]) == (want["pose"], want["max_dt"])
+    assert (got["final_pose"], got["max_dt"]) == (want["final_pose"], want["max_dt"])
 
 
 def test_a_heading_column_with_its_unit(capsys, tmp_path):
@@ -356,7 +356,8 @@ def test_a_heading_column_with_its_unit(capsys, tmp_path):
     is refused, named."""
     path = tmp_path / "yaw.csv"
     path.write_text("time,left.spin,right.spin,yaw [rad]\n0,0,0,0\n1,1,1,0.5\n")
-    assert _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--heading-column", "yaw"])["pose"][2] == 0.5
+    out = _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--heading-column", "yaw"])
+    assert out["final_pose"][2] == 0.5
     path.write_text("time,left.spin,right.spin,yaw [grad]\n0,0,0,0\n1,1,1,0.5\n")
     assert main(["odometry", "diff-drive", str(path), "--heading-column", "yaw"]) == 2
     assert "column 'yaw': unknown unit 'grad' (for a heading column: rad, deg)" in capsys.readouterr().err
@@ -384,7 +385,7 @@ def test_a_heading_or_gyro_column_in_degrees_is_read_as_its_header_says(capsys, 
     path.write_text(f"time,{','.join(joints)},{header}\n" + "\n".join(rows) + "\n")
     out = _json(capsys, ["odometry", "swerve-4", str(path), "--json", option, header.split()[0]])
     want = [(np.sin(1 + c) - np.sin(c)) / 0.5, (np.cos(c) - np.cos(1 + c)) / 0.5, 1.0]  # x = int cos(0.5 t + c)
-    np.testing.assert_allclose(out["pose"], want, atol=1e-8)
+    np.testing.assert_allclose(out["final_pose"], want, atol=1e-8)
     assert out["consistent"] is True
 
 
@@ -419,7 +420,7 @@ def test_a_heading_column_in_degrees_without_its_unit_is_refused(capsys, tmp_pat
     assert (got["file"], got["line"], got["field"]) == (str(path), 4, "yaw"), got
     assert got["error"].startswith("12 is beyond one turn as radians, probably degrees")
     path.write_text("time,left.spin,right.spin,yaw [rad]\n" + rows)
-    assert _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--heading-column", "yaw"])["pose"][2] \
+    assert _json(capsys, ["odometry", "diff-drive", str(path), "--json", "--heading-column", "yaw"])["final_pose"][2] \
         == pytest.approx(math.remainder(18, 2 * math.pi), abs=1e-12)  # the pose's heading is wrapped
 
 
@@ -481,7 +482,7 @@ def test_spin_columns_of_wheel_travel_in_metres_are_divided_by_the_radius(capsys
     path.write_text(f"time,{','.join(joints)}\n" + "\n".join(rows) + "\n")
     out = _json(capsys, ["odometry", "swerve-4", str(path), "--json"])
     want = [(np.sin(1 + c) - np.sin(c)) / 0.5, (np.cos(c) - np.cos(1 + c)) / 0.5, 1.0]
-    np.testing.assert_allclose(out["pose"], want, atol=1e-8)
+    np.testing.assert_allclose(out["final_pose"], want, atol=1e-8)
     assert out["consistent"] is True and out["distance"] == pytest.approx(2.0, rel=1e-9)
     with pytest.raises(WmrkitError, match=r"spin columns in m or m/s .* need the robot's wheel radii: pass robot="):
         load_csv(path, ["front_left.spin"], LogFormat(spin="distance" if unit == "m" else "speed"))
@@ -506,7 +507,7 @@ def test_spin_columns_in_degrees_or_turns_are_converted(capsys, tmp_path, unit, 
     path = tmp_path / "spin.csv"
     path.write_text(f"time,left.spin [{unit}],right.spin [{unit}]\n" + "\n".join(rows) + "\n")
     out = _json(capsys, ["odometry", "diff-drive", str(path), "--json"])
-    np.testing.assert_allclose(out["pose"], [np.sin(1.0) / 0.5 * 0.4, (1 - np.cos(1.0)) / 0.5 * 0.4, 1.0],
+    np.testing.assert_allclose(out["final_pose"], [np.sin(1.0) / 0.5 * 0.4, (1 - np.cos(1.0)) / 0.5 * 0.4, 1.0],
                                atol=1e-8)
     log = load_csv(path, ["left.spin", "right.spin"], header_format(path, "diff-drive", ["left.spin", "right.spin"]),
                    robot=diff)
@@ -528,7 +529,7 @@ def test_a_header_with_quoted_column_names_reads_as_without_quotes(capsys, tmp_p
     plain.write_text("time [s],left.spin [deg],right.spin [deg],volts\n" + rows)
     quoted.write_text('"time [s]", "left.spin [deg]","right.spin [deg]","battery, volts"\n' + rows)
     want = _json(capsys, ["odometry", "diff-drive", str(plain), "--json"])
-    assert _json(capsys, ["odometry", "diff-drive", str(quoted), "--json"])["pose"] == want["pose"]
+    assert _json(capsys, ["odometry", "diff-drive", str(quoted), "--json"])["final_pose"] == want["final_pose"]
     joints = ["left.spin", "right.spin"]
     log = load_csv(quoted, joints, header_format(quoted, "diff-drive", joints), robot=catalog.load("diff-drive"))
     np.testing.assert_allclose(log.positions[-1], np.radians([114.6, 229.2]), rtol=1e-12)

@@ -171,7 +171,7 @@ def test_swerve_log_in_module_angles_matches_wpilib_odometry(tmp_path, capsys):
     np.testing.assert_allclose(ours, want, rtol=0, atol=1e-12)
     assert main(["odometry", "swerve-4", str(tmp_path / "swerve.csv"), "--json", "--out",
                  str(tmp_path / "path.csv")]) == 0
-    np.testing.assert_allclose(json.loads(capsys.readouterr().out)["pose"], want[-1], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(json.loads(capsys.readouterr().out)["final_pose"], want[-1], rtol=0, atol=1e-12)
     from wmrkit.odometry.trajectories import read_trajectory_csv
 
     np.testing.assert_allclose(read_trajectory_csv(tmp_path / "path.csv").poses, want, rtol=0, atol=1e-9)

@@ -127,7 +127,7 @@ def test_summary_of_a_streamed_run(diff_run):
     assert s.distance == pytest.approx(3.0 * 0.4 + 2.0 * 0.5 + 3.0 * 0.4, rel=1e-9)  # path length of the profile
     assert s.rotation == pytest.approx(3.0 * 0.5 + 3.0 * 0.6, rel=1e-9)
     assert s.max_dt == pytest.approx(0.05)
-    assert s.to_dict()["pose"] == list(s.final_pose)
+    assert s.to_dict()["final_pose"] == list(s.final_pose)
     assert np.allclose(s.final_covariance, kept[-1].covariance[-1])
 
 

@@ -100,11 +100,11 @@ def test_degrees_and_counts_read_as_headings(capsys, tmp_path):
               np.column_stack([run.log.time, *(run.counts[j] for j in joints)]), fmt="%.10g")
     ref = odometry(SWERVE, run.log).final_pose
     for path in (rad, deg):
-        np.testing.assert_allclose(_json(capsys, ["odometry", "swerve-4", str(path), "--json"])["pose"], ref,
+        np.testing.assert_allclose(_json(capsys, ["odometry", "swerve-4", str(path), "--json"])["final_pose"], ref,
                                    atol=1e-9)
     out = _json(capsys, ["odometry", "swerve-4", str(counts), "--json", "--cpr", "4096",
                          "--steer-resolution", f"{360 / 4096} deg"])
-    np.testing.assert_allclose(out["pose"], ref, atol=1e-9)  # spins relative to the first sample: same motion
+    np.testing.assert_allclose(out["final_pose"], ref, atol=1e-9)  # spins relative to the first sample: same motion
     back = load_csv(deg, joints, LogFormat(steer="degrees", columns=tuple((j, f"{j} [{u}]") for j, u in zip(
         joints, ["deg" if j.endswith(".steer") else "rad" for j in joints], strict=True))), robot=SWERVE)
     _same_angles(back.positions, run.log.positions)
@@ -148,7 +148,7 @@ def test_ackermann_log_with_textbook_steering_angles_drives_the_circle(capsys, t
     write_csv(path, ("time", *columns), np.column_stack([t, *columns.values()]))
     out = _json(capsys, ["odometry", "ackermann", str(path), "--json"])
     circle = [radius * math.sin(turn), radius * (1 - math.cos(turn)), turn]
-    np.testing.assert_allclose(out["pose"], circle, atol=1e-9)
+    np.testing.assert_allclose(out["final_pose"], circle, atol=1e-9)
     assert out["consistent"] is True and out["max_slip"] < 1e-9
     legacy = _json(capsys, ["odometry", "ackermann", str(path), "--json", "--steer-convention", "beta"])
     assert legacy["consistent"] is False  # the same numbers read as the thesis's β: contradicting sensors
@@ -189,7 +189,7 @@ def test_legacy_beta_logs_stay_readable(capsys, tmp_path):
     joints = run.log.joints
     is_steer = np.array([j.endswith(".steer") for j in joints])
     write_log(tmp_path / "new.csv", run.log, robot)
-    ref = _json(capsys, ["odometry", "forklift", str(tmp_path / "new.csv"), "--json"])["pose"]
+    ref = _json(capsys, ["odometry", "forklift", str(tmp_path / "new.csv"), "--json"])["final_pose"]
     np.testing.assert_allclose(ref, run.truth[-1], atol=1e-9)
     beta_deg = np.where(is_steer, np.degrees(run.log.positions), run.log.positions)
     cases = {"deg": (beta_deg, "deg:beta", []), "rad": (run.log.positions, "rad:beta", []),
@@ -199,7 +199,7 @@ def test_legacy_beta_logs_stay_readable(capsys, tmp_path):
         header = [j if unit is None or not j.endswith(".steer") else f"{j} [{unit}]" for j in joints]
         write_csv(path, ("time", *header), np.column_stack([run.log.time, values]))
         out = _json(capsys, ["odometry", "forklift", str(path), "--json", *options])
-        np.testing.assert_allclose(out["pose"], ref, atol=1e-9)
+        np.testing.assert_allclose(out["final_pose"], ref, atol=1e-9)
     legacy = tmp_path / "plain.csv"  # β read as headings: 90 deg off, the sensors contradict each other
     assert _json(capsys, ["odometry", "forklift", str(legacy), "--json"])["consistent"] is False
     fmt = LogFormat(steer="degrees", steer_convention="beta", columns=(("steer.steer", "steer.steer [deg:beta]"),))
@@ -276,8 +276,8 @@ def test_headings_beyond_the_described_steer_range_are_refused(capsys, tmp_path)
                         "[-90, 90] deg; degrees read as radians? (CSV logs: --steer degrees)")
     assert "\n" not in err
     ok = _json(capsys, ["odometry", str(description), str(log), "--steer", "degrees", "--json"])
-    assert ok["pose"] == pytest.approx(_json(capsys, ["odometry", "forklift", str(log), "--steer", "degrees",
-                                                      "--json"])["pose"])
+    assert ok["final_pose"] == pytest.approx(_json(capsys, ["odometry", "forklift", str(log), "--steer", "degrees",
+                                                      "--json"])["final_pose"])
     assert main(["odometry", "forklift", str(log)]) == 0  # no range described: not checked
     capsys.readouterr()
     past = np.radians([[92.9], [-92.9]])

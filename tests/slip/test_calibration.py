@@ -83,10 +83,10 @@ def test_cli_calibrate_then_odometry(tmp_path, capsys, husky_run):
     w_path.write_text(json.dumps(out))
     assert main(["odometry", "skid-steer-4", str(log_path), "--method", "wls", "--slip-weights", str(w_path),
                  "--json"]) == 0
-    pose = json.loads(capsys.readouterr().out)["pose"]
+    pose = json.loads(capsys.readouterr().out)["final_pose"]
     assert math.hypot(pose[0] - husky_run.truth[-1, 0], pose[1] - husky_run.truth[-1, 1]) < 0.2
     assert main(["odometry", "skid-steer-4", str(log_path), "--json"]) == 0
-    plain = json.loads(capsys.readouterr().out)["pose"]
+    plain = json.loads(capsys.readouterr().out)["final_pose"]
     assert math.hypot(plain[0] - husky_run.truth[-1, 0], plain[1] - husky_run.truth[-1, 1]) > 0.5
     assert main(["calibrate", "skid-steer-4", str(log_path), "--reference", str(tmp_path / "none.tum")]) == 2
     assert capsys.readouterr().err.startswith("wmrkit: error:")

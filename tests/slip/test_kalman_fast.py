@@ -220,7 +220,7 @@ def test_a_result_that_is_not_finite_is_refused_not_printed():
     from wmrkit.odometry.pipeline import OdometrySummary
 
     good = OdometrySummary("forklift", "fk2", 3, 0.0, 1.0, (1.0, 2.0, 0.5), 3.0, 0.5, 0.0, 0.0, 0.01)
-    assert good.to_dict()["pose"] == [1.0, 2.0, 0.5]
+    assert good.to_dict()["final_pose"] == [1.0, 2.0, 0.5]
     with pytest.raises(WmrkitError, match="not finite"):
         OdometrySummary("forklift", "fk2", 3, 0.0, 1.0, (math.nan, 2.0, 0.5), 3.0, 0.5, 0.0, 0.0, 0.01)
     with pytest.raises(WmrkitError, match="not finite"):

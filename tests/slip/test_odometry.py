@@ -77,8 +77,8 @@ def test_cli_methods(tmp_path, forklift_run):
             assert main(args + (["--mu", "steer=0.01,1"] if method == "wls" else [])) == 0
         out[method] = json.loads(buf.getvalue())
     assert out["wls"]["method"] == "wls (exact)"
-    assert np.allclose(out["wls"]["pose"], out["exact"]["pose"], atol=1e-9)
-    assert np.allclose(out["wls"]["pose"], forklift_run.truth[-1], atol=1e-9)
+    assert np.allclose(out["wls"]["final_pose"], out["exact"]["final_pose"], atol=1e-9)
+    assert np.allclose(out["wls"]["final_pose"], forklift_run.truth[-1], atol=1e-9)
 
 
 def test_cli_refuses_bad_estimator_options(tmp_path, capsys, forklift_run):

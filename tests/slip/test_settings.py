@@ -128,7 +128,7 @@ def husky_files(tmp_path_factory):
 
 def _pose(capsys, argv) -> list[float]:
     assert main(argv) == 0
-    return json.loads(capsys.readouterr().out)["pose"]
+    return json.loads(capsys.readouterr().out)["final_pose"]
 
 
 def test_calibrate_description_odometry_round_trip(husky_files, capsys, tmp_path):

@@ -63,11 +63,12 @@ class OdometrySummary:
                               "wmrkit; please report it with the log")
 
     def to_dict(self) -> dict:
-        """JSON-ready mapping; ``pose`` is the final pose ``[x, y, theta]``."""
-        return {"robot": self.robot, "method": self.method, "pose": list(self.final_pose), "samples": self.samples,
-                "start_time": self.start_time, "end_time": self.end_time, "distance": self.distance,
-                "rotation": self.rotation, "max_slip": self.max_slip, "rms_slip": self.rms_slip,
-                "max_dt": self.max_dt,
+        """JSON-ready mapping; ``final_pose`` is the final pose ``[x, y, theta]`` (the key of every run's last pose,
+        as ``wmrkit simulate``'s; docs/limits.md, JSON answers)."""
+        return {"robot": self.robot, "method": self.method, "final_pose": list(self.final_pose),
+                "samples": self.samples, "start_time": self.start_time, "end_time": self.end_time,
+                "distance": self.distance, "rotation": self.rotation, "max_slip": self.max_slip,
+                "rms_slip": self.rms_slip, "max_dt": self.max_dt,
                 "covariance": None if self.final_covariance is None else [list(r) for r in self.final_covariance]}
 
 
