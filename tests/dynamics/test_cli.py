@@ -113,8 +113,8 @@ def test_simulate_path_json_out_and_plot(capsys, tmp_path):
 
 
 def test_simulate_reports_the_largest_slip_speed(capsys):
-    """'largest slip speed' (JSON max_slip) was the largest slip component, below the speed where a tyre slips both
-    sideways and along its rolling line (a skid steer's turn: 0.048 m/s printed for 0.059 m/s)."""
+    """'largest slip speed' (JSON max_slip_speed) was the largest slip component, below the speed where a tyre slips
+    both sideways and along its rolling line (a skid steer's turn: 0.048 m/s printed for 0.059 m/s)."""
     from wmrkit.dynamics.model import DynamicModel
     from wmrkit.dynamics.programs import path_program
     from wmrkit.dynamics.simulate import simulate
@@ -125,7 +125,7 @@ def test_simulate_reports_the_largest_slip_speed(capsys):
     sim = simulate(model, *path_program(model, "turn", speed=1.0), step=1e-3, record_step=0.01)
     speed = np.hypot(sim.slip[..., 0], sim.slip[..., 1]).max()
     assert speed > 1.2 * np.abs(sim.slip).max()  # both components matter here
-    assert json.loads(out)["max_slip"] == pytest.approx(speed, rel=1e-12)
+    assert json.loads(out)["max_slip_speed"] == pytest.approx(speed, rel=1e-12)
 
 
 def test_simulate_out_writes_steering_as_headings(capsys, tmp_path):
@@ -293,7 +293,7 @@ def test_simulate_refuses_an_initial_twist_that_does_not_roll(capsys, tmp_path):
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
     assert "'left_drive' would slip sideways at 0.1 m/s" in err and "VY = 0.1 m/s" in err
     code, out, err = run(capsys, *argv, "1", "0.1", "0.1")  # the rolling one
-    assert code == 0 and json.loads(out)["max_slip"] < 0.01
+    assert code == 0 and json.loads(out)["max_slip_speed"] < 0.01
 
 
 @pytest.mark.parametrize("extra", [[], ["--feedback", "wls"]])
