@@ -98,8 +98,8 @@ def test_follow_line_json_and_animation(tmp_path, capsys):
                         "--noise", "0.02", "3deg", "--animate", str(gif), "--json"], capsys)
     assert code == 0
     data = json.loads(out)
-    assert data["robot"] == "line-follower" and len(data["samples"]) == 7
-    assert data["samples"][-1]["h"] < 0.3
+    assert data["robot"] == "line-follower" and len(data["trace"]) == 7
+    assert data["trace"][-1]["h"] < 0.3
     assert gif.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
 
 

@@ -232,7 +232,7 @@ def test_a_robot_started_facing_back_follows_the_line_the_other_way_and_psi_stay
     out = run.to_dict()
     assert out["final_psi"] == pytest.approx(math.remainder(-run.pose[-1, 2], 2 * math.pi), abs=1e-12)
     assert -math.pi < out["final_psi"] <= math.pi
-    assert all(-math.pi < s["psi"] <= math.pi for s in out["samples"])
+    assert all(-math.pi < s["psi"] <= math.pi for s in out["trace"])
 
 
 @pytest.mark.parametrize("name", ["diff-drive", "thesis-tricycle", "ackermann"])

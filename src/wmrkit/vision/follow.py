@@ -183,7 +183,8 @@ class LineFollowing:
                 "from the line)")
 
     def to_dict(self) -> dict[str, Any]:
-        """Summary and samples (the ``wmrkit follow-line --json`` output); psi [rad] wrapped to (-pi, pi]; the wheel
+        """Summary and ``trace``, one ``{t, x, h, psi}`` a period (the ``wmrkit follow-line --json`` output;
+        ``samples`` is a count in every other answer); psi [rad] wrapped to (-pi, pi]; the wheel
         commands of each period: ``wheel_rates`` [rad/s] and ``steering`` headings [rad] of the steered wheels."""
         h = self.lateral
         return {
@@ -191,7 +192,7 @@ class LineFollowing:
             "final_h": float(h[-1]), "final_psi": float(wrap_angle(-self.pose[-1, 2])),
             "overshoot": float(max(0.0, -np.min(h * np.sign(h[0])))) if h[0] != 0 else 0.0,
             "settling_time_95": self.settling_time(), "lost_images": int(np.count_nonzero(self.lost)),
-            "samples": [{"t": float(t), "x": float(p[0]), "h": float(p[1]), "psi": float(wrap_angle(-p[2]))}
+            "trace": [{"t": float(t), "x": float(p[0]), "h": float(p[1]), "psi": float(wrap_angle(-p[2]))}
                         for t, p in zip(self.time, self.pose, strict=True)],
             "wheel_rates": {n: self.rates[:, i].tolist() for i, n in enumerate(self.rate_names)},
             "steering": {n: self.steer[:, i].tolist() for i, n in enumerate(self.steer_names)},
