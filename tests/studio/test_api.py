@@ -728,3 +728,27 @@ def test_open_runs_off_the_event_loop(tmp_path, monkeypatch):
     monkeypatch.setattr("wmrkit.studio.files.open_robot", probe)
     assert TestClient(create_app(tmp_path)).post("/api/open", json={"path": "a.yaml"}).status_code == 200
     assert seen == ["worker thread"]
+
+
+
+def _ring(moved: float) -> Robot:
+    """The browser test's 8-wheel Mecanum ring, its first wheel moved out by `moved` [m] and turned by as much."""
+    return robot_from_dict({"name": "mecanum-8", "wheels": [
+        {"name": f"w{i}", "type": "swedish", "l": 0.4 + (moved if i == 0 else 0.0),
+         "alpha": i * math.pi / 4 + (moved if i == 0 else 0.0), "beta": math.pi / 2, "r": 0.05,
+         "gamma": (-1) ** (i + 1) * math.pi / 4, "r_r": 0.01, "actuated": "spin", "sensed": "spin"}
+        for i in range(8)]})
+
+
+@pytest.mark.parametrize("robot", [catalog.load(n) for n in ("omni-3", "mecanum-4", "thesis-omni-castor")]
+                         + [_ring(m) for m in (0.0, 0.013, 0.05, 0.11, 0.2)], ids=lambda r: r.name)
+def test_the_live_natural_length_is_the_analysis_one_to_the_last_bits(robot):
+    """The studio's faster m = 3 search (rows computed once) finds the natural length and kappa of
+    isotropy.natural_length: both evaluate kappa with the same scaling (a gap of 4e-9 failed the browser test)."""
+    from wmrkit.analysis.isotropy import default_joints, natural_length
+    from wmrkit.studio.api import live_natural_length
+
+    joints = default_joints(robot)
+    length, kappa = live_natural_length(robot, joints)
+    expected_length, expected_kappa = natural_length(robot, joints=joints)
+    assert length == pytest.approx(expected_length, rel=1e-12) and kappa == pytest.approx(expected_kappa, rel=1e-12)

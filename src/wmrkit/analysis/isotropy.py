@@ -236,13 +236,13 @@ def _natural_length(model: TwistModel, beta: np.ndarray, size: float) -> tuple[f
 
         def many(lengths: np.ndarray) -> np.ndarray:
             scale = np.ones((len(lengths), 3))
-            scale[:, 2] = unit / lengths
+            scale[:, 2] = 1.0 / (lengths / unit)  # as kappa_cm scales (kappa_function: the same values)
             return condition_number(h * scale[:, None, :])
 
         def one(length: float) -> float:  # condition_number's value and threshold, on one (J, 3) matrix
             if h.shape[0] < 3:
                 return np.inf
-            sv = np.linalg.svd(h * np.array([1.0, 1.0, unit / length]), compute_uv=False)
+            sv = np.linalg.svd(h * np.array([1.0, 1.0, 1.0 / (length / unit)]), compute_uv=False)
             return float(sv[0] / sv[-1]) if sv[-1] > 1e-13 * sv[0] else np.inf
 
         return _minimise_length(one, model.robot, many)
