@@ -35,7 +35,7 @@ axes = [parse_vary("wheels[0].alpha,wheels[0].beta=30deg:90deg:13", omni),
         parse_vary("wheels.back.l=0.15:0.25:11", omni)]
 ALPHA, BACK_L = (axis.label for axis in axes)  # the keys of each design's row
 result = sweep(omni, axes, "kappa_mean", top=3)
-print(f"{result.total} designs in {result.seconds:.2f} s; the best three:")
+print(f"{result.total} designs in {result.wall_time:.2f} s; the best three:")
 for row in result.best:
     print(f"  alpha = beta = {math.degrees(row[ALPHA]):4.1f} deg, back l = {row[BACK_L]:.3f} m: "
           f"kappa {row['kappa_mean']:.6f} at D = {row['length']:.4f} m")

@@ -83,7 +83,7 @@ def test_sweep(capsys, tmp_path):
     data = _json(capsys, ["sweep", "omni-3", "--vary", "wheels[0].alpha,wheels[0].beta=30deg:90deg:7", "--vary",
                           "wheels.back.l=0.15:0.25:3", "--workers", "0", "--top", "2", "--out",
                           str(tmp_path / "s.parquet"), "--plot", str(tmp_path / "s.png"), "--json"])
-    assert data["designs"] == 21 and data["best"][0]["kappa_mean"] == pytest.approx(1.0)
+    assert data["designs"] == 21 and data["best"][0]["kappa_mean"] == pytest.approx(1.0) and data["wall_time"] > 0
     assert (tmp_path / "s.png").exists() and (tmp_path / "s.parquet").exists()
 
 

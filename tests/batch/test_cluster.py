@@ -45,7 +45,7 @@ def engines(cluster):
 
 
 def _strip(rows):
-    return [{k: v for k, v in r.items() if k != "seconds"} for r in rows]
+    return [{k: v for k, v in r.items() if k != "wall_time"} for r in rows]
 
 
 def test_batch_odometry_bit_identical_with_a_failing_log_and_resume(engines, fleet_dir, diff, tmp_path):

@@ -10,7 +10,7 @@ import pytest
 
 from wmrkit.batch.engine import BatchError
 from wmrkit.batch.fleet import SUMMARY_SCHEMA, batch_odometry, expand_logs
-from wmrkit.batch.parquet import RowSink, parts_dir, read_rows
+from wmrkit.batch.parquet import RowSink, parts_dir, read_rows, write_rows
 from wmrkit.odometry.bags import write_joint_states
 from wmrkit.odometry.logs import load_csv
 from wmrkit.odometry.pipeline import odometry
@@ -54,12 +54,25 @@ def test_rerun_resumes_and_retries_failures(fleet_dir, diff, tmp_path):
     first = batch_odometry(diff, [fleet_dir / "*.csv"], out=out, trajectories=tmp_path)
     again = batch_odometry(diff, [fleet_dir / "*.csv"], out=out, trajectories=tmp_path)
     assert again.skipped == 5 and again.failed == 1
-    assert [r["seconds"] for r in again.rows if not r["error"]] == [r["seconds"] for r in first.rows if not r["error"]]
+    kept = [r["wall_time"] for r in first.rows if not r["error"]]
+    assert [r["wall_time"] for r in again.rows if not r["error"]] == kept
     os.remove(first.rows[-1]["trajectory"])  # a missing trajectory is redone
     third = batch_odometry(diff, [fleet_dir / "*.csv"], out=out, trajectories=tmp_path)
     assert third.skipped == 4 and os.path.exists(first.rows[-1]["trajectory"])
     other = batch_odometry(diff, [fleet_dir / "*.csv"], out=out, method="euler")  # other options: all redone
     assert other.skipped == 0
+
+
+def test_a_table_from_before_the_wall_time_rename_is_redone(fleet_dir, diff, tmp_path):
+    """Each row's wall time [s] is the column 'wall_time' (sweep and park say so too); a table written when it was
+    'seconds' is of this command but lacks the column: it is redone, not resumed nor refused."""
+    out = tmp_path / "old.parquet"
+    old = tuple(("seconds", kind) if name == "wall_time" else (name, kind) for name, kind in SUMMARY_SCHEMA)
+    first = batch_odometry(diff, [fleet_dir], out=tmp_path / "ref.parquet")
+    write_rows(out, [{("seconds" if k == "wall_time" else k): v for k, v in r.items()} for r in first.rows], old)
+    res = batch_odometry(diff, [fleet_dir], out=out)
+    assert res.skipped == 0 and all(r["wall_time"] > 0 for r in res.rows)
+    assert pq.read_table(out).schema.names == [n for n, _ in SUMMARY_SCHEMA]
 
 
 def test_resume_from_the_parts_of_an_interrupted_run(fleet_dir, diff, tmp_path):
@@ -72,7 +85,7 @@ def test_resume_from_the_parts_of_an_interrupted_run(fleet_dir, diff, tmp_path):
     assert not out.exists() and len(read_rows(out)) == 2
     res = batch_odometry(diff, [fleet_dir], out=out)
     assert res.skipped == 2
-    strip = lambda rows: [{k: v for k, v in r.items() if k != "seconds"} for r in rows]  # noqa: E731
+    strip = lambda rows: [{k: v for k, v in r.items() if k != "wall_time"} for r in rows]  # noqa: E731
     assert strip(res.rows) == strip(full.rows)
     assert not parts_dir(out).exists() and len(read_rows(out)) == 6
 

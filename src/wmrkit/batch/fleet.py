@@ -37,7 +37,7 @@ SUMMARY_SCHEMA = (
     ("theta", "float64 rad"), ("path_length", "float64 m"), ("rotation", "float64 rad"),
     ("closure_error", "float64 m"), ("closure_heading", "float64 rad"), ("max_slip", "float64 m"),
     ("rms_slip", "float64 m"), ("max_dt", "float64 s"), ("warnings", "string"), ("error", "string"),
-    ("trajectory", "string"), ("seconds", "float64 s"), ("settings", "string"),
+    ("trajectory", "string"), ("wall_time", "float64 s"), ("settings", "string"),
 )
 #: Columns a table must have to be a batch-odometry table at all (an older one lacks some others: it is redone).
 KEY_COLUMNS = ("log", "robot", "method", "error", "trajectory")
@@ -132,7 +132,7 @@ def process_log(job: LogJob) -> dict[str, Any]:
                 options["fmt"] = header_format(job.path, job.robot.name, joints, **job.header)
             s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=job.model, **options)
         except Exception as err:
-            row.update(error=_message(err), trajectory=None, seconds=time.perf_counter() - t0)
+            row.update(error=_message(err), trajectory=None, wall_time=time.perf_counter() - t0)
             return row
     x, y, theta = s.final_pose
     notes = [" ".join(str(w.message).split()) for w in caught]
@@ -142,7 +142,7 @@ def process_log(job: LogJob) -> dict[str, Any]:
         notes.append("a single sample: no motion")
     row.update(samples=s.samples, start_time=s.start_time, duration=s.end_time - s.start_time, x=x, y=y, theta=theta,
                path_length=s.distance, rotation=s.rotation, max_slip=s.max_slip, rms_slip=s.rms_slip,
-               max_dt=s.max_dt, warnings="; ".join(notes) or None, seconds=time.perf_counter() - t0)
+               max_dt=s.max_dt, warnings="; ".join(notes) or None, wall_time=time.perf_counter() - t0)
     if job.closed:  # the run ends where it started (the start pose is the origin)
         row.update(closure_error=math.hypot(x, y), closure_heading=float(np.angle(np.exp(1j * theta))))
     return row

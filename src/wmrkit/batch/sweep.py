@@ -47,12 +47,12 @@ class SweepResult:
     chunks: int
     best: tuple[dict, ...]
     grid: np.ndarray
-    seconds: float
+    wall_time: float
 
     def to_dict(self) -> dict:
         """JSON-ready mapping."""
         return {"robot": self.robot, "metric": self.metric, "designs": self.total, "chunks": self.chunks,
-                "seconds": self.seconds,
+                "wall_time": self.wall_time,
                 "axes": [{"field": a.label, "start": float(a.values[0]), "stop": float(a.values[-1]),
                           "n": len(a.values), "unit": a.unit} for a in self.axes],
                 "best": [{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in b.items()}

@@ -292,7 +292,7 @@ def run_sweep(args: argparse.Namespace) -> int:
     if args.json:
         print_json(result.to_dict())
         return 0
-    print(f"robot {robot.name}: {args.metric} over {result.total:,} designs in {result.seconds:.3g} s")
+    print(f"robot {robot.name}: {args.metric} over {result.total:,} designs in {result.wall_time:.3g} s")
     for b in result.best:
         fields = ", ".join(f"{a.label} = {a.shown(b[a.label]):.6g} {a.shown_unit}" for a in axes)
         value = b[args.metric]

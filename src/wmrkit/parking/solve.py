@@ -17,23 +17,23 @@ from .verify import CollisionReport, check_plan
 
 @dataclass(frozen=True, eq=False)
 class Solution:
-    """``plan``; ``time_ms`` the planning time (median of `repeat` runs) [ms]; ``shortest_H`` [m] the shortest
+    """``plan``; ``wall_time`` the planning time (median of `repeat` runs) [s]; ``shortest_H`` [m] the shortest
     slot length that works when the plan is infeasible (None when feasible or when no length works);
     ``check`` the exact collision check (None unless asked)."""
 
     problem: ParkingProblem
     plan: ParkingPlan
-    time_ms: float
+    wall_time: float
     shortest_H: float | None
     check: CollisionReport | None
 
     def to_dict(self, pose_step: float = 0.05) -> dict[str, Any]:
-        """``{"maneuvers", "feasible", "reason", "path", "poses", "time_ms", ...}``; SI units, steering as
+        """``{"maneuvers", "feasible", "reason", "path", "poses", "wall_time", ...}``; SI units, steering as
         headings (the equivalent front wheel's, 0 = straight ahead); poses of P_f every `pose_step` [m]."""
         p, v, sp = self.plan, self.problem.vehicle, self.problem.space
         out: dict[str, Any] = {
             "problem": self.problem.name, "maneuvers": p.maneuvers, "feasible": p.feasible, "reason": p.reason,
-            "warnings": list(p.warnings), "time_ms": self.time_ms,
+            "warnings": list(p.warnings), "wall_time": self.wall_time,
             "length_ratio_percent": length_ratio(v, sp), "blackburn_min_H": blackburn_min_length(v),
             "shortest_H": self.shortest_H,
             "approach": {"dx1": _defined(p.dx1), "dy3": _defined(p.dy3), "pass_offset": p.pass_offset},
@@ -84,7 +84,7 @@ def solve(problem: ParkingProblem, *, check: bool = False, search: bool = True, 
     if not plan.feasible and search:
         shortest = shortest_slot(problem.vehicle, problem.space)
     report = check_plan(problem.vehicle, problem.space, plan.segments) if check and plan.feasible else None
-    return Solution(problem, plan, 1e3 * sorted(times)[len(times) // 2], shortest, report)
+    return Solution(problem, plan, sorted(times)[len(times) // 2], shortest, report)
 
 
 def _count(n: int, noun: str) -> str:
@@ -101,7 +101,7 @@ def describe(solution: Solution) -> str:
         changes = direction_changes(p.segments)
         lines.append(f"feasible: {_count(p.maneuvers, 'manoeuvre')}, final gap to the curb {p.final_gap * 100:.1f} "
                      f"cm, path {path_length(p.segments):.2f} m, {_count(changes, 'direction change')}, "
-                     f"planned in {solution.time_ms:.3f} ms")
+                     f"planned in {1e3 * solution.wall_time:.3f} ms")
         lines.append(f"approach point: dx1 = {p.dx1:.4g} m from the parked cars' side, pass {p.dy3:.4g} m past "
                      "the front one")
         for k, a in enumerate(p.arcs, 1):
