@@ -47,7 +47,7 @@ def ratio_figure() -> list[tuple[float, float, int, int]]:
             h = 2.85 + 0.05 * k
             slot = replace(p.space, H=h, dx2=dx2)
             plan = plan_parking(p.vehicle, slot)
-            r = length_ratio(p.vehicle, slot)
+            r = 100 * length_ratio(p.vehicle, slot)  # in percent, as Fig. 9.30
             if plan.feasible:
                 xs.append(r)
                 ys.append(plan.maneuvers)

@@ -23,6 +23,7 @@ def test_json_output_of_table_9_2(capsys):
     assert data["maneuvers"] == 4 and data["feasible"] is True
     assert {"path", "poses", "wall_time", "warnings"} <= data.keys()
     assert data["wall_time"] > 0 and data["warnings"]  # dx2 < c1/2 is reported
+    assert data["length_ratio"] == pytest.approx(0.706, abs=5e-4)  # (9.37), the digest's 70.6 %, as a fraction
     steering = [seg["steering"] for seg in data["path"]]
     # headings: the equivalent front wheel, 0 = straight, |steering| <= phi_max = 46 deg, atan(h1 kappa)
     assert max(abs(s) for s in steering) <= math.radians(46) + 1e-12

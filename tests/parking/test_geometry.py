@@ -59,8 +59,8 @@ def test_turning_radius_9_27_and_ratio_9_37():
     # the digest's computed values: rho_min 101.40 and 57.94 cm, ratios 32.2 % and 70.6 %
     assert turning_radius(1.05, math.radians(46)) == pytest.approx(1.0140, abs=5e-5)
     assert CAR_92.rho_min == pytest.approx(0.5794, abs=5e-5)
-    assert length_ratio(CAR_91, Space(3.35, 2.0, 0.2, 0.7, 0.07)) == pytest.approx(32.2, abs=0.05)
-    assert length_ratio(CAR_92, Space(3.30, 3.6, 0.12, 0.17, 0.17)) == pytest.approx(70.6, abs=0.05)
+    assert length_ratio(CAR_91, Space(3.35, 2.0, 0.2, 0.7, 0.07)) == pytest.approx(0.322, abs=5e-4)
+    assert length_ratio(CAR_92, Space(3.30, 3.6, 0.12, 0.17, 0.17)) == pytest.approx(0.706, abs=5e-4)
 
 
 @given(st.floats(0.05, 5.0), st.floats(0.0, math.pi / 2))

@@ -84,7 +84,7 @@ def test_figure_9_30_manoeuvres_grow_quickly_below_30_percent():
     counts = {}
     for h in (2.9, 3.0, 3.1, 3.3, 3.5, 3.7, 3.9, 4.1):
         s = replace(slot, H=h)
-        counts[round(length_ratio(CAR_91, s))] = plan_parking(CAR_91, s).maneuvers
+        counts[round(100 * length_ratio(CAR_91, s))] = plan_parking(CAR_91, s).maneuvers
     low = [n for r, n in counts.items() if r < 27]
     high = [n for r, n in counts.items() if r > 30]
     assert min(low) > 2 * max(high)

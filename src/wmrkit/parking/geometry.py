@@ -183,9 +183,10 @@ def arcs_through(X: float, Y: float) -> tuple[float, float]:
 
 
 def length_ratio(vehicle: Vehicle, space: Space) -> float:
-    """Free longitudinal space in percent, eq. (9.37): ``100 ((H - 2 MS) - (a1 + b1)) / (H - 2 MS)``."""
+    """Free longitudinal space as a fraction, eq. (9.37) over 100: ``((H - 2 MS) - (a1 + b1)) / (H - 2 MS)`` (the
+    thesis gives it in percent)."""
     free = space.effective_length
-    return 100.0 * (free - vehicle.length) / free
+    return (free - vehicle.length) / free
 
 
 def blackburn_min_length(vehicle: Vehicle, rho: float | None = None) -> float:

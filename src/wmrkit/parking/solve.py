@@ -34,7 +34,7 @@ class Solution:
         out: dict[str, Any] = {
             "problem": self.problem.name, "maneuvers": p.maneuvers, "feasible": p.feasible, "reason": p.reason,
             "warnings": list(p.warnings), "wall_time": self.wall_time,
-            "length_ratio_percent": length_ratio(v, sp), "blackburn_min_H": blackburn_min_length(v),
+            "length_ratio": length_ratio(v, sp), "blackburn_min_H": blackburn_min_length(v),
             "shortest_H": self.shortest_H,
             "approach": {"dx1": _defined(p.dx1), "dy3": _defined(p.dy3), "pass_offset": p.pass_offset},
             "final_gap": _defined(p.final_gap), "path_length": path_length(p.segments),
@@ -95,7 +95,7 @@ def describe(solution: Solution) -> str:
     """The text ``wmrkit park`` prints without ``--json``."""
     p, sp, v = solution.plan, solution.problem.space, solution.problem.vehicle
     lines = [f"problem {solution.problem.name}: slot {sp.H:.4g} x {sp.J:.4g} m, car {v.length:.4g} x {v.c1:.4g} m "
-             f"(length ratio {length_ratio(v, sp):.1f} %)"]
+             f"(length ratio {100 * length_ratio(v, sp):.1f} %)"]
     lines += [f"warning: {w}" for w in p.warnings]
     if p.feasible:
         changes = direction_changes(p.segments)
