@@ -49,7 +49,7 @@ for weights, name in (({}, "forklift"), ({"steer": 0.02}, "forklift_weighted")):
                             plot=out_dir / f"{name}.png")
     time, poses = read_tum(out_dir / f"{name}.tum")
     err = np.hypot(*(poses[-1, :2] - run.truth[-1, :2]))
-    print(f"weights {weights or 'all 1'}: {summary.samples} samples, {summary.distance:.2f} m driven; end-point "
-          f"error {err:.3f} m ({100 * err / summary.distance:.2f} %); slip indicator max "
+    print(f"weights {weights or 'all 1'}: {summary.samples} samples, {summary.path_length:.2f} m driven; end-point "
+          f"error {err:.3f} m ({100 * err / summary.path_length:.2f} %); slip indicator max "
           f"{summary.max_slip * 1e3:.2f} mm per interval")
 print(f"wrote {log_path.name} and the .tum/.png outputs in {out_dir}")

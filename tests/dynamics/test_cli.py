@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -126,6 +127,16 @@ def test_simulate_reports_the_largest_slip_speed(capsys):
     speed = np.hypot(sim.slip[..., 0], sim.slip[..., 1]).max()
     assert speed > 1.2 * np.abs(sim.slip).max()  # both components matter here
     assert json.loads(out)["max_slip_speed"] == pytest.approx(speed, rel=1e-12)
+
+
+def test_simulate_reports_the_path_length_under_its_one_name(capsys):
+    """The length of the path driven is 'path_length', as in odometry, park and batch odometry ('distance' before):
+    on a straight drive it is the distance from the start."""
+    code, out, err = run(capsys, "simulate", "skid-steer-4", "--path", "straight", "--duration", "0.5", "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert "distance" not in data and data["path_length"] > 0.1
+    assert data["path_length"] == pytest.approx(math.hypot(*data["final_pose"][:2]), rel=1e-9)
 
 
 def test_simulate_out_writes_steering_as_headings(capsys, tmp_path):

@@ -102,7 +102,7 @@ def test_forklift_counts_log_uses_the_catalog_encoders(capsys, tmp_path):
     geared = [_json(capsys, ["odometry", "forklift", str(path), "--json", "--spin", "counts", "--steer", "counts",
                              "--time-column", "stamp", *columns, *gear]) for gear in (["--gear", "2"],
                                                                                       ["--cpr", "8290", "--gear", "2"])]
-    assert geared[0] == geared[1] and geared[0]["distance"] == pytest.approx(out["distance"] / 2, rel=1e-9)
+    assert geared[0] == geared[1] and geared[0]["path_length"] == pytest.approx(out["path_length"] / 2, rel=1e-9)
 
 
 def test_wrapping_counter_and_sensed_subset(capsys, tmp_path, diff_run):
@@ -251,7 +251,7 @@ def test_units_in_the_header_need_no_options_and_contradicting_options_are_refus
     assert main(["odometry", "forklift", log, "--spin", "counts", "--steer", "counts", "--counter-bits", "16",
                  "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["final_pose"] == plain["final_pose"] and plain["consistent"] is True
-    assert 20 < plain["distance"] < 30  # the example's 24 m drive, not 85.9 km of counts read as radians
+    assert 20 < plain["path_length"] < 30  # the example's 24 m drive, not 85.9 km of counts read as radians
     assert main(["odometry", "forklift", log, "--spin", "angle"]) == 2
     assert "the header says --spin counts, the option says angle" in capsys.readouterr().err
 
@@ -483,7 +483,7 @@ def test_spin_columns_of_wheel_travel_in_metres_are_divided_by_the_radius(capsys
     out = _json(capsys, ["odometry", "swerve-4", str(path), "--json"])
     want = [(np.sin(1 + c) - np.sin(c)) / 0.5, (np.cos(c) - np.cos(1 + c)) / 0.5, 1.0]
     np.testing.assert_allclose(out["final_pose"], want, atol=1e-8)
-    assert out["consistent"] is True and out["distance"] == pytest.approx(2.0, rel=1e-9)
+    assert out["consistent"] is True and out["path_length"] == pytest.approx(2.0, rel=1e-9)
     with pytest.raises(WmrkitError, match=r"spin columns in m or m/s .* need the robot's wheel radii: pass robot="):
         load_csv(path, ["front_left.spin"], LogFormat(spin="distance" if unit == "m" else "speed"))
 

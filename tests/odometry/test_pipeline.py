@@ -124,7 +124,7 @@ def test_summary_of_a_streamed_run(diff_run):
     s = run_odometry(model, chunks, noise=CrowleyNoise(), sinks=[kept.append])
     assert s.samples == len(diff_run.log) == sum(map(len, kept))
     np.testing.assert_allclose(s.final_pose, diff_run.truth[-1], atol=1e-9)
-    assert s.distance == pytest.approx(3.0 * 0.4 + 2.0 * 0.5 + 3.0 * 0.4, rel=1e-9)  # path length of the profile
+    assert s.path_length == pytest.approx(3.0 * 0.4 + 2.0 * 0.5 + 3.0 * 0.4, rel=1e-9)  # path length of the profile
     assert s.rotation == pytest.approx(3.0 * 0.5 + 3.0 * 0.6, rel=1e-9)
     assert s.max_dt == pytest.approx(0.05)
     assert s.to_dict()["final_pose"] == list(s.final_pose)

@@ -54,7 +54,7 @@ def test_filters_stream_in_chunks_and_track_slip_free_motion(forklift_run):
     poses = np.vstack([p.poses for p in parts])
     assert poses.shape == (len(log), 3)
     err = np.hypot(*(poses[:, :2] - forklift_run.truth[:, :2]).T)
-    assert err.max() < 0.05 * whole.distance
+    assert err.max() < 0.05 * whole.path_length
 
 
 def test_cli_methods(tmp_path, forklift_run):
@@ -207,7 +207,7 @@ def test_a_filter_lagging_its_measurements_is_not_called_a_contradiction(tmp_pat
     assert main([*args, "--method", "fk2"]) == 0
     out, err = capsys.readouterr()
     data = json.loads(out)
-    motion = data["distance"] / (data["samples"] - 1)
+    motion = data["path_length"] / (data["samples"] - 1)
     assert data["rms_slip"] > 0.02 * motion  # the filter's indicator: above the tolerance
     assert "contradict" not in err and "the sensed joints themselves agree" in err
 

@@ -141,7 +141,7 @@ def process_log(job: LogJob) -> dict[str, Any]:
     if s.samples < 2:
         notes.append("a single sample: no motion")
     row.update(samples=s.samples, start_time=s.start_time, duration=s.end_time - s.start_time, x=x, y=y, theta=theta,
-               path_length=s.distance, rotation=s.rotation, max_slip=s.max_slip, rms_slip=s.rms_slip,
+               path_length=s.path_length, rotation=s.rotation, max_slip=s.max_slip, rms_slip=s.rms_slip,
                max_dt=s.max_dt, warnings="; ".join(notes) or None, wall_time=time.perf_counter() - t0)
     if job.closed:  # the run ends where it started (the start pose is the origin)
         row.update(closure_error=math.hypot(x, y), closure_heading=float(np.angle(np.exp(1j * theta))))

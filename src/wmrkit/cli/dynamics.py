@@ -157,7 +157,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     if args.json:
         print_json({"robot": model.robot.name, "method": sim.method, "step": step, "duration": duration,
                     "samples": len(sim.t), "final_time": end, "final_pose": pose.tolist(), "final_twist": tw.tolist(),
-                    "distance": travelled, "max_slip_speed": max_slip, "out": args.out}, warnings=True)
+                    "path_length": travelled, "max_slip_speed": max_slip, "out": args.out}, warnings=True)
     else:
         print(f"{model.robot.name}: {duration:g} s simulated ({sim.method}, step {step:g} s), {len(sim.t)} samples")
         print(f"final pose (t = {end:g} s): x = {pose[0]:.6g} m, y = {pose[1]:.6g} m, theta = {pose[2]:.6g} rad")

@@ -197,7 +197,7 @@ def _check_consistency(s: OdometrySummary, wheel_slips, *, filtered: str | None 
     its name) is its residual, which also holds its lag behind the measurements: where the no-slip model's own
     slips stay within the tolerance, the warning says the log changes faster than the filter expects, not that the
     joints contradict each other."""
-    motion = s.distance / max(s.samples - 1, 1)
+    motion = s.path_length / max(s.samples - 1, 1)
     tolerance = LOG_SLIP_RTOL * motion + 1e-9
     if s.rms_slip <= tolerance:
         return True
@@ -310,7 +310,7 @@ def format_summary(s: OdometrySummary) -> str:
     x, y, th = s.final_pose
     lines = [f"robot {s.robot}, method {s.method}: {s.samples} samples over {s.end_time - s.start_time:.6g} s",
              f"final pose: x = {x:.6f} m, y = {y:.6f} m, theta = {th:.6f} rad ({math.degrees(th):.3f} deg)",
-             f"path length {s.distance:.6g} m, rotation {s.rotation:.6g} rad, longest step {s.max_dt:.6g} s",
+             f"path length {s.path_length:.6g} m, rotation {s.rotation:.6g} rad, longest step {s.max_dt:.6g} s",
              f"slip indicator: max {s.max_slip:.3g} m, rms {s.rms_slip:.3g} m per interval"]
     if s.final_covariance is not None:
         c = s.final_covariance

@@ -45,7 +45,7 @@ class OdometrySummary:
     start_time: float
     end_time: float
     final_pose: tuple[float, float, float]
-    distance: float
+    path_length: float
     rotation: float
     max_slip: float
     rms_slip: float
@@ -55,11 +55,11 @@ class OdometrySummary:
     def __post_init__(self) -> None:
         """Inputs are checked finite and bounded, so a result that is not is an overflow inside wmrkit: refused
         here (one line from the CLI), never printed as NaN (null in JSON) with success."""
-        values = (*self.final_pose, self.distance, self.rotation, self.max_slip, self.rms_slip,
+        values = (*self.final_pose, self.path_length, self.rotation, self.max_slip, self.rms_slip,
                   *(v for row in self.final_covariance or () for v in row))
         if not all(math.isfinite(v) for v in values):
             raise WmrkitError(f"odometry ({self.method}) of robot '{self.robot}': the result is not finite (final "
-                              f"pose {list(self.final_pose)}, path length {self.distance}): a numerical overflow in "
+                              f"pose {list(self.final_pose)}, path length {self.path_length}): a numerical overflow in "
                               "wmrkit; please report it with the log")
 
     def to_dict(self) -> dict:
@@ -67,7 +67,7 @@ class OdometrySummary:
         as ``wmrkit simulate``'s; docs/limits.md, JSON answers)."""
         return {"robot": self.robot, "method": self.method, "final_pose": list(self.final_pose),
                 "samples": self.samples, "start_time": self.start_time, "end_time": self.end_time,
-                "distance": self.distance, "rotation": self.rotation, "max_slip": self.max_slip,
+                "path_length": self.path_length, "rotation": self.rotation, "max_slip": self.max_slip,
                 "rms_slip": self.rms_slip, "max_dt": self.max_dt,
                 "covariance": None if self.final_covariance is None else [list(r) for r in self.final_covariance]}
 
