@@ -88,6 +88,11 @@ def test_cli_calibrate_then_odometry(tmp_path, capsys, husky_run):
     assert main(["odometry", "skid-steer-4", str(log_path), "--json"]) == 0
     plain = json.loads(capsys.readouterr().out)["final_pose"]
     assert math.hypot(plain[0] - husky_run.truth[-1, 0], plain[1] - husky_run.truth[-1, 1]) > 0.5
+    # the final errors per model, each a number as rms_position_error's (final_error was {position, heading}):
+    # the no-slip model's is the plain odometry's distance from the reference's last pose
+    assert out["final_position_error"]["no_slip"] == pytest.approx(
+        math.hypot(plain[0] - husky_run.truth[-1, 0], plain[1] - husky_run.truth[-1, 1]), rel=1e-6)
+    assert out["final_heading_error"]["no_slip"] == pytest.approx(abs(plain[2] - husky_run.truth[-1, 2]), rel=1e-6)
     assert main(["calibrate", "skid-steer-4", str(log_path), "--reference", str(tmp_path / "none.tum")]) == 2
     assert capsys.readouterr().err.startswith("wmrkit: error:")
 
@@ -99,8 +104,10 @@ def test_cli_skid_study_quasi_static(tmp_path, capsys):
     assert out["source"] == "quasi-static" and len(out["figures"]) == 4
     for name in ("calibration run", "tight loop", "slalom"):
         r = out["runs"][name]
-        assert r["WLS"]["rms"] == pytest.approx(r["effective track"]["rms"], rel=1e-4, abs=1e-6)
-        assert r["WLS"]["rms"] < 0.5 * r["no slip (LS)"]["rms"]
+        rms = {model: e["rms_position_error"] for model, e in r.items()}
+        assert rms["WLS"] == pytest.approx(rms["effective track"], rel=1e-4, abs=1e-6)
+        assert rms["WLS"] < 0.5 * rms["no slip (LS)"]
+        assert all(0 <= e["final_position_error"] <= 3 * e["rms_position_error"] + 1 for e in r.values())
 
 
 def test_a_run_without_turning_determines_no_slip_parameter(tmp_path, capsys):

@@ -294,7 +294,7 @@ def run_study(args: argparse.Namespace) -> int:
         else:
             print(f"calibrated: WLS ratio {data['ratio']:.4g}, effective track multiplier {data['multiplier']:.4g}")
             for name, models in data["runs"].items():
-                print(f"{name}: " + ", ".join(f"{m} rms {v['rms']:.3g} m" for m, v in models.items()))
+                print(f"{name}: " + ", ".join(f"{m} rms {v['rms_position_error']:.3g} m" for m, v in models.items()))
         return 0
     from ..slip.study import forklift_study
 

@@ -65,7 +65,8 @@ class SlipCalibration:
                 "ratio": self.ratio,
                 "wheel_separation_multiplier": self.multiplier,
                 "rms_position_error": dict(self.rms),
-                "final_error": {n: {"position": p, "heading": h} for n, p, h in self.final}}
+                "final_position_error": {n: p for n, p, _ in self.final},
+                "final_heading_error": {n: h for n, _, h in self.final}}
 
     def format(self) -> str:
         """Human-readable summary."""

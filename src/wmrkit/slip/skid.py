@@ -71,7 +71,8 @@ def skid_comparison(robot: Robot, *, rate: float = 50.0, calibration=CALIBRATION
                     tests: Mapping[str, Sequence] | None = None, source: str = "md") -> dict:
     """Calibrate on `calibration` segments, evaluate on `tests`: JSON-ready results plus the paths.
 
-    Returns ``{"ratio", "multiplier", "runs": {name: {model: {"rms": m, "final": m}}}, "paths": {name: {label:
+    Returns ``{"ratio", "multiplier", "runs": {name: {model: {"rms_position_error": m,
+    "final_position_error": m}}}, "paths": {name: {label:
     poses}}}`` (``paths`` holds arrays, for plotting).
     """
     cal_log, cal_truth = segment_run(robot, calibration, rate, source)
@@ -87,7 +88,8 @@ def skid_comparison(robot: Robot, *, rate: float = 50.0, calibration=CALIBRATION
         for label, model in models.items():
             p = odometry(model, log).poses
             d = np.hypot(*(p[:, :2] - truth[:, :2]).T)
-            runs[name][label] = {"rms": float(np.sqrt(np.mean(d * d))), "final": float(d[-1])}
+            runs[name][label] = {"rms_position_error": float(np.sqrt(np.mean(d * d))),
+                                      "final_position_error": float(d[-1])}
             paths[name][label] = p
     return {"source": source, "ratio": cal.ratio, "multiplier": cal.multiplier, "runs": runs, "paths": paths}
 
