@@ -78,12 +78,32 @@ def test_examples_rank_the_models_as_the_thesis(study):
         assert j["WLS"] < 0.05  # every model within a few cm/s of the dynamics
 
 
+def _keys(x) -> set[str]:
+    if isinstance(x, dict):
+        return set(x).union(*(_keys(v) for v in x.values()))
+    return set().union(*(_keys(v) for v in x)) if isinstance(x, list) else set()
+
+
+def test_study_json_is_si_under_plain_names(study):
+    """The answer named its numbers with their units (settings' sample_period_s, steer_resolution_deg in degrees,
+    path_speed_m_s, ...; the sweep's max_residual_n, the runs' final_position_error_m and speed_m_s) and repeated
+    each example's J as J_percent: JSON answers are SI under plain names (docs/limits.md, JSON answers)."""
+    result, _ = study
+    found = _keys(result)
+    assert not [k for k in found if k.endswith(("_s", "_m", "_n", "_nm", "_m_s", "_deg", "_percent"))]
+    assert result["settings"]["steer_resolution"] == pytest.approx(math.radians(1.4118), rel=1e-12)
+    assert set(result["examples"][0]) == {"example", "J"}
+    runs = [r for r in result["paths"].values() if isinstance(r, dict) and "final_position_error" in r]
+    assert runs and all(1.8 <= r["speed"] <= 2.2 and r["final_position_error"].keys() == r["J_k"].keys()
+                        for r in runs)
+
+
 def test_study_output_and_figures(study):
     result, d = study
     assert set(result) >= {"examples", "paths", "sweep", "settings", "figures"}
     assert result["sweep"]["converged"] > 0.7 * result["sweep"]["points"]
     for run in result["paths"].values():
-        if isinstance(run, dict) and "speed_m_s" in run:  # the runs (not held_out)
+        if isinstance(run, dict) and "speed" in run:  # the runs (not held_out)
             assert set(run["J_k"]) == {"WLS", "WLS (thesis k)", "FK1", "FK2", "differential"}
             assert all(0 <= v < 0.2 for v in run["J_k"].values())
     assert all((d / p.rsplit("/", 1)[-1]).exists() for p in result["figures"])
@@ -109,7 +129,7 @@ def test_tuned_paths_rank_the_estimators_as_the_thesis(seed):
     held = result["held_out"]["J_k"]  # the tuned parameters on fresh runs (seed + 1): no tuning on the data judged
     assert result["held_out"]["seed"] == seed + 1 and result["ranking"]["held out"]["reproduced"]
     assert max(held["WLS"], held["FK2"]) < min(held["FK1"], held["differential"]) / 1.5
-    speeds = [run["speed_m_s"] for run in result["runs"].values()]
+    speeds = [run["speed"] for run in result["runs"].values()]
     assert len(speeds) == 5 and all(1.8 <= v <= 2.2 for v in speeds) and len(set(speeds)) == 5
 
 

@@ -29,14 +29,15 @@ from .weights import SlipWeights, wls_model
 
 DRIVES = ("right_drive.spin", "left_drive.spin")
 AXLE = (-1.0, 0.0)  # drive-axle mid-point in the catalog forklift's frame (origin at the fork tips)
-SETTINGS = {"sample_period_s": 0.05, "md_step_s": 1e-3, "encoder_counts_per_rev": 8290,
-            "steer_resolution_deg": 1.4118, "example_duration_s": 10.0, "example2_torque_nm": 30.0,
+#: SI units (s, rad, N m, m/s), as every JSON answer: ``slip-study forklift --json`` prints them under ``settings``.
+SETTINGS = {"sample_period": 0.05, "md_step": 1e-3, "encoder_counts_per_rev": 8290,
+            "steer_resolution": math.radians(1.4118), "example_duration": 10.0, "example2_torque": 30.0,
             "kalman_x0": "least squares of the first interval", "kalman_p0": "Q = k13^2 I, k13 = 1",
             "wls_thesis": (3.2e-3, 19.2), "fk1_thesis": (0.31, 1.09), "fk2_thesis": (0.28, 3.57, 0.28),
             # the five paths (section "Thesis 7.5 on the simulated forklift" of docs/slip.md gives the sources)
-            "path_speed_m_s": (1.8, 2.2), "drive": "differential", "traction_settling_s": 3.5,
-            "traction_overshoot": 0.15, "traction_control_period_s": 0.01, "traction_grip": 1.0,
-            "steer_settling_s": 1.5, "encoder_phase": "uniform random per run", "seed": 0,
+            "path_speed": (1.8, 2.2), "drive": "differential", "traction_settling_time": 3.5,
+            "traction_overshoot": 0.15, "traction_control_period": 0.01, "traction_grip": 1.0,
+            "steer_settling_time": 1.5, "encoder_phase": "uniform random per run", "seed": 0,
             "tuning_iterations": 80}
 DRIVE_MODES = ("differential", "servo")
 TUNED = ("WLS", "FK1", "FK2", "differential")  # the estimators of §7.5.4
@@ -64,7 +65,7 @@ def sweep(robot, quick: bool = False) -> dict:
     step = 1.0 if quick else 0.5
     u1, u2 = np.meshgrid(np.arange(0, 5 + 1e-9, step), np.arange(-5, 5 + 1e-9, step), indexing="ij")
     u1, u2 = u1.ravel(), u2.ravel()
-    res = math.radians(SETTINGS["steer_resolution_deg"])
+    res = SETTINGS["steer_resolution"]
     v, w = (u1 + u2) / 2, (u1 - u2) / (2 * 0.45)
     l3 = 1.35
     heading = np.where(v != 0, np.arctan(-l3 * w / np.where(v != 0, v, 1.0)), -np.sign(w) * np.pi / 2)
@@ -88,7 +89,7 @@ def sweep(robot, quick: bool = False) -> dict:
     fit = minimize(cost, [0.0, 0.0], method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-10})
     k11, k12 = (float(x) for x in 10.0 ** fit.x)
     return {"k11": k11, "k12": k12, "points": len(rates), "converged": int(ok.sum()),
-            "mean_abs_difference": float(fit.fun), "max_residual_n": float(np.max(ref.residual)),
+            "mean_abs_difference": float(fit.fun), "max_residual": float(np.max(ref.residual)),
             "_data": (rates, beta, ref, k11, k12)}
 
 
@@ -103,17 +104,17 @@ def example(robot, number: int, weights: SlipWeights) -> dict:
     model = DynamicModel.of(robot)
     twist0 = np.array([2.0, 0.3 * (0.0 - AXLE[0]), 0.3])  # v at the fork tips = v_axle + omega x (1, 0)
     heading = float(wheel_commands(robot, twist0).heading[robot.wheel_names.index("steer")])
-    duration = SETTINGS["example_duration_s"]
+    duration = SETTINGS["example_duration"]
     t = np.array([0.0, 1.0, 1.0 + 1e-6, duration])
     tau = np.zeros((4, model.n))
     if number == 2:
         for j in DRIVES:
-            tau[:2, model.names.index(j)] = SETTINGS["example2_torque_nm"]
+            tau[:2, model.names.index(j)] = SETTINGS["example2_torque"]
     kp, kd = steering_gains(model, [model.names.index("steer.steer")])
     inputs = Inputs(t, tau, np.zeros_like(tau), np.zeros(model.n), np.full(model.n, np.inf), np.full((4, 1), heading),
                     kp, kd)
-    sim = simulate(model, inputs, duration, step=SETTINGS["md_step_s"], initial_twist=twist0,
-                   record_step=SETTINGS["sample_period_s"])
+    sim = simulate(model, inputs, duration, step=SETTINGS["md_step"], initial_twist=twist0,
+                   record_step=SETTINGS["sample_period"])
     names = list(sim.joint_names)
     rates = sim.joint_rates[:, [names.index(j) for j in DRIVES]]
     beta = sim.joint_positions[:, [names.index("steer.steer")]]
@@ -123,7 +124,7 @@ def example(robot, number: int, weights: SlipWeights) -> dict:
               "MCD": at_axle(mcd(robot, DRIVES, rates, law, beta, loads=normal_loads(robot)).twist),
               "WLS": at_axle(wls(robot, DRIVES, rates, beta, weights).twist)}
     j = {m: j_model(twists["MD"], twists[m]) for m in ("MQE", "MCD", "WLS")}
-    return {"example": number, "J": j, "J_percent": {m: 100 * v for m, v in j.items()},
+    return {"example": number, "J": j,
             "_data": (sim.t, twists, sim.pose)}
 
 
@@ -132,7 +133,7 @@ def sensor_log(robot, sim, phase: tuple[float, float] = (0.0, 0.0)) -> JointLog:
     `phase` in counts, [0, 1) each), steering encoder (1.4118 deg, absolute, nearest), at the record step."""
     names = list(sim.joint_names)
     per_count = 2 * np.pi / SETTINGS["encoder_counts_per_rev"]
-    res = math.radians(SETTINGS["steer_resolution_deg"])
+    res = SETTINGS["steer_resolution"]
     offset = np.asarray(phase, dtype=float) * per_count
     spins = np.floor((sim.joint_positions[:, [names.index(j) for j in DRIVES]] + offset) / per_count) * per_count
     heading = robot.heading_of_beta(sim.joint_positions[:, [names.index("steer.steer")]])
@@ -154,20 +155,20 @@ def drive_path(robot, name: str, speed: float, drive: str = "differential"):
         raise WmrkitError(f"drive must be one of {', '.join(DRIVE_MODES)}, got '{drive}'")
     model = DynamicModel.of(robot)
     # the steering servo is critically damped (PD of natural frequency `bandwidth`): 2 % settling in 5.83 / wn
-    inputs, duration = path_program(model, name, speed=speed, bandwidth=5.83 / SETTINGS["steer_settling_s"])
-    step, record = SETTINGS["md_step_s"], SETTINGS["sample_period_s"]
+    inputs, duration = path_program(model, name, speed=speed, bandwidth=5.83 / SETTINGS["steer_settling_time"])
+    step, record = SETTINGS["md_step"], SETTINGS["sample_period"]
     if drive == "servo":
         return simulate(model, inputs, duration, step=step, record_step=record)
     contacts = [model.contacts.index(j.partition(".")[0]) for j in differential_joints(robot)]
     grip = SETTINGS["traction_grip"] * sum(model.normal_loads()[contacts]) * robot.wheel(DRIVES[0].split(".")[0]).r
-    loop = TractionLoop.tuned(carrier_inertia(model), SETTINGS["traction_settling_s"], SETTINGS["traction_overshoot"],
-                              grip, SETTINGS["traction_control_period_s"])
+    loop = TractionLoop.tuned(carrier_inertia(model), SETTINGS["traction_settling_time"],
+                              SETTINGS["traction_overshoot"], grip, SETTINGS["traction_control_period"])
     return simulate_differential(model, inputs, duration, loop, step=step, record_step=record)
 
 
 def paths(robot, k11: float, k12: float, quick: bool = False, *, seed: int = 0, drive: str = "differential",
           names: tuple[str, ...] | None = None) -> dict:
-    """The five experiment paths (speeds drawn in ``SETTINGS["path_speed_m_s"]`` from `seed`, encoder phases
+    """The five experiment paths (speeds drawn in ``SETTINGS["path_speed"]`` from `seed`, encoder phases
     too), simulated with the MD through `drive` (:func:`drive_path`), odometry by every estimator; J_k (7.80)
     against the simulated final pose (open-loop programs do not close exactly), with the thesis's parameters and
     tuned on these runs as the thesis did (``optimised``), and those tuned parameters on fresh runs of seed + 1
@@ -182,7 +183,7 @@ def paths(robot, k11: float, k12: float, quick: bool = False, *, seed: int = 0, 
         est = {k: f(log) for k, f in estimators.items()}
         jk = {k: float(sum(closure_error(p, sim.pose[-1])) / 2) for k, p in est.items()}
         final = {k: float(np.hypot(*(p[-1, :2] - sim.pose[-1, :2]))) for k, p in est.items()}
-        out[name] = {"J_k": jk, "final_position_error_m": final, "speed_m_s": speed}
+        out[name] = {"J_k": jk, "final_position_error": final, "speed": speed}
         data[name] = {"truth (MD)": np.asarray(sim.pose)}
     mean = {k: float(np.mean([v["J_k"][k] for v in out.values()])) for k in estimators}
     opt = optimise(robot, logs, 25 if quick else SETTINGS["tuning_iterations"])
@@ -203,7 +204,7 @@ def _runs(robot, names, seed: int, drive: str) -> dict:
     rng = np.random.default_rng(seed)
     out = {}
     for name in names:
-        speed, phase = float(rng.uniform(*SETTINGS["path_speed_m_s"])), tuple(rng.uniform(0.0, 1.0, 2))
+        speed, phase = float(rng.uniform(*SETTINGS["path_speed"])), tuple(rng.uniform(0.0, 1.0, 2))
         sim = drive_path(robot, name, speed, drive)
         out[name] = (speed, sim, sensor_log(robot, sim, phase))
     return out
@@ -283,7 +284,7 @@ def format_study(result: dict) -> str:
     lines = [f"sweep: {s['converged']}/{s['points']} MCD solves converged; k11 = {s['k11']:.4g}, "
              f"k12 = {s['k12']:.4g}, mean |MCD - WLS| = {s['mean_abs_difference']:.3g}"]
     for e in result["examples"]:
-        lines.append(f"example {e['example']}: " + ", ".join(f"J_{m} = {v:.3g} %" for m, v in e["J_percent"].items()))
+        lines.append(f"example {e['example']}: " + ", ".join(f"J_{m} = {100 * v:.3g} %" for m, v in e["J"].items()))
     for name, run in result["paths"].items():
         if isinstance(run, dict) and "J_k" in run:
             lines.append(f"{name}: " + ", ".join(f"{k} {100 * v:.3g} %" for k, v in run["J_k"].items()))

@@ -48,7 +48,7 @@ def save_study_figures(report, sw: dict, examples: list, pth: dict) -> list[str]
             ax.grid(True, alpha=0.3)
         axes[0].legend(fontsize="small", ncol=4)
         axes[-1].set_xlabel("t [s]")
-        j = e["J_percent"]
+        j = {m: 100 * v for m, v in e["J"].items()}
         fig.suptitle(f"example {e['example']}: J_MQE {j['MQE']:.3g} %, J_MCD {j['MCD']:.3g} %, J_WLS {j['WLS']:.3g} %"
                      " (drive-axle twist)")
         out.append(_save(fig, report, f"example-{e['example']}.png"))
