@@ -175,7 +175,7 @@ def test_a_reference_beyond_the_steering_range_is_reported_not_followed(period):
     run = track(car, builtin_reference("circle", size=1.0), period=period, duration=12)
     assert np.all(np.abs(run.heading) <= math.radians(40) + 1e-9)
     held = {v["wheel"]: v for v in run.range_violations()}
-    assert set(held) == {"front_left", "front_right"} and all(v["seconds"] > 5 for v in held.values())
+    assert set(held) == {"front_left", "front_right"} and all(v["duration"] > 5 for v in held.values())
     assert run.summary()["max_error"] > 0.3  # the circle is not followed
     assert run.to_dict()["beyond_steer_range"] == run.range_violations()
     wide = track(car, builtin_reference("circle", size=8.0), period=period, duration=12)  # within the range

@@ -193,7 +193,7 @@ def run_track(args: argparse.Namespace) -> int:
             warn(str(w.message))
     for v in run.range_violations():
         lo, hi = (math.degrees(a) for a in robot.wheel(v["wheel"]).steer_range)
-        warn(f"wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg for {v['seconds']:.3g} s "
+        warn(f"wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg for {v['duration']:.3g} s "
              f"(t = {v['from']:.4g} to {v['to']:.4g} s) and was held at its end: the robot cannot follow this "
              "reference there (its wheels scrub; the tracking errors are the result)")
     for c, ok in zip(robot.couplings, run.commands.in_gear.all(axis=0).tolist(), strict=True):

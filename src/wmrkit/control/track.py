@@ -79,8 +79,8 @@ class TrackingRun:
     feasibility: Feasibility | None = None
 
     def range_violations(self) -> list[dict[str, Any]]:
-        """Per steered wheel held at the end of its range: ``{"wheel", "from", "to", "seconds"}`` ([s]: first and
-        last sample, and the time spent beyond the range, counted in samples)."""
+        """Per steered wheel held at the end of its range: ``{"wheel", "from", "to", "duration"}`` ([s]: first
+        and last sample, and the time spent beyond the range, counted in samples)."""
         if self.beyond_range is None:
             return []
         return self._intervals(self.robot.steer_names, self.beyond_range)
@@ -101,7 +101,7 @@ class TrackingRun:
             if hit.any():
                 idx = np.flatnonzero(hit)
                 out.append({"wheel": name, "from": float(self.t[idx[0]]), "to": float(self.t[idx[-1]]),
-                            "seconds": float(dt[hit].sum())})
+                            "duration": float(dt[hit].sum())})
         return out
 
     def summary(self, settle: float = 0.0) -> dict[str, float]:
