@@ -7,6 +7,7 @@ robot, odometry's last pose was ``pose`` (simulate's ``final_pose``)."""
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 
@@ -16,6 +17,19 @@ from wmrkit.cli.main import build_parser, main
 
 #: The commands that answer in JSON.
 JSON_COMMANDS = sorted({cmd for cmd, a in options() if "--json" in a.option_strings})
+
+#: Key endings that name a unit other than SI's (or any unit: JSON answers are SI under plain names). Image
+#: quantities are in pixels (``focal_px``, as camera files write it: pixels have no SI unit).
+UNIT_SUFFIXES = ("_ms", "_us", "_ns", "_s", "_sec", "_min", "_hours", "_percent", "_pct", "_deg", "_degrees", "_mm",
+                 "_cm", "_km", "_m", "_kmh", "_mph", "_m_s", "_rpm", "_nm", "_n", "_kn", "_kg", "_g")
+#: Names a concept had besides its one name: the path driven (``path_length``), a command's wall time
+#: (``wall_time``), a final pose's errors (``final_position_error``, ``final_heading_error``).
+OTHER_NAMES = {"distance": "path_length", "seconds": "wall_time", "time_ms": "wall_time",
+               "final_error": "final_position_error"}
+#: Where each one name is expected.
+ONE_NAMES = {"path_length": {("odometry",), ("simulate",), ("park",), ("batch", "odometry")},
+             "wall_time": {("park",), ("sweep",), ("batch", "odometry")},
+             "final_position_error": {("calibrate",), ("slip-study",)}}
 
 #: A small successful (or 'no', exit 1) command line of each; {d}: a folder of files, from the repository's root.
 CASES: dict[tuple[str, ...], tuple[str, int]] = {
@@ -106,3 +120,41 @@ def test_a_json_answer_a_script_can_rely_on(command, files, capsys, monkeypatch)
     assert flat <= {"final_pose"}  # the last pose of a run has one name
     if command in {("odometry",), ("simulate",)}:
         assert flat == {"final_pose"}
+
+
+def keys(x) -> set[str]:
+    """Every key of a JSON value, nested dicts and lists walked (keys naming data, a batch's files, included)."""
+    if isinstance(x, dict):
+        return set(x).union(*(keys(v) for v in x.values()))
+    if isinstance(x, list):
+        return set().union(*(keys(v) for v in x))
+    return set()
+
+
+@pytest.mark.parametrize("command", sorted(CASES), ids=" ".join)
+def test_json_answers_are_si_under_one_name_per_concept(command, files, capsys, monkeypatch):
+    """No key ends in a unit (park's ``time_ms`` and ``length_ratio_percent`` did); the path driven is
+    ``path_length`` (odometry and simulate said ``distance``), a wall time ``wall_time`` (sweep and batch odometry
+    said ``seconds``, park ``time_ms`` [ms]), a final position error ``final_position_error`` (calibrate's
+    ``final_error`` was a {position, heading} object per model, track's summary a number)."""
+    from doc_examples import ROOT
+
+    monkeypatch.chdir(ROOT)
+    line, code = CASES[command]
+    assert main([*line.format(d=files).split(), "--json"]) == code
+    found = keys(json.loads(capsys.readouterr().out))
+    if command == ("track",):  # the summary of the tracking error: rms_error, max_error, final_error [m]
+        found -= {"final_error"}
+    assert not [k for k in found if k.lower().endswith(UNIT_SUFFIXES)]
+    assert not found & OTHER_NAMES.keys()
+    assert {name for name, where in ONE_NAMES.items() if command in where} <= found
+
+
+def test_the_forklift_study_settings_are_si_under_plain_names():
+    """``slip-study forklift --json`` prints ``settings`` (and its runs' speeds and errors): they were named with
+    their units (``sample_period_s``, ``steer_resolution_deg`` in degrees, ``path_speed_m_s``, ...) and the examples
+    repeated J as ``J_percent``."""
+    from wmrkit.slip.study import SETTINGS
+
+    assert not [k for k in keys(SETTINGS) if k.lower().endswith(UNIT_SUFFIXES)]
+    assert SETTINGS["steer_resolution"] == pytest.approx(math.radians(1.4118))
