@@ -404,3 +404,26 @@ def test_a_sampled_reference_coming_to_rest_on_a_curve_has_no_jump_at_its_end():
         robot = catalog.load(name)
         assert feasibility(robot, exact).feasible
         assert feasibility(robot, sampled).violations == ()
+
+
+@pytest.mark.parametrize("name", ["mecanum-4", "line-follower"])
+def test_each_framework_gives_its_own_reason_for_a_jump_of_type_1_and_type_2_off_axle(name):
+    """Type 1 and type 2 off the axle: the dynamic framework forbids a velocity (and type 1 a heading-rate) step
+    because the wheels' rates would jump, not because of the kinematics (which lets them jump: the kinematic
+    framework follows the same steps). The remedy said '(kinematics allows no jump here)' in both frameworks."""
+    t = np.arange(0.0, 10.0, 0.01)
+    x = np.where(t < 5, 0.5 * t, 2.5 + (t - 5))
+    theta = np.where(t < 5, 0.0, 0.2 * (t - 5))  # the heading rate steps from 0 to 0.2 rad/s
+    robot = catalog.load(name)
+    ref = reference_from_samples("steps.csv", t, np.column_stack([x, 0 * t, theta]))
+    assert feasibility(robot, ref, "kinematic").feasible
+    got = feasibility(robot, ref, "dynamic").violations
+    assert {v.signal for v in got} == ({"velocity", "omega"} if name == "mecanum-4" else {"velocity"})
+    for v in got:
+        assert "kinematics" not in v.remedy and "dynamic framework" in v.remedy and "rates would jump" in v.remedy
+        assert v.remedy.endswith("an error appears that the position loop then removes")
+    # a heading jump of type 1 in the kinematic framework: the pose is the twist's integral, it cannot jump
+    jump = reference_from_samples("turn.csv", t, np.column_stack([0.5 * t, 0 * t, np.where(t < 5, 0.0, 1.0)]))
+    if name == "mecanum-4":
+        (v,) = feasibility(robot, jump, "kinematic").violations
+        assert v.signal == "theta" and "kinematics allows no jump" in v.remedy

@@ -164,7 +164,8 @@ def test_a_run_past_the_reference_s_end_judges_the_stop_there(tmp_path, capsys):
     assert _warned(capsys.readouterr().err) == [
         f"{WARNING}'type 2, off axle' for the tracked point, dynamic framework): velocity jump (p_ref not C1) at "
         "t = 1 s (the reference's end: the run went on past it, where the reference stops, holding its last pose): "
-        "an error appears that the position loop then removes (kinematics allows no jump here)"]
+        "the velocity steps (the wheels' rates would jump, which the dynamic framework forbids): an error appears "
+        "that the position loop then removes"]
     assert main(["track", robot, "--reference", line, "--dynamics", "--duration", "1.5", "--json"]) == 0
     verdict = json.loads(capsys.readouterr().out)["feasibility"]
     assert [(v["t"], v["signal"], v["size"]) for v in verdict["violations"]] == [(1.0, "velocity", pytest.approx(0.1))]

@@ -366,6 +366,9 @@ def _remedy(req: Requirement, signal: str) -> str:
     if req.column == "type 4, on axle" and signal == "kappa":
         return _WHEEL
     if req.column.startswith("type 1") or req.column.startswith("type 2, off"):
+        if req.framework == "dynamic":  # velocity or heading rate: the pose stays continuous, the rates would not
+            return (f"the {'heading rate' if signal == 'omega' else 'velocity'} steps (the wheels' rates would jump, "
+                    "which the dynamic framework forbids): an error appears that the position loop then removes")
         return "an error appears that the position loop then removes (kinematics allows no jump here)"
     if signal == "velocity" and req.framework == "dynamic" and "l_o != 0" not in req.column:
         return "the speed steps (the wheels' rates would jump): an error appears that the position loop then removes"
