@@ -72,7 +72,8 @@ def test_feasibility_judges_the_point_given_as_track_judges_the_point_it_tracks(
     tracked = track(bicycle, arc_line).feasibility
     x, y = control_point(bicycle).point
     assert main(["feasibility", "bicycle", "--reference", "arc-line", "--point", str(x), str(y), "--json"]) == 0
-    assert json.loads(capsys.readouterr().out) == {"robot": "bicycle", **tracked.to_dict(), "warnings": []}
+    assert json.loads(capsys.readouterr().out) == {"robot": "bicycle", "reference_name": "arc-line",
+                                                   "reference_size": 1.5, **tracked.to_dict(), "warnings": []}
     assert main(["feasibility", "bicycle", "--reference", "arc-line", "--point", "0", "0"]) == 1  # R, as before
     assert "kappa not C0" in capsys.readouterr().out
     assert main(["feasibility", "bicycle", "--reference", "arc-line", "--point", "1e300", "0"]) == 2
@@ -217,8 +218,8 @@ def test_the_default_circle_of_track_is_one_the_robot_can_drive(capsys):
     the 3 m circle, and an explicit --size is kept as given."""
     assert main(["track", "ackermann", "--reference", "circle"]) == 0
     out, err = capsys.readouterr()
-    assert err == "" and "reference circle of radius 6 m (at least 1.5 times the robot's minimum turning radius, " \
-                         "3.993 m)" in out
+    assert err == "" and "reference circle of radius 6 m (its tightest turn at least 1.5 times the robot's minimum " \
+                         "turning radius, 3.993 m)" in out
     assert float(out.split("tracking error [m]: rms ")[1].split(",")[0]) < 1e-6
     assert main(["track", "ackermann", "--reference", "circle", "--duration", "2", "--json"]) == 0
     assert _radius(capsys) == pytest.approx(6.0, rel=1e-6)
@@ -227,3 +228,39 @@ def test_the_default_circle_of_track_is_one_the_robot_can_drive(capsys):
     assert main(["track", "ackermann", "--reference", "circle", "--size", "3", "--duration", "8", "--json"]) == 0
     out = capsys.readouterr().out
     assert "front_left" in {v["wheel"] for v in json.loads(out)["beyond_steer_range"]}
+
+
+def _tightest_turn(reference) -> float:
+    """The smallest radius of curvature [m] of a reference's path, from second differences of its positions."""
+    xy = reference.pose[:, :2]
+    d1, d2 = np.gradient(xy, axis=0), np.gradient(np.gradient(xy, axis=0), axis=0)
+    cross = np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])[2:-2]
+    return float(np.min(np.hypot(*d1[2:-2].T) ** 3 / np.maximum(cross, 1e-300)))
+
+
+@pytest.mark.parametrize("name", ["circle"])
+def test_feasibility_judges_the_reference_track_drives(name, capsys):
+    """One rule sizes a built-in reference for a robot in both commands: 'wmrkit feasibility ackermann --reference
+    circle' judged the 3 m circle while 'wmrkit track' drove a 6 m one. Now the shape's tightest turn, measured on the
+    reference itself, is at least 1.5 times the car's minimum turning radius (3.993 m) in both, and both answers name
+    the same reference and size; a robot that turns on the spot keeps the built-in size."""
+    from wmrkit.cli.control import min_turning_radius
+    from wmrkit.control.references import BUILTIN
+
+    answers = {}
+    for robot in ("ackermann", "diff-drive"):
+        main(["feasibility", robot, "--reference", name, "--json"])
+        verdict = json.loads(capsys.readouterr().out)
+        assert main(["track", robot, "--reference", name, "--duration", "1", "--json"]) == 0
+        run = json.loads(capsys.readouterr().out)
+        assert (verdict["reference_name"], verdict["reference_size"]) == (run["reference_name"], run["reference_size"])
+        answers[robot] = run["reference_size"]
+    assert answers["diff-drive"] == BUILTIN[name][2]
+    size = answers["ackermann"]
+    assert size == {"circle": 6, "figure-eight": 29, "arc-line": 6}[name]
+    turning = min_turning_radius(catalog.load("ackermann"))
+    assert turning == pytest.approx(3.993, abs=1e-3)
+    assert 1.5 * turning <= _tightest_turn(builtin_reference(name, size=size, dt=0.005)) < 1.5 * turning + 1.0
+    main(["feasibility", "ackermann", "--reference", name])
+    assert f"reference {name} of {'half width' if name == 'figure-eight' else 'radius'} {size:g} m (its tightest " \
+        "turn" in capsys.readouterr().out

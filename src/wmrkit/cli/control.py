@@ -14,6 +14,7 @@ from ._common import add_json_flag, add_robot_argument, check_plot_path, load_ro
 
 if TYPE_CHECKING:
     from ..control.feasibility import Feasibility
+    from ..control.references import Reference
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -81,21 +82,32 @@ def _reference_options(p: argparse.ArgumentParser) -> None:
                                                "corner leg (3); a line has none")
 
 
-#: ``track``'s default circle for a robot with a minimum turning radius (a car's steering stops): its radius is at
-#: least this many times that radius (rounded up to a metre), so the default run is one the robot can drive.
-CIRCLE_MARGIN = 1.5
+#: What the size of each built-in reference measures (``--size``).
+SIZE_WORDS = {"circle": "radius", "figure-eight": "half width", "square": "side", "arc-line": "radius",
+              "corner": "leg"}
 
 
-def _reference(args: argparse.Namespace, robot=None):
-    """The ``--reference`` (with ``--speed``, ``--size``); for `robot`'s ``track``, a circle without ``--size`` is
-    the built-in 3 m one, or :data:`CIRCLE_MARGIN` times the robot's minimum turning radius when that is larger."""
-    from ..control.references import BUILTIN, resolve_reference
+def _reference(args: argparse.Namespace, robot) -> tuple[Reference, float | None, str]:
+    """`robot`'s ``--reference`` (with ``--speed``, ``--size``), the same for ``track`` and ``feasibility``: without
+    ``--size``, a built-in shape whose turns tighten with its size is one the robot can drive
+    (:func:`wmrkit.control.references.default_size` at :func:`min_turning_radius`). Returns the reference, its size
+    [m] (None: a file, or the line) and the words naming it (``circle of radius 6 m (...)``)."""
+    from ..control.references import BUILTIN, TIGHTEST_TURN, TURN_MARGIN, default_size, resolve_reference
 
     speed = None if args.speed is None else _positive(args.speed, "--speed", "number")
     size = None if args.size is None else _positive(args.size, "--size", "length")
-    if size is None and robot is not None and args.reference == "circle":
-        size = max(BUILTIN["circle"][2], math.ceil(CIRCLE_MARGIN * min_turning_radius(robot)))
-    return resolve_reference(args.reference, speed=speed, size=size)
+    name = args.reference
+    if size is None and name in BUILTIN and name != "line":
+        size = default_size(name, min_turning_radius(robot))
+    reference = resolve_reference(name, speed=speed, size=size)
+    if size is None:
+        return reference, None, reference.name
+    words = f"{name} of {SIZE_WORDS[name]} {size:g} m"
+    if args.size is None and size > BUILTIN[name][2]:
+        tightest = "" if TIGHTEST_TURN[name] == 1 else f", of radius {TIGHTEST_TURN[name] * size:.4g} m,"
+        words += (f" (its tightest turn{tightest} at least {TURN_MARGIN:g} times the robot's minimum turning radius, "
+                  f"{min_turning_radius(robot):.4g} m)")
+    return reference, size, words
 
 
 def min_turning_radius(robot) -> float:
@@ -153,7 +165,7 @@ def run_track(args: argparse.Namespace) -> int:
     check_plot_path(args.plot)
     check_animation_path(args.animate)
     robot = load_robot(args.robot)
-    reference = _reference(args, robot)
+    reference, size, described = _reference(args, robot)
     start = None
     if args.start:
         start = [parse_value(args.start[0], "length", "--from X"), parse_value(args.start[1], "length", "--from Y"),
@@ -216,13 +228,10 @@ def run_track(args: argparse.Namespace) -> int:
         if args.animate:
             animate_run(run, args.animate)
     if args.json:
-        print_json(run.to_dict(), warnings=True)
+        print_json({**run.to_dict(), "reference_name": reference.name, "reference_size": size}, warnings=True)
     else:
         s = run.summary()
-        raised = args.reference == "circle" and args.size is None and min_turning_radius(robot) > 0
-        circle = (f" of radius {reference.pose[:, 1].max() / 2:.4g} m (at least {CIRCLE_MARGIN:g} times the robot's "
-                  f"minimum turning radius, {min_turning_radius(robot):.4g} m)" if raised else "")
-        print(f"robot {robot.name}, reference {reference.name}{circle}, controller {args.controller}, "
+        print(f"robot {robot.name}, reference {described}, controller {args.controller}, "
               f"{'continuous' if run.period is None else f'period {run.period:g} s, delay {args.delay}'}"
               f"{', through the dynamics' if args.dynamics else ''}"
               f"{f', {args.slip_model.upper()} commands' if args.slip_model != 'none' else ''}"
@@ -262,7 +271,8 @@ def run_feasibility(args: argparse.Namespace) -> int:
     from ..control.feasibility import feasibility
 
     check_plot_path(args.plot)
-    robot, reference = load_robot(args.robot), _reference(args)
+    robot = load_robot(args.robot)
+    reference, size, described = _reference(args, robot)
     point = None if args.point is None else (parse_value(args.point[0], "length", "--point X"),
                                               parse_value(args.point[1], "length", "--point Y"))
     result = feasibility(robot, reference, args.framework, point=point)
@@ -275,11 +285,13 @@ def run_feasibility(args: argparse.Namespace) -> int:
 
         plot_feasibility(result, reference, args.plot)
     if args.json:
-        print_json({"robot": robot.name, **result.to_dict()}, warnings=True)
+        print_json({"robot": robot.name, "reference_name": reference.name, "reference_size": size,
+                    **result.to_dict()}, warnings=True)
         return 0 if result.feasible else 1  # an answer that is no (docs/limits.md, Exit codes)
     r = result.requirement
     print(f"robot {robot.name}: Table 8.1 column '{r.column}', {r.references} pose references; "
           f"{r.framework} framework needs continuous: {', '.join(r.signals)}")
+    print(f"reference {described}")
     print("feasible: yes" if result.feasible else f"feasible: NO ({len(result.violations)} violation(s))")
     for v in result.violations:
         print(f"  t = {v.t:8.3f} s  {v.kind}, jump {v.size:.3g}: {v.remedy}")

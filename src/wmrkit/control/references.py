@@ -21,8 +21,8 @@ from ..errors import UnknownNameError, WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_table_size
 from ..units import BARE_ANGLE_LIMIT
 
-__all__ = ["BUILTIN", "Reference", "ReferenceError", "builtin_reference", "load_reference", "reference_from_samples",
-           "resolve_reference"]
+__all__ = ["BUILTIN", "TIGHTEST_TURN", "TURN_MARGIN", "Reference", "ReferenceError", "builtin_reference",
+           "default_size", "load_reference", "reference_from_samples", "resolve_reference"]
 
 
 class ReferenceError(WmrkitError, ValueError):
@@ -248,6 +248,26 @@ BUILTIN = {
     "arc-line": (_arc_line, 0.5, 1.5, lambda v, size: math.pi * size / v + 10.0),
     "corner": (_corner, 0.5, 3.0, lambda v, size: 2 * size / v),
 }
+
+#: The tightest turn of each built-in shape whose curvature scales with its size: its smallest radius of curvature
+#: per metre of size (the circle's is its radius).
+TIGHTEST_TURN = {"circle": 1.0}
+#: A robot's default size of such a shape makes its tightest turn at least this many times the robot's minimum
+#: turning radius (a car's steering stops), rounded up to a metre.
+TURN_MARGIN = 1.5
+
+
+def default_size(name: str, turning_radius: float = 0.0) -> float | None:
+    """The default size [m] of built-in reference `name` (None for ``line``, which has none) for a robot that turns
+    on `turning_radius` [m] at least (0: on the spot): the shape's own (:data:`BUILTIN`), or, for a shape of
+    :data:`TIGHTEST_TURN`, the smallest whole metre whose tightest turn is :data:`TURN_MARGIN` times
+    `turning_radius` when that is larger, so that the robot can drive it."""
+    if name == "line":
+        return None
+    size = BUILTIN[name][2]
+    if name in TIGHTEST_TURN and turning_radius > 0:
+        size = max(size, math.ceil(TURN_MARGIN * turning_radius / TIGHTEST_TURN[name]))
+    return size
 
 
 def builtin_reference(name: str, *, speed: float | None = None, size: float | None = None,
