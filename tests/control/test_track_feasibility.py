@@ -238,12 +238,13 @@ def _tightest_turn(reference) -> float:
     return float(np.min(np.hypot(*d1[2:-2].T) ** 3 / np.maximum(cross, 1e-300)))
 
 
-@pytest.mark.parametrize("name", ["circle"])
+@pytest.mark.parametrize("name", ["circle", "arc-line"])
 def test_feasibility_judges_the_reference_track_drives(name, capsys):
     """One rule sizes a built-in reference for a robot in both commands: 'wmrkit feasibility ackermann --reference
-    circle' judged the 3 m circle while 'wmrkit track' drove a 6 m one. Now the shape's tightest turn, measured on the
-    reference itself, is at least 1.5 times the car's minimum turning radius (3.993 m) in both, and both answers name
-    the same reference and size; a robot that turns on the spot keeps the built-in size."""
+    circle' judged the 3 m circle while 'wmrkit track' drove a 6 m one; the arc-line (1.5 m) kept the car's front
+    wheels at their steering stops. Now each shape's tightest turn, measured on the reference itself, is at least 1.5
+    times the car's minimum turning radius (3.993 m), and both answers name the same reference and size; a robot
+    that turns on the spot keeps the built-in size."""
     from wmrkit.cli.control import min_turning_radius
     from wmrkit.control.references import BUILTIN
 
@@ -257,10 +258,19 @@ def test_feasibility_judges_the_reference_track_drives(name, capsys):
         answers[robot] = run["reference_size"]
     assert answers["diff-drive"] == BUILTIN[name][2]
     size = answers["ackermann"]
-    assert size == {"circle": 6, "figure-eight": 29, "arc-line": 6}[name]
+    assert size == 6
     turning = min_turning_radius(catalog.load("ackermann"))
     assert turning == pytest.approx(3.993, abs=1e-3)
     assert 1.5 * turning <= _tightest_turn(builtin_reference(name, size=size, dt=0.005)) < 1.5 * turning + 1.0
     main(["feasibility", "ackermann", "--reference", name])
-    assert f"reference {name} of {'half width' if name == 'figure-eight' else 'radius'} {size:g} m (its tightest " \
+    assert f"reference {name} of radius {size:g} m (its tightest " \
         "turn" in capsys.readouterr().out
+
+
+def test_the_car_s_default_arc_line_keeps_its_wheels_off_their_stops(capsys):
+    """Through the 6 m arc's half turn: before, the 1.5 m arc-line held both front wheels at their stops from the
+    start."""
+    assert main(["track", "ackermann", "--reference", "arc-line", "--duration", "20", "--json"]) == 0
+    run = json.loads(capsys.readouterr().out)
+    assert run["beyond_steer_range"] == [] and run["warnings"] == []
+    assert run["summary"]["max_error"] < 1e-6
