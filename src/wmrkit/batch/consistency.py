@@ -140,7 +140,6 @@ def run_consistency(jac: np.ndarray, res: np.ndarray, sizes: Sequence[int], floo
     return Consistency(judged, True, message)
 
 
-
 #: Largest closed-path score of a fleet whose runs agree (:func:`judge`). Simulated fleets of 6 closed squares
 #: (diff-drive, sides 1-2.5 m, both ways, encoder noise 1e-6 to 1e-4 per rad): at most 6.6 over 600 runs of one
 #: noise level a fleet, 11.6 over 360 runs of mixed levels (fleets of 8: 5.3 and 11.4 over 320 runs each); a run of a
@@ -170,9 +169,8 @@ def _score(err: np.ndarray, k: int, rest: np.ndarray, floors: np.ndarray, n: int
 
 def _quadratic_scores(jac, res, hess, floors) -> tuple[np.ndarray, np.ndarray]:
     """Each run's score against the others refitted on the runs' quadratic models (no odometry), and that fit's
-    shift from the fleet fit; the score is NaN where the
-    others do not determine the parameters (their Jacobian's weakest singular value under :data:`RANK_TOL` of the
-    largest: e.g. equal squares all driven one way)."""
+    shift from the fleet fit; the score is NaN where the others do not determine the parameters (their Jacobian's
+    weakest singular value under :data:`RANK_TOL` of the largest: e.g. equal squares all driven one way)."""
     from scipy.optimize import least_squares
 
     g, _, n = jac.shape

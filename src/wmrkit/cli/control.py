@@ -97,8 +97,9 @@ def _reference(args: argparse.Namespace, robot) -> tuple[Reference, float | None
     speed = None if args.speed is None else _positive(args.speed, "--speed", "number")
     size = None if args.size is None else _positive(args.size, "--size", "length")
     name = args.reference
+    turning = min_turning_radius(robot)
     if size is None and name in BUILTIN and name != "line":
-        size = default_size(name, min_turning_radius(robot))
+        size = default_size(name, turning)
     reference = resolve_reference(name, speed=speed, size=size)
     if size is None:
         return reference, None, reference.name
@@ -106,7 +107,7 @@ def _reference(args: argparse.Namespace, robot) -> tuple[Reference, float | None
     if args.size is None and size > BUILTIN[name][2]:
         tightest = "" if TIGHTEST_TURN[name] == 1 else f", of radius {TIGHTEST_TURN[name] * size:.4g} m,"
         words += (f" (its tightest turn{tightest} at least {TURN_MARGIN:g} times the robot's minimum turning radius, "
-                  f"{min_turning_radius(robot):.4g} m)")
+                  f"{turning:.4g} m)")
     return reference, size, words
 
 
@@ -244,8 +245,12 @@ def run_track(args: argparse.Namespace) -> int:
 def verdict_line(verdict: Feasibility, point: str = "the tracked point") -> str:
     """One line: Table 8.1's column for `point`, the framework, and whether the reference can be followed."""
     r = verdict.requirement
-    return (f"Table 8.1 (column '{r.column}' for {point}, {r.framework} framework): feasible: "
-            f"{'yes' if verdict.feasible else f'NO ({len(verdict.violations)} violation(s))'}")
+    return f"Table 8.1 (column '{r.column}' for {point}, {r.framework} framework): {_feasible(verdict)}"
+
+
+def _feasible(verdict: Feasibility) -> str:
+    """``feasible: yes`` or ``feasible: NO (n violation(s))``."""
+    return "feasible: yes" if verdict.feasible else f"feasible: NO ({len(verdict.violations)} violation(s))"
 
 
 def warn_infeasible(verdict: Feasibility | None, end: float | None = None) -> None:
@@ -292,7 +297,7 @@ def run_feasibility(args: argparse.Namespace) -> int:
     print(f"robot {robot.name}: Table 8.1 column '{r.column}', {r.references} pose references; "
           f"{r.framework} framework needs continuous: {', '.join(r.signals)}")
     print(f"reference {described}")
-    print("feasible: yes" if result.feasible else f"feasible: NO ({len(result.violations)} violation(s))")
+    print(_feasible(result))
     for v in result.violations:
         print(f"  t = {v.t:8.3f} s  {v.kind}, jump {v.size:.3g}: {v.remedy}")
     return 0 if result.feasible else 1
