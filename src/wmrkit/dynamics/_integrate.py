@@ -161,18 +161,12 @@ def derivative(t, s, acc, pack, inp, w):
 
 
 @_inline
-def step_semi_implicit(t, s, dt, acc, pack, inp, w, jac):
-    """One linearly implicit Euler step: friction and servo Jacobians implicit, then positions with the new velocity.
-
-    The tyre Jacobian ``dF/dv_slip`` is refreshed when `jac` is true and reused otherwise (a W-method).
-    """
-    assemble(t, s, acc, pack, inp, jac, w)
-    _update_semi_implicit(s, dt, acc, w, pack)
-
-
-@_inline
 def _update_semi_implicit(s, dt, acc, w, pack):
-    """The update of :func:`step_semi_implicit` from the assembled work arrays `w`."""
+    """One linearly implicit Euler step from the assembled work arrays `w` (:func:`assemble`): friction and servo
+    Jacobians implicit, then positions with the new velocity.
+
+    The tyre Jacobian ``dF/dv_slip`` is refreshed when the assembly was asked for it and reused otherwise (a W-method).
+    """
     a, m, g, kdiag, rhs, mat = w[0], w[1], w[5], w[8], w[9], w[14]
     n = rhs.shape[0]
     for i in range(n):
@@ -251,7 +245,7 @@ def observe(t, s, acc, pack, inp, w, rec, i):
 
 @functools.partial(_njit, nrt=False)
 def run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0):
-    """`n_steps` semi-implicit steps (:func:`step_semi_implicit`) from `s` (changed in place) at step `k0`
+    """`n_steps` semi-implicit steps (:func:`_update_semi_implicit`) from `s` (changed in place) at step `k0`
     (``t = k0 dt``), refreshing the tyre Jacobian at the steps ``k = jac_phase (mod jac_every)``; a record every
     `every` steps from row `i0`; returns the next row. Compiled without reference counting (it allocates nothing).
     """
