@@ -1,5 +1,6 @@
 """Shared by the batch tests and importable by the cluster's workers (the cluster fixture puts this folder on
-their PYTHONPATH): calibration parameters with their true values, and a task that kills its worker once."""
+their PYTHONPATH): calibration parameters with their true values, a task that kills its worker once and one
+that raises."""
 
 import os
 
@@ -43,3 +44,8 @@ def closed_fleet(diff, seed, odd=None, runs=6, noise=1e-5):
                                                         seed=int(rng.integers(1 << 30))).log)
                     for k, r in enumerate(robots)]
 
+
+
+def refit_fails(args):
+    """In place of batch.calibrate._refit_without: the refit of a closed fleet's other runs raises (an error)."""
+    raise RuntimeError("injected refit failure")

@@ -138,3 +138,23 @@ def test_closed_path_fleet_judged_identically(engines, diff):
     for name, runner in engines.items():
         c = fleet_calibrate(diff, runs, params, runner=runner)
         assert c.residual_ratios == c0.residual_ratios and c.warnings == c0.warnings, name
+
+
+def test_a_failed_refit_leaves_the_calibration_not_judged(engines, diff, monkeypatch):
+    """The closed-path judge's one refit raises (on the cluster and serially): the whole calibration failed as 'task 0
+    failed' with the fit lost. Now the fit is returned, the same, and the runs are not judged: one reason naming the
+    run left out and the error."""
+    from batch_params import closed_fleet, refit_fails
+
+    from wmrkit.batch import calibrate
+
+    params, runs = closed_fleet(diff, 1, [0.06, 0.03])
+    c0 = fleet_calibrate(diff, runs, params)
+    monkeypatch.setattr(calibrate, "_refit_without", refit_fails)
+    for name, runner in {"serial": None, **engines}.items():
+        c = fleet_calibrate(diff, runs, params, runner=runner)
+        assert c.estimate == c0.estimate and c.interval == c0.interval, name
+        assert c.inconsistent is None and c.residual_ratios == (None,) * 6, name
+        assert c.not_judged.startswith("run 1 (<synthetic>): the fit of the other runs without it failed "
+                                       "(RuntimeError: injected refit failure)"), c.not_judged
+        assert c.to_dict()["not_judged"] == c.not_judged and not [w for w in c.warnings if "disagrees" in w]

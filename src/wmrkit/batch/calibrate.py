@@ -60,7 +60,7 @@ class FleetCalibration:
     (``None`` with fewer than 4 runs), for a fleet of closed paths over the other runs' RMS there (their closed-path
     score) and ``inconsistent``: the largest over :data:`~wmrkit.batch.consistency.MAX_RATIO` (closed paths:
     :data:`~wmrkit.batch.consistency.MAX_CLOSED_SCORE`; :mod:`wmrkit.batch.consistency`; ``None`` when not judged,
-    and ``not_judged`` says why: fewer than 4 runs, or fewer than 6 closed paths)."""
+    and ``not_judged`` says why: fewer than 4 runs, fewer than 6 closed paths, or a failed closed-path refit)."""
 
     robot: Robot
     parameters: tuple[tuple[str, ...], ...]
@@ -218,7 +218,8 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
                 notes += (f"bootstrap: {dropped} of {n_boot} replicates dropped, their resampled runs cannot tell "
                           "the parameters apart (the interval is over the others)",)
             lo, hi = np.quantile(kept, 0.5 - level / 2, axis=0), np.quantile(kept, 0.5 + level / 2, axis=0)
-        judged = judge(problem, fit, jacobian, lambda tasks: runner.map(_refit_without, tasks))
+        judged = judge(problem, fit, jacobian,  # a failed refit leaves the runs not judged, the fit stands
+                       lambda tasks: runner.map(_refit_without, tasks, errors="return"))
     finally:
         if own:
             runner.close()

@@ -31,6 +31,7 @@ import numpy as np
 
 from ..odometry.calibration import RANK_TOL, CalibrationProblem, CalibrationRun
 from ..robot import Robot
+from .engine import TaskFailure
 
 #: Largest residual ratio of a fleet whose runs agree. Simulated homogeneous fleets with encoder noise (1e-5 per
 #: rad): largest ratio up to 25.1 in 300 fleets of 8 runs (2 over 20), 21.4 in 80 of 16 runs, 26.2 in 150 of 4 runs
@@ -151,6 +152,10 @@ MAX_CLOSED_SCORE = 20.0
 MIN_CLOSED_RUNS = 6
 #: Runs refitted without (the one whose removal moves the quadratic model's fit the most).
 REFITS = 1
+#: Why a closed fleet is not judged when that refit fails (a worker's error, residuals not finite): the fleet fit is
+#: returned all the same ({run}: the run left out; {why}: the error).
+REFIT_FAILED = ("{run}: the fit of the other runs without it failed ({why}): the closed runs are not checked against "
+                "each other, a run of another robot is averaged in unseen (the fleet fit stands)")
 #: Step [parameter units] of the forward difference of the fleet fit's Jacobian that gives each run's curvature.
 CURVATURE_STEP = 1e-3
 
@@ -199,8 +204,9 @@ def judge(problem: CalibrationProblem, fit, jacobian: Callable, refit: Callable)
     along each parameter, no new odometry. That model is good for runs that agree, but an odd run pulls the fleet
     fit far from the others' (a track 10 % off) and its score there came out 25 where the others' refit gave 301
     (first order: 20 against 96). So the run whose removal moves that fit the most is refitted without, from there,
-    by `refit` (``[(problem, x0)] -> [(x, residuals of the problem's runs)]``, the engine's map; the problem's last
-    run is the one left out), and its score is the refit's: in fleets of 6 squares the odd run's equalled a refit of
+    by `refit` (``[(problem, x0)] -> [(x, residuals of the problem's runs) or a TaskFailure]``, the engine's map;
+    the problem's last run is the one left out; a failure leaves the fleet not judged, :data:`REFIT_FAILED`), and its
+    score is the refit's: in fleets of 6 squares the odd run's equalled a refit of
     every run. Over :data:`MAX_CLOSED_SCORE` the run of largest score is named; with fewer than
     :data:`MIN_CLOSED_RUNS` closed runs the fleet is not judged (:data:`CLOSED`)."""
     robot, runs, sizes = problem.robot, problem.runs, problem.sizes()
@@ -220,8 +226,12 @@ def judge(problem: CalibrationProblem, fit, jacobian: Callable, refit: Callable)
     if np.isnan(scores).any():  # a run without which the others cannot fit: not judged
         return judged
     again = [int(k) for k in np.argsort(np.linalg.norm(shift, axis=1))[::-1][:REFITS]]
-    for k, (_, err) in zip(again, refit([(problem.with_runs(runs[:k] + runs[k + 1:] + runs[k:k + 1]),
-                                          fit.x + shift[k]) for k in again]), strict=True):
+    for k, done in zip(again, refit([(problem.with_runs(runs[:k] + runs[k + 1:] + runs[k:k + 1]),
+                                      fit.x + shift[k]) for k in again]), strict=True):
+        err = None if isinstance(done, TaskFailure) else np.asarray(done[1], dtype=float)
+        if err is None or not np.isfinite(err).all():  # the fit stands; only the judging is lost
+            why = done if err is None else "its residuals are not finite"
+            return Consistency((None,) * g, None, not_judged=REFIT_FAILED.format(run=logs[k], why=why))
         order = np.r_[0:k, g - 1, k:g - 1]  # run k was put last
         scores[k] = _score(err.reshape(g, -1)[order] * w[:, None], k, np.delete(np.arange(g), k), floors, n)
     worst = int(np.argmax(scores))
