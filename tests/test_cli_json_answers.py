@@ -29,7 +29,10 @@ OTHER_NAMES = {"distance": "path_length", "seconds": "wall_time", "time_ms": "wa
 #: Where each one name is expected.
 ONE_NAMES = {"path_length": {("odometry",), ("simulate",), ("park",), ("batch", "odometry")},
              "wall_time": {("park",), ("sweep",), ("batch", "odometry")},
-             "final_position_error": {("calibrate",), ("slip-study",)}}
+             "final_position_error": {("calibrate",), ("slip-study",)},
+             # each run of a fleet: its residual ratio (runs with references) and its closed-path score (closed
+             # runs), each under its own key, the other null (the scores were under residual_ratio)
+             "residual_ratio": {("batch", "calibrate")}, "closed_score": {("batch", "calibrate")}}
 
 #: A small successful (or 'no', exit 1) command line of each; {d}: a folder of files, from the repository's root.
 CASES: dict[tuple[str, ...], tuple[str, int]] = {

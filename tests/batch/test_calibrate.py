@@ -560,7 +560,8 @@ def test_a_run_of_another_robot_is_flagged_and_named(diff):
         assert res.inconsistent is True
         odd = [w for w in res.warnings if "disagrees with the other runs" in w]
         assert len(odd) == 1 and odd[0].startswith(f"r{bad}.csv: "), res.warnings
-        assert res.to_dict()["per_run"][bad] == {"file": f"r{bad}.csv", "residual_ratio": res.residual_ratios[bad]}
+        assert res.to_dict()["per_run"][bad] == {"file": f"r{bad}.csv", "residual_ratio": res.residual_ratios[bad],
+                                                 "closed_score": None}  # runs with references: ratios, no scores
     # independent check of one ratio, a consistent run's: refit without it and alone
     k = 1
     others = calibrate(diff, runs[:k] + runs[k + 1:], PARAMS).robot
@@ -606,11 +607,11 @@ def test_closed_paths_of_another_robot_are_named(diff):
     for seed, odd in ((1, [0.06, 0.03]), (2, [0.01, 0.13])):
         params, runs = closed_fleet(diff, seed, odd)
         res = fleet_calibrate(diff, runs, params)
-        assert res.inconsistent is True and res.not_judged is None, res.residual_ratios
-        assert res.residual_ratios[0] > 2 * MAX_CLOSED_SCORE and max(res.residual_ratios[1:]) < MAX_CLOSED_SCORE / 2
+        assert res.inconsistent is True and res.not_judged is None, res.closed_scores
+        assert res.closed_scores[0] > 2 * MAX_CLOSED_SCORE and max(res.closed_scores[1:]) < MAX_CLOSED_SCORE / 2
         (warning,) = [w for w in res.warnings if "disagrees" in w]
         assert warning.startswith("run 1 (<synthetic>): disagrees with the other runs (closed-path score")
-        assert res.to_dict()["inconsistent"] is True
+        assert res.to_dict()["inconsistent"] is True and res.residual_ratios == (None,) * 6  # scores, not ratios
 
 
 def test_closed_paths_that_agree_are_judged_and_not_flagged(diff):
@@ -622,12 +623,12 @@ def test_closed_paths_that_agree_are_judged_and_not_flagged(diff):
         params, runs = closed_fleet(diff, seed, runs=6 + 2 * (seed % 2))
         res = fleet_calibrate(diff, runs, params)
         assert res.inconsistent is False and res.not_judged is None and not res.warnings
-        assert all(0 <= q < MAX_CLOSED_SCORE / 2 for q in res.residual_ratios), res.residual_ratios
+        assert all(0 <= q < MAX_CLOSED_SCORE / 2 for q in res.closed_scores), res.closed_scores
     res = fleet_calibrate(diff, runs[:5], params)
-    assert res.inconsistent is None and res.not_judged == CLOSED and res.residual_ratios == (None,) * 5
+    assert res.inconsistent is None and res.not_judged == CLOSED and res.closed_scores == (None,) * 5
     # noise-free: the runs that agree fit to round-off and are not judged on it (scores 0), one of a robot with a
     # 5 % wider track is named
     for odd in (None, [0.01, 0.08]):
         params, runs = closed_fleet(diff, 0, odd, noise=0.0)
         res = fleet_calibrate(diff, runs, params)
-        assert res.inconsistent is bool(odd) and max(res.residual_ratios[1:]) < 5
+        assert res.inconsistent is bool(odd) and max(res.closed_scores[1:]) < 5

@@ -137,7 +137,7 @@ def test_closed_path_fleet_judged_identically(engines, diff):
     assert c0.inconsistent is True
     for name, runner in engines.items():
         c = fleet_calibrate(diff, runs, params, runner=runner)
-        assert c.residual_ratios == c0.residual_ratios and c.warnings == c0.warnings, name
+        assert c.closed_scores == c0.closed_scores and c.warnings == c0.warnings, name
 
 
 def test_a_failed_refit_leaves_the_calibration_not_judged(engines, diff, monkeypatch):
@@ -154,7 +154,7 @@ def test_a_failed_refit_leaves_the_calibration_not_judged(engines, diff, monkeyp
     for name, runner in {"serial": None, **engines}.items():
         c = fleet_calibrate(diff, runs, params, runner=runner)
         assert c.estimate == c0.estimate and c.interval == c0.interval, name
-        assert c.inconsistent is None and c.residual_ratios == (None,) * 6, name
+        assert c.inconsistent is None and c.residual_ratios == c.closed_scores == (None,) * 6, name
         assert c.not_judged.startswith("run 1 (<synthetic>): the fit of the other runs without it failed "
                                        "(RuntimeError: injected refit failure)"), c.not_judged
         assert c.to_dict()["not_judged"] == c.not_judged and not [w for w in c.warnings if "disagrees" in w]

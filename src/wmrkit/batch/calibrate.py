@@ -57,8 +57,10 @@ class FleetCalibration:
     ``level``; residual RMS before and after; ``runs``, ``residuals`` counts; ``ci`` the interval method;
     ``warnings``: runs whose data do not fit the method (e.g. a closed path cut short) or disagree with the others;
     ``logs``: the runs' files; ``residual_ratios``: each run's RMS at the other runs' fit over that at its own
-    (``None`` with fewer than 4 runs), for a fleet of closed paths over the other runs' RMS there (their closed-path
-    score) and ``inconsistent``: the largest over :data:`~wmrkit.batch.consistency.MAX_RATIO` (closed paths:
+    (``None`` with fewer than 4 runs, and for closed paths); ``closed_scores``: for a fleet of closed paths, each
+    run's weighted final-pose error at the other runs' fit over the others' RMS there
+    (:func:`~wmrkit.batch.consistency.judge`; ``None`` for runs with reference trajectories); ``inconsistent``:
+    the largest over :data:`~wmrkit.batch.consistency.MAX_RATIO` (closed paths:
     :data:`~wmrkit.batch.consistency.MAX_CLOSED_SCORE`; :mod:`wmrkit.batch.consistency`; ``None`` when not judged,
     and ``not_judged`` says why: fewer than 4 runs, fewer than 6 closed paths, or a failed closed-path refit)."""
 
@@ -79,6 +81,7 @@ class FleetCalibration:
     residual_ratios: tuple[float | None, ...] = ()
     inconsistent: bool | None = None
     not_judged: str | None = None
+    closed_scores: tuple[float | None, ...] = ()
 
     def value(self, name: str) -> tuple[float, float, float]:
         """``(fitted, low, high)`` of the wheel field `name`."""
@@ -93,8 +96,9 @@ class FleetCalibration:
                 "residuals": self.residuals, "rms_before": self.rms_before, "rms_after": self.rms_after,
                 "success": self.success, "warnings": list(self.warnings), "inconsistent": self.inconsistent,
                 "not_judged": self.not_judged,
-                "per_run": [{"file": f, "residual_ratio": q} for f, q in zip(self.logs, self.residual_ratios,
-                                                                             strict=True)],
+                "per_run": [{"file": f, "residual_ratio": q, "closed_score": c}
+                            for f, q, c in zip(self.logs, self.residual_ratios,
+                                               self.closed_scores or (None,) * len(self.logs), strict=True)],
                 "parameters": [{"group": list(g), "p": p, "low": lo, "high": hi}
                                for g, p, (lo, hi) in zip(self.parameters, self.estimate, self.interval, strict=True)],
                 "values": [{"field": n, "nominal": a, "fitted": v, "low": lo, "high": hi}
@@ -289,7 +293,8 @@ def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float,
                             tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True)), tuple(values),
                             rms(r0), rms(fit.fun), len(problem.runs), int(r0.size), ci, level, bool(fit.success),
                             problem.warnings() + notes + ((judged.message,) if judged.message else ()), logs,
-                            judged.ratios, judged.inconsistent, judged.not_judged)
+                            judged.ratios, judged.inconsistent, judged.not_judged,
+                            judged.scores or (None,) * len(problem.runs))
 
 
 @dataclass(frozen=True)

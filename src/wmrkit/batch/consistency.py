@@ -72,13 +72,16 @@ CANDIDATES = 10
 class Consistency:
     """``ratios``: per run, or ``None`` (fewer than :data:`MIN_RUNS` runs, or fewer than :data:`MIN_DOF`
     residuals beyond its own parameters: closed paths); ``inconsistent``: the largest over
-    :data:`MAX_RATIO` (``None`` when not judged); ``message``: the warning that names the run, or ``None``;
-    ``not_judged``: why no run was judged (:data:`FEW_RUNS`, :data:`CLOSED`), or ``None``."""
+    :data:`MAX_RATIO` (closed paths: a score over :data:`MAX_CLOSED_SCORE`; ``None`` when not judged);
+    ``message``: the warning that names the run, or ``None``; ``not_judged``: why no run was judged
+    (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`REFIT_FAILED`), or ``None``; ``scores``: a fleet of closed paths'
+    per-run scores (:func:`judge`; another quantity than a ratio, under its own name), empty when not scored."""
 
     ratios: tuple[float | None, ...]
     inconsistent: bool | None
     message: str | None = None
     not_judged: str | None = None
+    scores: tuple[float | None, ...] = ()
 
 
 def travel(robot: Robot, run: CalibrationRun) -> float:
@@ -235,9 +238,10 @@ def judge(problem: CalibrationProblem, fit, jacobian: Callable, refit: Callable)
         order = np.r_[0:k, g - 1, k:g - 1]  # run k was put last
         scores[k] = _score(err.reshape(g, -1)[order] * w[:, None], k, np.delete(np.arange(g), k), floors, n)
     worst = int(np.argmax(scores))
+    scored = tuple(map(float, scores))
     if scores[worst] <= MAX_CLOSED_SCORE:
-        return Consistency(tuple(map(float, scores)), False)
-    return Consistency(tuple(map(float, scores)), True,
+        return Consistency(judged.ratios, False, scores=scored)
+    return Consistency(judged.ratios, True, scores=scored, message=
                        f"{logs[worst]}: disagrees with the other runs (closed-path score {scores[worst]:.3g}, over "
                        f"{MAX_CLOSED_SCORE:g}: the others' fit leaves it that many times their error): another robot, "
                        "load or floor? The fit averages it in; check it or fit without it")
