@@ -19,7 +19,8 @@ The denominator is at least :data:`ROUNDOFF` times the run's wheel travel: noise
 (1e-15 m on 6 m) and a ratio of round-off is meaningless; a noise-free run that disagrees still is flagged.
 
 Closed paths (a final pose: no own noise to divide by) are judged by :func:`judge` against the other runs' pooled
-noise instead, with 6 runs or more, from a quadratic model of each run about the fleet fit and one refit.
+noise instead, with 5 runs or more, from a quadratic model of each run about the fleet fit and one refit (of every
+run in a fleet of 5).
 """
 
 from __future__ import annotations
@@ -51,12 +52,12 @@ MIN_DOF = 6
 FEW_RUNS = (f"fewer than {MIN_RUNS} runs: the runs are not checked against each other (with 2 or 3, a run of "
             "another robot cannot be told from the others), a run that disagrees is averaged in unseen")
 #: ... and every run a closed path (or as short): its own noise cannot be measured from its one residual beyond the
-#: parameters, which the ratio's denominator needs; with 6 closed runs or more they are judged against the others'
+#: parameters, which the ratio's denominator needs; with 5 closed runs or more they are judged against the others'
 #: pooled noise instead (:func:`judge`), with fewer not (4 squares, two each way: each run moves the fit far, and
-#: the odd run's partner in direction scored 123).
-CLOSED = ("no run has 6 residuals beyond its own parameters (closed paths: a final pose) and there are fewer than 6 "
+#: the odd run's partner in direction scored 123; by refits of every run up to 57).
+CLOSED = ("no run has 6 residuals beyond its own parameters (closed paths: a final pose) and there are fewer than 5 "
           "runs, or a run without which the others cannot fit: the runs are not checked against each other, a run "
-          "of another robot is averaged in unseen; 6 closed runs or more, or runs with reference trajectories, "
+          "of another robot is averaged in unseen; 5 closed runs or more, or runs with reference trajectories, "
           "are checked")
 #: Why ``batch calibrate --slip`` does not judge its runs: the residual ratio is one of noise, and a slip fit's own
 #: residuals are the slip model's error. Simulated skid-steer fleets (quasi-static slip, 6 runs): agreeing runs up to
@@ -148,13 +149,18 @@ def run_consistency(jac: np.ndarray, res: np.ndarray, sizes: Sequence[int], floo
 #: (diff-drive, sides 1-2.5 m, both ways, encoder noise 1e-6 to 1e-4 per rad): at most 6.6 over 600 runs of one
 #: noise level a fleet, 11.6 over 360 runs of mixed levels (fleets of 8: 5.3 and 11.4 over 320 runs each); a run of a
 #: robot with a 10 % larger left radius 66 or more (15 fleets), 5 % 41 or more, a track 10 % wider 17-61 (1st and
-#: 50th percentiles: 18 of 20 fleets flagged), 5 % wider 9-32 (15 of 20).
+#: 50th percentiles: 18 of 20 fleets flagged), 5 % wider 9-32 (15 of 20). Fleets of 5 (every run refitted): at most 7.7
+#: over 750 runs of one level, 15.5 over 450 of mixed levels; a track 5 % wider 5-47 (30 of 40 fleets flagged).
 MAX_CLOSED_SCORE = 20.0
 #: Fewest closed runs to judge: with 4 (two squares each way) each run moves the fleet fit far, the quadratic model
-#: about it missed an odd run (scored 0.3 where the refit gave 4810) and refits of every run cost several fits.
-MIN_CLOSED_RUNS = 6
-#: Runs refitted without (the one whose removal moves the quadratic model's fit the most).
+#: about it missed an odd run (scored 0.3 where the refit gave 4810), and even refits of every run do not separate:
+#: the odd run's partner in direction scored 7-57 (20 fleets, a track 5 % off: 9 agreeing runs over 20).
+MIN_CLOSED_RUNS = 5
+#: Runs refitted without (the one whose removal moves the quadratic model's fit the most) ...
 REFITS = 1
+#: ... but every run in fleets of fewer closed runs: with 5 the model's one refit is not enough (each run moves the
+#: fit far), refits of all five separate (docs/batch.md's table).
+REFIT_EVERY = 6
 #: Why a closed fleet is not judged when that refit fails (a worker's error, residuals not finite): the fleet fit is
 #: returned all the same ({run}: the run left out; {why}: the error).
 REFIT_FAILED = ("{run}: the fit of the other runs without it failed ({why}): the closed runs are not checked against "
@@ -209,9 +215,9 @@ def judge(problem: CalibrationProblem, fit, jacobian: Callable, refit: Callable)
     (first order: 20 against 96). So the run whose removal moves that fit the most is refitted without, from there,
     by `refit` (``[(problem, x0)] -> [(x, residuals of the problem's runs) or a TaskFailure]``, the engine's map;
     the problem's last run is the one left out; a failure leaves the fleet not judged, :data:`REFIT_FAILED`), and its
-    score is the refit's: in fleets of 6 squares the odd run's equalled a refit of
-    every run. Over :data:`MAX_CLOSED_SCORE` the run of largest score is named; with fewer than
-    :data:`MIN_CLOSED_RUNS` closed runs the fleet is not judged (:data:`CLOSED`)."""
+    score is the refit's: in fleets of 6 squares the odd run's equalled a refit of every run. A fleet of fewer than
+    :data:`REFIT_EVERY` runs refits every run. Over :data:`MAX_CLOSED_SCORE` the run of largest score is named;
+    with fewer than :data:`MIN_CLOSED_RUNS` closed runs the fleet is not judged (:data:`CLOSED`)."""
     robot, runs, sizes = problem.robot, problem.runs, problem.sizes()
     logs = names(problem)
     travels = np.array([max(travel(robot, run), 1.0) for run in runs])
@@ -228,7 +234,7 @@ def judge(problem: CalibrationProblem, fit, jacobian: Callable, refit: Callable)
                                hess, floors)
     if np.isnan(scores).any():  # a run without which the others cannot fit: not judged
         return judged
-    again = [int(k) for k in np.argsort(np.linalg.norm(shift, axis=1))[::-1][:REFITS]]
+    again = [int(k) for k in np.argsort(np.linalg.norm(shift, axis=1))[::-1][:g if g < REFIT_EVERY else REFITS]]
     for k, done in zip(again, refit([(problem.with_runs(runs[:k] + runs[k + 1:] + runs[k:k + 1]),
                                       fit.x + shift[k]) for k in again]), strict=True):
         err = None if isinstance(done, TaskFailure) else np.asarray(done[1], dtype=float)
