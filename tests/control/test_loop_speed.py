@@ -13,11 +13,17 @@ for each entry of RUNS (its held front wheels, the hysteresis events, corners, c
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from wmrkit import catalog
-from wmrkit.control import builtin_reference, forklift_real_loops, track
+from wmrkit import Robot, catalog
+from wmrkit.control import Plant, builtin_reference, forklift_real_loops, track
+from wmrkit.control.loop import _Sim
+from wmrkit.kinematics.wheel_ik import checked_rates, checked_steering_config
 
 RUNS = {"ackermann circle": ("ackermann", "circle", {"duration": 12.0}),
         "ackermann figure-eight gain 3": ("ackermann", "figure-eight", {"duration": 8.0, "gain": 3.0}),
@@ -92,3 +98,27 @@ def test_the_continuous_loop_gives_the_poses_it_gave_before_its_speed_ups(name):
     run = track(catalog.load(robot), builtin_reference(reference), **options)
     idx = np.linspace(0, len(run.t) - 1, 7).round().astype(int)
     np.testing.assert_allclose(run.pose[idx], BEFORE[name], rtol=1e-12, atol=1e-12)
+
+
+def _ranged(name: str) -> Robot:
+    """A catalog robot whose twist-steered wheels (steerable, double) get an uneven steering range."""
+    robot = catalog.load(name)
+    return replace(robot, wheels=tuple(replace(w, steer_range=(-1.1, 0.7)) if w.type in ("steerable", "double")
+                                       else w for w in robot.wheels))
+
+
+@pytest.mark.parametrize("robot", [catalog.load("ackermann"), _ranged("swerve-4"), _ranged("agv-drive-unit"),
+                                   _ranged("thesis-steer-castor"), catalog.load("forklift")], ids=lambda r: r.name)
+@settings(max_examples=60, deadline=None)
+@given(twist=st.lists(st.floats(-3, 3), min_size=3, max_size=3), turns=st.lists(st.floats(-9, 9), min_size=4,
+                                                                                  max_size=4), still=st.integers(0, 3))
+def test_the_loops_plain_float_steering_is_the_ik_and_the_steering_choice_bit_for_bit(robot, twist, turns, still):
+    """The continuous loop's plain-float shortcut (the IK's angles alone, then whether every steered wheel fits a
+    root) gives checked_rates' configuration and commands' in_range, bit for bit (a twist at rest: held wheels)."""
+    twist = np.array(twist) * (still > 0)  # some twists at rest: every wheel held at its angle
+    beta = np.array(turns[:len(robot.steer_names)])
+    config = checked_steering_config(robot, twist, beta)
+    want = checked_rates(robot, twist, beta)[1]
+    assert config == want.tolist()
+    sim = _Sim(robot, Plant())
+    assert sim.all_fit(config) == bool(sim.commands(twist, beta).fits.all())

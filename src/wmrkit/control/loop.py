@@ -24,8 +24,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..kinematics._ik_fast import in_range_one, wrap_one
 from ..kinematics.linalg import solve_assigned
-from ..kinematics.wheel_ik import checked_rates, forward_kinematics
+from ..kinematics.wheel_ik import checked_rates, checked_steering_config, forward_kinematics
 from ..limits import MAX_QUERY_RATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import wrap_angle
@@ -150,6 +151,8 @@ class _Sim:
             if joint == "spin" and "spin" not in w.kind.rates:
                 raise ControlError(f"low-level loop on '{j}': wheel '{wheel}' has no 'spin' joint")
         self.limited = bool(np.isfinite(self.ranges).any())
+        self.ranged = [(k, float(self.delta[k]), float(lo), float(hi)) for k, (lo, hi) in enumerate(self.ranges)
+                       if not self.passive[k] and np.isfinite([lo, hi]).any()]  # the steered wheels with a range
         spins = [j for j in self.joints if j.endswith(".spin")]
         if (loops is not None or self.limited) and not spins:
             spins = [j for j in robot.actuated if j.endswith(_SPINS)]
@@ -187,10 +190,22 @@ class _Sim:
         the steering reached (the wheels scrub: the robot cannot move as commanded)."""
         if not self.limited:
             return twist, np.ones(len(self.ranges), dtype=bool)
+        if self.all_fit(checked_steering_config(self.robot, twist, beta)):  # the commanded twist: no wheel is held
+            return twist, np.ones(len(self.ranges), dtype=bool)
         cmd = self.commands(twist, beta)
         if cmd.fits.all():
             return twist, cmd.fits
         return self.least_squares_twist(cmd, cmd.target, {}), cmd.fits
+
+    def all_fit(self, target: list[float]) -> bool:
+        """Whether every steered wheel has a root of (8.9) within its range, the IK's steering `target` or that
+        plus pi: :func:`.steering.checked_steering`'s ``in_range`` (of any policy), in plain floats, the same
+        operations."""
+        for k, delta, lo, hi in self.ranged:
+            h0 = wrap_one(target[k] - math.pi / 2 + delta)
+            if not (in_range_one(h0, lo, hi) or in_range_one(wrap_one(h0 + math.pi), lo, hi)):
+                return False
+        return True
 
     def least_squares_twist(self, cmd: _Commands, beta: np.ndarray, actual: dict[str, float]) -> np.ndarray:
         """Twist (4.11) of the drive joints' rates (`actual` where given, else commanded) at steering `beta`:
@@ -412,9 +427,10 @@ def _given_steering(controller, sim: _Sim, t: float, x: np.ndarray, split) -> tu
     pose, integral, beta, _ = split(x)
     twist, _ = controller(t, pose, integral)
     ik = checked_rates(sim.robot, twist, beta)
-    target = sim.commands(twist, beta, HOLD_MARGIN, ik).target
+    cmd = sim.commands(twist, beta, HOLD_MARGIN, ik)
+    target = cmd.target
     out[:len(beta)][steered] = target[steered]
-    if not sim.limited:
+    if not sim.limited or cmd.fits.all():  # the margin only picks an end for a wheel that fits no root
         return out, False
     held = sim.commands(twist, beta, ik=ik).target  # within a step: held wheels stay at their ends
     return out, bool(np.any(np.abs(wrap_angle(target - held))[steered] > 1e-9))

@@ -18,7 +18,7 @@ from ..wheels import heading_from_beta
 from .actuators import LowLevelLoops
 from .feasibility import BLOCK, Feasibility, feasibility
 from .laws import PositionLaw, check_gate, check_sampling
-from .loop import Plant, law_controller, simulate
+from .loop import Plant, simulate
 from .points import ControlError, ControlPoint, StoppedRun, check_delay, control_point, point_pose
 from .references import Reference
 from .trackers import PathIndex, default_wheelbase, pure_pursuit, stanley
@@ -195,12 +195,10 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         if sampled is not None:
             check_sampling(law, sampled, delay=delay, stacklevel=3)
         check_gate(law, reference.velocity, stacklevel=3)
-        if dynamics:  # the same law in scalar arithmetic: the dynamic loop's per-period cost (issue 11)
-            from .dynamic_plant import fast_law_controller
+        # the law in scalar arithmetic (law_controller's numbers): a few us a call, for every loop (issue 11)
+        from .dynamic_plant import fast_law_controller
 
-            ctrl, tracked_point = fast_law_controller(cp, law, reference), cp.point
-        else:
-            ctrl, tracked_point = law_controller(cp, law, reference), cp.point
+        ctrl, tracked_point = fast_law_controller(cp, law, reference), cp.point
     elif controller == "pure-pursuit":
         ctrl, tracked_point = pure_pursuit(cp, reference, lookahead), cp.axle_point
     else:

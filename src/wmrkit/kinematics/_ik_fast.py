@@ -219,6 +219,44 @@ def _prefer_in_range(p: Plan, beta: np.ndarray, spin: np.ndarray, held: np.ndarr
         spin[flip[p.steered_spin_of]] *= -1.0
 
 
+def wrap_one(a: float) -> float:
+    """:func:`~wmrkit.wheels.wrap_angle` of one float, the same operations (``round`` halves to even, as ``rint``)."""
+    y = a - TWO_PI * round(a / TWO_PI)
+    return y + TWO_PI if y <= -math.pi else (y - TWO_PI if y > math.pi else y)
+
+
+def in_range_one(h: float, lo: float, hi: float, tol: float = 1e-12) -> bool:
+    """:func:`~wmrkit.wheels.heading_in_range` of one heading, the same operations (``%`` is ``np.mod``)."""
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return True
+    return (h - lo + tol) % TWO_PI - tol <= hi - lo + tol
+
+
+def steering_one(p: Plan, vx: float, vy: float, w: float, current: list[float], speed_tol: float) -> list[float]:
+    """The configuration (thesis angles, ``(n_steer,)``) :func:`steer_to_twist` and :func:`_prefer_in_range` give
+    one twist at steering `current`, in plain floats with the same operations (:func:`_steer_block`'s): a few µs
+    for a few wheels instead of a hundred, for a loop that needs only the angles (the continuous control loop).
+    Castor-like angles are kept (wrapped), as :func:`~wmrkit.kinematics.wheel_ik.wheel_commands` keeps them."""
+    config = [wrap_one(c) for c in current]
+    for i, k in enumerate(p.steered_beta.tolist()):
+        minus_ux = float(p.steered_y[i]) * w - vx
+        uy = float(p.steered_x[i]) * w + vy
+        speed = math.sqrt(minus_ux * minus_ux + uy * uy)
+        if speed <= speed_tol:  # held: the current angle, never flipped
+            continue
+        sign = minus_ux * math.sin(current[k]) + uy * math.cos(current[k])
+        sign = -1.0 if abs(sign) <= 1e-12 * speed else math.copysign(1.0, sign)
+        beta = math.atan2(minus_ux * sign + 0.0, uy * sign)
+        if p.steer_range is not None:
+            wheel = int(p.steer_wheels[k])
+            lo, hi = float(p.steer_range[0, wheel]), float(p.steer_range[1, wheel])
+            heading = beta + (float(p.wheel_delta[wheel]) - 0.5 * math.pi)
+            if not in_range_one(heading, lo, hi) and in_range_one(heading + math.pi, lo, hi):
+                beta = wrap_one(beta + math.pi)
+        config[k] = beta
+    return config
+
+
 def _steer_block(
     p: Plan, t: np.ndarray, cos_cur: np.ndarray, sin_cur: np.ndarray, speed_tol: float,
     beta: np.ndarray, spin: np.ndarray, held: np.ndarray,

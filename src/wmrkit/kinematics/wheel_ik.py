@@ -207,6 +207,15 @@ def checked_rates(robot: Robot, twist: np.ndarray, beta: np.ndarray) -> tuple[np
     return rates, config, spin
 
 
+def checked_steering_config(robot: Robot, twist: np.ndarray, beta: np.ndarray) -> list[float]:
+    """:func:`checked_rates`' steering configuration alone (thesis angles, ``(n_steer,)``), in plain floats
+    (:func:`_ik_fast.steering_one`): the same numbers, refusing what it refuses."""
+    if not ((np.abs(twist) <= MAX_QUERY_RATE).all() and (np.abs(beta) <= MAX_ANGLE).all()):  # NaN included
+        return checked_rates(robot, twist, beta)[1].tolist()  # raises
+    vx, vy, w = twist.tolist()
+    return _ik_fast.steering_one(_ik_fast.plan(robot), vx, vy, w, beta.tolist(), SPEED_TOL)
+
+
 def gear_error(coupling: Coupling, rate_names: tuple[str, ...], rates: np.ndarray) -> np.ndarray:
     """How far joint `rates` ``(..., n_rates)`` (`rate_names` order) are from turning together as a ``gear``
     coupling turns them, ``q_j = ratio_j * u`` (``docs/description-format.md``): the largest ``|q_j - ratio_j u|``
