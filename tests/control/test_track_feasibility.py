@@ -238,13 +238,13 @@ def _tightest_turn(reference) -> float:
     return float(np.min(np.hypot(*d1[2:-2].T) ** 3 / np.maximum(cross, 1e-300)))
 
 
-@pytest.mark.parametrize("name", ["circle", "arc-line"])
+@pytest.mark.parametrize("name", ["circle", "arc-line", "figure-eight"])
 def test_feasibility_judges_the_reference_track_drives(name, capsys):
     """One rule sizes a built-in reference for a robot in both commands: 'wmrkit feasibility ackermann --reference
     circle' judged the 3 m circle while 'wmrkit track' drove a 6 m one; the arc-line (1.5 m) kept the car's front
-    wheels at their steering stops. Now each shape's tightest turn, measured on the reference itself, is at least 1.5
-    times the car's minimum turning radius (3.993 m), and both answers name the same reference and size; a robot
-    that turns on the spot keeps the built-in size."""
+    wheels at their steering stops, and so did the 6 m figure-eight (turning on 1.25 m). Now each shape's tightest
+    turn, measured on the reference itself, is at least 1.5 times the car's minimum turning radius (3.993 m), and both
+    answers name the same reference and size; a robot that turns on the spot keeps the built-in size."""
     from wmrkit.cli.control import min_turning_radius
     from wmrkit.control.references import BUILTIN
 
@@ -258,13 +258,13 @@ def test_feasibility_judges_the_reference_track_drives(name, capsys):
         answers[robot] = run["reference_size"]
     assert answers["diff-drive"] == BUILTIN[name][2]
     size = answers["ackermann"]
-    assert size == 6
+    assert size == {"circle": 6, "arc-line": 6, "figure-eight": 29}[name]
     turning = min_turning_radius(catalog.load("ackermann"))
     assert turning == pytest.approx(3.993, abs=1e-3)
     assert 1.5 * turning <= _tightest_turn(builtin_reference(name, size=size, dt=0.005)) < 1.5 * turning + 1.0
     main(["feasibility", "ackermann", "--reference", name])
-    assert f"reference {name} of radius {size:g} m (its tightest " \
-        "turn" in capsys.readouterr().out
+    word = "half width" if name == "figure-eight" else "radius"
+    assert f"reference {name} of {word} {size:g} m (its tightest turn" in capsys.readouterr().out
 
 
 def test_the_car_s_default_arc_line_keeps_its_wheels_off_their_stops(capsys):
@@ -272,5 +272,16 @@ def test_the_car_s_default_arc_line_keeps_its_wheels_off_their_stops(capsys):
     start."""
     assert main(["track", "ackermann", "--reference", "arc-line", "--duration", "20", "--json"]) == 0
     run = json.loads(capsys.readouterr().out)
+    assert run["beyond_steer_range"] == [] and run["warnings"] == []
+    assert run["summary"]["max_error"] < 1e-6
+
+
+def test_the_car_s_default_figure_eight_keeps_its_wheels_off_their_stops(capsys):
+    """Through the first lobe's tightest turn (t = 109 s of the 29 m figure-eight's 437 s lap): before, the 6 m
+    figure-eight (turning on 1.25 m, the car's rear axle on 3.993 m at least) held both front wheels at their stops
+    for 64 s of its 94 s lap, with a warning per wheel."""
+    assert main(["track", "ackermann", "--reference", "figure-eight", "--duration", "120", "--json"]) == 0
+    run = json.loads(capsys.readouterr().out)
+    assert (run["reference_name"], run["reference_size"]) == ("figure-eight", 29)
     assert run["beyond_steer_range"] == [] and run["warnings"] == []
     assert run["summary"]["max_error"] < 1e-6

@@ -250,11 +250,11 @@ BUILTIN = {
 }
 
 #: The tightest turn of each built-in shape whose curvature scales with its size: its smallest radius of curvature
-#: per metre of size (the circle's is its radius, the arc-line's its arc's). Not the figure-eight (Gerono's
-#: lemniscate of half width A turns on A / 4.7903 at its tightest): a car's would be 29 m, a lap of 437 s that the
-#: continuous loop integrates in about its 2 min budget (docs/control.md). The line and the polylines (square,
-#: corner) have straight legs only: their corners are tangent jumps at any size (Table 8.1).
-TIGHTEST_TURN = {"circle": 1.0, "arc-line": 1.0}
+#: per metre of size (the circle's is its radius, the arc-line's its arc's; Gerono's lemniscate of half width A,
+#: the figure-eight, turns on 0.2087557 A at its tightest, where cos^2(w t) = 0.38643: rounded down here, so the
+#: sized shape's turn is never below the margin). The line and the polylines (square, corner) have straight legs
+#: only: their corners are tangent jumps at any size (Table 8.1).
+TIGHTEST_TURN = {"circle": 1.0, "arc-line": 1.0, "figure-eight": 0.208755}
 #: A robot's default size of such a shape makes its tightest turn at least this many times the robot's minimum
 #: turning radius (a car's steering stops), rounded up to a metre.
 TURN_MARGIN = 1.5
