@@ -427,3 +427,103 @@ def test_each_framework_gives_its_own_reason_for_a_jump_of_type_1_and_type_2_off
     if name == "mecanum-4":
         (v,) = feasibility(robot, jump, "kinematic").violations
         assert v.signal == "theta" and "kinematics allows no jump" in v.remedy
+
+
+def _twist_steps():
+    """References whose twist steps at t = 5 s, exact derivatives: (name, reference, robot-frame twist of the tracked
+    point just before and just after the step)."""
+    from wmrkit.control.references import Reference
+
+    t = np.arange(0.0, 10.0, 0.01)
+    after = t >= 5
+    s, ds = np.where(after, 2.5 + (t - 5), 0.5 * t), np.where(after, 1.0, 0.5)
+    zero = 0 * t
+    line = Reference("speed step on a line", t, np.column_stack([s, zero, zero]), np.column_stack([ds, zero, zero]),
+                     np.zeros((len(t), 3)))
+    ph = s / 3  # a 3 m circle, the heading along it: v and omega double together (the same ICR)
+    circle = Reference("speed step on a circle", t, np.column_stack([3 * np.sin(ph), 3 * (1 - np.cos(ph)), ph]),
+                       np.column_stack([ds * np.cos(ph), ds * np.sin(ph), ds / 3]),
+                       np.column_stack([-ds**2 / 3 * np.sin(ph), ds**2 / 3 * np.cos(ph), zero]))
+    th = np.where(after, 0.2 * (t - 5), 0.0)  # the heading rate steps from 0 to 0.2 rad/s: the ICR moves
+    turn = Reference("heading-rate step", t, np.column_stack([0.5 * t, zero, th]),
+                     np.column_stack([0.5 + zero, zero, np.where(after, 0.2, 0.0)]), np.zeros((len(t), 3)))
+    # robot-frame velocity of the point (0.5, 0.1) m/s and omega 0.2 rad/s from t = 5 s (before: (0.5, 0), 0)
+    tau = np.where(after, t - 5, 0.0)
+    c, sn = np.cos(0.2 * tau), np.sin(0.2 * tau)
+    vx, vy = np.where(after, 0.5 * c - 0.1 * sn, 0.5), np.where(after, 0.5 * sn + 0.1 * c, 0.0)
+    px = np.where(after, 2.5 + (0.5 * sn + 0.1 * (c - 1)) / 0.2, 0.5 * t)
+    py = np.where(after, (0.5 * (1 - c) + 0.1 * sn) / 0.2, 0.0)
+    bend = Reference("twist step keeping one wheel's heading", t, np.column_stack([px, py, 0.2 * tau]),
+                     np.column_stack([vx, vy, np.where(after, 0.2, 0.0)]),
+                     np.column_stack([-0.2 * vy * after, 0.2 * vx * after, zero]))
+    return {"line": (line, (0.5, 0, 0), (1, 0, 0)), "circle": (circle, (0.5, 0, 1 / 6), (1, 0, 1 / 3)),
+            "turn": (turn, (0.5, 0, 0), (0.5, 0, 0.2)), "bend": (bend, (0.5, 0, 0), (0.5, 0.1, 0.2))}
+
+
+@pytest.mark.parametrize(("name", "point", "case"), [
+    ("swerve-4", None, "line"), ("swerve-4", None, "circle"), ("swerve-4", None, "turn"),
+    ("thesis-two-steer-castor", None, "line"), ("thesis-two-steer-castor", None, "circle"),
+    ("thesis-two-steer-castor", None, "turn"), ("thesis-steer-castor", (0.5, 0.0), "bend"),
+    ("thesis-steer-castor", (0.5, 0.0), "turn")])
+def test_types_3_and_5_off_the_wheels_break_the_kinematic_framework_only_where_a_steered_wheel_turns(name, point,
+                                                                                                     case):
+    """Types 3 and 5 with some l_o != 0 (Table 8.1: p_ref C1, kinematic framework): the steering angles are states,
+    the spin rates may jump. A speed step along a line or a circle (the twist scaled: the same ICR) leaves every
+    steered wheel's heading where it was, and so does, for one steered wheel off the tracked point, a twist step that
+    keeps that wheel's velocity direction; a heading-rate step moves the ICR and turns the wheels. Each was a
+    'velocity jump' ('stop and re-orient the orientable wheels') before. The independent verdict: the no-slip IK's
+    headings just before and after the step (modulo half a turn, a 2-quadrant root), at R."""
+    from wmrkit.kinematics.wheel_ik import wheel_commands
+
+    reference, before, after = _twist_steps()[case]
+    robot = catalog.load(name)
+    px, py = (0.0, 0.0) if point is None else point
+    steered = [i for i, w in enumerate(robot.wheels) if w.type == "steerable"]
+    headings = [np.asarray(wheel_commands(robot, [vx + w * py, vy - w * px, w]).heading)[steered]
+                for vx, vy, w in (before, after)]
+    turn = np.abs(np.angle(np.exp(2j * (headings[1] - headings[0])))) / 2
+    turns = bool(turn.max() > 0.05)
+    assert turns == (case == "turn")
+    assert feasibility(robot, reference, point=point).requirement.column == "types 3 and 5, l_o != 0"
+    sampled = reference_from_samples(reference.name, reference.t, reference.pose)
+    for ref in (reference, sampled):
+        got = feasibility(robot, ref, point=point).violations
+        assert bool(got) == turns, (ref.name, [(v.signal, v.t, v.size) for v in got])
+        assert all(v.t == pytest.approx(5.0, abs=0.02) and "re-orient the orientable wheels" in v.remedy for v in got)
+        # the dynamic framework forbids every such step (the spin rates jump); a wheel is re-oriented only where
+        # one turns (a sampled step also spikes the acceleration: reported where it changes a steering rate)
+        got = feasibility(robot, ref, "dynamic", point=point).violations
+        assert {v.signal for v in got} & {"velocity", "omega"}, [(v.signal, v.t, v.size) for v in got]
+        assert all(("re-orient" in v.remedy) == turns for v in got), [v.remedy for v in got]
+
+
+@pytest.mark.parametrize("name", ["swerve-4", "thesis-two-steer-castor"])
+def test_types_3_and_5_follow_an_acceleration_step_that_keeps_the_icr_in_the_dynamic_framework(name):
+    """A trapezoidal speed profile on a line and on a circle with the heading along it: the acceleration steps
+    (Table 8.1's 'p_ref C2' is broken), but the twist keeps its direction, so every steered wheel holds its heading
+    (steering rate 0 on both sides, from the IK below) and the spin rates, proportional to the speed, stay continuous:
+    only the spin accelerations jump, which the dynamic framework allows. It was an 'acceleration jump (p_ref not
+    C2)': 'stop and re-orient the orientable wheels'."""
+    from wmrkit.control.references import Reference
+    from wmrkit.kinematics.wheel_ik import wheel_commands
+
+    robot = catalog.load(name)
+    t = np.arange(0.0, 10.0, 0.01)
+    s = np.where(t < 2, 0.25 * t**2, 1 + (t - 2))  # 0.5 m/s^2 up to 1 m/s at t = 2 s, then steady
+    ds, dds = np.where(t < 2, 0.5 * t, 1.0), np.where(t < 2, 0.5, 0.0)
+    ph = s / 3
+    zero = 0 * t
+    refs = [Reference("ramp on a line", t, np.column_stack([s, zero, zero]), np.column_stack([ds, zero, zero]),
+                      np.column_stack([dds, zero, zero])),
+            Reference("ramp on a circle", t, np.column_stack([3 * np.sin(ph), 3 * (1 - np.cos(ph)), ph]),
+                      np.column_stack([ds * np.cos(ph), ds * np.sin(ph), ds / 3]),
+                      np.column_stack([dds * np.cos(ph) - ds**2 / 3 * np.sin(ph),
+                                       dds * np.sin(ph) + ds**2 / 3 * np.cos(ph), dds / 3]))]
+    for curvature, ref in zip((0.0, 1 / 3), refs, strict=True):
+        # the IK at R around the step: headings constant (steering rate 0), spins continuous through it
+        ik = [wheel_commands(robot, [v, 0.0, v * curvature]) for v in (1 - 1e-6, 1.0)]
+        steered = [i for i, w in enumerate(robot.wheels) if w.type == "steerable"]
+        assert np.allclose(ik[0].heading[steered], ik[1].heading[steered], atol=1e-12)
+        assert np.abs(np.asarray(ik[1].spin) - np.asarray(ik[0].spin))[steered].max() < 1e-4
+        assert not feasibility(robot, ref, "dynamic").violations, ref.name
+        assert not feasibility(robot, reference_from_samples(ref.name, t, ref.pose), "dynamic").violations

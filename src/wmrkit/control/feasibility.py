@@ -5,6 +5,9 @@ The column of Table 8.1 follows from the vehicle type (:func:`wmrkit.analysis.cl
 point (the robot origin R, or a given point) lies: on the fixed axle (``beta_f - alpha_f = 0``) or off it, and for
 types 3 and 5 whether some steered wheel is away from it (``l_oi != 0``). The *kinematic* framework lets wheel
 rates jump; the *dynamic* one needs them continuous, so every condition goes one derivative higher (§8.5).
+For types 3 and 5 with some ``l_oi != 0`` a velocity or heading-rate step (kinematic), an acceleration or
+angular-acceleration step (dynamic), is a violation only where a steered wheel's heading, respectively steering rate,
+changes across it (:func:`_steered_turn`): a twist that only scales keeps them (docs/errata.md).
 
 Signals of the reference, sampled: position, tangent angle ``chi`` (8.29) and its rate ``omega_g`` (8.31),
 curvature ``kappa`` (8.33) and its rate, heading ``theta``, velocity and acceleration. A sample-to-sample change
@@ -204,7 +207,9 @@ BLOCK = 21
 
 
 def _jumps(x: np.ndarray, t: np.ndarray, turn: float | None, floor: float, factor: float,
-           at_rest: np.ndarray | None = None, across_rest: bool = False) -> list[tuple[int, float]]:
+           at_rest: np.ndarray | None = None, across_rest: bool = False) -> list[tuple[int, int, float]]:
+    """The jumps of `x` ``(n, ...)``: ``(first step, last step, size)`` of each (a step k goes from sample k to
+    k + 1)."""
     x = x.reshape(len(x), -1)
     cut = held = None
     # typical sample steps each step covers: its time over the median sample spacing (more for one bridged over
@@ -262,7 +267,7 @@ def _jumps(x: np.ndarray, t: np.ndarray, turn: float | None, floor: float, facto
         if turn:
             total = _wrap(total, turn)
         whole = float(np.sqrt(np.nansum(total * total)))
-        out.append((first, max(whole, float(size[top])) if np.all(np.isfinite(total)) else float(size[top])))
+        out.append((first, last, max(whole, float(size[top])) if np.all(np.isfinite(total)) else float(size[top])))
     return out
 
 
@@ -313,13 +318,18 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
         floor = _FLOOR[name]
         # a car (R on the fixed axle of a type 4) cannot turn at rest: its tangent is compared across a stop
         across = name == "chi" and req.column == "type 4, on axle"
-        for k, size in _jumps(x, ref.t, _TURN.get(name), floor, jump_factor, s["at_rest"], across):
+        for k, last, size in _jumps(x, ref.t, _TURN.get(name), floor, jump_factor, s["at_rest"], across):
             if name == "kappa_rate" and not _persists(x, k, floor):
                 continue  # ringing of a third finite difference, not a step of the curvature rate
+            turns = None
+            if req.column == "types 3 and 5, l_o != 0" and name in _STEERED:
+                turns = _steered_turn(robot, ref, point, k, last + 1, rate=_STEERED[name])
+                if not turns and (req.framework == "kinematic" or _STEERED[name]):
+                    continue  # the twist only scales (the same ICR): no steered wheel turns, only rates jump
             t = float(ref.t[k + 1])
             if any(v.t == t and v.signal in ("chi", "position") for v in found) and name != "position":
                 continue  # already reported by a lower-order signal at the same instant
-            found.append(Violation(t, name, KINDS[name], size, _remedy(req, name)))
+            found.append(Violation(t, name, KINDS[name], size, _remedy(req, name, turns)))
     found.sort(key=lambda v: v.t)
     return Feasibility(req, tuple(found))
 
@@ -358,14 +368,48 @@ def _curvature_reference(reference: Reference) -> Reference | None:
     return reference_from_samples(reference.name, t[::step], np.column_stack([p[::step, :2], np.zeros(len(t[::step]))]))
 
 
-def _remedy(req: Requirement, signal: str) -> str:
+#: Signals of types 3 and 5 with some l_o != 0 that break Table 8.1 only where a steered wheel turns: its heading
+#: (8.10) jumps with a velocity or heading-rate step (False), its steering rate with an acceleration step (True).
+#: Where the twist only scales (the same ICR: a speed step or a trapezoidal profile on a line or a circle) every
+#: steered wheel keeps its heading and its steering rate, and only spin rates (kinematic) or spin accelerations
+#: (dynamic) jump, which each framework allows: the table's 'p_ref C1 / C2' is sufficient, not necessary.
+_STEERED = {"velocity": False, "omega": False, "acceleration": True, "omega_rate": True}
+
+
+def _steered_turn(robot: Robot, reference: Reference, point: tuple[float, float] | None, before: int, after: int,
+                  *, rate: bool) -> bool:
+    """Whether some steered wheel's heading (or, with `rate`, its steering rate) differs between samples `before`
+    and `after` of `reference`, tracked at `point`: the direction (modulo half a turn, a 2-quadrant root of (8.9))
+    of the wheel centre's velocity in the robot frame, ``u = R^T v + omega J d``, and its rate
+    ``(u x u') / |u|^2`` with ``u' = R^T a - omega J R^T v + alpha J d`` (``d`` the wheel from the point). A wheel at
+    rest on either side turns freely there."""
+    p = np.zeros(2) if point is None else np.asarray(point, dtype=float)
+    d = np.array([w.position for w in robot.wheels if w.type in ("steerable", "double")]) - p
+    out = []
+    for k in (before, after):
+        c, s = math.cos(reference.pose[k, 2]), math.sin(reference.pose[k, 2])
+        (vx, vy, w), (ax, ay, al) = reference.velocity[k], reference.acceleration[k]
+        vr = np.array([c * vx + s * vy, -s * vx + c * vy])
+        ar = np.array([c * ax + s * ay, -s * ax + c * ay])
+        u = vr[:, None] + w * np.array([-d[:, 1], d[:, 0]])
+        du = (ar + w * np.array([vr[1], -vr[0]]))[:, None] + al * np.array([-d[:, 1], d[:, 0]])
+        speed2 = u[0] ** 2 + u[1] ** 2
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out.append((speed2, (u[0] * du[1] - u[1] * du[0]) / speed2 if rate else np.arctan2(u[1], u[0])))
+    (s0, x0), (s1, x1) = out
+    moving = (s0 > 1e-12) & (s1 > 1e-12)
+    change = np.abs(x1 - x0) if rate else np.abs(_wrap(x1 - x0, math.pi))
+    return bool(np.any(moving & (change > _FLOOR["chi_rate" if rate else "chi"])))
+
+
+def _remedy(req: Requirement, signal: str, turns: bool | None = None) -> str:
     if signal == "position":
         return "the reference jumps: no vehicle can follow it; the position loop removes the error afterwards"
     if req.column == "type 4, on axle" and signal == "chi":
         return (f"{_VEHICLE}, re-orienting the orientable wheel twice (tangent and curvature both jump)")
     if req.column == "type 4, on axle" and signal == "kappa":
         return _WHEEL
-    if req.column.startswith("type 1") or req.column.startswith("type 2, off"):
+    if req.column.startswith("type 1") or req.column.startswith("type 2, off") or turns is False:
         if req.framework == "dynamic":  # velocity or heading rate: the pose stays continuous, the rates would not
             return (f"the {'heading rate' if signal == 'omega' else 'velocity'} steps (the wheels' rates would jump, "
                     "which the dynamic framework forbids): an error appears that the position loop then removes")
