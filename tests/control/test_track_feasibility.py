@@ -115,7 +115,8 @@ def test_through_the_dynamics_the_dynamic_framework_judges(capsys):
     assert main(["track", "forklift", "--reference", "arc-line", "--dynamics", "--duration", "10"]) == 0
     assert _warned(capsys.readouterr().err) == [
         f"{WARNING}'type 4, off axle' for the tracked point, dynamic framework): turn-rate jump (chi not C1) at "
-        "t = 9.43 s: stop and re-orient the orientable wheel"]
+        "t = 9.43 s: the turn rate steps (the wheels' rates would jump, which the dynamic framework forbids; the "
+        "angles do not): slow to rest there, or an error appears that the position loop then removes"]
 
 
 def test_smooth_references_are_followed_by_every_catalog_robot_at_every_tracked_point():

@@ -402,18 +402,30 @@ def _steered_turn(robot: Robot, reference: Reference, point: tuple[float, float]
     return bool(np.any(moving & (change > _FLOOR["chi_rate" if rate else "chi"])))
 
 
+#: The rate signals, by name: a jump of one leaves every steering angle and the heading continuous (the wheels'
+#: rates jump), unless a steered wheel turns with a velocity or heading-rate step of types 3 and 5 (``turns``).
+_RATES = {"velocity": "velocity", "omega": "heading rate", "acceleration": "acceleration",
+          "omega_rate": "angular acceleration", "chi_rate": "turn rate", "kappa_rate": "curvature rate"}
+
+
 def _remedy(req: Requirement, signal: str, turns: bool | None = None) -> str:
+    """What to do about a jump of `signal` for `req`: Table 8.1's re-orientation only where an angle the vehicle
+    holds (a steering angle, or the heading of a vehicle tracked on its fixed axle) would jump."""
     if signal == "position":
         return "the reference jumps: no vehicle can follow it; the position loop removes the error afterwards"
+    if signal == "theta":  # the pose jumps: no wheel's re-orientation follows it
+        return "an error appears that the position loop then removes (kinematics allows no jump here)"
     if req.column == "type 4, on axle" and signal == "chi":
         return (f"{_VEHICLE}, re-orienting the orientable wheel twice (tangent and curvature both jump)")
     if req.column == "type 4, on axle" and signal == "kappa":
         return _WHEEL
-    if req.column.startswith("type 1") or req.column.startswith("type 2, off") or turns is False:
-        if req.framework == "dynamic":  # velocity or heading rate: the pose stays continuous, the rates would not
-            return (f"the {'heading rate' if signal == 'omega' else 'velocity'} steps (the wheels' rates would jump, "
-                    "which the dynamic framework forbids): an error appears that the position loop then removes")
-        return "an error appears that the position loop then removes (kinematics allows no jump here)"
-    if signal == "velocity" and req.framework == "dynamic" and "l_o != 0" not in req.column:
-        return "the speed steps (the wheels' rates would jump): an error appears that the position loop then removes"
+    if signal in _RATES and not (turns and signal in ("velocity", "omega")):
+        if signal in ("velocity", "omega"):
+            return (f"the {_RATES[signal]} steps (the wheels' rates would jump, which the dynamic framework "
+                    "forbids): an error appears that the position loop then removes")
+        # the angles stay continuous, their rates step: at rest on both sides every rate is 0 (the rates are the
+        # speed times their rate along the path)
+        return (f"the {_RATES[signal]} steps (the wheels' rates would jump, which the dynamic framework forbids; the "
+                "angles do not): slow to rest there, or an error appears that the position loop then "
+                "removes")
     return req.remedy
