@@ -158,7 +158,8 @@ def test_a_spike_is_reported_with_its_size():
     t = np.arange(0.0, 20.0, 0.01)
     jump = reference_from_samples("jump.csv", t, np.column_stack([np.where(t >= 10, 1.0, 0.0), 0 * t, 0 * t]))
     got = feasibility(catalog.load("omni-3"), jump, "dynamic").violations
-    assert [v.signal for v in got] == ["velocity"] and got[0].size == pytest.approx(50.0)  # 1 m over 2 x 0.01 s
+    # 1 m over 2 x 0.01 s; and the position's own jump (C1 is C0 too), as for every other column
+    assert [v.signal for v in got] == ["velocity", "position"] and got[0].size == pytest.approx(50.0)
 
 
 def _from_rest(t, ramp=4.0, v=1.0):
@@ -559,6 +560,26 @@ def test_a_remedy_re_orients_only_what_would_jump():
     assert v.signal == "omega" and "re-orient" not in v.remedy
     jump = reference_from_samples("turn.csv", t, np.column_stack([0.5 * t, 0 * t, np.where(t < 5, 0.0, 1.0)]))
     for name, framework in [("swerve-4", "kinematic"), ("swerve-4", "dynamic"), ("thesis-steer-castor", "kinematic"),
-                            ("thesis-steer-castor", "dynamic"), ("mecanum-4", "kinematic")]:
+                            ("thesis-steer-castor", "dynamic"), ("mecanum-4", "kinematic"), ("mecanum-4", "dynamic")]:
         got = [v for v in feasibility(catalog.load(name), jump, framework).violations if v.signal == "theta"]
         assert got and all("re-orient" not in v.remedy and "no jump" in v.remedy for v in got), (name, framework)
+
+
+def test_the_dynamic_framework_needs_the_pose_continuous_too():
+    """C1 is C0 too: a reference whose pose jumps at t = 5 s (1 m along x, 1 rad of heading) while the derivatives it
+    gives stay smooth (a Reference built in Python) was 'feasible: yes' in the dynamic framework of type 1 and type 2
+    off the axle, whose lists held the velocity (and heading rate) only; the kinematic framework found the jump."""
+    from wmrkit.control.references import Reference
+
+    t = np.arange(0.0, 10.0, 0.01)
+    z = 0 * t
+    jump = np.where(t < 5, 0.0, 1.0)
+    ref = Reference("teleport", t, np.column_stack([0.5 * t + jump, z, jump]), np.column_stack([0.5 + z, z, z]),
+                    np.zeros((len(t), 3)))
+    for name in ("mecanum-4", "line-follower", "diff-drive", "forklift", "swerve-4", "thesis-steer-castor"):
+        for framework in ("kinematic", "dynamic"):
+            got = feasibility(catalog.load(name), ref, framework).violations
+            assert [(v.signal, v.t) for v in got] == [("position", 5.0)], (name, framework)
+    turn = Reference("turn", t, np.column_stack([0.5 * t, z, jump]), ref.velocity, ref.acceleration)
+    got = feasibility(catalog.load("mecanum-4"), turn, "dynamic").violations  # the heading alone jumps
+    assert [(v.signal, v.t) for v in got] == [("theta", 5.0)]

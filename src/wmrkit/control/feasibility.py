@@ -46,10 +46,13 @@ _WHEELS = "stop and re-orient the orientable wheels"
 #: Table 8.1: column -> (pose references, kinematic signals, dynamic signals, remedy, footnote). The dynamic
 #: framework of every column also needs the velocity continuous: the drive wheels' rates are proportional to the
 #: speed, and the table's conditions on chi alone rest on (8.34) 'chi C1 => v_a C0', which a speed step on a line
-#: (chi constant) contradicts.
+#: (chi constant) contradicts. Its conditions include the kinematic ones (C1 is C0 too): a reference whose pose
+#: jumps while its given derivatives stay smooth was 'feasible: yes' in the dynamic framework of types 1 and 2 off
+#: the axle.
 COLUMNS: dict[str, tuple[int, tuple[str, ...], tuple[str, ...], str]] = {
-    "type 1": (3, ("position", "theta"), ("velocity", "omega"), "the reference must be continuous"),
-    "type 2, off axle": (2, ("position",), ("velocity",), "the reference must be continuous"),
+    "type 1": (3, ("position", "theta"), ("position", "theta", "velocity", "omega"),
+               "the reference must be continuous"),
+    "type 2, off axle": (2, ("position",), ("position", "velocity"), "the reference must be continuous"),
     "type 2, on axle": (2, ("position", "chi"), ("position", "chi", "velocity", "chi_rate"), _VEHICLE),
     "type 4, off axle": (2, ("position", "chi"), ("position", "chi", "velocity", "chi_rate"), _WHEEL),
     "type 4, on axle": (2, ("position", "chi", "kappa"), ("position", "chi", "velocity", "kappa", "kappa_rate"),
