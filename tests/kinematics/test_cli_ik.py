@@ -106,7 +106,8 @@ def test_ik_text_names_each_reason_once(capsys):
     (["ik", "no-such-robot", "--twist", "1", "0", "0"], "no robot 'no-such-robot'"),
     (["fk", "diff-drive", "--spin", "lft=1"], "no joint rate 'lft' (valid: left, right"),
     (["fk", "diff-drive", "--spin", "left=nan"], "--spin left: cannot read 'nan'"),
-    (["fk", "diff-drive"], "at least one joint rate"),
+    (["fk", "diff-drive"], "--spin: give at least one joint rate of robot 'diff-drive' as NAME=RATE, e.g. --spin "
+                           "left=10 (names: left.spin, right.spin, caster.steer, caster.spin)"),
 ])
 def test_user_mistakes_exit_2_with_one_line(capsys, argv, message):
     code, out, err = run(capsys, *argv)

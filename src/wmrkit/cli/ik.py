@@ -67,6 +67,10 @@ def run_fk(args: argparse.Namespace) -> int:
     """Print the twist and the slip residual; warn when the rates do not fix the twist or contradict each other."""
     robot = steered_robot(args.robot, args.steer)
     given = parse_assignments(args.spin, "--spin")
+    if not given:  # the library's "rates: ... got none" would name no option
+        spins = [w.name for w in robot.wheels if "spin" in w.kind.rates]
+        raise WmrkitError(f"--spin: give at least one joint rate of robot '{robot.name}' as NAME=RATE, e.g. --spin "
+                          f"{spins[0] if spins else robot.rate_names[0]}=10 (names: {', '.join(robot.rate_names)})")
     rates = {name: parse_value(value, "number", f"--spin {name}") for name, value in given.items()}
     for name, value in rates.items():
         if abs(value) > MAX_QUERY_RATE:
