@@ -11,7 +11,14 @@ import pytest
 
 from wmrkit import catalog
 from wmrkit.cli.main import main
-from wmrkit.control.references import BUILTIN, ReferenceError, builtin_reference, load_reference
+from wmrkit.control.references import (
+    BUILTIN,
+    TIGHTEST_TURN,
+    TURN_MARGIN,
+    ReferenceError,
+    builtin_reference,
+    load_reference,
+)
 from wmrkit.control.track import track
 from wmrkit.errors import UnknownNameError
 
@@ -336,6 +343,10 @@ def test_a_size_for_the_line_is_refused_and_help_gives_each_shapes_default(capsy
         text = " ".join(capsys.readouterr().out.split())
         stated = dict(re.findall(r"([a-z-]+) (?:radius|half width|side|leg) \((?:default )?([\d.]+)\)", text))
         assert stated == {n: f"{s0:g}" for n, (_, _, s0, _) in BUILTIN.items() if n != "line"}, stated
+        # the car's default circle is 6 m, not the 3 m stated: the help says which shapes grow, and by what rule
+        grows = re.search(r"the ([a-z, -]+) are larger by default for a robot whose steering limits its turns: "
+                          rf"their tightest turn {TURN_MARGIN:g} times its minimum turning radius", text)
+        assert grows and set(re.split(r", | and ", grows[1])) == set(TIGHTEST_TURN), text
 
 
 @pytest.mark.parametrize("options, advice", [(["--duration", "1e9"], "give a shorter duration (--duration)"),

@@ -79,7 +79,9 @@ def _reference_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--speed", metavar="V", help="speed of a built-in reference [m/s] (default 0.5)")
     p.add_argument("--size", metavar="L", help="size of a built-in reference [m]: circle radius (default 3), "
                                                "figure-eight half width (6), square side (6), arc-line radius (1.5), "
-                                               "corner leg (3); a line has none")
+                                               "corner leg (3); a line has none; the circle, figure-eight and "
+                                               "arc-line are larger by default for a robot whose steering limits "
+                                               "its turns: their tightest turn 1.5 times its minimum turning radius")
 
 
 #: What the size of each built-in reference measures (``--size``).
