@@ -176,6 +176,10 @@ def test_a_reference_beyond_the_steering_range_is_reported_not_followed(period):
     assert np.all(np.abs(run.heading) <= math.radians(40) + 1e-9)
     held = {v["wheel"]: v for v in run.range_violations()}
     assert set(held) == {"front_left", "front_right"} and all(v["duration"] > 5 for v in held.values())
+    for v in held.values():  # held to the run's end: the time held is the span, no interval past the last sample
+        assert v["to"] == run.t[-1] and v["duration"] <= v["to"] - v["from"] + 1e-9
+        hit = (run.t >= v["from"]) & (run.beyond_range[:, car.steer_names.index(v["wheel"])])
+        assert v["duration"] == pytest.approx(np.diff(run.t)[hit[:-1]].sum(), abs=1e-12)
     assert run.summary()["max_error"] > 0.3  # the circle is not followed
     assert run.to_dict()["beyond_steer_range"] == run.range_violations()
     wide = track(car, builtin_reference("circle", size=8.0), period=period, duration=12)  # within the range

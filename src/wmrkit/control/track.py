@@ -80,7 +80,8 @@ class TrackingRun:
 
     def range_violations(self) -> list[dict[str, Any]]:
         """Per steered wheel held at the end of its range: ``{"wheel", "from", "to", "duration"}`` ([s]: first
-        and last sample, and the time spent beyond the range, counted in samples)."""
+        and last sample, and the time spent beyond the range: each such sample's interval to the next, none after
+        the run's last sample)."""
         if self.beyond_range is None:
             return []
         return self._intervals(self.robot.steer_names, self.beyond_range)
@@ -94,7 +95,7 @@ class TrackingRun:
     def _intervals(self, names: tuple[str, ...], hits: np.ndarray) -> list[dict[str, Any]]:
         if not hits.any():
             return []
-        dt = np.diff(self.t, append=self.t[-1] + (self.t[-1] - self.t[-2] if len(self.t) > 1 else 0.0))
+        dt = np.diff(self.t, append=self.t[-1])  # each sample's interval to the next; the run ends at the last
         out = []
         for k, name in enumerate(names):
             hit = hits[:, k]
