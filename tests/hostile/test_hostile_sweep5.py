@@ -341,13 +341,13 @@ def test_track_a_diverging_sampled_loop_is_refused(capsys):
 
 
 def test_a_continuous_loop_stops_within_its_computing_time_and_names_a_wheel_held_at_its_range(monkeypatch, capsys):
-    # 'track ackermann --reference figure-eight --gain 3' ran 6 minutes before 'too stiff': the law asks for turns
-    # tighter than the +-40 deg rack allows, and a front wheel held at an end of its range switched ends at every
-    # crossing of the heading asked of it past 90 deg (since the hold margin, the run answers in about 11 s). The
-    # bound remains: at most MAX_CONTINUOUS_SECONDS of computing (lowered here), and the refusal says where it got
-    # and which wheel is held. The loop's clock is a fake one advancing 0.5 s a reading
-    # (one reading every 1000 evaluations): on a loaded machine 2 s of real computing stopped it before any wheel
-    # was held, and the message had no wheel to name.
+    # 'track ackermann --reference figure-eight --size 6 --gain 3' (6 m: the car's default before 2799d61) ran 6
+    # minutes before 'too stiff': the law asks for turns tighter than the +-40 deg rack allows, and a front wheel
+    # held at an end of its range switched ends at every crossing of the heading asked of it past 90 deg (since the
+    # hold margin, the run answers in about 11 s). The bound remains: at most MAX_CONTINUOUS_SECONDS of computing
+    # (lowered here), and the refusal says where it got and which wheel is held. The loop's clock is a fake one
+    # advancing 0.5 s a reading (one reading every 1000 evaluations): on a loaded machine 2 s of real computing
+    # stopped it before any wheel was held, and the message had no wheel to name.
     import types
 
     from wmrkit.control import loop
@@ -356,7 +356,7 @@ def test_a_continuous_loop_stops_within_its_computing_time_and_names_a_wheel_hel
     monkeypatch.setattr(loop, "time", types.SimpleNamespace(monotonic=lambda: 0.5 * next(readings)))
     monkeypatch.setattr(loop, "MAX_CONTINUOUS_SECONDS", 2.0)
     start = time.monotonic()
-    message = _refused(["track", "ackermann", "--reference", "figure-eight", "--gain", "3"], capsys)
+    message = _refused(["track", "ackermann", "--reference", "figure-eight", "--size", "6", "--gain", "3"], capsys)
     assert time.monotonic() - start < 30
     assert re.search(r"too stiff to integrate over 90.47 s: it reached t = \S+ s after \d+ evaluations and \d+ s of "
                      r"computing .*wheel 'front_(left|right)' is held at an end of its steer_range", message), message
