@@ -13,6 +13,7 @@ and every writer converts back. Files written in β by older wmrkit versions say
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -95,3 +96,66 @@ def convert_steering(robot: Robot | None, joints: Sequence[str], positions: np.n
     out = p.copy()
     out[:, cols] = converted[:, idx] if to == "beta" else np.unwrap(converted[:, idx], axis=0)
     return out
+
+
+#: The share of a wheel's travel its no-slip rows may miss and still agree with rolling: the slip tolerance of a
+#: log (``wmrkit odometry``'s consistency rule, 2 % of the motion per interval), here for one wheel and interval.
+STEP_RTOL = 0.02
+
+
+#: A step is a change in one interval whose larger part its neighbours do not explain: at least twice theirs.
+STEP_SHARE = 0.5
+
+
+@dataclass(frozen=True, slots=True)
+class SteeringStep:
+    """The largest steering step of one sensed joint (:func:`steering_steps`): `interval` k lies between samples k
+    and k + 1; `step` [rad] its wrapped change, `excess` [rad] how much it exceeds the neighbouring intervals'
+    changes, `travel` [m] its wheel's travel there, `bound` [m] how far that travel can be off its direction,
+    ``2 travel sin(|step| / 4)``; `count`: the joint's intervals found so."""
+
+    joint: str
+    interval: int
+    step: float
+    excess: float
+    travel: float
+    bound: float
+    count: int
+
+
+def steering_steps(model, positions: np.ndarray) -> list[SteeringStep]:
+    """Sensed steering angles that step within one interval while their wheel rolls, over joint positions ``(N + 1,
+    len(model.joints))`` (β) of an :class:`~.model.OdometryModel`: one :class:`SteeringStep` per joint that has one.
+
+    The no-slip rows take each interval's steering at mid-interval, which is second order while the angle changes
+    smoothly (docs/odometry.md). A change the samples cannot place, made at any instant of the interval, puts the
+    wheel's travel ``s`` there up to ``2 s sin(|step| / 4)`` off its direction (all of it at the angle before the
+    step, or after). A smooth steering changes in an interval by about as much as in its neighbours (their
+    difference is second order in the sample period; a quantised encoder adds one count, a glitch in one reading
+    two opposite changes of one size), so the part of a change that is a step is its `excess` over the neighbours'
+    larger change. A joint is reported where that part is at least :data:`STEP_SHARE` of the change (a step, not a
+    turn that speeds up) and puts more than :data:`STEP_RTOL` of the interval's travel, and of the wheel's mean
+    travel per interval, off its direction.
+    The travel is the displacement of the wheel's steering axis by the no-slip body increment (0 when the wheel
+    steers at rest)."""
+    p = np.asarray(positions, dtype=float)
+    if not model.steer_joints or len(p) < 3:  # a step needs a neighbouring interval to compare with
+        return []
+    inc = model.from_positions(p).increments_robot  # (N, 3)
+    found = []
+    for joint in model.steer_joints:
+        x, y = model.robot.wheel(joint.rpartition(".")[0]).position
+        travel = np.hypot(inc[:, 0] - inc[:, 2] * y, inc[:, 1] + inc[:, 2] * x)
+        step = (np.diff(p[:, model.joints.index(joint)]) + np.pi) % (2 * np.pi) - np.pi  # wrapped, as the model
+        size = np.abs(step)
+        around = np.maximum(np.append(-np.inf, size[:-1]), np.append(size[1:], -np.inf))
+        excess = np.maximum(size - around, 0.0)
+        off = 2 * travel * np.sin(excess / 4)
+        hit = np.flatnonzero((excess >= STEP_SHARE * size) & (off > STEP_RTOL * travel)
+                             & (off > STEP_RTOL * travel.mean()))
+        if hit.size:
+            bound = 2 * travel * np.sin(size / 4)
+            k = int(hit[np.argmax(bound[hit])])
+            found.append(SteeringStep(joint, k, float(step[k]), float(excess[k]), float(travel[k]), float(bound[k]),
+                                      int(hit.size)))
+    return found
