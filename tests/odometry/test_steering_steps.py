@@ -67,6 +67,19 @@ def test_a_drive_unit_pivoting_within_a_sample_warns(capsys, tmp_path):
     assert STEP_RTOL * travel < off <= bound * 1.001
 
 
+def test_modules_that_all_step_warn_in_one_line(capsys, tmp_path):
+    """swerve-4's square without pauses: its four modules step 45 deg at each corner; one line names them all (its
+    redundancy also shows the steps as slip)."""
+    robot = catalog.load("swerve-4")
+    write_log(tmp_path / "sq.csv", simulate(robot, square_path(1.5), 20.0).log, robot)
+    out, _ = _run(capsys, "swerve-4", tmp_path / "sq.csv")
+    (line,) = _steps(out)
+    named = [j for j in ("front_left", "front_right", "rear_left", "rear_right") if f"{j}.steer" in line]
+    assert len(named) == 4 and " 45 deg within one interval (t = 2.95 to 3 s;" in line.replace("-", " ").replace(
+        "+", " ")
+    assert not out["consistent"] and any("contradict" in w for w in out["warnings"])
+
+
 @pytest.mark.parametrize("rate", [20.0, 100.0])
 def test_the_bound_is_first_order_in_the_sample_period(rate):
     """The step's travel, and so its bound, shrinks with the sample period (0.019 m at 20 Hz, 0.0038 m at 100 Hz)."""

@@ -285,22 +285,27 @@ def _check_gears(robot, log: str, fmt: LogFormat, sensed) -> bool:
 
 
 def _check_steering_steps(robot, log: str, fmt: LogFormat, sensed) -> None:
-    """Warn (one line per joint) where a sensed steering angle steps within one interval while its wheel rolls, over
-    the first samples of a CSV log (:func:`wmrkit.odometry.steering.steering_steps`): the no-slip rows take the
-    angle at mid-interval, so that interval's travel may be off its direction (a drive unit pivoting 90 deg within a
-    sample at each corner of a square turned 0.09 rad too little at 20 Hz, with "consistent": true)."""
+    """Warn (one line, naming the worst step and the other joints that step) where a sensed steering angle steps
+    within one interval while its wheel rolls, over the first samples of a CSV log
+    (:func:`wmrkit.odometry.steering.steering_steps`): the no-slip rows take the angle at mid-interval, so that
+    interval's travel may be off its direction (a drive unit pivoting 90 deg within a sample at each corner of a
+    square turned 0.09 rad too little at 20 Hz, with "consistent": true)."""
     from ..odometry.steering import steering_steps
 
     if is_bag(log) or not any(j.endswith(".steer") for j in odometry_model(robot, sensed).joints):
         return
     model, first = _first_samples(robot, log, fmt, sensed)
-    for s in steering_steps(model, first.positions):
-        t0, t1 = first.time[s.interval], first.time[s.interval + 1]
-        more = f"; {s.count} such steps over the first {len(first)} samples" if s.count > 1 else ""
-        warn(f"{s.joint} steps {math.degrees(s.step):+.4g} deg within one interval (t = {t0:.6g} to {t1:.6g} s; the "
-             f"intervals around it change it by {math.degrees(abs(s.step) - s.excess):.3g} deg at most) while the "
-             f"wheel travels {s.travel:.3g} m: up to {s.bound:.3g} m of that travel off its direction{more}; the "
-             "odometry assumes the angle changes uniformly within an interval: log faster")
+    steps = sorted(steering_steps(model, first.positions), key=lambda s: -s.bound)
+    if not steps:
+        return
+    s = steps[0]
+    t0, t1 = first.time[s.interval], first.time[s.interval + 1]
+    more = f"; {s.count} such steps over the first {len(first)} samples" if s.count > 1 else ""
+    others = f" (also {', '.join(o.joint for o in steps[1:])})" if len(steps) > 1 else ""
+    warn(f"{s.joint} steps {math.degrees(s.step):+.4g} deg within one interval (t = {t0:.6g} to {t1:.6g} s; the "
+         f"intervals around it change it by {math.degrees(abs(s.step) - s.excess):.3g} deg at most) while the wheel "
+         f"travels {s.travel:.3g} m: up to {s.bound:.3g} m of that travel off its direction{more}{others}; the "
+         "odometry assumes the angle changes uniformly within an interval: log faster")
 
 
 def _wheel_slips(robot, log: str, fmt: LogFormat, sensed) -> dict[str, float]:

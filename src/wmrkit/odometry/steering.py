@@ -14,12 +14,15 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
 from ..errors import WmrkitError
 from ..robot import Robot
+
+if TYPE_CHECKING:
+    from .model import OdometryModel
 
 #: Conventions of a log's steering columns: the users' heading (default) or the thesis's β (legacy files).
 CONVENTIONS = ("heading", "beta")
@@ -123,7 +126,7 @@ class SteeringStep:
     count: int
 
 
-def steering_steps(model, positions: np.ndarray) -> list[SteeringStep]:
+def steering_steps(model: OdometryModel, positions: np.ndarray) -> list[SteeringStep]:
     """Sensed steering angles that step within one interval while their wheel rolls, over joint positions ``(N + 1,
     len(model.joints))`` (β) of an :class:`~.model.OdometryModel`: one :class:`SteeringStep` per joint that has one.
 
