@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import os
 import sys
@@ -155,12 +156,13 @@ def run(args: argparse.Namespace) -> int:
         summary = replace(summary, method=f"{args.method} ({args.scheme})")
     if args.method in ("fk1", "fk2"):
         _warn_ill_conditioned(args.method, slip_model.model)
-    consistent = _check_consistency(summary, lambda: _wheel_slips(robot, args.log, fmt, args.sensed),
+    first = functools.cache(lambda: _first_samples(robot, args.log, fmt, args.sensed))  # read once, if at all
+    consistent = _check_consistency(summary, lambda: _wheel_slips(args.log, first),
                                     filtered=args.method if args.method in ("fk1", "fk2") else None)
     if fmt.heading_column or fmt.gyro_column:
-        consistent = _check_heading(robot, args.log, fmt, args.sensed) and consistent
-    consistent = _check_gears(robot, args.log, fmt, args.sensed) and consistent
-    _check_steering_steps(robot, args.log, fmt, args.sensed)  # the sampling, not the data: consistent as it is
+        consistent = _check_heading(args.log, fmt, first) and consistent
+    consistent = _check_gears(robot, args.log, first) and consistent
+    _check_steering_steps(robot, args.log, args.sensed, first)  # the sampling, not the data: consistent as it is
     if args.json:
         print_json(summary.to_dict() | {"consistent": consistent}, warnings=True)
     else:
@@ -228,13 +230,13 @@ HEADING_RTOL = 0.8
 HEADING_MIN_TURN = 0.1
 
 
-def _check_heading(robot, log: str, fmt: LogFormat, sensed) -> bool:
+def _check_heading(log: str, fmt: LogFormat, samples) -> bool:
     """Warn (:func:`._common.warn`) when the external heading's turns contradict the wheels' over the first samples of
     a CSV log (:data:`HEADING_RTOL`); return whether they did not. Its changes replace the wheels' dtheta, so a
     heading in other units or of the other sign gave a wrong trajectory with "consistent": true."""
     if is_bag(log):
         return True
-    model, first = _first_samples(robot, log, fmt, sensed)
+    model, first = samples()
     wheels = model.from_positions(first.positions).column(2)
     external = np.diff(first.heading_world)
     wheels = np.zeros_like(external) if wheels is None else wheels
@@ -256,7 +258,7 @@ GEAR_RTOL = 0.1
 GEAR_MIN_TURN = 0.1
 
 
-def _check_gears(robot, log: str, fmt: LogFormat, sensed) -> bool:
+def _check_gears(robot, log: str, samples) -> bool:
     """Warn (one line on stderr per gear) when the logged joints of a description's ``gear`` coupling do not turn
     together at its ratios over the first samples of a CSV log (:data:`GEAR_RTOL`); return whether they all did.
     Odometry reads each joint on its own: a log breaking the gear (another robot's, or a wrong description) was
@@ -264,7 +266,7 @@ def _check_gears(robot, log: str, fmt: LogFormat, sensed) -> bool:
     gears = [c for c in robot.couplings if c.kind == "gear"]
     if not gears or is_bag(log):
         return True
-    model, first = _first_samples(robot, log, fmt, sensed)
+    model, first = samples()
     steps = np.diff(first.positions, axis=0)
     agrees = True
     for gear in gears:
@@ -284,7 +286,7 @@ def _check_gears(robot, log: str, fmt: LogFormat, sensed) -> bool:
     return agrees
 
 
-def _check_steering_steps(robot, log: str, fmt: LogFormat, sensed) -> None:
+def _check_steering_steps(robot, log: str, sensed, samples) -> None:
     """Warn (one line, naming the worst step and the other joints that step) where a sensed steering angle steps
     within one interval while its wheel rolls, over the first samples of a CSV log
     (:func:`wmrkit.odometry.steering.steering_steps`): the no-slip rows take the angle at mid-interval, so that
@@ -294,7 +296,7 @@ def _check_steering_steps(robot, log: str, fmt: LogFormat, sensed) -> None:
 
     if is_bag(log) or not any(j.endswith(".steer") for j in odometry_model(robot, sensed).joints):
         return
-    model, first = _first_samples(robot, log, fmt, sensed)
+    model, first = samples()
     steps = sorted(steering_steps(model, first.positions), key=lambda s: -s.bound)
     if not steps:
         return
@@ -308,13 +310,13 @@ def _check_steering_steps(robot, log: str, fmt: LogFormat, sensed) -> None:
          "odometry assumes the angle changes uniformly within an interval: log faster")
 
 
-def _wheel_slips(robot, log: str, fmt: LogFormat, sensed) -> dict[str, float]:
+def _wheel_slips(log: str, samples) -> dict[str, float]:
     """The wheels' RMS slip [m per interval] over the first samples of a CSV log ({} for a bag)."""
     from ..odometry.model import wheel_slip
 
     if is_bag(log):
         return {}
-    model, first = _first_samples(robot, log, fmt, sensed)
+    model, first = samples()
     return wheel_slip(model, first.positions)
 
 
@@ -324,7 +326,8 @@ FIRST_SAMPLES = 20_000
 
 
 def _first_samples(robot, log: str, fmt: LogFormat, sensed):
-    """The no-slip model and the first :data:`FIRST_SAMPLES` samples of a CSV log, for the diagnostics."""
+    """The no-slip model and the first :data:`FIRST_SAMPLES` samples of a CSV log, for the diagnostics (each takes
+    them as ``samples()``, read once a run)."""
     from ..odometry.logs import read_csv
 
     model = odometry_model(robot, sensed)
