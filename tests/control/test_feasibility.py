@@ -153,13 +153,47 @@ def test_a_reference_mostly_at_rest_has_no_jump_where_it_moves_smoothly():
 
 
 def test_a_spike_is_reported_with_its_size():
-    """A sampled position jump is a velocity spike, up and back down: the whole change across it is 0, and the
-    dynamic framework of a type 1 robot reported a 'velocity jump' of size 0.0. Its size is now the spike's."""
+    """A velocity spike, up and back down (one sample of 50 m/s given with a still pose): the whole change across it
+    is 0, and the dynamic framework of a type 1 robot reported a 'velocity jump' of size 0.0. Its size is now the
+    spike's."""
+    from wmrkit.control.references import Reference
+
     t = np.arange(0.0, 20.0, 0.01)
-    jump = reference_from_samples("jump.csv", t, np.column_stack([np.where(t >= 10, 1.0, 0.0), 0 * t, 0 * t]))
-    got = feasibility(catalog.load("omni-3"), jump, "dynamic").violations
-    # 1 m over 2 x 0.01 s; and the position's own jump (C1 is C0 too), as for every other column
-    assert [v.signal for v in got] == ["velocity", "position"] and got[0].size == pytest.approx(50.0)
+    velocity = np.zeros((len(t), 3))
+    velocity[1000, 0] = 50.0
+    spike = Reference("spike", t, np.zeros((len(t), 3)), velocity, np.zeros((len(t), 3)))
+    got = feasibility(catalog.load("omni-3"), spike, "dynamic").violations
+    assert [v.signal for v in got] == ["velocity"] and got[0].size == pytest.approx(50.0)
+
+
+@pytest.mark.parametrize(("name", "framework"), [("omni-3", "dynamic"), ("line-follower", "dynamic"),
+                                                 ("swerve-4", "kinematic"), ("swerve-4", "dynamic"),
+                                                 ("ackermann", "dynamic"), ("thesis-steer-castor", "dynamic")])
+def test_a_sampled_step_is_one_violation(name, framework):
+    """A file's step between two samples (a teleport of 1 m, a heading jump of 1 rad, a corner: a velocity step) is
+    also a spike of its finite-difference derivative over the samples around it, starting one sample earlier: it was
+    reported as a second violation ('velocity jump' at 9.99 s and 'position jump' at 10 s; 'heading-rate jump' and
+    'heading jump'; 'acceleration jump' and 'velocity jump'). Each step is now reported once, as the step; a genuine
+    step of the derivative elsewhere (the speed doubling at 15 s, the curvature of the arc-line stepping) still is."""
+    t = np.arange(0.0, 20.0, 0.01)
+    robot = catalog.load(name)
+    # the speed doubles at 15 s (an independent velocity step, which the kinematic framework follows)
+    x = np.where(t < 15, 0.5 * t, 7.5 + (t - 15))
+    speed = [("velocity", 15.0)] if framework == "dynamic" else []
+    teleport = np.where(t >= 10, 1.0, 0.0)
+    for pose, first in [(np.column_stack([x + teleport, 0 * t, 0 * t]), ("position", 10.0)),
+                        (np.column_stack([x, 0 * t, teleport]), ("theta", 10.0))]:
+        if first[0] not in requirement(robot, framework).signals:
+            continue  # a heading jump is nothing to types 2 and 4
+        got = feasibility(robot, reference_from_samples("step.csv", t, pose), framework).violations
+        assert [(v.signal, round(v.t, 2)) for v in got] == [first, *speed], got
+    # a corner at constant heading at 10 s (a velocity step: its acceleration spikes from 9.99 s), for swerve-4
+    corner = np.column_stack([np.minimum(0.5 * t, 5.0), np.clip(0.5 * t - 5.0, 0, None), 0 * t])
+    got = feasibility(robot, reference_from_samples("corner.csv", t, corner), framework).violations
+    assert len(got) == 1 and got[0].t == pytest.approx(10.0), got
+    if name == "ackermann":  # the curvature step of the sampled arc-line and its curvature-rate spike: the step
+        arc_line = reference_from_samples("arc-line.csv", REFS["arc-line"].t, REFS["arc-line"].pose)
+        assert [v.signal for v in feasibility(robot, arc_line, framework).violations] == ["kappa"]
 
 
 def _from_rest(t, ramp=4.0, v=1.0):
@@ -201,8 +235,8 @@ def test_real_jumps_after_a_start_from_rest_are_found_where_they_are():
     got = [(v.signal, v.t, v.size) for v in feasibility(car, arc).violations]
     assert [g[0] for g in got] == ["kappa"] and got[0][1] == pytest.approx(7.0, abs=0.02)
     assert got[0][2] == pytest.approx(1 / 3, rel=0.02)
-    got = feasibility(car, arc, "dynamic").violations
-    assert [v.signal for v in got] == ["kappa_rate", "kappa"] and all(abs(v.t - 7.0) < 0.03 for v in got)
+    got = feasibility(car, arc, "dynamic").violations  # the step, and not its curvature-rate spike too
+    assert [v.signal for v in got] == ["kappa"] and all(abs(v.t - 7.0) < 0.03 for v in got)
     got = feasibility(forklift, arc, "dynamic").violations
     assert [v.signal for v in got] == ["chi_rate"] and got[0].size == pytest.approx(1 / 3, rel=0.02)
     corner = reference_from_samples("corner.csv", t, np.column_stack(

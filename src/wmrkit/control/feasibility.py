@@ -12,7 +12,8 @@ changes across it (:func:`_steered_turn`): a twist that only scales keeps them (
 Signals of the reference, sampled: position, tangent angle ``chi`` (8.29) and its rate ``omega_g`` (8.31),
 curvature ``kappa`` (8.33) and its rate, heading ``theta``, velocity and acceleration. A sample-to-sample change
 larger than ``jump_factor`` times the typical one where it is (the median of its block of 21 steps, or of a
-neighbouring block when larger) and than an absolute floor is a discontinuity.
+neighbouring block when larger) and than an absolute floor is a discontinuity, reported once: the spike of a
+derivative around a step of its signal is that step (:func:`_folded`).
 
 ``kappa`` and the rates are not judged where the reference rests or starts or stops (its speed changes by more
 than 5 % in a sample step), ``chi`` at rest and where the speed changes by more than itself in a step: there they
@@ -313,6 +314,7 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
     dense = _curvature_reference(reference) if set(req.signals) & set(_CURVATURE) else None
     dense_sig = None if dense is None else signals(dense)
     found: list[Violation] = []
+    seen: list[tuple[str, float, float]] = []  # (signal, from, to) of each jump reported or folded into another
     for name in req.signals:
         ref, s = (dense, dense_sig) if dense is not None and name in _CURVATURE else (reference, sig)
         x = s[name]
@@ -324,17 +326,40 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
         for k, last, size in _jumps(x, ref.t, _TURN.get(name), floor, jump_factor, s["at_rest"], across):
             if name == "kappa_rate" and not _persists(x, k, floor):
                 continue  # ringing of a third finite difference, not a step of the curvature rate
+            span = (name, float(ref.t[k]), float(ref.t[last + 1]))
+            if _folded(span, seen):
+                seen.append(span)
+                continue  # the spike of a derivative where its signal steps: one discontinuity, reported once
             turns = None
             if req.column == "types 3 and 5, l_o != 0" and name in _STEERED:
                 turns = _steered_turn(robot, ref, point, k, last + 1, rate=_STEERED[name])
                 if not turns and (req.framework == "kinematic" or _STEERED[name]):
                     continue  # the twist only scales (the same ICR): no steered wheel turns, only rates jump
             t = float(ref.t[k + 1])
+            seen.append(span)
             if any(v.t == t and v.signal in ("chi", "position") for v in found) and name != "position":
                 continue  # already reported by a lower-order signal at the same instant
             found.append(Violation(t, name, KINDS[name], size, _remedy(req, name, turns)))
     found.sort(key=lambda v: v.t)
     return Feasibility(req, tuple(found))
+
+
+#: The signal each one is a derivative of (the tangent: of the position's direction). A sampled step of a signal is a
+#: spike of its finite-difference derivative over the samples around it, starting one sample earlier: a position
+#: step of a file was a 'velocity jump' at t - dt and a 'position jump' at t, two violations for one discontinuity.
+_SOURCE = {"velocity": "position", "chi": "position", "omega": "theta", "acceleration": "velocity",
+           "omega_rate": "omega", "chi_rate": "chi", "kappa": "chi", "kappa_rate": "kappa"}
+
+
+def _folded(span: tuple[str, float, float], seen: list[tuple[str, float, float]]) -> bool:
+    """Whether the jump `span` ``(signal, from, to)`` [s] overlaps one found of a signal it is a derivative of (or
+    of that one's, and so on): the spike of that step, not a discontinuity of its own."""
+    name, t0, t1 = span
+    sources = set()
+    while name in _SOURCE:
+        name = _SOURCE[name]
+        sources.add(name)
+    return any(other in sources and a <= t1 and t0 <= b for other, a, b in seen)
 
 
 #: Signals from the normal acceleration (second differences of the positions, for a file), and the curvature rate
