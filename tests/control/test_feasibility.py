@@ -617,3 +617,55 @@ def test_the_dynamic_framework_needs_the_pose_continuous_too():
     turn = Reference("turn", t, np.column_stack([0.5 * t, z, jump]), ref.velocity, ref.acceleration)
     got = feasibility(catalog.load("mecanum-4"), turn, "dynamic").violations  # the heading alone jumps
     assert [(v.signal, v.t) for v in got] == [("theta", 5.0)]
+
+
+def _s_curve(speed, radius=3.0, duration=40.0):
+    """A 3 m arc to the left then one to the right, at `speed` with the heading along the path (exact derivatives):
+    the heading rate steps from speed / radius to -speed / radius at half time."""
+    from wmrkit.control.references import Reference
+
+    t = np.arange(0.0, duration, 0.01)
+    s, a = speed * t, speed * duration / (2 * radius)
+    left = s < speed * duration / 2
+    th = np.where(left, s / radius, 2 * a - s / radius)
+    cx, cy = radius * np.sin(a) + radius * np.sin(a), radius * (1 - np.cos(a)) - radius * np.cos(a)
+    x = np.where(left, radius * np.sin(th), cx - radius * np.sin(th))
+    y = np.where(left, radius * (1 - np.cos(th)), cy + radius * np.cos(th))
+    w = np.where(left, 1.0, -1.0) * speed / radius
+    velocity = np.column_stack([speed * np.cos(th), speed * np.sin(th), w])
+    acceleration = np.column_stack([-speed * w * np.sin(th), speed * w * np.cos(th), 0 * t])
+    return Reference("s-curve", t, np.column_stack([x, y, th]), velocity, acceleration)
+
+
+@pytest.mark.parametrize("name", ["swerve-4", "thesis-two-steer-castor"])
+def test_a_steering_jump_at_a_low_speed_is_found(name):
+    """Types 3 and 5 off the wheels: a steering angle is a state at any speed, but a twist step under the floor of
+    its signal (0.02 m/s, 0.02 rad/s) went unreported: the S-curve reversing its curvature at 0.01 m/s (heading rate
+    +-0.0033 rad/s) and a corner at 0.01 m/s (a velocity step of 0.014 m/s) were 'feasible: yes' although the
+    wheels' headings jump (the no-slip IK just before and after, below). A step from rest turns no wheel that
+    moves (its heading is undefined at rest): still feasible."""
+    from wmrkit.kinematics.wheel_ik import wheel_commands
+
+    robot = catalog.load(name)
+    steered = [i for i, w in enumerate(robot.wheels) if w.type == "steerable"]
+
+    def turn(before, after):  # the largest heading change of a steered wheel, modulo half a turn
+        h = [np.asarray(wheel_commands(robot, list(tw)).heading)[steered] for tw in (before, after)]
+        return float(np.max(np.abs(np.angle(np.exp(2j * (h[1] - h[0])))) / 2))
+
+    exact = _s_curve(0.01)
+    assert turn((0.01, 0, 0.01 / 3), (0.01, 0, -0.01 / 3)) > 0.1  # robot-frame twists either side
+    corner_t = np.arange(0.0, 20.0, 0.01)
+    corner = reference_from_samples("corner.csv", corner_t, np.column_stack(
+        [np.minimum(0.01 * corner_t, 0.1), np.clip(0.01 * corner_t - 0.1, 0, None), 0 * corner_t]))
+    assert turn((0.01, 0, 0), (0, 0.01, 0)) == pytest.approx(np.pi / 2)
+    cases = [(exact, "omega", 20.0), (reference_from_samples("s.csv", exact.t, exact.pose), "omega", 20.0),
+             (corner, "velocity", 10.0)]
+    for ref, signal, t in cases:
+        for framework in ("kinematic", "dynamic"):
+            got = feasibility(robot, ref, framework).violations
+            assert [(v.signal, round(v.t, 2)) for v in got] == [(signal, t)], (ref.name, framework, got)
+            assert "re-orient the orientable wheels" in got[0].remedy
+    start = reference_from_samples("start.csv", corner_t, np.column_stack(
+        [0 * corner_t, 0.01 * np.clip(corner_t - 5, 0, None), 0 * corner_t]))
+    assert feasibility(robot, start).feasible

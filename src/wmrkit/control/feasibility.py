@@ -7,7 +7,9 @@ types 3 and 5 whether some steered wheel is away from it (``l_oi != 0``). The *k
 rates jump; the *dynamic* one needs them continuous, so every condition goes one derivative higher (§8.5).
 For types 3 and 5 with some ``l_oi != 0`` a velocity or heading-rate step (kinematic), an acceleration or
 angular-acceleration step (dynamic), is a violation only where a steered wheel's heading, respectively steering rate,
-changes across it (:func:`_steered_turn`): a twist that only scales keeps them (docs/errata.md).
+changes across it (:func:`_steered_turn`): a twist that only scales keeps them (docs/errata.md); a velocity or
+heading-rate step under its floor is one too where it turns a steered wheel (:func:`_slow_turns`: a steering angle
+is a state at any speed).
 
 Signals of the reference, sampled: position, tangent angle ``chi`` (8.29) and its rate ``omega_g`` (8.31),
 curvature ``kappa`` (8.33) and its rate, heading ``theta``, velocity and acceleration. A sample-to-sample change
@@ -323,7 +325,11 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
         floor = _FLOOR[name]
         # a car (R on the fixed axle of a type 4) cannot turn at rest: its tangent is compared across a stop
         across = name == "chi" and req.column == "type 4, on axle"
-        for k, last, size in _jumps(x, ref.t, _TURN.get(name), floor, jump_factor, s["at_rest"], across):
+        jumps = _jumps(x, ref.t, _TURN.get(name), floor, jump_factor, s["at_rest"], across)
+        slow = []
+        if req.column == "types 3 and 5, l_o != 0" and name in ("velocity", "omega"):
+            slow = _slow_turns(robot, ref, point, x, jumps, jump_factor)
+        for k, last, size in sorted(jumps + slow):
             if name == "kappa_rate" and not _persists(x, k, floor):
                 continue  # ringing of a third finite difference, not a step of the curvature rate
             span = (name, float(ref.t[k]), float(ref.t[last + 1]))
@@ -332,7 +338,7 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
                 continue  # the spike of a derivative where its signal steps: one discontinuity, reported once
             turns = None
             if req.column == "types 3 and 5, l_o != 0" and name in _STEERED:
-                turns = _steered_turn(robot, ref, point, k, last + 1, rate=_STEERED[name])
+                turns = (k, last, size) in slow or _steered_turn(robot, ref, point, k, last + 1, rate=_STEERED[name])
                 if not turns and (req.framework == "kinematic" or _STEERED[name]):
                     continue  # the twist only scales (the same ICR): no steered wheel turns, only rates jump
             t = float(ref.t[k + 1])
@@ -404,30 +410,57 @@ def _curvature_reference(reference: Reference) -> Reference | None:
 _STEERED = {"velocity": False, "omega": False, "acceleration": True, "omega_rate": True}
 
 
+#: Floor of a twist step below the usual one (m/s, rad/s) that may still turn a steered wheel: above the rounding of
+#: a smooth reference's finite differences.
+_SLOW_FLOOR = 1e-9
+
+
+def _slow_turns(robot: Robot, reference: Reference, point: tuple[float, float] | None, x: np.ndarray,
+                jumps: list[tuple[int, int, float]], factor: float) -> list[tuple[int, int, float]]:
+    """The steps of the velocity or heading rate `x` under its floor (away from the `jumps` found above it) that turn
+    a steered wheel (:func:`_steered_turns`). A steering angle is a state at any speed: a reference reversing its
+    curvature at 0.01 m/s (a heading-rate step of 0.007 rad/s on a 3 m radius) turns a swerve robot's wheels by
+    0.2 rad in a sample, and a corner at 0.01 m/s by a quarter turn; under the 0.02 floor of those signals both were
+    'feasible: yes'. A wheel at rest on either side turns freely (its heading is undefined there)."""
+    slow = [j for j in _jumps(x, reference.t, None, _SLOW_FLOOR, factor)
+            if not any(j[0] <= b + 2 and a - 2 <= j[1] for a, b, _ in jumps)]
+    if not slow:
+        return []
+    first, last = np.array([j[0] for j in slow]), np.array([j[1] + 1 for j in slow])
+    turns = _steered_turns(robot, reference, point, first, last, rate=False)
+    return [j for j, turn in zip(slow, turns, strict=True) if turn]
+
+
 def _steered_turn(robot: Robot, reference: Reference, point: tuple[float, float] | None, before: int, after: int,
                   *, rate: bool) -> bool:
+    """:func:`_steered_turns` of one pair of samples."""
+    return bool(_steered_turns(robot, reference, point, np.array([before]), np.array([after]), rate=rate)[0])
+
+
+def _steered_turns(robot: Robot, reference: Reference, point: tuple[float, float] | None, before: np.ndarray,
+                   after: np.ndarray, *, rate: bool) -> np.ndarray:
     """Whether some steered wheel's heading (or, with `rate`, its steering rate) differs between samples `before`
-    and `after` of `reference`, tracked at `point`: the direction (modulo half a turn, a 2-quadrant root of (8.9))
-    of the wheel centre's velocity in the robot frame, ``u = R^T v + omega J d``, and its rate
-    ``(u x u') / |u|^2`` with ``u' = R^T a - omega J R^T v + alpha J d`` (``d`` the wheel from the point). A wheel at
-    rest on either side turns freely there."""
+    and `after` (arrays of sample indices, one answer each) of `reference`, tracked at `point`: the direction
+    (modulo half a turn, a 2-quadrant root of (8.9)) of the wheel centre's velocity in the robot frame,
+    ``u = R^T v + omega J d``, and its rate ``(u x u') / |u|^2`` with ``u' = R^T a - omega J R^T v + alpha J d``
+    (``d`` the wheel from the point). A wheel at rest on either side turns freely there."""
     p = np.zeros(2) if point is None else np.asarray(point, dtype=float)
     d = np.array([w.position for w in robot.wheels if w.type in ("steerable", "double")]) - p
     out = []
-    for k in (before, after):
-        c, s = math.cos(reference.pose[k, 2]), math.sin(reference.pose[k, 2])
-        (vx, vy, w), (ax, ay, al) = reference.velocity[k], reference.acceleration[k]
-        vr = np.array([c * vx + s * vy, -s * vx + c * vy])
-        ar = np.array([c * ax + s * ay, -s * ax + c * ay])
-        u = vr[:, None] + w * np.array([-d[:, 1], d[:, 0]])
-        du = (ar + w * np.array([vr[1], -vr[0]]))[:, None] + al * np.array([-d[:, 1], d[:, 0]])
-        speed2 = u[0] ** 2 + u[1] ** 2
+    for k in (before, after):  # (samples, 1) against (wheels,)
+        c, s = np.cos(reference.pose[k, 2])[:, None], np.sin(reference.pose[k, 2])[:, None]
+        (vx, vy, w), (ax, ay, al) = reference.velocity[k].T[:, :, None], reference.acceleration[k].T[:, :, None]
+        vrx, vry = c * vx + s * vy, -s * vx + c * vy
+        ux, uy = vrx - w * d[:, 1], vry + w * d[:, 0]
+        dux = c * ax + s * ay + w * vry - al * d[:, 1]
+        duy = -s * ax + c * ay - w * vrx + al * d[:, 0]
+        speed2 = ux**2 + uy**2
         with np.errstate(invalid="ignore", divide="ignore"):
-            out.append((speed2, (u[0] * du[1] - u[1] * du[0]) / speed2 if rate else np.arctan2(u[1], u[0])))
+            out.append((speed2, (ux * duy - uy * dux) / speed2 if rate else np.arctan2(uy, ux)))
     (s0, x0), (s1, x1) = out
     moving = (s0 > 1e-12) & (s1 > 1e-12)
     change = np.abs(x1 - x0) if rate else np.abs(_wrap(x1 - x0, math.pi))
-    return bool(np.any(moving & (change > _FLOOR["chi_rate" if rate else "chi"])))
+    return np.any(moving & (change > _FLOOR["chi_rate" if rate else "chi"]), axis=1)
 
 
 #: The rate signals, by name: a jump of one leaves every steering angle and the heading continuous (the wheels'
