@@ -13,6 +13,7 @@ from wmrkit import catalog
 from wmrkit.cli.main import main
 from wmrkit.control.references import (
     BUILTIN,
+    CORNER_RECOVERY,
     TIGHTEST_TURN,
     TURN_MARGIN,
     ReferenceError,
@@ -347,6 +348,7 @@ def test_a_size_for_the_line_is_refused_and_help_gives_each_shapes_default(capsy
         grows = re.search(r"the ([a-z, -]+) are larger by default for a robot whose steering limits its turns: "
                           rf"their tightest turn {TURN_MARGIN:g} times its minimum turning radius", text)
         assert grows and set(re.split(r", | and ", grows[1])) == set(TIGHTEST_TURN), text
+        assert f"and the square and corner: legs of that radius plus {CORNER_RECOVERY:g} m" in text, text
 
 
 @pytest.mark.parametrize("options, advice", [(["--duration", "1e9"], "give a shorter duration (--duration)"),

@@ -81,7 +81,9 @@ def _reference_options(p: argparse.ArgumentParser) -> None:
                                                "figure-eight half width (6), square side (6), arc-line radius (1.5), "
                                                "corner leg (3); a line has none; the circle, figure-eight and "
                                                "arc-line are larger by default for a robot whose steering limits "
-                                               "its turns: their tightest turn 1.5 times its minimum turning radius")
+                                               "its turns: their tightest turn 1.5 times its minimum turning radius; "
+                                               "and the square and corner: legs of that radius plus 4 m, to recover "
+                                               "from each corner")
 
 
 #: What the size of each built-in reference measures (``--size``).
@@ -94,7 +96,14 @@ def _reference(args: argparse.Namespace, robot) -> tuple[Reference, float | None
     ``--size``, a built-in shape whose turns tighten with its size is one the robot can drive
     (:func:`wmrkit.control.references.default_size` at :func:`min_turning_radius`). Returns the reference, its size
     [m] (None: a file, or the line) and the words naming it (``circle of radius 6 m (...)``)."""
-    from ..control.references import BUILTIN, TIGHTEST_TURN, TURN_MARGIN, default_size, resolve_reference
+    from ..control.references import (
+        BUILTIN,
+        CORNER_RECOVERY,
+        TIGHTEST_TURN,
+        TURN_MARGIN,
+        default_size,
+        resolve_reference,
+    )
 
     speed = None if args.speed is None else _positive(args.speed, "--speed", "number")
     size = None if args.size is None else _positive(args.size, "--size", "length")
@@ -106,7 +115,10 @@ def _reference(args: argparse.Namespace, robot) -> tuple[Reference, float | None
     if size is None:
         return reference, None, reference.name
     words = f"{name} of {SIZE_WORDS[name]} {size:g} m"
-    if args.size is None and size > BUILTIN[name][2]:
+    if args.size is None and size > BUILTIN[name][2] and name not in TIGHTEST_TURN:  # square, corner
+        words += (f" (the robot's minimum turning radius, {turning:.4g} m, plus {CORNER_RECOVERY:g} m at least: "
+                  "room to recover from each corner)")
+    elif args.size is None and size > BUILTIN[name][2]:
         tightest = "" if TIGHTEST_TURN[name] == 1 else f", of radius {TIGHTEST_TURN[name] * size:.4g} m,"
         words += (f" (its tightest turn{tightest} at least {TURN_MARGIN:g} times the robot's minimum turning radius, "
                   f"{turning:.4g} m)")

@@ -21,8 +21,8 @@ from ..errors import UnknownNameError, WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_table_size
 from ..units import BARE_ANGLE_LIMIT
 
-__all__ = ["BUILTIN", "TIGHTEST_TURN", "TURN_MARGIN", "Reference", "ReferenceError", "builtin_reference",
-           "default_size", "load_reference", "reference_from_samples", "resolve_reference"]
+__all__ = ["BUILTIN", "CORNER_RECOVERY", "TIGHTEST_TURN", "TURN_MARGIN", "Reference", "ReferenceError",
+           "builtin_reference", "default_size", "load_reference", "reference_from_samples", "resolve_reference"]
 
 
 class ReferenceError(WmrkitError, ValueError):
@@ -253,23 +253,32 @@ BUILTIN = {
 #: per metre of size (the circle's is its radius, the arc-line's its arc's; Gerono's lemniscate of half width A,
 #: the figure-eight, turns on 0.2087557 A at its tightest, where cos^2(w t) = 0.38643: rounded down here, so the
 #: sized shape's turn is never below the margin). The line and the polylines (square, corner) have straight legs
-#: only: their corners are tangent jumps at any size (Table 8.1).
+#: only: their corners are tangent jumps at any size (Table 8.1), sized by :data:`CORNER_RECOVERY` instead.
 TIGHTEST_TURN = {"circle": 1.0, "arc-line": 1.0, "figure-eight": 0.208755}
 #: A robot's default size of such a shape makes its tightest turn at least this many times the robot's minimum
 #: turning radius (a car's steering stops), rounded up to a metre.
 TURN_MARGIN = 1.5
+#: The legs of a polyline (square, corner) for a robot that turns on R [m] at least are R plus this [m], rounded up
+#: to a metre: after each corner (a heading jump, Table 8.1) such a car turns with its wheels at their stops while
+#: about R of the reference passes, then the P law (8.2) closes its error e-fold every speed / gain (0.5 m at the
+#: defaults, 0.5 m/s and 1/s): 4 m more brings it back within 1 mm before the next corner (measured 2.5-2.8 m after
+#: the stops for R from 2.7 to 6.6 m; a faster speed or a softer gain needs longer legs, --size).
+CORNER_RECOVERY = 4.0
 
 
 def default_size(name: str, turning_radius: float = 0.0) -> float | None:
     """The default size [m] of built-in reference `name` (None for ``line``, which has none) for a robot that turns
-    on `turning_radius` [m] at least (0: on the spot): the shape's own (:data:`BUILTIN`), or, for a shape of
-    :data:`TIGHTEST_TURN`, the smallest whole metre whose tightest turn is :data:`TURN_MARGIN` times
-    `turning_radius` when that is larger, so that the robot can drive it."""
+    on `turning_radius` [m] at least (0: on the spot): the shape's own (:data:`BUILTIN`), or, when larger, for a
+    shape of :data:`TIGHTEST_TURN` the smallest whole metre whose tightest turn is :data:`TURN_MARGIN` times
+    `turning_radius`, so that the robot can drive it, and for the square and the corner legs of `turning_radius`
+    plus :data:`CORNER_RECOVERY` rounded up to a metre, so that it recovers from each corner within the next leg."""
     if name == "line":
         return None
     size = BUILTIN[name][2]
-    if name in TIGHTEST_TURN and turning_radius > 0:
+    if turning_radius > 0 and name in TIGHTEST_TURN:
         size = max(size, math.ceil(TURN_MARGIN * turning_radius / TIGHTEST_TURN[name]))
+    elif turning_radius > 0:  # the polylines: straight legs between corners
+        size = max(size, math.ceil(turning_radius + CORNER_RECOVERY))
     return size
 
 
