@@ -138,3 +138,24 @@ def test_odometry_feedback_through_the_dynamics():
     assert abs(run.error[-1] - drift[-1]) < est_error[-1] + 1e-9
     with pytest.raises(ControlError, match="dynamic plant"):
         track(fork, ref, feedback="odometry")
+
+
+@pytest.mark.parametrize("size", [3.0, 8.0])
+def test_stanley_s_projection_past_a_corner_takes_the_leg_ahead(size):
+    """A point past a corner on the first leg's extension is as far from both legs (the corner): the tie went to the
+    leg behind, so Stanley saw no heading or cross-track error and drove straight on for its 5 s search window
+    whenever roundoff put its front axle a hair left of that line ('wmrkit track ackermann --reference corner
+    --controller stanley --size 8': at the stops from t = 21 s, not 16, max error 4.09 m, not 1.36; the bicycle's
+    3.5 m, not 0.66). Now the leg ahead, as for a point a hair to the right of the line."""
+    from wmrkit.control.trackers import PathIndex
+
+    path = PathIndex(builtin_reference("corner", size=size))
+    corner = 2 * size  # [s]: the corner (0, -size), at arc length `size`, is reached at 0.5 m/s
+    for x in (0.0, -1e-15, 1e-15):
+        s, chi, e = path.project(np.array([x, -size - 0.3]), corner + 0.6)
+        assert (s, chi) == (pytest.approx(size), pytest.approx(0.0, abs=1e-12)), (x, s, chi)
+        assert e == pytest.approx(-0.3)  # right of the second leg, along +x
+    for robot in ("ackermann", "bicycle"):
+        run = track(catalog.load(robot), builtin_reference("corner", size=size), controller="stanley")
+        turned = run.pose[np.searchsorted(run.t, corner + 3.0), 2] - run.pose[0, 2]
+        assert turned > 0.5, (robot, turned)  # it turns left (to +x) within 3 s of the corner

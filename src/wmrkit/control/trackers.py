@@ -58,7 +58,7 @@ class PathIndex:
             u = 0.0 if n2 == 0 else min(max(float((point - a) @ d) / n2, 0.0), 1.0)
             q = a + u * d
             dist = float(np.hypot(*(point - q)))
-            if best is None or dist < best[0]:
+            if best is None or dist <= best[0]:  # a tie past a corner: the segment ahead
                 chi = math.atan2(d[1], d[0]) if n2 > 0 else self.tangent(j)
                 best = (dist, self.s[j] + u * math.sqrt(n2), chi, q)
         if best is None:
