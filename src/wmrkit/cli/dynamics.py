@@ -108,6 +108,7 @@ def run_tyre(args: argparse.Namespace) -> int:
 
 def run_simulate(args: argparse.Namespace) -> int:
     """Simulate, print a summary, write and plot on request."""
+    from ..dynamics.deviation import deviation_warning
     from ..dynamics.model import DynamicModel
     from ..dynamics.programs import path_program, read_torques
     from ..dynamics.simulate import MAX_STEPS, recordable_step, simulate
@@ -150,19 +151,26 @@ def run_simulate(args: argparse.Namespace) -> int:
     pose, tw, end = sim.pose[-1], sim.twist[-1], float(sim.t[-1])  # the last sample: the record step's multiple
     travelled = float(np.sum(np.hypot(*np.diff(sim.pose[:, :2], axis=0).T)))
     max_slip = float(np.hypot(sim.slip[..., 0], sim.slip[..., 1]).max())  # a contact's slip speed, not a component
+    deviation = sim.deviation()
     for warning in _tyre_warnings(model, sim.twist) + [
             f"{c.channel_name} is not modelled: each of its joints is driven on its own (docs/description-format.md, "
-            "Couplings)" for c in model.robot.couplings if c.kind == "gear"]:
-        warn(warning)
+            "Couplings)" for c in model.robot.couplings if c.kind == "gear"] + [
+            deviation_warning(model, inputs, deviation, max_slip) if deviation and deviation.large else ""]:
+        if warning:
+            warn(warning)
     if args.json:
         print_json({"robot": model.robot.name, "method": sim.method, "step": step, "duration": duration,
                     "samples": len(sim.t), "final_time": end, "final_pose": pose.tolist(), "final_twist": tw.tolist(),
-                    "path_length": travelled, "max_slip_speed": max_slip, "out": args.out}, warnings=True)
+                    "path_length": travelled, "max_slip_speed": max_slip,
+                    "deviation": deviation.to_dict() if deviation else None, "out": args.out}, warnings=True)
     else:
         print(f"{model.robot.name}: {duration:g} s simulated ({sim.method}, step {step:g} s), {len(sim.t)} samples")
         print(f"final pose (t = {end:g} s): x = {pose[0]:.6g} m, y = {pose[1]:.6g} m, theta = {pose[2]:.6g} rad")
         print(f"final twist (t = {end:g} s): vx = {tw[0]:.6g} m/s, vy = {tw[1]:.6g} m/s, omega = {tw[2]:.6g} rad/s")
         print(f"distance travelled: {travelled:.6g} m; largest slip speed {max_slip:.3g} m/s")
+        if deviation:
+            print(f"from the programmed path: {deviation.max_position:.3g} m at most (t = {deviation.max_time:g} s), "
+                  f"{deviation.end_position:.3g} m and {deviation.end_heading:.3g} rad at the end")
     return 0
 
 
@@ -266,7 +274,10 @@ def _plot_simulation(sim, name: str, out: str) -> None:
     import matplotlib.pyplot as plt
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
-    ax1.plot(sim.pose[:, 0], sim.pose[:, 1])
+    ax1.plot(sim.pose[:, 0], sim.pose[:, 1], label="simulated")
+    if sim.nominal_pose is not None:
+        ax1.plot(sim.nominal_pose[:, 0], sim.nominal_pose[:, 1], "--", label="programmed (no slip)")
+        ax1.legend()
     ax1.set(xlabel="x [m]", ylabel="y [m]", title=f"{name}: path", aspect="equal")
     for k, label in enumerate(("vx [m/s]", "vy [m/s]", "omega [rad/s]")):
         ax2.plot(sim.t, sim.twist[:, k], label=label)

@@ -110,7 +110,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
 
     t = _knots(time)
     _check_bandwidth(bandwidth)
-    twists = np.asarray(twists, dtype=float).reshape(len(t), 3)
+    twists = np.array(twists, dtype=float).reshape(len(t), 3)  # a copy: the inputs keep it (read-only)
     bad = ~(np.abs(twists) <= MAX_SPEED).all(axis=1)  # NaN included
     if bad.any():
         k = int(np.argmax(bad))
@@ -160,7 +160,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
             contact = _contacts_of(model, w.name)
             steer_limit[k] = max(loads[contact].sum(), 1.0) * lever
     return Inputs(*(readonly(a) for a in (t, np.zeros((len(t), n)), rates, gain, limit, headings, kp, kd,
-                                          steer_limit)))
+                                          steer_limit, twists, t.copy())))
 
 
 def _check_bandwidth(bandwidth: float) -> None:

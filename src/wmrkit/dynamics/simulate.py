@@ -9,6 +9,7 @@ scipy's LSODA), compiled with numba, with a ``tqdm`` bar on long runs. Inputs ar
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Literal
@@ -21,6 +22,7 @@ from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
+from .deviation import PathDeviation, nominal_poses
 from .model import DynamicModel
 from .runs import LiftOffError, adaptive_run, adaptive_samples, check_lift_off, fixed_run, records  # noqa: F401  (LiftOffError: API)
 from .tyres import Tyre
@@ -37,9 +39,13 @@ class Inputs:
     spins, steering); ``rate_reference (K, n)`` [rad/s] and ``rate_gain (n,)`` [N m s/rad]: wheel-rate servos
     ``tau += gain (reference - rate)``, saturated at ``torque_limit (n,)``; ``heading_reference (K, n_steer)``
     [rad, headings: 0 = rolling straight ahead] with ``steer_kp``, ``steer_kd (n_steer,)``: steering servos,
-    saturated smoothly at ``steer_limit (n_steer,)`` [N m] (``limit tanh(pd / limit)``; default and inf: none).
-    Checked when made (shapes that agree, times strictly increasing, finite values, gains and limits >= 0); a
-    simulator checks the widths against its model.
+    saturated smoothly at ``steer_limit (n_steer,)`` [N m] (``limit tanh(pd / limit)``; default and inf: none);
+    ``twist (M, 3)`` [m/s, m/s, rad/s] at the knots ``twist_time (M,)`` [s], or None: the body twists whose no-slip
+    motion the servo references are, linear between their knots (a twist program's, on its own time axis so that
+    ``dataclasses.replace(inputs, time=...)`` keeps them whole); :func:`simulate` integrates them into
+    :attr:`Simulation.nominal_pose`. Checked when made (shapes that agree,
+    times strictly increasing, finite values, gains and limits >= 0); a simulator checks the widths against its
+    model.
     """
 
     time: np.ndarray
@@ -51,6 +57,8 @@ class Inputs:
     steer_kp: np.ndarray
     steer_kd: np.ndarray
     steer_limit: np.ndarray | None = None
+    twist: np.ndarray | None = None
+    twist_time: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         _check_inputs(self)  # once, where the inputs are made; a simulator checks their widths against its model
@@ -78,7 +86,9 @@ class Simulation:
     ``t (N,)`` [s]; ``pose (N, 3)`` world ``(x, y, theta)``; ``twist (N, 3)`` robot frame; ``joint_positions``,
     ``joint_rates``, ``torques (N, n - 3)`` over ``joint_names`` (``names[3:]``; wheel angles, steering angles β);
     ``heading (N, n_steer)`` steering headings; ``forces (N, E, 2)`` [N] tyre forces (lateral, longitudinal; frame
-    Ē); ``loads (N, E)`` [N]; ``slip (N, E, 2)`` [m/s] slip velocities; ``wheel_speed (N, E)`` [m/s].
+    Ē); ``loads (N, E)`` [N]; ``slip (N, E, 2)`` [m/s] slip velocities; ``wheel_speed (N, E)`` [m/s];
+    ``nominal_pose (N, 3)`` or None: the poses of the program's twists (``Inputs.twist``) integrated from the
+    initial pose, the path the run was programmed to drive (:meth:`deviation`).
     """
 
     names: tuple[str, ...]
@@ -98,6 +108,13 @@ class Simulation:
     step: float
     info: dict = field(default_factory=dict)
     steered: tuple[str, ...] = ()  # the wheels of the heading columns
+    nominal_pose: np.ndarray | None = None
+
+    def deviation(self) -> PathDeviation | None:
+        """How far the run is from its program's path (:class:`~wmrkit.dynamics.deviation.PathDeviation`: end
+        position and heading errors, largest position and heading errors, at the records' times); None for inputs
+        that program no twists (torques)."""
+        return None if self.nominal_pose is None else PathDeviation.of(self.t, self.pose, self.nominal_pose)
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -200,7 +217,11 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     else:
         rec, info = fixed_run(model, s0, inp, duration, step, every, 0 if method == "semi-implicit" else 1, progress,
                            jac_every, allow_lift_off)
-    return _result(model, rec, method, step, info)
+    sim = _result(model, rec, method, step, info)
+    if inputs.twist is None:
+        return sim
+    nominal = nominal_poses(np.atleast_1d(inputs.twist_time), inputs.twist, sim.t, s0[:3])
+    return dataclasses.replace(sim, nominal_pose=readonly(nominal))
 
 
 class Stepper:
@@ -376,6 +397,13 @@ def _check_inputs(inputs: Inputs) -> None:
         bad = ~(a >= 0) if name == "torque_limit" else ~np.isfinite(a) | (a < 0 if ">=" in want else False)
         if bad.any():
             raise WmrkitError(f"{name}: expected {want}, got {float(a[bad].flat[0])!r}")
+    if (inputs.twist is None) != (inputs.twist_time is None):
+        raise WmrkitError("twist, twist_time: give both (body twists at their knots) or neither")
+    if inputs.twist is not None:
+        m = len(_knots(inputs.twist_time))
+        if not (np.shape(inputs.twist) == (m, 3) and np.all(np.isfinite(inputs.twist))):
+            raise ShapeError(f"twist: expected finite body twists of shape ({m}, 3), one per twist_time, got shape "
+                             f"{np.shape(inputs.twist)}")
 
 
 def _compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:

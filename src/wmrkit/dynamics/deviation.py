@@ -1,0 +1,136 @@
+"""How far a simulated run is from the path its program commands.
+
+A twist program (:func:`~wmrkit.dynamics.programs.twist_program`, the built-in paths of
+:func:`~wmrkit.dynamics.programs.path_program`) drives the wheels at the no-slip rates of body twists and does not
+feed the pose back: the robot goes where its tyres take it. :func:`nominal_poses` integrates the commanded twists
+(the pose rate of (3.15), ``R(theta) (vx, vy)`` and ``omega``) into the path the program describes, and
+:class:`PathDeviation` compares the simulated poses with it at the records' times.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Largest position deviation, as a share of the programmed path's size, and largest heading deviation, as a share
+#: of the programmed turn taken within [:data:`MIN_TURN`, one turn], that a run may show without a warning (measured
+#: over the catalog's robots with mass properties and the dynamics tests' robots x built-in paths x tyre models:
+#: docs/dynamics.md, "Deviation from the program": the forklift's largest 0.133 and 0.140, the skid steer's
+#: smallest 0.50 and 0.33 where it turns).
+POSITION_SHARE, TURN_SHARE = 0.25, 0.2
+#: Least programmed turn [rad] the heading share is taken of (a straight path's heading may drift 0.1 rad); the
+#: most is a turn (a heading 72 deg off is off the path, however many loops it has).
+MIN_TURN = 0.5
+#: Largest heading change [rad] of one quadrature piece of :func:`nominal_poses`, its turn-rate change times its
+#: duration included (three Gauss points a piece).
+_PIECE_TURN = 0.05
+_GAUSS = ((0.5 - 0.5 * math.sqrt(0.6), 5 / 18), (0.5, 8 / 18), (0.5 + 0.5 * math.sqrt(0.6), 5 / 18))
+
+
+def nominal_poses(time: np.ndarray, twists: np.ndarray, t: np.ndarray, pose0=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """Poses ``(len(t), 3)`` [m, m, rad] at the increasing times `t` of the robot moving at body `twists` ``(K,
+    3)`` (robot frame, linear between the knots `time`, held outside them) from `pose0` at ``t[0]``.
+
+    The heading is exact (the integral of a piecewise-linear turn rate); the position is integrated by three-point
+    Gauss quadrature on pieces whose turn plus turn-rate change times duration is at most 0.05 rad (relative error
+    about 1e-13), at most 64 pieces between two samples or knots.
+    """
+    t = np.asarray(t, dtype=float)
+    grid = np.union1d(t, time[(time > t[0]) & (time < t[-1])])
+    tw = np.column_stack([np.interp(grid, time, twists[:, k]) for k in range(3)])
+    h = np.diff(grid)
+    theta = pose0[2] + np.concatenate([[0.0], np.cumsum(h * (tw[:-1, 2] + tw[1:, 2]) / 2)])
+    xy = np.zeros((len(grid), 2))
+    xy[0] = pose0[:2]
+    bend = np.abs(theta[1:] - theta[:-1]) + np.abs(tw[1:, 2] - tw[:-1, 2]) * h
+    pieces = np.clip(np.ceil(bend / _PIECE_TURN), 1, 64).astype(int)
+    chunk = 1 << 16
+    for lo in range(0, len(h), chunk):  # bounded memory: at most 64 x 3 x chunk nodes at once
+        sl = slice(lo, lo + chunk)
+        m = pieces[sl]
+        interval = np.repeat(np.arange(len(m)), m)
+        first = np.repeat(np.cumsum(m) - m, m)
+        k = np.arange(len(interval)) - first  # the piece's index within its interval
+        increments = np.zeros((len(m), 2))
+        for g, share in _GAUSS:
+            s = (k + g) / m[interval]  # fraction of the interval
+            i = interval + lo
+            hi = h[i]
+            w0, w1 = tw[i], tw[i + 1]
+            v = w0 + (w1 - w0) * s[:, None]  # the twist, linear in time
+            th = theta[i] + hi * s * (w0[:, 2] + v[:, 2]) / 2  # exact: the mean of a linear rate
+            c, sn = np.cos(th), np.sin(th)
+            weight = hi / m[interval] * share
+            np.add.at(increments, interval, np.column_stack([c * v[:, 0] - sn * v[:, 1],
+                                                             sn * v[:, 0] + c * v[:, 1]]) * weight[:, None])
+        xy[lo + 1:lo + 1 + len(m)] = xy[lo] + np.cumsum(increments, axis=0)
+    at = np.searchsorted(grid, t)
+    return np.column_stack([xy[at], theta[at]])
+
+
+@dataclass(frozen=True)
+class PathDeviation:
+    """A simulated run against its program's path (:func:`nominal_poses`), at the records' times.
+
+    ``end_position`` [m]: the distance between the last simulated and programmed positions; ``end_heading`` [rad]:
+    the simulated heading minus the programmed one at the last sample (not wrapped: a robot that turned half as
+    much as programmed in a rectangle is about -3.1 rad off); ``max_position`` [m] at ``max_time`` [s]: the largest
+    position distance over the samples; ``max_heading`` [rad]: the largest heading difference (signed); ``size``
+    [m]: the programmed path's size (the diagonal of its positions' bounding box, at least 1 m); ``turn`` [rad]:
+    the programmed path's whole turn (the sum of its heading changes' magnitudes between samples).
+    """
+
+    end_position: float
+    end_heading: float
+    max_position: float
+    max_time: float
+    max_heading: float
+    size: float
+    turn: float
+
+    @classmethod
+    def of(cls, t: np.ndarray, pose: np.ndarray, nominal: np.ndarray) -> PathDeviation:
+        """The deviation of simulated poses ``(N, 3)`` at times `t` from the programmed poses `nominal`."""
+        distance = np.hypot(*(pose[:, :2] - nominal[:, :2]).T)
+        heading = pose[:, 2] - nominal[:, 2]
+        k = int(np.argmax(distance))
+        size = float(np.hypot(*np.ptp(nominal[:, :2], axis=0)))
+        turn = float(np.abs(np.diff(nominal[:, 2])).sum())
+        return cls(float(distance[-1]), float(heading[-1]), float(distance[k]), float(t[k]),
+                   float(heading[np.argmax(np.abs(heading))]), max(size, 1.0), turn)
+
+    @property
+    def large(self) -> bool:
+        """Whether the run left its program's path: its largest position deviation is more than
+        :data:`POSITION_SHARE` of the path's size, or its largest heading deviation more than :data:`TURN_SHARE`
+        of the programmed turn (within [:data:`MIN_TURN`, 2 pi])."""
+        return (self.max_position > POSITION_SHARE * self.size
+                or abs(self.max_heading) > TURN_SHARE * min(max(self.turn, MIN_TURN), 2 * math.pi))
+
+    def to_dict(self) -> dict:
+        """Plain data for JSON (m, rad, s)."""
+        return {"end_position": self.end_position, "end_heading": self.end_heading,
+                "max_position": self.max_position, "max_time": self.max_time, "max_heading": self.max_heading,
+                "path_size": self.size, "path_turn": self.turn, "large": self.large}
+
+
+def deviation_warning(model, inputs, deviation: PathDeviation, max_slip: float) -> str:
+    """One line saying that a run left its program's path, by how much, and why where that is knowable: a program
+    whose twists have no no-slip motion (a skid steer's turns: fixed wheels must slip sideways) turns less than its
+    wheel rates command."""
+    from ..kinematics.wheel_ik import wheel_commands
+    from .programs import SLIP_TOL
+
+    line = (f"the robot left the programmed path: up to {deviation.max_position:.3g} m from it (t = "
+            f"{deviation.max_time:g} s; the path is {deviation.size:.3g} m across and turns {deviation.turn:.3g} rad), "
+            f"{deviation.end_position:.3g} m and {deviation.end_heading:.3g} rad off at the end; ")
+    slip = np.abs(wheel_commands(model.robot, inputs.twist).slip)  # at the program's knots
+    if slip.max() > SLIP_TOL:
+        w = model.robot.wheel_names[int(np.argmax(slip.max(axis=0)))]
+        return line + (f"its twists have no no-slip motion (fixed wheel '{w}' must slip sideways, as a skid steer's "
+                       "do when it turns): the robot turns less than its wheel rates command (an effective track: "
+                       "wmrkit calibrate, docs/slip.md)")
+    return line + (f"its tyres slip (up to {max_slip:.3g} m/s): the program drives the wheel rates, not the pose "
+                   "(docs/dynamics.md)")
