@@ -63,8 +63,8 @@ def nominal_poses(time: np.ndarray, twists: np.ndarray, t: np.ndarray, pose0=(0.
             th = theta[i] + hi * s * (w0[:, 2] + v[:, 2]) / 2  # exact: the mean of a linear rate
             c, sn = np.cos(th), np.sin(th)
             weight = hi / m[interval] * share
-            np.add.at(increments, interval, np.column_stack([c * v[:, 0] - sn * v[:, 1],
-                                                             sn * v[:, 0] + c * v[:, 1]]) * weight[:, None])
+            increments[:, 0] += np.bincount(interval, (c * v[:, 0] - sn * v[:, 1]) * weight, len(m))
+            increments[:, 1] += np.bincount(interval, (sn * v[:, 0] + c * v[:, 1]) * weight, len(m))
         xy[lo + 1:lo + 1 + len(m)] = xy[lo] + np.cumsum(increments, axis=0)
     at = np.searchsorted(grid, t)
     return np.column_stack([xy[at], theta[at]])
