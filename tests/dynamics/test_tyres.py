@@ -297,3 +297,20 @@ def test_forces_at_slip_refuses_a_speed_below_the_regularisation_speed(capsys):
             tyre.forces_at_slip(1000.0, 0.01, 0.0, [2.0, 0.001])
     assert main(["tyre", "dugoff", "--load", "1000", "--slip-ratio", "0.01", "--speed", "0.001"]) == 2
     assert capsys.readouterr().err.startswith("wmrkit: error: --speed: must be at least the dugoff tyre's eps")
+
+
+def test_the_jacobian_triple_is_three_tyre_calls_bit_for_bit():
+    """contact_forces' forward differences share Pacejka's speed terms (the wheel speed does not change): the
+    three forces are those of three separate calls of each model's kernel, to the last bit."""
+    from wmrkit.dynamics import _kernels
+
+    rng = np.random.default_rng(7)
+    for kind in TYRES.values():
+        p = Tyre(kind.name).vector()
+        for fz, vl, vg, vw in rng.normal(0.0, 1.0, (50, 4)) * (5e3, 0.3, 0.3, 3.0) + (8e3, 0, 0, 0):
+            h = 1e-7 * (1.0 + abs(vl) + abs(vg))
+            got = _kernels.tyre_and_jacobian(kind.code, p, fz, vl, vg, vw, h)
+            want = (_kernels.tyre(kind.code, p, fz, vl, vg, vw, vg - vw),
+                    _kernels.tyre(kind.code, p, fz, vl + h, vg, vw, vg - vw),
+                    _kernels.tyre(kind.code, p, fz, vl, vg + h, vw, vg + h - vw))
+            assert got == want, kind.name

@@ -71,8 +71,9 @@ def _compiled_namespace():
     g = dict(vars(tyres))
     g["_asarray"] = _njit(_identity)
     g["TyreForces"] = _njit(_pair)
-    names = ("slip_ratio", "slip_angle", "magic_formula", "lu_longitudinal", "lu_lateral", "delft_combined",
-             "linear_forces", "coulomb_forces", "dugoff_forces", "pacejka_forces")
+    names = ("slip_ratio", "slip_angle", "magic_formula", "lu_longitudinal_coefficients", "lu_lateral_coefficients",
+             "lu_longitudinal", "lu_lateral", "delft_combined", "linear_forces", "coulomb_forces", "dugoff_forces",
+             "pacejka_speed_terms", "pacejka_at_speed", "pacejka_forces")
     for name in names:
         fn = getattr(tyres, name)
         g[name] = _njit(types.FunctionType(fn.__code__, g, name, fn.__defaults__, fn.__closure__))
@@ -83,6 +84,7 @@ drop_stale_cache([__file__, str(Path(__file__).with_name("_integrate.py")), tyre
 _NS = _compiled_namespace()
 _linear, _coulomb, _dugoff, _pacejka = (_NS[n] for n in ("linear_forces", "coulomb_forces", "dugoff_forces",
                                                           "pacejka_forces"))
+_pacejka_speed, _pacejka_at = _NS["pacejka_speed_terms"], _NS["pacejka_at_speed"]
 _rows = compile_cached(slip_row_entries, None)
 
 
@@ -96,6 +98,19 @@ def tyre(code, p, fz, vl, vg, vw, vr):
     if code == 2:
         return _dugoff(p[0], p[1], p[2], p[3], fz, vl, vg, vw, vr)
     return _pacejka(p[0], p[1], p[2], p[3], fz, vl, vg, vw, vr)
+
+
+@_inline
+def tyre_and_jacobian(code, p, fz, vl, vg, vw, h):
+    """:func:`tyre` at ``(vl, vg)``, ``(vl + h, vg)`` and ``(vl, vg + h)`` (rolling speed ``vg - vw``): the forward
+    differences of the Jacobian. Pacejka's speed terms are computed once: the wheel speed `vw` is the same."""
+    if code == 3:
+        terms = _pacejka_speed(p[0], p[2], vw)
+        return (_pacejka_at(terms, p[1], p[2], fz, vl, vg, vw, vg - vw),
+                _pacejka_at(terms, p[1], p[2], fz, vl + h, vg, vw, vg - vw),
+                _pacejka_at(terms, p[1], p[2], fz, vl, vg + h, vw, vg + h - vw))
+    return (tyre(code, p, fz, vl, vg, vw, vg - vw), tyre(code, p, fz, vl + h, vg, vw, vg - vw),
+            tyre(code, p, fz, vl, vg + h, vw, vg + h - vw))
 
 
 @_inline
@@ -189,14 +204,14 @@ def contact_forces(a, nu, pack, fz, f, g, vw, jac):
             vg += a[2 * e + 1, c] * nu[c]
             w += a[2 * e + 1, c] * nu[c] * carry[c]
         vw[e] = w
-        fl, fg = tyre(code[e], tp[e], fz[e], vl, vg, w, vg - w)
-        f[e, 0], f[e, 1] = fl, fg
         if jac:
             h = 1e-7 * (1.0 + abs(vl) + abs(vg))
-            fl2, fg2 = tyre(code[e], tp[e], fz[e], vl + h, vg, w, vg - w)
-            fl3, fg3 = tyre(code[e], tp[e], fz[e], vl, vg + h, w, vg + h - w)
+            (fl, fg), (fl2, fg2), (fl3, fg3) = tyre_and_jacobian(code[e], tp[e], fz[e], vl, vg, w, h)
+            f[e, 0], f[e, 1] = fl, fg
             g[e, 0, 0], g[e, 1, 0] = (fl2 - fl) / h, (fg2 - fg) / h
             g[e, 0, 1], g[e, 1, 1] = (fl3 - fl) / h, (fg3 - fg) / h
+        else:
+            f[e, 0], f[e, 1] = tyre(code[e], tp[e], fz[e], vl, vg, w, vg - w)
 
 
 @_inline

@@ -89,31 +89,45 @@ def magic_formula(x: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, e: Arr
     return d * np.sin(c * np.arctan(bx * (1 - e) + e * np.arctan(bx)))
 
 
+def lu_longitudinal_coefficients(v: ArrayLike, shifts: ArrayLike = 1.0) -> tuple:
+    """The speed-dependent terms of (7.82) at wheel speed `v` [m/s]: ``(shift, B, C, D, E)``, mu_y = magic formula
+    at ``s + shift``. They depend on the speed alone (the simulator's tyre Jacobian shares them)."""
+    v = np.abs(v)
+    c_sy = np.tan(np.pi / 180 * (84.21 + 5.16 * np.exp(-6.094 / (1 + v))))
+    shift = shifts * (0.0213 + 0.0086 * v) / c_sy
+    k8, k7 = 1.57, 0.8 - 0.0021 * v
+    k9 = c_sy / (k8 * k7)
+    s_m = 0.08 + 0.75 * np.exp(-v / 8)
+    k10 = (k9 * s_m - np.tan(0.5 * np.pi / k8)) / (k9 * s_m - np.arctan(k9 * s_m)) - 0.0162 * v
+    return shift, k9, k8, k7, k10
+
+
+def lu_lateral_coefficients(v: ArrayLike, shifts: ArrayLike = 1.0) -> tuple:
+    """The speed-dependent terms of (7.83) at wheel speed `v` [m/s]: ``(shift, B, C, D, E)`` (as
+    :func:`lu_longitudinal_coefficients`)."""
+    v = np.abs(v)
+    c_sx = 0.3 * np.tan(np.pi / 180 * (84.21 + 5.16 * np.exp(-6.094 / (1 + 5 * v))))
+    shift = shifts * (0.00639 + 0.0026 * v) / c_sx
+    k8, k7 = 1.2, 0.75 + 0.5 * np.exp(-v / 3)
+    k9 = c_sx / (k8 * k7)
+    a_m = 0.087 + 0.63 * np.exp(-v / 3)
+    k10 = (k9 * a_m - np.tan(0.5 * np.pi / k8)) / (k9 * a_m - np.arctan(k9 * a_m)) - 0.0162 * v
+    return shift, k9, k8, k7, k10
+
+
 def lu_longitudinal(s: ArrayLike, v: ArrayLike, shifts: ArrayLike = 1.0) -> np.ndarray:
     """Longitudinal coefficient mu_y(s, v) of appendix 7.A1, eq. (7.82) [Lu & Shih 05]; v = wheel speed [m/s].
 
     ``shifts = 0`` drops the horizontal shift (then mu_y(0) = 0 and the curve is odd).
     """
-    v = np.abs(v)
-    c_sy = np.tan(np.pi / 180 * (84.21 + 5.16 * np.exp(-6.094 / (1 + v))))
-    s_shifted = s + shifts * (0.0213 + 0.0086 * v) / c_sy
-    k8, k7 = 1.57, 0.8 - 0.0021 * v
-    k9 = c_sy / (k8 * k7)
-    s_m = 0.08 + 0.75 * np.exp(-v / 8)
-    k10 = (k9 * s_m - np.tan(0.5 * np.pi / k8)) / (k9 * s_m - np.arctan(k9 * s_m)) - 0.0162 * v
-    return magic_formula(s_shifted, k9, k8, k7, k10)
+    shift, k9, k8, k7, k10 = lu_longitudinal_coefficients(v, shifts)
+    return magic_formula(s + shift, k9, k8, k7, k10)
 
 
 def lu_lateral(alpha: ArrayLike, v: ArrayLike, shifts: ArrayLike = 1.0) -> np.ndarray:
     """Lateral coefficient mu_x(alpha, v) of appendix 7.A1, eq. (7.83); alpha in radians, v [m/s]."""
-    v = np.abs(v)
-    c_sx = 0.3 * np.tan(np.pi / 180 * (84.21 + 5.16 * np.exp(-6.094 / (1 + 5 * v))))
-    a_shifted = alpha + shifts * (0.00639 + 0.0026 * v) / c_sx
-    k8, k7 = 1.2, 0.75 + 0.5 * np.exp(-v / 3)
-    k9 = c_sx / (k8 * k7)
-    a_m = 0.087 + 0.63 * np.exp(-v / 3)
-    k10 = (k9 * a_m - np.tan(0.5 * np.pi / k8)) / (k9 * a_m - np.arctan(k9 * a_m)) - 0.0162 * v
-    return magic_formula(a_shifted, k9, k8, k7, k10)
+    shift, k9, k8, k7, k10 = lu_lateral_coefficients(v, shifts)
+    return magic_formula(alpha + shift, k9, k8, k7, k10)
 
 
 def delft_combined(s: ArrayLike, alpha: ArrayLike, mu_long: ArrayLike, mu_lat: ArrayLike,
@@ -166,12 +180,25 @@ def pacejka_forces(shifts, mu_scale, eps, _p3, fz, v_lat, v_long, v_wheel, v_rol
     The horizontal shifts (rolling resistance, a lateral bias) are scaled by ``tanh(|v_wheel| / eps)`` so that a
     wheel at rest feels no force without slip (the thesis does not treat standstill).
     """
+    return pacejka_at_speed(pacejka_speed_terms(shifts, eps, v_wheel), mu_scale, eps, fz, v_lat, v_long, v_wheel,
+                            v_roll)
+
+
+def pacejka_speed_terms(shifts, eps, v_wheel):
+    """The terms of :func:`pacejka_forces` that depend on the wheel speed alone: ``(shifts faded, (7.82)'s,
+    (7.83)'s)`` (:func:`lu_longitudinal_coefficients`, :func:`lu_lateral_coefficients`)."""
+    shifts = shifts * np.tanh(np.abs(v_wheel) / eps)  # the shifts fade out at standstill: no creep at rest
+    return shifts, lu_longitudinal_coefficients(v_wheel, shifts), lu_lateral_coefficients(v_wheel, shifts)
+
+
+def pacejka_at_speed(terms, mu_scale, eps, fz, v_lat, v_long, v_wheel, v_roll):
+    """:func:`pacejka_forces` from its speed terms (:func:`pacejka_speed_terms` at `v_wheel`)."""
+    shifts, (sh_y, b_y, c_y, d_y, e_y), (sh_x, b_x, c_x, d_x, e_x) = terms
     sigma = 1.0 - 2.0 * (v_wheel < 0)
     s = sigma * slip_ratio(v_long, v_wheel, v_roll, eps)
     a = sigma * slip_angle(v_lat, v_wheel, eps)
-    shifts = shifts * np.tanh(np.abs(v_wheel) / eps)  # the shifts fade out at standstill: no creep at rest
-    mu_long = lu_longitudinal(s, v_wheel, shifts)
-    mu_lat = lu_lateral(a, v_wheel, shifts)
+    mu_long = magic_formula(s + sh_y, b_y, c_y, d_y, e_y)
+    mu_lat = magic_formula(a + sh_x, b_x, c_x, d_x, e_x)
     comb = delft_combined(s, a, mu_long, mu_lat, shifts)
     load = -sigma * mu_scale * np.maximum(fz, 0.0)
     return load * comb[0], load * comb[1]
