@@ -45,7 +45,11 @@ def closed_fleet(diff, seed, odd=None, runs=6, noise=1e-5):
                     for k, r in enumerate(robots)]
 
 
-
 def refit_fails(args):
     """In place of batch.calibrate._refit_without: the refit of a closed fleet's other runs raises (an error)."""
     raise RuntimeError("injected refit failure")
+
+
+def curvature_fails(args):
+    """In place of batch.calibrate._curvature_of: the closed-path judge's Jacobian one step from the fit raises."""
+    raise RuntimeError("injected curvature failure")

@@ -158,3 +158,25 @@ def test_a_failed_refit_leaves_the_calibration_not_judged(engines, diff, monkeyp
         assert c.not_judged.startswith("run 1 (<synthetic>): the fit of the other runs without it failed "
                                        "(RuntimeError: injected refit failure)"), c.not_judged
         assert c.to_dict()["not_judged"] == c.not_judged and not [w for w in c.warnings if "disagrees" in w]
+
+
+def test_a_failed_curvature_leaves_the_calibration_not_judged(engines, diff, monkeypatch):
+    """The closed-path judge's curvature (the fleet Jacobian one step from the fit) raises on a worker: the whole
+    calibration failed as 'task 0 failed' (exit 2), the fit lost, where a failed refit kept it. Now the same as a
+    failed refit: the fit returned, the runs not judged, the reason naming the runs of the failed task and the error."""
+    from batch_params import closed_fleet, curvature_fails
+
+    from wmrkit.batch import calibrate
+
+    params, runs = closed_fleet(diff, 1, [0.06, 0.03])
+    c0 = fleet_calibrate(diff, runs, params)
+    assert c0.inconsistent is True  # judged without the failure (the odd run named)
+    monkeypatch.setattr(calibrate, "_curvature_of", curvature_fails)
+    for name, runner in {"serial": None, **engines}.items():
+        c = fleet_calibrate(diff, runs, params, runner=runner)
+        assert c.estimate == c0.estimate and c.interval == c0.interval, name
+        assert c.inconsistent is None and c.residual_ratios == c.closed_scores == (None,) * 6, name
+        runs_named = "every run" if name == "serial" else ", ".join(f"run {k} (<synthetic>)" for k in (1, 3, 5))
+        assert c.not_judged.startswith(f"{runs_named}: the Jacobian 0.001 from the fleet fit"), (name, c.not_judged)
+        assert "(RuntimeError: injected curvature failure)" in c.not_judged, c.not_judged
+        assert c.to_dict()["not_judged"] == c.not_judged and not [w for w in c.warnings if "disagrees" in w]

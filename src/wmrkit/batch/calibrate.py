@@ -115,6 +115,11 @@ def _jacobian_of(args: tuple[CalibrationProblem, np.ndarray, np.ndarray]) -> np.
     return problem.jacobian(p, r)
 
 
+def _curvature_of(args: tuple[CalibrationProblem, np.ndarray]) -> np.ndarray:
+    """The Jacobian of `problem`'s runs at `p` in one round trip (:func:`~wmrkit.batch.consistency.judge`'s)."""
+    return args[0].jacobian(args[1])
+
+
 #: Least fraction of bootstrap replicates that must determine the parameters (the others are dropped and counted).
 MIN_DETERMINED = 0.5
 
@@ -186,11 +191,16 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
 
         def jacobian(p: np.ndarray, r: np.ndarray | None) -> np.ndarray:
             """One round trip: each worker differentiates its own runs (their rows depend on them alone)."""
-            if r is None:
-                r = residuals(p)
-            runs_r = np.split(r, np.cumsum(problem.sizes())[:-1])
+            runs_r = np.split(residuals(p) if r is None else r, np.cumsum(problem.sizes())[:-1])
             mine = [np.concatenate([runs_r[j] for j in range(i, len(runs), k)]) for i in range(k)]
             return gather(runner.map(_jacobian_of, [(t, p, ri) for t, ri in zip(shared, mine, strict=True)]))
+
+        def curvature(points: list[np.ndarray]) -> list[np.ndarray | tuple[tuple[int, ...], TaskFailure]]:
+            """The Jacobian at each of `points`, one map; a point's failed task: its runs and error (judge's)."""
+            out = runner.map(_curvature_of, [(t, p) for p in points for t in shared], errors="return")
+            parts = [out[i * k:(i + 1) * k] for i in range(len(points))]
+            return [next(((tuple(range(i, len(runs), k)), f) for i, f in enumerate(part) if isinstance(f, TaskFailure)),
+                         None) or gather(part) for part in parts]
 
         r0 = residuals(np.zeros(len(params)))
         m, n = r0.size, len(params)
@@ -222,7 +232,7 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
                 notes += (f"bootstrap: {dropped} of {n_boot} replicates dropped, their resampled runs cannot tell "
                           "the parameters apart (the interval is over the others)",)
             lo, hi = np.quantile(kept, 0.5 - level / 2, axis=0), np.quantile(kept, 0.5 + level / 2, axis=0)
-        judged = judge(problem, fit, jacobian,  # a failed refit leaves the runs not judged, the fit stands
+        judged = judge(problem, fit, curvature,  # a failed refit or curvature: the runs not judged, the fit stands
                        lambda tasks: runner.map(_refit_without, tasks, errors="return"))
     finally:
         if own:

@@ -75,8 +75,9 @@ class Consistency:
     residuals beyond its own parameters: closed paths); ``inconsistent``: the largest over
     :data:`MAX_RATIO` (closed paths: a score over :data:`MAX_CLOSED_SCORE`; ``None`` when not judged);
     ``message``: the warning that names the run, or ``None``; ``not_judged``: why no run was judged
-    (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`REFIT_FAILED`), or ``None``; ``scores``: a fleet of closed paths'
-    per-run scores (:func:`judge`; another quantity than a ratio, under its own name), empty when not scored."""
+    (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`REFIT_FAILED`, :data:`CURVATURE_FAILED`), or ``None``; ``scores``: a
+    fleet of closed paths' per-run scores (:func:`judge`; another quantity than a ratio, under its own name), empty
+    when not scored."""
 
     ratios: tuple[float | None, ...]
     inconsistent: bool | None
@@ -167,6 +168,11 @@ REFIT_FAILED = ("{run}: the fit of the other runs without it failed ({why}): the
                 "each other, a run of another robot is averaged in unseen (the fleet fit stands)")
 #: Step [parameter units] of the forward difference of the fleet fit's Jacobian that gives each run's curvature.
 CURVATURE_STEP = 1e-3
+#: ... and why a closed fleet is not judged when that Jacobian fails (a worker's error, values not finite): the fleet
+#: fit is returned all the same ({runs}: those of the failed task or rows; {why}: the error).
+CURVATURE_FAILED = (f"{{runs}}: the Jacobian {CURVATURE_STEP:g} from the fleet fit (the closed-path judge's curvature) "
+                    "failed ({why}): the closed runs are not checked against each other, a run of another robot is "
+                    "averaged in unseen (the fleet fit stands)")
 
 
 def names(problem: CalibrationProblem) -> tuple[str, ...]:
@@ -203,14 +209,16 @@ def _quadratic_scores(jac, res, hess, floors) -> tuple[np.ndarray, np.ndarray]:
     return out, shift
 
 
-def judge(problem: CalibrationProblem, fit, jacobian: Callable, refit: Callable) -> Consistency:
+def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable) -> Consistency:
     """The runs of the fleet fit `fit` checked against each other: by their residual ratios
     (:func:`run_consistency`), else, for a fleet of closed paths (:data:`CLOSED`), each run against the others'
     pooled noise. A closed run's residuals (its final pose) are weighted by one over the square root of its wheel
     travel (at least 1 m: an encoder random walk's error grows so); its score is their RMS at the fit of the other
     runs over the others' RMS there (with ``R - n`` degrees of freedom). The others' fit is first taken on each run's
-    quadratic model about the fleet fit: the curvature from `jacobian` (the fit's) one :data:`CURVATURE_STEP` away
-    along each parameter, no new odometry. That model is good for runs that agree, but an odd run pulls the fleet
+    quadratic model about the fleet fit: the curvature from the fit's Jacobian one :data:`CURVATURE_STEP` away
+    along each parameter, no new odometry (`curvature`: ``[p] -> [that Jacobian, or (the runs of a task that
+    failed, its TaskFailure)]``, the engine's map; a failure or a value not finite leaves the fleet not judged,
+    :data:`CURVATURE_FAILED`). That model is good for runs that agree, but an odd run pulls the fleet
     fit far from the others' (a track 10 % off) and its score there came out 25 where the others' refit gave 301
     (first order: 20 against 96). So the run whose removal moves that fit the most is refitted without, from there,
     by `refit` (``[(problem, x0)] -> [(x, residuals of the problem's runs) or a TaskFailure]``, the engine's map;
@@ -227,7 +235,13 @@ def judge(problem: CalibrationProblem, fit, jacobian: Callable, refit: Callable)
     g, n = len(runs), fit.x.size
     w = 1 / np.sqrt(travels)
     floors = ROUNDOFF * np.sqrt(travels)  # ROUNDOFF times the travel, weighted
-    moved = [jacobian(fit.x + CURVATURE_STEP * np.eye(n)[i], None) for i in range(n)]
+    moved = curvature(list(fit.x + CURVATURE_STEP * np.eye(n)))
+    for m in moved:  # the fit stands; only the judging is lost
+        if isinstance(m, tuple) or not np.isfinite(m).all():
+            which, why = m if isinstance(m, tuple) else (np.flatnonzero(~np.isfinite(m).reshape(g, -1).all(axis=1)),
+                                                          "its values are not finite")
+            return Consistency((None,) * g, None, not_judged=CURVATURE_FAILED.format(
+                runs="every run" if len(which) == g else ", ".join(logs[k] for k in which), why=why))
     hess = np.stack([(j - fit.jac) / CURVATURE_STEP for j in moved], axis=-1).reshape(g, -1, n, n) \
         * w[:, None, None, None]
     scores, shift = _quadratic_scores(fit.jac.reshape(g, -1, n) * w[:, None, None], fit.fun.reshape(g, -1) * w[:, None],
