@@ -598,6 +598,25 @@ def test_three_runs_are_too_few_to_judge(diff):
     assert judged.inconsistent is False and judged.not_judged is None and judged.to_dict()["not_judged"] is None
 
 
+def test_runs_left_out_of_the_judging_are_named_with_the_reason(diff):
+    """A fleet of runs with references and closed paths among them (Python API), or one of a run whose reference has
+    two poses (also the CLI's): those runs had null ratios and scores while the others were judged, and not_judged
+    was null: nothing told "not judged because ..." from "missing". Now not_judged names them and says why."""
+    from wmrkit.batch.consistency import SOME_RUNS
+
+    refs = _fleet(diff, 5, n=4)
+    _, squares = closed_fleet(diff, 1, runs=2)
+    squares = [CalibrationRun.closed_path(replace(q.log, source=f"sq{k}.csv")) for k, q in enumerate(squares)]
+    short = replace(refs[0], log=replace(refs[0].log, source="short.csv"), reference=refs[0].reference[[4, 9]],
+                    at=refs[0].at[[4, 9]])  # run 0's log, two of its poses
+    for fleet, left in ((refs + squares, "sq0.csv, sq1.csv"), ([*refs, short], "short.csv")):
+        res = fleet_calibrate(diff, fleet, PARAMS)
+        assert res.inconsistent is False and res.closed_scores == (None,) * len(fleet)
+        assert [q is None for q in res.residual_ratios] == [f.log.source in left for f in fleet]
+        assert res.not_judged == res.to_dict()["not_judged"] == SOME_RUNS.format(runs=left)
+        assert res.not_judged.startswith(f"{left}: fewer than 6 residuals beyond the run's own parameters")
+
+
 def test_closed_paths_of_another_robot_are_named(diff):
     """Six closed squares, one of a robot with a 5 % larger left radius or a 10 % wider track: the fleet fit averaged
     it in with "inconsistent": null (not judged). Its score is now that many times the other runs' error at their

@@ -62,7 +62,8 @@ class FleetCalibration:
     (:func:`~wmrkit.batch.consistency.judge`; ``None`` for runs with reference trajectories); ``inconsistent``:
     the largest over :data:`~wmrkit.batch.consistency.MAX_RATIO` (closed paths:
     :data:`~wmrkit.batch.consistency.MAX_CLOSED_SCORE`; :mod:`wmrkit.batch.consistency`; ``None`` when not judged,
-    and ``not_judged`` says why: fewer than 4 runs, fewer than 5 closed paths, or a failed closed-path refit)."""
+    and ``not_judged`` says why: fewer than 4 runs, fewer than 5 closed paths, a failed closed-path refit or
+    curvature; it names the runs left out when the others are judged: closed paths among runs with references)."""
 
     robot: Robot
     parameters: tuple[tuple[str, ...], ...]

@@ -59,6 +59,11 @@ CLOSED = ("no run has 6 residuals beyond its own parameters (closed paths: a fin
           "runs, or a run without which the others cannot fit: the runs are not checked against each other, a run "
           "of another robot is averaged in unseen; 5 closed runs or more, or runs with reference trajectories, "
           "are checked")
+#: ... and why some runs are not judged while the others are: a closed path among runs with references, or a run
+#: whose reference has too few poses ({runs}: those runs, their per-run values null).
+SOME_RUNS = (f"{{runs}}: fewer than {MIN_DOF} residuals beyond the run's own parameters (a closed path, or a "
+             "reference of few poses) among runs with more: not checked against the other runs, a run of another "
+             "robot is averaged in unseen (the other runs are checked)")
 #: Why ``batch calibrate --slip`` does not judge its runs: the residual ratio is one of noise, and a slip fit's own
 #: residuals are the slip model's error. Simulated skid-steer fleets (quasi-static slip, 6 runs): agreeing runs up to
 #: 1.6 in 4 fleets, a run of a robot with twice the tyres' cornering stiffness (its friction ratio 1.59 against
@@ -75,7 +80,8 @@ class Consistency:
     residuals beyond its own parameters: closed paths); ``inconsistent``: the largest over
     :data:`MAX_RATIO` (closed paths: a score over :data:`MAX_CLOSED_SCORE`; ``None`` when not judged);
     ``message``: the warning that names the run, or ``None``; ``not_judged``: why no run was judged
-    (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`REFIT_FAILED`, :data:`CURVATURE_FAILED`), or ``None``; ``scores``: a
+    (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`REFIT_FAILED`, :data:`CURVATURE_FAILED`) or which runs were not
+    (:data:`SOME_RUNS`), or ``None``; ``scores``: a
     fleet of closed paths' per-run scores (:func:`judge`; another quantity than a ratio, under its own name), empty
     when not scored."""
 
@@ -129,9 +135,11 @@ def run_consistency(jac: np.ndarray, res: np.ndarray, sizes: Sequence[int], floo
     judged = tuple(None if np.isnan(q) else float(q) for q in ratios)
     if np.isnan(ratios).all():
         return Consistency(judged, None, not_judged=CLOSED)
+    unjudged = ", ".join(names[k] for k in np.flatnonzero(np.isnan(ratios)))
+    some = SOME_RUNS.format(runs=unjudged) if unjudged else None
     worst = int(np.nanargmax(ratios))
     if ratios[worst] <= MAX_RATIO:
-        return Consistency(judged, False)
+        return Consistency(judged, False, not_judged=some)
     rest = {int(k): float(np.nanmax(_ratios(a, b, c, own, everyone[everyone != k], d[k])[0], initial=0.0))
             for k in np.argsort(np.nan_to_num(ratios, nan=-1.0))[::-1][:CANDIDATES]}
     odd = min(rest, key=rest.__getitem__)
@@ -143,7 +151,7 @@ def run_consistency(jac: np.ndarray, res: np.ndarray, sizes: Sequence[int], floo
         message = (f"the runs disagree (residual ratio {ratios[worst]:.3g} for {names[worst]}, over {MAX_RATIO:g}) "
                    f"and no one run explains it (without {names[odd]} the largest is still {rest[odd]:.3g}): the fit "
                    "averages them; check the runs")
-    return Consistency(judged, True, message)
+    return Consistency(judged, True, message, some)
 
 
 #: Largest closed-path score of a fleet whose runs agree (:func:`judge`). Simulated fleets of 6 closed squares
