@@ -653,6 +653,27 @@ def test_closed_paths_that_agree_are_judged_and_not_flagged(diff):
         assert res.inconsistent is bool(odd) and max(res.closed_scores[1:]) < 5
 
 
+def test_a_closed_run_without_which_the_others_cannot_fit_is_named_not_flagged(diff):
+    """One clockwise square among five equal counter-clockwise ones, all of one robot, with --ci bootstrap (the
+    jacobian interval refuses the fleet): the five alone cannot tell the track from the radius ratio, so the lone
+    square's score measured their guess: 803, and it was named as another robot's. Now the fleet is not judged and
+    not_judged names that run and why (the jackknife interval's own test, CalibrationProblem.undetermined)."""
+    from wmrkit.batch.consistency import UNDETERMINED
+
+    params = default_parameters(diff, closed=True)
+    robot = apply_parameters(diff, params, [0.01, 0.03])
+    runs = [CalibrationRun.closed_path(simulate(robot, square_path(1.5 if k == 0 else 2.0, clockwise=k == 0, pause=0.5),
+                                                10.0, spin_noise_per_rad=1e-5, seed=k).log) for k in range(6)]
+    with pytest.raises(BatchError, match="without run 1 the other runs cannot tell these parameters apart"):
+        fleet_calibrate(diff, runs, params)
+    res = fleet_calibrate(diff, runs, params, ci="bootstrap", n_boot=40)
+    assert res.inconsistent is None and res.closed_scores == (None,) * 6 and not [w for w in res.warnings
+                                                                                  if "disagrees" in w]
+    assert res.not_judged == res.to_dict()["not_judged"]
+    head, _, _ = UNDETERMINED.partition("{why}")
+    assert res.not_judged.startswith(head.format(run="run 1 (<synthetic>)") + "their residuals leave"), res.not_judged
+
+
 def test_five_closed_paths_are_judged_by_refits_of_every_run(diff):
     """Five closed squares were not judged (not_judged, 'inconsistent': null): a run of a robot with a 5 % larger left
     radius or a 10 % wider track was averaged in unseen. Each run is now scored by the refit of the others without

@@ -56,9 +56,8 @@ FEW_RUNS = (f"fewer than {MIN_RUNS} runs: the runs are not checked against each 
 #: pooled noise instead (:func:`judge`), with fewer not (4 squares, two each way: each run moves the fit far, and
 #: the odd run's partner in direction scored 123; by refits of every run up to 57).
 CLOSED = ("no run has 6 residuals beyond its own parameters (closed paths: a final pose) and there are fewer than 5 "
-          "runs, or a run without which the others cannot fit: the runs are not checked against each other, a run "
-          "of another robot is averaged in unseen; 5 closed runs or more, or runs with reference trajectories, "
-          "are checked")
+          "runs: the runs are not checked against each other, a run of another robot is averaged in unseen; 5 closed "
+          "runs or more, or runs with reference trajectories, are checked")
 #: ... and why some runs are not judged while the others are: a closed path among runs with references, or a run
 #: whose reference has too few poses ({runs}: those runs, their per-run values null).
 SOME_RUNS = (f"{{runs}}: fewer than {MIN_DOF} residuals beyond the run's own parameters (a closed path, or a "
@@ -80,10 +79,9 @@ class Consistency:
     residuals beyond its own parameters: closed paths); ``inconsistent``: the largest over
     :data:`MAX_RATIO` (closed paths: a score over :data:`MAX_CLOSED_SCORE`; ``None`` when not judged);
     ``message``: the warning that names the run, or ``None``; ``not_judged``: why no run was judged
-    (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`REFIT_FAILED`, :data:`CURVATURE_FAILED`) or which runs were not
-    (:data:`SOME_RUNS`), or ``None``; ``scores``: a
-    fleet of closed paths' per-run scores (:func:`judge`; another quantity than a ratio, under its own name), empty
-    when not scored."""
+    (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`REFIT_FAILED`, :data:`CURVATURE_FAILED`, :data:`UNDETERMINED`) or
+    which runs were not (:data:`SOME_RUNS`), or ``None``; ``scores``: a fleet of closed paths' per-run scores
+    (:func:`judge`; another quantity than a ratio, under its own name), empty when not scored."""
 
     ratios: tuple[float | None, ...]
     inconsistent: bool | None
@@ -174,6 +172,13 @@ REFIT_EVERY = 6
 #: returned all the same ({run}: the run left out; {why}: the error).
 REFIT_FAILED = ("{run}: the fit of the other runs without it failed ({why}): the closed runs are not checked against "
                 "each other, a run of another robot is averaged in unseen (the fleet fit stands)")
+#: Why a closed fleet is not judged when the other runs without one cannot tell the parameters apart
+#: (:meth:`~wmrkit.odometry.calibration.CalibrationProblem.undetermined`, as the jackknife interval asks): the run's
+#: score would measure the others' guess (one clockwise square among 5 equal counter-clockwise ones, all of one
+#: robot: 803, named as another robot's). {run}: that run; {why}: the reason.
+UNDETERMINED = ("{run}: without it the other runs cannot tell the parameters apart ({why}): the closed runs are not "
+                "checked against each other, a run of another robot is averaged in unseen; add closed runs of other "
+                "sizes, both ways")
 #: Step [parameter units] of the forward difference of the fleet fit's Jacobian that gives each run's curvature.
 CURVATURE_STEP = 1e-3
 #: ... and why a closed fleet is not judged when that Jacobian fails (a worker's error, values not finite): the fleet
@@ -233,7 +238,8 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     the problem's last run is the one left out; a failure leaves the fleet not judged, :data:`REFIT_FAILED`), and its
     score is the refit's: in fleets of 6 squares the odd run's equalled a refit of every run. A fleet of fewer than
     :data:`REFIT_EVERY` runs refits every run. Over :data:`MAX_CLOSED_SCORE` the run of largest score is named;
-    with fewer than :data:`MIN_CLOSED_RUNS` closed runs the fleet is not judged (:data:`CLOSED`)."""
+    with fewer than :data:`MIN_CLOSED_RUNS` closed runs the fleet is not judged (:data:`CLOSED`), nor when the runs
+    but one cannot tell the parameters apart (:data:`UNDETERMINED`)."""
     robot, runs, sizes = problem.robot, problem.runs, problem.sizes()
     logs = names(problem)
     travels = np.array([max(travel(robot, run), 1.0) for run in runs])
@@ -241,6 +247,11 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     if judged.not_judged != CLOSED or len(runs) < MIN_CLOSED_RUNS or len(set(sizes)) != 1:
         return judged
     g, n = len(runs), fit.x.size
+    jac, res = fit.jac.reshape(g, -1, n), fit.fun.reshape(g, -1)
+    for k in range(g):  # the others must determine the parameters for a score (the jackknife interval's test)
+        why = problem.undetermined(fit.x, np.delete(jac, k, axis=0).reshape(-1, n), np.delete(res, k, axis=0).ravel())
+        if why is not None:
+            return Consistency(judged.ratios, None, not_judged=UNDETERMINED.format(run=logs[k], why=why))
     w = 1 / np.sqrt(travels)
     floors = ROUNDOFF * np.sqrt(travels)  # ROUNDOFF times the travel, weighted
     moved = curvature(list(fit.x + CURVATURE_STEP * np.eye(n)))
@@ -252,10 +263,11 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
                 runs="every run" if len(which) == g else ", ".join(logs[k] for k in which), why=why))
     hess = np.stack([(j - fit.jac) / CURVATURE_STEP for j in moved], axis=-1).reshape(g, -1, n, n) \
         * w[:, None, None, None]
-    scores, shift = _quadratic_scores(fit.jac.reshape(g, -1, n) * w[:, None, None], fit.fun.reshape(g, -1) * w[:, None],
-                               hess, floors)
+    scores, shift = _quadratic_scores(jac * w[:, None, None], res * w[:, None], hess, floors)
     if np.isnan(scores).any():  # a run without which the others cannot fit: not judged
-        return judged
+        k = int(np.flatnonzero(np.isnan(scores))[0])
+        return Consistency(judged.ratios, None, not_judged=UNDETERMINED.format(
+            run=logs[k], why=f"their weighted Jacobian's weakest direction under {RANK_TOL:g} of the largest"))
     again = [int(k) for k in np.argsort(np.linalg.norm(shift, axis=1))[::-1][:g if g < REFIT_EVERY else REFITS]]
     for k, done in zip(again, refit([(problem.with_runs(runs[:k] + runs[k + 1:] + runs[k:k + 1]),
                                       fit.x + shift[k]) for k in again]), strict=True):
