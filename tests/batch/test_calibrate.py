@@ -276,6 +276,9 @@ def test_cli_slip_weights_and_closure_warnings(skid_runs, diff, tmp_path, capsys
     direct = fleet_slip_calibrate(robot, [CalibrationRun(r.log, r.truth) for r in sims[:3]])
     assert out["ratio"] == pytest.approx(direct.ratio, rel=1e-6) and out["runs"] == 3
     assert out["ratio_interval"] == pytest.approx(list(direct.ratio_interval), rel=1e-6)
+    # each run's values name its log (they were unnamed: "compare the per-run values", but which is which?)
+    assert [r["file"] for r in out["per_run"]] == [str(tmp_path / f"s{i}.csv") for i in range(3)]
+    assert direct.logs == tuple(f"run {i} (<slip-synthetic>)" for i in (1, 2, 3))
     assert main(["batch", "calibrate", "skid-steer-4", str(tmp_path / "s*.csv"), "--reference", str(tmp_path / "ref"),
                  "--slip", "--workers", "0"]) == 0
     assert f"WLS mu_lateral / mu_longitudinal  {direct.ratio:.6g}" in capsys.readouterr().out

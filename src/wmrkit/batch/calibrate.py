@@ -96,8 +96,7 @@ class FleetCalibration:
         return {"robot": self.robot.name, "ci": self.ci, "level": self.level, "runs": self.runs,
                 "residuals": self.residuals, "rms_before": self.rms_before, "rms_after": self.rms_after,
                 "success": self.success, "warnings": list(self.warnings), "inconsistent": self.inconsistent,
-                "not_judged": self.not_judged,
-                "per_run": [{"file": f, "residual_ratio": q, "closed_score": c}
+                "not_judged": self.not_judged, "per_run": [{"file": f, "residual_ratio": q, "closed_score": c}
                             for f, q, c in zip(self.logs, self.residual_ratios,
                                                self.closed_scores or (None,) * len(self.logs), strict=True)],
                 "parameters": [{"group": list(g), "p": p, "low": lo, "high": hi}
@@ -107,13 +106,11 @@ class FleetCalibration:
 
 
 def _residuals_of(args: tuple[CalibrationProblem, np.ndarray]) -> np.ndarray:
-    problem, p = args
-    return problem.residuals(p)
+    return args[0].residuals(args[1])
 
 
 def _jacobian_of(args: tuple[CalibrationProblem, np.ndarray, np.ndarray]) -> np.ndarray:
-    problem, p, r = args
-    return problem.jacobian(p, r)
+    return args[0].jacobian(args[1], args[2])
 
 
 def _curvature_of(args: tuple[CalibrationProblem, np.ndarray]) -> np.ndarray:
@@ -299,7 +296,7 @@ def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float,
             a, b = (next(v for n, _, v in end if n == name) for end in ends)
             values.append((name, nominal, fitted, min(a, b), max(a, b)))
     groups = tuple((g,) if isinstance(g, str) else tuple(g) for g in params)
-    logs = names(problem)
+    logs = names(problem.runs)
     return FleetCalibration(apply_parameters(robot, params, fit.x), groups, tuple(map(float, fit.x)),
                             tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True)), tuple(values),
                             rms(r0), rms(fit.fun), len(problem.runs), int(r0.size), ci, level, bool(fit.success),
@@ -312,8 +309,8 @@ def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float,
 class FleetSlipCalibration:
     """Slip weights of a fleet: the WLS friction ratio ``mu_lateral / mu_longitudinal`` and the effective-track
     multiplier, each the geometric mean over the runs with its interval at ``level`` (Student's t over the runs'
-    log values: run-to-run variation, e.g. floors and loads); ``per_run``: ``(ratio, multiplier)`` of each run;
-    ``not_judged``: the runs are not checked against each other (why:
+    log values: run-to-run variation, e.g. floors and loads); ``per_run``: ``(ratio, multiplier)`` of each run, its
+    file in ``logs``; ``not_judged``: the runs are not checked against each other (why:
     :data:`~wmrkit.batch.consistency.SLIP_NOT_JUDGED`)."""
 
     robot: str
@@ -324,6 +321,7 @@ class FleetSlipCalibration:
     per_run: tuple[tuple[float, float], ...]
     level: float
     not_judged: str = SLIP_NOT_JUDGED
+    logs: tuple[str, ...] = ()
 
     @property
     def weights(self):
@@ -347,7 +345,8 @@ class FleetSlipCalibration:
                 "ratio": self.ratio, "ratio_interval": list(self.ratio_interval),
                 "wheel_separation_multiplier": self.multiplier, "multiplier_interval": list(self.multiplier_interval),
                 "not_judged": self.not_judged,
-                "per_run": [{"ratio": k, "wheel_separation_multiplier": m} for k, m in self.per_run]}
+                "per_run": [{"file": f, "ratio": k, "wheel_separation_multiplier": m}
+                            for f, (k, m) in zip(self.logs or (None,) * len(self.per_run), self.per_run, strict=True)]}
 
 
 def _slip_of(args: tuple) -> tuple[float, float]:
@@ -389,7 +388,8 @@ def fleet_slip_calibrate(robot: Robot, runs: Sequence[CalibrationRun], *, runner
     mean = logs.mean(axis=0)
     lo, hi, mid = np.exp(mean - half), np.exp(mean + half), np.exp(mean)
     return FleetSlipCalibration(robot.name, float(mid[0]), (float(lo[0]), float(hi[0])), float(mid[1]),
-                                (float(lo[1]), float(hi[1])), tuple((float(k), float(m)) for k, m in per_run), level)
+                                (float(lo[1]), float(hi[1])), tuple((float(k), float(m)) for k, m in per_run), level,
+                                logs=names(runs))
 
 
 def default_parameters(robot: Robot, *, closed: bool, sensed: Sequence[str] | None = None) -> list[Parameter]:

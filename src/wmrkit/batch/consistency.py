@@ -188,9 +188,9 @@ CURVATURE_FAILED = (f"{{runs}}: the Jacobian {CURVATURE_STEP:g} from the fleet f
                     "averaged in unseen (the fleet fit stands)")
 
 
-def names(problem: CalibrationProblem) -> tuple[str, ...]:
+def names(runs: Sequence[CalibrationRun]) -> tuple[str, ...]:
     """The runs' files as the answer names them (runs made in Python share '<log>' or '<synthetic>')."""
-    sources = [run.log.source for run in problem.runs]
+    sources = [run.log.source for run in runs]
     return tuple(s if sources.count(s) == 1 else f"run {k + 1} ({s})" for k, s in enumerate(sources))
 
 
@@ -241,7 +241,7 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     with fewer than :data:`MIN_CLOSED_RUNS` closed runs the fleet is not judged (:data:`CLOSED`), nor when the runs
     but one cannot tell the parameters apart (:data:`UNDETERMINED`)."""
     robot, runs, sizes = problem.robot, problem.runs, problem.sizes()
-    logs = names(problem)
+    logs = names(runs)
     travels = np.array([max(travel(robot, run), 1.0) for run in runs])
     judged = run_consistency(fit.jac, fit.fun, sizes, ROUNDOFF * travels, logs)
     if judged.not_judged != CLOSED or len(runs) < MIN_CLOSED_RUNS or len(set(sizes)) != 1:
