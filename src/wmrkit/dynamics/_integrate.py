@@ -8,8 +8,9 @@ wheel-rate servos ``tau += rate_gain (rate_ref - rate)`` saturated at ``tau_max`
 wrap(beta_ref - beta) - kd beta_dot``, saturated smoothly as ``steer_max tanh(u / steer_max)`` where ``steer_max >
 0``: the damping stays in the implicit matrix, so a saturated servo does not chatter between its limits.
 
-Speed (issue 10): every kernel of a step is inlined into :func:`run_semi_implicit`, which is compiled without numba's
-reference counting (nothing in it allocates); a record reuses the assembly of the step that starts at its time.
+Speed (issue 10): the kernels of a step are inlined into :func:`run_semi_implicit`, which is compiled without numba's
+reference counting (nothing in it allocates), but for the mass matrix and the normal loads, called (compiled once:
+:func:`wmrkit.dynamics._kernels._called`); a record reuses the assembly of the step that starts at its time.
 """
 
 from __future__ import annotations
