@@ -14,8 +14,9 @@ is a state at any speed).
 Signals of the reference, sampled: position, tangent angle ``chi`` (8.29) and its rate ``omega_g`` (8.31),
 curvature ``kappa`` (8.33) and its rate, heading ``theta``, velocity and acceleration. A sample-to-sample change
 larger than ``jump_factor`` times the typical one where it is (the median of its block of 21 steps, or of a
-neighbouring block when larger) and than an absolute floor is a discontinuity, reported once: the spike of a
-derivative around a step of its signal is that step (:func:`_folded`).
+neighbouring block when larger) is a discontinuity where it, or its run of such changes of one sign (a sampled step
+split by finite differences), is larger than an absolute floor, reported once: the spike of a derivative around a
+step of its signal is that step (:func:`_folded`).
 
 ``kappa`` and the rates are not judged where the reference rests or starts or stops (its speed changes by more
 than 5 % in a sample step), ``chi`` at rest and where the speed changes by more than itself in a step: there they
@@ -258,7 +259,14 @@ def _jumps(x: np.ndarray, t: np.ndarray, turn: float | None, floor: float, facto
     near = np.maximum(blocks, np.maximum(np.r_[blocks[:1], blocks[:-1]], np.r_[blocks[1:], blocks[-1:]]))
     # a step bridged over k undefined samples is the change of k steps: compared with k typical ones (at 10 Hz, a
     # smooth curvature changing by 0.09 over 6 samples whose speed changed too fast to judge them was a 'jump')
-    hit = np.flatnonzero(size > np.maximum(floor, factor * span * np.repeat(near, BLOCK)[:n]))
+    part = size > np.maximum(floor * 1e-3, factor * span * np.repeat(near, BLOCK)[:n])  # a thousandth: rounding
+    # the floor is compared with the whole step: finite differences split a sampled one into a run of changes of one
+    # sign, each maybe under it (the forklift's turn-rate step of 0.033 rad/s on an S-curve at 0.05 m/s was 2 x 0.017)
+    dz = np.where(part[:, None], np.nan_to_num(d.reshape(n, -1)), 0.0)
+    start = part & ~np.r_[False, part[:-1] & (np.sum(dz[1:] * dz[:-1], axis=-1) > 0)]
+    first, cz = np.flatnonzero(start), np.r_[np.zeros((1, dz.shape[1])), np.cumsum(dz, axis=0)]
+    run = np.r_[np.sqrt(((cz[np.r_[first[1:], n]] - cz[first]) ** 2).sum(axis=-1)), 0.0][np.cumsum(start) - 1]
+    hit = np.flatnonzero(part & ((size > floor) | (run > floor)))
     events: list[list[int]] = []  # [first step, last step, step of the largest]
     for k in hit:  # a jump spread over consecutive samples (finite differences) is one event
         if events and k - events[-1][1] <= 2:
