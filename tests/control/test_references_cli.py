@@ -153,6 +153,22 @@ def test_pure_pursuit_goal_past_the_path_end_lies_on_its_tangent():
     assert np.abs(run.twist[:, 2]).max() < 1e-9 and run.pose[-1, 0] == pytest.approx(2.5, abs=1e-3)
 
 
+@pytest.mark.parametrize("controller", ["pure-pursuit", "stanley"])
+def test_geometric_trackers_run_on_past_the_reference_s_end_at_rest(controller, capsys):
+    """Their path search looks within 5 s of the run's time: more than 5 s past the reference's end it looked in no
+    sample at all ('wmrkit track diff-drive --reference line --controller stanley --duration 40': a traceback,
+    ValueError: attempt to get argmin of an empty sequence). Past its end the reference is at rest: so is the robot."""
+    ref = builtin_reference("line", duration=4.0)  # 2 m along +x
+    run = track(catalog.load("diff-drive"), ref, controller=controller, duration=12.0)
+    rest = run.t >= 4.0 + 0.05
+    np.testing.assert_allclose(run.pose[rest], run.pose[rest][:1].repeat(rest.sum(), axis=0), atol=1e-12)
+    assert run.tracked[-1, :2] == pytest.approx([2.0, 0.0], abs=1e-3)
+    assert main(["track", "diff-drive", "--reference", "line", "--controller", controller, "--duration", "40",
+                 "--json"]) == 0
+    # at the line's end, 10 m along +x (within 5 mm: the continuous loop's step over the reference's stop at 20 s)
+    assert json.loads(capsys.readouterr().out)["summary"]["final_error"] < 5e-3
+
+
 def test_cli_track_json(capsys):
     assert main(["track", "forklift", "--reference", "circle", "--from", "0", "0.5", "0deg", "--duration", "4",
                  "--json"]) == 0

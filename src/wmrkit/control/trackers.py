@@ -40,6 +40,7 @@ class PathIndex:
     def nearest(self, point: np.ndarray, t: float) -> int:
         """Index of the path sample nearest to `point` among those within ``window`` s of time `t`."""
         lo, hi = np.searchsorted(self.ref.t, [t - self.window, t + self.window])
+        lo = min(lo, len(self.xy) - 1)  # past the reference's end (where it rests): its last sample
         hi = max(hi, lo + 1)
         d = np.sum((self.xy[lo:hi] - point) ** 2, axis=1)
         return int(lo + np.argmin(d))
