@@ -141,16 +141,20 @@ def test_pure_pursuit_turns_round_to_a_path_that_runs_behind_it(name):
 def test_pure_pursuit_goal_past_the_path_end_lies_on_its_tangent():
     """The goal point was held at the path's end: a robot that reached it before the reference's time ended circled
     it on ever tighter turns (``2 / L_d``, ``L_d -> 0``): a 2 m line from 0.5 m ahead was 'too stiff to integrate'
-    after 34 s, and the circle from 0.3 m off (the docs' comparison) after 2 min."""
+    after 34 s, and the circle from 0.3 m off (the docs' comparison) after 2 min. Past the end it stops (the path is
+    driven: it drove on along the tangent to x = 2.5 m until the reference's time ended)."""
     from wmrkit.control.points import control_point
     from wmrkit.control.trackers import pure_pursuit
 
     robot, ref = catalog.load("diff-drive"), builtin_reference("line", duration=4.0)  # 2 m along +x
     control = pure_pursuit(control_point(robot), ref, 1.0)
-    twist, _ = control(1.0, np.array([2.01, 0.0, 0.0]), np.zeros(3))  # 1 cm past the end, heading along the path
+    twist, _ = control(1.0, np.array([1.99, 0.0, 0.0]), np.zeros(3))  # 1 cm before the end, heading along the path
     assert twist[2] == pytest.approx(0.0) and twist[0] == pytest.approx(0.5)
+    twist, _ = control(1.0, np.array([2.01, 0.0, 0.0]), np.zeros(3))  # 1 cm past it: stopped
+    assert (twist == 0).all()
     run = track(robot, ref, controller="pure-pursuit", initial_pose=[0.5, 0.0, 0.0])
-    assert np.abs(run.twist[:, 2]).max() < 1e-9 and run.pose[-1, 0] == pytest.approx(2.5, abs=1e-3)
+    # the stop is a step of the speed inside an integration step: within 2 mm at the trackers' rtol 1e-5 (1.3 mm)
+    assert np.abs(run.twist[:, 2]).max() < 1e-9 and run.pose[-1, 0] == pytest.approx(2.0, abs=2e-3)
 
 
 @pytest.mark.parametrize("controller", ["pure-pursuit", "stanley"])
@@ -167,6 +171,40 @@ def test_geometric_trackers_run_on_past_the_reference_s_end_at_rest(controller, 
                  "--json"]) == 0
     # at the line's end, 10 m along +x (within 5 mm: the continuous loop's step over the reference's stop at 20 s)
     assert json.loads(capsys.readouterr().out)["summary"]["final_error"] < 5e-3
+
+
+def _distance_to_polyline(xy, p):
+    a, b = xy[:-1], xy[1:]
+    d = b - a
+    u = np.clip(np.sum((p - a) * d, axis=1) / np.maximum(np.sum(d * d, axis=1), 1e-300), 0.0, 1.0)
+    return float(np.hypot(*(p - a - u[:, None] * d).T).min())
+
+
+def test_the_path_search_follows_a_robot_off_the_reference_s_time():
+    """The path was searched within 5 s of the run's time only: a point further ahead or behind projected on that
+    window's edge (Stanley ahead on the car's square saw the path's end only from 59 s; pure pursuit behind aimed
+    from the window's first sample). 8 m square at 0.5 m/s: corners at arc lengths 8, 16, 24 m (16, 32, 48 s)."""
+    from wmrkit.control.trackers import PathIndex
+
+    path = PathIndex(builtin_reference("square", size=8.0))
+    for t, point, s, chi, e in ((0.0, (8.2, 3.0), 11.0, math.pi / 2, -0.2),  # 22 s ahead, on the 2nd leg
+                                (20.0, (3.0, -0.1), 3.0, 0.0, -0.1),  # 14 s behind, on the 1st
+                                (56.0, (0.1, -1.0), 32.0, -math.pi / 2, 0.1)):  # past the end (its last sample)
+        assert path.project(np.array(point), t) == (pytest.approx(s), pytest.approx(chi), pytest.approx(e))
+
+
+def test_stanley_stops_at_the_end_of_the_car_s_square():
+    """Stanley's front point gains on the reference at each corner (3.76 m by the 8 m square's end): it reached the
+    path's end at 56 s and drove on along its last tangent until the reference's time ended, 3.76 m past it: the
+    final cross-track error was its maximum. Now it stops there: the final point is on the path's end."""
+    ref = builtin_reference("square", size=8.0)
+    run = track(catalog.load("ackermann"), ref, controller="stanley")
+    end = run.tracked[-1, :2]
+    assert np.hypot(*(end - ref.pose[-1, :2])) < 5e-3 and _distance_to_polyline(ref.pose[:, :2], end) < 5e-3
+    assert run.cross_track[-1] == pytest.approx(_distance_to_polyline(ref.pose[:, :2], end), abs=1e-9)
+    ahead = run.t[np.argmax(np.hypot(*(run.tracked[:, :2] - ref.pose[-1, :2]).T) < 5e-3)]
+    assert ahead < 60.0  # it arrived early (no time law), and waited
+    assert run.summary()["final_error"] < 5e-3
 
 
 def test_cli_track_json(capsys):

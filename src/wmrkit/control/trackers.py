@@ -11,7 +11,9 @@ Both steer a point of the robot onto the reference *path* at the reference's spe
   ``F`` (positive left), curvature ``tan(delta) / wheelbase``.
 
 The resulting unicycle twist ``(v, omega)`` at ``A`` along the robot's rolling direction is moved to the origin
-(rigid body) and goes through the same per-wheel IK as the thesis's controller.
+(rigid body) and goes through the same per-wheel IK as the thesis's controller. Neither has a time law: each stops
+once its point has passed the path's end (a robot ahead of the reference waits there; one behind stops where it is
+when the reference does, at its end).
 """
 
 from __future__ import annotations
@@ -38,12 +40,35 @@ class PathIndex:
         self.window = window
 
     def nearest(self, point: np.ndarray, t: float) -> int:
-        """Index of the path sample nearest to `point` among those within ``window`` s of time `t`."""
+        """Index of the path sample nearest to `point` among those within ``window`` s of time `t`; when that is
+        the window's first or last sample, the path still nears `point` beyond it (a robot more than ``window`` s
+        ahead of or behind the reference's time): the window slides that way to the nearest sample there."""
+        n = len(self.xy)
         lo, hi = np.searchsorted(self.ref.t, [t - self.window, t + self.window])
-        lo = min(lo, len(self.xy) - 1)  # past the reference's end (where it rests): its last sample
+        lo = min(lo, n - 1)  # past the reference's end (where it rests): its last sample
         hi = max(hi, lo + 1)
-        d = np.sum((self.xy[lo:hi] - point) ** 2, axis=1)
-        return int(lo + np.argmin(d))
+        width = max(hi - lo, 2)
+        k = self._closest(point, lo, hi)
+        if k == hi - 1:
+            while k == hi - 1 and hi < n:  # ahead of the reference
+                lo, hi = k, min(k + width, n)
+                k = self._closest(point, lo, hi)
+        elif k == lo:
+            while k == lo and lo > 0:  # behind it
+                lo, hi = max(k - width + 1, 0), k + 1
+                k = self._closest(point, lo, hi)
+        return k
+
+    def _closest(self, point: np.ndarray, lo: int, hi: int) -> int:
+        return int(lo + np.argmin(np.sum((self.xy[lo:hi] - point) ** 2, axis=1)))
+
+    def done(self, point: np.ndarray, s: float) -> bool:
+        """Whether `point`, projected at arc length `s` [m] (:meth:`project`), has passed the path's end: it projects
+        on the end, past it along the last segment (a closed path's start, on its end, has not)."""
+        if s < self.s[-1]:
+            return False
+        a, b = self.xy[-2], self.xy[-1]
+        return float((point - b) @ (b - a)) >= 0 and float(np.hypot(*(point - b))) > 1e-9
 
     def project(self, point: np.ndarray, t: float) -> tuple[float, float, float]:
         """Continuous projection of `point` on the path near time `t`: ``(s [m], chi [rad], e [m], signed, left
@@ -140,6 +165,8 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0)
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         a, psi = _axle_state(cp, pose)
         s_near, _, _ = path.project(a, t)
+        if path.done(a, s_near):  # the path is driven: stop (no time law to wait for the reference)
+            return np.zeros(3), np.zeros(3)
         d = path.point_at(s_near + lookahead) - a
         c, s = math.cos(psi), math.sin(psi)
         x_g, y_g = c * d[0] + s * d[1], -s * d[0] + c * d[1]
@@ -171,7 +198,9 @@ def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         a, psi = _axle_state(cp, pose)
         f = a + length * np.array([math.cos(psi), math.sin(psi)])
-        _, chi, e = path.project(f, t)
+        s_front, chi, e = path.project(f, t)
+        if path.done(f, s_front):  # the path is driven: stop
+            return np.zeros(3), np.zeros(3)
         v = _speed(reference, t)
         psi_e = math.remainder(chi - psi, 2 * math.pi)
         delta = psi_e - math.atan2(gain * e, v + 1e-3)
