@@ -207,6 +207,15 @@ def test_stanley_stops_at_the_end_of_the_car_s_square():
     assert run.summary()["final_error"] < 5e-3
 
 
+@pytest.mark.parametrize(("controller", "labelled"), [("stanley", True), ("pure-pursuit", True), ("p", False)])
+def test_the_path_followers_tracking_error_says_what_it_measures(controller, labelled, capsys):
+    """Pure pursuit and Stanley have no time law: their tracking error (from the reference's pose at the same time)
+    grows with each corner at any size, and was printed as the thesis law's, which converges."""
+    assert main(["track", "diff-drive", "--reference", "line", "--controller", controller, "--duration", "2"]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("tracking error [m]: rms "))
+    assert ("not its timing" in line) is labelled
+
+
 def test_cli_track_json(capsys):
     assert main(["track", "forklift", "--reference", "circle", "--from", "0", "0.5", "0deg", "--duration", "4",
                  "--json"]) == 0

@@ -73,6 +73,12 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run_feasibility)
 
 
+#: What the tracking error of pure pursuit and Stanley measures (no time law: it grows with every corner).
+PATH_FOLLOWER_NOTE = (" (from the reference's pose at the same time: this controller follows the path, not its timing, "
+                      "so this measures how far ahead of or behind the reference it is; the cross-track error is its "
+                      "distance from the path)")
+
+
 def _reference_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--reference", required=True, metavar="FILE|NAME",
                    help="line, circle, figure-eight, square, arc-line, corner; or a TUM / CSV (t,x,y,theta) file")
@@ -251,7 +257,8 @@ def run_track(args: argparse.Namespace) -> int:
               f"{', through the dynamics' if args.dynamics else ''}"
               f"{f', {args.slip_model.upper()} commands' if args.slip_model != 'none' else ''}"
               f"{f', {args.feedback} feedback' if args.feedback != 'pose' else ''}")
-        print(f"tracking error [m]: rms {s['rms_error']:.4g}, max {s['max_error']:.4g}, final {s['final_error']:.4g}")
+        print(f"tracking error [m]: rms {s['rms_error']:.4g}, max {s['max_error']:.4g}, final {s['final_error']:.4g}"
+              f"{PATH_FOLLOWER_NOTE if args.controller in ('pure-pursuit', 'stanley') else ''}")
         print(f"cross-track error [m]: rms {s['rms_cross_track']:.4g}, max {s['max_cross_track']:.4g}")
     return 0
 
