@@ -194,13 +194,22 @@ def names(runs: Sequence[CalibrationRun]) -> tuple[str, ...]:
     return tuple(s if sources.count(s) == 1 else f"run {k + 1} ({s})" for k, s in enumerate(sources))
 
 
-def _score(err: np.ndarray, k: int, rest: np.ndarray, floors: np.ndarray, n: int) -> float:
-    """Run `k`'s weighted residual RMS over that of `rest` with ``R - n`` degrees of freedom (rows ``err``)."""
-    noise = max(float(np.sum(err[rest] ** 2)) / (err[rest].size - n), float(np.mean(floors[rest] ** 2)))
-    return float(np.sqrt(np.mean(err[k] ** 2) / noise))
+def counts(jac: np.ndarray, res: np.ndarray, sizes: Sequence[int]) -> np.ndarray:
+    """How many of each run's residuals (`sizes` rows each of `jac` and `res`) carry information: not those zero with
+    their Jacobian row, a reference pose where the run starts (it starts there by construction: a reference of two
+    poses is one final pose, as a closed path's)."""
+    live = np.any(jac != 0, axis=1) | (res != 0)
+    return np.add.reduceat(live.astype(int), np.r_[0, np.cumsum(sizes)[:-1]].astype(int))
 
 
-def _quadratic_scores(jac, res, hess, floors) -> tuple[np.ndarray, np.ndarray]:
+def _score(err: np.ndarray, k: int, rest: np.ndarray, floors: np.ndarray, n: int, m: np.ndarray) -> float:
+    """Run `k`'s weighted residual RMS over that of `rest` with ``R - n`` degrees of freedom (rows ``err``; `m`: each
+    run's residuals that count, :func:`counts`)."""
+    noise = max(float(np.sum(err[rest] ** 2)) / (m[rest].sum() - n), float(np.mean(floors[rest] ** 2)))
+    return float(np.sqrt(np.sum(err[k] ** 2) / max(m[k], 1) / noise))
+
+
+def _quadratic_scores(jac, res, hess, floors, m) -> tuple[np.ndarray, np.ndarray]:
     """Each run's score against the others refitted on the runs' quadratic models (no odometry), and that fit's
     shift from the fleet fit; the score is NaN where the others do not determine the parameters (their Jacobian's
     weakest singular value under :data:`RANK_TOL` of the largest: e.g. equal squares all driven one way)."""
@@ -212,12 +221,12 @@ def _quadratic_scores(jac, res, hess, floors) -> tuple[np.ndarray, np.ndarray]:
         rest = np.delete(np.arange(g), k)
         j, r, h = jac[rest].reshape(-1, n), res[rest].ravel(), hess[rest].reshape(-1, n, n)
         sv = np.linalg.svd(j, compute_uv=False)
-        if r.size <= n or sv[-1] < RANK_TOL * sv[0]:
+        if m[rest].sum() <= n or sv[-1] < RANK_TOL * sv[0]:
             continue
         d = least_squares(lambda d: r + j @ d + 0.5 * np.einsum("mij,i,j->m", h, d, d), np.zeros(n),  # noqa: B023
                           jac=lambda d: j + np.einsum("mij,j->mi", h, d), method="lm", xtol=1e-12,  # noqa: B023
                           ftol=1e-12).x
-        out[k] = _score(res + jac @ d + 0.5 * np.einsum("gmij,i,j->gm", hess, d, d), k, rest, floors, n)
+        out[k] = _score(res + jac @ d + 0.5 * np.einsum("gmij,i,j->gm", hess, d, d), k, rest, floors, n, m)
         shift[k] = d
     return out, shift
 
@@ -263,7 +272,8 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
                 runs="every run" if len(which) == g else ", ".join(logs[k] for k in which), why=why))
     hess = np.stack([(j - fit.jac) / CURVATURE_STEP for j in moved], axis=-1).reshape(g, -1, n, n) \
         * w[:, None, None, None]
-    scores, shift = _quadratic_scores(jac * w[:, None, None], res * w[:, None], hess, floors)
+    m = counts(fit.jac, fit.fun, sizes)
+    scores, shift = _quadratic_scores(jac * w[:, None, None], res * w[:, None], hess, floors, m)
     if np.isnan(scores).any():  # a run without which the others cannot fit: not judged
         k = int(np.flatnonzero(np.isnan(scores))[0])
         return Consistency(judged.ratios, None, not_judged=UNDETERMINED.format(
@@ -276,7 +286,7 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
             why = done if err is None else "its residuals are not finite"
             return Consistency((None,) * g, None, not_judged=REFIT_FAILED.format(run=logs[k], why=why))
         order = np.r_[0:k, g - 1, k:g - 1]  # run k was put last
-        scores[k] = _score(err.reshape(g, -1)[order] * w[:, None], k, np.delete(np.arange(g), k), floors, n)
+        scores[k] = _score(err.reshape(g, -1)[order] * w[:, None], k, np.delete(np.arange(g), k), floors, n, m)
     worst = int(np.argmax(scores))
     scored = tuple(map(float, scores))
     if scores[worst] <= MAX_CLOSED_SCORE:
