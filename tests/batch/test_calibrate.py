@@ -10,7 +10,7 @@ from batch_params import PARAMS, TRUE_P, closed_fleet
 
 from wmrkit import catalog
 from wmrkit.batch.calibrate import default_parameters, fleet_calibrate, fleet_slip_calibrate, load_runs
-from wmrkit.batch.consistency import travel
+from wmrkit.batch.consistency import MAX_CLOSED_SCORE, travel
 from wmrkit.batch.engine import BatchError
 from wmrkit.batch.fleet import expand_logs
 from wmrkit.odometry.calibration import CalibrationProblem, CalibrationRun, apply_parameters, calibrate
@@ -735,3 +735,25 @@ def test_scores_of_runs_with_two_pose_references_count_their_final_poses_only(di
         rest = np.delete(err, k, axis=0)
         score = np.sqrt(np.mean(err[k] ** 2) / (np.sum(rest ** 2) / (rest.size - 3)))
         assert res.closed_scores[k] == pytest.approx(score, rel=1e-3), k
+
+
+def test_a_reference_pose_at_the_start_is_no_residual_of_the_ratio(diff):
+    """Runs whose references have three poses (start, middle, end) got residual ratios: the start pose's residuals
+    (zero by construction) counted to MIN_DOF, so a run's own fit had 3 degrees of freedom where the ratio needs 6,
+    and agreeing fleets of 6 such runs were flagged (ratios 42 and 39 in 2 of 12 fleets). Now they have no ratio and
+    a fleet of them is judged as closed paths are (their scores); a run of a robot with a 5 % larger left radius is
+    named all the same."""
+    for seed in (10003, 10007):
+        res = fleet_calibrate(diff, _short_fleet(diff, seed, 6, poses=3), PARAMS)
+        assert res.residual_ratios == (None,) * 6 and res.not_judged is None, res.residual_ratios
+        assert res.inconsistent is False and max(res.closed_scores) < MAX_CLOSED_SCORE / 2, res.closed_scores
+    runs = _short_fleet(diff, 10003, 6, poses=3)
+    odd = apply_parameters(diff, PARAMS, [TRUE_P[0] + 0.05, *TRUE_P[1:]])
+    run = simulate(odd, TwistProfile.from_segments([(2.0, 0.35, 0.0, 0.5), (2.0, 0.3, 0.0, -0.2)]), 10.0,
+                   spin_noise_per_rad=1e-5, seed=3)
+    at = np.linspace(0, len(run.log) - 1, 3).astype(int)
+    res = fleet_calibrate(diff, [CalibrationRun(replace(run.log, source="odd.csv"), run.truth[at], at=at), *runs[1:]],
+                          PARAMS)
+    assert res.inconsistent is True and res.closed_scores[0] > MAX_CLOSED_SCORE > max(res.closed_scores[1:])
+    (warning,) = [w for w in res.warnings if "disagrees" in w]
+    assert warning.startswith("odd.csv: disagrees")

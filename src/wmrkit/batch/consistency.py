@@ -46,7 +46,9 @@ ROUNDOFF = 1e-9
 MIN_RUNS = 4
 #: Fewest residuals of a run beyond the rank of its own Jacobian for a ratio: with one (a closed path's final pose,
 #: three numbers, against two parameters) its own fit is near exact by chance and the ratio noise's (303 for a
-#: good closed square of four); a chi with 6 degrees of freedom is seldom near zero.
+#: good closed square of four); a chi with 6 degrees of freedom is seldom near zero. A reference pose where the run
+#: starts does not count (:func:`counts`): with it, runs whose references have three poses (start, middle, end: 3)
+#: had ratios, and agreeing fleets of 6 such runs had them up to 42, 2 of 12 flagged.
 MIN_DOF = 6
 #: Why a fleet is not judged (said by ``batch calibrate``'s text and JSON, ``not_judged``): too few runs.
 FEW_RUNS = (f"fewer than {MIN_RUNS} runs: the runs are not checked against each other (with 2 or 3, a run of "
@@ -98,6 +100,14 @@ def travel(robot: Robot, run: CalibrationRun) -> float:
     return float(np.mean(rolled)) if rolled else 0.0
 
 
+def counts(jac: np.ndarray, res: np.ndarray, sizes: Sequence[int]) -> np.ndarray:
+    """How many of each run's residuals (`sizes` rows each of `jac` and `res`) carry information: not those zero with
+    their Jacobian row, a reference pose where the run starts (it starts there by construction: a reference of two
+    poses is one final pose, as a closed path's)."""
+    live = np.any(jac != 0, axis=1) | (res != 0)
+    return np.add.reduceat(live.astype(int), np.r_[0, np.cumsum(sizes)[:-1]].astype(int))
+
+
 def _ratios(a: np.ndarray, b: np.ndarray, c: np.ndarray, own: np.ndarray, keep: np.ndarray,
             shift: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Ratios of the runs `keep` at the fit of the others among `keep` (module docstring), the residuals being
@@ -124,9 +134,9 @@ def run_consistency(jac: np.ndarray, res: np.ndarray, sizes: Sequence[int], floo
     b = np.array([j.T @ r for j, r in blocks])
     c = np.array([r @ r for _, r in blocks])
     own = np.full(g, np.nan)  # NaN: too few residuals beyond the run's own parameters (no ratio)
-    for k, ((j, r), f, s) in enumerate(zip(blocks, floors, sizes, strict=True)):
+    for k, ((j, r), f, s, live) in enumerate(zip(blocks, floors, sizes, counts(jac, res, sizes), strict=True)):
         step, _, rank, _ = np.linalg.lstsq(j, r, rcond=None)
-        if s - rank >= MIN_DOF:
+        if live - rank >= MIN_DOF:
             own[k] = max(float(np.sum(np.square(r - j @ step))), f * f * s)
     everyone = np.arange(g)
     ratios, d = _ratios(a, b, c, own, everyone, np.zeros(a.shape[1]))
@@ -192,14 +202,6 @@ def names(runs: Sequence[CalibrationRun]) -> tuple[str, ...]:
     """The runs' files as the answer names them (runs made in Python share '<log>' or '<synthetic>')."""
     sources = [run.log.source for run in runs]
     return tuple(s if sources.count(s) == 1 else f"run {k + 1} ({s})" for k, s in enumerate(sources))
-
-
-def counts(jac: np.ndarray, res: np.ndarray, sizes: Sequence[int]) -> np.ndarray:
-    """How many of each run's residuals (`sizes` rows each of `jac` and `res`) carry information: not those zero with
-    their Jacobian row, a reference pose where the run starts (it starts there by construction: a reference of two
-    poses is one final pose, as a closed path's)."""
-    live = np.any(jac != 0, axis=1) | (res != 0)
-    return np.add.reduceat(live.astype(int), np.r_[0, np.cumsum(sizes)[:-1]].astype(int))
 
 
 def _score(err: np.ndarray, k: int, rest: np.ndarray, floors: np.ndarray, n: int, m: np.ndarray) -> float:
