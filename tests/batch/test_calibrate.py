@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -757,3 +758,31 @@ def test_a_reference_pose_at_the_start_is_no_residual_of_the_ratio(diff):
     assert res.inconsistent is True and res.closed_scores[0] > MAX_CLOSED_SCORE > max(res.closed_scores[1:])
     (warning,) = [w for w in res.warnings if "disagrees" in w]
     assert warning.startswith("odd.csv: disagrees")
+
+
+def test_short_references_not_judged_say_so_in_their_own_words(diff, tmp_path, capsys):
+    """4 runs whose references have two poses were told 'no run has 6 residuals ... (closed paths: a final pose) ...
+    5 closed runs or more, or runs with reference trajectories, are checked': they are not closed paths and have
+    reference trajectories. 6 runs of 2 and 3 poses mixed were told the same, 'fewer than 5 runs' among them."""
+    from batch_params import write_log
+
+    from wmrkit.batch.consistency import SHORT, UNEQUAL
+    from wmrkit.cli.main import main
+    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+
+    runs = _short_fleet(diff, 10003, 4)
+    assert fleet_calibrate(diff, runs, PARAMS).not_judged == SHORT
+    mixed = _short_fleet(diff, 10003, 3) + _short_fleet(diff, 10007, 3, poses=3)
+    res = fleet_calibrate(diff, mixed, PARAMS)
+    assert res.inconsistent is None and res.not_judged == UNEQUAL and res.closed_scores == (None,) * 6
+    assert "closed paths" in UNEQUAL and "fewer than 5" not in UNEQUAL and "reference trajectories" not in SHORT
+    (tmp_path / "ref").mkdir()
+    for k, run in enumerate(runs):
+        write_log(tmp_path / f"r{k}.csv", run)
+        at = run.samples()
+        write_trajectory(tmp_path / "ref" / f"r{k}.tum", Trajectory(run.log.time[at], np.asarray(run.reference),
+                                                                    np.zeros(len(at)), None), "tum")
+    assert main(["batch", "calibrate", "diff-drive", str(tmp_path / "r*.csv"), "--reference", str(tmp_path / "ref"),
+                 "--workers", "0", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["not_judged"] == SHORT and data["inconsistent"] is None

@@ -26,7 +26,7 @@ run in a fleet of 5).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -60,6 +60,17 @@ FEW_RUNS = (f"fewer than {MIN_RUNS} runs: the runs are not checked against each 
 CLOSED = ("no run has 6 residuals beyond its own parameters (closed paths: a final pose) and there are fewer than 5 "
           "runs: the runs are not checked against each other, a run of another robot is averaged in unseen; 5 closed "
           "runs or more, or runs with reference trajectories, are checked")
+#: ... the same with runs of references of few poses (2 or 3: one or two poses beyond the start; they said "closed
+#: paths ... runs with reference trajectories are checked" to runs with reference trajectories). A reference of two
+#: poses is one final pose, as a closed path's, and 5 such runs or more are judged as closed paths are (docs/batch.md).
+SHORT = ("no run has 6 residuals beyond its own parameters (references of 2 or 3 poses, or closed paths) and there "
+         "are fewer than 5 runs: the runs are not checked against each other, a run of another robot is averaged in "
+         "unseen; 5 such runs or more, or references of 4 poses or more, are checked")
+#: ... and with 5 runs or more of such runs whose numbers of reference poses differ (the closed-path judge compares
+#: runs of equal numbers of residuals).
+UNEQUAL = ("no run has 6 residuals beyond its own parameters (references of 2 or 3 poses, or closed paths) and the "
+           "runs do not have the same number of reference poses: the runs are not checked against each other, a run "
+           "of another robot is averaged in unseen; give every run as many poses, or references of 4 poses or more")
 #: ... and why some runs are not judged while the others are: a closed path among runs with references, or a run
 #: whose reference has too few poses ({runs}: those runs, their per-run values null).
 SOME_RUNS = (f"{{runs}}: fewer than {MIN_DOF} residuals beyond the run's own parameters (a closed path, or a "
@@ -81,7 +92,8 @@ class Consistency:
     residuals beyond its own parameters: closed paths); ``inconsistent``: the largest over
     :data:`MAX_RATIO` (closed paths: a score over :data:`MAX_CLOSED_SCORE`; ``None`` when not judged);
     ``message``: the warning that names the run, or ``None``; ``not_judged``: why no run was judged
-    (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`REFIT_FAILED`, :data:`CURVATURE_FAILED`, :data:`UNDETERMINED`) or
+    (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`SHORT`, :data:`UNEQUAL`, :data:`REFIT_FAILED`,
+    :data:`CURVATURE_FAILED`, :data:`UNDETERMINED`) or
     which runs were not (:data:`SOME_RUNS`), or ``None``; ``scores``: a fleet of closed paths' per-run scores
     (:func:`judge`; another quantity than a ratio, under its own name), empty when not scored."""
 
@@ -249,14 +261,19 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     the problem's last run is the one left out; a failure leaves the fleet not judged, :data:`REFIT_FAILED`), and its
     score is the refit's: in fleets of 6 squares the odd run's equalled a refit of every run. A fleet of fewer than
     :data:`REFIT_EVERY` runs refits every run. Over :data:`MAX_CLOSED_SCORE` the run of largest score is named;
-    with fewer than :data:`MIN_CLOSED_RUNS` closed runs the fleet is not judged (:data:`CLOSED`), nor when the runs
+    with fewer than :data:`MIN_CLOSED_RUNS` closed runs the fleet is not judged (:data:`CLOSED`; runs of references of
+    few poses: :data:`SHORT`), nor runs of unequal numbers of reference poses (:data:`UNEQUAL`), nor when the runs
     but one cannot tell the parameters apart (:data:`UNDETERMINED`)."""
     robot, runs, sizes = problem.robot, problem.runs, problem.sizes()
     logs = names(runs)
     travels = np.array([max(travel(robot, run), 1.0) for run in runs])
     judged = run_consistency(fit.jac, fit.fun, sizes, ROUNDOFF * travels, logs)
-    if judged.not_judged != CLOSED or len(runs) < MIN_CLOSED_RUNS or len(set(sizes)) != 1:
+    if judged.not_judged != CLOSED:
         return judged
+    if len(runs) < MIN_CLOSED_RUNS or len(set(sizes)) != 1:
+        closed = all(run.closed for run in runs)
+        why = CLOSED if closed and len(runs) < MIN_CLOSED_RUNS else SHORT if len(runs) < MIN_CLOSED_RUNS else UNEQUAL
+        return replace(judged, not_judged=why)
     g, n = len(runs), fit.x.size
     jac, res = fit.jac.reshape(g, -1, n), fit.fun.reshape(g, -1)
     for k in range(g):  # the others must determine the parameters for a score (the jackknife interval's test)
