@@ -159,3 +159,44 @@ def test_stanley_s_projection_past_a_corner_takes_the_leg_ahead(size):
         run = track(catalog.load(robot), builtin_reference("corner", size=size), controller="stanley")
         turned = run.pose[np.searchsorted(run.t, corner + 3.0), 2] - run.pose[0, 2]
         assert turned > 0.5, (robot, turned)  # it turns left (to +x) within 3 s of the corner
+
+
+@settings(max_examples=60)
+@given(st.floats(-math.pi, math.pi), st.lists(st.tuples(st.floats(1.0, 3.0), st.floats(-1.5, 1.5)), min_size=1,
+                                              max_size=4),
+       st.floats(0.05, 0.5), st.data())
+def test_the_projection_is_the_nearest_point_of_the_polyline(heading, legs, spacing, data):
+    """Random polylines (legs of 1-3 m turning up to 1.5 rad at each corner, sampled every `spacing` m at 0.5 m/s,
+    the corners among the samples) and random points near them: PathIndex.project's arc length is that of the
+    nearest point of every segment, found here by brute force (ties: any of the nearest), and its cross-track error
+    the signed distance from the leg it lies on."""
+    from wmrkit.control.references import reference_from_samples
+    from wmrkit.control.trackers import PathIndex
+
+    pts, chi = [np.zeros(2)], heading
+    for length, turn in legs:
+        n = max(1, math.ceil(length / spacing))
+        step = length / n * np.array([math.cos(chi), math.sin(chi)])
+        pts += [pts[-1] + k * step for k in range(1, n + 1)]
+        chi += turn
+    xy = np.array(pts)
+    seg = np.hypot(*np.diff(xy, axis=0).T)
+    s_knots = np.concatenate([[0.0], np.cumsum(seg)])
+    t = s_knots / 0.5
+    path = PathIndex(reference_from_samples("polyline.csv", t, np.column_stack([xy, np.zeros(len(t))])))
+    j = data.draw(st.integers(0, len(xy) - 2))
+    u, offset = data.draw(st.floats(0, 1)), data.draw(st.floats(-0.3, 0.3)) * spacing
+    d = xy[j + 1] - xy[j]
+    point = xy[j] + u * d + offset * np.array([-d[1], d[0]]) / seg[j]
+    s, chi_, e = path.project(point, data.draw(st.floats(t[j] - 1.0, t[j + 1] + 1.0)))
+    # brute force: the nearest point of each segment
+    a, b = xy[:-1], xy[1:]
+    w = np.clip(np.sum((point - a) * (b - a), axis=1) / seg**2, 0, 1)
+    foot = a + w[:, None] * (b - a)
+    dist = np.hypot(*(point - foot).T)
+    nearest = dist <= dist.min() + 1e-12
+    assert np.min(np.abs(s_knots[:-1][nearest] + w[nearest] * seg[nearest] - s)) < 1e-9, (s, dist.min())
+    q = path.point_at(s)
+    assert np.hypot(*(point - q)) == pytest.approx(dist.min(), abs=1e-12)
+    assert e == pytest.approx((point - q) @ np.array([-math.sin(chi_), math.cos(chi_)]), abs=1e-12)
+    assert abs(e) <= dist.min() + 1e-12

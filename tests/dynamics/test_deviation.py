@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
+import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from wmrkit import catalog
 from wmrkit.cli.main import main
@@ -135,3 +139,54 @@ def test_simulate_errors_stay_json_objects(capsys, tmp_path):
     code = main(["simulate", "skid-steer-4", "--torques", str(torques), "--json"])
     data = json.loads(capsys.readouterr().out)
     assert code == 0 and data["deviation"] is None
+
+
+def _rk4_through_knots(time, twists, t_out, pose0, h=2e-3):
+    """The pose ODE by classical RK4 from ``t_out[0]``, stepping onto every knot and output time (the twist is
+    smooth within each step, so the error is O(h^4)); written here, independent of the library."""
+    def rate(t, s):
+        vx, vy, om = (np.interp(t, time, twists[:, k]) for k in range(3))
+        c, sn = math.cos(s[2]), math.sin(s[2])
+        return np.array([c * vx - sn * vy, sn * vx + c * vy, om])
+
+    stops = np.union1d(t_out, time[(time > t_out[0]) & (time < t_out[-1])])
+    s, out = np.array(pose0, dtype=float), [np.array(pose0, dtype=float)]
+    for a, b in itertools.pairwise(stops):
+        n = max(1, math.ceil((b - a) / h))
+        dt = (b - a) / n
+        for i in range(n):
+            t = a + i * dt
+            k1 = rate(t, s)
+            k2 = rate(t + dt / 2, s + dt / 2 * k1)
+            k3 = rate(t + dt / 2, s + dt / 2 * k2)
+            k4 = rate(t + dt, s + dt * k3)
+            s = s + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        if np.isin(b, t_out):
+            out.append(s.copy())
+    return np.array(out)
+
+
+_knot = st.tuples(st.floats(-2, 2), st.floats(-1, 1), st.floats(-3, 3))
+
+
+@settings(max_examples=25)
+@given(st.lists(st.tuples(st.floats(-1, 3.5), _knot), min_size=1, max_size=5, unique_by=lambda k: round(k[0], 3)),
+       st.sampled_from([0.05, 0.1, 0.3, 0.7]), st.floats(-0.5, 0.5), st.floats(0.5, 3.0),
+       st.tuples(st.floats(-5, 5), st.floats(-5, 5), st.floats(-4, 4)), st.booleans())
+def test_nominal_poses_of_random_twist_programs_are_rk4s(knots, dt, t0, duration, pose0, spin):
+    """Random piecewise-linear twist programs (reversing, sideways, turning either way; knots before, between and
+    after the samples; or a pure rotation) from a random pose: the poses are RK4's through the knots (written
+    here), and a pure rotation stays where it is with the exact heading (the integral of the rate)."""
+    knots = sorted(knots)
+    time = np.array([k for k, _ in knots])
+    twists = np.array([tw for _, tw in knots])
+    if spin:
+        twists[:, :2] = 0.0
+    t = t0 + np.arange(0.0, duration + dt / 2, dt)
+    got = nominal_poses(time, twists, t, pose0)
+    assert got == pytest.approx(_rk4_through_knots(time, twists, t, pose0), abs=1e-8)
+    if spin:
+        assert np.all(got[:, :2] == np.asarray(pose0[:2]))
+        fine = np.linspace(t[0], t[-1], 200_001)
+        heading = pose0[2] + np.trapezoid(np.interp(fine, time, twists[:, 2]), fine)
+        assert got[-1, 2] == pytest.approx(heading, abs=1e-6)

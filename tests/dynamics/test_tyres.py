@@ -314,3 +314,54 @@ def test_the_jacobian_triple_is_three_tyre_calls_bit_for_bit():
                     _kernels.tyre(kind.code, p, fz, vl + h, vg, vw, vg - vw),
                     _kernels.tyre(kind.code, p, fz, vl, vg + h, vw, vg + h - vw))
             assert got == want, kind.name
+
+
+def _appendix_7a1(shifts, mu_scale, eps, fz, v_lat, v_long, v_wheel, v_roll):
+    """(F_lat, F_long) of one contact, transcribed from the digest of appendix 7.A1 (spec ch. 7, section 9:
+    (7.81)-(7.84)) with the sign decision [A] of its section 10 and the library's documented additions: slips
+    regularised by eps, the shifts faded by tanh(|v| / eps) at standstill, mirrored in reverse (section 10.1)."""
+    v = abs(v_wheel)
+    f = shifts * math.tanh(v / eps)
+    sigma = -1.0 if v_wheel < 0 else 1.0
+    s = sigma * v_long / max(abs(v_roll), v, eps)
+    alpha = sigma * math.atan(v_lat / max(v, eps))
+
+    def magic(a, k7, k8, k9, k10):  # (7.81)
+        return k7 * math.sin(k8 * math.atan(k9 * (1 - k10) * a + k10 * math.atan(k9 * a)))
+
+    c_sy = math.tan(math.pi / 180 * (84.21 + 5.16 * math.exp(-6.094 / (1 + v))))  # (7.82)
+    k7y, k8y = 0.8 - 0.0021 * v, 1.57
+    k9y = c_sy / (k8y * k7y)
+    s_m = 0.08 + 0.75 * math.exp(-v / 8)
+    k10y = (k9y * s_m - math.tan(0.5 * math.pi / k8y)) / (k9y * s_m - math.atan(k9y * s_m)) - 0.0162 * v
+    mu_y = magic(s + f * (0.0213 + 0.0086 * v) / c_sy, k7y, k8y, k9y, k10y)
+    c_sx = 0.3 * math.tan(math.pi / 180 * (84.21 + 5.16 * math.exp(-6.094 / (1 + 5 * v))))  # (7.83)
+    k7x, k8x = 0.75 + 0.5 * math.exp(-v / 3), 1.2
+    k9x = c_sx / (k8x * k7x)
+    a_m = 0.087 + 0.63 * math.exp(-v / 3)
+    k10x = (k9x * a_m - math.tan(0.5 * math.pi / k8x)) / (k9x * a_m - math.atan(k9x * a_m)) - 0.0162 * v
+    mu_x = magic(alpha + f * (0.00639 + 0.0026 * v) / c_sx, k7x, k8x, k9x, k10x)
+    b_y = 1.25 * math.cos(math.atan(0.513 * s))  # (7.84)
+    mu_y_comb = (mu_y * math.cos(1.43 * math.atan(b_y * (f * 0.0056 + alpha)))
+                 / math.cos(1.43 * math.atan(b_y * f * 0.0056)))
+    b_x = 20.18 * math.cos(math.atan(0.137 * (alpha - 4.98)))
+    mu_x_comb = (mu_x * math.cos(1.01 * math.atan(b_x * (f * 0.204 * mu_y + s)))
+                 / math.cos(1.01 * math.atan(b_x * f * 0.204 * mu_y)))
+    return -sigma * mu_scale * fz * mu_x_comb, -sigma * mu_scale * fz * mu_y_comb
+
+
+@settings(max_examples=200)
+@given(st.sampled_from([0.0, 1.0]), st.floats(0.1, 2.0), st.floats(1e-3, 1.0), st.floats(0.0, 1e5),
+       slips, slips, st.one_of(st.floats(-20, 20), st.floats(-0.05, 0.05)), st.floats(-20, 20))
+def test_pacejka_forces_are_appendix_7a1_transcribed(shifts, mu_scale, eps, fz, v_lat, v_long, v_wheel, v_roll):
+    """The Pacejka tyre (numpy, and compiled for the simulator, with its shared speed terms) at random slips, wheel
+    speeds (reverse and standstill included), loads and parameters equals (7.82)-(7.84) written here from the
+    digest, scalar, with no code of the library."""
+    from wmrkit.dynamics import _kernels
+
+    want = _appendix_7a1(shifts, mu_scale, eps, fz, v_lat, v_long, v_wheel, v_roll)
+    tyre = Tyre.of("pacejka", {"shifts": shifts, "mu_scale": mu_scale, "eps": eps})
+    got = tyre.forces(fz, v_lat, v_long, v_wheel, v_roll)
+    compiled = _kernels.tyre(3, tyre.vector(), fz, v_lat, v_long, v_wheel, v_roll)
+    for forces in ((float(got.lateral), float(got.longitudinal)), compiled):
+        assert forces == pytest.approx(want, rel=1e-9, abs=1e-9 * fz)

@@ -1,0 +1,56 @@
+"""Property: a sampled reference with one step (a teleport, a heading jump, a speed step) at a random sample is one
+violation at that sample for robots of types 3 and 5 (l_o != 0), in both frameworks; the same reference without
+the step is none (feasibility's folding of a derivative's spike into its signal's step, and its slow turns)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+from wmrkit import catalog
+from wmrkit.control.feasibility import feasibility, requirement
+from wmrkit.control.references import reference_from_samples
+
+ROBOTS = {name: catalog.load(name) for name in ("swerve-4", "thesis-two-steer-castor", "thesis-two-steer-swedish")}
+COLUMN = "types 3 and 5, l_o != 0"
+
+
+@settings(max_examples=30)
+@given(st.sampled_from(sorted(ROBOTS)), st.one_of(st.none(), st.tuples(st.floats(-0.4, 0.4), st.floats(-0.4, 0.4))),
+       st.floats(0.005, 0.05), st.floats(0.2, 2.0), st.floats(-math.pi, math.pi), st.floats(-math.pi, math.pi),
+       st.floats(-0.5, 0.5), st.sampled_from(["position", "theta", "velocity"]), st.floats(0.25, 0.75),
+       st.floats(1.5, 3.0), st.booleans(), st.floats(-math.pi, math.pi))
+def test_one_step_is_one_violation_at_its_sample(name, point, dt, v, direction, theta0, w, kind, where, factor,
+                                                 down, angle):
+    """A robot of types 3 and 5 (optionally tracked at a random point off its wheels) following a line at a steady
+    speed and turn rate (which it follows: no violation), sampled every `dt` for 10 s, with one step at a random
+    sample: a teleport or heading jump (`factor` x 40 typical steps, above the floors) is one violation at that
+    sample in both frameworks; a speed step (x 0.3-0.7 or x 1.5-3) is one in the dynamic framework and at most
+    that one in the kinematic framework (only where it turns a steered wheel)."""
+    robot = ROBOTS[name]
+    assume(requirement(robot, point=point).column == COLUMN)
+    t = np.arange(0.0, 10.0, dt)
+    i = int(where * len(t))
+    heading = np.array([math.cos(direction), math.sin(direction)])
+    pose = np.column_stack([np.outer(v * t, heading), theta0 + w * t])
+    smooth = reference_from_samples("smooth.csv", t, pose)
+    for framework in ("kinematic", "dynamic"):
+        got = feasibility(robot, smooth, framework, point=point).violations
+        assert not got, (framework, [(x.signal, x.t, x.size) for x in got])
+    if kind == "position":
+        pose[i:, :2] += factor * max(0.01, 40 * v * dt) * np.array([math.cos(angle), math.sin(angle)])
+    elif kind == "theta":
+        pose[i:, 2] += math.copysign(min(3.0, factor * max(0.05, 40 * abs(w) * dt)), angle)
+    else:
+        ratio = 1 / factor if down else factor
+        pose[i:, :2] = pose[i, :2] + np.outer(ratio * v * (t[i:] - t[i]), heading)
+    stepped = reference_from_samples("step.csv", t, pose)
+    for framework in ("kinematic", "dynamic"):
+        got = [(x.signal, x.t) for x in feasibility(robot, stepped, framework, point=point).violations]
+        if kind == "velocity" and framework == "kinematic":
+            assert got in ([], [("velocity", t[i])]), got
+        else:
+            assert got == [(kind, t[i])], (framework, got)
