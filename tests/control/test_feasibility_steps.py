@@ -54,3 +54,17 @@ def test_one_step_is_one_violation_at_its_sample(name, point, dt, v, direction, 
             assert got in ([], [("velocity", t[i])]), got
         else:
             assert got == [(kind, t[i])], (framework, got)
+
+
+def test_a_sampled_speed_step_on_an_arc_is_found():
+    """A file's speed doubling (1 -> 2 m/s) on an arc of curvature 0.3 1/m, sampled at 32 Hz: its central-difference
+    velocity steps in two halves of 0.5 m/s, each under 20 typical steps of the turning velocity there (0.0375 m/s),
+    so the dynamic framework of omni-3 answered 'feasible' and swerve-4's reported only the acceleration's spike one
+    sample early. The halves together are the step: a velocity jump of 1 m/s at 5 s for both."""
+    t = np.arange(0.0, 10.0, 0.03125)
+    phi = np.where(t < 5.0, 0.3 * t, 1.5 + 0.6 * (t - 5.0))  # the tangent: speed 1, then 2, on radius 1/0.3
+    pose = np.column_stack([np.sin(phi) / 0.3, (1 - np.cos(phi)) / 0.3, 0 * t])
+    ref = reference_from_samples("arc.csv", t, pose)
+    for name in ("omni-3", "swerve-4"):
+        got = [(v.signal, v.t, round(v.size, 2)) for v in feasibility(catalog.load(name), ref, "dynamic").violations]
+        assert got == [("velocity", 5.0, 1.0)], (name, got)

@@ -1,30 +1,28 @@
 """Which references a robot can follow with zero error (thesis §8.5, Table 8.1), where a reference breaks that, and
 the remedy.
 
-The column of Table 8.1 follows from the vehicle type (:func:`wmrkit.analysis.classify`) and where the tracking
-point (the robot origin R, or a given point) lies: on the fixed axle (``beta_f - alpha_f = 0``) or off it, and for
-types 3 and 5 whether some steered wheel is away from it (``l_oi != 0``). The *kinematic* framework lets wheel
-rates jump; the *dynamic* one needs them continuous, so every condition goes one derivative higher (§8.5).
-For types 3 and 5 with some ``l_oi != 0`` a velocity or heading-rate step (kinematic), an acceleration or
-angular-acceleration step (dynamic), is a violation only where a steered wheel's heading, respectively steering rate,
-changes across it (:func:`_steered_turn`): a twist that only scales keeps them (docs/errata.md); a velocity or
-heading-rate step under its floor is one too where it turns a steered wheel (:func:`_slow_turns`: a steering angle
-is a state at any speed).
+The column of Table 8.1 follows from the vehicle type (:func:`wmrkit.analysis.classify`) and where the tracking point
+(the robot origin R, or a given point) lies: on the fixed axle (``beta_f - alpha_f = 0``) or off it, and for types 3
+and 5 whether some steered wheel is away from it (``l_oi != 0``). The *kinematic* framework lets wheel rates jump;
+the *dynamic* one needs them continuous, so every condition goes one derivative higher (§8.5). For types 3 and 5 with
+some ``l_oi != 0`` a velocity or heading-rate step (kinematic), an acceleration or angular-acceleration step
+(dynamic), is a violation only where a steered wheel's heading, respectively steering rate, changes across it
+(:func:`_steered_turn`): a twist that only scales keeps them (docs/errata.md); a velocity or heading-rate step under
+its floor is one too where it turns a steered wheel (:func:`_slow_turns`: a steering angle is a state at any speed).
 
-Signals of the reference, sampled: position, tangent angle ``chi`` (8.29) and its rate ``omega_g`` (8.31),
-curvature ``kappa`` (8.33) and its rate, heading ``theta``, velocity and acceleration. A sample-to-sample change
-larger than ``jump_factor`` times the typical one where it is (the median of its block of 21 steps, or of a
-neighbouring block when larger) is a discontinuity where it, or its run of such changes of one sign (a sampled step
-split by finite differences), is larger than an absolute floor, reported once: the spike of a derivative around a
-step of its signal is that step (:func:`_folded`).
+Signals of the reference, sampled: position, tangent angle ``chi`` (8.29) and its rate ``omega_g`` (8.31), curvature
+``kappa`` (8.33) and its rate, heading ``theta``, velocity and acceleration. A sample-to-sample change larger than
+``jump_factor`` times the typical one where it is (the median of its block of 21 steps, or of a neighbouring block
+when larger) is a discontinuity where it, or its run of such changes of one sign (a sampled step split by finite
+differences), is larger than an absolute floor, reported once: the spike of a derivative around a step of its signal
+is that step (:func:`_folded`).
 
-``kappa`` and the rates are not judged where the reference rests or starts or stops (its speed changes by more
-than 5 % in a sample step), ``chi`` at rest and where the speed changes by more than itself in a step: there they
-come from a velocity near zero (finite differences of positions that hardly move, for a file). A jump across such
-samples is still found, as the change from the last sample before to the first after (compared with as many
-typical steps as it spans), where it is reported; across
-a rest only for a car's tangent (R on the fixed axle of a type 4 cannot turn at rest; any other vehicle re-orients
-there, the remedy of Table 8.1).
+``kappa`` and the rates are not judged where the reference rests or starts or stops (its speed changes by more than
+5 % in a sample step), ``chi`` at rest and where the speed changes by more than itself in a step: there they come
+from a velocity near zero (finite differences of positions that hardly move, for a file). A jump across such samples is
+still found, as the change from the last sample before to the first after (compared with as many typical steps as it
+spans), where it is reported; across a rest only for a car's tangent (R on the fixed axle of a type 4 cannot turn at
+rest; any other vehicle re-orients there, the remedy of Table 8.1).
 """
 
 from __future__ import annotations
@@ -205,8 +203,7 @@ def _travel_sign(chi: np.ndarray) -> np.ndarray:
 
 
 _FLOOR = {"position": 1e-3, "theta": 0.02, "velocity": 0.02, "omega": 0.02, "acceleration": 0.05, "omega_rate": 0.05,
-          "chi": 0.05,
-          "chi_rate": 0.02, "kappa": 0.02, "kappa_rate": 0.02}
+          "chi": 0.05, "chi_rate": 0.02, "kappa": 0.02, "kappa_rate": 0.02}
 
 
 #: Steps in a block: a step's typical size is the median of its block or of a neighbouring one, whichever is larger.
@@ -215,8 +212,7 @@ BLOCK = 21
 
 def _jumps(x: np.ndarray, t: np.ndarray, turn: float | None, floor: float, factor: float,
            at_rest: np.ndarray | None = None, across_rest: bool = False) -> list[tuple[int, int, float]]:
-    """The jumps of `x` ``(n, ...)``: ``(first step, last step, size)`` of each (a step k goes from sample k to
-    k + 1)."""
+    """The jumps of `x` ``(n, ...)``: ``(first step, last step, size)`` of each (step k: from sample k to k + 1)."""
     x = x.reshape(len(x), -1)
     cut = held = None
     # typical sample steps each step covers: its time over the median sample spacing (more for one bridged over
@@ -259,7 +255,11 @@ def _jumps(x: np.ndarray, t: np.ndarray, turn: float | None, floor: float, facto
     near = np.maximum(blocks, np.maximum(np.r_[blocks[:1], blocks[:-1]], np.r_[blocks[1:], blocks[-1:]]))
     # a step bridged over k undefined samples is the change of k steps: compared with k typical ones (at 10 Hz, a
     # smooth curvature changing by 0.09 over 6 samples whose speed changed too fast to judge them was a 'jump')
-    part = size > np.maximum(floor * 1e-3, factor * span * np.repeat(near, BLOCK)[:n])  # a thousandth: rounding
+    limit = factor * span * np.repeat(near, BLOCK)[:n]
+    # central differences halve a step: two over half the limit whose sum is over it are one (a speed step on an arc)
+    pair = np.sqrt(np.nansum((_wrap(d[:-1] + d[1:], turn) if turn else d[:-1] + d[1:]) ** 2, axis=-1))
+    half = (size[:-1] > limit[:-1] / 2) & (size[1:] > limit[1:] / 2) & (pair > np.maximum(limit[:-1], limit[1:]))
+    part = (size > floor * 1e-3) & ((size > limit) | np.r_[half, False] | np.r_[False, half])  # 1e-3: rounding
     # the floor is compared with the whole step: finite differences split a sampled one into a run of changes of one
     # sign, each maybe under it (the forklift's turn-rate step of 0.033 rad/s on an S-curve at 0.05 m/s was 2 x 0.017)
     dz = np.where(part[:, None], np.nan_to_num(d.reshape(n, -1)), 0.0)
