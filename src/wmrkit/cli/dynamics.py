@@ -152,12 +152,13 @@ def run_simulate(args: argparse.Namespace) -> int:
     travelled = float(np.sum(np.hypot(*np.diff(sim.pose[:, :2], axis=0).T)))
     max_slip = float(np.hypot(sim.slip[..., 0], sim.slip[..., 1]).max())  # a contact's slip speed, not a component
     deviation = sim.deviation()
-    for warning in _tyre_warnings(model, sim.twist) + [
-            f"{c.channel_name} is not modelled: each of its joints is driven on its own (docs/description-format.md, "
-            "Couplings)" for c in model.robot.couplings if c.kind == "gear"] + [
-            deviation_warning(model, inputs, deviation, max_slip) if deviation and deviation.large else ""]:
-        if warning:
-            warn(warning)
+    warnings = _tyre_warnings(model, sim.twist) + [
+        f"{c.channel_name} is not modelled: each of its joints is driven on its own (docs/description-format.md, "
+        "Couplings)" for c in model.robot.couplings if c.kind == "gear"]
+    if deviation and deviation.large:
+        warnings.append(deviation_warning(model, inputs, deviation, max_slip))
+    for warning in warnings:
+        warn(warning)
     if args.json:
         print_json({"robot": model.robot.name, "method": sim.method, "step": step, "duration": duration,
                     "samples": len(sim.t), "final_time": end, "final_pose": pose.tolist(), "final_twist": tw.tolist(),

@@ -264,8 +264,8 @@ def _jumps(x: np.ndarray, t: np.ndarray, turn: float | None, floor: float, facto
     # sign, each maybe under it (the forklift's turn-rate step of 0.033 rad/s on an S-curve at 0.05 m/s was 2 x 0.017)
     dz = np.where(part[:, None], np.nan_to_num(d.reshape(n, -1)), 0.0)
     start = part & ~np.r_[False, part[:-1] & (np.sum(dz[1:] * dz[:-1], axis=-1) > 0)]
-    first, cz = np.flatnonzero(start), np.r_[np.zeros((1, dz.shape[1])), np.cumsum(dz, axis=0)]
-    run = np.r_[np.sqrt(((cz[np.r_[first[1:], n]] - cz[first]) ** 2).sum(axis=-1)), 0.0][np.cumsum(start) - 1]
+    starts, cz = np.flatnonzero(start), np.r_[np.zeros((1, dz.shape[1])), np.cumsum(dz, axis=0)]
+    run = np.r_[np.sqrt(((cz[np.r_[starts[1:], n]] - cz[starts]) ** 2).sum(axis=-1)), 0.0][np.cumsum(start) - 1]
     hit = np.flatnonzero(part & ((size > floor) | (run > floor)))
     events: list[list[int]] = []  # [first step, last step, step of the largest]
     for k in hit:  # a jump spread over consecutive samples (finite differences) is one event

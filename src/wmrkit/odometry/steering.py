@@ -141,6 +141,8 @@ def steering_steps(model: OdometryModel, positions: np.ndarray) -> list[Steering
     travel per interval, off its direction.
     The travel is the displacement of the wheel's steering axis by the no-slip body increment (0 when the wheel
     steers at rest)."""
+    from .model import wrap_angle
+
     p = np.asarray(positions, dtype=float)
     if not model.steer_joints or len(p) < 3:  # a step needs a neighbouring interval to compare with
         return []
@@ -149,7 +151,7 @@ def steering_steps(model: OdometryModel, positions: np.ndarray) -> list[Steering
     for joint in model.steer_joints:
         x, y = model.robot.wheel(joint.rpartition(".")[0]).position
         travel = np.hypot(inc[:, 0] - inc[:, 2] * y, inc[:, 1] + inc[:, 2] * x)
-        step = (np.diff(p[:, model.joints.index(joint)]) + np.pi) % (2 * np.pi) - np.pi  # wrapped, as the model
+        step = wrap_angle(np.diff(p[:, model.joints.index(joint)]))  # as the model wraps it
         size = np.abs(step)
         around = np.maximum(np.append(-np.inf, size[:-1]), np.append(size[1:], -np.inf))
         excess = np.maximum(size - around, 0.0)
