@@ -2,8 +2,9 @@
 
 Real robots couple joints mechanically: a car drives its rear wheels through a differential, a synchro drive turns
 every wheel with one chain, an Ackermann linkage steers both front wheels with one actuator. A description says so
-with ``couplings:`` (``docs/description-format.md``); the actuation and sensing analyses (thesis §4.4) then count
-one actuator or sensor per coupling instead of one per joint, and no longer report such a robot as fighting itself.
+with ``couplings:`` (``docs/description-format.md``); the actuation analysis (thesis §4.4) then counts one actuator
+per coupling instead of one per joint, and no longer reports such a robot as fighting itself. Sensors read their
+joints one by one; a gear's unsensed joints turn with its sensed ones (:func:`gear_fill`: fk, odometry, sensing).
 
 - ``differential``: one actuator drives the weighted sum ``sum(ratio_j * q_j)`` of the joints' rates (a mechanical
   differential: the mean of the two wheel rates with ratios 1/2, 1/2); the other combinations stay free.
@@ -179,3 +180,31 @@ def linked_steering(couplings: tuple[Coupling, ...], steering: tuple[str, ...]) 
         if c.kind == "linkage" and any(w in steering for w in wheels):
             out += [w for w in wheels if w not in out]
     return tuple(out)
+
+
+def gear_fill(couplings: tuple[Coupling, ...], names: tuple[str, ...],
+              given: tuple[int, ...]) -> tuple[tuple[int, ...], np.ndarray]:
+    """The joint rates a ``gear`` fixes from given ones: ``q_j = ratio_j * u``, ``u = k_g . q_g / k_g . k_g`` the
+    least-squares turn of the gear's given joints ``g`` (each given joint stays as given: sensors read per joint).
+
+    `names`: the columns (velocity or Jacobian-form names); `given`: the positions of the given rates, in order.
+    Returns ``(columns, F)``: `given` followed by the positions of the joints filled (those of `names` in a gear with
+    a given joint), and ``F`` ``(len(columns), len(given))`` with ``q[columns] = F @ q[given]``.
+    """
+    columns, rows = list(given), [np.eye(len(given))[i] for i in range(len(given))]
+    for c in couplings:
+        if c.kind != "gear":
+            continue
+        idx = [names.index(j) if j in names else -1 for j in c.joints]
+        k = np.array(c.ratios, dtype=float)
+        known = [i for i, col in enumerate(idx) if col in given]
+        if not known:
+            continue
+        u = np.zeros(len(given))  # u = F_u @ q_given
+        u[[given.index(idx[i]) for i in known]] = k[known] / (k[known] @ k[known])
+        for i, col in enumerate(idx):
+            if col >= 0 and col not in columns:
+                columns.append(col)
+                rows.append(k[i] * u)
+    return tuple(columns), np.array(rows, dtype=float).reshape(len(columns), len(given))
+

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ..couplings import channel_names
+from ..couplings import channel_names, gear_fill
 from ..errors import WmrkitError
 from ..kinematics.actuation import actuation_analysis
 from ..kinematics.sensing import sensing_analysis
@@ -198,8 +198,11 @@ def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) 
     else:
         d, kappa = float(length), float(twist_condition_number(robot, joints=joints, length=length))
     act, sen = actuation_analysis(robot), sensing_analysis(robot)
-    singular = {key: model_singular_set(robot, model_rates(robot, names), cls, resolution, coupled=key == "actuated")
-                for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed))}
+    sensed = model_rates(robot, robot.sensed)  # with the rates a gear turns with them, known as fk knows them
+    sensed = tuple(robot.rate_names[c] for c in gear_fill(robot.couplings, robot.rate_names,
+                                                          tuple(map(robot.rate_names.index, sensed)))[0])
+    singular = {key: model_singular_set(robot, names, cls, resolution, coupled=key == "actuated")
+                for key, names in (("actuated", model_rates(robot, robot.actuated)), ("sensed", sensed))}
     return Analysis(
         robot, cls, int(instantaneous_mobility(robot)), icr(robot),
         {"consistent": bool(np.all(act.consistent)), "sufficient": bool(np.all(act.sufficient)),

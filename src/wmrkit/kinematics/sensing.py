@@ -16,8 +16,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, matvec, readonly
+from ..couplings import gear_fill
 from ..robot import TWIST_NAMES, Robot
-from .actuation import body_only, minimal_set_search, split_jacobian, steering_split, verdict_texts
+from .actuation import body_only, coupled_constraints, minimal_set_search, split_jacobian, steering_split, verdict_texts
 from .linalg import delta_projector, matrix_rank, nondimensional
 from .models import bounded, configuration, mobility
 from .search import SetList
@@ -34,15 +35,20 @@ from .trees import (
 
 
 def _split(robot: Robot, sensed: Sequence[str] | None, beta: ArrayLike | None):
+    """Sensed columns, sensed steering, ``(I_bar, J_s, J_ns)``: a gear's unsensed joints turn with its sensed ones
+    (:func:`wmrkit.couplings.gear_fill`, as ``fk`` and ``odometry`` fill them), so they are known, not columns of
+    ``J_ns``, and ``J_s`` carries them; last, the known columns (sensed, then filled)."""
     columns, steering = select_columns(robot, robot.sensed if sensed is None else sensed, "sensed")
-    return (columns, steering, *split_jacobian(robot, columns, beta))
+    filled, fill = gear_fill(robot.couplings, jacobian_names(robot), columns)
+    i_bar, j_s, j_ns = split_jacobian(robot, filled, beta)
+    return columns, steering, i_bar, j_s @ fill, j_ns, filled
 
 
 def sensing_equation(
     robot: Robot, sensed: Sequence[str] | None = None, beta: ArrayLike | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """The vehicle sensing equation (4.34), ``I_s @ twist_robot = J_s @ q_dot_s``: ``(I_s (..., 3E, 3), J_s)``."""
-    _, _, i_bar, j_s, j_ns = _split(robot, sensed, beta)
+    _, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
     return reduced_equation(i_bar, j_s, j_ns), j_s
 
 
@@ -55,7 +61,7 @@ def sensed_direct_matrix(
     the composite form ``(I_bar^T Delta(J_ns) I_bar)^-1 I_bar^T Delta(J_ns) J_s``. Needs sufficient sensors;
     otherwise the pseudo-inverse gives the minimum-norm twist.
     """
-    _, _, i_bar, j_s, j_ns = _split(robot, sensed, beta)
+    _, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
     return partitioned_solution(i_bar, j_ns) @ j_s
 
 
@@ -68,7 +74,7 @@ def sensed_full_matrix(
     velocities in :func:`jacobian_names` order (the omega copies included). Pseudo-inverse: ``I_ns`` is
     rank-deficient when the sensors are insufficient.
     """
-    _, _, i_bar, j_s, j_ns = _split(robot, sensed, beta)
+    _, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
     return _full(i_bar, j_s, j_ns)
 
 
@@ -87,7 +93,7 @@ def sensing_tree(
     (redundant sensors, slip detectable), and with readings ``q_dot_s`` ``(..., n_s)`` ``consistent`` (no slip
     nor noise) or ``inconsistent``; the other leaves: insufficient sensors.
     """
-    _, _, i_bar, j_s, j_ns = _split(nondimensional(robot), sensed, beta)  # rates are angular: same units
+    _, _, i_bar, j_s, j_ns, _ = _split(nondimensional(robot), sensed, beta)  # rates are angular: same units
     delta = delta_projector(j_ns)  # the unsensed rates eliminated exactly, as in sensing_analysis
     return classify_system(delta @ i_bar, delta @ j_s, q_dot_s)
 
@@ -118,7 +124,7 @@ class SensingAnalysis:
     tree: TreeVerdict
     direct_matrix: np.ndarray  # (..., 3, n_s), (4.32)
     full_matrix: np.ndarray  # (..., 3 + n_ns, n_s), (4.31)
-    full_names: tuple[str, ...]  # rows of full_matrix: vx, vy, omega, then the non-sensed velocities
+    full_names: tuple[str, ...]  # rows of full_matrix: vx, vy, omega, then the unknown velocities (no gear-filled one)
     residual_matrix: np.ndarray  # (..., 3E, n_s): least-squares error of (4.31) per sensed rate
     unsensed: np.ndarray  # (...) int, motions with every sensed rate at rest (.trees.undriven_motions)
 
@@ -181,10 +187,10 @@ def sensing_analysis(
     solution ``.twist`` / ``.direct``.
     """
     beta = configuration(robot, beta, heading)
-    columns, steering, i_bar, j_s, j_ns = _split(robot, sensed, beta)
+    columns, steering, i_bar, j_s, j_ns, known = _split(robot, sensed, beta)
     unit = nondimensional(robot)  # rank decisions: the tolerance policy of .linalg
-    a = unit.constraint_matrix(beta)
-    _, _, i_bar1, j_s1, j_ns1 = _split(unit, sensed, beta)
+    a = coupled_constraints(unit, beta)  # the motions a gear allows, as the actuation analysis counts them
+    _, _, i_bar1, j_s1, j_ns1, _ = _split(unit, sensed, beta)
     names = jacobian_names(robot)
     full = _full(i_bar, j_s, j_ns)
     i_ns = np.concatenate([np.broadcast_to(i_bar, (*j_ns.shape[:-2], *i_bar.shape)), -j_ns], axis=-1)
@@ -193,7 +199,7 @@ def sensing_analysis(
         readonly(np.asarray(a.shape[-1] - matrix_rank(a))),
         eliminated_tree(i_bar1, j_s1, j_ns1),
         readonly(partitioned_solution(i_bar, j_ns) @ j_s), readonly(full),
-        TWIST_NAMES + tuple(n for c, n in enumerate(names) if c not in columns),
+        TWIST_NAMES + tuple(n for c, n in enumerate(names) if c not in known),
         readonly(i_ns @ full - j_s),
         readonly(undriven_motions(i_bar1, j_ns1)),
     )

@@ -4,7 +4,8 @@ Between two samples the no-slip equations (3.22)-(3.23), ``A(beta) q_dot = 0``, 
 hold for the rates integrated over the interval: ``A(beta_mid) dq = 0`` with ``beta_mid`` the steering angles at
 the middle of the interval (second order in the step). The sensed joint increments are *assigned* and the others
 (the body increment ``(dx, dy, dtheta)``, unsensed wheel rates) are solved by least squares with the ranks
-method (4.9)-(4.11) (:func:`wmrkit.kinematics.linalg.solve_assigned`); the residual ``A dq`` [m] is the slip
+method (4.9)-(4.11) (:func:`wmrkit.kinematics.linalg.solve_assigned`), the joints of a ``gear`` coupling that are
+not sensed assigned with its sensed ones (:func:`wmrkit.couplings.gear_fill`); the residual ``A dq`` [m] is the slip
 indicator of (4.11)/(4.82), zero when the sensors agree with rolling without slip. No division by a time step.
 
 Steering angles come from the sensed ``WHEEL.steer`` joints. A steering wheel whose steer angle is not sensed and
@@ -25,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_names, readonly
+from ..couplings import gear_fill
 from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import matrix_rank, solve_assigned
 from ..robot import Robot
@@ -201,6 +203,7 @@ class OdometryModel:
     row_weights: np.ndarray  # weight of each kept row in the least squares
     solution: np.ndarray | None  # (k, n_a), constant robots only
     residual_map: np.ndarray | None  # (R, n_a), constant robots with redundant sensors only
+    fill: np.ndarray  # (n_assigned, n_a): the assigned rates from the sensed ones (a gear turns its joints together)
     # maps per steering configuration met so far; not an init field, so dataclasses.replace starts a new one
     _cache: dict = field(init=False, default_factory=dict, compare=False, repr=False)
 
@@ -272,7 +275,7 @@ class OdometryModel:
         beta = np.asarray(beta, dtype=float)
         full = np.broadcast_to(self.robot.beta, (*beta.shape[:-1], len(self.robot.steer_names))).copy()
         full[..., self.steer_index] = beta
-        return solution_maps(self.robot, full, self.rows, self.cols, self.assigned, self.row_weights)
+        return solution_maps(self.robot, full, self.rows, self.cols, self.assigned, self.row_weights, self.fill)
 
     @property
     def columns(self) -> tuple[np.ndarray, np.ndarray]:
@@ -373,20 +376,23 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
                            f"than a factor {MAX_WEIGHT_RATIO:g}: the least squares would lose the smaller rows to "
                            "round-off (only ratios matter; a wheel without a weight has 1)")
     cols_a = np.array(cols)
-    assigned = np.array([cols.index(robot.velocity_index(j)) for j in rate_joints], dtype=int)
+    kept = tuple(robot.velocity_names[c] for c in cols)  # a gear's joint turns with its sensed ones (fill)
+    positions, fill = gear_fill(robot.couplings, kept, tuple(kept.index(j) for j in rate_joints))
     joints = tuple(dict.fromkeys([*rate_joints, *steer_joints]))
     model = OdometryModel(robot, joints, tuple(rate_joints), tuple(steer_joints), np.array(rows, dtype=int), cols_a,
-                          assigned, np.array(steer_index, dtype=int), frozen(np.array(row_weights)), None, None)
+                          np.array(positions, dtype=int), np.array(steer_index, dtype=int),
+                          frozen(np.array(row_weights)), None, None, frozen(fill))
     if steer_joints:
         return model
     if not _twist_determined(robot, robot.beta[None, :], model)[0]:
         raise SensingError(f"the sensed joints of robot '{robot.name}' ({', '.join(sensed) or 'none'}) do not "
                            "determine its motion")
-    s, rm = solution_maps(robot, robot.beta, model.rows, model.cols, model.assigned, model.row_weights)
+    s, rm = solution_maps(robot, robot.beta, model.rows, model.cols, model.assigned, model.row_weights, model.fill)
     scale = np.max(np.abs(_kept_matrix(robot, robot.beta, model.rows, model.cols)))
     redundant = np.max(np.abs(rm), initial=0.0) > 1e-12 * scale  # else A dq = 0 exactly: no spare sensor
-    return OdometryModel(robot, joints, tuple(rate_joints), (), model.rows, cols_a, assigned,
-                         model.steer_index, model.row_weights, frozen(s), frozen(rm) if redundant else None)
+    return OdometryModel(robot, joints, tuple(rate_joints), (), model.rows, cols_a, model.assigned,
+                         model.steer_index, model.row_weights, frozen(s), frozen(rm) if redundant else None,
+                         model.fill)
 
 
 def kernel_maps(solution: np.ndarray, residual_map: np.ndarray | None,
@@ -428,12 +434,12 @@ def _kept_matrix(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np
 
 
 def solution_maps(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np.ndarray,
-                  assigned: np.ndarray, row_weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                  assigned: np.ndarray, row_weights: np.ndarray, fill: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(S, Rm)`` from (4.11) for each configuration: solve_assigned (on the rows scaled by their weights) for
-    the unit vectors of the assigned rates; ``Rm = A S``, the unweighted residual map."""
+    the assigned rates of each sensed one's unit vector (``fill`` ``(n_assigned, n_a)``: the sensed rates and those
+    a gear turns with them); ``Rm = A S``, the unweighted residual map."""
     a = _kept_matrix(robot, beta_full, rows, cols)
-    n_a = len(assigned)
-    q, _ = solve_assigned((a * row_weights[:, None])[..., None, :, :], assigned, np.eye(n_a))  # (..., n_a, k)
+    q, _ = solve_assigned((a * row_weights[:, None])[..., None, :, :], assigned, fill.T)  # (..., n_a, k)
     s = np.swapaxes(q, -1, -2)
     return s, a @ s
 
