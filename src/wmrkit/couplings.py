@@ -208,3 +208,12 @@ def gear_fill(couplings: tuple[Coupling, ...], names: tuple[str, ...],
                 rows.append(k[i] * u)
     return tuple(columns), np.array(rows, dtype=float).reshape(len(columns), len(given))
 
+
+def steering_mechanisms(couplings: tuple[Coupling, ...], steered: list[str] | tuple[str, ...]) -> int:
+    """How many independent steering commands the `steered` wheels take: one per wheel, a ``linkage`` of several
+    of them (a synchro drive's chain, an Ackermann linkage) one for all."""
+    groups = {w: w for w in steered}
+    for c in (c for c in couplings if c.kind == "linkage"):
+        linked = [groups[w] for w in (j.partition(".")[0] for j in c.joints) if w in groups]
+        groups = {w: (linked[0] if g in linked else g) for w, g in groups.items()}
+    return len(set(groups.values()))

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..couplings import steering_mechanisms
 from ..errors import WmrkitError
 from ..kinematics.linalg import characteristic_length, matrix_rank
 from ..kinematics.models import configuration
@@ -61,6 +62,9 @@ class Classification:
     coordinated: bool  # the steered wheels must be coordinated (one common ICR) for the robot to move
     fixed_rank: int
     special: tuple[SpecialConfiguration, ...]
+    #: d the robot's steering mechanisms can command: at most one per steered wheel or ``linkage`` of them
+    #: (``couplings.steering_mechanisms``); below d when a linkage steers wheels that d counts as independent
+    commanded_steerability: int
 
     @property
     def name(self) -> str:
@@ -74,6 +78,8 @@ class Classification:
         extra = list(self.reasons)
         if self.coordinated:
             extra.append("the steered wheels must be coordinated so that all axles meet at one ICR")
+        if self.commanded_steerability < self.steerability:
+            extra.append(f"its steering linkages command d = {self.commanded_steerability} (couplings)")
         return head + ("; " + "; ".join(extra) if extra else "")
 
 
@@ -125,7 +131,8 @@ def classify(robot: Robot, *, samples: int = 8, seed: int = 0) -> Classification
         reasons.append(f"(m, d) = ({m}, {d}) is not in Table 5.1 (5.15)")
     kind = None if reasons else TABLE_5_1.get((m, d))
     special = _special(robot, steered, rf, m) if not reasons else ()
-    return Classification(m, d, kind, bool(reasons), tuple(reasons), coordinated, rf, special)
+    return Classification(m, d, kind, bool(reasons), tuple(reasons), coordinated, rf, special,
+                          min(d, steering_mechanisms(robot.couplings, steered)))
 
 
 def _size(robot: Robot) -> float:

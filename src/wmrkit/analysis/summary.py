@@ -49,7 +49,8 @@ class Analysis:
         c = self.classification
         return {
             "robot": self.robot.name,
-            "mobility": c.mobility, "steerability": c.steerability, "type": c.type, "type_name": c.name,
+            "mobility": c.mobility, "steerability": c.steerability, "commanded_steerability": c.commanded_steerability,
+            "type": c.type, "type_name": c.name,
             "degenerate": c.degenerate, "reasons": list(c.reasons), "coordinated_steering": c.coordinated,
             "instantaneous_mobility": self.instantaneous_mobility,
             "special_configurations": [{"heading": self.robot.heading_of_beta(s.beta).tolist(), "beta": list(s.beta),
