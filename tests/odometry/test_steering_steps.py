@@ -173,3 +173,40 @@ def test_the_forklift_example_log_does_not_warn(capsys, tmp_path):
                    capture_output=True)
     out, _ = _run(capsys, "forklift", tmp_path / "forklift_counts.csv")
     assert _steps(out) == []
+
+
+def _agv_logs(tmp_path) -> tuple[Path, Path, Path]:
+    """The AGV's square without pauses (its unit pivots within a sample) as a CSV log and as a ROS 2 bag, and with
+    pauses to steer (no step) as a CSV log."""
+    from wmrkit.odometry.bags import write_joint_states
+
+    robot = catalog.load("agv-drive-unit")
+    log = simulate(robot, square_path(1.5), 20.0).log
+    write_log(tmp_path / "agv.csv", log, robot)
+    write_joint_states(tmp_path / "agv.mcap", log, robot=robot)
+    write_log(tmp_path / "paused.csv", _agv_with_pauses()[1], robot)
+    return tmp_path / "agv.csv", tmp_path / "agv.mcap", tmp_path / "paused.csv"
+
+
+def test_a_bag_warns_of_a_steering_step_as_its_csv_does(capsys, tmp_path):
+    """The same log as a ROS 2 bag: no warning before (the diagnostic read CSV logs only), the CSV's line now."""
+    csv, bag, _ = _agv_logs(tmp_path)
+    (line,) = _steps(_run(capsys, "agv-drive-unit", csv)[0])
+    out, err = _run(capsys, "agv-drive-unit", bag)
+    assert _steps(out) == [line] and err.count("within one interval") == 1
+    assert line.startswith("unit.steer steps -90 deg within one interval (t = 2.95 to 3 s;")
+
+
+def test_batch_odometry_warns_of_a_steering_step_per_log(capsys, tmp_path):
+    """``batch odometry`` over the stepping log (CSV and bag) and the paused one: the stepping logs' rows carry
+    ``wmrkit odometry``'s line in their ``warnings`` column (and the answer's ``warnings`` names each log); the
+    paused log's row none. Before, no row said it."""
+    csv, bag, paused = _agv_logs(tmp_path)
+    (line,) = _steps(_run(capsys, "agv-drive-unit", csv)[0])
+    assert main(["batch", "odometry", "agv-drive-unit", str(csv), str(bag), str(paused), "--workers", "0",
+                 "--json"]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    rows = {r["log"]: r["warnings"] or "" for r in answer["rows"]}
+    assert line in rows[str(csv)] and line in rows[str(bag)] and "within one interval" not in rows[str(paused)]
+    said = [w for w in answer["warnings"] if "within one interval" in w]
+    assert [w.split(": ")[0] for w in said] == [str(csv), str(bag)] and all(line in w for w in said)

@@ -127,10 +127,11 @@ def process_log(job: LogJob) -> dict[str, Any]:
         warnings.simplefilter("always")
         try:
             options = dict(job.options)
+            model = job.model or odometry_model(job.robot, options.get("sensed"), weights=options.get("weights"))
             if job.header is not None and not is_bag(job.path):  # each log says its units (odometry's rule)
-                joints = (job.model or odometry_model(job.robot, options.get("sensed"))).joints
-                options["fmt"] = header_format(job.path, job.robot.name, joints, **job.header)
-            s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=job.model, **options)
+                options["fmt"] = header_format(job.path, job.robot.name, model.joints, **job.header)
+            s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=model, **options)
+            stepped = _steering_step(job.robot, job.path, model, options)
         except Exception as err:
             row.update(error=_message(err), trajectory=None, wall_time=time.perf_counter() - t0)
             return row
@@ -140,12 +141,27 @@ def process_log(job: LogJob) -> dict[str, Any]:
         notes.append(f"slip indicator up to {s.max_slip:.3g} m per interval (threshold {job.slip_warning:g} m)")
     if s.samples < 2:
         notes.append("a single sample: no motion")
+    if stepped:
+        notes.append(stepped)
     row.update(samples=s.samples, start_time=s.start_time, duration=s.end_time - s.start_time, x=x, y=y, theta=theta,
                path_length=s.path_length, rotation=s.rotation, max_slip=s.max_slip, rms_slip=s.rms_slip,
                max_dt=s.max_dt, warnings="; ".join(notes) or None, wall_time=time.perf_counter() - t0)
     if job.closed:  # the run ends where it started (the start pose is the origin)
         row.update(closure_error=math.hypot(x, y), closure_heading=float(np.angle(np.exp(1j * theta))))
     return row
+
+
+def _steering_step(robot: Robot, path: str, model, options: Mapping[str, Any]) -> str | None:
+    """``wmrkit odometry``'s steering-step warning over the log's first samples
+    (:func:`~wmrkit.odometry.steering.steering_step_warning`), None without sensed steering."""
+    from ..odometry.files import first_samples
+    from ..odometry.steering import steering_step_warning
+
+    if not model.steer_joints:
+        return None
+    log = first_samples(robot, path, model.joints, **{k: options[k] for k in ("fmt", "topic", "joint_names")
+                                                      if k in options})
+    return steering_step_warning(model, log)
 
 
 def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runner: Engine | None = None,

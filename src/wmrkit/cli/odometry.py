@@ -14,7 +14,7 @@ import numpy as np
 from ..errors import WmrkitError
 from ..limits import check_chunk_size
 from ..odometry.covariance import CrowleyNoise
-from ..odometry.files import is_bag, odometry_file
+from ..odometry.files import first_samples, is_bag, odometry_file
 from ..odometry.header import header_format
 from ..odometry.integrators import METHODS
 from ..odometry.logs import TIME_UNITS, LogFormat
@@ -156,7 +156,8 @@ def run(args: argparse.Namespace) -> int:
         summary = replace(summary, method=f"{args.method} ({args.scheme})")
     if args.method in ("fk1", "fk2"):
         _warn_ill_conditioned(args.method, slip_model.model)
-    first = functools.cache(lambda: _first_samples(robot, args.log, fmt, args.sensed))  # read once, if at all
+    names = parse_assignments(args.joint_name, "--joint-name")
+    first = functools.cache(lambda: _first_samples(robot, args.log, fmt, args.sensed, args.topic, names))  # once
     consistent = _check_consistency(summary, lambda: _wheel_slips(args.log, first),
                                     filtered=args.method if args.method in ("fk1", "fk2") else None)
     if fmt.heading_column or fmt.gyro_column:
@@ -287,27 +288,18 @@ def _check_gears(robot, log: str, samples) -> bool:
 
 
 def _check_steering_steps(robot, log: str, sensed, samples) -> None:
-    """Warn (one line, naming the worst step and the other joints that step) where a sensed steering angle steps
-    within one interval while its wheel rolls, over the first samples of a CSV log
-    (:func:`wmrkit.odometry.steering.steering_steps`): the no-slip rows take the angle at mid-interval, so that
-    interval's travel may be off its direction (a drive unit pivoting 90 deg within a sample at each corner of a
-    square turned 0.09 rad too little at 20 Hz, with "consistent": true)."""
-    from ..odometry.steering import steering_steps
+    """Warn (one line, :func:`wmrkit.odometry.steering.steering_step_warning`) where a sensed steering angle steps
+    within one interval while its wheel rolls, over the first samples of the log (CSV or bag): the no-slip rows take
+    the angle at mid-interval, so that interval's travel may be off its direction (a drive unit pivoting 90 deg
+    within a sample at each corner of a square turned 0.09 rad too little at 20 Hz, with "consistent": true)."""
+    from ..odometry.steering import steering_step_warning
 
-    if is_bag(log) or not any(j.endswith(".steer") for j in odometry_model(robot, sensed).joints):
+    if not odometry_model(robot, sensed).steer_joints:
         return
     model, first = samples()
-    steps = sorted(steering_steps(model, first.positions), key=lambda s: -s.bound)
-    if not steps:
-        return
-    s = steps[0]
-    t0, t1 = first.time[s.interval], first.time[s.interval + 1]
-    more = f"; {s.count} such steps over the first {len(first)} samples" if s.count > 1 else ""
-    others = f" (also {', '.join(o.joint for o in steps[1:])})" if len(steps) > 1 else ""
-    warn(f"{s.joint} steps {math.degrees(s.step):+.4g} deg within one interval (t = {t0:.6g} to {t1:.6g} s; the "
-         f"intervals around it change it by {math.degrees(abs(s.step) - s.excess):.3g} deg at most) while the wheel "
-         f"travels {s.travel:.3g} m: up to {s.bound:.3g} m of that travel off its direction{more}{others}; the "
-         "odometry assumes the angle changes uniformly within an interval: log faster")
+    message = steering_step_warning(model, first)
+    if message:
+        warn(message)
 
 
 def _wheel_slips(log: str, samples) -> dict[str, float]:
@@ -320,18 +312,11 @@ def _wheel_slips(log: str, samples) -> dict[str, float]:
     return wheel_slip(model, first.positions)
 
 
-#: Samples of a CSV log the diagnostics read (the per-wheel slip, the external heading against the wheels, the
-#: gears, the steering steps).
-FIRST_SAMPLES = 20_000
-
-
-def _first_samples(robot, log: str, fmt: LogFormat, sensed):
-    """The no-slip model and the first :data:`FIRST_SAMPLES` samples of a CSV log, for the diagnostics (each takes
-    them as ``samples()``, read once a run)."""
-    from ..odometry.logs import read_csv
-
+def _first_samples(robot, log: str, fmt: LogFormat, sensed, topic: str, joint_names):
+    """The no-slip model and the first samples of the log (:func:`wmrkit.odometry.files.first_samples`), for the
+    diagnostics (each takes them as ``samples()``, read once a run)."""
     model = odometry_model(robot, sensed)
-    return model, next(iter(read_csv(log, model.joints, fmt, robot=robot, chunk_size=FIRST_SAMPLES)))
+    return model, first_samples(robot, log, model.joints, fmt=fmt, topic=topic, joint_names=joint_names)
 
 
 def format_summary(s: OdometrySummary) -> str:

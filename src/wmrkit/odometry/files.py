@@ -22,7 +22,7 @@ from ..limits import same_file
 from ..robot import Robot
 from .bags import OdometryBagWriter, bag_message_count, read_joint_states
 from .integrators import Method, check_method
-from .logs import LogError, LogFormat, read_csv
+from .logs import JointLog, LogError, LogFormat, read_csv
 from .model import OdometryModel, odometry_model
 from .pipeline import Decimator, Noise, OdometrySummary, run_odometry
 from .trajectories import TrajectoryWriter
@@ -57,6 +57,26 @@ def _check_not_the_log(log_path: str | os.PathLike[str], outputs: Mapping[str, o
         if path is not None and same_file(log_path, path):  # type: ignore[arg-type]
             raise LogError(f"{os.fspath(log_path)}: the {what} file is the log itself (writing it would destroy the "
                            "log); choose another file")
+
+
+#: Samples of a log the diagnostics after a run read (the per-wheel slip, the external heading against the wheels,
+#: the gears, the steering steps): its first ones.
+FIRST_SAMPLES = 20_000
+
+
+def first_samples(robot: Robot, log_path: str | os.PathLike[str], joints: Sequence[str], *,
+                  fmt: LogFormat = DEFAULT_FORMAT, topic: str = "/joint_states",
+                  joint_names: Mapping[str, str] | None = None, count: int = FIRST_SAMPLES) -> JointLog:
+    """The first `count` samples of `joints` in a CSV log (read with `fmt`) or a ROS 2 bag (`topic`, `joint_names`),
+    steering in β, as :func:`odometry_file` reads them."""
+    if is_bag(log_path):
+        chunks = read_joint_states(log_path, joints, robot=robot, topic=topic, names=joint_names, chunk_size=count)
+    else:
+        chunks = read_csv(log_path, joints, fmt, robot=robot, chunk_size=count)
+    try:
+        return next(chunks)
+    finally:
+        chunks.close()  # the file (a bag's reader) closed now, not when collected
 
 
 def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFormat = DEFAULT_FORMAT,

@@ -12,6 +12,7 @@ and every writer converts back. Files written in β by older wmrkit versions say
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
@@ -22,6 +23,7 @@ from ..errors import WmrkitError
 from ..robot import Robot
 
 if TYPE_CHECKING:
+    from .logs import JointLog
     from .model import OdometryModel
 
 #: Conventions of a log's steering columns: the users' heading (default) or the thesis's β (legacy files).
@@ -164,3 +166,20 @@ def steering_steps(model: OdometryModel, positions: np.ndarray) -> list[Steering
             found.append(SteeringStep(joint, k, float(step[k]), float(excess[k]), float(travel[k]), float(bound[k]),
                                       int(hit.size)))
     return found
+
+
+def steering_step_warning(model: OdometryModel, log: JointLog) -> str | None:
+    """One line naming the largest steering step of `log` (joint positions in β, :func:`steering_steps`), its
+    interval's times, its wheel's travel and bound and the other joints that step; None when no joint steps. The
+    warning of ``wmrkit odometry`` and ``wmrkit batch odometry`` over a log's first samples (CSV or bag)."""
+    steps = sorted(steering_steps(model, log.positions), key=lambda s: -s.bound)
+    if not steps:
+        return None
+    s = steps[0]
+    t0, t1 = log.time[s.interval], log.time[s.interval + 1]
+    more = f"; {s.count} such steps over the first {len(log)} samples" if s.count > 1 else ""
+    others = f" (also {', '.join(o.joint for o in steps[1:])})" if len(steps) > 1 else ""
+    return (f"{s.joint} steps {math.degrees(s.step):+.4g} deg within one interval (t = {t0:.6g} to {t1:.6g} s; the "
+            f"intervals around it change it by {math.degrees(abs(s.step) - s.excess):.3g} deg at most) while the "
+            f"wheel travels {s.travel:.3g} m: up to {s.bound:.3g} m of that travel off its direction{more}{others}; "
+            "the odometry assumes the angle changes uniformly within an interval: log faster")
