@@ -2,7 +2,8 @@
 top-level ``error`` key in an answer (exit 0 or 1: ``error`` marks the failure object of exit 2), the robot named under
 ``robot`` by every command given a ROBOT, and the last pose of a run under ``final_pose`` ``[x, y, heading]``.
 'wmrkit track --json' had a per-sample ``error`` in its successful answers, ik, fk and feasibility did not name their
-robot, odometry's last pose was ``pose`` (simulate's ``final_pose``)."""
+robot, odometry's last pose was ``pose`` (simulate's ``final_pose``). ``tests/test_cli_contract.py`` checks the keys
+every answer has (``robot``, ``warnings``) and strict JSON."""
 
 from __future__ import annotations
 
@@ -64,6 +65,11 @@ CASES: dict[tuple[str, ...], tuple[str, int]] = {
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
+    return write_case_files(tmp_path_factory.mktemp("answers"))
+
+
+def write_case_files(d):
+    """The files of :data:`CASES` (``{d}``) into the folder `d`; returns it."""
     import numpy as np
 
     from wmrkit import catalog
@@ -72,7 +78,6 @@ def files(tmp_path_factory):
     from wmrkit.odometry.trajectories import Trajectory, write_trajectory
     from wmrkit.slip.synthetic import wheel_speed_run
 
-    d = tmp_path_factory.mktemp("answers")
     t = np.arange(21) * 0.1
     write_csv(d / "yaw.csv", ("time", "left.spin", "right.spin", "yaw"), np.column_stack([t, 10 * t, 10 * t, 0 * t]))
     (d / "bad.csv").write_text("time,left.spin,right.spin\n0,0,0\n0.1,x,0\n")
@@ -116,7 +121,7 @@ def test_a_json_answer_a_script_can_rely_on(command, files, capsys, monkeypatch)
         assert all("error" not in row for row in answer)
         return
     assert "error" not in answer  # the key of a failure object (exit 2)
-    if _takes_a_robot(command) and command != ("show",):  # show prints the description: its 'name'
+    if _takes_a_robot(command):
         assert answer["robot"] == argv[len(command)]
     flat = {k for k, v in answer.items() if isinstance(v, list) and len(v) == 3 and
             all(isinstance(x, float) for x in v) and "pose" in k}

@@ -122,7 +122,7 @@ def test_a_warning_said_outside_a_command_run_is_printed_only(capsys):
     from wmrkit.cli._common import print_json, warn
 
     warn("no run collects this")
-    print_json({"a": 1}, warnings=True)
+    print_json({"a": 1})
     out, err = capsys.readouterr()
     assert err == f"{PREFIX}no run collects this\n" and json.loads(out) == {"a": 1, "warnings": []}
 

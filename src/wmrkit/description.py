@@ -63,6 +63,9 @@ TOP_FIELDS = ("name", "wheels", "notes", "couplings", "body", "odometry")  # odo
 #: from it may keep them, and each must then equal what the wheels give (:func:`_check_derived`).
 DERIVED_FIELDS = {"velocity_names": "velocity_names", "steer_names": "steer_names", "actuated_joints": "actuated",
                   "sensed_joints": "sensed"}
+#: Keys of every command's JSON answer that ``wmrkit show --json`` has too (docs/limits.md, JSON answers): ``robot``
+#: (the name) and ``warnings`` (a list of text); a copy may keep them (:func:`_check_derived`).
+ANSWER_FIELDS = ("robot", "warnings")
 COMMON_WHEEL_FIELDS = ("name", "type", "position", "l", "alpha", "actuated", "sensed", "heading",
                        "inertia", "mass", "tyre",  # these three: wmrkit.dynamics.mass
                        "steer_range",  # _steer_range_from_dict
@@ -85,7 +88,7 @@ def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None
     check = FieldReader(source, line_of or (lambda loc: None))
     if not isinstance(data, Mapping):
         check.fail("a robot description is a mapping with the fields 'name' and 'wheels'", ())
-    check.reject_unknown(data, TOP_FIELDS + tuple(DERIVED_FIELDS), ())
+    check.reject_unknown(data, TOP_FIELDS + tuple(DERIVED_FIELDS) + ANSWER_FIELDS, ())
     name = check.text(data, "name", ())
     notes = check.text(data, "notes", (), required=False)
     _check_text_fields(name, notes, check)
@@ -118,13 +121,21 @@ def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None
 
 def _check_derived(data: Mapping[str, Any], robot: Robot, check: FieldReader) -> None:
     """The derived names of ``wmrkit show --json`` (:data:`DERIVED_FIELDS`), when present, equal the robot's: they
-    are read back, never used, so a copy whose wheels were edited is refused instead of silently contradicted."""
+    are read back, never used, so a copy whose wheels were edited is refused instead of silently contradicted. So
+    does its ``robot`` the name; its ``warnings`` are a list of text (:data:`ANSWER_FIELDS`)."""
     for key, attribute in DERIVED_FIELDS.items():
         if key in data:
             expected = list(getattr(robot, attribute))
             if data[key] != expected:
                 check.fail(f"derived from the wheels (wmrkit show --json writes it), so it must be {expected}, got "
                            f"{short_repr(data[key])}: correct it or delete it", (key,))
+    if "robot" in data and data["robot"] != robot.name:  # the answer's name of the robot, as every command's
+        check.fail(f"the robot's name (wmrkit show --json writes it), so it must be '{robot.name}' as 'name' says, got "
+                   f"{short_repr(data['robot'])}: correct it or delete it", ("robot",))
+    said = data.get("warnings", [])
+    if not (isinstance(said, list) and all(isinstance(w, str) for w in said)):
+        check.fail(f"the warnings of a wmrkit show --json answer: a list of text, got {short_repr(said)}",
+                   ("warnings",))
 
 
 def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) -> tuple[Coupling, ...]:

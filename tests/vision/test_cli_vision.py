@@ -45,7 +45,7 @@ def test_calibrate_then_locate_from_images(tmp_path, capsys):
                         "3.5cm", "--json"], capsys)
     assert code == 0
     fix = json.loads(out)
-    assert set(fix) == {"psi", "h", "lines"} and [ln["n"] for ln in fix["lines"]] == [-1, 0, 1]
+    assert set(fix) == {"psi", "h", "lines", "warnings"} and [ln["n"] for ln in fix["lines"]] == [-1, 0, 1]
     assert fix["psi"] == pytest.approx(-pose[2], abs=math.radians(0.5))
     assert fix["h"] == pytest.approx(pose[1], abs=0.002)
 

@@ -62,7 +62,7 @@ def collecting_warnings() -> Iterator[list[str]]:
 
 def warn(message: str) -> None:
     """A warning: one line ``wmrkit: warning: MESSAGE`` on stderr for people, and MESSAGE in the ``"warnings"``
-    list of the command's JSON answer (:func:`print_json` with ``warnings=True``) for scripts."""
+    list of the command's JSON answer (:func:`print_json`) for scripts."""
     print(f"wmrkit: warning: {message}", file=sys.stderr)
     said = _SAID.get()
     if said is not None:
@@ -74,12 +74,14 @@ def said() -> list[str]:
     return list(_SAID.get() or [])
 
 
-def print_json(data: Any, *, warnings: bool = False) -> None:
-    """Print `data` as JSON (NaN and infinities become null: JSON has none). With `warnings` (the commands that can
-    warn), the mapping gets a top-level ``"warnings"``: the messages of :func:`warn` in this run, [] when none."""
-    if warnings:
-        data = {**data, "warnings": said()}
-    print(json.dumps(_finite(data), indent=2))
+def print_json(data: Any) -> None:
+    """Print `data` as JSON (NaN and infinities become null: JSON has none). A mapping (every command's answer but
+    the ``robots`` list) gets a top-level ``"warnings"`` list, [] when none: its own (a parking plan's), then the
+    messages of :func:`warn` in this run that are not among them (docs/limits.md, JSON answers)."""
+    if isinstance(data, dict):
+        own = list(data.get("warnings") or [])
+        data = {**data, "warnings": own + [m for m in said() if m not in own]}
+    print(json.dumps(_finite(data), indent=2, allow_nan=False))  # a NaN left is a bug: raised, never printed
 
 
 def _finite(x: Any) -> Any:

@@ -169,7 +169,7 @@ def run_odometry(args: argparse.Namespace) -> int:
         if r["warnings"] and not r["error"]:
             warn(f"{r['log']}: {r['warnings']}")
     if args.json:
-        print_json({"robot": robot.name, **result.to_dict(), "rows": [dict(r) for r in result.rows]}, warnings=True)
+        print_json({"robot": robot.name, **result.to_dict(), "rows": [dict(r) for r in result.rows]})
         return 1 if result.failed else 0
     print(f"{len(result.rows)} logs: {len(result.rows) - result.failed} done ({result.skipped} from an earlier run), "
           f"{result.failed} failed" + (f"; table {args.out}" if args.out else ""))
@@ -212,7 +212,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
     for warning in () if args.slip else result.warnings:  # the slip fit has none
         warn(warning)
     if args.json:
-        print_json(result.to_dict(), warnings=True)
+        print_json(result.to_dict())
         return 0
     if args.slip:
         print(result.format())
@@ -264,7 +264,7 @@ def run_montecarlo(args: argparse.Namespace) -> int:
         warn(f"the analytic covariance (003, first order) leaves out the configuration error that the noise of the "
              f"castor angles {', '.join(castors)} builds up: trust the Monte Carlo spread")
     if args.json:
-        print_json(result.to_dict(), warnings=True)
+        print_json(result.to_dict())
         return 0
     d = result.to_dict()
     print(f"robot {robot.name}: {result.runs} runs over {result.samples} samples")

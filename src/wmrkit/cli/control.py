@@ -249,7 +249,7 @@ def run_track(args: argparse.Namespace) -> int:
         if args.animate:
             animate_run(run, args.animate)
     if args.json:
-        print_json({**run.to_dict(), "reference_name": reference.name, "reference_size": size}, warnings=True)
+        print_json({**run.to_dict(), "reference_name": reference.name, "reference_size": size})
     else:
         s = run.summary()
         print(f"robot {robot.name}, reference {described}, controller {args.controller}, "
@@ -312,7 +312,7 @@ def run_feasibility(args: argparse.Namespace) -> int:
         plot_feasibility(result, reference, args.plot)
     if args.json:
         print_json({"robot": robot.name, "reference_name": reference.name, "reference_size": size,
-                    **result.to_dict()}, warnings=True)
+                    **result.to_dict()})
         return 0 if result.feasible else 1  # an answer that is no (docs/limits.md, Exit codes)
     r = result.requirement
     print(f"robot {robot.name}: Table 8.1 column '{r.column}', {r.references} pose references; "

@@ -97,7 +97,7 @@ def run_tyre(args: argparse.Namespace) -> int:
         warn(warning)
     if args.json:
         print_json({"model": tyre.model, "params": tyre.as_dict(), "load": load, "slip_ratio": s, "slip_angle": a,
-                    "speed": speed, "Fx": fx, "Fy": fy, "mu_long": mu_long, "mu_lat": mu_lat}, warnings=True)
+                    "speed": speed, "Fx": fx, "Fy": fy, "mu_long": mu_long, "mu_lat": mu_lat})
     else:
         print(f"{tyre.model} tyre, load {load:g} N, slip ratio {s:g}, slip angle {a:g} rad, wheel speed {speed:g} m/s")
         print(f"Fx (longitudinal) = {fx:.6g} N")
@@ -163,7 +163,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         print_json({"robot": model.robot.name, "method": sim.method, "step": step, "duration": duration,
                     "samples": len(sim.t), "final_time": end, "final_pose": pose.tolist(), "final_twist": tw.tolist(),
                     "path_length": travelled, "max_slip_speed": max_slip,
-                    "deviation": deviation.to_dict() if deviation else None, "out": args.out}, warnings=True)
+                    "deviation": deviation.to_dict() if deviation else None, "out": args.out})
     else:
         print(f"{model.robot.name}: {duration:g} s simulated ({sim.method}, step {step:g} s), {len(sim.t)} samples")
         print(f"final pose (t = {end:g} s): x = {pose[0]:.6g} m, y = {pose[1]:.6g} m, theta = {pose[2]:.6g} rad")

@@ -57,7 +57,7 @@ def run_ik(args: argparse.Namespace) -> int:
     for why in _infeasible(robot, commands):
         warn(f"twist not feasible for robot '{robot.name}': {why}")
     if args.json:
-        print_json({"robot": robot.name, **commands.to_dict()}, warnings=True)
+        print_json({"robot": robot.name, **commands.to_dict()})
     else:
         print(format_commands(robot, commands))
     return 0 if commands.feasible else 1  # an answer that is no (docs/limits.md, Exit codes)
@@ -88,7 +88,7 @@ def run_fk(args: argparse.Namespace) -> int:
              f"tolerance {fk.tolerance:.3g} m/s); check units, signs and --steer headings")
     if args.json:
         print_json({"robot": robot.name, "twist": twist.tolist(), "determined": determined, "residual": fk.residual,
-                    "consistent": fk.consistent, "slipping": list(fk.slipping)}, warnings=True)
+                    "consistent": fk.consistent, "slipping": list(fk.slipping)})
     else:
         vx, vy, omega = (_num(v) for v in twist)
         print(f"twist (robot frame): vx = {vx} m/s, vy = {vy} m/s, omega = {omega} rad/s")

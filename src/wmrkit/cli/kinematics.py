@@ -52,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
 
         summary["generated"] = [str(p) for p in write_code(robot, lang, directory)]
     if args.json:
-        print_json(summary, warnings=True)
+        print_json(summary)
         return 0
     print(format_kinematics_summary(summary, limit=None if args.all else 12))
     if args.symbolic:

@@ -165,7 +165,7 @@ def run(args: argparse.Namespace) -> int:
     consistent = _check_gears(robot, args.log, first) and consistent
     _check_steering_steps(robot, args.log, args.sensed, first)  # the sampling, not the data: consistent as it is
     if args.json:
-        print_json(summary.to_dict() | {"consistent": consistent}, warnings=True)
+        print_json(summary.to_dict() | {"consistent": consistent})
     else:
         print(format_summary(summary))
     return 0

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import WmrkitError
-from ._common import add_json_flag, check_plot_path, print_json, said, warn
+from ._common import add_json_flag, check_plot_path, print_json, warn
 from .control import check_animation_path, verdict_line, warn_infeasible
 
 
@@ -69,7 +69,8 @@ def run(args: argparse.Namespace) -> int:
         if executed is not None:
             out["executed_check"] = {"mode": execution.mode, **check_dict(executed)}
         out["feasibility"] = None if verdict is None else verdict.to_dict()
-        print_json({**out, "warnings": [*out["warnings"], *said()]})  # the plan's, then the command's
+        robot = solution.problem.robot  # None: a vehicle given by its parameters
+        print_json({"robot": None if robot is None else robot.name, **out})  # warnings: the plan's, the command's
     else:
         print(describe(solution))
         if verdict is not None:

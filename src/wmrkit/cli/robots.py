@@ -54,8 +54,10 @@ def run_show(args: argparse.Namespace) -> int:
 
 
 def summary(robot: Robot) -> dict:
-    """Machine-readable summary: the description plus derived names."""
+    """Machine-readable summary: ``robot`` (its name, as every command's answer; the description's ``name`` too),
+    the description, and derived names."""
     return {
+        "robot": robot.name,
         **robot.to_dict(),
         "velocity_names": list(robot.velocity_names),
         "steer_names": list(robot.steer_names),

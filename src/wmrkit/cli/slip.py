@@ -288,7 +288,7 @@ def run_study(args: argparse.Namespace) -> int:
 
         result = skid_comparison(load_robot("skid-steer-4"), source=args.source or "md")
         figures = save_skid_figures(result, args.report) if args.report else []
-        data = {k: v for k, v in result.items() if k != "paths"} | {"figures": figures}
+        data = {"robot": args.study} | {k: v for k, v in result.items() if k != "paths"} | {"figures": figures}
         if args.json:
             print_json(data)
         else:
@@ -301,7 +301,7 @@ def run_study(args: argparse.Namespace) -> int:
     result = forklift_study(report=args.report, quick=args.quick, seed=0 if args.seed is None else args.seed,
                             drive=args.drive or "differential")
     if args.json:
-        print_json(result)
+        print_json({"robot": args.study, **result})  # the study's robot, as every command's answer names it
     else:
         from ..slip.study import format_study
 
