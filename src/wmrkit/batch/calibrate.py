@@ -63,7 +63,7 @@ class FleetCalibration:
     the largest over :data:`~wmrkit.batch.consistency.MAX_RATIO` (closed paths:
     :data:`~wmrkit.batch.consistency.MAX_CLOSED_SCORE`; :mod:`wmrkit.batch.consistency`; ``None`` when not judged,
     and ``not_judged`` says why: fewer than 4 runs, fewer than 5 closed paths (or references of 2-3 poses), a
-    failed closed-path refit or curvature; it names the runs left out when the others are judged)."""
+    failed closed-path refit or curvature; it names the runs left out or set aside when the others are judged)."""
 
     robot: Robot
     parameters: tuple[tuple[str, ...], ...]
@@ -300,7 +300,7 @@ def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float,
     return FleetCalibration(apply_parameters(robot, params, fit.x), groups, tuple(map(float, fit.x)),
                             tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True)), tuple(values),
                             rms(r0), rms(fit.fun), len(problem.runs), int(r0.size), ci, level, bool(fit.success),
-                            problem.warnings() + notes + ((judged.message,) if judged.message else ()), logs,
+                            problem.warnings() + notes + judged.messages, logs,
                             judged.ratios, judged.inconsistent, judged.not_judged,
                             judged.scores or (None,) * len(problem.runs))
 

@@ -66,11 +66,18 @@ CLOSED = ("no run has 6 residuals beyond its own parameters (closed paths: a fin
 SHORT = ("no run has 6 residuals beyond its own parameters (references of 2 or 3 poses, or closed paths) and there "
          "are fewer than 5 runs: the runs are not checked against each other, a run of another robot is averaged in "
          "unseen; 5 such runs or more, or references of 4 poses or more, are checked")
-#: ... and with 5 runs or more of such runs whose numbers of reference poses differ (the closed-path judge compares
-#: runs of equal numbers of residuals).
-UNEQUAL = ("no run has 6 residuals beyond its own parameters (references of 2 or 3 poses, or closed paths) and the "
-           "runs do not have the same number of reference poses: the runs are not checked against each other, a run "
-           "of another robot is averaged in unseen; give every run as many poses, or references of 4 poses or more")
+#: ... and with 5 runs or more of such runs, fewer than 5 of any one number of reference poses (the closed-path judge
+#: compares runs of equal numbers of residuals).
+UNEQUAL = ("no run has 6 residuals beyond its own parameters (references of 2 or 3 poses, or closed paths) and no "
+           "5 runs have as many reference poses (a closed path counts as a reference of 2): the runs are not checked "
+           "against each other, a run of another robot is averaged in unseen; give 5 runs or more as many poses, or "
+           "references of 4 poses or more")
+#: ... and why runs of such a fleet are set aside while the others are judged: each kind of 5 runs or more of as many
+#: reference poses is judged on its own ({runs}: the others; {judged}: the kinds judged). Before, a fleet of 5 runs
+#: of two-pose references and one of three was not judged at all (UNEQUAL).
+SET_ASIDE = ("{runs}: set aside, fewer than 5 runs have as many reference poses as each of these (the judged runs: "
+             "{judged}): not checked against the other runs (a closed-path score compares runs of as many poses), a "
+             "run of another robot among them is averaged in unseen")
 #: ... and why some runs are not judged while the others are: a closed path among runs with references, or a run
 #: whose reference has too few poses ({runs}: those runs, their per-run values null).
 SOME_RUNS = (f"{{runs}}: fewer than {MIN_DOF} residuals beyond the run's own parameters (a closed path, or a "
@@ -91,15 +98,15 @@ class Consistency:
     """``ratios``: per run, or ``None`` (fewer than :data:`MIN_RUNS` runs, or fewer than :data:`MIN_DOF`
     residuals beyond its own parameters: closed paths); ``inconsistent``: the largest over
     :data:`MAX_RATIO` (closed paths: a score over :data:`MAX_CLOSED_SCORE`; ``None`` when not judged);
-    ``message``: the warning that names the run, or ``None``; ``not_judged``: why no run was judged
-    (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`SHORT`, :data:`UNEQUAL`, :data:`REFIT_FAILED`,
+    ``messages``: the warnings that name the runs (one a kind of runs judged); ``not_judged``: why no run was
+    judged (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`SHORT`, :data:`UNEQUAL`, :data:`REFIT_FAILED`,
     :data:`CURVATURE_FAILED`, :data:`UNDETERMINED`) or
-    which runs were not (:data:`SOME_RUNS`), or ``None``; ``scores``: a fleet of closed paths' per-run scores
-    (:func:`judge`; another quantity than a ratio, under its own name), empty when not scored."""
+    which runs were not (:data:`SOME_RUNS`, :data:`SET_ASIDE`), or ``None``; ``scores``: a fleet of closed paths'
+    per-run scores (:func:`judge`; another quantity than a ratio, under its own name), empty when not scored."""
 
     ratios: tuple[float | None, ...]
     inconsistent: bool | None
-    message: str | None = None
+    messages: tuple[str, ...] = ()
     not_judged: str | None = None
     scores: tuple[float | None, ...] = ()
 
@@ -171,7 +178,7 @@ def run_consistency(jac: np.ndarray, res: np.ndarray, sizes: Sequence[int], floo
         message = (f"the runs disagree (residual ratio {ratios[worst]:.3g} for {names[worst]}, over {MAX_RATIO:g}) "
                    f"and no one run explains it (without {names[odd]} the largest is still {rest[odd]:.3g}): the fit "
                    "averages them; check the runs")
-    return Consistency(judged, True, message, some)
+    return Consistency(judged, True, (message,), some)
 
 
 #: Largest closed-path score of a fleet whose runs agree (:func:`judge`). Simulated fleets of 6 closed squares
@@ -260,57 +267,90 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     by `refit` (``[(problem, x0)] -> [(x, residuals of the problem's runs) or a TaskFailure]``, the engine's map;
     the problem's last run is the one left out; a failure leaves the fleet not judged, :data:`REFIT_FAILED`), and its
     score is the refit's: in fleets of 6 squares the odd run's equalled a refit of every run. A fleet of fewer than
-    :data:`REFIT_EVERY` runs refits every run. Over :data:`MAX_CLOSED_SCORE` the run of largest score is named;
-    with fewer than :data:`MIN_CLOSED_RUNS` closed runs the fleet is not judged (:data:`CLOSED`; runs of references of
-    few poses: :data:`SHORT`), nor runs of unequal numbers of reference poses (:data:`UNEQUAL`), nor when the runs
-    but one cannot tell the parameters apart (:data:`UNDETERMINED`)."""
+    :data:`REFIT_EVERY` runs refits every run. Over :data:`MAX_CLOSED_SCORE` the run of largest score is named.
+    Runs are compared with runs of as many reference poses (closed paths and references of two poses: one final
+    pose each): each kind of :data:`MIN_CLOSED_RUNS` runs or more is judged on its own, the other runs are set aside
+    and named (:data:`SET_ASIDE`); with no such kind the fleet is not judged (:data:`CLOSED`; runs of references of
+    few poses: :data:`SHORT`; of unequal numbers of poses: :data:`UNEQUAL`), nor when a kind's runs but one cannot
+    tell the parameters apart (:data:`UNDETERMINED`)."""
     robot, runs, sizes = problem.robot, problem.runs, problem.sizes()
     logs = names(runs)
     travels = np.array([max(travel(robot, run), 1.0) for run in runs])
     judged = run_consistency(fit.jac, fit.fun, sizes, ROUNDOFF * travels, logs)
     if judged.not_judged != CLOSED:
         return judged
-    if len(runs) < MIN_CLOSED_RUNS or len(set(sizes)) != 1:
-        closed = all(run.closed for run in runs)
-        why = CLOSED if closed and len(runs) < MIN_CLOSED_RUNS else SHORT if len(runs) < MIN_CLOSED_RUNS else UNEQUAL
-        return replace(judged, not_judged=why)
     g, n = len(runs), fit.x.size
-    jac, res = fit.jac.reshape(g, -1, n), fit.fun.reshape(g, -1)
-    for k in range(g):  # the others must determine the parameters for a score (the jackknife interval's test)
-        why = problem.undetermined(fit.x, np.delete(jac, k, axis=0).reshape(-1, n), np.delete(res, k, axis=0).ravel())
-        if why is not None:
-            return Consistency(judged.ratios, None, not_judged=UNDETERMINED.format(run=logs[k], why=why))
-    w = 1 / np.sqrt(travels)
-    floors = ROUNDOFF * np.sqrt(travels)  # ROUNDOFF times the travel, weighted
+    m = counts(fit.jac, fit.fun, sizes)
+    kinds = [np.flatnonzero(m == c) for c in sorted(set(m.tolist()), reverse=True)]
+    groups = [kind for kind in kinds if len(kind) >= MIN_CLOSED_RUNS]
+    if not groups:
+        closed = all(run.closed for run in runs)
+        why = CLOSED if closed and g < MIN_CLOSED_RUNS else SHORT if g < MIN_CLOSED_RUNS else UNEQUAL
+        return replace(judged, not_judged=why)
+    blocks = np.split(np.arange(fit.fun.size), np.cumsum(sizes)[:-1])
+    for group in groups:  # the others must determine the parameters for a score (the jackknife interval's test)
+        for k in group:
+            rows = np.concatenate([blocks[i] for i in group if i != k])
+            why = problem.undetermined(fit.x, fit.jac[rows], fit.fun[rows])
+            if why is not None:
+                return Consistency(judged.ratios, None, not_judged=UNDETERMINED.format(run=logs[k], why=why))
     moved = curvature(list(fit.x + CURVATURE_STEP * np.eye(n)))
-    for m in moved:  # the fit stands; only the judging is lost
-        if isinstance(m, tuple) or not np.isfinite(m).all():
-            which, why = m if isinstance(m, tuple) else (np.flatnonzero(~np.isfinite(m).reshape(g, -1).all(axis=1)),
-                                                          "its values are not finite")
+    for mv in moved:  # the fit stands; only the judging is lost
+        if isinstance(mv, tuple) or not np.isfinite(mv).all():
+            which, why = mv if isinstance(mv, tuple) else (
+                [k for k, b in enumerate(blocks) if not np.isfinite(mv[b]).all()], "its values are not finite")
             return Consistency((None,) * g, None, not_judged=CURVATURE_FAILED.format(
                 runs="every run" if len(which) == g else ", ".join(logs[k] for k in which), why=why))
-    hess = np.stack([(j - fit.jac) / CURVATURE_STEP for j in moved], axis=-1).reshape(g, -1, n, n) \
-        * w[:, None, None, None]
-    m = counts(fit.jac, fit.fun, sizes)
-    scores, shift = _quadratic_scores(jac * w[:, None, None], res * w[:, None], hess, floors, m)
+    hess = np.stack([(j - fit.jac) / CURVATURE_STEP for j in moved], axis=-1)  # (R, n, n)
+    live = np.split(np.any(fit.jac != 0, axis=1) | (fit.fun != 0), np.cumsum(sizes)[:-1])  # counts' rows
+    scores, messages = np.full(g, np.nan), []
+    for group in groups:
+        done = _group_scores(problem, fit, hess, group, [blocks[i][live[i]] for i in group], travels, live, refit)
+        if isinstance(done, str):
+            return Consistency((None,) * g, None, not_judged=done)
+        scores[group] = done
+        worst = int(group[np.argmax(done)])
+        if scores[worst] > MAX_CLOSED_SCORE:
+            messages.append(f"{logs[worst]}: disagrees with the other runs (closed-path score {scores[worst]:.3g}, "
+                            f"over {MAX_CLOSED_SCORE:g}: the others' fit leaves it that many times their error): "
+                            "another robot, load or floor? The fit averages it in; check it or fit without it")
+    aside = [k for k in range(g) if np.isnan(scores[k])]
+    why = None if not aside else SET_ASIDE.format(runs=", ".join(logs[k] for k in aside), judged=", ".join(
+        f"{len(group)} runs of {_poses(m[group[0]])}" for group in groups))
+    return Consistency(judged.ratios, bool(messages), tuple(messages), why,
+                       tuple(None if np.isnan(q) else float(q) for q in scores))
+
+
+def _poses(live: int) -> str:
+    """How a kind of runs of `live` residuals is named: by its reference poses beyond the start."""
+    return "one final pose (closed paths, references of 2 poses)" if live == 3 else f"{live // 3} poses past the start"
+
+
+def _group_scores(problem: CalibrationProblem, fit, hess: np.ndarray, group: np.ndarray, rows: list[np.ndarray],
+                  travels: np.ndarray, live: list[np.ndarray], refit: Callable) -> np.ndarray | str:
+    """The closed-path scores of the runs `group` (as many residuals each: their `rows` of the fleet fit) against
+    each other (:func:`judge`), or why they are not judged."""
+    runs, logs, n = problem.runs, names(problem.runs), fit.x.size
+    g, here = len(group), np.concatenate(rows)
+    w = 1 / np.sqrt(travels[group])
+    floors = ROUNDOFF * np.sqrt(travels[group])  # ROUNDOFF times the travel, weighted
+    jac, res = fit.jac[here].reshape(g, -1, n), fit.fun[here].reshape(g, -1)
+    m = np.full(g, res.shape[1])
+    scores, shift = _quadratic_scores(jac * w[:, None, None], res * w[:, None],
+                                      hess[here].reshape(g, -1, n, n) * w[:, None, None, None], floors, m)
     if np.isnan(scores).any():  # a run without which the others cannot fit: not judged
         k = int(np.flatnonzero(np.isnan(scores))[0])
-        return Consistency(judged.ratios, None, not_judged=UNDETERMINED.format(
-            run=logs[k], why=f"their weighted Jacobian's weakest direction under {RANK_TOL:g} of the largest"))
+        return UNDETERMINED.format(run=logs[group[k]], why=f"their weighted Jacobian's weakest direction under "
+                                   f"{RANK_TOL:g} of the largest")
     again = [int(k) for k in np.argsort(np.linalg.norm(shift, axis=1))[::-1][:g if g < REFIT_EVERY else REFITS]]
-    for k, done in zip(again, refit([(problem.with_runs(runs[:k] + runs[k + 1:] + runs[k:k + 1]),
-                                      fit.x + shift[k]) for k in again]), strict=True):
+    orders = [[int(i) for i in group if i != group[k]] + [int(group[k])] for k in again]  # the one left out last
+    tasks = [(problem.with_runs([runs[i] for i in o]), fit.x + shift[k]) for k, o in zip(again, orders, strict=True)]
+    for k, order, done in zip(again, orders, refit(tasks), strict=True):
         err = None if isinstance(done, TaskFailure) else np.asarray(done[1], dtype=float)
         if err is None or not np.isfinite(err).all():  # the fit stands; only the judging is lost
-            why = done if err is None else "its residuals are not finite"
-            return Consistency((None,) * g, None, not_judged=REFIT_FAILED.format(run=logs[k], why=why))
-        order = np.r_[0:k, g - 1, k:g - 1]  # run k was put last
-        scores[k] = _score(err.reshape(g, -1)[order] * w[:, None], k, np.delete(np.arange(g), k), floors, n, m)
-    worst = int(np.argmax(scores))
-    scored = tuple(map(float, scores))
-    if scores[worst] <= MAX_CLOSED_SCORE:
-        return Consistency(judged.ratios, False, scores=scored)
-    return Consistency(judged.ratios, True, scores=scored, message=
-                       f"{logs[worst]}: disagrees with the other runs (closed-path score {scores[worst]:.3g}, over "
-                       f"{MAX_CLOSED_SCORE:g}: the others' fit leaves it that many times their error): another robot, "
-                       "load or floor? The fit averages it in; check it or fit without it")
+            return REFIT_FAILED.format(run=logs[group[k]], why=done if err is None else "its residuals are not finite")
+        parts = np.split(err, np.cumsum([live[i].size for i in order])[:-1])
+        mine = dict(zip(order, (p[live[i]] for p, i in zip(parts, order, strict=True)), strict=True))
+        scores[k] = _score(np.array([mine[int(i)] for i in group]) * w[:, None], k, np.delete(np.arange(g), k),
+                           floors, n, m)
+    return scores

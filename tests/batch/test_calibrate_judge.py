@@ -1,0 +1,86 @@
+"""batch calibrate's judge over fleets of short references: mixed kinds of runs, bad runs planted, mixed noise."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+from batch_params import PARAMS, TRUE_P, write_log
+
+from wmrkit.batch.calibrate import fleet_calibrate
+from wmrkit.batch.consistency import MAX_CLOSED_SCORE
+from wmrkit.odometry.calibration import CalibrationRun, apply_parameters
+from wmrkit.odometry.synthetic import TwistProfile, simulate, square_path
+
+#: A robot of a 5 % larger left radius than the fleet's (TRUE_P: +1 %).
+BAD_RADIUS = [TRUE_P[0] + 0.05, *TRUE_P[1:]]
+
+
+def short_runs(diff, seed: int, n: int, poses: int, bad=(), odd=BAD_RADIUS, noise=1e-5, name="r"):
+    """`n` runs of three random arcs (about 2 m) whose references have `poses` poses (the start, the end and evenly
+    between), of the robot at TRUE_P; the runs `bad` of one at `odd`; `noise`: per run or one for all [rad^2/rad]."""
+    rng = np.random.default_rng(seed)
+    noises = np.broadcast_to(noise, n)
+    out = []
+    for i in range(n):
+        robot = apply_parameters(diff, PARAMS, odd if i in bad else TRUE_P)
+        segs = [(2.0, 0.3 + 0.1 * rng.random(), 0.0, rng.uniform(-0.6, 0.6)) for _ in range(3)]
+        run = simulate(robot, TwistProfile.from_segments(segs), 10.0, spin_noise_per_rad=float(noises[i]),
+                       seed=int(rng.integers(1 << 30)))
+        at = np.linspace(0, len(run.log) - 1, poses).astype(int)
+        out.append(CalibrationRun(replace(run.log, source=f"{name}{i}.csv"), run.truth[at], at=at))
+    return out
+
+
+def disagreeing(res) -> list[str]:
+    """The runs the fleet's warnings name as disagreeing."""
+    return [w.partition(":")[0] for w in res.warnings if "disagrees with the other runs" in w]
+
+
+def test_a_mixed_fleet_judges_its_comparable_runs_and_names_those_set_aside(diff, tmp_path, capsys):
+    """Five runs of two-pose references, one of a robot with a 5 % larger left radius, judged alone name it (score
+    33); with one run of a three-pose reference added, or two closed squares, the fleet was not judged at all
+    ('inconsistent': null, UNEQUAL) and the odd run averaged in unseen. Now runs of as many final poses are judged
+    together (closed paths and two-pose references: one final pose each; the same score as alone for the five),
+    and the three-pose run is named as set aside, in the API and the CLI's --json."""
+    from wmrkit.cli.main import main
+    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+
+    five = short_runs(diff, 11, 5, 2, bad=(1,))
+    alone = fleet_calibrate(diff, five, PARAMS)
+    assert alone.inconsistent is True and disagreeing(alone) == ["r1.csv"]
+    three = short_runs(diff, 12, 1, 3, name="t")
+    res = fleet_calibrate(diff, five + three, PARAMS)
+    assert res.inconsistent is True and disagreeing(res) == ["r1.csv"], res.not_judged
+    assert res.closed_scores[5] is None and np.allclose(res.closed_scores[:5], alone.closed_scores, rtol=1e-4)
+    from wmrkit.batch.consistency import SET_ASIDE
+    assert res.not_judged == res.to_dict()["not_judged"] == SET_ASIDE.format(
+        runs="t0.csv", judged="5 runs of one final pose (closed paths, references of 2 poses)")
+    true = apply_parameters(diff, PARAMS, TRUE_P)
+    squares = [CalibrationRun.closed_path(replace(simulate(true, square_path(1.5 + k / 2, clockwise=k == 1, pause=0.5),
+                                                           10.0, spin_noise_per_rad=1e-5, seed=k).log,
+                                                  source=f"sq{k}.csv")) for k in range(2)]
+    res = fleet_calibrate(diff, five + squares, PARAMS)
+    assert res.inconsistent is True and disagreeing(res) == ["r1.csv"] and res.not_judged is None
+    assert res.closed_scores[1] > MAX_CLOSED_SCORE > max(res.closed_scores[k] for k in (0, 2, 3, 4, 5, 6))
+    # the CLI, from files: the same verdict and the set-aside line
+    (tmp_path / "ref").mkdir()
+    for run in five + three:
+        stem = run.log.source.removesuffix(".csv")
+        write_log(tmp_path / f"{stem}.csv", run)
+        at = run.samples()
+        write_trajectory(tmp_path / "ref" / f"{stem}.tum", Trajectory(run.log.time[at], np.asarray(run.reference),
+                                                                      np.zeros(len(at)), None), "tum")
+    args = ["batch", "calibrate", "diff-drive", str(tmp_path / "*.csv"), "--reference", str(tmp_path / "ref"),
+            "--workers", "0"]
+    assert main([*args, "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["inconsistent"] is True and data["not_judged"].startswith(str(tmp_path / "t0.csv: set aside"))
+    assert [r["file"].endswith("r1.csv") for r in data["per_run"] if (r["closed_score"] or 0) > MAX_CLOSED_SCORE] \
+        == [True]
+    assert main(args) == 0
+    captured = capsys.readouterr()
+    assert f"not judged: {tmp_path / 't0.csv'}: set aside" in captured.out
+    (warning,) = [line for line in captured.err.splitlines() if "disagrees" in line]
+    assert warning.startswith(f"wmrkit: warning: {tmp_path / 'r1.csv'}: disagrees")
