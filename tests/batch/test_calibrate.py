@@ -556,9 +556,9 @@ def _fleet(diff, seed, n=8, bad=None, noise=1e-5):
 
 def test_a_run_of_another_robot_is_flagged_and_named(diff):
     """The audit: one run of a robot at +6 % among runs at +1 % pulled the fit (left.r +1.72 %, the track 3 % off)
-    with no warning. Now its residuals at the other runs' fit, tens of times those at its own, flag the fleet
-    and name that run (the largest ratio alone named a good run in half of such fleets); first order, the
-    ratios agree with refits of the other runs and of the run alone."""
+    with no warning. Now its residuals at the other runs' fit, tens of times what noise leaves (its own fit's and
+    the others' fit's error), flag the fleet and name that run; first order, the ratios agree with refits of the
+    other runs, of the run alone and of the others' jackknife."""
     for seed, bad in ((2000, 0), (2001, 1), (2003, 3), (2005, 5), (2007, 7)):
         runs = _fleet(diff, seed, bad=bad)
         res = fleet_calibrate(diff, runs, PARAMS)
@@ -567,12 +567,23 @@ def test_a_run_of_another_robot_is_flagged_and_named(diff):
         assert len(odd) == 1 and odd[0].startswith(f"r{bad}.csv: "), res.warnings
         assert res.to_dict()["per_run"][bad] == {"file": f"r{bad}.csv", "residual_ratio": res.residual_ratios[bad],
                                                  "closed_score": None}  # runs with references: ratios, no scores
-    # independent check of one ratio, a consistent run's: refit without it and alone
+    # independent check of one ratio, a consistent run's, by refits: without it, alone, and the others' jackknife
+    # (each of them left out in turn: the spread of the others' fit, which the ratio counts as noise)
     k = 1
-    others = calibrate(diff, runs[:k] + runs[k + 1:], PARAMS).robot
+    others = runs[:k] + runs[k + 1:]
+    fit = calibrate(diff, others, PARAMS).robot
     own = calibrate(diff, [runs[k]], PARAMS)
-    alone = CalibrationProblem(others, (PARAMS[0],), (runs[k],)).residuals([0.0])  # the others' robot itself
-    assert res.residual_ratios[k] == pytest.approx(np.sqrt(np.mean(alone ** 2)) / own.rms_after, rel=0.02)
+    alone = CalibrationProblem(fit, (PARAMS[0],), (runs[k],)).residuals([0.0])  # the others' robot itself
+
+    def p(robot):
+        return np.array([robot.wheel("left").r / diff.wheel("left").r, robot.wheel("right").r / diff.wheel("right").r,
+                         robot.wheel("left").l / diff.wheel("left").l]) - 1
+
+    jack = np.array([p(calibrate(diff, others[:h] + others[h + 1:], PARAMS).robot) - p(fit) for h in range(7)])
+    jac = CalibrationProblem(diff, tuple(PARAMS), (runs[k],)).jacobian(p(fit))
+    spread = np.trace(jac.T @ jac @ (jack.T @ jack)) * 6 / 7
+    assert res.residual_ratios[k] == pytest.approx(np.sqrt(np.sum(alone ** 2) / (own.rms_after ** 2 * alone.size
+                                                                                 + spread)), rel=0.02)
 
 
 def test_runs_that_agree_are_not_flagged_a_false_alarm_study(diff):
