@@ -119,3 +119,21 @@ def test_runs_of_mixed_noise_levels_are_not_flagged_for_their_noise(diff):
             assert max(np.delete(res.residual_ratios, bad)) < 3 < res.residual_ratios[bad]
             named += bool(res.inconsistent)
     assert named >= 21
+
+
+def test_one_bad_run_planted_among_six_three_pose_runs_is_the_one_named(diff):
+    """Brute force over plantings: in 12 fleets of 6 runs with three-pose references (start, middle, end: judged as
+    closed paths are), one run at a random place of a robot with a left radius 5 % larger, a right radius 5 %
+    smaller or a track 10 % wider. The judge names that run and no other wherever it flags (11 of 12; the miss, a
+    wider track on arcs that turn little, scored 13.6), the other runs' scores under 5 in every fleet."""
+    kinds = (BAD_RADIUS, [TRUE_P[0], TRUE_P[1] - 0.05, TRUE_P[2]], [*TRUE_P[:2], TRUE_P[2] + 0.1])
+    named = 0
+    for seed in range(12):
+        rng = np.random.default_rng(seed)
+        bad, kind = int(rng.integers(6)), int(rng.integers(3))
+        res = fleet_calibrate(diff, short_runs(diff, 20000 + seed, 6, 3, bad=(bad,), odd=kinds[kind]), PARAMS)
+        assert res.not_judged is None and res.residual_ratios == (None,) * 6
+        assert disagreeing(res) == ([f"r{bad}.csv"] if res.inconsistent else []), (seed, bad, res.closed_scores)
+        assert max(np.delete(res.closed_scores, bad)) < 5 < res.closed_scores[bad], (seed, res.closed_scores)
+        named += bool(res.inconsistent)
+    assert named >= 11
