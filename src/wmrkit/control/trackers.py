@@ -37,30 +37,57 @@ class PathIndex:
         self.xy = np.ascontiguousarray(reference.pose[:, :2])
         seg = np.hypot(*np.diff(self.xy, axis=0).T)
         self.s = np.concatenate([[0.0], np.cumsum(seg)])
+        self.half = 0.5 * seg
         self.window = window
 
-    def nearest(self, point: np.ndarray, t: float) -> int:
-        """Index of the path sample nearest to `point` among those within ``window`` s of time `t`; when that is
-        the window's first or last sample, the path still nears `point` beyond it (a robot more than ``window`` s
-        ahead of or behind the reference's time): the window slides that way to the nearest sample there."""
-        n = len(self.xy)
-        lo, hi = np.searchsorted(self.ref.t, [t - self.window, t + self.window])
-        lo = min(lo, n - 1)  # past the reference's end (where it rests): its last sample
-        hi = max(hi, lo + 1)
-        width = max(hi - lo, 2)
-        k = self._closest(point, lo, hi)
-        if k == hi - 1:
-            while k == hi - 1 and hi < n:  # ahead of the reference
-                lo, hi = k, min(k + width, n)
-                k = self._closest(point, lo, hi)
-        elif k == lo:
-            while k == lo and lo > 0:  # behind it
-                lo, hi = max(k - width + 1, 0), k + 1
-                k = self._closest(point, lo, hi)
-        return k
+    def _feet(self, point: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Distance [m] from `point` to segments `j` (segment ``j`` joins samples ``j`` and ``j + 1``) and the
+        fraction ``u`` along each of its foot."""
+        a, d = self.xy[j], self.xy[j + 1] - self.xy[j]
+        n2 = np.sum(d * d, axis=1)
+        u = np.clip(np.sum((point - a) * d, axis=1) / np.where(n2 > 0, n2, 1.0), 0.0, 1.0)
+        return np.hypot(*(point - a - u[:, None] * d).T), u
 
-    def _closest(self, point: np.ndarray, lo: int, hi: int) -> int:
-        return int(lo + np.argmin(np.sum((self.xy[lo:hi] - point) ** 2, axis=1)))
+    def _below(self, point: np.ndarray, lo: int, hi: int) -> np.ndarray:
+        """A lower bound [m] of the distance from `point` to each of segments ``lo .. hi - 1``: the nearer end's,
+        less half the segment's length (its foot is within that of one end)."""
+        d = np.hypot(*(self.xy[lo:hi + 1] - point).T)
+        return np.minimum(d[:-1], d[1:]) - self.half[lo:hi]
+
+    def _segment(self, point: np.ndarray, t: float) -> tuple[int, float]:
+        """The segment ``j`` of the path nearest to `point` near time `t` and its foot's fraction ``u``: among the
+        segments within ``window`` s of `t`, and beyond either end of that window as long as the path stays within
+        twice the window's nearest sample's distance of `point` (a robot ahead of or behind the reference's time:
+        the path it is near may leave the window through a corner; that nearer part of the path is found, not the
+        far side of the corner inside the window). Ties between adjacent segments (a corner): the segment ahead."""
+        m = len(self.xy) - 1  # segments
+        lo, hi = (int(k) for k in np.searchsorted(self.ref.t, [t - self.window, t + self.window]))
+        lo = min(lo, m - 1)  # past the reference's end (where it rests): its last segment
+        hi = min(max(hi, lo + 1), m)
+        d = np.hypot(*(self.xy[lo:hi + 1] - point).T)
+        reach, first, last = 2.0 * float(d.min()) + 1e-12, lo, hi
+        width = max(hi - lo, 2)
+        while lo > 0 and self._below(point, lo - 1, lo)[0] <= reach:  # the path before the window, within reach
+            start = max(lo - width, 0)
+            far = np.flatnonzero(self._below(point, start, lo) > reach)
+            lo = start + (int(far[-1]) + 1 if len(far) else 0)
+            if len(far):
+                break
+        while hi < m and self._below(point, hi, hi + 1)[0] <= reach:  # and after it
+            stop = min(hi + width, m)
+            far = np.flatnonzero(self._below(point, hi, stop) > reach)
+            hi = hi + int(far[0]) if len(far) else stop
+            if len(far):
+                break
+        if (lo, hi) != (first, last):
+            d = np.hypot(*(self.xy[lo:hi + 1] - point).T)
+        below = np.minimum(d[:-1], d[1:]) - self.half[lo:hi]
+        near = lo + np.flatnonzero(below <= d.min())  # the segments that may hold the nearest point
+        dist, u = self._feet(point, near)
+        k = int(np.argmin(dist))
+        while k + 1 < len(near) and near[k + 1] == near[k] + 1 and dist[k + 1] <= dist[k] + 1e-12:  # a corner's tie
+            k += 1
+        return int(near[k]), float(u[k])
 
     def done(self, point: np.ndarray, s: float) -> bool:
         """Whether `point`, projected at arc length `s` [m] (:meth:`project`), has passed the path's end: it projects
@@ -71,27 +98,15 @@ class PathIndex:
         return float((point - b) @ (b - a)) >= 0 and float(np.hypot(*(point - b))) > 1e-9
 
     def project(self, point: np.ndarray, t: float) -> tuple[float, float, float]:
-        """Continuous projection of `point` on the path near time `t`: ``(s [m], chi [rad], e [m], signed, left
-        positive)`` on the segments either side of the nearest sample (so the trackers' inputs do not jump)."""
-        i = self.nearest(point, t)
-        best = None
-        for j in (i - 1, i):
-            if j < 0 or j + 1 >= len(self.xy):
-                continue
-            a, b = self.xy[j], self.xy[j + 1]
-            d = b - a
-            n2 = float(d @ d)
-            u = 0.0 if n2 == 0 else min(max(float((point - a) @ d) / n2, 0.0), 1.0)
-            q = a + u * d
-            dist = float(np.hypot(*(point - q)))
-            if best is None or dist <= best[0]:  # a tie past a corner: the segment ahead
-                chi = math.atan2(d[1], d[0]) if n2 > 0 else self.tangent(j)
-                best = (dist, self.s[j] + u * math.sqrt(n2), chi, q)
-        if best is None:
-            return float(self.s[i]), self.tangent(i), 0.0
-        _, s_, chi, q = best
+        """Continuous projection of `point` on the path near time `t` (:meth:`_segment`): ``(s [m], chi [rad],
+        e [m], signed, left positive)``, the foot's arc length, its segment's direction and the signed distance."""
+        j, u = self._segment(point, t)
+        d = self.xy[j + 1] - self.xy[j]
+        length = float(np.hypot(*d))
+        chi = math.atan2(d[1], d[0]) if length > 0 else self.tangent(j)
+        q = self.xy[j] + u * d
         e = float((point - q) @ np.array([-math.sin(chi), math.cos(chi)]))
-        return float(s_), chi, e
+        return float(self.s[j] + u * length), chi, e
 
     def point_at(self, s: float) -> np.ndarray:
         """Path point at arc length `s` [m] (clamped to the start; beyond the end, on the end's tangent: a goal held
