@@ -3,6 +3,8 @@ default lookahead and the speed they drive at."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -55,3 +57,23 @@ def test_no_one_sample_spike_in_the_car_s_wheel_commands_on_its_square():
     rear = [run.robot.wheel_names.index(name) for name in ("rear_left", "rear_right")]
     assert _spikes(run.twist[:, 2:]).max() < 0.05
     assert _spikes(np.asarray(run.commands.spin)[:, rear]).max() < 0.05
+
+
+@pytest.mark.parametrize("controller", ["pure-pursuit", "stanley"])
+@pytest.mark.parametrize("name", ["square", "corner"])
+def test_the_trackers_ask_a_car_for_no_turn_tighter_than_its_steering_allows(controller, name):
+    """Pure pursuit's curvature was unbounded (2 / L_d = 2 1/m at a corner for a car that turns on 4 m at best) and
+    Stanley's steering limit 1.2 rad whatever the robot: 'wmrkit track ackermann --reference square --controller
+    pure-pursuit' asked the front wheels beyond their +-40 deg for 35 s of the 64 (Stanley 22 s), held them at the
+    stops and moved the car with the least-squares twist of wheels that scrub. Now both limit the commanded
+    curvature to the car's tightest turn: the wheels' headings stay within their ranges, and the axle point's
+    curvature (omega / v) within that of the circle the car drives with a wheel at its stop (Ackermann geometry:
+    the inner wheel at 40 deg, cot(40 deg) = (R - track / 2) / wheelbase)."""
+    car = catalog.load("ackermann")
+    run = track(car, builtin_reference(name, size=8.0), controller=controller)
+    assert run.range_violations() == []
+    assert np.abs(run.heading).max() <= math.radians(40) + 1e-9
+    front = car.wheel("front_left").position
+    radius = front[0] / math.tan(math.radians(40)) + abs(front[1])  # the inner wheel at its stop
+    moving = np.abs(run.twist[:, 0]) > 1e-9
+    assert np.all(np.abs(run.twist[moving, 2] / run.twist[moving, 0]) <= 1 / radius + 1e-9)

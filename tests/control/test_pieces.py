@@ -158,7 +158,9 @@ def test_stanley_s_projection_past_a_corner_takes_the_leg_ahead(size):
     for robot in ("ackermann", "bicycle"):
         run = track(catalog.load(robot), builtin_reference("corner", size=size), controller="stanley")
         turned = run.pose[np.searchsorted(run.t, corner + 3.0), 2] - run.pose[0, 2]
-        assert turned > 0.5, (robot, turned)  # it turns left (to +x) within 3 s of the corner
+        # it turns left (to +x) within 3 s of the corner: the car at its tightest (1.5 m of arc on its 3.99 m turning
+        # radius, 0.3757 rad; it turned 0.5 rad while its wheels were asked beyond their stops, and scrubbed)
+        assert turned > (0.99 * 1.5 / 3.993 if robot == "ackermann" else 0.5), (robot, turned)
 
 
 @settings(max_examples=60)

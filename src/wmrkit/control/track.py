@@ -21,7 +21,7 @@ from .laws import PositionLaw, check_gate, check_sampling
 from .loop import Plant, simulate
 from .points import ControlError, ControlPoint, StoppedRun, check_delay, control_point, point_pose
 from .references import Reference
-from .trackers import PathIndex, default_wheelbase, pure_pursuit, stanley
+from .trackers import PathIndex, default_wheelbase, max_curvature, pure_pursuit, stanley
 
 if TYPE_CHECKING:
     from ..slip.kalman import KalmanNoise
@@ -201,10 +201,10 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
 
         ctrl, tracked_point = fast_law_controller(cp, law, reference), cp.point
     elif controller == "pure-pursuit":
-        ctrl, tracked_point = pure_pursuit(cp, reference, lookahead), cp.axle_point
+        ctrl, tracked_point = pure_pursuit(cp, reference, lookahead, max_curvature(robot)), cp.axle_point
     else:
         length = default_wheelbase(cp)
-        ctrl = stanley(cp, reference, stanley_gain, length)
+        ctrl = stanley(cp, reference, stanley_gain, length, min(1.2, math.atan(length * max_curvature(robot))))
         tracked_point = cp.axle_point + length * np.array([math.cos(cp.forward), math.sin(cp.forward)])
     geometric = controller in ("pure-pursuit", "stanley")  # switching goal points: a looser tolerance
     if initial_pose is None and geometric:  # the tracker's own point starts on the reference, not the law's

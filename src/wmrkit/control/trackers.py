@@ -22,11 +22,12 @@ import math
 
 import numpy as np
 
+from ..robot import Robot
 from .loop import TwistController
 from .points import ControlError, ControlPoint
 from .references import Reference
 
-__all__ = ["PathIndex", "default_wheelbase", "pure_pursuit", "stanley"]
+__all__ = ["PathIndex", "default_wheelbase", "max_curvature", "pure_pursuit", "stanley"]
 
 
 class PathIndex:
@@ -154,6 +155,20 @@ def default_wheelbase(cp: ControlPoint) -> float:
     return d if d > 1e-6 else 0.5
 
 
+def max_curvature(robot: Robot) -> float:
+    """The largest curvature [1/m] the axle point of car-like `robot` drives within its wheels' ``steer_range``
+    (:func:`wmrkit.parking.problem.curvature_limit`, a hair inside it: the wheels then stay within their ranges);
+    inf for any other robot, or one whose ranges do not limit it."""
+    from ..errors import WmrkitError
+    from ..parking.problem import curvature_limit
+
+    try:
+        limit = curvature_limit(robot)
+    except WmrkitError:  # not car-like
+        return math.inf
+    return limit * (1 - 1e-9) if limit > 0 else math.inf
+
+
 def _axle_state(cp: ControlPoint, pose: np.ndarray) -> tuple[np.ndarray, float]:
     c, s = math.cos(pose[2]), math.sin(pose[2])
     a = cp.axle_point
@@ -171,8 +186,10 @@ def _speed(ref: Reference, t: float) -> float:
     return float(np.hypot(*ref.at(t)[1][:2]))
 
 
-def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0) -> TwistController:
-    """Pure-pursuit controller (see module doc); `lookahead` [m], > 0."""
+def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0,
+                 curvature: float = math.inf) -> TwistController:
+    """Pure-pursuit controller (see module doc); `lookahead` [m], > 0; the commanded curvature is limited to
+    ``+-curvature`` [1/m] (the robot's tightest turn, :func:`max_curvature`)."""
     if not 0 < lookahead < math.inf:  # NaN included
         raise ControlError(f"lookahead: expected a distance > 0 m along the path, got {lookahead}")
     path = PathIndex(reference)
@@ -192,6 +209,7 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0)
             kappa = 2.0 * y_g / dist2
         else:  # goal behind (the path runs against the robot): 2 y_g / L^2 ~ 0 drove straight away; turn round
             kappa = math.copysign(2.0 / math.sqrt(dist2), y_g)
+        kappa = min(max(kappa, -curvature), curvature)
         v = _speed(reference, t)
         return _twist_at_origin(cp, v, v * kappa), np.zeros(3)
 
