@@ -32,7 +32,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--gate", metavar="D", help="p, pi: apply the feedforward only within D [m] of the "
                                                "reference (8.53)")
     p.add_argument("--lookahead", metavar="L", help="pure-pursuit: lookahead distance along the path [m] "
-                                                    "(default 1)")
+                                                    "(default: the wheelbase of a robot with steered wheels, at "
+                                                    "least 1)")
     p.add_argument("--stanley-gain", metavar="K", help="stanley: cross-track gain [1/s] (default 1)")
     p.add_argument("--period", metavar="T", help="sample period [s]; without it the loop is continuous")
     p.add_argument("--delay", type=int, default=0, metavar="N",
@@ -143,6 +144,22 @@ def min_turning_radius(robot) -> float:
         return 0.0
 
 
+def _lookahead(args: argparse.Namespace, robot) -> tuple[float, str]:
+    """Pure pursuit's ``--lookahead`` [m] (default :func:`wmrkit.control.trackers.default_lookahead`) and the words
+    the summary line names it with (empty for another controller)."""
+    from ..control.points import control_point
+    from ..control.trackers import MIN_LOOKAHEAD, default_lookahead
+
+    if args.lookahead is not None:
+        value = _positive(args.lookahead, "--lookahead", "length")
+        return value, f" (lookahead {value:g} m)"
+    if args.controller != "pure-pursuit":
+        return MIN_LOOKAHEAD, ""
+    value = default_lookahead(control_point(robot))
+    why = ", the robot's wheelbase" if value > MIN_LOOKAHEAD else ""
+    return value, f" (lookahead {value:.4g} m{why})"
+
+
 def _positive(text: str, what: str, kind: str = "number") -> float:
     value = parse_value(text, kind, what)  # type: ignore[arg-type]
     if not value > 0 or value == float("inf"):
@@ -193,7 +210,7 @@ def run_track(args: argparse.Namespace) -> int:
                  parse_value(args.start[2], "angle", "--from THETA")]
     _check_controller_options(args)
     gain = 1.0 if args.gain is None else _non_negative(args.gain, "--gain")
-    lookahead = 1.0 if args.lookahead is None else _positive(args.lookahead, "--lookahead", "length")
+    lookahead, ahead_words = _lookahead(args, robot)
     stanley_gain = 1.0 if args.stanley_gain is None else _non_negative(args.stanley_gain, "--stanley-gain")
     period = None if args.period is None else _positive(args.period, "--period")
     duration = None if args.duration is None else _positive(args.duration, "--duration")
@@ -249,10 +266,11 @@ def run_track(args: argparse.Namespace) -> int:
         if args.animate:
             animate_run(run, args.animate)
     if args.json:
-        print_json({**run.to_dict(), "reference_name": reference.name, "reference_size": size})
+        looked = {"lookahead": lookahead} if args.controller == "pure-pursuit" else {}
+        print_json({**run.to_dict(), "reference_name": reference.name, "reference_size": size, **looked})
     else:
         s = run.summary()
-        print(f"robot {robot.name}, reference {described}, controller {args.controller}, "
+        print(f"robot {robot.name}, reference {described}, controller {args.controller}{ahead_words}, "
               f"{'continuous' if run.period is None else f'period {run.period:g} s, delay {args.delay}'}"
               f"{', through the dynamics' if args.dynamics else ''}"
               f"{f', {args.slip_model.upper()} commands' if args.slip_model != 'none' else ''}"

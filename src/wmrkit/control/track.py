@@ -21,7 +21,7 @@ from .laws import PositionLaw, check_gate, check_sampling
 from .loop import Plant, simulate
 from .points import ControlError, ControlPoint, StoppedRun, check_delay, control_point, point_pose
 from .references import Reference
-from .trackers import PathIndex, default_wheelbase, max_curvature, pure_pursuit, stanley
+from .trackers import PathIndex, default_lookahead, default_wheelbase, max_curvature, pure_pursuit, stanley
 
 if TYPE_CHECKING:
     from ..slip.kalman import KalmanNoise
@@ -147,7 +147,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
           integral_gain: float | None = None, gate: float | None = None, initial_pose: ArrayLike | None = None,
           period: float | None = None, delay: int = 0, duration: float | None = None,
           point: ArrayLike | None = None, loops: LowLevelLoops | None = None, policy: str = "closest",
-          skew_free: bool = False, lookahead: float = 1.0, stanley_gain: float = 1.0,
+          skew_free: bool = False, lookahead: float | None = None, stanley_gain: float = 1.0,
           output_dt: float = 0.05, dynamics: bool = False, tyre: str | None = None,
           feedback: str = "pose", slip_model: str = "none", weights: SlipWeights | None = None,
           noise: KalmanNoise | None = None, ramp: bool = False, progress: bool = False) -> TrackingRun:
@@ -161,7 +161,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     (:func:`initial_pose_on`; the geometric trackers' own point). `delay` in samples (discrete only). `point` ``(2,)``
     [m]: controlled point of a reduced-mobility robot (:func:`control_point`). `loops`: low-level actuator loops;
     `policy`: steering root (:mod:`.steering`). `skew_free`: second-order discretisation of the held twist. Geometric
-    trackers: `lookahead` [m] (pure pursuit), `stanley_gain` [1/s]. `dynamics`: the plant is the chapter-7 dynamic model
+    trackers: `lookahead` [m] (pure pursuit; default :func:`.trackers.default_lookahead`, the wheelbase of a
+    robot with steered wheels, at least 1 m), `stanley_gain` [1/s]. `dynamics`: the plant is the chapter-7 dynamic model
     with tyres (`tyre`: traction model name, default as described), driven by servos each period
     (:func:`.dynamic_plant.simulate_dynamics`; period default 0.02 s); with it, `feedback="odometry"` measures the
     pose by odometry from the sensed joints (``TrackingRun.estimate``) instead of exactly, ``"wls"`` by WLS odometry
@@ -201,7 +202,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
 
         ctrl, tracked_point = fast_law_controller(cp, law, reference), cp.point
     elif controller == "pure-pursuit":
-        ctrl, tracked_point = pure_pursuit(cp, reference, lookahead, max_curvature(robot)), cp.axle_point
+        ahead = default_lookahead(cp) if lookahead is None else lookahead
+        ctrl, tracked_point = pure_pursuit(cp, reference, ahead, max_curvature(robot)), cp.axle_point
     else:
         length = default_wheelbase(cp)
         ctrl = stanley(cp, reference, stanley_gain, length, min(1.2, math.atan(length * max_curvature(robot))))

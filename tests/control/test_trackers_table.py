@@ -1,0 +1,43 @@
+"""docs/control.md's table of the path followers on the catalog robots is what the code gives (some of its rows,
+recomputed: docs/figures/control/make_trackers_table.py writes it all)."""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+
+import pytest
+
+from doc_examples import ROOT
+
+SCRIPT = ROOT / "docs" / "figures" / "control" / "make_trackers_table.py"
+
+
+def _script():
+    spec = importlib.util.spec_from_file_location("make_trackers_table", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _doc_rows() -> list[str]:
+    text = (ROOT / "docs" / "control.md").read_text()
+    return [line for line in text.splitlines() if re.match(r"\| [\w-]+ \| [\w-]+ \| (pure-pursuit|stanley) \| [\d.]+ \|"
+                                                            r" [\d.]+ \| [\d.]+ \| [\d.]+ \|$", line)]
+
+
+def test_the_table_has_every_row_and_no_steering_held_at_a_stop():
+    """Every robot x reference x controller of the script is in the page, once; no steered wheel was held beyond
+    its range on any of them (the trackers ask a car for no turn tighter than its steering allows)."""
+    script, rows = _script(), _doc_rows()
+    keys = [tuple(r.split(" | ")[:3]) for r in rows]
+    assert sorted(keys) == sorted((f"| {a}", b, c) for a in script.ROBOTS for b in script.REFERENCES
+                                  for c in script.CONTROLLERS)
+    assert all(r.split(" | ")[5] == "0.0" for r in rows)
+
+
+@pytest.mark.parametrize(("robot", "reference", "controller"), [("ackermann", "square", "pure-pursuit"),
+                                                                ("ackermann", "figure-eight", "pure-pursuit"),
+                                                                ("forklift", "arc-line", "stanley")])
+def test_rows_of_the_table_are_what_the_code_gives(robot, reference, controller):
+    assert _script().row(robot, reference, controller) in _doc_rows()
