@@ -5,11 +5,13 @@ Both steer a point of the robot onto the reference *path* at the reference's spe
 - **pure pursuit** (Coulter 1992): the axle point ``A`` (the foot of the fixed axle, the origin without fixed wheels)
   drives on the arc through a goal point ``lookahead`` metres further along the path (past its end: on its final
   tangent): curvature ``kappa = 2 y_g / L_d^2``; a goal behind ``A`` (``x_g <= 0``) turns it round on the circle of
-  diameter ``L_d`` (``kappa = +-2 / L_d``, towards the goal's side, left when straight behind);
+  diameter ``L_d`` (``kappa = +-2 / L_d``, towards the goal's side, left when straight behind); ``L_d`` defaults to
+  the wheelbase (:func:`default_lookahead`);
 - **Stanley** (Thrun et al. 2006): a front point ``F`` at ``wheelbase`` ahead of ``A``; steering
   ``delta = psi_e - atan(k e / (v + eps))`` with the heading error ``psi_e`` and the signed cross-track error ``e`` of
   ``F`` (positive left), curvature ``tan(delta) / wheelbase``.
 
+Both limit the curvature to the robot's tightest turn (:func:`max_curvature`: a car's steering stops).
 The resulting unicycle twist ``(v, omega)`` at ``A`` along the robot's rolling direction is moved to the origin
 (rigid body) and goes through the same per-wheel IK as the thesis's controller. Neither has a time law: each stops
 once its point has passed the path's end (a robot ahead of the reference waits there; one behind stops where it is
