@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
@@ -56,15 +57,22 @@ def test_one_step_is_one_violation_at_its_sample(name, point, dt, v, direction, 
             assert got == [(kind, t[i])], (framework, got)
 
 
-def test_a_sampled_speed_step_on_an_arc_is_found():
-    """A file's speed doubling (1 -> 2 m/s) on an arc of curvature 0.3 1/m, sampled at 32 Hz: its central-difference
-    velocity steps in two halves of 0.5 m/s, each under 20 typical steps of the turning velocity there (0.0375 m/s),
-    so the dynamic framework of omni-3 answered 'feasible' and swerve-4's reported only the acceleration's spike one
-    sample early. The halves together are the step: a velocity jump of 1 m/s at 5 s for both."""
+@pytest.mark.parametrize("kappa", [0.3, 0.5, 1.0])
+def test_a_sampled_speed_step_on_an_arc_is_found(kappa):
+    """A file's speed doubling (1 -> 2 m/s) on an arc of curvature `kappa`, sampled at 32 Hz: its central-difference
+    velocity steps in two halves of 0.5 m/s, each under 20 typical steps of the turning velocity there (0.0375 m/s at
+    0.3 1/m), so the dynamic framework of omni-3 answered 'feasible' and swerve-4's reported only the acceleration's
+    spike one sample early; at 0.5 1/m the whole step is 16 typical steps, and both were missed. The velocity's
+    direction is continuous and its size steps by 1 m/s: a velocity jump of 1 m/s at 5 s for both (and for a diff
+    drive, with its turn-rate jump). The twist only scales (the heading stays 0): no steered wheel turns, and the
+    kinematic framework of swerve-4 has no violation, although at 1 1/m its wheels turn by 0.0625 rad a sample."""
     t = np.arange(0.0, 10.0, 0.03125)
-    phi = np.where(t < 5.0, 0.3 * t, 1.5 + 0.6 * (t - 5.0))  # the tangent: speed 1, then 2, on radius 1/0.3
-    pose = np.column_stack([np.sin(phi) / 0.3, (1 - np.cos(phi)) / 0.3, 0 * t])
+    phi = np.where(t < 5.0, kappa * t, 5 * kappa + 2 * kappa * (t - 5.0))  # the tangent: speed 1, then 2
+    pose = np.column_stack([np.sin(phi) / kappa, (1 - np.cos(phi)) / kappa, 0 * t])
     ref = reference_from_samples("arc.csv", t, pose)
-    for name in ("omni-3", "swerve-4"):
-        got = [(v.signal, v.t, round(v.size, 2)) for v in feasibility(catalog.load(name), ref, "dynamic").violations]
-        assert got == [("velocity", 5.0, 1.0)], (name, got)
+    for name in ("omni-3", "swerve-4", "diff-drive"):
+        got = [(v.signal, v.t, v.size) for v in feasibility(catalog.load(name), ref, "dynamic").violations]
+        assert [g[:2] for g in got] == [("velocity", 5.0)] + ([("chi_rate", 5.0625)] if name == "diff-drive" else []), (
+            name, got)
+        assert got[0][2] == pytest.approx(1.0, abs=0.01)  # plus the velocity's turning across the samples
+    assert feasibility(catalog.load("swerve-4"), ref).feasible

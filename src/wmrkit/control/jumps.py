@@ -2,8 +2,11 @@
 ``jump_factor`` times the typical one where it is (the median of its block of 21 steps, or of a neighbouring block
 when larger) is a discontinuity where it, or its run of such changes of one sign (a sampled step split by finite
 differences), is larger than an absolute floor, reported once: the spike of a derivative around a step of its signal
-is that step (:func:`_folded`). Undefined samples (NaN) are bridged: a jump across them is the change from the last
-sample before to the first after, compared with as many typical steps as it spans.
+is that step (:func:`_folded`). A change is also compared with the one its neighbours predict
+(:func:`_unpredicted`): what is left is a discontinuity where larger than ``jump_factor`` times the typical change of
+a step (or of what is left) and than the floor, which a signal that turns by a typical step every sample (the velocity
+on an arc) hides from the first comparison. Undefined samples (NaN) are bridged: a jump across them is the change
+from the last sample before to the first after, compared with as many typical steps as it spans.
 """
 
 from __future__ import annotations
@@ -52,33 +55,21 @@ def _jumps(x: np.ndarray, t: np.ndarray, turn: float | None, floor: float, facto
     size[np.any(np.isnan(d), axis=-1)] = 0.0
     if cut is not None:
         size[cut] = 0.0
-    # the typical step where each one is: the median of its block of steps, or of a neighbouring block when larger
-    # (a global median is 0 for a reference mostly at rest, and its every moving step was a jump)
     n = len(size)
-    if held is None:
-        blocks = np.median(np.pad(size / span, (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK), axis=1) if n else size
-    else:  # of the steps of the signal (per sample step for a bridged one), not of the 0s held over undefined ones
-        typical = np.pad(np.where(held, np.nan, size / span), (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK)
-        count = (~np.isnan(typical)).sum(axis=1)
-        typical = np.sort(typical, axis=1)  # NaN last; np.nanmedian gives the same, 7x slower on rows of 21
-        rows = np.arange(len(typical))
-        mid = 0.5 * (typical[rows, np.maximum(count - 1, 0) // 2] + typical[rows, count // 2 - (count == 0)])
-        blocks = np.where(count > 0, mid, 0.0)
-    near = np.maximum(blocks, np.maximum(np.r_[blocks[:1], blocks[:-1]], np.r_[blocks[1:], blocks[-1:]]))
-    # a step bridged over k undefined samples is the change of k steps: compared with k typical ones (at 10 Hz, a
-    # smooth curvature changing by 0.09 over 6 samples whose speed changed too fast to judge them was a 'jump')
-    limit = factor * span * np.repeat(near, BLOCK)[:n]
-    # central differences halve a step: two over half the limit whose sum is over it are one (a speed step on an arc)
-    pair = np.sqrt(np.nansum((_wrap(d[:-1] + d[1:], turn) if turn else d[:-1] + d[1:]) ** 2, axis=-1))
-    half = (size[:-1] > limit[:-1] / 2) & (size[1:] > limit[1:] / 2) & (pair > np.maximum(limit[:-1], limit[1:]))
-    part = (size > floor * 1e-3) & ((size > limit) | np.r_[half, False] | np.r_[False, half])  # 1e-3: rounding
-    # the floor is compared with the whole step: finite differences split a sampled one into a run of changes of one
-    # sign, each maybe under it (the forklift's turn-rate step of 0.033 rad/s on an S-curve at 0.05 m/s was 2 x 0.017)
-    dz = np.where(part[:, None], np.nan_to_num(d.reshape(n, -1)), 0.0)
-    start = part & ~np.r_[False, part[:-1] & (np.sum(dz[1:] * dz[:-1], axis=-1) > 0)]
-    starts, cz = np.flatnonzero(start), np.r_[np.zeros((1, dz.shape[1])), np.cumsum(dz, axis=0)]
-    run = np.r_[np.sqrt(((cz[np.r_[starts[1:], n]] - cz[starts]) ** 2).sum(axis=-1)), 0.0][np.cumsum(start) - 1]
-    hit = np.flatnonzero(part & ((size > floor) | (run > floor)))
+    steps = np.where(held, np.nan, size / span) if held is not None else size / span
+    part, run = _outliers(d, size, factor * span * _typical(steps), floor, turn)
+    # a step is also compared with the one its neighbours predict (:func:`_unpredicted`), and what is left with the
+    # typical change of a step (or that left, when larger): on an arc the velocity turns by a typical step every
+    # sample, and a speed doubling there (1 -> 2 m/s, curvature 0.5 1/m at 32 Hz) was 16 typical steps, under the
+    # factor, and 250 typical changes of a step
+    skip = np.isnan(steps) | np.isnan(d.reshape(n, -1)).any(axis=-1) | (False if cut is None else cut)
+    q = np.where(skip[:, None], np.nan, d.reshape(n, -1) / span[:, None])  # per sample; NaN: no step of the signal
+    r = np.nan_to_num(_unpredicted(q) * span[:, None])
+    rsize = np.sqrt((r * r).sum(axis=-1))
+    change = np.r_[np.sqrt((np.diff(q, axis=0) ** 2).sum(axis=-1)), np.nan]
+    limit = factor * span * np.maximum(_typical(np.where(skip, np.nan, rsize / span)), _typical(change))
+    rpart, rrun = _outliers(r, rsize, limit, floor, turn)
+    hit = np.flatnonzero((part & ((size > floor) | (run > floor))) | (rpart & ((rsize > floor) | (rrun > floor))))
     events: list[list[int]] = []  # [first step, last step, step of the largest]
     for k in hit:  # a jump spread over consecutive samples (finite differences) is one event
         if events and k - events[-1][1] <= 2:
@@ -95,6 +86,73 @@ def _jumps(x: np.ndarray, t: np.ndarray, turn: float | None, floor: float, facto
         whole = float(np.sqrt(np.nansum(total * total)))
         out.append((first, last, max(whole, float(size[top])) if np.all(np.isfinite(total)) else float(size[top])))
     return out
+
+
+def _typical(steps: np.ndarray) -> np.ndarray:
+    """The typical size of each of `steps` ``(n,)`` (NaN: not a step of the signal, left out): the median of its
+    block of :data:`BLOCK`, or of a neighbouring block when larger (a global median is 0 for a reference mostly at
+    rest, and its every moving step was a jump)."""
+    n = len(steps)
+    typical = np.pad(steps, (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK)
+    count = (~np.isnan(typical)).sum(axis=1)
+    typical = np.sort(typical, axis=1)  # NaN last; np.nanmedian gives the same, 7x slower on rows of 21
+    rows = np.arange(len(typical))
+    mid = 0.5 * (typical[rows, np.maximum(count - 1, 0) // 2] + typical[rows, count // 2 - (count == 0)])
+    blocks = np.where(count > 0, mid, 0.0)
+    near = np.maximum(blocks, np.maximum(np.r_[blocks[:1], blocks[:-1]], np.r_[blocks[1:], blocks[-1:]]))
+    return np.repeat(near, BLOCK)[:n]
+
+
+def _unpredicted(q: np.ndarray, chunk: int = 1 << 16) -> np.ndarray:
+    """What of each of the steps `q` ``(n, m)`` (per sample; NaN: none) its neighbours do not predict: the step less
+    the one extrapolated linearly from the steps two and three before it or after it, or the mean of the two,
+    whichever is nearest (NaN where a side has none: a start's first steps are too few to predict); then the
+    smallest of that and its sum with the next one's or the previous one's. The steps next to it are left out of the
+    prediction (central differences spread a sampled step over two); a kink of the signal (a step of its steps, no
+    jump of its own) follows one side or their mean, or central differences spread it over two steps whose
+    remainders cancel (a heading-rate reversal on an S-curve: +a/2 and -a/2). A smooth signal errs by about
+    ``3 h^2 q''``. In chunks of `chunk` rows, to bound the memory of a dense file."""
+    n = len(q)
+    if n > chunk:
+        out = np.empty_like(q)
+        for a in range(0, n, chunk):  # 4 rows on each side: the prediction's 3 and the sum's 1
+            lo = max(a - 4, 0)
+            out[a:a + chunk] = _unpredicted(q[lo:a + chunk + 4], chunk + 8)[a - lo:a - lo + chunk]
+        return out
+    qp = np.pad(q, ((3, 3), (0, 0)), constant_values=np.nan)
+    left, right = 3 * qp[1:n + 1] - 2 * qp[:n], 3 * qp[5:n + 5] - 2 * qp[6:n + 6]
+    r = _nearest(q - left, q - right, q - 0.5 * (left + right))
+    z = np.nan_to_num(r)
+    after, before = np.r_[z[1:], 0 * z[-1:]], np.r_[0 * z[:1], z[:-1]]
+    return np.where(np.isnan(r), np.nan, _nearest(z, z + after, z + before))
+
+
+def _nearest(*options: np.ndarray) -> np.ndarray:
+    """The smallest of `options` (each ``(n, m)``) for each of the n (NaN where one of them is NaN)."""
+    best, least = options[0], np.nan_to_num((options[0] ** 2).sum(axis=-1), nan=-1.0)  # a NaN one first
+    for z in options[1:]:
+        size = np.nan_to_num((z * z).sum(axis=-1), nan=-1.0)
+        best, least = np.where((size < least)[:, None], z, best), np.minimum(size, least)
+    return best
+
+
+def _outliers(d: np.ndarray, size: np.ndarray, limit: np.ndarray, floor: float,
+              turn: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """Which of the steps `d` ``(n, ...)`` of sizes `size` are over `limit`, or one of two consecutive ones each over
+    half of it whose sum is over it (central differences halve a step: a speed step on an arc), and each one's run:
+    the size of the sum of its run of such steps of one sign (finite differences split a sampled step into such a
+    run, each maybe under the floor: the forklift's turn-rate step of 0.033 rad/s on an S-curve at 0.05 m/s was
+    2 x 0.017). `turn`: the period of an angle signal, or None."""
+    n = len(size)
+    z = np.nan_to_num(d.reshape(n, -1))
+    pair = np.sqrt(((_wrap(z[:-1] + z[1:], turn) if turn else z[:-1] + z[1:]) ** 2).sum(axis=-1))
+    half = (size[:-1] > limit[:-1] / 2) & (size[1:] > limit[1:] / 2) & (pair > np.maximum(limit[:-1], limit[1:]))
+    part = (size > floor * 1e-3) & ((size > limit) | np.r_[half, False] | np.r_[False, half])  # 1e-3: rounding
+    dz = np.where(part[:, None], z, 0.0)
+    start = part & ~np.r_[False, part[:-1] & (np.sum(dz[1:] * dz[:-1], axis=-1) > 0)]
+    starts, cz = np.flatnonzero(start), np.r_[np.zeros((1, dz.shape[1])), np.cumsum(dz, axis=0)]
+    run = np.r_[np.sqrt(((cz[np.r_[starts[1:], n]] - cz[starts]) ** 2).sum(axis=-1)), 0.0][np.cumsum(start) - 1]
+    return part, run
 
 
 #: Period of the angle signals: a heading's turn, and half a turn for the tangent, which (8.29) defines as

@@ -51,25 +51,45 @@ def _steered_turn(robot: Robot, reference: Reference, point: tuple[float, float]
 def _steered_turns(robot: Robot, reference: Reference, point: tuple[float, float] | None, before: np.ndarray,
                    after: np.ndarray, *, rate: bool) -> np.ndarray:
     """Whether some steered wheel's heading (or, with `rate`, its steering rate) differs between samples `before`
-    and `after` (arrays of sample indices, one answer each) of `reference`, tracked at `point`: the direction
-    (modulo half a turn, a 2-quadrant root of (8.9)) of the wheel centre's velocity in the robot frame,
-    ``u = R^T v + omega J d``, and its rate ``(u x u') / |u|^2`` with ``u' = R^T a - omega J R^T v + alpha J d``
-    (``d`` the wheel from the point). A wheel at rest on either side turns freely there."""
-    p = np.zeros(2) if point is None else np.asarray(point, dtype=float)
-    d = np.array([w.position for w in robot.wheels if w.type in ("steerable", "double")]) - p
-    out = []
-    for k in (before, after):  # (samples, 1) against (wheels,)
-        c, s = np.cos(reference.pose[k, 2])[:, None], np.sin(reference.pose[k, 2])[:, None]
-        (vx, vy, w), (ax, ay, al) = reference.velocity[k].T[:, :, None], reference.acceleration[k].T[:, :, None]
-        vrx, vry = c * vx + s * vy, -s * vx + c * vy
-        ux, uy = vrx - w * d[:, 1], vry + w * d[:, 0]
-        dux = c * ax + s * ay + w * vry - al * d[:, 1]
-        duy = -s * ax + c * ay - w * vrx + al * d[:, 0]
-        speed2 = ux**2 + uy**2
-        with np.errstate(invalid="ignore", divide="ignore"):
-            out.append((speed2, (ux * duy - uy * dux) / speed2 if rate else np.arctan2(uy, ux)))
-    (s0, x0), (s1, x1) = out
+    and `after` (arrays of sample indices, one answer each) of `reference`, tracked at `point` (:func:`_wheels`),
+    by more than its floor; the heading by more than it turns at the rate of the sample steps on either side (on a
+    curve of radius 1 m at 2 m/s it turns by 0.0625 rad a sample at 32 Hz, over the floor, and a speed step there,
+    which keeps every wheel's heading, was a 'velocity jump' in the kinematic framework of swerve-4). A wheel at rest
+    on either side turns freely there."""
+    (s0, x0), (s1, x1) = (_wheels(robot, reference, point, k, rate=rate) for k in (before, after))
     moving = (s0 > 1e-12) & (s1 > 1e-12)
-    change = np.abs(x1 - x0) if rate else np.abs(_wrap(x1 - x0, math.pi))
+    if rate:
+        change = np.abs(x1 - x0)
+    else:
+        t, last = reference.t, len(reference.t) - 1
+        rates = []
+        for a, b in ((np.maximum(before - 1, 0), before), (after, np.minimum(after + 1, last))):
+            (sa, xa), (sb, xb) = (_wheels(robot, reference, point, k, rate=False) for k in (a, b))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                r = _wrap(xb - xa, math.pi) / (t[b] - t[a])[:, None]
+            rates.append(np.where((sa > 1e-12) & (sb > 1e-12) & (b > a)[:, None], r, np.nan))
+        known = np.isfinite(np.stack(rates))
+        smooth = np.nan_to_num(np.stack(rates)).sum(axis=0) / np.maximum(known.sum(axis=0), 1)  # 0: no side known
+        change = np.abs(_wrap(x1 - x0 - smooth * (t[after] - t[before])[:, None], math.pi))
     return np.any(moving & (change > _FLOOR["chi_rate" if rate else "chi"]), axis=1)
 
+
+def _wheels(robot: Robot, reference: Reference, point: tuple[float, float] | None, k: np.ndarray, *,
+            rate: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The squared speed ``(samples, wheels)`` of each steered wheel's centre at samples `k` of `reference` tracked
+    at `point`, and its heading: the direction (modulo half a turn, a 2-quadrant root of (8.9)) of its velocity in
+    the robot frame, ``u = R^T v + omega J d``, or with `rate` its rate ``(u x u') / |u|^2`` with
+    ``u' = R^T a - omega J R^T v + alpha J d`` (``d`` the wheel from the point)."""
+    p = np.zeros(2) if point is None else np.asarray(point, dtype=float)
+    d = np.array([w.position for w in robot.wheels if w.type in ("steerable", "double")]) - p
+    c, s = np.cos(reference.pose[k, 2])[:, None], np.sin(reference.pose[k, 2])[:, None]
+    (vx, vy, w), (ax, ay, al) = reference.velocity[k].T[:, :, None], reference.acceleration[k].T[:, :, None]
+    vrx, vry = c * vx + s * vy, -s * vx + c * vy
+    ux, uy = vrx - w * d[:, 1], vry + w * d[:, 0]
+    speed2 = ux**2 + uy**2
+    if not rate:
+        return speed2, np.arctan2(uy, ux)
+    dux = c * ax + s * ay + w * vry - al * d[:, 1]
+    duy = -s * ax + c * ay - w * vrx + al * d[:, 0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return speed2, (ux * duy - uy * dux) / speed2
