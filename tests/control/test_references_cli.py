@@ -280,7 +280,6 @@ def test_cli_feasibility_json(capsys):
     (["track", "forklift", "--reference", "nope"], "no built-in reference"),
     (["track", "forklift", "--reference", "line", "--period", "-1"], "--period"),
     (["track", "forklift", "--reference", "line", "--delay", "1"], "needs a sample period"),
-    (["feasibility", "skid-steer-4", "--reference", "line"], "degenerate"),
     (["track", "forklift", "--reference", "missing.csv"], "no such file"),
     (["track", "diff-drive", "--reference", "line", "--dynamics"], "no mass properties"),
     (["track", "diff-drive", "--reference", "circle", "--controller", "pure-pursuit", "--gain", "3"],

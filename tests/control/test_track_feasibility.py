@@ -102,9 +102,25 @@ def test_a_reference_from_a_file_is_judged_in_the_run_s_time(tmp_path, capsys):
         "t = 10 s: stop and re-orient the orientable wheel"]
 
 
-def test_a_degenerate_robot_has_no_verdict(capsys):
-    run = track(catalog.load("skid-steer-4"), builtin_reference("line"), duration=2)
-    assert run.feasibility is None and run.to_dict()["feasibility"] is None
+def test_a_skid_steer_is_judged_as_a_differential_drive(capsys):
+    """skid-steer-4 had no verdict (degenerate); 'wmrkit track' drives it as a differential drive, and Table 8.1
+    judges it as one: for the point it tracks, the verdict of diff-drive tracked at that point. From the CLI (exit 0
+    on a feasible circle, exit 1 on the square) a warning says so."""
+    ref = builtin_reference("square")
+    run = track(catalog.load("skid-steer-4"), ref, duration=15)
+    point = tuple(float(v) for v in control_point(catalog.load("skid-steer-4")).point)  # the p law's
+    same = feasibility(catalog.load("diff-drive"), ref, point=point)
+    assert run.feasibility is not None and run.feasibility.requirement.column == same.requirement.column
+    assert [(v.t, v.signal) for v in run.feasibility.violations] == [(v.t, v.signal) for v in same.violations
+                                                                      if v.t <= 15]
+    assert main(["feasibility", "skid-steer-4", "--reference", "circle", "--json"]) == 0
+    out = capsys.readouterr()
+    data = json.loads(out.out)
+    assert data["column"] == "type 2, on axle" and any("skid steer" in w for w in data["warnings"])
+    assert main(["feasibility", "skid-steer-4", "--reference", "square"]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith("wmrkit: warning: robot 'skid-steer-4' is degenerate") and (
+        "judges it as the differential drive it drives as (type 2)" in err[0])
 
 
 def test_through_the_dynamics_the_dynamic_framework_judges(capsys):

@@ -320,6 +320,8 @@ def run_feasibility(args: argparse.Namespace) -> int:
     point = None if args.point is None else (parse_value(args.point[0], "length", "--point X"),
                                               parse_value(args.point[1], "length", "--point Y"))
     result = feasibility(robot, reference, args.framework, point=point)
+    if result.requirement.note:  # a skid steer, judged as a differential drive
+        warn(result.requirement.note)
     for c in robot.couplings:
         if c.kind == "gear":  # Table 8.1 classifies the wheels' geometry only
             warn(f"{c.channel_name} is not considered: Table 8.1 judges the wheels alone; check the reference's "

@@ -71,7 +71,9 @@ KINDS = {"position": "position jump (p_ref not C0)", "theta": "heading jump (the
 @dataclass(frozen=True)
 class Requirement:
     """The Table 8.1 cell of a robot: ``column``, vehicle ``type``, number of pose ``references`` (2 or 3), the
-    ``signals`` that must be continuous in the chosen ``framework``, and the ``remedy`` when one is not."""
+    ``signals`` that must be continuous in the chosen ``framework``, and the ``remedy`` when one is not; ``note``:
+    why a robot outside the table is judged by a column of it (a skid steer, as the differential drive it drives
+    as), or empty."""
 
     column: str
     type: int
@@ -79,6 +81,7 @@ class Requirement:
     framework: str
     signals: tuple[str, ...]
     remedy: str
+    note: str = ""
 
 
 @dataclass(frozen=True)
@@ -122,23 +125,40 @@ def requirement(robot: Robot, framework: Literal["kinematic", "dynamic"] = "kine
     if framework not in ("kinematic", "dynamic"):
         raise ControlError(f"framework must be 'kinematic' or 'dynamic', got {framework!r}")
     c = classify(robot)
-    if c.type is None:
-        raise ControlError(f"robot '{robot.name}' is degenerate ({'; '.join(c.reasons)}): Table 8.1 does not apply")
+    kind, note = c.type, ""
+    if kind is None:
+        degenerate = f"robot '{robot.name}' is degenerate ({'; '.join(c.reasons)})"
+        if not _skid(robot):
+            raise ControlError(f"{degenerate}: Table 8.1 does not apply")
+        kind, note = 2, (f"{degenerate}: a skid steer turns only by slipping; Table 8.1 judges it as the "
+                         "differential drive it drives as (type 2)")
     p = np.zeros(2) if point is None else np.asarray(point, dtype=float)
     if p.shape != (2,) or not (np.abs(p) <= MAX_SIZE).all():  # NaN read as a point on the axle
         raise ControlError(f"point: expected (x, y), finite and within {MAX_SIZE:g} m of the robot origin, got "
                            f"{p.tolist()}")
-    if c.type in (2, 4):
+    if kind in (2, 4):
         on_axle = _on_axle(robot, p)
-        column = f"type {c.type}, {'on' if on_axle else 'off'} axle"
-    elif c.type == 1:
+        column = f"type {kind}, {'on' if on_axle else 'off'} axle"
+    elif kind == 1:
         column = "type 1"
     else:
         steered = [w for w in robot.wheels if w.type in ("steerable", "double")]
         away = any(np.hypot(*(np.asarray(w.position) - p)) > 1e-9 for w in steered)
-        column = "types 3 and 5, l_o != 0" if (away or c.type == 5) else "type 3, l_o = 0"
+        column = "types 3 and 5, l_o != 0" if (away or kind == 5) else "type 3, l_o = 0"
     refs, kin, dyn, remedy = COLUMNS[column]
-    return Requirement(column, c.type, refs, framework, kin if framework == "kinematic" else dyn, remedy)
+    return Requirement(column, kind, refs, framework, kin if framework == "kinematic" else dyn, remedy, note)
+
+
+def _skid(robot: Robot) -> bool:
+    """A skid steer: fixed wheels on parallel, distinct axles (the admissible twists of a differential drive, which
+    ``wmrkit track`` gives it: :func:`.points.control_point`) and no other wheel but castors."""
+    if not any(w.type == "fixed" for w in robot.wheels) or any(
+            w.type not in ("fixed", "castor", "double_castor") for w in robot.wheels):
+        return False
+    try:
+        return control_point(robot).skid
+    except ControlError:
+        return False
 
 
 def _on_axle(robot: Robot, p: np.ndarray) -> bool:

@@ -298,10 +298,12 @@ def _stopped(err: StoppedRun, robot: Robot, reference: Reference, point: np.ndar
 def _feasibility(robot: Robot, reference: Reference, point: np.ndarray,
                  framework: Literal["kinematic", "dynamic"], end: float) -> Feasibility | None:
     """Table 8.1's verdict on `reference` for `robot` tracked at `point` ``(2,)`` [m, robot frame], its violations
-    up to `end` [s]; None for a degenerate robot (no column of the table)."""
-    from ..analysis.classification import classify
+    up to `end` [s]; None for a degenerate robot (no column of the table) other than a skid steer."""
+    from .feasibility import requirement
 
-    if classify(robot).type is None:
+    try:  # a skid steer is judged as the differential drive it drives as, as feasibility does
+        requirement(robot, framework, point=(float(point[0]), float(point[1])))
+    except ControlError:
         return None
     # the run's part, and a margin to judge its end: a 10 s run (4.2 s) of an 8.8e6-sample circle judged it all in 3.9 s
     stop = int(np.searchsorted(reference.t, end, side="right")) + 2 * BLOCK
