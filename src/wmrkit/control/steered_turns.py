@@ -56,6 +56,11 @@ def _steered_turns(robot: Robot, reference: Reference, point: tuple[float, float
     curve of radius 1 m at 2 m/s it turns by 0.0625 rad a sample at 32 Hz, over the floor, and a speed step there,
     which keeps every wheel's heading, was a 'velocity jump' in the kinematic framework of swerve-4). A wheel at rest
     on either side turns freely there."""
+    # a file's rates are central differences of its poses, its accelerations second ones: a step of another signal
+    # there spreads over 1 (2) samples on either side (the heading rate of a square's corner was 78 rad/s at the
+    # sample before it, whose wheel headings turned: a 'velocity jump' the exact square has not)
+    wide = 2 if rate else 1
+    before, after = np.maximum(before - wide, 0), np.minimum(after + wide, len(reference.t) - 1)
     (s0, x0), (s1, x1) = (_wheels(robot, reference, point, k, rate=rate) for k in (before, after))
     moving = (s0 > 1e-12) & (s1 > 1e-12)
     if rate:
