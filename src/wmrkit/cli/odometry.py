@@ -158,12 +158,12 @@ def run(args: argparse.Namespace) -> int:
         _warn_ill_conditioned(args.method, slip_model.model)
     names = parse_assignments(args.joint_name, "--joint-name")
     first = functools.cache(lambda: _first_samples(robot, args.log, fmt, args.sensed, args.topic, names))  # once
-    consistent = _check_consistency(summary, lambda: _wheel_slips(args.log, first),
+    consistent = _check_consistency(summary, lambda: _wheel_slips(first),
                                     filtered=args.method if args.method in ("fk1", "fk2") else None)
     if fmt.heading_column or fmt.gyro_column:
-        consistent = _check_heading(args.log, fmt, first) and consistent
-    consistent = _check_gears(robot, args.log, first) and consistent
-    _check_steering_steps(robot, args.log, args.sensed, first)  # the sampling, not the data: consistent as it is
+        consistent = _check_heading(fmt, first) and consistent
+    consistent = _check_gears(robot, first) and consistent
+    _check_steering_steps(robot, args.sensed, first)  # the sampling, not the data: consistent as it is
     if args.json:
         print_json(summary.to_dict() | {"consistent": consistent})
     else:
@@ -231,12 +231,11 @@ HEADING_RTOL = 0.8
 HEADING_MIN_TURN = 0.1
 
 
-def _check_heading(log: str, fmt: LogFormat, samples) -> bool:
+def _check_heading(fmt: LogFormat, samples) -> bool:
     """Warn (:func:`._common.warn`) when the external heading's turns contradict the wheels' over the first samples of
-    a CSV log (:data:`HEADING_RTOL`); return whether they did not. Its changes replace the wheels' dtheta, so a
-    heading in other units or of the other sign gave a wrong trajectory with "consistent": true."""
-    if is_bag(log):
-        return True
+    a CSV log (:data:`HEADING_RTOL`; a bag has no external heading: JointState only); return whether they did not.
+    Its changes replace the wheels' dtheta, so a heading in other units or of the other sign gave a wrong trajectory
+    with "consistent": true."""
     model, first = samples()
     wheels = model.from_positions(first.positions).column(2)
     external = np.diff(first.heading_world)
@@ -259,13 +258,13 @@ GEAR_RTOL = 0.1
 GEAR_MIN_TURN = 0.1
 
 
-def _check_gears(robot, log: str, samples) -> bool:
+def _check_gears(robot, samples) -> bool:
     """Warn (one line on stderr per gear) when the logged joints of a description's ``gear`` coupling do not turn
-    together at its ratios over the first samples of a CSV log (:data:`GEAR_RTOL`); return whether they all did.
-    Odometry reads each joint on its own: a log breaking the gear (another robot's, or a wrong description) was
-    integrated as a turn with "consistent": true."""
+    together at its ratios over the first samples of the log, CSV or bag (:data:`GEAR_RTOL`); return whether they
+    all did. Odometry reads each joint on its own: a log breaking the gear (another robot's, or a wrong
+    description) was integrated as a turn with "consistent": true."""
     gears = [c for c in robot.couplings if c.kind == "gear"]
-    if not gears or is_bag(log):
+    if not gears:
         return True
     model, first = samples()
     steps = np.diff(first.positions, axis=0)
@@ -287,7 +286,7 @@ def _check_gears(robot, log: str, samples) -> bool:
     return agrees
 
 
-def _check_steering_steps(robot, log: str, sensed, samples) -> None:
+def _check_steering_steps(robot, sensed, samples) -> None:
     """Warn (one line, :func:`wmrkit.odometry.steering.steering_step_warning`) where a sensed steering angle steps
     within one interval while its wheel rolls, over the first samples of the log (CSV or bag): the no-slip rows take
     the angle at mid-interval, so that interval's travel may be off its direction (a drive unit pivoting 90 deg
@@ -302,12 +301,10 @@ def _check_steering_steps(robot, log: str, sensed, samples) -> None:
         warn(message)
 
 
-def _wheel_slips(log: str, samples) -> dict[str, float]:
-    """The wheels' RMS slip [m per interval] over the first samples of a CSV log ({} for a bag)."""
+def _wheel_slips(samples) -> dict[str, float]:
+    """The wheels' RMS slip [m per interval] over the first samples of the log (CSV or bag)."""
     from ..odometry.model import wheel_slip
 
-    if is_bag(log):
-        return {}
     model, first = samples()
     return wheel_slip(model, first.positions)
 
