@@ -30,6 +30,12 @@ CONSTANT_TYPES = ("fixed", "swedish", "ball", "orthogonal")
 TWIST_STEERED_TYPES = ("steerable", "double")
 
 
+#: Round-off of a fixed wheel's lateral slip per unit of ``|vx| + |vy| + l |omega|`` (its row's entries are at most
+#: 1, 1 and its distance l; cos(pi/2) is 6e-17): a slip within it is 0. A 1 km robot turning at 1e6 rad/s (the
+#: documented limits) left 1.2e-7 m/s on a wheel rolling exactly along its path, over slip_tol: "not feasible".
+SLIP_ROUNDOFF = 8 * float(np.finfo(float).eps)
+
+
 @dataclass(frozen=True, eq=False)
 class Plan:
     """Read-only arrays of one robot for the batched per-wheel IK (eq=False: array fields)."""
@@ -41,6 +47,7 @@ class Plan:
     constant_rates: np.ndarray  # (3, n_rates): rates = twist @ constant_rates; zero columns for other wheels
     fixed_wheels: np.ndarray  # (n_f,) wheel indices of fixed wheels
     fixed_lateral: np.ndarray  # (3, n_f): lateral slip = twist @ fixed_lateral (3.11 row 0 / 8.14) [m/s]
+    fixed_roundoff: np.ndarray  # (3, n_f): |twist| @ fixed_roundoff bounds that slip's round-off [m/s]
     steered_beta: np.ndarray  # (n_o,) index into beta of the twist-steered wheels
     steered_x: np.ndarray  # (n_o,) steering-axis position [m]
     steered_y: np.ndarray
@@ -128,6 +135,8 @@ def plan(robot: Robot) -> Plan:
         n_wheels=n, n_rates=len(col), n_steer=len(steer_names), constant_rates=readonly(constant),
         has_constant=any(w.type in CONSTANT_TYPES for w in robot.wheels),
         fixed_wheels=ints(fixed), fixed_lateral=readonly(np.array(lateral, dtype=float).reshape(-1, 3).T.copy()),
+        fixed_roundoff=readonly(SLIP_ROUNDOFF * np.array([[1.0, 1.0, robot.wheels[i].l] for i in fixed],
+                                                         dtype=float).reshape(-1, 3).T.copy()),
         steered_beta=ints(steered_beta), steered_x=floats(sx), steered_y=floats(sy),
         steered_spin_col=ints(spin_cols), steered_spin_of=ints(spin_of), steered_inv_r=floats(inv_r),
         element_beta=ints(e_beta), element_params=tuple(readonly(p.copy()) for p in params),

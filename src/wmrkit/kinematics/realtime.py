@@ -104,6 +104,7 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
     n_rates, n_steer = p.n_rates, p.n_steer
     constant = np.ascontiguousarray(p.constant_rates, dtype=float) if p.has_constant else np.zeros((3, n_rates))
     lateral = np.ascontiguousarray(p.fixed_lateral, dtype=float)
+    roundoff = np.ascontiguousarray(p.fixed_roundoff, dtype=float)
     n_fixed = lateral.shape[1]
     steered_beta, sx, sy = p.steered_beta.copy(), p.steered_x.copy(), p.steered_y.copy()
     n_o = len(sx)
@@ -188,7 +189,8 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
         feasible = True
         for f in range(n_fixed):
             slip = vx * lateral[0, f] + vy * lateral[1, f] + w * lateral[2, f]
-            if abs(slip) > slip_tol:
+            if abs(slip) > slip_tol and abs(slip) > (abs(vx) * roundoff[0, f] + abs(vy) * roundoff[1, f]
+                                                     + abs(w) * roundoff[2, f]):  # not round-off (wheel_commands)
                 feasible = False
         for k in range(n_steer):
             beta[k] = wrap(beta[k] + delta[k] - HALF_PI)

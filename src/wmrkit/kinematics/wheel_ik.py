@@ -48,7 +48,8 @@ class WheelCommands:
     - ``steer_rate`` ``(..., N)`` [rad/s]: castors (8.24), double castors; 0 for double wheels (angle held
       relative to the body); NaN where the twist alone does not define it (steerable) or there is no joint.
     - ``rates`` ``(..., n_rates)``: every joint rate in ``robot.rate_names`` order (rollers, ``spin1``/``spin2``).
-    - ``slip`` ``(..., N)`` [m/s]: lateral slip (3.11) row 0 / (8.14) left at each fixed wheel, 0 elsewhere.
+    - ``slip`` ``(..., N)`` [m/s]: lateral slip (3.11) row 0 / (8.14) left at each fixed wheel, 0 elsewhere and
+      where it is round-off (``_ik_fast.SLIP_ROUNDOFF``).
     - ``feasible`` ``(...)`` bool: every ``|slip| <= slip_tol``, every heading within its wheel's ``steer_range``
       and every gear coupling's rates in its ratios (``in_gear``).
     - ``in_range`` ``(..., N)`` bool: the wheel's heading lies in its ``steer_range`` (True for wheels without one,
@@ -158,7 +159,8 @@ def wheel_commands(
         feasible = np.broadcast_to(True, batch)
     else:
         slip = np.zeros((*batch, n))
-        slip[..., p.fixed_wheels] = twist @ p.fixed_lateral
+        lateral = twist @ p.fixed_lateral
+        slip[..., p.fixed_wheels] = np.where(np.abs(lateral) <= np.abs(twist) @ p.fixed_roundoff, 0.0, lateral)
         feasible = np.all(np.abs(slip) <= slip_tol, axis=-1)
     steer = _steer_columns(p, config, batch, n)
     heading = heading_from_beta(steer, p.wheel_delta)
