@@ -1,6 +1,7 @@
 """Odometry invariants over random robots (tests/strategies.py) with every joint sensed, driven along an arc (one
 constant twist, which the robot's fixed wheels allow) by :func:`simulate`: the exact scheme recovers the synthetic
-poses, the chunk size changes nothing, and the log played backwards from the end pose retraces the path."""
+poses, the chunk size changes nothing, and the log played backwards from the end pose retraces the path; a program
+of whole sample periods is recorded at the samples' own times (poses composed segment by segment in the test)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,8 @@ import numpy as np
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from strategies import robots
+from strategies import robots, wheels
+from wmrkit import Robot, catalog
 from wmrkit.errors import WmrkitError
 from wmrkit.odometry import JointLog, SensingError, TwistProfile, odometry, odometry_model, simulate
 
@@ -69,3 +71,62 @@ def test_the_log_played_backwards_from_the_end_retraces_the_path(robot, raw):
         np.testing.assert_allclose(backward.poses[::-1], forward.poses, atol=1e-12 * (1 + np.abs(forward.poses).max()),
                                    err_msg=method)
         np.testing.assert_allclose(backward.slip[1:], forward.slip[1:][::-1], atol=1e-12, err_msg=method)
+
+
+def _pose_after(pose, twist, t):
+    """`pose` moved by the constant body `twist` for `t` seconds: the exact SE(2) exponential, written here."""
+    x, y, th = pose
+    vx, vy, w = np.asarray(twist, float) * t
+    if abs(w) < 1e-12:
+        dx, dy = vx, vy
+    else:
+        s, c = math.sin(w) / w, (1 - math.cos(w)) / w
+        dx, dy = s * vx - c * vy, c * vx + s * vy
+    return np.array([x + math.cos(th) * dx - math.sin(th) * dy, y + math.sin(th) * dx + math.cos(th) * dy, th + w])
+
+
+def test_a_straight_run_is_recorded_at_the_samples_own_times():
+    """1 m/s straight ahead at 5 Hz: the pose at t is x = t and each wheel has turned t / r. The fine grid of 8
+    steps a sample put 8k / 40 s (rounded below k / 5) before the sample time, so samples 1, 2, 4, 5, 8-11 read the
+    run one fine step late (x = 0.225 m at 0.2 s) and the log's joints with them."""
+    robot = catalog.load("diff-drive")
+    run = simulate(robot, TwistProfile(np.array([2.4]), np.array([[1.0, 0.0, 0.0]])), 5.0)
+    np.testing.assert_allclose(run.truth[:, 0], run.log.time, atol=1e-12)
+    np.testing.assert_allclose(run.log.positions, run.log.time[:, None] / 0.075 * [1.0, 1.0], atol=1e-12)
+
+
+@st.composite
+def _rollers_only(draw):
+    """Random robots of 1-4 wheels that never steer (fixed, Swedish, ball, orthogonal), every joint sensed."""
+    n = draw(st.integers(1, 4))
+    kinds = st.sampled_from(["fixed", "swedish", "ball", "orthogonal"])
+    return Robot("r", tuple(replace(w, sensed=w.kind.joints)
+                            for w in (draw(wheels(draw(kinds), name=f"w{i}")) for i in range(n))))
+
+
+@settings(max_examples=20)
+@given(robot=_rollers_only(), rate=st.sampled_from([3.0, 5.0, 10.0, 20.0, 30.0]),
+       pose0=st.tuples(st.floats(-3, 3), st.floats(-3, 3), st.floats(-3, 3)),
+       segments=st.lists(st.tuples(st.integers(1, 10), st.lists(st.floats(-1, 1), min_size=3, max_size=3)),
+                         min_size=1, max_size=4))
+def test_a_program_of_whole_sample_periods_is_recorded_at_the_sample_times(robot, rate, pose0, segments):
+    """Segments of whole sample periods (twists projected onto those the fixed wheels allow): each sample's true
+    pose is the segments composed up to its time, and the exact scheme recovers it from the log (the twist is
+    constant over every interval, no wheel steers)."""
+    rows = np.array([[math.cos(w.beta), math.sin(w.beta), w.l * math.sin(w.beta - w.alpha)]
+                     for w in robot.wheels if w.type == "fixed"]).reshape(-1, 3)
+    twists = np.array([s[1] for s in segments])
+    twists = twists - (twists @ (np.linalg.pinv(rows) @ rows).T if len(rows) else 0.0)
+    periods = [s[0] for s in segments]
+    try:
+        run = simulate(robot, TwistProfile(np.array(periods) / rate, twists), rate, pose0=pose0)
+        got = odometry(odometry_model(robot), run.log, method="exact", pose0=pose0)
+    except (SensingError, WmrkitError):  # the sensed joints do not determine the twist
+        assume(False)
+    want = [np.array(pose0, float)]
+    for k, twist in zip(periods, twists, strict=True):
+        for _ in range(k):
+            want.append(_pose_after(want[-1], twist, 1 / rate))
+    scale = 1 + np.abs(want).max()
+    np.testing.assert_allclose(run.truth, want, atol=1e-12 * scale * len(want))
+    np.testing.assert_allclose(got.poses, want, atol=1e-12 * scale * len(want))

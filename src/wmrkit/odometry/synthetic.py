@@ -176,7 +176,10 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     if t_samples[-1] > profile.duration:  # the robot rests from the profile's end to the last sample
         profile = TwistProfile(np.append(profile.durations, t_samples[-1] - profile.duration),
                                np.vstack([profile.twists, np.zeros(3)]))
-    fine = np.union1d(np.linspace(0.0, t_samples[-1], (n - 1) * oversample + 1),
+    # every sample time itself a fine node (a linspace's 8k / 40 s fell below k / 5 s, and the sample read the node
+    # after it, one fine step late), each sample period cut into `oversample` steps
+    steps = t_samples[:-1, None] + np.diff(t_samples)[:, None] * (np.arange(oversample) / oversample)
+    fine = np.union1d(np.append(steps.reshape(-1), t_samples[-1]),
                       profile.boundaries[profile.boundaries <= t_samples[-1]])
     sample_idx = np.searchsorted(fine, t_samples)
     dt = np.diff(fine)
