@@ -4,7 +4,8 @@ State: the body twist ``x = (vx, vy, omega)``, a random walk (7.68) with process
 sample. Measurements: the no-slip rows (3.22) that hold only the twist and sensed rates,
 ``A_p x = -A_a qdot_a`` (the rows (7.69)/(7.70): a wheel's rolling row is a wheel-speed reading, a lateral row a
 pseudo-measurement with the steering angle inside ``C``), with noise ``R = diag(sigma^2)`` per row. Rows with an
-unsensed wheel rate (the steered wheel's free spin) are left out.
+unknown wheel rate (the steered wheel's free spin) are left out; a ``gear``'s unsensed joint is known from its
+sensed ones (``A_a`` maps the sensed rates through the odometry model's ``fill``, as odometry and ``fk`` use it).
 
 - **FK2** (7.70): every such row. The thesis merges the two identical lateral rows of the forklift's drive wheels
   into one of standard deviation ``k16``; kept apart, each has ``sqrt(2) k16``.
@@ -102,9 +103,9 @@ class KalmanModel:
     def matrices(self, beta_full: np.ndarray) -> tuple[np.ndarray, ...]:
         """``(H, M, C, A_a)`` per configuration ``(U, n_steer) -> (U, 3, 3), (U, 3, n_a), (U, m, 3), (U, m, n_a)``,
         ``H`` and ``M`` per unit of process variance (``R`` divided by ``Q``, see :func:`_run`)."""
-        a = self.odometry.robot.constraint_matrix(beta_full)[..., self.rows, :]
-        cols = np.array([self.odometry.robot.velocity_index(j) for j in self.odometry.rate_joints], dtype=int)
-        c, aa = a[..., :3], a[..., cols]
+        om = self.odometry
+        a = om.robot.constraint_matrix(beta_full)[..., self.rows, :]
+        c, aa = a[..., :3], a[..., known_columns(om)] @ om.fill  # a gear's unsensed joints: from the sensed rates
         ct_r = np.swapaxes(c, -1, -2) / self.relative_variances
         return ct_r @ c, -(ct_r @ aa), np.ascontiguousarray(c), np.ascontiguousarray(aa)
 
@@ -176,8 +177,7 @@ def kalman_model(robot: Robot, kind: str = "fk2", noise: KalmanNoise | None = No
     rng = np.random.default_rng(0)
     probe = np.vstack([robot.beta, robot.beta + rng.uniform(-1, 1, (3, len(robot.beta)))])
     a = robot.constraint_matrix(probe)
-    rate_cols = np.array([robot.velocity_index(j) for j in base.rate_joints], dtype=int)
-    unsensed = np.setdiff1d(np.arange(3, a.shape[-1]), rate_cols)
+    unsensed = np.setdiff1d(np.arange(3, a.shape[-1]), known_columns(base))
     rows, sigma, row = [], [], 0
     for w in robot.wheels:
         lat, lon = noise.of_wheel(w.name)
@@ -196,6 +196,12 @@ def kalman_model(robot: Robot, kind: str = "fk2", noise: KalmanNoise | None = No
         dropped = " (fk1 leaves out the lateral rows of fixed wheels, (7.69): use fk2)" if kind == "fk1" else ""
         raise WmrkitError(f"{kind}: the sensed rows of robot '{robot.name}' do not determine its twist{dropped}")
     return KalmanModel(base, rows_a, np.array(sigma), float(noise.process) ** 2, thesis_double_q)
+
+
+def known_columns(model: OdometryModel) -> np.ndarray:
+    """The velocity columns of the joint rates `model` knows: the sensed ones, then those a gear turns with them
+    (``model.fill`` maps the sensed rates onto them)."""
+    return model.cols[model.assigned]
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields

@@ -1,0 +1,76 @@
+"""The velocity filters FK1/FK2 know a ``gear``'s unsensed joints from its sensed ones, as odometry and ``fk`` do
+(``OdometryModel.fill``): on slip-free logs of constant twist they give the exact poses, as WLS does
+(tests/slip/test_odometry.py mirrors this for catalog robots). The truth: ``simulate``'s poses, and the closed form
+of a differential axle ``vx = r (q_l + q_r) / 2``, ``omega = r (q_r - q_l) / (2 b)``, ``q_r = ratio q_l``."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from wmrkit import Robot
+from wmrkit.cli.main import main
+from wmrkit.errors import WmrkitError
+from wmrkit.odometry.pipeline import odometry
+from wmrkit.odometry.synthetic import TwistProfile, simulate
+from wmrkit.slip.estimators import estimator
+from wmrkit.slip.kalman import kalman_model
+
+R, B = 0.075, 0.2
+AXLE = """name: geared-axle
+wheels:
+  - {name: left, type: fixed, position: [0, 0.2], heading: 0, r: 0.075, actuated: [spin], sensed: [spin]}
+  - {name: right, type: fixed, position: [0, -0.2], heading: 0, r: 0.075}
+  - {name: FRONT
+couplings:
+  - {kind: gear, joints: [left.spin, right.spin], ratios: [1, RATIO]}
+"""
+CASTOR = "caster, type: castor, position: [-0.25, 0], heading: 0, d: 0.04, r: 0.025}"
+STEERED = "front, type: steerable, position: [0.6, 0], heading: 0, r: 0.1, sensed: [steer]}"
+
+
+def cart(tmp_path, ratio: float, front: str = CASTOR) -> tuple:
+    path = tmp_path / "cart.yaml"
+    path.write_text(AXLE.replace("RATIO", repr(ratio)).replace("FRONT", front))
+    return path, Robot.from_file(path)
+
+
+def twist_of(rate: float, ratio: float) -> np.ndarray:
+    return np.array([R * (1 + ratio) * rate / 2, 0.0, R * (ratio - 1) * rate / (2 * B)])
+
+
+@pytest.mark.parametrize(("kind", "front", "ratio"), [
+    pytest.param("fk2", CASTOR, 1.0, id="fk2-castor-1"), pytest.param("fk2", CASTOR, 2.0, id="fk2-castor-2"),
+    pytest.param("fk2", CASTOR, -0.5, id="fk2-castor--0.5"), pytest.param("fk1", STEERED, 1.5, id="fk1-steered-1.5"),
+    pytest.param("fk2", STEERED, 1.5, id="fk2-steered-1.5")])
+def test_a_filter_on_a_geared_axle_is_exact_without_slip(tmp_path, kind, front, ratio):
+    """Before: 'fk2: the sensed rows of robot 'geared-axle' do not determine its twist' (the right wheel's rows were
+    left out, its spin unsensed); FK1 with a steered front wheel, whose lateral row it keeps, the same ('use fk2')."""
+    _, robot = cart(tmp_path, ratio, front)
+    run = simulate(robot, TwistProfile.from_segments([(3.0, *twist_of(8.0, ratio))]), 20.0)
+    assert run.log.joints[0] == "left.spin" and "right.spin" not in run.log.joints
+    poses = estimator(robot, kind).run([run.log]).final_pose
+    np.testing.assert_allclose(poses, run.truth[-1], atol=1e-9)
+    np.testing.assert_allclose(poses, odometry(robot, run.log).poses[-1], atol=1e-9)
+
+
+def test_fk1_still_needs_a_lateral_row(tmp_path):
+    """With the castor (no row without an unknown rate) FK1 keeps the two rolling rows only: vy is not measured,
+    as on a differential drive, and it says so."""
+    _, robot = cart(tmp_path, 1.0)
+    with pytest.raises(WmrkitError, match=r"fk1: the sensed rows .* do not determine its twist.*use fk2"):
+        kalman_model(robot, "fk1")
+
+
+def test_odometry_cli_fk2_on_a_solid_axle_with_one_encoder(tmp_path, capsys):
+    """`wmrkit odometry cart.yaml log.csv --method fk2` exited 2 before; now 10 rad of the left spin in 1 s move the
+    cart 10 r = 0.75 m straight ahead, as --method wls prints."""
+    path, _ = cart(tmp_path, 1.0)
+    log = tmp_path / "log.csv"
+    log.write_text("time,left.spin\n" + "".join(f"{t / 10:.1f},{t}\n" for t in range(11)))
+    assert main(["odometry", str(path), str(log), "--method", "fk2", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    np.testing.assert_allclose(out["final_pose"], [10 * R, 0, 0], atol=1e-12)
+    assert out["warnings"] == []
