@@ -217,3 +217,44 @@ def steering_mechanisms(couplings: tuple[Coupling, ...], steered: list[str] | tu
         linked = [groups[w] for w in (j.partition(".")[0] for j in c.joints) if w in groups]
         groups = {w: (linked[0] if g in linked else g) for w, g in groups.items()}
     return len(set(groups.values()))
+
+
+#: A gear's joints (``q_j = ratio_j * u``) contradict it when their ``u_j = q_j / ratio_j`` differ, summed over the
+#: rows, by more than this fraction of the largest ``|u_j|`` summed (backlash and encoder noise stay well within it):
+#: ``odometry`` judges a log's first intervals by it, ``fk`` its given rates.
+GEAR_BREACH_RTOL = 0.1
+
+
+@dataclass(frozen=True, slots=True)
+class GearBreach:
+    """A gear whose given joints (positions `given` in the names checked) turn `spread` apart (see
+    :data:`GEAR_BREACH_RTOL`)."""
+
+    coupling: Coupling
+    given: tuple[int, ...]
+    spread: float
+
+    @property
+    def head(self) -> str:
+        """The start of a warning naming the coupling and its ratios."""
+        ratios = ", ".join(f"{k:g}" for k in self.coupling.ratios)
+        return f"the joints of {self.coupling.channel_name} (ratios {ratios}) do not turn together"
+
+
+def gear_breaches(couplings: tuple[Coupling, ...], names: tuple[str, ...], q: np.ndarray,
+                  least: float = 0.0) -> list[GearBreach]:
+    """The ``gear`` couplings with two or more of `names` whose rates or increments `q` ``(N, len(names))`` (or one
+    row) break their ratios beyond :data:`GEAR_BREACH_RTOL`; a gear whose summed ``|u|`` is below `least` is not
+    judged (too little turning to tell)."""
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    out = []
+    for gear in (c for c in couplings if c.kind == "gear"):
+        read = [(names.index(j), k) for j, k in zip(gear.joints, gear.ratios, strict=True) if j in names]
+        if len(read) < 2:
+            continue
+        u = np.column_stack([q[:, i] / k for i, k in read])  # (N, joints): the gear's input by each joint
+        scale = float(np.abs(u).max(axis=1).sum())
+        off = float((u.max(axis=1) - u.min(axis=1)).sum())
+        if scale >= least and off > GEAR_BREACH_RTOL * scale:
+            out.append(GearBreach(gear, tuple(i for i, _ in read), off / scale))
+    return out

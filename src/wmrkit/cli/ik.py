@@ -7,9 +7,16 @@ import math
 
 import numpy as np
 
+from ..couplings import gear_breaches
 from ..description import described_type
 from ..errors import WmrkitError
-from ..kinematics.wheel_ik import WheelCommands, forward_kinematics_check, twist_is_determined, wheel_commands
+from ..kinematics.wheel_ik import (
+    WheelCommands,
+    forward_kinematics_check,
+    resolve_rate_name,
+    twist_is_determined,
+    wheel_commands,
+)
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from ..units import UnitError, parse_quantity
@@ -81,6 +88,7 @@ def run_fk(args: argparse.Namespace) -> int:
     twist, determined = fk.twist, bool(twist_is_determined(robot, list(rates)))
     if not determined:
         warn(f"these rates do not determine the twist of robot '{robot.name}'; printing the minimum-norm one")
+    consistent = fk.consistent and _check_gears(robot, rates)
     if not fk.consistent:
         names = fk.slipping or [robot.wheel_names[i] for i in np.argsort(-fk.wheel_slip) if fk.wheel_slip[i] > 0]
         worst = ", ".join(f"{n} {fk.wheel_slip[robot.wheel_names.index(n)]:.3g} m/s" for n in names)
@@ -88,12 +96,26 @@ def run_fk(args: argparse.Namespace) -> int:
              f"tolerance {fk.tolerance:.3g} m/s); check units, signs and --steer headings")
     if args.json:
         print_json({"robot": robot.name, "twist": twist.tolist(), "determined": determined, "residual": fk.residual,
-                    "consistent": fk.consistent, "slipping": list(fk.slipping)})
+                    "consistent": consistent, "slipping": list(fk.slipping)})
     else:
         vx, vy, omega = (_num(v) for v in twist)
         print(f"twist (robot frame): vx = {vx} m/s, vy = {vy} m/s, omega = {omega} rad/s")
-        print(f"residual (slip norm): {fk.residual:.3g} m/s ({'consistent' if fk.consistent else 'INCONSISTENT'})")
+        print(f"residual (slip norm): {fk.residual:.3g} m/s ({'consistent' if consistent else 'INCONSISTENT'})")
     return 0
+
+
+def _check_gears(robot: Robot, rates: dict[str, float]) -> bool:
+    """Warn (one line per gear, as ``odometry`` does for a log) when given rates of a ``gear`` coupling's joints break
+    its ratios (:func:`wmrkit.couplings.gear_breaches`): each is used as given, so no slip shows it; return whether
+    none did."""
+    names = tuple(robot.velocity_names[resolve_rate_name(robot, n)] for n in rates)
+    values = np.array(list(rates.values()), dtype=float)
+    breaches = gear_breaches(robot.couplings, names, values)
+    for b in breaches:
+        given = ", ".join(f"{names[i]} {values[i]:.4g}" for i in b.given)
+        warn(f"{b.head} ({given} rad/s; {b.spread:.0%} apart): the rates contradict the description's gear (each is "
+             "used as given); check the rates or the gear")
+    return not breaches
 
 
 def _finite(text: str) -> float:

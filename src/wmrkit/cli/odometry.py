@@ -11,6 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..couplings import gear_breaches
 from ..errors import WmrkitError
 from ..limits import check_chunk_size
 from ..odometry.covariance import CrowleyNoise
@@ -251,39 +252,25 @@ def _check_heading(fmt: LogFormat, samples) -> bool:
     return False
 
 
-#: A gear coupling's joints (q_j = ratio_j * u) contradict it when their u_j differ, interval by interval over the
-#: first samples, by more than this fraction of the largest (backlash and encoder noise stay well within it).
-GEAR_RTOL = 0.1
-#: Least turning [rad] of a gear's u over the first samples for that comparison.
+#: Least turning [rad] of a gear's u over the first samples for its check (couplings.gear_breaches).
 GEAR_MIN_TURN = 0.1
 
 
 def _check_gears(robot, samples) -> bool:
     """Warn (one line on stderr per gear) when the logged joints of a description's ``gear`` coupling do not turn
-    together at its ratios over the first samples of the log, CSV or bag (:data:`GEAR_RTOL`); return whether they
-    all did. Odometry reads each joint on its own: a log breaking the gear (another robot's, or a wrong
-    description) was integrated as a turn with "consistent": true."""
-    gears = [c for c in robot.couplings if c.kind == "gear"]
-    if not gears:
+    together at its ratios over the first samples of the log, CSV or bag (:func:`wmrkit.couplings.gear_breaches`);
+    return whether they all did. Odometry reads each joint on its own: a log breaking the gear (another robot's, or a
+    wrong description) was integrated as a turn with "consistent": true."""
+    if not any(c.kind == "gear" for c in robot.couplings):
         return True
     model, first = samples()
     steps = np.diff(first.positions, axis=0)
-    agrees = True
-    for gear in gears:
-        read = [(model.joints.index(j), k) for j, k in zip(gear.joints, gear.ratios, strict=True) if j in model.joints]
-        if len(read) < 2:
-            continue
-        u = np.column_stack([steps[:, i] / k for i, k in read])  # (N - 1, joints): the gear's input by each joint
-        scale = float(np.abs(u).max(axis=1).sum())
-        off = float((u.max(axis=1) - u.min(axis=1)).sum())
-        if scale < GEAR_MIN_TURN or off <= GEAR_RTOL * scale:
-            continue
-        agrees = False
-        turns = ", ".join(f"{model.joints[i]} {steps[:, i].sum():.4g} rad" for i, _ in read)
-        warn(f"the joints of {gear.channel_name} (ratios {', '.join(f'{k:g}' for k in gear.ratios)}) do not turn "
-             f"together over the first {len(first)} samples ({turns}; {off / scale:.0%} apart interval by interval): "
+    breaches = gear_breaches(robot.couplings, model.joints, steps, GEAR_MIN_TURN)
+    for b in breaches:
+        turns = ", ".join(f"{model.joints[i]} {steps[:, i].sum():.4g} rad" for i in b.given)
+        warn(f"{b.head} over the first {len(first)} samples ({turns}; {b.spread:.0%} apart interval by interval): "
              "the log is not of this robot, or its description's gear is wrong")
-    return agrees
+    return not breaches
 
 
 def _check_steering_steps(robot, sensed, samples) -> None:
