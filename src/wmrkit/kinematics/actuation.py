@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, matvec, readonly
-from ..couplings import coupled_columns, linked_steering
+from ..couplings import coupled_columns, gear_fill, linked_steering
 from ..robot import TWIST_NAMES, Robot
 from .linalg import delta_projector, matrix_rank, nondimensional
 from .models import bounded, configuration, mobility
@@ -257,20 +257,23 @@ def selectable_rates(robot: Robot) -> list[int]:
 
 
 def minimal_set_search(robot: Robot, beta: np.ndarray, size: int, wanted: str, what: str, *,
-                       drive_all: bool = False) -> SetList:
+                       drive_all: bool = False, gears: bool = False) -> SetList:
     """The sets of `size` selectable rates whose tree (4.28)/(4.34) is `wanted` with rank 3 at every
     configuration (and, `drive_all`, no motion left with them at rest: :func:`undriven_motions`): a bounded search
     (:mod:`.search`) pruned by the null-space test when ``size`` is the mobility (then the rates must be an
-    assignable set of the direct model), listing at most MAX_MINIMAL_SETS."""
+    assignable set of the direct model), listing at most MAX_MINIMAL_SETS. `gears`: a set's rates give those a
+    gear turns with them (:func:`wmrkit.couplings.gear_fill`, as the sensing analysis reads sensors), and the
+    null-space test is on the motions the gears allow (:func:`coupled_constraints`)."""
     def exact(sel: np.ndarray) -> np.ndarray:
-        i_bar, j_sel, j_rest = _split_sets(robot, beta, sel)
+        i_bar, j_sel, j_rest, zeroed = _split_sets(robot, beta, sel, gears)
         tree = eliminated_tree(i_bar, j_sel, j_rest)
         ok = (tree.leaf == wanted) & (tree.rank_a == 3)
-        if drive_all:
-            ok &= undriven_motions(i_bar, j_rest) == 0
+        if drive_all:  # a zeroed (filled) column of j_rest adds one to the nullity, no motion
+            ok &= undriven_motions(i_bar, j_rest) == zeroed.reshape(len(sel), *(1,) * (ok.ndim - 1))
         return ok.reshape(len(sel), -1).all(axis=1)
 
-    a = nondimensional(robot).constraint_matrix(beta)
+    unit = nondimensional(robot)
+    a = coupled_constraints(unit, beta) if gears else unit.constraint_matrix(beta)
     m = np.unique(a.shape[-1] - matrix_rank(a))
     prefilter = null_space_prefilter(a, size, offset=3) if len(m) == 1 and m[0] == size else None
     sets, complete, note = search_sets(selectable_rates(robot), size, exact, prefilter=prefilter,
@@ -282,17 +285,34 @@ def minimal_set_search(robot: Robot, beta: np.ndarray, size: int, wanted: str, w
 
 def trees_of(robot: Robot, beta: np.ndarray, sel: np.ndarray) -> TreeVerdict:
     """The trees (4.28)/(4.34) of the sets of rate columns `sel` ``(S, size)``: leaves ``(S, ...)``."""
-    return eliminated_tree(*_split_sets(robot, beta, sel))
+    return eliminated_tree(*_split_sets(robot, beta, sel)[:3])
 
 
-def _split_sets(robot: Robot, beta: np.ndarray, sel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(I_bar, J_sel, J_rest)`` of the nondimensional Jacobian form split by each set of columns `sel`
-    ``(S, size)``: ``(3E, 3), (S, ..., 3E, size), (S, ..., 3E, n_w - size)``."""
-    n_w = len(jacobian_names(robot))
+def _split_sets(robot: Robot, beta: np.ndarray, sel: np.ndarray,
+                gears: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(I_bar, J_sel, J_rest, zeroed)`` of the nondimensional Jacobian form split by each set of columns `sel`
+    ``(S, size)``: ``(3E, 3), (S, ..., 3E, size), (S, ..., 3E, n_w - size), (S,)``. With `gears`, the joints a gear
+    turns with a set's rates are known (:func:`wmrkit.couplings.gear_fill`): ``J_sel = J G`` with ``q = G q_sel``
+    on the known columns, and their columns of ``J_rest`` are zero (the same projector ``Delta(J_rest)``; `zeroed`
+    counts them per set)."""
+    names = jacobian_names(robot)
+    n_w, size = len(names), sel.shape[1]
     i_bar, j = nondimensional(robot).jacobian_form(beta)
     rest = np.array([[c for c in range(n_w) if c not in s] for s in sel.tolist()], dtype=int).reshape(
-        len(sel), n_w - sel.shape[1])
-    return i_bar, np.moveaxis(j[..., sel], -2, 0), np.moveaxis(j[..., rest], -2, 0)  # (..., 3E, S, k) -> (S, ...)
+        len(sel), n_w - size)
+    j_sel, j_rest = np.moveaxis(j[..., sel], -2, 0), np.moveaxis(j[..., rest], -2, 0)  # (..., 3E, S, k) -> (S, ...)
+    zeroed = np.zeros(len(sel), dtype=int)
+    if not gears or not any(c.kind == "gear" for c in robot.couplings):
+        return i_bar, j_sel, j_rest, zeroed
+    g, known = np.zeros((len(sel), n_w, size)), np.zeros((len(sel), n_w), dtype=bool)
+    for i, s in enumerate(sel.tolist()):
+        filled, fill = gear_fill(robot.couplings, names, tuple(s))
+        g[i, list(filled)], known[i, list(filled)] = fill, True
+    zeroed = known.sum(axis=1) - size
+    keep = ~np.take_along_axis(known, rest, axis=1)  # (S, n_w - size)
+    j_sel = np.einsum("...rn,snk->s...rk", j, g)
+    j_rest = j_rest * keep.reshape(len(sel), *(1,) * (j_rest.ndim - 2), n_w - size)
+    return i_bar, j_sel, j_rest, zeroed
 
 
 def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None, *,

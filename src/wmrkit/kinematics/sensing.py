@@ -20,7 +20,7 @@ from ..couplings import gear_fill
 from ..robot import TWIST_NAMES, Robot
 from .actuation import body_only, coupled_constraints, minimal_set_search, split_jacobian, steering_split, verdict_texts
 from .linalg import delta_projector, matrix_rank, nondimensional
-from .models import bounded, configuration, mobility
+from .models import bounded, configuration
 from .search import SetList
 from .trees import (
     TreeVerdict,
@@ -217,14 +217,15 @@ def minimal_sensor_sets(
     (thesis) or `heading` (0 = rolling forward), default as described.
     """
     beta = configuration(robot, beta, heading)
-    m = np.unique(mobility(robot, beta))
+    a = coupled_constraints(nondimensional(robot), beta)  # m counts a gear's motions, as sensing_analysis does
+    m = np.unique(a.shape[-1] - matrix_rank(a))
     if len(m) != 1 or m[0] == 0:
         return SetList()
     names, steer = jacobian_names(robot), tuple(f"{w}.steer" for w in steering_split(robot, ()))
     wanted = "overdetermined" if detect_slip else "determined"
     sizes = range(int(m[0]) + 1, len(robot.rate_names) + 1) if detect_slip else (int(m[0]),)
     for size in sizes:  # bounded searches (.search), pruned by the null-space test at size m
-        found = minimal_set_search(robot, beta, size, wanted, "minimal sensor sets", drive_all=True)
+        found = minimal_set_search(robot, beta, size, wanted, "minimal sensor sets", drive_all=True, gears=True)
         if found or not found.complete:
             return SetList([tuple(names[c] for c in s) + steer for s in found], found.complete, found.note)
     return SetList()
