@@ -124,11 +124,13 @@ def _summary_table(a: Analysis) -> str:
         ("degree of mobility m (5.13)", f"{c.mobility}" if a.instantaneous_mobility == c.mobility else
          f"{c.mobility}; {a.instantaneous_mobility} at the described steering (a special configuration)"),
         ("degree of steerability d (5.14)", c.steerability),
+        ("steerability its steering linkages command", c.commanded_steerability),
+        ("mobility with its gear couplings", a.coupled_mobility),
         ("actuation (ch. 4)", f"{actuation_words(a.actuation)}: {a.actuation['verdict']}"),
         ("sensing (ch. 4)", f"{'sufficient' if a.sensing['sufficient'] else 'insufficient'}: {a.sensing['verdict']}"),
     ]
-    if c.mobility <= 1:
-        rows.append(("isotropy (5.28)", f"does not apply (m = {c.mobility}: no two motions to balance)"))
+    if (note := a.isotropy_note()) is not None:
+        rows.append(("isotropy (5.28)", note))
     else:
         kappa = (f"{a.condition_number:.4g}" if math.isfinite(a.condition_number)
                  else "infinite (these joints do not determine the twist)")
@@ -156,6 +158,8 @@ def _isotropy_section(a: Analysis, out: Path, resolution: int, dpi: float | None
     if c.mobility <= 1:
         return _section("Isotropy", text + " With one degree of mobility every relation is scalar: κ = 1 wherever "
                         "the model exists (thesis §5.5.4-5.5.5); see the singularities below.", "")
+    if a.gear_mobility is not None:
+        return _section("Isotropy", text + f" Its gear couplings: isotropy {a.isotropy_note()}.", "")
     body = ""
     fig = length_figure(r, a.joints)
     if fig is not None:

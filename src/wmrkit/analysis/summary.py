@@ -43,13 +43,17 @@ class Analysis:
     characteristic_length: float
     natural: bool  # the length is the natural one (not given)
     singular: dict[str, SingularSet]  # "actuated", "sensed"
+    #: m at the described steering with the motions a gear coupling forbids removed (the actuation and sensing
+    #: verdicts' m, as fk and odometry use a gear); the type line's m is the thesis's, of the wheels alone
+    coupled_mobility: int
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary (SI units, radians); the keys of ``wmrkit analyze --json``."""
         c = self.classification
         return {
             "robot": self.robot.name,
-            "mobility": c.mobility, "steerability": c.steerability, "commanded_steerability": c.commanded_steerability,
+            "mobility": c.mobility, "coupled_mobility": self.coupled_mobility,
+            "steerability": c.steerability, "commanded_steerability": c.commanded_steerability,
             "type": c.type, "type_name": c.name,
             "degenerate": c.degenerate, "reasons": list(c.reasons), "coordinated_steering": c.coordinated,
             "instantaneous_mobility": self.instantaneous_mobility,
@@ -58,7 +62,7 @@ class Analysis:
             "icr": self.icr.describe(),
             "actuation": {k: self.actuation[k] for k in ("consistent", "sufficient", "verdict")},
             "sensing": {k: self.sensing[k] for k in ("sufficient", "verdict")},
-            "condition_number": self.condition_number,
+            "condition_number": None if self.gear_mobility is not None else self.condition_number,
             "characteristic_length": self.characteristic_length if self.has_length else None,
             "condition_joints": list(self.joints), "natural_length": self.natural,
             "singular": {k: singular_dict(s, self.robot) for k, s in self.singular.items()},
@@ -67,7 +71,28 @@ class Analysis:
     @property
     def has_length(self) -> bool:
         """A length goes with the condition number: given, or natural where it applies (:func:`.length_applies`)."""
+        if self.gear_mobility is not None:
+            return False
         return not self.natural or length_applies(self.classification.mobility, self.condition_number)
+
+    @property
+    def gear_mobility(self) -> int | None:
+        """The m that gear couplings leave when below the wheels' m at the described steering, else None."""
+        return self.coupled_mobility if self.coupled_mobility < self.instantaneous_mobility else None
+
+    def isotropy_note(self) -> str | None:
+        """Why no condition number is given, or None: m <= 1 (§5.5.4-5.5.5), or gear couplings that leave fewer
+        motions than the wheels' model of the condition number (5.28) has (one encoder of a solid axle gives the
+        twist, as fk says, though that model calls it infinite)."""
+        m, g = self.classification.mobility, self.gear_mobility
+        if m <= 1:
+            return f"does not apply (m = {m}: no two motions to balance)"
+        if g is None:
+            return None
+        if g <= 1:
+            return f"does not apply (its gear couplings leave m = {g}: no two motions to balance)"
+        return (f"not computed (its gear couplings leave m = {g} of {m}; the condition number is of the wheels' "
+                "model)")
 
     def condition_words(self) -> str:
         """The condition number and its length in words (the text summary and the report)."""
@@ -80,7 +105,9 @@ class Analysis:
     def format_text(self) -> str:
         """A concise terminal summary."""
         c, r = self.classification, self.robot
-        lines = [f"{r.name}: {c.describe()}"]
+        g = self.gear_mobility
+        gears = "" if g is None else f"; its gear couplings leave m = {g} (couplings)"
+        lines = [f"{r.name}: {c.describe()}{gears}"]
         if self.instantaneous_mobility != c.mobility:
             lines.append(f"  at the described steering: m = {self.instantaneous_mobility}")
         lines += [f"  {s.description}" for s in c.special]
@@ -89,8 +116,8 @@ class Analysis:
         lines.append(f"  actuation: {actuation_words(self.actuation)} ({', '.join(actuators) or 'nothing declared'})")
         lines.append(f"  sensing: {_yes(self.sensing['sufficient'], 'sufficient', 'insufficient')} "
                      f"({', '.join(r.sensed) or 'nothing declared'})")
-        if c.mobility <= 1:
-            lines.append(f"  isotropy: does not apply (m = {c.mobility}: no two motions to balance)")
+        if (note := self.isotropy_note()) is not None:
+            lines.append(f"  isotropy: {note}")
         else:
             lines.append(f"  condition number {self.condition_words()}, joints {', '.join(self.joints) or '-'}")
         for key, s in self.singular.items():
@@ -209,5 +236,5 @@ def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) 
         {"consistent": bool(np.all(act.consistent)), "sufficient": bool(np.all(act.sufficient)),
          "verdict": str(act.verdict)},
         {"sufficient": bool(np.all(sen.sufficient)), "verdict": str(sen.verdict)},
-        joints, float(kappa), float(d), length is None, singular,
+        joints, float(kappa), float(d), length is None, singular, int(act.mobility),
     )
