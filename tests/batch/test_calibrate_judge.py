@@ -6,6 +6,7 @@ import json
 from dataclasses import replace
 
 import numpy as np
+import pytest
 from batch_params import PARAMS, TRUE_P, write_log
 
 from wmrkit.batch.calibrate import fleet_calibrate
@@ -137,3 +138,72 @@ def test_one_bad_run_planted_among_six_three_pose_runs_is_the_one_named(diff):
         assert max(np.delete(res.closed_scores, bad)) < 5 < res.closed_scores[bad], (seed, res.closed_scores)
         named += bool(res.inconsistent)
     assert named >= 11
+
+
+def pair_named(res) -> list[str]:
+    """The pairs of runs the fleet's warnings name as disagreeing together ('A and B')."""
+    return [w.partition(":")[0] for w in res.warnings if "disagree with the other runs" in w]
+
+
+def pair_score_by_refit(diff, runs, pair) -> float:
+    """The pair score of `pair` recomputed independently: the other runs fitted by the single-log calibrate, each
+    run's final poses' error there weighted by one over the root of its wheel travel, each of the pair's RMS over the
+    others' pooled RMS (R - n degrees of freedom); the smaller of the two."""
+    from wmrkit.batch.consistency import travel
+    from wmrkit.odometry.calibration import CalibrationProblem, calibrate
+
+    cal = calibrate(diff, [r for k, r in enumerate(runs) if k not in pair], PARAMS)
+    err = [CalibrationProblem(cal.robot, tuple(PARAMS), (run,)).residuals(np.zeros(3)) / np.sqrt(max(travel(diff, run),
+           1.0)) for run in runs]
+    live = [e[np.abs(e) > 0] for e in err]
+    rest = [k for k in range(len(runs)) if k not in pair]
+    noise = sum(np.sum(live[k] ** 2) for k in rest) / (sum(live[k].size for k in rest) - len(PARAMS))
+    return min(float(np.sqrt(np.mean(live[k] ** 2) / noise)) for k in pair)
+
+
+def spy_pairs(monkeypatch) -> list:
+    """The leave-two-out step's answers (consistency._pair: the best pair and its score, or None), as it gives them."""
+    import wmrkit.batch.consistency as consistency
+
+    pairs = []
+    real = consistency._pair
+    monkeypatch.setattr(consistency, "_pair", lambda *args: pairs.append(real(*args)) or pairs[-1])
+    return pairs
+
+
+def test_two_bad_runs_that_hide_each_other_are_named_as_a_pair(diff, monkeypatch):
+    """Two runs of a robot with a 5 % larger left radius planted at random places in fleets of 6 runs with three-pose
+    references hid each other (each among the other's "others" inflates their pooled noise): every run's score under
+    MAX_CLOSED_SCORE, no fleet flagged. The leave-two-out step (no run over it, 6 runs or more) refits the others
+    without each pair: every fleet is flagged, the warning names exactly the planted pair, and its pair score equals
+    one recomputed from the single-log calibrate of the other four runs (to 1e-3: the two fits' tolerances)."""
+    pairs = spy_pairs(monkeypatch)
+    for seed in range(8):
+        bad = tuple(sorted(np.random.default_rng(seed).choice(6, 2, replace=False).tolist()))
+        runs = short_runs(diff, 30000 + seed, 6, 3, bad=bad)
+        res = fleet_calibrate(diff, runs, PARAMS)
+        assert max(res.closed_scores) < MAX_CLOSED_SCORE, res.closed_scores  # hidden from the one-run score
+        assert res.inconsistent is True and pair_named(res) == [f"r{bad[0]}.csv and r{bad[1]}.csv"], (seed, bad,
+                                                                                                    res.warnings)
+        assert not disagreeing(res)
+        assert pairs[-1][:2] == bad and f"pair score {pairs[-1][2]:.3g}," in res.warnings[-1]
+        assert pairs[-1][2] == pytest.approx(pair_score_by_refit(diff, runs, bad), rel=1e-3)
+
+
+def test_the_leave_two_out_step_flags_no_agreeing_fleet(diff, monkeypatch):
+    """Agreeing fleets of 6 three-pose runs, of one noise level, of levels drawn per run (1e-6 to 1e-4 per rad) and
+    of the worst mix (two runs at 1e-4 among four at 1e-6): the leave-two-out step runs (no run over
+    MAX_CLOSED_SCORE) and its largest pair score stays under MAX_PAIR_SCORE (under a third of it at one level), so no
+    fleet is flagged. A fleet of 5 has no such step (MIN_PAIR_RUNS: the 3 runs left would fit poorly)."""
+    from wmrkit.batch.consistency import MAX_PAIR_SCORE
+
+    pairs = spy_pairs(monkeypatch)
+    for seed in range(6):
+        worst = np.random.default_rng(seed).permutation([1e-4, 1e-4, 1e-6, 1e-6, 1e-6, 1e-6])
+        for noise, limit in ((1e-5, MAX_PAIR_SCORE / 3), (mixed_noise(seed), MAX_PAIR_SCORE), (worst, MAX_PAIR_SCORE)):
+            pairs.clear()
+            res = fleet_calibrate(diff, short_runs(diff, 31000 + seed, 6, 3, noise=noise), PARAMS)
+            assert res.inconsistent is False and not res.warnings, (seed, res.closed_scores, res.warnings)
+            assert len(pairs) == 1 and pairs[0][2] < limit, (seed, pairs)
+    pairs.clear()
+    assert fleet_calibrate(diff, short_runs(diff, 31000, 5, 3), PARAMS).inconsistent is False and pairs == []

@@ -131,11 +131,11 @@ def _refit(problem: CalibrationProblem) -> np.ndarray:
     return fit.x if undetermined is None else np.full(len(problem.parameters), np.nan)
 
 
-def _refit_without(args: tuple[CalibrationProblem, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """The fit of `problem`'s runs but the last from `x0`, in one process, and every run's residuals there
-    (:func:`~wmrkit.batch.consistency.judge`)."""
-    problem, x0 = args
-    others = problem.with_runs(problem.runs[:-1])
+def _refit_without(args: tuple[CalibrationProblem, np.ndarray, int]) -> tuple[np.ndarray, np.ndarray]:
+    """The fit of `problem`'s runs but the last `k` from `x0` (``args``: problem, x0, k), in one process, and every
+    run's residuals there (:func:`~wmrkit.batch.consistency.judge`)."""
+    problem, x0, k = args
+    others = problem.with_runs(problem.runs[:-k])
     x = solve(others.residuals, len(problem.parameters), x0, others.jacobian).x
     return x, problem.residuals(x)
 

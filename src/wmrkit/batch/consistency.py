@@ -22,7 +22,8 @@ The denominator is at least :data:`ROUNDOFF` times the run's wheel travel: noise
 
 Closed paths (a final pose: no own noise to divide by) are judged by :func:`judge` against the other runs' pooled
 noise instead, with 5 runs or more, from a quadratic model of each run about the fleet fit and one refit (of every
-run in a fleet of 5).
+run in a fleet of 5); with 6 or more and no run over the threshold, pairs of runs are left out together too (two bad
+runs hide each other, :func:`_pair`).
 """
 
 from __future__ import annotations
@@ -214,7 +215,7 @@ REFITS = 1
 REFIT_EVERY = 6
 #: Why a closed fleet is not judged when that refit fails (a worker's error, residuals not finite): the fleet fit is
 #: returned all the same ({run}: the run left out; {why}: the error).
-REFIT_FAILED = ("{run}: the fit of the other runs without it failed ({why}): the closed runs are not checked against "
+REFIT_FAILED = ("{run}: the fit of the other runs without {it} failed ({why}): the closed runs are not checked against "
                 "each other, a run of another robot is averaged in unseen (the fleet fit stands)")
 #: Why a closed fleet is not judged when the other runs without one cannot tell the parameters apart
 #: (:meth:`~wmrkit.odometry.calibration.CalibrationProblem.undetermined`, as the jackknife interval asks): the run's
@@ -223,6 +224,27 @@ REFIT_FAILED = ("{run}: the fit of the other runs without it failed ({why}): the
 UNDETERMINED = ("{run}: without it the other runs cannot tell the parameters apart ({why}): the closed runs are not "
                 "checked against each other, a run of another robot is averaged in unseen; add closed runs of other "
                 "sizes, both ways")
+#: Fewest runs of a kind for the leave-two-out step (:func:`_pair`): two bad runs hide each other (each is among the
+#: other's "others" and inflates their pooled noise: 0 of 75 fleets of 6-12 three-pose runs with two of a left radius
+#: +5 % flagged), so when no run scores over MAX_CLOSED_SCORE pairs are left out together; the 4 runs left must
+#: determine the fit as the others of the smallest fleet judged do (MIN_CLOSED_RUNS - 1).
+MIN_PAIR_RUNS = MIN_CLOSED_RUNS + 1
+#: Runs of largest score among which pairs are scored: at most 15 pairs whatever the fleet's size. The planted pairs
+#: ranked up to 5th of 6 by their own scores (so all pairs of 6), within the first 4 in fleets of 8 and 12.
+PAIR_CANDIDATES = 6
+#: Pairs refitted: those of largest score on the runs' quadratic model (no odometry). In all 115 fleets with a planted
+#: pair the best of these 3 refits was the best of refits of every pair (the fit 1.7x as long, 4.5x with 15 refits).
+PAIR_REFITS = 3
+#: Largest pair score of a fleet whose runs agree: the largest of up to 15 pairs, so above MAX_CLOSED_SCORE (that of
+#: one run of 6). Simulated fleets of 6 (docs/batch.md): agreeing runs of one noise level at most 5.4, of levels drawn
+#: per run 17.5, two runs at 1e-4 per rad among four at 1e-6 (the worst mix) 28.4; two runs of a left radius +5 %
+#: 24-128 (74 of 75 fleets of 6-12 over 30).
+MAX_PAIR_SCORE = 30.0
+#: The warning that names a pair ({a}, {b}: the runs; {score}: the pair's score).
+PAIR = ("{a} and {b}: disagree with the other runs (closed-path pair score {score:.3g}, over "
+        f"{MAX_PAIR_SCORE:g}: the fit of the runs but these two leaves each of them at least that many times the "
+        "others' error; each alone is hidden by the other): another robot, load or floor? The fit averages them in; "
+        "check them or fit without them")
 #: Step [parameter units] of the forward difference of the fleet fit's Jacobian that gives each run's curvature.
 CURVATURE_STEP = 1e-3
 #: ... and why a closed fleet is not judged when that Jacobian fails (a worker's error, values not finite): the fleet
@@ -245,16 +267,18 @@ def _score(err: np.ndarray, k: int, rest: np.ndarray, floors: np.ndarray, n: int
     return float(np.sqrt(np.sum(err[k] ** 2) / max(m[k], 1) / noise))
 
 
-def _quadratic_scores(jac, res, hess, floors, m) -> tuple[np.ndarray, np.ndarray]:
+def _quadratic_scores(jac, res, hess, floors, m, outs=None) -> tuple[np.ndarray, np.ndarray]:
     """Each run's score against the others refitted on the runs' quadratic models (no odometry), and that fit's
     shift from the fleet fit; the score is NaN where the others do not determine the parameters (their Jacobian's
-    weakest singular value under :data:`RANK_TOL` of the largest: e.g. equal squares all driven one way)."""
+    weakest singular value under :data:`RANK_TOL` of the largest: e.g. equal squares all driven one way). With
+    `outs` (tuples of runs), the same for each tuple left out together, scored by the smallest of its runs' scores."""
     from scipy.optimize import least_squares
 
     g, _, n = jac.shape
-    out, shift = np.full(g, np.nan), np.zeros((g, n))
-    for k in range(g):
-        rest = np.delete(np.arange(g), k)
+    outs = [(k,) for k in range(g)] if outs is None else outs
+    out, shift = np.full(len(outs), np.nan), np.zeros((len(outs), n))
+    for k, left in enumerate(outs):
+        rest = np.delete(np.arange(g), left)
         j, r, h = jac[rest].reshape(-1, n), res[rest].ravel(), hess[rest].reshape(-1, n, n)
         sv = np.linalg.svd(j, compute_uv=False)
         if m[rest].sum() <= n or sv[-1] < RANK_TOL * sv[0]:
@@ -262,7 +286,8 @@ def _quadratic_scores(jac, res, hess, floors, m) -> tuple[np.ndarray, np.ndarray
         d = least_squares(lambda d: r + j @ d + 0.5 * np.einsum("mij,i,j->m", h, d, d), np.zeros(n),  # noqa: B023
                           jac=lambda d: j + np.einsum("mij,j->mi", h, d), method="lm", xtol=1e-12,  # noqa: B023
                           ftol=1e-12).x
-        out[k] = _score(res + jac @ d + 0.5 * np.einsum("gmij,i,j->gm", hess, d, d), k, rest, floors, n, m)
+        err = res + jac @ d + 0.5 * np.einsum("gmij,i,j->gm", hess, d, d)
+        out[k] = min(_score(err, i, rest, floors, n, m) for i in left)
         shift[k] = d
     return out, shift
 
@@ -282,7 +307,9 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     by `refit` (``[(problem, x0)] -> [(x, residuals of the problem's runs) or a TaskFailure]``, the engine's map;
     the problem's last run is the one left out; a failure leaves the fleet not judged, :data:`REFIT_FAILED`), and its
     score is the refit's: in fleets of 6 squares the odd run's equalled a refit of every run. A fleet of fewer than
-    :data:`REFIT_EVERY` runs refits every run. Over :data:`MAX_CLOSED_SCORE` the run of largest score is named.
+    :data:`REFIT_EVERY` runs refits every run. Over :data:`MAX_CLOSED_SCORE` the run of largest score is named;
+    with none over it and :data:`MIN_PAIR_RUNS` runs or more, the pair of largest pair score over
+    :data:`MAX_PAIR_SCORE` is named (:data:`PAIR`; :func:`_pair`).
     Runs are compared with runs of as many reference poses (closed paths and references of two poses: one final
     pose each): each kind of :data:`MIN_CLOSED_RUNS` runs or more is judged on its own, the other runs are set aside
     and named (:data:`SET_ASIDE`); with no such kind the fleet is not judged (:data:`CLOSED`; runs of references of
@@ -323,12 +350,15 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
         done = _group_scores(problem, fit, hess, group, [blocks[i][live[i]] for i in group], travels, live, refit)
         if isinstance(done, str):
             return Consistency((None,) * g, None, not_judged=done)
+        done, pair = done
         scores[group] = done
         worst = int(group[np.argmax(done)])
         if scores[worst] > MAX_CLOSED_SCORE:
             messages.append(f"{logs[worst]}: disagrees with the other runs (closed-path score {scores[worst]:.3g}, "
                             f"over {MAX_CLOSED_SCORE:g}: the others' fit leaves it that many times their error): "
                             "another robot, load or floor? The fit averages it in; check it or fit without it")
+        elif pair is not None and pair[2] > MAX_PAIR_SCORE:
+            messages.append(PAIR.format(a=logs[pair[0]], b=logs[pair[1]], score=pair[2]))
     aside = [k for k in range(g) if np.isnan(scores[k])]
     why = None if not aside else SET_ASIDE.format(runs=", ".join(logs[k] for k in aside), judged=", ".join(
         f"{len(group)} runs of {_poses(m[group[0]])}" for group in groups))
@@ -342,30 +372,83 @@ def _poses(live: int) -> str:
 
 
 def _group_scores(problem: CalibrationProblem, fit, hess: np.ndarray, group: np.ndarray, rows: list[np.ndarray],
-                  travels: np.ndarray, live: list[np.ndarray], refit: Callable) -> np.ndarray | str:
+                  travels: np.ndarray, live: list[np.ndarray],
+                  refit: Callable) -> tuple[np.ndarray, tuple[int, int, float] | None] | str:
     """The closed-path scores of the runs `group` (as many residuals each: their `rows` of the fleet fit) against
-    each other (:func:`judge`), or why they are not judged."""
-    runs, logs, n = problem.runs, names(problem.runs), fit.x.size
+    each other (:func:`judge`) and, when none is over :data:`MAX_CLOSED_SCORE`, the pair of largest pair score
+    (:func:`_pair`: the two runs, their pair score; ``None`` if none was scored); or why they are not judged."""
+    logs, n = names(problem.runs), fit.x.size
     g, here = len(group), np.concatenate(rows)
     w = 1 / np.sqrt(travels[group])
     floors = ROUNDOFF * np.sqrt(travels[group])  # ROUNDOFF times the travel, weighted
     jac, res = fit.jac[here].reshape(g, -1, n), fit.fun[here].reshape(g, -1)
     m = np.full(g, res.shape[1])
-    scores, shift = _quadratic_scores(jac * w[:, None, None], res * w[:, None],
-                                      hess[here].reshape(g, -1, n, n) * w[:, None, None, None], floors, m)
+    model = (jac * w[:, None, None], res * w[:, None], hess[here].reshape(g, -1, n, n) * w[:, None, None, None])
+    scores, shift = _quadratic_scores(*model, floors, m)
     if np.isnan(scores).any():  # a run without which the others cannot fit: not judged
         k = int(np.flatnonzero(np.isnan(scores))[0])
         return UNDETERMINED.format(run=logs[group[k]], why=f"their weighted Jacobian's weakest direction under "
                                    f"{RANK_TOL:g} of the largest")
     again = [int(k) for k in np.argsort(np.linalg.norm(shift, axis=1))[::-1][:g if g < REFIT_EVERY else REFITS]]
-    orders = [[int(i) for i in group if i != group[k]] + [int(group[k])] for k in again]  # the one left out last
-    tasks = [(problem.with_runs([runs[i] for i in o]), fit.x + shift[k]) for k, o in zip(again, orders, strict=True)]
-    for k, order, done in zip(again, orders, refit(tasks), strict=True):
+    errs = _refits(problem, group, [(k,) for k in again], [fit.x + shift[k] for k in again], live, w, refit)
+    if isinstance(errs, str):
+        return errs
+    for k, err in zip(again, errs, strict=True):
+        scores[k] = _score(err, k, np.delete(np.arange(g), k), floors, n, m)
+    if g < MIN_PAIR_RUNS or scores.max() > MAX_CLOSED_SCORE:
+        return scores, None
+    pair = _pair(problem, fit, group, rows, scores, model, live, w, floors, m, refit)
+    return pair if isinstance(pair, str) else (scores, pair)
+
+
+def _pair(problem: CalibrationProblem, fit, group: np.ndarray, rows: list[np.ndarray], scores: np.ndarray,
+          model: tuple, live: list[np.ndarray], w: np.ndarray, floors: np.ndarray, m: np.ndarray,
+          refit: Callable) -> tuple[int, int, float] | str | None:
+    """The leave-two-out step of :func:`_group_scores`: each pair of the :data:`PAIR_CANDIDATES` runs of largest
+    `scores` whose removal leaves the parameters determined is scored on the runs' quadratic `model` (weighted
+    Jacobian, residuals, curvature), and the :data:`PAIR_REFITS` pairs of largest model score are refitted without
+    (from the model's fit); a pair's score is the smaller of its two runs' scores against the other runs' pooled
+    noise. The pair of largest refitted score (runs as indices of the problem), ``None`` if no pair was scored, or
+    why a refit failed (:data:`REFIT_FAILED`)."""
+    from itertools import combinations
+
+    g, n = len(group), fit.x.size
+    top = sorted(int(k) for k in np.argsort(scores)[::-1][:PAIR_CANDIDATES])
+    pairs = []
+    for out in combinations(top, 2):
+        here = np.concatenate([rows[k] for k in range(g) if k not in out])
+        if problem.undetermined(fit.x, fit.jac[here], fit.fun[here]) is None:
+            pairs.append(out)
+    guess, shift = _quadratic_scores(*model, floors, m, pairs)
+    again = [k for k in np.argsort(-guess, kind="stable")[:PAIR_REFITS] if not np.isnan(guess[k])]
+    errs = _refits(problem, group, [pairs[k] for k in again], [fit.x + shift[k] for k in again], live, w, refit)
+    if isinstance(errs, str) or not again:
+        return errs if isinstance(errs, str) else None
+    best = None
+    for k, err in zip(again, errs, strict=True):
+        (a, b), rest = pairs[k], np.delete(np.arange(g), pairs[k])
+        score = min(_score(err, a, rest, floors, n, m), _score(err, b, rest, floors, n, m))
+        if best is None or score > best[2]:
+            best = (int(group[a]), int(group[b]), score)
+    return best
+
+
+def _refits(problem: CalibrationProblem, group: np.ndarray, outs: list[tuple[int, ...]], starts: list[np.ndarray],
+            live: list[np.ndarray], w: np.ndarray, refit: Callable) -> list[np.ndarray] | str:
+    """For each of `outs` (places in `group`), the weighted counted residuals of the runs of `group` (a row each, in
+    its order) at the fit of its other runs from `starts` by `refit` (:func:`judge`'s); or why not
+    (:data:`REFIT_FAILED`)."""
+    runs, logs = problem.runs, names(problem.runs)
+    orders = [[int(i) for k, i in enumerate(group) if k not in out] + [int(group[k]) for k in out] for out in outs]
+    tasks = [(problem.with_runs([runs[i] for i in o]), x0, len(out))  # those left out last
+             for o, x0, out in zip(orders, starts, outs, strict=True)]
+    errs = []
+    for out, order, done in zip(outs, orders, refit(tasks), strict=True):
         err = None if isinstance(done, TaskFailure) else np.asarray(done[1], dtype=float)
         if err is None or not np.isfinite(err).all():  # the fit stands; only the judging is lost
-            return REFIT_FAILED.format(run=logs[group[k]], why=done if err is None else "its residuals are not finite")
+            return REFIT_FAILED.format(run=" and ".join(logs[group[k]] for k in out), it="them" if out[1:] else "it",
+                                       why=done if err is None else "its residuals are not finite")
         parts = np.split(err, np.cumsum([live[i].size for i in order])[:-1])
         mine = dict(zip(order, (p[live[i]] for p, i in zip(parts, order, strict=True)), strict=True))
-        scores[k] = _score(np.array([mine[int(i)] for i in group]) * w[:, None], k, np.delete(np.arange(g), k),
-                           floors, n, m)
-    return scores
+        errs.append(np.array([mine[int(i)] for i in group]) * w[:, None])
+    return errs
