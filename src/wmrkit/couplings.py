@@ -4,7 +4,8 @@ Real robots couple joints mechanically: a car drives its rear wheels through a d
 every wheel with one chain, an Ackermann linkage steers both front wheels with one actuator. A description says so
 with ``couplings:`` (``docs/description-format.md``); the actuation analysis (thesis §4.4) then counts one actuator
 per coupling instead of one per joint, and no longer reports such a robot as fighting itself. Sensors read their
-joints one by one; a gear's unsensed joints turn with its sensed ones (:func:`gear_fill`: fk, odometry, sensing).
+joints one by one; a gear's unsensed joints turn with its sensed ones (:func:`gear_fill`: fk, odometry, sensing),
+and a gear none of whose joints is read still turns as one (:func:`gear_free`).
 
 - ``differential``: one actuator drives the weighted sum ``sum(ratio_j * q_j)`` of the joints' rates (a mechanical
   differential: the mean of the two wheel rates with ratios 1/2, 1/2); the other combinations stay free.
@@ -207,6 +208,49 @@ def gear_fill(couplings: tuple[Coupling, ...], names: tuple[str, ...],
                 columns.append(col)
                 rows.append(k[i] * u)
     return tuple(columns), np.array(rows, dtype=float).reshape(len(columns), len(given))
+
+
+def gear_free(couplings: tuple[Coupling, ...], names: tuple[str, ...],
+              given: tuple[int, ...]) -> tuple[np.ndarray, tuple[str, ...]]:
+    """The unknown directions of the velocities `names` once the rates at positions `given` are known: one column
+    per unknown (``q_unknown = T @ p``), a joint in no gear its own, a ``gear`` with none of its joints given one
+    (its ratios ``q_j = ratio_j * u``: its constraint held though no joint of it is read), none for the joints a
+    gear fills from given ones (:func:`gear_fill`). Returns ``(T (len(names), p), the names of p)``, in the order
+    of `names` (a gear's column at its first joint, named by its channel)."""
+    n = len(names)
+    owner: dict[int, Coupling] = {}
+    for c in couplings:
+        if c.kind == "gear":
+            owner.update({names.index(j): c for j in c.joints if j in names})
+    cols, out_names, done = [], [], set()
+    for i in range(n):
+        c = owner.get(i)
+        if c is None:
+            if i not in given:
+                cols.append(np.eye(n)[i])
+                out_names.append(names[i])
+            continue
+        if c in done or any(owner.get(g) is c for g in given):
+            continue
+        done.add(c)
+        t = np.zeros(n)
+        for j, k in zip(c.joints, c.ratios, strict=True):
+            if j in names:
+                t[names.index(j)] = k
+        cols.append(t)
+        out_names.append(c.channel_name)
+    return np.array(cols, dtype=float).reshape(len(cols), n).T, tuple(out_names)
+
+
+def gear_unknowns(couplings: tuple[Coupling, ...], names: tuple[str, ...],
+                  given: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """``(free (len(names), p), known (len(names), len(given)))``: the velocities `names` are ``free @ p + known @
+    q_given`` with the rates at positions `given` known and every ``gear`` held (:func:`gear_fill`,
+    :func:`gear_free`); `p` the unknowns."""
+    filled, fill = gear_fill(couplings, names, given)
+    known = np.zeros((len(names), len(given)))
+    known[list(filled)] = fill
+    return gear_free(couplings, names, given)[0], known
 
 
 def steering_mechanisms(couplings: tuple[Coupling, ...], steered: list[str] | tuple[str, ...]) -> int:

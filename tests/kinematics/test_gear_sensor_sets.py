@@ -72,4 +72,4 @@ def test_kinematics_lists_one_encoder_of_a_solid_axle(tmp_path, capsys):
     path.write_text(ROBOTS["cart-castor-1"])
     assert main(["kinematics", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "  minimal sensor sets (2):\n    (left.spin)  (right.spin)\n" in out
+    assert "  minimal sensor sets (3):\n    (left.spin)  (right.spin)  (caster.spin)\n" in out  # the gear held unsensed

@@ -18,10 +18,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, matvec, readonly
-from ..couplings import coupled_columns, gear_fill, linked_steering
+from ..couplings import coupled_columns, gear_fill, gear_free, linked_steering
 from ..robot import TWIST_NAMES, Robot
 from .linalg import delta_projector, matrix_rank, nondimensional
-from .models import bounded, configuration, mobility
+from .models import bounded, configuration
 from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
 from .trees import (
     TreeVerdict,
@@ -257,23 +257,23 @@ def selectable_rates(robot: Robot) -> list[int]:
 
 
 def minimal_set_search(robot: Robot, beta: np.ndarray, size: int, wanted: str, what: str, *,
-                       drive_all: bool = False, gears: bool = False) -> SetList:
+                       drive_all: bool = False, couplings: str = "") -> SetList:
     """The sets of `size` selectable rates whose tree (4.28)/(4.34) is `wanted` with rank 3 at every
     configuration (and, `drive_all`, no motion left with them at rest: :func:`undriven_motions`): a bounded search
     (:mod:`.search`) pruned by the null-space test when ``size`` is the mobility (then the rates must be an
-    assignable set of the direct model), listing at most MAX_MINIMAL_SETS. `gears`: a set's rates give those a
-    gear turns with them (:func:`wmrkit.couplings.gear_fill`, as the sensing analysis reads sensors), and the
-    null-space test is on the motions the gears allow (:func:`coupled_constraints`)."""
+    assignable set of the direct model), listing at most MAX_MINIMAL_SETS. `couplings` ``"sensed"`` or
+    ``"actuated"``: each set judged under the robot's couplings as :func:`_split_sets` says (the sensing or the
+    actuation analysis), the null-space test on the motions the gears allow (:func:`coupled_constraints`)."""
     def exact(sel: np.ndarray) -> np.ndarray:
-        i_bar, j_sel, j_rest, zeroed = _split_sets(robot, beta, sel, gears)
+        i_bar, j_sel, j_rest, zeroed = _split_sets(robot, beta, sel, couplings)
         tree = eliminated_tree(i_bar, j_sel, j_rest)
         ok = (tree.leaf == wanted) & (tree.rank_a == 3)
-        if drive_all:  # a zeroed (filled) column of j_rest adds one to the nullity, no motion
+        if drive_all:  # a zero (padding) column of j_rest adds one to the nullity, no motion
             ok &= undriven_motions(i_bar, j_rest) == zeroed.reshape(len(sel), *(1,) * (ok.ndim - 1))
-        return ok.reshape(len(sel), -1).all(axis=1)
+        return ok.reshape(len(sel), -1).all(axis=1) & (zeroed >= 0)
 
     unit = nondimensional(robot)
-    a = coupled_constraints(unit, beta) if gears else unit.constraint_matrix(beta)
+    a = coupled_constraints(unit, beta) if couplings else unit.constraint_matrix(beta)
     m = np.unique(a.shape[-1] - matrix_rank(a))
     prefilter = null_space_prefilter(a, size, offset=3) if len(m) == 1 and m[0] == size else None
     sets, complete, note = search_sets(selectable_rates(robot), size, exact, prefilter=prefilter,
@@ -289,30 +289,36 @@ def trees_of(robot: Robot, beta: np.ndarray, sel: np.ndarray) -> TreeVerdict:
 
 
 def _split_sets(robot: Robot, beta: np.ndarray, sel: np.ndarray,
-                gears: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                couplings: str = "") -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``(I_bar, J_sel, J_rest, zeroed)`` of the nondimensional Jacobian form split by each set of columns `sel`
-    ``(S, size)``: ``(3E, 3), (S, ..., 3E, size), (S, ..., 3E, n_w - size), (S,)``. With `gears`, the joints a gear
-    turns with a set's rates are known (:func:`wmrkit.couplings.gear_fill`): ``J_sel = J G`` with ``q = G q_sel``
-    on the known columns, and their columns of ``J_rest`` are zero (the same projector ``Delta(J_rest)``; `zeroed`
-    counts them per set)."""
+    ``(S, size)``: ``(3E, 3), (S, ..., 3E, size), (S, ..., 3E, n_w - size or n_w), (S,)``. Under the couplings,
+    ``J_sel = J T_sel`` and ``J_rest = J T_rest``, padded with zero columns (`zeroed` counts those of ``J_rest``;
+    -1 marks a set of fewer channels than rates, never a minimal set): ``"sensed"`` as the sensing analysis (a
+    gear's joints known from a set's rates, :func:`wmrkit.couplings.gear_fill`; a gear with none of them one
+    unknown, :func:`wmrkit.couplings.gear_free`), ``"actuated"`` as the actuation analysis
+    (:func:`wmrkit.couplings.coupled_columns`: a coupling's joints one channel, a gear's across motions held)."""
     names = jacobian_names(robot)
     n_w, size = len(names), sel.shape[1]
     i_bar, j = nondimensional(robot).jacobian_form(beta)
-    rest = np.array([[c for c in range(n_w) if c not in s] for s in sel.tolist()], dtype=int).reshape(
-        len(sel), n_w - size)
-    j_sel, j_rest = np.moveaxis(j[..., sel], -2, 0), np.moveaxis(j[..., rest], -2, 0)  # (..., 3E, S, k) -> (S, ...)
+    kinds = ("gear",) if couplings == "sensed" else ("gear", "differential")
+    if not couplings or not any(c.kind in kinds for c in robot.couplings):
+        rest = np.array([[c for c in range(n_w) if c not in s] for s in sel.tolist()], dtype=int).reshape(
+            len(sel), n_w - size)
+        j_sel, j_rest = np.moveaxis(j[..., sel], -2, 0), np.moveaxis(j[..., rest], -2, 0)  # (..., 3E, S, k) -> (S, ...)
+        return i_bar, j_sel, j_rest, np.zeros(len(sel), dtype=int)
+    t_sel, t_rest = np.zeros((len(sel), n_w, size)), np.zeros((len(sel), n_w, n_w))  # rest: fewer channels, more
     zeroed = np.zeros(len(sel), dtype=int)
-    if not gears or not any(c.kind == "gear" for c in robot.couplings):
-        return i_bar, j_sel, j_rest, zeroed
-    g, known = np.zeros((len(sel), n_w, size)), np.zeros((len(sel), n_w), dtype=bool)
     for i, s in enumerate(sel.tolist()):
-        filled, fill = gear_fill(robot.couplings, names, tuple(s))
-        g[i, list(filled)], known[i, list(filled)] = fill, True
-    zeroed = known.sum(axis=1) - size
-    keep = ~np.take_along_axis(known, rest, axis=1)  # (S, n_w - size)
-    j_sel = np.einsum("...rn,snk->s...rk", j, g)
-    j_rest = j_rest * keep.reshape(len(sel), *(1,) * (j_rest.ndim - 2), n_w - size)
-    return i_bar, j_sel, j_rest, zeroed
+        if couplings == "sensed":
+            filled, fill = gear_fill(robot.couplings, names, tuple(s))
+            t_sel[i, list(filled)] = fill
+            free = gear_free(robot.couplings, names, tuple(s))[0]
+        else:
+            chosen, _, free, _ = coupled_columns(robot.couplings, names, tuple(s))
+            t_sel[i, :, :chosen.shape[1]] = chosen
+        t_rest[i, :, :free.shape[1]] = free
+        zeroed[i] = n_w - free.shape[1] if couplings == "sensed" or chosen.shape[1] == size else -1
+    return i_bar, np.einsum("...rn,snk->s...rk", j, t_sel), np.einsum("...rn,snk->s...rk", j, t_rest), zeroed
 
 
 def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None, *,
@@ -326,10 +332,12 @@ def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None, *,
     default as described.
     """
     beta = configuration(robot, beta, heading)
-    m = np.unique(mobility(robot, beta))
+    a = coupled_constraints(nondimensional(robot), beta)  # m counts a gear's motions, as actuation_analysis does
+    m = np.unique(a.shape[-1] - matrix_rank(a))
     if len(m) != 1 or m[0] == 0:
         return SetList()
-    found = minimal_set_search(robot, beta, int(m[0]), "determined", "minimal actuator sets", drive_all=True)
+    found = minimal_set_search(robot, beta, int(m[0]), "determined", "minimal actuator sets", drive_all=True,
+                               couplings="actuated")
     steer = tuple(f"{w}.steer" for w in steering_split(robot, ()))
     names = jacobian_names(robot)
     return SetList([tuple(names[c] for c in s) + steer for s in found], found.complete, found.note)

@@ -139,6 +139,37 @@ def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike,
     return q, (a @ q[..., None])[..., 0]
 
 
+def geared_solve(a: ArrayLike, couplings: tuple, names: tuple[str, ...], assigned: ArrayLike, q_assigned: ArrayLike,
+                 name: str = "q_assigned") -> tuple[np.ndarray, np.ndarray]:
+    """:func:`solve_assigned` with the robot's ``gear`` couplings held: the joints a gear turns with assigned ones
+    filled (:func:`wmrkit.couplings.gear_fill`), and a gear with no assigned joint one unknown, its turn
+    (:func:`wmrkit.couplings.gear_free`). `names`: the columns of `a`. Without a gear, :func:`solve_assigned`."""
+    from ..couplings import gear_unknowns
+
+    assigned = tuple(int(c) for c in np.asarray(assigned, dtype=int).reshape(-1))
+    if not any(c.kind == "gear" for c in couplings):
+        return solve_assigned(a, assigned, q_assigned, name)
+    a = np.asarray(a, dtype=float)
+    free, given = gear_unknowns(couplings, names, assigned)  # q = free @ p + given @ q_assigned
+    p = free.shape[1]
+    x, residual = solve_assigned(np.concatenate([a @ free, a @ given], axis=-1), np.arange(p, p + len(assigned)),
+                                 q_assigned, name)
+    return x[..., :p] @ free.T + x[..., p:] @ given.T, residual
+
+
+def geared_twist_determined(a: np.ndarray, couplings: tuple, names: tuple[str, ...],
+                            assigned: tuple[int, ...]) -> np.ndarray:
+    """Whether the `assigned` columns of `a` ``(..., R, k)`` (the twist first) fix the twist, gears held
+    (:func:`geared_solve`): ``rank(A T) = n_twist_free + rank(A T_rest)`` (4.10), ``T`` the unknown directions,
+    ``T_rest`` those of the joints. ``(...)`` bool."""
+    from ..couplings import gear_free
+
+    free = gear_free(couplings, names, assigned)[0]
+    twist = np.abs(free[:3]).sum(axis=0) > 0
+    a_free = a @ free
+    return matrix_rank(a_free) == int(twist.sum()) + matrix_rank(a_free[..., ~twist])
+
+
 def rref(m: ArrayLike, *, rtol: float = RANK_RTOL) -> tuple[np.ndarray, np.ndarray]:
     """Reduced row-echelon form by Gauss-Jordan elimination with partial pivoting, batched (thesis §4.2, 4.6).
 

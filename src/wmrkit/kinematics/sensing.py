@@ -16,9 +16,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, matvec, readonly
-from ..couplings import gear_fill
+from ..couplings import gear_fill, gear_free
 from ..robot import TWIST_NAMES, Robot
-from .actuation import body_only, coupled_constraints, minimal_set_search, split_jacobian, steering_split, verdict_texts
+from .actuation import body_only, coupled_constraints, minimal_set_search, steering_split, verdict_texts
 from .linalg import delta_projector, matrix_rank, nondimensional
 from .models import bounded, configuration
 from .search import SetList
@@ -37,11 +37,14 @@ from .trees import (
 def _split(robot: Robot, sensed: Sequence[str] | None, beta: ArrayLike | None):
     """Sensed columns, sensed steering, ``(I_bar, J_s, J_ns)``: a gear's unsensed joints turn with its sensed ones
     (:func:`wmrkit.couplings.gear_fill`, as ``fk`` and ``odometry`` fill them), so they are known, not columns of
-    ``J_ns``, and ``J_s`` carries them; last, the known columns (sensed, then filled)."""
+    ``J_ns``, and ``J_s`` carries them; a gear with no sensed joint is one unknown, its turn
+    (:func:`wmrkit.couplings.gear_free`); last, the names of the unknowns of ``J_ns``."""
     columns, steering = select_columns(robot, robot.sensed if sensed is None else sensed, "sensed")
-    filled, fill = gear_fill(robot.couplings, jacobian_names(robot), columns)
-    i_bar, j_s, j_ns = split_jacobian(robot, filled, beta)
-    return columns, steering, i_bar, j_s @ fill, j_ns, filled
+    names = jacobian_names(robot)
+    filled, fill = gear_fill(robot.couplings, names, columns)
+    free, free_names = gear_free(robot.couplings, names, columns)
+    i_bar, j = robot.jacobian_form(configuration(robot, beta))
+    return columns, steering, i_bar, j[..., list(filled)] @ fill, j @ free, free_names
 
 
 def sensing_equation(
@@ -124,7 +127,7 @@ class SensingAnalysis:
     tree: TreeVerdict
     direct_matrix: np.ndarray  # (..., 3, n_s), (4.32)
     full_matrix: np.ndarray  # (..., 3 + n_ns, n_s), (4.31)
-    full_names: tuple[str, ...]  # rows of full_matrix: vx, vy, omega, then the unknown velocities (no gear-filled one)
+    full_names: tuple[str, ...]  # rows of full_matrix: vx, vy, omega, the unknowns (a gear unsensed: its channel)
     residual_matrix: np.ndarray  # (..., 3E, n_s): least-squares error of (4.31) per sensed rate
     unsensed: np.ndarray  # (...) int, motions with every sensed rate at rest (.trees.undriven_motions)
 
@@ -187,7 +190,7 @@ def sensing_analysis(
     solution ``.twist`` / ``.direct``.
     """
     beta = configuration(robot, beta, heading)
-    columns, steering, i_bar, j_s, j_ns, known = _split(robot, sensed, beta)
+    columns, steering, i_bar, j_s, j_ns, unknown = _split(robot, sensed, beta)
     unit = nondimensional(robot)  # rank decisions: the tolerance policy of .linalg
     a = coupled_constraints(unit, beta)  # the motions a gear allows, as the actuation analysis counts them
     _, _, i_bar1, j_s1, j_ns1, _ = _split(unit, sensed, beta)
@@ -199,7 +202,7 @@ def sensing_analysis(
         readonly(np.asarray(a.shape[-1] - matrix_rank(a))),
         eliminated_tree(i_bar1, j_s1, j_ns1),
         readonly(partitioned_solution(i_bar, j_ns) @ j_s), readonly(full),
-        TWIST_NAMES + tuple(n for c, n in enumerate(names) if c not in known),
+        TWIST_NAMES + unknown,
         readonly(i_ns @ full - j_s),
         readonly(undriven_motions(i_bar1, j_ns1)),
     )
@@ -225,7 +228,8 @@ def minimal_sensor_sets(
     wanted = "overdetermined" if detect_slip else "determined"
     sizes = range(int(m[0]) + 1, len(robot.rate_names) + 1) if detect_slip else (int(m[0]),)
     for size in sizes:  # bounded searches (.search), pruned by the null-space test at size m
-        found = minimal_set_search(robot, beta, size, wanted, "minimal sensor sets", drive_all=True, gears=True)
+        found = minimal_set_search(robot, beta, size, wanted, "minimal sensor sets", drive_all=True,
+                                   couplings="sensed")
         if found or not found.complete:
             return SetList([tuple(names[c] for c in s) + steer for s in found], found.complete, found.note)
     return SetList()

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_names, as_reals, as_vectors, finite_number, readonly
-from ..couplings import Coupling, gear_fill
+from ..couplings import Coupling
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
@@ -24,7 +24,7 @@ from ..units import MAX_ANGLE, UnitError, parse_quantity
 from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
 from ._ik_fast import wrap_angle
-from .linalg import matrix_rank, solve_assigned
+from .linalg import geared_solve, geared_twist_determined
 
 __all__ = ["WheelCommands", "forward_kinematics", "gear_error", "resolve_rate_name", "twist_is_determined",
            "wheel_commands", "wrap_angle"]
@@ -311,8 +311,8 @@ def forward_kinematics(
         raise ShapeError(f"rates: the rates' shapes do not broadcast together: {shapes}") from None
     q_assigned = np.stack(values, axis=-1)
     _check_finite_rates(list(given), q_assigned)
-    columns, q_assigned = _gear_filled(robot, columns, q_assigned)
-    q_dot, slip = solve_assigned(robot.constraint_matrix(beta, heading=heading), columns, q_assigned, "rates")
+    q_dot, slip = geared_solve(robot.constraint_matrix(beta, heading=heading), robot.couplings, robot.velocity_names,
+                               columns, q_assigned, "rates")
     return readonly(q_dot[..., :3]), readonly(np.linalg.norm(slip, axis=-1))
 
 
@@ -351,7 +351,7 @@ def forward_kinematics_check(
     q_assigned = np.array([float(_rate_value(k, v)) for k, v in rates.items()])
     _check_finite_rates(list(rates), q_assigned)
     a = robot.constraint_matrix(beta, heading=heading)
-    q_dot, slip = solve_assigned(a, *_gear_filled(robot, columns, q_assigned))
+    q_dot, slip = geared_solve(a, robot.couplings, robot.velocity_names, columns, q_assigned)
     owner = robot.row_wheels
     wheel_slip = np.sqrt(np.bincount(owner, weights=slip**2, minlength=len(robot.wheels)))
     speeds = [abs(v) * (robot.wheel(n.partition(".")[0]).r if "." in n and not n.endswith(".steer") else 1.0)
@@ -372,11 +372,9 @@ def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: 
     those of the unknown joint rates, ``n_twist_free`` the twist components not assigned.
     """
     columns = _assigned_columns(robot, list(as_names(names, "names", "joint rate names", UnknownNameError)))
-    columns = gear_fill(robot.couplings, robot.velocity_names, tuple(columns.tolist()))[0]
     a = robot.constraint_matrix(beta, heading=heading)
-    free = np.setdiff1d(np.arange(a.shape[-1]), columns)
-    rest = free[free >= 3]
-    return readonly(np.asarray(matrix_rank(a[..., free]) == np.sum(free < 3) + matrix_rank(a[..., rest])))
+    return readonly(np.asarray(geared_twist_determined(a, robot.couplings, robot.velocity_names,
+                                                       tuple(columns.tolist()))))
 
 
 def _assigned_columns(robot: Robot, names: list[str]) -> np.ndarray:
@@ -387,15 +385,6 @@ def _assigned_columns(robot: Robot, names: list[str]) -> np.ndarray:
         if c in columns[:j]:
             raise UnknownNameError(f"rates: '{robot.velocity_names[c]}' given twice")
     return np.array(columns, dtype=int)
-
-
-def _gear_filled(robot: Robot, columns: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The given `columns` and rates `q` ``(..., n_a)`` with the rates a gear coupling fixes from them appended
-    (:func:`wmrkit.couplings.gear_fill`): a gear's unknown joint turns with its given ones."""
-    filled, f = gear_fill(robot.couplings, robot.velocity_names, tuple(columns.tolist()))
-    if len(filled) == len(columns):
-        return columns, q
-    return np.array(filled, dtype=int), q @ f.T
 
 
 def _first_bad(a: np.ndarray) -> float:

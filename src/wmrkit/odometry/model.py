@@ -5,7 +5,8 @@ hold for the rates integrated over the interval: ``A(beta_mid) dq = 0`` with ``b
 the middle of the interval (second order in the step). The sensed joint increments are *assigned* and the others
 (the body increment ``(dx, dy, dtheta)``, unsensed wheel rates) are solved by least squares with the ranks
 method (4.9)-(4.11) (:func:`wmrkit.kinematics.linalg.solve_assigned`), the joints of a ``gear`` coupling that are
-not sensed assigned with its sensed ones (:func:`wmrkit.couplings.gear_fill`); the residual ``A dq`` [m] is the slip
+not sensed assigned with its sensed ones (:func:`wmrkit.couplings.gear_fill`), a gear none of whose joints is sensed
+one unknown, its turn (:func:`wmrkit.kinematics.linalg.geared_solve`); the residual ``A dq`` [m] is the slip
 indicator of (4.11)/(4.82), zero when the sensors agree with rolling without slip. No division by a time step.
 
 Steering angles come from the sensed ``WHEEL.steer`` joints. A steering wheel whose steer angle is not sensed and
@@ -28,7 +29,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_names, readonly
 from ..couplings import gear_fill
 from ..errors import UnknownNameError, WmrkitError
-from ..kinematics.linalg import matrix_rank, solve_assigned
+from ..kinematics.linalg import geared_solve, geared_twist_determined
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .integrators import _finite
@@ -435,11 +436,13 @@ def _kept_matrix(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np
 
 def solution_maps(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np.ndarray,
                   assigned: np.ndarray, row_weights: np.ndarray, fill: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(S, Rm)`` from (4.11) for each configuration: solve_assigned (on the rows scaled by their weights) for
+    """``(S, Rm)`` from (4.11) for each configuration: geared_solve (on the rows scaled by their weights) for
     the assigned rates of each sensed one's unit vector (``fill`` ``(n_assigned, n_a)``: the sensed rates and those
     a gear turns with them); ``Rm = A S``, the unweighted residual map."""
     a = _kept_matrix(robot, beta_full, rows, cols)
-    q, _ = solve_assigned((a * row_weights[:, None])[..., None, :, :], assigned, fill.T)  # (..., n_a, k)
+    n_a = fill.shape[1]  # the sensed rates, first of `assigned`; a gear's other joints held (geared_solve)
+    q, _ = geared_solve((a * row_weights[:, None])[..., None, :, :], robot.couplings,
+                        tuple(robot.velocity_names[c] for c in cols), assigned[:n_a], np.eye(n_a))  # (..., n_a, k)
     s = np.swapaxes(q, -1, -2)
     return s, a @ s
 
@@ -451,8 +454,8 @@ def _twist_determined(robot: Robot, beta_full: np.ndarray, model: OdometryModel)
         full[:, model.steer_index] = beta_full
         beta_full = full
     a = _kept_matrix(robot, beta_full, model.rows, model.cols)
-    free = np.setdiff1d(np.arange(a.shape[-1]), model.assigned)
-    return matrix_rank(a[..., free]) == matrix_rank(a[..., free[3:]]) + 3
+    names = tuple(robot.velocity_names[c] for c in model.cols)
+    return geared_twist_determined(a, robot.couplings, names, tuple(model.assigned[:model.fill.shape[1]].tolist()))
 
 
 def frozen(a: ArrayLike) -> np.ndarray:

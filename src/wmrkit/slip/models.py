@@ -29,9 +29,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_names, batch_shape
+from ..couplings import gear_unknowns
 from ..dynamics.mass import Body, body_problem
 from ..errors import WmrkitError
-from ..kinematics.linalg import solve_assigned
+from ..kinematics.linalg import geared_solve
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot, element_beta
 from .weights import SlipWeights
@@ -148,7 +149,7 @@ def wls(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: Arra
     mu = (weights or SlipWeights()).row_mu(robot)
     a = robot.constraint_matrix(beta, heading=heading)
     cols, q_a = _assigned(robot, assigned, q_assigned)
-    q, _ = solve_assigned(np.sqrt(mu)[:, None] * a, cols, q_a)
+    q, _ = geared_solve(np.sqrt(mu)[:, None] * a, robot.couplings, robot.velocity_names, cols, q_a)
     slip = (a @ q[..., None])[..., 0]
     zero = np.zeros(slip.shape[:-1])
     return SlipSolution(q, slip, -mu * slip, zero, zero == 0)
@@ -255,7 +256,7 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
     a_all = np.broadcast_to(a_all, (*batch, *a_all.shape[-2:])).reshape(-1, *a_all.shape[-2:])
     q_a = np.broadcast_to(q_a, (*batch, len(cols))).reshape(-1, len(cols))
     k = a_all.shape[-1]
-    free = np.setdiff1d(np.arange(k), cols)
+    free, given = gear_unknowns(robot.couplings, robot.velocity_names, tuple(cols.tolist()))  # q = free z + given q_a
     n_e = a_all.shape[-2] // 2
     n_s = len(robot.steer_names)
     betas = (None if beta is None or n_s == 0
@@ -279,17 +280,14 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
     load_maps = None if quasi_static is None else _load_map(robot, quasi_static[0], betas)  # (E, 3) or (n, E, 3)
     for i in range(len(q_a)):
         a = a_all[i]
-        a_na, fixed = a[:, free], a[:, cols] @ q_a[i]
+        known = given @ q_a[i]
+        a_na, fixed = a @ free, a @ known
         body_part = a[:, :3]
         load_map = None if load_maps is None else load_maps[i] if load_maps.ndim == 3 else load_maps
-        known = np.zeros(k)
-        known[cols] = q_a[i]
 
         def equations(z, a_na=a_na, fixed=fixed, body_part=body_part, load_map=load_map, known=known):
             slip = a_na @ z + fixed
-            q = known.copy()
-            q[free] = z
-            twist = q[:3]  # assigned components included: the contacts' body velocities of the tyre laws
+            twist = known[:3] + free[:3] @ z  # assigned components included: the contacts' body velocities
             v_body = body_part @ twist
             if quasi_static is None:
                 f_n = static
@@ -304,11 +302,10 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
 
         if i == 0:
             _check_law(friction, slip_shape=(n_e, 2), loads=static if quasi_static is None else None)
-        scale = max(1.0, float(np.max(np.abs(equations(q0[i][free])))))
-        sol = root(lambda z, s=scale: equations(z) / s, q0[i][free], method="hybr", tol=tol * 1e-3)
-        q = np.empty(k)
-        q[free], q[cols] = sol.x, q_a[i]
-        q_out[i] = q
+        z0 = free.T @ q0[i] / np.sum(free**2, axis=0)  # free's columns have disjoint supports
+        scale = max(1.0, float(np.max(np.abs(equations(z0)))))
+        sol = root(lambda z, s=scale: equations(z) / s, z0, method="hybr", tol=tol * 1e-3)
+        q_out[i] = free @ sol.x + known
         res[i] = float(np.max(np.abs(equations(sol.x)), initial=0.0))
         ok[i] = res[i] <= tol * scale  # hybr may report no progress when it starts at the root
     a_b = a_all.reshape(*batch, *a_all.shape[-2:])
