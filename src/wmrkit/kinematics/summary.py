@@ -11,6 +11,7 @@ from ..errors import SingularError
 from ..robot import Robot
 from .actuation import actuation_analysis, minimal_actuator_sets
 from .extended import extended_dof
+from .linalg import characteristic_length
 from .models import (
     KinematicModel,
     assignable_sets,
@@ -48,6 +49,7 @@ def kinematics_summary(robot: Robot) -> dict[str, Any]:
         "steering": dict(zip(robot.steer_names, robot.heading.tolist(), strict=True)),  # headings [rad]
         "beta": dict(zip(robot.steer_names, robot.beta.tolist(), strict=True)),  # the thesis's angles [rad]
         "velocity_names": list(robot.velocity_names),
+        "size": characteristic_length(robot),  # L [m]: vx, vy in units of L make the models' entries comparable
         "mobility": int(mobility(robot)),
         "vehicle_dof": int(vehicle_dof(robot)),  # G (4.22): of the m above, motions of the body
         "generic_mobility": generic_mobility(robot),
@@ -65,7 +67,27 @@ def kinematics_summary(robot: Robot) -> dict[str, Any]:
     }
 
 
-def _matrix_table(model: dict[str, Any], indent: str = "    ") -> list[str]:
+#: A model entry printed as 0: within this fraction of the matrix's largest entry, both in the robot's size L
+#: (vx, vy in L/s), where the models are solved: least-squares round-off (5.5e-12 rad/s per rad/s on 64 castors
+#: whose largest entry is 415), not a value. The JSON keeps the computed values.
+ROUNDOFF = 1e-12
+
+
+def printed_matrix(model: dict[str, Any], size: float) -> np.ndarray:
+    """`model`'s matrix ``(n_solved, n_assigned)`` with the entries within :data:`ROUNDOFF` of its scale set to 0."""
+    matrix = np.asarray(model["matrix"], dtype=float).reshape(len(model["solved"]), len(model["assigned"]))
+    in_l = [1.0 / size if n in ("vx", "vy") else 1.0 for n in model["solved"]]  # rows: the solved velocities
+    per_l = [size if n in ("vx", "vy") else 1.0 for n in model["assigned"]]
+    scaled = np.abs(matrix) * np.array(in_l)[:, None] * np.array(per_l)
+    return np.where(scaled <= ROUNDOFF * scaled.max(initial=0.0), 0.0, matrix)
+
+
+def _cell(v: float, width: int) -> str:
+    text = f"{v:.6g}"
+    return f"{text:>{width}}" if len(text) < width else " " + text  # never run into the previous entry
+
+
+def _matrix_table(model: dict[str, Any], size: float, indent: str = "    ") -> list[str]:
     if "error" in model:
         return [f"{indent}not available: {model['error']}"]
     if not model["assigned"]:
@@ -74,10 +96,8 @@ def _matrix_table(model: dict[str, Any], indent: str = "    ") -> list[str]:
     name_width = max(len(n) for n in model["solved"]) if model["solved"] else 1
     head = f"{indent}{'':<{name_width}} = " + "".join(f"{n:>{width}}" for n in model["assigned"])
     rows = [head]
-    for name, row in zip(model["solved"], np.asarray(model["matrix"]).reshape(len(model["solved"]), -1),
-                         strict=True):
-        clean = np.where(np.abs(row) < 1e-12, 0.0, row)  # round-off of the least squares, not a value
-        rows.append(f"{indent}{name:<{name_width}} = " + "".join(f"{v:>{width}.6g}" for v in clean))
+    for name, row in zip(model["solved"], printed_matrix(model, size), strict=True):
+        rows.append(f"{indent}{name:<{name_width}} = " + "".join(_cell(v, width) for v in row.tolist()))
     return rows
 
 
@@ -126,7 +146,7 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
     for title, key in (("direct model", "direct_model"), ("inverse model", "inverse_model")):
         model = summary[key]
         kind = "" if "error" in model else f" ({model['kind']}, assigned: {', '.join(model['assigned'])})"
-        lines += [f"  {title}{kind}:", *_matrix_table(model)]
+        lines += [f"  {title}{kind}:", *_matrix_table(model, summary["size"])]
     act, sen = summary["actuation"], summary["sensing"]
     lines.append(f"  actuation [{', '.join(act['actuated'] + [s + '.steer' for s in act['steering_actuated']])}]: "
                  f"{act['verdict']}")
