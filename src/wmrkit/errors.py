@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 
 class WmrkitError(Exception):
     """Base of every error a user can cause (bad input, impossible request)."""
@@ -56,3 +58,15 @@ class SingularError(WmrkitError, ValueError):
 
 class SelectionError(WmrkitError, ValueError):
     """A choice of velocities or joints a method refuses (e.g. omega as an actuator); the message says why."""
+
+
+#: Names a message lists before counting the rest (:func:`name_list`).
+MAX_LISTED = 8
+
+
+def name_list(names: Sequence[str], limit: int = MAX_LISTED) -> str:
+    """``"a, b, c"``, or past `limit` names the first ones and a count: ``"a, b, ..., h and 181 more"`` (a message
+    about 64 double wheels listed 189 rates, 2,000 characters, on its one line)."""
+    names = list(names)
+    shown = ", ".join(names[:limit])
+    return shown if len(names) <= limit else f"{shown} and {len(names) - limit} more"

@@ -27,7 +27,7 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 
 from .._shapes import as_names
-from ..errors import SingularError, WmrkitError
+from ..errors import SingularError, WmrkitError, name_list
 from ..robot import TWIST_NAMES, Robot
 from .linalg import free_columns, matrix_rank, nondimensional
 from .symbolic import printable, sensed_rates, symbolic_constraint_matrix, symbolic_model
@@ -93,8 +93,8 @@ class _Plan:
         ranks = matrix_rank(a_na)
         if int(ranks.max()) < len(self.unknown_cols):  # name the rates left free, not every unknown
             free = free_columns(a_na[int(np.argmax(ranks))])
-            names = ", ".join(self.robot.velocity_names[j] for j, f in zip(self.unknown_cols, free, strict=True) if f)
-            raise SingularError(f"robot '{self.robot.name}': the sensed rates ({', '.join(self.sensed)}) do not "
+            names = name_list([self.robot.velocity_names[j] for j, f in zip(self.unknown_cols, free, strict=True) if f])
+            raise SingularError(f"robot '{self.robot.name}': the sensed rates ({name_list(self.sensed)}) do not "
                                 f"determine ({names}); sense more joints (the wheels' 'sensed' field of the "
                                 "description, or sensed= in Python)")
 

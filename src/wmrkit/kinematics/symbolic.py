@@ -24,7 +24,7 @@ import numpy as np
 import sympy as sp
 
 from .._shapes import as_names
-from ..errors import SingularError, UnknownNameError, WmrkitError
+from ..errors import SingularError, UnknownNameError, WmrkitError, name_list
 from ..robot import TWIST_NAMES, Robot
 from ..units import MAX_ANGLE, MAX_TURNS
 from ..wheels import GEOMETRY_FIELDS, Wheel, WheelError
@@ -252,8 +252,8 @@ def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], g
     if rank_na < len(na_idx):  # name the velocities left free, not every unknown
         free = free_columns(values[ranks_na.index(rank_na)][:, na_idx])
         raise SingularError(
-            f"robot '{robot.name}': assigning ({', '.join(assigned) or 'nothing'}) does not determine "
-            f"({', '.join(n for n, f in zip(solved, free, strict=True) if f)}): rank A_na = {rank_na} < "
+            f"robot '{robot.name}': assigning ({name_list(assigned) or 'nothing'}) does not determine "
+            f"({name_list([n for n, f in zip(solved, free, strict=True) if f])}): rank A_na = {rank_na} < "
             f"{len(na_idx)} unknowns (mobility m = {a.cols - rank})"
         )
     exact = rank_na == rank
