@@ -83,7 +83,7 @@ def test_angles_within_a_turn_or_with_a_unit_are_read(value):
      "cosine would be round-off)"),  # read as 1.7e306 rad: a fixed wheel shown at 0 deg, computed at about 104 deg
     (10**400, "length", "expected a length, got an integer too large for a float"),
     (True, "angle", "expected an angle, got a boolean"),
-    (None, "length", "expected a length, got NoneType"),
+    (None, "length", "expected a length, got no value (null)"),  # was NoneType: YAML "H:" or "H: null"
     ([1.0], "length", "expected a length, got list"),
 ])
 def test_rejections_say_why(value, kind, message):

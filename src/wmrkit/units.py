@@ -63,7 +63,8 @@ def parse_quantity(value: object, kind: Kind) -> float:
         exact = _DECIMAL.get(unit) if number and math.isfinite(number) else None  # '1e99999 mm': inf, refused below
         si = number * factor if exact is None else float(_CONTEXT.multiply(decimal.Decimal(match.group(1)), exact))
     else:
-        raise UnitError(f"expected {_a(kind)}, got {type(value).__name__}")
+        got = "no value (null)" if value is None else type(value).__name__  # YAML's 'H:' or 'H: null'
+        raise UnitError(f"expected {_a(kind)}, got {got}")
     if not math.isfinite(si):  # "1e308 km" overflows only in SI
         raise UnitError(f"must be finite, got {value!r}")
     if kind == "angle" and abs(si) > MAX_ANGLE:

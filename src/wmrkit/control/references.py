@@ -94,12 +94,12 @@ def reference_from_samples(name: str, t: np.ndarray, pose: np.ndarray) -> Refere
         raise ReferenceError(f"{name}: sample {k + 1}: {('t', 'x', 'y', 'theta')[c]} {value!r} is not a finite "
                              "number (times and poses must be)")
     if np.abs(pose[:, :2]).max() > MAX_COORDINATE:
-        k = int(np.argmax(np.abs(pose[:, :2]).max(axis=1)))
+        k = int(np.argmax(np.abs(pose[:, :2]).max(axis=1) > MAX_COORDINATE))  # the first, as for NaN above
         raise ReferenceError(f"{name}: sample {k + 1}: position ({pose[k, 0]:g}, {pose[k, 1]:g}) m is beyond "
                              f"{MAX_COORDINATE:g} m")
     if np.any(np.diff(t) <= 0):
         k = int(np.argmax(np.diff(t) <= 0))
-        raise ReferenceError(f"{name}: times must increase (sample {k + 1}: {t[k + 1]} after {t[k]})")
+        raise ReferenceError(f"{name}: times must increase (sample {k + 2}: {t[k + 1]} after {t[k]})")
     _check_radians(name, pose[:, 2])
     pose[:, 2] = np.unwrap(pose[:, 2])
     # second-order differences at the ends too: first-order ones put a false curvature jump at the first and last
