@@ -131,9 +131,17 @@ def parse_rows(rows: list[str], usecols: list[int], delimiter: str, source: str,
         if len(fields) != len(header):
             raise _error(f"{source}:{line + k}: expected {len(header)} fields, got {len(fields)}")
         for c in usecols:
-            try:
-                float(fields[c])
-            except ValueError:
+            if not _reads_as_loadtxt(fields[c]):
                 raise _error(f"{source}:{line + k}: column '{header[c]}': cannot read {short(fields[c].strip())} "
-                             f"as a number (field {c + 1})") from None
+                             f"as a number (field {c + 1})")
     raise _error(f"{source}:{line}: cannot read the rows that start here")  # pragma: no cover
+
+
+def _reads_as_loadtxt(field: str) -> bool:
+    """Whether numpy's loadtxt reads `field` as a number: Python's float also takes digit separators and other
+    scripts' digits ('1_0', Arabic-Indic '\u0661'), which loadtxt refuses (the row then got no field named)."""
+    try:
+        float(field)
+    except ValueError:
+        return False
+    return "_" not in field and field.strip().isascii()
