@@ -8,21 +8,12 @@ import json
 
 import pytest
 
+from geared import SYNCHRO
 from wmrkit import Robot, catalog
 from wmrkit.analysis.classification import classify
 from wmrkit.analysis.summary import analyze
 from wmrkit.cli.main import main
 from wmrkit.couplings import Coupling, steering_mechanisms
-
-SYNCHRO = """name: synchro-3
-wheels:
-  - {name: a, type: steerable, position: [0.2, 0], heading: 0, r: 0.05, actuated: [spin, steer], sensed: [spin, steer]}
-  - {name: b, type: steerable, position: [-0.1, 0.1732], heading: 0, r: 0.05, sensed: [steer]}
-  - {name: c, type: steerable, position: [-0.1, -0.1732], heading: 0, r: 0.05, sensed: [steer]}
-couplings:
-  - {kind: gear, joints: [a.spin, b.spin, c.spin]}
-  - {kind: linkage, joints: [a.steer, b.steer, c.steer]}
-"""
 
 
 def test_a_synchro_drive_commands_one_degree_of_steerability(tmp_path, capsys):

@@ -11,29 +11,12 @@ import json
 import numpy as np
 import pytest
 
+from geared import SYNCHRO, cart_yaml
 from wmrkit import Robot, catalog
 from wmrkit.analysis.report import write_report
 from wmrkit.analysis.summary import analyze
 from wmrkit.cli.main import main
 from wmrkit.kinematics.wheel_ik import twist_is_determined
-
-CART = """name: geared-axle
-wheels:
-  - {name: left, type: fixed, position: [0, 0.2], heading: 0, r: 0.075, actuated: [spin], sensed: [spin]}
-  - {name: right, type: fixed, position: [0, -0.2], heading: 0, r: 0.075}
-  - {name: caster, type: castor, position: [-0.25, 0], heading: 0, d: 0.04, r: 0.025}
-couplings:
-  - {kind: gear, joints: [left.spin, right.spin], ratios: [1, RATIO]}
-"""
-SYNCHRO = """name: synchro-3
-wheels:
-  - {name: a, type: steerable, position: [0.2, 0], heading: 0, r: 0.05, actuated: [spin, steer], sensed: [spin, steer]}
-  - {name: b, type: steerable, position: [-0.1, 0.1732], heading: 0, r: 0.05, sensed: [steer]}
-  - {name: c, type: steerable, position: [-0.1, -0.1732], heading: 0, r: 0.05, sensed: [steer]}
-couplings:
-  - {kind: gear, joints: [a.spin, b.spin, c.spin]}
-  - {kind: linkage, joints: [a.steer, b.steer, c.steer]}
-"""
 
 
 def geared_mobility(robot: Robot, ratios: dict[str, float]) -> int:
@@ -50,7 +33,7 @@ def geared_mobility(robot: Robot, ratios: dict[str, float]) -> int:
 @pytest.mark.parametrize("ratio", [1.0, 2.0])
 def test_a_solid_axle_reports_the_geared_mobility_and_no_infinite_condition_number(tmp_path, capsys, ratio):
     path = tmp_path / "cart.yaml"
-    path.write_text(CART.replace("RATIO", repr(ratio)))
+    path.write_text(cart_yaml(ratio))
     robot = Robot.from_file(path)
     m = geared_mobility(robot, {"left.spin": 1.0, "right.spin": ratio})
     assert m == 1 and bool(twist_is_determined(robot, ["left"]))  # as fk says: one encoder gives the twist

@@ -10,6 +10,7 @@ import json
 import numpy as np
 import pytest
 
+from geared import B, R, cart_yaml
 from wmrkit import Robot
 from wmrkit.analysis.summary import analyze
 from wmrkit.cli.main import main
@@ -18,20 +19,10 @@ from wmrkit.kinematics.sensing import sensing_analysis
 from wmrkit.kinematics.wheel_ik import forward_kinematics, forward_kinematics_check, twist_is_determined
 from wmrkit.odometry.model import odometry_model
 
-R, B = 0.075, 0.2
-AXLE = """name: geared-axle
-wheels:
-  - {name: left, type: fixed, position: [0, 0.2], heading: 0, r: 0.075, actuated: [spin], sensed: [spin]}
-  - {name: right, type: fixed, position: [0, -0.2], heading: 0, r: 0.075}
-  - {name: caster, type: castor, position: [-0.25, 0], heading: 0, d: 0.04, r: 0.025}
-couplings:
-  - {kind: gear, joints: [left.spin, right.spin], ratios: [1, RATIO]}
-"""
-
 
 def axle(tmp_path, ratio: float = 2.0):
     path = tmp_path / "axle.yaml"
-    path.write_text(AXLE.replace("RATIO", repr(ratio)))
+    path.write_text(cart_yaml(ratio))
     return path, Robot.from_file(path)
 
 

@@ -10,21 +10,13 @@ import math
 
 import pytest
 
+from geared import cart_yaml
 from wmrkit import Robot
 from wmrkit.cli.main import main
 from wmrkit.kinematics.actuation import selectable_rates
 from wmrkit.kinematics.sensing import minimal_sensor_sets, sensing_analysis
 from wmrkit.kinematics.trees import jacobian_names
 
-CART = """name: geared-axle
-wheels:
-  - {name: left, type: fixed, position: [0, 0.2], heading: 0, r: 0.075, actuated: [spin], sensed: [spin]}
-  - {name: right, type: fixed, position: [0, -0.2], heading: 0, r: 0.075}
-  - {name: FRONT
-couplings:
-  - {kind: gear, joints: [left.spin, right.spin], ratios: [1, RATIO]}
-"""
-CASTOR = "caster, type: castor, position: [-0.25, 0], heading: 0, d: 0.04, r: 0.025}"
 # ratio 2: vx = 1.5 r q, omega = 2.5 r q; the front wheel at x = 0.6 rolls along (vx, 0.6 omega): heading pi/4
 STEERED = f"front, type: steerable, position: [0.6, 0], heading: {math.pi / 4!r}, r: 0.1, sensed: [steer]}}"
 SYNCHRO = """name: synchro-3
@@ -36,9 +28,9 @@ couplings:
   - {kind: gear, joints: [a.spin, b.spin, c.spin]}
   - {kind: linkage, joints: [a.steer, b.steer, c.steer]}
 """
-ROBOTS = {"cart-castor-1": CART.replace("FRONT", CASTOR).replace("RATIO", "1"),
-          "cart-castor-2": CART.replace("FRONT", CASTOR).replace("RATIO", "2"),
-          "cart-steered-2": CART.replace("FRONT", STEERED).replace("RATIO", "2"),
+ROBOTS = {"cart-castor-1": cart_yaml(1),
+          "cart-castor-2": cart_yaml(2),
+          "cart-steered-2": cart_yaml(2, STEERED),
           "synchro-3": SYNCHRO}
 
 

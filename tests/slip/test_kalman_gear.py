@@ -10,6 +10,7 @@ import json
 import numpy as np
 import pytest
 
+from geared import CASTOR, STEERED, B, R, cart_yaml
 from wmrkit import Robot
 from wmrkit.cli.main import main
 from wmrkit.errors import WmrkitError
@@ -18,22 +19,10 @@ from wmrkit.odometry.synthetic import TwistProfile, simulate
 from wmrkit.slip.estimators import estimator
 from wmrkit.slip.kalman import kalman_model
 
-R, B = 0.075, 0.2
-AXLE = """name: geared-axle
-wheels:
-  - {name: left, type: fixed, position: [0, 0.2], heading: 0, r: 0.075, actuated: [spin], sensed: [spin]}
-  - {name: right, type: fixed, position: [0, -0.2], heading: 0, r: 0.075}
-  - {name: FRONT
-couplings:
-  - {kind: gear, joints: [left.spin, right.spin], ratios: [1, RATIO]}
-"""
-CASTOR = "caster, type: castor, position: [-0.25, 0], heading: 0, d: 0.04, r: 0.025}"
-STEERED = "front, type: steerable, position: [0.6, 0], heading: 0, r: 0.1, sensed: [steer]}"
-
 
 def cart(tmp_path, ratio: float, front: str = CASTOR) -> tuple:
     path = tmp_path / "cart.yaml"
-    path.write_text(AXLE.replace("RATIO", repr(ratio)).replace("FRONT", front))
+    path.write_text(cart_yaml(ratio, front))
     return path, Robot.from_file(path)
 
 
