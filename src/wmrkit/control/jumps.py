@@ -6,7 +6,8 @@ is that step (:func:`_folded`). A change is also compared with the one its neigh
 (:func:`_unpredicted`): what is left is a discontinuity where larger than ``jump_factor`` times the typical change of
 a step (or of what is left) and than the floor, which a signal that turns by a typical step every sample (the velocity
 on an arc) hides from the first comparison. Undefined samples (NaN) are bridged: a jump across them is the change
-from the last sample before to the first after, compared with as many typical steps as it spans.
+from the last sample before to the first after, compared with as many typical steps as it spans. Long signals are
+judged by the compiled passes of :mod:`._jump_kernels` (the same bits).
 """
 
 from __future__ import annotations
@@ -63,10 +64,7 @@ def _jumps(x: np.ndarray, t: np.ndarray, turn: float | None, floor: float, facto
     # sample, and a speed doubling there (1 -> 2 m/s, curvature 0.5 1/m at 32 Hz) was 16 typical steps, under the
     # factor, and 250 typical changes of a step
     skip = np.isnan(steps) | np.isnan(d.reshape(n, -1)).any(axis=-1) | (False if cut is None else cut)
-    q = np.where(skip[:, None], np.nan, d.reshape(n, -1) / span[:, None])  # per sample; NaN: no step of the signal
-    r = np.nan_to_num(_unpredicted(q) * span[:, None])
-    rsize = np.sqrt((r * r).sum(axis=-1))
-    change = np.r_[np.sqrt((np.diff(q, axis=0) ** 2).sum(axis=-1)), np.nan]
+    r, rsize, change = _remainders(d.reshape(n, -1), span, skip)
     limit = factor * span * np.maximum(_typical(np.where(skip, np.nan, rsize / span)), _typical(change))
     rpart, rrun = _outliers(r, rsize, limit, floor, turn)
     hit = np.flatnonzero((part & ((size > floor) | (run > floor))) | (rpart & ((rsize > floor) | (rrun > floor))))
@@ -101,6 +99,27 @@ def _typical(steps: np.ndarray) -> np.ndarray:
     blocks = np.where(count > 0, mid, 0.0)
     near = np.maximum(blocks, np.maximum(np.r_[blocks[:1], blocks[:-1]], np.r_[blocks[1:], blocks[-1:]]))
     return np.repeat(near, BLOCK)[:n]
+
+
+#: Samples from which a signal is judged by the compiled passes of :mod:`._jump_kernels` (the same bits): below, numpy
+#: answers before numba would have compiled them.
+COMPILED_FROM = 1 << 19
+
+
+def _remainders(d: np.ndarray, span: np.ndarray, skip: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What of each of the steps `d` ``(n, m)`` its neighbours do not predict (:func:`_unpredicted` of the steps per
+    sample, ``d / span``; none where `skip`), NaN as 0, its size, and the size of the change of each step per sample
+    to the next (NaN: the last)."""
+    q = d / span[:, None]  # per sample; NaN: no step of the signal
+    q[skip] = np.nan
+    if len(q) >= COMPILED_FROM and q.shape[1] < 8:  # numpy sums 8 or more numbers pairwise
+        from ._jump_kernels import unpredicted_sizes
+
+        r, rsize, change = np.empty(q.shape), np.empty(len(q)), np.empty(len(q))
+        unpredicted_sizes(q, np.ascontiguousarray(span), r, rsize, change)
+        return r, rsize, change
+    r = np.nan_to_num(_unpredicted(q) * span[:, None])
+    return r, np.sqrt((r * r).sum(axis=-1)), np.r_[np.sqrt((np.diff(q, axis=0) ** 2).sum(axis=-1)), np.nan]
 
 
 def _unpredicted(q: np.ndarray, chunk: int = 1 << 16) -> np.ndarray:
@@ -150,6 +169,12 @@ def _outliers(d: np.ndarray, size: np.ndarray, limit: np.ndarray, floor: float,
     run, each maybe under the floor: the forklift's turn-rate step of 0.033 rad/s on an S-curve at 0.05 m/s was
     2 x 0.017). `turn`: the period of an angle signal, or None."""
     n = len(size)
+    if n >= COMPILED_FROM and d.reshape(n, -1).shape[1] < 8:
+        from ._jump_kernels import outliers
+
+        part, run = np.empty(n, dtype=bool), np.empty(n)
+        outliers(*map(np.ascontiguousarray, (d.reshape(n, -1), size, limit)), floor, float(turn or 0.0), part, run)
+        return part, run
     z = np.nan_to_num(d.reshape(n, -1))
     pair = np.sqrt(((_wrap(z[:-1] + z[1:], turn) if turn else z[:-1] + z[1:]) ** 2).sum(axis=-1))
     half = (size[:-1] > limit[:-1] / 2) & (size[1:] > limit[1:] / 2) & (pair > np.maximum(limit[:-1], limit[1:]))
