@@ -92,3 +92,21 @@ def test_the_exit_code_says_answer_no_or_no_answer(command, line, code, files, c
         verdict = answer.get("feasible") if isinstance(answer, dict) else None
         if verdict is not None:  # the exit code is the answer's verdict
             assert code == (0 if verdict else 1)
+
+
+@pytest.mark.parametrize("json_flag", [[], ["--json"]])
+def test_running_out_of_memory_is_no_answer_not_a_no(json_flag, capsys, monkeypatch):
+    """A MemoryError (a 1e7-sample feasibility beside other work on a machine without swap) exited 1, an uncaught
+    exception's status, which says 'the reference is not feasible', after a traceback: now one line and 2."""
+    import importlib
+
+    def exhausted(*args, **kwargs):
+        raise MemoryError
+
+    module = importlib.import_module("wmrkit.control.feasibility")  # the module: wmrkit.control's name is its function
+    monkeypatch.setattr(module, "feasibility", exhausted)  # the CLI imports it from there when it runs
+    assert main(["feasibility", "diff-drive", "--reference", "circle", *json_flag]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and "Traceback" not in err and len(err.splitlines()) == 1
+    message = json.loads(err)["error"] if json_flag else err.removeprefix("wmrkit: error: ")
+    assert message.startswith("out of memory") and "'feasibility'" in message

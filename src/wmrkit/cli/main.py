@@ -93,6 +93,11 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except BrokenPipeError:  # e.g. `wmrkit robots | head` (an OSError: caught first)
         return 0
+    except MemoryError:  # no answer (2), not a "no" (1, the exit status of an uncaught exception)
+        report_error(WmrkitError(f"out of memory: the machine could not hold this run of '{command}' (its sizes "
+                                 "and the memory they take: docs/limits.md); free memory or ask for less"), as_json,
+                     argv)
+        return 2
     except OSError as err:
         if err.filename is None:  # not about a file: a bug, with its traceback
             raise
