@@ -21,6 +21,7 @@ from wmrkit.control.references import (
     load_reference,
 )
 from wmrkit.control.track import track
+from wmrkit.control.trackers import follower_duration
 from wmrkit.errors import UnknownNameError
 
 
@@ -149,7 +150,8 @@ def test_pure_pursuit_goal_past_the_path_end_lies_on_its_tangent():
     robot, ref = catalog.load("diff-drive"), builtin_reference("line", duration=4.0)  # 2 m along +x
     control = pure_pursuit(control_point(robot), ref, 1.0)
     twist, _ = control(1.0, np.array([1.99, 0.0, 0.0]), np.zeros(3))  # 1 cm before the end, heading along the path
-    assert twist[2] == pytest.approx(0.0) and twist[0] == pytest.approx(0.5)
+    # slowing to stop at the end: 0.5 m/s scaled by sqrt(0.01 m left / 1 m lookahead)
+    assert twist[2] == pytest.approx(0.0) and twist[0] == pytest.approx(0.5 * math.sqrt(0.01 / 1.0))
     twist, _ = control(1.0, np.array([2.01, 0.0, 0.0]), np.zeros(3))  # 1 cm past it: stopped
     assert (twist == 0).all()
     run = track(robot, ref, controller="pure-pursuit", initial_pose=[0.5, 0.0, 0.0])
@@ -161,10 +163,17 @@ def test_pure_pursuit_goal_past_the_path_end_lies_on_its_tangent():
 def test_geometric_trackers_run_on_past_the_reference_s_end_at_rest(controller, capsys):
     """Their path search looks within 5 s of the run's time: more than 5 s past the reference's end it looked in no
     sample at all ('wmrkit track diff-drive --reference line --controller stanley --duration 40': a traceback,
-    ValueError: attempt to get argmin of an empty sequence). Past its end the reference is at rest: so is the robot."""
+    ValueError: attempt to get argmin of an empty sequence). Once its point has passed the path's end (it slows to
+    stop there, so past the reference's end) the robot is at rest."""
     ref = builtin_reference("line", duration=4.0)  # 2 m along +x
     run = track(catalog.load("diff-drive"), ref, controller=controller, duration=12.0)
-    rest = run.t >= 4.0 + 0.05
+    assert run.t[-1] == pytest.approx(12.0)  # a given duration is run whole
+    arrived = run.t[np.argmax(run.tracked[:, 0] >= 2.0)]
+    assert 4.0 < arrived < 12.0 - 1.0
+    # at rest within the integration step over the stop (< 3 mm at its last 1 cm/s), then exactly
+    rest = run.t >= arrived
+    assert np.abs(run.pose[rest] - run.pose[-1]).max() < 3e-3
+    rest = run.t >= arrived + 1.0
     np.testing.assert_allclose(run.pose[rest], run.pose[rest][:1].repeat(rest.sum(), axis=0), atol=1e-12)
     assert run.tracked[-1, :2] == pytest.approx([2.0, 0.0], abs=1e-3)
     assert main(["track", "diff-drive", "--reference", "line", "--controller", controller, "--duration", "40",
@@ -198,15 +207,16 @@ def test_stanley_stops_at_the_end_of_the_car_s_square():
     path's end at 56 s and drove on along its last tangent until the reference's time ended, 3.76 m past it: the
     final cross-track error was its maximum. Now it stops there: the final point is on the path's end. (A 12 m square
     since Stanley's steering is limited to the car's: turning on its 4 m radius at the corners, it still ends 0.13 m
-    beside the 8 m square's last leg, which is too short to recover on; the 12 m one it reaches at 93.75 s of 96.)"""
+    beside the 8 m square's last leg, which is too short to recover on.) Its front point drives at the path's speed
+    (it reached the end at 93.75 s of 96 at the rear axle's), and slows to stop there: the run ends when it
+    arrives, after the reference's end, within the followers' bounded extra time."""
     ref = builtin_reference("square", size=12.0)
     run = track(catalog.load("ackermann"), ref, controller="stanley")
     end = run.tracked[-1, :2]
     assert np.hypot(*(end - ref.pose[-1, :2])) < 5e-3 and _distance_to_polyline(ref.pose[:, :2], end) < 5e-3
     assert run.cross_track[-1] == pytest.approx(_distance_to_polyline(ref.pose[:, :2], end), abs=1e-9)
     at_end = (np.hypot(*(run.tracked[:, :2] - ref.pose[-1, :2]).T) < 5e-3) & (run.t > 1.0)  # not its start
-    ahead = run.t[np.argmax(at_end)]
-    assert 1.0 < ahead < 95.0  # it arrived early (no time law), and waited
+    assert at_end[-1] and 96.0 < run.t[np.argmax(at_end)] <= follower_duration(96.0)
     assert run.summary()["final_error"] < 5e-3
 
 
@@ -437,7 +447,9 @@ def test_geometric_trackers_start_with_their_point_on_the_reference(controller, 
     robot, ref = catalog.load(name), builtin_reference("line")
     run = track(robot, ref, controller=controller)
     np.testing.assert_allclose(run.tracked[0, :2], ref.pose[0, :2], atol=1e-12)
-    assert run.summary()["max_error"] < 1e-6
+    assert run.cross_track[run.t <= 14.0].max() < 1e-6  # (past the end: the distance from the end point)
+    # on time until they slow to stop at the end (over at most the car's 2.7 m wheelbase, 5.4 s of the line's 20)
+    assert run.error[run.t <= 14.0].max() < 1e-6 and run.summary()["final_error"] < 1e-3
 
 
 def test_track_warns_when_the_wheels_must_slip_to_follow(capsys):

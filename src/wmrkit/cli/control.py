@@ -38,7 +38,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--period", metavar="T", help="sample period [s]; without it the loop is continuous")
     p.add_argument("--delay", type=int, default=0, metavar="N",
                    help="measurement delay in samples (with --period; default 0)")
-    p.add_argument("--duration", metavar="S", help="seconds to simulate (default: the reference's length)")
+    p.add_argument("--duration", metavar="S", help="seconds to simulate (default: the reference's length; pure "
+                   "pursuit and Stanley: until they reach the path's end, at most 50%% (10 s at least) longer)")
     p.add_argument("--steering", default="closest", choices=("closest", "4-quadrant", "2-quadrant"),
                    help="which of the two steering solutions (8.9) a wheel takes (within its steer_range; default "
                         "closest)")
@@ -199,6 +200,7 @@ def run_track(args: argparse.Namespace) -> int:
     """Simulate, then print a summary (or the time series as JSON); warnings on stderr (and in the JSON)."""
     from ..control.laws import GateWarning, SamplingWarning
     from ..control.track import track
+    from ..control.trackers import ArrivalWarning
 
     check_plot_path(args.plot)
     check_animation_path(args.animate)
@@ -227,6 +229,7 @@ def run_track(args: argparse.Namespace) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", SamplingWarning)
         warnings.simplefilter("always", GateWarning)
+        warnings.simplefilter("always", ArrivalWarning)
         try:
             run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
                         lookahead=lookahead, stanley_gain=stanley_gain, period=period, delay=args.delay,
@@ -239,7 +242,7 @@ def run_track(args: argparse.Namespace) -> int:
                 raise
             raise type(err)(f"{err} ({'; '.join(foretold)})") from None
     for w in caught:
-        if issubclass(w.category, (SamplingWarning, GateWarning)):
+        if issubclass(w.category, (SamplingWarning, GateWarning, ArrivalWarning)):
             warn(str(w.message))
     for v in run.range_violations():
         lo, hi = (math.degrees(a) for a in robot.wheel(v["wheel"]).steer_range)

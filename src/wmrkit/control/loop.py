@@ -244,14 +244,17 @@ class _Sim:
 def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *,
              period: float | None = None, delay: int = 0, plant: Plant | None = None, output_dt: float = 0.05,
              skew_free: bool = False, rtol: float = 1e-8, atol: float = 1e-10,
-             breaks: tuple[float, ...] = ()) -> dict[str, np.ndarray]:
+             breaks: tuple[float, ...] = (), until: Callable[[float, np.ndarray], bool] | None = None,
+             ) -> dict[str, np.ndarray]:
     """Close the loop of `robot` under `controller` from `initial_pose` for `duration` [s].
 
     Continuous time (``period`` None; RK45 with `rtol`/`atol`, sampled every `output_dt`: :func:`_integrate`) or
     discrete (commands held for `period` [s], pose measured `delay` samples late, ``skew_free`` applies
     :func:`discretize_twist` to the held twist). Returns arrays: ``t (n,)``, ``pose (n, 3)``, ``twist (n, 3)``
     (commanded), ``beta (n, n_steer)`` (actual steering), ``target (n, n_steer)`` (commanded steering).
-    ``breaks``: times where the reference is discontinuous; the continuous integration restarts there.
+    ``breaks``: times where the reference is discontinuous; the continuous integration restarts there. `until`
+    ``(t, pose) -> bool``: the run ends at the first output sample (or period) where it holds (a path follower that
+    has driven its path).
     """
     plant = plant or Plant()
     sim = _Sim(robot, plant)
@@ -308,7 +311,8 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
 
         sim.hold_margin = math.inf  # within a step; _given_steering switches ends as events
         records = _integrate(counted, x0, t_out, edges, lambda t, x: _record(controller, sim, t, x, split),
-                             lambda t, x: _given_steering(controller, sim, t, x, split), rtol, atol)
+                             lambda t, x: _given_steering(controller, sim, t, x, split), rtol, atol,
+                             None if until is None else lambda r: until(r["t"], r["pose"]))
     else:
         if not (math.isfinite(period) and period > 0):
             raise ControlError(f"period: expected a positive number of seconds, got {period}")
@@ -338,7 +342,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
             x[6:6 + n_s] = records[-1]["beta"]  # steered wheels keep the angle they were given
             if exact:  # a wheel held at the end of its range: the twist its wheels give instead (rhs does it else)
                 held = sim.realised(held, x[6:6 + n_s])[0]
-            if k == n - 1:
+            if k == n - 1 or (until is not None and until(t, x[:3])):
                 break
             x = _advance(rhs, x, t, period, subs, (held, de), exact)
             history.append(x[:3].copy())
@@ -365,14 +369,15 @@ def _advance(rhs, x: np.ndarray, t: float, period: float, subs: int, held: tuple
 
 
 def _integrate(fun, x0: np.ndarray, t_out: np.ndarray, edges: list[float], record, given, rtol: float,
-               atol: float) -> list[dict]:
+               atol: float, until=None) -> list[dict]:
     """The continuous loop: RK45 (scipy's, as ``solve_ivp``) step by step, restarted at the `edges`; `record(t, x)`
     at each of `t_out`. The steered wheels' entries of the state are constant within a step: the steering last
     given, from which the roots and ends are chosen (:func:`~.steering.choose_steering` ``current``), as the sampled
     loop keeps each period's angle. After each step they take the steering just given, ``given(t, x)`` (an array,
     and whether a held wheel changes ends there, past ``HOLD_MARGIN``); within a step a held wheel stays at its end,
     and where it changes ends the instant is located (bisection on the step's interpolant) and the integration
-    restarts there: the hysteresis makes the switch an event, not a discontinuity the integrator chatters on."""
+    restarts there: the hysteresis makes the switch an event, not a discontinuity the integrator chatters on.
+    `until(record)`: the records end at the first for which it holds."""
     from scipy.integrate import RK45
 
     records, x = [], x0
@@ -384,6 +389,8 @@ def _integrate(fun, x0: np.ndarray, t_out: np.ndarray, edges: list[float], recor
             if keep and keep[0] == t0:
                 records.append(record(t0, x))
                 keep.pop(0)
+                if until is not None and until(records[-1]):
+                    return records
             solver = RK45(fun, t0, x, hi, rtol=rtol, atol=atol, max_step=0.25)
             switched = None
             while solver.status == "running" and switched is None:
@@ -406,6 +413,8 @@ def _integrate(fun, x0: np.ndarray, t_out: np.ndarray, edges: list[float], recor
                     switched = b
                 while keep and keep[0] <= t_end:
                     records.append(record(keep[0], dense(keep.pop(0))))
+                    if until is not None and until(records[-1]):
+                        return records
                 y = y.copy()
                 y[6:] = new
                 if switched is None and solver.status == "running" and not np.array_equal(y, solver.y):

@@ -4,6 +4,7 @@ prints, and what a planner, e.g. the parking application, calls to execute a pla
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -21,7 +22,18 @@ from .laws import PositionLaw, check_gate, check_sampling
 from .loop import Plant, simulate
 from .points import ControlError, ControlPoint, StoppedRun, check_delay, control_point, point_pose
 from .references import Reference
-from .trackers import PathIndex, default_lookahead, default_wheelbase, max_curvature, pure_pursuit, stanley
+from .trackers import (
+    ARRIVAL_TOL,
+    ArrivalWarning,
+    PathFollower,
+    PathIndex,
+    default_lookahead,
+    default_wheelbase,
+    follower_duration,
+    max_curvature,
+    pure_pursuit,
+    stanley,
+)
 
 if TYPE_CHECKING:
     from ..slip.kalman import KalmanNoise
@@ -154,6 +166,9 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     """Track `reference` with `robot` (thesis ch. 8): closed loop, continuous (``period`` None) or discrete.
 
     The run's time 0 is the reference's first sample (:func:`from_first_sample`: TUM files carry Unix times).
+    `duration` [s]: default the reference's; a geometric tracker's default run ends once its point has passed the
+    path's end, within :func:`.trackers.follower_duration` (warning :class:`.trackers.ArrivalWarning` when it ends
+    more than ``ARRIVAL_TOL`` from the end); a given `duration` is run whole.
 
     `controller`: ``"p"`` (8.2), ``"pi"`` (8.3), ``"point"`` (8.1), ``"pure-pursuit"``, ``"stanley"``. `gain`: the pole
     ``a`` [1/s] of every coordinate; `integral_gain` ``b`` [1/s^2] of ``"pi"`` (default ``a^2/4``, critically damped);
@@ -180,7 +195,10 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     cp = control_point(robot, point)
     if reference.t[0] != 0.0:  # absolute (TUM: Unix) times: the run's clock starts at the first sample
         reference = from_first_sample(reference)
-    duration = reference.duration if duration is None else float(duration)
+    geometric = controller in ("pure-pursuit", "stanley")
+    given_duration = duration is not None
+    duration = float(duration) if given_duration else _default_duration(reference.duration, geometric, period,
+                                                                         dynamics, output_dt)
     sampled = 0.02 if dynamics and period is None else period
     _check_timing(duration, sampled, output_dt)
     check_delay(delay)
@@ -208,7 +226,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         length = default_wheelbase(cp)
         ctrl = stanley(cp, reference, stanley_gain, length, min(1.2, math.atan(length * max_curvature(robot))))
         tracked_point = cp.axle_point + length * np.array([math.cos(cp.forward), math.sin(cp.forward)])
-    geometric = controller in ("pure-pursuit", "stanley")  # switching goal points: a looser tolerance
+    until = ctrl.finished if isinstance(ctrl, PathFollower) and not given_duration else None
     if initial_pose is None and geometric:  # the tracker's own point starts on the reference, not the law's
         pose0 = initial_pose_on(_full_point(cp, tracked_point), reference)
     if dynamics:
@@ -251,15 +269,19 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         try:
             out = simulate(robot, ctrl, pose0, duration, period=period, delay=delay, plant=Plant(loops, policy),
                            output_dt=output_dt, skew_free=skew_free, breaks=reference.breaks,
-                           rtol=1e-5 if geometric else 1e-8, atol=1e-7 if geometric else 1e-10)
+                           rtol=1e-5 if geometric else 1e-8, atol=1e-7 if geometric else 1e-10, until=until)
         except StoppedRun as err:
             raise _stopped(err, robot, reference, tracked_point, "kinematic") from None
+    if dynamics and until is not None:  # the run ends once the follower has driven its path
+        out = _ended(out, until)
     t, pose = out["t"], out["pose"]
     if not (np.all(np.isfinite(pose)) and np.all(np.abs(pose[:, :2]) <= MAX_COORDINATE)):
         k = int(np.argmax(~(np.isfinite(pose).all(axis=1) & (np.abs(pose[:, :2]) <= MAX_COORDINATE).all(axis=1))))
         raise _stopped(StoppedRun(f"the closed loop diverged at t = {t[k]:.6g} s (the pose leaves "
                                   f"{MAX_COORDINATE:g} m): lower the gain, or shorten the period", float(t[k])),
                        robot, reference, tracked_point, "dynamic" if dynamics else "kinematic")
+    if isinstance(ctrl, PathFollower) and not given_duration:
+        _check_arrival(ctrl, float(t[-1]), pose[-1])
     tcp = _full_point(cp, tracked_point)
     tracked = point_pose(tcp, pose)
     ref = reference.sample(t)
@@ -277,7 +299,45 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                        commands, period, delay, readonly(out["estimate"]) if "estimate" in out and
                        feedback != "pose" else None, slip_model, feedback,
                        readonly(~out["in_range"]) if "in_range" in out else None,
-                       _feasibility(robot, reference, tracked_point, "dynamic" if dynamics else "kinematic", t[-1]))
+                       _feasibility(robot, reference, tracked_point, "dynamic" if dynamics else "kinematic",
+                                    # a follower slows to its own stop at the path's end, not the reference's
+                                    min(t[-1], reference.duration) if geometric else t[-1]))
+
+
+def _default_duration(duration: float, geometric: bool, period: float | None, dynamics: bool,
+                      output_dt: float) -> float:
+    """A run's default length [s]: the reference's `duration`; a path follower's the longer
+    :func:`.trackers.follower_duration` (it ends on arriving), within a continuous kinematic loop's limit."""
+    if not geometric:
+        return duration
+    longest = follower_duration(duration)
+    if period is None and not dynamics:
+        longest = min(longest, max(duration, MAX_CONTINUOUS_SAMPLES * output_dt))
+    return longest
+
+
+def _ended(out: dict[str, Any], until) -> dict[str, Any]:
+    """`out` of a loop through the dynamics up to the first sample where `until(t, pose)` holds."""
+    t = out["t"]
+    done = next((k for k in range(len(t)) if until(float(t[k]), out["pose"][k])), len(t) - 1)
+    return {key: v[:done + 1] if isinstance(v, np.ndarray) and len(v) == len(t) else v for key, v in out.items()}
+
+
+def _check_arrival(follower: PathFollower, end: float, pose: np.ndarray) -> None:
+    """Warn (:class:`.trackers.ArrivalWarning`) when a follower's default run ended with its tracked point more than
+    ``ARRIVAL_TOL`` from the path's end: still on its way after the bounded run, or past the end beside it."""
+    gap = follower.end_distance(pose)
+    if gap <= ARRIVAL_TOL:
+        return
+    if follower.finished(end, pose):
+        why = "it passed the path's end beside it"
+    else:
+        s = follower.path.project(follower.tracked(pose), end)[0]
+        why = (f"the run ended at {end:.4g} s (the reference's duration, {follower.path.ref.duration:.4g} s, and "
+               f"the followers' extra time) at {s:.4g} m of the path's {follower.path.s[-1]:.4g} m: give a longer "
+               "duration (--duration)")
+    warnings.warn(f"the path follower did not reach the path's end: its tracked point ended {gap:.4g} m from it, "
+                  f"beyond the {ARRIVAL_TOL:g} m tolerance; {why}", ArrivalWarning, stacklevel=3)
 
 
 def _stopped(err: StoppedRun, robot: Robot, reference: Reference, point: np.ndarray,

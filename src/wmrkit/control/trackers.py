@@ -1,26 +1,32 @@
 """What users use today, on the same robots and references: pure pursuit and Stanley (beyond the thesis).
 
-Both steer a point of the robot onto the reference *path* at the reference's speed (they do not correct timing):
+Both steer a point of the robot onto the reference *path* (they do not correct timing), at the path's speed where
+that point is on it (:meth:`PathIndex.speed`: the reference's speed where it passes the point's projection, as
+path followers take it from the path, not from a clock), slowing to stop at the path's end
+(:meth:`PathIndex.approach`):
 
 - **pure pursuit** (Coulter 1992): the axle point ``A`` (the foot of the fixed axle, the origin without fixed wheels)
   drives on the arc through a goal point ``lookahead`` metres further along the path (past its end: on its final
   tangent): curvature ``kappa = 2 y_g / L_d^2``; a goal behind ``A`` (``x_g <= 0``) turns it round on the circle of
   diameter ``L_d`` (``kappa = +-2 / L_d``, towards the goal's side, left when straight behind); ``L_d`` defaults to
   the wheelbase (:func:`default_lookahead`);
-- **Stanley** (Thrun et al. 2006): a front point ``F`` at ``wheelbase`` ahead of ``A``; steering
-  ``delta = psi_e - atan(k e / (v + eps))`` with the heading error ``psi_e`` and the signed cross-track error ``e`` of
-  ``F`` (positive left), curvature ``tan(delta) / wheelbase``.
+- **Stanley** (Thrun et al. 2006; Hoffmann et al. 2007): a front point ``F`` at ``wheelbase`` ahead of ``A``;
+  steering ``delta = psi_e - atan(k e / (v_F + eps))`` with the heading error ``psi_e``, the signed cross-track
+  error ``e`` of ``F`` (positive left) and ``F``'s speed ``v_F`` (the path's: the front axle's, as in Hoffmann's
+  law, whose cross-track error then obeys ``e' = -v_F sin(atan(k e / v_F))``); ``A`` drives at
+  ``v_F cos(delta)``, turning at ``v_F sin(delta) / wheelbase``.
 
 Both limit the curvature to the robot's tightest turn (:func:`max_curvature`: a car's steering stops).
 The resulting unicycle twist ``(v, omega)`` at ``A`` along the robot's rolling direction is moved to the origin
 (rigid body) and goes through the same per-wheel IK as the thesis's controller. Neither has a time law: each stops
-once its point has passed the path's end (a robot ahead of the reference waits there; one behind stops where it is
-when the reference does, at its end).
+once its point has passed the path's end (:class:`PathFollower`), and a default run of :func:`.track.track` lasts
+until then, or at most :func:`follower_duration` (:class:`ArrivalWarning` when it ends away from the end).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -29,10 +35,33 @@ from .loop import TwistController
 from .points import ControlError, ControlPoint
 from .references import Reference
 
-__all__ = ["PathIndex", "default_lookahead", "default_wheelbase", "max_curvature", "pure_pursuit", "stanley"]
+__all__ = ["ARRIVAL_TOL", "ArrivalWarning", "PathFollower", "PathIndex", "default_lookahead", "default_wheelbase",
+           "follower_duration", "max_curvature", "pure_pursuit", "stanley"]
 
 #: The shortest default lookahead of pure pursuit [m] (:func:`default_lookahead`).
 MIN_LOOKAHEAD = 1.0
+#: The slowest a follower drives along its path, as a fraction of the reference's top speed (where the reference is
+#: at rest, or crawls: a start from rest would never leave it).
+MIN_SPEED_FRACTION = 0.1
+#: A follower slows to stop at the path's end over its own length ``L`` (pure pursuit's lookahead; Stanley's
+#: wheelbase, at least ``MIN_LOOKAHEAD``): its
+#: speed is scaled by ``sqrt(d / L)`` within ``d < L`` of the end along the path (a constant deceleration, as a
+#: driver brakes), at least by ``APPROACH_FLOOR`` (it creeps over the last ``APPROACH_FLOOR**2 L``, and arrives).
+APPROACH_FLOOR = 0.005
+#: A follower's default run: the reference's duration and up to this fraction of it more, at least ``EXTRA_MIN`` s
+#: (:func:`follower_duration`); it ends once the tracked point has passed the path's end.
+EXTRA_FRACTION, EXTRA_MIN = 0.5, 10.0
+#: A follower that ends farther than this [m] from the path's end did not arrive (:class:`ArrivalWarning`).
+ARRIVAL_TOL = 0.1
+
+
+class ArrivalWarning(UserWarning):
+    """A path follower's default run ended with its tracked point away from the path's end."""
+
+
+def follower_duration(duration: float) -> float:
+    """The longest default run [s] of a path follower on a reference of `duration` [s]."""
+    return duration + max(EXTRA_MIN, EXTRA_FRACTION * duration)
 
 
 class PathIndex:
@@ -45,6 +74,23 @@ class PathIndex:
         self.s = np.concatenate([[0.0], np.cumsum(seg)])
         self.half = 0.5 * seg
         self.window = window
+        speed = np.hypot(*reference.velocity[:, :2].T)
+        moving = speed > 1e-9
+        self._s_moving, self._v_moving = self.s[moving], speed[moving]
+        self.min_speed = MIN_SPEED_FRACTION * float(speed.max())
+
+    def speed(self, s: float) -> float:
+        """The reference's speed [m/s] where it passes arc length `s` [m] (interpolated between its moving samples),
+        at least ``MIN_SPEED_FRACTION`` of its top speed; 0 for a reference that never moves."""
+        if not len(self._v_moving):
+            return 0.0
+        return max(float(np.interp(s, self._s_moving, self._v_moving)), self.min_speed)
+
+    def approach(self, s: float, length: float) -> float:
+        """The factor in [``APPROACH_FLOOR``, 1] of the speed at arc length `s` [m] that stops a follower of
+        `length` [m] at the path's end (see ``APPROACH_FLOOR``)."""
+        left = max(float(self.s[-1]) - s, 0.0)
+        return 1.0 if left >= length else max(math.sqrt(left / length), APPROACH_FLOOR)
 
     def _feet(self, point: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Distance [m] from `point` to segments `j` (segment ``j`` joins samples ``j`` and ``j + 1``) and the
@@ -196,12 +242,28 @@ def _twist_at_origin(cp: ControlPoint, v: float, omega: float) -> np.ndarray:
     return np.array([vx + omega * ay, vy - omega * ax, omega])
 
 
-def _speed(ref: Reference, t: float) -> float:
-    return float(np.hypot(*ref.at(t)[1][:2]))
+class PathFollower:
+    """A geometric tracker: the :data:`TwistController` `law`, and the path it follows with its `tracked` point
+    (``pose -> (2,)`` world [m]), to tell when that point has driven it to the end (:meth:`finished`)."""
+
+    def __init__(self, path: PathIndex, tracked: Callable[[np.ndarray], np.ndarray], law: TwistController) -> None:
+        self.path, self.tracked, self.law = path, tracked, law
+
+    def __call__(self, t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self.law(t, pose, integral)
+
+    def finished(self, t: float, pose: np.ndarray) -> bool:
+        """Whether the tracked point has passed the path's end at `t` (the law then commands rest, for ever)."""
+        p = self.tracked(pose)
+        return self.path.done(p, self.path.project(p, t)[0])
+
+    def end_distance(self, pose: np.ndarray) -> float:
+        """Distance [m] of the tracked point from the path's end."""
+        return float(np.hypot(*(self.tracked(pose) - self.path.xy[-1])))
 
 
 def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0,
-                 curvature: float = math.inf) -> TwistController:
+                 curvature: float = math.inf) -> PathFollower:
     """Pure-pursuit controller (see module doc); `lookahead` [m], > 0; the commanded curvature is limited to
     ``+-curvature`` [1/m] (the robot's tightest turn, :func:`max_curvature`)."""
     if not 0 < lookahead < math.inf:  # NaN included
@@ -211,7 +273,7 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0,
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         a, psi = _axle_state(cp, pose)
         s_near, _, _ = path.project(a, t)
-        if path.done(a, s_near):  # the path is driven: stop (no time law to wait for the reference)
+        if path.done(a, s_near):  # the path is driven: stop
             return np.zeros(3), np.zeros(3)
         d = path.point_at(s_near + lookahead) - a
         c, s = math.cos(psi), math.sin(psi)
@@ -224,14 +286,14 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0,
         else:  # goal behind (the path runs against the robot): 2 y_g / L^2 ~ 0 drove straight away; turn round
             kappa = math.copysign(2.0 / math.sqrt(dist2), y_g)
         kappa = min(max(kappa, -curvature), curvature)
-        v = _speed(reference, t)
+        v = path.speed(s_near) * path.approach(s_near, lookahead)  # the path's speed where the robot is on it
         return _twist_at_origin(cp, v, v * kappa), np.zeros(3)
 
-    return control
+    return PathFollower(path, lambda pose: _axle_state(cp, pose)[0], control)
 
 
 def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase: float | None = None,
-            max_steer: float = 1.2) -> TwistController:
+            max_steer: float = 1.2) -> PathFollower:
     """Stanley controller (see module doc); cross-track `gain` [1/s], steering limited to ``+-max_steer`` [rad]."""
     length = default_wheelbase(cp) if wheelbase is None else wheelbase
     if not 0 <= gain < math.inf:
@@ -240,18 +302,23 @@ def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase
         raise ControlError(f"wheelbase: expected a distance > 0 m, got {length}")
     if not 0 < max_steer < math.pi / 2:
         raise ControlError(f"max_steer: expected a steering limit in (0, 90) deg [rad], got {max_steer}")
-    path = PathIndex(reference)
+    path, stopping = PathIndex(reference), max(length, MIN_LOOKAHEAD)
+
+    def front(pose: np.ndarray) -> np.ndarray:
+        a, psi = _axle_state(cp, pose)
+        return a + length * np.array([math.cos(psi), math.sin(psi)])
 
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        a, psi = _axle_state(cp, pose)
-        f = a + length * np.array([math.cos(psi), math.sin(psi)])
+        psi = _axle_state(cp, pose)[1]
+        f = front(pose)
         s_front, chi, e = path.project(f, t)
         if path.done(f, s_front):  # the path is driven: stop
             return np.zeros(3), np.zeros(3)
-        v = _speed(reference, t)
+        v_front = path.speed(s_front) * path.approach(s_front, stopping)  # the front point's (Hoffmann et al. 2007)
         psi_e = math.remainder(chi - psi, 2 * math.pi)
-        delta = psi_e - math.atan2(gain * e, v + 1e-3)
+        delta = psi_e - math.atan2(gain * e, v_front + 1e-3)
         delta = min(max(delta, -max_steer), max_steer)
-        return _twist_at_origin(cp, v, v * math.tan(delta) / length), np.zeros(3)
+        v = v_front * math.cos(delta)  # the axle point's: the front one's along the heading
+        return _twist_at_origin(cp, v, v_front * math.sin(delta) / length), np.zeros(3)
 
-    return control
+    return PathFollower(path, front, control)
