@@ -320,9 +320,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
         n = math.floor(duration / period + 1e-9) + 1
         x, history, records = x0.copy(), [x0[:3].copy()], []
         integral = np.zeros(3)
-        exact = plant.loops is None and not sim.passive.any()  # the ideal plant's exact SE(2) step
-        step = 0.02 if plant.loops is None else min(0.02, plant.loops.time_scale)  # RK4 is stable within a few
-        subs = 1 if exact else max(1, math.ceil(min(period / step, 1e18)))  # time scales of the fastest loop
+        exact, step, subs = _sampled_steps(plant, bool(sim.passive.any()), period)
         work = n if exact else n * (1 + 4 * subs)
         if work > MAX_SAMPLED_EVALUATIONS:
             steps = "" if exact else (f" of {subs:.3g} RK4 substep(s) (castors, or low-level loops: each at most the "
@@ -347,6 +345,22 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
             x = _advance(rhs, x, t, period, subs, (held, de), exact)
             history.append(x[:3].copy())
     return {key: np.array([r[key] for r in records]) for key in ("t", "pose", "twist", "beta", "target", "in_range")}
+
+
+def _sampled_steps(plant: Plant, castors: bool, period: float) -> tuple[bool, float, int]:
+    """How a sampled loop advances a period: ``(exact, step, subs)``, the ideal plant's exact SE(2) step (one
+    evaluation a period), else `subs` RK4 substeps of at most `step` [s] (1 + 4 evaluations each)."""
+    exact = plant.loops is None and not castors
+    step = 0.02 if plant.loops is None else min(0.02, plant.loops.time_scale)  # RK4 is stable within a few
+    return exact, step, 1 if exact else max(1, math.ceil(min(period / step, 1e18)))  # time scales of the fastest
+
+
+def longest_sampled_run(robot: Robot, plant: Plant | None, period: float) -> float:
+    """The longest duration [s] a sampled loop of `robot` at `period` [s] simulates within
+    ``MAX_SAMPLED_EVALUATIONS`` (:func:`simulate` refuses a longer one)."""
+    castors = any(robot.wheel(n).type in ("castor", "double_castor") for n in robot.steer_names)
+    exact, _, subs = _sampled_steps(plant or Plant(), castors, period)
+    return (MAX_SAMPLED_EVALUATIONS // (1 if exact else 1 + 4 * subs) - 1) * period
 
 
 def _advance(rhs, x: np.ndarray, t: float, period: float, subs: int, held: tuple, exact: bool) -> np.ndarray:

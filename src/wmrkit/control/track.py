@@ -4,7 +4,6 @@ prints, and what a planner, e.g. the parking application, calls to execute a pla
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -18,18 +17,16 @@ from ..robot import Robot
 from ..wheels import heading_from_beta
 from .actuators import LowLevelLoops
 from .feasibility import BLOCK, Feasibility, feasibility
+from .follower_run import Limit, check_arrival, ended, follower_bound, span
 from .laws import PositionLaw, check_gate, check_sampling
-from .loop import Plant, simulate
+from .loop import MAX_SAMPLED_EVALUATIONS, Plant, longest_sampled_run, simulate
 from .points import ControlError, ControlPoint, StoppedRun, check_delay, control_point, point_pose
 from .references import Reference
 from .trackers import (
-    ARRIVAL_TOL,
-    ArrivalWarning,
     PathFollower,
     PathIndex,
     default_lookahead,
     default_wheelbase,
-    follower_duration,
     max_curvature,
     pure_pursuit,
     stanley,
@@ -167,8 +164,9 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
 
     The run's time 0 is the reference's first sample (:func:`from_first_sample`: TUM files carry Unix times).
     `duration` [s]: default the reference's; a geometric tracker's default run ends once its point has passed the
-    path's end, within :func:`.trackers.follower_duration` (warning :class:`.trackers.ArrivalWarning` when it ends
-    more than ``ARRIVAL_TOL`` from the end); a given `duration` is run whole.
+    path's end, within :func:`.trackers.follower_duration`, its extra time cut to what the loop's limits allow
+    (:func:`.follower_run.follower_bound`; warning :class:`.trackers.ArrivalWarning` when it ends more than
+    ``ARRIVAL_TOL`` from the end, naming the limit that cut it); a given `duration` is run whole.
 
     `controller`: ``"p"`` (8.2), ``"pi"`` (8.3), ``"point"`` (8.1), ``"pure-pursuit"``, ``"stanley"``. `gain`: the pole
     ``a`` [1/s] of every coordinate; `integral_gain` ``b`` [1/s^2] of ``"pi"`` (default ``a^2/4``, critically damped);
@@ -197,9 +195,16 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         reference = from_first_sample(reference)
     geometric = controller in ("pure-pursuit", "stanley")
     given_duration = duration is not None
-    duration = float(duration) if given_duration else _default_duration(reference.duration, geometric, period,
-                                                                         dynamics, output_dt)
     sampled = 0.02 if dynamics and period is None else period
+    slipping = slip_model != "none" or feedback not in ("pose", "odometry") or ramp
+    cut = None
+    if given_duration:
+        duration = float(duration)
+    elif geometric:  # a longer run, within the loop's limits
+        limits = _limits(robot, Plant(loops, policy), sampled, dynamics, slipping, output_dt)
+        duration, cut = follower_bound(reference.duration, limits)
+    else:
+        duration = reference.duration
     _check_timing(duration, sampled, output_dt)
     check_delay(delay)
     if sampled is not None and delay > 0 and delay * sampled >= duration:
@@ -238,7 +243,6 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         from ..dynamics.simulate import LiftOffError
 
         period = 0.02 if period is None else period
-        slipping = slip_model != "none" or feedback not in ("pose", "odometry") or ramp
         _check_dynamic_work(duration, period, slipping)
         try:
             if slipping:
@@ -273,7 +277,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         except StoppedRun as err:
             raise _stopped(err, robot, reference, tracked_point, "kinematic") from None
     if dynamics and until is not None:  # the run ends once the follower has driven its path
-        out = _ended(out, until)
+        out = ended(out, until)
     t, pose = out["t"], out["pose"]
     if not (np.all(np.isfinite(pose)) and np.all(np.abs(pose[:, :2]) <= MAX_COORDINATE)):
         k = int(np.argmax(~(np.isfinite(pose).all(axis=1) & (np.abs(pose[:, :2]) <= MAX_COORDINATE).all(axis=1))))
@@ -281,7 +285,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                                   f"{MAX_COORDINATE:g} m): lower the gain, or shorten the period", float(t[k])),
                        robot, reference, tracked_point, "dynamic" if dynamics else "kinematic")
     if isinstance(ctrl, PathFollower) and not given_duration:
-        _check_arrival(ctrl, float(t[-1]), pose[-1])
+        check_arrival(ctrl, float(t[-1]), pose[-1], cut)
     tcp = _full_point(cp, tracked_point)
     tracked = point_pose(tcp, pose)
     ref = reference.sample(t)
@@ -304,40 +308,28 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                                     min(t[-1], reference.duration) if geometric else t[-1]))
 
 
-def _default_duration(duration: float, geometric: bool, period: float | None, dynamics: bool,
-                      output_dt: float) -> float:
-    """A run's default length [s]: the reference's `duration`; a path follower's the longer
-    :func:`.trackers.follower_duration` (it ends on arriving), within a continuous kinematic loop's limit."""
-    if not geometric:
-        return duration
-    longest = follower_duration(duration)
-    if period is None and not dynamics:
-        longest = min(longest, max(duration, MAX_CONTINUOUS_SAMPLES * output_dt))
-    return longest
+def _limits(robot: Robot, plant: Plant, sampled: float | None, dynamics: bool, slipping: bool,
+            output_dt: float) -> list[Limit]:
+    """The longest runs the loop allows [s] (the refusals of :func:`_check_timing`, :func:`.loop.simulate`,
+    :func:`_check_continuous_work`, :func:`_check_dynamic_work`), each with how to lift it."""
+    step = output_dt if sampled is None else sampled
+    out = [Limit(span(MAX_SAMPLES, step), f"the limit of {MAX_SAMPLES:.0e} samples of {step:g} s",
+                 "give a longer period (--period)")]
+    if dynamics:
+        from ..dynamics.simulate import MAX_STEPS
 
-
-def _ended(out: dict[str, Any], until) -> dict[str, Any]:
-    """`out` of a loop through the dynamics up to the first sample where `until(t, pose)` holds."""
-    t = out["t"]
-    done = next((k for k in range(len(t)) if until(float(t[k]), out["pose"][k])), len(t) - 1)
-    return {key: v[:done + 1] if isinstance(v, np.ndarray) and len(v) == len(t) else v for key, v in out.items()}
-
-
-def _check_arrival(follower: PathFollower, end: float, pose: np.ndarray) -> None:
-    """Warn (:class:`.trackers.ArrivalWarning`) when a follower's default run ended with its tracked point more than
-    ``ARRIVAL_TOL`` from the path's end: still on its way after the bounded run, or past the end beside it."""
-    gap = follower.end_distance(pose)
-    if gap <= ARRIVAL_TOL:
-        return
-    if follower.finished(end, pose):
-        why = "it passed the path's end beside it"
+        out.append(Limit(span(MAX_STEPS, DYNAMICS_STEP), f"the dynamics' limit of {MAX_STEPS:.0e} integration steps",
+                         "give a shorter reference"))
+        if slipping:
+            out.append(Limit(span(MAX_SLIP_PERIODS, step), f"the limit of {MAX_SLIP_PERIODS} periods with the slip "
+                             "model", "give a longer period (--period)"))
+    elif sampled is None:
+        out.append(Limit(span(MAX_CONTINUOUS_SAMPLES, output_dt), "the continuous loop's limit of "
+                         f"{MAX_CONTINUOUS_SAMPLES * output_dt:g} s", "give a sample period (--period)"))
     else:
-        s = follower.path.project(follower.tracked(pose), end)[0]
-        why = (f"the run ended at {end:.4g} s (the reference's duration, {follower.path.ref.duration:.4g} s, and "
-               f"the followers' extra time) at {s:.4g} m of the path's {follower.path.s[-1]:.4g} m: give a longer "
-               "duration (--duration)")
-    warnings.warn(f"the path follower did not reach the path's end: its tracked point ended {gap:.4g} m from it, "
-                  f"beyond the {ARRIVAL_TOL:g} m tolerance; {why}", ArrivalWarning, stacklevel=3)
+        out.append(Limit(longest_sampled_run(robot, plant, sampled), f"the sampled loop's limit of "
+                         f"{MAX_SAMPLED_EVALUATIONS} evaluations", "give a longer period (--period)"))
+    return out
 
 
 def _stopped(err: StoppedRun, robot: Robot, reference: Reference, point: np.ndarray,
