@@ -21,7 +21,7 @@ import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -29,6 +29,11 @@ from ..odometry.logs import LogFormat
 from ..robot import Robot
 from .engine import BatchError, Engine, TaskFailure, engine
 from .parquet import RowSink, check_table, parts_dir, read_rows
+
+if TYPE_CHECKING:
+    from ..odometry.diagnostics import Diagnosis
+    from ..odometry.model import OdometryModel
+    from ..odometry.pipeline import OdometrySummary
 
 #: Columns of the batch-odometry table (name, type and unit, :data:`.parquet.Schema`).
 SUMMARY_SCHEMA = (
@@ -41,6 +46,9 @@ SUMMARY_SCHEMA = (
 )
 #: Columns a table must have to be a batch-odometry table at all (an older one lacks some others: it is redone).
 KEY_COLUMNS = ("log", "robot", "method", "error", "trajectory")
+#: Version of what a row holds, in its settings digest: a row of an older version is redone (2: odometry's
+#: diagnostic lines in ``warnings``).
+ROW_VERSION = 2
 #: Suffixes of single-file logs found in a folder (CSV joint logs, ROS 2 bag files).
 LOG_SUFFIXES = (".csv", ".db3", ".mcap")
 
@@ -54,7 +62,7 @@ class LogJob:
     method: str = "exact"
     trajectory: str | None = None
     closed: bool = False
-    slip_warning: float = 0.01
+    slip_warning: float | None = None  # an absolute slip threshold [m per interval] besides odometry's rule
     options: Mapping[str, Any] = field(default_factory=dict)  # more keyword arguments of odometry_file
     model: Any = None  # the odometry model, built once per batch (else per log, from options' sensed/weights)
     header: Mapping[str, Any] | None = None  # without options["fmt"]: a CSV log's format from its header and these
@@ -131,18 +139,16 @@ def process_log(job: LogJob) -> dict[str, Any]:
             if job.header is not None and not is_bag(job.path):  # each log says its units (odometry's rule)
                 options["fmt"] = header_format(job.path, job.robot.name, model.joints, **job.header)
             s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=model, **options)
-            stepped = _steering_step(job.robot, job.path, model, options)
+            diagnosis = _diagnose(job, s, model, options)
         except Exception as err:
             row.update(error=_message(err), trajectory=None, wall_time=time.perf_counter() - t0)
             return row
     x, y, theta = s.final_pose
-    notes = [" ".join(str(w.message).split()) for w in caught]
-    if s.max_slip > job.slip_warning:
+    notes = [" ".join(str(w.message).split()) for w in caught] + list(diagnosis.warnings)
+    if job.slip_warning is not None and s.max_slip > job.slip_warning:
         notes.append(f"slip indicator up to {s.max_slip:.3g} m per interval (threshold {job.slip_warning:g} m)")
     if s.samples < 2:
         notes.append("a single sample: no motion")
-    if stepped:
-        notes.append(stepped)
     row.update(samples=s.samples, start_time=s.start_time, duration=s.end_time - s.start_time, x=x, y=y, theta=theta,
                path_length=s.path_length, rotation=s.rotation, max_slip=s.max_slip, rms_slip=s.rms_slip,
                max_dt=s.max_dt, warnings="; ".join(notes) or None, wall_time=time.perf_counter() - t0)
@@ -151,23 +157,20 @@ def process_log(job: LogJob) -> dict[str, Any]:
     return row
 
 
-def _steering_step(robot: Robot, path: str, model, options: Mapping[str, Any]) -> str | None:
-    """``wmrkit odometry``'s steering-step warning over the log's first samples
-    (:func:`~wmrkit.odometry.steering.steering_step_warning`), None without sensed steering."""
+def _diagnose(job: LogJob, s: OdometrySummary, model: OdometryModel, options: Mapping[str, Any]) -> Diagnosis:
+    """``wmrkit odometry``'s diagnostics of the log's run `s` (:func:`~wmrkit.odometry.diagnostics.diagnose`: slip per
+    wheel, external heading, gears, steering steps), over its first samples, read only when a check needs them."""
+    from ..odometry.diagnostics import diagnose
     from ..odometry.files import first_samples
-    from ..odometry.steering import steering_step_warning
 
-    if not model.steer_joints:
-        return None
-    log = first_samples(robot, path, model.joints, **{k: options[k] for k in ("fmt", "topic", "joint_names")
-                                                      if k in options})
-    return steering_step_warning(model, log)
+    reading = {k: options[k] for k in ("fmt", "topic", "joint_names") if k in options}
+    return diagnose(s, model, lambda: first_samples(job.robot, job.path, model.joints, **reading), options.get("fmt"))
 
 
 def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runner: Engine | None = None,
                    method: str = "exact", out: str | os.PathLike[str] | None = None,
                    trajectories: str | os.PathLike[str] | None = None, trajectory_format: str = "tum",
-                   closed: bool = False, resume: bool = True, progress: bool = False, slip_warning: float = 0.01,
+                   closed: bool = False, resume: bool = True, progress: bool = False, slip_warning: float | None = None,
                    fmt: LogFormat | None = None, header: Mapping[str, Any] | None = None,
                    topic: str = "/joint_states", joint_names: Mapping[str, str] | None = None,
                    sensed: Sequence[str] | None = None, weights: Mapping[str, float] | None = None) -> FleetResult:
@@ -180,12 +183,15 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     `fmt`, each CSV log is read as its header says (units in brackets, :func:`~wmrkit.odometry.header.header_format`
     with the settings `header`, e.g. ``{"time_unit": "ms"}``), as ``wmrkit odometry`` reads one.
     With `resume`, rows of `out` (and of its part files) without error are kept and their logs skipped.
+    Each row's ``warnings`` are ``wmrkit odometry``'s lines for its log (:mod:`wmrkit.odometry.diagnostics`), and
+    with `slip_warning` [m] a note where the slip indicator exceeds it.
     """
     from ..odometry.integrators import check_method
     from ..odometry.model import odometry_model
 
     check_method(method)  # type: ignore[arg-type]
-    if not (isinstance(slip_warning, int | float) and math.isfinite(slip_warning) and slip_warning >= 0):
+    if slip_warning is not None and not (isinstance(slip_warning, int | float) and math.isfinite(slip_warning)
+                                         and slip_warning >= 0):
         raise BatchError(f"slip_warning must be a finite length >= 0 m, got {slip_warning!r}")  # NaN: never warned
     model = odometry_model(robot, sensed, weights=weights)  # once: the same for every log (a bad --sensed fails here)
     options = {"topic": topic, "joint_names": joint_names}
@@ -213,7 +219,7 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     if trajectory_format not in ("csv", "tum"):
         raise BatchError(f"trajectory format must be csv or tum, got '{trajectory_format}'")
     targets = _trajectory_names(paths, trajectories, trajectory_format)
-    batch = _fingerprint(robot, method, closed, slip_warning, options, header, sensed, weights)
+    batch = _fingerprint(robot, method, closed, slip_warning, options, header, sensed, weights, ROW_VERSION)
     settings = {p: _fingerprint(batch, _stat(p)) for p in paths}
     # an existing --out must be a table of this command (it is replaced at the end), even without resuming
     current = check_table(out, SUMMARY_SCHEMA, KEY_COLUMNS) if out is not None and Path(out).is_file() else True

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import functools
 import math
 import os
 import sys
@@ -11,14 +10,14 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..couplings import gear_breaches
 from ..errors import WmrkitError
 from ..limits import check_chunk_size
 from ..odometry.covariance import CrowleyNoise
+from ..odometry.diagnostics import diagnose
 from ..odometry.files import first_samples, is_bag, odometry_file
 from ..odometry.header import header_format
 from ..odometry.integrators import METHODS
-from ..odometry.logs import TIME_UNITS, LogFormat
+from ..odometry.logs import TIME_UNITS
 from ..odometry.model import odometry_model
 from ..odometry.pipeline import OdometrySummary, check_start_pose
 from ._common import (
@@ -110,7 +109,8 @@ def run(args: argparse.Namespace) -> int:
     check_chunk_size(args.chunk_size, WmrkitError, "--chunk-size")
     if not all(math.isfinite(k) and k >= 0 for k in args.crowley):
         raise WmrkitError(f"--crowley: coefficients must be finite and >= 0, got {' '.join(map(str, args.crowley))}")
-    joints = odometry_model(robot, args.sensed).joints
+    model = odometry_model(robot, args.sensed)  # the no-slip model of the diagnostics (the run's, without weights)
+    joints = model.joints
     steer_option = "--steer" if args.steer else "--steer-convention" if args.steer_convention else None
     if steer_option and not any(j.endswith(".steer") for j in joints):  # it would be ignored silently
         raise WmrkitError(f"{steer_option} applies to steering columns; robot '{robot.name}' reads none (sensed: "
@@ -158,13 +158,12 @@ def run(args: argparse.Namespace) -> int:
     if args.method in ("fk1", "fk2"):
         _warn_ill_conditioned(args.method, slip_model.model)
     names = parse_assignments(args.joint_name, "--joint-name")
-    first = functools.cache(lambda: _first_samples(robot, args.log, fmt, args.sensed, args.topic, names))  # once
-    consistent = _check_consistency(summary, lambda: _wheel_slips(first),
-                                    filtered=args.method if args.method in ("fk1", "fk2") else None)
-    if fmt.heading_column or fmt.gyro_column:
-        consistent = _check_heading(fmt, first) and consistent
-    consistent = _check_gears(robot, first) and consistent
-    _check_steering_steps(robot, args.sensed, first)  # the sampling, not the data: consistent as it is
+    filtered = args.method if args.method in ("fk1", "fk2") else None
+    diagnosis = diagnose(summary, model, lambda: first_samples(robot, args.log, model.joints, fmt=fmt, topic=args.topic,
+                                                               joint_names=names), fmt, filtered=filtered)
+    for line in diagnosis.warnings:
+        warn(line)
+    consistent = diagnosis.consistent
     if args.json:
         print_json(summary.to_dict() | {"consistent": consistent})
     else:
@@ -188,119 +187,6 @@ def _warn_ill_conditioned(name: str, model) -> None:
            f"barely fix the twist (condition number {worst[0]:.3g} > {ILL_CONDITIONED:g})")
     warn(f"{name}: at a steering heading of the log ({where}) its measurement rows {fix}: there the filter carries "
          f"its prediction and the trajectory can be far off{'; use --method fk2 or wls' if name == 'fk1' else ''}")
-
-
-#: Slip tolerance of a log: an RMS slip indicator above this fraction of the mean motion per interval means the
-#: sensed joints contradict each other (the same rule as ``wmrkit fk``, FK_SLIP_RTOL).
-LOG_SLIP_RTOL = 0.02
-
-
-def _check_consistency(s: OdometrySummary, wheel_slips, *, filtered: str | None = None) -> bool:
-    """Warn (:func:`._common.warn`) when the slip indicator exceeds the tolerance, naming the wheels that slip most
-    (`wheel_slips()`, RMS per wheel of the no-slip model); return whether it did not. A slip indicator as large as
-    the motion itself means units, signs or the description are wrong. A Kalman filter's indicator (`filtered`:
-    its name) is its residual, which also holds its lag behind the measurements: where the no-slip model's own
-    slips stay within the tolerance, the warning says the log changes faster than the filter expects, not that the
-    joints contradict each other."""
-    motion = s.path_length / max(s.samples - 1, 1)
-    tolerance = LOG_SLIP_RTOL * motion + 1e-9
-    if s.rms_slip <= tolerance:
-        return True
-    slips = wheel_slips()
-    if filtered and float(np.sqrt(sum(v * v for v in slips.values()))) <= tolerance:
-        warn(f"the {filtered} filter's residual (slip indicator rms {s.rms_slip:.3g} m per interval, max "
-             f"{s.max_slip:.3g} m, against {motion:.3g} m of motion) shows a log that changes faster than its process "
-             "noise allows: a glitch in a reading, slip, or a process noise too small (--kf-noise); the sensed "
-             "joints themselves agree")
-        return False
-    what = ("larger than the motion itself: check the columns' units (counts? degrees?), signs and the robot "
-            "description" if s.rms_slip > motion else "beyond measurement noise: wheels slip, or units or signs "
-            "are wrong")
-    named = ", ".join(f"{name} {value:.3g} m" for name, value in sorted(slips.items(), key=lambda kv: -kv[1]))
-    named = f" (slip per wheel: {named})" if named else ""
-    warn(f"the sensed joints contradict each other: slip indicator rms {s.rms_slip:.3g} m per interval (max "
-         f"{s.max_slip:.3g} m) against {motion:.3g} m of motion per interval{named}, {what}")
-    return False
-
-
-#: An external heading (heading or gyro column) contradicts the wheels when its turns over the first samples differ
-#: from theirs by more than this fraction of the larger, interval by interval. Turns k times apart (same sign) are
-#: 1 - 1/k apart: a gyro in deg/s read as rad/s is 0.98 apart, a clockwise (NED) yaw 1 or more; a skid steer, whose
-#: wheels turn up to 2-3 times the robot (ROS's wheel_separation_multiplier 1.5-2), is 0.67 apart at the most.
-HEADING_RTOL = 0.8
-#: Least turning [rad] of the wheels or the external heading over the first samples for that comparison.
-HEADING_MIN_TURN = 0.1
-
-
-def _check_heading(fmt: LogFormat, samples) -> bool:
-    """Warn (:func:`._common.warn`) when the external heading's turns contradict the wheels' over the first samples of
-    a CSV log (:data:`HEADING_RTOL`; a bag has no external heading: JointState only); return whether they did not.
-    Its changes replace the wheels' dtheta, so a heading in other units or of the other sign gave a wrong trajectory
-    with "consistent": true."""
-    model, first = samples()
-    wheels = model.from_positions(first.positions).column(2)
-    external = np.diff(first.heading_world)
-    wheels = np.zeros_like(external) if wheels is None else wheels
-    scale = float(np.maximum(np.abs(wheels), np.abs(external)).sum())
-    off = float(np.abs(external - wheels).sum())
-    if scale < HEADING_MIN_TURN or off <= HEADING_RTOL * scale:
-        return True
-    column, unit = (fmt.heading_column, "deg") if fmt.heading_column else (fmt.gyro_column, "deg/s")
-    warn(f"the external heading (column '{column}') turns {external.sum():.4g} rad over the first {len(first)} samples "
-         f"where the wheels turn {wheels.sum():.4g} rad ({off:.3g} rad apart interval by interval): its units (deg or "
-         f"deg/s? write them in the header: '{column} [{unit}]') or its sign (clockwise?) are probably wrong")
-    return False
-
-
-#: Least turning [rad] of a gear's u over the first samples for its check (couplings.gear_breaches).
-GEAR_MIN_TURN = 0.1
-
-
-def _check_gears(robot, samples) -> bool:
-    """Warn (one line on stderr per gear) when the logged joints of a description's ``gear`` coupling do not turn
-    together at its ratios over the first samples of the log, CSV or bag (:func:`wmrkit.couplings.gear_breaches`);
-    return whether they all did. Odometry reads each joint on its own: a log breaking the gear (another robot's, or a
-    wrong description) was integrated as a turn with "consistent": true."""
-    if not any(c.kind == "gear" for c in robot.couplings):
-        return True
-    model, first = samples()
-    steps = np.diff(first.positions, axis=0)
-    breaches = gear_breaches(robot.couplings, model.joints, steps, GEAR_MIN_TURN)
-    for b in breaches:
-        turns = ", ".join(f"{model.joints[i]} {steps[:, i].sum():.4g} rad" for i in b.given)
-        warn(f"{b.head} over the first {len(first)} samples ({turns}; {b.spread:.0%} apart interval by interval): "
-             "the log is not of this robot, or its description's gear is wrong")
-    return not breaches
-
-
-def _check_steering_steps(robot, sensed, samples) -> None:
-    """Warn (one line, :func:`wmrkit.odometry.steering.steering_step_warning`) where a sensed steering angle steps
-    within one interval while its wheel rolls, over the first samples of the log (CSV or bag): the no-slip rows take
-    the angle at mid-interval, so that interval's travel may be off its direction (a drive unit pivoting 90 deg
-    within a sample at each corner of a square turned 0.09 rad too little at 20 Hz, with "consistent": true)."""
-    from ..odometry.steering import steering_step_warning
-
-    if not odometry_model(robot, sensed).steer_joints:
-        return
-    model, first = samples()
-    message = steering_step_warning(model, first)
-    if message:
-        warn(message)
-
-
-def _wheel_slips(samples) -> dict[str, float]:
-    """The wheels' RMS slip [m per interval] over the first samples of the log (CSV or bag)."""
-    from ..odometry.model import wheel_slip
-
-    model, first = samples()
-    return wheel_slip(model, first.positions)
-
-
-def _first_samples(robot, log: str, fmt: LogFormat, sensed, topic: str, joint_names):
-    """The no-slip model and the first samples of the log (:func:`wmrkit.odometry.files.first_samples`), for the
-    diagnostics (each takes them as ``samples()``, read once a run)."""
-    model = odometry_model(robot, sensed)
-    return model, first_samples(robot, log, model.joints, fmt=fmt, topic=topic, joint_names=joint_names)
 
 
 def format_summary(s: OdometrySummary) -> str:
