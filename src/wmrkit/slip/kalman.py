@@ -5,7 +5,10 @@ sample. Measurements: the no-slip rows (3.22) that hold only the twist and sense
 ``A_p x = -A_a qdot_a`` (the rows (7.69)/(7.70): a wheel's rolling row is a wheel-speed reading, a lateral row a
 pseudo-measurement with the steering angle inside ``C``), with noise ``R = diag(sigma^2)`` per row. Rows with an
 unknown wheel rate (the steered wheel's free spin) are left out; a ``gear``'s unsensed joint is known from its
-sensed ones (``A_a`` maps the sensed rates through the odometry model's ``fill``, as odometry and ``fk`` use it).
+sensed ones (``A_a`` maps the sensed rates through the odometry model's ``fill``, as odometry and ``fk`` use it),
+and a gear none of whose joints is sensed is one unknown, its turn ``u`` (:func:`wmrkit.couplings.gear_free`, as
+WLS holds it): its rows are kept and ``u`` is eliminated, ``C`` and ``A_a`` projected (in the noise-weighted rows)
+onto the complement of the gear's columns, so the two rolling rows of an unsensed solid axle give one measurement.
 
 - **FK2** (7.70): every such row. The thesis merges the two identical lateral rows of the forklift's drive wheels
   into one of standard deviation ``k16``; kept apart, each has ``sqrt(2) k16``.
@@ -24,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import finite_number
+from ..couplings import gear_free
 from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..odometry.covariance import check_covariance
@@ -95,6 +99,8 @@ class KalmanModel:
     sigma: np.ndarray
     process: float
     thesis_double_q: bool = False
+    #: (n_velocities, p): the turns of the gears with no known joint (None: no such gear in the kept rows)
+    gears: np.ndarray | None = None
     # matrices per steering configuration met so far; not an init field, so dataclasses.replace starts a new one
     _cache: dict = field(init=False, default_factory=dict, compare=False, repr=False)
     # the worst-conditioned configuration met so far: {"condition": kappa, "config": (s,) angles}
@@ -106,8 +112,19 @@ class KalmanModel:
         om = self.odometry
         a = om.robot.constraint_matrix(beta_full)[..., self.rows, :]
         c, aa = a[..., :3], a[..., known_columns(om)] @ om.fill  # a gear's unsensed joints: from the sensed rates
+        if self.gears is not None:  # a gear with no known joint: its turn eliminated from the rows
+            c, aa = self._eliminate(a @ self.gears, c, aa)
         ct_r = np.swapaxes(c, -1, -2) / self.relative_variances
         return ct_r @ c, -(ct_r @ aa), np.ascontiguousarray(c), np.ascontiguousarray(aa)
+
+    def _eliminate(self, f: np.ndarray, c: np.ndarray, aa: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """`c`, `aa` ``(U, m, .)`` with the unknown turns of `f` ``(U, m, p)`` eliminated: ``S = W P W^-1``, ``W =
+        diag(sigma)``, ``P`` the projector onto the complement of ``W^-1 f``; ``(S C)^T R^-1 (S C) = C^T (R^-1 - R^-1 f
+        (f^T R^-1 f)^+ f^T R^-1) C``, the information the rows hold of the twist whatever the turns."""
+        fw = f / self.sigma[:, None]
+        p = np.eye(len(self.sigma)) - fw @ np.linalg.pinv(fw)
+        s = self.sigma[:, None] * p / self.sigma
+        return s @ c, s @ aa
 
     @property
     def relative_variances(self) -> np.ndarray:
@@ -177,7 +194,9 @@ def kalman_model(robot: Robot, kind: str = "fk2", noise: KalmanNoise | None = No
     rng = np.random.default_rng(0)
     probe = np.vstack([robot.beta, robot.beta + rng.uniform(-1, 1, (3, len(robot.beta)))])
     a = robot.constraint_matrix(probe)
-    unsensed = np.setdiff1d(np.arange(3, a.shape[-1]), known_columns(base))
+    gears = _free_gears(robot, known_columns(base))
+    held = np.flatnonzero(np.abs(gears).sum(axis=1)) if gears is not None else np.empty(0, dtype=int)
+    unsensed = np.setdiff1d(np.arange(3, a.shape[-1]), np.concatenate([known_columns(base), held]))
     rows, sigma, row = [], [], 0
     for w in robot.wheels:
         lat, lon = noise.of_wheel(w.name)
@@ -192,10 +211,22 @@ def kalman_model(robot: Robot, kind: str = "fk2", noise: KalmanNoise | None = No
                 sigma.append(s)
             row += 2
     rows_a = np.array(rows, dtype=int)
-    if np.linalg.matrix_rank(a[0][rows_a, :3]) < 3:  # the random walk would carry the undetermined directions
+    if gears is not None and not np.any(a[:, rows_a] @ gears):
+        gears = None  # no kept row turns with the gear: nothing to eliminate
+    model = KalmanModel(base, rows_a, np.array(sigma), float(noise.process) ** 2, thesis_double_q, gears)
+    if np.linalg.matrix_rank(model.matrices(probe[:1])[2][0]) < 3:  # the random walk would carry those directions
         dropped = " (fk1 leaves out the lateral rows of fixed wheels, (7.69): use fk2)" if kind == "fk1" else ""
         raise WmrkitError(f"{kind}: the sensed rows of robot '{robot.name}' do not determine its twist{dropped}")
-    return KalmanModel(base, rows_a, np.array(sigma), float(noise.process) ** 2, thesis_double_q)
+    return model
+
+
+def _free_gears(robot: Robot, known: np.ndarray) -> np.ndarray | None:
+    """The turns ``(n_velocities, p)`` of the gears none of whose joints `known` holds (velocity columns), one
+    column each with its ratios (:func:`wmrkit.couplings.gear_free`); None without such a gear."""
+    names = robot.velocity_names
+    free, free_names = gear_free(robot.couplings, names, tuple(int(k) for k in known))
+    geared = [i for i, n in enumerate(free_names) if n not in names]  # a gear's column is named by its channel
+    return free[:, geared] if geared else None
 
 
 def known_columns(model: OdometryModel) -> np.ndarray:
