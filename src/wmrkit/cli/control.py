@@ -39,7 +39,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--delay", type=int, default=0, metavar="N",
                    help="measurement delay in samples (with --period; default 0)")
     p.add_argument("--duration", metavar="S", help="seconds to simulate (default: the reference's length; pure "
-                   "pursuit and Stanley: until they reach the path's end, at most 50%% (10 s at least) longer)")
+                   "pursuit and Stanley: until they reach the path's end, at most 50%% (10 s at least) longer, "
+                   "within the loop's limits)")
     p.add_argument("--steering", default="closest", choices=("closest", "4-quadrant", "2-quadrant"),
                    help="which of the two steering solutions (8.9) a wheel takes (within its steer_range; default "
                         "closest)")
