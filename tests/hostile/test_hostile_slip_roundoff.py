@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from wmrkit import Robot
@@ -33,7 +33,9 @@ unit = st.floats(-1.0, 1.0)
 @settings(max_examples=60, deadline=None)
 @given(scale=size, icr=st.tuples(unit, unit), points=st.lists(st.tuples(unit, unit), min_size=2, max_size=4),
        omega=st.sampled_from([1.0, -1e3, 1e6, -1e6]))
+@example(scale=708.0, icr=(0.0, 0.0), points=[(0.0, 1.0), (1.0, 1.0)], omega=1.0)  # a wheel 1001 m out, refused
 def test_a_rotation_every_fixed_wheel_rolls_along_is_feasible_at_any_scale(scale, icr, points, omega):
+    scale /= 1.5  # the unit square's corners within 1 km of the origin (MAX_SIZE) at scale 1e3: 0.94 of it
     icr = (icr[0] * scale, icr[1] * scale)
     points = [(x * scale, y * scale) for x, y in points]
     if min(math.dist(p, icr) for p in points) < 1e-2 * scale:  # a wheel on the ICR has no rolling direction
