@@ -1,5 +1,6 @@
 """Geared test robots shared by the coupling tests: a cart on a solid axle and a synchro drive (YAML text).
 
+``TWO_ENCODERS``: two fixed wheels (r 0.1 m) on a solid axle (a 1:1 gear), both spins sensed, no third wheel.
 ``cart_yaml(ratio, front)``: two fixed wheels (r 0.075 m, half track 0.2 m) whose spins a ``gear`` turns at ratios
 ``1 : ratio``, one encoder on ``left.spin``, and a front or rear wheel (:data:`CASTOR` by default, or
 :data:`STEERED`). ``SYNCHRO``: three steered wheels, their spins on one gear, their steering on one linkage.
@@ -17,6 +18,13 @@ wheels:
   - {name: FRONT
 couplings:
   - {kind: gear, joints: [left.spin, right.spin], ratios: [1, RATIO]}
+"""
+TWO_ENCODERS = """name: geared
+wheels:
+  - {name: left, type: fixed, position: [0, 0.2], heading: 0, r: 0.1, actuated: [spin], sensed: [spin]}
+  - {name: right, type: fixed, position: [0, -0.2], heading: 0, r: 0.1, sensed: [spin]}
+couplings:
+  - {kind: gear, joints: [left.spin, right.spin], ratios: [1, 1]}
 """
 SYNCHRO = """name: synchro-3
 wheels:

@@ -10,18 +10,11 @@ import json
 import numpy as np
 import pytest
 
+from geared import TWO_ENCODERS as GEARED
 from wmrkit import catalog
 from wmrkit.cli.main import main
 from wmrkit.odometry import JointLog, simulate, write_log
 from wmrkit.odometry.synthetic import TwistProfile
-
-GEARED = """name: geared
-wheels:
-  - {name: left, type: fixed, position: [0, 0.2], heading: 0, r: 0.1, actuated: [spin], sensed: [spin]}
-  - {name: right, type: fixed, position: [0, -0.2], heading: 0, r: 0.1, sensed: [spin]}
-couplings:
-  - {kind: gear, joints: [left.spin, right.spin], ratios: [1, 1]}
-"""
 
 
 def _single(capsys, robot: str, log) -> list[str]:

@@ -8,6 +8,7 @@ import json
 import numpy as np
 import pytest
 
+from geared import TWO_ENCODERS as GEARED
 from wmrkit import catalog
 from wmrkit.cli.main import main
 from wmrkit.odometry import JointLog, simulate, write_log
@@ -62,13 +63,6 @@ def test_a_bag_names_the_slipping_wheel_as_its_csv_does(capsys, tmp_path, name):
     np.testing.assert_allclose(bag["final_pose"], csv["final_pose"], atol=1e-9)
 
 
-GEARED = """name: geared
-wheels:
-  - {name: left, type: fixed, position: [0, 0.2], heading: 0, r: 0.1, actuated: [spin], sensed: [spin]}
-  - {name: right, type: fixed, position: [0, -0.2], heading: 0, r: 0.1, sensed: [spin]}
-couplings:
-  - {kind: gear, joints: [left.spin, right.spin], ratios: [1, 1]}
-"""
 
 
 @pytest.mark.parametrize(("right", "agrees"), [(2.0, False), (1.0, True)])
