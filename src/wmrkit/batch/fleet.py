@@ -1,9 +1,10 @@
 """Batch odometry over a fleet's logs: every log through :func:`wmrkit.odometry.files.odometry_file`, in parallel.
 
 One row per log (:data:`SUMMARY_SCHEMA`, Parquet): the final pose as columns ``x, y, theta``, duration, path
-length, closure error for closed paths, slip statistics, warnings, the error when the log failed. A log that
-fails is recorded with its error and the batch goes on; a rerun with the same output skips logs already done
-(an error row is retried) and redoes a log whose trajectory file is missing.
+length, closure error for closed paths, slip statistics, warnings, whether the log is consistent (as ``wmrkit
+odometry`` says), the error when the log failed. A log that fails is recorded with its error and the batch goes on;
+a rerun with the same output skips logs already done (an error row is retried) and redoes a log whose trajectory
+file is missing.
 
 The serial engine and the workers run the same function, :func:`process_log`, on the same :class:`LogJob`s: a
 path (the worker reads the file itself; only a summary row comes back) and the odometry model, built once for
@@ -41,14 +42,14 @@ SUMMARY_SCHEMA = (
     ("start_time", "float64 s"), ("duration", "float64 s"), ("x", "float64 m"), ("y", "float64 m"),
     ("theta", "float64 rad"), ("path_length", "float64 m"), ("rotation", "float64 rad"),
     ("closure_error", "float64 m"), ("closure_heading", "float64 rad"), ("max_slip", "float64 m"),
-    ("rms_slip", "float64 m"), ("max_dt", "float64 s"), ("warnings", "string"), ("error", "string"),
-    ("trajectory", "string"), ("wall_time", "float64 s"), ("settings", "string"),
+    ("rms_slip", "float64 m"), ("max_dt", "float64 s"), ("warnings", "string"), ("consistent", "bool"),
+    ("error", "string"), ("trajectory", "string"), ("wall_time", "float64 s"), ("settings", "string"),
 )
 #: Columns a table must have to be a batch-odometry table at all (an older one lacks some others: it is redone).
 KEY_COLUMNS = ("log", "robot", "method", "error", "trajectory")
 #: Version of what a row holds, in its settings digest: a row of an older version is redone (2: odometry's
-#: diagnostic lines in ``warnings``).
-ROW_VERSION = 2
+#: diagnostic lines in ``warnings``; 3: ``consistent``, which part files of a version-2 run lack).
+ROW_VERSION = 3
 #: Suffixes of single-file logs found in a folder (CSV joint logs, ROS 2 bag files).
 LOG_SUFFIXES = (".csv", ".db3", ".mcap")
 
@@ -151,7 +152,8 @@ def process_log(job: LogJob) -> dict[str, Any]:
         notes.append("a single sample: no motion")
     row.update(samples=s.samples, start_time=s.start_time, duration=s.end_time - s.start_time, x=x, y=y, theta=theta,
                path_length=s.path_length, rotation=s.rotation, max_slip=s.max_slip, rms_slip=s.rms_slip,
-               max_dt=s.max_dt, warnings="; ".join(notes) or None, wall_time=time.perf_counter() - t0)
+               max_dt=s.max_dt, warnings="; ".join(notes) or None, consistent=diagnosis.consistent,
+               wall_time=time.perf_counter() - t0)
     if job.closed:  # the run ends where it started (the start pose is the origin)
         row.update(closure_error=math.hypot(x, y), closure_heading=float(np.angle(np.exp(1j * theta))))
     return row
@@ -184,7 +186,7 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     with the settings `header`, e.g. ``{"time_unit": "ms"}``), as ``wmrkit odometry`` reads one.
     With `resume`, rows of `out` (and of its part files) without error are kept and their logs skipped.
     Each row's ``warnings`` are ``wmrkit odometry``'s lines for its log (:mod:`wmrkit.odometry.diagnostics`), and
-    with `slip_warning` [m] a note where the slip indicator exceeds it.
+    with `slip_warning` [m] a note where the slip indicator exceeds it; its ``consistent`` is that command's verdict.
     """
     from ..odometry.integrators import check_method
     from ..odometry.model import odometry_model
