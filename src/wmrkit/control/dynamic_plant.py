@@ -16,6 +16,7 @@ scalar form, :func:`fast_law_controller` (the numbers of :func:`.loop.law_contro
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -31,7 +32,8 @@ __all__ = ["fast_law_controller", "rolling_start", "simulate_dynamics"]
 
 def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *,
                       period: float, delay: int = 0, tyre: str | None = None, step: float = 1e-3,
-                      feedback: str = "pose", policy: str = "closest") -> dict[str, np.ndarray]:
+                      feedback: str = "pose", policy: str = "closest",
+                      until: Callable[[float, np.ndarray], bool] | None = None) -> dict[str, np.ndarray]:
     """Close the loop of `controller` on the dynamic model of `robot` (same outputs as :func:`.loop.simulate`).
 
     `period` [s]: control period (commands held); `delay`: measurement delay in samples; `tyre`: traction model
@@ -84,7 +86,7 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
         out["beta"].append(s[steer])
         out["target"].append(beta_from_heading(heading, delta))  # Robot.beta_of_heading
         out["estimate"].append(history[-1].copy())
-        if k == n - 1:
+        if k == n - 1 or (until is not None and until(t, out["pose"][-1])):
             break
         stepper.advance(None, held)  # a WmrkitError if the dynamics diverge
         history.append(s[:3].copy() if odometer is None else odometer.step(s))

@@ -44,7 +44,9 @@ def follower_bound(duration: float, limits: list[Limit]) -> tuple[float, Limit |
 
 
 def ended(out: dict[str, Any], until: Callable[[float, np.ndarray], bool]) -> dict[str, Any]:
-    """`out` of a loop through the dynamics up to the first sample where `until(t, pose)` holds."""
+    """`out` of a loop (a dict of per-sample arrays) up to the first sample where `until(t, pose)` holds: where the
+    loops through the dynamics stop by their own `until` (:func:`.dynamic_plant.simulate_dynamics`,
+    :func:`.slip_loop.simulate_slip_control`); the trimming their whole run would need, to check them against."""
     t = out["t"]
     done = next((k for k in range(len(t)) if until(float(t[k]), out["pose"][k])), len(t) - 1)
     return {key: v[:done + 1] if isinstance(v, np.ndarray) and len(v) == len(t) else v for key, v in out.items()}

@@ -21,6 +21,7 @@ The estimators (:mod:`wmrkit.odometry`, :mod:`wmrkit.slip`) read the sensed join
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -46,7 +47,8 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
                           period: float, delay: int = 0, tyre: str | None = None, step: float = 1e-3,
                           slip_model: str = "mqe", feedback: str = "pose", weights: SlipWeights | None = None,
                           noise: KalmanNoise | None = None, inverse: SlipInverse | None = None,
-                          ramp: bool = False, progress: bool = False, policy: str = "closest") -> dict:
+                          ramp: bool = False, progress: bool = False, policy: str = "closest",
+                          until: Callable[[float, np.ndarray], bool] | None = None) -> dict:
     """Close the loop of `controller` on the dynamic model of `robot` with commands from `slip_model`.
 
     `period` [s] control period; `delay` measurement delay in samples; `tyre` the plant's traction model (default
@@ -54,6 +56,7 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     integration step. `ramp`: each period's commands are reached linearly over the period from the previous ones
     (a first-order hold, half a period of delay) instead of held from its start (zero-order hold). `progress`: a
     tqdm bar over the periods. `policy`: which root of (8.9) each steered wheel takes (:mod:`.steering`).
+    `until(t, pose)`: the run ends at the first control period whose sample holds it (a path follower that arrived).
 
     Returns arrays: ``t``, ``pose`` (true), ``twist`` (the law's), ``beta`` (actual steering), ``target``
     (commanded steering β), ``estimate`` (the fed-back pose), ``rates`` (commanded wheel rates of
@@ -127,7 +130,7 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
                   in_range)
         for key, value in zip(keys, values, strict=True):
             records[key].append(value)
-        if k == n - 1:
+        if k == n - 1 or (until is not None and until(t, records["pose"][-1])):
             break
         reference = np.zeros((1, model.n))
         reference[0, plant_cols] = rates

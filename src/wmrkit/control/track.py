@@ -17,7 +17,7 @@ from ..robot import Robot
 from ..wheels import heading_from_beta
 from .actuators import LowLevelLoops
 from .feasibility import BLOCK, Feasibility, feasibility
-from .follower_run import Limit, check_arrival, ended, follower_bound, span
+from .follower_run import Limit, check_arrival, follower_bound, span
 from .laws import PositionLaw, check_gate, check_sampling
 from .loop import MAX_SAMPLED_EVALUATIONS, Plant, longest_sampled_run, simulate
 from .points import ControlError, ControlPoint, StoppedRun, check_delay, control_point, point_pose
@@ -250,10 +250,11 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
 
                 out = simulate_slip_control(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
                                             slip_model=slip_model, feedback=feedback, weights=weights, noise=noise,
-                                            ramp=ramp, step=DYNAMICS_STEP, progress=progress, policy=policy)
+                                            ramp=ramp, step=DYNAMICS_STEP, progress=progress, policy=policy,
+                                            until=until)
             else:
                 out = simulate_dynamics(robot, ctrl, pose0, duration, period=period, delay=delay, tyre=tyre,
-                                        feedback=feedback, step=DYNAMICS_STEP, policy=policy)
+                                        feedback=feedback, step=DYNAMICS_STEP, policy=policy, until=until)
         except LiftOffError as err:
             raise _stopped(StoppedRun(
                 f"{err.what}; the servos follow each period's command with up to the grip's torque, so a step in the "
@@ -276,8 +277,6 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                            rtol=1e-5 if geometric else 1e-8, atol=1e-7 if geometric else 1e-10, until=until)
         except StoppedRun as err:
             raise _stopped(err, robot, reference, tracked_point, "kinematic") from None
-    if dynamics and until is not None:  # the run ends once the follower has driven its path
-        out = ended(out, until)
     t, pose = out["t"], out["pose"]
     if not (np.all(np.isfinite(pose)) and np.all(np.abs(pose[:, :2]) <= MAX_COORDINATE)):
         k = int(np.argmax(~(np.isfinite(pose).all(axis=1) & (np.abs(pose[:, :2]) <= MAX_COORDINATE).all(axis=1))))
