@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from contextlib import nullcontext
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from wmrkit.control.actuators import ActuatorLoop, LowLevelLoops
 from wmrkit.control.points import ControlError, control_point, point_pose, twist_for_velocity
 from wmrkit.control.references import builtin_reference
 from wmrkit.control.track import track
+from wmrkit.control.trackers import ArrivalWarning
 from wmrkit.kinematics.wheel_ik import wheel_commands
 
 
@@ -156,7 +158,11 @@ def test_stanley_s_projection_past_a_corner_takes_the_leg_ahead(size):
         assert (s, chi) == (pytest.approx(size), pytest.approx(0.0, abs=1e-12)), (x, s, chi)
         assert e == pytest.approx(-0.3)  # right of the second leg, along +x
     for robot in ("ackermann", "bicycle"):
-        run = track(catalog.load(robot), builtin_reference("corner", size=size), controller="stanley")
+        # the car's front point turns on 4.82 m at best (below): from the 3 m corner it is at the second leg's end's
+        # abscissa 4.46 m past the leg's line (sqrt(4.82**2 - 1.82**2)), and passes that end beside it
+        beside = robot == "ackermann" and size == 3.0
+        with pytest.warns(ArrivalWarning, match="passed the path's end beside it") if beside else nullcontext():
+            run = track(catalog.load(robot), builtin_reference("corner", size=size), controller="stanley")
         k0, k1 = np.searchsorted(run.t, [corner, corner + 3.0])
         turned = run.pose[k1, 2] - run.pose[0, 2]
         arc = np.hypot(*np.diff(run.tracked[k0:k1 + 1, :2], axis=0).T).sum()  # driven by the front point
