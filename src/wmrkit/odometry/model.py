@@ -276,7 +276,12 @@ class OdometryModel:
         beta = np.asarray(beta, dtype=float)
         full = np.broadcast_to(self.robot.beta, (*beta.shape[:-1], len(self.robot.steer_names))).copy()
         full[..., self.steer_index] = beta
-        return solution_maps(self.robot, full, self.rows, self.cols, self.assigned, self.row_weights, self.fill)
+        return solution_maps(self.robot, full, self.rows, self.cols, self.sensed, self.row_weights)
+
+    @property
+    def sensed(self) -> np.ndarray:
+        """Positions in ``cols`` of the sensed rates (``rate_joints``): the first of ``assigned``."""
+        return self.assigned[:len(self.rate_joints)]
 
     @property
     def columns(self) -> tuple[np.ndarray, np.ndarray]:
@@ -388,7 +393,7 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
     if not _twist_determined(robot, robot.beta[None, :], model)[0]:
         raise SensingError(f"the sensed joints of robot '{robot.name}' ({', '.join(sensed) or 'none'}) do not "
                            "determine its motion")
-    s, rm = solution_maps(robot, robot.beta, model.rows, model.cols, model.assigned, model.row_weights, model.fill)
+    s, rm = solution_maps(robot, robot.beta, model.rows, model.cols, model.sensed, model.row_weights)
     scale = np.max(np.abs(_kept_matrix(robot, robot.beta, model.rows, model.cols)))
     redundant = np.max(np.abs(rm), initial=0.0) > 1e-12 * scale  # else A dq = 0 exactly: no spare sensor
     return OdometryModel(robot, joints, tuple(rate_joints), (), model.rows, cols_a, model.assigned,
@@ -435,14 +440,14 @@ def _kept_matrix(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np
 
 
 def solution_maps(robot: Robot, beta_full: np.ndarray, rows: np.ndarray, cols: np.ndarray,
-                  assigned: np.ndarray, row_weights: np.ndarray, fill: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(S, Rm)`` from (4.11) for each configuration: geared_solve (on the rows scaled by their weights) for
-    the assigned rates of each sensed one's unit vector (``fill`` ``(n_assigned, n_a)``: the sensed rates and those
-    a gear turns with them); ``Rm = A S``, the unweighted residual map."""
+                  sensed: np.ndarray, row_weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(S, Rm)`` from (4.11) for each configuration: geared_solve (on the rows scaled by their weights, a gear's
+    other joints held) for the unit vector of each sensed rate (`sensed`: their positions in `cols`); ``Rm = A S``,
+    the unweighted residual map."""
     a = _kept_matrix(robot, beta_full, rows, cols)
-    n_a = fill.shape[1]  # the sensed rates, first of `assigned`; a gear's other joints held (geared_solve)
+    n_a = len(sensed)
     q, _ = geared_solve((a * row_weights[:, None])[..., None, :, :], robot.couplings,
-                        tuple(robot.velocity_names[c] for c in cols), assigned[:n_a], np.eye(n_a))  # (..., n_a, k)
+                        tuple(robot.velocity_names[c] for c in cols), sensed, np.eye(n_a))  # (..., n_a, k)
     s = np.swapaxes(q, -1, -2)
     return s, a @ s
 
@@ -455,7 +460,7 @@ def _twist_determined(robot: Robot, beta_full: np.ndarray, model: OdometryModel)
         beta_full = full
     a = _kept_matrix(robot, beta_full, model.rows, model.cols)
     names = tuple(robot.velocity_names[c] for c in model.cols)
-    return geared_twist_determined(a, robot.couplings, names, tuple(model.assigned[:model.fill.shape[1]].tolist()))
+    return geared_twist_determined(a, robot.couplings, names, tuple(model.sensed.tolist()))
 
 
 def frozen(a: ArrayLike) -> np.ndarray:

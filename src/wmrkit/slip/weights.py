@@ -119,6 +119,6 @@ def wls_model(robot: Robot, weights: SlipWeights | None = None, sensed=None) -> 
     w = np.sqrt((weights or SlipWeights()).row_mu(robot)[base.rows])
     if not base.constant:
         return replace(base, row_weights=frozen(w))
-    s, rm = solution_maps(robot, robot.beta, base.rows, base.cols, base.assigned, w, base.fill)
+    s, rm = solution_maps(robot, robot.beta, base.rows, base.cols, base.sensed, w)
     return replace(base, row_weights=frozen(w), solution=frozen(s),
                    residual_map=None if base.residual_map is None else frozen(rm))
