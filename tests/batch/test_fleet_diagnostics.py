@@ -148,3 +148,28 @@ def test_rows_written_without_the_consistent_column_are_redone(tmp_path, monkeyp
     res = fleet.batch_odometry(robot, logs, out=out)
     assert res.skipped == 0
     assert [r["consistent"] for r in res.rows] == [False, True]
+
+
+def test_the_summary_counts_and_names_the_inconsistent_logs(capsys, tmp_path):
+    """Four copies of the slipping mecanum log and the clean one: the summary line and the --json answer count the
+    logs that ``wmrkit odometry LOG --json`` (the oracle, run per log) calls inconsistent and name them (the text
+    the first three and how many more; the JSON all); exit code 0, as the single-log command's for each. Before,
+    the line said '5 logs: 5 done (0 from an earlier run), 0 failed' and the JSON had no count: a script had to
+    read every row."""
+    slips, clean = _mecanum_logs(tmp_path)
+    logs = [tmp_path / f"s{k}.csv" for k in range(4)] + [clean]
+    for log in logs[:4]:
+        shutil.copy(slips, log)
+    oracle = []
+    for log in logs:
+        assert main(["odometry", "mecanum-4", str(log), "--json"]) == 0
+        if not json.loads(capsys.readouterr().out)["consistent"]:
+            oracle.append(str(log))
+    assert oracle == list(map(str, logs[:4]))
+    assert main(["batch", "odometry", "mecanum-4", *map(str, logs), "--workers", "0", "--json"]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    assert answer["inconsistent"] == 4 and answer["inconsistent_logs"] == oracle
+    assert main(["batch", "odometry", "mecanum-4", *map(str, logs), "--workers", "0", "--quiet"]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    named = f"{', '.join(oracle[:3])} and 1 more"
+    assert first == f"5 logs: 5 done (0 from an earlier run), 0 failed, 4 inconsistent ({named})"

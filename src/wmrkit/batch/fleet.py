@@ -78,9 +78,15 @@ class FleetResult:
     skipped: int
     failed: int
 
+    @property
+    def inconsistent(self) -> tuple[str, ...]:
+        """The logs done whose diagnostics say inconsistent (``consistent`` false: ``wmrkit odometry``'s verdict)."""
+        return tuple(r["log"] for r in self.rows if r["consistent"] is False and not r["error"])
+
     def to_dict(self) -> dict:
         """JSON-ready summary of the batch."""
         return {"logs": len(self.rows), "skipped": self.skipped, "failed": self.failed,
+                "inconsistent": len(self.inconsistent), "inconsistent_logs": list(self.inconsistent),
                 "errors": {r["log"]: r["error"] for r in self.rows if r["error"]}}
 
 

@@ -7,7 +7,7 @@ import math
 import sys
 from pathlib import Path
 
-from ..errors import WmrkitError
+from ..errors import WmrkitError, name_list
 from ._common import (
     SCHEMES_HELP,
     add_json_flag,
@@ -151,9 +151,14 @@ def _described_method(robot) -> str:
     return method or "exact"
 
 
+#: Inconsistent logs the summary line of ``batch odometry`` names before counting the rest (the JSON lists them all).
+NAMED = 3
+
+
 def run_odometry(args: argparse.Namespace) -> int:
-    """Batch odometry; prints the number of logs done, skipped and failed (and each failure). Exit code 1 when a
-    log failed (the others are done and written)."""
+    """Batch odometry; prints the number of logs done, skipped, failed and inconsistent (naming the first
+    :data:`NAMED` of those, each failure). Exit code 1 when a log failed (the others are done and written); an
+    inconsistent log is a warning, as in ``wmrkit odometry`` (exit code 0)."""
     from ..batch.fleet import batch_odometry
 
     robot = load_robot(args.robot)
@@ -171,8 +176,10 @@ def run_odometry(args: argparse.Namespace) -> int:
     if args.json:
         print_json({"robot": robot.name, **result.to_dict(), "rows": [dict(r) for r in result.rows]})
         return 1 if result.failed else 0
+    odd = result.inconsistent
     print(f"{len(result.rows)} logs: {len(result.rows) - result.failed} done ({result.skipped} from an earlier run), "
-          f"{result.failed} failed" + (f"; table {args.out}" if args.out else ""))
+          f"{result.failed} failed, {len(odd)} inconsistent" + (f" ({name_list(odd, NAMED)})" if odd else "")
+          + (f"; table {args.out}" if args.out else ""))
     for r in result.rows:
         if r["error"]:  # a worker that died more often than allowed: its message does not name the log
             print(f"  failed: {r['error'] if r['error'].startswith(r['log']) else r['log'] + ': ' + r['error']}")
