@@ -79,7 +79,7 @@ DOCUMENTED = [
      10_000),
     ("wmrkit.batch.calibrate", "MAX_LEVEL", "in (0, 0.9999] (`batch.calibrate.MAX_LEVEL`)", 0.9999),
     ("wmrkit.batch.consistency", "MAX_RATIO", "exceeds 20 times what noise leaves there", 20.0),
-    ("wmrkit.batch.consistency", "MIN_RUNS", "judged with 4 runs or more (`MIN_RUNS`)", 4),
+    ("wmrkit.batch.consistency", "MIN_RUNS", "judged with 3 runs or more (`MIN_RUNS`)", 3),
     ("wmrkit.batch.consistency", "MIN_DOF", "6 or more residuals beyond their own parameters (`MIN_DOF`", 6),
     ("wmrkit.batch.consistency", "ROUNDOFF", "floored at 1e-9 of its wheel travel (`ROUNDOFF`", 1e-9),
     ("wmrkit.batch.consistency", "PAIR_CANDIDATES", "among the 6 runs of largest score", 6),

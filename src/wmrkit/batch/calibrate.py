@@ -57,12 +57,12 @@ class FleetCalibration:
     ``level``; residual RMS before and after; ``runs``, ``residuals`` counts; ``ci`` the interval method;
     ``warnings``: runs whose data do not fit the method (e.g. a closed path cut short) or disagree with the others;
     ``logs``: the runs' files; ``residual_ratios``: each run's RMS at the other runs' fit over that at its own
-    (``None`` with fewer than 4 runs, and for closed paths); ``closed_scores``: for a fleet of closed paths, each
+    (``None`` with fewer than 3 runs, and for closed paths); ``closed_scores``: for a fleet of closed paths, each
     run's weighted final-pose error at the other runs' fit over the others' RMS there
     (:func:`~wmrkit.batch.consistency.judge`; ``None`` for runs with references of 4 poses or more); ``inconsistent``:
     the largest over :data:`~wmrkit.batch.consistency.MAX_RATIO` (closed paths:
     :data:`~wmrkit.batch.consistency.MAX_CLOSED_SCORE`; :mod:`wmrkit.batch.consistency`; ``None`` when not judged,
-    and ``not_judged`` says why: fewer than 4 runs, fewer than 5 closed paths (or references of 2-3 poses), a
+    and ``not_judged`` says why: fewer than 3 runs, fewer than 5 closed paths (or references of 2-3 poses), a
     failed closed-path refit or curvature; it names the runs left out or set aside when the others are judged)."""
 
     robot: Robot
