@@ -12,12 +12,13 @@ import numpy as np
 
 from ..errors import WmrkitError
 from ..limits import check_chunk_size
+from ..odometry.bags import imu_topic
 from ..odometry.covariance import CrowleyNoise
-from ..odometry.diagnostics import diagnose
+from ..odometry.diagnostics import bag_imu_warning, diagnose
 from ..odometry.files import first_samples, is_bag, odometry_file
 from ..odometry.header import header_format
 from ..odometry.integrators import METHODS
-from ..odometry.logs import TIME_UNITS
+from ..odometry.logs import TIME_UNITS, LogError
 from ..odometry.model import odometry_model
 from ..odometry.pipeline import OdometrySummary, check_start_pose
 from ._common import (
@@ -87,6 +88,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     g.add_argument("--topic", default="/joint_states", help="JointState topic (default: /joint_states)")
     g.add_argument("--joint-name", action="append", metavar="ROS=JOINT", default=[],
                    help="map a ROS joint name to a robot joint WHEEL.spin/WHEEL.steer (repeat)")
+    g.add_argument("--imu", metavar="TOPIC", help="sensor_msgs/Imu topic whose yaw checks the odometry's heading "
+                   "(default: the bag's only Imu topic, if it has one)")
     p.add_argument("--chunk-size", type=int, default=1 << 16, help="samples per chunk (memory bound; default 65536)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_estimator_options(p)
@@ -121,9 +124,14 @@ def run(args: argparse.Namespace) -> int:
     for option, value in (("--cpr", args.cpr), ("--gear", args.gear), ("--steer-resolution", steer_res)):
         if value is not None and not (math.isfinite(value) and value > 0):  # the library's messages name its fields
             raise WmrkitError(f"{option} must be a finite number > 0, got {value:g}")
-    if os.path.isfile(args.log) and not is_bag(args.log) and (args.joint_name or args.topic != "/joint_states"):
-        raise WmrkitError(f"{'--joint-name' if args.joint_name else '--topic'} applies to ROS 2 bags; LOG {args.log} "
-                          "is read as a CSV log (it would be ignored; a CSV's columns are renamed by --column)")
+    if os.path.isfile(args.log) and not is_bag(args.log) and (args.joint_name or args.topic != "/joint_states"
+                                                               or args.imu is not None):
+        option = "--joint-name" if args.joint_name else "--topic" if args.topic != "/joint_states" else "--imu"
+        raise WmrkitError(f"{option} applies to ROS 2 bags; LOG {args.log} is read as a CSV log (it would be ignored; "
+                          "a CSV's columns are renamed by --column)")
+    imu, note = imu_topic(args.log, args.imu) if is_bag(args.log) and os.path.exists(args.log) else (None, None)
+    if note:
+        print(f"wmrkit: note: {note}", file=sys.stderr)
     if args.max_gap is not None and not args.max_gap > 0:
         raise WmrkitError(f"--max-gap must be > 0 s, got {args.max_gap:g}")
     if args.counter_bits is not None and not 2 <= args.counter_bits <= 64:
@@ -164,8 +172,18 @@ def run(args: argparse.Namespace) -> int:
     for line in diagnosis.warnings:
         warn(line)
     consistent = diagnosis.consistent
+    if imu is not None:
+        try:
+            line = bag_imu_warning(model, summary, args.log, imu, topic=args.topic, names=names)
+            consistent = consistent and line is None
+        except LogError as err:
+            if args.imu is not None:
+                raise
+            line, imu = f"{err} (the odometry is not checked against it)", None
+        if line:
+            warn(line)
     if args.json:
-        print_json(summary.to_dict() | {"consistent": consistent})
+        print_json(summary.to_dict() | {"consistent": consistent} | ({"imu": imu} if is_bag(args.log) else {}))
     else:
         print(format_summary(summary))
     return 0

@@ -1,4 +1,5 @@
-"""ROS 2 bags (via ``rosbags``): read ``sensor_msgs/msg/JointState`` as joint logs, write ``nav_msgs/msg/Odometry``.
+"""ROS 2 bags (via ``rosbags``): read ``sensor_msgs/msg/JointState`` as joint logs and ``sensor_msgs/msg/Imu`` as a
+yaw, write ``nav_msgs/msg/Odometry``.
 
 JointState ``position`` entries are read as cumulative wheel angles and steering **headings** [rad] (as
 ros2_control's joint state broadcaster publishes them: a steering joint reads 0 when its wheel rolls straight
@@ -15,6 +16,7 @@ YAML anchors, a message that does not decode) is refused with one :class:`LogErr
 
 from __future__ import annotations
 
+import math
 import os
 import re
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -35,6 +37,7 @@ if TYPE_CHECKING:
 from .trajectories import Trajectory, quaternion_z, yaw_of_quaternion
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
+IMU = "sensor_msgs/msg/Imu"
 #: How many of the names a bag's messages give an error quotes when none names the robot's joints.
 MAX_SEEN_NAMES = 16
 ODOMETRY = "nav_msgs/msg/Odometry"
@@ -334,6 +337,84 @@ def read_odometry(path: str | os.PathLike[str], *, topic: str = "/odom") -> Traj
     p = np.array(poses).reshape(-1, 3)
     p[:, 2] = np.unwrap(p[:, 2])
     return Trajectory(np.array(times), p, np.zeros(len(times)), np.array(covs).reshape(-1, 3, 3))
+
+
+def imu_topic(path: str | os.PathLike[str], topic: str | None = None) -> tuple[str | None, str | None]:
+    """The ``Imu`` topic of the bag at `path` to check its odometry with, and a note to say: `topic` itself (a
+    :class:`LogError` when the bag has no ``Imu`` topic of that name), else the bag's only ``Imu`` topic (noted), else
+    None (noted when it has several)."""
+    source, reader = os.fspath(path), _open(path)
+    try:
+        types = {c.topic: c.msgtype for c in reader.connections}
+    finally:
+        reader.close()
+    imus = sorted(t for t, m in types.items() if m == IMU)
+    if topic is not None:
+        if types.get(topic) != IMU:
+            what = f"carries {types[topic]}, not {IMU}" if topic in types else "is not in the bag"
+            raise LogError(f"{source}: --imu topic '{topic}' {what} ({IMU} topics: {', '.join(imus) or 'none'})")
+        return topic, None
+    if len(imus) == 1:
+        return imus[0], (f"heading checked against the IMU on {imus[0]}, the bag's one {IMU} topic (--imu TOPIC "
+                         "chooses it)")
+    return None, (f"heading not checked against an IMU: the bag has {len(imus)} {IMU} topics ({', '.join(imus)}); "
+                  "choose one with --imu TOPIC") if imus else None
+
+
+def read_imu_yaw(path: str | os.PathLike[str], topic: str, *,
+                 chunk_size: int = 1 << 14) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """``(time [s], yaw [rad])`` chunks of the ``Imu`` messages on `topic`, the yaw continuous (unwrapped).
+
+    The yaw is the orientation's (REP-103 / REP-145: about z, counter-clockwise, ZYX Euler angles); when the first
+    message has none (``orientation_covariance[0] == -1``, REP-145, or an all-zero quaternion) it is
+    ``angular_velocity.z`` [rad/s] integrated by trapezoids from 0. Time as JointState's (the header stamp, else the
+    receive time), strictly increasing. A :class:`LogError` names the message of a bad stamp or value.
+    """
+    source = os.fspath(path)
+    where = f"{source}: {topic}"
+    reader, ts = _open(source), _typestore()
+    try:
+        conns = [c for c in reader.connections if c.topic == topic and c.msgtype == IMU]
+        if not conns:  # (no connections would read every topic's messages)
+            raise LogError(f"{where}: no {IMU} topic of that name")
+        gyro, last, times, values = None, None, [], []
+        for index, (stamp_ns, msg) in enumerate(_messages(reader, conns, where, IMU, ts)):
+            o = msg.orientation
+            q = (o.x, o.y, o.z, o.w)
+            if gyro is None:
+                gyro = msg.orientation_covariance[0] == -1 or not any(q)
+            if gyro and not math.isfinite(msg.angular_velocity.z):
+                raise LogError(f"{where} message {index}: angular_velocity.z is {msg.angular_velocity.z}")
+            if not gyro and not (all(map(math.isfinite, q)) and any(q)):
+                raise LogError(f"{where} message {index}: orientation {list(q)} is no rotation")
+            stamp = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+            t = stamp if stamp > 0 else 1e-9 * stamp_ns
+            if t <= (times[-1] if times else last[0] if last else -math.inf):
+                raise LogError(f"{where} message {index}: time {t!r} s does not follow the previous message's")
+            times.append(t)
+            values.append(msg.angular_velocity.z if gyro else float(yaw_of_quaternion(np.array(q))))
+            if len(times) == chunk_size:
+                last = yield from _yaw_chunk(np.array(times), np.array(values), gyro, last)
+                times, values = [], []
+        if times:
+            yield from _yaw_chunk(np.array(times), np.array(values), gyro, last)
+        elif last is None:
+            raise LogError(f"{where}: no message")
+    finally:
+        reader.close()
+
+
+def _yaw_chunk(t: np.ndarray, v: np.ndarray, gyro: bool, last: tuple[float, float, float] | None):
+    """Yield one ``(time, yaw)`` chunk of :func:`read_imu_yaw` from its readings `v` (yaw or yaw rate), continuing
+    the `last` ``(time, yaw, reading)``; return the chunk's own."""
+    if gyro:
+        tt, r = (t, v) if last is None else (np.concatenate([[last[0]], t]), np.concatenate([[last[2]], v]))
+        yaw = np.cumsum(0.5 * (r[1:] + r[:-1]) * np.diff(tt)) + (0.0 if last is None else last[1])
+        yaw = np.concatenate([[0.0], yaw]) if last is None else yaw
+    else:
+        yaw = np.unwrap(v) if last is None else np.unwrap(np.concatenate([[last[1]], v]))[1:]
+    yield t, yaw
+    return float(t[-1]), float(yaw[-1]), float(v[-1])
 
 
 def _writer(path: str | os.PathLike[str]):

@@ -5,18 +5,19 @@ After the run, its summary and the log's first samples (:func:`~.files.first_sam
 check needs them) are judged: the sensed joints contradicting each other (slip, naming each wheel's slip), an
 external heading column contradicting the wheels' turns (CSV logs), joints breaking a description's ``gear``
 coupling, and a steering angle stepping within one sample interval (:func:`~.steering.steering_step_warning`).
+A bag's IMU checks the wheels' heading over the whole run (:func:`imu_warning`).
 """
 
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..couplings import gear_breaches
-from .logs import JointLog, LogFormat
+from .logs import JointLog, LogError, LogFormat
 from .model import OdometryModel, wheel_slip
 from .pipeline import OdometrySummary
 from .steering import steering_step_warning
@@ -33,6 +34,19 @@ HEADING_RTOL = 0.8
 HEADING_MIN_TURN = 0.1
 #: Least turning [rad] of a gear's u over the first samples for its check (couplings.gear_breaches).
 GEAR_MIN_TURN = 0.1
+#: The IMU check compares the turns of the wheels' heading and the IMU's yaw over the run and over windows this long
+#: [s], half a window apart (a turn of a few seconds, its start and end in one window; a gyro's drift small within).
+IMU_WINDOW = 10.0
+#: Turns within this fraction of the larger agree: a MEMS gyro's scale factor is within 3 % (MPU-6050: +-3 %;
+#: BMI088: +-1 %), a calibrated odometry's heading within a few % (wheel radii, track); a slipping skid steer's
+#: wheels turn 1.5-3 times the robot (ROS's wheel_separation_multiplier), 33-67 % apart.
+IMU_TURN_RTOL = 0.1
+#: ... within this many radians: a fused orientation's noise and jitter (about 1 deg, read twice) and the
+#: interpolation of both at a window's ends.
+IMU_TURN_ATOL = 0.05
+#: ... plus this drift rate [rad/s] times the span (0.29 deg/s): the bias left in a consumer MEMS gyro after its
+#: start-up calibration (0.01-0.1 deg/s, temperature drift) several times over; a run without turning stays within.
+IMU_DRIFT = 0.005
 
 
 @dataclass(frozen=True)
@@ -122,3 +136,83 @@ def gear_warnings(model: OdometryModel, first: Callable[[], JointLog]) -> list[s
         lines.append(f"{b.head} over the first {len(log)} samples ({turns}; {b.spread:.0%} apart interval by "
                      "interval): the log is not of this robot, or its description's gear is wrong")
     return lines
+
+
+def heading_series(model: OdometryModel, chunks: Iterable[JointLog]) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """``(time, heading [rad])`` of joint-log `chunks` by the no-slip `model` (its dtheta summed from 0 at the first
+    sample), chunk by chunk."""
+    heading, prev = 0.0, None
+    for chunk in chunks:
+        inc = model.from_positions(chunk.positions, previous=prev)
+        turns = inc.column(2)
+        turns = np.zeros(len(chunk) - (prev is None)) if turns is None else turns
+        h = heading + np.cumsum(turns)
+        yield chunk.time, (h if prev is not None else np.concatenate([[0.0], h]))
+        heading, prev = float(heading if not len(h) else h[-1]), chunk.positions[-1]
+
+
+def sample_at(series: Iterable[tuple[np.ndarray, np.ndarray]],
+              grid: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
+    """The piecewise-linear `series` (``(time, value)`` chunks, time increasing, at least one sample) at the `grid`
+    times (increasing), held constant before its first time and after its last; and those two times."""
+    out, last, first = np.empty(len(grid)), None, 0.0
+    for t, v in series:
+        if last is None:
+            first, lo = float(t[0]), -np.inf
+        else:
+            lo, t, v = float(last[0][0]), np.concatenate([last[0], t]), np.concatenate([last[1], v])
+        within = (grid > lo) & (grid <= t[-1])
+        out[within] = np.interp(grid[within], t, v)
+        last = t[-1:], v[-1:]
+    assert last is not None, "sample_at: an empty series"  # its readers refuse a topic without samples
+    out[grid > last[0][0]] = last[1][0]
+    return out, (first, float(last[0][0]))
+
+
+def imu_grid(start: float, end: float) -> np.ndarray:
+    """The window ends of the IMU check over a run from `start` to `end` [s]: every half :data:`IMU_WINDOW`, and the
+    end."""
+    return np.append(np.arange(start, end, IMU_WINDOW / 2), end)
+
+
+def imu_warning(grid: np.ndarray, wheels: np.ndarray, imu: np.ndarray, topic: str) -> str | None:
+    """The line when the wheels' heading and the IMU's yaw (both at the `grid` times of :func:`imu_grid`) turn apart,
+    over the run or over one window, by more than :data:`IMU_TURN_ATOL` + :data:`IMU_DRIFT` times its span +
+    :data:`IMU_TURN_RTOL` times the larger turn; else None. The line gives both turns over the run and over the worst
+    window."""
+    n = len(grid)
+    pairs = [(0, n - 1)] + [(i, i + 2) for i in range(n - 2)]
+
+    def excess(i: int, j: int) -> float:
+        a, b = wheels[j] - wheels[i], imu[j] - imu[i]
+        return abs(a - b) / (IMU_TURN_ATOL + IMU_DRIFT * (grid[j] - grid[i]) + IMU_TURN_RTOL * max(abs(a), abs(b)))
+
+    worst = max(pairs, key=lambda p: excess(*p))
+    if excess(*worst) <= 1.0:
+        return None
+    (i, j), (r0, r1) = worst, pairs[0]
+    window = (f"; from {grid[i] - grid[0]:.4g} s to {grid[j] - grid[0]:.4g} s into the run the odometry turned "
+              f"{wheels[j] - wheels[i]:.4g} rad and the IMU {imu[j] - imu[i]:.4g} rad" if worst != pairs[0] else "")
+    return (f"the odometry's heading contradicts the IMU on {topic}: over the run the odometry turned "
+            f"{wheels[r1] - wheels[r0]:.4g} rad and the IMU {imu[r1] - imu[r0]:.4g} rad{window} (beyond "
+            f"{IMU_TURN_ATOL:g} rad + {IMU_DRIFT:g} rad/s of gyro drift + {IMU_TURN_RTOL:.0%} of the turn): the wheels "
+            "slip (a skid steer turning?), or the description's track or wheel radii are wrong")
+
+
+def bag_imu_warning(model: OdometryModel, summary: OdometrySummary, path: str, imu_topic: str, *,
+                    topic: str = "/joint_states", names: Mapping[str, str] | None = None) -> str | None:
+    """:func:`imu_warning` of the run `summary` of the bag at `path`: its JointState messages on `topic` (`names`:
+    ROS names to the robot's joints) read again for the no-slip `model`'s heading, its IMU on `imu_topic`
+    (:func:`~.bags.read_imu_yaw`). An IMU with no message within the run is a :class:`~.logs.LogError`."""
+    from .bags import read_imu_yaw, read_joint_states
+
+    if summary.samples < 2:
+        return None
+    grid = imu_grid(summary.start_time, summary.end_time)
+    imu, (first, last) = sample_at(read_imu_yaw(path, imu_topic), grid)
+    if last <= grid[0] or first >= grid[-1]:
+        raise LogError(f"{path}: {imu_topic}: the IMU's stamps ({first:.9g} to {last:.9g} s) miss the joint states' "
+                       f"({grid[0]:.9g} to {grid[-1]:.9g} s): another clock?")
+    grid = np.clip(grid, first, last)  # where both have samples: the IMU's yaw held outside is its yaw there
+    joints = read_joint_states(path, model.joints, robot=model.robot, topic=topic, names=names)
+    return imu_warning(grid, sample_at(heading_series(model, joints), grid)[0], imu, imu_topic)
