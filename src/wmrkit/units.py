@@ -13,6 +13,8 @@ import re
 import unicodedata
 from typing import Literal
 
+from ._numbers import NUMBER
+
 Kind = Literal["length", "angle", "number"]
 
 #: Factor to SI for every unit accepted, by kind.
@@ -30,8 +32,9 @@ _DECIMAL = {unit: decimal.Decimal(repr(factor)) for unit, factor in (*UNITS["len
             if unit not in ("m", "rad", "deg", "°", "turn")}
 #: Enough digits for any number a description holds; no traps: an overflow gives inf, refused as not finite.
 _CONTEXT = decimal.Context(prec=10_000, Emax=decimal.MAX_EMAX, Emin=decimal.MIN_EMIN, traps=[])
-#: ASCII digits only: ``\d`` also matched '٣' and '１', which float() read as 3 and 1.
-_QUANTITY = re.compile(r"^\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*([^\s0-9.+-][^\s]*)?\s*$")
+#: The number of the tables' fields (ASCII digits only: ``\d`` also matched '٣' and '１', which float() read as 3 and
+#: 1), then a unit.
+_QUANTITY = re.compile(rf"^\s*({NUMBER})\s*([^\s0-9.+-][^\s]*)?\s*$")
 
 
 class UnitError(ValueError):

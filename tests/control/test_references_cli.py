@@ -99,14 +99,15 @@ def test_a_reference_faster_than_any_robot_is_refused(tmp_path):
         load_reference(fast)
 
 
-def test_a_value_that_is_not_a_number_is_named_with_its_sample_and_column(tmp_path):
-    """'times and poses must be finite numbers' left the user to search the file for it."""
+def test_a_value_that_is_not_a_number_is_named_with_its_line_and_column(tmp_path):
+    """'times and poses must be finite numbers' left the user to search the file for it; then 'sample 2: y nan',
+    counted from the first sample, not the file's line."""
     bad = tmp_path / "bad.csv"
     bad.write_text("t,x,y,theta\n0,0,0,0\n1,1,nan,0\n2,2,0,0\n")
-    with pytest.raises(ReferenceError, match=r"bad.csv: sample 2: y nan is not a finite number"):
+    with pytest.raises(ReferenceError, match=r"bad.csv:3: column 'y': value nan is not a finite number$"):
         load_reference(bad)
     bad.write_text("t,x,y,theta\n0,0,0,0\n1,1,0,0\ninf,2,0,0\n")
-    with pytest.raises(ReferenceError, match=r"sample 3: t inf is not a finite number"):
+    with pytest.raises(ReferenceError, match=r"bad.csv:4: column 't': value inf is not a finite number$"):
         load_reference(bad)
 
 

@@ -132,7 +132,8 @@ def test_torque_file(tmp_path, forklift):
     assert sim.twist[100, 0] > 1.0
     assert sim.heading[-1, 0] == pytest.approx(0.2, abs=0.02)
     for text, match in (("time,steer.spin\n0,1\n", "not actuated"), ("time,nope.spin\n0,1\n", "no joint"),
-                        ("time,left_drive.spin\n0,x\n", "not a number"), ("t,a\n", "header"),
+                        ("time,left_drive.spin\n0,x\n", ":2: column 'left_drive.spin': cannot read 'x' as a number"),
+                        ("t,a\n", "header"),
                         ("time,left_drive.spin\n1,0\n0,0\n", "increasing"),
                         ("time,left_drive.spin\n100,9\n101,9\n", r":2: the first row is at t = 100 s")):
         path.write_text(text)

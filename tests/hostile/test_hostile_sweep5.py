@@ -120,7 +120,7 @@ def test_track_limits_keep_runs_that_work():
 @pytest.mark.parametrize("text, expected", [
     ("t,x,y,theta\n0,0,0,0\n1,1,0,0\n2,2,0\n", "ref.csv:4: expected 4 fields, got 3"),  # numpy's message before
     ("t,x,y,theta\n0,0,0,0\n1,1,0,0\n2,2,0,0,5\n", "ref.csv:4: expected 4 fields, got 5"),  # accepted before
-    ("t,x,y,theta\n0,0,0,0\n1,1,0,0\n2,2,0,abc\n", "ref.csv:4: not a number"),
+    ("t,x,y,theta\n0,0,0,0\n1,1,0,0\n2,2,0,abc\n", "ref.csv:4: column 'theta': cannot read 'abc' as a number"),
     ("t,x,y,theta\n0,0,0,0\n1,1e308,0,0\n2,-1e308,0,0\n", "sample 2: position (1e+308, 0) m is beyond"),  # "feasible"
 ])
 def test_reference_files_are_read_row_by_row(text, expected, tmp_path, capsys):
@@ -141,7 +141,7 @@ def _skid_log(tmp_path: Path, n: int = 50) -> str:
 
 @pytest.mark.parametrize("tum, expected", [
     ("", "no poses in the file"),  # numpy's UserWarning and "8 columns, got 1" before
-    ("0 0 0 0 0 0 0 1\n0.1 nan 0 0 0 0 0 1\n0.2 0 0 0 0 0 0 1\n", "pose 2: times and positions must be finite"),
+    ("0 0 0 0 0 0 0 1\n0.1 nan 0 0 0 0 0 1\n0.2 0 0 0 0 0 0 1\n", ":2: column 'tx': value nan is not a finite number"),
     ("0 0 0 0 0 0 0 1\n0.2 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1\n", "pose 3: time 0.1 s does not increase"),  # silent
     ("0 0 0 0 0 0 0 0\n0.1 0 0 0 0 0 0 0\n0.2 0 0 0 0 0 0 0\n", "pose 1: the quaternion is (almost) zero"),  # silent
     ("0 0 0 0 0 0 0 1\n0.1 1e308 0 0 0 0 0 1\n0.2 0 0 0 0 0 0 1\n", "pose 2: a coordinate beyond"),  # printed inf

@@ -139,7 +139,7 @@ def test_a_run_that_fails_leaves_no_partial_output(tmp_path, name):
     rows = [f"{0.01 * i},{0.1 * i if i != 60 else 'nan'},{0.1 * i}" for i in range(100)]
     log.write_text("time,left.spin,right.spin\n" + "\n".join(rows) + "\n")
     out = tmp_path / name
-    with pytest.raises(LogError, match=r"left\.spin: value nan"):
+    with pytest.raises(LogError, match=r"log\.csv:62: column 'left\.spin': value nan"):
         odometry_file(catalog.load("diff-drive"), log, out=out, chunk_size=16)  # chunks before row 60 written
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["log.csv"]
 

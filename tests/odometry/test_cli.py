@@ -162,7 +162,7 @@ def test_an_external_heading_that_contradicts_the_wheels_warns(capsys, tmp_path,
 
 
 @pytest.mark.parametrize(("setup", "args", "message"), [
-    ("nan", [], r"x\.csv:4: right\.spin: value nan is not a finite number"),
+    ("nan", [], r"x\.csv:4: column 'right\.spin': value nan is not a finite number \(field 3\)"),
     ("repeat", [], r"x\.csv:4: time 0\.05 s repeats the previous sample \(a zero time step\)"),
     ("ok", ["--time-column", "stamp"], r"missing column 'stamp'"),
     ("wheels", [], r"column 'front\.spin' names no wheel of the robot"),

@@ -103,7 +103,7 @@ def test_heading_and_gyro_columns(tmp_path):
     ("time,left.spin,right.spin", ["0,0,0", "0.2,1,1", "0.1,2,2"], LogFormat(),
      r"x\.csv:4: time 0\.1 s goes backwards"),
     ("time,left.spin,right.spin", ["0,0,0", "0.1,nan,1"], LogFormat(),
-     r"x\.csv:3: left\.spin: value nan is not a finite number"),
+     r"x\.csv:3: column 'left\.spin': value nan is not a finite number \(field 2\)"),
     # the gyro's column was called 'heading', and neither it nor the time's was named as a column (--json: no field)
     ("time,left.spin,right.spin,gz", ["0,0,0,0", "0.1,1,1,nan"], LogFormat(gyro_column="gz"),
      r"x\.csv:3: column 'gz': value nan is not a finite number"),
@@ -149,7 +149,7 @@ def test_errors_in_later_chunks_name_the_right_line(tmp_path):
     rows = [f"{0.1 * k!r},{k},{k}" for k in range(50)]
     rows[37] = "3.6,nan,1"
     path = _write(tmp_path / "x.csv", "time,left.spin,right.spin", rows)
-    with pytest.raises(LogError, match=r"x\.csv:39: left\.spin"):
+    with pytest.raises(LogError, match=r"x\.csv:39: column 'left\.spin'"):
         list(read_csv(path, JOINTS, chunk_size=8))
 
 
@@ -227,14 +227,14 @@ def test_yaw_of_any_nonzero_quaternion_is_scipys():
         np.testing.assert_allclose(yaw_of_quaternion(q * scale), expected, atol=1e-12)
 
 
-def test_trajectory_files_with_non_finite_values_are_refused_at_their_pose(tmp_path):
+def test_trajectory_files_with_non_finite_values_are_refused_at_their_line_and_column(tmp_path):
     tum = tmp_path / "t.tum"
-    tum.write_text("0 0 0 0 0 0 0 1\n1 1 0 0 0 0 inf 1\n")
-    with pytest.raises(LogError, match=r"t\.tum: pose 2: the quaternion must be finite numbers$"):
+    tum.write_text("# t x y z qx qy qz qw\n0 0 0 0 0 0 0 1\n1 1 0 0 0 0 inf 1\n")
+    with pytest.raises(LogError, match=r"t\.tum:3: column 'qz': value inf is not a finite number$"):
         read_tum(tum)
     csv = tmp_path / "t.csv"
     csv.write_text("time,x,y,theta,slip\n0,0,0,0,0\n1,1,0,nan,0\n")
-    with pytest.raises(LogError, match=r"t\.csv: pose 2: theta, slip and the covariance must be finite numbers$"):
+    with pytest.raises(LogError, match=r"t\.csv:3: column 'theta': value nan is not a finite number$"):
         read_trajectory_csv(csv)
 
 

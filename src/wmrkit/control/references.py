@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._numbers import number_problem
 from .._shapes import readonly
 from ..errors import UnknownNameError, WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_table_size
@@ -133,8 +134,8 @@ def _check_radians(name: str, theta: np.ndarray) -> None:
 
 def _plain_csv(path: Path) -> np.ndarray | None:
     """The rows of a CSV reference whose header starts ``t,x,y,theta`` and whose every row is as many plain numbers,
-    by numpy's reader; None for anything else (quotes, blank fields, a bad row), which the row-by-row reader
-    refuses with its line. A 64 MiB file read as Python lists took 1.1 GB."""
+    by numpy's reader; None for anything else (quotes, blank fields, a bad row, a value that is not finite), which
+    the row-by-row reader refuses with its line. A 64 MiB file read as Python lists took 1.1 GB."""
     with open(path, encoding="utf-8-sig", newline="") as f:
         header = [h.strip().lower() for h in f.readline().strip("\r\n").split(",")]
         if header[:1] == ["time"]:
@@ -147,7 +148,8 @@ def _plain_csv(path: Path) -> np.ndarray | None:
                 data = np.loadtxt(f, delimiter=",", ndmin=2, comments=None, dtype=float)
         except ValueError:
             return None
-    return data if len(data) and data.shape[1] == len(header) else None
+    ok = len(data) and data.shape[1] == len(header) and np.isfinite(data[:, :4]).all()
+    return data if ok else None  # 'nan', 'inf', '1e400' (read as inf): named with their line by the row reader
 
 
 def load_reference(path: str | os.PathLike[str]) -> Reference:
@@ -174,15 +176,19 @@ def load_reference(path: str | os.PathLike[str]) -> Reference:
             for line, row in enumerate(rows[1:], start=2):
                 if row and len(row) != len(header):
                     raise ReferenceError(f"{path}:{line}: expected {len(header)} fields, got {len(row)}")
-                try:
-                    data += [[float(v) for v in row[:4]]] if row else []
-                except ValueError:
-                    raise ReferenceError(f"{path}:{line}: not a number in {','.join(row[:4])!r}") from None
+                for name, field in zip(header[:4], row[:4], strict=False):
+                    problem = number_problem(field)
+                    if problem is not None:
+                        raise ReferenceError(f"{path}:{line}: column '{name}': {problem}")
+                data += [[float(v) for v in row[:4]]] if row else []
             data = np.array(data, dtype=float).reshape(-1, 4)
             return reference_from_samples(str(path), data[:, 0], data[:, 1:4])
         from ..odometry.trajectories import read_tum
 
-        t, pose = read_tum(path)
+        try:
+            t, pose = read_tum(path)
+        except WmrkitError as err:  # its message names the file and the line already
+            raise ReferenceError(str(err)) from None
     except ReferenceError:
         raise
     except (ValueError, IndexError, UnicodeDecodeError, WmrkitError) as err:

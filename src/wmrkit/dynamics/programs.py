@@ -21,6 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._numbers import number_problem
 from .._shapes import readonly
 from ..errors import WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, check_table_size
@@ -224,12 +225,10 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
         if len(row) != len(header):
             raise WmrkitError(f"{source}:{i}: {len(row)} values for {len(header)} columns")
         for j, cell in enumerate(row):
-            try:
-                values[i - 2, j] = float(cell)
-            except ValueError:
-                raise WmrkitError(f"{source}:{i}: column '{header[j]}': not a number: {cell!r}") from None
-            if not math.isfinite(values[i - 2, j]):
-                raise WmrkitError(f"{source}:{i}: column '{header[j]}': must be finite")
+            problem = number_problem(cell)
+            if problem is not None:
+                raise WmrkitError(f"{source}:{i}: column '{header[j]}': {problem}")
+            values[i - 2, j] = float(cell)
     if np.any(np.diff(values[:, 0]) <= 0):
         raise WmrkitError(f"{source}: times must be strictly increasing")
     if values[0, 0] > 0:  # held before the first row, the first torques would act from t = 0

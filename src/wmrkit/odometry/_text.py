@@ -2,8 +2,8 @@
 
 Rows are read in bounded pieces (:data:`MAX_LINE`), so a file whose tail is one endless "line" (a logger's
 preallocated block of NUL bytes after a power loss, a binary file) costs no more memory than a chunk. The text
-of the readers' messages too: a field quoted short, a did-you-mean for a misspelt joint; and the rows' numbers
-(:func:`parse_rows`).
+of the readers' messages too: a did-you-mean for a misspelt joint; and the rows' numbers (:func:`parse_rows`), read
+as every text table's (:mod:`wmrkit._numbers`).
 """
 
 from __future__ import annotations
@@ -16,6 +16,8 @@ from collections.abc import Sequence
 from typing import IO
 
 import numpy as np
+
+from .._numbers import number_problem, short  # noqa: F401 (short: the readers' quoting)
 
 #: Longest row read [characters]: a longer line is not a row of a CSV log.
 MAX_LINE = 1 << 18
@@ -109,21 +111,19 @@ def did_you_mean(joint: str, wheels: Sequence[str], taken: Sequence[str] = ()) -
     return f" (did you mean '{close[0]}'?)" if close else ""
 
 
-def short(text: str, limit: int = 40) -> str:
-    """`text` quoted for a message, cut to about `limit` characters."""
-    return repr(text) if len(text) <= limit else repr(text[:limit]) + f"... ({len(text)} characters)"
-
-
 def parse_rows(rows: list[str], usecols: list[int], delimiter: str, source: str, line: int, lines: list[str],
                header: list[str]) -> np.ndarray:
     """The numbers of the columns `usecols` of `rows` ``(R, len(usecols))``; a field that is not a number is refused
-    naming its line and its column as the header writes it."""
+    naming its line and its column as the header writes it (:func:`wmrkit._numbers.number_problem`: finite numbers
+    in ASCII digits only)."""
     if not rows:
         return np.zeros((0, len(usecols)))
     try:
-        return np.loadtxt(rows, delimiter=delimiter, usecols=usecols, ndmin=2, comments=None, dtype=float)
+        data = np.loadtxt(rows, delimiter=delimiter, usecols=usecols, ndmin=2, comments=None, dtype=float)
     except ValueError:  # field counts are already checked (check_lines): a field is not a number
-        pass
+        data = None
+    if data is not None and np.isfinite(data).all():  # else 'nan', 'inf' or '1e400' (read as inf): named below
+        return data
     for k, ln in enumerate(lines):  # error path: find the first bad line
         if not ln.strip():
             continue
@@ -131,17 +131,8 @@ def parse_rows(rows: list[str], usecols: list[int], delimiter: str, source: str,
         if len(fields) != len(header):
             raise _error(f"{source}:{line + k}: expected {len(header)} fields, got {len(fields)}")
         for c in usecols:
-            if not _reads_as_loadtxt(fields[c]):
-                raise _error(f"{source}:{line + k}: column '{header[c]}': cannot read {short(fields[c].strip())} "
-                             f"as a number (field {c + 1})")
+            problem = number_problem(fields[c])
+            if problem is not None:
+                raise _error(f"{source}:{line + k}: column '{header[c]}': {problem} (field {c + 1})")
     raise _error(f"{source}:{line}: cannot read the rows that start here")  # pragma: no cover
 
-
-def _reads_as_loadtxt(field: str) -> bool:
-    """Whether numpy's loadtxt reads `field` as a number: Python's float also takes digit separators and other
-    scripts' digits ('1_0', Arabic-Indic '\u0661'), which loadtxt refuses (the row then got no field named)."""
-    try:
-        float(field)
-    except ValueError:
-        return False
-    return "_" not in field and field.strip().isascii()

@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import IO, Literal
+from typing import IO, Literal, NoReturn
 
 import numpy as np
 
+from .._numbers import number_problem
 from ..limits import MAX_COORDINATE, check_table_size
 from .logs import LogError
 
@@ -109,9 +110,13 @@ def write_trajectory(path: str | os.PathLike[str], trajectory: Trajectory, fmt: 
         w.write(trajectory)
 
 
+#: The columns of a TUM file, as messages name them.
+TUM_COLUMNS = ("timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw")
+
+
 def read_tum(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
     """A TUM file's times ``(N,)`` [s] and planar poses ``(N, 3)`` (yaw from the quaternion, z ignored)."""
-    data = _load_table(path, comments="#")
+    data = _load_table(path, TUM_COLUMNS, comments="#")
     if data.shape[1] != 8:
         raise LogError(f"{os.fspath(path)}: a TUM file has 8 columns, got {data.shape[1]}")
     _check_samples(path, data[:, 0], data[:, 1:4])
@@ -122,21 +127,50 @@ def read_tum(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
     return data[:, 0], np.column_stack([data[:, 1], data[:, 2], np.unwrap(yaw_of_quaternion(data[:, 4:8]))])
 
 
-def _load_table(path: str | os.PathLike[str], **options) -> np.ndarray:
-    """``np.loadtxt`` of a trajectory file with at least one row; errors name the file in one line."""
+def _load_table(path: str | os.PathLike[str], columns: tuple[str, ...], *, delimiter: str | None = None,
+                skiprows: int = 0, comments: str | None = None) -> np.ndarray:
+    """``np.loadtxt`` of a trajectory file (`columns` name its fields in messages) with at least one row of finite
+    numbers; a field that is none (:func:`wmrkit._numbers.number_problem`) is named with its line, in one line."""
     import warnings
 
     check_table_size(path, LogError, "trajectory")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # "input contained no data": refused below
-            data = np.loadtxt(path, ndmin=2, **options)
-    except (OSError, ValueError, UnicodeDecodeError) as err:
+            data = np.loadtxt(path, ndmin=2, delimiter=delimiter, skiprows=skiprows, comments=comments,
+                              encoding="utf-8-sig")  # -sig: a byte-order mark is not part of the first number
+    except (OSError, UnicodeDecodeError) as err:
         reason = getattr(err, "strerror", None) or str(err).splitlines()[0]
         raise LogError(f"{os.fspath(path)}: cannot read the trajectory ({reason})") from None
+    except ValueError:
+        data = None
+    if data is None or not np.isfinite(data).all():  # error path: name the field ('nan', '1e400' read as inf)
+        _refuse_field(path, columns, delimiter, skiprows, comments)
     if data.size == 0:
         raise LogError(f"{os.fspath(path)}: no poses in the file")
     return data
+
+
+def _refuse_field(path: str | os.PathLike[str], columns: tuple[str, ...], delimiter: str | None, skiprows: int,
+                  comments: str | None) -> NoReturn:
+    """Raise a :class:`LogError` naming the line and the column of the first field of the table at `path` that is
+    not a finite number, or the first row of another field count (the file is at most ``MAX_TABLE_SIZE``)."""
+    with open(path, encoding="utf-8-sig", newline="") as f:
+        lines = f.read().splitlines()
+    width = len(columns) if delimiter else None  # a CSV has its header's fields; read_tum counts a TUM file's
+    for k, text in enumerate(lines[skiprows:], start=skiprows + 1):
+        fields = (text.partition(comments)[0] if comments else text).split(delimiter)
+        if fields in ([], [""]) or not "".join(fields).strip():
+            continue  # a blank line or a comment
+        width = len(fields) if width is None else width
+        if len(fields) != width:
+            raise LogError(f"{os.fspath(path)}:{k}: expected {width} fields, got {len(fields)}")
+        for c, field in enumerate(fields):
+            problem = number_problem(field)
+            if problem is not None:
+                name = columns[c] if c < len(columns) else f"field {c + 1}"
+                raise LogError(f"{os.fspath(path)}:{k}: column '{name}': {problem}")
+    raise LogError(f"{os.fspath(path)}: cannot read the trajectory")  # pragma: no cover (loadtxt's reasons above)
 
 
 def _check_samples(path: str | os.PathLike[str], t: np.ndarray, position: np.ndarray) -> None:
@@ -162,7 +196,7 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
     """A trajectory CSV written by :class:`TrajectoryWriter` (covariance restored when present)."""
     check_table_size(path, LogError, "trajectory")  # before opening: a FIFO's open waits for a writer
     try:
-        with open(path, encoding="utf-8") as f:
+        with open(path, encoding="utf-8-sig") as f:
             header = f.readline().strip().split(",")
     except (OSError, UnicodeDecodeError) as err:
         raise LogError(f"{os.fspath(path)}: cannot read the trajectory ({getattr(err, 'strerror', None) or err})") \
@@ -170,7 +204,7 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
     if header[:5] != ["time", "x", "y", "theta", "slip"] or header[5:] not in ([], list(COV_COLUMNS)):
         raise LogError(f"{os.fspath(path)}:1: expected the columns time,x,y,theta,slip (and the covariance's "
                        f"{','.join(COV_COLUMNS)}), got {','.join(header)}")
-    data = _load_table(path, delimiter=",", skiprows=1)
+    data = _load_table(path, tuple(header), delimiter=",", skiprows=1)
     if data.shape[1] != len(header):
         raise LogError(f"{os.fspath(path)}: {data.shape[1]} values per row under a header of {len(header)} columns")
     _check_samples(path, data[:, 0], data[:, 1:3])
