@@ -27,8 +27,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_names, readonly
+from ..couplings import gear_fill
 from ..errors import ShapeError, UnknownNameError
-from ..kinematics.linalg import characteristic_length
+from ..kinematics.linalg import characteristic_length, matrix_rank
 from ..kinematics.models import configuration
 from ..robot import Robot
 from . import _fast
@@ -113,36 +114,60 @@ class TwistModel:
     """Joint rates as linear maps of the twist, and the robot's motion constraints, for fast batched evaluation.
 
     ``rates(beta) @ twist_robot`` gives the `joints` rates (per wheel ``-W^+ P``, eqs. 3.22, 4.5); the twists
-    the robot can make satisfy ``constraints(beta) @ twist_robot = 0`` (5.7). ``mobility`` is the generic m.
+    the robot can make satisfy ``constraints(beta) @ twist_robot = 0`` (5.7). ``mobility`` is the generic m;
+    `geared`: with the robot's ``gear`` couplings held (:func:`twist_model`), m the one they leave as described.
     """
 
     robot: Robot
     joints: tuple[str, ...]
     mobility: int
     coefficients: np.ndarray  # (n_joints, 2 n_elements)
+    geared: bool = False
 
     def rates(self, beta: ArrayLike | None = None) -> np.ndarray:
         """``(..., n_steer) -> (..., n_joints, 3)``: d(joint rate)/d(twist), rad/m and rad."""
         return np.einsum("jk,...kc->...jc", self.coefficients, element_rows(self.robot, beta))
 
     def constraints(self, beta: ArrayLike | None = None) -> np.ndarray:
-        """``(..., n_steer) -> (..., n_lines, 3)``: the axle lines K_r* (5.2), normalised."""
-        return constraint_lines(self.robot).lines(beta)
+        """``(..., n_steer) -> (..., n_lines, 3)``: the axle lines K_r* (5.2), normalised (with the lines a gear
+        adds when `geared`)."""
+        return constraint_lines(self.robot, coupled=self.geared).lines(beta)
 
 
-def twist_model(robot: Robot, joints: tuple[str, ...] | None = None) -> TwistModel:
-    """The :class:`TwistModel` of `robot` for `joints` (names from ``robot.rate_names``; default actuated)."""
+def twist_model(robot: Robot, joints: tuple[str, ...] | None = None, *, geared: bool = False) -> TwistModel:
+    """The :class:`TwistModel` of `robot` for `joints` (names from ``robot.rate_names``; default actuated).
+
+    `geared` (on a robot with a ``gear`` coupling; else ignored): the gears held, as ``fk`` and the actuation analysis
+    hold them. A gear is one mechanism, so one of its joints among `joints` brings in all of them
+    (:func:`~wmrkit.couplings.gear_fill`: the same model whichever of them the description lists), and the twists
+    are those the gears allow: the lines :func:`.lines.constraint_lines` gives with ``coupled``, m = 3 minus their
+    rank at the described configuration (a gear of two omni wheels' spins leaves m = 2: one line the ICR lies on,
+    the thesis's (v, D omega) pair about it, as for a fixed axle).
+    """
     joints = default_joints(robot) if joints is None else as_names(joints, "joints", "joint rate names",
                                                                    UnknownNameError)
     for n in joints:
         if n not in robot.rate_names:
             raise UnknownNameError(f"robot '{robot.name}' has no joint rate '{n}' "
                                    f"(rates: {', '.join(robot.rate_names)})")
-    return _twist_model(robot, joints)
+    if not (geared and any(c.kind == "gear" for c in robot.couplings)):
+        return _twist_model(robot, joints)
+    names = robot.rate_names
+    filled = gear_fill(robot.couplings, names, tuple(map(names.index, joints)))[0]
+    return _twist_model(robot, tuple(names[i] for i in filled), True)
+
+
+def _geared_mobility(robot: Robot) -> int:
+    """3 minus the rank of the lines the twist obeys with the gears held, at the described configuration (in the
+    robot's largest length: the rank decisions of :mod:`..kinematics.linalg`)."""
+    lines = constraint_lines(robot, coupled=True).lines()
+    if len(lines) == 0:
+        return 3
+    return 3 - int(matrix_rank(lines * np.array([1.0, 1.0, 1.0 / characteristic_length(robot)])))
 
 
 @functools.lru_cache(maxsize=256)
-def _twist_model(robot: Robot, joints: tuple[str, ...]) -> TwistModel:
+def _twist_model(robot: Robot, joints: tuple[str, ...], geared: bool = False) -> TwistModel:
     n_rows = 2 * sum(len(w.elements()) for w in robot.wheels)
     coefficients = np.zeros((len(joints), n_rows))
     start = 0
@@ -153,22 +178,25 @@ def _twist_model(robot: Robot, joints: tuple[str, ...]) -> TwistModel:
             if name in w.rate_names:
                 coefficients[j, start:start + rows] = inverse[w.rate_names.index(name)]
         start += rows
-    return TwistModel(robot, joints, classify(robot).mobility, readonly(coefficients))
+    mobility = _geared_mobility(robot) if geared else classify(robot).mobility
+    return TwistModel(robot, joints, mobility, readonly(coefficients), geared)
 
 
 def twist_condition_number(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple[str, ...] | None = None,
-                           length: float | None = None, heading: ArrayLike | None = None) -> np.ndarray:
+                           length: float | None = None, heading: ArrayLike | None = None,
+                           geared: bool = False) -> np.ndarray:
     """Condition number (5.28) of the joint rates as a function of the admissible twists ``(vx, vy, D omega)``.
 
     ``(..., n_steer) -> (...)``; `joints` default to :func:`default_joints`, `length` D [m] to the natural
     length at the described configuration. ``inf`` where the joints cannot tell some motions apart (a singular
     model, ch. 6); ``nan`` where the robot cannot move (uncoordinated steering). With m = 1 it is 1 wherever
-    defined: isotropy does not apply to types 4 and 5 (§5.5.4-5.5.5). Steering as `beta` or `heading`.
+    defined: isotropy does not apply to types 4 and 5 (§5.5.4-5.5.5). Steering as `beta` or `heading`;
+    `geared`: over the motions the robot's gears allow (:func:`twist_model`).
     """
-    model = twist_model(robot, joints)
+    model = twist_model(robot, joints, geared=geared)
     beta = configuration(robot, beta, heading)
     if length is None:
-        length = natural_length(robot, joints=model.joints)[0]
+        length = natural_length(robot, joints=model.joints, geared=geared)[0]
     else:
         check_positive_length(length)
     return _kappa(model, beta, float(length))
@@ -200,15 +228,15 @@ def length_applies(mobility: int, kappa: float) -> bool:
 
 
 def natural_length(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple[str, ...] | None = None,
-                   heading: ArrayLike | None = None) -> tuple[float, float]:
+                   heading: ArrayLike | None = None, geared: bool = False) -> tuple[float, float]:
     """The characteristic length minimising :func:`twist_condition_number` at one configuration: ``(D [m], kappa)``.
 
     m = 2: closed form ``D = |h_omega| / |h_v|``, the ratio of the column norms (equal diagonals of ``H^T H``,
     (5.50)-(5.51): D = l12 for a differential drive). m = 3: a 1-D search (D = sqrt(2) L for the isotropic
     three-wheel omni robot). Where kappa does not depend on D (m = 1) D is the robot size. Steering: `beta`
-    (thesis) or `heading` (0 = rolling forward), default as described.
+    (thesis) or `heading` (0 = rolling forward), default as described; `geared` as :func:`twist_model`.
     """
-    model = twist_model(robot, joints)
+    model = twist_model(robot, joints, geared=geared)
     beta = configuration(robot, beta, heading)
     if beta.ndim != 1:
         raise UnknownNameError("natural_length takes one configuration (shape (n_steer,))")
@@ -258,7 +286,8 @@ def _in_robot_lengths(model: TwistModel, rows: np.ndarray) -> tuple[np.ndarray, 
     unchanged; a length D of the robot is ``D / L`` here."""
     unit = characteristic_length(model.robot)
     scale = np.array([unit, unit, 1.0])[None, :, None]
-    lines = _fast.combine_lines(constraint_lines(model.robot), rows) * np.array([1.0, 1.0, 1.0 / unit])[None, :, None]
+    lines = _fast.combine_lines(constraint_lines(model.robot, coupled=model.geared), rows) * np.array(
+        [1.0, 1.0, 1.0 / unit])[None, :, None]
     return _fast.combine(model.coefficients, rows) * scale, _fast.normalize_cm(lines), unit
 
 

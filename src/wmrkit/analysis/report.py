@@ -158,8 +158,12 @@ def _isotropy_section(a: Analysis, out: Path, resolution: int, dpi: float | None
     if c.mobility <= 1:
         return _section("Isotropy", text + " With one degree of mobility every relation is scalar: κ = 1 wherever "
                         "the model exists (thesis §5.5.4-5.5.5); see the singularities below.", "")
-    if a.gear_mobility is not None:
+    if a.gears_leave_one:
         return _section("Isotropy", text + f" Its gear couplings: isotropy {a.isotropy_note()}.", "")
+    if a.gear_mobility is not None:
+        return _section("Isotropy", text + f" Its gear couplings leave m = {a.gear_mobility}: κ is over the motions "
+                        "they allow, every joint of a gear counted (its maps over D and the steering are not drawn).",
+                        "")
     body = ""
     fig = length_figure(r, a.joints)
     if fig is not None:

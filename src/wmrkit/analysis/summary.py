@@ -24,7 +24,7 @@ from ..wheels import heading_from_beta
 from .classification import Classification, classify, instantaneous_mobility
 from .coordinated import coordinated_singular_set
 from .icr import ICRSet, icr
-from .isotropy import default_joints, length_applies, natural_length, twist_condition_number
+from .isotropy import default_joints, length_applies, natural_length, twist_condition_number, twist_model
 from .singularity import SingularSet, singular_set
 
 
@@ -62,7 +62,7 @@ class Analysis:
             "icr": self.icr.describe(),
             "actuation": {k: self.actuation[k] for k in ("consistent", "sufficient", "verdict")},
             "sensing": {k: self.sensing[k] for k in ("sufficient", "verdict")},
-            "condition_number": None if self.gear_mobility is not None else self.condition_number,
+            "condition_number": None if self.gears_leave_one else self.condition_number,
             "characteristic_length": self.characteristic_length if self.has_length else None,
             "condition_joints": list(self.joints), "natural_length": self.natural,
             "singular": {k: singular_dict(s, self.robot) for k, s in self.singular.items()},
@@ -71,28 +71,33 @@ class Analysis:
     @property
     def has_length(self) -> bool:
         """A length goes with the condition number: given, or natural where it applies (:func:`.length_applies`)."""
-        if self.gear_mobility is not None:
+        if self.gears_leave_one:
             return False
-        return not self.natural or length_applies(self.classification.mobility, self.condition_number)
+        g = self.gear_mobility
+        m = self.classification.mobility if g is None else g
+        return not self.natural or length_applies(m, self.condition_number)
 
     @property
     def gear_mobility(self) -> int | None:
         """The m that gear couplings leave when below the wheels' m at the described steering, else None."""
         return self.coupled_mobility if self.coupled_mobility < self.instantaneous_mobility else None
 
+    @property
+    def gears_leave_one(self) -> bool:
+        """Gear couplings leave at most one motion: no condition number (one encoder of a solid axle gives the
+        twist, as fk says, and kappa = 1 says nothing)."""
+        return self.gear_mobility is not None and self.gear_mobility <= 1
+
     def isotropy_note(self) -> str | None:
-        """Why no condition number is given, or None: m <= 1 (§5.5.4-5.5.5), or gear couplings that leave fewer
-        motions than the wheels' model of the condition number (5.28) has (one encoder of a solid axle gives the
-        twist, as fk says, though that model calls it infinite)."""
+        """Why no condition number is given, or None: m <= 1 (§5.5.4-5.5.5), the wheels' or the one gear couplings
+        leave. With gears that leave m >= 2 the condition number is over the motions they allow (the geared
+        :func:`.isotropy.twist_model`)."""
         m, g = self.classification.mobility, self.gear_mobility
         if m <= 1:
             return f"does not apply (m = {m}: no two motions to balance)"
-        if g is None:
-            return None
-        if g <= 1:
+        if self.gears_leave_one:
             return f"does not apply (its gear couplings leave m = {g}: no two motions to balance)"
-        return (f"not computed (its gear couplings leave m = {g} of {m}; the condition number is of the wheels' "
-                "model)")
+        return None
 
     def condition_words(self) -> str:
         """The condition number and its length in words (the text summary and the report)."""
@@ -218,13 +223,13 @@ def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) 
     """
     check_resolution(resolution)
     cls = classify(robot)
-    joints = default_joints(robot)
+    joints = twist_model(robot, default_joints(robot), geared=True).joints  # a gear's joints: one mechanism
     if length is not None:  # as analyze --length: at 1e-9 m the twist read as undetermined
         check_length(length, WmrkitError)
     if length is None:
-        d, kappa = natural_length(robot, joints=joints)
+        d, kappa = natural_length(robot, joints=joints, geared=True)
     else:
-        d, kappa = float(length), float(twist_condition_number(robot, joints=joints, length=length))
+        d, kappa = float(length), float(twist_condition_number(robot, joints=joints, length=length, geared=True))
     act, sen = actuation_analysis(robot), sensing_analysis(robot)
     sensed = model_rates(robot, robot.sensed)  # with the rates a gear turns with them, known as fk knows them
     sensed = tuple(robot.rate_names[c] for c in gear_fill(robot.couplings, robot.rate_names,
