@@ -27,8 +27,8 @@ wheels:
   - {name: right, type: fixed, position: [0, -0.25], heading: 0, r: 0.1, actuated: [spin], sensed: [spin]}
 """
 T0 = 1000.0  # the bags' clock at the run's start [s]
-PATTERN = re.compile(r"over the run the odometry turned (\S+) rad and the IMU (\S+) rad(?:; from (\S+) s to (\S+) s "
-                     r"into the run the odometry turned (\S+) rad and the IMU (\S+) rad)?")
+PATTERN = re.compile(r"over the run the no-slip odometry turned (\S+) rad and the IMU (\S+) rad(?:; from (\S+) s to "
+                     r"(\S+) s into the run the no-slip odometry turned (\S+) rad and the IMU (\S+) rad)?")
 
 
 def _write(path, time, joints, positions, imus):
@@ -110,7 +110,7 @@ def test_a_skid_steer_turn_that_slips_is_flagged_with_both_turns(capsys, tmp_pat
     assert code == 0 and answer["imu"] == "/imu/data" and not answer["consistent"]
     assert "wmrkit: note: heading checked against the IMU on /imu/data" in err
     (line,) = answer["warnings"]
-    assert line.startswith("the odometry's heading contradicts the IMU on /imu/data")
+    assert line.startswith("the no-slip odometry's heading contradicts the IMU on /imu/data")
     m = PATTERN.search(line)
     assert float(m[1]) == pytest.approx(answer["final_pose"][2], rel=1e-3)
     turned = log.positions[-1, k] - log.positions[0, k]  # the differential drive's r (right - left) / track
@@ -233,3 +233,125 @@ def test_read_imu_yaw_unwraps_integrates_and_chunks(tmp_path):
         np.testing.assert_allclose(whole[0][0], T0 + t, atol=1e-9)
         np.testing.assert_allclose(whole[0][1], expected, atol=1e-9)
         np.testing.assert_allclose(np.concatenate([c[1] for c in chunks]), expected, atol=1e-9)
+
+
+@pytest.fixture(scope="module")
+def skid4_bag(tmp_path_factory, skid_turn):
+    """The slipping skid turn of all four wheels (``skid-steer-4``), its IMU the true heading (1.25 rad) on /imu and
+    the no-slip model's (its lateral rows halve the wheels' 5 rad: 2.5 rad) on /noslip."""
+    from wmrkit.odometry import odometry
+
+    log, truth = skid_turn
+    noslip = odometry(catalog.load("skid-steer-4"), log).poses[:, 2]
+    bag = tmp_path_factory.mktemp("skid4") / "run"
+    _write(bag, log.time, log.joints, log.positions, {"/imu": _imu(log.time, truth[:, 2], "orientation"),
+                                                      "/noslip": _imu(log.time, noslip, "orientation")})
+    return bag, truth[-1, 2] - truth[0, 2], noslip[-1] - noslip[0]
+
+
+def test_the_imu_judges_the_wls_trajectory_that_agrees(capsys, skid4_bag):
+    """--method wls with lateral rows weighted 3 times the rolling rows: its heading is the longitudinal rows' 5 rad x
+    1/(1+3) = 1.25 rad, the true turn. Before, the IMU was compared with the no-slip model's 2.5 rad and the run was
+    told "the odometry's heading contradicts the IMU"; now only the slip indicator's warning (the wheels do slip)."""
+    bag, true_turn, noslip_turn = skid4_bag
+    assert (true_turn, noslip_turn) == (pytest.approx(1.25, rel=2e-2), pytest.approx(2.5, rel=2e-2))
+    code, answer, err = _run(capsys, "skid-steer-4", bag, "--imu", "/imu", "--method", "wls", "--mu-default", "3,1")
+    assert code == 0 and answer["final_pose"][2] == pytest.approx(true_turn, rel=2e-2)
+    (line,) = answer["warnings"]
+    assert line.startswith("the sensed joints contradict each other") and "IMU" not in err
+
+
+@pytest.mark.parametrize(("options", "label"), [(("--method", "wls", "--mu-default", "3,1"), "wls"),
+                                                (("--weight", "front_left=0.001", "--weight", "front_right=0.001"),
+                                                 "weighted no-slip (--weight)")])
+def test_the_imu_judges_the_trajectory_that_disagrees_naming_it(capsys, skid4_bag, options, label):
+    """The IMU on /noslip agrees with the no-slip model (2.5 rad); the wls run (1.25 rad) and a run weighting the
+    front wheels 1/1000 (the rear wheels' rolling rows alone fix the turn: their 5 rad, the lateral rows absorbed by
+    v_y) do not. Before, no warning (the no-slip heading was judged); now the warning names the odometry judged and
+    gives its own turn, the run's final theta."""
+    bag, _, noslip_turn = skid4_bag
+    code, answer, _ = _run(capsys, "skid-steer-4", bag, "--imu", "/noslip", *options)
+    assert code == 0 and not answer["consistent"]
+    line = answer["warnings"][-1]
+    assert line.startswith(f"the {label} odometry's heading contradicts the IMU on /noslip: over the run the "
+                           f"{label} odometry turned ")
+    m = re.search(r"over the run the .* odometry turned (\S+) rad and the IMU (\S+) rad", line)
+    assert float(m[1]) == pytest.approx(answer["final_pose"][2], rel=1e-3)
+    assert float(m[1]) == pytest.approx(1.25 if label == "wls" else 5.0, rel=3e-2)
+    assert float(m[2]) == pytest.approx(noslip_turn, rel=1e-3)
+
+
+def test_the_joint_states_are_read_once(capsys, tmp_path, monkeypatch):
+    """The check samples the run's output as it is produced: every JointState message is decoded once (before, the
+    bag's joint states were read again after the run: twice)."""
+    from wmrkit.odometry import bags
+
+    robot = catalog.load("diff-drive")
+    run = simulate(robot, TwistProfile.from_segments([(12.0, 0.4, 0.0, 0.3)]), 20.0)
+    bag = tmp_path / "run"
+    _write(bag, run.log.time, run.log.joints, run.log.positions,
+           {"/imu": _imu(run.log.time, run.truth[:, 2], "orientation")})
+    decoded: dict[str, int] = {}
+    original = bags._messages
+
+    def counting(reader, conns, source, msgtype, typestore):
+        for item in original(reader, conns, source, msgtype, typestore):
+            decoded[msgtype] = decoded.get(msgtype, 0) + 1
+            yield item
+
+    monkeypatch.setattr(bags, "_messages", counting)
+    code, answer, _ = _run(capsys, "diff-drive", bag, "--chunk-size", "50")
+    assert code == 0 and answer["imu"] == "/imu" and answer["consistent"] and answer["samples"] == len(run.log)
+    assert decoded == {"sensor_msgs/msg/JointState": len(run.log), "sensor_msgs/msg/Imu": len(run.log) - 1}
+
+
+def _bad_imu_bag(tmp_path, run):
+    """A bag whose IMU's 10th message has a NaN orientation."""
+    t, yaw, _ = _imu(run.log.time, run.truth[:, 2], "orientation")
+    yaw = yaw.copy()
+    yaw[10] = np.nan
+    bag = tmp_path / "bad"
+    _write(bag, run.log.time, run.log.joints, run.log.positions, {"/imu": (t, yaw, None)})
+    return bag
+
+
+@pytest.mark.parametrize("out", ["traj.csv", "traj.tum", "odom_bag"])
+def test_a_named_bad_imu_leaves_no_output(capsys, tmp_path, short_run, out):
+    """Before, the run wrote --out, then the IMU failed to read: exit 2 and the trajectory left behind. Now the IMU is
+    read before the run: exit 2, one line naming its message, no output; found by itself it is a warning and the
+    run's output is written."""
+    bag, path = _bad_imu_bag(tmp_path, short_run), tmp_path / out
+    code, answer, _ = _run(capsys, "diff-drive", bag, "--imu", "/imu", "--out", str(path))
+    assert code == 2 and answer["error"].startswith("/imu message 10: orientation [") and answer["file"] == str(bag)
+    assert not path.exists()
+    code, answer, _ = _run(capsys, "diff-drive", bag, "--out", str(path))
+    assert code == 0 and answer["imu"] is None and path.exists()
+    (line,) = answer["warnings"]
+    assert "/imu message 10: orientation [" in line and line.endswith("(the odometry is not checked against it)")
+
+
+def test_a_named_imu_on_another_clock_leaves_no_output(capsys, tmp_path, short_run):
+    """The clock is the run's (known at its end): a named IMU missing it fails the run, whose output is removed."""
+    run = short_run
+    t, yaw, _ = _imu(run.log.time, run.truth[:, 2], "orientation")
+    bag, path = tmp_path / "clock", tmp_path / "traj.csv"
+    _write(bag, run.log.time, run.log.joints, run.log.positions, {"/imu": (t + 500.0, yaw, None)})
+    code, answer, _ = _run(capsys, "diff-drive", bag, "--imu", "/imu", "--out", str(path))
+    assert code == 2 and "another clock?" in answer["error"] and not path.exists()
+
+
+def test_an_imu_too_long_to_hold_is_refused(tmp_path, short_run, monkeypatch):
+    """The IMU's (time, yaw) are held whole: beyond bags.MAX_IMU_MESSAGES (16 bytes each, limits.MAX_TABLE_SIZE in
+    all) one error line, before the messages are read."""
+    from wmrkit.odometry import bags
+    from wmrkit.odometry.logs import LogError
+
+    assert bags.MAX_IMU_MESSAGES * 16 == bags.MAX_TABLE_SIZE
+    run = short_run
+    bag = tmp_path / "long"
+    _write(bag, run.log.time, run.log.joints, run.log.positions,
+           {"/imu": _imu(run.log.time, run.truth[:, 2], "orientation")})
+    assert len(bags.read_imu(bag, "/imu")[0]) == len(run.log) - 1
+    monkeypatch.setattr(bags, "MAX_IMU_MESSAGES", len(run.log) - 2)
+    with pytest.raises(LogError, match=rf"/imu: {len(run.log) - 1} messages, more than the {len(run.log) - 2} "):
+        bags.read_imu(bag, "/imu")

@@ -14,11 +14,11 @@ from ..errors import WmrkitError
 from ..limits import check_chunk_size
 from ..odometry.bags import imu_topic
 from ..odometry.covariance import CrowleyNoise
-from ..odometry.diagnostics import bag_imu_warning, diagnose
+from ..odometry.diagnostics import diagnose, imu_check
 from ..odometry.files import first_samples, is_bag, odometry_file
 from ..odometry.header import header_format
 from ..odometry.integrators import METHODS
-from ..odometry.logs import TIME_UNITS, LogError
+from ..odometry.logs import TIME_UNITS
 from ..odometry.model import odometry_model
 from ..odometry.pipeline import OdometrySummary, check_start_pose
 from ._common import (
@@ -153,6 +153,9 @@ def run(args: argparse.Namespace) -> int:
              parse_angle(args.pose[2], "--pose")]
     check_start_pose(np.array(pose0), "--pose")
     slip_model = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None
+    what = args.method if slip_model is not None else "weighted no-slip (--weight)" if args.weight else "no-slip"
+    # the IMU read now: a named one that fails is refused before any output is written
+    check, unread = imu_check(args.log, imu, what, named=args.imu is not None) if imu else (None, None)
     summary = odometry_file(
         robot, args.log, fmt=fmt, method=args.scheme if slip_model is not None else args.method, pose0=pose0,
         sensed=args.sensed, model=slip_model,
@@ -160,7 +163,8 @@ def run(args: argparse.Namespace) -> int:
         plot=args.plot, progress=not args.quiet and sys.stderr.isatty(), chunk_size=args.chunk_size,
         topic=args.topic, joint_names=parse_assignments(args.joint_name, "--joint-name"),
         weights={w: parse_value(v, "number", f"--weight {w}")
-                 for w, v in parse_assignments(args.weight, "--weight").items()})
+                 for w, v in parse_assignments(args.weight, "--weight").items()},
+        sinks=[check] if check else (), check=check.judge if check else None)
     if slip_model is not None:
         summary = replace(summary, method=f"{args.method} ({args.scheme})")
     if args.method in ("fk1", "fk2"):
@@ -173,13 +177,9 @@ def run(args: argparse.Namespace) -> int:
         warn(line)
     consistent = diagnosis.consistent
     if imu is not None:
-        try:
-            line = bag_imu_warning(model, summary, args.log, imu, topic=args.topic, names=names)
-            consistent = consistent and line is None
-        except LogError as err:
-            if args.imu is not None:
-                raise
-            line, imu = f"{err} (the odometry is not checked against it)", None
+        imu = check.topic if check and check.checked else None
+        consistent = consistent and not (imu and check.line)
+        line = check.line if check else unread
         if line:
             warn(line)
     if args.json:

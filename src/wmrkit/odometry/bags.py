@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WmrkitError
+from ..limits import MAX_TABLE_SIZE
 from ._text import did_you_mean
 from .integrators import sinc
 from .logs import MAX_RATE, JointLog, LogError, check_jumps, check_time, joint_names
@@ -48,6 +49,9 @@ MAX_STAMP = 2.0 ** 31
 
 #: Largest ``metadata.yaml`` read [bytes]; ``ros2 bag`` writes a few kilobytes.
 MAX_METADATA = 1 << 20
+#: Most ``Imu`` messages read for the heading check (:func:`read_imu`): their time and yaw are held whole, 16 bytes
+#: each, at most what wmrkit reads whole into memory (``limits.MAX_TABLE_SIZE``): 2.9 h at 400 Hz.
+MAX_IMU_MESSAGES = MAX_TABLE_SIZE // 16
 
 _YAML_ALIAS = re.compile(r"(?:^|[\s\[{,:-])[&*][^\s,\]}]")
 
@@ -402,6 +406,30 @@ def read_imu_yaw(path: str | os.PathLike[str], topic: str, *,
             raise LogError(f"{where}: no message")
     finally:
         reader.close()
+
+
+def read_imu(path: str | os.PathLike[str], topic: str) -> tuple[np.ndarray, np.ndarray]:
+    """The whole ``(time [s], yaw [rad])`` of :func:`read_imu_yaw`; more than :data:`MAX_IMU_MESSAGES` messages (by
+    the bag's count, then as read) are a :class:`LogError`."""
+    where, most = f"{os.fspath(path)}: {topic}", MAX_IMU_MESSAGES
+
+    def too_many(count: int) -> LogError:
+        return LogError(f"{where}: {count} messages, more than the {most} the IMU check holds in memory "
+                        f"({MAX_TABLE_SIZE} bytes, docs/limits.md)")
+
+    if (count := bag_message_count(path, topic)) > most:
+        raise too_many(count)
+    times, yaws, count, chunks = [], [], 0, read_imu_yaw(path, topic)
+    try:
+        for t, yaw in chunks:
+            count += len(t)
+            if count > most:  # the bag's count was wrong
+                raise too_many(count)
+            times.append(t)
+            yaws.append(yaw)
+    finally:
+        chunks.close()  # the bag's reader closed now
+    return np.concatenate(times), np.concatenate(yaws)
 
 
 def _yaw_chunk(t: np.ndarray, v: np.ndarray, gyro: bool, last: tuple[float, float, float] | None):

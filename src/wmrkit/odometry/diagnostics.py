@@ -5,13 +5,14 @@ After the run, its summary and the log's first samples (:func:`~.files.first_sam
 check needs them) are judged: the sensed joints contradicting each other (slip, naming each wheel's slip), an
 external heading column contradicting the wheels' turns (CSV logs), joints breaking a description's ``gear``
 coupling, and a steering angle stepping within one sample interval (:func:`~.steering.steering_step_warning`).
-A bag's IMU checks the wheels' heading over the whole run (:func:`imu_warning`).
+A bag's IMU checks the heading of the trajectory the run outputs, sampled during the run (:class:`ImuCheck`).
 """
 
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable, Iterable, Iterator, Mapping
+import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,6 +22,7 @@ from .logs import JointLog, LogError, LogFormat
 from .model import OdometryModel, wheel_slip
 from .pipeline import OdometrySummary
 from .steering import steering_step_warning
+from .trajectories import Trajectory
 
 #: Slip tolerance of a log: an RMS slip indicator above this fraction of the mean motion per interval means the
 #: sensed joints contradict each other (the same rule as ``wmrkit fk``, FK_SLIP_RTOL).
@@ -138,81 +140,115 @@ def gear_warnings(model: OdometryModel, first: Callable[[], JointLog]) -> list[s
     return lines
 
 
-def heading_series(model: OdometryModel, chunks: Iterable[JointLog]) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-    """``(time, heading [rad])`` of joint-log `chunks` by the no-slip `model` (its dtheta summed from 0 at the first
-    sample), chunk by chunk."""
-    heading, prev = 0.0, None
-    for chunk in chunks:
-        inc = model.from_positions(chunk.positions, previous=prev)
-        turns = inc.column(2)
-        turns = np.zeros(len(chunk) - (prev is None)) if turns is None else turns
-        h = heading + np.cumsum(turns)
-        yield chunk.time, (h if prev is not None else np.concatenate([[0.0], h]))
-        heading, prev = float(heading if not len(h) else h[-1]), chunk.positions[-1]
-
-
-def sample_at(series: Iterable[tuple[np.ndarray, np.ndarray]],
-              grid: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
-    """The piecewise-linear `series` (``(time, value)`` chunks, time increasing, at least one sample) at the `grid`
-    times (increasing), held constant before its first time and after its last; and those two times."""
-    out, last, first = np.empty(len(grid)), None, 0.0
-    for t, v in series:
-        if last is None:
-            first, lo = float(t[0]), -np.inf
-        else:
-            lo, t, v = float(last[0][0]), np.concatenate([last[0], t]), np.concatenate([last[1], v])
-        within = (grid > lo) & (grid <= t[-1])
-        out[within] = np.interp(grid[within], t, v)
-        last = t[-1:], v[-1:]
-    assert last is not None, "sample_at: an empty series"  # its readers refuse a topic without samples
-    out[grid > last[0][0]] = last[1][0]
-    return out, (first, float(last[0][0]))
-
-
 def imu_grid(start: float, end: float) -> np.ndarray:
-    """The window ends of the IMU check over a run from `start` to `end` [s]: every half :data:`IMU_WINDOW`, and the
-    end."""
-    return np.append(np.arange(start, end, IMU_WINDOW / 2), end)
+    """The window ends of the IMU check over a run from `start` to `end` [s]: every half :data:`IMU_WINDOW`
+    (``start + k IMU_WINDOW / 2``, the times :class:`ImuCheck` samples), and the end."""
+    grid = start + IMU_WINDOW / 2 * np.arange(math.ceil((end - start) / (IMU_WINDOW / 2)))
+    return np.append(grid[grid < end], end)
 
 
-def imu_warning(grid: np.ndarray, wheels: np.ndarray, imu: np.ndarray, topic: str) -> str | None:
-    """The line when the wheels' heading and the IMU's yaw (both at the `grid` times of :func:`imu_grid`) turn apart,
-    over the run or over one window, by more than :data:`IMU_TURN_ATOL` + :data:`IMU_DRIFT` times its span +
-    :data:`IMU_TURN_RTOL` times the larger turn; else None. The line gives both turns over the run and over the worst
-    window."""
+def imu_warning(grid: np.ndarray, heading: np.ndarray, imu: np.ndarray, topic: str,
+                what: str = "no-slip") -> str | None:
+    """The line when the `what` odometry's heading and the IMU's yaw (both at the `grid` times of :func:`imu_grid`)
+    turn apart, over the run or over one window, by more than :data:`IMU_TURN_ATOL` + :data:`IMU_DRIFT` times its
+    span + :data:`IMU_TURN_RTOL` times the larger turn; else None. The line gives both turns over the run and over
+    the worst window."""
     n = len(grid)
     pairs = [(0, n - 1)] + [(i, i + 2) for i in range(n - 2)]
 
     def excess(i: int, j: int) -> float:
-        a, b = wheels[j] - wheels[i], imu[j] - imu[i]
+        a, b = heading[j] - heading[i], imu[j] - imu[i]
         return abs(a - b) / (IMU_TURN_ATOL + IMU_DRIFT * (grid[j] - grid[i]) + IMU_TURN_RTOL * max(abs(a), abs(b)))
 
     worst = max(pairs, key=lambda p: excess(*p))
     if excess(*worst) <= 1.0:
         return None
     (i, j), (r0, r1) = worst, pairs[0]
-    window = (f"; from {grid[i] - grid[0]:.4g} s to {grid[j] - grid[0]:.4g} s into the run the odometry turned "
-              f"{wheels[j] - wheels[i]:.4g} rad and the IMU {imu[j] - imu[i]:.4g} rad" if worst != pairs[0] else "")
-    return (f"the odometry's heading contradicts the IMU on {topic}: over the run the odometry turned "
-            f"{wheels[r1] - wheels[r0]:.4g} rad and the IMU {imu[r1] - imu[r0]:.4g} rad{window} (beyond "
+    window = (f"; from {grid[i] - grid[0]:.4g} s to {grid[j] - grid[0]:.4g} s into the run the {what} odometry "
+              f"turned {heading[j] - heading[i]:.4g} rad and the IMU {imu[j] - imu[i]:.4g} rad"
+              if worst != pairs[0] else "")
+    return (f"the {what} odometry's heading contradicts the IMU on {topic}: over the run the {what} odometry turned "
+            f"{heading[r1] - heading[r0]:.4g} rad and the IMU {imu[r1] - imu[r0]:.4g} rad{window} (beyond "
             f"{IMU_TURN_ATOL:g} rad + {IMU_DRIFT:g} rad/s of gyro drift + {IMU_TURN_RTOL:.0%} of the turn): the wheels "
             "slip (a skid steer turning?), or the description's track or wheel radii are wrong")
 
 
-def bag_imu_warning(model: OdometryModel, summary: OdometrySummary, path: str, imu_topic: str, *,
-                    topic: str = "/joint_states", names: Mapping[str, str] | None = None) -> str | None:
-    """:func:`imu_warning` of the run `summary` of the bag at `path`: its JointState messages on `topic` (`names`:
-    ROS names to the robot's joints) read again for the no-slip `model`'s heading, its IMU on `imu_topic`
-    (:func:`~.bags.read_imu_yaw`). An IMU with no message within the run is a :class:`~.logs.LogError`."""
-    from .bags import read_imu_yaw, read_joint_states
+class ImuCheck:
+    """The IMU check of one run of a bag (:func:`imu_warning`) on the trajectory the run outputs, whatever its
+    estimator: a sink of its chunks (:func:`~.files.odometry_file`'s `sinks`) keeping their heading only at the
+    times the check reads (every half :data:`IMU_WINDOW` from the run's first sample, the IMU's first and last
+    stamps, the run's last sample), so the log is read once and memory stays small; then :meth:`judge`.
 
-    if summary.samples < 2:
-        return None
-    grid = imu_grid(summary.start_time, summary.end_time)
-    imu, (first, last) = sample_at(read_imu_yaw(path, imu_topic), grid)
-    if last <= grid[0] or first >= grid[-1]:
-        raise LogError(f"{path}: {imu_topic}: the IMU's stamps ({first:.9g} to {last:.9g} s) miss the joint states' "
-                       f"({grid[0]:.9g} to {grid[-1]:.9g} s): another clock?")
-    grid = np.clip(grid, first, last)  # where both have samples: the IMU's yaw held outside is its yaw there
-    joints = read_joint_states(path, model.joints, robot=model.robot, topic=topic, names=names)
-    return imu_warning(grid, sample_at(heading_series(model, joints), grid)[0], imu, imu_topic)
+    The IMU's `time` and `yaw` (:func:`~.bags.read_imu`, on `topic` of the bag at `path`) are read before the run;
+    `what` names the odometry judged in the warning (``no-slip``, ``wls``...). `named`: the user chose the IMU, so
+    stamps missing the run's are an error, not a warning.
+    """
+
+    def __init__(self, path: str, topic: str, time: np.ndarray, yaw: np.ndarray, what: str, *,
+                 named: bool) -> None:
+        self.path, self.topic, self.what, self.named = path, topic, what, named
+        self.imu = (np.asarray(time, dtype=float), np.asarray(yaw, dtype=float))
+        self._start = self._last = None  # the run's first time; its latest (time, heading)
+        self._next = 0  # k of the next grid time, start + k IMU_WINDOW / 2
+        self._times: list[np.ndarray] = []
+        self._headings: list[np.ndarray] = []
+        #: After :meth:`judge`: the warning line (or None), and whether the IMU checked the run.
+        self.line: str | None = None
+        self.checked = False
+
+    def __call__(self, chunk: Trajectory) -> None:
+        """Keep the heading of a trajectory `chunk` (they follow each other) at the check's times within it."""
+        t, h = chunk.time, chunk.poses[:, 2]
+        if not len(t):
+            return
+        if self._last is None:
+            self._start = float(t[0])
+            lo = math.nextafter(self._start, -math.inf)
+        else:  # continued from the previous chunk's last sample
+            lo = self._last[0]
+            t, h = np.concatenate([[lo], t]), np.concatenate([[self._last[1]], h])
+        hi, step = float(t[-1]), IMU_WINDOW / 2
+        grid = self._start + step * np.arange(self._next, math.floor((hi - self._start) / step) + 2)
+        grid = grid[grid <= hi]
+        self._next += len(grid)
+        at = np.concatenate([grid, [x for x in (self.imu[0][0], self.imu[0][-1]) if lo < x <= hi]])
+        self._times.append(at)
+        self._headings.append(np.interp(at, t, h))
+        self._last = (hi, float(h[-1]))
+
+    def judge(self) -> None:
+        """Judge the run fed so far (at least one sample): sets :attr:`line` and :attr:`checked`. An IMU whose stamps
+        miss the run's is a :class:`~.logs.LogError` when `named`, else a line saying it is not checked."""
+        assert self._last is not None, "ImuCheck.judge: no sample fed"  # a run without samples is an error itself
+        if self._last[0] <= self._start:  # one sample: no turn
+            self.checked = True
+            return
+        grid = imu_grid(self._start, self._last[0])
+        time, yaw = self.imu
+        if time[-1] <= grid[0] or time[0] >= grid[-1]:
+            err = LogError(f"{self.path}: {self.topic}: the IMU's stamps ({time[0]:.9g} to {time[-1]:.9g} s) miss the "
+                           f"joint states' ({grid[0]:.9g} to {grid[-1]:.9g} s): another clock?")
+            if self.named:
+                raise err
+            self.line = f"{err} (the odometry is not checked against it)"
+            return
+        grid = np.clip(grid, time[0], time[-1])  # where both have samples: the IMU's yaw held outside is its yaw there
+        at = np.concatenate([*self._times, [self._last[0]]])
+        order = np.argsort(at, kind="stable")
+        heading = np.interp(grid, at[order], np.concatenate([*self._headings, [self._last[1]]])[order])
+        self.line = imu_warning(grid, heading, np.interp(grid, time, yaw), self.topic, self.what)
+        self.checked = True
+
+
+def imu_check(path: str, topic: str, what: str, *, named: bool) -> tuple[ImuCheck | None, str | None]:
+    """The :class:`ImuCheck` of the IMU on `topic` of the bag at `path`, read now (before the run), and None; an IMU
+    that cannot be read is a :class:`~.logs.LogError` when `named`, else ``(None, the line saying it is not
+    checked)``."""
+    from .bags import read_imu
+
+    try:
+        return ImuCheck(path, topic, *read_imu(path, topic), what, named=named), None
+    except LogError as err:
+        if named:
+            raise
+        return None, f"{err} (the odometry is not checked against it)"

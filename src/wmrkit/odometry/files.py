@@ -3,16 +3,16 @@
 Inputs: CSV logs (:mod:`.logs`) or ROS 2 bags (a bag directory, or a ``.db3``/``.mcap`` file; :mod:`.bags`).
 Outputs chosen by ``out_format`` or the extension of ``out``: ``.csv`` (time, pose, slip, covariance), ``.tum``
 or ``.txt`` (TUM), anything else a new ROS 2 bag of ``nav_msgs/msg/Odometry``; a run that fails removes the output
-it began. A plot keeps a decimated copy of the trajectory, so memory stays bounded for any log length. Steering
-joints in either file are headings (0 = rolling straight ahead; :mod:`.steering`), converted to β with `robot`'s
-wheels by the readers.
+it began (so does a failing ``check``, e.g. a named IMU's). A plot keeps a decimated copy of the trajectory, so
+memory stays bounded for any log length. Steering joints in either file are headings (0 = rolling straight ahead;
+:mod:`.steering`), converted to β with `robot`'s wheels by the readers.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Literal
 
@@ -25,7 +25,7 @@ from .integrators import Method, check_method
 from .logs import JointLog, LogError, LogFormat, read_csv
 from .model import OdometryModel, odometry_model
 from .pipeline import Decimator, Noise, OdometrySummary, run_odometry
-from .trajectories import TrajectoryWriter
+from .trajectories import Trajectory, TrajectoryWriter
 
 OutFormat = Literal["csv", "tum", "bag"]
 DEFAULT_FORMAT = LogFormat()
@@ -85,14 +85,18 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
                   out_format: OutFormat | None = None, plot: str | os.PathLike[str] | None = None,
                   progress: bool = False, chunk_size: int = 1 << 16, topic: str = "/joint_states",
                   joint_names: Mapping[str, str] | None = None,
-                  weights: Mapping[str, float] | None = None, model=None) -> OdometrySummary:
+                  weights: Mapping[str, float] | None = None, model=None,
+                  sinks: Sequence[Callable[[Trajectory], object]] = (),
+                  check: Callable[[], object] | None = None) -> OdometrySummary:
     """Run odometry over the log at `log_path` and write the requested outputs (module docstring).
 
     `fmt` describes a CSV log; `topic` and `joint_names` (ROS name -> robot joint) a bag. `sensed` and `weights`
     go to :func:`~.model.odometry_model`. `progress` shows a tqdm bar on stderr. Returns the run's
     :class:`~.pipeline.OdometrySummary`. `model`, when given, replaces that model: an ``OdometryModel`` (e.g.
     WLS, :func:`wmrkit.slip.weights.wls_model`) or an estimator with ``joints`` and ``run(chunks, method=,
-    pose0=, sinks=)`` (the Kalman filters of :mod:`wmrkit.slip.estimators`).
+    pose0=, sinks=)`` (the Kalman filters of :mod:`wmrkit.slip.estimators`). `sinks` get every chunk of the
+    trajectory too (after the outputs), e.g. :class:`~.diagnostics.ImuCheck`; ``check()``, called after the run,
+    fails it like an error of the run (the output removed, no plot) when it raises.
     """
     from tqdm import tqdm
 
@@ -118,7 +122,7 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
                                        chunk_size=chunk_size, progress=bar.update)
         else:
             chunks = read_csv(log_path, model.joints, fmt, robot=robot, chunk_size=chunk_size, progress=bar.update)
-        sinks, writer = [], None
+        extra, sinks, writer = sinks, [], None
         if out_fmt == "bag":
             writer = OdometryBagWriter(out)
         elif out_fmt is not None:
@@ -128,11 +132,14 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
         decimated = Decimator() if plot is not None else None
         if decimated is not None:
             sinks.append(decimated)
+        sinks += extra
         done = False
         try:
             summary = (run_odometry(model, chunks, method=method, pose0=pose0, noise=noise, sinks=sinks)
                        if isinstance(model, OdometryModel) else model.run(chunks, method=method, pose0=pose0,
                                                                           sinks=sinks))
+            if check is not None:
+                check()
             done = True
         finally:
             if writer is not None:
