@@ -355,3 +355,20 @@ def test_an_imu_too_long_to_hold_is_refused(tmp_path, short_run, monkeypatch):
     monkeypatch.setattr(bags, "MAX_IMU_MESSAGES", len(run.log) - 2)
     with pytest.raises(LogError, match=rf"/imu: {len(run.log) - 1} messages, more than the {len(run.log) - 2} "):
         bags.read_imu(bag, "/imu")
+
+
+def test_read_imu_yaw_converts_a_chunk_of_quaternions_at_once(tmp_path, monkeypatch):
+    """The orientations' yaws are computed once per chunk (before, once per message: 41 calls for 41 messages), the
+    values those of the quaternions' yaw one by one."""
+    from wmrkit.odometry import bags
+    from wmrkit.odometry.trajectories import yaw_of_quaternion
+
+    t = np.linspace(0.0, 4.0, 41)
+    yaw = np.sin(t) * 3.0
+    bag = tmp_path / "imu"
+    _write(bag, t, ("left.spin",), np.zeros((41, 1)), {"/o": (t, yaw, None)})
+    calls = []
+    monkeypatch.setattr(bags, "yaw_of_quaternion", lambda q: calls.append(np.shape(q)) or yaw_of_quaternion(q))
+    chunks = list(bags.read_imu_yaw(bag, "/o", chunk_size=16))
+    assert calls == [(16, 4), (16, 4), (9, 4)]
+    np.testing.assert_allclose(np.concatenate([c[1] for c in chunks]), yaw, atol=1e-12)

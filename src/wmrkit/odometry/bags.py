@@ -396,12 +396,12 @@ def read_imu_yaw(path: str | os.PathLike[str], topic: str, *,
             if t <= (times[-1] if times else last[0] if last else -math.inf):
                 raise LogError(f"{where} message {index}: time {t!r} s does not follow the previous message's")
             times.append(t)
-            values.append(msg.angular_velocity.z if gyro else float(yaw_of_quaternion(np.array(q))))
+            values.append(msg.angular_velocity.z if gyro else q)
             if len(times) == chunk_size:
-                last = yield from _yaw_chunk(np.array(times), np.array(values), gyro, last)
+                last = yield from _yaw_chunk(np.array(times), _readings(values, gyro), gyro, last)
                 times, values = [], []
         if times:
-            yield from _yaw_chunk(np.array(times), np.array(values), gyro, last)
+            yield from _yaw_chunk(np.array(times), _readings(values, gyro), gyro, last)
         elif last is None:
             raise LogError(f"{where}: no message")
     finally:
@@ -430,6 +430,12 @@ def read_imu(path: str | os.PathLike[str], topic: str) -> tuple[np.ndarray, np.n
     finally:
         chunks.close()  # the bag's reader closed now
     return np.concatenate(times), np.concatenate(yaws)
+
+
+def _readings(values: list, gyro: bool) -> np.ndarray:
+    """The readings of a chunk of :func:`read_imu_yaw`: its rates, or the yaws of its quaternions (one vectorised
+    call per chunk: per message it took 40 us, as long as decoding the message)."""
+    return np.array(values) if gyro else yaw_of_quaternion(np.array(values))
 
 
 def _yaw_chunk(t: np.ndarray, v: np.ndarray, gyro: bool, last: tuple[float, float, float] | None):
