@@ -372,3 +372,20 @@ def test_read_imu_yaw_converts_a_chunk_of_quaternions_at_once(tmp_path, monkeypa
     chunks = list(bags.read_imu_yaw(bag, "/o", chunk_size=16))
     assert calls == [(16, 4), (16, 4), (9, 4)]
     np.testing.assert_allclose(np.concatenate([c[1] for c in chunks]), yaw, atol=1e-12)
+
+
+def test_samples_far_apart_in_time_keep_the_check_small():
+    """Two joint-state samples 2**31 s apart (and an IMU as long) once made the check sample 4e8 window ends (3.4 GB;
+    1e8 s here, 2e7 before): it samples at most diagnostics.MAX_IMU_WINDOWS of them, its windows longer."""
+    from wmrkit.odometry import diagnostics
+    from wmrkit.odometry.trajectories import Trajectory
+
+    span = 1e8
+    imu_time = np.linspace(0.0, span, 5)
+    check = diagnostics.ImuCheck("b", "/imu", imu_time, 3.0 * imu_time / span, "no-slip", named=True)
+    check(Trajectory(np.array([0.0]), np.zeros((1, 3)), np.zeros(1)))
+    check(Trajectory(np.array([span]), np.array([[0.0, 0.0, 1.0]]), np.zeros(1)))
+    held = sum(len(t) for t in check._times)
+    assert held <= diagnostics.MAX_IMU_WINDOWS + 3
+    check.judge()
+    assert check.checked and check.line is None  # 2 rad apart in 3 years: within the gyro's drift

@@ -39,6 +39,9 @@ GEAR_MIN_TURN = 0.1
 #: The IMU check compares the turns of the wheels' heading and the IMU's yaw over the run and over windows this long
 #: [s], half a window apart (a turn of a few seconds, its start and end in one window; a gyro's drift small within).
 IMU_WINDOW = 10.0
+#: Most window ends the IMU check samples: a run whose IMU spans longer than this many half windows (58 days) is
+#: sampled at that many, its windows longer, so that two samples far apart in time cannot make it hold more.
+MAX_IMU_WINDOWS = 1_000_000
 #: Turns within this fraction of the larger agree: a MEMS gyro's scale factor is within 3 % (MPU-6050: +-3 %;
 #: BMI088: +-1 %), a calibrated odometry's heading within a few % (wheel radii, track); a slipping skid steer's
 #: wheels turn 1.5-3 times the robot (ROS's wheel_separation_multiplier), 33-67 % apart.
@@ -140,11 +143,20 @@ def gear_warnings(model: OdometryModel, first: Callable[[], JointLog]) -> list[s
     return lines
 
 
-def imu_grid(start: float, end: float) -> np.ndarray:
-    """The window ends of the IMU check over a run from `start` to `end` [s]: every half :data:`IMU_WINDOW`
-    (``start + k IMU_WINDOW / 2``, the times :class:`ImuCheck` samples), and the end."""
-    grid = start + IMU_WINDOW / 2 * np.arange(math.ceil((end - start) / (IMU_WINDOW / 2)))
-    return np.append(grid[grid < end], end)
+def imu_step(imu_time: np.ndarray) -> float:
+    """The spacing [s] of the IMU check's window ends for an IMU read at `imu_time` (increasing): half
+    :data:`IMU_WINDOW`, or longer when the IMU spans more than :data:`MAX_IMU_WINDOWS` of them."""
+    return max(IMU_WINDOW / 2, float(imu_time[-1] - imu_time[0]) / MAX_IMU_WINDOWS)
+
+
+def imu_grid(start: float, end: float, step: float, lo: float, hi: float) -> np.ndarray:
+    """The window ends of the IMU check over a run from `start` to `end` [s] with an IMU from `lo` to `hi` [s] (they
+    overlap): the run's ends and ``start + k step`` (the times :class:`ImuCheck` samples), all within ``[lo, hi]``
+    (the IMU's yaw held outside is its yaw there)."""
+    first, last = max(start, lo), min(end, hi)
+    k = np.arange(math.ceil((first - start) / step), math.floor((last - start) / step) + 1)
+    inner = start + step * k
+    return np.concatenate([[first], inner[(inner > first) & (inner < last)], [last]])
 
 
 def imu_warning(grid: np.ndarray, heading: np.ndarray, imu: np.ndarray, topic: str,
@@ -189,7 +201,8 @@ class ImuCheck:
         self.path, self.topic, self.what, self.named = path, topic, what, named
         self.imu = (np.asarray(time, dtype=float), np.asarray(yaw, dtype=float))
         self._start = self._last = None  # the run's first time; its latest (time, heading)
-        self._next = 0  # k of the next grid time, start + k IMU_WINDOW / 2
+        self._step = imu_step(self.imu[0])
+        self._next = 0  # k of the next grid time, start + k step
         self._times: list[np.ndarray] = []
         self._headings: list[np.ndarray] = []
         #: After :meth:`judge`: the warning line (or None), and whether the IMU checked the run.
@@ -207,10 +220,14 @@ class ImuCheck:
         else:  # continued from the previous chunk's last sample
             lo = self._last[0]
             t, h = np.concatenate([[lo], t]), np.concatenate([[self._last[1]], h])
-        hi, step = float(t[-1]), IMU_WINDOW / 2
-        grid = self._start + step * np.arange(self._next, math.floor((hi - self._start) / step) + 2)
-        grid = grid[grid <= hi]
-        self._next += len(grid)
+        hi, step, (imu_lo, imu_hi) = float(t[-1]), self._step, (self.imu[0][0], self.imu[0][-1])
+        first = max(self._next, math.ceil((imu_lo - self._start) / step))  # none before the IMU's first stamp
+        k = np.arange(first, math.floor((min(hi, imu_hi) - self._start) / step) + 2)
+        grid = self._start + step * k
+        keep = (grid <= hi) & (grid <= imu_hi)
+        grid = grid[keep]
+        if len(grid):
+            self._next = int(k[keep][-1]) + 1
         at = np.concatenate([grid, [x for x in (self.imu[0][0], self.imu[0][-1]) if lo < x <= hi]])
         self._times.append(at)
         self._headings.append(np.interp(at, t, h))
@@ -223,16 +240,15 @@ class ImuCheck:
         if self._last[0] <= self._start:  # one sample: no turn
             self.checked = True
             return
-        grid = imu_grid(self._start, self._last[0])
         time, yaw = self.imu
-        if time[-1] <= grid[0] or time[0] >= grid[-1]:
+        if time[-1] <= self._start or time[0] >= self._last[0]:
             err = LogError(f"{self.path}: {self.topic}: the IMU's stamps ({time[0]:.9g} to {time[-1]:.9g} s) miss the "
-                           f"joint states' ({grid[0]:.9g} to {grid[-1]:.9g} s): another clock?")
+                           f"joint states' ({self._start:.9g} to {self._last[0]:.9g} s): another clock?")
             if self.named:
                 raise err
             self.line = f"{err} (the odometry is not checked against it)"
             return
-        grid = np.clip(grid, time[0], time[-1])  # where both have samples: the IMU's yaw held outside is its yaw there
+        grid = imu_grid(self._start, self._last[0], self._step, time[0], time[-1])  # where both have samples
         at = np.concatenate([*self._times, [self._last[0]]])
         order = np.argsort(at, kind="stable")
         heading = np.interp(grid, at[order], np.concatenate([*self._headings, [self._last[1]]])[order])
