@@ -13,7 +13,7 @@ from wmrkit.errors import WmrkitError
 from wmrkit.parking import Space, Vehicle, length_ratio, plan_parking, shortest_slot
 from wmrkit.parking.collisions import lateral_reach
 from wmrkit.parking.geometry import arcs_through, corner_distance
-from wmrkit.parking.planner import approach_point, first_reach, pass_end
+from wmrkit.parking.planner import approach_point, first_reach, pass_end, plan_thesis, roomy_length
 from wmrkit.parking.problem import load_problem
 
 #: Seconds past which a plan is taken to hang (the printed loops never end); a plan takes about 1 ms, which
@@ -166,10 +166,13 @@ def test_units_rounding_does_not_change_the_plan():
 
 
 def test_huge_but_finite_inputs_return_quickly():
-    """Python callers are not limited to 1 km: every loop and search stays bounded."""
+    """Python callers are not limited to 1 km: every loop and search stays bounded. (A 1e9 m slot parks in its
+    front part: a longer slot is never harder, tests/parking/test_long_slots.py.)"""
     t0 = time.perf_counter()
-    plan = plan_parking(CAR_91, replace(SLOT_91, H=1e9, dx2=1e6))
-    assert time.perf_counter() - t0 < HANG and not plan.feasible
+    space = replace(SLOT_91, H=1e9, dx2=1e6)
+    plan = plan_parking(CAR_91, space)
+    assert time.perf_counter() - t0 < HANG and plan.used_H <= roomy_length(CAR_91, space)
+    assert not plan_thesis(CAR_91, space).feasible  # Algorithm 3 alone reverses along the whole slot
     assert shortest_slot(replace(CAR_91, a1=1e4), replace(SLOT_91, J=1.3)) is None
     assert time.perf_counter() - t0 < 2 * HANG
 
@@ -204,5 +207,6 @@ def test_shortest_slot_over_a_huge_span_still_finds_the_window():
     assert found == pytest.approx(5.3246, abs=1e-3)
     assert shortest_slot(vehicle, space, span=1e9) == pytest.approx(found, abs=1e-3)
     reach = space.MS + vehicle.b1 + first_reach(vehicle)
-    assert plan_parking(vehicle, replace(space, H=reach - 1.0)).reason != plan_parking(
-        vehicle, replace(space, H=reach + 1.0)).reason  # the bound is where the planner's own reason changes
+    assert plan_thesis(vehicle, replace(space, H=reach - 1.0)).reason != plan_thesis(
+        vehicle, replace(space, H=reach + 1.0)).reason  # the bound is where the thesis planner's reason changes
+    assert plan_parking(vehicle, replace(space, H=reach + 1.0)).feasible  # in the slot's front part

@@ -20,11 +20,12 @@ from .geometry import (
     Vehicle,
     arcs_displacement,
     arcs_through,
+    blackburn_min_length,
     steering_angle,
     xi_from_lateral,
     xi_from_longitudinal,
 )
-from .path import Pose, Segment, arc_end
+from .path import Pose, Segment, arc_end, path_length
 
 #: Default decrement of the steering angle in Algorithm 3 (the thesis does not say; 1 deg reproduces §9.3.3).
 PHI_STEP = math.radians(1.0)
@@ -32,6 +33,8 @@ PHI_STEP = math.radians(1.0)
 DY3_STEP, DY3_RANGE = 0.01, 5.0
 #: Default bound on the number of manoeuvres (Fig. 9.30 shows 21 at a 20 % length ratio).
 MAX_MANEUVERS = 100
+#: Step of the part lengths :func:`best_part` tries [car lengths], and the most it tries.
+PART_STEP, MAX_PARTS = 1 / 200, 400
 #: Geometric tolerance of the stopping and inside-the-slot tests [m].
 TOL = 1e-9
 #: Most steering angles Algorithm 3 tries (``phi_max / phi_step``): each costs ~5 us, and phi_step = 1e-12 rad
@@ -60,7 +63,9 @@ class ParkingPlan:
     one included: the thesis's count); ``segments`` the whole path (phases 1-3) as stop-to-stop segments;
     ``arcs`` the manoeuvres' geometry; ``dx1`` the approach point's lateral offset of P_f from the obstacles'
     side line, ``dy3`` how far the pass runs past the front obstacle, ``pass_offset`` the lateral offset of the
-    pass actually driven [m]; ``final_gap`` the final gap to the curb [m]; ``warnings`` input adjustments.
+    pass actually driven [m]; ``final_gap`` the final gap to the curb [m]; ``warnings`` input adjustments;
+    ``used_H`` the length of the part of the slot behind the front obstacle the car parks in, when it is not
+    the whole slot [m] (:func:`plan_parking`).
     """
 
     vehicle: Vehicle
@@ -75,6 +80,7 @@ class ParkingPlan:
     pass_offset: float
     final_gap: float
     warnings: tuple[str, ...] = ()
+    used_H: float | None = None
 
     @property
     def final_pose(self) -> Pose:
@@ -87,14 +93,32 @@ def plan_parking(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
     """Plan a parallel parking manoeuvre (thesis §9.3.2, Algorithms 1-5); never loops without bound.
 
     `phi_step` [rad] is Algorithm 3's steering decrement (at least ``phi_max / MAX_PHI_STEPS``); `max_maneuvers`
-    (an integer >= 1) bounds phase 3.
+    (an integer >= 1) bounds phase 3. A slot up to :func:`roomy_length` gets :func:`plan_thesis`'s plan when it
+    has one; otherwise, and in any longer slot, the car parks in the part of the slot behind the front obstacle
+    where the thesis's planner does best (:func:`best_part`): a plan there is a plan in the whole slot, whose
+    rear obstacle only lies farther back. Algorithm 3 reverses along the whole slot, so a long slot meant a long,
+    shallow S and, past about 11 car lengths, no plan at all.
     """
+    _check_options(vehicle, phi_step, max_maneuvers)
+    roomy = roomy_length(vehicle, space)
+    plan = None
+    if space.H <= roomy:
+        plan = plan_thesis(vehicle, space, phi_step=phi_step, max_maneuvers=max_maneuvers)
+        if plan.feasible:
+            return plan
+    part = best_part(vehicle, space, min(space.H, roomy), phi_step, max_maneuvers)
+    if part is None:
+        return plan if plan is not None else plan_thesis(vehicle, space, phi_step=phi_step,
+                                                         max_maneuvers=max_maneuvers)
+    return _in_slot(part, space)
+
+
+def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
+                max_maneuvers: int = MAX_MANEUVERS) -> ParkingPlan:
+    """The thesis's planner as printed (with its errata) on the whole slot: the first backward manoeuvre reverses
+    from the approach point to ``MS`` from the rear obstacle (Algorithm 3), whatever the slot's length."""
     v, sp = vehicle, space
-    if not v.phi_max / MAX_PHI_STEPS <= phi_step < math.inf:  # NaN included
-        raise WmrkitError(f"phi_step: must be a finite angle >= phi_max / {MAX_PHI_STEPS} = "
-                          f"{v.phi_max / MAX_PHI_STEPS:.3g} rad (at most {MAX_PHI_STEPS} steering angles tried), "
-                          f"got {phi_step} rad")
-    _check_max_maneuvers(max_maneuvers)
+    _check_options(v, phi_step, max_maneuvers)
     warnings: list[str] = []
     pass_offset = sp.dx2
     if sp.dx2 < v.c1 / 2 - TOL:  # (not "70 cm" against "140 cm" / 2 in floating point)
@@ -326,8 +350,8 @@ def shortest_slot(vehicle: Vehicle, space: Space, *, step: float = 0.01, span: f
         return None
     step = max(step, span / 2000)
 
-    def works(h: float) -> bool:
-        return plan_parking(vehicle, replace(space, H=h), max_maneuvers=max_maneuvers).feasible
+    def works(h: float) -> bool:  # plan_parking's shortest slot is plan_thesis's: its parts are such slots
+        return plan_thesis(vehicle, replace(space, H=h), max_maneuvers=max_maneuvers).feasible
 
     n = math.ceil(span / step)
     prev = lo
@@ -340,6 +364,52 @@ def shortest_slot(vehicle: Vehicle, space: Space, *, step: float = 0.01, span: f
             return h
         prev = h
     return None
+
+
+def roomy_length(vehicle: Vehicle, space: Space) -> float:
+    """A slot length [m] past which the car never needs more of the slot: twice Blackburn's shortest
+    one-manoeuvre slot (:func:`~wmrkit.parking.geometry.blackburn_min_length`) plus the two margins. Beyond it
+    :func:`plan_parking` parks in the best part of the slot up to this length."""
+    return 2 * blackburn_min_length(vehicle) + 2 * space.MS
+
+
+def best_part(vehicle: Vehicle, space: Space, upto: float, phi_step: float = PHI_STEP,
+              max_maneuvers: int = MAX_MANEUVERS) -> ParkingPlan | None:
+    """The best :func:`plan_thesis` plan in a slot of length ``H <= upto`` (the part of `space` behind the front
+    obstacle), or None: fewest manoeuvres, then the shortest path after the detection pass, then the shortest
+    part. The lengths tried are ``a1 + b1 + 2 MS + k step`` with a step of ``PART_STEP`` car lengths (at most
+    ``MAX_PARTS`` of them up to :func:`roomy_length`); they do not depend on `upto` or ``space.H``, so a longer
+    slot tries every length a shorter one does. The plan keeps the part's slot (see :func:`plan_parking`)."""
+    lo = vehicle.length + 2 * space.MS
+    step = max(vehicle.length * PART_STEP, (roomy_length(vehicle, space) - lo) / MAX_PARTS)
+    best, best_key = None, None
+    for k in range(1, MAX_PARTS + 2):
+        H = lo + k * step
+        if H > upto:
+            break
+        plan = plan_thesis(vehicle, replace(space, H=H), phi_step=phi_step, max_maneuvers=max_maneuvers)
+        if plan.feasible:
+            rank = (plan.maneuvers, path_length([s for s in plan.segments if s.phase > 1]), H)
+            if best_key is None or rank < best_key:
+                best, best_key = plan, rank
+    return best
+
+
+def _in_slot(part: ParkingPlan, space: Space) -> ParkingPlan:
+    """`part` (a plan in the front part of `space`) as a plan in `space`: the detection pass from the whole
+    slot's start, ``used_H`` the part's length."""
+    v, first = part.vehicle, part.segments[0]
+    start: Pose = (-space.H - v.a1, first.start[1], 0.0)
+    detection = _straight(v, 1, 0, start, first.end[0] - start[0])
+    return replace(part, space=space, segments=(detection, *part.segments[1:]), used_H=part.space.H)
+
+
+def _check_options(vehicle: Vehicle, phi_step: float, max_maneuvers: object) -> None:
+    if not vehicle.phi_max / MAX_PHI_STEPS <= phi_step < math.inf:  # NaN included
+        raise WmrkitError(f"phi_step: must be a finite angle >= phi_max / {MAX_PHI_STEPS} = "
+                          f"{vehicle.phi_max / MAX_PHI_STEPS:.3g} rad (at most {MAX_PHI_STEPS} steering angles "
+                          f"tried), got {phi_step} rad")
+    _check_max_maneuvers(max_maneuvers)
 
 
 def _check_max_maneuvers(max_maneuvers: object) -> None:

@@ -35,7 +35,7 @@ class Solution:
             "problem": self.problem.name, "maneuvers": p.maneuvers, "feasible": p.feasible, "reason": p.reason,
             "warnings": list(p.warnings), "wall_time": self.wall_time,
             "length_ratio": length_ratio(v, sp), "blackburn_min_H": blackburn_min_length(v),
-            "shortest_H": self.shortest_H,
+            "shortest_H": self.shortest_H, "used_H": p.used_H,
             "approach": {"dx1": _defined(p.dx1), "dy3": _defined(p.dy3), "pass_offset": p.pass_offset},
             "final_gap": _defined(p.final_gap), "path_length": path_length(p.segments),
             "direction_changes": direction_changes(p.segments),
@@ -102,6 +102,9 @@ def describe(solution: Solution) -> str:
         lines.append(f"feasible: {_count(p.maneuvers, 'manoeuvre')}, final gap to the curb {p.final_gap * 100:.1f} "
                      f"cm, path {path_length(p.segments):.2f} m, {_count(changes, 'direction change')}, "
                      f"planned in {1e3 * solution.wall_time:.3f} ms")
+        if p.used_H is not None:
+            lines.append(f"parks in the {p.used_H:.4g} m of the slot behind the front car (the planner's best part "
+                         "of a long slot; it needs no more)")
         lines.append(f"approach point: dx1 = {p.dx1:.4g} m from the parked cars' side, pass {p.dy3:.4g} m past "
                      "the front one")
         for k, a in enumerate(p.arcs, 1):

@@ -1,0 +1,83 @@
+"""Long slots: a longer slot is never harder to park in. The car parks in the part of the slot behind the front
+obstacle where the thesis's planner does best; Algorithm 3 alone reverses along the whole slot."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from parking_cases import CAR_91, CAR_92, SLOT_91, SLOT_92
+
+from wmrkit.parking import Space, Vehicle, plan_parking
+from wmrkit.parking.path import path_length
+from wmrkit.parking.planner import plan_thesis, roomy_length
+from wmrkit.parking.verify import check_plan
+
+pytest.importorskip("shapely")
+
+
+def _after_pass(plan) -> float:
+    """P_f's path after the detection pass [m] (the pass runs along the whole slot, whatever the car does)."""
+    return path_length([s for s in plan.segments if s.phase > 1])
+
+
+@pytest.mark.parametrize(("car", "slot"), [(CAR_91, SLOT_91), (CAR_92, SLOT_92)])
+def test_a_1_km_slot_parks_with_no_more_than_the_thesis_slot_needs(car, slot):
+    """Before: 'the slot is longer than the first backward manoeuvre can span' (no plan) for example 1's car in a
+    1 km slot: Algorithm 3 reverses along the whole slot. Now a plan, with no more manoeuvres and no longer a
+    manoeuvre than the thesis's own slot needs, collision-free and inside the 1 km slot by the exact check."""
+    comfortable = plan_parking(car, slot)
+    space = replace(slot, H=1000.0)
+    plan = plan_parking(car, space)
+    assert plan.feasible, plan.reason
+    assert plan.maneuvers <= comfortable.maneuvers
+    assert _after_pass(plan) <= _after_pass(comfortable)
+    assert plan.used_H <= roomy_length(car, space) and plan.space == space
+    assert plan.final_gap < space.final_gap
+    first = plan.segments[0]  # the detection pass starts at the 1 km slot's start
+    assert first.phase == 1 and first.start[0] == pytest.approx(-space.H - car.a1)
+    report = check_plan(car, space, [s for s in plan.segments if s.phase > 1])
+    assert report.collision_free and report.inside
+
+
+@pytest.mark.parametrize("H", [25.0, 60.0, 400.0])
+def test_past_the_roomy_length_the_answer_no_longer_depends_on_the_length(H):
+    """Before: example 1's car in a 25 m slot reversed along 24 m in a 45 m shallow S; from 23 m on, no plan."""
+    plan = plan_parking(CAR_91, replace(SLOT_91, H=H))
+    far = plan_parking(CAR_91, replace(SLOT_91, H=1000.0))
+    assert plan.feasible and plan.arcs == far.arcs and plan.used_H == far.used_H
+    assert _after_pass(plan) < 5.0
+
+
+def test_slots_up_to_the_roomy_length_keep_the_thesis_plan():
+    """The thesis's examples and every slot its planner handles up to the roomy length are unchanged."""
+    for car, slot in ((CAR_91, SLOT_91), (CAR_92, SLOT_92), (CAR_91, replace(SLOT_91, H=5.5))):
+        assert slot.H <= roomy_length(car, slot)
+        plan = plan_parking(car, slot)
+        assert plan == plan_thesis(car, slot) and plan.used_H is None
+
+
+cars = st.builds(
+    lambda c1, h1, front, b1, phi: Vehicle(a1=h1 + front, b1=b1, c1=c1, h1=h1, track=0.8 * c1,
+                                           phi_max=math.radians(phi)),
+    st.floats(1.0, 2.5), st.floats(1.5, 3.5), st.floats(0.3, 1.5), st.floats(0.2, 1.2), st.floats(25.0, 45.0))
+
+
+@settings(max_examples=12)
+@given(cars, st.floats(0.1, 1.0), st.floats(0.0, 0.3), st.floats(0.0, 1.0), st.floats(0.0, 1.0),
+       st.floats(1.0, 100.0))
+def test_a_longer_slot_never_turns_yes_into_no_nor_needs_more_manoeuvres(car, room, margin, offset, where, longer):
+    """A slot of any length up to the roomy length against one past it (up to 100 times longer): a plan in the
+    shorter one means a plan in the longer one, with no more manoeuvres. Before, slots longer than about eleven
+    car lengths had no plan at all."""
+    slot = Space(H=10.0, J=car.c1 + room, MS=margin, dx2=car.c1 / 2 + offset, final_gap=0.05)
+    roomy = roomy_length(car, slot)
+    lo = car.length + 2 * margin
+    short = plan_parking(car, replace(slot, H=lo + where * (roomy - lo) + 1e-6))
+    long = plan_parking(car, replace(slot, H=roomy * longer + 1e-6))
+    if short.feasible:
+        assert long.feasible, long.reason
+        assert long.maneuvers <= short.maneuvers
