@@ -60,8 +60,12 @@ def run(args: argparse.Namespace) -> int:
     if solution.plan.feasible:  # Table 8.1 on the timed plan, at the point the closed loop tracks, as track judges
         from ..parking.execute import plan_feasibility
 
-        verdict = plan_feasibility(solution.plan, solution.problem.robot)
-        warn_infeasible(verdict)
+        try:
+            verdict = plan_feasibility(solution.plan, solution.problem.robot)
+        except WmrkitError as err:  # a plan too long to time is still the answer: judged, it was an error, exit 2
+            warn(f"Table 8.1 not judged: {err}")
+        else:
+            warn_infeasible(verdict)
     if args.animate and execution is None:  # an impossible slot is an answer (exit 1), not bad input
         warn(f"no plan, so no animation: {args.animate} not written")
     if args.json:
