@@ -81,3 +81,27 @@ def test_a_longer_slot_never_turns_yes_into_no_nor_needs_more_manoeuvres(car, ro
     if short.feasible:
         assert long.feasible, long.reason
         assert long.maneuvers <= short.maneuvers
+
+
+def _scaled(car: Vehicle, slot: Space, s: float) -> tuple[Vehicle, Space]:
+    return (replace(car, a1=car.a1 * s, b1=car.b1 * s, c1=car.c1 * s, h1=car.h1 * s, track=car.track * s),
+            replace(slot, H=slot.H * s, J=slot.J * s, MS=slot.MS * s, dx2=slot.dx2 * s, final_gap=slot.final_gap * s))
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+@pytest.mark.parametrize(("car", "slot"), [
+    (CAR_91, replace(SLOT_91, H=3.0)), (CAR_91, replace(SLOT_91, H=3.2, dx2=0.9)),
+    (CAR_91, replace(SLOT_91, H=30.0, dx2=0.9)), (CAR_92, replace(SLOT_92, H=3.9)), (CAR_92, replace(SLOT_92, H=40.0))])
+def test_a_mm_or_km_car_plans_the_same_manoeuvres_scaled(car, slot, scale):
+    """Geometry has no unit of length: the car and slot scaled by 1e-3 or 1e3 plan the same manoeuvres, scaled.
+    Before, Algorithm 4's pass-end search had a 1 cm step and a 5 m range in metres: example 1 with H = 3 m had
+    no plan, a 2 mm copy of it had one of 11 manoeuvres (its pass 1.8 km-equivalent past the front car), and a
+    2 km car with H = 3.2 km, dx2 = 0.9 km got an approach point 7 cm-equivalent off (0.771 vs 0.703 m)."""
+    plan = plan_parking(car, slot)
+    small = plan_parking(*_scaled(car, slot, scale))
+    assert (small.feasible, small.maneuvers) == (plan.feasible, plan.maneuvers)
+    if plan.feasible:
+        for name in ("dx1", "dy3", "final_gap"):
+            assert getattr(small, name) / scale == pytest.approx(getattr(plan, name), rel=1e-6, abs=1e-9), name
+        assert [a.rho / scale for a in small.arcs] == pytest.approx([a.rho for a in plan.arcs], rel=1e-6)
+        assert [a.xi for a in small.arcs] == pytest.approx([a.xi for a in plan.arcs], rel=1e-6)

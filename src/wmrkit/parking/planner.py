@@ -29,13 +29,17 @@ from .path import Pose, Segment, arc_end, path_length
 
 #: Default decrement of the steering angle in Algorithm 3 (the thesis does not say; 1 deg reproduces §9.3.3).
 PHI_STEP = math.radians(1.0)
-#: Resolution and range of the pass-end search of Algorithm 4 (its Delta dy3 and the bound the thesis lacks) [m].
-DY3_STEP, DY3_RANGE = 0.01, 5.0
+#: Resolution and range of the pass-end search of Algorithm 4 (its Delta dy3 and the bound the thesis lacks), in
+#: units of the car's larger dimension (:func:`size`; 1 cm and 5 m for example 1's 2 m car): in metres, a 2 mm
+#: car searched 2500 car lengths past the front car in steps of 5 car lengths, and a 2 km car a fraction of its
+#: length.
+DY3_STEP, DY3_RANGE = 1 / 200, 2.5
 #: Default bound on the number of manoeuvres (Fig. 9.30 shows 21 at a 20 % length ratio).
 MAX_MANEUVERS = 100
 #: Step of the part lengths :func:`best_part` tries [car lengths], and the most it tries.
 PART_STEP, MAX_PARTS = 1 / 200, 400
-#: Geometric tolerance of the stopping and inside-the-slot tests [m].
+#: Geometric tolerance of the stopping and inside-the-slot tests, in units of :func:`size` (1e-9 m measured a
+#: 2 mm car to 5e-7 of its length and a 2 km one to 5e-13, at the rounding of its coordinates).
 TOL = 1e-9
 #: Most steering angles Algorithm 3 tries (``phi_max / phi_step``): each costs ~5 us, and phi_step = 1e-12 rad
 #: meant 6e11 tries, days of looping.
@@ -119,15 +123,16 @@ def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
     from the approach point to ``MS`` from the rear obstacle (Algorithm 3), whatever the slot's length."""
     v, sp = vehicle, space
     _check_options(v, phi_step, max_maneuvers)
+    tol = TOL * size(v)
     warnings: list[str] = []
     pass_offset = sp.dx2
-    if sp.dx2 < v.c1 / 2 - TOL:  # (not "70 cm" against "140 cm" / 2 in floating point)
+    if sp.dx2 < v.c1 / 2 - tol:  # (not "70 cm" against "140 cm" / 2 in floating point)
         pass_offset = v.c1 / 2 + sp.MS
         warnings.append(f"dx2 = {sp.dx2:.4g} m puts the car over the parked cars (c1/2 = {v.c1 / 2:.4g} m); "
                         f"the detection pass is driven at c1/2 + MS = {pass_offset:.4g} m")
     fail = _failure(v, sp, pass_offset, warnings)
     free = sp.effective_length - v.length  # phase-3 longitudinal travel (Alg. 5, erratum: H' - (a1 + b1))
-    if free <= TOL:
+    if free <= tol:
         return fail(f"the slot is too short: H - 2 MS = {sp.effective_length:.4g} m leaves no room for a car of "
                     f"length a1 + b1 = {v.length:.4g} m")
     if sp.J < v.c1:
@@ -141,7 +146,7 @@ def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
         return fail("no steering angle lets the first backward manoeuvre enter the slot without touching the "
                     "curb, the rear obstacle or the front obstacle (Algorithm 3)")
     rho1, xi1, dx1 = first
-    if abs(dx1 - pass_offset) <= TOL:
+    if abs(dx1 - pass_offset) <= tol:
         dx1 = pass_offset
     pre = pass_end(v, dx1, pass_offset)
     if pre is None and dx1 < pass_offset:  # the rear corner would cut the obstacle's corner: approach farther out
@@ -149,7 +154,8 @@ def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
         pre = pass_end(v, dx1, pass_offset)
     if pre is None:
         return fail(f"from a pass at {pass_offset:.4g} m the approach point at {dx1:.4g} m cannot be reached "
-                    f"without touching the front obstacle (Algorithm 4 within {DY3_RANGE:g} m); pass farther out")
+                    f"without touching the front obstacle (Algorithm 4 within {DY3_RANGE * size(v):.4g} m); pass "
+                    "farther out")
     dy3, rho2, xi2 = pre
 
     segments: list[Segment] = []
@@ -165,7 +171,7 @@ def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
     direction = 1
     while True:
         gap = y + sp.J - v.c1 / 2
-        if gap < sp.final_gap and y + v.c1 / 2 <= TOL:
+        if gap < sp.final_gap and y + v.c1 / 2 <= tol:
             break
         if len(arcs) >= max_maneuvers:
             return fail(f"more than {max_maneuvers} manoeuvres needed (gap to the curb still {gap:.4g} m)")
@@ -229,8 +235,9 @@ def pass_end(vehicle: Vehicle, dx1: float, pass_offset: float) -> tuple[float, f
     ``dy3 += Delta`` may never end (the overshoot only tends to 0); here it is a bisection over a bounded range.
     """
     v = vehicle
+    tol = TOL * size(v)
     X = abs(dx1 - pass_offset)
-    if X <= TOL:
+    if X <= tol:
         return 0.0, math.inf, 0.0
 
     def arcs(dy3: float) -> tuple[float, float]:
@@ -238,16 +245,16 @@ def pass_end(vehicle: Vehicle, dx1: float, pass_offset: float) -> tuple[float, f
 
     def clear(rho: float, xi: float) -> bool:
         if dx1 < pass_offset:
-            return lateral_reach(v, rho, xi, 1) <= pass_offset + TOL
-        return trailing_dip(v, rho, xi, 2) <= pass_offset - v.c1 / 2 + TOL
+            return lateral_reach(v, rho, xi, 1) <= pass_offset + tol
+        return trailing_dip(v, rho, xi, 2) <= pass_offset - v.c1 / 2 + tol
 
     lo, rho, xi = shortest_s(v, X)
     if clear(rho, xi):
         return lo, rho, xi
-    hi = lo + DY3_RANGE
+    hi = lo + DY3_RANGE * size(v)
     if not clear(*arcs(hi)):
         return None
-    while hi - lo > DY3_STEP:
+    while hi - lo > DY3_STEP * size(v):
         mid = 0.5 * (lo + hi)
         if clear(*arcs(mid)):
             hi = mid
@@ -272,8 +279,8 @@ def lead_overshoot(vehicle: Vehicle, dx1: float, pass_offset: float) -> float:
     tends to 0 as the S lengthens; moving the approach point out by this much makes the longest S clear.
     """
     X = pass_offset - dx1
-    rho, xi = arcs_through(X, shortest_s(vehicle, X)[0] + DY3_RANGE)
-    return max(0.0, lateral_reach(vehicle, rho, xi, 1) - pass_offset) + TOL
+    rho, xi = arcs_through(X, shortest_s(vehicle, X)[0] + DY3_RANGE * size(vehicle))
+    return max(0.0, lateral_reach(vehicle, rho, xi, 1) - pass_offset) + TOL * size(vehicle)
 
 
 def maneuver_arcs(vehicle: Vehicle, free: float, room: float, direction: int) -> tuple[float, float] | None:
@@ -296,7 +303,7 @@ def maneuver_arcs(vehicle: Vehicle, free: float, room: float, direction: int) ->
 
     if excess(rho) <= 0:
         return rho, xi
-    if room <= v.c1 / 2 + TOL:
+    if room <= v.c1 / 2 + TOL * size(v):
         return None
     lo, hi = rho, 2 * rho
     for _ in range(200):  # the reach tends to c1/2 as rho grows, so a bracket exists
@@ -364,6 +371,12 @@ def shortest_slot(vehicle: Vehicle, space: Space, *, step: float = 0.01, span: f
             return h
         prev = h
     return None
+
+
+def size(vehicle: Vehicle) -> float:
+    """The car's larger dimension, ``max(a1 + b1, c1)`` [m]: the unit of the planner's search steps and
+    tolerances, so that a car and its slot scaled together plan the same manoeuvres, scaled."""
+    return max(vehicle.length, vehicle.c1)
 
 
 def roomy_length(vehicle: Vehicle, space: Space) -> float:
