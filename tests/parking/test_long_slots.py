@@ -105,3 +105,20 @@ def test_a_mm_or_km_car_plans_the_same_manoeuvres_scaled(car, slot, scale):
             assert getattr(small, name) / scale == pytest.approx(getattr(plan, name), rel=1e-6, abs=1e-9), name
         assert [a.rho / scale for a in small.arcs] == pytest.approx([a.rho for a in plan.arcs], rel=1e-6)
         assert [a.xi for a in small.arcs] == pytest.approx([a.xi for a in plan.arcs], rel=1e-6)
+
+
+@pytest.mark.parametrize(("scale", "H"), [(1.0, 1000.0), (1e-3, 3.35), (1e3, 3.35)])
+def test_the_plan_figure_frames_the_manoeuvres_at_any_scale(scale, H):
+    """The figure's frame is the slot (or the part parked in) and the path after the pass, padded in car sizes.
+    Before: a 1 km slot's figure spanned 1 km, the manoeuvre a speck; a 2 mm car sat in a frame padded by metres
+    (2.3 m wide for a 3.35 mm slot)."""
+    from wmrkit.parking.plot import plot_plan
+
+    car, slot = _scaled(CAR_91, replace(SLOT_91, H=H), scale)
+    plan = plan_parking(car, slot)
+    ax = plot_plan(plan).axes[0]
+    shown = plan.used_H if plan.used_H is not None else slot.H
+    (left, right), (bottom, top) = ax.get_xlim(), ax.get_ylim()
+    final = plan.final_pose
+    assert left < final[0] - car.b1 and right > 0 and bottom < -slot.J and top > plan.pass_offset  # all in view
+    assert right - left < shown + 3 * car.length and top - bottom < slot.J + plan.pass_offset + 2 * car.c1

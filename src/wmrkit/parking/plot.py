@@ -20,7 +20,7 @@ from ..plotting.files import check_count, save_gif, save_html, spread_indices
 from .execute import Execution, execute_plan
 from .geometry import Space, Vehicle, footprint
 from .path import sample_poses
-from .planner import ParkingPlan
+from .planner import ParkingPlan, size
 
 FORWARD, BACKWARD = "#1f77b4", "#d62728"
 #: Most samples of the trail an animation draws, spread evenly (every sample of a plan driven in under 10 min; each
@@ -38,11 +38,11 @@ def car_outline(vehicle: Vehicle, pose: np.ndarray) -> np.ndarray:
 
 
 def draw_scene(ax: Axes, space: Space, extent: float = 2.0) -> None:
-    """Parked cars (grey), the curb, the slot and its safety margins."""
+    """Parked cars (grey, `extent` [m] long), the curb, the slot and its safety margins."""
     H, J = space.H, space.J
     ax.add_patch(Rectangle((0, -J), extent, J, color="0.75", zorder=0))
     ax.add_patch(Rectangle((-H - extent, -J), extent, J, color="0.75", zorder=0))
-    ax.add_patch(Rectangle((-H - extent, -J - 0.3), H + 2 * extent, 0.3, color="0.45", zorder=0))
+    ax.add_patch(Rectangle((-H - extent, -J - 0.15 * extent), H + 2 * extent, 0.15 * extent, color="0.45", zorder=0))
     ax.plot([-H, 0, 0, -H, -H], [0, 0, -J, -J, 0], color="0.3", lw=0.8, ls="--", zorder=1)
     for x in (-H + space.MS, -space.MS):
         ax.plot([x, x], [-J, 0], color="0.5", lw=0.6, ls=":", zorder=1)
@@ -73,7 +73,7 @@ def plot_plan(plan: ParkingPlan, execution: Execution | None = None) -> Figure:
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     v, sp = plan.vehicle, plan.space
-    draw_scene(ax, sp)
+    draw_scene(ax, sp, size(v))
     for seg in plan.segments:
         xy = sample_poses([seg], 0.02)
         ax.plot(xy[:, 0], xy[:, 1], color=FORWARD if seg.direction > 0 else BACKWARD, lw=1.4, zorder=2)
@@ -87,7 +87,9 @@ def plot_plan(plan: ParkingPlan, execution: Execution | None = None) -> Figure:
         draw_car(ax, v, np.array(plan.final_pose), 0.0, color="#2ca02c", alpha=0.5, fill=True)
     plural = "" if plan.maneuvers == 1 else "s"
     verdict = f"{plan.maneuvers} manoeuvre{plural}" if plan.feasible else f"infeasible: {plan.reason[:70]}"
-    ax.set_title(f"H = {sp.H:.3g} m, J = {sp.J:.3g} m, car {v.length:.3g} x {v.c1:.3g} m: {verdict}", fontsize=9)
+    part = "" if plan.used_H is None else f" (parks in the {plan.used_H:.3g} m behind the front car)"
+    ax.set_title(f"H = {sp.H:.3g} m{part}, J = {sp.J:.3g} m, car {v.length:.3g} x {v.c1:.3g} m: {verdict}",
+                 fontsize=9)
     _frame(ax, plan)
     fig.tight_layout()
     return fig
@@ -124,7 +126,7 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
     fig = Figure(figsize=(8, 4.6))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
-    draw_scene(ax, plan.space)
+    draw_scene(ax, plan.space, size(plan.vehicle))
     _frame(ax, plan)
     direction = np.array([s.direction for s in plan.segments])[run.segment]
     trail_f, = ax.plot([], [], ".", color=FORWARD, ms=1.5)
@@ -154,16 +156,22 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
 
 
 def _frame(ax: Axes, plan: ParkingPlan) -> None:
+    """The slot (or the part of a long slot the car parks in, ``used_H``) and the path after the detection pass,
+    padded in units of the car's size: in metres, a 2 mm car was a dot in a 2 m frame, and a 1 km slot hid the
+    manoeuvre."""
     sp, v = plan.space, plan.vehicle
-    xs = [-sp.H - 1.0, 1.0]
-    ys = [-sp.J - 0.4, 0.5]
+    unit = size(v)
+    shown = sp.H if plan.used_H is None else plan.used_H
+    xs = [-shown - 0.5 * unit, 0.5 * unit]
+    ys = [-sp.J - 0.2 * unit, 0.25 * unit]
     for seg in plan.segments:
         for p in (seg.start, seg.end):
-            xs.append(p[0])
-            ys.append(p[1])
+            if seg.phase > 1 or plan.used_H is None or p is seg.end:
+                xs.append(p[0])
+                ys.append(p[1])
     pad = v.length
     ax.set_xlim(min(xs) - pad * 0.3, max(xs) + pad)
-    ax.set_ylim(min(ys) - 0.2, max(ys) + v.c1 / 2 + 0.4)
+    ax.set_ylim(min(ys) - 0.1 * unit, max(ys) + v.c1 / 2 + 0.2 * unit)
     ax.set_aspect("equal")
     ax.set_xlabel("x [m] (along the road)")
     ax.set_ylabel("y [m]")
