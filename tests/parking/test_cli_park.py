@@ -8,6 +8,8 @@ import math
 import pytest
 
 from wmrkit.cli.main import main
+from wmrkit.errors import WmrkitError
+from wmrkit.parking import plan_parking
 
 
 def run(capsys, *argv):
@@ -166,18 +168,30 @@ def test_output_files_it_cannot_write_are_refused_before_the_answer(capsys, tmp_
     assert list(tmp_path.iterdir()) == []
 
 
-def test_an_exact_check_too_big_is_refused_before_it_allocates(capsys, tmp_path):
+def test_an_exact_check_too_big_is_refused_before_it_allocates(capsys, tmp_path, monkeypatch):
     """A 600 m car in a 1 km slot (lengths within the 1 km bound) plans a 9.8 km path; '--check' sampled it every
     2 mm of corner motion, 4.5e6 car polygons at once: over 3.5 GB, a GEOS 'std::bad_alloc' traceback under a memory
-    limit. Now refused: one line naming the count and the bound, exit 2."""
+    limit. The check now samples in car sizes (0.6 m for this car: 28,030 poses, collision-free); 2 mm is refused
+    before anything is allocated, and so is a check past the bound from the command line: one line naming the
+    count and the bound, exit 2."""
+    from wmrkit.parking import verify
+    from wmrkit.parking.problem import load_problem
+
     f = tmp_path / "big.yaml"
     f.write_text("vehicle: {a1: 500, b1: 100, c1: 400, h1: 500, d1: 1, phi_max: 45 deg}\n"
                  "space: {H: 1000, J: 1000, MS: 0, dx2: 1000, final_gap: 0.01}\n")
     code, out, _ = run(capsys, str(f))
     assert code == 0 and "feasible: 13 manoeuvres" in out  # the plan itself is cheap
+    problem = load_problem(f)
+    plan = plan_parking(problem.vehicle, problem.space)
+    with pytest.raises(WmrkitError, match="at most 2000000"):
+        verify.check_plan(problem.vehicle, problem.space, plan.segments, corner_step=0.002)
+    code, out, _ = run(capsys, str(f), "--check")
+    assert code == 0 and "exact check (28030 poses): collision-free, ends inside the slot" in out
+    monkeypatch.setattr(verify, "MAX_CHECK_POSES", 20_000)
     code, out, err = run(capsys, str(f), "--check", "--json")
     assert code == 2 and out == "" and err.count("\n") == 1
-    assert "poses" in json.loads(err)["error"] and "at most 2000000" in err
+    assert "poses" in json.loads(err)["error"] and "at most 20000" in err
 
 
 def test_a_plan_too_long_to_time_is_still_the_answer_with_a_warning(capsys, tmp_path):

@@ -122,3 +122,23 @@ def test_the_plan_figure_frames_the_manoeuvres_at_any_scale(scale, H):
     final = plan.final_pose
     assert left < final[0] - car.b1 and right > 0 and bottom < -slot.J and top > plan.pass_offset  # all in view
     assert right - left < shown + 3 * car.length and top - bottom < slot.J + plan.pass_offset + 2 * car.c1
+
+
+@pytest.mark.parametrize("shift", [0.005, 0.05])
+@pytest.mark.parametrize("scale", [1e-3, 1.0, 1e3])
+def test_the_exact_check_finds_the_same_collisions_at_any_scale(scale, shift):
+    """Table 9.1's plan (after the pass) moved `shift` car-scaled metres toward the front car hits it, at any scale.
+    Before, the check sampled every 2 mm of corner motion, in metres: the 2 mm copy was checked at 7 poses and
+    called collision-free 50 um (5 cm scaled) into the front car; the 2 km copy was refused as too long."""
+    car, slot = _scaled(CAR_91, SLOT_91, scale)
+    plan = plan_parking(car, slot)
+    moved = [replace(s, start=(s.start[0] + shift * scale, *s.start[1:]), end=(s.end[0] + shift * scale, *s.end[1:]))
+             for s in plan.segments if s.phase > 1]
+    ref_car, ref_slot = _scaled(CAR_91, SLOT_91, 1.0)
+    reference = check_plan(ref_car, ref_slot, [replace(s, start=(s.start[0] + shift, *s.start[1:]),
+                                                       end=(s.end[0] + shift, *s.end[1:]))
+                                               for s in plan_parking(ref_car, ref_slot).segments if s.phase > 1])
+    report = check_plan(car, slot, moved)
+    assert not report.collision_free and report.what == "front"
+    assert len(report.poses) == len(reference.poses)
+    assert report.n_collisions == pytest.approx(reference.n_collisions, abs=2)
