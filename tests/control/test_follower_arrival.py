@@ -61,15 +61,16 @@ def test_a_run_that_cannot_arrive_says_so(capsys):
     """A follower that had not reached the path's end when the run ended said nothing (the car's corner: 0.58 m
     from the end under pure pursuit, 0.15 m late on the path and 0.56 m beside it). Now a default run that ends away
     from the end warns: still on its way after the bounded extra time (30 m behind the 10 m line: 15 m driven in
-    the 30 s bound), or past the end beside it (the car's corner under pure pursuit: a 4 m turning radius leaves
-    too short a last leg to recover on)."""
+    the 30 s bound), or past the end beside it (the car 1 m before the line's end and 0.5 m beside it: reaching the
+    end needs a turn of radius 1.25 m, inside its 4 m turning radius)."""
     assert main(["track", "diff-drive", "--reference", "line", "--controller", "pure-pursuit", "--from", "-30", "0",
                  "0", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["t"][-1] == pytest.approx(follower_duration(20.0)) == 30.0
     said = [w for w in out["warnings"] if "did not reach the path's end" in w]
     assert len(said) == 1 and "ended 25 m from it" in said[0] and "the run ended at 30 s" in said[0], said
-    assert main(["track", "ackermann", "--reference", "corner", "--controller", "pure-pursuit"]) == 0
+    assert main(["track", "ackermann", "--reference", "line", "--controller", "pure-pursuit", "--from", "9", "0.5",
+                 "0"]) == 0
     err = capsys.readouterr().err
     assert "wmrkit: warning: the path follower did not reach the path's end" in err
     assert "it passed the path's end beside it" in err

@@ -6,10 +6,12 @@ path followers take it from the path, not from a clock), slowing to stop at the 
 (:meth:`PathIndex.approach`):
 
 - **pure pursuit** (Coulter 1992): the axle point ``A`` (the foot of the fixed axle, the origin without fixed wheels)
-  drives on the arc through a goal point ``lookahead`` metres further along the path (past its end: on its final
-  tangent): curvature ``kappa = 2 y_g / L_d^2``; a goal behind ``A`` (``x_g <= 0``) turns it round on the circle of
-  diameter ``L_d`` (``kappa = +-2 / L_d``, towards the goal's side, left when straight behind); ``L_d`` defaults to
-  the wheelbase (:func:`default_lookahead`);
+  drives on the arc through a goal point ``lookahead`` metres further along the path, held at the path's end once
+  that is nearer (as MATLAB's ``controllerPurePursuit`` and Nav2's Regulated Pure Pursuit do: the arc through the
+  end reaches it), and on the end's tangent once the end is no longer ahead of ``A``, or within ``AIM_RADIUS`` of it
+  (a robot beside it, or at it, does not circle it): curvature ``kappa = 2 y_g / L_d^2``; a goal behind ``A``
+  (``x_g <= 0``) turns it round on the circle of diameter ``L_d`` (``kappa = +-2 / L_d``, towards the goal's side,
+  left when straight behind); ``L_d`` defaults to the wheelbase (:func:`default_lookahead`);
 - **Stanley** (Thrun et al. 2006; Hoffmann et al. 2007): a front point ``F`` at ``wheelbase`` ahead of ``A``;
   steering ``delta = psi_e - atan(k e / (v_F + eps))`` with the heading error ``psi_e``, the signed cross-track
   error ``e`` of ``F`` (positive left) and ``F``'s speed ``v_F`` (the path's: the front axle's, as in Hoffmann's
@@ -35,8 +37,8 @@ from .loop import TwistController
 from .points import ControlError, ControlPoint
 from .references import Reference
 
-__all__ = ["ARRIVAL_TOL", "ArrivalWarning", "PathFollower", "PathIndex", "default_lookahead", "default_wheelbase",
-           "follower_duration", "max_curvature", "pure_pursuit", "stanley"]
+__all__ = ["AIM_RADIUS", "ARRIVAL_TOL", "ArrivalWarning", "PathFollower", "PathIndex", "default_lookahead",
+           "default_wheelbase", "follower_duration", "max_curvature", "pure_pursuit", "stanley"]
 
 #: The shortest default lookahead of pure pursuit [m] (:func:`default_lookahead`).
 MIN_LOOKAHEAD = 1.0
@@ -53,6 +55,10 @@ APPROACH_FLOOR = 0.005
 EXTRA_FRACTION, EXTRA_MIN = 0.5, 10.0
 #: A follower that ends farther than this [m] from the path's end did not arrive (:class:`ArrivalWarning`).
 ARRIVAL_TOL = 0.1
+#: Pure pursuit aims at the path's end until it is this close [m] (or the end is no longer ahead), then drives on
+#: along the end's tangent: aiming at a point ``r`` away turns at up to ``2 / r``, and a robot at rest just short of
+#: it (the slip of the dynamics, a sample late) was steered round at the stops and tipped over.
+AIM_RADIUS = ARRIVAL_TOL / 2
 
 
 class ArrivalWarning(UserWarning):
@@ -161,8 +167,8 @@ class PathIndex:
         return float(self.s[j] + u * length), chi, e
 
     def point_at(self, s: float) -> np.ndarray:
-        """Path point at arc length `s` [m] (clamped to the start; beyond the end, on the end's tangent: a goal held
-        at the end point let a robot that reached it first circle it on ever tighter turns, ``2 / L_d``)."""
+        """Path point at arc length `s` [m] (clamped to the start; beyond the end, on the end's tangent: pure
+        pursuit's goal once the end is behind the robot, which circled it on ever tighter turns, ``2 / L_d``)."""
         beyond = s - self.s[-1]
         if beyond > 0:
             chi = self.tangent(len(self.xy) - 1)
@@ -275,9 +281,13 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0,
         s_near, _, _ = path.project(a, t)
         if path.done(a, s_near):  # the path is driven: stop
             return np.zeros(3), np.zeros(3)
-        d = path.point_at(s_near + lookahead) - a
         c, s = math.cos(psi), math.sin(psi)
+        ahead, end = s_near + lookahead, float(path.s[-1])
+        d = path.point_at(min(ahead, end)) - a  # the goal: held at the path's end (the arc through it reaches it)
         x_g, y_g = c * d[0] + s * d[1], -s * d[0] + c * d[1]
+        if ahead > end and (x_g <= 0 or x_g * x_g + y_g * y_g < AIM_RADIUS**2):  # the end passed, or reached:
+            d = path.point_at(ahead) - a  # on along the end's tangent
+            x_g, y_g = c * d[0] + s * d[1], -s * d[0] + c * d[1]
         dist2 = x_g * x_g + y_g * y_g
         if dist2 <= 1e-12:
             kappa = 0.0

@@ -1,0 +1,51 @@
+"""Pure pursuit arrives at the path's end wherever the geometry allows: its goal is held at the end once the end is
+nearer than the lookahead (the arc through it reaches it), and its run does not stop while the end is still ahead."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.cli.control import min_turning_radius
+from wmrkit.control.references import builtin_reference, default_size
+from wmrkit.control.track import track
+from wmrkit.control.trackers import ArrivalWarning, PathIndex, max_curvature
+
+#: How close [m] the continuous loop (rtol 1e-5) brings a robot to a point on an arc it drives exactly.
+ON_ARC = 1e-3
+
+
+def _end_curvature(point: np.ndarray, heading: float, end: np.ndarray) -> float:
+    """The curvature [1/m] of the circle through `point`, tangent to `heading`, through `end` (closed form)."""
+    d = end - point
+    lateral = -math.sin(heading) * d[0] + math.cos(heading) * d[1]
+    return 2.0 * lateral / float(d @ d)
+
+
+@pytest.mark.parametrize("lookahead", [1.0, 2.5])
+@pytest.mark.parametrize("name", ["ackermann", "bicycle", "forklift", "agv-drive-unit", "thesis-tricycle"])
+def test_pure_pursuit_arrives_at_the_end_of_smooth_paths(name, lookahead):
+    """Past the path's end the goal lay on the end's tangent: the robot straightened over the last lookahead while
+    the path still curved, and passed the end beside it (the 3 m circle at a 2.5 m lookahead: 0.12 m; the car's
+    circle at its 2.7 m wheelbase: 68 mm). Now the goal is held at the end once the end is nearer: from the pose
+    where that happens, the end lies on one arc within the robot's tightest turn (checked here, closed form), the
+    arc pure pursuit drives, so the tracked point ends on the end, to the integrator's accuracy."""
+    robot = catalog.load(name)
+    kappa_max = max_curvature(robot)
+    for ref_name in ("line", "circle", "figure-eight"):
+        ref = builtin_reference(ref_name, size=default_size(ref_name, min_turning_radius(robot)))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ArrivalWarning)
+            run = track(robot, ref, controller="pure-pursuit", lookahead=lookahead)
+        assert not [w for w in caught if issubclass(w.category, ArrivalWarning)], ref_name
+        path, end = PathIndex(ref), ref.pose[-1, :2]
+        s = np.array([path.project(p[:2], t)[0] for p, t in zip(run.tracked, run.t, strict=True)])
+        k = int(np.argmax(s + lookahead >= path.s[-1]))  # the goal reaches the end
+        step = run.tracked[k + 1, :2] - run.tracked[k, :2]
+        heading = math.atan2(step[1], step[0])  # the tracked point's direction of travel there
+        assert abs(_end_curvature(run.tracked[k, :2], heading, end)) < kappa_max, ref_name  # the geometry allows
+        assert float(np.hypot(*(run.tracked[-1, :2] - end))) < ON_ARC, ref_name
