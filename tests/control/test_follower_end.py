@@ -49,3 +49,23 @@ def test_pure_pursuit_arrives_at_the_end_of_smooth_paths(name, lookahead):
         heading = math.atan2(step[1], step[0])  # the tracked point's direction of travel there
         assert abs(_end_curvature(run.tracked[k, :2], heading, end)) < kappa_max, ref_name  # the geometry allows
         assert float(np.hypot(*(run.tracked[-1, :2] - end))) < ON_ARC, ref_name
+
+
+def test_pure_pursuit_does_not_stop_while_the_end_is_ahead_of_it():
+    """A run stopped once the tracked point crossed the end's line, wherever the end was: the diff drive 1 cm
+    before the line's end and 0.3 m beside it, on the arc of radius 0.15 m pure pursuit drives to it (closed form:
+    ``d^2 / (2 y)``), crossed the line at once and stopped 0.30 m from the end. Now it stops only once the end is no
+    longer ahead of it (or within ``AIM_RADIUS``), and drives to it at the speed that stops it there (its distance
+    to the end, not the path's arc length left, 0 once its projection is on the end: it crawled at 0.5 % speed)."""
+    robot, ref = catalog.load("diff-drive"), builtin_reference("line")  # 10 m along +x, at 0.5 m/s
+    end = ref.pose[-1, :2]
+    radius = 1.0 / abs(_end_curvature(np.array([9.99, 0.3]), 0.0, end))
+    assert radius == pytest.approx((0.01**2 + 0.3**2) / (2 * 0.3))  # within reach of a robot that turns in place
+    run = track(robot, ref, controller="pure-pursuit", initial_pose=[9.99, 0.3, 0.0])  # the axle point: the origin
+    assert float(np.hypot(*(run.tracked[-1, :2] - end))) < ON_ARC
+    assert run.t[-1] < 2 * math.pi * radius / (0.1 * 0.5)  # within half a turn at the least approach speed
+    path = PathIndex(ref)
+    ahead = np.array([10.05, 0.3])  # past the end's line, 0.3 m beside the end
+    assert path.done(ahead, path.s[-1])  # what ended the run: past the line (Stanley's rule, still)
+    assert not path.done(ahead, path.s[-1], heading=-math.pi / 2)  # the end ahead (to the right, 0.05 m back)
+    assert path.done(ahead, path.s[-1], heading=0.0)  # the end behind: passed beside it

@@ -21,7 +21,8 @@ path followers take it from the path, not from a clock), slowing to stop at the 
 Both limit the curvature to the robot's tightest turn (:func:`max_curvature`: a car's steering stops).
 The resulting unicycle twist ``(v, omega)`` at ``A`` along the robot's rolling direction is moved to the origin
 (rigid body) and goes through the same per-wheel IK as the thesis's controller. Neither has a time law: each stops
-once its point has passed the path's end (:class:`PathFollower`), and a default run of :func:`.track.track` lasts
+once its point has passed the path's end (pure pursuit: and the end is no longer ahead of it, or it is at the end;
+:class:`PathFollower`), and a default run of :func:`.track.track` lasts
 until then, or at most :func:`follower_duration` (:class:`ArrivalWarning` when it ends away from the end).
 """
 
@@ -55,10 +56,11 @@ APPROACH_FLOOR = 0.005
 EXTRA_FRACTION, EXTRA_MIN = 0.5, 10.0
 #: A follower that ends farther than this [m] from the path's end did not arrive (:class:`ArrivalWarning`).
 ARRIVAL_TOL = 0.1
-#: Pure pursuit aims at the path's end until it is this close [m] (or the end is no longer ahead), then drives on
-#: along the end's tangent: aiming at a point ``r`` away turns at up to ``2 / r``, and a robot at rest just short of
-#: it (the slip of the dynamics, a sample late) was steered round at the stops and tipped over.
-AIM_RADIUS = ARRIVAL_TOL / 2
+#: Pure pursuit has reached the path's end within this [m] (its run stops there: :meth:`PathIndex.done`); it aims at
+#: the end until then (or until the end is no longer ahead), and drives on along the end's tangent after: aiming at a
+#: point ``r`` away turns at up to ``2 / r``, and a robot at rest just short of the end (the slip of the dynamics)
+#: was steered round at the stops and tipped over.
+AIM_RADIUS = 0.001
 
 
 class ArrivalWarning(UserWarning):
@@ -92,10 +94,11 @@ class PathIndex:
             return 0.0
         return max(float(np.interp(s, self._s_moving, self._v_moving)), self.min_speed)
 
-    def approach(self, s: float, length: float) -> float:
+    def approach(self, s: float, length: float, to_end: float = 0.0) -> float:
         """The factor in [``APPROACH_FLOOR``, 1] of the speed at arc length `s` [m] that stops a follower of
-        `length` [m] at the path's end (see ``APPROACH_FLOOR``)."""
-        left = max(float(self.s[-1]) - s, 0.0)
+        `length` [m] at the path's end (see ``APPROACH_FLOOR``), `to_end` [m] from it at least (a point beside the
+        end that drives on to it: its projection is on the end)."""
+        left = max(float(self.s[-1]) - s, to_end, 0.0)
         return 1.0 if left >= length else max(math.sqrt(left / length), APPROACH_FLOOR)
 
     def _feet(self, point: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -147,13 +150,20 @@ class PathIndex:
             k += 1
         return int(near[k]), float(u[k])
 
-    def done(self, point: np.ndarray, s: float) -> bool:
+    def done(self, point: np.ndarray, s: float, heading: float | None = None) -> bool:
         """Whether `point`, projected at arc length `s` [m] (:meth:`project`), has passed the path's end: it projects
-        on the end, past it along the last segment (a closed path's start, on its end, has not)."""
+        on the end, past it along the last segment (a closed path's start, on its end, has not); given the `heading`
+        [rad] of a point that steers for the end (pure pursuit), also the end is no longer ahead of it (one that
+        crossed the end's line beside it, on an arc to it, drives on to it), unless it is at the end (within
+        ``AIM_RADIUS``: arrived, whatever its heading)."""
         if s < self.s[-1]:
             return False
         a, b = self.xy[-2], self.xy[-1]
-        return float((point - b) @ (b - a)) >= 0 and float(np.hypot(*(point - b))) > 1e-9
+        if heading is not None and float(np.hypot(*(point - b))) < AIM_RADIUS:  # at the end: arrived
+            return True
+        if not (float((point - b) @ (b - a)) >= 0 and float(np.hypot(*(point - b))) > 1e-9):
+            return False
+        return heading is None or float((b - point) @ np.array([math.cos(heading), math.sin(heading)])) <= 0
 
     def project(self, point: np.ndarray, t: float) -> tuple[float, float, float]:
         """Continuous projection of `point` on the path near time `t` (:meth:`_segment`): ``(s [m], chi [rad],
@@ -250,10 +260,12 @@ def _twist_at_origin(cp: ControlPoint, v: float, omega: float) -> np.ndarray:
 
 class PathFollower:
     """A geometric tracker: the :data:`TwistController` `law`, and the path it follows with its `tracked` point
-    (``pose -> (2,)`` world [m]), to tell when that point has driven it to the end (:meth:`finished`)."""
+    (``pose -> (2,)`` world [m]), to tell when that point has driven it to the end (:meth:`finished`); `heading`
+    (``pose -> rad``): that point's direction of travel, for a law that steers for the end (:meth:`PathIndex.done`)."""
 
-    def __init__(self, path: PathIndex, tracked: Callable[[np.ndarray], np.ndarray], law: TwistController) -> None:
-        self.path, self.tracked, self.law = path, tracked, law
+    def __init__(self, path: PathIndex, tracked: Callable[[np.ndarray], np.ndarray], law: TwistController,
+                 heading: Callable[[np.ndarray], float] | None = None) -> None:
+        self.path, self.tracked, self.law, self.heading = path, tracked, law, heading
 
     def __call__(self, t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return self.law(t, pose, integral)
@@ -261,7 +273,7 @@ class PathFollower:
     def finished(self, t: float, pose: np.ndarray) -> bool:
         """Whether the tracked point has passed the path's end at `t` (the law then commands rest, for ever)."""
         p = self.tracked(pose)
-        return self.path.done(p, self.path.project(p, t)[0])
+        return self.path.done(p, self.path.project(p, t)[0], None if self.heading is None else self.heading(pose))
 
     def end_distance(self, pose: np.ndarray) -> float:
         """Distance [m] of the tracked point from the path's end."""
@@ -279,7 +291,7 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0,
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         a, psi = _axle_state(cp, pose)
         s_near, _, _ = path.project(a, t)
-        if path.done(a, s_near):  # the path is driven: stop
+        if path.done(a, s_near, psi):  # the path is driven: stop
             return np.zeros(3), np.zeros(3)
         c, s = math.cos(psi), math.sin(psi)
         ahead, end = s_near + lookahead, float(path.s[-1])
@@ -296,10 +308,11 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0,
         else:  # goal behind (the path runs against the robot): 2 y_g / L^2 ~ 0 drove straight away; turn round
             kappa = math.copysign(2.0 / math.sqrt(dist2), y_g)
         kappa = min(max(kappa, -curvature), curvature)
-        v = path.speed(s_near) * path.approach(s_near, lookahead)  # the path's speed where the robot is on it
+        to_end = float(np.hypot(*(path.xy[-1] - a)))  # beside the end, on the arc to it: its projection is the end
+        v = path.speed(s_near) * path.approach(s_near, lookahead, to_end)  # the path's speed where it is on it
         return _twist_at_origin(cp, v, v * kappa), np.zeros(3)
 
-    return PathFollower(path, lambda pose: _axle_state(cp, pose)[0], control)
+    return PathFollower(path, lambda pose: _axle_state(cp, pose)[0], control, lambda pose: _axle_state(cp, pose)[1])
 
 
 def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase: float | None = None,
