@@ -69,3 +69,23 @@ def test_pure_pursuit_does_not_stop_while_the_end_is_ahead_of_it():
     assert path.done(ahead, path.s[-1])  # what ended the run: past the line (Stanley's rule, still)
     assert not path.done(ahead, path.s[-1], heading=-math.pi / 2)  # the end ahead (to the right, 0.05 m back)
     assert path.done(ahead, path.s[-1], heading=0.0)  # the end behind: passed beside it
+
+
+def test_a_follower_that_passes_the_end_beside_it_says_why():
+    """The warning said only "it passed the path's end beside it". Now, for pure pursuit, it names when the end
+    went out of reach and why: a turn tighter than the robot's tightest (the car 1 m before the line's end and
+    0.5 m beside it: the circle tangent to its heading through the end has radius (1 + 0.25) / (2 * 0.5) = 1.25 m,
+    its own 3.99 m), or the end behind it (the diff drive starting 0.2 m past the end's line)."""
+    radius = (1.0**2 + 0.5**2) / (2 * 0.5)
+    car = catalog.load("ackermann")
+    with pytest.warns(ArrivalWarning) as caught:
+        track(car, builtin_reference("line"), controller="pure-pursuit", initial_pose=[9.0, 0.5, 0.0])
+    said = str(caught[-1].message)
+    assert (f"it passed the path's end beside it: from t = 0 s, {math.hypot(1.0, 0.5):.3g} m from it, the end needed "
+            f"a turn of radius {radius:.3g} m, tighter than the robot's tightest ({min_turning_radius(car):.3g} m)"
+            in said), said
+    with pytest.warns(ArrivalWarning) as caught:
+        track(catalog.load("diff-drive"), builtin_reference("line"), controller="pure-pursuit",
+              initial_pose=[10.2, 0.3, 0.0])
+    said = str(caught[-1].message)
+    assert f"from t = 0 s, {math.hypot(0.2, 0.3):.3g} m from it, the end was behind it" in said, said

@@ -52,17 +52,43 @@ def ended(out: dict[str, Any], until: Callable[[float, np.ndarray], bool]) -> di
     return {key: v[:done + 1] if isinstance(v, np.ndarray) and len(v) == len(t) else v for key, v in out.items()}
 
 
-def check_arrival(follower: PathFollower, end: float, pose: np.ndarray, cut: Limit | None = None) -> None:
-    """Warn (:class:`.trackers.ArrivalWarning`) when a follower's default run ended with its tracked point more than
-    ``ARRIVAL_TOL`` from the path's end: still on its way after the bounded run (its extra time `cut` by a limit of
-    the loop, if given), or past the end beside it."""
-    gap = follower.end_distance(pose)
+def _out_of_reach(follower: PathFollower, t: np.ndarray, pose: np.ndarray) -> str:
+    """Why a follower that steers for the path's end within its tightest turn (pure pursuit) passed the end beside
+    it, from its run (times `t` ``(n,)`` [s], poses ``(n, 3)``): from the first sample after the last one where the
+    end lay ahead on an arc within that turn (the circle tangent to its heading through the end, closed form:
+    curvature ``2 y / d^2``), the end was out of its reach; "" when it never was (or the follower tells no heading)."""
+    if follower.heading is None:
+        return ""
+    end = follower.path.xy[-1]
+    d = np.array([end - follower.tracked(p) for p in pose])
+    h = np.array([follower.heading(p) for p in pose])
+    ahead, side = d[:, 0] * np.cos(h) + d[:, 1] * np.sin(h), d[:, 1] * np.cos(h) - d[:, 0] * np.sin(h)
+    need = 2.0 * np.abs(side) / np.maximum(np.sum(d * d, axis=1), 1e-300)
+    reach = np.flatnonzero((ahead > 0) & (need <= follower.tightest))
+    k = int(reach[-1]) + 1 if len(reach) else 0
+    if k >= len(t):
+        return ""
+    at = f"from t = {t[k]:.4g} s, {float(np.hypot(*d[k])):.3g} m from it,"
+    if ahead[k] <= 0:
+        return f"{at} the end was behind it"
+    return (f"{at} the end needed a turn of radius {1 / need[k]:.3g} m, tighter than the robot's tightest "
+            f"({1 / follower.tightest:.3g} m): start farther from the end, or on the path")
+
+
+def check_arrival(follower: PathFollower, t: np.ndarray, pose: np.ndarray, cut: Limit | None = None) -> None:
+    """Warn (:class:`.trackers.ArrivalWarning`) when a follower's default run (times `t` ``(n,)`` [s], poses
+    ``(n, 3)``) ended with its tracked point more than ``ARRIVAL_TOL`` from the path's end: still on its way after
+    the bounded run (its extra time `cut` by a limit of the loop, if given), or past the end beside it (and why,
+    where its turning radius tells: :func:`_out_of_reach`)."""
+    end, last = float(t[-1]), pose[-1]
+    gap = follower.end_distance(last)
     if gap <= ARRIVAL_TOL:
         return
-    if follower.finished(end, pose):
-        why = "it passed the path's end beside it"
+    if follower.finished(end, last):
+        reason = _out_of_reach(follower, t, pose)
+        why = "it passed the path's end beside it" + (f": {reason}" if reason else "")
     else:
-        s = follower.path.project(follower.tracked(pose), end)[0]
+        s = follower.path.project(follower.tracked(last), end)[0]
         at = f"at {s:.4g} m of the path's {follower.path.s[-1]:.4g} m"
         total = follower.path.ref.duration
         why = (f"the run ended at {end:.4g} s (the reference's duration, {total:.4g} s, and the followers' extra "

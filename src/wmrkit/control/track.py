@@ -284,7 +284,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                                   f"{MAX_COORDINATE:g} m): lower the gain, or shorten the period", float(t[k])),
                        robot, reference, tracked_point, "dynamic" if dynamics else "kinematic")
     if isinstance(ctrl, PathFollower) and not given_duration:
-        check_arrival(ctrl, float(t[-1]), pose[-1], cut)
+        check_arrival(ctrl, t, pose, cut)
     tcp = _full_point(cp, tracked_point)
     tracked = point_pose(tcp, pose)
     ref = reference.sample(t)

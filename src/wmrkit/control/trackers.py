@@ -261,11 +261,12 @@ def _twist_at_origin(cp: ControlPoint, v: float, omega: float) -> np.ndarray:
 class PathFollower:
     """A geometric tracker: the :data:`TwistController` `law`, and the path it follows with its `tracked` point
     (``pose -> (2,)`` world [m]), to tell when that point has driven it to the end (:meth:`finished`); `heading`
-    (``pose -> rad``): that point's direction of travel, for a law that steers for the end (:meth:`PathIndex.done`)."""
+    (``pose -> rad``): that point's direction of travel, for a law that steers for the end (:meth:`PathIndex.done`),
+    turning at most at curvature `tightest` [1/m]."""
 
     def __init__(self, path: PathIndex, tracked: Callable[[np.ndarray], np.ndarray], law: TwistController,
-                 heading: Callable[[np.ndarray], float] | None = None) -> None:
-        self.path, self.tracked, self.law, self.heading = path, tracked, law, heading
+                 heading: Callable[[np.ndarray], float] | None = None, tightest: float = math.inf) -> None:
+        self.path, self.tracked, self.law, self.heading, self.tightest = path, tracked, law, heading, tightest
 
     def __call__(self, t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return self.law(t, pose, integral)
@@ -312,7 +313,8 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0,
         v = path.speed(s_near) * path.approach(s_near, lookahead, to_end)  # the path's speed where it is on it
         return _twist_at_origin(cp, v, v * kappa), np.zeros(3)
 
-    return PathFollower(path, lambda pose: _axle_state(cp, pose)[0], control, lambda pose: _axle_state(cp, pose)[1])
+    return PathFollower(path, lambda pose: _axle_state(cp, pose)[0], control, lambda pose: _axle_state(cp, pose)[1],
+                        curvature)
 
 
 def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase: float | None = None,
