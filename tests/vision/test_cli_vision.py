@@ -75,6 +75,28 @@ def test_calibrate_from_measurements(capsys):
     assert code == 2 and "A must be below 50 px and x1, x2 below 50 px" in err
 
 
+def test_calibrate_refuses_rows_below_a_pixel(capsys):
+    """--rows 0.001 with x1 = 80, x2 = 40 px printed a camera 1.75 um high at 89.999 deg, exit 0."""
+    argv = ["vision", "calibrate", "--x1", "80", "--x2", "40", "--half-separation", "3.5cm", "--row-distance",
+            "10cm", "--rows"]
+    code, out, err = run([*argv, "0.001"], capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert "rows A must be at least 1 px from the image's centre (rows +-A are rows of the image), got 0.001 px" in err
+    assert run([*argv, "1"], capsys)[0] == 0
+
+
+def test_calibrate_prints_the_height_at_its_own_precision(capsys):
+    """The height is linear in the ground lengths (9.24): x_w and y_w scaled by 1e-4 scale it by 1e-4, the tilt
+    and focal length unchanged. It printed 'height = 0.00001 m' (one digit) for the 13.4 um camera."""
+    heights = []
+    for scale in (1.0, 1e-4):
+        code, out, _ = run(["vision", "calibrate", "--x1", "71.2357", "--x2", "49.0727", "--rows", "60",
+                            "--half-separation", str(0.035 * scale), "--row-distance", str(0.10221 * scale)], capsys)
+        assert code == 0
+        heights.append(float(out.split("height = ")[1].split(" m")[0]))
+    assert heights[1] == pytest.approx(1e-4 * heights[0], rel=1e-4)
+
+
 @pytest.mark.parametrize(("x1", "x2", "size", "message"), [
     ("71.2357", "49.0727", ["0", "0"], "calibrate: --size: the image is 0 x 0 px, expected 8 to 4096 px a side"),
     ("71.2357", "49.0727", ["100000", "480"], "calibrate: --size: the image is 100000 x 480 px, expected 8 to 4096"),

@@ -207,7 +207,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
         print_json(cal.to_dict())
     else:
         print(f"tilt = {cal.tilt:.6f} rad ({math.degrees(cal.tilt):.3f} deg), focal = {cal.focal_px:.2f} px, "
-              f"height = {cal.height:.5f} m" + (f"; camera file {args.out}" if args.out else ""))
+              f"height = {cal.height:.5g} m" + (f"; camera file {args.out}" if args.out else ""))
     return 0
 
 

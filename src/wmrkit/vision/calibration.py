@@ -26,6 +26,9 @@ __all__ = ["Calibration", "calibrate", "calibrate_image", "calibration_kernel"]
 #: Least difference x1 - x2 [px] calibrate_image accepts: below a pixel, the convergence of the stripes between rows
 #: +-A is not measured (rows +-0.01 px of the docs' image gave a tilt of 89.99 deg and a focal length of 2.8e6 px).
 MIN_CONVERGENCE_PX = 1.0
+#: Least rows A [px] calibrate accepts: rows +-A are rows of the image, a pixel apart at least (A = 0.001 px with
+#: x1 = 80, x2 = 40 px gave a camera 1.75 um high at 89.999 deg, exit 0).
+MIN_ROWS_PX = 1.0
 
 
 def calibration_kernel(x1: ArrayLike, x2: ArrayLike, rows_a: ArrayLike, half_separation: ArrayLike,
@@ -73,7 +76,7 @@ def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_d
 
     Raises :class:`CameraError` naming the measurement when they describe no camera (``x1 <= x2``, a tilt
     whose cosine is not in (0, 1), a height outside ``[MIN_SIZE, MAX_SIZE]`` of :mod:`wmrkit.limits`, a focal length
-    below :data:`.camera.MIN_FOCAL_PX`).
+    below :data:`.camera.MIN_FOCAL_PX`, rows A below :data:`MIN_ROWS_PX`).
     """
     for name, value in (("x1", x1), ("x2", x2), ("rows A", rows_a), ("half-separation", half_separation),
                         ("row distance", row_distance)):
@@ -95,6 +98,9 @@ def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_d
         raise CameraError(f"calibration: the measurements give a focal length of {focal:.4g} px, below "
                           f"{MIN_FOCAL_PX:g} px (no camera: see vision.camera.MIN_FOCAL_PX): check rows A, x1 and x2 "
                           "(pixels from the image's centre)")
+    if rows_a < MIN_ROWS_PX:
+        raise CameraError(f"calibration: rows A must be at least {MIN_ROWS_PX:g} px from the image's centre (rows "
+                          f"+-A are rows of the image), got {rows_a:g} px")
     return Calibration(tilt, focal, height, float(x1), float(x2), float(rows_a), float(half_separation),
                        float(row_distance))
 
