@@ -61,12 +61,12 @@ def test_a_check_in_chunks_sees_what_one_pass_sees(monkeypatch):
 
 def test_too_many_poses_are_refused_before_they_are_made():
     """At most MAX_CHECK_POSES poses: eleven 100 m stretches sampled every 0.1 mm of corner motion would be 1.1e7
-    (2.2e6 with the cap of sample_poses per segment)."""
+    (the count said 2.2e6 while sample_poses capped a segment at 200,000 poses: the check was coarser)."""
     from wmrkit.errors import WmrkitError
     from wmrkit.parking.verify import MAX_CHECK_POSES, densify
 
     segs = [Segment(1, 0, 1, 0.0, 100.0, 0.0, (100.0 * k, 5.0, 0.0), (100.0 * (k + 1), 5.0, 0.0)) for k in range(11)]
-    with pytest.raises(WmrkitError, match=f"would test 2.2e\\+06 poses .*at most {MAX_CHECK_POSES}"):
+    with pytest.raises(WmrkitError, match=f"would test 1.1e\\+07 poses .*at most {MAX_CHECK_POSES}"):
         check_plan(CAR_91, SLOT_91, segs, corner_step=1e-4)
     with pytest.raises(WmrkitError, match=f"at most {MAX_CHECK_POSES}"):
         check_poses(CAR_91, SLOT_91, np.zeros((MAX_CHECK_POSES + 1, 3)))

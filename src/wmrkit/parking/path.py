@@ -65,25 +65,28 @@ def arc_end(start: Pose, direction: int, curvature: float, length: float) -> Pos
     return (x + r * (math.sin(th + dth) - math.sin(th)), y - r * (math.cos(th + dth) - math.cos(th)), th + dth)
 
 
-def sample_poses(segments: tuple[Segment, ...] | list[Segment], step: float = 0.05) -> np.ndarray:
-    """P_f's poses along the segments, at most `step` [m] apart, ends included: ``(N, 3)``; at most
-    :data:`MAX_SAMPLES` per segment (then farther apart: a segment of kilometres).
+def sample_poses(segments: tuple[Segment, ...] | list[Segment], step: float = 0.05,
+                 cap: int | None = MAX_SAMPLES) -> np.ndarray:
+    """P_f's poses along the segments, at most `step` [m] apart, ends included: ``(N, 3)``; at most `cap` per
+    segment (then farther apart: 5 cm steps on a segment over 10 km), None for no cap (the exact check, which
+    bounds the total before sampling).
 
     Each segment is integrated from its start pose with the exact SE(2) step of the odometry
     (:func:`wmrkit.odometry.integrators.integrate_exact`), a body twist held constant over each distance.
     """
     chunks = []
     for k, seg in enumerate(segments):
-        n = sample_count(seg.length, step)
+        n = sample_count(seg.length, step, cap)
         s = np.linspace(0.0, seg.length, n + 1)[(1 if k else 0):]
         chunks.append(integrate_exact(np.array(seg.start), np.array(seg.twist), s))
     return np.concatenate(chunks) if chunks else np.zeros((0, 3))
 
 
-def sample_count(length: float, step: float) -> int:
+def sample_count(length: float, step: float, cap: int | None = MAX_SAMPLES) -> int:
     """Number of steps :func:`sample_poses` cuts a segment `length` [m] long into: at most `step` [m] each, at most
-    :data:`MAX_SAMPLES`."""
-    return min(max(1, math.ceil(length / step)), MAX_SAMPLES)
+    `cap` (None: no cap)."""
+    n = max(1, math.ceil(length / step))
+    return n if cap is None else min(n, cap)
 
 
 def path_length(segments: tuple[Segment, ...] | list[Segment]) -> float:

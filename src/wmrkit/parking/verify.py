@@ -104,11 +104,11 @@ def dense_poses(vehicle: Vehicle, segments: tuple[Segment, ...] | list[Segment],
     corner_step = CORNER_STEP * _unit(vehicle) if corner_step is None else corner_step
     reach = _corner_reach(vehicle)
     steps = [corner_step / (1 + reach * abs(seg.curvature)) for seg in segments]  # corner speed / P_f speed
-    check_count(1 + sum(sample_count(seg.length, step) for seg, step in zip(segments, steps, strict=True)),
+    check_count(1 + sum(sample_count(seg.length, step, None) for seg, step in zip(segments, steps, strict=True)),
                  corner_step)
     chunks = []
     for k, (seg, step) in enumerate(zip(segments, steps, strict=True)):
-        chunk = sample_poses([seg], step)
+        chunk = sample_poses([seg], step, cap=None)  # no per-segment cap: a 1 km pass was checked every 5 mm
         chunks.append(chunk if k == 0 else chunk[1:])
     return np.concatenate(chunks) if chunks else np.zeros((0, 3))
 
