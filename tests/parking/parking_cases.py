@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -35,3 +36,9 @@ def arc_poses(start, direction: int, curvature: float, length: float, n: int = 4
         return np.column_stack([x0 + s * math.cos(th0), y0 + s * math.sin(th0), th])
     r = 1 / curvature
     return np.column_stack([x0 + r * (np.sin(th) - math.sin(th0)), y0 - r * (np.cos(th) - math.cos(th0)), th])
+
+
+def scaled(car: Vehicle, slot: Space, s: float) -> tuple[Vehicle, Space]:
+    """`car` and `slot` with every length multiplied by `s` (angles kept)."""
+    return (replace(car, a1=car.a1 * s, b1=car.b1 * s, c1=car.c1 * s, h1=car.h1 * s, track=car.track * s),
+            replace(slot, H=slot.H * s, J=slot.J * s, MS=slot.MS * s, dx2=slot.dx2 * s, final_gap=slot.final_gap * s))

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from parking_cases import CAR_91, CAR_92, SLOT_91, SLOT_92
+from parking_cases import CAR_91, CAR_92, SLOT_91, SLOT_92, scaled
 
 from wmrkit.parking import Space, Vehicle, plan_parking
 from wmrkit.parking.path import path_length
@@ -84,22 +84,17 @@ def test_a_longer_slot_never_turns_yes_into_no_nor_needs_more_manoeuvres(car, ro
         assert long.maneuvers <= short.maneuvers
 
 
-def _scaled(car: Vehicle, slot: Space, s: float) -> tuple[Vehicle, Space]:
-    return (replace(car, a1=car.a1 * s, b1=car.b1 * s, c1=car.c1 * s, h1=car.h1 * s, track=car.track * s),
-            replace(slot, H=slot.H * s, J=slot.J * s, MS=slot.MS * s, dx2=slot.dx2 * s, final_gap=slot.final_gap * s))
-
-
 @pytest.mark.parametrize("scale", [1e-3, 1e3])
 @pytest.mark.parametrize(("car", "slot"), [
     (CAR_91, replace(SLOT_91, H=3.0)), (CAR_91, replace(SLOT_91, H=3.2, dx2=0.9)),
     (CAR_91, replace(SLOT_91, H=30.0, dx2=0.9)), (CAR_92, replace(SLOT_92, H=3.9)), (CAR_92, replace(SLOT_92, H=40.0))])
-def test_a_mm_or_km_car_plans_the_same_manoeuvres_scaled(car, slot, scale):
+def test_a_mm_or_km_car_plans_the_same_manoeuvresscaled(car, slot, scale):
     """Geometry has no unit of length: the car and slot scaled by 1e-3 or 1e3 plan the same manoeuvres, scaled.
     Before, Algorithm 4's pass-end search had a 1 cm step and a 5 m range in metres: example 1 with H = 3 m had
     no plan, a 2 mm copy of it had one of 11 manoeuvres (its pass 1.8 km-equivalent past the front car), and a
     2 km car with H = 3.2 km, dx2 = 0.9 km got an approach point 7 cm-equivalent off (0.771 vs 0.703 m)."""
     plan = plan_parking(car, slot)
-    small = plan_parking(*_scaled(car, slot, scale))
+    small = plan_parking(*scaled(car, slot, scale))
     assert (small.feasible, small.maneuvers) == (plan.feasible, plan.maneuvers)
     if plan.feasible:
         for name in ("dx1", "dy3", "final_gap"):
@@ -115,7 +110,7 @@ def test_the_plan_figure_frames_the_manoeuvres_at_any_scale(scale, H):
     (2.3 m wide for a 3.35 mm slot)."""
     from wmrkit.parking.plot import plot_plan
 
-    car, slot = _scaled(CAR_91, replace(SLOT_91, H=H), scale)
+    car, slot = scaled(CAR_91, replace(SLOT_91, H=H), scale)
     plan = plan_parking(car, slot)
     ax = plot_plan(plan).axes[0]
     shown = plan.used_H if plan.used_H is not None else slot.H
@@ -131,11 +126,11 @@ def test_the_exact_check_finds_the_same_collisions_at_any_scale(scale, shift):
     """Table 9.1's plan (after the pass) moved `shift` car-scaled metres toward the front car hits it, at any scale.
     Before, the check sampled every 2 mm of corner motion, in metres: the 2 mm copy was checked at 7 poses and
     called collision-free 50 um (5 cm scaled) into the front car; the 2 km copy was refused as too long."""
-    car, slot = _scaled(CAR_91, SLOT_91, scale)
+    car, slot = scaled(CAR_91, SLOT_91, scale)
     plan = plan_parking(car, slot)
     moved = [replace(s, start=(s.start[0] + shift * scale, *s.start[1:]), end=(s.end[0] + shift * scale, *s.end[1:]))
              for s in plan.segments if s.phase > 1]
-    ref_car, ref_slot = _scaled(CAR_91, SLOT_91, 1.0)
+    ref_car, ref_slot = scaled(CAR_91, SLOT_91, 1.0)
     reference = check_plan(ref_car, ref_slot, [replace(s, start=(s.start[0] + shift, *s.start[1:]),
                                                        end=(s.end[0] + shift, *s.end[1:]))
                                                for s in plan_parking(ref_car, ref_slot).segments if s.phase > 1])

@@ -28,8 +28,16 @@ from .planner import ParkingPlan
 if TYPE_CHECKING:
     from ..control.feasibility import Feasibility
 
-#: Wheel radius of the vehicle built from the planner's parameters (the thesis gives none) [m].
-WHEEL_RADIUS = 0.3
+#: Wheel radius of the vehicle built from the planner's parameters (the thesis gives none), in car lengths
+#: ``a1 + b1``: 0.3 m for example 1's 2 m car.
+WHEEL_RADIUS = 0.15
+#: Default top speed [car lengths/s] and acceleration [car lengths/s^2] of the execution, the length ``a1 + b1``
+#: along which the car drives: 0.5 m/s and 0.5 m/s^2 for example 1's 2 m car, 0.225 for example 2's 0.9 m one.
+#: In car lengths, so that a car and its plan scaled together are driven in the same time, and the same steering
+#: rate [rad/s], period `dt` [s] and gain [1/s] give the same answers, scaled: in m/s a 2 mm copy of example 1
+#: drove its 9 mm path in 7 samples and hit the front car, Table 8.1 "NO". (Not in :func:`.planner.size`: example
+#: 2's 3.5 m width would drive it at 0.875 m/s, and the closed loop then hit the rear car.)
+V_MAX, A_MAX = 0.25, 0.25
 #: Samples of the open loop's kinematics solved at once (its batched inverse and forward kinematics take about
 #: 2 KB a sample: a 9.8 km plan, 394,511 samples, took 870 MB at once, 280 MB in chunks).
 CHUNK = 10_000
@@ -65,9 +73,11 @@ class Execution:
         return float(self.t[-1] - self.t[0])
 
 
-def vehicle_robot(vehicle: Vehicle, r: float = WHEEL_RADIUS) -> Robot:
+def vehicle_robot(vehicle: Vehicle, r: float | None = None) -> Robot:
     """The car of Fig. 9.19 as a wmrkit robot: two fixed rear wheels at ``+-d1/2`` (one when ``d1 = 0``) and the
-    equivalent steering wheel at ``h1`` ahead; origin P_f, REP-103 frame; rear spins and steering actuated."""
+    equivalent steering wheel at ``h1`` ahead; origin P_f, REP-103 frame; rear spins and steering actuated. Wheel
+    radius `r` [m], by default :data:`WHEEL_RADIUS` car lengths."""
+    r = WHEEL_RADIUS * vehicle.length if r is None else r
     wheels = [{"name": "steer", "type": "steerable", "position": [vehicle.h1, 0.0], "beta": math.pi / 2, "r": r,
                "actuated": ["steer"], "sensed": ["spin", "steer"]}]
     half = vehicle.track / 2
@@ -134,10 +144,19 @@ def timed_reference(segments: tuple[Segment, ...] | list[Segment], *, v_max: flo
     return np.concatenate(ts), np.concatenate(poses), np.concatenate(dists), np.concatenate(segs)
 
 
-def execute_plan(plan: ParkingPlan, robot: Robot | None = None, *, v_max: float = 0.5, a_max: float = 0.5,
-                 steer_rate: float = 0.5, dt: float = 0.05, controller: str | None = None,
+def speed_limits(plan: ParkingPlan, v_max: float | None = None, a_max: float | None = None) -> tuple[float, float]:
+    """``(v_max [m/s], a_max [m/s^2])``: the ones given, else :data:`V_MAX` and :data:`A_MAX` car lengths."""
+    unit = plan.vehicle.length
+    return (V_MAX * unit if v_max is None else v_max, A_MAX * unit if a_max is None else a_max)
+
+
+def execute_plan(plan: ParkingPlan, robot: Robot | None = None, *, v_max: float | None = None,
+                 a_max: float | None = None, steer_rate: float = 0.5, dt: float = 0.05, controller: str | None = None,
                  gain: float = 1.0) -> Execution:
     """Drive `plan` with `robot` (default :func:`vehicle_robot`; a car-like robot with its origin anywhere).
+
+    Speed `v_max` [m/s] and acceleration `a_max` [m/s^2] default to :func:`speed_limits` (in car lengths); the
+    steering rate [rad/s], period `dt` [s] and `gain` [1/s] have no length, so a scaled car gets scaled answers.
 
     Open loop (``controller=None``): inverse kinematics of the robot for the planned twist, forward kinematics
     from the actuated wheel rates, exact integration. Closed loop: ``controller`` ``"p"`` or ``"pi"``, the
@@ -150,6 +169,7 @@ def execute_plan(plan: ParkingPlan, robot: Robot | None = None, *, v_max: float 
     robot = vehicle_robot(plan.vehicle) if robot is None else robot
     _check_steering(plan, robot)  # refuses robots that are not car-like, or cannot steer the plan
     offset = _rear_axle_midpoint(robot)
+    v_max, a_max = speed_limits(plan, v_max, a_max)
     t, ref, dist, seg = timed_reference(plan.segments, v_max=v_max, a_max=a_max, steer_rate=steer_rate, dt=dt)
     kappa = np.array([s.curvature for s in plan.segments])[seg]
     direction = np.array([s.direction for s in plan.segments])[seg]
@@ -265,8 +285,8 @@ def _steering_axle_reference(robot: Robot, offset: np.ndarray, t: np.ndarray, re
     return reference_from_samples("parking plan", t, target), front
 
 
-def plan_feasibility(plan: ParkingPlan, robot: Robot | None = None, *, v_max: float = 0.5, a_max: float = 0.5,
-                     steer_rate: float = 0.5, dt: float = 0.05) -> Feasibility:
+def plan_feasibility(plan: ParkingPlan, robot: Robot | None = None, *, v_max: float | None = None,
+                     a_max: float | None = None, steer_rate: float = 0.5, dt: float = 0.05) -> Feasibility:
     """Table 8.1's verdict (§8.5, kinematic framework) on `plan` timed as :func:`execute_plan` drives it (its
     ``v_max``, ``a_max``, ``steer_rate``, ``dt``), for `robot` (default :func:`vehicle_robot`) tracked at its
     steering axle's midpoint, as the closed loop tracks it: the same verdict as that run's ``feasibility``."""
@@ -275,6 +295,7 @@ def plan_feasibility(plan: ParkingPlan, robot: Robot | None = None, *, v_max: fl
     if not plan.feasible:
         raise WmrkitError(f"the plan is not feasible ({plan.reason}): nothing to judge")
     robot = vehicle_robot(plan.vehicle) if robot is None else robot
+    v_max, a_max = speed_limits(plan, v_max, a_max)
     t, ref, _, _ = timed_reference(plan.segments, v_max=v_max, a_max=a_max, steer_rate=steer_rate, dt=dt)
     reference, front = _steering_axle_reference(robot, _rear_axle_midpoint(robot), t, ref)
     return feasibility(robot, reference, point=(float(front[0]), float(front[1])))
