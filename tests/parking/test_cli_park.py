@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 
 from wmrkit.cli.main import main
@@ -264,3 +265,35 @@ def test_park_shows_table_8_1_s_verdict_on_the_timed_plan(capsys, monkeypatch):
     data = json.loads(capsys.readouterr().out)
     assert not data["feasibility"]["feasible"] and data["warnings"][0].startswith("the robot cannot follow")
 
+
+@pytest.mark.parametrize("scale", [1e-3, 1e-5, 1.0])
+def test_the_text_answer_prints_lengths_at_the_cars_scale(capsys, tmp_path, scale):
+    """Example 1 scaled: every length the text prints (read back with its unit) is within 1/1000 of the car's size
+    of the JSON's full-precision value. The 2 mm copy printed 'final gap to the curb 0.0 cm', 'lateral 0.2 cm',
+    'radius 0.001 m', a 2.7 % error of the car's size."""
+    import re
+
+    metres = {"nm": 1e-9, "um": 1e-6, "mm": 1e-3, "cm": 1e-2, "m": 1.0}
+    f = tmp_path / "scaled.yaml"
+    lengths = {"a1": 1.5, "b1": 0.5, "c1": 1.4, "h1": 1.05, "d1": 0.5}
+    space = {"H": 3.35, "J": 2.0, "MS": 0.2, "dx2": 0.7, "final_gap": 0.07}
+    f.write_text(json.dumps({"vehicle": {**{k: v * scale for k, v in lengths.items()}, "phi_max": "46 deg"},
+                             "space": {k: v * scale for k, v in space.items()}}))
+    code, text, _ = run(capsys, str(f), "--check")
+    code_json, out, _ = run(capsys, str(f), "--check", "--json")
+    data = json.loads(out)
+    assert code == code_json == 0
+
+    def printed(pattern: str) -> list[float]:
+        return [float(v) * metres[u] for v, u in re.findall(pattern + r"\s*(-?[\d.]+) (nm|um|mm|cm|m)\b", text)]
+
+    pairs = [(printed("final gap to the curb"), [data["final_gap"]]),
+             (printed("path"), [data["path_length"]]),
+             (printed("radius"), [a["radius"] for a in data["arcs"]]),
+             (printed("lateral"), [a["X"] for a in data["arcs"]]),
+             (printed("gap"), [a["gap_after"] for a in data["arcs"]]),
+             (printed("min clearance"), [data["check"]["min_clearance"]]),
+             (printed("dx1 ="), [data["approach"]["dx1"]])]
+    for shown, true in pairs:
+        assert len(shown) == len(true) and len(true) > 0
+        np.testing.assert_allclose(shown, true, rtol=0, atol=1e-3 * 2.0 * scale)

@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
         if executed is not None:
             law = execution.mode.upper()
             mode = "open loop" if execution.mode == "open-loop" else f"closed loop with the {law} law"
-            print(describe_check(executed, f"executed path, {mode}"))
+            print(describe_check(executed, f"executed path, {mode}", solution.problem.vehicle))
     if args.animate or args.plot:
         from ..parking import plot
 

@@ -8,7 +8,7 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from .geometry import blackburn_min_length, length_ratio
+from .geometry import Vehicle, blackburn_min_length, length_ratio
 from .path import direction_changes, path_length, sample_poses
 from .planner import ParkingPlan, plan_parking, shortest_slot
 from .problem import ParkingProblem
@@ -63,13 +63,27 @@ def check_dict(report: CollisionReport) -> dict[str, Any]:
             "poses_checked": len(report.poses)}
 
 
-def describe_check(report: CollisionReport, what: str = "exact check") -> str:
-    """One line: `what` (N poses): collision-free or how many poses hit what, inside the slot, min clearance."""
+#: The units of the text answer by the car's size: (least size [m], unit, its metres, small unit, its metres).
+#: The numbers print at the car's scale: a 2 mm copy of example 1 printed 'final gap to the curb 0.0 cm'.
+UNITS = ((0.063, "m", 1.0, "cm", 0.01), (6.3e-5, "mm", 1e-3, "um", 1e-6), (0.0, "um", 1e-6, "nm", 1e-9))
+
+
+def units(vehicle: Vehicle) -> tuple[str, float, str, float]:
+    """``(unit, its metres, small unit, its metres)`` of the text answer for `vehicle`: metres and centimetres
+    for a car from 6.3 cm up (example 1's as ever), millimetres and micrometres below, then micrometres and
+    nanometres (the JSON stays SI, full precision)."""
+    return next(u[1:] for u in UNITS if max(vehicle.length, vehicle.c1) >= u[0])
+
+
+def describe_check(report: CollisionReport, what: str = "exact check", vehicle: Vehicle | None = None) -> str:
+    """One line: `what` (N poses): collision-free or how many poses hit what, inside the slot, min clearance (in
+    the small unit of :func:`units`, centimetres without `vehicle`)."""
     c = report
+    small, f = ("cm", 0.01) if vehicle is None else units(vehicle)[2:]
     return (f"{what} ({len(c.poses)} poses): "
             f"{'collision-free' if c.collision_free else f'{c.n_collisions} poses hit the {c.what}'}, "
             f"{'ends inside the slot' if c.inside else 'does NOT end inside the slot'}, "
-            f"min clearance {c.min_clearance * 100:.2f} cm")
+            f"min clearance {c.min_clearance / f:.2f} {small}")
 
 
 def solve(problem: ParkingProblem, *, check: bool = False, search: bool = True, repeat: int = 5) -> Solution:
@@ -94,30 +108,32 @@ def _count(n: int, noun: str) -> str:
 def describe(solution: Solution) -> str:
     """The text ``wmrkit park`` prints without ``--json``."""
     p, sp, v = solution.plan, solution.problem.space, solution.problem.vehicle
-    lines = [f"problem {solution.problem.name}: slot {sp.H:.4g} x {sp.J:.4g} m, car {v.length:.4g} x {v.c1:.4g} m "
+    big, m, small, cm = units(v)
+    lines = [f"problem {solution.problem.name}: slot {sp.H / m:.4g} x {sp.J / m:.4g} {big}, car {v.length / m:.4g} x "
+             f"{v.c1 / m:.4g} {big} "
              f"(length ratio {100 * length_ratio(v, sp):.1f} %)"]
     lines += [f"warning: {w}" for w in p.warnings]
     if p.feasible:
         changes = direction_changes(p.segments)
-        lines.append(f"feasible: {_count(p.maneuvers, 'manoeuvre')}, final gap to the curb {p.final_gap * 100:.1f} "
-                     f"cm, path {path_length(p.segments):.2f} m, {_count(changes, 'direction change')}, "
+        lines.append(f"feasible: {_count(p.maneuvers, 'manoeuvre')}, final gap to the curb {p.final_gap / cm:.1f} "
+                     f"{small}, path {path_length(p.segments) / m:.2f} {big}, {_count(changes, 'direction change')}, "
                      f"planned in {1e3 * solution.wall_time:.3f} ms")
         if p.used_H is not None:
-            lines.append(f"parks in the {p.used_H:.4g} m of the slot behind the front car (the planner's best part "
-                         "of a long slot; it needs no more)")
-        lines.append(f"approach point: dx1 = {p.dx1:.4g} m from the parked cars' side, pass {p.dy3:.4g} m past "
-                     "the front one")
+            lines.append(f"parks in the {p.used_H / m:.4g} {big} of the slot behind the front car (the planner's best "
+                         "part of a long slot; it needs no more)")
+        lines.append(f"approach point: dx1 = {p.dx1 / m:.4g} {big} from the parked cars' side, pass "
+                     f"{p.dy3 / m:.4g} {big} past the front one")
         for k, a in enumerate(p.arcs, 1):
-            lines.append(f"  {k:2d} {'forward ' if a.direction > 0 else 'backward'} radius {a.rho:8.3f} m  "
-                         f"xi {math.degrees(a.xi):6.2f} deg  lateral {a.X * 100:6.1f} cm  "
-                         f"gap {a.gap_after * 100:6.1f} cm")
+            lines.append(f"  {k:2d} {'forward ' if a.direction > 0 else 'backward'} radius {a.rho / m:8.3f} {big}  "
+                         f"xi {math.degrees(a.xi):6.2f} deg  lateral {a.X / cm:6.1f} {small}  "
+                         f"gap {a.gap_after / cm:6.1f} {small}")
     else:
         lines.append(f"infeasible: {p.reason}")
         if solution.shortest_H is not None:
-            lines.append(f"shortest slot that works (all else equal): H = {solution.shortest_H:.3f} m"
+            lines.append(f"shortest slot that works (all else equal): H = {solution.shortest_H / m:.3f} {big}"
                          + (" (park in that much of this slot)" if solution.shortest_H < sp.H else ""))
         else:
             lines.append("no slot length works with this width, car and approach")
     if solution.check is not None:
-        lines.append(describe_check(solution.check))
+        lines.append(describe_check(solution.check, vehicle=v))
     return "\n".join(lines)
