@@ -156,3 +156,26 @@ def test_the_exact_check_samples_a_kilometre_pass_as_densely_as_a_short_one():
     moved = np.linalg.norm(np.diff(xy, axis=0), axis=-1).max()
     assert moved <= 1e-3 * max(CAR_91.length, CAR_91.c1) * (1 + 1e-9)
     assert len(poses) > 500_000  # the 1 km pass alone, every 2 mm
+
+
+def test_the_animation_of_a_long_slot_shows_the_car_in_every_frame(tmp_path, monkeypatch):
+    """Frames were spread over the whole drive: in a 1 km slot the 1 km detection pass took 2000 of the 2030 s,
+    and 197 of 200 frames showed the car outside the frame (framed like the plot, on the manoeuvre). Each frame's
+    car body (drawn, read back from its polygon) now overlaps the frame, and the last frame is the end."""
+    from wmrkit.parking import plot
+
+    drawn = []
+
+    def fake_save(fig, update, frames, path, **_):
+        ax = fig.axes[0]
+        for k in frames:
+            body = update(k)[0].get_xy()
+            drawn.append((body[:, 0].max() >= ax.get_xlim()[0] and body[:, 0].min() <= ax.get_xlim()[1],
+                          body[:4].mean(axis=0)))  # (closed: the first corner repeated)
+
+    monkeypatch.setattr(plot, "save_gif", fake_save)
+    plan = plan_parking(CAR_91, replace(SLOT_91, H=1000.0))
+    assert plot.animate_plan(plan, tmp_path / "a.gif", max_frames=200) == len(drawn) == 200
+    assert all(seen for seen, _ in drawn)
+    end = np.array(plan.final_pose[:2])  # the body's centre at the end: P_f plus half (a1 - b1) ahead
+    np.testing.assert_allclose(drawn[-1][1], end + np.array([(CAR_91.a1 - CAR_91.b1) / 2, 0.0]), atol=1e-6)
