@@ -143,8 +143,11 @@ def test_pass_touching_the_obstacles_cannot_back_away_from_them():
     """From a pass at c1/2 (touching the parked cars), any reverse S away from them swings the front corner in."""
     v = CAR_91
     assert pass_end(v, v.c1 / 2 + 0.2, v.c1 / 2) is None
-    plan = plan_parking(v, replace(SLOT_91, H=3.0))  # example 1's pass, a shorter slot needs dx1 > dx2
+    plan = plan_thesis(v, replace(SLOT_91, H=3.0))  # example 1's pass, a shorter slot needs dx1 > dx2
     assert not plan.feasible and "Algorithm 4" in plan.reason
+    # plan_parking steers the first manoeuvre less (13 deg, not Algorithm 3's): an approach point on the pass
+    gentler = plan_parking(v, replace(SLOT_91, H=3.0))
+    assert gentler.feasible and gentler.dx1 == v.c1 / 2 and gentler.maneuvers == 21
 
 
 def test_algorithm_5_root_touches_the_curb_exactly():

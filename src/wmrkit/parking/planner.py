@@ -108,6 +108,8 @@ def plan_parking(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
     plan = None
     if space.H <= roomy:
         plan = plan_thesis(vehicle, space, phi_step=phi_step, max_maneuvers=max_maneuvers)
+        if UNREACHABLE in plan.reason:
+            plan = _gentler_first(vehicle, space, plan, phi_step, max_maneuvers)
         if plan.feasible:
             return plan
     part = best_part(vehicle, space, min(space.H, roomy), phi_step, max_maneuvers)
@@ -117,10 +119,30 @@ def plan_parking(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
     return _in_slot(part, space)
 
 
+def _gentler_first(vehicle: Vehicle, space: Space, failed: ParkingPlan, phi_step: float,
+                   max_maneuvers: int) -> ParkingPlan:
+    """`failed` (Algorithm 4 cannot reach Algorithm 3's approach point) retried with the first manoeuvre steering
+    less: the plan of the largest smaller angle whose approach point Algorithm 4 reaches (feasible, or failing for
+    another reason), else `failed`. Algorithm 3 lowers the steering while the curb sweep needs the approach point
+    beyond the pass, not while the front obstacle's corner (Algorithm 2) does: a wider slot, whose curb no longer
+    forced a gentler angle, had no plan where a narrower one had."""
+    for skip in range(1, math.ceil(vehicle.phi_max / phi_step)):
+        plan = plan_thesis(vehicle, space, phi_step=phi_step, max_maneuvers=max_maneuvers, skip_angles=skip)
+        if UNREACHABLE not in plan.reason:  # a plan, or no approach point at all from here on, or phase 3 fails
+            return plan if plan.feasible or "manoeuvre" in plan.reason else failed  # phase 3 got further
+    return failed
+
+
+#: The part of the reason that says Algorithm 4 cannot reach the approach point (:func:`_gentler_first`).
+UNREACHABLE = "cannot be reached without touching the front obstacle"
+
+
 def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
-                max_maneuvers: int = MAX_MANEUVERS) -> ParkingPlan:
+                max_maneuvers: int = MAX_MANEUVERS, skip_angles: int = 0) -> ParkingPlan:
     """The thesis's planner as printed (with its errata) on the whole slot: the first backward manoeuvre reverses
-    from the approach point to ``MS`` from the rear obstacle (Algorithm 3), whatever the slot's length."""
+    from the approach point to ``MS`` from the rear obstacle (Algorithm 3), whatever the slot's length.
+    `skip_angles` > 0 starts Algorithm 3 that many steps of `phi_step` below ``phi_max`` (not the thesis's:
+    :func:`plan_parking`'s retry)."""
     v, sp = vehicle, space
     _check_options(v, phi_step, max_maneuvers)
     tol = TOL * size(v)
@@ -137,7 +159,7 @@ def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
                     f"length a1 + b1 = {v.length:.4g} m")
     if sp.J < v.c1:
         return fail(f"the slot is narrower (J = {sp.J:.4g} m) than the car (c1 = {v.c1:.4g} m)")
-    first = approach_point(v, sp, pass_offset, phi_step)
+    first = approach_point(v, sp, pass_offset, phi_step, skip_angles)
     if first is None:
         span = first_reach(v, phi_step)
         if sp.H - sp.MS - v.b1 > span:
@@ -153,9 +175,8 @@ def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
         dx1 = min(pass_offset, dx1 + lead_overshoot(v, dx1, pass_offset))
         pre = pass_end(v, dx1, pass_offset)
     if pre is None:
-        return fail(f"from a pass at {pass_offset:.4g} m the approach point at {dx1:.4g} m cannot be reached "
-                    f"without touching the front obstacle (Algorithm 4 within {DY3_RANGE * size(v):.4g} m); pass "
-                    "farther out")
+        return fail(f"from a pass at {pass_offset:.4g} m the approach point at {dx1:.4g} m {UNREACHABLE} "
+                    f"(Algorithm 4 within {DY3_RANGE * size(v):.4g} m); pass farther out")
     dy3, rho2, xi2 = pre
 
     segments: list[Segment] = []
@@ -188,19 +209,20 @@ def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
                        y + sp.J - v.c1 / 2, tuple(warnings))
 
 
-def approach_point(vehicle: Vehicle, space: Space, pass_offset: float,
-                   phi_step: float = PHI_STEP) -> tuple[float, float, float] | None:
+def approach_point(vehicle: Vehicle, space: Space, pass_offset: float, phi_step: float = PHI_STEP,
+                   skip: int = 0) -> tuple[float, float, float] | None:
     """Algorithm 3: ``(rho, xi, dx1)`` of the first backward manoeuvre from the approach point, or None.
 
     The steering angle starts at ``phi_max`` and drops by `phi_step` (bounded: at most ``phi_max / phi_step``
     tries) while the travel ``D_y = H - MS - b1`` exceeds ``2 rho`` ((9.31)b has no solution: erratum) or the
     P1 sweep would need the approach point beyond the pass (step 7). A rear overshoot (Algorithm 1 with P3) sets
     ``rho = c1/2``. ``dx1`` is the more restrictive of the curb sweep (9.33) and Algorithm 2, at least ``c1/2``.
+    The first `skip` angles are not tried (0: the thesis).
     """
     v, sp = vehicle, space
     d_y = sp.H - sp.MS - v.b1
     tries = math.ceil(v.phi_max / phi_step)
-    for k in range(tries):
+    for k in range(skip, tries):
         phi = v.phi_max - k * phi_step
         rho = v.h1 / math.tan(phi)
         xi = xi_from_longitudinal(d_y, rho)
