@@ -104,8 +104,9 @@ def test_runs_of_mixed_noise_levels_are_not_flagged_for_their_noise(diff):
     noisy ones (1e-4) got 30-63 from the noisy runs' error in the others' fit, and these agreeing fleets were flagged,
     one naming the noisiest run as another robot's. The others' fit's error now counts as noise (the jackknife of
     their own scores): not flagged, every ratio under half MAX_RATIO. A run of a robot with a 5 % larger left radius
-    planted in each fleet at each place (24 fleets) is the only run named where one is (21; missed: three quiet
-    runs, ratios 9-19), the other runs' ratios under 3."""
+    planted in each fleet at each place (24 fleets) is the only run named where one is (21 by their ratios; missed:
+    three quiet runs, ratios 9-19, which the fleet's homogeneity names, 24 in all), the other runs' ratios under
+    3."""
     from wmrkit.batch.consistency import MAX_RATIO
 
     named = 0
@@ -116,9 +117,11 @@ def test_runs_of_mixed_noise_levels_are_not_flagged_for_their_noise(diff):
         for bad in range(6):
             res = fleet_calibrate(diff, short_runs(diff, 500 + seed, 6, None, bad=(bad,), noise=mixed_noise(seed)),
                                   PARAMS)
-            assert disagreeing(res) == ([f"r{bad}.csv"] if res.inconsistent else []), (seed, bad, res.warnings)
+            by_ratio = disagreeing(res)
+            assert by_ratio in ([], [f"r{bad}.csv"]) and res.inconsistent, (seed, bad, res.warnings)
+            assert by_ratio or any(f"(without r{bad}.csv the others agree)" in w for w in res.warnings), res.warnings
             assert max(np.delete(res.residual_ratios, bad)) < 3 < res.residual_ratios[bad]
-            named += bool(res.inconsistent)
+            named += bool(by_ratio)
     assert named >= 21
 
 

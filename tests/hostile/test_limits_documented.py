@@ -87,6 +87,8 @@ DOCUMENTED = [
     ("wmrkit.batch.consistency", "MAX_PAIR_SCORE", "over 30, `MAX_PAIR_SCORE`", 30.0),
     ("wmrkit.batch.consistency", "MIN_CLOSED_RUNS", "judged with 5 runs or more (`MIN_CLOSED_RUNS`)", 5),
     ("wmrkit.batch.consistency", "MAX_CLOSED_SCORE", "over 20 (`MAX_CLOSED_SCORE`) names it", 20.0),
+    ("wmrkit.batch.homogeneity", "MAX_HOMOGENEITY", "over 60 (`homogeneity.MAX_HOMOGENEITY`)", 60.0),
+    ("wmrkit.batch.homogeneity", "MIN_DOF", "27 degrees of freedom or more (`homogeneity.MIN_DOF`", 27),
     ("wmrkit.batch.montecarlo", "MAX_LOG_VALUES", "at most 2^23 numbers, samples x (joints + 3) "
      "(`batch.montecarlo.MAX_LOG_VALUES`)", 1 << 23),
     ("wmrkit.batch.montecarlo", "MAX_WORK", "at most 2e9 numbers integrated per worker (`MAX_WORK`", 2e9),

@@ -60,7 +60,8 @@ class FleetCalibration:
     (``None`` with fewer than 3 runs, and for closed paths); ``closed_scores``: for a fleet of closed paths, each
     run's weighted final-pose error at the other runs' fit over the others' RMS there
     (:func:`~wmrkit.batch.consistency.judge`; ``None`` for runs with references of 4 poses or more); ``inconsistent``:
-    the largest over :data:`~wmrkit.batch.consistency.MAX_RATIO` (closed paths:
+    the largest over :data:`~wmrkit.batch.consistency.MAX_RATIO`, or the runs' homogeneity over
+    :data:`~wmrkit.batch.homogeneity.MAX_HOMOGENEITY` (several runs that disagree; a warning says so; closed paths:
     :data:`~wmrkit.batch.consistency.MAX_CLOSED_SCORE`; :mod:`wmrkit.batch.consistency`; ``None`` when not judged,
     and ``not_judged`` says why: fewer than 3 runs, fewer than 5 closed paths (or references of 2-3 poses), a
     failed closed-path refit or curvature; it names the runs left out or set aside when the others are judged)."""

@@ -23,7 +23,8 @@ The denominator is at least :data:`ROUNDOFF` times the run's wheel travel: noise
 Closed paths (a final pose: no own noise to divide by) are judged by :func:`judge` against the other runs' pooled
 noise instead, with 5 runs or more, from a quadratic model of each run about the fleet fit and one refit (of every
 run in a fleet of 5); with 6 or more and no run over the threshold, pairs of runs are left out together too (two bad
-runs hide each other, :func:`_pair`).
+runs hide each other, :func:`_pair`). Runs with references of many poses are also judged as a whole
+(:mod:`wmrkit.batch.homogeneity`): several bad runs hide each other from their ratios too.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ import numpy as np
 from ..odometry.calibration import RANK_TOL, CalibrationProblem, CalibrationRun
 from ..robot import Robot
 from .engine import TaskFailure
+from .homogeneity import fleet_warning
 
 #: Largest residual ratio of a fleet whose runs agree. Simulated fleets with encoder noise (1e-5 per rad, or drawn
 #: per run among 1e-6, 1e-5 and 1e-4), 4 to 16 runs (docs/batch.md's table): largest ratio 12.1 over 260 fleets;
@@ -104,7 +106,8 @@ SLIP_NOT_JUDGED = ("the runs are not checked against each other (a slip fit's re
 class Consistency:
     """``ratios``: per run, or ``None`` (fewer than :data:`MIN_RUNS` runs, or fewer than :data:`MIN_DOF`
     residuals beyond its own parameters: closed paths); ``inconsistent``: the largest over
-    :data:`MAX_RATIO` (closed paths: a score over :data:`MAX_CLOSED_SCORE`; ``None`` when not judged);
+    :data:`MAX_RATIO` or a fleet homogeneity over :data:`~wmrkit.batch.homogeneity.MAX_HOMOGENEITY` (closed paths: a
+    score over :data:`MAX_CLOSED_SCORE`; ``None`` when not judged);
     ``messages``: the warnings that name the runs (one a kind of runs judged); ``not_judged``: why no run was
     judged (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`SHORT`, :data:`UNEQUAL`, :data:`REFIT_FAILED`,
     :data:`CURVATURE_FAILED`, :data:`UNDETERMINED`) or
@@ -329,7 +332,9 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     travels = np.array([max(travel(robot, run), 1.0) for run in runs])
     judged = run_consistency(fit.jac, fit.fun, sizes, ROUNDOFF * travels, logs)
     if judged.not_judged != CLOSED:
-        return judged
+        which = [k for k, q in enumerate(judged.ratios) if q is not None]
+        fleet = fleet_warning(problem, fit.jac, fit.fun, which, ROUNDOFF * travels, logs, bool(judged.inconsistent))
+        return judged if fleet is None else replace(judged, inconsistent=True, messages=(*judged.messages, fleet))
     g, n = len(runs), fit.x.size
     m = counts(fit.jac, fit.fun, sizes)
     kinds = [np.flatnonzero(m == c) for c in sorted(set(m.tolist()), reverse=True)]
