@@ -86,10 +86,10 @@ def robot_figure(robot: Robot, cls: Classification) -> Figure:
         legend.remove()
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
     size = robot_size(robot)
-    cl = constraint_lines(robot)
-    for lam in cl.lines():
+    geared = any(c.kind == "gear" for c in robot.couplings)  # the gears' lines too, as analyze's ICR holds them
+    for lam in constraint_lines(robot, coupled=geared).lines():
         _draw_line(ax, lam, color="#555555", linestyle="--", linewidth=0.9, zorder=3)
-    s = icr(robot)
+    s = icr(robot, geared=True)
     if s.kind == "point":
         _mark_icr(ax, np.array([*s.point, 1.0]), size)
     elif s.kind == "infinity":

@@ -22,7 +22,7 @@ from ..errors import ShapeError
 from ..kinematics.linalg import characteristic_length, matrix_rank
 from ..kinematics.models import configuration
 from ..robot import Robot
-from .lines import common_point, constraint_lines, element_rows
+from .lines import ConstraintLines, common_point, constraint_lines, element_rows
 
 
 def icr_of_twist(twist_robot: ArrayLike) -> np.ndarray:
@@ -107,16 +107,22 @@ def format_coordinate(x: float) -> str:
     return "0.000" if text == "-0.000" else text
 
 
-def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None) -> ICRSet:
+def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None,
+        geared: bool = False) -> ICRSet:
     """The admissible ICRs of `robot` at one steering configuration ``(n_steer,)`` (5.9)-(5.10), given as the
-    thesis's `beta` or the users' `heading` (default the described one)."""
+    thesis's `beta` or the users' `heading` (default the described one).
+
+    `geared`: with the robot's ``gear`` couplings held (as ``analyze``, ``fk`` and the actuation analysis hold them):
+    the ICR also lies on the line each gear adds (:func:`.lines.constraint_lines` with ``coupled``), e.g. the line
+    of ICRs two omni wheels' spins on one gear leave, or the one point a solid axle's ratio fixes."""
     beta = configuration(robot, beta, heading)
-    g = constraint_lines(robot).lines(beta)
+    cl = constraint_lines(robot, coupled=geared and any(c.kind == "gear" for c in robot.couplings))
+    g = cl.lines(beta)
     rank = _rank(robot, g)
     if rank == 0:
         return ICRSet("plane")
     if rank == 3:
-        return _nearly_consistent(robot, beta, g)
+        return _nearly_consistent(robot, beta, cl, g)
     if rank == 1:
         row = g[np.argmax(np.linalg.norm(g, axis=-1))]
         return ICRSet("line", line=tuple(float(v) for v in row))
@@ -136,10 +142,11 @@ def _rank(robot: Robot, lines: np.ndarray) -> int:
     return int(matrix_rank(lines * [1.0, 1.0, 1.0 / characteristic_length(robot)])) if len(lines) else 0
 
 
-def _nearly_consistent(robot: Robot, beta: np.ndarray, lines: np.ndarray) -> ICRSet:
+def _nearly_consistent(robot: Robot, beta: np.ndarray, cl: ConstraintLines, lines: np.ndarray) -> ICRSet:
     """"none", with the headings that make the axles meet when re-aiming the steered wheels at the nearest common
-    point moves none of them by more than :data:`ROUNDING` (e.g. Ackermann headings given to 0.001 deg)."""
-    steered = np.array([w in robot.steer_names for w in constraint_lines(robot).wheels], dtype=bool)
+    point moves none of them by more than :data:`ROUNDING` (e.g. Ackermann headings given to 0.001 deg). `lines`:
+    those of `cl` at `beta` (a gear's line moves with the steering of any of its wheels)."""
+    steered = np.array(cl.steered, dtype=bool)
     fixed = null_space(lines[~steered]) if (~steered).any() else np.eye(3)  # points on every fixed axle
     if not steered.any() or fixed.shape[1] == 0:
         return ICRSet("none")
@@ -147,7 +154,7 @@ def _nearly_consistent(robot: Robot, beta: np.ndarray, lines: np.ndarray) -> ICR
     aimed = steer_to_icr(robot, np.array([-v[1], v[0], v[2]]))  # as common_point maps a line-space vector
     miss = np.abs(np.angle(np.exp(1j * (aimed - beta))))
     worst = int(np.argmax(miss))
-    if miss[worst] > ROUNDING or _rank(robot, constraint_lines(robot).lines(aimed)) == 3:
+    if miss[worst] > ROUNDING or _rank(robot, cl.lines(aimed)) == 3:
         return ICRSet("none")
     headings = robot.heading_of_beta(aimed)
     return ICRSet("none", consistent=tuple(zip(robot.steer_names, headings.tolist(), strict=True)),

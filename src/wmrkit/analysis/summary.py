@@ -237,7 +237,7 @@ def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) 
     singular = {key: model_singular_set(robot, names, cls, resolution, coupled=key == "actuated")
                 for key, names in (("actuated", model_rates(robot, robot.actuated)), ("sensed", sensed))}
     return Analysis(
-        robot, cls, int(instantaneous_mobility(robot)), icr(robot),
+        robot, cls, int(instantaneous_mobility(robot)), icr(robot, geared=True),
         {"consistent": bool(np.all(act.consistent)), "sufficient": bool(np.all(act.sufficient)),
          "verdict": str(act.verdict)},
         {"sufficient": bool(np.all(sen.sufficient)), "verdict": str(sen.verdict)},
