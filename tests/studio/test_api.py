@@ -743,12 +743,10 @@ def _ring(moved: float) -> Robot:
 @pytest.mark.parametrize("robot", [catalog.load(n) for n in ("omni-3", "mecanum-4", "thesis-omni-castor")]
                          + [_ring(m) for m in (0.0, 0.013, 0.05, 0.11, 0.2)], ids=lambda r: r.name)
 def test_the_live_natural_length_is_the_analysis_one_to_the_last_bits(robot):
-    """The studio's faster m = 3 search (rows computed once) finds the natural length and kappa of
-    isotropy.natural_length: both evaluate kappa with the same scaling (a gap of 4e-9 failed the browser test)."""
-    from wmrkit.analysis.isotropy import default_joints, natural_length
-    from wmrkit.studio.api import live_natural_length
+    """The studio's natural length and kappa are analyze's, to the last bit: one function computes both
+    (isotropy.described_condition; a gap of 4e-9 between two searches failed the browser test)."""
+    from wmrkit.studio.api import live_summary
 
-    joints = default_joints(robot)
-    length, kappa = live_natural_length(robot, joints)
-    expected_length, expected_kappa = natural_length(robot, joints=joints)
-    assert length == pytest.approx(expected_length, rel=1e-12) and kappa == pytest.approx(expected_kappa, rel=1e-12)
+    live, full = live_summary(robot), analyze(robot, resolution=8)
+    assert live["characteristic_length"] == full.characteristic_length
+    assert live["condition_number"] == full.condition_number

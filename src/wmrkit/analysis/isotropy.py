@@ -243,6 +243,17 @@ def natural_length(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple
     return _natural_length(model, beta, robot_size(robot))
 
 
+def described_condition(robot: Robot, length: float | None = None) -> tuple[tuple[str, ...], float, float]:
+    """The condition number ``analyze`` and the studio give, at the described configuration: ``(joints, D [m],
+    kappa)``. The joints are :func:`default_joints` with each gear's joints (one mechanism), the gears held
+    (``geared``, :func:`twist_model`); D is the natural length (:func:`natural_length`) unless `length` is given."""
+    joints = twist_model(robot, default_joints(robot), geared=True).joints
+    if length is None:
+        d, kappa = natural_length(robot, joints=joints, geared=True)
+        return joints, float(d), float(kappa)
+    return joints, float(length), float(twist_condition_number(robot, joints=joints, length=length, geared=True))
+
+
 def _natural_length(model: TwistModel, beta: np.ndarray, size: float) -> tuple[float, float]:
     """:func:`natural_length` at one checked configuration ``(n_steer,)``, the element rows computed once (the
     values of :func:`_kappa`); for m = 3 the search grid of lengths is one batched SVD."""
@@ -347,10 +358,10 @@ def golden_section(f, a: float, b: float, *, tol: float = 1e-13) -> float:
 
 
 def condition_map(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple[str, ...] | None = None,
-                  length: float | None = None, heading: ArrayLike | None = None) -> np.ndarray:
+                  length: float | None = None, heading: ArrayLike | None = None, geared: bool = False) -> np.ndarray:
     """:func:`twist_condition_number` over many configurations (the same kernel): ``(..., n_steer) -> (...)``,
-    steering `beta` (thesis) or `heading` (0 = rolling forward).
+    steering `beta` (thesis) or `heading` (0 = rolling forward); `geared` as :func:`twist_model`.
 
     Closed-form eigenvalues in cache-sized chunks: 10^6 configurations in well under 2 s (benchmarks/).
     """
-    return twist_condition_number(robot, beta, joints=joints, length=length, heading=heading)
+    return twist_condition_number(robot, beta, joints=joints, length=length, heading=heading, geared=geared)

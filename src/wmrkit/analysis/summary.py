@@ -7,6 +7,7 @@ model at the natural length (§5.4) and where the actuated and sensed models are
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
 from dataclasses import dataclass
@@ -24,7 +25,7 @@ from ..wheels import heading_from_beta
 from .classification import Classification, classify, instantaneous_mobility
 from .coordinated import coordinated_singular_set
 from .icr import ICRSet, icr
-from .isotropy import default_joints, length_applies, natural_length, twist_condition_number, twist_model
+from .isotropy import described_condition, length_applies
 from .singularity import SingularSet, singular_set
 
 
@@ -222,24 +223,28 @@ def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) 
     ``--resolution``).
     """
     check_resolution(resolution)
-    cls = classify(robot)
-    joints = twist_model(robot, default_joints(robot), geared=True).joints  # a gear's joints: one mechanism
-    if length is not None:  # as analyze --length: at 1e-9 m the twist read as undetermined
-        check_length(length, WmrkitError)
-    if length is None:
-        d, kappa = natural_length(robot, joints=joints, geared=True)
-    else:
-        d, kappa = float(length), float(twist_condition_number(robot, joints=joints, length=length, geared=True))
-    act, sen = actuation_analysis(robot), sensing_analysis(robot)
+    here = described_analysis(robot, length=length)
+    cls = here.classification
     sensed = model_rates(robot, robot.sensed)  # with the rates a gear turns with them, known as fk knows them
     sensed = tuple(robot.rate_names[c] for c in gear_fill(robot.couplings, robot.rate_names,
                                                           tuple(map(robot.rate_names.index, sensed)))[0])
     singular = {key: model_singular_set(robot, names, cls, resolution, coupled=key == "actuated")
                 for key, names in (("actuated", model_rates(robot, robot.actuated)), ("sensed", sensed))}
+    return dataclasses.replace(here, singular=singular)
+
+
+def described_analysis(robot: Robot, *, length: float | None = None) -> Analysis:
+    """:func:`analyze` without the singular sets over the steering space (``singular`` empty): the studio's
+    per-edit analysis, the same numbers (type, ICR and condition number with the gears held)."""
+    cls = classify(robot)
+    if length is not None:  # as analyze --length: at 1e-9 m the twist read as undetermined
+        check_length(length, WmrkitError)
+    joints, d, kappa = described_condition(robot, length)
+    act, sen = actuation_analysis(robot), sensing_analysis(robot)
     return Analysis(
         robot, cls, int(instantaneous_mobility(robot)), icr(robot, geared=True),
         {"consistent": bool(np.all(act.consistent)), "sufficient": bool(np.all(act.sufficient)),
          "verdict": str(act.verdict)},
         {"sufficient": bool(np.all(sen.sufficient)), "verdict": str(sen.verdict)},
-        joints, float(kappa), float(d), length is None, singular, int(act.mobility),
+        joints, kappa, d, length is None, {}, int(act.mobility),
     )

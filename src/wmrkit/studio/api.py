@@ -19,24 +19,14 @@ from typing import Any
 import numpy as np
 
 from .._shapes import as_angles
-from ..analysis.classification import classify, instantaneous_mobility
-from ..analysis.icr import ICRSet, icr, icr_of_twist
-from ..analysis.isotropy import (
-    _minimise_length,
-    condition_map,
-    default_joints,
-    kappa_function,
-    length_applies,
-    natural_length,
-    twist_model,
-)
+from ..analysis.classification import classify
+from ..analysis.icr import ICRSet, icr_of_twist
+from ..analysis.isotropy import condition_map, described_condition
 from ..analysis.optimize import isotropic_configurations
 from ..analysis.singularity import SINGULAR_RTOL, robot_size, singularity_distance
-from ..analysis.summary import describe_singular, model_rates, model_singular_set, singular_dict
+from ..analysis.summary import describe_singular, described_analysis, model_rates, model_singular_set, singular_dict
 from ..description import robot_from_dict, robot_to_dict
 from ..errors import ShapeError, WmrkitError
-from ..kinematics.actuation import actuation_analysis
-from ..kinematics.sensing import sensing_analysis
 from ..kinematics.wheel_ik import wheel_commands
 from ..limits import MAX_QUERY_RATE
 from ..odometry.integrators import integrate_exact
@@ -114,11 +104,10 @@ def analyze_live(request: Any) -> dict[str, Any]:
 
 
 def live_summary(robot: Robot) -> dict[str, Any]:
-    """The live analysis of :func:`analyze_live` as a mapping (JSON-ready; headings in radians)."""
-    cls = classify(robot)
-    joints = default_joints(robot)
-    length, kappa = live_natural_length(robot, joints)
-    act, sen = actuation_analysis(robot), sensing_analysis(robot)
+    """The live analysis of :func:`analyze_live` as a mapping (JSON-ready; headings in radians): the numbers of
+    :func:`~wmrkit.analysis.summary.described_analysis`, which ``analyze`` gives (the gears held)."""
+    a = described_analysis(robot)
+    cls, full = a.classification, a.to_dict()
     here = {}
     for key, names in (("actuated", robot.actuated), ("sensed", robot.sensed)):
         assigned = model_rates(robot, names)
@@ -126,33 +115,20 @@ def live_summary(robot: Robot) -> dict[str, Any]:
         # singular: the line test's own threshold (is_singular), sigma_min <= SINGULAR_RTOL sigma_max
         here[key] = {"assigned": list(assigned), "distance": dist, "singular": dist <= SINGULAR_RTOL,
                      "near": dist < NEAR_SINGULAR}
-    return {
-        "mobility": cls.mobility, "steerability": cls.steerability, "type": cls.type, "type_name": cls.name,
-        "degenerate": cls.degenerate, "reasons": list(cls.reasons), "coordinated_steering": cls.coordinated,
-        "instantaneous_mobility": int(instantaneous_mobility(robot)),
+    same = ("mobility", "coupled_mobility", "steerability", "commanded_steerability", "type", "type_name",
+            "degenerate", "reasons", "coordinated_steering", "instantaneous_mobility", "condition_joints",
+            "natural_length")
+    return {key: full[key] for key in same} | {
         "special_configurations": [{"heading": _headings(robot, s.beta), "mobility": s.mobility,
                                     "description": s.description} for s in cls.special],
-        "icr": icr_dict(icr(robot)),
-        "actuation": {"consistent": bool(np.all(act.consistent)), "sufficient": bool(np.all(act.sufficient)),
-                      "verdict": str(act.verdict), "joints": list(robot.actuated)},
-        "sensing": {"sufficient": bool(np.all(sen.sufficient)), "verdict": str(sen.verdict),
-                    "joints": list(robot.sensed)},
-        "condition_number": _finite(kappa),
-        "characteristic_length": _finite(length) if length_applies(cls.mobility, kappa) else None,
-        "condition_joints": list(joints), "natural_length": True,
+        "icr": icr_dict(a.icr),
+        "actuation": full["actuation"] | {"joints": list(robot.actuated)},
+        "sensing": full["sensing"] | {"joints": list(robot.sensed)},
+        "condition_number": _finite(full["condition_number"]),  # inf (undetermined twist): null, as JSON has no inf
+        "characteristic_length": _finite(full["characteristic_length"]),
         "steering": dict(zip(robot.steer_names, robot.heading.tolist(), strict=True)),
         "singular_here": here,
     }
-
-
-def live_natural_length(robot: Robot, joints: tuple[str, ...]) -> tuple[float, float]:
-    """:func:`~wmrkit.analysis.isotropy.natural_length` at the described configuration, the m = 3 search with
-    the element rows computed once (:func:`~wmrkit.analysis.isotropy.kappa_function`): same result, ~3x faster."""
-    model = twist_model(robot, joints)
-    if model.mobility != 3:
-        return natural_length(robot, joints=joints)
-    kappa = kappa_function(model, robot.beta[None])
-    return _minimise_length(lambda d: float(kappa(d)[0]), robot)
 
 
 def icr_dict(s: ICRSet) -> dict[str, Any]:
@@ -218,9 +194,8 @@ def kappa_map(request: Any) -> dict[str, Any]:
     headings = np.broadcast_to(robot.heading, (*grids[0].shape, len(steer))).copy()
     for name, g in zip(names, grids, strict=True):
         headings[..., steer.index(name)] = g
-    joints = default_joints(robot)
-    length = live_natural_length(robot, joints)[0]
-    kappa = condition_map(robot, robot.beta_of_heading(headings), joints=joints, length=length)
+    joints, length = described_condition(robot)[:2]  # analyze's joints and natural length, the gears held
+    kappa = condition_map(robot, robot.beta_of_heading(headings), joints=joints, length=length, geared=True)
     finite = np.where(np.isfinite(kappa), kappa, np.nan)
     best = int(np.nanargmin(finite)) if np.isfinite(finite).any() else None
     return {"wheels": names, "axis": axis.tolist(), "length": length,
@@ -307,7 +282,9 @@ def _headings(robot: Robot, beta: Any) -> list[float]:
     return [float(v) for v in robot.heading_of_beta(np.asarray(beta, dtype=float))]
 
 
-def _finite(x: float) -> float | None:
+def _finite(x: float | None) -> float | None:
+    if x is None:
+        return None
     x = float(x)
     return x if math.isfinite(x) else None
 
