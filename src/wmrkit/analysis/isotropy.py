@@ -43,18 +43,22 @@ LENGTH_RANGE = (1e-3, 1e3)
 
 
 def condition_number(h: ArrayLike) -> np.ndarray:
-    """``kappa = sigma_max / sigma_min`` of eq. (5.28); ``inf`` where H is singular. ``(..., f, f') -> (...)``,
-    finite entries, ``f, f' >= 1``. H maps the `f'` inputs (twist coordinates) to the `f` outputs (joint rates):
-    with fewer outputs than inputs some inputs give no output (``inf``)."""
+    """``kappa = sigma_max / sigma_min`` of eq. (5.28); ``inf`` where H is singular (``sigma_min <= 1e-13
+    sigma_max``). ``(..., f, f') -> (...)``, finite entries, ``f, f' >= 1``. H maps the `f'` inputs (twist
+    coordinates) to the `f` outputs (joint rates): with fewer outputs than inputs some inputs give no output
+    (``inf``). Each matrix is divided by its largest entry first (kappa does not change): its SVD can neither
+    overflow (entries of 1.7e308 gave kappa inf for 1) nor lose sigma_min to underflow."""
     h = np.asarray(h, dtype=float)
     if h.ndim < 2 or 0 in h.shape[-2:] or not np.all(np.isfinite(h)):
         raise ShapeError(f"condition_number: expected matrices (..., f, f') with f, f' >= 1 and finite entries, got "
                          f"shape {h.shape}" + ("" if np.all(np.isfinite(h)) else " with entries that are not finite"))
     if h.shape[-2] < h.shape[-1]:  # f joints cannot tell f' > f motions apart (the SVD would give f values)
         return np.full(h.shape[:-2], np.inf)
-    s = np.linalg.svd(h, compute_uv=False)
-    with np.errstate(divide="ignore"):
-        return np.where(s[..., -1] > 1e-13 * s[..., 0], s[..., 0] / np.where(s[..., -1] > 0, s[..., -1], 1.0), np.inf)
+    top = np.abs(h).max(axis=(-2, -1), keepdims=True)
+    s = np.linalg.svd(h / np.where(top > 0, top, 1.0), compute_uv=False)
+    # the ratio only where it is kappa: elsewhere s_max / s_min overflowed (s_min 1e-310) before np.where chose inf
+    regular = s[..., -1] > 1e-13 * s[..., 0]
+    return np.divide(s[..., 0], s[..., -1], out=np.full(s.shape[:-1], np.inf), where=regular)
 
 
 def isotropy_matrix(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...], selected: tuple[str, ...],
