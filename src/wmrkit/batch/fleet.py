@@ -32,7 +32,7 @@ from .engine import BatchError, Engine, TaskFailure, engine
 from .parquet import RowSink, check_table, parts_dir, read_rows
 
 if TYPE_CHECKING:
-    from ..odometry.diagnostics import Diagnosis
+    from ..odometry.diagnostics import Diagnosis, ImuCheck
     from ..odometry.model import OdometryModel
     from ..odometry.pipeline import OdometrySummary
 
@@ -44,12 +44,14 @@ SUMMARY_SCHEMA = (
     ("closure_error", "float64 m"), ("closure_heading", "float64 rad"), ("max_slip", "float64 m"),
     ("rms_slip", "float64 m"), ("max_dt", "float64 s"), ("warnings", "string"), ("consistent", "bool"),
     ("error", "string"), ("trajectory", "string"), ("wall_time", "float64 s"), ("settings", "string"),
+    ("imu", "string"),
 )
 #: Columns a table must have to be a batch-odometry table at all (an older one lacks some others: it is redone).
 KEY_COLUMNS = ("log", "robot", "method", "error", "trajectory")
 #: Version of what a row holds, in its settings digest: a row of an older version is redone (2: odometry's
-#: diagnostic lines in ``warnings``; 3: ``consistent``, which part files of a version-2 run lack).
-ROW_VERSION = 3
+#: diagnostic lines in ``warnings``; 3: ``consistent``, which part files of a version-2 run lack; 4: a bag's IMU
+#: check in ``warnings`` and ``consistent``, its topic in ``imu``).
+ROW_VERSION = 4
 #: Suffixes of single-file logs found in a folder (CSV joint logs, ROS 2 bag files).
 LOG_SUFFIXES = (".csv", ".db3", ".mcap")
 
@@ -67,6 +69,7 @@ class LogJob:
     options: Mapping[str, Any] = field(default_factory=dict)  # more keyword arguments of odometry_file
     model: Any = None  # the odometry model, built once per batch (else per log, from options' sensed/weights)
     header: Mapping[str, Any] | None = None  # without options["fmt"]: a CSV log's format from its header and these
+    imu: str | None = None  # a bag's Imu topic checking its heading (else the bag's only one)
 
 
 @dataclass(frozen=True)
@@ -145,24 +148,50 @@ def process_log(job: LogJob) -> dict[str, Any]:
             model = job.model or odometry_model(job.robot, options.get("sensed"), weights=options.get("weights"))
             if job.header is not None and not is_bag(job.path):  # each log says its units (odometry's rule)
                 options["fmt"] = header_format(job.path, job.robot.name, model.joints, **job.header)
-            s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=model, **options)
+            check, unread = _imu_check(job, model)  # made here, in the worker: only the row goes back
+            s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=model,
+                              sinks=[check] if check else (), check=check.judge if check else None, **options)
             diagnosis = _diagnose(job, s, model, options)
         except Exception as err:
             row.update(error=_message(err), trajectory=None, wall_time=time.perf_counter() - t0)
             return row
     x, y, theta = s.final_pose
     notes = [" ".join(str(w.message).split()) for w in caught] + list(diagnosis.warnings)
+    imu = check.topic if check and check.checked else None
+    if line := check.line if check else unread:  # after diagnose's lines, as wmrkit odometry says them
+        notes.append(line)
     if job.slip_warning is not None and s.max_slip > job.slip_warning:
         notes.append(f"slip indicator up to {s.max_slip:.3g} m per interval (threshold {job.slip_warning:g} m)")
     if s.samples < 2:
         notes.append("a single sample: no motion")
     row.update(samples=s.samples, start_time=s.start_time, duration=s.end_time - s.start_time, x=x, y=y, theta=theta,
                path_length=s.path_length, rotation=s.rotation, max_slip=s.max_slip, rms_slip=s.rms_slip,
-               max_dt=s.max_dt, warnings="; ".join(notes) or None, consistent=diagnosis.consistent,
-               wall_time=time.perf_counter() - t0)
+               max_dt=s.max_dt, warnings="; ".join(notes) or None, imu=imu,
+               consistent=diagnosis.consistent and not (imu and check.line), wall_time=time.perf_counter() - t0)
     if job.closed:  # the run ends where it started (the start pose is the origin)
         row.update(closure_error=math.hypot(x, y), closure_heading=float(np.angle(np.exp(1j * theta))))
     return row
+
+
+def _imu_check(job: LogJob, model: OdometryModel) -> tuple[ImuCheck | None, str | None]:
+    """``wmrkit odometry``'s IMU check of a bag's run (:func:`~wmrkit.odometry.diagnostics.imu_check`): on the
+    batch's `job.imu` topic, else the bag's only ``Imu`` topic, judging the run of `model` (named as that command
+    names it: "weighted no-slip (--weight)" when its rows are weighted); ``(None, None)`` for a CSV log or a bag
+    without one. An IMU that cannot be found or read is ``(None, the line saying the log is not checked against
+    it)``, never the log's error (a bag that cannot be read at all fails in the run, with its own message)."""
+    from ..odometry.bags import imu_topic
+    from ..odometry.diagnostics import imu_check
+    from ..odometry.files import is_bag
+    from ..odometry.logs import LogError
+
+    if not is_bag(job.path):
+        return None, None
+    try:
+        topic, _note = imu_topic(job.path, job.imu)
+    except LogError as err:
+        return None, f"{err} (the odometry is not checked against it)"
+    what = "weighted no-slip (--weight)" if np.any(np.asarray(model.row_weights) != 1.0) else "no-slip"
+    return imu_check(job.path, topic, what, named=False) if topic else (None, None)
 
 
 def _diagnose(job: LogJob, s: OdometrySummary, model: OdometryModel, options: Mapping[str, Any]) -> Diagnosis:
@@ -181,7 +210,8 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
                    closed: bool = False, resume: bool = True, progress: bool = False, slip_warning: float | None = None,
                    fmt: LogFormat | None = None, header: Mapping[str, Any] | None = None,
                    topic: str = "/joint_states", joint_names: Mapping[str, str] | None = None,
-                   sensed: Sequence[str] | None = None, weights: Mapping[str, float] | None = None) -> FleetResult:
+                   sensed: Sequence[str] | None = None, weights: Mapping[str, float] | None = None,
+                   imu: str | None = None) -> FleetResult:
     """Odometry of every log in `logs` (files, globs, folders; :func:`expand_logs`) on `runner` (default: a
     serial engine); the table is written to `out` (Parquet) and each trajectory to `trajectories`/``NAME.EXT`` (the
     folder made when missing).
@@ -193,7 +223,10 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     With `resume`, rows of `out` (and of its part files) without error are kept and their logs skipped.
     Each row's ``warnings`` are ``wmrkit odometry``'s lines for its log (:mod:`wmrkit.odometry.diagnostics`), and
     with `slip_warning` [m] a note where the slip indicator exceeds it; its ``consistent`` is that command's verdict.
+    A bag's IMU checks its heading as there: the `imu` topic, else the bag's only ``Imu`` topic; its ``imu`` column
+    says the topic checked (an IMU that cannot be read is a warning line, not the log's error).
     """
+    from ..odometry.files import is_bag
     from ..odometry.integrators import check_method
     from ..odometry.model import odometry_model
 
@@ -211,6 +244,8 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     paths = expand_logs(logs)
     if not paths:
         raise BatchError("batch odometry: no logs given")
+    if imu is not None and not any(is_bag(p) for p in paths):  # it would be ignored
+        raise BatchError(f"--imu {imu} applies to ROS 2 bags; none of the {len(paths)} logs is one")
     if out is not None and not Path(out).absolute().parent.is_dir():
         raise BatchError(f"--out {os.fspath(out)}: the folder {Path(out).absolute().parent} does not exist")
     if out is not None and Path(out).is_dir():  # else refused only when the table is written, after the work
@@ -227,12 +262,12 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     if trajectory_format not in ("csv", "tum"):
         raise BatchError(f"trajectory format must be csv or tum, got '{trajectory_format}'")
     targets = _trajectory_names(paths, trajectories, trajectory_format)
-    batch = _fingerprint(robot, method, closed, slip_warning, options, header, sensed, weights, ROW_VERSION)
+    batch = _fingerprint(robot, method, closed, slip_warning, options, header, sensed, weights, imu, ROW_VERSION)
     settings = {p: _fingerprint(batch, _stat(p)) for p in paths}
     # an existing --out must be a table of this command (it is replaced at the end), even without resuming
     current = check_table(out, SUMMARY_SCHEMA, KEY_COLUMNS) if out is not None and Path(out).is_file() else True
     done = _done(out, robot, method, targets, settings) if resume and out is not None and current else {}
-    jobs = [LogJob(p, robot, method, targets[p], closed, slip_warning, options, model, header)
+    jobs = [LogJob(p, robot, method, targets[p], closed, slip_warning, options, model, header, imu)
             for p in paths if p not in done]
     sink = RowSink(out, SUMMARY_SCHEMA)
     rows: dict[str, Mapping[str, Any]] = dict(done)

@@ -50,6 +50,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--trajectory-format", choices=("tum", "csv"), help="trajectory files (default tum)")
     p.add_argument("--closed", action="store_true", help="every run ends at its start: report the closure error")
     p.add_argument("--no-resume", action="store_true", help="redo every log even if --out has it")
+    p.add_argument("--imu", metavar="TOPIC", help="sensor_msgs/Imu topic of the bags whose yaw checks the odometry's "
+                   "heading (default: each bag's only Imu topic, if it has one)")
     _log_options(p)
     _engine_options(p)
     p.set_defaults(run=run_odometry)
@@ -169,7 +171,7 @@ def run_odometry(args: argparse.Namespace) -> int:
         result = batch_odometry(robot, args.logs, runner=runner, method=args.method, out=args.out,
                                 trajectories=args.trajectories, trajectory_format=args.trajectory_format or "tum",
                                 closed=args.closed, resume=not args.no_resume, progress=_progress(args),
-                                **_options(args))
+                                imu=args.imu, **_options(args))
     for r in result.rows:  # they were only in the table's 'warnings' column (or nowhere, without --out)
         if r["warnings"] and not r["error"]:
             warn(f"{r['log']}: {r['warnings']}")

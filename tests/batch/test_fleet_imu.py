@@ -1,0 +1,194 @@
+"""``wmrkit batch odometry`` checks each bag against its IMU as ``wmrkit odometry ROBOT BAG`` does: the same warning
+line (the oracle: that command run per bag with ``--json``), ``consistent`` false when it fires, the summary's
+inconsistent count; an IMU that cannot be read is a "not checked" line, never the log's error. The check runs in the
+Dask workers of a real ``LocalCluster`` (two processes, one thread each); the bags are written here: JointState of a
+run and an Imu whose orientation is the run's true heading, a few hundred messages each."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.cli.main import main
+from wmrkit.description import load_robot_file
+from wmrkit.odometry import simulate
+from wmrkit.odometry.synthetic import TwistProfile
+
+distributed = pytest.importorskip("distributed")
+pytest.importorskip("pyarrow")
+pytest.importorskip("rosbags")
+
+#: A skid steer described as a differential drive (its front wheels): two spins, nothing redundant, so only the IMU
+#: sees its wheels slip sideways in a turn.
+SKID_AS_DIFF = """name: skid-as-diff
+wheels:
+  - {name: left, type: fixed, position: [0, 0.25], heading: 0, r: 0.1, actuated: [spin], sensed: [spin]}
+  - {name: right, type: fixed, position: [0, -0.25], heading: 0, r: 0.1, actuated: [spin], sensed: [spin]}
+"""
+JOINTS = ("left.spin", "right.spin")
+T0 = 1000.0  # the bags' clock at the runs' start [s]
+TURNS = re.compile(r"over the run the no-slip odometry turned (\S+) rad and the IMU (\S+) rad")
+
+
+def _bag(path: Path, time, positions, imus: dict) -> Path:
+    """A bag of JointState (`positions` of :data:`JOINTS` at `time` [s]) and Imu topics (`imus`: topic -> (time,
+    yaw), the yaw as the orientation's quaternion about z)."""
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    T = ts.types
+
+    def header(t):
+        sec = math.floor(t)
+        return T["std_msgs/msg/Header"](stamp=T["builtin_interfaces/msg/Time"](
+            sec=sec, nanosec=round((t - sec) * 1e9) % 10**9), frame_id="")
+
+    with Writer(path, version=8) as w:
+        conn, empty = w.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=ts), np.zeros(0)
+        for t, row in zip(T0 + time, positions, strict=True):
+            msg = T["sensor_msgs/msg/JointState"](header=header(t), name=list(JOINTS), position=row.astype(float),
+                                                  velocity=empty, effort=empty)
+            w.write(conn, round(t * 1e9), ts.serialize_cdr(msg, "sensor_msgs/msg/JointState"))
+        for topic, (times, yaw) in imus.items():
+            conn = w.add_connection(topic, "sensor_msgs/msg/Imu", typestore=ts)
+            vec, cov = T["geometry_msgs/msg/Vector3"], np.zeros(9)
+            for t, a in zip(T0 + times, yaw, strict=True):
+                msg = T["sensor_msgs/msg/Imu"](
+                    header=header(t), orientation=T["geometry_msgs/msg/Quaternion"](0.0, 0.0, math.sin(a / 2),
+                                                                                     math.cos(a / 2)),
+                    orientation_covariance=cov, angular_velocity=vec(x=0.0, y=0.0, z=0.0),
+                    angular_velocity_covariance=cov, linear_acceleration=vec(x=0.0, y=0.0, z=9.81),
+                    linear_acceleration_covariance=cov)
+                w.write(conn, round(t * 1e9), ts.serialize_cdr(msg, "sensor_msgs/msg/Imu"))
+    return path
+
+
+def _imu(time, heading):
+    """``(time, yaw)`` of an IMU reading `heading` 7 ms after the joint states, at their rate."""
+    t = time[1:] + 0.007
+    return t, np.interp(t, time, heading)
+
+
+@pytest.fixture(scope="module")
+def fleet(tmp_path_factory):
+    """The robot file and three bags: the skid steer turning on the spot (its wheels turn 5 rad, the IMU 1.25 rad:
+    the quasi-static slip model), a differential drive rolling through turns (its IMU agreeing), and that run with
+    its IMU's 10th orientation NaN (unreadable). The slipping bag's (wheels' turn, true turn) come with it."""
+    from wmrkit.slip.skid import segment_run
+
+    d = tmp_path_factory.mktemp("imu-fleet")
+    robot = d / "skid.yaml"
+    robot.write_text(SKID_AS_DIFF)
+    log, truth = segment_run(catalog.load("skid-steer-4"), ((2.0, 1.0, 0.0), (4.0, 0.0, 1.25), (2.0, 1.0, 0.0)), 50.0,
+                             source="quasi-static")
+    k = [log.joints.index("front_left.spin"), log.joints.index("front_right.spin")]
+    slips = _bag(d / "slips", log.time, log.positions[:, k], {"/imu": _imu(log.time, truth[:, 2])})
+    turned = log.positions[-1, k] - log.positions[0, k]
+    turns = (0.1 * (turned[1] - turned[0]) / 0.5, truth[-1, 2] - truth[0, 2])  # r (right - left) / track; the truth
+    profile = TwistProfile.from_segments([(4.0, 0.3, 0.0, 0.0), (4.0, 0.3, 0.0, 0.4), (4.0, 0.3, 0.0, -0.3),
+                                          (4.0, 0.3, 0.0, 0.0)])
+    run = simulate(load_robot_file(robot), profile, 25.0)
+    clean = _bag(d / "clean", run.log.time, run.log.positions, {"/imu": _imu(run.log.time, run.truth[:, 2])})
+    t, yaw = _imu(run.log.time, run.truth[:, 2])
+    yaw[10] = np.nan
+    unread = _bag(d / "unread", run.log.time, run.log.positions, {"/imu": (t, yaw)})
+    return robot, [slips, clean, unread], turns
+
+
+@pytest.fixture(scope="module")
+def scheduler():
+    """The address of a two-worker LocalCluster (the workers read this clone's wmrkit: PYTHONPATH)."""
+    path = os.pathsep.join(p for p in (str(Path(__file__).parent), os.environ.get("PYTHONPATH", "")) if p)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  silence_logs=50, env={"PYTHONPATH": path}) as c:
+        yield c.scheduler_address
+
+
+def _single(capsys, robot, bag, *extra) -> dict:
+    """``wmrkit odometry ROBOT BAG --json``'s answer."""
+    code = main(["odometry", str(robot), str(bag), "--json", *extra])
+    out = capsys.readouterr()
+    assert code == 0, out
+    return json.loads(out.out)
+
+
+def test_each_bag_is_checked_against_its_imu_on_the_cluster(capsys, tmp_path, fleet, scheduler):
+    """The slipping bag's row has the IMU line of ``wmrkit odometry --json`` for it, its turns the closed forms (the
+    wheels' r (right - left) / track, the slip model's true turn), ``consistent`` false, counted and named by the
+    summary; the clean bag has no line; the unreadable IMU's bag has the single command's "not checked" line and
+    stays consistent. Before, every row was consistent without a warning: the batch read no IMU."""
+    robot, bags, (wheels, true) = fleet
+    single = {str(b): _single(capsys, robot, b) for b in bags}
+    slips, clean, unread = map(str, bags)
+    (line,) = single[slips]["warnings"]
+    assert line.startswith("the no-slip odometry's heading contradicts the IMU on /imu: ")
+    m = TURNS.search(line)
+    assert float(m[1]) == pytest.approx(wheels, rel=1e-3) and float(m[2]) == pytest.approx(true, rel=1e-3)
+    assert wheels == pytest.approx(5.0, rel=2e-2) and true == pytest.approx(1.25, rel=2e-2)
+    assert single[clean]["warnings"] == [] and single[clean]["consistent"]
+    (not_checked,) = single[unread]["warnings"]
+    assert not_checked.endswith("(the odometry is not checked against it)") and "message 10" in not_checked
+    out = tmp_path / "fleet.parquet"
+    command = ["batch", "odometry", str(robot), *map(str, bags), "--scheduler", scheduler, "--out", str(out)]
+    assert main([*command, "--json"]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    rows = {r["log"]: r for r in answer["rows"]}
+    for bag, s in single.items():
+        assert rows[bag]["warnings"] == ("; ".join(s["warnings"]) or None), bag
+        assert (rows[bag]["consistent"], rows[bag]["imu"], rows[bag]["error"]) == (s["consistent"], s["imu"], None)
+    assert (rows[slips]["imu"], rows[clean]["imu"], rows[unread]["imu"]) == ("/imu", "/imu", None)
+    assert answer["inconsistent"] == 1 and answer["inconsistent_logs"] == [slips] and answer["failed"] == 0
+    assert answer["warnings"] == [f"{b}: {'; '.join(s['warnings'])}" for b, s in single.items() if s["warnings"]]
+    import pyarrow.parquet as pq
+
+    table = {r["log"]: r for r in pq.read_table(out).to_pylist()}
+    assert {b: (r["consistent"], r["imu"]) for b, r in table.items()} == {
+        b: (s["consistent"], s["imu"]) for b, s in single.items()}
+    assert main([*command, "--quiet"]) == 0  # the rerun resumes every row, the check's verdict kept
+    out_lines = capsys.readouterr().out.splitlines()
+    assert out_lines[0] == f"3 logs: 3 done (3 from an earlier run), 0 failed, 1 inconsistent ({slips}); table {out}"
+
+
+def test_a_named_imu_is_the_one_checked(capsys, tmp_path, fleet):
+    """A bag with two Imu topics, /imu/true (the robot's turn) and /imu/wheels (the wheels' no-slip heading): no
+    topic is checked by default (imu null, as the single command's "imu"); ``--imu /imu/true`` flags it with the
+    single command's line and ``--imu /imu/wheels`` does not; ``--imu /none`` is a "not checked" line, the log done."""
+    from wmrkit.slip.skid import segment_run
+
+    robot = fleet[0]
+    log, truth = segment_run(catalog.load("skid-steer-4"), ((2.0, 1.0, 0.0), (4.0, 0.0, 1.25), (2.0, 1.0, 0.0)), 50.0,
+                             source="quasi-static")
+    k = [log.joints.index("front_left.spin"), log.joints.index("front_right.spin")]
+    positions = log.positions[:, k]
+    wheels = 0.1 * (positions[:, 1] - positions[:, 0]) / 0.5  # the differential drive's no-slip heading
+    bag = _bag(tmp_path / "two", log.time, positions, {"/imu/true": _imu(log.time, truth[:, 2]),
+                                                       "/imu/wheels": _imu(log.time, wheels - wheels[0])})
+    for extra, flagged in (((), False), (("--imu", "/imu/true"), True), (("--imu", "/imu/wheels"), False)):
+        s = _single(capsys, robot, bag, *extra)
+        assert main(["batch", "odometry", str(robot), str(bag), "--workers", "0", "--json", *extra]) == 0
+        (row,) = json.loads(capsys.readouterr().out)["rows"]
+        assert (row["warnings"], row["consistent"], row["imu"]) == ("; ".join(s["warnings"]) or None, s["consistent"],
+                                                                   s["imu"]), extra
+        assert row["consistent"] is not flagged and (row["imu"] is None) is not extra
+    assert main(["batch", "odometry", str(robot), str(bag), "--workers", "0", "--json", "--imu", "/none"]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    (row,) = answer["rows"]
+    assert row["warnings"] == (f"{bag}: --imu topic '/none' is not in the bag (sensor_msgs/msg/Imu topics: /imu/true, "
+                               "/imu/wheels) (the odometry is not checked against it)")
+    assert row["consistent"] and row["imu"] is None and answer["failed"] == 0
+
+
+def test_imu_without_a_bag_is_refused(capsys, tmp_path):
+    """``--imu`` on a batch of CSV logs only would be ignored: one error line, exit 2."""
+    log = tmp_path / "a.csv"
+    log.write_text("time,left.spin,right.spin\n0,0,0\n1,1,1\n")
+    assert main(["batch", "odometry", "diff-drive", str(log), "--workers", "0", "--imu", "/imu", "--json"]) == 2
+    assert json.loads(capsys.readouterr().err)["error"] == "--imu /imu applies to ROS 2 bags; none of the 1 logs is one"
