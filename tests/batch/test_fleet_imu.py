@@ -159,7 +159,7 @@ def test_each_bag_is_checked_against_its_imu_on_the_cluster(capsys, tmp_path, fl
 
 def test_a_named_imu_is_the_one_checked(capsys, tmp_path, fleet):
     """A bag with two Imu topics, /imu/true (the robot's turn) and /imu/wheels (the wheels' no-slip heading): no
-    topic is checked by default (imu null, as the single command's "imu"); ``--imu /imu/true`` flags it with the
+    topic is checked by default (imu null and a warning, as the single command's); ``--imu /imu/true`` flags it with the
     single command's line and ``--imu /imu/wheels`` does not; ``--imu /none`` is a "not checked" line, the log done."""
     from wmrkit.slip.skid import segment_run
 
@@ -178,6 +178,7 @@ def test_a_named_imu_is_the_one_checked(capsys, tmp_path, fleet):
         assert (row["warnings"], row["consistent"], row["imu"]) == ("; ".join(s["warnings"]) or None, s["consistent"],
                                                                    s["imu"]), extra
         assert row["consistent"] is not flagged and (row["imu"] is None) is not extra
+        assert ("choose one with --imu TOPIC" in (row["warnings"] or "")) == (not extra)  # said, not silently skipped
     assert main(["batch", "odometry", str(robot), str(bag), "--workers", "0", "--json", "--imu", "/none"]) == 0
     answer = json.loads(capsys.readouterr().out)
     (row,) = answer["rows"]

@@ -178,15 +178,17 @@ def short_run(tmp_path_factory):
 
 
 def test_imu_topics_choice_and_refusals(capsys, tmp_path, short_run):
-    """Two Imu topics: none is checked (a note says so); --imu chooses one; --imu naming no Imu topic, or on a CSV
-    log, is one error line (exit 2)."""
+    """Two Imu topics: none is checked (a warning says so: it was a note, not in the JSON's warnings); --imu chooses
+    one; --imu naming no Imu topic, or on a CSV log, is one error line (exit 2)."""
     run = short_run
     imu = _imu(run.log.time, run.truth[:, 2], "orientation")
     bag = tmp_path / "two"
     _write(bag, run.log.time, run.log.joints, run.log.positions, {"/imu/a": imu, "/imu/b": imu})
     code, answer, err = _run(capsys, "diff-drive", bag)
     assert code == 0 and answer["imu"] is None
-    assert "the bag has 2 sensor_msgs/msg/Imu topics (/imu/a, /imu/b); choose one with --imu TOPIC" in err
+    line = ("heading not checked against an IMU: the bag has 2 sensor_msgs/msg/Imu topics (/imu/a, /imu/b); choose "
+            "one with --imu TOPIC")
+    assert answer["warnings"] == [line] and f"wmrkit: warning: {line}" in err
     code, answer, err = _run(capsys, "diff-drive", bag, "--imu", "/imu/b")
     assert code == 0 and answer["imu"] == "/imu/b" and answer["warnings"] == [] and "note" not in err
     for topic, what in (("/imu/c", "is not in the bag"),

@@ -177,8 +177,9 @@ def _imu_check(job: LogJob, model: OdometryModel) -> tuple[ImuCheck | None, str 
     """``wmrkit odometry``'s IMU check of a bag's run (:func:`~wmrkit.odometry.diagnostics.imu_check`): on the
     batch's `job.imu` topic, else the bag's only ``Imu`` topic, judging the run of `model` (named as that command
     names it: "weighted no-slip (--weight)" when its rows are weighted); ``(None, None)`` for a CSV log or a bag
-    without one. An IMU that cannot be found or read is ``(None, the line saying the log is not checked against
-    it)``, never the log's error (a bag that cannot be read at all fails in the run, with its own message)."""
+    without one, ``(None, the line saying none is checked)`` for a bag with several and no `job.imu`. An IMU that
+    cannot be found or read is ``(None, the line saying the log is not checked against it)``, never the log's
+    error (a bag that cannot be read at all fails in the run, with its own message)."""
     from ..odometry.bags import imu_topic
     from ..odometry.diagnostics import imu_check
     from ..odometry.files import is_bag
@@ -187,9 +188,11 @@ def _imu_check(job: LogJob, model: OdometryModel) -> tuple[ImuCheck | None, str 
     if not is_bag(job.path):
         return None, None
     try:
-        topic, _note = imu_topic(job.path, job.imu)
+        topic, note = imu_topic(job.path, job.imu)
     except LogError as err:
         return None, f"{err} (the odometry is not checked against it)"
+    if topic is None:  # several Imu topics (a warning, as wmrkit odometry's), or none (nothing to say)
+        return None, note
     what = "weighted no-slip (--weight)" if np.any(np.asarray(model.row_weights) != 1.0) else "no-slip"
     return imu_check(job.path, topic, what, named=False) if topic else (None, None)
 

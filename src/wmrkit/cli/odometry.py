@@ -130,7 +130,9 @@ def run(args: argparse.Namespace) -> int:
         raise WmrkitError(f"{option} applies to ROS 2 bags; LOG {args.log} is read as a CSV log (it would be ignored; "
                           "a CSV's columns are renamed by --column)")
     imu, note = imu_topic(args.log, args.imu) if is_bag(args.log) and os.path.exists(args.log) else (None, None)
-    if note:
+    if note and imu is None:  # several Imu topics: the heading is not checked, a warning (batch odometry's too)
+        warn(note)
+    elif note:
         print(f"wmrkit: note: {note}", file=sys.stderr)
     if args.max_gap is not None and not args.max_gap > 0:
         raise WmrkitError(f"--max-gap must be > 0 s, got {args.max_gap:g}")
