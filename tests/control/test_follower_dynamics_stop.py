@@ -42,8 +42,8 @@ def _check_same_as_trimmed(calls: list, run) -> None:
         if isinstance(value, np.ndarray):
             assert value.dtype == stopped[key].dtype and np.array_equal(value, stopped[key]), key
     assert len(stopped["t"]) < len(whole["t"])  # fewer periods simulated than the whole bound
-    assert until(float(stopped["t"][-1]), stopped["pose"][-1])
-    assert not any(until(float(t), p) for t, p in zip(stopped["t"][:-1], stopped["pose"][:-1], strict=True))
+    hits = [until(float(t), p) for t, p in zip(stopped["t"], stopped["pose"], strict=True)]  # a run's samples
+    assert hits[-1] and not any(hits[:-1])
     assert np.array_equal(run.t, stopped["t"]) and np.array_equal(run.pose, stopped["pose"])
 
 

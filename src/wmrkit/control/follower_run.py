@@ -11,7 +11,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .trackers import ARRIVAL_TOL, ArrivalWarning, PathFollower, follower_duration
+from .trackers import ARRIVAL_TOL, ArrivalWarning, PathFollower, arrived, follower_duration
 
 __all__ = ["Limit", "check_arrival", "ended", "follower_bound", "span"]
 
@@ -75,18 +75,26 @@ def _out_of_reach(follower: PathFollower, t: np.ndarray, pose: np.ndarray) -> st
             f"({1 / follower.tightest:.3g} m): start farther from the end, or on the path")
 
 
-def check_arrival(follower: PathFollower, t: np.ndarray, pose: np.ndarray, cut: Limit | None = None) -> None:
+def check_arrival(follower: PathFollower, t: np.ndarray, pose: np.ndarray, cut: Limit | None = None,
+                  delay: int | None = None) -> None:
     """Warn (:class:`.trackers.ArrivalWarning`) when a follower's default run (times `t` ``(n,)`` [s], poses
     ``(n, 3)``) ended with its tracked point more than ``ARRIVAL_TOL`` from the path's end: still on its way after
     the bounded run (its extra time `cut` by a limit of the loop, if given), or past the end beside it (and why,
-    where its turning radius tells: :func:`_out_of_reach`)."""
+    where its turning radius tells: :func:`_out_of_reach`); `delay`: the loop's (:meth:`.PathFollower.stop_rule`)."""
     end, last = float(t[-1]), pose[-1]
     gap = follower.end_distance(last)
     if gap <= ARRIVAL_TOL:
         return
-    if follower.finished(end, last):
-        reason = _out_of_reach(follower, t, pose)
-        why = "it passed the path's end beside it" + (f": {reason}" if reason else "")
+    rule = follower.stop_rule(delay)
+    if [rule(float(t[k]), pose[k]) for k in range(max(len(t) - 2, 0), len(t))][-1]:
+        q, p = (follower.tracked(x) for x in pose[-2:]) if len(t) > 1 else (None, None)
+        step = 0.0 if q is None else float(np.hypot(*(p - q)))
+        if delay is not None and step > 0 and arrived(q, p, follower.path.xy[-1], (1 + delay) * step):
+            why = (f"it passed the path's end between its last two samples, {step:.3g} m apart (the sampled loop's "
+                   f"step, its pose seen {delay} period(s) late): a shorter period (--period) stops it nearer")
+        else:
+            reason = _out_of_reach(follower, t, pose)
+            why = "it passed the path's end beside it" + (f": {reason}" if reason else "")
     else:
         s = follower.path.project(follower.tracked(last), end)[0]
         at = f"at {s:.4g} m of the path's {follower.path.s[-1]:.4g} m"

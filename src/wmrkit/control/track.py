@@ -231,7 +231,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         length = default_wheelbase(cp)
         ctrl = stanley(cp, reference, stanley_gain, length, min(1.2, math.atan(length * max_curvature(robot))))
         tracked_point = cp.axle_point + length * np.array([math.cos(cp.forward), math.sin(cp.forward)])
-    until = ctrl.finished if isinstance(ctrl, PathFollower) and not given_duration else None
+    stops = isinstance(ctrl, PathFollower) and not given_duration
+    until = ctrl.stop_rule(None if sampled is None else delay) if stops else None
     if initial_pose is None and geometric:  # the tracker's own point starts on the reference, not the law's
         pose0 = initial_pose_on(_full_point(cp, tracked_point), reference)
     if dynamics:
@@ -284,7 +285,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                                   f"{MAX_COORDINATE:g} m): lower the gain, or shorten the period", float(t[k])),
                        robot, reference, tracked_point, "dynamic" if dynamics else "kinematic")
     if isinstance(ctrl, PathFollower) and not given_duration:
-        check_arrival(ctrl, t, pose, cut)
+        check_arrival(ctrl, t, pose, cut, None if sampled is None else delay)
     tcp = _full_point(cp, tracked_point)
     tracked = point_pose(tcp, pose)
     ref = reference.sample(t)

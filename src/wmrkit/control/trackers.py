@@ -38,8 +38,8 @@ from .loop import TwistController
 from .points import ControlError, ControlPoint
 from .references import Reference
 
-__all__ = ["AIM_RADIUS", "ARRIVAL_TOL", "ArrivalWarning", "PathFollower", "PathIndex", "default_lookahead",
-           "default_wheelbase", "follower_duration", "max_curvature", "pure_pursuit", "stanley"]
+__all__ = ["AIM_RADIUS", "ARRIVAL_TOL", "ArrivalWarning", "PathFollower", "PathIndex", "arrived",
+           "default_lookahead", "default_wheelbase", "follower_duration", "max_curvature", "pure_pursuit", "stanley"]
 
 #: The shortest default lookahead of pure pursuit [m] (:func:`default_lookahead`).
 MIN_LOOKAHEAD = 1.0
@@ -150,15 +150,21 @@ class PathIndex:
             k += 1
         return int(near[k]), float(u[k])
 
-    def done(self, point: np.ndarray, s: float, heading: float | None = None) -> bool:
+    def done(self, point: np.ndarray, s: float, heading: float | None = None, previous: np.ndarray | None = None,
+             steps: int = 0) -> bool:
         """Whether `point`, projected at arc length `s` [m] (:meth:`project`), has passed the path's end: it projects
         on the end, past it along the last segment (a closed path's start, on its end, has not); given the `heading`
         [rad] of a point that steers for the end (pure pursuit), also the end is no longer ahead of it (one that
-        crossed the end's line beside it, on an arc to it, drives on to it), unless it is at the end (within
-        ``AIM_RADIUS``: arrived, whatever its heading)."""
+        crossed the end's line beside it, on an arc to it, drives on to it), unless it has arrived: it is within
+        ``AIM_RADIUS`` of the end, whatever its heading, or its step from `previous` (its position a sample before)
+        passed the end within ``steps`` times that step, at least ``AIM_RADIUS`` (:func:`arrived`)."""
+        a, b = self.xy[-2], self.xy[-1]
+        if heading is not None and previous is not None:  # its last step passed the end: arrived
+            reach = max(AIM_RADIUS, steps * float(np.hypot(*(point - previous))))
+            if s >= self.s[-1] - reach - AIM_RADIUS and arrived(previous, point, b, reach):
+                return True
         if s < self.s[-1]:
             return False
-        a, b = self.xy[-2], self.xy[-1]
         if heading is not None and float(np.hypot(*(point - b))) < AIM_RADIUS:  # at the end: arrived
             return True
         if not (float((point - b) @ (b - a)) >= 0 and float(np.hypot(*(point - b))) > 1e-9):
@@ -209,6 +215,17 @@ class PathIndex:
             u = np.clip(np.sum((points - a) * d, axis=1) / n2, 0.0, 1.0)
             best = np.minimum(best, np.hypot(*(points - a - u[:, None] * d).T))
         return best
+
+
+def arrived(q: np.ndarray, p: np.ndarray, end: np.ndarray, reach: float) -> bool:
+    """Whether a point that moved from `q` to `p` in a sample passed `end` within `reach` [m] (the step's nearest
+    point to it is between them). A sampled loop moves ``v T`` between its decisions and sees its pose ``delay``
+    samples late: it passes the end between two samples, off it by up to about ``(1 + delay) v T``, and a test of
+    `p` alone against ``AIM_RADIUS`` is met only by luck (:meth:`PathFollower.stop_rule`)."""
+    d = p - q
+    n2 = float(d @ d)
+    u = float((end - q) @ d) / n2 if n2 > 0 else 1.0
+    return 0 < u < 1 and float(np.hypot(*(q + u * d - end))) < reach
 
 
 def default_wheelbase(cp: ControlPoint) -> float:
@@ -271,10 +288,28 @@ class PathFollower:
     def __call__(self, t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return self.law(t, pose, integral)
 
-    def finished(self, t: float, pose: np.ndarray) -> bool:
-        """Whether the tracked point has passed the path's end at `t` (the law then commands rest, for ever)."""
+    def finished(self, t: float, pose: np.ndarray, previous: np.ndarray | None = None, steps: int = 0) -> bool:
+        """Whether the tracked point has passed the path's end at `t` (the law then commands rest, for ever);
+        `previous`: the pose a sample before, `steps`: a sampled loop's (:meth:`PathIndex.done`)."""
         p = self.tracked(pose)
-        return self.path.done(p, self.path.project(p, t)[0], None if self.heading is None else self.heading(pose))
+        q = None if previous is None else self.tracked(previous)
+        heading = None if self.heading is None else self.heading(pose)
+        return self.path.done(p, self.path.project(p, t)[0], heading, q, steps)
+
+    def stop_rule(self, delay: int | None = None) -> Callable[[float, np.ndarray], bool]:
+        """:meth:`finished` on a run's successive samples ``(t, pose)``, each with the one before, for a continuous
+        loop (`delay` None) or a sampled one measuring its pose `delay` periods late: a loop's `until`. Its point
+        has arrived once its last step passed the end within ``(1 + delay)`` times that step (at least
+        ``AIM_RADIUS``): what the loop resolves (:func:`arrived`). A sample no later than the last starts a run."""
+        last: list = [math.inf, None]
+        steps = 0 if delay is None else 1 + delay
+
+        def until(t: float, pose: np.ndarray) -> bool:
+            previous = last[1] if t > last[0] else None
+            last[:] = [t, np.array(pose, dtype=float)]
+            return self.finished(t, pose, previous, steps)
+
+        return until
 
     def end_distance(self, pose: np.ndarray) -> float:
         """Distance [m] of the tracked point from the path's end."""
