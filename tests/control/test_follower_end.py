@@ -4,6 +4,7 @@ nearer than the lookahead (the arc through it reaches it), and its run does not 
 from __future__ import annotations
 
 import math
+import re
 import warnings
 
 import numpy as np
@@ -89,3 +90,31 @@ def test_a_follower_that_passes_the_end_beside_it_says_why():
               initial_pose=[10.2, 0.3, 0.0])
     said = str(caught[-1].message)
     assert f"from t = 0 s, {math.hypot(0.2, 0.3):.3g} m from it, the end was behind it" in said, said
+
+
+def test_stanley_that_passes_the_end_beside_it_says_why():
+    """Stanley's warning gave no reason. Its tracked point is the front point ``F``, ``L`` = 2.7 m ahead of the car's
+    axle point ``A``: from ``A`` = (7, 1) facing +x, ``F`` = (9.7, 1), the circle of ``A`` whose ``F`` passes
+    through the end (10, 0) has radius ``R`` with ``|E - C| = |F - C|``, ``C = A - R (0, 1)`` (a right turn),
+    solved here by bisection, inside the car's 3.99 m: the warning names it (from t = 0 s, ``F`` 1.04 m from the
+    end)."""
+    car = catalog.load("ackermann")
+    a, f, end = np.array([7.0, 1.0]), np.array([9.7, 1.0]), np.array([10.0, 0.0])
+
+    def gap(r: float) -> float:  # |E - C| - |F - C| for the centre C of a right turn of radius r
+        c = a - r * np.array([0.0, 1.0])
+        return float(np.hypot(*(end - c)) - np.hypot(*(f - c)))
+
+    lo, hi = 0.5, 3.0
+    assert gap(lo) * gap(hi) < 0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if gap(lo) * gap(mid) > 0 else (lo, mid)
+    with pytest.warns(ArrivalWarning) as caught:
+        track(car, builtin_reference("line"), controller="stanley", initial_pose=[7.0, 1.0, 0.0])
+    said = str(caught[-1].message)
+    assert (f"it passed the path's end beside it: from t = 0 s, {float(np.hypot(*(end - f))):.3g} m from it, the "
+            "end needed a turn of radius " in said), said
+    assert abs(float(re.search(r"a turn of radius ([0-9.]+) m", said)[1]) - lo) <= 5e-3 + 1e-9  # as shown: 3 digits
+    assert (f"m (of its axle point, 2.7 m behind its tracked point), tighter than Stanley's tightest "
+            f"({min_turning_radius(car):.3g} m: its steering limit)" in said), said

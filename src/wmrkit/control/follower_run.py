@@ -53,26 +53,36 @@ def ended(out: dict[str, Any], until: Callable[[float, np.ndarray], bool]) -> di
 
 
 def _out_of_reach(follower: PathFollower, t: np.ndarray, pose: np.ndarray) -> str:
-    """Why a follower that steers for the path's end within its tightest turn (pure pursuit) passed the end beside
-    it, from its run (times `t` ``(n,)`` [s], poses ``(n, 3)``): from the first sample after the last one where the
-    end lay ahead on an arc within that turn (the circle tangent to its heading through the end, closed form:
-    curvature ``2 y / d^2``), the end was out of its reach; "" when it never was (or the follower tells no heading)."""
-    if follower.heading is None:
+    """Why a follower passed the path's end beside it, from its run (times `t` ``(n,)`` [s], poses ``(n, 3)``):
+    from the first sample after the last one where the end lay ahead of its tracked point, on the arc of a turn
+    within its tightest, that point's arc through the end needed a tighter turn (or the end was behind it); "" when
+    it never was (or the follower tells no axle). The tracked point ``F`` is ``L`` (`offset`) ahead of the axle
+    point ``A`` (pure pursuit: ``L = 0``; Stanley: its front point): ``A`` on a circle of radius ``R`` (centre
+    ``A + R n``) carries ``F`` on one of radius ``sqrt(R^2 + L^2)``, through the end ``E`` for
+    ``1 / R = 2 y / (|E - A|^2 - L^2)``, ``y`` the end's side of ``A`` (closed form)."""
+    if follower.axle is None:
         return ""
-    end = follower.path.xy[-1]
-    d = np.array([end - follower.tracked(p) for p in pose])
-    h = np.array([follower.heading(p) for p in pose])
+    end, offset = follower.path.xy[-1], follower.offset
+    axle = [follower.axle(p) for p in pose]
+    d = np.array([end - a for a, _ in axle])
+    h = np.array([psi for _, psi in axle])
     ahead, side = d[:, 0] * np.cos(h) + d[:, 1] * np.sin(h), d[:, 1] * np.cos(h) - d[:, 0] * np.sin(h)
-    need = 2.0 * np.abs(side) / np.maximum(np.sum(d * d, axis=1), 1e-300)
-    reach = np.flatnonzero((ahead > 0) & (need <= follower.tightest))
+    need = 2.0 * np.abs(side) / np.maximum(np.abs(np.sum(d * d, axis=1) - offset**2), 1e-300)
+    reach = np.flatnonzero((ahead > offset) & (need <= follower.tightest))
     k = int(reach[-1]) + 1 if len(reach) else 0
     if k >= len(t):
         return ""
-    at = f"from t = {t[k]:.4g} s, {float(np.hypot(*d[k])):.3g} m from it,"
-    if ahead[k] <= 0:
+    gap = float(np.hypot(*(end - follower.tracked(pose[k]))))
+    at = f"from t = {t[k]:.4g} s, {gap:.3g} m from it,"
+    if ahead[k] <= offset:
         return f"{at} the end was behind it"
-    return (f"{at} the end needed a turn of radius {1 / need[k]:.3g} m, tighter than the robot's tightest "
-            f"({1 / follower.tightest:.3g} m): start farther from the end, or on the path")
+    turn = f"a turn of radius {1 / need[k]:.3g} m"
+    if offset > 0:  # Stanley: its steering limit
+        turn += (f" (of its axle point, {offset:.3g} m behind its tracked point), tighter than Stanley's tightest "
+                 f"({1 / follower.tightest:.3g} m: its steering limit)")
+    else:
+        turn += f", tighter than the robot's tightest ({1 / follower.tightest:.3g} m)"
+    return f"{at} the end needed {turn}: start farther from the end, or on the path"
 
 
 def check_arrival(follower: PathFollower, t: np.ndarray, pose: np.ndarray, cut: Limit | None = None,

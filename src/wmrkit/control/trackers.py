@@ -278,12 +278,15 @@ def _twist_at_origin(cp: ControlPoint, v: float, omega: float) -> np.ndarray:
 class PathFollower:
     """A geometric tracker: the :data:`TwistController` `law`, and the path it follows with its `tracked` point
     (``pose -> (2,)`` world [m]), to tell when that point has driven it to the end (:meth:`finished`); `heading`
-    (``pose -> rad``): that point's direction of travel, for a law that steers for the end (:meth:`PathIndex.done`),
-    turning at most at curvature `tightest` [1/m]."""
+    (``pose -> rad``): that point's direction of travel, for a law that steers for the end (:meth:`PathIndex.done`);
+    `axle` (``pose -> (A, psi)``): the axle point and its heading, the tracked point being `offset` [m] ahead of it,
+    ``A`` turning at most at curvature `tightest` [1/m] (why it missed the end: :mod:`.follower_run`)."""
 
     def __init__(self, path: PathIndex, tracked: Callable[[np.ndarray], np.ndarray], law: TwistController,
-                 heading: Callable[[np.ndarray], float] | None = None, tightest: float = math.inf) -> None:
+                 heading: Callable[[np.ndarray], float] | None = None, tightest: float = math.inf,
+                 axle: Callable[[np.ndarray], tuple[np.ndarray, float]] | None = None, offset: float = 0.0) -> None:
         self.path, self.tracked, self.law, self.heading, self.tightest = path, tracked, law, heading, tightest
+        self.axle, self.offset = axle, offset
 
     def __call__(self, t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return self.law(t, pose, integral)
@@ -349,7 +352,7 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0,
         return _twist_at_origin(cp, v, v * kappa), np.zeros(3)
 
     return PathFollower(path, lambda pose: _axle_state(cp, pose)[0], control, lambda pose: _axle_state(cp, pose)[1],
-                        curvature)
+                        curvature, lambda pose: _axle_state(cp, pose))
 
 
 def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase: float | None = None,
@@ -381,4 +384,5 @@ def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase
         v = v_front * math.cos(delta)  # the axle point's: the front one's along the heading
         return _twist_at_origin(cp, v, v_front * math.sin(delta) / length), np.zeros(3)
 
-    return PathFollower(path, front, control)
+    return PathFollower(path, front, control, tightest=math.tan(max_steer) / length,
+                        axle=lambda pose: _axle_state(cp, pose), offset=length)
