@@ -624,16 +624,54 @@ def test_open_invalid_file_names_the_file_not_the_current_robot(page, server):
     assert not pg.errors
 
 
-def test_infinite_condition_number_has_no_length(page):
-    """A swerve with one wheel turned cannot move: 'κ = – at D = 0.396 m' was shown (no length minimises κ)."""
+def test_infinite_condition_number_has_no_length(page, server):
+    """A swerve with one wheel turned cannot move: 'κ = – at D = 0.396 m' was shown (no length minimises κ). Its
+    m is 1: isotropy does not apply, as `wmrkit analyze` says. An omni-3 whose back wheel drives nothing (m = 3,
+    two actuated joints) has an infinite κ: its joints do not determine the twist."""
     pg = page
+    _, root = server
     open_catalog(pg, "swerve-4")
     pg.click('[data-wheel="front_left"]')
     edit(pg, "heading", "30 deg")
     assert shown(pg, "a-kappa") == [None, None]
-    assert pg.inner_text("#a-kappa").startswith("κ infinite"), pg.inner_text("#a-kappa")
+    assert pg.inner_text("#a-kappa").startswith("isotropy does not apply (m = 1: no two motions to balance)")
     pg.click("#undo")
     settle(pg)
+    d = catalog.load("omni-3").to_dict()
+    d["wheels"][1]["actuated"] = []
+    open_file(pg, root, "two-driven.json", d)
+    assert math.isinf(analyze(robot_from_dict(d)).condition_number)
+    assert shown(pg, "a-kappa") == [None, None]
+    assert pg.inner_text("#a-kappa").startswith("κ infinite"), pg.inner_text("#a-kappa")
+    assert not pg.errors
+
+
+def open_file(pg, root: Path, name: str, description: dict) -> None:
+    """Write `description` to `name` in the studio's folder and open it with the page's file list."""
+    (root / name).write_text(json.dumps(description))
+    pg.evaluate("call('/api/files').then((f) => fillFiles(f.data.files))")
+    pg.wait_for_function(f"() => [...document.getElementById('files').options].some((o) => o.value === '{name}')")
+    pg.select_option("#catalog", "")
+    pg.select_option("#files", name)
+    pg.click("#open")
+    settle(pg)
+    assert pg.evaluate("S.desc") == robot_from_dict(description).to_dict()
+
+
+def test_gears_that_leave_one_motion_are_not_called_infinite(page, server):
+    """diff-drive with its two wheels on a 1:1 gear (a solid axle) goes straight only: the page said 'κ infinite
+    (these joints do not determine the twist)', yet they do (actuation and sensing sufficient); `wmrkit analyze`
+    says isotropy does not apply, and so does the page now."""
+    pg = page
+    _, root = server
+    d = catalog.load("diff-drive").to_dict()
+    d["couplings"] = [{"kind": "gear", "joints": ["left.spin", "right.spin"], "ratios": [1.0, 1.0]}]
+    open_file(pg, root, "solid-axle.json", d)
+    full = analyze(robot_from_dict(d))
+    assert shown(pg, "a-kappa") == [None, None] == [full.to_dict()["condition_number"], None]
+    text = pg.inner_text("#a-kappa")
+    assert text.startswith(f"isotropy {full.isotropy_note()}") and "infinite" not in text, text
+    assert "gear couplings leave m = 1" in text
     assert not pg.errors
 
 

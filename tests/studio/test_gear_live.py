@@ -25,9 +25,9 @@ def geared(name: str, joints: list[str], ratios: list[float], actuated: dict[str
     return d
 
 
-def brute_kappa(robot: Robot, beta: np.ndarray, joints: tuple[str, ...], lengths: np.ndarray) -> np.ndarray:
-    """kappa of `joints` as a function of the twists the geared robot admits at `beta` (m = 2: a line of ICRs), in
-    (v, D omega) at the foot P of the perpendicular from the origin to that line, the thesis's pair (5.47)."""
+def geared_kernel(robot: Robot, beta: np.ndarray) -> np.ndarray:
+    """The (twist, joint rates) the robot with its first coupling (a gear) admits at `beta`, one per row: the
+    kernel of the no-slip rows (3.22) plus the gear's rows, by an SVD done here."""
     a = robot.constraint_matrix(beta)
     c = robot.couplings[0]
     gear = np.zeros(a.shape[1])
@@ -37,7 +37,13 @@ def brute_kappa(robot: Robot, beta: np.ndarray, joints: tuple[str, ...], lengths
             row[robot.velocity_index(c.joints[0])], row[robot.velocity_index(j)] = 1 / c.ratios[0], -1 / k
             a = np.vstack([a, row])
     _, s, vh = np.linalg.svd(a)
-    kernel = vh[int(np.sum(s > 1e-10 * s[0])):]  # (twist, rates) the robot can have, one per row
+    return vh[int(np.sum(s > 1e-10 * s[0])):]
+
+
+def brute_kappa(robot: Robot, beta: np.ndarray, joints: tuple[str, ...], lengths: np.ndarray) -> np.ndarray:
+    """kappa of `joints` as a function of the twists the geared robot admits at `beta` (m = 2: a line of ICRs), in
+    (v, D omega) at the foot P of the perpendicular from the origin to that line, the thesis's pair (5.47)."""
+    kernel = geared_kernel(robot, beta)  # (twist, rates) the robot can have, one per row
     assert len(kernel) == 2
     rates = kernel[:, [robot.velocity_index(j) for j in joints]]
     n = np.cross(kernel[0, :3], kernel[1, :3])  # n . twist = 0: the ICR (x, y) obeys n0 y - n1 x + n2 = 0
@@ -89,3 +95,29 @@ def test_the_kappa_map_of_a_geared_castor_robot_holds_the_gear():
             assert kappa[i, j] is None, (i, j, want)
         else:
             assert kappa[i, j] == pytest.approx(want, rel=1e-8), (i, j)
+
+
+@pytest.mark.parametrize("ratios", [[1.0, 1.0], [1.0, -1.0]])
+def test_gears_that_leave_one_motion_say_isotropy_does_not_apply(ratios):
+    """diff-drive with left.spin and right.spin on one gear (1:1, a solid axle: straight only; 1:-1, turning on the
+    spot only). The page said 'κ infinite (these joints do not determine the twist)' from the null condition
+    number, yet the joints determine the twist; `wmrkit analyze` says isotropy does not apply. Checked by an SVD
+    done here: one motion is left, and the geared joints turn on it (their rates are not all zero)."""
+    d = geared("diff-drive", ["left.spin", "right.spin"], ratios)
+    robot = robot_from_dict(d)
+    kernel = geared_kernel(robot, robot.beta)
+    assert len(kernel) == 1
+    rates = kernel[0, [robot.velocity_index(j) for j in ("left.spin", "right.spin")]]
+    assert np.abs(rates).max() > 0.1 * np.abs(kernel[0]).max()  # they see the one motion: the twist is determined
+    live = api.analyze_live({"description": d})["analysis"]
+    assert live["condition_number"] is None and live["characteristic_length"] is None
+    assert live["isotropy_note"] == "does not apply (its gear couplings leave m = 1: no two motions to balance)"
+
+
+@pytest.mark.parametrize(("name", "note"), [("omni-3", None), ("diff-drive", None),
+                                            ("ackermann", "does not apply (m = 1: no two motions to balance)")])
+def test_the_isotropy_note_is_analyze_s(name, note):
+    """Without gears: m = 1 (ackermann) leaves no two motions to balance, m >= 2 has a condition number (no note)."""
+    robot = catalog.load(name)
+    assert api.analyze_live({"description": robot.to_dict()})["analysis"]["isotropy_note"] == note
+    assert analyze(robot, resolution=8).isotropy_note() == note

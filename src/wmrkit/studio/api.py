@@ -126,6 +126,7 @@ def live_summary(robot: Robot) -> dict[str, Any]:
         "sensing": full["sensing"] | {"joints": list(robot.sensed)},
         "condition_number": _finite(full["condition_number"]),  # inf (undetermined twist): null, as JSON has no inf
         "characteristic_length": _finite(full["characteristic_length"]),
+        "isotropy_note": a.isotropy_note(),  # m <= 1, of the wheels or left by gears: no condition number to give
         "steering": dict(zip(robot.steer_names, robot.heading.tolist(), strict=True)),
         "singular_here": here,
     }

@@ -553,7 +553,10 @@ function renderAnalysis() {
   const verdict = (v, ok) => `<span class="${ok ? "good" : "warn"}">${esc(v.verdict)}</span> <span class="hint">(${esc(v.joints.join(", ") || "nothing declared")})</span>`;
   setCell("a-actuation", verdict(a.actuation, a.actuation.consistent && a.actuation.sufficient), a.actuation);
   setCell("a-sensing", verdict(a.sensing, a.sensing.sufficient), a.sensing);
-  setCell("a-kappa", (a.condition_number === null ? "κ infinite (these joints do not determine the twist) "
+  // m <= 1 (of the wheels, or left by gear couplings): no two motions to balance, as `wmrkit analyze` says (a null
+  // condition number there was shown as "infinite", though the joints determine the twist)
+  setCell("a-kappa", (a.isotropy_note !== null ? `isotropy ${esc(a.isotropy_note)} `
+    : a.condition_number === null ? "κ infinite (these joints do not determine the twist) "
     : `κ = ${fmt(a.condition_number, 6)} ` + (a.characteristic_length === null ? ""
       : `at D = ${fmt(a.characteristic_length, 4)} m `)) +
     `<span class="hint">(${esc(a.condition_joints.join(", "))})</span>`, [a.condition_number, a.characteristic_length]);
