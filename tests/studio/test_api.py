@@ -472,6 +472,32 @@ def test_meta_and_catalog(client):
     assert client.post("/api/open", json={"catalog": "swerv-4"}).status_code == 400
 
 
+def test_meta_reads_the_start_file_as_it_is_now(tmp_path):
+    """`wmrkit studio mine.yaml`, the file then edited on disk: reloading the page showed the robot read at start
+    (r 0.05 m where the file said 0.07 m), and Save, once confirmed, wrote that stale robot over the edit. Now
+    /api/meta reads the file again; a file now invalid or gone keeps the last good robot, with the error naming it."""
+    path = tmp_path / "mine.yaml"
+    catalog.load("omni-3").to_file(path)
+    client = TestClient(create_app(tmp_path, Robot.from_file(path), robot_spec="mine.yaml"))
+    assert client.get("/api/meta").json()["start"]["description"] == Robot.from_file(path).to_dict()
+    path.write_text(path.read_text().replace("r: 0.05\n", "r: 0.07\n"))
+    edited = Robot.from_file(path)
+    assert [w.r for w in edited.wheels] == [0.07] * 3
+    start = client.get("/api/meta").json()["start"]
+    assert start == {"spec": "mine.yaml", "description": edited.to_dict()}
+    path.write_text(path.read_text().replace("r: 0.07\n", "r: -0.07\n", 1))
+    r = client.get("/api/meta")
+    assert r.status_code == 200 and r.json()["start"]["description"] == edited.to_dict()  # the last good robot
+    error = r.json()["start"]["error"]  # the file, its line, the wheel's field: as `wmrkit show mine.yaml`
+    assert f"{path}:" in error and error.endswith(": wheels[0].r: must be > 0, got -0.07 m"), error
+    path.unlink()
+    start = client.get("/api/meta").json()["start"]
+    assert start["description"] == edited.to_dict() and "no file 'mine.yaml'" in start["error"]
+    catalog_start = TestClient(create_app(tmp_path, catalog.load("swerve-4"), robot_spec="swerve-4"))
+    assert catalog_start.get("/api/meta").json()["start"] == {"spec": "swerve-4",
+                                                               "description": catalog.load("swerve-4").to_dict()}
+
+
 def test_save_round_trips_like_to_file(tmp_path, client):
     robot = catalog.load("thesis-steer-castor")
     d = robot.to_dict()

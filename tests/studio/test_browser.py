@@ -7,6 +7,7 @@ recorded (``window.studioStats``) and printed, not asserted tightly: the machine
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -675,33 +676,68 @@ def test_gears_that_leave_one_motion_are_not_called_infinite(page, server):
     assert not pg.errors
 
 
-def test_started_with_a_yml_file_saves_to_it(page):
-    """`wmrkit studio mine.yml`: the save field said 'omni-3.yaml' (only .yaml and .json were taken as files), so
-    Save wrote another file than the one opened."""
+@contextlib.contextmanager
+def started_with_file(page, name: str):
+    """A page of a studio started with the file `name` (omni-3) of a folder of its own: (page, path of the file)."""
     import uvicorn
 
-    root = Path(tempfile.mkdtemp(prefix="wmrkit-studio-yml-"))
-    catalog.load("omni-3").to_file(root / "Mine.YML")
+    root = Path(tempfile.mkdtemp(prefix="wmrkit-studio-file-"))
+    catalog.load("omni-3").to_file(root / name)
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
-    app = create_app(root, Robot.from_file(root / "Mine.YML"), robot_spec="Mine.YML", allowed_hosts=LOCAL_HOSTS)
+    app = create_app(root, Robot.from_file(root / name), robot_spec=name, allowed_hosts=LOCAL_HOSTS)
     srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
     thread = threading.Thread(target=srv.run, daemon=True)
     thread.start()
     pg = page.context.new_page()
+    pg.errors = []
+    pg.on("pageerror", lambda e: pg.errors.append(str(e)))
     try:
         deadline = time.monotonic() + 20
         while not srv.started and time.monotonic() < deadline:
             time.sleep(0.05)
         pg.goto(f"http://127.0.0.1:{port}/")
         pg.wait_for_function("() => window.studioStats && window.studioStats.rendered > 0")
-        assert pg.input_value("#save-path") == "Mine.YML"
+        yield pg, root / name
     finally:
         pg.close()
         srv.should_exit = True
         thread.join(10)
         shutil.rmtree(root, ignore_errors=True)
+
+
+def test_started_with_a_yml_file_saves_to_it(page):
+    """`wmrkit studio mine.yml`: the save field said 'omni-3.yaml' (only .yaml and .json were taken as files), so
+    Save wrote another file than the one opened."""
+    with started_with_file(page, "Mine.YML") as (pg, _):
+        assert pg.input_value("#save-path") == "Mine.YML"
+
+
+def test_reload_shows_the_start_file_as_edited_on_disk(page):
+    """`wmrkit studio mine.yaml`, the file then edited in an editor, the page reloaded: it showed the robot read at
+    start (r 0.05 m, the file said 0.07 m), and Save wrote that over the edit. A file made invalid keeps the last
+    good robot on screen, with the error line naming the file and its field."""
+    with started_with_file(page, "mine.yaml") as (pg, path):
+        assert page_robot(pg) == Robot.from_file(path)
+        path.write_text(path.read_text().replace("r: 0.05\n", "r: 0.07\n"))
+        edited = Robot.from_file(path)
+        assert [w.r for w in edited.wheels] == [0.07] * 3
+        pg.reload()
+        pg.wait_for_function("() => window.studioStats && window.studioStats.rendered > 0")
+        settle(pg)
+        assert page_robot(pg) == edited
+        assert pg.evaluate("document.getElementById('error').hidden")
+        path.write_text(path.read_text().replace("r: 0.07\n", "r: -0.07\n", 1))
+        pg.reload()
+        pg.wait_for_function("() => window.studioStats && window.studioStats.rendered > 0")
+        settle(pg)
+        assert page_robot(pg) == edited
+        text = pg.inner_text("#error")
+        assert f"{path}:" in text and text.endswith("wheels[0].r: must be > 0, got -0.07 m"), text
+        assert pg.locator(".invalid").count() == 0  # the file's field, not one of the robot on screen
+        assert pg.input_value("#save-path") == "mine.yaml"
+        assert not pg.errors
 
 
 def test_drive_table_shows_roller_rates(page):

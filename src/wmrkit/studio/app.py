@@ -118,10 +118,24 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
 
         return handle
 
+    start_file = robot_spec if robot_spec and Path(robot_spec).suffix.lower() in files.SUFFIXES else None
+    last_good = {"description": api.description_of(start)}
+
+    def start_robot() -> dict[str, Any]:
+        """The robot the page starts with. A start file is read again (it may have been edited since: a reload
+        showed the robot read at start, and Save then wrote it over the edit); one now invalid or gone keeps the
+        last good robot, with the error naming the file."""
+        out: dict[str, Any] = {"spec": robot_spec or start.name}
+        if start_file is not None:
+            try:
+                last_good["description"] = files.open_robot(root, {"path": start_file})["description"]
+            except WmrkitError as err:
+                out["error"] = str(err)
+        return out | {"description": last_good["description"]}
+
     def meta(_: Any) -> dict[str, Any]:
         return {"catalog": list(catalog.names()), "kinds": api.kinds(), "root": root.name or str(root),
-                "files": files.list_files(root), "start": {"spec": robot_spec or start.name,
-                                                           "description": api.description_of(start)}}
+                "files": files.list_files(root), "start": start_robot()}
 
     async def http_error(request, err: HTTPException) -> Response:  # 404, 405: JSON as every other mistake
         response = respond({"error": f"{err.detail}: {request.method} {request.url.path[:200]}"}, err.status_code)

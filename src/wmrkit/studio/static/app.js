@@ -11,6 +11,7 @@ const S = {
   analysedText: "", configsText: null,  // the descriptions (JSON) the analysis and the configurations are about
   selected: null, selIndex: -1, undo: [], redo: [], twist: [0, 0, 0], heading: {}, path: "",
   inflight: false, pending: false, driving: 0, driveSeq: 0, editTime: 0, seq: 0, anim: null, view: null,
+  startError: null,  // the start file could not be read again (invalid or gone): shown over its last good robot
 };
 // Timings for the docs and the browser test: round trip edit -> numbers shown [ms], server time [ms].
 window.studioStats = { edits: [], server: [], rendered: 0 };
@@ -146,7 +147,7 @@ async function send() {
   S.inflight = false;
   if (r.ok) {
     S.geometry = r.data.geometry; S.analysis = r.data.analysis; S.valid = desc; S.analysedText = text;
-    showError(null);
+    showError(S.startError && { error: S.startError }); S.startError = null;
   } else {
     showError(r.data);
   }
@@ -770,6 +771,7 @@ async function main() {
     else if (k === "delete") deleteWheel();
   });
   setTwist([0, 0, 0]);
+  S.startError = S.meta.start.error || null;
   load(S.meta.start.description, /\.(ya?ml|json)$/i.test(S.meta.start.spec)  // a file: .yaml, .yml, .json (files.py)
     ? S.meta.start.spec : `${S.meta.start.description.name}.yaml`);
 }
