@@ -271,6 +271,21 @@ def test_steering_robot_kappa_map_and_rotate(page):
     assert not pg.errors
 
 
+def test_kappa_map_of_a_one_motion_robot_says_isotropy_does_not_apply(page):
+    """Ackermann (m = 1): the map's note said 'best κ = 1' next to the analysis's 'isotropy does not apply (m = 1)'.
+    With one motion κ is 1 wherever the robot moves (one singular value), which the map's values confirm."""
+    pg = page
+    open_catalog(pg, "ackermann")
+    values = [v for v in pg.evaluate("S.kappa.kappa") if v is not None]
+    assert values and all(v == pytest.approx(1.0, abs=1e-12) for v in values)
+    note = pg.inner_text("#k-note")
+    assert note.startswith("isotropy does not apply (m = 1: no two motions to balance): κ = 1 wherever") and \
+        "best" not in note, note
+    open_catalog(pg, "thesis-steer-castor")  # m = 2: the best κ of the map
+    assert "best κ = " in pg.inner_text("#k-note") and "isotropy" not in pg.inner_text("#k-note")
+    assert not pg.errors
+
+
 def test_drive_coordinated_robot(page):
     """Ackermann: the front wheels turn to the twist's ICR; the headings shown are the library's."""
     pg = page

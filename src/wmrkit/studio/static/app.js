@@ -664,8 +664,11 @@ function renderKappa() {
   x.fillStyle = "#333"; x.font = "10px system-ui";
   x.fillText(`${k.wheels[0]} heading: -180 … 180 deg`, P, c.height - 6);
   if (k.wheels.length > 1) { x.save(); x.translate(10, 4 + H); x.rotate(-Math.PI / 2); x.fillText(`${k.wheels[1]} heading`, 0, 0); x.restore(); }
-  $("k-note").textContent = `log10 κ from 0 (isotropic, yellow at ${fmt(hi, 2)}) ; grey: the robot cannot move or the model is singular; ` +
-    (k.best ? `best κ = ${fmt(k.best.kappa, 4)}` : "") + ". Click to steer there.";
+  // m <= 1 (the analysis's note): one motion, κ = 1 wherever the robot moves ("best κ = 1" said it was isotropic)
+  const note = S.analysis && S.analysis.isotropy_note;
+  $("k-note").textContent = (note ? `isotropy ${note}: κ = 1 wherever the robot can move`
+    : `log10 κ from 0 (isotropic, yellow at ${fmt(hi, 2)})`) + "; grey: the robot cannot move or the model is singular" +
+    (k.best && !note ? `; best κ = ${fmt(k.best.kappa, 4)}` : "") + ". Click to steer there.";
 }
 // Cell i of the map shows κ at axis[i] = -π + 2π i / n and spans [i, i + 1) / n of the axis: headings are placed at
 // cell centres (h = axis[i] at (i + 0.5) / n), by the cross and by clicks alike.
