@@ -11,11 +11,12 @@ import math
 import numpy as np
 from matplotlib.figure import Figure
 
+from ..kinematics.linalg import characteristic_length
 from ..plotting.robot import draw_robot
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .classification import Classification
-from .icr import icr, steer_to_icr, twist_of_icr
+from .icr import icr, line_rank, meeting_point, steer_to_icr, twist_of_icr
 from .isotropy import condition_map, natural_length, twist_condition_number
 from .lines import common_point, constraint_lines
 from .singularity import SingularSet, robot_size
@@ -101,23 +102,39 @@ def robot_figure(robot: Robot, cls: Classification) -> Figure:
 
 
 def sample_icrs(robot: Robot, cls: Classification) -> list[np.ndarray]:
-    """A few admissible homogeneous ICRs (the fixed wheels allow them; steered wheels are aimed at them)."""
-    size = robot_size(robot)
-    if cls.fixed_rank >= 3 or cls.mobility == 0:
+    """A few admissible homogeneous ICRs: on every axle that does not steer and every line a gear adds (the gears
+    held, as analyze's ICR holds them), the steered wheels aimed at them; a sample whose aimed steering turns a
+    gear's line off it (a gear on a steered wheel) is left out."""
+    if cls.mobility == 0:
         return []
-    cl = constraint_lines(robot)
-    steer = set(robot.steer_names)
-    fixed = [lam for lam, w in zip(cl.lines(), cl.wheels, strict=True) if w not in steer]
-    if cls.fixed_rank == 2:
-        s = icr(robot)
-        return [np.array([*s.point, 1.0])] if s.kind == "point" else [np.array([-s.direction[1], s.direction[0], 0.0])]
-    if cls.fixed_rank == 1:
-        lx, ly, d = fixed[0] / np.hypot(*fixed[0][:2])
+    size = robot_size(robot)
+    cl = constraint_lines(robot, coupled=any(c.kind == "gear" for c in robot.couplings))
+    fixed = cl.lines()[~np.array(cl.steered, dtype=bool)]
+    rank = line_rank(robot, fixed)
+    if rank == 3:
+        return []
+    if rank == 2:
+        s = meeting_point(robot, fixed)
+        samples = [np.array([*s.point, 1.0]) if s.kind == "point" else np.array([-s.direction[1], s.direction[0], 0.0])]
+    elif rank == 1:
+        lx, ly, d = fixed[np.argmax(np.linalg.norm(fixed[:, :2], axis=-1))]
+        lx, ly, d = np.array([lx, ly, d]) / np.hypot(lx, ly)
         foot, u = np.array([d * ly, -d * lx]), np.array([lx, ly])
-        pts = [foot, foot + 1.6 * size * u, foot - 3.0 * size * u]
-        return [np.array([*p, 1.0]) for p in pts] + [np.array([lx, ly, 0.0])]
-    return [np.array([0.0, 0.0, 1.0]), np.array([1.2 * size, 1.5 * size, 1.0]),
-            np.array([-2.5 * size, 0.8 * size, 1.0]), np.array([1.0, 0.0, 0.0])]
+        samples = [np.array([*p, 1.0]) for p in (foot, foot + 1.6 * size * u, foot - 3.0 * size * u)]
+        samples.append(np.array([lx, ly, 0.0]))
+    else:
+        samples = [np.array([0.0, 0.0, 1.0]), np.array([1.2 * size, 1.5 * size, 1.0]),
+                   np.array([-2.5 * size, 0.8 * size, 1.0]), np.array([1.0, 0.0, 0.0])]
+    return [h for h in samples if _holds(robot, cl, h)]
+
+
+def _holds(robot: Robot, cl, h: np.ndarray) -> bool:
+    """Whether the homogeneous ICR `h` [m] lies on every line of `cl` with the steered wheels aimed at it."""
+    beta = steer_to_icr(robot, h) if robot.steer_names else robot.beta
+    unit = characteristic_length(robot)
+    v = np.array([h[1] / unit, -h[0] / unit, h[2]])  # h as a line-space vector (common_point's map), in robot sizes
+    lines = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / unit])
+    return bool(np.all(np.abs(lines @ (v / np.linalg.norm(v))) < 1e-9))
 
 
 def motions_figure(robot: Robot, cls: Classification) -> Figure | None:

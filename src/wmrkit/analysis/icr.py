@@ -118,7 +118,7 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
     beta = configuration(robot, beta, heading)
     cl = constraint_lines(robot, coupled=geared and any(c.kind == "gear" for c in robot.couplings))
     g = cl.lines(beta)
-    rank = _rank(robot, g)
+    rank = line_rank(robot, g)
     if rank == 0:
         return ICRSet("plane")
     if rank == 3:
@@ -126,8 +126,14 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
     if rank == 1:
         row = g[np.argmax(np.linalg.norm(g, axis=-1))]
         return ICRSet("line", line=tuple(float(v) for v in row))
+    return meeting_point(robot, g)
+
+
+def meeting_point(robot: Robot, lines: np.ndarray) -> ICRSet:
+    """The common point of `robot`'s `lines` ``(n, 3)`` of rank 2: "point", or "infinity" where they are parallel
+    within rounding (:data:`ROUNDING_W`)."""
     size = characteristic_length(robot)
-    _, s, vt = np.linalg.svd(g * [1.0, 1.0, 1.0 / size])  # nondimensional: lengths in robot sizes
+    _, s, vt = np.linalg.svd(lines * [1.0, 1.0, 1.0 / size])  # nondimensional: lengths in robot sizes
     x, y, w = -vt[-1, 1], vt[-1, 0], vt[-1, 2]  # the common point as common_point maps it, in robot sizes
     # no distance beyond which a point is "at infinity": the robot size depends on the frame's origin, so the
     # same axles would meet in one frame and not in another (1.25e9 sizes away: steering 1e-10 rad)
@@ -137,7 +143,7 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
     return ICRSet("point", point=(float(size * x / w), float(size * y / w)))
 
 
-def _rank(robot: Robot, lines: np.ndarray) -> int:
+def line_rank(robot: Robot, lines: np.ndarray) -> int:
     """Rank of the constraint lines, nondimensional (0: no line)."""
     return int(matrix_rank(lines * [1.0, 1.0, 1.0 / characteristic_length(robot)])) if len(lines) else 0
 
@@ -154,7 +160,7 @@ def _nearly_consistent(robot: Robot, beta: np.ndarray, cl: ConstraintLines, line
     aimed = steer_to_icr(robot, np.array([-v[1], v[0], v[2]]))  # as common_point maps a line-space vector
     miss = np.abs(np.angle(np.exp(1j * (aimed - beta))))
     worst = int(np.argmax(miss))
-    if miss[worst] > ROUNDING or _rank(robot, cl.lines(aimed)) == 3:
+    if miss[worst] > ROUNDING or line_rank(robot, cl.lines(aimed)) == 3:
         return ICRSet("none")
     headings = robot.heading_of_beta(aimed)
     return ICRSet("none", consistent=tuple(zip(robot.steer_names, headings.tolist(), strict=True)),
