@@ -10,6 +10,7 @@ import math
 from dataclasses import replace
 
 import numpy as np
+import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
@@ -87,3 +88,23 @@ def test_the_icr_moves_with_the_frame_is_mirrored_and_scales_with_the_robot(robo
         if here.kind == "infinity":  # a direction up to its sign
             expected = direction(np.array(here.direction))
             assert min(np.abs(np.array(there.direction) - s * expected).max() for s in (1, -1)) < 1e-6
+
+
+def test_a_castor_at_the_origin_spins_for_no_turn_in_every_frame():
+    """A double castor at the origin (d -0.5, r 0.25, b 0.5, spin1 actuated) and a fixed wheel (r 0.5, spin actuated)
+    l = 3.1e-13 m ahead of it, its axle along x (vx = 0: the twists (vy, omega), m = 2). The castor's steering takes
+    the turn, so spin1 = -vy / 0.25 (no omega); the wheel spins -(vy + l omega) / 0.5: on (vy, omega)
+    H = [[-4, 0], [-2, -2 l]]. Closed form (5.50)-(5.51): D = |h_omega| / |h_v| = 2 l / (2 sqrt 5) = l / sqrt 5,
+    and H with its omega column divided by D is 2 [[-2, 0], [-1, -sqrt 5]]: H^T H has eigenvalues 4 (5 +- sqrt 5),
+    kappa = sqrt((5 + sqrt 5) / (5 - sqrt 5)), the golden ratio. Before, the castor's 0 was round-off
+    (1e-16) beside the wheel's 6e-13: kappa 1.62028 here, 1.61933 mirrored, 1.61790 scaled by 3."""
+    l0 = 3.0984068663353514e-13
+    robot = Robot(name="r", wheels=(
+        Wheel(name="c0", type="double_castor", l=0.0, alpha=0.0, beta=0.0, r=0.25, d=-0.5, b=0.5, actuated=("spin1",)),
+        Wheel(name="w0", type="fixed", l=l0, alpha=0.0, beta=0.0, r=0.5, actuated=("spin",))))
+    golden = (1 + math.sqrt(5)) / 2
+    for other, joints, k in ((robot, ("c0.spin1", "w0.spin"), 1.0), (moved(robot, (0.0, 0.0), 2.9), None, 1.0),
+                             (mirrored(robot), ("c0.spin2", "w0.spin"), 1.0), (scaled(robot, 3.0), None, 3.0)):
+        d, kappa = natural_length(other, joints=joints or ("c0.spin1", "w0.spin"))
+        assert kappa == pytest.approx(golden, rel=1e-9)
+        assert d == pytest.approx(k * l0 / math.sqrt(5), rel=1e-6)

@@ -303,7 +303,7 @@ def _in_robot_lengths(model: TwistModel, rows: np.ndarray) -> tuple[np.ndarray, 
     scale = np.array([unit, unit, 1.0])[None, :, None]
     lines = _fast.combine_lines(constraint_lines(model.robot, coupled=model.geared), rows) * np.array(
         [1.0, 1.0, 1.0 / unit])[None, :, None]
-    return _fast.combine(model.coefficients, rows) * scale, _fast.normalize_cm(lines), unit
+    return _fast.combine_rates(model.coefficients, rows) * scale, _fast.normalize_cm(lines), unit
 
 
 def _blind(v: float, w: float) -> bool:
