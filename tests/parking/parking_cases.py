@@ -42,3 +42,11 @@ def scaled(car: Vehicle, slot: Space, s: float) -> tuple[Vehicle, Space]:
     """`car` and `slot` with every length multiplied by `s` (angles kept)."""
     return (replace(car, a1=car.a1 * s, b1=car.b1 * s, c1=car.c1 * s, h1=car.h1 * s, track=car.track * s),
             replace(slot, H=slot.H * s, J=slot.J * s, MS=slot.MS * s, dx2=slot.dx2 * s, final_gap=slot.final_gap * s))
+
+#: A car whose approach point, 1.559 m wide slot, needs Algorithm 3 to lower the steering for the curb; from 1.8 m
+#: the curb no longer does, the front obstacle's corner puts the approach point 0.9 m out, and Algorithm 4 cannot
+#: reach it from the 0.57 m pass: the thesis's planner has no plan.
+WIDE_CAR = Vehicle(a1=3.4382196736820223, b1=0.8614207508747462, c1=1.0384271766264899, h1=2.2398390573335183,
+                   track=0.8307417413011919, phi_max=0.6473252632996291)
+WIDE_SLOT = Space(H=5.507194104501224, J=1.559457498490115, MS=0.05624681031140825, dx2=0.5674678760290668,
+                   final_gap=0.05)

@@ -10,18 +10,12 @@ from dataclasses import replace
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from parking_cases import WIDE_CAR as CAR
+from parking_cases import WIDE_SLOT as SLOT
 
 from wmrkit.parking import Space, Vehicle, plan_parking
 from wmrkit.parking.planner import plan_thesis, roomy_length
 from wmrkit.parking.verify import check_plan
-
-#: A car whose approach point, 1.559 m wide slot, needs Algorithm 3 to lower the steering for the curb; from 1.8 m
-#: the curb no longer does, the front obstacle's corner puts the approach point 0.9 m out, and Algorithm 4 cannot
-#: reach it from the 0.57 m pass: the thesis's planner has no plan.
-CAR = Vehicle(a1=3.4382196736820223, b1=0.8614207508747462, c1=1.0384271766264899, h1=2.2398390573335183,
-              track=0.8307417413011919, phi_max=0.6473252632996291)
-SLOT = Space(H=5.507194104501224, J=1.559457498490115, MS=0.05624681031140825, dx2=0.5674678760290668,
-             final_gap=0.05)
 
 
 @pytest.mark.parametrize("J", [1.796, 1.915, 2.2, 2.5])

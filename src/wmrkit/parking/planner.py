@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass, replace
+from typing import Literal
 
 from ..errors import WmrkitError
 from .collisions import approach_offset_closed_form, front_rear_collision, lateral_reach, trailing_dip
@@ -38,6 +39,9 @@ DY3_STEP, DY3_RANGE = 1 / 200, 2.5
 MAX_MANEUVERS = 100
 #: Step of the part lengths :func:`best_part` tries [car lengths], and the most it tries.
 PART_STEP, MAX_PARTS = 1 / 200, 400
+#: Where a plan failed (``ParkingPlan.failed_at``): the slot's size, Algorithm 3's approach point, Algorithm 4's pass
+#: to it, phase 3's manoeuvres; "" for a plan.
+FailedAt = Literal["", "slot", "approach", "pass", "maneuvers"]
 #: Geometric tolerance of the stopping and inside-the-slot tests, in units of :func:`size` (1e-9 m measured a
 #: 2 mm car to 5e-7 of its length and a 2 km one to 5e-13, at the rounding of its coordinates).
 TOL = 1e-9
@@ -69,7 +73,7 @@ class ParkingPlan:
     side line, ``dy3`` how far the pass runs past the front obstacle, ``pass_offset`` the lateral offset of the
     pass actually driven [m]; ``final_gap`` the final gap to the curb [m]; ``warnings`` input adjustments;
     ``used_H`` the length of the part of the slot behind the front obstacle the car parks in, when it is not
-    the whole slot [m] (:func:`plan_parking`).
+    the whole slot [m] (:func:`plan_parking`); ``failed_at`` the stage that failed (:data:`FailedAt`).
     """
 
     vehicle: Vehicle
@@ -85,6 +89,7 @@ class ParkingPlan:
     final_gap: float
     warnings: tuple[str, ...] = ()
     used_H: float | None = None
+    failed_at: FailedAt = ""
 
     @property
     def final_pose(self) -> Pose:
@@ -108,7 +113,7 @@ def plan_parking(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
     plan = None
     if space.H <= roomy:
         plan = plan_thesis(vehicle, space, phi_step=phi_step, max_maneuvers=max_maneuvers)
-        if UNREACHABLE in plan.reason:
+        if plan.failed_at == "pass":
             plan = _gentler_first(vehicle, space, plan, phi_step, max_maneuvers)
         if plan.feasible:
             return plan
@@ -128,13 +133,9 @@ def _gentler_first(vehicle: Vehicle, space: Space, failed: ParkingPlan, phi_step
     forced a gentler angle, had no plan where a narrower one had."""
     for skip in range(1, math.ceil(vehicle.phi_max / phi_step)):
         plan = plan_thesis(vehicle, space, phi_step=phi_step, max_maneuvers=max_maneuvers, skip_angles=skip)
-        if UNREACHABLE not in plan.reason:  # a plan, or no approach point at all from here on, or phase 3 fails
-            return plan if plan.feasible or "manoeuvre" in plan.reason else failed  # phase 3 got further
+        if plan.failed_at != "pass":  # a plan, or no approach point at all from here on, or phase 3 fails
+            return plan if plan.failed_at in ("", "maneuvers") else failed  # phase 3 got further
     return failed
-
-
-#: The part of the reason that says Algorithm 4 cannot reach the approach point (:func:`_gentler_first`).
-UNREACHABLE = "cannot be reached without touching the front obstacle"
 
 
 def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
@@ -155,18 +156,19 @@ def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
     fail = _failure(v, sp, pass_offset, warnings)
     free = sp.effective_length - v.length  # phase-3 longitudinal travel (Alg. 5, erratum: H' - (a1 + b1))
     if free <= tol:
-        return fail(f"the slot is too short: H - 2 MS = {sp.effective_length:.4g} m leaves no room for a car of "
-                    f"length a1 + b1 = {v.length:.4g} m")
+        return fail("slot", f"the slot is too short: H - 2 MS = {sp.effective_length:.4g} m leaves no room for a "
+                    f"car of length a1 + b1 = {v.length:.4g} m")
     if sp.J < v.c1:
-        return fail(f"the slot is narrower (J = {sp.J:.4g} m) than the car (c1 = {v.c1:.4g} m)")
+        return fail("slot", f"the slot is narrower (J = {sp.J:.4g} m) than the car (c1 = {v.c1:.4g} m)")
     first = approach_point(v, sp, pass_offset, phi_step, skip_angles)
     if first is None:
         span = first_reach(v, phi_step)
         if sp.H - sp.MS - v.b1 > span:
-            return fail(f"the slot is longer than the first backward manoeuvre can span: Algorithm 3 reverses "
-                        f"along the whole slot, at most 2 rho = {span:.4g} m at the smallest steering angle tried")
-        return fail("no steering angle lets the first backward manoeuvre enter the slot without touching the "
-                    "curb, the rear obstacle or the front obstacle (Algorithm 3)")
+            return fail("approach", "the slot is longer than the first backward manoeuvre can span: Algorithm 3 "
+                        f"reverses along the whole slot, at most 2 rho = {span:.4g} m at the smallest steering angle "
+                        "tried")
+        return fail("approach", "no steering angle lets the first backward manoeuvre enter the slot without touching "
+                    "the curb, the rear obstacle or the front obstacle (Algorithm 3)")
     rho1, xi1, dx1 = first
     if abs(dx1 - pass_offset) <= tol:
         dx1 = pass_offset
@@ -175,8 +177,9 @@ def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
         dx1 = min(pass_offset, dx1 + lead_overshoot(v, dx1, pass_offset))
         pre = pass_end(v, dx1, pass_offset)
     if pre is None:
-        return fail(f"from a pass at {pass_offset:.4g} m the approach point at {dx1:.4g} m {UNREACHABLE} "
-                    f"(Algorithm 4 within {DY3_RANGE * size(v):.4g} m); pass farther out")
+        return fail("pass", f"from a pass at {pass_offset:.4g} m the approach point at {dx1:.4g} m cannot be reached "
+                    f"without touching the front obstacle (Algorithm 4 within {DY3_RANGE * size(v):.4g} m); pass "
+                    "farther out")
     dy3, rho2, xi2 = pre
 
     segments: list[Segment] = []
@@ -195,10 +198,10 @@ def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
         if gap < sp.final_gap and y + v.c1 / 2 <= tol:
             break
         if len(arcs) >= max_maneuvers:
-            return fail(f"more than {max_maneuvers} manoeuvres needed (gap to the curb still {gap:.4g} m)")
+            return fail("maneuvers", f"more than {max_maneuvers} manoeuvres needed (gap to the curb still {gap:.4g} m)")
         step = maneuver_arcs(v, free, y + sp.J, direction)
         if step is None:
-            return fail(f"no manoeuvre gets closer to the curb (gap {gap:.4g} m) without touching it")
+            return fail("maneuvers", f"no manoeuvre gets closer to the curb (gap {gap:.4g} m) without touching it")
         rho, xi = step
         X, Y, _ = arcs_displacement(rho, xi)
         segments += _symmetric_arcs(v, 3, len(arcs) + 1, _end(segments), direction, -1, rho, xi)
@@ -453,9 +456,9 @@ def _check_max_maneuvers(max_maneuvers: object) -> None:
 
 
 def _failure(v: Vehicle, sp: Space, pass_offset: float, warnings: list[str]):
-    def fail(reason: str) -> ParkingPlan:
+    def fail(stage: FailedAt, reason: str) -> ParkingPlan:
         return ParkingPlan(v, sp, False, reason, 0, (), (), math.nan, math.nan, pass_offset, math.nan,
-                           tuple(warnings))
+                           tuple(warnings), failed_at=stage)
 
     return fail
 
