@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, matvec, readonly
 from ..couplings import coupled_columns, gear_fill, gear_free, linked_steering
 from ..robot import TWIST_NAMES, Robot
-from .linalg import delta_projector, matrix_rank, nondimensional
+from .linalg import coupled_constraints, delta_projector, matrix_rank, nondimensional
 from .models import bounded, configuration
 from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
 from .trees import (
@@ -225,18 +225,6 @@ def actuation_analysis(
         readonly(partitioned_solution(j_u, j_nu) @ i_bar),
         readonly(undriven_motions(i_bar1, j_nu1)),
     )
-
-
-def coupled_constraints(robot: Robot, beta: np.ndarray) -> np.ndarray:
-    """The no-slip constraint matrix (3.22) with one more row per direction a ``gear`` coupling holds at zero (its
-    joints turn together): its null space is the motions the mechanism allows, ``(..., 3E + n_g, 3 + n_w)``."""
-    a = robot.constraint_matrix(beta)
-    if not any(c.kind == "gear" for c in robot.couplings):
-        return a
-    drop = coupled_columns(robot.couplings, jacobian_names(robot), ())[3]
-    rows = np.zeros((drop.shape[1], a.shape[-1]))
-    rows[:, 3:] = drop[: a.shape[-1] - 3].T  # jacobian_names: the wheel rates first, as after the twist in (3.22)
-    return np.concatenate([a, np.broadcast_to(rows, (*a.shape[:-2], *rows.shape))], axis=-2)
 
 
 def subset_trees(robot: Robot, beta: np.ndarray, size: int) -> tuple[list[tuple[int, ...]], TreeVerdict | None]:

@@ -170,6 +170,19 @@ def geared_twist_determined(a: np.ndarray, couplings: tuple, names: tuple[str, .
     return matrix_rank(a_free) == int(twist.sum()) + matrix_rank(a_free[..., ~twist])
 
 
+def coupled_constraints(robot: Robot, beta: np.ndarray) -> np.ndarray:
+    """The no-slip constraint matrix (3.22) of `robot` at `beta` with one more row per direction a ``gear`` coupling
+    holds at zero (its joints turn together, ``q_j = ratio_j * u``): its null space is the motions the mechanism
+    allows, ``(..., 3E + n_g, k)``. Without a gear, the matrix (3.22) itself."""
+    from ..couplings import coupled_columns
+
+    a = robot.constraint_matrix(beta)
+    if not any(c.kind == "gear" for c in robot.couplings):
+        return a
+    rows = coupled_columns(robot.couplings, robot.velocity_names, ())[3].T  # (n_g, k): across each gear's ratios
+    return np.concatenate([a, np.broadcast_to(rows, (*a.shape[:-2], *rows.shape))], axis=-2)
+
+
 def rref(m: ArrayLike, *, rtol: float = RANK_RTOL) -> tuple[np.ndarray, np.ndarray]:
     """Reduced row-echelon form by Gauss-Jordan elimination with partial pivoting, batched (thesis §4.2, 4.6).
 

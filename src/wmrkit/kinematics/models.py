@@ -4,7 +4,9 @@ A model assigns (chooses freely) ``m`` of the velocities ``q_dot = (vx, vy, omeg
 others: ``q_solved = matrix @ q_assigned``. Assigning wheel rates gives the *direct* model, twist components the
 *inverse* model, a mixture a *mixed* model (§4.2). Everything is batched over steering configurations
 ``beta`` ``(..., n_steer)`` (``None``: the described configuration, batch shape ``()``); assignability depends
-on the configuration, and a set assignable at generic angles can fail at a singular one.
+on the configuration, and a set assignable at generic angles can fail at a singular one. A ``gear`` coupling's
+joints turn together (``q_j = ratio_j * u``): its rows ``q_i / ratio_i = q_j / ratio_j`` join the constraint matrix
+(:func:`constraints`), so the mobility, the sets and the models are those of the motions the mechanism allows.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from .._shapes import as_names, as_vectors, matvec, readonly
 from ..errors import ShapeError, SingularError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..robot import TWIST_NAMES, Robot
-from .linalg import matrix_rank, nondimensional, velocity_scale
+from .linalg import coupled_constraints, matrix_rank, nondimensional, velocity_scale
 from .nullspace import null_space_assignable, null_space_solution, rref_solution
 from .ranks import ranks_assignable, ranks_solution
 from .search import SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
@@ -96,9 +98,19 @@ def describe_configuration(robot: Robot, beta: np.ndarray, index: tuple[int, ...
     return f"{where}heading ({angles})"
 
 
-def mobility(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None) -> np.ndarray:
-    """Degree of mobility ``m = k - rank A`` (4.3): ``(..., n_steer) -> (...)`` int (β or `heading`)."""
-    a = nondimensional(robot).constraint_matrix(configuration(robot, beta, heading))
+def constraints(robot: Robot, beta: np.ndarray, gears: bool = True) -> np.ndarray:
+    """The matrix every model here derives from: the nondimensional (:mod:`.linalg`) no-slip matrix (3.22) at `beta`,
+    with a row per direction a ``gear`` coupling holds (:func:`~.linalg.coupled_constraints`) unless not `gears`."""
+    unit = nondimensional(robot)
+    return coupled_constraints(unit, beta) if gears else unit.constraint_matrix(beta)
+
+
+def mobility(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None,
+             gears: bool = True) -> np.ndarray:
+    """Degree of mobility ``m = k - rank A`` (4.3): ``(..., n_steer) -> (...)`` int (β or `heading`). ``A`` holds the
+    robot's ``gear`` couplings (a row per direction a gear forbids), as the models here do; ``gears=False``: the
+    wheels' alone, the thesis's m (equal without a gear)."""
+    a = constraints(robot, configuration(robot, beta, heading), gears)
     return a.shape[-1] - matrix_rank(a)
 
 
@@ -138,7 +150,7 @@ def is_assignable(
 ) -> np.ndarray:
     """Whether the velocities `names` can be assigned, (4.5)/(4.6)/(4.10): ``(..., n_steer) -> (...)`` bool;
     steering `beta` (thesis) or `heading` (0 = rolling forward)."""
-    a = nondimensional(robot).constraint_matrix(configuration(robot, beta, heading))
+    a = constraints(robot, configuration(robot, beta, heading))
     return _assignable(a, velocity_indices(robot, names)[None, :], method)[0]
 
 
@@ -162,7 +174,7 @@ def assignable_sets(
 
     Sets are tuples of velocity names in the robot's order, listed lexicographically.
     """
-    return _sets_at(robot, nondimensional(robot).constraint_matrix(configuration(robot, beta, heading)), method)
+    return _sets_at(robot, constraints(robot, configuration(robot, beta, heading)), method)
 
 
 def generic_configurations(robot: Robot) -> np.ndarray:
@@ -184,7 +196,7 @@ def generically_assignable_sets(robot: Robot) -> tuple[tuple[str, ...], ...]:
     nowhere.
     """
     samples = generic_configurations(robot)
-    a = nondimensional(robot).constraint_matrix(samples)
+    a = constraints(robot, samples)
     m = generic_mobility(robot)
     generic = a.shape[-1] - matrix_rank(a) == m
     tests = [null_space_prefilter(a[i], m) for i in np.flatnonzero(generic)]
@@ -227,7 +239,7 @@ def kinematic_model(
     """
     beta = configuration(robot, beta, heading)
     idx = velocity_indices(robot, assigned)
-    a = nondimensional(robot).constraint_matrix(beta)
+    a = constraints(robot, beta)
     if method == "ranks":
         ok, matrix = ranks_assignable(a, idx[None, :])[0], ranks_solution(a, idx)
     elif method in ("nullspace", "rref"):
@@ -283,7 +295,7 @@ def direct_model(
     beta = configuration(robot, beta, heading)
     if rates is not None:
         return kinematic_model(robot, rates, beta)
-    a = nondimensional(robot).constraint_matrix(beta)
+    a = constraints(robot, beta)
     m = int(np.max(a.shape[-1] - matrix_rank(a)))
     usable = [n for n in robot.rate_names if not n.endswith(".roller")]
     sensed = [n for n in usable if n in robot.sensed]
@@ -308,7 +320,7 @@ def inverse_model(
     beta = configuration(robot, beta, heading)
     if twist_names is not None:
         return kinematic_model(robot, twist_names, beta)
-    a = nondimensional(robot).constraint_matrix(beta)
+    a = constraints(robot, beta)
     free = robot.free_steering  # double wheels' steering rates: no twist determines them, always assigned
     m = int(np.max(a.shape[-1] - matrix_rank(a))) - len(free)
     if free:

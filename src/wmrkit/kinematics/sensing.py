@@ -18,8 +18,8 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, matvec, readonly
 from ..couplings import gear_fill, gear_free
 from ..robot import TWIST_NAMES, Robot
-from .actuation import body_only, coupled_constraints, minimal_set_search, steering_split, verdict_texts
-from .linalg import delta_projector, matrix_rank, nondimensional
+from .actuation import body_only, minimal_set_search, steering_split, verdict_texts
+from .linalg import coupled_constraints, delta_projector, matrix_rank, nondimensional
 from .models import bounded, configuration
 from .search import SetList
 from .trees import (

@@ -50,9 +50,12 @@ def kinematics_summary(robot: Robot) -> dict[str, Any]:
         "beta": dict(zip(robot.steer_names, robot.beta.tolist(), strict=True)),  # the thesis's angles [rad]
         "velocity_names": list(robot.velocity_names),
         "size": characteristic_length(robot),  # L [m]: vx, vy in units of L make the models' entries comparable
-        "mobility": int(mobility(robot)),
+        "mobility": int(mobility(robot, gears=False)),  # the wheels' m (4.3), the thesis's
         "vehicle_dof": int(vehicle_dof(robot)),  # G (4.22): of the m above, motions of the body
-        "generic_mobility": generic_mobility(robot),
+        # m with the gear couplings held (analyze's coupled_mobility): the sets' size, the models' m
+        "coupled_mobility": int(mobility(robot)),
+        "gears": [c.channel_name for c in robot.couplings if c.kind == "gear"],  # held by the sets and models
+        "generic_mobility": generic_mobility(robot),  # the models' m at generic steering
         "extended_dof": extended_dof(robot),
         "assignable_sets": [list(s) for s in here],
         "lost_here": [list(s) for s in generic if s not in here_set] if getattr(here, "complete", True) else [],
@@ -125,15 +128,20 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
     list (None: all).
     """
     steer = ", ".join(f"heading {n} = {math.degrees(v):.6g} deg" for n, v in summary["steering"].items())
-    m, generic = summary["mobility"], summary["generic_mobility"]
-    mobility = (f"  mobility m = {m}" if m == generic else
-                f"  mobility m = {m} at this steering (m = {generic} at generic steering: a special configuration)")
+    m, generic, coupled = summary["mobility"], summary["generic_mobility"], summary["coupled_mobility"]
+    gears = summary["gears"]
+    special = "" if coupled == generic else (f" at this steering (m = {generic} at generic steering: a special "
+                                             "configuration)")
+    mobility = f"  mobility m = {m}" + (" of the wheels alone" if gears else special)
     self_motions = m - summary["vehicle_dof"]
     if self_motions > 0:
         mobility += (f" (4.3): {summary['vehicle_dof']} of the body (G, 4.22; the classification's m) and "
                      f"{self_motions} of the joints with the body at rest")
-    extra = summary["extended_dof"] - m
+    extra = summary["extended_dof"] - coupled
     lines = [f"robot {summary['robot']} ({steer or 'no steering'})", mobility]
+    if gears:
+        lines.append(f"  with its gear couplings m = {coupled}{special} ({', '.join(gears)}, q_j = ratio_j * u): "
+                     "the sets and models below hold them")
     if extra > 0:
         lines.append(f"  with its {extra} steering rate{'s' if extra > 1 else ''} (extended solutions, §4.5), "
                      f"{summary['extended_dof']} velocities can be assigned")
