@@ -38,14 +38,19 @@ def run(args: argparse.Namespace) -> int:
         raise WmrkitError(f"--codegen: language must be one of {', '.join(CODEGEN_LANGUAGES)}, got '{args.codegen[0]}'")
     robot = steered_robot(args.robot, args.steer)
     summary = kinematics_summary(robot)
-    for c in robot.couplings if args.symbolic or args.codegen else ():
-        if c.kind == "gear":  # the closed forms are the uncoupled wheels' (docs/description-format.md, Couplings)
-            warn(f"{c.channel_name} is not used by the closed forms or the generated code: an inverse model may give "
-                 "rates it forbids (check a twist with 'wmrkit ik')")
+    for c in robot.couplings if args.codegen else ():
+        if c.kind == "gear":  # the generated code is the uncoupled wheels' (docs/description-format.md, Couplings)
+            warn(f"{c.channel_name} is not used by the generated code: its inverse model may give rates it forbids "
+                 "(check a twist with 'wmrkit ik')")
     if args.symbolic:
         from ..kinematics.symbolic import format_symbolic
 
         summary["symbolic"] = format_symbolic(robot)
+        if summary["gears"]:
+            from ..kinematics.symbolic import unheld_gears
+
+            for message in unheld_gears(robot):
+                warn(message)
     if args.codegen:
         lang, directory = args.codegen
         from ..kinematics.codegen import write_code

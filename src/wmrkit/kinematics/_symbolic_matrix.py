@@ -8,6 +8,7 @@ pair (sin, cos) per steering angle (or geometry symbol) remains for the exact li
 from __future__ import annotations
 
 import functools
+import itertools
 import math
 from collections.abc import Mapping
 from fractions import Fraction
@@ -183,3 +184,15 @@ def constraint(robot: Robot, beta: tuple[sp.Expr, ...], geometry: tuple) -> sp.I
             rows.append([*row[:3], *([0] * start), *row[3:], *([0] * (n_rates - start - n))])
         start += n
     return sp.ImmutableMatrix(rows)
+
+
+def gear_rows(robot: Robot) -> sp.ImmutableMatrix:
+    """``q_i / ratio_i - q_j / ratio_j`` (exact) per pair of consecutive joints of each ``gear`` coupling of
+    `robot`, over ``robot.velocity_names``: the rows a gear adds under ``A`` (3.22). ``(n_pairs, k)``."""
+    names, rows = robot.velocity_names, []
+    for c in (c for c in robot.couplings if c.kind == "gear"):
+        for (i, ki), (j, kj) in itertools.pairwise(zip(c.joints, c.ratios, strict=True)):
+            row = [sp.Integer(0)] * len(names)
+            row[names.index(i)], row[names.index(j)] = 1 / exact_number(ki, "length"), -1 / exact_number(kj, "length")
+            rows.append(row)
+    return sp.ImmutableMatrix(len(rows), len(names), [v for row in rows for v in row])

@@ -80,7 +80,7 @@ class _Plan:
         self._check_forward()
         self.free_steer = robot.free_steering  # a double wheel's steering rate: an input besides the twist
         self.steer_rate = tuple(sp.Symbol(f"s{i}", real=True) for i in range(len(self.free_steer)))
-        model = symbolic_model(robot, TWIST_NAMES + self.free_steer, self.beta)
+        model = symbolic_model(robot, TWIST_NAMES + self.free_steer, self.beta, gears=False)  # (warned)
         self.inverse_exact = model.exact
         self.rates = model.solved
         self.inverse = [e for e in model.matrix * sp.Matrix(self.twist + self.steer_rate)]

@@ -29,7 +29,7 @@ from ..robot import TWIST_NAMES, Robot
 from ..units import MAX_ANGLE, MAX_TURNS
 from ..wheels import GEOMETRY_FIELDS, Wheel, WheelError
 from ._exact_linalg import _components, agrees, equilibrated, numeric, random_points, solve_exactly
-from ._symbolic_matrix import AssignmentError, _nice_number, constraint, exact_number, geometry_fields
+from ._symbolic_matrix import AssignmentError, _nice_number, constraint, exact_number, gear_rows, geometry_fields
 from .linalg import free_columns, matrix_rank
 
 Geometry = Literal["numeric", "symbolic"] | Mapping[str, sp.Expr]
@@ -41,6 +41,10 @@ MAX_LSQ_ANGLES = 4
 
 class ClosedFormTooLargeError(WmrkitError, ValueError):
     """A least-squares closed form that couples more steering angles than allowed (it would take too long)."""
+
+
+class GearedLeastSquaresError(SingularError):
+    """A set that is not assignable on the motions a robot's gears allow: no exact closed form holds the gears."""
 
 
 # ---- symbols ---------------------------------------------------------------------------------------------
@@ -215,6 +219,7 @@ def symbolic_model(
     geometry: Geometry = "numeric",
     max_lsq_angles: int = MAX_LSQ_ANGLES,
     heading: Sequence[sp.Expr | float] | None = None,
+    gears: bool = True,
 ) -> SymbolicModel:
     """Closed-form solution of ``A q = 0`` for the velocities not in `assigned`, thesis (4.5)/(4.9)-(4.11).
 
@@ -225,6 +230,9 @@ def symbolic_model(
     values of every symbol. `beta`, `heading`, `geometry`: as in :func:`symbolic_constraint_matrix`. A
     least-squares form whose unknowns couple more than `max_lsq_angles` steering symbols (:data:`MAX_LSQ_ANGLES`)
     is refused at once with :class:`ClosedFormTooLargeError` (the derivation grows about fourfold per angle).
+    `gears`: the robot's ``gear`` couplings are held, rows ``q_i / ratio_i - q_j / ratio_j`` under ``A`` (as
+    :mod:`.models` does; ``rank``/``mobility`` count them); a least-squares form of a geared robot is refused
+    (:class:`SingularError`: its fit would weigh the gear rows, rad/s, against slip, m/s). False: the wheels' alone.
     """
     names = as_names(assigned, "assigned", error=AssignmentError)
     for n in names:
@@ -234,13 +242,21 @@ def symbolic_model(
     if isinstance(max_lsq_angles, bool) or not isinstance(max_lsq_angles, int) or max_lsq_angles < 0:
         raise AssignmentError(f"max_lsq_angles: expected a whole number >= 0, got {max_lsq_angles!r}")
     key = _geometry_key(robot, geometry)
-    return _solve(robot, names, _steering_values(robot, beta, heading, key), key, max_lsq_angles)
+    model = _solve(robot, names, _steering_values(robot, beta, heading, key), key, max_lsq_angles, bool(gears))
+    if not model.exact and gears and gear_rows(robot).rows:
+        raise GearedLeastSquaresError(
+            f"robot '{robot.name}': ({name_list(names) or 'nothing'}) is not an assignable set of the motions its "
+            f"gears allow (mobility m = {model.mobility}): no exact closed form, and a least-squares one would "
+            "weigh the gear rows against slip; gears=False gives the wheels' least squares, 'wmrkit ik' holds the gear")
+    return model
 
 
 @functools.lru_cache(maxsize=128)
 def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], geometry: tuple,
-           max_lsq_angles: int) -> SymbolicModel:
+           max_lsq_angles: int, gears: bool = True) -> SymbolicModel:
     a = constraint(robot, beta, geometry)
+    held = gear_rows(robot) if gears else sp.ImmutableMatrix(0, a.cols, [])
+    a = sp.ImmutableMatrix(a.col_join(held)) if held.rows else a
     a_idx = [robot.velocity_index(n) for n in assigned]
     na_idx = [j for j in range(a.cols) if j not in a_idx]
     points = random_points(a)
@@ -302,7 +318,8 @@ def twist_assignment(robot: Robot) -> tuple[str, ...]:
     the ``robot.free_steering`` rates, always assigned), else the whole twist (wheel rates by least squares, as a
     controller computes them); then the free steering rates."""
     free = robot.free_steering
-    rank = symbolic_model(robot, TWIST_NAMES + free).rank
+    key = _geometry_key(robot, "numeric")
+    rank = _solve(robot, TWIST_NAMES + free, _steering_values(robot, None, None, key), key, MAX_LSQ_ANGLES).rank
     m = len(robot.velocity_names) - rank - len(free)
     for subset in itertools.combinations(TWIST_NAMES, m) if 0 < m <= 3 else ():
         try:
@@ -313,24 +330,59 @@ def twist_assignment(robot: Robot) -> tuple[str, ...]:
     return TWIST_NAMES + free
 
 
+def held_model(robot: Robot, names: Sequence[str]) -> tuple[SymbolicModel, bool]:
+    """The closed form of `names` holding the robot's gears, and True; when no exact one does
+    (:class:`GearedLeastSquaresError`), the wheels' least squares, and False."""
+    try:
+        return symbolic_model(robot, names), True
+    except GearedLeastSquaresError:
+        return symbolic_model(robot, names, gears=False), False
+
+
+def default_sets(robot: Robot) -> list[tuple[str, tuple[str, ...]]]:
+    """The titled sets :func:`format_symbolic` shows by default: the direct (sensed) and the inverse model's."""
+    return [("direct model (sensed)", sensed_rates(robot)), ("inverse model", twist_assignment(robot))]
+
+
+def unheld_gears(robot: Robot) -> list[str]:
+    """One sentence per default closed form (:func:`default_sets`) that does not hold the robot's gears (the wheels'
+    least squares, :func:`held_model`); a form not determined or too large says so in its own line, not here."""
+    gears = ", ".join(c.channel_name for c in robot.couplings if c.kind == "gear")
+    out = []
+    for title, names in default_sets(robot) if gears else ():
+        try:
+            held = held_model(robot, names)[1]
+        except (SingularError, ClosedFormTooLargeError):
+            continue
+        if not held:
+            out.append(f"the closed-form {title} ({', '.join(names)}) is of the wheels alone, not holding {gears}: it "
+                       "may give rates they forbid (check a twist with 'wmrkit ik')")
+    return out
+
+
 def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, latex: bool = False) -> str:
     """The closed forms of the direct (sensed) and inverse models of `robot`, or of one `assigned` set.
 
     Plain text (``name = expression``, velocity names as in ``robot.velocity_names``, steering angles
     ``beta_<wheel>`` [rad], geometry exact from the robot's numbers), or LaTeX ``aligned`` blocks. Each model
-    says whether it is exact (4.5)/(4.11) or least squares (4.11)/(4.82), whose residual ``A q`` is slip.
+    says whether it is exact (4.5)/(4.11) or least squares (4.11)/(4.82), whose residual ``A q`` is slip, and,
+    on a robot with a ``gear``, whether it holds the gears (:func:`held_model`).
     """
-    sets = [("model", as_names(assigned, "assigned", error=AssignmentError))] if assigned is not None else [
-        ("direct model (sensed)", sensed_rates(robot)), ("inverse model", twist_assignment(robot))]
+    sets = [("model", as_names(assigned, "assigned", error=AssignmentError))] if assigned is not None else (
+        default_sets(robot))
     comment = "% " if latex else ""
     lines = [f"{comment}{robot.name}: no-slip kinematic models in closed form (thesis ch. 4)",
              f"{comment}  velocities: {', '.join(robot.velocity_names)}",
              f"{comment}  steering [rad]: {_steering_note(robot)}; geometry: the robot's numbers, exact (m, rad)"]
+    gears = [c.channel_name for c in robot.couplings if c.kind == "gear"]
+    if gears:
+        lines.append(f"{comment}  gears: {', '.join(gears)}, q_j = ratio_j * u (rows q_i/ratio_i - q_j/ratio_j = 0 "
+                     "under A): held by every form below that does not say otherwise")
     for title, names in sets:
         lines.append("")
         lines.append(f"{comment}{title}, assigned: {', '.join(names) or 'nothing'}")
         try:
-            model = symbolic_model(robot, names)
+            model, held = held_model(robot, names)
         except SingularError as err:
             lines.append(f"{comment}  not determined: {err}")
             continue
@@ -342,6 +394,8 @@ def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, late
         else:
             how = (f"least squares (4.11)/(4.82): {len(names)} assigned for mobility m = {model.mobility}; "
                    "a residual A q != 0 is slip")
+        if not held:
+            how += "; of the wheels alone, the gears not held (no exact form holds them: check with 'wmrkit ik')"
         lines.append(f"{comment}  {how}")
         lines += _latex_block(model) if latex else [f"    {n} = {_linear_form(model, i)}" for i, n in
                                                     enumerate(model.solved)]
