@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
-from geared import SYNCHRO, cart_yaml
+from geared import STEERED, SYNCHRO, cart_yaml
 from wmrkit import Robot
 from wmrkit.cli.main import main
 from wmrkit.kinematics.models import (
@@ -155,3 +155,18 @@ def test_cli_says_both_mobilities_and_that_the_models_hold_the_gear(tmp_path, ca
     analysis = json.loads(capsys.readouterr().out)
     assert analysis["coupled_mobility"] == data["coupled_mobility"]
     assert analysis["instantaneous_mobility"] == data["mobility"]
+
+
+def test_a_gear_that_locks_the_cart_leaves_no_motion(tmp_path, capsys):
+    # ratio -1: the axle only turns on the spot, which the front wheel (heading 0, at x = 0.6) forbids
+    robot = load(cart_yaml(-1.0, STEERED))
+    assert null_space(augmented(robot)).shape[1] == 0 == int(mobility(robot))
+    assert int(mobility(robot, gears=False)) == null_space(robot.constraint_matrix()).shape[1] == 1
+    assert list(assignable_sets(robot)) == [()]
+    path = tmp_path / "locked.yaml"
+    path.write_text(cart_yaml(-1.0, STEERED))
+    assert main(["kinematics", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "  with its gear couplings m = 0 (gear(left.spin, right.spin)" in out
+    assert "  with its 1 steering rate (extended solutions, §4.5), 1 velocity can be assigned\n" in out
+    assert "    the robot cannot move (m = 0): every velocity is zero" in out

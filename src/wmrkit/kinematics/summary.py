@@ -143,8 +143,9 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
         lines.append(f"  with its gear couplings m = {coupled}{special} ({', '.join(gears)}, q_j = ratio_j * u): "
                      "the sets and models below hold them")
     if extra > 0:
+        n = summary["extended_dof"]
         lines.append(f"  with its {extra} steering rate{'s' if extra > 1 else ''} (extended solutions, §4.5), "
-                     f"{summary['extended_dof']} velocities can be assigned")
+                     f"{n} velocit{'ies' if n > 1 else 'y'} can be assigned")
     lines += [f"  velocities: {', '.join(summary['velocity_names'])}",
               f"  assignable sets ({len(summary['assignable_sets'])}):", *_sets(summary["assignable_sets"], limit)]
     lost = [s for s in summary["lost_here"] if s]
