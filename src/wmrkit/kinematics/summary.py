@@ -154,7 +154,8 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
                   *_sets(lost, limit)]
     for title, key in (("direct model", "direct_model"), ("inverse model", "inverse_model")):
         model = summary[key]
-        kind = "" if "error" in model else f" ({model['kind']}, assigned: {', '.join(model['assigned'])})"
+        kind = "" if "error" in model or not model["assigned"] else (  # m = 0: nothing assigned, one line says so
+            f" ({model['kind']}, assigned: {', '.join(model['assigned'])})")
         lines += [f"  {title}{kind}:", *_matrix_table(model, summary["size"])]
     act, sen = summary["actuation"], summary["sensing"]
     lines.append(f"  actuation [{', '.join(act['actuated'] + [s + '.steer' for s in act['steering_actuated']])}]: "
