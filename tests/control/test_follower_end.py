@@ -56,7 +56,7 @@ def test_pure_pursuit_does_not_stop_while_the_end_is_ahead_of_it():
     """A run stopped once the tracked point crossed the end's line, wherever the end was: the diff drive 1 cm
     before the line's end and 0.3 m beside it, on the arc of radius 0.15 m pure pursuit drives to it (closed form:
     ``d^2 / (2 y)``), crossed the line at once and stopped 0.30 m from the end. Now it stops only once the end is no
-    longer ahead of it (or within ``AIM_RADIUS``), and drives to it at the speed that stops it there (its distance
+    longer ahead of it (or within its aim radius), and drives to it at the speed that stops it there (its distance
     to the end, not the path's arc length left, 0 once its projection is on the end: it crawled at 0.5 % speed)."""
     robot, ref = catalog.load("diff-drive"), builtin_reference("line")  # 10 m along +x, at 0.5 m/s
     end = ref.pose[-1, :2]

@@ -91,8 +91,9 @@ def test_the_trackers_ask_a_car_for_no_turn_tighter_than_its_steering_allows(con
 def test_pure_pursuit_looks_a_wheelbase_ahead_by_default(capsys):
     """The lookahead was 1 m for every robot: the car (2.7 m wheelbase) on its figure-eight at 5 m/s, sampled at
     0.1 s and one sample late, oscillated about the path (cross-track 138 mm RMS, 605 mm max). Now the default is
-    the distance from the axle point to the steered wheels (the car's front axle, read off its wheels here), 1 m at
-    least: 15 mm RMS; the summary line and the JSON answer name it."""
+    the distance from the axle point to the steered wheels (the car's front axle, read off its wheels here): 15 mm
+    RMS (not 2 s at the top speed, 11.8 m, as for a robot without steered wheels: 807 mm); the summary line and the
+    JSON answer name it."""
     from wmrkit.cli.main import main
 
     car = catalog.load("ackermann")

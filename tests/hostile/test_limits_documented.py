@@ -65,6 +65,11 @@ DOCUMENTED = [
      40_000),
     ("wmrkit.control.track", "MAX_SLIP_PERIODS", "at most 50,000 control periods (`control.track.MAX_SLIP_PERIODS`",
      50_000),
+    ("wmrkit.control.trackers", "MIN_LOOKAHEAD_TIME", "2 s at the reference's top speed "
+     "(`trackers.MIN_LOOKAHEAD_TIME`", 2.0),
+    ("wmrkit.control.trackers", "ARRIVAL_FRACTION", "farther than 0.1 of the follower's length", 0.1),
+    ("wmrkit.control.trackers", "AIM_FRACTION", "aim radius 1e-3 of its lookahead (`trackers.AIM_FRACTION`)", 1e-3),
+    ("wmrkit.control.trackers", "EPS_FRACTION", "eps 2e-3 of the top speed (`trackers.EPS_FRACTION`)", 2e-3),
     ("wmrkit.parking.execute", "MAX_SAMPLES", "at most 500,000 samples (`parking.execute.MAX_SAMPLES`", 500_000),
     ("wmrkit.parking.execute", "CHUNK", "10,000 samples at a time (`execute.CHUNK`)", 10_000),
     ("wmrkit.parking.verify", "MAX_CHECK_POSES", "at most 2e6 poses (`verify.MAX_CHECK_POSES`", 2e6),

@@ -5,7 +5,8 @@ recomputes some of its rows).
 
 Columns: RMS and max cross-track error [mm] of the tracked point, the seconds a steered wheel was held at the end of
 its range (the longest of the wheels), and the tracked point's final distance from the path's end [mm] (the rows
-where it exceeds ``trackers.ARRIVAL_TOL`` are those whose run gives an ArrivalWarning, not repeated on stderr)."""
+where it exceeds the follower's tolerance, ``trackers.ARRIVAL_FRACTION`` of its length, are those whose run gives an
+ArrivalWarning, not repeated on stderr)."""
 
 from __future__ import annotations
 
@@ -33,7 +34,7 @@ def row(robot_name: str, ref_name: str, controller: str) -> str:
     """One row of the table: `robot_name` following built-in `ref_name` under `controller`, CLI defaults."""
     robot = catalog.load(robot_name)
     ref = builtin_reference(ref_name, size=default_size(ref_name, min_turning_radius(robot)))
-    with warnings.catch_warnings():  # its ArrivalWarning (ended beyond ARRIVAL_TOL from the path's end): the
+    with warnings.catch_warnings():  # its ArrivalWarning (ended beyond its tolerance from the path's end): the
         warnings.simplefilter("ignore", ArrivalWarning)  # row's last column states that distance
         run = track(robot, ref, controller=controller)
     s = run.summary()

@@ -32,8 +32,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--gate", metavar="D", help="p, pi: apply the feedforward only within D [m] of the "
                                                "reference (8.53)")
     p.add_argument("--lookahead", metavar="L", help="pure-pursuit: lookahead distance along the path [m] "
-                                                    "(default: the wheelbase of a robot with steered wheels, at "
-                                                    "least 1)")
+                                                    "(default: the wheelbase of a robot with steered wheels, "
+                                                    "else 2 s at the reference's top speed: 1 m at 0.5 m/s)")
     p.add_argument("--stanley-gain", metavar="K", help="stanley: cross-track gain [1/s] (default 1)")
     p.add_argument("--period", metavar="T", help="sample period [s]; without it the loop is continuous")
     p.add_argument("--delay", type=int, default=0, metavar="N",
@@ -146,19 +146,22 @@ def min_turning_radius(robot) -> float:
         return 0.0
 
 
-def _lookahead(args: argparse.Namespace, robot) -> tuple[float, str]:
-    """Pure pursuit's ``--lookahead`` [m] (default :func:`wmrkit.control.trackers.default_lookahead`) and the words
-    the summary line names it with (empty for another controller)."""
+def _lookahead(args: argparse.Namespace, robot, reference) -> tuple[float | None, str]:
+    """Pure pursuit's ``--lookahead`` [m] (default :func:`wmrkit.control.trackers.default_lookahead` on
+    `reference`) and the words the summary line names it with (None and empty for another controller)."""
     from ..control.points import control_point
-    from ..control.trackers import MIN_LOOKAHEAD, default_lookahead
+    from ..control.trackers import MIN_LOOKAHEAD_TIME, default_lookahead, default_wheelbase, steers, top_speed
 
     if args.lookahead is not None:
         value = _positive(args.lookahead, "--lookahead", "length")
         return value, f" (lookahead {value:g} m)"
     if args.controller != "pure-pursuit":
-        return MIN_LOOKAHEAD, ""
-    value = default_lookahead(control_point(robot))
-    why = ", the robot's wheelbase" if value > MIN_LOOKAHEAD else ""
+        return None, ""
+    cp, speed = control_point(robot), top_speed(reference)
+    value = default_lookahead(cp, speed)
+    wheelbase = value == default_wheelbase(cp) and (steers(cp) or speed == 0)
+    why = (", the robot's wheelbase" if wheelbase else
+           f", {MIN_LOOKAHEAD_TIME:g} s at the reference's top speed {speed:.4g} m/s")
     return value, f" (lookahead {value:.4g} m{why})"
 
 
@@ -213,7 +216,7 @@ def run_track(args: argparse.Namespace) -> int:
                  parse_value(args.start[2], "angle", "--from THETA")]
     _check_controller_options(args)
     gain = 1.0 if args.gain is None else _non_negative(args.gain, "--gain")
-    lookahead, ahead_words = _lookahead(args, robot)
+    lookahead, ahead_words = _lookahead(args, robot, reference)
     stanley_gain = 1.0 if args.stanley_gain is None else _non_negative(args.stanley_gain, "--stanley-gain")
     period = None if args.period is None else _positive(args.period, "--period")
     duration = None if args.duration is None else _positive(args.duration, "--duration")

@@ -11,7 +11,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .trackers import ARRIVAL_TOL, ArrivalWarning, PathFollower, arrived, follower_duration
+from .trackers import ARRIVAL_FRACTION, ArrivalWarning, PathFollower, arrived, follower_duration
 
 __all__ = ["Limit", "check_arrival", "ended", "follower_bound", "span"]
 
@@ -88,12 +88,13 @@ def _out_of_reach(follower: PathFollower, t: np.ndarray, pose: np.ndarray) -> st
 def check_arrival(follower: PathFollower, t: np.ndarray, pose: np.ndarray, cut: Limit | None = None,
                   delay: int | None = None) -> None:
     """Warn (:class:`.trackers.ArrivalWarning`) when a follower's default run (times `t` ``(n,)`` [s], poses
-    ``(n, 3)``) ended with its tracked point more than ``ARRIVAL_TOL`` from the path's end: still on its way after
+    ``(n, 3)``) ended with its tracked point more than its ``arrival_tol`` (``ARRIVAL_FRACTION`` of its length
+    ``L``) from the path's end: still on its way after
     the bounded run (its extra time `cut` by a limit of the loop, if given), or past the end beside it (and why,
     where its turning radius tells: :func:`_out_of_reach`); `delay`: the loop's (:meth:`.PathFollower.stop_rule`)."""
     end, last = float(t[-1]), pose[-1]
     gap = follower.end_distance(last)
-    if gap <= ARRIVAL_TOL:
+    if gap <= follower.arrival_tol:
         return
     rule = follower.stop_rule(delay)
     if [rule(float(t[k]), pose[k]) for k in range(max(len(t) - 2, 0), len(t))][-1]:
@@ -114,4 +115,5 @@ def check_arrival(follower: PathFollower, t: np.ndarray, pose: np.ndarray, cut: 
                f"the run ended at {end:.4g} s {at}: the followers' extra time after the reference's {total:.4g} s "
                f"was cut to {end - total:.4g} s by {cut.what}; {cut.remedy}")
     warnings.warn(f"the path follower did not reach the path's end: its tracked point ended {gap:.4g} m from it, "
-                  f"beyond the {ARRIVAL_TOL:g} m tolerance; {why}", ArrivalWarning, stacklevel=3)
+                  f"beyond the {follower.arrival_tol:.4g} m tolerance ({ARRIVAL_FRACTION:g} of its length "
+                  f"{follower.length:.4g} m); {why}", ArrivalWarning, stacklevel=3)

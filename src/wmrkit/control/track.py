@@ -25,11 +25,11 @@ from .references import Reference
 from .trackers import (
     PathFollower,
     PathIndex,
-    default_lookahead,
     default_wheelbase,
     max_curvature,
     pure_pursuit,
     stanley,
+    top_speed,
 )
 
 if TYPE_CHECKING:
@@ -166,23 +166,24 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     `duration` [s]: default the reference's; a geometric tracker's default run ends once its point has passed the
     path's end, within :func:`.trackers.follower_duration`, its extra time cut to what the loop's limits allow
     (:func:`.follower_run.follower_bound`; warning :class:`.trackers.ArrivalWarning` when it ends more than
-    ``ARRIVAL_TOL`` from the end, naming the limit that cut it); a given `duration` is run whole.
+    its ``arrival_tol`` from the end, naming the limit that cut it); a given `duration` is run whole.
 
     `controller`: ``"p"`` (8.2), ``"pi"`` (8.3), ``"point"`` (8.1), ``"pure-pursuit"``, ``"stanley"``. `gain`: the pole
     ``a`` [1/s] of every coordinate; `integral_gain` ``b`` [1/s^2] of ``"pi"`` (default ``a^2/4``, critically damped);
     `gate` [m]: feedforward gate (8.53). `initial_pose` ``(3,)`` default: the tracked point on the reference
     (:func:`initial_pose_on`; the geometric trackers' own point). `delay` in samples (discrete only). `point` ``(2,)``
     [m]: controlled point of a reduced-mobility robot (:func:`control_point`). `loops`: low-level actuator loops;
-    `policy`: steering root (:mod:`.steering`). `skew_free`: second-order discretisation of the held twist. Geometric
-    trackers: `lookahead` [m] (pure pursuit; default :func:`.trackers.default_lookahead`, the wheelbase of a
-    robot with steered wheels, at least 1 m), `stanley_gain` [1/s]. `dynamics`: the plant is the chapter-7 dynamic model
-    with tyres (`tyre`: traction model name, default as described), driven by servos each period
-    (:func:`.dynamic_plant.simulate_dynamics`; period default 0.02 s); with it, `feedback="odometry"` measures the
-    pose by odometry from the sensed joints (``TrackingRun.estimate``) instead of exactly, ``"wls"`` by WLS odometry
-    with friction coefficients `weights`, ``"fk2"`` by the Kalman filter FK2 with `noise`; `slip_model` ``"mqe"`` or
-    ``"mcd"``: the wheel commands come from the inverse slip model instead of the no-slip IK (thesis future work 4,
-    :func:`.slip_loop.simulate_slip_control`); `ramp`: there, each period's commands are reached linearly over the
-    period instead of held (first-order hold). `progress`: a tqdm bar over the periods of such a loop.
+    `policy`: steering root (:mod:`.steering`). `skew_free`: second-order discretisation of the held twist.
+    Geometric trackers: `lookahead` [m] (pure pursuit; default :func:`.trackers.default_lookahead`, the wheelbase of
+    a robot with steered wheels, at least 2 s at the reference's top speed), `stanley_gain` [1/s]. `dynamics`: the
+    plant is the chapter-7 dynamic model with tyres (`tyre`: traction model name, default as described), driven by
+    servos each period (:func:`.dynamic_plant.simulate_dynamics`; period default 0.02 s); with it,
+    `feedback="odometry"` measures the pose by odometry from the sensed joints (``TrackingRun.estimate``) instead of
+    exactly, ``"wls"`` by WLS odometry with friction coefficients `weights`, ``"fk2"`` by the Kalman filter FK2 with
+    `noise`; `slip_model` ``"mqe"`` or ``"mcd"``: the wheel commands come from the inverse slip model instead of the
+    no-slip IK (thesis future work 4, :func:`.slip_loop.simulate_slip_control`); `ramp`: there, each period's
+    commands are reached linearly over the period instead of held (first-order hold). `progress`: a tqdm bar over
+    the periods of such a loop.
     """
     if controller not in CONTROLLERS:
         raise ControlError(f"unknown controller '{controller}' (controllers: {', '.join(CONTROLLERS)})")
@@ -225,8 +226,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
 
         ctrl, tracked_point = fast_law_controller(cp, law, reference), cp.point
     elif controller == "pure-pursuit":
-        ahead = default_lookahead(cp) if lookahead is None else lookahead
-        ctrl, tracked_point = pure_pursuit(cp, reference, ahead, max_curvature(robot)), cp.axle_point
+        ctrl, tracked_point = pure_pursuit(cp, reference, lookahead, max_curvature(robot)), cp.axle_point
     else:
         length = default_wheelbase(cp)
         ctrl = stanley(cp, reference, stanley_gain, length, min(1.2, math.atan(length * max_curvature(robot))))
@@ -275,7 +275,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         try:
             out = simulate(robot, ctrl, pose0, duration, period=period, delay=delay, plant=Plant(loops, policy),
                            output_dt=output_dt, skew_free=skew_free, breaks=reference.breaks,
-                           rtol=1e-5 if geometric else 1e-8, atol=1e-7 if geometric else 1e-10, until=until)
+                           rtol=1e-5 if geometric else 1e-8, until=until,
+                           atol=GEOMETRIC_ATOL_TIME * top_speed(reference) if geometric else 1e-10)
         except StoppedRun as err:
             raise _stopped(err, robot, reference, tracked_point, "kinematic") from None
     t, pose = out["t"], out["pose"]
@@ -435,6 +436,9 @@ def _check_continuous_work(cp: ControlPoint, reference: Reference, pose0: np.nda
 
 #: Integration step of the loops through the dynamics [s] (their default).
 DYNAMICS_STEP = 1e-3
+#: The geometric trackers' absolute integration tolerance [m] as a time [s] at the reference's top speed (1e-7 m at
+#: 0.5 m/s): relative, as their lengths are (:mod:`.trackers`), so a scaled run is the same run scaled.
+GEOMETRIC_ATOL_TIME = 2e-7
 #: Most control periods of a loop with slip-model commands or slip-aware feedback: each solves the nonlinear slip
 #: model (1 to 2.3 ms a period for the skid steer and the forklift: at most about 2 min).
 MAX_SLIP_PERIODS = 50_000

@@ -8,15 +8,22 @@ path followers take it from the path, not from a clock), slowing to stop at the 
 - **pure pursuit** (Coulter 1992): the axle point ``A`` (the foot of the fixed axle, the origin without fixed wheels)
   drives on the arc through a goal point ``lookahead`` metres further along the path, held at the path's end once
   that is nearer (as MATLAB's ``controllerPurePursuit`` and Nav2's Regulated Pure Pursuit do: the arc through the
-  end reaches it), and on the end's tangent once the end is no longer ahead of ``A``, or within ``AIM_RADIUS`` of it
+  end reaches it), and on the end's tangent once the end is no longer ahead of ``A``, or within its aim radius
+  (``AIM_FRACTION`` of ``L_d``)
   (a robot beside it, or at it, does not circle it): curvature ``kappa = 2 y_g / L_d^2``; a goal behind ``A``
   (``x_g <= 0``) turns it round on the circle of diameter ``L_d`` (``kappa = +-2 / L_d``, towards the goal's side,
-  left when straight behind); ``L_d`` defaults to the wheelbase (:func:`default_lookahead`);
+  left when straight behind); ``L_d`` defaults to the wheelbase of a robot with steered wheels, else to
+  ``MIN_LOOKAHEAD_TIME`` at the reference's top speed (:func:`default_lookahead`);
 - **Stanley** (Thrun et al. 2006; Hoffmann et al. 2007): a front point ``F`` at ``wheelbase`` ahead of ``A``;
   steering ``delta = psi_e - atan(k e / (v_F + eps))`` with the heading error ``psi_e``, the signed cross-track
   error ``e`` of ``F`` (positive left) and ``F``'s speed ``v_F`` (the path's: the front axle's, as in Hoffmann's
   law, whose cross-track error then obeys ``e' = -v_F sin(atan(k e / v_F))``); ``A`` drives at
-  ``v_F cos(delta)``, turning at ``v_F sin(delta) / wheelbase``.
+  ``v_F cos(delta)``, turning at ``v_F sin(delta) / wheelbase``; ``eps`` is ``EPS_FRACTION`` of the reference's
+  top speed.
+
+Every length of the followers is relative (the same robot and reference scaled by any factor, speeds with them and
+times kept, give the same run scaled): to the follower's own length ``L`` (:attr:`PathFollower.length`: pure
+pursuit's lookahead, Stanley's stopping length), or to the reference's top speed times a time.
 
 Both limit the curvature to the robot's tightest turn (:func:`max_curvature`: a car's steering stops).
 The resulting unicycle twist ``(v, omega)`` at ``A`` along the robot's rolling direction is moved to the origin
@@ -38,29 +45,37 @@ from .loop import TwistController
 from .points import ControlError, ControlPoint
 from .references import Reference
 
-__all__ = ["AIM_RADIUS", "ARRIVAL_TOL", "ArrivalWarning", "PathFollower", "PathIndex", "arrived",
-           "default_lookahead", "default_wheelbase", "follower_duration", "max_curvature", "pure_pursuit", "stanley"]
+__all__ = ["AIM_FRACTION", "ARRIVAL_FRACTION", "ArrivalWarning", "PathFollower", "PathIndex", "arrived",
+           "default_lookahead", "default_wheelbase", "follower_duration", "max_curvature", "min_length", "pure_pursuit",
+           "stanley", "steers", "top_speed"]
 
-#: The shortest default lookahead of pure pursuit [m] (:func:`default_lookahead`).
-MIN_LOOKAHEAD = 1.0
+#: Pure pursuit's default lookahead for a robot without steered wheels, and the shortest stopping length of Stanley,
+#: as a time [s] at the reference's top speed (Nav2's Regulated Pure Pursuit's ``lookahead_time``): 1 m at 0.5 m/s
+#: (:func:`default_lookahead`).
+MIN_LOOKAHEAD_TIME = 2.0
+#: Stanley's ``eps`` (the speed added to the front point's in ``atan(k e / (v_F + eps))``) as a fraction of the
+#: reference's top speed: 1e-3 m/s at 0.5 m/s.
+EPS_FRACTION = 2e-3
 #: The slowest a follower drives along its path, as a fraction of the reference's top speed (where the reference is
 #: at rest, or crawls: a start from rest would never leave it).
 MIN_SPEED_FRACTION = 0.1
 #: A follower slows to stop at the path's end over its own length ``L`` (pure pursuit's lookahead; Stanley's
-#: wheelbase, at least ``MIN_LOOKAHEAD``): its
+#: wheelbase, at least ``MIN_LOOKAHEAD_TIME`` at the reference's top speed): its
 #: speed is scaled by ``sqrt(d / L)`` within ``d < L`` of the end along the path (a constant deceleration, as a
 #: driver brakes), at least by ``APPROACH_FLOOR`` (it creeps over the last ``APPROACH_FLOOR**2 L``, and arrives).
 APPROACH_FLOOR = 0.005
 #: A follower's default run: the reference's duration and up to this fraction of it more, at least ``EXTRA_MIN`` s
 #: (:func:`follower_duration`); it ends once the tracked point has passed the path's end.
 EXTRA_FRACTION, EXTRA_MIN = 0.5, 10.0
-#: A follower that ends farther than this [m] from the path's end did not arrive (:class:`ArrivalWarning`).
-ARRIVAL_TOL = 0.1
-#: Pure pursuit has reached the path's end within this [m] (its run stops there: :meth:`PathIndex.done`); it aims at
+#: A follower that ends farther than this fraction of its length ``L`` (:attr:`PathFollower.length`) from the path's
+#: end did not arrive (:class:`ArrivalWarning`): 0.1 m at ``L`` = 1 m.
+ARRIVAL_FRACTION = 0.1
+#: Pure pursuit has reached the path's end within its aim radius, this fraction of its lookahead ``L`` (1 mm at
+#: ``L`` = 1 m; its run stops there: :meth:`PathIndex.done`); it aims at
 #: the end until then (or until the end is no longer ahead), and drives on along the end's tangent after: aiming at a
 #: point ``r`` away turns at up to ``2 / r``, and a robot at rest just short of the end (the slip of the dynamics)
 #: was steered round at the stops and tipped over.
-AIM_RADIUS = 0.001
+AIM_FRACTION = 1e-3
 
 
 class ArrivalWarning(UserWarning):
@@ -82,10 +97,14 @@ class PathIndex:
         self.s = np.concatenate([[0.0], np.cumsum(seg)])
         self.half = 0.5 * seg
         self.window = window
+        # a round-off guard [m] of distances between its points (ties at a corner): above the coordinates' rounding
+        # (1e-16 of them) at any size, far below any length the followers use (1e-9 of a 1 mm path)
+        self.tie = 1e-12 * max(1.0, float(np.abs(self.xy).max()))
         speed = np.hypot(*reference.velocity[:, :2].T)
-        moving = speed > 1e-9
+        self.top_speed = float(speed.max())
+        moving = speed > 1e-9 * self.top_speed  # at rest: a relative round-off guard
         self._s_moving, self._v_moving = self.s[moving], speed[moving]
-        self.min_speed = MIN_SPEED_FRACTION * float(speed.max())
+        self.min_speed = MIN_SPEED_FRACTION * self.top_speed
 
     def speed(self, s: float) -> float:
         """The reference's speed [m/s] where it passes arc length `s` [m] (interpolated between its moving samples),
@@ -126,7 +145,7 @@ class PathIndex:
         lo = min(lo, m - 1)  # past the reference's end (where it rests): its last segment
         hi = min(max(hi, lo + 1), m)
         d = np.hypot(*(self.xy[lo:hi + 1] - point).T)
-        reach, first, last = 2.0 * float(d.min()) + 1e-12, lo, hi
+        reach, first, last = 2.0 * float(d.min()) + self.tie, lo, hi
         width = max(hi - lo, 2)
         while lo > 0 and self._below(point, lo - 1, lo)[0] <= reach:  # the path before the window, within reach
             start = max(lo - width, 0)
@@ -146,28 +165,28 @@ class PathIndex:
         near = lo + np.flatnonzero(below <= d.min())  # the segments that may hold the nearest point
         dist, u = self._feet(point, near)
         k = int(np.argmin(dist))
-        while k + 1 < len(near) and near[k + 1] == near[k] + 1 and dist[k + 1] <= dist[k] + 1e-12:  # a corner's tie
+        while k + 1 < len(near) and near[k + 1] == near[k] + 1 and dist[k + 1] <= dist[k] + self.tie:  # a corner's tie
             k += 1
         return int(near[k]), float(u[k])
 
     def done(self, point: np.ndarray, s: float, heading: float | None = None, previous: np.ndarray | None = None,
-             steps: int = 0) -> bool:
+             steps: int = 0, aim: float = 0.0) -> bool:
         """Whether `point`, projected at arc length `s` [m] (:meth:`project`), has passed the path's end: it projects
         on the end, past it along the last segment (a closed path's start, on its end, has not); given the `heading`
         [rad] of a point that steers for the end (pure pursuit), also the end is no longer ahead of it (one that
         crossed the end's line beside it, on an arc to it, drives on to it), unless it has arrived: it is within
-        ``AIM_RADIUS`` of the end, whatever its heading, or its step from `previous` (its position a sample before)
-        passed the end within ``steps`` times that step, at least ``AIM_RADIUS`` (:func:`arrived`)."""
+        `aim` [m] (its aim radius) of the end, whatever its heading, or its step from `previous` (its position a
+        sample before) passed the end within ``steps`` times that step, at least `aim` (:func:`arrived`)."""
         a, b = self.xy[-2], self.xy[-1]
         if heading is not None and previous is not None:  # its last step passed the end: arrived
-            reach = max(AIM_RADIUS, steps * float(np.hypot(*(point - previous))))
-            if s >= self.s[-1] - reach - AIM_RADIUS and arrived(previous, point, b, reach):
+            reach = max(aim, steps * float(np.hypot(*(point - previous))))
+            if s >= self.s[-1] - reach - aim and arrived(previous, point, b, reach):
                 return True
         if s < self.s[-1]:
             return False
-        if heading is not None and float(np.hypot(*(point - b))) < AIM_RADIUS:  # at the end: arrived
+        if heading is not None and float(np.hypot(*(point - b))) < aim:  # at the end: arrived
             return True
-        if not (float((point - b) @ (b - a)) >= 0 and float(np.hypot(*(point - b))) > 1e-9):
+        if not (float((point - b) @ (b - a)) >= 0 and float(np.hypot(*(point - b))) > 1e3 * self.tie):
             return False
         return heading is None or float((b - point) @ np.array([math.cos(heading), math.sin(heading)])) <= 0
 
@@ -194,7 +213,7 @@ class PathIndex:
     def tangent(self, i: int) -> float:
         """Path direction [rad] at sample `i` (from the reference velocity, or the chord)."""
         v = self.ref.velocity[i, :2]
-        if np.hypot(*v) > 1e-9:
+        if np.hypot(*v) > 1e-9 * self.top_speed:
             return math.atan2(v[1], v[0])
         j = min(i + 1, len(self.xy) - 1)
         k = max(j - 1, 0)
@@ -221,7 +240,7 @@ def arrived(q: np.ndarray, p: np.ndarray, end: np.ndarray, reach: float) -> bool
     """Whether a point that moved from `q` to `p` in a sample passed `end` within `reach` [m] (the step's nearest
     point to it is between them). A sampled loop moves ``v T`` between its decisions and sees its pose ``delay``
     samples late: it passes the end between two samples, off it by up to about ``(1 + delay) v T``, and a test of
-    `p` alone against ``AIM_RADIUS`` is met only by luck (:meth:`PathFollower.stop_rule`)."""
+    `p` alone against the aim radius is met only by luck (:meth:`PathFollower.stop_rule`)."""
     d = p - q
     n2 = float(d @ d)
     u = float((end - q) @ d) / n2 if n2 > 0 else 1.0
@@ -239,13 +258,32 @@ def default_wheelbase(cp: ControlPoint) -> float:
     return d if d > 1e-6 else 0.5
 
 
-def default_lookahead(cp: ControlPoint) -> float:
-    """Pure pursuit's default lookahead [m]: the wheelbase (:func:`default_wheelbase`) of a robot that steers with
-    steered wheels, at least ``MIN_LOOKAHEAD``; ``MIN_LOOKAHEAD`` for any other (a shorter lookahead than the
-    wheelbase oscillates once the loop is sampled at speed: the car's figure-eight at 5 m/s, period 0.1 s and one
-    sample late, 138 mm RMS cross-track at 1 m against 15 mm at its 2.7 m wheelbase)."""
-    steered = any(w.type in ("steerable", "double") for w in cp.robot.wheels)
-    return max(MIN_LOOKAHEAD, default_wheelbase(cp)) if steered and cp.reduced else MIN_LOOKAHEAD
+def top_speed(reference: Reference) -> float:
+    """The reference's top speed [m/s] along its path (0 for one at rest)."""
+    return float(np.hypot(*reference.velocity[:, :2].T).max())
+
+
+def min_length(speed: float) -> float:
+    """``MIN_LOOKAHEAD_TIME`` at a reference's top `speed` [m/s], in metres: pure pursuit's default lookahead for a
+    robot without steered wheels, and Stanley's shortest stopping length."""
+    return MIN_LOOKAHEAD_TIME * speed
+
+
+def steers(cp: ControlPoint) -> bool:
+    """Whether the robot of `cp` steers with steered wheels (a reduced robot with type-4 or double wheels)."""
+    return cp.reduced and any(w.type in ("steerable", "double") for w in cp.robot.wheels)
+
+
+def default_lookahead(cp: ControlPoint, speed: float) -> float:
+    """Pure pursuit's default lookahead [m] on a reference of top `speed` [m/s]: the wheelbase
+    (:func:`default_wheelbase`) of a robot that steers with steered wheels (a shorter lookahead oscillates once the
+    loop is sampled at speed: the car's figure-eight at 5 m/s, period 0.1 s and one sample late, 138 mm RMS
+    cross-track at 1 m against 15 mm at its 2.7 m wheelbase; a longer one cuts its turns: 807 mm at 2 s at that
+    speed, 11.8 m); for any other robot :func:`min_length`, 2 s at the top speed (1 m at 0.5 m/s); the wheelbase
+    where that is 0 (a reference at rest: its run stops at once)."""
+    wheelbase = default_wheelbase(cp)
+    ahead = wheelbase if steers(cp) and wheelbase > 0 else min_length(speed)
+    return ahead if ahead > 0 else wheelbase
 
 
 def max_curvature(robot: Robot) -> float:
@@ -280,13 +318,17 @@ class PathFollower:
     (``pose -> (2,)`` world [m]), to tell when that point has driven it to the end (:meth:`finished`); `heading`
     (``pose -> rad``): that point's direction of travel, for a law that steers for the end (:meth:`PathIndex.done`);
     `axle` (``pose -> (A, psi)``): the axle point and its heading, the tracked point being `offset` [m] ahead of it,
-    ``A`` turning at most at curvature `tightest` [1/m] (why it missed the end: :mod:`.follower_run`)."""
+    ``A`` turning at most at curvature `tightest` [1/m] (why it missed the end: :mod:`.follower_run`); `length` [m]:
+    its own length ``L`` (pure pursuit's lookahead, Stanley's stopping length), which its tolerances are relative
+    to: ``aim`` = ``AIM_FRACTION L`` (its aim radius), ``arrival_tol`` = ``ARRIVAL_FRACTION L``."""
 
     def __init__(self, path: PathIndex, tracked: Callable[[np.ndarray], np.ndarray], law: TwistController,
                  heading: Callable[[np.ndarray], float] | None = None, tightest: float = math.inf,
-                 axle: Callable[[np.ndarray], tuple[np.ndarray, float]] | None = None, offset: float = 0.0) -> None:
+                 axle: Callable[[np.ndarray], tuple[np.ndarray, float]] | None = None, offset: float = 0.0,
+                 length: float = 1.0) -> None:
         self.path, self.tracked, self.law, self.heading, self.tightest = path, tracked, law, heading, tightest
-        self.axle, self.offset = axle, offset
+        self.axle, self.offset, self.length = axle, offset, length
+        self.aim, self.arrival_tol = AIM_FRACTION * length, ARRIVAL_FRACTION * length
 
     def __call__(self, t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return self.law(t, pose, integral)
@@ -297,13 +339,13 @@ class PathFollower:
         p = self.tracked(pose)
         q = None if previous is None else self.tracked(previous)
         heading = None if self.heading is None else self.heading(pose)
-        return self.path.done(p, self.path.project(p, t)[0], heading, q, steps)
+        return self.path.done(p, self.path.project(p, t)[0], heading, q, steps, self.aim)
 
     def stop_rule(self, delay: int | None = None) -> Callable[[float, np.ndarray], bool]:
         """:meth:`finished` on a run's successive samples ``(t, pose)``, each with the one before, for a continuous
         loop (`delay` None) or a sampled one measuring its pose `delay` periods late: a loop's `until`. Its point
-        has arrived once its last step passed the end within ``(1 + delay)`` times that step (at least
-        ``AIM_RADIUS``): what the loop resolves (:func:`arrived`). A sample no later than the last starts a run."""
+        has arrived once its last step passed the end within ``(1 + delay)`` times that step (at least its aim
+        radius): what the loop resolves (:func:`arrived`). A sample no later than the last starts a run."""
         last: list = [math.inf, None]
         steps = 0 if delay is None else 1 + delay
 
@@ -319,28 +361,30 @@ class PathFollower:
         return float(np.hypot(*(self.tracked(pose) - self.path.xy[-1])))
 
 
-def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0,
+def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float | None = None,
                  curvature: float = math.inf) -> PathFollower:
-    """Pure-pursuit controller (see module doc); `lookahead` [m], > 0; the commanded curvature is limited to
-    ``+-curvature`` [1/m] (the robot's tightest turn, :func:`max_curvature`)."""
+    """Pure-pursuit controller (see module doc); `lookahead` [m], > 0 (default :func:`default_lookahead`); the
+    commanded curvature is limited to ``+-curvature`` [1/m] (the robot's tightest turn, :func:`max_curvature`)."""
+    if lookahead is None:
+        lookahead = default_lookahead(cp, top_speed(reference))
     if not 0 < lookahead < math.inf:  # NaN included
         raise ControlError(f"lookahead: expected a distance > 0 m along the path, got {lookahead}")
-    path = PathIndex(reference)
+    path, aim = PathIndex(reference), AIM_FRACTION * lookahead
 
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         a, psi = _axle_state(cp, pose)
         s_near, _, _ = path.project(a, t)
-        if path.done(a, s_near, psi):  # the path is driven: stop
+        if path.done(a, s_near, psi, aim=aim):  # the path is driven: stop
             return np.zeros(3), np.zeros(3)
         c, s = math.cos(psi), math.sin(psi)
         ahead, end = s_near + lookahead, float(path.s[-1])
         d = path.point_at(min(ahead, end)) - a  # the goal: held at the path's end (the arc through it reaches it)
         x_g, y_g = c * d[0] + s * d[1], -s * d[0] + c * d[1]
-        if ahead > end and (x_g <= 0 or x_g * x_g + y_g * y_g < AIM_RADIUS**2):  # the end passed, or reached:
+        if ahead > end and (x_g <= 0 or x_g * x_g + y_g * y_g < aim * aim):  # the end passed, or reached:
             d = path.point_at(ahead) - a  # on along the end's tangent
             x_g, y_g = c * d[0] + s * d[1], -s * d[0] + c * d[1]
         dist2 = x_g * x_g + y_g * y_g
-        if dist2 <= 1e-12:
+        if dist2 <= (1e-3 * aim) ** 2:  # at the goal (1e-6 of the lookahead: a round-off guard)
             kappa = 0.0
         elif x_g > 0:
             kappa = 2.0 * y_g / dist2
@@ -352,7 +396,7 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float = 1.0,
         return _twist_at_origin(cp, v, v * kappa), np.zeros(3)
 
     return PathFollower(path, lambda pose: _axle_state(cp, pose)[0], control, lambda pose: _axle_state(cp, pose)[1],
-                        curvature, lambda pose: _axle_state(cp, pose))
+                        curvature, lambda pose: _axle_state(cp, pose), length=lookahead)
 
 
 def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase: float | None = None,
@@ -365,7 +409,8 @@ def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase
         raise ControlError(f"wheelbase: expected a distance > 0 m, got {length}")
     if not 0 < max_steer < math.pi / 2:
         raise ControlError(f"max_steer: expected a steering limit in (0, 90) deg [rad], got {max_steer}")
-    path, stopping = PathIndex(reference), max(length, MIN_LOOKAHEAD)
+    path = PathIndex(reference)
+    stopping, eps = max(length, min_length(path.top_speed)), EPS_FRACTION * path.top_speed
 
     def front(pose: np.ndarray) -> np.ndarray:
         a, psi = _axle_state(cp, pose)
@@ -379,10 +424,10 @@ def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase
             return np.zeros(3), np.zeros(3)
         v_front = path.speed(s_front) * path.approach(s_front, stopping)  # the front point's (Hoffmann et al. 2007)
         psi_e = math.remainder(chi - psi, 2 * math.pi)
-        delta = psi_e - math.atan2(gain * e, v_front + 1e-3)
+        delta = psi_e - math.atan2(gain * e, v_front + eps)
         delta = min(max(delta, -max_steer), max_steer)
         v = v_front * math.cos(delta)  # the axle point's: the front one's along the heading
         return _twist_at_origin(cp, v, v_front * math.sin(delta) / length), np.zeros(3)
 
     return PathFollower(path, front, control, tightest=math.tan(max_steer) / length,
-                        axle=lambda pose: _axle_state(cp, pose), offset=length)
+                        axle=lambda pose: _axle_state(cp, pose), offset=length, length=stopping)
