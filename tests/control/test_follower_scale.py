@@ -4,7 +4,8 @@ metres: at k = 1e-3 pure pursuit's lookahead was floored at 1 m (``MIN_LOOKAHEAD
 the end of its 4 mm-radius circle, with no warning (``ARRIVAL_TOL`` = 0.1 m was longer than the whole run);
 Stanley's stopping length was floored there too and its ``eps`` was 1e-3 m/s (the car ended 9.0 mm from its circle's
 end, 26 mm from its figure-eight's). Now they are relative: to the follower's own length ``L``, or to the reference's
-top speed."""
+top speed. The default control point of a robot whose origin is on its fixed axle (the diff drive's: Stanley's
+wheelbase) was at least 0.1 m ahead; now at its largest wheel distance, scaled with it."""
 
 from __future__ import annotations
 
@@ -29,12 +30,9 @@ def _run(robot_name: str, ref_name: str, controller: str, k: float) -> tuple[flo
     robot = catalog.load(robot_name)
     size = default_size(ref_name, min_turning_radius(robot))
     ref = builtin_reference(ref_name, speed=0.5 * k, size=size * k)
-    # the diff drive's control point (Stanley's wheelbase) given, scaled: control_point's default has a 0.1 m floor
-    # (points.py, not the followers'); the car's followers use its wheels, not that point
-    point = control_point(robot).point * k if robot_name == "diff-drive" else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ArrivalWarning)
-        run = track(scaled(robot, k), ref, controller=controller, point=point)
+        run = track(scaled(robot, k), ref, controller=controller)
     end = float(np.hypot(*(run.tracked[-1, :2] - ref.pose[-1, :2])))
     warned = sum(issubclass(w.category, ArrivalWarning) for w in caught)
     return end / k, run.summary()["rms_cross_track"] / k, warned
@@ -69,3 +67,12 @@ def test_the_default_lookahead_is_the_wheelbase_or_two_seconds_at_the_top_speed(
     assert top_speed(eight) == pytest.approx(0.5 * 2**0.5 / 1.2, rel=1e-12)
     assert default_lookahead(diff, 5e-4) == pytest.approx(1e-3) == min_length(5e-4)
     assert default_lookahead(car, 50.0) == pytest.approx(2.7) and default_lookahead(diff, 50.0) == 100.0
+
+
+@pytest.mark.parametrize("k", SCALES)
+def test_the_default_control_point_scales_with_the_robot(k):
+    """The diff drive's default point (its origin on its axle): 0.25 m ahead at 1:1, 0.25 k at scale k (was 0.1 m at
+    1e-3, the floor, 400 times its wheel distance)."""
+    robot = catalog.load("diff-drive")
+    reach = max(w.l for w in robot.wheels)
+    np.testing.assert_allclose(control_point(scaled(robot, k)).point, [reach * k, 0.0], rtol=1e-12, atol=0)

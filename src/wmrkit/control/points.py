@@ -107,7 +107,9 @@ def _cached(robot: Robot, point: tuple[float, float] | None, reduced: bool | Non
     if point is None:
         p = np.zeros(2)
         if is_reduced and abs(_gain_det(basis, p)) < 1e-9:
-            reach = max([w.l for w in robot.wheels] + [0.1])
+            # the largest wheel distance (a wheel radius if every wheel is at the origin): at the robot's scale,
+            # not a fixed length (a 0.1 m floor put a 0.5 mm robot's point 200 of its sizes ahead)
+            reach = max(w.l for w in robot.wheels) or max(w.r for w in robot.wheels)
             p = reach * np.array([math.cos(forward), math.sin(forward)])
     else:
         p = np.asarray(point, dtype=float)
@@ -138,7 +140,8 @@ def control_point(robot: Robot, point: ArrayLike | None = None, *, reduced: bool
     """What the loop controls for `robot` (§8.2): full pose, or ``(x, y)`` of `point` [m, robot frame].
 
     `reduced`: None picks it from the robot (fixed wheels -> reduced). Default point: the robot origin, or when the
-    origin lies on the fixed axle, a point ahead of it at the robot's largest wheel distance.
+    origin lies on the fixed axle, a point ahead of it at the robot's largest wheel distance (its largest wheel radius
+    when every wheel is at the origin).
     """
     key = None if point is None else tuple(float(v) for v in as_vectors(point, 2, "point"))
     if key is not None and not all(abs(v) <= MAX_SIZE for v in key):  # NaN included
