@@ -78,9 +78,9 @@ def test_cli_symbolic_says_which_forms_do_not_hold_the_synchro_gear(tmp_path, ca
     assert json.loads(out)["symbolic"].count("of the wheels alone, the gears not held") == 2
 
 
-def test_cli_codegen_still_warns_that_the_generated_code_ignores_a_gear(tmp_path, capsys):
+def test_cli_codegen_holds_the_gear_without_a_warning(tmp_path, capsys):
+    """The generated code holds gears (tests/kinematics/test_gear_codegen.py): no warning any more."""
     path = tmp_path / "axle.yaml"
-    path.write_text(TWO_ENCODERS)  # both spins sensed: the generated forward model needs no gear
+    path.write_text(TWO_ENCODERS)
     assert main(["kinematics", str(path), "--codegen", "python", str(tmp_path / "out")]) == 0
-    err = capsys.readouterr().err
-    assert "wmrkit: warning: gear(left.spin, right.spin) is not used by the generated code" in err
+    assert "warning" not in capsys.readouterr().err

@@ -38,10 +38,6 @@ def run(args: argparse.Namespace) -> int:
         raise WmrkitError(f"--codegen: language must be one of {', '.join(CODEGEN_LANGUAGES)}, got '{args.codegen[0]}'")
     robot = steered_robot(args.robot, args.steer)
     summary = kinematics_summary(robot)
-    for c in robot.couplings if args.codegen else ():
-        if c.kind == "gear":  # the generated code is the uncoupled wheels' (docs/description-format.md, Couplings)
-            warn(f"{c.channel_name} is not used by the generated code: its inverse model may give rates it forbids "
-                 "(check a twist with 'wmrkit ik')")
     if args.symbolic:
         from ..kinematics.symbolic import format_symbolic
 

@@ -6,103 +6,37 @@ controller needs it. ``forward(sensed, heading) -> twist`` solves the no-slip eq
 unsensed rate by least squares (4.11): the generated C carries a small Householder-QR routine (no closed form
 to blow up), the generated Python calls ``numpy.linalg.pinv``; the residual ``|A q|`` [m/s] is the slip (4.16).
 Both are printed from the same symbolic constraint matrix (3.22), with common-subexpression elimination.
+A ``gear`` coupling is held as ``fk`` and ``ik`` hold it: the forward model's unknowns are those of
+:func:`wmrkit.couplings.gear_unknowns` (a gear's unsensed joints filled from its sensed ones, its turn an unknown
+when none is sensed), and ``in_gear`` checks the inverse model's rates against the ratios (``wheel_commands``).
 The steering inputs are headings (0 = rolling straight ahead, counter-clockwise positive), what encoders and
 controllers use; the generated code turns each into the thesis's angle, ``beta = heading + pi/2 - delta``.
 """
 
 from __future__ import annotations
 
-import json
-import keyword
-import math
 import os
 import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Literal
 
-import numpy as np
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
-from sympy.printing.numpy import NumPyPrinter
 
-from .._shapes import as_names
-from ..errors import SingularError, WmrkitError, name_list
-from ..robot import TWIST_NAMES, Robot
-from .linalg import free_columns, matrix_rank, nondimensional
-from .symbolic import printable, sensed_rates, symbolic_constraint_matrix, symbolic_model
+from ..robot import Robot
+from ._codegen_plan import C_KEYWORDS, CodegenError, Plan, cse, identifier
+from ._codegen_python import python_file
+from .symbolic import printable
+from .wheel_ik import GEAR_RTOL
 
-C_KEYWORDS = frozenset(
-    "auto break case char const continue default do double else enum extern float for goto if inline int long "
-    "register restrict return short signed sizeof static struct switch typedef union unsigned void volatile while "
-    "_Bool _Complex _Imaginary".split()
-)
-
+__all__ = ["C_KEYWORDS", "MAX_FILENAME", "MAX_STACK_WORK", "CodegenError", "identifier", "write_code"]
 
 #: Longest file name (bytes) most file systems allow (ext4, APFS, NTFS); longer robot names are refused.
 MAX_FILENAME = 255
 #: Largest workspace of the C forward model kept on the stack [doubles, 4 KiB]: a larger one (64 double wheels
 #: sensing one spin each: 270 KB) overflowed small stacks (a 32 KiB thread, a microcontroller's task) and is static.
 MAX_STACK_WORK = 512
-
-
-class CodegenError(WmrkitError, ValueError):
-    """A code-generation request that cannot be met (unknown language, sensed set, directory, existing file)."""
-
-
-def identifier(name: str) -> str:
-    """A C and Python identifier from a robot name: ``"diff-drive 2" -> "diff_drive_2"``, never a keyword."""
-    ident = re.sub(r"\W", "_", name, flags=re.ASCII).strip("_") or "robot"
-    if ident[0].isdigit():
-        ident = f"robot_{ident}"
-    return f"{ident}_" if ident in C_KEYWORDS or keyword.iskeyword(ident) else ident
-
-
-class _Plan:
-    """Everything the printers need: symbols, the constraint matrix, inverse closed form, forward split."""
-
-    def __init__(self, robot: Robot, sensed: Sequence[str] | None) -> None:
-        self.robot, self.name = robot, identifier(robot.name)
-        self.beta = tuple(sp.Symbol(f"b{i}", real=True) for i in range(len(robot.steer_names)))
-        # beta = heading + offset (Robot.beta_of_heading; the offset is beta at heading 0, pi/2 - delta)
-        self.offsets = tuple(float(b) for b in robot.beta_of_heading(np.zeros(len(self.beta))))
-        self.twist = tuple(sp.Symbol(n, real=True) for n in TWIST_NAMES)
-        self.sensed = as_names(sensed, "sensed", error=CodegenError) if sensed is not None else sensed_rates(robot)
-        for n in self.sensed:
-            if robot.velocity_index(n) < 3:
-                raise CodegenError(f"sensed: '{n}' is a body velocity; sensed inputs are wheel joint rates")
-        if len(set(self.sensed)) != len(self.sensed) or not self.sensed:
-            raise CodegenError(f"sensed: expected distinct wheel rates, got ({', '.join(self.sensed)})")
-        self.q = tuple(sp.Symbol(f"q{i}", real=True) for i in range(len(self.sensed)))
-        self.a = symbolic_constraint_matrix(robot, self.beta)
-        self.sensed_cols = [robot.velocity_index(n) for n in self.sensed]
-        self.unknown_cols = [j for j in range(self.a.cols) if j not in self.sensed_cols]
-        self._check_forward()
-        self.free_steer = robot.free_steering  # a double wheel's steering rate: an input besides the twist
-        self.steer_rate = tuple(sp.Symbol(f"s{i}", real=True) for i in range(len(self.free_steer)))
-        model = symbolic_model(robot, TWIST_NAMES + self.free_steer, self.beta, gears=False)  # (warned)
-        self.inverse_exact = model.exact
-        self.rates = model.solved
-        self.inverse = [e for e in model.matrix * sp.Matrix(self.twist + self.steer_rate)]
-
-    def _check_forward(self) -> None:
-        beta = np.random.default_rng(7).uniform(-math.pi, math.pi, (3, len(self.robot.steer_names)))
-        # on the nondimensional robot, as the numeric models decide ranks: raw, a 1 um robot's 1 nm castor was lost
-        a = nondimensional(self.robot).constraint_matrix(beta)
-        a_na = a[..., self.unknown_cols]
-        ranks = matrix_rank(a_na)
-        if int(ranks.max()) < len(self.unknown_cols):  # name the rates left free, not every unknown
-            free = free_columns(a_na[int(np.argmax(ranks))])
-            names = name_list([self.robot.velocity_names[j] for j, f in zip(self.unknown_cols, free, strict=True) if f])
-            raise SingularError(f"robot '{self.robot.name}': the sensed rates ({name_list(self.sensed)}) do not "
-                                f"determine ({names}); sense more joints (the wheels' 'sensed' field of the "
-                                "description, or sensed= in Python)")
-
-    def forward_exprs(self) -> tuple[list[sp.Expr], list[sp.Expr]]:
-        """Entries of ``A_na`` (row-major) and of ``b = -A_s q_s``."""
-        a_na = self.a[:, self.unknown_cols]
-        b = -self.a[:, self.sensed_cols] * sp.Matrix(self.q)
-        return list(a_na), list(b)
 
 
 def write_code(
@@ -124,8 +58,8 @@ def write_code(
     directory = Path(directory)
     if directory.exists() and not directory.is_dir():
         raise CodegenError(f"{directory}: not a directory")
-    plan = _Plan(robot, sensed)
-    files = _c_files(plan) if lang == "c" else _python_file(plan)
+    plan = Plan(robot, sensed)
+    files = _c_files(plan) if lang == "c" else python_file(plan)
     for filename, text in files:  # every file checked before any is written: no half-written pair
         _check_target(directory, filename, text, robot.name)
     directory.mkdir(parents=True, exist_ok=True)
@@ -162,23 +96,6 @@ def _head(path: Path) -> list[str]:
     """The first two lines of an existing file (as text; bytes that are not UTF-8 never match generated code)."""
     with path.open(encoding="utf-8", errors="replace", newline="") as f:
         return [f.readline(10_000).rstrip("\n") for _ in range(2)]
-
-
-def _c_numbers(e: sp.Expr) -> sp.Expr:
-    table: dict[sp.Expr, sp.Expr] = {sp.pi: sp.Float(math.pi, 20)}
-    for n in e.atoms(sp.Rational):
-        if abs(n.p) > 2**31 or abs(n.q) > 2**31:
-            table[n] = sp.Float(n, 20)
-    return e.xreplace(table)
-
-
-def _cse(exprs: list[sp.Expr], printer: C99CodePrinter | NumPyPrinter) -> tuple[list[str], list[str]]:
-    """Common subexpressions ``t0, t1...`` as ``name = code`` lines, and the reduced expressions, printed."""
-    if isinstance(printer, C99CodePrinter):  # C: no M_PI in strict C99, no integer literal beyond 64 bits
-        exprs = [_c_numbers(e) for e in exprs]
-    replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), optimizations="basic")
-    lines = [f"{sym} = {printer.doprint(value)}" for sym, value in replacements]
-    return lines, [printer.doprint(e) for e in reduced]
 
 
 # ---- C ---------------------------------------------------------------------------------------------------
@@ -227,8 +144,8 @@ def _c_printer() -> C99CodePrinter:
     return C99CodePrinter({"math_macros": {}})
 
 
-def _c_body(plan: _Plan, exprs: list[sp.Expr], targets: list[str], comments: list[str] | None = None) -> str:
-    temps, reduced = _cse(exprs, _c_printer())
+def _c_body(plan: Plan, exprs: list[sp.Expr], targets: list[str], comments: list[str] | None = None) -> str:
+    temps, reduced = cse(exprs, _c_printer())
     lines = [f"    const double {t};" for t in temps]
     for k, (target, code) in enumerate(zip(targets, reduced, strict=True)):
         note = f" /* {_c_comment(comments[k])} */" if comments else ""
@@ -236,7 +153,7 @@ def _c_body(plan: _Plan, exprs: list[sp.Expr], targets: list[str], comments: lis
     return "\n".join(lines)
 
 
-def _c_unpack(plan: _Plan, sensed: bool = False, twist: bool = False) -> str:
+def _c_unpack(plan: Plan, sensed: bool = False, twist: bool = False) -> str:
     """Named locals for the inputs, each cast to void once: a model need not use every input."""
     lines, names = [], []
     if twist:
@@ -255,10 +172,10 @@ def _c_unpack(plan: _Plan, sensed: bool = False, twist: bool = False) -> str:
     return "\n".join(lines)
 
 
-def _c_files(plan: _Plan) -> list[tuple[str, str]]:
+def _c_files(plan: Plan) -> list[tuple[str, str]]:
     r, n, p = plan.robot, plan.name, plan.name.upper()
     beta_param = f"const double heading[{p}_N_STEER]" if plan.beta else "const double *heading"
-    rows, na = plan.a.rows, len(plan.unknown_cols)
+    rows, na = plan.a.rows, len(plan.unknown_names)
     sizes = {"N_STEER": len(plan.beta), "N_RATES": len(plan.rates), "N_SENSED": len(plan.sensed),
              "N_ROWS": rows, "N_VEL": plan.a.cols, "N_UNKNOWN": na, "N_WORK": rows * na + rows + na}
     on_stack = sizes["N_WORK"] <= MAX_STACK_WORK
@@ -273,6 +190,9 @@ def _c_files(plan: _Plan) -> list[tuple[str, str]]:
         f"int {n}_forward_work(const double sensed[{p}_N_SENSED], {beta_param}, double twist[3], double *residual, "
         f"double work[{p}_N_WORK]);",
     ]
+    if plan.geared:  # wmrkit ik's check of the inverse model's rates
+        sizes["N_GEARS"] = len(plan.gears)
+        protos.append(f"int {n}_in_gear(const double rates[{p}_N_RATES], {steer_param}int in_gear[{p}_N_GEARS]);")
     work_bytes = 8 * sizes["N_WORK"]
     header = "\n".join([
         f"/* {n}_kinematics.h: no-slip kinematic models of robot '{_c_comment(r.name)}' (L. Gracia's thesis, ch. 4).",
@@ -301,6 +221,7 @@ def _c_files(plan: _Plan) -> list[tuple[str, str]]:
         + ("on the stack (reentrant)." if on_stack else
            f"a static buffer (not reentrant: over {8 * MAX_STACK_WORK} bytes, too many for small stacks)."),
         f" * {n}_forward_work: {n}_forward in the caller's workspace, work[{p}_N_WORK] (reentrant: one per thread).",
+        *(_c_gear_doc(plan) if plan.geared else []),
         " */",
         f"#ifndef {p}_KINEMATICS_H", f"#define {p}_KINEMATICS_H", "",
         *[f"#define {p}_{k} {v}" for k, v in sizes.items()], "",
@@ -323,15 +244,63 @@ def _c_files(plan: _Plan) -> list[tuple[str, str]]:
         protos[3][:-1], "{",
         f"    double *a = work, *b = work + {p}_N_ROWS * {p}_N_UNKNOWN, *x = b + {p}_N_ROWS;",
         _c_unpack(plan, sensed=True),
-        f"    /* unknowns x: {_c_comment(', '.join(r.velocity_names[j] for j in plan.unknown_cols))} */",
+        f"    /* unknowns x: {_c_comment(', '.join(plan.unknown_names))} */",
         _c_body(plan, a_na + b, fw_targets),
         f"    int status = lstsq({p}_N_ROWS, {na}, a, b, x, residual);",
         f"    for (int i = 0; status == 0 && i < {na}; ++i) if (!isfinite(x[i])) status = -1; /* NaN or inf input */",
         "    for (int i = 0; i < 3; ++i) twist[i] = status == 0 ? x[i] : (double)NAN;",
         "    if (status != 0 && residual) *residual = NAN;",
-        "    return status;", "}", "",
+        "    return status;", "}", "", *_c_in_gear(plan, protos[-1]),
     ])
     return [(f"{n}_kinematics.h", header), (f"{n}_kinematics.c", source)]
+
+
+def _c_gear_doc(plan: Plan) -> list[str]:
+    """The header's lines on the gears (robots with one)."""
+    n, p = plan.name, plan.name.upper()
+    return [" * The forward model holds the gears: a gear's unsensed joints turn with its sensed ones,",
+            " *   q_j = ratio_j u; a gear none of whose joints is sensed is one unknown, its turn u (as wmrkit fk).",
+            f" * {n}_in_gear: whether each gear turns the rates (of {n}_inverse) in its ratios, in_gear[{p}_N_GEARS]",
+            f" *   (as wmrkit ik: max |q_j - ratio_j u| <= {GEAR_RTOL!r} max |q|, u = k.q / k.k); returns 1 if all do,",
+            _c_list(" *   else 0 (also for a NaN rate). Gears", [g for g, _, _ in plan.gears])]
+
+
+def _c_in_gear(plan: Plan, proto: str) -> list[str]:
+    """The body of ``NAME_in_gear`` (robots with a gear): each gear's joints (their positions in the rates, then the
+    steering rates) and ratios in tables, ``wmrkit ik``'s check of them."""
+    if not plan.geared:
+        return []
+    p, steer = plan.name.upper(), len(plan.free_steer)
+    size = f"{p}_N_RATES + {p}_N_FREE_STEER" if steer else f"{p}_N_RATES"
+    joints = [j for _, idx, _ in plan.gears for j in idx]
+    ratios = [k for _, _, ks in plan.gears for k in ks]
+    starts = [0]
+    for _, idx, _ in plan.gears:
+        starts.append(starts[-1] + len(idx))
+    copy = [f"    for (int i = 0; i < {p}_N_RATES; ++i) q[i] = rates[i];"]
+    if steer:
+        copy.append(f"    for (int i = 0; i < {p}_N_FREE_STEER; ++i) q[{p}_N_RATES + i] = steer_rate[i];")
+    return [
+        f"static const int gear_joint[{len(joints)}] = {{{', '.join(map(str, joints))}}};",
+        f"static const double gear_ratio[{len(ratios)}] = {{{', '.join(map(repr, ratios))}}};",
+        f"static const int gear_start[{len(starts)}] = {{{', '.join(map(str, starts))}}};", "",
+        proto[:-1], "{",
+        f"    double q[{size}], scale = 0.0;", *copy,
+        f"    for (int i = 0; i < {size}; ++i) scale = fmax(scale, fabs(q[i]));",
+        "    int all = 1;",
+        f"    for (int g = 0; g < {p}_N_GEARS; ++g) {{",
+        "        double kq = 0.0, kk = 0.0, error = 0.0;",
+        "        for (int j = gear_start[g]; j < gear_start[g + 1]; ++j) {",
+        "            kq += gear_ratio[j] * q[gear_joint[j]];",
+        "            kk += gear_ratio[j] * gear_ratio[j];",
+        "        }",
+        "        for (int j = gear_start[g]; j < gear_start[g + 1]; ++j)",
+        "            error = fmax(error, fabs(q[gear_joint[j]] - gear_ratio[j] * (kq / kk)));",
+        f"        in_gear[g] = error <= {GEAR_RTOL!r} * scale; /* u = kq / kk, the gear's least-squares turn */",
+        "        all = all && in_gear[g];",
+        "    }",
+        "    return all;", "}", "",
+    ]
 
 
 def _c_comment(text: str) -> str:
@@ -342,134 +311,3 @@ def _c_comment(text: str) -> str:
 def _c_list(title: str, names: Sequence[str]) -> str:
     items = ", ".join(f"{i} {_c_comment(name)}" for i, name in enumerate(names)) or "(none)"
     return f"{title}: {items}"
-
-
-# ---- Python ----------------------------------------------------------------------------------------------
-def _py_body(exprs: list[sp.Expr], targets: list[str]) -> str:
-    temps, reduced = _cse(exprs, NumPyPrinter())
-    lines = [f"    {t}" for t in temps]
-    lines += [f"    {target} = {code}" for target, code in zip(targets, reduced, strict=True)]
-    return "\n".join(lines)
-
-
-def _python_file(plan: _Plan) -> list[tuple[str, str]]:
-    r = plan.robot
-    unpack = "\n".join(f"    b{i} = beta[..., {i}]  # {printable(n)}" for i, n in enumerate(r.steer_names))
-    a_targets = [f"out[..., {i}, {j}]" for i in range(plan.a.rows) for j in range(plan.a.cols)]
-    inputs, k = plan.twist + plan.steer_rate, 3 + len(plan.free_steer)
-    m = sp.Matrix(plan.inverse).jacobian(sp.Matrix(inputs))
-    m_targets = [f"out[..., {i}, {j}]" for i in range(m.rows) for j in range(k)]
-    inputs_doc = "(twist, steer_rate)" if plan.free_steer else "twist"
-    if plan.free_steer:
-        steer_doc = (f"\n- ``steer_rate``: ``(..., {len(plan.free_steer)})`` steering rates of the double wheels "
-                     "[rad/s], order ``FREE_STEER_NAMES``\n  (an input of the inverse model: no twist determines "
-                     "them);")
-        inverse_def = f'''def inverse(twist, steer_rate, heading=None):
-    """Wheel rates [rad/s] for body twists and double-wheel steering rates:
-    ``(..., 3), (..., {len(plan.free_steer)}), (..., {len(plan.beta)}) -> (..., {m.rows})``.
-    """
-    twist = _vectors(twist, 3, "twist")
-    steer_rate = _vectors(steer_rate, {len(plan.free_steer)}, "steer_rate")
-    shape = numpy.broadcast_shapes(twist.shape[:-1], steer_rate.shape[:-1])
-    inputs = numpy.concatenate([numpy.broadcast_to(twist, shape + (3,)),
-                                numpy.broadcast_to(steer_rate, shape + ({len(plan.free_steer)},))], axis=-1)
-    return (inverse_matrix(heading) @ inputs[..., None])[..., 0]'''
-    else:
-        steer_doc = ""
-        inverse_def = f'''def inverse(twist, heading=None):
-    """Wheel rates [rad/s] for body twists: ``(..., 3), (..., {len(plan.beta)}) -> (..., {m.rows})``."""
-    twist = _vectors(twist, 3, "twist")
-    return (inverse_matrix(heading) @ twist[..., None])[..., 0]'''
-    text = f'''"""No-slip kinematic models of robot {json.dumps(r.name)} (thesis ch. 4), generated by wmrkit.
-
-Do not edit; regenerate with ``wmrkit kinematics ROBOT --codegen python DIR``. Needs only numpy. SI units,
-robot frame x forward, y left. Arrays take leading batch axes, which broadcast:
-
-- ``twist``: ``(..., 3)`` = (vx [m/s], vy [m/s], omega [rad/s]) in the robot frame;{steer_doc}
-- ``heading``: ``(..., {len(plan.beta)})`` steering headings [rad], 0 = rolling straight ahead, counter-clockwise
-  positive, order ``STEER_NAMES`` (None: as described);
-- wheel rates: ``(..., {len(plan.rates)})`` [rad/s], order ``RATE_NAMES``;
-- ``sensed``: ``(..., {len(plan.sensed)})`` [rad/s], order ``SENSED_NAMES``.
-"""
-
-import numpy
-
-STEER_NAMES = {tuple(r.steer_names)!r}
-RATE_NAMES = {tuple(plan.rates)!r}
-SENSED_NAMES = {tuple(plan.sensed)!r}
-FREE_STEER_NAMES = {tuple(plan.free_steer)!r}
-VELOCITY_NAMES = {tuple(r.velocity_names)!r}
-HEADING_DESCRIBED = {tuple(float(h) for h in r.heading)!r}
-_BETA_OFFSET = {tuple(plan.offsets)!r}  # the thesis's beta = heading + pi/2 - delta
-_SENSED_COLUMNS = {list(plan.sensed_cols)!r}
-_UNKNOWN_COLUMNS = {list(plan.unknown_cols)!r}
-
-
-def _beta(heading):
-    heading = numpy.asarray(HEADING_DESCRIBED if heading is None else heading, dtype=float)
-    if heading.shape[-1:] != ({len(plan.beta)},):
-        raise ValueError(f"heading: expected shape (..., {len(plan.beta)}), got {{heading.shape}}")
-    return heading + numpy.asarray(_BETA_OFFSET)
-
-
-def _vectors(x, n, name):
-    x = numpy.asarray(x, dtype=float)
-    if x.shape[-1:] != (n,):
-        raise ValueError(f"{{name}}: expected shape (..., {{n}}), got {{x.shape}}")
-    return x
-
-
-def constraint_matrix(heading=None):
-    """Slip matrix A (3.22), roller frame, columns VELOCITY_NAMES.
-
-    ``(..., {len(plan.beta)}) -> (..., {plan.a.rows}, {plan.a.cols})``.
-    """
-    beta = _beta(heading)
-{unpack}
-    out = numpy.zeros(beta.shape[:-1] + ({plan.a.rows}, {plan.a.cols}))
-{_py_body(list(plan.a), a_targets)}
-    return out
-
-
-def inverse_matrix(heading=None):
-    """``rates = M @ {inputs_doc}`` ({"exact" if plan.inverse_exact else "least squares per wheel"}, 4.11).
-
-    ``(..., {len(plan.beta)}) -> (..., {m.rows}, {k})``.
-    """
-    beta = _beta(heading)
-{unpack}
-    out = numpy.zeros(beta.shape[:-1] + ({m.rows}, {k}))
-{_py_body(list(m), m_targets)}
-    return out
-
-
-{inverse_def}
-
-
-def forward_with_residual(sensed, heading=None):
-    """Least-squares twist (4.11) and slip residual ``|A q|`` [m/s].
-
-    ``(..., {len(plan.sensed)}) -> (..., 3), (...)``. Both are NaN where the sensed rates do not determine the twist
-    at those headings (the smallest singular value of the unknowns' columns, each scaled to norm 1 whatever its
-    units, <= 1e-9 rows) or an input is not finite, as the C code's -1.
-    """
-    sensed = _vectors(sensed, {len(plan.sensed)}, "sensed")
-    a = constraint_matrix(heading)
-    finite = numpy.isfinite(a).all(axis=(-2, -1)) & numpy.isfinite(sensed).all(axis=-1)
-    a = numpy.where(finite[..., None, None], a, 0.0)
-    sensed = numpy.where(finite[..., None], sensed, 0.0)
-    a_na = a[..., _UNKNOWN_COLUMNS]
-    rhs = -(a[..., _SENSED_COLUMNS] @ sensed[..., None])
-    norms = numpy.linalg.norm(a_na, axis=-2, keepdims=True)  # columns of norm 1: m/s and m alike
-    unit = a_na / numpy.where(norms > 0, norms, 1.0)
-    x = (numpy.linalg.pinv(unit) @ rhs) / numpy.where(norms > 0, norms, 1.0).swapaxes(-1, -2)
-    residual = numpy.linalg.norm((a_na @ x - rhs)[..., 0], axis=-1)
-    ok = finite & (numpy.linalg.svd(unit, compute_uv=False)[..., -1] > 1e-9 * a_na.shape[-2])
-    return numpy.where(ok[..., None], x[..., :3, 0], numpy.nan), numpy.where(ok, residual, numpy.nan)
-
-
-def forward(sensed, heading=None):
-    """Least-squares body twist from sensed rates (4.11): ``(..., {len(plan.sensed)}) -> (..., 3)``."""
-    return forward_with_residual(sensed, heading)[0]
-'''
-    return [(f"{plan.name}_kinematics.py", text)]

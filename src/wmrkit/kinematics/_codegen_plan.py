@@ -1,0 +1,126 @@
+"""The plan of generated code (:mod:`wmrkit.kinematics.codegen`): symbols, the constraint matrix (3.22), the inverse
+closed form, the forward model's unknowns with the robot's gears held, and the common-subexpression printer."""
+
+from __future__ import annotations
+
+import keyword
+import math
+import re
+from collections.abc import Sequence
+
+import numpy as np
+import sympy as sp
+from sympy.printing.c import C99CodePrinter
+from sympy.printing.numpy import NumPyPrinter
+
+from .._shapes import as_names
+from ..couplings import gear_free, gear_unknowns
+from ..errors import SingularError, WmrkitError, name_list
+from ..robot import TWIST_NAMES, Robot
+from ._symbolic_matrix import exact_number
+from .linalg import free_columns, matrix_rank, nondimensional
+from .symbolic import sensed_rates, symbolic_constraint_matrix, symbolic_model
+
+C_KEYWORDS = frozenset(
+    "auto break case char const continue default do double else enum extern float for goto if inline int long "
+    "register restrict return short signed sizeof static struct switch typedef union unsigned void volatile while "
+    "_Bool _Complex _Imaginary".split()
+)
+
+
+
+class CodegenError(WmrkitError, ValueError):
+    """A code-generation request that cannot be met (unknown language, sensed set, directory, existing file)."""
+
+
+def identifier(name: str) -> str:
+    """A C and Python identifier from a robot name: ``"diff-drive 2" -> "diff_drive_2"``, never a keyword."""
+    ident = re.sub(r"\W", "_", name, flags=re.ASCII).strip("_") or "robot"
+    if ident[0].isdigit():
+        ident = f"robot_{ident}"
+    return f"{ident}_" if ident in C_KEYWORDS or keyword.iskeyword(ident) else ident
+
+
+class Plan:
+    """Everything the printers need: symbols, the constraint matrix, inverse closed form, forward split."""
+
+    def __init__(self, robot: Robot, sensed: Sequence[str] | None) -> None:
+        self.robot, self.name = robot, identifier(robot.name)
+        self.beta = tuple(sp.Symbol(f"b{i}", real=True) for i in range(len(robot.steer_names)))
+        # beta = heading + offset (Robot.beta_of_heading; the offset is beta at heading 0, pi/2 - delta)
+        self.offsets = tuple(float(b) for b in robot.beta_of_heading(np.zeros(len(self.beta))))
+        self.twist = tuple(sp.Symbol(n, real=True) for n in TWIST_NAMES)
+        self.sensed = as_names(sensed, "sensed", error=CodegenError) if sensed is not None else sensed_rates(robot)
+        for n in self.sensed:
+            if robot.velocity_index(n) < 3:
+                raise CodegenError(f"sensed: '{n}' is a body velocity; sensed inputs are wheel joint rates")
+        if len(set(self.sensed)) != len(self.sensed) or not self.sensed:
+            raise CodegenError(f"sensed: expected distinct wheel rates, got ({', '.join(self.sensed)})")
+        self.q = tuple(sp.Symbol(f"q{i}", real=True) for i in range(len(self.sensed)))
+        self.a = symbolic_constraint_matrix(robot, self.beta)
+        self.sensed_cols = [robot.velocity_index(n) for n in self.sensed]
+        self.unknown_cols = [j for j in range(self.a.cols) if j not in self.sensed_cols]
+        # q = free @ x + known @ q_sensed: a gear's joints filled from its sensed ones, a gear none of whose joints
+        # is sensed one unknown (its turn), as fk solves them (linalg.geared_solve); without a gear, the columns
+        self.geared = any(c.kind == "gear" for c in robot.couplings)
+        names, given = robot.velocity_names, tuple(self.sensed_cols)
+        self.free, self.known = gear_unknowns(robot.couplings, names, given)
+        self.unknown_names = gear_free(robot.couplings, names, given)[1]
+        self._check_forward()
+        self.free_steer = robot.free_steering  # a double wheel's steering rate: an input besides the twist
+        self.steer_rate = tuple(sp.Symbol(f"s{i}", real=True) for i in range(len(self.free_steer)))
+        model = symbolic_model(robot, TWIST_NAMES + self.free_steer, self.beta, gears=False)  # per wheel, as ik's
+        self.inverse_exact = model.exact
+        self.rates = model.solved
+        self.inverse = [e for e in model.matrix * sp.Matrix(self.twist + self.steer_rate)]
+        # each gear: its name, its joints' positions in the rates then the steering rates, its ratios (ik's check)
+        joints = (*self.rates, *self.free_steer)
+        self.gears = tuple((c.channel_name, tuple(joints.index(j) for j in c.joints), tuple(map(float, c.ratios)))
+                           for c in robot.couplings if c.kind == "gear")
+
+    def _check_forward(self) -> None:
+        beta = np.random.default_rng(7).uniform(-math.pi, math.pi, (3, len(self.robot.steer_names)))
+        # on the nondimensional robot, as the numeric models decide ranks: raw, a 1 um robot's 1 nm castor was lost
+        a = nondimensional(self.robot).constraint_matrix(beta)
+        a_na = a @ self.free
+        ranks = matrix_rank(a_na)
+        if int(ranks.max()) < len(self.unknown_names):  # name the rates left free, not every unknown
+            free = free_columns(a_na[int(np.argmax(ranks))])
+            names = name_list([n for n, f in zip(self.unknown_names, free, strict=True) if f])
+            raise SingularError(f"robot '{self.robot.name}': the sensed rates ({name_list(self.sensed)}) do not "
+                                f"determine ({names}); sense more joints (the wheels' 'sensed' field of the "
+                                "description, or sensed= in Python)")
+
+    def forward_exprs(self) -> tuple[list[sp.Expr], list[sp.Expr]]:
+        """Entries of ``A_na = A F`` (row-major) and of ``b = -A K q_s``, ``F, K`` :attr:`free`, :attr:`known`
+        (made exact: without a gear, the unknown and the sensed columns of ``A``)."""
+        a_na = _combine(self.a, self.free)
+        b = -_combine(self.a, self.known) * sp.Matrix(self.q)
+        return list(a_na), list(b)
+
+
+def _combine(a: sp.Matrix, m: np.ndarray) -> sp.Matrix:
+    """``a @ m`` for a numeric `m` of gear ratios, 0 and 1 (its entries made exact, ``0.4 -> 2/5``), summing only
+    the nonzero terms: a column selecting one column of `a` is that column, as it is."""
+    cols = []
+    for c in m.T:
+        terms = [a[:, j] if v == 1 else a[:, j] * exact_number(v, "length") for j, v in enumerate(c) if v != 0]
+        cols.append(sum(terms[1:], terms[0]) if terms else sp.zeros(a.rows, 1))
+    return sp.Matrix.hstack(*cols) if cols else sp.zeros(a.rows, 0)
+
+
+def _c_numbers(e: sp.Expr) -> sp.Expr:
+    table: dict[sp.Expr, sp.Expr] = {sp.pi: sp.Float(math.pi, 20)}
+    for n in e.atoms(sp.Rational):
+        if abs(n.p) > 2**31 or abs(n.q) > 2**31:
+            table[n] = sp.Float(n, 20)
+    return e.xreplace(table)
+
+
+def cse(exprs: list[sp.Expr], printer: C99CodePrinter | NumPyPrinter) -> tuple[list[str], list[str]]:
+    """Common subexpressions ``t0, t1...`` as ``name = code`` lines, and the reduced expressions, printed."""
+    if isinstance(printer, C99CodePrinter):  # C: no M_PI in strict C99, no integer literal beyond 64 bits
+        exprs = [_c_numbers(e) for e in exprs]
+    replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), optimizations="basic")
+    lines = [f"{sym} = {printer.doprint(value)}" for sym, value in replacements]
+    return lines, [printer.doprint(e) for e in reduced]
