@@ -5,7 +5,8 @@ A centred steerable wheel's steering rate is not a column of ``A`` (3.22), but s
 make them slip-free (4.76). At a given ``beta`` the least-squares solution (4.11) of the over-assigned system
 is (4.82); its residual ``A q_dot`` is the slip indicator. The steering-angle conditions (4.83) are the roots of
 that residual over the steering angles, found here numerically (batched Levenberg-Marquardt from several
-starts); substituting them gives the slip-free extended solution (4.84).
+starts); substituting them gives the slip-free extended solution (4.84). A ``gear`` coupling is held throughout, as
+``fk`` holds it (:func:`~.linalg.geared_solve`), and :func:`extended_dof` counts the mobility it leaves.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_names, as_vectors, readonly
 from ..errors import ShapeError, SingularError, UnknownNameError
 from ..robot import Robot
-from .linalg import solve_assigned
+from .linalg import geared_solve
 from .models import bounded, configuration, describe_configuration, generic_mobility, velocity_indices
 
 #: Most grid starts per problem of :func:`solve_steering` (its default 8 per wheel on 4 steered wheels); beyond,
@@ -70,7 +71,8 @@ class ExtendedSolution:
 
 
 def extended_dof(robot: Robot) -> int:
-    """Velocities an extended solution may assign: ``m + n_o`` (§4.5), n_o = centred steerable wheels."""
+    """Velocities an extended solution may assign: ``m + n_o`` (§4.5), n_o = centred steerable wheels, m with the
+    robot's gears (:func:`~.models.mobility`)."""
     return generic_mobility(robot) + sum(w.type == "steerable" for w in robot.wheels)
 
 
@@ -86,10 +88,16 @@ def extended_solution(
     """
     beta = configuration(robot, beta, heading)
     idx, q = _assigned(robot, assigned, q_assigned)
-    q_dot, residual = solve_assigned(robot.constraint_matrix(beta), idx, q)
+    q_dot, residual = _solve(robot, robot.constraint_matrix(beta), idx, q)
     beta = np.broadcast_to(beta, (*q_dot.shape[:-1], beta.shape[-1]))
     return ExtendedSolution(robot.name, robot.velocity_names, tuple(assigned), readonly(np.array(beta)),
                             readonly(q_dot), readonly(residual))
+
+
+def _solve(robot: Robot, a: np.ndarray, idx: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(4.11) with the robot's ``gear`` couplings held, as ``fk`` holds them (:func:`~.linalg.geared_solve`): a gear's
+    joints turn together, so the residual is the slip of motions the mechanism allows."""
+    return geared_solve(a, robot.couplings, robot.velocity_names, idx, q, "q_assigned")
 
 
 def _assigned(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
@@ -141,7 +149,7 @@ def solve_steering(
         def residual(x: np.ndarray) -> np.ndarray:
             beta = np.broadcast_to(guess[rows], (*x.shape[:-1], guess.shape[-1])).copy()
             beta[..., free] = x
-            return solve_assigned(robot.constraint_matrix(beta), idx, q[rows])[1]
+            return _solve(robot, robot.constraint_matrix(beta), idx, q[rows])[1]
 
         return _levenberg_marquardt(residual, x0, iterations, tol[rows])
 
