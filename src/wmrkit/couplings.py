@@ -284,6 +284,12 @@ class GearBreach:
         ratios = ", ".join(f"{k:g}" for k in self.coupling.ratios)
         return f"the joints of {self.coupling.channel_name} (ratios {ratios}) do not turn together"
 
+    def warning(self, names: tuple[str, ...], values: np.ndarray) -> str:
+        """The warning of ``fk`` (and the extended solutions) on given `values` of the joints `names` (one row)."""
+        given = ", ".join(f"{names[i]} {values[i]:.4g}" for i in self.given)
+        return (f"{self.head} ({given} rad/s; {self.spread:.0%} apart): the rates contradict the description's gear "
+                "(each is used as given); check the rates or the gear")
+
 
 def gear_breaches(couplings: tuple[Coupling, ...], names: tuple[str, ...], q: np.ndarray,
                   least: float = 0.0) -> list[GearBreach]:

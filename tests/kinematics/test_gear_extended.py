@@ -8,13 +8,23 @@ gear's row ``q_left / 1 - q_right / ratio = 0`` by an SVD in the test.
 
 from __future__ import annotations
 
+import json
+import warnings
+
 import numpy as np
 import pytest
 import yaml
 
-from geared import STEERED, cart_yaml
+from geared import STEERED, B, R, cart_yaml
 from wmrkit import Robot
-from wmrkit.kinematics.extended import extended_dof, extended_solution, no_slip_extended_solution
+from wmrkit.cli.main import main
+from wmrkit.kinematics.extended import (
+    GearWarning,
+    extended_dof,
+    extended_solution,
+    no_slip_extended_solution,
+    solve_steering,
+)
 
 
 def load(ratio: float) -> Robot:
@@ -71,3 +81,59 @@ def test_extended_solution_holds_the_gear_at_any_heading(ratio):
     np.testing.assert_allclose(right, ratio * left, atol=1e-12)
     np.testing.assert_allclose(sol.slip, np.linalg.norm(np.einsum("...ij,...j->...i", robot.constraint_matrix(
         sol.beta), sol.q_dot), axis=-1), atol=1e-12)
+
+
+def fk_answer(capsys, tmp_path, rates: dict[str, float]) -> dict:
+    """`wmrkit fk cart.yaml --spin ... --json` on the ratio-2 cart: its residual, consistency and warnings."""
+    path = tmp_path / "cart.yaml"
+    path.write_text(cart_yaml(2.0, STEERED))
+    spins = [a for n, v in rates.items() for a in ("--spin", f"{n}={v}")]
+    assert main(["fk", str(path), *spins, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_an_assignment_out_of_the_gears_ratio_is_not_claimed_consistent(capsys, tmp_path):
+    """Both joints of the 1:2 axle assigned 1, 1 rad/s: the gear wants right = 2 left. fk warns ("do not turn
+    together") and says INCONSISTENT while its residual stays the wheels' slip; the extended solution the same
+    (before: no warning, no flag, slip 5.5e-17 alone)."""
+    robot = load(2.0)
+    rates = {"left.spin": 1.0, "right.spin": 1.0}
+    fk = fk_answer(capsys, tmp_path, rates)
+    assert fk["consistent"] is False and len(fk["warnings"]) == 1
+    with pytest.warns(GearWarning) as caught:
+        sol = extended_solution(robot, list(rates), list(rates.values()), heading=[0.0])
+    assert [str(w.message) for w in caught] == fk["warnings"]  # the same helper, the same words
+    assert sol.in_gear.tolist() == [False] and sol.as_dict()["in_gear"] == [False]
+    # the slip is the wheels' own, as fk's residual: straight ahead at 0.075 m/s, no wheel slips
+    assert float(sol.slip) == pytest.approx(fk["residual"], abs=1e-12)
+    np.testing.assert_allclose(sol.values(["vx", "vy", "omega"]), [R, 0.0, 0.0], atol=1e-12)
+
+
+def test_a_batch_is_judged_row_by_row_and_warns_once_per_gear():
+    robot = load(2.0)
+    q = [[1.0, 2.0], [1.0, 1.0], [-0.5, -1.0], [1.0, 1.0]]  # in, out, in, out of the 1:2 ratio
+    with pytest.warns(GearWarning) as caught:
+        sol = extended_solution(robot, ["left.spin", "right.spin"], q, heading=[0.3])
+    assert len(caught) == 1
+    assert sol.in_gear[:, 0].tolist() == [True, False, True, False]
+
+
+def test_the_slip_free_search_warns_once_on_a_broken_gear():
+    robot = load(2.0)
+    with pytest.warns(GearWarning) as caught:
+        sol = no_slip_extended_solution(robot, ["left.spin", "right.spin"], [1.0, 1.0], heading=[0.3])
+    assert len(caught) == 1 and sol.in_gear.tolist() == [False]
+    with pytest.warns(GearWarning):
+        solve_steering(robot, ["left.spin", "right.spin"], [1.0, 1.0], heading=[0.3])
+
+
+def test_rates_in_the_gears_ratio_give_no_warning():
+    robot = load(2.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", GearWarning)
+        sol = no_slip_extended_solution(robot, ["left.spin", "right.spin"], [1.0, 2.0], heading=[0.3])
+        one = extended_solution(robot, ["vx"], [0.3], heading=[0.3])  # one joint of the gear: nothing to judge
+    assert sol.in_gear.tolist() == [True] and one.in_gear.tolist() == [True]
+    # ratio 2: omega = vx (k - 1) / (b (k + 1)) with vx = r (1 + 2) / 2
+    assert sol.values(["omega"])[0] == pytest.approx(R * 1.5 / (B * 3.0))
+

@@ -112,9 +112,7 @@ def _check_gears(robot: Robot, rates: dict[str, float]) -> bool:
     values = np.array(list(rates.values()), dtype=float)
     breaches = gear_breaches(robot.couplings, names, values)
     for b in breaches:
-        given = ", ".join(f"{names[i]} {values[i]:.4g}" for i in b.given)
-        warn(f"{b.head} ({given} rad/s; {b.spread:.0%} apart): the rates contradict the description's gear (each is "
-             "used as given); check the rates or the gear")
+        warn(b.warning(names, values))
     return not breaches
 
 

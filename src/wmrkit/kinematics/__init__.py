@@ -4,7 +4,14 @@ Listed by hand (no star imports); see ``docs/kinematics.md`` and ``docs/wheel-ik
 """
 
 from .actuation import ActuationAnalysis, actuation_analysis, minimal_actuator_sets
-from .extended import ExtendedSolution, extended_dof, extended_solution, no_slip_extended_solution, solve_steering
+from .extended import (
+    ExtendedSolution,
+    GearWarning,
+    extended_dof,
+    extended_solution,
+    no_slip_extended_solution,
+    solve_steering,
+)
 from .linalg import delta_projector, matrix_rank, solve_assigned
 from .models import (
     KinematicModel,
@@ -22,6 +29,7 @@ from .wheel_ik import WheelCommands, forward_kinematics, twist_is_determined, wh
 __all__ = [
     "ActuationAnalysis",
     "ExtendedSolution",
+    "GearWarning",
     "KinematicModel",
     "SensingAnalysis",
     "WheelCommands",

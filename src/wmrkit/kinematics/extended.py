@@ -6,11 +6,13 @@ make them slip-free (4.76). At a given ``beta`` the least-squares solution (4.11
 is (4.82); its residual ``A q_dot`` is the slip indicator. The steering-angle conditions (4.83) are the roots of
 that residual over the steering angles, found here numerically (batched Levenberg-Marquardt from several
 starts); substituting them gives the slip-free extended solution (4.84). A ``gear`` coupling is held throughout, as
-``fk`` holds it (:func:`~.linalg.geared_solve`), and :func:`extended_dof` counts the mobility it leaves.
+``fk`` holds it (:func:`~.linalg.geared_solve`), and :func:`extended_dof` counts the mobility it leaves; assigned
+rates out of a gear's ratios are used as given, with a :class:`GearWarning`.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -19,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_names, as_vectors, readonly
+from ..couplings import gear_breaches
 from ..errors import ShapeError, SingularError, UnknownNameError
 from ..robot import Robot
 from .linalg import geared_solve
@@ -31,12 +34,19 @@ MAX_STARTS = 4096
 ROOT_TOL = 1e-9
 
 
+class GearWarning(UserWarning):
+    """Assigned rates of a ``gear`` coupling's joints break its ratios (:func:`wmrkit.couplings.gear_breaches`, the
+    check and the words of ``fk``): each is used as given, so the slip does not show it."""
+
+
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
 class ExtendedSolution:
     """Least-squares velocities for an over-assigned set at a batch of configurations, (4.11)/(4.82).
 
     ``q_dot``: ``(..., k)`` in the robot's velocity order (assigned entries copied in); ``residual``:
-    ``(..., 2 n_contacts)`` slip along the roller axes (3.6) [m/s]; ``beta``: ``(..., n_steer)`` [rad].
+    ``(..., 2 n_contacts)`` slip along the roller axes (3.6) [m/s]; ``beta``: ``(..., n_steer)`` [rad];
+    ``in_gear``: ``(..., n_couplings)`` bool, False where the assigned rates of a ``gear``'s joints break its ratios
+    (:class:`GearWarning`; True for the other couplings).
     """
 
     robot_name: str
@@ -45,10 +55,13 @@ class ExtendedSolution:
     beta: np.ndarray
     q_dot: np.ndarray
     residual: np.ndarray
+    in_gear: np.ndarray
 
     @property
     def slip(self) -> np.ndarray:
-        """Norm of the residual ``|A q_dot|`` [m/s], ``(...)``: zero iff the assignment is slip-free here."""
+        """Norm of the residual ``|A q_dot|`` [m/s], ``(...)``: zero iff the wheels do not slip here. Assigned rates
+        that break a gear are used as given, as ``fk`` uses them: the wheels may roll without slip while the gear
+        forbids the motion, so the assignment is consistent only where also every ``in_gear``."""
         return np.linalg.norm(self.residual, axis=-1)
 
     @property
@@ -67,7 +80,8 @@ class ExtendedSolution:
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready summary (lists and plain values)."""
         return {"assigned": list(self.assigned), "velocity_names": list(self.velocity_names),
-                "beta": self.beta.tolist(), "q_dot": self.q_dot.tolist(), "slip": self.slip.tolist()}
+                "beta": self.beta.tolist(), "q_dot": self.q_dot.tolist(), "slip": self.slip.tolist(),
+                "in_gear": self.in_gear.tolist()}
 
 
 def extended_dof(robot: Robot) -> int:
@@ -85,13 +99,44 @@ def extended_solution(
     ``q_assigned``: ``(..., n_a)``; ``beta``: ``(..., n_steer)`` or None; they broadcast. For a set that is
     assignable (4.10) the residual is zero; with more than m assigned velocities it is zero only at the
     steering angles of :func:`solve_steering`. ``heading`` (0 = rolling forward) instead of ``beta``: the same.
+    Assigned rates that break a ``gear``'s ratios: :class:`GearWarning`, ``in_gear`` False.
     """
-    beta = configuration(robot, beta, heading)
+    return _extended_solution(robot, assigned, q_assigned, configuration(robot, beta, heading), 4)
+
+
+def _extended_solution(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: np.ndarray,
+                       stacklevel: int | None) -> ExtendedSolution:
+    """:func:`extended_solution` at the thesis's `beta`; `stacklevel`: of the warning on a broken gear (None: the
+    caller warned)."""
     idx, q = _assigned(robot, assigned, q_assigned)
+    in_gear = _in_gear(robot, idx, q, stacklevel)
     q_dot, residual = _solve(robot, robot.constraint_matrix(beta), idx, q)
-    beta = np.broadcast_to(beta, (*q_dot.shape[:-1], beta.shape[-1]))
+    batch = q_dot.shape[:-1]
+    beta = np.broadcast_to(beta, (*batch, beta.shape[-1]))
     return ExtendedSolution(robot.name, robot.velocity_names, tuple(assigned), readonly(np.array(beta)),
-                            readonly(q_dot), readonly(residual))
+                            readonly(q_dot), readonly(residual),
+                            readonly(np.array(np.broadcast_to(in_gear, (*batch, in_gear.shape[-1])))))
+
+
+def _in_gear(robot: Robot, idx: np.ndarray, q: np.ndarray, stacklevel: int | None) -> np.ndarray:
+    """``(..., n_couplings)`` bool: False where the assigned rates `q` ``(..., n_a)`` (columns `idx`) of a ``gear``'s
+    joints break its ratios, judged row by row as ``fk`` judges its rates (:func:`wmrkit.couplings.gear_breaches`);
+    a :class:`GearWarning` per gear broken (its first row's numbers) at `stacklevel` (None: no warning)."""
+    couplings = robot.couplings
+    names = tuple(robot.velocity_names[i] for i in idx)
+    out = np.ones((*q.shape[:-1], len(couplings)), dtype=bool)
+    if not any(c.kind == "gear" and sum(j in names for j in c.joints) >= 2 for c in couplings):
+        return out  # nothing to judge: no row loop
+    rows, inverse = np.unique(q.reshape(-1, q.shape[-1]), axis=0, return_inverse=True)
+    flat, said = out.reshape(-1, len(couplings)), set()
+    for r, row in enumerate(rows):
+        for b in gear_breaches(couplings, names, row):
+            k = next(i for i, c in enumerate(couplings) if c is b.coupling)
+            flat[inverse.reshape(-1) == r, k] = False
+            if stacklevel is not None and k not in said:
+                said.add(k)
+                warnings.warn(b.warning(names, row), GearWarning, stacklevel=stacklevel)
+    return out
 
 
 def _solve(robot: Robot, a: np.ndarray, idx: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -126,14 +171,22 @@ def solve_steering(
     of the grid). ``q_assigned``: ``(..., n_a)``, finite, within ``MAX_QUERY_RATE``; ``beta_guess``:
     ``(..., n_steer)`` or None (described), or the guess as the users' ``heading`` (0 = rolling forward). Returns
     the thesis's β ``(..., n_steer)`` [rad], steerable angles wrapped to [-pi, pi). Raises
-    :class:`~wmrkit.errors.SingularError` where no angle makes the assignment slip-free.
+    :class:`~wmrkit.errors.SingularError` where no angle makes the assignment slip-free. Assigned rates that break a
+    ``gear``'s ratios are used as given (the wheels' slip only): :class:`GearWarning`, as ``fk`` warns.
     """
+    return _solve_steering(robot, assigned, q_assigned, beta_guess, heading, starts, iterations, 4)
+
+
+def _solve_steering(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta_guess: ArrayLike | None,
+                    heading: ArrayLike | None, starts: int, iterations: int, stacklevel: int) -> np.ndarray:
+    """:func:`solve_steering`, its :class:`GearWarning` at `stacklevel`."""
     if not (isinstance(starts, int | np.integer) and starts >= 1 and isinstance(iterations, int | np.integer)
             and iterations >= 0):
         raise ShapeError(f"solve_steering: expected starts >= 1 and iterations >= 0 (integers), got {starts!r} and "
                          f"{iterations!r}")
     guess = configuration(robot, beta_guess, heading)
     idx, q = _assigned(robot, assigned, q_assigned)
+    _in_gear(robot, idx, q, stacklevel)
     batch = np.broadcast_shapes(q.shape[:-1], guess.shape[:-1])
     guess = np.broadcast_to(guess, (*batch, guess.shape[-1])).reshape(-1, guess.shape[-1])
     q = np.broadcast_to(q, (*batch, q.shape[-1])).reshape(-1, q.shape[-1])
@@ -221,5 +274,5 @@ def no_slip_extended_solution(
     ``(..., n_a), (..., n_steer) -> ExtendedSolution`` whose ``beta`` holds the angles to steer to (the thesis's β);
     the guess as `beta_guess` or as the users' `heading`.
     """
-    beta = solve_steering(robot, assigned, q_assigned, beta_guess, heading=heading)
-    return extended_solution(robot, assigned, q_assigned, beta)
+    beta = _solve_steering(robot, assigned, q_assigned, beta_guess, heading, 8, 60, 4)  # warns on a broken gear
+    return _extended_solution(robot, assigned, q_assigned, beta, None)
