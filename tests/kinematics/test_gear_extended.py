@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 import yaml
 
-from geared import STEERED, B, R, cart_yaml
+from geared import STEERED, SYNCHRO, B, R, cart_yaml
 from wmrkit import Robot
 from wmrkit.cli.main import main
 from wmrkit.kinematics.extended import (
@@ -137,3 +137,20 @@ def test_rates_in_the_gears_ratio_give_no_warning():
     # ratio 2: omega = vx (k - 1) / (b (k + 1)) with vx = r (1 + 2) / 2
     assert sol.values(["omega"])[0] == pytest.approx(R * 1.5 / (B * 3.0))
 
+
+def test_extended_dof_counts_steering_joints_not_linkages():
+    """The synchro's three steering angles are one linkage, but wmrkit does not model a linkage's geometry
+    (description-format.md): extended_dof counts every steering joint, m (gears held, generic steering) + 3, the same
+    as without the linkage."""
+    text = SYNCHRO
+    robot = Robot.from_dict(yaml.safe_load(text))
+    unlinked = Robot.from_dict(yaml.safe_load(text.replace("  - {kind: linkage, joints: [a.steer, b.steer, c.steer]}\n",
+                                                           "")))
+    assert len(unlinked.couplings) == 1 and len(robot.couplings) == 2
+    a = robot.constraint_matrix(np.random.default_rng(1).uniform(-np.pi, np.pi, 3))
+    spin = [robot.velocity_index(f"{w}.spin") for w in "abc"]
+    gear = np.zeros((2, a.shape[1]))  # ratios 1, 1, 1: a.spin = b.spin = c.spin
+    gear[[0, 1], spin[0]], gear[0, spin[1]], gear[1, spin[2]] = 1.0, -1.0, -1.0
+    held = np.vstack([a, gear])
+    nullity = held.shape[1] - np.linalg.matrix_rank(held)
+    assert extended_dof(robot) == extended_dof(unlinked) == nullity + 3

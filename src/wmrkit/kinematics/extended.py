@@ -7,7 +7,7 @@ is (4.82); its residual ``A q_dot`` is the slip indicator. The steering-angle co
 that residual over the steering angles, found here numerically (batched Levenberg-Marquardt from several
 starts); substituting them gives the slip-free extended solution (4.84). A ``gear`` coupling is held throughout, as
 ``fk`` holds it (:func:`~.linalg.geared_solve`), and :func:`extended_dof` counts the mobility it leaves; assigned
-rates out of a gear's ratios are used as given, with a :class:`GearWarning`.
+rates out of a gear's ratios are used as given, with a :class:`GearWarning`. A ``linkage`` is not used.
 """
 
 from __future__ import annotations
@@ -85,8 +85,9 @@ class ExtendedSolution:
 
 
 def extended_dof(robot: Robot) -> int:
-    """Velocities an extended solution may assign: ``m + n_o`` (§4.5), n_o = centred steerable wheels, m with the
-    robot's gears (:func:`~.models.mobility`)."""
+    """Velocities an extended solution may assign: ``m + n_o`` (§4.5), m with the robot's gears
+    (:func:`~.models.mobility`), n_o the steering joints (centred steerable wheels), linkages not used: wmrkit does
+    not model a ``linkage``'s geometry, so a synchro drive's three linked wheels count 3, not 1."""
     return generic_mobility(robot) + sum(w.type == "steerable" for w in robot.wheels)
 
 
