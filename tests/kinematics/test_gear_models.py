@@ -172,3 +172,18 @@ def test_a_gear_that_locks_the_cart_leaves_no_motion(tmp_path, capsys):
     assert "    the robot cannot move (m = 0): every velocity is zero" in out
     assert "  direct model:\n" in out and "  inverse model:\n" in out and "assigned: )" not in out  # was "(inverse,
     # assigned: )" for both
+
+
+def test_the_extended_count_says_a_linkage_is_not_used(tmp_path, capsys):
+    """The synchro drive's three steered wheels on one linkage: extended_dof counts each steered wheel (the linkage's
+    geometry is not modelled, test_gear_extended.py checks the count); the text said "3 velocities can be assigned"
+    without saying so, and the JSON had no linkage."""
+    path = tmp_path / "synchro.yaml"
+    path.write_text(SYNCHRO)
+    assert main(["kinematics", str(path), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["linkages"] == ["linkage(a.steer, b.steer, c.steer)"] and data["extended_dof"] == 3
+    assert main(["kinematics", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert ("3 velocities can be assigned (each steered wheel counted: linkage(a.steer, b.steer, c.steer) not used, "
+            "its geometry not modelled)\n") in out
