@@ -179,3 +179,46 @@ def test_the_animation_of_a_long_slot_shows_the_car_in_every_frame(tmp_path, mon
     assert all(seen for seen, _ in drawn)
     end = np.array(plan.final_pose[:2])  # the body's centre at the end: P_f plus half (a1 - b1) ahead
     np.testing.assert_allclose(drawn[-1][1], end + np.array([(CAR_91.a1 - CAR_91.b1) / 2, 0.0]), atol=1e-6)
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1.0, 1e3])
+def test_the_plan_figure_draws_the_arcs_at_the_cars_scale(scale):
+    """Each drawn arc's chords stay within 5e-5 car sizes of the circle (distance of each chord's midpoint to the
+    arc's centre, placed from the segment's start pose by hand), and the path and rear axle are drawn with the same
+    points at any scale. Before: samples every 2 cm, so a 2 mm car's 1.75 mm arcs were single chords (sagitta
+    0.5 car sizes), and its rear axle a 5 cm bar."""
+    from matplotlib.colors import to_hex
+
+    from wmrkit.parking.plot import BACKWARD, FORWARD, plot_plan
+
+    car, slot = scaled(CAR_91, SLOT_91, scale)
+    plan = plan_parking(car, slot)
+    ax = plot_plan(plan).axes[0]
+    paths = [ln for ln in ax.lines if to_hex(ln.get_color()) in (FORWARD, BACKWARD) and ln.get_linewidth() == 1.4]
+    assert len(paths) == len(plan.segments)
+    unit = max(car.length, car.c1)
+    counts = []
+    for seg, line in zip(plan.segments, paths, strict=True):
+        xy = np.asarray(line.get_xydata())
+        counts.append(len(xy))
+        assert np.allclose(xy[[0, -1]], [seg.start[:2], seg.end[:2]], atol=1e-9 * unit)
+        if seg.curvature == 0:
+            continue
+        r = 1 / seg.curvature  # signed: the centre is on the left for r > 0
+        x0, y0, th0 = seg.start
+        centre = np.array([x0 - r * math.sin(th0), y0 + r * math.cos(th0)])
+        mid = (xy[1:] + xy[:-1]) / 2
+        sagitta = abs(r) - np.hypot(*(mid - centre).T)
+        assert sagitta.max() < 5e-5 * unit
+    assert counts == [len(ln.get_xydata()) for ln in _path_lines_at_scale_1()]
+    axle = ax.lines[-1].get_xydata()  # the final car's rear axle is drawn last
+    assert math.dist(*axle) == pytest.approx(car.track, rel=1e-9)
+
+
+def _path_lines_at_scale_1():
+    from matplotlib.colors import to_hex
+
+    from wmrkit.parking.plot import BACKWARD, FORWARD, plot_plan
+
+    ax = plot_plan(plan_parking(CAR_91, SLOT_91)).axes[0]
+    return [ln for ln in ax.lines if to_hex(ln.get_color()) in (FORWARD, BACKWARD) and ln.get_linewidth() == 1.4]

@@ -28,6 +28,9 @@ FORWARD, BACKWARD = "#1f77b4", "#d62728"
 MAX_TRAIL = 12_000
 #: Most frames of an animation (matplotlib embeds at most 20 MB in an HTML page; a GIF frame is about 0.25 MB).
 MAX_FRAMES = 800
+#: Spacing of the drawn path's samples, and the shortest rear axle drawn, in car sizes (:func:`size`; 2 cm and 5 cm for
+#: example 1's 2 m car). In metres, a 2 mm car's arcs were drawn as chords and its axle as a 5 cm bar.
+PATH_STEP, MIN_AXLE = 0.01, 0.025
 
 
 def car_outline(vehicle: Vehicle, pose: np.ndarray) -> np.ndarray:
@@ -61,7 +64,7 @@ def draw_car(ax: Axes, vehicle: Vehicle, pose: np.ndarray, steering: float = 0.0
     d = np.array([math.cos(pose[2] + steering), math.sin(pose[2] + steering)]) * w
     wheel, = ax.plot([front[0] - d[0], front[0] + d[0]], [front[1] - d[1], front[1] + d[1]], color=color,
                      lw=3, alpha=alpha, zorder=4)
-    half = np.array([-s, c]) * max(vehicle.track, 0.05) / 2
+    half = np.array([-s, c]) * max(vehicle.track, MIN_AXLE * size(vehicle)) / 2
     axle, = ax.plot([pose[0] - half[0], pose[0] + half[0]], [pose[1] - half[1], pose[1] + half[1]], color=color,
                     lw=2, alpha=alpha, zorder=4)
     return [body, wheel, axle]
@@ -75,7 +78,7 @@ def plot_plan(plan: ParkingPlan, execution: Execution | None = None) -> Figure:
     v, sp = plan.vehicle, plan.space
     draw_scene(ax, sp, size(v))
     for seg in plan.segments:
-        xy = sample_poses([seg], 0.02)
+        xy = sample_poses([seg], PATH_STEP * size(v))
         ax.plot(xy[:, 0], xy[:, 1], color=FORWARD if seg.direction > 0 else BACKWARD, lw=1.4, zorder=2)
         if seg.phase == 3:
             draw_car(ax, v, np.array(seg.end), seg.steering, color="0.35", alpha=0.45)
