@@ -297,3 +297,35 @@ def test_the_text_answer_prints_lengths_at_the_cars_scale(capsys, tmp_path, scal
     for shown, true in pairs:
         assert len(shown) == len(true) and len(true) > 0
         np.testing.assert_allclose(shown, true, rtol=0, atol=1e-3 * 2.0 * scale)
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1.0])
+def test_table_8_1_and_the_closed_loop_run_agree_at_any_scale(capsys, tmp_path, monkeypatch, scale):
+    """`park FILE --check --controller p`: Table 8.1's line on the plan and the closed-loop run's own verdict
+    (control.track's TrackingRun.feasibility, captured) are the same, and no warning calls the plan's stops jumps.
+    Before the speeds were in car lengths (9197d37), the 2 mm copy of example 1 at 0.5 m/s moved 12 car lengths a
+    sample: 'feasible: NO (3 violation(s))' and the warning 'position jump (p_ref not C0) at t = 0.04924, 1.51,
+    4.21 s'; the stops and cusps of a parking plan are at rest, which Table 8.1's type-4 column allows."""
+    import importlib
+
+    tracking = importlib.import_module("wmrkit.control.track")  # the module (wmrkit.control.track is the function)
+    runs = []
+    real = tracking.track
+
+    def spy(*args, **kwargs):
+        runs.append(real(*args, **kwargs))
+        return runs[-1]
+
+    monkeypatch.setattr(tracking, "track", spy)
+    f = tmp_path / "scaled.yaml"
+    lengths = {"a1": 1.5, "b1": 0.5, "c1": 1.4, "h1": 1.05, "d1": 0.5}
+    space = {"H": 3.35, "J": 2.0, "MS": 0.2, "dx2": 0.7, "final_gap": 0.07}
+    f.write_text(json.dumps({"vehicle": {**{k: v * scale for k, v in lengths.items()}, "phi_max": "46 deg"},
+                             "space": {k: v * scale for k, v in space.items()}}))
+    _, text, err = run(capsys, str(f), "--check", "--controller", "p")
+    _, out, err_json = run(capsys, str(f), "--check", "--controller", "p", "--json")
+    data = json.loads(out)
+    assert err == err_json == "" and data["warnings"] == []
+    assert "kinematic framework): feasible: yes" in text and data["feasibility"]["feasible"]
+    assert len(runs) == 2 and all(r.feasibility.feasible for r in runs)
+    assert runs[0].feasibility.requirement.column == data["feasibility"]["column"] == "type 4, off axle"
