@@ -329,3 +329,21 @@ def test_table_8_1_and_the_closed_loop_run_agree_at_any_scale(capsys, tmp_path, 
     assert "kinematic framework): feasible: yes" in text and data["feasibility"]["feasible"]
     assert len(runs) == 2 and all(r.feasibility.feasible for r in runs)
     assert runs[0].feasibility.requirement.column == data["feasibility"]["column"] == "type 4, off axle"
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e2])  # (1e3: a 1.5 km car is beyond the 1 km parking limit)
+def test_json_poses_are_as_many_at_any_scale(capsys, tmp_path, scale):
+    """The JSON's poses of example 1 scaled by k are those of 1:1 scaled by k (one every 1/40 car size): a fixed 5 cm
+    step gave the 2 mm car 6 poses (its segment ends) against 190."""
+    lengths = {"a1": 1.5, "b1": 0.5, "c1": 1.4, "h1": 1.05, "d1": 0.5}
+    space = {"H": 3.35, "J": 2.0, "MS": 0.2, "dx2": 0.7, "final_gap": 0.07}
+    poses = []
+    for k in (1.0, scale):
+        f = tmp_path / f"k{k:g}.yaml"
+        f.write_text(json.dumps({"vehicle": {**{n: v * k for n, v in lengths.items()}, "phi_max": "46 deg"},
+                                 "space": {n: v * k for n, v in space.items()}}))
+        _, out, _ = run(capsys, str(f), "--json")
+        poses.append(np.array(json.loads(out)["poses"]))
+    assert len(poses[0]) > 100 and poses[1].shape == poses[0].shape
+    np.testing.assert_allclose(poses[1][:, :2] / scale, poses[0][:, :2], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(poses[1][:, 2], poses[0][:, 2], rtol=0, atol=1e-9)
