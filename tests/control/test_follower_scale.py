@@ -20,7 +20,7 @@ from wmrkit.cli.control import min_turning_radius
 from wmrkit.control.points import control_point
 from wmrkit.control.references import builtin_reference, default_size
 from wmrkit.control.track import track
-from wmrkit.control.trackers import ArrivalWarning, default_lookahead, min_length, top_speed
+from wmrkit.control.trackers import ArrivalWarning, default_lookahead, default_wheelbase, min_length, stanley, top_speed
 
 SCALES = (1e-3, 1.0, 1e3)
 
@@ -76,3 +76,25 @@ def test_the_default_control_point_scales_with_the_robot(k):
     robot = catalog.load("diff-drive")
     reach = max(w.l for w in robot.wheels)
     np.testing.assert_allclose(control_point(scaled(robot, k)).point, [reach * k, 0.0], rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("robot_name", ["mecanum-4", "omni-3", "swerve-4"])
+def test_an_omnidirectional_robot_under_stanley_gives_the_same_run_scaled(robot_name):
+    """Stanley on a robot whose control point is its axle point (no fixed wheels): its wheelbase is the robot's size
+    (its largest wheel distance), scaled with it. Before, it was a fixed 0.5 m: at k = 1e-3 the mecanum-4 looked
+    1,300 of its sizes ahead and ended 2.89 mm (2.89 m scaled back) from its circle's end, with no warning. At every
+    k it now arrives within the aim radius 1e-3 ``L`` (``L`` its stopping length), without a warning, its RMS
+    cross-track / k within 1e-4 ``L`` of the 1:1 run's. (Its end distances / k, 0.02 to 0.23 mm, spread by the
+    integrator's relative 1e-5: at 1e-8 those at k = 1e-3 and 1 agree, 6.8 and 7.9 um.)"""
+    robot = catalog.load(robot_name)
+    cp = control_point(robot)
+    reach = max(w.l for w in robot.wheels)
+    assert default_wheelbase(cp) == pytest.approx(reach, rel=1e-12)
+    assert default_wheelbase(control_point(scaled(robot, 1e-3))) == pytest.approx(1e-3 * reach, rel=1e-12)
+    ref = builtin_reference("circle", size=default_size("circle", min_turning_radius(robot)))
+    length = stanley(cp, ref).length
+    runs = [_run(robot_name, "circle", "stanley", k) for k in SCALES]
+    ends, rms, warned = (np.array(column) for column in zip(*runs, strict=True))
+    assert warned.tolist() == [0, 0, 0], ends
+    assert (ends < 1e-3 * length).all(), ends
+    np.testing.assert_allclose(rms, rms[1], rtol=1e-4, atol=1e-4 * length)

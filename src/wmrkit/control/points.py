@@ -24,7 +24,8 @@ from ..limits import MAX_SIZE
 from ..robot import Robot
 from ..wheels import heading_from_beta
 
-__all__ = ["ControlError", "ControlPoint", "StoppedRun", "control_point", "point_pose", "twist_for_velocity"]
+__all__ = ["ControlError", "ControlPoint", "StoppedRun", "control_point", "point_pose", "robot_reach",
+           "twist_for_velocity"]
 
 
 class ControlError(WmrkitError, ValueError):
@@ -107,10 +108,8 @@ def _cached(robot: Robot, point: tuple[float, float] | None, reduced: bool | Non
     if point is None:
         p = np.zeros(2)
         if is_reduced and abs(_gain_det(basis, p)) < 1e-9:
-            # the largest wheel distance (a wheel radius if every wheel is at the origin): at the robot's scale,
-            # not a fixed length (a 0.1 m floor put a 0.5 mm robot's point 200 of its sizes ahead)
-            reach = max(w.l for w in robot.wheels) or max(w.r for w in robot.wheels)
-            p = reach * np.array([math.cos(forward), math.sin(forward)])
+            # at the robot's scale, not a fixed length (a 0.1 m floor put a 0.5 mm robot's point 200 of its sizes ahead)
+            p = robot_reach(robot) * np.array([math.cos(forward), math.sin(forward)])
     else:
         p = np.asarray(point, dtype=float)
     if is_reduced and abs(_gain_det(basis, p)) < 1e-9:
@@ -124,6 +123,12 @@ def _cached(robot: Robot, point: tuple[float, float] | None, reduced: bool | Non
     gain = basis @ np.linalg.inv(_point_map(p) @ basis) if is_reduced else None
     return ControlPoint(robot, is_reduced, readonly(p.copy()), readonly(np.ascontiguousarray(basis)), forward,
                         readonly(foot), skid, None if gain is None else readonly(gain))
+
+
+def robot_reach(robot: Robot) -> float:
+    """The robot's size [m]: its largest wheel distance from the origin (its largest wheel radius when every wheel is
+    at the origin)."""
+    return max(w.l for w in robot.wheels) or max(w.r for w in robot.wheels)
 
 
 def _gain_det(basis: np.ndarray, p: np.ndarray) -> float:

@@ -42,7 +42,7 @@ import numpy as np
 
 from ..robot import Robot
 from .loop import TwistController
-from .points import ControlError, ControlPoint
+from .points import ControlError, ControlPoint, robot_reach
 from .references import Reference
 
 __all__ = ["AIM_FRACTION", "ARRIVAL_FRACTION", "ArrivalWarning", "PathFollower", "PathIndex", "arrived",
@@ -248,14 +248,16 @@ def arrived(q: np.ndarray, p: np.ndarray, end: np.ndarray, reach: float) -> bool
 
 
 def default_wheelbase(cp: ControlPoint) -> float:
-    """Distance [m] from the axle point to the steered wheels (type 4), else to the control point, else 0.5 m."""
+    """Distance [m] from the axle point to the steered wheels (type 4), else to the control point, else (a robot
+    whose point is its axle point: an omnidirectional one) the robot's size (:func:`.points.robot_reach`): at its
+    scale (a fixed 0.5 m made Stanley on a mecanum-4 scaled by 1e-3 look 1,300 of its sizes ahead)."""
     a = cp.axle_point
     steered = [w.position for w in cp.robot.wheels if w.type in ("steerable", "double")]
     ahead = np.array([math.cos(cp.forward), math.sin(cp.forward)])
     if cp.reduced and steered:
         return float(max(abs((np.asarray(p) - a) @ ahead) for p in steered))
-    d = float(np.hypot(*(cp.point - a)))
-    return d if d > 1e-6 else 0.5
+    d, size = float(np.hypot(*(cp.point - a))), robot_reach(cp.robot)
+    return d if d > 1e-9 * size else size  # a round-off guard relative to the robot's size
 
 
 def top_speed(reference: Reference) -> float:
