@@ -97,7 +97,10 @@ def check_arrival(follower: PathFollower, t: np.ndarray, pose: np.ndarray, cut: 
     if gap <= follower.arrival_tol:
         return
     rule = follower.stop_rule(delay)
-    if [rule(float(t[k]), pose[k]) for k in range(max(len(t) - 2, 0), len(t))][-1]:
+    if follower.path.at_rest:
+        why = ("the reference is at rest (its path has zero length): a path follower has no path to drive and stays "
+               "where it starts; start on the reference's pose (the default), or use the p controller")
+    elif [rule(float(t[k]), pose[k]) for k in range(max(len(t) - 2, 0), len(t))][-1]:
         q, p = (follower.tracked(x) for x in pose[-2:]) if len(t) > 1 else (None, None)
         step = 0.0 if q is None else float(np.hypot(*(p - q)))
         if delay is not None and step > 0 and arrived(q, p, follower.path.xy[-1], (1 + delay) * step):

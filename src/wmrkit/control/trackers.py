@@ -105,6 +105,7 @@ class PathIndex:
         moving = speed > 1e-9 * self.top_speed  # at rest: a relative round-off guard
         self._s_moving, self._v_moving = self.s[moving], speed[moving]
         self.min_speed = MIN_SPEED_FRACTION * self.top_speed
+        self.at_rest = float(self.s[-1]) <= self.tie  # a path of zero length: its start is its end
 
     def speed(self, s: float) -> float:
         """The reference's speed [m/s] where it passes arc length `s` [m] (interpolated between its moving samples),
@@ -176,7 +177,10 @@ class PathIndex:
         [rad] of a point that steers for the end (pure pursuit), also the end is no longer ahead of it (one that
         crossed the end's line beside it, on an arc to it, drives on to it), unless it has arrived: it is within
         `aim` [m] (its aim radius) of the end, whatever its heading, or its step from `previous` (its position a
-        sample before) passed the end within ``steps`` times that step, at least `aim` (:func:`arrived`)."""
+        sample before) passed the end within ``steps`` times that step, at least `aim` (:func:`arrived`). A path of
+        zero length (a reference at rest) is driven at once: there is nothing to follow."""
+        if self.at_rest:
+            return True
         a, b = self.xy[-2], self.xy[-1]
         if heading is not None and previous is not None:  # its last step passed the end: arrived
             reach = max(aim, steps * float(np.hypot(*(point - previous))))
