@@ -60,3 +60,18 @@ def test_cli_track_on_a_reference_at_rest(tmp_path, capsys, controller, start):
     data = json.loads(capsys.readouterr().out)
     assert len(data["warnings"]) == (1 if start else 0)
     assert all("the reference is at rest" in w for w in data["warnings"])
+
+
+@pytest.mark.parametrize("start", [[], ["--from", "0", "2", "0"]])
+@pytest.mark.parametrize("controller", ["stanley", "pure-pursuit"])
+def test_cli_track_on_a_reference_at_rest_for_a_given_duration(tmp_path, capsys, controller, start):
+    """With --duration the run is integrated to it: its tolerance was the reference's top speed (0) times a time, the
+    integrator's first step at t = NaN and a traceback ('attempt to get argmin of an empty sequence'); now the robot's
+    size per second sets it. The robot stays where it is (the path has zero length): its error is its distance."""
+    path = tmp_path / "rest.csv"
+    path.write_text("t,x,y,theta\n" + "".join(f"{t},{REST[0]},{REST[1]},{REST[2]}\n" for t in range(3)))
+    argv = ["track", "diff-drive", "--reference", str(path), "--controller", controller, "--duration", "3", "--json"]
+    assert main([*argv, *start]) == 0
+    data = json.loads(capsys.readouterr().out)
+    pose = np.array(data["pose"])
+    assert data["t"][-1] == pytest.approx(3.0) and np.all(pose == pose[0])

@@ -20,7 +20,15 @@ from .feasibility import BLOCK, Feasibility, feasibility
 from .follower_run import Limit, check_arrival, follower_bound, span
 from .laws import PositionLaw, check_gate, check_sampling
 from .loop import MAX_SAMPLED_EVALUATIONS, Plant, longest_sampled_run, simulate
-from .points import ControlError, ControlPoint, StoppedRun, check_delay, control_point, point_pose
+from .points import (
+    ControlError,
+    ControlPoint,
+    StoppedRun,
+    check_delay,
+    control_point,
+    point_pose,
+    robot_reach,
+)
 from .references import Reference
 from .trackers import (
     PathFollower,
@@ -276,7 +284,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
             out = simulate(robot, ctrl, pose0, duration, period=period, delay=delay, plant=Plant(loops, policy),
                            output_dt=output_dt, skew_free=skew_free, breaks=reference.breaks,
                            rtol=1e-5 if geometric else 1e-8, until=until,
-                           atol=GEOMETRIC_ATOL_TIME * top_speed(reference) if geometric else 1e-10)
+                           atol=GEOMETRIC_ATOL_TIME * _speed_scale(robot, reference) if geometric else 1e-10)
         except StoppedRun as err:
             raise _stopped(err, robot, reference, tracked_point, "kinematic") from None
     t, pose = out["t"], out["pose"]
@@ -439,6 +447,13 @@ DYNAMICS_STEP = 1e-3
 #: The geometric trackers' absolute integration tolerance [m] as a time [s] at the reference's top speed (1e-7 m at
 #: 0.5 m/s): relative, as their lengths are (:mod:`.trackers`), so a scaled run is the same run scaled.
 GEOMETRIC_ATOL_TIME = 2e-7
+def _speed_scale(robot: Robot, reference: Reference) -> float:
+    """The speed [m/s] setting a geometric tracker's integration tolerance: the reference's top speed, or for a
+    reference at rest (0: the tolerance 0, the integrator's first step at t = NaN, a traceback) the robot's size
+    per second."""
+    return top_speed(reference) or robot_reach(robot)
+
+
 #: Most control periods of a loop with slip-model commands or slip-aware feedback: each solves the nonlinear slip
 #: model (1 to 2.3 ms a period for the skid steer and the forklift: at most about 2 min).
 MAX_SLIP_PERIODS = 50_000
