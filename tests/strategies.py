@@ -33,6 +33,8 @@ def wheels(draw, type_name: str | None = None, name: str = "w") -> Wheel:
     kind = KINDS[type_name]
     values = {key: draw(_FIELDS[key]) for key in (*kind.required, *kind.optional)}
     values.setdefault("beta", 0.0)
+    if "r_r" in values:  # the rollers sit on the rim: r_r <= r (descriptions refuse more)
+        values["r_r"] = min(values["r_r"], values["r"])
     in_order = lambda js: tuple(sorted(js, key=kind.joints.index))  # noqa: E731
     joints = st.lists(st.sampled_from(kind.joints), unique=True).map(in_order)
     return Wheel(name=name, type=type_name, l=draw(st.floats(0, 1.5)), alpha=draw(_angle),

@@ -314,6 +314,8 @@ def descriptions(draw) -> tuple[dict, list[dict]]:
                 item[field], si[field] = draw(_quantity(field))
             else:
                 si[field] = kind.optional[field]
+        if si.get("r_r", 0.0) > si["r"]:  # the rollers sit on the rim: r_r <= r (r_r = r: a ball's rollers)
+            item["r_r"], si["r_r"] = item["r"], si["r"]
         if "beta" in kind.optional and "beta" not in item:  # a steered wheel given no angle rolls straight ahead
             si["beta"] = math.pi / 2 - si.get("delta", 0.0)
         for role in ("actuated", "sensed"):

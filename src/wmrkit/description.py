@@ -307,7 +307,8 @@ def _mecanum_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc) ->
     if "beta" not in data and "heading" not in data:
         data["heading"] = 0.0
     if "gamma" not in data:
-        probe = _wheel_from_dict({**data, "gamma": MECANUM_GAMMA, "r_r": data.get("r_r", 1.0)}, check, loc, "swedish")
+        probe = {**data, "gamma": MECANUM_GAMMA, "r_r": data.get("r_r", data.get("r"))}  # r_r <= r: read as given
+        probe = _wheel_from_dict(probe, check, loc, "swedish")
         x, y = probe.position
         if abs(x * y) <= 1e-12 * max(probe.l * probe.l, 1e-300):  # l * l: inf, never OverflowError
             check.fail("a mecanum wheel on an axis of the robot frame has no quadrant to take its roller angle "
