@@ -11,6 +11,7 @@ import math
 import numbers
 import os
 import re
+import warnings
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -317,7 +318,20 @@ def _mecanum_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc) ->
     if "r_r" not in data:
         r = check.quantity(check.require(item, "r", loc), "length", (*loc, "r"))
         data["r_r"] = r / 4
-    return _wheel_from_dict(data, check, loc, "swedish")
+    wheel = _wheel_from_dict(data, check, loc, "swedish")
+    if abs(abs(math.remainder(wheel.gamma, math.pi)) - MECANUM_GAMMA) > 1e-6:  # a roller line: gamma mod 180 deg
+        where = (*loc, "gamma")
+        warnings.warn(str(DescriptionError(
+            f"wheel '{wheel.name}' is of type mecanum with gamma {math.degrees(wheel.gamma):g} deg, not the +-45 deg "
+            "of Mecanum rollers" + (" (an omni wheel)" if abs(math.cos(wheel.gamma)) < 1e-6 else "") + ": write "
+            "'type: swedish' for this roller angle, or leave gamma out for the standard layout",
+            source=check.source, loc=where, line=check.line_of(where))), DescriptionWarning, stacklevel=2)
+    return wheel
+
+
+class DescriptionWarning(UserWarning):
+    """A description read whose field is likely not what its author meant: ``source:line: field: message`` naming
+    the wheel (the CLI says it as a ``wmrkit: warning:`` line and in the JSON answer's ``warnings``)."""
 
 
 def _check_geometry(type_name: str, v: dict[str, float], check: FieldReader, loc: Loc) -> None:

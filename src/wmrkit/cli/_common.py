@@ -8,6 +8,7 @@ import json
 import math
 import os
 import sys
+import warnings
 from collections.abc import Iterator
 from contextvars import ContextVar
 from pathlib import Path
@@ -35,8 +36,18 @@ def add_json_flag(parser: argparse.ArgumentParser) -> None:
 
 
 def load_robot(spec: str) -> Robot:
-    """The robot named by a ROBOT argument."""
-    return catalog.resolve(spec)
+    """The robot named by a ROBOT argument; the description's warnings said (:func:`warn`)."""
+    from ..description import DescriptionWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", DescriptionWarning)
+        robot = catalog.resolve(spec)
+    for w in caught:  # the others as Python would have said them
+        if issubclass(w.category, DescriptionWarning):
+            warn(str(w.message))
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return robot
 
 
 def wheel_column_width(robot: Robot, least: int = 14) -> int:
