@@ -44,8 +44,8 @@ def test_json_output_has_the_keys_of_the_issue(capsys):
     assert set(out["actuation"]) >= {"consistent", "sufficient"} and set(out["sensing"]) >= {"sufficient"}
     assert out["actuation"]["consistent"] is True  # two driven wheels, one motor: the catalog declares the differential
     assert out["actuation"]["sufficient"] is True and out["sensing"]["sufficient"] is True
-    assert out["condition_number"] == pytest.approx(1.0)
-    assert out["characteristic_length"] is None  # m = 1: kappa = 1 at every length, none to choose
+    assert out["condition_number"] is None and out["isotropy_note"].startswith("does not apply (m = 1")
+    assert out["characteristic_length"] is None  # m = 1: isotropy does not apply, no length to choose
 
 
 def test_couplings_decide_the_actuation_verdict(capsys):
@@ -198,7 +198,7 @@ def test_no_natural_length_where_isotropy_does_not_apply(name, capsys):
     isotropy does not apply. No length is reported now unless one is given."""
     assert main(["analyze", name, "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert out["mobility"] == 1 and out["condition_number"] == pytest.approx(1.0)
+    assert out["mobility"] == 1 and out["condition_number"] is None  # as the text: isotropy does not apply
     assert out["characteristic_length"] is None
     assert main(["analyze", name, "--json", "--length", "300 mm"]) == 0
     out = json.loads(capsys.readouterr().out)

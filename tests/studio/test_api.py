@@ -90,8 +90,10 @@ def test_no_natural_length_where_kappa_is_infinite(client):
     'D = 0.396 m' (natural_length's fallback, the robot size, minimising nothing) where `wmrkit analyze` gives none."""
     robot = catalog.load("swerve-4").with_steering({"front_left": math.radians(30)})
     live = client.post("/api/analyze", json={"description": robot.to_dict()}).json()["analysis"]
-    full = analyze(robot).to_dict()
-    assert full["characteristic_length"] is None and not math.isfinite(full["condition_number"])
+    a = analyze(robot)
+    full = a.to_dict()  # m = 1 (type 5): isotropy does not apply, so no kappa in the answer (as the text says)
+    assert full["characteristic_length"] is None and full["condition_number"] is None
+    assert not math.isfinite(a.condition_number)
     assert live["condition_number"] is None and live["characteristic_length"] is None
 
 

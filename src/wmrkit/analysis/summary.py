@@ -63,7 +63,8 @@ class Analysis:
             "icr": self.icr.describe(),
             "actuation": {k: self.actuation[k] for k in ("consistent", "sufficient", "verdict")},
             "sensing": {k: self.sensing[k] for k in ("sufficient", "verdict")},
-            "condition_number": None if self.gears_leave_one else self.condition_number,
+            "isotropy_note": self.isotropy_note(),  # m <= 1, of the wheels or left by gears: as the text says
+            "condition_number": None if self.isotropy_note() is not None else self.condition_number,
             "characteristic_length": self.characteristic_length if self.has_length else None,
             "condition_joints": list(self.joints), "natural_length": self.natural,
             "singular": {k: singular_dict(s, self.robot) for k, s in self.singular.items()},
@@ -71,9 +72,8 @@ class Analysis:
 
     @property
     def has_length(self) -> bool:
-        """A length goes with the condition number: given, or natural where it applies (:func:`.length_applies`)."""
-        if self.gears_leave_one:
-            return False
+        """A length goes with the condition number: given, or natural where it applies (:func:`.length_applies`;
+        not where isotropy does not apply, m <= 1 of the wheels or left by gears)."""
         g = self.gear_mobility
         m = self.classification.mobility if g is None else g
         return not self.natural or length_applies(m, self.condition_number)
