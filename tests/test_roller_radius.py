@@ -5,11 +5,14 @@ wheel was read silently (``wmrkit show`` exit 0)."""
 from __future__ import annotations
 
 import json
+import math
+from dataclasses import replace
 
 import pytest
 
-from wmrkit import Robot
+from wmrkit import Robot, Wheel
 from wmrkit.cli.main import main
+from wmrkit.wheels import WheelError
 
 WHEEL = "{{name: {name}, type: {type}, position: [0.2, 0.15], {extra}r: 0.05, r_r: {r_r}, actuated: spin}}"
 
@@ -43,3 +46,21 @@ def test_a_roller_up_to_the_wheel_radius_is_read(tmp_path, capsys, r_r):
     assert main(["show", path]) == 0
     want = 0.05 if r_r in ("0.05", "50 mm") else 0.0125
     assert Robot.from_file(path).wheel("fl").r_r == pytest.approx(want, rel=1e-12)
+
+
+def test_a_wheel_built_in_python_with_a_roller_larger_than_it_is_refused_in_the_same_words(tmp_path, capsys):
+    """Before, ``Wheel(type='swedish', r=0.05, r_r=1)`` was built (only descriptions refused it); the rim bound
+    r_r <= r holds for every wheel, with the description's words and the wheel and field named."""
+    kw = {"name": "fl", "type": "swedish", "l": 0.25, "alpha": 0.6, "beta": 0.0, "gamma": math.pi / 4, "r": 0.05}
+    with pytest.raises(WheelError) as err:
+        Wheel(**kw, r_r=1.0)
+    assert isinstance(err.value, ValueError) and "\n" not in str(err.value)
+    assert str(err.value).startswith("wheel 'fl': r_r: a roller sits on the wheel's rim: ")
+    assert main(["show", _write(tmp_path, "swedish", "1")]) == 2  # the description of the same wheel
+    assert capsys.readouterr().err.strip().endswith(str(err.value).removeprefix("wheel 'fl': r_r: "))
+    ok = Wheel(**kw, r_r=0.05)  # r_r = r: the ball wheel's roller (§3.5.2)
+    with pytest.raises(WheelError, match=r"^wheel 'fl': r_r: a roller sits on the wheel's rim"):
+        Wheel(**kw, r_r=math.nextafter(0.05, 1.0))  # one ulp above r
+    with pytest.raises(WheelError, match=r"^wheel 'fl': r_r: "):
+        replace(ok, r=0.04)  # a smaller wheel under the same rollers
+    assert replace(ok, r=0.06, r_r=0.0125).r_r == 0.0125

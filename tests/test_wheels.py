@@ -122,8 +122,9 @@ def test_generic_rows_match_3d_oracle_with_all_parameters(data):
 
 # ---- oracle 2: particularisations (3.11)-(3.13), written out from the digest ---------------------------------------
 @given(l=st.floats(0, 2), alpha=st.floats(-4, 4), beta=st.floats(-4, 4), d=st.floats(-1, 1), delta=st.floats(-4, 4),
-       gamma=st.floats(-4, 4), r=st.floats(0.01, 1), r_r=st.floats(0.01, 1))
-def test_particularisations(l, alpha, beta, d, delta, gamma, r, r_r):
+       gamma=st.floats(-4, 4), r=st.floats(0.01, 1), rim=st.floats(0.01, 1))
+def test_particularisations(l, alpha, beta, d, delta, gamma, r, rim):
+    r_r = rim * r  # the rollers sit on the rim: r_r <= r (Wheel refuses more)
     a = beta - alpha
     eq_3_11 = [[cos(beta), sin(beta), l * sin(a), 0], [-sin(beta), cos(beta), l * cos(a), r]]
     bd = beta + delta
@@ -158,8 +159,9 @@ def _jacobians_3_19(l, alpha, beta, d, delta, gamma, r, r_r):
 
 
 @given(l=st.floats(0, 2), alpha=st.floats(-4, 4), beta=st.floats(-4, 4), d=st.floats(-1, 1), delta=st.floats(-4, 4),
-       gamma=st.floats(-4, 4), r=st.floats(0.01, 1), r_r=st.floats(0.01, 1))
-def test_jacobians_3_19_and_determinants(l, alpha, beta, d, delta, gamma, r, r_r):
+       gamma=st.floats(-4, 4), r=st.floats(0.01, 1), rim=st.floats(0.01, 1))
+def test_jacobians_3_19_and_determinants(l, alpha, beta, d, delta, gamma, r, rim):
+    r_r = rim * r  # the rollers sit on the rim: r_r <= r (Wheel refuses more)
     j_fo, j_s, j_c = _jacobians_3_19(l, alpha, beta, d, delta, gamma, r, r_r)
     kw = {"name": "w", "l": l, "alpha": alpha, "beta": beta, "r": r}
     np.testing.assert_allclose(wheel_jacobian(Wheel(type="fixed", **kw)), j_fo, atol=1e-12)

@@ -79,13 +79,16 @@ def geometry_problem(type_name: str, v: dict[str, float], *, degenerate: bool = 
     """The first geometric field of a wheel of `type_name` (values `v`, SI) that the model cannot use, with why;
     None when all can be used. Descriptions and :class:`Wheel` ask the same question; a :class:`Wheel` built in
     Python may be degenerate (`degenerate=False`: a castor without offset, Swedish rollers along the axle; their
-    slip rows (3.12)/(3.13) exist, their Jacobians (3.19) are singular; Swedish rollers larger than the wheel), a
-    description may not."""
+    slip rows (3.12)/(3.13) exist, their Jacobians (3.19) are singular), a description may not. Neither may have
+    Swedish rollers larger than the wheel (r_r > r): they sit on its rim."""
     if v.get("l", 0.0) < 0:
         return "l", f"must be >= 0 (the direction is alpha), got {v['l']} m"
     for key in ("r", "r_r", "b"):
         if key in v and v[key] <= 0:
             return key, f"must be > 0, got {v[key]} m"
+    if type_name == "swedish" and v["r_r"] > v["r"]:
+        return "r_r", (f"a roller sits on the wheel's rim: its radius is at most the wheel's r = {v['r']:g} m "
+                       f"(r_r = r: a ball wheel), got {v['r_r']:g} m")
     if not degenerate:
         return None
     if type_name in ("castor", "double_castor") and v["d"] == 0:
@@ -94,9 +97,6 @@ def geometry_problem(type_name: str, v: dict[str, float], *, degenerate: bool = 
     if type_name == "castor" and abs(math.cos(v["delta"])) < 1e-9:
         return "delta", ("a castor with delta = +-90 deg has its axle along the arm and cannot steer itself "
                          "(det J_c = -r d cos(delta) = 0, eq. 3.19)")
-    if type_name == "swedish" and v["r_r"] > v["r"]:
-        return "r_r", (f"a roller sits on the wheel's rim: its radius is at most the wheel's r = {v['r']:g} m "
-                       f"(r_r = r: a ball wheel), got {v['r_r']:g} m")
     if type_name == "swedish" and abs(math.sin(v["gamma"])) < 1e-9:
         return "gamma", ("a Swedish wheel with gamma = 0 (or 180 deg) has rollers parallel to the axle and does not "
                          "roll (det J_s = r r_r sin(gamma) = 0, eq. 3.19); omni: 90 deg, Mecanum: 45 deg")
