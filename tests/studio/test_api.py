@@ -486,7 +486,7 @@ def test_meta_reads_the_start_file_as_it_is_now(tmp_path):
     edited = Robot.from_file(path)
     assert [w.r for w in edited.wheels] == [0.07] * 3
     start = client.get("/api/meta").json()["start"]
-    assert start == {"spec": "mine.yaml", "description": edited.to_dict()}
+    assert start == {"spec": "mine.yaml", "description": edited.to_dict(), "warnings": []}
     path.write_text(path.read_text().replace("r: 0.07\n", "r: -0.07\n", 1))
     r = client.get("/api/meta")
     assert r.status_code == 200 and r.json()["start"]["description"] == edited.to_dict()  # the last good robot
@@ -496,7 +496,7 @@ def test_meta_reads_the_start_file_as_it_is_now(tmp_path):
     start = client.get("/api/meta").json()["start"]
     assert start["description"] == edited.to_dict() and "no file 'mine.yaml'" in start["error"]
     catalog_start = TestClient(create_app(tmp_path, catalog.load("swerve-4"), robot_spec="swerve-4"))
-    assert catalog_start.get("/api/meta").json()["start"] == {"spec": "swerve-4",
+    assert catalog_start.get("/api/meta").json()["start"] == {"spec": "swerve-4", "warnings": [],
                                                                "description": catalog.load("swerve-4").to_dict()}
 
 

@@ -794,6 +794,10 @@ def test_mecanum_wheel_fields_are_editable(page):
     settle(pg)
     assert pg.evaluate("document.getElementById('error').hidden"), pg.inner_text("#error")
     assert page_robot(pg).wheels[-1].type == "swedish"
+    pg.click('[data-wheel="front_left"]')
+    edit(pg, "gamma", "90 deg")  # an omni wheel under the mecanum name: the description's warning is on the page
+    settle(pg)
+    assert "wheels[0].gamma: wheel 'front_left' is of type mecanum with gamma 90 deg" in pg.inner_text("#warnings")
     assert not pg.errors
 
 

@@ -89,6 +89,26 @@ def test_a_linked_file_is_opened_and_saved_where_it_is(tmp_path, monkeypatch):
     assert seen == {"root": (tmp_path / "designs").resolve(), "spec": "v3.yaml"}
 
 
+def test_the_start_file_warnings_are_wmrkit_warning_lines(tmp_path, monkeypatch, capsys):
+    """A start file with a mecanum wheel at gamma 90 deg: Python's two-line DescriptionWarning (the source line of
+    description.py) was printed; now the one ``wmrkit: warning:`` line `wmrkit show` prints for the same file."""
+    from wmrkit.studio import app as studio_app
+
+    path = tmp_path / "mg.yaml"
+    path.write_text(catalog.source_text("mecanum-4").replace("type: mecanum,", "type: mecanum, gamma: 90 deg,", 1))
+    assert main(["show", str(path)]) == 0
+    want = capsys.readouterr().err
+    assert want.startswith(f"wmrkit: warning: {path}:") and want.count("\n") == 1, want
+
+    def create_app(root, robot, *, robot_spec=None, allowed_hosts=None):
+        raise KeyboardInterrupt  # stop before serving
+
+    monkeypatch.setattr(studio_app, "create_app", create_app)
+    with pytest.raises(KeyboardInterrupt):
+        main(["studio", str(path), "--port", "0", "--no-browser"])
+    assert capsys.readouterr().err == want
+
+
 def test_a_loopback_host_answers_at_its_own_address(tmp_path, monkeypatch):
     """`--host 127.0.0.2` (a loopback address) printed and opened http://127.0.0.2:PORT/, which answered 400
     'Invalid host header': only the Host names 127.0.0.1, localhost and ::1 were answered."""

@@ -11,7 +11,7 @@ import webbrowser
 from pathlib import Path
 
 from ..errors import WmrkitError
-from ._common import warn
+from ._common import load_robot, warn
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -29,7 +29,6 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 
 def run_studio(args: argparse.Namespace) -> int:
     """Start the server (blocking until Ctrl+C) and open the page."""
-    from .. import catalog
     from ..studio.app import LOCAL_HOSTS, create_app
 
     spec = args.robot
@@ -39,7 +38,7 @@ def run_studio(args: argparse.Namespace) -> int:
         root, spec = target.parent, target.name
     else:
         root = Path.cwd()
-    robot = catalog.resolve(args.robot)
+    robot = load_robot(args.robot)  # its description's warnings: wmrkit: warning: lines (the page shows them too)
     if not 0 <= args.port <= 65535:
         raise WmrkitError(f"--port: from 0 to 65535, got {args.port}")
     shown = f"[{args.host}]" if ":" in args.host else args.host

@@ -13,8 +13,10 @@ sets over the whole steering space, which :func:`configurations` gives on demand
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from typing import Any
+import threading
+import warnings
+from collections.abc import Callable, Mapping
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -25,7 +27,7 @@ from ..analysis.isotropy import condition_map, described_condition
 from ..analysis.optimize import isotropic_configurations
 from ..analysis.singularity import SINGULAR_RTOL, robot_size, singularity_distance
 from ..analysis.summary import describe_singular, described_analysis, model_rates, model_singular_set, singular_dict
-from ..description import robot_from_dict, robot_to_dict
+from ..description import DescriptionWarning, robot_from_dict, robot_to_dict
 from ..errors import ShapeError, WmrkitError
 from ..kinematics.wheel_ik import wheel_commands
 from ..limits import MAX_QUERY_RATE
@@ -42,6 +44,9 @@ MAX_RESOLUTION = 181
 #: the 2-core machine; the search grows with every steering angle): beyond, not searched, with a note.
 MAX_ISOTROPIC_STEERING = 4
 SOURCE = "studio"
+T = TypeVar("T")
+#: catch_warnings swaps the process's warning state: one description read at a time (the endpoints run in threads).
+_READING = threading.Lock()
 
 
 class StudioError(WmrkitError, ValueError):
@@ -50,9 +55,30 @@ class StudioError(WmrkitError, ValueError):
 
 # ---- descriptions ------------------------------------------------------------------------------------------
 def robot_of(request: Any) -> Robot:
-    """The :class:`Robot` of ``request["description"]`` (the description format reads ``heading`` or ``beta``)."""
+    """The :class:`Robot` of ``request["description"]`` (the description format reads ``heading`` or ``beta``);
+    its warnings are :func:`read_robot`'s (the page shows them from /api/analyze), not the server's stderr."""
+    return read_robot(request)[0]
+
+
+def read_robot(request: Any) -> tuple[Robot, list[str]]:
+    """:func:`robot_of` and the description's warnings (``source: field: message`` lines)."""
     data = _field(request, "description", Mapping)
-    return robot_from_dict(data, source=SOURCE)
+    return with_warnings(lambda: robot_from_dict(data, source=SOURCE))
+
+
+def with_warnings(read: Callable[[], T]) -> tuple[T, list[str]]:
+    """``read()`` and the :class:`~wmrkit.description.DescriptionWarning` lines it raised (the answer's
+    ``warnings``, as ``--json`` gives them), said nowhere else; other Python warnings are passed on as they were."""
+    with _READING, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", DescriptionWarning)
+        out = read()
+    said = []
+    for w in caught:
+        if issubclass(w.category, DescriptionWarning):
+            said.append(str(w.message))
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return out, said
 
 
 def description_of(robot: Robot) -> dict[str, Any]:
@@ -92,15 +118,16 @@ def kinds() -> dict[str, Any]:
 
 # ---- analysis ----------------------------------------------------------------------------------------------
 def analyze_live(request: Any) -> dict[str, Any]:
-    """Per-edit analysis: type (m, s), degeneracy, verdicts, condition number, ICR set, distance to singularity.
+    """Per-edit analysis: type (m, s), degeneracy, verdicts, condition number, ICR set, distance to singularity;
+    ``warnings``: the description's (a ``mecanum`` wheel whose ``gamma`` is not +-45 deg), as ``analyze --json``.
 
     The same numbers as :func:`wmrkit.analysis.analyze` (its ``to_dict`` keys), minus the singular sets over
     the steering space (:func:`configurations`), plus ``singular_here`` and the drawing's ``geometry``.
     """
     check_fields(request, "description")
-    robot = robot_of(request)
+    robot, said = read_robot(request)
     return {"robot": robot.name, "description": description_of(robot), "geometry": geometry(robot),
-            "analysis": live_summary(robot)}
+            "analysis": live_summary(robot), "warnings": said}
 
 
 def live_summary(robot: Robot) -> dict[str, Any]:

@@ -119,19 +119,20 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
         return handle
 
     start_file = robot_spec if robot_spec and Path(robot_spec).suffix.lower() in files.SUFFIXES else None
-    last_good = {"description": api.description_of(start)}
+    last_good: dict[str, Any] = {"description": api.description_of(start), "warnings": []}
 
     def start_robot() -> dict[str, Any]:
         """The robot the page starts with. A start file is read again (it may have been edited since: a reload
         showed the robot read at start, and Save then wrote it over the edit); one now invalid or gone keeps the
-        last good robot, with the error naming the file."""
+        last good robot, with the error naming the file. ``warnings``: the description's (of that robot)."""
         out: dict[str, Any] = {"spec": robot_spec or start.name}
         if start_file is not None:
             try:
-                last_good["description"] = files.open_robot(root, {"path": start_file})["description"]
+                opened = files.open_robot(root, {"path": start_file})
+                last_good.update(description=opened["description"], warnings=opened["warnings"])
             except WmrkitError as err:
                 out["error"] = str(err)
-        return out | {"description": last_good["description"]}
+        return out | {"description": last_good["description"], "warnings": last_good["warnings"]}
 
     def meta(_: Any) -> dict[str, Any]:
         return {"catalog": list(catalog.names()), "kinds": api.kinds(), "root": root.name or str(root),

@@ -22,7 +22,7 @@ from .. import catalog
 from ..description import robot_from_text
 from ..documents import read_file
 from ..errors import WmrkitError
-from .api import StudioError, check_fields, description_of, robot_of
+from .api import StudioError, check_fields, description_of, robot_of, with_warnings
 
 SUFFIXES = (".yaml", ".yml", ".json")
 #: At most this many files are listed, at most this deep below the root.
@@ -119,7 +119,8 @@ def _plain_name(name: str) -> bool:
 
 
 def open_robot(root: Path, request: Any) -> dict[str, Any]:
-    """``{"path": ...}`` (a file in `root`) or ``{"catalog": name}`` -> its description (SI) and source text."""
+    """``{"path": ...}`` (a file in `root`) or ``{"catalog": name}`` -> its description (SI), source text and
+    ``warnings`` (the description's, naming the file, line and field)."""
     if not isinstance(request, Mapping):
         raise StudioError("the request body must be a JSON object")
     check_fields(request, "catalog", "path")
@@ -129,8 +130,9 @@ def open_robot(root: Path, request: Any) -> dict[str, Any]:
         name = request["catalog"]
         if not isinstance(name, str):
             raise StudioError("catalog: a robot name (see 'wmrkit robots')")
-        robot = catalog.load(name)
-        return {"catalog": name, "description": description_of(robot), "text": catalog.source_text(name)}
+        robot, said = with_warnings(lambda: catalog.load(name))
+        return {"catalog": name, "description": description_of(robot), "text": catalog.source_text(name),
+                "warnings": said}
     path = safe_path(root, request.get("path"))
     try:
         if not path.is_file():
@@ -138,8 +140,10 @@ def open_robot(root: Path, request: Any) -> dict[str, Any]:
     except OSError as err:
         raise StudioError(f"path: '{_shown(request['path'])}': {err.strerror or err}") from None
     text = read_file(path)  # at most MAX_FILE_SIZE bytes; an unreadable file is a DescriptionError naming it
-    robot = robot_from_text(text, source=str(path), fmt="json" if path.suffix.lower() == ".json" else "yaml")
-    return {"path": path.relative_to(root.resolve()).as_posix(), "description": description_of(robot), "text": text}
+    fmt = "json" if path.suffix.lower() == ".json" else "yaml"
+    robot, said = with_warnings(lambda: robot_from_text(text, source=str(path), fmt=fmt))
+    return {"path": path.relative_to(root.resolve()).as_posix(), "description": description_of(robot), "text": text,
+            "warnings": said}
 
 
 def save_robot(root: Path, request: Any) -> dict[str, Any]:

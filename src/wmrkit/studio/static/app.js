@@ -12,6 +12,8 @@ const S = {
   selected: null, selIndex: -1, undo: [], redo: [], twist: [0, 0, 0], heading: {}, path: "",
   inflight: false, pending: false, driving: 0, driveSeq: 0, editTime: 0, seq: 0, anim: null, view: null,
   startError: null,  // the start file could not be read again (invalid or gone): shown over its last good robot
+  loadWarnings: [],  // the warnings of the file or catalog robot as read, shown until another is loaded or saved
+  descWarnings: [],  // the warnings of the description analysed last (a mecanum wheel whose gamma is not +-45 deg)
 };
 // Timings for the docs and the browser test: round trip edit -> numbers shown [ms], server time [ms].
 window.studioStats = { edits: [], server: [], rendered: 0 };
@@ -148,6 +150,7 @@ async function send() {
   if (r.ok) {
     S.geometry = r.data.geometry; S.analysis = r.data.analysis; S.valid = desc; S.analysedText = text;
     showError(S.startError && { error: S.startError }); S.startError = null;
+    S.descWarnings = r.data.warnings; showWarnings();
   } else {
     showError(r.data);
   }
@@ -211,6 +214,10 @@ async function driveNow() {
 }
 
 // ---- errors in place ------------------------------------------------------------------------------------------
+function showWarnings() {  // the description's warnings (the CLI's wmrkit: warning: lines), one a line
+  const box = $("warnings"), lines = [...S.loadWarnings, ...S.descWarnings];
+  box.hidden = !lines.length; box.textContent = lines.map((w) => `warning: ${w}`).join("\n");
+}
 function showError(err) {
   document.querySelectorAll(".invalid").forEach((e) => e.classList.remove("invalid"));
   document.querySelectorAll("[data-msg]").forEach((e) => { e.textContent = ""; });
@@ -694,7 +701,7 @@ async function openRobot() {
   const r = await call("/api/open", file ? { path: file } : { catalog: $("catalog").value });
   // The error is about the file's wheels, not the robot on screen: its message (naming the file), no field marked.
   if (!r.ok) { showError({ error: r.data.error }); return; }
-  load(r.data.description, file || `${r.data.description.name}.yaml`);
+  load(r.data.description, file || `${r.data.description.name}.yaml`, r.data.warnings);
 }
 async function saveRobot() {
   const path = $("save-path").value.trim();
@@ -705,6 +712,7 @@ async function saveRobot() {
   }
   if (!r.ok) { showError(r.data); return; }
   showError(null);
+  S.loadWarnings = []; showWarnings();  // the file loaded is not what it was: its warnings no longer hold
   $("status").textContent = `saved ${r.data.path}`;
   const f = await call("/api/files");
   if (f.ok) fillFiles(f.data.files);
@@ -714,8 +722,8 @@ function fillFiles(files) {
   sel.length = 1;
   for (const f of files) sel.add(new Option(f, f, false, f === keep));
 }
-function load(desc, path) {
-  S.desc = desc; S.undo = []; S.redo = []; S.selected = null; S.heading = {}; S.view = null;
+function load(desc, path, warnings = []) {
+  S.loadWarnings = warnings; S.desc = desc; S.undo = []; S.redo = []; S.selected = null; S.heading = {}; S.view = null;
   $("save-path").value = path;
   $("robot-name").value = desc.name;
   renderWheelPanel();
@@ -776,6 +784,6 @@ async function main() {
   setTwist([0, 0, 0]);
   S.startError = S.meta.start.error || null;
   load(S.meta.start.description, /\.(ya?ml|json)$/i.test(S.meta.start.spec)  // a file: .yaml, .yml, .json (files.py)
-    ? S.meta.start.spec : `${S.meta.start.description.name}.yaml`);
+    ? S.meta.start.spec : `${S.meta.start.description.name}.yaml`, S.meta.start.warnings);
 }
 main();
