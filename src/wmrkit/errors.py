@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import threading
+import warnings
+from collections.abc import Callable, Sequence
+from typing import TypeVar
+
+T = TypeVar("T")
+_CATCHING = threading.Lock()  # warnings.catch_warnings changes process-wide state: one reader at a time
 
 
 class WmrkitError(Exception):
@@ -70,3 +76,18 @@ def name_list(names: Sequence[str], limit: int = MAX_LISTED) -> str:
     names = list(names)
     shown = ", ".join(names[:limit])
     return shown if len(names) <= limit else f"{shown} and {len(names) - limit} more"
+
+
+def said_warnings(read: Callable[[], T], category: type[Warning]) -> tuple[T, list[str]]:
+    """``read()`` and the lines of the `category` warnings it raised (said by the caller: the CLI's ``wmrkit:
+    warning:`` lines, the studio's answers), said nowhere else; other warnings are passed on as they were."""
+    with _CATCHING, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", category)
+        out = read()
+    said = []
+    for w in caught:
+        if issubclass(w.category, category):
+            said.append(str(w.message))
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return out, said

@@ -8,7 +8,6 @@ import json
 import math
 import os
 import sys
-import warnings
 from collections.abc import Iterator
 from contextvars import ContextVar
 from pathlib import Path
@@ -38,15 +37,11 @@ def add_json_flag(parser: argparse.ArgumentParser) -> None:
 def load_robot(spec: str) -> Robot:
     """The robot named by a ROBOT argument; the description's warnings said (:func:`warn`)."""
     from ..description import DescriptionWarning
+    from ..errors import said_warnings
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", DescriptionWarning)
-        robot = catalog.resolve(spec)
-    for w in caught:  # the others as Python would have said them
-        if issubclass(w.category, DescriptionWarning):
-            warn(str(w.message))
-        else:
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    robot, lines = said_warnings(lambda: catalog.resolve(spec), DescriptionWarning)
+    for line in lines:
+        warn(line)
     return robot
 
 

@@ -38,7 +38,7 @@ def run_studio(args: argparse.Namespace) -> int:
         root, spec = target.parent, target.name
     else:
         root = Path.cwd()
-    robot = load_robot(args.robot)  # its description's warnings: wmrkit: warning: lines (the page shows them too)
+    robot = load_robot(args.robot)  # its description's warnings said as warning lines (the page shows them too)
     if not 0 <= args.port <= 65535:
         raise WmrkitError(f"--port: from 0 to 65535, got {args.port}")
     shown = f"[{args.host}]" if ":" in args.host else args.host

@@ -13,8 +13,6 @@ sets over the whole steering space, which :func:`configurations` gives on demand
 from __future__ import annotations
 
 import math
-import threading
-import warnings
 from collections.abc import Callable, Mapping
 from typing import Any, TypeVar
 
@@ -28,7 +26,7 @@ from ..analysis.optimize import isotropic_configurations
 from ..analysis.singularity import SINGULAR_RTOL, robot_size, singularity_distance
 from ..analysis.summary import describe_singular, described_analysis, model_rates, model_singular_set, singular_dict
 from ..description import DescriptionWarning, robot_from_dict, robot_to_dict
-from ..errors import ShapeError, WmrkitError
+from ..errors import ShapeError, WmrkitError, said_warnings
 from ..kinematics.wheel_ik import wheel_commands
 from ..limits import MAX_QUERY_RATE
 from ..odometry.integrators import integrate_exact
@@ -45,8 +43,6 @@ MAX_RESOLUTION = 181
 MAX_ISOTROPIC_STEERING = 4
 SOURCE = "studio"
 T = TypeVar("T")
-#: catch_warnings swaps the process's warning state: one description read at a time (the endpoints run in threads).
-_READING = threading.Lock()
 
 
 class StudioError(WmrkitError, ValueError):
@@ -68,17 +64,8 @@ def read_robot(request: Any) -> tuple[Robot, list[str]]:
 
 def with_warnings(read: Callable[[], T]) -> tuple[T, list[str]]:
     """``read()`` and the :class:`~wmrkit.description.DescriptionWarning` lines it raised (the answer's
-    ``warnings``, as ``--json`` gives them), said nowhere else; other Python warnings are passed on as they were."""
-    with _READING, warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", DescriptionWarning)
-        out = read()
-    said = []
-    for w in caught:
-        if issubclass(w.category, DescriptionWarning):
-            said.append(str(w.message))
-        else:
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    return out, said
+    ``warnings``, as ``--json`` gives them), said nowhere else (:func:`wmrkit.errors.said_warnings`)."""
+    return said_warnings(read, DescriptionWarning)
 
 
 def description_of(robot: Robot) -> dict[str, Any]:
