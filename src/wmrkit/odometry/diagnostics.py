@@ -149,19 +149,9 @@ def imu_step(imu_time: np.ndarray) -> float:
     return max(IMU_WINDOW / 2, float(imu_time[-1] - imu_time[0]) / MAX_IMU_WINDOWS)
 
 
-def imu_grid(start: float, end: float, step: float, lo: float, hi: float) -> np.ndarray:
-    """The window ends of the IMU check over a run from `start` to `end` [s] with an IMU from `lo` to `hi` [s] (they
-    overlap): the run's ends and ``start + k step`` (the times :class:`ImuCheck` samples), all within ``[lo, hi]``
-    (the IMU's yaw held outside is its yaw there)."""
-    first, last = max(start, lo), min(end, hi)
-    k = np.arange(math.ceil((first - start) / step), math.floor((last - start) / step) + 1)
-    inner = start + step * k
-    return np.concatenate([[first], inner[(inner > first) & (inner < last)], [last]])
-
-
 def imu_warning(grid: np.ndarray, heading: np.ndarray, imu: np.ndarray, topic: str,
                 what: str = "no-slip") -> str | None:
-    """The line when the `what` odometry's heading and the IMU's yaw (both at the `grid` times of :func:`imu_grid`)
+    """The line when the `what` odometry's heading and the IMU's yaw (both at the `grid` times of :class:`ImuCheck`)
     turn apart, over the run or over one window, by more than :data:`IMU_TURN_ATOL` + :data:`IMU_DRIFT` times its
     span + :data:`IMU_TURN_RTOL` times the larger turn; else None. The line gives both turns over the run and over
     the worst window."""
@@ -248,11 +238,12 @@ class ImuCheck:
                 raise err
             self.line = f"{err} (the odometry is not checked against it)"
             return
-        grid = imu_grid(self._start, self._last[0], self._step, time[0], time[-1])  # where both have samples
+        # the window ends: the times kept where both have samples (the run's ends or the IMU's, start + k step)
         at = np.concatenate([*self._times, [self._last[0]]])
-        order = np.argsort(at, kind="stable")
-        heading = np.interp(grid, at[order], np.concatenate([*self._headings, [self._last[1]]])[order])
-        self.line = imu_warning(grid, heading, np.interp(grid, time, yaw), self.topic, self.what)
+        grid, first = np.unique(at, return_index=True)
+        within = (grid >= time[0]) & (grid <= time[-1])
+        heading = np.concatenate([*self._headings, [self._last[1]]])[first][within]
+        self.line = imu_warning(grid[within], heading, np.interp(grid[within], time, yaw), self.topic, self.what)
         self.checked = True
 
 
