@@ -181,7 +181,7 @@ def _imu_check(job: LogJob, model: OdometryModel) -> tuple[ImuCheck | None, str 
     cannot be found or read is ``(None, the line saying the log is not checked against it)``, never the log's
     error (a bag that cannot be read at all fails in the run, with its own message)."""
     from ..odometry.bags import imu_topic
-    from ..odometry.diagnostics import imu_check
+    from ..odometry.diagnostics import imu_check, odometry_name
     from ..odometry.files import is_bag
     from ..odometry.logs import LogError
 
@@ -193,7 +193,7 @@ def _imu_check(job: LogJob, model: OdometryModel) -> tuple[ImuCheck | None, str 
         return None, f"{err} (the odometry is not checked against it)"
     if topic is None:  # several Imu topics (a warning, as wmrkit odometry's), or none (nothing to say)
         return None, note
-    what = "weighted no-slip (--weight)" if np.any(np.asarray(model.row_weights) != 1.0) else "no-slip"
+    what = odometry_name(None, bool(np.any(np.asarray(model.row_weights) != 1.0)))
     return imu_check(job.path, topic, what, named=False) if topic else (None, None)
 
 

@@ -14,7 +14,7 @@ from ..errors import WmrkitError
 from ..limits import check_chunk_size
 from ..odometry.bags import imu_topic
 from ..odometry.covariance import CrowleyNoise
-from ..odometry.diagnostics import diagnose, imu_check
+from ..odometry.diagnostics import diagnose, imu_check, odometry_name
 from ..odometry.files import first_samples, is_bag, odometry_file
 from ..odometry.header import header_format
 from ..odometry.integrators import METHODS
@@ -155,7 +155,7 @@ def run(args: argparse.Namespace) -> int:
              parse_angle(args.pose[2], "--pose")]
     check_start_pose(np.array(pose0), "--pose")
     slip_model = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None
-    what = args.method if slip_model is not None else "weighted no-slip (--weight)" if args.weight else "no-slip"
+    what = odometry_name(args.method if slip_model is not None else None, bool(args.weight))
     # the IMU read now: a named one that fails is refused before any output is written
     check, unread = imu_check(args.log, imu, what, named=args.imu is not None) if imu else (None, None)
     summary = odometry_file(

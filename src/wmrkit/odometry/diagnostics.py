@@ -175,6 +175,12 @@ def imu_warning(grid: np.ndarray, heading: np.ndarray, imu: np.ndarray, topic: s
             "slip (a skid steer turning?), or the description's track or wheel radii are wrong")
 
 
+def odometry_name(estimator: str | None, weighted: bool) -> str:
+    """How the IMU check's warning names the odometry it judges: the slip-aware `estimator` (``wls``, ``fk1``,
+    ``fk2``), else the no-slip model, ``weighted`` by ``--weight`` or not."""
+    return estimator or ("weighted no-slip (--weight)" if weighted else "no-slip")
+
+
 class ImuCheck:
     """The IMU check of one run of a bag (:func:`imu_warning`) on the trajectory the run outputs, whatever its
     estimator: a sink of its chunks (:func:`~.files.odometry_file`'s `sinks`) keeping their heading only at the
