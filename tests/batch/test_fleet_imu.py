@@ -1,8 +1,9 @@
 """``wmrkit batch odometry`` checks each bag against its IMU as ``wmrkit odometry ROBOT BAG`` does: the same warning
 line (the oracle: that command run per bag with ``--json``), ``consistent`` false when it fires, the summary's
-inconsistent count; an IMU that cannot be read is a "not checked" line, never the log's error. The check runs in the
-Dask workers of a real ``LocalCluster`` (two processes, one thread each); the bags are written here: JointState of a
-run and an Imu whose orientation is the run's true heading, a few hundred messages each."""
+inconsistent count; an IMU found by itself that cannot be read is a "not checked" line, a named one the log's
+error. The check runs in the Dask workers of a real ``LocalCluster`` (two processes, one thread each); the bags are
+written here: JointState of a run and an Imu whose orientation is the run's true heading, a few hundred messages
+each."""
 
 from __future__ import annotations
 
@@ -160,7 +161,7 @@ def test_each_bag_is_checked_against_its_imu_on_the_cluster(capsys, tmp_path, fl
 def test_a_named_imu_is_the_one_checked(capsys, tmp_path, fleet):
     """A bag with two Imu topics, /imu/true (the robot's turn) and /imu/wheels (the wheels' no-slip heading): no
     topic is checked by default (imu null and a warning, as the single command's); ``--imu /imu/true`` flags it with the
-    single command's line and ``--imu /imu/wheels`` does not; ``--imu /none`` is a "not checked" line, the log done."""
+    single command's line and ``--imu /imu/wheels`` does not."""
     from wmrkit.slip.skid import segment_run
 
     robot = fleet[0]
@@ -179,12 +180,63 @@ def test_a_named_imu_is_the_one_checked(capsys, tmp_path, fleet):
                                                                    s["imu"]), extra
         assert row["consistent"] is not flagged and (row["imu"] is None) is not extra
         assert ("choose one with --imu TOPIC" in (row["warnings"] or "")) == (not extra)  # said, not silently skipped
-    assert main(["batch", "odometry", str(robot), str(bag), "--workers", "0", "--json", "--imu", "/none"]) == 0
-    answer = json.loads(capsys.readouterr().out)
-    (row,) = answer["rows"]
-    assert row["warnings"] == (f"{bag}: --imu topic '/none' is not in the bag (sensor_msgs/msg/Imu topics: /imu/true, "
-                               "/imu/wheels) (the odometry is not checked against it)")
-    assert row["consistent"] and row["imu"] is None and answer["failed"] == 0
+
+
+def _batch(capsys, robot, bags, *extra) -> tuple[int, dict, str]:
+    """``wmrkit batch odometry ROBOT BAGS --workers 0 --json``'s exit code, answer and stderr."""
+    code = main(["batch", "odometry", str(robot), *map(str, bags), "--workers", "0", "--json", *extra])
+    out = capsys.readouterr()
+    return code, json.loads(out.out), out.err
+
+
+def test_a_named_imu_a_bag_cannot_give_fails_that_bag_as_wmrkit_odometry_refuses_it(capsys, tmp_path, fleet):
+    """``--imu TOPIC`` names the IMU: a bag without that Imu topic, one whose IMU has a NaN orientation and one whose
+    IMU is on another clock each fail (their error the one ``wmrkit odometry --imu TOPIC`` exits 2 with, their
+    trajectory not written), the bag with a usable IMU is done, and the batch exits 1. Before, each was a "not
+    checked" warning, the batch exit 0 with ``failed`` 0."""
+    robot, (_, clean, unread), _ = fleet
+    log = tmp_path / "log"
+    log.mkdir()
+    run = simulate(load_robot_file(robot), TwistProfile.from_segments([(3.0, 0.3, 0.0, 0.2)]), 25.0)
+    t, yaw = _imu(run.log.time, run.truth[:, 2])
+    other = _bag(log / "other", run.log.time, run.log.positions, {"/imu/other": (t, yaw)})
+    clock = _bag(log / "clock", run.log.time, run.log.positions, {"/imu": (t + 500.0, yaw)})
+    bags = [clean, other, unread, clock]
+    errors = {}
+    for bag in bags[1:]:
+        code = main(["odometry", str(robot), str(bag), "--json", "--imu", "/imu"])
+        answer = json.loads(capsys.readouterr().err)
+        assert code == 2, bag
+        errors[str(bag)] = f"{answer['file']}: {answer['error']}"
+    assert "is not in the bag" in errors[str(other)] and "message 10" in errors[str(unread)]
+    assert "another clock?" in errors[str(clock)]
+    code, answer, _ = _batch(capsys, robot, bags, "--imu", "/imu", "--trajectories", str(tmp_path / "traj"))
+    assert code == 1 and answer["failed"] == 3 and answer["errors"] == errors
+    rows = {r["log"]: r for r in answer["rows"]}
+    assert rows[str(clean)]["imu"] == "/imu" and rows[str(clean)]["error"] is None
+    assert sorted(p.name for p in (tmp_path / "traj").iterdir()) == ["clean.tum"]
+    code, answer, _ = _batch(capsys, robot, [clean, other], "--imu", "/imu/other")
+    assert code == 1 and list(answer["errors"]) == [str(clean)] and answer["rows"][1]["imu"] == "/imu/other"
+    assert answer["errors"][str(clean)].startswith(f"{clean}: --imu topic '/imu/other' is not in the bag")
+
+
+def test_the_imu_found_in_each_bag_is_said(capsys, tmp_path, fleet):
+    """Without --imu, the IMU each bag holds alone is checked: a note on stderr names the topics found (``wmrkit
+    odometry``'s note; before, batch said nothing), each row's ``imu`` names its own, and the text lines without
+    --out say it per bag; a bag whose IMU cannot be used is not counted (a warning says so, its imu null)."""
+    robot, (slips, clean, unread), _ = fleet
+    code, answer, err = _batch(capsys, robot, [clean, unread, slips])
+    assert code == 0 and [r["imu"] for r in answer["rows"]] == ["/imu", None, "/imu"]
+    assert ("wmrkit: note: heading of 2 bags checked against the IMU on each bag's one sensor_msgs/msg/Imu topic "
+            "(/imu; --imu TOPIC chooses it; each row's imu names the topic)") in err.splitlines()
+    assert main(["batch", "odometry", str(robot), str(clean), str(unread), "--workers", "0", "--quiet"]) == 0
+    out = capsys.readouterr()
+    assert "wmrkit: note: heading of 1 bag checked against the IMU" in out.err
+    lines = out.out.splitlines()
+    assert lines[1].startswith(f"  {clean}: x ") and lines[1].endswith(", heading checked against the IMU on /imu")
+    assert lines[2].startswith(f"  {unread}: x ") and "IMU" not in lines[2]
+    assert main(["batch", "odometry", str(robot), str(clean), "--workers", "0", "--quiet", "--imu", "/imu"]) == 0
+    assert "note" not in capsys.readouterr().err  # named: nothing found by itself
 
 
 def test_imu_without_a_bag_is_refused(capsys, tmp_path):

@@ -50,8 +50,9 @@ SUMMARY_SCHEMA = (
 KEY_COLUMNS = ("log", "robot", "method", "error", "trajectory")
 #: Version of what a row holds, in its settings digest: a row of an older version is redone (2: odometry's
 #: diagnostic lines in ``warnings``; 3: ``consistent``, which part files of a version-2 run lack; 4: a bag's IMU
-#: check in ``warnings`` and ``consistent``, its topic in ``imu``).
-ROW_VERSION = 4
+#: check in ``warnings`` and ``consistent``, its topic in ``imu``; 5: a named IMU that cannot be used is the log's
+#: error, no longer a warning).
+ROW_VERSION = 5
 #: Suffixes of single-file logs found in a folder (CSV joint logs, ROS 2 bag files).
 LOG_SUFFIXES = (".csv", ".db3", ".mcap")
 
@@ -69,7 +70,7 @@ class LogJob:
     options: Mapping[str, Any] = field(default_factory=dict)  # more keyword arguments of odometry_file
     model: Any = None  # the odometry model, built once per batch (else per log, from options' sensed/weights)
     header: Mapping[str, Any] | None = None  # without options["fmt"]: a CSV log's format from its header and these
-    imu: str | None = None  # a bag's Imu topic checking its heading (else the bag's only one)
+    imu: str | None = None  # a bag's Imu topic checking its heading, named (else the bag's only one, found)
 
 
 @dataclass(frozen=True)
@@ -177,9 +178,10 @@ def _imu_check(job: LogJob, model: OdometryModel) -> tuple[ImuCheck | None, str 
     """``wmrkit odometry``'s IMU check of a bag's run (:func:`~wmrkit.odometry.diagnostics.imu_check`): on the
     batch's `job.imu` topic, else the bag's only ``Imu`` topic, judging the run of `model` (named as that command
     names it: "weighted no-slip (--weight)" when its rows are weighted); ``(None, None)`` for a CSV log or a bag
-    without one, ``(None, the line saying none is checked)`` for a bag with several and no `job.imu`. An IMU that
-    cannot be found or read is ``(None, the line saying the log is not checked against it)``, never the log's
-    error (a bag that cannot be read at all fails in the run, with its own message)."""
+    without one, ``(None, the line saying none is checked)`` for a bag with several and no `job.imu`. As in that
+    command, a named IMU that cannot be used (not in the bag, not an ``Imu``, unreadable, or its stamps missing the
+    run's: raised by the check after the run) is a :class:`~wmrkit.odometry.logs.LogError`, the log's error; one found
+    by itself is ``(None, the line saying the log is not checked against it)``."""
     from ..odometry.bags import imu_topic
     from ..odometry.diagnostics import imu_check, odometry_name
     from ..odometry.files import is_bag
@@ -187,14 +189,17 @@ def _imu_check(job: LogJob, model: OdometryModel) -> tuple[ImuCheck | None, str 
 
     if not is_bag(job.path):
         return None, None
+    named = job.imu is not None
     try:
         topic, note = imu_topic(job.path, job.imu)
     except LogError as err:
+        if named:
+            raise
         return None, f"{err} (the odometry is not checked against it)"
     if topic is None:  # several Imu topics (a warning, as wmrkit odometry's), or none (nothing to say)
         return None, note
     what = odometry_name(None, bool(np.any(np.asarray(model.row_weights) != 1.0)))
-    return imu_check(job.path, topic, what, named=False) if topic else (None, None)
+    return imu_check(job.path, topic, what, named=named)
 
 
 def _diagnose(job: LogJob, s: OdometrySummary, model: OdometryModel, options: Mapping[str, Any]) -> Diagnosis:
@@ -227,7 +232,8 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     Each row's ``warnings`` are ``wmrkit odometry``'s lines for its log (:mod:`wmrkit.odometry.diagnostics`), and
     with `slip_warning` [m] a note where the slip indicator exceeds it; its ``consistent`` is that command's verdict.
     A bag's IMU checks its heading as there: the `imu` topic, else the bag's only ``Imu`` topic; its ``imu`` column
-    says the topic checked (an IMU that cannot be read is a warning line, not the log's error).
+    says the topic checked. An IMU found by itself that cannot be used is a warning line; a named `imu` that a bag
+    lacks or that cannot be used is that log's error (the other logs run), as ``wmrkit odometry --imu`` refuses it.
     """
     from ..odometry.files import is_bag
     from ..odometry.integrators import check_method

@@ -159,8 +159,9 @@ NAMED = 3
 
 def run_odometry(args: argparse.Namespace) -> int:
     """Batch odometry; prints the number of logs done, skipped, failed and inconsistent (naming the first
-    :data:`NAMED` of those, each failure). Exit code 1 when a log failed (the others are done and written); an
-    inconsistent log is a warning, as in ``wmrkit odometry`` (exit code 0)."""
+    :data:`NAMED` of those, each failure). Exit code 1 when a log failed (the others are done and written; a bag
+    lacking the --imu topic, or whose named IMU cannot be used, fails); an inconsistent log is a warning, as in
+    ``wmrkit odometry`` (exit code 0). A note on stderr names the IMU topics found by themselves, as that command's."""
     from ..batch.fleet import batch_odometry
 
     robot = load_robot(args.robot)
@@ -175,6 +176,11 @@ def run_odometry(args: argparse.Namespace) -> int:
     for r in result.rows:  # they were only in the table's 'warnings' column (or nowhere, without --out)
         if r["warnings"] and not r["error"]:
             warn(f"{r['log']}: {r['warnings']}")
+    found = [r["imu"] for r in result.rows if r["imu"] and not r["error"]]
+    if found and args.imu is None:  # each bag's own Imu topic, found by itself: wmrkit odometry's note
+        print(f"wmrkit: note: heading of {len(found)} bag{'s' if len(found) > 1 else ''} checked against the IMU on "
+              f"each bag's one sensor_msgs/msg/Imu topic ({', '.join(sorted(set(found)))}; --imu TOPIC chooses it; "
+              "each row's imu names the topic)", file=sys.stderr)
     if args.json:
         print_json({"robot": robot.name, **result.to_dict(), "rows": [dict(r) for r in result.rows]})
         return 1 if result.failed else 0
@@ -187,7 +193,8 @@ def run_odometry(args: argparse.Namespace) -> int:
             print(f"  failed: {r['error'] if r['error'].startswith(r['log']) else r['log'] + ': ' + r['error']}")
         elif not args.out:
             print(f"  {r['log']}: x {r['x']:.4f} m, y {r['y']:.4f} m, theta {r['theta']:.4f} rad, "
-                  f"path {r['path_length']:.4g} m")
+                  f"path {r['path_length']:.4g} m" + (f", heading checked against the IMU on {r['imu']}"
+                                                      if r["imu"] else ""))
     return 1 if result.failed else 0  # a pipeline must tell a batch with failed logs from a complete one
 
 
