@@ -391,3 +391,58 @@ def test_samples_far_apart_in_time_keep_the_check_small():
     assert held <= diagnostics.MAX_IMU_WINDOWS + 3
     check.judge()
     assert check.checked and check.line is None  # 2 rad apart in 3 years: within the gyro's drift
+
+
+#: The ends of the lines of diagnostics.IMU_FRAME_SCALES and of the odometry's (the generic line).
+OPPOSITE = "is the IMU mounted upside down, or its frame not REP-103 (z down, NED)?"
+DEG_S = "the IMU's yaw turns 57.3 times the odometry's: does the IMU publish deg/s?"
+SLIP = "the wheels slip (a skid steer turning?), or the description's track or wheel radii are wrong"
+
+
+@pytest.fixture(scope="module")
+def turning_run():
+    """A differential drive rolling through turns both ways (30 s; its heading spans about 3.4 rad), no slip."""
+    profile = TwistProfile.from_segments([(3.0, 0.4, 0.0, 0.0), (3.0, 0.2, 0.0, 0.6), (3.0, 0.4, 0.0, 0.0),
+                                          (6.0, 0.1, 0.0, -0.5), (15.0, 0.3, 0.0, 0.1)])
+    return simulate(catalog.load("diff-drive"), profile, 20.0)
+
+
+@pytest.mark.parametrize(("kind", "scale", "said"), [("gyro", -1.0, OPPOSITE), ("orientation", -1.0, OPPOSITE),
+                                                     ("gyro", 180 / math.pi, DEG_S),
+                                                     ("gyro", -180 / math.pi, "does the IMU publish deg/s")])
+def test_an_imu_upside_down_or_in_deg_s_is_said_to_be_so(capsys, tmp_path, turning_run, kind, scale, said):
+    """The odometry is right (the run's own joints, no slip); the IMU reads the true heading times -1 (a gyro upside
+    down, an orientation in a NED frame), 57.3 (a gyro in deg/s) or both. Before, the line blamed the wheels ("the
+    wheels slip ..., or the description's track or wheel radii are wrong"); now it says what the IMU looks like, and
+    the turns it gives are the truth's and the truth's times the scale."""
+    run = turning_run
+    t, yaw, rate = _imu(run.log.time, run.truth[:, 2], kind)
+    yaw, rate = (None, scale * rate) if kind == "gyro" else (scale * yaw, None)
+    bag = tmp_path / "run"
+    _write(bag, run.log.time, run.log.joints, run.log.positions, {"/imu": (t, yaw, rate)})
+    code, answer, err = _run(capsys, "diff-drive", bag)
+    assert code == 0 and answer["imu"] == "/imu" and not answer["consistent"]
+    (line,) = answer["warnings"]
+    assert said in line and SLIP not in line and f"wmrkit: warning: {line}" in err
+    m = PATTERN.search(line)
+    true = run.truth[-1, 2] - run.truth[0, 2]
+    assert float(m[1]) == pytest.approx(true, rel=1e-3)
+    assert float(m[2]) == pytest.approx(scale * true, rel=2e-2)
+
+
+@pytest.mark.parametrize(("scale", "turn", "said"), [(-1.0, 1.0, OPPOSITE), (-0.95, 3.0, OPPOSITE), (-0.85, 3.0, SLIP),
+                                                     (-1.0, 0.5, OPPOSITE), (-1.0, 0.4, SLIP),
+                                                     (0.97 * 180 / math.pi, 1.0, DEG_S), (30.0, 1.0, SLIP),
+                                                     (0.5, 1.0, SLIP)])
+def test_the_imu_frame_is_said_within_the_check_tolerance_and_past_a_least_turn(scale, turn, said):
+    """The heading turns `turn` rad in 5 s and back over 20 s; the IMU reads `scale` times it. The IMU's frame or
+    units are said when its turns over the scale agree with the heading's by the check's rule (0.05 rad + 0.005 rad/s
+    x 10 s + 10 % of the turn: over 3 rad, -0.95 does and -0.85 does not; 0.97 x 57.3 does; 30 and 0.5 fit no scale)
+    and the odometry turns 0.5 rad somewhere (diagnostics.IMU_FRAME_MIN_TURN: 0.4 rad does not)."""
+    from wmrkit.odometry.diagnostics import IMU_FRAME_MIN_TURN, imu_warning
+
+    assert IMU_FRAME_MIN_TURN == 0.5
+    grid = np.arange(0.0, 20.01, 5.0)
+    heading = turn * np.array([0.0, 1.0, 1.0, 0.0, 0.0])
+    line = imu_warning(grid, heading, scale * heading, "/imu")
+    assert line is not None and said in line and (said == SLIP) == line.endswith(SLIP)

@@ -51,8 +51,8 @@ KEY_COLUMNS = ("log", "robot", "method", "error", "trajectory")
 #: Version of what a row holds, in its settings digest: a row of an older version is redone (2: odometry's
 #: diagnostic lines in ``warnings``; 3: ``consistent``, which part files of a version-2 run lack; 4: a bag's IMU
 #: check in ``warnings`` and ``consistent``, its topic in ``imu``; 5: a named IMU that cannot be used is the log's
-#: error, no longer a warning).
-ROW_VERSION = 5
+#: error, no longer a warning; 6: the IMU's line says when the IMU looks upside down or in deg/s).
+ROW_VERSION = 6
 #: Suffixes of single-file logs found in a folder (CSV joint logs, ROS 2 bag files).
 LOG_SUFFIXES = (".csv", ".db3", ".mcap")
 

@@ -53,6 +53,24 @@ IMU_TURN_ATOL = 0.05
 #: start-up calibration (0.01-0.1 deg/s, temperature drift) several times over; a run without turning stays within.
 IMU_DRIFT = 0.005
 
+#: The IMU's yaw over these scales (keys) agreeing with the odometry's heading (:func:`imu_warning`'s rule) is said to
+#: be the IMU's frame or units (values): an IMU mounted upside down (z down) or in a NED frame reads the opposite yaw
+#: rate; one publishing deg/s (sensor_msgs/Imu: rad/s) reads 180/pi = 57.3 times the rate. Over large turns the
+#: check's 10 % lets the IMU turn 0.9 to 1.11 times the scale (-0.9 to -1.11; 51.6 to 63.7); its 0.05 rad and drift
+#: widen that over small ones.
+IMU_FRAME_SCALES = {
+    -1.0: "the IMU's yaw rate is the opposite of the odometry's: is the IMU mounted upside down, or its frame not "
+          "REP-103 (z down, NED)? (Else the odometry turns the wrong way: the description's left and right swapped?)",
+    180 / math.pi: "the IMU's yaw turns 57.3 times the odometry's: does the IMU publish deg/s? (sensor_msgs/Imu's "
+                   "angular_velocity is in rad/s)",
+    -180 / math.pi: "the IMU's yaw turns -57.3 times the odometry's: does the IMU publish deg/s (sensor_msgs/Imu's "
+                    "angular_velocity is in rad/s), and is it mounted upside down, or its frame not REP-103?",
+}
+#: ... only when the odometry turns at least this much [rad] over the run or a window (29 deg: 5 times the check's
+#: 0.05 rad + 10 s of drift), so that a run without turning, the IMU's drift and noise all it reads, is not said to be
+#: upside down or in deg/s.
+IMU_FRAME_MIN_TURN = 0.5
+
 
 @dataclass(frozen=True)
 class Diagnosis:
@@ -154,25 +172,31 @@ def imu_warning(grid: np.ndarray, heading: np.ndarray, imu: np.ndarray, topic: s
     """The line when the `what` odometry's heading and the IMU's yaw (both at the `grid` times of :class:`ImuCheck`)
     turn apart, over the run or over one window, by more than :data:`IMU_TURN_ATOL` + :data:`IMU_DRIFT` times its
     span + :data:`IMU_TURN_RTOL` times the larger turn; else None. The line gives both turns over the run and over
-    the worst window."""
+    the worst window, and says why: the IMU's frame or units when its yaw divided by a scale of
+    :data:`IMU_FRAME_SCALES` agrees with the heading by that rule and the odometry turns :data:`IMU_FRAME_MIN_TURN`
+    somewhere, else the odometry (slip, the description)."""
     n = len(grid)
-    pairs = [(0, n - 1)] + [(i, i + 2) for i in range(n - 2)]
+    i, j = np.r_[0, np.arange(n - 2)], np.r_[n - 1, np.arange(2, n)]  # the run, then each window
+    a = heading[j] - heading[i]
+    span = grid[j] - grid[i]
 
-    def excess(i: int, j: int) -> float:
-        a, b = heading[j] - heading[i], imu[j] - imu[i]
-        return abs(a - b) / (IMU_TURN_ATOL + IMU_DRIFT * (grid[j] - grid[i]) + IMU_TURN_RTOL * max(abs(a), abs(b)))
+    def excess(scale: float) -> np.ndarray:
+        b = (imu[j] - imu[i]) / scale
+        return np.abs(a - b) / (IMU_TURN_ATOL + IMU_DRIFT * span + IMU_TURN_RTOL * np.maximum(np.abs(a), np.abs(b)))
 
-    worst = max(pairs, key=lambda p: excess(*p))
-    if excess(*worst) <= 1.0:
+    apart = excess(1.0)
+    worst = int(np.argmax(apart))
+    if apart[worst] <= 1.0:
         return None
-    (i, j), (r0, r1) = worst, pairs[0]
-    window = (f"; from {grid[i] - grid[0]:.4g} s to {grid[j] - grid[0]:.4g} s into the run the {what} odometry "
-              f"turned {heading[j] - heading[i]:.4g} rad and the IMU {imu[j] - imu[i]:.4g} rad"
-              if worst != pairs[0] else "")
+    why = next((said for scale, said in IMU_FRAME_SCALES.items() if np.max(excess(scale)) <= 1.0),
+               None) if np.max(np.abs(a)) >= IMU_FRAME_MIN_TURN else None
+    w, k = i[worst], j[worst]
+    window = (f"; from {grid[w] - grid[0]:.4g} s to {grid[k] - grid[0]:.4g} s into the run the {what} odometry "
+              f"turned {heading[k] - heading[w]:.4g} rad and the IMU {imu[k] - imu[w]:.4g} rad" if worst else "")
     return (f"the {what} odometry's heading contradicts the IMU on {topic}: over the run the {what} odometry turned "
-            f"{heading[r1] - heading[r0]:.4g} rad and the IMU {imu[r1] - imu[r0]:.4g} rad{window} (beyond "
-            f"{IMU_TURN_ATOL:g} rad + {IMU_DRIFT:g} rad/s of gyro drift + {IMU_TURN_RTOL:.0%} of the turn): the wheels "
-            "slip (a skid steer turning?), or the description's track or wheel radii are wrong")
+            f"{heading[-1] - heading[0]:.4g} rad and the IMU {imu[-1] - imu[0]:.4g} rad{window} (beyond "
+            f"{IMU_TURN_ATOL:g} rad + {IMU_DRIFT:g} rad/s of gyro drift + {IMU_TURN_RTOL:.0%} of the turn): "
+            + (why or "the wheels slip (a skid steer turning?), or the description's track or wheel radii are wrong"))
 
 
 def odometry_name(estimator: str | None, weighted: bool) -> str:
