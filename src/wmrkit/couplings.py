@@ -264,9 +264,18 @@ def steering_mechanisms(couplings: tuple[Coupling, ...], steered: list[str] | tu
 
 
 #: A gear's joints (``q_j = ratio_j * u``) contradict it when their ``u_j = q_j / ratio_j`` differ, summed over the
-#: rows, by more than this fraction of the largest ``|u_j|`` summed (backlash and encoder noise stay well within it):
-#: ``odometry`` judges a log's first intervals by it, ``fk`` its given rates.
+#: rows, by more than a fraction of the largest ``|u_j|`` summed. Measured joints (a log's first intervals, judged by
+#: ``odometry``): this fraction, backlash and encoder noise well within it.
 GEAR_BREACH_RTOL = 0.1
+#: The fraction for exact rates, given by a person or a program (``fk``'s given rates, the extended solutions'
+#: assigned ones): round-off of a typed or unit-converted rate, ~1e-16 of it, with room to spare; rates typed
+#: 0.1 % out of ratio are out of it.
+GEAR_EXACT_RTOL = 1e-9
+
+
+class GearWarning(UserWarning):
+    """Given rates of a ``gear`` coupling's joints break its ratios (:func:`gear_breaches` at
+    :data:`GEAR_EXACT_RTOL`): each is used as given, so the slip does not show it."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -287,15 +296,16 @@ class GearBreach:
     def warning(self, names: tuple[str, ...], values: np.ndarray) -> str:
         """The warning of ``fk`` (and the extended solutions) on given `values` of the joints `names` (one row)."""
         given = ", ".join(f"{names[i]} {values[i]:.4g}" for i in self.given)
-        return (f"{self.head} ({given} rad/s; {self.spread:.0%} apart): the rates contradict the description's gear "
+        apart = f"{self.spread:.0%}" if self.spread >= 0.005 else f"{100 * self.spread:.1g}%"  # never "0%"
+        return (f"{self.head} ({given} rad/s; {apart} apart): the rates contradict the description's gear "
                 "(each is used as given); check the rates or the gear")
 
 
-def gear_breaches(couplings: tuple[Coupling, ...], names: tuple[str, ...], q: np.ndarray,
+def gear_breaches(couplings: tuple[Coupling, ...], names: tuple[str, ...], q: np.ndarray, rtol: float,
                   least: float = 0.0) -> list[GearBreach]:
     """The ``gear`` couplings with two or more of `names` whose rates or increments `q` ``(N, len(names))`` (or one
-    row) break their ratios beyond :data:`GEAR_BREACH_RTOL`; a gear whose summed ``|u|`` is below `least` is not
-    judged (too little turning to tell)."""
+    row) break their ratios beyond `rtol` (:data:`GEAR_BREACH_RTOL` for measured joints, :data:`GEAR_EXACT_RTOL`
+    for given ones); a gear whose summed ``|u|`` is below `least` is not judged (too little turning to tell)."""
     q = np.atleast_2d(np.asarray(q, dtype=float))
     out = []
     for gear in (c for c in couplings if c.kind == "gear"):
@@ -305,6 +315,6 @@ def gear_breaches(couplings: tuple[Coupling, ...], names: tuple[str, ...], q: np
         u = np.column_stack([q[:, i] / k for i, k in read])  # (N, joints): the gear's input by each joint
         scale = float(np.abs(u).max(axis=1).sum())
         off = float((u.max(axis=1) - u.min(axis=1)).sum())
-        if scale >= least and off > GEAR_BREACH_RTOL * scale:
+        if scale >= least and off > rtol * scale:
             out.append(GearBreach(gear, tuple(i for i, _ in read), off / scale))
     return out

@@ -7,13 +7,12 @@ import math
 
 import numpy as np
 
-from ..couplings import gear_breaches
+from ..couplings import GearWarning
 from ..description import described_type
-from ..errors import WmrkitError
+from ..errors import WmrkitError, said_warnings
 from ..kinematics.wheel_ik import (
     WheelCommands,
     forward_kinematics_check,
-    resolve_rate_name,
     twist_is_determined,
     wheel_commands,
 )
@@ -83,37 +82,26 @@ def run_fk(args: argparse.Namespace) -> int:
         if abs(value) > MAX_QUERY_RATE:
             raise WmrkitError(f"--spin {name}: {value:g} is beyond {MAX_QUERY_RATE:g} rad/s (m/s), no wheel turns so "
                               "fast")
-    fk = forward_kinematics_check(robot, rates)
+    fk, gear_lines = said_warnings(lambda: forward_kinematics_check(robot, rates), GearWarning)
     _check_finite("fk", fk.twist, fk.residual)
     twist, determined = fk.twist, bool(twist_is_determined(robot, list(rates)))
     if not determined:
         warn(f"these rates do not determine the twist of robot '{robot.name}'; printing the minimum-norm one")
-    consistent = fk.consistent and _check_gears(robot, rates)
-    if not fk.consistent:
+    for line in gear_lines:  # given joints of a gear out of its ratios (fk.out_of_gear)
+        warn(line)
+    if fk.residual > fk.tolerance:  # the wheels slip (fk.consistent is also False for a gear broken)
         names = fk.slipping or [robot.wheel_names[i] for i in np.argsort(-fk.wheel_slip) if fk.wheel_slip[i] > 0]
         worst = ", ".join(f"{n} {fk.wheel_slip[robot.wheel_names.index(n)]:.3g} m/s" for n in names)
         warn(f"the rates contradict each other: the wheels slip ({worst}; residual {fk.residual:.3g} m/s > "
              f"tolerance {fk.tolerance:.3g} m/s); check units, signs and --steer headings")
     if args.json:
         print_json({"robot": robot.name, "twist": twist.tolist(), "determined": determined, "residual": fk.residual,
-                    "consistent": consistent, "slipping": list(fk.slipping)})
+                    "consistent": fk.consistent, "slipping": list(fk.slipping)})
     else:
         vx, vy, omega = (_num(v) for v in twist)
         print(f"twist (robot frame): vx = {vx} m/s, vy = {vy} m/s, omega = {omega} rad/s")
-        print(f"residual (slip norm): {fk.residual:.3g} m/s ({'consistent' if consistent else 'INCONSISTENT'})")
+        print(f"residual (slip norm): {fk.residual:.3g} m/s ({'consistent' if fk.consistent else 'INCONSISTENT'})")
     return 0
-
-
-def _check_gears(robot: Robot, rates: dict[str, float]) -> bool:
-    """Warn (one line per gear, as ``odometry`` does for a log) when given rates of a ``gear`` coupling's joints break
-    its ratios (:func:`wmrkit.couplings.gear_breaches`): each is used as given, so no slip shows it; return whether
-    none did."""
-    names = tuple(robot.velocity_names[resolve_rate_name(robot, n)] for n in rates)
-    values = np.array(list(rates.values()), dtype=float)
-    breaches = gear_breaches(robot.couplings, names, values)
-    for b in breaches:
-        warn(b.warning(names, values))
-    return not breaches
 
 
 def _finite(text: str) -> float:

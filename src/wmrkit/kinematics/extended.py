@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_names, as_vectors, readonly
-from ..couplings import gear_breaches
+from ..couplings import GEAR_EXACT_RTOL, GearWarning, gear_breaches
 from ..errors import ShapeError, SingularError, UnknownNameError
 from ..robot import Robot
 from .linalg import geared_solve
@@ -32,11 +32,6 @@ from .models import bounded, configuration, describe_configuration, generic_mobi
 MAX_STARTS = 4096
 #: Residual norm [m/s] below which steering angles count as slip-free (times ``1 + |A|_max |q_assigned|``).
 ROOT_TOL = 1e-9
-
-
-class GearWarning(UserWarning):
-    """Assigned rates of a ``gear`` coupling's joints break its ratios (:func:`wmrkit.couplings.gear_breaches`, the
-    check and the words of ``fk``): each is used as given, so the slip does not show it."""
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
@@ -131,7 +126,7 @@ def _in_gear(robot: Robot, idx: np.ndarray, q: np.ndarray, stacklevel: int | Non
     rows, inverse = np.unique(q.reshape(-1, q.shape[-1]), axis=0, return_inverse=True)
     flat, said = out.reshape(-1, len(couplings)), set()
     for r, row in enumerate(rows):
-        for b in gear_breaches(couplings, names, row):
+        for b in gear_breaches(couplings, names, row, GEAR_EXACT_RTOL):
             k = next(i for i, c in enumerate(couplings) if c is b.coupling)
             flat[inverse.reshape(-1) == r, k] = False
             if stacklevel is not None and k not in said:

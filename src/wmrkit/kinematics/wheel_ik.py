@@ -8,6 +8,7 @@ explains them and the slip they leave. ``docs/wheel-ik.md`` states the policies 
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -16,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_names, as_reals, as_vectors, finite_number, readonly
-from ..couplings import Coupling
+from ..couplings import GEAR_EXACT_RTOL, Coupling, GearWarning, gear_breaches
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
@@ -326,8 +327,9 @@ class ForwardKinematics:
     """The twist that best explains some joint rates, and whether the rates agree with each other (one sample).
 
     ``twist`` (3,) [m/s, rad/s]; ``residual`` the slip norm [m/s]; ``wheel_slip`` (N,) each wheel's slip norm
-    [m/s]; ``tolerance`` [m/s]; ``consistent``: ``residual <= tolerance``; ``slipping``: the wheels whose slip
-    exceeds the tolerance.
+    [m/s]; ``tolerance`` [m/s]; ``consistent``: ``residual <= tolerance`` and no gear broken; ``slipping``: the
+    wheels whose slip exceeds the tolerance; ``out_of_gear``: the channel names of the ``gear`` couplings whose given
+    joints break its ratios (each used as given, so the slip does not show it: a :class:`GearWarning` each).
     """
 
     twist: np.ndarray
@@ -336,6 +338,7 @@ class ForwardKinematics:
     tolerance: float
     consistent: bool
     slipping: tuple[str, ...]
+    out_of_gear: tuple[str, ...] = ()
 
 
 def forward_kinematics_check(
@@ -345,7 +348,9 @@ def forward_kinematics_check(
     """:func:`forward_kinematics` for one sample, with the slip split by wheel and judged against a tolerance.
 
     The tolerance is `rtol` times the fastest given wheel surface speed ``|r phi_dot|`` (or speed) plus 1e-9 m/s:
-    rates that contradict each other beyond it (slip larger than measurement noise) are not ``consistent``.
+    rates that contradict each other beyond it (slip larger than measurement noise) are not ``consistent``, nor are
+    given joints of a ``gear`` out of its ratios beyond round-off (:data:`wmrkit.couplings.GEAR_EXACT_RTOL`): each
+    such gear is named in ``out_of_gear``, with a :class:`~wmrkit.couplings.GearWarning`.
     """
     columns = _assigned_columns(robot, list(rates))
     q_assigned = np.array([float(_rate_value(k, v)) for k, v in rates.items()])
@@ -359,8 +364,13 @@ def forward_kinematics_check(
     tolerance = rtol * max(speeds, default=0.0) + 1e-9
     residual = float(np.linalg.norm(slip))
     slipping = tuple(robot.wheel_names[i] for i in np.flatnonzero(wheel_slip > tolerance))
-    consistent = bool(residual <= tolerance)
-    return ForwardKinematics(_ro(q_dot[:3]), residual, _ro(wheel_slip), tolerance, consistent, slipping)
+    names = tuple(robot.velocity_names[c] for c in columns)
+    breaches = gear_breaches(robot.couplings, names, q_assigned, GEAR_EXACT_RTOL)
+    for b in breaches:
+        warnings.warn(b.warning(names, q_assigned), GearWarning, stacklevel=2)
+    consistent = bool(residual <= tolerance) and not breaches
+    return ForwardKinematics(_ro(q_dot[:3]), residual, _ro(wheel_slip), tolerance, consistent, slipping,
+                             tuple(b.coupling.channel_name for b in breaches))
 
 
 def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: ArrayLike | None = None, *,

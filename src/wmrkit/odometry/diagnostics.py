@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..couplings import gear_breaches
+from ..couplings import GEAR_BREACH_RTOL, gear_breaches
 from .logs import JointLog, LogError, LogFormat
 from .model import OdometryModel, wheel_slip
 from .pipeline import OdometrySummary
@@ -154,7 +154,7 @@ def gear_warnings(model: OdometryModel, first: Callable[[], JointLog]) -> list[s
     log = first()
     steps = np.diff(log.positions, axis=0)
     lines = []
-    for b in gear_breaches(couplings, model.joints, steps, GEAR_MIN_TURN):
+    for b in gear_breaches(couplings, model.joints, steps, GEAR_BREACH_RTOL, GEAR_MIN_TURN):
         turns = ", ".join(f"{model.joints[i]} {steps[:, i].sum():.4g} rad" for i in b.given)
         lines.append(f"{b.head} over the first {len(log)} samples ({turns}; {b.spread:.0%} apart interval by "
                      "interval): the log is not of this robot, or its description's gear is wrong")
