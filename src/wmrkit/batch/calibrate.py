@@ -38,6 +38,7 @@ from ..odometry.calibration import (
     RunWeights,
     apply_parameters,
     check_options,
+    fitted_robot,
     rms,
     solve,
 )
@@ -298,7 +299,7 @@ def _result(problem: CalibrationProblem, fit, lo, hi, r0, ci: str, level: float,
             values.append((name, nominal, fitted, min(a, b), max(a, b)))
     groups = tuple((g,) if isinstance(g, str) else tuple(g) for g in params)
     logs = names(problem.runs)
-    return FleetCalibration(apply_parameters(robot, params, fit.x), groups, tuple(map(float, fit.x)),
+    return FleetCalibration(fitted_robot(robot, params, fit.x), groups, tuple(map(float, fit.x)),
                             tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True)), tuple(values),
                             rms(r0), rms(fit.fun), len(problem.runs), int(r0.size), ci, level, bool(fit.success),
                             problem.warnings() + notes + judged.messages, logs,

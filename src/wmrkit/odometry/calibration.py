@@ -8,6 +8,9 @@ factor ``1 + p``; angles (``alpha``, ``beta``, ``delta``, ``gamma``) are offset 
 with ``-`` moves the other way (``1 - p``, ``-p``): ``("left.r", "-right.r")`` changes the ratio of the radii and
 keeps their mean (to first order), which is all that closed paths can tell: a closed path returns to its start
 at any scale, so the mean radius needs a run with a known distance (a reference trajectory, or an open path).
+A Swedish wheel's roller radius ``r_r`` moves with its ``r`` (in the same parameter, same sign) unless a parameter
+names it: odometry cannot see ``r_r`` (it scales the unsensed roller rate alone), and the wheel scaled as a whole
+keeps its rollers within its rim (``r_r <= r``), which a smaller fitted ``r`` alone could break.
 
 The fit is nonlinear least squares (``scipy.optimize.least_squares``) of odometry against the reference poses,
 over one or more runs: whole reference trajectories, or only the final poses of closed paths. Closed squares
@@ -313,6 +316,19 @@ def apply_parameters(robot: Robot, parameters: Sequence[Parameter], p: ArrayLike
     return replace(robot, wheels=tuple(wheels[w.name] for w in robot.wheels))
 
 
+def fitted_robot(robot: Robot, parameters: Sequence[Parameter], p: ArrayLike) -> Robot:
+    """:func:`apply_parameters` at a fit `p`, each wheel checked as :class:`~wmrkit.wheels.Wheel` checks one built in
+    Python: a fit that gives a wheel no description allows (Swedish rollers fitted on their own past the wheel's
+    radius) is refused, naming the wheel and the field."""
+    out = apply_parameters(robot, parameters, p)
+    for wheel in out.wheels:
+        try:
+            replace(wheel)
+        except WmrkitError as err:
+            raise WmrkitError(f"calibrate: the fit gives a wheel that cannot exist: {err}") from None
+    return out
+
+
 def _trial(wheel: Wheel, field: str, value: float) -> Wheel:
     """`wheel` with `field` set to `value`, unchecked: the solver's trial values may take a length through zero,
     which :class:`~wmrkit.wheels.Wheel` refuses; a fit that ends there is refused by
@@ -355,7 +371,7 @@ def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence
     if reason is not None:
         raise WmrkitError(f"calibrate: the runs cannot tell these parameters apart: {reason}{problem.hint()}; add "
                           f"runs of other shapes or fit fewer parameters")
-    return Calibration(apply_parameters(robot, parameters, fit.x), problem.values(fit.x), rms(r0), rms(fit.fun),
+    return Calibration(fitted_robot(robot, parameters, fit.x), problem.values(fit.x), rms(r0), rms(fit.fun),
                        bool(fit.success), problem.warnings())
 
 
@@ -412,4 +428,8 @@ def _groups(robot: Robot, parameters: Sequence[Parameter]) -> list[list[tuple[st
         groups.append(group)
     if not groups:
         raise WmrkitError("calibrate: no parameters to fit")
+    named = {(w, f) for group in groups for w, f, _ in group}
+    for group in groups:  # a Swedish wheel's rollers scale with it (module docstring), unless fitted on their own
+        group += [(w, "r_r", sign) for w, f, sign in list(group)
+                  if f == "r" and robot.wheel(w).type == "swedish" and (w, "r_r") not in named]
     return groups
