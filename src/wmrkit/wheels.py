@@ -206,8 +206,8 @@ class Wheel:
 
 
 def _check_steer_range(wheel: Wheel, kind: WheelKind) -> None:
-    """``steer_range`` as a description has it (``description._steer_range_from_dict``): on a wheel that steers, a
-    tuple ``(min, max)`` of headings [rad], min < max within one turn."""
+    """``steer_range`` as a description has it (``_description_wheels._steer_range_from_dict``): on a wheel that
+    steers, a tuple ``(min, max)`` of headings [rad], min < max within one turn."""
     lo_hi = wheel.steer_range
     where = f"wheel '{wheel.name}': steer_range"
     if not kind.steers:
