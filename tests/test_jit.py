@@ -83,3 +83,38 @@ def test_a_changed_helper_file_drops_the_cached_kernels_that_call_it(tmp_path):
     helper.write_text("x = 2\n")
     drop_stale_cache([str(kernel)], [str(helper)])  # the helper changed: dropped, other modules' caches kept
     assert not any(f.exists() for f in kept) and all(f.exists() for f in unrelated)
+
+
+def test_every_kernel_module_runs_with_no_writable_cache_directory(tmp_path):
+    """A read-only installation whose user has no writable cache directory either (a container's system install):
+    numba cannot cache, every kernel module still imports and compiles in memory. ``kinematics/realtime.py`` asked
+    numba for ``cache=True`` itself: its import raised "cannot cache function '_step': no locator available" (a
+    traceback from ``wmrkit track ... --dynamics``). A diff drive's realtime odometry step then gives the arc's
+    closed form."""
+    import os
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    copy = tmp_path / "site"
+    shutil.copytree(Path(jit.__file__).parent, copy / "wmrkit", ignore=shutil.ignore_patterns("__pycache__"))
+    for d in [copy / "wmrkit", *(p for p in (copy / "wmrkit").rglob("*") if p.is_dir())]:
+        (d / "__pycache__").write_text("a file where numba would make its cache directory")
+    blocker = copy / "wmrkit" / "__pycache__"
+    env = {**os.environ, "PYTHONPATH": str(copy), "PYTHONDONTWRITEBYTECODE": "1",
+           "XDG_CACHE_HOME": str(blocker / "cache"), "HOME": str(blocker / "home")}
+    env.pop("NUMBA_CACHE_DIR", None)
+    modules = ("_constraint_kernel", "control._jump_kernels", "dynamics._integrate", "dynamics._kernels",
+               "kinematics.realtime", "odometry._kernels", "odometry._steering_kernels", "slip._kalman_kernel")
+    code = (f"import importlib, numpy as np; [importlib.import_module('wmrkit.' + m) for m in {modules!r}]; "
+            "from wmrkit import catalog; from wmrkit.kinematics.realtime import realtime; "
+            "rt = realtime(catalog.load('diff-drive')); pose = np.zeros(3); "
+            "rt.odometry_step(pose, np.zeros(2), np.array([4.0, 6.0]), np.zeros(0)); print(*pose)")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-500:]
+    # wheels 0.2 m left and right of the axle's middle, radius 0.075 m, turned 4 and 6 rad: an arc
+    v, turn = 0.075 * (4 + 6) / 2, 0.075 * (6 - 4) / 0.4
+    np.testing.assert_allclose([float(x) for x in out.stdout.split()],
+                               [v / turn * np.sin(turn), v / turn * (1 - np.cos(turn)), turn], rtol=0, atol=1e-15)
+    assert [p for p in copy.rglob("*") if p.suffix in (".nbi", ".nbc")] == []

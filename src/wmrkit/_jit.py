@@ -1,10 +1,12 @@
 """Lazy numba compilation shared by the compiled kernels (constraint matrices, odometry).
 
 A kernel is compiled for one explicit signature when the work it is given first exceeds a small budget, cached on
-disk when a cache directory is writable and compiled in memory otherwise (a read-only installation). Below the
-budget its Python source runs as plain Python (with every numba helper it calls replaced by that helper's Python
-source): a command on a small robot or a short log answers at once instead of spending seconds compiling kernels
-it barely uses (issue 8: the first run of every command under 2 s). ``.py_func`` keeps the Python source.
+disk where numba finds a writable cache directory (``NUMBA_CACHE_DIR``, else the ``__pycache__`` beside the source,
+else the user's cache directory, ``~/.cache/numba`` on Linux: a read-only installation) and compiled in memory in
+each process when none is. Below the budget its Python source runs as plain Python (with every numba helper it calls
+replaced by that helper's Python source): a command on a small robot or a short log answers at once instead of
+spending seconds compiling kernels it barely uses (issue 8: the first run of every command under 2 s). ``.py_func``
+keeps the Python source.
 """
 
 from __future__ import annotations
@@ -77,13 +79,15 @@ def _rebind(fn: types.FunctionType, namespace: dict) -> types.FunctionType:
     return out
 
 
-def compile_cached(fn: Callable, signature) -> Callable:
-    """``numba.njit`` cached on disk when a cache directory is writable, else in memory only."""
+def compile_cached(fn: Callable, signature=None, **options) -> Callable:
+    """``numba.njit(signature, **options)`` cached on disk where numba finds a writable cache directory (module
+    docstring), else in memory only. The one place a wmrkit kernel asks for caching: ``cache=True`` itself raises
+    at import when no directory is writable."""
     args = () if signature is None else (signature,)  # None: compiled for the types of its first call
     try:
-        return numba.njit(*args, cache=True)(fn)
+        return numba.njit(*args, cache=True, **options)(fn)
     except RuntimeError:  # numba: "cannot cache function ...: no locator available for file ..."
-        return numba.njit(*args)(fn)
+        return numba.njit(*args, **options)(fn)
 
 
 def drop_stale_cache(kernels: Sequence[str], helpers: Sequence[str] = ()) -> None:

@@ -22,8 +22,6 @@ import math
 import types
 from pathlib import Path
 
-import numba
-
 from .._jit import compile_cached, drop_stale_cache
 from ..wheels import __file__ as wheels_file
 from ..wheels import slip_row_entries
@@ -40,10 +38,7 @@ FASTMATH = ("nnan", "ninf", "nsz")
 
 def _compile(fn, inline: str = "never", nrt: bool = True):
     """``numba.njit`` with the :data:`FASTMATH` flags, cached on disk where possible."""
-    try:
-        return numba.njit(cache=True, fastmath=set(FASTMATH), inline=inline, _nrt=nrt)(fn)
-    except RuntimeError:  # no writable cache location
-        return numba.njit(fastmath=set(FASTMATH), inline=inline, _nrt=nrt)(fn)
+    return compile_cached(fn, fastmath=set(FASTMATH), inline=inline, _nrt=nrt)
 
 
 def _inline(fn):

@@ -25,7 +25,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from .._jit import drop_stale_cache, float64_vector
+from .._jit import compile_cached, drop_stale_cache, float64_vector
 from .._shapes import as_names
 from ..errors import SelectionError, WmrkitError
 from ..limits import MAX_QUERY_RATE
@@ -257,7 +257,7 @@ def _constant_step(twist_map: np.ndarray):
     return step
 
 
-@numba.njit(cache=True)
+@compile_cached
 def _step(pose, previous, positions, twist_map):
     """One exact SE(2) step (paper 003 (21)-(25)): body increments ``twist_map @ dq``, chord ``sinc(h)`` along the
     mid heading, with the odometry kernels' own sine and cosine (the batched path's numbers). Returns False, and
