@@ -59,8 +59,12 @@ def test_the_python_source_calls_no_compiled_helper():
     assert helpers == []
 
 
-def test_a_changed_helper_file_drops_the_cached_kernels_that_call_it(tmp_path):
+def test_a_changed_helper_file_drops_the_cached_kernels_that_call_it(tmp_path, monkeypatch):
+    import numba
+
     from wmrkit._jit import drop_stale_cache
+
+    monkeypatch.setattr(numba.config, "CACHE_DIR", "")  # numba caches beside the sources (a working copy)
 
     kernel, helper, other = tmp_path / "kern.py", tmp_path / "help.py", tmp_path / "other.py"
     for f in (kernel, helper, other):
@@ -118,3 +122,34 @@ def test_every_kernel_module_runs_with_no_writable_cache_directory(tmp_path):
     np.testing.assert_allclose([float(x) for x in out.stdout.split()],
                                [v / turn * np.sin(turn), v / turn * (1 - np.cos(turn)), turn], rtol=0, atol=1e-15)
     assert [p for p in copy.rglob("*") if p.suffix in (".nbi", ".nbc")] == []
+
+
+def test_a_changed_helper_file_drops_the_kernels_cached_outside_the_sources(tmp_path, monkeypatch):
+    """Under ``NUMBA_CACHE_DIR`` (and in the user's cache directory, a read-only installation's, which an upgrade in
+    place changes) numba caches a kernel away from its ``__pycache__``: drop_stale_cache looked only there, and a
+    kernel whose helper file changed came back from the cache with the old helper's arithmetic (2.0 for 3.0)."""
+    import importlib
+    import sys
+
+    import numba
+
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "numba-cache"))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    (tmp_path / "stale_help.py").write_text("import numba\n\n@numba.njit\ndef bump(x):\n    return x + 1.0\n")
+    (tmp_path / "stale_kern.py").write_text(
+        "import stale_help\nfrom stale_help import bump\nfrom wmrkit._jit import compile_cached, drop_stale_cache\n\n"
+        "drop_stale_cache([__file__], [stale_help.__file__])\n\n@compile_cached\ndef kernel(x):\n    return bump(x)\n")
+
+    def kernel_of_fresh_modules():
+        for name in ("stale_kern", "stale_help"):
+            sys.modules.pop(name, None)
+        importlib.invalidate_caches()
+        return importlib.import_module("stale_kern").kernel
+
+    first = kernel_of_fresh_modules()
+    assert first(1.0) == 2.0 and first.stats.cache_misses  # compiled, and cached under CACHE_DIR
+    assert kernel_of_fresh_modules()(1.0) == 2.0
+    (tmp_path / "stale_help.py").write_text("import numba\n\n@numba.njit\ndef bump(x):\n    return x + 2.0\n")
+    assert kernel_of_fresh_modules()(1.0) == 3.0
+    for name in ("stale_kern", "stale_help"):
+        sys.modules.pop(name, None)

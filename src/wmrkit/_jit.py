@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numba
 import numpy as np
+from numba.core.caching import FunctionCache
 from numba.extending import overload
 
 #: Array elements a kernel may process as plain Python, over the whole process, before it is compiled. Set the
@@ -90,26 +91,43 @@ def compile_cached(fn: Callable, signature=None, **options) -> Callable:
         return numba.njit(*args, **options)(fn)
 
 
+def cache_dir(source: str | Path) -> Path | None:
+    """The directory numba caches the kernels of the file `source` in (its cache locators' choice: ``NUMBA_CACHE_DIR``,
+    the file's ``__pycache__``, the user's cache directory), None when none is writable."""
+    stub = types.FunctionType(_stub.__code__.replace(co_filename=str(source)), {})  # numba reads only its file
+    try:
+        return Path(FunctionCache(stub).cache_path)
+    except RuntimeError:
+        return None
+
+
+def _stub() -> None:
+    """A function that :func:`cache_dir` moves into another file."""
+
+
 def drop_stale_cache(kernels: Sequence[str], helpers: Sequence[str] = ()) -> None:
     """Numba checks a cached kernel against its own file only, not against the compiled helpers it calls from other
     files: drop the cached kernels of the `kernels` files when any of them or of the `helpers` files changed (a
-    fingerprint of their contents kept beside the cache). Call at the import of a kernel module, before any of its
-    kernels loads; an installed package never changes, so this only acts in a working copy."""
+    fingerprint of their contents kept beside the cache), in the directory numba caches them in (:func:`cache_dir`:
+    a working copy's ``__pycache__``, ``NUMBA_CACHE_DIR``, or the user's cache directory of a read-only
+    installation, which an upgrade in place changes). Call at the import of a kernel module, before any of its
+    kernels loads."""
     files = [Path(f) for f in kernels]
     try:
         digest = hashlib.sha256(b"".join(p.read_bytes() for p in (*files, *map(Path, helpers)))).hexdigest()
-        cache = files[0].parent / "__pycache__"
-        stamp = cache / f"{files[0].stem}.numba-stamp"
+        dirs = [cache_dir(f) for f in files]
+        if dirs[0] is None:  # no writable cache directory: numba compiles in memory
+            return
+        stamp = dirs[0] / f"{files[0].stem}.numba-stamp"
         if stamp.exists() and stamp.read_text() == digest:
             return
-        for f in files:
-            for cached in (f.parent / "__pycache__").glob(f"{f.stem}.*.nb[ic]"):
+        for f, cache in zip(files, dirs, strict=True):
+            for cached in cache.glob(f"{f.stem}.*.nb[ic]") if cache else ():
                 cached.unlink(missing_ok=True)
-        cache.mkdir(exist_ok=True)
-        scratch = cache / f"{stamp.name}.{os.getpid()}"
+        scratch = dirs[0] / f"{stamp.name}.{os.getpid()}"
         scratch.write_text(digest)
         os.replace(scratch, stamp)  # atomic: processes starting together read a whole stamp or none
-    except OSError:  # a read-only installation: numba compiles in memory anyway
+    except OSError:  # a cache directory that turned read-only: nothing cached there to go stale
         pass
 
 
