@@ -153,3 +153,30 @@ def test_a_changed_helper_file_drops_the_kernels_cached_outside_the_sources(tmp_
     assert kernel_of_fresh_modules()(1.0) == 3.0
     for name in ("stale_kern", "stale_help"):
         sys.modules.pop(name, None)
+
+
+def test_a_kernel_numba_cannot_cache_is_named_and_the_notice_says_it_compiles_at_every_run(monkeypatch, capsys):
+    """No writable cache directory: compile_cached compiles in memory and names the kernel, and the CLI's notice of
+    a long compilation says it happens again at every run, naming NUMBA_CACHE_DIR (it said "first run only; cached
+    for the next runs")."""
+    import threading
+
+    from numba.core.caching import FunctionCache
+
+    import wmrkit.cli.main as cli
+
+    monkeypatch.setattr(FunctionCache._impl_class, "_locator_classes", [])  # numba finds no cache directory
+    monkeypatch.setattr(jit, "UNCACHED", set())
+
+    def twice(x):
+        return 2.0 * x
+
+    assert jit.compile_cached(twice)(1.5) == 3.0
+    assert [n.rsplit(".", 2)[1:] for n in jit.UNCACHED] == [["<locals>", "twice"]]
+    monkeypatch.setattr(cli, "COMPILE_NOTICE_AFTER", 0.05)
+    monkeypatch.setattr(cli, "_compiling", lambda: True)
+    watcher = threading.Thread(target=cli._compile_notice, args=(threading.Event(), 0.01))
+    watcher.start()
+    watcher.join(5)
+    err = capsys.readouterr().err
+    assert err == cli.COMPILE_NOTICE_UNCACHED + "\n" and "NUMBA_CACHE_DIR" in err and "first run only" not in err

@@ -80,6 +80,11 @@ def _rebind(fn: types.FunctionType, namespace: dict) -> types.FunctionType:
     return out
 
 
+#: The kernels compiled in memory, for no writable cache directory: compiled again in every process (the CLI's notice
+#: of a long compilation says so).
+UNCACHED: set[str] = set()
+
+
 def compile_cached(fn: Callable, signature=None, **options) -> Callable:
     """``numba.njit(signature, **options)`` cached on disk where numba finds a writable cache directory (module
     docstring), else in memory only. The one place a wmrkit kernel asks for caching: ``cache=True`` itself raises
@@ -88,6 +93,7 @@ def compile_cached(fn: Callable, signature=None, **options) -> Callable:
     try:
         return numba.njit(*args, cache=True, **options)(fn)
     except RuntimeError:  # numba: "cannot cache function ...: no locator available for file ..."
+        UNCACHED.add(f"{fn.__module__}.{fn.__qualname__}")
         return numba.njit(*args, **options)(fn)
 
 

@@ -128,6 +128,9 @@ def wants_json(argv: Sequence[str]) -> bool:
 COMPILE_NOTICE_AFTER = 2.0
 #: The line it prints on stderr (before an answer or an error line).
 COMPILE_NOTICE = "wmrkit: compiling numerical kernels for this machine (first run only; cached for the next runs)..."
+#: The line instead when numba found no writable directory to cache them in (``_jit.UNCACHED``).
+COMPILE_NOTICE_UNCACHED = ("wmrkit: compiling numerical kernels for this machine (again at every run: no writable "
+                           "cache directory; set NUMBA_CACHE_DIR to one)...")
 
 
 def _compile_notice(done: threading.Event, poll: float = 0.25) -> None:
@@ -138,7 +141,8 @@ def _compile_notice(done: threading.Event, poll: float = 0.25) -> None:
     while not done.wait(poll):
         busy = busy + poll if _compiling() else 0.0
         if busy >= COMPILE_NOTICE_AFTER:
-            print(COMPILE_NOTICE, file=sys.stderr, flush=True)
+            uncached = getattr(sys.modules.get("wmrkit._jit"), "UNCACHED", ())
+            print(COMPILE_NOTICE_UNCACHED if uncached else COMPILE_NOTICE, file=sys.stderr, flush=True)
             return
 
 
