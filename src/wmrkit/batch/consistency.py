@@ -38,6 +38,7 @@ from ..odometry.calibration import RANK_TOL, CalibrationProblem, CalibrationRun
 from ..robot import Robot
 from .engine import TaskFailure
 from .homogeneity import fleet_warning
+from .likelihood import MIN_OWN_DOF, few_pose_warning, own_noise
 
 #: Largest residual ratio of a fleet whose runs agree. Simulated fleets with encoder noise (1e-5 per rad, or drawn
 #: per run among 1e-6, 1e-5 and 1e-4), 4 to 16 runs (docs/batch.md's table): largest ratio 12.1 over 260 fleets;
@@ -272,10 +273,11 @@ def names(runs: Sequence[CalibrationRun]) -> tuple[str, ...]:
     return tuple(s if sources.count(s) == 1 else f"run {k + 1} ({s})" for k, s in enumerate(sources))
 
 
-def _score(err: np.ndarray, k: int, rest: np.ndarray, floors: np.ndarray, n: int, m: np.ndarray) -> float:
+def _score(err: np.ndarray, k: int, rest: np.ndarray, floors: np.ndarray, n: int, m: np.ndarray,
+           own: float = 0.0) -> float:
     """Run `k`'s weighted residual RMS over that of `rest` with ``R - n`` degrees of freedom (rows ``err``; `m`: each
-    run's residuals that count, :func:`counts`)."""
-    noise = max(float(np.sum(err[rest] ** 2)) / (m[rest].sum() - n), float(np.mean(floors[rest] ** 2)))
+    run's residuals that count, :func:`counts`), or over its `own` noise (mean square a row) if larger."""
+    noise = max(float(np.sum(err[rest] ** 2)) / (m[rest].sum() - n), float(np.mean(floors[rest] ** 2)), own)
     return float(np.sqrt(np.sum(err[k] ** 2) / max(m[k], 1) / noise))
 
 
@@ -373,6 +375,10 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
                             "another robot, load or floor? The fit averages it in; check it or fit without it")
         elif pair is not None and pair[2] > MAX_PAIR_SCORE:
             messages.append(PAIR.format(a=logs[pair[0]], b=logs[pair[1]], score=pair[2]))
+        named = 1 if scores[worst] > MAX_CLOSED_SCORE else 2 if pair is not None and pair[2] > MAX_PAIR_SCORE else 0
+        if m[group[0]] - n >= MIN_OWN_DOF and problem.run_weights is None and problem.heading_weight != 0 and (
+                said := few_pose_warning(problem, fit.jac, fit.fun, group, ROUNDOFF * travels, logs, named)):
+            messages.append(said)  # several runs that disagree (wmrkit.batch.likelihood)
     aside = [k for k in range(g) if np.isnan(scores[k])]
     why = None if not aside else SET_ASIDE.format(runs=", ".join(logs[k] for k in aside), judged=", ".join(
         f"{len(group)} runs of {_poses(m[group[0]])}" for group in groups))
@@ -422,8 +428,9 @@ def _pair(problem: CalibrationProblem, fit, group: np.ndarray, rows: list[np.nda
     `scores` whose removal leaves the parameters determined is scored on the runs' quadratic `model` (weighted
     Jacobian, residuals, curvature), and the :data:`PAIR_REFITS` pairs of largest model score are refitted without
     (from the model's fit); a pair's score is the smaller of its two runs' scores against the other runs' pooled
-    noise. The pair of largest refitted score (runs as indices of the problem), ``None`` if no pair was scored, or
-    why a refit failed (:data:`REFIT_FAILED`)."""
+    noise, or against the pair's own where larger (:func:`~wmrkit.batch.likelihood.own_noise`). The pair of largest
+    refitted score (runs as indices of the problem), ``None`` if no pair was scored, or why a refit failed
+    (:data:`REFIT_FAILED`)."""
     from itertools import combinations
 
     g, n = len(group), fit.x.size
@@ -434,6 +441,7 @@ def _pair(problem: CalibrationProblem, fit, group: np.ndarray, rows: list[np.nda
         if problem.undetermined(fit.x, fit.jac[here], fit.fun[here]) is None:
             pairs.append(out)
     guess, shift = _quadratic_scores(*model, floors, m, pairs)
+    own = own_noise(*model, m)
     again = [k for k in np.argsort(-guess, kind="stable")[:PAIR_REFITS] if not np.isnan(guess[k])]
     errs = _refits(problem, group, [pairs[k] for k in again], [fit.x + shift[k] for k in again], live, w, refit)
     if isinstance(errs, str) or not again:
@@ -441,7 +449,9 @@ def _pair(problem: CalibrationProblem, fit, group: np.ndarray, rows: list[np.nda
     best = None
     for k, err in zip(again, errs, strict=True):
         (a, b), rest = pairs[k], np.delete(np.arange(g), pairs[k])
-        score = min(_score(err, a, rest, floors, n, m), _score(err, b, rest, floors, n, m))
+        mine = own[a] + own[b]  # the pair's own noise, pooled
+        mine = mine[0] / mine[1] if mine[1] else 0.0
+        score = min(_score(err, a, rest, floors, n, m, mine), _score(err, b, rest, floors, n, m, mine))
         if best is None or score > best[2]:
             best = (int(group[a]), int(group[b]), score)
     return best

@@ -21,7 +21,7 @@ subset of 1, 2, ... runs up to :data:`SEARCH` subsets: that many runs at least d
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from itertools import combinations
 
 import numpy as np
@@ -133,20 +133,30 @@ def fleet_warning(problem: CalibrationProblem, jac: np.ndarray, res: np.ndarray,
 
 
 def fewest_apart(a: np.ndarray, b: np.ndarray, own: np.ndarray, dof: np.ndarray) -> tuple[int, tuple[int, ...]]:
-    """The fewest runs whose removal leaves runs that agree (``H`` at most :data:`MAX_HOMOGENEITY`, two runs left at
-    least) and the subset of them leaving the least ``H``; ``(k, ())`` when no subset of fewer than ``k`` runs does,
-    within :data:`SEARCH` subsets (``k`` is then a lower bound)."""
-    g, tried = len(a), 0
+    """The fewest runs whose removal leaves runs that agree (``H`` at most :data:`MAX_HOMOGENEITY`) and the subset of
+    them leaving the least ``H`` (:func:`fewest`)."""
+    def h(keep: np.ndarray) -> float | None:
+        value, df = homogeneity(a[keep], b[keep], own[keep], dof[keep])
+        return value if df else None
+
+    return fewest(len(a), h, MAX_HOMOGENEITY)
+
+
+def fewest(g: int, stat: Callable[[np.ndarray], float | None], limit: float) -> tuple[int, tuple[int, ...]]:
+    """The fewest of `g` runs whose removal leaves runs that agree (`stat` of the runs kept, indices, at most `limit`;
+    ``None``: nothing to compare; two runs left at least) and the subset of them leaving the least `stat`; ``(k,
+    ())`` when no subset of fewer than ``k`` runs does, within :data:`SEARCH` subsets (``k`` is then a lower
+    bound)."""
+    tried = 0
     for k in range(1, g - 1):
         best = None
         for out in combinations(range(g), k):
             if tried >= SEARCH:
                 return k, ()
             tried += 1
-            keep = np.delete(np.arange(g), out)
-            h, df = homogeneity(a[keep], b[keep], own[keep], dof[keep])
-            if df and h <= MAX_HOMOGENEITY and (best is None or h < best[0]):
-                best = (h, out)
+            value = stat(np.delete(np.arange(g), out))
+            if value is not None and value <= limit and (best is None or value < best[0]):
+                best = (value, out)
         if best is not None:
             return k, best[1]
     return g - 1, ()

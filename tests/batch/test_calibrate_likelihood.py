@@ -1,0 +1,74 @@
+"""batch calibrate over fleets of three-pose runs: several bad runs judged as a whole, and the pair score against
+each pair's own noise (noise levels drawn per run no longer make a pair of noisy runs look like another robot's)."""
+
+from __future__ import annotations
+
+import numpy as np
+from batch_params import PARAMS
+from scipy.optimize import minimize
+from test_calibrate_judge import short_runs
+
+from wmrkit.batch.calibrate import fleet_calibrate
+from wmrkit.batch.likelihood import likelihood_ratio
+
+
+def whole(res) -> list[str]:
+    return [w for w in res.warnings if "disagree among themselves" in w]
+
+
+def test_likelihood_ratio_is_the_profile_likelihood_of_runs_with_their_own_noise():
+    """Against a direct minimisation (from many random starts) of sum_g m_g log RSS_g(t) less the runs' own fits',
+    for runs of two clusters (the likelihood has a mode at each: the smaller is the answer) and noise levels 1 to
+    100; and the ratio's scale: multiplying every run's residuals and Jacobian by its own factor changes nothing."""
+    rng = np.random.default_rng(4)
+    g, n, rows = 6, 3, 6
+    js = [rng.normal(size=(rows, n)) for _ in range(g)]
+    truth = [np.zeros(n) if k < 4 else np.array([3.0, -2.0, 1.0]) for k in range(g)]
+    rs = [-j @ t + rng.normal(size=rows) * 10.0 ** (k % 3) * 0.1
+          for k, (j, t) in enumerate(zip(js, truth, strict=True))]
+
+    def parts(js, rs):
+        a = np.array([j.T @ j for j in js])
+        b = np.array([j.T @ r for j, r in zip(js, rs, strict=True)])
+        c = np.array([r @ r for r in rs])
+        own = np.array([np.sum((r - j @ np.linalg.lstsq(j, r, rcond=None)[0]) ** 2)
+                        for j, r in zip(js, rs, strict=True)])
+        return a, b, c, own, np.full(g, float(rows))
+
+    a, b, c, own, m = parts(js, rs)
+    objective = lambda t: sum(rows * np.log(np.sum((r + j @ t) ** 2)) for j, r in zip(js, rs, strict=True))  # noqa: E731
+    best = min(minimize(objective, rng.normal(size=n) * 4, method="Nelder-Mead",
+                        options={"xatol": 1e-10, "fatol": 1e-12, "maxiter": 20000}).fun for _ in range(40))
+    got = likelihood_ratio(a, b, c, own, m)
+    assert np.isclose(got, best - rows * np.log(own).sum(), rtol=1e-7)
+    scale = 10.0 ** rng.uniform(-3, 3, g)
+    assert np.isclose(likelihood_ratio(*parts([j * s for j, s in zip(js, scale, strict=True)],
+                                             [r * s for r, s in zip(rs, scale, strict=True)])), got, rtol=1e-7)
+
+
+def test_three_bad_runs_among_six_three_pose_runs_are_flagged(diff):
+    """Three runs of a left radius +5 % planted at random among 6 runs of three-pose references (noise 1e-5 per
+    rad): each hides the others from the one-run and the pair scores, and every fleet was reported clean
+    ('inconsistent' false, no warning; 0 of 150 fleets of mixed noise levels). The fleet's likelihood ratio flags
+    each (which runs to leave out is ambiguous with half the fleet bad: the warning may name good ones, and says to
+    calibrate them apart); among 8 the runs it leaves out are bad ones."""
+    for seed in range(6):
+        n = 6 if seed < 3 else 8
+        bad = sorted(np.random.default_rng(seed).choice(n, 3, replace=False).tolist())
+        res = fleet_calibrate(diff, short_runs(diff, 40000 + seed, n, 3, bad=bad), PARAMS)
+        assert res.inconsistent is True and len(whole(res)) == 1, (seed, res.warnings)
+        out = whole(res)[0].partition("(without ")[2].partition(" the others agree")[0].split(", ")
+        assert n == 6 or {f"r{k}.csv" for k in bad} >= set(out), (seed, bad, out)
+
+
+def test_agreeing_fleets_of_mixed_noise_are_no_longer_flagged_by_a_noisy_pair(diff):
+    """Agreeing fleets of 6 three-pose runs whose pair score flagged them: two runs at 1e-4 per rad among four at
+    1e-6 (seed 100485 of 500 such fleets: 44.9, and 3 more over 30) and levels drawn per run (seed 320: 37.2): the
+    pair of the two noisiest runs scored against the others' noise alone, the ratio of their levels. Against the
+    pair's own noise where larger: not flagged, and the fleet's likelihood ratio is under its threshold too."""
+    worst = np.random.default_rng(485).permutation([1e-4] * 2 + [1e-6] * 4)
+    drawn = np.random.default_rng(320).choice([1e-6, 1e-5, 1e-4], 6)
+    for seed, noise in ((100485, worst), (320, drawn)):
+        res = fleet_calibrate(diff, short_runs(diff, seed, 6, 3, noise=noise), PARAMS)
+        assert res.inconsistent is False and not res.warnings, (seed, res.warnings)
+
