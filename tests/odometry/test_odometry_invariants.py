@@ -99,7 +99,7 @@ def _pose_after(pose, twist, t):
     if abs(w) < 1e-12:
         dx, dy = vx, vy
     else:
-        s, c = math.sin(w) / w, (1 - math.cos(w)) / w
+        s, c = math.sin(w) / w, 2 * math.sin(w / 2) ** 2 / w  # not (1 - cos w) / w: 0 for |w| < 1e-8
         dx, dy = s * vx - c * vy, c * vx + s * vy
     return np.array([x + math.cos(th) * dx - math.sin(th) * dy, y + math.sin(th) * dx + math.cos(th) * dy, th + w])
 
@@ -130,6 +130,9 @@ def _rollers_only(draw):
                          min_size=1, max_size=4))
 @example(robot=_parallel(5.478042762003488e-08, 0.5), rate=3.0,
          pose0=(0.0, 0.0, 0.0), segments=[(1, [0.0, 1.0, 0.0])])  # wheels 55 nm apart: theta off by 9.3e-10 rad
+@example(robot=Robot("r", (*_parallel(0.0, 0.5).wheels, Wheel("w2", "swedish", 1.0, 0.0, 0.0, 0.5, gamma=-1.0,
+                                                            r_r=0.0625, sensed=("spin",)))),
+         rate=3.0, pose0=(0.0, 0.0, 0.0), segments=[(1, [0.0, 1.0, 2.5e-08])])  # x = -vy t (w t) / 2 = -1.4e-9
 def test_a_program_of_whole_sample_periods_is_recorded_at_the_sample_times(robot, rate, pose0, segments):
     """Segments of whole sample periods (twists projected onto those the fixed wheels allow): each sample's true
     pose is the segments composed up to its time, and the exact scheme recovers it from the log (the twist is
