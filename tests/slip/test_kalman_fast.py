@@ -94,7 +94,7 @@ def test_filter_equals_the_textbook_kalman_filter(kernels, name, kind, noise):
     poses = kalman_odometry(model, log, x0=x0, p0=p0).poses  # composed in the same pass: the exact SE(2) step
     x, y, th = 0.0, 0.0, 0.0
     for dx, dy, dth in run.increments:
-        s, c = (math.sin(dth) / dth, (1 - math.cos(dth)) / dth) if dth else (1.0, 0.0)
+        s, c = (math.sin(dth) / dth, 2 * math.sin(dth / 2) ** 2 / dth) if dth else (1.0, 0.0)
         u, v = s * dx - c * dy, c * dx + s * dy
         x, y, th = x + math.cos(th) * u - math.sin(th) * v, y + math.sin(th) * u + math.cos(th) * v, th + dth
     np.testing.assert_allclose(poses[-1], [x, y, th], rtol=0, atol=1e-12 * len(log))
