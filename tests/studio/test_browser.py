@@ -993,3 +993,23 @@ def test_stopping_after_a_turn_beyond_the_rack_is_feasible(page):
         cell = pg.locator(f'#commands tr[data-wheel="{name}"] td').nth(1)
         assert abs(float(cell.get_attribute("data-value"))) <= rack + 1e-12
     assert not pg.errors
+
+
+def test_special_configurations_are_shown_as_analyze_says(page):
+    """thesis-two-steer-castor: m = 1, but m = 2 when both steerable wheels' axles lie on the line through their
+    centres (o1, o2 at (+-0.5, 0) m: headings +-90 deg). `wmrkit analyze` prints that line; the page said only
+    'm = 1, s = 2'."""
+    pg = page
+    open_catalog(pg, "thesis-two-steer-castor")
+    robot = catalog.load("thesis-two-steer-castor")
+    special = analyze(robot).to_dict()["special_configurations"]
+    assert len(special) == 1 and special[0]["mobility"] == 2
+    # independent of the library's sentence: o1, o2 sit on the x axis, so their axles are on it at headings +-90 deg
+    assert [robot.wheel(n).position[1] for n in ("o1", "o2")] == pytest.approx([0, 0], abs=1e-12)
+    assert "headings -90.0 or 90.0 deg" in special[0]["description"]
+    cell = pg.inner_text("#a-ms")
+    assert cell.startswith("m = 1, s = 2")
+    assert special[0]["description"] in cell, cell
+    open_catalog(pg, "swerve-4")  # no special configuration: nothing more than m and s
+    assert pg.inner_text("#a-ms") == "m = 1, s = 2; steering must be coordinated"
+    assert not pg.errors

@@ -554,7 +554,10 @@ function renderAnalysis() {
   setCell("a-type", a.type === null ? '<span class="bad">none (degenerate)</span>' : `type ${a.type}: ${a.type_name}`, a.type);
   setCell("a-ms", `m = ${a.mobility}, s = ${a.steerability}` +
     (a.instantaneous_mobility !== a.mobility ? ` (here m = ${a.instantaneous_mobility})` : "") +
-    (a.coordinated_steering ? "; steering must be coordinated" : ""), [a.mobility, a.steerability]);
+    (a.coordinated_steering ? "; steering must be coordinated" : "") +
+    // the steering configurations where m is higher, as `wmrkit analyze` prints them under its type line
+    a.special_configurations.map((c) => `<br><span class="hint">${esc(c.description)}</span>`).join(""),
+    [a.mobility, a.steerability]);
   setCell("a-degenerate", a.degenerate ? `<span class="bad">yes</span>: ${esc(a.reasons.join("; "))}`
     : '<span class="good">no</span>', a.degenerate);
   setCell("a-icr", esc(a.icr.text), a.icr);
