@@ -1013,3 +1013,29 @@ def test_special_configurations_are_shown_as_analyze_says(page):
     open_catalog(pg, "swerve-4")  # no special configuration: nothing more than m and s
     assert pg.inner_text("#a-ms") == "m = 1, s = 2; steering must be coordinated"
     assert not pg.errors
+
+
+def test_drive_table_shows_castor_steer_rates(page):
+    """A castor swivels while the robot moves: `wmrkit ik` prints its steer rate, the page's table had no such
+    column. Closed form, a castor (delta = 0) trailing its joint p by d along its heading h: no lateral slip of
+    the wheel centre gives steer rate = (v + omega x p) . (-sin h, cos h) / d - omega."""
+    pg = page
+    open_catalog(pg, "thesis-omni-castor")
+    twist = [0.3, -0.2, 0.4]
+    pg.evaluate(f"setTwist({twist})")
+    settle(pg)
+    robot = page_robot(pg)
+    vx, vy, w = twist
+    for wheel in robot.wheels:
+        assert wheel.type == "castor" and wheel.delta == 0
+        (px, py), h = wheel.position, wheel.heading
+        want = ((vx - w * py) * -math.sin(h) + (vy + w * px) * math.cos(h)) / wheel.d - w
+        cell = pg.locator(f'#commands tr[data-wheel="{wheel.name}"] td').nth(3)
+        assert float(cell.get_attribute("data-value")) == pytest.approx(want, rel=1e-9), wheel.name
+        assert cell.inner_text() == f"{float(f'{want:.4g}'):g}"
+    assert "steer rate [rad/s]" in pg.inner_text("#commands tr:first-child")
+    open_catalog(pg, "diff-drive")  # fixed wheels have no steer rate: a dash, as in `wmrkit ik`
+    assert pg.locator('#commands tr[data-wheel="left"] td').nth(3).inner_text() == "–"
+    pg.evaluate("setTwist([0, 0, 0])")
+    settle(pg)
+    assert not pg.errors

@@ -608,13 +608,15 @@ function renderDrive() {
     : `<span class="bad">infeasible: ${esc(why.join("; "))}</span>`;
   $("d-feasible").dataset.value = JSON.stringify(d.feasible);
   $("d-icr").textContent = d.icr.text;
-  tab.innerHTML = "<tr><th>wheel</th><th>heading [deg]</th><th>spin [rad/s]</th><th>slip [m/s]</th></tr>";
+  // the columns of `wmrkit ik`: a castor's steer rate (it swivels as the robot moves), "–" where none
+  tab.innerHTML = "<tr><th>wheel</th><th>heading [deg]</th><th>spin [rad/s]</th><th>steer rate [rad/s]</th><th>slip [m/s]</th></tr>";
   for (const [name, c] of Object.entries(d.wheels)) {
     const tr = document.createElement("tr"); tr.dataset.wheel = name;
     const joints = Object.entries(c).filter(([k]) => !["heading", "spin", "speed", "steer_rate", "slip"].includes(k))
       .map(([k, v]) => `${esc(k)} ${fmt(v, 4)}`);  // a double wheel's spin1, spin2 (spin: their mean), rollers
     tr.innerHTML = `<td>${esc(name)}</td><td data-value="${c.heading}">${fmt(deg(c.heading), 4)}</td>` +
-      `<td data-value="${c.spin}">${fmt(c.spin, 4)}${joints.length ? ` <span class="hint">(${joints.join(", ")})</span>` : ""}</td><td class="${Math.abs(c.slip) > 1e-9 ? "bad" : ""}">${fmt(c.slip, 3)}</td>`;
+      `<td data-value="${c.spin}">${fmt(c.spin, 4)}${joints.length ? ` <span class="hint">(${joints.join(", ")})</span>` : ""}</td>` +
+      `<td data-value="${c.steer_rate}">${fmt(c.steer_rate, 4)}</td><td class="${Math.abs(c.slip) > 1e-9 ? "bad" : ""}">${fmt(c.slip, 3)}</td>`;
     tab.appendChild(tr);
   }
 }
