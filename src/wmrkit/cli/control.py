@@ -150,10 +150,18 @@ def _lookahead(args: argparse.Namespace, robot, reference) -> tuple[float | None
     """Pure pursuit's ``--lookahead`` [m] (default :func:`wmrkit.control.trackers.default_lookahead` on
     `reference`) and the words the summary line names it with (None and empty for another controller)."""
     from ..control.points import control_point
-    from ..control.trackers import MIN_LOOKAHEAD_TIME, default_lookahead, default_wheelbase, steers, top_speed
+    from ..control.trackers import (
+        MIN_LOOKAHEAD_TIME,
+        check_lookahead,
+        default_lookahead,
+        default_wheelbase,
+        steers,
+        top_speed,
+    )
 
     if args.lookahead is not None:
         value = _positive(args.lookahead, "--lookahead", "length")
+        check_lookahead(value, "--lookahead")
         return value, f" (lookahead {value:g} m)"
     if args.controller != "pure-pursuit":
         return None, ""

@@ -40,14 +40,15 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..limits import MAX_COORDINATE
 from ..robot import Robot
 from .loop import TwistController
 from .points import ControlError, ControlPoint, robot_reach
 from .references import Reference
 
-__all__ = ["AIM_FRACTION", "ARRIVAL_FRACTION", "ArrivalWarning", "PathFollower", "PathIndex", "arrived",
-           "default_lookahead", "default_wheelbase", "follower_duration", "max_curvature", "min_length", "pure_pursuit",
-           "stanley", "steers", "top_speed"]
+__all__ = ["AIM_FRACTION", "ARRIVAL_FRACTION", "MAX_LOOKAHEAD", "ArrivalWarning", "PathFollower", "PathIndex",
+           "arrived", "check_lookahead", "default_lookahead", "default_wheelbase", "follower_duration", "max_curvature",
+           "min_length", "pure_pursuit", "stanley", "steers", "top_speed"]
 
 #: Pure pursuit's default lookahead for a robot without steered wheels, and the shortest stopping length of Stanley,
 #: as a time [s] at the reference's top speed (Nav2's Regulated Pure Pursuit's ``lookahead_time``): 1 m at 0.5 m/s
@@ -76,6 +77,9 @@ ARRIVAL_FRACTION = 0.1
 #: point ``r`` away turns at up to ``2 / r``, and a robot at rest just short of the end (the slip of the dynamics)
 #: was steered round at the stops and tipped over.
 AIM_FRACTION = 1e-3
+#: The longest lookahead [m]: the largest coordinate of a reference (``limits.MAX_COORDINATE``); any lookahead longer
+#: than the path aims at its end alike (a lookahead of 1e308 m overflowed the goal test, a traceback).
+MAX_LOOKAHEAD = MAX_COORDINATE
 
 
 class ArrivalWarning(UserWarning):
@@ -367,14 +371,19 @@ class PathFollower:
         return float(np.hypot(*(self.tracked(pose) - self.path.xy[-1])))
 
 
+def check_lookahead(lookahead: float, what: str = "lookahead") -> None:
+    """Raise :class:`ControlError` naming `what` unless `lookahead` [m] is in ``(0, MAX_LOOKAHEAD]``."""
+    if not 0 < lookahead <= MAX_LOOKAHEAD:  # NaN included
+        raise ControlError(f"{what}: expected a distance in (0, {MAX_LOOKAHEAD:g}] m along the path, got {lookahead}")
+
+
 def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float | None = None,
                  curvature: float = math.inf) -> PathFollower:
     """Pure-pursuit controller (see module doc); `lookahead` [m], > 0 (default :func:`default_lookahead`); the
     commanded curvature is limited to ``+-curvature`` [1/m] (the robot's tightest turn, :func:`max_curvature`)."""
     if lookahead is None:
         lookahead = default_lookahead(cp, top_speed(reference))
-    if not 0 < lookahead < math.inf:  # NaN included
-        raise ControlError(f"lookahead: expected a distance > 0 m along the path, got {lookahead}")
+    check_lookahead(lookahead)
     path, aim = PathIndex(reference), AIM_FRACTION * lookahead
 
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
