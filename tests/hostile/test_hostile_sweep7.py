@@ -51,3 +51,35 @@ def test_a_lookahead_at_the_bound_still_runs(capsys):
                  "1e9", "--json"]) == 0
     answer = json.loads(capsys.readouterr().out)
     assert answer["summary"]["max_cross_track"] < 1e-3
+
+
+@pytest.mark.parametrize(("argv", "expected"), [
+    # was 'time: input times must be at least one, finite and strictly increasing, got [0.0, 1.0, 1.2, inf]' (the
+    # program's knots at 2 / 1e-320 = inf s): an internal name, no option
+    (["--path", "straight", "--speed", "1e-320"], "error: speed: 9.99989e-321 m/s: program 'straight' would never end"),
+    # was '--duration 3.77e+07 s and --step ...': no --duration was given, the program at --speed lasts that long
+    (["--path", "figure-eight", "--speed", "1e-6"],
+     "--path figure-eight at --speed 1e-06 m/s lasts 3.77e+07 s; --step 0.001 s: need 0 < step <= duration and at "
+     "most 5e+07 steps"),
+    (["--path", "straight", "--duration", "1e9"], "--duration 1e+09 s; --step 0.001 s: need 0 < step"),
+])
+def test_simulate_names_what_makes_a_program_too_long(argv, expected, capsys):
+    err = _one_line_error(["simulate", "forklift", *argv], capsys)
+    assert expected in err
+
+
+def test_simulate_names_the_torque_file_that_makes_a_run_too_long(tmp_path, capsys):
+    # was '--duration 1e+09 s and --step 0.001 s': no --duration was given, the file ends at 1e9 s
+    torques = tmp_path / "t.csv"
+    torques.write_text("time,right_drive.spin,left_drive.spin\n0,10,10\n1e9,10,10\n")
+    err = _one_line_error(["simulate", "forklift", "--torques", str(torques)], capsys)
+    assert f"{torques}: the file ends at t = 1e+09 s; --step 0.001 s: need 0 < step <= duration" in err
+
+
+def test_path_program_refuses_a_speed_at_which_it_never_ends():
+    from wmrkit.dynamics.model import DynamicModel
+    from wmrkit.dynamics.programs import path_program
+
+    model = DynamicModel.of(catalog.load("forklift"))
+    with pytest.raises(WmrkitError, match=r"^speed: 9.99989e-321 m/s: program 'turn' would never end"):
+        path_program(model, "turn", speed=1e-320)

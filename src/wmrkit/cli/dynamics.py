@@ -130,12 +130,13 @@ def run_simulate(args: argparse.Namespace) -> int:
     if args.duration is not None:
         duration = _positive(parse_value(args.duration, "number", "--duration"), "--duration")
     step = _positive(parse_value(args.step, "number", "--step"), "--step")
+    source = ("--duration" if args.duration is not None else f"{args.torques}: the file ends at t =" if args.torques
+              else f"--path {args.path} at --speed {speed:g} m/s lasts")  # what set the duration
     if duration <= 0 or step > duration or duration / step > MAX_STEPS:
-        raise WmrkitError(f"--duration {duration:g} s and --step {step:g} s: need 0 < step <= duration and at most "
+        raise WmrkitError(f"{source} {duration:g} s; --step {step:g} s: need 0 < step <= duration and at most "
                           f"{MAX_STEPS:.0e} steps")
     steps = round(duration / step)  # what the fixed steps run; a program's own duration may end within a step
     if args.method != "adaptive" and (args.duration or args.torques) and abs(duration / step - steps) > 1e-6:
-        source = "--duration" if args.duration is not None else f"{args.torques}: the file ends at t ="
         raise WmrkitError(f"{source} {duration:g} s is not a whole number of --step {step:g} s steps: the run would "
                           f"end at t = {steps * step:g} s; give a step that divides it")
     twist = [0.0, 0.0, 0.0] if args.initial_twist is None else [

@@ -65,6 +65,9 @@ def path_program(model: DynamicModel, name: str, *, speed: float = 2.0, radius_s
         times += [t + min(0.2, dt / 4), t + dt] if k else [t + dt]
         twists += [twist, twist] if k else [twist]
         t += dt
+    if not math.isfinite(t):  # its knots at inf s: twist_program refused them under the name 'time'
+        raise WmrkitError(f"speed: {speed:g} m/s: program '{name}' would never end (its segments last "
+                          f"{radius_scale:g} x 2 m/s / speed times their durations at 2 m/s)")
     feasible = feasible_twists(model, np.array(twists))  # the slip left (a skid steer's turns) is the robot's
     return twist_program(model, np.array(times), feasible, bandwidth=bandwidth, allow_slip=True), t
 
