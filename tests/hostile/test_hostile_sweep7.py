@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from pathlib import Path
 
 import pytest
 
@@ -83,3 +84,29 @@ def test_path_program_refuses_a_speed_at_which_it_never_ends():
     model = DynamicModel.of(catalog.load("forklift"))
     with pytest.raises(WmrkitError, match=r"^speed: 9.99989e-321 m/s: program 'turn' would never end"):
         path_program(model, "turn", speed=1e-320)
+
+
+THESIS_9_1 = Path(__file__).parents[2] / "src" / "wmrkit" / "parking" / "problems" / "thesis-9.1.yaml"
+
+
+@pytest.mark.parametrize(("name", "expected"), [
+    # printed raw: 'problem two' on one line, 'lines<ESC>[31mRED: slot 3.35 x 2 m, ...' in red on the next (exit 0)
+    ('"two\\nlines\\e[31mRED"', "p.yaml:4: name: must be printable text on one line, got the character '\\n'"),
+    ('"right-to-left \\u202e override"', "p.yaml:4: name: must be printable text on one line, got the character "
+                                         "'\\u202e'"),
+    ("x" * 5000, "p.yaml:4: name: at most 64 characters, got 5000"),  # printed whole in every answer
+])
+def test_a_parking_problems_name_follows_the_rules_of_a_robots_name(name, expected, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    Path("p.yaml").write_text(THESIS_9_1.read_text(encoding="utf-8").replace("name: thesis-9.1", f"name: {name}"),
+                              encoding="utf-8")
+    err = _one_line_error(["park", "p.yaml"], capsys)
+    assert err.strip() == f"wmrkit: error: {expected}"
+
+
+def test_a_parking_problems_printable_name_is_kept(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    Path("p.yaml").write_text(THESIS_9_1.read_text(encoding="utf-8").replace("name: thesis-9.1", "name: Plaza Mayor ✓"),
+                              encoding="utf-8")
+    assert main(["park", "p.yaml", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["problem"] == "Plaza Mayor ✓"

@@ -20,6 +20,7 @@ from typing import Any
 from ..catalog import resolve as resolve_robot
 from ..documents import FieldReader, read_document, read_file
 from ..errors import UnknownNameError, WmrkitError
+from ..limits import _check_text_fields
 from ..robot import Robot
 from ..wheels import Wheel, heading_from_beta, heading_in_range
 from .geometry import Space, Vehicle, gap_too_wide, no_free_length, wheels_outside
@@ -73,7 +74,9 @@ def problem_from_dict(data: Any, *, source: str = "<dict>", line_of=None, base: 
     if not isinstance(data, dict):
         check.fail("a parking problem is a mapping with the sections 'vehicle' and 'space'", ())
     check.reject_unknown(data, ("name", "vehicle", "space"), ())
-    name = check.text(data, "name", (), required=False) or Path(source).stem
+    name = check.text(data, "name", (), required=False)
+    _check_text_fields(name, "", check)  # printed in every answer: a robot's name's rules (one line, 64 characters)
+    name = name or Path(source).stem
     vehicle, robot = _vehicle(check, check.require(data, "vehicle", ()), base)
     space = _space(check, check.require(data, "space", ()))
     return ParkingProblem(name, vehicle, space, robot)
