@@ -218,7 +218,7 @@ def test_tyre_overflow_is_one_line_without_warnings(capsys):
     (["--blur", "1e308"], "blur in [0, 50] px"),  # cv2.error traceback
     (["--period", "1e-320"], "more than 10000 periods"),  # OverflowError traceback
     (["--speed", "1e308"], "faster than 1000 m/s"),  # printed final h = nan cm
-    (["--line-width", "1e308"], "width must be in (0, 1000] m"),  # RuntimeWarning lines
+    (["--line-width", "1e308"], "width must be in [1e-06, 1000] m"),  # RuntimeWarning lines
     (["--start", "1e308", "0"], "start position (0, 1e+308) m is beyond"),  # RuntimeWarning lines
 ])
 def test_follow_line_options_are_checked(option, expected, capsys):

@@ -110,3 +110,54 @@ def test_a_parking_problems_printable_name_is_kept(tmp_path, capsys, monkeypatch
                               encoding="utf-8")
     assert main(["park", "p.yaml", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["problem"] == "Plaza Mayor ✓"
+
+
+def _skid_log(path: Path) -> Path:
+    """A 2 s log of the skid steer driving straight at 1 m/s (wheel angles of radius 0.1 m), 21 samples."""
+    rows = [f"{k / 10:g}" + f",{k:g}" * 4 for k in range(21)]
+    path.write_text("time,front_left.spin,front_right.spin,rear_left.spin,rear_right.spin\n" + "\n".join(rows) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("mu", ["1e300,1e300", "1e308,1e308"])
+def test_wls_friction_coefficients_near_the_largest_float_give_the_answer_without_a_python_warning(mu, tmp_path,
+                                                                                                   capsys):
+    # printed 'weights.py:88: RuntimeWarning: overflow encountered in scalar multiply' and its source line on
+    # stderr before the answer (MAX_RATIO * mu.min() overflowed); only ratios matter, so the answer is that of 1,1
+    log = _skid_log(tmp_path / "log.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert main(["odometry", "skid-steer-4", str(log), "--method", "wls", "--mu-default", mu, "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert err == ""
+    assert json.loads(out)["final_pose"] == pytest.approx([2.0, 0.0, 0.0], abs=1e-12)
+
+
+def test_slip_weights_refuse_a_spread_beyond_max_ratio_even_near_the_largest_float():
+    from wmrkit.slip.weights import SlipWeightError, SlipWeights
+
+    robot = catalog.load("skid-steer-4")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert SlipWeights.uniform(1e308, 1e308).row_mu(robot).tolist() == [1e308] * 8
+        with pytest.raises(SlipWeightError, match="differ by more than a factor 1e"):
+            SlipWeights.uniform(1e295, 1e308).row_mu(robot)  # 1e13 apart
+
+
+def test_vision_points_far_outside_the_image_are_refused_without_a_python_warning(tmp_path, capsys):
+    # printed 'positioning.py:119: RuntimeWarning: overflow encountered in scalar subtract' (the row difference
+    # 1e308 - -1e308) before the line refusing the point
+    points = tmp_path / "points.json"
+    points.write_text('{"lines": [{"n": 0, "points": [[0, 1e308], [0, -1e308]]}]}')
+    camera = Path(__file__).parents[2] / "docs" / "figures" / "vision" / "follower-camera.yaml"
+    err = _one_line_error(["vision", "locate", "--points", str(points), "--camera", str(camera)], capsys)
+    assert "lines[0]: a point [[0.0, 1e+308], [0.0, -1e+308]] lies outside the 320 x 240 image" in err
+
+
+def test_follow_line_refuses_a_line_narrower_than_the_lengths_wmrkit_handles(capsys):
+    # 1e-320 m printed 'render.py:79: RuntimeWarning: overflow encountered in divide' and its source line, then
+    # 'the camera does not see the line at the start pose'
+    camera = Path(__file__).parents[2] / "docs" / "figures" / "vision" / "follower-camera.yaml"
+    err = _one_line_error(["follow-line", "line-follower", "--camera", str(camera), "--line-width", "1e-320",
+                           "--duration", "2"], capsys)
+    assert "width must be in [1e-06, 1000] m, got 1e-320" in err

@@ -85,7 +85,7 @@ class SlipWeights:
             rows += [f"{w.name} (lateral)", f"{w.name} (longitudinal)"] * len(w.elements())
             wheels += [w.name] * (2 * len(w.elements()))
         mu = np.array(out, dtype=float)
-        if mu.size and mu.max() > MAX_RATIO * mu.min():
+        if mu.size and float(mu.max()) > MAX_RATIO * float(mu.min()):  # Python floats: inf, not a numpy warning
             lo, hi = int(np.argmin(mu)), int(np.argmax(mu))
             err = SlipWeightError(f"friction coefficients of wheel {rows[lo]} ({mu[lo]:g}) and {rows[hi]} "
                                   f"({mu[hi]:g}) differ by more than a factor {MAX_RATIO:g}: the weighted least "

@@ -116,11 +116,11 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
             raise CameraError(f"points: lines[{i}].n: must be -1, 0 or 1, got {n!r}")
         if n != 0 and not spacing > 0:
             raise CameraError(f"points: lines[{i}]: n = {n} needs the line spacing (--spacing D > 0)")
-        if abs(pts[0, 1] - pts[1, 1]) < 1e-9:
-            raise CameraError(f"points: lines[{i}]: the two points are on one image row (y_u1 = y_u2)")
         if np.any(np.abs(pts) > [camera.width, camera.rows]):  # outside the image (by more than its size)
             raise CameraError(f"points: lines[{i}]: a point {pts.tolist()} lies outside the {camera.width} x "
                               f"{camera.rows} image (pixels from its centre)")
+        if abs(pts[0, 1] - pts[1, 1]) < 1e-9:  # after the bound: 1e308 - -1e308 overflowed with a numpy warning
+            raise CameraError(f"points: lines[{i}]: the two points are on one image row (y_u1 = y_u2)")
         if any(n == other for other, _ in lines[:i]):  # two lines said to be the same one would be averaged
             raise CameraError(f"points: lines[{i}].n: line n = {n} given twice")
         try:  # points outside the image may lie beyond the fold of a k1 < 0 model

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
-from ..limits import MAX_SIZE
+from ..limits import MAX_SIZE, MIN_SIZE
 from .camera import Camera, CameraError, extrinsics, ground_from_image, undistort
 
 __all__ = ["Scene", "render"]
@@ -47,8 +47,8 @@ class Scene:
     def __post_init__(self) -> None:
         if self.style not in ("paint", "crops"):
             raise CameraError(f"scene: style must be 'paint' or 'crops', got {self.style!r}")
-        if not 0 < self.width <= MAX_SIZE:
-            raise CameraError(f"scene: width must be in (0, {MAX_SIZE:g}] m, got {self.width}")
+        if not MIN_SIZE <= self.width <= MAX_SIZE:  # the lengths wmrkit handles: 1e-320 m overflowed the coverage
+            raise CameraError(f"scene: width must be in [{MIN_SIZE:g}, {MAX_SIZE:g}] m, got {self.width}")
         if not 0 <= self.spacing <= MAX_SIZE:  # NaN included: it rendered garbage with a numpy warning
             raise CameraError(f"scene: spacing must be in [0, {MAX_SIZE:g}] m, got {self.spacing}")
         if not all(abs(x) <= MAX_SIZE for x in self.extra):
