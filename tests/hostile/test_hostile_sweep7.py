@@ -161,3 +161,24 @@ def test_follow_line_refuses_a_line_narrower_than_the_lengths_wmrkit_handles(cap
     err = _one_line_error(["follow-line", "line-follower", "--camera", str(camera), "--line-width", "1e-320",
                            "--duration", "2"], capsys)
     assert "width must be in [1e-06, 1000] m, got 1e-320" in err
+
+
+def test_a_body_heavier_than_a_thousand_tonnes_is_refused(tmp_path, capsys):
+    # mass 1e300 kg: 'wmrkit simulate' answered with exit 0 and "max_slip_speed": 2e+295 m/s (normal loads of
+    # 1e300 N in the compiled model, which the `tyre` command refuses beyond 1e7 N)
+    description = catalog.load("forklift").to_dict()
+    description["body"]["mass"] = 1e300
+    path = tmp_path / "heavy.json"
+    path.write_text(json.dumps(description))
+    err = _one_line_error(["simulate", str(path), "--path", "straight"], capsys)
+    assert "body.mass: at most 1e+06 kg (a thousand tonnes" in err
+
+
+def test_body_refuses_the_same_mass_from_python():
+    from wmrkit.dynamics.mass import MAX_MASS, Body, body_problem
+    from wmrkit.dynamics.model import GRAVITY
+    from wmrkit.dynamics.tyres import MAX_LOAD
+
+    assert MAX_MASS * GRAVITY <= MAX_LOAD  # the whole weight on one tyre stays within what a tyre takes
+    assert body_problem(Body(MAX_MASS, 1.0)) == ""
+    assert body_problem(Body(2 * MAX_MASS, 1.0)).startswith("body.mass: at most 1e+06 kg")

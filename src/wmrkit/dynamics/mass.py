@@ -27,9 +27,15 @@ from ..limits import MAX_SIZE
 from .tyres import TYRES, Tyre, param_problem
 
 BODY_FIELDS = ("mass", "inertia", "com", "com_height")
+#: Heaviest body [kg]: a thousand tonnes, whose whole weight (9.8e6 N) one tyre still takes (``tyres.MAX_LOAD``, 1e7 N);
+#: a body of 1e300 kg was simulated with normal loads of 1e300 N and printed slip speeds of 2e295 m/s.
+MAX_MASS = 1e6
 INERTIA_JOINTS = {"spin": "spin", "steer": "steer", "roller": "roller"}
 CASTOR_TYPES = ("castor", "double_castor")
 CENTRED_STEER_TYPES = ("steerable", "double")
+
+
+_HEAVY = f"at most {MAX_MASS:g} kg (a thousand tonnes: its weight on one tyre within the largest load a tyre takes)"
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,6 +53,8 @@ def body_problem(body: Body) -> str:
     what a description's ``body`` section allows (:func:`body_from_dict`)."""
     if not 0 < body.mass < math.inf:  # NaN included
         return f"body.mass: expected a finite number > 0 kg, got {body.mass}"
+    if body.mass > MAX_MASS:
+        return f"body.mass: {_HEAVY}, got {body.mass:g} kg"
     if not 0 < body.inertia < math.inf:
         return f"body.inertia: expected a finite number > 0 kg m^2, got {body.inertia}"
     if len(body.com) != 2 or not all(abs(c) <= MAX_SIZE for c in body.com):
@@ -66,6 +74,8 @@ def body_from_dict(data: Mapping[str, Any], check: Any) -> Body | None:
         check.fail("must be a mapping {mass, inertia, com: [x, y], com_height}", loc)
     check.reject_unknown(item, BODY_FIELDS, loc)
     mass = _positive(check, check.require(item, "mass", loc), (*loc, "mass"), "kg")
+    if mass > MAX_MASS:
+        check.fail(f"{_HEAVY}, got {mass:g} kg", (*loc, "mass"))
     inertia = _positive(check, check.require(item, "inertia", loc), (*loc, "inertia"), "kg m^2")
     com = item.get("com", [0.0, 0.0])
     if not isinstance(com, list | tuple) or len(com) != 2:
