@@ -182,3 +182,10 @@ def test_body_refuses_the_same_mass_from_python():
     assert MAX_MASS * GRAVITY <= MAX_LOAD  # the whole weight on one tyre stays within what a tyre takes
     assert body_problem(Body(MAX_MASS, 1.0)) == ""
     assert body_problem(Body(2 * MAX_MASS, 1.0)).startswith("body.mass: at most 1e+06 kg")
+
+
+def test_a_pi_gain_whose_integral_gain_overflows_is_refused_by_its_name(capsys):
+    # was 'gain b: expected three finite numbers >= 0, got (inf, inf, inf)': b = a^2 / 4, which no option sets
+    err = _one_line_error(["track", "diff-drive", "--reference", "circle", "--controller", "pi", "--gain", "1e200"],
+                          capsys)
+    assert "error: gain: 1e+200 1/s: the PI law's integral gain a^2 / 4 overflows" in err

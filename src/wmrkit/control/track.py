@@ -225,6 +225,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                            f"got {pose0.tolist()}")
     if controller in ("p", "pi", "point"):
         b = gain * gain / 4 if integral_gain is None else integral_gain
+        if controller == "pi" and integral_gain is None and not math.isfinite(b):  # beyond a ~ 1.3e154 1/s
+            raise ControlError(f"gain: {gain:g} 1/s: the PI law's integral gain a^2 / 4 overflows")
         law = PositionLaw.uniform(controller, gain, b if controller == "pi" else 0.0, gate)  # type: ignore[arg-type]
         if sampled is not None:
             check_sampling(law, sampled, delay=delay, stacklevel=3)
