@@ -68,7 +68,8 @@ def ratio_figure() -> list[tuple[float, float, int, int]]:
     return rows
 
 
-def comparison() -> str:
+def comparison(repeat: int = 7) -> str:
+    """The comparison table, each planner timed over `repeat` runs (tests/parking/test_docs.py: one)."""
     p1, p2 = load_problem("thesis-9.1"), load_problem("thesis-9.2")
     cases = [("Table 9.1", p1.vehicle, p1.space), ("Table 9.2", p2.vehicle, p2.space),
              ("9.1, H = 3.0 m, dx2 = 0.9 m", p1.vehicle, replace(p1.space, H=3.0, dx2=0.9)),
@@ -78,7 +79,7 @@ def comparison() -> str:
     lines = ["| slot | planner | success | path [m] | direction changes | planning time [ms] | colliding poses |",
              "|---|---|---|---|---|---|---|"]
     for name, car, slot in cases:
-        for o in compare(car, slot, repeat=7):
+        for o in compare(car, slot, repeat=repeat):
             length = "-" if math.isnan(o.length) else f"{o.length:.2f}"
             lines.append(f"| {name} | {o.planner} | {'yes' if o.success else 'no'} | {length} | {o.cusps} | "
                          f"{o.time_ms:.3f} | {o.colliding} |")
