@@ -50,3 +50,17 @@ def test_every_row_on_a_smooth_reference_ends_at_the_path_s_end():
                                                                 ("forklift", "arc-line", "stanley")])
 def test_rows_of_the_table_are_what_the_code_gives(robot, reference, controller):
     assert _script().row(robot, reference, controller) in _doc_rows()
+
+
+def test_the_page_s_bounds_on_the_last_column_are_the_table_s():
+    """The sentence under the table bounds its last column per follower ("Stanley's every row within 19 mm (...),
+    pure pursuit's within 0.3 mm, and no row warns") by the table's own largest values: it said three rows ended
+    beside the end and warned (339, 515, 108.5 mm) while those rows read 0.0 since pure pursuit holds its goal
+    point at the end."""
+    text = " ".join((ROOT / "docs" / "control.md").read_text().split())
+    said = re.search(r"Stanley's every row within ([\d.]+) mm \([^)]*\), pure pursuit's within ([\d.]+) mm, and no row "
+                     r"warns", text)
+    assert said, "the sentence bounding the table's last column"
+    for controller, bound in (("stanley", float(said[1])), ("pure-pursuit", float(said[2]))):
+        largest = max(float(r.split(" | ")[6].rstrip(" |")) for r in _doc_rows() if r.split(" | ")[2] == controller)
+        assert largest <= bound < largest + 1, (controller, largest, bound)
