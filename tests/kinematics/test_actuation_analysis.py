@@ -243,3 +243,22 @@ def test_the_analyses_solutions_refuse_values_that_are_not_finite_or_beyond_1e6(
     for method in (sensing.twist, sensing.direct):
         with pytest.raises(ShapeError, match=r"q_dot_s: f2\.spin: expected finite numbers within 1e\+06"):
             method([1.0, bad])
+
+
+def test_the_verdicts_name_the_joint_models_mobility_not_a_second_m(capsys):
+    """`wmrkit analyze agv-drive-unit --json` gives m = 1 (the type's, Table 5.1) while its verdicts said
+    '(2 actuated rates, m = 2)': that 2 is the joint model's mobility (4.3), k - rank A with the turntable's free
+    turn. The verdicts now name it so; the 2 is checked against the null space of A (3.22) computed here."""
+    from wmrkit import catalog
+    from wmrkit.cli.main import main
+
+    agv = catalog.load("agv-drive-unit")
+    a = agv.constraint_matrix()
+    joint_m = a.shape[1] - int(np.linalg.matrix_rank(a))
+    assert main(["analyze", "agv-drive-unit", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mobility"] == 1 and joint_m == 2
+    for key, n in (("actuation", "2 actuated rates"), ("sensing", "3 sensed rates")):
+        verdict = out[key]["verdict"]
+        assert "m = " not in verdict, verdict
+        assert verdict.endswith(f"({n}; the joint model's mobility {joint_m}, eq. 4.3)"), verdict

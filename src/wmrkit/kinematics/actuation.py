@@ -188,11 +188,14 @@ def body_only(leaf: np.ndarray, free: np.ndarray) -> np.ndarray:
 
 def verdict_texts(leaf: np.ndarray, texts: dict[str, str], n: int, m: np.ndarray,
                   missing: tuple[str, ...], role: str) -> np.ndarray:
-    """One sentence per leaf of a tree ``(...)`` str: the leaf's text, counts, and missing steering joints."""
+    """One sentence per leaf of a tree ``(...)`` str: the leaf's text, counts, and missing steering joints. `m` is
+    the joint model's mobility (4.3, the gears held), named so: it is not the type's m (Table 5.1) of a robot whose
+    joints move with the body at rest (a drive unit's turntable: m = 1, the joint model's 2)."""
     note = (f"; the thesis needs the steering of {', '.join(missing)} {role} too (the model depends on beta)"
             if missing else "")
     plural = "" if n == 1 else "s"
-    words = np.frompyfunc(lambda lf, mob: f"{texts[lf]} ({n} {role} rate{plural}, m = {mob}){note}", 2, 1)
+    words = np.frompyfunc(
+        lambda lf, mob: f"{texts[lf]} ({n} {role} rate{plural}; the joint model's mobility {mob}, eq. 4.3){note}", 2, 1)
     return readonly(np.asarray(words(leaf, m), dtype=object))
 
 
