@@ -416,6 +416,23 @@ def test_configurations(client):
     assert all(c["condition_number"] == pytest.approx(1.0) for c in diff["isotropic"])
 
 
+def test_isotropic_configurations_name_their_wheels(client):
+    """The page listed "(90, 180, -110) deg" for thesis-steer-castor without saying which wheel each heading is.
+    The answer names them (`isotropic_wheels`, as a singular set's `variables`); checked independently: the robot
+    steered by name to each configuration is isotropic (kappa = 1 at its length), and not with the names turned."""
+    from wmrkit.analysis.isotropy import twist_condition_number
+
+    robot = catalog.load("thesis-steer-castor")
+    data = client.post("/api/configurations", json={"description": robot.to_dict()}).json()
+    names, found = data["isotropic_wheels"], data["isotropic"]
+    assert sorted(names) == ["c2", "c3", "o1"] and found
+    for c in found:
+        steered = robot.with_steering(dict(zip(names, c["heading"], strict=True)))
+        assert float(twist_condition_number(steered, length=c["length"])) == pytest.approx(1.0, abs=1e-5)
+        turned = robot.with_steering(dict(zip(names[1:] + names[:1], c["heading"], strict=True)))
+        assert float(twist_condition_number(turned, length=c["length"])) > 1.01
+
+
 def test_singular_text_in_headings(client):
     """The page shows headings like the CLI ('at beta front = -180.00, 0.00 deg' before: the thesis's beta)."""
     from wmrkit.analysis.classification import classify

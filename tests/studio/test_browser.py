@@ -1015,6 +1015,22 @@ def test_special_configurations_are_shown_as_analyze_says(page):
     assert not pg.errors
 
 
+def test_isotropic_and_singular_headings_name_their_wheels(page):
+    """thesis-steer-castor: the page listed "(90, 180, -110) deg" without saying which wheel each heading is. It
+    names them now, in the order of the answer's `isotropic_wheels` (checked in the API test by steering the robot
+    by name) and of each singular set's `variables`."""
+    pg = page
+    open_catalog(pg, "thesis-steer-castor")
+    pg.wait_for_function("() => S.configsText === S.analysedText")
+    configs = pg.evaluate("S.configs")
+    assert configs["isotropic"] and configs["isotropic_wheels"] == ["o1", "c2", "c3"]
+    want = ", ".join("(" + ", ".join(f"{float(f'{math.degrees(v):.4g}'):g}" for v in c["heading"]) + ")"
+                     for c in configs["isotropic"][:4])
+    assert pg.inner_text("#a-isotropic") == f"headings of (o1, c2, c3): {want} deg"
+    assert "headings of (o1, c2): (" in pg.inner_text("#a-singular")  # 'on curves over (o1, c2)'
+    assert not pg.errors
+
+
 def test_drive_table_shows_castor_steer_rates(page):
     """A castor swivels while the robot moves: `wmrkit ik` prints its steer rate, the page's table had no such
     column. Closed form, a castor (delta = 0) trailing its joint p by d along its heading h: no lateral slip of

@@ -182,6 +182,7 @@ def configurations(request: Any) -> dict[str, Any]:
     iso = isotropic_configurations(robot) if searched else ()
     out["isotropic_searched"] = searched
     out["isotropic_note"] = note
+    out["isotropic_wheels"] = list(robot.steer_names)  # whose headings each configuration lists, in order
     out["isotropic"] = [{"heading": _headings(robot, c.beta), "length": c.length,
                          "condition_number": c.condition_number} for c in iso]
     return out

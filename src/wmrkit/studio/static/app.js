@@ -580,12 +580,17 @@ function renderAnalysis() {
     const note = `<span class="hint">${c === undefined ? "computing…" : "not available"}</span>`;
     setCell("a-singular", note, null); setCell("a-isotropic", note, null);
   } else {
-    setCell("a-singular", Object.entries(c.singular).map(([k, s]) => `${k}: ${esc(s.text.replace(/-?\d+\.\d+/g, (m) => m))}` +
-      (s.headings.length ? `<br><span class="hint">headings ${s.headings.slice(0, 4).map((h) => "(" + h.map((v) => fmt(deg(v), 4)).join(", ") + ")").join(" ")} deg</span>` : "")).join("<br>"), c.singular);
+    setCell("a-singular", Object.entries(c.singular).map(([k, s]) => `${k}: ${esc(s.text)}` +
+      (s.headings.length ? `<br><span class="hint">${namedHeadings(s.variables, s.headings)}</span>` : "")).join("<br>"), c.singular);
     setCell("a-isotropic", !c.isotropic_searched ? `<span class="hint">${esc(c.isotropic_note || "not searched (see the κ map)")}</span>`
-      : c.isotropic.length ? c.isotropic.slice(0, 4).map((i) => "(" + i.heading.map((v) => fmt(deg(v), 4)).join(", ") + ") deg").join(", ")
-        : "none", c.isotropic);
+      : c.isotropic.length ? namedHeadings(c.isotropic_wheels, c.isotropic.map((i) => i.heading)) : "none", c.isotropic);
   }
+}
+// Configurations (lists of headings [rad]) with the wheels they are of, as `wmrkit analyze` names a singular set's:
+// "headings of (o1, c2, c3): (90, 180, -110), (90, 0, 110) deg" (the first four).
+function namedHeadings(names, configs) {
+  return `headings of (${names.map(esc).join(", ")}): ` +
+    configs.slice(0, 4).map((h) => "(" + h.map((v) => fmt(deg(v), 4)).join(", ") + ")").join(", ") + " deg";
 }
 function esc(s) { return String(s).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" })[c]); }
 
