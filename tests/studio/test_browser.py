@@ -1031,6 +1031,63 @@ def test_isotropic_and_singular_headings_name_their_wheels(page):
     assert not pg.errors
 
 
+def test_steer_range_is_shown_edited_validated_kept_and_saved(page, server):
+    """A wheel's `steer_range` was neither shown nor editable in the panel, and retyping the wheel dropped it
+    silently. It is a field now (headings in deg, bare numbers in deg), refused as a description refuses it, kept
+    by a retype to a type that steers, said dropped by one to a type that does not, and saved as typed."""
+    from wmrkit import DescriptionError
+
+    pg = page
+    _, root = server
+    open_catalog(pg, "ackermann")
+    pg.click('[data-wheel="front_left"]')
+    field = '#wheel-fields [data-field="steer_range"]'
+    assert pg.input_value(field) == "-40 deg, 40 deg"  # the catalog's [-40 deg, 40 deg]
+    pg.click('[data-wheel="rear_left"]')
+    assert pg.locator(field).count() == 0  # a fixed wheel does not steer: no range to give
+    pg.click('[data-wheel="front_left"]')
+    edit(pg, "steer_range", "-30, 45")
+    assert page_robot(pg).wheel("front_left").steer_range == pytest.approx((math.radians(-30), math.radians(45)))
+    assert pg.input_value(field) == "-30 deg, 45 deg"
+    for bad in ("30", "45, -30", "10 deg, 50 deg"):  # one value; min > max; the heading (0) outside it
+        edit(pg, "steer_range", bad)
+        with pytest.raises(DescriptionError) as err:  # the library's own message for the same description
+            robot_from_dict(pg.evaluate("S.desc"))
+        marked = "steer_range" if bad != "10 deg, 50 deg" else "heading"
+        assert pg.locator(f'#wheel-fields [data-field="{marked}"].invalid').count() == 1, bad
+        assert pg.inner_text(f'#wheel-fields [data-msg="{marked}"]') in str(err.value), bad
+        pg.click("#undo")
+        settle(pg)
+    assert pg.locator(".invalid").count() == 0
+    edited = page_robot(pg)
+    pg.fill("#save-path", "ranged.yaml")
+    pg.click("#save")
+    pg.wait_for_function("() => document.getElementById('status').textContent.startsWith('saved')")
+    assert Robot.from_file(root / "ranged.yaml") == edited
+    pg.select_option("#catalog", "")
+    pg.select_option("#files", "ranged.yaml")
+    pg.click("#open")
+    settle(pg)
+    assert page_robot(pg) == edited  # round trip: the same robot
+    pg.click('[data-wheel="front_left"]')
+    assert pg.input_value(field) == "-30 deg, 45 deg"
+    pg.select_option('#wheel-fields [data-field="type"]', "castor")  # steers: the range stays
+    settle(pg)
+    assert page_robot(pg).wheel("front_left").steer_range == pytest.approx((math.radians(-30), math.radians(45)))
+    assert pg.locator('#wheel-fields [data-note="type"]').count() == 0  # nothing dropped, nothing said
+    pg.select_option('#wheel-fields [data-field="type"]', "fixed")  # does not steer: dropped, and said so
+    settle(pg)
+    assert page_robot(pg).wheel("front_left").steer_range is None
+    note = pg.inner_text('#wheel-fields [data-note="type"]')
+    assert note == ("retyped to fixed: dropped d, steer_range [-30 deg, 45 deg] (a fixed wheel does not steer), "
+                    "actuated steer, sensed steer"), note  # the castor's d, the joints a fixed wheel has not
+    pg.click("#undo")
+    settle(pg)
+    assert pg.locator('#wheel-fields [data-note="type"]').count() == 0
+    assert pg.input_value(field) == "-30 deg, 45 deg"
+    assert not pg.errors
+
+
 def test_drive_table_shows_castor_steer_rates(page):
     """A castor swivels while the robot moves: `wmrkit ik` prints its steer rate, the page's table had no such
     column. Closed form, a castor (delta = 0) trailing its joint p by d along its heading h: no lateral slip of

@@ -14,6 +14,7 @@ const S = {
   startError: null,  // the start file could not be read again (invalid or gone): shown over its last good robot
   loadWarnings: [],  // the warnings of the file or catalog robot as read, shown until another is loaded or saved
   descWarnings: [],  // the warnings of the description analysed last (a mecanum wheel whose gamma is not +-45 deg)
+  notice: null,  // {name, index, text}: what the last retype of that wheel dropped, shown under its type until an edit
 };
 // Timings for the docs and the browser test: round trip edit -> numbers shown [ms], server time [ms].
 window.studioStats = { edits: [], server: [], rendered: 0 };
@@ -59,8 +60,18 @@ function typed(field, text) {  // a bare number typed in a field shown in mm or 
   return unit && BARE_NUMBER.test(text) ? `${text} ${unit}` : text;
 }
 
+// A steering range [min, max] (headings) as shown, "-40 deg, 40 deg", and as typed: "[-40, 40]" or "-40 deg, 0.7 rad"
+// give the description's list of two headings, bare numbers in deg; anything else goes to the server as typed (a
+// list of its comma-separated parts), which says what is wrong on the field, as for a description file.
+function shownRange(range) {
+  if (range === undefined || range === null) return "";
+  return Array.isArray(range) ? range.map((v) => shown(v, "heading")).join(", ") : String(range);
+}
+function typedRange(text) { return text.replace(/^\[(.*)\]$/s, "$1").split(",").map((p) => typed("heading", p.trim())); }
+
 // ---- editing, undo/redo ---------------------------------------------------------------------------------------
 function commit(mutate, { push = true } = {}) {
+  S.notice = null;  // said once, after the retype that dropped something (the mutation may set it again)
   const before = JSON.stringify(S.desc);
   const next = JSON.parse(before);
   mutate(next);
@@ -71,7 +82,7 @@ function commit(mutate, { push = true } = {}) {
   refresh();
 }
 function restore(text) {  // undo, redo: the selection and the driven headings may name wheels that are gone
-  S.desc = JSON.parse(text);
+  S.desc = JSON.parse(text); S.notice = null;
   afterChange();
   renderWheelPanel();
   refresh();
@@ -279,12 +290,18 @@ function renderWheelPanel() {
   sel.addEventListener("change", () => changeType(sel.value));
   l.appendChild(sel); box.appendChild(l);
   const tm = document.createElement("div"); tm.className = "msg"; tm.dataset.msg = "type"; box.appendChild(tm);
+  if (S.notice && S.notice.index === i && S.notice.name === w.name) {  // what the retype dropped
+    const n = document.createElement("div"); n.className = "msg note"; n.dataset.note = "type";
+    n.textContent = S.notice.text; box.appendChild(n);
+  }
   const pos = Array.isArray(w.position) ? w.position : (g ? g.joint : [0, 0]);
   row("x", "x", shown(pos[0], "x"), "forward, from the robot origin");
   row("y", "y", shown(pos[1], "y"), "left, from the robot origin");
   const heading = "heading" in w ? w.heading : (g ? g.heading : 0);
   row(kind && kind.steers ? "heading" : "heading (axle ⟂)", "heading", shown(heading, "heading"),
     "rolling direction: 0 = straight ahead (+x), counter-clockwise positive");
+  if (kind && kind.steers) row("steer range", "steer_range", shownRange(w.steer_range),
+    "min, max headings the steering reaches (0 = straight ahead), e.g. -90, 90; empty: no limit");
   for (const f of kind ? [...kind.required, ...Object.keys(kind.optional)] : []) {
     if (f === "beta") continue;
     row(f, f, shown(f in w ? w[f] : kind.optional[f], f));
@@ -329,6 +346,7 @@ function editField(field, text) {
       pos[field === "x" ? 0 : 1] = text; setPlace(w, pos[0], pos[1]); return;
     }
     if (field === "heading") { setHeading(w, text); delete S.heading[name]; return; }  // drawn as typed
+    if (field === "steer_range") { if (text === "") delete w.steer_range; else w.steer_range = typedRange(text); return; }
     if (text === "") delete w[field]; else w[field] = text;
   });
 }
@@ -344,10 +362,16 @@ function changeType(type) {
     const defaults = { r, d: 0.04, b: 0.08, gamma: "90 deg", r_r: "10 mm", delta: 0 };
     for (const f of kind.required) if (f !== "beta") w[f] = f in old ? old[f] : defaults[f];
     for (const f of Object.keys(kind.optional)) if (f !== "beta" && f in old) w[f] = old[f];
+    if (kind.steers && "steer_range" in old) w.steer_range = old.steer_range;  // headings: the same stops
+    const dropped = Object.keys(old).filter((f) => !(f in w) && !["beta", "l", "alpha", "heading", "actuated", "sensed"].includes(f))
+      .map((f) => (f === "steer_range" ? `steer_range [${shownRange(old[f])}] (a ${type} wheel does not steer)` : f));
     for (const group of ["actuated", "sensed"]) {
-      const keep = (Array.isArray(old[group]) ? old[group] : [old[group]]).filter((j) => kind.joints.includes(j));
+      const had = old[group] === undefined ? [] : Array.isArray(old[group]) ? old[group] : [old[group]];
+      const keep = had.filter((j) => kind.joints.includes(j));
       if (keep.length) w[group] = keep;
+      dropped.push(...had.filter((j) => !keep.includes(j)).map((j) => `${group} ${j}`));
     }
+    if (dropped.length) S.notice = { name: old.name, index: i, text: `retyped to ${type}: dropped ${dropped.join(", ")}` };
     d.wheels[i] = w;
     rewriteCouplings(d, name, { type });
   });
