@@ -129,3 +129,29 @@ def test_one_step_in_a_noisy_circle_is_found_once_at_its_sample(dt, radius, v, w
     got = [(x.signal, x.t) for x in feasibility(catalog.load("omni-3"), ref,
                                                 "kinematic" if kind == "position" else "dynamic").violations]
     assert got == [(kind, t[i])], got
+
+
+def _clothoid_with_a_step(slope, step, at, dt):
+    """A path driven at 1 m/s (arc length s = t) whose curvature rate is ``slope s`` [1/(m s)], less `step` from
+    s = `at` (kappa = slope s^2 / 2 - step (s - at)+), integrated on a 50 times finer grid and sampled every `dt`."""
+    from scipy.integrate import cumulative_simpson
+
+    s = np.arange(0.0, 4.0 + dt / 2, dt / 50)
+    th = slope * s**3 / 6 - step * np.clip(s - at, 0, None) ** 2 / 2
+    xy = [cumulative_simpson(f(th), x=s, initial=0.0)[::50] for f in (np.cos, np.sin)]
+    return reference_from_samples("clothoid.csv", s[::50], np.column_stack([*xy, th[::50]]))
+
+
+@pytest.mark.parametrize("slope, step, dt", [(0.2, 0.3, 0.01), (-0.2, 0.3, 0.01), (0.2, -0.3, 0.01),
+                                             (-0.2, 0.5, 0.01), (1.0, 0.5, 0.01),
+                                             (0.0, 0.03, 0.01), (0.2, 0.03, 0.001), (-0.2, 0.1, 0.001),
+                                             (1.0, 0.1, 0.001), (1.0, -0.5, 0.001)])
+@pytest.mark.parametrize("at", [2.0, 2.0037])
+def test_a_curvature_rate_step_on_a_slope_is_reported_with_its_size(slope, step, at, dt):
+    """A car's curvature-rate step of `step` 1/(m s) where the rate rises steadily by `slope` 1/(m s^2): one
+    violation, whose size is the step (closed form). Finite differences spread it over about 5 samples, and only
+    those over the jump limit were summed, with the slope's own change: 0.313 for a step of 0.5 on a slope of 1 at
+    100 Hz, 0.28 for 0.3 on 0.2."""
+    got = feasibility(catalog.load("ackermann"), _clothoid_with_a_step(slope, step, at, dt), "dynamic").violations
+    assert [v.signal for v in got] == ["kappa_rate"]
+    assert got[0].size == pytest.approx(abs(step), rel=1e-3)

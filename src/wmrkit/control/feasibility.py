@@ -28,7 +28,7 @@ import numpy as np
 from ..analysis.classification import classify
 from ..limits import MAX_SIZE
 from ..robot import Robot
-from .jumps import _FLOOR, _TURN, _folded, _jumps, _persists
+from .jumps import _FLOOR, _TURN, _folded, _held, _jumps, _persists
 from .jumps import BLOCK as BLOCK  # importable from here (track)
 from .points import ControlError, control_point
 from .reference_signals import _CURVATURE, _curvature_reference, signals
@@ -197,8 +197,14 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
         if req.column == "types 3 and 5, l_o != 0" and name in ("velocity", "omega"):
             slow = _slow_turns(robot, ref, point, x, jumps, jump_factor)
         for k, last, size in sorted(jumps + slow):
-            if name == "kappa_rate" and not _persists(x, k, floor):
-                continue  # ringing of a third finite difference, not a step of the curvature rate
+            if name == "kappa_rate":
+                if not _persists(x, k, floor):
+                    continue  # ringing of a third finite difference, not a step of the curvature rate
+                # its size: the whole step less the rate's slope (finite differences spread it over about 5 samples,
+                # of which only those over the jump limit were summed: a step of 0.5 1/(m s) on a slope of 1 1/(m s^2)
+                # at 100 Hz was 0.313)
+                held = abs(_held(x, k, last))
+                size = held if math.isfinite(held) else size
             span = (name, float(ref.t[k]), float(ref.t[last + 1]))
             if _folded(span, seen):
                 seen.append(span)

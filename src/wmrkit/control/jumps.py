@@ -206,20 +206,24 @@ PERSIST = 4
 
 
 def _persists(x: np.ndarray, k: int, floor: float) -> bool:
-    """Whether the jump of step `k` (from sample k to k + 1) is still larger than `floor` between the samples
-    :data:`PERSIST` before and after it (undefined there: kept), less the change the signal's slope on either side
-    (over the :data:`PERSIST` samples beyond them, where defined) predicts across them: the curvature rate of a
-    parabola driven from a 0.5 s ramp changed by 0.03 1/(m s) over those samples, its own steady slope, and the
-    ringing of the ramp's end between them was a 'curvature-rate jump'."""
+    """Whether the jump of step `k` (from sample k to k + 1) is still larger than `floor` across the samples
+    :data:`PERSIST` before and after it, less its slope's change (:func:`_held`; undefined there: kept): the
+    curvature rate of a parabola driven from a 0.5 s ramp changed by 0.03 1/(m s) over those samples, its own steady
+    slope, and the ringing of the ramp's end between them was a 'curvature-rate jump'."""
+    return not abs(_held(x, k, k)) <= floor
+
+
+def _held(x: np.ndarray, first: int, last: int) -> float:
+    """The change of `x` from :data:`PERSIST` samples before step `first` to as many after step `last` (clipped to
+    the signal), less the change the signal's slope on either side (over the :data:`PERSIST` samples beyond them,
+    where defined) predicts across them: the step of a signal with a steady slope, which finite differences spread
+    over several samples (NaN: undefined at either end)."""
     n = len(x)
-    lo, hi = max(k - PERSIST, 0), min(k + 1 + PERSIST, n - 1)
-    before, after = x[lo], x[hi]
-    if not (np.isfinite(before) and np.isfinite(after)):
-        return True
+    lo, hi = max(first - PERSIST, 0), min(last + 1 + PERSIST, n - 1)
     slopes = [(x[a] - x[b]) / (a - b) for a, b in ((lo, lo - PERSIST), (hi + PERSIST, hi)) if 0 <= b and a < n]
     slopes = [s for s in slopes if np.isfinite(s)]
     trend = float(np.mean(slopes)) * (hi - lo) if slopes else 0.0
-    return abs(float(after - before) - trend) > floor
+    return float(x[hi] - x[lo]) - trend
 
 
 #: The signal each one is a derivative of (the tangent: of the position's direction). A sampled step of a signal is a
