@@ -84,14 +84,16 @@ class Classification:
 
 
 def instantaneous_mobility(robot: Robot, beta: ArrayLike | None = None, *,
-                           heading: ArrayLike | None = None) -> np.ndarray:
+                           heading: ArrayLike | None = None, geared: bool = False) -> np.ndarray:
     """Degrees of freedom of the twist, ``3 - rank K_r*(beta)`` (5.13). ``(..., n_steer) -> (...)``; steering
-    `beta` (thesis) or `heading` (0 = rolling forward), default as described.
+    `beta` (thesis) or `heading` (0 = rolling forward), default as described. `geared`: with the robot's ``gear``
+    couplings held (the lines they add, as :func:`.icr.icr` holds them), the twists the mechanism allows.
 
-    Equals ``k - rank A`` (6.8) for robots whose wheel rates are all fixed by the twist (all but double wheels).
+    Equals ``k - rank A`` (6.8) for robots whose wheel rates are all fixed by the twist (all but double wheels:
+    their joints also move with the body at rest, which this m does not count).
     """
     beta = configuration(robot, beta, heading)
-    cl = constraint_lines(robot)
+    cl = constraint_lines(robot, coupled=geared and any(c.kind == "gear" for c in robot.couplings))
     if not cl.labels:
         return np.full(beta.shape[:-1], 3)
     g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / _size(robot)])

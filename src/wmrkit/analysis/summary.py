@@ -44,8 +44,9 @@ class Analysis:
     characteristic_length: float
     natural: bool  # the length is the natural one (not given)
     singular: dict[str, SingularSet]  # "actuated", "sensed"
-    #: m at the described steering with the motions a gear coupling forbids removed (the actuation and sensing
-    #: verdicts' m, as fk and odometry use a gear); the type line's m is the thesis's, of the wheels alone
+    #: the twist's m at the described steering with the motions a gear coupling forbids removed (as fk and odometry
+    #: use a gear), comparable with the type line's m, the thesis's, of the wheels alone: the verdicts' k - rank A
+    #: also counts the motions of a double wheel's joints with the body at rest
     coupled_mobility: int
 
     def to_dict(self) -> dict[str, Any]:
@@ -246,5 +247,5 @@ def described_analysis(robot: Robot, *, length: float | None = None) -> Analysis
         {"consistent": bool(np.all(act.consistent)), "sufficient": bool(np.all(act.sufficient)),
          "verdict": str(act.verdict)},
         {"sufficient": bool(np.all(sen.sufficient)), "verdict": str(sen.verdict)},
-        joints, kappa, d, length is None, {}, int(act.mobility),
+        joints, kappa, d, length is None, {}, int(instantaneous_mobility(robot, geared=True)),
     )
