@@ -8,6 +8,7 @@ explains them and the slip they leave. ``docs/wheel-ik.md`` states the policies 
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -347,7 +348,8 @@ def forward_kinematics_check(
 ) -> ForwardKinematics:
     """:func:`forward_kinematics` for one sample, with the slip split by wheel and judged against a tolerance.
 
-    The tolerance is `rtol` times the fastest given wheel surface speed ``|r phi_dot|`` (or speed) plus 1e-9 m/s:
+    The tolerance is `rtol` times the fastest speed a given rate stands for (:func:`_speed_per_rate`: a spin's
+    ``|r phi_dot|``, a steering rate's contact speed) plus 1e-9 m/s:
     rates that contradict each other beyond it (slip larger than measurement noise) are not ``consistent``, nor are
     given joints of a ``gear`` out of its ratios beyond round-off (:data:`wmrkit.couplings.GEAR_EXACT_RTOL`): each
     such gear is named in ``out_of_gear``, with a :class:`~wmrkit.couplings.GearWarning`.
@@ -359,7 +361,7 @@ def forward_kinematics_check(
     q_dot, slip = geared_solve(a, robot.couplings, robot.velocity_names, columns, q_assigned)
     owner = robot.row_wheels
     wheel_slip = np.sqrt(np.bincount(owner, weights=slip**2, minlength=len(robot.wheels)))
-    speeds = [abs(v) * (robot.wheel(n.partition(".")[0]).r if "." in n and not n.endswith(".steer") else 1.0)
+    speeds = [abs(v) * _speed_per_rate(robot, n)
               for n, v in zip((robot.velocity_names[c] for c in columns), q_assigned, strict=True)]
     tolerance = rtol * max(speeds, default=0.0) + 1e-9
     residual = float(np.linalg.norm(slip))
@@ -371,6 +373,17 @@ def forward_kinematics_check(
     consistent = bool(residual <= tolerance) and not breaches
     return ForwardKinematics(_ro(q_dot[:3]), residual, _ro(wheel_slip), tolerance, consistent, slipping,
                              tuple(b.coupling.channel_name for b in breaches))
+
+
+def _speed_per_rate(robot: Robot, name: str) -> float:
+    """The contact speed [m/s] one unit of the velocity `name` stands for: a spin's ``r``; a steering rate's lever
+    from the steering axis to the contact points, ``hypot(d, b)`` (a castor's offset, a double wheel's half
+    spacing: not 1 m, which read 1 rad/s of a castor with d = 0.04 m as 1 m/s); 1 for vx, vy and omega."""
+    wheel, _, joint = name.partition(".")
+    if not joint:
+        return 1.0
+    w = robot.wheel(wheel)
+    return math.hypot(w.d, w.b) if joint == "steer" else w.r
 
 
 def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: ArrayLike | None = None, *,
