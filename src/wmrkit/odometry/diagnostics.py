@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.singularity import robot_size
 from ..couplings import GEAR_BREACH_RTOL, gear_breaches
 from .logs import JointLog, LogError, LogFormat
 from .model import OdometryModel, wheel_slip
@@ -88,7 +89,8 @@ def diagnose(summary: OdometrySummary, model: OdometryModel, read: Callable[[], 
     external heading is checked), None for a bag. `filtered`: the Kalman filter that ran (fk1, fk2), whose slip
     indicator is its residual (:func:`slip_warning`)."""
     first = functools.cache(read)
-    said = [slip_warning(summary, lambda: wheel_slip(model, first().positions), filtered=filtered)]
+    said = [slip_warning(summary, lambda: wheel_slip(model, first().positions), filtered=filtered,
+                         length=robot_size(model.robot))]
     if fmt is not None and (fmt.heading_column or fmt.gyro_column):
         said.append(heading_warning(fmt, model, first()))
     said += gear_warnings(model, first)
@@ -98,14 +100,15 @@ def diagnose(summary: OdometrySummary, model: OdometryModel, read: Callable[[], 
 
 
 def slip_warning(s: OdometrySummary, wheel_slips: Callable[[], dict[str, float]], *,
-                 filtered: str | None = None) -> str | None:
+                 filtered: str | None = None, length: float = 0.0) -> str | None:
     """The line when the slip indicator exceeds the tolerance (:data:`LOG_SLIP_RTOL` of the mean motion per
-    interval), naming the wheels that slip most (`wheel_slips()`, RMS per wheel of the no-slip model); None within
-    it. A slip indicator as large as the motion itself means units, signs or the description are wrong. A Kalman
-    filter's indicator (`filtered`: its name) is its residual, which also holds its lag behind the measurements:
-    where the no-slip model's own slips stay within the tolerance, the line says the log changes faster than the
-    filter expects, not that the joints contradict each other."""
-    motion = s.path_length / max(s.samples - 1, 1)
+    interval: the path length plus the rotation at `length` [m], the wheels' distance from the origin, so that a
+    turn on the spot has its wheels' motion, not none), naming the wheels that slip most (`wheel_slips()`, RMS per
+    wheel of the no-slip model); None within it. A slip indicator as large as the motion itself means units, signs
+    or the description are wrong. A Kalman filter's indicator (`filtered`: its name) is its residual, which also
+    holds its lag behind the measurements: where the no-slip model's own slips stay within the tolerance, the line
+    says the log changes faster than the filter expects, not that the joints contradict each other."""
+    motion = (s.path_length + s.rotation * length) / max(s.samples - 1, 1)
     tolerance = LOG_SLIP_RTOL * motion + 1e-9
     if s.rms_slip <= tolerance:
         return None
