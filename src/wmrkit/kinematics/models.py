@@ -308,6 +308,15 @@ def direct_model(
     return kinematic_model(robot, choice, beta)
 
 
+def _free_steering(robot: Robot) -> tuple[str, ...]:
+    """``robot.free_steering`` with one steering rate per ``gear`` turning several of them (its turn, one input)."""
+    free = robot.free_steering
+    for c in (c for c in robot.couplings if c.kind == "gear"):
+        tied = [j for j in c.joints if j in free]
+        free = tuple(j for j in free if j not in tied[1:])
+    return free
+
+
 def inverse_model(
     robot: Robot, twist_names: Sequence[str] | None = None, beta: ArrayLike | None = None, *,
     heading: ArrayLike | None = None,
@@ -321,16 +330,18 @@ def inverse_model(
     if twist_names is not None:
         return kinematic_model(robot, twist_names, beta)
     a = constraints(robot, beta)
-    free = robot.free_steering  # double wheels' steering rates: no twist determines them, always assigned
+    free = _free_steering(robot)  # double wheels' steering rates: no twist determines them, always assigned
     m = int(np.max(a.shape[-1] - matrix_rank(a))) - len(free)
     if free:
         fixed = [robot.velocity_index(n) for n in free]
-        choice = next((c + free for c in itertools.combinations(TWIST_NAMES, m) if 0 < m <= 3 and ranks_assignable(
+        combinations = itertools.combinations(TWIST_NAMES, m) if 0 < m <= 3 else ()  # gears can leave m <= 0
+        choice = next((c + free for c in combinations if ranks_assignable(
             a, [[robot.velocity_index(n) for n in c] + fixed]).all()), None)
         note = ""
     else:
         choice, note = _first_assignable(robot, a, TWIST_NAMES, m)
     if choice is None:
         also = f" with {', '.join(free)}" if free else ""
-        raise _none_assignable(robot, f"{m} of (vx, vy, omega){also}", beta, note)
+        count = f"{m} of" if m > 0 else "set of"  # the gears may leave no twist beside the free steering rates
+        raise _none_assignable(robot, f"{count} (vx, vy, omega){also}", beta, note)
     return kinematic_model(robot, choice, beta)
