@@ -4,9 +4,14 @@
 ``cart_yaml(ratio, front)``: two fixed wheels (r 0.075 m, half track 0.2 m) whose spins a ``gear`` turns at ratios
 ``1 : ratio``, one encoder on ``left.spin``, and a front or rear wheel (:data:`CASTOR` by default, or
 :data:`STEERED`). ``SYNCHRO``: three steered wheels, their spins on one gear, their steering on one linkage.
+:func:`held_constraints`: the no-slip rows with every gear's rows, built here (the tests' brute force).
 """
 
 from __future__ import annotations
+
+import numpy as np
+
+from wmrkit import Robot
 
 R, B = 0.075, 0.2  # the cart's wheel radius and half track [m]
 CASTOR = "caster, type: castor, position: [-0.25, 0], heading: 0, d: 0.04, r: 0.025}"
@@ -41,3 +46,16 @@ def cart_yaml(ratio: float = 1.0, front: str = CASTOR) -> str:
     """The solid-axle cart's description, its gear at ``1 : ratio``, with `front` (:data:`CASTOR`, :data:`STEERED`,
     or another wheel's fields after ``name:``)."""
     return _CART.replace("FRONT", front).replace("RATIO", repr(float(ratio)))
+
+
+def held_constraints(robot: Robot, beta: np.ndarray | None = None) -> np.ndarray:
+    """The slip matrix (3.22) of `robot` at `beta` with a row ``q_0 / k_0 - q_j / k_j = 0`` per further joint of each
+    ``gear`` coupling (``q_j = k_j u``), built here by hand: the brute force the coupling tests check against."""
+    a = robot.constraint_matrix() if beta is None else robot.constraint_matrix(beta)
+    rows = [a]
+    for c in (c for c in robot.couplings if c.kind == "gear"):
+        for j, k in zip(c.joints[1:], c.ratios[1:], strict=True):
+            row = np.zeros(a.shape[1])
+            row[robot.velocity_index(c.joints[0])], row[robot.velocity_index(j)] = 1 / c.ratios[0], -1 / k
+            rows.append(row[None])
+    return np.vstack(rows)

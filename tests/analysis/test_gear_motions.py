@@ -12,7 +12,7 @@ import pytest
 from test_gear_icr import off
 from test_gear_isotropy import omni
 
-from geared import STEERED, SYNCHRO, cart_yaml
+from geared import STEERED, SYNCHRO, cart_yaml, held_constraints
 from wmrkit import Robot
 from wmrkit.analysis.classification import classify
 from wmrkit.analysis.figures import motions_figure, sample_icrs
@@ -21,15 +21,7 @@ from wmrkit.analysis.icr import steer_to_icr, twist_of_icr
 
 def admitted(robot: Robot, beta: np.ndarray) -> np.ndarray:
     """An orthonormal basis (rows) of the twists (vx, vy, omega) the wheels admit at `beta` with every gear held."""
-    rows = [robot.constraint_matrix(beta)]
-    for c in robot.couplings:
-        if c.kind == "gear":
-            for i in range(1, len(c.joints)):
-                row = np.zeros(rows[0].shape[1])
-                row[robot.velocity_index(c.joints[0])] = 1 / c.ratios[0]
-                row[robot.velocity_index(c.joints[i])] = -1 / c.ratios[i]
-                rows.append(row[None])
-    a = np.vstack(rows)
+    a = held_constraints(robot, beta)
     _, s, vh = np.linalg.svd(a)
     kernel = vh[int(np.sum(s > 1e-10 * s[0])):]
     _, s2, vt = np.linalg.svd(kernel[:, :3])

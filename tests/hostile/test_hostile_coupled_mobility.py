@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
+from geared import held_constraints
 from wmrkit import Robot
 from wmrkit.cli.main import main
 
@@ -24,15 +25,7 @@ _GEAR = "couplings:\n  - {kind: gear, joints: [d1.spin1, d1.spin2], ratios: [1, 
 def _twist_mobility(robot: Robot) -> int:
     """Brute force: the rank of the twist part of the null space of (3.22) with a row q_i / k_i - q_0 / k_0 = 0 per
     further joint of each gear."""
-    a = robot.constraint_matrix()
-    rows = []
-    for c in (c for c in robot.couplings if c.kind == "gear"):
-        for j, k in zip(c.joints[1:], c.ratios[1:], strict=True):
-            row = np.zeros(a.shape[1])
-            row[robot.velocity_index(c.joints[0])], row[robot.velocity_index(j)] = 1 / c.ratios[0], -1 / k
-            rows.append(row)
-    full = np.vstack([a, *rows]) if rows else a
-    basis = scipy.linalg.null_space(full)
+    basis = scipy.linalg.null_space(held_constraints(robot))
     return int(np.linalg.matrix_rank(basis[:3], tol=1e-9)) if basis.size else 0
 
 

@@ -9,21 +9,14 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from geared import cart_yaml
+from geared import cart_yaml, held_constraints
 from wmrkit import Robot
 from wmrkit.cli.main import main
 
 
 def _motions(robot: Robot) -> np.ndarray:
-    """Brute force: the no-slip motions, the null space of (3.22) with the gear rows q_j / k_j - q_0 / k_0 = 0."""
-    a = robot.constraint_matrix()
-    rows = []
-    for c in (c for c in robot.couplings if c.kind == "gear"):
-        for j, k in zip(c.joints[1:], c.ratios[1:], strict=True):
-            row = np.zeros(a.shape[1])
-            row[robot.velocity_index(c.joints[0])], row[robot.velocity_index(j)] = 1 / c.ratios[0], -1 / k
-            rows.append(row)
-    return scipy.linalg.null_space(np.vstack([a, *rows]))
+    """Brute force: the no-slip motions, the null space of (3.22) with the gear rows."""
+    return scipy.linalg.null_space(held_constraints(robot))
 
 
 @pytest.mark.parametrize("steer", [1.0, -0.5, 3.0])

@@ -8,6 +8,7 @@ import json
 import numpy as np
 import scipy.linalg
 
+from geared import held_constraints
 from wmrkit import Robot
 from wmrkit.cli.main import main
 
@@ -20,23 +21,13 @@ couplings:
 """
 
 
-def _held(robot: Robot) -> np.ndarray:
-    """(3.22) with the gear rows q_j / k_j - q_0 / k_0 = 0 (brute force)."""
-    a = robot.constraint_matrix()
-    rows = []
-    for c in (c for c in robot.couplings if c.kind == "gear"):
-        for j, k in zip(c.joints[1:], c.ratios[1:], strict=True):
-            row = np.zeros(a.shape[1])
-            row[robot.velocity_index(c.joints[0])], row[robot.velocity_index(j)] = 1 / c.ratios[0], -1 / k
-            rows.append(row)
-    return np.vstack([a, *rows])
 
 
 def test_geared_steering_of_double_wheels_is_one_input_of_the_inverse_model(tmp_path, capsys):
     path = tmp_path / "dbl.yaml"
     path.write_text(_TWO)
     robot = Robot.from_file(path)
-    held = _held(robot)
+    held = held_constraints(robot)
     assert scipy.linalg.null_space(held).shape[1] == 2  # a translation along x and the geared steering
     assert main(["kinematics", str(path), "--json"]) == 0
     model = json.loads(capsys.readouterr().out)["inverse_model"]
@@ -52,7 +43,7 @@ def test_a_gear_leaving_no_twist_beside_the_steering_is_refused_in_words(tmp_pat
     path = tmp_path / "dbl.yaml"
     path.write_text(_TWO + "  - {kind: gear, joints: [d1.spin1, d1.spin2], ratios: [1, -1]}\n")  # d1 turns on the spot
     robot = Robot.from_file(path)
-    motions = scipy.linalg.null_space(_held(robot))
+    motions = scipy.linalg.null_space(held_constraints(robot))
     assert motions.shape[1] == 1 and np.abs(motions[:3]).max() < 1e-12  # only the steering, the body at rest
     for extra in ([], ["--codegen", "python", str(tmp_path / "gen")]):
         assert main(["kinematics", str(path), "--json", *extra]) == 0  # was a traceback

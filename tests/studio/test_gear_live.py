@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from geared import held_constraints
 from wmrkit import catalog
 from wmrkit.analysis.summary import analyze
 from wmrkit.description import robot_from_dict
@@ -26,16 +27,9 @@ def geared(name: str, joints: list[str], ratios: list[float], actuated: dict[str
 
 
 def geared_kernel(robot: Robot, beta: np.ndarray) -> np.ndarray:
-    """The (twist, joint rates) the robot with its first coupling (a gear) admits at `beta`, one per row: the
-    kernel of the no-slip rows (3.22) plus the gear's rows, by an SVD done here."""
-    a = robot.constraint_matrix(beta)
-    c = robot.couplings[0]
-    gear = np.zeros(a.shape[1])
-    for j, k in zip(c.joints, c.ratios, strict=True):  # q_j = k_j u: q_0 / k_0 - q_j / k_j = 0
-        if j != c.joints[0]:
-            row = gear.copy()
-            row[robot.velocity_index(c.joints[0])], row[robot.velocity_index(j)] = 1 / c.ratios[0], -1 / k
-            a = np.vstack([a, row])
+    """The (twist, joint rates) the robot with its gear admits at `beta`, one per row: the kernel of the no-slip
+    rows (3.22) plus the gear's rows, by an SVD done here."""
+    a = held_constraints(robot, beta)
     _, s, vh = np.linalg.svd(a)
     return vh[int(np.sum(s > 1e-10 * s[0])):]
 
