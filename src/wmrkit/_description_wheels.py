@@ -40,6 +40,21 @@ MECANUM_GAMMA = math.pi / 4
 WHEEL_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
 
 
+def kind_of_type(type_name: str) -> str:
+    """The wheel kind a description type reads as: ``mecanum`` is a ``swedish`` wheel."""
+    return "swedish" if type_name == "mecanum" else type_name
+
+
+def accepted_fields(type_name: str) -> tuple[str, ...]:
+    """The fields a wheel of description type `type_name` may have, by the rules :func:`_wheel_from_dict` reads it
+    with: the common ones (``mass`` for castor units only, ``steer_range`` where it steers) and its kind's geometry
+    (``inertia`` takes the joints of :func:`wmrkit.dynamics.mass.inertia_joints`)."""
+    kind = KINDS[kind_of_type(type_name)]
+    common = tuple(f for f in COMMON_WHEEL_FIELDS
+                   if (f != "mass" or kind.name in mass.CASTOR_TYPES) and (f != "steer_range" or kind.steers))
+    return common + kind.required + tuple(kind.optional)
+
+
 def _wheel_from_dict(item: Any, check: FieldReader, loc: Loc, kind_name: str | None = None) -> Wheel:
     """The wheel `item`; `kind_name`: the wheel kind of its type (``swedish`` for ``type: mecanum``, which the
     messages keep saying)."""

@@ -19,6 +19,8 @@ from ._description_wheels import (  # noqa: F401  (the wheel entries' names are 
     WHEEL_TYPES,
     DescriptionWarning,
     _wheel_from_dict,
+    accepted_fields,
+    kind_of_type,
 )
 from ._description_writer import HEADING_SPREAD, described_type, robot_to_dict  # noqa: F401  (re-exported)
 from .couplings import COUPLING_KINDS, Coupling, joint_problem

@@ -491,6 +491,37 @@ def test_meta_and_catalog(client):
     assert client.post("/api/open", json={"catalog": "swerv-4"}).status_code == 400
 
 
+#: A valid value of each wheel field that not every type takes (the joints: the type's first one).
+FIELD_SAMPLES = {"d": 0.04, "b": 0.08, "r": 0.05, "r_r": 0.01, "gamma": math.pi / 4, "delta": 0.01, "mass": 1.0,
+                 "tyre": "linear", "steer_range": [-1.0, 1.0], "slip": {"lateral": 1, "longitudinal": 0.5}}
+
+
+def test_meta_kinds_say_which_fields_each_type_takes_as_the_reader_does(client):
+    """A retype in the page dropped inertia, mass, tyre and slip even where the new type takes them: /api/meta
+    said no more than each type's geometry. Each type's `fields` and `inertia` (the joints its inertia takes) are
+    checked by brute force against robot_from_dict: a one-wheel robot of that type with just that field added
+    reads, or is refused on that very field."""
+    kinds = client.get("/api/meta").json()["kinds"]
+    place = {"name", "type", "position", "l", "alpha", "heading", "beta"}  # every type: the retype writes them
+    for type_name, kind in kinds.items():
+        assert place <= set(kind["fields"]), type_name
+        base = {"name": "w", "type": type_name, "position": [0.3, 0.2], "heading": 0.0}
+        base |= {f: FIELD_SAMPLES[f] for f in kind["required"] if f != "beta"}
+        samples = FIELD_SAMPLES | {"actuated": [kind["joints"][0]], "sensed": [kind["joints"][0]]}
+        tries = [(f, {f: v}) for f, v in samples.items()]
+        tries += [(f"inertia.{j}", {"inertia": {j: 0.1}}) for j in ("spin", "steer", "roller")]
+        for name, extra in tries:
+            field = name.split(".")[0]
+            try:
+                robot_from_dict({"name": "one", "wheels": [base | extra]})
+                taken = True
+            except DescriptionError as err:
+                assert err.loc[:3] == ("wheels", 0, field), (type_name, name, err)
+                taken = False
+            said = name.split(".")[1] in kind["inertia"] if "." in name else field in kind["fields"]
+            assert said == taken, (type_name, name, taken)
+
+
 def test_meta_reads_the_start_file_as_it_is_now(tmp_path):
     """`wmrkit studio mine.yaml`, the file then edited on disk: reloading the page showed the robot read at start
     (r 0.05 m where the file said 0.07 m), and Save, once confirmed, wrote that stale robot over the edit. Now

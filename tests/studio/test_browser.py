@@ -1074,7 +1074,8 @@ def test_steer_range_is_shown_edited_validated_kept_and_saved(page, server):
     pg.select_option('#wheel-fields [data-field="type"]', "castor")  # steers: the range stays
     settle(pg)
     assert page_robot(pg).wheel("front_left").steer_range == pytest.approx((math.radians(-30), math.radians(45)))
-    assert pg.locator('#wheel-fields [data-note="type"]').count() == 0  # nothing dropped, nothing said
+    assert pg.inner_text('#wheel-fields [data-note="type"]') == (  # no field dropped; its steer is a rate now
+        "retyped to castor: removed the linkage coupling (front_left.steer, front_right.steer)")
     pg.select_option('#wheel-fields [data-field="type"]', "fixed")  # does not steer: dropped, and said so
     settle(pg)
     assert page_robot(pg).wheel("front_left").steer_range is None
@@ -1111,4 +1112,58 @@ def test_drive_table_shows_castor_steer_rates(page):
     assert pg.locator('#commands tr[data-wheel="left"] td').nth(3).inner_text() == "–"
     pg.evaluate("setTwist([0, 0, 0])")
     settle(pg)
+    assert not pg.errors
+
+
+def test_retype_keeps_what_the_new_type_takes_and_names_what_it_drops(page, server):
+    """Changing a wheel's type dropped its inertia, tyre and slip (and a castor's mass) even where the new type
+    takes them, and removed the Ackermann linkage without a word. The expected robots are the description edited
+    by hand (the new type, its default, the fields it cannot take and the coupling removed): the page's equals
+    them, the note names exactly what went, and Save then Open gives the same robot."""
+    pg = page
+    _, root = server
+    extras = {"inertia": {"spin": 0.05, "steer": 0.2}, "tyre": "linear", "slip": {"lateral": 1, "longitudinal": 0.5}}
+    car = catalog.load("ackermann").to_dict()
+    car["wheels"][2] |= extras
+    open_file(pg, root, "car.json", car)
+    note = '#wheel-fields [data-note="type"]'
+    pg.click('[data-wheel="front_left"]')
+    pg.select_option('#wheel-fields [data-field="type"]', "castor")  # takes every field; its steer is a rate
+    settle(pg)
+    car["wheels"][2] |= {"type": "castor", "d": 0.04}
+    car["couplings"] = [c for c in car["couplings"] if c["kind"] != "linkage"]
+    assert page_robot(pg) == robot_from_dict(car)
+    assert pg.inner_text(note) == ("retyped to castor: removed the linkage coupling "
+                                   "(front_left.steer, front_right.steer)")
+    pg.select_option('#wheel-fields [data-field="type"]', "fixed")
+    settle(pg)
+    fixed = car["wheels"][2]
+    for field in ("d", "steer_range", "actuated"):
+        del fixed[field]
+    fixed |= {"type": "fixed", "inertia": {"spin": 0.05}, "sensed": ["spin"]}
+    assert page_robot(pg) == robot_from_dict(car)
+    assert pg.inner_text(note) == ("retyped to fixed: dropped d, steer_range [-40 deg, 40 deg] (a fixed wheel does not "
+                                   "steer), inertia steer, actuated steer, sensed steer")
+    edited = page_robot(pg)
+    pg.fill("#save-path", "retyped.yaml")
+    pg.click("#save")
+    pg.wait_for_function("() => document.getElementById('status').textContent.startsWith('saved')")
+    assert Robot.from_file(root / "retyped.yaml") == edited
+    pg.select_option("#catalog", "")
+    pg.select_option("#files", "retyped.yaml")
+    pg.click("#open")
+    settle(pg)
+    assert page_robot(pg) == edited  # round trip: the same robot, its tyre and slip included
+    assert edited.wheel("front_left").tyre is not None and edited.odometry is not None
+
+    castors = catalog.load("thesis-omni-castor").to_dict()
+    castors["wheels"][0] |= extras | {"mass": 1.5}
+    open_file(pg, root, "castors.json", castors)
+    pg.click('[data-wheel="c1"]')
+    pg.select_option('#wheel-fields [data-field="type"]', "steerable")  # mass: castor units only
+    settle(pg)
+    castors["wheels"][0] = {k: v for k, v in castors["wheels"][0].items() if k not in ("d", "delta", "mass")}
+    castors["wheels"][0]["type"] = "steerable"
+    assert page_robot(pg) == robot_from_dict(castors)
+    assert pg.inner_text(note) == "retyped to steerable: dropped d, delta, mass"
     assert not pg.errors

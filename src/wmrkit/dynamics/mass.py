@@ -100,16 +100,12 @@ def body_to_dict(body: Body | None) -> dict[str, Any]:
 
 def wheel_dynamics_from_dict(item: Mapping[str, Any], check: Any, loc: tuple, type_name: str) -> dict[str, Any]:
     """The Wheel fields ``spin_inertia, steer_inertia, roller_inertia, mass, tyre`` given in a wheel mapping."""
-    from ..wheels import KINDS
-
-    kind, out = KINDS[type_name], {}
+    out: dict[str, Any] = {}
     if "inertia" in item:
         inertia = item["inertia"]
         if not isinstance(inertia, Mapping) or not inertia:
             check.fail("must be a mapping of joint inertias [kg m^2], e.g. {spin: 1.0, steer: 0.8}", (*loc, "inertia"))
-        joints = tuple(j for j in INERTIA_JOINTS if j in kind.rates or any(r.startswith(j) for r in kind.rates)
-                       or (j == "steer" and kind.steers))
-        check.reject_unknown(inertia, joints, (*loc, "inertia"))
+        check.reject_unknown(inertia, inertia_joints(type_name), (*loc, "inertia"))
         for joint in inertia:
             value = check.quantity(inertia[joint], "number", (*loc, "inertia", joint))
             if value < 0:
@@ -125,6 +121,16 @@ def wheel_dynamics_from_dict(item: Mapping[str, Any], check: Any, loc: tuple, ty
     if "tyre" in item:
         out["tyre"] = tyre_from_dict(item["tyre"], check, (*loc, "tyre"))
     return out
+
+
+def inertia_joints(type_name: str) -> tuple[str, ...]:
+    """The joints whose ``inertia`` a wheel kind's description takes: those among its rates (``spin1``, ``spin2``:
+    ``spin``) and ``steer`` where it steers."""
+    from ..wheels import KINDS
+
+    kind = KINDS[type_name]
+    return tuple(j for j in INERTIA_JOINTS if j in kind.rates or any(r.startswith(j) for r in kind.rates)
+                 or (j == "steer" and kind.steers))
 
 
 def tyre_from_dict(item: Any, check: Any, loc: tuple) -> Tyre:

@@ -25,7 +25,8 @@ from ..analysis.isotropy import condition_map, described_condition
 from ..analysis.optimize import isotropic_configurations
 from ..analysis.singularity import SINGULAR_RTOL, robot_size, singularity_distance
 from ..analysis.summary import describe_singular, described_analysis, model_rates, model_singular_set, singular_dict
-from ..description import DescriptionWarning, robot_from_dict, robot_to_dict
+from ..description import DescriptionWarning, accepted_fields, kind_of_type, robot_from_dict, robot_to_dict
+from ..dynamics.mass import inertia_joints
 from ..errors import ShapeError, WmrkitError, said_warnings
 from ..kinematics.wheel_ik import wheel_commands
 from ..limits import MAX_QUERY_RATE
@@ -93,13 +94,17 @@ def geometry(robot: Robot) -> dict[str, Any]:
 
 def kinds() -> dict[str, Any]:
     """The wheel types a description may use: fields (required, optional with defaults), joints, whether they
-    steer, a summary. ``mecanum`` is a Swedish wheel whose ``gamma`` (from its quadrant) and ``r_r`` (``r / 4``)
-    are optional without a fixed default (null)."""
+    steer, a summary; ``fields``: every field the type takes and ``inertia``: the joints of its ``inertia`` (a
+    retype keeps those, :func:`wmrkit.description.accepted_fields`). ``mecanum`` is a Swedish wheel whose
+    ``gamma`` (from its quadrant) and ``r_r`` (``r / 4``) are optional without a fixed default (null)."""
     out = {k.name: {"required": list(k.required), "optional": dict(k.optional), "joints": list(k.joints),
                     "rates": list(k.rates), "steers": k.steers, "summary": k.summary} for k in KINDS.values()}
     out["mecanum"] = out["swedish"] | {
         "required": ["r"], "optional": {"gamma": None, "r_r": None},
         "summary": "Swedish wheel of the standard X layout: gamma +-45 deg from its quadrant, r_r = r / 4 unless given"}
+    for name, kind in out.items():
+        kind["fields"] = list(accepted_fields(name))
+        kind["inertia"] = list(inertia_joints(kind_of_type(name)))
     return out
 
 

@@ -113,9 +113,10 @@ function steeringHeadings(heading) {  // the driven headings of wheels that stil
 }
 // Couplings name joints 'wheel.joint': renaming a wheel rewrites them; deleting it, or a type without the joint
 // (or where it changes role: a linkage couples steering angles, the others rates), drops the joint from its
-// coupling, and the coupling when fewer than two joints remain.
+// coupling, and the coupling when fewer than two joints remain. Returns what it removed, for the retype's note.
 function rewriteCouplings(d, name, { rename = null, type = undefined } = {}) {
-  if (!Array.isArray(d.couplings)) return;
+  const removed = [];
+  if (!Array.isArray(d.couplings)) return removed;
   const kind = type === undefined ? undefined : type === null ? null : S.meta.kinds[type];
   d.couplings = d.couplings.filter((c) => {
     if (!c || !Array.isArray(c.joints)) return true;
@@ -133,12 +134,15 @@ function rewriteCouplings(d, name, { rename = null, type = undefined } = {}) {
       if (kind && kind.joints.includes(part) && angle === (c.kind === "linkage")) { joints.push(j); kept.push(i); }
     });
     if (!touched) return true;
-    if (joints.length < 2) return false;
+    const gone = c.joints.filter((j, i) => !kept.includes(i)), of = `the ${c.kind} coupling (${c.joints.join(", ")})`;
+    if (joints.length < 2) { removed.push(of); return false; }
+    if (gone.length) removed.push(`${gone.join(", ")} from ${of}`);
     c.joints = joints;
     if (ratios) c.ratios = kept.map((i) => ratios[i]);
     return true;
   });
   if (!d.couplings.length) delete d.couplings;
+  return removed;
 }
 function geometryOf(name) { return S.geometry && S.geometry.wheels.find((w) => w.name === name); }
 
@@ -361,19 +365,27 @@ function changeType(type) {
     const r = "r" in old ? old.r : 0.05;
     const defaults = { r, d: 0.04, b: 0.08, gamma: "90 deg", r_r: "10 mm", delta: 0 };
     for (const f of kind.required) if (f !== "beta") w[f] = f in old ? old[f] : defaults[f];
-    for (const f of Object.keys(kind.optional)) if (f !== "beta" && f in old) w[f] = old[f];
-    if (kind.steers && "steer_range" in old) w.steer_range = old.steer_range;  // headings: the same stops
-    const dropped = Object.keys(old).filter((f) => !(f in w) && !["beta", "l", "alpha", "heading", "actuated", "sensed"].includes(f))
-      .map((f) => (f === "steer_range" ? `steer_range [${shownRange(old[f])}] (a ${type} wheel does not steer)` : f));
+    const dropped = [];
+    for (const [f, v] of Object.entries(old)) {  // every other field the new type takes (/api/meta) is kept
+      if (f in w || ["beta", "l", "alpha", "heading", "actuated", "sensed"].includes(f)) continue;
+      if (!kind.fields.includes(f)) {
+        dropped.push(f === "steer_range" ? `steer_range [${shownRange(v)}] (a ${type} wheel does not steer)` : f);
+      } else if (f === "inertia" && v && typeof v === "object" && !Array.isArray(v)) {  // the joints it has
+        const keep = Object.keys(v).filter((j) => kind.inertia.includes(j));
+        if (keep.length) w.inertia = Object.fromEntries(keep.map((j) => [j, v[j]]));
+        dropped.push(...Object.keys(v).filter((j) => !keep.includes(j)).map((j) => `inertia ${j}`));
+      } else w[f] = v;  // steer_range: headings, the same stops
+    }
     for (const group of ["actuated", "sensed"]) {
       const had = old[group] === undefined ? [] : Array.isArray(old[group]) ? old[group] : [old[group]];
       const keep = had.filter((j) => kind.joints.includes(j));
       if (keep.length) w[group] = keep;
       dropped.push(...had.filter((j) => !keep.includes(j)).map((j) => `${group} ${j}`));
     }
-    if (dropped.length) S.notice = { name: old.name, index: i, text: `retyped to ${type}: dropped ${dropped.join(", ")}` };
     d.wheels[i] = w;
-    rewriteCouplings(d, name, { type });
+    const uncoupled = rewriteCouplings(d, name, { type });
+    const said = [dropped.length ? `dropped ${dropped.join(", ")}` : "", uncoupled.length ? `removed ${uncoupled.join(", ")}` : ""];
+    if (dropped.length || uncoupled.length) S.notice = { name: old.name, index: i, text: `retyped to ${type}: ${said.filter(Boolean).join("; ")}` };
   });
 }
 function addWheel() {
