@@ -109,6 +109,18 @@ def test_analyze_headings_and_geometry(client):
         assert angle_close(wheels[w.name]["heading"], 0.0)
 
 
+def test_geometry_gives_a_mecanum_wheels_gamma_from_its_quadrant(client):
+    """The page retyped a mecanum wheel to swedish with gamma 90 deg (an omni wheel): the gamma it was read with
+    came from its quadrant and was nowhere in the page. The geometry gives it: +-45 deg, the sign of x y
+    (docs/conventions.md), and r_r as written."""
+    d = desc("mecanum-4")
+    wheels = client.post("/api/analyze", json={"description": d}).json()["geometry"]["wheels"]
+    for w, given in zip(wheels, d["wheels"], strict=True):
+        x, y = given["position"]
+        assert w["fields"]["gamma"] == pytest.approx(math.copysign(math.pi / 4, x * y), abs=1e-15), w["name"]
+        assert w["fields"]["r_r"] == given["r_r"] and w["fields"]["r"] == given["r"]
+
+
 def test_heading_replaces_beta(client):
     d = desc("swerve-4")
     assert "beta" not in d["wheels"][0]  # descriptions are written with headings (to_dict)

@@ -1166,4 +1166,11 @@ def test_retype_keeps_what_the_new_type_takes_and_names_what_it_drops(page, serv
     castors["wheels"][0]["type"] = "steerable"
     assert page_robot(pg) == robot_from_dict(castors)
     assert pg.inner_text(note) == "retyped to steerable: dropped d, delta, mass"
+
+    open_catalog(pg, "mecanum-4")  # gamma from the quadrant: kept by a retype to swedish, as read (not 90 deg)
+    pg.click('[data-wheel="front_right"]')
+    pg.select_option('#wheel-fields [data-field="type"]', "swedish")
+    settle(pg)
+    assert page_robot(pg) == catalog.load("mecanum-4")  # the same wheels: mecanum is a swedish wheel
+    assert pg.evaluate("S.desc.wheels[1].type") == "swedish"
     assert not pg.errors

@@ -75,7 +75,8 @@ def description_of(robot: Robot) -> dict[str, Any]:
 
 
 def geometry(robot: Robot) -> dict[str, Any]:
-    """What the plan view draws, in robot coordinates [m] and radians: per wheel its joint, heading, elements."""
+    """What the plan view draws, in robot coordinates [m] and radians: per wheel its joint, heading, elements, and
+    ``fields``: its geometry as read (a mecanum wheel's gamma from its quadrant, r_r; a retype keeps them)."""
     from ..plotting.robot import element_geometry  # the drawing's own geometry (eq. 3.8), not re-derived here
 
     wheels = []
@@ -85,6 +86,7 @@ def geometry(robot: Robot) -> dict[str, Any]:
             "name": w.name, "type": w.type, "steers": w.kind.steers,
             "joint": [float(v) for v in els[0].joint], "heading": float(w.heading), "beta": w.beta,
             "actuated": list(w.actuated), "sensed": list(w.sensed),
+            "fields": {f: getattr(w, f) for f in (*w.kind.required, *w.kind.optional) if f != "beta"},
             "elements": [{"centre": [float(v) for v in e.centre], "axle": float(e.axle),
                           "roller": None if e.roller is None else float(e.roller), "r": float(e.r),
                           "spin_joint": e.spin_joint} for e in els],

@@ -364,7 +364,8 @@ function changeType(type) {
     w.heading = "heading" in old ? old.heading : (g ? g.heading : 0);
     const r = "r" in old ? old.r : 0.05;
     const defaults = { r, d: 0.04, b: 0.08, gamma: "90 deg", r_r: "10 mm", delta: 0 };
-    for (const f of kind.required) if (f !== "beta") w[f] = f in old ? old[f] : defaults[f];
+    const read = (g && g.fields) || {};  // as the server read it: a mecanum wheel's gamma from its quadrant
+    for (const f of kind.required) if (f !== "beta") w[f] = f in old ? old[f] : f in read ? read[f] : defaults[f];
     const dropped = [];
     for (const [f, v] of Object.entries(old)) {  // every other field the new type takes (/api/meta) is kept
       if (f in w || ["beta", "l", "alpha", "heading", "actuated", "sensed"].includes(f)) continue;
