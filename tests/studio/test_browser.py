@@ -499,6 +499,11 @@ def test_couplings_follow_renamed_deleted_retyped_wheels(page):
     settle(pg)
     assert pg.evaluate("S.error") is None and page_robot(pg).couplings == ()
     assert "couplings" not in pg.evaluate("S.desc")
+    # deleting it removed the linkage without a word (a retype says what it removes)
+    assert pg.inner_text('#wheel-fields [data-note="delete"]') == ("deleted front_right: removed the linkage coupling "
+                                                                   "(fl.steer, front_right.steer)")
+    pg.click('[data-wheel="fl"]')  # said once: the next selection shows the wheel
+    assert pg.locator('[data-note="delete"]').count() == 0
     assert not pg.errors
 
 

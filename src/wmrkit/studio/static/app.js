@@ -15,6 +15,7 @@ const S = {
   loadWarnings: [],  // the warnings of the file or catalog robot as read, shown until another is loaded or saved
   descWarnings: [],  // the warnings of the description analysed last (a mecanum wheel whose gamma is not +-45 deg)
   notice: null,  // {name, index, text}: what the last retype of that wheel dropped, shown under its type until an edit
+                //   (index -1: what deleting a wheel removed, shown where the wheel's panel was)
 };
 // Timings for the docs and the browser test: round trip edit -> numbers shown [ms], server time [ms].
 window.studioStats = { edits: [], server: [], rendered: 0 };
@@ -275,7 +276,14 @@ function renderWheelPanel() {
   const box = $("wheel-fields");
   const i = selectedIndex();
   $("wheel-title").textContent = i < 0 ? "" : S.selected;
-  if (i < 0) { box.innerHTML = '<p class="hint">click a wheel</p>'; return; }
+  if (i < 0) {
+    box.innerHTML = '<p class="hint">click a wheel</p>';
+    if (S.notice && S.notice.index < 0) {  // what deleting a wheel removed with it
+      const n = document.createElement("div"); n.className = "msg note"; n.dataset.note = "delete";
+      n.textContent = S.notice.text; box.appendChild(n);
+    }
+    return;
+  }
   const w = S.desc.wheels[i], g = geometryOf(w.name), kind = S.meta.kinds[w.type];
   box.innerHTML = "";
   const row = (label, field, value, title = "") => {
@@ -409,7 +417,8 @@ function deleteWheel() {
   if (i < 0) { S.selected = null; renderWheelPanel(); return; }
   commit((d) => {
     d.wheels.splice(i, 1);
-    rewriteCouplings(d, name, { type: null });
+    const uncoupled = rewriteCouplings(d, name, { type: null });
+    if (uncoupled.length) S.notice = { name: null, index: -1, text: `deleted ${name}: removed ${uncoupled.join(", ")}` };
   });
   S.selected = null; renderWheelPanel();
 }
