@@ -24,8 +24,8 @@ import numpy as np
 from ..wheels import wrap_angle
 from .points import ControlError, check_delay
 
-__all__ = ["KINDS", "GateWarning", "PositionLaw", "SamplingWarning", "check_gate", "check_sampling", "law_velocity",
-           "sampled_root"]
+__all__ = ["KINDS", "GateWarning", "PositionLaw", "SamplingWarning", "check_gate", "check_sampling", "fastest_pole",
+           "law_velocity", "sampled_root"]
 
 KINDS = ("point", "p", "pi")
 
@@ -89,6 +89,18 @@ def law_velocity(law: PositionLaw, pose_ref: np.ndarray, velocity_ref: np.ndarra
         out = out + ff * np.asarray(velocity_ref, dtype=float)
     if law.kind == "pi":
         out = out + np.asarray(law.b) * integral
+    return out
+
+
+def fastest_pole(law: PositionLaw) -> float:
+    """The largest modulus [1/s] of the continuous error dynamics' poles (8.5)/(8.6): ``a``, or under ``"pi"`` the
+    roots of ``s^2 + a s + b`` (computed without squaring ``a``: finite for any finite gains)."""
+    if law.kind != "pi":
+        return max(law.a)
+    out = 0.0
+    for a, b in zip(law.a, law.b, strict=True):
+        h, r = a / 2, math.sqrt(b)
+        out = max(out, h + math.sqrt(h - r) * math.sqrt(h + r) if r <= h else r)
     return out
 
 

@@ -67,6 +67,10 @@ def check_diverged(twist: np.ndarray, t: float) -> None:
 #: takes thousands), and at most this many seconds of computing (each evaluation costs 0.2 to 1 ms: the
 #: evaluation budget alone let a car with its steering at the ends of its range run for 6 minutes).
 MAX_EVALUATIONS, EVALUATIONS_PER_SECOND, MAX_CONTINUOUS_SECONDS = 20_000, 2_000, 120.0
+#: Fewest evaluations of the continuous loop per simulated second per 1/s of its fastest pole: RK45 (6 evaluations a
+#: step) is stable for steps up to about 3.3 / pole (4 at most off the real axis); measured 1.9 to 4.5 for Stanley
+#: gains and p-law poles of 300 to 3000 1/s.
+EVALUATIONS_PER_POLE = 1.5
 #: Most evaluations of a sampled loop: one a period for the ideal plant's exact step, one plus four per RK4 substep
 #: otherwise (castors, low-level loops). Each costs 0.5 to 1 ms (law, wheel IK, record), so 1e6 periods of a diff
 #: drive at 0.02 s (its RK4 step for the castor) ran for about an hour.
@@ -77,6 +81,24 @@ MAX_SAMPLED_EVALUATIONS = 100_000
 HOLD_MARGIN = math.radians(2.0)
 #: Bisections locating the instant a held wheel changes ends in the continuous loop (to 2**-40 of a step).
 SWITCH_BISECTIONS = 40
+
+
+def evaluation_budget(duration: float) -> int:
+    """The evaluations a continuous loop of `duration` [s] may make."""
+    return int(MAX_EVALUATIONS + EVALUATIONS_PER_SECOND * duration)
+
+
+def check_stiffness(pole: float, run: float, duration: float, what: str) -> None:
+    """Refuse up front a continuous loop whose error decays at `pole` [1/s] so fast that its explicit integrator
+    surely exhausts the :func:`evaluation_budget` of `duration` [s] in the `run` [s] it integrates (a Stanley gain of
+    1e308 crawled to the budget for 40 s); `what` names the gain and its value."""
+    budget = evaluation_budget(duration)
+    highest = budget / (EVALUATIONS_PER_POLE * run)
+    if pole > highest:
+        raise ControlError(f"{what}: the continuous loop's error decays at {pole:g} 1/s, and its explicit integrator "
+                           f"needs at least {EVALUATIONS_PER_POLE:g} evaluations per simulated second per 1/s of it "
+                           f"(its stable step): over {run:g} s at most {highest:.4g} 1/s fits its budget of {budget} "
+                           "evaluations; lower the gain, or give a sample period (--period)")
 
 
 def _too_stiff(controller: TwistController, sim: _Sim, t: float, x: np.ndarray, duration: float, evaluations: int,
@@ -300,7 +322,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
         if t_out[-1] < duration - 1e-9 or len(t_out) == 1:  # the last sample at the end of the run
             t_out = np.append(t_out, duration)
         edges = [0.0, *sorted(b for b in breaks if 0 < b < t_out[-1]), float(t_out[-1])]
-        allowed = int(MAX_EVALUATIONS + EVALUATIONS_PER_SECOND * duration)
+        allowed = evaluation_budget(duration)
         budget, start = [allowed], time.monotonic()
 
         def counted(t: float, x: np.ndarray) -> np.ndarray:

@@ -18,8 +18,8 @@ from ..wheels import heading_from_beta
 from .actuators import LowLevelLoops
 from .feasibility import BLOCK, Feasibility, feasibility
 from .follower_run import Limit, check_arrival, follower_bound, span
-from .laws import PositionLaw, check_gate, check_sampling
-from .loop import MAX_SAMPLED_EVALUATIONS, Plant, longest_sampled_run, simulate
+from .laws import PositionLaw, check_gate, check_sampling, fastest_pole
+from .loop import MAX_SAMPLED_EVALUATIONS, Plant, check_stiffness, longest_sampled_run, simulate
 from .points import (
     ControlError,
     ControlPoint,
@@ -235,12 +235,15 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         from .dynamic_plant import fast_law_controller
 
         ctrl, tracked_point = fast_law_controller(cp, law, reference), cp.point
+        pole, what = fastest_pole(law), f"gain (--gain) {gain:g} 1/s"
     elif controller == "pure-pursuit":
         ctrl, tracked_point = pure_pursuit(cp, reference, lookahead, max_curvature(robot)), cp.axle_point
+        pole, what = 0.0, ""
     else:
         length = default_wheelbase(cp)
         ctrl = stanley(cp, reference, stanley_gain, length, min(1.2, math.atan(length * max_curvature(robot))))
         tracked_point = cp.axle_point + length * np.array([math.cos(cp.forward), math.sin(cp.forward)])
+        pole, what = stanley_gain, f"stanley gain (--stanley-gain) {stanley_gain:g} 1/s"  # e' = -k e near the path
     stops = isinstance(ctrl, PathFollower) and not given_duration
     until = ctrl.stop_rule(None if sampled is None else delay) if stops else None
     if initial_pose is None and geometric:  # the tracker's own point starts on the reference, not the law's
@@ -282,6 +285,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         if period is None:
             _check_continuous_work(cp, reference, pose0, duration, output_dt,
                                    gain if controller in ("p", "pi", "point") else None)
+            if top_speed(reference) > 0:  # a follower stops at the path's end (at rest, errors may stay exactly 0)
+                check_stiffness(pole, min(duration, reference.duration) if stops else duration, duration, what)
         try:
             out = simulate(robot, ctrl, pose0, duration, period=period, delay=delay, plant=Plant(loops, policy),
                            output_dt=output_dt, skew_free=skew_free, breaks=reference.breaks,

@@ -1,0 +1,77 @@
+"""Sweep 8 of the chapter 7-9 doors (session 30): doors that answered slowly, silently wrongly or in a confusing
+line (`track` with a stiff gain, a camera file's focal length, `simulate --step`, the torque file's whole steps,
+`track --speed`, `calibrate` on a straight log); each now answers right or refuses in one located line, at once."""
+
+from __future__ import annotations
+
+import time
+import warnings
+
+import numpy as np
+import pytest
+
+from wmrkit.cli.main import main
+
+
+def _one_line_error(argv: list[str], capsys) -> str:
+    """Run `argv`: exit 2, nothing on stdout, one line on stderr (no Python warning before it); return it."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("wmrkit: error: ")
+    return err
+
+
+# 1. A gain so stiff the continuous loop's integrator surely exhausts its budget is judged before integrating.
+
+@pytest.mark.parametrize(("controller", "option", "gain"), [("stanley", "--stanley-gain", "1e308"),
+                                                            ("stanley", "--stanley-gain", "1e4"),
+                                                            ("p", "--gain", "1e4")])
+def test_track_refuses_a_stiff_gain_before_integrating(controller, option, gain, capsys, monkeypatch):
+    # --stanley-gain 1e308 computed for 40 s (83 s on a slow core) before "too stiff", not naming the gain; the
+    # budget of seconds is cut here so that, without the up-front judgement, the test fails in seconds, not minutes
+    from wmrkit.control import loop
+
+    monkeypatch.setattr(loop, "MAX_CONTINUOUS_SECONDS", 3.0)
+    start = time.process_time()
+    err = _one_line_error(["track", "diff-drive", "--reference", "circle", "--controller", controller, option, gain],
+                          capsys)
+    assert f"({option}) {float(gain):g} 1/s: the continuous loop's error decays at" in err
+    assert "lower the gain, or give a sample period (--period)" in err
+    assert time.process_time() - start < 2.0
+
+
+def test_the_stiffness_bound_is_below_the_evaluations_a_stiff_loop_takes(monkeypatch):
+    """The refusal's premise, measured: RK45 takes at least EVALUATIONS_PER_POLE evaluations per simulated second
+    per 1/s of the pole, for Stanley's cross-track gain and the p law's pole alike."""
+    from wmrkit import catalog
+    from wmrkit.control import builtin_reference, loop
+    from wmrkit.control.track import track
+
+    calls = [0]
+    integrate = loop._integrate
+
+    def counting(fun, *args, **kwargs):
+        def counted(t, x):
+            calls[0] += 1
+            return fun(t, x)
+        return integrate(counted, *args, **kwargs)
+
+    monkeypatch.setattr(loop, "_integrate", counting)
+    robot, reference = catalog.load("diff-drive"), builtin_reference("circle")
+    for controller, gains in (("stanley", {"stanley_gain": 400.0}), ("p", {"gain": 400.0})):
+        calls[0] = 0
+        track(robot, reference, controller=controller, duration=2.0, **gains)
+        assert calls[0] >= loop.EVALUATIONS_PER_POLE * 400.0 * 2.0, (controller, calls[0])
+
+
+def test_fastest_pole_of_the_pi_law_is_the_largest_root():
+    from wmrkit.control.laws import PositionLaw, fastest_pole
+
+    for a, b in ((10.0, 25.0), (10.0, 9.0), (2.0, 100.0), (1e200, 1e300), (3.0, 0.0)):
+        roots = np.roots([1.0, a / 1e100, b / 1e200]) * 1e100 if a > 1e100 else np.roots([1.0, a, b])
+        assert fastest_pole(PositionLaw.uniform("pi", a, b)) == pytest.approx(max(abs(roots)), rel=1e-9)
+    assert fastest_pole(PositionLaw.uniform("p", 7.0)) == 7.0
