@@ -4,6 +4,7 @@ line (`track` with a stiff gain, a camera file's focal length, `simulate --step`
 
 from __future__ import annotations
 
+import math
 import time
 import warnings
 
@@ -75,3 +76,24 @@ def test_fastest_pole_of_the_pi_law_is_the_largest_root():
         roots = np.roots([1.0, a / 1e100, b / 1e200]) * 1e100 if a > 1e100 else np.roots([1.0, a, b])
         assert fastest_pole(PositionLaw.uniform("pi", a, b)) == pytest.approx(max(abs(roots)), rel=1e-9)
     assert fastest_pole(PositionLaw.uniform("p", 7.0)) == 7.0
+
+
+# 2. A camera's focal length is bounded above, as it is below.
+
+def test_a_camera_file_with_an_impossible_focal_length_is_refused_naming_it(tmp_path, capsys):
+    # focal_px: 1e308 was accepted: `vision locate` answered from an image spanning 1e-305 rad, exit 0
+    camera = tmp_path / "camera.yaml"
+    camera.write_text("focal_px: 1e308\ntilt: 1.3264502315156905\nheight: 1.42\n")
+    err = _one_line_error(["vision", "locate", "--points", "docs/figures/vision/chufa-points.json", "--camera",
+                           str(camera), "--spacing", "60cm"], capsys)
+    assert str(camera) in err and "focal_px: out of range, got 1e+308 (expected a number in [1, 1e+07] px)" in err
+
+
+def test_calibrate_refuses_a_focal_length_no_camera_has(capsys):
+    # nearly parallel stripes on a 4096 px image printed 'focal = 83362280.31 px', exit 0
+    err = _one_line_error(["vision", "calibrate", "--x1", "2047", "--x2", "2046", "--rows", "2000",
+                           "--half-separation", "0.05", "--row-distance", "1", "--size", "4096", "4096"], capsys)
+    assert "focal length of 8.336e+07 px, above 1e+07 px" in err
+    # the same measurements' tilt (9.18) and focal length (9.21) in closed form: tan(phi) A (x1 + x2) / (x1 - x2)
+    cos_phi = 2000 * (0.05 / 1) * (1 / 2047 + 1 / 2046)
+    assert math.tan(math.acos(cos_phi)) * 2000 * 4093 == pytest.approx(8.336e7, rel=1e-3)

@@ -113,6 +113,7 @@ DOCUMENTED = [
     ("wmrkit.studio.files", "MAX_ENTRIES", "among at most 20,000 folder entries", 20_000),
     ("wmrkit.vision.camera", "MAX_PIXELS", "at most 4096 px a side (`vision.camera.MAX_PIXELS`)", 4096),
     ("wmrkit.vision.camera", "MIN_FOCAL_PX", "at least 1 px (`vision.camera.MIN_FOCAL_PX`", 1.0),
+    ("wmrkit.vision.camera", "MAX_FOCAL_PX", "at most 1e7 px (`vision.camera.MAX_FOCAL_PX`", 1e7),
     ("wmrkit.vision.calibration", "MIN_CONVERGENCE_PX", "at least 1 px (`vision.calibration.MIN_CONVERGENCE_PX`)",
      1.0),
     ("wmrkit.vision.positioning", "SPACING_TOLERANCE", "within 25 % of the spacing", 0.25),

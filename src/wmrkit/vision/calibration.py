@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..limits import MAX_SIZE, MIN_SIZE
-from .camera import MIN_FOCAL_PX, Camera, CameraError
+from .camera import MAX_FOCAL_PX, MIN_FOCAL_PX, Camera, CameraError
 
 __all__ = ["Calibration", "calibrate", "calibrate_image", "calibration_kernel"]
 
@@ -76,7 +76,7 @@ def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_d
 
     Raises :class:`CameraError` naming the measurement when they describe no camera (``x1 <= x2``, a tilt
     whose cosine is not in (0, 1), a height outside ``[MIN_SIZE, MAX_SIZE]`` of :mod:`wmrkit.limits`, a focal length
-    below :data:`.camera.MIN_FOCAL_PX`, rows A below :data:`MIN_ROWS_PX`).
+    outside :data:`.camera.MIN_FOCAL_PX` to :data:`.camera.MAX_FOCAL_PX`, rows A below :data:`MIN_ROWS_PX`).
     """
     for name, value in (("x1", x1), ("x2", x2), ("rows A", rows_a), ("half-separation", half_separation),
                         ("row distance", row_distance)):
@@ -98,6 +98,10 @@ def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_d
         raise CameraError(f"calibration: the measurements give a focal length of {focal:.4g} px, below "
                           f"{MIN_FOCAL_PX:g} px (no camera: see vision.camera.MIN_FOCAL_PX): check rows A, x1 and x2 "
                           "(pixels from the image's centre)")
+    if not focal <= MAX_FOCAL_PX:
+        raise CameraError(f"calibration: the measurements give a focal length of {focal:.4g} px, above "
+                          f"{MAX_FOCAL_PX:g} px (no camera: see vision.camera.MAX_FOCAL_PX): check x1 and x2 (nearly "
+                          "equal when the stripes look parallel) and rows A")
     if rows_a < MIN_ROWS_PX:
         raise CameraError(f"calibration: rows A must be at least {MIN_ROWS_PX:g} px from the image's centre (rows "
                           f"+-A are rows of the image), got {rows_a:g} px")

@@ -49,6 +49,10 @@ MAX_PIXELS = 4096
 #: Smallest focal length [px]: below it a pixel subtends more than 53 deg (a 1e-300 px camera file positioned a line
 #: 2.3e284 m away, exit 0).
 MIN_FOCAL_PX = 1.0
+#: Largest focal length [px]: beyond it a pixel subtends less than 1e-7 rad (0.02 arcsec, finer than a space
+#: telescope resolves; a 1 um pixel behind a 10 m lens): a camera file with 1e308 px was accepted and positioned
+#: lines from an image spanning 1e-305 rad.
+MAX_FOCAL_PX = 1e7
 
 
 #: The unit kind of each camera field (:func:`wmrkit.units.parse_quantity`); the others are plain numbers.
@@ -59,8 +63,8 @@ _FIELD_KINDS = {"tilt": "angle", "height": "length"}
 class Camera:
     """A calibrated camera looking at the ground (§9.2.1.D-E). Frozen.
 
-    - ``focal_px`` f [px] (9.1)-(9.2) with unit pixel size, at least ``MIN_FOCAL_PX``; ``tilt`` phi [rad], from
-      the vertical (9.3);
+    - ``focal_px`` f [px] (9.1)-(9.2) with unit pixel size, in ``[MIN_FOCAL_PX, MAX_FOCAL_PX]``; ``tilt`` phi
+      [rad], from the vertical (9.3);
     - ``height`` v [m], of the lens above the ground (9.7), at most ``limits.MAX_SIZE``; ``width``, ``rows``:
       image size [px];
     - ``k1``: radial distortion coefficient (0: an ideal pinhole).
@@ -84,7 +88,8 @@ class Camera:
                 if isinstance(value, bool) or not isinstance(value, numbers.Real):
                     raise CameraError(f"camera: {name}: expected a number, got {value!r}")
                 object.__setattr__(self, name, float(value))
-        checks = {"focal_px": (self.focal_px >= MIN_FOCAL_PX, f"a finite number >= {MIN_FOCAL_PX:g} [px]"),
+        checks = {"focal_px": (MIN_FOCAL_PX <= self.focal_px <= MAX_FOCAL_PX,
+                               f"a number in [{MIN_FOCAL_PX:g}, {MAX_FOCAL_PX:g}] px"),
                   "tilt": (0 < self.tilt < math.pi / 2, "an angle in (0, 90 deg) from the vertical"),
                   "height": (0 < self.height <= MAX_SIZE, f"a length in (0, {MAX_SIZE:g}] m"),
                   "width": (8 <= self.width <= MAX_PIXELS, f"[8, {MAX_PIXELS}] px"),
