@@ -97,3 +97,31 @@ def test_calibrate_refuses_a_focal_length_no_camera_has(capsys):
     # the same measurements' tilt (9.18) and focal length (9.21) in closed form: tan(phi) A (x1 + x2) / (x1 - x2)
     cos_phi = 2000 * (0.05 / 1) * (1 / 2047 + 1 / 2046)
     assert math.tan(math.acos(cos_phi)) * 2000 * 4093 == pytest.approx(8.336e7, rel=1e-3)
+
+
+# 3. A fixed step longer than the program's servos' time constant is refused.
+
+@pytest.mark.parametrize("extra", [["--step", "1e9", "--duration", "1e9"], ["--step", "0.05"]])
+def test_simulate_refuses_a_step_its_program_servos_cannot_be_resolved_with(extra, capsys):
+    # '--step 1e9 --duration 1e9': one step at the inputs of t = 0 (at rest); the robot did not move, exit 0
+    err = _one_line_error(["simulate", "forklift", "--path", "straight", *extra], capsys)
+    assert f"--step {float(extra[1]):g} s: longer than the time constant of the servos" in err
+    assert "(1 / 30 rad/s = 0.03333 s)" in err
+
+
+def test_the_refused_step_misses_the_program_the_default_step_follows():
+    """The refusal's premise, against the program's own closed form (straight: 1 s ramp to 2 m/s, then 2 m/s): one
+    step of 1e9 s leaves the forklift at rest; 1 ms steps drive it within 5 % of the programmed 1 m + 2 m/s."""
+    from wmrkit import catalog
+    from wmrkit.dynamics.model import DynamicModel
+    from wmrkit.dynamics.programs import path_program
+    from wmrkit.dynamics.simulate import simulate
+
+    model = DynamicModel.of(catalog.load("forklift"))
+    inputs, duration = path_program(model, "straight")
+    assert duration == pytest.approx(2.0)
+    programmed = 0.5 * 2.0 * 1.0 + 2.0 * 1.0  # the ramp's area and the cruise
+    fine = simulate(model, inputs, duration, step=1e-3, record_step=0.01)
+    assert float(np.hypot(*fine.pose[-1, :2])) == pytest.approx(programmed, rel=0.05)
+    coarse = simulate(model, inputs, 1e9, step=1e9)
+    assert float(np.hypot(*coarse.pose[-1, :2])) == 0.0

@@ -106,6 +106,18 @@ def run_tyre(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_program_step(step: float, name: str) -> None:
+    """Refuse a fixed `step` [s] longer than the time constant of a --path program's servos (1 /
+    ``programs.BANDWIDTH``), which it cannot resolve (nor the program's parts shorter than it, which they smooth):
+    '--step 1e9 --duration 1e9' took one step at the inputs of t = 0, at rest: a robot that never moved, exit 0."""
+    from ..dynamics.programs import BANDWIDTH
+
+    if step > 1.0 / BANDWIDTH:
+        raise WmrkitError(f"--step {step:g} s: longer than the time constant of the servos that drive the wheels of "
+                          f"--path {name} (1 / {BANDWIDTH:g} rad/s = {1.0 / BANDWIDTH:.4g} s), a step cannot resolve "
+                          "their motion; give a shorter step (default 0.001 s)")
+
+
 def run_simulate(args: argparse.Namespace) -> int:
     """Simulate, print a summary, write and plot on request."""
     from ..dynamics.deviation import deviation_warning
@@ -135,6 +147,8 @@ def run_simulate(args: argparse.Namespace) -> int:
     if duration <= 0 or step > duration or duration / step > MAX_STEPS:
         raise WmrkitError(f"{source} {duration:g} s; --step {step:g} s: need 0 < step <= duration and at most "
                           f"{MAX_STEPS:.0e} steps")
+    if args.path and args.method != "adaptive":
+        _check_program_step(step, args.path)
     steps = round(duration / step)  # what the fixed steps run; a program's own duration may end within a step
     if args.method != "adaptive" and (args.duration or args.torques) and abs(duration / step - steps) > 1e-6:
         raise WmrkitError(f"{source} {duration:g} s is not a whole number of --step {step:g} s steps: the run would "

@@ -29,6 +29,9 @@ from ..units import BARE_ANGLE_LIMIT
 from .model import DynamicModel
 from .simulate import Inputs, _knots, joint_column
 
+#: Natural frequency [rad/s] of the programs' servos (the default `bandwidth`): a fixed step longer than its
+#: inverse cannot resolve them (``wmrkit simulate --path``).
+BANDWIDTH = 30.0
 #: Side slip [m/s] of a fixed wheel above which :func:`twist_program` calls a twist infeasible.
 SLIP_TOL = 1e-6
 #: Built-in programs: name -> segments (duration [s], forward speed factor, curvature [1/m] at speed 1).
@@ -44,7 +47,7 @@ PATHS: dict[str, tuple[tuple[float, float, float], ...]] = {
 
 
 def path_program(model: DynamicModel, name: str, *, speed: float = 2.0, radius_scale: float = 1.0,
-                 bandwidth: float = 30.0) -> tuple[Inputs, float]:
+                 bandwidth: float = BANDWIDTH) -> tuple[Inputs, float]:
     """Inputs of the built-in program `name` (:data:`PATHS`) at `speed` [m/s]; returns ``(inputs, duration)``.
 
     Each segment holds a forward speed and a curvature (radius ``3 m x radius_scale`` in the turns); the first
@@ -90,7 +93,7 @@ def feasible_twists(model: DynamicModel, twists: ArrayLike) -> np.ndarray:
     return twists
 
 
-def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, bandwidth: float = 30.0,
+def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, bandwidth: float = BANDWIDTH,
                   allow_slip: bool = False) -> Inputs:
     """Servo inputs that make the actuated joints follow the no-slip joint motion of body `twists` ``(K, 3)``.
 
@@ -178,7 +181,7 @@ def _contacts_of(model: DynamicModel, wheel: str) -> list[int]:
 
 
 def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequence[int] = (),
-                   bandwidth: float = 30.0) -> tuple[np.ndarray, np.ndarray]:
+                   bandwidth: float = BANDWIDTH) -> tuple[np.ndarray, np.ndarray]:
     """Gains ``(kp, kd)`` ``(n_steer,)`` of critically damped PD steering servos of natural frequency `bandwidth`
     [rad/s] on the steering columns `servoed` (0 elsewhere): ``kp = J w^2``, ``kd = 2 J w`` with ``J`` the
     inertia each servo moves (:meth:`DynamicModel.steering_inertia`) while the servoed joints and the columns
