@@ -210,8 +210,9 @@ def test_simulate_out_is_csv_or_json(capsys, tmp_path, name):
 
 
 @pytest.mark.parametrize("extra, place, end", [
-    (["--duration", "1", "--step", "0.6"], "--duration 1 s", "1.2"),
-    (["--step", "0.3"], "{torques}: the file ends at t = 1 s", "0.9"),
+    (["--duration", "1", "--step", "0.6"], "--duration 1 s is", "1.2"),
+    # was '...: the file ends at t = 1 s is not a whole number': no sentence
+    (["--step", "0.3"], "{torques}: the file ends at t = 1 s, which is", "0.9"),
 ])
 def test_simulate_refuses_a_duration_that_is_not_whole_steps(capsys, tmp_path, extra, place, end):
     """A fixed-step run takes round(duration / step) steps: '--duration 1 --step 0.6' ran 1.2 s, printing
@@ -220,7 +221,7 @@ def test_simulate_refuses_a_duration_that_is_not_whole_steps(capsys, tmp_path, e
     torques.write_text("time,left_drive.spin,right_drive.spin\n0,100,100\n1,100,100\n")
     code, out, err = run(capsys, "simulate", "forklift", "--torques", str(torques), "--tyre", "linear", *extra)
     assert code == 2 and out == ""
-    assert err.strip() == (f"wmrkit: error: {place.format(torques=torques)} is not a whole number of --step "
+    assert err.strip() == (f"wmrkit: error: {place.format(torques=torques)} not a whole number of --step "
                            f"{extra[-1]} s steps: the run would end at t = {end} s; give a step that divides it")
 
 

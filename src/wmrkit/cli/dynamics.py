@@ -151,8 +151,9 @@ def run_simulate(args: argparse.Namespace) -> int:
         _check_program_step(step, args.path)
     steps = round(duration / step)  # what the fixed steps run; a program's own duration may end within a step
     if args.method != "adaptive" and (args.duration or args.torques) and abs(duration / step - steps) > 1e-6:
-        raise WmrkitError(f"{source} {duration:g} s is not a whole number of --step {step:g} s steps: the run would "
-                          f"end at t = {steps * step:g} s; give a step that divides it")
+        which = " is" if args.duration else ", which is"  # "the file ends at t = 1 s is not": no sentence
+        raise WmrkitError(f"{source} {duration:g} s{which} not a whole number of --step {step:g} s steps: the run "
+                          f"would end at t = {steps * step:g} s; give a step that divides it")
     twist = [0.0, 0.0, 0.0] if args.initial_twist is None else [
         parse_value(v, "number", "--initial-twist") for v in args.initial_twist]
     _check_rolling(model, twist)
