@@ -125,3 +125,21 @@ def test_the_refused_step_misses_the_program_the_default_step_follows():
     assert float(np.hypot(*fine.pose[-1, :2])) == pytest.approx(programmed, rel=0.05)
     coarse = simulate(model, inputs, 1e9, step=1e9)
     assert float(np.hypot(*coarse.pose[-1, :2])) == 0.0
+
+
+# 5. A built-in reference too slow ever to end is refused naming --speed.
+
+@pytest.mark.parametrize(("command", "reference"), [("track", "circle"), ("feasibility", "arc-line")])
+def test_a_reference_too_slow_ever_to_end_is_refused_naming_its_speed(command, reference, capsys):
+    # was "reference 'circle': duration must be a positive number, got inf": no duration was given
+    assert math.isinf(2 * math.pi * 3.0 / 1e-320)  # the circle's lap [s] at that speed overflows
+    err = _one_line_error([command, "diff-drive", "--reference", reference, "--speed", "1e-320"], capsys)
+    assert f"reference '{reference}': speed (--speed) " in err and "would never end; give a higher speed" in err
+    assert "duration" not in err
+
+
+def test_a_reference_of_too_many_samples_says_how_many_in_a_few_digits(capsys):
+    # --speed 1e-300 printed the sample count as a 304-digit integer
+    err = _one_line_error(["track", "diff-drive", "--reference", "circle", "--speed", "1e-300"], capsys)
+    samples = 2 * math.pi * 3.0 / 1e-300 / 0.01
+    assert f"gives {samples:.4g} samples (3 to 10^7 allowed)" in err

@@ -334,6 +334,9 @@ def builtin_reference(name: str, *, speed: float | None = None, size: float | No
         if not (math.isfinite(value) and value > 0):
             raise ReferenceError(f"reference '{name}': {what} must be a positive number, got {value}")
     dur = d0(v, size) if duration is None else duration
+    if duration is None and not math.isfinite(dur):  # 'duration must be a positive number, got inf': not given
+        raise ReferenceError(f"reference '{name}': speed (--speed) {v:g} m/s: one lap of size {size:g} m would never "
+                             "end; give a higher speed")
     for what, value in (("duration", dur),):
         if not (math.isfinite(value) and value > 0):
             raise ReferenceError(f"reference '{name}': {what} must be a positive number, got {value}")
@@ -341,7 +344,7 @@ def builtin_reference(name: str, *, speed: float | None = None, size: float | No
     if n < 3 or n > 10_000_000:
         lap = " (one lap at this speed and size)" if duration is None else ""
         raise ReferenceError(f"reference '{name}' at {v:g} m/s, size {size:g} m: {dur:.4g} s{lap} sampled every "
-                             f"{dt:g} s gives {n} samples (3 to 10^7 allowed)")
+                             f"{dt:g} s gives {n if n < 10**9 else f'{n:.4g}'} samples (3 to 10^7 allowed)")
     t = np.arange(n) * dt
     pose, vel, acc, breaks = fn(t, v, size)
     return Reference(name, readonly(t), readonly(np.ascontiguousarray(pose, dtype=float)),
