@@ -143,3 +143,23 @@ def test_a_reference_of_too_many_samples_says_how_many_in_a_few_digits(capsys):
     err = _one_line_error(["track", "diff-drive", "--reference", "circle", "--speed", "1e-300"], capsys)
     samples = 2 * math.pi * 3.0 / 1e-300 / 0.01
     assert f"gives {samples:.4g} samples (3 to 10^7 allowed)" in err
+
+
+# 6. calibrate on a straight log whose reference turns says which of them turns.
+
+def test_calibrate_on_a_straight_log_whose_reference_turns_says_the_log_does_not(tmp_path, capsys):
+    # said "(the log turns: no slip in it, or robot 'skid-steer-4' whose wheels make its odometry independent ...)"
+    from wmrkit import catalog
+    from wmrkit.odometry.logs import write_csv
+    from wmrkit.odometry.synthetic import TwistProfile, simulate
+    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+
+    straight = simulate(catalog.load("skid-steer-4"), TwistProfile.from_segments([(5.0, 1.0, 0.0, 0.0)]), 50.0)
+    arc = simulate(catalog.load("diff-drive"), TwistProfile.from_segments([(5.0, 1.0, 0.0, 0.2)]), 50.0)
+    assert np.all(straight.truth[:, 2] == 0.0) and arc.truth[-1, 2] == pytest.approx(5.0 * 0.2)  # closed forms
+    log, ref = tmp_path / "straight.csv", tmp_path / "arc.tum"
+    write_csv(log, ("time", *straight.log.joints), np.column_stack([straight.log.time, straight.log.positions]))
+    write_trajectory(ref, Trajectory(arc.log.time, arc.truth, np.zeros(len(arc.log))), fmt="tum")
+    err = _one_line_error(["calibrate", "skid-steer-4", str(log), "--reference", str(ref)], capsys)
+    assert "the log turns" not in err
+    assert "the log's wheels do not turn it, where the reference turns 1 rad: do they record the same run?" in err

@@ -96,8 +96,8 @@ def effective_track_model(robot: Robot, multiplier: float):
 #: A slip parameter is determined by a log when changing it tenfold moves the odometry by more than this fraction of
 #: the run's extent (a straight run moves it by 0: the fit returned its start guess, 10^0.1 for the track).
 IDENTIFIED = 1e-6
-#: A reference that turns through more than this [rad] is a run that turns (for the message when a parameter is not
-#: determined).
+#: A log (its no-slip odometry) or a reference that turns through more than this [rad] turns (for the message when
+#: a parameter is not determined).
 TURNING = 0.1
 #: The reference and the log's no-slip odometry may travel distances at most this factor apart (and differ by at
 #: least ``MIN_DISAGREEMENT`` m before that is refused): beyond it they are not the same run, or not in the same
@@ -149,7 +149,8 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
         err[:, 2] = heading_weight * np.unwrap(err[:, 2])  # 0 at the start; wrapped, it had a minimum every turn
         return err.ravel()
 
-    travelled = _path_length(t_ref, ref[:, :2]), _path_length(t_ref, poses_of(wls_model(robot))[:, :2])
+    plain = poses_of(wls_model(robot))  # the no-slip odometry: what the log's wheels say
+    travelled = _path_length(t_ref, ref[:, :2]), _path_length(t_ref, plain[:, :2])
     if abs(travelled[0] - travelled[1]) > max(MIN_DISAGREEMENT, (MAX_SCALE - 1) * min(travelled)):
         raise WmrkitError(f"{source}: the reference travels {travelled[0]:.4g} m where the log's odometry travels "
                           f"{travelled[1]:.4g} m (more than a factor {MAX_SCALE:g} apart): the log and the reference "
@@ -161,13 +162,15 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
     fit_m = least_squares(lambda p: residuals(poses_of(models["effective track"](p[0]))),
                           [0.1], bounds=([-2.0], [2.0]), x_scale=[0.1], diff_step=[1e-6])
     scale = max(1.0, float(np.ptp(ref[:, :2], axis=0).max()))  # the run's extent [m]
-    turns = float(np.ptp(ref[:, 2])) > TURNING
+    turns, turned = float(np.ptp(plain[:, 2])) > TURNING, float(np.ptp(ref[:, 2]))  # the log's, the reference's
     for fit, what in ((fit_k, "WLS ratio"), (fit_m, "effective track")):
         at = fit.fun  # the residuals at the fit
         moved = max(float(np.max(np.abs(residuals(poses_of(models[what](fit.x[0] + s))) - at))) for s in (-1, 1))
         if not moved > IDENTIFIED * scale:  # the start guess would be reported as a fit
             reason = (f"the log turns: no slip in it, or robot '{robot.name}' whose wheels make its odometry "
-                      f"independent of the {what}") if turns else "a run without turning?"
+                      f"independent of the {what}" if turns else "a run without turning?" if turned <= TURNING else
+                      f"the log's wheels do not turn it, where the reference turns {turned:.3g} rad: do they record "
+                      "the same run?")  # 'the log turns' was said of a straight log whose reference turned
             raise WmrkitError(f"the log does not determine the {what}: the odometry moves less than "
                               f"{IDENTIFIED * scale:.2g} m when it changes tenfold ({reason}); "
                               "calibrate on a log that turns" + (" and slips" if turns else ""))
