@@ -36,9 +36,10 @@ import numpy as np
 
 from ..odometry.calibration import RANK_TOL, CalibrationProblem, CalibrationRun
 from ..robot import Robot
-from .engine import TaskFailure
 from .homogeneity import fleet_warning
 from .likelihood import MIN_OWN_DOF, few_pose_warning, own_noise
+from .refits import REFIT_FAILED as REFIT_FAILED  # re-exported: batch.consistency.REFIT_FAILED
+from .refits import own_fits, refits
 
 #: Largest residual ratio of a fleet whose runs agree. Simulated fleets with encoder noise (1e-5 per rad, or drawn
 #: per run among 1e-6, 1e-5 and 1e-4), 4 to 16 runs (docs/batch.md's table): largest ratio 12.1 over 260 fleets;
@@ -226,10 +227,6 @@ REFITS = 1
 #: ... but every run in fleets of fewer closed runs: with 5 the model's one refit is not enough (each run moves the
 #: fit far), refits of all five separate (docs/batch.md's table).
 REFIT_EVERY = 6
-#: Why a closed fleet is not judged when that refit fails (a worker's error, residuals not finite): the fleet fit is
-#: returned all the same ({run}: the run left out; {why}: the error).
-REFIT_FAILED = ("{run}: the fit of the other runs without {it} failed ({why}): the closed runs are not checked against "
-                "each other, a run of another robot is averaged in unseen (the fleet fit stands)")
 #: Why a closed fleet is not judged when the other runs without one cannot tell the parameters apart
 #: (:meth:`~wmrkit.odometry.calibration.CalibrationProblem.undetermined`, as the jackknife interval asks): the run's
 #: score would measure the others' guess (one clockwise square among 5 equal counter-clockwise ones, all of one
@@ -281,11 +278,12 @@ def _score(err: np.ndarray, k: int, rest: np.ndarray, floors: np.ndarray, n: int
     return float(np.sqrt(np.sum(err[k] ** 2) / max(m[k], 1) / noise))
 
 
-def _quadratic_scores(jac, res, hess, floors, m, outs=None) -> tuple[np.ndarray, np.ndarray]:
+def _quadratic_scores(jac, res, hess, floors, m, outs=None, own=None) -> tuple[np.ndarray, np.ndarray]:
     """Each run's score against the others refitted on the runs' quadratic models (no odometry), and that fit's
     shift from the fleet fit; the score is NaN where the others do not determine the parameters (their Jacobian's
     weakest singular value under :data:`RANK_TOL` of the largest: e.g. equal squares all driven one way). With
-    `outs` (tuples of runs), the same for each tuple left out together, scored by the smallest of its runs' scores."""
+    `outs` (tuples of runs), the same for each tuple left out together, scored by the smallest of its runs' scores.
+    `own`: each run's own noise (mean square a row), the denominator where larger."""
     from scipy.optimize import least_squares
 
     g, _, n = jac.shape
@@ -301,7 +299,7 @@ def _quadratic_scores(jac, res, hess, floors, m, outs=None) -> tuple[np.ndarray,
                           jac=lambda d: j + np.einsum("mij,j->mi", h, d), method="lm", xtol=1e-12,  # noqa: B023
                           ftol=1e-12).x
         err = res + jac @ d + 0.5 * np.einsum("gmij,i,j->gm", hess, d, d)
-        out[k] = min(_score(err, i, rest, floors, n, m) for i in left)
+        out[k] = min(_score(err, i, rest, floors, n, m, 0.0 if own is None else own[i]) for i in left)
         shift[k] = d
     return out, shift
 
@@ -311,7 +309,10 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     (:func:`run_consistency`), else, for a fleet of closed paths (:data:`CLOSED`), each run against the others'
     pooled noise. A closed run's residuals (its final pose) are weighted by one over the square root of its wheel
     travel (at least 1 m: an encoder random walk's error grows so); its score is their RMS at the fit of the other
-    runs over the others' RMS there (with ``R - n`` degrees of freedom). The others' fit is first taken on each run's
+    runs over the others' RMS there (with ``R - n`` degrees of freedom); a run over :data:`MAX_CLOSED_SCORE` whose own
+    fit has degrees of freedom (three-pose references) is rescored over its own noise where larger
+    (:func:`~wmrkit.batch.refits.own_fits`: a noisy run among quiet ones scored their ratio of noise levels). The
+    others' fit is first taken on each run's
     quadratic model about the fleet fit: the curvature from the fit's Jacobian one :data:`CURVATURE_STEP` away
     along each parameter, no new odometry (`curvature`: ``[p] -> [that Jacobian, or (the runs of a task that
     failed, its TaskFailure)]``, the engine's map; a failure or a value not finite leaves the fleet not judged,
@@ -371,7 +372,8 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
         worst = int(group[np.argmax(done)])
         if scores[worst] > MAX_CLOSED_SCORE:
             messages.append(f"{logs[worst]}: disagrees with the other runs (closed-path score {scores[worst]:.3g}, "
-                            f"over {MAX_CLOSED_SCORE:g}: the others' fit leaves it that many times their error): "
+                            f"over {MAX_CLOSED_SCORE:g}: the others' fit leaves it that many times their error, or its "
+                            "own where larger): "
                             "another robot, load or floor? The fit averages it in; check it or fit without it")
         elif pair is not None and pair[2] > MAX_PAIR_SCORE:
             messages.append(PAIR.format(a=logs[pair[0]], b=logs[pair[1]], score=pair[2]))
@@ -410,11 +412,20 @@ def _group_scores(problem: CalibrationProblem, fit, hess: np.ndarray, group: np.
         return UNDETERMINED.format(run=logs[group[k]], why=f"their weighted Jacobian's weakest direction under "
                                    f"{RANK_TOL:g} of the largest")
     again = [int(k) for k in np.argsort(np.linalg.norm(shift, axis=1))[::-1][:g if g < REFIT_EVERY else REFITS]]
-    errs = _refits(problem, group, [(k,) for k in again], [fit.x + shift[k] for k in again], live, w, refit)
+    errs = refits(problem, group, [(k,) for k in again], [fit.x + shift[k] for k in again], live, w, refit, logs)
     if isinstance(errs, str):
         return errs
-    for k, err in zip(again, errs, strict=True):
+    errs = dict(zip(again, errs, strict=True))
+    for k, err in errs.items():
         scores[k] = _score(err, k, np.delete(np.arange(g), k), floors, n, m)
+    over = np.flatnonzero(scores > MAX_CLOSED_SCORE)  # over their own noise where larger (it only lowers a score)
+    own = own_fits(problem, fit.x, group, model[0], m, live, w, refit, logs, over) if over.size else None
+    if isinstance(own, str):
+        return own
+    if own is not None and (fitted := [k for k in over if k not in errs]):
+        scores[fitted] = _quadratic_scores(*model, floors, m, [(k,) for k in fitted], own)[0]
+    for k in (k for k in over if k in errs):
+        scores[k] = _score(errs[k], k, np.delete(np.arange(g), k), floors, n, m, own[k])
     if g < MIN_PAIR_RUNS or scores.max() > MAX_CLOSED_SCORE:
         return scores, None
     pair = _pair(problem, fit, group, rows, scores, model, live, w, floors, m, refit)
@@ -433,7 +444,7 @@ def _pair(problem: CalibrationProblem, fit, group: np.ndarray, rows: list[np.nda
     (:data:`REFIT_FAILED`)."""
     from itertools import combinations
 
-    g, n = len(group), fit.x.size
+    g, n, logs = len(group), fit.x.size, names(problem.runs)
     top = sorted(int(k) for k in np.argsort(scores)[::-1][:PAIR_CANDIDATES])
     pairs = []
     for out in combinations(top, 2):
@@ -443,7 +454,7 @@ def _pair(problem: CalibrationProblem, fit, group: np.ndarray, rows: list[np.nda
     guess, shift = _quadratic_scores(*model, floors, m, pairs)
     own = own_noise(*model, m)
     again = [k for k in np.argsort(-guess, kind="stable")[:PAIR_REFITS] if not np.isnan(guess[k])]
-    errs = _refits(problem, group, [pairs[k] for k in again], [fit.x + shift[k] for k in again], live, w, refit)
+    errs = refits(problem, group, [pairs[k] for k in again], [fit.x + shift[k] for k in again], live, w, refit, logs)
     if isinstance(errs, str) or not again:
         return errs if isinstance(errs, str) else None
     best = None
@@ -455,24 +466,3 @@ def _pair(problem: CalibrationProblem, fit, group: np.ndarray, rows: list[np.nda
         if best is None or score > best[2]:
             best = (int(group[a]), int(group[b]), score)
     return best
-
-
-def _refits(problem: CalibrationProblem, group: np.ndarray, outs: list[tuple[int, ...]], starts: list[np.ndarray],
-            live: list[np.ndarray], w: np.ndarray, refit: Callable) -> list[np.ndarray] | str:
-    """For each of `outs` (places in `group`), the weighted counted residuals of the runs of `group` (a row each, in
-    its order) at the fit of its other runs from `starts` by `refit` (:func:`judge`'s); or why not
-    (:data:`REFIT_FAILED`)."""
-    runs, logs = problem.runs, names(problem.runs)
-    orders = [[int(i) for k, i in enumerate(group) if k not in out] + [int(group[k]) for k in out] for out in outs]
-    tasks = [(problem.with_runs([runs[i] for i in o]), x0, len(out))  # those left out last
-             for o, x0, out in zip(orders, starts, outs, strict=True)]
-    errs = []
-    for out, order, done in zip(outs, orders, refit(tasks), strict=True):
-        err = None if isinstance(done, TaskFailure) else np.asarray(done[1], dtype=float)
-        if err is None or not np.isfinite(err).all():  # the fit stands; only the judging is lost
-            return REFIT_FAILED.format(run=" and ".join(logs[group[k]] for k in out), it="them" if out[1:] else "it",
-                                       why=done if err is None else "its residuals are not finite")
-        parts = np.split(err, np.cumsum([live[i].size for i in order])[:-1])
-        mine = dict(zip(order, (p[live[i]] for p, i in zip(parts, order, strict=True)), strict=True))
-        errs.append(np.array([mine[int(i)] for i in group]) * w[:, None])
-    return errs
