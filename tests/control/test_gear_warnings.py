@@ -35,3 +35,16 @@ def test_track_warns_when_its_commands_break_a_gear(tmp_path, capsys):
     assert f"the commands turn the joints of {GEAR} out of its ratios (ratios 1, 1)" in err
     assert main(["track", path, "--reference", "line", "--duration", "3"]) == 0  # straight: the axle turns as one
     assert "out of its ratios" not in capsys.readouterr().err
+
+
+def test_track_dynamics_holds_the_gear_and_says_its_servos_fight(tmp_path, capsys):
+    """Through the dynamics the gear holds (the forklift's drive wheels on a solid axle), so the warning no longer
+    says that the simulation does not model it."""
+    fork = catalog.load("forklift")
+    drives = ("right_drive.spin", "left_drive.spin")
+    path = tmp_path / "fork.yaml"
+    dataclasses.replace(fork, couplings=(Coupling("gear", drives, (1.0, 1.0)),)).to_file(path)
+    assert main(["track", str(path), "--reference", "circle", "--duration", "2", "--dynamics"]) == 0
+    err = capsys.readouterr().err
+    assert f"gear({', '.join(drives)}) out of its ratios (ratios 1, 1); the dynamics hold the gear" in err
+    assert "does not model" not in err

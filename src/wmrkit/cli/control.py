@@ -262,10 +262,12 @@ def run_track(args: argparse.Namespace) -> int:
              f"(t = {v['from']:.4g} to {v['to']:.4g} s) and was held at its end: the robot cannot follow this "
              "reference there (its wheels scrub; the tracking errors are the result)")
     for c, ok in zip(robot.couplings, run.commands.in_gear.all(axis=0).tolist(), strict=True):
-        if not ok:  # the plants drive each joint on its own (docs/description-format.md, Couplings)
+        if not ok:  # the kinematic plants drive each joint on its own; the dynamics hold the gear
             warn(f"the commands turn the joints of {c.channel_name} out of its ratios (ratios "
-                 f"{', '.join(f'{k:g}' for k in c.ratios)}); the simulation does not model gear couplings, so the "
-                 "real robot cannot drive this run")
+                 f"{', '.join(f'{k:g}' for k in c.ratios)}); " + (
+                     "the dynamics hold the gear, so its servos fight and the robot cannot follow them"
+                     if args.dynamics else "the kinematic loop does not model gear couplings, so the real robot "
+                     "cannot drive this run (--dynamics holds the gear)"))
     slipping = [] if args.dynamics else run.slip_violations()  # the dynamics' tyres do slip, and show it
     if slipping:
         warn(f"wheel{'s' if len(slipping) > 1 else ''} {', '.join(repr(v['wheel']) for v in slipping)} must slip "

@@ -169,8 +169,8 @@ def run_simulate(args: argparse.Namespace) -> int:
     max_slip = float(np.hypot(sim.slip[..., 0], sim.slip[..., 1]).max())  # a contact's slip speed, not a component
     deviation = sim.deviation()
     warnings = _tyre_warnings(model, sim.twist) + [
-        f"{c.channel_name} is not modelled: each of its joints is driven on its own (docs/description-format.md, "
-        "Couplings)" for c in model.robot.couplings if c.kind == "gear"]
+        f"{c.channel_name} is not held by the dynamics: each steering angle follows its own servo (wmrkit has no "
+        "model of a linkage's geometry; docs/dynamics.md)" for c in model.robot.couplings if c.kind == "linkage"]
     if deviation and deviation.large:
         warnings.append(deviation_warning(model, inputs, deviation, max_slip))
     for warning in warnings:
@@ -192,15 +192,23 @@ def run_simulate(args: argparse.Namespace) -> int:
 
 
 def _check_rolling(model, twist: list[float]) -> None:
-    """Refuse an ``--initial-twist`` at which a fixed wheel would slip sideways: the start rolls without slip (the
-    forklift, whose origin is at the fork tips, turns with ``vy = -omega x_axle``; a skid steer cannot turn so)."""
+    """Refuse an ``--initial-twist`` at which a fixed wheel would slip sideways or a gear's joints turn out of its
+    ratios: the start rolls without slip (the forklift, whose origin is at the fork tips, turns with ``vy = -omega
+    x_axle``; a skid steer cannot turn so, nor a solid axle)."""
     from ..dynamics.programs import SLIP_TOL, feasible_twists
     from ..kinematics.wheel_ik import wheel_commands
 
     if not np.all(np.abs(twist) <= MAX_SPEED):  # left to initial_state's message
         return
-    slip = np.abs(wheel_commands(model.robot, twist).slip)
+    cmd = wheel_commands(model.robot, twist)
+    slip = np.abs(cmd.slip)
     if slip.max() <= SLIP_TOL:
+        for c, ok in zip(model.robot.couplings, cmd.in_gear.tolist(), strict=True):
+            if not ok:
+                raise WmrkitError(f"--initial-twist {' '.join(f'{v:g}' for v in twist)}: it turns the joints of "
+                                  f"{c.channel_name} out of its ratios ({', '.join(f'{k:g}' for k in c.ratios)}), "
+                                  "which the gear holds together, and the simulation starts rolling without slip "
+                                  "(wmrkit ik says which twists the gear allows)")
         return
     w = int(np.argmax(slip))
     rolling = feasible_twists(model, [twist])[0]

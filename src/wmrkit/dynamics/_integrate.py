@@ -28,7 +28,6 @@ from ._kernels import (
     mass_matrix,
     normal_loads,
     slip_matrix,
-    solve,
     solve_in_place,
 )
 
@@ -129,12 +128,54 @@ def assemble(t, s, acc, pack, inp, jac, w):
         rhs[c] += acc_c
 
 
-def work_arrays(n: int, n_el: int, n_steer: int) -> tuple:
-    """Scratch arrays of :func:`assemble`."""
+def work_arrays(n: int, n_el: int, n_steer: int, n_geared: int = 0) -> tuple:
+    """Scratch arrays of :func:`assemble` and of :func:`solve_geared` (`n_geared`: the columns of the model's gear
+    basis, ``pack[16]``)."""
     return (np.zeros((2 * n_el, n)), np.zeros((n, n)), np.zeros((n_steer, n, n)), np.zeros(n_el),
             np.zeros((n_el, 2)), np.zeros((n_el, 2, 2)), np.zeros(n_el), np.zeros(n), np.zeros(n), np.zeros(n),
             np.zeros(n_steer), np.zeros(n_steer), np.zeros(n), np.zeros(n_steer), np.zeros((n, n)),
-            np.zeros(1), np.zeros(3))
+            np.zeros(1), np.zeros(3), np.zeros((n_geared, n_geared)), np.zeros(n_geared))
+
+
+def model_work_arrays(model) -> tuple:
+    """:func:`work_arrays` of a :class:`wmrkit.dynamics.model.DynamicModel`."""
+    return work_arrays(model.n, len(model.contacts), len(model.steer_columns), model.pack[16].shape[1])
+
+
+@_inline
+def solve_geared(mat, rhs, t, red, y):
+    """`rhs` becomes ``mat^-1 rhs`` with the gears held: ``T (T' mat T)^-1 T' rhs`` for the gear basis ``t (n, p)``
+    (``model.gear_basis``; the plain solve when ``p = 0``, no gear); `mat` is overwritten, `red` ``(p, p)`` and
+    `y` ``(p,)`` are scratch."""
+    n, p = t.shape
+    if p == 0:
+        solve_in_place(mat, rhs)
+        return
+    for i in range(p):
+        acc = 0.0
+        for k in range(n):
+            acc += t[k, i] * rhs[k]
+        y[i] = acc
+    for k in range(n):  # mat <- mat T, in its first p columns
+        for i in range(p):
+            acc = 0.0
+            for l in range(n):
+                acc += mat[k, l] * t[l, i]
+            rhs[i] = acc  # rhs is free once y holds T' rhs: a row of (mat T)
+        for i in range(p):
+            mat[k, i] = rhs[i]
+    for i in range(p):
+        for j in range(p):
+            acc = 0.0
+            for k in range(n):
+                acc += t[k, i] * mat[k, j]
+            red[i, j] = acc
+    solve_in_place(red, y)
+    for k in range(n):
+        acc = 0.0
+        for i in range(p):
+            acc += t[k, i] * y[i]
+        rhs[k] = acc
 
 
 @functools.partial(_njit, nrt=False)
@@ -156,7 +197,8 @@ def derivative(t, s, acc, pack, inp, w):
     out[0] = math.cos(th) * s[n] - math.sin(th) * s[n + 1]
     out[1] = math.sin(th) * s[n] + math.cos(th) * s[n + 1]
     out[2:n] = s[n + 2:2 * n]
-    out[n:] = solve(w[1], w[9])
+    out[n:] = w[9]
+    solve_geared(w[1].copy(), out[n:], pack[16], w[17], w[18])
     acc[:] = out[n:]
     return out
 
@@ -191,7 +233,7 @@ def _update_semi_implicit(s, dt, acc, w, pack):
             for d in range(n):
                 if d != c and group[d] == group[c]:
                     mat[c, d] -= dt * kdiag[c] * ratio[d] / ratio[c]
-    solve_in_place(mat, rhs)  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt
+    solve_geared(mat, rhs, pack[16], w[17], w[18])  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt, gears held
     dnu = rhs
     for c in range(n):
         acc[c] = dnu[c]

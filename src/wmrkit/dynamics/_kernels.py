@@ -13,7 +13,9 @@ rate in the velocity vector; ``steer_kind (S,)`` int: 0 centred (its z-inertia i
 ``steer_prm (S, 5)``: ``I_s, m, l, alpha, d``; ``diag_I (n,)``: spin/roller inertia per column; ``carry (n,)``:
 1 for the columns that carry the wheel (twist, steering rates), 0 for rolling ones; ``body (6,)``: ``M, I, cx, cy,
 h, g``; ``pinv (E, 3)``: static load map when the contacts do not move (``fixed_loads``), ``fixed_loads (1,)``;
-``group (n,)`` int: the differential coupling of each column (-1: none) and ``ratio (n,)`` its ratio there.
+``group (n,)`` int: the differential coupling of each column (-1: none) and ``ratio (n,)`` its ratio there;
+``loaded (E,)``: 1 for the contacts loaded at rest; ``gears (n, p)``: the motions the gear couplings allow,
+``nu = gears @ p`` (``model.gear_basis``; ``(n, 0)`` without a gear).
 """
 
 from __future__ import annotations

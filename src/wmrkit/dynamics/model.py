@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_angles, readonly
+from ..couplings import gear_free
 from ..errors import ShapeError, WmrkitError
 from ..robot import Robot, element_table
 from .mass import CASTOR_TYPES, Body, body_problem
@@ -161,7 +162,10 @@ class DynamicModel:
         b = np.zeros(self.n)
         bias(nu, nu[list(self.steer_columns)].copy(), m, dm, self.pack[5], self.pack[6], b)
         rhs = tau + self.slip_matrix(beta).T @ f.reshape(-1) + b
-        return readonly(np.linalg.solve(m, rhs))
+        t = self.pack[16]
+        if t.shape[1] == 0:
+            return readonly(np.linalg.solve(m, rhs))
+        return readonly(t @ np.linalg.solve(t.T @ m @ t, t.T @ rhs))  # held gears (gear_basis)
 
     def steering_inertia(self, held: Iterable[int] = ()) -> np.ndarray:
         """Inertia [kg m^2] that each steering joint's servo moves at the described configuration ``(n_steer,)``.
@@ -268,7 +272,8 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
 
     static = np.zeros(n_el)
     normal_loads(np.array(robot.beta, dtype=float), np.zeros(n), np.zeros(n), pack, static)
-    pack = (*pack, (static > 0).astype(float))  # 15: the contacts loaded at rest (lift-off: _integrate.assemble)
+    pack = (*pack, (static > 0).astype(float),  # 15: the contacts loaded at rest (lift-off: _integrate.assemble)
+            gear_basis(robot, tuple(names)))  # 16: the motions the gears allow (none: no gear)
     contacts = contact_names(robot)
     spread = np.linalg.svd(geo, compute_uv=False)
     if len(spread) < 3 or spread[2] <= 1e-9 * spread[0]:  # (7.64) has no solution: a pitch moment would be left
@@ -291,6 +296,17 @@ def contact_names(robot: Robot) -> list[str]:
         k = len(w.elements())
         names.extend([w.name] if k == 1 else [f"{w.name}.{j + 1}" for j in range(k)])
     return names
+
+
+def gear_basis(robot: Robot, names: tuple[str, ...]) -> np.ndarray:
+    """``T (n, p)``: the velocities the ``gear`` couplings allow are ``nu = T p``, a column per joint in no gear and
+    one per gear (its ratios, ``q_j = ratio_j u``; :func:`wmrkit.couplings.gear_free`); ``(n, 0)`` without a gear.
+    A gear is a holonomic constraint between joint angles; the dynamics hold it in these reduced coordinates,
+    ``T' M T p' = T' rhs``: torques on any of its joints act on the whole chain, its inertias reflect through the
+    ratios, and the constraint force does no work."""
+    if not any(c.kind == "gear" for c in robot.couplings):
+        return np.zeros((len(names), 0))
+    return np.ascontiguousarray(gear_free(robot.couplings, names, ())[0], dtype=float)
 
 
 def _differentials(robot: Robot, names: list[str]) -> tuple[np.ndarray, np.ndarray]:

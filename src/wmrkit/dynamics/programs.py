@@ -100,7 +100,9 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     A twist that has no no-slip motion (a fixed wheel would slip sideways by more than ``SLIP_TOL``: ``(v, 0,
     omega)`` for the forklift, whose origin is at the fork tips, or any turn of a skid steer) raises
     :class:`WmrkitError` naming the knot and the wheel; :func:`feasible_twists` gives the closest feasible twists,
-    and ``allow_slip=True`` commands the wheels' rolling components and lets the tyres slip (skid steering).
+    and ``allow_slip=True`` commands the wheels' rolling components and lets the tyres slip (skid steering). So is a
+    twist that a ``gear`` coupling forbids (its joints out of its ratios: a solid axle turning); with ``allow_slip``
+    each joint's servo follows its own rate and they fight through the gear, which holds.
     Twists are finite, their speeds within ``limits.MAX_SPEED`` [m/s] and their turn rates within as many rad/s.
 
     Rate servos on actuated wheel joints (gain ``bandwidth x`` the wheel's reflected inertia, at least the grip
@@ -136,6 +138,13 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
                           f"'{robot.name}': fixed wheel '{robot.wheel_names[w]}' would slip sideways at "
                           f"{abs(cmd.slip[k, w]):.3g} m/s; use feasible_twists(model, twists) for the closest "
                           "feasible motion, or allow_slip=True to let the tyres slip (skid steering)")
+    if not allow_slip and not cmd.in_gear.all():
+        k, g = (int(i) for i in np.argwhere(~cmd.in_gear)[0])
+        c = robot.couplings[g]
+        raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion for "
+                          f"'{robot.name}': it would turn the joints of {c.channel_name} out of its ratios "
+                          f"({', '.join(f'{r:g}' for r in c.ratios)}), which the gear holds together; use "
+                          "allow_slip=True to let its servos fight and the tyres slip")
     rates = np.zeros((len(t), n))
     rates[:, 3:3 + cmd.rates.shape[-1]] = np.nan_to_num(cmd.rates)
     gain, limit = np.zeros(n), np.full(n, np.inf)

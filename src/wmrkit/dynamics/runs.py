@@ -44,11 +44,11 @@ def records(model: DynamicModel, n_rec: int) -> tuple:
 def fixed_run(model, s0, inp, duration, step, every, method, progress, jac_every, allow_lift_off):
     """`duration` [s] from state `s0` in compiled fixed steps (`method` 0: semi-implicit, 1: rk4), recording every
     `every` steps, in chunks (a ``tqdm`` bar on long runs); ``(records, info)``."""
-    from ._integrate import observe, run, work_arrays
+    from ._integrate import model_work_arrays, observe, run
 
     n_steps = round(duration / step)
     rec = records(model, n_steps // every + 1)
-    w = work_arrays(model.n, len(model.contacts), len(model.steer_columns))
+    w = model_work_arrays(model)
     s, acc = s0.copy(), np.zeros(model.n)
     observe(0.0, s, acc, model.pack, inp, w, rec, 0)
     i, done = 1, 0
@@ -94,9 +94,9 @@ def adaptive_run(model, s0, inp, duration, record, rtol, allow_lift_off):
     :data:`MAX_EVALUATIONS` evaluations of the model; ``(records, info)``."""
     from scipy.integrate import solve_ivp
 
-    from ._integrate import derivative, observe, work_arrays
+    from ._integrate import derivative, model_work_arrays, observe
 
-    w = work_arrays(model.n, len(model.contacts), len(model.steer_columns))
+    w = model_work_arrays(model)
     acc = np.zeros(model.n)
     t_eval = record * np.arange(adaptive_samples(duration, record))  # the multiples within the duration
     ts, ys, evaluations = t_eval, s0[:, None], 0  # one sample (record > duration): t = 0, as the fixed steps

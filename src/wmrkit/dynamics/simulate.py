@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
+from ..couplings import GEAR_EXACT_RTOL, gear_breaches
 from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
@@ -239,7 +240,7 @@ class Stepper:
     def __init__(self, model: Robot | DynamicModel, state: ArrayLike | None = None, *, step: float = 1e-3,
                  method: Literal["semi-implicit", "rk4"] = "semi-implicit", jac_every: int = 20, t: float = 0.0,
                  tyre: Tyre | str | None = None, allow_lift_off: bool = False) -> None:
-        from ._integrate import work_arrays
+        from ._integrate import model_work_arrays
 
         self.model = model if isinstance(model, DynamicModel) else DynamicModel.of(model, tyre)
         if method not in ("semi-implicit", "rk4"):
@@ -256,13 +257,17 @@ class Stepper:
             state = np.array(as_vectors(state, 2 * n, "state"), dtype=float)
         if not np.all(np.isfinite(state)):
             raise WmrkitError("state: every entry must be finite")
+        for breach in gear_breaches(self.model.robot.couplings, self.model.names, state[n:], GEAR_EXACT_RTOL):
+            rates = ", ".join(f"{self.model.names[i]} {state[n + i]:.6g}" for i in breach.given)
+            raise WmrkitError(f"state: {breach.head} ({rates} rad/s): the dynamics hold the gear, so a state turns "
+                              "its joints in its ratios (initial_state does)")
         self.state: np.ndarray = state
         self.step, self.jac_every, self.allow_lift_off = float(step), jac_every, allow_lift_off
         self._method = 0 if method == "semi-implicit" else 1
         self._k = round(t / step)
         self._phase = self._k  # the tyre Jacobian is refreshed at the first step, then every jac_every steps
         self._acc = np.zeros(n)
-        self._w = work_arrays(n, len(self.model.contacts), len(self.model.steer_columns))
+        self._w = model_work_arrays(self.model)
         self._rec = records(self.model, 0)
         self._inputs: tuple | None = None
         self._delta = np.array([w.delta for w in self.model.robot.wheels if w.kind.steers], dtype=float)
@@ -338,6 +343,8 @@ def advance(model: Robot | DynamicModel, state: ArrayLike, inputs: Inputs, durat
 
 def initial_state(model: DynamicModel, twist: ArrayLike = (0, 0, 0), pose: ArrayLike = (0, 0, 0)) -> np.ndarray:
     """State ``(2n,)`` rolling without slip at `twist`: pose, joint positions (steering at IK angles), velocities.
+    A twist at which a ``gear``'s joints would turn out of its ratios (a solid axle turning) keeps the twist and turns
+    each gear at the least-squares fit of those rates: the wheels slip from the start.
 
     The twist's speeds and turn rate are within ``limits.MAX_SPEED`` (m/s, rad/s), the pose's position within
     ``limits.MAX_COORDINATE`` and its heading finite."""
@@ -358,6 +365,9 @@ def initial_state(model: DynamicModel, twist: ArrayLike = (0, 0, 0), pose: Array
         cmd = wheel_commands(model.robot, twist)
         beta = np.asarray(cmd.beta, dtype=float)
         s[n + 3:n + 3 + len(cmd.rates)] = cmd.rates
+        gears = model.pack[16]
+        if gears.shape[1]:  # a twist a gear forbids: its joints at their least-squares turn (the wheels slip)
+            s[n:] = gears @ ((gears.T @ s[n:]) / (gears * gears).sum(axis=0))
     for k, c in enumerate(model.steer_columns):
         s[c] = beta[k]
     return s
