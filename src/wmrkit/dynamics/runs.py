@@ -43,7 +43,8 @@ def records(model: DynamicModel, n_rec: int) -> tuple:
 
 def fixed_run(model, s0, inp, duration, step, every, method, progress, jac_every, allow_lift_off):
     """`duration` [s] from state `s0` in compiled fixed steps (`method` 0: semi-implicit, 1: rk4), recording every
-    `every` steps, in chunks (a ``tqdm`` bar on long runs); ``(records, info)``."""
+    `every` steps, in chunks (a ``tqdm`` bar on long runs); ``(records, info)``. A run that stops (a lift-off, a
+    divergence) is re-checked at a shorter step (:func:`_stop`)."""
     from ._integrate import model_work_arrays, observe, run
 
     n_steps = round(duration / step)
@@ -64,14 +65,62 @@ def fixed_run(model, s0, inp, duration, step, every, method, progress, jac_every
         done += k
         if bar is not None:
             bar.update(k)
-        if not np.all(np.isfinite(s)):
-            raise WmrkitError(f"the simulation diverged before t = {done * step:.6g} s; use a smaller --step (or "
-                              "smaller torques or speeds)")
-        if not allow_lift_off:
-            check_lift_off(model, w)
+        diverged = not np.all(np.isfinite(s))
+        if diverged or (w[16][0] and not allow_lift_off):
+            if bar is not None:
+                bar.close()
+            _stop(model, tuple(r[:i] for r in rec), inp, w, done * step, duration, step, method, jac_every,
+                  allow_lift_off, diverged)
     if bar is not None:
         bar.close()
     return tuple(r[:i] for r in rec), {"steps": n_steps}
+
+
+#: Most semi-implicit steps of the re-check of a fixed-step run that stopped (:func:`_stop`; a quarter as many rk4
+#: steps): about 3 s of computing for the forklift.
+RECHECK_STEPS = 1_000_000
+#: Longest step [s] of that re-check, by method (0: semi-implicit, 1: rk4): the steps docs/dynamics.md finds stable
+#: with the catalog's stiff tyres.
+RECHECK_MAX_STEP = (1e-3, 1e-4)
+
+
+def recheck_step(step: float, method: int) -> float:
+    """The step of the re-check of a fixed-step run at `step` [s] that stopped: a whole fraction of it, at most a
+    quarter and at most :data:`RECHECK_MAX_STEP` (so that the re-check restarts on the run's own records' times)."""
+    return step / max(4, math.ceil(step / RECHECK_MAX_STEP[method] * (1 - 1e-9)))
+
+
+def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_lift_off, diverged):
+    """Raise the error of a fixed-step run that stopped at `t_run` [s] (diverged, or the lift-off `w` recorded),
+    after re-running the stretch that led there at :func:`recheck_step`: from the first of the records `rows` at
+    most :data:`RECHECK_STEPS` of those steps before its end (at the latest the last one before the stop) to
+    ``max(0.1 s, 10 steps)`` past the stop (or the run's end). The stop is the robot's (or its inputs') when the
+    shorter step stops too; when it does not, the step was too long for the tyres and the error says so (the load
+    transfer lags a step and the tyres saturate within one, which the implicit step does not cover: the forklift's
+    rectangle 'lifted off' its steered wheel from 8 ms; docs/dynamics.md)."""
+    from ._integrate import model_work_arrays, run
+
+    t_stop = t_run if diverged else float(w[16][1])
+    fine = recheck_step(step, method)
+    k_end = round(min(duration, t_stop + max(0.1, 10 * step)) / fine)
+    budget = RECHECK_STEPS // (1 + 3 * method)  # an rk4 step evaluates the model four times
+    j = min(int(np.searchsorted(rows[0], (k_end - budget) * fine)),  # the first record in the budget, and at
+            max(0, int(np.searchsorted(rows[0], t_stop)) - 1))  # the latest the last one before the stop
+    k0 = round(rows[0][j] / fine)  # a record's time is a whole number of steps, each a whole number of fine ones
+    s, acc = rows[1][j].copy(), np.zeros(model.n)
+    wf = model_work_arrays(model)
+    run(s, k0, fine, k_end - k0, 1 << 62, method, jac_every, acc, model.pack, inp, wf, records(model, 0), 0)
+    if np.all(np.isfinite(s)) and (allow_lift_off or not wf[16][0]):
+        what = (f"the simulation diverged before t = {t_stop:.6g} s" if diverged else
+                f"contact '{model.contacts[int(w[16][2])]}' lost its load at t = {t_stop:.6g} s")
+        raise WmrkitError(f"{what} at step {step:g} s, but a run at step {fine:.3g} s goes on to t = "
+                          f"{k_end * fine:.6g} s without it: the step is too long for the tyres (the integration is "
+                          f"unstable, not the robot); use a step of at most {fine:.3g} s (--step) or the adaptive "
+                          "method")
+    if diverged:
+        raise WmrkitError(f"the simulation diverged before t = {t_run:.6g} s; use a smaller --step (or smaller "
+                          "torques or speeds)")
+    check_lift_off(model, w)
 
 
 #: Most evaluations of the model an adaptive run makes (LSODA, 10-15 us each: about 2 min; the forklift's 22 s

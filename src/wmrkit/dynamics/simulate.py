@@ -189,7 +189,9 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
 
     A wheel loaded at rest whose normal load falls to 0 lifts off; the planar model cannot follow it (it clips the
     load and keeps the wheel down), so the run stops with a :class:`WmrkitError` naming the contact and the time,
-    unless `allow_lift_off`.
+    unless `allow_lift_off`. A fixed-step run that stops so (or diverges) is re-run over that stretch at a shorter
+    step (:func:`~wmrkit.dynamics.runs.recheck_step`); when that one does not stop, the error says the step was too
+    long for the tyres (the integrator unstable, not the robot) and names the step that ran.
     """
     model = robot if isinstance(robot, DynamicModel) else DynamicModel.of(robot, tyre)
     if method not in METHODS:
