@@ -323,7 +323,7 @@ def _element_rows_one(p, beta: np.ndarray) -> np.ndarray:
 
 
 def _minimise_length(kappa, robot: Robot, many=None) -> tuple[float, float]:
-    """Minimise ``kappa(D)`` over D from ``LENGTH_RANGE[0]`` times `robot`'s size (:func:`.singularity.robot_size`)
+    """Minimise ``kappa(D)`` over D from ``LENGTH_RANGE[0]`` times `robot`'s size (:func:`robot_size`)
     to ``LENGTH_RANGE[1]`` times its largest length (log scale); ties go to the size. `many`, if given, is `kappa`
     over an array of lengths at once (the same values). The top is not 1000 sizes: a double castor of 0.5 m offset
     and radius mounted at the origin, natural length 0.29 m, once sized 1 mm, was searched up to 1 m only."""

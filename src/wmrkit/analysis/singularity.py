@@ -26,7 +26,7 @@ from scipy.optimize import minimize
 from .._shapes import as_names
 from ..couplings import coupled_columns
 from ..errors import UnknownNameError, WmrkitError
-from ..kinematics.linalg import characteristic_length, matrix_rank, nondimensional
+from ..kinematics.linalg import matrix_rank, nondimensional, robot_size
 from ..kinematics.models import configuration
 from ..robot import Robot
 from . import _fast
@@ -108,19 +108,6 @@ def check_positive_length(length: float) -> None:
     which the user's doors bound with :func:`wmrkit.limits.check_length` (``analyze``, ``--length``)."""
     if not 0 < length < np.inf:  # NaN included
         raise WmrkitError(f"length: must be a finite number > 0 m, got {length}")
-
-
-#: Least :func:`robot_size` as a fraction of the robot's largest length
-#: (:func:`~wmrkit.kinematics.linalg.characteristic_length`): wheels all mounted at the origin still make a robot of
-#: some size, and the default lengths scale with the robot at every size.
-SIZE_FRACTION = 0.1
-
-
-def robot_size(robot: Robot) -> float:
-    """RMS distance of the wheels' mount points from the robot origin [m], at least :data:`SIZE_FRACTION` of its
-    largest length: a default length."""
-    rms = float(np.sqrt(np.mean([w.l**2 for w in robot.wheels])))
-    return max(rms, SIZE_FRACTION * characteristic_length(robot))
 
 
 @dataclass(frozen=True, eq=False)

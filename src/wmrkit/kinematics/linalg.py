@@ -73,6 +73,19 @@ def _characteristic_length(robot: Robot) -> float:
     return size if 0.0 < size < np.inf else 1.0
 
 
+#: Least :func:`robot_size` as a fraction of the robot's largest length
+#: (:func:`characteristic_length`): wheels all mounted at the origin still make a robot of
+#: some size, and the default lengths scale with the robot at every size.
+SIZE_FRACTION = 0.1
+
+
+def robot_size(robot: Robot) -> float:
+    """RMS distance of the wheels' mount points from the robot origin [m], at least :data:`SIZE_FRACTION` of its
+    largest length: a default length."""
+    rms = float(np.sqrt(np.mean([w.l**2 for w in robot.wheels])))
+    return max(rms, SIZE_FRACTION * characteristic_length(robot))
+
+
 @functools.lru_cache(maxsize=256)
 def nondimensional(robot: Robot) -> Robot:
     """`robot` with every length divided by :func:`characteristic_length`: the robot rank decisions are made on.

@@ -26,7 +26,7 @@ from ..units import MAX_ANGLE, UnitError, parse_quantity
 from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
 from ._ik_fast import wrap_angle
-from .linalg import geared_solve, geared_twist_determined
+from .linalg import geared_solve, geared_twist_determined, robot_size
 
 __all__ = ["WheelCommands", "forward_kinematics", "gear_error", "resolve_rate_name", "twist_is_determined",
            "wheel_commands", "wrap_angle"]
@@ -349,7 +349,7 @@ def forward_kinematics_check(
     """:func:`forward_kinematics` for one sample, with the slip split by wheel and judged against a tolerance.
 
     The tolerance is `rtol` times the fastest speed a given rate stands for (:func:`_speed_per_rate`: a spin's
-    ``|r phi_dot|``, a steering rate's contact speed) plus 1e-9 m/s:
+    ``|r phi_dot|``, a steering rate's contact speed, ``omega`` times the robot's size) plus 1e-9 m/s:
     rates that contradict each other beyond it (slip larger than measurement noise) are not ``consistent``, nor are
     given joints of a ``gear`` out of its ratios beyond round-off (:data:`wmrkit.couplings.GEAR_EXACT_RTOL`): each
     such gear is named in ``out_of_gear``, with a :class:`~wmrkit.couplings.GearWarning`.
@@ -378,10 +378,11 @@ def forward_kinematics_check(
 def _speed_per_rate(robot: Robot, name: str) -> float:
     """The contact speed [m/s] one unit of the velocity `name` stands for: a spin's ``r``; a steering rate's lever
     from the steering axis to the contact points, ``hypot(d, b)`` (a castor's offset, a double wheel's half
-    spacing: not 1 m, which read 1 rad/s of a castor with d = 0.04 m as 1 m/s); 1 for vx, vy and omega."""
+    spacing: not 1 m, which read 1 rad/s of a castor with d = 0.04 m as 1 m/s); ``omega``'s lever the robot's size
+    (:func:`robot_size`: 1 m read a gyro's 0.5 rad/s on a robot 1 mm across as 0.5 m/s); 1 for vx and vy."""
     wheel, _, joint = name.partition(".")
     if not joint:
-        return 1.0
+        return robot_size(robot) if name == "omega" else 1.0
     w = robot.wheel(wheel)
     return math.hypot(w.d, w.b) if joint == "steer" else w.r
 
