@@ -242,18 +242,27 @@ def symbolic_model(
     if isinstance(max_lsq_angles, bool) or not isinstance(max_lsq_angles, int) or max_lsq_angles < 0:
         raise AssignmentError(f"max_lsq_angles: expected a whole number >= 0, got {max_lsq_angles!r}")
     key = _geometry_key(robot, geometry)
-    model = _solve(robot, names, _steering_values(robot, beta, heading, key), key, max_lsq_angles, bool(gears))
-    if not model.exact and gears and gear_rows(robot).rows:
-        raise GearedLeastSquaresError(
-            f"robot '{robot.name}': ({name_list(names) or 'nothing'}) is not an assignable set of the motions its "
-            f"gears allow (mobility m = {model.mobility}): no exact closed form, and a least-squares one would "
-            "weigh the gear rows against slip; gears=False gives the wheels' least squares, 'wmrkit ik' holds the gear")
-    return model
+    return _solve(robot, names, _steering_values(robot, beta, heading, key), key, max_lsq_angles, bool(gears))
+
+
+@dataclass(frozen=True)
+class _Ranked:
+    """The system of one assignment (``A`` with the held gear rows under it) and its generic ranks."""
+
+    a: sp.ImmutableMatrix
+    a_idx: list[int]
+    na_idx: list[int]
+    points: list
+    values: list
+    rank: int
+    rank_na: int
 
 
 @functools.lru_cache(maxsize=128)
-def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], geometry: tuple,
-           max_lsq_angles: int, gears: bool = True) -> SymbolicModel:
+def _ranked(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], geometry: tuple,
+            gears: bool) -> _Ranked:
+    """The ranks of :func:`_solve`'s system, without deriving its closed form; :class:`SingularError` when the
+    assigned set leaves unknowns free."""
     a = constraint(robot, beta, geometry)
     held = gear_rows(robot) if gears else sp.ImmutableMatrix(0, a.cols, [])
     a = sp.ImmutableMatrix(a.col_join(held)) if held.rows else a
@@ -272,13 +281,29 @@ def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], g
             f"({name_list([n for n, f in zip(solved, free, strict=True) if f])}): rank A_na = {rank_na} < "
             f"{len(na_idx)} unknowns (mobility m = {a.cols - rank})"
         )
-    exact = rank_na == rank
+    return _Ranked(a, a_idx, na_idx, points, values, rank, rank_na)
+
+
+@functools.lru_cache(maxsize=128)
+def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], geometry: tuple,
+           max_lsq_angles: int, gears: bool) -> SymbolicModel:
+    """The closed form of :func:`symbolic_model`; a least-squares one of a geared robot is refused before its
+    derivation (:class:`GearedLeastSquaresError`), which ``--symbolic`` then made in vain."""
+    r = _ranked(robot, assigned, beta, geometry, gears)
+    a, a_idx, na_idx, points, values, rank = r.a, r.a_idx, r.na_idx, r.points, r.values, r.rank
+    solved = tuple(robot.velocity_names[j] for j in na_idx)
+    exact = r.rank_na == rank
     coupled = [] if exact else _coupled_angles(a, na_idx, beta)
     if len(coupled) > max_lsq_angles:
         raise ClosedFormTooLargeError(
             f"robot '{robot.name}': the least-squares closed form for ({', '.join(assigned) or 'nothing'}) couples "
             f"{len(coupled)} steering angles ({', '.join(coupled)}), more than max_lsq_angles = {max_lsq_angles}: "
             "it would take minutes to hours; use the numeric models ('wmrkit kinematics') or the generated code")
+    if not exact and gears and gear_rows(robot).rows:
+        raise GearedLeastSquaresError(
+            f"robot '{robot.name}': ({name_list(assigned) or 'nothing'}) is not an assignable set of the motions its "
+            f"gears allow (mobility m = {a.cols - rank}): no exact closed form, and a least-squares one would "
+            "weigh the gear rows against slip; gears=False gives the wheels' least squares, 'wmrkit ik' holds the gear")
     try:
         m, residual = solve_exactly(a, na_idx, a_idx, exact, values[0])
         ok = agrees(m, a, na_idx, a_idx, points[1])
@@ -319,7 +344,7 @@ def twist_assignment(robot: Robot) -> tuple[str, ...]:
     controller computes them); then the free steering rates."""
     free = robot.free_steering
     key = _geometry_key(robot, "numeric")
-    rank = _solve(robot, TWIST_NAMES + free, _steering_values(robot, None, None, key), key, MAX_LSQ_ANGLES).rank
+    rank = _ranked(robot, TWIST_NAMES + free, _steering_values(robot, None, None, key), key, True).rank
     m = len(robot.velocity_names) - rank - len(free)
     for subset in itertools.combinations(TWIST_NAMES, m) if 0 < m <= 3 else ():
         try:
