@@ -9,28 +9,17 @@ import warnings
 from pathlib import Path
 
 import pytest
+from refusal import one_line_error
 
 from wmrkit import catalog
 from wmrkit.cli.main import main
 from wmrkit.errors import WmrkitError
 
 
-def _one_line_error(argv: list[str], capsys) -> str:
-    """Run `argv`: exit 2, nothing on stdout, one line on stderr (no Python warning before it); return it."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")  # a RuntimeWarning would print its own lines on stderr
-        assert main(argv) == 2
-    out, err = capsys.readouterr()
-    assert out == ""
-    assert len(err.splitlines()) == 1, err
-    assert err.startswith("wmrkit: error: ")
-    return err
-
-
 @pytest.mark.parametrize("lookahead", ["1e308", "1e10"])
 def test_track_refuses_a_lookahead_beyond_the_coordinates_it_handles(lookahead, capsys):
     # 1e308: OverflowError traceback in pure pursuit's goal test, (1e-3 * aim) ** 2 (exit 1)
-    err = _one_line_error(["track", "diff-drive", "--reference", "circle", "--controller", "pure-pursuit",
+    err = one_line_error(["track", "diff-drive", "--reference", "circle", "--controller", "pure-pursuit",
                            "--lookahead", lookahead], capsys)
     assert "--lookahead: expected a distance in (0, 1e+09] m along the path" in err
 
@@ -65,7 +54,7 @@ def test_a_lookahead_at_the_bound_still_runs(capsys):
     (["--path", "straight", "--duration", "1e9"], "--duration 1e+09 s; --step 0.001 s: need 0 < step"),
 ])
 def test_simulate_names_what_makes_a_program_too_long(argv, expected, capsys):
-    err = _one_line_error(["simulate", "forklift", *argv], capsys)
+    err = one_line_error(["simulate", "forklift", *argv], capsys)
     assert expected in err
 
 
@@ -73,7 +62,7 @@ def test_simulate_names_the_torque_file_that_makes_a_run_too_long(tmp_path, caps
     # was '--duration 1e+09 s and --step 0.001 s': no --duration was given, the file ends at 1e9 s
     torques = tmp_path / "t.csv"
     torques.write_text("time,right_drive.spin,left_drive.spin\n0,10,10\n1e9,10,10\n")
-    err = _one_line_error(["simulate", "forklift", "--torques", str(torques)], capsys)
+    err = one_line_error(["simulate", "forklift", "--torques", str(torques)], capsys)
     assert f"{torques}: the file ends at t = 1e+09 s; --step 0.001 s: need 0 < step <= duration" in err
 
 
@@ -100,7 +89,7 @@ def test_a_parking_problems_name_follows_the_rules_of_a_robots_name(name, expect
     monkeypatch.chdir(tmp_path)
     Path("p.yaml").write_text(THESIS_9_1.read_text(encoding="utf-8").replace("name: thesis-9.1", f"name: {name}"),
                               encoding="utf-8")
-    err = _one_line_error(["park", "p.yaml"], capsys)
+    err = one_line_error(["park", "p.yaml"], capsys)
     assert err.strip() == f"wmrkit: error: {expected}"
 
 
@@ -150,7 +139,7 @@ def test_vision_points_far_outside_the_image_are_refused_without_a_python_warnin
     points = tmp_path / "points.json"
     points.write_text('{"lines": [{"n": 0, "points": [[0, 1e308], [0, -1e308]]}]}')
     camera = Path(__file__).parents[2] / "docs" / "figures" / "vision" / "follower-camera.yaml"
-    err = _one_line_error(["vision", "locate", "--points", str(points), "--camera", str(camera)], capsys)
+    err = one_line_error(["vision", "locate", "--points", str(points), "--camera", str(camera)], capsys)
     assert "lines[0]: a point [[0.0, 1e+308], [0.0, -1e+308]] lies outside the 320 x 240 image" in err
 
 
@@ -158,7 +147,7 @@ def test_follow_line_refuses_a_line_narrower_than_the_lengths_wmrkit_handles(cap
     # 1e-320 m printed 'render.py:79: RuntimeWarning: overflow encountered in divide' and its source line, then
     # 'the camera does not see the line at the start pose'
     camera = Path(__file__).parents[2] / "docs" / "figures" / "vision" / "follower-camera.yaml"
-    err = _one_line_error(["follow-line", "line-follower", "--camera", str(camera), "--line-width", "1e-320",
+    err = one_line_error(["follow-line", "line-follower", "--camera", str(camera), "--line-width", "1e-320",
                            "--duration", "2"], capsys)
     assert "width must be in [1e-06, 1000] m, got 1e-320" in err
 
@@ -170,7 +159,7 @@ def test_a_body_heavier_than_a_thousand_tonnes_is_refused(tmp_path, capsys):
     description["body"]["mass"] = 1e300
     path = tmp_path / "heavy.json"
     path.write_text(json.dumps(description))
-    err = _one_line_error(["simulate", str(path), "--path", "straight"], capsys)
+    err = one_line_error(["simulate", str(path), "--path", "straight"], capsys)
     assert "body.mass: at most 1e+06 kg (a thousand tonnes" in err
 
 
@@ -186,6 +175,6 @@ def test_body_refuses_the_same_mass_from_python():
 
 def test_a_pi_gain_whose_integral_gain_overflows_is_refused_by_its_name(capsys):
     # was 'gain b: expected three finite numbers >= 0, got (inf, inf, inf)': b = a^2 / 4, which no option sets
-    err = _one_line_error(["track", "diff-drive", "--reference", "circle", "--controller", "pi", "--gain", "1e200"],
+    err = one_line_error(["track", "diff-drive", "--reference", "circle", "--controller", "pi", "--gain", "1e200"],
                           capsys)
     assert "error: gain: 1e+200 1/s: the PI law's integral gain a^2 / 4 overflows" in err

@@ -6,25 +6,10 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 
 import numpy as np
 import pytest
-
-from wmrkit.cli.main import main
-
-
-def _one_line_error(argv: list[str], capsys) -> str:
-    """Run `argv`: exit 2, nothing on stdout, one line on stderr (no Python warning before it); return it."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        assert main(argv) == 2
-    out, err = capsys.readouterr()
-    assert out == ""
-    assert len(err.splitlines()) == 1, err
-    assert err.startswith("wmrkit: error: ")
-    return err
-
+from refusal import one_line_error
 
 # 1. A gain so stiff the continuous loop's integrator surely exhausts its budget is judged before integrating.
 
@@ -38,7 +23,7 @@ def test_track_refuses_a_stiff_gain_before_integrating(controller, option, gain,
 
     monkeypatch.setattr(loop, "MAX_CONTINUOUS_SECONDS", 3.0)
     start = time.process_time()
-    err = _one_line_error(["track", "diff-drive", "--reference", "circle", "--controller", controller, option, gain],
+    err = one_line_error(["track", "diff-drive", "--reference", "circle", "--controller", controller, option, gain],
                           capsys)
     assert f"({option}) {float(gain):g} 1/s: the continuous loop's error decays at" in err
     assert "lower the gain, or give a sample period (--period)" in err
@@ -84,14 +69,14 @@ def test_a_camera_file_with_an_impossible_focal_length_is_refused_naming_it(tmp_
     # focal_px: 1e308 was accepted: `vision locate` answered from an image spanning 1e-305 rad, exit 0
     camera = tmp_path / "camera.yaml"
     camera.write_text("focal_px: 1e308\ntilt: 1.3264502315156905\nheight: 1.42\n")
-    err = _one_line_error(["vision", "locate", "--points", "docs/figures/vision/chufa-points.json", "--camera",
+    err = one_line_error(["vision", "locate", "--points", "docs/figures/vision/chufa-points.json", "--camera",
                            str(camera), "--spacing", "60cm"], capsys)
     assert str(camera) in err and "focal_px: out of range, got 1e+308 (expected a number in [1, 1e+07] px)" in err
 
 
 def test_calibrate_refuses_a_focal_length_no_camera_has(capsys):
     # nearly parallel stripes on a 4096 px image printed 'focal = 83362280.31 px', exit 0
-    err = _one_line_error(["vision", "calibrate", "--x1", "2047", "--x2", "2046", "--rows", "2000",
+    err = one_line_error(["vision", "calibrate", "--x1", "2047", "--x2", "2046", "--rows", "2000",
                            "--half-separation", "0.05", "--row-distance", "1", "--size", "4096", "4096"], capsys)
     assert "focal length of 8.336e+07 px, above 1e+07 px" in err
     # the same measurements' tilt (9.18) and focal length (9.21) in closed form: tan(phi) A (x1 + x2) / (x1 - x2)
@@ -104,7 +89,7 @@ def test_calibrate_refuses_a_focal_length_no_camera_has(capsys):
 @pytest.mark.parametrize("extra", [["--step", "1e9", "--duration", "1e9"], ["--step", "0.05"]])
 def test_simulate_refuses_a_step_its_program_servos_cannot_be_resolved_with(extra, capsys):
     # '--step 1e9 --duration 1e9': one step at the inputs of t = 0 (at rest); the robot did not move, exit 0
-    err = _one_line_error(["simulate", "forklift", "--path", "straight", *extra], capsys)
+    err = one_line_error(["simulate", "forklift", "--path", "straight", *extra], capsys)
     assert f"--step {float(extra[1]):g} s: longer than the time constant of the servos" in err
     assert "(1 / 30 rad/s = 0.03333 s)" in err
 
@@ -133,14 +118,14 @@ def test_the_refused_step_misses_the_program_the_default_step_follows():
 def test_a_reference_too_slow_ever_to_end_is_refused_naming_its_speed(command, reference, capsys):
     # was "reference 'circle': duration must be a positive number, got inf": no duration was given
     assert math.isinf(2 * math.pi * 3.0 / 1e-320)  # the circle's lap [s] at that speed overflows
-    err = _one_line_error([command, "diff-drive", "--reference", reference, "--speed", "1e-320"], capsys)
+    err = one_line_error([command, "diff-drive", "--reference", reference, "--speed", "1e-320"], capsys)
     assert f"reference '{reference}': speed (--speed) " in err and "would never end; give a higher speed" in err
     assert "duration" not in err
 
 
 def test_a_reference_of_too_many_samples_says_how_many_in_a_few_digits(capsys):
     # --speed 1e-300 printed the sample count as a 304-digit integer
-    err = _one_line_error(["track", "diff-drive", "--reference", "circle", "--speed", "1e-300"], capsys)
+    err = one_line_error(["track", "diff-drive", "--reference", "circle", "--speed", "1e-300"], capsys)
     samples = 2 * math.pi * 3.0 / 1e-300 / 0.01
     assert f"gives {samples:.4g} samples (3 to 10^7 allowed)" in err
 
@@ -160,6 +145,6 @@ def test_calibrate_on_a_straight_log_whose_reference_turns_says_the_log_does_not
     log, ref = tmp_path / "straight.csv", tmp_path / "arc.tum"
     write_csv(log, ("time", *straight.log.joints), np.column_stack([straight.log.time, straight.log.positions]))
     write_trajectory(ref, Trajectory(arc.log.time, arc.truth, np.zeros(len(arc.log))), fmt="tum")
-    err = _one_line_error(["calibrate", "skid-steer-4", str(log), "--reference", str(ref)], capsys)
+    err = one_line_error(["calibrate", "skid-steer-4", str(log), "--reference", str(ref)], capsys)
     assert "the log turns" not in err
     assert "the log's wheels do not turn it, where the reference turns 1 rad: do they record the same run?" in err
