@@ -667,6 +667,22 @@ def test_infinite_condition_number_has_no_length(page, server):
     assert not pg.errors
 
 
+def saved_and_reopened(pg, root: Path, name: str) -> Robot:
+    """Save the page's robot as `name`, check the file reads as that robot, open it again and check the page shows
+    the same robot (the round trip); return it."""
+    edited = page_robot(pg)
+    pg.fill("#save-path", name)
+    pg.click("#save")
+    pg.wait_for_function("() => document.getElementById('status').textContent.startsWith('saved')")
+    assert Robot.from_file(root / name) == edited
+    pg.select_option("#catalog", "")
+    pg.select_option("#files", name)
+    pg.click("#open")
+    settle(pg)
+    assert page_robot(pg) == edited
+    return edited
+
+
 def open_file(pg, root: Path, name: str, description: dict) -> None:
     """Write `description` to `name` in the studio's folder and open it with the page's file list."""
     (root / name).write_text(json.dumps(description))
@@ -1064,16 +1080,7 @@ def test_steer_range_is_shown_edited_validated_kept_and_saved(page, server):
         pg.click("#undo")
         settle(pg)
     assert pg.locator(".invalid").count() == 0
-    edited = page_robot(pg)
-    pg.fill("#save-path", "ranged.yaml")
-    pg.click("#save")
-    pg.wait_for_function("() => document.getElementById('status').textContent.startsWith('saved')")
-    assert Robot.from_file(root / "ranged.yaml") == edited
-    pg.select_option("#catalog", "")
-    pg.select_option("#files", "ranged.yaml")
-    pg.click("#open")
-    settle(pg)
-    assert page_robot(pg) == edited  # round trip: the same robot
+    saved_and_reopened(pg, root, "ranged.yaml")
     pg.click('[data-wheel="front_left"]')
     assert pg.input_value(field) == "-30 deg, 45 deg"
     pg.select_option('#wheel-fields [data-field="type"]', "castor")  # steers: the range stays
@@ -1149,16 +1156,7 @@ def test_retype_keeps_what_the_new_type_takes_and_names_what_it_drops(page, serv
     assert page_robot(pg) == robot_from_dict(car)
     assert pg.inner_text(note) == ("retyped to fixed: dropped d, steer_range [-40 deg, 40 deg] (a fixed wheel does not "
                                    "steer), inertia steer, actuated steer, sensed steer")
-    edited = page_robot(pg)
-    pg.fill("#save-path", "retyped.yaml")
-    pg.click("#save")
-    pg.wait_for_function("() => document.getElementById('status').textContent.startsWith('saved')")
-    assert Robot.from_file(root / "retyped.yaml") == edited
-    pg.select_option("#catalog", "")
-    pg.select_option("#files", "retyped.yaml")
-    pg.click("#open")
-    settle(pg)
-    assert page_robot(pg) == edited  # round trip: the same robot, its tyre and slip included
+    edited = saved_and_reopened(pg, root, "retyped.yaml")  # its tyre and slip included
     assert edited.wheel("front_left").tyre is not None and edited.odometry is not None
 
     castors = catalog.load("thesis-omni-castor").to_dict()
