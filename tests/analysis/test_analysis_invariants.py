@@ -32,7 +32,7 @@ def _same(a, b, rtol):
     np.testing.assert_allclose(a, b, rtol=rtol + 10 * np.finfo(float).eps * np.max(b, initial=0.0), atol=1e-9)
 
 
-@settings(max_examples=40)
+@settings(max_examples=300)
 @given(robot=robots(max_wheels=4), phi=st.floats(-3, 3), k=st.floats(0.01, 100), length=st.floats(0.05, 2),
        data=st.data())
 def test_kappa_and_the_natural_length_ignore_frame_turns_mirrors_and_order_and_scale_with_the_robot(

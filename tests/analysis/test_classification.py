@@ -197,7 +197,7 @@ def _coordinated_beta(r: Robot, rng) -> np.ndarray:
     return np.array(beta)
 
 
-@settings(max_examples=150)
+@settings(max_examples=1000)
 @given(simple_robots(), st.integers(0, 2**16))
 def test_random_robots_agree_with_the_rank_of_the_constraint_matrix(r, seed):
     pts = np.array([w.position for w in r.wheels])

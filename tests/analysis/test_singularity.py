@@ -51,7 +51,7 @@ def numerical_tie(r, beta, assigned) -> bool:
     return len(line) > 1 or len(rank) > 1
 
 
-@settings(max_examples=300)
+@settings(max_examples=1000)
 @given(cases())
 def test_line_test_equals_rank_test_on_random_robots(case):
     r, assigned, beta = case
@@ -59,7 +59,7 @@ def test_line_test_equals_rank_test_on_random_robots(case):
     assert bool(is_singular(r, beta, assigned)) == bool(is_singular_rank(r, beta, assigned))
 
 
-@settings(max_examples=60)
+@settings(max_examples=180)
 @given(robots(max_wheels=3), st.integers(0, 2**16))
 def test_singular_set_points_are_rank_singular(r, seed):
     rng = np.random.default_rng(seed)
@@ -304,7 +304,7 @@ def _coincident_castors_geared():
     return robot, (), np.array([0.0, -0.81011685, 0.0])
 
 
-@settings(max_examples=200)
+@settings(max_examples=600)
 @given(coupled_cases())
 @example(_coincident_castors_geared())
 def test_coupled_line_test_equals_coupled_rank_test_on_random_robots(case):
