@@ -6,7 +6,7 @@ import itertools
 import sys
 
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wmrkit.batch.engine import BatchError, TaskFailure, chunk_spans, engine
@@ -44,6 +44,7 @@ def test_without_dask_serial_fallback_and_scheduler_error(monkeypatch, capsys):
         engine("tcp://127.0.0.1:8786")
 
 
+@settings(max_examples=300)
 @given(st.integers(0, 3000), st.integers(1, 100), st.integers(1, 8))
 def test_chunk_spans_cover_the_items_in_shrinking_tasks(n, chunk, workers):
     spans = chunk_spans(n, chunk, workers)
