@@ -25,7 +25,7 @@ LAWS = [PositionLaw.uniform("p", 0.7), PositionLaw.uniform("p", 0.7, gate=0.2),
 
 
 @pytest.mark.parametrize("name", ["forklift", "swerve-4", "diff-drive"])  # reduced, full, reduced (skid-free)
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=100, deadline=None)
 @given(k=st.integers(0, 10_000), dx=st.floats(-2, 2), dy=st.floats(-2, 2), dth=st.floats(-7, 7),
        integral=st.lists(st.floats(-3, 3), min_size=3, max_size=3), law=st.sampled_from(LAWS))
 def test_fast_law_controller_equals_law_controller(name, k, dx, dy, dth, integral, law):

@@ -294,7 +294,7 @@ def test_a_stop_and_turn_in_place_is_a_tangent_jump_for_a_car_only():
     assert feasibility(catalog.load("ackermann"), straight, "dynamic").feasible
 
 
-@settings(max_examples=40)
+@settings(max_examples=120)
 @example(0.5, 1.0, 0.0, 0.25, 1.0)  # the ramp's end rang in the curvature rate, while it fell by 0.03 1/(m s) anyway
 @given(st.floats(0.5, 8.0), st.floats(0.2, 2.0), st.floats(-0.5, 0.5), st.floats(-0.3, 0.3), st.floats(0.5, 4.0))
 def test_smooth_paths_from_rest_have_no_jump(ramp, speed, amplitude, bend, period):

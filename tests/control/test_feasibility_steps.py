@@ -19,7 +19,7 @@ ROBOTS = {name: catalog.load(name) for name in ("swerve-4", "thesis-two-steer-ca
 COLUMN = "types 3 and 5, l_o != 0"
 
 
-@settings(max_examples=30)
+@settings(max_examples=90)
 @given(st.sampled_from(sorted(ROBOTS)), st.one_of(st.none(), st.tuples(st.floats(-0.4, 0.4), st.floats(-0.4, 0.4))),
        st.floats(0.005, 0.05), st.floats(0.2, 2.0), st.floats(-math.pi, math.pi), st.floats(-math.pi, math.pi),
        st.floats(-0.5, 0.5), st.sampled_from(["position", "theta", "velocity"]), st.floats(0.25, 0.75),
@@ -101,7 +101,7 @@ def test_a_built_in_reference_read_from_a_file_gets_the_same_verdict(shape):
             assert all(abs(g[1] - w[1]) <= 0.0201 for g, w in zip(got, want, strict=True)), (name, framework, want, got)
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=75, deadline=None)
 @example(dt=0.001, radius=1.0, v=0.3, where=0.25, kind="velocity", amount=0.0, angle=0.0, seed=0)
 @given(st.sampled_from([0.01, 0.002, 0.001]), st.floats(1.0, 5.0), st.floats(0.3, 2.0), st.floats(0.2, 0.8),
        st.sampled_from(["position", "velocity"]), st.floats(0.0, 1.0), st.floats(-math.pi, math.pi),

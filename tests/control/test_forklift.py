@@ -30,7 +30,7 @@ def _thesis_rows(beta3):
             generic_slip_rows(beta3, L3, -math.pi / 2, 0, 0, 0, R, 0)]
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=200, deadline=None)
 @given(vx=st.floats(-2, 2), vy=st.floats(-2, 2), theta=st.floats(-math.pi, math.pi), quadrants=st.sampled_from([2, 4]))
 @example(vx=1.0, vy=0.0, theta=0.0, quadrants=2)  # R v_y = 0: sign(R v_y) of (8.51) undefined (docs/errata.md)
 @example(vx=-1.0, vy=0.0, theta=0.0, quadrants=2)
@@ -79,7 +79,7 @@ def test_ik_of_large_velocities_does_not_overflow(recwarn):
     assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(vx=st.floats(-2, 2), vy=st.floats(-2, 2), theta=st.floats(-math.pi, math.pi))
 def test_ik_equals_the_generic_per_wheel_ik_on_the_catalog_truck(vx, vy, theta):
     """The catalog forklift (REP-103: x = thesis Y, y = -thesis X) through wheel_commands: thesis spins negated,

@@ -37,7 +37,7 @@ def _signal(seed: int, n: int, m: int, kind: int) -> np.ndarray:
     return x
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=200, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), n=st.integers(3, 90), m=st.integers(1, 3), kind=st.integers(0, 3),
        turn=st.sampled_from([None, np.pi, 2 * np.pi]))
 def test_the_compiled_passes_give_the_numpy_bits(seed, n, m, kind, turn):

@@ -117,7 +117,7 @@ def _ranged(name: str) -> Robot:
 
 @pytest.mark.parametrize("robot", [catalog.load("ackermann"), _ranged("swerve-4"), _ranged("agv-drive-unit"),
                                    _ranged("thesis-steer-castor"), catalog.load("forklift")], ids=lambda r: r.name)
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=200, deadline=None)
 @given(twist=st.lists(st.floats(-3, 3), min_size=3, max_size=3), turns=st.lists(st.floats(-9, 9), min_size=4,
                                                                                   max_size=4), still=st.integers(0, 3))
 def test_the_loops_plain_float_steering_is_the_ik_and_the_steering_choice_bit_for_bit(robot, twist, turns, still):

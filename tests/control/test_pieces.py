@@ -58,7 +58,7 @@ def test_coupled_loops_disturb_each_other_and_uncoupled_do_not():
 REDUCED = [n for n in catalog.names() if control_point(catalog.load(n)).reduced]
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=100, deadline=None)
 @given(name=st.sampled_from(REDUCED), vx=st.floats(-2, 2), vy=st.floats(-2, 2), th=st.floats(-math.pi, math.pi))
 def test_point_twist_gives_the_point_its_velocity_and_no_slip(name, vx, vy, th):
     """The admissible twist (null space of (8.14)) moves P at the wanted world velocity and the fixed wheels do not
@@ -173,7 +173,7 @@ def test_stanley_s_projection_past_a_corner_takes_the_leg_ahead(size):
         assert turned > (0.99 * arc / math.hypot(3.993, 2.7) if robot == "ackermann" else 0.5), (robot, turned)
 
 
-@settings(max_examples=60)
+@settings(max_examples=200)
 @given(st.floats(-math.pi, math.pi), st.lists(st.tuples(st.floats(1.0, 3.0), st.floats(-1.5, 1.5)), min_size=1,
                                               max_size=4),
        st.floats(0.05, 0.5), st.data())

@@ -120,7 +120,7 @@ def test_commands_tend_to_the_no_slip_ik_as_the_friction_stiffens(whole):
     assert sizes[2] / sizes[1] == pytest.approx(0.1, rel=0.03)
 
 
-@settings(max_examples=6, deadline=None)
+@settings(max_examples=20, deadline=None)
 @given(st.floats(0.3, 2.0), st.floats(-0.35, 0.35))
 def test_forklift_inverse_then_forward_is_the_identity(v, curvature):
     inv = slip_inverse(FORK)

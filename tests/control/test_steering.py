@@ -26,6 +26,7 @@ def _wrapped(a):
     return np.angle(np.exp(1j * np.asarray(a)))
 
 
+@settings(max_examples=300)
 @given(h=angles, s=st.floats(-5, 5), cur=angles, lo=st.floats(-math.pi, 0), width=st.floats(0.5, 2 * math.pi - 0.1))
 def test_choice_is_a_root_and_within_range(h, s, cur, lo, width):
     """The chosen (heading, spin) is (h, s) or (h + pi, -s), and inside the range whenever one root fits."""
@@ -51,6 +52,7 @@ def test_closest_breaks_a_tie_by_rolling_forward(h, s):
     assert c.spin[0] == abs(s) and abs(_wrapped(c.heading[0] - (h if s > 0 else h + math.pi))) < 1e-12
 
 
+@settings(max_examples=300)
 @given(h=angles, s=st.floats(-5, 5))
 def test_quadrant_policies(h, s):
     four = choose_steering([h], [s], [0.0], policy="4-quadrant")
@@ -85,7 +87,7 @@ def test_crab_mode_points_every_module_the_same_way():
 
 
 @given(cx=st.floats(-3, 3), cy=st.floats(-3, 3), w=st.floats(0.1, 2))
-@settings(max_examples=40)
+@settings(max_examples=200)
 def test_icr_mode_rolls_every_module_perpendicular_to_the_icr(cx, cy, w):
     """Arbitrary ICR (ros2_controllers #2000): each module's rolling direction is perpendicular to ICR -> module."""
     pos = np.array([wh.position for wh in SWERVE.wheels])
@@ -104,6 +106,7 @@ def test_ackermann_mode_puts_the_icr_on_the_virtual_rear_axle():
     np.testing.assert_allclose(ackermann_twist(1.0, 0.0, -0.28), [1, 0, 0])
 
 
+@settings(max_examples=300)
 @given(vx=st.floats(-3, 3), vy=st.floats(-3, 3), w=st.floats(-4, 4), dt=st.floats(0.005, 0.5))
 def test_skew_free_twist_ends_at_the_straight_pose(vx, vy, w, dt):
     """Held for dt through the exact SE(2) step, the discretised twist ends at (vx dt, vy dt, omega dt)."""
