@@ -169,7 +169,7 @@ def _rk4_through_knots(time, twists, t_out, pose0, h=2e-3):
 _knot = st.tuples(st.floats(-2, 2), st.floats(-1, 1), st.floats(-3, 3))
 
 
-@settings(max_examples=25)
+@settings(max_examples=75)
 @given(st.lists(st.tuples(st.floats(-1, 3.5), _knot), min_size=1, max_size=5, unique_by=lambda k: round(k[0], 3)),
        st.sampled_from([0.05, 0.1, 0.3, 0.7]), st.floats(-0.5, 0.5), st.floats(0.5, 3.0),
        st.tuples(st.floats(-5, 5), st.floats(-5, 5), st.floats(-4, 4)), st.booleans())
