@@ -93,7 +93,7 @@ def _corrupt(data: bytes, op: tuple) -> bytes:
     return b"\n".join(lines[:k + 1] + lines[k:])
 
 
-@settings(max_examples=120)
+@settings(max_examples=400)
 @given(n=st.integers(2, 12), ops=st.lists(_CORRUPTIONS, min_size=1, max_size=3))
 def test_a_corrupted_log_gives_a_clean_error_or_the_correct_pose(tmp_path_factory, n, ops):
     data = _valid_log(n).encode()

@@ -34,7 +34,7 @@ def _size(robot) -> float:
     return max(abs(getattr(w, f)) for w in robot.wheels for f in LENGTH_FIELDS)
 
 
-@settings(max_examples=60)
+@settings(max_examples=180)
 @given(robot=robots(max_wheels=3), exponent=st.floats(math.log10(MIN_SIZE), math.log10(MAX_SIZE)))
 def test_the_same_robot_at_any_size_of_the_envelope_gets_the_same_answers(robot, exponent):
     scaled = _scaled(robot, 10.0**exponent / _size(robot))
@@ -49,7 +49,7 @@ def test_the_same_robot_at_any_size_of_the_envelope_gets_the_same_answers(robot,
     assert (a.mobility, a.steerability, a.type) == (b.mobility, b.steerability, b.type)
 
 
-@settings(max_examples=15)
+@settings(max_examples=60)
 @given(robot=robots(max_wheels=3), exponent=st.floats(math.log10(MIN_SIZE), math.log10(MAX_SIZE)))
 def test_a_model_of_a_scaled_robot_solves_its_own_no_slip_equations(robot, exponent):
     scaled = _scaled(robot, 10.0**exponent / _size(robot))
@@ -97,7 +97,7 @@ def test_the_envelope_s_edges_are_accepted_and_just_beyond_refused():
         robot_from_dict(tiny)
 
 
-@settings(max_examples=25)
+@settings(max_examples=75)
 @given(robot=robots(max_wheels=3), exponent=st.sampled_from([math.log10(MIN_SIZE), math.log10(MAX_SIZE)]),
        beta=st.lists(st.floats(-3, 3), min_size=3, max_size=3))
 def test_the_default_lengths_scale_with_the_robot_at_the_ends_of_the_envelope(robot, exponent, beta):

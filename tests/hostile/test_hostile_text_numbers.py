@@ -128,7 +128,7 @@ def _loadtxt_finite(text: str) -> float | None:
     return float(value) if np.isfinite(value) else None
 
 
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=1000, deadline=None)
 @given(st.text(alphabet="0123456789.eE+-_ \t\u0661\uff14naifxINF", max_size=8))
 def test_the_grammar_is_numpys_finite_numbers(text):
     """Accepted exactly when numpy's reader gives a finite number, and then as the same number (another reader)."""
