@@ -143,7 +143,7 @@ def test_427_a_square_jacobian_with_nothing_selected_is_inverted():
 ONE_CONTACT = ["fixed", "steerable", "castor", "swedish", "ball", "orthogonal"]
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=400, deadline=None)
 @given(st.lists(st.sampled_from([*ONE_CONTACT, "double", "double_castor"]), min_size=1, max_size=3).flatmap(
     lambda types: st.tuples(*[wheels(t, name=f"w{i}") for i, t in enumerate(types)])))
 def test_minimal_actuator_sets_are_the_assignable_wheel_rate_sets(ws):
@@ -181,7 +181,7 @@ def _tree_from_constraints(robot: Robot, joints) -> tuple[bool, bool]:
     return consistent, bool(np.abs(null[:, :3]).max(initial=0.0) < 1e-9)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=400, deadline=None)
 @given(st.lists(st.sampled_from([*ONE_CONTACT, "double", "double_castor"]), min_size=1, max_size=3).flatmap(
     lambda types: st.tuples(*[wheels(t, name=f"w{i}") for i, t in enumerate(types)])))
 def test_the_trees_agree_with_the_no_slip_equations_double_wheels_included(ws):

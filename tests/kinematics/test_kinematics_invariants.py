@@ -55,7 +55,7 @@ def _scale(robot: Robot, twist) -> float:
     return 1.0 + float(np.abs(twist).sum()) * (1 + max(w.l + abs(w.d) + w.b for w in robot.wheels))
 
 
-@settings(max_examples=60)
+@settings(max_examples=500)
 @given(robot=robots(max_wheels=4), twist=_twists, c=st.lists(st.floats(-1, 1), min_size=2, max_size=2).map(np.array),
        phi=st.floats(-math.pi, math.pi))
 def test_moving_the_reference_frame_transforms_the_twist_and_keeps_the_joint_rates(robot, twist, c, phi):
@@ -78,7 +78,7 @@ def test_moving_the_reference_frame_transforms_the_twist_and_keeps_the_joint_rat
     np.testing.assert_allclose(got2, moved_twist(got, c, phi), atol=1e-6 * _scale(robot, twist))
 
 
-@settings(max_examples=60)
+@settings(max_examples=500)
 @given(robot=robots(max_wheels=4), twist=_twists)
 def test_a_robot_mirrored_in_y_mirrors_the_twist_and_keeps_the_spins(robot, twist):
     mirror = mirrored(robot)
@@ -102,7 +102,7 @@ def test_a_robot_mirrored_in_y_mirrors_the_twist_and_keeps_the_spins(robot, twis
     np.testing.assert_allclose(got2, got * np.array([1.0, -1.0, -1.0]), atol=1e-6 * _scale(robot, twist))
 
 
-@settings(max_examples=40)
+@settings(max_examples=400)
 @given(robot=robots(max_wheels=4), twist=_twists, k=st.floats(1e-3, 1e3))
 def test_every_length_times_k_scales_the_linear_velocities_and_keeps_the_joint_rates(robot, twist, k):
     a, b = wheel_commands(robot, twist), wheel_commands(scaled(robot, k), twist * np.array([k, k, 1.0]))
@@ -117,7 +117,7 @@ def test_every_length_times_k_scales_the_linear_velocities_and_keeps_the_joint_r
     np.testing.assert_array_equal(np.where(crossed, a.feasible, b.feasible), a.feasible)
 
 
-@settings(max_examples=40)
+@settings(max_examples=400)
 @given(robot=robots(max_wheels=4), twist=_twists, data=st.data())
 def test_reordering_the_wheels_permutes_the_results_and_nothing_else(robot, twist, data):
     order = data.draw(st.permutations(range(len(robot.wheels))))

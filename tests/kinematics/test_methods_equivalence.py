@@ -29,7 +29,7 @@ from wmrkit.kinematics.trees import (
     wheel_jacobians,
 )
 
-EXAMPLES = settings(max_examples=25)
+EXAMPLES = settings(max_examples=200)
 
 
 def clear_ranks(*matrices: np.ndarray) -> bool:

@@ -70,7 +70,7 @@ def test_exact_numbers():
     assert exact_number(0.123456789, "length") == sp.Rational(123456789, 10**9)
 
 
-@settings(max_examples=12)
+@settings(max_examples=40)
 @given(robots(max_wheels=3))
 def test_symbolic_matrix_is_the_numeric_one(robot):
     """Built from the same kernel: equal to Robot.constraint_matrix at random steering angles."""
@@ -82,7 +82,7 @@ def test_symbolic_matrix_is_the_numeric_one(robot):
                                    rtol=0, atol=1e-12)
 
 
-@settings(max_examples=10)
+@settings(max_examples=40)
 @given(robots(max_wheels=3))
 def test_symbolic_geometry_evaluates_to_the_numeric_matrix(robot):
     """geometry="symbolic" for every wheel type: substituting the wheels' numbers gives Robot.constraint_matrix."""
@@ -146,7 +146,7 @@ def millimetres(robot: Robot) -> Robot:
                                        for w in robot.wheels))
 
 
-@settings(max_examples=10)
+@settings(max_examples=30)
 @given(robots(max_wheels=3).map(millimetres))
 def test_closed_form_is_the_numeric_least_squares(robot):
     """M(beta) q_a equals solve_assigned (4.11) for the sensed rates and for the twist, when determined."""

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import assume, given
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from strategies import robots
@@ -247,6 +247,7 @@ def _feasible(robot: Robot, twist: np.ndarray) -> np.ndarray:
     return twist - np.linalg.pinv(rows) @ (rows @ twist) if len(rows) else twist
 
 
+@settings(max_examples=400)
 @given(robot=robots(max_wheels=4), raw=st.lists(st.floats(-2, 2), min_size=3, max_size=3))
 def test_ik_then_fk_returns_the_twist_and_no_wheel_slips(robot, raw):
     twist = _feasible(robot, np.array(raw))
