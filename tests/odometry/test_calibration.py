@@ -76,7 +76,7 @@ def test_a_closed_square_cut_short_biases_the_track_and_is_flagged():
     assert at_rest.value("left.l") == pytest.approx(0.2 * 1.03, rel=1e-9) and not at_rest.warnings
 
 
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=36, deadline=None)
 @given(ratio=st.floats(-0.02, 0.02), track=st.floats(-0.05, 0.05), side=st.sampled_from([1.0, 1.5, 2.5]),
        first_clockwise=st.booleans())
 def test_zero_noise_closed_squares_recover_the_truth(ratio, track, side, first_clockwise):

@@ -77,7 +77,7 @@ def _recursion(poses, inc, q, method, p0):
     return np.array(out)
 
 
-@settings(max_examples=25)
+@settings(max_examples=100)
 @given(st.integers(1, 40), st.sampled_from(METHODS), st.integers(0, 2**32 - 1), st.floats(-50, 50))
 def test_closed_form_propagation_equals_the_recursion(n, method, seed, offset):
     rng = np.random.default_rng(seed)

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wmrkit.errors import UnknownNameError
@@ -48,6 +48,7 @@ def test_wrap_around_of_fixed_width_counters(bits, signed):
     np.testing.assert_array_equal(enc.count_increments(shown), steps)
 
 
+@settings(max_examples=400)
 @given(st.integers(2, 63), st.booleans(), st.lists(st.integers(-(1 << 60), 1 << 60), min_size=2, max_size=30))
 def test_unwrap_recovers_any_steps_below_half_the_range(bits, signed, raw):
     half = 1 << (bits - 1)

@@ -8,7 +8,7 @@ import math
 import mpmath
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wmrkit import ShapeError, WmrkitError
@@ -210,6 +210,7 @@ def test_external_heading_replaces_the_wheel_heading():
         np.testing.assert_allclose(poses, integrate_increments([1.0, 2.0, heading[0]], swapped, method), atol=1e-13)
 
 
+@settings(max_examples=400)
 @given(st.floats(-3, 3), st.floats(-1, 1), st.floats(-1, 1), st.floats(-6, 6))
 def test_exact_steps_form_a_one_parameter_group(theta, dx, dy, dth):
     """exp(u/2) exp(u/2) = exp(u): two half steps of a constant twist are one step."""

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wmrkit import Robot, catalog
@@ -187,6 +187,7 @@ def test_from_positions_differences_and_midpoint_steering():
     np.testing.assert_allclose(out.increments_robot, ref.increments_robot, atol=1e-12)  # steering wraps across pi
 
 
+@settings(max_examples=300)
 @given(st.floats(-50, 50))
 def test_wrap_angle(a):
     w = wrap_angle(a)

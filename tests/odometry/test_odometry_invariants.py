@@ -56,7 +56,7 @@ def _parallel(gap: float, r1: float) -> Robot:
 _arcs = {"robot": robots(max_wheels=4), "raw": st.lists(st.floats(-1, 1), min_size=3, max_size=3).map(np.array)}
 
 
-@settings(max_examples=20)
+@settings(max_examples=60)
 @given(**_arcs, chunk=st.integers(1, 7))
 @example(robot=_parallel(2.7557313707070068e-06, 0.01171875), raw=np.array([0.0, 1.0, 0.0]), chunk=1)  # theta off 4e-10
 def test_exact_odometry_recovers_the_synthetic_arc_and_chunks_change_nothing(robot, raw, chunk):
@@ -74,7 +74,7 @@ def test_exact_odometry_recovers_the_synthetic_arc_and_chunks_change_nothing(rob
             np.testing.assert_allclose(whole.poses, run.truth, atol=(1e-12 + _roundoff(model, run.log)) * scale)
 
 
-@settings(max_examples=20)
+@settings(max_examples=60)
 @given(**_arcs)
 def test_the_log_played_backwards_from_the_end_retraces_the_path(robot, raw):
     """The exact step's inverse is the step of the negated increment, and RK2's midpoint rule is symmetric: both
@@ -123,7 +123,7 @@ def _rollers_only(draw):
                             for w in (draw(wheels(draw(kinds), name=f"w{i}")) for i in range(n))))
 
 
-@settings(max_examples=20)
+@settings(max_examples=60)
 @given(robot=_rollers_only(), rate=st.sampled_from([3.0, 5.0, 10.0, 20.0, 30.0]),
        pose0=st.tuples(st.floats(-3, 3), st.floats(-3, 3), st.floats(-3, 3)),
        segments=st.lists(st.tuples(st.integers(1, 10), st.lists(st.floats(-1, 1), min_size=3, max_size=3)),

@@ -110,7 +110,7 @@ def test_degrees_and_counts_read_as_headings(capsys, tmp_path):
     _same_angles(back.positions, run.log.positions)
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=100, deadline=None)
 @given(heading=st.floats(-math.pi, math.pi), speed=st.floats(0.1, 2.0))
 def test_swerve_modules_at_one_heading_drive_the_robot_along_it(heading, speed):
     """ROS-style joint data (steering 0 = straight ahead): four modules held at heading h, wheels rolling at
