@@ -31,7 +31,7 @@ def manoeuvre(vehicle, rho, xi, direction, n=3000):
     return [arc_poses(s.start, s.direction, s.curvature, s.length, n) for s in segs]
 
 
-@settings(max_examples=60)
+@settings(max_examples=200)
 @given(vehicles, st.floats(0.1, 6.0), st.floats(0.01, math.pi / 2), st.sampled_from([-1, 1]))
 def test_lateral_reach_9_33_is_the_sampled_maximum_of_the_second_arc(vehicle, rho, xi, direction):
     """(9.33) with the clamp theta = min(delta_i, xi): the leading outer corner's farthest lateral reach."""
@@ -43,7 +43,7 @@ def test_lateral_reach_9_33_is_the_sampled_maximum_of_the_second_arc(vehicle, rh
     assert lateral_reach(vehicle, rho, xi, 1 if direction < 0 else 2) == pytest.approx(reach, abs=step)
 
 
-@settings(max_examples=40)
+@settings(max_examples=150)
 @given(vehicles, st.floats(0.05, 3.0), st.floats(0.01, math.pi / 2), st.sampled_from([-1, 1]))
 def test_with_rho_at_least_half_the_width_the_second_arc_decides(vehicle, rho, xi, direction):
     """The thesis's "only the second arc matters": no part of the body reaches farther over the whole manoeuvre."""
@@ -66,7 +66,7 @@ def test_errata_9_33_maximum_needs_the_clamp():
     assert lateral_reach(CAR_91, rho, xi, 2) == pytest.approx(true_reach, abs=1e-5)
 
 
-@settings(max_examples=60)
+@settings(max_examples=200)
 @given(vehicles, st.one_of(st.floats(0.05, 0.95), st.floats(1.05, 2.0)), st.floats(0.01, math.pi / 2),
        st.sampled_from([-1, 1]))
 def test_algorithm_1_front_rear_overshoot(vehicle, scale, xi, direction):
@@ -122,7 +122,7 @@ def test_algorithm_2_no_constraint_in_example_1():
     assert approach_offset_closed_form(CAR_91, 1.05 / math.tan(math.radians(37)), math.radians(71.97)) is None
 
 
-@settings(max_examples=40)
+@settings(max_examples=150)
 @given(vehicles, st.floats(0.1, 6.0), st.floats(0.01, math.pi / 2))
 def test_trailing_dip_is_the_sampled_swing_of_the_first_arc(vehicle, rho, xi):
     """Reversing to the left (away from y < 0), the front-right corner swings right in the first arc."""

@@ -7,7 +7,7 @@ from dataclasses import asdict
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from parking_cases import CAR_91, CAR_92, SLOT_91, arc_poses, corners_world
 
@@ -32,6 +32,7 @@ rho_st = st.floats(0.2, 20.0)
 xi_st = st.floats(0.01, math.pi / 2)
 
 
+@settings(max_examples=300)
 @given(rho_st, xi_st, st.sampled_from([-1, 1]), st.sampled_from([-1, 1]))
 def test_symmetric_arcs_displacement_9_31(rho, xi, direction, side):
     """Two arcs of opposite curvature end parallel, displaced by (Y, X) of (9.31); the second ICR is at (Y, Z)."""
@@ -45,6 +46,7 @@ def test_symmetric_arcs_displacement_9_31(rho, xi, direction, side):
     np.testing.assert_allclose(icr, [direction * Y, side * Z], atol=1e-9 * max(1, rho))
 
 
+@settings(max_examples=300)
 @given(rho_st, xi_st)
 def test_inverse_solutions_of_9_31(rho, xi):
     X, Y, _ = arcs_displacement(rho, xi)
@@ -63,6 +65,7 @@ def test_turning_radius_9_27_and_ratio_9_37():
     assert length_ratio(CAR_92, Space(3.30, 3.6, 0.12, 0.17, 0.17)) == pytest.approx(0.706, abs=5e-4)
 
 
+@settings(max_examples=300)
 @given(st.floats(0.05, 5.0), st.floats(0.0, math.pi / 2))
 def test_corner_polar_coordinates_9_28_to_9_30(rho, theta):
     """(9.29): at angle theta of the last arc each corner sits at d_i (9.28) from the ICR, at theta -+ delta_i."""
@@ -86,6 +89,7 @@ def test_corner_angle_uses_atan2_for_icr_inside_the_width():
     assert math.pi / 2 < corner_angle(CAR_91, rho, 4) <= math.pi
 
 
+@settings(max_examples=300)
 @given(st.floats(0.05, 3.0), st.one_of(st.just(0.0), st.floats(0.01, 1.0), st.floats(-1.0, -0.01)),
        st.sampled_from([-1, 1]))
 def test_arc_end_and_sampled_poses_agree_with_the_exact_integrator(length, curvature, direction):

@@ -67,7 +67,7 @@ cars = st.builds(
     st.floats(1.0, 2.5), st.floats(1.5, 3.5), st.floats(0.3, 1.5), st.floats(0.2, 1.2), st.floats(25.0, 45.0))
 
 
-@settings(max_examples=12)
+@settings(max_examples=36)
 @given(cars, st.floats(0.1, 1.0), st.floats(0.0, 0.3), st.floats(0.0, 1.0), st.floats(0.0, 1.0),
        st.floats(1.0, 100.0))
 def test_a_longer_slot_never_turns_yes_into_no_nor_needs_more_manoeuvres(car, room, margin, offset, where, longer):

@@ -96,7 +96,7 @@ def problems(draw):
     return Vehicle(a1, b1, c1, h1, 0.5, phi), Space(max(H, 0.1), max(J, 0.1), ms, max(dx2, 0.0), gap)
 
 
-@settings(max_examples=80)
+@settings(max_examples=240)
 @given(problems())
 def test_planner_never_loops_and_feasible_plans_are_exactly_collision_free(problem):
     vehicle, space = problem
@@ -147,7 +147,7 @@ def test_errata_algorithm_5_travel_is_the_free_length(car, slot):
             assert report.what == "front"
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(seed=st.integers(0, 10**6), step=st.floats(0.001, 0.01))
 def test_densified_poses_move_no_corner_more_than_the_step(seed, step):
     """Between neighbours of :func:`densify` no corner of the car moves more than `step` (corners placed by

@@ -39,7 +39,7 @@ cars = st.builds(
     st.floats(1.0, 2.5), st.floats(1.5, 3.5), st.floats(0.3, 1.5), st.floats(0.2, 1.2), st.floats(25.0, 45.0))
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=100, deadline=None)
 @given(cars, st.floats(0.1, 1.0), st.floats(0.0, 0.3), st.floats(0.0, 1.0), st.floats(0.0, 1.0),
        st.floats(0.0, 1.0))
 def test_a_wider_slot_is_refused_only_for_the_manoeuvre_bound(car, room, margin, offset, where, extra):
