@@ -49,7 +49,7 @@ def forklift_wls(u1, u2, beta3, k11, k12, mx=1.0):
     return wls(robot, SPINS, np.stack([u1, u2], -1) / R, np.asarray(beta3)[..., None] + np.pi / 2, w)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=200, deadline=None)
 @given(st.floats(-5, 5), st.floats(-5, 5), st.floats(-1.5, 1.5), st.floats(-3, 2), st.floats(-3, 2),
        st.sampled_from([1.0, 0.05, 20.0]))
 def test_general_wls_is_the_forklift_closed_form(u1, u2, beta3, lk11, lk12, mx):

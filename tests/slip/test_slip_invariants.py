@@ -19,7 +19,7 @@ def _law(v_slip, v_body, loads):
     return -np.tanh(v_slip / 0.5) * loads[..., None]
 
 
-@settings(max_examples=40)
+@settings(max_examples=300)
 @given(robot=robots(max_wheels=4), c=st.tuples(st.floats(-1, 1), st.floats(-1, 1)), phi=st.floats(-3, 3),
        data=st.data())
 def test_slip_models_transform_with_the_frame_and_the_mirror(robot, c, phi, data):
