@@ -31,7 +31,7 @@ FUZZ = st.recursive(
 )
 
 
-@settings(max_examples=20, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=100, suppress_health_check=[HealthCheck.too_slow])
 @given(robots(max_wheels=3))
 def test_live_analysis_equals_library(robot):
     try:
@@ -48,7 +48,7 @@ def test_live_analysis_equals_library(robot):
     assert (k is None and (want is None or not math.isfinite(want))) or k == pytest.approx(want, rel=1e-9)
 
 
-@settings(max_examples=60, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=200, suppress_health_check=[HealthCheck.too_slow])
 @given(st.sampled_from(["/api/analyze", "/api/drive", "/api/kappa", "/api/configurations", "/api/open"]),
        st.dictionaries(st.sampled_from(["description", "twist", "heading", "wheels", "resolution", "catalog",
                                         "samples", "duration"]), FUZZ, max_size=4))
