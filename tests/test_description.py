@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wmrkit import KINDS, DescriptionError, Robot, Wheel, catalog
@@ -331,6 +331,7 @@ def descriptions(draw) -> tuple[dict, list[dict]]:
     return data, expected
 
 
+@settings(max_examples=200)
 @given(description=descriptions())
 def test_valid_descriptions_load_with_si_values_and_round_trip(description, tmp_path_factory):
     data, expected = description
@@ -350,6 +351,7 @@ def test_valid_descriptions_load_with_si_values_and_round_trip(description, tmp_
     assert Robot.from_dict(robot.to_dict()) == robot
 
 
+@settings(max_examples=300)
 @given(descriptions(), st.data())
 def test_line_numbers_are_one_based_and_right(description, data):
     """Break one field of a dumped description: the error is on that field's line, found by scanning the text."""
@@ -412,6 +414,7 @@ def _broken(draw) -> dict:
     return data
 
 
+@settings(max_examples=300)
 @given(_broken())
 def test_broken_descriptions_raise_only_description_errors(data):
     _assert_only_description_errors(lambda: Robot.from_dict(data))
@@ -419,11 +422,13 @@ def test_broken_descriptions_raise_only_description_errors(data):
     _assert_only_description_errors(lambda: robot_from_text(json.dumps(data), source="b", fmt="json"))
 
 
+@settings(max_examples=500)
 @given(st.text(max_size=300), st.sampled_from(["yaml", "json"]))
 def test_random_text_raises_only_description_errors(text, fmt):
     _assert_only_description_errors(lambda: robot_from_text(text, source="r", fmt=fmt))
 
 
+@settings(max_examples=300)
 @given(st.data())
 def test_damaged_valid_text_raises_only_description_errors(data):
     text = yaml.safe_dump(data.draw(descriptions())[0], sort_keys=False)

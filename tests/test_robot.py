@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.linalg import null_space
 
@@ -53,6 +53,7 @@ def test_frozen_hashable_and_read_only():
         r.beta[0] = 1.0
 
 
+@settings(max_examples=300)
 @given(robots())
 def test_dict_round_trip(robot):
     again = Robot.from_dict(robot.to_dict())
@@ -113,6 +114,7 @@ def _jacobian_system(robot: Robot, beta: np.ndarray) -> np.ndarray:
     return m
 
 
+@settings(max_examples=400)
 @given(robot=robots(), seed=st.integers(0, 2**32 - 1))
 def test_jacobian_form_agrees_with_constraint_matrix(robot, seed):
     """Every (twist, rates) in the null space of A (3.23) satisfies I_bar twist = J q_w (3.20), and back."""

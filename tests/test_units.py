@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wmrkit import parse_quantity
@@ -37,6 +37,7 @@ def test_examples(text, kind, si):
     assert parse_quantity(text, kind) == pytest.approx(si, rel=1e-15)
 
 
+@settings(max_examples=500)
 @given(x=st.floats(-1e6, 1e6), data=st.data())
 def test_any_number_with_any_unit(x, data):
     kind = data.draw(st.sampled_from(["length", "angle"]))
@@ -93,6 +94,7 @@ def test_rejections_say_why(value, kind, message):
     assert isinstance(err.value, ValueError)
 
 
+@settings(max_examples=500)
 @given(st.text(max_size=20) | st.from_type(object), st.sampled_from(["length", "angle", "number"]))
 def test_anything_else_is_a_unit_error_or_a_finite_float(value, kind):
     try:
@@ -126,6 +128,7 @@ def test_decimal_units_give_the_float_nearest_the_quantity_written(unit):
         assert parse_quantity(f"{text} {unit}", kind) == float(Fraction(text) * Fraction(DECIMAL_FACTORS[unit])), text
 
 
+@settings(max_examples=500)
 @given(st.decimals(allow_nan=False, allow_infinity=False, places=6, min_value=-10**6, max_value=10**6),
        st.sampled_from(sorted(DECIMAL_FACTORS)))
 def test_any_decimal_with_a_decimal_unit_is_read_exactly(number, unit):

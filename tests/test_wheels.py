@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy import cos, sin
 from scipy.linalg import null_space
@@ -87,6 +87,7 @@ def _oracle(robot: Robot, beta: np.ndarray, q_dot: np.ndarray, frame: str) -> np
 
 # ---- oracle 1: the generic slip rows are the 3-D slip velocity ---------------------------------------------------
 @pytest.mark.parametrize("type_name", list(KINDS))
+@settings(max_examples=250)
 @given(data=st.data())
 def test_constraint_matrix_is_the_3d_slip_velocity(type_name, data):
     w = data.draw(wheels(type_name, name="u"))
@@ -106,6 +107,7 @@ def test_constraint_matrix_is_the_3d_slip_velocity(type_name, data):
                                                                  own, "roller"), atol=1e-12)
 
 
+@settings(max_examples=400)
 @given(data=st.data())
 def test_generic_rows_match_3d_oracle_with_all_parameters(data):
     """The fully general wheel (3.6)/(3.10): d, delta, gamma and r_r all non-zero at once (castor with rollers)."""
@@ -121,6 +123,7 @@ def test_generic_rows_match_3d_oracle_with_all_parameters(data):
 
 
 # ---- oracle 2: particularisations (3.11)-(3.13), written out from the digest ---------------------------------------
+@settings(max_examples=400)
 @given(l=st.floats(0, 2), alpha=st.floats(-4, 4), beta=st.floats(-4, 4), d=st.floats(-1, 1), delta=st.floats(-4, 4),
        gamma=st.floats(-4, 4), r=st.floats(0.01, 1), rim=st.floats(0.01, 1))
 def test_particularisations(l, alpha, beta, d, delta, gamma, r, rim):
@@ -158,6 +161,7 @@ def _jacobians_3_19(l, alpha, beta, d, delta, gamma, r, r_r):
     return np.array(j_fo), np.array(j_s), np.array(j_c)
 
 
+@settings(max_examples=400)
 @given(l=st.floats(0, 2), alpha=st.floats(-4, 4), beta=st.floats(-4, 4), d=st.floats(-1, 1), delta=st.floats(-4, 4),
        gamma=st.floats(-4, 4), r=st.floats(0.01, 1), rim=st.floats(0.01, 1))
 def test_jacobians_3_19_and_determinants(l, alpha, beta, d, delta, gamma, r, rim):
@@ -182,6 +186,7 @@ def test_determinant_oracles():
 
 
 @pytest.mark.parametrize("type_name", ["fixed", "steerable", "castor", "swedish", "ball", "orthogonal"])
+@settings(max_examples=300)
 @given(data=st.data())
 def test_jacobian_pairs_do_not_slip(type_name, data):
     """Every (twist, wheel rates) with twist = J q_w (3.18) makes both slip rows (3.6) zero."""
@@ -218,6 +223,7 @@ def _no_slip_motions(robot: Robot, rng: np.random.Generator, n: int = 8) -> np.n
 
 
 @pytest.mark.parametrize("unit", ["double", "double_castor"])
+@settings(max_examples=300)
 @given(data=st.data())
 def test_double_units_equal_their_single_wheel(unit, data):
     """Semisum (3.28)/(3.35) and semidifference (3.29)/(3.36) from random no-slip motions of the unit."""
@@ -317,6 +323,7 @@ def test_errata_3_4_body_velocity_is_planar(type_name):
     np.testing.assert_allclose(a[:, 2], np.concatenate(expected), atol=1e-15)
 
 
+@settings(max_examples=300)
 @given(l=st.floats(0, 2), alpha=st.floats(-4, 4), beta=st.floats(-4, 4), d=st.floats(-1, 1), delta=st.floats(-4, 4),
        gamma=st.floats(-4, 4), r=st.floats(0.01, 1), r_r=st.floats(0.01, 1))
 def test_errata_3_6_3_10_layout_and_distance_components(l, alpha, beta, d, delta, gamma, r, r_r):
