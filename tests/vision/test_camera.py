@@ -35,6 +35,7 @@ def printed_9_3(psi: float, phi: float) -> np.ndarray:
     return np.array([[cp, sp, 0], [sp * cf, -cp * cf, -sf], [sp * sf, cp * sf, -cf]])
 
 
+@settings(max_examples=300)
 @given(angles, tilts)
 def test_errata_9_3_printed_matrix_is_not_a_rotation_r_prime_is(psi, phi):
     r = rotation(psi, phi)
@@ -49,6 +50,7 @@ def test_errata_9_3_printed_matrix_is_not_a_rotation_r_prime_is(psi, phi):
     np.testing.assert_allclose(rotation(0.0, phi), printed_9_3(0.0, phi), atol=1e-15)
 
 
+@settings(max_examples=300)
 @given(angles, tilts, st.floats(-1, 1), st.floats(-1, 1), st.floats(0.5, 2))
 def test_projection_is_9_4_with_r_prime_numerators(psi, phi, tx, ty, tz):
     cp, sp, cf, sf = math.cos(psi), math.sin(psi), math.cos(phi), math.sin(phi)
@@ -70,6 +72,7 @@ def test_optical_axis_and_image_axes_in_the_ground_frame():
     np.testing.assert_allclose(np.cross(r[0], r[1]), r[2], atol=1e-15)  # right-handed
 
 
+@settings(max_examples=300)
 @given(st.floats(-2, 2), st.floats(-0.5, 0.5), angles, st.floats(0, 1.0))
 def test_extrinsics_place_the_lens_at_height_v_behind_p(x, y, theta, z_p):
     cam = Camera(300, 1.0, 0.4)
@@ -84,6 +87,7 @@ def test_extrinsics_place_the_lens_at_height_v_behind_p(x, y, theta, z_p):
     np.testing.assert_allclose(p_w[:2], [-y, x], atol=1e-12)
 
 
+@settings(max_examples=300)
 @given(st.floats(-300, 300), st.floats(-200, 200))
 def test_ground_from_image_inverts_projection(xu, yu):
     cam = Camera(320, 0.9, 0.5)
@@ -97,6 +101,7 @@ def test_ground_from_image_inverts_projection(xu, yu):
     assert camera_coordinates([g[0], g[1], 0.0], psi, cam.tilt, t)[2] > 0
 
 
+@settings(max_examples=300)
 @given(st.floats(-300, 300), st.floats(-240, 240), st.floats(-0.2, 0.2))
 def test_undistort_inverts_distort(x, y, k1):
     d = distort([x, y], k1, 400.0)
@@ -145,7 +150,7 @@ def test_undistort_round_trips_over_the_whole_image_across_the_accepted_k1(k1):
         assert np.all(np.diff(np.hypot(*undistort(ray, k1, f).T)) > 0)
 
 
-@settings(max_examples=300)
+@settings(max_examples=600)
 @given(st.floats(-0.999, 0.999), st.floats(50, 3000), st.integers(8, 1024), st.integers(8, 1024),
        st.floats(-0.5, 0.5), st.floats(-0.5, 0.5))
 def test_undistort_inverts_distort_on_every_accepted_camera(k1, f, width, rows, a, b):

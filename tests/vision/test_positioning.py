@@ -25,7 +25,7 @@ def setups(draw):
     return cam, pose, z_p, spacing, n
 
 
-@settings(max_examples=200)
+@settings(max_examples=500)
 @given(setups(), st.floats(0.2, 5.0), st.floats(0.2, 5.0))
 def test_projection_then_positioning_recovers_psi_and_h_exactly(setup, ahead1, gap):
     cam, (x, y, theta), z_p, d, n = setup
