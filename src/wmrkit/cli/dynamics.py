@@ -120,7 +120,7 @@ def _check_program_step(step: float, name: str) -> None:
 
 def run_simulate(args: argparse.Namespace) -> int:
     """Simulate, print a summary, write and plot on request."""
-    from ..dynamics.deviation import deviation_warning
+    from ..dynamics.deviation import check_step, deviation_warning
     from ..dynamics.model import DynamicModel
     from ..dynamics.programs import path_program, read_torques
     from ..dynamics.simulate import MAX_STEPS, recordable_step, simulate
@@ -160,6 +160,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
                    record_step=recordable_step(model, duration, step, max(step, min(0.01, duration))),
                    progress=False if args.json else None)
+    check_step(model, inputs, sim, initial_twist=twist)  # a run off its path at an unstable step is refused
     if args.out:
         _write(sim, args.out)
     if args.plot:

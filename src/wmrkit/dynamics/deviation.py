@@ -4,15 +4,19 @@ A twist program (:func:`~wmrkit.dynamics.programs.twist_program`, the built-in p
 :func:`~wmrkit.dynamics.programs.path_program`) drives the wheels at the no-slip rates of body twists and does not
 feed the pose back: the robot goes where its tyres take it. :func:`nominal_poses` integrates the commanded twists
 (the pose rate of (3.15), ``R(theta) (vx, vy)`` and ``omega``) into the path the program describes, and
-:class:`PathDeviation` compares the simulated poses with it at the records' times.
+:class:`PathDeviation` compares the simulated poses with it at the records' times, and :func:`check_step` refuses a
+fixed-step run whose deviation a shorter step does not reproduce (the step's, not the robot's).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from ..errors import WmrkitError
 
 #: Largest position deviation, as a share of the programmed path's size, and largest heading deviation, as a share
 #: of the programmed turn taken within [:data:`MIN_TURN`, one turn], that a run may show without a warning (measured
@@ -141,3 +145,41 @@ def deviation_warning(model, inputs, deviation: PathDeviation, max_slip: float) 
                        "wmrkit calibrate, docs/slip.md)")
     return line + (f"its tyres slip (up to {max_slip:.3g} m/s): the program drives the wheel rates, not the pose "
                    "(docs/dynamics.md)")
+
+
+def check_step(model, inputs, sim, initial_twist=(0.0, 0.0, 0.0), jac_every: int = 20) -> None:
+    """Refuse a fixed-step run `sim` of `inputs` (a twist program, from `initial_twist` at ``sim.pose[0]``) that
+    left its program's path when a run at :func:`~wmrkit.dynamics.runs.recheck_step` is as far from it as the
+    path's own tolerance (:attr:`PathDeviation.large` with the program's size and turn): the deviation is then the
+    step's (an integrator unstable or far from converged with stiff tyres), not the robot's. The re-run goes from
+    t = 0 over at most :data:`~wmrkit.dynamics.runs.RECHECK_STEPS` of its steps (a quarter for rk4), on the run's
+    record times; a run that left its path by as much at both steps passes (its deviation is the robot's)."""
+    from .runs import RECHECK_STEPS, recheck_step
+    from .simulate import simulate
+
+    deviation = sim.deviation()
+    if sim.method == "adaptive" or deviation is None or not deviation.large or len(sim.t) < 2:
+        return
+    method = 0 if sim.method == "semi-implicit" else 1
+    step, fine = sim.step, recheck_step(sim.step, method)
+    every = round((sim.t[1] - sim.t[0]) / step)  # steps between records
+    m = min(len(sim.t), RECHECK_STEPS // (1 + 3 * method) // (every * round(step / fine)) + 1)
+    if m < 2:
+        return
+    try:
+        check = simulate(model, inputs, (m - 1) * every * step, step=fine, method=sim.method,
+                         initial_twist=initial_twist, initial_pose=sim.pose[0], record_step=every * step,
+                         progress=False, jac_every=jac_every)
+    except WmrkitError as e:
+        raise WmrkitError(f"the robot left the programmed path at step {step:g} s (up to {deviation.max_position:.3g} "
+                          f"m from it), and a run at step {fine:.3g} s to check it stops: {e}") from None
+    t, nominal = sim.t[:m], sim.nominal_pose[:m]
+    along = PathDeviation.of(t, check.pose, nominal)
+    apart = dataclasses.replace(PathDeviation.of(t, sim.pose[:m], check.pose), size=along.size, turn=along.turn)
+    if apart.large:
+        raise WmrkitError(
+            f"the robot left the programmed path at step {step:g} s (up to {deviation.max_position:.3g} m from it), "
+            f"but a run at step {fine:.3g} s to t = {t[-1]:g} s keeps within {along.max_position:.3g} m of the path "
+            f"and is up to {apart.max_position:.3g} m and {abs(apart.max_heading):.3g} rad from that run: the step is "
+            f"too long for the tyres (the integration's error, not the robot's path); use a step of at most "
+            f"{fine:.3g} s (--step) or the adaptive method")
