@@ -1,0 +1,77 @@
+"""A ring of 16 double wheels whose neighbours' spins and steering turn on gears (m = 8 with them): its assignable
+sets are the 6**8 picks of one rate per geared pair, none of them with a twist component (the body cannot move).
+
+Before: the lexicographic walk spent its budget (98,304 of C(51, 8) candidates) on sets holding two rates of the
+first pair, so `kinematics` listed "assignable sets (0)", no direct model and no minimal actuator or sensor set.
+The brute force here is the null space of the slip matrix with each gear's rows (tests/geared.py).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from scipy.linalg import null_space
+
+from wmrkit.description import robot_from_dict
+from wmrkit.kinematics import assignable_sets, direct_model, minimal_actuator_sets
+
+from ..geared import held_constraints
+
+
+def _ring(n: int = 16):
+    wheels = [{"name": f"w{i}", "type": "double", "position": [0.5 * math.cos(a), 0.5 * math.sin(a)], "heading": a,
+               "b": 0.05, "r": 0.05, "actuated": ["spin1"], "sensed": ["spin1", "steer"]}
+              for i, a in enumerate(2 * math.pi * np.arange(n) / n)]
+    gears = [{"kind": "gear", "joints": [f"w{i}.{j}", f"w{i + 1}.{j}"]} for i in range(0, n, 2)
+             for j in ("spin1", "spin2", "steer")]
+    return robot_from_dict({"name": "ring", "wheels": wheels, "couplings": gears})
+
+
+def _brute(robot):
+    basis = null_space(held_constraints(robot))
+    full = lambda s: np.linalg.matrix_rank(basis[list(s)], tol=1e-9) == basis.shape[1]  # noqa: E731
+    first, rank = [], 0  # the lexicographically first basis of the row matroid is the greedy one
+    for i in range(basis.shape[0]):
+        if np.linalg.matrix_rank(basis[[*first, i]], tol=1e-9) > rank:
+            first, rank = [*first, i], rank + 1
+    return basis, full, tuple(first)
+
+
+def test_the_geared_ring_has_assignable_sets_and_a_direct_model_as_the_brute_force_says():
+    robot = _ring()
+    basis, full, first = _brute(robot)
+    assert basis.shape[1] == 8 and np.abs(basis[:3]).max() < 1e-12  # m = 8, the body at rest
+    names = robot.velocity_names
+    sets = assignable_sets(robot)
+    assert len(sets) > 0
+    assert sets[0] == tuple(names[i] for i in first)
+    assert all(full([names.index(v) for v in s]) for s in sets)
+    model = direct_model(robot)
+    assert model.assigned == tuple(names[i] for i in first)
+    q = np.random.default_rng(1).normal(size=8)
+    expected = basis @ np.linalg.solve(basis[list(first)], q)  # the null-space motion with those rates
+    assert np.allclose(model.velocities(q), expected, atol=1e-9)
+    assert len(minimal_actuator_sets(robot)) > 0
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_pruned_walk_yields_exactly_the_sets_of_independent_rows_in_order(seed):
+    """Against itertools over every candidate: random rows with repeated, parallel and zero rows, 1 or 2
+    configurations (a set must be independent at each)."""
+    from wmrkit.kinematics.search import PrunedCombinations
+
+    rng = np.random.default_rng(seed)
+    k, m = 11, 4
+    rows = rng.normal(size=(2, k, m))
+    rows[:, 3] = 2 * rows[:, 1]
+    rows[:, 5] = 0
+    rows[1, 7] = rows[1, 0] - rows[1, 2]
+    basis = rows / np.linalg.norm(rows, axis=(-2, -1), keepdims=True)  # singular values <= 1, as an orthonormal basis's
+    for b in (basis[:1], basis):
+        good = [s for s in itertools.combinations(range(k), m)
+                if all(np.linalg.svd(x[list(s)], compute_uv=False)[-1] > 1e-9 * m for x in b)]
+        walk = PrunedCombinations(range(k), m, lambda cols, b=b: b[:, list(cols)], budget=10**9)
+        assert list(walk) == good and walk.covered == math.comb(k, m)
