@@ -50,4 +50,6 @@ def test_a_gear_leaving_no_twist_beside_the_steering_is_refused_in_words(tmp_pat
         out = json.loads(capsys.readouterr().out)
         if not extra:
             assert out["inverse_model"]["error"] == ("robot 'dbl': no set of (vx, vy, omega) with d1.steer can be "
-                                                     "assigned at heading (d1=0 deg, d2=0 deg)")
+                                                     "assigned at heading (d1=0 deg, d2=0 deg): the body cannot move "
+                                                     "(its degree of freedom moves the joints with the body at "
+                                                     "rest; the direct model assigns them)")

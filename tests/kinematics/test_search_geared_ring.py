@@ -16,7 +16,8 @@ import pytest
 from scipy.linalg import null_space
 
 from wmrkit.description import robot_from_dict
-from wmrkit.kinematics import assignable_sets, direct_model, minimal_actuator_sets
+from wmrkit.errors import SingularError
+from wmrkit.kinematics import assignable_sets, direct_model, inverse_model, minimal_actuator_sets
 
 from ..geared import held_constraints
 
@@ -55,6 +56,12 @@ def test_the_geared_ring_has_assignable_sets_and_a_direct_model_as_the_brute_for
     expected = basis @ np.linalg.solve(basis[list(first)], q)  # the null-space motion with those rates
     assert np.allclose(model.velocities(q), expected, atol=1e-9)
     assert len(minimal_actuator_sets(robot)) > 0
+
+
+def test_the_inverse_model_of_the_geared_ring_says_why_no_twist_can_be_assigned():
+    with pytest.raises(SingularError, match=r"no set of \(vx, vy, omega\) with w0\.steer, .* the body cannot move "
+                                            r"\(its 8 degrees of freedom move the joints with the body at rest"):
+        inverse_model(_ring())
 
 
 @pytest.mark.parametrize("seed", range(6))

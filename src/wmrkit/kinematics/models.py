@@ -25,7 +25,7 @@ from ..errors import ShapeError, SingularError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..robot import TWIST_NAMES, Robot
 from .linalg import coupled_constraints, matrix_rank, nondimensional, velocity_scale
-from .nullspace import null_space_assignable, null_space_solution, rref_solution
+from .nullspace import null_space_assignable, null_space_basis, null_space_solution, rref_solution
 from .ranks import ranks_assignable, ranks_solution
 from .search import SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
 
@@ -343,5 +343,11 @@ def inverse_model(
     if choice is None:
         also = f" with {', '.join(free)}" if free else ""
         count = f"{m} of" if m > 0 else "set of"  # the gears may leave no twist beside the free steering rates
-        raise _none_assignable(robot, f"{count} (vx, vy, omega){also}", beta, note)
+        error = _none_assignable(robot, f"{count} (vx, vy, omega){also}", beta, note)
+        dof = int(np.max(a.shape[-1] - matrix_rank(a)))
+        if dof and np.all(np.abs(null_space_basis(a, dof)[..., :3, :]) < 1e-9):  # the twist rows of N(A) are 0
+            its = "its degree of freedom moves" if dof == 1 else f"its {dof} degrees of freedom move"
+            error = SingularError(f"{error}: the body cannot move ({its} the joints with the body at rest; the "
+                                  "direct model assigns them)")
+        raise error
     return kinematic_model(robot, choice, beta)
