@@ -1176,4 +1176,32 @@ def test_retype_keeps_what_the_new_type_takes_and_names_what_it_drops(page, serv
     settle(pg)
     assert page_robot(pg) == catalog.load("mecanum-4")  # the same wheels: mecanum is a swedish wheel
     assert pg.evaluate("S.desc.wheels[1].type") == "swedish"
+    pg.select_option('#wheel-fields [data-field="type"]', "mecanum")  # and back: its -45 deg gamma kept
+    settle(pg)
+    assert page_robot(pg) == catalog.load("mecanum-4")
+    assert pg.evaluate("S.desc.wheels[1].gamma") == -math.pi / 4
+    assert pg.locator(note).count() == 0
+
+    # an omni wheel (gamma 90 deg) to mecanum: its gamma dropped and named, so that the quadrant gives it (was kept:
+    # an omni wheel typed mecanum, and the page warned it is not the +-45 deg of Mecanum rollers)
+    omni = catalog.load("omni-4").to_dict()
+    open_file(pg, root, "omni.json", omni)
+    pg.click('[data-wheel="front_right"]')
+    pg.select_option('#wheel-fields [data-field="type"]', "mecanum")
+    settle(pg)
+    assert pg.inner_text(note) == ("retyped to mecanum: dropped gamma 90 deg (a mecanum wheel's rollers are at "
+                                   "±45 deg from its quadrant)")
+    omni["wheels"][1] = {k: v for k, v in omni["wheels"][1].items() if k != "gamma"} | {"type": "mecanum"}
+    x, y = omni["wheels"][1]["position"]
+    robot = page_robot(pg)
+    assert robot == robot_from_dict(omni)
+    assert robot.wheel("front_right").gamma == pytest.approx(math.copysign(math.pi / 4, x * y), abs=1e-12)  # -45 deg
+    assert robot.wheel("front_right").r_r == 0.01  # kept: the mecanum default r / 4 applies only where it is absent
+    assert pg.evaluate("S.descWarnings") == []
+    open_catalog(pg, "omni-3")  # "back" at (-0.2, 0): on an axis, no quadrant to take gamma from: kept (warned)
+    pg.click('[data-wheel="back"]')
+    pg.select_option('#wheel-fields [data-field="type"]', "mecanum")
+    settle(pg)
+    assert pg.evaluate("S.desc.wheels[1]") | {"type": "swedish"} == catalog.load("omni-3").to_dict()["wheels"][1]
+    assert pg.locator(note).count() == 0
     assert not pg.errors

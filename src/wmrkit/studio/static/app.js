@@ -362,6 +362,13 @@ function editField(field, text) {
     if (text === "") delete w[field]; else w[field] = text;
   });
 }
+// A gamma [rad] a retype to mecanum drops, so that the wheel takes it from its quadrant as the reader does: not
+// +-45 deg (mod 180 deg) and the wheel (as read, g) has a quadrant (on an axis it needs its gamma; the page warns).
+function offMecanumRollers(gamma, g) {
+  if (typeof gamma !== "number" || !g) return false;
+  const [x, y] = g.joint, rem = gamma - Math.PI * Math.round(gamma / Math.PI);
+  return Math.abs(Math.abs(rem) - Math.PI / 4) > 1e-6 && Math.abs(x * y) > 1e-12 * (x * x + y * y);
+}
 function changeType(type) {
   const name = S.selected, i = selectedIndex(), kind = S.meta.kinds[type];
   if (i < 0 || !kind) return;
@@ -383,6 +390,8 @@ function changeType(type) {
         const keep = Object.keys(v).filter((j) => kind.inertia.includes(j));
         if (keep.length) w.inertia = Object.fromEntries(keep.map((j) => [j, v[j]]));
         dropped.push(...Object.keys(v).filter((j) => !keep.includes(j)).map((j) => `inertia ${j}`));
+      } else if (f === "gamma" && type === "mecanum" && offMecanumRollers(typeof v === "number" ? v : read.gamma, g)) {
+        dropped.push(`gamma ${shown(v, "gamma")} (a mecanum wheel's rollers are at ±45 deg from its quadrant)`);
       } else w[f] = v;  // steer_range: headings, the same stops
     }
     for (const group of ["actuated", "sensed"]) {
