@@ -9,12 +9,14 @@ The brute force here is the null space of the slip matrix with each gear's rows 
 from __future__ import annotations
 
 import itertools
+import json
 import math
 
 import numpy as np
 import pytest
 from scipy.linalg import null_space
 
+from wmrkit.cli.main import main
 from wmrkit.description import robot_from_dict
 from wmrkit.errors import SingularError
 from wmrkit.kinematics import assignable_sets, direct_model, inverse_model, minimal_actuator_sets
@@ -22,13 +24,22 @@ from wmrkit.kinematics import assignable_sets, direct_model, inverse_model, mini
 from ..geared import held_constraints
 
 
-def _ring(n: int = 16):
+def _ring(n: int = 16, own: bool = False):
+    return robot_from_dict(_ring_dict(n, own))
+
+
+def _ring_dict(n: int, own: bool) -> dict:
+    """Neighbours' spins and steering on gears; `own`: each wheel's spins at 1:k (k = 1, 2, 3) and the pairs'
+    steering, which lock it (m = 0; /tmp/s30h17_work/r16own.yaml)."""
     wheels = [{"name": f"w{i}", "type": "double", "position": [0.5 * math.cos(a), 0.5 * math.sin(a)], "heading": a,
                "b": 0.05, "r": 0.05, "actuated": ["spin1"], "sensed": ["spin1", "steer"]}
               for i, a in enumerate(2 * math.pi * np.arange(n) / n)]
     gears = [{"kind": "gear", "joints": [f"w{i}.{j}", f"w{i + 1}.{j}"]} for i in range(0, n, 2)
-             for j in ("spin1", "spin2", "steer")]
-    return robot_from_dict({"name": "ring", "wheels": wheels, "couplings": gears})
+             for j in (("steer",) if own else ("spin1", "spin2", "steer"))]
+    if own:
+        gears += [{"kind": "gear", "joints": [f"w{i}.spin1", f"w{i}.spin2"], "ratios": [1, i % 3 + 1]}
+                  for i in range(n)]
+    return {"name": "ring", "wheels": wheels, "couplings": gears}
 
 
 def _brute(robot):
@@ -62,6 +73,24 @@ def test_the_inverse_model_of_the_geared_ring_says_why_no_twist_can_be_assigned(
     with pytest.raises(SingularError, match=r"no set of \(vx, vy, omega\) with w0\.steer, .* the body cannot move "
                                             r"\(its 8 degrees of freedom move the joints with the body at rest"):
         inverse_model(_ring())
+
+
+def test_the_inverse_model_of_a_locked_ring_says_the_robot_cannot_move_as_the_direct_model(tmp_path, capsys):
+    """Before: the inverse model said "no set of (vx, vy, omega) with w0.steer, w2.steer, ..., w14.steer can be
+    assigned", naming steering rates the gears lock, while the direct model said the robot cannot move."""
+    robot = _ring(own=True)
+    assert null_space(held_constraints(robot)).shape[1] == 0  # the brute force: nothing moves
+    model = inverse_model(robot)
+    assert model.assigned == () and np.array_equal(model.velocities(np.zeros(0)), np.zeros(len(robot.velocity_names)))
+    path = tmp_path / "locked.yaml"
+    path.write_text(json.dumps(_ring_dict(16, own=True)))
+    assert main(["kinematics", str(path)]) == 0
+    out = capsys.readouterr().out
+    stuck = "    the robot cannot move (m = 0): every velocity is zero\n"
+    assert f"  direct model:\n{stuck}  inverse model:\n{stuck}" in out and "no set of" not in out
+    assert main(["kinematics", str(path), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["coupled_mobility"] == 0 and data["inverse_model"]["assigned"] == data["direct_model"]["assigned"] == []
 
 
 @pytest.mark.parametrize("seed", range(6))

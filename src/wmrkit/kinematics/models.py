@@ -330,8 +330,9 @@ def inverse_model(
     if twist_names is not None:
         return kinematic_model(robot, twist_names, beta)
     a = constraints(robot, beta)
-    free = _free_steering(robot)  # double wheels' steering rates: no twist determines them, always assigned
-    m = int(np.max(a.shape[-1] - matrix_rank(a))) - len(free)
+    dof = int(np.max(a.shape[-1] - matrix_rank(a)))
+    free = _free_steering(robot) if dof else ()  # double wheels' steering rates: no twist determines them, always
+    m = dof - len(free)  # assigned, unless the gears lock everything (dof 0: the empty model, as the direct one's)
     if free:
         fixed = [robot.velocity_index(n) for n in free]
         combinations = itertools.combinations(TWIST_NAMES, m) if 0 < m <= 3 else ()  # gears can leave m <= 0
@@ -344,7 +345,6 @@ def inverse_model(
         also = f" with {', '.join(free)}" if free else ""
         count = f"{m} of" if m > 0 else "set of"  # the gears may leave no twist beside the free steering rates
         error = _none_assignable(robot, f"{count} (vx, vy, omega){also}", beta, note)
-        dof = int(np.max(a.shape[-1] - matrix_rank(a)))
         if dof and np.all(np.abs(null_space_basis(a, dof)[..., :3, :]) < 1e-9):  # the twist rows of N(A) are 0
             its = "its degree of freedom moves" if dof == 1 else f"its {dof} degrees of freedom move"
             error = SingularError(f"{error}: the body cannot move ({its} the joints with the body at rest; the "
