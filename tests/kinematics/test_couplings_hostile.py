@@ -179,7 +179,7 @@ def _coupled_tree(robot: Robot) -> tuple[int, str, bool]:
     return allowed.shape[1], leaf, clear
 
 
-@settings(max_examples=1000, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(coupled_robots())
 def test_coupled_verdicts_and_mobility_agree_with_the_no_slip_equations(robot):
     unit = nondimensional(robot)
