@@ -292,14 +292,6 @@ def _contact_offset(beta, el, el_steer, e, gx, gy):
             el[e, 0] * math.sin(el[e, 1]) + el[e, 2] * math.cos(be) - gy)
 
 
-@_njit
-def solve(mat, rhs):
-    """``mat^-1 rhs`` by :func:`solve_in_place` on copies."""
-    x = rhs.copy()
-    solve_in_place(mat.copy(), x)
-    return x
-
-
 @_inline
 def solve_in_place(a, x):
     """Gaussian elimination with partial pivoting (small dense systems; no LAPACK call overhead): `x` becomes

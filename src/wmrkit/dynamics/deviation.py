@@ -154,7 +154,7 @@ def check_step(model, inputs, sim, initial_twist=(0.0, 0.0, 0.0), jac_every: int
     step's (an integrator unstable or far from converged with stiff tyres), not the robot's. The re-run goes from
     t = 0 over at most :data:`~wmrkit.dynamics.runs.RECHECK_STEPS` of its steps (a quarter for rk4), on the run's
     record times; a run that left its path by as much at both steps passes (its deviation is the robot's)."""
-    from .runs import RECHECK_STEPS, recheck_step
+    from .runs import recheck_budget, recheck_step
     from .simulate import simulate
 
     deviation = sim.deviation()
@@ -163,7 +163,7 @@ def check_step(model, inputs, sim, initial_twist=(0.0, 0.0, 0.0), jac_every: int
     method = 0 if sim.method == "semi-implicit" else 1
     step, fine = sim.step, recheck_step(sim.step, method)
     every = round((sim.t[1] - sim.t[0]) / step)  # steps between records
-    m = min(len(sim.t), RECHECK_STEPS // (1 + 3 * method) // (every * round(step / fine)) + 1)
+    m = min(len(sim.t), recheck_budget(method) // (every * round(step / fine)) + 1)
     if m < 2:
         return
     try:

@@ -90,6 +90,11 @@ def recheck_step(step: float, method: int) -> float:
     return step / max(4, math.ceil(step / RECHECK_MAX_STEP[method] * (1 - 1e-9)))
 
 
+def recheck_budget(method: int) -> int:
+    """Most steps of a re-check by `method` (0: semi-implicit, 1: rk4, whose step evaluates the model four times)."""
+    return RECHECK_STEPS // (1 + 3 * method)
+
+
 def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_lift_off, diverged):
     """Raise the error of a fixed-step run that stopped at `t_run` [s] (diverged, or the lift-off `w` recorded),
     after re-running the stretch that led there at :func:`recheck_step`: from the first of the records `rows` at
@@ -103,7 +108,7 @@ def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_l
     t_stop = t_run if diverged else float(w[16][1])
     fine = recheck_step(step, method)
     k_end = round(min(duration, t_stop + max(0.1, 10 * step)) / fine)
-    budget = RECHECK_STEPS // (1 + 3 * method)  # an rk4 step evaluates the model four times
+    budget = recheck_budget(method)
     j = min(int(np.searchsorted(rows[0], (k_end - budget) * fine)),  # the first record in the budget, and at
             max(0, int(np.searchsorted(rows[0], t_stop)) - 1))  # the latest the last one before the stop
     k0 = round(rows[0][j] / fine)  # a record's time is a whole number of steps, each a whole number of fine ones

@@ -18,6 +18,8 @@ from collections.abc import Callable, Iterator, Sequence
 
 import numpy as np
 
+from .linalg import RANK_RTOL, matrix_rank
+
 #: Most sets a search lists; more are reported as "more than MAX_SETS".
 MAX_SETS = 1000
 #: Most minimal actuator / sensor sets listed (each is confirmed by an exact tree of the robot's size).
@@ -59,7 +61,6 @@ class SetList(tuple):
 def null_space_prefilter(a: np.ndarray, m: int, offset: int = 0) -> Test:
     """The null-space test (4.5) as a prefilter: candidates (columns of A, minus `offset`) whose rows ``B_a`` of a
     null-space basis of `a` ``(..., R, k)`` are invertible at every configuration of the batch."""
-    from .linalg import matrix_rank
     from .nullspace import null_space_basis
 
     basis = null_space_basis(a, m)
@@ -88,8 +89,6 @@ class PrunedCombinations:
         self.nodes = self.covered = 0
 
     def _full(self, cols: list[int], rank: int) -> bool:
-        from .linalg import RANK_RTOL
-
         self.nodes += 1
         s = np.linalg.svd(self.rows(cols), compute_uv=False)
         return bool((s.shape[-1] >= rank) and np.all(s[..., rank - 1] > RANK_RTOL * self.size))
