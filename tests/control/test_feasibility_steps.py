@@ -155,3 +155,47 @@ def test_a_curvature_rate_step_on_a_slope_is_reported_with_its_size(slope, step,
     got = feasibility(catalog.load("ackermann"), _clothoid_with_a_step(slope, step, at, dt), "dynamic").violations
     assert [v.signal for v in got] == ["kappa_rate"]
     assert got[0].size == pytest.approx(abs(step), rel=1e-3)
+
+
+@settings(max_examples=40, deadline=None)
+@example(1.0, 0.1, 2.0)  # five changes of at most 0.033, under 20 times the slope's 0.01: not found
+@example(-1.0, 0.3, 2.5063)
+@example(0.0, 0.1, 2.5063)  # found, but at its first change: 2.48 s
+@given(st.floats(-1.0, 1.0), st.one_of(st.floats(0.03, 0.3), st.floats(-0.3, -0.03)), st.floats(1.0, 3.0))
+def test_a_small_curvature_rate_step_is_found_on_any_slope_at_its_time(slope, step, at):
+    """A curvature-rate step of 0.03 to 0.3 1/(m s) where the rate rises by up to 1 1/(m s^2), at 100 Hz (closed
+    form: a clothoid of rate ``slope s``, less `step` from ``s = at``): one violation, of the step's size, reported at
+    the first sample after the step or the sample before, whatever the slope."""
+    dt = 0.01
+    got = feasibility(catalog.load("ackermann"), _clothoid_with_a_step(slope, step, at, dt), "dynamic").violations
+    assert [v.signal for v in got] == ["kappa_rate"]
+    assert got[0].size == pytest.approx(abs(step), rel=1e-3)
+    assert abs(got[0].t - at) <= dt * (1 + 1e-9)
+
+
+def _smooth_curvature(coefficients, knots, values, dt):
+    """A path at 1 m/s (s = t, 4 s) whose curvature is the polynomial `coefficients` (lowest first) plus the cubic
+    spline through `values` at `knots`, integrated on a 50 times finer grid and sampled every `dt`."""
+    from scipy.integrate import cumulative_simpson
+    from scipy.interpolate import CubicSpline
+
+    s = np.arange(0.0, 4.0 + dt / 2, dt / 50)
+    kappa = np.polynomial.polynomial.polyval(s, coefficients) + CubicSpline(knots, values)(s)
+    th = cumulative_simpson(kappa, x=s, initial=0.0)
+    xy = [cumulative_simpson(f(th), x=s, initial=0.0)[::50] for f in (np.cos, np.sin)]
+    return reference_from_samples("smooth.csv", s[::50], np.column_stack([*xy, th[::50]]))
+
+
+@settings(max_examples=40, deadline=None)
+@example([0.0, 0.5], [0.0, 0.0], 0.01)  # a clothoid from its start: 'a jump' of 0.25 at 0.01 s
+@example([0.0, 0.0, 0.5], [0.0, 0.0], 0.001)
+@given(st.lists(st.floats(-0.5, 0.5), min_size=1, max_size=4), st.lists(st.floats(-0.5, 0.5), min_size=2, max_size=8),
+       st.sampled_from([0.01, 0.001]))
+def test_a_smooth_curvature_has_no_curvature_rate_jump(coefficients, values, dt):
+    """Random smooth curvatures (a polynomial of degree up to 3 plus a cubic spline through up to 8 evenly spaced
+    knots) driven at 1 m/s: a car follows
+    them in the dynamic framework. The curvature rate's first and last samples (one-sided differences, off by about
+    half of it) were a jump."""
+    ref = _smooth_curvature(coefficients, np.linspace(0.0, 4.0, len(values)), values, dt)
+    got = feasibility(catalog.load("ackermann"), ref, "dynamic").violations
+    assert not got, [(v.signal, v.t, v.size) for v in got]

@@ -90,15 +90,34 @@ def _typical(steps: np.ndarray) -> np.ndarray:
     """The typical size of each of `steps` ``(n,)`` (NaN: not a step of the signal, left out): the median of its
     block of :data:`BLOCK`, or of a neighbouring block when larger (a global median is 0 for a reference mostly at
     rest, and its every moving step was a jump)."""
-    n = len(steps)
-    typical = np.pad(steps, (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK)
-    count = (~np.isnan(typical)).sum(axis=1)
-    typical = np.sort(typical, axis=1)  # NaN last; np.nanmedian gives the same, 7x slower on rows of 21
-    rows = np.arange(len(typical))
-    mid = 0.5 * (typical[rows, np.maximum(count - 1, 0) // 2] + typical[rows, count // 2 - (count == 0)])
-    blocks = np.where(count > 0, mid, 0.0)
+    blocks = _block_medians(steps)
+    blocks = np.where(np.isnan(blocks), 0.0, blocks)
     near = np.maximum(blocks, np.maximum(np.r_[blocks[:1], blocks[:-1]], np.r_[blocks[1:], blocks[-1:]]))
-    return np.repeat(near, BLOCK)[:n]
+    return np.repeat(near, BLOCK)[:len(steps)]
+
+
+def _block_medians(values: np.ndarray) -> np.ndarray:
+    """The median of each block of :data:`BLOCK` of `values` ``(n,)`` (the last one padded with its last value; NaN
+    left out: NaN for a block of NaN only)."""
+    n = len(values)
+    blocks = np.pad(values, (0, -n % BLOCK), mode="edge").reshape(-1, BLOCK)
+    count = (~np.isnan(blocks)).sum(axis=1)
+    blocks = np.sort(blocks, axis=1)  # NaN last; np.nanmedian gives the same, 7x slower on rows of 21
+    rows = np.arange(len(blocks))
+    mid = 0.5 * (blocks[rows, np.maximum(count - 1, 0) // 2] + blocks[rows, count // 2 - (count == 0)])
+    return np.where(count > 0, mid, np.nan)
+
+
+def _detrended(x: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """`x` ``(n,)`` (NaN: undefined) less its slope, integrated over time: the median rate of each block of
+    :data:`BLOCK` steps. A step that finite differences spread over several samples then stands out of a signal
+    with a steep slope as out of a level one (the curvature rate's step of 0.3 1/(m s) on a slope of 1 1/(m s^2) at
+    100 Hz was five changes, each under 20 times the slope's step), while a curved signal keeps its typical steps
+    (the changes of its slope across a block): a small step is no jump where the slope itself changes fast."""
+    dt = np.diff(t)
+    blocks = _block_medians(np.diff(x) / dt)
+    rate = np.repeat(np.where(np.isnan(blocks), 0.0, blocks), BLOCK)[:len(dt)]
+    return x - np.r_[0.0, np.cumsum(rate * dt)]
 
 
 #: Samples from which a signal is judged by the compiled passes of :mod:`._jump_kernels` (the same bits): below, numpy
@@ -224,6 +243,19 @@ def _held(x: np.ndarray, first: int, last: int) -> float:
     slopes = [s for s in slopes if np.isfinite(s)]
     trend = float(np.mean(slopes)) * (hi - lo) if slopes else 0.0
     return float(x[hi] - x[lo]) - trend
+
+
+def _middle(x: np.ndarray, t: np.ndarray, first: int, last: int) -> int:
+    """The first sample at or after the middle of the jump of `x` ``(n,)`` (:func:`_detrended`) over steps `first`
+    to `last`: the mean time of its steps, weighted by their share of its change. Finite differences spread a
+    step over several samples on either side of it (a curvature-rate step over about five), and the first of them
+    was reported, two samples early on a level signal and one to three on a slope."""
+    d = np.nan_to_num(np.diff(x[first:last + 2]))
+    w = np.clip(d * np.sign(d.sum()), 0.0, None)
+    if not w.sum() > 0:
+        return first + 1
+    middle = float(np.dot(w, 0.5 * (t[first:last + 1] + t[first + 1:last + 2])) / w.sum())
+    return int(min(max(np.searchsorted(t, middle), first + 1), last + 1))
 
 
 #: The signal each one is a derivative of (the tangent: of the position's direction). A sampled step of a signal is a

@@ -23,7 +23,8 @@ def signals(reference: Reference, *, speed_tol: float = 1e-6, slow: float = 0.05
     and, for a sampled reference, from finite differences of positions that hardly move (a 3 m circle from rest at
     100 Hz had a curvature of 0 to 1.6 1/m over its first 0.15 s, and a tangent pointing backwards at its first
     sample). A constant-speed reference, or
-    one with exact derivatives at a steady speed, has none of them undefined."""
+    one with exact derivatives at a steady speed, has none of them undefined but the curvature rate at its first and
+    last :data:`_EDGE` samples (one-sided differences)."""
     p, v, a = reference.pose, reference.velocity, reference.acceleration
     speed = np.hypot(v[:, 0], v[:, 1])
     t = reference.t
@@ -40,10 +41,19 @@ def signals(reference: Reference, *, speed_tol: float = 1e-6, slow: float = 0.05
         cross = v[:, 0] * a[:, 1] - v[:, 1] * a[:, 0]
         kappa = np.where(steady, cross / speed**3, np.nan) * _travel_sign(chi)
         chi_rate = np.where(steady, cross / speed**2, np.nan)
+        kappa_rate = np.gradient(kappa, t) * (t[1] - t[0])
+    kappa_rate[:_EDGE] = kappa_rate[-_EDGE:] = np.nan
     return {"position": p[:, :2], "theta": p[:, 2], "velocity": v[:, :2], "omega": v[:, 2], "acceleration": a[:, :2],
             "omega_rate": a[:, 2],
             "chi": chi, "chi_rate": chi_rate, "kappa": kappa,
-            "kappa_rate": np.gradient(kappa, t) * (t[1] - t[0]), "at_rest": at_rest}
+            "kappa_rate": kappa_rate, "at_rest": at_rest}
+
+
+#: Samples at either end where the curvature rate is undefined: a third difference of a file's positions, it takes
+#: one-sided differences there (of the velocity, the acceleration and the curvature), off by about half of itself
+#: (0.25, 0.31, 0.44 for a clothoid's 0.5 1/(m s)): a 'curvature-rate jump' at the start of a clothoid, and at its
+#: end once the rate's slope no longer hid it.
+_EDGE = 3
 
 
 def _travel_sign(chi: np.ndarray) -> np.ndarray:
