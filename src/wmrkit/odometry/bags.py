@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WmrkitError
-from ..limits import MAX_TABLE_SIZE
+from ..limits import MAX_SPEED, MAX_TABLE_SIZE
 from ._text import did_you_mean
 from .integrators import sinc
 from .logs import MAX_RATE, JointLog, LogError, check_jumps, check_time, joint_names
@@ -371,8 +371,9 @@ def read_imu_yaw(path: str | os.PathLike[str], topic: str, *,
 
     The yaw is the orientation's (REP-103 / REP-145: about z, counter-clockwise, ZYX Euler angles); when the first
     message has none (``orientation_covariance[0] == -1``, REP-145, or an all-zero quaternion) it is
-    ``angular_velocity.z`` [rad/s] integrated by trapezoids from 0. Time as JointState's (the header stamp, else the
-    receive time), strictly increasing. A :class:`LogError` names the message of a bad stamp or value.
+    ``angular_velocity.z`` [rad/s, at most :data:`~wmrkit.limits.MAX_SPEED`] integrated by trapezoids from 0. Time
+    as JointState's (the header stamp, else the receive time), strictly increasing. A :class:`LogError` names the
+    message of a bad stamp or value.
     """
     source = os.fspath(path)
     where = f"{source}: {topic}"
@@ -387,8 +388,9 @@ def read_imu_yaw(path: str | os.PathLike[str], topic: str, *,
             q = (o.x, o.y, o.z, o.w)
             if gyro is None:
                 gyro = msg.orientation_covariance[0] == -1 or not any(q)
-            if gyro and not math.isfinite(msg.angular_velocity.z):
-                raise LogError(f"{where} message {index}: angular_velocity.z is {msg.angular_velocity.z}")
+            if gyro and not abs(msg.angular_velocity.z) <= MAX_SPEED:  # NaN included
+                raise LogError(f"{where} message {index}: angular_velocity.z is {msg.angular_velocity.z:g} rad/s, not "
+                               f"a finite rate within the {MAX_SPEED:g} rad/s of any wheeled robot (docs/limits.md)")
             if not gyro and not (all(map(math.isfinite, q)) and any(q)):
                 raise LogError(f"{where} message {index}: orientation {list(q)} is no rotation")
             stamp = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
