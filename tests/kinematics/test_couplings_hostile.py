@@ -193,6 +193,30 @@ def test_coupled_verdicts_and_mobility_agree_with_the_no_slip_equations(robot):
     assert str(actuation_tree(robot).leaf) == leaf
 
 
+def _double_wheel_differential(k3: float) -> Robot:
+    """A fixed wheel and an actuated double wheel whose steering drives, through a differential, with a spin of each."""
+    from wmrkit.wheels import Wheel
+
+    w0 = Wheel(name="w0", type="fixed", l=0.0, alpha=0.0, beta=0.0, r=0.5)
+    w1 = Wheel(name="w1", type="double", l=1.0, alpha=1.0, beta=0.0, r=0.5, b=0.5, actuated=("steer",))
+    return Robot("r", (w0, w1), couplings=(Coupling("differential", ("w0.spin", "w1.steer", "w1.spin1"),
+                                                    (-1.0, -1.0, k3)),))
+
+
+@pytest.mark.parametrize("eps", [1e-9, 1e-10, 1e-12, 1e-14])
+def test_a_ratio_within_the_rank_tolerance_of_a_singular_one_gets_its_verdict(eps):
+    """Ratios (-1, -1, -1 - eps): with eps below the rank tolerance (RANK_RTOL) the library must answer as for
+    -1 exactly: the channel drives the body (the no-slip equations, ``_coupled_tree``: determined). Before, the
+    exact elimination's projector (a pseudo-inverse at 1e-15) kept the eps direction that the rank tests
+    dropped, and eps = 1e-10..1e-14 read 'overdetermined' (inconsistent: one channel on a 2-dof mechanism)."""
+    exact = _coupled_tree(nondimensional(_double_wheel_differential(-1.0)))
+    assert exact[1:] == ("determined", True)
+    robot = _double_wheel_differential(-1.0 - eps)
+    analysis = actuation_analysis(robot)
+    assert (int(analysis.mobility), str(analysis.leaf), bool(analysis.consistent)) == (exact[0], exact[1], True)
+    assert str(actuation_tree(robot).leaf) == exact[1]
+
+
 def test_a_joint_repeated_in_one_coupling_is_named_as_such():
     """Before: "joint 'right_drive.spin' is in two couplings" of a description with one coupling."""
     data = catalog.load("forklift").to_dict()

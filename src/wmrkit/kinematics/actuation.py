@@ -20,12 +20,11 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, matvec, readonly
 from ..couplings import coupled_columns, gear_fill, gear_free, linked_steering
 from ..robot import TWIST_NAMES, Robot
-from .linalg import coupled_constraints, delta_projector, matrix_rank, nondimensional
+from .linalg import coupled_constraints, matrix_rank, nondimensional
 from .models import bounded, configuration
 from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
 from .trees import (
     TreeVerdict,
-    classify_system,
     eliminated_tree,
     jacobian_names,
     partitioned_solution,
@@ -106,8 +105,7 @@ def actuation_tree(
     """
     columns, _ = select_columns(robot, robot.actuated if actuated is None else actuated, "actuated")
     i_bar, j_u, j_nu, _ = coupled_split(nondimensional(robot), columns, beta)  # rates are angular: same units
-    delta = delta_projector(j_nu)
-    return classify_system(delta @ i_bar, delta @ j_u, q_dot_u)
+    return eliminated_tree(i_bar, j_u, j_nu, q_dot_u)
 
 
 _ACTUATION_TEXT = {

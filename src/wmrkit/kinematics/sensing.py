@@ -19,12 +19,11 @@ from .._shapes import as_vectors, matvec, readonly
 from ..couplings import gear_fill, gear_free
 from ..robot import TWIST_NAMES, Robot
 from .actuation import body_only, minimal_set_search, steering_split, verdict_texts
-from .linalg import coupled_constraints, delta_projector, matrix_rank, nondimensional
+from .linalg import coupled_constraints, matrix_rank, nondimensional
 from .models import bounded, configuration
 from .search import SetList
 from .trees import (
     TreeVerdict,
-    classify_system,
     eliminated_tree,
     jacobian_names,
     partitioned_solution,
@@ -97,8 +96,7 @@ def sensing_tree(
     nor noise) or ``inconsistent``; the other leaves: insufficient sensors.
     """
     _, _, i_bar, j_s, j_ns, _ = _split(nondimensional(robot), sensed, beta)  # rates are angular: same units
-    delta = delta_projector(j_ns)  # the unsensed rates eliminated exactly, as in sensing_analysis
-    return classify_system(delta @ i_bar, delta @ j_s, q_dot_s)
+    return eliminated_tree(i_bar, j_s, j_ns, q_dot_s)  # the unsensed rates eliminated exactly
 
 
 _SENSING_TEXT = {

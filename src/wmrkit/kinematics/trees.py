@@ -68,11 +68,14 @@ def classify_system(a: ArrayLike, b: ArrayLike, y: ArrayLike | None = None) -> T
     ``underdetermined``.
     """
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    rank_a, rank_ab = matrix_rank(a), matrix_rank(_hstack(a, b))
+    rank_aby = None if y is None else matrix_rank(_hstack(a, b @ np.asarray(y, dtype=float)[..., None]))
+    return _leaves(matrix_rank(a), matrix_rank(_hstack(a, b)), rank_aby, int(a.shape[-1]))
+
+
+def _leaves(rank_a: np.ndarray, rank_ab: np.ndarray, rank_aby: np.ndarray | None, n: int) -> TreeVerdict:
+    """The leaf of Fig. 4.1 from the ranks of ``A``, ``[A, B]`` and (or None) ``[A, B y]``, ``n`` unknowns."""
     batch = np.broadcast_shapes(np.shape(rank_a), np.shape(rank_ab))
-    if y is not None:
-        by = (b @ np.asarray(y, dtype=float)[..., None])
-        rank_aby = matrix_rank(_hstack(a, by))
+    if rank_aby is not None:
         batch = np.broadcast_shapes(batch, np.shape(rank_aby))
         fits = rank_aby == rank_a
         over = np.where(fits, "consistent", "inconsistent")
@@ -80,14 +83,14 @@ def classify_system(a: ArrayLike, b: ArrayLike, y: ArrayLike | None = None) -> T
     else:
         over = np.full(batch, "overdetermined")
         under = np.where(rank_ab == rank_a, "indeterminate", "underdetermined")
-    full = rank_a == a.shape[-1]
+    full = rank_a == n
     leaf = np.where(full, np.where(rank_ab == rank_a, "determined", over), under)
     leaf = np.broadcast_to(leaf, batch).astype(str)
     return TreeVerdict(
         readonly(leaf),
         readonly(np.broadcast_to(rank_a, batch).copy()),
         readonly(np.broadcast_to(rank_ab, batch).copy()),
-        int(a.shape[-1]),
+        n,
     )
 
 
@@ -219,16 +222,27 @@ def reduced_equation(i_bar: ArrayLike, j_sel: ArrayLike, j_rest: ArrayLike) -> n
     return i_bar - j_rest @ (partitioned_solution(j_rest, j_sel) @ i_bar)
 
 
-def eliminated_tree(i_bar: ArrayLike, j_sel: ArrayLike, j_rest: ArrayLike) -> TreeVerdict:
+def eliminated_tree(i_bar: ArrayLike, j_sel: ArrayLike, j_rest: ArrayLike, y: ArrayLike | None = None) -> TreeVerdict:
     """The tree of the actuation (4.28) or sensing (4.34) equation, from ``I_bar twist = J_sel q_sel + J_rest
     q_rest`` with ``q_rest`` eliminated exactly: ``Delta(J_rest) I_bar twist = Delta(J_rest) J_sel q_sel`` (the
-    rows orthogonal to every unselected velocity). :func:`reduced_equation` eliminates ``q_rest`` by least
-    squares after projecting out ``J_sel``, which is the same only while ``Delta(J_sel) J_rest`` has full column
-    rank: a double wheel whose spins are selected shares its unselected steering rate between its two contacts,
-    and there the reduced equation called a unit driven by its spins over-actuated (and a robot it could not
-    steer sufficiently actuated); the elimination gives the ranks of the no-slip equations (3.22)."""
-    delta = delta_projector(j_rest)
-    return classify_system(delta @ np.asarray(i_bar, dtype=float), delta @ np.asarray(j_sel, dtype=float))
+    rows orthogonal to every unselected velocity); `y` ``(..., n_sel)`` or None as in :func:`classify_system`.
+    :func:`reduced_equation` eliminates ``q_rest`` by least squares after projecting out ``J_sel``, which is the
+    same only while ``Delta(J_sel) J_rest`` has full column rank: a double wheel whose spins are selected shares its
+    unselected steering rate between its two contacts, and there the reduced equation called a unit driven by its
+    spins over-actuated (and a robot it could not steer sufficiently actuated); the elimination gives the ranks of
+    the no-slip equations (3.22). Each rank is ``rank [M, J_rest] - rank J_rest``, decided on unprojected matrices:
+    a projector built with another tolerance than the rank tests' kept a near-dependent direction of ``J_rest`` and
+    turned its rounding into a verdict (ratios 1e-10 from a singular one read 'overdetermined')."""
+    i_bar = np.asarray(i_bar, dtype=float)
+    j_sel, j_rest = np.asarray(j_sel, dtype=float), np.asarray(j_rest, dtype=float)
+    rank_rest = matrix_rank(j_rest)
+    rank_a = matrix_rank(_hstack(i_bar, j_rest)) - rank_rest
+    rank_ab = matrix_rank(_hstack(_hstack(i_bar, j_sel), j_rest)) - rank_rest
+    rank_aby = None
+    if y is not None:
+        by = j_sel @ np.asarray(y, dtype=float)[..., None]
+        rank_aby = matrix_rank(_hstack(_hstack(i_bar, by), j_rest)) - rank_rest
+    return _leaves(rank_a, rank_ab, rank_aby, int(i_bar.shape[-1]))
 
 
 def select_columns(robot: Robot, joints: Sequence[str], role: str) -> tuple[tuple[int, ...], tuple[str, ...]]:
