@@ -82,6 +82,7 @@ def test_the_inverse_model_of_a_locked_ring_says_the_robot_cannot_move_as_the_di
     assert null_space(held_constraints(robot)).shape[1] == 0  # the brute force: nothing moves
     model = inverse_model(robot)
     assert model.assigned == () and np.array_equal(model.velocities(np.zeros(0)), np.zeros(len(robot.velocity_names)))
+    assert model.kind == direct_model(robot).kind == "none"  # nothing assigned: was "inverse" (all([]) is True)
     path = tmp_path / "locked.yaml"
     path.write_text(json.dumps(_ring_dict(16, own=True)))
     assert main(["kinematics", str(path)]) == 0
@@ -91,6 +92,7 @@ def test_the_inverse_model_of_a_locked_ring_says_the_robot_cannot_move_as_the_di
     assert main(["kinematics", str(path), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["coupled_mobility"] == 0 and data["inverse_model"]["assigned"] == data["direct_model"]["assigned"] == []
+    assert data["inverse_model"]["kind"] == data["direct_model"]["kind"] == "none"
 
 
 @pytest.mark.parametrize("seed", range(6))

@@ -53,8 +53,11 @@ class KinematicModel:
 
     @property
     def kind(self) -> str:
-        """``'direct'`` (wheel rates assigned), ``'inverse'`` (twist components assigned) or ``'mixed'``."""
+        """``'direct'`` (wheel rates assigned), ``'inverse'`` (twist components assigned), ``'mixed'``, or
+        ``'none'`` when nothing is assigned (m = 0: the robot cannot move)."""
         twist = [n in TWIST_NAMES for n in self.assigned]
+        if not twist:
+            return "none"
         return "inverse" if all(twist) else "direct" if not any(twist) else "mixed"
 
     def solve(self, q_assigned: ArrayLike) -> np.ndarray:
