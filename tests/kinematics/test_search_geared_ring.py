@@ -113,3 +113,38 @@ def test_the_pruned_walk_yields_exactly_the_sets_of_independent_rows_in_order(se
                 if all(np.linalg.svd(x[list(s)], compute_uv=False)[-1] > 1e-9 * m for x in b)]
         walk = PrunedCombinations(range(k), m, lambda cols, b=b: b[:, list(cols)], budget=10**9)
         assert list(walk) == good and walk.covered == math.comb(k, m)
+
+
+def _held_spins(n: int, held: list[int], ratio: float = 2.0, steer_gear: bool = False):
+    """A ring of `n` double wheels, the spins of the wheels `held` geared at 1:ratio (a wheel turns on the spot only
+    with ratio -1), and with `steer_gear` the steering of w0 and w1 on a gear."""
+    wheels = [{"name": f"w{i}", "type": "double", "position": [0.5 * math.cos(a), 0.5 * math.sin(a)], "heading": a,
+               "b": 0.05, "r": 0.05} for i, a in enumerate(2 * math.pi * np.arange(n) / n)]
+    gears = [{"kind": "gear", "joints": [f"w{i}.spin1", f"w{i}.spin2"], "ratios": [1, ratio]} for i in held]
+    gears += [{"kind": "gear", "joints": ["w0.steer", "w1.steer"]}] if steer_gear else []
+    return robot_from_dict({"name": "held", "wheels": wheels, "couplings": gears})
+
+
+@pytest.mark.parametrize("args", [(2, [0, 1]), (2, [0]), (3, [0]), (4, [0, 1]), (4, [1, 2], 2.0, True),
+                                  (4, [0, 1, 2, 3], -1.0)], ids=str)
+def test_the_inverse_model_assigns_only_the_steering_rates_the_gears_leave_free(args):
+    """A double wheel whose spins a gear holds at 1:2 cannot turn on the spot: its steering rate turns with the
+    twist. Before: the inverse model of two such wheels (m = 1, the body rolls) said "no set of (vx, vy, omega)
+    with w0.steer, w1.steer can be assigned"; with the body at rest it named steering rates the gears lock.
+    Brute force (tests/geared.py): N, the null space with the gears' rows; the twist's rows have rank g."""
+    robot = _held_spins(*args)
+    basis = null_space(held_constraints(robot))
+    g, names = np.linalg.matrix_rank(basis[:3], tol=1e-9), robot.velocity_names
+    moving = [n for n in robot.free_steering if np.abs(basis[names.index(n)]).max() > 1e-9]
+    if g == 0:  # the body cannot move: the message names the steering rates that do
+        with pytest.raises(SingularError, match=r"the body cannot move") as err:
+            inverse_model(robot)
+        named = str(err.value).split(" with ")[1].split(" can be assigned")[0].split(", ")
+        assert named == moving
+        return
+    model = inverse_model(robot)
+    twist = [n for n in model.assigned if n in ("vx", "vy", "omega")]
+    assert len(twist) == g and len(model.assigned) == basis.shape[1]
+    assert np.linalg.matrix_rank(basis[[names.index(n) for n in model.assigned]], tol=1e-9) == basis.shape[1]
+    q = model.velocities(np.random.default_rng(2).normal(size=len(model.assigned)))
+    assert np.abs(held_constraints(robot) @ q).max() < 1e-9 * np.abs(q).max()

@@ -311,13 +311,21 @@ def direct_model(
     return kinematic_model(robot, choice, beta)
 
 
-def _free_steering(robot: Robot) -> tuple[str, ...]:
-    """``robot.free_steering`` with one steering rate per ``gear`` turning several of them (its turn, one input)."""
-    free = robot.free_steering
-    for c in (c for c in robot.couplings if c.kind == "gear"):
-        tied = [j for j in c.joints if j in free]
-        free = tuple(j for j in free if j not in tied[1:])
-    return free
+def _free_steering(robot: Robot, a: np.ndarray, dof: int) -> tuple[str, ...]:
+    """The double wheels' steering rates (``robot.free_steering``) that no twist determines on the motions `a`
+    ``(..., R, k)`` allows (`dof` of them), in order: each one kept while its row of the null space adds to the rank
+    of the twist's rows and those kept. A ``gear`` turning several is one input (its first joint); a wheel whose
+    spins a gear holds apart from turning on the spot steers with the twist, and with every joint locked (dof 0)
+    none is free."""
+    if not dof:
+        return ()
+    basis = null_space_basis(a, dof)
+    rows, rank, free = basis[..., :3, :], matrix_rank(basis[..., :3, :]), []
+    for name in robot.free_steering:
+        more = np.concatenate([rows, basis[..., [robot.velocity_index(name)], :]], axis=-2)
+        if np.any(matrix_rank(more) > rank):
+            rows, rank, free = more, matrix_rank(more), [*free, name]
+    return tuple(free)
 
 
 def inverse_model(
@@ -327,14 +335,15 @@ def inverse_model(
     """Inverse model (§4.2): the wheel rates (and remaining twist components) from m assigned twist components.
 
     ``twist_names=None`` takes the first assignable subset of ``(vx, vy, omega)`` of size m, with the steering
-    rates of double wheels (``robot.free_steering``: no twist determines them) assigned too.
+    rates of double wheels that no twist determines (``robot.free_steering``, but those the gears tie to the twist
+    or to another) assigned too.
     """
     beta = configuration(robot, beta, heading)
     if twist_names is not None:
         return kinematic_model(robot, twist_names, beta)
     a = constraints(robot, beta)
     dof = int(np.max(a.shape[-1] - matrix_rank(a)))
-    free = _free_steering(robot) if dof else ()  # double wheels' steering rates: no twist determines them, always
+    free = _free_steering(robot, a, dof)  # double wheels' steering rates that no twist determines
     m = dof - len(free)  # assigned, unless the gears lock everything (dof 0: the empty model, as the direct one's)
     if free:
         fixed = [robot.velocity_index(n) for n in free]
