@@ -90,18 +90,20 @@ def test_a_robot_of_double_wheels_is_searched_within_the_walk_budget(monkeypatch
     robot = robot_from_dict({"name": "doubles", "wheels": wheels})  # k = 27, generic m = 8: 2,220,075 sets
     walked = []
 
-    def counting(a, m, offset=0):
-        test = search.null_space_prefilter(a, m, offset)
+    def counting(a, m, offset=0, every=True):  # the depth-first walk's work: its rank tests (PrunedCombinations)
+        test = search.null_space_prefilter(a, m, offset, every)
+        rows, cost = test.rows, search.null_space_cost(a.shape, m)
 
-        def count(sets):
-            walked.append(len(sets) * search.null_space_cost(a.shape, m))
-            assert sum(walked) <= WALK_WORK + search.BATCH * search.null_space_cost(a.shape, m), "walk not bounded"
-            return test(sets)
-        return count
+        def count(cols):
+            walked.append(cost)
+            assert sum(walked) <= WALK_WORK + cost, "walk not bounded"
+            return rows(cols)
+        test.rows = count
+        return test
 
     monkeypatch.setattr(models, "null_space_prefilter", counting)
     sets = generically_assignable_sets(robot)
-    assert not sets.complete and "search stopped after" in sets.note
+    assert walked and not sets.complete and "search stopped after" in sets.note
 
 
 def test_a_search_stopped_before_a_set_is_found_does_not_claim_there_is_none(monkeypatch):

@@ -19,7 +19,14 @@ from scipy.linalg import null_space
 from wmrkit.cli.main import main
 from wmrkit.description import robot_from_dict
 from wmrkit.errors import SingularError
-from wmrkit.kinematics import assignable_sets, direct_model, inverse_model, minimal_actuator_sets
+from wmrkit.kinematics import (
+    assignable_sets,
+    direct_model,
+    generically_assignable_sets,
+    inverse_model,
+    minimal_actuator_sets,
+)
+from wmrkit.kinematics.models import generic_configurations
 
 from ..geared import held_constraints
 
@@ -69,6 +76,28 @@ def test_the_geared_ring_has_assignable_sets_and_a_direct_model_as_the_brute_for
     assert len(minimal_actuator_sets(robot)) > 0
 
 
+def test_the_generically_assignable_sets_of_the_geared_ring_walk_the_pruned_tree():
+    """Before: the lexicographic walk spent its budget on sets holding two rates of the first pair and listed none
+    ("search stopped after 32768 of 636763050 candidate generically assignable sets"). Brute force at the generic
+    samples: a set is generically assignable when its null-space rows have full rank at one of them at least, and
+    the first such set is the smallest of the samples' greedy first bases."""
+    robot = _ring()
+    names, sets = robot.velocity_names, generically_assignable_sets(robot)
+    samples = [null_space(held_constraints(robot, beta)) for beta in generic_configurations(robot)]
+    firsts = []
+    for basis in samples:
+        first, rank = [], 0
+        for i in range(basis.shape[0]):
+            if np.linalg.matrix_rank(basis[[*first, i]], tol=1e-9) > rank:
+                first, rank = [*first, i], rank + 1
+        firsts.append(tuple(first))
+    assert len(sets) > 0 and "exact tests" in sets.note  # the walk reached candidates; the exact budget ended it
+    assert sets[0] == tuple(names[i] for i in min(firsts))
+    assert list(sets) == sorted(set(sets), key=lambda s: [names.index(v) for v in s])
+    assert all(any(np.linalg.matrix_rank(b[[names.index(v) for v in s]], tol=1e-9) == 8 for b in samples)
+               for s in sets)
+
+
 def test_the_inverse_model_of_the_geared_ring_says_why_no_twist_can_be_assigned():
     with pytest.raises(SingularError, match=r"no set of \(vx, vy, omega\) with w0\.steer, .* the body cannot move "
                                             r"\(its 8 degrees of freedom move the joints with the body at rest"):
@@ -98,7 +127,7 @@ def test_the_inverse_model_of_a_locked_ring_says_the_robot_cannot_move_as_the_di
 @pytest.mark.parametrize("seed", range(6))
 def test_the_pruned_walk_yields_exactly_the_sets_of_independent_rows_in_order(seed):
     """Against itertools over every candidate: random rows with repeated, parallel and zero rows, 1 or 2
-    configurations (a set must be independent at each)."""
+    configurations (a set must be independent at each, or with ``every=False`` at one at least: the generic sets)."""
     from wmrkit.kinematics.search import PrunedCombinations
 
     rng = np.random.default_rng(seed)
@@ -108,10 +137,10 @@ def test_the_pruned_walk_yields_exactly_the_sets_of_independent_rows_in_order(se
     rows[:, 5] = 0
     rows[1, 7] = rows[1, 0] - rows[1, 2]
     basis = rows / np.linalg.norm(rows, axis=(-2, -1), keepdims=True)  # singular values <= 1, as an orthonormal basis's
-    for b in (basis[:1], basis):
+    for b, every in itertools.product((basis[:1], basis), (True, False)):  # not every: at one configuration at least
         good = [s for s in itertools.combinations(range(k), m)
-                if all(np.linalg.svd(x[list(s)], compute_uv=False)[-1] > 1e-9 * m for x in b)]
-        walk = PrunedCombinations(range(k), m, lambda cols, b=b: b[:, list(cols)], budget=10**9)
+                if (all if every else any)(np.linalg.svd(x[list(s)], compute_uv=False)[-1] > 1e-9 * m for x in b)]
+        walk = PrunedCombinations(range(k), m, lambda cols, b=b: b[:, list(cols)], budget=10**9, every=every)
         assert list(walk) == good and walk.covered == math.comb(k, m)
 
 

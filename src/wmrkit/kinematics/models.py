@@ -201,13 +201,11 @@ def generically_assignable_sets(robot: Robot) -> tuple[tuple[str, ...], ...]:
     samples = generic_configurations(robot)
     a = constraints(robot, samples)
     m = generic_mobility(robot)
-    generic = a.shape[-1] - matrix_rank(a) == m
-    tests = [null_space_prefilter(a[i], m) for i in np.flatnonzero(generic)]
-    sets, complete, note = search_sets(  # bounded, pruned by the null-space test (.search)
+    generic = a.shape[-1] - matrix_rank(a) == m  # one at least: m is the smallest of the samples' mobilities
+    sets, complete, note = search_sets(  # bounded, pruned by the null-space test at one generic sample at least
         range(a.shape[-1]), m, lambda s: (ranks_assignable(a, s) & generic).any(axis=1),
-        prefilter=lambda s: np.any([t(s) for t in tests], axis=0) if tests else np.zeros(len(s), dtype=bool),
-        max_exact=exact_budget(a.shape, 2), walk_cost=len(tests) * null_space_cost(a.shape[1:], m),
-        what="generically assignable sets")
+        prefilter=null_space_prefilter(a[generic], m, every=False), max_exact=exact_budget(a.shape, 2),
+        walk_cost=null_space_cost(a[generic].shape, m), what="generically assignable sets")
     names = robot.velocity_names
     return SetList([tuple(names[i] for i in s) for s in sets], complete, note)
 

@@ -1,7 +1,8 @@
 """Bounded searches over sets of velocities (assignable sets 4.8, minimal actuator and sensor sets, Figs. 4.4-4.5).
 
 The number of candidate sets grows as ``C(n, m)``: 6,545 for 16 castors, 341,376 for 64. A search here walks the
-candidates in lexicographic order, in batches, through a cheap *necessary* test (the null-space test (4.5): the
+candidates in lexicographic order (depth-first, :class:`PrunedCombinations`, with a null-space prefilter), in
+batches, through a cheap *necessary* test (the null-space test (4.5): the
 rows ``B_a`` of a null-space basis invertible, a batch of ``m x m`` matrices), then confirms the survivors with
 the exact test of the caller, and stops after ``limit`` sets found, :data:`MAX_CANDIDATES` candidates walked or
 :data:`WALK_WORK` spent in the prefilter (each candidate costs an SVD of ``m x m`` per configuration: with the
@@ -58,18 +59,21 @@ class SetList(tuple):
         return str(len(self)) if self.complete else f"{len(self)} listed; {self.note}"
 
 
-def null_space_prefilter(a: np.ndarray, m: int, offset: int = 0) -> Test:
+def null_space_prefilter(a: np.ndarray, m: int, offset: int = 0, every: bool = True) -> Test:
     """The null-space test (4.5) as a prefilter: candidates (columns of A, minus `offset`) whose rows ``B_a`` of a
-    null-space basis of `a` ``(..., R, k)`` are invertible at every configuration of the batch."""
+    null-space basis of `a` ``(..., R, k)`` are invertible at every configuration of the batch (not `every`: at
+    one of them at least, as a generically assignable set is)."""
     from .nullspace import null_space_basis
 
     basis = null_space_basis(a, m)
+    reduce = np.all if every else np.any
 
     def test(sets: np.ndarray) -> np.ndarray:
         b_a = np.moveaxis(basis[..., sets + offset, :], -3, 0)  # (S, ..., m, m)
-        return (matrix_rank(b_a) == m).reshape(len(sets), -1).all(axis=1)
+        return reduce((matrix_rank(b_a) == m).reshape(len(sets), -1), axis=1)
 
     test.rows = lambda cols: basis[..., np.asarray(cols, dtype=int) + offset, :]  # type: ignore[attr-defined]
+    test.every = every  # type: ignore[attr-defined]
     return test
 
 
@@ -81,17 +85,26 @@ class PrunedCombinations:
     only raises the smallest one), so it yields exactly the candidates :func:`null_space_prefilter` passes, without
     walking the ``C(n, size)`` others one by one (a geared ring of 16 double wheels: 6**8 sets among C(51, 8)).
     ``nodes`` counts the rank tests (the work; the walk ends at `budget` of them), ``covered`` the candidates
-    yielded or dropped so far."""
+    yielded or dropped so far. Not `every`: independent at one configuration at least (both tests at the same one),
+    the prefilter of the generically assignable sets."""
 
     def __init__(self, columns: Sequence[int], size: int, rows: Callable[[Sequence[int]], np.ndarray],
-                 budget: int) -> None:
+                 budget: int, every: bool = True) -> None:
         self.columns, self.size, self.rows, self.budget = list(columns), size, rows, budget
+        self.reduce = np.all if every else np.any
         self.nodes = self.covered = 0
 
-    def _full(self, cols: list[int], rank: int) -> bool:
+    def _full(self, cols: list[int], rank: int) -> np.ndarray:
+        """Per configuration ``(...)`` bool: the rows of `cols` have rank `rank`."""
         self.nodes += 1
         s = np.linalg.svd(self.rows(cols), compute_uv=False)
-        return bool((s.shape[-1] >= rank) and np.all(s[..., rank - 1] > RANK_RTOL * self.size))
+        return s[..., rank - 1] > RANK_RTOL * self.size if s.shape[-1] >= rank else np.zeros(s.shape[:-1], bool)
+
+    def _keep(self, cand: list[int], rest: list[int]) -> bool:
+        ok = self._full(cand, len(cand))
+        if not self.reduce(ok) or not rest:
+            return bool(self.reduce(ok))
+        return bool(self.reduce(ok & self._full(cand + rest, self.size)))
 
     def __iter__(self):
         return self._walk([], 0)
@@ -102,8 +115,7 @@ class PrunedCombinations:
             if self.nodes >= self.budget:
                 return
             cand = [*prefix, self.columns[i]]
-            ok = self._full(cand, len(cand)) and (need == 0 or self._full(cand + self.columns[i + 1:], self.size))
-            if not ok:
+            if not self._keep(cand, self.columns[i + 1:] if need else []):
                 self.covered += math.comb(n - i - 1, need)
             elif need == 0:
                 self.covered += 1
@@ -149,7 +161,7 @@ def search_sets(columns: Sequence[int], size: int, exact: Test, *, prefilter: Te
     if prefilter is not None and walk_cost > 0:
         max_walk = min(MAX_CANDIDATES, max(1, int(WALK_WORK / walk_cost)))
     if prefilter is not None and hasattr(prefilter, "rows") and size > 0:
-        pruned = PrunedCombinations(columns, size, prefilter.rows, max_walk)
+        pruned = PrunedCombinations(columns, size, prefilter.rows, max_walk, getattr(prefilter, "every", True))
         candidates, prefilter = iter(pruned), None  # it yields exactly what the prefilter passes
     with tqdm(total=total, disable=None if total > PROGRESS_FROM else True, leave=False, unit="set",
               desc=f"searching {what}") as bar:
