@@ -225,3 +225,26 @@ def test_a_result_that_is_not_finite_is_refused_not_printed():
         OdometrySummary("forklift", "fk2", 3, 0.0, 1.0, (math.nan, 2.0, 0.5), 3.0, 0.5, 0.0, 0.0, 0.01)
     with pytest.raises(WmrkitError, match="not finite"):
         OdometrySummary("forklift", "fk2", 3, 0.0, 1.0, (1.0, 2.0, 0.5), 3.0, 0.5, 0.0, math.inf, 0.01)
+
+
+@pytest.mark.parametrize(("rows", "cols"), [(0, 5), (1, 5), (2, 5), (3, 5), (4, 5), (5, 5), (4, 6)])
+def test_the_slip_norms_of_two_rates_are_the_generic_ones_bit_for_bit(rows, cols):
+    """The slip indicator's one-loop form for five columns (two sensed rates) against the generic loops per row and
+    column (:func:`_norm_rows`, same sums in the same order: equal bits) and against numpy (round-off); six
+    columns take the generic loops. Runs of every length, the short ones of a quantised steering angle first."""
+    from wmrkit.odometry._kernels import BLOCK, _norm_rows
+
+    rng = np.random.default_rng(rows)
+    ca = np.triu(rng.normal(size=(3, rows, cols)))
+    z = rng.normal(size=(cols, BLOCK)) * 10.0 ** rng.integers(-3, 4, size=(cols, 1))
+    lengths = [1, 2, 3, 4, 5, 1, 8, 1, 17, 2, 60]
+    seg_start = np.cumsum([0, *lengths, BLOCK - sum(lengths)])
+    seg_u = np.arange(len(seg_start) - 1) % 3
+    count = len(seg_u)
+    want, got, acc = np.empty(BLOCK), np.full(BLOCK, np.nan), np.empty(BLOCK)
+    _norm_rows.py_func(ca, seg_u, seg_start, count, z, True, acc, want)
+    for fn in (_kalman_kernel._slip_norms, _kalman_kernel._slip_norms.py_func):
+        fn(ca, seg_u, seg_start, count, z, acc, got)
+        np.testing.assert_array_equal(got, want)
+    u = np.repeat(seg_u, np.diff(seg_start))
+    np.testing.assert_allclose(got, np.linalg.norm(np.einsum("jrc,cj->jr", ca[u], z), axis=1), rtol=1e-13, atol=0)

@@ -19,6 +19,8 @@ the blocks of :mod:`wmrkit.odometry._kernels`.
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
@@ -134,7 +136,7 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
         for j in range(bm):
             d = dt[j]
             bx[j], by[j], bth[j] = z[0, j] * d, z[1, j] * d, z[2, j] * d
-        _norm_rows(ca, seg_u, seg_start, count, z, True, acc, norm)  # |C x + A_a qdot| = |T z|, z = (x, qdot)
+        _slip_norms(ca, seg_u, seg_start, count, z, acc, norm)  # |C x + A_a qdot| = |T z|, z = (x, qdot)
         for j in range(bm):
             slip[block + j] = norm[j] * dt[j]
         if with_increments:
@@ -150,6 +152,50 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
             return block + bm, _configurations_from(positions, before, steer_cols, block + bm, missing)
     _store(filt, x_0, x_1, x_2, p00, p01, p02, p11, p12, p22)
     return n, 0
+
+
+@numba.njit
+def _slip_norms(ca, seg_u, seg_start, count, z, acc, norm):
+    """``norm[j] = |T z[:, j]|``, T = ``ca[u]`` triangular (:func:`_norm_rows`). With two sensed rates (T of five
+    columns: the forklift's drive wheels, a differential drive) every row of a run in one loop, instead of a loop
+    per row and column (which costs more than the arithmetic on the short runs of a quantised steering angle), as
+    :func:`wmrkit.odometry._kernels._maps_two_rates`: the same sums in the same order, so the same numbers."""
+    n_r = ca.shape[1]
+    if ca.shape[2] != 5 or n_r > 5:
+        _norm_rows(ca, seg_u, seg_start, count, z, True, acc, norm)
+        return
+    t00 = t01 = t02 = t03 = t04 = t11 = t12 = t13 = t14 = t22 = t23 = t24 = t33 = t34 = t44 = 0.0
+    for g in range(count):
+        u, j0, j1 = seg_u[g], max(seg_start[g], 0), seg_start[g + 1]
+        if n_r > 0:
+            t00, t01, t02, t03, t04 = ca[u, 0, 0], ca[u, 0, 1], ca[u, 0, 2], ca[u, 0, 3], ca[u, 0, 4]
+        if n_r > 1:
+            t11, t12, t13, t14 = ca[u, 1, 1], ca[u, 1, 2], ca[u, 1, 3], ca[u, 1, 4]
+        if n_r > 2:
+            t22, t23, t24 = ca[u, 2, 2], ca[u, 2, 3], ca[u, 2, 4]
+        if n_r > 3:
+            t33, t34 = ca[u, 3, 3], ca[u, 3, 4]
+        if n_r > 4:
+            t44 = ca[u, 4, 4]
+        for k in range(j0, j1):
+            z0, z1, z2, z3, z4 = z[0, k], z[1, k], z[2, k], z[3, k], z[4, k]
+            total = 0.0
+            if n_r > 0:
+                a = ((((0.0 + t00 * z0) + t01 * z1) + t02 * z2) + t03 * z3) + t04 * z4
+                total += a * a
+            if n_r > 1:
+                a = (((0.0 + t11 * z1) + t12 * z2) + t13 * z3) + t14 * z4
+                total += a * a
+            if n_r > 2:
+                a = ((0.0 + t22 * z2) + t23 * z3) + t24 * z4
+                total += a * a
+            if n_r > 3:
+                a = (0.0 + t33 * z3) + t34 * z4
+                total += a * a
+            if n_r > 4:
+                a = 0.0 + t44 * z4
+                total += a * a
+            norm[k] = math.sqrt(total)
 
 
 @numba.njit
