@@ -174,7 +174,9 @@ class DynamicModel:
         roll without slip (``A nu = 0``) and the columns `held` (the other servoed joints) stay at rest. A
         steerable wheel turns alone (its ``inertia.steer``); a double wheel whose spins are held turns the body
         about its pivot (``I + m x^2`` and more); where the constraints lock the joint (no such motion: the tyres
-        would have to slip) it is the wheel's own ``inertia.steer``.
+        would have to slip) it is the wheel's own ``inertia.steer``. The motions hold the gears (``gear_basis``):
+        the joints geared to a steering joint turn with it, their inertias reflected through the ratios, and holding
+        one joint of a gear holds the whole gear.
         """
         from scipy.linalg import null_space
 
@@ -182,11 +184,12 @@ class DynamicModel:
         bad = [j for j in held if not (isinstance(j, int | np.integer) and 3 <= j < self.n)]
         if bad:
             raise WmrkitError(f"held: expected joint columns of model.names (3 to {self.n - 1}), got {bad}")
-        a, m = self.slip_matrix(), self.mass_matrix()
+        t = self.pack[16] if self.pack[16].shape[1] else np.eye(self.n)  # the motions the couplings allow
+        a, m = self.slip_matrix() @ t, self.mass_matrix()
         out = np.zeros(len(self.steer_columns))
         own = [w.steer_inertia for w in self.robot.wheels if w.kind.steers]
         for k, c in enumerate(self.steer_columns):
-            basis = null_space(np.vstack([a, np.eye(self.n)[[j for j in held if j != c]]]))
+            basis = t @ null_space(np.vstack([a, t[[j for j in held if j != c]]]))
             g = basis[c]
             if g @ g < 1e-18:  # locked: no rolling motion turns it
                 out[k] = own[k]
