@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
+
 from wmrkit import Robot
 
 
@@ -52,3 +56,41 @@ def double_unit_robot(steer_range: list | None = None, actuated: tuple = ("spin1
         "wheels": [drive, {"name": "left", "position": [-0.3, 0.2], **castor},
                    {"name": "right", "position": [-0.3, -0.2], **castor}],
     })
+
+
+def linked_car(linkage: bool = True, front_heading: float = 0.0, tyre: dict | str = "dugoff") -> Robot:
+    """A small car (wheelbase 0.6 m, track 0.4 m, origin at the rear axle's middle): fixed rear wheels, steerable
+    front wheels at Ackermann headings for `front_heading` [rad] of the left one, held by a ``linkage``."""
+    wheelbase, half = 0.6, 0.2
+    icr = half + wheelbase / math.tan(front_heading) if front_heading else math.inf  # the ICR's y on the rear axle
+    right = math.atan2(wheelbase, icr + half) if front_heading else 0.0
+    wheel = {"r": 0.1, "tyre": tyre}
+    front = {**wheel, "type": "steerable", "actuated": ["steer"], "inertia": {"spin": 0.01, "steer": 0.05}}
+    data = {
+        "name": "linked-car",
+        "body": {"mass": 30, "inertia": 1.5, "com": [0.25, 0.0], "com_height": 0.2},
+        "wheels": [
+            {**wheel, "name": "rl", "type": "fixed", "position": [0, half], "heading": 0, "actuated": ["spin"],
+             "inertia": {"spin": 0.02}},
+            {**wheel, "name": "rr", "type": "fixed", "position": [0, -half], "heading": 0, "actuated": ["spin"],
+             "inertia": {"spin": 0.02}},
+            {**front, "name": "fl", "position": [wheelbase, half], "heading": f"{front_heading} rad"},
+            {**front, "name": "fr", "position": [wheelbase, -half], "heading": f"{right} rad"},
+        ],
+    }
+    if linkage:
+        data["couplings"] = [{"kind": "linkage", "joints": ["fl.steer", "fr.steer"]}]
+    return Robot.from_dict(data)
+
+
+def least_energy_inertia(model, rows, c):
+    """The inertia a servo on column `c` moves, by another method than ``steering_inertia``'s null space: the
+    KKT system of ``min nu' M nu`` subject to ``rows nu = 0`` and ``nu_c = 1``; returns ``nu* ' M nu*`` (twice the
+    kinetic energy (7.17) of that motion, from ``model.kinetic_energy``) and the motion ``nu*``."""
+    m = model.mass_matrix()
+    con = np.vstack([rows, np.eye(model.n)[c]])
+    kkt = np.block([[2 * m, con.T], [con, np.zeros((len(con), len(con)))]])
+    rhs = np.zeros(len(kkt))
+    rhs[-1] = 1.0
+    nu = np.linalg.lstsq(kkt, rhs, rcond=None)[0][:model.n]
+    return 2 * model.kinetic_energy(None, nu), nu

@@ -8,7 +8,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from dynamics_robots import castor_robot
+from dynamics_robots import castor_robot, least_energy_inertia
 
 from wmrkit import catalog
 from wmrkit.couplings import Coupling
@@ -141,19 +141,6 @@ def test_twist_program_refuses_a_twist_the_gear_forbids_unless_allowed_to_slip()
     twist_program(model, [0.0], [(0.5, 0.0, 0.0)])  # straight: the axle turns as one
 
 
-def _least_energy_inertia(model, rows, c):
-    """The inertia a servo on column `c` moves, by another method than ``steering_inertia``'s null space: the
-    KKT system of ``min nu' M nu`` subject to ``rows nu = 0`` and ``nu_c = 1``; returns ``nu* ' M nu*`` (twice the
-    kinetic energy (7.17) of that motion, from ``model.kinetic_energy``) and the motion ``nu*``."""
-    m = model.mass_matrix()
-    con = np.vstack([rows, np.eye(model.n)[c]])
-    kkt = np.block([[2 * m, con.T], [con, np.zeros((len(con), len(con)))]])
-    rhs = np.zeros(len(kkt))
-    rhs[-1] = 1.0
-    nu = np.linalg.lstsq(kkt, rhs, rcond=None)[0][:model.n]
-    return 2 * model.kinetic_energy(None, nu), nu
-
-
 @pytest.mark.parametrize("ratios", [(1.0, 1.0), (1.0, 2.0)])
 def test_steering_inertia_turns_the_joints_geared_to_the_steering(ratios):
     """A double wheel whose two spins are geared (ratios 1:1 or 1:2) cannot counter-rotate them to turn under the
@@ -170,10 +157,10 @@ def test_steering_inertia_turns_the_joints_geared_to_the_steering(ratios):
     gear = np.zeros(model.n)
     gear[i], gear[j] = 1 / ratios[0], -1 / ratios[1]
     a = model.slip_matrix()
-    expected, nu = _least_energy_inertia(model, np.vstack([a, gear]), c)
+    expected, nu = least_energy_inertia(model, np.vstack([a, gear]), c)
     assert np.abs(a @ nu).max() < 1e-9 and nu[j] == pytest.approx(ratios[1] / ratios[0] * nu[i], rel=1e-9)
     assert expected > 10 * robot.wheel("drive").steer_inertia  # the body turns with the unit
     assert model.steering_inertia()[0] == pytest.approx(expected, rel=1e-9)
-    held, _ = _least_energy_inertia(model, np.vstack([a, gear, np.eye(model.n)[i]]), c)
+    held, _ = least_energy_inertia(model, np.vstack([a, gear, np.eye(model.n)[i]]), c)
     assert model.steering_inertia([i])[0] == pytest.approx(held, rel=1e-9)
     assert model.steering_inertia([j])[0] == pytest.approx(held, rel=1e-9)

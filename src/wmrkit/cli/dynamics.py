@@ -169,9 +169,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     travelled = float(np.sum(np.hypot(*np.diff(sim.pose[:, :2], axis=0).T)))
     max_slip = float(np.hypot(sim.slip[..., 0], sim.slip[..., 1]).max())  # a contact's slip speed, not a component
     deviation = sim.deviation()
-    warnings = _tyre_warnings(model, sim.twist) + [
-        f"{c.channel_name} is not held by the dynamics: each steering angle follows its own servo (wmrkit has no "
-        "model of a linkage's geometry; docs/dynamics.md)" for c in model.robot.couplings if c.kind == "linkage"]
+    warnings = _tyre_warnings(model, sim.twist)
     if deviation and deviation.large:
         warnings.append(deviation_warning(model, inputs, deviation, max_slip))
     for warning in warnings:
@@ -193,9 +191,10 @@ def run_simulate(args: argparse.Namespace) -> int:
 
 
 def _check_rolling(model, twist: list[float]) -> None:
-    """Refuse an ``--initial-twist`` at which a fixed wheel would slip sideways or a gear's joints turn out of its
-    ratios: the start rolls without slip (the forklift, whose origin is at the fork tips, turns with ``vy = -omega
-    x_axle``; a skid steer cannot turn so, nor a solid axle)."""
+    """Refuse an ``--initial-twist`` at which a fixed wheel would slip sideways, a gear's joints turn out of its
+    ratios or the wheels steer as a linkage cannot: the start rolls without slip (the forklift, whose origin is at
+    the fork tips, turns with ``vy = -omega x_axle``; a skid steer cannot turn so, nor a solid axle)."""
+    from ..dynamics.linkages import linkage_breach
     from ..dynamics.programs import SLIP_TOL, feasible_twists
     from ..kinematics.wheel_ik import wheel_commands
 
@@ -210,6 +209,11 @@ def _check_rolling(model, twist: list[float]) -> None:
                                   f"{c.channel_name} out of its ratios ({', '.join(f'{k:g}' for k in c.ratios)}), "
                                   "which the gear holds together, and the simulation starts rolling without slip "
                                   "(wmrkit ik says which twists the gear allows)")
+        breach = linkage_breach(model, np.asarray(cmd.beta, dtype=float))
+        if breach:
+            raise WmrkitError(f"--initial-twist {' '.join(f'{v:g}' for v in twist)}: its wheels' steering breaks "
+                              f"a linkage ({breach}), which the dynamics hold, and the simulation starts rolling "
+                              "without slip")
         return
     w = int(np.argmax(slip))
     rolling = feasible_twists(model, [twist])[0]

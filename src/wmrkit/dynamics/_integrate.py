@@ -25,6 +25,7 @@ from ._kernels import (
     _njit,
     bias,
     contact_forces,
+    hold_linkages,
     mass_matrix,
     normal_loads,
     slip_matrix,
@@ -52,9 +53,11 @@ def _interp(values, k, k1, w, out):
 def assemble(t, s, acc, pack, inp, jac, w):
     """Everything at state `s`, time `t`, into the work arrays `w` (see :func:`work_arrays`); returns nothing.
 
-    ``w = (a, m, dm, fz, f, g, vw, tau, kdiag, rhs, beta, beta_rate, rate_ref, beta_ref, mat, filled, lift)``
-    (``lift``: 1, the time and the contact of the first lift-off, see
-    :func:`wmrkit.dynamics.runs.check_lift_off`):
+    ``w = (a, m, dm, fz, f, g, vw, tau, kdiag, rhs, beta, beta_rate, rate_ref, beta_ref, mat, filled, lift, red, y,
+    basis, c)`` (``lift``: 1, the time and the contact of the first lift-off, see
+    :func:`wmrkit.dynamics.runs.check_lift_off`; ``basis``, ``c``: :func:`solve_held`). `s` holds the linkages
+    (its callers set it on them: :func:`~._kernels.hold_linkages`; writing `s` here cost the fixed-step loop of a
+    robot without a linkage 7 %);
     ``rhs = tau + A' F + bias`` so that
     ``m nu' = rhs``; ``kdiag`` holds the servo terms of ``d rhs / d nu``.
     """
@@ -134,12 +137,16 @@ def work_arrays(n: int, n_el: int, n_steer: int, n_geared: int = 0) -> tuple:
     return (np.zeros((2 * n_el, n)), np.zeros((n, n)), np.zeros((n_steer, n, n)), np.zeros(n_el),
             np.zeros((n_el, 2)), np.zeros((n_el, 2, 2)), np.zeros(n_el), np.zeros(n), np.zeros(n), np.zeros(n),
             np.zeros(n_steer), np.zeros(n_steer), np.zeros(n), np.zeros(n_steer), np.zeros((n, n)),
-            np.zeros(1), np.zeros(3), np.zeros((n_geared, n_geared)), np.zeros(n_geared))
+            np.zeros(1), np.zeros(3), np.zeros((n_geared, n_geared)), np.zeros(n_geared), np.zeros((n, n_geared)),
+            np.zeros(n))
 
 
 def model_work_arrays(model) -> tuple:
-    """:func:`work_arrays` of a :class:`wmrkit.dynamics.model.DynamicModel`."""
-    return work_arrays(model.n, len(model.contacts), len(model.steer_columns), model.pack[16].shape[1])
+    """:func:`work_arrays` of a :class:`wmrkit.dynamics.model.DynamicModel` (its basis copied in: the linkages'
+    entries of it change with the state)."""
+    w = work_arrays(model.n, len(model.contacts), len(model.steer_columns), model.pack[16].shape[1])
+    w[19][:] = model.pack[16]
+    return w
 
 
 @_inline
@@ -178,6 +185,24 @@ def solve_geared(mat, rhs, t, red, y):
         rhs[k] = acc
 
 
+@_inline
+def solve_held(mat, rhs, pack, w):
+    """:func:`solve_geared` with the linkages held too: ``nu' = T p' + c`` with the state's basis ``T = w[19]`` and
+    velocity-product accelerations ``c = w[20]`` (filled by :func:`assemble`), so ``rhs`` becomes ``T (T' mat
+    T)^-1 T' (rhs - mat c) + c``; without a linkage exactly :func:`solve_geared` on the model's basis."""
+    linked, c, n = pack[17].shape[0] > 0, w[20], rhs.shape[0]
+    if linked:
+        for i in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += mat[i, j] * c[j]
+            rhs[i] -= acc
+    solve_geared(mat, rhs, w[19] if linked else pack[16], w[17], w[18])  # one copy of the solve, inlined
+    if linked:
+        for i in range(n):
+            rhs[i] += c[i]
+
+
 @functools.partial(_njit, nrt=False)
 def assembled(t, s, acc, pack, inp, jac, w):
     """:func:`assemble` compiled once, for the records (:func:`observe`, the last one of a run) and the explicit
@@ -189,7 +214,11 @@ def assembled(t, s, acc, pack, inp, jac, w):
 
 @_njit
 def derivative(t, s, acc, pack, inp, w):
-    """``ds/dt`` (explicit form): pose rate from the twist (3.15), joint rates, ``nu' = M^-1 rhs``."""
+    """``ds/dt`` (explicit form): pose rate from the twist (3.15), joint rates, ``nu' = M^-1 rhs``; `s` is not
+    changed (a copy is set on the linkages)."""
+    if pack[17].shape[0] > 0:
+        s = s.copy()
+        hold_linkages(s, pack, w[19], w[20], True)
     assembled(t, s, acc, pack, inp, False, w)
     n = w[9].shape[0]
     out = np.empty(2 * n)
@@ -198,13 +227,13 @@ def derivative(t, s, acc, pack, inp, w):
     out[1] = math.sin(th) * s[n] + math.cos(th) * s[n + 1]
     out[2:n] = s[n + 2:2 * n]
     out[n:] = w[9]
-    solve_geared(w[1].copy(), out[n:], pack[16], w[17], w[18])
+    solve_held(w[1].copy(), out[n:], pack, w)
     acc[:] = out[n:]
     return out
 
 
 @_inline
-def _update_semi_implicit(s, dt, acc, w, pack):
+def _update_semi_implicit(s, dt, acc, w, pack, linked):
     """One linearly implicit Euler step from the assembled work arrays `w` (:func:`assemble`): friction and servo
     Jacobians implicit, then positions with the new velocity.
 
@@ -233,7 +262,9 @@ def _update_semi_implicit(s, dt, acc, w, pack):
             for d in range(n):
                 if d != c and group[d] == group[c]:
                     mat[c, d] -= dt * kdiag[c] * ratio[d] / ratio[c]
-    solve_geared(mat, rhs, pack[16], w[17], w[18])  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt, gears held
+    if linked:
+        hold_linkages(s, pack, w[19], w[20], False)  # the linkages' basis at the step's start
+    solve_held(mat, rhs, pack, w)  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt, gears and linkages held
     dnu = rhs
     for c in range(n):
         acc[c] = dnu[c]
@@ -243,6 +274,8 @@ def _update_semi_implicit(s, dt, acc, w, pack):
     s[1] += dt * (math.sin(th) * s[n] + math.cos(th) * s[n + 1])
     for c in range(2, n):
         s[c] += dt * s[n + c]
+    if linked:
+        hold_linkages(s, pack, w[19], w[20], True)  # the followers set from their leaders (no drift)
 
 
 @_njit
@@ -253,6 +286,7 @@ def step_rk4(t, s, dt, acc, pack, inp, w):
     k3 = derivative(t + dt / 2, s + dt / 2 * k2, acc, pack, inp, w)
     k4 = derivative(t + dt, s + dt * k3, acc, pack, inp, w)
     s += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    hold_linkages(s, pack, w[19], w[20], True)
 
 
 @_inline
@@ -282,16 +316,19 @@ def _store(t, s, w, rec, i):
 
 @_njit
 def observe(t, s, acc, pack, inp, w, rec, i):
-    """Store the state's outputs in the record arrays ``rec`` at row `i`."""
+    """Store the state's outputs in the record arrays ``rec`` at row `i`, `s` first set on the linkages (an
+    adaptive run's states: the solver integrates the followers too)."""
+    hold_linkages(s, pack, w[19], w[20], True)
     _observe(t, s, acc, pack, inp, w, rec, i)
 
 
-@functools.partial(_njit, nrt=False)
-def run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0):
-    """`n_steps` semi-implicit steps (:func:`_update_semi_implicit`) from `s` (changed in place) at step `k0`
-    (``t = k0 dt``), refreshing the tyre Jacobian at the steps ``k = jac_phase (mod jac_every)``; a record every
-    `every` steps from row `i0`; returns the next row. Compiled without reference counting (it allocates nothing).
-    """
+@_njit
+def _hold(s, pack, w):
+    hold_linkages(s, pack, w[19], w[20], True)
+
+
+@_inline
+def _semi_implicit_steps(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0, linked):
     i = i0
     for j in range(n_steps):
         k = k0 + j
@@ -299,12 +336,29 @@ def run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack
         if j > 0 and k % every == 0 and i < rec[0].shape[0]:  # the step's assembly is the record at t = k dt
             _store(k * dt, s, w, rec, i)
             i += 1
-        _update_semi_implicit(s, dt, acc, w, pack)
+        _update_semi_implicit(s, dt, acc, w, pack, linked)
     k = k0 + n_steps
     if n_steps > 0 and k % every == 0 and i < rec[0].shape[0]:
         _observe(k * dt, s, acc, pack, inp, w, rec, i)
         i += 1
     return i
+
+
+@functools.partial(_njit, nrt=False)
+def run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0):
+    """`n_steps` semi-implicit steps (:func:`_update_semi_implicit`) from `s` (changed in place) at step `k0`
+    (``t = k0 dt``), refreshing the tyre Jacobian at the steps ``k = jac_phase (mod jac_every)``; a record every
+    `every` steps from row `i0`; returns the next row. Compiled without reference counting (it allocates nothing).
+    For a robot without a linkage: the linkages' code is compiled out of its loop (in it, not taken, it cost 5-7 %).
+    """
+    return _semi_implicit_steps(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0, False)
+
+
+@functools.partial(_njit, nrt=False)
+def run_semi_implicit_linked(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0):
+    """:func:`run_semi_implicit` holding the linkages (``pack[17]``): each step sets the followers from their leaders;
+    compiled at its first use, by a robot with a linkage."""
+    return _semi_implicit_steps(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0, True)
 
 
 @_njit
@@ -328,9 +382,12 @@ def run(s, k0, dt, n_steps, every, method, jac_every, acc, pack, inp, w, rec, i0
     A state that overflows (the compiled kernels then raise ZeroDivisionError) comes back as NaN, for the caller's
     divergence check.
     """
+    if pack[17].shape[0]:  # a state changed in between (Stepper.state is the caller's) starts on the linkages
+        _hold(s, pack, w)
     try:
         if method == 0:
-            return run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0)
+            steps = run_semi_implicit_linked if pack[17].shape[0] else run_semi_implicit
+            return steps(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0)
         return run_rk4(s, k0, dt, n_steps, every, acc, pack, inp, w, rec, i0)
     except ZeroDivisionError:
         s[:] = math.nan

@@ -14,8 +14,9 @@ rate in the velocity vector; ``steer_kind (S,)`` int: 0 centred (its z-inertia i
 1 for the columns that carry the wheel (twist, steering rates), 0 for rolling ones; ``body (6,)``: ``M, I, cx, cy,
 h, g``; ``pinv (E, 3)``: static load map when the contacts do not move (``fixed_loads``), ``fixed_loads (1,)``;
 ``group (n,)`` int: the differential coupling of each column (-1: none) and ``ratio (n,)`` its ratio there;
-``loaded (E,)``: 1 for the contacts loaded at rest; ``gears (n, p)``: the motions the gear couplings allow,
-``nu = gears @ p`` (``model.gear_basis``; ``(n, 0)`` without a gear).
+``loaded (E,)``: 1 for the contacts loaded at rest; ``basis (n, p)``: the motions the gear and linkage couplings
+allow, ``nu = basis @ p`` (``model.gear_basis`` less the linkages' followers, whose rows depend on the state:
+:func:`hold_linkages`; ``(n, 0)`` without a coupling to hold); ``linkages (L, 10)``: :mod:`wmrkit.dynamics.linkages`.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from pathlib import Path
 from .._jit import compile_cached, drop_stale_cache
 from ..wheels import __file__ as wheels_file
 from ..wheels import slip_row_entries
-from . import tyres
+from . import linkages, tyres
 
 #: Fast-math flags of the dynamics kernels: no NaN or infinity reaches them (the simulator checks the state between
 #: chunks) and the sign of zero does not matter, but no contraction into fused multiply-adds and no reassociation:
@@ -86,12 +87,31 @@ def _compiled_namespace():
     return g
 
 
-drop_stale_cache([__file__, str(Path(__file__).with_name("_integrate.py")), tyres.__file__], [wheels_file])
+drop_stale_cache([__file__, str(Path(__file__).with_name("_integrate.py")), tyres.__file__],
+                 [wheels_file, linkages.__file__])
 _NS = _compiled_namespace()
 _linear, _coulomb, _dugoff, _pacejka = (_NS[n] for n in ("linear_forces", "coulomb_forces", "dugoff_forces",
                                                           "pacejka_forces"))
 _pacejka_speed, _pacejka_at = _NS["pacejka_speed_terms"], _NS["pacejka_at_speed"]
 _rows = compile_cached(slip_row_entries, None)
+_law = _inline(linkages.law)
+
+
+@_inline
+def hold_linkages(s, pack, t, c, project):
+    """Set each linkage's entry of the basis `t` (the model's, ``pack[16]``, elsewhere) to ``f'`` and its
+    velocity-product acceleration ``c = f'' beta_i'^2`` at the state `s` (:mod:`.linkages`); with `project`, first
+    set its follower in `s` from its leader (angle ``f(beta_i)``, rate ``f' beta_i'``: the constraint held to
+    round-off). Nothing without a linkage."""
+    table = pack[17]
+    n = s.shape[0] // 2
+    for r in range(table.shape[0]):
+        j, i = int(table[r, 0]), int(table[r, 1])
+        f, slope, curvature = _law(table[r], s[i])
+        if project:
+            s[j], s[n + j] = f, slope * s[n + i]
+        t[j, int(table[r, 2])] = slope
+        c[j] = curvature * s[n + i] * s[n + i]
 
 
 @_inline

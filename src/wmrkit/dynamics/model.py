@@ -31,6 +31,7 @@ from .._shapes import as_angles, readonly
 from ..couplings import gear_free
 from ..errors import ShapeError, WmrkitError
 from ..robot import Robot, element_table
+from .linkages import coupling_basis, linkage_breach, linkage_table, reduced
 from .mass import CASTOR_TYPES, Body, body_problem
 from .tyres import Tyre
 
@@ -162,10 +163,13 @@ class DynamicModel:
         b = np.zeros(self.n)
         bias(nu, nu[list(self.steer_columns)].copy(), m, dm, self.pack[5], self.pack[6], b)
         rhs = tau + self.slip_matrix(beta).T @ f.reshape(-1) + b
-        t = self.pack[16]
-        if t.shape[1] == 0:
+        if self.pack[16].shape[1] == 0:
             return readonly(np.linalg.solve(m, rhs))
-        return readonly(t @ np.linalg.solve(t.T @ m @ t, t.T @ rhs))  # held gears (gear_basis)
+        breach = linkage_breach(self, beta, nu)
+        if breach:
+            raise WmrkitError(f"beta, nu: {breach}: the dynamics hold the linkage")
+        t, c = self._basis(beta, nu)  # held gears and linkages: nu' = T p' + c
+        return readonly(t @ np.linalg.solve(t.T @ m @ t, t.T @ (rhs - m @ c)) + c)
 
     def steering_inertia(self, held: Iterable[int] = ()) -> np.ndarray:
         """Inertia [kg m^2] that each steering joint's servo moves at the described configuration ``(n_steer,)``.
@@ -184,7 +188,7 @@ class DynamicModel:
         bad = [j for j in held if not (isinstance(j, int | np.integer) and 3 <= j < self.n)]
         if bad:
             raise WmrkitError(f"held: expected joint columns of model.names (3 to {self.n - 1}), got {bad}")
-        t = self.pack[16] if self.pack[16].shape[1] else np.eye(self.n)  # the motions the couplings allow
+        t = self._basis(self.robot.beta)[0]  # the motions the couplings allow
         a, m = self.slip_matrix() @ t, self.mass_matrix()
         out = np.zeros(len(self.steer_columns))
         own = [w.steer_inertia for w in self.robot.wheels if w.kind.steers]
@@ -196,6 +200,14 @@ class DynamicModel:
                 continue
             out[k] = 1.0 / float(g @ np.linalg.solve(basis.T @ m @ basis, g))
         return readonly(out)
+
+    def _basis(self, beta: ArrayLike, nu: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``(T (n, p), c (n,))``: the motions the gears and linkages allow at steering angles `beta`, ``nu = T p``,
+        and the linkages' velocity-product acceleration at velocities `nu` (``nu' = T p' + c``; 0 without `nu`)."""
+        if self.pack[16].shape[1] == 0:
+            return np.eye(self.n), np.zeros(self.n)
+        columns = list(self.steer_columns)
+        return reduced(self.pack[17], self.pack[16], lambda c: float(beta[columns.index(c)]), nu)
 
     def _beta(self, beta: ArrayLike | None) -> np.ndarray:
         if beta is None:
@@ -276,7 +288,7 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
     static = np.zeros(n_el)
     normal_loads(np.array(robot.beta, dtype=float), np.zeros(n), np.zeros(n), pack, static)
     pack = (*pack, (static > 0).astype(float),  # 15: the contacts loaded at rest (lift-off: _integrate.assemble)
-            gear_basis(robot, tuple(names)))  # 16: the motions the gears allow (none: no gear)
+            *_coupling_pack(robot, tuple(names)))  # 16, 17: the motions the couplings allow, the linkages
     contacts = contact_names(robot)
     spread = np.linalg.svd(geo, compute_uv=False)
     if len(spread) < 3 or spread[2] <= 1e-9 * spread[0]:  # (7.64) has no solution: a pitch moment would be left
@@ -310,6 +322,13 @@ def gear_basis(robot: Robot, names: tuple[str, ...]) -> np.ndarray:
     if not any(c.kind == "gear" for c in robot.couplings):
         return np.zeros((len(names), 0))
     return np.ascontiguousarray(gear_free(robot.couplings, names, ())[0], dtype=float)
+
+
+def _coupling_pack(robot: Robot, names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """``(basis (n, p), linkages (L, 10))``: :func:`gear_basis` less the linkages' followers, whose rows the
+    integrators fill per state, and the linkage table (:mod:`.linkages`); ``(n, 0)`` without gear or linkage."""
+    table = linkage_table(robot, names)
+    return coupling_basis(gear_basis(robot, names), table, len(names)), table
 
 
 def _differentials(robot: Robot, names: list[str]) -> tuple[np.ndarray, np.ndarray]:

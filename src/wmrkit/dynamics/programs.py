@@ -26,6 +26,7 @@ from .._shapes import readonly
 from ..errors import WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, check_table_size
 from ..units import BARE_ANGLE_LIMIT
+from .linkages import linkage_breach
 from .model import DynamicModel
 from .simulate import Inputs, _knots, joint_column
 
@@ -102,7 +103,8 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     :class:`WmrkitError` naming the knot and the wheel; :func:`feasible_twists` gives the closest feasible twists,
     and ``allow_slip=True`` commands the wheels' rolling components and lets the tyres slip (skid steering). So is a
     twist that a ``gear`` coupling forbids (its joints out of its ratios: a solid axle turning); with ``allow_slip``
-    each joint's servo follows its own rate and they fight through the gear, which holds.
+    each joint's servo follows its own rate and they fight through the gear, which holds; and one whose steering a
+    ``linkage`` cannot set (:mod:`.linkages`; ``allow_slip``: the steering servos fight through it).
     Twists are finite, their speeds within ``limits.MAX_SPEED`` [m/s] and their turn rates within as many rad/s.
 
     Rate servos on actuated wheel joints (gain ``bandwidth x`` the wheel's reflected inertia, at least the grip
@@ -145,6 +147,12 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
                           f"'{robot.name}': it would turn the joints of {c.channel_name} out of its ratios "
                           f"({', '.join(f'{r:g}' for r in c.ratios)}), which the gear holds together; use "
                           "allow_slip=True to let its servos fight and the tyres slip")
+    headings = np.zeros((len(t), len(model.steer_columns)))
+    steer_wheels = [w for w in robot.wheels if w.kind.steers]
+    for k, w in enumerate(steer_wheels):
+        h = cmd.heading[:, robot.wheel_names.index(w.name)]
+        headings[:, k] = np.where(np.isfinite(h), h, w.heading)
+    _check_linkages(model, t, twists, headings, allow_slip)
     rates = np.zeros((len(t), n))
     rates[:, 3:3 + cmd.rates.shape[-1]] = np.nan_to_num(cmd.rates)
     gain, limit = np.zeros(n), np.full(n, np.inf)
@@ -162,11 +170,6 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
         members = [c for c in driven if group[c] == k]
         r = ratio[members] / ratio[members].mean()
         gain[members], limit[members] = r * gain[members].mean(), r * (limit[members] / r).min()
-    headings = np.zeros((len(t), len(model.steer_columns)))
-    steer_wheels = [w for w in robot.wheels if w.kind.steers]
-    for k, w in enumerate(steer_wheels):
-        h = cmd.heading[:, robot.wheel_names.index(w.name)]
-        headings[:, k] = np.where(np.isfinite(h), h, w.heading)
     servoed = [c for c in model.steer_columns if model.is_actuated(c)]
     kp, kd = steering_gains(model, servoed, held=driven, bandwidth=bandwidth)
     steer_limit = np.full(len(steer_wheels), np.inf)
@@ -177,6 +180,20 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
             steer_limit[k] = max(loads[contact].sum(), 1.0) * lever
     return Inputs(*(readonly(a) for a in (t, np.zeros((len(t), n)), rates, gain, limit, headings, kp, kd,
                                           steer_limit, twists, t.copy())))
+
+
+def _check_linkages(model: DynamicModel, t: np.ndarray, twists: np.ndarray, headings: np.ndarray,
+                    allow_slip: bool) -> None:
+    """Refuse (unless `allow_slip`) the first knot whose IK `headings` ``(K, n_steer)`` break a ``linkage`` the
+    dynamics hold (:mod:`.linkages`: a synchro chain asked to turn its wheels apart), naming it."""
+    if allow_slip or not len(model.pack[17]):
+        return
+    for k, beta in enumerate(model.robot.beta_of_heading(headings)):
+        breach = linkage_breach(model, beta)
+        if breach:
+            raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion "
+                              f"for '{model.robot.name}': its wheels' steering breaks a linkage ({breach}), which "
+                              "the dynamics hold; use allow_slip=True to let its servos fight and the tyres slip")
 
 
 def _check_bandwidth(bandwidth: float) -> None:

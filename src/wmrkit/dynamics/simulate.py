@@ -24,6 +24,7 @@ from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .deviation import PathDeviation, nominal_poses
+from .linkages import linkage_breach
 from .model import DynamicModel
 from .runs import LiftOffError, adaptive_run, adaptive_samples, check_lift_off, fixed_run, records  # noqa: F401  (LiftOffError: API)
 from .tyres import Tyre
@@ -263,6 +264,10 @@ class Stepper:
             rates = ", ".join(f"{self.model.names[i]} {state[n + i]:.6g}" for i in breach.given)
             raise WmrkitError(f"state: {breach.head} ({rates} rad/s): the dynamics hold the gear, so a state turns "
                               "its joints in its ratios (initial_state does)")
+        linked = linkage_breach(self.model, state[list(self.model.steer_columns)], state[n:])
+        if linked:
+            raise WmrkitError(f"state: {linked}: the dynamics hold the linkage, so a state steers its wheels as it "
+                              "does (initial_state does)")
         self.state: np.ndarray = state
         self.step, self.jac_every, self.allow_lift_off = float(step), jac_every, allow_lift_off
         self._method = 0 if method == "semi-implicit" else 1
@@ -346,7 +351,8 @@ def advance(model: Robot | DynamicModel, state: ArrayLike, inputs: Inputs, durat
 def initial_state(model: DynamicModel, twist: ArrayLike = (0, 0, 0), pose: ArrayLike = (0, 0, 0)) -> np.ndarray:
     """State ``(2n,)`` rolling without slip at `twist`: pose, joint positions (steering at IK angles), velocities.
     A twist at which a ``gear``'s joints would turn out of its ratios (a solid axle turning) keeps the twist and turns
-    each gear at the least-squares fit of those rates: the wheels slip from the start.
+    each gear at the least-squares fit of those rates: the wheels slip from the start. One whose steering a
+    ``linkage`` cannot set (:mod:`.linkages`) is refused, naming it.
 
     The twist's speeds and turn rate are within ``limits.MAX_SPEED`` (m/s, rad/s), the pose's position within
     ``limits.MAX_COORDINATE`` and its heading finite."""
@@ -370,6 +376,10 @@ def initial_state(model: DynamicModel, twist: ArrayLike = (0, 0, 0), pose: Array
         gears = model.pack[16]
         if gears.shape[1]:  # a twist a gear forbids: its joints at their least-squares turn (the wheels slip)
             s[n:] = gears @ ((gears.T @ s[n:]) / (gears * gears).sum(axis=0))
+    breach = linkage_breach(model, beta)
+    if breach:
+        raise WmrkitError(f"initial twist {twist.tolist()}: its wheels' steering (wheel IK) breaks a linkage "
+                          f"({breach}), which the dynamics hold")
     for k, c in enumerate(model.steer_columns):
         s[c] = beta[k]
     return s
