@@ -270,3 +270,38 @@ def test_batch_calibrate_names_a_closed_run_of_another_robot(capsys, diff, tmp_p
     assert data["per_run"][0]["closed_score"] > 40 > max(r["closed_score"] for r in data["per_run"][1:])
     assert all(r["residual_ratio"] is None for r in data["per_run"])
     assert any("sq0.csv: disagrees" in w for w in data["warnings"])
+
+
+def test_a_refused_jacobian_interval_names_the_run_by_its_file(capsys, tmp_path):
+    """Six three-pose runs, one of a left radius +20 % (14 of 200 such seeded fleets): without a good run the others
+    do leave the track undetermined (the fit of the other five moves it by +24 % of its length, the standard error
+    is 11 %), so the refusal stands; it said "without run 4 ... add runs (closed squares: two in each direction)":
+    an index into the glob and a hint for closed paths. Now it names the file, and for runs with references says
+    to add runs of other shapes or check the runs (the one of another robot pulls the fit)."""
+    import numpy as np
+    from batch_params import PARAMS, TRUE_P, write_log
+    from test_calibrate_judge import short_runs
+
+    from wmrkit import catalog
+    from wmrkit.cli.main import main
+    from wmrkit.odometry.calibration import CalibrationProblem
+    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+
+    diff, rng = catalog.load("diff-drive"), np.random.default_rng(1)
+    noise = rng.choice([1e-6, 1e-5, 1e-4], 6)
+    runs = short_runs(diff, 100001, 6, 3, bad=(4,), odd=[TRUE_P[0] + 0.2, *TRUE_P[1:]], noise=noise)
+    (tmp_path / "ref").mkdir()
+    for i, run in enumerate(runs):
+        write_log(tmp_path / f"r{i}.csv", run)
+        write_trajectory(tmp_path / "ref" / f"r{i}.tum", Trajectory(run.log.time[run.at], np.reshape(
+            run.reference, (-1, 3)), np.zeros(len(run.at)), None), "tum")
+    fits = [CalibrationProblem(diff, tuple(PARAMS), tuple(r)).solve().x for r in (runs, runs[:3] + runs[4:])]
+    assert abs(fits[1][2] - fits[0][2]) > 0.2  # the refusal is warranted: the track moves far without r3
+    argv = ["batch", "calibrate", "diff-drive", str(tmp_path / "r*.csv"), "--reference", str(tmp_path / "ref"),
+            "--workers", "0"]
+    assert main([*argv, "--json"]) == 2
+    error = json.loads(capsys.readouterr().err)["error"]
+    assert error.startswith(f"calibrate: without {tmp_path / 'r3.csv'} the other runs cannot tell these parameters")
+    assert "check the runs" in error and "closed squares" not in error
+    assert main(argv) == 2
+    assert capsys.readouterr().err == f"wmrkit: error: {error}\n"
