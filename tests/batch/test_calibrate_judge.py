@@ -148,11 +148,11 @@ def pair_named(res) -> list[str]:
     return [w.partition(":")[0] for w in res.warnings if "disagree with the other runs" in w]
 
 
-def pair_score_by_refit(diff, runs, pair) -> float:
+def pair_score_by_refit(diff, runs, pair, own: bool = True) -> float:
     """The pair score of `pair` recomputed independently: the other runs fitted by the single-log calibrate, each
     run's final poses' error there weighted by one over the root of its wheel travel, each of the pair's RMS over the
     others' pooled RMS (R - n degrees of freedom) or the pair's own (each run fitted alone by the single-log
-    calibrate, pooled, m - n degrees of freedom each) where larger; the smaller of the two."""
+    calibrate, pooled, m - n degrees of freedom each) where larger (`own`); the smaller of the two."""
     from wmrkit.batch.consistency import travel
     from wmrkit.odometry.calibration import CalibrationProblem, calibrate
 
@@ -162,9 +162,10 @@ def pair_score_by_refit(diff, runs, pair) -> float:
     live = [e[np.abs(e) > 0] for e in err]
     rest = [k for k in range(len(runs)) if k not in pair]
     noise = sum(np.sum(live[k] ** 2) for k in rest) / (sum(live[k].size for k in rest) - len(PARAMS))
-    own = [CalibrationProblem(calibrate(diff, [runs[k]], PARAMS).robot, tuple(PARAMS), (runs[k],)).residuals(
+    mine = [CalibrationProblem(calibrate(diff, [runs[k]], PARAMS).robot, tuple(PARAMS), (runs[k],)).residuals(
         np.zeros(3)) / np.sqrt(max(travel(diff, runs[k]), 1.0)) for k in pair]
-    noise = max(noise, sum(np.sum(e ** 2) for e in own) / sum(live[k].size - len(PARAMS) for k in pair))
+    if own:
+        noise = max(noise, sum(np.sum(e ** 2) for e in mine) / sum(live[k].size - len(PARAMS) for k in pair))
     return min(float(np.sqrt(np.mean(live[k] ** 2) / noise)) for k in pair)
 
 

@@ -78,11 +78,12 @@ def test_a_noisy_run_among_quiet_ones_is_scored_over_its_own_noise(diff):
     """Agreeing fleets of 6 three-pose runs flagged by one run's own closed-path score: it divided the run's error at
     the others' fit by the others' noise alone, so a run at 1e-4 per rad among quieter ones scored about the ratio of
     the levels (levels drawn per run, seeds 25 and 178: 31.4 and 30.1; the worst mix, two at 1e-4 among four at 1e-6,
-    seeds 222 and 278: 20.1 and 23.3), named as another robot's. Over its own noise where larger (its own fit, 3
-    degrees of freedom): not flagged, and the noisiest run's score equals one recomputed independently (the
-    single-log calibrate of the other five runs and of the run alone; to 1 %: a run not refitted, as in seed 222, is
-    scored on the runs' quadratic model, 4.241 against 4.236)."""
-    from test_calibrate_judge import pair_score_by_refit
+    seeds 222 and 278: 20.1 and 23.3), named as another robot's. Against its own noise too (its own fit, 3 degrees
+    of freedom; an F test on its whitened motions' errors, test_calibrate_own_noise): not flagged, and the noisiest
+    run's score equals one recomputed independently (the single-log calibrate of the other five runs and of the run
+    alone; to 1 %: a run not over 20 against the others, as in seed 222, is scored on the runs' quadratic model,
+    4.241 against 4.236)."""
+    from test_calibrate_own_noise import score_by_refit
 
     for seed, draw in ((25, "drawn"), (178, "drawn"), (222, "worst"), (278, "worst")):
         rng = np.random.default_rng(seed)
@@ -92,17 +93,18 @@ def test_a_noisy_run_among_quiet_ones_is_scored_over_its_own_noise(diff):
         assert res.inconsistent is False and not res.warnings, (seed, res.closed_scores, res.warnings)
         k = int(np.argmax(res.closed_scores))
         assert noise[k] == 1e-4 and res.closed_scores[k] < 20
-        assert np.isclose(res.closed_scores[k], pair_score_by_refit(diff, runs, (k,)), rtol=1e-2), seed
+        assert np.isclose(res.closed_scores[k], score_by_refit(diff, runs, k, res.robot), rtol=1e-2), seed
 
 
 def test_a_bad_run_is_still_named_over_its_own_noise(diff):
     """One run of a left radius +5 % or +20 % among 6 three-pose runs of levels drawn per run: still named (it is
     the run refitted without), its score equal to one recomputed independently (the single-log calibrate of the other
-    five and of the run alone; a noisy bad run, seed 0, scores 279.5 over its own noise where it scored 366 over the
-    others'). The run's own fit is a refit: on the runs' quadratic model about the fleet fit, a quiet run +20 % (seed 2)
-    kept 8 times its own RSS and scored 32 against 285."""
+    five and of the run alone; a noisy bad run, seed 0, scores 273.6 against its own noise where it scored 366 over
+    the others'). The run's own fit is a refit: on the runs' quadratic model about the fleet fit, a quiet run +20 %
+    (seed 2) kept 8 times its own RSS and scored 32 against 285."""
     from batch_params import TRUE_P
-    from test_calibrate_judge import disagreeing, pair_score_by_refit
+    from test_calibrate_judge import disagreeing
+    from test_calibrate_own_noise import score_by_refit
 
     for seed, pct in ((0, 20), (2, 20), (0, 5), (1, 5)):
         rng = np.random.default_rng(seed)
@@ -111,4 +113,4 @@ def test_a_bad_run_is_still_named_over_its_own_noise(diff):
         runs = short_runs(diff, 100000 + seed, 6, 3, bad=(k,), odd=[TRUE_P[0] + pct / 100, *TRUE_P[1:]], noise=noise)
         res = fleet_calibrate(diff, runs, PARAMS)
         assert res.inconsistent is True and disagreeing(res) == [f"r{k}.csv"], (seed, res.warnings)
-        assert np.isclose(res.closed_scores[k], pair_score_by_refit(diff, runs, (k,)), rtol=1e-3), seed
+        assert np.isclose(res.closed_scores[k], score_by_refit(diff, runs, k, res.robot), rtol=1e-3), seed

@@ -39,7 +39,7 @@ from ..robot import Robot
 from .homogeneity import fleet_warning
 from .likelihood import MIN_OWN_DOF, few_pose_warning, own_noise
 from .refits import REFIT_FAILED as REFIT_FAILED  # re-exported: batch.consistency.REFIT_FAILED
-from .refits import own_fits, refits
+from .refits import own_dof, own_scores, refits
 
 #: Largest residual ratio of a fleet whose runs agree. Simulated fleets with encoder noise (1e-5 per rad, or drawn
 #: per run among 1e-6, 1e-5 and 1e-4), 4 to 16 runs (docs/batch.md's table): largest ratio 12.1 over 260 fleets;
@@ -278,7 +278,7 @@ def _score(err: np.ndarray, k: int, rest: np.ndarray, floors: np.ndarray, n: int
     return float(np.sqrt(np.sum(err[k] ** 2) / max(m[k], 1) / noise))
 
 
-def _quadratic_scores(jac, res, hess, floors, m, outs=None, own=None) -> tuple[np.ndarray, np.ndarray]:
+def _quadratic_scores(jac, res, hess, floors, m, outs=None) -> tuple[np.ndarray, np.ndarray]:
     """Each run's score against the others refitted on the runs' quadratic models (no odometry), and that fit's
     shift from the fleet fit; the score is NaN where the others do not determine the parameters (their Jacobian's
     weakest singular value under :data:`RANK_TOL` of the largest: e.g. equal squares all driven one way). With
@@ -299,7 +299,7 @@ def _quadratic_scores(jac, res, hess, floors, m, outs=None, own=None) -> tuple[n
                           jac=lambda d: j + np.einsum("mij,j->mi", h, d), method="lm", xtol=1e-12,  # noqa: B023
                           ftol=1e-12).x
         err = res + jac @ d + 0.5 * np.einsum("gmij,i,j->gm", hess, d, d)
-        out[k] = min(_score(err, i, rest, floors, n, m, 0.0 if own is None else own[i]) for i in left)
+        out[k] = min(_score(err, i, rest, floors, n, m) for i in left)
         shift[k] = d
     return out, shift
 
@@ -310,8 +310,9 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     pooled noise. A closed run's residuals (its final pose) are weighted by one over the square root of its wheel
     travel (at least 1 m: an encoder random walk's error grows so); its score is their RMS at the fit of the other
     runs over the others' RMS there (with ``R - n`` degrees of freedom); a run over :data:`MAX_CLOSED_SCORE` whose own
-    fit has degrees of freedom (three-pose references) is rescored over its own noise where larger
-    (:func:`~wmrkit.batch.refits.own_fits`: a noisy run among quiet ones scored their ratio of noise levels). The
+    fit has degrees of freedom (three-pose references) is refitted without and scored against its own noise too, the
+    smaller score kept (:func:`~wmrkit.batch.refits.own_scores`, an F test: a noisy run among quiet ones scored their
+    ratio of noise levels). The
     others' fit is first taken on each run's
     quadratic model about the fleet fit: the curvature from the fit's Jacobian one :data:`CURVATURE_STEP` away
     along each parameter, no new odometry (`curvature`: ``[p] -> [that Jacobian, or (the runs of a task that
@@ -372,8 +373,8 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
         worst = int(group[np.argmax(done)])
         if scores[worst] > MAX_CLOSED_SCORE:
             messages.append(f"{logs[worst]}: disagrees with the other runs (closed-path score {scores[worst]:.3g}, "
-                            f"over {MAX_CLOSED_SCORE:g}: the others' fit leaves it that many times their error, or its "
-                            "own where larger): "
+                            f"over {MAX_CLOSED_SCORE:g}: the others' fit leaves it that many times their error, and "
+                            "its own noise does not explain it): "
                             "another robot, load or floor? The fit averages it in; check it or fit without it")
         elif pair is not None and pair[2] > MAX_PAIR_SCORE:
             messages.append(PAIR.format(a=logs[pair[0]], b=logs[pair[1]], score=pair[2]))
@@ -418,14 +419,19 @@ def _group_scores(problem: CalibrationProblem, fit, hess: np.ndarray, group: np.
     errs = dict(zip(again, errs, strict=True))
     for k, err in errs.items():
         scores[k] = _score(err, k, np.delete(np.arange(g), k), floors, n, m)
-    over = np.flatnonzero(scores > MAX_CLOSED_SCORE)  # over their own noise where larger (it only lowers a score)
-    own = own_fits(problem, fit.x, group, model[0], m, live, w, refit, logs, over) if over.size else None
+    over = [int(k) for k in np.flatnonzero((scores > MAX_CLOSED_SCORE) & (own_dof(model[0], m) >= MIN_OWN_DOF))]
+    more = [k for k in over if k not in errs]  # refitted without too, then scored over their own noise
+    done = refits(problem, group, [(k,) for k in more], [fit.x + shift[k] for k in more], live, w, refit, logs)
+    if isinstance(done, str):
+        return done
+    for k, err in zip(more, done, strict=True):
+        errs[k] = err
+        scores[k] = _score(err, k, np.delete(np.arange(g), k), floors, n, m)
+    own = own_scores(problem, fit, group, live, w, refit, logs, over, errs) if over else None
     if isinstance(own, str):
         return own
-    if own is not None and (fitted := [k for k in over if k not in errs]):
-        scores[fitted] = _quadratic_scores(*model, floors, m, [(k,) for k in fitted], own)[0]
-    for k in (k for k in over if k in errs):
-        scores[k] = _score(errs[k], k, np.delete(np.arange(g), k), floors, n, m, own[k])
+    if own is not None:  # the smaller score: it disagrees beyond the others' noise and beyond its own
+        scores[over] = np.minimum(scores[over], MAX_CLOSED_SCORE * own[over])
     if g < MIN_PAIR_RUNS or scores.max() > MAX_CLOSED_SCORE:
         return scores, None
     pair = _pair(problem, fit, group, rows, scores, model, live, w, floors, m, refit)
