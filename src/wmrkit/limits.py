@@ -39,9 +39,10 @@ MAX_QUERY_RATE = 1e6
 MAX_WHEELS = 64
 #: Longest robot and wheel names, and notes [characters]: they are printed in tables and reports.
 MAX_NAME, MAX_NOTES = 64, 4096
-#: The robot's size (its largest length: wheel distance, radius, offset) lies in [MIN_SIZE, MAX_SIZE] [m].
+#: The robot's reach (its largest length from its origin: wheel distance, radius, offset) lies in [MIN_SIZE, MAX_SIZE]
+#: [m] (``kinematics.linalg.reach``; its three sizes: docs/limits.md, the physical envelope).
 MIN_SIZE, MAX_SIZE = 1e-6, 1e3
-#: Radii, roller radii, castor offsets and half-widths are at least MIN_RATIO times the robot's size.
+#: Radii, roller radii, castor offsets and half-widths are at least MIN_RATIO times the robot's reach.
 MIN_RATIO = 1e-4
 #: A coupling's ratios: each of magnitude in [MIN_COUPLING_RATIO, MAX_COUPLING_RATIO], the largest at most
 #: 1 / MIN_RATIO times the smallest (rank decisions would lose the smaller to round-off).
@@ -135,8 +136,9 @@ def _check_text_fields(name: str, notes: str, check: Any) -> None:
 
 
 def _check_envelope(wheels: list[Wheel], check: Any, positioned: Collection[int] = ()) -> None:
-    """The physical envelope wmrkit's numbers are valid in (docs/limits.md): the robot's size (its largest length)
-    from 1 um to 1 km, radii and offsets not below MIN_RATIO of it (rank decisions are made relative to the size),
+    """The physical envelope wmrkit's numbers are valid in (docs/limits.md): the robot's reach (its largest length
+    from its origin, ``kinematics.linalg.reach``, here of the wheels being read) from 1 um to 1 km, radii and
+    offsets not below MIN_RATIO of it (rank decisions are made relative to a size at most twice it),
     Swedish rollers and castor axles at least ANGLE_MARGIN away from the angles where the wheel degenerates.
 
     `positioned`: indices of the wheels described by ``position: [x, y]`` rather than ``l``/``alpha``; a distance

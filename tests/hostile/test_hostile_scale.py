@@ -20,7 +20,7 @@ from wmrkit.analysis.singularity import robot_size, singularity_distance
 from wmrkit.description import ANGLE_MARGIN, MAX_SIZE, MIN_RATIO, MIN_SIZE, robot_from_dict, robot_to_dict
 from wmrkit.errors import DescriptionError
 from wmrkit.kinematics import actuation_analysis, assignable_sets, minimal_actuator_sets, mobility, sensing_analysis
-from wmrkit.kinematics.linalg import LENGTH_FIELDS, characteristic_length
+from wmrkit.kinematics.linalg import LENGTH_FIELDS, characteristic_length, reach
 from wmrkit.kinematics.models import direct_model
 
 
@@ -39,7 +39,8 @@ def _size(robot) -> float:
 def test_the_same_robot_at_any_size_of_the_envelope_gets_the_same_answers(robot, exponent):
     scaled = _scaled(robot, 10.0**exponent / _size(robot))
     assert robot_from_dict(robot_to_dict(scaled)) == scaled  # inside the envelope: the loader accepts it
-    assert characteristic_length(scaled) == pytest.approx(10.0**exponent)
+    assert reach(scaled) == pytest.approx(10.0**exponent)  # the envelope's size (docs/limits.md)
+    assert characteristic_length(scaled) == pytest.approx(characteristic_length(robot) * 10.0**exponent / _size(robot))
     assert int(mobility(scaled)) == int(mobility(robot))
     assert tuple(assignable_sets(scaled)) == tuple(assignable_sets(robot))
     assert tuple(minimal_actuator_sets(scaled)) == tuple(minimal_actuator_sets(robot))

@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike
 
 from ..couplings import steering_mechanisms
 from ..errors import WmrkitError
-from ..kinematics.linalg import characteristic_length, matrix_rank
+from ..kinematics.linalg import centred, centroid, characteristic_length, matrix_rank
 from ..kinematics.models import configuration
 from ..limits import check_seed
 from ..robot import Robot
@@ -96,8 +96,7 @@ def instantaneous_mobility(robot: Robot, beta: ArrayLike | None = None, *,
     cl = constraint_lines(robot, coupled=geared and any(c.kind == "gear" for c in robot.couplings))
     if not cl.labels:
         return np.full(beta.shape[:-1], 3)
-    g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / _size(robot)])
-    return 3 - matrix_rank(g)
+    return 3 - matrix_rank(centred(robot, cl.lines(beta), metres=True))
 
 
 def classify(robot: Robot, *, samples: int = 8, seed: int = 0) -> Classification:
@@ -112,8 +111,7 @@ def classify(robot: Robot, *, samples: int = 8, seed: int = 0) -> Classification
     steer = set(robot.steer_names)
     fixed_rows = [i for i, w in enumerate(cl.wheels) if w not in steer]
     steered = sorted({w for w in cl.wheels if w in steer}, key=robot.steer_names.index)
-    scale = np.array([1.0, 1.0, 1.0 / _size(robot)])
-    g_fixed = cl.lines(robot.beta)[fixed_rows] * scale
+    g_fixed = centred(robot, cl.lines(robot.beta)[fixed_rows], metres=True)
     rf = int(matrix_rank(g_fixed)) if fixed_rows else 0
     reasons: list[str] = []
     if rf >= 2:
@@ -143,13 +141,15 @@ def _size(robot: Robot) -> float:
 
 
 def _admissible_configurations(robot: Robot, g_fixed: np.ndarray, rf: int, n: int, rng) -> np.ndarray:
-    """Configurations with every steered axle through a common random ICR allowed by the fixed wheels."""
+    """Configurations with every steered axle through a common random ICR allowed by the fixed wheels. `g_fixed`:
+    their lines about the wheels' centroid, nondimensional (``linalg.centred``)."""
     if rf >= 3:
         return np.zeros((0, len(robot.steer_names)))
     _, _, vh = np.linalg.svd(np.vstack([g_fixed, np.zeros((3, 3))]))
-    basis = vh[rf:].T  # twists (scaled) allowed by the fixed wheels
+    basis = vh[rf:].T  # twists of the centroid (vx, vy, omega L) allowed by the fixed wheels
     twists = (rng.normal(size=(n, 3 - rf)) @ basis.T) * np.array([1.0, 1.0, 1.0 / _size(robot)])
-    icr_h = np.stack([-twists[:, 1], twists[:, 0], twists[:, 2]], axis=-1)
+    cx, cy = centroid(robot)  # ICRs about the centroid, back in the robot frame
+    icr_h = np.stack([-twists[:, 1] + cx * twists[:, 2], twists[:, 0] + cy * twists[:, 2], twists[:, 2]], axis=-1)
     beta = steer_to_icr(robot, icr_h)
     castors = [j for j, s in enumerate(robot.steer_names) if s not in set(constraint_lines(robot).wheels)]
     beta[:, castors] = rng.uniform(-np.pi, np.pi, (n, len(castors)))
@@ -183,7 +183,8 @@ def _special(robot: Robot, steered: list[str], rf: int, m: int) -> tuple[Special
     if rf != 0 or len(steered) < 2:
         return ()
     centres = np.array([robot.wheel(n).position for n in steered])
-    if matrix_rank(np.hstack([centres, np.ones((len(steered), 1))]) / np.array([_size(robot), _size(robot), 1])) > 2:
+    about = (centres - centroid(robot)) / _size(robot)  # collinear in every frame alike
+    if matrix_rank(np.hstack([about, np.ones((len(steered), 1))])) > 2:
         return ()
     direction = centres[-1] - centres[0]
     beta = steer_to_icr(robot, np.array([direction[0], direction[1], 0.0]))  # ICR at infinity along the line

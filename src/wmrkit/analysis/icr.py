@@ -19,7 +19,7 @@ from scipy.linalg import null_space
 
 from .._shapes import as_vectors
 from ..errors import ShapeError
-from ..kinematics.linalg import characteristic_length, matrix_rank
+from ..kinematics.linalg import centred, centroid, characteristic_length, matrix_rank
 from ..kinematics.models import configuration
 from ..robot import Robot
 from .lines import ConstraintLines, common_point, constraint_lines, element_rows
@@ -132,20 +132,20 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
 def meeting_point(robot: Robot, lines: np.ndarray) -> ICRSet:
     """The common point of `robot`'s `lines` ``(n, 3)`` of rank 2: "point", or "infinity" where they are parallel
     within rounding (:data:`ROUNDING_W`)."""
-    size = characteristic_length(robot)
-    _, s, vt = np.linalg.svd(lines * [1.0, 1.0, 1.0 / size])  # nondimensional: lengths in robot sizes
+    size, (cx, cy) = characteristic_length(robot), centroid(robot)
+    _, s, vt = np.linalg.svd(centred(robot, lines, metres=True))  # about the wheels' centroid, in robot sizes
     x, y, w = -vt[-1, 1], vt[-1, 0], vt[-1, 2]  # the common point as common_point maps it, in robot sizes
-    # no distance beyond which a point is "at infinity": the robot size depends on the frame's origin, so the
-    # same axles would meet in one frame and not in another (1.25e9 sizes away: steering 1e-10 rad)
+    # no distance beyond which a point is "at infinity": the same axles would meet in one frame and not in another
     if abs(w) <= ROUNDING_W * s[0] / s[1]:
         n = np.hypot(x, y) * (1.0 if y > 1e-12 or (abs(y) <= 1e-12 and x < 0) else -1.0)  # either sign: +x first
         return ICRSet("infinity", direction=(float(y / n), float(-x / n)))
-    return ICRSet("point", point=(float(size * x / w), float(size * y / w)))
+    return ICRSet("point", point=(float(cx + size * x / w), float(cy + size * y / w)))
 
 
 def line_rank(robot: Robot, lines: np.ndarray) -> int:
-    """Rank of the constraint lines, nondimensional (0: no line)."""
-    return int(matrix_rank(lines * [1.0, 1.0, 1.0 / characteristic_length(robot)])) if len(lines) else 0
+    """Rank of the constraint lines, about the wheels' centroid and nondimensional (``linalg.centred``; 0: no
+    line): the same in every robot frame."""
+    return int(matrix_rank(centred(robot, lines, metres=True))) if len(lines) else 0
 
 
 def _nearly_consistent(robot: Robot, beta: np.ndarray, cl: ConstraintLines, lines: np.ndarray) -> ICRSet:

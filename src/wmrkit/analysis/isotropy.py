@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_names, readonly
 from ..couplings import gear_fill
 from ..errors import ShapeError, UnknownNameError
-from ..kinematics.linalg import characteristic_length, matrix_rank
+from ..kinematics.linalg import centred, matrix_rank, reach
 from ..kinematics.models import configuration
 from ..robot import Robot
 from . import _fast
@@ -38,7 +38,7 @@ from .lines import _rate_block, constraint_lines, element_rows, line_parameters,
 from .singularity import check_positive_length, robot_size
 
 #: Search interval of the natural length (see :func:`natural_length`): from ``LENGTH_RANGE[0]`` robot sizes to
-#: ``LENGTH_RANGE[1]`` times the robot's largest length (:func:`~wmrkit.kinematics.linalg.characteristic_length`).
+#: ``LENGTH_RANGE[1]`` times the robot's largest length from its origin (:func:`~wmrkit.kinematics.linalg.reach`).
 LENGTH_RANGE = (1e-3, 1e3)
 
 
@@ -162,12 +162,12 @@ def twist_model(robot: Robot, joints: tuple[str, ...] | None = None, *, geared: 
 
 
 def _geared_mobility(robot: Robot) -> int:
-    """3 minus the rank of the lines the twist obeys with the gears held, at the described configuration (in the
-    robot's largest length: the rank decisions of :mod:`..kinematics.linalg`)."""
+    """3 minus the rank of the lines the twist obeys with the gears held, at the described configuration (about the
+    wheels' centroid in the robot's size: the rank decisions of :mod:`..kinematics.linalg`)."""
     lines = constraint_lines(robot, coupled=True).lines()
     if len(lines) == 0:
         return 3
-    return 3 - int(matrix_rank(lines * np.array([1.0, 1.0, 1.0 / characteristic_length(robot)])))
+    return 3 - int(matrix_rank(centred(robot, lines, metres=True)))
 
 
 @functools.lru_cache(maxsize=256)
@@ -294,12 +294,11 @@ def _natural_length(model: TwistModel, beta: np.ndarray, size: float) -> tuple[f
 
 def _in_robot_lengths(model: TwistModel, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """The joint rates ``(J, 3, N)`` and normalised axle lines ``(R, 3, N)`` at element `rows` in the robot's
-    largest length ``L`` (:func:`~wmrkit.kinematics.linalg.characteristic_length`), and ``L`` [m]: the twist's
-    lengths and the lines' ``d`` divided by L (rates per unit speed times L), as
-    :func:`~wmrkit.kinematics.linalg.nondimensional` makes the rank decisions. Every threshold of :mod:`._fast`
-    is then relative: a robot of 1 um had its axles "one line" within 1e-6 m, all of them. Condition numbers are
-    unchanged; a length D of the robot is ``D / L`` here."""
-    unit = characteristic_length(model.robot)
+    largest length from its origin ``L`` (:func:`~wmrkit.kinematics.linalg.reach`: the twist is the origin's), and
+    ``L`` [m]: the twist's lengths and the lines' ``d`` divided by L (rates per unit speed times L). Every
+    threshold of :mod:`._fast` is then relative: a robot of 1 um had its axles "one line" within 1e-6 m, all of
+    them. Condition numbers are unchanged; a length D of the robot is ``D / L`` here."""
+    unit = reach(model.robot)
     scale = np.array([unit, unit, 1.0])[None, :, None]
     lines = _fast.combine_lines(constraint_lines(model.robot, coupled=model.geared), rows) * np.array(
         [1.0, 1.0, 1.0 / unit])[None, :, None]
@@ -324,11 +323,12 @@ def _element_rows_one(p, beta: np.ndarray) -> np.ndarray:
 
 def _minimise_length(kappa, robot: Robot, many=None) -> tuple[float, float]:
     """Minimise ``kappa(D)`` over D from ``LENGTH_RANGE[0]`` times `robot`'s size (:func:`robot_size`)
-    to ``LENGTH_RANGE[1]`` times its largest length (log scale); ties go to the size. `many`, if given, is `kappa`
-    over an array of lengths at once (the same values). The top is not 1000 sizes: a double castor of 0.5 m offset
-    and radius mounted at the origin, natural length 0.29 m, once sized 1 mm, was searched up to 1 m only."""
+    to ``LENGTH_RANGE[1]`` times its :func:`~wmrkit.kinematics.linalg.reach` (log scale); ties go to the size.
+    `many`, if given, is `kappa` over an array of lengths at once (the same values). The top is not 1000 sizes: a
+    double castor of 0.5 m offset and radius mounted at the origin, natural length 0.29 m, once sized 1 mm, was
+    searched up to 1 m only."""
     size = robot_size(robot)
-    lo, hi = np.log(LENGTH_RANGE[0] * size), np.log(LENGTH_RANGE[1] * characteristic_length(robot))
+    lo, hi = np.log(LENGTH_RANGE[0] * size), np.log(LENGTH_RANGE[1] * reach(robot))
     grid = np.linspace(lo, hi, 121)
     values = many(np.exp(grid)) if many is not None else np.array([kappa(np.exp(x)) for x in grid])
     k_size = kappa(size)

@@ -26,7 +26,7 @@ from scipy.optimize import minimize
 from .._shapes import as_names
 from ..couplings import coupled_columns
 from ..errors import UnknownNameError, WmrkitError
-from ..kinematics.linalg import matrix_rank, nondimensional, robot_size
+from ..kinematics.linalg import centred, matrix_rank, nondimensional, robot_size
 from ..kinematics.models import configuration
 from ..robot import Robot
 from . import _fast
@@ -47,6 +47,8 @@ def is_singular_rank(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, 
     """
     cols = [robot.velocity_index(n) for n in assigned]
     a = nondimensional(robot).constraint_matrix(beta, heading=heading)  # kinematics.linalg's tolerances
+    if not {0, 1, 2} & set(cols):  # the whole twist free: that of the centroid, the same in every frame
+        a = centred(robot, a)
     if coupled:
         rates = robot.rate_names
         rest = coupled_columns(robot.couplings, rates, tuple(rates.index(n) for n in assigned if n in rates))[2]
@@ -71,7 +73,7 @@ def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...],
     beta = configuration(robot, beta, heading)
     if cl.internal or len(cl.labels) < 3:
         return np.ones(beta.shape[:-1], bool)
-    g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / robot_size(robot)])
+    g = centred(robot, cl.lines(beta), metres=True)  # the same in every robot frame (kinematics.linalg)
     norm = np.linalg.norm(g, axis=-1, keepdims=True)  # a line through a coupling can vanish at some configurations
     sv = np.linalg.svd(g / np.where(norm > 0, norm, 1.0), compute_uv=False)
     return sv[..., 2] <= rtol * sv[..., 0]
@@ -320,6 +322,6 @@ def _newton(c: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 def _rank_deficient(cl, beta: np.ndarray) -> np.ndarray:
     """Where the lines really have rank < 3 (all minors vanish): ``(n, n_steer) -> (n,)`` bool."""
-    g = cl.lines(beta) * np.array([1.0, 1.0, 1.0 / robot_size(cl.robot)])
+    g = centred(cl.robot, cl.lines(beta), metres=True)
     s = np.linalg.svd(g, compute_uv=False)
     return s[:, -1] < 1e-6 * s[:, 0]

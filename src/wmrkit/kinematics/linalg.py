@@ -6,13 +6,18 @@ divided by its :func:`characteristic_length`), with the one tolerance of :func:`
 lengths by ``L`` maps the velocities ``(vx, vy, omega, rates)`` to ``(vx / L, vy / L, omega, rates)``
 (:func:`velocity_scale`), a diagonal change of variables that keeps every rank, null space and assignable set,
 so the decisions do not depend on the robot's scale (a micrometre robot and a kilometre one get the same
-answers). Descriptions keep radii and offsets at least ``MIN_RATIO`` of ``L`` (``docs/limits.md``), far above
-the tolerance.
+answers). ``L`` is the wheels' spread about their centroid, and a decision that takes the whole twist is made
+on the twist of the centroid (:func:`centred`), so neither depends on where the robot frame is. The robot's
+three sizes, each with its purpose, are documented in ``docs/limits.md`` (the physical envelope): ``L``,
+:func:`reach` (lengths from the origin) and :func:`robot_size` (a default length at the origin). Descriptions
+keep radii and offsets at least ``MIN_RATIO`` of the reach, so at least half that of ``L``, far above the
+tolerance.
 """
 
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -59,31 +64,89 @@ LENGTH_FIELDS = ("l", "d", "r", "r_r", "b")
 
 
 def characteristic_length(robot: Robot) -> float:
-    """The robot's size ``L`` [m]: its largest length (wheel distance from the origin, radius, offset, half-width).
+    """The robot's size ``L`` [m], the unit of every rank decision: the largest distance of a wheel's mount point
+    from the wheels' centroid (:func:`centroid`), or of a wheel length (radius, roller radius, offset, half-width)
+    if larger (one wheel, or all at one point).
 
-    The unit of the nondimensional matrices of the rank decisions; positive for any robot with a wheel off the
-    origin or of non-zero radius (1 m for a robot of no length at all).
+    It does not depend on where the robot frame is (a rigid change of frame keeps it), so neither do the decisions
+    made in it (:func:`centred`). Positive for any robot with a length; 1 m for a robot of no length at all.
     """
     return _characteristic_length(robot)
 
 
 @functools.lru_cache(maxsize=256)
 def _characteristic_length(robot: Robot) -> float:
+    c = np.array(centroid(robot))
+    spread = max((float(np.hypot(*(np.array(w.position) - c))) for w in robot.wheels), default=0.0)
+    own = max((abs(float(getattr(w, f))) for w in robot.wheels for f in LENGTH_FIELDS if f != "l"), default=0.0)
+    size = max(spread, own)
+    return size if 0.0 < size < np.inf else 1.0
+
+
+def centroid(robot: Robot) -> tuple[float, float]:
+    """The mean of the wheels' mount points in the robot frame [m]: the origin rank decisions are made at."""
+    return _centroid(robot)
+
+
+@functools.lru_cache(maxsize=256)
+def _centroid(robot: Robot) -> tuple[float, float]:
+    x, y = np.mean([w.position for w in robot.wheels], axis=0) if robot.wheels else (0.0, 0.0)
+    return float(x), float(y)
+
+
+def centred(robot: Robot, m: ArrayLike, *, metres: bool = False) -> np.ndarray:
+    """`m` ``(..., r, c >= 3)``, rows acting on the twist ``(vx, vy, omega)`` of the robot's origin in its first
+    three columns, acting on the twist of the wheels' :func:`centroid` instead: the matrix rank decisions that take
+    the whole twist are made on, the same however the robot frame is placed and turned (a turn of the frame turns
+    ``(vx, vy)``, which keeps every singular value). `m` in the velocities of :func:`nondimensional`, or with
+    `metres`, in `robot`'s (the omega column then divided by :func:`characteristic_length`, e.g. the lines of
+    :mod:`wmrkit.analysis.lines`). Its ranks are those of `m`: the change of twist is invertible.
+    """
+    m = np.array(m, dtype=float)
+    size = characteristic_length(robot)
+    cx, cy = centroid(robot)
+    if metres:
+        m[..., 2] /= size
+    # the twist at c: (vx - omega cy, vy + omega cx, omega); a row g acts on it as g T^-1
+    m[..., 2] += (cy * m[..., 0] - cx * m[..., 1]) / size
+    return m
+
+
+def centred_twist(robot: Robot, twist: ArrayLike) -> np.ndarray:
+    """Twists ``(..., 3)`` of the robot's origin in the velocities of :func:`nondimensional` as the twists of the
+    wheels' :func:`centroid` (the same units): what the matrices of :func:`centred` act on."""
+    t = np.array(twist, dtype=float)
+    cx, cy = centroid(robot)
+    size = characteristic_length(robot)
+    t[..., 0] -= t[..., 2] * cy / size
+    t[..., 1] += t[..., 2] * cx / size
+    return t
+
+
+def reach(robot: Robot) -> float:
+    """The robot's largest length measured from its origin [m]: a wheel's distance from the origin, or a radius,
+    roller radius, offset or half-width if larger (1 m for a robot of no length at all). It moves with the origin:
+    the unit of what is defined at the origin (the twist of the condition number, :func:`robot_size`), never of a
+    rank decision (:func:`characteristic_length`)."""
+    return _reach(robot)
+
+
+@functools.lru_cache(maxsize=256)
+def _reach(robot: Robot) -> float:
     size = max((abs(float(getattr(w, f))) for w in robot.wheels for f in LENGTH_FIELDS), default=0.0)
     return size if 0.0 < size < np.inf else 1.0
 
 
-#: Least :func:`robot_size` as a fraction of the robot's largest length
-#: (:func:`characteristic_length`): wheels all mounted at the origin still make a robot of
-#: some size, and the default lengths scale with the robot at every size.
+#: Least :func:`robot_size` as a fraction of the robot's :func:`reach`: wheels all mounted at the origin still
+#: make a robot of some size, and the default lengths scale with the robot at every size.
 SIZE_FRACTION = 0.1
 
 
 def robot_size(robot: Robot) -> float:
     """RMS distance of the wheels' mount points from the robot origin [m], at least :data:`SIZE_FRACTION` of its
-    largest length: a default length."""
+    :func:`reach`: the default length that weighs a turn rate about the origin against speeds (``omega`` times it)."""
     rms = float(np.sqrt(np.mean([w.l**2 for w in robot.wheels])))
-    return max(rms, SIZE_FRACTION * characteristic_length(robot))
+    return max(rms, SIZE_FRACTION * reach(robot))
 
 
 @functools.lru_cache(maxsize=256)
@@ -98,6 +161,21 @@ def nondimensional(robot: Robot) -> Robot:
         return robot
     wheels = tuple(replace(w, **{f: getattr(w, f) / size for f in LENGTH_FIELDS}) for w in robot.wheels)
     return replace(robot, wheels=wheels)
+
+
+@functools.lru_cache(maxsize=256)
+def centred_robot(robot: Robot) -> Robot:
+    """:func:`nondimensional` described from the wheels' :func:`centroid` (same axes): the robot whose Jacobian form
+    (3.20) the decisions that take the whole twist are made on, the same in every frame (the Jacobian form moves
+    with the origin through its wheels' ``l`` and ``alpha``, not by a change of the twist alone). Its twist is
+    :func:`centred_twist`'s."""
+    unit = nondimensional(robot)
+    cx, cy = centroid(unit)
+    wheels = []
+    for w in unit.wheels:
+        x, y = w.position
+        wheels.append(replace(w, l=math.hypot(x - cx, y - cy), alpha=math.atan2(y - cy, x - cx)))
+    return replace(unit, wheels=tuple(wheels))
 
 
 def velocity_scale(robot: Robot) -> np.ndarray:

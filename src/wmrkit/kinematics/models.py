@@ -24,7 +24,7 @@ from .._shapes import as_names, as_vectors, matvec, readonly
 from ..errors import ShapeError, SingularError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..robot import TWIST_NAMES, Robot
-from .linalg import coupled_constraints, matrix_rank, nondimensional, velocity_scale
+from .linalg import centred, coupled_constraints, matrix_rank, nondimensional, velocity_scale
 from .nullspace import null_space_assignable, null_space_basis, null_space_solution, rref_solution
 from .ranks import ranks_assignable, ranks_solution
 from .search import SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
@@ -114,7 +114,7 @@ def mobility(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike 
     robot's ``gear`` couplings (a row per direction a gear forbids), as the models here do; ``gears=False``: the
     wheels' alone, the thesis's m (equal without a gear)."""
     a = constraints(robot, configuration(robot, beta, heading), gears)
-    return a.shape[-1] - matrix_rank(a)
+    return a.shape[-1] - matrix_rank(centred(robot, a))  # the twist of the centroid: the same in every frame
 
 
 def bounded(q: np.ndarray, names: Sequence[str], argument: str, limit: float = MAX_QUERY_RATE) -> np.ndarray:

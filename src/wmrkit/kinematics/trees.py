@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_names, readonly
 from ..errors import SelectionError, UnknownNameError
 from ..robot import TWIST_NAMES, Robot
-from .linalg import delta_projector, matrix_rank, nondimensional, velocity_scale
+from .linalg import centred_robot, centred_twist, delta_projector, matrix_rank, velocity_scale
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
@@ -148,7 +148,7 @@ def direct_tree(robot: Robot, beta: ArrayLike | None = None, q_dot_w: ArrayLike 
     ``determined`` only for one contact (no slip possible); otherwise ``overdetermined``, and with ``q_dot_w``
     ``(..., n_w)`` ``consistent`` (no slip) or ``inconsistent`` (some wheel slips).
     """
-    i_bar, j = nondimensional(robot).jacobian_form(beta)  # the tolerance policy of .linalg
+    i_bar, j = centred_robot(robot).jacobian_form(beta)  # the tolerance policy of .linalg, the same in every frame
     return classify_system(i_bar, j, q_dot_w)
 
 
@@ -158,9 +158,9 @@ def inverse_tree(robot: Robot, beta: ArrayLike | None = None, twist_robot: Array
     ``determined`` iff every wheel is omnidirectional with a full-rank Jacobian (4.21), 3 DOF; otherwise
     ``overdetermined``, and a given twist ``(..., 3)`` is ``consistent`` (feasible) or ``inconsistent``.
     """
-    i_bar, j = nondimensional(robot).jacobian_form(beta)
-    if twist_robot is not None:  # in the nondimensional velocities (vx / L, vy / L, omega)
-        twist_robot = np.asarray(twist_robot, dtype=float) * velocity_scale(robot)[:3]
+    i_bar, j = centred_robot(robot).jacobian_form(beta)
+    if twist_robot is not None:  # in the nondimensional velocities (vx / L, vy / L, omega), of the centroid
+        twist_robot = centred_twist(robot, np.asarray(twist_robot, dtype=float) * velocity_scale(robot)[:3])
     return classify_system(j, i_bar, twist_robot)
 
 
@@ -169,7 +169,7 @@ def independent_wheel_rates(robot: Robot, beta: ArrayLike | None = None) -> np.n
 
     ``(..., n_steer) -> (...)`` int. Equal to the mobility m (4.75).
     """
-    i_bar, j = nondimensional(robot).jacobian_form(beta)
+    i_bar, j = centred_robot(robot).jacobian_form(beta)
     return j.shape[-1] - matrix_rank(delta_projector(i_bar) @ j)
 
 
@@ -179,7 +179,7 @@ def vehicle_dof(robot: Robot, beta: ArrayLike | None = None) -> np.ndarray:
     ``(..., n_steer) -> (...)`` int: the twist degrees of freedom. Equal to the mobility m (4.75), except for
     double wheels, whose steering turns without moving the body: ``m - G`` such self-motions (docs/kinematics.md).
     """
-    i_bar, j = nondimensional(robot).jacobian_form(beta)
+    i_bar, j = centred_robot(robot).jacobian_form(beta)
     return 3 - matrix_rank(delta_projector(j) @ i_bar)
 
 
