@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from ..analysis.conditioning import ill_conditioned_pairs
 from ..analysis.summary import analyze, check_resolution
 from ..errors import WmrkitError
 from ..limits import check_length
@@ -14,6 +15,7 @@ from ._common import (
     parse_value,
     print_json,
     steered_robot,
+    warn,
 )
 
 
@@ -37,6 +39,8 @@ def run(args: argparse.Namespace) -> int:
     robot = steered_robot(args.robot, args.steer)
     check_resolution(args.resolution, "--resolution")
     result = analyze(robot, length=_length(args.length), resolution=args.resolution)
+    for message in ill_conditioned_pairs(robot):  # said, not refused: the verdicts stand as computed
+        warn(f"{args.robot}: {message}")
     if args.report:
         from ..analysis.report import write_report
 
