@@ -41,7 +41,7 @@ def robot_to_dict(robot: Robot, *, thesis: bool = False) -> dict[str, Any]:
             w |= entries.get("wheels", {}).get(w["name"], {})
     if robot.couplings:
         out["couplings"] = [{"kind": c.kind, "joints": list(c.joints), "ratios": list(c.ratios)}
-                            for c in robot.couplings]
+                            | ({"law": c.law} if c.law is not None else {}) for c in robot.couplings]
     return out
 
 

@@ -13,7 +13,7 @@ and a gear none of whose joints is read still turns as one (:func:`gear_free`).
 - ``linkage``: steering joints moved by one mechanism (an Ackermann linkage); the angles are a configuration, so
   the coupling says that actuating one of them sets them all. Sensing stays per angle (the kinematics do not
   model the linkage's geometry: its ratios are not used), as it does per joint under the other kinds; the dynamics
-  hold the ideal geometry (:mod:`wmrkit.dynamics.linkages`).
+  hold its ideal ``law`` (:data:`LINKAGE_LAWS`, :func:`linkage_law`, :mod:`wmrkit.dynamics.linkages`).
 """
 
 from __future__ import annotations
@@ -33,6 +33,9 @@ if TYPE_CHECKING:
     from .wheels import Wheel
 
 COUPLING_KINDS = ("differential", "gear", "linkage")
+#: The laws a ``linkage`` may state: ``ackermann``, the linked wheels' axles meet on the fixed wheels' axle line;
+#: ``parallel``, the linked wheels turn together (a synchro drive's chain, a crab-steering pair).
+LINKAGE_LAWS = ("ackermann", "parallel")
 
 
 class CouplingError(WmrkitError, ValueError):
@@ -41,11 +44,13 @@ class CouplingError(WmrkitError, ValueError):
 
 @dataclass(frozen=True, slots=True)
 class Coupling:
-    """Joints ``wheel.joint`` moved by one mechanism of `kind`, with one ratio per joint (see module docstring)."""
+    """Joints ``wheel.joint`` moved by one mechanism of `kind`, with one ratio per joint (see module docstring); a
+    linkage's `law` (:data:`LINKAGE_LAWS`), None when the description does not state it (:func:`linkage_law`)."""
 
     kind: str
     joints: tuple[str, ...]
     ratios: tuple[float, ...]
+    law: str | None = None
 
     def __post_init__(self) -> None:
         joints = as_names(self.joints, f"coupling {self.kind}: joints", "'wheel.joint' names", CouplingError)
@@ -63,6 +68,8 @@ class Coupling:
         if max(map(abs, self.ratios)) > min(map(abs, self.ratios)) / MIN_RATIO:
             raise CouplingError(f"{name}: the largest ratio is more than {1 / MIN_RATIO:g} times the smallest "
                                 "(docs/limits.md)")
+        if self.law is not None and (self.kind != "linkage" or self.law not in LINKAGE_LAWS):
+            raise CouplingError(f"{name}: law {self.law!r}: {law_problem(self.kind, self.law)}")
 
     @property
     def rates(self) -> bool:
@@ -90,6 +97,58 @@ def joint_problem(kind: str, joint: str, wheels: Mapping[str, Wheel],
     return None
 
 
+def law_problem(kind: str, law: object) -> str:
+    """Why `law` is no law of a coupling of `kind` (a linkage's is one of :data:`LINKAGE_LAWS`)."""
+    if kind != "linkage":
+        return f"only a linkage has a law (a {kind} turns its joints in its ratios)"
+    return f"a linkage's law is one of {', '.join(LINKAGE_LAWS)}"
+
+
+def fixed_axle(wheels: tuple[Wheel, ...] | list[Wheel]) -> tuple[np.ndarray, float, str | None] | None:
+    """``(point, heading, odd)`` of the fixed wheels' common axle line: a point on it, their rolling direction
+    [rad], and None, or the name of the first fixed wheel whose axle is off the first one's line; None without a
+    fixed wheel."""
+    fixed = [w for w in wheels if w.type == "fixed"]
+    if not fixed:
+        return None
+    p0, h0 = wheel_point(fixed[0]), fixed[0].heading
+    n0 = np.array([np.cos(h0), np.sin(h0)])
+    scale = max(1.0, *(float(np.abs(wheel_point(w)).max()) for w in fixed))
+    odd = next((w.name for w in fixed[1:] if abs(np.sin(w.heading - h0)) > 1e-9
+                or abs(n0 @ (wheel_point(w) - p0)) > 1e-9 * scale), None)
+    return p0, h0, odd
+
+
+def wheel_point(w: Wheel) -> np.ndarray:
+    """The wheel's steering point ``(x, y)`` [m] in the robot frame."""
+    return np.array([w.l * np.cos(w.alpha), w.l * np.sin(w.alpha)])
+
+
+def axle_problem(wheels: tuple[Wheel, ...] | list[Wheel]) -> str | None:
+    """Why the wheels give no axle line for ``law: ackermann`` (the linked wheels' axles meet on it), or None."""
+    axle = fixed_axle(wheels)
+    if axle is None:
+        return ("its wheels' axles would meet on the fixed wheels' axle line, and the robot has no fixed "
+                "wheel (state law: parallel if the linked wheels turn together)")
+    if axle[2] is not None:
+        first = next(w.name for w in wheels if w.type == "fixed")
+        return (f"the fixed wheels' axles ({first}, {axle[2]}) are not one line, so no ICR is common to them and "
+                "the linked wheels")
+    return None
+
+
+def linkage_law(c: Coupling, wheels: tuple[Wheel, ...] | list[Wheel]) -> str | None:
+    """The law the dynamics hold on linkage `c` of a robot with `wheels`: the one it states; else ``ackermann``
+    with fixed wheels, ``parallel`` when it links every wheel with a steering angle (a synchro drive); else None,
+    not held: wmrkit does not guess (a four-wheel-steer car's front pair may be an Ackermann linkage)."""
+    if c.law is not None:
+        return c.law
+    if any(w.type == "fixed" for w in wheels):
+        return "ackermann"
+    steered = {w.name for w in wheels if "steer" in w.kind.joints and "steer" not in w.kind.rates}
+    return "parallel" if steered == {j.partition(".")[0] for j in c.joints} else None
+
+
 def check_couplings(robot: Robot) -> None:
     """A robot built in Python couples joints as a description does (``description._couplings_from_dict``): a
     tuple of :class:`Coupling` whose joints the robot has, each in one coupling at most; else :class:`CouplingError`
@@ -106,6 +165,9 @@ def check_couplings(robot: Robot) -> None:
             if problem is not None:
                 raise CouplingError(f"robot '{robot.name}': couplings[{i}] {c.channel_name}: {problem}")
             used.add(joint)
+        problem = axle_problem(robot.wheels) if c.law == "ackermann" else None
+        if problem is not None:
+            raise CouplingError(f"robot '{robot.name}': couplings[{i}] {c.channel_name}: law ackermann: {problem}")
 
 
 def channel_names(couplings: tuple[Coupling, ...], joints: tuple[str, ...]) -> tuple[str, ...]:

@@ -23,7 +23,7 @@ from ._description_wheels import (  # noqa: F401  (the wheel entries' names are 
     kind_of_type,
 )
 from ._description_writer import HEADING_SPREAD, described_type, robot_to_dict  # noqa: F401  (re-exported)
-from .couplings import COUPLING_KINDS, Coupling, joint_problem
+from .couplings import COUPLING_KINDS, LINKAGE_LAWS, Coupling, axle_problem, joint_problem, law_problem
 from .documents import (
     DescriptionError,
     FieldReader,
@@ -130,7 +130,7 @@ def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) ->
         loc: Loc = ("couplings", i)
         if not isinstance(item, Mapping):
             check.fail("a coupling is a mapping {kind, joints, ratios}", loc)
-        check.reject_unknown(item, ("kind", "joints", "ratios"), loc)
+        check.reject_unknown(item, ("kind", "joints", "ratios", "law"), loc)
         kind = check.text(item, "kind", loc)
         if kind not in COUPLING_KINDS:
             check.fail(f"unknown coupling kind '{kind}'{hint(kind, COUPLING_KINDS)} (kinds: "
@@ -161,8 +161,24 @@ def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) ->
         if max(sizes) > min(sizes) / MIN_RATIO:
             check.fail(f"the largest ratio is more than {1 / MIN_RATIO:g} times the smallest: rank decisions would "
                        "lose the smaller to round-off (docs/limits.md)", (*loc, "ratios"))
-        out.append(Coupling(kind, tuple(joints), ratios))
+        out.append(Coupling(kind, tuple(joints), ratios, _law(item, kind, joints, wheels, check, loc)))
     return tuple(out)
+
+
+def _law(item: Mapping[str, Any], kind: str, joints: list[str], wheels: list[Wheel], check: FieldReader,
+         loc: Loc) -> str | None:
+    """A linkage's ``law`` (``wmrkit.couplings.LINKAGE_LAWS``), None when absent; ``ackermann`` needs the fixed
+    wheels' axle line, on which the linked wheels' axles meet."""
+    if "law" not in item:
+        return None
+    law = check.text(item, "law", loc)
+    if kind != "linkage" or law not in LINKAGE_LAWS:
+        check.fail(f"'{law}': {law_problem(kind, law)}{hint(law, LINKAGE_LAWS) if kind == 'linkage' else ''}",
+                   (*loc, "law"))
+    problem = axle_problem(wheels) if law == "ackermann" else None
+    if problem is not None:
+        check.fail(f"{kind}({', '.join(joints)}): law ackermann: {problem}", (*loc, "law"))
+    return law
 
 
 def _joint_names(wheels: list[Wheel]) -> list[str]:

@@ -485,10 +485,12 @@ def test_couplings_follow_renamed_deleted_retyped_wheels(page):
     """ackermann: rear_left to double answered "couplings[0].joints[0]: no joint 'rear_left.spin'"."""
     pg = page
     open_catalog(pg, "ackermann")
+    pg.evaluate("S.desc.couplings[1].law = 'ackermann'")  # a linkage's law (docs/description-format.md) is kept
     pg.click('[data-wheel="front_left"]')
     edit(pg, "name", "fl")
     assert pg.evaluate("S.error") is None
     assert page_robot(pg).couplings[1].joints == ("fl.steer", "front_right.steer")
+    assert page_robot(pg).couplings[1].law == "ackermann"
     pg.click('[data-wheel="rear_left"]')
     pg.select_option('#wheel-fields [data-field="type"]', "double")
     settle(pg)

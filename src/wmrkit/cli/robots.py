@@ -89,7 +89,9 @@ def format_summary(robot: Robot) -> str:
     if robot.steer_names:
         lines.append(f"  steered wheels: {', '.join(robot.steer_names)}")
     for c in robot.couplings:
-        lines.append(f"  coupling: {c.kind} of {', '.join(c.joints)} (ratios {', '.join(_g(k) for k in c.ratios)})")
+        law = f"; law {c.law}" if c.law is not None else ""  # a linkage's, stated
+        ratios = ", ".join(_g(k) for k in c.ratios)
+        lines.append(f"  coupling: {c.kind} of {', '.join(c.joints)} (ratios {ratios}{law})")
     return "\n".join(lines)
 
 

@@ -1,16 +1,18 @@
 """Steering linkages held by the dynamics: each ``linkage`` coupling is a holonomic constraint between steering
 angles, ``beta_j = f(beta_i)`` for every wheel j it links to its leader i (``docs/dynamics.md``, Couplings).
 
-A description gives no linkage geometry, so the dynamics hold the ideal one the robot's wheels define:
+A description gives no linkage geometry, so the dynamics hold the ideal one of its ``law``
+(:func:`wmrkit.couplings.linkage_law`: the law it states, else ``ackermann`` with fixed wheels, ``parallel`` over
+every steerable wheel of a robot without one, else none: the linkage is not held, :func:`unheld`):
 
-- with fixed wheels (their axles on one line, the ``axle``), the linked wheels' axles meet on that line: the
+- ``ackermann`` (fixed wheels, their axles on one line, the ``axle``): the linked wheels' axles meet on that line, the
   exact Ackermann law. In the axle's frame (x along the fixed wheels' rolling direction, y along the axle, x_i, y_i
   the steering point of wheel i, psi its heading from the fixed wheels'), ``psi_j = atan2(x_j sin psi_i, x_i cos
   psi_i + (y_i - y_j) sin psi_i)`` (mod pi), so ``f' = x_i x_j / D`` with ``D`` the squared norm of that pair;
-- without a fixed wheel, the linked wheels turn together, ``beta_j - beta_j0 = beta_i - beta_i0`` (a synchro
-  drive's chain: one ICR at infinity while they stay parallel).
+- ``parallel``: the linked wheels turn together, ``beta_j - beta_j0 = beta_i - beta_i0`` (a synchro drive's chain:
+  one ICR at infinity while they stay parallel).
 
-The leader is the linkage's first wheel (with fixed wheels, the first one off the axle line). The ratios are not
+The leader is the linkage's first wheel (``ackermann``: the first one off the axle line). The ratios are not
 used. In reduced coordinates the basis depends on the leader's angle, ``nu = T(beta) p``, and the follower's
 acceleration has the velocity-product term ``f''(beta_i) beta_i'^2`` (:func:`reduced`).
 
@@ -25,6 +27,7 @@ import math
 
 import numpy as np
 
+from ..couplings import axle_problem, fixed_axle, linkage_law, wheel_point
 from ..errors import WmrkitError
 from ..wheels import heading_from_beta
 
@@ -50,14 +53,15 @@ def law(row, beta):
 
 
 def linkage_table(robot, names: tuple[str, ...]) -> np.ndarray:
-    """The table of the module docstring for `robot` with velocity `names` (the model's); ``(0, 10)`` without a
-    linkage. Raises :class:`WmrkitError` naming the linkage when the robot cannot hold it."""
-    linkages = [c for c in robot.couplings if c.kind == "linkage"]
+    """The table of the module docstring for `robot` with velocity `names` (the model's), a row per follower of each
+    linkage with a law (:func:`wmrkit.couplings.linkage_law`; :func:`unheld` the others); ``(0, 10)`` without one.
+    Raises :class:`WmrkitError` naming the linkage when the robot cannot hold it."""
     rows = []
-    if not linkages:
-        return np.zeros((0, COLUMNS))
-    axle = _axle(robot)
-    for c in linkages:
+    for c in robot.couplings:
+        kind = linkage_law(c, robot.wheels) if c.kind == "linkage" else None
+        if kind is None:
+            continue
+        axle = _axle(robot, c) if kind == "ackermann" else None
         wheels = [robot.wheel(j.partition(".")[0]) for j in c.joints]
         frame = [(0.0, 0.0, w.beta) for w in wheels] if axle is None else [_in_axle(axle, w) for w in wheels]
         lead = next((k for k, (x, _, _) in enumerate(frame) if axle is None or abs(x) > 1e-9), None)
@@ -87,34 +91,32 @@ def linkage_table(robot, names: tuple[str, ...]) -> np.ndarray:
     return np.array(rows, dtype=float).reshape(-1, COLUMNS)
 
 
-def _axle(robot) -> tuple[np.ndarray, float] | None:
-    """``(point, heading)`` of the fixed wheels' common axle line (a point on it, their rolling direction), None
-    without a fixed wheel; :class:`WmrkitError` when their axles are not one line (no ICR for a linkage)."""
-    fixed = [w for w in robot.wheels if w.type == "fixed"]
-    if not fixed:
-        return None
-    p0, h0 = _position(fixed[0]), float(heading_from_beta(fixed[0].beta, fixed[0].delta))
-    n0 = np.array([math.cos(h0), math.sin(h0)])
-    scale = max(1.0, *(float(np.abs(_position(w)).max()) for w in fixed))
-    for w in fixed[1:]:
-        h = float(heading_from_beta(w.beta, w.delta))
-        if abs(math.sin(h - h0)) > 1e-9 or abs(n0 @ (_position(w) - p0)) > 1e-9 * scale:
-            links = ", ".join(c.channel_name for c in robot.couplings if c.kind == "linkage")
-            raise WmrkitError(f"robot '{robot.name}': {links}: the fixed wheels' axles ({fixed[0].name}, {w.name}) "
-                              "are not one line, so no ICR is common to them and the linked wheels; the dynamics "
-                              "cannot hold the linkage")
+def unheld(robot) -> list[str]:
+    """The warnings of the linkages of `robot` the dynamics do not hold (no law stated and none to default to:
+    :func:`wmrkit.couplings.linkage_law`): each steering angle follows its own servo."""
+    return [f"{c.channel_name} is not held by the dynamics: the robot has no fixed wheel and the linkage does not link "
+            "every steerable wheel, so its law is not known and each steering angle follows its own servo; state it "
+            "in the coupling's law field (law: parallel if the linked wheels turn together; "
+            "docs/description-format.md)"
+            for c in robot.couplings if c.kind == "linkage" and linkage_law(c, robot.wheels) is None]
+
+
+def _axle(robot, c) -> tuple[np.ndarray, float]:
+    """``(point, heading)`` of the fixed wheels' common axle line, on which the ``ackermann`` linkage `c`'s axles
+    meet; :class:`WmrkitError` naming it when the wheels give none (:func:`wmrkit.couplings.axle_problem`)."""
+    problem = axle_problem(robot.wheels)
+    if problem is not None:
+        raise WmrkitError(f"robot '{robot.name}': {c.channel_name}: law ackermann: {problem}; the dynamics cannot "
+                          "hold the linkage")
+    p0, h0, _ = fixed_axle(robot.wheels)
     return p0, h0
-
-
-def _position(w) -> np.ndarray:
-    return np.array([w.l * math.cos(w.alpha), w.l * math.sin(w.alpha)])
 
 
 def _in_axle(axle: tuple[np.ndarray, float], w) -> tuple[float, float, float]:
     """``(x, y, psi)`` of wheel `w` in the axle's frame: along the fixed wheels' rolling direction, along the axle,
     its heading from theirs."""
     p0, h0 = axle
-    r = _position(w) - p0
+    r = wheel_point(w) - p0
     return (float(r[0] * math.cos(h0) + r[1] * math.sin(h0)), float(-r[0] * math.sin(h0) + r[1] * math.cos(h0)),
             float(heading_from_beta(w.beta, w.delta)) - h0)
 
