@@ -103,29 +103,54 @@ def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_l
     shorter step stops too; when it does not, the step was too long for the tyres and the error says so (the load
     transfer lags a step and the tyres saturate within one, which the implicit step does not cover: the forklift's
     rectangle 'lifted off' its steered wheel from 8 ms; docs/dynamics.md)."""
-    from ._integrate import model_work_arrays, run
-
     t_stop = t_run if diverged else float(w[16][1])
     fine = recheck_step(step, method)
-    k_end = round(min(duration, t_stop + max(0.1, 10 * step)) / fine)
+    k_end = round(min(duration, recheck_end(t_stop, step)) / fine)
     budget = recheck_budget(method)
     j = min(int(np.searchsorted(rows[0], (k_end - budget) * fine)),  # the first record in the budget, and at
             max(0, int(np.searchsorted(rows[0], t_stop)) - 1))  # the latest the last one before the stop
     k0 = round(rows[0][j] / fine)  # a record's time is a whole number of steps, each a whole number of fine ones
-    s, acc = rows[1][j].copy(), np.zeros(model.n)
-    wf = model_work_arrays(model)
-    run(s, k0, fine, k_end - k0, 1 << 62, method, jac_every, acc, model.pack, inp, wf, records(model, 0), 0)
-    if np.all(np.isfinite(s)) and (allow_lift_off or not wf[16][0]):
-        what = (f"the simulation diverged before t = {t_stop:.6g} s" if diverged else
-                f"contact '{model.contacts[int(w[16][2])]}' lost its load at t = {t_stop:.6g} s")
-        raise WmrkitError(f"{what} at step {step:g} s, but a run at step {fine:.3g} s goes on to t = "
-                          f"{k_end * fine:.6g} s without it: the step is too long for the tyres (the integration is "
-                          f"unstable, not the robot); use a step of at most {fine:.3g} s (--step) or the adaptive "
-                          "method")
+    if goes_on(model, rows[1][j], [(k0, k_end - k0, inp)], fine, method, jac_every, allow_lift_off):
+        raise unstable_step(stop_phrase(model, w, t_stop, diverged), step, fine, k_end * fine,
+                            "(--step) or the adaptive method")
     if diverged:
         raise WmrkitError(f"the simulation diverged before t = {t_run:.6g} s; use a smaller --step (or smaller "
                           "torques or speeds)")
     check_lift_off(model, w)
+
+
+def recheck_end(t_stop: float, step: float) -> float:
+    """The time [s] a re-check of a run at `step` that stopped at `t_stop` runs to: ``max(0.1 s, 10 steps)`` past."""
+    return t_stop + max(0.1, 10 * step)
+
+
+def goes_on(model: DynamicModel, s: np.ndarray, stretch: list, fine: float, method: int, jac_every: int,
+            allow_lift_off: bool) -> bool:
+    """Whether a fresh integrator run from state `s` (not changed) at step `fine` [s] through `stretch`, the
+    consecutive pieces ``(k0, steps, compiled inputs)`` counted in steps of `fine`, neither diverges nor (unless
+    `allow_lift_off`) lifts a wheel off: the re-check of a stop (:func:`_stop`)."""
+    from ._integrate import model_work_arrays, run
+
+    s, acc, w, rec = s.copy(), np.zeros(model.n), model_work_arrays(model), records(model, 0)
+    for k0, steps, inp in stretch:
+        run(s, k0, fine, steps, 1 << 62, method, jac_every, acc, model.pack, inp, w, rec, 0)
+        if not np.all(np.isfinite(s)) or (w[16][0] and not allow_lift_off):
+            return False
+    return True
+
+
+def stop_phrase(model: DynamicModel, w: tuple, t_stop: float, diverged: bool) -> str:
+    """What stopped a fixed-step run at `t_stop` [s]: it diverged, or the lift-off the work arrays `w` recorded."""
+    return (f"the simulation diverged before t = {t_stop:.6g} s" if diverged else
+            f"contact '{model.contacts[int(w[16][2])]}' lost its load at t = {t_stop:.6g} s")
+
+
+def unstable_step(what: str, step: float, fine: float, t_end: float, where: str, rerun: str = "a run") -> WmrkitError:
+    """The error of a fixed-step run at `step` [s] that stopped (`what`: :func:`stop_phrase`) where a re-check,
+    `rerun` at `fine` [s], went on to `t_end` [s]: the step's, not the robot's; `where` says how to set the step."""
+    return WmrkitError(f"{what} at step {step:g} s, but {rerun} at step {fine:.3g} s goes on to t = {t_end:.6g} s "
+                       "without it: the step is too long for the tyres (the integration is unstable, not the robot); "
+                       f"use a step of at most {fine:.3g} s {where}")
 
 
 #: Most evaluations of the model an adaptive run makes (LSODA, 10-15 us each: about 2 min; the forklift's 22 s
