@@ -88,7 +88,7 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     plant_cols = [model.names.index(j) for j in assigned]
     steer = list(model.steer_columns)
     template = twist_program(model, [0.0], np.zeros((1, 3)))  # the servos' gains and limits
-    stepper = Stepper(model, rolling_start(model, controller, initial_pose), step=step)
+    stepper = Stepper(model, rolling_start(model, controller, initial_pose), step=step, recheck=False)
     s = stepper.state
     sensor = _Sensor(robot, model, s, feedback, weights, noise)
     n = math.floor(duration / period + 1e-9) + 1

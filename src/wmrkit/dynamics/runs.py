@@ -4,7 +4,9 @@ check both make."""
 
 from __future__ import annotations
 
+import bisect
 import math
+from collections import deque
 
 import numpy as np
 
@@ -128,7 +130,7 @@ def goes_on(model: DynamicModel, s: np.ndarray, stretch: list, fine: float, meth
             allow_lift_off: bool) -> bool:
     """Whether a fresh integrator run from state `s` (not changed) at step `fine` [s] through `stretch`, the
     consecutive pieces ``(k0, steps, compiled inputs)`` counted in steps of `fine`, neither diverges nor (unless
-    `allow_lift_off`) lifts a wheel off: the re-check of a stop (:func:`_stop`)."""
+    `allow_lift_off`) lifts a wheel off: the re-check of a stop (:func:`_stop`, :meth:`StepLog.recheck`)."""
     from ._integrate import model_work_arrays, run
 
     s, acc, w, rec = s.copy(), np.zeros(model.n), model_work_arrays(model), records(model, 0)
@@ -151,6 +153,50 @@ def unstable_step(what: str, step: float, fine: float, t_end: float, where: str,
     return WmrkitError(f"{what} at step {step:g} s, but {rerun} at step {fine:.3g} s goes on to t = {t_end:.6g} s "
                        "without it: the step is too long for the tyres (the integration is unstable, not the robot); "
                        f"use a step of at most {fine:.3g} s {where}")
+
+
+class StepLog:
+    """What a :class:`~wmrkit.dynamics.simulate.Stepper` advanced through, to re-check a stop as :func:`_stop` does:
+    its pieces ``(k0, steps, state at k0, compiled inputs)`` (in its steps; each at most ``span`` of them) over its
+    last :func:`recheck_budget` steps of :func:`recheck_step` (older ones are dropped)."""
+
+    def __init__(self, step: float, method: int) -> None:
+        self.fine = recheck_step(step, method)
+        self.ratio = round(step / self.fine)
+        self.span = max(1, recheck_budget(method) // self.ratio)
+        self.pieces: deque = deque()
+
+    def add(self, k0: int, steps: int, state: np.ndarray, inp: tuple) -> int:
+        """Log the next piece of a run of `steps` steps from step `k0` at `state` (copied) with the compiled inputs
+        `inp` (which the stepper no longer changes): at most ``span`` steps, how many it returns. Drops the pieces
+        that start more than ``span`` steps before its end."""
+        steps, pieces = min(steps, self.span), self.pieces
+        pieces.append((k0, steps, state.copy(), inp))
+        while pieces[0][0] < k0 + steps - self.span:
+            pieces.popleft()
+        return steps
+
+    def recheck(self, model: DynamicModel, w: tuple, t_now: float, step: float, method: int, jac_every: int,
+                allow_lift_off: bool, diverged: bool) -> None:
+        """Raise :func:`unstable_step` when the stepper stopped at `t_now` [s] (diverged, or the lift-off `w`
+        recorded), and its logged inputs, run again at :func:`recheck_step` from the logged state at most
+        :func:`recheck_budget` of those steps before :func:`recheck_end` (at the latest the last piece before the
+        stop), the last inputs held past `t_now`, go on without it."""
+        t_stop = t_now if diverged else float(w[16][1])
+        r, fine, pieces = self.ratio, self.fine, list(self.pieces)
+        k_end = round(recheck_end(t_stop, step) / fine)
+        starts = [piece[0] for piece in pieces]
+        j = min(bisect.bisect_left(starts, -(-(k_end - recheck_budget(method)) // r)),
+                max(0, bisect.bisect_left(starts, round(t_stop / step)) - 1))
+        stretch = [(k0 * r, min(steps * r, k_end - k0 * r), inp) for k0, steps, _, inp in pieces[j:]
+                   if k0 * r < k_end]
+        last = pieces[-1]
+        tail = (last[0] + last[1]) * r
+        if tail < k_end:
+            stretch.append((tail, k_end - tail, last[3]))
+        if goes_on(model, pieces[j][2], stretch, fine, method, jac_every, allow_lift_off):
+            raise unstable_step(stop_phrase(model, w, t_stop, diverged), step, fine, k_end * fine,
+                                "(the step argument)", "a run of its inputs")
 
 
 #: Most evaluations of the model an adaptive run makes (LSODA, 10-15 us each: about 2 min; the forklift's 22 s

@@ -26,7 +26,15 @@ from ..wheels import heading_from_beta
 from .deviation import PathDeviation, nominal_poses
 from .linkages import linkage_breach
 from .model import DynamicModel
-from .runs import LiftOffError, adaptive_run, adaptive_samples, check_lift_off, fixed_run, records  # noqa: F401  (LiftOffError: API)
+from .runs import (  # noqa: F401  (LiftOffError: API)
+    LiftOffError,
+    StepLog,
+    adaptive_run,
+    adaptive_samples,
+    check_lift_off,
+    fixed_run,
+    records,
+)
 from .tyres import Tyre
 
 Method = Literal["semi-implicit", "rk4", "adaptive"]
@@ -235,14 +243,17 @@ class Stepper:
     velocities ``nu (n,)`` (default :func:`initial_state`, at rest); a float64 C-contiguous array is used in place
     (caller-owned), anything else is copied. :meth:`advance` integrates with the semi-implicit method (or ``"rk4"``)
     at `step` [s] from time `t` [s]; it raises when a wheel lifts off unless `allow_lift_off` (as
-    :func:`simulate`). The stepper carries all the integrator carries (the last acceleration for the
-    load transfer, the tyre Jacobian and its refresh phase): advancing in pieces gives, bit for bit, the run of one
-    :func:`simulate` call.
+    :func:`simulate`), and a stop is re-checked as there: the inputs it was given (logged: :class:`~.runs.StepLog`)
+    are run again at a shorter step over the stretch that led to it, and when that run goes on, the error blames the
+    step and names the one that ran (`recheck` False: no log and no re-check, as the loops through the dynamics,
+    :mod:`wmrkit.control.dynamic_plant`, whose log would cost about 3 % of a period). The stepper carries all
+    the integrator carries (the last acceleration for the load transfer, the tyre Jacobian and its refresh phase):
+    advancing in pieces gives, bit for bit, the run of one :func:`simulate` call.
     """
 
     def __init__(self, model: Robot | DynamicModel, state: ArrayLike | None = None, *, step: float = 1e-3,
                  method: Literal["semi-implicit", "rk4"] = "semi-implicit", jac_every: int = 20, t: float = 0.0,
-                 tyre: Tyre | str | None = None, allow_lift_off: bool = False) -> None:
+                 tyre: Tyre | str | None = None, allow_lift_off: bool = False, recheck: bool = True) -> None:
         from ._integrate import model_work_arrays
 
         self.model = model if isinstance(model, DynamicModel) else DynamicModel.of(model, tyre)
@@ -276,7 +287,8 @@ class Stepper:
         self._acc = np.zeros(n)
         self._w = model_work_arrays(self.model)
         self._rec = records(self.model, 0)
-        self._inputs: tuple | None = None
+        self._inputs: tuple | None = None  # compiled; hold() replaces the arrays it changes (the log keeps them)
+        self._log = StepLog(self.step, self._method) if recheck else None
         self._delta = np.array([w.delta for w in self.model.robot.wheels if w.kind.steers], dtype=float)
 
     @property
@@ -296,11 +308,20 @@ class Stepper:
         if not 0 <= duration / self.step <= MAX_STEPS:  # NaN and infinities included
             raise WmrkitError(f"duration must be >= 0 and at most {MAX_STEPS:.0e} steps of {self.step:g} s, got "
                               f"{duration}")
-        n_steps = round(duration / self.step)
-        run(self.state, self._k, self.step, n_steps, 1 << 62, self._method, self.jac_every, self._acc,
-            self.model.pack, self._inputs, self._w, self._rec, 0, self._phase)
-        self._k += n_steps
-        if not math.isfinite(self.state.sum()):  # NaN and infinities propagate into the sum
+        n_steps, log = round(duration / self.step), self._log
+        while True:  # with a log, in pieces of at most its span (the same steps), each logged for a re-check
+            steps = n_steps if log is None else log.add(self._k, n_steps, self.state, self._inputs)
+            run(self.state, self._k, self.step, steps, 1 << 62, self._method, self.jac_every, self._acc,
+                self.model.pack, self._inputs, self._w, self._rec, 0, self._phase)
+            self._k += steps
+            n_steps -= steps
+            if not n_steps:
+                break
+        diverged = not math.isfinite(self.state.sum())  # NaN and infinities propagate into the sum
+        if log is not None and (diverged or (self._w[16][0] and not self.allow_lift_off)):
+            log.recheck(self.model, self._w, self.t, self.step, self._method, self.jac_every, self.allow_lift_off,
+                        diverged)
+        if diverged:
             raise WmrkitError(f"the simulation diverged before t = {self.t:.6g} s; use a smaller step")
         if not self.allow_lift_off:
             check_lift_off(self.model, self._w)
@@ -310,7 +331,8 @@ class Stepper:
              torques: ArrayLike | None = None) -> None:
         """Hold new joint references from now on (a controller's period): wheel-rate references ``(n,)`` [rad/s]
         over ``model.names``, steering headings ``(n_steer,)`` [rad], feed-forward torques ``(n,)`` [N m]. Gains,
-        limits and the values not given are those of the last inputs at the current time (in place, a few µs)."""
+        limits and the values not given are those of the last inputs at the current time (in place, a few µs; new
+        rows while the stepper logs them)."""
         if self._inputs is None:
             raise WmrkitError("hold: give inputs (their servo gains) to advance() first")
         tk, tau, rref, gain, limit, bref, kp, kd, steer_limit = self._inputs
@@ -319,6 +341,9 @@ class Stepper:
             tau, rref, bref = (np.array([np.interp(t, tk, col) for col in a.T], dtype=float).reshape(1, a.shape[1])
                                for a in (tau, rref, bref))
             tk = np.array([t])
+            self._inputs = (tk, tau, rref, gain, limit, bref, kp, kd, steer_limit)
+        elif self._log is not None:  # the log keeps the rows it advanced with: new ones
+            tau, rref, bref = tau.copy(), rref.copy(), bref.copy()
             self._inputs = (tk, tau, rref, gain, limit, bref, kp, kd, steer_limit)
         if rate_reference is not None:
             rref[0] = _held(rate_reference, rref.shape[1], "rate_reference")

@@ -1,0 +1,96 @@
+"""A ``Stepper`` (the single-step API: closed loops, the slip studies' drivetrain) that stops (a wheel "lifts off",
+the state diverges) is re-checked as ``simulate`` is: the inputs it was given, logged, are run again at a shorter
+step over the stretch that led to the stop; when that run goes on, the error blames the step, not the robot."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.dynamics._integrate import model_work_arrays, run
+from wmrkit.dynamics.model import DynamicModel
+from wmrkit.dynamics.programs import path_program, twist_program
+from wmrkit.dynamics.runs import LiftOffError, recheck_step, records
+from wmrkit.dynamics.simulate import Stepper, advance, initial_state
+from wmrkit.errors import WmrkitError
+
+
+@pytest.fixture(scope="module")
+def rectangle():
+    model = DynamicModel.of(catalog.load("forklift"))
+    return model, path_program(model, "rectangle")[0]
+
+
+@pytest.mark.parametrize("piece", [0.01, 0.05, 0.5])
+def test_a_stepper_lift_off_of_the_step_is_called_the_step(rectangle, piece):
+    """At 10 ms the forklift's rectangle 'loses' its steered wheel's load at t = 0.22 s (`simulate` says so since
+    session 30); a Stepper said "lifts off the ground ...; use smaller torques or speeds", whatever its pieces."""
+    model, inputs = rectangle
+    stepper = Stepper(model, step=0.01)
+    with pytest.raises(WmrkitError) as err:
+        for _ in range(round(0.5 / piece)):
+            stepper.advance(inputs, piece)
+    assert not isinstance(err.value, LiftOffError)
+    message = str(err.value)
+    assert message.startswith("contact 'steer' lost its load at t = 0.22 s at step 0.01 s, but a run of its inputs at "
+                              "step 0.001 s goes on to t = ")
+    assert message.endswith("the step is too long for the tyres (the integration is unstable, not the robot); use a "
+                            "step of at most 0.001 s (the step argument)")
+    # independently: the same inputs at that step, through the Stepper, run past the stop with the wheel loaded
+    fine = Stepper(model, step=recheck_step(0.01, 0))
+    fine.advance(inputs, 0.5)
+    assert fine.t == pytest.approx(0.5)
+
+
+def test_advance_blames_the_step_too(rectangle):
+    model, inputs = rectangle
+    with pytest.raises(WmrkitError, match=r"at step 0\.01 s, but a run of its inputs at step 0\.001 s goes on"):
+        advance(model, initial_state(model), inputs, 0.5, step=0.01)
+
+
+@pytest.mark.parametrize("step", [1e-3, 5e-3, 1e-2])
+def test_a_real_lift_off_through_the_stepper_still_says_lift_off(step):
+    """Braking the forklift from 1 m/s at the grip tips it (the adaptive integrator sees it too:
+    test_unstable_step.py): the re-check at the shorter step stops as well, so the error stays the lift-off."""
+    model = DynamicModel.of(catalog.load("forklift"), "pacejka")
+    stepper = Stepper(model, initial_state(model, (1.0, 0.0, 0.0)), step=step)
+    with pytest.raises(LiftOffError, match=r"contact 'steer' lifts off the ground.*smaller torques or speeds"):
+        for _ in range(30):
+            stepper.advance(twist_program(model, [0.0], [(0.0, 0.0, 0.0)]), 0.01)
+
+
+def test_the_log_replays_the_held_inputs_bit_for_bit(rectangle):
+    """The log keeps each piece's inputs as the stepper advanced with them (hold() writes new rows, not the logged
+    ones): run again at the same step from the first piece, they give the stepper's state bit for bit."""
+    model, inputs = rectangle
+    stepper = Stepper(model, step=1e-3)
+    stepper.advance(inputs, 0.02)
+    rates = np.zeros(model.n)
+    for k in range(40):
+        rates[3:] = 2.0 + 0.1 * k
+        stepper.hold(rates, np.full(len(model.steer_columns), 0.01 * k))
+        stepper.advance(None, 0.005)
+    pieces = list(stepper._log.pieces)
+    s, acc, w = pieces[0][2].copy(), np.zeros(model.n), model_work_arrays(model)
+    for k0, steps, _, inp in pieces:
+        run(s, k0, 1e-3, steps, 1 << 62, 0, 20, acc, model.pack, inp, w, records(model, 0), 0)
+    np.testing.assert_array_equal(s, stepper.state)
+    assert len({id(p[3]) for p in pieces[1:]}) == 40  # one set of inputs a hold
+
+
+def test_the_log_is_bounded_by_the_recheck_budget():
+    model = DynamicModel.of(catalog.load("skid-steer-4"))
+    stepper = Stepper(model, step=0.02, method="rk4")  # re-checked at 1e-4 s: 1250 of its steps
+    stepper.advance(twist_program(model, [0.0], [(0.3, 0.0, 0.0)]), 0.0)
+    for _ in range(3000):
+        stepper.advance(None, 0.02)
+    log = stepper._log
+    assert log.span == 1250 and len(log.pieces) <= log.span + 1
+    assert stepper._k - log.pieces[0][0] <= log.span + 1
+
+
+def test_without_a_log_a_stop_is_not_rechecked(rectangle):
+    model, inputs = rectangle
+    with pytest.raises(LiftOffError, match="contact 'steer' lifts off the ground"):
+        Stepper(model, step=0.01, recheck=False).advance(inputs, 0.5)
