@@ -31,7 +31,7 @@ from ..kinematics.wheel_ik import WheelCommands
 from ..robot import Robot
 from ..slip.kalman import KalmanNoise
 from ..slip.weights import SlipWeights
-from .dynamic_plant import rolling_start
+from .dynamic_plant import rechecked, rolling_start
 from .loop import TwistController, check_command
 from .points import ControlError, check_delay
 from .slip_control import SLIP_MODELS, SlipCommander, SlipInverse, _Forward, slip_inverse
@@ -62,8 +62,20 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     (commanded steering β), ``estimate`` (the fed-back pose), ``rates`` (commanded wheel rates of
     ``info["assigned"]``), ``predicted`` (the slip model's twist at the commands; the twist itself for ``"none"``),
     ``velocity`` (the true body twist), ``joint_rates`` (the actual rates of the assigned joints) and ``info``
-    (dict: ``assigned``, ``failures``, ``worst_error`` [m/s] of the inverse, ``evaluations``).
+    (dict: ``assigned``, ``failures``, ``worst_error`` [m/s] of the inverse, ``evaluations``). A stop is re-checked
+    at a shorter step (:func:`.dynamic_plant.rechecked`).
     """
+    return rechecked(lambda d, h, again: _slip_loop(
+        robot, controller, initial_pose, d, period=period, delay=delay, tyre=tyre, step=h, slip_model=slip_model,
+        feedback=feedback, weights=weights, noise=noise, inverse=inverse, ramp=ramp, progress=progress and not again,
+        policy=policy, until=until), duration, step)
+
+
+def _slip_loop(robot: Robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *,
+               period: float, delay: int, tyre: str | None, step: float, slip_model: str, feedback: str,
+               weights: SlipWeights | None, noise: KalmanNoise | None, inverse: SlipInverse | None, ramp: bool,
+               progress: bool, policy: str, until: Callable[[float, np.ndarray], bool] | None) -> dict:
+    """The loop of :func:`simulate_slip_control`, not re-checked."""
     from ..dynamics.model import DynamicModel
     from ..dynamics.programs import twist_program
     from ..dynamics.simulate import Stepper

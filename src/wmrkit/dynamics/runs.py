@@ -16,11 +16,21 @@ from .model import DynamicModel
 
 class LiftOffError(WmrkitError):
     """A wheel loaded at rest lost its load: the run stops there (:func:`check_lift_off`). ``what`` states it
-    (contact, time, load at rest), ``t`` its time [s]; the message adds what to change, which a caller may replace."""
+    (contact, time, load at rest), ``t`` its time [s], ``contact`` its name; the message adds what to change, which a
+    caller may replace."""
 
-    def __init__(self, what: str, advice: str = "use smaller torques or speeds", t: float = math.nan) -> None:
-        self.what, self.advice, self.t = what, advice, t
+    def __init__(self, what: str, advice: str = "use smaller torques or speeds", t: float = math.nan,
+                 contact: str = "") -> None:
+        self.what, self.advice, self.t, self.contact = what, advice, t, contact
         super().__init__(f"{what}; {advice}")
+
+
+class DivergedError(WmrkitError):
+    """A fixed-step run whose state overflowed before ``t`` [s] (:class:`~wmrkit.dynamics.simulate.Stepper`)."""
+
+    def __init__(self, message: str, t: float) -> None:
+        self.t = t
+        super().__init__(message)
 
 
 def check_lift_off(model: DynamicModel, w: tuple) -> None:
@@ -32,7 +42,7 @@ def check_lift_off(model: DynamicModel, w: tuple) -> None:
         e = int(lift[2])
         raise LiftOffError(f"contact '{model.contacts[e]}' lifts off the ground at t = {lift[1]:.6g} s (normal load "
                            f"0; {model.normal_loads()[e]:.4g} N at rest): the planar model keeps every wheel on the "
-                           "ground, so the motion would not be physical", t=float(lift[1]))
+                           "ground, so the motion would not be physical", t=float(lift[1]), contact=model.contacts[e])
 
 
 def records(model: DynamicModel, n_rec: int) -> tuple:

@@ -26,7 +26,8 @@ from ..wheels import heading_from_beta
 from .deviation import PathDeviation, nominal_poses
 from .linkages import linkage_breach
 from .model import DynamicModel
-from .runs import (  # noqa: F401  (LiftOffError: API)
+from .runs import (  # noqa: F401  (LiftOffError, DivergedError: API)
+    DivergedError,
     LiftOffError,
     StepLog,
     adaptive_run,
@@ -245,8 +246,8 @@ class Stepper:
     at `step` [s] from time `t` [s]; it raises when a wheel lifts off unless `allow_lift_off` (as
     :func:`simulate`), and a stop is re-checked as there: the inputs it was given (logged: :class:`~.runs.StepLog`)
     are run again at a shorter step over the stretch that led to it, and when that run goes on, the error blames the
-    step and names the one that ran (`recheck` False: no log and no re-check, as the loops through the dynamics,
-    :mod:`wmrkit.control.dynamic_plant`, whose log would cost about 3 % of a period). The stepper carries all
+    step and names the one that ran (`recheck` False: no log and no re-check, for a caller that re-runs itself, as
+    the loops through the dynamics do: :func:`wmrkit.control.dynamic_plant.rechecked`). The stepper carries all
     the integrator carries (the last acceleration for the load transfer, the tyre Jacobian and its refresh phase):
     advancing in pieces gives, bit for bit, the run of one :func:`simulate` call.
     """
@@ -322,7 +323,7 @@ class Stepper:
             log.recheck(self.model, self._w, self.t, self.step, self._method, self.jac_every, self.allow_lift_off,
                         diverged)
         if diverged:
-            raise WmrkitError(f"the simulation diverged before t = {self.t:.6g} s; use a smaller step")
+            raise DivergedError(f"the simulation diverged before t = {self.t:.6g} s; use a smaller step", self.t)
         if not self.allow_lift_off:
             check_lift_off(self.model, self._w)
         return self.state

@@ -1,0 +1,63 @@
+"""A closed loop through the dynamics (``track --dynamics``, ``simulate_dynamics``, ``simulate_slip_control``) that
+stops at a step too long for the tyres is re-run at a shorter step: when the same loop goes on there, the error
+blames the step, not the robot; a stop that the shorter step reproduces keeps its message."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from wmrkit import catalog
+from wmrkit.control import builtin_reference, control_point
+from wmrkit.control.dynamic_plant import fast_law_controller, simulate_dynamics
+from wmrkit.control.laws import PositionLaw
+from wmrkit.control.slip_loop import simulate_slip_control
+from wmrkit.control.track import initial_pose_on
+from wmrkit.dynamics.runs import LiftOffError
+from wmrkit.errors import WmrkitError
+
+
+def _loop(robot, reference):
+    cp = control_point(robot)
+    return fast_law_controller(cp, PositionLaw.uniform("p", 1.0), reference), initial_pose_on(cp, reference)
+
+
+def test_a_loop_that_lifts_off_only_at_a_long_step_blames_the_step():
+    """The skid steer on the square at a 20 ms step: its turns oscillate from the first corner on and 'lift off'
+    a wheel at t = 36.24 s (it said "contact 'front_left' lifts off the ground ..."); the same loop at 1 ms drives
+    the whole square with its wheels down."""
+    robot, square = catalog.load("skid-steer-4"), builtin_reference("square")
+    controller, pose0 = _loop(robot, square)
+    with pytest.raises(WmrkitError) as err:
+        simulate_dynamics(robot, controller, pose0, square.duration, period=0.02, step=0.02)
+    assert not isinstance(err.value, LiftOffError)
+    assert str(err.value) == (
+        "contact 'front_left' lost its load at t = 36.24 s at step 0.02 s, but the same loop at step 0.001 s goes on "
+        f"to t = {square.duration:g} s without it: the step is too long for the tyres (the integration is unstable, "
+        "not the robot); use a step of at most 0.001 s (the step argument)")
+    fine = simulate_dynamics(robot, controller, pose0, square.duration, period=0.02, step=0.001)  # independent
+    assert fine["t"][-1] == pytest.approx(square.duration) and np.all(np.isfinite(fine["pose"]))
+
+
+def test_the_slip_control_loop_blames_the_step_too():
+    robot, square = catalog.load("skid-steer-4"), builtin_reference("square")
+    controller, pose0 = _loop(robot, square)
+    with pytest.raises(WmrkitError, match=r"lost its load at t = 13.6 s at step 0.04 s, but the same loop at step "
+                                          r"0.001 s goes on to t = 15 s without it"):
+        simulate_slip_control(robot, controller, pose0, 15.0, period=0.04, step=0.04, slip_model="mqe")
+
+
+@pytest.mark.parametrize(("name", "contact", "step", "first", "last"),
+                         [("corner", "steer", 0.001, 1.5, 1.51), ("corner", "steer", 0.02, 1.5, 1.53),
+                          ("arc-line", "left_drive", 0.001, 2.4, 2.41)])
+def test_a_real_lift_off_in_the_loop_still_says_lift_off(name, contact, step, first, last):
+    """The forklift at 2 m/s takes the corner reference's corner at the grip and tips onto its drive wheels at
+    t = 1.50 s at 1 ms and 1.52 s at 20 ms: the shorter step stops too, so the error is the lift-off. On the
+    arc-line it lifts a drive wheel off at t = 2.40 s at 1 ms, and at 2.52 s at 0.25, 0.125 and 0.0625 ms (the
+    robot's, later): a re-check only to 0.1 s past the stop, as simulate's, would blame the step; the loop's runs
+    to the loop's end."""
+    robot, reference = catalog.load("forklift"), builtin_reference(name, speed=2.0)
+    controller, pose0 = _loop(robot, reference)
+    with pytest.raises(LiftOffError, match=f"contact '{contact}' lifts off the ground") as err:
+        simulate_dynamics(robot, controller, pose0, reference.duration, period=0.02, step=step)
+    assert first <= err.value.t <= last
