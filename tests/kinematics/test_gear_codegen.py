@@ -160,19 +160,24 @@ def test_in_gear_of_rates_in_and_out_of_the_ratios(name, tmp_path):
     assert mod.in_gear(np.array([q, off, bad])).tolist() == [[True], [False], [False]]
 
 
-def test_a_gear_on_double_wheels_steering_rates_checks_the_steer_rate_input(tmp_path):
-    """A double wheel's steering rate is an input of the inverse (not in RATE_NAMES): ``in_gear`` takes it after the
-    rates, in the Python and the C; the forward model is ``fk``'s."""
+def test_a_gear_on_double_wheels_steering_rates_is_one_input(tmp_path):
+    """A gear turning two double wheels' steering rates is one input of the inverse, as the numeric inverse model's
+    (``drive.steer``); the gear sets the other (``rear.steer = 2 drive.steer``, a rate) and ``in_gear`` checks it.
+    Before, both were inputs (``FREE_STEER_NAMES == ("drive.steer", "rear.steer")``). The forward model is ``fk``'s."""
     from test_codegen import ROBOTS as PLAIN
+
+    from wmrkit.kinematics.models import inverse_model
 
     d = PLAIN["double units"].to_dict()
     d["couplings"] = [{"kind": "gear", "joints": ["drive.steer", "rear.steer"], "ratios": [1, 2]}]
     robot = Robot.from_dict(d)
     mod = load_module(write_code(robot, "python", tmp_path)[0])
-    assert mod.FREE_STEER_NAMES == ("drive.steer", "rear.steer")
-    rates = mod.inverse([0.3, 0.1, -0.2], [0.5, -1.0], [0.2, -0.4, 1.0])
-    steer = np.array([[0.5, 1.0], [0.5, -1.0], [0.0, 0.0]])
-    assert mod.in_gear(np.broadcast_to(rates, (3, rates.size)), steer).tolist() == [[True], [False], [True]]
+    assert mod.FREE_STEER_NAMES == ("drive.steer",) == inverse_model(robot).assigned[-1:]  # after ("vx",)
+    rates = mod.inverse([0.3, 0.1, -0.2], [0.5], [0.2, -0.4, 1.0])
+    assert rates[mod.RATE_NAMES.index("rear.steer")] == pytest.approx(1.0, abs=1e-15)
+    off = rates.copy()
+    off[mod.RATE_NAMES.index("rear.steer")] = -1.0
+    assert mod.in_gear(np.array([rates, off]), [0.5]).tolist() == [[True], [False]]
     q_s, heading = samples(robot, 5)
     twist, slip = reference(robot, q_s, heading)
     got_twist, got_slip = mod.forward_with_residual(q_s, heading)
@@ -182,5 +187,6 @@ def test_a_gear_on_double_wheels_steering_rates_checks_the_steer_rate_input(tmp_
         lib, ident = compile_c(robot, tmp_path / "c")
         check = getattr(lib, f"{ident}_in_gear")
         flags = np.zeros(1, dtype=np.intc)
-        for s, expect in zip(steer, (1, 0, 1), strict=True):
-            assert check(_ptr(rates), _ptr(s), flags.ctypes.data_as(ctypes.POINTER(ctypes.c_int))) == expect == flags[0]
+        for r, expect in ((rates, 1), (off, 0)):
+            assert check(_ptr(r), _ptr(np.array([0.5])), flags.ctypes.data_as(ctypes.POINTER(ctypes.c_int))) == expect
+            assert flags[0] == expect

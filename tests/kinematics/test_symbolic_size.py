@@ -35,7 +35,7 @@ def test_a_least_squares_form_over_many_angles_is_refused_at_once(monkeypatch):
     (twelve castors: hours), now ClosedFormTooLargeError names them at once: before any derivation (no wall-clock
     bound: the derivation is made to fail if it starts). The exact inverse model is still derived (one angle per
     wheel)."""
-    from wmrkit.kinematics import symbolic
+    from wmrkit.kinematics import _exact_linalg
 
     robot = Robot.from_dict(castors(6))
 
@@ -43,7 +43,7 @@ def test_a_least_squares_form_over_many_angles_is_refused_at_once(monkeypatch):
         raise AssertionError("the closed form was derived before the refusal")
 
     with monkeypatch.context() as patch:
-        patch.setattr(symbolic, "solve_exactly", derivation)
+        patch.setattr(_exact_linalg, "solve_exactly", derivation)
         with pytest.raises(ClosedFormTooLargeError, match=r"couples 6 steering angles \(beta_w0, beta_w1, beta_w2, "
                                                           r"beta_w3, beta_w4, beta_w5\), more than max_lsq_angles = 4"):
             symbolic_model(robot, sensed_rates(robot))

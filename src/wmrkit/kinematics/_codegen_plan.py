@@ -17,8 +17,9 @@ from .._shapes import as_names
 from ..couplings import gear_free, gear_unknowns
 from ..errors import SingularError, WmrkitError, name_list
 from ..robot import TWIST_NAMES, Robot
-from ._symbolic_matrix import exact_number
+from ._symbolic_held import combine, held_gears, substituted_form
 from .linalg import free_columns, matrix_rank, nondimensional
+from .models import generic_inputs
 from .symbolic import sensed_rates, symbolic_constraint_matrix, symbolic_model
 
 C_KEYWORDS = frozenset(
@@ -67,12 +68,11 @@ class Plan:
         self.free, self.known = gear_unknowns(robot.couplings, names, given)
         self.unknown_names = gear_free(robot.couplings, names, given)[1]
         self._check_forward()
-        self.free_steer = robot.free_steering  # a double wheel's steering rate: an input besides the twist
+        # the double wheels' steering rates no twist determines: inputs besides the twist, as the inverse model's
+        self.free_steer = generic_inputs(robot)[0]
         self.steer_rate = tuple(sp.Symbol(f"s{i}", real=True) for i in range(len(self.free_steer)))
-        model = symbolic_model(robot, TWIST_NAMES + self.free_steer, self.beta, gears=False)  # per wheel, as ik's
-        self.inverse_exact = model.exact
-        self.rates = model.solved
-        self.inverse = [e for e in model.matrix * sp.Matrix(self.twist + self.steer_rate)]
+        self.rates, matrix, self.inverse_exact = self._inverse_form(TWIST_NAMES + self.free_steer)
+        self.inverse = [e for e in matrix * sp.Matrix(self.twist + self.steer_rate)]
         # each gear: its name, its joints' positions in the rates then the steering rates, its ratios (ik's check)
         joints = (*self.rates, *self.free_steer)
         self.gears = tuple((c.channel_name, tuple(joints.index(j) for j in c.joints), tuple(map(float, c.ratios)))
@@ -91,22 +91,23 @@ class Plan:
                                 f"determine ({names}); sense more joints (the wheels' 'sensed' field of the "
                                 "description, or sensed= in Python)")
 
+    def _inverse_form(self, inputs: tuple[str, ...]) -> tuple[tuple[str, ...], sp.Matrix, bool]:
+        """The rates not in `inputs`, ``M`` with ``rates = M @ inputs``, and whether it is exact: least squares per
+        wheel (4.11), as ``ik``; the gears that set a double wheel's steering rate held exactly (``_symbolic_held``),
+        the others left to ``in_gear``."""
+        held = held_gears(self.robot, inputs)
+        if not held:
+            model = symbolic_model(self.robot, inputs, self.beta, gears=False)
+            return model.solved, model.matrix, model.exact
+        solved, matrix, _, exact = substituted_form(self.robot, inputs, self.a, held)
+        return solved, matrix, exact
+
     def forward_exprs(self) -> tuple[list[sp.Expr], list[sp.Expr]]:
         """Entries of ``A_na = A F`` (row-major) and of ``b = -A K q_s``, ``F, K`` :attr:`free`, :attr:`known`
         (made exact: without a gear, the unknown and the sensed columns of ``A``)."""
-        a_na = _combine(self.a, self.free)
-        b = -_combine(self.a, self.known) * sp.Matrix(self.q)
+        a_na = combine(self.a, self.free)
+        b = -combine(self.a, self.known) * sp.Matrix(self.q)
         return list(a_na), list(b)
-
-
-def _combine(a: sp.Matrix, m: np.ndarray) -> sp.Matrix:
-    """``a @ m`` for a numeric `m` of gear ratios, 0 and 1 (its entries made exact, ``0.4 -> 2/5``), summing only
-    the nonzero terms: a column selecting one column of `a` is that column, as it is."""
-    cols = []
-    for c in m.T:
-        terms = [a[:, j] if v == 1 else a[:, j] * exact_number(v, "length") for j, v in enumerate(c) if v != 0]
-        cols.append(sum(terms[1:], terms[0]) if terms else sp.zeros(a.rows, 1))
-    return sp.Matrix.hstack(*cols) if cols else sp.zeros(a.rows, 0)
 
 
 def _c_numbers(e: sp.Expr) -> sp.Expr:

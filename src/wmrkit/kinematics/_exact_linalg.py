@@ -123,6 +123,28 @@ def agrees(m: sp.MatrixBase, a: sp.MatrixBase, na_idx: list[int], a_idx: list[in
     return bool(np.allclose(numeric(m, point), expected, rtol=1e-8, atol=1e-10))
 
 
+def generic_ranks(a: sp.MatrixBase, na_idx: list[int]) -> tuple[list, list[np.ndarray], int, list[int]]:
+    """Two random points of `a`'s symbols, its values there (columns equilibrated), its generic rank and the ranks
+    of its columns `na_idx` at each point."""
+    points = random_points(a)
+    values = [equilibrated(numeric(a, p)) for p in points]  # ranks of columns of order 1 (units, tiny robots)
+    return points, values, max(int(matrix_rank(v)) for v in values), [int(matrix_rank(v[:, na_idx])) for v in values]
+
+
+def closed_form(a: sp.MatrixBase, na_idx: list[int], a_idx: list[int], exact: bool, values: list[np.ndarray],
+                points: list) -> tuple[sp.Matrix, sp.Matrix]:
+    """:func:`solve_exactly` checked against numeric least squares at the second point; a pivot that vanishes only
+    on sin^2 + cos^2 = 1 is redone over plain expressions (slower)."""
+    try:
+        m, residual = solve_exactly(a, na_idx, a_idx, exact, values[0])
+        ok = agrees(m, a, na_idx, a_idx, points[1])
+    except ZeroDivisionError:
+        ok = False
+    if not ok:
+        m, residual = solve_exactly(a, na_idx, a_idx, exact, values[0], generators=False)
+    return m, residual
+
+
 def _independent_rows(values: np.ndarray, rows: list[int], cols: list[int]) -> list[int]:
     chosen: list[int] = []
     for i in rows:

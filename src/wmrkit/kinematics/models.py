@@ -326,6 +326,15 @@ def _free_steering(robot: Robot, a: np.ndarray, dof: int) -> tuple[str, ...]:
     return tuple(free)
 
 
+def generic_inputs(robot: Robot) -> tuple[tuple[str, ...], int]:
+    """The default inverse model's steering inputs (:func:`_free_steering`) and the mobility m with the gears, at
+    generic steering (three random configurations): the inputs of the closed forms and of the generated code."""
+    beta = np.random.default_rng(7).uniform(-math.pi, math.pi, (3, len(robot.steer_names)))
+    a = constraints(robot, beta)
+    dof = int(np.max(a.shape[-1] - matrix_rank(a)))
+    return _free_steering(robot, a, dof), dof
+
+
 def inverse_model(
     robot: Robot, twist_names: Sequence[str] | None = None, beta: ArrayLike | None = None, *,
     heading: ArrayLike | None = None,

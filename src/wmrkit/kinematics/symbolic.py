@@ -23,7 +23,8 @@ import sympy as sp
 from .._shapes import as_names
 from ..errors import SingularError, WmrkitError, name_list
 from ..robot import TWIST_NAMES, Robot
-from ._exact_linalg import _components, agrees, equilibrated, numeric, random_points, solve_exactly
+from ._exact_linalg import _components, closed_form, generic_ranks
+from ._symbolic_held import held_gears, substituted_form
 from ._symbolic_inputs import (  # noqa: F401  (the symbols: public API, re-exported)
     Geometry,
     _geometry_key,
@@ -40,7 +41,8 @@ from ._symbolic_matrix import (  # noqa: F401  (exact_number, geometry_fields: r
     gear_rows,
     geometry_fields,
 )
-from .linalg import free_columns, matrix_rank
+from .linalg import free_columns
+from .models import generic_inputs
 
 #: Steering angles one least-squares closed form (4.11) may couple by default: its derivation grows about fourfold
 #: per angle (castors: 3 take seconds, 4 about 20 s, 5 a minute and a half, 6 several minutes, 12 hours).
@@ -165,10 +167,7 @@ def _ranked(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], 
     a = sp.ImmutableMatrix(a.col_join(held)) if held.rows else a
     a_idx = [robot.velocity_index(n) for n in assigned]
     na_idx = [j for j in range(a.cols) if j not in a_idx]
-    points = random_points(a)
-    values = [equilibrated(numeric(a, p)) for p in points]  # ranks of columns of order 1 (units, tiny robots)
-    rank = max(int(matrix_rank(v)) for v in values)
-    ranks_na = [int(matrix_rank(v[:, na_idx])) for v in values]
+    points, values, rank, ranks_na = generic_ranks(a, na_idx)
     rank_na = max(ranks_na)
     solved = tuple(robot.velocity_names[j] for j in na_idx)
     if rank_na < len(na_idx):  # name the velocities left free, not every unknown
@@ -201,13 +200,7 @@ def _solve(robot: Robot, assigned: tuple[str, ...], beta: tuple[sp.Expr, ...], g
             f"robot '{robot.name}': ({name_list(assigned) or 'nothing'}) is not an assignable set of the motions its "
             f"gears allow (mobility m = {a.cols - rank}): no exact closed form, and a least-squares one would "
             "weigh the gear rows against slip; gears=False gives the wheels' least squares, 'wmrkit ik' holds the gear")
-    try:
-        m, residual = solve_exactly(a, na_idx, a_idx, exact, values[0])
-        ok = agrees(m, a, na_idx, a_idx, points[1])
-    except ZeroDivisionError:
-        ok = False
-    if not ok:  # a pivot that vanishes only on sin^2 + cos^2 = 1: redo over plain expressions (slower)
-        m, residual = solve_exactly(a, na_idx, a_idx, exact, values[0], generators=False)
+    m, residual = closed_form(a, na_idx, a_idx, exact, values, points)
     return SymbolicModel(
         robot_name=robot.name, assigned=assigned, solved=solved,
         matrix=sp.ImmutableMatrix(m), residual=sp.ImmutableMatrix(residual),
@@ -237,12 +230,11 @@ def sensed_rates(robot: Robot) -> tuple[str, ...]:
 
 def twist_assignment(robot: Robot) -> tuple[str, ...]:
     """Inputs of the inverse model: the first assignable (4.10) subset of ``(vx, vy, omega)`` with m members (less
-    the ``robot.free_steering`` rates, always assigned), else the whole twist (wheel rates by least squares, as a
-    controller computes them); then the free steering rates."""
-    free = robot.free_steering
-    key = _geometry_key(robot, "numeric")
-    rank = _ranked(robot, TWIST_NAMES + free, _steering_values(robot, None, None, key), key, True).rank
-    m = len(robot.velocity_names) - rank - len(free)
+    the double wheels' steering rates no twist determines, always assigned: the numeric inverse model's at generic
+    steering, :func:`~.models.generic_inputs`), else the whole twist (wheel rates by least squares, as a controller
+    computes them); then those steering rates."""
+    free, dof = generic_inputs(robot)
+    m = dof - len(free)
     for subset in itertools.combinations(TWIST_NAMES, m) if 0 < m <= 3 else ():
         try:
             if symbolic_model(robot, subset + free).exact:
@@ -252,13 +244,40 @@ def twist_assignment(robot: Robot) -> tuple[str, ...]:
     return TWIST_NAMES + free
 
 
-def held_model(robot: Robot, names: Sequence[str]) -> tuple[SymbolicModel, bool]:
-    """The closed form of `names` holding the robot's gears, and True; when no exact one does
-    (:class:`GearedLeastSquaresError`), the wheels' least squares, and False."""
+def held_model(robot: Robot, names: Sequence[str]) -> tuple[SymbolicModel, tuple[str, ...]]:
+    """The closed form of `names` holding the robot's gears, and the gears it does not hold: none for the exact one;
+    when none is exact (:class:`GearedLeastSquaresError`), the least squares holding the gears that set a double
+    wheel's steering rate not in `names` (:func:`~._symbolic_held.held_gears`, by substitution), else the wheels'."""
     try:
-        return symbolic_model(robot, names), True
+        return symbolic_model(robot, names), ()
     except GearedLeastSquaresError:
-        return symbolic_model(robot, names, gears=False), False
+        pass
+    held = held_gears(robot, names)
+    model = _substituted_model(robot, tuple(names), held) if held else symbolic_model(robot, names, gears=False)
+    return model, tuple(c.channel_name for c in robot.couplings if c.kind == "gear" and c not in held)
+
+
+@functools.lru_cache(maxsize=32)
+def _substituted_model(robot: Robot, names: tuple[str, ...], held: tuple) -> SymbolicModel:
+    """:func:`~._symbolic_held.substituted_form` at symbolic steering, the robot's geometry; a least-squares form
+    coupling more than :data:`MAX_LSQ_ANGLES` steering angles is refused before its derivation."""
+    key = _geometry_key(robot, "numeric")
+    beta = _steering_values(robot, None, None, key)
+    a = constraint(robot, beta, key)
+
+    def guard(system: sp.Matrix, na: list[int], exact: bool) -> None:
+        coupled = [] if exact else _coupled_angles(system, na, beta)
+        if len(coupled) > MAX_LSQ_ANGLES:
+            raise ClosedFormTooLargeError(
+                f"robot '{robot.name}': the least-squares closed form for ({', '.join(names)}) couples "
+                f"{len(coupled)} steering angles ({', '.join(coupled)}), more than max_lsq_angles = "
+                f"{MAX_LSQ_ANGLES}: it would take minutes to hours; use the numeric models or the generated code")
+
+    solved, matrix, residual, exact = substituted_form(robot, names, a, held, guard)
+    dof = generic_inputs(robot)[1]
+    return SymbolicModel(robot_name=robot.name, assigned=names, solved=solved, matrix=sp.ImmutableMatrix(matrix),
+                         residual=sp.ImmutableMatrix(residual), exact=exact, steering=beta, rank=a.cols - dof,
+                         mobility=dof)
 
 
 def default_sets(robot: Robot) -> list[tuple[str, tuple[str, ...]]]:
@@ -269,16 +288,17 @@ def default_sets(robot: Robot) -> list[tuple[str, tuple[str, ...]]]:
 def unheld_gears(robot: Robot) -> list[str]:
     """One sentence per default closed form (:func:`default_sets`) that does not hold the robot's gears (the wheels'
     least squares, :func:`held_model`); a form not determined or too large says so in its own line, not here."""
-    gears = ", ".join(c.channel_name for c in robot.couplings if c.kind == "gear")
+    gears = tuple(c.channel_name for c in robot.couplings if c.kind == "gear")
     out = []
     for title, names in default_sets(robot) if gears else ():
         try:
-            held = held_model(robot, names)[1]
+            unheld = held_model(robot, names)[1]
         except (SingularError, ClosedFormTooLargeError):
             continue
-        if not held:
-            out.append(f"the closed-form {title} ({', '.join(names)}) is of the wheels alone, not holding {gears}: it "
-                       "may give rates they forbid (check a twist with 'wmrkit ik')")
+        alone = "is of the wheels alone, not holding" if unheld == gears else "does not hold"
+        if unheld:
+            out.append(f"the closed-form {title} ({', '.join(names)}) {alone} {', '.join(unheld)}: it may give rates "
+                       "they forbid (check a twist with 'wmrkit ik')")
     return out
 
 
@@ -304,7 +324,7 @@ def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, late
         lines.append("")
         lines.append(f"{comment}{title}, assigned: {', '.join(names) or 'nothing'}")
         try:
-            model, held = held_model(robot, names)
+            model, unheld = held_model(robot, names)
         except SingularError as err:
             lines.append(f"{comment}  not determined: {err}")
             continue
@@ -316,8 +336,11 @@ def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, late
         else:
             how = (f"least squares (4.11)/(4.82): {len(names)} assigned for mobility m = {model.mobility}; "
                    "a residual A q != 0 is slip")
-        if not held:
+        if unheld and len(unheld) == len(gears):
             how += "; of the wheels alone, the gears not held (no exact form holds them: check with 'wmrkit ik')"
+        elif unheld:
+            how += (f"; holding the gears that set double wheels' steering rates, not {', '.join(unheld)} (no exact "
+                    "form holds them: check with 'wmrkit ik')")
         lines.append(f"{comment}  {how}")
         lines += _latex_block(model) if latex else [f"    {n} = {_linear_form(model, i)}" for i, n in
                                                     enumerate(model.solved)]
