@@ -94,7 +94,8 @@ DOCUMENTED = [
     ("wmrkit.batch.consistency", "MAX_CLOSED_SCORE", "over 20 (`MAX_CLOSED_SCORE`) names it", 20.0),
     ("wmrkit.batch.homogeneity", "MAX_HOMOGENEITY", "over 60 (`homogeneity.MAX_HOMOGENEITY`)", 60.0),
     ("wmrkit.batch.homogeneity", "MIN_DOF", "27 degrees of freedom or more (`homogeneity.MIN_DOF`", 27),
-    ("wmrkit.batch.likelihood", "MAX_PER_RUN", "over 24 a run (`likelihood.MAX_PER_RUN`)", 24.0),
+    ("wmrkit.batch.likelihood", "LEVEL", "over its 0.1 % point for agreeing fleets of as many runs (`likelihood.LEVEL`",
+     1e-3),
     ("wmrkit.batch.likelihood", "MIN_OWN_DOF", "3 degrees of freedom of their own, `likelihood.MIN_OWN_DOF`", 3),
     ("wmrkit.batch.montecarlo", "MAX_LOG_VALUES", "at most 2^23 numbers, samples x (joints + 3) "
      "(`batch.montecarlo.MAX_LOG_VALUES`)", 1 << 23),

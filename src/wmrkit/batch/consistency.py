@@ -380,7 +380,7 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
             messages.append(PAIR.format(a=logs[pair[0]], b=logs[pair[1]], score=pair[2]))
         named = 1 if scores[worst] > MAX_CLOSED_SCORE else 2 if pair is not None and pair[2] > MAX_PAIR_SCORE else 0
         if m[group[0]] - n >= MIN_OWN_DOF and problem.run_weights is None and problem.heading_weight != 0 and (
-                said := few_pose_warning(problem, fit.jac, fit.fun, group, ROUNDOFF * travels, logs, named)):
+                said := few_pose_warning(problem, fit.x, fit.jac, fit.fun, group, ROUNDOFF * travels, logs, named)):
             messages.append(said)  # several runs that disagree (wmrkit.batch.likelihood)
     aside = [k for k in range(g) if np.isnan(scores[k])]
     why = None if not aside else SET_ASIDE.format(runs=", ".join(logs[k] for k in aside), judged=", ".join(

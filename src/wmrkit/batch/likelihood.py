@@ -1,38 +1,51 @@
-"""Do runs of few reference poses agree as a whole? A likelihood ratio that each run's own noise level cannot move.
+"""Do runs of few reference poses agree as a whole? A likelihood ratio judged at one false-alarm level for any fleet.
 
-Runs whose references have three poses (start, middle, end) give 6 motion errors each
-(:func:`~wmrkit.batch.homogeneity.increments`) against 3 parameters: 3 degrees of freedom of their own, too few for
-Cochran's statistic (:mod:`wmrkit.batch.homogeneity`: a run's noise estimate small by chance weighs it up without bound;
-references of 4 poses already reached 333). Each run ``g`` has its own unknown noise level, so the test of common
-parameters is the profile likelihood ratio (normal errors, one variance per run)::
+Runs whose references have three poses (start, middle, end) give 6 motion errors each against 3 parameters: 3
+degrees of freedom of their own, too few for Cochran's statistic (:mod:`wmrkit.batch.homogeneity`: a run's noise
+estimate small by chance weighs it up without bound; references of 4 poses already reached 333). The errors are
+those of the motions between reference poses whitened by the encoders' noise model
+(:func:`~wmrkit.batch.motions.whitening`): independent and of one variance, the run's own unknown noise level. The
+test of common parameters is the profile likelihood ratio (normal errors, one variance per run)::
 
     L = min_t  sum_g m_g log RSS_g(t)  -  sum_g m_g log RSS_g(t_g),
 
-``RSS_g(t) = |r_g + J_g t|^2`` of the ``m_g`` motion errors (linear at the fleet fit), ``t_g`` the run's own fit. A
-run's term is ``m_g log(1 + excess_g / own_g)``: a ratio of two quadratic forms of the same noise, so a run's noise
-level does not move its term's distribution (at the true parameters exactly; noise-free runs' own fits count as the
-round-off floor), and the logarithm tames the small own fits that make Cochran's weights blow up. Agreeing fleets of
-mixed noise levels score as fleets of one level (median 10.7 and 10.5 against 10.4 a run, fleets of 6). ``L`` grows with
-the runs (about 10 a run in agreeing fleets), so a fleet is judged by ``L / G`` over :data:`MAX_PER_RUN`. The minimum is
-found from the fleet fit and each run's own fit (the likelihood has a mode per cluster of runs) by iteratively
-reweighted least squares (weights ``m_g / RSS_g``: a majorise-minimise step, never uphill).
+``RSS_g(t) = |r_g + J_g t|^2`` of the ``m_g`` whitened motion errors (linear at the fleet fit), ``t_g`` the run's own
+fit. A run's term at the true parameters is ``m_g log(1 + X / Y)``, ``X`` and ``Y`` its noise's chi-square parts of
+``rank_g`` (its whitened Jacobian's) and ``m_g - rank_g`` degrees of freedom, whatever its noise level: ``-m_g
+log(1 - B)``, ``B`` of the beta distribution ``(rank_g / 2, (m_g - rank_g) / 2)``. Their sum over all runs bounds
+``L``; where one run is much quieter than the others (the fleet fit is its own) ``L`` is exactly the sum over the
+others, and it is so distributed for any mix of noise levels and paths within simulation error (40,000 fleets of 5 and
+8 runs, precisions drawn over 4 decades: over the 1 % point 1.03 % and 0.98 %, over the 0.1 % point 0.12 % and
+0.06 %). So a fleet is flagged when ``L`` is over that sum's point of chance :data:`LEVEL` (:func:`threshold`, exact
+on a grid): about one false-alarm rate for any number of runs (12 runs: 0.05-0.11 %). Unwhitened (before), the terms
+depended on each run's motions (agreeing fleets of 5: median 10.2 a run; whitened 3.9) and the fleet was flagged at
+``L / G`` over 24, 4.5 spreads of the agreeing fleets' mean for 5 runs and 5.3 for 8: no stated level, and 3 bad runs
+of 6 missed in 4 of 150 fleets. Noise-free runs' own fits count as the round-off floor, whitened. The minimum is found
+from the fleet fit and each run's own fit (the likelihood has a mode per cluster of runs) by iteratively reweighted
+least squares (weights ``m_g / RSS_g``: a majorise-minimise step, never uphill).
 """
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Sequence
+from functools import lru_cache
 
 import numpy as np
 
 from ..odometry.calibration import CalibrationProblem
-from .homogeneity import fewest, increments
+from .homogeneity import fewest
+from .motions import whitening
 
-#: Largest ``L / G`` of a fleet whose runs agree. Simulated agreeing fleets of three-pose runs (random arcs as the
-#: tests'; noise 1e-5 per rad, levels drawn per run among 1e-6, 1e-5 and 1e-4, or two runs at 1e-4 among four at
-#: 1e-6): 3,800 of 5 runs at most 23.1 (next 21.1, 99.9th percentile 20.5), 2,000 of 6 at most 19.8 (one level:
-#: 19.8, the worst mix: 18.5, drawn: 19.8), 500 of 8 18.4. Three runs of a left radius +5 % among 6: 23.2 or more,
-#: 147 of 150 over 24.
-MAX_PER_RUN = 24.0
+#: Chance that a fleet of agreeing runs is said to disagree (``L`` over its :func:`threshold`), for any number of runs.
+#: Seeded fleets of three-pose runs (random arcs, levels drawn per run among 1e-6, 1e-5 and 1e-4 per rad): agreeing,
+#: 0 of 300 of 5 and of 6 flagged, 1 of 300 of 8; 3 runs of a left radius +5 % among 6, 150 of 150 (146 at 24 a
+#: run before), 2 bad: 93 of 150 (87), 4 bad: 78 of 100 (66). At 1e-4 the 2 and 4 bad runs: 44 and 45 (docs/batch.md).
+LEVEL = 1e-3
+#: Least step of the grid on which :func:`threshold` sums the runs' terms' distributions: the step is the sum's range
+#: over 65,536 where larger (fleets of more than 6 three-pose runs; 0.09 for 50), each term rounded to its nearest
+#: point (simulated sums over it: the level within 3 standard errors, tests/batch/test_calibrate_likelihood_level.py).
+GRID = 0.01
 #: Fewest degrees of freedom of every run's own fit for this check (three-pose references: 3; a closed path or a
 #: reference of two poses has none, its own fit is exact, and its fleet's homogeneity is not judged).
 MIN_OWN_DOF = 3
@@ -40,58 +53,108 @@ MIN_OWN_DOF = 3
 ITERATIONS = 200
 
 
-def likelihood_ratio(a: np.ndarray, b: np.ndarray, c: np.ndarray, own: np.ndarray, m: np.ndarray) -> float:
-    """``L`` (module docstring) of the runs of normal matrices `a` ``(G, n, n)``, scores `b` ``(G, n)``, sums of
-    squares at the fleet fit `c`, own-fit sums of squares `own` (at least the round-off floor) and motion errors
-    `m`."""
-    starts = np.vstack([np.zeros(a.shape[1]), -np.einsum("gij,gj->gi", np.linalg.pinv(a, hermitian=True), b)])
+def likelihood_ratio(a: np.ndarray, b: np.ndarray, c: np.ndarray, own: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """``L`` (module docstring) of the runs of normal matrices `a` ``(..., G, n, n)``, scores `b` ``(..., G, n)``, sums
+    of squares at the fleet fit `c`, own-fit sums of squares `own` (at least the round-off floor) and motion errors
+    `m` ``(..., G)``: one per fleet of the leading axes (a float for one fleet), each iterated until it settles."""
+    lead, n = c.shape[:-1], b.shape[-1]
+    m = np.broadcast_to(np.asarray(m, dtype=float), c.shape)
+    a, b, c, own, m = (np.reshape(x, (-1, *x.shape[len(lead):])) for x in (a, b, c, own, m))
+    d = -np.einsum("fgij,fgj->fgi", np.linalg.pinv(a, hermitian=True), b)
+    d = np.concatenate([np.zeros((len(c), 1, n)), d], axis=1)  # (F, S, n): the fleet fit and each run's own
 
-    def rss(d: np.ndarray) -> np.ndarray:  # (S, G) at the shifts d (S, n)
-        return np.maximum(c + 2 * d @ b.T + np.einsum("si,gij,sj->sg", d, a, d), own)
+    def rss(d: np.ndarray, f: np.ndarray | slice) -> np.ndarray:  # (F', S, G) at the shifts d (F', S, n)
+        ad = np.einsum("fgij,fsj->fsgi", a[f], d)
+        return np.maximum(c[f][:, None] + 2 * np.einsum("fsi,fgi->fsg", d, b[f])
+                          + np.einsum("fsgi,fsi->fsg", ad, d), own[f][:, None])
 
-    d = starts
+    live = np.arange(len(c))
     for _ in range(ITERATIONS):
-        w = m / rss(d)
-        new = -np.linalg.solve(np.einsum("sg,gij->sij", w, a), (w @ b)[..., None])[..., 0]
-        done = np.allclose(new, d, rtol=1e-12, atol=1e-300)
-        d = new
-        if done:
+        w = m[live][:, None] / rss(d[live], live)
+        new = -np.linalg.solve(np.einsum("fsg,fgij->fsij", w, a[live]),
+                               np.einsum("fsg,fgi->fsi", w, b[live])[..., None])[..., 0]
+        moved = ~np.all(np.isclose(new, d[live], rtol=1e-12, atol=1e-300), axis=(1, 2))
+        d[live] = new
+        live = live[moved]
+        if not live.size:
             break
-    return float(np.min(np.log(rss(d)) @ m) - np.log(own) @ m)
+    out = (np.min(np.einsum("fsg,fg->fs", np.log(rss(d, slice(None))), m), axis=1)
+           - np.einsum("fg,fg->f", np.log(own), m)).reshape(lead)
+    return out if lead else float(out)
 
 
-def few_pose_warning(problem: CalibrationProblem, jac: np.ndarray, res: np.ndarray, group: Sequence[int],
-                     floors: Sequence[float], logs: Sequence[str], named: int = 0) -> str | None:
-    """The warning when the runs `group` (as many reference poses each; `jac`, `res` of the fleet fit; `floors`:
-    least RSS root of each run's own fit [m]) do not agree as a whole (``L / G`` over :data:`MAX_PER_RUN`), with the
-    fewest runs whose removal leaves the others agreeing; ``None`` when they agree, or when as many runs as were
-    `named` (1: by a closed-path score, 2: by the pair score) explain it."""
+def whitened_parts(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray, res: np.ndarray, group: Sequence[int],
+                   floors: Sequence[float]) -> tuple[tuple[np.ndarray, ...], list[int]]:
+    """The arguments of :func:`likelihood_ratio` for the runs `group` (`jac`, `res` of the fleet fit at parameters
+    `p`; `floors`: least RSS root of each run's own fit [m]) on their whitened motions' errors
+    (:func:`~wmrkit.batch.motions.whitening`), and the rank of each run's whitened Jacobian; runs that cannot be
+    whitened are left out (the places in `group` kept, last)."""
     sizes = problem.sizes()
     ends = np.cumsum(sizes)
-    parts = [], [], [], [], []
-    for k in group:
+    parts, kept = ([], [], [], [], [], []), []
+    for i, k in enumerate(group):
         lo, hi = int(ends[k] - sizes[k]), int(ends[k])
-        j, r = increments(problem.runs[k], problem.heading_weight, jac[lo:hi], res[lo:hi])
-        live = np.any(j != 0, axis=1) | (r != 0)
-        j, r = j[live], r[live]
-        step = np.linalg.lstsq(j, r, rcond=None)[0]
-        for part, x in zip(parts, (j.T @ j, j.T @ r, r @ r, max(float(np.sum(np.square(r - j @ step))),
-                                                                   floors[k] ** 2 * len(r)), len(r)), strict=True):
+        white = whitening(problem, p, problem.runs[k], res[lo:hi])
+        if white is None:
+            continue
+        j, r = white @ jac[lo:hi], white @ res[lo:hi]
+        step, _, rank, _ = np.linalg.lstsq(j, r, rcond=None)
+        own = max(float(np.sum(np.square(r - j @ step))), floors[k] ** 2 * float(np.sum(np.square(white))))
+        for part, x in zip(parts, (j.T @ j, j.T @ r, r @ r, own, len(r), rank), strict=True):
             part.append(x)
-    a, b, c, own, m = (np.array(x, dtype=float) for x in parts)
+        kept.append(i)
+    return (*(np.array(x, dtype=float) for x in parts[:5]), np.array(parts[5], dtype=int)), kept
 
-    def per_run(keep: np.ndarray) -> float:
-        return likelihood_ratio(a[keep], b[keep], c[keep], own[keep], m[keep]) / len(keep)
 
-    score = per_run(np.arange(len(group)))
-    if score <= MAX_PER_RUN:
+@lru_cache(maxsize=1024)
+def threshold(runs: tuple[tuple[int, int], ...], level: float = LEVEL) -> float:
+    """The point ``L`` of agreeing runs of `runs` ``(m_g, rank_g)`` (motion errors and rank of the whitened Jacobian,
+    sorted) exceeds with the chance `level`: that of the sum of the terms at the true parameters of all runs but one
+    of largest rank (module docstring), each ``-m log(1 - B)``, ``B ~ Beta(rank / 2, (m - rank) / 2)``, summed exactly
+    on a grid (by FFT; each term rounded to its nearest point, :data:`GRID` apart or more)."""
+    from scipy import special, stats
+
+    terms = sorted(runs, key=lambda x: x[1])[:-1]
+    tops = [-m * np.log1p(-stats.beta.isf(1e-13, r / 2, (m - r) / 2)) if r else 0.0 for m, r in terms]
+    step = max(GRID, sum(tops) / (1 << 16))
+    n = int(np.ceil(sum(tops) / step)) + 2
+    grid = np.arange(n) * step
+    size = 1 << int(np.ceil(np.log2(2 * n)))
+    total = np.ones(size // 2 + 1, dtype=complex)
+    for (m, r), count in Counter(terms).items():
+        cdf = special.betainc(r / 2, (m - r) / 2, -np.expm1(-(grid + step / 2) / m)) if r else np.ones(n)
+        total *= np.fft.rfft(np.diff(np.r_[0.0, cdf]), size) ** count
+    cdf = np.cumsum(np.fft.irfft(total, size)[:n])
+    return float(grid[min(int(np.searchsorted(cdf, 1 - level)), n - 1)])
+
+
+def few_pose_warning(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray, res: np.ndarray,
+                     group: Sequence[int], floors: Sequence[float], logs: Sequence[str], named: int = 0) -> str | None:
+    """The warning when the runs `group` (as many reference poses each; `jac`, `res` of the fleet fit at parameters
+    `p`; `floors`: least RSS root of each run's own fit [m]) do not agree as a whole (``L`` over its
+    :func:`threshold`), with the fewest runs whose removal leaves the others agreeing; ``None`` when they agree, or
+    when as many runs as were `named` (1: by a closed-path score, 2: by the pair score) explain it."""
+    (a, b, c, own, m, rank), kept = whitened_parts(problem, p, jac, res, group, floors)
+    if len(kept) < 3:
         return None
-    n, out = fewest(len(group), per_run, MAX_PER_RUN)
+
+    def limit(keep: np.ndarray) -> float:
+        return threshold(tuple(sorted(zip(m[keep].astype(int).tolist(), rank[keep].tolist(), strict=True))))
+
+    def over(keep: np.ndarray) -> float:  # L over its threshold: at most 1 when the runs `keep` agree
+        return likelihood_ratio(a[keep], b[keep], c[keep], own[keep], m[keep]) / limit(keep)
+
+    every = np.arange(len(kept))
+    score, top = likelihood_ratio(a, b, c, own, m), limit(every)
+    if score <= top:
+        return None
+    n, out = fewest(len(kept), over, 1.0)
     if n <= named:
         return None
-    without = f" (without {', '.join(logs[group[i]] for i in out)} the others agree)" if out else ""
-    return (f"the runs disagree among themselves (fleet likelihood ratio {score:.3g} a run, over {MAX_PER_RUN:g}: "
-            "their parameters are further apart than each run's own noise allows): at least "
+    without = f" (without {', '.join(logs[group[kept[i]]] for i in out)} the others agree)" if out else ""
+    return (f"the runs disagree among themselves (fleet likelihood ratio {score:.3g}, over {top:.3g}, which "
+            f"{len(kept)} agreeing runs exceed with a chance of {LEVEL:g}: their parameters are further apart than "
+            "each run's own noise allows): at least "
             f"{'one run disagrees' if n == 1 else f'{n} runs disagree'} with the others{without}: another robot, load "
             "or floor? The fit averages them; calibrate them apart")
 
