@@ -9,7 +9,8 @@ from importlib import resources
 from pathlib import Path
 
 from ..description import robot_from_text
-from ..errors import UnknownNameError
+from ..documents import read_document, read_file
+from ..errors import DescriptionError, UnknownNameError
 from ..robot import Robot
 
 
@@ -48,8 +49,8 @@ def resolve(spec: str | os.PathLike[str]) -> Robot:
         spec = os.fspath(spec)
     if not isinstance(spec, str):
         raise TypeError(f"a robot is a catalog name or a description file's path, got {type(spec).__name__}")
-    path = Path(spec)
-    if path.suffix.lower() in (".yaml", ".yml", ".json") or (path.exists() and not (path.is_dir() and spec in names())):
+    path = _file(spec)
+    if path is not None:
         if not path.exists():
             hint = f" (the catalog's robot is '{path.stem}', without '{path.suffix}')" if path.stem in names() else ""
             raise UnknownNameError(f"{spec}: no such file{hint}")
@@ -59,3 +60,24 @@ def resolve(spec: str | os.PathLike[str]) -> Robot:
         if files:
             raise UnknownNameError(f"no robot '{spec}' in the catalog; did you mean the file '{files[0]}'?")
     return load(spec)
+
+
+def _file(spec: str) -> Path | None:
+    """The description file :func:`resolve` reads for `spec`, or None for a catalog name."""
+    path = Path(spec)
+    if path.suffix.lower() in (".yaml", ".yml", ".json") or (path.exists() and not (path.is_dir() and spec in names())):
+        return path
+    return None
+
+
+def locate(err: DescriptionError, spec: str) -> DescriptionError:
+    """`err`, raised about a field of the robot :func:`resolve` gave for `spec` (a check of the dynamics, whose
+    robot knows no file), placed in that robot's description: its file (``catalog:NAME``) and the field's line."""
+    path = _file(spec)
+    source = f"catalog:{spec}" if path is None else str(path)
+    try:
+        text = source_text(spec) if path is None else read_file(path)
+        line = read_document(text, source, "json" if source.lower().endswith(".json") else "yaml")[1](err.loc)
+    except (OSError, DescriptionError, UnknownNameError):  # the file changed since: its place without a line
+        line = None
+    return DescriptionError(err.message, source=source, loc=err.loc, line=line, wheel=err.wheel)

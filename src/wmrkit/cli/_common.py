@@ -45,6 +45,20 @@ def load_robot(spec: str) -> Robot:
     return robot
 
 
+def dynamic_model(robot: Robot, spec: str, tyre: str | None = None) -> Any:
+    """The :class:`~wmrkit.dynamics.model.DynamicModel` of `robot`, loaded from the ROBOT argument `spec`: what its
+    description lacks for the dynamics (a body, an inertia) is an error naming its file, line, wheel and field."""
+    from ..dynamics.model import DynamicModel
+    from ..errors import DescriptionError
+
+    try:
+        return DynamicModel.of(robot, tyre)
+    except DescriptionError as err:
+        if err.source != f"robot '{robot.name}'":
+            raise
+        raise catalog.locate(err, spec) from None
+
+
 def wheel_column_width(robot: Robot, least: int = 14) -> int:
     """Width of a table's wheel-name column: `least`, or the longest name and two spaces (ROS 2's
     'front_left_wheel_joint' ran into the next column)."""

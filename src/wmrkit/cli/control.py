@@ -10,7 +10,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import WmrkitError
-from ._common import add_json_flag, add_robot_argument, check_plot_path, load_robot, parse_value, print_json, warn
+from ._common import (
+    add_json_flag,
+    add_robot_argument,
+    check_plot_path,
+    dynamic_model,
+    load_robot,
+    parse_value,
+    print_json,
+    warn,
+)
 
 if TYPE_CHECKING:
     from ..control.feasibility import Feasibility
@@ -217,6 +226,8 @@ def run_track(args: argparse.Namespace) -> int:
     check_plot_path(args.plot)
     check_animation_path(args.animate)
     robot = load_robot(args.robot)
+    if args.dynamics:  # what the description lacks for the dynamics, named in its file
+        dynamic_model(robot, args.robot)
     reference, size, described = _reference(args, robot)
     start = None
     if args.start:

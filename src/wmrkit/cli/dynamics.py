@@ -14,6 +14,7 @@ from ._common import (
     add_json_flag,
     add_robot_argument,
     check_plot_path,
+    dynamic_model,
     load_robot,
     parse_assignments,
     parse_value,
@@ -122,13 +123,12 @@ def run_simulate(args: argparse.Namespace) -> int:
     """Simulate, print a summary, write and plot on request."""
     from ..dynamics.deviation import check_step, deviation_warning
     from ..dynamics.linkages import unheld
-    from ..dynamics.model import DynamicModel
     from ..dynamics.programs import path_program, read_torques
     from ..dynamics.simulate import MAX_STEPS, recordable_step, simulate
 
     if args.out is not None and Path(args.out).suffix.lower() not in (".csv", ".json"):  # not CSV under another name
         raise WmrkitError(f"--out {args.out}: the samples are written as .csv or .json")
-    model = DynamicModel.of(load_robot(args.robot), args.tyre)
+    model = dynamic_model(load_robot(args.robot), args.robot, args.tyre)
     check_plot_path(args.plot)
     if args.speed is not None and not args.path:  # it sets a program's speed: with --torques it would be ignored
         raise WmrkitError("--speed applies to --path (the speed of a built-in program; it would be ignored)")

@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_angles, readonly
 from ..couplings import gear_free
-from ..errors import ShapeError, WmrkitError
+from ..errors import DescriptionError, ShapeError, WmrkitError
 from ..robot import Robot, element_table
 from .linkages import coupling_basis, linkage_breach, linkage_table, reduced
 from .mass import CASTOR_TYPES, Body, body_problem
@@ -232,8 +232,8 @@ def _one(x: ArrayLike, size: int, name: str, columns: int | None = None) -> np.n
 def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
     body = robot.body
     if body is None:
-        raise WmrkitError(f"robot '{robot.name}' has no mass properties: add a 'body: {{mass, inertia, com, "
-                          "com_height}' section to its description (docs/dynamics.md)")
+        raise _located(robot, ("body",), "the robot has no mass properties: add a 'body: {mass, inertia, com, "
+                       "com_height}' section to its description (docs/dynamics.md)")
     problem = body_problem(body)
     if problem:
         raise WmrkitError(f"robot '{robot.name}': {problem}")
@@ -254,15 +254,15 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
         wheel, joint = name.split(".")
         w = robot.wheel(wheel)
         if joint.startswith("spin"):
-            diag_i[c] = _need(w.spin_inertia, robot, wheel, "inertia.spin")
+            diag_i[c] = _need(w.spin_inertia, robot, wheel, "spin")
         elif joint == "roller":
-            diag_i[c] = _need(w.roller_inertia, robot, wheel, "inertia.roller")
+            diag_i[c] = _need(w.roller_inertia, robot, wheel, "roller")
     steer_kind, steer_prm = [], []
     for w in robot.wheels:
         if w.kind.steers:
             castor = w.type in CASTOR_TYPES
             steer_kind.append(1 if castor else 0)
-            i_s = _need(w.steer_inertia, robot, w.name, "inertia.steer")
+            i_s = _need(w.steer_inertia, robot, w.name, "steer")
             steer_prm.append((i_s, w.mass if castor else 0.0, w.l, w.alpha, w.d if castor else 0.0))
     tyres_e = tuple(tyre or robot.wheels[i].tyre or Tyre.of("pacejka") for i in t.element_wheel)
     el = np.column_stack([t.l, t.alpha, t.d, t.delta, t.gamma, t.r, t.r_r, t.element_beta_fixed,
@@ -292,15 +292,15 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
     contacts = contact_names(robot)
     spread = np.linalg.svd(geo, compute_uv=False)
     if len(spread) < 3 or spread[2] <= 1e-9 * spread[0]:  # (7.64) has no solution: a pitch moment would be left
-        raise WmrkitError(f"robot '{robot.name}': the contacts of its wheels ({', '.join(contacts)}) lie on one "
-                          "line, so nothing holds the body up about that line and the normal loads (7.64) cannot "
-                          "balance it; add a wheel (a castor) off that line")
+        raise _located(robot, ("wheels",), f"the contacts of its wheels ({', '.join(contacts)}) lie on one line, "
+                       "so nothing holds the body up about that line and the normal loads (7.64) cannot balance it; "
+                       "add a wheel (a castor) off that line")
     weight = (body.mass + sum(prm[1] for prm in steer_prm)) * gravity
     if gravity > 0 and static.sum() > weight * (1 + 1e-9):  # a load below 0 was clipped: no balance at rest
         unloaded = [c for c, f in zip(contacts, static, strict=True) if f == 0.0]
-        raise WmrkitError(f"robot '{robot.name}': its centre of mass (body.com {list(body.com)} m) is not supported "
-                          f"by its wheels: at rest the normal loads (7.64) would pull {', '.join(unloaded)} down "
-                          "(negative), so the robot tips over; move body.com inside the wheels' contacts")
+        raise _located(robot, ("body", "com"), f"the robot's centre of mass ({list(body.com)} m) is not supported by "
+                       f"its wheels: at rest the normal loads (7.64) would pull {', '.join(unloaded)} down (negative), "
+                       "so the robot tips over; move body.com inside the wheels' contacts")
     return DynamicModel(robot, tuple(names), tuple(contacts), tuple(steer_cols), tyres_e, gravity, pack)
 
 
@@ -342,8 +342,16 @@ def _differentials(robot: Robot, names: list[str]) -> tuple[np.ndarray, np.ndarr
     return group, ratio
 
 
-def _need(value: float, robot: Robot, wheel: str, field: str) -> float:
+def _need(value: float, robot: Robot, wheel: str, joint: str) -> float:
+    """`value`, the inertia [kg m^2] of `wheel`'s `joint` (spin, steer or roller), which the dynamics needs > 0."""
     if value <= 0:
-        raise WmrkitError(f"robot '{robot.name}': wheel '{wheel}' needs '{field}' > 0 for the dynamics "
-                          "(docs/dynamics.md)")
+        raise _located(robot, ("wheels", robot.wheel_names.index(wheel), "inertia", joint),
+                       f"wheel '{wheel}' needs 'inertia.{joint}' > 0 kg m^2 for the dynamics (docs/dynamics.md)",
+                       wheel)
     return value
+
+
+def _located(robot: Robot, loc: tuple[str | int, ...], message: str, wheel: str | None = None) -> DescriptionError:
+    """What the dynamics lacks in `robot`'s description, at field `loc` of it: placed in the robot's file by the
+    command line (``cli._common.dynamic_model``); ``robot 'NAME': FIELD: message`` in Python."""
+    return DescriptionError(message, source=f"robot '{robot.name}'", loc=loc, wheel=wheel)

@@ -1,0 +1,72 @@
+"""Session 31's sweep of one-line answers: what the dynamics lacks in a description, a torque beyond any motor, the
+IMU check of `odometry`, the gear check of a tiny `--initial-twist`, `batch calibrate --level` and an overflowing
+log: each refused or said in one line naming its file, wheel (row) and field (column or option)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from refusal import one_line_error
+
+from wmrkit.cli.main import main
+
+# 1. What the dynamics needs of a description (a body, inertias, a stance) is named at its file, line and field.
+
+AXLE = """\
+name: axle
+body:
+  mass: 50
+  inertia: 2.0
+  com: [{com}, 0]
+wheels:
+  - {{name: left, type: fixed, position: [0, 0.25], beta: 90 deg, r: 0.10, actuated: [spin]{left}}}
+  - {{name: right, type: fixed, position: [0, -0.25], beta: 90 deg, r: 0.10, actuated: [spin], inertia: {{spin: 0.01}}}}
+  - {{name: caster, type: {kind}, position: [-0.4, 0], r: 0.05, {caster}}}
+"""
+SPIN = ", inertia: {spin: 0.01}"
+CASTOR = "d: 0.05, inertia: {spin: 0.001, steer: 0.001}"
+ROLLERS = "heading: 0, gamma: 45 deg, r_r: 0.01, inertia: {spin: 0.001}"  # no 'roller'
+
+
+def _line(text: str, word: str) -> int:
+    """The 1-based line of `text` where `word` first appears: where the file says it, independently of wmrkit."""
+    return next(i for i, line in enumerate(text.splitlines(), start=1) if word in line)
+
+
+@pytest.mark.parametrize(("left", "kind", "caster", "com", "wheel", "field", "word"), [
+    ("", "castor", CASTOR, 0, "left", "inertia.spin", "name: left"),  # no inertia at all
+    (", inertia: {spin: 0}", "castor", CASTOR, 0, "left", "inertia.spin", "name: left"),
+    (SPIN, "castor", "d: 0.05, inertia: {spin: 0.001}", 0, "caster", "inertia.steer", "name: caster"),
+    (SPIN, "swedish", ROLLERS, 0, "caster", "inertia.roller", "name: caster"),
+    (SPIN, "castor", CASTOR, 1.0, None, "body.com", "com:"),  # ahead of the axle: the castor would lift
+])
+def test_what_the_dynamics_lacks_is_named_at_its_file_line_wheel_and_field(
+        left, kind, caster, com, wheel, field, word, tmp_path, capsys):
+    # 'robot 'axle': wheel 'left' needs 'inertia.spin' > 0 for the dynamics' named neither the file nor the line
+    text = AXLE.format(left=left, kind=kind, caster=caster, com=com)
+    robot, torques = tmp_path / "axle.yaml", tmp_path / "t.csv"
+    robot.write_text(text)
+    torques.write_text("time,left.spin,right.spin\n0,1,1\n1,1,1\n")
+    where = f"{robot}:{_line(text, word)}: " + (f"wheels[{['left', 'right', 'caster'].index(wheel)}].{field}: "
+                                                if wheel else f"{field}: ")
+    for argv in (["simulate", str(robot), "--torques", str(torques)],
+                 ["track", str(robot), "--reference", "line", "--dynamics"]):
+        assert one_line_error(argv, capsys).startswith(f"wmrkit: error: {where}")
+        assert main([*argv, "--json"]) == 2
+        out, err = capsys.readouterr()
+        assert out == ""
+        data = json.loads(err)
+        assert (data["file"], data["line"], data["wheel"], data["field"]) == (
+            str(robot), _line(text, word), wheel, field)
+
+
+def test_contacts_on_one_line_and_a_missing_body_name_the_file(tmp_path, capsys):
+    text = AXLE.format(left=SPIN, kind="castor", caster=CASTOR, com=0)
+    robot = tmp_path / "two.yaml"
+    robot.write_text(text.rsplit("  - {name: caster", 1)[0])  # the two wheels of one axle
+    err = one_line_error(["simulate", str(robot), "--path", "straight"], capsys)
+    assert err.startswith(f"wmrkit: error: {robot}:{_line(text, 'wheels:')}: wheels: the contacts of its wheels "
+                          "(left, right) lie on one line")
+    err = one_line_error(["simulate", "diff-drive", "--path", "straight"], capsys)
+    assert err.startswith("wmrkit: error: catalog:diff-drive: body: the robot has no mass properties")
