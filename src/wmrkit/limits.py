@@ -32,6 +32,11 @@ MAX_TABLE_SIZE = 1 << 26
 MAX_CHUNK = 1 << 22
 #: Fastest speed a command or program may ask of a wheeled robot [m/s].
 MAX_SPEED = 1e3
+#: Largest torque [N m] a torque file (``simulate --torques``) or ``Inputs.torques`` applies to a joint: the largest
+#: load of one tyre (``dynamics.tyres.MAX_LOAD``, 1e7 N: a thousand tonnes) on a lever of the longest length wmrkit
+#: handles (MAX_SIZE, 1 km), a hundred thousand times the largest wheel motors built. Beyond it a value is a unit
+#: mistake or a placeholder: 1e12 N m on the skid steer's wheels, and 1e308, overflowed the run.
+MAX_TORQUE = 1e10
 #: Largest speed [m/s], turn rate [rad/s] or joint rate [rad/s] a kinematic query accepts (``wmrkit ik --twist``,
 #: ``fk --spin``, the studio's drive): far beyond any wheeled robot, and small enough that no result overflows.
 MAX_QUERY_RATE = 1e6

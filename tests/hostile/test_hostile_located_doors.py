@@ -70,3 +70,35 @@ def test_contacts_on_one_line_and_a_missing_body_name_the_file(tmp_path, capsys)
                           "(left, right) lie on one line")
     err = one_line_error(["simulate", "diff-drive", "--path", "straight"], capsys)
     assert err.startswith("wmrkit: error: catalog:diff-drive: body: the robot has no mass properties")
+
+
+# 2. A torque beyond any motor (limits.MAX_TORQUE) is refused at its file, line and column, not "diverged".
+
+@pytest.mark.parametrize("value", ["1e308", "-1e308", "1.0000001e10", "-2e10"])
+def test_a_torque_beyond_the_limit_is_refused_at_its_row_and_column(value, tmp_path, capsys):
+    # 1e308 N m printed "the simulation diverged before t = 2 s; use a smaller --step", naming no file nor column
+    from wmrkit.limits import MAX_TORQUE
+
+    assert abs(float(value)) > MAX_TORQUE
+    torques = tmp_path / "t.csv"
+    torques.write_text(f"time,front_left.spin,front_right.spin\n0,1,1\n1,1,{value}\n2,1,1\n")
+    err = one_line_error(["simulate", "skid-steer-4", "--torques", str(torques)], capsys)
+    assert err.startswith(f"wmrkit: error: {torques}:3: column 'front_right.spin': {float(value):.8g} N m is beyond "
+                          "the largest torque wmrkit applies, 1e+10 N m")
+    assert main(["simulate", "skid-steer-4", "--torques", str(torques), "--json"]) == 2
+    data = json.loads(capsys.readouterr().err)
+    assert (data["file"], data["line"], data["field"]) == (str(torques), 3, "front_right.spin")
+
+
+def test_the_limit_itself_is_a_torque_and_python_inputs_are_bound_alike():
+    from wmrkit import catalog
+    from wmrkit.dynamics.model import DynamicModel
+    from wmrkit.dynamics.simulate import Inputs
+    from wmrkit.errors import WmrkitError
+    from wmrkit.limits import MAX_TORQUE
+
+    model = DynamicModel.of(catalog.load("skid-steer-4"))
+    at = Inputs.torques_only(model, [0.0], {"front_left.spin": [MAX_TORQUE]})  # accepted (its run lifts off)
+    assert at.torques.max() == MAX_TORQUE
+    with pytest.raises(WmrkitError, match=r"torques: expected torques within 1e\+10 N m .*got -30000000000\.0"):
+        Inputs.torques_only(model, [0.0], {"front_left.spin": [-3e10]})

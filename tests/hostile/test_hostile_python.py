@@ -327,7 +327,8 @@ def _body(**fields):
     (lambda: _inputs(rate_gain=[-1.0] * 7), r"^rate_gain: expected finite numbers >= 0, got -1.0"),  # ran
     (lambda: _inputs(steer_kd=[np.nan]), r"^steer_kd: expected finite numbers >= 0, got nan"),
     (lambda: _inputs(torque_limit=[np.nan] * 7), r"^torque_limit: expected numbers >= 0 \(inf: no limit\), got nan"),
-    (lambda: _inputs(torques=np.full((2, 7), np.inf)), r"^torques: expected finite numbers, got inf"),
+    (lambda: _inputs(torques=np.full((2, 7), np.inf)),
+     r"^torques: expected torques within 1e\+10 N m \(limits\.MAX_TORQUE\), got inf"),
     (lambda: _inputs(heading_reference=np.zeros((3, 1))), r"^heading_reference: expected shape \(K, n_steer\) "
                                                           r"with K = 2 rows, one per time, got \(3, 1\)"),
     (lambda: _inputs(steer_kp=np.zeros(2)), r"^steer_kp: expected shape \(1,\)"),

@@ -27,6 +27,7 @@ DOCUMENTED = [
     ("wmrkit.limits", "MAX_CHUNK", "1 to 2^22 samples (`limits.MAX_CHUNK`)", 1 << 22),
     ("wmrkit.limits", "MAX_COORDINATE", "within 1e9 m (`MAX_COORDINATE`)", 1e9),
     ("wmrkit.limits", "MAX_SPEED", "up to 1e3 m/s (`MAX_SPEED`)", 1e3),
+    ("wmrkit.limits", "MAX_TORQUE", "within 1e10 N m (`limits.MAX_TORQUE`)", 1e10),
     ("wmrkit.kinematics.codegen", "MAX_FILENAME", "255 bytes (`codegen.MAX_FILENAME`)", 255),
     ("wmrkit.kinematics.codegen", "MAX_STACK_WORK", "512 doubles, 4 KiB (`codegen.MAX_STACK_WORK`)", 512),
     ("wmrkit.kinematics.search", "MAX_SETS", "after 1000 sets (`MAX_SETS`", 1000),

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike
 from .._numbers import number_problem
 from .._shapes import readonly
 from ..errors import WmrkitError
-from ..limits import MAX_SIZE, MAX_SPEED, check_table_size
+from ..limits import MAX_SIZE, MAX_SPEED, MAX_TORQUE, check_table_size
 from ..units import BARE_ANGLE_LIMIT
 from .linkages import linkage_breach
 from .model import DynamicModel
@@ -237,6 +237,14 @@ def _check_radians(source: str, column: str, headings: np.ndarray) -> None:
                           f"is more than a turn; degrees? {h:g} deg = {math.radians(h):.6g} rad")
 
 
+def _check_torques(source: str, column: str, torques: np.ndarray) -> None:
+    """A torque column [N m] stays within :data:`~wmrkit.limits.MAX_TORQUE`."""
+    beyond = np.flatnonzero(np.abs(torques) > MAX_TORQUE)
+    if beyond.size:
+        raise WmrkitError(f"{source}:{beyond[0] + 2}: column '{column}': {torques[beyond[0]]:.8g} N m is beyond the "
+                          f"largest torque wmrkit applies, {MAX_TORQUE:g} N m (docs/limits.md)")
+
+
 def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     """:class:`Inputs` from a torque CSV (module docstring); errors name the file, the line and the column."""
     source = str(path)
@@ -271,6 +279,8 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
         wheel, _, joint = name.partition(".")
         if joint == "heading":
             _check_radians(source, name, values[:, j])
+        else:
+            _check_torques(source, name, values[:, j])
         try:
             if joint == "heading":
                 steered = model.robot.steer_names

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, readonly
 from ..couplings import GEAR_EXACT_RTOL, gear_breaches
 from ..errors import ShapeError, WmrkitError
-from ..limits import MAX_COORDINATE, MAX_SPEED
+from ..limits import MAX_COORDINATE, MAX_SPEED, MAX_TORQUE
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .deviation import PathDeviation, nominal_poses
@@ -420,7 +420,8 @@ def _knots(time: ArrayLike) -> np.ndarray:
 
 
 #: The fields of :class:`Inputs` after ``time``, in the kernels' order, and the values each one may hold.
-_INPUT_FIELDS = (("torques", "finite numbers"), ("rate_reference", "finite numbers"),
+_INPUT_FIELDS = (("torques", f"torques within {MAX_TORQUE:g} N m (limits.MAX_TORQUE)"),
+                 ("rate_reference", "finite numbers"),
                  ("rate_gain", "finite numbers >= 0"), ("torque_limit", "numbers >= 0 (inf: no limit)"),
                  ("heading_reference", "finite numbers"), ("steer_kp", "finite numbers >= 0"),
                  ("steer_kd", "finite numbers >= 0"))
@@ -443,6 +444,8 @@ def _check_inputs(inputs: Inputs) -> None:
             raise ShapeError(f"{name}: expected shape {shape} ({n} velocities as torques, {s} steering joints as "
                              f"heading_reference), got {a.shape}")
         bad = ~(a >= 0) if name == "torque_limit" else ~np.isfinite(a) | (a < 0 if ">=" in want else False)
+        if name == "torques":
+            bad = ~(np.abs(a) <= MAX_TORQUE)  # NaN included
         if bad.any():
             raise WmrkitError(f"{name}: expected {want}, got {float(a[bad].flat[0])!r}")
     if (inputs.twist is None) != (inputs.twist_time is None):
