@@ -102,3 +102,59 @@ def test_the_limit_itself_is_a_torque_and_python_inputs_are_bound_alike():
     assert at.torques.max() == MAX_TORQUE
     with pytest.raises(WmrkitError, match=r"torques: expected torques within 1e\+10 N m .*got -30000000000\.0"):
         Inputs.torques_only(model, [0.0], {"front_left.spin": [-3e10]})
+
+
+# 3. The IMU check of `odometry` says one thing: checked (a note), or not checked (a warning saying why).
+
+@pytest.fixture(scope="module")
+def imu_run():
+    pytest.importorskip("rosbags")
+    from wmrkit import catalog
+    from wmrkit.odometry import simulate
+    from wmrkit.odometry.synthetic import TwistProfile
+
+    return simulate(catalog.load("diff-drive"), TwistProfile.from_segments([(2.0, 0.5, 0.0, 0.2)]), 10.0)
+
+
+def _imu_bag(tmp_path, run, pick, shift=0.0):
+    """A bag of `run`'s joint states and one Imu topic, /imu, reading its heading at the messages `pick` selects."""
+    from test_bag_imu import _imu, _write
+
+    t, yaw, _ = _imu(run.log.time, run.truth[:, 2], "orientation")
+    bag = tmp_path / "run"
+    _write(bag, run.log.time, run.log.joints, run.log.positions, {"/imu": (t[pick] + shift, yaw[pick], None)})
+    return bag
+
+
+def _odometry(bag, capsys, *extra) -> tuple[dict, str]:
+    assert main(["odometry", "diff-drive", str(bag), "--json", *extra]) == 0
+    out, err = capsys.readouterr()
+    return json.loads(out), err
+
+
+@pytest.mark.parametrize(("pick", "shift", "why"), [
+    (slice(5, 6), 0.0, "1 IMU message (at 1000.607 s): too few to measure a turn"),
+    (slice(5, 6), 0.0, None),  # the same bag, --imu naming the topic: an error
+    (slice(None), 100.0, "the IMU's stamps (1100.107 to 1102.007 s) miss the joint states' (1000 to 1002 s)"),
+])
+def test_an_imu_that_checks_nothing_is_said_not_checked_once(pick, shift, why, imu_run, tmp_path, capsys):
+    # a one-message IMU answered "consistent": true, "imu": "/imu" and the note "heading checked against the IMU",
+    # having compared no turn; stamps missing the run's printed that note, then "... not checked against it"
+    bag = _imu_bag(tmp_path, imu_run, pick, shift)
+    if why is None:
+        err = one_line_error(["odometry", "diff-drive", str(bag), "--imu", "/imu"], capsys)
+        assert err == f"wmrkit: error: {bag}: /imu: 1 IMU message (at 1000.607 s): too few to measure a turn\n"
+        return
+    answer, err = _odometry(bag, capsys)
+    line = f"{bag}: /imu: {why}"
+    assert answer["imu"] is None
+    (said,) = answer["warnings"]
+    assert said.startswith(line) and said.endswith("(the odometry is not checked against it)")
+    assert "checked against the IMU" not in err  # no note saying the opposite
+    assert err.count("wmrkit: ") == 1 and err.startswith(f"wmrkit: warning: {line}")
+
+
+def test_an_imu_of_two_messages_checks_the_stretch_between_them(imu_run, tmp_path, capsys):
+    answer, err = _odometry(_imu_bag(tmp_path, imu_run, slice(5, 7)), capsys)
+    assert answer["imu"] == "/imu" and answer["warnings"] == [] and answer["consistent"]
+    assert err.startswith("wmrkit: note: heading checked against the IMU on /imu")

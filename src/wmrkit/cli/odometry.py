@@ -132,8 +132,6 @@ def run(args: argparse.Namespace) -> int:
     imu, note = imu_topic(args.log, args.imu) if is_bag(args.log) and os.path.exists(args.log) else (None, None)
     if note and imu is None:  # several Imu topics: the heading is not checked, a warning (batch odometry's too)
         warn(note)
-    elif note:
-        print(f"wmrkit: note: {note}", file=sys.stderr)
     if args.max_gap is not None and not args.max_gap > 0:
         raise WmrkitError(f"--max-gap must be > 0 s, got {args.max_gap:g}")
     if args.counter_bits is not None and not 2 <= args.counter_bits <= 64:
@@ -181,6 +179,8 @@ def run(args: argparse.Namespace) -> int:
     if imu is not None:
         imu = check.topic if check and check.checked else None
         consistent = consistent and not (imu and check.line)
+        if note and imu:  # said once checked: an IMU found, then not usable, is only the warning that says so
+            print(f"wmrkit: note: {note}", file=sys.stderr)
         line = check.line if check else unread
         if line:
             warn(line)

@@ -264,9 +264,15 @@ class ImuCheck:
             self.checked = True
             return
         time, yaw = self.imu
+        err = None
         if time[-1] <= self._start or time[0] >= self._last[0]:
             err = LogError(f"{self.path}: {self.topic}: the IMU's stamps ({time[0]:.9g} to {time[-1]:.9g} s) miss the "
                            f"joint states' ({self._start:.9g} to {self._last[0]:.9g} s): another clock?")
+        elif time[-1] <= time[0]:  # one stamp: no turn to compare ("consistent" over nothing)
+            at = f"1 IMU message (at {time[0]:.9g} s)" if len(time) == 1 else \
+                f"{len(time)} IMU messages, all at {time[0]:.9g} s"
+            err = LogError(f"{self.path}: {self.topic}: {at}: too few to measure a turn")
+        if err is not None:
             if self.named:
                 raise err
             self.line = f"{err} (the odometry is not checked against it)"
