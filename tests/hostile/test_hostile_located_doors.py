@@ -158,3 +158,52 @@ def test_an_imu_of_two_messages_checks_the_stretch_between_them(imu_run, tmp_pat
     answer, err = _odometry(_imu_bag(tmp_path, imu_run, slice(5, 7)), capsys)
     assert answer["imu"] == "/imu" and answer["warnings"] == [] and answer["consistent"]
     assert err.startswith("wmrkit: note: heading checked against the IMU on /imu")
+
+
+# 4. A gear's check has the slip check's absolute floor (SLIP_TOL [m/s] at the contacts), at any robot scale.
+
+def _geared_cart(scale: float) -> str:
+    """A cart on a solid axle (a 1:1 gear: both spins equal) and a castor, every length times `scale`."""
+    m = min(scale, 1.0) ** 3  # a body of the same density (at most the 1e6 kg wmrkit takes: 20 kg)
+    return f"""name: geared-axle
+body: {{mass: {20 * m!r}, inertia: {0.5 * m * scale ** 2!r}, com: [{-0.05 * scale!r}, 0], com_height: {0.1 * scale!r}}}
+wheels:
+  - {{name: left, type: fixed, position: [0, {0.2 * scale!r}], heading: 0, r: {0.075 * scale!r}, actuated: [spin],
+     inertia: {{spin: {0.01 * m * scale ** 2!r}}}}}
+  - {{name: right, type: fixed, position: [0, {-0.2 * scale!r}], heading: 0, r: {0.075 * scale!r},
+     inertia: {{spin: {0.01 * m * scale ** 2!r}}}}}
+  - {{name: caster, type: castor, position: [{-0.25 * scale!r}, 0], heading: 0, d: {0.04 * scale!r},
+     r: {0.025 * scale!r}, inertia: {{spin: {0.001 * m * scale ** 2!r}, steer: {0.001 * m * scale ** 2!r}}}}}
+couplings:
+  - {{kind: gear, joints: [left.spin, right.spin], ratios: [1, 1]}}
+"""
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e-3, 1e3])
+@pytest.mark.parametrize("factor", [1e-300, 0.9, 1.1])
+def test_the_gear_check_and_the_slip_check_share_their_absolute_floor(scale, factor):
+    # '--initial-twist 0 0 1e-320' was refused by the gear check (relative to the rates, all ~1e-320), while
+    # '0 1e-320 0' passed the slip check (SLIP_TOL = 1e-6 m/s, absolute)
+    from wmrkit import Robot
+    from wmrkit.dynamics.model import DynamicModel
+    from wmrkit.dynamics.programs import SLIP_TOL, twist_program
+    from wmrkit.errors import WmrkitError
+
+    model = DynamicModel.of(Robot.from_dict(__import__("yaml").safe_load(_geared_cart(scale))))
+    # a turn at omega spins the two wheels of the axle apart: the gear holds them equal, so each contact slips
+    # along by omega * (half track) from the gear's common turn; a lateral speed vy slips both sideways by vy
+    turn, side = factor * SLIP_TOL / (0.2 * scale), factor * SLIP_TOL
+    for twist, what in (([0.0, 0.0, turn], "out of its ratios"), ([0.0, side, 0.0], "would slip sideways")):
+        if factor < 1:
+            twist_program(model, [0.0], [twist])  # within the floor: rolls
+        else:
+            with pytest.raises(WmrkitError, match=what):
+                twist_program(model, [0.0], [twist])
+
+
+@pytest.mark.parametrize("twist", [["0", "0", "1e-320"], ["0", "1e-320", "0"]])
+def test_a_tiny_initial_twist_starts_alike_whichever_speed_it_holds(twist, tmp_path, capsys):
+    robot = tmp_path / "cart.yaml"
+    robot.write_text(_geared_cart(1.0))
+    assert main(["simulate", str(robot), "--path", "straight", "--duration", "0.01", "--initial-twist", *twist]) == 0
+    assert "0.01 s simulated" in capsys.readouterr().out
