@@ -249,7 +249,7 @@ def test_fleet_slip_weights_from_closed_paths_and_errors(skid_runs):
     with pytest.raises(BatchError, match="confidence level"):
         fleet_slip_calibrate(robot, truth_end, level=1.5)
     for level in (0.9999999999999999, 0.999999):  # 0.5 + level / 2 rounded to 1: [-inf, inf]; or +-6e5 errors
-        with pytest.raises(BatchError, match=r"confidence level must be in \(0, 0\.9999\]"):
+        with pytest.raises(BatchError, match=r"confidence level must be in \(0\.5, 0\.9999\]"):
             fleet_slip_calibrate(robot, truth_end, level=level)
     from scipy import stats
 

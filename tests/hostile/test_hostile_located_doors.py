@@ -207,3 +207,36 @@ def test_a_tiny_initial_twist_starts_alike_whichever_speed_it_holds(twist, tmp_p
     robot.write_text(_geared_cart(1.0))
     assert main(["simulate", str(robot), "--path", "straight", "--duration", "0.01", "--initial-twist", *twist]) == 0
     assert "0.01 s simulated" in capsys.readouterr().out
+
+
+# 5. `batch calibrate --level` within (0.5, 0.9999], named; the level printed as given.
+
+@pytest.fixture(scope="module")
+def closed_runs(tmp_path_factory):
+    from batch_params import write_log
+
+    from wmrkit import catalog
+    from wmrkit.odometry.synthetic import simulate, square_path
+
+    d = tmp_path_factory.mktemp("closed")
+    for i in range(3):
+        write_log(d / f"run{i}.csv", simulate(catalog.load("diff-drive"), square_path(1.0 + 0.2 * i), 10.0,
+                                              spin_noise_per_rad=1e-5, seed=i))
+    return d
+
+
+@pytest.mark.parametrize("level", ["1e-320", "0", "0.5", "1", "0.99999", "nan", "-0.95"])
+def test_a_confidence_level_outside_its_range_is_refused_naming_the_option(level, closed_runs, capsys):
+    # 1e-320 printed "0% intervals" (exit 0), intervals of no width
+    err = one_line_error(["batch", "calibrate", "diff-drive", str(closed_runs / "*.csv"), "--closed", "--workers",
+                          "0", "--level", level], capsys)
+    assert err.startswith("wmrkit: error: --level must be in (0.5, 0.9999] (a confidence level: 0.95 for 95 % "
+                          f"intervals), got {float(level)!r}")
+
+
+@pytest.mark.parametrize(("level", "shown"), [("0.9999", "99.99%"), ("0.95", "95%"), ("0.500001", "50.0001%")])
+def test_the_level_is_printed_as_given(level, shown, closed_runs, capsys):
+    # 0.9999 printed "100% intervals" (':.0%')
+    assert main(["batch", "calibrate", "diff-drive", str(closed_runs / "*.csv"), "--closed", "--workers", "0",
+                 "--level", level]) == 0
+    assert f"; {shown} intervals (jacobian)" in capsys.readouterr().out

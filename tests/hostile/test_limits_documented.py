@@ -83,7 +83,8 @@ DOCUMENTED = [
     ("wmrkit.batch.calibrate", "MAX_BOOTSTRAP", "2 to 10,000 replicates "
      "(`--bootstrap`, `batch.calibrate.MAX_BOOTSTRAP`)",
      10_000),
-    ("wmrkit.batch.calibrate", "MAX_LEVEL", "in (0, 0.9999] (`batch.calibrate.MAX_LEVEL`)", 0.9999),
+    ("wmrkit.batch.calibrate", "MAX_LEVEL", "in (0.5, 0.9999] (`batch.calibrate.MIN_LEVEL`, `MAX_LEVEL`)", 0.9999),
+    ("wmrkit.batch.calibrate", "MIN_LEVEL", "in (0.5, 0.9999] (`batch.calibrate.MIN_LEVEL`, `MAX_LEVEL`)", 0.5),
     ("wmrkit.batch.consistency", "MAX_RATIO", "exceeds 20 times what noise leaves there", 20.0),
     ("wmrkit.batch.consistency", "MIN_RUNS", "judged with 3 runs or more (`MIN_RUNS`)", 3),
     ("wmrkit.batch.consistency", "MIN_DOF", "6 or more residuals beyond their own parameters (`MIN_DOF`", 6),

@@ -243,12 +243,21 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
 #: Highest confidence level: beyond it Student's quantile with the few degrees of freedom of a fleet is astronomic (1
 #: run of freedom at 0.999999: +-636,619 standard errors), and 0.5 + level / 2 rounds to 1 (an infinite interval).
 MAX_LEVEL = 0.9999
+#: Lowest confidence level (excluded): an interval of 50 % or less misses the value at least as often as it holds
+#: it, no confidence; 1e-320 printed "0% intervals" of zero width.
+MIN_LEVEL = 0.5
 
 
-def check_level(level: float) -> None:
-    """Refuse a confidence level outside ``(0, MAX_LEVEL]``."""
-    if isinstance(level, bool) or not (finite_number(level) and 0 < level <= MAX_LEVEL):
-        raise BatchError(f"confidence level must be in (0, {MAX_LEVEL:g}], got {level!r}")
+def check_level(level: float, what: str = "confidence level") -> None:
+    """Refuse a confidence level (`what`: its name at the door) outside ``(MIN_LEVEL, MAX_LEVEL]``."""
+    if isinstance(level, bool) or not (finite_number(level) and MIN_LEVEL < level <= MAX_LEVEL):
+        raise BatchError(f"{what} must be in ({MIN_LEVEL:g}, {MAX_LEVEL:g}] (a confidence level: 0.95 for 95 % "
+                         f"intervals), got {level!r}")
+
+
+def level_text(level: float) -> str:
+    """A confidence `level` as printed: ``95%``, ``99.99%`` (``:.0%`` printed 0.9999 as 100%)."""
+    return f"{100 * level:g}%"
 
 
 def _t_quantile(level: float, dof: int) -> float:
@@ -344,7 +353,7 @@ class FleetSlipCalibration:
 
     def format(self) -> str:
         """Human-readable summary."""
-        return (f"robot {self.robot}: {len(self.per_run)} runs; {self.level:.0%} intervals\n"
+        return (f"robot {self.robot}: {len(self.per_run)} runs; {level_text(self.level)} intervals\n"
                 f"  WLS mu_lateral / mu_longitudinal  {self.ratio:.6g}  [{self.ratio_interval[0]:.6g}, "
                 f"{self.ratio_interval[1]:.6g}]\n"
                 f"  effective track multiplier        {self.multiplier:.6g}  [{self.multiplier_interval[0]:.6g}, "

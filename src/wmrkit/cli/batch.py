@@ -200,7 +200,14 @@ def run_odometry(args: argparse.Namespace) -> int:
 
 def run_calibrate(args: argparse.Namespace) -> int:
     """Fleet calibration; prints each fitted field with its interval."""
-    from ..batch.calibrate import check_bootstrap, default_parameters, fleet_calibrate, load_runs
+    from ..batch.calibrate import (
+        check_bootstrap,
+        check_level,
+        default_parameters,
+        fleet_calibrate,
+        level_text,
+        load_runs,
+    )
     from ..batch.fleet import expand_logs
 
     robot = load_robot(args.robot)
@@ -213,6 +220,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
     params = ([tuple(n.strip() for n in p.split(",") if n.strip()) for p in args.param] if args.param
               else [] if args.slip else default_parameters(robot, closed=args.closed, sensed=args.sensed))
     check_bootstrap(args.bootstrap, "--bootstrap")
+    check_level(args.level, "--level")
     with _runner(args) as runner:
         runs = load_runs(robot, expand_logs(args.logs), reference_dir=args.reference, closed=args.closed,
                          runner=runner, options=_options(args), progress=_progress(args))
@@ -234,7 +242,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
         print(result.format())
         return 0
     print(f"robot {robot.name}: {result.runs} runs, {result.residuals} residuals, RMS {result.rms_before:.4g} -> "
-          f"{result.rms_after:.4g}; {result.level:.0%} intervals ({result.ci})")
+          f"{result.rms_after:.4g}; {level_text(result.level)} intervals ({result.ci})")
     for name, nominal, value, lo, hi in result.values:
         print(f"  {name:<24} {nominal:.6g} -> {value:.6g}  [{lo:.6g}, {hi:.6g}]")
     if result.not_judged:
