@@ -240,3 +240,21 @@ def test_the_level_is_printed_as_given(level, shown, closed_runs, capsys):
     assert main(["batch", "calibrate", "diff-drive", str(closed_runs / "*.csv"), "--closed", "--workers", "0",
                  "--level", level]) == 0
     assert f"; {shown} intervals (jacobian)" in capsys.readouterr().out
+
+
+# 5b. A log whose spin step or rate overflows says so at its sample, never "inf rad/s".
+
+@pytest.mark.parametrize(("rows", "line", "said"), [
+    ("0,0,0\n0.01,1e308,0\n", 3, "turns 1e+308 rad in 0.01 s, a rate that overflows (at most 10000 rad/s)"),
+    ("0,0,0\n1e-300,1e10,0\n", 3, "turns 1e+10 rad in 1e-300 s, a rate that overflows (at most 10000 rad/s)"),
+    ("0,1e308,0\n0.01,-1e308,0\n", 3, "from 1e+308 rad to -1e+308 rad, a step that overflows (values too large to "
+                                      "subtract)"),
+    ("0,0,0\n0.01,0.5,0\n0.02,300.5,0\n", 4, "turns 300 rad in 0.01 s (3e+04 rad/s > 10000 rad/s)"),  # finite
+])
+def test_an_overflowing_spin_is_named_at_its_sample(rows, line, said, tmp_path, capsys):
+    # "turns 1e+308 rad in 0.01 s (inf rad/s > 10000 rad/s)", and "turns inf rad in 0.01 s (inf rad/s > ...)"
+    log = tmp_path / "log.csv"
+    log.write_text("time,left.spin,right.spin\n" + rows)
+    err = one_line_error(["odometry", "diff-drive", str(log)], capsys)
+    assert err.startswith(f"wmrkit: error: {log}:{line}: left.spin: {said}: an implausible jump")
+    assert "inf" not in err.replace("(encoder glitch", "")

@@ -329,10 +329,15 @@ def check_jumps(log: JointLog, positions: np.ndarray, previous: np.ndarray | Non
             return
         k, c = (int(x) for x in np.argwhere(bad)[0])
         rate = float(step[k, c] / dt[k])
-    name = log.joints[spin[c]]
-    raise LogError(f"{log.where(k + shift)}: {name}: turns {float(step[k, c]):.6g} rad in {float(dt[k]):.6g} s "
-                   f"({rate:.3g} rad/s > {max_rate:g} rad/s): an implausible jump (encoder glitch, wrong "
-                   "counter width or counts per revolution?)")
+    name, turn = log.joints[spin[c]], float(step[k, c])
+    if not np.isfinite(turn):  # finite positions whose difference overflows ("turns inf rad")
+        a, b = (float(x) for x in full[k:k + 2, spin[c]])
+        what = f"from {a:.6g} rad to {b:.6g} rad, a step that overflows (values too large to subtract)"
+    else:  # a rate beyond the largest float ("inf rad/s")
+        speed = f" ({rate:.3g} rad/s > " if np.isfinite(rate) else ", a rate that overflows (at most "
+        what = f"turns {turn:.6g} rad in {float(dt[k]):.6g} s{speed}{max_rate:g} rad/s)"
+    raise LogError(f"{log.where(k + shift)}: {name}: {what}: an implausible jump (encoder glitch, wrong counter width "
+                   "or counts per revolution?)")
 
 
 def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat = LogFormat(), *,
