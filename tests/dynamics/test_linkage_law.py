@@ -17,6 +17,7 @@ from dynamics_robots import linked_car
 from wmrkit import Robot
 from wmrkit.cli.main import main
 from wmrkit.couplings import Coupling, CouplingError
+from wmrkit.dynamics.linkages import LinkageWarning
 from wmrkit.dynamics.model import DynamicModel
 from wmrkit.errors import WmrkitError
 
@@ -59,7 +60,8 @@ def test_a_four_wheel_steer_car_without_a_law_is_warned_and_not_held(tmp_path, c
     assert said[0].startswith("linkage(fl.steer, fr.steer) is not held by the dynamics")
     assert heading["fl"][-1] == pytest.approx(TAU * DURATION ** 2 / (2 * I_STEER), rel=2e-3)
     assert np.abs(heading["fr"]).max() < 1e-3 * heading["fl"][-1]
-    model = DynamicModel.of(Robot.from_dict(four_wheel_steer()))
+    with pytest.warns(LinkageWarning, match="not held"):
+        model = DynamicModel.of(Robot.from_dict(four_wheel_steer()))
     assert model.pack[17].shape == (0, 10)
     assert model.steering_inertia() == pytest.approx([I_STEER] * 4, rel=1e-12)  # each wheel its own
 
@@ -93,7 +95,8 @@ def test_a_synchro_drive_holds_parallel_by_default_and_not_over_some_of_its_whee
     assert model.steering_inertia() == pytest.approx([4 * I_STEER] * 4, rel=1e-12)
     assert model.pack[17].shape == (3, 10) and not model.pack[17][:, 3].any()  # law 0: parallel
     some = four_wheel_steer(linkages=[STEERS[:3]])
-    model = DynamicModel.of(Robot.from_dict(some))
+    with pytest.warns(LinkageWarning, match=r"linkage\(fl.steer, fr.steer, rl.steer\) is not held"):
+        model = DynamicModel.of(Robot.from_dict(some))
     assert model.pack[17].shape == (0, 10)
     assert model.steering_inertia() == pytest.approx([I_STEER] * 4, rel=1e-12)
 

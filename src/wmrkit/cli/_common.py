@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import catalog
-from ..errors import ShapeError, WmrkitError
+from ..errors import ShapeError, WmrkitError, said_warnings
 from ..limits import same_file
 from ..robot import Robot
 from ..units import Kind, UnitError, parse_quantity
@@ -37,26 +37,30 @@ def add_json_flag(parser: argparse.ArgumentParser) -> None:
 def load_robot(spec: str) -> Robot:
     """The robot named by a ROBOT argument; the description's warnings said (:func:`warn`)."""
     from ..description import DescriptionWarning
-    from ..errors import said_warnings
-
     robot, lines = said_warnings(lambda: catalog.resolve(spec), DescriptionWarning)
     for line in lines:
         warn(line)
     return robot
 
 
-def dynamic_model(robot: Robot, spec: str, tyre: str | None = None) -> Any:
+def dynamic_model(robot: Robot, spec: str, tyre: str | None = None, *, say: bool = True) -> Any:
     """The :class:`~wmrkit.dynamics.model.DynamicModel` of `robot`, loaded from the ROBOT argument `spec`: what its
-    description lacks for the dynamics (a body, an inertia) is an error naming its file, line, wheel and field."""
+    description lacks for the dynamics (a body, an inertia) is an error naming its file, line, wheel and field. Its
+    :class:`~wmrkit.dynamics.linkages.LinkageWarning` lines are said (:func:`warn`) unless `say` is False (a caller
+    whose run builds the model again and says them then)."""
+    from ..dynamics.linkages import LinkageWarning
     from ..dynamics.model import DynamicModel
     from ..errors import DescriptionError
 
     try:
-        return DynamicModel.of(robot, tyre)
+        model, lines = said_warnings(lambda: DynamicModel.of(robot, tyre), LinkageWarning)
     except DescriptionError as err:
         if err.source != f"robot '{robot.name}'":
             raise
         raise catalog.locate(err, spec) from None
+    for line in lines if say else ():
+        warn(line)
+    return model
 
 
 def wheel_column_width(robot: Robot, least: int = 14) -> int:

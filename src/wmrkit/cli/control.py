@@ -222,12 +222,13 @@ def run_track(args: argparse.Namespace) -> int:
     from ..control.laws import GateWarning, SamplingWarning
     from ..control.track import track
     from ..control.trackers import ArrivalWarning
+    from ..dynamics.linkages import LinkageWarning
 
     check_plot_path(args.plot)
     check_animation_path(args.animate)
     robot = load_robot(args.robot)
     if args.dynamics:  # what the description lacks for the dynamics, named in its file
-        dynamic_model(robot, args.robot)
+        dynamic_model(robot, args.robot, say=False)  # the run builds it again and says its linkages
     reference, size, described = _reference(args, robot)
     start = None
     if args.start:
@@ -253,6 +254,7 @@ def run_track(args: argparse.Namespace) -> int:
         warnings.simplefilter("always", SamplingWarning)
         warnings.simplefilter("always", GateWarning)
         warnings.simplefilter("always", ArrivalWarning)
+        warnings.simplefilter("always", LinkageWarning)  # --dynamics: a linkage the model does not hold
         try:
             run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
                         lookahead=lookahead, stanley_gain=stanley_gain, period=period, delay=args.delay,
@@ -260,13 +262,16 @@ def run_track(args: argparse.Namespace) -> int:
                         feedback=args.feedback, weights=weights, noise=noise, ramp=args.ramp,
                         progress=sys.stderr.isatty() and not args.json)
         except WmrkitError as err:  # the sampling warning that foretold it, in the one line of the error
+            for line in dict.fromkeys(str(w.message) for w in caught if issubclass(w.category, LinkageWarning)):
+                warn(line)  # what the model is, said before the error its run met
             foretold = [str(w.message) for w in caught if issubclass(w.category, SamplingWarning)]
             if not foretold:
                 raise
             raise type(err)(f"{err} ({'; '.join(foretold)})") from None
-    for w in caught:
-        if issubclass(w.category, (SamplingWarning, GateWarning, ArrivalWarning)):
-            warn(str(w.message))
+    for message in dict.fromkeys(str(w.message) for w in caught  # a model built twice says it once
+                                 if issubclass(w.category, (LinkageWarning, SamplingWarning, GateWarning,
+                                                            ArrivalWarning))):
+        warn(message)
     for v in run.range_violations():
         lo, hi = (math.degrees(a) for a in robot.wheel(v["wheel"]).steer_range)
         warn(f"wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg for {v['duration']:.3g} s "

@@ -122,7 +122,6 @@ def _check_program_step(step: float, name: str) -> None:
 def run_simulate(args: argparse.Namespace) -> int:
     """Simulate, print a summary, write and plot on request."""
     from ..dynamics.deviation import check_step, deviation_warning
-    from ..dynamics.linkages import unheld
     from ..dynamics.programs import path_program, read_torques
     from ..dynamics.simulate import MAX_STEPS, recordable_step, simulate
 
@@ -170,7 +169,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     travelled = float(np.sum(np.hypot(*np.diff(sim.pose[:, :2], axis=0).T)))
     max_slip = float(np.hypot(sim.slip[..., 0], sim.slip[..., 1]).max())  # a contact's slip speed, not a component
     deviation = sim.deviation()
-    warnings = unheld(model.robot) + _tyre_warnings(model, sim.twist)
+    warnings = _tyre_warnings(model, sim.twist)
     if deviation and deviation.large:
         warnings.append(deviation_warning(model, inputs, deviation, max_slip))
     for warning in warnings:

@@ -91,9 +91,14 @@ def linkage_table(robot, names: tuple[str, ...]) -> np.ndarray:
     return np.array(rows, dtype=float).reshape(-1, COLUMNS)
 
 
+class LinkageWarning(UserWarning):
+    """A ``linkage`` coupling the dynamics do not hold (:func:`unheld`), warned by
+    :meth:`~wmrkit.dynamics.model.DynamicModel.of`: each of its steering angles follows its own servo."""
+
+
 def unheld(robot) -> list[str]:
     """The warnings of the linkages of `robot` the dynamics do not hold (no law stated and none to default to:
-    :func:`wmrkit.couplings.linkage_law`): each steering angle follows its own servo."""
+    :func:`wmrkit.couplings.linkage_law`): each steering angle follows its own servo (:class:`LinkageWarning`)."""
     return [f"{c.channel_name} is not held by the dynamics: the robot has no fixed wheel and the linkage does not link "
             "every steerable wheel, so its law is not known and each steering angle follows its own servo; state it "
             "in the coupling's law field (law: parallel if the linked wheels turn together; "

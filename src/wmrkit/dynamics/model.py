@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -31,7 +32,7 @@ from .._shapes import as_angles, readonly
 from ..couplings import gear_free
 from ..errors import DescriptionError, ShapeError, WmrkitError
 from ..robot import Robot, element_table
-from .linkages import coupling_basis, linkage_breach, linkage_table, reduced
+from .linkages import LinkageWarning, coupling_basis, linkage_breach, linkage_table, reduced, unheld
 from .mass import CASTOR_TYPES, Body, body_problem
 from .tyres import Tyre
 
@@ -61,7 +62,9 @@ class DynamicModel:
         """The model of `robot`; `tyre` (a :class:`Tyre` or a model name) replaces every wheel's own tyre.
 
         Wheels without a tyre get ``pacejka`` (appendix 7.A1). Raises :class:`WmrkitError` when the description
-        lacks what the dynamics needs (``body``, a spin inertia, a roller or castor-steering inertia).
+        lacks what the dynamics needs (``body``, a spin inertia, a roller or castor-steering inertia). A ``linkage``
+        the dynamics do not hold (no ``law`` and none to default to) gives a
+        :class:`~wmrkit.dynamics.linkages.LinkageWarning` each (:func:`~wmrkit.dynamics.linkages.unheld`).
         """
         if isinstance(tyre, str):
             tyre = Tyre.of(tyre)
@@ -69,7 +72,10 @@ class DynamicModel:
             raise TypeError(f"tyre: expected a Tyre, a tyre model's name or None, got {type(tyre).__name__}")
         if not 0 < float(gravity) < math.inf:  # NaN included
             raise WmrkitError(f"gravity: expected a finite number > 0 m/s^2, got {gravity}")
-        return _build(robot, tyre, float(gravity))
+        model = _build(robot, tyre, float(gravity))
+        for message in unheld(robot):  # here, not in the cached _build: every model built says it
+            warnings.warn(message, LinkageWarning, stacklevel=2)
+        return model
 
     @property
     def n(self) -> int:
