@@ -9,6 +9,8 @@ every steerable wheel of a robot without one, else none: the linkage is not held
   exact Ackermann law. In the axle's frame (x along the fixed wheels' rolling direction, y along the axle, x_i, y_i
   the steering point of wheel i, psi its heading from the fixed wheels'), ``psi_j = atan2(x_j sin psi_i, x_i cos
   psi_i + (y_i - y_j) sin psi_i)`` (mod pi), so ``f' = x_i x_j / D`` with ``D`` the squared norm of that pair;
+  a follower on the axle line (``x_j = 0`` within :data:`AXLE_TOL`) keeps its rest angle, ``f' = 0`` (``D`` is 0
+  where the ICR is on it);
 - ``parallel``: the linked wheels turn together, ``beta_j - beta_j0 = beta_i - beta_i0`` (a synchro drive's chain:
   one ICR at infinity while they stay parallel).
 
@@ -35,6 +37,9 @@ from ..wheels import heading_from_beta
 COLUMNS = 10
 #: A steering angle [rad] (or a rate, relative to the leader's) farther than this from its linkage's law breaks it.
 LINKAGE_TOL = 1e-9
+#: A steering point [m] closer than this to the fixed wheels' axle line is on it (``ackermann``): a leader is
+#: chosen off it; a follower on it keeps its rest angle (its axle is that line, through every ICR on it).
+AXLE_TOL = 1e-9
 
 
 def law(row, beta):
@@ -42,6 +47,8 @@ def law(row, beta):
     :mod:`._kernels`): the follower's angle, continuous from its rest angle (it turns less than half round)."""
     if row[3] == 0.0:
         return row[9] + beta - row[8], 1.0, 0.0
+    if row[5] == 0.0:  # a follower on the axle line: f' = 0 / D, and 0 / 0 where the ICR is its steering point
+        return row[9], 0.0, 0.0
     xi, xj, dy = row[4], row[5], row[6]
     psi, psi0 = beta - row[7], row[8] - row[7]
     s, c, s0, c0 = math.sin(psi), math.cos(psi), math.sin(psi0), math.cos(psi0)
@@ -64,7 +71,8 @@ def linkage_table(robot, names: tuple[str, ...]) -> np.ndarray:
         axle = _axle(robot, c) if kind == "ackermann" else None
         wheels = [robot.wheel(j.partition(".")[0]) for j in c.joints]
         frame = [(0.0, 0.0, w.beta) for w in wheels] if axle is None else [_in_axle(axle, w) for w in wheels]
-        lead = next((k for k, (x, _, _) in enumerate(frame) if axle is None or abs(x) > 1e-9), None)
+        frame = [(0.0 if abs(x) <= AXLE_TOL else x, y, psi) for x, y, psi in frame]  # on the line: exactly
+        lead = next((k for k, (x, _, _) in enumerate(frame) if axle is None or x != 0.0), None)
         if lead is None:
             raise WmrkitError(f"robot '{robot.name}': {c.channel_name}: every linked wheel is on the fixed wheels' "
                               "axle line, so no steering angle sets the ICR; the dynamics cannot hold it")
