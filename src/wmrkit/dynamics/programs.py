@@ -246,6 +246,11 @@ def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequenc
     inertia each servo moves (:meth:`DynamicModel.steering_inertia`) while the servoed joints and the columns
     `held` (wheel-rate servos) keep still. A double wheel whose spins are servoed turns the whole body about its
     pivot: its own ``inertia.steer`` would leave that servo some 100 times too soft (damping ratio near 0.1).
+
+    The servoed steering joints of one ``linkage`` act as one servo on it: their gains, each in proportion to its
+    own wheel's inertia, sum through the law's slopes to ``J w^2`` and ``2 J w``, ``J`` the linkage's reflected
+    inertia with the other joints held (two servos of a synchro drive's four wheels, each tuned on its own wheel,
+    gave ``w / sqrt 2`` and damping ratio 0.71: a 4.3 % overshoot).
     """
     kp, kd = np.zeros(len(model.steer_columns)), np.zeros(len(model.steer_columns))
     if not set(servoed) <= set(model.steer_columns):
@@ -254,7 +259,18 @@ def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequenc
     _check_bandwidth(bandwidth)
     if not servoed:
         return kp, kd
-    inertia = model.steering_inertia([*servoed, *held])
+    inertia = np.array(model.steering_inertia([*servoed, *held]))
+    table, columns = model.pack[17], list(model.steer_columns)
+    t = model._basis(model.robot.beta)[0]  # the motions the couplings allow: nu = T p
+    for lead, p in {int(row[1]): int(row[2]) for row in table}.items():  # each held linkage: its leader
+        together = [j for j in servoed if t[j, p] != 0 and (j == lead or any(  # (slope 0: it stays, here)
+            row[0] == j and row[1] == lead for row in table))]
+        if len(together) < 2:  # one servo: tuned on the linkage above (the others do not hold it)
+            continue
+        slope = t[together, p]  # each joint's rate per unit rate of the leader
+        ks = [columns.index(j) for j in together]
+        moved = model.steering_inertia([j for j in [*servoed, *held] if j not in together])[ks[0]] * slope[0] ** 2
+        inertia[ks] *= moved / float(slope ** 2 @ inertia[ks])  # sum slope^2 kp = moved w^2
     on = np.isin(model.steer_columns, servoed)
     kp[on] = inertia[on] * bandwidth ** 2
     kd[on] = 2 * inertia[on] * bandwidth
