@@ -195,15 +195,15 @@ def _check_rolling(model, twist: list[float]) -> None:
     ratios or the wheels steer as a linkage cannot: the start rolls without slip (the forklift, whose origin is at
     the fork tips, turns with ``vy = -omega x_axle``; a skid steer cannot turn so, nor a solid axle)."""
     from ..dynamics.linkages import linkage_breach
-    from ..dynamics.programs import SLIP_TOL, feasible_twists, rolls_in_gear
+    from ..dynamics.programs import SLIP_TOL, feasible_twists
     from ..kinematics.wheel_ik import wheel_commands
 
     if not np.all(np.abs(twist) <= MAX_SPEED):  # left to initial_state's message
         return
-    cmd = wheel_commands(model.robot, twist)
+    cmd = wheel_commands(model.robot, twist, slip_tol=SLIP_TOL)
     slip = np.abs(cmd.slip)
     if slip.max() <= SLIP_TOL:
-        for c, ok in zip(model.robot.couplings, rolls_in_gear(model.robot, cmd).tolist(), strict=True):
+        for c, ok in zip(model.robot.couplings, cmd.in_gear.tolist(), strict=True):
             if not ok:
                 raise WmrkitError(f"--initial-twist {' '.join(f'{v:g}' for v in twist)}: it turns the joints of "
                                   f"{c.channel_name} out of its ratios ({', '.join(f'{k:g}' for k in c.ratios)}), "

@@ -125,14 +125,14 @@ def deviation_warning(model, inputs, deviation: PathDeviation, max_slip: float) 
     whose twists have no no-slip motion (a skid steer's turns: fixed wheels must slip sideways) turns less than its
     wheel rates command; one whose twists a ``gear`` forbids (a solid axle asked to turn) cannot follow them."""
     from ..kinematics.wheel_ik import wheel_commands
-    from .programs import SLIP_TOL, rolls_in_gear
+    from .programs import SLIP_TOL
 
     line = (f"the robot left the programmed path: up to {deviation.max_position:.3g} m from it (t = "
             f"{deviation.max_time:g} s; the path is {deviation.size:.3g} m across and turns {deviation.turn:.3g} rad), "
             f"{deviation.end_position:.3g} m and {deviation.end_heading:.3g} rad off at the end; ")
-    cmd = wheel_commands(model.robot, inputs.twist)  # at the program's knots
+    cmd = wheel_commands(model.robot, inputs.twist, slip_tol=SLIP_TOL)  # at the program's knots
     slip = np.abs(cmd.slip)
-    geared = rolls_in_gear(model.robot, cmd).all(axis=0).tolist()
+    geared = cmd.in_gear.all(axis=0).tolist()
     broken = [c for c, ok in zip(model.robot.couplings, geared, strict=True) if not ok]
     if broken:
         ratios = ", ".join(f"{k:g}" for k in broken[0].ratios)

@@ -17,7 +17,6 @@ import csv
 import math
 import os
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -30,11 +29,6 @@ from ..units import BARE_ANGLE_LIMIT
 from .linkages import linkage_breach
 from .model import DynamicModel
 from .simulate import Inputs, _knots, joint_column
-
-if TYPE_CHECKING:
-    from ..kinematics.wheel_ik import WheelCommands
-    from ..robot import Robot
-    from ..wheels import Wheel
 
 #: Natural frequency [rad/s] of the programs' servos (the default `bandwidth`): a fixed step longer than its
 #: inverse cannot resolve them (``wmrkit simulate --path``).
@@ -80,32 +74,6 @@ def path_program(model: DynamicModel, name: str, *, speed: float = 2.0, radius_s
                           f"{radius_scale:g} x 2 m/s / speed times their durations at 2 m/s)")
     feasible = feasible_twists(model, np.array(twists))  # the slip left (a skid steer's turns) is the robot's
     return twist_program(model, np.array(times), feasible, bandwidth=bandwidth, allow_slip=True), t
-
-
-def rolls_in_gear(robot: Robot, cmd: WheelCommands) -> np.ndarray:
-    """``(..., n_couplings)`` bool: `cmd` (:func:`~wmrkit.kinematics.wheel_ik.wheel_commands` of `robot`) turns each
-    coupling's joints in its ratios as the slip check judges a fixed wheel's slip: within ``wheel_ik.GEAR_RTOL`` of
-    the largest rate (``cmd.in_gear``) or, the same absolute floor as ``SLIP_TOL`` [m/s], a joint's rate off the
-    gear's by at most ``SLIP_TOL`` over its lever (a spin's wheel radius, a steering rate's castor offset or
-    half-width: the speed it moves a contact at). A twist of 1e-320 rad/s was out of gear, 1e-320 m/s of slip not."""
-    ok = np.array(cmd.in_gear)
-    for g, c in enumerate(robot.couplings):
-        if c.kind != "gear":
-            continue
-        cols = [cmd.rate_names.index(j) for j in c.joints]
-        lever = np.array([_lever(robot.wheel(j.partition(".")[0]), j.partition(".")[2]) for j in c.joints])
-        q, k = cmd.rates[..., cols], np.array(c.ratios, dtype=float)
-        off = np.abs(q - (q @ k / (k @ k))[..., None] * k) * lever  # wheel_ik.gear_error's terms, as speeds
-        ok[..., g] |= np.max(off, axis=-1) <= SLIP_TOL
-    return ok
-
-
-def _lever(wheel: Wheel, joint: str) -> float:
-    """The length [m] turning `joint`'s rate [rad/s] into the speed of the wheel's contact: the radius of a spin,
-    the castor offset or half-width (the larger) of a steering rate."""
-    if joint.startswith("spin"):
-        return abs(wheel.r)
-    return max(abs(getattr(wheel, key)) for key in ("d", "b") if key in wheel.kind.required)
 
 
 def feasible_twists(model: DynamicModel, twists: ArrayLike) -> np.ndarray:
@@ -172,7 +140,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
                           f"'{robot.name}': fixed wheel '{robot.wheel_names[w]}' would slip sideways at "
                           f"{abs(cmd.slip[k, w]):.3g} m/s; use feasible_twists(model, twists) for the closest "
                           "feasible motion, or allow_slip=True to let the tyres slip (skid steering)")
-    geared = rolls_in_gear(robot, cmd)
+    geared = cmd.in_gear  # each departure's contact speed within SLIP_TOL too (gear_check)
     if not allow_slip and not geared.all():
         k, g = (int(i) for i in np.argwhere(~geared)[0])
         c = robot.couplings[g]

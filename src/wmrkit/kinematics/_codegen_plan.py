@@ -18,6 +18,7 @@ from ..couplings import gear_free, gear_unknowns
 from ..errors import SingularError, WmrkitError, name_list
 from ..robot import TWIST_NAMES, Robot
 from ._symbolic_held import combine, held_gears, substituted_form
+from .gear_check import gear_table
 from .linalg import free_columns, matrix_rank, nondimensional
 from .models import generic_inputs
 from .symbolic import sensed_rates, symbolic_constraint_matrix, symbolic_model
@@ -73,10 +74,9 @@ class Plan:
         self.steer_rate = tuple(sp.Symbol(f"s{i}", real=True) for i in range(len(self.free_steer)))
         self.rates, matrix, self.inverse_exact = self._inverse_form(TWIST_NAMES + self.free_steer)
         self.inverse = [e for e in matrix * sp.Matrix(self.twist + self.steer_rate)]
-        # each gear: its name, its joints' positions in the rates then the steering rates, its ratios (ik's check)
-        joints = (*self.rates, *self.free_steer)
-        self.gears = tuple((c.channel_name, tuple(joints.index(j) for j in c.joints), tuple(map(float, c.ratios)))
-                           for c in robot.couplings if c.kind == "gear")
+        # the gears over the rates then the steering rates (gear_check's tables: ik's check), and their names
+        self.gear_table = gear_table(robot, (*self.rates, *self.free_steer))
+        self.gear_names = tuple(robot.couplings[i].channel_name for i in self.gear_table.coupling)
 
     def _check_forward(self) -> None:
         beta = np.random.default_rng(7).uniform(-math.pi, math.pi, (3, len(self.robot.steer_names)))

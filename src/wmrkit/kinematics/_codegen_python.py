@@ -8,8 +8,9 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
 from ._codegen_plan import Plan, cse
+from .gear_check import GEAR_RTOL
 from .symbolic import printable
-from .wheel_ik import GEAR_RTOL
+from .wheel_ik import SLIP_TOL
 
 
 def _py_body(exprs: list[sp.Expr], targets: list[str]) -> str:
@@ -25,15 +26,23 @@ def _py_unknowns(plan: Plan) -> str:
     if not plan.geared:
         return f"_SENSED_COLUMNS = {list(plan.sensed_cols)!r}\n_UNKNOWN_COLUMNS = {list(plan.unknown_cols)!r}"
     return "\n".join([
-        f"GEAR_NAMES = {tuple(name for name, _, _ in plan.gears)!r}",
+        f"GEAR_NAMES = {plan.gear_names!r}",
         f"GEAR_RTOL = {GEAR_RTOL!r}",
-        f"_GEARS = {tuple((idx, k) for _, idx, k in plan.gears)!r}  # (joints in the rates, ratios)",
+        f"SLIP_TOL = {SLIP_TOL!r}  # [m/s]",
+        f"_GEARS = {_py_gears(plan)!r}  # (joints in the rates, ratios, levers [m])",
         "# the forward model's unknowns x: the twist, the unsensed rates, a gear none of whose joints is sensed (its",
         "# turn u); every velocity q = _FREE @ x + _KNOWN @ sensed, a gear's joints turning together, "
         "q_j = ratio_j * u",
         f"UNKNOWN_NAMES = {tuple(plan.unknown_names)!r}",
         f"_FREE = numpy.array({plan.free.tolist()!r})",
         f"_KNOWN = numpy.array({plan.known.tolist()!r})"])
+
+
+def _py_gears(plan: Plan) -> tuple[tuple[tuple[int, ...], tuple[float, ...], tuple[float, ...]], ...]:
+    """Each gear's joints (positions in the rates then the steering rates), ratios and levers [m]."""
+    t = plan.gear_table
+    spans = [slice(int(t.start[g]), int(t.start[g + 1])) for g in range(len(t.coupling))]
+    return tuple((tuple(t.joint[s].tolist()), tuple(t.ratio[s].tolist()), tuple(t.lever[s].tolist())) for s in spans)
 
 
 def _py_forward_system(plan: Plan) -> str:
@@ -59,16 +68,25 @@ def _py_in_gear(plan: Plan) -> str:
 
 def in_gear({args}):
     """Whether each gear (``GEAR_NAMES``) turns its joints in its ratios, ``q_j = ratio_j * u``, as ``wmrkit ik``
-    checks a twist: ``max |q_j - ratio_j u| <= GEAR_RTOL max |q|``, ``u = k.q / k.k``; ``(..., {len(plan.rates)})``
-    rates{" and steering rates" if plan.free_steer else ""} (from ``inverse``) ``-> (..., {len(plan.gears)})`` bool.
+    checks a twist: with ``u = k.q / k.k`` and ``e_j = |q_j - ratio_j u|``, every ``e_j <= GEAR_RTOL max |q|`` or
+    every ``e_j lever_j <= SLIP_TOL`` [m/s] (the contact speed of the departure);
+    ``(..., {len(plan.rates)})`` rates{" and steering rates" if plan.free_steer else ""} (from ``inverse``) \
+``-> (..., {len(plan.gear_names)})`` bool.
     """
     {"rates" if s else "q"} = {inputs}
     scale = GEAR_RTOL * numpy.abs(q).max(axis=-1)
     out = []
-    for joints, k in _GEARS:
-        k, g = numpy.asarray(k), q[..., list(joints)]
-        error = numpy.abs(g - (g @ k / (k @ k))[..., None] * k).max(axis=-1)
-        out.append(error <= scale)
+    for joints, ratios, levers in _GEARS:
+        kq = kk = 0.0
+        for j, k in zip(joints, ratios):
+            kq = kq + k * q[..., j]
+            kk = kk + k * k
+        relative = absolute = True
+        for j, k, lever in zip(joints, ratios, levers):
+            e = numpy.abs(q[..., j] - k * (kq / kk))
+            relative = relative & (e <= scale)
+            absolute = absolute & (e * lever <= SLIP_TOL)
+        out.append(relative | absolute)
     return numpy.stack(out, axis=-1)'''
 
 

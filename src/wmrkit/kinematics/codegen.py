@@ -27,8 +27,9 @@ from sympy.printing.c import C99CodePrinter
 from ..robot import Robot
 from ._codegen_plan import C_KEYWORDS, CodegenError, Plan, cse, identifier
 from ._codegen_python import python_file
+from .gear_check import GEAR_RTOL
 from .symbolic import printable
-from .wheel_ik import GEAR_RTOL
+from .wheel_ik import SLIP_TOL
 
 __all__ = ["C_KEYWORDS", "MAX_FILENAME", "MAX_STACK_WORK", "CodegenError", "identifier", "write_code"]
 
@@ -191,7 +192,7 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
         f"double work[{p}_N_WORK]);",
     ]
     if plan.geared:  # wmrkit ik's check of the inverse model's rates
-        sizes["N_GEARS"] = len(plan.gears)
+        sizes["N_GEARS"] = len(plan.gear_names)
         protos.append(f"int {n}_in_gear(const double rates[{p}_N_RATES], {steer_param}int in_gear[{p}_N_GEARS]);")
     work_bytes = 8 * sizes["N_WORK"]
     header = "\n".join([
@@ -261,8 +262,9 @@ def _c_gear_doc(plan: Plan) -> list[str]:
     return [" * The forward model holds the gears: a gear's unsensed joints turn with its sensed ones,",
             " *   q_j = ratio_j u; a gear none of whose joints is sensed is one unknown, its turn u (as wmrkit fk).",
             f" * {n}_in_gear: whether each gear turns the rates (of {n}_inverse) in its ratios, in_gear[{p}_N_GEARS]",
-            f" *   (as wmrkit ik: max |q_j - ratio_j u| <= {GEAR_RTOL!r} max |q|, u = k.q / k.k); returns 1 if all do,",
-            _c_list(" *   else 0 (also for a NaN rate). Gears", [g for g, _, _ in plan.gears])]
+            f" *   as wmrkit ik: u = k.q / k.k, e_j = |q_j - ratio_j u|, every e_j <= {GEAR_RTOL!r} max |q| or every",
+            f" *   e_j lever_j <= {SLIP_TOL!r} m/s (the contact speed of the departure); returns 1 if all do,",
+            _c_list(" *   else 0 (also for a NaN rate). Gears", plan.gear_names)]
 
 
 def _c_in_gear(plan: Plan, proto: str) -> list[str]:
@@ -272,31 +274,33 @@ def _c_in_gear(plan: Plan, proto: str) -> list[str]:
         return []
     p, steer = plan.name.upper(), len(plan.free_steer)
     size = f"{p}_N_RATES + {p}_N_FREE_STEER" if steer else f"{p}_N_RATES"
-    joints = [j for _, idx, _ in plan.gears for j in idx]
-    ratios = [k for _, _, ks in plan.gears for k in ks]
-    starts = [0]
-    for _, idx, _ in plan.gears:
-        starts.append(starts[-1] + len(idx))
+    t = plan.gear_table
+    joints, ratios, levers, starts = t.joint.tolist(), t.ratio.tolist(), t.lever.tolist(), t.start.tolist()
     copy = [f"    for (int i = 0; i < {p}_N_RATES; ++i) q[i] = rates[i];"]
     if steer:
         copy.append(f"    for (int i = 0; i < {p}_N_FREE_STEER; ++i) q[{p}_N_RATES + i] = steer_rate[i];")
     return [
         f"static const int gear_joint[{len(joints)}] = {{{', '.join(map(str, joints))}}};",
         f"static const double gear_ratio[{len(ratios)}] = {{{', '.join(map(repr, ratios))}}};",
+        f"static const double gear_lever[{len(levers)}] = {{{', '.join(map(repr, levers))}}}; /* [m] */",
         f"static const int gear_start[{len(starts)}] = {{{', '.join(map(str, starts))}}};", "",
         proto[:-1], "{",
         f"    double q[{size}], scale = 0.0;", *copy,
-        f"    for (int i = 0; i < {size}; ++i) scale = fmax(scale, fabs(q[i]));",
+        f"    for (int i = 0; i < {size}; ++i) scale = fabs(q[i]) > scale || isnan(q[i]) ? fabs(q[i]) : scale;",
         "    int all = 1;",
         f"    for (int g = 0; g < {p}_N_GEARS; ++g) {{",
-        "        double kq = 0.0, kk = 0.0, error = 0.0;",
+        "        double kq = 0.0, kk = 0.0;",
+        "        int relative = 1, absolute = 1; /* round-off of the rates, or the slip floor at the contacts */",
         "        for (int j = gear_start[g]; j < gear_start[g + 1]; ++j) {",
         "            kq += gear_ratio[j] * q[gear_joint[j]];",
         "            kk += gear_ratio[j] * gear_ratio[j];",
         "        }",
-        "        for (int j = gear_start[g]; j < gear_start[g + 1]; ++j)",
-        "            error = fmax(error, fabs(q[gear_joint[j]] - gear_ratio[j] * (kq / kk)));",
-        f"        in_gear[g] = error <= {GEAR_RTOL!r} * scale; /* u = kq / kk, the gear's least-squares turn */",
+        "        for (int j = gear_start[g]; j < gear_start[g + 1]; ++j) {",
+        "            double e = fabs(q[gear_joint[j]] - gear_ratio[j] * (kq / kk)); /* u = kq / kk, the gear's turn */",
+        f"            relative = relative && e <= {GEAR_RTOL!r} * scale;",
+        f"            absolute = absolute && e * gear_lever[j] <= {SLIP_TOL!r};",
+        "        }",
+        "        in_gear[g] = relative || absolute;",
         "        all = all && in_gear[g];",
         "    }",
         "    return all;", "}", "",

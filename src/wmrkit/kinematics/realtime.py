@@ -34,7 +34,8 @@ from ..odometry._kernels import _cos_sin, _sinc
 from ..robot import Robot
 from ..units import MAX_ANGLE, MAX_TURNS
 from . import _ik_fast
-from .wheel_ik import GEAR_RTOL, check_tolerances
+from .gear_check import GEAR_RTOL, gear_table
+from .wheel_ik import SLIP_TOL, check_tolerances
 
 drop_stale_cache([__file__], [_kernels.__file__])
 
@@ -68,7 +69,7 @@ class Realtime:
 
 @functools.lru_cache(maxsize=16)
 def realtime(robot: Robot, sensed: tuple[str, ...] | None = None, *, speed_tol: float = 1e-12,
-             slip_tol: float = 1e-9) -> Realtime:
+             slip_tol: float = SLIP_TOL) -> Realtime:
     """Compile the single-call kinematics of `robot` (about a second, once per robot and process: kept); `sensed`
     as for the odometry model."""
     from ..odometry.model import odometry_model
@@ -126,11 +127,9 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
     too_big = f"ik: the twist (vx, vy, omega) must be finite, each at most {limit:g} in size"
     bad_heading = f"ik: the headings must be finite, at most {MAX_TURNS:g} turns [rad]"
     max_angle = MAX_ANGLE  # wheel_commands' bound (as_angles): beyond, the wrapped angle is round-off
-    gears = [c for c in robot.couplings if c.kind == "gear"]  # wheel_commands' in_gear, flattened
-    gear_cols = np.array([robot.rate_names.index(j) for c in gears for j in c.joints], dtype=np.int64)
-    gear_k = np.array([k for c in gears for k in c.ratios], dtype=float)
-    gear_start = np.cumsum([0] + [len(c.joints) for c in gears]).astype(np.int64)
-    n_gears, gear_rtol = len(gears), GEAR_RTOL
+    gears = gear_table(robot, robot.rate_names)  # wheel_commands' in_gear (gear_check.gears_hold), flattened
+    gear_cols, gear_k, gear_lever, gear_start = gears.joint, gears.ratio, gears.lever, gears.start
+    n_gears, gear_rtol = len(gears.coupling), GEAR_RTOL
 
     @numba.njit(cache=False)
     def wrap(a):
@@ -199,14 +198,18 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
         largest = 0.0
         for j in range(n_rates if n_gears else 0):  # robots without gears skip this (the one-call path's cost)
             largest = max(largest, abs(rates_out[j]))
-        for g in range(n_gears):  # a gear turns its joints as q_j = k_j u (wheel_ik.gear_error)
+        for g in range(n_gears):  # a gear turns its joints as q_j = k_j u (gear_check.gears_hold)
             kq, kk = 0.0, 0.0
             for t in range(gear_start[g], gear_start[g + 1]):
                 kq += gear_k[t] * rates_out[gear_cols[t]]
                 kk += gear_k[t] * gear_k[t]
+            relative, absolute = True, True  # round-off of the rates, or the slip floor at the contacts
             for t in range(gear_start[g], gear_start[g + 1]):
-                if abs(rates_out[gear_cols[t]] - gear_k[t] * (kq / kk)) > gear_rtol * largest:
-                    feasible = False
+                e = abs(rates_out[gear_cols[t]] - gear_k[t] * (kq / kk))
+                relative = relative and e <= gear_rtol * largest
+                absolute = absolute and e * gear_lever[t] <= slip_tol
+            if not (relative or absolute):
+                feasible = False
         return feasible
 
     return ik

@@ -26,16 +26,17 @@ from ..units import MAX_ANGLE, UnitError, parse_quantity
 from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
 from ._ik_fast import wrap_angle
+from .gear_check import GEAR_RTOL, gear_table, gears_hold
 from .linalg import geared_solve, geared_twist_determined, robot_size
 
-__all__ = ["WheelCommands", "forward_kinematics", "gear_error", "resolve_rate_name", "twist_is_determined",
+__all__ = ["GEAR_RTOL", "WheelCommands", "forward_kinematics", "gear_error", "resolve_rate_name", "twist_is_determined",
            "wheel_commands", "wrap_angle"]
 
-#: A gear coupling's rates are in its ratios when they depart from them by at most this fraction of the largest
-#: joint rate of the command (round-off of the rates (8.12)-(8.28) is ~1e-16 of it).
-GEAR_RTOL = 1e-9
 #: :func:`wheel_commands`' default ``speed_tol`` [m/s]: a steering axis slower than this holds its angle.
 SPEED_TOL = 1e-12
+#: :func:`wheel_commands`' default ``slip_tol`` [m/s]: a fixed wheel's side slip, and a gear's departure at a contact
+#: (:mod:`.gear_check`), within it roll (also the floor of ``realtime``'s ik and the generated ``in_gear``).
+SLIP_TOL = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,8 +64,9 @@ class WheelCommands:
       that do not steer. ``steer`` is the same angle in the thesis's convention (β, the axle).
     - ``held`` ``(..., N)`` bool: the steering axis does not move, the angle is undefined and was kept.
     - ``in_gear`` ``(..., n_couplings)`` bool, one per ``robot.couplings``: a ``gear``'s joint rates are
-      ``ratio_j * u`` for one ``u`` (:func:`gear_error` within ``GEAR_RTOL`` of the largest rate); True for the
-      other kinds (a differential leaves the rates' difference free; a linkage's geometry is not modelled).
+      ``ratio_j * u`` for one ``u`` (:func:`~wmrkit.kinematics.gear_check.gears_hold`: each departure within
+      ``GEAR_RTOL`` of the largest rate, or moving its contact by at most ``slip_tol``); True for the other
+      kinds (a differential leaves the rates' difference free; a linkage's geometry is not modelled).
     """
 
     wheel_names: tuple[str, ...]
@@ -122,7 +124,7 @@ def check_tolerances(speed_tol: float, slip_tol: float) -> None:
 
 def wheel_commands(
     robot: Robot, twist_robot: ArrayLike, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None,
-    speed_tol: float = SPEED_TOL, slip_tol: float = 1e-9,
+    speed_tol: float = SPEED_TOL, slip_tol: float = SLIP_TOL,
 ) -> WheelCommands:
     """Per-wheel inverse kinematics of the thesis §8.4 for a batch of body twists.
 
@@ -139,7 +141,8 @@ def wheel_commands(
     - fixed: spin (8.12) at its constant angle, and the lateral slip (8.14) the twist leaves: ``feasible`` is
       False when any exceeds `slip_tol` [m/s] (e.g. ``v_y != 0`` for a differential drive).
     - a ``gear`` coupling (``robot.couplings``) whose joints the twist asks to turn out of its ratios (a solid rear
-      axle asked to turn) makes it False too: ``in_gear``.
+      axle asked to turn) makes it False too: ``in_gear``, a departure moving a contact by more than `slip_tol`
+      (the floor of the slip check: a turn of 1e-320 rad/s rolls as a side speed of 1e-320 m/s does).
     """
     check_tolerances(speed_tol, slip_tol)
     p = _ik_fast.plan(robot)
@@ -172,9 +175,9 @@ def wheel_commands(
         in_range = heading_in_range(np.nan_to_num(heading), *p.steer_range)
         feasible = feasible & np.all(in_range, axis=-1)
     in_gear = np.ones((*batch, len(robot.couplings)), dtype=bool)
-    for i, c in enumerate(robot.couplings):
-        if c.kind == "gear":
-            in_gear[..., i] = gear_error(c, p.rate_names, rates) <= GEAR_RTOL * np.abs(rates).max(axis=-1)
+    gears = gear_table(robot, p.rate_names) if robot.couplings else None
+    if gears is not None and gears.coupling:
+        in_gear[..., list(gears.coupling)] = gears_hold(gears, rates, slip_tol)
     feasible = feasible & np.all(in_gear, axis=-1)
     return WheelCommands(
         wheel_names=p.wheel_names, rate_names=p.rate_names, steer=_ro(steer), spin=_ro(spin),
