@@ -209,6 +209,16 @@ def test_a_tiny_initial_twist_starts_alike_whichever_speed_it_holds(twist, tmp_p
     assert "0.01 s simulated" in capsys.readouterr().out
 
 
+@pytest.mark.parametrize("vy", ["1.1e-6", "-1.1e-6"])
+def test_the_initial_twist_refusal_says_vy_0_not_minus_0(vy, tmp_path, capsys):
+    # a side speed of the cart (axle at the origin: it rolls at VY = 0 whatever VX and OMEGA) printed "VY = -0 m/s"
+    robot = tmp_path / "cart.yaml"
+    robot.write_text(_geared_cart(1.0))
+    assert main(["simulate", str(robot), "--path", "straight", "--initial-twist", "0", vy, "0"]) == 2
+    err = capsys.readouterr().err
+    assert "it rolls at VY = 0 m/s)" in err and "VY = -0" not in err
+
+
 # 5. `batch calibrate --level` within (0.5, 0.9999], named; the level printed as given.
 
 @pytest.fixture(scope="module")

@@ -217,7 +217,7 @@ def _check_rolling(model, twist: list[float]) -> None:
         return
     w = int(np.argmax(slip))
     rolling = feasible_twists(model, [twist])[0]
-    hint = (f"with this VX and OMEGA it rolls at VY = {rolling[1]:.6g} m/s"
+    hint = (f"with this VX and OMEGA it rolls at VY = {rolling[1] + 0.0:.6g} m/s"  # + 0.0: no "-0"
             if np.abs(wheel_commands(model.robot, rolling).slip).max() <= SLIP_TOL else "no VY makes it roll")
     raise WmrkitError(f"--initial-twist {' '.join(f'{v:g}' for v in twist)}: fixed wheel "
                       f"'{model.robot.wheel_names[w]}' would slip sideways at {slip[w]:.3g} m/s, and the simulation "
