@@ -13,6 +13,7 @@ from wmrkit.control.dynamic_plant import fast_law_controller, simulate_dynamics
 from wmrkit.control.laws import PositionLaw
 from wmrkit.control.slip_loop import simulate_slip_control
 from wmrkit.control.track import initial_pose_on
+from wmrkit.dynamics import runs
 from wmrkit.dynamics.runs import LiftOffError
 from wmrkit.errors import WmrkitError
 
@@ -61,3 +62,18 @@ def test_a_real_lift_off_in_the_loop_still_says_lift_off(name, contact, step, fi
     with pytest.raises(LiftOffError, match=f"contact '{contact}' lifts off the ground") as err:
         simulate_dynamics(robot, controller, pose0, reference.duration, period=0.02, step=step)
     assert first <= err.value.t <= last
+
+
+def test_a_loop_recheck_whose_budget_ends_before_the_loop_does_says_so(monkeypatch):
+    """With a budget of 40 s of 1 ms steps the re-run of the skid steer's square (48 s) stops short of its end: it
+    blamed the step ("goes on to t = 40 s without it: the step is too long ..."), and now says it is not known."""
+    monkeypatch.setattr(runs, "RECHECK_STEPS", 40_000)
+    robot, square = catalog.load("skid-steer-4"), builtin_reference("square")
+    controller, pose0 = _loop(robot, square)
+    with pytest.raises(WmrkitError) as err:
+        simulate_dynamics(robot, controller, pose0, square.duration, period=0.02, step=0.02)
+    assert str(err.value) == (
+        "contact 'front_left' lost its load at t = 36.24 s at step 0.02 s; the same loop at step 0.001 s goes on "
+        f"without it to t = 40 s, where the re-check's budget ends, short of the end at t = {square.duration:g} s: "
+        "whether the step (the integration unstable) or the robot stops it is not known; use a step of at most "
+        "0.001 s (the step argument) to tell, or smaller torques or speeds")

@@ -11,9 +11,10 @@ import pytest
 
 from wmrkit import catalog
 from wmrkit.cli.main import main
+from wmrkit.dynamics import runs
 from wmrkit.dynamics.model import DynamicModel
 from wmrkit.dynamics.programs import path_program, twist_program
-from wmrkit.dynamics.runs import RECHECK_MAX_STEP, recheck_step
+from wmrkit.dynamics.runs import RECHECK_MAX_STEP, LiftOffError, recheck_step
 from wmrkit.dynamics.simulate import simulate
 from wmrkit.errors import WmrkitError
 
@@ -90,3 +91,36 @@ def test_the_recheck_step_is_a_whole_fraction_of_the_step_at_most_a_quarter_and_
     assert fine <= RECHECK_MAX_STEP[method] * (1 + 1e-12)
     assert fine > RECHECK_MAX_STEP[method] / 2 or round(parts) == 4  # not needlessly short
     assert np.isfinite(fine)
+
+
+def test_a_robot_lift_off_the_shorter_step_reaches_late_is_not_blamed_on_the_step(capsys):
+    """The forklift's figure-eight at 2.8 m/s 'loses' a drive wheel's load at t = 1.41 s at 10 ms, and the robot
+    loses it at t = 7.81 s: the re-check ran only to 0.1 s past the stop and said "... goes on to t = 1.51 s without
+    it: the step is too long for the tyres (the integration is unstable, not the robot)"; it runs to the end now."""
+    err = _error(capsys, "simulate", "forklift", "--path", "figure-eight", "--speed", "2.8", "--step", "0.01")
+    assert err == ("wmrkit: error: contact 'left_drive' lost its load at t = 1.41 s at step 0.01 s, but a run at step "
+                   "0.001 s goes on without it until contact 'left_drive' lost its load at t = 7.809 s: the robot's "
+                   "stop, which the step brought early; use smaller torques or speeds, and a step of at most 0.001 s "
+                   "(--step) or the adaptive method\n")
+    # independently, without the re-check: the 1 ms run keeps the wheel loaded past 1.51 s and empties it by 7.81 s
+    model = DynamicModel.of(catalog.load("forklift"))
+    inputs, _ = path_program(model, "figure-eight", speed=2.8)
+    sim = simulate(model, inputs, 7.85, record_step=0.01, allow_lift_off=True)
+    load = sim.loads[:, model.contacts.index("left_drive")]
+    assert load[sim.t <= 7.75].min() > 0 and load[sim.t >= 7.82].min() == 0.0
+
+
+def test_a_recheck_whose_budget_ends_before_the_run_does_says_so(monkeypatch):
+    """The re-check of the rectangle's stop at 10 ms (t = 0.22 s) at 1 ms with a budget of 2 s of steps cannot
+    reach the run's end: it blamed the step ("goes on to t = 0.32 s"), and now says the verdict is not known."""
+    monkeypatch.setattr(runs, "RECHECK_STEPS", 2000)
+    model = DynamicModel.of(catalog.load("forklift"))
+    inputs, duration = path_program(model, "rectangle")
+    with pytest.raises(WmrkitError) as err:
+        simulate(model, inputs, duration, step=0.01)
+    assert str(err.value) == (
+        f"contact 'steer' lost its load at t = 0.22 s at step 0.01 s; a run at step 0.001 s goes on without it to "
+        f"t = 2.21 s, where the re-check's budget ends, short of the end at t = {round(duration / 0.01) * 0.01:.6g} s: "
+        "whether the step (the integration unstable) or the robot stops it is not known; use a step of at most "
+        "0.001 s (--step) or the adaptive method to tell, or smaller torques or speeds")
+    assert not isinstance(err.value, LiftOffError)

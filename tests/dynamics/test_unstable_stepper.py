@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from wmrkit import catalog
+from wmrkit.dynamics import runs
 from wmrkit.dynamics._integrate import model_work_arrays, run
 from wmrkit.dynamics.model import DynamicModel
 from wmrkit.dynamics.programs import path_program, twist_program
@@ -94,3 +95,35 @@ def test_without_a_log_a_stop_is_not_rechecked(rectangle):
     model, inputs = rectangle
     with pytest.raises(LiftOffError, match="contact 'steer' lifts off the ground"):
         Stepper(model, step=0.01, recheck=False).advance(inputs, 0.5)
+
+
+def test_a_robot_lift_off_the_shorter_step_reaches_late_is_not_blamed_on_the_step():
+    """The figure-eight program at 2.8 m/s through a Stepper at 10 ms 'loses' a drive wheel's load at t = 1.41 s;
+    the robot loses it at 7.81 s (test_unstable_step.py checks it without the re-check). The re-check held the
+    inputs 0.1 s past the stop and blamed the step ("goes on to t = 1.51 s"); it runs the program to its end now."""
+    model = DynamicModel.of(catalog.load("forklift"))
+    inputs, duration = path_program(model, "figure-eight", speed=2.8)
+    stepper = Stepper(model, step=0.01)
+    with pytest.raises(LiftOffError) as err:
+        for _ in range(round(duration / 0.05)):
+            stepper.advance(inputs, 0.05)
+    assert str(err.value) == (
+        "contact 'left_drive' lost its load at t = 1.41 s at step 0.01 s, but a run of its inputs at step 0.001 s "
+        "goes on without it until contact 'left_drive' lost its load at t = 7.809 s: the robot's stop, which the "
+        "step brought early; use smaller torques or speeds, and a step of at most 0.001 s (the step argument)")
+    assert err.value.t == pytest.approx(7.809) and err.value.contact == "left_drive"
+
+
+def test_a_recheck_whose_budget_ends_before_the_inputs_do_says_so(rectangle, monkeypatch):
+    """With a budget of 2 s of 1 ms steps, the re-check of the rectangle's stop at 10 ms cannot reach the program's
+    end (its last knot, 22.4 s): it blamed the step, and now says the verdict is not known."""
+    monkeypatch.setattr(runs, "RECHECK_STEPS", 2000)
+    model, inputs = rectangle
+    stepper = Stepper(model, step=0.01)
+    with pytest.raises(WmrkitError) as err:
+        stepper.advance(inputs, 0.5)
+    assert str(err.value) == (
+        "contact 'steer' lost its load at t = 0.22 s at step 0.01 s; a run of its inputs at step 0.001 s goes on "
+        f"without it to t = 2 s, where the re-check's budget ends, short of the end at t = {inputs.time[-1]:.6g} s: "
+        "whether the step (the integration unstable) or the robot stops it is not known; use a step of at most "
+        "0.001 s (the step argument) to tell, or smaller torques or speeds")

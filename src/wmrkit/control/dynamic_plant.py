@@ -48,40 +48,42 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
     """
     return rechecked(lambda d, h, _: _dynamics_loop(robot, controller, initial_pose, d, period=period, delay=delay,
                                                     tyre=tyre, step=h, feedback=feedback, policy=policy,
-                                                    until=until), duration, step)
+                                                    until=until), duration, step, period)
 
 
-def rechecked(loop: Callable[[float, float, bool], dict], duration: float, step: float) -> dict:
-    """``loop(duration, step, False)``: a closed loop through the dynamics for `duration` [s] at `step` [s] (its
-    :class:`~wmrkit.dynamics.simulate.Stepper` made with ``recheck=False``; the last argument True for the re-run),
-    re-checked when it stops at t (a wheel lifts off, the state or the law's command diverges): the same loop runs
-    again from t = 0 at
-    :func:`~wmrkit.dynamics.runs.recheck_step` to its end (at most :func:`~wmrkit.dynamics.runs.recheck_budget`
-    steps, and at least to :func:`~wmrkit.dynamics.runs.recheck_end`, else there is no re-check), and when it runs
-    there without stopping, the error blames the step (the integration unstable, not the robot: the skid steer on
-    the square 'lost' a wheel's load at t = 36.2 s at a 20 ms step, and keeps its wheels down at 1 ms). To its end,
-    not 0.1 s past the stop as :func:`wmrkit.dynamics.simulate.simulate`: the forklift on the arc-line at 2 m/s
-    lifts a drive wheel off at t = 2.40 s at 1 ms, and at 2.52 s from 0.25 ms down. The loop's `controller` and
-    `until` are called again from t = 0 (a law is a function of its arguments)."""
-    from ..dynamics.runs import DivergedError, LiftOffError, recheck_budget, recheck_end, recheck_step, unstable_step
+def rechecked(loop: Callable[[float, float, bool], dict], duration: float, step: float, period: float) -> dict:
+    """``loop(duration, step, False)``: a closed loop through the dynamics for `duration` [s] at `step` [s], control
+    `period` [s] (its :class:`~wmrkit.dynamics.simulate.Stepper` made with ``recheck=False``; the last argument True
+    for the re-run), re-checked when it stops at t (a wheel lifts off, the state or the law's command diverges): the
+    same loop runs again from t = 0 at :func:`~wmrkit.dynamics.runs.recheck_step` to its end, or as far as
+    :func:`~wmrkit.dynamics.runs.recheck_budget` steps reach. When that run stops too the stop is the robot's; when it
+    runs to the end without stopping, the error blames the step (the integration unstable, not the robot: the skid
+    steer on the square 'lost' a wheel's load at t = 36.2 s at a 20 ms step, and keeps its wheels down at 1 ms); when
+    the budget ends first, it says the verdict is not known. To its end, not 0.1 s past the stop: the forklift on
+    the arc-line at 2 m/s lifts a drive wheel off at t = 2.40 s at 1 ms, and at 2.52 s from 0.25 ms down. The loop's
+    `controller` and `until` are called again from t = 0 (a law is a function of its arguments)."""
+    from ..dynamics.runs import DivergedError, LiftOffError, recheck_budget, recheck_step, unstable_step
 
     try:
         return loop(duration, step, False)
     except (LiftOffError, DivergedError, StoppedRun) as err:
         fine, t = recheck_step(step, 0), err.t
-        end = min(duration, recheck_budget(0) * fine)
-        if not (math.isfinite(t) and end >= recheck_end(t, step)):
+        if not math.isfinite(t):
             raise
+        end = min(duration, recheck_budget(0) * fine)
         try:
             out = loop(end, fine, True)
         except (LiftOffError, DivergedError, StoppedRun):
             raise err from None
-        if out["t"][-1] < t:  # it ended (arrived) before the stop: no verdict
+        reached = float(out["t"][-1])
+        cut = end < duration and reached > end - period  # by the budget, not by the loop's own end (`until`)
+        if reached < t and not cut:  # it ended (arrived) before the stop: no verdict
             raise
         what = (f"contact '{err.contact}' lost its load at t = {t:.6g} s" if isinstance(err, LiftOffError) else
                 f"the simulation diverged before t = {t:.6g} s" if isinstance(err, DivergedError) else
                 f"the loop diverged at t = {t:.6g} s")
-        raise unstable_step(what, step, fine, float(out["t"][-1]), "(the step argument)", "the same loop") from None
+        raise unstable_step(what, step, fine, reached, "(the step argument)", "the same loop",
+                            duration if cut else -math.inf) from None
 
 
 def _dynamics_loop(robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *, period: float,

@@ -68,7 +68,7 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     return rechecked(lambda d, h, again: _slip_loop(
         robot, controller, initial_pose, d, period=period, delay=delay, tyre=tyre, step=h, slip_model=slip_model,
         feedback=feedback, weights=weights, noise=noise, inverse=inverse, ramp=ramp, progress=progress and not again,
-        policy=policy, until=until), duration, step)
+        policy=policy, until=until), duration, step, period)
 
 
 def _slip_loop(robot: Robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *,

@@ -109,46 +109,67 @@ def recheck_budget(method: int) -> int:
 
 def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_lift_off, diverged):
     """Raise the error of a fixed-step run that stopped at `t_run` [s] (diverged, or the lift-off `w` recorded),
-    after re-running the stretch that led there at :func:`recheck_step`: from the first of the records `rows` at
-    most :data:`RECHECK_STEPS` of those steps before its end (at the latest the last one before the stop) to
-    ``max(0.1 s, 10 steps)`` past the stop (or the run's end). The stop is the robot's (or its inputs') when the
-    shorter step stops too; when it does not, the step was too long for the tyres and the error says so (the load
-    transfer lags a step and the tyres saturate within one, which the implicit step does not cover: the forklift's
-    rectangle 'lifted off' its steered wheel from 8 ms; docs/dynamics.md)."""
+    after re-running it at :func:`recheck_step` to its end (`duration`): from the first of the records `rows` at
+    most :func:`recheck_budget` of those steps before the end (at the latest the last one before the stop), for at
+    most that many steps. The stop is the robot's (or its inputs') when the shorter step stops too; when it goes on
+    to the end, the step was too long for the tyres and the error says so (the load transfer lags a step and the
+    tyres saturate within one, which the implicit step does not cover: the forklift's rectangle 'lifted off' its
+    steered wheel from 8 ms; docs/dynamics.md); when its budget ends first, the error says the verdict is not known.
+    To the end, not a margin past the stop: a shorter step can reach the robot's own lift-off much later (the
+    forklift's arc-line at 2 m/s: 2.40 s at 1 ms, 2.52 s at 0.25 ms)."""
     t_stop = t_run if diverged else float(w[16][1])
-    fine = recheck_step(step, method)
-    k_end = round(min(duration, recheck_end(t_stop, step)) / fine)
-    budget = recheck_budget(method)
+    fine, budget = recheck_step(step, method), recheck_budget(method)
+    k_end = round(duration / step) * round(step / fine)  # the run's end, in fine steps
     j = min(int(np.searchsorted(rows[0], (k_end - budget) * fine)),  # the first record in the budget, and at
             max(0, int(np.searchsorted(rows[0], t_stop)) - 1))  # the latest the last one before the stop
     k0 = round(rows[0][j] / fine)  # a record's time is a whole number of steps, each a whole number of fine ones
-    if goes_on(model, rows[1][j], [(k0, k_end - k0, inp)], fine, method, jac_every, allow_lift_off):
-        raise unstable_step(stop_phrase(model, w, t_stop, diverged), step, fine, k_end * fine,
-                            "(--step) or the adaptive method")
+    k_last = min(k_end, k0 + budget)
+    judge(model, w, t_stop, diverged, rerun_stop(model, rows[1][j], [(k0, k_last - k0, inp)], fine, method,
+                                                 jac_every, allow_lift_off),
+          step, fine, k_last * fine, k_end * fine, "(--step) or the adaptive method")
     if diverged:
         raise WmrkitError(f"the simulation diverged before t = {t_run:.6g} s; use a smaller --step (or smaller "
                           "torques or speeds)")
     check_lift_off(model, w)
 
 
-def recheck_end(t_stop: float, step: float) -> float:
-    """The time [s] a re-check of a run at `step` that stopped at `t_stop` runs to: ``max(0.1 s, 10 steps)`` past."""
-    return t_stop + max(0.1, 10 * step)
-
-
-def goes_on(model: DynamicModel, s: np.ndarray, stretch: list, fine: float, method: int, jac_every: int,
-            allow_lift_off: bool) -> bool:
-    """Whether a fresh integrator run from state `s` (not changed) at step `fine` [s] through `stretch`, the
-    consecutive pieces ``(k0, steps, compiled inputs)`` counted in steps of `fine`, neither diverges nor (unless
-    `allow_lift_off`) lifts a wheel off: the re-check of a stop (:func:`_stop`, :meth:`StepLog.recheck`)."""
+def rerun_stop(model: DynamicModel, s: np.ndarray, stretch: list, fine: float, method: int, jac_every: int,
+               allow_lift_off: bool) -> tuple[bool, float, tuple] | None:
+    """Where a fresh integrator run from state `s` (not changed) at step `fine` [s] through `stretch`, the
+    consecutive pieces ``(k0, steps, compiled inputs)`` counted in steps of `fine`, stops: None when it neither
+    diverges nor (unless `allow_lift_off`) lifts a wheel off, else ``(diverged, time [s], its work arrays)``: the
+    re-check of a stop (:func:`_stop`, :meth:`StepLog.recheck`)."""
     from ._integrate import model_work_arrays, run
 
     s, acc, w, rec = s.copy(), np.zeros(model.n), model_work_arrays(model), records(model, 0)
     for k0, steps, inp in stretch:
         run(s, k0, fine, steps, 1 << 62, method, jac_every, acc, model.pack, inp, w, rec, 0)
-        if not np.all(np.isfinite(s)) or (w[16][0] and not allow_lift_off):
-            return False
-    return True
+        if not np.all(np.isfinite(s)):
+            return True, (k0 + steps) * fine, w
+        if w[16][0] and not allow_lift_off:
+            return False, float(w[16][1]), w
+    return None
+
+
+def judge(model: DynamicModel, w: tuple, t_stop: float, diverged: bool, fine_stop: tuple | None, step: float,
+          fine: float, t_reached: float, end: float, where: str, rerun: str = "a run") -> None:
+    """Raise the verdict on a fixed-step run at `step` [s] that stopped at `t_stop` [s] (diverged, or the lift-off
+    its work arrays `w` recorded), given where its re-check `rerun` at `fine` [s] stopped (:func:`rerun_stop`) or
+    that it reached `t_reached` [s] of the run's `end` [s]: the step's (:func:`unstable_step`), or, when the re-check
+    stops only after :func:`recheck_end`, the robot's later stop that the step ran into early; returns when the
+    re-check stops by then (the caller raises the stop as the robot's)."""
+    what = stop_phrase(model, w, t_stop, diverged)
+    if fine_stop is None:
+        raise unstable_step(what, step, fine, t_reached, where, rerun, end)
+    fine_diverged, t_fine, w_fine = fine_stop
+    if t_fine <= recheck_end(t_stop, step):
+        return
+    later = (f"{what} at step {step:g} s, but {rerun} at step {fine:.3g} s goes on without it until "
+             f"{stop_phrase(model, w_fine, t_fine, fine_diverged)}: the robot's stop, which the step brought early")
+    advice = f"use smaller torques or speeds, and a step of at most {fine:.3g} s {where}"
+    if fine_diverged:
+        raise DivergedError(f"{later}; {advice}", t_fine)
+    raise LiftOffError(later, advice, t_fine, model.contacts[int(w_fine[16][2])])
 
 
 def stop_phrase(model: DynamicModel, w: tuple, t_stop: float, diverged: bool) -> str:
@@ -157,12 +178,36 @@ def stop_phrase(model: DynamicModel, w: tuple, t_stop: float, diverged: bool) ->
             f"contact '{model.contacts[int(w[16][2])]}' lost its load at t = {t_stop:.6g} s")
 
 
-def unstable_step(what: str, step: float, fine: float, t_end: float, where: str, rerun: str = "a run") -> WmrkitError:
+def recheck_end(t_stop: float, step: float) -> float:
+    """``max(0.1 s, 10 steps)`` past the stop `t_stop` [s] of a run at `step` [s]: a re-check that stops by then
+    reproduces that stop (:func:`judge`), and a :class:`StepLog`'s re-check runs at least to it."""
+    return t_stop + max(0.1, 10 * step)
+
+
+class UnstableStepError(WmrkitError):
+    """A fixed-step run stopped where a re-check at the shorter step `fine` [s] went on (:func:`unstable_step`):
+    ``head`` says so, ``conclusive`` whether that re-check reached the run's end (else its budget ended first); the
+    message ends with how to set the step, `where`."""
+
+    def __init__(self, head: str, fine: float, where: str, conclusive: bool = True) -> None:
+        self.head, self.fine, self.where, self.conclusive = head, fine, where, conclusive
+        tell = "" if conclusive else " to tell, or smaller torques or speeds"
+        super().__init__(f"{head}; use a step of at most {fine:.3g} s {where}{tell}")
+
+
+def unstable_step(what: str, step: float, fine: float, t_end: float, where: str, rerun: str = "a run",
+                  end: float = -math.inf) -> UnstableStepError:
     """The error of a fixed-step run at `step` [s] that stopped (`what`: :func:`stop_phrase`) where a re-check,
-    `rerun` at `fine` [s], went on to `t_end` [s]: the step's, not the robot's; `where` says how to set the step."""
-    return WmrkitError(f"{what} at step {step:g} s, but {rerun} at step {fine:.3g} s goes on to t = {t_end:.6g} s "
-                       "without it: the step is too long for the tyres (the integration is unstable, not the robot); "
-                       f"use a step of at most {fine:.3g} s {where}")
+    `rerun` at `fine` [s], went on to `t_end` [s]: the step's, not the robot's; or, when `t_end` falls short of the
+    run's `end` [s] (the re-check's budget ended first), not known. `where` says how to set the step."""
+    if t_end < end * (1 - 1e-12):
+        return UnstableStepError(
+            f"{what} at step {step:g} s; {rerun} at step {fine:.3g} s goes on without it to t = {t_end:.6g} s, where "
+            f"the re-check's budget ends, short of the end at t = {end:.6g} s: whether the step (the integration "
+            "unstable) or the robot stops it is not known", fine, where, conclusive=False)
+    return UnstableStepError(f"{what} at step {step:g} s, but {rerun} at step {fine:.3g} s goes on to t = "
+                             f"{t_end:.6g} s without it: the step is too long for the tyres (the integration is "
+                             "unstable, not the robot)", fine, where)
 
 
 class StepLog:
@@ -189,24 +234,26 @@ class StepLog:
     def recheck(self, model: DynamicModel, w: tuple, t_now: float, step: float, method: int, jac_every: int,
                 allow_lift_off: bool, diverged: bool) -> None:
         """Raise :func:`unstable_step` when the stepper stopped at `t_now` [s] (diverged, or the lift-off `w`
-        recorded), and its logged inputs, run again at :func:`recheck_step` from the logged state at most
-        :func:`recheck_budget` of those steps before :func:`recheck_end` (at the latest the last piece before the
-        stop), the last inputs held past `t_now`, go on without it."""
+        recorded), after its logged inputs are run again at :func:`recheck_step` from the logged state at most
+        :func:`recheck_budget` of those steps before their end (at the latest the last piece before the stop), for
+        at most that many steps. Their end: the last inputs' last knot (the program given), at least `t_now` (the
+        run asked for) and at least :func:`recheck_end` (held past it: a guess of what comes next, a loop's)."""
         t_stop = t_now if diverged else float(w[16][1])
-        r, fine, pieces = self.ratio, self.fine, list(self.pieces)
-        k_end = round(recheck_end(t_stop, step) / fine)
-        starts = [piece[0] for piece in pieces]
-        j = min(bisect.bisect_left(starts, -(-(k_end - recheck_budget(method)) // r)),
-                max(0, bisect.bisect_left(starts, round(t_stop / step)) - 1))
-        stretch = [(k0 * r, min(steps * r, k_end - k0 * r), inp) for k0, steps, _, inp in pieces[j:]
-                   if k0 * r < k_end]
+        r, fine, pieces, budget = self.ratio, self.fine, list(self.pieces), recheck_budget(method)
         last = pieces[-1]
+        k_end = round(max(t_now, float(last[3][0][-1]), recheck_end(t_stop, step)) / fine)
+        starts = [piece[0] for piece in pieces]
+        j = min(bisect.bisect_left(starts, -(-(k_end - budget) // r)),
+                max(0, bisect.bisect_left(starts, round(t_stop / step)) - 1))
+        k_last = min(k_end, starts[j] * r + budget)
+        stretch = [(k0 * r, min(steps * r, k_last - k0 * r), inp) for k0, steps, _, inp in pieces[j:]
+                   if k0 * r < k_last]
         tail = (last[0] + last[1]) * r
-        if tail < k_end:
-            stretch.append((tail, k_end - tail, last[3]))
-        if goes_on(model, pieces[j][2], stretch, fine, method, jac_every, allow_lift_off):
-            raise unstable_step(stop_phrase(model, w, t_stop, diverged), step, fine, k_end * fine,
-                                "(the step argument)", "a run of its inputs")
+        if tail < k_last:
+            stretch.append((tail, k_last - tail, last[3]))
+        judge(model, w, t_stop, diverged, rerun_stop(model, pieces[j][2], stretch, fine, method, jac_every,
+                                                     allow_lift_off),
+              step, fine, k_last * fine, k_end * fine, "(the step argument)", "a run of its inputs")
 
 
 #: Most evaluations of the model an adaptive run makes (LSODA, 10-15 us each: about 2 min; the forklift's 22 s

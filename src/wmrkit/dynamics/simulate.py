@@ -199,9 +199,11 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
 
     A wheel loaded at rest whose normal load falls to 0 lifts off; the planar model cannot follow it (it clips the
     load and keeps the wheel down), so the run stops with a :class:`WmrkitError` naming the contact and the time,
-    unless `allow_lift_off`. A fixed-step run that stops so (or diverges) is re-run over that stretch at a shorter
-    step (:func:`~wmrkit.dynamics.runs.recheck_step`); when that one does not stop, the error says the step was too
-    long for the tyres (the integrator unstable, not the robot) and names the step that ran.
+    unless `allow_lift_off`. A fixed-step run that stops so (or diverges) is re-run to its end at a shorter step
+    (:func:`~wmrkit.dynamics.runs.recheck_step`); when that one does not stop, the error says the step was too long
+    for the tyres (the integrator unstable, not the robot) and names the step that ran; when it stops later, it
+    names that stop too; when the re-check's budget ends first, it says the verdict is not known
+    (:func:`~wmrkit.dynamics.runs.judge`).
     """
     model = robot if isinstance(robot, DynamicModel) else DynamicModel.of(robot, tyre)
     if method not in METHODS:
@@ -245,11 +247,11 @@ class Stepper:
     (caller-owned), anything else is copied. :meth:`advance` integrates with the semi-implicit method (or ``"rk4"``)
     at `step` [s] from time `t` [s]; it raises when a wheel lifts off unless `allow_lift_off` (as
     :func:`simulate`), and a stop is re-checked as there: the inputs it was given (logged: :class:`~.runs.StepLog`)
-    are run again at a shorter step over the stretch that led to it, and when that run goes on, the error blames the
-    step and names the one that ran (`recheck` False: no log and no re-check, for a caller that re-runs itself, as
-    the loops through the dynamics do: :func:`wmrkit.control.dynamic_plant.rechecked`). The stepper carries all
-    the integrator carries (the last acceleration for the load transfer, the tyre Jacobian and its refresh phase):
-    advancing in pieces gives, bit for bit, the run of one :func:`simulate` call.
+    are run again at a shorter step to their end (:meth:`~.runs.StepLog.recheck`), and when that run goes on, the
+    error blames the step and names the one that ran (`recheck` False: no log and no re-check, for a caller that
+    re-runs itself, as the loops through the dynamics do: :func:`wmrkit.control.dynamic_plant.rechecked`). The
+    stepper carries all the integrator carries (the last acceleration for the load transfer, the tyre Jacobian and
+    its refresh phase): advancing in pieces gives, bit for bit, the run of one :func:`simulate` call.
     """
 
     def __init__(self, model: Robot | DynamicModel, state: ArrayLike | None = None, *, step: float = 1e-3,
