@@ -77,3 +77,30 @@ def test_a_loop_recheck_whose_budget_ends_before_the_loop_does_says_so(monkeypat
         f"without it to t = 40 s, where the re-check's budget ends, short of the end at t = {square.duration:g} s: "
         "whether the step (the integration unstable) or the robot stops it is not known; use a step of at most "
         "0.001 s (the step argument) to tell, or smaller torques or speeds")
+
+
+def test_track_names_no_step_option_when_the_step_is_to_blame(monkeypatch, capsys):
+    """track integrates at DYNAMICS_STEP, which no option sets: a stop blamed on the step told its users "use a step
+    of at most 0.001 s (the step argument)", which neither track() nor `wmrkit track` takes. With that step made
+    20 ms (as simulate_dynamics at step=0.02 above), the error says what they can do instead."""
+    import importlib
+
+    from wmrkit.cli.main import main
+
+    tracking = importlib.import_module("wmrkit.control.track")  # the module (wmrkit.control.track is the function)
+
+    monkeypatch.setattr(tracking, "DYNAMICS_STEP", 0.02)
+    advice = ("track integrates at 0.02 s, which no option changes; in Python, wmrkit.control.simulate_dynamics(..., "
+              "step=0.001) runs the loop at the step that went on")
+    with pytest.raises(WmrkitError) as err:
+        tracking.track(catalog.load("skid-steer-4"), builtin_reference("square"), dynamics=True)
+    assert str(err.value).startswith("contact 'front_left' lost its load at t = 36.24 s at step 0.02 s, but the "
+                                     "same loop at step 0.001 s goes on to t = 48 s without it")
+    assert str(err.value).endswith(f"(the integration is unstable, not the robot); {advice}")
+    assert main(["track", "skid-steer-4", "--reference", "square", "--dynamics"]) == 2
+    assert capsys.readouterr().err.endswith(f"; {advice}\n")
+    monkeypatch.setattr(runs, "RECHECK_STEPS", 40_000)  # the verdict not known: no step option to tell it either
+    with pytest.raises(WmrkitError, match=r"whether the step \(the integration unstable\) or the robot stops it is "
+                                          r"not known; track integrates at 0.02 s, which no option changes; in "
+                                          r"Python, .*step=0.001\) runs the loop at the step that would tell$"):
+        tracking.track(catalog.load("skid-steer-4"), builtin_reference("square"), dynamics=True)

@@ -254,6 +254,7 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         if loops is not None or skew_free:
             raise ControlError("dynamics: the wheels are driven by the dynamic model's servos; no low-level loops "
                                "or skew-free option with it")
+        from ..dynamics.runs import UnstableStepError
         from ..dynamics.simulate import LiftOffError
 
         period = 0.02 if period is None else period
@@ -277,6 +278,11 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                 "dynamic") from None
         except StoppedRun as err:
             raise _stopped(err, robot, reference, tracked_point, "dynamic") from None
+        except UnstableStepError as err:  # its step is no option of track's
+            call = "simulate_slip_control" if slipping else "simulate_dynamics"
+            raise err.advised(f"track integrates at {DYNAMICS_STEP:g} s, which no option changes; in Python, "
+                              f"wmrkit.control.{call}(..., step={err.fine:.3g}) runs the loop at the step that "
+                              + ("went on" if err.conclusive else "would tell")) from None
     elif feedback != "pose" or slip_model != "none" or ramp:
         what = (f"feedback='{feedback}'" if feedback != "pose" else f"slip_model='{slip_model}'"
                 if slip_model != "none" else "ramp=True")

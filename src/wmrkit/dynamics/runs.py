@@ -187,12 +187,17 @@ def recheck_end(t_stop: float, step: float) -> float:
 class UnstableStepError(WmrkitError):
     """A fixed-step run stopped where a re-check at the shorter step `fine` [s] went on (:func:`unstable_step`):
     ``head`` says so, ``conclusive`` whether that re-check reached the run's end (else its budget ended first); the
-    message ends with how to set the step, `where`."""
+    message ends with what to do: a step of at most `fine` set as `where` says (a door whose user sets it otherwise,
+    or not at all, says so instead: :meth:`advised`)."""
 
-    def __init__(self, head: str, fine: float, where: str, conclusive: bool = True) -> None:
-        self.head, self.fine, self.where, self.conclusive = head, fine, where, conclusive
+    def __init__(self, head: str, fine: float, where: str, conclusive: bool = True, advice: str = "") -> None:
+        self.head, self.fine, self.conclusive = head, fine, conclusive
         tell = "" if conclusive else " to tell, or smaller torques or speeds"
-        super().__init__(f"{head}; use a step of at most {fine:.3g} s {where}{tell}")
+        super().__init__(f"{head}; {advice or f'use a step of at most {fine:.3g} s {where}{tell}'}")
+
+    def advised(self, advice: str) -> UnstableStepError:
+        """The same error ending with `advice` (what the door's user can change) after its ``head``."""
+        return UnstableStepError(self.head, self.fine, "", self.conclusive, advice)
 
 
 def unstable_step(what: str, step: float, fine: float, t_end: float, where: str, rerun: str = "a run",
