@@ -122,5 +122,20 @@ def test_a_recheck_whose_budget_ends_before_the_run_does_says_so(monkeypatch):
         f"contact 'steer' lost its load at t = 0.22 s at step 0.01 s; a run at step 0.001 s goes on without it to "
         f"t = 2.21 s, where the re-check's budget ends, short of the end at t = {round(duration / 0.01) * 0.01:.6g} s: "
         "whether the step (the integration unstable) or the robot stops it is not known; use a step of at most "
-        "0.001 s (--step) or the adaptive method to tell, or smaller torques or speeds")
+        "0.001 s (the step keyword) or method='adaptive' to tell, or smaller torques or speeds")
     assert not isinstance(err.value, LiftOffError)
+
+
+def test_python_simulate_names_its_keyword_and_the_cli_its_option(capsys):
+    """simulate() told Python callers "use a step of at most 0.001 s (--step) or the adaptive method", the CLI's
+    option; now its keyword, and `wmrkit simulate` its option (the later stop's advice as well)."""
+    model = DynamicModel.of(catalog.load("forklift"))
+    for name, speed in (("rectangle", 2.0), ("figure-eight", 2.8)):
+        inputs, duration = path_program(model, name, speed=speed)
+        with pytest.raises(WmrkitError) as err:
+            simulate(model, inputs, duration, step=0.01, record_step=0.01)
+        assert str(err.value).endswith("a step of at most 0.001 s (the step keyword) or method='adaptive'")
+        assert "--step" not in str(err.value)
+        cli = _error(capsys, "simulate", "forklift", "--path", name, "--speed", str(speed), "--step", "0.01")
+        assert cli == f"wmrkit: error: {err.value}\n".replace("(the step keyword) or method='adaptive'",
+                                                               "(--step) or the adaptive method")

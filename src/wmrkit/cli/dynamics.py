@@ -123,6 +123,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     """Simulate, print a summary, write and plot on request."""
     from ..dynamics.deviation import check_step, deviation_warning
     from ..dynamics.programs import path_program, read_torques
+    from ..dynamics.runs import at_door
     from ..dynamics.simulate import MAX_STEPS, recordable_step, simulate
 
     if args.out is not None and Path(args.out).suffix.lower() not in (".csv", ".json"):  # not CSV under another name
@@ -157,9 +158,12 @@ def run_simulate(args: argparse.Namespace) -> int:
     twist = [0.0, 0.0, 0.0] if args.initial_twist is None else [
         parse_value(v, "number", "--initial-twist") for v in args.initial_twist]
     _check_rolling(model, twist)
-    sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
-                   record_step=recordable_step(model, duration, step, max(step, min(0.01, duration))),
-                   progress=False if args.json else None)
+    try:
+        sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
+                       record_step=recordable_step(model, duration, step, max(step, min(0.01, duration))),
+                       progress=False if args.json else None)
+    except WmrkitError as err:  # a stop's re-check names the step as the CLI sets it
+        raise at_door(err, "(--step) or the adaptive method") from None
     check_step(model, inputs, sim, initial_twist=twist)  # a run off its path at an unstable step is refused
     if args.out:
         _write(sim, args.out)

@@ -126,11 +126,25 @@ def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_l
     k_last = min(k_end, k0 + budget)
     judge(model, w, t_stop, diverged, rerun_stop(model, rows[1][j], [(k0, k_last - k0, inp)], fine, method,
                                                  jac_every, allow_lift_off),
-          step, fine, k_last * fine, k_end * fine, "(--step) or the adaptive method")
+          step, fine, k_last * fine, k_end * fine, SIMULATE_STEP)
     if diverged:
-        raise WmrkitError(f"the simulation diverged before t = {t_run:.6g} s; use a smaller --step (or smaller "
-                          "torques or speeds)")
+        err = WmrkitError(f"the simulation diverged before t = {t_run:.6g} s; use a smaller step {SIMULATE_STEP} (or "
+                          "smaller torques or speeds)")
+        err.where = SIMULATE_STEP
+        raise err
     check_lift_off(model, w)
+
+
+#: How a caller of :func:`~wmrkit.dynamics.simulate.simulate` sets the step, as its stop's errors say it (their
+#: ``where``; another door says it its own way: :func:`at_door`).
+SIMULATE_STEP = "(the step keyword) or method='adaptive'"
+
+
+def at_door(err: WmrkitError, where: str) -> WmrkitError:
+    """`err` saying how to set the step as `where` (the CLI's option) where it says its ``where`` (an error of a
+    stop's re-check: :func:`judge`, :func:`_stop`); any other error as it is."""
+    said = getattr(err, "where", "")
+    return WmrkitError(str(err).replace(said, where)) if said else err
 
 
 def rerun_stop(model: DynamicModel, s: np.ndarray, stretch: list, fine: float, method: int, jac_every: int,
@@ -167,9 +181,10 @@ def judge(model: DynamicModel, w: tuple, t_stop: float, diverged: bool, fine_sto
     later = (f"{what} at step {step:g} s, but {rerun} at step {fine:.3g} s goes on without it until "
              f"{stop_phrase(model, w_fine, t_fine, fine_diverged)}: the robot's stop, which the step brought early")
     advice = f"use smaller torques or speeds, and a step of at most {fine:.3g} s {where}"
-    if fine_diverged:
-        raise DivergedError(f"{later}; {advice}", t_fine)
-    raise LiftOffError(later, advice, t_fine, model.contacts[int(w_fine[16][2])])
+    err = (DivergedError(f"{later}; {advice}", t_fine) if fine_diverged else
+           LiftOffError(later, advice, t_fine, model.contacts[int(w_fine[16][2])]))
+    err.where = where
+    raise err
 
 
 def stop_phrase(model: DynamicModel, w: tuple, t_stop: float, diverged: bool) -> str:
@@ -191,7 +206,7 @@ class UnstableStepError(WmrkitError):
     or not at all, says so instead: :meth:`advised`)."""
 
     def __init__(self, head: str, fine: float, where: str, conclusive: bool = True, advice: str = "") -> None:
-        self.head, self.fine, self.conclusive = head, fine, conclusive
+        self.head, self.fine, self.conclusive, self.where = head, fine, conclusive, where
         tell = "" if conclusive else " to tell, or smaller torques or speeds"
         super().__init__(f"{head}; {advice or f'use a step of at most {fine:.3g} s {where}{tell}'}")
 
