@@ -94,3 +94,15 @@ def least_energy_inertia(model, rows, c):
     rhs[-1] = 1.0
     nu = np.linalg.lstsq(kkt, rhs, rcond=None)[0][:model.n]
     return 2 * model.kinetic_energy(None, nu), nu
+
+
+def frictionless_coast(model, s0: np.ndarray, periods: int = 10):
+    """The states every 0.1 s of `model` (frozen tyres) coasting without torque from `s0` (rk4, 1e-4 s steps), each
+    with its kinetic energy: the checks that a constraint does no work."""
+    from wmrkit.dynamics.simulate import Inputs, Stepper
+
+    stepper = Stepper(model, s0.copy(), step=1e-4, method="rk4", allow_lift_off=True)
+    steer, n = list(model.steer_columns), model.n
+    for _ in range(periods):
+        s = stepper.advance(Inputs.torques_only(model, [0.0], {}), 0.1)
+        yield s, model.kinetic_energy(s[steer], s[n:])
