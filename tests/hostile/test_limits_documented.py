@@ -28,6 +28,7 @@ DOCUMENTED = [
     ("wmrkit.limits", "MAX_COORDINATE", "within 1e9 m (`MAX_COORDINATE`)", 1e9),
     ("wmrkit.limits", "MAX_SPEED", "up to 1e3 m/s (`MAX_SPEED`)", 1e3),
     ("wmrkit.limits", "MAX_TORQUE", "within 1e10 N m (`limits.MAX_TORQUE`)", 1e10),
+    ("wmrkit.dynamics.linkages", "SETPOINT_TOL", "within 1e-5 rad (`linkages.SETPOINT_TOL`", 1e-5),
     ("wmrkit.kinematics.codegen", "MAX_FILENAME", "255 bytes (`codegen.MAX_FILENAME`)", 255),
     ("wmrkit.kinematics.codegen", "MAX_STACK_WORK", "512 doubles, 4 KiB (`codegen.MAX_STACK_WORK`)", 512),
     ("wmrkit.kinematics.search", "MAX_SETS", "after 1000 sets (`MAX_SETS`", 1000),

@@ -37,6 +37,10 @@ from ..wheels import heading_from_beta
 COLUMNS = 10
 #: A steering angle [rad] (or a rate, relative to the leader's) farther than this from its linkage's law breaks it.
 LINKAGE_TOL = 1e-9
+#: A heading set-point [rad] (a torque file's, :func:`wmrkit.dynamics.programs.read_torques`) farther than this from
+#: its linkage's law, given the other set-points of the linkage, fights it: headings written to six significant
+#: digits pass, the servos then settle within that of both.
+SETPOINT_TOL = 1e-5
 #: A steering point [m] closer than this to the fixed wheels' axle line is on it (``ackermann``): a leader is
 #: chosen off it; a follower on it keeps its rest angle (its axle is that line, through every ICR on it).
 AXLE_TOL = 1e-9
@@ -177,6 +181,44 @@ def linkage_breach(model, beta: np.ndarray, nu: np.ndarray | None = None) -> str
             return (f"{name} turns {model.names[int(row[0])]} at {slope * nu[int(row[1])]:.6g} rad/s with "
                     f"{model.names[int(row[1])]}, not {nu[int(row[0])]:.6g} rad/s")
     return None
+
+
+def setpoint_breach(model, beta: np.ndarray, commanded: set[int],
+                    tol: float = SETPOINT_TOL) -> tuple[int, int | None, float] | None:
+    """The first set-point that breaks a held linkage of `model`: steering angles `beta` ``(n_steer,)`` whose
+    indices `commanded` have a servo; ``(follower, reference, angle)``: the index off the law by more than `tol`
+    [rad], the commanded one of its linkage it is measured from (None: on the axle line, it keeps its rest angle
+    whatever the others do) and the angle the law gives it. The reference is the leader if commanded, else the first
+    commanded follower (its leader's angle found from it, :func:`_leader_of`). None when they agree."""
+    table, cols = model.pack[17], list(model.steer_columns)
+    for lead in dict.fromkeys(int(r[1]) for r in table):
+        rows = [r for r in table if int(r[1]) == lead and cols.index(int(r[0])) in commanded]
+        ref = cols.index(lead)
+        if ref in commanded:
+            b = beta[ref]
+        else:
+            first = next((r for r in rows if r[3] == 0.0 or r[5] != 0.0), None)
+            ref = None if first is None else cols.index(int(first[0]))
+            b = beta[cols.index(lead)] if first is None else _leader_of(first, beta[ref])
+        for r in rows:
+            j, f = cols.index(int(r[0])), law(r, b)[0]
+            if abs(math.remainder(beta[j] - f, 2 * math.pi)) > tol:
+                return j, ref, f
+    return None
+
+
+def _leader_of(row, beta: float) -> float:
+    """The leader's angle at which the linkage row `row` sets its follower at `beta` (the law's inverse; a follower
+    off the axle line): ``parallel`` by the shift, ``ackermann`` by the same geometry with the two wheels swapped,
+    on the branch that gives `beta` (the law's ``psi`` are mod pi)."""
+    if row[3] == 0.0:
+        return row[8] + beta - row[9]
+    xi, xj, dy = row[4], row[5], row[6]
+    s0, c0 = math.sin(row[8] - row[7]), math.cos(row[8] - row[7])
+    psi_j = beta - row[9] + math.atan2(xj * s0, xi * c0 + dy * s0)  # the follower's psi: its rest one's + turn
+    psi_i = math.atan2(xi * math.sin(psi_j), xj * math.cos(psi_j) - dy * math.sin(psi_j))
+    lead = row[8] + math.remainder(psi_i + row[7] - row[8], math.pi)
+    return lead if abs(math.remainder(law(row, lead)[0] - beta, 2 * math.pi)) < math.pi / 2 else lead + math.pi
 
 
 def _heading(model, k: int, beta: float) -> float:

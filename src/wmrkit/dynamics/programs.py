@@ -3,7 +3,8 @@
 A torque file is a CSV with a header ``time,<wheel>.<joint>,...``: times [s] strictly increasing from at most 0,
 torques [N m] on actuated joints (``spin``, ``spin1``/``spin2``, ``steer``), linear between rows, the last row held;
 a ``<wheel>.heading`` column [rad] is a steering-servo reference instead (the users' heading, 0 = straight ahead;
-actuated steering only: a castor steers passively).
+actuated steering only: a castor steers passively); the set-points of one held linkage on its law at each row
+(:func:`~wmrkit.dynamics.linkages.setpoint_breach`).
 
 A built-in program (:func:`path_program`) is a schedule of body twists; each actuated wheel follows the no-slip
 rate of its twist (wheel IK, §8.4) through a saturated rate servo and each actuated steering the IK heading
@@ -26,7 +27,7 @@ from .._shapes import readonly
 from ..errors import WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, MAX_TORQUE, check_table_size
 from ..units import BARE_ANGLE_LIMIT
-from .linkages import linkage_breach
+from .linkages import SETPOINT_TOL, linkage_breach, setpoint_breach
 from .model import DynamicModel
 from .simulate import Inputs, _knots, joint_column
 
@@ -262,6 +263,28 @@ def _check_torques(source: str, column: str, torques: np.ndarray) -> None:
                           f"largest torque wmrkit applies, {MAX_TORQUE:g} N m (docs/limits.md)")
 
 
+def _check_setpoints(source: str, model: DynamicModel, href: np.ndarray, commanded: list[int]) -> None:
+    """Refuse the first row whose heading set-points `href` ``(K, n_steer)`` break a linkage the dynamics hold
+    (:func:`~wmrkit.dynamics.linkages.setpoint_breach`): their servos would fight it, naming the two columns."""
+    if not len(model.pack[17]):
+        return
+    steered = model.robot.steer_names
+    for k, beta in enumerate(model.robot.beta_of_heading(href)):
+        breach = setpoint_breach(model, beta, set(commanded))
+        if breach is None:
+            continue
+        j, ref, f = breach
+        name = next(c.channel_name for c in model.robot.couplings
+                    if c.kind == "linkage" and f"{steered[j]}.steer" in c.joints)
+        want = float(model.robot.heading_of_beta(np.where(np.arange(len(beta)) == j, f, beta))[j])
+        by = "whatever the others do" if ref is None else (f"with column '{steered[ref]}.heading' at "
+                                                        f"{href[k, ref]:.6g} rad")
+        raise WmrkitError(f"{source}:{k + 2}: column '{steered[j]}.heading': {href[k, j]:.6g} rad breaks {name}, "
+                          f"which sets {steered[j]} at heading {want:.6g} rad {by}: the steering servos would fight "
+                          f"the linkage the dynamics hold; give headings on its law (within {SETPOINT_TOL:g} rad) or "
+                          "one heading column per linkage (docs/dynamics.md)")
+
+
 def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     """:class:`Inputs` from a torque CSV (module docstring); errors name the file, the line and the column."""
     source = str(path)
@@ -322,6 +345,7 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     for k, c in enumerate(model.steer_columns):
         if c in headings:
             href[:, k] = headings[c]
+    _check_setpoints(source, model, href, [k for k, c in enumerate(model.steer_columns) if c in headings])
     kp, kd = steering_gains(model, list(headings))
     return Inputs(inputs.time, inputs.torques, inputs.rate_reference, inputs.rate_gain, inputs.torque_limit,
                   readonly(href), readonly(kp), readonly(kd))

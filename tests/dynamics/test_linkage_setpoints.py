@@ -1,0 +1,131 @@
+"""A torque file's heading set-points for the wheels of one held linkage must agree with its law (within
+``SETPOINT_TOL``), or the steering servos fight the constraint (docs/dynamics.md, Couplings). The law is written
+here independently, as the Ackermann ICR geometry (every axle through one point of the rear axle line) and a
+synchro chain's common turn."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+from dynamics_robots import linked_car
+from test_linkage_law import four_wheel_steer
+
+from wmrkit import Robot
+from wmrkit.cli.main import main
+from wmrkit.dynamics.linkages import SETPOINT_TOL
+from wmrkit.dynamics.model import DynamicModel
+from wmrkit.dynamics.programs import read_torques
+from wmrkit.errors import WmrkitError
+
+CATALOG = Path(__file__).parents[2] / "src" / "wmrkit" / "catalog" / "ackermann.yaml"
+
+
+def icr_heading(x: float, y: float, yc: float) -> float:
+    """The heading of a wheel at ``(x, y)`` whose axle passes through the ICR ``(0, yc)`` on the rear axle line,
+    rolling forward (the body turns left for ``yc > y``)."""
+    return math.atan2(x, yc - y) if yc > y else math.atan2(-x, y - yc)
+
+
+def _car(tmp_path: Path) -> Path:
+    """The catalog's Ackermann car (wheelbase 2.70 m, track 1.55 m) with the mass properties the dynamics need."""
+    text = CATALOG.read_text().replace("r: 0.33, actuated", "r: 0.33, inertia: {spin: 1.0}, actuated").replace(
+        "r: 0.33, steer_range", "r: 0.33, inertia: {spin: 1.0, steer: 0.5}, steer_range")
+    path = tmp_path / "car.yaml"
+    path.write_text(text + "body: {mass: 1500, inertia: 2500, com: [1.2, 0], com_height: 0.5}\n")
+    return path
+
+
+def test_a_follower_off_the_ackermann_law_is_refused_at_its_row_and_columns(tmp_path, capsys):
+    """Before, ``simulate car --torques`` with front_left at 0.3 rad and front_right at 0 ran (exit 0) while the
+    two steering servos fought the linkage."""
+    car, torques = _car(tmp_path), tmp_path / "h.csv"
+    torques.write_text("time,front_left.heading,front_right.heading\n0,0,0\n1,0.3,0\n")
+    right = icr_heading(2.70, -0.775, 0.775 + 2.70 / math.tan(0.3))
+    argv = ["simulate", str(car), "--torques", str(torques), "--duration", "0.01"]
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and len(err.splitlines()) == 1
+    assert err.startswith(f"wmrkit: error: {torques}:3: column 'front_right.heading': 0 rad breaks "
+                          f"linkage(front_left.steer, front_right.steer), which sets front_right at heading "
+                          f"{right:.6g} rad with column 'front_left.heading' at 0.3 rad")
+    assert main([*argv, "--json"]) == 2
+    data = json.loads(capsys.readouterr().err)
+    assert (data["file"], data["line"], data["field"]) == (str(torques), 3, "front_right.heading")
+
+
+def test_set_points_on_the_ackermann_law_are_accepted(tmp_path, capsys):
+    car, torques = _car(tmp_path), tmp_path / "h.csv"
+    rows = [(0.0, 0.0), *((h, icr_heading(2.70, -0.775, 0.775 + 2.70 / math.tan(h))) for h in (0.3, -0.5, 0.6))]
+    torques.write_text("time,front_left.heading,front_right.heading\n" +
+                       "".join(f"{k},{a!r},{b!r}\n" for k, (a, b) in enumerate(rows)))
+    assert main(["simulate", str(car), "--torques", str(torques), "--duration", "0.01"]) == 0
+    assert "front_right" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("heading", [-0.5, -0.1, 0.2, 0.6])
+def test_the_tolerance_is_the_documented_one(heading, tmp_path):
+    model = DynamicModel.of(linked_car())
+    right = icr_heading(0.6, -0.2, 0.2 + 0.6 / math.tan(heading))
+    path = tmp_path / "h.csv"
+    for off, ok in ((0.5 * SETPOINT_TOL, True), (2 * SETPOINT_TOL, False), (-2 * SETPOINT_TOL, False)):
+        path.write_text(f"time,fl.heading,fr.heading\n0,0,0\n1,{heading!r},{right + off!r}\n2,0,0\n")
+        if ok:
+            read_torques(model, path)
+        else:
+            with pytest.raises(WmrkitError, match=r"h\.csv:3: column 'fr\.heading': .* breaks linkage"):
+                read_torques(model, path)
+
+
+def _three_wheel_ackermann() -> DynamicModel:
+    """linked_car with a third steered wheel, ``ml`` at (0.3, 0.2), on the front pair's linkage (leader fl)."""
+    wheel = {"r": 0.1, "tyre": "dugoff"}
+    steer = {**wheel, "type": "steerable", "actuated": ["steer"], "inertia": {"spin": 0.01, "steer": 0.05}}
+    fixed = {**wheel, "type": "fixed", "heading": 0, "actuated": ["spin"], "inertia": {"spin": 0.02}}
+    return DynamicModel.of(Robot.from_dict({
+        "name": "three", "body": {"mass": 30, "inertia": 1.5, "com": [0.25, 0.0], "com_height": 0.2},
+        "wheels": [{**fixed, "name": "rl", "position": [0, 0.2]}, {**fixed, "name": "rr", "position": [0, -0.2]},
+                   {**steer, "name": "fl", "position": [0.6, 0.2]}, {**steer, "name": "fr", "position": [0.6, -0.2]},
+                   {**steer, "name": "ml", "position": [0.3, 0.2]}],
+        "couplings": [{"kind": "linkage", "joints": ["fl.steer", "fr.steer", "ml.steer"]}]}))
+
+
+@pytest.mark.parametrize("yc", [2.0, 0.9, -1.5, -0.7])
+def test_followers_without_their_leader_are_checked_against_each_other(yc, tmp_path):
+    """fr and ml commanded, the leader fl not: the leader's angle is found from fr (the law's inverse)."""
+    model, path = _three_wheel_ackermann(), tmp_path / "h.csv"
+    fr, ml = icr_heading(0.6, -0.2, yc), icr_heading(0.3, 0.2, yc)
+    path.write_text(f"time,fr.heading,ml.heading\n0,0,0\n1,{fr!r},{ml!r}\n")
+    read_torques(model, path)
+    path.write_text(f"time,fr.heading,ml.heading\n0,0,0\n1,{fr!r},{ml + 1e-3!r}\n")
+    with pytest.raises(WmrkitError, match=r":3: column 'ml\.heading': .* with column 'fr\.heading' at"):
+        read_torques(model, path)
+
+
+def test_a_synchro_chain_commanded_apart_is_refused(tmp_path):
+    model = DynamicModel.of(Robot.from_dict(four_wheel_steer(linkages=[("fl", "fr", "rl", "rr")])))
+    path = tmp_path / "h.csv"
+    path.write_text("time,fr.heading,rl.heading\n0,0,0\n1,0.4,0.4\n")
+    read_torques(model, path)
+    path.write_text("time,fr.heading,rl.heading\n0,0,0\n1,0.4,0.4\n2,0.4,0.35\n")
+    with pytest.raises(WmrkitError, match=r":4: column 'rl\.heading': 0\.35 rad breaks .* sets rl at heading 0\.4 "
+                                          r"rad with column 'fr\.heading' at 0\.4 rad"):
+        read_torques(model, path)
+
+
+def test_a_follower_on_the_axle_line_keeps_its_rest_heading_whatever_is_commanded(tmp_path):
+    """An Ackermann follower on the fixed wheels' axle line is held at its rest heading (its axle is that line):
+    a set-point elsewhere fights the linkage even as the linkage's only servo."""
+    data = linked_car().to_dict()
+    data["wheels"].append({"name": "side", "type": "steerable", "position": [0, 0.5], "heading": 0, "r": 0.1,
+                           "inertia": {"spin": 0.01, "steer": 0.05}, "tyre": "dugoff", "actuated": ["steer"]})
+    data["couplings"] = [{"kind": "linkage", "joints": ["fl.steer", "fr.steer", "side.steer"]}]
+    model, path = DynamicModel.of(Robot.from_dict(data)), tmp_path / "h.csv"
+    path.write_text("time,fl.heading,side.heading\n0,0.3,0\n")
+    read_torques(model, path)
+    path.write_text("time,side.heading\n0,0\n1,0.2\n")
+    with pytest.raises(WmrkitError, match=r":3: column 'side\.heading': 0\.2 rad breaks .* sets side at heading 0 "
+                                          r"rad whatever the others do"):
+        read_torques(model, path)
