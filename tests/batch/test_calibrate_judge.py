@@ -18,10 +18,10 @@ from wmrkit.odometry.synthetic import TwistProfile, simulate, square_path
 BAD_RADIUS = [TRUE_P[0] + 0.05, *TRUE_P[1:]]
 
 
-def short_runs(diff, seed: int, n: int, poses: int | None, bad=(), odd=BAD_RADIUS, noise=1e-5, name="r"):
+def short_runs(diff, seed: int, n: int, poses: int | None, bad=(), odd=BAD_RADIUS, noise=1e-5, name="r", early=()):
     """`n` runs of three random arcs (about 2 m) whose references have `poses` poses (the start, the end and evenly
     between; ``None``: every 5th sample), of the robot at TRUE_P; the runs `bad` of one at `odd`; `noise`: per run or
-    one for all [rad^2/rad]."""
+    one for all [rad^2/rad]; the runs `early` have their second reference pose one sample after the start."""
     rng = np.random.default_rng(seed)
     noises = np.broadcast_to(noise, n)
     out = []
@@ -31,6 +31,7 @@ def short_runs(diff, seed: int, n: int, poses: int | None, bad=(), odd=BAD_RADIU
         run = simulate(robot, TwistProfile.from_segments(segs), 10.0, spin_noise_per_rad=float(noises[i]),
                        seed=int(rng.integers(1 << 30)))
         at = np.arange(0, len(run.log), 5) if poses is None else np.linspace(0, len(run.log) - 1, poses).astype(int)
+        at[1] = 1 if i in early else at[1]
         out.append(CalibrationRun(replace(run.log, source=f"{name}{i}.csv"), run.truth[at], at=at))
     return out
 

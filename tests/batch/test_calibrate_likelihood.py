@@ -3,8 +3,10 @@ each pair's own noise (noise levels drawn per run no longer make a pair of noisy
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
-from batch_params import PARAMS
+from batch_params import PARAMS, write_log
 from scipy.optimize import minimize
 from test_calibrate_judge import short_runs
 
@@ -114,3 +116,39 @@ def test_a_bad_run_is_still_named_over_its_own_noise(diff):
         res = fleet_calibrate(diff, runs, PARAMS)
         assert res.inconsistent is True and disagreeing(res) == [f"r{k}.csv"], (seed, res.warnings)
         assert np.isclose(res.closed_scores[k], score_by_refit(diff, runs, k, res.robot), rtol=1e-3), seed
+
+
+def test_runs_left_out_of_the_whole_fleet_check_are_named(diff, tmp_path, capsys):
+    """A three-pose run whose middle reference pose is one sample after the start: that motion's covariance under the
+    encoders' noise model is of rank 2 (two encoders over one step: ``J Q J'`` of a 3 x 2 ``J``), so its errors
+    cannot be whitened and the fleet likelihood ratio leaves it out. Before, nothing said so ('not_judged' null,
+    the warning counting the runs checked); now 'not_judged' names it, the motion and why, in the API and the CLI's
+    text and JSON. With 4 such runs of 6 the check is not made at all, and that is said."""
+    from wmrkit.batch.likelihood import LEFT_OUT
+    from wmrkit.cli.main import main
+    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+
+    runs = short_runs(diff, 40000, 6, 3, early=(0,))
+    res = fleet_calibrate(diff, runs, PARAMS)
+    why = ("r0.csv: its motion from sample 0 to 1, t 0-0.1 s, has a covariance of rank 2 of 3: the encoders do not "
+           "see every direction of it")
+    assert res.not_judged == res.to_dict()["not_judged"] == LEFT_OUT.format(
+        runs="r0.csv", why=why, rest="the other 5 runs are checked")
+    assert all(q is not None for q in res.closed_scores)  # its own score against the others stands
+    res = fleet_calibrate(diff, short_runs(diff, 40001, 6, 3, early=(0, 2, 3, 5)), PARAMS)
+    assert res.not_judged.startswith("r0.csv, r2.csv, r3.csv, r5.csv: left out of the whole-fleet check")
+    assert "; 2 runs are left, too few: the check is not made" in res.not_judged
+    (tmp_path / "ref").mkdir()
+    for run in runs:
+        stem = run.log.source.removesuffix(".csv")
+        write_log(tmp_path / f"{stem}.csv", run)
+        at = run.samples()
+        write_trajectory(tmp_path / "ref" / f"{stem}.tum", Trajectory(run.log.time[at], np.asarray(run.reference),
+                                                                      np.zeros(len(at)), None), "tum")
+    args = ["batch", "calibrate", "diff-drive", str(tmp_path / "*.csv"), "--reference", str(tmp_path / "ref"),
+            "--workers", "0"]
+    assert main([*args, "--json"]) == 0
+    said = f"{tmp_path / 'r0.csv'}: left out of the whole-fleet check"
+    assert json.loads(capsys.readouterr().out)["not_judged"].startswith(said)
+    assert main(args) == 0
+    assert f"not judged: {said}" in capsys.readouterr().out

@@ -113,7 +113,8 @@ class Consistency:
     ``messages``: the warnings that name the runs (one a kind of runs judged); ``not_judged``: why no run was
     judged (:data:`FEW_RUNS`, :data:`CLOSED`, :data:`SHORT`, :data:`UNEQUAL`, :data:`REFIT_FAILED`,
     :data:`CURVATURE_FAILED`, :data:`UNDETERMINED`) or
-    which runs were not (:data:`SOME_RUNS`, :data:`SET_ASIDE`), or ``None``; ``scores``: a fleet of closed paths'
+    which runs were not (:data:`SOME_RUNS`, :data:`SET_ASIDE`; left out of the whole-fleet check of three-pose
+    runs: :data:`~wmrkit.batch.likelihood.LEFT_OUT`, after), or ``None``; ``scores``: a fleet of closed paths'
     per-run scores (:func:`judge`; another quantity than a ratio, under its own name), empty when not scored."""
 
     ratios: tuple[float | None, ...]
@@ -363,7 +364,7 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
                 runs="every run" if len(which) == g else ", ".join(logs[k] for k in which), why=why))
     hess = np.stack([(j - fit.jac) / CURVATURE_STEP for j in moved], axis=-1)  # (R, n, n)
     live = np.split(np.any(fit.jac != 0, axis=1) | (fit.fun != 0), np.cumsum(sizes)[:-1])  # counts' rows
-    scores, messages = np.full(g, np.nan), []
+    scores, messages, left = np.full(g, np.nan), [], []
     for group in groups:
         done = _group_scores(problem, fit, hess, group, [blocks[i][live[i]] for i in group], travels, live, refit)
         if isinstance(done, str):
@@ -379,13 +380,14 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
         elif pair is not None and pair[2] > MAX_PAIR_SCORE:
             messages.append(PAIR.format(a=logs[pair[0]], b=logs[pair[1]], score=pair[2]))
         named = 1 if scores[worst] > MAX_CLOSED_SCORE else 2 if pair is not None and pair[2] > MAX_PAIR_SCORE else 0
-        if m[group[0]] - n >= MIN_OWN_DOF and problem.run_weights is None and problem.heading_weight != 0 and (
-                said := few_pose_warning(problem, fit.x, fit.jac, fit.fun, group, ROUNDOFF * travels, logs, named)):
-            messages.append(said)  # several runs that disagree (wmrkit.batch.likelihood)
+        if m[group[0]] - n >= MIN_OWN_DOF and problem.run_weights is None and problem.heading_weight != 0:
+            said, out = few_pose_warning(problem, fit.x, fit.jac, fit.fun, group, ROUNDOFF * travels, logs, named)
+            messages += [said] if said else []  # several runs that disagree (wmrkit.batch.likelihood)
+            left += [out] if out else []  # runs left out of that check (likelihood.LEFT_OUT)
     aside = [k for k in range(g) if np.isnan(scores[k])]
-    why = None if not aside else SET_ASIDE.format(runs=", ".join(logs[k] for k in aside), judged=", ".join(
-        f"{len(group)} runs of {_poses(m[group[0]])}" for group in groups))
-    return Consistency(judged.ratios, bool(messages), tuple(messages), why,
+    why = [] if not aside else [SET_ASIDE.format(runs=", ".join(logs[k] for k in aside), judged=", ".join(
+        f"{len(group)} runs of {_poses(m[group[0]])}" for group in groups))]
+    return Consistency(judged.ratios, bool(messages), tuple(messages), "; ".join(why + left) or None,
                        tuple(None if np.isnan(q) else float(q) for q in scores))
 
 

@@ -51,6 +51,11 @@ GRID = 0.01
 MIN_OWN_DOF = 3
 #: Most iterations of the reweighted least squares from each start.
 ITERATIONS = 200
+#: Why runs are left out of this check (said in ``not_judged``; {runs}: the runs; {why}: each run's why; {rest}: what
+#: is checked): their motions' errors cannot be whitened. Before, they were left out unsaid.
+LEFT_OUT = ("{runs}: left out of the whole-fleet check (the fleet likelihood ratio of the runs of as many reference "
+            "poses, which finds several runs that disagree), the motions' errors cannot be whitened by the encoders' "
+            "noise model ({why}); {rest}, and each run is still scored against the others on its own")
 
 
 def likelihood_ratio(a: np.ndarray, b: np.ndarray, c: np.ndarray, own: np.ndarray, m: np.ndarray) -> np.ndarray:
@@ -84,18 +89,19 @@ def likelihood_ratio(a: np.ndarray, b: np.ndarray, c: np.ndarray, own: np.ndarra
 
 
 def whitened_parts(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray, res: np.ndarray, group: Sequence[int],
-                   floors: Sequence[float]) -> tuple[tuple[np.ndarray, ...], list[int]]:
+                   floors: Sequence[float]) -> tuple[tuple[np.ndarray, ...], list[int], dict[int, str]]:
     """The arguments of :func:`likelihood_ratio` for the runs `group` (`jac`, `res` of the fleet fit at parameters
     `p`; `floors`: least RSS root of each run's own fit [m]) on their whitened motions' errors
     (:func:`~wmrkit.batch.motions.whitening`), and the rank of each run's whitened Jacobian; runs that cannot be
-    whitened are left out (the places in `group` kept, last)."""
+    whitened are left out: the places in `group` kept, and those left out with why."""
     sizes = problem.sizes()
     ends = np.cumsum(sizes)
-    parts, kept = ([], [], [], [], [], []), []
+    parts, kept, left = ([], [], [], [], [], []), [], {}
     for i, k in enumerate(group):
         lo, hi = int(ends[k] - sizes[k]), int(ends[k])
         white = whitening(problem, p, problem.runs[k], res[lo:hi])
-        if white is None:
+        if isinstance(white, str):
+            left[i] = white
             continue
         j, r = white @ jac[lo:hi], white @ res[lo:hi]
         step, _, rank, _ = np.linalg.lstsq(j, r, rcond=None)
@@ -103,7 +109,7 @@ def whitened_parts(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray, 
         for part, x in zip(parts, (j.T @ j, j.T @ r, r @ r, own, len(r), rank), strict=True):
             part.append(x)
         kept.append(i)
-    return (*(np.array(x, dtype=float) for x in parts[:5]), np.array(parts[5], dtype=int)), kept
+    return (*(np.array(x, dtype=float) for x in parts[:5]), np.array(parts[5], dtype=int)), kept, left
 
 
 @lru_cache(maxsize=1024)
@@ -128,15 +134,28 @@ def threshold(runs: tuple[tuple[int, int], ...], level: float = LEVEL) -> float:
     return float(grid[min(int(np.searchsorted(cdf, 1 - level)), n - 1)])
 
 
+def left_out(group: Sequence[int], kept: Sequence[int], left: dict[int, str], logs: Sequence[str]) -> str | None:
+    """:data:`LEFT_OUT` for the runs of places `left` in `group` (with why; `kept`: those checked), or ``None``."""
+    if not left:
+        return None
+    return LEFT_OUT.format(runs=", ".join(logs[group[i]] for i in left),
+                           why="; ".join(f"{logs[group[i]]}: {why}" for i, why in left.items()),
+                           rest=f"the other {len(kept)} runs are checked" if len(kept) >= 3 else
+                           f"{len(kept)} runs are left, too few: the check is not made")
+
+
 def few_pose_warning(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray, res: np.ndarray,
-                     group: Sequence[int], floors: Sequence[float], logs: Sequence[str], named: int = 0) -> str | None:
+                     group: Sequence[int], floors: Sequence[float], logs: Sequence[str],
+                     named: int = 0) -> tuple[str | None, str | None]:
     """The warning when the runs `group` (as many reference poses each; `jac`, `res` of the fleet fit at parameters
     `p`; `floors`: least RSS root of each run's own fit [m]) do not agree as a whole (``L`` over its
     :func:`threshold`), with the fewest runs whose removal leaves the others agreeing; ``None`` when they agree, or
-    when as many runs as were `named` (1: by a closed-path score, 2: by the pair score) explain it."""
-    (a, b, c, own, m, rank), kept = whitened_parts(problem, p, jac, res, group, floors)
+    when as many runs as were `named` (1: by a closed-path score, 2: by the pair score) explain it. And the runs
+    left out of the check, named with why (:data:`LEFT_OUT`), or ``None``."""
+    (a, b, c, own, m, rank), kept, left = whitened_parts(problem, p, jac, res, group, floors)
+    aside = left_out(group, kept, left, logs)
     if len(kept) < 3:
-        return None
+        return None, aside
 
     def limit(keep: np.ndarray) -> float:
         return threshold(tuple(sorted(zip(m[keep].astype(int).tolist(), rank[keep].tolist(), strict=True))))
@@ -147,16 +166,16 @@ def few_pose_warning(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray
     every = np.arange(len(kept))
     score, top = likelihood_ratio(a, b, c, own, m), limit(every)
     if score <= top:
-        return None
+        return None, aside
     n, out = fewest(len(kept), over, 1.0)
     if n <= named:
-        return None
+        return None, aside
     without = f" (without {', '.join(logs[group[kept[i]]] for i in out)} the others agree)" if out else ""
     return (f"the runs disagree among themselves (fleet likelihood ratio {score:.3g}, over {top:.3g}, which "
             f"{len(kept)} agreeing runs exceed with a chance of {LEVEL:g}: their parameters are further apart than "
             "each run's own noise allows): at least "
             f"{'one run disagrees' if n == 1 else f'{n} runs disagree'} with the others{without}: another robot, load "
-            "or floor? The fit averages them; calibrate them apart")
+            "or floor? The fit averages them; calibrate them apart"), aside
 
 
 def own_noise(jac: np.ndarray, res: np.ndarray, hess: np.ndarray, m: np.ndarray) -> np.ndarray:

@@ -39,20 +39,24 @@ def motion_covariances(problem: CalibrationProblem, p: np.ndarray, run: Calibrat
     return out
 
 
-def whitening(problem: CalibrationProblem, p: np.ndarray, run: CalibrationRun, res: np.ndarray) -> np.ndarray | None:
+def whitening(problem: CalibrationProblem, p: np.ndarray, run: CalibrationRun, res: np.ndarray) -> np.ndarray | str:
     """The linear map ``(3M', 3M)`` from the run's pose residuals (unweighted, heading times the heading weight) to
     its whitened motions' errors, about its odometry at parameters `p` (`res`: its residuals there): the motions'
     errors of :func:`~wmrkit.batch.homogeneity.increments`, each motion's three times the inverse square root of its
-    covariance (:func:`motion_covariances`), motions of no sample left out; ``None`` where a motion's covariance is
-    singular (wheels at rest, or a robot whose encoders do not see every motion)."""
+    covariance (:func:`motion_covariances`), motions of no sample left out; or why not, where a motion's covariance
+    is singular (a robot whose encoders do not see every motion, or a motion of one sample of a robot of two
+    encoders) or no motion moves the wheels."""
     to_motions, _ = increments(run, problem.heading_weight, np.eye(res.size), res)
     cov = motion_covariances(problem, p, run)
+    at = run.samples()
     rows = []
-    for c, block in zip(cov, to_motions.reshape(len(cov), 3, -1), strict=True):
+    for c, block, a, b in zip(cov, to_motions.reshape(len(cov), 3, -1), np.r_[0, at[:-1]], at, strict=True):
         if not c.any():
             continue
         val, vec = np.linalg.eigh(c)
         if not val[0] > 1e-9 * val[-1]:
-            return None
+            t = run.log.time
+            return (f"its motion from sample {a} to {b}, t {t[a]:.6g}-{t[b]:.6g} s, has a covariance of rank "
+                    f"{int(np.sum(val > 1e-9 * val[-1]))} of 3: the encoders do not see every direction of it")
         rows.append((vec / np.sqrt(val)) @ vec.T @ block)
-    return np.concatenate(rows) if rows else None
+    return np.concatenate(rows) if rows else "its wheels do not turn between its reference poses"

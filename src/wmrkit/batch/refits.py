@@ -95,8 +95,8 @@ def own_scores(problem: CalibrationProblem, fit, group: np.ndarray, live: list[n
         run, rows = problem.runs[i], slice(int(starts[i]), int(starts[i] + sizes[i]))
         weight = np.ones(sizes[i]) if problem.run_weights is None else np.repeat(
             np.asarray(problem.run_weights(run), dtype=float), 3)
-        white = whitening(problem, fit.x, run, fit.fun[rows] / weight) if np.all(weight > 0) else None
-        if white is None:
+        white = whitening(problem, fit.x, run, fit.fun[rows] / weight) if np.all(weight > 0) else "weighted 0"
+        if isinstance(white, str):
             continue
         poses = np.zeros((2, sizes[i]))  # its weighted live rows, alone and at the others' fit -> pose errors
         poses[:, live[i]] = np.array([mine[k], errs[k][k]]) / w[k]
