@@ -52,25 +52,29 @@ class GearTable:
 
 @functools.lru_cache(maxsize=64)
 def gear_table(robot: Robot, names: tuple[str, ...]) -> GearTable:
-    """The :class:`GearTable` of `robot`'s gears over rates named `names` (``wheel.joint``, each gear's joints among
-    them). Kept per robot (a frozen value)."""
-    gears = [(i, c) for i, c in enumerate(robot.couplings) if c.kind == "gear"]
-    joints = [j for _, c in gears for j in c.joints]
+    """The :class:`GearTable` of `robot`'s gears over rates named `names` (``wheel.joint``): each gear's joints among
+    them (all, for ik's rates; ``fk``'s given rates may name some: a gear with fewer than two is left out, nothing
+    to judge). Kept per robot (a frozen value)."""
+    gears = [(i, [(j, k) for j, k in zip(c.joints, c.ratios, strict=True) if j in names])
+             for i, c in enumerate(robot.couplings) if c.kind == "gear"]
+    gears = [(i, read) for i, read in gears if len(read) >= 2]
+    joints = [j for _, read in gears for j, _ in read]
     arrays = (np.array([names.index(j) for j in joints], dtype=np.int64),
-              np.array([k for _, c in gears for k in c.ratios], dtype=float),
+              np.array([k for _, read in gears for _, k in read], dtype=float),
               np.array([contact_lever(robot.wheel(j.partition(".")[0]), j.partition(".")[2]) for j in joints],
                        dtype=float),
-              np.cumsum([0] + [len(c.joints) for _, c in gears]).astype(np.int64))
+              np.cumsum([0] + [len(read) for _, read in gears]).astype(np.int64))
     for a in arrays:
         a.flags.writeable = False
     return GearTable(tuple(i for i, _ in gears), *arrays)
 
 
-def gears_hold(table: GearTable, q: np.ndarray, slip_tol: float) -> np.ndarray:
+def gears_hold(table: GearTable, q: np.ndarray, slip_tol: float, rtol: float = GEAR_RTOL) -> np.ndarray:
     """Whether each gear of `table` turns the rates `q` ``(..., n)`` in its ratios (the module's rule, with the
     slip check's floor `slip_tol` [m/s]): ``(..., n_gears)`` bool; False where a rate of the gear is NaN. The sums
-    run joint by joint in the table's order, as the compiled and generated loops run them."""
-    scale = GEAR_RTOL * np.abs(q).max(axis=-1, initial=0.0)
+    run joint by joint in the table's order, as the compiled and generated loops run them. `rtol` 0 judges by the
+    floor alone (``fk``'s given rates, judged relatively by :func:`wmrkit.couplings.gear_breaches`)."""
+    scale = rtol * np.abs(q).max(axis=-1, initial=0.0)
     out = []
     for g in range(len(table.coupling)):
         span = range(int(table.start[g]), int(table.start[g + 1]))

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_names, as_reals, as_vectors, finite_number, readonly
-from ..couplings import GEAR_EXACT_RTOL, Coupling, GearWarning, gear_breaches
+from ..couplings import GEAR_EXACT_RTOL, Coupling, GearBreach, GearWarning, gear_breaches
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
@@ -35,7 +35,8 @@ __all__ = ["GEAR_RTOL", "WheelCommands", "forward_kinematics", "gear_error", "re
 #: :func:`wheel_commands`' default ``speed_tol`` [m/s]: a steering axis slower than this holds its angle.
 SPEED_TOL = 1e-12
 #: :func:`wheel_commands`' default ``slip_tol`` [m/s]: a fixed wheel's side slip, and a gear's departure at a contact
-#: (:mod:`.gear_check`), within it roll (also the floor of ``realtime``'s ik and the generated ``in_gear``).
+#: (:mod:`.gear_check`), within it roll (also the floor of ``realtime``'s ik, the generated ``in_gear`` and
+#: :func:`forward_kinematics_check`'s tolerance and gear check).
 SLIP_TOL = 1e-9
 
 
@@ -352,10 +353,11 @@ def forward_kinematics_check(
     """:func:`forward_kinematics` for one sample, with the slip split by wheel and judged against a tolerance.
 
     The tolerance is `rtol` times the fastest speed a given rate stands for (:func:`_speed_per_rate`: a spin's
-    ``|r phi_dot|``, a steering rate's contact speed, ``omega`` times the robot's size) plus 1e-9 m/s:
+    ``|r phi_dot|``, a steering rate's contact speed, ``omega`` times the robot's size) plus :data:`SLIP_TOL`:
     rates that contradict each other beyond it (slip larger than measurement noise) are not ``consistent``, nor are
-    given joints of a ``gear`` out of its ratios beyond round-off (:data:`wmrkit.couplings.GEAR_EXACT_RTOL`): each
-    such gear is named in ``out_of_gear``, with a :class:`~wmrkit.couplings.GearWarning`.
+    given joints of a ``gear`` out of its ratios beyond round-off (:data:`wmrkit.couplings.GEAR_EXACT_RTOL`) by more
+    than :data:`SLIP_TOL` at a contact: each such gear is named in ``out_of_gear``, with a
+    :class:`~wmrkit.couplings.GearWarning`.
     """
     columns = _assigned_columns(robot, list(rates))
     q_assigned = np.array([float(_rate_value(k, v)) for k, v in rates.items()])
@@ -366,16 +368,27 @@ def forward_kinematics_check(
     wheel_slip = np.sqrt(np.bincount(owner, weights=slip**2, minlength=len(robot.wheels)))
     speeds = [abs(v) * _speed_per_rate(robot, n)
               for n, v in zip((robot.velocity_names[c] for c in columns), q_assigned, strict=True)]
-    tolerance = rtol * max(speeds, default=0.0) + 1e-9
+    tolerance = rtol * max(speeds, default=0.0) + SLIP_TOL
     residual = float(np.linalg.norm(slip))
     slipping = tuple(robot.wheel_names[i] for i in np.flatnonzero(wheel_slip > tolerance))
     names = tuple(robot.velocity_names[c] for c in columns)
-    breaches = gear_breaches(robot.couplings, names, q_assigned, GEAR_EXACT_RTOL)
+    breaches = _given_gear_breaches(robot, names, q_assigned)
     for b in breaches:
         warnings.warn(b.warning(names, q_assigned), GearWarning, stacklevel=2)
     consistent = bool(residual <= tolerance) and not breaches
     return ForwardKinematics(_ro(q_dot[:3]), residual, _ro(wheel_slip), tolerance, consistent, slipping,
                              tuple(b.coupling.channel_name for b in breaches))
+
+
+def _given_gear_breaches(robot: Robot, names: tuple[str, ...], q: np.ndarray) -> list[GearBreach]:
+    """The gears whose given rates `q` (one row, of the joints `names`) break their ratios beyond round-off
+    (:data:`GEAR_EXACT_RTOL`), unless each joint's departure moves its contact within the slip floor
+    :data:`SLIP_TOL` (:func:`~wmrkit.kinematics.gear_check.gears_hold` with no relative part): 1e-320 rad/s on one
+    wheel of a 1:1 axle and 0 on the other roll alike, as ik judges them."""
+    table = gear_table(robot, names)
+    held = gears_hold(table, q, SLIP_TOL, rtol=0.0)
+    within = {id(robot.couplings[i]) for i, h in zip(table.coupling, held, strict=True) if h}
+    return [b for b in gear_breaches(robot.couplings, names, q, GEAR_EXACT_RTOL) if id(b.coupling) not in within]
 
 
 def _speed_per_rate(robot: Robot, name: str) -> float:
