@@ -8,7 +8,6 @@ explains them and the slip they leave. ``docs/wheel-ik.md`` states the policies 
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -26,7 +25,7 @@ from ..units import MAX_ANGLE, UnitError, parse_quantity
 from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
 from ._ik_fast import wrap_angle
-from .gear_check import GEAR_RTOL, gear_table, gears_hold
+from .gear_check import GEAR_RTOL, contact_lever, gear_table, gears_hold
 from .linalg import geared_solve, geared_twist_determined, robot_size
 
 __all__ = ["GEAR_RTOL", "WheelCommands", "forward_kinematics", "gear_error", "resolve_rate_name", "twist_is_determined",
@@ -353,11 +352,11 @@ def forward_kinematics_check(
     """:func:`forward_kinematics` for one sample, with the slip split by wheel and judged against a tolerance.
 
     The tolerance is `rtol` times the fastest speed a given rate stands for (:func:`_speed_per_rate`: a spin's
-    ``|r phi_dot|``, a steering rate's contact speed, ``omega`` times the robot's size) plus :data:`SLIP_TOL`:
-    rates that contradict each other beyond it (slip larger than measurement noise) are not ``consistent``, nor are
-    given joints of a ``gear`` out of its ratios beyond round-off (:data:`wmrkit.couplings.GEAR_EXACT_RTOL`) by more
-    than :data:`SLIP_TOL` at a contact: each such gear is named in ``out_of_gear``, with a
-    :class:`~wmrkit.couplings.GearWarning`.
+    ``|r phi_dot|``, a Swedish roller's ``|r_r phi_r_dot|``, a steering rate's contact speed, ``omega`` times the
+    robot's size) plus :data:`SLIP_TOL`: rates that contradict each other beyond it (slip larger than measurement
+    noise) are not ``consistent``, nor are given joints of a ``gear`` out of its ratios beyond round-off
+    (:data:`wmrkit.couplings.GEAR_EXACT_RTOL`) by more than :data:`SLIP_TOL` at a contact: each such gear is named in
+    ``out_of_gear``, with a :class:`~wmrkit.couplings.GearWarning`.
     """
     columns = _assigned_columns(robot, list(rates))
     q_assigned = np.array([float(_rate_value(k, v)) for k, v in rates.items()])
@@ -392,15 +391,15 @@ def _given_gear_breaches(robot: Robot, names: tuple[str, ...], q: np.ndarray) ->
 
 
 def _speed_per_rate(robot: Robot, name: str) -> float:
-    """The contact speed [m/s] one unit of the velocity `name` stands for: a spin's ``r``; a steering rate's lever
-    from the steering axis to the contact points, ``hypot(d, b)`` (a castor's offset, a double wheel's half
-    spacing: not 1 m, which read 1 rad/s of a castor with d = 0.04 m as 1 m/s); ``omega``'s lever the robot's size
-    (:func:`robot_size`: 1 m read a gyro's 0.5 rad/s on a robot 1 mm across as 0.5 m/s); 1 for vx and vy."""
+    """The contact speed [m/s] one unit of the velocity `name` stands for: a joint's
+    :func:`~wmrkit.kinematics.gear_check.contact_lever` (a spin's ``r``, a Swedish roller's ``r_r``, a steering
+    rate's ``hypot(d, b)``: not 1 m, which read 1 rad/s of a castor with d = 0.04 m as 1 m/s); ``omega``'s lever the
+    robot's size (:func:`robot_size`: 1 m read a gyro's 0.5 rad/s on a robot 1 mm across as 0.5 m/s); 1 for vx and
+    vy."""
     wheel, _, joint = name.partition(".")
     if not joint:
         return robot_size(robot) if name == "omega" else 1.0
-    w = robot.wheel(wheel)
-    return math.hypot(w.d, w.b) if joint == "steer" else w.r
+    return contact_lever(robot.wheel(wheel), joint)
 
 
 def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: ArrayLike | None = None, *,
