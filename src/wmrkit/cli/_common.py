@@ -8,7 +8,8 @@ import json
 import math
 import os
 import sys
-from collections.abc import Iterator
+import warnings
+from collections.abc import Iterable, Iterator
 from contextvars import ContextVar
 from pathlib import Path
 from typing import Any
@@ -91,6 +92,23 @@ def warn(message: str) -> None:
     said = _SAID.get()
     if said is not None:
         said.append(message)
+
+
+def say_caught(caught: Iterable[warnings.WarningMessage], skip: tuple[type[Warning], ...] = ()) -> None:
+    """Say the warnings a command's run recorded (``warnings.catch_warnings(record=True)``): wmrkit's own, each
+    message once, with :func:`warn` (but those of a category in `skip`, which the caller says otherwise); the
+    others (numpy's, scipy's, ...) passed on as they were, once per message and place."""
+    caught = list(caught)
+    foreign = {(w.category, str(w.message), w.filename, w.lineno): w for w in caught if not _own(w.category)}
+    for w in foreign.values():
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    for line in dict.fromkeys(str(w.message) for w in caught if _own(w.category) and not issubclass(w.category, skip)):
+        warn(line)
+
+
+def _own(category: type[Warning]) -> bool:
+    """Whether `category` is one of wmrkit's warning classes."""
+    return category.__module__.split(".")[0] == "wmrkit"
 
 
 def said() -> list[str]:

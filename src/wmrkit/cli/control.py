@@ -18,6 +18,7 @@ from ._common import (
     load_robot,
     parse_value,
     print_json,
+    say_caught,
     warn,
 )
 
@@ -219,10 +220,8 @@ def check_animation_path(path: str | None, suffixes: tuple[str, ...] = (".gif",)
 
 def run_track(args: argparse.Namespace) -> int:
     """Simulate, then print a summary (or the time series as JSON); warnings on stderr (and in the JSON)."""
-    from ..control.laws import GateWarning, SamplingWarning
+    from ..control.laws import SamplingWarning
     from ..control.track import track
-    from ..control.trackers import ArrivalWarning
-    from ..dynamics.linkages import LinkageWarning
 
     check_plot_path(args.plot)
     check_animation_path(args.animate)
@@ -250,28 +249,23 @@ def run_track(args: argparse.Namespace) -> int:
 
         settings = odometry_settings(args.robot)
         weights, noise = settings.weights(), settings.kalman_noise()
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", SamplingWarning)
-        warnings.simplefilter("always", GateWarning)
-        warnings.simplefilter("always", ArrivalWarning)
-        warnings.simplefilter("always", LinkageWarning)  # --dynamics: a linkage the model does not hold
+    failed: WmrkitError | None = None
+    with warnings.catch_warnings(record=True) as caught:  # every one said below (after: one passed on is not caught)
+        warnings.simplefilter("always", UserWarning)  # wmrkit's classes (a model built twice says it once)
         try:
             run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
                         lookahead=lookahead, stanley_gain=stanley_gain, period=period, delay=args.delay,
                         duration=duration, policy=args.steering, dynamics=args.dynamics, slip_model=args.slip_model,
                         feedback=args.feedback, weights=weights, noise=noise, ramp=args.ramp,
                         progress=sys.stderr.isatty() and not args.json)
-        except WmrkitError as err:  # the sampling warning that foretold it, in the one line of the error
-            for line in dict.fromkeys(str(w.message) for w in caught if issubclass(w.category, LinkageWarning)):
-                warn(line)  # what the model is, said before the error its run met
-            foretold = [str(w.message) for w in caught if issubclass(w.category, SamplingWarning)]
-            if not foretold:
-                raise
-            raise type(err)(f"{err} ({'; '.join(foretold)})") from None
-    for message in dict.fromkeys(str(w.message) for w in caught  # a model built twice says it once
-                                 if issubclass(w.category, (LinkageWarning, SamplingWarning, GateWarning,
-                                                            ArrivalWarning))):
-        warn(message)
+        except WmrkitError as err:
+            failed = err
+    foretold = [str(w.message) for w in caught if issubclass(w.category, SamplingWarning)] if failed else []
+    say_caught(caught, skip=(SamplingWarning,) if foretold else ())  # the others said before the error
+    if failed is not None:  # the sampling warning that foretold it, in the one line of the error
+        if not foretold:
+            raise failed
+        raise type(failed)(f"{failed} ({'; '.join(foretold)})") from None
     for v in run.range_violations():
         lo, hi = (math.degrees(a) for a in robot.wheel(v["wheel"]).steer_range)
         warn(f"wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg for {v['duration']:.3g} s "
