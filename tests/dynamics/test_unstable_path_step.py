@@ -101,3 +101,43 @@ def test_check_step_passes_runs_on_their_path_and_adaptive_runs():
     check_step(model, inputs, simulate(model, inputs, 1.0, step=0.005))  # on its path: nothing re-run
     with pytest.raises(WmrkitError, match=r"at step 0\.0333 s .* use a step of at most 0\.0001 s"):
         check_step(model, inputs, simulate(model, inputs, 2.997, method="rk4", step=0.0333))
+
+
+def test_check_step_names_the_step_keyword_and_the_cli_its_option(capsys):
+    """check_step() told Python callers "use a step of at most 0.0001 s (--step) or the adaptive method", the CLI's
+    option; now simulate()'s keyword, and `wmrkit simulate` its option, as simulate()'s own stops do."""
+    model = DynamicModel.of(catalog.load("forklift"))
+    inputs, duration = path_program(model, "turn")
+    with pytest.raises(WmrkitError) as err:
+        check_step(model, inputs, simulate(model, inputs, duration, method="rk4", step=0.0333, record_step=0.0333))
+    assert str(err.value).endswith("use a step of at most 0.0001 s (the step keyword) or method='adaptive'")
+    assert "--step" not in str(err.value)
+    cli = _refused(capsys, "simulate", "forklift", "--path", "turn", "--method", "rk4", "--step", "0.0333")
+    assert cli == f"wmrkit: error: {err.value}\n".replace("(the step keyword) or method='adaptive'",
+                                                           "(--step) or the adaptive method")
+
+
+def test_a_stop_of_check_steps_rerun_says_the_step_as_each_door_sets_it(monkeypatch, capsys):
+    """A re-run that stops is quoted in check_step's error: its advice (simulate()'s keyword) is said by the CLI as
+    its option, as simulate()'s own stops."""
+    import wmrkit.dynamics.simulate as simulate_module
+    from wmrkit.dynamics.runs import SIMULATE_STEP
+
+    real = simulate_module.simulate
+
+    def stopping(model, inputs, duration, **kwargs):
+        if kwargs.get("step") == 0.0001:  # the re-run of check_step
+            err = WmrkitError(f"the re-run stopped; use a step of at most 1e-05 s {SIMULATE_STEP}")
+            err.where = SIMULATE_STEP
+            raise err
+        return real(model, inputs, duration, **kwargs)
+
+    monkeypatch.setattr(simulate_module, "simulate", stopping)
+    model = DynamicModel.of(catalog.load("forklift"))
+    inputs, duration = path_program(model, "turn")
+    with pytest.raises(WmrkitError, match=r"to check it stops: the re-run stopped; .* \(the step keyword\) or"):
+        check_step(model, inputs, real(model, inputs, duration, method="rk4", step=0.0333, record_step=0.0333))
+    assert main(["simulate", "forklift", "--path", "turn", "--method", "rk4", "--step", "0.0333"]) == 2
+    err = capsys.readouterr().err
+    assert err.endswith("to check it stops: the re-run stopped; use a step of at most 1e-05 s (--step) or the adaptive "
+                        "method\n") and "keyword" not in err

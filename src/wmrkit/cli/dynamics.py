@@ -162,9 +162,9 @@ def run_simulate(args: argparse.Namespace) -> int:
         sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
                        record_step=recordable_step(model, duration, step, max(step, min(0.01, duration))),
                        progress=False if args.json else None)
-    except WmrkitError as err:  # a stop's re-check names the step as the CLI sets it
+        check_step(model, inputs, sim, initial_twist=twist)  # a run off its path at an unstable step is refused
+    except WmrkitError as err:  # a stop's re-check, or the step's, names the step as the CLI sets it
         raise at_door(err, "(--step) or the adaptive method") from None
-    check_step(model, inputs, sim, initial_twist=twist)  # a run off its path at an unstable step is refused
     if args.out:
         _write(sim, args.out)
     if args.plot:

@@ -154,8 +154,9 @@ def check_step(model, inputs, sim, initial_twist=(0.0, 0.0, 0.0), jac_every: int
     path's own tolerance (:attr:`PathDeviation.large` with the program's size and turn): the deviation is then the
     step's (an integrator unstable or far from converged with stiff tyres), not the robot's. The re-run goes from
     t = 0 over at most :data:`~wmrkit.dynamics.runs.RECHECK_STEPS` of its steps (a quarter for rk4), on the run's
-    record times; a run that left its path by as much at both steps passes (its deviation is the robot's)."""
-    from .runs import recheck_budget, recheck_step
+    record times; a run that left its path by as much at both steps passes (its deviation is the robot's). Its
+    error names the step keyword (:data:`~wmrkit.dynamics.runs.SIMULATE_STEP`; the CLI its option: ``at_door``)."""
+    from .runs import SIMULATE_STEP, recheck_budget, recheck_step
     from .simulate import simulate
 
     deviation = sim.deviation()
@@ -172,15 +173,19 @@ def check_step(model, inputs, sim, initial_twist=(0.0, 0.0, 0.0), jac_every: int
                          initial_twist=initial_twist, initial_pose=sim.pose[0], record_step=every * step,
                          progress=False, jac_every=jac_every)
     except WmrkitError as e:
-        raise WmrkitError(f"the robot left the programmed path at step {step:g} s (up to {deviation.max_position:.3g} "
-                          f"m from it), and a run at step {fine:.3g} s to check it stops: {e}") from None
+        err = WmrkitError(f"the robot left the programmed path at step {step:g} s (up to {deviation.max_position:.3g} "
+                          f"m from it), and a run at step {fine:.3g} s to check it stops: {e}")
+        err.where = getattr(e, "where", "")  # the stop's advice, said at each door its own way (runs.at_door)
+        raise err from None
     t, nominal = sim.t[:m], sim.nominal_pose[:m]
     along = PathDeviation.of(t, check.pose, nominal)
     apart = dataclasses.replace(PathDeviation.of(t, sim.pose[:m], check.pose), size=along.size, turn=along.turn)
     if apart.large:
-        raise WmrkitError(
+        err = WmrkitError(
             f"the robot left the programmed path at step {step:g} s (up to {deviation.max_position:.3g} m from it), "
             f"but a run at step {fine:.3g} s to t = {t[-1]:g} s keeps within {along.max_position:.3g} m of the path "
             f"and is up to {apart.max_position:.3g} m and {abs(apart.max_heading):.3g} rad from that run: the step is "
             f"too long for the tyres (the integration's error, not the robot's path); use a step of at most "
-            f"{fine:.3g} s (--step) or the adaptive method")
+            f"{fine:.3g} s {SIMULATE_STEP}")
+        err.where = SIMULATE_STEP  # the CLI says its option (runs.at_door)
+        raise err
