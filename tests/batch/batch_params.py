@@ -29,6 +29,22 @@ def write_log(path, run) -> str:
     return str(path)
 
 
+def write_fleet(directory, runs) -> list[str]:
+    """Each calibration run's log as ``directory/STEM.csv`` and its reference poses as ``directory/ref/STEM.tum``;
+    the ``batch calibrate diff-drive`` arguments that read them (no worker processes)."""
+    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+
+    (directory / "ref").mkdir()
+    for run in runs:
+        stem = run.log.source.removesuffix(".csv")
+        write_log(directory / f"{stem}.csv", run)
+        at = run.samples()
+        write_trajectory(directory / "ref" / f"{stem}.tum", Trajectory(run.log.time[at], np.asarray(run.reference),
+                                                                       np.zeros(len(at)), None), "tum")
+    return ["batch", "calibrate", "diff-drive", str(directory / "*.csv"), "--reference", str(directory / "ref"),
+            "--workers", "0"]
+
+
 def closed_fleet(diff, seed, odd=None, runs=6, noise=1e-5):
     """Closed squares of 1-2.5 m, both ways, encoder noise `noise` per rad, of a robot at radius ratio +1 % and track
     +3 %; run 0 of one at `odd` ``(ratio, track)`` instead."""

@@ -7,7 +7,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from batch_params import PARAMS, TRUE_P, write_log
+from batch_params import PARAMS, TRUE_P, write_fleet
 
 from wmrkit.batch.calibrate import fleet_calibrate
 from wmrkit.batch.consistency import MAX_CLOSED_SCORE
@@ -48,7 +48,6 @@ def test_a_mixed_fleet_judges_its_comparable_runs_and_names_those_set_aside(diff
     together (closed paths and two-pose references: one final pose each; the same score as alone for the five),
     and the three-pose run is named as set aside, in the API and the CLI's --json."""
     from wmrkit.cli.main import main
-    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
 
     five = short_runs(diff, 11, 5, 2, bad=(1,))
     alone = fleet_calibrate(diff, five, PARAMS)
@@ -68,15 +67,7 @@ def test_a_mixed_fleet_judges_its_comparable_runs_and_names_those_set_aside(diff
     assert res.inconsistent is True and disagreeing(res) == ["r1.csv"] and res.not_judged is None
     assert res.closed_scores[1] > MAX_CLOSED_SCORE > max(res.closed_scores[k] for k in (0, 2, 3, 4, 5, 6))
     # the CLI, from files: the same verdict and the set-aside line
-    (tmp_path / "ref").mkdir()
-    for run in five + three:
-        stem = run.log.source.removesuffix(".csv")
-        write_log(tmp_path / f"{stem}.csv", run)
-        at = run.samples()
-        write_trajectory(tmp_path / "ref" / f"{stem}.tum", Trajectory(run.log.time[at], np.asarray(run.reference),
-                                                                      np.zeros(len(at)), None), "tum")
-    args = ["batch", "calibrate", "diff-drive", str(tmp_path / "*.csv"), "--reference", str(tmp_path / "ref"),
-            "--workers", "0"]
+    args = write_fleet(tmp_path, five + three)
     assert main([*args, "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["inconsistent"] is True and data["not_judged"].startswith(str(tmp_path / "t0.csv: set aside"))

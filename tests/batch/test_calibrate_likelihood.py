@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
-from batch_params import PARAMS, write_log
+from batch_params import PARAMS, write_fleet
 from scipy.optimize import minimize
 from test_calibrate_judge import short_runs
 
@@ -126,7 +126,6 @@ def test_runs_left_out_of_the_whole_fleet_check_are_named(diff, tmp_path, capsys
     text and JSON. With 4 such runs of 6 the check is not made at all, and that is said."""
     from wmrkit.batch.likelihood import LEFT_OUT
     from wmrkit.cli.main import main
-    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
 
     runs = short_runs(diff, 40000, 6, 3, early=(0,))
     res = fleet_calibrate(diff, runs, PARAMS)
@@ -138,15 +137,7 @@ def test_runs_left_out_of_the_whole_fleet_check_are_named(diff, tmp_path, capsys
     res = fleet_calibrate(diff, short_runs(diff, 40001, 6, 3, early=(0, 2, 3, 5)), PARAMS)
     assert res.not_judged.startswith("r0.csv, r2.csv, r3.csv, r5.csv: left out of the whole-fleet check")
     assert "; 2 runs are left, too few: the check is not made" in res.not_judged
-    (tmp_path / "ref").mkdir()
-    for run in runs:
-        stem = run.log.source.removesuffix(".csv")
-        write_log(tmp_path / f"{stem}.csv", run)
-        at = run.samples()
-        write_trajectory(tmp_path / "ref" / f"{stem}.tum", Trajectory(run.log.time[at], np.asarray(run.reference),
-                                                                      np.zeros(len(at)), None), "tum")
-    args = ["batch", "calibrate", "diff-drive", str(tmp_path / "*.csv"), "--reference", str(tmp_path / "ref"),
-            "--workers", "0"]
+    args = write_fleet(tmp_path, runs)
     assert main([*args, "--json"]) == 0
     said = f"{tmp_path / 'r0.csv'}: left out of the whole-fleet check"
     assert json.loads(capsys.readouterr().out)["not_judged"].startswith(said)
