@@ -143,3 +143,34 @@ def test_runs_left_out_of_the_whole_fleet_check_are_named(diff, tmp_path, capsys
     assert json.loads(capsys.readouterr().out)["not_judged"].startswith(said)
     assert main(args) == 0
     assert f"not judged: {said}" in capsys.readouterr().out
+
+
+def test_runs_not_scored_against_their_own_noise_are_named(diff, tmp_path, capsys):
+    """An agreeing fleet of 6 three-pose runs of levels drawn per run (seed 25, not flagged): with the noisiest run's
+    (1e-4 per rad among quieter ones) middle reference one sample after the start, its motions' errors cannot be
+    whitened, so the F test against its own noise that clears such runs (test above) is not made: it scored 29.3 over
+    the others' noise alone and was named as another robot's with 'its own noise does not explain it', and
+    not_judged said only that it was left out of the whole-fleet check. Now the warning says its own noise is not
+    measured and not_judged names the skipped test and why (refits.OWN_SKIPPED), in the API and the CLI's text and
+    JSON."""
+    from wmrkit.batch.likelihood import LEFT_OUT
+    from wmrkit.batch.refits import OWN_SKIPPED
+    from wmrkit.cli.main import main
+
+    noise = np.random.default_rng(25).choice([1e-6, 1e-5, 1e-4], 6)
+    assert noise[2] == 1e-4 and not fleet_calibrate(diff, short_runs(diff, 100025, 6, 3, noise=noise), PARAMS).warnings
+    runs = short_runs(diff, 100025, 6, 3, noise=noise, early=(2,))
+    res = fleet_calibrate(diff, runs, PARAMS)
+    assert res.closed_scores[2] > 20 and len(res.warnings) == 1, res.closed_scores
+    assert res.warnings[0].startswith("r2.csv: disagrees") and "its own noise is not measured" in res.warnings[0]
+    why = ("r2.csv: its motion from sample 0 to 1, t 0-0.1 s, has a covariance of rank 2 of 3: the encoders do not "
+           "see every direction of it")
+    assert res.not_judged == res.to_dict()["not_judged"] == "; ".join([
+        LEFT_OUT.format(runs="r2.csv", why=why, rest="the other 5 runs are checked"),
+        OWN_SKIPPED.format(runs="r2.csv", why=why)])
+    args = write_fleet(tmp_path, runs)
+    assert main([*args, "--json"]) == 0
+    said = f"{tmp_path / 'r2.csv'}: scored against the other runs' noise only, not against its own"
+    assert said in json.loads(capsys.readouterr().out)["not_judged"]
+    assert main(args) == 0
+    assert said in capsys.readouterr().out

@@ -39,7 +39,7 @@ from ..robot import Robot
 from .homogeneity import fleet_warning
 from .likelihood import MIN_OWN_DOF, few_pose_warning, own_noise
 from .refits import REFIT_FAILED as REFIT_FAILED  # re-exported: batch.consistency.REFIT_FAILED
-from .refits import own_dof, own_scores, refits
+from .refits import own_dof, own_scores, own_skipped, refits
 
 #: Largest residual ratio of a fleet whose runs agree. Simulated fleets with encoder noise (1e-5 per rad, or drawn
 #: per run among 1e-6, 1e-5 and 1e-4), 4 to 16 runs (docs/batch.md's table): largest ratio 12.1 over 260 fleets;
@@ -364,9 +364,10 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
                 runs="every run" if len(which) == g else ", ".join(logs[k] for k in which), why=why))
     hess = np.stack([(j - fit.jac) / CURVATURE_STEP for j in moved], axis=-1)  # (R, n, n)
     live = np.split(np.any(fit.jac != 0, axis=1) | (fit.fun != 0), np.cumsum(sizes)[:-1])  # counts' rows
-    scores, messages, left = np.full(g, np.nan), [], []
+    scores, messages, left, skipped = np.full(g, np.nan), [], [], {}
     for group in groups:
-        done = _group_scores(problem, fit, hess, group, [blocks[i][live[i]] for i in group], travels, live, refit)
+        done = _group_scores(problem, fit, hess, group, [blocks[i][live[i]] for i in group], travels, live, refit,
+                             skipped)
         if isinstance(done, str):
             return Consistency((None,) * g, None, not_judged=done)
         done, pair = done
@@ -375,11 +376,12 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
         if scores[worst] > MAX_CLOSED_SCORE:
             messages.append(f"{logs[worst]}: disagrees with the other runs (closed-path score {scores[worst]:.3g}, "
                             f"over {MAX_CLOSED_SCORE:g}: the others' fit leaves it that many times their error, and "
-                            "its own noise does not explain it): "
+                            f"its own noise {'is not measured' if worst in skipped else 'does not explain it'}): "
                             "another robot, load or floor? The fit averages it in; check it or fit without it")
         elif pair is not None and pair[2] > MAX_PAIR_SCORE:
             messages.append(PAIR.format(a=logs[pair[0]], b=logs[pair[1]], score=pair[2]))
         named = 1 if scores[worst] > MAX_CLOSED_SCORE else 2 if pair is not None and pair[2] > MAX_PAIR_SCORE else 0
+        # run_weights or heading_weight 0 skip it unsaid: only a Python caller sets them (batch calibrate sets neither)
         if m[group[0]] - n >= MIN_OWN_DOF and problem.run_weights is None and problem.heading_weight != 0:
             said, out = few_pose_warning(problem, fit.x, fit.jac, fit.fun, group, ROUNDOFF * travels, logs, named)
             messages += [said] if said else []  # several runs that disagree (wmrkit.batch.likelihood)
@@ -387,6 +389,7 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     aside = [k for k in range(g) if np.isnan(scores[k])]
     why = [] if not aside else [SET_ASIDE.format(runs=", ".join(logs[k] for k in aside), judged=", ".join(
         f"{len(group)} runs of {_poses(m[group[0]])}" for group in groups))]
+    left += [own_skipped(skipped, logs)] if skipped else []  # runs not scored against their own noise
     return Consistency(judged.ratios, bool(messages), tuple(messages), "; ".join(why + left) or None,
                        tuple(None if np.isnan(q) else float(q) for q in scores))
 
@@ -398,9 +401,10 @@ def _poses(live: int) -> str:
 
 def _group_scores(problem: CalibrationProblem, fit, hess: np.ndarray, group: np.ndarray, rows: list[np.ndarray],
                   travels: np.ndarray, live: list[np.ndarray],
-                  refit: Callable) -> tuple[np.ndarray, tuple[int, int, float] | None] | str:
+                  refit: Callable, skipped: dict[int, str]) -> tuple[np.ndarray, tuple[int, int, float] | None] | str:
     """The closed-path scores of the runs `group` (as many residuals each: their `rows` of the fleet fit) against
-    each other (:func:`judge`) and, when none is over :data:`MAX_CLOSED_SCORE`, the pair of largest pair score
+    each other (:func:`judge`; runs not scored against their own noise put in `skipped`) and, when none is over
+    :data:`MAX_CLOSED_SCORE`, the pair of largest pair score
     (:func:`_pair`: the two runs, their pair score; ``None`` if none was scored); or why they are not judged."""
     logs, n = names(problem.runs), fit.x.size
     g, here = len(group), np.concatenate(rows)
@@ -429,7 +433,7 @@ def _group_scores(problem: CalibrationProblem, fit, hess: np.ndarray, group: np.
     for k, err in zip(more, done, strict=True):
         errs[k] = err
         scores[k] = _score(err, k, np.delete(np.arange(g), k), floors, n, m)
-    own = own_scores(problem, fit, group, live, w, refit, logs, over, errs) if over else None
+    own = own_scores(problem, fit, group, live, w, refit, logs, over, errs, skipped) if over else None
     if isinstance(own, str):
         return own
     if own is not None:  # the smaller score: it disagrees beyond the others' noise and beyond its own

@@ -36,6 +36,12 @@ OWN_LEVEL = 0.01
 #: returned all the same ({run}: the run left out; {why}: the error).
 REFIT_FAILED = ("{run}: the fit of the other runs without {it} failed ({why}): the closed runs are not checked against "
                 "each other, a run of another robot is averaged in unseen (the fleet fit stands)")
+#: Why runs named over the other runs' noise were not scored against their own (said in ``not_judged``; {runs}: the
+#: runs; {why}: each run's why): :func:`own_scores` has no F test for them. Before, they were skipped unsaid and
+#: their warning said their own noise did not explain their score (an agreeing run at 1e-4 per rad among quieter
+#: ones, its middle reference one sample after the start: 29.3, named as another robot's).
+OWN_SKIPPED = ("{runs}: scored against the other runs' noise only, not against its own ({why}): a run noisier than "
+               "the others scores high there too, so its warning may be its noise, not another robot")
 
 
 def refits(problem: CalibrationProblem, group: np.ndarray, outs: list[tuple[int, ...]], starts: list[np.ndarray],
@@ -70,7 +76,8 @@ def own_dof(jac: np.ndarray, m: np.ndarray) -> np.ndarray:
 
 
 def own_scores(problem: CalibrationProblem, fit, group: np.ndarray, live: list[np.ndarray], w: np.ndarray,
-               refit: Callable, logs: Sequence[str], which: Sequence[int], errs: dict) -> np.ndarray | str:
+               refit: Callable, logs: Sequence[str], which: Sequence[int], errs: dict,
+               skipped: dict[int, str]) -> np.ndarray | str:
     """Each of the runs `which` (places in `group`; `errs`: for each, the weighted residuals of `group` at the fit of
     the others, :func:`refits`) scored against its own noise: the F statistic of its motions' errors, whitened by
     its encoders' noise model about the fleet fit (:func:`~wmrkit.batch.motions.whitening`), at the others' fit
@@ -79,7 +86,8 @@ def own_scores(problem: CalibrationProblem, fit, group: np.ndarray, live: list[n
     ``sqrt(F / F_crit)`` (over 1: the run disagrees beyond its own noise), ``F_crit`` the F distribution's
     :data:`OWN_LEVEL` point of ``(rank, dof)`` degrees of freedom (module docstring); ``inf`` where the run has no
     such score (fewer than :data:`~wmrkit.batch.likelihood.MIN_OWN_DOF` degrees of freedom, a motion the encoders do
-    not see, a sample weighted 0, a noise-free own fit), ``(G,)``; or why a fit failed."""
+    not see, a sample weighted 0: each put in `skipped`, run index to why, :func:`own_skipped`; a noise-free own
+    fit, whose F is infinite), ``(G,)``; or why a fit failed."""
     from scipy import stats
 
     sizes = problem.sizes()
@@ -95,8 +103,10 @@ def own_scores(problem: CalibrationProblem, fit, group: np.ndarray, live: list[n
         run, rows = problem.runs[i], slice(int(starts[i]), int(starts[i] + sizes[i]))
         weight = np.ones(sizes[i]) if problem.run_weights is None else np.repeat(
             np.asarray(problem.run_weights(run), dtype=float), 3)
-        white = whitening(problem, fit.x, run, fit.fun[rows] / weight) if np.all(weight > 0) else "weighted 0"
+        white = whitening(problem, fit.x, run, fit.fun[rows] / weight) if np.all(weight > 0) else (
+            "a sample of it weighted 0")
         if isinstance(white, str):
+            skipped[i] = white
             continue
         poses = np.zeros((2, sizes[i]))  # its weighted live rows, alone and at the others' fit -> pose errors
         poses[:, live[i]] = np.array([mine[k], errs[k][k]]) / w[k]
@@ -104,7 +114,16 @@ def own_scores(problem: CalibrationProblem, fit, group: np.ndarray, live: list[n
         rw, far = (white @ (poses / weight).T).T
         step, _, rank, _ = np.linalg.lstsq(jw, rw, rcond=None)
         own, free = float(np.sum(np.square(rw - jw @ step))), rw.size - rank
-        if free >= MIN_OWN_DOF and own > 0:
+        if free < MIN_OWN_DOF:
+            skipped[i] = (f"its whitened motions' errors have {free} degrees of freedom beyond its own fit, fewer "
+                          f"than {MIN_OWN_DOF}")
+        elif free >= MIN_OWN_DOF and own > 0:
             f = max(float(far @ far) - own, 0.0) / rank / (own / free)
             out[k] = np.sqrt(f / stats.f(rank, free).isf(OWN_LEVEL))
     return out
+
+
+def own_skipped(skipped: dict[int, str], logs: Sequence[str]) -> str:
+    """:data:`OWN_SKIPPED` for the runs `skipped` (run index to why, :func:`own_scores`)."""
+    return OWN_SKIPPED.format(runs=", ".join(logs[i] for i in skipped),
+                              why="; ".join(f"{logs[i]}: {why}" for i, why in skipped.items()))
