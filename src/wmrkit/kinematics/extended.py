@@ -21,11 +21,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_names, as_vectors, readonly
-from ..couplings import GEAR_EXACT_RTOL, GearWarning, gear_breaches
+from ..couplings import GearWarning
 from ..errors import ShapeError, SingularError, UnknownNameError
 from ..robot import Robot
+from .gear_check import given_gear_breaches
 from .linalg import geared_solve
 from .models import bounded, configuration, describe_configuration, generic_mobility, velocity_indices
+from .wheel_ik import SLIP_TOL
 
 #: Most grid starts per problem of :func:`solve_steering` (its default 8 per wheel on 4 steered wheels); beyond,
 #: a seeded sample of the grid. Each start costs about 7 ms when no root exists (4096: 27 s for a swerve-4).
@@ -116,8 +118,9 @@ def _extended_solution(robot: Robot, assigned: Sequence[str], q_assigned: ArrayL
 
 def _in_gear(robot: Robot, idx: np.ndarray, q: np.ndarray, stacklevel: int | None) -> np.ndarray:
     """``(..., n_couplings)`` bool: False where the assigned rates `q` ``(..., n_a)`` (columns `idx`) of a ``gear``'s
-    joints break its ratios, judged row by row as ``fk`` judges its rates (:func:`wmrkit.couplings.gear_breaches`);
-    a :class:`GearWarning` per gear broken (its first row's numbers) at `stacklevel` (None: no warning)."""
+    joints break its ratios, judged row by row as ``fk`` judges its rates
+    (:func:`~.gear_check.given_gear_breaches`: beyond round-off and the slip floor); a :class:`GearWarning` per
+    gear broken (its first row's numbers) at `stacklevel` (None: no warning)."""
     couplings = robot.couplings
     names = tuple(robot.velocity_names[i] for i in idx)
     out = np.ones((*q.shape[:-1], len(couplings)), dtype=bool)
@@ -126,7 +129,7 @@ def _in_gear(robot: Robot, idx: np.ndarray, q: np.ndarray, stacklevel: int | Non
     rows, inverse = np.unique(q.reshape(-1, q.shape[-1]), axis=0, return_inverse=True)
     flat, said = out.reshape(-1, len(couplings)), set()
     for r, row in enumerate(rows):
-        for b in gear_breaches(couplings, names, row, GEAR_EXACT_RTOL):
+        for b in given_gear_breaches(robot, names, row, SLIP_TOL):
             k = next(i for i, c in enumerate(couplings) if c is b.coupling)
             flat[inverse.reshape(-1) == r, k] = False
             if stacklevel is not None and k not in said:

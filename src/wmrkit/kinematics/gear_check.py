@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..couplings import GEAR_EXACT_RTOL, GearBreach, gear_breaches
 from ..robot import Robot
 from ..wheels import Wheel
 
@@ -89,3 +90,15 @@ def gears_hold(table: GearTable, q: np.ndarray, slip_tol: float, rtol: float = G
             absolute = absolute & (e * table.lever[t] <= slip_tol)
         out.append(relative | absolute)
     return np.stack(out, axis=-1) if out else np.zeros((*q.shape[:-1], 0), dtype=bool)
+
+
+def given_gear_breaches(robot: Robot, names: tuple[str, ...], q: np.ndarray, slip_tol: float) -> list[GearBreach]:
+    """The gears whose given rates `q` (one row, of the joints `names`) break their ratios beyond round-off
+    (:func:`wmrkit.couplings.gear_breaches` at :data:`~wmrkit.couplings.GEAR_EXACT_RTOL`), unless each joint's
+    departure moves its contact within the slip floor `slip_tol` [m/s] (:func:`gears_hold` with no relative part):
+    1e-320 rad/s on one wheel of a 1:1 axle and 0 on the other roll alike, as ik judges them (``fk``'s given rates,
+    the extended solutions' assigned rows, a simulator state)."""
+    table = gear_table(robot, names)
+    held = gears_hold(table, np.asarray(q, dtype=float), slip_tol, rtol=0.0)
+    within = {id(robot.couplings[i]) for i, h in zip(table.coupling, held, strict=True) if h}
+    return [b for b in gear_breaches(robot.couplings, names, q, GEAR_EXACT_RTOL) if id(b.coupling) not in within]

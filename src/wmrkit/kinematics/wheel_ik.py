@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_names, as_reals, as_vectors, finite_number, readonly
-from ..couplings import GEAR_EXACT_RTOL, Coupling, GearBreach, GearWarning, gear_breaches
+from ..couplings import Coupling, GearWarning
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
@@ -25,7 +25,7 @@ from ..units import MAX_ANGLE, UnitError, parse_quantity
 from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
 from ._ik_fast import wrap_angle
-from .gear_check import GEAR_RTOL, contact_lever, gear_table, gears_hold
+from .gear_check import GEAR_RTOL, contact_lever, gear_table, gears_hold, given_gear_breaches
 from .linalg import geared_solve, geared_twist_determined, robot_size
 
 __all__ = ["GEAR_RTOL", "WheelCommands", "forward_kinematics", "gear_error", "resolve_rate_name", "twist_is_determined",
@@ -371,23 +371,12 @@ def forward_kinematics_check(
     residual = float(np.linalg.norm(slip))
     slipping = tuple(robot.wheel_names[i] for i in np.flatnonzero(wheel_slip > tolerance))
     names = tuple(robot.velocity_names[c] for c in columns)
-    breaches = _given_gear_breaches(robot, names, q_assigned)
+    breaches = given_gear_breaches(robot, names, q_assigned, SLIP_TOL)
     for b in breaches:
         warnings.warn(b.warning(names, q_assigned), GearWarning, stacklevel=2)
     consistent = bool(residual <= tolerance) and not breaches
     return ForwardKinematics(_ro(q_dot[:3]), residual, _ro(wheel_slip), tolerance, consistent, slipping,
                              tuple(b.coupling.channel_name for b in breaches))
-
-
-def _given_gear_breaches(robot: Robot, names: tuple[str, ...], q: np.ndarray) -> list[GearBreach]:
-    """The gears whose given rates `q` (one row, of the joints `names`) break their ratios beyond round-off
-    (:data:`GEAR_EXACT_RTOL`), unless each joint's departure moves its contact within the slip floor
-    :data:`SLIP_TOL` (:func:`~wmrkit.kinematics.gear_check.gears_hold` with no relative part): 1e-320 rad/s on one
-    wheel of a 1:1 axle and 0 on the other roll alike, as ik judges them."""
-    table = gear_table(robot, names)
-    held = gears_hold(table, q, SLIP_TOL, rtol=0.0)
-    within = {id(robot.couplings[i]) for i, h in zip(table.coupling, held, strict=True) if h}
-    return [b for b in gear_breaches(robot.couplings, names, q, GEAR_EXACT_RTOL) if id(b.coupling) not in within]
 
 
 def _speed_per_rate(robot: Robot, name: str) -> float:
