@@ -18,7 +18,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
-from ..couplings import GEAR_EXACT_RTOL, gear_breaches
 from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED, MAX_TORQUE
 from ..robot import Robot
@@ -257,6 +256,8 @@ class Stepper:
     def __init__(self, model: Robot | DynamicModel, state: ArrayLike | None = None, *, step: float = 1e-3,
                  method: Literal["semi-implicit", "rk4"] = "semi-implicit", jac_every: int = 20, t: float = 0.0,
                  tyre: Tyre | str | None = None, allow_lift_off: bool = False, recheck: bool = True) -> None:
+        from ..kinematics.gear_check import given_gear_breaches
+        from ..kinematics.wheel_ik import SLIP_TOL
         from ._integrate import model_work_arrays
 
         self.model = model if isinstance(model, DynamicModel) else DynamicModel.of(model, tyre)
@@ -274,7 +275,7 @@ class Stepper:
             state = np.array(as_vectors(state, 2 * n, "state"), dtype=float)
         if not np.all(np.isfinite(state)):
             raise WmrkitError("state: every entry must be finite")
-        for breach in gear_breaches(self.model.robot.couplings, self.model.names, state[n:], GEAR_EXACT_RTOL):
+        for breach in given_gear_breaches(self.model.robot, self.model.names, state[n:], SLIP_TOL):
             rates = ", ".join(f"{self.model.names[i]} {state[n + i]:.6g}" for i in breach.given)
             raise WmrkitError(f"state: {breach.head} ({rates} rad/s): the dynamics hold the gear, so a state turns "
                               "its joints in its ratios (initial_state does)")
