@@ -111,17 +111,12 @@ def fixed_axle(wheels: tuple[Wheel, ...] | list[Wheel]) -> tuple[np.ndarray, flo
     fixed = [w for w in wheels if w.type == "fixed"]
     if not fixed:
         return None
-    p0, h0 = wheel_point(fixed[0]), fixed[0].heading
+    p0, h0 = np.array(fixed[0].position), fixed[0].heading
     n0 = np.array([np.cos(h0), np.sin(h0)])
-    scale = max(1.0, *(float(np.abs(wheel_point(w)).max()) for w in fixed))
+    scale = max(1.0, *(float(np.abs(w.position).max()) for w in fixed))
     odd = next((w.name for w in fixed[1:] if abs(np.sin(w.heading - h0)) > 1e-9
-                or abs(n0 @ (wheel_point(w) - p0)) > 1e-9 * scale), None)
+                or abs(n0 @ (np.array(w.position) - p0)) > 1e-9 * scale), None)
     return p0, h0, odd
-
-
-def wheel_point(w: Wheel) -> np.ndarray:
-    """The wheel's steering point ``(x, y)`` [m] in the robot frame."""
-    return np.array([w.l * np.cos(w.alpha), w.l * np.sin(w.alpha)])
 
 
 def axle_problem(wheels: tuple[Wheel, ...] | list[Wheel]) -> str | None:

@@ -29,7 +29,7 @@ import math
 
 import numpy as np
 
-from ..couplings import axle_problem, fixed_axle, linkage_law, wheel_point
+from ..couplings import axle_problem, fixed_axle, linkage_law
 from ..errors import WmrkitError
 from ..wheels import heading_from_beta
 
@@ -133,7 +133,7 @@ def _in_axle(axle: tuple[np.ndarray, float], w) -> tuple[float, float, float]:
     """``(x, y, psi)`` of wheel `w` in the axle's frame: along the fixed wheels' rolling direction, along the axle,
     its heading from theirs."""
     p0, h0 = axle
-    r = wheel_point(w) - p0
+    r = np.array(w.position) - p0
     return (float(r[0] * math.cos(h0) + r[1] * math.sin(h0)), float(-r[0] * math.sin(h0) + r[1] * math.cos(h0)),
             float(heading_from_beta(w.beta, w.delta)) - h0)
 
