@@ -11,12 +11,14 @@ import contextlib
 import json
 import math
 import os
+import re
 import shutil
 import socket
 import tempfile
 import threading
 import time
 from pathlib import Path
+from urllib.parse import urlsplit
 
 import numpy as np
 import pytest
@@ -91,12 +93,42 @@ def page(server):
         pg = context.new_page()
         errors: list[str] = []
         pg.on("pageerror", lambda e: errors.append(str(e)))
+        console: list[str] = []
+        pg.on("console", lambda m: console.append(console_entry(m)) if m.type == "error" else None)
         pg.goto(url)
         pg.wait_for_function("() => window.studioStats && window.studioStats.rendered > 0")
         pg.errors = errors
+        pg.console_errors = console
         yield pg
         context.close()
     shutil.rmtree(profile, ignore_errors=True)
+
+
+def console_entry(message) -> str:
+    """A console error as '<path> <status>' for an HTTP error answer ('/api/analyze 422'), '<path> <text>' for
+    another failed load ('/api/analyze net::ERR_FAILED'), else its text."""
+    path = urlsplit(message.location.get("url") or "").path
+    status = re.fullmatch(r"Failed to load resource: the server responded with a status of (\d{3}) .*", message.text)
+    if status:
+        return f"{path} {status[1]}"
+    failed = re.fullmatch(r"Failed to load resource: (net::\S+)", message.text)
+    return f"{path} {failed[1]}" if failed else message.text
+
+
+@pytest.fixture
+def console_expected() -> list[str]:
+    """The console errors (:func:`console_entry`) a test provokes on purpose, e.g. '/api/analyze 422' for an
+    invalid value it types; it appends them."""
+    return []
+
+
+@pytest.fixture(autouse=True)
+def console_clean(page, console_expected):
+    """No console error (a 4xx/5xx answer, a failed load, a CSP refusal) other than those a test expects."""
+    page.console_errors.clear()
+    yield
+    unexpected = [e for e in page.console_errors if e not in console_expected]
+    assert not unexpected, f"unexpected console errors: {unexpected}"
 
 
 def settle(pg) -> None:
@@ -196,9 +228,12 @@ def test_open_drag_retype_drive_save(page, server):
     screenshot(pg, "edit.png")
 
     # an invalid value marks its field with the library's message, and the last valid drawing stays
+    assert not pg.console_errors  # no request of the flow so far was refused
     pg.fill('[data-field="r"]', "-3 mm")
     pg.press('[data-field="r"]', "Enter")
     settle(pg)
+    assert set(pg.console_errors) == {"/api/analyze 422"}  # the server refuses the invalid radius, as it should
+    pg.console_errors.clear()  # any other refusal of the flow fails the test (console_clean)
     assert pg.locator('[data-field="r"].invalid').count() == 1
     assert "must be > 0" in pg.inner_text('[data-msg="r"]')
     screenshot(pg, "error.png")
@@ -400,7 +435,9 @@ def test_late_slow_answers_do_not_overwrite_newer_ones(page):
         assert len(pg.evaluate("S.configs.singular.actuated.variables")) > 1  # diff-drive's has one (the castor)
         assert pg.evaluate("S.kappa.wheels") == list(robot.steer_names[:2])
     finally:
-        pg.evaluate("window.fetch = window.realFetch")
+        # a function, not the expression "window.fetch = window.realFetch": Playwright calls an expression's value
+        # when it is a function, here fetch() itself (a GET /null answered 404 in the console)
+        pg.evaluate("() => { window.fetch = window.realFetch; }")
     assert not pg.errors
 
 
@@ -425,7 +462,9 @@ def test_configurations_of_an_earlier_robot_are_not_shown(page):
         pg.wait_for_function("() => S.configsText === S.analysedText", timeout=60_000)
         assert pg.inner_text("#a-singular") not in ("computing…", old)
     finally:
-        pg.evaluate("window.fetch = window.realFetch")
+        # a function, not the expression "window.fetch = window.realFetch": Playwright calls an expression's value
+        # when it is a function, here fetch() itself (a GET /null answered 404 in the console)
+        pg.evaluate("() => { window.fetch = window.realFetch; }")
     assert not pg.errors
 
 
@@ -509,7 +548,8 @@ def test_couplings_follow_renamed_deleted_retyped_wheels(page):
     assert not pg.errors
 
 
-def test_errors_marked_on_their_own_field_naming_the_wheel(page):
+def test_errors_marked_on_their_own_field_naming_the_wheel(page, console_expected):
+    console_expected.append("/api/analyze 422")  # on purpose
     pg = page
     open_catalog(pg, "diff-drive")
     pg.click('[data-wheel="left"]')
@@ -543,7 +583,8 @@ def test_errors_marked_on_their_own_field_naming_the_wheel(page):
     assert not pg.errors
 
 
-def test_save_asks_before_replacing(page, server):
+def test_save_asks_before_replacing(page, server, console_expected):
+    console_expected.append("/api/save 409")  # on purpose
     pg = page
     _, root = server
     open_catalog(pg, "omni-3")
@@ -624,9 +665,10 @@ def test_handle_heading_is_a_clean_value(page):
     assert not pg.errors
 
 
-def test_open_invalid_file_names_the_file_not_the_current_robot(page, server):
+def test_open_invalid_file_names_the_file_not_the_current_robot(page, server, console_expected):
     """Opening an invalid file named the wheel at the same index of the robot on screen (and selected it, marking
     its field): 'wheel 'right', r: must be > 0' for the file's wheel 'b'; the error names the file and its wheel."""
+    console_expected.append("/api/open 422")  # on purpose
     pg = page
     _, root = server
     open_catalog(pg, "diff-drive")
@@ -824,10 +866,11 @@ def test_mecanum_wheel_fields_are_editable(page):
     assert not pg.errors
 
 
-def test_duplicate_name_keeps_the_renamed_wheel_selected(page):
+def test_duplicate_name_keeps_the_renamed_wheel_selected(page, console_expected):
     """Renaming 'right' to 'left' (a duplicate: an error) selected the first wheel of that name, the other one:
     its fields were shown, and typing 'right' back renamed the original left wheel, swapping the two names
     without an error."""
+    console_expected.append("/api/analyze 422")  # on purpose
     pg = page
     open_catalog(pg, "diff-drive")
     pg.click('[data-wheel="right"]')
@@ -951,9 +994,10 @@ def test_keys_stay_within_the_sliders(page):
     assert not pg.errors
 
 
-def test_edits_resume_after_the_server_did_not_answer(page):
+def test_edits_resume_after_the_server_did_not_answer(page, console_expected):
     """A request that got no answer (the server stopped, fetch failed) left the analysis 'in flight' for good: no
     error shown, and every later edit waited behind it, even once the server answered again."""
+    console_expected.append("/api/analyze net::ERR_FAILED")  # on purpose
     pg = page
     open_catalog(pg, "diff-drive")
     settle(pg)
@@ -1054,10 +1098,11 @@ def test_isotropic_and_singular_headings_name_their_wheels(page):
     assert not pg.errors
 
 
-def test_steer_range_is_shown_edited_validated_kept_and_saved(page, server):
+def test_steer_range_is_shown_edited_validated_kept_and_saved(page, server, console_expected):
     """A wheel's `steer_range` was neither shown nor editable in the panel, and retyping the wheel dropped it
     silently. It is a field now (headings in deg, bare numbers in deg), refused as a description refuses it, kept
     by a retype to a type that steers, said dropped by one to a type that does not, and saved as typed."""
+    console_expected.append("/api/analyze 422")  # on purpose
     from wmrkit import DescriptionError
 
     pg = page
