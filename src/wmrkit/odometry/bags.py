@@ -28,6 +28,7 @@ import numpy as np
 from ..errors import WmrkitError
 from ..limits import MAX_SPEED, MAX_TABLE_SIZE
 from ._text import did_you_mean
+from .imu_mount import TF_MESSAGE, TF_STATIC, mounting, quaternion_product, static_tree, yaw_row
 from .integrators import sinc
 from .logs import MAX_RATE, JointLog, LogError, check_jumps, check_time, joint_names
 from .pipeline import check_finite
@@ -373,7 +374,9 @@ def read_imu_yaw(path: str | os.PathLike[str], topic: str, *,
     message has none (``orientation_covariance[0] == -1``, REP-145, or an all-zero quaternion) it is
     ``angular_velocity.z`` [rad/s, at most :data:`~wmrkit.limits.MAX_SPEED`] integrated by trapezoids from 0. Time
     as JointState's (the header stamp, else the receive time), strictly increasing. A :class:`LogError` names the
-    message of a bad stamp or value.
+    message of a bad stamp or value. An IMU whose ``frame_id`` the bag's ``/tf_static`` places on the robot turned
+    (:mod:`.imu_mount`) gives the body's yaw (rate); one that tree does not place is a :class:`LogError` (its
+    mounting unknown); a bag without ``/tf_static`` has its IMU taken as level (z up).
     """
     source = os.fspath(path)
     where = f"{source}: {topic}"
@@ -382,14 +385,24 @@ def read_imu_yaw(path: str | os.PathLike[str], topic: str, *,
         conns = [c for c in reader.connections if c.topic == topic and c.msgtype == IMU]
         if not conns:  # (no connections would read every topic's messages)
             raise LogError(f"{where}: no {IMU} topic of that name")
-        gyro, last, times, values = None, None, [], []
+        tf = [c for c in reader.connections if c.topic == TF_STATIC and c.msgtype == TF_MESSAGE]
+        where_tf = f"{source}: {TF_STATIC}"
+        tree = static_tree((m for _, m in _messages(reader, tf, where_tf, TF_MESSAGE, ts)), where_tf) if tf else {}
+        gyro, last, times, values, mount = None, None, [], [], None
         for index, (stamp_ns, msg) in enumerate(_messages(reader, conns, where, IMU, ts)):
-            o = msg.orientation
+            o, frame = msg.orientation, msg.header.frame_id
             q = (o.x, o.y, o.z, o.w)
             if gyro is None:
                 gyro = msg.orientation_covariance[0] == -1 or not any(q)
-            if gyro and not abs(msg.angular_velocity.z) <= MAX_SPEED:  # NaN included
-                raise LogError(f"{where} message {index}: angular_velocity.z is {msg.angular_velocity.z:g} rad/s, not "
+                first_frame, mount = frame, mounting(tree, frame, where)
+            elif frame != first_frame:
+                raise LogError(f"{where} message {index}: frame_id '{frame}', not the first message's "
+                               f"'{first_frame}' (one IMU has one mounting)")
+            w = msg.angular_velocity
+            rate, what = (w.z, "angular_velocity.z") if mount is None else \
+                (float(yaw_row(mount) @ (w.x, w.y, w.z)), f"the yaw rate (angular_velocity turned from '{frame}')")
+            if gyro and not abs(rate) <= MAX_SPEED:  # NaN included
+                raise LogError(f"{where} message {index}: {what} is {rate:g} rad/s, not "
                                f"a finite rate within the {MAX_SPEED:g} rad/s of any wheeled robot (docs/limits.md)")
             if not gyro and not (all(map(math.isfinite, q)) and any(q)):
                 raise LogError(f"{where} message {index}: orientation {list(q)} is no rotation")
@@ -398,12 +411,12 @@ def read_imu_yaw(path: str | os.PathLike[str], topic: str, *,
             if t <= (times[-1] if times else last[0] if last else -math.inf):
                 raise LogError(f"{where} message {index}: time {t!r} s does not follow the previous message's")
             times.append(t)
-            values.append(msg.angular_velocity.z if gyro else q)
+            values.append(rate if gyro else q)
             if len(times) == chunk_size:
-                last = yield from _yaw_chunk(np.array(times), _readings(values, gyro), gyro, last)
+                last = yield from _yaw_chunk(np.array(times), _readings(values, gyro, mount), gyro, last)
                 times, values = [], []
         if times:
-            yield from _yaw_chunk(np.array(times), _readings(values, gyro), gyro, last)
+            yield from _yaw_chunk(np.array(times), _readings(values, gyro, mount), gyro, last)
         elif last is None:
             raise LogError(f"{where}: no message")
     finally:
@@ -434,10 +447,14 @@ def read_imu(path: str | os.PathLike[str], topic: str) -> tuple[np.ndarray, np.n
     return np.concatenate(times), np.concatenate(yaws)
 
 
-def _readings(values: list, gyro: bool) -> np.ndarray:
-    """The readings of a chunk of :func:`read_imu_yaw`: its rates, or the yaws of its quaternions (one vectorised
-    call per chunk: per message it took 40 us, as long as decoding the message)."""
-    return np.array(values) if gyro else yaw_of_quaternion(np.array(values))
+def _readings(values: list, gyro: bool, mount: np.ndarray | None) -> np.ndarray:
+    """The readings of a chunk of :func:`read_imu_yaw`: its rates, or the yaws of its quaternions, the body's
+    (``q_world_imu conj(mount)``) for an IMU turned by `mount` (one vectorised call per chunk: per message it took
+    40 us, as long as decoding the message)."""
+    if gyro:
+        return np.array(values)
+    q = np.array(values)
+    return yaw_of_quaternion(q if mount is None else quaternion_product(q, mount * (-1.0, -1.0, -1.0, 1.0)))
 
 
 def _yaw_chunk(t: np.ndarray, v: np.ndarray, gyro: bool, last: tuple[float, float, float] | None):
