@@ -180,3 +180,23 @@ def test_a_kernel_numba_cannot_cache_is_named_and_the_notice_says_it_compiles_at
     watcher.join(5)
     err = capsys.readouterr().err
     assert err == cli.COMPILE_NOTICE_UNCACHED + "\n" and "NUMBA_CACHE_DIR" in err and "first run only" not in err
+
+
+def test_a_kernel_cache_past_its_limit_is_dropped_and_no_other(tmp_path, monkeypatch):
+    """Numba caches one copy per robot of the realtime kernels (their constants are the robot's): drop_oversized_cache
+    drops a file's cached kernels once together they pass the limit, and keeps them below it and other files'."""
+    import numba
+
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "numba-cache"))
+    kernel = tmp_path / "kern.py"
+    kernel.write_text("")
+    cache = jit.cache_dir(kernel)
+    cache.mkdir(parents=True, exist_ok=True)
+    mine = [cache / f"kern.f-{k}.py311.{s}" for k in range(3) for s in ("nbi", "1.nbc")]
+    other = cache / "kernel2.f-1.py311.1.nbc"  # another file's, its name starting as this one's
+    for f in (*mine, other):
+        f.write_bytes(b"x" * 100)
+    jit.drop_oversized_cache(str(kernel), 600)  # 600 bytes: kept
+    assert all(f.exists() for f in (*mine, other))
+    jit.drop_oversized_cache(str(kernel), 599)
+    assert not any(f.exists() for f in mine) and other.exists()

@@ -137,6 +137,23 @@ def drop_stale_cache(kernels: Sequence[str], helpers: Sequence[str] = ()) -> Non
         pass
 
 
+def drop_oversized_cache(kernel: str, limit: int) -> None:
+    """Numba caches one compiled copy per robot of a kernel whose constants are a robot's (``kinematics.realtime``,
+    about 0.2 MB each): drop the cached kernels of the file `kernel` when together they exceed `limit` bytes, so that
+    a cache fed by many robots (random robots in tests, a studio session) stays bounded; they are compiled again when
+    next used. Call at the import of the kernel module, as :func:`drop_stale_cache`."""
+    try:
+        cache = cache_dir(kernel)
+        if cache is None:
+            return
+        cached = list(cache.glob(f"{Path(kernel).stem}.*.nb[ic]"))
+        if sum(f.stat().st_size for f in cached) > limit:
+            for f in cached:
+                f.unlink(missing_ok=True)
+    except OSError:  # a file removed by another process meanwhile, a directory turned read-only: nothing to bound
+        pass
+
+
 def float64_vector(a) -> bool:
     """In compiled code: whether `a` is a 1-D float64 array, decided when the caller is compiled (a kernel writing
     its results into an integer or float32 array would truncate or round them silently)."""

@@ -183,3 +183,53 @@ def test_headings_beyond_a_million_turns_are_refused_as_by_the_batched_ik(headin
     with pytest.raises(ValueError, match="fk: the headings must be a finite array of shape \\(4,\\), at most 1e\\+06"):
         rt.fk(np.ones(len(rt.rate_joints)), np.full(len(rt.steer_joints), heading), np.empty(3))
     rt.ik(1.0, 0.0, 0.0, np.full(4, 2 * np.pi * 1e6), rates, out)  # the bound itself is an angle
+
+
+#: A process calling one robot's ik, fk and odometry step, printing each kernel's numba cache hits and misses, then
+#: its ik's rates for a twist and wheel_commands' (the numbers, whatever the cache gave).
+_PROCESS = """
+import json, sys
+import numpy as np
+from wmrkit import wheel_commands
+from wmrkit.description import robot_from_dict
+from wmrkit.kinematics.realtime import realtime
+robot = robot_from_dict(json.loads(sys.argv[1]))
+rt = realtime(robot)
+n, m = len(robot.rate_names), len(rt.rate_joints)
+rates = np.zeros(n)
+rt.ik(0.3, 0.1, 0.4, np.zeros(0), rates, np.zeros(0))
+rt.fk(np.ones(m), np.zeros(0), np.zeros(3))
+rt.odometry_step(np.zeros(3), np.zeros(m), np.ones(m), np.zeros(0))
+stats = {k: [sum(f.stats.cache_hits.values()), sum(f.stats.cache_misses.values())]
+         for k, f in (("ik", rt.ik), ("fk", rt.fk), ("odometry_step", rt.odometry_step))}
+print(json.dumps({"stats": stats, "rates": rates.tolist(),
+                  "expected": wheel_commands(robot, [0.3, 0.1, 0.4]).rates.tolist()}))
+"""
+
+
+def test_a_second_process_loads_the_compiled_kernels_from_the_cache(tmp_path):
+    """The single-call kernels were compiled in every process (cache=False): 3 to 6 s before the first tick of a
+    diff drive. Now cached on disk: a second process loads all three (numba's cache hits, no miss), and a robot of
+    other dimensions, the same code with other constants, compiles its own and gives its own numbers."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba"), "WMRKIT_INTERPRET_BUDGET": "0"}
+
+    def run(track: float) -> dict:
+        wheels = [{"name": n, "type": "fixed", "position": [0.0, y], "heading": 0.0, "r": 0.1,
+                   "actuated": ["spin"], "sensed": ["spin"]} for n, y in (("left", track / 2), ("right", -track / 2))]
+        out = subprocess.run([sys.executable, "-c", _PROCESS, json.dumps({"name": "dd", "wheels": wheels})],
+                             env=env, capture_output=True, text=True, timeout=600)
+        assert out.returncode == 0, out.stderr[-800:]
+        answer = json.loads(out.stdout)
+        np.testing.assert_allclose(answer["rates"], answer["expected"], rtol=1e-12, atol=1e-12)
+        return answer["stats"]
+
+    first = run(0.4)
+    assert all(hits == 0 and misses >= 1 for hits, misses in first.values()), first
+    assert all(hits >= 1 and misses == 0 for hits, misses in run(0.4).values())
+    other = run(0.6)  # the rates checked against wheel_commands: not the 0.4 m robot's kernel
+    assert other["ik"][1] >= 1 and other["fk"][1] >= 1

@@ -3,10 +3,12 @@
 The batched functions (:func:`~wmrkit.kinematics.wheel_ik.wheel_commands`, :func:`~wmrkit.kinematics.wheel_ik.
 forward_kinematics`, :func:`wmrkit.odometry.odometry`) are made for arrays of twists and samples; one call on one
 twist pays tens of microseconds of NumPy overhead. :func:`realtime` compiles, once per robot, a numba kernel with the
-robot's geometry frozen in as constants. Each call then takes scalars and caller-owned arrays and writes its results
-into them: no Python objects are created per call. The numbers are those of the batched path (same formulas: the
-three wheel groups of ``_ik_fast`` (§8.4), the sensed direct model (4.11) of :func:`wmrkit.odometry.odometry_model`,
-the exact SE(2) step of paper 003 with the same inlined sine and cosine). ``benchmarks/bench_realtime.py`` times them
+robot's geometry frozen in as constants, cached on disk (numba keys it by those constants: another robot's is
+another kernel), so that a later process loads it instead of compiling it again (seconds). Each call then takes
+scalars and caller-owned arrays and writes its results into them: no Python objects are created per call. The
+numbers are those of the batched path (same formulas: the three wheel groups of ``_ik_fast`` (§8.4), the sensed
+direct model (4.11) of :func:`wmrkit.odometry.odometry_model`, the exact SE(2) step of paper 003 with the same
+inlined sine and cosine). ``benchmarks/bench_realtime.py`` times them
 against WPILib per call.
 
 Steering angles at this door are headings (0 = rolling straight ahead), as everywhere a user types or reads one.
@@ -22,10 +24,10 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-import numba
 import numpy as np
 
-from .._jit import compile_cached, drop_stale_cache, float64_vector
+from .. import _jit
+from .._jit import compile_cached, drop_oversized_cache, drop_stale_cache, float64_vector
 from .._shapes import as_names
 from ..errors import SelectionError, WmrkitError
 from ..limits import MAX_QUERY_RATE
@@ -37,7 +39,12 @@ from . import _ik_fast
 from .gear_check import GEAR_RTOL, gear_table
 from .wheel_ik import SLIP_TOL, check_tolerances
 
-drop_stale_cache([__file__], [_kernels.__file__])
+#: Most bytes of compiled kernels cached for this file (one set per robot, about 0.2 MB: some 150 robots); beyond, the
+#: cache is dropped at import (:func:`~wmrkit._jit.drop_oversized_cache`).
+MAX_CACHE_BYTES = 32 << 20
+
+drop_stale_cache([__file__], [_kernels.__file__, _jit.__file__])
+drop_oversized_cache(__file__, MAX_CACHE_BYTES)
 
 HALF_PI = 0.5 * math.pi
 OVERFLOW = ("odometry_step: the step overflows (joint positions too far from the previous ones); the pose and "
@@ -70,8 +77,9 @@ class Realtime:
 @functools.lru_cache(maxsize=16)
 def realtime(robot: Robot, sensed: tuple[str, ...] | None = None, *, speed_tol: float = 1e-12,
              slip_tol: float = SLIP_TOL) -> Realtime:
-    """Compile the single-call kinematics of `robot` (about a second, once per robot and process: kept); `sensed`
-    as for the odometry model."""
+    """The single-call kinematics of `robot`, compiled at their first call (seconds, once per robot: cached on disk,
+    a later process loads them in about half a second; :data:`MAX_CACHE_BYTES`); `sensed` as for the odometry
+    model."""
     from ..odometry.model import odometry_model
 
     check_tolerances(speed_tol, slip_tol)
@@ -116,7 +124,6 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
     offset, el, ealpha, ed, edelta, egamma, er, _ = (a.copy() for a in p.element_params)
     n_e = len(e_beta)
     delta = np.array([w.delta for w in robot.wheels if w.kind.steers], dtype=float)
-    two_pi = 2.0 * math.pi
     ranges = (p.steer_range[:, p.steer_wheels] if p.steer_range is not None
               else np.array([[-np.inf], [np.inf]]).repeat(n_steer, axis=1))
     ranged = np.isfinite(ranges).all(axis=0)  # (n_steer,): the wheels with a steer_range (heading lo, hi)
@@ -131,21 +138,6 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
     gear_cols, gear_k, gear_lever, gear_start = gears.joint, gears.ratio, gears.lever, gears.start
     n_gears, gear_rtol = len(gears.coupling), GEAR_RTOL
 
-    @numba.njit(cache=False)
-    def wrap(a):
-        y = a - two_pi * np.round(a / two_pi)
-        if y <= -math.pi:
-            return y + two_pi
-        if y > math.pi:
-            return y - two_pi
-        return y
-
-    @numba.njit(cache=False)
-    def in_range(h, k):  # wheels.heading_in_range of heading h: counter-clockwise from lo, within the width
-        off = (h - lo[k] + 1e-12) % two_pi - 1e-12
-        return off <= width[k] + 1e-12
-
-    @numba.njit(cache=False)
     def ik(vx, vy, w, heading, rates_out, heading_out):
         if not (float64_vector(rates_out) and float64_vector(heading_out) and heading.shape[0] == n_steer
                 and heading_out.shape[0] == n_steer and rates_out.shape[0] == n_rates):
@@ -157,7 +149,7 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
                 raise ValueError(bad_heading)
         beta = heading_out  # the thesis's angles while computing, headings on return: nothing is allocated
         for k in range(n_steer):
-            beta[k] = wrap(heading[k] - delta[k] + HALF_PI)
+            beta[k] = _wrap(heading[k] - delta[k] + HALF_PI)
         for j in range(n_rates):
             rates_out[j] = vx * constant[0, j] + vy * constant[1, j] + w * constant[2, j]
         for i in range(n_o):  # (8.9), (8.12): the steering axis's velocity u, the closer of b and b + pi
@@ -171,8 +163,8 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             if moving:
                 beta[k] = math.atan2(minus_ux * sign + 0.0, uy * sign)
                 h = beta[k] + (delta[k] - HALF_PI)
-                if ranged[k] and not in_range(h, k) and in_range(h + math.pi, k):
-                    beta[k] = wrap(beta[k] + math.pi)  # the other root is within the steer_range: take it
+                if ranged[k] and not _in_range(h, lo[k], width[k]) and _in_range(h + math.pi, lo[k], width[k]):
+                    beta[k] = _wrap(beta[k] + math.pi)  # the other root is within the steer_range: take it
                     sign = -sign
             if spin_col[i] >= 0:
                 rates_out[spin_col[i]] = -speed * sign * inv_r[i] if moving else 0.0
@@ -192,8 +184,8 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
                                                      + abs(w) * roundoff[2, f]):  # not round-off (wheel_commands)
                 feasible = False
         for k in range(n_steer):
-            beta[k] = wrap(beta[k] + delta[k] - HALF_PI)
-            if ranged[k] and not in_range(beta[k], k):
+            beta[k] = _wrap(beta[k] + delta[k] - HALF_PI)
+            if ranged[k] and not _in_range(beta[k], lo[k], width[k]):
                 feasible = False
         largest = 0.0
         for j in range(n_rates if n_gears else 0):  # robots without gears skip this (the one-call path's cost)
@@ -212,7 +204,26 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
                 feasible = False
         return feasible
 
-    return ik
+    return compile_cached(ik)
+
+
+@compile_cached
+def _wrap(a):
+    """The angle `a` [rad] wrapped into (-pi, pi]."""
+    two_pi = 2.0 * math.pi
+    y = a - two_pi * np.round(a / two_pi)
+    if y <= -math.pi:
+        return y + two_pi
+    if y > math.pi:
+        return y - two_pi
+    return y
+
+
+@compile_cached
+def _in_range(h, lo, width):
+    """wheels.heading_in_range of heading `h`: counter-clockwise from `lo`, within `width` [rad]."""
+    off = (h - lo + 1e-12) % (2.0 * math.pi) - 1e-12
+    return off <= width + 1e-12
 
 
 def _constant_fk(twist_map: np.ndarray):
@@ -221,7 +232,6 @@ def _constant_fk(twist_map: np.ndarray):
     bad = f"fk: the rates must be finite, each at most {MAX_QUERY_RATE:g} in size [rad/s]"
     limit = MAX_QUERY_RATE
 
-    @numba.njit(cache=False)
     def fk(rates, heading, twist_out):
         if not (float64_vector(twist_out) and twist_out.shape[0] == 3 and rates.shape[0] == n_a):
             raise ValueError(shapes)
@@ -234,7 +244,7 @@ def _constant_fk(twist_map: np.ndarray):
                 acc += twist_map[r, j] * rates[j]
             twist_out[r] = acc
 
-    return fk
+    return compile_cached(fk)
 
 
 def _constant_step(twist_map: np.ndarray):
@@ -244,7 +254,6 @@ def _constant_step(twist_map: np.ndarray):
     bad = "odometry_step: the pose and the joint positions must be finite"
     overflow = OVERFLOW
 
-    @numba.njit(cache=False)
     def step(pose, previous, positions, heading_mid):
         if not (float64_vector(pose) and float64_vector(previous) and pose.shape[0] == 3
                 and previous.shape[0] == n_a and positions.shape[0] == n_a):
@@ -257,7 +266,7 @@ def _constant_step(twist_map: np.ndarray):
         if not _step(pose, previous, positions, twist_map):
             raise ValueError(overflow)
 
-    return step
+    return compile_cached(step)
 
 
 @compile_cached
