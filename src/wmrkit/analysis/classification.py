@@ -102,7 +102,9 @@ def instantaneous_mobility(robot: Robot, beta: ArrayLike | None = None, *,
 def classify(robot: Robot, *, samples: int = 8, seed: int = 0) -> Classification:
     """Type (1)-(5) of Table 5.1, degrees of mobility m and steerability d, degeneracy (5.11)-(5.15).
 
-    `samples` random admissible configurations (axles aimed at random ICRs) give the generic ranks.
+    `samples` random admissible configurations (axles aimed at random ICRs) give the generic ranks: the largest
+    rank met, i.e. the least m, since a rank only drops on a special set of configurations (and numerically near
+    it: two axles 100 nm apart aimed at an ICR 100 m away read as one line).
     """
     if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or not 1 <= samples <= 10_000:
         raise WmrkitError(f"samples must be an integer in [1, 10000], got {samples!r}")
@@ -119,9 +121,9 @@ def classify(robot: Robot, *, samples: int = 8, seed: int = 0) -> Classification
         reasons.append(f"fixed wheels {', '.join(names)} have different axles: they fight (5.11)")
     rng = np.random.default_rng(seed)
     admissible = _admissible_configurations(robot, g_fixed, rf, samples, rng)
-    m = int(instantaneous_mobility(robot, admissible).max()) if len(admissible) else 0
+    m = int(instantaneous_mobility(robot, admissible).min()) if len(admissible) else 0
     random_beta = _turn(robot) + rng.uniform(-np.pi, np.pi, (samples, len(robot.steer_names)))
-    m_random = int(instantaneous_mobility(robot, random_beta).max())
+    m_random = int(instantaneous_mobility(robot, random_beta).min())
     coordinated = m_random < m
     d = max(3 - rf - m, 0)
     if m == 0:
