@@ -41,7 +41,7 @@ from ._symbolic_matrix import (  # noqa: F401  (exact_number, geometry_fields: r
     gear_rows,
     geometry_fields,
 )
-from .linalg import free_columns
+from .linalg import free_columns, matrix_rank
 from .models import generic_inputs
 
 #: Steering angles one least-squares closed form (4.11) may couple by default: its derivation grows about fourfold
@@ -281,8 +281,28 @@ def _substituted_model(robot: Robot, names: tuple[str, ...], held: tuple) -> Sym
 
 
 def default_sets(robot: Robot) -> list[tuple[str, tuple[str, ...]]]:
-    """The titled sets :func:`format_symbolic` shows by default: the direct (sensed) and the inverse model's."""
+    """The titled sets :func:`format_symbolic` shows by default: the direct (sensed) and the inverse model's; nothing
+    assigned for a robot that :func:`cannot_move` (its exact form: every velocity is zero)."""
+    if cannot_move(robot):
+        return [("direct model (sensed)", ()), ("inverse model", ())]
     return [("direct model (sensed)", sensed_rates(robot)), ("inverse model", twist_assignment(robot))]
+
+
+def cannot_move(robot: Robot) -> bool:
+    """Whether every velocity is zero at every steering, gears held: m = 0 generically, and the rows that do not
+    depend on the steering (wheels that do not steer, gears) hold the twist at zero, ``rank R = 3 + rank R_joints``
+    (4.10); a steered wheel's rates are then zero too (a double wheel's self-motion would make m > 0 generically).
+    Generic m = 0 alone does not say it: a car whose front wheels steer independently moves once they are
+    coordinated, and its least-squares forms are the extended solutions (4.82)."""
+    key = _geometry_key(robot, "numeric")
+    try:
+        ranked = _ranked(robot, (), _steering_values(robot, None, None, key), key, True)
+    except SingularError:  # assigning nothing leaves velocities free: m > 0
+        return False
+    steering = set(steering_symbols(robot))
+    rows = [i for i in range(ranked.a.rows) if not ranked.a.row(i).free_symbols & steering]
+    fixed = ranked.values[0][rows]
+    return bool(rows) and int(matrix_rank(fixed)) == 3 + int(matrix_rank(fixed[:, 3:]))
 
 
 def unheld_gears(robot: Robot) -> list[str]:
@@ -331,7 +351,10 @@ def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, late
         except ClosedFormTooLargeError as err:
             lines.append(f"{comment}  not derived: {err}")
             continue
-        if model.exact:
+        if model.exact and not names and cannot_move(robot):
+            how = (f"exact (4.5)/(4.11): the robot cannot move (m = 0 at every steering, rank A = {model.rank}): every "
+                   "velocity is zero")
+        elif model.exact:
             how = f"exact (4.5)/(4.11): assignable set, generic rank A = {model.rank}, mobility m = {model.mobility}"
         else:
             how = (f"least squares (4.11)/(4.82): {len(names)} assigned for mobility m = {model.mobility}; "
