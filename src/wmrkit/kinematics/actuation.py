@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, matvec, readonly
 from ..couplings import coupled_columns, gear_fill, gear_free, linked_steering
+from ..errors import SingularError
 from ..robot import TWIST_NAMES, Robot
 from .linalg import coupled_constraints, matrix_rank, nondimensional
 from .models import bounded, configuration
@@ -30,6 +31,7 @@ from .trees import (
     partitioned_solution,
     reduced_equation,
     select_columns,
+    selected_determined,
     undriven_motions,
 )
 
@@ -134,8 +136,11 @@ class ActuationAnalysis:
     steering_missing: tuple[str, ...]  # steerable wheels whose steering is not actuated
     mobility: np.ndarray  # (...) int, m (3.22) with the gear couplings held: the motions the mechanism allows
     tree: TreeVerdict
-    inverse_matrix: np.ndarray  # (..., n_u, 3), (4.26)
+    inverse_matrix: np.ndarray  # (..., n_u, 3), (4.26); one of many where not inverse_determined
     undriven: np.ndarray  # (...) int, motions with every actuated rate at rest (:func:`undriven_motions`)
+    #: (...) bool: the twist fixes the actuated rates, so (4.26) is their solution; False where some of them also turn
+    #: joints with the body at rest (a drive unit's two spins steer it on the spot, 4.69): many rates give one twist
+    inverse_determined: np.ndarray
 
     @property
     def sufficient(self) -> np.ndarray:
@@ -163,6 +168,10 @@ class ActuationAnalysis:
     def inverse(self, twist_robot: ArrayLike) -> np.ndarray:
         """Actuated rates for a (feasible) body twist, (4.26): ``(..., 3) -> (..., n_u)`` [rad/s, m/s]."""
         t = bounded(as_vectors(twist_robot, 3, "twist_robot"), TWIST_NAMES, "twist_robot")
+        require_determined(self.inverse_determined, f"robot '{self.robot_name}': the twist does not determine the "
+                           f"actuated rates ({', '.join(self.actuated)}): they also turn joints with the body at rest "
+                           "(a double wheel steering on the spot, 4.69), so (4.26) has many solutions; assign those "
+                           "joints' rates too (the inverse model, 'wmrkit ik')")
         return matvec(self.inverse_matrix, t, "twist_robot")
 
     def as_dict(self) -> dict[str, Any]:
@@ -173,8 +182,27 @@ class ActuationAnalysis:
             "leaf": self.leaf.tolist(), "sufficient": self.sufficient.tolist(),
             "consistent": self.consistent.tolist(), "undriven_motions": self.undriven.tolist(),
             "verdict": self.verdict.tolist(),
-            "inverse_matrix": self.inverse_matrix.tolist(),
+            "inverse_matrix": where_determined(self.inverse_matrix, self.inverse_determined),
+            "inverse_determined": self.inverse_determined.tolist(),
         }
+
+
+def require_determined(determined: np.ndarray, message: str) -> None:
+    """Raise :class:`SingularError` with `message` (and the first configuration of a batch where it applies) unless
+    every entry of `determined` ``(...)`` is True: a solution that is one of many is refused, not returned."""
+    if determined.all():
+        return
+    where = "" if not determined.ndim else f" (configuration {np.argwhere(~determined)[0].tolist()} of the batch)"
+    raise SingularError(message + where)
+
+
+def where_determined(matrix: np.ndarray, determined: np.ndarray) -> Any:
+    """`matrix` ``(..., r, c)`` as nested lists, each configuration's matrix None where `determined` ``(...)`` is
+    False (JSON null: no matrix that is one of many)."""
+    out = np.empty(determined.shape, dtype=object)
+    for index in np.ndindex(determined.shape):
+        out[index] = matrix[index].tolist() if determined[index] else None
+    return out.tolist() if determined.ndim else out[()]
 
 
 def body_only(leaf: np.ndarray, free: np.ndarray) -> np.ndarray:
@@ -225,6 +253,7 @@ def actuation_analysis(
         eliminated_tree(i_bar1, j_u1, j_nu1),
         readonly(partitioned_solution(j_u, j_nu) @ i_bar),
         readonly(undriven_motions(i_bar1, j_nu1)),
+        readonly(np.asarray(selected_determined(j_u1, j_nu1))),
     )
 
 

@@ -18,7 +18,14 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, matvec, readonly
 from ..couplings import gear_fill, gear_free
 from ..robot import TWIST_NAMES, Robot
-from .actuation import body_only, minimal_set_search, steering_split, verdict_texts
+from .actuation import (
+    body_only,
+    minimal_set_search,
+    require_determined,
+    steering_split,
+    verdict_texts,
+    where_determined,
+)
 from .linalg import coupled_constraints, matrix_rank, nondimensional
 from .models import bounded, configuration
 from .search import SetList
@@ -151,18 +158,33 @@ class SensingAnalysis:
         return verdict_texts(body_only(self.leaf, self.unsensed), _SENSING_TEXT, len(self.sensed), self.mobility,
                              self.steering_missing, "sensed")
 
+    @property
+    def twist_determined(self) -> np.ndarray:
+        """``rank I_s = 3`` ``(...)`` bool: the sensed rates fix the twist, so (4.31)/(4.32) give it (elsewhere the
+        twist is one of many; :meth:`twist` and :meth:`direct` refuse it)."""
+        return self.tree.rank_a == 3
+
+    def _require_twist(self) -> None:
+        require_determined(self.twist_determined, f"robot '{self.robot_name}': the sensed rates "
+                           f"({', '.join(self.sensed) or 'none'}) do not determine the twist (insufficient sensors, "
+                           "rank I_s < 3), so (4.32) has many solutions")
+
     def twist(self, q_dot_s: ArrayLike) -> np.ndarray:
-        """The body twist from sensed rates, (4.32): ``(..., n_s) -> (..., 3)`` [m/s, rad/s]."""
+        """The body twist from sensed rates, (4.32): ``(..., n_s) -> (..., 3)`` [m/s, rad/s]; :class:`SingularError`
+        where the sensed rates do not fix it (:attr:`twist_determined`)."""
         q = bounded(as_vectors(q_dot_s, len(self.sensed), "q_dot_s"), self.sensed, "q_dot_s")
+        self._require_twist()
         return matvec(self.direct_matrix, q, "q_dot_s")
 
     def direct(self, q_dot_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Twist and residual from sensed rates, (4.31): ``(..., n_s) -> ((..., 3), (..., 3E))``.
 
         The residual is ``I_ns (twist; q_dot_ns) - J_s q_dot_s``: zero without slip or noise, the slip
-        indicator otherwise (when ``slip_detectable``).
+        indicator otherwise (when ``slip_detectable``). :class:`SingularError` where the sensed rates do not fix the
+        twist (:attr:`twist_determined`).
         """
         q = bounded(as_vectors(q_dot_s, len(self.sensed), "q_dot_s"), self.sensed, "q_dot_s")
+        self._require_twist()
         return matvec(self.full_matrix, q, "q_dot_s")[..., :3], matvec(self.residual_matrix, q, "q_dot_s")
 
     def as_dict(self) -> dict[str, Any]:
@@ -173,7 +195,8 @@ class SensingAnalysis:
             "leaf": self.leaf.tolist(), "sufficient": self.sufficient.tolist(),
             "slip_detectable": self.slip_detectable.tolist(), "unsensed_motions": self.unsensed.tolist(),
             "verdict": self.verdict.tolist(),
-            "direct_matrix": self.direct_matrix.tolist(),
+            "direct_matrix": where_determined(self.direct_matrix, self.twist_determined),
+            "twist_determined": self.twist_determined.tolist(),
         }
 
 

@@ -201,13 +201,23 @@ def partitioned_solution(j_sel: ArrayLike, j_rest: ArrayLike) -> np.ndarray:
 
     ``(..., R, s), (..., R, p) -> (..., s, R)``: ``q_sel = (J_sel^T Delta(J_rest) J_sel)^-1 J_sel^T
     Delta(J_rest) y``, the block-inverse form (4.38)-(4.40) of Proof 4.2; per wheel when J is block diagonal.
-    Pseudo-inverse for the inner matrix, so a rank-deficient split returns the minimum-norm part.
+    Pseudo-inverse for the inner matrix, so a rank-deficient split returns the minimum-norm part, one of many:
+    :func:`selected_determined` says where the part is the solution, and the callers refuse it elsewhere.
     """
     j_sel, j_rest = np.asarray(j_sel, dtype=float), np.asarray(j_rest, dtype=float)
     weighted = np.swapaxes(j_sel, -1, -2) @ delta_projector(j_rest)  # (..., s, R)
     if j_sel.shape[-1] == 0:
         return weighted
     return np.linalg.pinv(weighted @ j_sel) @ weighted
+
+
+def selected_determined(j_sel: ArrayLike, j_rest: ArrayLike) -> np.ndarray:
+    """Whether ``y = J_sel q_sel + J_rest q_rest`` fixes ``q_sel``: ``rank [J_sel, J_rest] - rank J_rest = s``, the
+    rank of ``Delta(J_rest) J_sel`` (the inner matrix of :func:`partitioned_solution`) decided on unprojected
+    matrices with the rank tolerance, as :func:`eliminated_tree` decides. ``(..., R, s), (..., R, p) -> (...)`` bool;
+    pass the matrices of the ``nondimensional`` robot (the tolerance policy of :mod:`.linalg`)."""
+    j_sel, j_rest = np.asarray(j_sel, dtype=float), np.asarray(j_rest, dtype=float)
+    return matrix_rank(_hstack(j_sel, j_rest)) - matrix_rank(j_rest) == j_sel.shape[-1]
 
 
 def reduced_equation(i_bar: ArrayLike, j_sel: ArrayLike, j_rest: ArrayLike) -> np.ndarray:

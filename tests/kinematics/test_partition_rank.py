@@ -1,0 +1,92 @@
+"""The actuated inverse (4.26) and the sensed direct solution (4.32) are refused where they are one of many: the
+pseudo-inverse of ``partitioned_solution`` returned its minimum-norm choice silently. Checked against the null space
+of the no-slip matrix (3.22), computed here by SVD."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from wmrkit import SingularError, catalog
+from wmrkit.cli.main import main
+from wmrkit.kinematics.actuation import actuation_analysis
+from wmrkit.kinematics.sensing import sensing_analysis
+
+
+def _null_space(a: np.ndarray) -> np.ndarray:
+    """Orthonormal basis ``(k, n)`` of the motions that roll without slip, by SVD."""
+    _, s, vh = np.linalg.svd(a)
+    return vh[int(np.sum(s > 1e-9 * s[0])):].T
+
+
+def _tricycle_icr_at_f1():
+    """thesis-tricycle-ch4 with its steered axle through the rear wheel f1: it turns about f1, whose spin is then 0."""
+    robot = catalog.load("thesis-tricycle-ch4")
+    d = np.subtract(robot.wheel("f1").position, robot.wheel("o3").position)
+    return robot, float(np.arctan2(d[1], d[0]))
+
+
+def test_one_rear_encoder_does_not_give_the_twist_where_the_robot_turns_about_that_wheel():
+    """Before: sensing_analysis(...).twist([1.0]) returned (0.0075, -0.0438, -0.0219), a minimum-norm pick, while
+    the leaf said underdetermined."""
+    robot, beta = _tricycle_icr_at_f1()
+    names = robot.velocity_names
+    null = _null_space(robot.constraint_matrix(np.array([beta])))
+    at_rest = null[:, np.abs(null[names.index("f1.spin")]) < 1e-9]  # motions with f1.spin = 0 ...
+    assert np.abs(at_rest[:3]).max() > 1e-3  # ... that move the body: the sensed rate does not fix the twist
+    sensing = sensing_analysis(robot, np.array([beta]), sensed=["f1.spin"])
+    assert not sensing.twist_determined
+    for method in (sensing.twist, sensing.direct):
+        with pytest.raises(SingularError, match=r"the sensed rates \(f1\.spin\) do not determine the twist"):
+            method([1.0])
+    assert sensing.as_dict()["direct_matrix"] is None and sensing.as_dict()["twist_determined"] is False
+
+
+def test_one_rear_encoder_gives_the_twist_elsewhere():
+    """0.3 rad away the twist for f1.spin = 1 rad/s is the no-slip motion (3.22) with that spin (one-dimensional)."""
+    robot, beta = _tricycle_icr_at_f1()
+    beta = np.array([beta + 0.3])
+    null = _null_space(robot.constraint_matrix(beta))
+    assert null.shape[1] == 1
+    expected = null[:3, 0] / null[robot.velocity_names.index("f1.spin"), 0]
+    sensing = sensing_analysis(robot, beta, sensed=["f1.spin"])
+    assert sensing.twist_determined
+    np.testing.assert_allclose(sensing.twist([1.0]), expected, atol=1e-12)
+
+
+def test_a_drive_unit_s_two_spins_are_not_fixed_by_the_twist():
+    """agv-drive-unit: turning the unit on the spot moves its spins with the body at rest (a motion of (3.22)), so
+    one twist has many actuated spins. Before, inverse((0.3, 0, 0)) returned (3, 3) (the unit held straight) and
+    `wmrkit kinematics agv-drive-unit --json` printed that matrix."""
+    robot = catalog.load("agv-drive-unit")
+    names = robot.velocity_names
+    null = _null_space(robot.constraint_matrix())
+    spins = [names.index("unit.spin1"), names.index("unit.spin2")]
+    _, s, vh = np.linalg.svd(null[:3])
+    body_at_rest = null @ vh[int(np.sum(s > 1e-9 * s[0])):].T  # the motions with the twist 0
+    assert np.abs(body_at_rest[spins]).max() > 0.1
+    actuation = actuation_analysis(robot)
+    assert not actuation.inverse_determined
+    with pytest.raises(SingularError, match=r"the twist does not determine the actuated rates \(unit\.spin1, "):
+        actuation.inverse([0.3, 0.0, 0.0])
+
+
+def test_the_json_answer_has_no_matrix_that_is_one_of_many(capsys):
+    assert main(["kinematics", "agv-drive-unit", "--json"]) == 0
+    actuation = json.loads(capsys.readouterr().out)["actuation"]
+    assert actuation["inverse_matrix"] is None and actuation["inverse_determined"] is False
+
+
+def test_a_determined_inverse_is_the_no_slip_solution():
+    """diff-drive: the twist fixes both spins; (4.26) gives the rates of the no-slip motion with that twist."""
+    robot = catalog.load("diff-drive")
+    actuation = actuation_analysis(robot)
+    assert actuation.inverse_determined and actuation.as_dict()["inverse_matrix"] is not None
+    null = _null_space(robot.constraint_matrix())
+    twist = np.array([0.4, 0.0, -0.7])
+    motion = null @ np.linalg.lstsq(null[:3], twist, rcond=None)[0]
+    np.testing.assert_allclose(motion[:3], twist, atol=1e-12)  # a feasible twist
+    spins = [robot.velocity_names.index(n) for n in actuation.actuated]
+    np.testing.assert_allclose(actuation.inverse(twist), motion[spins], atol=1e-12)
