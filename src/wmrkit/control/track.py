@@ -4,14 +4,14 @@ prints, and what a planner, e.g. the parking application, calls to execute a pla
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any, Literal
+from dataclasses import replace
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
-from ..kinematics.wheel_ik import WheelCommands, wheel_commands
+from ..kinematics.wheel_ik import wheel_commands
 from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
@@ -39,116 +39,16 @@ from .trackers import (
     stanley,
     top_speed,
 )
+from .tracking_run import SLIP_TOL, TrackingRun
 
 if TYPE_CHECKING:
     from ..slip.kalman import KalmanNoise
     from ..slip.weights import SlipWeights
 
-__all__ = ["CONTROLLERS", "TrackingRun", "from_first_sample", "initial_pose_on", "track"]
+__all__ = ["CONTROLLERS", "SLIP_TOL", "TrackingRun", "from_first_sample", "initial_pose_on", "track"]
 
 #: Controllers: the thesis's laws (8.1)-(8.3) and the two geometric trackers users use.
 CONTROLLERS = ("p", "pi", "point", "pure-pursuit", "stanley")
-
-
-#: Lateral slip [m/s] of a fixed wheel's commands beyond which a run reports it (:meth:`TrackingRun.slip_violations`).
-SLIP_TOL = 1e-6
-
-
-@dataclass(frozen=True, eq=False)
-class TrackingRun:
-    """A closed-loop run (frozen; arrays read-only; eq=False: array fields). ``n`` samples:
-
-    - ``t`` ``(n,)`` [s]; ``pose`` ``(n, 3)`` world pose of R ``(x, y, theta)``;
-    - ``reference`` ``(n, 3)`` the reference at ``t``; ``tracked`` ``(n, 3)`` the pose of the tracked point
-      (the control point for the thesis's laws, the axle point for pure pursuit, the front point for Stanley);
-    - ``error`` ``(n,)`` [m] distance of the tracked point from the reference at ``t``; ``cross_track`` ``(n,)``
-      [m] its distance from the reference path;
-    - ``twist`` ``(n, 3)`` commanded body twist; ``heading`` ``(n, n_steer)`` [rad] actual steering headings;
-    - ``commands``: the per-wheel commands (:class:`WheelCommands`, batch ``(n,)``) at the commanded steering;
-    - ``estimate`` ``(n, 3)``: the odometry's pose estimate when the loop was closed on it, else None;
-    - ``slip_model``: where the wheel commands came from (``"none"``: the no-slip IK; ``"mqe"``, ``"mcd"``: the
-      inverse slip model, :mod:`.slip_control`); ``feedback``: what the controller measured (:mod:`.slip_loop`);
-    - ``beyond_range`` ``(n, n_steer)`` bool: where a steered wheel was asked for a heading outside its
-      ``steer_range`` and held at the end of it (the robot then moves with the least-squares twist of its drive
-      wheels: it cannot follow as commanded); :meth:`range_violations` lists them per wheel;
-    - ``feasibility``: the reference judged by Table 8.1 (§8.5, :func:`.feasibility.feasibility`) for the tracked
-      point, in the kinematic framework (the dynamic one through the dynamics), its violations up to the run's end;
-      None for a robot Table 8.1 does not apply to (degenerate: the skid steer).
-    """
-
-    robot: Robot
-    controller: str
-    t: np.ndarray
-    pose: np.ndarray
-    reference: np.ndarray
-    tracked: np.ndarray
-    error: np.ndarray
-    cross_track: np.ndarray
-    twist: np.ndarray
-    heading: np.ndarray
-    commands: WheelCommands
-    period: float | None = None
-    delay: int = 0
-    estimate: np.ndarray | None = None
-    slip_model: str = "none"
-    feedback: str = "pose"
-    beyond_range: np.ndarray | None = None
-    feasibility: Feasibility | None = None
-
-    def range_violations(self) -> list[dict[str, Any]]:
-        """Per steered wheel held at the end of its range: ``{"wheel", "from", "to", "duration"}`` ([s]: first
-        and last sample, and the time spent beyond the range: each such sample's interval to the next, none after
-        the run's last sample)."""
-        if self.beyond_range is None:
-            return []
-        return self._intervals(self.robot.steer_names, self.beyond_range)
-
-    def slip_violations(self, tol: float = SLIP_TOL) -> list[dict[str, Any]]:
-        """Per fixed wheel whose commands leave a lateral slip (8.14) beyond `tol` [m/s] (a skid steer turning: the
-        wheels must scrub to move as commanded, which the kinematic plant does not show): listed as by
-        :meth:`range_violations`."""
-        return self._intervals(self.robot.wheel_names, np.abs(np.asarray(self.commands.slip)) > tol)
-
-    def _intervals(self, names: tuple[str, ...], hits: np.ndarray) -> list[dict[str, Any]]:
-        if not hits.any():
-            return []
-        dt = np.diff(self.t, append=self.t[-1])  # each sample's interval to the next; the run ends at the last
-        out = []
-        for k, name in enumerate(names):
-            hit = hits[:, k]
-            if hit.any():
-                idx = np.flatnonzero(hit)
-                out.append({"wheel": name, "from": float(self.t[idx[0]]), "to": float(self.t[idx[-1]]),
-                            "duration": float(dt[hit].sum())})
-        return out
-
-    def summary(self, settle: float = 0.0) -> dict[str, float]:
-        """RMS, max and final tracking and cross-track errors [m] after time `settle` [s]."""
-        m = self.t >= settle
-        e, c = self.error[m], self.cross_track[m]
-        return {"rms_error": float(np.sqrt(np.mean(e * e))), "max_error": float(e.max()),
-                "final_error": float(self.error[-1]), "rms_cross_track": float(np.sqrt(np.mean(c * c))),
-                "max_cross_track": float(c.max())}
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready: ``t``, ``pose`` and ``reference`` as ``(x, y, theta)`` rows, ``tracking_error`` (the
-        tracked point's distance from the reference, :attr:`error`; never ``error``, the key of a failure), per-wheel
-        ``heading`` (steering, null for wheels that do not steer) and ``spin`` series and the summary."""
-        wheels: dict[str, dict[str, Any]] = {}
-        steer = self.robot.steer_names
-        for i, name in enumerate(self.robot.wheel_names):
-            h = self.heading[:, steer.index(name)].tolist() if name in steer else None
-            wheels[name] = {"heading": h, "spin": np.asarray(self.commands.spin[:, i]).tolist()}
-        out = {"robot": self.robot.name, "controller": self.controller, "period": self.period, "delay": self.delay,
-               "t": self.t.tolist(), "pose": self.pose.tolist(), "reference": self.reference.tolist(),
-               "tracking_error": self.error.tolist(), "wheels": wheels, "summary": self.summary()}
-        if self.estimate is not None:
-            out["estimate"] = self.estimate.tolist()
-        if self.slip_model != "none" or self.feedback != "pose":
-            out["slip_model"], out["feedback"] = self.slip_model, self.feedback
-        out["beyond_steer_range"] = self.range_violations()
-        out["feasibility"] = None if self.feasibility is None else self.feasibility.to_dict()
-        return out
 
 
 def initial_pose_on(cp: ControlPoint, reference: Reference) -> np.ndarray:
