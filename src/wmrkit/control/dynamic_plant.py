@@ -17,9 +17,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..errors import WmrkitError
 from ..wheels import beta_from_heading, heading_from_beta
 from .laws import PositionLaw
 from .loop import TwistController, check_command
@@ -27,6 +29,9 @@ from .points import ControlError, ControlPoint, StoppedRun, check_delay
 from .references import Reference
 from .steering import check_steering_driven, range_keeper
 from .tick import scalar_law
+
+if TYPE_CHECKING:
+    from ..dynamics.runs import Stop
 
 __all__ = ["fast_law_controller", "rechecked", "rolling_start", "simulate_dynamics"]
 
@@ -62,7 +67,7 @@ def rechecked(loop: Callable[[float, float, bool], dict], duration: float, step:
     the budget ends first, it says the verdict is not known. To its end, not 0.1 s past the stop: the forklift on
     the arc-line at 2 m/s lifts a drive wheel off at t = 2.40 s at 1 ms, and at 2.52 s from 0.25 ms down. The loop's
     `controller` and `until` are called again from t = 0 (a law is a function of its arguments)."""
-    from ..dynamics.runs import DivergedError, LiftOffError, recheck_budget, recheck_step, unstable_step
+    from ..dynamics.runs import DivergedError, LiftOffError, Recheck, judge, recheck_budget, recheck_step
 
     try:
         return loop(duration, step, False)
@@ -79,11 +84,22 @@ def rechecked(loop: Callable[[float, float, bool], dict], duration: float, step:
         cut = end < duration and reached > end - period  # by the budget, not by the loop's own end (`until`)
         if reached < t and not cut:  # it ended (arrived) before the stop: no verdict
             raise
-        what = (f"contact '{err.contact}' lost its load at t = {t:.6g} s" if isinstance(err, LiftOffError) else
-                f"the simulation diverged before t = {t:.6g} s" if isinstance(err, DivergedError) else
-                f"the loop diverged at t = {t:.6g} s")
-        raise unstable_step(what, step, fine, reached, "(the step argument)", "the same loop",
-                            duration if cut else -math.inf) from None
+        verdict = judge(_loop_stop(err), Recheck(step, fine, None, reached, duration if cut else -math.inf,
+                                                "the same loop"), "(the step argument)")
+        raise verdict from None  # the re-run went on: the step's error (or not known), never None
+
+
+def _loop_stop(err: WmrkitError) -> Stop:
+    """Where a loop through the dynamics stopped, as :func:`~wmrkit.dynamics.runs.judge` takes it (a
+    :class:`~wmrkit.dynamics.runs.Stop`): `err` a lift-off, a divergence of the state, or the law's command diverging
+    (:class:`.points.StoppedRun`), each with its time ``t`` [s]."""
+    from ..dynamics.runs import LiftOffError, Stop
+
+    if isinstance(err, LiftOffError):
+        return Stop.lift_off(err.t, err.contact)
+    if isinstance(err, StoppedRun):
+        return Stop(err.t, f"the loop diverged at t = {err.t:.6g} s")
+    return Stop.diverged(err.t)
 
 
 def _dynamics_loop(robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *, period: float,

@@ -1,12 +1,13 @@
 """The runs of :func:`~wmrkit.dynamics.simulate.simulate`: fixed-step (compiled, chunked, a ``tqdm`` bar on long
 runs) and adaptive (scipy's LSODA, at most :data:`MAX_EVALUATIONS` evaluations), their records, and the lift-off
-check both make."""
+check both make; the re-check of a fixed step's stop at a shorter step (:func:`judge`)."""
 
 from __future__ import annotations
 
 import bisect
 import math
 from collections import deque
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -94,6 +95,12 @@ RECHECK_STEPS = 1_000_000
 #: Longest step [s] of that re-check, by method (0: semi-implicit, 1: rk4): the steps docs/dynamics.md finds stable
 #: with the catalog's stiff tyres.
 RECHECK_MAX_STEP = (1e-3, 1e-4)
+#: How a caller of :func:`~wmrkit.dynamics.simulate.simulate` sets the step, as its stop's errors say it (their
+#: ``where``; another door says it its own way: :func:`at_door`).
+SIMULATE_STEP = "(the step keyword) or method='adaptive'"
+
+# The re-check of a stop, in three parts: where the run stopped (a Stop), a shorter step run again over its end
+# (rerun_stop: another Stop, or None), and the verdict on the two (judge, given a Recheck).
 
 
 def recheck_step(step: float, method: int) -> float:
@@ -107,37 +114,126 @@ def recheck_budget(method: int) -> int:
     return RECHECK_STEPS // (1 + 3 * method)
 
 
+def recheck_end(t_stop: float, step: float) -> float:
+    """``max(0.1 s, 10 steps)`` past the stop `t_stop` [s] of a run at `step` [s]: a re-check that stops by then
+    reproduces that stop (:func:`judge`), and a :class:`StepLog`'s re-check runs at least to it."""
+    return t_stop + max(0.1, 10 * step)
+
+
+@dataclass(frozen=True)
+class Stop:
+    """Where a fixed-step run stopped: at ``t`` [s], ``what`` stopped it (in words, with its time), and for a
+    lift-off the ``contact`` that lost its load (empty: the state, or a loop's command, diverged)."""
+
+    t: float
+    what: str
+    contact: str = ""
+
+    @classmethod
+    def diverged(cls, t: float) -> Stop:
+        """The state diverged before `t` [s]."""
+        return cls(t, f"the simulation diverged before t = {t:.6g} s")
+
+    @classmethod
+    def lift_off(cls, t: float, contact: str) -> Stop:
+        """`contact` lost its load at `t` [s]."""
+        return cls(t, f"contact '{contact}' lost its load at t = {t:.6g} s", contact)
+
+    @classmethod
+    def of_run(cls, model: DynamicModel, w: tuple, t_run: float, diverged: bool) -> Stop:
+        """The stop of a run advanced to `t_run` [s]: it diverged before then, or the lift-off that its work arrays
+        `w` recorded."""
+        return cls.diverged(t_run) if diverged else cls.lift_off(float(w[16][1]), model.contacts[int(w[16][2])])
+
+
+@dataclass(frozen=True)
+class Recheck:
+    """A stop's re-check: the run's ``step`` and the re-run's ``fine`` step [s] (``rerun`` names the re-run in the
+    error: "a run", "the same loop"); where the re-run stopped (``stop``; None: it did not); how far it went
+    (``reached`` [s]) of the ``end`` [s] it was to reach (-inf: no end to judge it by)."""
+
+    step: float
+    fine: float
+    stop: Stop | None
+    reached: float
+    end: float
+    rerun: str = "a run"
+
+
+def judge(stop: Stop, check: Recheck, where: str) -> WmrkitError | None:
+    """The verdict on a fixed-step run's `stop` given its re-check `check`, as the error to raise:
+
+    - None when the re-run stops too, by :func:`recheck_end`: the stop is the robot's (the caller raises it);
+    - an :class:`UnstableStepError` when the re-run goes on to its end: the step's (the integration is unstable, not
+      the robot); or, when it went on but fell short of ``check.end`` (its budget ended first), not known;
+    - when the re-run stops only later, the robot's later stop, which the step brought early: a
+      :class:`LiftOffError` (or :class:`DivergedError`) at the re-run's time, naming both stops.
+
+    `where` says how to set the step (each error's ``where``, for :func:`at_door`)."""
+    step, fine, rerun, later = check.step, check.fine, check.rerun, check.stop
+    if later is None and check.reached < check.end * (1 - 1e-12):
+        return UnstableStepError(
+            f"{stop.what} at step {step:g} s; {rerun} at step {fine:.3g} s goes on without it to t = "
+            f"{check.reached:.6g} s, where the re-check's budget ends, short of the end at t = {check.end:.6g} s: "
+            "whether the step (the integration unstable) or the robot stops it is not known", fine, where,
+            conclusive=False)
+    if later is None:
+        return UnstableStepError(f"{stop.what} at step {step:g} s, but {rerun} at step {fine:.3g} s goes on to t = "
+                                 f"{check.reached:.6g} s without it: the step is too long for the tyres (the "
+                                 "integration is unstable, not the robot)", fine, where)
+    if later.t <= recheck_end(stop.t, step):
+        return None
+    head = (f"{stop.what} at step {step:g} s, but {rerun} at step {fine:.3g} s goes on without it until "
+            f"{later.what}: the robot's stop, which the step brought early")
+    advice = f"use smaller torques or speeds, and a step of at most {fine:.3g} s {where}"
+    err = (LiftOffError(head, advice, later.t, later.contact) if later.contact else
+           DivergedError(f"{head}; {advice}", later.t))
+    err.where = where
+    return err
+
+
+def rerun_stop(model: DynamicModel, s: np.ndarray, stretch: list, fine: float, method: int, jac_every: int,
+               allow_lift_off: bool) -> Stop | None:
+    """Where a fresh integrator run from state `s` (not changed) at step `fine` [s] through `stretch`, the
+    consecutive pieces ``(k0, steps, compiled inputs)`` counted in steps of `fine`, stops: None when it neither
+    diverges nor (unless `allow_lift_off`) lifts a wheel off (the re-run of :func:`_stop`, :meth:`StepLog.recheck`)."""
+    from ._integrate import model_work_arrays, run
+
+    s, acc, w, rec = s.copy(), np.zeros(model.n), model_work_arrays(model), records(model, 0)
+    for k0, steps, inp in stretch:
+        run(s, k0, fine, steps, 1 << 62, method, jac_every, acc, model.pack, inp, w, rec, 0)
+        diverged = not np.all(np.isfinite(s))
+        if diverged or (w[16][0] and not allow_lift_off):
+            return Stop.of_run(model, w, (k0 + steps) * fine, diverged)
+    return None
+
+
 def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_lift_off, diverged):
     """Raise the error of a fixed-step run that stopped at `t_run` [s] (diverged, or the lift-off `w` recorded),
     after re-running it at :func:`recheck_step` to its end (`duration`): from the first of the records `rows` at
     most :func:`recheck_budget` of those steps before the end (at the latest the last one before the stop), for at
-    most that many steps. The stop is the robot's (or its inputs') when the shorter step stops too; when it goes on
-    to the end, the step was too long for the tyres and the error says so (the load transfer lags a step and the
-    tyres saturate within one, which the implicit step does not cover: the forklift's rectangle 'lifted off' its
-    steered wheel from 8 ms; docs/dynamics.md); when its budget ends first, the error says the verdict is not known.
-    To the end, not a margin past the stop: a shorter step can reach the robot's own lift-off much later (the
-    forklift's arc-line at 2 m/s: 2.40 s at 1 ms, 2.52 s at 0.25 ms)."""
-    t_stop = t_run if diverged else float(w[16][1])
+    most that many steps, and judged (:func:`judge`). To the end, not a margin past the stop: a shorter step can
+    reach the robot's own lift-off much later (the forklift's arc-line at 2 m/s: 2.40 s at 1 ms, 2.52 s at 0.25 ms);
+    a step too long for the tyres 'lifted off' the forklift's steered wheel on its rectangle from 8 ms (the load
+    transfer lags a step and the tyres saturate within one, which the implicit step does not cover:
+    docs/dynamics.md)."""
+    stop = Stop.of_run(model, w, t_run, diverged)
     fine, budget = recheck_step(step, method), recheck_budget(method)
     k_end = round(duration / step) * round(step / fine)  # the run's end, in fine steps
     j = min(int(np.searchsorted(rows[0], (k_end - budget) * fine)),  # the first record in the budget, and at
-            max(0, int(np.searchsorted(rows[0], t_stop)) - 1))  # the latest the last one before the stop
+            max(0, int(np.searchsorted(rows[0], stop.t)) - 1))  # the latest the last one before the stop
     k0 = round(rows[0][j] / fine)  # a record's time is a whole number of steps, each a whole number of fine ones
     k_last = min(k_end, k0 + budget)
-    judge(model, w, t_stop, diverged, rerun_stop(model, rows[1][j], [(k0, k_last - k0, inp)], fine, method,
-                                                 jac_every, allow_lift_off),
-          step, fine, k_last * fine, k_end * fine, SIMULATE_STEP)
+    again = rerun_stop(model, rows[1][j], [(k0, k_last - k0, inp)], fine, method, jac_every, allow_lift_off)
+    error = judge(stop, Recheck(step, fine, again, k_last * fine, k_end * fine), SIMULATE_STEP)
+    if error is not None:
+        raise error
     if diverged:
         err = WmrkitError(f"the simulation diverged before t = {t_run:.6g} s; use a smaller step {SIMULATE_STEP} (or "
                           "smaller torques or speeds)")
         err.where = SIMULATE_STEP
         raise err
     check_lift_off(model, w)
-
-
-#: How a caller of :func:`~wmrkit.dynamics.simulate.simulate` sets the step, as its stop's errors say it (their
-#: ``where``; another door says it its own way: :func:`at_door`).
-SIMULATE_STEP = "(the step keyword) or method='adaptive'"
 
 
 def at_door(err: WmrkitError, where: str) -> WmrkitError:
@@ -147,63 +243,11 @@ def at_door(err: WmrkitError, where: str) -> WmrkitError:
     return WmrkitError(str(err).replace(said, where)) if said else err
 
 
-def rerun_stop(model: DynamicModel, s: np.ndarray, stretch: list, fine: float, method: int, jac_every: int,
-               allow_lift_off: bool) -> tuple[bool, float, tuple] | None:
-    """Where a fresh integrator run from state `s` (not changed) at step `fine` [s] through `stretch`, the
-    consecutive pieces ``(k0, steps, compiled inputs)`` counted in steps of `fine`, stops: None when it neither
-    diverges nor (unless `allow_lift_off`) lifts a wheel off, else ``(diverged, time [s], its work arrays)``: the
-    re-check of a stop (:func:`_stop`, :meth:`StepLog.recheck`)."""
-    from ._integrate import model_work_arrays, run
-
-    s, acc, w, rec = s.copy(), np.zeros(model.n), model_work_arrays(model), records(model, 0)
-    for k0, steps, inp in stretch:
-        run(s, k0, fine, steps, 1 << 62, method, jac_every, acc, model.pack, inp, w, rec, 0)
-        if not np.all(np.isfinite(s)):
-            return True, (k0 + steps) * fine, w
-        if w[16][0] and not allow_lift_off:
-            return False, float(w[16][1]), w
-    return None
-
-
-def judge(model: DynamicModel, w: tuple, t_stop: float, diverged: bool, fine_stop: tuple | None, step: float,
-          fine: float, t_reached: float, end: float, where: str, rerun: str = "a run") -> None:
-    """Raise the verdict on a fixed-step run at `step` [s] that stopped at `t_stop` [s] (diverged, or the lift-off
-    its work arrays `w` recorded), given where its re-check `rerun` at `fine` [s] stopped (:func:`rerun_stop`) or
-    that it reached `t_reached` [s] of the run's `end` [s]: the step's (:func:`unstable_step`), or, when the re-check
-    stops only after :func:`recheck_end`, the robot's later stop that the step ran into early; returns when the
-    re-check stops by then (the caller raises the stop as the robot's)."""
-    what = stop_phrase(model, w, t_stop, diverged)
-    if fine_stop is None:
-        raise unstable_step(what, step, fine, t_reached, where, rerun, end)
-    fine_diverged, t_fine, w_fine = fine_stop
-    if t_fine <= recheck_end(t_stop, step):
-        return
-    later = (f"{what} at step {step:g} s, but {rerun} at step {fine:.3g} s goes on without it until "
-             f"{stop_phrase(model, w_fine, t_fine, fine_diverged)}: the robot's stop, which the step brought early")
-    advice = f"use smaller torques or speeds, and a step of at most {fine:.3g} s {where}"
-    err = (DivergedError(f"{later}; {advice}", t_fine) if fine_diverged else
-           LiftOffError(later, advice, t_fine, model.contacts[int(w_fine[16][2])]))
-    err.where = where
-    raise err
-
-
-def stop_phrase(model: DynamicModel, w: tuple, t_stop: float, diverged: bool) -> str:
-    """What stopped a fixed-step run at `t_stop` [s]: it diverged, or the lift-off the work arrays `w` recorded."""
-    return (f"the simulation diverged before t = {t_stop:.6g} s" if diverged else
-            f"contact '{model.contacts[int(w[16][2])]}' lost its load at t = {t_stop:.6g} s")
-
-
-def recheck_end(t_stop: float, step: float) -> float:
-    """``max(0.1 s, 10 steps)`` past the stop `t_stop` [s] of a run at `step` [s]: a re-check that stops by then
-    reproduces that stop (:func:`judge`), and a :class:`StepLog`'s re-check runs at least to it."""
-    return t_stop + max(0.1, 10 * step)
-
-
 class UnstableStepError(WmrkitError):
-    """A fixed-step run stopped where a re-check at the shorter step `fine` [s] went on (:func:`unstable_step`):
-    ``head`` says so, ``conclusive`` whether that re-check reached the run's end (else its budget ended first); the
-    message ends with what to do: a step of at most `fine` set as `where` says (a door whose user sets it otherwise,
-    or not at all, says so instead: :meth:`advised`)."""
+    """A fixed-step run stopped where a re-check at the shorter step `fine` [s] went on (:func:`judge`): ``head``
+    says so, ``conclusive`` whether that re-check reached the run's end (else its budget ended first); the message
+    ends with what to do: a step of at most `fine` set as `where` says (a door whose user sets it otherwise, or not
+    at all, says so instead: :meth:`advised`)."""
 
     def __init__(self, head: str, fine: float, where: str, conclusive: bool = True, advice: str = "") -> None:
         self.head, self.fine, self.conclusive, self.where = head, fine, conclusive, where
@@ -213,21 +257,6 @@ class UnstableStepError(WmrkitError):
     def advised(self, advice: str) -> UnstableStepError:
         """The same error ending with `advice` (what the door's user can change) after its ``head``."""
         return UnstableStepError(self.head, self.fine, "", self.conclusive, advice)
-
-
-def unstable_step(what: str, step: float, fine: float, t_end: float, where: str, rerun: str = "a run",
-                  end: float = -math.inf) -> UnstableStepError:
-    """The error of a fixed-step run at `step` [s] that stopped (`what`: :func:`stop_phrase`) where a re-check,
-    `rerun` at `fine` [s], went on to `t_end` [s]: the step's, not the robot's; or, when `t_end` falls short of the
-    run's `end` [s] (the re-check's budget ended first), not known. `where` says how to set the step."""
-    if t_end < end * (1 - 1e-12):
-        return UnstableStepError(
-            f"{what} at step {step:g} s; {rerun} at step {fine:.3g} s goes on without it to t = {t_end:.6g} s, where "
-            f"the re-check's budget ends, short of the end at t = {end:.6g} s: whether the step (the integration "
-            "unstable) or the robot stops it is not known", fine, where, conclusive=False)
-    return UnstableStepError(f"{what} at step {step:g} s, but {rerun} at step {fine:.3g} s goes on to t = "
-                             f"{t_end:.6g} s without it: the step is too long for the tyres (the integration is "
-                             "unstable, not the robot)", fine, where)
 
 
 class StepLog:
@@ -253,27 +282,30 @@ class StepLog:
 
     def recheck(self, model: DynamicModel, w: tuple, t_now: float, step: float, method: int, jac_every: int,
                 allow_lift_off: bool, diverged: bool) -> None:
-        """Raise :func:`unstable_step` when the stepper stopped at `t_now` [s] (diverged, or the lift-off `w`
+        """Raise :func:`judge`'s error when the stepper stopped at `t_now` [s] (diverged, or the lift-off `w`
         recorded), after its logged inputs are run again at :func:`recheck_step` from the logged state at most
         :func:`recheck_budget` of those steps before their end (at the latest the last piece before the stop), for
-        at most that many steps. Their end: the last inputs' last knot (the program given), at least `t_now` (the
-        run asked for) and at least :func:`recheck_end` (held past it: a guess of what comes next, a loop's)."""
-        t_stop = t_now if diverged else float(w[16][1])
+        at most that many steps; return when the re-run reproduces the stop. Their end: the last inputs' last knot
+        (the program given), at least `t_now` (the run asked for) and at least :func:`recheck_end` (held past it: a
+        guess of what comes next, a loop's)."""
+        stop = Stop.of_run(model, w, t_now, diverged)
         r, fine, pieces, budget = self.ratio, self.fine, list(self.pieces), recheck_budget(method)
         last = pieces[-1]
-        k_end = round(max(t_now, float(last[3][0][-1]), recheck_end(t_stop, step)) / fine)
+        k_end = round(max(t_now, float(last[3][0][-1]), recheck_end(stop.t, step)) / fine)
         starts = [piece[0] for piece in pieces]
         j = min(bisect.bisect_left(starts, -(-(k_end - budget) // r)),
-                max(0, bisect.bisect_left(starts, round(t_stop / step)) - 1))
+                max(0, bisect.bisect_left(starts, round(stop.t / step)) - 1))
         k_last = min(k_end, starts[j] * r + budget)
         stretch = [(k0 * r, min(steps * r, k_last - k0 * r), inp) for k0, steps, _, inp in pieces[j:]
                    if k0 * r < k_last]
         tail = (last[0] + last[1]) * r
         if tail < k_last:
             stretch.append((tail, k_last - tail, last[3]))
-        judge(model, w, t_stop, diverged, rerun_stop(model, pieces[j][2], stretch, fine, method, jac_every,
-                                                     allow_lift_off),
-              step, fine, k_last * fine, k_end * fine, "(the step argument)", "a run of its inputs")
+        again = rerun_stop(model, pieces[j][2], stretch, fine, method, jac_every, allow_lift_off)
+        error = judge(stop, Recheck(step, fine, again, k_last * fine, k_end * fine, "a run of its inputs"),
+                      "(the step argument)")
+        if error is not None:
+            raise error
 
 
 #: Most evaluations of the model an adaptive run makes (LSODA, 10-15 us each: about 2 min; the forklift's 22 s
