@@ -61,12 +61,15 @@ def rechecked(loop: Callable[[float, float, bool], dict], duration: float, step:
     `period` [s] (its :class:`~wmrkit.dynamics.simulate.Stepper` made with ``recheck=False``; the last argument True
     for the re-run), re-checked when it stops at t (a wheel lifts off, the state or the law's command diverges): the
     same loop runs again from t = 0 at :func:`~wmrkit.dynamics.runs.recheck_step` to its end, or as far as
-    :func:`~wmrkit.dynamics.runs.recheck_budget` steps reach. When that run stops too the stop is the robot's; when it
-    runs to the end without stopping, the error blames the step (the integration unstable, not the robot: the skid
-    steer on the square 'lost' a wheel's load at t = 36.2 s at a 20 ms step, and keeps its wheels down at 1 ms); when
-    the budget ends first, it says the verdict is not known. To its end, not 0.1 s past the stop: the forklift on
-    the arc-line at 2 m/s lifts a drive wheel off at t = 2.40 s at 1 ms, and at 2.52 s from 0.25 ms down. The loop's
-    `controller` and `until` are called again from t = 0 (a law is a function of its arguments)."""
+    :func:`~wmrkit.dynamics.runs.recheck_budget` steps reach, and judged as a fixed-step run's stop
+    (:func:`~wmrkit.dynamics.runs.judge`). When that run stops too, by 0.1 s past the stop, the stop is the robot's;
+    when it stops only later, the error is that later stop (the robot's, which the step brought early), naming both:
+    the forklift on the arc-line at 2 m/s lifts a drive wheel off at t = 2.40 s at 1 ms, and at 2.52 s from 0.25 ms
+    down (hence to its end, not 0.1 s past the stop); when it runs to the end without stopping, the error blames the
+    step (the integration unstable, not the robot: the skid steer on the square 'lost' a wheel's load at t = 36.2 s
+    at a 20 ms step, and keeps its wheels down at 1 ms); when the budget ends first, it says the verdict is not
+    known. The loop's `controller` and `until` are called again from t = 0 (a law is a function of its
+    arguments)."""
     from ..dynamics.runs import DivergedError, LiftOffError, Recheck, judge, recheck_budget, recheck_step
 
     try:
@@ -78,8 +81,14 @@ def rechecked(loop: Callable[[float, float, bool], dict], duration: float, step:
         end = min(duration, recheck_budget(0) * fine)
         try:
             out = loop(end, fine, True)
-        except (LiftOffError, DivergedError, StoppedRun):
-            raise err from None
+        except (LiftOffError, DivergedError, StoppedRun) as again:
+            if not math.isfinite(again.t):
+                raise err from None
+            later = judge(_loop_stop(err), Recheck(step, fine, _loop_stop(again), again.t, end, "the same loop"),
+                          "(the step argument)")
+            if later is None:  # it stops too, by recheck_end: the robot's stop, at the loop's own step
+                raise err from None
+            raise (StoppedRun(str(later), later.t) if isinstance(again, StoppedRun) else later) from None
         reached = float(out["t"][-1])
         cut = end < duration and reached > end - period  # by the budget, not by the loop's own end (`until`)
         if reached < t and not cut:  # it ended (arrived) before the stop: no verdict
