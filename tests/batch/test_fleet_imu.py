@@ -245,3 +245,24 @@ def test_imu_without_a_bag_is_refused(capsys, tmp_path):
     log.write_text("time,left.spin,right.spin\n0,0,0\n1,1,1\n")
     assert main(["batch", "odometry", "diff-drive", str(log), "--workers", "0", "--imu", "/imu", "--json"]) == 2
     assert json.loads(capsys.readouterr().err)["error"] == "--imu /imu applies to ROS 2 bags; none of the 1 logs is one"
+
+
+def test_a_failed_bag_keeps_what_was_said_before_it_failed(capsys, tmp_path, fleet):
+    """A bag with two Imu topics (its heading not checked: choose one with --imu) whose joint states jump: ``wmrkit
+    odometry`` says the not-checked line, then fails. The batch's row kept only the error ('warnings' null, nothing on
+    stderr nor in the JSON answer's warnings); now it keeps that command's line, said as every log's warnings are."""
+    robot = fleet[0]
+    run = simulate(load_robot_file(robot), TwistProfile.from_segments([(3.0, 0.3, 0.0, 0.2)]), 25.0)
+    positions = run.log.positions.copy()
+    positions[40:, 0] += 1e5  # an implausible jump: the log fails
+    t, yaw = _imu(run.log.time, run.truth[:, 2])
+    bag = _bag(tmp_path / "jump", run.log.time, positions, {"/imu/a": (t, yaw), "/imu/b": (t, yaw)})
+    assert main(["odometry", str(robot), str(bag)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    said = [line.removeprefix("wmrkit: warning: ") for line in err if line.startswith("wmrkit: warning: ")]
+    assert len(said) == 1 and "choose one with --imu TOPIC" in said[0] and err[-1].startswith("wmrkit: error: ")
+    code, answer, stderr = _batch(capsys, robot, [bag])
+    (row,) = answer["rows"]
+    assert code == 1 and answer["failed"] == 1 and row["error"] is not None
+    assert row["warnings"] == said[0] and answer["warnings"] == [f"{bag}: {said[0]}"]
+    assert f"wmrkit: warning: {bag}: {said[0]}" in stderr.splitlines()

@@ -142,6 +142,7 @@ def process_log(job: LogJob) -> dict[str, Any]:
     row: dict[str, Any] = {name: None for name, _ in SUMMARY_SCHEMA}
     row.update(log=job.path, robot=job.robot.name, method=job.method, trajectory=job.trajectory)
     t0 = time.perf_counter()
+    unread = None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
@@ -153,8 +154,10 @@ def process_log(job: LogJob) -> dict[str, Any]:
             s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=model,
                               sinks=[check] if check else (), check=check.judge if check else None, **options)
             diagnosis = _diagnose(job, s, model, options)
-        except Exception as err:
-            row.update(error=_message(err), trajectory=None, wall_time=time.perf_counter() - t0)
+        except Exception as err:  # what was said before it failed stays said (wmrkit odometry says it too)
+            said = [" ".join(str(w.message).split()) for w in caught] + ([unread] if unread else [])
+            row.update(error=_message(err), trajectory=None, warnings="; ".join(said) or None,
+                       wall_time=time.perf_counter() - t0)
             return row
     x, y, theta = s.final_pose
     notes = [" ".join(str(w.message).split()) for w in caught] + list(diagnosis.warnings)

@@ -174,7 +174,7 @@ def run_odometry(args: argparse.Namespace) -> int:
                                 closed=args.closed, resume=not args.no_resume, progress=_progress(args),
                                 imu=args.imu, **_options(args))
     for r in result.rows:  # they were only in the table's 'warnings' column (or nowhere, without --out)
-        if r["warnings"] and not r["error"]:
+        if r["warnings"]:  # a failed log's too, said before its error as wmrkit odometry says them
             warn(f"{r['log']}: {r['warnings']}")
     found = [r["imu"] for r in result.rows if r["imu"] and not r["error"]]
     if found and args.imu is None:  # each bag's own Imu topic, found by itself: wmrkit odometry's note
