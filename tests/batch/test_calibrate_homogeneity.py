@@ -112,3 +112,19 @@ def test_fewest_apart_finds_the_smallest_set_of_runs_to_leave_out():
     own, dof = np.ones(8), np.full(8, 30.0)
     assert homogeneity(a, b, own, dof)[0] > MAX_HOMOGENEITY
     assert fewest_apart(a, b, own, dof) == (3, (1, 4, 6))
+
+
+def test_a_fleet_fitted_with_run_weights_says_it_is_not_checked_as_a_whole(diff):
+    """The fleet of three runs of another robot among 8 (test above) fitted with ``run_weights`` of one (the same
+    fit): the homogeneity check needs the plain residuals and is not made. Before, that was unsaid: 'inconsistent'
+    false, no warning, 'not_judged' null, where the same fleet unweighted is flagged. Now 'not_judged' says so."""
+    from wmrkit.batch.homogeneity import NOT_PLAIN
+
+    runs = short_runs(diff, 5, 8, None, bad=(2, 5, 7), odd=FAR)
+    plain = fleet_calibrate(diff, runs, PARAMS)
+    weighted = fleet_calibrate(diff, runs, PARAMS, run_weights=lambda run: np.ones(len(run.samples())))
+    np.testing.assert_allclose(weighted.estimate, plain.estimate, rtol=1e-12, atol=1e-15)
+    assert plain.inconsistent is True and len(fleet_warnings(plain)) == 1 and plain.not_judged is None
+    assert not fleet_warnings(weighted) and weighted.inconsistent is False
+    assert weighted.not_judged == weighted.to_dict()["not_judged"] == NOT_PLAIN.format(
+        check="the fleet homogeneity", why="weighs its residuals by run_weights")

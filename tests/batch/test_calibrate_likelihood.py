@@ -8,7 +8,7 @@ import json
 import numpy as np
 from batch_params import PARAMS, write_fleet
 from scipy.optimize import minimize
-from test_calibrate_judge import short_runs
+from test_calibrate_judge import disagreeing, short_runs
 
 from wmrkit.batch.calibrate import fleet_calibrate
 from wmrkit.batch.likelihood import likelihood_ratio
@@ -174,3 +174,35 @@ def test_runs_not_scored_against_their_own_noise_are_named(diff, tmp_path, capsy
     assert said in json.loads(capsys.readouterr().out)["not_judged"]
     assert main(args) == 0
     assert said in capsys.readouterr().out
+
+
+def test_a_fleet_fitted_with_run_weights_or_no_heading_says_it_is_not_checked_as_a_whole(diff):
+    """Three bad runs among 6 three-pose runs (flagged by the fleet likelihood ratio, test above) fitted with
+    ``run_weights`` of one (the same fit): the check needs the plain residuals and was skipped unsaid ('inconsistent'
+    false, 'not_judged' null); now 'not_judged' says it is not made. Four-pose runs fitted with ``heading_weight`` 0
+    (6 residuals, closed-path scores) with a bad run: its F test against its own noise divided by the heading weight
+    (RuntimeWarnings, an error here) and said 'a covariance of rank 2 of 3: the encoders do not see every direction
+    of it'; now it says the fit has no heading, and that the whole-fleet check is not made."""
+    import warnings
+
+    from wmrkit.batch.homogeneity import NOT_PLAIN
+    from wmrkit.batch.refits import OWN_SKIPPED
+
+    check = "the fleet likelihood ratio of the runs of as many reference poses"
+    bad = sorted(np.random.default_rng(0).choice(6, 3, replace=False).tolist())
+    runs = short_runs(diff, 40000, 6, 3, bad=bad)
+    plain = fleet_calibrate(diff, runs, PARAMS)
+    weighted = fleet_calibrate(diff, runs, PARAMS, run_weights=lambda run: np.ones(len(run.samples())))
+    np.testing.assert_allclose(weighted.estimate, plain.estimate, rtol=1e-12, atol=1e-15)
+    assert plain.inconsistent is True and len(whole(plain)) == 1 and plain.not_judged is None
+    assert weighted.inconsistent is False and not weighted.warnings
+    assert weighted.not_judged == NOT_PLAIN.format(check=check, why="weighs its residuals by run_weights")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = fleet_calibrate(diff, short_runs(diff, 40000, 6, 4, bad=(1,)), PARAMS, heading_weight=0.0)
+    assert res.closed_scores[1] > 20 and disagreeing(res) == ["r1.csv"], res.closed_scores
+    assert "its own noise is not measured" in res.warnings[0]
+    assert res.not_judged == "; ".join([
+        NOT_PLAIN.format(check=check, why="has no heading (heading_weight 0)"),
+        OWN_SKIPPED.format(runs="r1.csv", why="r1.csv: the fit has no heading (heading_weight 0): its motions' errors "
+                           "are not known")])

@@ -338,7 +338,9 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     judged = run_consistency(fit.jac, fit.fun, sizes, ROUNDOFF * travels, logs)
     if judged.not_judged != CLOSED:
         which = [k for k, q in enumerate(judged.ratios) if q is not None]
-        fleet = fleet_warning(problem, fit.jac, fit.fun, which, ROUNDOFF * travels, logs, bool(judged.inconsistent))
+        fleet, unmade = fleet_warning(problem, fit.jac, fit.fun, which, ROUNDOFF * travels, logs,
+                                      bool(judged.inconsistent))
+        judged = replace(judged, not_judged="; ".join(x for x in (judged.not_judged, unmade) if x) or None)
         return judged if fleet is None else replace(judged, inconsistent=True, messages=(*judged.messages, fleet))
     g, n = len(runs), fit.x.size
     m = counts(fit.jac, fit.fun, sizes)
@@ -381,11 +383,10 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
         elif pair is not None and pair[2] > MAX_PAIR_SCORE:
             messages.append(PAIR.format(a=logs[pair[0]], b=logs[pair[1]], score=pair[2]))
         named = 1 if scores[worst] > MAX_CLOSED_SCORE else 2 if pair is not None and pair[2] > MAX_PAIR_SCORE else 0
-        # run_weights or heading_weight 0 skip it unsaid: only a Python caller sets them (batch calibrate sets neither)
-        if m[group[0]] - n >= MIN_OWN_DOF and problem.run_weights is None and problem.heading_weight != 0:
+        if m[group[0]] - n >= MIN_OWN_DOF:  # not made with run_weights or heading_weight 0, and said
             said, out = few_pose_warning(problem, fit.x, fit.jac, fit.fun, group, ROUNDOFF * travels, logs, named)
             messages += [said] if said else []  # several runs that disagree (wmrkit.batch.likelihood)
-            left += [out] if out else []  # runs left out of that check (likelihood.LEFT_OUT)
+            left += [out] if out else []  # runs left out of that check, or why not made (LEFT_OUT, NOT_PLAIN)
     aside = [k for k in range(g) if np.isnan(scores[k])]
     why = [] if not aside else [SET_ASIDE.format(runs=", ".join(logs[k] for k in aside), judged=", ".join(
         f"{len(group)} runs of {_poses(m[group[0]])}" for group in groups))]

@@ -41,6 +41,21 @@ MAX_HOMOGENEITY = 60.0
 MIN_DOF = 27
 #: Most subsets of runs left out in the search for the fewest runs that explain a disagreement.
 SEARCH = 5000
+#: Why a whole-fleet check (this one, or :mod:`wmrkit.batch.likelihood`'s) is not made for runs it would judge
+#: ({check}: which; {why}: :func:`plain_only`): the motions' errors need the plain residuals and the odometry's
+#: heading. Said in ``not_judged``; before, a Python fit with ``run_weights`` or ``heading_weight=0`` skipped it
+#: unsaid (three runs of another robot among 8: 'inconsistent' false, no warning, 'not_judged' null).
+NOT_PLAIN = ("the whole-fleet check ({check}, which finds several runs that disagree) is not made: the fit {why} (the "
+             "check needs each run's plain residuals with their heading, as batch calibrate fits them); each run is "
+             "still checked against the others on its own, several runs that disagree may hide each other")
+
+
+def plain_only(problem: CalibrationProblem) -> str | None:
+    """Why the problem's residuals are not the plain ones the whole-fleet checks need (:data:`NOT_PLAIN`), or
+    ``None``."""
+    if problem.run_weights is not None:
+        return "weighs its residuals by run_weights"
+    return "has no heading (heading_weight 0)" if problem.heading_weight == 0 else None
 
 
 def increments(run: CalibrationRun, heading_weight: float, jac: np.ndarray,
@@ -93,23 +108,25 @@ def homogeneity(a: np.ndarray, b: np.ndarray, own: np.ndarray, dof: np.ndarray) 
 
 
 def fleet_warning(problem: CalibrationProblem, jac: np.ndarray, res: np.ndarray, which: Sequence[int],
-                  floors: Sequence[float], logs: Sequence[str], named: bool) -> str | None:
+                  floors: Sequence[float], logs: Sequence[str], named: bool) -> tuple[str | None, str | None]:
     """The warning when the runs `which` of the fleet fit (`jac`, `res`; `floors`: least RSS root of each run's own
     fit [m], per run of the problem) do not agree as a whole (``H`` over :data:`MAX_HOMOGENEITY`), else ``None``;
-    runs of fewer than :data:`MIN_DOF` are left out; a fleet is not checked whose residuals carry run weights or
-    no heading (``heading_weight`` 0): the motions' errors need the plain residuals and the odometry's heading.
+    runs of fewer than :data:`MIN_DOF` are left out; and why the check is not made (:data:`NOT_PLAIN`) where it
+    would judge 3 runs or more, else ``None``: a fleet whose residuals carry run weights or no heading
+    (``heading_weight`` 0) is not checked, the motions' errors need the plain residuals and the odometry's heading.
     `named`: the residual ratio already named one run, so a disagreement one run explains is not said twice."""
-    if problem.run_weights is not None or problem.heading_weight == 0:
-        return None
     sizes = problem.sizes()
     ends = np.cumsum(sizes)
     rows = {k: (int(ends[k] - sizes[k]), int(ends[k])) for k in which}
+    why = plain_only(problem)
+    if why is not None:  # the runs it would judge, by their pose errors' degrees of freedom (as many as the motions')
+        judged = sum(_own_fit(jac[lo:hi], res[lo:hi])[1] >= MIN_DOF for lo, hi in rows.values())
+        return None, NOT_PLAIN.format(check="the fleet homogeneity", why=why) if judged >= 3 else None
     keep, a, b, own, dof = [], [], [], [], []
     for k, (lo, hi) in rows.items():
         run = problem.runs[k]
         j, r = increments(run, problem.heading_weight, jac[lo:hi], res[lo:hi])
-        step, _, rank, _ = np.linalg.lstsq(j, r, rcond=None)
-        free = int(np.count_nonzero(np.any(j != 0, axis=1) | (r != 0))) - rank
+        step, free = _own_fit(j, r)
         if free >= MIN_DOF:
             keep.append(k)
             a.append(j.T @ j)
@@ -117,19 +134,26 @@ def fleet_warning(problem: CalibrationProblem, jac: np.ndarray, res: np.ndarray,
             own.append(max(float(np.sum(np.square(r - j @ step))), floors[k] ** 2 * (hi - lo)))
             dof.append(free)
     if len(keep) < 3:
-        return None
+        return None, None
     parts = tuple(np.array(x, dtype=float) for x in (a, b, own, dof))
     h, _ = homogeneity(*parts)
     if h <= MAX_HOMOGENEITY:
-        return None
+        return None, None
     n, out = fewest_apart(*parts)
     if n == 1 and named:
-        return None
+        return None, None
     without = f" (without {', '.join(logs[keep[i]] for i in out)} the others agree)" if out else ""
     return (f"the runs disagree among themselves (fleet homogeneity {h:.3g}, over {MAX_HOMOGENEITY:g}: their "
             "parameters are further apart than each run's own noise allows): at least "
             f"{'one run disagrees' if n == 1 else f'{n} runs disagree'} with the others{without}: another robot, load "
-            "or floor? The fit averages them; calibrate them apart")
+            "or floor? The fit averages them; calibrate them apart"), None
+
+
+def _own_fit(j: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, int]:
+    """A run's own least-squares step on its rows `j`, `r` and its degrees of freedom: its rows that carry
+    information (not zero with their Jacobian row) less the rank of `j`."""
+    step, _, rank, _ = np.linalg.lstsq(j, r, rcond=None)
+    return step, int(np.count_nonzero(np.any(j != 0, axis=1) | (r != 0))) - int(rank)
 
 
 def fewest_apart(a: np.ndarray, b: np.ndarray, own: np.ndarray, dof: np.ndarray) -> tuple[int, tuple[int, ...]]:

@@ -35,7 +35,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..odometry.calibration import CalibrationProblem
-from .homogeneity import fewest
+from .homogeneity import NOT_PLAIN, fewest, plain_only
 from .motions import whitening
 
 #: Chance that a fleet of agreeing runs is said to disagree (``L`` over its :func:`threshold`), for any number of runs.
@@ -152,7 +152,12 @@ def few_pose_warning(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray
     `p`; `floors`: least RSS root of each run's own fit [m]) do not agree as a whole (``L`` over its
     :func:`threshold`), with the fewest runs whose removal leaves the others agreeing; ``None`` when they agree, or
     when as many runs as were `named` (1: by a closed-path score, 2: by the pair score) explain it. And the runs
-    left out of the check, named with why (:data:`LEFT_OUT`), or ``None``."""
+    left out of the check, named with why (:data:`LEFT_OUT`), or why it is not made at all (run weights or no
+    heading: :data:`~wmrkit.batch.homogeneity.NOT_PLAIN`), or ``None``."""
+    why = plain_only(problem)
+    if why is not None:
+        return None, NOT_PLAIN.format(check="the fleet likelihood ratio of the runs of as many reference poses",
+                                      why=why)
     (a, b, c, own, m, rank), kept, left = whitened_parts(problem, p, jac, res, group, floors)
     aside = left_out(group, kept, left, logs)
     if len(kept) < 3:

@@ -45,7 +45,10 @@ def whitening(problem: CalibrationProblem, p: np.ndarray, run: CalibrationRun, r
     errors of :func:`~wmrkit.batch.homogeneity.increments`, each motion's three times the inverse square root of its
     covariance (:func:`motion_covariances`), motions of no sample left out; or why not, where a motion's covariance
     is singular (a robot whose encoders do not see every motion, or a motion of one sample of a robot of two
-    encoders) or no motion moves the wheels."""
+    encoders), no motion moves the wheels or the fit has no heading (``heading_weight`` 0: the motions' errors
+    were divided by it, NaN and a RuntimeWarning, and their covariance said the encoders did not see them)."""
+    if problem.heading_weight == 0:
+        return "the fit has no heading (heading_weight 0): its motions' errors are not known"
     to_motions, _ = increments(run, problem.heading_weight, np.eye(res.size), res)
     cov = motion_covariances(problem, p, run)
     at = run.samples()
