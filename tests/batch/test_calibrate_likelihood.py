@@ -4,9 +4,10 @@ each pair's own noise (noise levels drawn per run no longer make a pair of noisy
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
-from batch_params import PARAMS, write_fleet
+from batch_params import PARAMS, TRUE_P, write_fleet
 from scipy.optimize import minimize
 from test_calibrate_judge import disagreeing, short_runs
 
@@ -104,8 +105,6 @@ def test_a_bad_run_is_still_named_over_its_own_noise(diff):
     five and of the run alone; a noisy bad run, seed 0, scores 273.6 against its own noise where it scored 366 over
     the others'). The run's own fit is a refit: on the runs' quadratic model about the fleet fit, a quiet run +20 %
     (seed 2) kept 8 times its own RSS and scored 32 against 285."""
-    from batch_params import TRUE_P
-    from test_calibrate_judge import disagreeing
     from test_calibrate_own_noise import score_by_refit
 
     for seed, pct in ((0, 20), (2, 20), (0, 5), (1, 5)):
@@ -206,3 +205,44 @@ def test_a_fleet_fitted_with_run_weights_or_no_heading_says_it_is_not_checked_as
         NOT_PLAIN.format(check=check, why="has no heading (heading_weight 0)"),
         OWN_SKIPPED.format(runs="r1.csv", why="r1.csv: the fit has no heading (heading_weight 0): its motions' errors "
                            "are not known")])
+
+
+def test_a_run_whose_reference_moves_while_its_wheels_are_still_is_said_not_a_crash(diff, tmp_path, capsys):
+    """Five three-pose runs and one that stands still 1 s before its arcs, its middle reference (0.5 s into the
+    pause) 0.1 m, 0.05 m and 0.05 rad from the start (pushed, or a wrong reference pose). Its still motion has no
+    variance under the encoders' noise model and was dropped unsaid from its whitened errors: one motion left, 3
+    errors of rank 3, and the fleet likelihood ratio's threshold came out NaN: ValueError out of fleet_calibrate (a
+    traceback from the CLI). Now the run is left out of that check with its degrees of freedom (0: 3 errors of the
+    one motion its wheels turn in, less its 3 parameters), its F test against its own noise is not made for the
+    same reason (refits' 'fewer than 3 degrees of freedom' branch), its closed-path score names it ('its own noise is
+    not measured'), and the still motion is said with the reference's move (the push: hypot(0.1, 0.05) m, 0.05 rad)."""
+    from wmrkit.cli.main import main
+    from wmrkit.odometry.calibration import CalibrationRun, apply_parameters
+    from wmrkit.odometry.synthetic import TwistProfile, simulate
+
+    rng = np.random.default_rng(3)
+    segs = [(1.0, 0.0, 0.0, 0.0)] + [(2.0, 0.3 + 0.1 * rng.random(), 0.0, rng.uniform(-0.6, 0.6)) for _ in range(3)]
+    run = simulate(apply_parameters(diff, PARAMS, TRUE_P), TwistProfile.from_segments(segs), 10.0,
+                   spin_noise_per_rad=1e-5, seed=int(rng.integers(1 << 30)))
+    at = np.array([0, 5, len(run.log) - 1])
+    ref = run.truth[at] + [[0, 0, 0], [0.1, 0.05, 0.05], [0, 0, 0]]
+    pushed = CalibrationRun(replace(run.log, source="p0.csv"), ref, at=at)
+    moving = sum(bool(np.ptp(run.log.positions[a:b + 1], axis=0).any()) for a, b in ((0, 5), (5, at[2])))
+    free = 3 * moving - len(TRUE_P)
+    assert moving == 1 and free == 0
+    runs = [*short_runs(diff, 7, 5, 3), pushed]
+    res = fleet_calibrate(diff, runs, PARAMS)
+    from wmrkit.batch.likelihood import FEW_DOF, LEFT_OUT  # after the fit: they are new, the fit raised before
+    from wmrkit.batch.motions import AT_REST
+    from wmrkit.batch.refits import OWN_SKIPPED
+
+    assert res.closed_scores[5] > 20 > max(res.closed_scores[:5]) and disagreeing(res) == ["p0.csv"], res.closed_scores
+    assert "its own noise is not measured" in res.warnings[0]
+    few = FEW_DOF.format(free=free)
+    assert res.not_judged == "; ".join([
+        LEFT_OUT.format(runs="p0.csv", why=f"p0.csv: {few}", rest="the other 5 runs are checked"),
+        AT_REST.format(runs=f"p0.csv (samples 0-5: {np.hypot(0.1, 0.05):.3g} m, 0.05 rad)"),
+        OWN_SKIPPED.format(runs="p0.csv", why=f"p0.csv: {few}")])
+    args = write_fleet(tmp_path, runs)
+    assert main([*args, "--json"]) == 0
+    assert "the reference moves while the wheels are still" in json.loads(capsys.readouterr().out)["not_judged"]

@@ -38,6 +38,7 @@ from ..odometry.calibration import RANK_TOL, CalibrationProblem, CalibrationRun
 from ..robot import Robot
 from .homogeneity import fleet_warning
 from .likelihood import MIN_OWN_DOF, few_pose_warning, own_noise
+from .motions import moved_at_rest
 from .refits import REFIT_FAILED as REFIT_FAILED  # re-exported: batch.consistency.REFIT_FAILED
 from .refits import own_dof, own_scores, own_skipped, refits
 
@@ -387,6 +388,7 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
             said, out = few_pose_warning(problem, fit.x, fit.jac, fit.fun, group, ROUNDOFF * travels, logs, named)
             messages += [said] if said else []  # several runs that disagree (wmrkit.batch.likelihood)
             left += [out] if out else []  # runs left out of that check, or why not made (LEFT_OUT, NOT_PLAIN)
+            left += [rest] if (rest := moved_at_rest(problem, fit.x, group, fit.fun, logs)) else []
     aside = [k for k in range(g) if np.isnan(scores[k])]
     why = [] if not aside else [SET_ASIDE.format(runs=", ".join(logs[k] for k in aside), judged=", ".join(
         f"{len(group)} runs of {_poses(m[group[0]])}" for group in groups))]

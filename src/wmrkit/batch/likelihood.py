@@ -50,6 +50,11 @@ GRID = 0.01
 #: Fewest degrees of freedom of every run's own fit for this check (three-pose references: 3; a closed path or a
 #: reference of two poses has none, its own fit is exact, and its fleet's homogeneity is not judged).
 MIN_OWN_DOF = 3
+#: Why a run's whitened motions' errors are not judged ({free}: their degrees of freedom beyond its own fit): too
+#: few (a motion left out: at rest, :data:`~wmrkit.batch.motions.AT_REST`). Before, such a run with one motion left
+#: (3 errors, rank 3) made the fleet likelihood ratio's threshold NaN: ValueError out of the fleet fit.
+FEW_DOF = ("its whitened motions' errors have {free} degrees of freedom beyond its own fit, fewer than "
+           f"{MIN_OWN_DOF}")
 #: Most iterations of the reweighted least squares from each start.
 ITERATIONS = 200
 #: Why runs are left out of this check (said in ``not_judged``; {runs}: the runs; {why}: each run's why; {rest}: what
@@ -94,7 +99,8 @@ def whitened_parts(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray, 
     """The arguments of :func:`likelihood_ratio` for the runs `group` (`jac`, `res` of the fleet fit at parameters
     `p`; `floors`: least RSS root of each run's own fit [m]) on their whitened motions' errors
     (:func:`~wmrkit.batch.motions.whitening`), and the rank of each run's whitened Jacobian; runs that cannot be
-    whitened are left out: the places in `group` kept, and those left out with why."""
+    whitened, or have fewer than :data:`MIN_OWN_DOF` degrees of freedom so (:data:`FEW_DOF`), are left out: the
+    places in `group` kept, and those left out with why."""
     sizes = problem.sizes()
     ends = np.cumsum(sizes)
     parts, kept, left = ([], [], [], [], [], []), [], {}
@@ -106,6 +112,9 @@ def whitened_parts(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray, 
             continue
         j, r = white @ jac[lo:hi], white @ res[lo:hi]
         step, _, rank, _ = np.linalg.lstsq(j, r, rcond=None)
+        if r.size - rank < MIN_OWN_DOF:
+            left[i] = FEW_DOF.format(free=r.size - rank)
+            continue
         own = max(float(np.sum(np.square(r - j @ step))), floors[k] ** 2 * float(np.sum(np.square(white))))
         for part, x in zip(parts, (j.T @ j, j.T @ r, r @ r, own, len(r), rank), strict=True):
             part.append(x)

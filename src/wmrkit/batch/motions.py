@@ -13,6 +13,8 @@ against 5.4; tested), and a run's own fit measures its noise with the degrees of
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from ..odometry.calibration import CalibrationProblem, CalibrationRun, apply_parameters
@@ -20,6 +22,16 @@ from ..odometry.covariance import JointNoise
 from ..odometry.model import odometry_model
 from ..odometry.pipeline import odometry
 from .homogeneity import increments
+
+#: Runs whose reference moves while their wheels are still ({runs}: each with its motions, how far the reference
+#: moved): the checks on whitened motions' errors leave such a motion out (its covariance under the encoders' noise
+#: model is zero: no variance to weigh its error by). Before, they were left out unsaid: a three-pose run whose
+#: middle reference, 0.5 s into a pause, was 2.2 cm from the start had its F test and likelihood terms on the other
+#: motion alone, and among 5 three-pose runs the fleet fit raised ValueError (a likelihood term of no degree of
+#: freedom).
+AT_REST = ("{runs}: the reference moves while the wheels are still (pushed, sliding, or a wrong reference pose?): "
+           "such a motion is left out of the checks on whitened motions' errors (the fleet likelihood ratio, a run's "
+           "F test against its own noise), the encoders' noise model gives it no variance")
 
 
 def motion_covariances(problem: CalibrationProblem, p: np.ndarray, run: CalibrationRun) -> np.ndarray:
@@ -63,3 +75,25 @@ def whitening(problem: CalibrationProblem, p: np.ndarray, run: CalibrationRun, r
                     f"{int(np.sum(val > 1e-9 * val[-1]))} of 3: the encoders do not see every direction of it")
         rows.append((vec / np.sqrt(val)) @ vec.T @ block)
     return np.concatenate(rows) if rows else "its wheels do not turn between its reference poses"
+
+
+def moved_at_rest(problem: CalibrationProblem, p: np.ndarray, runs: Sequence[int], res: np.ndarray,
+                  logs: Sequence[str]) -> str | None:
+    """:data:`AT_REST` for the `runs` (indices of the problem's; `res`: the fleet fit's residuals at parameters `p`)
+    with a motion between reference poses that :func:`whitening` leaves out (covariance zero: no sensed wheel
+    turns) while its reference moves (its error not zero), each motion named by its samples with the reference's
+    move [m, rad]; ``None`` when there is none (a still reference of a still robot carries no information)."""
+    if problem.heading_weight == 0:  # no motion is whitened at all (whitening says why)
+        return None
+    sizes = problem.sizes()
+    ends = np.cumsum(sizes)
+    said = []
+    for k in runs:
+        run, r = problem.runs[k], res[int(ends[k] - sizes[k]):int(ends[k])]
+        _, err = increments(run, problem.heading_weight, np.eye(r.size), r)
+        at = run.samples()
+        moved = [f"samples {a}-{b}: {np.hypot(*e[:2]):.3g} m, {abs(e[2]) / problem.heading_weight:.3g} rad"
+                 for c, e, a, b in zip(motion_covariances(problem, p, run), err.reshape(-1, 3), np.r_[0, at[:-1]], at,
+                                       strict=True) if not c.any() and e.any()]
+        said += [f"{logs[k]} ({'; '.join(moved)})"] if moved else []
+    return AT_REST.format(runs=", ".join(said)) if said else None

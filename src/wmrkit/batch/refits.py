@@ -20,7 +20,7 @@ import numpy as np
 
 from ..odometry.calibration import CalibrationProblem
 from .engine import TaskFailure
-from .likelihood import MIN_OWN_DOF
+from .likelihood import FEW_DOF, MIN_OWN_DOF
 from .motions import whitening
 
 #: Level of the F test of a run's misfit at the other runs' fit against its own noise (:func:`own_scores`): the
@@ -115,9 +115,8 @@ def own_scores(problem: CalibrationProblem, fit, group: np.ndarray, live: list[n
         step, _, rank, _ = np.linalg.lstsq(jw, rw, rcond=None)
         own, free = float(np.sum(np.square(rw - jw @ step))), rw.size - rank
         if free < MIN_OWN_DOF:
-            skipped[i] = (f"its whitened motions' errors have {free} degrees of freedom beyond its own fit, fewer "
-                          f"than {MIN_OWN_DOF}")
-        elif free >= MIN_OWN_DOF and own > 0:
+            skipped[i] = FEW_DOF.format(free=free)
+        elif own > 0:
             f = max(float(far @ far) - own, 0.0) / rank / (own / free)
             out[k] = np.sqrt(f / stats.f(rank, free).isf(OWN_LEVEL))
     return out
