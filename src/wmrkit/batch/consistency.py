@@ -23,8 +23,8 @@ The denominator is at least :data:`ROUNDOFF` times the run's wheel travel: noise
 Closed paths (a final pose: no own noise to divide by) are judged by :func:`judge` against the other runs' pooled
 noise instead, with 5 runs or more, from a quadratic model of each run about the fleet fit and one refit (of every
 run in a fleet of 5); with 6 or more and no run over the threshold, pairs of runs are left out together too (two bad
-runs hide each other, :func:`_pair`). Runs with references of many poses are also judged as a whole
-(:mod:`wmrkit.batch.homogeneity`): several bad runs hide each other from their ratios too.
+runs hide each other, :func:`_pair`). Runs with references of 4 poses or more are also judged as a whole
+(:mod:`wmrkit.batch.whole`): several bad runs hide each other from their ratios too.
 """
 
 from __future__ import annotations
@@ -36,11 +36,11 @@ import numpy as np
 
 from ..odometry.calibration import RANK_TOL, CalibrationProblem, CalibrationRun
 from ..robot import Robot
-from .homogeneity import fleet_warning
 from .likelihood import MIN_OWN_DOF, few_pose_warning, own_noise
 from .motions import moved_at_rest
 from .refits import REFIT_FAILED as REFIT_FAILED  # re-exported: batch.consistency.REFIT_FAILED
 from .refits import own_dof, own_scores, own_skipped, refits
+from .whole import whole_fleet
 
 #: Largest residual ratio of a fleet whose runs agree. Simulated fleets with encoder noise (1e-5 per rad, or drawn
 #: per run among 1e-6, 1e-5 and 1e-4), 4 to 16 runs (docs/batch.md's table): largest ratio 12.1 over 260 fleets;
@@ -339,10 +339,10 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     judged = run_consistency(fit.jac, fit.fun, sizes, ROUNDOFF * travels, logs)
     if judged.not_judged != CLOSED:
         which = [k for k, q in enumerate(judged.ratios) if q is not None]
-        fleet, unmade = fleet_warning(problem, fit.jac, fit.fun, which, ROUNDOFF * travels, logs,
-                                      bool(judged.inconsistent))
+        said, unmade = whole_fleet(problem, fit.x, fit.jac, fit.fun, which, ROUNDOFF * travels, logs,
+                                   bool(judged.inconsistent))
         judged = replace(judged, not_judged="; ".join(x for x in (judged.not_judged, unmade) if x) or None)
-        return judged if fleet is None else replace(judged, inconsistent=True, messages=(*judged.messages, fleet))
+        return replace(judged, inconsistent=True, messages=(*judged.messages, *said)) if said else judged
     g, n = len(runs), fit.x.size
     m = counts(fit.jac, fit.fun, sizes)
     kinds = [np.flatnonzero(m == c) for c in sorted(set(m.tolist()), reverse=True)]

@@ -108,20 +108,22 @@ def homogeneity(a: np.ndarray, b: np.ndarray, own: np.ndarray, dof: np.ndarray) 
 
 
 def fleet_warning(problem: CalibrationProblem, jac: np.ndarray, res: np.ndarray, which: Sequence[int],
-                  floors: Sequence[float], logs: Sequence[str], named: bool) -> tuple[str | None, str | None]:
+                  floors: Sequence[float], logs: Sequence[str],
+                  named: bool) -> tuple[str | None, str | None, list[int]]:
     """The warning when the runs `which` of the fleet fit (`jac`, `res`; `floors`: least RSS root of each run's own
     fit [m], per run of the problem) do not agree as a whole (``H`` over :data:`MAX_HOMOGENEITY`), else ``None``;
-    runs of fewer than :data:`MIN_DOF` are left out; and why the check is not made (:data:`NOT_PLAIN`) where it
-    would judge 3 runs or more, else ``None``: a fleet whose residuals carry run weights or no heading
-    (``heading_weight`` 0) is not checked, the motions' errors need the plain residuals and the odometry's heading.
-    `named`: the residual ratio already named one run, so a disagreement one run explains is not said twice."""
+    runs of fewer than :data:`MIN_DOF` are left out; why the check is not made (:data:`NOT_PLAIN`) where it would
+    judge 3 runs or more, else ``None``: a fleet whose residuals carry run weights or no heading (``heading_weight``
+    0) is not checked, the motions' errors need the plain residuals and the odometry's heading; and the runs of
+    :data:`MIN_DOF` or more (those it covers). `named`: the residual ratio already named one run, so a disagreement
+    one run explains is not said twice."""
     sizes = problem.sizes()
     ends = np.cumsum(sizes)
     rows = {k: (int(ends[k] - sizes[k]), int(ends[k])) for k in which}
     why = plain_only(problem)
     if why is not None:  # the runs it would judge, by their pose errors' degrees of freedom (as many as the motions')
-        judged = sum(_own_fit(jac[lo:hi], res[lo:hi])[1] >= MIN_DOF for lo, hi in rows.values())
-        return None, NOT_PLAIN.format(check="the fleet homogeneity", why=why) if judged >= 3 else None
+        judged = [k for k, (lo, hi) in rows.items() if _own_fit(jac[lo:hi], res[lo:hi])[1] >= MIN_DOF]
+        return None, NOT_PLAIN.format(check="the fleet homogeneity", why=why) if len(judged) >= 3 else None, judged
     keep, a, b, own, dof = [], [], [], [], []
     for k, (lo, hi) in rows.items():
         run = problem.runs[k]
@@ -134,19 +136,19 @@ def fleet_warning(problem: CalibrationProblem, jac: np.ndarray, res: np.ndarray,
             own.append(max(float(np.sum(np.square(r - j @ step))), floors[k] ** 2 * (hi - lo)))
             dof.append(free)
     if len(keep) < 3:
-        return None, None
+        return None, None, keep
     parts = tuple(np.array(x, dtype=float) for x in (a, b, own, dof))
     h, _ = homogeneity(*parts)
     if h <= MAX_HOMOGENEITY:
-        return None, None
+        return None, None, keep
     n, out = fewest_apart(*parts)
     if n == 1 and named:
-        return None, None
+        return None, None, keep
     without = f" (without {', '.join(logs[keep[i]] for i in out)} the others agree)" if out else ""
     return (f"the runs disagree among themselves (fleet homogeneity {h:.3g}, over {MAX_HOMOGENEITY:g}: their "
             "parameters are further apart than each run's own noise allows): at least "
             f"{'one run disagrees' if n == 1 else f'{n} runs disagree'} with the others{without}: another robot, load "
-            "or floor? The fit averages them; calibrate them apart"), None
+            "or floor? The fit averages them; calibrate them apart"), None, keep
 
 
 def _own_fit(j: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, int]:
