@@ -69,3 +69,11 @@ def refit_fails(args):
 def curvature_fails(args):
     """In place of batch.calibrate._curvature_of: the closed-path judge's Jacobian one step from the fit raises."""
     raise RuntimeError("injected curvature failure")
+
+
+def no_own_noise(res, runs=None) -> str:
+    """The not_judged note of a fleet whose runs (`runs`, else all of `res.logs`) are scored as closed paths: not
+    checked as a whole (batch.whole.NO_OWN_NOISE)."""
+    from wmrkit.batch.whole import NO_OWN_NOISE
+
+    return NO_OWN_NOISE.format(runs=", ".join(res.logs if runs is None else runs))

@@ -7,7 +7,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from batch_params import PARAMS, TRUE_P, closed_fleet
+from batch_params import PARAMS, TRUE_P, closed_fleet, no_own_noise
 
 from wmrkit import catalog
 from wmrkit.batch.calibrate import default_parameters, fleet_calibrate, fleet_slip_calibrate, load_runs
@@ -653,7 +653,7 @@ def test_closed_paths_of_another_robot_are_named(diff):
     for seed, odd in ((1, [0.06, 0.03]), (2, [0.01, 0.13])):
         params, runs = closed_fleet(diff, seed, odd)
         res = fleet_calibrate(diff, runs, params)
-        assert res.inconsistent is True and res.not_judged is None, res.closed_scores
+        assert res.inconsistent is True and res.not_judged == no_own_noise(res), res.closed_scores
         assert res.closed_scores[0] > 2 * MAX_CLOSED_SCORE and max(res.closed_scores[1:]) < MAX_CLOSED_SCORE / 2
         (warning,) = [w for w in res.warnings if "disagrees" in w]
         assert warning.startswith("run 1 (<synthetic>): disagrees with the other runs (closed-path score")
@@ -668,7 +668,7 @@ def test_closed_paths_that_agree_are_judged_and_not_flagged(diff):
     for seed in range(4):
         params, runs = closed_fleet(diff, seed, runs=6 + 2 * (seed % 2))
         res = fleet_calibrate(diff, runs, params)
-        assert res.inconsistent is False and res.not_judged is None and not res.warnings
+        assert res.inconsistent is False and res.not_judged == no_own_noise(res) and not res.warnings
         assert all(0 <= q < MAX_CLOSED_SCORE / 2 for q in res.closed_scores), res.closed_scores
     res = fleet_calibrate(diff, runs[:4], params)
     assert res.inconsistent is None and res.not_judged == CLOSED and res.closed_scores == (None,) * 4
@@ -713,14 +713,14 @@ def test_five_closed_paths_are_judged_by_refits_of_every_run(diff):
         params, runs = closed_fleet(diff, seed, odd)  # run 0 turns counter-clockwise, as runs 2 and 4
         for keep in ([0, 1, 2, 3, 4], [0, 1, 3, 5, 2]):  # run 0 among 3 squares of its direction; among 2
             res = fleet_calibrate(diff, [runs[k] for k in keep], params)
-            assert res.inconsistent is True and res.not_judged is None, res.closed_scores
+            assert res.inconsistent is True and res.not_judged == no_own_noise(res), res.closed_scores
             assert res.closed_scores[0] > 2 * MAX_CLOSED_SCORE and max(res.closed_scores[1:]) < res.closed_scores[0]
             (warning,) = [w for w in res.warnings if "disagrees" in w]
             assert warning.startswith("run 1 (<synthetic>): disagrees with the other runs (closed-path score")
     for seed in range(3):
         params, runs = closed_fleet(diff, 10 + seed, runs=5, noise=10.0 ** -(4 + seed % 3))
         res = fleet_calibrate(diff, runs, params)
-        assert res.inconsistent is False and res.not_judged is None and not res.warnings
+        assert res.inconsistent is False and res.not_judged == no_own_noise(res) and not res.warnings
         assert all(0 <= q < MAX_CLOSED_SCORE / 2 for q in res.closed_scores), res.closed_scores
 
 
@@ -747,7 +747,7 @@ def test_scores_of_runs_with_two_pose_references_count_their_final_poses_only(di
     5. Checked against refits of the other runs with wmrkit.odometry.calibrate, the score recomputed by hand."""
     runs = _short_fleet(diff, 7, 5)
     res = fleet_calibrate(diff, runs, PARAMS)
-    assert res.inconsistent is False and res.not_judged is None
+    assert res.inconsistent is False and res.not_judged == no_own_noise(res)
     problem = CalibrationProblem(diff, tuple(PARAMS), tuple(runs))
     w = 1 / np.sqrt([max(travel(diff, r), 1.0) for r in runs])
     for k in range(5):

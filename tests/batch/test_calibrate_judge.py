@@ -7,7 +7,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from batch_params import PARAMS, TRUE_P, write_fleet
+from batch_params import PARAMS, TRUE_P, no_own_noise, write_fleet
 
 from wmrkit.batch.calibrate import fleet_calibrate
 from wmrkit.batch.consistency import MAX_CLOSED_SCORE
@@ -57,14 +57,15 @@ def test_a_mixed_fleet_judges_its_comparable_runs_and_names_those_set_aside(diff
     assert res.inconsistent is True and disagreeing(res) == ["r1.csv"], res.not_judged
     assert res.closed_scores[5] is None and np.allclose(res.closed_scores[:5], alone.closed_scores, rtol=1e-4)
     from wmrkit.batch.consistency import SET_ASIDE
-    assert res.not_judged == res.to_dict()["not_judged"] == SET_ASIDE.format(
-        runs="t0.csv", judged="5 runs of one final pose (closed paths, references of 2 poses)")
+    assert res.not_judged == res.to_dict()["not_judged"] == "; ".join([SET_ASIDE.format(
+        runs="t0.csv", judged="5 runs of one final pose (closed paths, references of 2 poses)"),
+        no_own_noise(res, [f"r{k}.csv" for k in range(5)])])
     true = apply_parameters(diff, PARAMS, TRUE_P)
     squares = [CalibrationRun.closed_path(replace(simulate(true, square_path(1.5 + k / 2, clockwise=k == 1, pause=0.5),
                                                            10.0, spin_noise_per_rad=1e-5, seed=k).log,
                                                   source=f"sq{k}.csv")) for k in range(2)]
     res = fleet_calibrate(diff, five + squares, PARAMS)
-    assert res.inconsistent is True and disagreeing(res) == ["r1.csv"] and res.not_judged is None
+    assert res.inconsistent is True and disagreeing(res) == ["r1.csv"] and res.not_judged == no_own_noise(res)
     assert res.closed_scores[1] > MAX_CLOSED_SCORE > max(res.closed_scores[k] for k in (0, 2, 3, 4, 5, 6))
     # the CLI, from files: the same verdict and the set-aside line
     args = write_fleet(tmp_path, five + three)

@@ -67,7 +67,9 @@ def test_batch_calibrate_and_montecarlo(capsys, calibration_data, fleet_dir, tmp
     assert main(["batch", "calibrate", "diff-drive", str(calibration_data / "c*.csv"), "--closed", "--workers", "0",
                  "--param", "left.r,-right.r"]) == 0
     out = capsys.readouterr().out
-    assert "left.r" in out and "not judged" not in out  # eight closed runs are judged (consistency.judge)
+    assert "left.r" in out and "not checked against each other" not in out  # eight closed runs are judged
+    # ... one by one: not as a whole, and that is said (batch.whole.NO_OWN_NOISE)
+    assert "c7.csv: not checked as a whole (closed paths or references of 2 poses" in out
     # fewer than 5 closed runs are not checked against each other: said, not only a null in the JSON
     from wmrkit.batch.consistency import CLOSED
 
@@ -263,9 +265,9 @@ def test_batch_calibrate_names_a_closed_run_of_another_robot(capsys, diff, tmp_p
     assert main(args) == 0
     out, err = capsys.readouterr()
     assert err.count("wmrkit: warning:") == 1 and "sq0.csv: disagrees with the other runs (closed-path score" in err
-    assert "not judged" not in out
+    assert f"  not judged: {tmp_path / 'sq0.csv'}, " in out and ": not checked as a whole (closed paths" in out
     data = _json(capsys, [*args, "--json"])
-    assert data["inconsistent"] is True and data["not_judged"] is None
+    assert data["inconsistent"] is True and data["not_judged"].startswith(f"{tmp_path / 'sq0.csv'}, ")
     assert [r["file"].rsplit("/", 1)[-1] for r in data["per_run"]] == [f"sq{k}.csv" for k in range(6)]
     assert data["per_run"][0]["closed_score"] > 40 > max(r["closed_score"] for r in data["per_run"][1:])
     assert all(r["residual_ratio"] is None for r in data["per_run"])

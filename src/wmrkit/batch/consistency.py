@@ -40,7 +40,7 @@ from .likelihood import MIN_OWN_DOF, few_pose_warning, own_noise
 from .motions import moved_at_rest
 from .refits import REFIT_FAILED as REFIT_FAILED  # re-exported: batch.consistency.REFIT_FAILED
 from .refits import own_dof, own_scores, own_skipped, refits
-from .whole import whole_fleet
+from .whole import NO_OWN_NOISE, whole_fleet
 
 #: Largest residual ratio of a fleet whose runs agree. Simulated fleets with encoder noise (1e-5 per rad, or drawn
 #: per run among 1e-6, 1e-5 and 1e-4), 4 to 16 runs (docs/batch.md's table): largest ratio 12.1 over 260 fleets;
@@ -389,6 +389,8 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
             messages += [said] if said else []  # several runs that disagree (wmrkit.batch.likelihood)
             left += [out] if out else []  # runs left out of that check, or why not made (LEFT_OUT, NOT_PLAIN)
             left += [rest] if (rest := moved_at_rest(problem, fit.x, group, fit.fun, logs)) else []
+        else:  # closed paths, references of 2 poses (or 3 without heading): no own noise to judge by
+            left.append(NO_OWN_NOISE.format(runs=", ".join(logs[k] for k in group)))
     aside = [k for k in range(g) if np.isnan(scores[k])]
     why = [] if not aside else [SET_ASIDE.format(runs=", ".join(logs[k] for k in aside), judged=", ".join(
         f"{len(group)} runs of {_poses(m[group[0]])}" for group in groups))]

@@ -26,6 +26,14 @@ UNCOVERED = (f"{{runs}}: not checked as a whole with the other runs (fewer than 
              "own fit for the fleet homogeneity, and fewer than 3 such runs for the fleet likelihood ratio): each is "
              "still checked against the others on its own")
 
+#: Runs scored as closed paths whose own fits leave fewer than :data:`~wmrkit.batch.likelihood.MIN_OWN_DOF` degrees of
+#: freedom ({runs}: closed paths, references of 2 poses): no whole-fleet check can judge them (each needs a run's own
+#: noise), so three runs or more that disagree hide each other from their scores (one is named by its score, two by
+#: the pair score). Before, nothing said so ('not_judged' null).
+NO_OWN_NOISE = ("{runs}: not checked as a whole (closed paths or references of 2 poses: a run's own fit leaves no "
+                "noise to judge it by): three runs or more that disagree may hide each other from their scores; one "
+                "run or a pair that disagrees is looked for")
+
 
 def whole_fleet(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray, res: np.ndarray, which: Sequence[int],
                 floors: Sequence[float], logs: Sequence[str], named: bool) -> tuple[tuple[str, ...], str | None]:
