@@ -42,3 +42,20 @@ def test_runs_no_whole_fleet_check_covers_are_named(diff):
     res = fleet_calibrate(diff, runs, PARAMS)
     assert all(q is not None for q in res.residual_ratios) and res.inconsistent is False, res.warnings
     assert res.not_judged == res.to_dict()["not_judged"] == UNCOVERED.format(runs="f0.csv, f1.csv")
+
+
+def test_one_or_two_runs_of_many_poses_join_the_likelihood_ratio(diff):
+    """Two runs with references every 5th sample (27 degrees of freedom or more), both of a left radius +5 %, among
+    four four-pose runs of the fleet's robot: too few for the homogeneity, and they were not judged as a whole
+    (ratios under 20, the fleet reported clean, nothing said). Now they join the four in the fleet likelihood
+    ratio, which flags the fleet and leaves out exactly the two planted runs."""
+    from batch_params import TRUE_P
+
+    odd = [TRUE_P[0] + 0.05, *TRUE_P[1:]]
+    for seed in range(2):
+        runs = short_runs(diff, 100 + seed, 2, None, bad=(0, 1), odd=odd) + short_runs(diff, 200 + seed, 4, 4,
+                                                                                          name="f")
+        res = fleet_calibrate(diff, runs, PARAMS)
+        assert max(res.residual_ratios) < 20 and res.not_judged is None
+        assert res.inconsistent is True and len(whole(res)) == 1, (seed, res.warnings)
+        assert "(without r0.csv, r1.csv the others agree)" in whole(res)[0]

@@ -7,7 +7,8 @@ poses) by the fleet likelihood ratio of their whitened motions' errors
 (:func:`~wmrkit.batch.likelihood.few_pose_warning`, designed for few degrees of freedom, its level exact for any
 number of them). Before, those were not judged as a whole and nothing said so: 3 runs of a left radius +5 % among
 6 four-pose runs, 'inconsistent' false, no warning, 'not_judged' null. Fewer than 3 such runs are named as not so
-judged (:data:`UNCOVERED`).
+judged (:data:`UNCOVERED`); 1 or 2 runs of 27 degrees of freedom or more join the others in the likelihood ratio
+(before, they too were left out unsaid).
 """
 
 from __future__ import annotations
@@ -22,9 +23,9 @@ from .likelihood import few_pose_warning
 
 #: Runs judged by their ratios that no whole-fleet check covers ({runs}): fewer than 3 runs of fewer than
 #: :data:`~wmrkit.batch.homogeneity.MIN_DOF` degrees of freedom of their own fit.
-UNCOVERED = (f"{{runs}}: not checked as a whole with the other runs (fewer than {MIN_DOF} degrees of freedom of their "
-             "own fit for the fleet homogeneity, and fewer than 3 such runs for the fleet likelihood ratio): each is "
-             "still checked against the others on its own")
+UNCOVERED = ("{runs}: not checked as a whole with the other runs (each whole-fleet check needs 3 runs or more: the "
+             f"fleet homogeneity runs of {MIN_DOF} degrees of freedom of their own fit or more, the fleet likelihood "
+             "ratio the others): each is still checked against the others on its own")
 
 #: Runs scored as closed paths whose own fits leave fewer than :data:`~wmrkit.batch.likelihood.MIN_OWN_DOF` degrees of
 #: freedom ({runs}: closed paths, references of 2 poses): no whole-fleet check can judge them (each needs a run's own
@@ -41,7 +42,7 @@ def whole_fleet(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray, res
     fleet fit's at parameters `p`; `floors`: least RSS root of each run's own fit [m]; `named`: a ratio named one
     run) and what they leave out or do not make (joined), or ``None`` (module docstring)."""
     warning, unmade, covered = fleet_warning(problem, jac, res, which, floors, logs, named)
-    rest = [k for k in which if k not in covered]
+    rest = [k for k in which if len(covered) < 3 or k not in covered]  # 1 or 2 such runs: with the others
     said, aside = (None, UNCOVERED.format(runs=", ".join(logs[k] for k in rest)) if rest else None)
     if len(rest) >= 3:
         said, aside = few_pose_warning(problem, p, jac, res, rest, floors, logs, int(named))
