@@ -59,9 +59,9 @@ FEW_DOF = ("its whitened motions' errors have {free} degrees of freedom beyond i
 ITERATIONS = 200
 #: Why runs are left out of this check (said in ``not_judged``; {runs}: the runs; {why}: each run's why; {rest}: what
 #: is checked): their motions' errors cannot be whitened. Before, they were left out unsaid.
-LEFT_OUT = ("{runs}: left out of the whole-fleet check (the fleet likelihood ratio of the runs of as many reference "
-            "poses, which finds several runs that disagree), the motions' errors cannot be whitened by the encoders' "
-            "noise model ({why}); {rest}, and each run is still scored against the others on its own")
+LEFT_OUT = ("{runs}: left out of the whole-fleet check (the fleet likelihood ratio of the runs' motions' errors "
+            "whitened by the encoders' noise model, which finds several runs that disagree): {why}; {rest}, and each "
+            "run is still scored against the others on its own")
 
 
 def likelihood_ratio(a: np.ndarray, b: np.ndarray, c: np.ndarray, own: np.ndarray, m: np.ndarray) -> np.ndarray:
@@ -165,8 +165,7 @@ def few_pose_warning(problem: CalibrationProblem, p: np.ndarray, jac: np.ndarray
     heading: :data:`~wmrkit.batch.homogeneity.NOT_PLAIN`), or ``None``."""
     why = plain_only(problem)
     if why is not None:
-        return None, NOT_PLAIN.format(check="the fleet likelihood ratio of the runs of as many reference poses",
-                                      why=why)
+        return None, NOT_PLAIN.format(check="the fleet likelihood ratio of the runs' whitened motions' errors", why=why)
     (a, b, c, own, m, rank), kept, left = whitened_parts(problem, p, jac, res, group, floors)
     aside = left_out(group, kept, left, logs)
     if len(kept) < 3:
