@@ -333,6 +333,23 @@ def test_errors_about_an_image_or_a_points_file_name_it(tmp_path, capsys):
     assert code == 2 and err.startswith(f"wmrkit: error: {tmp_path / 'p.json'}: lines[0]: a point ")
 
 
+@pytest.mark.parametrize(("stripes", "rows", "message"), [
+    ((), "60", "the image does not show two stripes"),
+    ((), "200", "rows A must be in (0, 120) px, got 200"),
+    ((-0.035, 0.0, 0.035), "60", "the image shows more than two stripes"),
+])
+def test_calibrate_names_the_image_whose_content_it_refuses(stripes, rows, message, tmp_path, capsys):
+    """'calibration: the image does not show two stripes' named no file (file null under --json), where `locate`
+    names the IMAGE of every error about its content."""
+    image = tmp_path / "stripes.png"
+    cv2.imwrite(str(image), render(THESIS_CAMERA, [0, 0, 0], Scene(ns=(), extra=stripes, width=0.008)))
+    argv = ["vision", "calibrate", str(image), "--rows", rows, "--half-separation", "3.5cm", "--row-distance", "10cm"]
+    code, out, err = run(argv, capsys)
+    assert code == 2 and out == "" and err.startswith(f"wmrkit: error: {image}: {message}") and err.count("\n") == 1
+    code, _, err = run([*argv, "--json"], capsys)
+    assert code == 2 and json.loads(err)["file"] == str(image) and json.loads(err)["error"].startswith(message)
+
+
 def test_calibrate_an_image_of_one_row_gives_one_line(tmp_path, capsys):
     """OpenCV's resize raised on it: a traceback."""
     row = np.full((1, 1000), 70, np.uint8)

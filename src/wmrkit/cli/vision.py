@@ -122,12 +122,14 @@ def read_image(path: str) -> np.ndarray:
 
 
 @contextmanager
-def _naming(path: str, prefix: str) -> Iterator[None]:
-    """Errors about the file's content (messages starting with `prefix`, e.g. "image: found 0 line(s)") name it."""
+def _naming(path: str, *prefixes: str) -> Iterator[None]:
+    """Errors about the file's content (messages starting with one of `prefixes`, e.g. "image: found 0 line(s)")
+    name it."""
     try:
         yield
     except WmrkitError as err:
-        if not str(err).startswith(prefix):
+        prefix = next((p for p in prefixes if str(err).startswith(p)), None)
+        if prefix is None:
             raise
         raise WmrkitError(f"{path}: {str(err).removeprefix(prefix)}") from None
 
@@ -198,7 +200,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
         if args.size is not None:  # it would be ignored
             raise WmrkitError("calibrate: --size applies to --x1/--x2 (the camera file of an image has its size)")
         image = read_image(args.image)
-        with _naming(args.image, "image: "):
+        with _naming(args.image, "image: ", "calibration: "):  # what the image shows, or the camera it gives
             cal = calibrate_image(image, args.rows, xw, yw)
         rows, width = image.shape
     if args.out:
