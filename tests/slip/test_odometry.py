@@ -212,6 +212,20 @@ def test_a_filter_lagging_its_measurements_is_not_called_a_contradiction(tmp_pat
     assert "contradict" not in err and "the sensed joints themselves agree" in err
 
 
+def test_a_filter_whose_rows_barely_fix_the_twist_of_a_robot_that_does_not_steer_names_no_heading(tmp_path, capsys):
+    """A differential drive whose lateral rows are 1e3 times noisier than its rolling rows: the weighted rows fix vy
+    1e3 times more weakly than vx (their condition number, worked by hand: 1e3). The warning said "at a steering
+    heading of the log () ...", naming an empty list of steered wheels."""
+    t = np.arange(0, 2.0001, 0.02)
+    path = tmp_path / "dd.csv"
+    path.write_text("time,left.spin,right.spin\n" + "".join(f"{a:.2f},{8 * a:.6f},{12 * a:.6f}\n" for a in t))
+    assert main(["odometry", "diff-drive", str(path), "--method", "fk2", "--kf-noise", "1", "1e3", "1", "--json"]) == 0
+    err = capsys.readouterr().err
+    assert err.splitlines() == ["wmrkit: warning: fk2: its measurement rows barely fix the twist (condition number "
+                                "1e+03 > 100): there the filter carries its prediction and the trajectory can be far "
+                                "off"]
+
+
 def test_fk1_warns_where_its_rows_do_not_fix_the_twist(tmp_path, capsys):
     """The forklift turning on the spot with its steered wheel at heading 90 deg: FK1's kept rows (the steered
     wheel's and the drive wheels' rolling rows, (7.69)) lose the sideways speed there, so FK1 ended at (0, 0),

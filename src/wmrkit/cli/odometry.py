@@ -205,7 +205,8 @@ def _warn_ill_conditioned(name: str, model) -> None:
     where = ", ".join(f"{n} {math.degrees(heading[om.robot.steer_names.index(n)]):.4g} deg" for n in beta)
     fix = ("do not fix the twist" if math.isinf(worst[0]) else
            f"barely fix the twist (condition number {worst[0]:.3g} > {ILL_CONDITIONED:g})")
-    warn(f"{name}: at a steering heading of the log ({where}) its measurement rows {fix}: there the filter carries "
+    at = f"at a steering heading of the log ({where}) " if beta else ""  # a robot that does not steer: everywhere
+    warn(f"{name}: {at}its measurement rows {fix}: there the filter carries "
          f"its prediction and the trajectory can be far off{'; use --method fk2 or wls' if name == 'fk1' else ''}")
 
 
