@@ -255,6 +255,17 @@ def test_the_constructor_is_of_with_the_defaults_and_the_checks():
         Tyre("michelin")
 
 
+@pytest.mark.parametrize("value", [-1.0, -1e-300, 0.0, -0.0])
+@pytest.mark.parametrize(("model", "name"), [("coulomb", "mu_lat"), ("coulomb", "mu_long"), ("dugoff", "mu"),
+                                             ("dugoff", "eps"), ("pacejka", "mu_scale")])
+def test_a_parameter_that_must_be_positive_says_so_of_a_negative_value(model, name, value):
+    """'mu_lat=-1' was refused as 'must be >= 0', which 0 is, and 0 is refused too ('must be > 0'): the bound given
+    is the one the parameter has, whatever the value's sign. Each of these parameters refuses 0 and accepts 1e-3."""
+    Tyre.of(model, {name: 1e-3})
+    with pytest.raises(WmrkitError, match=rf"^tyre parameter {name}: must be > 0, got "):
+        Tyre.of(model, {name: value})
+
+
 def test_arguments_that_do_not_broadcast_are_named():
     """numpy's 'shape mismatch: objects cannot be broadcast to a single shape' named no argument."""
     from wmrkit.errors import ShapeError

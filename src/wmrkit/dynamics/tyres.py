@@ -268,7 +268,7 @@ def beyond_fit(model: str, speed: float) -> str | None:
 def param_problem(name: str, value: float) -> str:
     """Why `value` cannot be tyre parameter `name` (a phrase for a one-line error), or ``""``."""
     if value < 0 or (name in POSITIVE_PARAMS and value == 0):
-        return f"must be {'>= 0' if value < 0 else '> 0'}, got {value:g}"
+        return f"must be {'> 0' if name in POSITIVE_PARAMS else '>= 0'}, got {value:g}"
     if name == "shifts" and value not in (0.0, 1.0):
         return f"must be 0 or 1, got {value:g}"
     if name == "eps" and value > 1.0:  # a regularisation speed: above 1 m/s it smooths away the friction of motion
