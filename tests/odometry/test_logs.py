@@ -227,6 +227,36 @@ def test_yaw_of_any_nonzero_quaternion_is_scipys():
         np.testing.assert_allclose(yaw_of_quaternion(q * scale), expected, atol=1e-12)
 
 
+def test_a_tum_file_reads_quaternions_of_any_finite_norm_without_a_python_warning(tmp_path):
+    """Quaternions beyond 1e154 (their squared norm overflows) printed numpy's 'RuntimeWarning: overflow encountered
+    in multiply' and its source line on stderr before `calibrate`'s answer. Their yaw is that of the normalised
+    quaternion, and the zero test still refuses a quaternion of norm below 1e-6 (and only those)."""
+    import warnings
+
+    from scipy.spatial.transform import Rotation
+
+    q = np.random.default_rng(5).normal(size=(6, 4))
+    expected = Rotation.from_quat(q).as_euler("ZYX")[:, 0]
+    tum = tmp_path / "t.tum"
+    for scale in (1e-6, 1e200, 1e307):
+        rows = q * (scale / np.abs(q).max(axis=1, keepdims=True))  # each row's largest component: 'scale'
+        tum.write_text("".join(f"{k} {k} 0 0 {' '.join(repr(float(v)) for v in row)}\n" for k, row in enumerate(rows)))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            _, pose = read_tum(tum)
+        np.testing.assert_allclose(np.angle(np.exp(1j * (pose[:, 2] - expected))), 0, atol=1e-12)
+    for row, zero in (("0 0 0 1e-300", True), ("4.9e-7 4.9e-7 4.9e-7 4.9e-7", True), ("5.1e-7 5e-7 5e-7 5e-7", False),
+                      ("1e308 1e308 1e308 1e308", False)):  # norms 1e-300, 9.8e-7, 1.0005e-6, 2e308
+        tum.write_text(f"0 0 0 0 {row}\n1 1 0 0 0 0 0 1\n")
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            if zero:
+                with pytest.raises(LogError, match=r"pose 1: the quaternion is \(almost\) zero"):
+                    read_tum(tum)
+            else:
+                read_tum(tum)
+
+
 def test_trajectory_files_with_non_finite_values_are_refused_at_their_line_and_column(tmp_path):
     tum = tmp_path / "t.tum"
     tum.write_text("# t x y z qx qy qz qw\n0 0 0 0 0 0 0 1\n1 1 0 0 0 0 inf 1\n")

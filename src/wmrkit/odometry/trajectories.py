@@ -121,9 +121,10 @@ def read_tum(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
         raise LogError(f"{os.fspath(path)}: a TUM file has 8 columns, got {data.shape[1]}")
     _check_samples(path, data[:, 0], data[:, 1:4])
     _check_finite(path, data[:, 4:8], "the quaternion")
-    norm = np.linalg.norm(data[:, 4:8], axis=1)
-    if np.any(norm < 1e-6):
-        raise LogError(f"{os.fspath(path)}: pose {int(np.argmax(norm < 1e-6)) + 1}: the quaternion is (almost) zero")
+    scale = np.max(np.abs(data[:, 4:8]), axis=1)  # the norm as scale * |q / scale|: |q|^2 overflows beyond 1e154
+    zero = scale < 1e-6 / np.linalg.norm(data[:, 4:8] / np.where(scale > 0, scale, 1.0)[:, None], axis=1).clip(1.0)
+    if np.any(zero):
+        raise LogError(f"{os.fspath(path)}: pose {int(np.argmax(zero)) + 1}: the quaternion is (almost) zero")
     return data[:, 0], np.column_stack([data[:, 1], data[:, 2], np.unwrap(yaw_of_quaternion(data[:, 4:8]))])
 
 
