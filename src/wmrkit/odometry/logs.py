@@ -36,6 +36,7 @@ from ..limits import check_chunk_size, regular_file_problem
 from ._text import check_lines, did_you_mean, encoded, parse_rows, read_lines, short
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
 from .header import SPIN_MODES, bare_heading_problem, header_names, travel_radii
+from .log_writer import write_csv, write_log  # noqa: F401  (re-exported: their home before)
 from .steering import CONVENTIONS, check_robot, check_steer_range, convert_steering
 
 if TYPE_CHECKING:
@@ -46,6 +47,9 @@ TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 
 #: Default largest plausible spin rate of a wheel [rad/s] (about 95,000 rpm): faster is an encoder glitch.
 MAX_RATE = 1e4
+#: Largest cumulative spin angle of a log [rad], 2**42 (7e11 turns: 1400 years at 100 rad/s): beyond it float64
+#: rounds an angle by 1 mrad or more, and angles of 1e17 rad (16 rad apart) turned a calibration into noise.
+MAX_SPIN_ANGLE = 2.0**42
 
 #: Longest header line read [characters]: a longer first line is not a CSV log (e.g. a binary file).
 MAX_HEADER = 1 << 16
@@ -322,11 +326,11 @@ def check_jumps(log: JointLog, positions: np.ndarray, previous: np.ndarray | Non
             raise LogError(f"{log.where(i)}: time {float(log.time[i])!r} s: the time step overflows (values too "
                            "large to subtract)")
         if max_rate is None or not spin or len(full) < 2:
-            return
+            return _check_spin_angles(log, positions, spin)
         step = np.abs(np.diff(full[:, spin], axis=0))
         bad = ~(step <= max_rate * dt[:, None])
         if not bad.any():
-            return
+            return _check_spin_angles(log, positions, spin)
         k, c = (int(x) for x in np.argwhere(bad)[0])
         rate = float(step[k, c] / dt[k])
     name, turn = log.joints[spin[c]], float(step[k, c])
@@ -338,6 +342,17 @@ def check_jumps(log: JointLog, positions: np.ndarray, previous: np.ndarray | Non
         what = f"turns {turn:.6g} rad in {float(dt[k]):.6g} s{speed}{max_rate:g} rad/s)"
     raise LogError(f"{log.where(k + shift)}: {name}: {what}: an implausible jump (encoder glitch, wrong counter width "
                    "or counts per revolution?)")
+
+
+def _check_spin_angles(log: JointLog, positions: np.ndarray, spin: list[int]) -> None:
+    """Refuse a spin angle beyond :data:`MAX_SPIN_ANGLE` [rad] (`positions` ``(N, n)``, the rows of `log`): its
+    increments would be round-off (a counter that was never reset, a value in the wrong unit)."""
+    far = np.abs(positions[:, spin]) > MAX_SPIN_ANGLE
+    if far.any():
+        k, c = (int(x) for x in np.argwhere(far)[0])
+        raise LogError(f"{log.where(k)}: {log.joints[spin[c]]}: a cumulative angle of {positions[k, spin[c]]:.6g} rad, "
+                       f"beyond {MAX_SPIN_ANGLE:.3g} rad (7e11 turns), where floats are 1 mrad or more apart and its "
+                       "steps would be round-off: log the angle since the start of the run")
 
 
 def read_csv(path: str | os.PathLike[str], joints: Sequence[str], fmt: LogFormat = LogFormat(), *,
@@ -404,25 +419,6 @@ def concatenate(chunks: Sequence[JointLog]) -> JointLog:
     return JointLog(np.concatenate([c.time for c in chunks]), first.joints,
                     np.concatenate([c.positions for c in chunks]), heading, first.source, first.first_line,
                     first.first_index)
-
-
-def write_csv(path: str | os.PathLike[str], names: Sequence[str], values: np.ndarray, *,
-              fmt: str = "%.17g") -> None:
-    """Write a CSV file with header `names` and rows `values` ``(N, len(names))`` (e.g. a synthetic log)."""
-    values = np.asarray(values)
-    with open(path, "w", encoding="utf-8", newline="") as f:
-        f.write(",".join(names) + "\n")
-        row = ",".join([fmt] * len(names)) + "\n"
-        for start in range(0, len(values), 1 << 16):
-            block = values[start:start + (1 << 16)]
-            f.write((row * len(block)) % tuple(block.ravel().tolist()))  # one formatting call per block
-
-
-def write_log(path: str | os.PathLike[str], log: JointLog, robot: Robot | None = None, *,
-              fmt: str = "%.17g") -> None:
-    """Write `log` as a CSV log in the default format (``time``, then its joints; steering as headings, converted
-    with `robot`'s wheels, so that :func:`load_csv` with the same robot reads it back)."""
-    write_csv(path, ("time", *log.joints), np.column_stack([log.time, log.heading_positions(robot)]), fmt=fmt)
 
 
 def _columns(header: list[str], joints: Sequence[str], fmt: LogFormat, wheels: Sequence[str],
