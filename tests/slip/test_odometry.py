@@ -278,3 +278,26 @@ def test_weight_with_a_slip_aware_method_names_that_methods_option(method, inste
     assert main(["odometry", "diff-drive", str(log), "--method", method, "--weight", "left=2"]) == 2
     assert capsys.readouterr().err == (f"wmrkit: error: --weight applies to the kinematic methods; with --method "
                                        f"{method} use {instead} WHEEL=LAT,LONG\n")
+
+
+@pytest.mark.parametrize("gap", [1e9, 1e308])
+def test_a_filter_whose_pose_leaves_the_range_handled_is_refused_at_that_row(gap, tmp_path, capsys):
+    """A pause of about `gap` seconds after 11 samples of a turning differential drive: the filters carry the twist from
+    before it across the whole pause (docs/slip.md, gaps), and fk2 printed a heading of 5.7e8 rad (1e9 s; exit 0
+    with a warning), or 'a numerical overflow in wmrkit; please report it' after numpy's RuntimeWarning (1e308 s).
+    The filters now hold the bounds the no-slip odometry holds (a pose beyond 1e9 m or 1e6 turns: refused at its
+    row); the exact method integrates the wheel travel, whose heading is r (right - left) / track (0.075 m, 0.4 m)."""
+    rows = [f"{0.02 * k if k <= 10 else gap!r},{0.16 * k!r},{0.24 * k!r}" for k in range(12)]  # the last after it
+    log = tmp_path / "gap.csv"
+    log.write_text("time,left.spin,right.spin\n" + "\n".join(rows) + "\n")
+    for method in ("fk2", "wls", "exact"):
+        code = main(["odometry", "diff-drive", str(log), "--method", method, "--quiet", "--json"])
+        out, err = capsys.readouterr()
+        if method == "fk2":
+            assert code == 2 and out == "" and err.count("\n") == 1
+            data = json.loads(err)
+            assert data["line"] == 13 and data["file"] == str(log)  # the first sample after the gap
+            assert data["error"].startswith("the pose [") and "is beyond 1e+09 m or 1e+06 turns here" in data["error"]
+        else:
+            assert code == 0 and err == ""
+            assert json.loads(out)["final_pose"][2] == pytest.approx(0.075 * (0.24 - 0.16) * 11 / 0.4, rel=1e-12)

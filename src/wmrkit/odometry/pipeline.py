@@ -354,6 +354,15 @@ def _check_inputs(noise: Noise | None, initial_covariance: ArrayLike | None) -> 
         check_covariance(initial_covariance, "initial_covariance")
 
 
+def check_poses(chunk: JointLog, poses: np.ndarray) -> None:
+    """Refuse poses ``(N, 3)`` of the rows of `chunk` that are not finite or lie beyond :data:`MAX_COORDINATE` or
+    :data:`MAX_ANGLE`, naming the first such row (the bounds of :func:`run_odometry`, for other integrators: the
+    Kalman filters')."""
+    if not np.isfinite(poses).all():
+        _overflow(chunk, poses)
+    _beyond(chunk, poses)
+
+
 def _overflow(chunk: JointLog, values: np.ndarray, what: str = "pose") -> None:
     """Name the first row whose `values` ``(N, ...)`` are not finite: the log's numbers overflow the integration."""
     bad = ~np.isfinite(values.reshape(len(values), -1)).all(axis=1)

@@ -20,7 +20,7 @@ from ..errors import WmrkitError
 from ..odometry.integrators import Method, check_method, integrate_increments
 from ..odometry.logs import JointLog, LogError
 from ..odometry.model import OdometryModel
-from ..odometry.pipeline import OdometrySummary, start_pose
+from ..odometry.pipeline import OdometrySummary, check_poses, start_pose
 from ..odometry.trajectories import Trajectory
 from ..robot import Robot
 from .kalman import FILTERS, KalmanModel, KalmanNoise, _filter, check_log, kalman_model
@@ -71,7 +71,9 @@ class KalmanEstimator:
             if len(chunk) >= 2:
                 run = _filter(self.model, chunk, x, p)
                 x, p = run.twist[-1], run.covariance
-                poses = integrate_increments(pose, run.increments, method)
+                with np.errstate(over="ignore", invalid="ignore"):  # an overflow is named by check_poses
+                    poses = integrate_increments(pose, run.increments, method)
+                check_poses(chunk.slice(1, len(chunk)), poses)  # a gap of 1e9 s turned the twist 5.7e8 rad
                 for sink in sinks:
                     sink(Trajectory(chunk.time[1:], poses, run.slip))
                 n = len(run.slip)
