@@ -26,6 +26,7 @@ import types
 from pathlib import Path
 
 from .._jit import compile_cached, drop_stale_cache
+from ..kinematics import linkage_law
 from ..wheels import __file__ as wheels_file
 from ..wheels import slip_row_entries
 from . import linkages, tyres
@@ -88,7 +89,7 @@ def _compiled_namespace():
 
 
 drop_stale_cache([__file__, str(Path(__file__).with_name("_integrate.py")), tyres.__file__],
-                 [wheels_file, linkages.__file__])
+                 [wheels_file, linkages.__file__, linkage_law.__file__])
 _NS = _compiled_namespace()
 _linear, _coulomb, _dugoff, _pacejka = (_NS[n] for n in ("linear_forces", "coulomb_forces", "dugoff_forces",
                                                           "pacejka_forces"))

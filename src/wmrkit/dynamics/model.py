@@ -31,8 +31,9 @@ from numpy.typing import ArrayLike
 from .._shapes import as_angles, readonly
 from ..couplings import gear_free
 from ..errors import DescriptionError, ShapeError, WmrkitError
+from ..kinematics.linkage_law import linkage_table
 from ..robot import Robot, element_table
-from .linkages import LinkageWarning, coupling_basis, linkage_breach, linkage_table, reduced, unheld
+from .linkages import LinkageWarning, coupling_basis, linkage_breach, reduced, unheld
 from .mass import CASTOR_TYPES, Body, body_problem
 from .tyres import Tyre
 
