@@ -11,9 +11,10 @@ and a gear none of whose joints is read still turns as one (:func:`gear_free`).
   differential: the mean of the two wheel rates with ratios 1/2, 1/2); the other combinations stay free.
 - ``gear``: the joints turn together, rigidly, ``q_j = ratio_j * u`` (a chain, a gear train, a synchro drive).
 - ``linkage``: steering joints moved by one mechanism (an Ackermann linkage); the angles are a configuration, so
-  the coupling says that actuating one of them sets them all. Sensing stays per angle (the kinematics do not
-  model the linkage's geometry: its ratios are not used), as it does per joint under the other kinds; the dynamics
-  hold its ideal ``law`` (:data:`LINKAGE_LAWS`, :func:`linkage_law`, :mod:`wmrkit.dynamics.linkages`).
+  the coupling says that actuating one of them sets them all. Sensing stays per angle (its ratios are not used), as
+  it does per joint under the other kinds; the dynamics hold its ideal ``law`` (:data:`LINKAGE_LAWS`,
+  :func:`linkage_law`, :mod:`wmrkit.kinematics.linkage_law`), and ``ik`` and ``fk`` check angles against it
+  (:mod:`wmrkit.kinematics.linkage_check`).
 """
 
 from __future__ import annotations

@@ -78,11 +78,13 @@ def name_list(names: Sequence[str], limit: int = MAX_LISTED) -> str:
     return shown if len(names) <= limit else f"{shown} and {len(names) - limit} more"
 
 
-def said_warnings(read: Callable[[], T], category: type[Warning]) -> tuple[T, list[str]]:
-    """``read()`` and the lines of the `category` warnings it raised (said by the caller: the CLI's ``wmrkit:
-    warning:`` lines, the studio's answers), said nowhere else; other warnings are passed on as they were."""
+def said_warnings(read: Callable[[], T], category: type[Warning] | tuple[type[Warning], ...]) -> tuple[T, list[str]]:
+    """``read()`` and the lines of the `category` warnings (a class or a tuple of them) it raised (said by the
+    caller: the CLI's ``wmrkit: warning:`` lines, the studio's answers), in order, said nowhere else; other warnings
+    are passed on as they were. Not nested (one reader at a time): give every category at once."""
     with _CATCHING, warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", category)
+        for c in category if isinstance(category, tuple) else (category,):
+            warnings.simplefilter("always", c)
         out = read()
     said = []
     for w in caught:

@@ -23,7 +23,8 @@ def test_ik_json_has_the_documented_shape(capsys):
     code, out, err = run(capsys, "ik", "swerve-4", "--twist", "1", "0.5", "0.2", "--json")
     assert code == 0 and err == ""
     data = json.loads(out)
-    assert set(data) == {"robot", "wheels", "slip", "out_of_range", "out_of_gear", "feasible", "warnings"}
+    assert set(data) == {"robot", "wheels", "slip", "out_of_range", "out_of_gear", "out_of_linkage", "feasible",
+                         "warnings"}
     assert data["robot"] == "swerve-4"
     assert data["feasible"] is True and data["warnings"] == []
     assert data["out_of_range"] == []
@@ -146,7 +147,9 @@ def test_fk_contradicting_rates_warn_and_say_so_in_json(capsys):
     code, out, err = run(capsys, *argv, "--json")
     data = json.loads(out)
     assert code == 0 and data["consistent"] is False and set(data["slipping"]) >= {"front_left", "front_right"}
-    assert err.startswith("wmrkit: warning: the rates contradict each other") and err.count("\n") == 1
+    lines = err.splitlines()  # the headings also break the linkage (at 99.66 deg it sets front_right at 68.0 deg)
+    assert len(lines) == 2 and lines[0].startswith("wmrkit: warning: the headings break a steering linkage")
+    assert lines[1].startswith("wmrkit: warning: the rates contradict each other")
     code, out, err = run(capsys, *argv)
     assert "INCONSISTENT" in out and "front_left" in err
 

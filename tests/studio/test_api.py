@@ -320,6 +320,20 @@ def test_drive_says_why_a_twist_is_infeasible(client):
     assert side["feasible"] is False and side["slips"] is True and side["out_of_range"] == []
 
 
+def test_drive_names_a_linkage_that_cannot_set_the_headings(client):
+    """A synchro drive (one linkage of its three steerable wheels) asked to turn: no wheel slips (each its own angle),
+    the linkage is the reason; before, ``out_of_linkage`` was missing and the twist feasible."""
+    wheels = [{"name": n, "type": "steerable", "position": list(p), "heading": 0, "r": 0.05}
+              for n, p in zip("abc", [(0.2, 0.0), (-0.1, 0.173), (-0.1, -0.173)], strict=True)]
+    description = {"name": "synchro", "wheels": wheels,
+                   "couplings": [{"kind": "linkage", "joints": ["a.steer", "b.steer", "c.steer"]}]}
+    turn = client.post("/api/drive", json={"description": description, "twist": [1, 0, 0.5]}).json()
+    assert turn["feasible"] is False and turn["slips"] is False
+    assert turn["out_of_linkage"] == ["linkage(a.steer, b.steer, c.steer)"]
+    straight = client.post("/api/drive", json={"description": description, "twist": [1, 0.3, 0]}).json()
+    assert straight["feasible"] is True and straight["out_of_linkage"] == []
+
+
 def test_drive_icr_and_trajectory(client):
     twist = [0.5, 0.1, 0.25]
     data = client.post("/api/drive", json={"description": desc("omni-3"), "twist": twist,

@@ -269,9 +269,14 @@ def add_steer_option(parser: argparse.ArgumentParser, text: str = "heading of a 
 
 def steered_robot(spec: str, steer: list[str] | None) -> Robot:
     """The robot named by a ROBOT argument, at the headings of its ``--steer`` options (0 = straight ahead)."""
+    return with_steer(load_robot(spec), steer)
+
+
+def with_steer(robot: Robot, steer: list[str] | None) -> Robot:
+    """`robot` at the headings of the ``--steer`` options `steer` (its described ones kept apart: the rest angles
+    a linkage's law is measured from, :mod:`wmrkit.kinematics.linkage_law`)."""
     from ..wheels import WheelError
 
-    robot = load_robot(spec)
     for name, value in parse_assignments(steer, "--steer").items():
         heading = parse_angle(value, f"--steer {name}")
         try:

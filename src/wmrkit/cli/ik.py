@@ -10,7 +10,9 @@ import numpy as np
 from ..couplings import GearWarning
 from ..description import described_type
 from ..errors import WmrkitError, said_warnings
+from ..kinematics.linkage_check import LinkageAngleWarning, ik_breaches
 from ..kinematics.wheel_ik import (
+    SLIP_TOL,
     WheelCommands,
     forward_kinematics_check,
     twist_is_determined,
@@ -23,12 +25,13 @@ from ._common import (
     add_json_flag,
     add_robot_argument,
     add_steer_option,
+    load_robot,
     parse_assignments,
     parse_value,
     print_json,
-    steered_robot,
     warn,
     wheel_column_width,
+    with_steer,
 )
 
 
@@ -57,21 +60,22 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 def run_ik(args: argparse.Namespace) -> int:
     """Print the per-wheel commands; warn when the twist makes a fixed wheel slip or a wheel steer out of range, and
     exit 1 then (the answer is no: the commands printed do not give the twist)."""
-    robot = steered_robot(args.robot, args.steer)
-    commands = wheel_commands(robot, args.twist)
+    robot = load_robot(args.robot)  # as described: its linkages' rest angles (with_steer)
+    commands = wheel_commands(robot, args.twist, with_steer(robot, args.steer).beta)
     _check_finite("ik", commands.rates, commands.slip)
-    for why in _infeasible(robot, commands):
+    for why in _infeasible(robot, commands, args.twist):
         warn(f"twist not feasible for robot '{robot.name}': {why}")
     if args.json:
         print_json({"robot": robot.name, **commands.to_dict()})
     else:
-        print(format_commands(robot, commands))
+        print(format_commands(robot, commands, args.twist))
     return 0 if commands.feasible else 1  # an answer that is no (docs/limits.md, Exit codes)
 
 
 def run_fk(args: argparse.Namespace) -> int:
     """Print the twist and the slip residual; warn when the rates do not fix the twist or contradict each other."""
-    robot = steered_robot(args.robot, args.steer)
+    robot = load_robot(args.robot)  # as described: its linkages' rest angles (with_steer)
+    beta = with_steer(robot, args.steer).beta
     given = parse_assignments(args.spin, "--spin")
     if not given:  # the library's "rates: ... got none" would name no option
         spins = [w.name for w in robot.wheels if "spin" in w.kind.rates]
@@ -82,12 +86,12 @@ def run_fk(args: argparse.Namespace) -> int:
         if abs(value) > MAX_QUERY_RATE:
             raise WmrkitError(f"--spin {name}: {value:g} is beyond {MAX_QUERY_RATE:g} rad/s (m/s), no wheel turns so "
                               "fast")
-    fk, gear_lines = said_warnings(lambda: forward_kinematics_check(robot, rates), GearWarning)
+    fk, lines = said_warnings(lambda: forward_kinematics_check(robot, rates, beta), (GearWarning, LinkageAngleWarning))
     _check_finite("fk", fk.twist, fk.residual)
-    twist, determined = fk.twist, bool(twist_is_determined(robot, list(rates)))
+    twist, determined = fk.twist, bool(twist_is_determined(robot, list(rates), beta))
     if not determined:
         warn(f"these rates do not determine the twist of robot '{robot.name}'; printing the minimum-norm one")
-    for line in gear_lines:  # given joints of a gear out of its ratios (fk.out_of_gear)
+    for line in lines:  # given joints of a gear out of its ratios (fk.out_of_gear), headings off a linkage
         warn(line)
     if fk.residual > fk.tolerance:  # the wheels slip (fk.consistent is also False for a gear broken)
         names = fk.slipping or [robot.wheel_names[i] for i in np.argsort(-fk.wheel_slip) if fk.wheel_slip[i] > 0]
@@ -123,7 +127,7 @@ def _check_finite(what: str, *arrays) -> None:
         raise WmrkitError(f"{what}: the result overflows for this robot; give smaller rates")
 
 
-def format_commands(robot: Robot, commands: WheelCommands) -> str:
+def format_commands(robot: Robot, commands: WheelCommands, twist) -> str:
     """Human-readable table of one twist's wheel commands: heading in degrees (0 = rolling straight ahead)."""
     data, width = commands.to_dict(), wheel_column_width(robot)
     lines = [f"{'wheel':<{width}}{'type':<14}{'heading [deg]':>14}{'spin [rad/s]':>14}{'steer rate [rad/s]':>20}"
@@ -134,15 +138,15 @@ def format_commands(robot: Robot, commands: WheelCommands) -> str:
         heading = math.degrees(entry.get("heading", math.nan))
         lines.append(f"{w.name:<{width}}{described_type(w):<14}{_num(heading):>14}{_num(entry['spin']):>14}"
                      f"{_num(entry['steer_rate']):>20}{_num(data['slip'][w.name]):>12}  {other}".rstrip())
-    reasons = dict.fromkeys(why.split(":")[0] for why in _infeasible(robot, commands))  # each reason once
+    reasons = dict.fromkeys(why.split(":")[0] for why in _infeasible(robot, commands, twist))  # each reason once
     lines.append("feasible: " + ("yes" if data["feasible"] else f"NO ({'; '.join(reasons)})"))
     return "\n".join(lines)
 
 
-def _infeasible(robot, commands: WheelCommands) -> list[str]:
-    """Why one twist's commands are not feasible: a fixed wheel that slips sideways, a gear coupling whose joints
-    would turn out of its ratios, steered wheels whose heading is outside their steer_range (each
-    ``"reason: detail"``)."""
+def _infeasible(robot, commands: WheelCommands, twist) -> list[str]:
+    """Why the commands for one `twist` are not feasible: a fixed wheel that slips sideways, a gear coupling whose
+    joints would turn out of its ratios, a linkage whose law the headings break, steered wheels whose heading is
+    outside their steer_range (each ``"reason: detail"``)."""
     out = []
     if np.any(np.abs(commands.slip) > 1e-9):
         worst = int(np.argmax(np.abs(commands.slip)))
@@ -153,6 +157,10 @@ def _infeasible(robot, commands: WheelCommands) -> list[str]:
             asked = ", ".join(f"{j} {_num(commands.rates[robot.rate_names.index(j)])}" for j in c.joints)
             out.append(f"a gear coupling cannot turn its joints so: {c.channel_name} turns them in the ratios "
                        f"{', '.join(f'{k:g}' for k in c.ratios)}, the twist needs {asked} rad/s")
+    if not commands.in_linkage.all():
+        for b in ik_breaches(robot, np.asarray(twist, dtype=float), commands.beta, SLIP_TOL):
+            out.append(f"a steering linkage cannot set these headings: {b.describe(robot)}, which the twist needs "
+                       f"(set by the linkage, the wheel would slip sideways at {b.slip:.3g} m/s)")
     for i in np.flatnonzero(~commands.in_range):
         lo, hi = (math.degrees(a) for a in robot.wheels[i].steer_range)
         out.append(f"a wheel cannot steer there: wheel '{robot.wheel_names[i]}' would steer to heading "

@@ -27,6 +27,7 @@ from . import _ik_fast
 from ._ik_fast import wrap_angle
 from .gear_check import GEAR_RTOL, contact_lever, gear_table, gears_hold, given_gear_breaches
 from .linalg import geared_solve, geared_twist_determined, robot_size
+from .linkage_check import LinkageAngleWarning, given_breaches, linkage_holds
 
 __all__ = ["GEAR_RTOL", "WheelCommands", "forward_kinematics", "gear_error", "resolve_rate_name", "twist_is_determined",
            "wheel_commands", "wrap_angle"]
@@ -53,8 +54,9 @@ class WheelCommands:
     - ``rates`` ``(..., n_rates)``: every joint rate in ``robot.rate_names`` order (rollers, ``spin1``/``spin2``).
     - ``slip`` ``(..., N)`` [m/s]: lateral slip (3.11) row 0 / (8.14) left at each fixed wheel, 0 elsewhere and
       where it is round-off (``_ik_fast.SLIP_ROUNDOFF``).
-    - ``feasible`` ``(...)`` bool: every ``|slip| <= slip_tol``, every heading within its wheel's ``steer_range``
-      and every gear coupling's rates in its ratios (``in_gear``).
+    - ``feasible`` ``(...)`` bool: every ``|slip| <= slip_tol``, every heading within its wheel's ``steer_range``,
+      every gear coupling's rates in its ratios (``in_gear``) and every held linkage's angles on its law
+      (``in_linkage``).
     - ``in_range`` ``(..., N)`` bool: the wheel's heading lies in its ``steer_range`` (True for wheels without one,
       and for those that do not steer). The root of (8.9) is the one closest to the current heading unless only
       the other lies within the range; when neither does the twist is not feasible (the steering cannot reach it).
@@ -66,7 +68,10 @@ class WheelCommands:
     - ``in_gear`` ``(..., n_couplings)`` bool, one per ``robot.couplings``: a ``gear``'s joint rates are
       ``ratio_j * u`` for one ``u`` (:func:`~wmrkit.kinematics.gear_check.gears_hold`: each departure within
       ``GEAR_RTOL`` of the largest rate, or moving its contact by at most ``slip_tol``); True for the other
-      kinds (a differential leaves the rates' difference free; a linkage's geometry is not modelled).
+      kinds (a differential leaves the rates' difference free).
+    - ``in_linkage`` ``(..., n_couplings)`` bool: a ``linkage``'s steering angles on the ideal law it holds
+      (:mod:`~wmrkit.kinematics.linkage_check`: each wheel off it would slip sideways by at most ``slip_tol``);
+      True for the other couplings and the linkages with no law to hold.
     """
 
     wheel_names: tuple[str, ...]
@@ -82,6 +87,7 @@ class WheelCommands:
     heading: np.ndarray
     in_range: np.ndarray
     in_gear: np.ndarray
+    in_linkage: np.ndarray
     couplings: tuple[Coupling, ...] = ()
 
     def velocity(self, twist_robot: ArrayLike) -> np.ndarray:
@@ -94,7 +100,8 @@ class WheelCommands:
 
         ``{"wheels": {name: {"heading", "spin", "steer_rate", other joint rates...}}, "slip": {name: m/s},
         "out_of_range": [names of wheels outside their steer_range], "out_of_gear": [channel names of the gear
-        couplings the rates break], "feasible": bool}``: ``heading`` [rad] only
+        couplings the rates break], "out_of_linkage": [those of the linkages the headings break], "feasible":
+        bool}``: ``heading`` [rad] only
         for steered wheels (0 = rolling straight ahead). Only for a single twist (batch shape ``()``).
         """
         if self.feasible.shape != ():
@@ -112,6 +119,8 @@ class WheelCommands:
                 "out_of_range": [n for n, ok in zip(self.wheel_names, self.in_range.tolist(), strict=True) if not ok],
                 "out_of_gear": [c.channel_name for c, ok in zip(self.couplings, self.in_gear.tolist(), strict=True)
                                 if not ok],
+                "out_of_linkage": [c.channel_name for c, ok in zip(self.couplings, self.in_linkage.tolist(),
+                                                                    strict=True) if not ok],
                 "feasible": bool(self.feasible)}
 
 
@@ -143,6 +152,8 @@ def wheel_commands(
     - a ``gear`` coupling (``robot.couplings``) whose joints the twist asks to turn out of its ratios (a solid rear
       axle asked to turn) makes it False too: ``in_gear``, a departure moving a contact by more than `slip_tol`
       (the floor of the slip check: a turn of 1e-320 rad/s rolls as a side speed of 1e-320 m/s does).
+    - a ``linkage`` whose held law the angles break (a synchro drive's wheels, turning together, asked to turn the
+      robot) makes it False too: ``in_linkage`` (:mod:`~wmrkit.kinematics.linkage_check`).
     """
     check_tolerances(speed_tol, slip_tol)
     p = _ik_fast.plan(robot)
@@ -178,12 +189,13 @@ def wheel_commands(
     gears = gear_table(robot, p.rate_names) if robot.couplings else None
     if gears is not None and gears.coupling:
         in_gear[..., list(gears.coupling)] = gears_hold(gears, rates, slip_tol)
-    feasible = feasible & np.all(in_gear, axis=-1)
+    in_linkage = linkage_holds(robot, twist, config, slip_tol)
+    feasible = feasible & np.all(in_gear, axis=-1) & np.all(in_linkage, axis=-1)
     return WheelCommands(
         wheel_names=p.wheel_names, rate_names=p.rate_names, steer=_ro(steer), spin=_ro(spin),
         steer_rate=_ro(_columns(rates, p.steer_rate_select, batch, n)), rates=_ro(rates), slip=_ro(slip),
         feasible=_ro(feasible), beta=_ro(config), held=_ro(held), heading=_ro(heading), in_range=_ro(in_range),
-        in_gear=_ro(in_gear), couplings=robot.couplings,
+        in_gear=_ro(in_gear), in_linkage=_ro(in_linkage), couplings=robot.couplings,
     )
 
 
@@ -333,7 +345,9 @@ class ForwardKinematics:
     ``twist`` (3,) [m/s, rad/s]; ``residual`` the slip norm [m/s]; ``wheel_slip`` (N,) each wheel's slip norm
     [m/s]; ``tolerance`` [m/s]; ``consistent``: ``residual <= tolerance`` and no gear broken; ``slipping``: the
     wheels whose slip exceeds the tolerance; ``out_of_gear``: the channel names of the ``gear`` couplings whose given
-    joints break its ratios (each used as given, so the slip does not show it: a :class:`GearWarning` each).
+    joints break its ratios (each used as given, so the slip does not show it: a :class:`GearWarning` each);
+    ``out_of_linkage``: those of the ``linkage`` couplings whose law the steering breaks (a
+    :class:`~wmrkit.kinematics.linkage_check.LinkageAngleWarning` each).
     """
 
     twist: np.ndarray
@@ -343,6 +357,7 @@ class ForwardKinematics:
     consistent: bool
     slipping: tuple[str, ...]
     out_of_gear: tuple[str, ...] = ()
+    out_of_linkage: tuple[str, ...] = ()
 
 
 def forward_kinematics_check(
@@ -356,7 +371,9 @@ def forward_kinematics_check(
     robot's size) plus :data:`SLIP_TOL`: rates that contradict each other beyond it (slip larger than measurement
     noise) are not ``consistent``, nor are given joints of a ``gear`` out of its ratios beyond round-off
     (:data:`wmrkit.couplings.GEAR_EXACT_RTOL`) by more than :data:`SLIP_TOL` at a contact: each such gear is named in
-    ``out_of_gear``, with a :class:`~wmrkit.couplings.GearWarning`.
+    ``out_of_gear``, with a :class:`~wmrkit.couplings.GearWarning`; nor is a steering that breaks a held ``linkage``'s
+    law by more than ``asin(rtol)`` (a wheel so set would slip at that fraction of its speed: ``out_of_linkage``, a
+    :class:`~wmrkit.kinematics.linkage_check.LinkageAngleWarning`).
     """
     columns = _assigned_columns(robot, list(rates))
     q_assigned = np.array([float(_rate_value(k, v)) for k, v in rates.items()])
@@ -374,9 +391,16 @@ def forward_kinematics_check(
     breaches = given_gear_breaches(robot, names, q_assigned, SLIP_TOL)
     for b in breaches:
         warnings.warn(b.warning(names, q_assigned), GearWarning, stacklevel=2)
-    consistent = bool(residual <= tolerance) and not breaches
+    steering = robot.steering(beta, heading)
+    off = given_breaches(robot, robot.beta if steering is None else steering, rtol)
+    for b in off:
+        warnings.warn(f"the headings break a steering linkage: {b.describe(robot)}: it cannot set them, so the "
+                      "twist found from them is not the robot's; check the headings", LinkageAngleWarning,
+                      stacklevel=2)
+    consistent = bool(residual <= tolerance) and not breaches and not off
     return ForwardKinematics(_ro(q_dot[:3]), residual, _ro(wheel_slip), tolerance, consistent, slipping,
-                             tuple(b.coupling.channel_name for b in breaches))
+                             tuple(b.coupling.channel_name for b in breaches),
+                             tuple(robot.couplings[b.coupling].channel_name for b in off))
 
 
 def _speed_per_rate(robot: Robot, name: str) -> float:
