@@ -27,9 +27,9 @@ from .._shapes import readonly
 from ..errors import WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, MAX_TORQUE, check_table_size
 from ..units import BARE_ANGLE_LIMIT
+from .inputs import Inputs, joint_column, knots
 from .linkages import SETPOINT_TOL, linkage_breach, setpoint_breach
 from .model import DynamicModel
-from .simulate import Inputs, _knots, joint_column
 
 #: Natural frequency [rad/s] of the programs' servos (the default `bandwidth`): a fixed step longer than its
 #: inverse cannot resolve them (``wmrkit simulate --path``).
@@ -120,7 +120,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     """
     from ..kinematics.wheel_ik import wheel_commands
 
-    t = _knots(time)
+    t = knots(time)
     _check_bandwidth(bandwidth)
     twists = np.array(twists, dtype=float).reshape(len(t), 3)  # a copy: the inputs keep it (read-only)
     bad = ~(np.abs(twists) <= MAX_SPEED).all(axis=1)  # NaN included

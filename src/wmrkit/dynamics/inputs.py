@@ -1,0 +1,154 @@
+"""Inputs of the simulator (:class:`Inputs`): joint torques, servo references and gains over time, checked where they
+are made, and compiled for the kernels against a model (:func:`compiled_inputs`)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._shapes import readonly
+from ..errors import ShapeError, WmrkitError
+from ..limits import MAX_TORQUE
+from .model import DynamicModel
+
+
+@dataclass(frozen=True, eq=False)
+class Inputs:
+    """Joint inputs over time, linear between the knots ``time`` and held outside them.
+
+    ``torques (K, n)`` [N m]: feed-forward generalized torques on the columns of ``DynamicModel.names`` (wheel
+    spins, steering); ``rate_reference (K, n)`` [rad/s] and ``rate_gain (n,)`` [N m s/rad]: wheel-rate servos
+    ``tau += gain (reference - rate)``, saturated at ``torque_limit (n,)``; ``heading_reference (K, n_steer)``
+    [rad, headings: 0 = rolling straight ahead] with ``steer_kp``, ``steer_kd (n_steer,)``: steering servos,
+    saturated smoothly at ``steer_limit (n_steer,)`` [N m] (``limit tanh(pd / limit)``; default and inf: none);
+    ``twist (M, 3)`` [m/s, m/s, rad/s] at the knots ``twist_time (M,)`` [s], or None: the body twists whose no-slip
+    motion the servo references are, linear between their knots (a twist program's, on its own time axis so that
+    ``dataclasses.replace(inputs, time=...)`` keeps them whole); :func:`~.simulate.simulate` integrates them into
+    :attr:`~.simulate.Simulation.nominal_pose`. Checked when made (shapes that agree,
+    times strictly increasing, finite values, gains and limits >= 0); a simulator checks the widths against its
+    model.
+    """
+
+    time: np.ndarray
+    torques: np.ndarray
+    rate_reference: np.ndarray
+    rate_gain: np.ndarray
+    torque_limit: np.ndarray
+    heading_reference: np.ndarray
+    steer_kp: np.ndarray
+    steer_kd: np.ndarray
+    steer_limit: np.ndarray | None = None
+    twist: np.ndarray | None = None
+    twist_time: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        _check_inputs(self)  # once, where the inputs are made; a simulator checks their widths against its model
+
+    @classmethod
+    def torques_only(cls, model: DynamicModel, time: ArrayLike, torques: dict[str, ArrayLike]) -> Inputs:
+        """Pure torque inputs: `torques` maps actuated joints (``wheel.spin``, ``wheel.steer``) to values (K,)."""
+        t = knots(time)
+        tau = np.zeros((len(t), model.n))
+        for name, values in torques.items():
+            column, values = joint_column(model, name), np.asarray(values, dtype=float)
+            if values.shape not in ((), (1,), t.shape):
+                raise ShapeError(f"torques['{name}']: expected one value or {len(t)}, one per time, got shape "
+                                 f"{values.shape}")
+            tau[:, column] = values
+        s = len(model.steer_columns)
+        return cls(*(readonly(a) for a in (t, tau, np.zeros_like(tau), np.zeros(model.n), np.full(model.n, np.inf),
+                                            np.zeros((len(t), s)), np.zeros(s), np.zeros(s))))
+
+
+def joint_column(model: DynamicModel, name: str) -> int:
+    """Column of the actuated joint `name` (``wheel.spin``, ``wheel.steer``...), or a one-line error."""
+    if name not in model.names[3:]:
+        raise WmrkitError(f"robot '{model.robot.name}' has no joint '{name}' (joints: {', '.join(model.names[3:])})")
+    if not model.is_actuated(model.names.index(name)):
+        raise WmrkitError(f"joint '{name}' of robot '{model.robot.name}' is not actuated (actuated: "
+                          f"{', '.join(model.robot.actuated) or 'none'})")
+    return model.names.index(name)
+
+
+def knots(time: ArrayLike) -> np.ndarray:
+    """`time` as the knots of inputs ``(K,)`` [s], or a one-line error: at least one, finite, strictly increasing."""
+    t = np.atleast_1d(np.asarray(time, dtype=float))  # strictly increasing with finite ends: finite
+    if t.ndim != 1 or not len(t) or not (math.isfinite(t[0]) and math.isfinite(t[-1]) and (t[1:] > t[:-1]).all()):
+        raise WmrkitError(f"time: input times must be at least one, finite and strictly increasing, got "
+                          f"{t.tolist() if t.size <= 6 else f'shape {t.shape}'}")
+    return t
+
+
+#: The fields of :class:`Inputs` after ``time``, in the kernels' order, and the values each one may hold.
+_INPUT_FIELDS = (("torques", f"torques within {MAX_TORQUE:g} N m (limits.MAX_TORQUE)"),
+                 ("rate_reference", "finite numbers"),
+                 ("rate_gain", "finite numbers >= 0"), ("torque_limit", "numbers >= 0 (inf: no limit)"),
+                 ("heading_reference", "finite numbers"), ("steer_kp", "finite numbers >= 0"),
+                 ("steer_kd", "finite numbers >= 0"))
+
+
+def _check_inputs(inputs: Inputs) -> None:
+    """Raise :class:`WmrkitError` naming the field of `inputs` whose shape does not agree with the others (K times,
+    n velocities, n_steer steering joints) or whose values make no sense (times not strictly increasing, values not
+    finite, gains or limits below 0); the model's sizes are checked by :func:`compiled_inputs`."""
+    k = len(knots(inputs.time))
+    arrays = [np.asarray(getattr(inputs, name), dtype=float) for name, _ in _INPUT_FIELDS]
+    for j, size in ((0, "n"), (4, "n_steer")):
+        if arrays[j].ndim != 2 or len(arrays[j]) != k:
+            raise ShapeError(f"{_INPUT_FIELDS[j][0]}: expected shape (K, {size}) with K = {k} rows, one per time, "
+                             f"got {arrays[j].shape}")
+    n, s = arrays[0].shape[1], arrays[4].shape[1]
+    for (name, want), a, shape in zip(_INPUT_FIELDS, arrays, ((k, n), (k, n), (n,), (n,), (k, s), (s,), (s,)),
+                                      strict=True):
+        if a.shape != shape:
+            raise ShapeError(f"{name}: expected shape {shape} ({n} velocities as torques, {s} steering joints as "
+                             f"heading_reference), got {a.shape}")
+        bad = ~(a >= 0) if name == "torque_limit" else ~np.isfinite(a) | (a < 0 if ">=" in want else False)
+        if name == "torques":
+            bad = ~(np.abs(a) <= MAX_TORQUE)  # NaN included
+        if bad.any():
+            raise WmrkitError(f"{name}: expected {want}, got {float(a[bad].flat[0])!r}")
+    if (inputs.twist is None) != (inputs.twist_time is None):
+        raise WmrkitError("twist, twist_time: give both (body twists at their knots) or neither")
+    if inputs.twist is not None:
+        m = len(knots(inputs.twist_time))
+        if not (np.shape(inputs.twist) == (m, 3) and np.all(np.isfinite(inputs.twist))):
+            raise ShapeError(f"twist: expected finite body twists of shape ({m}, 3), one per twist_time, got shape "
+                             f"{np.shape(inputs.twist)}")
+
+
+def compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
+    """The kernels' inputs (writable C copies: one compiled signature); :class:`ShapeError` naming the field of
+    `inputs` whose width does not fit `model` (the kernels would read out of bounds)."""
+    arrays = [np.array(getattr(inputs, name), dtype=float, order="C") for name, _ in _INPUT_FIELDS]
+    n, s = model.n, len(model.steer_columns)
+    for (name, _), a, width in zip(_INPUT_FIELDS, arrays, (n, n, n, n, s, s, s), strict=True):
+        if a.shape[-1] != width:
+            raise ShapeError(f"{name}: expected {width} columns for robot '{model.robot.name}' (n = {n} velocities "
+                             f"of model.names, n_steer = {s}), got shape {a.shape}")
+    tau, rref, gain, limit, href, kp, kd = arrays
+    beta_ref = np.array(model.robot.beta_of_heading(href), dtype=float, order="C") if s else href
+    return (np.array(np.atleast_1d(inputs.time), dtype=float), tau, rref, gain, limit, beta_ref, kp, kd,
+            _steer_limits(model, inputs.steer_limit))
+
+
+def _steer_limits(model: DynamicModel, limit: ArrayLike | None) -> np.ndarray:
+    """The compiled kernels' steering-servo limits, 0 where there is none (no infinity may reach them)."""
+    if limit is None:
+        return np.zeros(len(model.steer_columns))
+    limit = np.asarray(limit, dtype=float)
+    if limit.shape != (len(model.steer_columns),) or not np.all(limit > 0):  # NaN included
+        raise WmrkitError(f"steer_limit: expected {len(model.steer_columns)} torques > 0 N m (inf: none), got "
+                          f"{limit.tolist()}")
+    return np.where(np.isinf(limit), 0.0, limit)
+
+
+def held_values(value: ArrayLike, size: int, name: str) -> np.ndarray:
+    """`value` as `size` floats for :meth:`~.simulate.Stepper.hold` (its argument `name`), or a one-line error."""
+    value = np.asarray(value, dtype=float)
+    if value.shape != (size,):
+        raise WmrkitError(f"hold: {name} must be {size} numbers, got shape {value.shape}")
+    return value  # not checked for NaN here: a NaN reference makes the state NaN, which advance() reports
