@@ -9,6 +9,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 from dynamics_robots import linked_car
 from test_linkage_law import four_wheel_steer
@@ -129,3 +130,39 @@ def test_a_follower_on_the_axle_line_keeps_its_rest_heading_whatever_is_commande
     with pytest.raises(WmrkitError, match=r":3: column 'side\.heading': 0\.2 rad breaks .* sets side at heading 0 "
                                           r"rad whatever the others do"):
         read_torques(model, path)
+
+
+def _interpolated(inputs, column: int, t):
+    return np.interp(t, inputs.time, inputs.heading_reference[:, column])
+
+
+def test_between_rows_the_follower_set_point_follows_the_law_of_the_interpolated_leader(tmp_path):
+    """Before, the rows 0 and 0.5 rad (fr on the law at each) were interpolated linearly, fr too: half-way fr's
+    set-point was 0.0246 rad off the law of fl's, the servos fighting the linkage between every two rows."""
+    model, path = DynamicModel.of(linked_car()), tmp_path / "h.csv"
+    rows = [(0.0, 0.0, 5.0), (1.0, 0.5, -3.0), (3.0, -0.4, 1.0)]
+    path.write_text("time,fl.heading,fr.heading,rl.spin\n" + "".join(
+        f"{t!r},{h!r},{icr_heading(0.6, -0.2, 0.2 + 0.6 / math.tan(h)) if h else 0.0!r},{tau!r}\n"
+        for t, h, tau in rows))
+    inputs = read_torques(model, path)
+    t = np.linspace(0.0, 3.0, 3001)
+    times, fl, tau = (np.array(c) for c in zip(*rows, strict=True))
+    assert _interpolated(inputs, 0, t) == pytest.approx(np.interp(t, times, fl), abs=1e-12)  # fl: its rows
+    law = [icr_heading(0.6, -0.2, 0.2 + 0.6 / math.tan(h)) if h else 0.0 for h in _interpolated(inputs, 0, t)]
+    assert np.abs(_interpolated(inputs, 1, t) - law).max() <= SETPOINT_TOL
+    rl = list(model.names).index("rl.spin")
+    assert np.interp(t, inputs.time, inputs.torques[:, rl]) == pytest.approx(np.interp(t, times, tau), abs=1e-12)
+
+
+def test_between_rows_followers_without_their_leader_stay_on_the_law(tmp_path):
+    """fr and ml commanded, the leader fl not: ml follows the law of the leader angle fr's interpolation gives."""
+    model, path = _three_wheel_ackermann(), tmp_path / "h.csv"
+    rows = [(0.0, 2.0), (2.0, -0.9)]  # ICRs on the rear axle line at y = yc
+    path.write_text("time,fr.heading,ml.heading\n" + "".join(
+        f"{t!r},{icr_heading(0.6, -0.2, yc)!r},{icr_heading(0.3, 0.2, yc)!r}\n" for t, yc in rows))
+    inputs = read_torques(model, path)
+    t = np.linspace(0.0, 2.0, 2001)
+    fr, ml = _interpolated(inputs, 1, t), _interpolated(inputs, 2, t)
+    yc = -0.2 + 0.6 / np.tan(fr)  # fr's axle meets the rear axle line there
+    law = [icr_heading(0.3, 0.2, y) for y in yc]
+    assert np.abs(np.remainder(ml - law + np.pi, 2 * np.pi) - np.pi).max() <= SETPOINT_TOL

@@ -97,7 +97,16 @@ def setpoint_breach(model, beta: np.ndarray, commanded: set[int],
     [rad], the commanded one of its linkage it is measured from (None: on the axle line, it keeps its rest angle
     whatever the others do) and the angle the law gives it. The reference is the leader if commanded, else the first
     commanded follower (its leader's angle found from it, :func:`_leader_of`). None when they agree."""
-    table, cols = model.pack[17], list(model.steer_columns)
+    for j, ref, f in _set_by_law(model, beta, commanded):
+        if abs(math.remainder(beta[j] - f, 2 * math.pi)) > tol:
+            return j, ref, f
+    return None
+
+
+def _set_by_law(model, beta: np.ndarray, commanded: set[int]) -> list[tuple[int, int | None, float]]:
+    """``(follower, reference, angle)`` for each commanded follower of a held linkage (:func:`setpoint_breach`):
+    the angle its linkage's law gives it from its reference's set-point in `beta`."""
+    table, cols, out = model.pack[17], list(model.steer_columns), []
     for lead in dict.fromkeys(int(r[1]) for r in table):
         rows = [r for r in table if int(r[1]) == lead and cols.index(int(r[0])) in commanded]
         ref = cols.index(lead)
@@ -107,11 +116,51 @@ def setpoint_breach(model, beta: np.ndarray, commanded: set[int],
             first = next((r for r in rows if r[3] == 0.0 or r[5] != 0.0), None)
             ref = None if first is None else cols.index(int(first[0]))
             b = beta[cols.index(lead)] if first is None else _leader_of(first, beta[ref])
-        for r in rows:
-            j, f = cols.index(int(r[0])), law(r, b)[0]
-            if abs(math.remainder(beta[j] - f, 2 * math.pi)) > tol:
-                return j, ref, f
-    return None
+        out += [(cols.index(int(r[0])), ref, law(r, b)[0]) for r in rows if cols.index(int(r[0])) != ref]
+    return out
+
+
+#: Most knots :func:`setpoint_knots` makes of a torque file's rows (as many as the rows of a 1 GiB table).
+MAX_SETPOINT_KNOTS = 10_000_000
+
+
+def setpoint_knots(model, t: np.ndarray, beta: np.ndarray, commanded: set[int],
+                   tol: float = SETPOINT_TOL) -> tuple[np.ndarray, np.ndarray]:
+    """Knots ``(t, beta)`` whose linear interpolation keeps the set-points of each held linkage on its law between
+    rows: times `t` ``(K,)`` [s], steering set-points `beta` ``(K, n_steer)`` [rad] on the law at each row
+    (:func:`setpoint_breach`), the indices `commanded` servoed. Between two rows the reference of each linkage moves
+    linearly and the law sets its commanded followers from it (:func:`_on_law`): knots are inserted, evenly in
+    time, until the followers' interpolation is within `tol` / 2 of the law at the middle of every interval (the
+    law is smooth: a short chord's largest error is at its middle); the other columns keep their rows'
+    interpolation. Without a commanded follower the rows are returned as they are; :class:`WmrkitError` beyond
+    :data:`MAX_SETPOINT_KNOTS` knots."""
+    if len(t) < 2 or not _set_by_law(model, beta[0], commanded):
+        return t, beta
+    times, rows = [t[:1]], [_on_law(model, beta[0], commanded)[None]]
+    for k in range(len(t) - 1):
+        pieces = 1
+        while True:
+            s = np.linspace(0.0, 1.0, 2 * pieces + 1)  # the knots and the middles of their intervals
+            on = np.array([_on_law(model, (1 - a) * beta[k] + a * beta[k + 1], commanded) for a in s])
+            off = np.abs(on[1:-1:2] - (on[:-2:2] + on[2::2]) / 2).max()
+            if off <= tol / 2:
+                break
+            pieces = max(2 * pieces, math.ceil(pieces * math.sqrt(2 * off / tol)))
+            if pieces + sum(len(x) for x in times) > MAX_SETPOINT_KNOTS:
+                raise WmrkitError(f"heading set-points: more than {MAX_SETPOINT_KNOTS:.0e} knots would keep a held "
+                                  "linkage's followers on its law between the rows; give rows closer together")
+        times.append(np.append(t[k] + (t[k + 1] - t[k]) * s[2:-1:2], t[k + 1]))
+        rows.append(on[2::2])
+    return np.concatenate(times), np.concatenate(rows)
+
+
+def _on_law(model, beta: np.ndarray, commanded: set[int]) -> np.ndarray:
+    """`beta` with each commanded follower of a held linkage at the angle its law gives it (:func:`_set_by_law`),
+    the turn nearest its value in `beta`."""
+    beta = np.array(beta, dtype=float)
+    for j, _, f in _set_by_law(model, beta, commanded):
+        beta[j] += math.remainder(f - beta[j], 2 * math.pi)
+    return beta
 
 
 def _heading(model, k: int, beta: float) -> float:

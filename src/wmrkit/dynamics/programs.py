@@ -4,7 +4,8 @@ A torque file is a CSV with a header ``time,<wheel>.<joint>,...``: times [s] str
 torques [N m] on actuated joints (``spin``, ``spin1``/``spin2``, ``steer``), linear between rows, the last row held;
 a ``<wheel>.heading`` column [rad] is a steering-servo reference instead (the users' heading, 0 = straight ahead;
 actuated steering only: a castor steers passively); the set-points of one held linkage on its law at each row
-(:func:`~wmrkit.dynamics.linkages.setpoint_breach`).
+(:func:`~wmrkit.dynamics.linkages.setpoint_breach`) and, between rows, the linkage's other columns set by its law
+from its reference column's interpolation (:func:`~wmrkit.dynamics.linkages.setpoint_knots`).
 
 A built-in program (:func:`path_program`) is a schedule of body twists; each actuated wheel follows the no-slip
 rate of its twist (wheel IK, §8.4) through a saturated rate servo and each actuated steering the IK heading
@@ -28,7 +29,7 @@ from ..errors import WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, MAX_TORQUE, check_table_size
 from ..units import BARE_ANGLE_LIMIT
 from .inputs import Inputs, joint_column, knots
-from .linkages import SETPOINT_TOL, linkage_breach, setpoint_breach
+from .linkages import SETPOINT_TOL, linkage_breach, setpoint_breach, setpoint_knots
 from .model import DynamicModel
 
 #: Natural frequency [rad/s] of the programs' servos (the default `bandwidth`): a fixed step longer than its
@@ -285,6 +286,11 @@ def _check_setpoints(source: str, model: DynamicModel, href: np.ndarray, command
                           "one heading column per linkage (docs/dynamics.md)")
 
 
+def _lerp(at: np.ndarray, t: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """The columns of `values` ``(K, m)`` at knots `t` interpolated linearly at the times `at`."""
+    return np.column_stack([np.interp(at, t, column) for column in values.T])
+
+
 def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     """:class:`Inputs` from a torque CSV (module docstring); errors name the file, the line and the column."""
     source = str(path)
@@ -338,14 +344,21 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
                 joint_column(model, name)
         except (WmrkitError, ValueError) as err:
             raise WmrkitError(f"{source}:1: column '{name}': {err}") from None
-    inputs = Inputs.torques_only(model, values[:, 0], torques)
+    t = values[:, 0]
     if not headings:
-        return inputs
+        return Inputs.torques_only(model, t, torques)
     href = np.tile(model.robot.heading, (len(values), 1))
     for k, c in enumerate(model.steer_columns):
         if c in headings:
             href[:, k] = headings[c]
-    _check_setpoints(source, model, href, [k for k, c in enumerate(model.steer_columns) if c in headings])
+    commanded = [k for k, c in enumerate(model.steer_columns) if c in headings]
+    _check_setpoints(source, model, href, commanded)
+    beta = model.robot.beta_of_heading(href)
+    knots, on_law = setpoint_knots(model, t, beta, set(commanded))  # the followers on the law between the rows
+    if len(knots) > len(t):
+        href = _lerp(knots, t, href) + on_law - _lerp(knots, t, beta)
+        torques = {name: np.interp(knots, t, column) for name, column in torques.items()}
+    inputs = Inputs.torques_only(model, knots, torques)
     kp, kd = steering_gains(model, list(headings))
     return Inputs(inputs.time, inputs.torques, inputs.rate_reference, inputs.rate_gain, inputs.torque_limit,
                   readonly(href), readonly(kp), readonly(kd))
