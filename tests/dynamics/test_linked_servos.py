@@ -85,3 +85,33 @@ def test_an_ackermann_pair_sums_through_the_slope_to_its_reflected_inertia():
     kp, kd = steering_gains(model, [fl, fr], held=held)
     assert kp[0] + slope ** 2 * kp[1] == pytest.approx(inertia * BANDWIDTH ** 2, rel=1e-6)
     assert kd[0] + slope ** 2 * kd[1] == pytest.approx(2 * inertia * BANDWIDTH, rel=1e-6)
+
+
+def _geared_units(ratios: tuple[float, float]) -> DynamicModel:
+    """Two double wheels (differential steering units, spins free) whose steering is geared in `ratios`, each with
+    a steering motor."""
+    unit = {"type": "double", "heading": 0, "b": 0.06, "r": 0.08, "actuated": ["steer"],
+            "inertia": {"spin": 0.01, "steer": 0.05},
+            "tyre": {"model": "dugoff", "cs": 2000, "calpha": 1500, "mu": 0.8}}
+    return DynamicModel.of(Robot.from_dict({
+        "name": "geared-units", "body": {"mass": 50, "inertia": 2.0, "com": [0, 0], "com_height": 0.2},
+        "wheels": [{**unit, "name": "front", "position": [0.3, 0.2]},
+                   {**unit, "name": "rear", "position": [-0.3, -0.2]}],
+        "couplings": [{"kind": "gear", "joints": ["front.steer", "rear.steer"], "ratios": list(ratios)}]}))
+
+
+@pytest.mark.parametrize("ratios", [(1.0, 1.0), (1.0, 2.0), (3.0, -1.0)])
+def test_two_servos_of_a_gear_sum_through_its_ratios_to_its_reflected_inertia(ratios):
+    """Before, each servo of the gear was tuned on its own unit's inertia.steer (holding its partner locked the
+    gear): for 1:2, kp_front + 4 kp_rear = 0.25 w^2 on the gear's 0.306 kg m^2, so 0.905 w and damping ratio 0.90.
+    ``J``: the least-energy inertia of the KKT system under the gear's row ``q_f / k_f - q_r / k_r = 0``."""
+    model = _geared_units(ratios)
+    front, rear = model.names.index("front.steer"), model.names.index("rear.steer")
+    gear = np.zeros(model.n)
+    gear[front], gear[rear] = 1 / ratios[0], -1 / ratios[1]
+    inertia, nu = least_energy_inertia(model, np.vstack([model.slip_matrix(), gear]), front)
+    slope = ratios[1] / ratios[0]
+    assert nu[rear] == pytest.approx(slope, rel=1e-9)
+    kp, kd = steering_gains(model, [front, rear])
+    assert kp[0] + slope ** 2 * kp[1] == pytest.approx(inertia * BANDWIDTH ** 2, rel=1e-9)
+    assert kd[0] + slope ** 2 * kd[1] == pytest.approx(2 * inertia * BANDWIDTH, rel=1e-9)

@@ -217,10 +217,11 @@ def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequenc
     `held` (wheel-rate servos) keep still. A double wheel whose spins are servoed turns the whole body about its
     pivot: its own ``inertia.steer`` would leave that servo some 100 times too soft (damping ratio near 0.1).
 
-    The servoed steering joints of one ``linkage`` act as one servo on it: their gains, each in proportion to its
-    own wheel's inertia, sum through the law's slopes to ``J w^2`` and ``2 J w``, ``J`` the linkage's reflected
-    inertia with the other joints held (two servos of a synchro drive's four wheels, each tuned on its own wheel,
-    gave ``w / sqrt 2`` and damping ratio 0.71: a 4.3 % overshoot).
+    The servoed steering joints of one ``linkage`` (or one ``gear``: castors', double wheels' steering) act as one
+    servo on it: their gains, each in proportion to its own wheel's inertia, sum through the law's slopes (the
+    gear's ratios) to ``J w^2`` and ``2 J w``, ``J`` the linkage's (gear's) reflected inertia with the other joints
+    held (two servos of a synchro drive's four wheels, each tuned on its own wheel, gave ``w / sqrt 2`` and damping
+    ratio 0.71: a 4.3 % overshoot; two double wheels' steering geared 1:2, ``0.905 w`` and 0.90).
     """
     kp, kd = np.zeros(len(model.steer_columns)), np.zeros(len(model.steer_columns))
     if not set(servoed) <= set(model.steer_columns):
@@ -230,12 +231,11 @@ def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequenc
     if not servoed:
         return kp, kd
     inertia = np.array(model.steering_inertia([*servoed, *held]))
-    table, columns = model.pack[17], list(model.steer_columns)
+    columns = list(model.steer_columns)
     t = model._basis(model.robot.beta)[0]  # the motions the couplings allow: nu = T p
-    for lead, p in {int(row[1]): int(row[2]) for row in table}.items():  # each held linkage: its leader
-        together = [j for j in servoed if t[j, p] != 0 and (j == lead or any(  # (slope 0: it stays, here)
-            row[0] == j and row[1] == lead for row in table))]
-        if len(together) < 2:  # one servo: tuned on the linkage above (the others do not hold it)
+    for p in range(t.shape[1]):  # each motion: a held linkage (its leader's), a gear, or one joint
+        together = [j for j in servoed if t[j, p] != 0]  # (a follower of slope 0 stays, here)
+        if len(together) < 2:  # one servo: tuned on the linkage or gear above (the others do not hold it)
             continue
         slope = t[together, p]  # each joint's rate per unit rate of the leader
         ks = [columns.index(j) for j in together]
