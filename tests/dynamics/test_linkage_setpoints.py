@@ -16,6 +16,7 @@ from test_linkage_law import four_wheel_steer
 
 from wmrkit import Robot
 from wmrkit.cli.main import main
+from wmrkit.dynamics.inputs import compiled_inputs
 from wmrkit.dynamics.linkages import SETPOINT_TOL
 from wmrkit.dynamics.model import DynamicModel
 from wmrkit.dynamics.programs import read_torques
@@ -132,26 +133,33 @@ def test_a_follower_on_the_axle_line_keeps_its_rest_heading_whatever_is_commande
         read_torques(model, path)
 
 
-def _interpolated(inputs, column: int, t):
-    return np.interp(t, inputs.time, inputs.heading_reference[:, column])
+def _compiled(model, inputs):
+    """The knots, headings and torques the kernels interpolate linearly (``compiled_inputs``)."""
+    time, torques, *_ = compiled = compiled_inputs(model, inputs)
+    return time, model.robot.heading_of_beta(compiled[5]), torques
+
+
+def _interpolated(compiled, column: int, t):
+    return np.interp(t, compiled[0], compiled[1][:, column])
 
 
 def test_between_rows_the_follower_set_point_follows_the_law_of_the_interpolated_leader(tmp_path):
     """Before, the rows 0 and 0.5 rad (fr on the law at each) were interpolated linearly, fr too: half-way fr's
-    set-point was 0.0246 rad off the law of fl's, the servos fighting the linkage between every two rows."""
+    set-point was 0.0246 rad off the law of fl's, the servos fighting the linkage between every two rows. Now the
+    simulator interpolates fr through knots on the law of fl's interpolation, the torques as they were."""
     model, path = DynamicModel.of(linked_car()), tmp_path / "h.csv"
     rows = [(0.0, 0.0, 5.0), (1.0, 0.5, -3.0), (3.0, -0.4, 1.0)]
     path.write_text("time,fl.heading,fr.heading,rl.spin\n" + "".join(
         f"{t!r},{h!r},{icr_heading(0.6, -0.2, 0.2 + 0.6 / math.tan(h)) if h else 0.0!r},{tau!r}\n"
         for t, h, tau in rows))
-    inputs = read_torques(model, path)
+    inputs = _compiled(model, read_torques(model, path))
     t = np.linspace(0.0, 3.0, 3001)
     times, fl, tau = (np.array(c) for c in zip(*rows, strict=True))
     assert _interpolated(inputs, 0, t) == pytest.approx(np.interp(t, times, fl), abs=1e-12)  # fl: its rows
     law = [icr_heading(0.6, -0.2, 0.2 + 0.6 / math.tan(h)) if h else 0.0 for h in _interpolated(inputs, 0, t)]
     assert np.abs(_interpolated(inputs, 1, t) - law).max() <= SETPOINT_TOL
     rl = list(model.names).index("rl.spin")
-    assert np.interp(t, inputs.time, inputs.torques[:, rl]) == pytest.approx(np.interp(t, times, tau), abs=1e-12)
+    assert np.interp(t, inputs[0], inputs[2][:, rl]) == pytest.approx(np.interp(t, times, tau), abs=1e-12)
 
 
 def test_between_rows_followers_without_their_leader_stay_on_the_law(tmp_path):
@@ -160,7 +168,7 @@ def test_between_rows_followers_without_their_leader_stay_on_the_law(tmp_path):
     rows = [(0.0, 2.0), (2.0, -0.9)]  # ICRs on the rear axle line at y = yc
     path.write_text("time,fr.heading,ml.heading\n" + "".join(
         f"{t!r},{icr_heading(0.6, -0.2, yc)!r},{icr_heading(0.3, 0.2, yc)!r}\n" for t, yc in rows))
-    inputs = read_torques(model, path)
+    inputs = _compiled(model, read_torques(model, path))
     t = np.linspace(0.0, 2.0, 2001)
     fr, ml = _interpolated(inputs, 1, t), _interpolated(inputs, 2, t)
     yc = -0.2 + 0.6 / np.tan(fr)  # fr's axle meets the rear axle line there

@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike
 from .._shapes import readonly
 from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_TORQUE
+from .linkages import SETPOINT_TOL, heading_breach, setpoint_knots
 from .model import DynamicModel
 
 
@@ -29,7 +30,12 @@ class Inputs:
     ``dataclasses.replace(inputs, time=...)`` keeps them whole); :func:`~.simulate.simulate` integrates them into
     :attr:`~.simulate.Simulation.nominal_pose`. Checked when made (shapes that agree,
     times strictly increasing, finite values, gains and limits >= 0); a simulator checks the widths against its
-    model.
+    model, and the heading set-points of the servoed (``steer_kp > 0``) wheels of each ``linkage`` it holds: on its
+    law at every knot (within ``linkages.SETPOINT_TOL``; else :func:`~.simulate.simulate` refuses them, the servos
+    would fight it, and a :class:`~.simulate.Stepper` runs them as given) and, between knots, its followers set by
+    the law from the reference's interpolation (its leader's, else its first servoed follower's;
+    :func:`~.linkages.setpoint_knots`); ``fight_linkages`` True: neither (the servos fight through the linkage, as
+    :func:`~.programs.twist_program` lets them with ``allow_slip``).
     """
 
     time: np.ndarray
@@ -43,6 +49,7 @@ class Inputs:
     steer_limit: np.ndarray | None = None
     twist: np.ndarray | None = None
     twist_time: np.ndarray | None = None
+    fight_linkages: bool = False
 
     def __post_init__(self) -> None:
         _check_inputs(self)  # once, where the inputs are made; a simulator checks their widths against its model
@@ -120,9 +127,12 @@ def _check_inputs(inputs: Inputs) -> None:
                              f"{np.shape(inputs.twist)}")
 
 
-def compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
+def compiled_inputs(model: DynamicModel, inputs: Inputs, refuse: bool = False) -> tuple:
     """The kernels' inputs (writable C copies: one compiled signature); :class:`ShapeError` naming the field of
-    `inputs` whose width does not fit `model` (the kernels would read out of bounds)."""
+    `inputs` whose width does not fit `model` (the kernels would read out of bounds). Heading set-points on the law
+    of each held linkage at every knot get knots between them on it (:class:`Inputs`); set-points off it at a knot
+    are refused if `refuse` (:func:`~.simulate.simulate`), else run as given (``fight_linkages``: a
+    :class:`~.simulate.Stepper`'s, whose loops through the dynamics may command linked wheels apart)."""
     arrays = [np.array(getattr(inputs, name), dtype=float, order="C") for name, _ in _INPUT_FIELDS]
     n, s = model.n, len(model.steer_columns)
     for (name, _), a, width in zip(_INPUT_FIELDS, arrays, (n, n, n, n, s, s, s), strict=True):
@@ -130,9 +140,33 @@ def compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
             raise ShapeError(f"{name}: expected {width} columns for robot '{model.robot.name}' (n = {n} velocities "
                              f"of model.names, n_steer = {s}), got shape {a.shape}")
     tau, rref, gain, limit, href, kp, kd = arrays
+    tk = np.array(np.atleast_1d(inputs.time), dtype=float)
     beta_ref = np.array(model.robot.beta_of_heading(href), dtype=float, order="C") if s else href
-    return (np.array(np.atleast_1d(inputs.time), dtype=float), tau, rref, gain, limit, beta_ref, kp, kd,
+    commanded = set(np.flatnonzero(kp > 0).tolist())
+    if len(model.pack[17]) and commanded and not inputs.fight_linkages:
+        off = next(((k, p) for k, row in enumerate(href) if (p := setpoint_problem(model, row, commanded))), None)
+        if off and refuse:
+            raise WmrkitError(f"heading_reference: at t = {tk[off[0]]:g} s, {off[1]}")
+        at, on_law = (tk, beta_ref) if off else setpoint_knots(model, tk, beta_ref, commanded)
+        if len(at) > len(tk):  # the linkages' followers on their laws between the knots
+            tau, rref = (np.column_stack([np.interp(at, tk, c) for c in a.T]) for a in (tau, rref))
+            tk, beta_ref = at, np.ascontiguousarray(on_law)
+    return (tk, np.ascontiguousarray(tau), np.ascontiguousarray(rref), gain, limit, beta_ref, kp, kd,
             _steer_limits(model, inputs.steer_limit))
+
+
+def setpoint_problem(model: DynamicModel, headings: np.ndarray, commanded: set[int]) -> str | None:
+    """Why heading set-points `headings` ``(n_steer,)`` [rad] of the servoed indices `commanded` break a linkage
+    `model` holds (:func:`~.linkages.heading_breach`), naming the wheels; None when they do not."""
+    breach = heading_breach(model, headings, commanded)
+    if breach is None:
+        return None
+    j, ref, want, name = breach
+    steered = model.robot.steer_names
+    by = "whatever the others do" if ref is None else f"with {steered[ref]}'s at {headings[ref]:.6g} rad"
+    return (f"{steered[j]}'s {headings[j]:.6g} rad breaks {name}, which sets {steered[j]} at heading {want:.6g} rad "
+            f"{by}: the steering servos would fight the linkage the dynamics hold; give headings on its law (within "
+            f"{SETPOINT_TOL:g} rad), steer_kp > 0 on one wheel per linkage, or fight_linkages=True")
 
 
 def _steer_limits(model: DynamicModel, limit: ArrayLike | None) -> np.ndarray:

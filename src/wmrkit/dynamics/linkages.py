@@ -103,6 +103,18 @@ def setpoint_breach(model, beta: np.ndarray, commanded: set[int],
     return None
 
 
+def heading_breach(model, headings: np.ndarray, commanded: set[int]) -> tuple[int, int | None, float, str] | None:
+    """:func:`setpoint_breach` of heading set-points `headings` ``(n_steer,)`` [rad] as users read it: ``(follower,
+    reference, heading the law gives the follower [rad], the linkage's name)``; None when they agree."""
+    breach = setpoint_breach(model, model.robot.beta_of_heading(headings), commanded)
+    if breach is None:
+        return None
+    j, ref, f = breach
+    steer = f"{model.robot.steer_names[j]}.steer"
+    name = next(c.channel_name for c in model.robot.couplings if c.kind == "linkage" and steer in c.joints)
+    return j, ref, _heading(model, j, f), name
+
+
 def _set_by_law(model, beta: np.ndarray, commanded: set[int]) -> list[tuple[int, int | None, float]]:
     """``(follower, reference, angle)`` for each commanded follower of a held linkage (:func:`setpoint_breach`):
     the angle its linkage's law gives it from its reference's set-point in `beta`."""

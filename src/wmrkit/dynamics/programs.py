@@ -4,8 +4,8 @@ A torque file is a CSV with a header ``time,<wheel>.<joint>,...``: times [s] str
 torques [N m] on actuated joints (``spin``, ``spin1``/``spin2``, ``steer``), linear between rows, the last row held;
 a ``<wheel>.heading`` column [rad] is a steering-servo reference instead (the users' heading, 0 = straight ahead;
 actuated steering only: a castor steers passively); the set-points of one held linkage on its law at each row
-(:func:`~wmrkit.dynamics.linkages.setpoint_breach`) and, between rows, the linkage's other columns set by its law
-from its reference column's interpolation (:func:`~wmrkit.dynamics.linkages.setpoint_knots`).
+(:func:`~wmrkit.dynamics.linkages.heading_breach`) and, between rows, the linkage's other columns set by its law
+from its reference column's interpolation (:class:`~wmrkit.dynamics.inputs.Inputs`).
 
 A built-in program (:func:`path_program`) is a schedule of body twists; each actuated wheel follows the no-slip
 rate of its twist (wheel IK, §8.4) through a saturated rate servo and each actuated steering the IK heading
@@ -29,7 +29,7 @@ from ..errors import WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, MAX_TORQUE, check_table_size
 from ..units import BARE_ANGLE_LIMIT
 from .inputs import Inputs, joint_column, knots
-from .linkages import SETPOINT_TOL, linkage_breach, setpoint_breach, setpoint_knots
+from .linkages import SETPOINT_TOL, heading_breach, linkage_breach
 from .model import DynamicModel
 
 #: Natural frequency [rad/s] of the programs' servos (the default `bandwidth`): a fixed step longer than its
@@ -155,7 +155,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     for k, w in enumerate(steer_wheels):
         h = cmd.heading[:, robot.wheel_names.index(w.name)]
         headings[:, k] = np.where(np.isfinite(h), h, w.heading)
-    _check_linkages(model, t, twists, headings, allow_slip)
+    fight = _check_linkages(model, t, twists, headings, allow_slip)
     rates = np.zeros((len(t), n))
     rates[:, 3:3 + cmd.rates.shape[-1]] = np.nan_to_num(cmd.rates)
     gain, limit = np.zeros(n), np.full(n, np.inf)
@@ -182,21 +182,25 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
             contact = _contacts_of(model, w.name)
             steer_limit[k] = max(loads[contact].sum(), 1.0) * lever
     return Inputs(*(readonly(a) for a in (t, np.zeros((len(t), n)), rates, gain, limit, headings, kp, kd,
-                                          steer_limit, twists, t.copy())))
+                                          steer_limit, twists, t.copy())), fight_linkages=fight)
 
 
 def _check_linkages(model: DynamicModel, t: np.ndarray, twists: np.ndarray, headings: np.ndarray,
-                    allow_slip: bool) -> None:
+                    allow_slip: bool) -> bool:
     """Refuse (unless `allow_slip`) the first knot whose IK `headings` ``(K, n_steer)`` break a ``linkage`` the
-    dynamics hold (:mod:`.linkages`: a synchro chain asked to turn its wheels apart), naming it."""
-    if allow_slip or not len(model.pack[17]):
-        return
+    dynamics hold (:mod:`.linkages`: a synchro chain asked to turn its wheels apart), naming it; whether one does
+    (with `allow_slip`: the servos fight through it, ``Inputs.fight_linkages``)."""
+    if not len(model.pack[17]):
+        return False
     for k, beta in enumerate(model.robot.beta_of_heading(headings)):
         breach = linkage_breach(model, beta)
+        if breach and allow_slip:
+            return True
         if breach:
             raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion "
                               f"for '{model.robot.name}': its wheels' steering breaks a linkage ({breach}), which "
                               "the dynamics hold; use allow_slip=True to let its servos fight and the tyres slip")
+    return False
 
 
 def _check_bandwidth(bandwidth: float) -> None:
@@ -266,29 +270,21 @@ def _check_torques(source: str, column: str, torques: np.ndarray) -> None:
 
 def _check_setpoints(source: str, model: DynamicModel, href: np.ndarray, commanded: list[int]) -> None:
     """Refuse the first row whose heading set-points `href` ``(K, n_steer)`` break a linkage the dynamics hold
-    (:func:`~wmrkit.dynamics.linkages.setpoint_breach`): their servos would fight it, naming the two columns."""
+    (:func:`~wmrkit.dynamics.linkages.heading_breach`): their servos would fight it, naming the two columns."""
     if not len(model.pack[17]):
         return
     steered = model.robot.steer_names
-    for k, beta in enumerate(model.robot.beta_of_heading(href)):
-        breach = setpoint_breach(model, beta, set(commanded))
+    for k, row in enumerate(href):
+        breach = heading_breach(model, row, set(commanded))
         if breach is None:
             continue
-        j, ref, f = breach
-        name = next(c.channel_name for c in model.robot.couplings
-                    if c.kind == "linkage" and f"{steered[j]}.steer" in c.joints)
-        want = float(model.robot.heading_of_beta(np.where(np.arange(len(beta)) == j, f, beta))[j])
+        j, ref, want, name = breach
         by = "whatever the others do" if ref is None else (f"with column '{steered[ref]}.heading' at "
                                                         f"{href[k, ref]:.6g} rad")
         raise WmrkitError(f"{source}:{k + 2}: column '{steered[j]}.heading': {href[k, j]:.6g} rad breaks {name}, "
                           f"which sets {steered[j]} at heading {want:.6g} rad {by}: the steering servos would fight "
                           f"the linkage the dynamics hold; give headings on its law (within {SETPOINT_TOL:g} rad) or "
                           "one heading column per linkage (docs/dynamics.md)")
-
-
-def _lerp(at: np.ndarray, t: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """The columns of `values` ``(K, m)`` at knots `t` interpolated linearly at the times `at`."""
-    return np.column_stack([np.interp(at, t, column) for column in values.T])
 
 
 def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
@@ -351,14 +347,8 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     for k, c in enumerate(model.steer_columns):
         if c in headings:
             href[:, k] = headings[c]
-    commanded = [k for k, c in enumerate(model.steer_columns) if c in headings]
-    _check_setpoints(source, model, href, commanded)
-    beta = model.robot.beta_of_heading(href)
-    knots, on_law = setpoint_knots(model, t, beta, set(commanded))  # the followers on the law between the rows
-    if len(knots) > len(t):
-        href = _lerp(knots, t, href) + on_law - _lerp(knots, t, beta)
-        torques = {name: np.interp(knots, t, column) for name, column in torques.items()}
-    inputs = Inputs.torques_only(model, knots, torques)
+    _check_setpoints(source, model, href, [k for k, c in enumerate(model.steer_columns) if c in headings])
+    inputs = Inputs.torques_only(model, t, torques)  # between rows, the linkages' followers on their laws (Inputs)
     kp, kd = steering_gains(model, list(headings))
     return Inputs(inputs.time, inputs.torques, inputs.rate_reference, inputs.rate_gain, inputs.torque_limit,
                   readonly(href), readonly(kp), readonly(kd))

@@ -168,7 +168,7 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     if not 0 < rtol < 1:
         raise WmrkitError(f"rtol: expected a relative tolerance in (0, 1), got {rtol}")
     s0 = initial_state(model, initial_twist, initial_pose)
-    inp = compiled_inputs(model, inputs)
+    inp = compiled_inputs(model, inputs, refuse=True)
     if method == "adaptive":
         rec, info = adaptive_run(model, s0, inp, duration, record, rtol, allow_lift_off)
     else:
@@ -279,7 +279,8 @@ class Stepper:
         """Hold new joint references from now on (a controller's period): wheel-rate references ``(n,)`` [rad/s]
         over ``model.names``, steering headings ``(n_steer,)`` [rad], feed-forward torques ``(n,)`` [N m]. Gains,
         limits and the values not given are those of the last inputs at the current time (in place, a few µs; new
-        rows while the stepper logs them)."""
+        rows while the stepper logs them). Headings that break a held linkage are not refused (as :meth:`advance`'s
+        are not)."""
         if self._inputs is None:
             raise WmrkitError("hold: give inputs (their servo gains) to advance() first")
         tk, tau, rref, gain, limit, bref, kp, kd, steer_limit = self._inputs
