@@ -21,6 +21,8 @@ from pathlib import Path
 import numba
 import numpy as np
 from numba.core.caching import FunctionCache
+from numba.core.dispatcher import Dispatcher
+from numba.core.serialize import dumps
 from numba.extending import overload
 
 #: Array elements a kernel may process as plain Python, over the whole process, before it is compiled. Set the
@@ -91,10 +93,32 @@ def compile_cached(fn: Callable, signature=None, **options) -> Callable:
     at import when no directory is writable."""
     args = () if signature is None else (signature,)  # None: compiled for the types of its first call
     try:
-        return numba.njit(*args, cache=True, **options)(fn)
+        kernel = numba.njit(*args, cache=True, **options)(fn)
     except RuntimeError:  # numba: "cannot cache function ...: no locator available for file ..."
         UNCACHED.add(f"{fn.__module__}.{fn.__qualname__}")
         return numba.njit(*args, **options)(fn)
+    if any(isinstance(c.cell_contents, Dispatcher) for c in fn.__closure__ or ()):
+        kernel._cache = _KernelsKeyedCache(fn)
+    return kernel
+
+
+class _KernelsKeyedCache(FunctionCache):
+    """Numba's disk cache of a kernel whose closure holds other kernels (``control.tick``: the robot's IK), keyed by
+    what they compute: numba keys a closure by the pickle of its cells, and a kernel pickles with an identifier drawn
+    at random in each process, so that such a kernel was compiled again in every process (and its cache grew by one
+    entry each time). Their source files are the kernel's helpers for :func:`drop_stale_cache`."""
+
+    def _index_key(self, sig, codegen):
+        return sig, codegen.magic_tuple(), hashlib.sha256(_closure_key(self._py_func)).hexdigest()
+
+
+def _closure_key(fn: types.FunctionType) -> bytes:
+    """`fn`'s bytecode and its closure's contents, each kernel among them by its own such key."""
+    parts = [fn.__qualname__.encode(), fn.__code__.co_code]
+    for cell in fn.__closure__ or ():
+        value = cell.cell_contents
+        parts.append(_closure_key(value.py_func) if isinstance(value, Dispatcher) else dumps(value))
+    return b"".join(hashlib.sha256(part).digest() for part in parts)
 
 
 def cache_dir(source: str | Path) -> Path | None:

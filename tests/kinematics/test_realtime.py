@@ -233,3 +233,56 @@ def test_a_second_process_loads_the_compiled_kernels_from_the_cache(tmp_path):
     assert all(hits >= 1 and misses == 0 for hits, misses in run(0.4).values())
     other = run(0.6)  # the rates checked against wheel_commands: not the 0.4 m robot's kernel
     assert other["ik"][1] >= 1 and other["fk"][1] >= 1
+
+
+#: A process compiling or loading the control tick of a differential drive of track `track` for the P law of gain
+#: `gain`, printing its numba cache hits and misses, its twist and rates for one pose, and law_controller's twist
+#: and wheel_commands' rates (the numbers, whatever the cache gave).
+_TICK_PROCESS = """
+import json, sys
+import numpy as np
+from wmrkit import wheel_commands
+from wmrkit.control import PositionLaw, control_point, control_tick
+from wmrkit.control.loop import law_controller
+from wmrkit.control.references import Reference
+from wmrkit.description import robot_from_dict
+robot = robot_from_dict(json.loads(sys.argv[1]))
+law = PositionLaw.uniform("p", float(sys.argv[2]))
+tick = control_tick(robot, law).tick
+twist, rates = np.zeros(3), np.zeros(2)
+tick(0.0, 0.1, 0.2, 1.0, 0.0, 0.0, 0.5, 0.0, 0.0, np.zeros(0), twist, rates, np.zeros(0))
+ref = Reference("still", np.array([0.0, 1.0]), np.array([[1.0, 0.0, 0.0]] * 2),
+                np.array([[0.5, 0.0, 0.0]] * 2), np.zeros((2, 3)))
+want, _ = law_controller(control_point(robot), law, ref)(0.0, np.array([0.0, 0.1, 0.2]), np.zeros(3))
+print(json.dumps({"stats": [sum(tick.stats.cache_hits.values()), sum(tick.stats.cache_misses.values())],
+                  "twist": twist.tolist(), "want": want.tolist(), "rates": rates.tolist(),
+                  "expected": wheel_commands(robot, want).rates.tolist()}))
+"""
+
+
+def test_a_second_process_loads_the_control_tick_from_the_cache(tmp_path):
+    """control_tick's kernel (the law around the robot's IK) was compiled in every process (cache=False; numba's
+    key of a closure holding a kernel changes in every process). Now a second process loads it (a cache hit, no
+    miss), and a robot of another track, or another gain, compiles its own and gives its own numbers."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba"), "WMRKIT_INTERPRET_BUDGET": "0"}
+
+    def run(track: float, gain: float) -> list[int]:
+        wheels = [{"name": n, "type": "fixed", "position": [0.0, y], "heading": 0.0, "r": 0.1,
+                   "actuated": ["spin"], "sensed": ["spin"]} for n, y in (("left", track / 2), ("right", -track / 2))]
+        out = subprocess.run([sys.executable, "-c", _TICK_PROCESS, json.dumps({"name": "dd", "wheels": wheels}),
+                              str(gain)], env=env, capture_output=True, text=True, timeout=600)
+        assert out.returncode == 0, out.stderr[-800:]
+        answer = json.loads(out.stdout)
+        np.testing.assert_allclose(answer["twist"], answer["want"], rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(answer["rates"], answer["expected"], rtol=1e-12, atol=1e-12)
+        return answer["stats"]
+
+    hits, misses = run(0.4, 1.0)
+    assert hits == 0 and misses == 1
+    assert run(0.4, 1.0) == [1, 0]
+    assert run(0.6, 1.0)[1] == 1 and run(0.4, 2.0)[1] == 1  # another IK, another law: not the first's kernel

@@ -9,6 +9,7 @@ controller), compiled here together with the robot's per-wheel IK kernel of
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -24,6 +25,9 @@ from .points import ControlError, ControlPoint, control_point
 __all__ = ["ControlTick", "control_tick", "scalar_law"]
 
 TWO_PI = 2.0 * math.pi
+#: Most bytes of compiled ticks cached for this file (one per robot and law, about 0.2 MB each, as
+#: :data:`wmrkit.kinematics.realtime.MAX_CACHE_BYTES`); beyond, the cache is dropped before the next tick compiles.
+MAX_CACHE_BYTES = 32 << 20
 
 
 @dataclass(frozen=True, eq=False)
@@ -97,17 +101,18 @@ def scalar_law(cp: ControlPoint, law: PositionLaw):
 
 
 def _tick_kernel(ik, law_twist):
-    """The tick: `law_twist` (:func:`scalar_law`) compiled around the robot's IK kernel `ik`."""
+    """The tick: `law_twist` (:func:`scalar_law`) compiled around the robot's IK kernel `ik`, cached on disk (keyed by
+    the IK's and the law's constants: one kernel per robot and law, :data:`MAX_CACHE_BYTES`)."""
     import numba
 
-    from .._jit import float64_vector
+    from .._jit import compile_cached, float64_vector
 
+    _drop_stale_ticks()
     law = numba.njit(inline="always")(law_twist)
     shapes = "tick: twist_out must be a float64 array of shape (3,)"
     big = MAX_COORDINATE
     bad = f"tick: the pose, the reference and its velocity must be finite, each at most {big:g} in size"
 
-    @numba.njit(cache=False)
     def tick(x, y, theta, x_ref, y_ref, theta_ref, vx_ref, vy_ref, omega_ref, heading, twist_out, rates_out,
              heading_out):
         if not (float64_vector(twist_out) and twist_out.shape[0] == 3):
@@ -119,4 +124,15 @@ def _tick_kernel(ik, law_twist):
         twist_out[0], twist_out[1], twist_out[2] = vx, vy, w
         return ik(vx, vy, w, heading, rates_out, heading_out)
 
-    return tick
+    return compile_cached(tick)  # a later process loads it (seconds to compile)
+
+
+@functools.cache
+def _drop_stale_ticks() -> None:
+    """Bound the ticks' cache and drop it when the code compiled into them changed (once per process, before the
+    first tick compiles or loads: :func:`~wmrkit._jit.drop_stale_cache`)."""
+    from .. import _jit
+    from ..kinematics import realtime
+
+    _jit.drop_stale_cache([__file__], [realtime.__file__, _jit.__file__])
+    _jit.drop_oversized_cache(__file__, MAX_CACHE_BYTES)
