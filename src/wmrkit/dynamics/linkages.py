@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from ..couplings import linkage_law
+from ..errors import WmrkitError
 from ..kinematics.linkage_law import LINKAGE_TOL, law
 from ..kinematics.linkage_law import leader_of as _leader_of
 
