@@ -110,7 +110,8 @@ def test_every_kernel_module_runs_with_no_writable_cache_directory(tmp_path):
            "XDG_CACHE_HOME": str(blocker / "cache"), "HOME": str(blocker / "home")}
     env.pop("NUMBA_CACHE_DIR", None)
     modules = ("_constraint_kernel", "control._jump_kernels", "dynamics._integrate", "dynamics._kernels",
-               "kinematics.realtime", "odometry._kernels", "odometry._steering_kernels", "slip._kalman_kernel")
+               "kinematics._linkage_kernel", "kinematics.realtime", "odometry._kernels", "odometry._steering_kernels",
+               "slip._kalman_kernel")
     code = (f"import importlib, numpy as np; [importlib.import_module('wmrkit.' + m) for m in {modules!r}]; "
             "from wmrkit import catalog; from wmrkit.kinematics.realtime import realtime; "
             "rt = realtime(catalog.load('diff-drive')); pose = np.zeros(3); "

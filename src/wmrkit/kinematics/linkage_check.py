@@ -28,7 +28,11 @@ import numpy as np
 
 from ..robot import Robot
 from ..wheels import heading_from_beta
-from .linkage_law import LINKAGE_TOL, law, leader_of, linkage_table
+from .linkage_law import LINKAGE_TOL, law, leader_of, linkage_table, remainder
+
+#: Twists from which a batch is judged by the compiled kernel (:mod:`._linkage_kernel`), below by its Python
+#: source: numba takes a moment to import, a few twists do not.
+COMPILED_BATCH = 64
 
 
 class LinkageAngleWarning(UserWarning):
@@ -38,12 +42,15 @@ class LinkageAngleWarning(UserWarning):
 
 @dataclass(frozen=True, eq=False)
 class _Plan:
-    """A robot's held linkages: per linkage its position in ``robot.couplings``, its columns (the leader's first),
-    its table rows (as lists) and the ``(column, row)`` of the wheels its leader's angle can be found from (the leader,
-    row None; a follower whose law turns it)."""
+    """A robot's held linkages, flat for a loop (read-only arrays): the follower rows of :func:`linkage_table`,
+    linkage ``g``'s rows ``start[g]:start[g + 1]``, its leader's column ``lead[g]`` and its position in
+    ``robot.couplings`` ``coupling[g]``; the steering axes ``x``, ``y`` [m] ``(n_steer,)``."""
 
-    groups: tuple[tuple[int, list[int], list[list[float]], list[tuple[int, list[float] | None]]], ...]
-    x: np.ndarray  # (n_steer,) steering axes [m]
+    table: np.ndarray
+    start: np.ndarray
+    lead: np.ndarray
+    coupling: np.ndarray
+    x: np.ndarray
     y: np.ndarray
 
 
@@ -51,14 +58,53 @@ class _Plan:
 def _plan(robot: Robot) -> _Plan:
     names = tuple(f"{n}.steer" for n in robot.steer_names)
     table = linkage_table(robot, names, strict=False)
-    groups = []
-    for lead in dict.fromkeys(int(r[1]) for r in table):
-        index = next(i for i, c in enumerate(robot.couplings) if c.kind == "linkage" and names[lead] in c.joints)
-        rows = table[table[:, 1] == lead].tolist()
-        able = [(lead, None), *((int(r[0]), r) for r in rows if r[3] == 0.0 or r[5] != 0.0)]
-        groups.append((index, [lead, *(int(r[0]) for r in rows)], rows, able))
+    leads = list(dict.fromkeys(int(r[1]) for r in table))
+    coupling = [next(i for i, c in enumerate(robot.couplings) if c.kind == "linkage" and names[k] in c.joints)
+                for k in leads]
+    rows = [table[table[:, 1] == k] for k in leads]
     xy = np.array([robot.wheel(n).position for n in robot.steer_names], dtype=float).reshape(-1, 2)
-    return _Plan(tuple(groups), xy[:, 0], xy[:, 1])
+    arrays = (np.concatenate([table[:0], *rows]), np.cumsum([0, *map(len, rows)]).astype(np.int64),
+              np.array(leads, dtype=np.int64), np.array(coupling, dtype=np.int64), xy[:, 0].copy(), xy[:, 1].copy())
+    for a in arrays:
+        a.flags.writeable = False
+    return _Plan(*arrays)
+
+
+def _breach(table, first, last, lead, beta, speed, by_speed, slip_tol, tol):
+    """The first wheel that the linkage of rows `first:last` of `table` (leader column `lead`) breaks at steering
+    angles `beta` ``(n_steer,)``: ``(column, want, reference column, slip)``, column -1 for none (written to compile:
+    :mod:`._linkage_kernel`). `by_speed` (ik): axis speeds `speed`, mod pi on the slip floor, the reference the first
+    of the fastest wheels the leader's angle can be found from (the leader, a follower whose law turns it); else
+    (fk) mod 2 pi within `tol`, the reference the leader."""
+    ref, ref_row = lead, -1
+    if by_speed:
+        top = speed[lead]
+        for r in range(first, last):
+            top = max(top, speed[int(table[r, 0])])
+        if top == 0.0:
+            return -1, 0.0, lead, 0.0
+        for r in range(first, last):
+            k = int(table[r, 0])
+            if (table[r, 3] == 0.0 or table[r, 5] != 0.0) and speed[k] > speed[ref]:
+                ref, ref_row = k, r
+    b = beta[lead] if ref_row < 0 else leader_of(table[ref_row], beta[ref])
+    period = math.pi if by_speed else 2.0 * math.pi
+    for r in range(first - 1, last):  # the leader, then its followers
+        k = lead if r < first else int(table[r, 0])
+        off = remainder(beta[k] - (b if r < first else law(table[r], b)[0]), period)
+        slip = speed[k] * abs(math.sin(off)) if by_speed else 0.0
+        if abs(off) > tol and (slip > slip_tol or not by_speed):
+            return k, beta[k] - off, ref, slip
+    return -1, 0.0, ref, 0.0
+
+
+def _holds(table, start, lead, coupling, beta, speed, slip_tol, tol, out):
+    """:func:`linkage_holds` over rows ``(N, n_steer)`` of `beta` and `speed`: `out` ``(N, n_couplings)`` (all True
+    on entry) False at each linkage broken (written to compile: :mod:`._linkage_kernel`)."""
+    for i in range(beta.shape[0]):
+        for g in range(lead.shape[0]):
+            if _breach(table, start[g], start[g + 1], lead[g], beta[i], speed[i], True, slip_tol, tol)[0] >= 0:
+                out[i, coupling[g]] = False
 
 
 @dataclass(frozen=True)
@@ -87,25 +133,15 @@ class Breach:
                 f"{head[0]:.6g} deg with {names[self.reference]} at {head[1]:.6g} deg, not {head[2]:.6g} deg")
 
 
-def _judge(plan: _Plan, beta: list[float], speed: list[float] | None, slip_tol: float, tol: float) -> list[Breach]:
-    """The breaches of steering angles `beta` ``(n_steer,)``: with axis speeds `speed` (ik) mod pi on the slip
-    floor, the reference the fastest; without (fk) mod 2 pi within `tol`, the reference the leader."""
+def _judge(plan: _Plan, beta: np.ndarray, speed: np.ndarray | None, slip_tol: float, tol: float) -> list[Breach]:
+    """The breaches of steering angles `beta` ``(n_steer,)`` (:func:`_breach`; `speed` None: fk's)."""
     out = []
-    for index, members, rows, able in plan.groups:
-        lead = members[0]
-        ref, ref_row = lead, None
-        if speed is not None:
-            if max(speed[k] for k in members) == 0.0:
-                continue
-            ref, ref_row = max(able, key=lambda a: speed[a[0]])  # the first of the fastest: the leader on a tie
-        b = beta[lead] if ref_row is None else leader_of(ref_row, beta[ref])
-        wants = [b, *(law(r, b)[0] for r in rows)]
-        for k, want in zip(members, wants, strict=True):
-            off = math.remainder(beta[k] - want, math.pi if speed is not None else 2 * math.pi)
-            slip = 0.0 if speed is None else speed[k] * abs(math.sin(off))
-            if abs(off) > tol and (speed is None or slip > slip_tol):
-                out.append(Breach(index, k, float(beta[k]), float(beta[k] - off), ref, float(beta[ref]), slip))
-                break
+    for g in range(len(plan.lead)):
+        k, want, ref, slip = _breach(plan.table, int(plan.start[g]), int(plan.start[g + 1]), int(plan.lead[g]), beta,
+                                     beta if speed is None else speed, speed is not None, slip_tol, tol)
+        if k >= 0:
+            out.append(Breach(int(plan.coupling[g]), k, float(beta[k]), float(want), ref, float(beta[ref]),
+                              float(slip)))
     return out
 
 
@@ -119,26 +155,29 @@ def ik_breaches(robot: Robot, twist: np.ndarray, beta: np.ndarray, slip_tol: flo
     """The linkages (one breach each, the first wheel off) that ``ik``'s steering `beta` ``(n_steer,)`` for one
     `twist` ``(3,)`` breaks (module docstring)."""
     plan = _plan(robot)
-    if not plan.groups:
+    if not len(plan.lead):
         return []
-    speed = _speeds(plan, np.asarray(twist, dtype=float)).tolist()
-    return _judge(plan, np.asarray(beta, dtype=float).tolist(), speed, slip_tol, LINKAGE_TOL)
+    speed = _speeds(plan, np.asarray(twist, dtype=float))
+    return _judge(plan, np.asarray(beta, dtype=float), speed, slip_tol, LINKAGE_TOL)
 
 
 def linkage_holds(robot: Robot, twist: np.ndarray, beta: np.ndarray, slip_tol: float) -> np.ndarray:
     """``(..., n_couplings)`` bool: False at a linkage the steering `beta` ``(..., n_steer)`` that ``ik`` gives for
-    `twist` ``(..., 3)`` breaks (:func:`ik_breaches`); True for the other couplings."""
+    `twist` ``(..., 3)`` breaks (:func:`ik_breaches`); True for the other couplings. A batch of at least
+    :data:`COMPILED_BATCH` twists is judged by the compiled :func:`_holds` (numba loads on first use)."""
     plan = _plan(robot)
     batch = np.broadcast_shapes(twist.shape[:-1], beta.shape[:-1])
     out = np.ones((*batch, len(robot.couplings)), dtype=bool)
-    if not plan.groups:
+    if not len(plan.lead):
         return out
-    speed = np.broadcast_to(_speeds(plan, twist), (*batch, len(plan.x))).reshape(-1, len(plan.x)).tolist()
-    flat_beta = np.broadcast_to(beta, (*batch, len(plan.x))).reshape(-1, len(plan.x)).tolist()
-    flat = out.reshape(-1, len(robot.couplings))
-    for i, (b_i, s_i) in enumerate(zip(flat_beta, speed, strict=True)):
-        for b in _judge(plan, b_i, s_i, slip_tol, LINKAGE_TOL):
-            flat[i, b.coupling] = False
+    n = len(plan.x)
+    speed = np.broadcast_to(_speeds(plan, twist), (*batch, n)).reshape(-1, n)
+    flat_beta = np.broadcast_to(beta, (*batch, n)).reshape(-1, n)
+    holds = _holds
+    if len(speed) >= COMPILED_BATCH:
+        from ._linkage_kernel import holds
+    holds(plan.table, plan.start, plan.lead, plan.coupling, flat_beta, speed, float(slip_tol), LINKAGE_TOL,
+          out.reshape(-1, len(robot.couplings)))
     return out
 
 
@@ -147,4 +186,4 @@ def given_breaches(robot: Robot, beta: np.ndarray, rtol: float) -> list[Breach]:
     off the law at its leader's angle by more than ``asin(rtol)`` (mod 2 pi; module docstring)."""
     plan = _plan(robot)
     tol = math.asin(min(rtol, 1.0))
-    return _judge(plan, np.asarray(beta, dtype=float).tolist(), None, 0.0, tol) if plan.groups else []
+    return _judge(plan, np.asarray(beta, dtype=float), None, 0.0, tol) if len(plan.lead) else []

@@ -114,8 +114,20 @@ def leader_of(row, beta: float) -> float:
     s0, c0 = math.sin(row[8] - row[7]), math.cos(row[8] - row[7])
     psi_j = beta - row[9] + math.atan2(xj * s0, xi * c0 + dy * s0)  # the follower's psi: its rest one's + turn
     psi_i = math.atan2(xi * math.sin(psi_j), xj * math.cos(psi_j) - dy * math.sin(psi_j))
-    lead = row[8] + math.remainder(psi_i + row[7] - row[8], math.pi)
-    return lead if abs(math.remainder(law(row, lead)[0] - beta, 2 * math.pi)) < math.pi / 2 else lead + math.pi
+    lead = row[8] + remainder(psi_i + row[7] - row[8], math.pi)
+    return lead if abs(remainder(law(row, lead)[0] - beta, 2 * math.pi)) < math.pi / 2 else lead + math.pi
+
+
+def remainder(x, y):
+    """``math.remainder(x, y)`` for finite `x` and ``y > 0``, exact, written to compile (numba has no
+    ``math.remainder``): ``fmod`` by ``2 y`` (exact), then down by ``y`` at most twice (exact, a tie to the even
+    quotient), as C libraries reduce."""
+    r = abs(np.fmod(x, 2.0 * y))
+    if r > 0.5 * y:
+        r -= y
+        if r >= 0.5 * y:
+            r -= y
+    return float(r) if math.copysign(1.0, x) > 0 else float(-r)
 
 
 def _axle(robot, c) -> tuple[np.ndarray, float]:
