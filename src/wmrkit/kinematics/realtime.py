@@ -5,7 +5,8 @@ forward_kinematics`, :func:`wmrkit.odometry.odometry`) are made for arrays of tw
 twist pays tens of microseconds of NumPy overhead. :func:`realtime` compiles, once per robot, a numba kernel with the
 robot's geometry frozen in as constants, cached on disk (numba keys it by those constants: another robot's is
 another kernel), so that a later process loads it instead of compiling it again (seconds). Each call then takes
-scalars and caller-owned arrays and writes its results into them: no Python objects are created per call. The
+scalars and caller-owned arrays and writes its results into them: no Python objects are created per call (the ik of
+a robot with a held linkage allocates one array, its steering axes' speeds). The
 numbers are those of the batched path (same formulas: the three wheel groups of ``_ik_fast`` (§8.4), the sensed
 direct model (4.11) of :func:`wmrkit.odometry.odometry_model`, the exact SE(2) step of paper 003 with the same
 inlined sine and cosine). ``benchmarks/bench_realtime.py`` times them
@@ -35,15 +36,18 @@ from ..odometry import _kernels
 from ..odometry._kernels import _cos_sin, _sinc
 from ..robot import Robot
 from ..units import MAX_ANGLE, MAX_TURNS
-from . import _ik_fast
+from . import _ik_fast, _linkage_kernel, linkage_check, linkage_law
+from ._linkage_kernel import _breach
 from .gear_check import GEAR_RTOL, gear_table
+from .linkage_law import LINKAGE_TOL
 from .wheel_ik import SLIP_TOL, check_tolerances
 
 #: Most bytes of compiled kernels cached for this file (one set per robot, about 0.2 MB: some 150 robots); beyond, the
 #: cache is dropped at import (:func:`~wmrkit._jit.drop_oversized_cache`).
 MAX_CACHE_BYTES = 32 << 20
 
-drop_stale_cache([__file__], [_kernels.__file__, _jit.__file__])
+drop_stale_cache([__file__], [_kernels.__file__, _jit.__file__, _linkage_kernel.__file__, linkage_check.__file__,
+                              linkage_law.__file__])
 drop_oversized_cache(__file__, MAX_CACHE_BYTES)
 
 HALF_PI = 0.5 * math.pi
@@ -58,7 +62,8 @@ class Realtime:
     - ``ik(vx, vy, omega, heading, rates_out, heading_out) -> bool``: per-wheel IK of one twist. `heading`
       ``(n_steer,)`` the current headings [rad]; writes the joint rates ``(n_rates,)`` (``robot.rate_names``) and
       the new headings; returns whether the twist is feasible (no fixed wheel slips beyond 1e-9 m/s, every heading
-      within its wheel's ``steer_range``, every gear coupling's rates in its ratios), as ``wheel_commands``.
+      within its wheel's ``steer_range``, every gear coupling's rates in its ratios, every held linkage's angles on
+      its law), as ``wheel_commands``.
     - ``fk(rates, heading, twist_out)``: the twist ``(3,)`` from the sensed joint rates ``(n_a,)`` (``rate_joints``)
       by the least squares (4.11), at headings ``(n_steer_sensed,)`` of ``steer_joints`` (ignored when constant).
     - ``odometry_step(pose, previous, positions, heading_mid)``: one exact SE(2) step; `pose` ``(3,)`` is updated
@@ -137,6 +142,9 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
     gears = gear_table(robot, robot.rate_names)  # wheel_commands' in_gear (gear_check.gears_hold), flattened
     gear_cols, gear_k, gear_lever, gear_start = gears.joint, gears.ratio, gears.lever, gears.start
     n_gears, gear_rtol = len(gears.coupling), GEAR_RTOL
+    links = linkage_check._plan(robot)  # wheel_commands' in_linkage (linkage_check.linkage_holds), its judge compiled
+    link_table, link_start, link_lead, link_x, link_y = links.table, links.start, links.lead, links.x, links.y
+    n_links, link_tol = len(links.lead), LINKAGE_TOL
 
     def ik(vx, vy, w, heading, rates_out, heading_out):
         if not (float64_vector(rates_out) and float64_vector(heading_out) and heading.shape[0] == n_steer
@@ -183,6 +191,14 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             if abs(slip) > slip_tol and abs(slip) > (abs(vx) * roundoff[0, f] + abs(vy) * roundoff[1, f]
                                                      + abs(w) * roundoff[2, f]):  # not round-off (wheel_commands)
                 feasible = False
+        if n_links and feasible:  # the axes' speeds (linkage_check._speeds), each linkage judged on the angles
+            speed = np.empty(n_steer)
+            for k in range(n_steer):
+                speed[k] = math.hypot(vx - w * link_y[k], vy + w * link_x[k])
+            for g in range(n_links):
+                if _breach(link_table, link_start[g], link_start[g + 1], link_lead[g], beta, speed, True, slip_tol,
+                           link_tol)[0] >= 0:
+                    feasible = False
         for k in range(n_steer):
             beta[k] = _wrap(beta[k] + delta[k] - HALF_PI)
             if ranged[k] and not _in_range(beta[k], lo[k], width[k]):
