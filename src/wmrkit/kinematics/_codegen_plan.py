@@ -20,6 +20,7 @@ from ..robot import TWIST_NAMES, Robot
 from ._symbolic_held import combine, held_gears, substituted_form
 from .gear_check import gear_table
 from .linalg import free_columns, matrix_rank, nondimensional
+from .linkage_check import _plan as linkage_plan
 from .models import generic_inputs
 from .symbolic import sensed_rates, symbolic_constraint_matrix, symbolic_model
 
@@ -77,6 +78,9 @@ class Plan:
         # the gears over the rates then the steering rates (gear_check's tables: ik's check), and their names
         self.gear_table = gear_table(robot, (*self.rates, *self.free_steer))
         self.gear_names = tuple(robot.couplings[i].channel_name for i in self.gear_table.coupling)
+        # the held linkages (linkage_check's flat plan: ik's check of the headings) and their names
+        self.links = linkage_plan(robot)
+        self.linkage_names = tuple(robot.couplings[int(i)].channel_name for i in self.links.coupling)
 
     def _check_forward(self) -> None:
         beta = np.random.default_rng(7).uniform(-math.pi, math.pi, (3, len(self.robot.steer_names)))

@@ -7,6 +7,7 @@ import json
 import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
+from ._codegen_linkage import has_linkages, py_constants, py_in_linkage
 from ._codegen_plan import Plan, cse
 from .gear_check import GEAR_RTOL
 from .symbolic import printable
@@ -90,6 +91,13 @@ def in_gear({args}):
     return numpy.stack(out, axis=-1)'''
 
 
+def _py_imports(plan: Plan) -> str:
+    """The generated module's imports: numpy, and for the linkages' judge math and numpy as ``np``."""
+    if has_linkages(plan):
+        return "\nimport math\n\nimport numpy\n\nnp = numpy  # the linkages' judge (below) names it np\n"
+    return "\nimport numpy\n"
+
+
 def python_file(plan: Plan) -> list[tuple[str, str]]:
     r = plan.robot
     unpack = "\n".join(f"    b{i} = beta[..., {i}]  # {printable(n)}" for i, n in enumerate(r.steer_names))
@@ -129,9 +137,7 @@ robot frame x forward, y left. Arrays take leading batch axes, which broadcast:
 - wheel rates: ``(..., {len(plan.rates)})`` [rad/s], order ``RATE_NAMES``;
 - ``sensed``: ``(..., {len(plan.sensed)})`` [rad/s], order ``SENSED_NAMES``.
 """
-
-import numpy
-
+{_py_imports(plan)}
 STEER_NAMES = {tuple(r.steer_names)!r}
 RATE_NAMES = {tuple(plan.rates)!r}
 SENSED_NAMES = {tuple(plan.sensed)!r}
@@ -139,7 +145,7 @@ FREE_STEER_NAMES = {tuple(plan.free_steer)!r}
 VELOCITY_NAMES = {tuple(r.velocity_names)!r}
 HEADING_DESCRIBED = {tuple(float(h) for h in r.heading)!r}
 _BETA_OFFSET = {tuple(plan.offsets)!r}  # the thesis's beta = heading + pi/2 - delta
-{_py_unknowns(plan)}
+{_py_unknowns(plan)}{py_constants(plan)}
 
 
 def _beta(heading):
@@ -180,7 +186,7 @@ def inverse_matrix(heading=None):
     return out
 
 
-{inverse_def}{_py_in_gear(plan)}
+{inverse_def}{_py_in_gear(plan)}{py_in_linkage(plan)}
 
 
 def forward_with_residual(sensed, heading=None):

@@ -25,6 +25,7 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
 from ..robot import Robot
+from . import _codegen_linkage
 from ._codegen_plan import C_KEYWORDS, CodegenError, Plan, cse, identifier
 from ._codegen_python import python_file
 from .gear_check import GEAR_RTOL
@@ -194,6 +195,9 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
     if plan.geared:  # wmrkit ik's check of the inverse model's rates
         sizes["N_GEARS"] = len(plan.gear_names)
         protos.append(f"int {n}_in_gear(const double rates[{p}_N_RATES], {steer_param}int in_gear[{p}_N_GEARS]);")
+    if _codegen_linkage.has_linkages(plan):  # wmrkit ik's check of the headings against the linkages' laws
+        sizes["N_LINKAGES"] = len(plan.linkage_names)
+        protos.append(f"int {n}_in_linkage(const double twist[3], {beta_param}, int in_linkage[{p}_N_LINKAGES]);")
     work_bytes = 8 * sizes["N_WORK"]
     header = "\n".join([
         f"/* {n}_kinematics.h: no-slip kinematic models of robot '{_c_comment(r.name)}' (L. Gracia's thesis, ch. 4).",
@@ -223,6 +227,8 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
            f"a static buffer (not reentrant: over {8 * MAX_STACK_WORK} bytes, too many for small stacks)."),
         f" * {n}_forward_work: {n}_forward in the caller's workspace, work[{p}_N_WORK] (reentrant: one per thread).",
         *(_c_gear_doc(plan) if plan.geared else []),
+        *(_codegen_linkage.c_doc(plan, _c_list(" *   Linkages", plan.linkage_names))
+          if _codegen_linkage.has_linkages(plan) else []),
         " */",
         f"#ifndef {p}_KINEMATICS_H", f"#define {p}_KINEMATICS_H", "",
         *[f"#define {p}_{k} {v}" for k, v in sizes.items()], "",
@@ -251,7 +257,8 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
         f"    for (int i = 0; status == 0 && i < {na}; ++i) if (!isfinite(x[i])) status = -1; /* NaN or inf input */",
         "    for (int i = 0; i < 3; ++i) twist[i] = status == 0 ? x[i] : (double)NAN;",
         "    if (status != 0 && residual) *residual = NAN;",
-        "    return status;", "}", "", *_c_in_gear(plan, protos[-1]),
+        "    return status;", "}", "", *_c_in_gear(plan, protos[4] if plan.geared else ""),
+        *_codegen_linkage.c_in_linkage(plan, protos[-1]),
     ])
     return [(f"{n}_kinematics.h", header), (f"{n}_kinematics.c", source)]
 
