@@ -27,6 +27,7 @@ from .._shapes import as_vectors, readonly
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from ..wheels import heading_in_range, wrap_angle
+from .linked_ranges import LinkedRanges
 from .points import ControlError
 
 __all__ = ["POLICIES", "SteeringChoice", "ackermann_twist", "check_policy", "choose_steering", "crab_twist",
@@ -187,21 +188,34 @@ def range_keeper(robot: Robot, policy: str = "closest") -> Callable[[np.ndarray,
     ``steer_range`` (its spins for that root, :func:`reverse_spins`), or to the end of the range nearest to either
     root when neither fits; returns which fitted (:func:`.steering.choose_steering`); every steered wheel's
     steering is actuated (:func:`check_steering_driven`). With ``"closest"`` and no range it does nothing: the IK
-    has picked the root closest to `current` already."""
+    has picked the root closest to `current` already.
+
+    The wheels of a ``linkage`` the dynamics hold are not kept one by one (that breaks the linkage): its leader is
+    kept within the arc where every linked wheel fits its range, and the followers are set from it by the
+    linkage's law (:class:`.linked_ranges.LinkedRanges`), their spins negated where they turn half round; when the
+    leader is held at an end of that arc, none of the linkage's wheels fitted."""
     check_policy(policy)
     ranges, columns = steer_ranges(robot), spin_columns(robot)
+    links = LinkedRanges.of(robot, ranges)
     chosen = (np.isfinite(ranges).any(axis=1) | (policy != "closest")) & (columns[:, 0] >= 0)
-    columns = columns[chosen]
+    if links is not None:
+        ranges = links.ranges
+        chosen[links.leaders] |= np.isfinite(ranges[links.leaders]).any(axis=1) & (columns[links.leaders, 0] >= 0)
+        chosen[links.followers] = False
+    steered = columns[chosen]
 
     def keep(heading: np.ndarray, rates: np.ndarray, current: np.ndarray) -> np.ndarray:
-        if not chosen.any():
-            return np.ones(len(heading), dtype=bool)
-        ch = choose_steering(heading[chosen], unit_spin(rates, columns), current[chosen], policy=policy,
-                             ranges=ranges[chosen])
-        heading[chosen] = ch.heading
-        reverse_spins(rates, columns, ch.reversed)
         fits = np.ones(len(heading), dtype=bool)
-        fits[chosen] = ch.in_range
+        if chosen.any():
+            ch = choose_steering(heading[chosen], unit_spin(rates, steered), current[chosen], policy=policy,
+                                 ranges=ranges[chosen])
+            heading[chosen] = ch.heading
+            reverse_spins(rates, steered, ch.reversed)
+            fits[chosen] = ch.in_range
+        if links is not None:
+            reverse_spins(rates, columns, links.follow(heading) & (columns[:, 0] >= 0))
+            for row in links.table:
+                fits[int(row[0])] = fits[int(row[1])]
         return fits
 
     return keep

@@ -1,0 +1,89 @@
+"""Steering ranges of linked wheels (control/linked_ranges.py): the loops through the dynamics keep a held linkage's
+leader where every linked wheel fits its range and set the followers by the law, instead of clipping each wheel on
+its own. Checked against the closed-form Ackermann geometry of the linked car (wheelbase 0.6 m, track 0.4 m): the
+right wheel's heading whose axle meets the left one's on the rear axle line."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from dynamics_robots import linked_car
+
+from wmrkit import Robot
+from wmrkit.control import builtin_reference, control_point
+from wmrkit.control.dynamic_plant import fast_law_controller, simulate_dynamics
+from wmrkit.control.laws import PositionLaw
+from wmrkit.control.steering import range_keeper
+from wmrkit.control.track import initial_pose_on
+from wmrkit.dynamics.linkages import SETPOINT_TOL
+
+WHEELBASE, TRACK, LIMIT = 0.6, 0.4, 0.5
+
+
+def _right(left: float) -> float:
+    """fr's heading for fl's `left` (closed form: both axles through the ICR on the rear axle line; mod pi)."""
+    return math.atan(WHEELBASE / (WHEELBASE / math.tan(left) + TRACK)) if left else 0.0
+
+
+def _left(right: float) -> float:
+    """fl's heading for fr's `right` (the same geometry, solved for the left wheel)."""
+    return math.atan(WHEELBASE / (WHEELBASE / math.tan(right) - TRACK)) if right else 0.0
+
+
+def _ranged_car(fl=(-LIMIT, LIMIT), fr=(-LIMIT, LIMIT)) -> Robot:
+    data = linked_car().to_dict()
+    for w in data["wheels"]:
+        if w["name"] in ("fl", "fr"):
+            w["steer_range"] = list(fl if w["name"] == "fl" else fr)
+    return Robot.from_dict(data)
+
+
+def _keep(robot, fl: float, spins=(1.0, 1.0), policy="closest"):
+    headings = np.array([fl, _right(fl)])
+    rates = np.zeros(len(robot.rate_names))
+    for name, s in zip(("fl", "fr"), spins, strict=True):
+        rates[robot.rate_names.index(f"{name}.spin")] = s
+    fits = range_keeper(robot, policy)(headings, rates, np.zeros(2))
+    return headings, rates, fits
+
+
+@pytest.mark.parametrize("asked", [0.3, -0.3, 0.8, -0.8, 1.4, -0.9])  # the ICR beyond both wheels
+def test_the_kept_headings_are_on_the_law_and_in_range(asked):
+    """Before, a tight turn clipped fl and fr each at its own end, 0.5 and 0.5 (left) or -0.5 and -0.5 (right):
+    up to 0.1 rad off the law; now the inner wheel is at its end and the outer one where the law sets it."""
+    robot = _ranged_car()
+    (fl, fr), rates, fits = _keep(robot, asked)
+    assert fr == pytest.approx(_right(fl), abs=1e-12)
+    assert -LIMIT - 1e-12 <= fl <= LIMIT + 1e-12 and -LIMIT - 1e-12 <= fr <= LIMIT + 1e-12
+    if abs(asked) <= 0.3:  # both fit: kept as asked
+        assert (fl, fr) == pytest.approx((asked, _right(asked)), abs=1e-12) and fits.all()
+    elif asked > 0:  # a left turn: fl is the inner wheel
+        assert fl == pytest.approx(LIMIT, abs=1e-12) and not fits.any()
+    else:
+        assert fr == pytest.approx(-LIMIT, abs=1e-12) and fl == pytest.approx(_left(-LIMIT), abs=1e-12)
+        assert not fits.any()
+    assert rates[robot.rate_names.index("fl.spin")] == rates[robot.rate_names.index("fr.spin")] == 1.0
+
+
+def test_a_follower_narrower_than_its_leader_bounds_the_leader():
+    """fr within [-0.2, 0.2]: a left turn stops where fr reaches 0.2, fl at the closed form's 0.2-inverse."""
+    robot = _ranged_car(fr=(-0.2, 0.2))
+    (fl, fr), _, fits = _keep(robot, 0.45)
+    assert fr == pytest.approx(0.2, abs=1e-12) and fl == pytest.approx(_left(0.2), abs=1e-12) and not fits.any()
+
+
+def test_the_tracking_run_commands_headings_on_the_law_and_in_range():
+    """``wmrkit track lcar.json --reference corner --dynamics --size 1 --duration 10``: before, the commanded
+    headings were clipped wheel by wheel, fl at -0.5 and fr at +0.5 (1.2 rad off the law) for 8 s."""
+    robot = _ranged_car()
+    reference = builtin_reference("corner", size=1.0)
+    cp = control_point(robot)
+    out = simulate_dynamics(robot, fast_law_controller(cp, PositionLaw.uniform("p", 1.0), reference),
+                            initial_pose_on(cp, reference), 10.0, period=0.02)
+    heading = np.array(robot.heading_of_beta(out["target"]))
+    assert np.all(np.abs(heading) <= LIMIT + 1e-12)
+    off = [abs(math.remainder(fr - _right(fl), 2 * math.pi)) for fl, fr in heading]
+    assert max(off) <= SETPOINT_TOL
+    assert (np.abs(heading) >= LIMIT - 1e-12).any()  # the range was reached
