@@ -70,3 +70,52 @@ def test_a_twist_program_between_its_knots_keeps_the_law():
     fl, fr = (np.interp(t, compiled[0], headings[:, k]) for k in (0, 1))
     assert fl[-1] == pytest.approx(math.atan2(0.6, 1 / 0.7 - 0.2), abs=1e-12)
     assert np.abs(fr - [right_of(h) for h in fl]).max() <= SETPOINT_TOL
+
+
+def test_too_many_knots_is_a_one_line_error(monkeypatch):
+    """Before, setpoint_knots raised a NameError (WmrkitError was not imported in dynamics/linkages.py) where the
+    knots keeping a linkage's law between two knots would pass MAX_SETPOINT_KNOTS."""
+    from wmrkit.dynamics import linkages
+
+    monkeypatch.setattr(linkages, "MAX_SETPOINT_KNOTS", 3)
+    model = DynamicModel.of(linked_car())
+    with pytest.raises(WmrkitError, match="knots would keep a held linkage's followers on its law"):
+        compiled_inputs(model, _servo_inputs(model, [0.0, 1.0], [[0.0, 0.0], [0.5, right_of(0.5)]]))
+
+
+def test_a_stepper_refuses_what_simulate_refuses():
+    """Before, Stepper.advance ran these set-points, the servos fighting the linkage, where simulate() refused them."""
+    from wmrkit.dynamics.simulate import Stepper
+
+    model = DynamicModel.of(linked_car())
+    off = _servo_inputs(model, [0.0, 1.0], [[0.0, 0.0], [0.3, 0.0]])
+    with pytest.raises(WmrkitError) as err:
+        Stepper(model).advance(off, 0.01)
+    with pytest.raises(WmrkitError) as by_simulate:
+        simulate(model, off, 0.01)
+    assert str(err.value) == str(by_simulate.value)
+    fight = _servo_inputs(model, [0.0, 1.0], [[0.0, 0.0], [0.3, 0.0]], fight_linkages=True)
+    assert np.isfinite(Stepper(model).advance(fight, 0.01)).all()
+
+
+@pytest.mark.parametrize("fight", [False, True])
+def test_a_stepper_holds_headings_on_the_law_and_refuses_others(fight):
+    """Before, hold() wrote any headings into the servos' references; now those off the law are refused (nothing is
+    held: the state advances as before) unless the last inputs let the servos fight."""
+    from wmrkit.dynamics.simulate import Stepper
+
+    model = DynamicModel.of(linked_car())
+    stepper = Stepper(model)
+    stepper.advance(_servo_inputs(model, [0.0], [[0.0, 0.0]], fight_linkages=fight), 0.01)
+    stepper.hold(heading_reference=[0.3, right_of(0.3)])  # on the law
+    if fight:
+        stepper.hold(heading_reference=[0.3, 0.0])
+        return
+    with pytest.raises(WmrkitError) as err:
+        stepper.hold(heading_reference=[0.3, 0.0])
+    assert str(err.value).startswith(
+        f"hold: heading_reference: at t = 0.01 s, fr's 0 rad breaks linkage(fl.steer, fr.steer), which sets fr at "
+        f"heading {right_of(0.3):.6g} rad with fl's at 0.3 rad: the steering servos would fight")
+    stepper.advance(None, 0.2)
+    fl, fr = model.robot.heading_of_beta(stepper.state[list(model.steer_columns)])
+    assert fl > 0.1 and fr == pytest.approx(right_of(fl), abs=1e-9)  # turning to the held on-law headings

@@ -31,8 +31,8 @@ class Inputs:
     :attr:`~.simulate.Simulation.nominal_pose`. Checked when made (shapes that agree,
     times strictly increasing, finite values, gains and limits >= 0); a simulator checks the widths against its
     model, and the heading set-points of the servoed (``steer_kp > 0``) wheels of each ``linkage`` it holds: on its
-    law at every knot (within ``linkages.SETPOINT_TOL``; else :func:`~.simulate.simulate` refuses them, the servos
-    would fight it, and a :class:`~.simulate.Stepper` runs them as given) and, between knots, its followers set by
+    law at every knot (within ``linkages.SETPOINT_TOL``; else :func:`~.simulate.simulate` and a
+    :class:`~.simulate.Stepper` refuse them: the servos would fight it) and, between knots, its followers set by
     the law from the reference's interpolation (its leader's, else its first servoed follower's;
     :func:`~.linkages.setpoint_knots`); ``fight_linkages`` True: neither (the servos fight through the linkage, as
     :func:`~.programs.twist_program` lets them with ``allow_slip``).
@@ -127,12 +127,11 @@ def _check_inputs(inputs: Inputs) -> None:
                              f"{np.shape(inputs.twist)}")
 
 
-def compiled_inputs(model: DynamicModel, inputs: Inputs, refuse: bool = False) -> tuple:
+def compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
     """The kernels' inputs (writable C copies: one compiled signature); :class:`ShapeError` naming the field of
     `inputs` whose width does not fit `model` (the kernels would read out of bounds). Heading set-points on the law
     of each held linkage at every knot get knots between them on it (:class:`Inputs`); set-points off it at a knot
-    are refused if `refuse` (:func:`~.simulate.simulate`), else run as given (``fight_linkages``: a
-    :class:`~.simulate.Stepper`'s, whose loops through the dynamics may command linked wheels apart)."""
+    are refused (:func:`setpoint_problem`), unless ``inputs.fight_linkages``: then both are run as given."""
     arrays = [np.array(getattr(inputs, name), dtype=float, order="C") for name, _ in _INPUT_FIELDS]
     n, s = model.n, len(model.steer_columns)
     for (name, _), a, width in zip(_INPUT_FIELDS, arrays, (n, n, n, n, s, s, s), strict=True):
@@ -145,9 +144,9 @@ def compiled_inputs(model: DynamicModel, inputs: Inputs, refuse: bool = False) -
     commanded = set(np.flatnonzero(kp > 0).tolist())
     if len(model.pack[17]) and commanded and not inputs.fight_linkages:
         off = next(((k, p) for k, row in enumerate(href) if (p := setpoint_problem(model, row, commanded))), None)
-        if off and refuse:
+        if off:
             raise WmrkitError(f"heading_reference: at t = {tk[off[0]]:g} s, {off[1]}")
-        at, on_law = (tk, beta_ref) if off else setpoint_knots(model, tk, beta_ref, commanded)
+        at, on_law = setpoint_knots(model, tk, beta_ref, commanded)
         if len(at) > len(tk):  # the linkages' followers on their laws between the knots
             tau, rref = (np.column_stack([np.interp(at, tk, c) for c in a.T]) for a in (tau, rref))
             tk, beta_ref = at, np.ascontiguousarray(on_law)

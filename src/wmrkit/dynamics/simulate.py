@@ -23,7 +23,13 @@ from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .deviation import PathDeviation, nominal_poses
-from .inputs import Inputs, compiled_inputs, held_values, joint_column  # noqa: F401  (Inputs, joint_column: API)
+from .inputs import (  # noqa: F401  (Inputs, joint_column: API)
+    Inputs,
+    compiled_inputs,
+    held_values,
+    joint_column,
+    setpoint_problem,
+)
 from .linkages import linkage_breach
 from .model import DynamicModel
 from .runs import (  # noqa: F401  (LiftOffError, DivergedError: API)
@@ -168,7 +174,7 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     if not 0 < rtol < 1:
         raise WmrkitError(f"rtol: expected a relative tolerance in (0, 1), got {rtol}")
     s0 = initial_state(model, initial_twist, initial_pose)
-    inp = compiled_inputs(model, inputs, refuse=True)
+    inp = compiled_inputs(model, inputs)
     if method == "adaptive":
         rec, info = adaptive_run(model, s0, inp, duration, record, rtol, allow_lift_off)
     else:
@@ -235,6 +241,7 @@ class Stepper:
         self._w = model_work_arrays(self.model)
         self._rec = records(self.model, 0)
         self._inputs: tuple | None = None  # compiled; hold() replaces the arrays it changes (the log keeps them)
+        self._fight = False  # the last inputs' fight_linkages: hold() lets their servos fight a linkage too
         self._log = StepLog(self.step, self._method) if recheck else None
         self._delta = np.array([w.delta for w in self.model.robot.wheels if w.kind.steers], dtype=float)
 
@@ -245,11 +252,12 @@ class Stepper:
 
     def advance(self, inputs: Inputs | None, duration: float) -> np.ndarray:
         """Integrate ``round(duration / step)`` steps (at most :data:`MAX_STEPS`) with `inputs` (time axis: the
-        simulation time; None: the last ones); changes :attr:`state` in place and returns it."""
+        simulation time; None: the last ones); changes :attr:`state` in place and returns it. Heading set-points
+        that break a held linkage are refused, as :func:`simulate` refuses them (``Inputs.fight_linkages``: run)."""
         from ._integrate import run
 
         if inputs is not None:
-            self._inputs = compiled_inputs(self.model, inputs)
+            self._inputs, self._fight = compiled_inputs(self.model, inputs), inputs.fight_linkages
         if self._inputs is None:
             raise WmrkitError("advance: no inputs given yet")
         if not 0 <= duration / self.step <= MAX_STEPS:  # NaN and infinities included
@@ -279,11 +287,17 @@ class Stepper:
         """Hold new joint references from now on (a controller's period): wheel-rate references ``(n,)`` [rad/s]
         over ``model.names``, steering headings ``(n_steer,)`` [rad], feed-forward torques ``(n,)`` [N m]. Gains,
         limits and the values not given are those of the last inputs at the current time (in place, a few µs; new
-        rows while the stepper logs them). Headings that break a held linkage are not refused (as :meth:`advance`'s
-        are not)."""
+        rows while the stepper logs them). Headings that break a held linkage are refused, as :meth:`advance`
+        refuses them (unless the last inputs' ``fight_linkages``), before anything is held."""
         if self._inputs is None:
             raise WmrkitError("hold: give inputs (their servo gains) to advance() first")
         tk, tau, rref, gain, limit, bref, kp, kd, steer_limit = self._inputs
+        if heading_reference is not None:
+            heading_reference = held_values(heading_reference, bref.shape[1], "heading_reference")
+            if len(self.model.pack[17]) and not self._fight:
+                problem = setpoint_problem(self.model, heading_reference, set(np.flatnonzero(kp > 0).tolist()))
+                if problem:
+                    raise WmrkitError(f"hold: heading_reference: at t = {self.t:.6g} s, {problem}")
         if tk.shape[0] != 1:  # the values at the current time, held from now on
             t = self.t
             tau, rref, bref = (np.array([np.interp(t, tk, col) for col in a.T], dtype=float).reshape(1, a.shape[1])
@@ -299,7 +313,7 @@ class Stepper:
             tau[0] = held_values(torques, tau.shape[1], "torques")
         if heading_reference is not None:  # the thesis's beta = heading - delta + pi/2, as Robot.beta_of_heading
             row = bref[0]
-            np.subtract(held_values(heading_reference, bref.shape[1], "heading_reference"), self._delta, out=row)
+            np.subtract(heading_reference, self._delta, out=row)
             row += 0.5 * math.pi
 
 
