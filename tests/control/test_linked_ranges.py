@@ -10,6 +10,7 @@ import math
 import numpy as np
 import pytest
 from dynamics_robots import linked_car
+from test_linked_servos import _geared_units
 
 from wmrkit import Robot
 from wmrkit.control import builtin_reference, control_point
@@ -87,3 +88,40 @@ def test_the_tracking_run_commands_headings_on_the_law_and_in_range():
     off = [abs(math.remainder(fr - _right(fl), 2 * math.pi)) for fl, fr in heading]
     assert max(off) <= SETPOINT_TOL
     assert (np.abs(heading) >= LIMIT - 1e-12).any()  # the range was reached
+
+
+def _geared(ranges: float | None = None, ratios=(1.0, 2.0)) -> Robot:
+    """Two double wheels whose steering a gear turns in `ratios` (tests' ``_geared_units``), every joint driven,
+    each unit's steering within +-`ranges` [rad] when given."""
+    data = _geared_units(ratios).robot.to_dict()
+    for w in data["wheels"]:
+        w["actuated"] = ["steer", "spin1", "spin2"]
+        if ranges is not None:
+            w["steer_range"] = [-ranges, ranges]
+    return Robot.from_dict(data)
+
+
+@pytest.mark.parametrize(("asked", "kept"), [((0.1, -0.1), (-0.02, -0.04)), ((0.25, 0.5), (0.15, 0.3)),
+                                            ((-0.25, -0.5), (-0.15, -0.3))])
+def test_a_steering_gear_takes_its_least_squares_turn_within_both_ranges(asked, kept):
+    """Units geared 1:2 (rest headings 0), each within +-0.3 rad: asked (0.1, -0.1) the gear turns u = (1 * 0.1 + 2 *
+    -0.1) / 5 = -0.02; asked (0.25, 0.5) the rear's range stops the front at 0.15. Before, each unit kept its own
+    heading (0.1, -0.1; 0.25, 0.3): off the gear's ratio, the servos fighting it."""
+    robot = _geared(0.3)
+    headings, rates = np.array(asked), np.zeros(len(robot.rate_names))
+    fits = range_keeper(robot)(headings, rates, np.zeros(2))
+    np.testing.assert_allclose(headings, kept, atol=1e-12)
+    assert fits.all() == (abs(asked[0]) < 0.15)
+
+
+def test_a_geared_robot_tracks_with_its_headings_in_the_ratios():
+    """``track --dynamics`` on the geared units along a 3 m circle: the commanded headings in the gear's ratios
+    (before: the wheel IK's, front 0.107 rad and rear -0.093 rad where the gear turns the rear twice the front)."""
+    robot = _geared()
+    reference = builtin_reference("circle", size=3.0)
+    cp = control_point(robot)
+    out = simulate_dynamics(robot, fast_law_controller(cp, PositionLaw.uniform("p", 1.0), reference),
+                            initial_pose_on(cp, reference), 3.0, period=0.02)
+    front, rear = np.array(robot.heading_of_beta(out["target"])).T
+    assert np.abs(rear - 2 * front).max() <= SETPOINT_TOL
+    assert np.abs(front).max() > 0.01  # it steers

@@ -1,16 +1,19 @@
-"""Steering ranges of the wheels a ``linkage`` holds (:mod:`wmrkit.dynamics.linkages`): the range of the leader's
-heading that keeps every linked wheel within its own ``steer_range``, and the followers' headings set from the
-leader's by the linkage's law (:func:`wmrkit.kinematics.linkage_law.law`, the one the dynamics hold).
+"""Steering ranges of wheels whose steering the dynamics hold together: a ``linkage`` (:mod:`wmrkit.dynamics.
+linkages`, its law :func:`wmrkit.kinematics.linkage_law.law`) or a ``gear`` between steering joints (``h_j - h_j0 =
+k_j u`` from the described headings, :func:`wmrkit.dynamics.linkages.gear_breach`). The range of the leader's
+heading that keeps every wheel held with it within its own ``steer_range``, and the followers' headings set from the
+leader's by the law or the ratios.
 
-Clipping each linked wheel to its range on its own breaks the linkage: a car with +-0.5 rad front wheels asked for a
-tight left turn had its left wheel clipped at 0.5 and its right one at 0.5 too, 0.1 rad off the Ackermann law, the
-servos fighting the linkage (and a right turn the other way round). Keeping the leader in the range where every
-follower fits, and setting the followers by the law, holds the ICR on the linkage's geometry.
+Clipping each linked wheel to its range on its own breaks the linkage: a car with +-0.5 rad front wheels on a
+corner had its left wheel clipped at -0.5 and its right one at +0.5, 1.2 rad off the Ackermann law, the servos
+fighting the linkage. Keeping the leader in the range where every follower fits, and setting the followers by the
+law, holds the ICR on the linkage's geometry.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,64 +26,117 @@ TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
-class LinkedRanges:
-    """The held linkages of a robot over its steered wheels (``robot.steer_names`` indices): ``table`` the rows of
-    :func:`~wmrkit.kinematics.linkage_law.linkage_table` (columns: steered-wheel indices), ``leaders`` and
-    ``followers`` their indices, ``ranges (n_steer, 2)`` each wheel's heading range with each leader's narrowed to
-    the arc where its followers fit their own ranges, ``delta`` the wheels' steering offsets."""
+class _Link:
+    """A steered wheel (``robot.steer_names`` index) held by a leader: its heading from the leader's, the leader's
+    from its own (the inverse), whether that increases, whether headings are angles (mod 2 pi: a linkage's law) or
+    plain numbers (a gear's ratios), and whether the follower is free of the leader (on the axle line)."""
 
-    table: np.ndarray
+    follower: int
+    leader: int
+    to_follower: Callable[[float], float]
+    to_leader: Callable[[float], float]
+    increasing: bool
+    angular: bool
+    fixed: bool = False
+
+
+@dataclass(frozen=True)
+class LinkedRanges:
+    """The steering couplings of a robot the dynamics hold, over its steered wheels (``robot.steer_names``
+    indices): ``links``, ``leaders`` and ``followers`` their indices, ``ranges (n_steer, 2)`` each wheel's heading
+    range with each leader's narrowed to the arc where its followers fit their own ranges."""
+
+    links: tuple[_Link, ...]
     leaders: np.ndarray
     followers: np.ndarray
     ranges: np.ndarray
-    delta: np.ndarray
+    gears: tuple[tuple[list[int], np.ndarray], ...] = ()  # each gear's steered wheels and ratios
 
     @classmethod
     def of(cls, robot: Robot, ranges: np.ndarray) -> LinkedRanges | None:
-        """The linkages of `robot` the dynamics hold with the wheels' heading `ranges` ``(n_steer, 2)``
+        """The held linkages and steering gears of `robot` with the wheels' heading `ranges` ``(n_steer, 2)``
         (:func:`.steering.steer_ranges`), or None without one. Every wheel's rest heading is within its range (the
-        description's rule) and the rest headings are on the law (:func:`~wmrkit.kinematics.linkage_law.
-        linkage_table` refuses others), so the arcs share the leader's rest heading: the part of them kept."""
-        names = tuple(f"{n}.steer" for n in robot.steer_names)
-        table = linkage_table(robot, names)
-        if not len(table):
+        description's rule) and on the law and the ratios (the dynamics refuse others), so the arcs share the
+        leader's rest heading: the part of them kept."""
+        gears = _gears(robot)
+        links = _linkage_links(robot) + [link for idx, k in gears for link in _gear_links(robot, idx, k)]
+        if not links:
             return None
-        delta = np.array([robot.wheel(n).delta for n in robot.steer_names], dtype=float)
         narrowed = np.array(ranges, dtype=float)
-        leaders = np.unique(table[:, 1].astype(int))
+        leaders = np.array(sorted({k.leader for k in links}), dtype=int)
         for lead in leaders:
             arc = None if not np.isfinite(ranges[lead]).all() else (float(ranges[lead, 0]), float(ranges[lead, 1]))
-            for row in table[table[:, 1] == lead]:
-                arc = _meet(arc, _leader_arc(row, ranges[int(row[0])], delta[lead], delta[int(row[0])]),
-                            float(robot.heading[lead]))
+            for link in (k for k in links if k.leader == lead):
+                arc = _meet(arc, _leader_arc(link, ranges[link.follower]), float(robot.heading[lead]))
             if arc is not None:
                 narrowed[lead] = arc
-        return cls(table, leaders, table[:, 0].astype(int), narrowed, delta)
+        return cls(tuple(links), leaders, np.array([k.follower for k in links], dtype=int), narrowed, tuple(gears))
+
+    def settle(self, heading: np.ndarray, rest: np.ndarray) -> None:
+        """Set, in place, each gear's leader in `heading` ``(n_steer,)`` [rad] at the least-squares turn ``u = k .
+        d / k . k`` of the headings asked of its wheels, ``d`` their turns from the `rest` headings (the least
+        -squares fit :func:`wmrkit.couplings.gear_fill` makes of given rates): the gear's motion nearest to them."""
+        for idx, k in self.gears:
+            turn = np.remainder(heading[idx] - rest[idx] + math.pi, TWO_PI) - math.pi
+            heading[idx[0]] = rest[idx[0]] + k[0] * float(k @ turn) / float(k @ k)
 
     def follow(self, heading: np.ndarray) -> np.ndarray:
-        """Set, in place, each follower's heading in `heading` ``(n_steer,)`` [rad] from its leader's by the law;
-        returns which followers turned half round from the heading they had (their spins to negate)."""
+        """Set, in place, each follower's heading in `heading` ``(n_steer,)`` [rad] from its leader's; returns which
+        followers turned half round from the heading they had (their spins to negate)."""
         reverse = np.zeros(len(heading), dtype=bool)
-        for row in self.table:
-            j, i = int(row[0]), int(row[1])
-            f = float(heading_from_beta(law(row, float(heading[i]) - self.delta[i] + 0.5 * math.pi)[0],
-                                        self.delta[j]))
-            reverse[j] = abs(math.remainder(f - heading[j], TWO_PI)) > 0.5 * math.pi
-            heading[j] = f
+        for link in self.links:
+            f = link.to_follower(float(heading[link.leader]))
+            reverse[link.follower] = abs(math.remainder(f - heading[link.follower], TWO_PI)) > 0.5 * math.pi
+            heading[link.follower] = f
         return reverse
 
 
-def _leader_arc(row: np.ndarray, rng: np.ndarray, lead_delta: float, delta: float) -> tuple[float, float] | None:
-    """The arc ``(lo, hi)`` of leader headings (counter-clockwise from lo) at which the follower of linkage row
-    `row` is within its heading range `rng`; None: any (no range, or a follower on the axle line: it keeps its rest
-    angle, within its range, whatever the leader does)."""
-    if not np.isfinite(rng).all() or (row[3] == 1.0 and row[5] == 0.0):
+def _linkage_links(robot: Robot) -> list[_Link]:
+    """The followers of the held linkages (the rows of :func:`~wmrkit.kinematics.linkage_law.linkage_table`)."""
+    table = linkage_table(robot, tuple(f"{n}.steer" for n in robot.steer_names))
+    delta = [robot.wheel(n).delta for n in robot.steer_names]
+    out = []
+    for row in table:
+        j, i = int(row[0]), int(row[1])
+        to_j = (lambda h, row=row, i=i, j=j:  # noqa: E731  (one per row)
+                float(heading_from_beta(law(row, h - delta[i] + 0.5 * math.pi)[0], delta[j])))
+        to_i = (lambda h, row=row, i=i, j=j:  # noqa: E731
+                float(heading_from_beta(leader_of(row, h - delta[j] + 0.5 * math.pi), delta[i])))
+        out.append(_Link(j, i, to_j, to_i, not (row[3] == 1.0 and row[4] * row[5] < 0), True,
+                         row[3] == 1.0 and row[5] == 0.0))
+    return out
+
+
+def _gears(robot: Robot) -> list[tuple[list[int], np.ndarray]]:
+    """The ``gear`` couplings turning two or more steered wheels: their indices and ratios."""
+    names, out = robot.steer_names, []
+    for c in (c for c in robot.couplings if c.kind == "gear"):
+        steered = [(names.index(j[:-6]), k) for j, k in zip(c.joints, c.ratios, strict=True)
+                   if j.endswith(".steer") and j[:-6] in names]
+        if len(steered) > 1:
+            out.append(([i for i, _ in steered], np.array([k for _, k in steered], dtype=float)))
+    return out
+
+
+def _gear_links(robot: Robot, idx: list[int], k: np.ndarray) -> list[_Link]:
+    """The steered wheels a gear turns with its first one: ``h_j = h_j0 + k_j / k_i (h_i - h_i0)``."""
+    rest, i, out = robot.heading, idx[0], []
+    for j, r in zip(idx[1:], k[1:] / k[0], strict=True):
+        out.append(_Link(j, i, lambda h, j=j, r=r: float(rest[j] + r * (h - rest[i])),
+                         lambda h, j=j, r=r: float(rest[i] + (h - rest[j]) / r), r > 0, False))
+    return out
+
+
+def _leader_arc(link: _Link, rng: np.ndarray) -> tuple[float, float] | None:
+    """The arc ``(lo, hi)`` of leader headings (counter-clockwise from lo) at which `link`'s follower is within its
+    heading range `rng`; None: any (no range, or a follower on the axle line: it keeps its rest angle, within its
+    range, whatever the leader does)."""
+    if not np.isfinite(rng).all() or link.fixed:
         return None
-    to_beta = 0.5 * math.pi - delta
-    ends = [float(heading_from_beta(leader_of(row, float(h) + to_beta), lead_delta)) for h in rng]
-    if row[3] == 1.0 and row[4] * row[5] < 0:  # the law decreases: the range's ends swap
+    ends = [link.to_leader(float(h)) for h in rng]
+    if not link.increasing:  # the range's ends swap
         ends.reverse()
-    return ends[0], ends[0] + float(np.mod(ends[1] - ends[0], TWO_PI))
+    return ends[0], ends[0] + (float(np.mod(ends[1] - ends[0], TWO_PI)) if link.angular else ends[1] - ends[0])
 
 
 def _meet(a: tuple[float, float] | None, b: tuple[float, float] | None, rest: float) -> tuple[float, float] | None:

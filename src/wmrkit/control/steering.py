@@ -190,10 +190,12 @@ def range_keeper(robot: Robot, policy: str = "closest") -> Callable[[np.ndarray,
     steering is actuated (:func:`check_steering_driven`). With ``"closest"`` and no range it does nothing: the IK
     has picked the root closest to `current` already.
 
-    The wheels of a ``linkage`` the dynamics hold are not kept one by one (that breaks the linkage): its leader is
-    kept within the arc where every linked wheel fits its range, and the followers are set from it by the
-    linkage's law (:class:`.linked_ranges.LinkedRanges`), their spins negated where they turn half round; when the
-    leader is held at an end of that arc, none of the linkage's wheels fitted."""
+    The wheels of a ``linkage`` the dynamics hold, or of a ``gear`` between steering joints, are not kept one by
+    one (that breaks it): its leader is kept within the arc where every wheel held with it fits its range, and the
+    followers are set from it by the linkage's law or the gear's ratios (:class:`.linked_ranges.LinkedRanges`; a
+    gear's leader first at the gear's least-squares turn to the headings asked),
+    their spins negated where they turn half round; when the leader is held at an end of that arc, none of those
+    wheels fitted."""
     check_policy(policy)
     ranges, columns = steer_ranges(robot), spin_columns(robot)
     links = LinkedRanges.of(robot, ranges)
@@ -202,10 +204,12 @@ def range_keeper(robot: Robot, policy: str = "closest") -> Callable[[np.ndarray,
         ranges = links.ranges
         chosen[links.leaders] |= np.isfinite(ranges[links.leaders]).any(axis=1) & (columns[links.leaders, 0] >= 0)
         chosen[links.followers] = False
-    steered = columns[chosen]
+    steered, rest = columns[chosen], robot.heading
 
     def keep(heading: np.ndarray, rates: np.ndarray, current: np.ndarray) -> np.ndarray:
         fits = np.ones(len(heading), dtype=bool)
+        if links is not None:
+            links.settle(heading, rest)
         if chosen.any():
             ch = choose_steering(heading[chosen], unit_spin(rates, steered), current[chosen], policy=policy,
                                  ranges=ranges[chosen])
@@ -214,8 +218,8 @@ def range_keeper(robot: Robot, policy: str = "closest") -> Callable[[np.ndarray,
             fits[chosen] = ch.in_range
         if links is not None:
             reverse_spins(rates, columns, links.follow(heading) & (columns[:, 0] >= 0))
-            for row in links.table:
-                fits[int(row[0])] = fits[int(row[1])]
+            for link in links.links:
+                fits[link.follower] = fits[link.leader]
         return fits
 
     return keep
