@@ -142,7 +142,7 @@ def compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
     tk = np.array(np.atleast_1d(inputs.time), dtype=float)
     beta_ref = np.array(model.robot.beta_of_heading(href), dtype=float, order="C") if s else href
     commanded = set(np.flatnonzero(kp > 0).tolist())
-    if len(model.pack[17]) and commanded and not inputs.fight_linkages:
+    if (len(model.pack[17]) or model.pack[16].shape[1]) and commanded and not inputs.fight_linkages:
         off = next(((k, p) for k, row in enumerate(href) if (p := setpoint_problem(model, row, commanded))), None)
         if off:
             raise WmrkitError(f"heading_reference: at t = {tk[off[0]]:g} s, {off[1]}")
@@ -156,16 +156,18 @@ def compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
 
 def setpoint_problem(model: DynamicModel, headings: np.ndarray, commanded: set[int]) -> str | None:
     """Why heading set-points `headings` ``(n_steer,)`` [rad] of the servoed indices `commanded` break a linkage
-    `model` holds (:func:`~.linkages.heading_breach`), naming the wheels; None when they do not."""
+    or steering gear `model` holds (:func:`~.linkages.heading_breach`), naming the wheels; None when they do not."""
     breach = heading_breach(model, headings, commanded)
     if breach is None:
         return None
     j, ref, want, name = breach
     steered = model.robot.steer_names
     by = "whatever the others do" if ref is None else f"with {steered[ref]}'s at {headings[ref]:.6g} rad"
+    kind = name.partition("(")[0]
     return (f"{steered[j]}'s {headings[j]:.6g} rad breaks {name}, which sets {steered[j]} at heading {want:.6g} rad "
-            f"{by}: the steering servos would fight the linkage the dynamics hold; give headings on its law (within "
-            f"{SETPOINT_TOL:g} rad), steer_kp > 0 on one wheel per linkage, or fight_linkages=True")
+            f"{by}: the steering servos would fight the {kind} the dynamics hold; give headings on its "
+            f"{'law' if kind == 'linkage' else 'ratios'} (within {SETPOINT_TOL:g} rad), steer_kp > 0 on one wheel per "
+            f"{kind}, or fight_linkages=True")
 
 
 def _steer_limits(model: DynamicModel, limit: ArrayLike | None) -> np.ndarray:

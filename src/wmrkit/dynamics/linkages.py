@@ -9,6 +9,9 @@ and table of :mod:`wmrkit.kinematics.linkage_law` (which the kinematics check to
 In reduced coordinates the basis depends on the leader's angle, ``nu = T(beta) p``, and the follower's
 acceleration has the velocity-product term ``f''(beta_i) beta_i'^2`` (:func:`reduced`).
 
+Heading set-points are checked against the law (:func:`heading_breach`), and against the ratios of a ``gear``
+between steering joints (:func:`gear_breach`), which the dynamics hold too.
+
 Table (``pack[17]``, ``(L, 10)``, one row per follower): follower column, leader column, the leader's column in the
 basis, law (0 parallel, 1 axle), ``x_i``, ``x_j``, ``y_i - y_j``, ``beta_i - psi_i``, the rest angles ``beta_i0``,
 ``beta_j0``.
@@ -105,15 +108,42 @@ def setpoint_breach(model, beta: np.ndarray, commanded: set[int],
 
 
 def heading_breach(model, headings: np.ndarray, commanded: set[int]) -> tuple[int, int | None, float, str] | None:
-    """:func:`setpoint_breach` of heading set-points `headings` ``(n_steer,)`` [rad] as users read it: ``(follower,
-    reference, heading the law gives the follower [rad], the linkage's name)``; None when they agree."""
+    """:func:`setpoint_breach` of heading set-points `headings` ``(n_steer,)`` [rad] as users read it, then
+    :func:`gear_breach`: ``(follower, reference, heading the law (the gear) gives the follower [rad], the
+    coupling's name)``; None when they agree."""
     breach = setpoint_breach(model, model.robot.beta_of_heading(headings), commanded)
     if breach is None:
-        return None
+        return gear_breach(model, headings, commanded)
     j, ref, f = breach
     steer = f"{model.robot.steer_names[j]}.steer"
     name = next(c.channel_name for c in model.robot.couplings if c.kind == "linkage" and steer in c.joints)
     return j, ref, _heading(model, j, f), name
+
+
+def gear_breach(model, headings: np.ndarray, commanded: set[int],
+                tol: float = SETPOINT_TOL) -> tuple[int, int, float, str] | None:
+    """The first heading set-point of `headings` ``(n_steer,)`` [rad] (the indices `commanded` servoed) that breaks
+    a ``gear`` the dynamics hold between steering joints: the gear turns them in its ratios from the described
+    headings, ``h_j - h_j0 = k_j u``, so ``(follower, reference, heading the gear gives it, the gear's name)``, the
+    reference the gear's first commanded joint; None when they agree (within `tol` [rad])."""
+    base, cols = model.pack[16], list(model.steer_columns)
+    if not base.shape[1]:
+        return None
+    rest, gears = model.robot.heading, {}
+    for k in sorted(commanded):  # each commanded steering joint in a gear: its gear's column and its ratio
+        p = np.flatnonzero(base[cols[k]])
+        if len(p) == 1:
+            gears.setdefault(int(p[0]), []).append(k)
+    for p, joints in gears.items():
+        ref = joints[0]
+        u = (headings[ref] - rest[ref]) / base[cols[ref], p]
+        for j in joints[1:]:
+            want = rest[j] + base[cols[j], p] * u
+            if abs(headings[j] - want) > tol:
+                steer = f"{model.robot.steer_names[j]}.steer"
+                name = next(c.channel_name for c in model.robot.couplings if c.kind == "gear" and steer in c.joints)
+                return j, ref, float(want), name
+    return None
 
 
 def _set_by_law(model, beta: np.ndarray, commanded: set[int]) -> list[tuple[int, int | None, float]]:

@@ -29,7 +29,7 @@ from ..errors import WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, MAX_TORQUE, check_table_size
 from ..units import BARE_ANGLE_LIMIT
 from .inputs import Inputs, joint_column, knots
-from .linkages import SETPOINT_TOL, heading_breach, linkage_breach
+from .linkages import SETPOINT_TOL, gear_breach, heading_breach, linkage_breach
 from .model import DynamicModel
 
 #: Natural frequency [rad/s] of the programs' servos (the default `bandwidth`): a fixed step longer than its
@@ -188,14 +188,25 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
 def _check_linkages(model: DynamicModel, t: np.ndarray, twists: np.ndarray, headings: np.ndarray,
                     allow_slip: bool) -> bool:
     """Refuse (unless `allow_slip`) the first knot whose IK `headings` ``(K, n_steer)`` break a ``linkage`` the
-    dynamics hold (:mod:`.linkages`: a synchro chain asked to turn its wheels apart), naming it; whether one does
-    (with `allow_slip`: the servos fight through it, ``Inputs.fight_linkages``)."""
-    if not len(model.pack[17]):
+    dynamics hold (:mod:`.linkages`: a synchro chain asked to turn its wheels apart), or the ratios of a ``gear``
+    between servoed steering joints (:func:`~.linkages.gear_breach`: two units geared 1:2 asked to crab), naming
+    it; whether one does (with `allow_slip`: the servos fight through it, ``Inputs.fight_linkages``)."""
+    if not len(model.pack[17]) and not model.pack[16].shape[1]:
         return False
+    servoed = {k for k, c in enumerate(model.steer_columns) if model.is_actuated(c)}
     for k, beta in enumerate(model.robot.beta_of_heading(headings)):
-        breach = linkage_breach(model, beta)
-        if breach and allow_slip:
+        breach = linkage_breach(model, beta) if len(model.pack[17]) else None
+        geared = gear_breach(model, headings[k], servoed)
+        if (breach or geared) and allow_slip:
             return True
+        if geared:
+            j, ref, want, name = geared
+            steered = model.robot.steer_names
+            raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion "
+                              f"for '{model.robot.name}': its wheels' steering breaks the ratios of {name} (it sets "
+                              f"{steered[j]} at heading {want:.6g} rad with {steered[ref]}'s at "
+                              f"{headings[k, ref]:.6g} rad, the wheel IK {headings[k, j]:.6g} rad), which the "
+                              "dynamics hold; use allow_slip=True to let its servos fight and the tyres slip")
         if breach:
             raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion "
                               f"for '{model.robot.name}': its wheels' steering breaks a linkage ({breach}), which "
@@ -269,9 +280,10 @@ def _check_torques(source: str, column: str, torques: np.ndarray) -> None:
 
 
 def _check_setpoints(source: str, model: DynamicModel, href: np.ndarray, commanded: list[int]) -> None:
-    """Refuse the first row whose heading set-points `href` ``(K, n_steer)`` break a linkage the dynamics hold
-    (:func:`~wmrkit.dynamics.linkages.heading_breach`): their servos would fight it, naming the two columns."""
-    if not len(model.pack[17]):
+    """Refuse the first row whose heading set-points `href` ``(K, n_steer)`` break a linkage or a steering gear the
+    dynamics hold (:func:`~wmrkit.dynamics.linkages.heading_breach`): their servos would fight it, naming the two
+    columns."""
+    if not len(model.pack[17]) and not model.pack[16].shape[1]:
         return
     steered = model.robot.steer_names
     for k, row in enumerate(href):
@@ -281,10 +293,12 @@ def _check_setpoints(source: str, model: DynamicModel, href: np.ndarray, command
         j, ref, want, name = breach
         by = "whatever the others do" if ref is None else (f"with column '{steered[ref]}.heading' at "
                                                         f"{href[k, ref]:.6g} rad")
+        kind = name.partition("(")[0]
         raise WmrkitError(f"{source}:{k + 2}: column '{steered[j]}.heading': {href[k, j]:.6g} rad breaks {name}, "
                           f"which sets {steered[j]} at heading {want:.6g} rad {by}: the steering servos would fight "
-                          f"the linkage the dynamics hold; give headings on its law (within {SETPOINT_TOL:g} rad) or "
-                          "one heading column per linkage (docs/dynamics.md)")
+                          f"the {kind} the dynamics hold; give headings on its "
+                          f"{'law' if kind == 'linkage' else 'ratios'} (within {SETPOINT_TOL:g} rad) or one heading "
+                          f"column per {kind} (docs/dynamics.md)")
 
 
 def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:

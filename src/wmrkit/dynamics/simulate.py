@@ -294,7 +294,7 @@ class Stepper:
         tk, tau, rref, gain, limit, bref, kp, kd, steer_limit = self._inputs
         if heading_reference is not None:
             heading_reference = held_values(heading_reference, bref.shape[1], "heading_reference")
-            if len(self.model.pack[17]) and not self._fight:
+            if (len(self.model.pack[17]) or self.model.pack[16].shape[1]) and not self._fight:
                 problem = setpoint_problem(self.model, heading_reference, set(np.flatnonzero(kp > 0).tolist()))
                 if problem:
                     raise WmrkitError(f"hold: heading_reference: at t = {self.t:.6g} s, {problem}")
