@@ -14,14 +14,16 @@ from ..wheels import wrap_angle
 from ._loop_plant import HOLD_MARGIN, _Sim
 from .points import ControlError, StoppedRun
 
+#: What to change when a loop's law diverges (its commands grow without bound).
+LAW_ADVICE = "lower the gain or the period"
+
 
 def check_command(twist: np.ndarray, t: float) -> None:
     """Refuse a law's twist beyond ``limits.MAX_SPEED`` (m/s, rad/s) at `t`: a loop through the dynamics has
     diverged (the plant would be driven far outside any robot's envelope, slowly and meaninglessly)."""
     if not np.all(np.abs(twist) <= MAX_SPEED):  # NaN included
         raise StoppedRun(f"the loop diverged: at t = {t:.6g} s the law commands the twist "
-                         f"{tuple(float(v) for v in twist)}, beyond {MAX_SPEED:g} m/s or rad/s; lower the gain or "
-                         "the period", t)
+                         f"{tuple(float(v) for v in twist)}, beyond {MAX_SPEED:g} m/s or rad/s; {LAW_ADVICE}", t)
 
 
 def check_diverged(twist: np.ndarray, t: float) -> None:
@@ -29,8 +31,7 @@ def check_diverged(twist: np.ndarray, t: float) -> None:
     there (:func:`wheel_commands` refuses it), the loop has diverged."""
     if not np.all(np.abs(twist) <= MAX_QUERY_RATE):  # NaN included
         raise StoppedRun(f"the closed loop diverged at t = {t:.6g} s: the law commands the twist "
-                         f"{tuple(float(v) for v in twist)}, beyond {MAX_QUERY_RATE:g} m/s or rad/s; lower the gain "
-                         "or the period", t)
+                         f"{tuple(float(v) for v in twist)}, beyond {MAX_QUERY_RATE:g} m/s or rad/s; {LAW_ADVICE}", t)
 
 #: Bisections locating the instant a held wheel changes ends in the continuous loop (to 2**-40 of a step).
 SWITCH_BISECTIONS = 40

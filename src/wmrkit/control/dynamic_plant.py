@@ -23,6 +23,7 @@ import numpy as np
 
 from ..errors import WmrkitError
 from ..wheels import beta_from_heading, heading_from_beta
+from ._loop_steps import LAW_ADVICE
 from .laws import PositionLaw
 from .loop import TwistController, check_command
 from .points import ControlError, ControlPoint, StoppedRun, check_delay
@@ -34,6 +35,9 @@ if TYPE_CHECKING:
     from ..dynamics.runs import Stop
 
 __all__ = ["fast_law_controller", "rechecked", "rolling_start", "simulate_dynamics"]
+
+#: How a caller of the loops through the dynamics sets their step, as their errors say it (:func:`rechecked`).
+STEP_ARGUMENT = "(the step argument)"
 
 def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *,
                       period: float, delay: int = 0, tyre: str | None = None, step: float = 1e-3,
@@ -85,17 +89,31 @@ def rechecked(loop: Callable[[float, float, bool], dict], duration: float, step:
             if not math.isfinite(again.t):
                 raise err from None
             later = judge(_loop_stop(err), Recheck(step, fine, _loop_stop(again), again.t, end, "the same loop"),
-                          "(the step argument)")
+                          STEP_ARGUMENT)
             if later is None:  # it stops too, by recheck_end: the robot's stop, at the loop's own step
-                raise err from None
-            raise (StoppedRun(str(later), later.t) if isinstance(again, StoppedRun) else later) from None
+                raise _reproduced(err, step, fine) from None
+            if isinstance(again, StoppedRun):  # the law diverged: its advice, not the step's nor the torques'
+                raise StoppedRun(f"{later.what}; {LAW_ADVICE}", later.t) from None
+            raise later from None
         reached = float(out["t"][-1])
         cut = end < duration and reached > end - period  # by the budget, not by the loop's own end (`until`)
         if reached < t and not cut:  # it ended (arrived) before the stop: no verdict
             raise
         verdict = judge(_loop_stop(err), Recheck(step, fine, None, reached, duration if cut else -math.inf,
-                                                "the same loop"), "(the step argument)")
+                                                "the same loop"), STEP_ARGUMENT)
         raise verdict from None  # the re-run went on: the step's error (or not known), never None
+
+
+def _reproduced(err: WmrkitError, step: float, fine: float) -> WmrkitError:
+    """The stop `err` of a loop at `step` [s] that its re-run at `fine` [s] reproduced, as it is; but the state's
+    divergence, whose advice (the stepper's: "use a smaller step") the shorter step did not bear out, says both."""
+    from ..dynamics.runs import DivergedError
+
+    if not isinstance(err, DivergedError):
+        return err
+    what = f"{err.what} at step {step:g} s, and the same loop at step {fine:.3g} s diverges too"
+    return DivergedError(f"{what}: lower the speeds or the gain, or use a step below {fine:.3g} s {STEP_ARGUMENT}",
+                         err.t, what)
 
 
 def _loop_stop(err: WmrkitError) -> Stop:
@@ -107,7 +125,7 @@ def _loop_stop(err: WmrkitError) -> Stop:
     if isinstance(err, LiftOffError):
         return Stop.lift_off(err.t, err.contact)
     if isinstance(err, StoppedRun):
-        return Stop(err.t, f"the loop diverged at t = {err.t:.6g} s")
+        return Stop(err.t, f"the loop diverged at t = {err.t:.6g} s", whose="the loop's")
     return Stop.diverged(err.t)
 
 

@@ -154,11 +154,12 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
         if loops is not None or skew_free:
             raise ControlError("dynamics: the wheels are driven by the dynamic model's servos; no low-level loops "
                                "or skew-free option with it")
-        from ..dynamics.runs import UnstableStepError
+        from ..dynamics.runs import DivergedError, UnstableStepError
         from ..dynamics.simulate import LiftOffError
 
         period = 0.02 if period is None else period
         _check_dynamic_work(duration, period, slipping)
+        call = f"wmrkit.control.{'simulate_slip_control' if slipping else 'simulate_dynamics'}"  # has a step
         try:
             if slipping:
                 from .slip_loop import simulate_slip_control
@@ -176,12 +177,16 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                 "command (a corner of the reference, a start off it) can tip the robot: give a smoother reference, a "
                 "lower speed or gain, or start on the reference", err.t), robot, reference, tracked_point,
                 "dynamic") from None
+        except DivergedError as err:  # the state's: its advice named a step, which is no option of track's
+            raise _stopped(StoppedRun(
+                f"{err.what}; lower the speed or the gain; track integrates at {DYNAMICS_STEP:g} s, which no option "
+                f"changes (in Python, {call}(..., step=...) runs the loop at a shorter one)", err.t), robot, reference,
+                tracked_point, "dynamic") from None
         except StoppedRun as err:
             raise _stopped(err, robot, reference, tracked_point, "dynamic") from None
         except UnstableStepError as err:  # its step is no option of track's
-            call = "simulate_slip_control" if slipping else "simulate_dynamics"
             raise err.advised(f"track integrates at {DYNAMICS_STEP:g} s, which no option changes; in Python, "
-                              f"wmrkit.control.{call}(..., step={err.fine:.3g}) runs the loop at the step that "
+                              f"{call}(..., step={err.fine:.3g}) runs the loop at the step that "
                               + ("went on" if err.conclusive else "would tell")) from None
     elif feedback != "pose" or slip_model != "none" or ramp:
         what = (f"feedback='{feedback}'" if feedback != "pose" else f"slip_model='{slip_model}'"

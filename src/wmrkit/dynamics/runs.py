@@ -27,10 +27,12 @@ class LiftOffError(WmrkitError):
 
 
 class DivergedError(WmrkitError):
-    """A fixed-step run whose state overflowed before ``t`` [s] (:class:`~wmrkit.dynamics.simulate.Stepper`)."""
+    """A fixed-step run whose state overflowed before ``t`` [s] (:class:`~wmrkit.dynamics.simulate.Stepper`).
+    ``what`` states the stop without the message's advice, which a caller may replace (default: the state diverged
+    before ``t``)."""
 
-    def __init__(self, message: str, t: float) -> None:
-        self.t = t
+    def __init__(self, message: str, t: float, what: str = "") -> None:
+        self.t, self.what = t, what or Stop.diverged(t).what
         super().__init__(message)
 
 
@@ -123,11 +125,13 @@ def recheck_end(t_stop: float, step: float) -> float:
 @dataclass(frozen=True)
 class Stop:
     """Where a fixed-step run stopped: at ``t`` [s], ``what`` stopped it (in words, with its time), and for a
-    lift-off the ``contact`` that lost its load (empty: the state, or a loop's command, diverged)."""
+    lift-off the ``contact`` that lost its load (empty: the state, or a loop's command, diverged); ``whose`` stop it
+    is when a shorter step reproduces it (a loop's law diverging is the loop's, not the robot's)."""
 
     t: float
     what: str
     contact: str = ""
+    whose: str = "the robot's"
 
     @classmethod
     def diverged(cls, t: float) -> Stop:
@@ -184,10 +188,10 @@ def judge(stop: Stop, check: Recheck, where: str) -> WmrkitError | None:
     if later.t <= recheck_end(stop.t, step):
         return None
     head = (f"{stop.what} at step {step:g} s, but {rerun} at step {fine:.3g} s goes on without it until "
-            f"{later.what}: the robot's stop, which the step brought early")
+            f"{later.what}: {later.whose} stop, which the step brought early")
     advice = f"use smaller torques or speeds, and a step of at most {fine:.3g} s {where}"
     err = (LiftOffError(head, advice, later.t, later.contact) if later.contact else
-           DivergedError(f"{head}; {advice}", later.t))
+           DivergedError(f"{head}; {advice}", later.t, head))
     err.where = where
     return err
 
