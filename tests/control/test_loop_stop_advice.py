@@ -8,6 +8,7 @@ import json
 import math
 import re
 
+import numpy as np
 import pytest
 
 from cli_options import options
@@ -155,3 +156,19 @@ def test_track_from_python_names_the_loop_that_takes_a_step(diverging):
         track(catalog.load("skid-steer-4"), builtin_reference("circle"), dynamics=True, duration=3.0)
     assert "step argument" not in str(err.value) and "smaller step" not in str(err.value)
     assert "in Python, wmrkit.control.simulate_dynamics(..., step=...)" in str(err.value)
+
+
+@pytest.mark.parametrize("period", [None, 0.05])
+def test_a_diverged_kinematic_law_advises_a_period_only_when_the_loop_has_one(period):
+    """A continuous loop (``period=None``) whose law's command passes 1e6 m/s said "lower the gain or the period":
+    it has no period. Its twist grows as exp(t / 0.01 s) from t = 0.5 s (a law of ours, independent of the loop);
+    the continuous loop says "lower the gain", the sampled one the period too."""
+    from wmrkit.control.loop import simulate
+
+    def exploding(t, pose, integral):
+        return np.array([math.exp(max(0.0, t - 0.5) / 0.01), 0.0, 0.0]), np.zeros(3)
+
+    with pytest.raises(StoppedRun) as err:
+        simulate(catalog.load("diff-drive"), exploding, np.zeros(3), 1.0, period=period)
+    assert 0.5 + 0.01 * math.log(1e6) - 0.05 <= err.value.t <= 0.5 + 0.01 * math.log(1e6) + 0.05  # where it passes
+    assert str(err.value).endswith("lower the gain" if period is None else "lower the gain or the period")

@@ -26,12 +26,14 @@ def check_command(twist: np.ndarray, t: float) -> None:
                          f"{tuple(float(v) for v in twist)}, beyond {MAX_SPEED:g} m/s or rad/s; {LAW_ADVICE}", t)
 
 
-def check_diverged(twist: np.ndarray, t: float) -> None:
+def check_diverged(twist: np.ndarray, t: float, sampled: bool = True) -> None:
     """Refuse a law's twist beyond ``limits.MAX_QUERY_RATE`` at `t` in a kinematic loop: no wheel command is defined
-    there (:func:`wheel_commands` refuses it), the loop has diverged."""
+    there (:func:`wheel_commands` refuses it), the loop has diverged. Not `sampled` (a continuous loop): no period
+    to lower."""
     if not np.all(np.abs(twist) <= MAX_QUERY_RATE):  # NaN included
         raise StoppedRun(f"the closed loop diverged at t = {t:.6g} s: the law commands the twist "
-                         f"{tuple(float(v) for v in twist)}, beyond {MAX_QUERY_RATE:g} m/s or rad/s; {LAW_ADVICE}", t)
+                         f"{tuple(float(v) for v in twist)}, beyond {MAX_QUERY_RATE:g} m/s or rad/s; "
+                         f"{LAW_ADVICE if sampled else 'lower the gain'}", t)
 
 #: Bisections locating the instant a held wheel changes ends in the continuous loop (to 2**-40 of a step).
 SWITCH_BISECTIONS = 40
@@ -136,7 +138,7 @@ def _given_steering(controller, sim: _Sim, t: float, x: np.ndarray, split) -> tu
 def _record(controller, sim: _Sim, t: float, x: np.ndarray, split) -> dict:
     pose, integral, beta, _ = split(x)
     twist, _ = controller(t, pose, integral)
-    check_diverged(twist, t)
+    check_diverged(twist, t, sampled=False)  # the continuous loop's records
     return _record_held(sim, t, x, split, twist, beta)
 
 

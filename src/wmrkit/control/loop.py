@@ -146,7 +146,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
         pose, integral, beta, ls = split(x)
         if held is None:
             twist, de = controller(t, pose, integral)
-            check_diverged(twist, t)
+            check_diverged(twist, t, sampled=False)  # the continuous loop (the sampled one holds its command)
         else:
             twist, de = held
         if plant.loops is None:  # ideal joints: the robot moves with the commanded twist, if its wheels can
