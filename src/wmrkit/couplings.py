@@ -27,7 +27,7 @@ import numpy as np
 
 from ._shapes import as_names, finite_number
 from .errors import UnknownNameError, WmrkitError
-from .limits import MAX_COUPLING_RATIO, MIN_COUPLING_RATIO, MIN_RATIO
+from .limits import MAX_COUPLING_RATIO, MIN_COUPLING_RATIO, MIN_RATIO, below
 
 if TYPE_CHECKING:
     from .robot import Robot
@@ -66,7 +66,7 @@ class Coupling:
         if not all(finite_number(k) and MIN_COUPLING_RATIO <= abs(k) <= MAX_COUPLING_RATIO for k in self.ratios):
             raise CouplingError(f"{name}: ratios {self.ratios}: each must be of magnitude {MIN_COUPLING_RATIO:g} to "
                                 f"{MAX_COUPLING_RATIO:g} (docs/limits.md)")
-        if max(map(abs, self.ratios)) > min(map(abs, self.ratios)) / MIN_RATIO:
+        if below(min(map(abs, self.ratios)), MIN_RATIO * max(map(abs, self.ratios))):
             raise CouplingError(f"{name}: the largest ratio is more than {1 / MIN_RATIO:g} times the smallest "
                                 "(docs/limits.md)")
         if self.law is not None and (self.kind != "linkage" or self.law not in LINKAGE_LAWS):

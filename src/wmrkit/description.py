@@ -50,6 +50,7 @@ from .limits import (  # noqa: F401  (the limits are part of the description for
     _check_envelope,
     _check_size,
     _check_text_fields,
+    below,
 )
 from .robot import Robot
 from .wheels import Wheel
@@ -158,7 +159,7 @@ def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) ->
             if not MIN_COUPLING_RATIO <= size <= MAX_COUPLING_RATIO:
                 check.fail(f"{ratios[j]:g}: outside the ratios wmrkit handles ({MIN_COUPLING_RATIO:g} to "
                            f"{MAX_COUPLING_RATIO:g} in magnitude, docs/limits.md)", (*loc, "ratios", j))
-        if max(sizes) > min(sizes) / MIN_RATIO:
+        if below(min(sizes), MIN_RATIO * max(sizes)):
             check.fail(f"the largest ratio is more than {1 / MIN_RATIO:g} times the smallest: rank decisions would "
                        "lose the smaller to round-off (docs/limits.md)", (*loc, "ratios"))
         out.append(Coupling(kind, tuple(joints), ratios, _law(item, kind, joints, wheels, check, loc)))

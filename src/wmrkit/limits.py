@@ -10,6 +10,7 @@ import math
 import os
 import re
 import stat
+import sys
 from collections.abc import Collection
 from typing import TYPE_CHECKING, Any
 
@@ -54,6 +55,22 @@ MIN_RATIO = 1e-4
 MIN_COUPLING_RATIO, MAX_COUPLING_RATIO = 1e-6, 1e6
 #: Swedish gamma at least this far from 0 and 180 deg; castor delta at least this far from +-90 deg [rad].
 ANGLE_MARGIN = math.radians(1.0)
+
+
+#: Relative round-off of an edge computed from typed numbers: 1e-4 of a reach, 1e4 times a ratio. Decimals read as
+#: binary floats, and their product, are each off by half an ulp: ``1e-4 * 0.979`` rounds above ``9.79e-05``, and
+#: a radius exactly 1e-4 of a reach of 0.979 m was refused as less than that.
+EDGE_ROUNDOFF = 4 * sys.float_info.epsilon
+
+
+def below(value: float, edge: float) -> bool:
+    """Whether `value` lies below `edge` (computed from typed numbers) by more than its round-off."""
+    return value < edge * (1.0 - EDGE_ROUNDOFF)
+
+
+def shown(value: float, edge: float) -> str:
+    """`value` printed ``:g``, or with every digit when that would print the `edge` it lies beyond."""
+    return f"{value:g}" if f"{value:g}" != f"{edge:g}" else repr(value)
 
 
 #: Control characters (C0, DEL, C1) and lone surrogates (bytes that are not UTF-8): they break printing.
@@ -156,7 +173,8 @@ def _check_envelope(wheels: list[Wheel], check: Any, positioned: Collection[int]
         return ("wheels", i, "position", int(abs(y) > abs(x)))
 
     def what(size: float, i: int, key: str) -> str:
-        return f"{size:g} m" if key != "l" or i not in positioned else f"{size:g} m from the robot's origin"
+        text = f"{shown(size, MAX_SIZE)} m"
+        return text if key != "l" or i not in positioned else f"{text} from the robot's origin"
 
     lengths = []
     for i, w in enumerate(wheels):
@@ -169,12 +187,12 @@ def _check_envelope(wheels: list[Wheel], check: Any, positioned: Collection[int]
         check.fail(f"{what(size, i, key)}: longer than {MAX_SIZE:g} m, outside the lengths wmrkit handles "
                    "(1 um to 1 km)", where(i, key))
     if size < MIN_SIZE:
-        check.fail(f"the robot's size ({size:g} m, its largest length) is below {MIN_SIZE:g} m (1 um)",
+        check.fail(f"the robot's size ({shown(size, MIN_SIZE)} m, its largest length) is below {MIN_SIZE:g} m (1 um)",
                    where(i, key))
     for value, i, key in lengths:
-        if key != "l" and value < MIN_RATIO * size:
-            check.fail(f"{value:g} m is less than {MIN_RATIO:g} of the robot's size ({size:g} m, its largest "
-                       "length): too small to tell from 0 in the rank decisions", ("wheels", i, key))
+        if key != "l" and below(value, MIN_RATIO * size):
+            check.fail(f"{shown(value, MIN_RATIO * size)} m is less than {MIN_RATIO:g} of the robot's size ({size:g} "
+                       "m, its largest length): too small to tell from 0 in the rank decisions", ("wheels", i, key))
     for i, w in enumerate(wheels):
         if w.type == "swedish" and abs(math.sin(w.gamma)) < math.sin(ANGLE_MARGIN):
             check.fail(f"gamma = {math.degrees(w.gamma):.6g} deg: rollers within {math.degrees(ANGLE_MARGIN):g} "

@@ -51,6 +51,8 @@ def _factor(robot, exponent: float) -> float:
 @given(robot=robots(max_wheels=3), exponent=st.floats(math.log10(MIN_SIZE), math.log10(MAX_SIZE)))
 @example(robot=Robot(name="r", wheels=(Wheel(name="w0", type="fixed", l=1.427734375, alpha=0.0, beta=0.0, r=0.5),)),
          exponent=3.0)  # the edge 1 km, drawn on a 2026-12-01 explore run
+@example(robot=Robot(name="r", wheels=(Wheel(name="w0", type="fixed", l=0.0, alpha=0.0, beta=0.0, r=0.46875),)),
+         exponent=3.0)  # a radius one ulp past 1 km under the plain factor (CI, 2026-12-01)
 def test_the_same_robot_at_any_size_of_the_envelope_gets_the_same_answers(robot, exponent):
     scaled = _scaled(robot, factor := _factor(robot, exponent))
     assert robot_from_dict(robot_to_dict(scaled)) == scaled  # inside the envelope: the loader accepts it
