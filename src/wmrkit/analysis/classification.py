@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike
 from ..couplings import steering_mechanisms
 from ..errors import WmrkitError
 from ..kinematics.linalg import centred, centroid, characteristic_length, matrix_rank
-from ..kinematics.models import configuration
+from ..kinematics.models import configuration, own_turn, random_steering
 from ..limits import check_seed
 from ..robot import Robot
 from .icr import steer_to_icr
@@ -122,7 +122,7 @@ def classify(robot: Robot, *, samples: int = 8, seed: int = 0) -> Classification
     rng = np.random.default_rng(seed)
     admissible = _admissible_configurations(robot, g_fixed, rf, samples, rng)
     m = int(instantaneous_mobility(robot, admissible).min()) if len(admissible) else 0
-    random_beta = _turn(robot) + rng.uniform(-np.pi, np.pi, (samples, len(robot.steer_names)))
+    random_beta = random_steering(robot, samples, rng)
     m_random = int(instantaneous_mobility(robot, random_beta).min())
     coordinated = m_random < m
     d = max(3 - rf - m, 0)
@@ -142,30 +142,23 @@ def _size(robot: Robot) -> float:
     return characteristic_length(robot)
 
 
-def _turn(robot: Robot) -> float:
-    """The angle [rad] of the robot's own axes the random configurations are drawn in: the first wheel's described
-    ``beta`` (its axle, or a castor's steering frame), which turns with the robot frame, so a rigid change of frame
-    draws the same configurations of the wheels (the robot's x axis would draw other ones in a turned frame)."""
-    return float(robot.wheels[0].beta) if robot.wheels else 0.0
-
-
 def _admissible_configurations(robot: Robot, g_fixed: np.ndarray, rf: int, n: int, rng) -> np.ndarray:
     """Configurations with every steered axle through a common random ICR allowed by the fixed wheels. `g_fixed`:
     their lines about the wheels' centroid, nondimensional (``linalg.centred``). The twists are drawn in the axes
-    of :func:`_turn` and projected onto those the fixed wheels allow (a projector, unlike a basis, is unique), so
-    they are the same twists of the wheels in every robot frame."""
+    of :func:`~wmrkit.kinematics.models.own_turn` and projected onto those the fixed wheels allow (a projector,
+    unlike a basis, is unique), so they are the same twists of the wheels in every robot frame."""
     if rf >= 3:
         return np.zeros((0, len(robot.steer_names)))
     _, _, vh = np.linalg.svd(np.vstack([g_fixed, np.zeros((3, 3))]))
     allowed = vh[rf:].T @ vh[rf:]  # projector onto the twists of the centroid (vx, vy, omega L) the fixed wheels allow
-    c, s = np.cos(_turn(robot)), np.sin(_turn(robot))
+    c, s = np.cos(own_turn(robot)), np.sin(own_turn(robot))
     drawn = rng.normal(size=(n, 3)) @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # turned into the frame
     twists = (drawn @ allowed) * np.array([1.0, 1.0, 1.0 / _size(robot)])
     cx, cy = centroid(robot)  # ICRs about the centroid, back in the robot frame
     icr_h = np.stack([-twists[:, 1] + cx * twists[:, 2], twists[:, 0] + cy * twists[:, 2], twists[:, 2]], axis=-1)
     beta = steer_to_icr(robot, icr_h)
     castors = [j for j, s in enumerate(robot.steer_names) if s not in set(constraint_lines(robot).wheels)]
-    beta[:, castors] = _turn(robot) + rng.uniform(-np.pi, np.pi, (n, len(castors)))
+    beta[:, castors] = own_turn(robot) + rng.uniform(-np.pi, np.pi, (n, len(castors)))
     return beta
 
 

@@ -90,6 +90,20 @@ def configuration(robot: Robot, beta: ArrayLike | None, heading: ArrayLike | Non
     return robot.beta if beta is None else beta
 
 
+def own_turn(robot: Robot) -> float:
+    """The angle [rad] of the robot's own axes random configurations are drawn in: the first wheel's described
+    ``beta`` (its axle, or a castor's steering frame), which turns with the robot frame, so a rigid change of frame
+    draws the same configurations of the wheels (the robot's x axis would draw other ones in a turned frame)."""
+    return float(robot.wheels[0].beta) if robot.wheels else 0.0
+
+
+def random_steering(robot: Robot, n: int, rng: np.random.Generator) -> np.ndarray:
+    """`n` random configurations ``(n, n_steer)``: steering angles uniform about the robot's own axes
+    (:func:`own_turn`). The generic rank over them is the largest met (the least m): a rank only drops on a special
+    set of configurations, and numerically near it."""
+    return own_turn(robot) + rng.uniform(-np.pi, np.pi, (n, len(robot.steer_names)))
+
+
 def describe_configuration(robot: Robot, beta: np.ndarray, index: tuple[int, ...] = ()) -> str:
     """``"beta (w3=0.4 rad)"``, with ``[i, j]`` for an element of a batch; ``"the fixed geometry"`` if no steering."""
     if not robot.steer_names:
@@ -326,13 +340,14 @@ def _free_steering(robot: Robot, a: np.ndarray, dof: int) -> tuple[str, ...]:
     return tuple(free)
 
 
-def generic_inputs(robot: Robot) -> tuple[tuple[str, ...], int]:
+def generic_inputs(robot: Robot, samples: int = 8) -> tuple[tuple[str, ...], int]:
     """The default inverse model's steering inputs (:func:`_free_steering`) and the mobility m with the gears, at
-    generic steering (three random configurations): the inputs of the closed forms and of the generated code."""
-    beta = np.random.default_rng(7).uniform(-math.pi, math.pi, (3, len(robot.steer_names)))
-    a = constraints(robot, beta)
-    dof = int(np.max(a.shape[-1] - matrix_rank(a)))
-    return _free_steering(robot, a, dof), dof
+    generic steering (the least m over `samples` :func:`random_steering` configurations, and the inputs on those
+    that meet it): the inputs of the closed forms and of the generated code."""
+    a = constraints(robot, random_steering(robot, samples, np.random.default_rng(7)))
+    nullity = a.shape[-1] - matrix_rank(a)
+    dof = int(nullity.min())
+    return _free_steering(robot, a[nullity == dof], dof), dof
 
 
 def inverse_model(
