@@ -4,6 +4,7 @@ of the no-slip matrix (3.22), computed here by SVD."""
 
 from __future__ import annotations
 
+import itertools
 import json
 
 import numpy as np
@@ -11,8 +12,9 @@ import pytest
 
 from wmrkit import SingularError, catalog
 from wmrkit.cli.main import main
-from wmrkit.kinematics.actuation import actuation_analysis
-from wmrkit.kinematics.sensing import sensing_analysis
+from wmrkit.kinematics.actuation import actuation_analysis, actuation_equation, split_jacobian
+from wmrkit.kinematics.sensing import sensing_analysis, sensing_equation
+from wmrkit.kinematics.trees import reduced_equation, select_columns
 
 
 def _null_space(a: np.ndarray) -> np.ndarray:
@@ -90,3 +92,45 @@ def test_a_determined_inverse_is_the_no_slip_solution():
     np.testing.assert_allclose(motion[:3], twist, atol=1e-12)  # a feasible twist
     spins = [robot.velocity_names.index(n) for n in actuation.actuated]
     np.testing.assert_allclose(actuation.inverse(twist), motion[spins], atol=1e-12)
+
+
+
+def _residual(robot, i_sel: np.ndarray, j_sel: np.ndarray, selected: list[str]) -> float:
+    """Largest violation of ``I_sel twist = J_sel q_sel`` over the no-slip motions (3.22) of `robot` (by SVD)."""
+    null = _null_space(robot.constraint_matrix())
+    rows = [robot.velocity_names.index(n) for n in selected]
+    return float(np.abs(i_sel @ null[:3] - j_sel @ null[rows]).max())
+
+
+@pytest.mark.parametrize(("equation", "role"), [(actuation_equation, "actuated"), (sensing_equation, "sensed")])
+def test_the_reduced_equation_is_refused_where_the_split_leaves_the_other_rates_free(equation, role):
+    """agv-drive-unit with its two spins selected: the unit's steering turns with the spins, so (4.26)'s substitution
+    of it is one of many. Before, actuation_equation and sensing_equation returned the pseudo-inverse's I_u, which
+    the motions of the no-slip equations (3.22) break by 0.04 (a real equation holds to round-off)."""
+    robot, spins = catalog.load("agv-drive-unit"), ["unit.spin1", "unit.spin2"]
+    columns, _ = select_columns(robot, spins, role)
+    i_bar, j_sel, j_rest = split_jacobian(robot, columns)
+    assert _residual(robot, reduced_equation(i_bar, j_sel, j_rest), j_sel, spins) > 0.01  # the pick breaks (3.22)
+    with pytest.raises(SingularError, match=rf"robot 'agv-drive-unit': the {role} rates \(unit\.spin1, unit\.spin2\)"
+                                            r" and the twist do not determine the other joints' rates"):
+        equation(robot, spins)
+
+
+@pytest.mark.parametrize("name", catalog.names())
+def test_a_reduced_equation_is_returned_exactly_where_it_holds_on_every_no_slip_motion(name):
+    """Every catalog robot and selection of up to two rates: actuation_equation returns (4.28) where it holds on the
+    no-slip motions (3.22), and refuses it where the pseudo-inverse's pick breaks them (the agv's unit spins; its
+    rear spins, or nothing selected, are returned although the unit's J is rank deficient, 4.69)."""
+    robot = catalog.load(name)
+    rates = [n for n in robot.rate_names if not n.endswith(".roller")]
+    for selected in [[], *([n] for n in rates), *(list(p) for p in itertools.combinations(rates, 2))]:
+        columns, _ = select_columns(robot, selected, "actuated")
+        i_bar, j_sel, j_rest = split_jacobian(robot, columns)
+        holds = _residual(robot, reduced_equation(i_bar, j_sel, j_rest), j_sel, selected) < 1e-12
+        assert holds or _residual(robot, reduced_equation(i_bar, j_sel, j_rest), j_sel, selected) > 1e-3, selected
+        if holds:
+            i_sel, _ = actuation_equation(robot, selected)
+            np.testing.assert_array_equal(i_sel, reduced_equation(i_bar, j_sel, j_rest))
+        else:
+            with pytest.raises(SingularError, match="do not determine the other joints' rates"):
+                actuation_equation(robot, selected)

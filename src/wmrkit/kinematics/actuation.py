@@ -30,6 +30,7 @@ from .trees import (
     jacobian_names,
     partitioned_solution,
     reduced_equation,
+    reduction_exact,
     select_columns,
     selected_determined,
     undriven_motions,
@@ -76,6 +77,8 @@ def actuation_equation(
     """
     columns, _ = select_columns(robot, robot.actuated if actuated is None else actuated, "actuated")
     i_bar, j_u, j_nu = split_jacobian(robot, columns, beta)
+    _, j_u1, j_nu1 = split_jacobian(nondimensional(robot), columns, beta)  # rank decisions: the tolerance policy
+    require_determined(reduction_exact(j_u1, j_nu1), not_reduced(robot, columns, "actuated", "(4.28)"))
     return reduced_equation(i_bar, j_u, j_nu), j_u
 
 
@@ -194,6 +197,17 @@ def require_determined(determined: np.ndarray, message: str) -> None:
         return
     where = "" if not determined.ndim else f" (configuration {np.argwhere(~determined)[0].tolist()} of the batch)"
     raise SingularError(message + where)
+
+
+def not_reduced(robot: Robot, columns: Sequence[int], role: str, equation: str) -> str:
+    """The refusal of the reduced equation `equation` where the selected rates (`columns` of
+    :func:`jacobian_names`) and the twist do not fix the others: (4.26) substitutes one of many values for them, and
+    motions of the no-slip equations (3.22) break the equation (docs/errata.md)."""
+    names = jacobian_names(robot)
+    return (f"robot '{robot.name}': the {role} rates ({', '.join(names[c] for c in columns) or 'none'}) and the "
+            "twist do not determine the other joints' rates (as a double wheel's steering, shared by its two "
+            f"contacts, 4.69), so the reduced equation {equation} does not hold: its left-hand matrix would be one "
+            f"of many; the {role} tree eliminates them exactly")
 
 
 def where_determined(matrix: np.ndarray, determined: np.ndarray) -> Any:

@@ -21,6 +21,7 @@ from ..robot import TWIST_NAMES, Robot
 from .actuation import (
     body_only,
     minimal_set_search,
+    not_reduced,
     require_determined,
     steering_split,
     verdict_texts,
@@ -35,6 +36,7 @@ from .trees import (
     jacobian_names,
     partitioned_solution,
     reduced_equation,
+    reduction_exact,
     select_columns,
     undriven_motions,
 )
@@ -57,7 +59,9 @@ def sensing_equation(
     robot: Robot, sensed: Sequence[str] | None = None, beta: ArrayLike | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """The vehicle sensing equation (4.34), ``I_s @ twist_robot = J_s @ q_dot_s``: ``(I_s (..., 3E, 3), J_s)``."""
-    _, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
+    columns, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
+    _, _, _, j_s1, j_ns1, _ = _split(nondimensional(robot), sensed, beta)  # rank decisions: the tolerance policy
+    require_determined(reduction_exact(j_s1, j_ns1), not_reduced(robot, columns, "sensed", "(4.34)"))
     return reduced_equation(i_bar, j_s, j_ns), j_s
 
 

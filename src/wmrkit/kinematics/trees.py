@@ -220,6 +220,16 @@ def selected_determined(j_sel: ArrayLike, j_rest: ArrayLike) -> np.ndarray:
     return matrix_rank(_hstack(j_sel, j_rest)) - matrix_rank(j_rest) == j_sel.shape[-1]
 
 
+def reduction_exact(j_sel: ArrayLike, j_rest: ArrayLike) -> np.ndarray:
+    """Whether :func:`reduced_equation` holds on every motion of ``I_bar twist = J_sel q_sel + J_rest q_rest``: its
+    residual there is ``J_rest (I - M^+ M) q_rest`` with ``M = Delta(J_sel) J_rest``, zero for every ``q_rest``
+    iff ``rank M = rank J_rest``, i.e. ``rank [J_sel, J_rest] - rank J_sel = rank J_rest`` (no motion of the unselected
+    rates is also one of the selected). Decided on unprojected matrices with the rank tolerance, as
+    :func:`selected_determined`; ``(..., R, s), (..., R, p) -> (...)`` bool, for the ``nondimensional`` robot."""
+    j_sel, j_rest = np.asarray(j_sel, dtype=float), np.asarray(j_rest, dtype=float)
+    return matrix_rank(_hstack(j_sel, j_rest)) - matrix_rank(j_sel) == matrix_rank(j_rest)
+
+
 def reduced_equation(i_bar: ArrayLike, j_sel: ArrayLike, j_rest: ArrayLike) -> np.ndarray:
     """The left-hand matrix of the actuation (4.28) or sensing (4.34) equation, ``I_sel twist = J_sel q_sel``.
 
