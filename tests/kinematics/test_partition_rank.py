@@ -12,8 +12,8 @@ import pytest
 
 from wmrkit import SingularError, catalog
 from wmrkit.cli.main import main
-from wmrkit.kinematics.actuation import actuation_analysis, actuation_equation, split_jacobian
-from wmrkit.kinematics.sensing import sensing_analysis, sensing_equation
+from wmrkit.kinematics.actuation import actuated_inverse_matrix, actuation_analysis, actuation_equation, split_jacobian
+from wmrkit.kinematics.sensing import sensed_direct_matrix, sensing_analysis, sensing_equation
 from wmrkit.kinematics.trees import reduced_equation, select_columns
 
 
@@ -134,3 +134,60 @@ def test_a_reduced_equation_is_returned_exactly_where_it_holds_on_every_no_slip_
         else:
             with pytest.raises(SingularError, match="do not determine the other joints' rates"):
                 actuation_equation(robot, selected)
+
+
+def _kernel(a: np.ndarray) -> np.ndarray:
+    """Orthonormal basis ``(n, k)`` of the null space of `a` ``(r, n)`` by SVD (every direction when ``r = 0``)."""
+    if a.shape[0] == 0:
+        return np.eye(a.shape[1])
+    _, s, vh = np.linalg.svd(a)
+    return vh[int(np.sum(s > 1e-9 * max(s[0], 1.0))):].T
+
+
+def _selections(robot) -> list[list[str]]:
+    rates = [n for n in robot.rate_names if not n.endswith(".roller")]
+    return [[], *([n] for n in rates), *(list(p) for p in itertools.combinations(rates, 2))]
+
+
+def test_the_actuated_inverse_matrix_of_a_drive_unit_s_spins_is_refused():
+    """Before: actuated_inverse_matrix(agv-drive-unit) returned [[10, 0, 0], [10, 0, 0]], the pseudo-inverse's pick
+    (the unit held straight) while its spins also turn it on the spot (4.69), as ActuationAnalysis.inverse refuses."""
+    with pytest.raises(SingularError, match=r"robot 'agv-drive-unit': the twist does not determine the actuated "
+                                            r"rates \(unit\.spin1, unit\.spin2\)"):
+        actuated_inverse_matrix(catalog.load("agv-drive-unit"))
+
+
+def test_the_sensed_direct_matrix_of_one_rear_encoder_is_refused_where_the_robot_turns_about_it():
+    """Before: sensed_direct_matrix returned the minimum-norm twist per f1.spin, (0.0075, -0.0438, -0.0219), as
+    SensingAnalysis.twist refuses; diff-drive with one spin sensed the same."""
+    robot, beta = _tricycle_icr_at_f1()
+    with pytest.raises(SingularError, match=r"the sensed rates \(f1\.spin\) do not determine the twist"):
+        sensed_direct_matrix(robot, ["f1.spin"], np.array([beta]))
+    with pytest.raises(SingularError, match=r"robot 'diff-drive': the sensed rates \(left\.spin\) do not determine"):
+        sensed_direct_matrix(catalog.load("diff-drive"), ["left.spin"])
+
+
+@pytest.mark.parametrize("name", catalog.names())
+def test_the_matrices_4_26_and_4_32_are_returned_exactly_where_they_are_the_no_slip_solution(name):
+    """Every catalog robot and selection of up to two rates, against the no-slip motions (3.22) by SVD: (4.26) is
+    returned where no motion with the body at rest moves a selected rate, and then gives a motion's selected rates
+    from its twist; (4.32) where no motion with the selected rates at rest moves the body, and then gives the twist."""
+    robot = catalog.load(name)
+    null = _null_space(robot.constraint_matrix())
+    motion = null @ np.random.default_rng(7).normal(size=null.shape[1])  # a generic no-slip motion
+    for selected in _selections(robot):
+        rows = [robot.velocity_names.index(n) for n in selected]
+        moved = np.abs((null @ _kernel(null[:3]))[rows])  # selected rates of the motions with the body at rest
+        assert moved.size == 0 or moved.max() < 1e-9 or moved.max() > 1e-3, selected
+        if moved.size == 0 or moved.max() < 1e-9:
+            np.testing.assert_allclose(actuated_inverse_matrix(robot, selected) @ motion[:3], motion[rows], atol=1e-9)
+        else:
+            with pytest.raises(SingularError, match="the twist does not determine the actuated rates"):
+                actuated_inverse_matrix(robot, selected)
+        body = np.abs((null @ _kernel(null[rows]))[:3])  # twists of the motions with the selected rates at rest
+        assert body.size == 0 or body.max() < 1e-9 or body.max() > 1e-3, selected
+        if body.size == 0 or body.max() < 1e-9:
+            np.testing.assert_allclose(sensed_direct_matrix(robot, selected) @ motion[rows], motion[:3], atol=1e-9)
+        else:
+            with pytest.raises(SingularError, match="do not determine the twist"):
+                sensed_direct_matrix(robot, selected)

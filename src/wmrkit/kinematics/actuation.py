@@ -88,10 +88,14 @@ def actuated_inverse_matrix(
     """Actuated inverse solution (4.26)/(4.27): ``q_dot_u = M @ twist_robot``, ``(..., n_steer) -> (..., n_u, 3)``.
 
     Per wheel ``(J_iu^T Delta(J_inu) J_iu)^-1 J_iu^T Delta(J_inu)``; ``J_i^-1`` for an omnidirectional wheel with
-    every variable actuated. The twist must satisfy the motion constraints or the wheels slip.
+    every variable actuated. The twist must satisfy the motion constraints or the wheels slip. :class:`SingularError`
+    where the twist does not fix the actuated rates (as :meth:`ActuationAnalysis.inverse`): M would be one of many.
     """
     columns, _ = select_columns(robot, robot.actuated if actuated is None else actuated, "actuated")
     i_bar, j_u, j_nu = split_jacobian(robot, columns, beta)
+    _, j_u1, j_nu1 = split_jacobian(nondimensional(robot), columns, beta)  # rank decisions: the tolerance policy
+    names = jacobian_names(robot)
+    require_determined(selected_determined(j_u1, j_nu1), not_fixed(robot.name, tuple(names[c] for c in columns)))
     return partitioned_solution(j_u, j_nu) @ i_bar
 
 
@@ -171,10 +175,7 @@ class ActuationAnalysis:
     def inverse(self, twist_robot: ArrayLike) -> np.ndarray:
         """Actuated rates for a (feasible) body twist, (4.26): ``(..., 3) -> (..., n_u)`` [rad/s, m/s]."""
         t = bounded(as_vectors(twist_robot, 3, "twist_robot"), TWIST_NAMES, "twist_robot")
-        require_determined(self.inverse_determined, f"robot '{self.robot_name}': the twist does not determine the "
-                           f"actuated rates ({', '.join(self.actuated)}): they also turn joints with the body at rest "
-                           "(a double wheel steering on the spot, 4.69), so (4.26) has many solutions; assign those "
-                           "joints' rates too (the inverse model, 'wmrkit ik')")
+        require_determined(self.inverse_determined, not_fixed(self.robot_name, self.actuated))
         return matvec(self.inverse_matrix, t, "twist_robot")
 
     def as_dict(self) -> dict[str, Any]:
@@ -197,6 +198,13 @@ def require_determined(determined: np.ndarray, message: str) -> None:
         return
     where = "" if not determined.ndim else f" (configuration {np.argwhere(~determined)[0].tolist()} of the batch)"
     raise SingularError(message + where)
+
+
+def not_fixed(robot_name: str, actuated: Sequence[str]) -> str:
+    """The refusal of the actuated inverse (4.26) where the twist does not fix the `actuated` rates."""
+    return (f"robot '{robot_name}': the twist does not determine the actuated rates ({', '.join(actuated)}): they"
+            " also turn joints with the body at rest (a double wheel steering on the spot, 4.69), so (4.26) has "
+            "many solutions; assign those joints' rates too (the inverse model, 'wmrkit ik')")
 
 
 def not_reduced(robot: Robot, columns: Sequence[int], role: str, equation: str) -> str:

@@ -38,6 +38,7 @@ from .trees import (
     reduced_equation,
     reduction_exact,
     select_columns,
+    selected_determined,
     undriven_motions,
 )
 
@@ -71,10 +72,14 @@ def sensed_direct_matrix(
     """Reduced sensed direct solution (4.32): ``twist_robot = M @ q_dot_s``, ``(..., n_steer) -> (..., 3, n_s)``.
 
     ``M = (sum_i Delta(J_ins))^-1 (Delta(J_1ns) J_1s ... Delta(J_Nns) J_Ns)`` for one-contact wheels, here in
-    the composite form ``(I_bar^T Delta(J_ns) I_bar)^-1 I_bar^T Delta(J_ns) J_s``. Needs sufficient sensors;
-    otherwise the pseudo-inverse gives the minimum-norm twist.
+    the composite form ``(I_bar^T Delta(J_ns) I_bar)^-1 I_bar^T Delta(J_ns) J_s``. :class:`~wmrkit.SingularError`
+    where the sensed rates do not fix the twist (``rank I_s < 3``, as :meth:`SensingAnalysis.twist`): the
+    pseudo-inverse's minimum-norm twist would be one of many.
     """
-    _, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
+    columns, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
+    _, _, i_bar1, _, j_ns1, _ = _split(nondimensional(robot), sensed, beta)  # rank decisions: the tolerance policy
+    names = jacobian_names(robot)
+    require_determined(selected_determined(i_bar1, j_ns1), twist_not_fixed(robot.name, [names[c] for c in columns]))
     return partitioned_solution(i_bar, j_ns) @ j_s
 
 
@@ -169,9 +174,7 @@ class SensingAnalysis:
         return self.tree.rank_a == 3
 
     def _require_twist(self) -> None:
-        require_determined(self.twist_determined, f"robot '{self.robot_name}': the sensed rates "
-                           f"({', '.join(self.sensed) or 'none'}) do not determine the twist (insufficient sensors, "
-                           "rank I_s < 3), so (4.32) has many solutions")
+        require_determined(self.twist_determined, twist_not_fixed(self.robot_name, self.sensed))
 
     def twist(self, q_dot_s: ArrayLike) -> np.ndarray:
         """The body twist from sensed rates, (4.32): ``(..., n_s) -> (..., 3)`` [m/s, rad/s]; :class:`SingularError`
@@ -202,6 +205,12 @@ class SensingAnalysis:
             "direct_matrix": where_determined(self.direct_matrix, self.twist_determined),
             "twist_determined": self.twist_determined.tolist(),
         }
+
+
+def twist_not_fixed(robot_name: str, sensed: Sequence[str]) -> str:
+    """The refusal of the sensed direct solution (4.31)/(4.32) where the `sensed` rates do not fix the twist."""
+    return (f"robot '{robot_name}': the sensed rates ({', '.join(sensed) or 'none'}) do not determine the twist "
+            "(insufficient sensors, rank I_s < 3), so (4.32) has many solutions")
 
 
 def sensing_analysis(
