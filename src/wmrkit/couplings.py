@@ -27,7 +27,7 @@ import numpy as np
 
 from ._shapes import as_names, finite_number
 from .errors import UnknownNameError, WmrkitError
-from .limits import MAX_COUPLING_RATIO, MIN_COUPLING_RATIO, MIN_RATIO, below
+from .limits import MAX_COUPLING_RATIO, MIN_COUPLING_RATIO, MIN_RATIO, below, shown
 
 if TYPE_CHECKING:
     from .robot import Robot
@@ -63,12 +63,10 @@ class Coupling:
             raise CouplingError(f"{name}: unknown kind (kinds: {', '.join(COUPLING_KINDS)})")
         if len(self.joints) < 2 or len(set(self.joints)) != len(self.joints) or len(self.ratios) != len(self.joints):
             raise CouplingError(f"{name}: expected two or more distinct joints and one ratio per joint")
-        if not all(finite_number(k) and MIN_COUPLING_RATIO <= abs(k) <= MAX_COUPLING_RATIO for k in self.ratios):
-            raise CouplingError(f"{name}: ratios {self.ratios}: each must be of magnitude {MIN_COUPLING_RATIO:g} to "
-                                f"{MAX_COUPLING_RATIO:g} (docs/limits.md)")
-        if below(min(map(abs, self.ratios)), MIN_RATIO * max(map(abs, self.ratios))):
-            raise CouplingError(f"{name}: the largest ratio is more than {1 / MIN_RATIO:g} times the smallest "
-                                "(docs/limits.md)")
+        problem = ratios_problem(self.ratios)
+        if problem is not None:
+            index, reason = problem
+            raise CouplingError(f"{name}: ratios{'' if index is None else f'[{index}]'}: {reason}")
         if self.law is not None and (self.kind != "linkage" or self.law not in LINKAGE_LAWS):
             raise CouplingError(f"{name}: law {self.law!r}: {law_problem(self.kind, self.law)}")
 
@@ -81,6 +79,25 @@ class Coupling:
     def channel_name(self) -> str:
         """The name of the one actuator or sensor it makes of its joints: ``differential(a.spin, b.spin)``."""
         return f"{self.kind}({', '.join(self.joints)})"
+
+
+def ratios_problem(ratios: tuple[float, ...]) -> tuple[int | None, str] | None:
+    """Why `ratios` are no coupling's, or None: the index of the ratio at fault (None: the set, too spread) and the
+    reason. The one rule of :class:`Coupling` and the description's located check: each non-zero, of magnitude
+    ``MIN_COUPLING_RATIO`` to ``MAX_COUPLING_RATIO``, the largest at most ``1 / MIN_RATIO`` times the smallest."""
+    for j, k in enumerate(ratios):
+        if k == 0:
+            return j, "must be non-zero (a joint with ratio 0 is not coupled)"
+        if not (finite_number(k) and MIN_COUPLING_RATIO <= abs(k) <= MAX_COUPLING_RATIO):
+            edge = MAX_COUPLING_RATIO if finite_number(k) and abs(k) > 1 else MIN_COUPLING_RATIO
+            value = shown(k, edge) if finite_number(k) else repr(k)
+            return j, (f"{value}: outside the ratios wmrkit handles ({MIN_COUPLING_RATIO:g} to {MAX_COUPLING_RATIO:g}"
+                       " in magnitude, docs/limits.md)")
+    sizes = [abs(k) for k in ratios]
+    if below(min(sizes), MIN_RATIO * max(sizes)):
+        return None, (f"the largest ratio is more than {1 / MIN_RATIO:g} times the smallest: rank decisions would "
+                      "lose the smaller to round-off (docs/limits.md)")
+    return None
 
 
 def joint_problem(kind: str, joint: str, wheels: Mapping[str, Wheel],

@@ -23,7 +23,15 @@ from ._description_wheels import (  # noqa: F401  (the wheel entries' names are 
     kind_of_type,
 )
 from ._description_writer import HEADING_SPREAD, described_type, robot_to_dict  # noqa: F401  (re-exported)
-from .couplings import COUPLING_KINDS, LINKAGE_LAWS, Coupling, axle_problem, joint_problem, law_problem
+from .couplings import (
+    COUPLING_KINDS,
+    LINKAGE_LAWS,
+    Coupling,
+    axle_problem,
+    joint_problem,
+    law_problem,
+    ratios_problem,
+)
 from .documents import (
     DescriptionError,
     FieldReader,
@@ -50,7 +58,6 @@ from .limits import (  # noqa: F401  (the limits are part of the description for
     _check_envelope,
     _check_size,
     _check_text_fields,
-    below,
 )
 from .robot import Robot
 from .wheels import Wheel
@@ -152,16 +159,10 @@ def _couplings_from_dict(items: Any, wheels: list[Wheel], check: FieldReader) ->
         if not isinstance(raw, list) or len(raw) != len(joints):
             check.fail(f"must be a list of {len(joints)} numbers, one per joint", (*loc, "ratios"))
         ratios = tuple(check.quantity(v, "number", (*loc, "ratios", j)) for j, v in enumerate(raw))
-        if any(r == 0 for r in ratios):
-            check.fail("ratios must be non-zero (a joint with ratio 0 is not coupled)", (*loc, "ratios"))
-        sizes = [abs(r) for r in ratios]
-        for j, size in enumerate(sizes):
-            if not MIN_COUPLING_RATIO <= size <= MAX_COUPLING_RATIO:
-                check.fail(f"{ratios[j]:g}: outside the ratios wmrkit handles ({MIN_COUPLING_RATIO:g} to "
-                           f"{MAX_COUPLING_RATIO:g} in magnitude, docs/limits.md)", (*loc, "ratios", j))
-        if below(min(sizes), MIN_RATIO * max(sizes)):
-            check.fail(f"the largest ratio is more than {1 / MIN_RATIO:g} times the smallest: rank decisions would "
-                       "lose the smaller to round-off (docs/limits.md)", (*loc, "ratios"))
+        problem = ratios_problem(ratios)
+        if problem is not None:
+            index, reason = problem
+            check.fail(reason, (*loc, "ratios") if index is None else (*loc, "ratios", index))
         out.append(Coupling(kind, tuple(joints), ratios, _law(item, kind, joints, wheels, check, loc)))
     return tuple(out)
 

@@ -16,6 +16,7 @@ from wmrkit.errors import DescriptionError
 from wmrkit.kinematics.actuation import actuation_analysis, actuation_tree
 from wmrkit.kinematics.linalg import matrix_rank, nondimensional
 from wmrkit.kinematics.sensing import sensing_analysis, sensing_tree
+from wmrkit.limits import MAX_COUPLING_RATIO, MIN_COUPLING_RATIO, MIN_RATIO
 
 
 def forklift_with(ratios: list[float], kind: str = "differential") -> dict:
@@ -255,3 +256,30 @@ def test_one_joint_of_a_coupling_listed_as_actuated_actuates_the_mechanism():
     both, single = actuation_analysis(car).as_dict(), actuation_analysis(one).as_dict()
     assert single["verdict"] == both["verdict"] and single["consistent"] and single["sufficient"]
     assert single["actuated"] == both["actuated"] == ["differential(rear_left.spin, rear_right.spin)"]
+
+
+_NEXT_ABOVE_MAX = float(np.nextafter(MAX_COUPLING_RATIO, np.inf))
+
+
+@pytest.mark.parametrize(("ratios", "field", "reason"), [
+    ([_NEXT_ABOVE_MAX, 1e6], "ratios[0]", f"{_NEXT_ABOVE_MAX!r}: outside the ratios wmrkit handles (1e-06 to 1e+06 in "
+                                         "magnitude, docs/limits.md)"),
+    ([1.0, 0.0], "ratios[1]", "must be non-zero (a joint with ratio 0 is not coupled)"),
+    ([2.0, -3e-7], "ratios[1]", "-3e-07: outside the ratios wmrkit handles (1e-06 to 1e+06 in magnitude, "
+                                "docs/limits.md)"),
+    ([1.0, -2e4], "ratios", "the largest ratio is more than 10000 times the smallest: rank decisions would lose the "
+                            "smaller to round-off (docs/limits.md)"),
+], ids=["ulp above 1e6", "zero", "tiny", "spread"])
+def test_a_description_and_a_python_coupling_refuse_ratios_with_one_located_reason(ratios, field, reason):
+    """One rule (couplings.ratios_problem) for the description and Coupling(). Before: the description printed
+    "ratios[0]: 1e+06: outside the ratios ... (1e-06 to 1e+06 ...)" for the float just above 1e6 (`:g` hid the ulp),
+    "ratios: ratios must be non-zero" without the entry, and Coupling() "ratios (...): each must be of magnitude ..."
+    or "the largest ratio is more than 10000 times the smallest (docs/limits.md)", another text for the same rule."""
+    assert abs(ratios[0]) > MAX_COUPLING_RATIO or 0 in ratios or min(map(abs, ratios)) < MIN_COUPLING_RATIO or (
+        max(map(abs, ratios)) > min(map(abs, ratios)) / MIN_RATIO)  # each case breaks a documented rule
+    with pytest.raises(DescriptionError) as described:
+        Robot.from_dict(forklift_with(ratios, "gear"))
+    assert str(described.value) == f"<dict>: couplings[0].{field}: {reason}"
+    with pytest.raises(CouplingError) as built:
+        Coupling("gear", ("a.spin", "b.spin"), tuple(ratios))
+    assert str(built.value) == f"coupling gear(a.spin, b.spin): {field}: {reason}"
