@@ -13,8 +13,8 @@ import pytest
 from wmrkit import SingularError, catalog
 from wmrkit.cli.main import main
 from wmrkit.kinematics.actuation import actuated_inverse_matrix, actuation_analysis, actuation_equation, split_jacobian
-from wmrkit.kinematics.sensing import sensed_direct_matrix, sensing_analysis, sensing_equation
-from wmrkit.kinematics.trees import reduced_equation, select_columns
+from wmrkit.kinematics.sensing import sensed_direct_matrix, sensed_full_matrix, sensing_analysis, sensing_equation
+from wmrkit.kinematics.trees import jacobian_names, reduced_equation, select_columns
 
 
 def _null_space(a: np.ndarray) -> np.ndarray:
@@ -191,3 +191,41 @@ def test_the_matrices_4_26_and_4_32_are_returned_exactly_where_they_are_the_no_s
         else:
             with pytest.raises(SingularError, match="do not determine the twist"):
                 sensed_direct_matrix(robot, selected)
+
+
+def test_the_full_sensed_solution_of_a_drive_unit_s_rear_encoders_is_refused():
+    """agv-drive-unit sensing its rear spins: they fix the twist, but the unit turns on the spot with them at rest
+    (a motion of (3.22) by SVD), so its steering and spin rates are not fixed. Before, sensed_full_matrix returned
+    the pinv pick (driving straight at 1 rad/s: unit.steer 0, unit spins 1 and 1)."""
+    robot, rear = catalog.load("agv-drive-unit"), ["rear_left.spin", "rear_right.spin"]
+    null = _null_space(robot.constraint_matrix())
+    at_rest = null @ _kernel(null[[robot.velocity_names.index(n) for n in rear]])
+    assert at_rest.shape[1] == 1 and np.abs(at_rest[:3]).max() < 1e-9  # the twist is fixed ...
+    assert np.abs(at_rest[robot.velocity_names.index("unit.steer")]).max() > 0.1  # ... the unit's steering is not
+    with pytest.raises(SingularError, match=r"the sensed rates \(rear_left\.spin, rear_right\.spin\) fix the twist "
+                                            r"but not the unsensed rates"):
+        sensed_full_matrix(robot, rear)
+    r = robot.wheel("rear_left").r  # both rear wheels roll at 1 rad/s: straight ahead at r m/s
+    np.testing.assert_allclose(sensing_analysis(robot, sensed=rear).direct([1.0, 1.0])[0], [r, 0.0, 0.0], atol=1e-12)
+
+
+@pytest.mark.parametrize("name", catalog.names())
+def test_the_full_sensed_solution_4_31_is_returned_exactly_where_the_sensed_rates_fix_every_velocity(name):
+    """Every catalog robot and selection of up to two rates: (4.31) is returned where no no-slip motion (3.22, by
+    SVD) keeps the sensed rates at rest, and then gives a generic motion's twist and unsensed rates; refused
+    elsewhere."""
+    robot = catalog.load(name)
+    null = _null_space(robot.constraint_matrix())
+    motion = null @ np.random.default_rng(8).normal(size=null.shape[1])
+    for selected in _selections(robot):
+        rows = [robot.velocity_names.index(n) for n in selected]
+        free = null @ _kernel(null[rows])  # the motions with the sensed rates at rest
+        if free.shape[1] == 0:
+            full = sensed_full_matrix(robot, selected) @ motion[rows]
+            unknowns = [n for n in jacobian_names(robot) if n not in selected]
+            expected = [motion[robot.velocity_names.index(n)] if n in robot.velocity_names else motion[2]
+                        for n in unknowns]  # omega@wheel: the body's omega
+            np.testing.assert_allclose(full, [*motion[:3], *expected], atol=1e-9)
+        else:
+            with pytest.raises(SingularError, match=r"do not determine the twist|but not the unsensed rates"):
+                sensed_full_matrix(robot, selected)

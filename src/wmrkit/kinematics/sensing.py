@@ -89,10 +89,19 @@ def sensed_full_matrix(
     """Sensed direct solution (4.31) corrected: ``(twist; q_dot_ns) = (I_ns^T I_ns)^-1 I_ns^T J_s q_dot_s``.
 
     ``(..., n_steer) -> (..., 3 + n_ns, n_s)`` with ``I_ns = [I_bar, -J_ns]`` (4.30); the non-sensed
-    velocities in :func:`jacobian_names` order (the omega copies included). Pseudo-inverse: ``I_ns`` is
-    rank-deficient when the sensors are insufficient.
+    velocities in :func:`jacobian_names` order (the omega copies included). :class:`~wmrkit.SingularError` where
+    ``I_ns`` is rank deficient (insufficient sensors, ``SensingAnalysis.sufficient`` False): the twist is not fixed,
+    or a motion with the sensed rates at rest turns unsensed joints (a drive unit on the spot, 4.69), and the
+    pseudo-inverse's pick would be one of many (``SensingAnalysis.direct`` still gives a fixed twist).
     """
-    _, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
+    columns, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
+    _, _, i_bar1, _, j_ns1, _ = _split(nondimensional(robot), sensed, beta)  # rank decisions: the tolerance policy
+    names = [jacobian_names(robot)[c] for c in columns]
+    require_determined(selected_determined(i_bar1, j_ns1), twist_not_fixed(robot.name, names))
+    require_determined(undriven_motions(i_bar1, j_ns1) == 0, (
+        f"robot '{robot.name}': the sensed rates ({', '.join(names)}) fix the twist but not the unsensed "
+        "rates: a motion with them at rest turns other joints (a double wheel on the spot, 4.69), so (4.31) has many "
+        "solutions; SensingAnalysis.direct gives the twist"))
     return _full(i_bar, j_s, j_ns)
 
 
@@ -140,7 +149,7 @@ class SensingAnalysis:
     mobility: np.ndarray  # (...) int
     tree: TreeVerdict
     direct_matrix: np.ndarray  # (..., 3, n_s), (4.32)
-    full_matrix: np.ndarray  # (..., 3 + n_ns, n_s), (4.31)
+    full_matrix: np.ndarray  # (..., 3 + n_ns, n_s), (4.31): rows past the twist one of many where unsensed > 0
     full_names: tuple[str, ...]  # rows of full_matrix: vx, vy, omega, the unknowns (a gear unsensed: its channel)
     residual_matrix: np.ndarray  # (..., 3E, n_s): least-squares error of (4.31) per sensed rate
     unsensed: np.ndarray  # (...) int, motions with every sensed rate at rest (.trees.undriven_motions)
