@@ -79,7 +79,7 @@ def test_too_many_knots_is_a_one_line_error(monkeypatch):
 
     monkeypatch.setattr(linkages, "MAX_SETPOINT_KNOTS", 3)
     model = DynamicModel.of(linked_car())
-    with pytest.raises(WmrkitError, match="knots would keep a held linkage's followers on its law"):
+    with pytest.raises(WmrkitError, match=r"keeping a held linkage's followers on its law between the rows would"):
         compiled_inputs(model, _servo_inputs(model, [0.0, 1.0], [[0.0, 0.0], [0.5, right_of(0.5)]]))
 
 

@@ -174,3 +174,155 @@ def test_between_rows_followers_without_their_leader_stay_on_the_law(tmp_path):
     yc = -0.2 + 0.6 / np.tan(fr)  # fr's axle meets the rear axle line there
     law = [icr_heading(0.3, 0.2, y) for y in yc]
     assert np.abs(np.remainder(ml - law + np.pi, 2 * np.pi) - np.pi).max() <= SETPOINT_TOL
+
+
+# The knots between rows, as setpoint_knots made them row by row before it was vectorised (the oracle of the tests
+# below: the same knots and values, bit for bit, from every row at once, plain or compiled).
+
+def _old_set_by_law(model, beta, commanded):
+    from wmrkit.kinematics.linkage_law import law, leader_of
+    table, cols, out = model.pack[17], list(model.steer_columns), []
+    for lead in dict.fromkeys(int(r[1]) for r in table):
+        rows = [r for r in table if int(r[1]) == lead and cols.index(int(r[0])) in commanded]
+        ref = cols.index(lead)
+        if ref in commanded:
+            b = beta[ref]
+        else:
+            first = next((r for r in rows if r[3] == 0.0 or r[5] != 0.0), None)
+            ref = None if first is None else cols.index(int(first[0]))
+            b = beta[cols.index(lead)] if first is None else leader_of(first, beta[ref])
+        out += [(cols.index(int(r[0])), ref, law(r, b)[0]) for r in rows if cols.index(int(r[0])) != ref]
+    return out
+
+
+def _old_on_law(model, beta, commanded):
+    beta = np.array(beta, dtype=float)
+    for j, _, f in _old_set_by_law(model, beta, commanded):
+        beta[j] += math.remainder(f - beta[j], 2 * math.pi)
+    return beta
+
+
+def _old_setpoint_knots(model, t, beta, commanded, tol=SETPOINT_TOL):
+    if len(t) < 2 or not _old_set_by_law(model, beta[0], commanded):
+        return t, beta
+    times, rows = [t[:1]], [_old_on_law(model, beta[0], commanded)[None]]
+    for k in range(len(t) - 1):
+        pieces = 1
+        while True:
+            s = np.linspace(0.0, 1.0, 2 * pieces + 1)
+            on = np.array([_old_on_law(model, (1 - a) * beta[k] + a * beta[k + 1], commanded) for a in s])
+            off = np.abs(on[1:-1:2] - (on[:-2:2] + on[2::2]) / 2).max()
+            if off <= tol / 2:
+                break
+            pieces = max(2 * pieces, math.ceil(pieces * math.sqrt(2 * off / tol)))
+        times.append(np.append(t[k] + (t[k + 1] - t[k]) * s[2:-1:2], t[k + 1]))
+        rows.append(on[2::2])
+    return np.concatenate(times), np.concatenate(rows)
+
+
+def _models() -> dict:
+    """Robots and servoed steering indices: a leader and its follower; followers without their leader (the law's
+    inverse); a synchro chain; a follower on the axle line."""
+    side = linked_car().to_dict()
+    side["wheels"].append({"name": "side", "type": "steerable", "position": [0, 0.5], "heading": 0, "r": 0.1,
+                           "inertia": {"spin": 0.01, "steer": 0.05}, "tyre": "dugoff", "actuated": ["steer"]})
+    side["couplings"] = [{"kind": "linkage", "joints": ["fl.steer", "fr.steer", "side.steer"]}]
+    three = _three_wheel_ackermann()
+    synchro = DynamicModel.of(Robot.from_dict(four_wheel_steer(linkages=[("fl", "fr", "rl", "rr")])))
+    return {"pair": (DynamicModel.of(linked_car()), {0, 1}), "inverse": (three, {1, 2}), "three": (three, {0, 1, 2}),
+            "synchro": (synchro, {1, 2, 3}), "axle": (DynamicModel.of(Robot.from_dict(side)), {0, 1, 2})}
+
+
+def _random_rows(model, commanded, rng, k: int, step: float):
+    """`k` rows of set-points on the law (the oracle's projection, each follower's turn nearest its last row's), the
+    headings a random walk of steps up to `step` [rad] (some rows repeated), at random increasing times."""
+    walk = np.cumsum(rng.uniform(-step, step, (k, len(model.steer_columns))) * (rng.random((k, 1)) > 0.1), axis=0)
+    beta = np.array(model.robot.beta_of_heading(np.clip(walk, -1.3, 1.3)), dtype=float)
+    followers = [j for j, _, _ in _old_set_by_law(model, beta[0], commanded)]
+    for row in range(k):
+        if row:
+            beta[row, followers] = beta[row - 1, followers]
+        beta[row] = _old_on_law(model, beta[row], commanded)
+    return np.cumsum(rng.uniform(0.01, 2.0, k)), beta
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+@pytest.mark.parametrize("name", ["pair", "inverse", "three", "synchro", "axle"])
+def test_the_knots_of_every_row_at_once_are_those_made_row_by_row(name, compiled, monkeypatch):
+    """setpoint_knots looped over the rows in Python, a law evaluation per call (1.5 s for a 2001-knot twist
+    program; minutes for a torque file near the table limit): now its loops run over every row at once, compiled
+    for large tables. The same knots and values, bit for bit, including steps cut into hundreds of pieces."""
+    from wmrkit.dynamics import _setpoints, linkages
+
+    monkeypatch.setattr(_setpoints, "COMPILED_WORK", 0 if compiled else 10**9)
+    model, commanded = _models()[name]
+    rng = np.random.default_rng(7)
+    for k, step in ((2, 1.2), (30, 0.05), (40, 0.8)):
+        t, beta = _random_rows(model, commanded, rng, k, step)
+        at, on = linkages.setpoint_knots(model, t, beta, commanded)
+        want_at, want_on = _old_setpoint_knots(model, t, beta, commanded)
+        assert np.array_equal(at, want_at) and np.array_equal(on, want_on)
+        assert len(at) > k or name in ("synchro", "axle")  # knots were inserted (a chain's law is linear)
+
+
+def _counted(monkeypatch) -> list[int]:
+    """The law evaluations of setpoint_knots (its loops as plain Python), counted."""
+    from wmrkit.dynamics import _setpoints
+
+    count, law = [0], _setpoints.law
+
+    def counting(row, beta):
+        count[0] += 1
+        return law(row, beta)
+
+    monkeypatch.setattr(_setpoints, "COMPILED_WORK", 10**12)
+    monkeypatch.setattr(_setpoints, "law", counting)
+    return count
+
+
+@pytest.mark.parametrize("swing", [0.02, 0.3, 0.9])
+def test_the_work_is_bounded_by_the_rows_and_the_knots_inserted(swing, monkeypatch):
+    """At most ``4 (rows - 1) + 12 knots + 1`` law evaluations (a follower, its leader commanded): each step puts 3
+    set-points on the law at first and, cut into p > 1 pieces, ``2 p + 1`` in each round, p at least doubling (at
+    most 5 P for its last P), then P knots; P - 1 >= P / 2 knots inserted. At the cap (linkages.MAX_SETPOINT_KNOTS)
+    that is at most 1.2e7 evaluations past the rows' (about a second compiled, 0.1 us each); before, the cap was 1e7
+    knots (1.2e8 evaluations at 13 us each in Python: half an hour)."""
+    from wmrkit.dynamics import linkages
+
+    count = _counted(monkeypatch)
+    model = DynamicModel.of(linked_car())
+    t = np.arange(200.0)
+    fl = swing * np.where(np.arange(200) % 2, 1.0, -1.0) * np.random.default_rng(3).random(200)
+    rows = [(h, icr_heading(0.6, -0.2, 0.2 + 0.6 / math.tan(h))) for h in fl]
+    at, _ = linkages.setpoint_knots(model, t, np.array(model.robot.beta_of_heading(np.array(rows))), {0, 1})
+    inserted = len(at) - len(t)
+    assert 0 < count[0] <= 4 * (len(t) - 1) + 12 * inserted + 1
+    assert 12 * linkages.MAX_SETPOINT_KNOTS <= 1.2e7
+
+
+def test_the_knot_cap_is_reached_before_its_knots_are_computed(monkeypatch):
+    """Beyond MAX_SETPOINT_KNOTS inserted knots, a one-line WmrkitError saying what to do, the law evaluated at
+    most ``4 (rows - 1) + 12 cap + 1`` times; just within the cap, the knots. Before, the cap counted the rows too,
+    was checked only while a step was cut (a million rows passed it unchecked) and said to give rows closer
+    together (which inserts as many knots)."""
+    from wmrkit.dynamics import linkages
+
+    model = DynamicModel.of(linked_car())
+    t = np.arange(50.0)
+    fl = np.where(np.arange(50) % 2, 0.7, -0.7)
+    rows = [(h, icr_heading(0.6, -0.2, 0.2 + 0.6 / math.tan(h))) for h in fl]
+    beta = np.array(model.robot.beta_of_heading(np.array(rows)))
+    inserted = len(linkages.setpoint_knots(model, t, beta, {0, 1})[0]) - len(t)
+    monkeypatch.setattr(linkages, "MAX_SETPOINT_KNOTS", inserted)
+    assert len(linkages.setpoint_knots(model, t, beta, {0, 1})[0]) == len(t) + inserted
+    monkeypatch.setattr(linkages, "MAX_SETPOINT_KNOTS", inserted - 1)
+    count = _counted(monkeypatch)
+    with pytest.raises(WmrkitError) as err:
+        linkages.setpoint_knots(model, t, beta, {0, 1})
+    assert count[0] <= 4 * (len(t) - 1) + 12 * (inserted - 1) + 1
+    assert "\n" not in str(err.value)
+    assert str(err.value).startswith(
+        f"heading set-points: keeping a held linkage's followers on its law between the rows would insert more than "
+        f"{inserted - 1:.0e} knots (the step from t = 0 s to 1 s alone at least ")
+    assert str(err.value).endswith("give the heading of one wheel per linkage (the linkage turns the others) or "
+                                   "smaller heading steps between rows")

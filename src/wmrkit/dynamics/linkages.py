@@ -27,6 +27,7 @@ from ..couplings import linkage_law
 from ..errors import WmrkitError
 from ..kinematics.linkage_law import LINKAGE_TOL, law
 from ..kinematics.linkage_law import leader_of as _leader_of
+from . import _setpoints
 
 #: A heading set-point [rad] (a torque file's, :func:`wmrkit.dynamics.programs.read_torques`) farther than this from
 #: its linkage's law, given the other set-points of the linkage, fights it: headings written to six significant
@@ -148,23 +149,34 @@ def gear_breach(model, headings: np.ndarray, commanded: set[int],
 
 def _set_by_law(model, beta: np.ndarray, commanded: set[int]) -> list[tuple[int, int | None, float]]:
     """``(follower, reference, angle)`` for each commanded follower of a held linkage (:func:`setpoint_breach`):
-    the angle its linkage's law gives it from its reference's set-point in `beta`."""
-    table, cols, out = model.pack[17], list(model.steer_columns), []
+    the angle its linkage's law gives it from its reference's set-point in `beta` (:func:`_law_plan`)."""
+    table = model.pack[17]
+    return [(j, src if src in commanded else None,
+             law(table[r], beta[src] if inv < 0 else _leader_of(table[inv], beta[src]))[0])
+            for j, r, src, inv in _law_plan(model, commanded).tolist()]
+
+
+def _law_plan(model, commanded: set[int]) -> np.ndarray:
+    """``(F, 4)`` int, a row per commanded follower of a held linkage: its index, its row of the table, the index
+    whose set-point gives its leader's angle (the leader if commanded, else the first commanded follower the leader's
+    angle is found from, else the leader: a follower on the axle line keeps its rest angle whatever it is) and the
+    table row whose inverse finds it (:func:`_leader_of`; -1: the leader's own)."""
+    table, cols, plan = model.pack[17], list(model.steer_columns), []
     for lead in dict.fromkeys(int(r[1]) for r in table):
-        rows = [r for r in table if int(r[1]) == lead and cols.index(int(r[0])) in commanded]
-        ref = cols.index(lead)
-        if ref in commanded:
-            b = beta[ref]
-        else:
-            first = next((r for r in rows if r[3] == 0.0 or r[5] != 0.0), None)
-            ref = None if first is None else cols.index(int(first[0]))
-            b = beta[cols.index(lead)] if first is None else _leader_of(first, beta[ref])
-        out += [(cols.index(int(r[0])), ref, law(r, b)[0]) for r in rows if cols.index(int(r[0])) != ref]
-    return out
+        rows = [k for k, r in enumerate(table) if int(r[1]) == lead and cols.index(int(r[0])) in commanded]
+        src, inv = cols.index(lead), -1
+        if src not in commanded:
+            inv = next((k for k in rows if table[k, 3] == 0.0 or table[k, 5] != 0.0), -1)
+            src = src if inv < 0 else cols.index(int(table[inv, 0]))
+        plan += [(cols.index(int(table[k, 0])), k, src, inv) for k in rows if cols.index(int(table[k, 0])) != src]
+    return np.array(plan, dtype=np.int64).reshape(-1, 4)
 
 
-#: Most knots :func:`setpoint_knots` makes of a torque file's rows (as many as the rows of a 1 GiB table).
-MAX_SETPOINT_KNOTS = 10_000_000
+#: Most knots :func:`setpoint_knots` inserts between the rows of a set-point table (a 0.5 rad row step of a small
+#: car's steering inserts 139): its loops put at most ``4 (rows - 1) + 12 knots + 1`` set-points on the law
+#: (tests/dynamics/test_linkage_setpoints.py): about two seconds for a million rows and these knots, which with the
+#: torques interpolated at them take some 100 MB per ten columns.
+MAX_SETPOINT_KNOTS = 1_000_000
 
 
 def setpoint_knots(model, t: np.ndarray, beta: np.ndarray, commanded: set[int],
@@ -172,38 +184,43 @@ def setpoint_knots(model, t: np.ndarray, beta: np.ndarray, commanded: set[int],
     """Knots ``(t, beta)`` whose linear interpolation keeps the set-points of each held linkage on its law between
     rows: times `t` ``(K,)`` [s], steering set-points `beta` ``(K, n_steer)`` [rad] on the law at each row
     (:func:`setpoint_breach`), the indices `commanded` servoed. Between two rows the reference of each linkage moves
-    linearly and the law sets its commanded followers from it (:func:`_on_law`): knots are inserted, evenly in
-    time, until the followers' interpolation is within `tol` / 2 of the law at the middle of every interval (the
-    law is smooth: a short chord's largest error is at its middle); the other columns keep their rows'
-    interpolation. Without a commanded follower the rows are returned as they are; :class:`WmrkitError` beyond
-    :data:`MAX_SETPOINT_KNOTS` knots."""
-    if len(t) < 2 or not _set_by_law(model, beta[0], commanded):
+    linearly and the law sets its commanded followers from it (:func:`_set_by_law`): each step is cut into even
+    pieces in time, their number raised (at least doubled, every step at once) until the followers'
+    interpolation is within `tol` / 2 of the law at the middle of every piece (the law is smooth: a short chord's
+    largest error is at its middle); the other columns keep their rows' interpolation. Without a commanded follower
+    the rows are returned as they are; :class:`WmrkitError` where more than :data:`MAX_SETPOINT_KNOTS` knots would
+    be inserted (before they are computed)."""
+    plan = _law_plan(model, commanded)
+    if len(t) < 2 or not len(plan):
         return t, beta
-    times, rows = [t[:1]], [_on_law(model, beta[0], commanded)[None]]
-    for k in range(len(t) - 1):
-        pieces = 1
-        while True:
-            s = np.linspace(0.0, 1.0, 2 * pieces + 1)  # the knots and the middles of their intervals
-            on = np.array([_on_law(model, (1 - a) * beta[k] + a * beta[k + 1], commanded) for a in s])
-            off = np.abs(on[1:-1:2] - (on[:-2:2] + on[2::2]) / 2).max()
-            if off <= tol / 2:
-                break
-            pieces = max(2 * pieces, math.ceil(pieces * math.sqrt(2 * off / tol)))
-            if pieces + sum(len(x) for x in times) > MAX_SETPOINT_KNOTS:
-                raise WmrkitError(f"heading set-points: more than {MAX_SETPOINT_KNOTS:.0e} knots would keep a held "
-                                  "linkage's followers on its law between the rows; give rows closer together")
-        times.append(np.append(t[k] + (t[k + 1] - t[k]) * s[2:-1:2], t[k + 1]))
-        rows.append(on[2::2])
-    return np.concatenate(times), np.concatenate(rows)
+    args = (np.ascontiguousarray(model.pack[17], dtype=float), plan)
+    t, beta = np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(beta, dtype=float)
+    pieces, rows = np.ones(len(t) - 1, dtype=np.int64), np.arange(len(t) - 1)
+    while len(rows):
+        off = np.empty(len(rows))
+        _loops(int(np.sum(2 * pieces[rows] + 1))).chord_errors(*args, beta, rows, pieces[rows], off)
+        rows, off = rows[off > tol / 2], off[off > tol / 2]
+        more = np.maximum(2.0 * pieces[rows], np.ceil(pieces[rows] * np.sqrt(2 * off / tol)))
+        if np.sum(pieces - 1) + np.sum(more - pieces[rows]) > MAX_SETPOINT_KNOTS:
+            worst = rows[np.argmax(more)]
+            raise WmrkitError(
+                f"heading set-points: keeping a held linkage's followers on its law between the rows would insert "
+                f"more than {MAX_SETPOINT_KNOTS:.0e} knots (the step from t = {t[worst]:g} s to {t[worst + 1]:g} s "
+                f"alone at least {more.max() - 1:.0f}); give the heading of one wheel per linkage (the linkage turns "
+                "the others) or smaller heading steps between rows")
+        pieces[rows] = more
+    at, on = np.empty(1 + int(pieces.sum())), np.empty((1 + int(pieces.sum()), beta.shape[1]))
+    _loops(len(at)).knots(*args, t, beta, pieces, at, on)
+    return at, on
 
 
-def _on_law(model, beta: np.ndarray, commanded: set[int]) -> np.ndarray:
-    """`beta` with each commanded follower of a held linkage at the angle its law gives it (:func:`_set_by_law`),
-    the turn nearest its value in `beta`."""
-    beta = np.array(beta, dtype=float)
-    for j, _, f in _set_by_law(model, beta, commanded):
-        beta[j] += math.remainder(f - beta[j], 2 * math.pi)
-    return beta
+def _loops(work: int):
+    """The loops of :func:`setpoint_knots` for `work` law evaluations: plain Python, compiled from
+    :data:`~._setpoints.COMPILED_WORK`."""
+    if work < _setpoints.COMPILED_WORK:
+        return _setpoints
+    from . import _setpoint_kernel
+    return _setpoint_kernel
 
 
 def _heading(model, k: int, beta: float) -> float:

@@ -1,0 +1,27 @@
+"""The compiled loops of :func:`wmrkit.dynamics.linkages.setpoint_knots` (:mod:`._setpoints`, compiled as they are,
+each calling the others and the law compiled as ``ik``'s linkage check compiles them:
+:mod:`wmrkit.kinematics._linkage_kernel`). Imported for a table of at least
+:data:`~._setpoints.COMPILED_WORK` law evaluations (numba takes a moment to import)."""
+
+from __future__ import annotations
+
+import types
+
+from .._jit import compile_cached, drop_stale_cache
+from ..kinematics import _linkage_kernel, linkage_law
+from . import _setpoints
+
+drop_stale_cache([__file__, _setpoints.__file__], [linkage_law.__file__, _linkage_kernel.__file__])
+
+
+def _compiled(name: str, names: dict):
+    """:mod:`._setpoints`' function `name` compiled, its globals with `names` (compiled helpers) in place of its own."""
+    fn = getattr(_setpoints, name)
+    return compile_cached(types.FunctionType(fn.__code__, {**vars(_setpoints), **names}, name))
+
+
+_names = dict(_linkage_kernel._judge_names)
+_names["project"] = _compiled("project", _names)
+_names["between"] = _compiled("between", _names)
+chord_errors = _compiled("chord_errors", _names)
+knots = _compiled("knots", _names)

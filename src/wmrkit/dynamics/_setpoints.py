@@ -1,0 +1,76 @@
+"""The loops of :func:`wmrkit.dynamics.linkages.setpoint_knots`, over every row of a set-point table at once: plain
+Python for a small table, compiled as they are by :mod:`._setpoint_kernel` for a large one (numba loads on first
+use). No formula is written here: the law, its inverse and the reduction are :mod:`wmrkit.kinematics.linkage_law`'s.
+
+``plan`` ``(F, 4)`` int, a row per commanded follower of a held linkage (:func:`~.linkages._law_plan`): its index
+in the set-points, its linkage table row, the index whose set-point gives its leader's angle, and the table row
+through whose inverse it does (:func:`~wmrkit.kinematics.linkage_law.leader_of`), -1: the set-point is the
+leader's.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..kinematics.linkage_law import law, leader_of, remainder
+
+#: Law evaluations (set-points put on the law) from which the compiled loops run.
+COMPILED_WORK = 20_000
+
+
+def project(table, plan, point, out):
+    """`out` ``(n_steer,)``: the set-points `point` with each follower of `plan` at the angle its law gives it, the
+    turn nearest its value in `point`."""
+    for m in range(point.shape[0]):
+        out[m] = point[m]
+    for q in range(plan.shape[0]):
+        src, inv = plan[q, 2], plan[q, 3]
+        b = point[src] if inv < 0 else leader_of(table[inv], point[src])
+        j = plan[q, 0]
+        out[j] = point[j] + remainder(law(table[plan[q, 1]], b)[0] - point[j], 2.0 * math.pi)
+
+
+def between(table, plan, beta, k, s, point, out):
+    """:func:`project` of the set-points interpolated linearly at `s` in [0, 1] from row `k` of `beta` to the next
+    (`point`: work space)."""
+    for m in range(beta.shape[1]):
+        point[m] = (1 - s) * beta[k, m] + s * beta[k + 1, m]
+    project(table, plan, point, out)
+
+
+def chord_errors(table, plan, beta, rows, pieces, off):
+    """`off[q]`: the largest distance, over the set-points, between the law at the middle of each of `pieces[q]`
+    even pieces of the step from row ``rows[q]`` of `beta` to the next and the mean of the law at its ends."""
+    n = beta.shape[1]
+    point, a, mid, b = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    for q in range(rows.shape[0]):
+        k, p = rows[q], pieces[q]
+        step = 1.0 / (2 * p)  # the knots and the middles at i step, as np.linspace(0, 1, 2 p + 1)
+        between(table, plan, beta, k, 0.0, point, a)
+        worst = 0.0
+        for i in range(1, p + 1):
+            between(table, plan, beta, k, (2 * i - 1) * step, point, mid)
+            between(table, plan, beta, k, 1.0 if i == p else (2 * i) * step, point, b)
+            for m in range(n):
+                worst = max(worst, abs(mid[m] - (a[m] + b[m]) / 2))
+            a, b = b, a
+        off[q] = worst
+
+
+def knots(table, plan, t, beta, pieces, at, on):
+    """The knots ``(at, on)``: the first row projected, then each step from row k of `t`, `beta` to the next cut
+    into `pieces[k]` even pieces, each piece's end projected (:func:`between`)."""
+    point = np.empty(beta.shape[1])
+    at[0] = t[0]
+    project(table, plan, beta[0], on[0])
+    o = 1
+    for k in range(pieces.shape[0]):
+        p = pieces[k]
+        step = 1.0 / (2 * p)
+        for i in range(1, p + 1):
+            s = 1.0 if i == p else (2 * i) * step
+            at[o] = t[k + 1] if i == p else t[k] + (t[k + 1] - t[k]) * s
+            between(table, plan, beta, k, s, point, on[o])
+            o += 1
