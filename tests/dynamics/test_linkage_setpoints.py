@@ -326,3 +326,23 @@ def test_the_knot_cap_is_reached_before_its_knots_are_computed(monkeypatch):
         f"{inserted - 1:.0e} knots (the step from t = 0 s to 1 s alone at least ")
     assert str(err.value).endswith("give the heading of one wheel per linkage (the linkage turns the others) or "
                                    "smaller heading steps between rows")
+
+
+def test_the_cli_names_the_torque_file_past_the_knot_cap(tmp_path, capsys, monkeypatch):
+    """Before, ``simulate car --torques h.csv`` past the cap printed the error without the file (JSON file null)."""
+    from wmrkit.dynamics import linkages
+
+    monkeypatch.setattr(linkages, "MAX_SETPOINT_KNOTS", 3)
+    car, torques = tmp_path / "car.json", tmp_path / "h.csv"
+    car.write_text(json.dumps(linked_car().to_dict()))
+    right = icr_heading(0.6, -0.2, 0.2 + 0.6 / math.tan(0.5))
+    torques.write_text(f"time,fl.heading,fr.heading\n0,0,0\n1,0.5,{right!r}\n")
+    argv = ["simulate", str(car), "--torques", str(torques), "--duration", "0.01"]
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and len(err.splitlines()) == 1
+    assert err.startswith(f"wmrkit: error: {torques}: heading set-points: keeping a held linkage's followers on its "
+                          "law between the rows would insert more than 3e+00 knots (the step from t = 0 s to 1 s ")
+    assert main([*argv, "--json"]) == 2
+    data = json.loads(capsys.readouterr().err)
+    assert data["file"] == str(torques) and data["error"].startswith("heading set-points: keeping")

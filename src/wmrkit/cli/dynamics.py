@@ -122,6 +122,7 @@ def _check_program_step(step: float, name: str) -> None:
 def run_simulate(args: argparse.Namespace) -> int:
     """Simulate, print a summary, write and plot on request."""
     from ..dynamics.deviation import check_step, deviation_warning
+    from ..dynamics.linkages import SetpointKnotsError
     from ..dynamics.programs import path_program, read_torques
     from ..dynamics.runs import at_door
     from ..dynamics.simulate import MAX_STEPS, recordable_step, simulate
@@ -163,6 +164,8 @@ def run_simulate(args: argparse.Namespace) -> int:
                        record_step=recordable_step(model, duration, step, max(step, min(0.01, duration))),
                        progress=False if args.json else None)
         check_step(model, inputs, sim, initial_twist=twist)  # a run off its path at an unstable step is refused
+    except SetpointKnotsError as err:  # the knots between the torque file's rows (the program's)
+        raise WmrkitError(f"{args.torques or f'--path {args.path}'}: {err}") from None
     except WmrkitError as err:  # a stop's re-check, or the step's, names the step as the CLI sets it
         raise at_door(err, "(--step) or the adaptive method") from None
     if args.out:

@@ -179,6 +179,10 @@ def _law_plan(model, commanded: set[int]) -> np.ndarray:
 MAX_SETPOINT_KNOTS = 1_000_000
 
 
+class SetpointKnotsError(WmrkitError):
+    """More than :data:`MAX_SETPOINT_KNOTS` knots :func:`setpoint_knots` would insert (a door names its source)."""
+
+
 def setpoint_knots(model, t: np.ndarray, beta: np.ndarray, commanded: set[int],
                    tol: float = SETPOINT_TOL) -> tuple[np.ndarray, np.ndarray]:
     """Knots ``(t, beta)`` whose linear interpolation keeps the set-points of each held linkage on its law between
@@ -188,8 +192,8 @@ def setpoint_knots(model, t: np.ndarray, beta: np.ndarray, commanded: set[int],
     pieces in time, their number raised (at least doubled, every step at once) until the followers'
     interpolation is within `tol` / 2 of the law at the middle of every piece (the law is smooth: a short chord's
     largest error is at its middle); the other columns keep their rows' interpolation. Without a commanded follower
-    the rows are returned as they are; :class:`WmrkitError` where more than :data:`MAX_SETPOINT_KNOTS` knots would
-    be inserted (before they are computed)."""
+    the rows are returned as they are; :class:`SetpointKnotsError` where more than :data:`MAX_SETPOINT_KNOTS`
+    knots would be inserted (before they are computed)."""
     plan = _law_plan(model, commanded)
     if len(t) < 2 or not len(plan):
         return t, beta
@@ -203,7 +207,7 @@ def setpoint_knots(model, t: np.ndarray, beta: np.ndarray, commanded: set[int],
         more = np.maximum(2.0 * pieces[rows], np.ceil(pieces[rows] * np.sqrt(2 * off / tol)))
         if np.sum(pieces - 1) + np.sum(more - pieces[rows]) > MAX_SETPOINT_KNOTS:
             worst = rows[np.argmax(more)]
-            raise WmrkitError(
+            raise SetpointKnotsError(
                 f"heading set-points: keeping a held linkage's followers on its law between the rows would insert "
                 f"more than {MAX_SETPOINT_KNOTS:.0e} knots (the step from t = {t[worst]:g} s to {t[worst + 1]:g} s "
                 f"alone at least {more.max() - 1:.0f}); give the heading of one wheel per linkage (the linkage turns "
