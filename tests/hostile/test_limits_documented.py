@@ -29,6 +29,8 @@ DOCUMENTED = [
     ("wmrkit.limits", "MAX_SPEED", "up to 1e3 m/s (`MAX_SPEED`)", 1e3),
     ("wmrkit.limits", "MAX_TORQUE", "within 1e10 N m (`limits.MAX_TORQUE`)", 1e10),
     ("wmrkit.dynamics.linkages", "SETPOINT_TOL", "within 1e-5 rad (`linkages.SETPOINT_TOL`", 1e-5),
+    ("wmrkit.dynamics.linkages", "MAX_SETPOINT_KNOTS", "at most 1e6 inserted knots (`linkages.MAX_SETPOINT_KNOTS`",
+     1e6),
     ("wmrkit.kinematics.codegen", "MAX_FILENAME", "255 bytes (`codegen.MAX_FILENAME`)", 255),
     ("wmrkit.kinematics.codegen", "MAX_STACK_WORK", "512 doubles, 4 KiB (`codegen.MAX_STACK_WORK`)", 512),
     ("wmrkit.kinematics.search", "MAX_SETS", "after 1000 sets (`MAX_SETS`", 1000),
