@@ -7,7 +7,11 @@ is (4.82); its residual ``A q_dot`` is the slip indicator. The steering-angle co
 that residual over the steering angles, found here numerically (batched Levenberg-Marquardt from several
 starts); substituting them gives the slip-free extended solution (4.84). A ``gear`` coupling is held throughout, as
 ``fk`` holds it (:func:`~.linalg.geared_solve`), and :func:`extended_dof` counts the mobility it leaves; assigned
-rates out of a gear's ratios are used as given, with a :class:`GearWarning`. A ``linkage`` is not used.
+rates out of a gear's ratios are used as given, with a :class:`GearWarning`. A held ``linkage`` is judged as ``ik`` and
+``fk`` judge it (:mod:`.linkage_check`): each steerable wheel keeps its own angle, and ``in_linkage`` is False where
+they break the linkage's law (:class:`LinkageAngleWarning`, naming it and the wheels): angles found for the assigned
+velocities (:func:`solve_steering`, :func:`no_slip_extended_solution`) as ``ik`` judges its angles for a twist, given
+ones (:func:`extended_solution`) as ``fk`` judges given headings.
 """
 
 from __future__ import annotations
@@ -26,8 +30,9 @@ from ..errors import ShapeError, SingularError, UnknownNameError
 from ..robot import Robot
 from .gear_check import given_gear_breaches
 from .linalg import geared_solve
+from .linkage_check import LinkageAngleWarning, given_breaches, ik_breaches, linkage_holds
 from .models import bounded, configuration, describe_configuration, generic_mobility, velocity_indices
-from .wheel_ik import SLIP_TOL
+from .wheel_ik import FK_SLIP_RTOL, SLIP_TOL
 
 #: Most grid starts per problem of :func:`solve_steering` (its default 8 per wheel on 4 steered wheels); beyond,
 #: a seeded sample of the grid. Each start costs about 7 ms when no root exists (4096: 27 s for a swerve-4).
@@ -43,7 +48,8 @@ class ExtendedSolution:
     ``q_dot``: ``(..., k)`` in the robot's velocity order (assigned entries copied in); ``residual``:
     ``(..., 2 n_contacts)`` slip along the roller axes (3.6) [m/s]; ``beta``: ``(..., n_steer)`` [rad];
     ``in_gear``: ``(..., n_couplings)`` bool, False where the assigned rates of a ``gear``'s joints break its ratios
-    (:class:`GearWarning`; True for the other couplings).
+    (:class:`GearWarning`; True for the other couplings); ``in_linkage``: the same shape, False where ``beta`` breaks
+    a held ``linkage``'s law (:class:`LinkageAngleWarning`; module docstring).
     """
 
     robot_name: str
@@ -53,12 +59,14 @@ class ExtendedSolution:
     q_dot: np.ndarray
     residual: np.ndarray
     in_gear: np.ndarray
+    in_linkage: np.ndarray
 
     @property
     def slip(self) -> np.ndarray:
         """Norm of the residual ``|A q_dot|`` [m/s], ``(...)``: zero iff the wheels do not slip here. Assigned rates
-        that break a gear are used as given, as ``fk`` uses them: the wheels may roll without slip while the gear
-        forbids the motion, so the assignment is consistent only where also every ``in_gear``."""
+        that break a gear are used as given, as ``fk`` uses them, and each wheel keeps its own steering angle: the
+        wheels may roll without slip while a gear or linkage forbids the motion, so the assignment is consistent only
+        where also every ``in_gear`` and every ``in_linkage``."""
         return np.linalg.norm(self.residual, axis=-1)
 
     @property
@@ -78,13 +86,14 @@ class ExtendedSolution:
         """JSON-ready summary (lists and plain values)."""
         return {"assigned": list(self.assigned), "velocity_names": list(self.velocity_names),
                 "beta": self.beta.tolist(), "q_dot": self.q_dot.tolist(), "slip": self.slip.tolist(),
-                "in_gear": self.in_gear.tolist()}
+                "in_gear": self.in_gear.tolist(), "in_linkage": self.in_linkage.tolist()}
 
 
 def extended_dof(robot: Robot) -> int:
     """Velocities an extended solution may assign: ``m + n_o`` (§4.5), m with the robot's gears
-    (:func:`~.models.mobility`), n_o the steering joints (centred steerable wheels), linkages not used: wmrkit does
-    not model a ``linkage``'s geometry, so a synchro drive's three linked wheels count 3, not 1."""
+    (:func:`~.models.mobility`), n_o the steering joints (centred steerable wheels), linkages not used: each steered
+    wheel counts, so a synchro drive's three linked wheels count 3, not 1 (the solutions judge the angles against the
+    linkage: ``in_linkage``)."""
     return generic_mobility(robot) + sum(w.type == "steerable" for w in robot.wheels)
 
 
@@ -97,23 +106,63 @@ def extended_solution(
     ``q_assigned``: ``(..., n_a)``; ``beta``: ``(..., n_steer)`` or None; they broadcast. For a set that is
     assignable (4.10) the residual is zero; with more than m assigned velocities it is zero only at the
     steering angles of :func:`solve_steering`. ``heading`` (0 = rolling forward) instead of ``beta``: the same.
-    Assigned rates that break a ``gear``'s ratios: :class:`GearWarning`, ``in_gear`` False.
+    Assigned rates that break a ``gear``'s ratios: :class:`GearWarning`, ``in_gear`` False. Given angles that break a
+    held ``linkage``'s law by more than ``asin(FK_SLIP_RTOL)`` (1.15 deg), as ``fk`` judges given headings: the
+    linkage cannot set them, :class:`LinkageAngleWarning`, ``in_linkage`` False.
     """
-    return _extended_solution(robot, assigned, q_assigned, configuration(robot, beta, heading), 4)
+    return _extended_solution(robot, assigned, q_assigned, configuration(robot, beta, heading), 4, given=True)
 
 
 def _extended_solution(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: np.ndarray,
-                       stacklevel: int | None) -> ExtendedSolution:
-    """:func:`extended_solution` at the thesis's `beta`; `stacklevel`: of the warning on a broken gear (None: the
-    caller warned)."""
+                       stacklevel: int | None, *, given: bool) -> ExtendedSolution:
+    """:func:`extended_solution` at the thesis's `beta`; `stacklevel`: of the warnings on a broken gear or linkage
+    (None: the caller warned); `given`: `beta` judged as ``fk`` judges given angles, else as ``ik`` judges its
+    angles for the solution's twist (:func:`_in_linkage`)."""
     idx, q = _assigned(robot, assigned, q_assigned)
     in_gear = _in_gear(robot, idx, q, stacklevel)
     q_dot, residual = _solve(robot, robot.constraint_matrix(beta), idx, q)
     batch = q_dot.shape[:-1]
-    beta = np.broadcast_to(beta, (*batch, beta.shape[-1]))
-    return ExtendedSolution(robot.name, robot.velocity_names, tuple(assigned), readonly(np.array(beta)),
+    beta = np.array(np.broadcast_to(beta, (*batch, beta.shape[-1])))
+    in_linkage = _in_linkage(robot, beta, None if given else q_dot[..., :3], stacklevel)
+    return ExtendedSolution(robot.name, robot.velocity_names, tuple(assigned), readonly(beta),
                             readonly(q_dot), readonly(residual),
-                            readonly(np.array(np.broadcast_to(in_gear, (*batch, in_gear.shape[-1])))))
+                            readonly(np.array(np.broadcast_to(in_gear, (*batch, in_gear.shape[-1])))),
+                            readonly(in_linkage))
+
+
+def _in_linkage(robot: Robot, beta: np.ndarray, twist: np.ndarray | None, stacklevel: int | None) -> np.ndarray:
+    """``(..., n_couplings)`` bool: False where the steering `beta` ``(..., n_steer)`` breaks a held ``linkage``'s law
+    (:mod:`.linkage_check`, the judge of ``ik`` and ``fk``): with the solution's `twist` ``(..., 3)``, as ``ik``
+    judges its angles for a twist (:func:`~.linkage_check.linkage_holds`: a wheel off the law would slip sideways
+    beyond the slip floor); `twist` None, as ``fk`` judges given angles (:func:`~.linkage_check.given_breaches`,
+    off by more than ``asin(FK_SLIP_RTOL)``). A :class:`LinkageAngleWarning` per linkage broken in the first row
+    that breaks one, at `stacklevel` (None: no warning)."""
+    out = np.ones((*beta.shape[:-1], len(robot.couplings)), dtype=bool)
+    if not any(c.kind == "linkage" for c in robot.couplings):
+        return out
+    if twist is not None:
+        out = linkage_holds(robot, twist, beta, SLIP_TOL)
+        bad = np.argwhere(~out.all(axis=-1))
+        if stacklevel is not None and len(bad):
+            row = tuple(bad[0])
+            for b in ik_breaches(robot, twist[row], beta[row], SLIP_TOL):
+                warnings.warn(f"a steering linkage cannot set these steering angles: {b.describe(robot)}, which the "
+                              f"assigned velocities need (set by the linkage, the wheel would slip sideways at "
+                              f"{b.slip:.3g} m/s)", LinkageAngleWarning, stacklevel=stacklevel)
+        return out
+    rows, inverse = np.unique(beta.reshape(-1, beta.shape[-1]), axis=0, return_inverse=True)
+    flat, said = out.reshape(-1, len(robot.couplings)), False
+    for r, row in enumerate(rows):
+        off = given_breaches(robot, row, FK_SLIP_RTOL)
+        for b in off:
+            flat[inverse.reshape(-1) == r, b.coupling] = False
+        if stacklevel is not None and off and not said:
+            said = True
+            for b in off:
+                warnings.warn(f"the steering angles break a steering linkage: {b.describe(robot)}: it cannot set "
+                              "them, so the solution at them is not the robot's motion; check the angles",
+                              LinkageAngleWarning, stacklevel=stacklevel)
+    return out
 
 
 def _in_gear(robot: Robot, idx: np.ndarray, q: np.ndarray, stacklevel: int | None) -> np.ndarray:
@@ -171,7 +220,9 @@ def solve_steering(
     ``(..., n_steer)`` or None (described), or the guess as the users' ``heading`` (0 = rolling forward). Returns
     the thesis's β ``(..., n_steer)`` [rad], steerable angles wrapped to [-pi, pi). Raises
     :class:`~wmrkit.errors.SingularError` where no angle makes the assignment slip-free. Assigned rates that break a
-    ``gear``'s ratios are used as given (the wheels' slip only): :class:`GearWarning`, as ``fk`` warns.
+    ``gear``'s ratios are used as given (the wheels' slip only): :class:`GearWarning`, as ``fk`` warns. Each steerable
+    wheel gets its own angle; angles a held ``linkage`` cannot set for the solution's twist, as ``ik`` judges them:
+    :class:`LinkageAngleWarning` naming it and the wheels.
     """
     return _solve_steering(robot, assigned, q_assigned, beta_guess, heading, starts, iterations, 4)
 
@@ -231,6 +282,8 @@ def _solve_steering(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike
             f"(smallest residual {float(np.sqrt(cost[bad[0]])):.3g} m/s)")
     out = guess.copy()
     out[:, free] = _wrap(x)
+    if any(c.kind == "linkage" for c in robot.couplings):  # ik's judge on the solution's twist
+        _in_linkage(robot, out, _solve(robot, robot.constraint_matrix(out), idx, q)[0][:, :3], stacklevel)
     return readonly(out.reshape(*batch, -1))
 
 
@@ -271,7 +324,8 @@ def no_slip_extended_solution(
     """The slip-free extended solution (4.84): (4.82) at the steering angles of :func:`solve_steering`.
 
     ``(..., n_a), (..., n_steer) -> ExtendedSolution`` whose ``beta`` holds the angles to steer to (the thesis's β);
-    the guess as `beta_guess` or as the users' `heading`.
+    the guess as `beta_guess` or as the users' `heading`. ``in_linkage``: the angles judged as ``ik`` judges its
+    angles for the solution's twist (:class:`LinkageAngleWarning` where a held linkage cannot set them).
     """
-    beta = _solve_steering(robot, assigned, q_assigned, beta_guess, heading, 8, 60, 4)  # warns on a broken gear
-    return _extended_solution(robot, assigned, q_assigned, beta, None)
+    beta = _solve_steering(robot, assigned, q_assigned, beta_guess, heading, 8, 60, 4)  # warns: gear, linkage
+    return _extended_solution(robot, assigned, q_assigned, beta, None, given=False)

@@ -55,7 +55,7 @@ def kinematics_summary(robot: Robot) -> dict[str, Any]:
         # m with the gear couplings held (analyze's coupled_mobility): the sets' size, the models' m
         "coupled_mobility": int(mobility(robot)),
         "gears": [c.channel_name for c in robot.couplings if c.kind == "gear"],  # held by the sets and models
-        "linkages": [c.channel_name for c in robot.couplings if c.kind == "linkage"],  # not by extended_dof
+        "linkages": [c.channel_name for c in robot.couplings if c.kind == "linkage"],  # not counted by extended_dof
         "generic_mobility": generic_mobility(robot),  # the models' m at generic steering
         "extended_dof": extended_dof(robot),
         "assignable_sets": [list(s) for s in here],
@@ -148,7 +148,8 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
         linked = summary.get("linkages")
         lines.append(f"  with its {extra} steering rate{'s' if extra > 1 else ''} (extended solutions, §4.5), "
                      f"{n} velocit{'ies' if n > 1 else 'y'} can be assigned"
-                     + (f" (each steered wheel counted: {', '.join(linked)} not used, its geometry not modelled)"
+                     + (f" (each steered wheel counted, {', '.join(linked)} not as one: the solutions judge their "
+                        "angles against its law)"
                         if linked else ""))
     lines += [f"  velocities: {', '.join(summary['velocity_names'])}",
               f"  assignable sets ({len(summary['assignable_sets'])}):", *_sets(summary["assignable_sets"], limit)]
