@@ -18,6 +18,7 @@ from ..errors import WmrkitError
 from .coordinated import coordinated_singular_set
 from .figures import condition_figure, length_figure, motions_figure, robot_figure, singular_figure
 from .lines import constraint_lines
+from .linkage_reach import unreachable_note
 from .singularity import singular_set
 from .summary import Analysis, actuation_words, assigned_names, check_resolution, describe_singular
 
@@ -139,8 +140,10 @@ def _summary_table(a: Analysis) -> str:
             rows.append(("characteristic length D",
                          f"{a.characteristic_length:.4g} m ({'natural' if a.natural else 'given'})"))
     for key, s in a.singular.items():
+        note = unreachable_note(a.robot, s)
         rows.append((f"singular {key} model",
-                     f"({', '.join(assigned_names(s, a.robot)) or '-'}): {describe_singular(s, a.robot)}"))
+                     f"({', '.join(assigned_names(s, a.robot)) or '-'}): {describe_singular(s, a.robot)}"
+                     + ("" if note is None else f"; {note}")))
     rows += [("special configuration", s.description) for s in c.special]
     body = "".join(f"<tr><th>{_e(k)}</th><td>{_e(v)}</td></tr>" for k, v in rows)
     return f"<table>{body}</table>"

@@ -26,6 +26,7 @@ from .classification import Classification, classify, instantaneous_mobility
 from .coordinated import coordinated_singular_set
 from .icr import ICRSet, icr
 from .isotropy import described_condition, length_applies
+from .linkage_reach import unreachable, unreachable_note
 from .singularity import SingularSet, singular_set
 
 
@@ -129,6 +130,8 @@ class Analysis:
             lines.append(f"  condition number {self.condition_words()}, joints {', '.join(self.joints) or '-'}")
         for key, s in self.singular.items():
             lines.append(f"  singular ({key}: {', '.join(assigned_names(s, r)) or '-'}): {describe_singular(s, r)}")
+            if (note := unreachable_note(r, s)) is not None:  # a held linkage cannot set them
+                lines.append(f"    {note}")
         return "\n".join(lines)
 
 
@@ -153,13 +156,16 @@ def assigned_names(s: SingularSet, robot: Robot) -> tuple[str, ...]:
 
 def singular_dict(s: SingularSet, robot: Robot) -> dict[str, Any]:
     """JSON of a singular set: ``configurations`` as the thesis's β of `variables`, ``headings`` the same angles
-    as the wheels' headings (0 = rolling straight ahead)."""
+    as the wheels' headings (0 = rolling straight ahead); ``unreachable``: per configuration listed, True where a held
+    ``linkage`` cannot set it (:mod:`.linkage_reach`), and ``unreachable_note`` the report's line on it (or None)."""
     delta = np.array([robot.wheel(v).delta for v in s.variables], dtype=float)
     configs = s.configurations[:24]
+    bad, _ = unreachable(robot, s)
     return {"assigned": list(s.assigned), "variables": list(s.variables), "always": s.always, "never": s.never,
             "exact": s.exact, "count": len(s.configurations), "configurations": configs.tolist(),
             "headings": heading_from_beta(configs, delta).tolist(), "reasons": list(s.reasons),
-            "channels": list(assigned_names(s, robot))}
+            "channels": list(assigned_names(s, robot)), "unreachable": bad[:24].tolist(),
+            "unreachable_note": unreachable_note(robot, s)}
 
 
 def describe_singular(s: SingularSet, robot: Robot | None = None, *, limit: int = 6) -> str:
