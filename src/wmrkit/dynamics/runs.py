@@ -81,11 +81,11 @@ def fixed_run(model, s0, inp, duration, step, every, method, progress, jac_every
         if bar is not None:
             bar.update(k)
         diverged = not np.all(np.isfinite(s))
-        if diverged or (w[16][0] and not allow_lift_off):
+        if diverged or lifted(w, allow_lift_off):
             if bar is not None:
                 bar.close()
             _stop(model, tuple(r[:i] for r in rec), inp, w, done * step, duration, step, method, jac_every,
-                  allow_lift_off, diverged)
+                  allow_lift_off)
     if bar is not None:
         bar.close()
     return tuple(r[:i] for r in rec), {"steps": n_steps}
@@ -144,10 +144,20 @@ class Stop:
         return cls(t, f"contact '{contact}' lost its load at t = {t:.6g} s", contact)
 
     @classmethod
-    def of_run(cls, model: DynamicModel, w: tuple, t_run: float, diverged: bool) -> Stop:
-        """The stop of a run advanced to `t_run` [s]: it diverged before then, or the lift-off that its work arrays
-        `w` recorded."""
-        return cls.diverged(t_run) if diverged else cls.lift_off(float(w[16][1]), model.contacts[int(w[16][2])])
+    def of_run(cls, model: DynamicModel, w: tuple, t_run: float, allow_lift_off: bool) -> Stop:
+        """The stop of a run advanced to `t_run` [s]: the lift-off that its work arrays `w` recorded (unless
+        `allow_lift_off`), which comes first when the state diverged later in the same run (:func:`lifted`), or the
+        divergence before `t_run`."""
+        if lifted(w, allow_lift_off):
+            return cls.lift_off(float(w[16][1]), model.contacts[int(w[16][2])])
+        return cls.diverged(t_run)
+
+
+def lifted(w: tuple, allow_lift_off: bool) -> bool:
+    """Whether a run stops at the lift-off its work arrays `w` recorded (unless `allow_lift_off`): before a state
+    diverges, the loads of the motion leading there empty a wheel (1e9 N m on a 0.1 kg robot lifts a wheel off at
+    the first step and overflows the state later), and the lift-off says why, with the advice that fits."""
+    return bool(w[16][0]) and not allow_lift_off
 
 
 @dataclass(frozen=True)
@@ -206,14 +216,13 @@ def rerun_stop(model: DynamicModel, s: np.ndarray, stretch: list, fine: float, m
     s, acc, w, rec = s.copy(), np.zeros(model.n), model_work_arrays(model), records(model, 0)
     for k0, steps, inp in stretch:
         run(s, k0, fine, steps, 1 << 62, method, jac_every, acc, model.pack, inp, w, rec, 0)
-        diverged = not np.all(np.isfinite(s))
-        if diverged or (w[16][0] and not allow_lift_off):
-            return Stop.of_run(model, w, (k0 + steps) * fine, diverged)
+        if not np.all(np.isfinite(s)) or lifted(w, allow_lift_off):
+            return Stop.of_run(model, w, (k0 + steps) * fine, allow_lift_off)
     return None
 
 
-def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_lift_off, diverged):
-    """Raise the error of a fixed-step run that stopped at `t_run` [s] (diverged, or the lift-off `w` recorded),
+def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_lift_off):
+    """Raise the error of a fixed-step run that stopped at `t_run` [s] (the lift-off `w` recorded, or diverged),
     after re-running it at :func:`recheck_step` to its end (`duration`): from the first of the records `rows` at
     most :func:`recheck_budget` of those steps before the end (at the latest the last one before the stop), for at
     most that many steps, and judged (:func:`judge`). To the end, not a margin past the stop: a shorter step can
@@ -221,7 +230,7 @@ def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_l
     a step too long for the tyres 'lifted off' the forklift's steered wheel on its rectangle from 8 ms (the load
     transfer lags a step and the tyres saturate within one, which the implicit step does not cover:
     docs/dynamics.md)."""
-    stop = Stop.of_run(model, w, t_run, diverged)
+    stop = Stop.of_run(model, w, t_run, allow_lift_off)
     fine, budget = recheck_step(step, method), recheck_budget(method)
     k_end = round(duration / step) * round(step / fine)  # the run's end, in fine steps
     j = min(int(np.searchsorted(rows[0], (k_end - budget) * fine)),  # the first record in the budget, and at
@@ -232,12 +241,12 @@ def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_l
     error = judge(stop, Recheck(step, fine, again, k_last * fine, k_end * fine), SIMULATE_STEP)
     if error is not None:
         raise error
-    if diverged:
-        err = WmrkitError(f"the simulation diverged before t = {t_run:.6g} s; use a smaller step {SIMULATE_STEP} (or "
-                          "smaller torques or speeds)")
-        err.where = SIMULATE_STEP
-        raise err
-    check_lift_off(model, w)
+    if lifted(w, allow_lift_off):
+        check_lift_off(model, w)
+    err = WmrkitError(f"the simulation diverged before t = {t_run:.6g} s; use a smaller step {SIMULATE_STEP} (or "
+                      "smaller torques or speeds)")
+    err.where = SIMULATE_STEP
+    raise err
 
 
 def at_door(err: WmrkitError, where: str) -> WmrkitError:
@@ -285,14 +294,14 @@ class StepLog:
         return steps
 
     def recheck(self, model: DynamicModel, w: tuple, t_now: float, step: float, method: int, jac_every: int,
-                allow_lift_off: bool, diverged: bool) -> None:
+                allow_lift_off: bool) -> None:
         """Raise :func:`judge`'s error when the stepper stopped at `t_now` [s] (diverged, or the lift-off `w`
         recorded), after its logged inputs are run again at :func:`recheck_step` from the logged state at most
         :func:`recheck_budget` of those steps before their end (at the latest the last piece before the stop), for
         at most that many steps; return when the re-run reproduces the stop. Their end: the last inputs' last knot
         (the program given), at least `t_now` (the run asked for) and at least :func:`recheck_end` (held past it: a
         guess of what comes next, a loop's)."""
-        stop = Stop.of_run(model, w, t_now, diverged)
+        stop = Stop.of_run(model, w, t_now, allow_lift_off)
         r, fine, pieces, budget = self.ratio, self.fine, list(self.pieces), recheck_budget(method)
         last = pieces[-1]
         k_end = round(max(t_now, float(last[3][0][-1]), recheck_end(stop.t, step)) / fine)

@@ -40,6 +40,7 @@ from .runs import (  # noqa: F401  (LiftOffError, DivergedError: API)
     adaptive_samples,
     check_lift_off,
     fixed_run,
+    lifted,
     records,
 )
 from .tyres import Tyre
@@ -273,13 +274,12 @@ class Stepper:
             if not n_steps:
                 break
         diverged = not math.isfinite(self.state.sum())  # NaN and infinities propagate into the sum
-        if log is not None and (diverged or (self._w[16][0] and not self.allow_lift_off)):
-            log.recheck(self.model, self._w, self.t, self.step, self._method, self.jac_every, self.allow_lift_off,
-                        diverged)
+        if log is not None and (diverged or lifted(self._w, self.allow_lift_off)):
+            log.recheck(self.model, self._w, self.t, self.step, self._method, self.jac_every, self.allow_lift_off)
+        if lifted(self._w, self.allow_lift_off):  # first, when the state diverged after it
+            check_lift_off(self.model, self._w)
         if diverged:
             raise DivergedError(f"the simulation diverged before t = {self.t:.6g} s; use a smaller step", self.t)
-        if not self.allow_lift_off:
-            check_lift_off(self.model, self._w)
         return self.state
 
     def hold(self, rate_reference: ArrayLike | None = None, heading_reference: ArrayLike | None = None,
