@@ -21,7 +21,9 @@ def _compiled(name: str, names: dict):
 
 
 _names = dict(_linkage_kernel._judge_names)
+_names["angle"] = _compiled("angle", _names)
 _names["project"] = _compiled("project", _names)
 _names["between"] = _compiled("between", _names)
 chord_errors = _compiled("chord_errors", _names)
 knots = _compiled("knots", _names)
+law_offs = _compiled("law_offs", _names)

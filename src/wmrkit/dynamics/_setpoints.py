@@ -1,4 +1,5 @@
-"""The loops of :func:`wmrkit.dynamics.linkages.setpoint_knots`, over every row of a set-point table at once: plain
+"""The loops of :func:`wmrkit.dynamics.linkages.setpoint_knots` and of the set-point checks
+(:func:`~wmrkit.dynamics.linkages.first_breach`), over every row of a set-point table at once: plain
 Python for a small table, compiled as they are by :mod:`._setpoint_kernel` for a large one (numba loads on first
 use). No formula is written here: the law, its inverse and the reduction are :mod:`wmrkit.kinematics.linkage_law`'s.
 
@@ -26,10 +27,23 @@ def project(table, plan, point, out):
     for m in range(point.shape[0]):
         out[m] = point[m]
     for q in range(plan.shape[0]):
-        src, inv = plan[q, 2], plan[q, 3]
-        b = point[src] if inv < 0 else leader_of(table[inv], point[src])
         j = plan[q, 0]
-        out[j] = point[j] + remainder(law(table[plan[q, 1]], b)[0] - point[j], 2.0 * math.pi)
+        out[j] = point[j] + remainder(angle(table, plan, q, point) - point[j], 2.0 * math.pi)
+
+
+def angle(table, plan, q, point):
+    """The angle the law of follower ``plan[q]`` gives it from the set-points `point` ``(n_steer,)``."""
+    src, inv = plan[q, 2], plan[q, 3]
+    return law(table[plan[q, 1]], point[src] if inv < 0 else leader_of(table[inv], point[src]))[0]
+
+
+def law_offs(table, plan, beta, at, off):
+    """For each row k of the set-points `beta` ``(K, n_steer)`` and follower ``plan[q]``: `at[k, q]` the angle its
+    law gives it (:func:`angle`), `off[k, q]` how far its set-point is from it, ``|remainder(beta - at, 2 pi)|``."""
+    for k in range(beta.shape[0]):
+        for q in range(plan.shape[0]):
+            at[k, q] = angle(table, plan, q, beta[k])
+            off[k, q] = abs(remainder(beta[k, plan[q, 0]] - at[k, q], 2.0 * math.pi))
 
 
 def between(table, plan, beta, k, s, point, out):

@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike
 from .._shapes import readonly
 from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_TORQUE
-from .linkages import SETPOINT_TOL, heading_breach, setpoint_knots
+from .linkages import SETPOINT_TOL, first_breach, heading_breach, setpoint_knots
 from .model import DynamicModel
 
 
@@ -143,9 +143,10 @@ def compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
     beta_ref = np.array(model.robot.beta_of_heading(href), dtype=float, order="C") if s else href
     commanded = set(np.flatnonzero(kp > 0).tolist())
     if (len(model.pack[17]) or model.pack[16].shape[1]) and commanded and not inputs.fight_linkages:
-        off = next(((k, p) for k, row in enumerate(href) if (p := setpoint_problem(model, row, commanded))), None)
-        if off:
-            raise WmrkitError(f"heading_reference: at t = {tk[off[0]]:g} s, {off[1]}")
+        k = first_breach(model, href, commanded)  # every row at once
+        problem = None if k is None else setpoint_problem(model, href[k], commanded)
+        if problem:
+            raise WmrkitError(f"heading_reference: at t = {tk[k]:g} s, {problem}")
         at, on_law = setpoint_knots(model, tk, beta_ref, commanded)
         if len(at) > len(tk):  # the linkages' followers on their laws between the knots
             tau, rref = (np.column_stack([np.interp(at, tk, c) for c in a.T]) for a in (tau, rref))

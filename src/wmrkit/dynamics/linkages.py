@@ -10,7 +10,8 @@ In reduced coordinates the basis depends on the leader's angle, ``nu = T(beta) p
 acceleration has the velocity-product term ``f''(beta_i) beta_i'^2`` (:func:`reduced`).
 
 Heading set-points are checked against the law (:func:`heading_breach`), and against the ratios of a ``gear``
-between steering joints (:func:`gear_breach`), which the dynamics hold too.
+between steering joints (:func:`gear_breach`), which the dynamics hold too; a table of them every row at once
+(:func:`first_breach`).
 
 Table (``pack[17]``, ``(L, 10)``, one row per follower): follower column, leader column, the leader's column in the
 basis, law (0 parallel, 1 axle), ``x_i``, ``x_j``, ``y_i - y_j``, ``beta_i - psi_i``, the rest angles ``beta_i0``,
@@ -26,7 +27,6 @@ import numpy as np
 from ..couplings import linkage_law
 from ..errors import WmrkitError
 from ..kinematics.linkage_law import LINKAGE_TOL, law
-from ..kinematics.linkage_law import leader_of as _leader_of
 from . import _setpoints
 
 #: A heading set-point [rad] (a torque file's, :func:`wmrkit.dynamics.programs.read_torques`) farther than this from
@@ -101,11 +101,15 @@ def setpoint_breach(model, beta: np.ndarray, commanded: set[int],
     indices `commanded` have a servo; ``(follower, reference, angle)``: the index off the law by more than `tol`
     [rad], the commanded one of its linkage it is measured from (None: on the axle line, it keeps its rest angle
     whatever the others do) and the angle the law gives it. The reference is the leader if commanded, else the first
-    commanded follower (its leader's angle found from it, :func:`_leader_of`). None when they agree."""
-    for j, ref, f in _set_by_law(model, beta, commanded):
-        if abs(math.remainder(beta[j] - f, 2 * math.pi)) > tol:
-            return j, ref, f
-    return None
+    commanded follower (its leader's angle found from it, :func:`~wmrkit.kinematics.linkage_law.leader_of`).
+    None when they agree."""
+    plan = _law_plan(model, commanded)
+    at, off = _law_offs(model, plan, np.asarray(beta, dtype=float)[None])
+    off = np.flatnonzero(off[0] > tol)
+    if not len(off):
+        return None
+    j, _, src, _ = plan[off[0]].tolist()
+    return j, src if src in commanded else None, float(at[0, off[0]])
 
 
 def heading_breach(model, headings: np.ndarray, commanded: set[int]) -> tuple[int, int | None, float, str] | None:
@@ -121,46 +125,67 @@ def heading_breach(model, headings: np.ndarray, commanded: set[int]) -> tuple[in
     return j, ref, _heading(model, j, f), name
 
 
+def first_breach(model, headings: np.ndarray, commanded: set[int]) -> int | None:
+    """The first row of heading set-points `headings` ``(K, n_steer)`` [rad] (the indices `commanded` servoed) that
+    :func:`heading_breach` refuses, every row judged at once (compiled for a large table); None when none is."""
+    headings = np.asarray(headings, dtype=float).reshape(len(headings), -1)
+    bad = np.zeros(len(headings), dtype=bool)
+    plan = _law_plan(model, commanded)
+    if len(plan):
+        bad |= (_law_offs(model, plan, model.robot.beta_of_heading(headings))[1] > SETPOINT_TOL).any(axis=1)
+    for j, _, want in _geared(model, headings, commanded):
+        bad |= np.abs(headings[:, j] - want) > SETPOINT_TOL
+    return int(np.argmax(bad)) if bad.any() else None
+
+
 def gear_breach(model, headings: np.ndarray, commanded: set[int],
                 tol: float = SETPOINT_TOL) -> tuple[int, int, float, str] | None:
     """The first heading set-point of `headings` ``(n_steer,)`` [rad] (the indices `commanded` servoed) that breaks
-    a ``gear`` the dynamics hold between steering joints: the gear turns them in its ratios from the described
-    headings, ``h_j - h_j0 = k_j u``, so ``(follower, reference, heading the gear gives it, the gear's name)``, the
-    reference the gear's first commanded joint; None when they agree (within `tol` [rad])."""
+    a ``gear`` the dynamics hold between steering joints (:func:`_geared`): ``(follower, reference, heading the gear
+    gives it, the gear's name)``; None when they agree (within `tol` [rad])."""
+    for j, ref, want in _geared(model, headings, commanded):
+        if abs(headings[j] - want) > tol:
+            steer = f"{model.robot.steer_names[j]}.steer"
+            name = next(c.channel_name for c in model.robot.couplings if c.kind == "gear" and steer in c.joints)
+            return j, ref, float(want), name
+    return None
+
+
+def _geared(model, headings: np.ndarray, commanded: set[int]) -> list[tuple[int, int, np.ndarray]]:
+    """``(follower, reference, heading)`` for each commanded steering joint of a ``gear`` the dynamics hold but its
+    first commanded one, the reference: the gear turns them in its ratios from the described headings,
+    ``h_j - h_j0 = k_j u``, so the heading [rad] it gives the follower from the reference's in `headings`
+    ``(..., n_steer)`` (one per row)."""
     base, cols = model.pack[16], list(model.steer_columns)
     if not base.shape[1]:
-        return None
-    rest, gears = model.robot.heading, {}
+        return []
+    rest, gears, out = model.robot.heading, {}, []
     for k in sorted(commanded):  # each commanded steering joint in a gear: its gear's column and its ratio
         p = np.flatnonzero(base[cols[k]])
         if len(p) == 1:
             gears.setdefault(int(p[0]), []).append(k)
     for p, joints in gears.items():
         ref = joints[0]
-        u = (headings[ref] - rest[ref]) / base[cols[ref], p]
-        for j in joints[1:]:
-            want = rest[j] + base[cols[j], p] * u
-            if abs(headings[j] - want) > tol:
-                steer = f"{model.robot.steer_names[j]}.steer"
-                name = next(c.channel_name for c in model.robot.couplings if c.kind == "gear" and steer in c.joints)
-                return j, ref, float(want), name
-    return None
+        u = (headings[..., ref] - rest[ref]) / base[cols[ref], p]
+        out += [(j, ref, rest[j] + base[cols[j], p] * u) for j in joints[1:]]
+    return out
 
 
-def _set_by_law(model, beta: np.ndarray, commanded: set[int]) -> list[tuple[int, int | None, float]]:
-    """``(follower, reference, angle)`` for each commanded follower of a held linkage (:func:`setpoint_breach`):
-    the angle its linkage's law gives it from its reference's set-point in `beta` (:func:`_law_plan`)."""
-    table = model.pack[17]
-    return [(j, src if src in commanded else None,
-             law(table[r], beta[src] if inv < 0 else _leader_of(table[inv], beta[src]))[0])
-            for j, r, src, inv in _law_plan(model, commanded).tolist()]
+def _law_offs(model, plan: np.ndarray, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(at, off)`` ``(K, F)``: the angle the law gives each follower of `plan` (:func:`_law_plan`) from each row
+    of the steering set-points `beta` ``(K, n_steer)``, and how far its set-point is from it [rad]."""
+    beta = np.ascontiguousarray(beta, dtype=float)
+    at, off = np.empty((len(beta), len(plan))), np.empty((len(beta), len(plan)))
+    if len(plan):
+        _loops(at.size).law_offs(np.ascontiguousarray(model.pack[17], dtype=float), plan, beta, at, off)
+    return at, off
 
 
 def _law_plan(model, commanded: set[int]) -> np.ndarray:
     """``(F, 4)`` int, a row per commanded follower of a held linkage: its index, its row of the table, the index
     whose set-point gives its leader's angle (the leader if commanded, else the first commanded follower the leader's
     angle is found from, else the leader: a follower on the axle line keeps its rest angle whatever it is) and the
-    table row whose inverse finds it (:func:`_leader_of`; -1: the leader's own)."""
+    table row whose inverse finds it (:func:`~wmrkit.kinematics.linkage_law.leader_of`; -1: the leader's own)."""
     table, cols, plan = model.pack[17], list(model.steer_columns), []
     for lead in dict.fromkeys(int(r[1]) for r in table):
         rows = [k for k, r in enumerate(table) if int(r[1]) == lead and cols.index(int(r[0])) in commanded]
@@ -188,7 +213,7 @@ def setpoint_knots(model, t: np.ndarray, beta: np.ndarray, commanded: set[int],
     """Knots ``(t, beta)`` whose linear interpolation keeps the set-points of each held linkage on its law between
     rows: times `t` ``(K,)`` [s], steering set-points `beta` ``(K, n_steer)`` [rad] on the law at each row
     (:func:`setpoint_breach`), the indices `commanded` servoed. Between two rows the reference of each linkage moves
-    linearly and the law sets its commanded followers from it (:func:`_set_by_law`): each step is cut into even
+    linearly and the law sets its commanded followers from it (:func:`._setpoints.angle`): each step is cut into even
     pieces in time, their number raised (at least doubled, every step at once) until the followers'
     interpolation is within `tol` / 2 of the law at the middle of every piece (the law is smooth: a short chord's
     largest error is at its middle); the other columns keep their rows' interpolation. Without a commanded follower

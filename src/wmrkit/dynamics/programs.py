@@ -29,7 +29,7 @@ from ..errors import WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, MAX_TORQUE, check_table_size
 from ..units import BARE_ANGLE_LIMIT
 from .inputs import Inputs, joint_column, knots
-from .linkages import SETPOINT_TOL, gear_breach, heading_breach, linkage_breach
+from .linkages import SETPOINT_TOL, first_breach, gear_breach, heading_breach, linkage_breach
 from .model import DynamicModel
 
 #: Natural frequency [rad/s] of the programs' servos (the default `bandwidth`): a fixed step longer than its
@@ -281,15 +281,13 @@ def _check_torques(source: str, column: str, torques: np.ndarray) -> None:
 
 def _check_setpoints(source: str, model: DynamicModel, href: np.ndarray, commanded: list[int]) -> None:
     """Refuse the first row whose heading set-points `href` ``(K, n_steer)`` break a linkage or a steering gear the
-    dynamics hold (:func:`~wmrkit.dynamics.linkages.heading_breach`): their servos would fight it, naming the two
-    columns."""
+    dynamics hold (:func:`~wmrkit.dynamics.linkages.first_breach`, every row at once; its
+    :func:`~wmrkit.dynamics.linkages.heading_breach`): their servos would fight it, naming the two columns."""
     if not len(model.pack[17]) and not model.pack[16].shape[1]:
         return
-    steered = model.robot.steer_names
-    for k, row in enumerate(href):
-        breach = heading_breach(model, row, set(commanded))
-        if breach is None:
-            continue
+    steered, k = model.robot.steer_names, first_breach(model, href, set(commanded))
+    breach = None if k is None else heading_breach(model, href[k], set(commanded))
+    if breach is not None:
         j, ref, want, name = breach
         by = "whatever the others do" if ref is None else (f"with column '{steered[ref]}.heading' at "
                                                         f"{href[k, ref]:.6g} rad")
