@@ -17,7 +17,7 @@ from wmrkit.control import builtin_reference, control_point
 from wmrkit.control.dynamic_plant import fast_law_controller, simulate_dynamics
 from wmrkit.control.laws import PositionLaw
 from wmrkit.control.steering import range_keeper
-from wmrkit.control.track import initial_pose_on
+from wmrkit.control.track import initial_pose_on, track
 from wmrkit.dynamics.linkages import SETPOINT_TOL
 
 WHEELBASE, TRACK, LIMIT = 0.6, 0.4, 0.5
@@ -66,6 +66,29 @@ def test_the_kept_headings_are_on_the_law_and_in_range(asked):
         assert fr == pytest.approx(-LIMIT, abs=1e-12) and fl == pytest.approx(_left(-LIMIT), abs=1e-12)
         assert not fits.any()
     assert rates[robot.rate_names.index("fl.spin")] == rates[robot.rate_names.index("fr.spin")] == 1.0
+
+
+@pytest.mark.parametrize("omega", [1.0, -1.0])
+def test_a_turn_sharper_than_the_stops_holds_the_linkage_at_the_stop_of_that_turn(omega):
+    """The twist (0.1 m/s, 0, +-1 rad/s): the ICR 0.1 m to the left (right) of the rear axle's middle, between the
+    rear wheels; the inner front wheel is asked about 100 deg, past its 0.5 rad stop, the outer one about 80 deg.
+    The linkage is held at the stop of that turn: the inner wheel at +-0.5, the outer one by the law (closed form),
+    the wheels rolling forward. Before, the leader fl alone chose the end nearest its own roots: for the left turn
+    the right stop (fl at -0.381, fr at -0.5), and the car turned away from its reference."""
+    from wmrkit.kinematics.wheel_ik import checked_rates
+
+    robot = _ranged_car()
+    rates, beta, _ = checked_rates(robot, np.array([0.1, 0.0, omega]), np.array(robot.beta, dtype=float))
+    headings, rates = np.array(robot.heading_of_beta(beta)), np.array(rates)
+    assert all(abs(math.remainder(h, math.pi)) > LIMIT + 0.5 for h in headings)  # both axles past the stops
+    fits = range_keeper(robot)(headings, rates, np.zeros(2))
+    fl, fr = headings
+    if omega > 0:
+        assert (fl, fr) == pytest.approx((LIMIT, _right(LIMIT)), abs=1e-12)
+    else:
+        assert (fl, fr) == pytest.approx((_left(-LIMIT), -LIMIT), abs=1e-12)
+    assert not fits.any()
+    assert rates[robot.rate_names.index("fl.spin")] > 0 and rates[robot.rate_names.index("fr.spin")] > 0
 
 
 def test_a_follower_narrower_than_its_leader_bounds_the_leader():
@@ -125,3 +148,32 @@ def test_a_geared_robot_tracks_with_its_headings_in_the_ratios():
     front, rear = np.array(robot.heading_of_beta(out["target"])).T
     assert np.abs(rear - 2 * front).max() <= SETPOINT_TOL
     assert np.abs(front).max() > 0.01  # it steers
+
+
+@pytest.mark.parametrize("period", [None, 0.02])
+def test_the_kinematic_loop_commands_headings_on_the_law_and_in_range(period):
+    """``wmrkit track lcar.json --reference corner --size 1 --duration 10`` without ``--dynamics``: before, the
+    kinematic plant clipped each wheel on its own, fl at -0.5 and fr at +0.5 (1.21 rad off the law) for 8 s. Now
+    the headings are on the law (closed form) and in range, the inner wheel fl at its end, and the held car turns
+    left, the way the law asks (the rate of turn from the poses)."""
+    robot = _ranged_car()
+    run = track(robot, builtin_reference("corner", size=1.0), duration=10.0, period=period)
+    fl, fr = run.heading.T
+    assert max(abs(math.remainder(b - _right(a), 2 * math.pi)) for a, b in zip(fl, fr, strict=True)) <= SETPOINT_TOL
+    assert np.all(np.abs(run.heading) <= LIMIT + 1e-12)
+    held = np.flatnonzero(np.isclose(fl[:-1], LIMIT, rtol=0, atol=1e-9))
+    assert len(held) > 50
+    assert np.array_equal(np.sign(np.diff(run.pose[:, 2])[held]), np.sign(run.twist[held, 2]))
+
+
+def test_the_kinematic_loop_keeps_a_steering_gear_in_its_ratios():
+    """``wmrkit track geared.json --reference circle --size 3 --duration 3`` without ``--dynamics``: before, the
+    ideal plant commanded the wheel IK's headings (front 0.107 rad, rear -0.093 rad where the gear turns the rear
+    twice the front) and tracked the circle to 6e-11 m, a motion the gear forbids. Now the headings keep the ratios
+    and the robot moves as its geared wheels can (it scrubs: the error is no longer round-off)."""
+    robot = _geared()
+    run = track(robot, builtin_reference("circle", size=3.0), duration=3.0)
+    front, rear = run.heading.T
+    assert np.abs(rear - 2 * front).max() <= SETPOINT_TOL
+    assert np.abs(front).max() > 0.01 and run.summary()["max_error"] > 1e-3
+

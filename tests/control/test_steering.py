@@ -177,12 +177,16 @@ def test_a_reference_beyond_the_steering_range_is_reported_not_followed(period):
     car = catalog.load("ackermann")
     run = track(car, builtin_reference("circle", size=1.0), period=period, duration=12)
     assert np.all(np.abs(run.heading) <= math.radians(40) + 1e-9)
-    held = {v["wheel"]: v for v in run.range_violations()}
-    assert set(held) == {"front_left", "front_right"} and all(v["duration"] > 5 for v in held.values())
-    for v in held.values():  # held to the run's end: the time held is the span, no interval past the last sample
-        assert v["to"] == run.t[-1] and v["duration"] <= v["to"] - v["from"] + 1e-9
-        hit = (run.t >= v["from"]) & (run.beyond_range[:, car.steer_names.index(v["wheel"])])
-        assert v["duration"] == pytest.approx(np.diff(run.t)[hit[:-1]].sum(), abs=1e-12)
+    held: dict[str, list] = {}
+    for v in run.range_violations():  # a wheel at its own stop, and held by the linkage at the other's
+        held.setdefault(v["wheel"], []).append(v)
+    assert set(held) == {"front_left", "front_right"}
+    for name, entries in held.items():  # held to the run's end: the time held is the span, none past the last sample
+        assert max(v["to"] for v in entries) == run.t[-1]
+        assert all(v["duration"] <= v["to"] - v["from"] + 1e-9 for v in entries)
+        hit = run.beyond_range[:, car.steer_names.index(name)]
+        total = sum(v["duration"] for v in entries)
+        assert total > 5 and total == pytest.approx(np.diff(run.t)[hit[:-1]].sum(), abs=1e-12)
     assert run.summary()["max_error"] > 0.3  # the circle is not followed
     assert run.to_dict()["beyond_steer_range"] == run.range_violations()
     wide = track(car, builtin_reference("circle", size=8.0), period=period, duration=12)  # within the range
@@ -277,8 +281,8 @@ def test_a_car_held_at_its_steering_stops_still_turns_the_way_it_is_told():
     so turns the wrong way, and about 190 crossings in this run)."""
     car = catalog.load("ackermann")
     run = track(car, builtin_reference("circle", size=1.0), period=0.05, duration=12)
-    front = run.heading[:-1, 0]
-    held = np.isclose(np.abs(front), math.radians(40), rtol=0, atol=1e-9)
+    front = run.heading[:-1, 0]  # the linkage's leader; the inner wheel is at the stop, the outer one on the law
+    held = np.isclose(np.abs(run.heading[:-1]), math.radians(40), rtol=0, atol=1e-9).any(axis=1)
     realised = np.diff(run.pose[:, 2]) / 0.05
     assert held.sum() > 100
     assert np.array_equal(np.sign(realised[held]), np.sign(run.twist[:-1, 2][held]))

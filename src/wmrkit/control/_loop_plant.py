@@ -1,6 +1,7 @@
 """The plant of the kinematic loop (:mod:`.loop`): per-run arrays of which steering angles are commanded,
-integrated (castors) or in a low-level loop, the wheel commands with the steering policy and ranges applied, and
-the twist the ideal plant realises when a wheel is held at the end of its range."""
+integrated (castors) or in a low-level loop, the wheel commands with the steering policy and ranges applied (and a
+held linkage's law and a steering gear's ratios: :func:`.steering.range_keeper`, as the loops through the dynamics),
+and the twist the ideal plant realises when a wheel is held at the end of its range or off the IK's heading."""
 
 from __future__ import annotations
 
@@ -16,14 +17,18 @@ from ..kinematics.wheel_ik import checked_rates, checked_steering_config, forwar
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from .actuators import LowLevelLoops
+from .linked_ranges import LinkedRanges
 from .points import ControlError
-from .steering import checked_steering, reverse_spins, spin_columns, steer_ranges, unit_spin
+from .steering import range_keeper, spin_columns, steer_ranges, unit_spin
 
 _SPINS = (".spin", ".spin1", ".spin2")  # the joints that drive a wheel
 
 #: A steered wheel of the ideal plant held at an end of its steering range stays there unless the other end serves
 #: the heading asked of it better by more than this [rad] (:func:`~.steering.choose_steering` ``hold_margin``).
 HOLD_MARGIN = math.radians(2.0)
+#: A steered wheel's axle within this [rad] of the IK's (mod pi) rolls as the commanded twist asks (round-off of a
+#: linkage's law or a gear's ratios, 4e-16 rad on the catalog car); further, the ideal plant moves it by least squares.
+AXLE_TOL = 1e-9
 
 
 class _Commands(NamedTuple):
@@ -69,12 +74,18 @@ class _Sim:
             if joint == "spin" and "spin" not in w.kind.rates:
                 raise ControlError(f"low-level loop on '{j}': wheel '{wheel}' has no 'spin' joint")
         self.limited = bool(np.isfinite(self.ranges).any())
-        self.ranged = [(k, float(self.delta[k]), float(lo), float(hi)) for k, (lo, hi) in enumerate(self.ranges)
-                       if not self.passive[k] and np.isfinite([lo, hi]).any()]  # the steered wheels with a range
+        self.links = LinkedRanges.of(robot, self.ranges)  # the wheels kept on a law or in ratios
+        self.linked = self.links is not None
+        self.keep = range_keeper(robot, plant.policy)
+        kept = self.ranges if self.links is None else self.links.ranges  # a leader's: where its followers fit
+        held = set() if self.links is None else set(self.links.followers.tolist())
+        leads = set() if self.links is None else set(self.links.leaders.tolist())
+        self.ranged = [(k, float(self.delta[k]), float(lo), float(hi), k in leads) for k, (lo, hi) in enumerate(kept)
+                       if not self.passive[k] and k not in held and np.isfinite([lo, hi]).any()]  # with a range
         spins = [j for j in self.joints if j.endswith(".spin")]
-        if (loops is not None or self.limited) and not spins:
+        if (loops is not None or self.limited or self.linked) and not spins:
             spins = [j for j in robot.actuated if j.endswith(_SPINS)]
-        if self.limited and not spins:  # no actuator described: every wheel spins as the IK commands it
+        if (self.limited or self.linked) and not spins:  # no actuator described: each wheel spins as the IK says
             spins = [j for j in robot.rate_names if j.endswith(_SPINS)]
         self.drive = tuple(spins)
         self.drive_columns = np.array([robot.velocity_names.index(j) for j in spins], dtype=int)
@@ -83,45 +94,54 @@ class _Sim:
 
     def commands(self, twist: np.ndarray, beta: np.ndarray, hold_margin: float | None = None,
                  ik: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> _Commands:
-        """Wheel commands at steering `beta`, with the policy and ranges applied to the steered wheels; a wheel held
-        at an end changes ends past `hold_margin` (default ``self.hold_margin``). `ik`: the IK's rates, steering and
-        spins at `(twist, beta)` (:func:`checked_rates`), when already computed."""
+        """Wheel commands at steering `beta`, with the policy, ranges, linkages and gears applied to the steered
+        wheels (:func:`.steering.range_keeper`); a wheel held at an end changes ends past `hold_margin` (default
+        ``self.hold_margin``). `ik`: the IK's rates, steering and spins at `(twist, beta)` (:func:`checked_rates`),
+        when already computed."""
         rates, target, spin_all = checked_rates(self.robot, twist, beta) if ik is None else ik
         target, rates = np.array(target), np.array(rates)
         fits = np.ones(len(target), dtype=bool)
-        if len(target) and (self.plant.policy != "closest" or self.limited):
-            steered = ~self.passive
+        if len(target) and (self.plant.policy != "closest" or self.limited or self.linked):
             heading = target - math.pi / 2 + self.delta
             margin = self.hold_margin if hold_margin is None else hold_margin
-            chosen, _, in_range, reverse = checked_steering(heading, spin_all[self.wheel_of_steer],
-                                                            beta - math.pi / 2 + self.delta, self.plant.policy,
-                                                            self.ranges, margin)
-            target = np.where(steered, chosen + math.pi / 2 - self.delta, target)
-            reverse_spins(rates, self.spin_columns, reverse & steered)
-            fits = in_range | self.passive
+            fits = self.keep(heading, rates, beta - math.pi / 2 + self.delta, margin) | self.passive
+            target = np.where(self.passive, target, heading + math.pi / 2 - self.delta)
         spin = np.where(self.passive, spin_all[self.wheel_of_steer], unit_spin(rates, self.spin_columns))
         return _Commands(target, rates, spin, fits)
 
     def realised(self, twist: np.ndarray, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The ideal plant's twist and which steered wheels fit their ranges: the commanded twist, or, when a wheel
-        is held at the end of its range, the least-squares twist (4.11) of the actuated wheels' commanded rates at
-        the steering reached (the wheels scrub: the robot cannot move as commanded)."""
-        if not self.limited:
+        is held at the end of its range or off the IK's axle (set by a linkage's law or a gear's ratios), the
+        least-squares twist (4.11) of the actuated wheels' commanded rates at the steering reached (the wheels
+        scrub: the robot cannot move as commanded)."""
+        if not (self.limited or self.linked):
             return twist, np.ones(len(self.ranges), dtype=bool)
-        if self.all_fit(checked_steering_config(self.robot, twist, beta)):  # the commanded twist: no wheel is held
+        if self.all_fit(checked_steering_config(self.robot, twist, beta)):  # no wheel is held or moved
             return twist, np.ones(len(self.ranges), dtype=bool)
-        cmd = self.commands(twist, beta)
-        if cmd.fits.all():
+        ik = checked_rates(self.robot, twist, beta)
+        cmd = self.commands(twist, beta, ik=ik)
+        off = np.abs(np.remainder(cmd.target - np.asarray(ik[1]) + math.pi / 2, math.pi) - math.pi / 2)
+        if cmd.fits.all() and (self.passive | (off <= AXLE_TOL)).all():  # every axle where the IK puts it
             return twist, cmd.fits
         return self.least_squares_twist(cmd, cmd.target, {}), cmd.fits
 
     def all_fit(self, target: list[float]) -> bool:
         """Whether every steered wheel has a root of (8.9) within its range, the IK's steering `target` or that
         plus pi: :func:`.steering.checked_steering`'s ``in_range`` (of any policy), in plain floats, the same
-        operations."""
-        for k, delta, lo, hi in self.ranged:
+        operations. With linkages or gears (:attr:`links`), only where the keeper surely keeps the IK's axles (False
+        sends :meth:`realised` the long way, which decides): policy ``"closest"``, each leader's IK root itself
+        within its kept arc (so the one the keeper takes), each follower's IK axle where the law or ratios set it
+        from there."""
+        if self.links is not None and self.plant.policy != "closest":
+            return False
+        for k, delta, lo, hi, lead in self.ranged:
             h0 = wrap_one(target[k] - math.pi / 2 + delta)
-            if not (in_range_one(h0, lo, hi) or in_range_one(wrap_one(h0 + math.pi), lo, hi)):
+            if not (in_range_one(h0, lo, hi) or (not lead and in_range_one(wrap_one(h0 + math.pi), lo, hi))):
+                return False
+        for link in () if self.links is None else self.links.links:
+            f = link.to_follower(target[link.leader] - math.pi / 2 + float(self.delta[link.leader]))
+            if abs(math.remainder(f - target[link.follower] + math.pi / 2 - float(self.delta[link.follower]),
+                                  math.pi)) > AXLE_TOL:
                 return False
         return True
 

@@ -80,6 +80,27 @@ class LinkedRanges:
             turn = np.remainder(heading[idx] - rest[idx] + math.pi, TWO_PI) - math.pi
             heading[idx[0]] = rest[idx[0]] + k[0] * float(k @ turn) / float(k @ k)
 
+    def held_end(self, lead: int, asked: np.ndarray, current: float, kept: float, margin: float) -> float:
+        """The end of leader `lead`'s kept arc to hold it at, when no root of the heading `asked` of it fits: the one
+        at which the axles of its wheels (itself and its followers, set by the law or the ratios) are nearest those
+        `asked` ``(n_steer,)`` of them (the sum of their misses, mod pi). A car's inner wheel asked a turn sharper
+        than its stop, near 90 deg, is nearly as far from both, but the outer wheel is not: the leader alone chose
+        the wrong stop, and the catalog car turned away from its reference for over 9 s at a corner. `kept`: the
+        end the leader alone chose; it stays when `current` is there and the other end is not nearer by more than
+        `margin`."""
+        wheels = [lead, *(k.follower for k in self.links if k.leader == lead)]
+        ends = [float(e) for e in self.ranges[lead]]
+        miss = []
+        for end in ends:
+            h = np.array(asked, dtype=float)
+            h[lead] = end
+            self.follow(h)
+            miss.append(sum(abs(math.remainder(float(h[w] - asked[w]), math.pi)) for w in wheels))
+        held = abs(math.remainder(current - kept, TWO_PI)) <= 1e-9 and kept in ends
+        if held and abs(miss[0] - miss[1]) <= margin:
+            return kept
+        return ends[0] if miss[0] < miss[1] else ends[1] if miss[1] < miss[0] else kept
+
     def follow(self, heading: np.ndarray) -> np.ndarray:
         """Set, in place, each follower's heading in `heading` ``(n_steer,)`` [rad] from its leader's; returns which
         followers turned half round from the heading they had (their spins to negate)."""

@@ -182,20 +182,22 @@ def check_steering_driven(robot: Robot) -> None:
                                "to its 'actuated', or track without the dynamics (ideal joints)")
 
 
-def range_keeper(robot: Robot, policy: str = "closest") -> Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
-    """``(headings, rates, current) -> in_range`` for the loops through the dynamics: moves, in place, each steered
-    wheel's heading to the root of (8.9) that `policy` picks from the `current` headings, within its
-    ``steer_range`` (its spins for that root, :func:`reverse_spins`), or to the end of the range nearest to either
-    root when neither fits; returns which fitted (:func:`.steering.choose_steering`); every steered wheel's
-    steering is actuated (:func:`check_steering_driven`). With ``"closest"`` and no range it does nothing: the IK
-    has picked the root closest to `current` already.
+def range_keeper(robot: Robot, policy: str = "closest") -> Callable[..., np.ndarray]:
+    """``(headings, rates, current, hold_margin=0) -> in_range`` for the loops (the kinematic plant's commands,
+    :mod:`._loop_plant`, and those through the dynamics): moves, in place, each steered wheel's heading to the root
+    of (8.9) that `policy` picks from the `current` headings, within its ``steer_range`` (its spins for that root,
+    :func:`reverse_spins`), or to the end of the range nearest to either root when neither fits (`hold_margin`:
+    :func:`choose_steering`'s, whose checks are the caller's: the IK's finite headings); returns which fitted. With
+    ``"closest"`` and no range it does nothing to a wheel on its own: the IK has picked the root closest to
+    `current` already.
 
-    The wheels of a ``linkage`` the dynamics hold, or of a ``gear`` between steering joints, are not kept one by
+    The wheels of a ``linkage``, or of a ``gear`` between steering joints, are not kept one by
     one (that breaks it): its leader is kept within the arc where every wheel held with it fits its range, and the
     followers are set from it by the linkage's law or the gear's ratios (:class:`.linked_ranges.LinkedRanges`; a
     gear's leader first at the gear's least-squares turn to the headings asked),
     their spins negated where they turn half round; when the leader is held at an end of that arc, none of those
-    wheels fitted."""
+    wheels fitted, and the end is the one nearer the headings asked of them all
+    (:meth:`.linked_ranges.LinkedRanges.held_end`)."""
     check_policy(policy)
     ranges, columns = steer_ranges(robot), spin_columns(robot)
     links = LinkedRanges.of(robot, ranges)
@@ -206,17 +208,21 @@ def range_keeper(robot: Robot, policy: str = "closest") -> Callable[[np.ndarray,
         chosen[links.followers] = False
     steered, rest = columns[chosen], robot.heading
 
-    def keep(heading: np.ndarray, rates: np.ndarray, current: np.ndarray) -> np.ndarray:
-        fits = np.ones(len(heading), dtype=bool)
+    def keep(heading: np.ndarray, rates: np.ndarray, current: np.ndarray, hold_margin: float = 0.0) -> np.ndarray:
+        fits, reversed_ = np.ones(len(heading), dtype=bool), np.zeros(len(heading), dtype=bool)
         if links is not None:
             links.settle(heading, rest)
-        if chosen.any():
-            ch = choose_steering(heading[chosen], unit_spin(rates, steered), current[chosen], policy=policy,
-                                 ranges=ranges[chosen])
-            heading[chosen] = ch.heading
-            reverse_spins(rates, steered, ch.reversed)
-            fits[chosen] = ch.in_range
+        asked = heading.copy()
+        if chosen.any():  # the IK's headings and spins (finite), the policy checked above
+            heading[chosen], _, fits[chosen], reversed_[chosen] = checked_steering(
+                heading[chosen], unit_spin(rates, steered), np.asarray(current, dtype=float)[chosen], policy,
+                ranges[chosen], hold_margin)
+            reverse_spins(rates, steered, reversed_[chosen])
         if links is not None:
+            for lead in links.leaders[~fits[links.leaders] & chosen[links.leaders]].tolist():
+                heading[lead] = links.held_end(lead, asked, float(current[lead]), float(heading[lead]), hold_margin)
+                if (abs(float(wrap_angle(asked[lead] - heading[lead]))) > 0.5 * math.pi) != reversed_[lead]:
+                    reverse_spins(rates, columns[[lead]], np.ones(1, dtype=bool))  # the other root's spin
             reverse_spins(rates, columns, links.follow(heading) & (columns[:, 0] >= 0))
             for link in links.links:
                 fits[link.follower] = fits[link.leader]
