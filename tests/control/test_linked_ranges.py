@@ -177,3 +177,25 @@ def test_the_kinematic_loop_keeps_a_steering_gear_in_its_ratios():
     assert np.abs(rear - 2 * front).max() <= SETPOINT_TOL
     assert np.abs(front).max() > 0.01 and run.summary()["max_error"] > 1e-3
 
+
+def test_a_follower_held_by_its_linkage_is_not_said_to_be_beyond_its_range(capsys, tmp_path):
+    """``wmrkit track lcar.json --reference corner --size 1 --duration 10 --json``: fl, the inner wheel of the left
+    turn, is held at its end 0.5 rad, and fr where the law sets it from there (closed form: 0.411 rad), within its
+    range. Before, both were listed alike and fr's warning said it "was asked to steer beyond its range ... and was
+    held at its end"; now fr's entry names the linkage and the heading it was held at, and so does its warning."""
+    import json
+
+    from wmrkit.cli.main import main
+
+    path = tmp_path / "lcar.json"
+    path.write_text(json.dumps(_ranged_car().to_dict()))
+    assert main(["track", str(path), "--reference", "corner", "--size", "1", "--duration", "10", "--json"]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    fl, fr = sorted(answer["beyond_steer_range"], key=lambda v: v["wheel"])
+    assert (fl["wheel"], fr["wheel"], "held_by" in fl) == ("fl", "fr", False)
+    assert fr["held_by"] == "linkage(fl.steer, fr.steer)"
+    assert fr["headings"] == pytest.approx([_right(LIMIT)] * 2, abs=1e-12) and abs(_right(LIMIT)) < LIMIT - 0.05
+    said = {w.split("'")[1]: w for w in answer["warnings"] if w.startswith("wheel ")}
+    assert "beyond its range" in said["fl"] and "held at its end" in said["fl"]
+    assert "beyond its range" not in said["fr"] and "held at its end" in said["fr"]  # the other wheel's end
+    assert f"held by its linkage(fl.steer, fr.steer) at heading {math.degrees(_right(LIMIT)):.4g} deg" in said["fr"]

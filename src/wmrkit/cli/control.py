@@ -267,10 +267,18 @@ def run_track(args: argparse.Namespace) -> int:
             raise failed
         raise type(failed)(f"{failed} ({'; '.join(foretold)})") from None
     for v in run.range_violations():
+        when = f"for {v['duration']:.3g} s (t = {v['from']:.4g} to {v['to']:.4g} s)"
+        if "held_by" in v:  # short of its own ends: held there by its linkage or gear, another wheel at its end
+            lo, hi = (math.degrees(a) for a in v["headings"])
+            at = f"{lo:.4g} deg" if f"{lo:.4g}" == f"{hi:.4g}" else f"{lo:.4g} to {hi:.4g} deg"
+            warn(f"wheel '{v['wheel']}' was held by its {v['held_by']} at heading {at}, within its range, {when}, "
+                 "while another of its wheels was held at its end: the robot cannot follow this reference there "
+                 "(its wheels scrub; the tracking errors are the result)")
+            continue
         lo, hi = (math.degrees(a) for a in robot.wheel(v["wheel"]).steer_range)
-        warn(f"wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg for {v['duration']:.3g} s "
-             f"(t = {v['from']:.4g} to {v['to']:.4g} s) and was held at its end: the robot cannot follow this "
-             "reference there (its wheels scrub; the tracking errors are the result)")
+        warn(f"wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg {when} and was held at "
+             "its end: the robot cannot follow this reference there (its wheels scrub; the tracking errors are the "
+             "result)")
     for c, ok in zip(robot.couplings, run.commands.in_gear.all(axis=0).tolist(), strict=True):
         if not ok:  # the kinematic plants drive each joint on its own; the dynamics hold the gear
             warn(f"the commands turn the joints of {c.channel_name} out of its ratios (ratios "

@@ -232,7 +232,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                        readonly(~out["in_range"]) if "in_range" in out else None,
                        _feasibility(robot, reference, tracked_point, "dynamic" if dynamics else "kinematic",
                                     # a follower slows to its own stop at the path's end, not the reference's
-                                    min(t[-1], reference.duration) if geometric else t[-1]))
+                                    min(t[-1], reference.duration) if geometric else t[-1]),
+                       readonly(np.asarray(heading_from_beta(out["target"], steer_delta))))
 
 
 def _limits(robot: Robot, plant: Plant, sampled: float | None, dynamics: bool, slipping: bool,

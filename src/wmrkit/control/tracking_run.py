@@ -11,12 +11,26 @@ import numpy as np
 
 from ..kinematics.wheel_ik import WheelCommands
 from ..robot import Robot
+from ..wheels import wrap_angle
 from .feasibility import Feasibility
 
 __all__ = ["SLIP_TOL", "TrackingRun"]
 
 #: Lateral slip [m/s] of a fixed wheel's commands beyond which a run reports it (:meth:`TrackingRun.slip_violations`).
 SLIP_TOL = 1e-6
+#: A commanded heading within this [rad] of an end of its wheel's range is at that end (the keeper sets a linked
+#: wheel there from its leader's end through the law: round-off away).
+AT_END = 1e-9
+
+
+def _holder(robot: Robot, wheel: str) -> str | None:
+    """The ``linkage`` or ``gear`` coupling that holds `wheel`'s steering with another wheel's, by its channel name,
+    or None."""
+    for c in robot.couplings:
+        if c.kind in ("linkage", "gear") and f"{wheel}.steer" in c.joints and sum(
+                j.endswith(".steer") for j in c.joints) > 1:
+            return c.channel_name
+    return None
 
 
 @dataclass(frozen=True, eq=False)
@@ -38,7 +52,9 @@ class TrackingRun:
       wheels: it cannot follow as commanded); :meth:`range_violations` lists them per wheel;
     - ``feasibility``: the reference judged by Table 8.1 (§8.5, :func:`.feasibility.feasibility`) for the tracked
       point, in the kinematic framework (the dynamic one through the dynamics), its violations up to the run's end;
-      None for a robot Table 8.1 does not apply to (degenerate: the skid steer).
+      None for a robot Table 8.1 does not apply to (degenerate: the skid steer);
+    - ``commanded`` ``(n, n_steer)`` [rad]: the commanded steering headings (the policy, ranges, linkages and gears
+      applied), which ``heading`` follows (at once with ideal joints).
     """
 
     robot: Robot
@@ -59,14 +75,32 @@ class TrackingRun:
     feedback: str = "pose"
     beyond_range: np.ndarray | None = None
     feasibility: Feasibility | None = None
+    commanded: np.ndarray | None = None
 
     def range_violations(self) -> list[dict[str, Any]]:
         """Per steered wheel held at the end of its range: ``{"wheel", "from", "to", "duration"}`` ([s]: first
         and last sample, and the time spent beyond the range: each such sample's interval to the next, none after
-        the run's last sample)."""
+        the run's last sample). A wheel a ``linkage`` or steering ``gear`` held with another one at its end, its own
+        commanded heading short of its range's ends, is listed apart, with ``"held_by"`` (the coupling's
+        :attr:`~wmrkit.couplings.Coupling.channel_name`) and ``"headings"`` ([rad] the least and largest it was held
+        at): it was not asked beyond its own range."""
         if self.beyond_range is None:
             return []
-        return self._intervals(self.robot.steer_names, self.beyond_range)
+        names = self.robot.steer_names
+        target = self.heading if self.commanded is None else self.commanded
+        by = [_holder(self.robot, n) for n in names]
+        short = np.zeros_like(self.beyond_range)
+        for k, name in enumerate(names):
+            rng = self.robot.wheel(name).steer_range
+            if by[k] is not None:  # its coupling's other wheel at an end, or this one at its own
+                short[:, k] = True if rng is None else ~np.any([np.abs(wrap_angle(target[:, k] - e)) <= AT_END
+                                                                for e in rng], axis=0)
+        out = self._intervals(names, self.beyond_range & ~short)
+        for v in self._intervals(names, self.beyond_range & short):
+            k = names.index(v["wheel"])
+            held = target[self.beyond_range[:, k] & short[:, k], k]
+            out.append({**v, "held_by": by[k], "headings": [float(held.min()), float(held.max())]})
+        return sorted(out, key=lambda v: names.index(v["wheel"]))  # stable: a wheel's own end first
 
     def slip_violations(self, tol: float = SLIP_TOL) -> list[dict[str, Any]]:
         """Per fixed wheel whose commands leave a lateral slip (8.14) beyond `tol` [m/s] (a skid steer turning: the
