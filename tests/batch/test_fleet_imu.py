@@ -266,3 +266,25 @@ def test_a_failed_bag_keeps_what_was_said_before_it_failed(capsys, tmp_path, fle
     assert code == 1 and answer["failed"] == 1 and row["error"] is not None
     assert row["warnings"] == said[0] and answer["warnings"] == [f"{bag}: {said[0]}"]
     assert f"wmrkit: warning: {bag}: {said[0]}" in stderr.splitlines()
+
+
+def test_a_weighted_batch_names_its_own_argument_not_another_commands_option(capsys, fleet):
+    """``batch_odometry(..., weights={"left": 2})`` on the slipping bag: its warning names the weighted odometry by
+    that argument, ``weights=``. Before, "the weighted no-slip (--weight) odometry's heading contradicts the IMU":
+    ``--weight`` is ``wmrkit odometry``'s option, which ``wmrkit batch odometry`` does not have. Every option a
+    warning names is one of its command's (``wmrkit odometry --weight`` still names ``--weight``)."""
+    from cli_options import options
+    from wmrkit.batch import batch_odometry
+
+    robot, (slips, _, _), _ = fleet
+    commands = {words: {o for w, a in options() if w == words for o in a.option_strings}
+                for words in (("odometry",), ("batch", "odometry"))}
+    (row,) = batch_odometry(load_robot_file(robot), [slips], weights={"left": 2.0}).rows
+    assert row["warnings"].startswith("the weighted no-slip (weights=) odometry's heading contradicts the IMU")
+    assert set(re.findall(r"--[a-z][a-z-]*", row["warnings"])) <= commands[("batch", "odometry")]
+    code, answer, _ = _batch(capsys, robot, [slips])
+    assert code == 0 and set(re.findall(r"--[a-z][a-z-]*", answer["rows"][0]["warnings"])) <= commands[
+        ("batch", "odometry")]
+    single = _single(capsys, robot, slips, "--weight", "left=2")
+    assert "weighted no-slip (--weight)" in single["warnings"][0]
+    assert set(re.findall(r"--[a-z][a-z-]*", " ".join(single["warnings"]))) <= commands[("odometry",)]

@@ -180,11 +180,12 @@ def process_log(job: LogJob) -> dict[str, Any]:
 def _imu_check(job: LogJob, model: OdometryModel) -> tuple[ImuCheck | None, str | None]:
     """``wmrkit odometry``'s IMU check of a bag's run (:func:`~wmrkit.odometry.diagnostics.imu_check`): on the
     batch's `job.imu` topic, else the bag's only ``Imu`` topic, judging the run of `model` (named as that command
-    names it: "weighted no-slip (--weight)" when its rows are weighted); ``(None, None)`` for a CSV log or a bag
-    without one, ``(None, the line saying none is checked)`` for a bag with several and no `job.imu`. As in that
-    command, a named IMU that cannot be used (not in the bag, not an ``Imu``, unreadable, or its stamps missing the
-    run's: raised by the check after the run) is a :class:`~wmrkit.odometry.logs.LogError`, the log's error; one found
-    by itself is ``(None, the line saying the log is not checked against it)``."""
+    names it, but by this door's option: "weighted no-slip (weights=)" when its rows are weighted, which only
+    :func:`batch_odometry`'s `weights` does, ``wmrkit batch odometry`` having no ``--weight``); ``(None, None)`` for
+    a CSV log or a bag without one, ``(None, the line saying none is checked)`` for a bag with several and no
+    `job.imu`. As in that command, a named IMU that cannot be used (not in the bag, not an ``Imu``, unreadable, or
+    its stamps missing the run's: raised by the check after the run) is a :class:`~wmrkit.odometry.logs.LogError`,
+    the log's error; one found by itself is ``(None, the line saying the log is not checked against it)``."""
     from ..odometry.bags import imu_topic
     from ..odometry.diagnostics import imu_check, odometry_name
     from ..odometry.files import is_bag
@@ -201,7 +202,7 @@ def _imu_check(job: LogJob, model: OdometryModel) -> tuple[ImuCheck | None, str 
         return None, f"{err} (the odometry is not checked against it)"
     if topic is None:  # several Imu topics (a warning, as wmrkit odometry's), or none (nothing to say)
         return None, note
-    what = odometry_name(None, bool(np.any(np.asarray(model.row_weights) != 1.0)))
+    what = odometry_name(None, "weights=" if np.any(np.asarray(model.row_weights) != 1.0) else None)
     return imu_check(job.path, topic, what, named=named)
 
 

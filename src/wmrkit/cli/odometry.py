@@ -153,7 +153,7 @@ def run(args: argparse.Namespace) -> int:
              parse_angle(args.pose[2], "--pose")]
     check_start_pose(np.array(pose0), "--pose")
     slip_model = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None
-    what = odometry_name(args.method if slip_model is not None else None, bool(args.weight))
+    what = odometry_name(args.method if slip_model is not None else None, "--weight" if args.weight else None)
     # the IMU read now: a named one that fails is refused before any output is written
     check, unread = imu_check(args.log, imu, what, named=args.imu is not None) if imu else (None, None)
     summary = odometry_file(

@@ -202,10 +202,11 @@ def imu_warning(grid: np.ndarray, heading: np.ndarray, imu: np.ndarray, topic: s
             + (why or "the wheels slip (a skid steer turning?), or the description's track or wheel radii are wrong"))
 
 
-def odometry_name(estimator: str | None, weighted: bool) -> str:
+def odometry_name(estimator: str | None, weighted_by: str | None) -> str:
     """How the IMU check's warning names the odometry it judges: the slip-aware `estimator` (``wls``, ``fk1``,
-    ``fk2``), else the no-slip model, ``weighted`` by ``--weight`` or not."""
-    return estimator or ("weighted no-slip (--weight)" if weighted else "no-slip")
+    ``fk2``), else the no-slip model, weighted by the door's option `weighted_by` (``--weight`` of ``wmrkit
+    odometry``, ``weights=`` of :func:`wmrkit.batch.batch_odometry`) or not weighted (None)."""
+    return estimator or (f"weighted no-slip ({weighted_by})" if weighted_by else "no-slip")
 
 
 class ImuCheck:
