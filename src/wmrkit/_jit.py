@@ -76,6 +76,12 @@ def _python_namespace(module_globals: dict, made: dict[int, dict]) -> dict:
     return namespace
 
 
+def with_globals(fn: types.FunctionType, **names) -> types.FunctionType:
+    """`fn` with `names` (compiled helpers) in place of its module's globals of those names: a kernel compiled as it
+    is, calling the others compiled."""
+    return _rebind(fn, {**fn.__globals__, **names})
+
+
 def _rebind(fn: types.FunctionType, namespace: dict) -> types.FunctionType:
     out = types.FunctionType(fn.__code__, namespace, fn.__name__, fn.__defaults__, fn.__closure__)
     out.__kwdefaults__ = fn.__kwdefaults__

@@ -91,10 +91,8 @@ def robot_figure(robot: Robot, cls: Classification) -> Figure:
     for lam in constraint_lines(robot, coupled=geared).lines():
         _draw_line(ax, lam, color="#555555", linestyle="--", linewidth=0.9, zorder=3)
     s = icr(robot, geared=True)
-    if s.kind == "point":
-        _mark_icr(ax, np.array([*s.point, 1.0]), size)
-    elif s.kind == "infinity":
-        _mark_icr(ax, np.array([-s.direction[1], s.direction[0], 0.0]), size)
+    if s.kind in ("point", "infinity"):
+        _mark_icr(ax, s.homogeneous(), size)
     elif s.kind == "line":
         _draw_line(ax, s.line, color=ICR_COLOR, linewidth=2.5, alpha=0.6, zorder=4)
     ax.set_title(f"{robot.name}: {s.describe()}", fontsize=10)

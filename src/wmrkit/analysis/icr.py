@@ -73,6 +73,18 @@ class ICRSet:
     consistent: tuple[tuple[str, float], ...] | None = None
     miss: tuple[str, float] | None = None
 
+    def homogeneous(self) -> np.ndarray | None:
+        """The ICR as a homogeneous point ``(x, y, w)``: the point (w = 1), at infinity (w = 0, perpendicular to the
+        translation), the foot of the line (its point nearest the origin); None for "plane" and "none"."""
+        if self.kind == "point":
+            return np.array([*self.point, 1.0])
+        if self.kind == "infinity":
+            return np.array([-self.direction[1], self.direction[0], 0.0])
+        if self.kind == "line":
+            lx, ly, d = self.line
+            return np.array([d * ly, -d * lx, 1.0])
+        return None
+
     def describe(self) -> str:
         """One line for people, e.g. ``ICR at (0.000, -2.747) m``."""
         f = format_coordinate

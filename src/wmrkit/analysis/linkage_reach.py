@@ -20,19 +20,6 @@ from .icr import icr, twist_of_icr
 from .singularity import SingularSet
 
 
-def _icr_h(robot: Robot, beta: np.ndarray) -> np.ndarray | None:
-    """The homogeneous ICR of the steering `beta` (a point, at infinity, or the foot of a line), None for none."""
-    s = icr(robot, beta)
-    if s.kind == "point":
-        return np.array([*s.point, 1.0])
-    if s.kind == "infinity":
-        return np.array([-s.direction[1], s.direction[0], 0.0])
-    if s.kind == "line":
-        lx, ly, d = s.line
-        return np.array([d * ly, -d * lx, 1.0])
-    return None
-
-
 def unreachable(robot: Robot, s: SingularSet) -> tuple[np.ndarray, tuple[str, ...]]:
     """``(n,)`` bool over ``s.configurations``: True where a held linkage cannot set that steering (judged at a unit
     twist about its ICR, as ``ik``; a configuration with no single ICR is not judged), and the linkages that break,
@@ -44,7 +31,7 @@ def unreachable(robot: Robot, s: SingularSet) -> tuple[np.ndarray, tuple[str, ..
         return none, ()
     out, broken = none.copy(), set()
     for i, beta in enumerate(np.asarray(s.configurations, dtype=float)):
-        h = _icr_h(robot, beta)
+        h = icr(robot, beta).homogeneous()
         if h is None:
             continue
         twist = twist_of_icr(h)

@@ -5,9 +5,7 @@ each calling the others and the law compiled as ``ik``'s linkage check compiles 
 
 from __future__ import annotations
 
-import types
-
-from .._jit import compile_cached, drop_stale_cache
+from .._jit import compile_cached, drop_stale_cache, with_globals
 from ..kinematics import _linkage_kernel, linkage_law
 from . import _setpoints
 
@@ -16,8 +14,7 @@ drop_stale_cache([__file__, _setpoints.__file__], [linkage_law.__file__, _linkag
 
 def _compiled(name: str, names: dict):
     """:mod:`._setpoints`' function `name` compiled, its globals with `names` (compiled helpers) in place of its own."""
-    fn = getattr(_setpoints, name)
-    return compile_cached(types.FunctionType(fn.__code__, {**vars(_setpoints), **names}, name))
+    return compile_cached(with_globals(getattr(_setpoints, name), **names))
 
 
 _names = dict(_linkage_kernel._judge_names)

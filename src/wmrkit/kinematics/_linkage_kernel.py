@@ -7,24 +7,17 @@ the law (:mod:`.linkage_law`) are compiled as they are, each calling the others 
 
 from __future__ import annotations
 
-import types
-
 import numba
 
-from .._jit import compile_cached, drop_stale_cache, jit
+from .._jit import compile_cached, drop_stale_cache, jit, with_globals
 from . import linkage_check, linkage_law
 
 drop_stale_cache([__file__, linkage_check.__file__], [linkage_law.__file__])
 
 
-def _compiled(fn, **names):
-    """`fn` compiled, its module's globals with `names` (compiled helpers) in place of its own."""
-    return compile_cached(types.FunctionType(fn.__code__, {**fn.__globals__, **names}, fn.__name__))
-
-
 _law_names = {"law": compile_cached(linkage_law.law), "remainder": compile_cached(linkage_law.remainder)}
-_judge_names = {**_law_names, "leader_of": _compiled(linkage_law.leader_of, **_law_names)}
-_breach = _compiled(linkage_check._breach, **_judge_names)
+_judge_names = {**_law_names, "leader_of": compile_cached(with_globals(linkage_law.leader_of, **_law_names))}
+_breach = compile_cached(with_globals(linkage_check._breach, **_judge_names))
 
 _TABLE = numba.types.Array(numba.float64, 2, "A", readonly=True)
 _INDEX = numba.types.Array(numba.int64, 1, "A", readonly=True)
@@ -34,4 +27,4 @@ _OUT = numba.types.Array(numba.boolean, 2, "A")
 #: ``_holds(table, start, lead, coupling, beta, speed, slip_tol, tol, out)``, compiled once the batches given to it
 #: exceed the interpret budget (:func:`wmrkit._jit.jit`).
 holds = jit((_TABLE, _INDEX, _INDEX, _INDEX, _ROWS, _ROWS, numba.float64, numba.float64, _OUT))(
-    types.FunctionType(linkage_check._holds.__code__, {**vars(linkage_check), "_breach": _breach}, "_holds"))
+    with_globals(linkage_check._holds, _breach=_breach))
