@@ -201,7 +201,7 @@ rt.ik(0.3, 0.1, 0.4, np.zeros(0), rates, np.zeros(0))
 rt.fk(np.ones(m), np.zeros(0), np.zeros(3))
 rt.odometry_step(np.zeros(3), np.zeros(m), np.ones(m), np.zeros(0))
 stats = {k: [sum(f.stats.cache_hits.values()), sum(f.stats.cache_misses.values())]
-         for k, f in (("ik", rt.ik), ("fk", rt.fk), ("odometry_step", rt.odometry_step))}
+         for k, f in (("ik", rt.ik), ("fk", rt.fk), ("odometry_step", rt.odometry_step.kernel))}
 print(json.dumps({"stats": stats, "rates": rates.tolist(),
                   "expected": wheel_commands(robot, [0.3, 0.1, 0.4]).rates.tolist()}))
 """
@@ -286,3 +286,29 @@ def test_a_second_process_loads_the_control_tick_from_the_cache(tmp_path):
     assert hits == 0 and misses == 1
     assert run(0.4, 1.0) == [1, 0]
     assert run(0.6, 1.0)[1] == 1 and run(0.4, 2.0)[1] == 1  # another IK, another law: not the first's kernel
+
+
+def test_the_odometry_step_casts_its_positions_at_the_door():
+    """Integer or float32 joint positions (encoder counts, a float32 bus), a list, or another heading_mid each compiled
+    one more specialisation of the step (seconds, and a kernel held per dtype); now cast to float64 at the door: one
+    compiled step serves them all, with the numbers of float64 positions."""
+    from wmrkit.kinematics import realtime as rt_module
+
+    rt = realtime(catalog.load("diff-drive"), ("left.spin", "right.spin"))
+    kernel = getattr(rt.odometry_step, "kernel", rt.odometry_step)  # the compiled step behind the door
+    pose, previous = np.zeros(3), np.zeros(2)
+    rt.odometry_step(pose, previous, np.array([1.0, 2.0]), np.zeros(0))
+    counts = len(kernel.signatures), len(rt_module._step.signatures)
+    expected_pose, expected_previous = pose.copy(), previous.copy()
+    for positions, heading_mid in ((np.array([2, 4], dtype=np.int64), np.zeros(0)),
+                                   (np.array([3.0, 6.0], dtype=np.float32), np.zeros(0)),
+                                   ([4.0, 8.0], None), (np.array([5, 10], dtype=np.int32), 0.0)):
+        rt.odometry_step(pose, previous, positions, heading_mid)
+        rt_float = realtime(catalog.load("diff-drive"), ("left.spin", "right.spin"))
+        rt_float.odometry_step(expected_pose, expected_previous, np.asarray(positions, dtype=float), np.zeros(0))
+        np.testing.assert_array_equal(pose, expected_pose)
+        np.testing.assert_array_equal(previous, expected_previous)
+    assert (len(kernel.signatures), len(rt_module._step.signatures)) == counts
+    for args in ((pose, previous, np.ones((1, 2))), ([0.0, 0.0, 0.0], previous, np.ones(2))):
+        with pytest.raises(ValueError, match=r"odometry_step: pose must be a float64 array of shape \(3,\)"):
+            rt.odometry_step(*args, np.zeros(0))

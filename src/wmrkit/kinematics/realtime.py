@@ -67,7 +67,8 @@ class Realtime:
     - ``fk(rates, heading, twist_out)``: the twist ``(3,)`` from the sensed joint rates ``(n_a,)`` (``rate_joints``)
       by the least squares (4.11), at headings ``(n_steer_sensed,)`` of ``steer_joints`` (ignored when constant).
     - ``odometry_step(pose, previous, positions, heading_mid)``: one exact SE(2) step; `pose` ``(3,)`` is updated
-      in place from the joint positions ``(n_a,)`` (``rate_joints``) and `previous` (updated to `positions`).
+      in place from the joint positions ``(n_a,)`` (``rate_joints``; any real dtype or a list, cast to float64 at
+      the door: one compiled kernel serves them all) and `previous` (updated to `positions`).
     """
 
     robot: Robot
@@ -270,7 +271,7 @@ def _constant_step(twist_map: np.ndarray):
     bad = "odometry_step: the pose and the joint positions must be finite"
     overflow = OVERFLOW
 
-    def step(pose, previous, positions, heading_mid):
+    def step(pose, previous, positions):
         if not (float64_vector(pose) and float64_vector(previous) and pose.shape[0] == 3
                 and previous.shape[0] == n_a and positions.shape[0] == n_a):
             raise ValueError(shapes)
@@ -282,7 +283,19 @@ def _constant_step(twist_map: np.ndarray):
         if not _step(pose, previous, positions, twist_map):
             raise ValueError(overflow)
 
-    return compile_cached(step)
+    kernel, ndarray, float64 = compile_cached(step), np.ndarray, np.dtype(float)
+
+    def odometry_step(pose, previous, positions, heading_mid):
+        """The door of the compiled `kernel`: positions cast to a float64 vector (integer counts, float32, a list)
+        and `heading_mid` (constant model) not passed, so that one compiled specialisation serves every caller."""
+        if positions.__class__ is not ndarray or positions.dtype is not float64:
+            positions = np.asarray(positions, dtype=float)
+        if pose.__class__ is not ndarray or previous.__class__ is not ndarray or positions.ndim != 1:
+            raise ValueError(shapes)  # (a list or a 2-D array was numba's TypingError)
+        kernel(pose, previous, positions)
+
+    odometry_step.kernel = kernel  # type: ignore[attr-defined]
+    return odometry_step
 
 
 @compile_cached
