@@ -41,7 +41,7 @@ def test_a_reference_whose_times_do_not_increase_names_the_sample_that_does_not(
     (H + "0,0,0,0,1\n", ":2: expected 4 fields, got 5"),
     ("t,x,y,\u03b8\n0,0,0,0\n", ":1: expected the columns t,x,y,theta"),
     (H + "0,0,0,0\n0.001,100,0,0\n0.002,200,0,0\n", "samples 1-2 move at 1e+05 m/s"),
-    ("0 0 0 0 0 0 0 0\n1 1 0 0 0 0 0 0\n2 2 0 0 0 0 0 0\n", "pose 1: the quaternion is (almost) zero"),
+    ("0 0 0 0 0 0 0 0\n1 1 0 0 0 0 0 0\n2 2 0 0 0 0 0 0\n", "ref.csv:1: the quaternion is (almost) zero"),
     ("0 0 0 0\n1 1 0 0\n", "a TUM file has 8 columns, got 4"),
 ])
 @pytest.mark.parametrize("command", ["feasibility", "track"])

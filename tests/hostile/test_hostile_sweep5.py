@@ -142,9 +142,9 @@ def _skid_log(tmp_path: Path, n: int = 50) -> str:
 @pytest.mark.parametrize("tum, expected", [
     ("", "no poses in the file"),  # numpy's UserWarning and "8 columns, got 1" before
     ("0 0 0 0 0 0 0 1\n0.1 nan 0 0 0 0 0 1\n0.2 0 0 0 0 0 0 1\n", ":2: column 'tx': value nan is not a finite number"),
-    ("0 0 0 0 0 0 0 1\n0.2 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1\n", "pose 3: time 0.1 s does not increase"),  # silent
-    ("0 0 0 0 0 0 0 0\n0.1 0 0 0 0 0 0 0\n0.2 0 0 0 0 0 0 0\n", "pose 1: the quaternion is (almost) zero"),  # silent
-    ("0 0 0 0 0 0 0 1\n0.1 1e308 0 0 0 0 0 1\n0.2 0 0 0 0 0 0 1\n", "pose 2: a coordinate beyond"),  # printed inf
+    ("0 0 0 0 0 0 0 1\n0.2 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1\n", "ref.tum:3: time 0.1 s does not increase"),  # silent
+    ("0 0 0 0 0 0 0 0\n0.1 0 0 0 0 0 0 0\n0.2 0 0 0 0 0 0 0\n", "ref.tum:1: the quaternion is (almost) zero"),  # silent
+    ("0 0 0 0 0 0 0 1\n0.1 1e308 0 0 0 0 0 1\n0.2 0 0 0 0 0 0 1\n", "ref.tum:2: a coordinate beyond"),  # printed inf
 ])
 def test_calibrate_refuses_a_broken_reference_trajectory(tum, expected, tmp_path, capsys):
     ref = _write(tmp_path / "ref.tum", tum)

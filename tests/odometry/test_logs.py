@@ -251,7 +251,7 @@ def test_a_tum_file_reads_quaternions_of_any_finite_norm_without_a_python_warnin
         with warnings.catch_warnings():
             warnings.simplefilter("error")
             if zero:
-                with pytest.raises(LogError, match=r"pose 1: the quaternion is \(almost\) zero"):
+                with pytest.raises(LogError, match=r"t.tum:1: the quaternion is \(almost\) zero"):
                     read_tum(tum)
             else:
                 read_tum(tum)
@@ -377,3 +377,20 @@ def test_a_header_with_units_read_without_its_format_names_header_format(tmp_pat
                    robot=robot)
     np.testing.assert_allclose(log.time, [0.0, 0.1])
     np.testing.assert_allclose(log.positions, [[0, 0], [1, 2]])
+
+
+def test_trajectory_file_errors_name_the_file_and_line(tmp_path):
+    """A zero quaternion, a coordinate too far, a time not increasing were 'FILE: pose N: ...' (N counting poses, not
+    the lines of a file with comments and blank lines); now 'FILE:LINE: ...', the line an editor jumps to."""
+    tum = tmp_path / "t.tum"
+    head = "# timestamp tx ty tz qx qy qz qw\n\n0 0 0 0 0 0 0 1\n# a comment\n"
+    for bad, message in (("1 1 0 0 0 0 0 0", r"the quaternion is \(almost\) zero"),
+                         ("1 1e300 0 0 0 0 0 1", "a coordinate beyond"),
+                         ("0 1 0 0 0 0 0 1", r"time 0\.0 s does not increase")):
+        tum.write_text(f"{head}{bad}\n2 2 0 0 0 0 0 1\n")
+        with pytest.raises(LogError, match=rf"^{re.escape(str(tum))}:5: {message}"):
+            read_tum(tum)
+    csv = tmp_path / "t.csv"
+    csv.write_text("time,x,y,theta,slip\n0,0,0,0,0\n0,1,0,0,0\n")
+    with pytest.raises(LogError, match=rf"^{re.escape(str(csv))}:3: time 0\.0 s does not increase"):
+        read_trajectory_csv(csv)

@@ -7,7 +7,9 @@ TUM is the format trajectory-evaluation tools (``evo``, the TUM RGB-D benchmark 
 
 from __future__ import annotations
 
+import itertools
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import IO, Literal, NoReturn
 
@@ -119,12 +121,12 @@ def read_tum(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
     data = _load_table(path, TUM_COLUMNS, comments="#")
     if data.shape[1] != 8:
         raise LogError(f"{os.fspath(path)}: a TUM file has 8 columns, got {data.shape[1]}")
-    _check_samples(path, data[:, 0], data[:, 1:4])
-    _check_finite(path, data[:, 4:8], "the quaternion")
+    _check_samples(path, data[:, 0], data[:, 1:4], 0, "#")
+    _check_finite(path, data[:, 4:8], "the quaternion", 0, "#")
     scale = np.max(np.abs(data[:, 4:8]), axis=1)  # the norm as scale * |q / scale|: |q|^2 overflows beyond 1e154
     zero = scale < 1e-6 / np.linalg.norm(data[:, 4:8] / np.where(scale > 0, scale, 1.0)[:, None], axis=1).clip(1.0)
     if np.any(zero):
-        raise LogError(f"{os.fspath(path)}: pose {int(np.argmax(zero)) + 1}: the quaternion is (almost) zero")
+        raise LogError(f"{_line_of(path, int(np.argmax(zero)), 0, '#')}: the quaternion is (almost) zero")
     return data[:, 0], np.column_stack([data[:, 1], data[:, 2], np.unwrap(yaw_of_quaternion(data[:, 4:8]))])
 
 
@@ -156,13 +158,9 @@ def _refuse_field(path: str | os.PathLike[str], columns: tuple[str, ...], delimi
                   comments: str | None) -> NoReturn:
     """Raise a :class:`LogError` naming the line and the column of the first field of the table at `path` that is
     not a finite number, or the first row of another field count (the file is at most ``MAX_TABLE_SIZE``)."""
-    with open(path, encoding="utf-8-sig", newline="") as f:
-        lines = f.read().splitlines()
     width = len(columns) if delimiter else None  # a CSV has its header's fields; read_tum counts a TUM file's
-    for k, text in enumerate(lines[skiprows:], start=skiprows + 1):
-        fields = (text.partition(comments)[0] if comments else text).split(delimiter)
-        if fields in ([], [""]) or not "".join(fields).strip():
-            continue  # a blank line or a comment
+    for k, text in _data_lines(path, skiprows, comments):
+        fields = text.split(delimiter)
         width = len(fields) if width is None else width
         if len(fields) != width:
             raise LogError(f"{os.fspath(path)}:{k}: expected {width} fields, got {len(fields)}")
@@ -174,23 +172,42 @@ def _refuse_field(path: str | os.PathLike[str], columns: tuple[str, ...], delimi
     raise LogError(f"{os.fspath(path)}: cannot read the trajectory")  # pragma: no cover (loadtxt's reasons above)
 
 
-def _check_samples(path: str | os.PathLike[str], t: np.ndarray, position: np.ndarray) -> None:
-    """Times finite and strictly increasing, positions finite within :data:`wmrkit.limits.MAX_COORDINATE`."""
-    _check_finite(path, np.column_stack([t, position]), "times and positions")
+def _data_lines(path: str | os.PathLike[str], skiprows: int, comments: str | None) -> Iterator[tuple[int, str]]:
+    """``(line number (1-based), text without its comment)`` of the data lines of the table at `path` as
+    :func:`_load_table` reads them: `skiprows` header lines, blank and `comments` lines skipped (error paths only)."""
+    with open(path, encoding="utf-8-sig", newline="") as f:
+        lines = f.read().splitlines()
+    for k, text in enumerate(lines[skiprows:], start=skiprows + 1):
+        data = text.partition(comments)[0] if comments else text
+        if data.strip():
+            yield k, data
+
+
+def _line_of(path: str | os.PathLike[str], row: int, skiprows: int, comments: str | None) -> str:
+    """``FILE:LINE`` of the data `row` (0-based) of the table at `path` (:func:`_data_lines`)."""
+    return f"{os.fspath(path)}:{next(itertools.islice(_data_lines(path, skiprows, comments), row, None))[0]}"
+
+
+def _check_samples(path: str | os.PathLike[str], t: np.ndarray, position: np.ndarray, skiprows: int,
+                   comments: str | None) -> None:
+    """Times finite and strictly increasing, positions finite within :data:`wmrkit.limits.MAX_COORDINATE`; else a
+    :class:`LogError` naming the file and line (`skiprows`, `comments` as :func:`_load_table`'s)."""
+    _check_finite(path, np.column_stack([t, position]), "times and positions", skiprows, comments)
     if np.abs(position).max() > MAX_COORDINATE:
-        raise LogError(f"{os.fspath(path)}: pose {int(np.argmax(np.abs(position).max(axis=1))) + 1}: a coordinate "
-                       f"beyond {MAX_COORDINATE:g} m")
+        row = int(np.argmax(np.abs(position).max(axis=1)))
+        raise LogError(f"{_line_of(path, row, skiprows, comments)}: a coordinate beyond {MAX_COORDINATE:g} m")
     if np.any(np.diff(t) <= 0):
         k = int(np.argmax(np.diff(t) <= 0))
-        raise LogError(f"{os.fspath(path)}: pose {k + 2}: time {float(t[k + 1])!r} s does not increase (after "
-                       f"{float(t[k])!r} s)")
+        raise LogError(f"{_line_of(path, k + 1, skiprows, comments)}: time {float(t[k + 1])!r} s does not increase "
+                       f"(after {float(t[k])!r} s)")
 
 
-def _check_finite(path: str | os.PathLike[str], values: np.ndarray, what: str) -> None:
-    """Every row of `values` ``(N, k)`` finite, or a :class:`LogError` naming the file, the pose and `what`."""
+def _check_finite(path: str | os.PathLike[str], values: np.ndarray, what: str, skiprows: int,
+                  comments: str | None) -> None:
+    """Every row of `values` ``(N, k)`` finite, or a :class:`LogError` naming the file and line and `what`."""
     finite = np.isfinite(values).all(axis=1)
     if not finite.all():
-        raise LogError(f"{os.fspath(path)}: pose {int(np.argmin(finite)) + 1}: {what} must be finite numbers")
+        raise LogError(f"{_line_of(path, int(np.argmin(finite)), skiprows, comments)}: {what} must be finite numbers")
 
 
 def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
@@ -208,8 +225,8 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
     data = _load_table(path, tuple(header), delimiter=",", skiprows=1)
     if data.shape[1] != len(header):
         raise LogError(f"{os.fspath(path)}: {data.shape[1]} values per row under a header of {len(header)} columns")
-    _check_samples(path, data[:, 0], data[:, 1:3])
-    _check_finite(path, data[:, 3:], "theta, slip and the covariance")
+    _check_samples(path, data[:, 0], data[:, 1:3], 1, None)
+    _check_finite(path, data[:, 3:], "theta, slip and the covariance", 1, None)
     cov = None
     if len(header) > 5:
         cov = np.zeros((len(data), 3, 3))
