@@ -54,6 +54,27 @@ def between(table, plan, beta, k, s, point, out):
     project(table, plan, point, out)
 
 
+def continued(table, plan, beta, out):
+    """`out` ``(K, n_steer)``: the set-points `beta` with each follower of `plan` moved by whole turns to the one
+    its law reaches along the steps from its first row: each step's change of the law, from the row to the law at
+    the step's middle (:func:`between`'s point at 1/2) and on to the next row, each part the short way round (a
+    follower's heading written wrapped, +179 deg then -179 deg, is the law turning 2 deg, not 358)."""
+    point = np.empty(beta.shape[1])
+    for k in range(beta.shape[0]):
+        for m in range(beta.shape[1]):
+            out[k, m] = beta[k, m]
+    for k in range(beta.shape[0] - 1):
+        for m in range(beta.shape[1]):
+            point[m] = 0.5 * (beta[k, m] + beta[k + 1, m])
+        for q in range(plan.shape[0]):
+            j = plan[q, 0]
+            mid = angle(table, plan, q, point)
+            reached = out[k, j] + remainder(mid - beta[k, j], 2.0 * math.pi) + remainder(beta[k + 1, j] - mid,
+                                                                                        2.0 * math.pi)
+            turns = np.round((reached - beta[k + 1, j]) / (2.0 * math.pi))  # whole turns: a row kept as it is
+            out[k + 1, j] = beta[k + 1, j] + turns * 2.0 * math.pi
+
+
 def chord_errors(table, plan, beta, rows, pieces, off):
     """`off[q]`: the largest distance, over the set-points, between the law at the middle of each of `pieces[q]`
     even pieces of the step from row ``rows[q]`` of `beta` to the next and the mean of the law at its ends."""

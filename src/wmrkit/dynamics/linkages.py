@@ -198,7 +198,7 @@ def _law_plan(model, commanded: set[int]) -> np.ndarray:
 
 
 #: Most knots :func:`setpoint_knots` inserts between the rows of a set-point table (a 0.5 rad row step of a small
-#: car's steering inserts 139): its loops put at most ``4 (rows - 1) + 12 knots + 1`` set-points on the law
+#: car's steering inserts 139): its loops put at most ``5 (rows - 1) + 12 knots + 1`` set-points on the law
 #: (tests/dynamics/test_linkage_setpoints.py): about two seconds for a million rows and these knots, which with the
 #: torques interpolated at them take some 100 MB per ten columns.
 MAX_SETPOINT_KNOTS = 1_000_000
@@ -212,18 +212,22 @@ def setpoint_knots(model, t: np.ndarray, beta: np.ndarray, commanded: set[int],
                    tol: float = SETPOINT_TOL) -> tuple[np.ndarray, np.ndarray]:
     """Knots ``(t, beta)`` whose linear interpolation keeps the set-points of each held linkage on its law between
     rows: times `t` ``(K,)`` [s], steering set-points `beta` ``(K, n_steer)`` [rad] on the law at each row
-    (:func:`setpoint_breach`), the indices `commanded` servoed. Between two rows the reference of each linkage moves
-    linearly and the law sets its commanded followers from it (:func:`._setpoints.angle`): each step is cut into even
-    pieces in time, their number raised (at least doubled, every step at once) until the followers'
-    interpolation is within `tol` / 2 of the law at the middle of every piece (the law is smooth: a short chord's
-    largest error is at its middle); the other columns keep their rows' interpolation. Without a commanded follower
-    the rows are returned as they are; :class:`SetpointKnotsError` where more than :data:`MAX_SETPOINT_KNOTS`
-    knots would be inserted (before they are computed)."""
+    (:func:`setpoint_breach`), the indices `commanded` servoed; each follower's rows taken on the turn its law
+    reaches from its first row (:func:`._setpoints.continued`: a heading written wrapped turns the short way).
+    Between two rows the reference of each linkage moves linearly and the law sets its commanded followers from it
+    (:func:`._setpoints.angle`): each step is cut into even pieces in time, their number raised (at least doubled,
+    every step at once) until the followers' interpolation is within `tol` / 2 of the law at the middle of every
+    piece (the law is smooth: a short chord's largest error is at its middle); the other columns keep their rows'
+    interpolation. Without a commanded follower the rows are returned as they are; :class:`SetpointKnotsError`
+    where more than :data:`MAX_SETPOINT_KNOTS` knots would be inserted (before they are computed)."""
     plan = _law_plan(model, commanded)
     if len(t) < 2 or not len(plan):
         return t, beta
     args = (np.ascontiguousarray(model.pack[17], dtype=float), plan)
     t, beta = np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(beta, dtype=float)
+    turned = np.empty_like(beta)  # each follower's rows on the turns its law reaches (a wrapped heading: the short way)
+    _loops(len(t) * len(plan)).continued(*args, beta, turned)
+    beta = turned
     pieces, rows = np.ones(len(t) - 1, dtype=np.int64), np.arange(len(t) - 1)
     while len(rows):
         off = np.empty(len(rows))
