@@ -138,6 +138,21 @@ def first_breach(model, headings: np.ndarray, commanded: set[int]) -> int | None
     return int(np.argmax(bad)) if bad.any() else None
 
 
+def first_ik_breach(model, headings: np.ndarray, servoed: set[int]) -> int | None:
+    """The first row of wheel-IK headings `headings` ``(K, n_steer)`` [rad] that breaks a held linkage (every
+    follower off its leader's law by more than ``LINKAGE_TOL``: :func:`linkage_breach`) or the ratios of a ``gear``
+    between the steering joints `servoed` (:func:`gear_breach`), every row judged at once (compiled for a large
+    table); None when none does. A twist program's check (:func:`~.programs.twist_program`)."""
+    headings = np.asarray(headings, dtype=float).reshape(len(headings), -1)
+    bad = np.zeros(len(headings), dtype=bool)
+    plan = _law_plan(model, set(range(headings.shape[1])))  # every follower from its leader, as linkage_breach
+    if len(plan):
+        bad |= (_law_offs(model, plan, model.robot.beta_of_heading(headings))[1] > LINKAGE_TOL).any(axis=1)
+    for j, _, want in _geared(model, headings, servoed):
+        bad |= np.abs(headings[:, j] - want) > SETPOINT_TOL
+    return int(np.argmax(bad)) if bad.any() else None
+
+
 def gear_breach(model, headings: np.ndarray, commanded: set[int],
                 tol: float = SETPOINT_TOL) -> tuple[int, int, float, str] | None:
     """The first heading set-point of `headings` ``(n_steer,)`` [rad] (the indices `commanded` servoed) that breaks

@@ -29,7 +29,7 @@ from ..errors import WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, MAX_TORQUE, check_table_size
 from ..units import BARE_ANGLE_LIMIT
 from .inputs import Inputs, joint_column, knots
-from .linkages import SETPOINT_TOL, first_breach, gear_breach, heading_breach, linkage_breach
+from .linkages import SETPOINT_TOL, first_breach, first_ik_breach, gear_breach, heading_breach, linkage_breach
 from .model import DynamicModel
 
 #: Natural frequency [rad/s] of the programs' servos (the default `bandwidth`): a fixed step longer than its
@@ -190,28 +190,27 @@ def _check_linkages(model: DynamicModel, t: np.ndarray, twists: np.ndarray, head
     """Refuse (unless `allow_slip`) the first knot whose IK `headings` ``(K, n_steer)`` break a ``linkage`` the
     dynamics hold (:mod:`.linkages`: a synchro chain asked to turn its wheels apart), or the ratios of a ``gear``
     between servoed steering joints (:func:`~.linkages.gear_breach`: two units geared 1:2 asked to crab), naming
-    it; whether one does (with `allow_slip`: the servos fight through it, ``Inputs.fight_linkages``)."""
+    it; whether one does (with `allow_slip`: the servos fight through it, ``Inputs.fight_linkages``). Every knot at
+    once (:func:`~.linkages.first_ik_breach`), the message from the first one that breaks one."""
     if not len(model.pack[17]) and not model.pack[16].shape[1]:
         return False
     servoed = {k for k, c in enumerate(model.steer_columns) if model.is_actuated(c)}
-    for k, beta in enumerate(model.robot.beta_of_heading(headings)):
-        breach = linkage_breach(model, beta) if len(model.pack[17]) else None
-        geared = gear_breach(model, headings[k], servoed)
-        if (breach or geared) and allow_slip:
-            return True
-        if geared:
-            j, ref, want, name = geared
-            steered = model.robot.steer_names
-            raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion "
-                              f"for '{model.robot.name}': its wheels' steering breaks the ratios of {name} (it sets "
-                              f"{steered[j]} at heading {want:.6g} rad with {steered[ref]}'s at "
-                              f"{headings[k, ref]:.6g} rad, the wheel IK {headings[k, j]:.6g} rad), which the "
-                              "dynamics hold; use allow_slip=True to let its servos fight and the tyres slip")
-        if breach:
-            raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion "
-                              f"for '{model.robot.name}': its wheels' steering breaks a linkage ({breach}), which "
-                              "the dynamics hold; use allow_slip=True to let its servos fight and the tyres slip")
-    return False
+    k = first_ik_breach(model, headings, servoed)  # every knot at once
+    if k is None or allow_slip:
+        return k is not None
+    geared = gear_breach(model, headings[k], servoed)
+    if geared:
+        j, ref, want, name = geared
+        steered = model.robot.steer_names
+        raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion "
+                          f"for '{model.robot.name}': its wheels' steering breaks the ratios of {name} (it sets "
+                          f"{steered[j]} at heading {want:.6g} rad with {steered[ref]}'s at "
+                          f"{headings[k, ref]:.6g} rad, the wheel IK {headings[k, j]:.6g} rad), which the "
+                          "dynamics hold; use allow_slip=True to let its servos fight and the tyres slip")
+    breach = linkage_breach(model, model.robot.beta_of_heading(headings[k]))
+    raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion "
+                      f"for '{model.robot.name}': its wheels' steering breaks a linkage ({breach}), which "
+                      "the dynamics hold; use allow_slip=True to let its servos fight and the tyres slip")
 
 
 def _check_bandwidth(bandwidth: float) -> None:
