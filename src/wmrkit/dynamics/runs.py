@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import WmrkitError
+from ..limits import MAX_SPEED
 from .model import DynamicModel
 
 
@@ -59,7 +60,8 @@ def records(model: DynamicModel, n_rec: int) -> tuple:
 def fixed_run(model, s0, inp, duration, step, every, method, progress, jac_every, allow_lift_off):
     """`duration` [s] from state `s0` in compiled fixed steps (`method` 0: semi-implicit, 1: rk4), recording every
     `every` steps, in chunks (a ``tqdm`` bar on long runs); ``(records, info)``. A run that stops (a lift-off, a
-    divergence) is re-checked at a shorter step (:func:`_stop`)."""
+    divergence, a recorded state out of the physical range: :func:`first_escape`, as the adaptive run stops) is
+    re-checked at a shorter step (:func:`_stop`)."""
     from ._integrate import model_work_arrays, observe, run
 
     n_steps = round(duration / step)
@@ -74,18 +76,20 @@ def fixed_run(model, s0, inp, duration, step, every, method, progress, jac_every
         from tqdm import tqdm
 
         bar = tqdm(total=n_steps, unit="step", desc="simulate", leave=False)
+    lever = levers(model, s0[list(model.steer_columns)])
     while done < n_steps:
-        k = min(chunk, n_steps - done)
+        k, i0 = min(chunk, n_steps - done), i
         i = run(s, done, step, k, every, method, jac_every, acc, model.pack, inp, w, rec, i)
         done += k
         if bar is not None:
             bar.update(k)
         diverged = not np.all(np.isfinite(s))
-        if diverged or lifted(w, allow_lift_off):
+        far = first_escape(model, lever, rec[0][i0:i], rec[1][i0:i], done * step, s)
+        if diverged or far is not None or lifted(w, allow_lift_off):
             if bar is not None:
                 bar.close()
             _stop(model, tuple(r[:i] for r in rec), inp, w, done * step, duration, step, method, jac_every,
-                  allow_lift_off)
+                  allow_lift_off, far)
     if bar is not None:
         bar.close()
     return tuple(r[:i] for r in rec), {"steps": n_steps}
@@ -144,13 +148,20 @@ class Stop:
         return cls(t, f"contact '{contact}' lost its load at t = {t:.6g} s", contact)
 
     @classmethod
-    def of_run(cls, model: DynamicModel, w: tuple, t_run: float, allow_lift_off: bool) -> Stop:
+    def escaped(cls, t: float, why: str) -> Stop:
+        """The state left the physical range at `t` [s] (:func:`escaped` says `why`)."""
+        return cls(t, f"the simulation left the physical range at t = {t:.6g} s ({why})")
+
+    @classmethod
+    def of_run(cls, model: DynamicModel, w: tuple, t_run: float, allow_lift_off: bool,
+               far: tuple[float, str] | None = None) -> Stop:
         """The stop of a run advanced to `t_run` [s]: the lift-off that its work arrays `w` recorded (unless
         `allow_lift_off`), which comes first when the state diverged later in the same run (:func:`lifted`), or the
-        divergence before `t_run`."""
+        state out of the physical range at ``far = (t, why)`` (:func:`first_escape`), or the divergence before
+        `t_run`."""
         if lifted(w, allow_lift_off):
             return cls.lift_off(float(w[16][1]), model.contacts[int(w[16][2])])
-        return cls.diverged(t_run)
+        return cls.diverged(t_run) if far is None else cls.escaped(*far)
 
 
 def lifted(w: tuple, allow_lift_off: bool) -> bool:
@@ -207,21 +218,46 @@ def judge(stop: Stop, check: Recheck, where: str) -> WmrkitError | None:
 
 
 def rerun_stop(model: DynamicModel, s: np.ndarray, stretch: list, fine: float, method: int, jac_every: int,
-               allow_lift_off: bool) -> Stop | None:
+               allow_lift_off: bool, lever: np.ndarray | None = None) -> Stop | None:
     """Where a fresh integrator run from state `s` (not changed) at step `fine` [s] through `stretch`, the
     consecutive pieces ``(k0, steps, compiled inputs)`` counted in steps of `fine`, stops: None when it neither
-    diverges nor (unless `allow_lift_off`) lifts a wheel off (the re-run of :func:`_stop`, :meth:`StepLog.recheck`)."""
+    diverges nor (unless `allow_lift_off`) lifts a wheel off, nor, given the :func:`levers` `lever`, leaves the
+    physical range (judged every :data:`ESCAPE_CHECK` s) (the re-run of :func:`_stop`, :meth:`StepLog.recheck`)."""
     from ._integrate import model_work_arrays, run
 
     s, acc, w, rec = s.copy(), np.zeros(model.n), model_work_arrays(model), records(model, 0)
+    every = (1 << 62) if lever is None else max(1, round(ESCAPE_CHECK / fine))
     for k0, steps, inp in stretch:
-        run(s, k0, fine, steps, 1 << 62, method, jac_every, acc, model.pack, inp, w, rec, 0)
-        if not np.all(np.isfinite(s)) or lifted(w, allow_lift_off):
-            return Stop.of_run(model, w, (k0 + steps) * fine, allow_lift_off)
+        for k in range(k0, k0 + steps, every):  # in pieces: the same steps (_integrate.run)
+            run(s, k, fine, min(every, k0 + steps - k), 1 << 62, method, jac_every, acc, model.pack, inp, w, rec, 0)
+            t = min(k + every, k0 + steps) * fine
+            why = "" if lever is None else escaped(model, lever, s)
+            if not np.all(np.isfinite(s)) or lifted(w, allow_lift_off):
+                return Stop.of_run(model, w, t, allow_lift_off)
+            if why:
+                return Stop.escaped(t, why)
     return None
 
 
-def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_lift_off):
+#: How often [s] the re-check of a fixed-step run that left the physical range judges its state (:func:`rerun_stop`).
+ESCAPE_CHECK = 0.01
+
+
+def first_escape(model: DynamicModel, lever: np.ndarray, t: np.ndarray, states: np.ndarray, t_run: float,
+                 s: np.ndarray) -> tuple[float, str] | None:
+    """``(time [s], why)`` of the first of the recorded `states` ``(N, 2n)`` at times `t` ``(N,)``, else of the
+    state `s` at `t_run` [s], that is finite and out of the physical range (:func:`escaped`); None when none is (a
+    state that is not finite first: the run diverged)."""
+    for time, state in ((t, states), (np.array([t_run]), s[None])):
+        speed = np.abs(state[:, model.n:]) * lever
+        finite = np.isfinite(speed).all(axis=1)
+        out = np.flatnonzero(~finite | (speed > MAX_SPEED).any(axis=1))
+        if len(out):
+            return (float(time[out[0]]), escaped(model, lever, state[out[0]])) if finite[out[0]] else None
+    return None
+
+
+def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_lift_off, far=None):
     """Raise the error of a fixed-step run that stopped at `t_run` [s] (the lift-off `w` recorded, or diverged),
     after re-running it at :func:`recheck_step` to its end (`duration`): from the first of the records `rows` at
     most :func:`recheck_budget` of those steps before the end (at the latest the last one before the stop), for at
@@ -229,20 +265,23 @@ def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_l
     reach the robot's own lift-off much later (the forklift's arc-line at 2 m/s: 2.40 s at 1 ms, 2.52 s at 0.25 ms);
     a step too long for the tyres 'lifted off' the forklift's steered wheel on its rectangle from 8 ms (the load
     transfer lags a step and the tyres saturate within one, which the implicit step does not cover:
-    docs/dynamics.md)."""
-    stop = Stop.of_run(model, w, t_run, allow_lift_off)
+    docs/dynamics.md). `far`: where a recorded state left the physical range (:func:`first_escape`), judged so."""
+    stop = Stop.of_run(model, w, t_run, allow_lift_off, far)
     fine, budget = recheck_step(step, method), recheck_budget(method)
     k_end = round(duration / step) * round(step / fine)  # the run's end, in fine steps
     j = min(int(np.searchsorted(rows[0], (k_end - budget) * fine)),  # the first record in the budget, and at
             max(0, int(np.searchsorted(rows[0], stop.t)) - 1))  # the latest the last one before the stop
     k0 = round(rows[0][j] / fine)  # a record's time is a whole number of steps, each a whole number of fine ones
     k_last = min(k_end, k0 + budget)
-    again = rerun_stop(model, rows[1][j], [(k0, k_last - k0, inp)], fine, method, jac_every, allow_lift_off)
+    lever = levers(model, rows[1][0][list(model.steer_columns)])
+    again = rerun_stop(model, rows[1][j], [(k0, k_last - k0, inp)], fine, method, jac_every, allow_lift_off, lever)
     error = judge(stop, Recheck(step, fine, again, k_last * fine, k_end * fine), SIMULATE_STEP)
     if error is not None:
         raise error
     if lifted(w, allow_lift_off):
         check_lift_off(model, w)
+    if far is not None:
+        raise WmrkitError(f"{stop.what}; use smaller torques or speeds")
     err = WmrkitError(f"the simulation diverged before t = {t_run:.6g} s; use a smaller step {SIMULATE_STEP} (or "
                       "smaller torques or speeds)")
     err.where = SIMULATE_STEP
@@ -351,8 +390,6 @@ def levers(model: DynamicModel, beta: np.ndarray) -> np.ndarray:
 def escaped(model: DynamicModel, lever: np.ndarray, s: np.ndarray) -> str:
     """Why the state `s` is outside the physical range (a velocity column times its :func:`levers` beyond
     :data:`~wmrkit.limits.MAX_SPEED`, or not finite), or ``""``."""
-    from ..limits import MAX_SPEED
-
     speed = np.abs(s[model.n:]) * lever
     c = int(np.argmax(np.where(np.isfinite(speed), speed, np.inf)))
     if speed[c] <= MAX_SPEED:
