@@ -765,3 +765,24 @@ def test_a_heading_outside_the_wheel_s_own_steer_range_is_refused(extra, field, 
         pytest.approx(math.radians(-175))
     with pytest.raises(DescriptionError, match=r"wheels\[0\]\.heading: heading 160 deg is outside"):
         Robot.from_dict({"name": "bot", "wheels": [{**across, "heading": "160 deg"}]})
+
+
+def test_to_dict_writes_what_the_description_format_page_says_it_writes():
+    """docs/description-format.md's `robot.to_dict()` row: every geometric field of the type, defaults too, the other
+    fields only when set. The row said 'every optional field written out', while a wheel without sensors has no
+    `sensed` and a `type: mecanum` wheel no `gamma`."""
+    row = " ".join(next(line for line in DOC.read_text().splitlines() if line.startswith("| `robot.to_dict()`"))
+                   .split())
+    assert "every optional field" not in row
+    assert "every geometric field of the wheel's type written out, defaults too (a castor's `delta: 0.0`" in row
+    shown = re.search(r"the other fields \(([^)]*)\) only when set", row)[1]
+    others = [name.strip("` ") for name in shown.split(",")]
+    robot = Robot.from_dict({"name": "r", "wheels": [
+        {"name": "c", "type": "castor", "position": [-0.3, 0], "d": 0.05, "r": 0.1},
+        {"name": "m", "type": "mecanum", "position": [0.2, 0.15], "r": 0.08}]})
+    castor, mecanum = robot.to_dict()["wheels"]
+    assert castor["delta"] == 0.0 and {"gamma", "r_r"}.isdisjoint(mecanum)
+    assert not {*others} & ({*castor} | {*mecanum})
+    full = catalog.load("forklift").to_dict()["wheels"][0]  # sensed, actuated, inertia, tyre set: written
+    set_here = {"actuated", "sensed", "inertia", "tyre"}
+    assert set_here <= {*full} and set_here <= {*others}
