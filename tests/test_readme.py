@@ -79,3 +79,22 @@ def test_the_described_robot_is_rated_as_the_readme_says(tmp_path, capsys):
     report = json.loads(capsys.readouterr().out)
     assert (report["type"], report["mobility"], report["steerability"]) == (4, 1, 1)
     assert report["actuation"]["sufficient"] and report["actuation"]["consistent"]
+
+
+def test_what_you_get_names_every_command():
+    """Each command of `wmrkit --help` has a line (or, needing files of one's own, a comment) in "What you get":
+    `sweep`, `slip-study`, `vision` and `calibrate` had none, and `batch ...  # also sweep, montecarlo` sent a
+    reader to a `wmrkit batch sweep` that does not exist."""
+    import argparse
+
+    from wmrkit.cli.main import build_parser
+
+    block = README.split("## What you get", 1)[1].split("```", 2)[1]
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
+    assert [c for c in commands if f"wmrkit {c} " not in block + " "] == []
+    for group in ("batch", "vision"):
+        said = {m for line in block.splitlines() if line.startswith(f"wmrkit {group} ")
+                for m in re.findall(r"[\w-]+", line.split()[2] + " " + line.partition("# ")[2])}
+        assert said & set(commands[group]._subparsers._group_actions[0].choices)  # a real subcommand
+        assert not re.search(rf"wmrkit {group}\b.*#.*\balso\b.*\bsweep\b", block)
