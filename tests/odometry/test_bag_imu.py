@@ -221,7 +221,7 @@ def test_an_imu_on_another_clock(capsys, tmp_path, short_run):
 def test_read_imu_yaw_unwraps_integrates_and_chunks(tmp_path):
     """The orientation's yaw past pi read continuous; the gyro's constant rate integrated exactly (trapezoids); the
     same values in chunks of 7 as in one."""
-    from wmrkit.odometry.bags import read_imu_yaw
+    from wmrkit.odometry.bag_imu import read_imu_yaw
 
     t = np.linspace(0.0, 4.0, 41)
     yaw = 1.5 * t  # 6 rad: past pi, wrapped by the quaternion
@@ -286,7 +286,7 @@ def test_the_imu_judges_the_trajectory_that_disagrees_naming_it(capsys, skid4_ba
 def test_the_joint_states_are_read_once(capsys, tmp_path, monkeypatch):
     """The check samples the run's output as it is produced: every JointState message is decoded once (before, the
     bag's joint states were read again after the run: twice)."""
-    from wmrkit.odometry import bags
+    from wmrkit.odometry import bag_imu, bags
 
     robot = catalog.load("diff-drive")
     run = simulate(robot, TwistProfile.from_segments([(12.0, 0.4, 0.0, 0.3)]), 20.0)
@@ -302,6 +302,7 @@ def test_the_joint_states_are_read_once(capsys, tmp_path, monkeypatch):
             yield item
 
     monkeypatch.setattr(bags, "_messages", counting)
+    monkeypatch.setattr(bag_imu, "_messages", counting)
     code, answer, _ = _run(capsys, "diff-drive", bag, "--chunk-size", "50")
     assert code == 0 and answer["imu"] == "/imu" and answer["consistent"] and answer["samples"] == len(run.log)
     assert decoded == {"sensor_msgs/msg/JointState": len(run.log), "sensor_msgs/msg/Imu": len(run.log) - 1}
@@ -343,26 +344,26 @@ def test_a_named_imu_on_another_clock_leaves_no_output(capsys, tmp_path, short_r
 
 
 def test_an_imu_too_long_to_hold_is_refused(tmp_path, short_run, monkeypatch):
-    """The IMU's (time, yaw) are held whole: beyond bags.MAX_IMU_MESSAGES (16 bytes each, limits.MAX_TABLE_SIZE in
-    all) one error line, before the messages are read."""
-    from wmrkit.odometry import bags
+    """The IMU's (time, yaw) are held whole: beyond bag_imu.MAX_IMU_MESSAGES (16 bytes each, limits.MAX_TABLE_SIZE
+    in all) one error line, before the messages are read."""
+    from wmrkit.odometry import bag_imu
     from wmrkit.odometry.logs import LogError
 
-    assert bags.MAX_IMU_MESSAGES * 16 == bags.MAX_TABLE_SIZE
+    assert bag_imu.MAX_IMU_MESSAGES * 16 == bag_imu.MAX_TABLE_SIZE
     run = short_run
     bag = tmp_path / "long"
     _write(bag, run.log.time, run.log.joints, run.log.positions,
            {"/imu": _imu(run.log.time, run.truth[:, 2], "orientation")})
-    assert len(bags.read_imu(bag, "/imu")[0]) == len(run.log) - 1
-    monkeypatch.setattr(bags, "MAX_IMU_MESSAGES", len(run.log) - 2)
+    assert len(bag_imu.read_imu(bag, "/imu")[0]) == len(run.log) - 1
+    monkeypatch.setattr(bag_imu, "MAX_IMU_MESSAGES", len(run.log) - 2)
     with pytest.raises(LogError, match=rf"/imu: {len(run.log) - 1} messages, more than the {len(run.log) - 2} "):
-        bags.read_imu(bag, "/imu")
+        bag_imu.read_imu(bag, "/imu")
 
 
 def test_read_imu_yaw_converts_a_chunk_of_quaternions_at_once(tmp_path, monkeypatch):
     """The orientations' yaws are computed once per chunk (before, once per message: 41 calls for 41 messages), the
     values those of the quaternions' yaw one by one."""
-    from wmrkit.odometry import bags
+    from wmrkit.odometry import bag_imu
     from wmrkit.odometry.trajectories import yaw_of_quaternion
 
     t = np.linspace(0.0, 4.0, 41)
@@ -370,8 +371,8 @@ def test_read_imu_yaw_converts_a_chunk_of_quaternions_at_once(tmp_path, monkeypa
     bag = tmp_path / "imu"
     _write(bag, t, ("left.spin",), np.zeros((41, 1)), {"/o": (t, yaw, None)})
     calls = []
-    monkeypatch.setattr(bags, "yaw_of_quaternion", lambda q: calls.append(np.shape(q)) or yaw_of_quaternion(q))
-    chunks = list(bags.read_imu_yaw(bag, "/o", chunk_size=16))
+    monkeypatch.setattr(bag_imu, "yaw_of_quaternion", lambda q: calls.append(np.shape(q)) or yaw_of_quaternion(q))
+    chunks = list(bag_imu.read_imu_yaw(bag, "/o", chunk_size=16))
     assert calls == [(16, 4), (16, 4), (9, 4)]
     np.testing.assert_allclose(np.concatenate([c[1] for c in chunks]), yaw, atol=1e-12)
 

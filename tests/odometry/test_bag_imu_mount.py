@@ -16,7 +16,7 @@ from scipy.spatial.transform import Rotation
 from wmrkit import catalog
 from wmrkit.cli.main import main
 from wmrkit.odometry import simulate
-from wmrkit.odometry.bags import read_imu
+from wmrkit.odometry.bag_imu import read_imu
 from wmrkit.odometry.logs import LogError
 from wmrkit.odometry.synthetic import TwistProfile
 

@@ -17,6 +17,7 @@ from ..odometry.covariance import CrowleyNoise
 from ..odometry.diagnostics import diagnose, imu_check, odometry_name
 from ..odometry.files import first_samples, is_bag, odometry_file
 from ..odometry.header import header_format
+from ..odometry.imu_mount import ASSUMED_LEVEL
 from ..odometry.integrators import METHODS
 from ..odometry.logs import TIME_UNITS
 from ..odometry.model import odometry_model
@@ -90,6 +91,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    help="map a ROS joint name to a robot joint WHEEL.spin/WHEEL.steer (repeat)")
     g.add_argument("--imu", metavar="TOPIC", help="sensor_msgs/Imu topic whose yaw checks the odometry's heading "
                    "(default: the bag's only Imu topic, if it has one)")
+    g.add_argument("--imu-mount", nargs=3, metavar=("ROLL", "PITCH", "YAW"),
+                   help="the IMU's orientation on the robot (URDF/REP-103 rpy, Rz Ry Rx), radians or with 'deg'; "
+                        "overrides the bag's /tf_static (default: /tf_static's, else level)")
     p.add_argument("--chunk-size", type=int, default=1 << 16, help="samples per chunk (memory bound; default 65536)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_estimator_options(p)
@@ -124,12 +128,18 @@ def run(args: argparse.Namespace) -> int:
     for option, value in (("--cpr", args.cpr), ("--gear", args.gear), ("--steer-resolution", steer_res)):
         if value is not None and not (math.isfinite(value) and value > 0):  # the library's messages name its fields
             raise WmrkitError(f"{option} must be a finite number > 0, got {value:g}")
+    mount = None if args.imu_mount is None else [
+        parse_angle(a, f"--imu-mount {n}") for a, n in zip(args.imu_mount, ("ROLL", "PITCH", "YAW"), strict=True)]
     if os.path.isfile(args.log) and not is_bag(args.log) and (args.joint_name or args.topic != "/joint_states"
-                                                               or args.imu is not None):
-        option = "--joint-name" if args.joint_name else "--topic" if args.topic != "/joint_states" else "--imu"
+                                                               or args.imu is not None or mount is not None):
+        option = "--joint-name" if args.joint_name else "--topic" if args.topic != "/joint_states" else \
+            "--imu" if args.imu is not None else "--imu-mount"
         raise WmrkitError(f"{option} applies to ROS 2 bags; LOG {args.log} is read as a CSV log (it would be ignored; "
                           "a CSV's columns are renamed by --column)")
     imu, note = imu_topic(args.log, args.imu) if is_bag(args.log) and os.path.exists(args.log) else (None, None)
+    if mount is not None and imu is None and is_bag(args.log) and os.path.exists(args.log):  # it would be ignored
+        raise WmrkitError(f"--imu-mount applies to the IMU the heading is checked against; {args.log} has "
+                          + ("several Imu topics: choose one with --imu TOPIC" if note else "no Imu topic"))
     if note and imu is None:  # several Imu topics: the heading is not checked, a warning (batch odometry's too)
         warn(note)
     if args.max_gap is not None and not args.max_gap > 0:
@@ -155,7 +165,10 @@ def run(args: argparse.Namespace) -> int:
     slip_model = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None
     what = odometry_name(args.method if slip_model is not None else None, "--weight" if args.weight else None)
     # the IMU read now: a named one that fails is refused before any output is written
-    check, unread = imu_check(args.log, imu, what, named=args.imu is not None) if imu else (None, None)
+    check, unread = imu_check(args.log, imu, what, named=args.imu is not None, mount=mount,
+                              mount_option="--imu-mount") if imu else (None, None)
+    if check and check.mounting.note:  # --imu-mount and the bag's /tf_static disagree
+        warn(check.mounting.note)
     summary = odometry_file(
         robot, args.log, fmt=fmt, method=args.scheme if slip_model is not None else args.method, pose0=pose0,
         sensed=args.sensed, model=slip_model,
@@ -175,9 +188,10 @@ def run(args: argparse.Namespace) -> int:
                                                                joint_names=names), fmt, filtered=filtered)
     for line in diagnosis.warnings:
         warn(line)
-    consistent = diagnosis.consistent
+    consistent, mounted = diagnosis.consistent, None
     if imu is not None:
         imu = check.topic if check and check.checked else None
+        mounted = check.mounting.source if imu else None
         consistent = consistent and not (imu and check.line)
         if note and imu:  # said once checked: an IMU found, then not usable, is only the warning that says so
             print(f"wmrkit: note: {note}", file=sys.stderr)
@@ -185,9 +199,11 @@ def run(args: argparse.Namespace) -> int:
         if line:
             warn(line)
     if args.json:
-        print_json(summary.to_dict() | {"consistent": consistent} | ({"imu": imu} if is_bag(args.log) else {}))
+        print_json(summary.to_dict() | {"consistent": consistent}
+                   | ({"imu": imu, "imu_mount": mounted} if is_bag(args.log) else {}))
     else:
-        print(format_summary(summary))
+        print(format_summary(summary) + (f"\nheading checked against the IMU on {imu}, its mounting "
+                                         f"{'' if mounted == ASSUMED_LEVEL else 'from '}{mounted}" if imu else ""))
     return 0
 
 

@@ -16,9 +16,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..analysis.singularity import robot_size
 from ..couplings import GEAR_BREACH_RTOL, gear_breaches
+from .imu_mount import ImuMounting
 from .logs import JointLog, LogError, LogFormat
 from .model import OdometryModel, wheel_slip
 from .pipeline import OdometrySummary
@@ -215,14 +217,15 @@ class ImuCheck:
     times the check reads (every half :data:`IMU_WINDOW` from the run's first sample, the IMU's first and last
     stamps, the run's last sample), so the log is read once and memory stays small; then :meth:`judge`.
 
-    The IMU's `time` and `yaw` (:func:`~.bags.read_imu`, on `topic` of the bag at `path`) are read before the run;
-    `what` names the odometry judged in the warning (``no-slip``, ``wls``...). `named`: the user chose the IMU, so
-    stamps missing the run's are an error, not a warning.
+    The IMU's `time` and `yaw` (:func:`~.bag_imu.read_imu`, on `topic` of the bag at `path`) are read before the
+    run; `what` names the odometry judged in the warning (``no-slip``, ``wls``...). `named`: the user chose the IMU,
+    so stamps missing the run's are an error, not a warning. `mounting`: the IMU's, and where it came from
+    (:class:`~.imu_mount.ImuMounting`), for the answer to say.
     """
 
     def __init__(self, path: str, topic: str, time: np.ndarray, yaw: np.ndarray, what: str, *,
-                 named: bool) -> None:
-        self.path, self.topic, self.what, self.named = path, topic, what, named
+                 named: bool, mounting: ImuMounting | None = None) -> None:
+        self.path, self.topic, self.what, self.named, self.mounting = path, topic, what, named, mounting
         self.imu = (np.asarray(time, dtype=float), np.asarray(yaw, dtype=float))
         self._start = self._last = None  # the run's first time; its latest (time, heading)
         self._step = imu_step(self.imu[0])
@@ -287,14 +290,17 @@ class ImuCheck:
         self.checked = True
 
 
-def imu_check(path: str, topic: str, what: str, *, named: bool) -> tuple[ImuCheck | None, str | None]:
+def imu_check(path: str, topic: str, what: str, *, named: bool, mount: ArrayLike | None = None,
+              mount_option: str = "mount=") -> tuple[ImuCheck | None, str | None]:
     """The :class:`ImuCheck` of the IMU on `topic` of the bag at `path`, read now (before the run), and None; an IMU
     that cannot be read is a :class:`~.logs.LogError` when `named`, else ``(None, the line saying it is not
-    checked)``."""
-    from .bags import read_imu
+    checked)``. `mount`: the IMU's ``(roll, pitch, yaw)`` [rad] on the robot, overriding the bag's ``/tf_static``
+    (:func:`~.bag_imu.read_imu_yaw`; `mount_option` names it in the check's :class:`~.imu_mount.ImuMounting`)."""
+    from .bag_imu import read_imu_mounted
 
     try:
-        return ImuCheck(path, topic, *read_imu(path, topic), what, named=named), None
+        time, yaw, mounting = read_imu_mounted(path, topic, mount=mount, option=mount_option)
+        return ImuCheck(path, topic, time, yaw, what, named=named, mounting=mounting), None
     except LogError as err:
         if named:
             raise
