@@ -162,3 +162,103 @@ def test_an_imu_changing_frame_is_refused(tmp_path, run):
     with pytest.raises(LogError, match=r"run: /imu message 7: frame_id 'base_link', not the first message's "
                                        r"'imu_link'"):
         read_imu(bag, "/imu")
+
+
+def _rpy(rotation: Rotation) -> list[float]:
+    """URDF's (roll, pitch, yaw) of a rotation, by scipy: intrinsic ZYX angles reversed."""
+    return rotation.as_euler("ZYX")[::-1].tolist()
+
+
+R_TILTED = TILTED[0][2]
+
+
+@pytest.mark.parametrize("kind", ["gyro", "orientation"])
+def test_mount_reads_a_tilted_imu_of_a_bag_without_tf_static(tmp_path, run, kind):
+    """No /tf_static, an IMU tilted on the robot: taken as level its gyro turns 0.42 times the robot (its z only) and
+    its orientation's yaw starts 0.7 rad off; with mount=(roll, pitch, yaw) both are the robot's heading."""
+    bag = tmp_path / "run"
+    _write(bag, run, kind, TILTED, tf=False)
+    heading = run.truth[:, 2]
+    _, level = read_imu(bag, "/imu")
+    _, mounted = read_imu(bag, "/imu", mount=_rpy(R_TILTED))
+    if kind == "gyro":
+        assert abs((level[-1] - level[0]) - (heading[-1] - heading[0])) > 0.1
+        assert np.max(np.abs(level - (heading - heading[0]))) > 0.5
+        np.testing.assert_allclose(mounted, heading - heading[0], atol=5e-3)
+    else:
+        assert abs(level[0] - heading[0] - 0.7) < 1e-9
+        np.testing.assert_allclose(mounted, heading, atol=1e-9)
+
+
+def test_imu_mount_makes_a_tilted_imu_agree_with_the_odometry(capsys, tmp_path, run):
+    """The CLI end to end on the bag above (gyro): without --imu-mount "assumed level (no /tf_static)" and the IMU
+    contradicts the odometry; with it (degrees read as other angle options) consistent, no warning; the text and
+    JSON say where the mounting came from."""
+    bag = tmp_path / "run"
+    _write(bag, run, "gyro", TILTED, tf=False)
+    code, answer, err = _odometry(capsys, bag)
+    assert code == 0 and answer["imu"] == "/imu" and answer["imu_mount"] == "assumed level (no /tf_static)"
+    assert not answer["consistent"] and "contradicts the IMU on /imu" in answer["warnings"][0]
+    roll, pitch, yaw = _rpy(R_TILTED)
+    code, answer, err = _odometry(capsys, bag, "--imu-mount", repr(roll), f"{math.degrees(pitch)!r} deg", repr(yaw))
+    assert code == 0 and answer["consistent"] and answer["warnings"] == [] and "warning" not in err
+    assert answer["imu"] == "/imu" and answer["imu_mount"] == "--imu-mount"
+    assert main(["odometry", "diff-drive", str(bag), "--imu-mount", repr(roll), repr(pitch), repr(yaw)]) == 0
+    assert capsys.readouterr().out.endswith("heading checked against the IMU on /imu, its mounting from --imu-mount\n")
+    assert main(["odometry", "diff-drive", str(bag)]) == 0
+    assert capsys.readouterr().out.endswith(
+        "heading checked against the IMU on /imu, its mounting assumed level (no /tf_static)\n")
+
+
+def test_imu_mount_overrides_tf_static_and_says_when_they_disagree(capsys, tmp_path, run):
+    """A bag whose /tf_static says the IMU is on its side while it is tilted: --imu-mount wins, a warning says how far
+    apart the two are (the angle by scipy); one that agrees with /tf_static (90 deg, 0, 0.3) says nothing; an IMU frame
+    /tf_static does not place is read with --imu-mount, not refused."""
+    bag = tmp_path / "wrong-tf"
+    _write(bag, run, "gyro", SIDEWAYS, turned=R_TILTED)
+    code, answer, _ = _odometry(capsys, bag)
+    assert code == 0 and answer["imu_mount"] == "/tf_static" and not answer["consistent"]
+    code, answer, err = _odometry(capsys, bag, "--imu-mount", *map(repr, _rpy(R_TILTED)))
+    assert code == 0 and answer["imu_mount"] == "--imu-mount" and answer["consistent"]
+    (line,) = answer["warnings"]
+    apart = (Rotation.from_euler("z", 0.3) * Rotation.from_euler("x", math.pi / 2)).inv() * R_TILTED
+    assert line.startswith(f"{bag}: /imu: --imu-mount turns the IMU {apart.magnitude():.3g} rad (")
+    assert "from the mounting the bag's /tf_static gives its frame 'imu_link' (roll, pitch, yaw 1.571, 0, 0.3 rad): " \
+           "--imu-mount is used" in line and f"wmrkit: warning: {line}" in err
+    bag = tmp_path / "sideways"
+    _write(bag, run, "gyro", SIDEWAYS)
+    code, answer, _ = _odometry(capsys, bag, "--imu-mount", "90deg", "0", "0.3")
+    assert code == 0 and answer["consistent"] and answer["warnings"] == [] and answer["imu_mount"] == "--imu-mount"
+    bag = tmp_path / "unplaced"
+    _write(bag, run, "gyro", SIDEWAYS, frame="imu_top", turned=R_TILTED)
+    code, answer, _ = _odometry(capsys, bag, "--imu", "/imu", "--imu-mount", *map(repr, _rpy(R_TILTED)))
+    assert code == 0 and answer["consistent"] and answer["warnings"] == [] and answer["imu_mount"] == "--imu-mount"
+
+
+def test_a_bad_imu_mount_is_one_line(capsys, tmp_path, run):
+    """Not three finite angles, on a CSV log, on a bag without an Imu topic: one line, exit 2 (JSON under --json);
+    in Python a ShapeError naming mount, before the bag is read."""
+    from wmrkit.errors import ShapeError
+    from wmrkit.odometry.bags import write_joint_states
+
+    bag = tmp_path / "run"
+    _write(bag, run, "gyro", TILTED, tf=False)
+    code, answer, _ = _odometry(capsys, bag, "--imu-mount", "nan", "0", "0")
+    assert code == 2 and answer["error"].startswith("--imu-mount ROLL: cannot read 'nan' as an angle")
+    code, answer, _ = _odometry(capsys, bag, "--imu-mount", "0", "1e400", "0")
+    assert code == 2 and answer["error"].startswith("--imu-mount PITCH: must be finite")
+    assert main(["odometry", "diff-drive", str(bag), "--imu-mount", "0", "0"]) == 2
+    assert "argument --imu-mount: expected 3 arguments" in capsys.readouterr().err
+    csv = tmp_path / "log.csv"
+    csv.write_text("time,left.spin,right.spin\n0,0,0\n1,1,1\n")
+    code, answer, _ = _odometry(capsys, csv, "--imu-mount", "0", "0", "0")
+    assert code == 2 and answer["error"].startswith("--imu-mount applies to ROS 2 bags")
+    plain = tmp_path / "no-imu"
+    write_joint_states(plain, run.log)
+    code, answer, _ = _odometry(capsys, plain, "--imu-mount", "0", "0", "0")
+    assert code == 2 and answer["error"] == f"--imu-mount applies to the IMU the heading is checked against; {plain} " \
+                                            "has no Imu topic"
+    for mount, said in (((math.nan, 0, 0), r"mount: angles must be finite"), ((0.0, 0.0), r"mount: expected shape"),
+                        ("0 0 0", r"mount: got the text"), (np.zeros((2, 3)), r"mount: expected 3 angles")):
+        with pytest.raises(ShapeError, match=said):
+            read_imu(tmp_path / "no-such-bag", "/imu", mount=mount)

@@ -55,7 +55,7 @@ def _imu_chunks(path: str | os.PathLike[str], topic: str, mount: ArrayLike | Non
                 said: list[ImuMounting]) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """:func:`read_imu_yaw`, appending the IMU's mounting to `said` at its first message (`option` names `mount`)."""
     if mount is not None:
-        quaternion_rpy(mount, option.rstrip("="))  # refused before the bag is opened
+        quaternion_rpy(mount, option.rstrip("="))  # refused before the bag is opened (at the first chunk asked)
     source = os.fspath(path)
     where = f"{source}: {topic}"
     reader, ts = _open(source), _typestore()
@@ -122,6 +122,8 @@ def read_imu_mounted(path: str | os.PathLike[str], topic: str, *, mount: ArrayLi
         return LogError(f"{where}: {count} messages, more than the {most} the IMU check holds in memory "
                         f"({MAX_TABLE_SIZE} bytes, docs/limits.md)")
 
+    if mount is not None:
+        quaternion_rpy(mount, option.rstrip("="))  # refused before the bag is opened
     if (count := bag_message_count(path, topic)) > most:
         raise too_many(count)
     said: list[ImuMounting] = []
