@@ -3,8 +3,9 @@
 One module per concept: :mod:`.encoders` (counts to radians), :mod:`.model` (the sensed direct model over samples,
 (4.11)), :mod:`.integrators` (exact SE(2), RK2, Euler, 002 (15)), :mod:`.covariance` (003 (17), propagation),
 :mod:`.calibration`, :mod:`.logs` (CSV), :mod:`.steering` (headings in files, β inside), :mod:`.trajectories`
-(CSV, TUM), :mod:`.bags` (ROS 2), :mod:`.pipeline` (streaming), :mod:`.files` (what the CLI calls),
-:mod:`.diagnostics` (the warnings after a run over a log),
+(CSV, TUM), :mod:`.bags` (ROS 2), :mod:`.bag_imu` and :mod:`.imu_mount` (a bag's IMU, its mounting),
+:mod:`.pipeline` (streaming), :mod:`.files` (what the CLI calls), :mod:`.diagnostics` (the warnings after a run over a
+log),
 :mod:`.synthetic` (test data). See ``docs/odometry.md``.
 """
 
