@@ -279,13 +279,22 @@ def run_track(args: argparse.Namespace) -> int:
         warn(f"wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg {when} and was held at "
              "its end: the robot cannot follow this reference there (its wheels scrub; the tracking errors are the "
              "result)")
+    for v in run.held_off_axle():  # no twist_miss through the dynamics
+        moved = (f"so the kinematic loop moved the robot with the least-squares twist of its wheels, up to "
+                 f"{v['twist_miss'][0]:.3g} m/s and {v['twist_miss'][1]:.3g} rad/s off the commanded one"
+                 if "twist_miss" in v else "and through the dynamics their tyres slip sideways")
+        warn(f"the {v['coupling']} held wheel{'s' if len(v['wheels']) > 1 else ''} "
+             f"{', '.join(repr(w) for w in v['wheels'])} up to {math.degrees(v['axle_miss']):.3g} deg off the axles "
+             f"the commanded twist needs for {v['duration']:.3g} s (t = {v['from']:.4g} to {v['to']:.4g} s): that "
+             f"twist is not realisable without the wheels scrubbing, {moved}; the tracking errors are the result")
     for c, ok in zip(robot.couplings, run.commands.in_gear.all(axis=0).tolist(), strict=True):
-        if not ok:  # the kinematic plants drive each joint on its own; the dynamics hold the gear
+        if not ok:  # the kinematic plants hold a gear of steering joints only; the dynamics hold every gear
             warn(f"the commands turn the joints of {c.channel_name} out of its ratios (ratios "
                  f"{', '.join(f'{k:g}' for k in c.ratios)}); " + (
                      "the dynamics hold the gear, so its servos fight and the robot cannot follow them"
-                     if args.dynamics else "the kinematic loop does not model gear couplings, so the real robot "
-                     "cannot drive this run (--dynamics holds the gear)"))
+                     if args.dynamics else "the kinematic loop holds the ratios of steering joints only, not these "
+                     "(it moved the robot as commanded), so the real robot cannot drive this run (--dynamics holds "
+                     "the gear)"))
     slipping = [] if args.dynamics else run.slip_violations()  # the dynamics' tyres do slip, and show it
     if slipping:
         warn(f"wheel{'s' if len(slipping) > 1 else ''} {', '.join(repr(v['wheel']) for v in slipping)} must slip "

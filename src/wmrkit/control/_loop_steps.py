@@ -147,5 +147,8 @@ def _record_held(sim: _Sim, t: float, x: np.ndarray, split, twist: np.ndarray, p
     beta = np.where(sim.passive, beta, prev)  # castors: integrated state; steered wheels: the last angle given
     cmd = sim.commands(twist, beta)
     actual = sim.actual_beta(cmd.target, beta, ls)
-    return {"t": t, "pose": pose.copy(), "twist": np.asarray(twist, dtype=float), "beta": actual,
-            "target": cmd.target, "in_range": cmd.fits}
+    out = {"t": t, "pose": pose.copy(), "twist": np.asarray(twist, dtype=float), "beta": actual,
+           "target": cmd.target, "in_range": cmd.fits}
+    if sim.plant.loops is None:  # the ideal plant: the twist its wheels move it with (the loops add their lag)
+        out["moved"] = sim.realised(out["twist"], actual)[0]
+    return out

@@ -121,7 +121,8 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
     Continuous time (``period`` None; RK45 with `rtol`/`atol`, sampled every `output_dt`: :func:`_integrate`) or
     discrete (commands held for `period` [s], pose measured `delay` samples late, ``skew_free`` applies
     :func:`discretize_twist` to the held twist). Returns arrays: ``t (n,)``, ``pose (n, 3)``, ``twist (n, 3)``
-    (commanded), ``beta (n, n_steer)`` (actual steering), ``target (n, n_steer)`` (commanded steering).
+    (commanded), ``beta (n, n_steer)`` (actual steering), ``target (n, n_steer)`` (commanded steering),
+    ``in_range (n, n_steer)`` and, with ideal joints, ``moved (n, 3)`` (the twist the plant moved the robot with).
     ``breaks``: times where the reference is discontinuous; the continuous integration restarts there. `until`
     ``(t, pose) -> bool``: the run ends at the first output sample (or period) where it holds (a path follower that
     has driven its path).
@@ -214,7 +215,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
                 break
             x = _advance(rhs, x, t, period, subs, (held, de), exact)
             history.append(x[:3].copy())
-    return {key: np.array([r[key] for r in records]) for key in ("t", "pose", "twist", "beta", "target", "in_range")}
+    return {key: np.array([r[key] for r in records]) for key in records[0]}
 
 
 def _sampled_steps(plant: Plant, castors: bool, period: float) -> tuple[bool, float, int]:

@@ -233,7 +233,8 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
                        _feasibility(robot, reference, tracked_point, "dynamic" if dynamics else "kinematic",
                                     # a follower slows to its own stop at the path's end, not the reference's
                                     min(t[-1], reference.duration) if geometric else t[-1]),
-                       readonly(np.asarray(heading_from_beta(out["target"], steer_delta))))
+                       readonly(np.asarray(heading_from_beta(out["target"], steer_delta))),
+                       readonly(out["moved"]) if "moved" in out else None)
 
 
 def _limits(robot: Robot, plant: Plant, sampled: float | None, dynamics: bool, slipping: bool,

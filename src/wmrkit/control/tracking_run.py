@@ -14,10 +14,13 @@ from ..robot import Robot
 from ..wheels import wrap_angle
 from .feasibility import Feasibility
 
-__all__ = ["SLIP_TOL", "TrackingRun"]
+__all__ = ["AXLE_MISS_TOL", "SLIP_TOL", "TrackingRun"]
 
 #: Lateral slip [m/s] of a fixed wheel's commands beyond which a run reports it (:meth:`TrackingRun.slip_violations`).
 SLIP_TOL = 1e-6
+#: A wheel of a ``linkage`` or steering ``gear`` whose commanded axle is more than this [rad] (mod pi) off the one the
+#: commanded twist needs is held off it (:meth:`TrackingRun.held_off_axle`): a metre rolled there scrubs 1 um sideways.
+AXLE_MISS_TOL = 1e-6
 #: A commanded heading within this [rad] of an end of its wheel's range is at that end (the keeper sets a linked
 #: wheel there from its leader's end through the law: round-off away).
 AT_END = 1e-9
@@ -54,7 +57,10 @@ class TrackingRun:
       point, in the kinematic framework (the dynamic one through the dynamics), its violations up to the run's end;
       None for a robot Table 8.1 does not apply to (degenerate: the skid steer);
     - ``commanded`` ``(n, n_steer)`` [rad]: the commanded steering headings (the policy, ranges, linkages and gears
-      applied), which ``heading`` follows (at once with ideal joints).
+      applied), which ``heading`` follows (at once with ideal joints);
+    - ``moved`` ``(n, 3)``: the body twist the kinematic plant with ideal joints moved the robot with (``twist``, or
+      the least-squares twist of its wheels where one is held at its range's end or off the commanded twist's axle by
+      a linkage or gear: :meth:`held_off_axle`); None through the dynamics or low-level loops.
     """
 
     robot: Robot
@@ -76,6 +82,7 @@ class TrackingRun:
     beyond_range: np.ndarray | None = None
     feasibility: Feasibility | None = None
     commanded: np.ndarray | None = None
+    moved: np.ndarray | None = None
 
     def range_violations(self) -> list[dict[str, Any]]:
         """Per steered wheel held at the end of its range: ``{"wheel", "from", "to", "duration"}`` ([s]: first
@@ -101,6 +108,35 @@ class TrackingRun:
             held = target[self.beyond_range[:, k] & short[:, k], k]
             out.append({**v, "held_by": by[k], "headings": [float(held.min()), float(held.max())]})
         return sorted(out, key=lambda v: names.index(v["wheel"]))  # stable: a wheel's own end first
+
+    def held_off_axle(self, tol: float = AXLE_MISS_TOL) -> list[dict[str, Any]]:
+        """Per ``linkage`` or steering ``gear`` that held a wheel's axle more than `tol` [rad] (mod pi) off the one the
+        commanded twist needs (the IK's, ``commands``), none of its wheels at the end of its range
+        (:meth:`range_violations` lists those): the commanded twist is not realisable there, the wheels scrub.
+        ``{"coupling", "wheels", "from", "to", "duration", "axle_miss"}`` (its channel name, its steered wheels, the
+        times as :meth:`range_violations`, [rad] the largest miss) and, with :attr:`moved`, ``"twist_miss"``: the
+        largest ``[speed of R [m/s], turn rate [rad/s]]`` of the commanded twist less the one the robot moved with."""
+        if self.commanded is None:
+            return []
+        names = self.robot.steer_names
+        ik = np.asarray(self.commands.heading)[:, [self.robot.wheel_names.index(n) for n in names]]
+        miss = np.abs(np.remainder(ik - self.commanded + 0.5 * np.pi, np.pi) - 0.5 * np.pi)
+        beyond = np.zeros(miss.shape, dtype=bool) if self.beyond_range is None else self.beyond_range
+        by = [_holder(self.robot, n) for n in names]
+        out = []
+        for coupling in dict.fromkeys(b for b in by if b is not None):
+            idx = [k for k, b in enumerate(by) if b == coupling]
+            hit = (miss[:, idx] > tol).any(axis=1) & ~beyond[:, idx].any(axis=1)
+            if not hit.any():
+                continue
+            when = self._intervals((coupling,), hit[:, None])[0]
+            entry = {"coupling": coupling, "wheels": [names[k] for k in idx], "from": when["from"],
+                     "to": when["to"], "duration": when["duration"], "axle_miss": float(miss[hit][:, idx].max())}
+            if self.moved is not None:
+                d = self.twist[hit] - self.moved[hit]
+                entry["twist_miss"] = [float(np.hypot(d[:, 0], d[:, 1]).max()), float(np.abs(d[:, 2]).max())]
+            out.append(entry)
+        return out
 
     def slip_violations(self, tol: float = SLIP_TOL) -> list[dict[str, Any]]:
         """Per fixed wheel whose commands leave a lateral slip (8.14) beyond `tol` [m/s] (a skid steer turning: the
@@ -146,5 +182,6 @@ class TrackingRun:
         if self.slip_model != "none" or self.feedback != "pose":
             out["slip_model"], out["feedback"] = self.slip_model, self.feedback
         out["beyond_steer_range"] = self.range_violations()
+        out["held_off_axle"] = self.held_off_axle()
         out["feasibility"] = None if self.feasibility is None else self.feasibility.to_dict()
         return out

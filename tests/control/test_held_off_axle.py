@@ -1,0 +1,67 @@
+"""A steering gear or linkage that holds its wheels off the axles the commanded twist needs is reported
+(``TrackingRun.held_off_axle``, JSON ``held_off_axle``, a warning of ``wmrkit track``). Before, ``wmrkit track
+geared.json --reference circle --size 3`` (two double wheels whose steering a gear turns 1:2) ended 0.46 m off the
+circle without a word: the gear held the wheels up to 75 deg off the commanded twist's axles and the kinematic loop
+moved the robot with the least-squares twist of its wheels, 1.5 rad/s off the commanded turn rate."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from test_linked_ranges import _geared
+
+from wmrkit import catalog
+from wmrkit.cli.main import main
+from wmrkit.control import builtin_reference
+from wmrkit.control.track import track
+
+GEAR = "gear(front.steer, rear.steer)"
+CIRCLE = builtin_reference("circle", size=3.0)
+
+
+def _axle_miss(robot, twist: np.ndarray, commanded: np.ndarray) -> np.ndarray:
+    """``(n, n_steer)`` [rad]: each steered wheel's commanded heading off the direction its steering axis moves at
+    the commanded `twist` (mod pi), from the wheel positions (brute force: ``v + omega z x p``)."""
+    out = np.zeros(commanded.shape)
+    for k, name in enumerate(robot.steer_names):
+        x, y = robot.wheel(name).position
+        vx, vy = twist[:, 0] - twist[:, 2] * y, twist[:, 1] + twist[:, 2] * x
+        out[:, k] = np.abs([math.remainder(a, math.pi) for a in np.arctan2(vy, vx) - commanded[:, k]])
+    return out
+
+
+def test_a_steering_gear_off_the_commanded_axles_is_reported_with_the_twist_the_robot_moved_with():
+    robot = _geared()
+    run = track(robot, CIRCLE, duration=3.0)
+    (v,) = run.held_off_axle()
+    assert (v["coupling"], v["wheels"], v["from"], v["to"]) == (GEAR, ["front", "rear"], 0.0, 3.0)
+    miss = _axle_miss(robot, run.twist, run.commanded)
+    assert v["axle_miss"] == pytest.approx(miss.max(), abs=1e-9) and v["axle_miss"] > 0.5
+    # the twist the robot moved with, against the poses' own rates (central differences, 0.05 s apart)
+    dpose = np.gradient(run.pose, run.t, axis=0)[1:-1]
+    c, s = np.cos(run.pose[1:-1, 2]), np.sin(run.pose[1:-1, 2])
+    body = np.stack([c * dpose[:, 0] + s * dpose[:, 1], -s * dpose[:, 0] + c * dpose[:, 1], dpose[:, 2]], axis=1)
+    np.testing.assert_allclose(run.moved[1:-1], body, atol=5e-3)
+    assert v["twist_miss"][1] > 1.0  # the commanded turn rate is far from the one the geared wheels give
+    assert json.loads(json.dumps(run.to_dict()))["held_off_axle"] == [v]
+
+
+def test_track_warns_of_a_gear_holding_its_wheels_off_the_commanded_axles(tmp_path, capsys):
+    path = tmp_path / "geared.json"
+    path.write_text(json.dumps(_geared().to_dict()))
+    assert main(["track", str(path), "--reference", "circle", "--size", "3", "--duration", "3", "--json"]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    (said,) = [w for w in answer["warnings"] if GEAR in w]
+    v = answer["held_off_axle"][0]
+    assert said.startswith(f"the {GEAR} held wheels 'front', 'rear' up to {math.degrees(v['axle_miss']):.3g} deg off "
+                           "the axles the commanded twist needs for 3 s (t = 0 to 3 s): that twist is not realisable")
+    assert f"{v['twist_miss'][0]:.3g} m/s and {v['twist_miss'][1]:.3g} rad/s off the commanded one" in said
+
+
+def test_a_linkage_on_the_commanded_axles_is_not_reported():
+    """The catalog car's Ackermann linkage sets both front wheels on the axles of any twist its rear axle allows."""
+    run = track(catalog.load("ackermann"), builtin_reference("circle", size=6.0), duration=5.0)
+    assert run.held_off_axle() == [] and run.moved is not None
