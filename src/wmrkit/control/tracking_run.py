@@ -168,7 +168,9 @@ class TrackingRun:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: ``t``, ``pose`` and ``reference`` as ``(x, y, theta)`` rows, ``tracking_error`` (the
         tracked point's distance from the reference, :attr:`error`; never ``error``, the key of a failure), per-wheel
-        ``heading`` (steering, null for wheels that do not steer) and ``spin`` series and the summary."""
+        ``heading`` (steering, null for wheels that do not steer) and ``spin`` series, the summary,
+        ``beyond_steer_range`` (:meth:`range_violations`), ``held_off_axle`` (:meth:`held_off_axle`) and
+        ``feasibility``."""
         wheels: dict[str, dict[str, Any]] = {}
         steer = self.robot.steer_names
         for i, name in enumerate(self.robot.wheel_names):
