@@ -34,7 +34,7 @@ def test_track_warns_when_its_commands_break_a_gear(tmp_path, capsys):
     err = capsys.readouterr().err
     assert f"the commands turn the joints of {GEAR} out of its ratios (ratios 1, 1)" in err
     # the kinematic loop holds a steering gear's ratios (control.linked_ranges), not a gear of spins
-    assert "the kinematic loop holds the ratios of steering joints only, not these (it moved the robot as" in err
+    assert "the kinematic loop holds the ratios of steering joints only, not these (it drives each on its own)" in err
     assert main(["track", path, "--reference", "line", "--duration", "3"]) == 0  # straight: the axle turns as one
     assert "out of its ratios" not in capsys.readouterr().err
 

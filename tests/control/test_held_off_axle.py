@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from test_linked_ranges import _geared
 
+from geared import SYNCHRO
 from wmrkit import catalog
 from wmrkit.cli.main import main
 from wmrkit.control import builtin_reference
@@ -65,3 +66,20 @@ def test_a_linkage_on_the_commanded_axles_is_not_reported():
     """The catalog car's Ackermann linkage sets both front wheels on the axles of any twist its rear axle allows."""
     run = track(catalog.load("ackermann"), builtin_reference("circle", size=6.0), duration=5.0)
     assert run.held_off_axle() == [] and run.moved is not None
+
+
+def test_feasibility_says_a_linkage_or_steering_gear_that_steers_wheels_together_is_not_considered(tmp_path, capsys):
+    """A synchro drive (three wheels on one parallel linkage: it cannot turn) answered "feasible: yes" to a circle
+    without a word of its linkage; the geared units' warning sent the user to ``wmrkit ik``, which does not check a
+    steering gear's angles (it answers "feasible: yes" to headings out of the ratios)."""
+    synchro, geared = tmp_path / "synchro.yaml", tmp_path / "geared.json"
+    synchro.write_text(SYNCHRO)
+    geared.write_text(json.dumps(_geared().to_dict()))
+    said = "is not considered: Table 8.1 judges the wheels alone, each steered on its own, and it steers them together"
+    assert main(["feasibility", str(synchro), "--reference", "circle"]) == 0
+    assert f"linkage(a.steer, b.steer, c.steer) {said}" in capsys.readouterr().err
+    assert main(["feasibility", str(geared), "--reference", "circle", "--size", "3"]) == 0
+    err = capsys.readouterr().err
+    assert f"{GEAR} {said}" in err and "wmrkit ik" not in err
+    assert main(["feasibility", "ackermann", "--reference", "circle"]) == 0  # its linkage sets the axles d asks
+    assert capsys.readouterr().err == ""

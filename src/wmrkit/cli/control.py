@@ -293,8 +293,8 @@ def run_track(args: argparse.Namespace) -> int:
                  f"{', '.join(f'{k:g}' for k in c.ratios)}); " + (
                      "the dynamics hold the gear, so its servos fight and the robot cannot follow them"
                      if args.dynamics else "the kinematic loop holds the ratios of steering joints only, not these "
-                     "(it moved the robot as commanded), so the real robot cannot drive this run (--dynamics holds "
-                     "the gear)"))
+                     "(it drives each on its own), so the real robot cannot drive this run (--dynamics holds the "
+                     "gear)"))
     slipping = [] if args.dynamics else run.slip_violations()  # the dynamics' tyres do slip, and show it
     if slipping:
         warn(f"wheel{'s' if len(slipping) > 1 else ''} {', '.join(repr(v['wheel']) for v in slipping)} must slip "
@@ -357,6 +357,7 @@ def run_feasibility(args: argparse.Namespace) -> int:
     """Print the Table 8.1 requirement and every violation with its remedy; exit 1 when there is one (the answer is
     no)."""
     from ..control.feasibility import feasibility
+    from ..control.tracking_run import steers_together
 
     check_plot_path(args.plot)
     robot = load_robot(args.robot)
@@ -366,10 +367,21 @@ def run_feasibility(args: argparse.Namespace) -> int:
     result = feasibility(robot, reference, args.framework, point=point)
     if result.requirement.note:  # a skid steer, judged as a differential drive
         warn(result.requirement.note)
-    for c in robot.couplings:
-        if c.kind == "gear":  # Table 8.1 classifies the wheels' geometry only
+    fewer = None  # whether the linkages command fewer steering angles than the wheels' steerability d
+    for c in robot.couplings:  # Table 8.1 classifies the wheels' geometry only
+        if c.kind == "gear" and not steers_together(c):
             warn(f"{c.channel_name} is not considered: Table 8.1 judges the wheels alone; check the reference's "
                  "twists with 'wmrkit ik' (a gear may forbid them)")
+        elif steers_together(c):
+            if c.kind == "linkage" and fewer is None:
+                from ..analysis.classification import classify
+
+                k = classify(robot)
+                fewer = k.commanded_steerability < k.steerability
+            if c.kind == "gear" or fewer:
+                warn(f"{c.channel_name} is not considered: Table 8.1 judges the wheels alone, each steered on its "
+                     "own, and it steers them together, so it may forbid the reference's twists; 'wmrkit track' "
+                     "says where it holds the wheels off the axles the commanded twist needs")
     if args.plot:
         from ..control.plots import plot_feasibility
 

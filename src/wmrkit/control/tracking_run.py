@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from ..couplings import Coupling
 from ..kinematics.wheel_ik import WheelCommands
 from ..robot import Robot
 from ..wheels import wrap_angle
@@ -26,12 +27,16 @@ AXLE_MISS_TOL = 1e-6
 AT_END = 1e-9
 
 
+def steers_together(coupling: Coupling) -> bool:
+    """Whether `coupling` is a ``linkage`` or ``gear`` holding the steering of two or more wheels together."""
+    return coupling.kind in ("linkage", "gear") and sum(j.endswith(".steer") for j in coupling.joints) > 1
+
+
 def _holder(robot: Robot, wheel: str) -> str | None:
     """The ``linkage`` or ``gear`` coupling that holds `wheel`'s steering with another wheel's, by its channel name,
     or None."""
     for c in robot.couplings:
-        if c.kind in ("linkage", "gear") and f"{wheel}.steer" in c.joints and sum(
-                j.endswith(".steer") for j in c.joints) > 1:
+        if steers_together(c) and f"{wheel}.steer" in c.joints:
             return c.channel_name
     return None
 
