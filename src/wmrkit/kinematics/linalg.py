@@ -44,8 +44,14 @@ def matrix_rank(m: ArrayLike, *, rtol: float = RANK_RTOL) -> np.ndarray:
     if m.shape[-1] == 0 or m.shape[-2] == 0:
         return np.zeros(m.shape[:-2], dtype=int)
     s = np.linalg.svd(m, compute_uv=False)
-    scale = np.maximum(s[..., :1], 1.0)
-    return np.sum(s > rtol * max(m.shape[-2:]) * scale, axis=-1)
+    return np.sum(s > rank_cutoff(s, m.shape, rtol), axis=-1)
+
+
+def rank_cutoff(s: np.ndarray, shape: tuple[int, ...], rtol: float = RANK_RTOL) -> np.ndarray:
+    """The singular value at and below which :func:`matrix_rank` counts one as 0, ``(..., n) -> (..., 1)``: `s` the
+    singular values (descending) of matrices of `shape` ``(..., r, c)``; ``rtol * max(r, c) * max(s_max, 1)``.
+    The one rank tolerance, shared by the least squares of :func:`solve_assigned` given an `rtol`."""
+    return rtol * max(shape[-2:]) * np.maximum(s[..., :1], 1.0)
 
 
 def free_columns(m: ArrayLike, *, rtol: float = RANK_RTOL) -> np.ndarray:
@@ -199,7 +205,7 @@ def delta_projector(m: ArrayLike) -> np.ndarray:
 
 
 def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike,
-                   name: str = "q_assigned") -> tuple[np.ndarray, np.ndarray]:
+                   name: str = "q_assigned", *, rtol: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Ranks-method solution (4.9)-(4.11): the velocities not assigned, by least squares, and the residual.
 
     ``a``: ``(..., R, k)`` slip matrix (3.22); ``assigned``: column indices (n_a,); ``q_assigned``:
@@ -207,7 +213,11 @@ def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike,
     copied in) and ``a @ q_dot`` ``(..., R)``, zero when the assignment is consistent with no slip; its norm is
     the slip indicator of (4.11)/(4.82). Uses the pseudo-inverse, so a non-assignable set returns the
     minimum-norm solution rather than failing: check assignability with ``matrix_rank`` (4.10). `name` names
-    ``q_assigned`` when its batch shape does not broadcast with ``a``'s.
+    ``q_assigned`` when its batch shape does not broadcast with ``a``'s. With `rtol` (on a nondimensional matrix:
+    :func:`robot_solve`, :func:`~.ranks.ranks_solution`) the pseudo-inverse drops the singular values
+    :func:`matrix_rank` counts as 0 with that `rtol` (:func:`rank_cutoff`), so a direction the rank tests call
+    undetermined is not solved from round-off; without, only those numpy's least squares drops (``eps``), the
+    answer for a matrix in any units.
     """
     a = np.asarray(a, dtype=float)
     assigned = np.asarray(assigned, dtype=int)
@@ -216,13 +226,17 @@ def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike,
     free_mask[assigned] = False
     free = np.flatnonzero(free_mask)  # (np.setdiff1d costs ~20 us, a quarter of a small solve)
     a_na, a_a = a[..., free], a[..., assigned]
-    if a.ndim == 2 and len(free) and len(assigned) and q_assigned.size:  # one matrix: LAPACK least squares on
-        rhs = -(a_a @ q_assigned.reshape(-1, len(assigned)).T)  # every right-hand side at once; same minimum-norm
-        # solution, ~1.7x faster (an empty batch takes the general path: LAPACK refuses zero right-hand sides)
-        q_na = _min_norm_lstsq(a_na, rhs).T.reshape(*q_assigned.shape[:-1], len(free))
+    one = a.ndim == 2 and len(free) and len(assigned) and q_assigned.size
+    if one and rtol is None:  # one matrix: LAPACK least squares on every right-hand side at once; same minimum-norm
+        rhs = -(a_a @ q_assigned.reshape(-1, len(assigned)).T)  # solution, ~1.7x faster (an empty batch takes the
+        q_na = _min_norm_lstsq(a_na, rhs).T.reshape(*q_assigned.shape[:-1], len(free))  # general path: LAPACK
+        # refuses zero right-hand sides)
+    elif one:
+        rhs = -(a_a @ q_assigned.reshape(-1, len(assigned)).T)
+        q_na = (_pinv(a_na, rtol) @ rhs).T.reshape(*q_assigned.shape[:-1], len(free))
     else:
         rhs = -matvec(a_a, q_assigned, name)[..., None]
-        q_na = (np.linalg.pinv(a_na) @ rhs)[..., 0]
+        q_na = ((np.linalg.pinv(a_na) if rtol is None else _pinv(a_na, rtol)) @ rhs)[..., 0]
     batch = np.broadcast_shapes(q_na.shape[:-1], q_assigned.shape[:-1])
     q = np.empty((*batch, a.shape[-1]))
     q[..., free] = q_na
@@ -231,21 +245,50 @@ def solve_assigned(a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike,
 
 
 def geared_solve(a: ArrayLike, couplings: tuple, names: tuple[str, ...], assigned: ArrayLike, q_assigned: ArrayLike,
-                 name: str = "q_assigned") -> tuple[np.ndarray, np.ndarray]:
+                 name: str = "q_assigned", *, rtol: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """:func:`solve_assigned` with the robot's ``gear`` couplings held: the joints a gear turns with assigned ones
     filled (:func:`wmrkit.couplings.gear_fill`), and a gear with no assigned joint one unknown, its turn
-    (:func:`wmrkit.couplings.gear_free`). `names`: the columns of `a`. Without a gear, :func:`solve_assigned`."""
+    (:func:`wmrkit.couplings.gear_free`). `names`: the columns of `a`. Without a gear, :func:`solve_assigned`
+    (`rtol` as there)."""
     from ..couplings import gear_unknowns
 
     assigned = tuple(int(c) for c in np.asarray(assigned, dtype=int).reshape(-1))
     if not any(c.kind == "gear" for c in couplings):
-        return solve_assigned(a, assigned, q_assigned, name)
+        return solve_assigned(a, assigned, q_assigned, name, rtol=rtol)
     a = np.asarray(a, dtype=float)
     free, given = gear_unknowns(couplings, names, assigned)  # q = free @ p + given @ q_assigned
     p = free.shape[1]
     x, residual = solve_assigned(np.concatenate([a @ free, a @ given], axis=-1), np.arange(p, p + len(assigned)),
-                                 q_assigned, name)
+                                 q_assigned, name, rtol=rtol)
     return x[..., :p] @ free.T + x[..., p:] @ given.T, residual
+
+
+def decision_matrix(robot: Robot, a: ArrayLike, assigned: tuple[int, ...]) -> tuple[np.ndarray, bool]:
+    """`robot`'s slip matrix `a` ``(..., R, k)`` (3.22) in the velocities of :func:`nondimensional` (row units
+    ``1 / L``), and of the wheels' :func:`centroid` (:func:`centred`) when no twist component is among the
+    `assigned` columns: the matrix the rank decisions and the least squares of :func:`robot_solve` and
+    ``twist_is_determined`` are made on, the same at any scale and, for a whole unknown twist, in any frame.
+    Returns it and whether it was centred."""
+    unit = np.asarray(a, dtype=float) / (velocity_scale(robot) * characteristic_length(robot))
+    whole = not any(c < 3 for c in assigned)
+    return (centred(robot, unit) if whole else unit), whole
+
+
+def robot_solve(robot: Robot, a: ArrayLike, assigned: ArrayLike, q_assigned: ArrayLike,
+                name: str = "q_assigned") -> tuple[np.ndarray, np.ndarray]:
+    """:func:`geared_solve` of `robot`'s slip matrix `a` ``(..., R, k)`` made on its :func:`decision_matrix`, the
+    answer back in `robot`'s velocities: ``(q_dot (..., k), residual (..., R) [m/s])``. Its rank decisions are those
+    of ``twist_is_determined`` (one tolerance, :func:`rank_cutoff`), whatever the robot's scale and frame."""
+    assigned = tuple(int(c) for c in np.asarray(assigned, dtype=int).reshape(-1))
+    unit, whole = decision_matrix(robot, a, assigned)
+    scale, size = velocity_scale(robot), characteristic_length(robot)
+    q, residual = geared_solve(unit, robot.couplings, robot.velocity_names, assigned,
+                               np.asarray(q_assigned, dtype=float) * scale[list(assigned)], name, rtol=RANK_RTOL)
+    if whole:  # the centroid's twist back to the origin's (the inverse of centred_twist)
+        cx, cy = centroid(robot)
+        q[..., 0] += q[..., 2] * cy / size
+        q[..., 1] -= q[..., 2] * cx / size
+    return q / scale, residual * size
 
 
 def geared_twist_determined(a: np.ndarray, couplings: tuple, names: tuple[str, ...],
@@ -310,6 +353,16 @@ def rref(m: ArrayLike, *, rtol: float = RANK_RTOL) -> tuple[np.ndarray, np.ndarr
         pivots[b, j] = True
         next_row[b] += 1
     return out.reshape(m.shape), pivots.reshape(*m.shape[:-2], n_cols)
+
+
+def _pinv(a: np.ndarray, rtol: float) -> np.ndarray:
+    """Pseudo-inverse ``(..., r, c) -> (..., c, r)`` dropping the singular values at or below :func:`rank_cutoff`."""
+    if a.shape[-1] == 0 or a.shape[-2] == 0:
+        return np.zeros((*a.shape[:-2], a.shape[-1], a.shape[-2]))
+    u, s, vt = np.linalg.svd(a, full_matrices=False)
+    keep = s > rank_cutoff(s, a.shape, rtol)
+    inverse = np.divide(1.0, s, out=np.zeros_like(s), where=keep)
+    return np.swapaxes(vt, -1, -2) @ (inverse[..., None] * np.swapaxes(u, -1, -2))
 
 
 def _min_norm_lstsq(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .linalg import matrix_rank, solve_assigned
+from .linalg import RANK_RTOL, matrix_rank, solve_assigned
 
 
 def ranks_assignable(a: ArrayLike, subsets: ArrayLike) -> np.ndarray:
@@ -31,10 +31,11 @@ def ranks_solution(a: ArrayLike, assigned: ArrayLike) -> np.ndarray:
     """The matrix of the kinematic solution (4.11), ``q_na = -(A_na^T A_na)^-1 A_na^T A_a q_a``.
 
     ``(..., R, k), (n_a,) -> (..., k - n_a, n_a)``, rows in ascending column order. Computed with
-    :func:`~wmrkit.kinematics.linalg.solve_assigned` (pseudo-inverse), one unit assigned vector per column.
+    :func:`~wmrkit.kinematics.linalg.solve_assigned` (pseudo-inverse, the rank tolerance of :func:`ranks_assignable`),
+    one unit assigned vector per column.
     """
     a = np.asarray(a, dtype=float)
     assigned = np.asarray(assigned, dtype=int).reshape(-1)
     free = np.setdiff1d(np.arange(a.shape[-1]), assigned)
-    q, _ = solve_assigned(a[..., None, :, :], assigned, np.eye(len(assigned)))  # (..., n_a, k)
+    q, _ = solve_assigned(a[..., None, :, :], assigned, np.eye(len(assigned)), rtol=RANK_RTOL)  # (..., n_a, k)
     return np.swapaxes(q[..., free], -1, -2)

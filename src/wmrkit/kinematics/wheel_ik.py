@@ -26,7 +26,7 @@ from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
 from ._ik_fast import wrap_angle
 from .gear_check import GEAR_RTOL, contact_lever, gear_table, gears_hold, given_gear_breaches
-from .linalg import geared_solve, geared_twist_determined, robot_size
+from .linalg import decision_matrix, geared_twist_determined, robot_size, robot_solve
 from .linkage_check import LinkageAngleWarning, given_breaches, linkage_holds
 
 __all__ = ["GEAR_RTOL", "WheelCommands", "forward_kinematics", "gear_error", "resolve_rate_name", "twist_is_determined",
@@ -328,8 +328,7 @@ def forward_kinematics(
         raise ShapeError(f"rates: the rates' shapes do not broadcast together: {shapes}") from None
     q_assigned = np.stack(values, axis=-1)
     _check_finite_rates(list(given), q_assigned)
-    q_dot, slip = geared_solve(robot.constraint_matrix(beta, heading=heading), robot.couplings, robot.velocity_names,
-                               columns, q_assigned, "rates")
+    q_dot, slip = robot_solve(robot, robot.constraint_matrix(beta, heading=heading), columns, q_assigned, "rates")
     return readonly(q_dot[..., :3]), readonly(np.linalg.norm(slip, axis=-1))
 
 
@@ -373,13 +372,16 @@ def forward_kinematics_check(
     (:data:`wmrkit.couplings.GEAR_EXACT_RTOL`) by more than :data:`SLIP_TOL` at a contact: each such gear is named in
     ``out_of_gear``, with a :class:`~wmrkit.couplings.GearWarning`; nor is a steering that breaks a held ``linkage``'s
     law by more than ``asin(rtol)`` (a wheel so set would slip at that fraction of its speed: ``out_of_linkage``, a
-    :class:`~wmrkit.kinematics.linkage_check.LinkageAngleWarning`).
+    :class:`~wmrkit.kinematics.linkage_check.LinkageAngleWarning`). `rtol`: a fraction in [0, 1], else
+    :class:`~wmrkit.errors.ShapeError`.
     """
+    if not (finite_number(rtol) and not isinstance(rtol, bool) and 0.0 <= rtol <= 1.0):
+        raise ShapeError(f"rtol: expected a fraction of the fastest wheel's speed in [0, 1], got {rtol!r}")
     columns = _assigned_columns(robot, list(rates))
     q_assigned = np.array([float(_rate_value(k, v)) for k, v in rates.items()])
     _check_finite_rates(list(rates), q_assigned)
     a = robot.constraint_matrix(beta, heading=heading)
-    q_dot, slip = geared_solve(a, robot.couplings, robot.velocity_names, columns, q_assigned)
+    q_dot, slip = robot_solve(robot, a, columns, q_assigned)
     owner = robot.row_wheels
     wheel_slip = np.sqrt(np.bincount(owner, weights=slip**2, minlength=len(robot.wheels)))
     speeds = [abs(v) * _speed_per_rate(robot, n)
@@ -424,9 +426,9 @@ def twist_is_determined(robot: Robot, names: list[str] | tuple[str, ...], beta: 
     those of the unknown joint rates, ``n_twist_free`` the twist components not assigned.
     """
     columns = _assigned_columns(robot, list(as_names(names, "names", "joint rate names", UnknownNameError)))
-    a = robot.constraint_matrix(beta, heading=heading)
-    return readonly(np.asarray(geared_twist_determined(a, robot.couplings, robot.velocity_names,
-                                                       tuple(columns.tolist()))))
+    assigned = tuple(columns.tolist())
+    a = decision_matrix(robot, robot.constraint_matrix(beta, heading=heading), assigned)[0]
+    return readonly(np.asarray(geared_twist_determined(a, robot.couplings, robot.velocity_names, assigned)))
 
 
 def _assigned_columns(robot: Robot, names: list[str]) -> np.ndarray:
