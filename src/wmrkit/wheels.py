@@ -198,7 +198,13 @@ class Wheel:
     def with_heading(self, heading: float) -> Wheel:
         """The same wheel steered to rolling direction `heading` [rad] (0 = forward along +x)."""
         heading = as_angles([heading], 1, f"{self.name}: heading")[0]
-        return replace(self, beta=float(beta_from_heading(heading, self.delta)))
+        beta = float(beta_from_heading(heading, self.delta))
+        if abs(beta) > MAX_ANGLE:  # a heading within the limit whose beta is not: named as the user gave it
+            edge = math.copysign(MAX_ANGLE, beta) + self.delta - HALF_PI
+            raise WheelError(f"wheel '{self.name}': heading: {heading / (2 * math.pi):.10g} turns is beyond "
+                             f"{edge / (2 * math.pi):.10g} turns, where the thesis's beta (heading - delta + 90 deg) "
+                             f"reaches the {MAX_TURNS:g}-turn limit of every angle (no angle to steer by)")
+        return replace(self, beta=beta)
 
     def elements(self) -> tuple[Element, ...]:
         """The contact elements this wheel expands into (see module docstring)."""

@@ -115,6 +115,9 @@ def _headline(a: Analysis) -> str:
     text = f"Type {c.type} of the thesis's Table 5.1 ({c.name}): m = {c.mobility}, d = {c.steerability}. It {what}."
     if c.coordinated:
         text += " Its steered wheels must be coordinated (all axles through one point) or the wheels slip."
+    if a.linked is not None and not a.linked.every:
+        text += (f" Its steering linkages leave m = {a.linked.mobility}, d = {a.linked.steerability}: "
+                 f"{a.linked.words}; the type is of its wheels alone.")
     return text
 
 
@@ -127,6 +130,8 @@ def _summary_table(a: Analysis) -> str:
         ("degree of steerability d (5.14)", c.steerability),
         ("steerability its steering linkages command", c.commanded_steerability),
         ("mobility with its gear couplings", a.coupled_mobility),
+        *([] if a.linked is None else [("with its steering linkages held (m, d)",
+                                        f"{a.linked.mobility}, {a.linked.steerability}: {a.linked.words}")]),
         ("actuation (ch. 4)", f"{actuation_words(a.actuation)}: {a.actuation['verdict']}"),
         ("sensing (ch. 4)", f"{'sufficient' if a.sensing['sufficient'] else 'insufficient'}: {a.sensing['verdict']}"),
     ]

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..couplings import channel_names, gear_fill
 from ..errors import WmrkitError
-from ..kinematics.actuation import actuation_analysis
+from ..kinematics.actuation import actuation_analysis, actuator_names
 from ..kinematics.sensing import sensing_analysis
 from ..limits import check_length
 from ..robot import Robot
@@ -26,7 +26,7 @@ from .classification import Classification, classify, instantaneous_mobility
 from .coordinated import coordinated_singular_set
 from .icr import ICRSet, icr
 from .isotropy import described_condition, length_applies
-from .linkage_reach import unreachable, unreachable_note
+from .linkage_reach import LinkedReach, linked_reach, unreachable, unreachable_note
 from .singularity import SingularSet, singular_set
 
 
@@ -49,6 +49,9 @@ class Analysis:
     #: use a gear), comparable with the type line's m, the thesis's, of the wheels alone: the verdicts' k - rank A
     #: also counts the motions of a double wheel's joints with the body at rest
     coupled_mobility: int
+    #: what the held steering ``linkage`` couplings leave of the ICRs the wheels allow (None without one): the
+    #: classification above is the thesis's, of the wheels' geometry alone (:mod:`.linkage_reach`)
+    linked: LinkedReach | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary (SI units, radians); the keys of ``wmrkit analyze --json``."""
@@ -70,6 +73,7 @@ class Analysis:
             "characteristic_length": self.characteristic_length if self.has_length else None,
             "condition_joints": list(self.joints), "natural_length": self.natural,
             "singular": {k: singular_dict(s, self.robot) for k, s in self.singular.items()},
+            "linkages": None if self.linked is None else self.linked.to_dict(),
         }
 
     @property
@@ -116,11 +120,13 @@ class Analysis:
         g = self.gear_mobility
         gears = "" if g is None else f"; its gear couplings leave m = {g} (couplings)"
         lines = [f"{r.name}: {c.describe()}{gears}"]
+        if self.linked is not None and not self.linked.every:  # the type line is the wheels' geometry alone
+            lines.append(f"  {self.linked.describe()}; the type is of the wheels alone (thesis Table 5.1)")
         if self.instantaneous_mobility != c.mobility:
             lines.append(f"  at the described steering: m = {self.instantaneous_mobility}")
         lines += [f"  {s.description}" for s in c.special]
         lines.append(f"  {self.icr.describe()}")
-        actuators = channel_names(r.couplings, r.actuated)  # a differential's joints are one actuator
+        actuators = actuator_names(r, r.actuated)  # a differential's, a linkage's joints are one actuator
         lines.append(f"  actuation: {actuation_words(self.actuation)} ({', '.join(actuators) or 'nothing declared'})")
         lines.append(f"  sensing: {_yes(self.sensing['sufficient'], 'sufficient', 'insufficient')} "
                      f"({', '.join(r.sensed) or 'nothing declared'})")
@@ -230,7 +236,7 @@ def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) 
     ``--resolution``).
     """
     check_resolution(resolution)
-    here = described_analysis(robot, length=length)
+    here = described_analysis(robot, length=length, resolution=resolution)
     cls = here.classification
     sensed = model_rates(robot, robot.sensed)  # with the rates a gear turns with them, known as fk knows them
     sensed = tuple(robot.rate_names[c] for c in gear_fill(robot.couplings, robot.rate_names,
@@ -240,9 +246,10 @@ def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) 
     return dataclasses.replace(here, singular=singular)
 
 
-def described_analysis(robot: Robot, *, length: float | None = None) -> Analysis:
+def described_analysis(robot: Robot, *, length: float | None = None, resolution: int = 90) -> Analysis:
     """:func:`analyze` without the singular sets over the steering space (``singular`` empty): the studio's
-    per-edit analysis, the same numbers (type, ICR and condition number with the gears held)."""
+    per-edit analysis, the same numbers (type, ICR and condition number with the gears held, the ICRs the
+    linkages leave on a grid of `resolution` points per turn)."""
     cls = classify(robot)
     if length is not None:  # as analyze --length: at 1e-9 m the twist read as undetermined
         check_length(length, WmrkitError)
@@ -254,4 +261,5 @@ def described_analysis(robot: Robot, *, length: float | None = None) -> Analysis
          "verdict": str(act.verdict)},
         {"sufficient": bool(np.all(sen.sufficient)), "verdict": str(sen.verdict)},
         joints, kappa, d, length is None, {}, int(instantaneous_mobility(robot, geared=True)),
+        linked_reach(robot, resolution),
     )

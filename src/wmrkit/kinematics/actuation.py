@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, matvec, readonly
-from ..couplings import coupled_columns, gear_fill, gear_free, linked_steering
+from ..couplings import channel_names, coupled_columns, gear_fill, gear_free, linked_steering
 from ..errors import SingularError
 from ..robot import TWIST_NAMES, Robot
 from .linalg import coupled_constraints, matrix_rank, nondimensional
@@ -148,6 +148,8 @@ class ActuationAnalysis:
     #: (...) bool: the twist fixes the actuated rates, so (4.26) is their solution; False where some of them also turn
     #: joints with the body at rest (a drive unit's two spins steer it on the spot, 4.69): many rates give one twist
     inverse_determined: np.ndarray
+    #: the steering actuators: a ``linkage``'s joints one (its channel, ``linkage(a.steer, b.steer)``), else ``w.steer``
+    steering_actuators: tuple[str, ...] = ()
 
     @property
     def sufficient(self) -> np.ndarray:
@@ -182,7 +184,8 @@ class ActuationAnalysis:
         """JSON-ready summary (lists and plain values)."""
         return {
             "actuated": list(self.actuated), "steering_actuated": list(self.steering),
-            "steering_not_actuated": list(self.steering_missing), "mobility": self.mobility.tolist(),
+            "steering_not_actuated": list(self.steering_missing),
+            "steering_actuators": list(self.steering_actuators), "mobility": self.mobility.tolist(),
             "leaf": self.leaf.tolist(), "sufficient": self.sufficient.tolist(),
             "consistent": self.consistent.tolist(), "undriven_motions": self.undriven.tolist(),
             "verdict": self.verdict.tolist(),
@@ -247,6 +250,31 @@ def verdict_texts(leaf: np.ndarray, texts: dict[str, str], n: int, m: np.ndarray
     return readonly(np.asarray(words(leaf, m), dtype=object))
 
 
+def steering_channels(robot: Robot, wheels: Sequence[str]) -> tuple[str, ...]:
+    """The steering actuators of the steered `wheels`, in their order: the channel of each ``linkage`` holding one
+    of them (``linkage(a.steer, b.steer)``: one mechanism, one actuator), else the wheel's ``w.steer``."""
+    out: list[str] = []
+    for w in wheels:
+        c = next((c for c in robot.couplings if c.kind == "linkage" and f"{w}.steer" in c.joints), None)
+        name = f"{w}.steer" if c is None else c.channel_name
+        if name not in out:
+            out.append(name)
+    return tuple(out)
+
+
+def actuator_names(robot: Robot, joints: Sequence[str]) -> tuple[str, ...]:
+    """`joints` (``wheel.joint``) as the actuators that drive them, once each: a rate coupling's joints as its
+    channel (:func:`wmrkit.couplings.channel_names`), a steering ``linkage``'s as its channel."""
+    rates = channel_names(robot.couplings, tuple(joints))
+    out: list[str] = []
+    for j in rates:
+        wheel, _, part = j.partition(".")
+        name = steering_channels(robot, (wheel,))[0] if part == "steer" and wheel in robot.steer_names else j
+        if name not in out:
+            out.append(name)
+    return tuple(out)
+
+
 def steering_split(robot: Robot, steering: tuple[str, ...]) -> tuple[str, ...]:
     """The centred steerable wheels not in `steering` (their steering is not actuated/sensed)."""
     return tuple(w.name for w in robot.wheels if w.type == "steerable" and w.name not in steering)
@@ -276,6 +304,7 @@ def actuation_analysis(
         readonly(partitioned_solution(j_u, j_nu) @ i_bar),
         readonly(undriven_motions(i_bar1, j_nu1)),
         readonly(np.asarray(selected_determined(j_u1, j_nu1))),
+        steering_channels(robot, steering),
     )
 
 
@@ -366,8 +395,9 @@ def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None, *,
     """The smallest actuator choices with consistent actuation (Fig. 4.4 ``determined``) at every configuration.
 
     Each set has m (B.3.8) wheel rates, followed by the ``steer`` joints of the centred steerable wheels, which the
-    thesis requires actuated. m = G, the body's degrees of freedom, except with a double wheel, whose steering
-    turns with the body at rest (4.69): one more rate must drive it (:func:`undriven_motions`). Empty when no
+    thesis requires actuated: one per steering ``linkage`` (its first joint; any one actuates the mechanism).
+    m = G, the body's degrees of freedom, except with a double wheel, whose steering turns with the body at rest
+    (4.69): one more rate must drive it (:func:`undriven_motions`). Empty when no
     choice of wheel rates works (e.g. m = 0). Steering: `beta` (thesis) or `heading` (0 = rolling forward),
     default as described.
     """
@@ -378,6 +408,11 @@ def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None, *,
         return SetList()
     found = minimal_set_search(robot, beta, int(m[0]), "determined", "minimal actuator sets", drive_all=True,
                                couplings="actuated")
-    steer = tuple(f"{w}.steer" for w in steering_split(robot, ()))
+    steer = tuple(_first_joint(robot, c) for c in steering_channels(robot, steering_split(robot, ())))
     names = jacobian_names(robot)
     return SetList([tuple(names[c] for c in s) + steer for s in found], found.complete, found.note)
+
+
+def _first_joint(robot: Robot, channel: str) -> str:
+    """The first joint of the steering actuator `channel` (:func:`steering_channels`): itself, or its linkage's."""
+    return next((c.joints[0] for c in robot.couplings if c.channel_name == channel), channel)

@@ -163,7 +163,7 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
             f" ({model['kind']}, assigned: {', '.join(model['assigned'])})")
         lines += [f"  {title}{kind}:", *_matrix_table(model, summary["size"])]
     act, sen = summary["actuation"], summary["sensing"]
-    lines.append(f"  actuation [{', '.join(act['actuated'] + [s + '.steer' for s in act['steering_actuated']])}]: "
+    lines.append(f"  actuation [{', '.join(act['actuated'] + act['steering_actuators'])}]: "
                  f"{act['verdict']}")
     lines.append(f"  sensing [{', '.join(sen['sensed'] + [s + '.steer' for s in sen['steering_sensed']])}]: "
                  f"{sen['verdict']}")
