@@ -203,7 +203,7 @@ class Wheel:
             edge = math.copysign(MAX_ANGLE, beta) + self.delta - HALF_PI
             raise WheelError(f"wheel '{self.name}': heading: {heading / (2 * math.pi):.10g} turns is beyond "
                              f"{edge / (2 * math.pi):.10g} turns, where the thesis's beta (heading - delta + 90 deg) "
-                             f"reaches the {MAX_TURNS:g}-turn limit of every angle (no angle to steer by)")
+                             f"reaches the limit of every angle, {MAX_TURNS:g} turns (no angle to steer by)")
         return replace(self, beta=beta)
 
     def elements(self) -> tuple[Element, ...]:

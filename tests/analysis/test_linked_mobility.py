@@ -130,7 +130,7 @@ def test_a_steer_heading_beyond_the_limit_is_named_as_a_heading(capsys):
     assert main(["analyze", "forklift", "--steer", "steer=1e6 turn"]) == 2
     err = capsys.readouterr().err
     assert err == ("wmrkit: error: --steer steer=1e6 turn: wheel 'steer': heading: 1000000 turns is beyond 999999.75 "
-                   "turns, where the thesis's beta (heading - delta + 90 deg) reaches the 1e+06-turn limit of every "
-                   "angle (no angle to steer by)\n")
+                   "turns, where the thesis's beta (heading - delta + 90 deg) reaches the limit of every angle, "
+                   "1e+06 turns (no angle to steer by)\n")
     with pytest.raises(WheelError, match=r"^wheel 'steer': heading: 1000000 turns is beyond 999999.75 turns"):
         catalog.load("forklift").with_steering({"steer": 2e6 * np.pi})

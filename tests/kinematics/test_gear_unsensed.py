@@ -52,7 +52,12 @@ ROBOTS = {"cart-1": lambda: cart(), "cart-2": lambda: cart(ratio=2.0), "cart-min
 def brute_force_actuators(robot: Robot) -> list[tuple[str, ...]]:
     """Every set of m selectable rates (m: actuation_analysis's) that actuation_analysis calls consistent and
     sufficient (determined, nothing undriven)."""
-    names, steer = jacobian_names(robot), tuple(f"{w.name}.steer" for w in robot.wheels if w.type == "steerable")
+    names, steer = jacobian_names(robot), []
+    for w in (w for w in robot.wheels if w.type == "steerable"):  # one steering actuator per linkage: its first joint
+        link = next((c.joints for c in robot.couplings if c.kind == "linkage" and f"{w.name}.steer" in c.joints),
+                    (f"{w.name}.steer",))
+        steer += [] if link[0] in steer else [link[0]]
+    steer = tuple(steer)
     m = int(actuation_analysis(robot).mobility)
     out = []
     for s in itertools.combinations(selectable_rates(robot), m):
