@@ -25,6 +25,7 @@ from ..couplings import linkage_law
 from ..kinematics.linkage_check import _plan, _speeds, linkage_holds
 from ..kinematics.wheel_ik import SLIP_TOL
 from ..robot import Robot
+from ._fast import CHUNK
 from .classification import classify
 from .coordinated import admissible_icrs
 from .icr import ICRSet, icr, twist_of_icr
@@ -32,6 +33,9 @@ from .singularity import SingularSet
 
 #: Isolated reachable ICRs listed by :class:`LinkedReach` (and ``analyze --json``).
 MAX_LISTED = 8
+#: Finest grid :func:`linked_reach` judges [points per turn]: a set's dimension needs no finer one (at 1440, the
+#: finest ``--resolution``, a plane of ICRs took 5 s).
+MAX_REACH_RESOLUTION = 360
 
 
 def _holds(robot: Robot, h: np.ndarray, beta: np.ndarray) -> np.ndarray:
@@ -48,9 +52,13 @@ def reachable(robot: Robot, icr_h: np.ndarray) -> np.ndarray:
     from .icr import steer_to_icr
 
     h = np.asarray(icr_h, dtype=float).reshape(-1, 3)
-    if not len(_plan(robot).lead) or not len(h):
-        return np.ones(len(h), dtype=bool)
-    return _holds(robot, h, steer_to_icr(robot, h)).all(axis=-1)
+    out = np.ones(len(h), dtype=bool)
+    if not len(_plan(robot).lead):
+        return out
+    for s in range(0, len(h), CHUNK):  # a fine grid of a many-wheeled robot at once took gigabytes
+        part = h[s:s + CHUNK]
+        out[s:s + CHUNK] = _holds(robot, part, steer_to_icr(robot, part)).all(axis=-1)
+    return out
 
 
 def held_linkages(robot: Robot) -> tuple[str, ...]:
@@ -92,14 +100,15 @@ class LinkedReach:
 
 def linked_reach(robot: Robot, resolution: int = 90) -> LinkedReach | None:
     """Which of the ICRs `robot`'s wheels allow its held linkages reach (module docstring): judged on the grid of
-    :func:`.coordinated.admissible_icrs` of `resolution` points per turn, on the line through each linkage's first
-    two steering axes (where wheels held parallel meet at a finite ICR: their common axle) and at the described ICR;
-    None without a held linkage or for a robot the thesis calls degenerate. An ICR reached off those (a linkage with
-    odd rest angles) is not found."""
+    :func:`.coordinated.admissible_icrs` of `resolution` points per turn (at most :data:`MAX_REACH_RESOLUTION`), on
+    the line through each linkage's first two steering axes (where wheels held parallel meet at a finite ICR: their
+    common axle) and at the described ICR; None without a held linkage or for a robot the thesis calls degenerate.
+    An ICR reached off those (a linkage with odd rest angles) is not found."""
     held = held_linkages(robot)
     cls = classify(robot)
     if not held or cls.degenerate or cls.fixed_rank > 1:
         return None
+    resolution = min(resolution, MAX_REACH_RESOLUTION)
     grid, dims = admissible_icrs(robot, resolution)
     ok = reachable(robot, grid)
     lines = _pair_lines(robot, resolution) if dims == 2 else np.zeros((0, resolution, 3))
