@@ -46,6 +46,7 @@ from ..odometry.integrators import check_method
 from ..robot import Robot
 from .consistency import SLIP_NOT_JUDGED, Consistency, judge, names
 from .engine import BatchError, Engine, TaskFailure, engine
+from .motions import REFERENCE_NOISE, check_reference_noise
 from .runs import find_reference as find_reference  # read from log files (re-exported: their public home was here)
 from .runs import load_run as load_run
 from .runs import load_runs as load_runs
@@ -156,8 +157,11 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
                     runner: Engine | None = None, ci: str = "jacobian", level: float = 0.95, n_boot: int = 200,
                     seed: int = 0, method: str = "exact", heading_weight: float = 1.0,
                     sensed: Sequence[str] | None = None, weights: Mapping[str, float] | None = None,
-                    run_weights: RunWeights | None = None, progress: bool = False) -> FleetCalibration:
-    """Fit `parameters` of `robot` to all `runs` at once (module docstring); intervals at `level`."""
+                    run_weights: RunWeights | None = None, progress: bool = False,
+                    reference_noise: Sequence[float] = REFERENCE_NOISE) -> FleetCalibration:
+    """Fit `parameters` of `robot` to all `runs` at once (module docstring); intervals at `level`;
+    `reference_noise` ``(m, rad)``: the references' noise, below which a still robot's reference may move unsaid
+    (:data:`~wmrkit.batch.motions.REFERENCE_NOISE`)."""
     if not runs:
         raise BatchError("calibrate: no runs")
     if ci not in ("jacobian", "bootstrap"):
@@ -168,6 +172,7 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
         check_seed(seed, BatchError)
     sensed = check_options(heading_weight, sensed)  # as wmrkit.odometry.calibrate checks them, before any work
     check_method(method)
+    reference_noise = check_reference_noise(reference_noise)
     apply_parameters(robot, parameters, np.zeros(len(parameters)))  # names checked here, in the caller's process
     params = tuple(parameters)
     problem = CalibrationProblem(robot, params, tuple(runs), method, heading_weight,
@@ -233,7 +238,7 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
                           "the parameters apart (the interval is over the others)",)
             lo, hi = np.quantile(kept, 0.5 - level / 2, axis=0), np.quantile(kept, 0.5 + level / 2, axis=0)
         judged = judge(problem, fit, curvature,  # a failed refit or curvature: the runs not judged, the fit stands
-                       lambda tasks: runner.map(_refit_without, tasks, errors="return"))
+                       lambda tasks: runner.map(_refit_without, tasks, errors="return"), reference_noise)
     finally:
         if own:
             runner.close()

@@ -37,7 +37,7 @@ import numpy as np
 from ..odometry.calibration import RANK_TOL, CalibrationProblem, CalibrationRun
 from ..robot import Robot
 from .likelihood import MIN_OWN_DOF, few_pose_warning, own_noise
-from .motions import moved_at_rest
+from .motions import REFERENCE_NOISE, moved_at_rest
 from .refits import REFIT_FAILED as REFIT_FAILED  # re-exported: batch.consistency.REFIT_FAILED
 from .refits import own_dof, own_scores, own_skipped, refits
 from .whole import NO_OWN_NOISE, whole_fleet
@@ -306,7 +306,8 @@ def _quadratic_scores(jac, res, hess, floors, m, outs=None) -> tuple[np.ndarray,
     return out, shift
 
 
-def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable) -> Consistency:
+def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable,
+          reference_noise: Sequence[float] = REFERENCE_NOISE) -> Consistency:
     """The runs of the fleet fit `fit` checked against each other: by their residual ratios
     (:func:`run_consistency`), else, for a fleet of closed paths (:data:`CLOSED`), each run against the others'
     pooled noise. A closed run's residuals (its final pose) are weighted by one over the square root of its wheel
@@ -327,7 +328,8 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
     score is the refit's: in fleets of 6 squares the odd run's equalled a refit of every run. A fleet of fewer than
     :data:`REFIT_EVERY` runs refits every run. Over :data:`MAX_CLOSED_SCORE` the run of largest score is named;
     with none over it and :data:`MIN_PAIR_RUNS` runs or more, the pair of largest pair score over
-    :data:`MAX_PAIR_SCORE` is named (:data:`PAIR`; :func:`_pair`).
+    :data:`MAX_PAIR_SCORE` is named (:data:`PAIR`; :func:`_pair`). A reference that moves beyond its
+    `reference_noise` ``(m, rad)`` while the wheels are still is said (:func:`~wmrkit.batch.motions.moved_at_rest`).
     Runs are compared with runs of as many reference poses (closed paths and references of two poses: one final
     pose each): each kind of :data:`MIN_CLOSED_RUNS` runs or more is judged on its own, the other runs are set aside
     and named (:data:`SET_ASIDE`); with no such kind the fleet is not judged (:data:`CLOSED`; runs of references of
@@ -388,7 +390,8 @@ def judge(problem: CalibrationProblem, fit, curvature: Callable, refit: Callable
             said, out = few_pose_warning(problem, fit.x, fit.jac, fit.fun, group, ROUNDOFF * travels, logs, named)
             messages += [said] if said else []  # several runs that disagree (wmrkit.batch.likelihood)
             left += [out] if out else []  # runs left out of that check, or why not made (LEFT_OUT, NOT_PLAIN)
-            left += [rest] if (rest := moved_at_rest(problem, fit.x, group, fit.fun, logs)) else []
+            left += [rest] if (rest := moved_at_rest(problem, fit.x, group, fit.fun, logs,
+                                                       reference_noise)) else []
         else:  # closed paths, references of 2 poses (or 3 without heading): no own noise to judge by
             left.append(NO_OWN_NOISE.format(runs=", ".join(logs[k] for k in group)))
     aside = [k for k in range(g) if np.isnan(scores[k])]

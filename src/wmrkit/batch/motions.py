@@ -17,21 +17,51 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .._shapes import finite_number
 from ..odometry.calibration import CalibrationProblem, CalibrationRun, apply_parameters
 from ..odometry.covariance import JointNoise
 from ..odometry.model import odometry_model
 from ..odometry.pipeline import odometry
+from .engine import BatchError
 from .homogeneity import increments
 
 #: Runs whose reference moves while their wheels are still ({runs}: each with its motions, how far the reference
-#: moved): the checks on whitened motions' errors leave such a motion out (its covariance under the encoders' noise
-#: model is zero: no variance to weigh its error by). Before, they were left out unsaid: a three-pose run whose
-#: middle reference, 0.5 s into a pause, was 2.2 cm from the start had its F test and likelihood terms on the other
-#: motion alone, and among 5 three-pose runs the fleet fit raised ValueError (a likelihood term of no degree of
-#: freedom).
-AT_REST = ("{runs}: the reference moves while the wheels are still (pushed, sliding, or a wrong reference pose?): "
-           "such a motion is left out of the checks on whitened motions' errors (the fleet likelihood ratio, a run's "
-           "F test against its own noise), the encoders' noise model gives it no variance")
+#: moved; {tol}: how far its noise moves it, :func:`rest_tolerance`): the checks on whitened motions' errors leave
+#: such a motion out (its covariance under the encoders' noise model is zero: no variance to weigh its error by).
+#: Before, they were left out unsaid: a three-pose run whose middle reference, 0.5 s into a pause, was 2.2 cm from
+#: the start had its F test and likelihood terms on the other motion alone, and among 5 three-pose runs the fleet
+#: fit raised ValueError (a likelihood term of no degree of freedom).
+AT_REST = ("{runs}: the reference moves while the wheels are still, beyond its noise ({tol}) (pushed, sliding, or a "
+           "wrong reference pose?): such a motion is left out of the checks on whitened motions' errors (the fleet "
+           "likelihood ratio, a run's F test against its own noise), the encoders' noise model gives it no variance")
+#: The reference's noise assumed unless given (``reference_noise``, ``--reference-noise``): the standard deviation of
+#: each of a reference pose's x and y [m] and of its heading [rad], a motion-capture system's order. A run's three
+#: reference poses cannot measure it (its moving motions' errors hold the encoders' noise too: 5-9 mm on 2 m arcs at
+#: 1e-5 rad^2/rad, where the reference's was 1 mm), so it is an option.
+REFERENCE_NOISE = (1e-3, 1e-3)
+#: A still motion's move is said (:data:`AT_REST`) beyond this many standard deviations of the difference of two
+#: reference poses of the reference's noise (sqrt(2) times it), x and y together, heading apart. Before, any move at
+#: all was said: with 1 mm and 1 mrad of noise on the references, every fleet of runs that paused between reference
+#: poses was said pushed (5 of 5). Fleets of 6 three-pose runs each pausing 1 s (that noise; docs/batch.md): none said
+#: over 40 fleets (240 still motions; the chance of noise alone beyond 5: 4e-6 per motion); one run pushed 1 cm said
+#: in 38 of 40 (the noise moves it about the 7.07 mm tolerance), turned 0.02 rad in 40 of 40.
+REST_FACTOR = 5.0
+
+
+def check_reference_noise(noise: Sequence[float]) -> tuple[float, float]:
+    """`noise` as ``(m, rad)``, or :class:`~wmrkit.errors.BatchError` naming ``reference_noise``: two finite
+    numbers >= 0."""
+    values = tuple(noise) if isinstance(noise, Sequence) and not isinstance(noise, str) else ()
+    if len(values) != 2 or not all(finite_number(v) and not isinstance(v, bool) and v >= 0 for v in values):
+        raise BatchError(f"reference_noise: expected the reference's noise (x and y [m], heading [rad]): two finite "
+                         f"numbers >= 0, got {noise!r}")
+    return float(values[0]), float(values[1])
+
+
+def rest_tolerance(noise: Sequence[float]) -> np.ndarray:
+    """``(2,)``: how far a still reference may move [m, rad] under its `noise` ``(m, rad)``
+    (:data:`REST_FACTOR` times sqrt(2) times it)."""
+    return REST_FACTOR * np.sqrt(2.0) * np.asarray(check_reference_noise(noise))
 
 
 def motion_covariances(problem: CalibrationProblem, p: np.ndarray, run: CalibrationRun) -> np.ndarray:
@@ -78,22 +108,25 @@ def whitening(problem: CalibrationProblem, p: np.ndarray, run: CalibrationRun, r
 
 
 def moved_at_rest(problem: CalibrationProblem, p: np.ndarray, runs: Sequence[int], res: np.ndarray,
-                  logs: Sequence[str]) -> str | None:
+                  logs: Sequence[str], noise: Sequence[float] = REFERENCE_NOISE) -> str | None:
     """:data:`AT_REST` for the `runs` (indices of the problem's; `res`: the fleet fit's residuals at parameters `p`)
     with a motion between reference poses that :func:`whitening` leaves out (covariance zero: no sensed wheel
-    turns) while its reference moves (its error not zero), each motion named by its samples with the reference's
-    move [m, rad]; ``None`` when there is none (a still reference of a still robot carries no information)."""
+    turns) while its reference moves beyond its `noise` ``(m, rad)`` (:func:`rest_tolerance`), each motion named by
+    its samples with the reference's move [m, rad]; ``None`` when there is none (a still reference of a still robot
+    carries no information)."""
     if problem.heading_weight == 0:  # no motion is whitened at all (whitening says why)
         return None
+    tol = rest_tolerance(noise)
     sizes = problem.sizes()
     ends = np.cumsum(sizes)
     said = []
     for k in runs:
         run, r = problem.runs[k], res[int(ends[k] - sizes[k]):int(ends[k])]
         _, err = increments(run, problem.heading_weight, np.eye(r.size), r)
+        moves = np.column_stack([np.hypot(*err.reshape(-1, 3)[:, :2].T), np.abs(err[2::3]) / problem.heading_weight])
         at = run.samples()
-        moved = [f"samples {a}-{b}: {np.hypot(*e[:2]):.3g} m, {abs(e[2]) / problem.heading_weight:.3g} rad"
-                 for c, e, a, b in zip(motion_covariances(problem, p, run), err.reshape(-1, 3), np.r_[0, at[:-1]], at,
-                                       strict=True) if not c.any() and e.any()]
+        moved = [f"samples {a}-{b}: {m[0]:.3g} m, {m[1]:.3g} rad"
+                 for c, m, a, b in zip(motion_covariances(problem, p, run), moves, np.r_[0, at[:-1]], at, strict=True)
+                 if not c.any() and (m > tol).any()]
         said += [f"{logs[k]} ({'; '.join(moved)})"] if moved else []
-    return AT_REST.format(runs=", ".join(said)) if said else None
+    return AT_REST.format(runs=", ".join(said), tol=f"{tol[0]:.3g} m, {tol[1]:.3g} rad") if said else None

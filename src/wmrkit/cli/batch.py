@@ -71,6 +71,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--method", choices=METHODS, default="exact",
                    help=f"integration scheme: {SCHEMES_HELP} (default: exact)")
     p.add_argument("--slip", action="store_true", help="fit the slip weights (WLS ratio, effective track) instead")
+    p.add_argument("--reference-noise", metavar="XY,HEADING",
+                   help="the references' noise: std of x and y [m or mm] and of heading [rad or deg], under which a "
+                        "still robot's reference may move unsaid (default 1mm,1e-3)")
     _log_options(p)
     _engine_options(p)
     p.set_defaults(run=run_calibrate)
@@ -198,6 +201,22 @@ def run_odometry(args: argparse.Namespace) -> int:
     return 1 if result.failed else 0  # a pipeline must tell a batch with failed logs from a complete one
 
 
+def _reference_noise(text: str | None) -> tuple[float, float]:
+    """``--reference-noise XY,HEADING`` as ``(m, rad)``, each finite and >= 0 (default
+    :data:`~wmrkit.batch.motions.REFERENCE_NOISE`)."""
+    from ..batch.motions import REFERENCE_NOISE
+
+    if text is None:
+        return REFERENCE_NOISE
+    parts = text.split(",")
+    if len(parts) != 2:
+        raise WmrkitError(f"--reference-noise: expected XY,HEADING (e.g. 1mm,0.1deg), got '{text}'")
+    noise = parse_value(parts[0], "length", "--reference-noise"), parse_angle(parts[1], "--reference-noise")
+    if not all(math.isfinite(v) and v >= 0 for v in noise):
+        raise WmrkitError(f"--reference-noise: expected finite values >= 0, got '{text}'")
+    return noise
+
+
 def run_calibrate(args: argparse.Namespace) -> int:
     """Fleet calibration; prints each fitted field with its interval."""
     from ..batch.calibrate import (
@@ -211,8 +230,9 @@ def run_calibrate(args: argparse.Namespace) -> int:
     from ..batch.fleet import expand_logs
 
     robot = load_robot(args.robot)
-    if args.slip and (args.param or args.ci or args.sensed):  # the slip fit has its own two parameters and interval,
-        given = "--param" if args.param else "--ci" if args.ci else "--sensed"  # and takes every sensed joint
+    if args.slip and (args.param or args.ci or args.sensed or args.reference_noise):  # the slip fit has its own two
+        given = ("--param" if args.param else "--ci" if args.ci else "--sensed" if args.sensed  # parameters, interval
+                 else "--reference-noise")  # and judging, and takes every sensed joint
         raise WmrkitError(f"{given} is for the geometry fit; --slip fits slip weights")
     if args.bootstrap is not None and args.ci != "bootstrap":
         raise WmrkitError("--bootstrap is the number of replicates of --ci bootstrap")
@@ -221,6 +241,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
               else [] if args.slip else default_parameters(robot, closed=args.closed, sensed=args.sensed))
     check_bootstrap(args.bootstrap, "--bootstrap")
     check_level(args.level, "--level")
+    noise = _reference_noise(args.reference_noise)
     with _runner(args) as runner:
         runs = load_runs(robot, expand_logs(args.logs), reference_dir=args.reference, closed=args.closed,
                          runner=runner, options=_options(args), progress=_progress(args))
@@ -232,7 +253,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
         else:
             result = fleet_calibrate(robot, runs, params, runner=runner, ci=args.ci, level=args.level,
                                      n_boot=args.bootstrap, method=args.method, sensed=args.sensed,
-                                     progress=_progress(args))
+                                     progress=_progress(args), reference_noise=noise)
     for warning in () if args.slip else result.warnings:  # the slip fit has none
         warn(warning)
     if args.json:
