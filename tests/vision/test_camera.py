@@ -250,10 +250,10 @@ def test_camera_file_round_trip_and_errors(tmp_path):
     cam.to_file(path)
     assert Camera.from_file(path) == cam
     (tmp_path / "bad.yaml").write_text("focal_px: 300\ntilt: 0.8\nheigth: 0.2\n")
-    with pytest.raises(CameraError, match=r"bad.yaml: unknown field 'heigth'"):
+    with pytest.raises(CameraError, match=r"bad.yaml:3: heigth: unknown field \(camera fields: focal_px, "):
         Camera.from_file(tmp_path / "bad.yaml")
     (tmp_path / "neg.yaml").write_text("focal_px: 300\ntilt: 2.0\nheight: 0.2\n")
-    with pytest.raises(WmrkitError, match=r"neg.yaml: tilt: out of range"):
+    with pytest.raises(WmrkitError, match=r"neg.yaml:2: tilt: out of range"):
         Camera.from_file(tmp_path / "neg.yaml")
     with pytest.raises(CameraError, match="cannot read"):
         Camera.from_file(tmp_path / "missing.yaml")

@@ -319,6 +319,30 @@ def test_a_broken_image_file_gives_one_line(tmp_path, capfd):
         f"wmrkit: error: {tmp_path / 'broken.png'}: not an image OpenCV can read"]
 
 
+@pytest.mark.parametrize(("text", "field", "line", "message"), [
+    ("focal_px: 300\ntilt: 0.8\nheight: -1\n", "height", 3, "out of range, got -1.0 (expected a length in (0, "),
+    ("focal_px: 300\ntilt: 0.8\nheigth: 0.2\n", "heigth", 3, "unknown field (camera fields: focal_px, height, "),
+    ("focal_px: 300\ntilt: 0.8\n", "height", None, "missing field (a camera file needs focal_px, tilt and height)"),
+    ("focal_px: 300 px\ntilt: 0.8\nheight: 0.2\n", "focal_px", 1, "unknown unit 'px' in '300 px'"),
+    ("focal_px: 300\ntilt: 0.8\nheight: 0.2\nwidth: 64.5\n", "width", 4, "expected a whole number of pixels"),
+    ("focal_px: 300\ntilt: 0.8\nheight: 0.2\nk1: -0.9\n", "k1", 4, "-0.9 folds the distortion model over"),
+    ("focal_px: 300\ntilt: 0.8\nheight: 0.2\ntilt: 0.9\n", "tilt", 4, "field 'tilt' given twice"),
+])
+def test_a_camera_file_error_names_its_field_and_line(tmp_path, capsys, text, field, line, message):
+    """Under --json every camera file error had field null (and line null but for duplicate keys): the field was
+    in the message only."""
+    cam = tmp_path / "cam.yaml"
+    cam.write_text(text)
+    code, _, err = run(["vision", "locate", "--points", str(tmp_path / "p.json"), "--camera", str(cam), "--json"],
+                       capsys)
+    data = json.loads(err)
+    assert code == 2 and data["error"].startswith(message), data
+    assert (data["file"], data["field"], data["line"], data["wheel"]) == (str(cam), field, line, None)
+    code, _, err = run(["vision", "locate", "--points", str(tmp_path / "p.json"), "--camera", str(cam)], capsys)
+    place = f"{cam}:{line}" if line else str(cam)
+    assert code == 2 and err.startswith(f"wmrkit: error: {place}: {field}: {message}") and err.count("\n") == 1
+
+
 def test_errors_about_an_image_or_a_points_file_name_it(tmp_path, capsys):
     """'image: found 0 line(s), expected 1' and 'points: lines[0]: ...' named neither the IMAGE nor the file."""
     cv2.imwrite(str(tmp_path / "black.png"), np.zeros((240, 320), np.uint8))

@@ -29,17 +29,22 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
-from ..documents import read_document, read_file, write_document
+from ..documents import LineOf, read_document, read_file, write_document
 from ..errors import DescriptionError, WmrkitError
 from ..limits import MAX_SIZE
 from ..units import UnitError, parse_quantity
 
-__all__ = ["Camera", "CameraError", "camera_coordinates", "check_lens_image", "distort", "extrinsics", "fold_radius",
-           "ground_from_image", "project", "rotation", "undistort"]
+__all__ = ["Camera", "CameraError", "CameraFileError", "camera_coordinates", "check_lens_image", "distort",
+           "extrinsics", "fold_radius", "ground_from_image", "project", "rotation", "undistort"]
 
 
 class CameraError(WmrkitError, ValueError):
     """A camera description, image or measurement that cannot be used; the message names the field."""
+
+
+class CameraFileError(DescriptionError, CameraError):
+    """A camera (or points) file that cannot be used, located as a description's errors are: file, line and field
+    (``wmrkit --json`` reports them; before, ``field`` and mostly ``line`` were null)."""
 
 
 #: Largest image side [px]: the synthetic camera holds several float arrays of the image's size.
@@ -112,35 +117,43 @@ class Camera:
         return asdict(self)
 
     @classmethod
-    def from_dict(cls, data: Any, *, source: str = "<camera>") -> Camera:
-        """A camera from a mapping (a camera file's content); unknown fields are refused."""
+    def from_dict(cls, data: Any, *, source: str = "<camera>", line_of: LineOf | None = None) -> Camera:
+        """A camera from a mapping (a camera file's content; `line_of`: its fields' lines); unknown fields are
+        refused. Errors are :class:`CameraFileError` naming `source`, the field and its line when known."""
+
+        def fail(message: str, name: str | None = None) -> CameraFileError:
+            loc = () if name is None else (name,)
+            return CameraFileError(message, source=source, loc=loc, line=line_of(loc) if line_of and loc else None)
+
         if not isinstance(data, dict):
-            raise CameraError(f"{source}: expected a mapping of camera fields")
+            raise fail("expected a mapping of camera fields")
         allowed = {f.name for f in fields(cls)}
-        unknown = sorted(set(data) - allowed)
+        unknown = sorted(set(data) - allowed, key=str)
         if unknown:
-            raise CameraError(f"{source}: unknown field '{unknown[0]}' (fields: {', '.join(sorted(allowed))})")
+            raise fail(f"unknown field (camera fields: {', '.join(sorted(allowed))})", str(unknown[0]))
         missing = [n for n in ("focal_px", "tilt", "height") if n not in data]
         if missing:
-            raise CameraError(f"{source}: missing field '{missing[0]}'")
+            raise fail("missing field (a camera file needs focal_px, tilt and height)", missing[0])
         values: dict[str, Any] = {}
         for name, value in data.items():  # units as in descriptions: '60 deg', '30 cm', '1e-7' (YAML 1.1 reads a str)
             try:
                 number = parse_quantity(value, _FIELD_KINDS.get(name, "number"))
             except UnitError as err:
-                raise CameraError(f"{source}: {name}: {err}") from None
+                raise fail(str(err), name) from None
             if name in ("width", "rows") and not number.is_integer():
-                raise CameraError(f"{source}: {name}: expected a whole number of pixels, got {value!r}")
+                raise fail(f"expected a whole number of pixels, got {value!r}", name)
             values[name] = int(number) if name in ("width", "rows") else number
         try:
             return cls(**values)
-        except CameraError as err:
-            raise CameraError(f"{source}: {str(err).removeprefix('camera: ')}") from None
+        except CameraError as err:  # "camera: NAME: message" (Camera's checks name their field so)
+            name, _, message = str(err).removeprefix("camera: ").partition(": ")
+            raise (fail(message, name) if name in allowed else fail(str(err).removeprefix("camera: "))) from None
 
     @classmethod
     def from_file(cls, path: str | Path) -> Camera:
         """Read a camera file (YAML, as ``wmrkit vision calibrate --out`` writes)."""
-        return cls.from_dict(read_located(path, "camera file", "yaml"), source=str(path))
+        data, line_of = read_located(path, "camera file", "yaml", lines=True)
+        return cls.from_dict(data, source=str(path), line_of=line_of)
 
     def to_file(self, path: str | Path) -> None:
         """Write the camera file, plain SI numbers: JSON for a ``.json`` file, else YAML (``.yaml``, ``.yml``; other
@@ -155,13 +168,15 @@ class Camera:
             raise CameraError(f"{path}: cannot write the camera file ({err.strerror or err})") from None
 
 
-def read_located(path: str | Path, what: str, fmt: str) -> Any:
+def read_located(path: str | Path, what: str, fmt: str, *, lines: bool = False) -> Any:
     """The data of a YAML or JSON file read as :func:`wmrkit.documents.read_file` and ``read_document`` do
-    (bounded size, safe YAML, duplicate keys refused); their located errors as :class:`CameraError`."""
+    (bounded size, safe YAML, duplicate keys refused), with `lines` ``(data, line_of)``; their located errors as
+    :class:`CameraFileError` (file, line and field kept)."""
     try:
-        return read_document(read_file(path, what), str(path), fmt)[0]
+        got = read_document(read_file(path, what), str(path), fmt)
     except DescriptionError as err:
-        raise CameraError(str(err)) from None
+        raise CameraFileError(err.message, source=err.source, loc=err.loc, line=err.line) from None
+    return got if lines else got[0]
 
 
 def rotation(psi: ArrayLike, tilt: ArrayLike) -> np.ndarray:
