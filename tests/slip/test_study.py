@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 
 import numpy as np
 import pytest
@@ -164,3 +165,25 @@ def test_open_differential_leaves_the_speed_difference_free_and_tracks_the_carri
     assert np.all(rates[turning, 1] < rates[turning, 0])  # the left (inner) wheel turns slower in a left turn
     assert run.twist[turning, 2].mean() > 0.5
     assert np.all(np.abs(run.carrier_torque) <= 4000.0 + 1e-9)
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux's /proc")
+@pytest.mark.parametrize("study", ["forklift", "skid-steer-4"])
+def test_a_report_folder_that_cannot_be_made_is_refused_before_the_study(study, monkeypatch, capsys):
+    """'--report /proc/x' passed the up-front check as root (os.access says yes to root everywhere) and the forklift
+    study failed after its 5 minutes of work ('No such file or directory'). Now refused at once, exit 2, before any
+    study runs (JSON too)."""
+    import wmrkit.slip.skid
+    import wmrkit.slip.study
+
+    def ran(*args, **kwargs):
+        raise AssertionError("the study ran")
+
+    monkeypatch.setattr(wmrkit.slip.study, "forklift_study", ran)
+    monkeypatch.setattr(wmrkit.slip.skid, "skid_comparison", ran)
+    assert main(["slip-study", study, "--report", "/proc/wmrkit-x"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wmrkit: error: --report /proc/wmrkit-x: cannot write into '/proc' (")
+    assert err.count("\n") == 1
+    assert main(["slip-study", study, "--report", "/proc/wmrkit-x", "--json"]) == 2
+    assert json.loads(capsys.readouterr().err)["error"].startswith("--report /proc/wmrkit-x: cannot write into '/proc'")

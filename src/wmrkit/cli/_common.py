@@ -8,6 +8,7 @@ import json
 import math
 import os
 import sys
+import tempfile
 import warnings
 from collections.abc import Iterable, Iterator
 from contextvars import ContextVar
@@ -219,6 +220,11 @@ def output_problem(path: str, folder: bool) -> str | None:
         return f"no such folder '{parent}'" if not parent.exists() else f"'{parent}' is not a folder"
     if not os.access(parent, os.W_OK | os.X_OK):
         return f"cannot write into '{parent}' (permission denied)"
+    try:  # os.access says yes to root everywhere: /proc refused the folder only after a 5-minute slip-study
+        with tempfile.TemporaryDirectory(dir=parent, prefix=".wmrkit-probe-"):
+            pass
+    except OSError as err:
+        return f"cannot write into '{parent}' ({err.strerror or err})"
     return None
 
 
