@@ -46,7 +46,8 @@ def test_a_noisy_reference_of_a_still_robot_is_not_said_pushed_a_moved_one_is(di
     assert STILL not in (fleet_calibrate(diff, runs, PARAMS, reference_noise=(0.01, 0.01)).not_judged or "")
 
 
-@pytest.mark.parametrize("noise", [(-1e-3, 0.0), (1e-3, float("nan")), (1e-3,), "1mm", (True, 0.0)])
+@pytest.mark.parametrize("noise", [(-1e-3, 0.0), (1e-3, float("nan")), (1e-3,), "1mm", (True, 0.0), (1e308, 0.0),
+                                   (0.0, 4.0)])
 def test_a_bad_reference_noise_is_refused_by_name(diff, noise):
     from wmrkit.errors import WmrkitError
 
@@ -54,8 +55,11 @@ def test_a_bad_reference_noise_is_refused_by_name(diff, noise):
         fleet_calibrate(diff, paused_fleet(diff, 1)[:2], PARAMS, reference_noise=noise)
 
 
-@pytest.mark.parametrize(("given", "said"), [("1mm", "expected XY,HEADING"), ("-1mm,0", "expected finite values"),
-                                             ("1mm,nan", "cannot read 'nan' as an angle")])
+@pytest.mark.parametrize(("given", "said"), [
+    ("1mm", "expected XY,HEADING"), ("1mm,nan", "cannot read 'nan' as an angle"),
+    ("-1mm,0", "expected the reference's noise (x and y [m], heading [rad]): two numbers in [0, 1000] m and [0, pi] "
+               "rad, got (-0.001, 0.0)"),
+    ("1e308,0", "expected the reference's noise")])
 def test_cli_refuses_a_bad_reference_noise_before_any_work(tmp_path, capsys, given, said):
     from wmrkit.cli.main import main
 

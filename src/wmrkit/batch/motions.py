@@ -13,11 +13,13 @@ against 5.4; tested), and a run's own fit measures its noise with the degrees of
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
 
 from .._shapes import finite_number
+from ..limits import MAX_SIZE
 from ..odometry.calibration import CalibrationProblem, CalibrationRun, apply_parameters
 from ..odometry.covariance import JointNoise
 from ..odometry.model import odometry_model
@@ -50,11 +52,12 @@ REST_FACTOR = 5.0
 
 def check_reference_noise(noise: Sequence[float]) -> tuple[float, float]:
     """`noise` as ``(m, rad)``, or :class:`~wmrkit.errors.BatchError` naming ``reference_noise``: two finite
-    numbers >= 0."""
+    numbers >= 0, at most ``limits.MAX_SIZE`` m and pi rad (1e308 m made an infinite tolerance)."""
     values = tuple(noise) if isinstance(noise, Sequence) and not isinstance(noise, str) else ()
-    if len(values) != 2 or not all(finite_number(v) and not isinstance(v, bool) and v >= 0 for v in values):
-        raise BatchError(f"reference_noise: expected the reference's noise (x and y [m], heading [rad]): two finite "
-                         f"numbers >= 0, got {noise!r}")
+    if len(values) != 2 or not all(finite_number(v) and not isinstance(v, bool) and 0 <= v <= top
+                                   for v, top in zip(values, (MAX_SIZE, math.pi), strict=True)):
+        raise BatchError(f"reference_noise: expected the reference's noise (x and y [m], heading [rad]): two numbers "
+                         f"in [0, {MAX_SIZE:g}] m and [0, pi] rad, got {noise!r}")
     return float(values[0]), float(values[1])
 
 

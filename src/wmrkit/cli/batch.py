@@ -202,9 +202,9 @@ def run_odometry(args: argparse.Namespace) -> int:
 
 
 def _reference_noise(text: str | None) -> tuple[float, float]:
-    """``--reference-noise XY,HEADING`` as ``(m, rad)``, each finite and >= 0 (default
+    """``--reference-noise XY,HEADING`` as ``(m, rad)``, checked as ``reference_noise`` is (default
     :data:`~wmrkit.batch.motions.REFERENCE_NOISE`)."""
-    from ..batch.motions import REFERENCE_NOISE
+    from ..batch.motions import REFERENCE_NOISE, check_reference_noise
 
     if text is None:
         return REFERENCE_NOISE
@@ -212,9 +212,10 @@ def _reference_noise(text: str | None) -> tuple[float, float]:
     if len(parts) != 2:
         raise WmrkitError(f"--reference-noise: expected XY,HEADING (e.g. 1mm,0.1deg), got '{text}'")
     noise = parse_value(parts[0], "length", "--reference-noise"), parse_angle(parts[1], "--reference-noise")
-    if not all(math.isfinite(v) and v >= 0 for v in noise):
-        raise WmrkitError(f"--reference-noise: expected finite values >= 0, got '{text}'")
-    return noise
+    try:
+        return check_reference_noise(noise)
+    except WmrkitError as err:
+        raise WmrkitError(f"--reference-noise: {str(err).partition(': ')[2]}") from None
 
 
 def run_calibrate(args: argparse.Namespace) -> int:
