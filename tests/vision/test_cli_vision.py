@@ -247,6 +247,24 @@ def test_locate_refuses_a_negative_spacing_instead_of_ignoring_it(capsys):
     assert code == 2 and out == "" and "spacing: expected a length in [0, 1000] m" in err
 
 
+@pytest.mark.parametrize(("option", "value", "said"), [
+    ("--spacing", "1e308", "--spacing: expected a length in [0, 1000] m (0: one line), got 1e+308"),
+    ("--z-p", "-1e300", "--z-p: expected a length in [-1000, 1000] m, got -1e+300"),
+])
+def test_locate_names_the_option_of_a_placement_out_of_range(monkeypatch, capsys, option, value, said):
+    """'--spacing 1e308' said 'spacing: ...' and '--z-p 1e300' 'z_p: ...' (the API's names), after the image's lines
+    were extracted; now the option, before the image is read."""
+    import wmrkit.vision.follow
+
+    def extracted(*args, **kwargs):
+        raise AssertionError("the image was read")
+
+    monkeypatch.setattr(wmrkit.vision.follow, "locate_image", extracted)
+    code, out, err = run(["vision", "locate", str(FIGURES / "three-lines.png"), "--camera",
+                          str(FIGURES / "thesis-camera.yaml"), option, value], capsys)
+    assert code == 2 and out == "" and err == f"wmrkit: error: {said}\n"
+
+
 @pytest.mark.parametrize("lines", ["2", "3"])
 def test_locate_lines_without_spacing_names_the_options(lines, capsys):
     # the error named 'points: lines[0]', which an IMAGE does not have

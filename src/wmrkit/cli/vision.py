@@ -137,11 +137,12 @@ def _naming(path: str, *prefixes: str) -> Iterator[None]:
 def run_locate(args: argparse.Namespace) -> int:
     """``wmrkit vision locate``."""
     from ..vision.follow import locate_image
-    from ..vision.positioning import locate_points, read_points
+    from ..vision.positioning import check_placement, locate_points, read_points
 
     camera = _camera(args.camera)
     spacing = parse_value(args.spacing, "length", "--spacing")
     z_p = parse_value(args.z_p, "length", "--z-p")
+    check_placement(spacing, z_p, ("--spacing", "--z-p"))  # before an image is read and its lines extracted
     if args.points is not None:
         for option, value in (("--lines", args.lines), ("--mode", args.mode)):
             if value is not None:  # it would be ignored

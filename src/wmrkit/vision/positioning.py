@@ -102,10 +102,7 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
 
     if not lines:
         raise CameraError("points: no lines given")
-    if not 0 <= spacing <= MAX_SIZE:  # NaN included; a negative spacing was read as none (one line), silently
-        raise CameraError(f"spacing: expected a length in [0, {MAX_SIZE:g}] m (0: one line), got {spacing:g}")
-    if not abs(z_p) <= MAX_SIZE:
-        raise CameraError(f"z_p: expected a length in [-{MAX_SIZE:g}, {MAX_SIZE:g}] m, got {z_p:g}")
+    check_placement(spacing, z_p)
     horizon = -camera.focal_px / math.tan(camera.tilt)  # image row of the horizon [px, y down]
     fixes = []
     for i, (n, pts) in enumerate(lines):
@@ -141,6 +138,15 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
 #: Largest relative difference between the line spacing the image shows and the one given (the thesis's chufa field,
 #: real image points, shows 0.569 m for rows sown 0.60 m apart: 5 %).
 SPACING_TOLERANCE = 0.25
+
+
+def check_placement(spacing: float, z_p: float, names: tuple[str, str] = ("spacing", "z_p")) -> None:
+    """Refuse (:class:`CameraError` naming it by `names`) a `spacing` outside ``[0, limits.MAX_SIZE]`` m or a `z_p`
+    beyond ``limits.MAX_SIZE`` m, NaN included (a negative spacing was read as none, one line, silently)."""
+    if not 0 <= spacing <= MAX_SIZE:
+        raise CameraError(f"{names[0]}: expected a length in [0, {MAX_SIZE:g}] m (0: one line), got {spacing:g}")
+    if not abs(z_p) <= MAX_SIZE:
+        raise CameraError(f"{names[1]}: expected a length in [-{MAX_SIZE:g}, {MAX_SIZE:g}] m, got {z_p:g}")
 
 
 def check_spacing(fixes: Sequence[LineFix], spacing: float) -> None:
