@@ -277,3 +277,27 @@ def test_noise_keywords_must_be_numbers(diff, square, keyword, value):
     check; True was read as 1."""
     with pytest.raises(BatchError, match=rf"{keyword}: expected a number .* got {value!r}"):
         monte_carlo(diff, square, 4, **{keyword: value})
+
+
+@pytest.mark.parametrize(("option", "said"), [
+    (["-n", "1"], "-n/--runs: a Monte Carlo study needs at least 2 runs and at most 1000000, got 1"),
+    (["--noise", "nan"], "--noise: noise must be in [0, 1] (per rad), got nan"),
+    (["--resolution", "4"], "--resolution: resolution must be in [0, pi] rad, got 4"),
+    (["--slip", "2"], "--slip: expected a slip in [0, 1] (the standard deviation of a slip ratio), got 2"),
+])
+def test_the_cli_names_the_option_out_of_range_before_the_log_is_read(option, said, tmp_path, capsys):
+    """'--noise nan' said 'noise must be in [0, 1] (per rad), resolution in [0, pi] rad and slip in [0, 1] ..., got
+    nan, 0, 0' (three ranges, no option named) and '-n 1' 'Monte Carlo needs at least 2 runs' after reading the
+    LOG; now the option, before (a LOG that does not exist is not reached)."""
+    from wmrkit.cli.main import main
+
+    assert main(["batch", "montecarlo", "diff-drive", str(tmp_path / "none.csv"), "--workers", "0", *option]) == 2
+    assert capsys.readouterr().err == f"wmrkit: error: {said}\n"
+
+
+def test_monte_carlo_names_the_argument_out_of_range(diff):
+    log = path_log(diff, "arc", 5.0)
+    for kwargs, said in (({"per_rad": -1.0}, "per_rad: noise must be in"), ({"slip_std": 1.5}, "slip_std: expected"),
+                         ({"resolution": math.inf}, "resolution: resolution must be in")):
+        with pytest.raises(BatchError, match=f"^{said}"):
+            monte_carlo(diff, log, 4, **kwargs)

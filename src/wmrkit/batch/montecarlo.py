@@ -182,6 +182,27 @@ def study_cost(model: OdometryModel, log: JointLog, runs: int) -> float:
     return runs * (len(log) * per_sample + per_run)
 
 
+def _whole(n: object) -> bool:
+    return isinstance(n, int | np.integer) and not isinstance(n, bool)
+
+
+def check_study(runs: int, per_rad: float, resolution: float, slip_std: float,
+                names: tuple[str, str, str, str] = ("runs", "per_rad", "resolution", "slip_std")) -> None:
+    """Refuse (:class:`BatchError` naming the argument by `names`: the CLI's options) a number of `runs` outside
+    ``[2, MAX_RUNS]`` and noise levels that are not numbers in range; one message said all three ranges, naming
+    none ("noise must be in ..., got nan, 0, 0")."""
+    if not _whole(runs) or not 2 <= runs <= MAX_RUNS:
+        raise BatchError(f"{names[0]}: a Monte Carlo study needs at least 2 runs and at most {MAX_RUNS}, got {runs!r}")
+    ranges = ((per_rad, 1.0, "noise must be in [0, 1] (per rad)"), (resolution, math.pi, "resolution must be in "
+              "[0, pi] rad"), (slip_std, 1.0, "expected a slip in [0, 1] (the standard deviation of a slip ratio)"))
+    for name, (value, top, expected) in zip(names[1:], ranges, strict=True):
+        if isinstance(value, bool) or not isinstance(value, Real):  # text: the range check raised TypeError
+            raise BatchError(f"{name}: expected a number (rad^2/rad, rad, a ratio; the Python API reads no units), "
+                             f"got {value!r}")
+        if not 0 <= value <= top:
+            raise BatchError(f"{name}: {expected}, got {value:g}")
+
+
 def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4, resolution: float = 0.0,
                 slip_std: float = 0.0, method: str = "exact", seed: int = 0, block: int = 256,
                 runner: Engine | None = None, progress: bool = False) -> MonteCarloResult:
@@ -189,18 +210,9 @@ def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4
     from ..odometry.covariance import JointNoise
     from ..odometry.pipeline import odometry
 
-    whole = lambda n: isinstance(n, int | np.integer) and not isinstance(n, bool)  # noqa: E731
-    if not whole(runs) or not 2 <= runs <= MAX_RUNS:
-        raise BatchError(f"Monte Carlo needs at least 2 runs and at most {MAX_RUNS}, got {runs!r}")
-    if not whole(block) or block < 1:  # 0 raised range()'s ValueError, a negative one 'need at least one array'
+    check_study(runs, per_rad, resolution, slip_std)
+    if not _whole(block) or block < 1:  # 0 raised range()'s ValueError, a negative one 'need at least one array'
         raise BatchError(f"block: expected a whole number of runs >= 1, got {block!r}")
-    for name, value in (("per_rad", per_rad), ("resolution", resolution), ("slip_std", slip_std)):
-        if isinstance(value, bool) or not isinstance(value, Real):  # text: the range check raised TypeError
-            raise BatchError(f"{name}: expected a number (rad^2/rad, rad, a ratio; the Python API reads no units), "
-                             f"got {value!r}")
-    if not (0 <= per_rad <= 1 and 0 <= resolution <= math.pi and 0 <= slip_std <= 1):
-        raise BatchError(f"noise must be in [0, 1] (per rad), resolution in [0, pi] rad and slip in [0, 1] (the "
-                         f"standard deviation of a slip ratio), got {per_rad:g}, {resolution:g}, {slip_std:g}")
     check_seed(seed, BatchError)
     if len(log) < 2:  # no motion to perturb (every run failed in the kernel, naming neither log nor option)
         raise BatchError(f"{log.source}: {len(log)} sample{'s' * (len(log) != 1)}: a Monte Carlo study needs a log of "

@@ -274,7 +274,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
 
 def run_montecarlo(args: argparse.Namespace) -> int:
     """Monte Carlo against the analytic covariance; prints both standard deviations."""
-    from ..batch.montecarlo import monte_carlo, path_log, plot_monte_carlo
+    from ..batch.montecarlo import check_study, monte_carlo, path_log, plot_monte_carlo
 
     robot = load_robot(args.robot)
     check_plot_path(args.plot)
@@ -283,6 +283,8 @@ def run_montecarlo(args: argparse.Namespace) -> int:
     from ..odometry.model import odometry_model
 
     model = odometry_model(robot)
+    resolution = parse_angle(args.resolution, "--resolution")  # before the log is read or the path sampled
+    check_study(args.runs, args.noise, resolution, args.slip, ("-n/--runs", "--noise", "--resolution", "--slip"))
     if args.log is not None and args.rate is not None:  # the log's own times are used: it was ignored silently
         raise WmrkitError("--rate sets the sample rate of a built-in --path; a LOG keeps its own times")
     if args.log is not None and Path(args.log).exists() and not Path(args.log).is_file():  # a FIFO: read forever
@@ -300,8 +302,7 @@ def run_montecarlo(args: argparse.Namespace) -> int:
             raise WmrkitError(f"--rate must be > 0 Hz, got {rate}")
         log = path_log(robot, args.path, rate)
     with _runner(args) as runner:
-        result = monte_carlo(robot, log, args.runs, per_rad=args.noise,
-                             resolution=parse_angle(args.resolution, "--resolution"), slip_std=args.slip,
+        result = monte_carlo(robot, log, args.runs, per_rad=args.noise, resolution=resolution, slip_std=args.slip,
                              method=args.method, seed=args.seed, runner=runner, progress=_progress(args))
     if args.plot:
         plot_monte_carlo(result, args.plot)
