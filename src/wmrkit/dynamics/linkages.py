@@ -27,6 +27,7 @@ import numpy as np
 from ..couplings import linkage_law
 from ..errors import WmrkitError
 from ..kinematics.linkage_law import LINKAGE_TOL, law
+from ..wheels import wrap_angle
 from . import _setpoints
 
 #: A heading set-point [rad] (a torque file's, :func:`wmrkit.dynamics.programs.read_torques`) farther than this from
@@ -134,7 +135,7 @@ def first_breach(model, headings: np.ndarray, commanded: set[int]) -> int | None
     if len(plan):
         bad |= (_law_offs(model, plan, model.robot.beta_of_heading(headings))[1] > SETPOINT_TOL).any(axis=1)
     for j, _, want in _geared(model, headings, commanded):
-        bad |= np.abs(headings[:, j] - want) > SETPOINT_TOL
+        bad |= _gear_off(headings[:, j], want) > SETPOINT_TOL
     return int(np.argmax(bad)) if bad.any() else None
 
 
@@ -149,7 +150,7 @@ def first_ik_breach(model, headings: np.ndarray, servoed: set[int]) -> int | Non
     if len(plan):
         bad |= (_law_offs(model, plan, model.robot.beta_of_heading(headings))[1] > LINKAGE_TOL).any(axis=1)
     for j, _, want in _geared(model, headings, servoed):
-        bad |= np.abs(headings[:, j] - want) > SETPOINT_TOL
+        bad |= _gear_off(headings[:, j], want) > SETPOINT_TOL
     return int(np.argmax(bad)) if bad.any() else None
 
 
@@ -159,11 +160,17 @@ def gear_breach(model, headings: np.ndarray, commanded: set[int],
     a ``gear`` the dynamics hold between steering joints (:func:`_geared`): ``(follower, reference, heading the gear
     gives it, the gear's name)``; None when they agree (within `tol` [rad])."""
     for j, ref, want in _geared(model, headings, commanded):
-        if abs(headings[j] - want) > tol:
+        if _gear_off(headings[j], want) > tol:
             steer = f"{model.robot.steer_names[j]}.steer"
             name = next(c.channel_name for c in model.robot.couplings if c.kind == "gear" and steer in c.joints)
             return j, ref, float(want), name
     return None
+
+
+def _gear_off(heading: np.ndarray, want: np.ndarray) -> np.ndarray:
+    """How far [rad] a follower's `heading` is from the one its gear gives it, `want`, the short way round (a
+    heading is an orientation: 179 deg and -181 deg are one). ``(...), (...) -> (...)``."""
+    return np.abs(wrap_angle(np.asarray(heading) - want))
 
 
 def _geared(model, headings: np.ndarray, commanded: set[int]) -> list[tuple[int, int, np.ndarray]]:
