@@ -241,6 +241,9 @@ def rerun_stop(model: DynamicModel, s: np.ndarray, stretch: list, fine: float, m
 
 #: How often [s] the re-check of a fixed-step run that left the physical range judges its state (:func:`rerun_stop`).
 ESCAPE_CHECK = 0.01
+#: How often [s] a :class:`~wmrkit.dynamics.simulate.Stepper` judges its state's range within one advance (it
+#: records no states; every ESCAPE_CHECK made a 10 s advance of a 1 kHz run five times as long).
+RANGE_CHECK = 0.1
 
 
 def first_escape(model: DynamicModel, lever: np.ndarray, t: np.ndarray, states: np.ndarray, t_run: float,
@@ -333,14 +336,16 @@ class StepLog:
         return steps
 
     def recheck(self, model: DynamicModel, w: tuple, t_now: float, step: float, method: int, jac_every: int,
-                allow_lift_off: bool) -> None:
-        """Raise :func:`judge`'s error when the stepper stopped at `t_now` [s] (diverged, or the lift-off `w`
-        recorded), after its logged inputs are run again at :func:`recheck_step` from the logged state at most
-        :func:`recheck_budget` of those steps before their end (at the latest the last piece before the stop), for
-        at most that many steps; return when the re-run reproduces the stop. Their end: the last inputs' last knot
-        (the program given), at least `t_now` (the run asked for) and at least :func:`recheck_end` (held past it: a
-        guess of what comes next, a loop's)."""
-        stop = Stop.of_run(model, w, t_now, allow_lift_off)
+                allow_lift_off: bool, far: tuple[float, str] | None = None,
+                lever: np.ndarray | None = None) -> None:
+        """Raise :func:`judge`'s error when the stepper stopped at `t_now` [s] (diverged, the lift-off `w`
+        recorded, or its state out of the physical range at ``far``: :func:`first_escape`, which the re-run judges
+        too given the :func:`levers` `lever`), after its logged inputs are run again at :func:`recheck_step` from
+        the logged state at most :func:`recheck_budget` of those steps before their end (at the latest the last
+        piece before the stop), for at most that many steps; return when the re-run reproduces the stop. Their end:
+        the last inputs' last knot (the program given), at least `t_now` (the run asked for) and at least
+        :func:`recheck_end` (held past it: a guess of what comes next, a loop's)."""
+        stop = Stop.of_run(model, w, t_now, allow_lift_off, far)
         r, fine, pieces, budget = self.ratio, self.fine, list(self.pieces), recheck_budget(method)
         last = pieces[-1]
         k_end = round(max(t_now, float(last[3][0][-1]), recheck_end(stop.t, step)) / fine)
@@ -353,7 +358,7 @@ class StepLog:
         tail = (last[0] + last[1]) * r
         if tail < k_last:
             stretch.append((tail, k_last - tail, last[3]))
-        again = rerun_stop(model, pieces[j][2], stretch, fine, method, jac_every, allow_lift_off)
+        again = rerun_stop(model, pieces[j][2], stretch, fine, method, jac_every, allow_lift_off, lever)
         error = judge(stop, Recheck(step, fine, again, k_last * fine, k_end * fine, "a run of its inputs"),
                       "(the step argument)")
         if error is not None:

@@ -33,13 +33,17 @@ from .inputs import (  # noqa: F401  (Inputs, joint_column: API)
 from .linkages import linkage_breach
 from .model import DynamicModel
 from .runs import (  # noqa: F401  (LiftOffError, DivergedError: API)
+    RANGE_CHECK,
     DivergedError,
     LiftOffError,
     StepLog,
+    Stop,
     adaptive_run,
     adaptive_samples,
     check_lift_off,
+    first_escape,
     fixed_run,
+    levers,
     lifted,
     records,
 )
@@ -245,6 +249,9 @@ class Stepper:
         self._fight = False  # the last inputs' fight_linkages: hold() lets their servos fight a linkage too
         self._log = StepLog(self.step, self._method) if recheck else None
         self._delta = np.array([w.delta for w in self.model.robot.wheels if w.kind.steers], dtype=float)
+        self._lever = levers(self.model, state[list(self.model.steer_columns)])  # runs.first_escape's
+        self._top_rate = MAX_SPEED / self._lever  # a quick test of the range before first_escape says why
+        self._unrecorded = (np.zeros(0), np.zeros((0, 2 * n)))  # no records: first_escape judges the state alone
 
     @property
     def t(self) -> float:
@@ -254,7 +261,9 @@ class Stepper:
     def advance(self, inputs: Inputs | None, duration: float) -> np.ndarray:
         """Integrate ``round(duration / step)`` steps (at most :data:`MAX_STEPS`) with `inputs` (time axis: the
         simulation time; None: the last ones); changes :attr:`state` in place and returns it. Heading set-points
-        that break a held linkage are refused, as :func:`simulate` refuses them (``Inputs.fight_linkages``: run)."""
+        that break a held linkage are refused, as :func:`simulate` refuses them (``Inputs.fight_linkages``: run).
+        A state that leaves the physical range (:func:`~.runs.first_escape`, judged at the end and every
+        :data:`~.runs.RANGE_CHECK` s) stops it there, as :func:`simulate`'s runs stop (a :class:`DivergedError`)."""
         from ._integrate import run
 
         if inputs is not None:
@@ -264,20 +273,26 @@ class Stepper:
         if not 0 <= duration / self.step <= MAX_STEPS:  # NaN and infinities included
             raise WmrkitError(f"duration must be >= 0 and at most {MAX_STEPS:.0e} steps of {self.step:g} s, got "
                               f"{duration}")
-        n_steps, log = round(duration / self.step), self._log
-        while True:  # with a log, in pieces of at most its span (the same steps), each logged for a re-check
-            steps = n_steps if log is None else log.add(self._k, n_steps, self.state, self._inputs)
+        n_steps, log, far = round(duration / self.step), self._log, None
+        piece, n = max(1, round(RANGE_CHECK / self.step)), self.model.n  # the range judged after each piece
+        while n_steps and far is None:  # with a log, in pieces of at most its span, each logged for a re-check
+            steps = min(n_steps, piece)
+            steps = steps if log is None else log.add(self._k, steps, self.state, self._inputs)
             run(self.state, self._k, self.step, steps, 1 << 62, self._method, self.jac_every, self._acc,
                 self.model.pack, self._inputs, self._w, self._rec, 0, self._phase)
             self._k += steps
             n_steps -= steps
-            if not n_steps:
-                break
+            if (np.abs(self.state[n:]) > self._top_rate).any():
+                far = first_escape(self.model, self._lever, *self._unrecorded, self.t, self.state)
         diverged = not math.isfinite(self.state.sum())  # NaN and infinities propagate into the sum
-        if log is not None and (diverged or lifted(self._w, self.allow_lift_off)):
-            log.recheck(self.model, self._w, self.t, self.step, self._method, self.jac_every, self.allow_lift_off)
+        if log is not None and (diverged or far is not None or lifted(self._w, self.allow_lift_off)):
+            log.recheck(self.model, self._w, self.t, self.step, self._method, self.jac_every, self.allow_lift_off,
+                        far, self._lever)
         if lifted(self._w, self.allow_lift_off):  # first, when the state diverged after it
             check_lift_off(self.model, self._w)
+        if far is not None:
+            what = Stop.escaped(*far).what
+            raise DivergedError(f"{what}; use smaller torques or speeds", far[0], what)
         if diverged:
             raise DivergedError(f"the simulation diverged before t = {self.t:.6g} s; use a smaller step", self.t)
         return self.state
