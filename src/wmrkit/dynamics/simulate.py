@@ -276,14 +276,16 @@ class Stepper:
         n_steps, log, far = round(duration / self.step), self._log, None
         piece, n = max(1, round(RANGE_CHECK / self.step)), self.model.n  # the range judged after each piece
         while n_steps and far is None:  # with a log, in pieces of at most its span, each logged for a re-check
-            steps = min(n_steps, piece)
-            steps = steps if log is None else log.add(self._k, steps, self.state, self._inputs)
-            run(self.state, self._k, self.step, steps, 1 << 62, self._method, self.jac_every, self._acc,
-                self.model.pack, self._inputs, self._w, self._rec, 0, self._phase)
-            self._k += steps
+            steps = n_steps if log is None else log.add(self._k, n_steps, self.state, self._inputs)
             n_steps -= steps
-            if (np.abs(self.state[n:]) > self._top_rate).any():
-                far = first_escape(self.model, self._lever, *self._unrecorded, self.t, self.state)
+            while steps and far is None:  # the same steps, the range judged every `piece` of them
+                part = min(steps, piece)
+                run(self.state, self._k, self.step, part, 1 << 62, self._method, self.jac_every, self._acc,
+                    self.model.pack, self._inputs, self._w, self._rec, 0, self._phase)
+                self._k += part
+                steps -= part
+                if (np.abs(self.state[n:]) > self._top_rate).any():
+                    far = first_escape(self.model, self._lever, *self._unrecorded, self.t, self.state)
         diverged = not math.isfinite(self.state.sum())  # NaN and infinities propagate into the sum
         if log is not None and (diverged or far is not None or lifted(self._w, self.allow_lift_off)):
             log.recheck(self.model, self._w, self.t, self.step, self._method, self.jac_every, self.allow_lift_off,
