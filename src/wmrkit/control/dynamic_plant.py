@@ -107,10 +107,13 @@ def rechecked(loop: Callable[[float, float, bool], dict], duration: float, step:
 def _reproduced(err: WmrkitError, step: float, fine: float) -> WmrkitError:
     """The stop `err` of a loop at `step` [s] that its re-run at `fine` [s] reproduced, as it is; but the state's
     divergence, whose advice (the stepper's: "use a smaller step") the shorter step did not bear out, says both."""
-    from ..dynamics.runs import DivergedError
+    from ..dynamics.runs import DivergedError, Stop
 
     if not isinstance(err, DivergedError):
         return err
+    if err.what != Stop.diverged(err.t).what:  # the state left the physical range: a shorter step is no cure
+        what = f"{err.what} at step {step:g} s, and the same loop at step {fine:.3g} s leaves it too"
+        return DivergedError(f"{what}: lower the speeds or the gain", err.t, what)
     what = f"{err.what} at step {step:g} s, and the same loop at step {fine:.3g} s diverges too"
     return DivergedError(f"{what}: lower the speeds or the gain, or use a step below {fine:.3g} s {STEP_ARGUMENT}",
                          err.t, what)
@@ -119,14 +122,15 @@ def _reproduced(err: WmrkitError, step: float, fine: float) -> WmrkitError:
 def _loop_stop(err: WmrkitError) -> Stop:
     """Where a loop through the dynamics stopped, as :func:`~wmrkit.dynamics.runs.judge` takes it (a
     :class:`~wmrkit.dynamics.runs.Stop`): `err` a lift-off, a divergence of the state, or the law's command diverging
-    (:class:`.points.StoppedRun`), each with its time ``t`` [s]."""
+    (:class:`.points.StoppedRun`), each with its time ``t`` [s]; a divergence keeps its own words (a state out of the
+    physical range, :func:`~wmrkit.dynamics.runs.first_escape`, is not "diverged before t")."""
     from ..dynamics.runs import LiftOffError, Stop
 
     if isinstance(err, LiftOffError):
         return Stop.lift_off(err.t, err.contact)
     if isinstance(err, StoppedRun):
         return Stop(err.t, f"the loop diverged at t = {err.t:.6g} s", whose="the loop's")
-    return Stop.diverged(err.t)
+    return Stop(err.t, err.what)  # the state diverged, or left the physical range (its own words)
 
 
 def _dynamics_loop(robot, controller: TwistController, initial_pose: np.ndarray, duration: float, *, period: float,
