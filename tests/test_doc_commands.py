@@ -146,3 +146,31 @@ def test_commands_that_say_what_they_write_run_as_written_and_write_it(tmp_path,
         assert main(command.split()[1:]) == 0, (page, command, capsys.readouterr().err)
         written = [Path(path)] + ([Path(path).with_suffix(other)] if other else [])
         assert all(p.is_file() for p in written), (page, command, written)
+
+
+def test_files_the_commands_read_are_in_the_repository_or_made_on_the_page():
+    """A file a `wmrkit` command of these pages reads (`LOG.csv`, `--torques`, `--slip-weights`, a description) is in
+    the repository, or a line of the page writes it first (`--out`, `> FILE`, `# writes FILE`, `write_log("FILE"`,
+    `savetxt('FILE'`). slip.md read log.csv and calib.json, dynamics.md torques.csv, kinematics.md robot.yaml and
+    odometry.md log.csv and counts.csv that no one had. UPPER-case names (`LOG`, `TRAJ.tum`) are placeholders."""
+    import itertools
+    import shlex
+
+    outputs = ("--out", "--plot", "--report", "--animate", "--trajectories")
+    unmade = []
+    for name in ("dynamics.md", "kinematics.md", "odometry.md", "slip.md"):
+        text, written, inside = (ROOT / "docs" / name).read_text(), set(), False
+        for number, line in enumerate(text.splitlines(), 1):
+            written |= set(re.findall(r"(?:--out|--plot|>|# writes)\s+([\w./-]+\.\w+)", line))
+            written |= set(re.findall(r"""(?:write_\w+|savetxt)\(["']([\w./-]+)["']""", line))
+            if line.startswith("```"):
+                inside = not inside
+            command = re.split(r"\s+#\s", line.strip().removeprefix("$ "))[0]
+            if not inside or not command.startswith("wmrkit "):
+                continue
+            words = shlex.split(command)
+            for before, word in itertools.pairwise(words):
+                if before not in outputs and re.fullmatch(r"[\w./-]+\.(csv|json|ya?ml|tum|txt)", word) \
+                        and not Path(word).stem.isupper() and word not in written and not (ROOT / word).exists():
+                    unmade.append(f"{name}:{number}: {word}")
+    assert unmade == []
