@@ -88,7 +88,7 @@ BAD = {
     "joint-not-on-type": ("actuated: [spin]", "actuated: [steer]", 8,
                           "wheels[0].actuated[0]: no joint 'steer' on a fixed wheel (joints: spin)"),
     "bad-date": ("r: 0.1", "r: 2020-13-45", 7,
-                 "malformed YAML: cannot read '2020-13-45' as timestamp (month must be in 1..12)"),
+                 "wheels[0].r: malformed YAML: cannot read '2020-13-45' as timestamp (month must be in 1..12)"),
     "slip-zero": ("    actuated: [spin]\n", "    actuated: [spin]\n    slip: {lateral: 0, longitudinal: 1}\n", 9,
                   "wheels[0].slip.lateral: must be a number > 0, got 0.0"),
     "slip-missing": ("    actuated: [spin]\n", "    actuated: [spin]\n    slip: {lateral: 2}\n", 9,
@@ -671,11 +671,16 @@ def test_an_error_in_a_wheel_s_type_names_the_wheel(item, tmp_path, capsys):
 @pytest.mark.parametrize(("written", "read_as"), [("010", "8"), ("-010", "-8"), ("1:30", "90"), ("1:30.5", "90.5")])
 def test_numbers_yaml_1_1_reads_otherwise_than_they_look_are_refused(written, read_as):
     """PyYAML follows YAML 1.1: 'position: [010, 0]' put the wheel 8 m ahead (octal), 'r: 1:30' made a 90 m wheel
-    (base 60), without a word. JSON refuses both; YAML 1.2 reads 010 as 10. Now a located error says what YAML read."""
+    (base 60), without a word. JSON refuses both; YAML 1.2 reads 010 as 10. Now a located error says what YAML read,
+    naming the field and the wheel (it gave the file and line only: 'r.yaml:3: malformed YAML: ...')."""
     text = f"name: r\nwheels:\n  - {{name: w, type: fixed, position: [{written}, 0.2], r: 0.1, heading: 0}}\n"
     with pytest.raises(DescriptionError) as err:
         robot_from_text(text, source="r.yaml")
-    assert str(err.value).startswith("r.yaml:3: malformed YAML: ")
+    assert str(err.value).startswith("r.yaml:3: wheels[0].position[0]: malformed YAML: ")
+    assert (err.value.loc, err.value.wheel) == (("wheels", 0, "position", 0), "w")
+    text = f"name: r\nwheels:\n  - name: w\n    type: fixed\n    position: [0.3, 0.2]\n    r: {written}\n"
+    with pytest.raises(DescriptionError, match=r"^r\.yaml:6: wheels\[0\]\.r: malformed YAML: "):
+        robot_from_text(text, source="r.yaml")
     assert f"YAML 1.1 reads it as {read_as}, not as it looks" in str(err.value)
     for plain in ("0", "00", "007", "08", "1_0", "0.5", "00.5", "'010'"):  # read as they look: kept
         text = f"name: r\nwheels:\n  - {{name: w, type: fixed, position: [{plain}, 0.2], r: 0.1, heading: 0}}\n"

@@ -12,7 +12,7 @@ import json
 import os
 import reprlib
 import sys
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -169,6 +169,7 @@ def parse_document(text: str, source: str, fmt: str) -> tuple[yaml.Node | None, 
             what = (f"a number of more than {sys.get_int_max_str_digits()} digits" if "integer string" in str(err)
                     else str(err).splitlines()[0])
             raise DescriptionError(f"malformed JSON: {what}", source=source) from None
+    root = None
     try:
         loader = _SafeLoader(text)  # the reader already rejects some characters
         try:
@@ -180,7 +181,8 @@ def parse_document(text: str, source: str, fmt: str) -> tuple[yaml.Node | None, 
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
-        raise DescriptionError(f"malformed YAML: {problem}", source=source,
+        loc, wheel = _node_at(root, mark)  # a value the constructors refuse ('010'): its field and wheel
+        raise DescriptionError(f"malformed YAML: {problem}", source=source, loc=loc, wheel=wheel,
                                line=None if mark is None else mark.line + 1) from None
     except RecursionError:
         raise DescriptionError("malformed YAML: nesting too deep", source=source) from None
@@ -238,26 +240,43 @@ def compose(text: str) -> yaml.Node | None:
         return None
 
 
-def _reject_duplicate_keys(root: yaml.Node | None, source: str) -> None:
-    """YAML and JSON parsers keep the last of two equal keys; a description must not say a field twice."""
+def _nodes(root: yaml.Node | None) -> Iterator[tuple[yaml.Node, Loc, str | None]]:
+    """Each node of the tree `root` once (an alias's target once), with its location and the name of the wheel
+    (``wheels[i]``) it belongs to, if any; a mapping comes before its values."""
     seen: set[int] = set()
-    stack: list[tuple[yaml.Node | None, Loc]] = [(root, ())]
+    stack: list[tuple[yaml.Node | None, Loc, str | None]] = [(root, (), None)]
     while stack:
-        node, loc = stack.pop()
+        node, loc, wheel = stack.pop()
         if node is None or id(node) in seen:
             continue
         seen.add(id(node))
         if isinstance(node, yaml.MappingNode):
+            wheel = _wheel_name(node, loc) or wheel
+            stack.extend((v, (*loc, k.value) if isinstance(k, yaml.ScalarNode) else loc, wheel) for k, v in node.value)
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend((v, (*loc, i), wheel) for i, v in enumerate(node.value))
+        yield node, loc, wheel
+
+
+def _node_at(root: yaml.Node | None, mark: yaml.Mark | None) -> tuple[Loc, str | None]:
+    """Location and wheel of the innermost node of `root` that starts at `mark`, or ``((), None)``."""
+    if root is None or mark is None:
+        return (), None
+    found = [(loc, wheel) for node, loc, wheel in _nodes(root) if node.start_mark.index == mark.index]
+    return max(found, key=lambda f: len(f[0]), default=((), None))
+
+
+def _reject_duplicate_keys(root: yaml.Node | None, source: str) -> None:
+    """YAML and JSON parsers keep the last of two equal keys; a description must not say a field twice."""
+    for node, loc, wheel in _nodes(root):
+        if isinstance(node, yaml.MappingNode):
             keys: set[str] = set()
-            for k, v in node.value:
+            for k, _ in node.value:
                 if isinstance(k, yaml.ScalarNode) and k.value != "<<":
                     if k.value in keys:
                         raise DescriptionError(f"field '{k.value}' given twice", source=source, loc=(*loc, k.value),
-                                               line=k.start_mark.line + 1, wheel=_wheel_name(node, loc))
+                                               line=k.start_mark.line + 1, wheel=wheel)
                     keys.add(k.value)
-                stack.append((v, (*loc, k.value) if isinstance(k, yaml.ScalarNode) else loc))
-        elif isinstance(node, yaml.SequenceNode):
-            stack.extend((v, (*loc, i)) for i, v in enumerate(node.value))
 
 
 def _wheel_name(node: yaml.MappingNode, loc: Loc) -> str | None:
