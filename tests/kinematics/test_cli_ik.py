@@ -23,8 +23,8 @@ def test_ik_json_has_the_documented_shape(capsys):
     code, out, err = run(capsys, "ik", "swerve-4", "--twist", "1", "0.5", "0.2", "--json")
     assert code == 0 and err == ""
     data = json.loads(out)
-    assert set(data) == {"robot", "wheels", "slip", "out_of_range", "out_of_gear", "out_of_linkage", "feasible",
-                         "warnings"}
+    assert set(data) == {"robot", "wheels", "slip", "out_of_range", "out_of_gear", "out_of_steer_gear",
+                         "out_of_linkage", "feasible", "warnings"}
     assert data["robot"] == "swerve-4"
     assert data["feasible"] is True and data["warnings"] == []
     assert data["out_of_range"] == []

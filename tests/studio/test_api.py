@@ -852,3 +852,17 @@ def test_the_live_natural_length_is_the_analysis_one_to_the_last_bits(robot):
     live, full = live_summary(robot), analyze(robot, resolution=8)
     assert live["characteristic_length"] == full.characteristic_length
     assert live["condition_number"] == full.condition_number
+
+
+def test_drive_names_a_steering_gear_that_cannot_set_the_headings(client):
+    """Two double wheels whose steering a gear turns 1:2, asked for headings 20.6 and -14.0 deg: no wheel slips, the
+    gear is the reason; before, the twist was feasible."""
+    unit = {"type": "double", "heading": 0, "b": 0.06, "r": 0.08}
+    description = {"name": "geared", "wheels": [{**unit, "name": "front", "position": [0.3, 0.2]},
+                                                {**unit, "name": "rear", "position": [-0.3, -0.2]}],
+                   "couplings": [{"kind": "gear", "joints": ["front.steer", "rear.steer"], "ratios": [1, 2]}]}
+    turn = client.post("/api/drive", json={"description": description, "twist": [1, 0, 1]}).json()
+    assert turn["feasible"] is False and turn["slips"] is False
+    assert turn["out_of_steer_gear"] == ["gear(front.steer, rear.steer)"]
+    straight = client.post("/api/drive", json={"description": description, "twist": [1, 0, 0]}).json()
+    assert straight["feasible"] is True and straight["out_of_steer_gear"] == []

@@ -10,6 +10,7 @@ import numpy as np
 from ..couplings import GearWarning
 from ..description import described_type
 from ..errors import WmrkitError, said_warnings
+from ..kinematics.gear_check import steer_breaches
 from ..kinematics.linkage_check import LinkageAngleWarning, ik_breaches
 from ..kinematics.wheel_ik import (
     SLIP_TOL,
@@ -157,6 +158,9 @@ def _infeasible(robot, commands: WheelCommands, twist) -> list[str]:
             asked = ", ".join(f"{j} {_num(commands.rates[robot.rate_names.index(j)])}" for j in c.joints)
             out.append(f"a gear coupling cannot turn its joints so: {c.channel_name} turns them in the ratios "
                        f"{', '.join(f'{k:g}' for k in c.ratios)}, the twist needs {asked} rad/s")
+    if not commands.in_steer_gear.all():
+        for b in steer_breaches(robot, np.asarray(twist, dtype=float), commands.beta, SLIP_TOL):
+            out.append(f"a steering gear cannot set these headings: {b.describe(robot)}")
     if not commands.in_linkage.all():
         for b in ik_breaches(robot, np.asarray(twist, dtype=float), commands.beta, SLIP_TOL):
             out.append(f"a steering linkage cannot set these headings: {b.describe(robot)}, which the twist needs "

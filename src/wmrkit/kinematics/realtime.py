@@ -36,9 +36,10 @@ from ..odometry import _kernels
 from ..odometry._kernels import _cos_sin, _sinc
 from ..robot import Robot
 from ..units import MAX_ANGLE, MAX_TURNS
-from . import _ik_fast, _linkage_kernel, linkage_check, linkage_law
+from . import _gear_kernel, _ik_fast, _linkage_kernel, gear_check, linkage_check, linkage_law
+from ._gear_kernel import steer_breach
 from ._linkage_kernel import _breach
-from .gear_check import GEAR_RTOL, gear_table
+from .gear_check import GEAR_RTOL, gear_table, steer_gears
 from .linkage_law import LINKAGE_TOL
 from .wheel_ik import SLIP_TOL, check_tolerances
 
@@ -47,7 +48,7 @@ from .wheel_ik import SLIP_TOL, check_tolerances
 MAX_CACHE_BYTES = 32 << 20
 
 drop_stale_cache([__file__], [_kernels.__file__, _jit.__file__, _linkage_kernel.__file__, linkage_check.__file__,
-                              linkage_law.__file__])
+                              linkage_law.__file__, _gear_kernel.__file__, gear_check.__file__])
 drop_oversized_cache(__file__, MAX_CACHE_BYTES)
 
 HALF_PI = 0.5 * math.pi
@@ -62,8 +63,8 @@ class Realtime:
     - ``ik(vx, vy, omega, heading, rates_out, heading_out) -> bool``: per-wheel IK of one twist. `heading`
       ``(n_steer,)`` the current headings [rad]; writes the joint rates ``(n_rates,)`` (``robot.rate_names``) and
       the new headings; returns whether the twist is feasible (no fixed wheel slips beyond 1e-9 m/s, every heading
-      within its wheel's ``steer_range``, every gear coupling's rates in its ratios, every held linkage's angles on
-      its law), as ``wheel_commands``.
+      within its wheel's ``steer_range``, every gear coupling's rates in its ratios and a steering gear's angles
+      too, every held linkage's angles on its law), as ``wheel_commands``.
     - ``fk(rates, heading, twist_out)``: the twist ``(3,)`` from the sensed joint rates ``(n_a,)`` (``rate_joints``)
       by the least squares (4.11), at headings ``(n_steer_sensed,)`` of ``steer_joints`` (ignored when constant).
     - ``odometry_step(pose, previous, positions, heading_mid)``: one exact SE(2) step; `pose` ``(3,)`` is updated
@@ -146,6 +147,10 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
     links = linkage_check._plan(robot)  # wheel_commands' in_linkage (linkage_check.linkage_holds), its judge compiled
     link_table, link_start, link_lead, link_x, link_y = links.table, links.start, links.lead, links.x, links.y
     n_links, link_tol = len(links.lead), LINKAGE_TOL
+    sg = steer_gears(robot)  # wheel_commands' in_steer_gear (gear_check.steer_breach, compiled)
+    sg_joint, sg_k, sg_start, sg_rest, sg_x, sg_y = (sg.table.joint, sg.table.ratio, sg.table.start, sg.rest, sg.x,
+                                                     sg.y)
+    n_sgears = len(sg.table.coupling)
 
     def ik(vx, vy, w, heading, rates_out, heading_out):
         if not (float64_vector(rates_out) and float64_vector(heading_out) and heading.shape[0] == n_steer
@@ -200,6 +205,10 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
                 if _breach(link_table, link_start[g], link_start[g + 1], link_lead[g], beta, speed, True, slip_tol,
                            link_tol)[0] >= 0:
                     feasible = False
+        for g in range(n_sgears if feasible else 0):  # a gear between steering joints sets their angles too
+            if steer_breach(sg_joint, sg_k, sg_start[g], sg_start[g + 1], sg_rest, sg_x, sg_y, vx, vy, w, beta,
+                            slip_tol, link_tol)[0] >= 0:
+                feasible = False
         for k in range(n_steer):
             beta[k] = _wrap(beta[k] + delta[k] - HALF_PI)
             if ranged[k] and not _in_range(beta[k], lo[k], width[k]):

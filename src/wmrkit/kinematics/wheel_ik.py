@@ -25,7 +25,7 @@ from ..units import MAX_ANGLE, UnitError, parse_quantity
 from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
 from ._ik_fast import wrap_angle
-from .gear_check import GEAR_RTOL, contact_lever, gear_table, gears_hold, given_gear_breaches
+from .gear_check import GEAR_RTOL, contact_lever, gear_table, gears_hold, given_gear_breaches, steer_gears_hold
 from .linalg import decision_matrix, geared_twist_determined, robot_size, robot_solve
 from .linkage_check import LinkageAngleWarning, given_breaches, linkage_holds
 
@@ -55,8 +55,8 @@ class WheelCommands:
     - ``slip`` ``(..., N)`` [m/s]: lateral slip (3.11) row 0 / (8.14) left at each fixed wheel, 0 elsewhere and
       where it is round-off (``_ik_fast.SLIP_ROUNDOFF``).
     - ``feasible`` ``(...)`` bool: every ``|slip| <= slip_tol``, every heading within its wheel's ``steer_range``,
-      every gear coupling's rates in its ratios (``in_gear``) and every held linkage's angles on its law
-      (``in_linkage``).
+      every gear coupling's rates in its ratios (``in_gear``), every steering gear's angles in its ratios
+      (``in_steer_gear``) and every held linkage's angles on its law (``in_linkage``).
     - ``in_range`` ``(..., N)`` bool: the wheel's heading lies in its ``steer_range`` (True for wheels without one,
       and for those that do not steer). The root of (8.9) is the one closest to the current heading unless only
       the other lies within the range; when neither does the twist is not feasible (the steering cannot reach it).
@@ -72,6 +72,10 @@ class WheelCommands:
     - ``in_linkage`` ``(..., n_couplings)`` bool: a ``linkage``'s steering angles on the ideal law it holds
       (:mod:`~wmrkit.kinematics.linkage_check`: each wheel off it would slip sideways by at most ``slip_tol``);
       True for the other couplings and the linkages with no law to hold.
+    - ``in_steer_gear`` ``(..., n_couplings)`` bool: a ``gear`` between steering joints turns their angles too,
+      ``beta_j - beta_j0 = ratio_j u``: False where it cannot set the angles the twist needs (each wheel it sets
+      off would slip sideways by more than ``slip_tol``; :func:`~wmrkit.kinematics.gear_check.steer_breach`); True
+      for the other couplings.
     """
 
     wheel_names: tuple[str, ...]
@@ -88,6 +92,7 @@ class WheelCommands:
     in_range: np.ndarray
     in_gear: np.ndarray
     in_linkage: np.ndarray
+    in_steer_gear: np.ndarray
     couplings: tuple[Coupling, ...] = ()
 
     def velocity(self, twist_robot: ArrayLike) -> np.ndarray:
@@ -100,8 +105,8 @@ class WheelCommands:
 
         ``{"wheels": {name: {"heading", "spin", "steer_rate", other joint rates...}}, "slip": {name: m/s},
         "out_of_range": [names of wheels outside their steer_range], "out_of_gear": [channel names of the gear
-        couplings the rates break], "out_of_linkage": [those of the linkages the headings break], "feasible":
-        bool}``: ``heading`` [rad] only
+        couplings the rates break], "out_of_steer_gear": [those of the steering gears that cannot set the headings],
+        "out_of_linkage": [those of the linkages the headings break], "feasible": bool}``: ``heading`` [rad] only
         for steered wheels (0 = rolling straight ahead). Only for a single twist (batch shape ``()``).
         """
         if self.feasible.shape != ():
@@ -115,13 +120,13 @@ class WheelCommands:
                 if wheel == name and joint not in ("spin", "steer"):
                     entry[joint] = value
             wheels[name] = entry
+        def broken(held: np.ndarray) -> list[str]:
+            return [c.channel_name for c, ok in zip(self.couplings, held.tolist(), strict=True) if not ok]
+
         return {"wheels": wheels, "slip": dict(zip(self.wheel_names, self.slip.tolist(), strict=True)),
                 "out_of_range": [n for n, ok in zip(self.wheel_names, self.in_range.tolist(), strict=True) if not ok],
-                "out_of_gear": [c.channel_name for c, ok in zip(self.couplings, self.in_gear.tolist(), strict=True)
-                                if not ok],
-                "out_of_linkage": [c.channel_name for c, ok in zip(self.couplings, self.in_linkage.tolist(),
-                                                                    strict=True) if not ok],
-                "feasible": bool(self.feasible)}
+                "out_of_gear": broken(self.in_gear), "out_of_steer_gear": broken(self.in_steer_gear),
+                "out_of_linkage": broken(self.in_linkage), "feasible": bool(self.feasible)}
 
 
 def check_tolerances(speed_tol: float, slip_tol: float) -> None:
@@ -152,6 +157,8 @@ def wheel_commands(
     - a ``gear`` coupling (``robot.couplings``) whose joints the twist asks to turn out of its ratios (a solid rear
       axle asked to turn) makes it False too: ``in_gear``, a departure moving a contact by more than `slip_tol`
       (the floor of the slip check: a turn of 1e-320 rad/s rolls as a side speed of 1e-320 m/s does).
+    - a ``gear`` between steering joints that cannot set the angles (8.9) the twist needs (two double wheels geared
+      1:2 asked for 20.6 and -14.0 deg) makes it False too: ``in_steer_gear`` (:mod:`~wmrkit.kinematics.gear_check`).
     - a ``linkage`` whose held law the angles break (a synchro drive's wheels, turning together, asked to turn the
       robot) makes it False too: ``in_linkage`` (:mod:`~wmrkit.kinematics.linkage_check`).
     """
@@ -190,12 +197,14 @@ def wheel_commands(
     if gears is not None and gears.coupling:
         in_gear[..., list(gears.coupling)] = gears_hold(gears, rates, slip_tol)
     in_linkage = linkage_holds(robot, twist, config, slip_tol)
-    feasible = feasible & np.all(in_gear, axis=-1) & np.all(in_linkage, axis=-1)
+    in_steer_gear = steer_gears_hold(robot, twist, config, slip_tol)
+    feasible = feasible & np.all(in_gear & in_steer_gear & in_linkage, axis=-1)
     return WheelCommands(
         wheel_names=p.wheel_names, rate_names=p.rate_names, steer=_ro(steer), spin=_ro(spin),
         steer_rate=_ro(_columns(rates, p.steer_rate_select, batch, n)), rates=_ro(rates), slip=_ro(slip),
         feasible=_ro(feasible), beta=_ro(config), held=_ro(held), heading=_ro(heading), in_range=_ro(in_range),
         in_gear=_ro(in_gear), in_linkage=_ro(in_linkage), couplings=robot.couplings,
+        in_steer_gear=_ro(in_steer_gear),
     )
 
 

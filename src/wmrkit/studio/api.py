@@ -283,7 +283,8 @@ def drive(request: Any) -> dict[str, Any]:
     return {"twist": twist.tolist(), "wheels": wheels, "heading": dict(zip(robot.steer_names, now_heading.tolist(),
                                                                            strict=True)),
             "feasible": bool(c.feasible) and not slips, "slips": slips, "out_of_range": out_of_range,
-            "out_of_gear": data["out_of_gear"], "out_of_linkage": data["out_of_linkage"],
+            "out_of_gear": data["out_of_gear"], "out_of_steer_gear": data["out_of_steer_gear"],
+            "out_of_linkage": data["out_of_linkage"],
             "residual": residual,
             "icr": twist_icr(twist), "times": t.tolist(), "poses": poses.tolist()}
 

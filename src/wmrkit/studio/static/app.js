@@ -663,6 +663,7 @@ function renderDrive() {
   const why = [];  // an Ackermann turn beyond the rack was 'the wheels would slip (residual 4.9e-16 m/s)'
   if (d.out_of_range.length) why.push(`${d.out_of_range.join(", ")} beyond the steering range`);
   if (d.out_of_gear.length) why.push(`${d.out_of_gear.join(", ")} cannot turn its joints so`);
+  if (d.out_of_steer_gear.length) why.push(`${d.out_of_steer_gear.join(", ")} cannot set these headings`);
   if (d.out_of_linkage.length) why.push(`${d.out_of_linkage.join(", ")} cannot set these headings`);
   if (d.slips || !why.length) why.push(`the wheels would slip (residual ${fmt(d.residual, 3)} m/s)`);
   $("d-feasible").innerHTML = d.feasible ? '<span class="good">feasible: no wheel slips</span>'
