@@ -70,8 +70,8 @@ def test_a_linkage_on_the_commanded_axles_is_not_reported():
 
 def test_feasibility_says_a_linkage_or_steering_gear_that_steers_wheels_together_is_not_considered(tmp_path, capsys):
     """A synchro drive (three wheels on one parallel linkage: it cannot turn) answered "feasible: yes" to a circle
-    without a word of its linkage; the geared units' warning sent the user to ``wmrkit ik``, which does not check a
-    steering gear's angles (it answers "feasible: yes" to headings out of the ratios)."""
+    without a word of its linkage; the geared units' warning sent the user to ``wmrkit ik``, which then did not check a
+    steering gear's angles (it answered "feasible: yes" to headings out of the ratios)."""
     synchro, geared = tmp_path / "synchro.yaml", tmp_path / "geared.json"
     synchro.write_text(SYNCHRO)
     geared.write_text(json.dumps(_geared().to_dict()))
