@@ -28,6 +28,7 @@ import numpy as np
 from ..couplings import GEAR_EXACT_RTOL, GearBreach, gear_breaches
 from ..robot import Robot
 from ..wheels import Wheel, heading_from_beta
+from .linkage_check import Breach
 from .linkage_law import LINKAGE_TOL, remainder
 
 #: A gear's rates are in its ratios when each departs from them by at most this fraction of the command's largest
@@ -205,19 +206,11 @@ def steer_gears_hold(robot: Robot, twist: np.ndarray, beta: np.ndarray, slip_tol
     return out
 
 
-@dataclass(frozen=True)
-class SteerBreach:
+class SteerBreach(Breach):
     """A wheel (steering `column`) at angle `beta` [rad] that the gear at `coupling` (its position in
     ``robot.couplings``) sets at `want` (on the wheel's branch, mod pi) with its `reference` wheel at `ref_beta`;
-    `slip` [m/s] the side speed the wheel would roll at, so set."""
-
-    coupling: int
-    column: int
-    beta: float
-    want: float
-    reference: int
-    ref_beta: float
-    slip: float
+    `slip` [m/s] the side speed the wheel would roll at, so set (a linkage's :class:`.linkage_check.Breach`, worded
+    for a gear)."""
 
     def describe(self, robot: Robot) -> str:
         """``"<gear> (ratios ...) sets <wheel> at heading ... deg with <reference> at ... deg, not ... deg (... deg
