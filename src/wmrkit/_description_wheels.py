@@ -14,7 +14,7 @@ from typing import Any
 
 from .documents import DescriptionError, FieldReader, Loc, hint
 from .dynamics import mass
-from .units import MAX_ANGLE, MAX_TURNS
+from .units import MAX_TURNS
 from .wheels import (
     GEOMETRY_FIELDS,
     KINDS,
@@ -23,6 +23,7 @@ from .wheels import (
     geometry_problem,
     heading_from_beta,
     heading_in_range,
+    heading_limit,
 )
 
 #: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
@@ -157,10 +158,12 @@ def _read_heading(item: Mapping[str, Any], values: dict[str, float], check: Fiel
         check.fail("give either 'heading' (rolling direction, 0 = straight ahead) or 'beta' (the thesis's axle "
                    "angle, heading + 90 deg), not both", (*loc, "heading"))
     heading = check.quantity(item["heading"], "angle", (*loc, "heading"))
-    values["beta"] = float(beta_from_heading(heading, values.get("delta", 0.0)))
-    if abs(values["beta"]) > MAX_ANGLE:  # a heading of 1e6 turns passed, and its beta failed later, unlocated
-        check.fail(f"{item['heading']!r} is more than {MAX_TURNS:g} turns as the thesis's beta (heading - delta + "
-                   "90 deg): no angle to steer by", (*loc, "heading"))
+    delta = values.get("delta", 0.0)
+    if not abs(heading) <= heading_limit(delta):  # 1e6 turns passed, and its beta failed later, unlocated
+        check.fail(f"{item['heading']!r} is beyond +-{heading_limit(delta) / (2 * math.pi):.10g} turns, where the "
+                   f"thesis's beta (heading - delta + 90 deg) of one sign reaches {MAX_TURNS:g} turns: no angle to "
+                   "steer by", (*loc, "heading"))
+    values["beta"] = float(beta_from_heading(heading, delta))
 
 
 def _mecanum_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc) -> Wheel:

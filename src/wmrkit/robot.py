@@ -122,10 +122,16 @@ class Robot:
 
     def beta_of_heading(self, heading: ArrayLike) -> np.ndarray:
         """The thesis's β of the steering wheels from headings: ``(..., n_steer) -> (..., n_steer)`` [rad]."""
-        from .wheels import beta_from_heading
+        from .wheels import beta_from_heading, heading_limit
 
-        heading = as_angles(heading, len(self.steer_names), "heading")
-        return beta_from_heading(heading, _steer_delta(self))
+        heading, delta = as_angles(heading, len(self.steer_names), "heading"), _steer_delta(self)
+        far = ~(np.abs(heading) <= heading_limit(delta))  # as Wheel.with_heading refuses one
+        if far.any():
+            index = np.argwhere(far)[0]
+            raise ShapeError(f"heading: {self.steer_names[index[-1]]}: {heading[tuple(index)]!r} rad is beyond "
+                             f"+-{heading_limit(delta[index[-1]]):.10g} rad, where the thesis's beta (heading - "
+                             "delta + 90 deg) of one sign reaches the limit of every angle (no angle to steer by)")
+        return beta_from_heading(heading, delta)
 
     @property
     def actuated(self) -> tuple[str, ...]:

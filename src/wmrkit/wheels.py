@@ -198,13 +198,13 @@ class Wheel:
     def with_heading(self, heading: float) -> Wheel:
         """The same wheel steered to rolling direction `heading` [rad] (0 = forward along +x)."""
         heading = as_angles([heading], 1, f"{self.name}: heading")[0]
-        beta = float(beta_from_heading(heading, self.delta))
-        if abs(beta) > MAX_ANGLE:  # a heading within the limit whose beta is not: named as the user gave it
-            edge = math.copysign(MAX_ANGLE, beta) + self.delta - HALF_PI
+        limit = heading_limit(self.delta)
+        if not abs(heading) <= limit:  # within as_angles' limit, its beta (or -heading's) not: named as given
             raise WheelError(f"wheel '{self.name}': heading: {heading / (2 * math.pi):.10g} turns is beyond "
-                             f"{edge / (2 * math.pi):.10g} turns, where the thesis's beta (heading - delta + 90 deg) "
-                             f"reaches the limit of every angle, {MAX_TURNS:g} turns (no angle to steer by)")
-        return replace(self, beta=beta)
+                             f"+-{limit / (2 * math.pi):.10g} turns, where the thesis's beta (heading - delta + 90 "
+                             f"deg) of one sign reaches the limit of every angle, {MAX_TURNS:g} turns (no angle to "
+                             "steer by)")
+        return replace(self, beta=float(beta_from_heading(heading, self.delta)))
 
     def elements(self) -> tuple[Element, ...]:
         """The contact elements this wheel expands into (see module docstring)."""
@@ -323,6 +323,13 @@ def heading_from_beta(beta: ArrayLike, delta: ArrayLike = 0.0) -> np.ndarray:
 def beta_from_heading(heading: ArrayLike, delta: ArrayLike = 0.0) -> np.ndarray:
     """The thesis's β from the users' heading: ``beta = heading - delta + pi/2`` (not wrapped). ``(...) -> (...)``."""
     return np.asarray(heading, dtype=float) - delta + HALF_PI
+
+
+def heading_limit(delta: float | np.ndarray) -> float | np.ndarray:
+    """Largest ``|heading|`` [rad] a wheel of offset `delta` takes, ``MAX_ANGLE - |pi/2 - delta|``: where the
+    thesis's β of a heading of one sign or the other (``heading - delta + pi/2``) reaches the limit of every angle.
+    ``(...) -> (...)``. Symmetric: -1e6 turns was taken (an ICR 3.5e9 m away, round-off) where +1e6 was refused."""
+    return MAX_ANGLE - abs(HALF_PI - delta)  # abs: a float stays a float, an array an array
 
 
 def slip_row_entries(beta, l, alpha, d, delta, gamma, r, r_r, sin=np.sin, cos=np.cos):

@@ -136,8 +136,8 @@ def test_a_steer_heading_beyond_the_limit_is_named_as_a_heading(capsys):
     6283186.877975913': the thesis's beta, in radians, though the user gave a heading in turns."""
     assert main(["analyze", "forklift", "--steer", "steer=1e6 turn"]) == 2
     err = capsys.readouterr().err
-    assert err == ("wmrkit: error: --steer steer=1e6 turn: wheel 'steer': heading: 1000000 turns is beyond 999999.75 "
-                   "turns, where the thesis's beta (heading - delta + 90 deg) reaches the limit of every angle, "
-                   "1e+06 turns (no angle to steer by)\n")
-    with pytest.raises(WheelError, match=r"^wheel 'steer': heading: 1000000 turns is beyond 999999.75 turns"):
+    assert err == ("wmrkit: error: --steer steer=1e6 turn: wheel 'steer': heading: 1000000 turns is beyond "
+                   "+-999999.75 turns, where the thesis's beta (heading - delta + 90 deg) of one sign reaches the "
+                   "limit of every angle, 1e+06 turns (no angle to steer by)\n")
+    with pytest.raises(WheelError, match=r"^wheel 'steer': heading: 1000000 turns is beyond \+-999999.75 turns"):
         catalog.load("forklift").with_steering({"steer": 2e6 * np.pi})
