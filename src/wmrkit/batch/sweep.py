@@ -59,6 +59,17 @@ class SweepResult:
                          for b in self.best]}
 
 
+def check_counts(chunk: int, top: int, names: tuple[str, str] = ("chunk", "top")) -> None:
+    """Refuse (:class:`BatchError` naming the argument by `names`: the CLI's options) a `chunk` or `top` that is
+    not an integer >= 1, or a `top` above :data:`MAX_TOP`."""
+    for name, value in zip(names, (chunk, top), strict=True):
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+            raise BatchError(f"{name}: expected an integer >= 1, got {value!r}")
+    if top > MAX_TOP:
+        raise BatchError(f"{names[1]}: {top} is more than {MAX_TOP} best designs (every design is in the table "
+                         "written by --out)")
+
+
 def sweep(robot: Robot, axes: Sequence[Axis], metric: str = "kappa_mean", *, runner: Engine | None = None,
           chunk: int = 4096, out: str | os.PathLike[str] | None = None, top: int = 10, length: float | None = None,
           configs: int = 64, seed: int = 0, progress: bool = False) -> SweepResult:
@@ -66,11 +77,7 @@ def sweep(robot: Robot, axes: Sequence[Axis], metric: str = "kappa_mean", *, run
     natural length of each design); `configs` steering configurations per design for steered robots."""
     if metric not in METRICS:
         raise BatchError(f"unknown metric '{metric}' (metrics: {', '.join(METRICS)})")
-    for name, value in (("chunk", chunk), ("top", top)):
-        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
-            raise BatchError(f"{name}: expected an integer >= 1, got {value!r}")
-    if top > MAX_TOP:
-        raise BatchError(f"--top {top}: at most {MAX_TOP} best designs (every design is in the --out table)")
+    check_counts(chunk, top)
     t0 = time.perf_counter()
     axes = tuple(axes)
     spec = build_spec(robot, list(axes), metric, length=length, configs=configs, seed=seed, progress=progress)

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import catalog
-from ..errors import ShapeError, WmrkitError, said_warnings
+from ..errors import WmrkitError, said_warnings
 from ..limits import same_file
 from ..robot import Robot
 from ..units import Kind, UnitError, parse_quantity
@@ -278,15 +278,25 @@ def steered_robot(spec: str, steer: list[str] | None) -> Robot:
     return with_steer(load_robot(spec), steer)
 
 
+class OptionError(WmrkitError):
+    """A command-line option's value refused, the message starting with the option (``--steer front=2 turn: ...``);
+    `wheel`: the wheel the value names, the ``"wheel"`` of the JSON error (``cli.main.report_error``)."""
+
+    def __init__(self, message: str, *, wheel: str | None = None) -> None:
+        super().__init__(message)
+        self.wheel = wheel
+
+
 def with_steer(robot: Robot, steer: list[str] | None) -> Robot:
     """`robot` at the headings of the ``--steer`` options `steer` (its described ones kept apart: the rest angles
-    a linkage's law is measured from, :mod:`wmrkit.kinematics.linkage_law`)."""
-    from ..wheels import WheelError
-
+    a linkage's law is measured from, :mod:`wmrkit.kinematics.linkage_law`); errors name the option and wheel."""
     for name, value in parse_assignments(steer, "--steer").items():
-        heading = parse_angle(value, f"--steer {name}")
+        try:
+            heading = parse_angle(value, f"--steer {name}")
+        except WmrkitError as err:  # "--steer NAME: cannot read 'fast' as an angle"
+            raise OptionError(str(err), wheel=name) from None
         try:
             robot = robot.with_steering({name: heading})
-        except (ShapeError, WheelError) as err:  # e.g. a beta beyond the angle limit (1e6 turns): name the option
-            raise WmrkitError(f"--steer {name}={value}: {err}") from None
+        except WmrkitError as err:  # a beta beyond the angle limit (1e6 turns), no such wheel, one that does not steer
+            raise OptionError(f"--steer {name}={value}: {err}", wheel=name) from None
     return robot

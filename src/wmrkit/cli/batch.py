@@ -322,9 +322,10 @@ def run_montecarlo(args: argparse.Namespace) -> int:
 
 def run_sweep(args: argparse.Namespace) -> int:
     """A design sweep; prints the best designs."""
-    from ..batch.sweep import plot_sweep, sweep
+    from ..batch.sweep import check_counts, plot_sweep, sweep
     from ..batch.sweep_kernel import parse_vary
 
+    check_counts(args.chunk, args.top, ("--chunk", "--top"))  # by the options' names, before the robot is read
     robot = load_robot(args.robot)
     check_plot_path(args.plot)
     axes = [parse_vary(v, robot) for v in args.vary]

@@ -151,8 +151,10 @@ def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> N
 
     JSON: ``{"error": message, "file": ..., "wheel": ..., "field": ..., "line": ...}``; the place keys are null when the
     error has no such place. A message about a file of the command line (`argv`), ``FILE[:LINE]: [column
-    'NAME': |WHEEL.spin: |WHEEL.steer: ]...`` (logs, torque files, references, trajectories), gives ``file``, ``line``
-    and ``field``.
+    'NAME': |WHEEL.spin: |WHEEL.steer: |lines[I].n: ]...`` (logs, torque files, references, trajectories, points
+    files), gives ``file``, ``line`` and ``field`` (and ``wheel``, that of a joint); one about an option, ``--OPTION[
+    VALUE]: ...`` (or argparse's ``argument --OPTION: ...``), gives the option as ``field`` (and, for ``--steer``,
+    the wheel).
     """
     if not as_json:
         if isinstance(err, UsageError):
@@ -168,8 +170,26 @@ def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> N
             loc = loc[2:]
         data["field"] = ".".join(str(p) for p in loc) or None
     else:
-        data |= _file_place(data["error"], argv)
+        data |= _file_place(data["error"], argv) or _option_place(err, data["error"])
     print(json.dumps(data), file=sys.stderr)
+
+
+#: The option that starts an error's message, as the message names it: ``--chunk: ...``, ``-n/--runs: ...``,
+#: ``--configs must be ...``, ``--steer front=1e7 turn: ...``; and the argument argparse names in a usage error
+#: (``sweep: argument --metric: invalid choice ...``).
+_OPTION_FIRST = re.compile(r"(-\w/--[\w-]+|--[\w-]+)(?=[\s:=]|$)")
+_ARGPARSE_ARGUMENT = re.compile(r"(?:[\w -]+: )?argument ([^\s:]+): ")
+
+
+def _option_place(err: WmrkitError, message: str) -> dict:
+    """``field`` (the option) and ``wheel`` (the wheel its value names, :class:`._common.OptionError`) of an error
+    about an option of the command line; {} when the message names none first."""
+    from ._common import OptionError
+
+    place = (_ARGPARSE_ARGUMENT if isinstance(err, UsageError) else _OPTION_FIRST).match(message)
+    if place is None:
+        return {}
+    return {"field": place.group(1), "wheel": err.wheel if isinstance(err, OptionError) else None}
 
 
 def _file_place(message: str, argv: Sequence[str]) -> dict:
@@ -192,8 +212,12 @@ def _file_place(message: str, argv: Sequence[str]) -> dict:
                      flags=re.S)
     line, column, joint, rest = place.groups()
     missing = re.match(r"\s*missing column '([^']*)'", rest)  # "x.csv:1: missing column 'right.spin' (columns: ...)"
+    if joint is None:  # a place in a JSON file: "p.json: lines[0].n: must be -1, 0 or 1"
+        path = re.match(r"\s*([A-Za-z_]\w*(?:\[\d+\])+(?:\.\w+|\[\d+\])*):(.*)", rest, flags=re.S)
+        joint, rest = (path.group(1), path.group(2)) if path else (None, rest)
     return {"error": rest.strip(), "file": name, "line": int(line) if line else None,
-            "field": column or joint or (missing.group(1) if missing else None)}
+            "field": column or joint or (missing.group(1) if missing else None),
+            "wheel": joint.rsplit(".", 1)[0] if joint and re.search(r"\.(?:spin|steer)$", joint) else None}
 
 
 #: Longest error message printed [characters]; longer ones (quoting huge user text) are cut.
