@@ -107,3 +107,13 @@ def test_a_heading_within_the_limit_is_taken_either_way():
         steered = forklift.with_steering({"steer": 2 * math.pi * turns})
         assert np.isfinite(steered.beta).all()
         assert forklift.beta_of_heading([2 * math.pi * turns]) == pytest.approx(steered.beta, rel=0, abs=0)
+
+
+@pytest.mark.parametrize("value", ["1e300", "-6283185.307179586"])  # -1e6 turns: its beta is within 1e6 turns
+def test_a_logged_heading_beyond_the_limit_names_the_log_row_and_joint(value, tmp_path, capsys):
+    """"heading: angles must be finite numbers of at most 1e+06 turns [rad], got 1e+300": no file, line or joint."""
+    log = tmp_path / "fk.csv"
+    log.write_text(f"time,right_drive.spin,left_drive.spin,steer.steer\n0,0,0,0\n0.1,0.1,0.1,{value}\n")
+    error = _error(["odometry", "forklift", str(log)], capsys)
+    assert (error["file"], error["line"], error["field"], error["wheel"]) == (str(log), 3, "steer.steer", "steer")
+    assert error["error"].startswith(f"heading {float(value):.6g} rad is beyond +-6283183.736 rad")

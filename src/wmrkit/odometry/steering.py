@@ -57,15 +57,25 @@ def check_steer_range(robot: Robot | None, joints: Sequence[str], headings: np.n
     :data:`RANGE_MARGIN` (:class:`SteeringError` located by ``where(row)``): inconsistent data, often degrees read
     as radians (said so when the value is past half a turn and, in degrees, within the range). `headings`
     ``(N, len(joints))``; wheels without a ``steer_range`` are not checked (a multi-turn swerve module may count
-    past a turn)."""
+    past a turn). Every wheel's headings are checked against the limit of every heading
+    (:func:`wmrkit.wheels.heading_limit`: the conversion refused them later, naming neither log nor row)."""
+    from ..wheels import heading_limit
+
     if robot is None:
         return
     for k in steer_columns(joints):
         wheel = joints[k].rpartition(".")[0]
-        rng = robot.wheel(wheel).steer_range if wheel in robot.steer_names else None  # else: convert_steering's
+        if wheel not in robot.steer_names:  # convert_steering's
+            continue
+        col, limit = headings[:, k], heading_limit(robot.wheel(wheel).delta)
+        far = np.flatnonzero(np.abs(col) > limit)
+        if far.size:
+            raise SteeringError(f"{where(int(far[0]))}: {joints[k]}: heading {float(col[far[0]]):.6g} rad is beyond "
+                                f"+-{limit:.10g} rad, where the thesis's beta (heading - delta + 90 deg) of one sign "
+                                "reaches the limit of every angle, 1e+06 turns (no angle to steer by)")
+        rng = robot.wheel(wheel).steer_range
         if rng is None:
             continue
-        col = headings[:, k]
         bad = np.flatnonzero((col < rng[0] - RANGE_MARGIN) | (col > rng[1] + RANGE_MARGIN))
         if bad.size:
             i, value = int(bad[0]), float(col[bad[0]])
