@@ -55,24 +55,35 @@ def between(table, plan, beta, k, s, point, out):
 
 
 def continued(table, plan, beta, out):
-    """`out` ``(K, n_steer)``: the set-points `beta` with each follower of `plan` moved by whole turns to the one
-    its law reaches along the steps from its first row: each step's change of the law, from the row to the law at
-    the step's middle (:func:`between`'s point at 1/2) and on to the next row, each part the short way round (a
-    follower's heading written wrapped, +179 deg then -179 deg, is the law turning 2 deg, not 358)."""
-    point = np.empty(beta.shape[1])
+    """`out` ``(K, n_steer)``: the set-points `beta` moved by whole turns so that each step from a row to the next
+    turns the short way: each column not a follower of `plan` (a leader, any directly commanded steering) by its own
+    change, the short way round; each follower to the turn its law reaches along the steps from its first row: each
+    step's change of the law, from the row to the law at the step's middle (the continued columns' middle) and on to
+    the next row, each part the short way round (a heading written wrapped, +179 deg then -179 deg, turns 2 deg, not
+    358)."""
+    n = beta.shape[1]
+    point, follower = np.empty(n), np.zeros(n, dtype=np.bool_)
+    for q in range(plan.shape[0]):
+        follower[plan[q, 0]] = True
     for k in range(beta.shape[0]):
-        for m in range(beta.shape[1]):
+        for m in range(n):
             out[k, m] = beta[k, m]
     for k in range(beta.shape[0] - 1):
-        for m in range(beta.shape[1]):
-            point[m] = 0.5 * (beta[k, m] + beta[k + 1, m])
+        for m in range(n):
+            if not follower[m]:
+                out[k + 1, m] = _turned(out[k, m] + remainder(beta[k + 1, m] - beta[k, m], 2.0 * math.pi),
+                                        beta[k + 1, m])
+            point[m] = 0.5 * (out[k, m] + out[k + 1, m])
         for q in range(plan.shape[0]):
             j = plan[q, 0]
             mid = angle(table, plan, q, point)
-            reached = out[k, j] + remainder(mid - beta[k, j], 2.0 * math.pi) + remainder(beta[k + 1, j] - mid,
-                                                                                        2.0 * math.pi)
-            turns = np.round((reached - beta[k + 1, j]) / (2.0 * math.pi))  # whole turns: a row kept as it is
-            out[k + 1, j] = beta[k + 1, j] + turns * 2.0 * math.pi
+            out[k + 1, j] = _turned(out[k, j] + remainder(mid - beta[k, j], 2.0 * math.pi)
+                                    + remainder(beta[k + 1, j] - mid, 2.0 * math.pi), beta[k + 1, j])
+
+
+def _turned(reached, row):
+    """`row` moved by the whole turns nearest `reached` (the row kept as it is, bit for bit, but for those)."""
+    return row + np.round((reached - row) / (2.0 * math.pi)) * 2.0 * math.pi
 
 
 def chord_errors(table, plan, beta, rows, pieces, off):

@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike
 from .._shapes import readonly
 from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_TORQUE
-from .linkages import SETPOINT_TOL, first_breach, heading_breach, setpoint_knots
+from .linkages import SETPOINT_TOL, continued, first_breach, heading_breach, setpoint_knots
 from .model import DynamicModel
 
 
@@ -131,7 +131,9 @@ def compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
     """The kernels' inputs (writable C copies: one compiled signature); :class:`ShapeError` naming the field of
     `inputs` whose width does not fit `model` (the kernels would read out of bounds). Heading set-points on the law
     of each held linkage at every knot get knots between them on it (:class:`Inputs`); set-points off it at a knot
-    are refused (:func:`setpoint_problem`), unless ``inputs.fight_linkages``: then both are run as given."""
+    are refused (:func:`setpoint_problem`), unless ``inputs.fight_linkages``: then both are run as given. Each step of
+    a steering set-point between knots turns the short way (:func:`~.linkages.continued`: +179 deg then -179 deg is
+    2 deg, not 358)."""
     arrays = [np.array(getattr(inputs, name), dtype=float, order="C") for name, _ in _INPUT_FIELDS]
     n, s = model.n, len(model.steer_columns)
     for (name, _), a, width in zip(_INPUT_FIELDS, arrays, (n, n, n, n, s, s, s), strict=True):
@@ -151,6 +153,10 @@ def compiled_inputs(model: DynamicModel, inputs: Inputs) -> tuple:
         if len(at) > len(tk):  # the linkages' followers on their laws between the knots
             tau, rref = (np.column_stack([np.interp(at, tk, c) for c in a.T]) for a in (tau, rref))
             tk, beta_ref = at, np.ascontiguousarray(on_law)
+        else:
+            beta_ref = on_law
+    elif s:
+        beta_ref = continued(model, beta_ref, set())  # each step the short way (a heading written wrapped)
     return (tk, np.ascontiguousarray(tau), np.ascontiguousarray(rref), gain, limit, beta_ref, kp, kd,
             _steer_limits(model, inputs.steer_limit))
 

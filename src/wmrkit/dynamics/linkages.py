@@ -235,21 +235,20 @@ def setpoint_knots(model, t: np.ndarray, beta: np.ndarray, commanded: set[int],
     """Knots ``(t, beta)`` whose linear interpolation keeps the set-points of each held linkage on its law between
     rows: times `t` ``(K,)`` [s], steering set-points `beta` ``(K, n_steer)`` [rad] on the law at each row
     (:func:`setpoint_breach`), the indices `commanded` servoed; each follower's rows taken on the turn its law
-    reaches from its first row (:func:`._setpoints.continued`: a heading written wrapped turns the short way).
+    reaches from its first row and every other column's steps taken the short way (:func:`continued`: a heading
+    written wrapped turns the short way).
     Between two rows the reference of each linkage moves linearly and the law sets its commanded followers from it
     (:func:`._setpoints.angle`): each step is cut into even pieces in time, their number raised (at least doubled,
     every step at once) until the followers' interpolation is within `tol` / 2 of the law at the middle of every
     piece (the law is smooth: a short chord's largest error is at its middle); the other columns keep their rows'
-    interpolation. Without a commanded follower the rows are returned as they are; :class:`SetpointKnotsError`
+    interpolation. Without a commanded follower the rows are returned continued; :class:`SetpointKnotsError`
     where more than :data:`MAX_SETPOINT_KNOTS` knots would be inserted (before they are computed)."""
     plan = _law_plan(model, commanded)
+    beta = continued(model, beta, commanded)
     if len(t) < 2 or not len(plan):
         return t, beta
     args = (np.ascontiguousarray(model.pack[17], dtype=float), plan)
-    t, beta = np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(beta, dtype=float)
-    turned = np.empty_like(beta)  # each follower's rows on the turns its law reaches (a wrapped heading: the short way)
-    _loops(len(t) * len(plan)).continued(*args, beta, turned)
-    beta = turned
+    t = np.ascontiguousarray(t, dtype=float)
     pieces, rows = np.ones(len(t) - 1, dtype=np.int64), np.arange(len(t) - 1)
     while len(rows):
         off = np.empty(len(rows))
@@ -267,6 +266,20 @@ def setpoint_knots(model, t: np.ndarray, beta: np.ndarray, commanded: set[int],
     at, on = np.empty(1 + int(pieces.sum())), np.empty((1 + int(pieces.sum()), beta.shape[1]))
     _loops(len(at)).knots(*args, t, beta, pieces, at, on)
     return at, on
+
+
+def continued(model, beta: np.ndarray, commanded: set[int]) -> np.ndarray:
+    """The steering set-points `beta` ``(K, n_steer)`` [rad] moved by whole turns so that each step between rows turns
+    the short way (:func:`._setpoints.continued`): a heading written wrapped, +179 deg then -179 deg, turns 2 deg, not
+    358; the commanded followers of each held linkage (indices `commanded`; none: every column on its own) the way
+    their law turns."""
+    beta = np.ascontiguousarray(beta, dtype=float)
+    if len(beta) < 2:
+        return beta
+    plan, turned = _law_plan(model, commanded), np.empty_like(beta)
+    _loops(len(beta) * max(len(plan), 1)).continued(np.ascontiguousarray(model.pack[17], dtype=float), plan, beta,
+                                                    turned)
+    return turned
 
 
 def _loops(work: int):
