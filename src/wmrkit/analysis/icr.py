@@ -22,6 +22,7 @@ from ..errors import ShapeError
 from ..kinematics.linalg import centred, centroid, characteristic_length, matrix_rank
 from ..kinematics.models import configuration
 from ..robot import Robot
+from ..units import MAX_ANGLE
 from .lines import ConstraintLines, common_point, constraint_lines, element_rows
 
 
@@ -194,7 +195,8 @@ def steer_to_icr(robot: Robot, icr_h: ArrayLike) -> np.ndarray:
     as the thesis's β (``robot.heading_of_beta`` gives the headings, 0 = rolling forward).
 
     Each axle is aimed at the ICR (the branch nearest the described angle, since beta and beta + pi give the same
-    axle); castors and wheels at the ICR keep their described angle. This is the coordination (Ackermann, swerve)
+    axle, the other where the nearest is beyond the angle limit: a beta described within a quarter turn of 1e6
+    turns); castors and wheels at the ICR keep their described angle. This is the coordination (Ackermann, swerve)
     that lets a robot with several steered wheels move (§5.3, consequence 3 of 5.12).
     """
     h = _homogeneous(icr_h)
@@ -206,6 +208,7 @@ def steer_to_icr(robot: Robot, icr_h: ArrayLike) -> np.ndarray:
     ok = np.hypot(dx, dy) > 1e-12 * np.maximum(np.abs(h).max(axis=-1), 1e-300)[..., None]
     axle = np.arctan2(dy, dx) + offset
     branch = axle + np.pi * np.round((described - axle) / np.pi)
+    branch = np.where(np.abs(branch) <= MAX_ANGLE, branch, branch - np.pi * np.sign(branch))  # the limit's side
     beta[..., j] = np.where(ok, branch, described)
     return beta
 

@@ -93,8 +93,9 @@ def configuration(robot: Robot, beta: ArrayLike | None, heading: ArrayLike | Non
 def own_turn(robot: Robot) -> float:
     """The angle [rad] of the robot's own axes random configurations are drawn in: the first wheel's described
     ``beta`` (its axle, or a castor's steering frame), which turns with the robot frame, so a rigid change of frame
-    draws the same configurations of the wheels (the robot's x axis would draw other ones in a turned frame)."""
-    return float(robot.wheels[0].beta) if robot.wheels else 0.0
+    draws the same configurations of the wheels (the robot's x axis would draw other ones in a turned frame); within
+    half a turn of 0 (a beta described near the angle limit of 1e6 turns leaves room to draw about it)."""
+    return math.remainder(robot.wheels[0].beta, 2 * math.pi) if robot.wheels else 0.0
 
 
 def random_steering(robot: Robot, n: int, rng: np.random.Generator) -> np.ndarray:
