@@ -7,6 +7,7 @@ import argparse
 import fnmatch
 import glob
 import importlib
+import itertools
 import json
 import os
 import re
@@ -170,26 +171,50 @@ def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> N
             loc = loc[2:]
         data["field"] = ".".join(str(p) for p in loc) or None
     else:
-        data |= _file_place(data["error"], argv) or _option_place(err, data["error"])
+        data |= _file_place(data["error"], argv) or _option_place(err, data["error"], argv)
     print(json.dumps(data), file=sys.stderr)
 
 
 #: The option that starts an error's message, as the message names it: ``--chunk: ...``, ``-n/--runs: ...``,
 #: ``--configs must be ...``, ``--steer front=1e7 turn: ...``; and the argument argparse names in a usage error
-#: (``sweep: argument --metric: invalid choice ...``).
+#: (``sweep: argument --metric: invalid choice ...``), or the first of those it lists (``park: unrecognized
+#: arguments: --space 1``, ``tyre: ambiguous option: --slip could match ...``, ``calibrate: the following arguments
+#: are required: --reference``).
 _OPTION_FIRST = re.compile(r"(-\w/--[\w-]+|--[\w-]+)(?=[\s:=]|$)")
-_ARGPARSE_ARGUMENT = re.compile(r"(?:[\w -]+: )?argument ([^\s:]+): ")
+_ARGPARSE_ARGUMENT = re.compile(r"(?:[\w -]+: )?(?:argument ([^\s:]+): |(?:unrecognized arguments|ambiguous option|"
+                                r"the following arguments are required): (--[\w-]+))")
+#: The option a message names in parentheses, after the name of its value (``blur (--blur): ...``, ``line width
+#: (--line-width) 100 m ...``, ``duration 1e+12 s ...; give a shorter duration (--duration)``).
+_OPTION_IN_PARENTHESES = re.compile(r"\((--[\w-]+)[^)]*\)")
+_ANY_OPTION = re.compile(r"(?<![\w-])--[A-Za-z][\w-]*")
 
 
-def _option_place(err: WmrkitError, message: str) -> dict:
+def _option_place(err: WmrkitError, message: str, argv: Sequence[str] = ()) -> dict:
     """``field`` (the option) and ``wheel`` (the wheel its value names, :class:`._common.OptionError`) of an error
-    about an option of the command line; {} when the message names none first."""
+    about an option of the command line: one the message starts with, after the words of the command in `argv`
+    (``ik: --twist 1e7: ...``, ``vision calibrate: --size: ...``), or the only option it names, in parentheses
+    (``follow-line: blur (--blur): ...``); {} when it names none so."""
     from ._common import OptionError
 
-    place = (_ARGPARSE_ARGUMENT if isinstance(err, UsageError) else _OPTION_FIRST).match(message)
+    if isinstance(err, UsageError):
+        place = _ARGPARSE_ARGUMENT.match(message)
+        return {} if place is None else {"field": place.group(1) or place.group(2), "wheel": None}
+    rest = _after_command(message, argv)
+    place = _OPTION_FIRST.match(rest)
     if place is None:
-        return {}
+        inside = _OPTION_IN_PARENTHESES.search(rest)
+        if inside is None or set(_ANY_OPTION.findall(rest)) != {inside.group(1)}:
+            return {}
+        place = inside
     return {"field": place.group(1), "wheel": err.wheel if isinstance(err, OptionError) else None}
+
+
+def _after_command(message: str, argv: Sequence[str]) -> str:
+    """`message` without the words of the (sub)command in `argv` it starts with (``locate: ``, ``vision locate: ``,
+    ``follow-line: ``)."""
+    words = list(itertools.takewhile(lambda a: not a.startswith("-"), argv))[:2]
+    prefix = next((p for p in (" ".join(words), *words) if p and message.startswith(f"{p}: ")), None)
+    return message if prefix is None else message[len(prefix) + 2:]
 
 
 def _file_place(message: str, argv: Sequence[str]) -> dict:
