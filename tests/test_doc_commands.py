@@ -13,7 +13,8 @@ PAGES = sorted(p.name for p in (ROOT / "docs").glob("*.md") if command_examples(
 
 
 def test_the_pages_with_command_examples_are_found():
-    assert {"control.md", "vision.md", "wheel-ik.md", "slip-control.md", "limits.md", "parking.md"} <= set(PAGES)
+    assert {"control.md", "vision.md", "wheel-ik.md", "slip-control.md", "limits.md", "parking.md",
+            "batch.md"} <= set(PAGES)
 
 
 @pytest.mark.parametrize("page", PAGES)
