@@ -1,9 +1,10 @@
 """The generated ``in_linkage`` of :func:`wmrkit.kinematics.codegen.write_code` (robots with a held ``linkage``):
 ``wmrkit ik``'s check of steering headings against the linkages' laws (:mod:`.linkage_check`) for a twist.
 
-The Python file carries the judge's own source (:func:`~.linkage_check._breach`, :func:`~.linkage_law.law`,
-:func:`~.linkage_law.leader_of`, :func:`~.linkage_law.remainder`); the C, the same steps printed in C99 (its
-``remainder`` is the IEEE one). Both take the linkages' rows (:func:`~.linkage_law.linkage_table`) as tables.
+The Python file carries the judge's own source (:func:`~.linkage_check._breach` with its ``_reference`` and
+``_breach_at``, :func:`~.linkage_law.law`, :func:`~.linkage_law.leader_of`, :func:`~.linkage_law.remainder`); the
+C, the same steps printed in C99 (its ``remainder`` is the IEEE one). Both take the linkages' rows
+(:func:`~.linkage_law.linkage_table`) as tables.
 """
 
 from __future__ import annotations
@@ -119,7 +120,8 @@ def py_in_linkage(plan: Plan) -> str:
     if not has_linkages(plan):
         return ""
     sources = "\n\n".join(inspect.getsource(f).rstrip() for f in (
-        linkage_law.law, linkage_law.leader_of, linkage_law.remainder, linkage_check._breach))
+        linkage_law.law, linkage_law.leader_of, linkage_law.remainder, linkage_check._reference,
+        linkage_check._breach, linkage_check._breach_at))
     n = len(plan.linkage_names)
     return f'''
 

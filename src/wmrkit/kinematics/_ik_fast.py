@@ -6,8 +6,8 @@ A robot's wheels fall into three groups, each solved for a whole batch of twists
   (rolling row of (3.11); (8.27)/(8.28) for rollers) and a fixed wheel's lateral row (8.14) gives its slip.
 - *steered by the twist*: steerable (centred orientable) and double wheels. The angle zeroing the lateral slip is
   (8.9), ``atan2(-u_x, u_y)`` with ``u`` the velocity of the steering axis; of it and its opposite the one closest to
-  the current angle is kept (the other one when only it is within the wheel's ``steer_range``), and the spin
-  follows from (8.12) with the matching sign.
+  the current angle is kept (the other one when only it is within the wheel's ``steer_range``; a linked wheel the
+  one its linkage sets, :func:`steer_linked`), and the spin follows from (8.12) with the matching sign.
 - *at the current angle*: castors, double castors (and the sub-wheels of a double wheel once its angle is chosen):
   the element rows (3.10) at that angle give the steering rate (8.24) and the spins (8.25).
 """
@@ -24,6 +24,8 @@ from .._shapes import readonly
 from ..errors import SingularError
 from ..robot import Robot
 from ..wheels import generic_slip_rows, geometry_problem, heading_in_range, wrap_angle
+from .linkage_check import _Plan as _LinkPlan
+from .linkage_check import _roots, linkage_turns
 
 TWO_PI = 2.0 * math.pi
 CONSTANT_TYPES = ("fixed", "swedish", "ball", "orthogonal")
@@ -216,6 +218,28 @@ def steer_to_twist(
     return (beta.T.reshape(*batch, n_o), spin.T.reshape(*batch, n_s), held.T.reshape(*batch, n_o))
 
 
+def steer_linked(
+    robot: Robot, p: Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...], speed_tol: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`steer_to_twist`'s angles ``(..., n_o)``, spins ``(..., n_s)`` and held flags ``(..., n_o)`` of the
+    twist-steered wheels at steering `current` ``(..., n_steer)``, each linked wheel it moves set on the root of (8.9)
+    its linkage sets, its spin reversed (:func:`~wmrkit.kinematics.linkage_check.linkage_turns`)."""
+    steered = current if p.only_steerable else current[..., p.steered_beta]
+    angles, spins, held = steer_to_twist(p, twist, steered, speed_tol)
+    if not any(c.kind == "linkage" for c in robot.couplings):
+        return angles, spins, held
+    config = np.broadcast_to(wrap_angle(current), (*batch, p.n_steer)).copy()
+    config[..., p.steered_beta] = angles
+    turn = linkage_turns(robot, twist, config)
+    if turn is None:
+        return angles, spins, held
+    turn = turn[..., p.steered_beta] & ~held
+    if turn.any():
+        angles = np.where(turn, wrap_angle(angles + np.pi), angles)
+        spins = np.where(turn[..., p.steered_spin_of], -spins, spins)
+    return angles, spins, held
+
+
 def _prefer_in_range(p: Plan, beta: np.ndarray, spin: np.ndarray, held: np.ndarray) -> None:
     """Where the closest root's heading is outside its wheel's ``steer_range`` and the other root's is inside,
     take the other root (``beta + pi``, spin negated): the wheel can follow the twist. In place, ``(n_o, m)``."""
@@ -241,12 +265,16 @@ def in_range_one(h: float, lo: float, hi: float, tol: float = 1e-12) -> bool:
     return (h - lo + tol) % TWO_PI - tol <= hi - lo + tol
 
 
-def steering_one(p: Plan, vx: float, vy: float, w: float, current: list[float], speed_tol: float) -> list[float]:
+def steering_one(p: Plan, vx: float, vy: float, w: float, current: list[float], speed_tol: float,
+                 links: _LinkPlan | None = None) -> list[float]:
     """The configuration (thesis angles, ``(n_steer,)``) :func:`steer_to_twist` and :func:`_prefer_in_range` give
     one twist at steering `current`, in plain floats with the same operations (:func:`_steer_block`'s): a few µs
     for a few wheels instead of a hundred, for a loop that needs only the angles (the continuous control loop).
-    Castor-like angles are kept (wrapped), as :func:`~wmrkit.kinematics.wheel_ik.wheel_commands` keeps them."""
+    Castor-like angles are kept (wrapped), as :func:`~wmrkit.kinematics.wheel_ik.wheel_commands` keeps them; with
+    the robot's held linkages `links` (:func:`wmrkit.kinematics.linkage_check._plan`) a linked wheel it moves is
+    set on the root its linkage sets (:func:`wmrkit.kinematics.linkage_check._roots`), as ``wheel_commands`` sets it."""
     config = [wrap_one(c) for c in current]
+    moved = []
     for i, k in enumerate(p.steered_beta.tolist()):
         minus_ux = float(p.steered_y[i]) * w - vx
         uy = float(p.steered_x[i]) * w + vy
@@ -263,6 +291,15 @@ def steering_one(p: Plan, vx: float, vy: float, w: float, current: list[float], 
             if not in_range_one(heading, lo, hi) and in_range_one(heading + math.pi, lo, hi):
                 beta = wrap_one(beta + math.pi)
         config[k] = beta
+        moved.append(k)
+    if links is not None and len(links.lead):
+        speeds = [math.hypot(vx - w * y, vy + w * x) for x, y in zip(links.x.tolist(), links.y.tolist(), strict=True)]
+        turn = [False] * len(config)
+        for g, lead in enumerate(links.lead.tolist()):
+            _roots(links.table, int(links.start[g]), int(links.start[g + 1]), lead, config, speeds, turn)
+        for k in moved:
+            if turn[k]:
+                config[k] = wrap_one(config[k] + math.pi)
     return config
 
 

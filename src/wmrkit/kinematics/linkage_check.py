@@ -70,24 +70,40 @@ def _plan(robot: Robot) -> _Plan:
     return _Plan(*arrays)
 
 
+def _reference(table, first, last, lead, beta, speed):
+    """``ik``'s reference of the linkage of rows `first:last` of `table` (leader column `lead`) at steering angles
+    `beta` and axis speeds `speed` ``(n_steer,)``: the first of its fastest wheels the leader's angle can be found
+    from (the leader, a follower whose law turns it), and the leader's angle it gives, ``(column, angle)``; column -1
+    when none of its axes moves (written to compile: :mod:`._linkage_kernel`)."""
+    top = speed[lead]
+    for r in range(first, last):
+        top = max(top, speed[int(table[r, 0])])
+    if top == 0.0:
+        return -1, 0.0
+    ref, ref_row = lead, -1
+    for r in range(first, last):
+        k = int(table[r, 0])
+        if (table[r, 3] == 0.0 or table[r, 5] != 0.0) and speed[k] > speed[ref]:
+            ref, ref_row = k, r
+    return ref, (beta[lead] if ref_row < 0 else leader_of(table[ref_row], beta[ref]))
+
+
 def _breach(table, first, last, lead, beta, speed, by_speed, slip_tol, tol):
     """The first wheel that the linkage of rows `first:last` of `table` (leader column `lead`) breaks at steering
     angles `beta` ``(n_steer,)``: ``(column, want, reference column, slip)``, column -1 for none (written to compile:
-    :mod:`._linkage_kernel`). `by_speed` (ik): axis speeds `speed`, mod pi on the slip floor, the reference the first
-    of the fastest wheels the leader's angle can be found from (the leader, a follower whose law turns it); else
-    (fk) mod 2 pi within `tol`, the reference the leader."""
-    ref, ref_row = lead, -1
+    :mod:`._linkage_kernel`). `by_speed` (ik): axis speeds `speed`, mod pi on the slip floor, the reference
+    :func:`_reference`'s; else (fk) mod 2 pi within `tol`, the reference the leader."""
+    ref, b = lead, beta[lead]
     if by_speed:
-        top = speed[lead]
-        for r in range(first, last):
-            top = max(top, speed[int(table[r, 0])])
-        if top == 0.0:
+        ref, b = _reference(table, first, last, lead, beta, speed)
+        if ref < 0:
             return -1, 0.0, lead, 0.0
-        for r in range(first, last):
-            k = int(table[r, 0])
-            if (table[r, 3] == 0.0 or table[r, 5] != 0.0) and speed[k] > speed[ref]:
-                ref, ref_row = k, r
-    b = beta[lead] if ref_row < 0 else leader_of(table[ref_row], beta[ref])
+    return _breach_at(table, first, last, lead, beta, speed, by_speed, slip_tol, tol, ref, b)
+
+
+def _breach_at(table, first, last, lead, beta, speed, by_speed, slip_tol, tol, ref, b):
+    """:func:`_breach` from the reference column `ref` and the leader's angle `b` it gives (found once by a caller
+    that also sets the roots, :func:`_roots_at`)."""
     period = math.pi if by_speed else 2.0 * math.pi
     for r in range(first - 1, last):  # the leader, then its followers
         k = lead if r < first else int(table[r, 0])
@@ -98,6 +114,25 @@ def _breach(table, first, last, lead, beta, speed, by_speed, slip_tol, tol):
     return -1, 0.0, ref, 0.0
 
 
+def _roots(table, first, last, lead, beta, speed, turn):
+    """The wheels of the linkage of rows `first:last` of `table` (leader column `lead`) that ``ik``'s steering angles
+    `beta` ``(n_steer,)`` put on the root of (8.9) its law does not set, from :func:`_reference` (axis speeds
+    `speed`), as :func:`_breach` judges them: :func:`_roots_at` (written to compile: :mod:`._linkage_kernel`)."""
+    ref, b = _reference(table, first, last, lead, beta, speed)
+    if ref >= 0:
+        _roots_at(table, first, last, lead, beta, b, turn)
+
+
+def _roots_at(table, first, last, lead, beta, b, turn):
+    """``turn[k] = True`` for each wheel k of the linkage whose angle ``beta[k]`` is more than 90 deg from the angle
+    the law sets it at from the leader's angle `b` (the other root of (8.9) is the linkage's); ``turn`` is left as it
+    is elsewhere."""
+    for r in range(first - 1, last):  # the leader, then its followers
+        k = lead if r < first else int(table[r, 0])
+        if math.cos(beta[k] - (b if r < first else law(table[r], b)[0])) < 0.0:
+            turn[k] = True
+
+
 def _holds(table, start, lead, coupling, beta, speed, slip_tol, tol, out):
     """:func:`linkage_holds` over rows ``(N, n_steer)`` of `beta` and `speed`: `out` ``(N, n_couplings)`` (all True
     on entry) False at each linkage broken (written to compile: :mod:`._linkage_kernel`)."""
@@ -105,6 +140,14 @@ def _holds(table, start, lead, coupling, beta, speed, slip_tol, tol, out):
         for g in range(lead.shape[0]):
             if _breach(table, start[g], start[g + 1], lead[g], beta[i], speed[i], True, slip_tol, tol)[0] >= 0:
                 out[i, coupling[g]] = False
+
+
+def _turns(table, start, lead, beta, speed, out):
+    """:func:`_roots` of every linkage over rows ``(N, n_steer)`` of `beta` and `speed`: `out` ``(N, n_steer)``
+    (all False on entry) True at each wheel on the other root (written to compile: :mod:`._linkage_kernel`)."""
+    for i in range(beta.shape[0]):
+        for g in range(lead.shape[0]):
+            _roots(table, start[g], start[g + 1], lead[g], beta[i], speed[i], out[i])
 
 
 @dataclass(frozen=True)
@@ -179,6 +222,27 @@ def linkage_holds(robot: Robot, twist: np.ndarray, beta: np.ndarray, slip_tol: f
     holds(plan.table, plan.start, plan.lead, plan.coupling, flat_beta, speed, float(slip_tol), LINKAGE_TOL,
           out.reshape(-1, len(robot.couplings)))
     return out
+
+
+def linkage_turns(robot: Robot, twist: np.ndarray, beta: np.ndarray) -> np.ndarray | None:
+    """``(..., n_steer)`` bool: the linked wheels whose angle in ``ik``'s steering `beta` ``(..., n_steer)`` for
+    `twist` ``(..., 3)`` is the root of (8.9) their linkage does not set (:func:`_roots`: more than 90 deg from the
+    law's angle from the linkage's reference wheel, the one :func:`linkage_holds` judges from); None for a robot
+    without a held linkage. ``ik`` turns those it chooses (moving, steered by the twist) half round, spin reversed.
+    A batch of at least :data:`COMPILED_BATCH` twists is judged by the compiled :func:`_turns`."""
+    plan = _plan(robot)
+    if not len(plan.lead):
+        return None
+    n = len(plan.x)
+    batch = np.broadcast_shapes(twist.shape[:-1], beta.shape[:-1])
+    speed = np.broadcast_to(_speeds(plan, twist), (*batch, n)).reshape(-1, n)
+    flat_beta = np.broadcast_to(beta, (*batch, n)).reshape(-1, n)
+    out = np.zeros(flat_beta.shape, dtype=bool)
+    turns = _turns
+    if len(speed) >= COMPILED_BATCH:
+        from ._linkage_kernel import turns
+    turns(plan.table, plan.start, plan.lead, flat_beta, speed, out)
+    return out.reshape(*batch, n)
 
 
 def given_breaches(robot: Robot, beta: np.ndarray, rtol: float) -> list[Breach]:

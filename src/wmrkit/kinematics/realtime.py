@@ -6,7 +6,8 @@ twist pays tens of microseconds of NumPy overhead. :func:`realtime` compiles, on
 robot's geometry frozen in as constants, cached on disk (numba keys it by those constants: another robot's is
 another kernel), so that a later process loads it instead of compiling it again (seconds). Each call then takes
 scalars and caller-owned arrays and writes its results into them: no Python objects are created per call (the ik of
-a robot with a held linkage allocates one array, its steering axes' speeds). The
+a robot with a held linkage allocates two small arrays, its steering axes' speeds and the wheels it turns onto the
+root their linkage sets). The
 numbers are those of the batched path (same formulas: the three wheel groups of ``_ik_fast`` (§8.4), the sensed
 direct model (4.11) of :func:`wmrkit.odometry.odometry_model`, the exact SE(2) step of paper 003 with the same
 inlined sine and cosine). ``benchmarks/bench_realtime.py`` times them
@@ -38,7 +39,7 @@ from ..robot import Robot
 from ..units import MAX_ANGLE, MAX_TURNS
 from . import _gear_kernel, _ik_fast, _linkage_kernel, gear_check, linkage_check, linkage_law
 from ._gear_kernel import steer_breach
-from ._linkage_kernel import _breach
+from ._linkage_kernel import _breach_at, _reference, _roots_at
 from .gear_check import GEAR_RTOL, gear_table, steer_gears
 from .linkage_law import LINKAGE_TOL
 from .wheel_ik import SLIP_TOL, check_tolerances
@@ -182,6 +183,28 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
                     sign = -sign
             if spin_col[i] >= 0:
                 rates_out[spin_col[i]] = -speed * sign * inv_r[i] if moving else 0.0
+        linked = True
+        if n_links:  # each linkage's reference found once: its wheels on the roots it sets, then its law judged
+            axis_speed = np.empty(n_steer)
+            turn = np.zeros(n_steer, dtype=np.bool_)
+            for k in range(n_steer):  # the axes' speeds (linkage_check._speeds)
+                axis_speed[k] = math.hypot(vx - w * link_y[k], vy + w * link_x[k])
+            for g in range(n_links):
+                first, last, lead = link_start[g], link_start[g + 1], link_lead[g]
+                ref, b = _reference(link_table, first, last, lead, beta, axis_speed)
+                if ref < 0:  # no axis moves: nothing to set or break
+                    continue
+                _roots_at(link_table, first, last, lead, beta, b, turn)
+                for i in range(n_o):
+                    k = steered_beta[i]
+                    minus_ux, uy = sy[i] * w - vx, sx[i] * w + vy
+                    if turn[k] and math.sqrt(minus_ux * minus_ux + uy * uy) > speed_tol:  # moving: ik's choice
+                        beta[k] = _wrap(beta[k] + math.pi)
+                        if spin_col[i] >= 0:
+                            rates_out[spin_col[i]] = -rates_out[spin_col[i]]
+                    turn[k] = False
+                breach = _breach_at(link_table, first, last, lead, beta, axis_speed, True, slip_tol, link_tol, ref, b)
+                linked = linked and breach[0] < 0
         for e in range(n_e):  # castor-like elements at the (new) angle: rows (3.10), (8.24), (8.25)
             theta = beta[e_beta[e]] + offset[e] + edelta[e] + egamma[e]
             c, s = math.cos(theta), math.sin(theta)
@@ -191,20 +214,12 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             beta_dot = -lat / (-ed[e] * cdg) if e_castor[e] else 0.0
             rates_out[e_steer[e]] = beta_dot
             rates_out[e_spin[e]] = -(roll + ed[e] * sdg * beta_dot) / (er[e] * math.cos(egamma[e]))
-        feasible = True
+        feasible = linked
         for f in range(n_fixed):
             slip = vx * lateral[0, f] + vy * lateral[1, f] + w * lateral[2, f]
             if abs(slip) > slip_tol and abs(slip) > (abs(vx) * roundoff[0, f] + abs(vy) * roundoff[1, f]
                                                      + abs(w) * roundoff[2, f]):  # not round-off (wheel_commands)
                 feasible = False
-        if n_links and feasible:  # the axes' speeds (linkage_check._speeds), each linkage judged on the angles
-            speed = np.empty(n_steer)
-            for k in range(n_steer):
-                speed[k] = math.hypot(vx - w * link_y[k], vy + w * link_x[k])
-            for g in range(n_links):
-                if _breach(link_table, link_start[g], link_start[g + 1], link_lead[g], beta, speed, True, slip_tol,
-                           link_tol)[0] >= 0:
-                    feasible = False
         for g in range(n_sgears if feasible else 0):  # a gear between steering joints sets their angles too
             if steer_breach(sg_joint, sg_k, sg_start[g], sg_start[g + 1], sg_rest, sg_x, sg_y, vx, vy, w, beta,
                             slip_tol, link_tol)[0] >= 0:

@@ -28,6 +28,7 @@ from ._ik_fast import wrap_angle
 from .gear_check import GEAR_RTOL, contact_lever, gear_table, gears_hold, given_gear_breaches, steer_gears_hold
 from .linalg import decision_matrix, geared_twist_determined, robot_size, robot_solve
 from .linkage_check import LinkageAngleWarning, given_breaches, linkage_holds
+from .linkage_check import _plan as linkage_plan
 
 __all__ = ["GEAR_RTOL", "WheelCommands", "forward_kinematics", "gear_error", "resolve_rate_name", "twist_is_determined",
            "wheel_commands", "wrap_angle"]
@@ -47,7 +48,8 @@ class WheelCommands:
     ``eq=False``: array fields. With ``N`` wheels, ``n_steer`` steering angles and ``n_rates`` joint rates:
 
     - ``steer`` ``(..., N)`` [rad] in ``(-pi, pi]``: steerable and double wheels the angle zeroing the lateral slip
-      (8.9), closest to the current one; castors the current angle; NaN for wheels that do not steer.
+      (8.9), closest to the current one (a linked wheel: the root its linkage sets); castors the current angle; NaN
+      for wheels that do not steer.
     - ``spin`` ``(..., N)`` [rad/s]: spin rate; double wheels and double castors the mean of the two (3.28)/(3.35).
     - ``steer_rate`` ``(..., N)`` [rad/s]: castors (8.24), double castors; 0 for double wheels (angle held
       relative to the body); NaN where the twist alone does not define it (steerable) or there is no joint.
@@ -148,7 +150,8 @@ def wheel_commands(
 
     - steerable / double wheels: angle (8.9) of the two solutions ``b`` and ``b + pi`` closest to the current
       angle (the spin sign flips rather than the wheel turning half round), or the other one when only it is within
-      the wheel's ``steer_range``, spin (8.12) with that sign; where the
+      the wheel's ``steer_range``, spin (8.12) with that sign; a wheel in a held ``linkage`` the root its linkage
+      sets from its reference wheel (:func:`~wmrkit.kinematics.linkage_check.linkage_turns`); where the
       steering axis moves slower than `speed_tol` [m/s] the angle is undefined: current angle kept, spin 0.
     - castor: steering rate (8.24) and spin (8.25) at the current angle; double castor likewise (3.31)-(3.36).
     - Swedish, ball, orthogonal: spin (8.27) and roller rate (8.28, with the roller radius r_r).
@@ -176,7 +179,7 @@ def wheel_commands(
         raise ShapeError(f"twist_robot {twist.shape} and the steering {current.shape}: their batch shapes (all but "
                          "the last axis) do not broadcast") from None
     n = p.n_wheels
-    rates, config, held, spin = _rates(p, twist, current, batch, speed_tol)
+    rates, config, held, spin = _rates(robot, p, twist, current, batch, speed_tol)
     if len(p.fixed_wheels) == 0:
         slip = np.broadcast_to(0.0, (*batch, n))
         feasible = np.broadcast_to(True, batch)
@@ -208,13 +211,13 @@ def wheel_commands(
     )
 
 
-def _rates(p: _ik_fast.Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...],
+def _rates(robot: Robot, p: _ik_fast.Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...],
            speed_tol: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The joint rates, steering configuration, held flags and spins ``(..., N)`` of :func:`wheel_commands`."""
     if p.only_steerable:  # swerve-like: the angles are the configuration, the spins the rates
-        config, rates, held = _ik_fast.steer_to_twist(p, twist, current, speed_tol)
+        config, rates, held = _ik_fast.steer_linked(robot, p, twist, current, batch, speed_tol)
     else:
-        rates, config, held = _general(p, twist, current, batch, speed_tol)
+        rates, config, held = _general(robot, p, twist, current, batch, speed_tol)
     spin = _columns(rates, p.spin_select, batch, p.n_wheels)
     doubles = p.spin2_col >= 0
     if doubles.any():
@@ -231,7 +234,7 @@ def checked_rates(robot: Robot, twist: np.ndarray, beta: np.ndarray) -> tuple[np
     if not ((np.abs(twist) <= MAX_QUERY_RATE).all() and (np.abs(beta) <= MAX_ANGLE).all()):  # NaN included
         c = wheel_commands(robot, twist, beta)  # raises; kept should its bounds ever differ
         return c.rates, c.beta, c.spin
-    rates, config, _, spin = _rates(_ik_fast.plan(robot), twist, beta, (), SPEED_TOL)
+    rates, config, _, spin = _rates(robot, _ik_fast.plan(robot), twist, beta, (), SPEED_TOL)
     return rates, config, spin
 
 
@@ -241,7 +244,8 @@ def checked_steering_config(robot: Robot, twist: np.ndarray, beta: np.ndarray) -
     if not ((np.abs(twist) <= MAX_QUERY_RATE).all() and (np.abs(beta) <= MAX_ANGLE).all()):  # NaN included
         return checked_rates(robot, twist, beta)[1].tolist()  # raises
     vx, vy, w = twist.tolist()
-    return _ik_fast.steering_one(_ik_fast.plan(robot), vx, vy, w, beta.tolist(), SPEED_TOL)
+    links = linkage_plan(robot) if any(c.kind == "linkage" for c in robot.couplings) else None
+    return _ik_fast.steering_one(_ik_fast.plan(robot), vx, vy, w, beta.tolist(), SPEED_TOL, links)
 
 
 def gear_error(coupling: Coupling, rate_names: tuple[str, ...], rates: np.ndarray) -> np.ndarray:
@@ -268,7 +272,7 @@ def _steer_columns(p: _ik_fast.Plan, config: np.ndarray, batch: tuple[int, ...],
 
 
 def _general(
-    p: _ik_fast.Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...], speed_tol: float
+    robot: Robot, p: _ik_fast.Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...], speed_tol: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rates ``(..., n_rates)``, configuration ``(..., n_steer)`` and held flags ``(..., N)`` of any robot."""
     if p.has_constant:  # fixed wheels' spins (3.11), Swedish spins and rollers (8.27)/(8.28)
@@ -284,7 +288,7 @@ def _general(
     if len(p.steered_beta):
         config = np.broadcast_to(wrap_angle(current), (*batch, p.n_steer)).copy()
         held = np.zeros((*batch, p.n_wheels), dtype=bool)
-        angles, spins, held_o = _ik_fast.steer_to_twist(p, twist, current[..., p.steered_beta], speed_tol)
+        angles, spins, held_o = _ik_fast.steer_linked(robot, p, twist, current, batch, speed_tol)
         config[..., p.steered_beta] = angles
         rates[..., p.steered_spin_col] = spins
         held[..., p.steer_wheels[p.steered_beta]] = held_o
