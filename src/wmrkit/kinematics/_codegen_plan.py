@@ -18,7 +18,7 @@ from ..couplings import gear_free, gear_unknowns
 from ..errors import SingularError, WmrkitError, name_list
 from ..robot import TWIST_NAMES, Robot
 from ._symbolic_held import combine, held_gears, substituted_form
-from .gear_check import gear_table
+from .gear_check import gear_table, steer_gears
 from .linalg import free_columns, matrix_rank, nondimensional
 from .linkage_check import _plan as linkage_plan
 from .models import generic_inputs
@@ -81,6 +81,9 @@ class Plan:
         # the held linkages (linkage_check's flat plan: ik's check of the headings) and their names
         self.links = linkage_plan(robot)
         self.linkage_names = tuple(robot.couplings[int(i)].channel_name for i in self.links.coupling)
+        # the gears between steering joints (gear_check's flat tables: ik's out_of_steer_gear) and their names
+        self.steer_gears = steer_gears(robot)
+        self.steer_gear_names = tuple(robot.couplings[i].channel_name for i in self.steer_gears.table.coupling)
 
     def _check_forward(self) -> None:
         beta = np.random.default_rng(7).uniform(-math.pi, math.pi, (3, len(self.robot.steer_names)))

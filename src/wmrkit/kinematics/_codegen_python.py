@@ -7,6 +7,7 @@ import json
 import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
+from . import _codegen_steer_gear
 from ._codegen_linkage import has_linkages, py_constants, py_in_linkage
 from ._codegen_plan import Plan, cse
 from .gear_check import GEAR_RTOL
@@ -92,9 +93,12 @@ def in_gear({args}):
 
 
 def _py_imports(plan: Plan) -> str:
-    """The generated module's imports: numpy, and for the linkages' judge math and numpy as ``np``."""
+    """The generated module's imports: numpy, and for the linkages' or steering gears' judge math and numpy as
+    ``np``."""
     if has_linkages(plan):
         return "\nimport math\n\nimport numpy\n\nnp = numpy  # the linkages' judge (below) names it np\n"
+    if _codegen_steer_gear.has_steer_gears(plan):
+        return "\nimport math\n\nimport numpy\n\nnp = numpy  # the steering gears' judge (below) names it np\n"
     return "\nimport numpy\n"
 
 
@@ -145,7 +149,7 @@ FREE_STEER_NAMES = {tuple(plan.free_steer)!r}
 VELOCITY_NAMES = {tuple(r.velocity_names)!r}
 HEADING_DESCRIBED = {tuple(float(h) for h in r.heading)!r}
 _BETA_OFFSET = {tuple(plan.offsets)!r}  # the thesis's beta = heading + pi/2 - delta
-{_py_unknowns(plan)}{py_constants(plan)}
+{_py_unknowns(plan)}{py_constants(plan)}{_codegen_steer_gear.py_constants(plan)}
 
 
 def _beta(heading):
@@ -186,7 +190,7 @@ def inverse_matrix(heading=None):
     return out
 
 
-{inverse_def}{_py_in_gear(plan)}{py_in_linkage(plan)}
+{inverse_def}{_py_in_gear(plan)}{py_in_linkage(plan)}{_codegen_steer_gear.py_in_steer_gear(plan)}
 
 
 def forward_with_residual(sensed, heading=None):

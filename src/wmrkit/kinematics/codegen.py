@@ -25,7 +25,7 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
 from ..robot import Robot
-from . import _codegen_linkage
+from . import _codegen_linkage, _codegen_steer_gear
 from ._codegen_plan import C_KEYWORDS, CodegenError, Plan, cse, identifier
 from ._codegen_python import python_file
 from .gear_check import GEAR_RTOL
@@ -198,6 +198,11 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
     if _codegen_linkage.has_linkages(plan):  # wmrkit ik's check of the headings against the linkages' laws
         sizes["N_LINKAGES"] = len(plan.linkage_names)
         protos.append(f"int {n}_in_linkage(const double twist[3], {beta_param}, int in_linkage[{p}_N_LINKAGES]);")
+    steer_geared = _codegen_steer_gear.has_steer_gears(plan)
+    if steer_geared:  # wmrkit ik's check of the headings against the gears between steering joints
+        sizes["N_STEER_GEARS"] = len(plan.steer_gear_names)
+        protos.append(f"int {n}_in_steer_gear(const double twist[3], {beta_param}, "
+                      f"int in_steer_gear[{p}_N_STEER_GEARS]);")
     work_bytes = 8 * sizes["N_WORK"]
     header = "\n".join([
         f"/* {n}_kinematics.h: no-slip kinematic models of robot '{_c_comment(r.name)}' (L. Gracia's thesis, ch. 4).",
@@ -229,6 +234,8 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
         *(_c_gear_doc(plan) if plan.geared else []),
         *(_codegen_linkage.c_doc(plan, _c_list(" *   Linkages", plan.linkage_names))
           if _codegen_linkage.has_linkages(plan) else []),
+        *(_codegen_steer_gear.c_doc(plan, _c_list(" *   Steering gears", plan.steer_gear_names))
+          if steer_geared else []),
         " */",
         f"#ifndef {p}_KINEMATICS_H", f"#define {p}_KINEMATICS_H", "",
         *[f"#define {p}_{k} {v}" for k, v in sizes.items()], "",
@@ -258,7 +265,8 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
         "    for (int i = 0; i < 3; ++i) twist[i] = status == 0 ? x[i] : (double)NAN;",
         "    if (status != 0 && residual) *residual = NAN;",
         "    return status;", "}", "", *_c_in_gear(plan, protos[4] if plan.geared else ""),
-        *_codegen_linkage.c_in_linkage(plan, protos[-1]),
+        *_codegen_linkage.c_in_linkage(plan, protos[-2] if steer_geared else protos[-1]),
+        *_codegen_steer_gear.c_in_steer_gear(plan, protos[-1]),
     ])
     return [(f"{n}_kinematics.h", header), (f"{n}_kinematics.c", source)]
 
