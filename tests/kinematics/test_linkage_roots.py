@@ -124,6 +124,35 @@ def test_a_batch_judged_compiled_sets_the_same_roots():
     assert (sides[:, 0] == sides[:, 1]).all() and batch.feasible.all()
 
 
+def ranged_synchro() -> Robot:
+    """A synchro drive whose first wheel steers within +-100 deg and second within [0, 180] deg."""
+    data = synchro().to_dict()
+    data["wheels"][0]["steer_range"] = ["-100 deg", "100 deg"]
+    data["wheels"][1]["steer_range"] = ["0 deg", "180 deg"]
+    return Robot.from_dict({**data, "name": "ranged-synchro"})
+
+
+def test_a_linkage_whose_wheels_fit_their_ranges_only_turned_half_round_is_turned():
+    """A translation at heading 95 deg from current headings -85 deg: w0 (the reference: all axes equally fast) may
+    take -85 deg or 95 deg, both within +-100 deg, and keeps the closer, -85 deg; the linkage then sets w1 at -85 deg,
+    outside [0, 180] deg. Turned half round together (w0 too), all three fit: feasible, every path."""
+    robot = ranged_synchro()
+    twist = [math.cos(math.radians(95)), math.sin(math.radians(95)), 0.0]
+    current = np.radians([-85.0, -85.0, -85.0])
+    c = wheel_commands(robot, twist, heading=current)
+    np.testing.assert_allclose(np.degrees(c.heading), 95.0, atol=1e-9)
+    assert c.feasible and (c.spin > 0).all()
+    rates, out = np.empty(3), np.empty(3)
+    assert realtime(robot).ik(*twist, current, rates, out)
+    np.testing.assert_allclose(out, c.heading, atol=1e-12)
+    np.testing.assert_allclose(rates, c.rates, atol=1e-12)
+    config = checked_steering_config(robot, np.array(twist), robot.beta_of_heading(current))
+    np.testing.assert_allclose(config, c.beta, rtol=0, atol=ULPS)
+    batch = wheel_commands(robot, np.tile(twist, (70, 1)), heading=current)  # the compiled batch
+    assert batch.feasible.all()
+    np.testing.assert_allclose(batch.heading, np.tile(c.heading, (70, 1)), rtol=0, atol=ULPS)
+
+
 def realtime_robots() -> list[Robot]:
     return [car_without_racks(), ackermann_car(1.7, 1.1, -0.4, 0.3), synchro()]
 

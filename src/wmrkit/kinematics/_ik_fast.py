@@ -230,10 +230,12 @@ def steer_linked(
         return angles, spins, held
     config = np.broadcast_to(wrap_angle(current), (*batch, p.n_steer)).copy()
     config[..., p.steered_beta] = angles
-    turn = linkage_turns(robot, twist, config)
+    free = np.zeros((*held.shape[:-1], p.n_steer), dtype=bool)
+    free[..., p.steered_beta] = ~held
+    turn = linkage_turns(robot, twist, config, free)
     if turn is None:
         return angles, spins, held
-    turn = turn[..., p.steered_beta] & ~held
+    turn = turn[..., p.steered_beta]
     if turn.any():
         angles = np.where(turn, wrap_angle(angles + np.pi), angles)
         spins = np.where(turn[..., p.steered_spin_of], -spins, spins)
@@ -294,9 +296,10 @@ def steering_one(p: Plan, vx: float, vy: float, w: float, current: list[float], 
         moved.append(k)
     if links is not None and len(links.lead):
         speeds = [math.hypot(vx - w * y, vy + w * x) for x, y in zip(links.x.tolist(), links.y.tolist(), strict=True)]
-        turn = [False] * len(config)
+        turn, free = [False] * len(config), [k in moved for k in range(len(config))]
         for g, lead in enumerate(links.lead.tolist()):
-            _roots(links.table, int(links.start[g]), int(links.start[g + 1]), lead, config, speeds, turn)
+            _roots(links.table, int(links.start[g]), int(links.start[g + 1]), lead, config, speeds, free, links.lo,
+                   links.width, links.offset, turn)
         for k in moved:
             if turn[k]:
                 config[k] = wrap_one(config[k] + math.pi)

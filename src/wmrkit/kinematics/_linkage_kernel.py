@@ -22,7 +22,9 @@ _judge_names = {**_law_names, "leader_of": compile_cached(with_globals(linkage_l
 _reference = compile_cached(with_globals(linkage_check._reference, **_judge_names))
 _breach_at = compile_cached(with_globals(linkage_check._breach_at, **_judge_names))
 _breach = compile_cached(with_globals(linkage_check._breach, _reference=_reference, _breach_at=_breach_at))
-_roots_at = compile_cached(with_globals(linkage_check._roots_at, **_judge_names))
+in_range_at = compile_cached(linkage_check.in_range_at)
+_set_roots = compile_cached(with_globals(linkage_check._set_roots, **_judge_names, in_range_at=in_range_at))
+_roots_at = compile_cached(with_globals(linkage_check._roots_at, _set_roots=_set_roots))
 _roots = compile_cached(with_globals(linkage_check._roots, _reference=_reference, _roots_at=_roots_at))
 
 _TABLE = numba.types.Array(numba.float64, 2, "A", readonly=True)
@@ -37,4 +39,7 @@ holds = jit((_TABLE, _INDEX, _INDEX, _INDEX, _ROWS, _ROWS, numba.float64, numba.
 
 #: ``_turns(table, start, lead, beta, speed, out)``: the wheels ``ik`` turns onto the root their linkage sets
 #: (:func:`~wmrkit.kinematics.linkage_check.linkage_turns`), compiled as ``holds``.
-turns = jit((_TABLE, _INDEX, _INDEX, _ROWS, _ROWS, _OUT))(with_globals(linkage_check._turns, _roots=_roots))
+_FLAGS = numba.types.Array(numba.boolean, 2, "A", readonly=True)
+_VECTOR = numba.types.Array(numba.float64, 1, "A", readonly=True)
+turns = jit((_TABLE, _INDEX, _INDEX, _ROWS, _ROWS, _FLAGS, _VECTOR, _VECTOR, _VECTOR, _OUT))(
+    with_globals(linkage_check._turns, _roots=_roots))

@@ -44,7 +44,9 @@ class LinkageAngleWarning(UserWarning):
 class _Plan:
     """A robot's held linkages, flat for a loop (read-only arrays): the follower rows of :func:`linkage_table`,
     linkage ``g``'s rows ``start[g]:start[g + 1]``, its leader's column ``lead[g]`` and its position in
-    ``robot.couplings`` ``coupling[g]``; the steering axes ``x``, ``y`` [m] ``(n_steer,)``."""
+    ``robot.couplings`` ``coupling[g]``; the steering axes ``x``, ``y`` [m], the ``steer_range`` as its start ``lo``
+    and ``width`` [rad] (0 and inf without one) and ``offset`` = ``delta - pi/2`` (heading = beta + offset), each
+    ``(n_steer,)``."""
 
     table: np.ndarray
     start: np.ndarray
@@ -52,6 +54,9 @@ class _Plan:
     coupling: np.ndarray
     x: np.ndarray
     y: np.ndarray
+    lo: np.ndarray
+    width: np.ndarray
+    offset: np.ndarray
 
 
 @functools.lru_cache(maxsize=64)
@@ -62,9 +67,13 @@ def _plan(robot: Robot) -> _Plan:
     coupling = [next(i for i, c in enumerate(robot.couplings) if c.kind == "linkage" and names[k] in c.joints)
                 for k in leads]
     rows = [table[table[:, 1] == k] for k in leads]
-    xy = np.array([robot.wheel(n).position for n in robot.steer_names], dtype=float).reshape(-1, 2)
+    wheels = [robot.wheel(n) for n in robot.steer_names]
+    xy = np.array([w.position for w in wheels], dtype=float).reshape(-1, 2)
+    ranges = np.array([w.steer_range or (0.0, math.inf) for w in wheels], dtype=float).reshape(-1, 2)
     arrays = (np.concatenate([table[:0], *rows]), np.cumsum([0, *map(len, rows)]).astype(np.int64),
-              np.array(leads, dtype=np.int64), np.array(coupling, dtype=np.int64), xy[:, 0].copy(), xy[:, 1].copy())
+              np.array(leads, dtype=np.int64), np.array(coupling, dtype=np.int64), xy[:, 0].copy(), xy[:, 1].copy(),
+              ranges[:, 0].copy(), ranges[:, 1] - ranges[:, 0],
+              np.array([w.delta - 0.5 * math.pi for w in wheels], dtype=float))
     for a in arrays:
         a.flags.writeable = False
     return _Plan(*arrays)
@@ -114,23 +123,44 @@ def _breach_at(table, first, last, lead, beta, speed, by_speed, slip_tol, tol, r
     return -1, 0.0, ref, 0.0
 
 
-def _roots(table, first, last, lead, beta, speed, turn):
+def _roots(table, first, last, lead, beta, speed, free, lo, width, offset, turn):
     """The wheels of the linkage of rows `first:last` of `table` (leader column `lead`) that ``ik``'s steering angles
-    `beta` ``(n_steer,)`` put on the root of (8.9) its law does not set, from :func:`_reference` (axis speeds
+    `beta` ``(n_steer,)`` put on a root of (8.9) the linkage does not set, from :func:`_reference` (axis speeds
     `speed`), as :func:`_breach` judges them: :func:`_roots_at` (written to compile: :mod:`._linkage_kernel`)."""
     ref, b = _reference(table, first, last, lead, beta, speed)
     if ref >= 0:
-        _roots_at(table, first, last, lead, beta, b, turn)
+        _roots_at(table, first, last, lead, beta, b, free, lo, width, offset, turn)
 
 
-def _roots_at(table, first, last, lead, beta, b, turn):
-    """``turn[k] = True`` for each wheel k of the linkage whose angle ``beta[k]`` is more than 90 deg from the angle
-    the law sets it at from the leader's angle `b` (the other root of (8.9) is the linkage's); ``turn`` is left as it
-    is elsewhere."""
+def _roots_at(table, first, last, lead, beta, b, free, lo, width, offset, turn):
+    """``turn[k]`` for each wheel k of the linkage that ik chose the root of (``free[k]``: moving, steered by the
+    twist): whether its angle ``beta[k]`` is more than 90 deg from the angle the law sets it at from the leader's
+    angle `b`; from ``b + pi`` (every such wheel, the reference's too, turned with it) when that puts all of them
+    within their steering ranges (``heading = beta + offset`` at most ``width`` counter-clockwise from ``lo``) and
+    `b` does not. ``turn`` is left as it is elsewhere."""
+    if not _set_roots(table, first, last, lead, beta, b, free, lo, width, offset, turn, True):
+        if _set_roots(table, first, last, lead, beta, b + math.pi, free, lo, width, offset, turn, False):
+            _set_roots(table, first, last, lead, beta, b + math.pi, free, lo, width, offset, turn, True)
+
+
+def _set_roots(table, first, last, lead, beta, b, free, lo, width, offset, turn, write):
+    """Whether every free wheel of the linkage fits its steering range on the root the law sets from the leader's
+    angle `b`, those roots written to ``turn`` (True: the other one) if `write`."""
+    fits = True
     for r in range(first - 1, last):  # the leader, then its followers
         k = lead if r < first else int(table[r, 0])
-        if math.cos(beta[k] - (b if r < first else law(table[r], b)[0])) < 0.0:
-            turn[k] = True
+        if free[k]:
+            other = math.cos(beta[k] - (b if r < first else law(table[r], b)[0])) < 0.0
+            fits = fits and in_range_at(beta[k] + offset[k] + (math.pi if other else 0.0), lo[k], width[k])
+            if write:
+                turn[k] = other
+    return fits
+
+
+def in_range_at(h, lo, width):
+    """Whether heading `h` [rad] is within `width` counter-clockwise of `lo` (:func:`wmrkit.wheels.heading_in_range`'s
+    operations, tolerance 1e-12; ``width`` inf: no range; written to compile, the ``realtime`` ik's too)."""
+    return (h - lo + 1e-12) % (2.0 * math.pi) - 1e-12 <= width + 1e-12
 
 
 def _holds(table, start, lead, coupling, beta, speed, slip_tol, tol, out):
@@ -142,12 +172,13 @@ def _holds(table, start, lead, coupling, beta, speed, slip_tol, tol, out):
                 out[i, coupling[g]] = False
 
 
-def _turns(table, start, lead, beta, speed, out):
-    """:func:`_roots` of every linkage over rows ``(N, n_steer)`` of `beta` and `speed`: `out` ``(N, n_steer)``
-    (all False on entry) True at each wheel on the other root (written to compile: :mod:`._linkage_kernel`)."""
+def _turns(table, start, lead, beta, speed, free, lo, width, offset, out):
+    """:func:`_roots` of every linkage over rows ``(N, n_steer)`` of `beta`, `speed` and `free`: `out` ``(N,
+    n_steer)`` (all False on entry) True at each wheel to turn onto its other root (written to compile:
+    :mod:`._linkage_kernel`)."""
     for i in range(beta.shape[0]):
         for g in range(lead.shape[0]):
-            _roots(table, start[g], start[g + 1], lead[g], beta[i], speed[i], out[i])
+            _roots(table, start[g], start[g + 1], lead[g], beta[i], speed[i], free[i], lo, width, offset, out[i])
 
 
 @dataclass(frozen=True)
@@ -224,24 +255,26 @@ def linkage_holds(robot: Robot, twist: np.ndarray, beta: np.ndarray, slip_tol: f
     return out
 
 
-def linkage_turns(robot: Robot, twist: np.ndarray, beta: np.ndarray) -> np.ndarray | None:
-    """``(..., n_steer)`` bool: the linked wheels whose angle in ``ik``'s steering `beta` ``(..., n_steer)`` for
-    `twist` ``(..., 3)`` is the root of (8.9) their linkage does not set (:func:`_roots`: more than 90 deg from the
-    law's angle from the linkage's reference wheel, the one :func:`linkage_holds` judges from); None for a robot
-    without a held linkage. ``ik`` turns those it chooses (moving, steered by the twist) half round, spin reversed.
-    A batch of at least :data:`COMPILED_BATCH` twists is judged by the compiled :func:`_turns`."""
+def linkage_turns(robot: Robot, twist: np.ndarray, beta: np.ndarray, free: np.ndarray) -> np.ndarray | None:
+    """``(..., n_steer)`` bool: the linked wheels whose root of (8.9) ``ik`` chose (`free` ``(..., n_steer)``: moving,
+    steered by the twist) and whose angle in its steering `beta` ``(..., n_steer)`` for `twist` ``(..., 3)`` is the
+    root their linkage does not set (:func:`_roots`: from the linkage's reference wheel, the one
+    :func:`linkage_holds` judges from, or all turned half round with it where only that fits their steering ranges);
+    None for a robot without a held linkage. ``ik`` turns them half round, spin reversed. A batch of at least
+    :data:`COMPILED_BATCH` twists is judged by the compiled :func:`_turns`."""
     plan = _plan(robot)
     if not len(plan.lead):
         return None
     n = len(plan.x)
-    batch = np.broadcast_shapes(twist.shape[:-1], beta.shape[:-1])
+    batch = np.broadcast_shapes(twist.shape[:-1], beta.shape[:-1], free.shape[:-1])
     speed = np.broadcast_to(_speeds(plan, twist), (*batch, n)).reshape(-1, n)
     flat_beta = np.broadcast_to(beta, (*batch, n)).reshape(-1, n)
+    flat_free = np.broadcast_to(free, (*batch, n)).reshape(-1, n)
     out = np.zeros(flat_beta.shape, dtype=bool)
     turns = _turns
     if len(speed) >= COMPILED_BATCH:
         from ._linkage_kernel import turns
-    turns(plan.table, plan.start, plan.lead, flat_beta, speed, out)
+    turns(plan.table, plan.start, plan.lead, flat_beta, speed, flat_free, plan.lo, plan.width, plan.offset, out)
     return out.reshape(*batch, n)
 
 

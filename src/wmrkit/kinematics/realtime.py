@@ -40,6 +40,7 @@ from ..units import MAX_ANGLE, MAX_TURNS
 from . import _gear_kernel, _ik_fast, _linkage_kernel, gear_check, linkage_check, linkage_law
 from ._gear_kernel import steer_breach
 from ._linkage_kernel import _breach_at, _reference, _roots_at
+from ._linkage_kernel import in_range_at as _in_range
 from .gear_check import GEAR_RTOL, gear_table, steer_gears
 from .linkage_law import LINKAGE_TOL
 from .wheel_ik import SLIP_TOL, check_tolerances
@@ -147,6 +148,7 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
     n_gears, gear_rtol = len(gears.coupling), GEAR_RTOL
     links = linkage_check._plan(robot)  # wheel_commands' in_linkage (linkage_check.linkage_holds), its judge compiled
     link_table, link_start, link_lead, link_x, link_y = links.table, links.start, links.lead, links.x, links.y
+    link_lo, link_width, link_offset = links.lo, links.width, links.offset
     n_links, link_tol = len(links.lead), LINKAGE_TOL
     sg = steer_gears(robot)  # wheel_commands' in_steer_gear (gear_check.steer_breach, compiled)
     sg_joint, sg_k, sg_start, sg_rest, sg_x, sg_y = (sg.table.joint, sg.table.ratio, sg.table.start, sg.rest, sg.x,
@@ -186,19 +188,21 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
         linked = True
         if n_links:  # each linkage's reference found once: its wheels on the roots it sets, then its law judged
             axis_speed = np.empty(n_steer)
-            turn = np.zeros(n_steer, dtype=np.bool_)
+            turn, free = np.zeros(n_steer, dtype=np.bool_), np.zeros(n_steer, dtype=np.bool_)
             for k in range(n_steer):  # the axes' speeds (linkage_check._speeds)
                 axis_speed[k] = math.hypot(vx - w * link_y[k], vy + w * link_x[k])
+            for i in range(n_o):  # the wheels whose root ik chose: steered by the twist, moving
+                minus_ux, uy = sy[i] * w - vx, sx[i] * w + vy
+                free[steered_beta[i]] = math.sqrt(minus_ux * minus_ux + uy * uy) > speed_tol
             for g in range(n_links):
                 first, last, lead = link_start[g], link_start[g + 1], link_lead[g]
                 ref, b = _reference(link_table, first, last, lead, beta, axis_speed)
                 if ref < 0:  # no axis moves: nothing to set or break
                     continue
-                _roots_at(link_table, first, last, lead, beta, b, turn)
+                _roots_at(link_table, first, last, lead, beta, b, free, link_lo, link_width, link_offset, turn)
                 for i in range(n_o):
                     k = steered_beta[i]
-                    minus_ux, uy = sy[i] * w - vx, sx[i] * w + vy
-                    if turn[k] and math.sqrt(minus_ux * minus_ux + uy * uy) > speed_tol:  # moving: ik's choice
+                    if turn[k]:
                         beta[k] = _wrap(beta[k] + math.pi)
                         if spin_col[i] >= 0:
                             rates_out[spin_col[i]] = -rates_out[spin_col[i]]
@@ -258,13 +262,6 @@ def _wrap(a):
     if y > math.pi:
         return y - two_pi
     return y
-
-
-@compile_cached
-def _in_range(h, lo, width):
-    """wheels.heading_in_range of heading `h`: counter-clockwise from `lo`, within `width` [rad]."""
-    off = (h - lo + 1e-12) % (2.0 * math.pi) - 1e-12
-    return off <= width + 1e-12
 
 
 def _constant_fk(twist_map: np.ndarray):
