@@ -377,3 +377,30 @@ def test_pacejka_forces_are_appendix_7a1_transcribed(shifts, mu_scale, eps, fz, 
     compiled = _kernels.tyre(3, tyre.vector(), fz, v_lat, v_long, v_wheel, v_roll)
     for forces in ((float(got.lateral), float(got.longitudinal)), compiled):
         assert forces == pytest.approx(want, rel=1e-9, abs=1e-9 * fz)
+
+
+velocities = st.floats(-1e3, 1e3) | st.floats(-1e-3, 1e-3)
+
+
+@settings(max_examples=300, deadline=None)
+@given(model=st.sampled_from(["coulomb", "dugoff", "pacejka"]), fz=st.floats(0.0, 1e5), v_lat=velocities,
+       v_long=velocities, v_wheel=velocities, mu=st.floats(0.05, 2.0))
+def test_no_force_exceeds_the_tyre_s_grip(model, fz, v_lat, v_long, v_wheel, mu):
+    """The semi-implicit step re-linearises a force beyond ``Tyre.grip`` (docs/dynamics.md), so the grip must bound
+    every force the model gives, component by component, from standstill to sliding."""
+    params = {"coulomb": {"mu_lat": mu, "mu_long": 0.8}, "dugoff": {"mu": mu}, "pacejka": {"mu_scale": mu}}[model]
+    tyre = Tyre.of(model, params)
+    forces, grip = tyre.forces(fz, v_lat, v_long, v_wheel, v_long - v_wheel), tyre.grip(fz)
+    assert abs(forces.lateral) <= grip.lateral * (1 + 1e-12) + 1e-9
+    assert abs(forces.longitudinal) <= grip.longitudinal * (1 + 1e-12) + 1e-9
+
+
+def test_the_grip_is_mu_fz_and_reached_and_the_linear_tyre_has_none():
+    assert tuple(Tyre.of("dugoff", {"mu": 0.6}).grip(100.0)) == (60.0, 60.0)
+    assert tuple(Tyre.of("coulomb", {"mu_lat": 0.5, "mu_long": 0.9}).grip(100.0)) == (50.0, 90.0)
+    assert np.isinf(Tyre.of("linear").grip([1.0, 2.0])).all()
+    sliding = Tyre.of("dugoff", {"mu": 0.6}).forces(100.0, 0.0, -50.0, 0.01, -50.01)  # full slip: the grip reached
+    assert abs(sliding.longitudinal) == pytest.approx(60.0, rel=1e-3)
+    pacejka = Tyre.of("pacejka")  # its lateral peak 1.25 at standstill is reached at a slow wheel's slip angle
+    lateral = pacejka.forces(100.0, np.linspace(0, 1, 2001) * 0.02, 0.0, 0.001, -0.001).lateral
+    assert np.abs(lateral).max() == pytest.approx(pacejka.grip(100.0).lateral, rel=0.01)

@@ -204,6 +204,26 @@ def pacejka_at_speed(terms, mu_scale, eps, fz, v_lat, v_long, v_wheel, v_roll):
     return load * comb[0], load * comb[1]
 
 
+# ---- grips: the largest force each model gives, per component (the semi-implicit step's bound) --------------
+def coulomb_grip(mu_lat, mu_long, _k, _p3, fz):
+    """Largest ``(|F_lat|, |F_long|)`` of :func:`coulomb_forces`: ``mu Fz`` per component ((7.28) below 1)."""
+    return mu_lat * np.maximum(fz, 0.0), mu_long * np.maximum(fz, 0.0)
+
+
+def dugoff_grip(_cs, _calpha, mu, _eps, fz):
+    """Largest ``(|F_lat|, |F_long|)`` of :func:`dugoff_forces`: ``mu Fz`` (its magnitude ``n f / (1 - |s|)`` is
+    ``mu Fz (1 - lambda / 2)`` below ``lambda = 1``, at most ``mu Fz / 2`` above)."""
+    return mu * np.maximum(fz, 0.0), mu * np.maximum(fz, 0.0)
+
+
+def pacejka_grip(_shifts, mu_scale, _eps, _p3, fz):
+    """Largest ``(|F_lat|, |F_long|)`` of :func:`pacejka_forces` at pure slip: the peaks D of (7.83) and (7.82)
+    at standstill, 1.25 and 0.8, times ``mu_scale Fz`` (they fall with speed; the weights (7.84) are 1 at pure
+    slip and below it at combined slip but for their small shifts)."""
+    load = mu_scale * np.maximum(fz, 0.0)
+    return 1.25 * load, 0.8 * load
+
+
 @dataclass(frozen=True, slots=True)
 class TyreKind:
     """A tyre model: its parameters (name -> default, in order) with units, and its force kernel."""
@@ -213,6 +233,7 @@ class TyreKind:
     params: tuple[tuple[str, float, str], ...]  # (name, default, unit), the kernel's p0, p1, ... in this order
     kernel: Callable
     summary: str
+    grip: Callable | None = None  # (p0, p1, p2, p3, fz) -> largest (|F_lat|, |F_long|); None: no limit (linear)
 
     @property
     def defaults(self) -> dict[str, float]:
@@ -226,11 +247,12 @@ TYRES: dict[str, TyreKind] = {
         TyreKind("linear", 0, (("c_lat", 5e4, "N s/m"), ("c_long", 5e4, "N s/m")), linear_forces,
                  "linear uncoupled friction (7.59), the law under which WLS = MCD"),
         TyreKind("coulomb", 1, (("mu_lat", 0.8, ""), ("mu_long", 0.8, ""), ("k", 50.0, "s/m")), coulomb_forces,
-                 "coupled Coulomb friction: ellipse (7.29)-(7.30), smoothed as (7.28)"),
+                 "coupled Coulomb friction: ellipse (7.29)-(7.30), smoothed as (7.28)", coulomb_grip),
         TyreKind("dugoff", 2, (("cs", 8e4, "N"), ("calpha", 5e4, "N/rad"), ("mu", 0.8, ""), ("eps", 0.01, "m/s")),
-                 dugoff_forces, "Dugoff's tyre: stiffnesses cs, calpha and friction mu"),
+                 dugoff_forces, "Dugoff's tyre: stiffnesses cs, calpha and friction mu", dugoff_grip),
         TyreKind("pacejka", 3, (("shifts", 1.0, ""), ("mu_scale", 1.0, ""), ("eps", 0.01, "m/s")), pacejka_forces,
-                 "magic formula with the speed-dependent coefficients and combined slip of appendix 7.A1"),
+                 "magic formula with the speed-dependent coefficients and combined slip of appendix 7.A1",
+                 pacejka_grip),
     )
 }
 N_PARAMS = 4
@@ -347,6 +369,15 @@ class Tyre:
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # callers check the forces are finite
             f_lat, f_long = self.kind.kernel(*p, *args)
         return TyreForces(np.asarray(f_lat, dtype=float), np.asarray(f_long, dtype=float))
+
+    def grip(self, fz: ArrayLike) -> TyreForces:
+        """The largest force components ``(|F_lat|, |F_long|)`` [N] the model gives at normal load `fz` [N] (any
+        slip): ``mu Fz`` and the like; infinite for the linear model, which does not saturate. ``(...) -> (...)``."""
+        fz = np.asarray(fz, dtype=float)
+        if self.kind.grip is None:
+            return TyreForces(np.full(fz.shape, np.inf), np.full(fz.shape, np.inf))
+        lat, long = self.kind.grip(*self.vector(), fz)
+        return TyreForces(np.asarray(lat, dtype=float), np.asarray(long, dtype=float))
 
     def forces_at_slip(self, fz: ArrayLike, slip_ratio: ArrayLike, slip_angle: ArrayLike,
                        speed: ArrayLike = 2.0) -> TyreForces:
