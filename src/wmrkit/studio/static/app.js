@@ -179,7 +179,7 @@ async function send() {
   if (r.ok) { driveNow(); later("configs", loadConfigurations, 350); later("kappa", loadKappa, 250); }
 }
 const timers = {};
-function later(key, fn, ms) { clearTimeout(timers[key]); timers[key] = setTimeout(fn, ms); }
+function later(key, fn, ms) { clearTimeout(timers[key]); timers[key] = setTimeout(() => { delete timers[key]; fn(); }, ms); }
 
 // The slow answers (/api/configurations, /api/kappa): one request of each in flight, the latest edit waiting
 // (requests do not pile up in the server's threads), and an answer older than the latest request is dropped.
