@@ -25,7 +25,6 @@ from ._kernels import (
     _njit,
     bias,
     contact_forces,
-    grip,
     hold_linkages,
     mass_matrix,
     normal_loads,
@@ -133,15 +132,13 @@ def assemble(t, s, acc, pack, inp, jac, w):
 
 
 def work_arrays(n: int, n_el: int, n_steer: int, n_geared: int = 0) -> tuple:
-    """Scratch arrays of :func:`assemble`, of :func:`solve_geared` (`n_geared`: the columns of the model's gear
-    basis, ``pack[16]``) and of the step's re-linearisation (``w[21:26]``: :func:`_relinearise`; ``w[26]``: 1
-    after one, the next step refreshing the tyre Jacobian)."""
+    """Scratch arrays of :func:`assemble` and of :func:`solve_geared` (`n_geared`: the columns of the model's gear
+    basis, ``pack[16]``)."""
     return (np.zeros((2 * n_el, n)), np.zeros((n, n)), np.zeros((n_steer, n, n)), np.zeros(n_el),
             np.zeros((n_el, 2)), np.zeros((n_el, 2, 2)), np.zeros(n_el), np.zeros(n), np.zeros(n), np.zeros(n),
             np.zeros(n_steer), np.zeros(n_steer), np.zeros(n), np.zeros(n_steer), np.zeros((n, n)),
             np.zeros(1), np.zeros(3), np.zeros((n_geared, n_geared)), np.zeros(n_geared), np.zeros((n, n_geared)),
-            np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n_el, 2)), np.zeros(n), np.zeros(n_el),
-            np.zeros(1), np.zeros((n_el, 2)))
+            np.zeros(n))
 
 
 def model_work_arrays(model) -> tuple:
@@ -235,20 +232,19 @@ def derivative(t, s, acc, pack, inp, w):
     return out
 
 
-#: Newton iterations at most in a semi-implicit step whose linearised tyre forces exceed their grip.
-GRIP_ITERATIONS = 8
-#: How far (relative) a linearised tyre force may exceed the tyre's grip before the step is re-linearised.
-GRIP_SLACK = 1e-3
-
-
 @_inline
-def _implicit_matrix(a, m, g, kdiag, pack, dt, mat):
-    """``mat = M - dt (A' G A + servo terms)``: the matrix of the linearly implicit step (tyre Jacobian `g`)."""
-    n = mat.shape[0]
+def _update_semi_implicit(s, dt, acc, w, pack, linked):
+    """One linearly implicit Euler step from the assembled work arrays `w` (:func:`assemble`): friction and servo
+    Jacobians implicit, then positions with the new velocity.
+
+    The tyre Jacobian ``dF/dv_slip`` is refreshed when the assembly was asked for it and reused otherwise (a W-method).
+    """
+    a, m, g, kdiag, rhs, mat = w[0], w[1], w[5], w[8], w[9], w[14]
+    n = rhs.shape[0]
     for i in range(n):
         for j in range(n):
             mat[i, j] = m[i, j]
-    for e in range(g.shape[0]):
+    for e in range(g.shape[0]):  # mat = M - dt (A' G A + servo terms)
         for i in range(n):
             a0, a1 = a[2 * e, i], a[2 * e + 1, i]
             if a0 == 0.0 and a1 == 0.0:
@@ -266,104 +262,9 @@ def _implicit_matrix(a, m, g, kdiag, pack, dt, mat):
             for d in range(n):
                 if d != c and group[d] == group[c]:
                     mat[c, d] -= dt * kdiag[c] * ratio[d] / ratio[c]
-
-
-@_inline
-def _beyond_grip(a, dnu, d_lin, f, g, fz, pack, dt, pred):
-    """Whether a contact's linearised force ``f + dt g A (dnu - d_lin)`` (the step's, linearised at the velocity
-    change ``dt d_lin``; stored in `pred`) exceeds the tyre's grip (``kernels.grip``) by more than
-    :data:`GRIP_SLACK`."""
-    code, tp = pack[3], pack[4]
-    n = dnu.shape[0]
-    beyond = False
-    for e in range(code.shape[0]):
-        if code[e] == 0:
-            continue  # linear tyres: no grip, and the linearisation is exact
-        dl, dg = 0.0, 0.0
-        for c in range(n):
-            dd = dnu[c] - d_lin[c]
-            dl += a[2 * e, c] * dd
-            dg += a[2 * e + 1, c] * dd
-        fl = f[e, 0] + dt * (g[e, 0, 0] * dl + g[e, 0, 1] * dg)
-        fg = f[e, 1] + dt * (g[e, 1, 0] * dl + g[e, 1, 1] * dg)
-        pred[e, 0], pred[e, 1] = fl, fg
-        lat, lon = grip(code[e], tp[e], fz[e])
-        beyond = beyond or abs(fl) > lat * (1.0 + GRIP_SLACK) or abs(fg) > lon * (1.0 + GRIP_SLACK)
-    return beyond
-
-
-@_inline
-def _converged(f, pred, fz, pack):
-    """Whether the tyre forces `f` where the step arrived are those its linearisation predicted (`pred`), within
-    :data:`GRIP_SLACK` of each tyre's grip: the Newton iterations of the step have converged."""
-    code, tp = pack[3], pack[4]
-    for e in range(code.shape[0]):
-        if code[e] == 0:
-            continue
-        lat, lon = grip(code[e], tp[e], fz[e])
-        if abs(f[e, 0] - pred[e, 0]) > GRIP_SLACK * lat or abs(f[e, 1] - pred[e, 1]) > GRIP_SLACK * lon:
-            return False
-    return True
-
-
-@_inline
-def _relinearise(s, dt, w, pack):
-    """One Newton iteration of the implicit step in the tyre forces: linearise them at the velocity the step
-    reached, ``nu + dt dnu`` (``dnu`` in ``w[9]``), and solve again from the step's ``rhs`` (kept in ``w[21]``):
-    ``(M - dt A' G_i A - dt K) dnu' = rhs + A' (F_i - F - dt G_i A dnu)``. The new Jacobian stays in ``w[5]``."""
-    a, m, fz, f0, g, kdiag, rhs, mat = w[0], w[1], w[3], w[4], w[5], w[8], w[9], w[14]
-    rhs0, nu_i, f_i, d_lin, vw = w[21], w[22], w[23], w[24], w[25]
-    n = rhs.shape[0]
-    for c in range(n):
-        d_lin[c] = rhs[c]
-        nu_i[c] = s[n + c] + dt * rhs[c]
-        rhs[c] = rhs0[c]
-    contact_forces(a, nu_i, pack, fz, f_i, g, vw, True)
-    if _converged(f_i, w[27], fz, pack):
-        for c in range(n):
-            rhs[c] = d_lin[c]
-        return True
-    _implicit_matrix(a, m, g, kdiag, pack, dt, mat)
-    for e in range(f_i.shape[0]):
-        dl, dg = 0.0, 0.0
-        for c in range(n):
-            dl += a[2 * e, c] * d_lin[c]
-            dg += a[2 * e + 1, c] * d_lin[c]
-        r0 = f_i[e, 0] - f0[e, 0] - dt * (g[e, 0, 0] * dl + g[e, 0, 1] * dg)
-        r1 = f_i[e, 1] - f0[e, 1] - dt * (g[e, 1, 0] * dl + g[e, 1, 1] * dg)
-        for c in range(n):
-            rhs[c] += a[2 * e, c] * r0 + a[2 * e + 1, c] * r1
-    solve_held(mat, rhs, pack, w)
-    return False
-
-
-@_inline
-def _update_semi_implicit(s, dt, acc, w, pack, linked):
-    """One linearly implicit Euler step from the assembled work arrays `w` (:func:`assemble`): friction and servo
-    Jacobians implicit, then positions with the new velocity.
-
-    The tyre Jacobian ``dF/dv_slip`` is refreshed when the assembly was asked for it and reused otherwise (a W-method).
-    A step whose linearised tyre forces exceed their grip (from rest, the slope at zero slip would grip at many
-    times ``mu Fz``; a Jacobian kept from grip while the tyre now slides) is re-linearised where it arrived, Newton
-    iterations of the implicit step (:func:`_relinearise`), until no force exceeds its grip, at most
-    :data:`GRIP_ITERATIONS`.
-    """
-    f, g, rhs, mat, rhs0, d_lin = w[4], w[5], w[9], w[14], w[21], w[24]
-    n = rhs.shape[0]
-    for c in range(n):
-        rhs0[c] = rhs[c]
-        d_lin[c] = 0.0
-    _implicit_matrix(w[0], w[1], g, w[8], pack, dt, mat)
     if linked:
         hold_linkages(s, pack, w[19], w[20], False)  # the linkages' basis at the step's start
     solve_held(mat, rhs, pack, w)  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt, gears and linkages held
-    w[26][0] = 0.0
-    if _beyond_grip(w[0], rhs, d_lin, f, g, w[3], pack, dt, w[27]):
-        w[26][0] = 1.0  # `g` becomes the Jacobian where the step arrived: the next step refreshes it at its start
-        it = 0
-        while it < GRIP_ITERATIONS and not _relinearise(s, dt, w, pack):
-            _beyond_grip(w[0], rhs, d_lin, w[23], g, w[3], pack, dt, w[27])  # the new prediction, in w[27]
-            it += 1
     dnu = rhs
     for c in range(n):
         acc[c] = dnu[c]
@@ -431,7 +332,7 @@ def _semi_implicit_steps(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, p
     i = i0
     for j in range(n_steps):
         k = k0 + j
-        assemble(k * dt, s, acc, pack, inp, (k - jac_phase) % jac_every == 0 or w[26][0] == 1.0, w)
+        assemble(k * dt, s, acc, pack, inp, (k - jac_phase) % jac_every == 0, w)
         if j > 0 and k % every == 0 and i < rec[0].shape[0]:  # the step's assembly is the record at t = k dt
             _store(k * dt, s, w, rec, i)
             i += 1
