@@ -169,6 +169,7 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             beta[k] = _wrap(heading[k] - delta[k] + HALF_PI)
         for j in range(n_rates):
             rates_out[j] = vx * constant[0, j] + vy * constant[1, j] + w * constant[2, j]
+        free = np.zeros(n_steer if n_links else 0, dtype=np.bool_)  # the wheels whose root ik chose: moving
         for i in range(n_o):  # (8.9), (8.12): the steering axis's velocity u, the closer of b and b + pi
             k = steered_beta[i]
             minus_ux = sy[i] * w - vx
@@ -177,6 +178,8 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             along = minus_ux * math.sin(beta[k]) + uy * math.cos(beta[k])
             sign = -1.0 if abs(along) <= 1e-12 * speed else math.copysign(1.0, along)  # a tie: rolling forward
             moving = speed > speed_tol
+            if n_links:
+                free[k] = moving
             if moving:
                 beta[k] = math.atan2(minus_ux * sign + 0.0, uy * sign)
                 h = beta[k] + (delta[k] - HALF_PI)
@@ -188,12 +191,9 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
         linked = True
         if n_links:  # each linkage's reference found once: its wheels on the roots it sets, then its law judged
             axis_speed = np.empty(n_steer)
-            turn, free = np.zeros(n_steer, dtype=np.bool_), np.zeros(n_steer, dtype=np.bool_)
+            turn = np.zeros(n_steer, dtype=np.bool_)
             for k in range(n_steer):  # the axes' speeds (linkage_check._speeds)
                 axis_speed[k] = math.hypot(vx - w * link_y[k], vy + w * link_x[k])
-            for i in range(n_o):  # the wheels whose root ik chose: steered by the twist, moving
-                minus_ux, uy = sy[i] * w - vx, sx[i] * w + vy
-                free[steered_beta[i]] = math.sqrt(minus_ux * minus_ux + uy * uy) > speed_tol
             for g in range(n_links):
                 first, last, lead = link_start[g], link_start[g + 1], link_lead[g]
                 ref, b = _reference(link_table, first, last, lead, beta, axis_speed)
