@@ -32,11 +32,11 @@ def test_batch_odometry(capsys, fleet_dir, tmp_path):
 
 @pytest.mark.parametrize(("described", "given", "method"), [
     ("rk2", [], "rk2"), ("euler", ["--method", "exact"], "exact"), ("wls", ["--method", "rk2"], "rk2"),
-    ("wls", [], None),
+    ("wls", [], "wls"), ("fk2", [], "fk2"),
 ])
 def test_batch_odometry_runs_the_described_method(capsys, fleet_dir, tmp_path, described, given, method):
     """A description's odometry.method was ignored (exact ran, where 'wmrkit odometry' ran the described rk2); a
-    slip-aware one, which batch odometry does not run, is refused by name unless --method says which to run."""
+    slip-aware one was refused (batch odometry ran no estimator): it runs now, as 'wmrkit odometry' runs it."""
     import yaml
 
     from wmrkit import catalog
@@ -45,14 +45,9 @@ def test_batch_odometry_runs_the_described_method(capsys, fleet_dir, tmp_path, d
     robot = tmp_path / "r.yaml"
     robot.write_text(yaml.safe_dump(data))
     argv = ["batch", "odometry", str(robot), str(fleet_dir / "run0.csv"), "--workers", "0", "--json", *given]
-    if method is None:
-        assert main(argv) == 2
-        error = json.loads(capsys.readouterr().err)["error"]
-        assert "odometry.method is wls, which batch odometry does not run" in error
-        return
     rows = _json(capsys, argv)["rows"]
-    assert [r["method"] for r in rows] == [method] and not rows[0]["error"]
     single = _json(capsys, ["odometry", str(robot), str(fleet_dir / "run0.csv"), "--json", "--method", method])
+    assert [r["method"] for r in rows] == [single["method"]] and not rows[0]["error"]
     assert [rows[0]["x"], rows[0]["y"], rows[0]["theta"]] == pytest.approx(single["final_pose"], abs=1e-12)
 
 

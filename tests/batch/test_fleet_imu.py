@@ -288,3 +288,20 @@ def test_a_weighted_batch_names_its_own_argument_not_another_commands_option(cap
     single = _single(capsys, robot, slips, "--weight", "left=2")
     assert "weighted no-slip (--weight)" in single["warnings"][0]
     assert set(re.findall(r"--[a-z][a-z-]*", " ".join(single["warnings"]))) <= commands[("odometry",)]
+
+
+@pytest.mark.parametrize("mount", [(), ("0", "0", "0"), ("180deg", "5deg", "0.3")])
+def test_an_imu_mount_is_the_one_wmrkit_odometry_uses(capsys, fleet, mount):
+    """``--imu-mount ROLL PITCH YAW`` mounts each bag's IMU as ``wmrkit odometry --imu-mount`` does: the same lines
+    and verdict, and ``imu_mount`` says where the mounting came from (the option, else level: these bags have no
+    /tf_static). Before, batch odometry had no --imu-mount and its rows did not say the mounting."""
+    from wmrkit.odometry.imu_mount import ASSUMED_LEVEL
+
+    robot, (slips, clean, _), _ = fleet
+    given = ("--imu-mount", *mount) if mount else ()
+    code, answer, _ = _batch(capsys, robot, [slips, clean], *given)
+    assert code == 0
+    for row, bag in zip(answer["rows"], (slips, clean), strict=True):
+        single = _single(capsys, robot, bag, *given)
+        assert row["imu_mount"] == single["imu_mount"] == ("--imu-mount" if mount else ASSUMED_LEVEL)
+        assert (row["warnings"], row["consistent"]) == ("; ".join(single["warnings"]) or None, single["consistent"])

@@ -35,6 +35,9 @@ if TYPE_CHECKING:
     from ..odometry.diagnostics import Diagnosis, ImuCheck
     from ..odometry.model import OdometryModel
     from ..odometry.pipeline import OdometrySummary
+    from ..slip.estimators import EstimatorSpec
+    from ..slip.kalman import KalmanNoise
+    from ..slip.weights import SlipWeights
 
 #: Columns of the batch-odometry table (name, type and unit, :data:`.parquet.Schema`).
 SUMMARY_SCHEMA = (
@@ -44,15 +47,16 @@ SUMMARY_SCHEMA = (
     ("closure_error", "float64 m"), ("closure_heading", "float64 rad"), ("max_slip", "float64 m"),
     ("rms_slip", "float64 m"), ("max_dt", "float64 s"), ("warnings", "string"), ("consistent", "bool"),
     ("error", "string"), ("trajectory", "string"), ("wall_time", "float64 s"), ("settings", "string"),
-    ("imu", "string"),
+    ("imu", "string"), ("imu_mount", "string"),
 )
 #: Columns a table must have to be a batch-odometry table at all (an older one lacks some others: it is redone).
 KEY_COLUMNS = ("log", "robot", "method", "error", "trajectory")
 #: Version of what a row holds, in its settings digest: a row of an older version is redone (2: odometry's
 #: diagnostic lines in ``warnings``; 3: ``consistent``, which part files of a version-2 run lack; 4: a bag's IMU
 #: check in ``warnings`` and ``consistent``, its topic in ``imu``; 5: a named IMU that cannot be used is the log's
-#: error, no longer a warning; 6: the IMU's line says when the IMU looks upside down or in deg/s).
-ROW_VERSION = 6
+#: error, no longer a warning; 6: the IMU's line says when the IMU looks upside down or in deg/s; 7: the IMU's
+#: mounting in ``imu_mount``, a filter's conditioning line in ``warnings``).
+ROW_VERSION = 7
 #: Suffixes of single-file logs found in a folder (CSV joint logs, ROS 2 bag files).
 LOG_SUFFIXES = (".csv", ".db3", ".mcap")
 
@@ -71,6 +75,9 @@ class LogJob:
     model: Any = None  # the odometry model, built once per batch (else per log, from options' sensed/weights)
     header: Mapping[str, Any] | None = None  # without options["fmt"]: a CSV log's format from its header and these
     imu: str | None = None  # a bag's Imu topic checking its heading, named (else the bag's only one, found)
+    imu_mount: tuple[float, float, float] | None = None  # the IMU's (roll, pitch, yaw) [rad], over /tf_static's
+    imu_mount_option: str = "imu_mount="  # the door's name of imu_mount, in the row's imu_mount and its lines
+    estimator: EstimatorSpec | None = None  # a slip-aware estimator, built per log (method: its scheme)
 
 
 @dataclass(frozen=True)
@@ -140,7 +147,8 @@ def process_log(job: LogJob) -> dict[str, Any]:
     from ..odometry.model import odometry_model
 
     row: dict[str, Any] = {name: None for name, _ in SUMMARY_SCHEMA}
-    row.update(log=job.path, robot=job.robot.name, method=job.method, trajectory=job.trajectory)
+    row.update(log=job.path, robot=job.robot.name, method=job.estimator.label if job.estimator else job.method,
+               trajectory=job.trajectory)
     t0 = time.perf_counter()
     unread = None
     with warnings.catch_warnings(record=True) as caught:
@@ -151,17 +159,22 @@ def process_log(job: LogJob) -> dict[str, Any]:
             if job.header is not None and not is_bag(job.path):  # each log says its units (odometry's rule)
                 options["fmt"] = header_format(job.path, job.robot.name, model.joints, **job.header)
             check, unread = _imu_check(job, model)  # made here, in the worker: only the row goes back
-            s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=model,
+            estimator = job.estimator.build(job.robot) if job.estimator else None
+            s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=estimator or model,
                               sinks=[check] if check else (), check=check.judge if check else None, **options)
             diagnosis = _diagnose(job, s, model, options)
+            filtered = getattr(estimator, "conditioning_warning", lambda: None)()
         except Exception as err:  # what was said before it failed stays said (wmrkit odometry says it too)
             said = [" ".join(str(w.message).split()) for w in caught] + ([unread] if unread else [])
             row.update(error=_message(err), trajectory=None, warnings="; ".join(said) or None,
                        wall_time=time.perf_counter() - t0)
             return row
     x, y, theta = s.final_pose
-    notes = [" ".join(str(w.message).split()) for w in caught] + list(diagnosis.warnings)
+    notes = [" ".join(str(w.message).split()) for w in caught] + list(diagnosis.warnings) + ([filtered] if filtered
+                                                                                                 else [])
     imu = check.topic if check and check.checked else None
+    if check and check.mounting.note:  # the given mounting and the bag's /tf_static disagree
+        notes.append(check.mounting.note)
     if line := check.line if check else unread:  # after diagnose's lines, as wmrkit odometry says them
         notes.append(line)
     if job.slip_warning is not None and s.max_slip > job.slip_warning:
@@ -171,6 +184,7 @@ def process_log(job: LogJob) -> dict[str, Any]:
     row.update(samples=s.samples, start_time=s.start_time, duration=s.end_time - s.start_time, x=x, y=y, theta=theta,
                path_length=s.path_length, rotation=s.rotation, max_slip=s.max_slip, rms_slip=s.rms_slip,
                max_dt=s.max_dt, warnings="; ".join(notes) or None, imu=imu,
+               imu_mount=check.mounting.source if imu else None,
                consistent=diagnosis.consistent and not (imu and check.line), wall_time=time.perf_counter() - t0)
     if job.closed:  # the run ends where it started (the start pose is the origin)
         row.update(closure_error=math.hypot(x, y), closure_heading=float(np.angle(np.exp(1j * theta))))
@@ -202,8 +216,10 @@ def _imu_check(job: LogJob, model: OdometryModel) -> tuple[ImuCheck | None, str 
         return None, f"{err} (the odometry is not checked against it)"
     if topic is None:  # several Imu topics (a warning, as wmrkit odometry's), or none (nothing to say)
         return None, note
-    what = odometry_name(None, "weights=" if np.any(np.asarray(model.row_weights) != 1.0) else None)
-    return imu_check(job.path, topic, what, named=named)
+    what = odometry_name(job.estimator.name if job.estimator else None,
+                         "weights=" if np.any(np.asarray(model.row_weights) != 1.0) else None)
+    return imu_check(job.path, topic, what, named=named, mount=job.imu_mount,
+                     mount_option=job.imu_mount_option)
 
 
 def _diagnose(job: LogJob, s: OdometrySummary, model: OdometryModel, options: Mapping[str, Any]) -> Diagnosis:
@@ -213,7 +229,9 @@ def _diagnose(job: LogJob, s: OdometrySummary, model: OdometryModel, options: Ma
     from ..odometry.files import first_samples
 
     reading = {k: options[k] for k in ("fmt", "topic", "joint_names") if k in options}
-    return diagnose(s, model, lambda: first_samples(job.robot, job.path, model.joints, **reading), options.get("fmt"))
+    filtered = job.estimator.name if job.estimator and job.estimator.name != "wls" else None
+    return diagnose(s, model, lambda: first_samples(job.robot, job.path, model.joints, **reading), options.get("fmt"),
+                    filtered=filtered)
 
 
 def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runner: Engine | None = None,
@@ -223,7 +241,10 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
                    fmt: LogFormat | None = None, header: Mapping[str, Any] | None = None,
                    topic: str = "/joint_states", joint_names: Mapping[str, str] | None = None,
                    sensed: Sequence[str] | None = None, weights: Mapping[str, float] | None = None,
-                   imu: str | None = None) -> FleetResult:
+                   imu: str | None = None, imu_mount: Sequence[float] | None = None,
+                   imu_mount_option: str = "imu_mount=", scheme: str | None = None,
+                   slip_weights: SlipWeights | None = None, noise: KalmanNoise | None = None,
+                   thesis_double_q: bool = False) -> FleetResult:
     """Odometry of every log in `logs` (files, globs, folders; :func:`expand_logs`) on `runner` (default: a
     serial engine); the table is written to `out` (Parquet) and each trajectory to `trajectories`/``NAME.EXT`` (the
     folder made when missing).
@@ -238,12 +259,18 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     A bag's IMU checks its heading as there: the `imu` topic, else the bag's only ``Imu`` topic; its ``imu`` column
     says the topic checked. An IMU found by itself that cannot be used is a warning line; a named `imu` that a bag
     lacks or that cannot be used is that log's error (the other logs run), as ``wmrkit odometry --imu`` refuses it.
+    `imu_mount` ``(roll, pitch, yaw)`` [rad]: the IMU's mounting, over each bag's ``/tf_static`` (its ``imu_mount``
+    column says where each row's came from, `imu_mount_option` naming this one).
+
+    `method` ``wls``, ``fk1`` or ``fk2``: the slip-aware estimators of ``wmrkit odometry --method`` (thesis §7.4-7.5),
+    WLS with the friction coefficients `slip_weights`, a filter with `noise` (and `thesis_double_q`), their twists
+    integrated by `scheme` (default exact; rows say ``fk2 (exact)``); each log gets its own estimator.
     """
     from ..odometry.files import is_bag
-    from ..odometry.integrators import check_method
     from ..odometry.model import odometry_model
 
-    check_method(method)  # type: ignore[arg-type]
+    spec = _estimator_spec(robot, method, scheme, sensed, weights, slip_weights, noise, thesis_double_q)
+    label = spec.label if spec else method  # each row's method
     if slip_warning is not None and not (isinstance(slip_warning, int | float) and math.isfinite(slip_warning)
                                          and slip_warning >= 0):
         raise BatchError(f"slip_warning must be a finite length >= 0 m, got {slip_warning!r}")  # NaN: never warned
@@ -259,6 +286,14 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
         raise BatchError("batch odometry: no logs given")
     if imu is not None and not any(is_bag(p) for p in paths):  # it would be ignored
         raise BatchError(f"--imu {imu} applies to ROS 2 bags; none of the {len(paths)} logs is one")
+    if imu_mount is not None:
+        from ..odometry.imu_mount import quaternion_rpy
+
+        quaternion_rpy(imu_mount, imu_mount_option.rstrip("="))  # three finite angles, else refused by that name
+        imu_mount = tuple(float(a) for a in imu_mount)
+        if not any(is_bag(p) for p in paths):  # it would be ignored
+            raise BatchError(f"{imu_mount_option.rstrip('=')} applies to the IMU of ROS 2 bags; none of the "
+                             f"{len(paths)} logs is one")
     if out is not None and not Path(out).absolute().parent.is_dir():
         raise BatchError(f"--out {os.fspath(out)}: the folder {Path(out).absolute().parent} does not exist")
     if out is not None and Path(out).is_dir():  # else refused only when the table is written, after the work
@@ -275,13 +310,14 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     if trajectory_format not in ("csv", "tum"):
         raise BatchError(f"trajectory format must be csv or tum, got '{trajectory_format}'")
     targets = _trajectory_names(paths, trajectories, trajectory_format)
-    batch = _fingerprint(robot, method, closed, slip_warning, options, header, sensed, weights, imu, ROW_VERSION)
+    batch = _fingerprint(robot, method, closed, slip_warning, options, header, sensed, weights, imu, ROW_VERSION,
+                         imu_mount, spec)
     settings = {p: _fingerprint(batch, _stat(p)) for p in paths}
     # an existing --out must be a table of this command (it is replaced at the end), even without resuming
     current = check_table(out, SUMMARY_SCHEMA, KEY_COLUMNS) if out is not None and Path(out).is_file() else True
-    done = _done(out, robot, method, targets, settings) if resume and out is not None and current else {}
-    jobs = [LogJob(p, robot, method, targets[p], closed, slip_warning, options, model, header, imu)
-            for p in paths if p not in done]
+    done = _done(out, robot, label, targets, settings) if resume and out is not None and current else {}
+    jobs = [LogJob(p, robot, spec.scheme if spec else method, targets[p], closed, slip_warning, options, model, header,
+                   imu, imu_mount, imu_mount_option, spec) for p in paths if p not in done]
     sink = RowSink(out, SUMMARY_SCHEMA)
     rows: dict[str, Mapping[str, Any]] = dict(done)
     own = runner is None
@@ -291,7 +327,7 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
         for index, row in runner.as_completed(process_log, jobs, progress=progress, desc="logs", chunk=chunk):
             if isinstance(row, TaskFailure):  # the worker died more often than the scheduler allows
                 row = {name: None for name, _ in SUMMARY_SCHEMA} | {"log": jobs[index].path, "robot": robot.name,
-                                                                     "method": method, "error": str(row)}
+                                                                     "method": label, "error": str(row)}
             row = dict(row) | {"settings": settings[row["log"]]}
             rows[row["log"]] = row
             sink.add(row)
@@ -302,6 +338,31 @@ def batch_odometry(robot: Robot, logs: Sequence[str | os.PathLike[str]], *, runn
     ordered = tuple(rows[p] for p in paths)
     sink.finish(ordered)
     return FleetResult(ordered, len(done), sum(1 for r in ordered if r["error"]))
+
+
+def _estimator_spec(robot: Robot, method: str, scheme: str | None, sensed: Sequence[str] | None,
+                    weights: Mapping[str, float] | None, slip_weights: SlipWeights | None, noise: KalmanNoise | None,
+                    thesis_double_q: bool) -> EstimatorSpec | None:
+    """The slip-aware estimator of :func:`batch_odometry`'s `method` (built once here: a bad one fails before any
+    log), None for a no-slip scheme; an option the method does not use is refused (it would be ignored)."""
+    from ..odometry.integrators import METHODS, check_method
+    from ..slip.estimators import ESTIMATORS, EstimatorSpec
+
+    uses = {"scheme": ESTIMATORS, "slip_weights": ("wls",), "noise": ("fk1", "fk2"), "thesis_double_q": ("fk1", "fk2"),
+            "weights": METHODS}
+    for name, value in (("scheme", scheme), ("slip_weights", slip_weights), ("noise", noise),
+                        ("thesis_double_q", thesis_double_q), ("weights", weights)):
+        if value and method not in uses[name]:
+            where = "the no-slip methods" if name == "weights" else f"method {' or '.join(uses[name])}"
+            raise BatchError(f"{name}= applies to {where}, not to method {method} (it would be ignored)")
+    if method not in ESTIMATORS:
+        check_method(method)  # type: ignore[arg-type]
+        return None
+    check_method(scheme or "exact")  # type: ignore[arg-type]
+    spec = EstimatorSpec(method, scheme or "exact", None if sensed is None else tuple(sensed), slip_weights, noise,
+                         thesis_double_q)  # type: ignore[arg-type]
+    spec.build(robot)
+    return spec
 
 
 def _done(out, robot: Robot, method: str, targets: Mapping[str, str | None],

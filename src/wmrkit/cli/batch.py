@@ -21,6 +21,7 @@ from ._common import (
     seed,
     warn,
 )
+from .slip import ESTIMATOR_METHODS, add_estimator_options, check_estimator_options, estimator_from_args, resolve_method
 
 
 def _engine_options(p: argparse.ArgumentParser) -> None:
@@ -42,8 +43,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = sub.add_parser("odometry", help="odometry of many logs in parallel, one summary row per log (Parquet)")
     add_robot_argument(p)
     p.add_argument("logs", nargs="+", metavar="LOG", help="CSV logs, ROS 2 bags, globs or folders")
-    p.add_argument("--method", choices=METHODS,
-                   help=f"integration scheme: {SCHEMES_HELP} (default: the description's odometry.method, as for "
+    p.add_argument("--method", choices=(*METHODS, *ESTIMATOR_METHODS),
+                   help=f"integration scheme: {SCHEMES_HELP}; or a slip-aware estimator: wls (weighted least "
+                        "squares), fk1 or fk2 (Kalman filters) (default: the description's odometry.method, as for "
                         "'wmrkit odometry', else exact)")
     p.add_argument("--out", metavar="FILE", help="summary table (Parquet); a rerun skips the logs done")
     p.add_argument("--trajectories", metavar="DIR", help="write each log's trajectory to DIR/NAME.tum")
@@ -52,7 +54,11 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--no-resume", action="store_true", help="redo every log even if --out has it")
     p.add_argument("--imu", metavar="TOPIC", help="sensor_msgs/Imu topic of the bags whose yaw checks the odometry's "
                    "heading (default: each bag's only Imu topic, if it has one)")
+    p.add_argument("--imu-mount", nargs=3, metavar=("ROLL", "PITCH", "YAW"),
+                   help="the IMU's orientation on the robot (URDF/REP-103 rpy, Rz Ry Rx), radians or with 'deg'; "
+                        "overrides each bag's /tf_static (default: /tf_static's, else level)")
     _log_options(p)
+    add_estimator_options(p)
     _engine_options(p)
     p.set_defaults(run=run_odometry)
 
@@ -142,20 +148,6 @@ def _progress(args: argparse.Namespace) -> bool:
     return not args.quiet and not args.json and sys.stderr.isatty()
 
 
-def _described_method(robot) -> str:
-    """The description's ``odometry.method`` where ``batch odometry`` runs it (a no-slip scheme), else ``exact``
-    when it names none; a slip-aware estimator is refused: the rows would be the no-slip model's, which the
-    description says the robot needs more than (``wmrkit odometry`` runs it)."""
-    from ..odometry.integrators import METHODS
-
-    method = robot.odometry.method if robot.odometry is not None else None
-    if method is not None and method not in METHODS:
-        raise WmrkitError(f"robot '{robot.name}': its description's odometry.method is {method}, which batch odometry "
-                          f"does not run ('wmrkit odometry' does, one log at a time); give --method "
-                          f"{'|'.join(METHODS)} for the no-slip model")
-    return method or "exact"
-
-
 #: Inconsistent logs the summary line of ``batch odometry`` names before counting the rest (the JSON lists them all).
 NAMED = 3
 
@@ -168,14 +160,21 @@ def run_odometry(args: argparse.Namespace) -> int:
     from ..batch.fleet import batch_odometry
 
     robot = load_robot(args.robot)
-    args.method = args.method or _described_method(robot)
+    settings = resolve_method(args)  # --method, --scheme: the options, else the description's odometry block
+    check_estimator_options(args)
+    spec = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None
+    mount = None if args.imu_mount is None else [
+        parse_angle(a, f"--imu-mount {n}") for a, n in zip(args.imu_mount, ("ROLL", "PITCH", "YAW"), strict=True)]
     if args.trajectory_format is not None and args.trajectories is None:  # no trajectory written: it was ignored
         raise WmrkitError("--trajectory-format is the format of the --trajectories files; give --trajectories DIR")
     with _runner(args) as runner:
+        estimator = {} if spec is None else {"scheme": spec.scheme, "slip_weights": spec.weights,
+                                             "noise": spec.noise, "thesis_double_q": spec.thesis_double_q}
         result = batch_odometry(robot, args.logs, runner=runner, method=args.method, out=args.out,
                                 trajectories=args.trajectories, trajectory_format=args.trajectory_format or "tum",
                                 closed=args.closed, resume=not args.no_resume, progress=_progress(args),
-                                imu=args.imu, **_options(args))
+                                imu=args.imu, imu_mount=mount, imu_mount_option="--imu-mount", **estimator,
+                                **_options(args))
     for r in result.rows:  # they were only in the table's 'warnings' column (or nowhere, without --out)
         if r["warnings"]:  # a failed log's too, said before its error as wmrkit odometry says them
             warn(f"{r['log']}: {r['warnings']}")

@@ -104,12 +104,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Parse the options into a log format, run :func:`wmrkit.odometry.files.odometry_file`, print the summary."""
     robot = load_robot(args.robot)
-    scheme_given = args.scheme is not None
     settings = resolve_method(args)  # --method, --scheme: the options, else the description's odometry block
     check_estimator_options(args)
-    if scheme_given and args.method not in ESTIMATOR_METHODS:
-        raise WmrkitError(f"--scheme applies to --method wls, fk1 or fk2 (their integration); --method {args.method} "
-                          "is a scheme itself (it would be ignored)")
     if args.crowley is not None and not args.covariance:
         raise WmrkitError("--crowley applies with --covariance (it would be ignored)")
     args.crowley = args.crowley or (0.001, 0.003, 0.001)
@@ -162,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
     pose0 = [parse_value(args.pose[0], "length", "--pose X"), parse_value(args.pose[1], "length", "--pose Y"),
              parse_angle(args.pose[2], "--pose")]
     check_start_pose(np.array(pose0), "--pose")
-    slip_model = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None
+    slip_model = estimator_from_args(robot, args, settings).build(robot) if args.method in ESTIMATOR_METHODS else None
     what = odometry_name(args.method if slip_model is not None else None, "--weight" if args.weight else None)
     # the IMU read now: a named one that fails is refused before any output is written
     check, unread = imu_check(args.log, imu, what, named=args.imu is not None, mount=mount,
@@ -180,8 +176,8 @@ def run(args: argparse.Namespace) -> int:
         sinks=[check] if check else (), check=check.judge if check else None)
     if slip_model is not None:
         summary = replace(summary, method=f"{args.method} ({args.scheme})")
-    if args.method in ("fk1", "fk2"):
-        _warn_ill_conditioned(args.method, slip_model.model)
+    if args.method in ("fk1", "fk2") and (line := slip_model.conditioning_warning()):
+        warn(line)
     names = parse_assignments(args.joint_name, "--joint-name")
     filtered = args.method if args.method in ("fk1", "fk2") else None
     diagnosis = diagnose(summary, model, lambda: first_samples(robot, args.log, model.joints, fmt=fmt, topic=args.topic,
@@ -205,25 +201,6 @@ def run(args: argparse.Namespace) -> int:
         print(format_summary(summary) + (f"\nheading checked against the IMU on {imu}, its mounting "
                                          f"{'' if mounted == ASSUMED_LEVEL else 'from '}{mounted}" if imu else ""))
     return 0
-
-
-def _warn_ill_conditioned(name: str, model) -> None:
-    """Warn (:func:`._common.warn`) when, at a steering configuration of the log, the filter's kept rows barely fixed
-    the twist (:attr:`~wmrkit.slip.kalman.KalmanModel.worst_conditioning`): its answer there is its prediction."""
-    from ..slip.kalman import ILL_CONDITIONED
-
-    worst = model.worst_conditioning
-    if worst is None or worst[0] <= ILL_CONDITIONED:
-        return
-    om = model.odometry
-    beta = dict(zip((om.robot.steer_names[i] for i in om.steer_index), worst[1], strict=True))
-    heading = om.robot.with_beta_angles(beta).heading
-    where = ", ".join(f"{n} {math.degrees(heading[om.robot.steer_names.index(n)]):.4g} deg" for n in beta)
-    fix = ("do not fix the twist" if math.isinf(worst[0]) else
-           f"barely fix the twist (condition number {worst[0]:.3g} > {ILL_CONDITIONED:g})")
-    at = f"at a steering heading of the log ({where}) " if beta else ""  # a robot that does not steer: everywhere
-    warn(f"{name}: {at}its measurement rows {fix}: there the filter carries "
-         f"its prediction and the trajectory can be far off{'; use --method fk2 or wls' if name == 'fk1' else ''}")
 
 
 def format_summary(s: OdometrySummary) -> str:

@@ -63,6 +63,9 @@ def resolve_method(args: argparse.Namespace):
     from ..slip.settings import odometry_settings
 
     settings = odometry_settings(args.robot)
+    if args.scheme is not None and (args.method or settings.method) not in ESTIMATOR_METHODS:
+        raise WmrkitError(f"--scheme applies to --method wls, fk1 or fk2 (their integration); --method "
+                          f"{args.method or settings.method or 'exact'} is a scheme itself (it would be ignored)")
     args.method_described = args.method is None and settings.method is not None  # named in its errors
     args.method = args.method or settings.method or "exact"
     args.scheme = args.scheme or settings.scheme or "exact"
@@ -167,14 +170,15 @@ def check_estimator_options(args: argparse.Namespace) -> None:
 
 
 def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
-    """The estimator of ``--method wls|fk1|fk2`` with its options over the description's `settings`."""
-    from ..slip.estimators import estimator
+    """The estimator of ``--method wls|fk1|fk2`` (:class:`~wmrkit.slip.estimators.EstimatorSpec`, integrated by
+    ``--scheme``) with its options over the description's `settings`, checked by building it once."""
+    from ..slip.estimators import EstimatorSpec
     from ..slip.kalman import noise_from_options
 
-    if args.weight:
+    if getattr(args, "weight", None):
         other = "--mu WHEEL=LAT,LONG" if args.method == "wls" else "--kf-wheel WHEEL=LAT,LONG"
         raise WmrkitError(f"--weight applies to the kinematic methods; with --method {args.method} use {other}")
-    if args.covariance:
+    if getattr(args, "covariance", False):
         raise WmrkitError(f"--covariance is not available with --method {args.method} (kinematic methods only)")
     described = settings.kalman_noise() if settings is not None else None
     k = args.kf_noise or (described and (described.process, described.lateral, described.longitudinal)) \
@@ -189,9 +193,10 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
         given = [o for o, v in (("--kf-noise", args.kf_noise), ("--kf-wheel", args.kf_wheel)) if v]
         raise WmrkitError(f"{' with '.join(given)}: {e}") from None
     weights = weights_from_args(args, settings, robot) if args.method == "wls" else None
+    spec = EstimatorSpec(args.method, args.scheme, None if args.sensed is None else tuple(args.sensed), weights,
+                         noise, args.thesis_double_q)
     try:
-        chosen = estimator(robot, args.method, sensed=args.sensed, weights=weights, noise=noise,
-                           thesis_double_q=args.thesis_double_q)
+        chosen = spec.build(robot)
     except WmrkitError as err:  # a method the user did not type: say where it came from
         if not getattr(args, "method_described", False):
             raise
@@ -204,7 +209,7 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
             raise WmrkitError(f"{option} {name}: wheel '{name}' has no no-slip rows in the {args.method} model of the "
                               f"sensed joints (its rows hold rates that are not sensed); its coefficients would be "
                               f"ignored (wheels with rows: {', '.join(n for n in robot.wheel_names if n in used)})")
-    return chosen
+    return spec
 
 
 def _read_json(path: str):

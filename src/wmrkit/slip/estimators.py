@@ -23,7 +23,7 @@ from ..odometry.model import OdometryModel
 from ..odometry.pipeline import OdometrySummary, check_poses, start_pose
 from ..odometry.trajectories import Trajectory
 from ..robot import Robot
-from .kalman import FILTERS, KalmanModel, KalmanNoise, _filter, check_log, kalman_model
+from .kalman import FILTERS, ILL_CONDITIONED, KalmanModel, KalmanNoise, _filter, check_log, kalman_model
 from .weights import SlipWeights, wls_model
 
 ESTIMATORS = ("wls", *FILTERS)
@@ -45,6 +45,23 @@ class KalmanEstimator:
     def robot(self) -> Robot:
         """The robot."""
         return self.model.odometry.robot
+
+    def conditioning_warning(self) -> str | None:
+        """The line saying that, at a steering configuration met so far, the filter's kept rows barely fixed the
+        twist (:attr:`~.kalman.KalmanModel.worst_conditioning` above :data:`~.kalman.ILL_CONDITIONED`): its answer
+        there is its prediction; None when they fixed it everywhere."""
+        worst = self.model.worst_conditioning
+        if worst is None or worst[0] <= ILL_CONDITIONED:
+            return None
+        om = self.model.odometry
+        beta = dict(zip((om.robot.steer_names[i] for i in om.steer_index), worst[1], strict=True))
+        heading = om.robot.with_beta_angles(beta).heading
+        where = ", ".join(f"{n} {math.degrees(heading[om.robot.steer_names.index(n)]):.4g} deg" for n in beta)
+        fix = ("do not fix the twist" if math.isinf(worst[0]) else
+               f"barely fix the twist (condition number {worst[0]:.3g} > {ILL_CONDITIONED:g})")
+        at = f"at a steering heading of the log ({where}) " if beta else ""  # a robot that does not steer: everywhere
+        return (f"{self.name}: {at}its measurement rows {fix}: there the filter carries its prediction and the "
+                f"trajectory can be far off{'; use --method fk2 or wls' if self.name == 'fk1' else ''}")
 
     def run(self, chunks: Iterable[JointLog], *, method: Method = "exact", pose0: ArrayLike = (0.0, 0.0, 0.0),
             sinks: Sequence[Callable[[Trajectory], object]] = ()) -> OdometrySummary:
@@ -90,6 +107,30 @@ class KalmanEstimator:
         rms = math.sqrt(sq / (n_total - 1)) if n_total > 1 else 0.0
         return OdometrySummary(self.robot.name, self.name, n_total, t0, t1, tuple(float(v) for v in pose),
                                dist, rot, max_slip, rms, max_dt)
+
+
+@dataclass(frozen=True)
+class EstimatorSpec:
+    """What :func:`estimator` builds a slip-aware estimator from, and the `scheme` integrating its twists: a plain
+    value (``wmrkit batch odometry`` sends it to its workers, which build one estimator per log, so that a filter's
+    :meth:`KalmanEstimator.conditioning_warning` is that log's)."""
+
+    name: str
+    scheme: Method = "exact"
+    sensed: tuple[str, ...] | None = None
+    weights: SlipWeights | None = None
+    noise: KalmanNoise | None = None
+    thesis_double_q: bool = False
+
+    @property
+    def label(self) -> str:
+        """The method as ``wmrkit odometry`` names it in its summary: ``fk2 (exact)``."""
+        return f"{self.name} ({self.scheme})"
+
+    def build(self, robot: Robot) -> OdometryModel | KalmanEstimator:
+        """A new estimator of `robot` (:func:`estimator`)."""
+        return estimator(robot, self.name, sensed=self.sensed, weights=self.weights, noise=self.noise,
+                         thesis_double_q=self.thesis_double_q)
 
 
 def estimator(robot: Robot, name: str, *, sensed: Sequence[str] | None = None, weights: SlipWeights | None = None,
