@@ -252,6 +252,13 @@ def parse_angle(text: str, what: str) -> float:
     return parse_value(text, "angle", what)
 
 
+def parse_mount(values: list[str] | None) -> list[float] | None:
+    """``--imu-mount ROLL PITCH YAW``: three angles [rad, or with 'deg'], None when not given."""
+    if values is None:
+        return None
+    return [parse_angle(a, f"--imu-mount {n}") for a, n in zip(values, ("ROLL", "PITCH", "YAW"), strict=True)]
+
+
 def parse_assignments(items: list[str] | None, what: str) -> dict[str, str]:
     """``NAME=VALUE`` pairs from repeated options, as a dict of strings."""
     out: dict[str, str] = {}

@@ -16,6 +16,7 @@ from ._common import (
     load_robot,
     parse_angle,
     parse_assignments,
+    parse_mount,
     parse_value,
     print_json,
     seed,
@@ -163,8 +164,7 @@ def run_odometry(args: argparse.Namespace) -> int:
     settings = resolve_method(args)  # --method, --scheme: the options, else the description's odometry block
     check_estimator_options(args)
     spec = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None
-    mount = None if args.imu_mount is None else [
-        parse_angle(a, f"--imu-mount {n}") for a, n in zip(args.imu_mount, ("ROLL", "PITCH", "YAW"), strict=True)]
+    mount = parse_mount(args.imu_mount)
     if args.trajectory_format is not None and args.trajectories is None:  # no trajectory written: it was ignored
         raise WmrkitError("--trajectory-format is the format of the --trajectories files; give --trajectories DIR")
     with _runner(args) as runner:

@@ -30,6 +30,7 @@ from ._common import (
     load_robot,
     parse_angle,
     parse_assignments,
+    parse_mount,
     parse_value,
     print_json,
     warn,
@@ -124,8 +125,7 @@ def run(args: argparse.Namespace) -> int:
     for option, value in (("--cpr", args.cpr), ("--gear", args.gear), ("--steer-resolution", steer_res)):
         if value is not None and not (math.isfinite(value) and value > 0):  # the library's messages name its fields
             raise WmrkitError(f"{option} must be a finite number > 0, got {value:g}")
-    mount = None if args.imu_mount is None else [
-        parse_angle(a, f"--imu-mount {n}") for a, n in zip(args.imu_mount, ("ROLL", "PITCH", "YAW"), strict=True)]
+    mount = parse_mount(args.imu_mount)
     if os.path.isfile(args.log) and not is_bag(args.log) and (args.joint_name or args.topic != "/joint_states"
                                                                or args.imu is not None or mount is not None):
         option = "--joint-name" if args.joint_name else "--topic" if args.topic != "/joint_states" else \
