@@ -266,7 +266,8 @@ def test_json_errors_about_a_file_give_its_place(capsys, tmp_path):
     missing = str(tmp_path / "none.csv")
     assert main(["odometry", "forklift", missing, "--json"]) == 2
     data = json.loads(capsys.readouterr().err)
-    assert (data["file"], data["line"], data["field"], data["error"]) == (missing, None, None, "no such file")
+    # field: the argument that gave the file
+    assert (data["file"], data["line"], data["field"], data["error"]) == (missing, None, "LOG", "no such file")
     assert main(["ik", "swerve-4", "--twist", "1", "0", "--json"]) == 2  # not about a file: no place
     assert json.loads(capsys.readouterr().err)["file"] is None
 

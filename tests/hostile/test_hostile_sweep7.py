@@ -46,11 +46,12 @@ def test_a_lookahead_at_the_bound_still_runs(capsys):
 @pytest.mark.parametrize(("argv", "expected"), [
     # was 'time: input times must be at least one, finite and strictly increasing, got [0.0, 1.0, 1.2, inf]' (the
     # program's knots at 2 / 1e-320 = inf s): an internal name, no option
-    (["--path", "straight", "--speed", "1e-320"], "error: speed: 9.99989e-321 m/s: program 'straight' would never end"),
+    (["--path", "straight", "--speed", "1e-320"],
+     "error: --speed: 9.99989e-321 m/s: program 'straight' would never end"),
     # was '--duration 3.77e+07 s and --step ...': no --duration was given, the program at --speed lasts that long
     (["--path", "figure-eight", "--speed", "1e-6"],
-     "--path figure-eight at --speed 1e-06 m/s lasts 3.77e+07 s; --step 0.001 s: need 0 < step <= duration and at "
-     "most 5e+07 steps"),
+     "--speed 1e-06 m/s: --path figure-eight at this speed lasts 3.77e+07 s; --step 0.001 s: need 0 < step <= "
+     "duration and at most 5e+07 steps"),
     (["--path", "straight", "--duration", "1e9"], "--duration 1e+09 s; --step 0.001 s: need 0 < step"),
 ])
 def test_simulate_names_what_makes_a_program_too_long(argv, expected, capsys):

@@ -110,11 +110,21 @@ def test_calibration_refuses_what_is_no_calibration():
 @pytest.mark.parametrize("x1, x2, rows_a, x_w, y_w, height", [
     (60, 59.9999999, 60, 0.035, 0.1022, "3.06e+07"),  # stripes that look parallel: focal 7.7e10 px, exit 0
     (60, 30, 1e-300, 0.035, 1e-300, "2.333e-303"),  # printed 'focal = 0.00 px, height = 0.00000 m'
-    (60, 30, 60, 1e300, 1e301, "3.816e+300"),
 ])
 def test_calibration_refuses_an_impossible_camera_height(x1, x2, rows_a, x_w, y_w, height):
     with pytest.raises(CameraError, match=rf"camera height of {re.escape(height)} m, outside the lengths"):
         calibrate(x1, x2, rows_a, x_w, y_w)
+
+
+@pytest.mark.parametrize(("x_w", "y_w", "message"), [
+    (1e300, 1e301, "half-separation must be at most 1000 m (the lengths wmrkit handles), got 1e+300 m"),
+    (0.035, 1001, "row distance must be at most 1000 m (the lengths wmrkit handles), got 1001 m"),
+])
+def test_calibration_refuses_ground_lengths_beyond_those_wmrkit_handles(x_w, y_w, message):
+    """1e300 m was refused as a camera height of 3.8e300 m, and '--half-separation 1e300' as a tilt's cosine of
+    7e300, naming neither length."""
+    with pytest.raises(CameraError, match=f"^calibration: {re.escape(message)}$"):
+        calibrate(60, 30, 60, x_w, y_w)
 
 
 @pytest.mark.parametrize("third", [-0.02, 0.01])

@@ -72,7 +72,8 @@ def test_calibrate_from_measurements(capsys):
     # rows +-60 px and x1 = 71 px lie outside a 100 x 100 px image: refused (it wrote a camera file)
     code, out, err = run(["vision", "calibrate", "--x1", "71.2357", "--x2", "49.0727", "--rows", "60",
                           "--half-separation", "0.035", "--row-distance", "0.10221", "--size", "100", "100"], capsys)
-    assert code == 2 and "A must be below 50 px and x1, x2 below 50 px" in err
+    assert code == 2 and "--rows 60 px: measured from the centre of a 100 x 100 px image" in err
+    assert "it must be below 50 px" in err  # it named --size, not the measurement beyond the image
 
 
 def test_calibrate_refuses_rows_below_a_pixel(capsys):
@@ -100,8 +101,8 @@ def test_calibrate_prints_the_height_at_its_own_precision(capsys):
 @pytest.mark.parametrize(("x1", "x2", "size", "message"), [
     ("71.2357", "49.0727", ["0", "0"], "calibrate: --size: the image is 0 x 0 px, expected 8 to 4096 px a side"),
     ("71.2357", "49.0727", ["100000", "480"], "calibrate: --size: the image is 100000 x 480 px, expected 8 to 4096"),
-    ("nan", "49.0727", [], "calibration: x1 must be > 0, got nan"),
-    ("71.2357", "nan", [], "calibration: x2 must be > 0, got nan"),
+    ("nan", "49.0727", [], "--x1: x1 must be > 0, got nan"),
+    ("71.2357", "nan", [], "--x2: x2 must be > 0, got nan"),
 ])
 def test_calibrate_names_a_bad_size_or_measurement(x1, x2, size, message, tmp_path, capsys):
     """'--size 0 0' said 'A must be below 0 px and x1, x2 below 0 px', '--size 100000 480' was refused after the
@@ -367,7 +368,7 @@ def test_errors_about_an_image_or_a_points_file_name_it(tmp_path, capsys):
     code, _, err = run(["vision", "locate", str(tmp_path / "black.png"), "--camera",
                         str(FIGURES / "thesis-camera.yaml"), "--json"], capsys)
     assert code == 2 and json.loads(err) == {"error": "found 0 line(s), expected 1",
-                                             "file": str(tmp_path / "black.png"), "wheel": None, "field": None,
+                                             "file": str(tmp_path / "black.png"), "wheel": None, "field": "IMAGE",
                                              "line": None}
     (tmp_path / "p.json").write_text('{"lines": [{"n": 0, "points": [[300, -200], [-300, -199]]}]}')
     code, _, err = run(["vision", "locate", "--points", str(tmp_path / "p.json"), "--camera",
@@ -377,7 +378,7 @@ def test_errors_about_an_image_or_a_points_file_name_it(tmp_path, capsys):
 
 @pytest.mark.parametrize(("stripes", "rows", "message"), [
     ((), "60", "the image does not show two stripes"),
-    ((), "200", "rows A must be in (0, 120) px, got 200"),
+    ((), "200", "--rows: rows A must be in (0, 120) px, got 200"),
     ((-0.035, 0.0, 0.035), "60", "the image shows more than two stripes"),
 ])
 def test_calibrate_names_the_image_whose_content_it_refuses(stripes, rows, message, tmp_path, capsys):
@@ -389,7 +390,9 @@ def test_calibrate_names_the_image_whose_content_it_refuses(stripes, rows, messa
     code, out, err = run(argv, capsys)
     assert code == 2 and out == "" and err.startswith(f"wmrkit: error: {image}: {message}") and err.count("\n") == 1
     code, _, err = run([*argv, "--json"], capsys)
-    assert code == 2 and json.loads(err)["file"] == str(image) and json.loads(err)["error"].startswith(message)
+    error = json.loads(err)
+    assert code == 2 and error["file"] == str(image) and error["error"].startswith(message.removeprefix("--rows: "))
+    assert error["field"] == ("--rows" if message.startswith("--rows") else "IMAGE")  # what was wrong: null
 
 
 def test_calibrate_an_image_of_one_row_gives_one_line(tmp_path, capsys):

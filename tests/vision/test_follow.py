@@ -137,7 +137,8 @@ def test_the_run_ends_within_its_duration():
     """Periods were rounded: 20.3 s ran 20.5 s, and 0.1 s at T = 0.5 s ran no period, its start printed as a result."""
     assert follow_line(ROBOT, CAMERA, duration=20.3, from_image=False).time[-1] == 20.0
     assert follow_line(ROBOT, CAMERA, duration=0.5 * 3, period=0.5, from_image=False).time[-1] == 1.5
-    with pytest.raises(WmrkitError, match=re.escape("follow-line: duration 0.1 s is shorter than one period (0.5 s)")):
+    with pytest.raises(WmrkitError, match=re.escape("follow-line: duration (--duration) 0.1 s is shorter than one "
+                                                    "period (--period, 0.5 s)")):
         follow_line(ROBOT, CAMERA, duration=0.1)
 
 
@@ -200,7 +201,7 @@ def test_a_camera_too_noisy_to_see_the_line_is_an_error_with_its_reason(capsys):
     camera = str(Path(__file__).resolve().parents[2] / "docs" / "figures" / "vision" / "follower-camera.yaml")
     assert main(["follow-line", "line-follower", "--camera", camera, "--image-noise", "40"]) == 2
     err = capsys.readouterr().err
-    assert "follow-line: the camera does not see the line at the start pose: image: too noisy" in err
+    assert "follow-line: the camera does not see the line at the start pose (--start): image: too noisy" in err
     assert main(["follow-line", "line-follower", "--camera", camera, "--image-noise", "1e300"]) == 2
     assert "image noise must be in [0, 255] grey levels" in capsys.readouterr().err
 
@@ -267,7 +268,8 @@ def test_a_bad_loop_setting_is_named(kwargs, named):
 
 @pytest.mark.parametrize("kwargs, message", [
     ({"noise": (0.1,)}, "noise: expected shape (..., 2), got (1,)"),  # IndexError: tuple index out of range
-    ({"start": (0.0, 0.3, math.nan)}, "follow-line: start: expected a finite pose (x, y, theta), got (0, 0.3, nan)"),
+    ({"start": (0.0, 0.3, math.nan)},
+     "follow-line: start (--start): expected a finite pose (x, y, theta), got (0, 0.3, nan)"),
 ])
 def test_follow_line_names_a_bad_noise_or_start(kwargs, message):
     # a NaN start was refused by render, as 'render: pose and z_p must be finite'

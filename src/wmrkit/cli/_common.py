@@ -239,6 +239,22 @@ def seed(text: str) -> int:
     return value
 
 
+@contextlib.contextmanager
+def renaming(starts: dict[str, str]) -> Iterator[None]:
+    """An error whose message starts with a key of `starts` (the library's name of a value or file: ``"speed: "``,
+    ``"calibration: x1 "``, ``"image: "``) re-raised starting with its value instead (the option or file the user
+    gave: ``"--speed: "``; the JSON error's field or file, ``cli.main.report_error``); the first key that matches
+    is used; any other error passes as it is."""
+    try:
+        yield
+    except WmrkitError as err:
+        message = str(err)
+        start = next((s for s in starts if message.startswith(s)), None)
+        if start is None:
+            raise
+        raise WmrkitError(starts[start] + message.removeprefix(start)) from None
+
+
 def parse_value(text: str, kind: Kind, what: str) -> float:
     """A number from the command line (SI, or with a unit such as ``deg``, ``mm``); errors name the option."""
     try:

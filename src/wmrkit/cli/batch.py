@@ -19,6 +19,7 @@ from ._common import (
     parse_mount,
     parse_value,
     print_json,
+    renaming,
     seed,
     warn,
 )
@@ -299,7 +300,8 @@ def run_montecarlo(args: argparse.Namespace) -> int:
         rate = 20.0 if args.rate is None else args.rate
         if not rate > 0:
             raise WmrkitError(f"--rate must be > 0 Hz, got {rate}")
-        log = path_log(robot, args.path, rate)
+        with renaming({"rate": "--rate"}):  # 'rate: expected a finite number', 'rate 1e+300 Hz over the profile's'
+            log = path_log(robot, args.path, rate)
     with _runner(args) as runner:
         result = monte_carlo(robot, log, args.runs, per_rad=args.noise, resolution=resolution, slip_std=args.slip,
                              method=args.method, seed=args.seed, runner=runner, progress=_progress(args))

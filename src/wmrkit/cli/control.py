@@ -18,6 +18,7 @@ from ._common import (
     load_robot,
     parse_value,
     print_json,
+    renaming,
     say_caught,
     warn,
 )
@@ -130,7 +131,8 @@ def _reference(args: argparse.Namespace, robot) -> tuple[Reference, float | None
     turning = min_turning_radius(robot)
     if size is None and name in BUILTIN and name != "line":
         size = default_size(name, turning)
-    reference = resolve_reference(name, speed=speed, size=size)
+    with renaming({f"reference '{name}' at ": f"reference '{name}' (--speed, --size) at "}):  # too many samples
+        reference = resolve_reference(name, speed=speed, size=size)
     if size is None:
         return reference, None, reference.name
     words = f"{name} of {SIZE_WORDS[name]} {size:g} m"
@@ -218,6 +220,11 @@ def check_animation_path(path: str | None, suffixes: tuple[str, ...] = (".gif",)
         raise WmrkitError(f"--animate {path}: the animation is written as {' or '.join(suffixes)}")
 
 
+#: The keywords of :func:`wmrkit.control.track.track` its errors start with, and the options of ``track``.
+TRACK_KEYWORDS = {"initial_pose: ": "--from: initial pose ", "period: expected": "--period: expected",
+                  "delay: expected": "--delay: expected"}
+
+
 def run_track(args: argparse.Namespace) -> int:
     """Simulate, then print a summary (or the time series as JSON); warnings on stderr (and in the JSON)."""
     from ..control.laws import SamplingWarning
@@ -253,11 +260,12 @@ def run_track(args: argparse.Namespace) -> int:
     with warnings.catch_warnings(record=True) as caught:  # every one said below (after: one passed on is not caught)
         warnings.simplefilter("always", UserWarning)  # wmrkit's classes (a model built twice says it once)
         try:
-            run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
-                        lookahead=lookahead, stanley_gain=stanley_gain, period=period, delay=args.delay,
-                        duration=duration, policy=args.steering, dynamics=args.dynamics, slip_model=args.slip_model,
-                        feedback=args.feedback, weights=weights, noise=noise, ramp=args.ramp,
-                        progress=sys.stderr.isatty() and not args.json)
+            with renaming(TRACK_KEYWORDS):
+                run = track(robot, reference, controller=args.controller, gain=gain, gate=gate, initial_pose=start,
+                            lookahead=lookahead, stanley_gain=stanley_gain, period=period, delay=args.delay,
+                            duration=duration, policy=args.steering, dynamics=args.dynamics,
+                            slip_model=args.slip_model, feedback=args.feedback, weights=weights, noise=noise,
+                            ramp=args.ramp, progress=sys.stderr.isatty() and not args.json)
         except WmrkitError as err:
             failed = err
     foretold = [str(w.message) for w in caught if issubclass(w.category, SamplingWarning)] if failed else []
@@ -364,7 +372,8 @@ def run_feasibility(args: argparse.Namespace) -> int:
     reference, size, described = _reference(args, robot)
     point = None if args.point is None else (parse_value(args.point[0], "length", "--point X"),
                                               parse_value(args.point[1], "length", "--point Y"))
-    result = feasibility(robot, reference, args.framework, point=point)
+    with renaming({"point: ": "--point: "}):
+        result = feasibility(robot, reference, args.framework, point=point)
     if result.requirement.note:  # a skid steer, judged as a differential drive
         warn(result.requirement.note)
     fewer = None  # whether the linkages command fewer steering angles than the wheels' steerability d

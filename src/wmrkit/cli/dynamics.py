@@ -19,8 +19,12 @@ from ._common import (
     parse_assignments,
     parse_value,
     print_json,
+    renaming,
     warn,
 )
+
+#: ``simulate --step`` when not given [s].
+DEFAULT_STEP = 0.001
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -51,7 +55,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     source.add_argument("--path", metavar="NAME", choices=list(PATHS), help=f"built-in program: {', '.join(PATHS)}")
     p.add_argument("--tyre", choices=list(TYRES), help="tyre model for every wheel (default: each wheel's own)")
     p.add_argument("--duration", metavar="S", help="simulated time [s] (default: the program's or the file's)")
-    p.add_argument("--step", default="0.001", metavar="DT", help="integration step [s] (default 0.001)")
+    p.add_argument("--step", metavar="DT", help=f"integration step [s] (default {DEFAULT_STEP:g})")
     p.add_argument("--method", default="semi-implicit", choices=["semi-implicit", "rk4", "adaptive"],
                    help="integrator: semi-implicit Euler (default; stable with stiff tyres at 1 ms), rk4 (fixed "
                         "step, non-stiff tyres only: docs/dynamics.md) or adaptive (LSODA)")
@@ -72,7 +76,8 @@ def run_tyre(args: argparse.Namespace) -> int:
     check_plot_path(args.plot)
     params = {k: math.inf if k == "k" and v.strip().lower() in ("inf", "+inf", "infinity") else  # discontinuous
               parse_value(v, "number", f"--param {k}") for k, v in parse_assignments(args.param, "--param").items()}
-    tyre = Tyre.of(args.model, params)
+    with renaming({"tyre parameter ": "--param ", "tyre model ": "--param: tyre model "}):
+        tyre = Tyre.of(args.model, params)
     load = _positive(parse_value(args.load, "number", "--load"), "--load", zero=True)
     if load > MAX_LOAD:
         raise WmrkitError(f"--load: at most {MAX_LOAD:g} N (a thousand tonnes on one tyre), got {load:g} N")
@@ -107,6 +112,25 @@ def run_tyre(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_steps(step: float, duration: float, source: str, culprit: str, step_given: bool) -> None:
+    """Refuse a `step` [s] longer than the run's `duration` [s] or more than ``simulate.MAX_STEPS`` of them, the
+    message starting with what to change (the field of the JSON error): --step when it was given and the duration
+    fits the default step, or when nothing given set the duration; else `culprit`, what set the duration
+    (``--duration D s``, ``FILE: the file ends at t = D s``, ``--speed V m/s: --path NAME at this speed lasts D s``);
+    `source` says what set it after --step. '--path turn --step 10' named --path."""
+    from ..dynamics.simulate import MAX_STEPS
+
+    def fits(dt: float) -> bool:
+        return 0 < dt <= duration and duration / dt <= MAX_STEPS
+
+    if fits(step):
+        return
+    need = f"need 0 < step <= duration and at most {MAX_STEPS:.0e} steps"
+    if (step_given and fits(DEFAULT_STEP)) or not culprit:
+        raise WmrkitError(f"--step {step:g} s: {source} {duration:g} s; {need}")
+    raise WmrkitError(f"{culprit}; --step {step:g} s: {need}")
+
+
 def _check_program_step(step: float, name: str) -> None:
     """Refuse a fixed `step` [s] longer than the time constant of a --path program's servos (1 /
     ``programs.BANDWIDTH``), which it cannot resolve (nor the program's parts shorter than it, which they smooth):
@@ -125,7 +149,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     from ..dynamics.linkages import SetpointKnotsError
     from ..dynamics.programs import path_program, read_torques
     from ..dynamics.runs import at_door
-    from ..dynamics.simulate import MAX_STEPS, recordable_step, simulate
+    from ..dynamics.simulate import recordable_step, simulate
 
     if args.out is not None and Path(args.out).suffix.lower() not in (".csv", ".json"):  # not CSV under another name
         raise WmrkitError(f"--out {args.out}: the samples are written as .csv or .json")
@@ -135,7 +159,8 @@ def run_simulate(args: argparse.Namespace) -> int:
         raise WmrkitError("--speed applies to --path (the speed of a built-in program; it would be ignored)")
     speed = _positive(parse_value("2" if args.speed is None else args.speed, "number", "--speed"), "--speed")
     if args.path:
-        inputs, duration = path_program(model, args.path, speed=speed)
+        with renaming({"speed: ": "--speed: "}):
+            inputs, duration = path_program(model, args.path, speed=speed)
     else:
         inputs = read_torques(model, args.torques)
         duration = float(inputs.time[-1])
@@ -143,12 +168,13 @@ def run_simulate(args: argparse.Namespace) -> int:
             raise WmrkitError(f"{args.torques}: the file ends at t = {duration:g} s: give --duration")
     if args.duration is not None:
         duration = _positive(parse_value(args.duration, "number", "--duration"), "--duration")
-    step = _positive(parse_value(args.step, "number", "--step"), "--step")
+    step = _positive(parse_value(f"{DEFAULT_STEP}" if args.step is None else args.step, "number", "--step"), "--step")
     source = ("--duration" if args.duration is not None else f"{args.torques}: the file ends at t =" if args.torques
               else f"--path {args.path} at --speed {speed:g} m/s lasts")  # what set the duration
-    if duration <= 0 or step > duration or duration / step > MAX_STEPS:
-        raise WmrkitError(f"{source} {duration:g} s; --step {step:g} s: need 0 < step <= duration and at most "
-                          f"{MAX_STEPS:.0e} steps")
+    culprit = (f"--duration {duration:g} s" if args.duration is not None else
+               f"{args.torques}: the file ends at t = {duration:g} s" if args.torques else
+               f"--speed {speed:g} m/s: --path {args.path} at this speed lasts {duration:g} s" if args.speed else "")
+    _check_steps(step, duration, source, culprit, args.step is not None)
     if args.path and args.method != "adaptive":
         _check_program_step(step, args.path)
     steps = round(duration / step)  # what the fixed steps run; a program's own duration may end within a step
@@ -160,9 +186,10 @@ def run_simulate(args: argparse.Namespace) -> int:
         parse_value(v, "number", "--initial-twist") for v in args.initial_twist]
     _check_rolling(model, twist)
     try:
-        sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
-                       record_step=recordable_step(model, duration, step, max(step, min(0.01, duration))),
-                       progress=False if args.json else None)
+        with renaming({"initial twist ": "--initial-twist "}):
+            sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
+                           record_step=recordable_step(model, duration, step, max(step, min(0.01, duration))),
+                           progress=False if args.json else None)
         check_step(model, inputs, sim, initial_twist=twist)  # a run off its path at an unstable step is refused
     except SetpointKnotsError as err:  # the knots between the torque file's rows (the program's)
         raise WmrkitError(f"{args.torques or f'--path {args.path}'}: {err}") from None

@@ -13,11 +13,11 @@ import os
 import re
 import sys
 import threading
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import NoReturn
 
 from ..errors import DescriptionError, WmrkitError
-from ._common import check_blank, check_outputs, collecting_warnings, output_option
+from ._common import check_blank, check_outputs, collecting_warnings, named_values, output_option
 
 #: Each command and the module of ``wmrkit.cli`` that registers it (``add_parsers``), in ``--help`` order.
 COMMANDS = {
@@ -78,7 +78,7 @@ def main(argv: list[str] | None = None) -> int:
     done = threading.Event()
     if not as_json:
         threading.Thread(target=_compile_notice, args=(done,), daemon=True).start()
-    args = None
+    parser = args = None
     try:
         parser = build_parser(command)
         args, unknown = parser.parse_known_args(argv)
@@ -90,7 +90,7 @@ def main(argv: list[str] | None = None) -> int:
         with collecting_warnings():
             return int(args.run(args) or 0)
     except WmrkitError as err:
-        report_error(err, as_json, argv)
+        report_error(err, as_json, argv, given_names(parser, args))
         return 2
     except BrokenPipeError:  # e.g. `wmrkit robots | head` (an OSError: caught first)
         return 0
@@ -116,6 +116,18 @@ def chosen_parser(parser: argparse.ArgumentParser, args: argparse.Namespace) -> 
         if isinstance(action, argparse._SubParsersAction) and getattr(args, action.dest, None) in action.choices:
             return chosen_parser(action.choices[getattr(args, action.dest)], args)
     return parser
+
+
+def given_names(parser: argparse.ArgumentParser | None, args: argparse.Namespace | None) -> dict[str, str]:
+    """Each text value of the parsed command line and the argument that gave it, as the user sees it (``{"run.csv":
+    "--torques", "img.png": "IMAGE"}``; the first of two that gave the same); {} before the parsing."""
+    if parser is None or args is None:
+        return {}
+    names: dict[str, str] = {}
+    for name, _, value in named_values(parser, args):
+        if isinstance(value, str):
+            names.setdefault(value, name)
+    return names
 
 
 def wants_json(argv: Sequence[str]) -> bool:
@@ -147,15 +159,17 @@ def _compile_notice(done: threading.Event, poll: float = 0.25) -> None:
             return
 
 
-def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> None:
+def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = (),
+                 names: Mapping[str, str] | None = None) -> None:
     """One line on stderr: ``wmrkit: error: ...``, or under ``--json`` a JSON object with the error's place.
 
     JSON: ``{"error": message, "file": ..., "wheel": ..., "field": ..., "line": ...}``; the place keys are null when the
     error has no such place. A message about a file of the command line (`argv`), ``FILE[:LINE]: [column
-    'NAME': |WHEEL.spin: |WHEEL.steer: |lines[I].n: ]...`` (logs, torque files, references, trajectories, points
-    files), gives ``file``, ``line`` and ``field`` (and ``wheel``, that of a joint); one about an option, ``--OPTION[
-    VALUE]: ...`` (or argparse's ``argument --OPTION: ...``), gives the option as ``field`` (and, for ``--steer``,
-    the wheel).
+    'NAME': |WHEEL.spin: |WHEEL.steer: |lines[I].n: |--OPTION: ]...`` (logs, torque files, references, trajectories,
+    points files, images), gives ``file``, ``line`` and ``field`` (and ``wheel``, that of a joint), the field being
+    the argument that gave the file (`names`: :func:`given_names`) when the message names none; one about an
+    option, ``--OPTION[ VALUE]: ...`` (or argparse's ``argument --OPTION: ...``), gives the option as ``field`` (and,
+    for ``--steer``, the wheel).
     """
     if not as_json:
         if isinstance(err, UsageError):
@@ -172,6 +186,8 @@ def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = ()) -> N
         data["field"] = ".".join(str(p) for p in loc) or None
     else:
         data |= _file_place(data["error"], argv) or _option_place(err, data["error"], argv)
+    if data["file"] is not None and data["field"] is None:  # the whole file: the argument that gave it
+        data["field"] = (names or {}).get(data["file"])
     print(json.dumps(data), file=sys.stderr)
 
 
@@ -192,8 +208,10 @@ _ANY_OPTION = re.compile(r"(?<![\w-])--[A-Za-z][\w-]*")
 def _option_place(err: WmrkitError, message: str, argv: Sequence[str] = ()) -> dict:
     """``field`` (the option) and ``wheel`` (the wheel its value names, :class:`._common.OptionError`) of an error
     about an option of the command line: one the message starts with, after the words of the command in `argv`
-    (``ik: --twist 1e7: ...``, ``vision calibrate: --size: ...``), or the only option it names, in parentheses
-    (``follow-line: blur (--blur): ...``); {} when it names none so."""
+    (``ik: --twist 1e7: ...``, ``vision calibrate: --size: ...``), the only option it names, in parentheses
+    (``follow-line: blur (--blur): ...``), or, of the options it names so, the only one `argv` gives
+    (``duration (--duration) 20 s is shorter than one period (--period, 100 s)`` after ``--period 100``); {} when it
+    names none so."""
     from ._common import OptionError
 
     if isinstance(err, UsageError):
@@ -201,12 +219,16 @@ def _option_place(err: WmrkitError, message: str, argv: Sequence[str] = ()) -> d
         return {} if place is None else {"field": place.group(1) or place.group(2), "wheel": None}
     rest = _after_command(message, argv)
     place = _OPTION_FIRST.match(rest)
-    if place is None:
-        inside = _OPTION_IN_PARENTHESES.search(rest)
-        if inside is None or set(_ANY_OPTION.findall(rest)) != {inside.group(1)}:
-            return {}
-        place = inside
-    return {"field": place.group(1), "wheel": err.wheel if isinstance(err, OptionError) else None}
+    if place is not None:
+        return {"field": place.group(1), "wheel": err.wheel if isinstance(err, OptionError) else None}
+    named = set(_ANY_OPTION.findall(rest))
+    inside = _OPTION_IN_PARENTHESES.search(rest)
+    if inside is not None and named == {inside.group(1)}:
+        return {"field": inside.group(1), "wheel": None}
+    given = named & {a.partition("=")[0] for a in argv}  # of several named in parentheses, the one typed
+    if inside is None or len(given) != 1:
+        return {}
+    return {"field": given.pop(), "wheel": None}
 
 
 def _after_command(message: str, argv: Sequence[str]) -> str:
@@ -237,8 +259,9 @@ def _file_place(message: str, argv: Sequence[str]) -> dict:
                      flags=re.S)
     line, column, joint, rest = place.groups()
     missing = re.match(r"\s*missing column '([^']*)'", rest)  # "x.csv:1: missing column 'right.spin' (columns: ...)"
-    if joint is None:  # a place in a JSON file: "p.json: lines[0].n: must be -1, 0 or 1"
-        path = re.match(r"\s*([A-Za-z_]\w*(?:\[\d+\])+(?:\.\w+|\[\d+\])*):(.*)", rest, flags=re.S)
+    if joint is None:  # a place in a JSON file: "p.json: lines[0].n: must be -1, 0 or 1"; an option measured in the
+        # file: "img.png: --rows: rows A must be in (0, 120) px"
+        path = re.match(r"\s*([A-Za-z_]\w*(?:\[\d+\])+(?:\.\w+|\[\d+\])*|--[\w-]+):(.*)", rest, flags=re.S)
         joint, rest = (path.group(1), path.group(2)) if path else (None, rest)
     return {"error": rest.strip(), "file": name, "line": int(line) if line else None,
             "field": column or joint or (missing.group(1) if missing else None),

@@ -24,6 +24,7 @@ from ..odometry.model import odometry_model
 from ..odometry.pipeline import OdometrySummary, check_start_pose
 from ._common import (
     SCHEMES_HELP,
+    OptionError,
     add_json_flag,
     add_robot_argument,
     check_plot_path,
@@ -33,6 +34,7 @@ from ._common import (
     parse_mount,
     parse_value,
     print_json,
+    renaming,
     warn,
 )
 from .slip import ESTIMATOR_METHODS, add_estimator_options, check_estimator_options, estimator_from_args, resolve_method
@@ -114,6 +116,7 @@ def run(args: argparse.Namespace) -> int:
     if not all(math.isfinite(k) and k >= 0 for k in args.crowley):
         raise WmrkitError(f"--crowley: coefficients must be finite and >= 0, got {' '.join(map(str, args.crowley))}")
     model = odometry_model(robot, args.sensed)  # the no-slip model of the diagnostics (the run's, without weights)
+    weights = _weights(robot, args)
     joints = model.joints
     steer_option = "--steer" if args.steer else "--steer-convention" if args.steer_convention else None
     if steer_option and not any(j.endswith(".steer") for j in joints):  # it would be ignored silently
@@ -171,8 +174,7 @@ def run(args: argparse.Namespace) -> int:
         noise=CrowleyNoise(*args.crowley) if args.covariance else None, out=args.out, out_format=args.out_format,
         plot=args.plot, progress=not args.quiet and sys.stderr.isatty(), chunk_size=args.chunk_size,
         topic=args.topic, joint_names=parse_assignments(args.joint_name, "--joint-name"),
-        weights={w: parse_value(v, "number", f"--weight {w}")
-                 for w, v in parse_assignments(args.weight, "--weight").items()},
+        weights=weights,
         sinks=[check] if check else (), check=check.judge if check else None)
     if slip_model is not None:
         summary = replace(summary, method=f"{args.method} ({args.scheme})")
@@ -215,3 +217,19 @@ def format_summary(s: OdometrySummary) -> str:
         lines.append(f"final std: x {math.sqrt(c[0][0]):.4g} m, y {math.sqrt(c[1][1]):.4g} m, "
                      f"theta {math.sqrt(c[2][2]):.4g} rad")
     return "\n".join(lines)
+
+
+def _weights(robot, args: argparse.Namespace) -> dict[str, float]:
+    """The ``--weight WHEEL=W`` options, each refused naming the option and its wheel (the JSON error's field and
+    wheel: 'weight of wheel ... must be > 0' named neither), then together (their ratio)."""
+    weights = {}
+    for wheel, text in parse_assignments(args.weight, "--weight").items():
+        try:
+            weights[wheel] = parse_value(text, "number", f"--weight {wheel}")
+            odometry_model(robot, args.sensed, weights={wheel: weights[wheel]})
+        except WmrkitError as err:
+            raise OptionError(f"--weight {wheel}={text}: {str(err).removeprefix(f'--weight {wheel}: ')}",
+                              wheel=wheel) from None
+    with renaming({"weights ": "--weight: weights "}):
+        odometry_model(robot, args.sensed, weights=weights)
+    return weights

@@ -6,14 +6,21 @@ from __future__ import annotations
 import argparse
 import math
 import os
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import WmrkitError
-from ._common import add_json_flag, add_robot_argument, load_robot, parse_angle, parse_value, print_json, seed
+from ._common import (
+    add_json_flag,
+    add_robot_argument,
+    load_robot,
+    parse_angle,
+    parse_value,
+    print_json,
+    renaming,
+    seed,
+)
 from .control import check_animation_path
 
 
@@ -121,17 +128,16 @@ def read_image(path: str) -> np.ndarray:
     return img
 
 
-@contextmanager
-def _naming(path: str, *prefixes: str) -> Iterator[None]:
-    """Errors about the file's content (messages starting with one of `prefixes`, e.g. "image: found 0 line(s)")
-    name it."""
-    try:
-        yield
-    except WmrkitError as err:
-        prefix = next((p for p in prefixes if str(err).startswith(p)), None)
-        if prefix is None:
-            raise
-        raise WmrkitError(f"{path}: {str(err).removeprefix(prefix)}") from None
+def _calibration_starts(image: str | None) -> dict[str, str]:
+    """What :func:`._common.renaming` puts at the start of ``calibration: ...`` errors: the option of the measurement
+    the command line gave (rows A, the ground lengths; x1, x2 without an IMAGE), after the IMAGE when there is one;
+    the IMAGE for what it shows and the camera it gives."""
+    given = {"rows A": "--rows", "half-separation": "--half-separation", "row distance": "--row-distance"}
+    if image is None:
+        given |= {"x1": "--x1", "x2": "--x2"}
+    file = "" if image is None else f"{image}: "
+    starts = {f"calibration: {name} ": f"{file}{option}: {name} " for name, option in given.items()}
+    return starts if image is None else starts | {"image: ": file, "calibration: ": file}
 
 
 def run_locate(args: argparse.Namespace) -> int:
@@ -147,7 +153,7 @@ def run_locate(args: argparse.Namespace) -> int:
         for option, value in (("--lines", args.lines), ("--mode", args.mode)):
             if value is not None:  # it would be ignored
                 raise WmrkitError(f"locate: {option} applies to an IMAGE, not to --points")
-        with _naming(args.points, "points: "):
+        with renaming({"points: ": f"{args.points}: "}):
             fix = locate_points(camera, read_points(args.points), spacing=spacing, z_p=z_p)
     else:
         layouts = {1: (0,), 2: (-1, 1), 3: (-1, 0, 1)}
@@ -162,7 +168,7 @@ def run_locate(args: argparse.Namespace) -> int:
         if image.shape != (camera.rows, camera.width):
             raise WmrkitError(f"{args.image}: {image.shape[1]} x {image.shape[0]} px, the camera file says "
                               f"{camera.width} x {camera.rows}")
-        with _naming(args.image, "image: "):
+        with renaming({"image: ": f"{args.image}: "}):
             fix = locate_image(camera, image, spacing=spacing, ns=ns, z_p=z_p, mode=args.mode or "threshold")
     if args.json:
         print_json(fix.to_dict())
@@ -191,17 +197,19 @@ def run_calibrate(args: argparse.Namespace) -> int:
             # refused after the calibration as the camera's 'width'
             raise WmrkitError(f"calibrate: --size: the image is {width} x {rows} px, expected 8 to {MAX_PIXELS} px a "
                               "side (a camera's)")
-        if args.rows >= rows / 2 or max(args.x1, args.x2) >= width / 2:  # inside the image, as from IMAGE (NaN: named
-            # by calibrate)
-            raise WmrkitError(f"calibrate: rows A ({args.rows:g} px) and x1, x2 ({args.x1:g}, {args.x2:g} px) are "
-                              f"measured from the centre of a {width} x {rows} px image (--size): A must be below "
-                              f"{rows / 2:g} px and x1, x2 below {width / 2:g} px")
-        cal = calibrate(args.x1, args.x2, args.rows, xw, yw)
+        for option, value, half in (("--rows", args.rows, rows / 2), ("--x1", args.x1, width / 2),
+                                    ("--x2", args.x2, width / 2)):
+            if value >= half:  # inside the image, as from IMAGE (NaN: named by calibrate); it named --size
+                raise WmrkitError(f"calibrate: {option} {value:g} px: measured from the centre of a {width} x {rows} "
+                                  f"px image (the size the camera file gets, default 640 480), it must be below "
+                                  f"{half:g} px")
+        with renaming(_calibration_starts(None)):
+            cal = calibrate(args.x1, args.x2, args.rows, xw, yw)
     else:
         if args.size is not None:  # it would be ignored
             raise WmrkitError("calibrate: --size applies to --x1/--x2 (the camera file of an image has its size)")
         image = read_image(args.image)
-        with _naming(args.image, "image: ", "calibration: "):  # what the image shows, or the camera it gives
+        with renaming(_calibration_starts(args.image)):
             cal = calibrate_image(image, args.rows, xw, yw)
         rows, width = image.shape
     if args.out:
@@ -224,11 +232,13 @@ def run_follow(args: argparse.Namespace) -> int:
     noise = (0.0, 0.0) if not args.noise else (parse_value(args.noise[0], "length", "--noise H"),
                                                 parse_angle(args.noise[1], "--noise PSI"))
     start = (0.0, parse_value(args.start[0], "length", "--start H"), parse_angle(args.start[1], "--start THETA"))
+    with renaming({"scene: width ": "--line-width: width "}):
+        scene = Scene(ns=(0,), width=parse_value(args.line_width, "length", "--line-width"))
     run = follow_line(robot, camera, gain=args.gain, speed=parse_value(args.speed, "number", "--speed"),
                       period=args.period, duration=args.duration, start=start,
                       z_p=parse_value(args.z_p, "length", "--z-p"), noise=noise, image_noise=args.image_noise,
                       blur=args.blur, clutter=args.clutter, seed=args.seed, keep_images=bool(args.animate),
-                      scene=Scene(ns=(0,), width=parse_value(args.line_width, "length", "--line-width")))
+                      scene=scene)
     if args.animate:
         from ..vision.animation import save_animation
 

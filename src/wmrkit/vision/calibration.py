@@ -74,14 +74,19 @@ class Calibration:
 def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_distance: float) -> Calibration:
     """Calibrate from image measurements (x1, x2, A) [px] and ground ones (x_w, y_w) [m], (9.18)-(9.24).
 
-    Raises :class:`CameraError` naming the measurement when they describe no camera (``x1 <= x2``, a tilt
-    whose cosine is not in (0, 1), a height outside ``[MIN_SIZE, MAX_SIZE]`` of :mod:`wmrkit.limits`, a focal length
-    outside :data:`.camera.MIN_FOCAL_PX` to :data:`.camera.MAX_FOCAL_PX`, rows A below :data:`MIN_ROWS_PX`).
+    Raises :class:`CameraError` naming the measurement when they describe no camera (``x1 <= x2``, a half-separation
+    or row distance above ``MAX_SIZE``, a tilt whose cosine is not in (0, 1), a height outside ``[MIN_SIZE,
+    MAX_SIZE]`` of :mod:`wmrkit.limits`, a focal length outside :data:`.camera.MIN_FOCAL_PX` to
+    :data:`.camera.MAX_FOCAL_PX`, rows A below :data:`MIN_ROWS_PX`).
     """
     for name, value in (("x1", x1), ("x2", x2), ("rows A", rows_a), ("half-separation", half_separation),
                         ("row distance", row_distance)):
         if not (math.isfinite(value) and value > 0):
             raise CameraError(f"calibration: {name} must be > 0, got {value}")
+    for name, value in (("half-separation", half_separation), ("row distance", row_distance)):
+        if value > MAX_SIZE:  # 1e300 m: refused as a tilt's cosine of 7e300, naming neither
+            raise CameraError(f"calibration: {name} must be at most {MAX_SIZE:g} m (the lengths wmrkit handles), "
+                              f"got {value:g} m")
     if x1 <= x2:
         raise CameraError(f"calibration: x1 (near row +A, {x1:g} px) must exceed x2 (far row -A, {x2:g} px)")
     with np.errstate(over="ignore", invalid="ignore"):  # an overflow gives NaN, refused below

@@ -242,13 +242,14 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
             got = f"{value:g}" if number else repr(value)
             raise WmrkitError(f"follow-line: {name} (--{name}): expected a finite number > 0 [{unit}], got {got}")
     if speed > MAX_SPEED:
-        raise WmrkitError(f"follow-line: speed {speed:g} m/s is faster than {MAX_SPEED:g} m/s")
+        raise WmrkitError(f"follow-line: speed (--speed) {speed:g} m/s is faster than {MAX_SPEED:g} m/s")
     if not duration / period <= MAX_PERIODS:
-        raise WmrkitError(f"follow-line: duration {duration:g} s at a period of {period:g} s is more than "
-                          f"{MAX_PERIODS} periods (one image each)")
+        raise WmrkitError(f"follow-line: duration (--duration) {duration:g} s at a period of {period:g} s is more "
+                          f"than {MAX_PERIODS} periods (one image each)")
     n_steps = math.floor(duration / period + 1e-9)  # whole periods within the duration (rounding ran past it)
     if n_steps < 1:  # no period: the start was printed as the result
-        raise WmrkitError(f"follow-line: duration {duration:g} s is shorter than one period ({period:g} s)")
+        raise WmrkitError(f"follow-line: duration (--duration) {duration:g} s is shorter than one period (--period, "
+                          f"{period:g} s)")
     if from_image and n_steps * camera.width * camera.rows > MAX_RUN_PIXELS:
         raise WmrkitError(f"follow-line: {n_steps} periods of {camera.width} x {camera.rows} px "
                           f"images are more than the {MAX_RUN_PIXELS:.3g} pixels a run renders (docs/limits.md): "
@@ -277,8 +278,8 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     noise = (abs(float(noise[0])), abs(float(noise[1])))  # -0.0 is a bound of 0 (numpy's uniform refuses it)
     check_seed(seed, WmrkitError, "follow-line: seed")
     if gain * period >= 1:
-        raise WmrkitError(f"follow-line: gain * period = {gain * period:g} >= 1: the delayed loop is unstable "
-                          "(digest §2.6: a_x T < 1)")
+        raise WmrkitError(f"follow-line: gain (--gain) * period (--period) = {gain * period:g} >= 1: the delayed "
+                          "loop is unstable (digest §2.6: a_x T < 1)")
     scene = scene or Scene(ns=(0,), width=0.02)
     view = view_width(camera)
     if scene.width >= view:  # the line fills the positioning row: no edge, nothing to locate
@@ -301,10 +302,10 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     pose = np.empty((n_steps + 1, 3))
     pose[0] = as_vectors(start, 3, "start")
     if not np.all(np.isfinite(pose[0])):  # render refused it, naming 'pose and z_p'
-        raise WmrkitError(f"follow-line: start: expected a finite pose (x, y, theta), got "
+        raise WmrkitError(f"follow-line: start (--start): expected a finite pose (x, y, theta), got "
                           f"({', '.join(f'{v:g}' for v in pose[0])})")
     if not np.all(np.abs(pose[0, :2]) <= MAX_COORDINATE):
-        raise WmrkitError(f"follow-line: start position ({pose[0, 0]:g}, {pose[0, 1]:g}) m is beyond "
+        raise WmrkitError(f"follow-line: start position (--start) ({pose[0, 0]:g}, {pose[0, 1]:g}) m is beyond "
                           f"{MAX_COORDINATE:g} m")
     if gain * (abs(pose[0, 1]) + noise[0]) > MAX_SPEED:  # the first command: |h| up to the start's plus the noise
         raise WmrkitError(f"follow-line: gain {gain:g} 1/s times the start's distance to the line and the noise bound "
@@ -336,7 +337,7 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
 
     last = position(pose[0], True)  # the image taken before starting
     if last is None:
-        raise WmrkitError(f"follow-line: the camera does not see the line at the start pose: {why[0]}")
+        raise WmrkitError(f"follow-line: the camera does not see the line at the start pose (--start): {why[0]}")
     for k in range(n_steps):
         psi, h = last
         measured[k] = psi, h
