@@ -79,6 +79,11 @@ TRACK = ["track", "diff-drive", "--reference", "circle"]
     ([*TRACK, "--period", "0.1", "--delay", "-1"], "--delay"),  # 'delay: expected a number of samples >= 0'
     (["feasibility", "diff-drive", "--reference", "circle", "--point", "1e300", "0"], "--point"),
     (["batch", "montecarlo", "diff-drive", "--path", "arc", "--rate", "inf", "--workers", "0"], "--rate"),
+    (["batch", "montecarlo", "diff-drive", "--path", "nope", "--workers", "0"], "--path"),  # 'unknown path'
+    (["feasibility", "diff-drive", "--reference", "nope"], "--reference"),  # 'no built-in reference'
+    (["fk", "diff-drive", "--spin", "nope=1"], "--spin"),  # "robot 'diff-drive' has no joint rate 'nope'"
+    (["odometry", "mecanum-4", LOG, "--sensed", "nope.spin"], "--sensed"),  # "robot ... has no wheel 'nope'"
+    (["odometry", "mecanum-4", LOG, "--sensed", "front_left.steer"], "--sensed"),  # has no joint 'steer'
     (["batch", "montecarlo", "diff-drive", "--path", "arc", "--rate", "1e300", "--workers", "0"], "--rate"),
 ])
 def test_an_error_naming_its_option_after_the_command_gives_it_as_field(argv, field, capsys):

@@ -300,7 +300,7 @@ def run_montecarlo(args: argparse.Namespace) -> int:
         rate = 20.0 if args.rate is None else args.rate
         if not rate > 0:
             raise WmrkitError(f"--rate must be > 0 Hz, got {rate}")
-        with renaming({"rate": "--rate"}):  # 'rate: expected a finite number', 'rate 1e+300 Hz over the profile's'
+        with renaming({"rate": "--rate", "unknown path": "--path: unknown path"}):  # 'rate: expected a finite ...'
             log = path_log(robot, args.path, rate)
     with _runner(args) as runner:
         result = monte_carlo(robot, log, args.runs, per_rad=args.noise, resolution=resolution, slip_std=args.slip,

@@ -131,7 +131,8 @@ def _reference(args: argparse.Namespace, robot) -> tuple[Reference, float | None
     turning = min_turning_radius(robot)
     if size is None and name in BUILTIN and name != "line":
         size = default_size(name, turning)
-    with renaming({f"reference '{name}' at ": f"reference '{name}' (--speed, --size) at "}):  # too many samples
+    with renaming({f"reference '{name}' at ": f"reference '{name}' (--speed, --size) at ",  # too many samples
+                   "no built-in reference ": "--reference: no built-in reference "}):
         reference = resolve_reference(name, speed=speed, size=size)
     if size is None:
         return reference, None, reference.name

@@ -30,6 +30,7 @@ from ._common import (
     parse_assignments,
     parse_value,
     print_json,
+    renaming,
     warn,
     wheel_column_width,
     with_steer,
@@ -87,7 +88,10 @@ def run_fk(args: argparse.Namespace) -> int:
         if abs(value) > MAX_QUERY_RATE:
             raise WmrkitError(f"--spin {name}: {value:g} is beyond {MAX_QUERY_RATE:g} rad/s (m/s), no wheel turns so "
                               "fast")
-    fk, lines = said_warnings(lambda: forward_kinematics_check(robot, rates, beta), (GearWarning, LinkageAngleWarning))
+    unknown = f"robot '{robot.name}' has no joint rate "
+    with renaming({unknown: f"--spin: {unknown}"}):
+        fk, lines = said_warnings(lambda: forward_kinematics_check(robot, rates, beta),
+                                  (GearWarning, LinkageAngleWarning))
     _check_finite("fk", fk.twist, fk.residual)
     twist, determined = fk.twist, bool(twist_is_determined(robot, list(rates), beta))
     if not determined:

@@ -115,7 +115,8 @@ def run(args: argparse.Namespace) -> int:
     check_chunk_size(args.chunk_size, WmrkitError, "--chunk-size")
     if not all(math.isfinite(k) and k >= 0 for k in args.crowley):
         raise WmrkitError(f"--crowley: coefficients must be finite and >= 0, got {' '.join(map(str, args.crowley))}")
-    model = odometry_model(robot, args.sensed)  # the no-slip model of the diagnostics (the run's, without weights)
+    with renaming({"": "--sensed: "} if args.sensed else {}):  # a joint the robot has not, or that cannot tell
+        model = odometry_model(robot, args.sensed)  # the no-slip model of the diagnostics (the run's, no weights)
     weights = _weights(robot, args)
     joints = model.joints
     steer_option = "--steer" if args.steer else "--steer-convention" if args.steer_convention else None
