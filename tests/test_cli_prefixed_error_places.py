@@ -77,6 +77,9 @@ TRACK = ["track", "diff-drive", "--reference", "circle"]
     ([*TRACK, "--controller", "stanley", "--stanley-gain", "1e300"], "--stanley-gain"),
     ([*TRACK, "--period", "1e300"], "--period"),  # 'period: expected a sample period ...'
     ([*TRACK, "--period", "0.1", "--delay", "-1"], "--delay"),  # 'delay: expected a number of samples >= 0'
+    ([*TRACK, "--period", "0.1", "--delay", "1000"], "--delay"),  # 'delay: 1000 samples ... reach past the run'
+    (["vision", "locate", "--camera", str(VISION / "thesis-camera.yaml"), str(VISION / "three-lines.png"), "--lines",
+      "2", "--spacing", "0.1"], "--spacing"),  # 'spacing: the lines n = -1 and +1 are 0.0175 m apart ...'
     (["feasibility", "diff-drive", "--reference", "circle", "--point", "1e300", "0"], "--point"),
     (["batch", "montecarlo", "diff-drive", "--path", "arc", "--rate", "inf", "--workers", "0"], "--rate"),
     (["batch", "montecarlo", "diff-drive", "--path", "nope", "--workers", "0"], "--path"),  # 'unknown path'

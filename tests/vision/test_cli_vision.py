@@ -198,7 +198,7 @@ def test_locate_refuses_a_spacing_the_image_contradicts(spacing, lines, seen, ca
     code, out, err = run(["vision", "locate", image, "--camera", str(FIGURES / "thesis-camera.yaml"),
                           "--spacing", spacing, *lines], capsys)
     assert code == 2 and out == ""
-    assert err.startswith("wmrkit: error: spacing: the lines n = -1 and +1 ") and seen in err
+    assert err.startswith("wmrkit: error: --spacing: the lines n = -1 and +1 ") and seen in err
     assert "--spacing says" in err and len(err.strip().splitlines()) == 1
 
 

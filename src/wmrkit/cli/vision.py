@@ -153,7 +153,7 @@ def run_locate(args: argparse.Namespace) -> int:
         for option, value in (("--lines", args.lines), ("--mode", args.mode)):
             if value is not None:  # it would be ignored
                 raise WmrkitError(f"locate: {option} applies to an IMAGE, not to --points")
-        with renaming({"points: ": f"{args.points}: "}):
+        with renaming({"points: ": f"{args.points}: ", "spacing: ": "--spacing: "}):
             fix = locate_points(camera, read_points(args.points), spacing=spacing, z_p=z_p)
     else:
         layouts = {1: (0,), 2: (-1, 1), 3: (-1, 0, 1)}
@@ -168,7 +168,7 @@ def run_locate(args: argparse.Namespace) -> int:
         if image.shape != (camera.rows, camera.width):
             raise WmrkitError(f"{args.image}: {image.shape[1]} x {image.shape[0]} px, the camera file says "
                               f"{camera.width} x {camera.rows}")
-        with renaming({"image: ": f"{args.image}: "}):
+        with renaming({"image: ": f"{args.image}: ", "spacing: ": "--spacing: "}):
             fix = locate_image(camera, image, spacing=spacing, ns=ns, z_p=z_p, mode=args.mode or "threshold")
     if args.json:
         print_json(fix.to_dict())
