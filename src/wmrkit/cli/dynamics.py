@@ -35,9 +35,13 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = commands.add_parser("tyre", help="tyre forces of a traction model at a slip ratio and slip angle (thesis 7.3)")
     p.add_argument("model", metavar="MODEL", choices=list(TYRES), help=f"one of: {', '.join(TYRES)}")
     p.add_argument("--load", required=True, metavar="FZ", help="normal load [N]")
-    p.add_argument("--slip-ratio", default="0", metavar="S",
-                   help="longitudinal slip ratio (7.31), in (-1, 2]; positive: the contact slides forward (braking) "
-                        "(default 0)")
+    slip = p.add_mutually_exclusive_group()
+    slip.add_argument("--slip-ratio", metavar="S",
+                      help="longitudinal slip ratio (7.31), in (-1, 2]; positive: the contact slides forward "
+                           "(braking) (default 0)")
+    slip.add_argument("--kappa", metavar="K",
+                      help="or the practical slip of SAE J670 / ISO 8855 (Pacejka), (r phi_dot - v) / v, at least -2; "
+                           "positive: driving")
     p.add_argument("--slip-angle", default="0", metavar="A",
                    help="slip angle (7.35): radians, or degrees with 'deg'; positive: the contact slides left "
                         "(default 0)")
@@ -81,7 +85,7 @@ def run_tyre(args: argparse.Namespace) -> int:
     load = _positive(parse_value(args.load, "number", "--load"), "--load", zero=True)
     if load > MAX_LOAD:
         raise WmrkitError(f"--load: at most {MAX_LOAD:g} N (a thousand tonnes on one tyre), got {load:g} N")
-    s = parse_value(args.slip_ratio, "number", "--slip-ratio")
+    s, kappa = _slip_ratio(args)
     a = parse_value(args.slip_angle, "angle", "--slip-angle")
     speed = _positive(parse_value(args.speed, "number", "--speed"), "--speed")
     try:
@@ -102,10 +106,12 @@ def run_tyre(args: argparse.Namespace) -> int:
     if warning:
         warn(warning)
     if args.json:
-        print_json({"model": tyre.model, "params": tyre.as_dict(), "load": load, "slip_ratio": s, "slip_angle": a,
+        print_json({"model": tyre.model, "params": tyre.as_dict(), "load": load, "slip_ratio": s,
+                    "kappa": kappa, "slip_angle": a,
                     "speed": speed, "Fx": fx, "Fy": fy, "mu_long": mu_long, "mu_lat": mu_lat})
     else:
-        print(f"{tyre.model} tyre, load {load:g} N, slip ratio {s:g}, slip angle {a:g} rad, wheel speed {speed:g} m/s")
+        print(f"{tyre.model} tyre, load {load:g} N, slip ratio {s:g} (kappa {kappa:g}), "
+              f"slip angle {a:g} rad, wheel speed {speed:g} m/s")
         print(f"Fx (longitudinal) = {fx:.6g} N")
         print(f"Fy (lateral)      = {fy:.6g} N")
         print("(force of the ground on the tyre, opposing the slip)")
@@ -129,6 +135,21 @@ def _check_steps(step: float, duration: float, source: str, culprit: str, step_g
     if (step_given and fits(DEFAULT_STEP)) or not culprit:
         raise WmrkitError(f"--step {step:g} s: {source} {duration:g} s; {need}")
     raise WmrkitError(f"{culprit}; --step {step:g} s: {need}")
+
+
+def _slip_ratio(args: argparse.Namespace) -> tuple[float, float]:
+    """The slip ratio (7.31) and the practical slip kappa (SAE/ISO) of ``--slip-ratio``, else of ``--kappa``
+    (:func:`~wmrkit.dynamics.tyres.slip_ratio_from_kappa`), else 0; refused in one line naming the option."""
+    from ..dynamics.tyres import kappa_from_slip_ratio, slip_ratio_from_kappa
+
+    if args.kappa is None:
+        s = parse_value(args.slip_ratio or "0", "number", "--slip-ratio")
+        return s, (float(kappa_from_slip_ratio(s)) if -1 < s <= 2 else math.nan)  # else refused by the model's call
+    kappa = parse_value(args.kappa, "number", "--kappa")
+    try:
+        return float(slip_ratio_from_kappa(kappa)), kappa
+    except WmrkitError as err:  # "kappa: ..." -> "--kappa: ..."
+        raise WmrkitError(f"--{err}") from None
 
 
 def _check_program_step(step: float, name: str) -> None:

@@ -75,6 +75,32 @@ def slip_ratio(v_slip: ArrayLike, v_wheel: ArrayLike, v_roll: ArrayLike, eps: Ar
     return v_slip / np.maximum(np.maximum(np.abs(v_roll), np.abs(v_wheel)), eps)
 
 
+#: The largest practical slip ``kappa`` :func:`slip_ratio_from_kappa` takes (the rim 1e15 times faster than the wheel
+#: moves): beyond about 1e16 its slip ratio rounds to -1, outside (7.31)'s range.
+MAX_KAPPA = 1e15
+
+
+def slip_ratio_from_kappa(kappa: ArrayLike) -> np.ndarray:
+    """wmrkit's slip ratio (7.31) of the practical longitudinal slip ``kappa = (r phi_dot - v) / v`` of SAE J670 and
+    ISO 8855 (Pacejka's book, the ``pacejka`` package: positive driving), ``v`` the wheel centre's speed:
+    ``-kappa / (1 + kappa)`` driving (the rim is the faster), ``-kappa`` braking. ``kappa`` at least -2 (the rim
+    turning backwards as fast as the wheel moves: s = 2), at most :data:`MAX_KAPPA`. ``(...) -> (...)``."""
+    k = _asarray(kappa)
+    ok = np.isfinite(k) & (k >= -2) & (k <= MAX_KAPPA)
+    if not np.all(ok):
+        raise WmrkitError(f"kappa: must be a number in [-2, {MAX_KAPPA:g}], got {k[~ok].flat[0]:g}")
+    return np.where(k > 0, -k / (1 + np.maximum(k, 0.0)), -k) + 0.0
+
+
+def kappa_from_slip_ratio(s: ArrayLike) -> np.ndarray:
+    """The practical slip ``kappa`` (SAE, ISO: positive driving) of wmrkit's slip ratio `s` in (-1, 2]: the inverse
+    of :func:`slip_ratio_from_kappa`, ``-s / (1 + s)`` driving (``s < 0``), ``-s`` braking. ``(...) -> (...)``."""
+    s = _asarray(s)
+    if not np.all((s > -1) & (s <= 2)):
+        raise WmrkitError(f"slip ratio: must be in (-1, 2], got {s[~((s > -1) & (s <= 2))].flat[0]:g}")
+    return np.where(s < 0, -s / (1 + np.minimum(s, 0.0)), -s) + 0.0
+
+
 def slip_angle(v_lat: ArrayLike, v_wheel: ArrayLike, eps: ArrayLike = 1e-3) -> np.ndarray:
     """Slip angle (7.35) [rad] with the lateral slip's sign: ``atan(v_lat / max(|v_wheel|, eps))``."""
     return np.arctan2(v_lat, np.maximum(np.abs(v_wheel), eps))
@@ -409,7 +435,7 @@ def slip_velocities(s: ArrayLike, alpha: ArrayLike, speed: ArrayLike) -> tuple[n
     for name, values, ok, allowed in checks:
         if not np.all(ok):
             raise WmrkitError(f"{name}: must be {allowed}, got {values[~ok].flat[0]:g}")
-    v_roll = np.where(s >= 0, v * (s - 1), -v / (1 + np.maximum(s, -0.999999)))
+    v_roll = np.where(s >= 0, v * (s - 1), -v / (1 + np.minimum(s, 0.0)))  # each branch where it is taken
     return v * np.tan(alpha), v + v_roll, v, v_roll
 
 
