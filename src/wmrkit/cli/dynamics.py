@@ -85,14 +85,12 @@ def run_tyre(args: argparse.Namespace) -> int:
     load = _positive(parse_value(args.load, "number", "--load"), "--load", zero=True)
     if load > MAX_LOAD:
         raise WmrkitError(f"--load: at most {MAX_LOAD:g} N (a thousand tonnes on one tyre), got {load:g} N")
-    s, kappa = _slip_ratio(args)
     a = parse_value(args.slip_angle, "angle", "--slip-angle")
     speed = _positive(parse_value(args.speed, "number", "--speed"), "--speed")
-    try:
+    with renaming({f"{name.replace('-', ' ')}: ": f"--{name}: " for name in ("kappa", "slip-ratio", "slip-angle",
+                                                                           "speed")}):
+        s, kappa = _slip_ratio(args)
         f = tyre.forces_at_slip(load, s, a, speed)
-    except WmrkitError as err:  # "slip ratio: ..." -> "--slip-ratio: ..."
-        field, _, problem = str(err).partition(":")
-        raise WmrkitError(f"--{field.replace(' ', '-')}:{problem}") from None
     fx, fy = float(f.longitudinal) + 0.0, float(f.lateral) + 0.0  # no "-0"
     if not (math.isfinite(fx) and math.isfinite(fy)):
         raise WmrkitError("the model gives no finite force at these inputs")
@@ -139,17 +137,15 @@ def _check_steps(step: float, duration: float, source: str, culprit: str, step_g
 
 def _slip_ratio(args: argparse.Namespace) -> tuple[float, float]:
     """The slip ratio (7.31) and the practical slip kappa (SAE/ISO) of ``--slip-ratio``, else of ``--kappa``
-    (:func:`~wmrkit.dynamics.tyres.slip_ratio_from_kappa`), else 0; refused in one line naming the option."""
+    (:func:`~wmrkit.dynamics.tyres.slip_ratio_from_kappa`), else 0 (the library's errors: ``slip ratio: ...``,
+    ``kappa: ...``)."""
     from ..dynamics.tyres import kappa_from_slip_ratio, slip_ratio_from_kappa
 
     if args.kappa is None:
         s = parse_value(args.slip_ratio or "0", "number", "--slip-ratio")
-        return s, (float(kappa_from_slip_ratio(s)) if -1 < s <= 2 else math.nan)  # else refused by the model's call
+        return s, float(kappa_from_slip_ratio(s))
     kappa = parse_value(args.kappa, "number", "--kappa")
-    try:
-        return float(slip_ratio_from_kappa(kappa)), kappa
-    except WmrkitError as err:  # "kappa: ..." -> "--kappa: ..."
-        raise WmrkitError(f"--{err}") from None
+    return float(slip_ratio_from_kappa(kappa)), kappa
 
 
 def _check_program_step(step: float, name: str) -> None:
