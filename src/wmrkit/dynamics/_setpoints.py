@@ -81,6 +81,41 @@ def continued(table, plan, beta, out):
                                     + remainder(beta[k + 1, j] - mid, 2.0 * math.pi), beta[k + 1, j])
 
 
+#: Turns of a gear's reference tried on either side of the one nearest its previous row (:func:`gear_continued`).
+GEAR_TRIES = 4
+
+
+def gear_continued(cols, ratios, rest, tol, beta, out):
+    """`out[:, cols]`: the set-points `beta` ``(K, n_steer)`` of one gear's commanded joints (indices `cols`, the first
+    its reference; `ratios`, rest angles `rest`: the gear holds ``beta_j - rest_j = ratios_j u``) moved by whole
+    turns so that the gear's turn ``u`` steps the short way: at each row the ``u`` nearest the previous row's among
+    the reference's turns (its row, plus :data:`GEAR_TRIES` turns either side of the nearest) at which every joint's
+    row is on the gear (within `tol`, whole turns aside; the row's own ``u`` always is: the rows were checked), each
+    joint then on the turn the gear reaches from its first row. Their linear interpolation stays on the gear."""
+    two_pi = 2.0 * math.pi
+    k0, c0, r0 = ratios[0], cols[0], rest[0]
+    u = (beta[0, c0] - r0) / k0
+    offset = np.empty(cols.shape[0])
+    for i in range(cols.shape[0]):
+        offset[i] = beta[0, cols[i]] - (rest[i] + ratios[i] * u)
+        out[0, cols[i]] = beta[0, cols[i]]
+    for k in range(1, beta.shape[0]):
+        best = (beta[k, c0] - r0) / k0
+        centre = round((k0 * u - (beta[k, c0] - r0)) / two_pi)
+        for m in range(centre - GEAR_TRIES, centre + GEAR_TRIES + 1):
+            cand = (beta[k, c0] - r0 + two_pi * m) / k0
+            if abs(cand - u) >= abs(best - u):
+                continue
+            on = True
+            for i in range(1, cols.shape[0]):
+                on = on and abs(remainder(rest[i] + ratios[i] * cand - beta[k, cols[i]], two_pi)) <= tol
+            if on:
+                best = cand
+        u = best
+        for i in range(cols.shape[0]):
+            out[k, cols[i]] = _turned(rest[i] + ratios[i] * u + offset[i], beta[k, cols[i]])
+
+
 def _turned(reached, row):
     """`row` moved by the whole turns nearest `reached` (the row kept as it is, bit for bit, but for those)."""
     return row + np.round((reached - row) / (2.0 * math.pi)) * 2.0 * math.pi

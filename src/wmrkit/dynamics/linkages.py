@@ -173,23 +173,30 @@ def _gear_off(heading: np.ndarray, want: np.ndarray) -> np.ndarray:
     return np.abs(wrap_angle(np.asarray(heading) - want))
 
 
-def _geared(model, headings: np.ndarray, commanded: set[int]) -> list[tuple[int, int, np.ndarray]]:
-    """``(follower, reference, heading)`` for each commanded steering joint of a ``gear`` the dynamics hold but its
-    first commanded one, the reference: the gear turns them in its ratios from the described headings,
-    ``h_j - h_j0 = k_j u``, so the heading [rad] it gives the follower from the reference's in `headings`
-    ``(..., n_steer)`` (one per row)."""
+def _gears(model, commanded: set[int]) -> list[tuple[list[int], np.ndarray]]:
+    """``(joints, ratios)`` of each ``gear`` the dynamics hold between commanded steering joints: their indices
+    (ascending; the first, the gear's reference) and their ratios ``k_j`` (the gear turns them ``h_j - h_j0 = k_j u``
+    from the described headings)."""
     base, cols = model.pack[16], list(model.steer_columns)
     if not base.shape[1]:
         return []
-    rest, gears, out = model.robot.heading, {}, []
-    for k in sorted(commanded):  # each commanded steering joint in a gear: its gear's column and its ratio
+    gears: dict[int, list[int]] = {}
+    for k in sorted(commanded):  # each commanded steering joint in a gear: its gear's column
         p = np.flatnonzero(base[cols[k]])
         if len(p) == 1:
             gears.setdefault(int(p[0]), []).append(k)
-    for p, joints in gears.items():
+    return [(joints, np.array([base[cols[j], p] for j in joints])) for p, joints in gears.items()]
+
+
+def _geared(model, headings: np.ndarray, commanded: set[int]) -> list[tuple[int, int, np.ndarray]]:
+    """``(follower, reference, heading)`` for each commanded steering joint of a ``gear`` the dynamics hold but its
+    first commanded one, the reference (:func:`_gears`): the heading [rad] the gear gives the follower from the
+    reference's in `headings` ``(..., n_steer)`` (one per row)."""
+    rest, out = model.robot.heading, []
+    for joints, ratios in _gears(model, commanded):
         ref = joints[0]
-        u = (headings[..., ref] - rest[ref]) / base[cols[ref], p]
-        out += [(j, ref, rest[j] + base[cols[j], p] * u) for j in joints[1:]]
+        u = (headings[..., ref] - rest[ref]) / ratios[0]
+        out += [(j, ref, rest[j] + k * u) for j, k in zip(joints[1:], ratios[1:], strict=True)]
     return out
 
 
@@ -272,13 +279,20 @@ def continued(model, beta: np.ndarray, commanded: set[int]) -> np.ndarray:
     """The steering set-points `beta` ``(K, n_steer)`` [rad] moved by whole turns so that each step between rows turns
     the short way (:func:`._setpoints.continued`): a heading written wrapped, +179 deg then -179 deg, turns 2 deg, not
     358; the commanded followers of each held linkage (indices `commanded`; none: every column on its own) the way
-    their law turns."""
+    their law turns; the commanded joints of each steering gear the way the gear turns them, its turn stepping the
+    short way (:func:`._setpoints.gear_continued`: with 1:2, the front turning 100 deg turns the rear 200 deg, not
+    its own short way, -160 deg)."""
     beta = np.ascontiguousarray(beta, dtype=float)
     if len(beta) < 2:
         return beta
     plan, turned = _law_plan(model, commanded), np.empty_like(beta)
     _loops(len(beta) * max(len(plan), 1)).continued(np.ascontiguousarray(model.pack[17], dtype=float), plan, beta,
                                                     turned)
+    for joints, ratios in _gears(model, commanded):
+        if len(joints) > 1:  # a gear's reference alone steps the short way as any column
+            rest = np.asarray(model.robot.beta, dtype=float)[joints]
+            _loops(len(beta) * len(joints) * _setpoints.GEAR_TRIES).gear_continued(
+                np.array(joints, dtype=np.int64), ratios, rest, SETPOINT_TOL, beta, turned)
     return turned
 
 
