@@ -568,3 +568,16 @@ def test_a_log_that_breaks_a_gear_coupling_warns_and_says_inconsistent(capsys, t
     else:
         assert out.err.count("\n") == 1 and out.err.startswith(
             f"wmrkit: warning: the joints of gear(left.spin, right.spin) (ratios 1, {ratio:g}) do not turn together")
+
+
+@pytest.mark.parametrize("name", ["traj.json", "t.TUM.bak", "odom.bag2"])
+def test_an_out_with_an_unknown_suffix_is_refused_not_written_as_a_bag(diff_csv, tmp_path, capsys, name):
+    """'--out traj.json' wrote a ROS 2 bag, a folder named traj.json, exit 0. Now refused naming --out and the file;
+    --format bag (or a name without a suffix) writes the bag."""
+    out = tmp_path / name
+    assert main(["odometry", "diff-drive", diff_csv, "--out", str(out), "--json"]) == 2
+    error = json.loads(capsys.readouterr().err)
+    assert (error["field"], error["file"]) == ("--out", str(out)) and not out.exists()
+    assert "no trajectory format has the suffix" in error["error"]
+    assert main(["odometry", "diff-drive", diff_csv, "--out", str(out), "--format", "bag"]) == 0
+    assert (out / "metadata.yaml").exists()

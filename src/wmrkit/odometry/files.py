@@ -38,9 +38,19 @@ def is_bag(path: str | os.PathLike[str]) -> bool:
 
 
 def out_format_of(path: str | os.PathLike[str]) -> OutFormat:
-    """Output format implied by a file name: ``.csv`` -> csv, ``.tum``/``.txt`` -> tum, else a bag."""
+    """Output format implied by a file name: ``.csv`` -> csv, ``.tum``/``.txt`` -> tum, no suffix -> a ROS 2 bag (a
+    folder); any other suffix is refused (:class:`LogError`): ``traj.json`` was written as a bag, a folder of that
+    name, where the user meant a file (give the format to write one)."""
     suffix = Path(path).suffix.lower()
-    return "csv" if suffix == ".csv" else "tum" if suffix in (".tum", ".txt") else "bag"
+    if suffix == ".csv":
+        return "csv"
+    if suffix in (".tum", ".txt"):
+        return "tum"
+    if suffix:
+        raise LogError(f"{os.fspath(path)}: no trajectory format has the suffix '{Path(path).suffix}' (.csv, .tum or "
+                       ".txt; a ROS 2 bag is a folder, named without a suffix); give the format (--format) to write "
+                       "it anyway")
+    return "bag"
 
 
 def _remove(path: str | os.PathLike[str]) -> None:
