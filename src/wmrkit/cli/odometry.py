@@ -49,8 +49,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    help=f"integration scheme of the no-slip model, {SCHEMES_HELP}; or a slip-aware estimator: wls "
                         "(weighted least squares), fk1, fk2 (Kalman filters), see docs/slip.md (default: the "
                         "description's odometry.method, else exact)")
-    p.add_argument("--out", metavar="FILE", help="trajectory output: .csv, .tum/.txt (TUM), or a name without a suffix: a new ROS 2 bag "
-                   "(another suffix is refused unless --format says)")
+    p.add_argument("--out", metavar="FILE", help="trajectory output: .csv, .tum/.txt (TUM), or a name without a "
+                   "suffix: a new ROS 2 bag (another suffix is refused unless --format says)")
     p.add_argument("--format", dest="out_format", choices=("csv", "tum", "bag"), help="output format (default: "
                    "from the --out extension)")
     p.add_argument("--plot", metavar="FILE", help="draw the path to FILE (.png, .svg or .pdf)")
