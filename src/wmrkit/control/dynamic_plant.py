@@ -70,9 +70,9 @@ def rechecked(loop: Callable[[float, float, bool], dict], duration: float, step:
     when it stops only later, the error is that later stop (the robot's, which the step brought early), naming both:
     the forklift on the arc-line at 2 m/s lifts a drive wheel off at t = 2.40 s at 1 ms, and at 2.52 s from 0.25 ms
     down (hence to its end, not 0.1 s past the stop); when it runs to the end without stopping, the error blames the
-    step (the integration unstable, not the robot: the skid steer on the square 'lost' a wheel's load at t = 36.2 s
-    at a 20 ms step, and keeps its wheels down at 1 ms); when the budget ends first, it says the verdict is not
-    known. The loop's `controller` and `until` are called again from t = 0 (a law is a function of its
+    step (the integration unstable, not the robot: the skid steer on the square 'loses' a wheel's load at t = 25 s
+    at a 0.1 s step and period, and keeps its wheels down at 1 ms); when the budget ends first, it says the verdict
+    is not known. The loop's `controller` and `until` are called again from t = 0 (a law is a function of its
     arguments)."""
     from ..dynamics.runs import DivergedError, LiftOffError, Recheck, judge, recheck_budget, recheck_step
 

@@ -31,6 +31,7 @@ from ._kernels import (
     slip_matrix,
     solve_in_place,
 )
+from ._newton import GRIP_ITERATIONS, beyond_grip, relinearise
 
 
 @_inline
@@ -132,13 +133,14 @@ def assemble(t, s, acc, pack, inp, jac, w):
 
 
 def work_arrays(n: int, n_el: int, n_steer: int, n_geared: int = 0) -> tuple:
-    """Scratch arrays of :func:`assemble` and of :func:`solve_geared` (`n_geared`: the columns of the model's gear
-    basis, ``pack[16]``)."""
+    """Scratch arrays of :func:`assemble`, of :func:`solve_geared` (`n_geared`: the columns of the model's gear
+    basis, ``pack[16]``) and of the step's Newton iterations at the grip (``w[21:28]``: :mod:`._newton`)."""
     return (np.zeros((2 * n_el, n)), np.zeros((n, n)), np.zeros((n_steer, n, n)), np.zeros(n_el),
             np.zeros((n_el, 2)), np.zeros((n_el, 2, 2)), np.zeros(n_el), np.zeros(n), np.zeros(n), np.zeros(n),
             np.zeros(n_steer), np.zeros(n_steer), np.zeros(n), np.zeros(n_steer), np.zeros((n, n)),
             np.zeros(1), np.zeros(3), np.zeros((n_geared, n_geared)), np.zeros(n_geared), np.zeros((n, n_geared)),
-            np.zeros(n))
+            np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n_el, 2)), np.zeros(n), np.zeros(n_el),
+            np.zeros(1), np.zeros((n_el, 2)))
 
 
 def model_work_arrays(model) -> tuple:
@@ -233,18 +235,13 @@ def derivative(t, s, acc, pack, inp, w):
 
 
 @_inline
-def _update_semi_implicit(s, dt, acc, w, pack, linked):
-    """One linearly implicit Euler step from the assembled work arrays `w` (:func:`assemble`): friction and servo
-    Jacobians implicit, then positions with the new velocity.
-
-    The tyre Jacobian ``dF/dv_slip`` is refreshed when the assembly was asked for it and reused otherwise (a W-method).
-    """
-    a, m, g, kdiag, rhs, mat = w[0], w[1], w[5], w[8], w[9], w[14]
-    n = rhs.shape[0]
+def _implicit_matrix(a, m, g, kdiag, pack, dt, mat):
+    """``mat = M - dt (A' G A + servo terms)``: the matrix of the linearly implicit step (tyre Jacobian `g`)."""
+    n = mat.shape[0]
     for i in range(n):
         for j in range(n):
             mat[i, j] = m[i, j]
-    for e in range(g.shape[0]):  # mat = M - dt (A' G A + servo terms)
+    for e in range(g.shape[0]):
         for i in range(n):
             a0, a1 = a[2 * e, i], a[2 * e + 1, i]
             if a0 == 0.0 and a1 == 0.0:
@@ -262,9 +259,35 @@ def _update_semi_implicit(s, dt, acc, w, pack, linked):
             for d in range(n):
                 if d != c and group[d] == group[c]:
                     mat[c, d] -= dt * kdiag[c] * ratio[d] / ratio[c]
+
+
+@_inline
+def _update_semi_implicit(s, dt, acc, w, pack, linked):
+    """One linearly implicit Euler step from the assembled work arrays `w` (:func:`assemble`): friction and servo
+    Jacobians implicit, then positions with the new velocity.
+
+    The tyre Jacobian ``dF/dv_slip`` is refreshed when the assembly was asked for it and reused otherwise (a W-method).
+    A step whose linearised tyre forces exceed their grip is linearised again where it arrived and solved again,
+    Newton iterations of the implicit step (:mod:`._newton`), at most ``GRIP_ITERATIONS``; the next step then
+    refreshes the Jacobian. One loop solves them all: one copy of the solve to compile (two took a sixth longer).
+    """
+    a, m, fz, f, g, kdiag, rhs, mat = w[0], w[1], w[3], w[4], w[5], w[8], w[9], w[14]
+    n = rhs.shape[0]
+    for c in range(n):
+        w[21][c] = rhs[c]
+        w[24][c] = 0.0
     if linked:
         hold_linkages(s, pack, w[19], w[20], False)  # the linkages' basis at the step's start
-    solve_held(mat, rhs, pack, w)  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt, gears and linkages held
+    w[26][0] = 0.0
+    it = 0
+    while True:
+        _implicit_matrix(a, m, g, kdiag, pack, dt, mat)
+        solve_held(mat, rhs, pack, w)  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt, gears and linkages held
+        beyond = beyond_grip(a, rhs, w[24], w[23] if it > 0 else f, g, fz, pack, dt, w[27])
+        if it == GRIP_ITERATIONS or (it == 0 and not beyond) or relinearise(s, dt, w, pack):
+            break
+        w[26][0] = 1.0  # `g` is the Jacobian where the step arrived: the next step refreshes it at its start
+        it += 1
     dnu = rhs
     for c in range(n):
         acc[c] = dnu[c]
@@ -332,7 +355,7 @@ def _semi_implicit_steps(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, p
     i = i0
     for j in range(n_steps):
         k = k0 + j
-        assemble(k * dt, s, acc, pack, inp, (k - jac_phase) % jac_every == 0, w)
+        assemble(k * dt, s, acc, pack, inp, (k - jac_phase) % jac_every == 0 or w[26][0] == 1.0, w)
         if j > 0 and k % every == 0 and i < rec[0].shape[0]:  # the step's assembly is the record at t = k dt
             _store(k * dt, s, w, rec, i)
             i += 1

@@ -81,19 +81,21 @@ def _compiled_namespace():
     g["TyreForces"] = _njit(_pair)
     names = ("slip_ratio", "slip_angle", "magic_formula", "lu_longitudinal_coefficients", "lu_lateral_coefficients",
              "lu_longitudinal", "lu_lateral", "delft_combined", "linear_forces", "coulomb_forces", "dugoff_forces",
-             "pacejka_speed_terms", "pacejka_at_speed", "pacejka_forces")
+             "pacejka_speed_terms", "pacejka_at_speed", "pacejka_forces", "coulomb_grip", "dugoff_grip",
+             "pacejka_grip")
     for name in names:
         fn = getattr(tyres, name)
         g[name] = _njit(types.FunctionType(fn.__code__, g, name, fn.__defaults__, fn.__closure__))
     return g
 
 
-drop_stale_cache([__file__, str(Path(__file__).with_name("_integrate.py")), tyres.__file__],
-                 [wheels_file, linkages.__file__, linkage_law.__file__])
+_STEPS = [str(Path(__file__).with_name(f)) for f in ("_integrate.py", "_newton.py")]  # step kernels
+drop_stale_cache([__file__, *_STEPS, tyres.__file__], [wheels_file, linkages.__file__, linkage_law.__file__])
 _NS = _compiled_namespace()
 _linear, _coulomb, _dugoff, _pacejka = (_NS[n] for n in ("linear_forces", "coulomb_forces", "dugoff_forces",
                                                           "pacejka_forces"))
 _pacejka_speed, _pacejka_at = _NS["pacejka_speed_terms"], _NS["pacejka_at_speed"]
+_grip_coulomb, _grip_dugoff, _grip_pacejka = (_NS[n] for n in ("coulomb_grip", "dugoff_grip", "pacejka_grip"))
 _rows = compile_cached(slip_row_entries, None)
 _law = _inline(linkages.law)
 
@@ -125,6 +127,19 @@ def tyre(code, p, fz, vl, vg, vw, vr):
     if code == 2:
         return _dugoff(p[0], p[1], p[2], p[3], fz, vl, vg, vw, vr)
     return _pacejka(p[0], p[1], p[2], p[3], fz, vl, vg, vw, vr)
+
+
+@_inline
+def grip(code, p, fz):
+    """Largest ``(|F_lat|, |F_long|)`` of tyre model `code` at load `fz` (``TyreKind.grip``); ``(-1, -1)`` for the
+    linear model, which has no limit (no infinity reaches the kernels: :data:`FASTMATH`)."""
+    if code == 0:
+        return -1.0, -1.0
+    if code == 1:
+        return _grip_coulomb(p[0], p[1], p[2], p[3], fz)
+    if code == 2:
+        return _grip_dugoff(p[0], p[1], p[2], p[3], fz)
+    return _grip_pacejka(p[0], p[1], p[2], p[3], fz)
 
 
 @_inline
@@ -223,7 +238,13 @@ def bias(nu, beta_rate, m, dm, steer_col, steer_kind, out):
 @_inline
 def contact_forces(a, nu, pack, fz, f, g, vw, jac):
     """Tyre forces ``f (E, 2)`` on the slips ``a @ nu``; with `jac`, ``g (E, 2, 2) = dF/dv_slip`` (forward diff.)."""
-    code, tp, carry = pack[3], pack[4], pack[9]
+    _contacts(a, nu, pack[3], pack[4], pack[9], fz, f, g, vw, jac)
+
+
+@_called
+def _contacts(a, nu, code, tp, carry, fz, f, g, vw, jac):
+    """:func:`contact_forces` on the arrays of `pack` it reads. Called, not inlined: the step loop, the records and
+    the step's re-linearisation at the grip (:mod:`._newton`) share one compiled copy of the four tyre models."""
     for e in range(code.shape[0]):
         vl, vg, w = 0.0, 0.0, 0.0
         for c in range(nu.shape[0]):

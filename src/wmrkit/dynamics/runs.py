@@ -266,9 +266,9 @@ def _stop(model, rows, inp, w, t_run, duration, step, method, jac_every, allow_l
     most :func:`recheck_budget` of those steps before the end (at the latest the last one before the stop), for at
     most that many steps, and judged (:func:`judge`). To the end, not a margin past the stop: a shorter step can
     reach the robot's own lift-off much later (the forklift's arc-line at 2 m/s: 2.40 s at 1 ms, 2.52 s at 0.25 ms);
-    a step too long for the tyres 'lifted off' the forklift's steered wheel on its rectangle from 8 ms (the load
-    transfer lags a step and the tyres saturate within one, which the implicit step does not cover:
-    docs/dynamics.md). `far`: where a recorded state left the physical range (:func:`first_escape`), judged so."""
+    a step too long for the tyres 'lifts off' the forklift's steered wheel on its rectangle at 25 ms (the load
+    transfer lags a step: docs/dynamics.md). `far`: where a recorded state left the physical range
+    (:func:`first_escape`), judged so."""
     stop = Stop.of_run(model, w, t_run, allow_lift_off, far)
     fine, budget = recheck_step(step, method), recheck_budget(method)
     k_end = round(duration / step) * round(step / fine)  # the run's end, in fine steps
