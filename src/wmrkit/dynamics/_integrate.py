@@ -269,7 +269,7 @@ def _update_semi_implicit(s, dt, acc, w, pack, linked):
     The tyre Jacobian ``dF/dv_slip`` is refreshed when the assembly was asked for it and reused otherwise (a W-method).
     A step whose linearised tyre forces exceed their grip is linearised again where it arrived and solved again,
     Newton iterations of the implicit step (:mod:`._newton`), at most ``GRIP_ITERATIONS``; the next step then
-    refreshes the Jacobian. One loop solves them all: one copy of the solve to compile (two took a sixth longer).
+    refreshes the Jacobian. One loop solves them all: one copy of the solve to compile (docs/limits.md).
     """
     a, m, fz, f, g, kdiag, rhs, mat = w[0], w[1], w[3], w[4], w[5], w[8], w[9], w[14]
     n = rhs.shape[0]
@@ -284,9 +284,11 @@ def _update_semi_implicit(s, dt, acc, w, pack, linked):
         _implicit_matrix(a, m, g, kdiag, pack, dt, mat)
         solve_held(mat, rhs, pack, w)  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt, gears and linkages held
         beyond = beyond_grip(a, rhs, w[24], w[23] if it > 0 else f, g, fz, pack, dt, w[27])
-        if it == GRIP_ITERATIONS or (it == 0 and not beyond) or relinearise(s, dt, w, pack):
+        if it == GRIP_ITERATIONS or (it == 0 and not beyond):
             break
-        w[26][0] = 1.0  # `g` is the Jacobian where the step arrived: the next step refreshes it at its start
+        w[26][0] = 1.0  # `g` becomes the Jacobian where the step arrived: the next step refreshes it at its start
+        if relinearise(s, dt, w, pack):
+            break
         it += 1
     dnu = rhs
     for c in range(n):
