@@ -2,7 +2,8 @@
 
 wmrkit: :func:`wmrkit.kinematics.realtime.realtime`, outputs written into caller-owned arrays. WPILib (robotpy-wpimath):
 ``SwerveDrive4Kinematics.toSwerveModuleStates`` + ``SwerveModuleState.optimize`` per module, ``MecanumDriveKinematics
-.toWheelSpeeds``, ``DifferentialDriveOdometry.update``. Target: no slower than WPILib per call (ratio >= 1).
+.toWheelSpeeds``, ``DifferentialDriveOdometry.update``. Target: no slower than WPILib per call (ratio >= 1). Also
+the IK of two units whose steering is geared 1:2 (no peer): the root its gear sets, then its check.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import time
 
 import numpy as np
 
-from wmrkit import catalog
+from wmrkit import Robot, catalog
 from wmrkit.kinematics.realtime import realtime
 
 from ._harness import Result, peer
@@ -26,6 +27,14 @@ def _per_call(fn, n: int) -> float:
             fn()
         best = min(best, (time.perf_counter() - t0) / n)
     return best
+
+
+def _geared_units() -> Robot:
+    """Two double wheels at (0.3, 0.2), (-0.3, -0.2) m whose steering a gear turns 1:2 (docs/wheel-ik.md)."""
+    unit = {"type": "double", "heading": 0, "b": 0.06, "r": 0.08, "actuated": ["steer", "spin1", "spin2"]}
+    return Robot.from_dict({"name": "geared-units", "wheels": [
+        {**unit, "name": "front", "position": [0.3, 0.2]}, {**unit, "name": "rear", "position": [-0.3, -0.2]}],
+        "couplings": [{"kind": "gear", "joints": ["front.steer", "rear.steer"], "ratios": [1, 2]}]})
 
 
 def run(quick: bool) -> list[Result]:
@@ -48,6 +57,11 @@ def run(quick: bool) -> list[Result]:
 
         theirs = _per_call(wpilib_swerve, n)
     out.append(Result("single call: swerve-4 IK + closest angle", 1, ours, "WPILib", theirs, "ratio >= 1"))
+
+    geared = _geared_units()  # a gear between steering joints: the root its gear sets, then its check
+    rtg, gear_rates, gear_heading = realtime(geared), np.empty(len(geared.rate_names)), np.empty(2)
+    ours = _per_call(lambda: rtg.ik(1.0, 0.5, 0.3, heading[:2], gear_rates, gear_heading), n)
+    out.append(Result("single call: units geared 1:2, IK + gear roots", 1, ours, "none (no geared peer)", None))
 
     mecanum = catalog.load("mecanum-4")
     rtm, spins, none = realtime(mecanum), np.empty(8), np.empty(0)

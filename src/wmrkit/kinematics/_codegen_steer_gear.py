@@ -40,9 +40,10 @@ def c_doc(plan: Plan, names: str) -> list[str]:
     return [f" * {n}_in_steer_gear: whether each gear between steering joints can set the headings for the twist,",
             f" *   in_steer_gear[{p}_N_STEER_GEARS], as wmrkit ik (kinematics/gear_check.py, out_of_steer_gear): the",
             " *   gear turns its angles as beta_j - beta_j0 = ratio_j u, u from its wheel whose steering axis moves",
-            " *   fastest (either root); a wheel the gear sets off its heading by e (mod pi) whose axis moves at s",
-            f" *   breaks it when |e| > {LINKAGE_TOL!r} rad and s |sin e| > {SLIP_TOL!r} m/s; returns 1 if all hold,",
-            " *   else 0 (also for a non-finite input). Give it the headings the wheels are set at (wmrkit ik's).",
+            " *   fastest (its heading, -1 to 2 turns on); a wheel the gear sets off its heading by e (mod 2 pi)",
+            f" *   whose axis moves at s breaks it when |e| > {LINKAGE_TOL!r} rad and s sin(min(|e|, pi/2)) >",
+            f" *   {SLIP_TOL!r} m/s; returns 1 if all hold, else 0 (also for a non-finite input). Give it the",
+            " *   headings the wheels are set at (wmrkit ik's).",
             names]
 
 
@@ -81,14 +82,15 @@ def c_in_steer_gear(plan: Plan, proto: str) -> list[str]:
         "        if (ok && ref >= 0) {",
         f"            const double turn = remainder(beta[sg_joint[ref]] - sg_rest[sg_joint[ref]], 2.0 * {_PI});",
         "            int holds = 0;",
-        "            for (int m = 0; m < 2 && !holds; ++m) { /* the reference's root b, then b + pi */",
-        f"                const double u = (turn + m * {_PI}) / sg_ratio[ref];",
+        "            for (int m = -1; m < 3 && !holds; ++m) { /* the reference's heading, whole turns on or back */",
+        f"                const double u = (turn + 2.0 * m * {_PI}) / sg_ratio[ref];",
         "                int hit = 0;",
         "                for (int t = first; t < last && !hit; ++t) {",
         "                    const int k = sg_joint[t];",
-        f"                    const double off = remainder(beta[k] - sg_rest[k] - sg_ratio[t] * u, {_PI});",
+        f"                    const double off = remainder(beta[k] - sg_rest[k] - sg_ratio[t] * u, 2.0 * {_PI});",
         f"                    if (t == ref || fabs(off) <= {LINKAGE_TOL!r}) continue;",
-        f"                    hit = hypot(vx - w * sg_y[k], vy + w * sg_x[k]) * fabs(sin(off)) > {SLIP_TOL!r};",
+        f"                    hit = hypot(vx - w * sg_y[k], vy + w * sg_x[k]) * sin(fmin(fabs(off), 0.5 * {_PI}))",
+        f"                          > {SLIP_TOL!r};",
         "                }",
         "                holds = !hit;",
         "            }",
@@ -120,7 +122,8 @@ def py_in_steer_gear(plan: Plan) -> str:
     """The generated ``in_steer_gear`` and the judge's source (robots with a steering gear), else nothing."""
     if not has_steer_gears(plan):
         return ""
-    functions = (gear_check.steer_breach,) if has_linkages(plan) else (linkage_law.remainder, gear_check.steer_breach)
+    functions = (() if has_linkages(plan) else (linkage_law.remainder,)) + (gear_check.gear_reference,
+                                                                           gear_check.steer_breach)
     sources = "\n\n".join(inspect.getsource(f).rstrip() for f in functions)
     n, s = len(plan.steer_gear_names), len(plan.beta)
     return f'''
@@ -129,8 +132,9 @@ def py_in_steer_gear(plan: Plan) -> str:
 def in_steer_gear(twist, heading=None):
     """Whether each gear between steering joints (``STEER_GEAR_NAMES``) can set the headings for the twist, as
     ``wmrkit ik`` checks them (``out_of_steer_gear``): the gear turns its angles as ``beta_j - beta_j0 = ratio_j u``,
-    ``u`` from its wheel whose steering axis moves fastest (either root); a wheel it sets off its heading by ``e``
-    (mod pi) whose axis moves at ``s`` breaks it when ``|e| > STEER_GEAR_TOL`` and ``s |sin e| > SLIP_TOL`` [m/s];
+    ``u`` from its wheel whose steering axis moves fastest (its heading, -1 to 2 turns on); a wheel it sets
+    off its heading by ``e`` (mod 2 pi) whose axis moves at ``s`` breaks it when ``|e| > STEER_GEAR_TOL`` and
+    ``s sin(min(|e|, pi/2)) > SLIP_TOL`` [m/s];
     ``(..., 3), (..., {s}) -> (..., {n})`` bool, False for a non-finite input. Give it the headings the wheels are
     set at (``wmrkit ik``'s for the twist).
     """

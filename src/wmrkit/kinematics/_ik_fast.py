@@ -24,8 +24,10 @@ from .._shapes import readonly
 from ..errors import SingularError
 from ..robot import Robot
 from ..wheels import generic_slip_rows, geometry_problem, heading_in_range, wrap_angle
+from .gear_check import SteerGears, steer_gear_turns, steer_gears, steer_roots
 from .linkage_check import _Plan as _LinkPlan
 from .linkage_check import _roots, linkage_turns
+from .linkage_law import LINKAGE_TOL
 
 TWO_PI = 2.0 * math.pi
 CONSTANT_TYPES = ("fixed", "swedish", "ball", "orthogonal")
@@ -219,27 +221,37 @@ def steer_to_twist(
 
 
 def steer_linked(
-    robot: Robot, p: Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...], speed_tol: float
+    robot: Robot, p: Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...], speed_tol: float,
+    slip_tol: float,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`steer_to_twist`'s angles ``(..., n_o)``, spins ``(..., n_s)`` and held flags ``(..., n_o)`` of the
     twist-steered wheels at steering `current` ``(..., n_steer)``, each linked wheel it moves set on the root of (8.9)
-    its linkage sets, its spin reversed (:func:`~wmrkit.kinematics.linkage_check.linkage_turns`)."""
+    its linkage sets (:func:`~wmrkit.kinematics.linkage_check.linkage_turns`), then each geared one on the root its
+    gear between steering joints sets (:func:`~wmrkit.kinematics.gear_check.steer_gear_turns`; `slip_tol` [m/s] the
+    gear check's floor), its spin reversed."""
     steered = current if p.only_steerable else current[..., p.steered_beta]
     angles, spins, held = steer_to_twist(p, twist, steered, speed_tol)
-    if not any(c.kind == "linkage" for c in robot.couplings):
+    if not (any(c.kind == "linkage" for c in robot.couplings) or steer_gears(robot).table.coupling):
         return angles, spins, held
     config = np.broadcast_to(wrap_angle(current), (*batch, p.n_steer)).copy()
     config[..., p.steered_beta] = angles
     free = np.zeros((*held.shape[:-1], p.n_steer), dtype=bool)
     free[..., p.steered_beta] = ~held
-    turn = linkage_turns(robot, twist, config, free)
-    if turn is None:
-        return angles, spins, held
-    turn = turn[..., p.steered_beta]
-    if turn.any():
-        angles = np.where(turn, wrap_angle(angles + np.pi), angles)
-        spins = np.where(turn[..., p.steered_spin_of], -spins, spins)
+    angles, spins = _turned(p, linkage_turns(robot, twist, config, free), angles, spins, config)
+    angles, spins = _turned(p, steer_gear_turns(robot, twist, config, free, slip_tol), angles, spins, config)
     return angles, spins, held
+
+
+def _turned(p: Plan, turn: np.ndarray | None, angles: np.ndarray, spins: np.ndarray,
+            config: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The angles ``(..., n_o)`` and spins ``(..., n_s)`` with the wheels `turn` ``(..., n_steer)`` (None: none) turned
+    half round, spins reversed; `config` ``(..., n_steer)`` updated in place."""
+    if turn is None or not turn.any():
+        return angles, spins
+    turn = turn[..., p.steered_beta]
+    angles = np.where(turn, wrap_angle(angles + np.pi), angles)
+    config[..., p.steered_beta] = angles
+    return angles, np.where(turn[..., p.steered_spin_of], -spins, spins)
 
 
 def _prefer_in_range(p: Plan, beta: np.ndarray, spin: np.ndarray, held: np.ndarray) -> None:
@@ -267,14 +279,17 @@ def in_range_one(h: float, lo: float, hi: float, tol: float = 1e-12) -> bool:
     return (h - lo + tol) % TWO_PI - tol <= hi - lo + tol
 
 
-def steering_one(p: Plan, vx: float, vy: float, w: float, current: list[float], speed_tol: float,
-                 links: _LinkPlan | None = None) -> list[float]:
+def steering_one(p: Plan, vx: float, vy: float, w: float, current: list[float], speed_tol: float, slip_tol: float,
+                 links: _LinkPlan | None = None, gears: SteerGears | None = None) -> list[float]:
     """The configuration (thesis angles, ``(n_steer,)``) :func:`steer_to_twist` and :func:`_prefer_in_range` give
     one twist at steering `current`, in plain floats with the same operations (:func:`_steer_block`'s): a few µs
     for a few wheels instead of a hundred, for a loop that needs only the angles (the continuous control loop).
     Castor-like angles are kept (wrapped), as :func:`~wmrkit.kinematics.wheel_ik.wheel_commands` keeps them; with
     the robot's held linkages `links` (:func:`wmrkit.kinematics.linkage_check._plan`) a linked wheel it moves is
-    set on the root its linkage sets (:func:`wmrkit.kinematics.linkage_check._roots`), as ``wheel_commands`` sets it."""
+    set on the root its linkage sets (:func:`wmrkit.kinematics.linkage_check._roots`), with its gears between steering
+    joints `gears` (:func:`wmrkit.kinematics.gear_check.steer_gears`; `links` given too) a geared one on the root its
+    gear sets (:func:`wmrkit.kinematics.gear_check.steer_roots`, `slip_tol` the gear check's floor), as
+    ``wheel_commands`` sets them."""
     config = [wrap_one(c) for c in current]
     moved = []
     for i, k in enumerate(p.steered_beta.tolist()):
@@ -300,6 +315,17 @@ def steering_one(p: Plan, vx: float, vy: float, w: float, current: list[float], 
         for g, lead in enumerate(links.lead.tolist()):
             _roots(links.table, int(links.start[g]), int(links.start[g + 1]), lead, config, speeds, free, links.lo,
                    links.width, links.offset, turn)
+        for k in moved:
+            if turn[k]:
+                config[k] = wrap_one(config[k] + math.pi)
+    if gears is not None and links is not None and gears.table.coupling:
+        t, turn = gears.table, [False] * len(config)
+        speeds = [math.hypot(vx - w * y, vy + w * x) for x, y in zip(gears.x.tolist(), gears.y.tolist(), strict=True)]
+        free = [k in moved for k in range(len(config))]
+        for g in range(len(t.coupling)):
+            steer_roots(t.joint, t.ratio, int(t.start[g]), int(t.start[g + 1]), gears.rest, gears.x, gears.y, vx, vy, w,
+                        gears.rows, gears.turns, config, speeds, slip_tol, LINKAGE_TOL, free, links.lo, links.width,
+                        links.offset, turn)
         for k in moved:
             if turn[k]:
                 config[k] = wrap_one(config[k] + math.pi)

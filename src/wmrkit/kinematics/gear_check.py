@@ -10,11 +10,14 @@ moves the joint's contact at (:func:`contact_lever`) within the slip check's abs
 
 A gear between steering joints (two double wheels' steering turned 1:2) turns their angles too, ``beta_j - beta_j0 =
 ratio_j u`` from the described ones (the dynamics' rule, :func:`wmrkit.dynamics.linkages.gear_breach`), while ik sets
-each wheel's angle by (8.9) on its own: :func:`steer_breach` judges those angles as the linkage check judges a
-linkage's (:mod:`.linkage_check`). ``u`` is found from the gear's wheel whose steering axis moves fastest (its angle
-the best defined), from either of its roots (``b``, ``b + pi``); a wheel the gear then sets off its own angle by ``e``
-(mod pi: it rolls either way) breaks the gear when ``|e| > LINKAGE_TOL`` and its axis speed times ``|sin e|`` (the
-side speed it would slip at, set by the gear) exceeds ``slip_tol``.
+each wheel's line by (8.9) on its own, and the gear the root on it: :func:`steer_roots` puts every moving wheel of the
+gear on the root the gear sets from its reference wheel, the one whose steering axis moves fastest (its angle the
+best defined), with the linkages' code (:func:`.linkage_check._roots_at`, the gear a row of law 2,
+:func:`.linkage_law.law`): from the reference's root ``b``, or ``b + pi`` where only that one sets every wheel on its
+line, or fits their steering ranges and ``b`` does not. :func:`steer_breach` judges the headings so set: ``u`` from the
+reference's heading (-1 to 2 whole turns on), a wheel the gear sets off its heading by ``e`` (mod 360 deg: a wheel half
+a turn off would roll against its spin) breaks the gear when ``|e| > LINKAGE_TOL`` and its axis speed times
+``sin(min(|e|, 90 deg))`` (the side speed it would slip at, set by the gear) exceeds ``slip_tol``.
 """
 
 from __future__ import annotations
@@ -28,8 +31,9 @@ import numpy as np
 from ..couplings import GEAR_EXACT_RTOL, GearBreach, gear_breaches
 from ..robot import Robot
 from ..wheels import Wheel, heading_from_beta
-from .linkage_check import Breach
-from .linkage_law import LINKAGE_TOL, remainder
+from .linkage_check import Breach, _roots_at, _speeds
+from .linkage_check import _plan as _link_plan
+from .linkage_law import COLUMNS, LINKAGE_TOL, remainder
 
 #: A gear's rates are in its ratios when each departs from them by at most this fraction of the command's largest
 #: joint rate (round-off of the rates (8.12)-(8.28) is ~1e-16 of it).
@@ -118,12 +122,17 @@ def given_gear_breaches(robot: Robot, names: tuple[str, ...], q: np.ndarray, sli
 class SteerGears:
     """A robot's gears between steering joints, flat for a loop: `table` their :class:`GearTable` over the steering
     angles (``joint`` a column of ``robot.steer_names``), `rest` the described angles (thesis, ``(n_steer,)`` [rad]),
-    `x`, `y` the steering axes [m] ``(n_steer,)``. Read-only arrays."""
+    `x`, `y` the steering axes [m] ``(n_steer,)``; `rows` each entry as a row of a linkage table
+    (:mod:`.linkage_law`, law 2) from its gear's first joint, ``(n_entries, 10)``, for the root choice
+    (:func:`steer_roots`), and `turns` its candidate half turns with each entry the reference, ``(n_entries, 6)``
+    (:func:`candidate_turns`, :data:`NO_TURN` after the last). Read-only arrays."""
 
     table: GearTable
     rest: np.ndarray
     x: np.ndarray
     y: np.ndarray
+    rows: np.ndarray
+    turns: np.ndarray
 
 
 @functools.lru_cache(maxsize=64)
@@ -131,35 +140,136 @@ def steer_gears(robot: Robot) -> SteerGears:
     """The :class:`SteerGears` of `robot` (kept per robot, a frozen value)."""
     table = gear_table(robot, tuple(f"{n}.steer" for n in robot.steer_names))
     xy = np.array([robot.wheel(n).position for n in robot.steer_names], dtype=float).reshape(-1, 2)
-    arrays = (np.array(robot.beta, dtype=float).reshape(-1), xy[:, 0].copy(), xy[:, 1].copy())
+    rest = np.array(robot.beta, dtype=float).reshape(-1)
+    rows = np.zeros((len(table.joint), COLUMNS))
+    turns = np.full((len(table.joint), len(HALF_TURNS)), NO_TURN, dtype=np.int64)
+    for g in range(len(table.coupling)):
+        first, last = int(table.start[g]), int(table.start[g + 1])
+        lead = table.joint[first]
+        for t in range(first, last):
+            rows[t] = (table.joint[t], lead, -1, 2.0, table.ratio[first], table.ratio[t], 0.0, 0.0, rest[lead],
+                       rest[table.joint[t]])
+            kept = candidate_turns(table.ratio[first:last] / table.ratio[t])
+            turns[t, :len(kept)] = kept
+    arrays = (rest, xy[:, 0].copy(), xy[:, 1].copy(), rows, turns)
     for a in arrays:
         a.flags.writeable = False
     return SteerGears(table, *arrays)
 
 
-def steer_breach(joint, ratio, first, last, rest, x, y, vx, vy, w, beta, slip_tol, tol):
-    """The first steering angle that the gear of entries `first:last` (``joint``, ``ratio``) breaks at angles `beta`
-    ``(n_steer,)`` under the twist ``(vx, vy, w)`` (module docstring): ``(entry, angle the gear sets it at, on its
-    branch, reference entry, side speed [m/s])``, entry -1 for none (written to compile: :mod:`._gear_kernel` and the
-    ``realtime`` ik call it compiled)."""
+def gear_reference(joint, first, last, x, y, vx, vy, w):
+    """The entry of the gear of entries `first:last` whose steering axis moves fastest under the twist ``(vx, vy,
+    w)`` (the first of them), -1 if none moves (written to compile)."""
     ref, top = -1, 0.0
     for t in range(first, last):
         s = math.hypot(vx - w * y[joint[t]], vy + w * x[joint[t]])
         if s > top:
             ref, top = t, s
+    return ref
+
+
+def steer_roots(joint, ratio, first, last, rest, x, y, vx, vy, w, rows, turns, beta, speed, slip_tol, tol, free, lo,
+                width, offset, turn):
+    """``turn[k]`` for each wheel k of the gear of entries `first:last` whose root ``ik`` chose (``free[k]``): whether
+    its angle ``beta[k]`` is the root of (8.9) the gear does not set (module docstring; axis speeds `speed`, steering
+    ranges `lo`, `width`, `offset` as :func:`.linkage_check._roots_at` takes them; `rows`, `turns` the gear's in
+    :class:`SteerGears`); none where no turn of the gear sets every wheel on its line (:func:`_gear_turn`). Written
+    to compile."""
+    ref = gear_reference(joint, first, last, x, y, vx, vy, w)
+    if ref < 0:
+        return
+    k, step = joint[ref], math.pi / ratio[ref]  # step: the gear's turn that turns the reference half round
+    u = remainder(beta[k] - rest[k], 2.0 * math.pi) / ratio[ref]
+    m = _gear_turn(joint, ratio, first, last, rest, beta, speed, free, u, step, turns[ref], slip_tol, tol)
+    if m == NO_TURN:
+        return
+    u += m * step
+    ranged = False  # a free wheel with a steering range: the reference turned half round may be wanted
+    for t in range(first, last):
+        ranged = ranged or (free[joint[t]] and width[joint[t]] < 2.0 * math.pi)
+    other = ranged and _turned(joint, ratio, first, last, rest, beta, speed, free, u + step, slip_tol, tol) >= 0
+    lead = joint[first]
+    _roots_at(rows, first + 1, last, lead, beta, rest[lead] + ratio[first] * u, ratio[first] * step if other else 0.0,
+              free, lo, width, offset, turn)
+
+
+#: The reference's half turns ``m`` that :func:`steer_roots` may give its gear (``u + m pi / ratio_ref``), in order:
+#: on its root, a whole turn on or back (which moves the wheels geared to it by other than whole turns), then turned.
+HALF_TURNS = (0, 2, -2, 1, -1, 3)
+#: :func:`_gear_turn`'s answer when no candidate holds the gear; ``SteerGears.turns`` after its last candidate.
+NO_TURN = 99
+
+
+def candidate_turns(ratios: np.ndarray) -> list[int]:
+    """The half turns of :data:`HALF_TURNS` worth trying for a gear whose wheels turn `ratios` ``(n,)`` [rad per rad]
+    of its reference's turn: those that set them at headings no earlier one sets (mod 2 pi), and an odd one (the
+    reference turned) only where no even one sets them on the same lines (mod pi: it holds the gear where that one
+    does, and loses to it). Ratios 1 or 2 of the reference leave one, ``[0]``; 1/2 leaves ``[0, 2, 1, -1]``."""
+    def same(a: list[float], b: list[float], period: float) -> bool:
+        return all(abs(math.remainder(p - q, period)) <= 1e-9 for p, q in zip(a, b, strict=True))
+
+    kept: list[tuple[int, list[float]]] = []
+    for m in HALF_TURNS:
+        shift = [m * math.pi * float(r) for r in ratios]
+        if not any(same(shift, s, 2.0 * math.pi) or (m % 2 and not n % 2 and same(shift, s, math.pi))
+                   for n, s in kept):
+            kept.append((m, shift))
+    return [m for m, _ in kept]
+
+
+def _gear_turn(joint, ratio, first, last, rest, beta, speed, free, u, step, turns, slip_tol, tol):
+    """Of the reference's half turns `turns` (:func:`candidate_turns`, `u` the gear's turn with it on its root, `step`
+    its turn for half a turn of it), the one that holds the gear with the reference on its root if any can, then
+    with the fewest wheels off the roots ``ik`` chose (each the one closest to its current angle, so the set-point
+    stays continuous); :data:`NO_TURN` if none holds (written to compile)."""
+    best, score = NO_TURN, -1
+    for m in turns:
+        if m == NO_TURN:
+            break
+        turned = _turned(joint, ratio, first, last, rest, beta, speed, free, u + m * step, slip_tol, tol)
+        here = turned + (m % 2) * (last - first + 1)
+        if turned >= 0 and (score < 0 or here < score):
+            best, score = m, here
+            if score == 0:  # every wheel on the root ik chose: nothing nearer
+                break
+    return best
+
+
+def _turned(joint, ratio, first, last, rest, beta, speed, free, u, slip_tol, tol):
+    """How many free wheels of the gear of entries `first:last` its turn `u` sets half a turn from their angles
+    `beta`, or -1 if it sets one off its line (mod pi, beyond :func:`steer_breach`'s floor: `tol` [rad], its side
+    speed at axis speed `speed` over `slip_tol` [m/s]). Written to compile."""
+    turned = 0
+    for t in range(first, last):
+        j = joint[t]
+        off = remainder(beta[j] - rest[j] - ratio[t] * u, 2.0 * math.pi)
+        line = min(abs(off), math.pi - abs(off))  # abs(remainder(off, pi)), exactly
+        if line > tol and speed[j] * abs(math.sin(off)) > slip_tol:
+            return -1
+        if free[j] and abs(off) > 0.5 * math.pi:
+            turned += 1
+    return turned
+
+
+def steer_breach(joint, ratio, first, last, rest, x, y, vx, vy, w, beta, slip_tol, tol):
+    """The first steering angle that the gear of entries `first:last` (``joint``, ``ratio``) breaks at angles `beta`
+    ``(n_steer,)`` under the twist ``(vx, vy, w)`` (module docstring): ``(entry, angle the gear sets it at, reference
+    entry, side speed [m/s])``, entry -1 for none (written to compile: :mod:`._gear_kernel` and the ``realtime`` ik
+    call it compiled)."""
+    ref = gear_reference(joint, first, last, x, y, vx, vy, w)
     if ref < 0:
         return -1, 0.0, first, 0.0
     turn = remainder(beta[joint[ref]] - rest[joint[ref]], 2.0 * math.pi)
     found, want, slip = -1, 0.0, 0.0
-    for m in range(2):  # the reference's root b, then b + pi
-        u = (turn + m * math.pi) / ratio[ref]
+    for m in (0, 1, -1, 2):  # u from the reference's heading, then a turn further (ik's gear roots, wrapped)
+        u = (turn + 2.0 * m * math.pi) / ratio[ref]
         hit = -1
         for t in range(first, last):
             k = joint[t]
-            off = remainder(beta[k] - rest[k] - ratio[t] * u, math.pi)
+            off = remainder(beta[k] - rest[k] - ratio[t] * u, 2.0 * math.pi)
             if t == ref or abs(off) <= tol:
                 continue
-            side = math.hypot(vx - w * y[k], vy + w * x[k]) * abs(math.sin(off))
+            side = math.hypot(vx - w * y[k], vy + w * x[k]) * math.sin(min(abs(off), 0.5 * math.pi))
             if side > slip_tol:
                 hit = t
                 if m == 0:
@@ -180,8 +290,43 @@ def _steer_holds(joint, ratio, start, rest, x, y, twist, beta, slip_tol, tol, ou
                 out[i, g] = False
 
 
+def _steer_turns(joint, ratio, start, rest, x, y, rows, turns, twist, beta, speed, slip_tol, tol, free, lo, width,
+                 offset, out):
+    """:func:`steer_roots` of every gear over rows ``(N, 3)`` of `twist` and ``(N, n_steer)`` of `beta`, `speed`,
+    `free`: `out` ``(N, n_steer)`` (all False on entry) True at each wheel to turn onto its other root (written to
+    compile: :mod:`._gear_kernel`)."""
+    for i in range(beta.shape[0]):
+        for g in range(start.shape[0] - 1):
+            steer_roots(joint, ratio, start[g], start[g + 1], rest, x, y, twist[i, 0], twist[i, 1], twist[i, 2], rows,
+                        turns, beta[i], speed[i], slip_tol, tol, free[i], lo, width, offset, out[i])
+
+
 #: Twists from which a batch of steering gears is judged by the compiled kernel (:mod:`._gear_kernel`).
 COMPILED_BATCH = 64
+
+
+def steer_gear_turns(robot: Robot, twist: np.ndarray, beta: np.ndarray, free: np.ndarray,
+                     slip_tol: float) -> np.ndarray | None:
+    """``(..., n_steer)`` bool: the geared wheels whose root of (8.9) ``ik`` chose (`free` ``(..., n_steer)``:
+    moving, steered by the twist) and whose angle in its steering `beta` ``(..., n_steer)`` for `twist` ``(..., 3)``
+    is the root their gear does not set (:func:`steer_roots`); None for a robot without a steering gear. ``ik`` turns
+    them half round, spin reversed. A batch of at least :data:`COMPILED_BATCH` twists is set compiled."""
+    sg = steer_gears(robot)
+    if not sg.table.coupling:
+        return None
+    n, links = len(sg.rest), _link_plan(robot)
+    batch = np.broadcast_shapes(twist.shape[:-1], beta.shape[:-1], free.shape[:-1])
+    rows = np.ascontiguousarray(np.broadcast_to(twist, (*batch, 3)).reshape(-1, 3), dtype=float)
+    flat_beta = np.broadcast_to(beta, (*batch, n)).reshape(-1, n)
+    speed = np.broadcast_to(_speeds(sg, twist), (*batch, n)).reshape(-1, n)
+    flat_free = np.broadcast_to(free, (*batch, n)).reshape(-1, n)
+    out = np.zeros(flat_beta.shape, dtype=bool)
+    kernel, t = _steer_turns, sg.table
+    if len(rows) >= COMPILED_BATCH:
+        from ._gear_kernel import turns as kernel
+    kernel(t.joint, t.ratio, t.start, sg.rest, sg.x, sg.y, sg.rows, sg.turns, rows, flat_beta, speed, float(slip_tol),
+          LINKAGE_TOL, flat_free, links.lo, links.width, links.offset, out)
+    return out.reshape(*batch, n)
 
 
 def steer_gears_hold(robot: Robot, twist: np.ndarray, beta: np.ndarray, slip_tol: float) -> np.ndarray:
@@ -208,7 +353,7 @@ def steer_gears_hold(robot: Robot, twist: np.ndarray, beta: np.ndarray, slip_tol
 
 class SteerBreach(Breach):
     """A wheel (steering `column`) at angle `beta` [rad] that the gear at `coupling` (its position in
-    ``robot.couplings``) sets at `want` (on the wheel's branch, mod pi) with its `reference` wheel at `ref_beta`;
+    ``robot.couplings``) sets at `want` (mod 2 pi) with its `reference` wheel at `ref_beta`;
     `slip` [m/s] the side speed the wheel would roll at, so set (a linkage's :class:`.linkage_check.Breach`, worded
     for a gear)."""
 

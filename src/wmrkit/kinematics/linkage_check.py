@@ -129,18 +129,19 @@ def _roots(table, first, last, lead, beta, speed, free, lo, width, offset, turn)
     `speed`), as :func:`_breach` judges them: :func:`_roots_at` (written to compile: :mod:`._linkage_kernel`)."""
     ref, b = _reference(table, first, last, lead, beta, speed)
     if ref >= 0:
-        _roots_at(table, first, last, lead, beta, b, free, lo, width, offset, turn)
+        _roots_at(table, first, last, lead, beta, b, math.pi, free, lo, width, offset, turn)
 
 
-def _roots_at(table, first, last, lead, beta, b, free, lo, width, offset, turn):
+def _roots_at(table, first, last, lead, beta, b, half, free, lo, width, offset, turn):
     """``turn[k]`` for each wheel k of the linkage that ik chose the root of (``free[k]``: moving, steered by the
     twist): whether its angle ``beta[k]`` is more than 90 deg from the angle the law sets it at from the leader's
-    angle `b`; from ``b + pi`` (every such wheel, the reference's too, turned with it) when that puts all of them
-    within their steering ranges (``heading = beta + offset`` at most ``width`` counter-clockwise from ``lo``) and
-    `b` does not. ``turn`` is left as it is elsewhere."""
+    angle `b`; from ``b + half`` (the leader's angle with the reference wheel turned half round: pi for a linkage,
+    every such wheel turned with it; a gear's ratio of the two, :func:`.gear_check.steer_roots`) when that puts all
+    of them within their steering ranges (``heading = beta + offset`` at most ``width`` counter-clockwise from
+    ``lo``) and `b` does not. ``turn`` is left as it is elsewhere."""
     if not _set_roots(table, first, last, lead, beta, b, free, lo, width, offset, turn, True):
-        if _set_roots(table, first, last, lead, beta, b + math.pi, free, lo, width, offset, turn, False):
-            _set_roots(table, first, last, lead, beta, b + math.pi, free, lo, width, offset, turn, True)
+        if half != 0.0 and _set_roots(table, first, last, lead, beta, b + half, free, lo, width, offset, turn, False):
+            _set_roots(table, first, last, lead, beta, b + half, free, lo, width, offset, turn, True)
 
 
 def _set_roots(table, first, last, lead, beta, b, free, lo, width, offset, turn, write):
@@ -159,8 +160,9 @@ def _set_roots(table, first, last, lead, beta, b, free, lo, width, offset, turn,
 
 def in_range_at(h, lo, width):
     """Whether heading `h` [rad] is within `width` counter-clockwise of `lo` (:func:`wmrkit.wheels.heading_in_range`'s
-    operations, tolerance 1e-12; ``width`` inf: no range; written to compile, the ``realtime`` ik's too)."""
-    return (h - lo + 1e-12) % (2.0 * math.pi) - 1e-12 <= width + 1e-12
+    operations, tolerance 1e-12; ``width`` inf: no range, answered without the reduction, as any width of a whole
+    turn; written to compile, the ``realtime`` ik's too)."""
+    return width >= 2.0 * math.pi or (h - lo + 1e-12) % (2.0 * math.pi) - 1e-12 <= width + 1e-12
 
 
 def _holds(table, start, lead, coupling, beta, speed, slip_tol, tol, out):

@@ -17,7 +17,9 @@ The leader is the linkage's first wheel (``ackermann``: the first one off the ax
 
 Table (one row per follower): follower column, leader column, the leader's column in the dynamics' basis (-1 until
 set), law (0 parallel, 1 axle), ``x_i``, ``x_j``, ``y_i - y_j``, ``beta_i - psi_i``, the rest angles ``beta_i0``,
-``beta_j0``.
+``beta_j0``. Law 2 is a ``gear`` between steering joints, ``beta_j - beta_j0 = (k_j / k_i) (beta_i - beta_i0)`` with
+the ratios ``k_i``, ``k_j`` in the ``x`` columns: the kinematics set a geared wheel's root with the linkages' code
+(:func:`wmrkit.kinematics.gear_check.steer_gears`); the dynamics hold a gear otherwise.
 """
 
 from __future__ import annotations
@@ -45,6 +47,8 @@ def law(row, beta):
     round)."""
     if row[3] == 0.0:
         return row[9] + beta - row[8], 1.0, 0.0
+    if row[3] == 2.0:  # a gear between steering joints (the kinematics' root choice only)
+        return row[9] + row[5] * (beta - row[8]) / row[4], row[5] / row[4], 0.0
     if row[5] == 0.0:  # a follower on the axle line: f' = 0 / D, and 0 / 0 where the ICR is its steering point
         return row[9], 0.0, 0.0
     xi, xj, dy = row[4], row[5], row[6]

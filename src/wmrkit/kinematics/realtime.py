@@ -38,7 +38,7 @@ from ..odometry._kernels import _cos_sin, _sinc
 from ..robot import Robot
 from ..units import MAX_ANGLE, MAX_TURNS
 from . import _gear_kernel, _ik_fast, _linkage_kernel, gear_check, linkage_check, linkage_law
-from ._gear_kernel import steer_breach
+from ._gear_kernel import steer_breach, steer_roots
 from ._linkage_kernel import _breach_at, _reference, _roots_at
 from ._linkage_kernel import in_range_at as _in_range
 from .gear_check import GEAR_RTOL, gear_table, steer_gears
@@ -153,7 +153,8 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
     sg = steer_gears(robot)  # wheel_commands' in_steer_gear (gear_check.steer_breach, compiled)
     sg_joint, sg_k, sg_start, sg_rest, sg_x, sg_y = (sg.table.joint, sg.table.ratio, sg.table.start, sg.rest, sg.x,
                                                      sg.y)
-    n_sgears = len(sg.table.coupling)
+    sg_rows, sg_turns, n_sgears = sg.rows, sg.turns, len(sg.table.coupling)
+    coupled = n_links > 0 or n_sgears > 0  # the axes' speeds and the wheels whose root ik chose are needed
 
     def ik(vx, vy, w, heading, rates_out, heading_out):
         if not (float64_vector(rates_out) and float64_vector(heading_out) and heading.shape[0] == n_steer
@@ -169,7 +170,7 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             beta[k] = _wrap(heading[k] - delta[k] + HALF_PI)
         for j in range(n_rates):
             rates_out[j] = vx * constant[0, j] + vy * constant[1, j] + w * constant[2, j]
-        free = np.zeros(n_steer if n_links else 0, dtype=np.bool_)  # the wheels whose root ik chose: moving
+        free = np.zeros(n_steer if coupled else 0, dtype=np.bool_)  # the wheels whose root ik chose: moving
         for i in range(n_o):  # (8.9), (8.12): the steering axis's velocity u, the closer of b and b + pi
             k = steered_beta[i]
             minus_ux = sy[i] * w - vx
@@ -178,7 +179,7 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             along = minus_ux * math.sin(beta[k]) + uy * math.cos(beta[k])
             sign = -1.0 if abs(along) <= 1e-12 * speed else math.copysign(1.0, along)  # a tie: rolling forward
             moving = speed > speed_tol
-            if n_links:
+            if coupled:
                 free[k] = moving
             if moving:
                 beta[k] = math.atan2(minus_ux * sign + 0.0, uy * sign)
@@ -189,17 +190,17 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
             if spin_col[i] >= 0:
                 rates_out[spin_col[i]] = -speed * sign * inv_r[i] if moving else 0.0
         linked = True
+        axis_speed = np.empty(n_steer if coupled else 0)
+        turn = np.zeros(n_steer if coupled else 0, dtype=np.bool_)
+        for k in range(n_steer if coupled else 0):  # the axes' speeds (linkage_check._speeds)
+            axis_speed[k] = math.hypot(vx - w * link_y[k], vy + w * link_x[k])
         if n_links:  # each linkage's reference found once: its wheels on the roots it sets, then its law judged
-            axis_speed = np.empty(n_steer)
-            turn = np.zeros(n_steer, dtype=np.bool_)
-            for k in range(n_steer):  # the axes' speeds (linkage_check._speeds)
-                axis_speed[k] = math.hypot(vx - w * link_y[k], vy + w * link_x[k])
             for g in range(n_links):
                 first, last, lead = link_start[g], link_start[g + 1], link_lead[g]
                 ref, b = _reference(link_table, first, last, lead, beta, axis_speed)
                 if ref < 0:  # no axis moves: nothing to set or break
                     continue
-                _roots_at(link_table, first, last, lead, beta, b, free, link_lo, link_width, link_offset, turn)
+                _roots_at(link_table, first, last, lead, beta, b, math.pi, free, link_lo, link_width, link_offset, turn)
                 for i in range(n_o):
                     k = steered_beta[i]
                     if turn[k]:
@@ -209,6 +210,18 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
                     turn[k] = False
                 breach = _breach_at(link_table, first, last, lead, beta, axis_speed, True, slip_tol, link_tol, ref, b)
                 linked = linked and breach[0] < 0
+        if n_sgears:  # each gear between steering joints: its wheels on the roots it sets (judged below)
+            for g in range(n_sgears):
+                steer_roots(sg_joint, sg_k, sg_start[g], sg_start[g + 1], sg_rest, sg_x, sg_y, vx, vy, w, sg_rows,
+                            sg_turns, beta, axis_speed, slip_tol, link_tol, free, link_lo, link_width, link_offset,
+                            turn)
+                for i in range(n_o):
+                    k = steered_beta[i]
+                    if turn[k]:
+                        beta[k] = _wrap(beta[k] + math.pi)
+                        if spin_col[i] >= 0:
+                            rates_out[spin_col[i]] = -rates_out[spin_col[i]]
+                    turn[k] = False
         for e in range(n_e):  # castor-like elements at the (new) angle: rows (3.10), (8.24), (8.25)
             theta = beta[e_beta[e]] + offset[e] + edelta[e] + egamma[e]
             c, s = math.cos(theta), math.sin(theta)

@@ -23,7 +23,7 @@ from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from ..units import MAX_ANGLE, UnitError, parse_quantity
 from ..wheels import heading_from_beta, heading_in_range
-from . import _ik_fast
+from . import _ik_fast, gear_check
 from ._ik_fast import wrap_angle
 from .gear_check import GEAR_RTOL, contact_lever, gear_table, gears_hold, given_gear_breaches, steer_gears_hold
 from .linalg import decision_matrix, geared_twist_determined, robot_size, robot_solve
@@ -179,7 +179,7 @@ def wheel_commands(
         raise ShapeError(f"twist_robot {twist.shape} and the steering {current.shape}: their batch shapes (all but "
                          "the last axis) do not broadcast") from None
     n = p.n_wheels
-    rates, config, held, spin = _rates(robot, p, twist, current, batch, speed_tol)
+    rates, config, held, spin = _rates(robot, p, twist, current, batch, speed_tol, slip_tol)
     if len(p.fixed_wheels) == 0:
         slip = np.broadcast_to(0.0, (*batch, n))
         feasible = np.broadcast_to(True, batch)
@@ -212,12 +212,12 @@ def wheel_commands(
 
 
 def _rates(robot: Robot, p: _ik_fast.Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...],
-           speed_tol: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+           speed_tol: float, slip_tol: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The joint rates, steering configuration, held flags and spins ``(..., N)`` of :func:`wheel_commands`."""
     if p.only_steerable:  # swerve-like: the angles are the configuration, the spins the rates
-        config, rates, held = _ik_fast.steer_linked(robot, p, twist, current, batch, speed_tol)
+        config, rates, held = _ik_fast.steer_linked(robot, p, twist, current, batch, speed_tol, slip_tol)
     else:
-        rates, config, held = _general(robot, p, twist, current, batch, speed_tol)
+        rates, config, held = _general(robot, p, twist, current, batch, speed_tol, slip_tol)
     spin = _columns(rates, p.spin_select, batch, p.n_wheels)
     doubles = p.spin2_col >= 0
     if doubles.any():
@@ -234,7 +234,7 @@ def checked_rates(robot: Robot, twist: np.ndarray, beta: np.ndarray) -> tuple[np
     if not ((np.abs(twist) <= MAX_QUERY_RATE).all() and (np.abs(beta) <= MAX_ANGLE).all()):  # NaN included
         c = wheel_commands(robot, twist, beta)  # raises; kept should its bounds ever differ
         return c.rates, c.beta, c.spin
-    rates, config, _, spin = _rates(robot, _ik_fast.plan(robot), twist, beta, (), SPEED_TOL)
+    rates, config, _, spin = _rates(robot, _ik_fast.plan(robot), twist, beta, (), SPEED_TOL, SLIP_TOL)
     return rates, config, spin
 
 
@@ -244,8 +244,9 @@ def checked_steering_config(robot: Robot, twist: np.ndarray, beta: np.ndarray) -
     if not ((np.abs(twist) <= MAX_QUERY_RATE).all() and (np.abs(beta) <= MAX_ANGLE).all()):  # NaN included
         return checked_rates(robot, twist, beta)[1].tolist()  # raises
     vx, vy, w = twist.tolist()
-    links = linkage_plan(robot) if any(c.kind == "linkage" for c in robot.couplings) else None
-    return _ik_fast.steering_one(_ik_fast.plan(robot), vx, vy, w, beta.tolist(), SPEED_TOL, links)
+    gears = gear_check.steer_gears(robot)
+    links = linkage_plan(robot) if any(c.kind == "linkage" for c in robot.couplings) or gears.table.coupling else None
+    return _ik_fast.steering_one(_ik_fast.plan(robot), vx, vy, w, beta.tolist(), SPEED_TOL, SLIP_TOL, links, gears)
 
 
 def gear_error(coupling: Coupling, rate_names: tuple[str, ...], rates: np.ndarray) -> np.ndarray:
@@ -272,7 +273,8 @@ def _steer_columns(p: _ik_fast.Plan, config: np.ndarray, batch: tuple[int, ...],
 
 
 def _general(
-    robot: Robot, p: _ik_fast.Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...], speed_tol: float
+    robot: Robot, p: _ik_fast.Plan, twist: np.ndarray, current: np.ndarray, batch: tuple[int, ...], speed_tol: float,
+    slip_tol: float,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rates ``(..., n_rates)``, configuration ``(..., n_steer)`` and held flags ``(..., N)`` of any robot."""
     if p.has_constant:  # fixed wheels' spins (3.11), Swedish spins and rollers (8.27)/(8.28)
@@ -288,7 +290,7 @@ def _general(
     if len(p.steered_beta):
         config = np.broadcast_to(wrap_angle(current), (*batch, p.n_steer)).copy()
         held = np.zeros((*batch, p.n_wheels), dtype=bool)
-        angles, spins, held_o = _ik_fast.steer_linked(robot, p, twist, current, batch, speed_tol)
+        angles, spins, held_o = _ik_fast.steer_linked(robot, p, twist, current, batch, speed_tol, slip_tol)
         config[..., p.steered_beta] = angles
         rates[..., p.steered_spin_col] = spins
         held[..., p.steer_wheels[p.steered_beta]] = held_o
