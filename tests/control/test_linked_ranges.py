@@ -137,6 +137,20 @@ def test_a_steering_gear_takes_its_least_squares_turn_within_both_ranges(asked, 
     assert fits.all() == (abs(asked[0]) < 0.15)
 
 
+@pytest.mark.parametrize("ratios", [(1.0, 2.0), (2.0, 1.0), (1.0, -3.0)])
+@pytest.mark.parametrize("u", [0.3, 2.0, 2.9, -2.5, 3.1])
+def test_headings_on_a_gear_turned_far_are_kept_on_it(ratios, u):
+    """Units geared 1:2 (2:1, 1:-3), no range, asked headings on the gear at turn `u` (written wrapped): the kept
+    headings are those, mod 2 pi. Before, each wheel's turn was wrapped to (-pi, pi] before the least-squares fit:
+    at u = 2 rad the rear's 4 rad read -2.28 and the gear was fitted at u = -0.51, both wheels 2.5 and 5 rad off
+    what the IK asked (tests/kinematics/test_steer_gear_roots.py puts the IK on the gear)."""
+    robot = _geared(None, ratios)
+    asked = np.array([math.remainder(ratios[0] * u, 2 * math.pi), math.remainder(ratios[1] * u, 2 * math.pi)])
+    headings = asked.copy()
+    range_keeper(robot)(headings, np.zeros(len(robot.rate_names)), np.zeros(2))
+    np.testing.assert_allclose(np.remainder(headings - asked + math.pi, 2 * math.pi) - math.pi, 0.0, atol=1e-9)
+
+
 def test_a_geared_robot_tracks_with_its_headings_in_the_ratios():
     """``track --dynamics`` on the geared units along a 3 m circle: the commanded headings in the gear's ratios
     (before: the wheel IK's, front 0.107 rad and rear -0.093 rad where the gear turns the rear twice the front)."""
