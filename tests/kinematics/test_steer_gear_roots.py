@@ -56,13 +56,16 @@ def fk_twist(robot: Robot, c) -> np.ndarray:
     return forward_kinematics(robot, rates, heading=c.heading[steer])[0]
 
 
-def every_path(robot: Robot, twist, current) -> tuple:
-    """``wheel_commands``' commands, after checking that the other paths give its headings and feasibility."""
+def every_path(robot: Robot, twist, current, compiled: bool = True) -> tuple:
+    """``wheel_commands``' commands, after checking that the other paths give its headings and feasibility (the
+    compiled ``realtime`` one when `compiled`: it compiles a kernel for each new robot, some 3 s)."""
     twist, current = np.asarray(twist, dtype=float), np.asarray(current, dtype=float)
     c = wheel_commands(robot, twist, heading=current)
     steer = [robot.wheel_names.index(n) for n in robot.steer_names]
     config = checked_steering_config(robot, twist, robot.beta_of_heading(current))
     np.testing.assert_allclose(config, c.beta, rtol=0, atol=ULPS)
+    if not compiled:
+        return c, c.heading[steer]
     rates, out = np.empty(len(robot.rate_names)), np.empty(len(steer))
     assert realtime(robot).ik(*twist.tolist(), current.copy(), rates, out) == bool(c.feasible)
     np.testing.assert_allclose(np.remainder(out - c.heading[steer] + np.pi, 2 * np.pi) - np.pi, 0.0, atol=ULPS)
@@ -116,7 +119,8 @@ RATIOS = st.sampled_from([1.0, -1.0, 2.0, -2.0])
        current=st.tuples(st.floats(-math.pi, math.pi), st.floats(-math.pi, math.pi)))
 def test_random_geared_robots_get_the_headings_their_gear_sets(pos, ratios, rests, u, omega, current):
     """Any twist a gear can roll (the axles meeting at the headings it sets at some turn u): feasible, headings the
-    gear sets (mod 2 pi), fk at them gives the twist back, every path agrees."""
+    gear sets (mod 2 pi), fk at them gives the twist back, the Python paths agree (the compiled one on the fixed
+    robots above and below: a kernel a robot, 354 s for these examples)."""
     positions = [(pos[0], pos[1]), (pos[2], pos[3])]
     assume(math.dist(*positions) > 0.1)
     heading = [h0 + k * u for h0, k in zip(rests, ratios, strict=True)]
@@ -126,7 +130,7 @@ def test_random_geared_robots_get_the_headings_their_gear_sets(pos, ratios, rest
     speeds = [math.hypot(twist[0] - omega * y, twist[1] + omega * x) for x, y in positions]
     assume(min(speeds) > 1e-3 and abs(speeds[0] - speeds[1]) > 1e-9 * max(speeds))  # no wheel at the ICR, no tie
     assume(max(abs(twist)) < 1e3)
-    c, got = every_path(robot, twist, current)
+    c, got = every_path(robot, twist, current, compiled=False)
     assert c.feasible and c.in_steer_gear.all()
     assert gear_turns(robot, got), (np.degrees(got), np.degrees(heading))
     np.testing.assert_allclose(fk_twist(robot, c), twist, rtol=1e-9, atol=1e-9 * max(1.0, max(abs(twist))))
@@ -193,3 +197,23 @@ def test_the_gear_s_candidate_turns_set_the_roots_all_six_set(ratios, rests, u, 
         got.append(turn.tolist())
     assert got[0] == got[1]
     assert (len(candidate_turns(np.array(ratios) / ratios[0])) == 1) == (ratios[1] / ratios[0] % 1 == 0)
+
+
+FIXED = {ratios: geared([(0.3, 0.2), (-0.3, -0.2)], ratios, rests=(0.4, -0.7)) for ratios in ((1, 2), (2, -1))}
+
+
+@settings(max_examples=60, deadline=None)
+@given(ratios=st.sampled_from(sorted(FIXED)), u=st.floats(-3, 3),
+       omega=st.floats(0.2, 3).flatmap(lambda w: st.sampled_from([w, -w])),
+       current=st.tuples(st.floats(-math.pi, math.pi), st.floats(-math.pi, math.pi)))
+def test_the_compiled_ik_sets_the_roots_the_python_one_sets(ratios, u, omega, current):
+    """The compiled path (``realtime(robot).ik``) on any twist of two geared robots (one kernel each)."""
+    robot = FIXED[ratios]
+    positions = [(0.3, 0.2), (-0.3, -0.2)]
+    heading = [h0 + k * u for h0, k in zip((0.4, -0.7), ratios, strict=True)]
+    assume(abs(math.sin(heading[0] - heading[1])) > 0.1)
+    twist = twist_for(positions, heading, omega)
+    speeds = [math.hypot(twist[0] - omega * y, twist[1] + omega * x) for x, y in positions]
+    assume(min(speeds) > 1e-3 and abs(speeds[0] - speeds[1]) > 1e-9 * max(speeds) and max(abs(twist)) < 1e3)
+    c, got = every_path(robot, twist, current)
+    assert c.feasible and gear_turns(robot, got)
