@@ -201,13 +201,7 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
                 if ref < 0:  # no axis moves: nothing to set or break
                     continue
                 _roots_at(link_table, first, last, lead, beta, b, math.pi, free, link_lo, link_width, link_offset, turn)
-                for i in range(n_o):
-                    k = steered_beta[i]
-                    if turn[k]:
-                        beta[k] = _wrap(beta[k] + math.pi)
-                        if spin_col[i] >= 0:
-                            rates_out[spin_col[i]] = -rates_out[spin_col[i]]
-                    turn[k] = False
+                _turn_half_round(steered_beta, spin_col, turn, beta, rates_out)
                 breach = _breach_at(link_table, first, last, lead, beta, axis_speed, True, slip_tol, link_tol, ref, b)
                 linked = linked and breach[0] < 0
         if n_sgears:  # each gear between steering joints: its wheels on the roots it sets (judged below)
@@ -215,13 +209,7 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
                 steer_roots(sg_joint, sg_k, sg_start[g], sg_start[g + 1], sg_rest, sg_x, sg_y, vx, vy, w, sg_rows,
                             sg_turns, beta, axis_speed, slip_tol, link_tol, free, link_lo, link_width, link_offset,
                             turn)
-                for i in range(n_o):
-                    k = steered_beta[i]
-                    if turn[k]:
-                        beta[k] = _wrap(beta[k] + math.pi)
-                        if spin_col[i] >= 0:
-                            rates_out[spin_col[i]] = -rates_out[spin_col[i]]
-                    turn[k] = False
+                _turn_half_round(steered_beta, spin_col, turn, beta, rates_out)
         for e in range(n_e):  # castor-like elements at the (new) angle: rows (3.10), (8.24), (8.25)
             theta = beta[e_beta[e]] + offset[e] + edelta[e] + egamma[e]
             c, s = math.cos(theta), math.sin(theta)
@@ -263,6 +251,19 @@ def _ik_kernel(p: _ik_fast.Plan, robot: Robot, speed_tol: float, slip_tol: float
         return feasible
 
     return compile_cached(ik)
+
+
+@compile_cached
+def _turn_half_round(steered_beta, spin_col, turn, beta, rates_out):
+    """Each steered wheel whose root a linkage or gear set half a turn from its own (`turn`, by ``beta`` index):
+    its angle turned by pi, its spin (column `spin_col`, -1: none) negated; `turn` cleared."""
+    for i in range(steered_beta.shape[0]):
+        k = steered_beta[i]
+        if turn[k]:
+            beta[k] = _wrap(beta[k] + math.pi)
+            if spin_col[i] >= 0:
+                rates_out[spin_col[i]] = -rates_out[spin_col[i]]
+        turn[k] = False
 
 
 @compile_cached
