@@ -163,7 +163,8 @@ def run(args: argparse.Namespace) -> int:
     pose0 = [parse_value(args.pose[0], "length", "--pose X"), parse_value(args.pose[1], "length", "--pose Y"),
              parse_angle(args.pose[2], "--pose")]
     check_start_pose(np.array(pose0), "--pose")
-    slip_model = estimator_from_args(robot, args, settings).build(robot) if args.method in ESTIMATOR_METHODS else None
+    spec = estimator_from_args(robot, args, settings) if args.method in ESTIMATOR_METHODS else None
+    slip_model = spec.build(robot) if spec is not None else None
     what = odometry_name(args.method if slip_model is not None else None, "--weight" if args.weight else None)
     # the IMU read now: a named one that fails is refused before any output is written
     check, unread = imu_check(args.log, imu, what, named=args.imu is not None, mount=mount,
@@ -178,8 +179,8 @@ def run(args: argparse.Namespace) -> int:
         topic=args.topic, joint_names=parse_assignments(args.joint_name, "--joint-name"),
         weights=weights,
         sinks=[check] if check else (), check=check.judge if check else None)
-    if slip_model is not None:
-        summary = replace(summary, method=f"{args.method} ({args.scheme})")
+    if spec is not None:
+        summary = replace(summary, method=spec.label)
     if args.method in ("fk1", "fk2") and (line := slip_model.conditioning_warning()):
         warn(line)
     names = parse_assignments(args.joint_name, "--joint-name")
