@@ -1257,3 +1257,20 @@ def test_retype_keeps_what_the_new_type_takes_and_names_what_it_drops(page, serv
     assert pg.evaluate("S.desc.wheels[1]") | {"type": "swedish"} == catalog.load("omni-3").to_dict()["wheels"][1]
     assert pg.locator(note).count() == 0
     assert not pg.errors
+
+
+def test_a_kappa_map_is_asked_only_of_the_description_analysed(page):
+    """The κ map's request checked that the robot steers on the last *analysis*, but sent the current description:
+    a κ map asked (250 ms after swerve-4's analysis, or queued behind one in flight) once omni-3 was opened and
+    before its analysis answered sent omni-3 and got '/api/kappa 400' (does not steer) in the console (seen on a
+    loaded CI machine). It now waits for the analysis of the description it would send."""
+    pg = page
+    open_catalog(pg, "swerve-4")
+    assert pg.evaluate("S.kappa.wheels.length") == 2
+    omni = json.dumps(catalog.load("omni-3").to_dict())
+    pg.evaluate(f"async () => {{ S.desc = {omni}; await loadKappa(); }}")  # omni-3 opened, not yet analysed
+    assert pg.console_errors == []
+    assert pg.evaluate("S.kappa.wheels.length") == 2  # swerve-4's map stays until omni-3's analysis
+    pg.evaluate("refresh()")
+    settle(pg)
+    assert pg.evaluate("S.kappa") is None  # omni-3 does not steer: no map

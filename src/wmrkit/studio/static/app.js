@@ -205,6 +205,9 @@ function loadConfigurations() {
 }
 function loadKappa() {
   return loadSlow("kappa", async () => {
+    // whether the robot steers is known of the analysed description only: a newer one waits for its analysis, which
+    // asks for its map (sent before, omni-3 opened after swerve-4 got '400: does not steer')
+    if (S.analysedText !== JSON.stringify(S.desc)) return undefined;
     if (!S.analysis || Object.keys(S.analysis.steering).length === 0) return { ok: false, data: null };
     return call("/api/kappa", { description: S.desc, resolution: 72 });
   }, (r) => {
