@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
@@ -35,19 +36,36 @@ unit = st.floats(-1.0, 1.0)
        omega=st.sampled_from([1.0, -1e3, 1e6, -1e6]))
 @example(scale=708.0, icr=(0.0, 0.0), points=[(0.0, 1.0), (1.0, 1.0)], omega=1.0)  # a wheel 1001 m out, refused
 def test_a_rotation_every_fixed_wheel_rolls_along_is_feasible_at_any_scale(scale, icr, points, omega):
+    _check_rolling(scale, icr, points, omega, compiled=False)
+
+
+@pytest.mark.parametrize(("scale", "icr", "points", "omega"), [
+    (1e3, (0.0, 0.0), [(0.9, 0.0), (-0.9, 0.0), (0.0, 0.9)], 1e6),  # 600 m out at 1e6 rad/s: 6e8 m/s at the wheels
+    (1e3, (0.5, -0.3), [(-0.8, 0.6), (0.7, 0.9)], -1e3),
+    (1e-3, (0.2, 0.1), [(0.9, -0.4), (-0.6, -0.7), (0.1, 0.95), (-0.9, 0.3)], 1e6)])
+def test_the_compiled_ik_finds_the_same_rotations_feasible(scale, icr, points, omega):
+    """The single-call ik of three robots at the envelope's corners (compiled per robot: seconds each, so not for
+    each of the random robots above)."""
+    _check_rolling(scale, icr, points, omega, compiled=True)
+
+
+def _check_rolling(scale, icr, points, omega, compiled: bool) -> None:
     scale /= 1.5  # the unit square's corners within 1 km of the origin (MAX_SIZE) at scale 1e3: 0.94 of it
     icr = (icr[0] * scale, icr[1] * scale)
     points = [(x * scale, y * scale) for x, y in points]
     if min(math.dist(p, icr) for p in points) < 1e-2 * scale:  # a wheel on the ICR has no rolling direction
+        assert not compiled, "a fixed case must be a real one"
         return
     robot = _rolling_about(icr, points)
     twist = np.array([omega * icr[1], -omega * icr[0], omega])  # v = omega z x (0 - icr)
     if np.abs(twist).max() > 1e6:
+        assert not compiled, "a fixed case must be a real one"
         return
     commands = wheel_commands(robot, twist)
     assert bool(commands.feasible), commands.slip
-    ik = realtime(robot).ik
-    assert ik(*twist.tolist(), np.zeros(0), np.zeros(len(robot.rate_names)), np.zeros(0))
+    if compiled:
+        ik = realtime(robot).ik
+        assert ik(*twist.tolist(), np.zeros(0), np.zeros(len(robot.rate_names)), np.zeros(0))
     # the same twist plus a motion along the first wheel's axle of 1e-6 of the wheel speeds (far above round-off)
     speed = max(abs(omega) * math.dist(p, icr) for p in points)
     heading = math.atan2(points[0][0] - icr[0], -(points[0][1] - icr[1]))

@@ -153,7 +153,8 @@ def test_an_execution_of_too_many_samples_is_refused_before_it_is_sampled():
 def test_a_gif_renders_each_frame_once_and_draws_a_bounded_trail(tmp_path, monkeypatch):
     """animate_plan rendered every frame twice (FuncAnimation.save's draw_idle, then the writer's savefig) and kept
     it as RGBA until the end; its trail drew every sample up to the frame (800 frames of a 9.8 km plan, 394,511
-    samples: over 6 min and 1.2 GB). Now each frame is rendered once and the trail draws at most MAX_TRAIL dots."""
+    samples: over 6 min and 1.2 GB). Now the figure is rendered once, each frame draws only what moves over it (blit),
+    and the trail draws at most MAX_TRAIL dots."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.lines import Line2D
     from PIL import Image
@@ -167,7 +168,7 @@ def test_a_gif_renders_each_frame_once_and_draws_a_bounded_trail(tmp_path, monke
     monkeypatch.setattr(FigureCanvasAgg, "draw", lambda self, *a, **k: renders.append(1) or draw(self, *a, **k))
     monkeypatch.setattr(Line2D, "set_data", lambda self, *a: drawn.append(len(a[0])) or set_data(self, *a))
     assert animate_plan(plan, tmp_path / "a.gif", run, max_frames=5) == 5
-    assert len(renders) == 5
+    assert len(renders) == 1  # the background; the frames are the moving artists drawn over it
     assert max(drawn) <= MAX_TRAIL < len(run.t) and sum(drawn[-2:]) == MAX_TRAIL  # the last frame: the whole trail
     with Image.open(tmp_path / "a.gif") as gif:
         assert gif.n_frames == 5 and gif.size == (640, 368)

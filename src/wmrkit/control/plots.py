@@ -93,30 +93,37 @@ def animate_run(run: TrackingRun, path: str | os.PathLike[str], *, frames: int =
     steer = robot.steer_names
     fixed_heading = {w.name: w.heading for w in robot.wheels}
 
-    def frame(k: int):
+    # the reference under the moving robot (zorder 0.5, the body's fill 1): the frames draw the robot over the
+    # figure rendered once, in the order a full redraw would
+    ax.plot(run.reference[:, 0], run.reference[:, 1], "k--", lw=1, zorder=0.5)
+    tracked, = ax.plot([], [], "C0")
+    outline, = ax.fill([], [], color="#c9d6e3", alpha=0.6)
+    wheels = [ax.plot([], [], "k", lw=3)[0] for _ in robot.wheels]
+    origin, = ax.plot([], [], "C1o", ms=4)
+    ax.set_xlim(centre[0] - span / 2, centre[0] + span / 2)
+    ax.set_ylim(centre[1] - span / 2, centre[1] + span / 2)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    title = ax.set_title("", fontsize=9)
+
+    def frame(k: int) -> list:
         i = int(idx[k])
-        ax.clear()
-        ax.plot(run.reference[:, 0], run.reference[:, 1], "k--", lw=1)
-        ax.plot(run.tracked[: i + 1, 0], run.tracked[: i + 1, 1], "C0")
+        tracked.set_data(run.tracked[: i + 1, 0], run.tracked[: i + 1, 1])
         x, y, th = run.pose[i]
         c, s = math.cos(th), math.sin(th)
         world = np.column_stack([x + c * mounts[:, 0] - s * mounts[:, 1], y + s * mounts[:, 0] + c * mounts[:, 1]])
-        ax.fill(x + c * body[:, 0] - s * body[:, 1], y + s * body[:, 0] + c * body[:, 1], color="#c9d6e3", alpha=0.6)
-        for j, w in enumerate(robot.wheels):
+        outline.set_xy(np.column_stack([x + c * body[:, 0] - s * body[:, 1], y + s * body[:, 0] + c * body[:, 1]]))
+        for j, (w, line) in enumerate(zip(robot.wheels, wheels, strict=True)):
             h = th + (run.heading[i, steer.index(w.name)] if w.name in steer else fixed_heading[w.name])
             d = max(w.r, 0.05) * np.array([math.cos(h), math.sin(h)])
-            ax.plot([world[j, 0] - d[0], world[j, 0] + d[0]], [world[j, 1] - d[1], world[j, 1] + d[1]], "k", lw=3)
-        ax.plot(world[-1, 0], world[-1, 1], "C1o", ms=4)
-        ax.set_xlim(centre[0] - span / 2, centre[0] + span / 2)
-        ax.set_ylim(centre[1] - span / 2, centre[1] + span / 2)
-        ax.set_aspect("equal")
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
-        ax.set_title(f"{robot.name}, {run.controller}: t = {run.t[i]:.1f} s", fontsize=9)
-        return []
+            line.set_data([world[j, 0] - d[0], world[j, 0] + d[0]], [world[j, 1] - d[1], world[j, 1] + d[1]])
+        origin.set_data([world[-1, 0]], [world[-1, 1]])
+        title.set_text(f"{robot.name}, {run.controller}: t = {run.t[i]:.1f} s")
+        return [tracked, outline, *wheels, origin, title]
 
     try:
-        save_gif(fig, frame, range(len(idx)), path, fps=12)
+        save_gif(fig, frame, range(len(idx)), path, fps=12, blit=True)
     except (OSError, ValueError) as err:
         raise WmrkitError(f"{path}: cannot save the animation ({err})") from None
     finally:

@@ -154,8 +154,10 @@ def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Exe
                        f"steering {math.degrees(run.steering[i]):+5.1f} deg")
         return [*artists, trail_f, trail_b, title]
 
-    save = save_gif if suffix == ".gif" else save_html
-    save(fig, update, range(len(frames)), path, fps=fps, dpi=80)
+    if suffix == ".gif":
+        save_gif(fig, update, range(len(frames)), path, fps=fps, dpi=80, blit=True)
+    else:
+        save_html(fig, update, range(len(frames)), path, fps=fps, dpi=80)
     return len(frames)
 
 

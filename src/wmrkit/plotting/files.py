@@ -49,24 +49,40 @@ MAX_EMBED_MB = 2048
 
 
 def save_gif(fig, draw: Callable[[int], object], frames: Iterable[int], path: str | os.PathLike[str], *,
-             fps: float, dpi: float | None = None) -> None:
+             fps: float, dpi: float | None = None, blit: bool = False) -> None:
     """Write a GIF of `fig`, calling ``draw(k)`` for each item of `frames` before rendering it (Agg, off-screen).
 
-    Each frame is rendered once and kept as a palette image (1 byte a pixel), as GIF stores it: matplotlib's
-    ``FuncAnimation.save`` with ``PillowWriter`` rendered every frame twice and kept it as RGBA until the end
-    (800 frames of 640 x 368 px: 4 min and 840 MB on the shared 2-core machine)."""
+    Each frame is rendered once and kept as a palette image (1 byte a pixel, the palette of a fast octree), as GIF
+    stores it: matplotlib's ``FuncAnimation.save`` with ``PillowWriter`` rendered every frame twice and kept it as
+    RGBA until the end (800 frames of 640 x 368 px: 4 min and 840 MB on the shared 2-core machine). With `blit`,
+    ``draw(k)`` returns every artist it changes or adds, as for ``FuncAnimation(..., blit=True)``: the rest of the
+    figure is rendered once and each frame draws only those, in their z-order, over it (a parking plan's 200 frames:
+    about 2 s instead of 20)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from PIL import Image
 
     if dpi is not None:
         fig.set_dpi(dpi)
     canvas = FigureCanvasAgg(fig)
+    frames = list(frames)
+    background = None
+    if blit and frames:
+        for artist in draw(frames[0]):
+            artist.set_animated(True)  # left out of the background
+        canvas.draw()
+        background = canvas.copy_from_bbox(fig.bbox)
     images = []
     for k in frames:
-        draw(k)
-        canvas.draw()
-        rgba = Image.fromarray(np.asarray(canvas.buffer_rgba()))
-        images.append(rgba.convert("RGB").convert("P", palette=Image.Palette.ADAPTIVE))
+        changed = draw(k)
+        if background is None:
+            canvas.draw()
+        else:
+            canvas.restore_region(background)
+            for artist in sorted(changed, key=lambda a: a.get_zorder()):
+                artist.set_animated(True)
+                fig.draw_artist(artist)
+        rgb = Image.fromarray(np.asarray(canvas.buffer_rgba())).convert("RGB")
+        images.append(rgb.quantize(256, method=Image.Quantize.FASTOCTREE))
     images[0].save(os.fspath(path), save_all=True, append_images=images[1:], duration=int(1000 / fps), loop=0)
 
 
