@@ -105,7 +105,7 @@ def _real_array(x: object, name: str, angles: bool) -> np.ndarray:
                 return a.astype(float)  # Fraction, Decimal; None reads as NaN, which the callers' checks refuse
             got = _REFUSED_KINDS.get(a.dtype.kind, f"values of type {a.dtype}")
             if a.dtype.kind == "U":
-                got = f"the text {str(next((v for v in a.flat if not _number(v)), a.flat[0]))!r}"
+                got = f"the text {str(next((v for v in a.flat if not reads_as_number(v)), a.flat[0]))!r}"
         except (TypeError, ValueError, OverflowError):  # a ragged nested list, an element that is no number
             got = f"a {type(x).__name__} of values that are no numbers, or of rows of different lengths"
     unit = "radians (e.g. math.radians(30))" if angles else "SI units (m, rad, m/s, rad/s)"
@@ -114,7 +114,8 @@ def _real_array(x: object, name: str, angles: bool) -> np.ndarray:
     raise ShapeError(f"{name}: expected real numbers in {unit}, got {got}")
 
 
-def _number(text: str) -> bool:
+def reads_as_number(text: str) -> bool:
+    """Whether `text` reads as a number (``float(text)``: '1e3', 'nan', '-inf')."""
     try:
         float(text)
     except ValueError:

@@ -302,12 +302,14 @@ def steered_robot(spec: str, steer: list[str] | None) -> Robot:
 
 
 class OptionError(WmrkitError):
-    """A command-line option's value refused, the message starting with the option (``--steer front=2 turn: ...``);
-    `wheel`: the wheel the value names, the ``"wheel"`` of the JSON error (``cli.main.report_error``)."""
+    """A command-line argument's value refused, the message starting with the option (``--steer front=2 turn: ...``);
+    `wheel`: the wheel the value names, `field`: the argument at fault when the message does not start with it
+    (``LOG`` of ``give a LOG or --path NAME``), the ``"wheel"`` and ``"field"`` of the JSON error
+    (``cli.main.report_error``)."""
 
-    def __init__(self, message: str, *, wheel: str | None = None) -> None:
+    def __init__(self, message: str, *, wheel: str | None = None, field: str | None = None) -> None:
         super().__init__(message)
-        self.wheel = wheel
+        self.wheel, self.field = wheel, field
 
 
 def with_steer(robot: Robot, steer: list[str] | None) -> Robot:

@@ -10,6 +10,7 @@ from pathlib import Path
 from ..errors import WmrkitError, name_list
 from ._common import (
     SCHEMES_HELP,
+    OptionError,
     add_json_flag,
     add_robot_argument,
     check_plot_path,
@@ -229,6 +230,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
         load_runs,
     )
     from ..batch.fleet import expand_logs
+    from ..odometry.calibration import apply_parameters
 
     robot = load_robot(args.robot)
     if args.slip and (args.param or args.ci or args.sensed or args.reference_noise):  # the slip fit has its own two
@@ -240,6 +242,14 @@ def run_calibrate(args: argparse.Namespace) -> int:
     args.ci, args.bootstrap = args.ci or "jacobian", 200 if args.bootstrap is None else args.bootstrap
     params = ([tuple(n.strip() for n in p.split(",") if n.strip()) for p in args.param] if args.param
               else [] if args.slip else default_parameters(robot, closed=args.closed, sensed=args.sensed))
+    if () in params:  # '--param ,': the library's 'an empty parameter group' named no option
+        raise WmrkitError(f"--param {args.param[params.index(())]!r}: names no WHEEL.FIELD")
+    if args.param:
+        with renaming({"parameter '": "--param '"}):  # its names, before the logs are read
+            apply_parameters(robot, params, [0.0] * len(params))
+    if args.reference is not None and not Path(args.reference).is_dir():  # "LOG: no reference ... in nope"
+        raise WmrkitError(f"--reference {args.reference}: "
+                          f"{'not a folder' if Path(args.reference).exists() else 'no such folder'}")
     check_bootstrap(args.bootstrap, "--bootstrap")
     check_level(args.level, "--level")
     noise = _reference_noise(args.reference_noise)
@@ -278,8 +288,8 @@ def run_montecarlo(args: argparse.Namespace) -> int:
 
     robot = load_robot(args.robot)
     check_plot_path(args.plot)
-    if (args.log is None) == (args.path is None):
-        raise WmrkitError("give a LOG or --path NAME (one of the two)")
+    if (args.log is None) == (args.path is None):  # both: --path is the one too many, as argparse names it
+        raise OptionError("give a LOG or --path NAME (one of the two)", field="LOG" if args.path is None else "--path")
     from ..odometry.model import odometry_model
 
     model = odometry_model(robot)

@@ -223,8 +223,8 @@ def check_animation_path(path: str | None, suffixes: tuple[str, ...] = (".gif",)
 
 #: The keywords of :func:`wmrkit.control.track.track` its errors start with, and the options of ``track``.
 TRACK_KEYWORDS = {"initial_pose: ": "--from: initial pose ", "period: expected": "--period: expected",
-                  "delay: a measurement delay": "delay: a measurement delay",  # '... needs a sample period (--period)'
-                  "delay: ": "--delay: "}
+                  "delay: ": "--delay: "}  # '--delay: ... needs a sample period (--period)' is --delay's error, as
+# '--feedback needs --dynamics' is --feedback's
 
 
 def run_track(args: argparse.Namespace) -> int:

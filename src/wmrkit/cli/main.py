@@ -16,6 +16,7 @@ import threading
 from collections.abc import Mapping, Sequence
 from typing import NoReturn
 
+from .._shapes import reads_as_number
 from ..errors import DescriptionError, WmrkitError
 from ._common import check_blank, check_outputs, collecting_warnings, named_values, output_option
 
@@ -120,13 +121,18 @@ def chosen_parser(parser: argparse.ArgumentParser, args: argparse.Namespace) -> 
 
 def given_names(parser: argparse.ArgumentParser | None, args: argparse.Namespace | None) -> dict[str, str]:
     """Each text value of the parsed command line and the argument that gave it, as the user sees it (``{"run.csv":
-    "--torques", "img.png": "IMAGE"}``; the first of two that gave the same); {} before the parsing."""
+    "--torques", "img.png": "IMAGE"}``; the first of two that gave the same), and the NAME of each ``NAME=VALUE``
+    (``{"nope.spin": "--column"}``); {} before the parsing."""
     if parser is None or args is None:
         return {}
     names: dict[str, str] = {}
     for name, _, value in named_values(parser, args):
         if isinstance(value, str):
             names.setdefault(value, name)
+    for value, name in list(names.items()):  # the NAME of a NAME=VALUE (--column, --spin): a joint an error quotes
+        key, sep, _ = value.partition("=")
+        if sep and key:
+            names.setdefault(key, name)
     return names
 
 
@@ -185,20 +191,23 @@ def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = (),
             loc = loc[2:]
         data["field"] = ".".join(str(p) for p in loc) or None
     else:
-        data |= _file_place(data["error"], argv) or _option_place(err, data["error"], argv)
-    if data["file"] is not None and data["field"] is None:  # the whole file: the argument that gave it
-        data["field"] = (names or {}).get(data["file"])
+        data |= (_file_place(data["error"], argv) or _option_place(err, data["error"], argv)
+                 or _argument_place(data["error"], names))
+    if data["file"] is not None and data["field"] is None:  # an argument it quotes, else the whole file: the
+        # argument that gave it
+        data["field"] = _quoted_argument(data["error"], names) or (names or {}).get(data["file"])
     print(json.dumps(data), file=sys.stderr)
 
 
 #: The option that starts an error's message, as the message names it: ``--chunk: ...``, ``-n/--runs: ...``,
 #: ``--configs must be ...``, ``--steer front=1e7 turn: ...``; and the argument argparse names in a usage error
 #: (``sweep: argument --metric: invalid choice ...``), or the first of those it lists (``park: unrecognized
-#: arguments: --space 1``, ``tyre: ambiguous option: --slip could match ...``, ``calibrate: the following arguments
-#: are required: --reference``).
+#: arguments: --space 1``, ``tyre: ambiguous option: --slip could match ...``, ``odometry: the following arguments
+#: are required: ROBOT, LOG``, ``simulate: one of the arguments --torques --path is required``).
 _OPTION_FIRST = re.compile(r"(-\w/--[\w-]+|--[\w-]+)(?=[\s:=]|$)")
-_ARGPARSE_ARGUMENT = re.compile(r"(?:[\w -]+: )?(?:argument ([^\s:]+): |(?:unrecognized arguments|ambiguous option|"
-                                r"the following arguments are required): (--[\w-]+))")
+_ARGPARSE_ARGUMENT = re.compile(r"(?:[\w -]+: )?(?:argument ([^\s:]+): |(?:unrecognized arguments|ambiguous option): "
+                                r"(--[\w-]+)|the following arguments are required: ([^\s,]+)|one of the arguments "
+                                r"(\S+) .*is required)")
 #: The option a message names in parentheses, after the name of its value (``blur (--blur): ...``, ``line width
 #: (--line-width) 100 m ...``, ``duration 1e+12 s ...; give a shorter duration (--duration)``).
 _OPTION_IN_PARENTHESES = re.compile(r"\((--[\w-]+)[^)]*\)")
@@ -207,28 +216,51 @@ _ANY_OPTION = re.compile(r"(?<![\w-])--[A-Za-z][\w-]*")
 
 def _option_place(err: WmrkitError, message: str, argv: Sequence[str] = ()) -> dict:
     """``field`` (the option) and ``wheel`` (the wheel its value names, :class:`._common.OptionError`) of an error
-    about an option of the command line: one the message starts with, after the words of the command in `argv`
-    (``ik: --twist 1e7: ...``, ``vision calibrate: --size: ...``), the only option it names, in parentheses
-    (``follow-line: blur (--blur): ...``), or, of the options it names so, the only one `argv` gives
-    (``duration (--duration) 20 s is shorter than one period (--period, 100 s)`` after ``--period 100``); {} when it
-    names none so."""
+    about an option of the command line: the argument an :class:`._common.OptionError` names as its ``field``, the
+    option the message starts with, after the words of the command in `argv` (``ik: --twist 1e7: ...``, ``vision
+    calibrate: --size: ...``), the only option it names, in parentheses (``follow-line: blur (--blur): ...``), or,
+    of the options it names, the first one `argv` gives (``duration (--duration) 20 s is shorter than one period
+    (--period, 100 s)`` after ``--period 100``; ``two --vary axes move the same field``); {} when it names none so."""
     from ._common import OptionError
 
     if isinstance(err, UsageError):
         place = _ARGPARSE_ARGUMENT.match(message)
-        return {} if place is None else {"field": place.group(1) or place.group(2), "wheel": None}
+        return {} if place is None else {"field": next(g for g in place.groups() if g), "wheel": None}
+    if isinstance(err, OptionError) and err.field is not None:
+        return {"field": err.field, "wheel": err.wheel}
     rest = _after_command(message, argv)
     place = _OPTION_FIRST.match(rest)
     if place is not None:
         return {"field": place.group(1), "wheel": err.wheel if isinstance(err, OptionError) else None}
-    named = set(_ANY_OPTION.findall(rest))
+    named = list(dict.fromkeys(_ANY_OPTION.findall(rest)))
     inside = _OPTION_IN_PARENTHESES.search(rest)
-    if inside is not None and named == {inside.group(1)}:
+    if inside is not None and named == [inside.group(1)]:
         return {"field": inside.group(1), "wheel": None}
-    given = named & {a.partition("=")[0] for a in argv}  # of several named in parentheses, the one typed
-    if inside is None or len(given) != 1:
-        return {}
-    return {"field": given.pop(), "wheel": None}
+    typed = {a.partition("=")[0] for a in argv}  # of the options it names, the first one typed
+    given = [option for option in named if option in typed]
+    return {"field": given[0], "wheel": None} if given else {}
+
+
+#: A value the message quotes (``no robot 'nope' in the catalog``, ``parameter 'front_left.x': ...``).
+_QUOTED = re.compile(r"'([^'\n]+)'")
+
+
+def _argument_place(message: str, names: Mapping[str, str] | None) -> dict:
+    """``field`` of an error that names no option or file: the one argument (`names`: :func:`given_names`) whose
+    value the message quotes (not a number: ``got '0'`` would be anyone's), else ROBOT when the message is about a
+    robot (``robot 'x': its origin ...``) and the command has that argument; {} otherwise."""
+    field = _quoted_argument(message, names)
+    if field is None and re.search(r"\brobot '", message) and "ROBOT" in (names or {}).values():
+        field = "ROBOT"
+    return {} if field is None else {"field": field}
+
+
+def _quoted_argument(message: str, names: Mapping[str, str] | None) -> str | None:
+    """The one argument whose value (or NAME of NAME=VALUE) `message` quotes, a number's excepted; else None."""
+    names = names or {}
+    quoted = {names[q] for q in _QUOTED.findall(message) if q in names and not reads_as_number(q)}
+    return quoted.pop() if len(quoted) == 1 else None
+
 
 
 def _after_command(message: str, argv: Sequence[str]) -> str:

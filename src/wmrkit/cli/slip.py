@@ -265,7 +265,8 @@ def add_study_parser(commands: argparse._SubParsersAction) -> None:
     """Register ``slip-study``."""
     p = commands.add_parser("slip-study", help="reproduce the slip studies: thesis §7.5 on the forklift, or the "
                                                "skid-steer comparison of docs/slip.md")
-    p.add_argument("study", choices=("forklift", "skid-steer-4"), help="which study")
+    p.add_argument("study", choices=("forklift", "skid-steer-4"), metavar="STUDY",
+                   help="which study: forklift or skid-steer-4")
     p.add_argument("--report", metavar="DIR", help="write the figures into DIR")
     p.add_argument("--quick", action="store_true", help="forklift: fewer sweep points and shorter runs (a smoke run)")
     p.add_argument("--seed", type=seed, help="forklift: seed of the experiments' speeds and encoder phases (default 0)")

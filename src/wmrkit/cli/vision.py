@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import WmrkitError
 from ._common import (
+    OptionError,
     add_json_flag,
     add_robot_argument,
     load_robot,
@@ -187,8 +188,8 @@ def run_calibrate(args: argparse.Namespace) -> int:
     xw = parse_value(args.half_separation, "length", "--half-separation")
     yw = parse_value(args.row_distance, "length", "--row-distance")
     by_points = args.x1 is not None or args.x2 is not None
-    if by_points == (args.image is not None):
-        raise WmrkitError("calibrate: give either IMAGE or both --x1 and --x2")
+    if by_points == (args.image is not None):  # both: the --x1/--x2 typed are the field (cli.main._option_place)
+        raise OptionError("calibrate: give either IMAGE or both --x1 and --x2", field=None if by_points else "IMAGE")
     if by_points:
         if args.x1 is None or args.x2 is None:
             raise WmrkitError("calibrate: --x1 and --x2 go together")

@@ -412,7 +412,10 @@ def _groups(robot: Robot, parameters: Sequence[Parameter]) -> list[list[tuple[st
         for signed in names:
             name, sign = (signed[1:], -1.0) if signed.startswith("-") else (signed, 1.0)
             wheel, _, fld = name.partition(".")
-            w = robot.wheel(wheel)
+            try:
+                w = robot.wheel(wheel)
+            except UnknownNameError as err:  # "robot has no wheel 'nope'" named no parameter
+                raise UnknownNameError(f"parameter '{name}': {err}") from None
             allowed = [f for f in GEOMETRY_FIELDS if f in ("l", "alpha") or f in w.kind.required
                        or f in w.kind.optional]
             if fld not in allowed:
