@@ -41,6 +41,7 @@ CASES = [
     (["batch", "calibrate", "mecanum-4", LOG, "--reference", "nope", "--workers", "0"], "--reference",
      "--reference nope: no such folder"),
     (["batch", "calibrate", "mecanum-4", LOG, "--reference", LOG, "--workers", "0"], "--reference", "not a folder"),
+    ([*CALIBRATE, "--slip"], "LOG", "LOG: slip weights with an interval (--slip) need at least two logs, got 1"),
     # an option the message names, or the two-of-one refusals of the command itself
     (["track", "diff-drive", "--reference", "circle", "--delay", "2"], "--delay",
      "--delay: a measurement delay in samples needs a sample period (--period)"),

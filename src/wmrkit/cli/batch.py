@@ -253,8 +253,12 @@ def run_calibrate(args: argparse.Namespace) -> int:
     check_bootstrap(args.bootstrap, "--bootstrap")
     check_level(args.level, "--level")
     noise = _reference_noise(args.reference_noise)
+    logs = expand_logs(args.logs)
+    if args.slip and len(logs) < 2:  # the library's 'need at least two runs' came after a cluster had started
+        raise OptionError(f"LOG: slip weights with an interval (--slip) need at least two logs, got {len(logs)}",
+                          field="LOG")
     with _runner(args) as runner:
-        runs = load_runs(robot, expand_logs(args.logs), reference_dir=args.reference, closed=args.closed,
+        runs = load_runs(robot, logs, reference_dir=args.reference, closed=args.closed,
                          runner=runner, options=_options(args), progress=_progress(args))
         if args.slip:
             from ..batch.calibrate import fleet_slip_calibrate
