@@ -11,9 +11,10 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..kinematics import _ik_fast
 from ..kinematics._ik_fast import in_range_one, wrap_one
 from ..kinematics.linalg import solve_assigned
-from ..kinematics.wheel_ik import checked_rates, checked_steering_config, forward_kinematics
+from ..kinematics.wheel_ik import checked_castor_rates, checked_rates, checked_steering_config, forward_kinematics
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from .actuators import LowLevelLoops
@@ -61,9 +62,9 @@ class _Sim:
         self.delta = np.array([robot.wheel(n).delta for n in names], dtype=float)
         self.ranges, self.spin_columns = steer_ranges(robot), spin_columns(robot)
         self.wheel_of_steer = np.array([robot.wheel_names.index(n) for n in names], dtype=int)
-        self.castor_rate_columns = np.array([robot.rate_names.index(f"{n}.steer") for n, p in zip(names, self.passive,
-                                                                                                    strict=True) if p],
-                                            dtype=int)  # the castors' steering rates (8.24) in the IK's rates
+        columns = _ik_fast.plan(robot).element_steer_col.tolist()  # the castors' steering rates (8.24) among the IK's
+        self.castor_elements = [columns.index(robot.rate_names.index(f"{n}.steer"))
+                                for n, p in zip(names, self.passive, strict=True) if p]
         loops = plant.loops
         self.joints = () if loops is None else loops.joints
         for j in self.joints:
@@ -91,6 +92,8 @@ class _Sim:
         self.drive_columns = np.array([robot.velocity_names.index(j) for j in spins], dtype=int)
         self.n_loop = 0 if loops is None else loops.size
         self.hold_margin = HOLD_MARGIN  # the continuous loop holds ends within a step (inf) and switches at events
+        # the steering targets are the IK's own (no policy, range, linkage or gear to apply): plain floats suffice
+        self.plain = plant.policy == "closest" and not (self.limited or self.linked)
 
     def commands(self, twist: np.ndarray, beta: np.ndarray, hold_margin: float | None = None,
                  ik: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> _Commands:
@@ -108,6 +111,19 @@ class _Sim:
             target = np.where(self.passive, target, heading + math.pi / 2 - self.delta)
         spin = np.where(self.passive, spin_all[self.wheel_of_steer], unit_spin(rates, self.spin_columns))
         return _Commands(target, rates, spin, fits)
+
+    def castor_rates(self, twist: np.ndarray, beta: np.ndarray) -> np.ndarray:
+        """The castors' steering rates (8.24) ``(n_castors,)`` [rad/s] at `twist` and steering `beta`
+        (:func:`checked_castor_rates`: a few µs)."""
+        return np.array(checked_castor_rates(self.robot, twist, beta, self.castor_elements))
+
+    def targets(self, twist: np.ndarray, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`commands`' steering targets and fits alone: for a :attr:`plain` plant the IK's configuration in
+        plain floats (:func:`checked_steering_config`, a few µs instead of the rates' hundred), every wheel fitting."""
+        if self.plain:
+            return np.array(checked_steering_config(self.robot, twist, beta)), np.ones(len(beta), dtype=bool)
+        cmd = self.commands(twist, beta)
+        return cmd.target, cmd.fits
 
     def realised(self, twist: np.ndarray, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The ideal plant's twist and which steered wheels fit their ranges: the commanded twist, or, when a wheel

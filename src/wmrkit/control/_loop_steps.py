@@ -125,6 +125,9 @@ def _given_steering(controller, sim: _Sim, t: float, x: np.ndarray, split) -> tu
         return out, False
     pose, integral, beta, _ = split(x)
     twist, _ = controller(t, pose, integral)
+    if sim.plain:  # the IK's angles, nothing held
+        out[:len(beta)][steered] = sim.targets(twist, beta)[0][steered]
+        return out, False
     ik = checked_rates(sim.robot, twist, beta)
     cmd = sim.commands(twist, beta, HOLD_MARGIN, ik)
     target = cmd.target
@@ -145,10 +148,10 @@ def _record(controller, sim: _Sim, t: float, x: np.ndarray, split) -> dict:
 def _record_held(sim: _Sim, t: float, x: np.ndarray, split, twist: np.ndarray, prev: np.ndarray) -> dict:
     pose, _, beta, ls = split(x)
     beta = np.where(sim.passive, beta, prev)  # castors: integrated state; steered wheels: the last angle given
-    cmd = sim.commands(twist, beta)
-    actual = sim.actual_beta(cmd.target, beta, ls)
+    target, fits = sim.targets(twist, beta)
+    actual = sim.actual_beta(target, beta, ls)
     out = {"t": t, "pose": pose.copy(), "twist": np.asarray(twist, dtype=float), "beta": actual,
-           "target": cmd.target, "in_range": cmd.fits}
+           "target": target, "in_range": fits}
     if sim.plant.loops is None:  # the ideal plant: the twist its wheels move it with (the loops add their lag)
         out["moved"] = sim.realised(out["twist"], actual)[0]
     return out

@@ -24,7 +24,6 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..kinematics.wheel_ik import checked_rates
 from ..robot import Robot
 from ._loop_plant import HOLD_MARGIN, Plant, _Sim
 from ._loop_steps import (
@@ -162,7 +161,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
                           math.sin(th) * moving[0] + math.cos(th) * moving[1], moving[2]])
         dbeta = np.zeros(n_s)
         if sim.passive.any():  # castors turn by themselves (8.24): integrate at the actual twist
-            dbeta[sim.passive] = checked_rates(robot, moving, actual_beta)[0][sim.castor_rate_columns]
+            dbeta[sim.passive] = sim.castor_rates(moving, actual_beta)
         dls = ls[:0] if plant.loops is None else plant.loops.derivative(ls, sim.joint_commands(cmd))
         return np.concatenate([dpose, de if held is None else np.zeros(3), dbeta, dls])
 

@@ -100,6 +100,8 @@ class PathIndex:
         seg = np.hypot(*np.diff(self.xy, axis=0).T)
         self.s = np.concatenate([[0.0], np.cumsum(seg)])
         self.half = 0.5 * seg
+        self._t = np.array(reference.t, dtype=float)  # writable: the compiled search's signature
+        self._last: tuple[tuple[float, ...], tuple[float, float, float]] = ((math.nan,), (0.0, 0.0, 0.0))
         self.window = window
         # a round-off guard [m] of distances between its points (ties at a corner): above the coordinates' rounding
         # (1e-16 of them) at any size, far below any length the followers use (1e-9 of a 1 mm path)
@@ -125,54 +127,17 @@ class PathIndex:
         left = max(float(self.s[-1]) - s, to_end, 0.0)
         return 1.0 if left >= length else max(math.sqrt(left / length), APPROACH_FLOOR)
 
-    def _feet(self, point: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Distance [m] from `point` to segments `j` (segment ``j`` joins samples ``j`` and ``j + 1``) and the
-        fraction ``u`` along each of its foot."""
-        a, d = self.xy[j], self.xy[j + 1] - self.xy[j]
-        n2 = np.sum(d * d, axis=1)
-        u = np.clip(np.sum((point - a) * d, axis=1) / np.where(n2 > 0, n2, 1.0), 0.0, 1.0)
-        return np.hypot(*(point - a - u[:, None] * d).T), u
-
-    def _below(self, point: np.ndarray, lo: int, hi: int) -> np.ndarray:
-        """A lower bound [m] of the distance from `point` to each of segments ``lo .. hi - 1``: the nearer end's,
-        less half the segment's length (its foot is within that of one end)."""
-        d = np.hypot(*(self.xy[lo:hi + 1] - point).T)
-        return np.minimum(d[:-1], d[1:]) - self.half[lo:hi]
-
     def _segment(self, point: np.ndarray, t: float) -> tuple[int, float]:
         """The segment ``j`` of the path nearest to `point` near time `t` and its foot's fraction ``u``: among the
         segments within ``window`` s of `t`, and beyond either end of that window as long as the path stays within
         twice the window's nearest sample's distance of `point` (a robot ahead of or behind the reference's time:
         the path it is near may leave the window through a corner; that nearer part of the path is found, not the
-        far side of the corner inside the window). Ties between adjacent segments (a corner): the segment ahead."""
-        m = len(self.xy) - 1  # segments
-        lo, hi = (int(k) for k in np.searchsorted(self.ref.t, [t - self.window, t + self.window]))
-        lo = min(lo, m - 1)  # past the reference's end (where it rests): its last segment
-        hi = min(max(hi, lo + 1), m)
-        d = np.hypot(*(self.xy[lo:hi + 1] - point).T)
-        reach, first, last = 2.0 * float(d.min()) + self.tie, lo, hi
-        width = max(hi - lo, 2)
-        while lo > 0 and self._below(point, lo - 1, lo)[0] <= reach:  # the path before the window, within reach
-            start = max(lo - width, 0)
-            far = np.flatnonzero(self._below(point, start, lo) > reach)
-            lo = start + (int(far[-1]) + 1 if len(far) else 0)
-            if len(far):
-                break
-        while hi < m and self._below(point, hi, hi + 1)[0] <= reach:  # and after it
-            stop = min(hi + width, m)
-            far = np.flatnonzero(self._below(point, hi, stop) > reach)
-            hi = hi + int(far[0]) if len(far) else stop
-            if len(far):
-                break
-        if (lo, hi) != (first, last):
-            d = np.hypot(*(self.xy[lo:hi + 1] - point).T)
-        below = np.minimum(d[:-1], d[1:]) - self.half[lo:hi]
-        near = lo + np.flatnonzero(below <= d.min())  # the segments that may hold the nearest point
-        dist, u = self._feet(point, near)
-        k = int(np.argmin(dist))
-        while k + 1 < len(near) and near[k + 1] == near[k] + 1 and dist[k + 1] <= dist[k] + self.tie:  # a corner's tie
-            k += 1
-        return int(near[k]), float(u[k])
+        far side of the corner inside the window). Ties between adjacent segments (a corner): the segment ahead.
+        One compiled pass (:func:`._path_kernel.nearest_segment`): a few µs a call."""
+        from ._path_kernel import nearest_segment
+
+        return nearest_segment(self.xy, self.half, self._t, float(point[0]), float(point[1]), float(t),
+                               float(self.window), self.tie)
 
     def done(self, point: np.ndarray, s: float, heading: float | None = None, previous: np.ndarray | None = None,
              steps: int = 0, aim: float = 0.0) -> bool:
@@ -200,14 +165,20 @@ class PathIndex:
 
     def project(self, point: np.ndarray, t: float) -> tuple[float, float, float]:
         """Continuous projection of `point` on the path near time `t` (:meth:`_segment`): ``(s [m], chi [rad],
-        e [m], signed, left positive)``, the foot's arc length, its segment's direction and the signed distance."""
+        e [m], signed, left positive)``, the foot's arc length, its segment's direction and the signed distance.
+        The last query's answer is kept: a loop's record asks it again of the same point (its stop rule)."""
+        key = (float(point[0]), float(point[1]), float(t))
+        if key == self._last[0]:
+            return self._last[1]
         j, u = self._segment(point, t)
-        d = self.xy[j + 1] - self.xy[j]
-        length = float(np.hypot(*d))
-        chi = math.atan2(d[1], d[0]) if length > 0 else self.tangent(j)
-        q = self.xy[j] + u * d
-        e = float((point - q) @ np.array([-math.sin(chi), math.cos(chi)]))
-        return float(self.s[j] + u * length), chi, e
+        x0, y0 = self.xy[j]
+        dx, dy = self.xy[j + 1, 0] - x0, self.xy[j + 1, 1] - y0
+        length = math.hypot(dx, dy)
+        chi = math.atan2(dy, dx) if length > 0 else self.tangent(j)
+        e = (key[0] - (x0 + u * dx)) * -math.sin(chi) + (key[1] - (y0 + u * dy)) * math.cos(chi)
+        out = (float(self.s[j] + u * length), chi, float(e))
+        self._last = (key, out)
+        return out
 
     def point_at(self, s: float) -> np.ndarray:
         """Path point at arc length `s` [m] (clamped to the start; beyond the end, on the end's tangent: pure
