@@ -108,3 +108,20 @@ def test_pure_pursuit_looks_a_wheelbase_ahead_by_default(capsys):
     assert main(["track", "diff-drive", "--reference", "line", "--controller", "pure-pursuit", "--duration", "1",
                  "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["lookahead"] == 1.0
+
+
+@pytest.mark.parametrize("name", ["circle", "square", "line"])
+def test_the_compiled_search_projects_on_the_brute_force_nearest_point(name):
+    """:meth:`PathIndex.project` (one compiled pass, :mod:`wmrkit.control._path_kernel`) on points up to about 0.5 m
+    off the path within 2 s of their time: the arc length and distance of the nearest point over every segment (not
+    within 5 s of the ends: the circle and the square close there, and the path near the other end is not
+    searched). Past the interpret budget (the first calls run as Python): the Python and the compiled search."""
+    ref = builtin_reference(name)
+    path, rng = PathIndex(ref), np.random.default_rng(5)
+    for _ in range(200):
+        k = int(rng.integers(500, len(ref.t) - 500))  # samples of 0.01 s
+        point, t = ref.pose[k, :2] + rng.normal(0.0, 0.2, 2), float(ref.t[k] + rng.uniform(-2.0, 2.0))
+        s = path.project(point, t)[0]
+        s_true, dist = _brute_force(ref.pose[:, :2], point)
+        assert float(np.hypot(*(path.point_at(s) - point))) == pytest.approx(dist, abs=1e-9)
+        assert s == pytest.approx(s_true, abs=1e-9) or name == "square"  # a square's corner: either leg, as near

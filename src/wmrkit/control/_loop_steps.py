@@ -30,7 +30,7 @@ def check_diverged(twist: np.ndarray, t: float, sampled: bool = True) -> None:
     """Refuse a law's twist beyond ``limits.MAX_QUERY_RATE`` at `t` in a kinematic loop: no wheel command is defined
     there (:func:`wheel_commands` refuses it), the loop has diverged. Not `sampled` (a continuous loop): no period
     to lower."""
-    if not np.all(np.abs(twist) <= MAX_QUERY_RATE):  # NaN included
+    if not all(abs(v) <= MAX_QUERY_RATE for v in np.asarray(twist, dtype=float).tolist()):  # NaN included; floats
         raise StoppedRun(f"the closed loop diverged at t = {t:.6g} s: the law commands the twist "
                          f"{tuple(float(v) for v in twist)}, beyond {MAX_QUERY_RATE:g} m/s or rad/s; "
                          f"{LAW_ADVICE if sampled else 'lower the gain'}", t)

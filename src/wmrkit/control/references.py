@@ -59,21 +59,23 @@ class Reference:
         ts = self.t
         if t > ts[-1]:
             return self.pose[-1].copy(), np.zeros(3)
-        k = min(max(int(np.searchsorted(ts, t, side="right")) - 1, 0), len(ts) - 2)
-        h = ts[k + 1] - ts[k]
-        corner = next((b for b in self.breaks if ts[k] < b <= ts[k + 1]), None)
+        k = min(max(int(ts.searchsorted(t, side="right")) - 1, 0), len(ts) - 2)
+        t0, t1 = ts[k:k + 2].tolist()
+        h = t1 - t0
+        corner = next((b for b in self.breaks if t0 < b <= t1), None) if self.breaks else None
         if corner is not None:  # a corner inside the interval: Taylor from the sample on t's side of it
             j = k if t < corner else k + 1
             dt = t - ts[j]
             p, v, a = self.pose[j], self.velocity[j], self.acceleration[j]
             return p + dt * v + (0.5 * dt * dt) * a, v + dt * a
-        u = min(max((t - ts[k]) / h, 0.0), 1.0)
+        u = min(max((t - t0) / h, 0.0), 1.0)
         u2, u3 = u * u, u * u * u
         h00, h10, h01, h11 = 2 * u3 - 3 * u2 + 1, u3 - 2 * u2 + u, -2 * u3 + 3 * u2, u3 - u2
-        p, v, a = self.pose, self.velocity, self.acceleration
-        pose = h00 * p[k] + (h10 * h) * v[k] + h01 * p[k + 1] + (h11 * h) * v[k + 1]
-        vel = h00 * v[k] + (h10 * h) * a[k] + h01 * v[k + 1] + (h11 * h) * a[k + 1]
-        return pose, vel
+        # in floats, the operations of the arrays' (a few µs instead of tens: the loop asks it at every evaluation)
+        (p0, p1), (v0, v1), (a0, a1) = (x[k:k + 2].tolist() for x in (self.pose, self.velocity, self.acceleration))
+        pose = [h00 * p0[i] + (h10 * h) * v0[i] + h01 * p1[i] + (h11 * h) * v1[i] for i in range(3)]
+        vel = [h00 * v0[i] + (h10 * h) * a0[i] + h01 * v1[i] + (h11 * h) * a1[i] for i in range(3)]
+        return np.array(pose), np.array(vel)
 
     def sample(self, t: np.ndarray) -> np.ndarray:
         """Poses at times `t` ``(m,) -> (m, 3)`` (linear interpolation, held after the end)."""

@@ -101,6 +101,7 @@ class PathIndex:
         self.s = np.concatenate([[0.0], np.cumsum(seg)])
         self.half = 0.5 * seg
         self._t = np.array(reference.t, dtype=float)  # writable: the compiled search's signature
+        self._search: Callable[..., tuple[int, float]] | None = None
         self._last: tuple[tuple[float, ...], tuple[float, float, float]] = ((math.nan,), (0.0, 0.0, 0.0))
         self.window = window
         # a round-off guard [m] of distances between its points (ties at a corner): above the coordinates' rounding
@@ -134,9 +135,11 @@ class PathIndex:
         the path it is near may leave the window through a corner; that nearer part of the path is found, not the
         far side of the corner inside the window). Ties between adjacent segments (a corner): the segment ahead.
         One compiled pass (:func:`._path_kernel.nearest_segment`): a few µs a call."""
-        from ._path_kernel import nearest_segment
+        if self._search is None:  # imported at the first query: numba
+            from ._path_kernel import nearest_segment
 
-        return nearest_segment(self.xy, self.half, self._t, float(point[0]), float(point[1]), float(t),
+            self._search = nearest_segment
+        return self._search(self.xy, self.half, self._t, float(point[0]), float(point[1]), float(t),
                                float(self.window), self.tie)
 
     def done(self, point: np.ndarray, s: float, heading: float | None = None, previous: np.ndarray | None = None,
