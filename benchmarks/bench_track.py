@@ -7,7 +7,11 @@
 - the least-squares twist (4.11) of the car's rear spins, held at its stops (``_Sim.least_squares_twist``), against
   ``forward_kinematics`` on the same rates;
 - whole runs with the defaults (the car on the circle and the figure-eight, a diff drive and its castor on the circle,
-  swerve-4 on the square, thesis-steer-castor's castors): wall time against the reference's duration.
+  swerve-4 on the square, thesis-steer-castor's castors): wall time against the reference's duration;
+- the cost per output sample (every 0.05 s) of the forklift and the diff drive under the P law, pure pursuit and
+  Stanley (``examples/track_forklift.py``'s loop): CPU time, best of 3. No peer simulates these loops; the figures
+  of the same runs before the path search was compiled and the loop's IK and reference moved to plain floats
+  (commit 42ea6d6, this machine, same measure) are printed beside them (:data:`BEFORE_US`).
 """
 
 from __future__ import annotations
@@ -24,6 +28,13 @@ from wmrkit.control.steering import choose_steering
 from wmrkit.kinematics.wheel_ik import forward_kinematics, wheel_commands
 
 from ._harness import Result, best_time
+
+#: CPU µs per output sample of :func:`_per_sample`'s runs at commit 42ea6d6 (before the compiled path search and the
+#: plain-float IK, reference and checks of the continuous loop), best of 3 on the 2-core development machine.
+BEFORE_US = {("forklift", "circle", "p"): 522, ("forklift", "figure-eight", "p"): 508,
+             ("diff-drive", "circle", "p"): 1648, ("diff-drive", "figure-eight", "pure-pursuit"): 755,
+             ("diff-drive", "figure-eight", "stanley"): 1478, ("forklift", "figure-eight", "pure-pursuit"): 599,
+             ("forklift", "figure-eight", "stanley"): 597}
 
 
 def _evaluations(name: str, n: int) -> Result:
@@ -65,6 +76,26 @@ def _least_squares(n: int) -> Result:
                   best_time(general))
 
 
+def _per_sample(robot: str, reference: str, controller: str) -> Result:
+    """CPU time of one continuous run with the defaults, per output sample, beside its figure before."""
+    import warnings
+
+    bot, ref = catalog.load(robot), builtin_reference(reference)
+    track(bot, ref, controller=controller, duration=2.0)  # loads the compiled path search
+    best, samples = math.inf, 0
+    for _ in range(3):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # a follower's arrival: not what is timed
+            t0 = time.process_time()
+            samples = len(track(bot, ref, controller=controller).t)
+            best = min(best, time.process_time() - t0)
+    us = 1e6 * best / samples
+    before = BEFORE_US.get((robot, reference, controller))
+    note = f"{us:.0f} us/sample" + ("" if before is None else f"; 42ea6d6: {before} us/sample, {before / us:.1f}x")
+    return Result(f"track {robot} {reference} {controller}: CPU per sample", samples, best,
+                  "no peer simulates this loop", None, target=note)
+
+
 def run(quick: bool) -> list[Result]:
     """Per-evaluation costs against the general path, and whole continuous runs against real time."""
     n = 200 if quick else 2000
@@ -80,7 +111,8 @@ def run(quick: bool) -> list[Result]:
         duration = float(result.t[-1])
         # the ratio is how many times faster than real time; no target is stated for it
         out.append(Result(f"track {robot} {name} (continuous, defaults)", len(result.t), wall, "real time", duration))
-    return out
+    cases = list(BEFORE_US)[:3:2] if quick else list(BEFORE_US)
+    return out + [_per_sample(*case) for case in cases]
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .._shapes import readonly
 from ..kinematics import _ik_fast
 from ..kinematics._ik_fast import in_range_one, wrap_one
 from ..kinematics.linalg import solve_assigned
@@ -59,6 +60,8 @@ class _Sim:
         names = robot.steer_names
         types = [robot.wheel(n).type for n in names]
         self.passive = np.array([t in ("castor", "double_castor") for t in types], dtype=bool)
+        self.castors = bool(self.passive.any())
+        self._all_fit = readonly(np.ones(len(names), dtype=bool))  # every steered wheel within its range
         self.delta = np.array([robot.wheel(n).delta for n in names], dtype=float)
         self.ranges, self.spin_columns = steer_ranges(robot), spin_columns(robot)
         self.wheel_of_steer = np.array([robot.wheel_names.index(n) for n in names], dtype=int)
@@ -121,7 +124,7 @@ class _Sim:
         """:meth:`commands`' steering targets and fits alone: for a :attr:`plain` plant the IK's configuration in
         plain floats (:func:`checked_steering_config`, a few µs instead of the rates' hundred), every wheel fitting."""
         if self.plain:
-            return np.array(checked_steering_config(self.robot, twist, beta)), np.ones(len(beta), dtype=bool)
+            return np.array(checked_steering_config(self.robot, twist, beta)), self._all_fit
         cmd = self.commands(twist, beta)
         return cmd.target, cmd.fits
 
@@ -131,9 +134,9 @@ class _Sim:
         least-squares twist (4.11) of the actuated wheels' commanded rates at the steering reached (the wheels
         scrub: the robot cannot move as commanded)."""
         if not (self.limited or self.linked):
-            return twist, np.ones(len(self.ranges), dtype=bool)
+            return twist, self._all_fit
         if self.all_fit(checked_steering_config(self.robot, twist, beta)):  # no wheel is held or moved
-            return twist, np.ones(len(self.ranges), dtype=bool)
+            return twist, self._all_fit
         ik = checked_rates(self.robot, twist, beta)
         cmd = self.commands(twist, beta, ik=ik)
         off = np.abs(np.remainder(cmd.target - np.asarray(ik[1]) + math.pi / 2, math.pi) - math.pi / 2)

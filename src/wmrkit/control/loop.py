@@ -156,14 +156,17 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
             ls = plant.loops.settle_ideal(ls, sim.joint_commands(cmd))
             actual_beta = sim.actual_beta(cmd.target, beta, ls)
             moving = sim.plant_twist(twist, cmd, actual_beta, ls)
-        th = pose[2]
-        dpose = np.array([math.cos(th) * moving[0] - math.sin(th) * moving[1],
-                          math.sin(th) * moving[0] + math.cos(th) * moving[1], moving[2]])
-        dbeta = np.zeros(n_s)
-        if sim.passive.any():  # castors turn by themselves (8.24): integrate at the actual twist
-            dbeta[sim.passive] = sim.castor_rates(moving, actual_beta)
-        dls = ls[:0] if plant.loops is None else plant.loops.derivative(ls, sim.joint_commands(cmd))
-        return np.concatenate([dpose, de if held is None else np.zeros(3), dbeta, dls])
+        out = np.zeros(len(x))  # d pose, d integral, d beta, d loops
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        m0, m1, m2 = np.asarray(moving, dtype=float).tolist()
+        out[:3] = c * m0 - s * m1, s * m0 + c * m1, m2
+        if held is None:
+            out[3:6] = de
+        if sim.castors:  # castors turn by themselves (8.24): integrate at the actual twist
+            out[6:6 + n_s][sim.passive] = sim.castor_rates(moving, actual_beta)
+        if plant.loops is not None:
+            out[6 + n_s:] = plant.loops.derivative(ls, sim.joint_commands(cmd))
+        return out
 
     if period is None:
         t_out = np.arange(0.0, duration + 1e-9, output_dt)
