@@ -30,11 +30,12 @@ from wmrkit.kinematics.wheel_ik import forward_kinematics, wheel_commands
 from ._harness import Result, best_time
 
 #: CPU µs per output sample of :func:`_per_sample`'s runs at commit 42ea6d6 (before the compiled path search and the
-#: plain-float IK, reference and checks of the continuous loop), best of 3 on the 2-core development machine.
-BEFORE_US = {("forklift", "circle", "p"): 522, ("forklift", "figure-eight", "p"): 508,
-             ("diff-drive", "circle", "p"): 1648, ("diff-drive", "figure-eight", "pure-pursuit"): 755,
-             ("diff-drive", "figure-eight", "stanley"): 1478, ("forklift", "figure-eight", "pure-pursuit"): 599,
-             ("forklift", "figure-eight", "stanley"): 597}
+#: plain-float IK, reference and checks of the continuous loop), best of 6 on the 2-core development machine at load
+#: 2.5-3 (measured interleaved with this code's runs; at load 5 both were 1.3-2x slower, the old more).
+BEFORE_US = {("forklift", "circle", "p"): 299, ("forklift", "figure-eight", "p"): 297,
+             ("diff-drive", "circle", "p"): 1028, ("diff-drive", "figure-eight", "pure-pursuit"): 629,
+             ("diff-drive", "figure-eight", "stanley"): 1083, ("forklift", "figure-eight", "pure-pursuit"): 447,
+             ("forklift", "figure-eight", "stanley"): 392}
 
 
 def _evaluations(name: str, n: int) -> Result:

@@ -49,6 +49,17 @@ def _below(xy, half, j, px, py):
 
 
 @numba.njit(inline="always")
+def _beyond(xy, half, j, px, py, reach):
+    """Whether :func:`_below` of segment `j` exceeds `reach` [m]: squared distances decide where they surely do
+    (no root), :func:`_below` itself elsewhere."""
+    dx0, dy0, dx1, dy1 = xy[j, 0] - px, xy[j, 1] - py, xy[j + 1, 0] - px, xy[j + 1, 1] - py
+    cut = (reach + half[j]) * (1.0 + 1e-9)
+    if reach + half[j] >= 0 and min(dx0 * dx0 + dy0 * dy0, dx1 * dx1 + dy1 * dy1) > cut * cut:
+        return True
+    return _below(xy, half, j, px, py) > reach
+
+
+@numba.njit(inline="always")
 def _foot(xy, j, px, py):
     """Distance [m] from `(px, py)` to segment `j` and the fraction ``u`` along it of its foot."""
     ax, ay = xy[j, 0], xy[j, 1]
@@ -73,22 +84,22 @@ def nearest_segment(xy, half, ts, px, py, t, window, tie):
     near = _nearest(xy, lo, hi + 1, px, py, math.inf)
     reach = 2.0 * near + tie
     width = max(hi - lo, 2)
-    while lo > 0 and _below(xy, half, lo - 1, px, py) <= reach:  # the path before the window, within reach
+    while lo > 0 and not _beyond(xy, half, lo - 1, px, py, reach):  # the path before the window, within reach
         start = max(lo - width, 0)
         far = -1
         for j in range(lo - 1, start - 1, -1):
-            if _below(xy, half, j, px, py) > reach:
+            if _beyond(xy, half, j, px, py, reach):
                 far = j
                 break
         if far >= 0:
             lo = far + 1
             break
         lo = start
-    while hi < m and _below(xy, half, hi, px, py) <= reach:  # and after it
+    while hi < m and not _beyond(xy, half, hi, px, py, reach):  # and after it
         stop = min(hi + width, m)
         far = -1
         for j in range(hi, stop):
-            if _below(xy, half, j, px, py) > reach:
+            if _beyond(xy, half, j, px, py, reach):
                 far = j
                 break
         if far >= 0:
@@ -98,16 +109,12 @@ def nearest_segment(xy, half, ts, px, py, t, window, tie):
     near = _nearest(xy, last + 1, hi + 1, px, py, _nearest(xy, lo, first, px, py, near))  # the extended range's
     best, best_d, best_u = -1, math.inf, 0.0  # the segments that may hold the nearest point: the first nearest
     for j in range(lo, hi):
-        dx0, dy0, dx1, dy1 = xy[j, 0] - px, xy[j, 1] - py, xy[j + 1, 0] - px, xy[j + 1, 1] - py
-        cut = (near + half[j]) * (1.0 + 1e-9)  # surely farther than its bound allows: squares decide, no root
-        if min(dx0 * dx0 + dy0 * dy0, dx1 * dx1 + dy1 * dy1) > cut * cut:
-            continue
-        if _below(xy, half, j, px, py) <= near:
+        if not _beyond(xy, half, j, px, py, near):
             d, u = _foot(xy, j, px, py)
             if d < best_d:
                 best, best_d, best_u = j, d, u
     j = best
-    while j + 1 < hi and _below(xy, half, j + 1, px, py) <= near:  # a corner's tie: the segment ahead
+    while j + 1 < hi and not _beyond(xy, half, j + 1, px, py, near):  # a corner's tie: the segment ahead
         d, u = _foot(xy, j + 1, px, py)
         if not d <= best_d + tie:
             break
