@@ -1,7 +1,7 @@
 """The continuous control loop (``wmrkit track`` without ``--period``): the cost of one evaluation, and whole runs.
 
 - one evaluation's wheel commands, ``_Sim.commands`` (the IK and the steering choice with the loop's checked
-  arguments, :func:`~wmrkit.kinematics.wheel_ik.checked_rates` and :func:`~wmrkit.control.steering.checked_steering`)
+  arguments, :func:`~wmrkit.kinematics.loop_ik.checked_rates` and :func:`~wmrkit.control.steering.checked_steering`)
   against the general path measured in the same run, ``wheel_commands`` + ``choose_steering`` on the same twist and
   steering (what the loop called before), for the car (its front wheels at their stops) and a swerve-4;
 - the least-squares twist (4.11) of the car's rear spins, held at its stops (``_Sim.least_squares_twist``), against

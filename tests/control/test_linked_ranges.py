@@ -75,7 +75,7 @@ def test_a_turn_sharper_than_the_stops_holds_the_linkage_at_the_stop_of_that_tur
     The linkage is held at the stop of that turn: the inner wheel at +-0.5, the outer one by the law (closed form),
     the wheels rolling forward. Before, the leader fl alone chose the end nearest its own roots: for the left turn
     the right stop (fl at -0.381, fr at -0.5), and the car turned away from its reference."""
-    from wmrkit.kinematics.wheel_ik import checked_rates
+    from wmrkit.kinematics.loop_ik import checked_rates
 
     robot = _ranged_car()
     rates, beta, _ = checked_rates(robot, np.array([0.1, 0.0, omega]), np.array(robot.beta, dtype=float))

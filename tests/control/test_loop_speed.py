@@ -30,7 +30,7 @@ from wmrkit import Robot, catalog
 from wmrkit.control import Plant, builtin_reference, forklift_real_loops, track
 from wmrkit.control._loop_plant import AXLE_TOL
 from wmrkit.control.loop import _Sim
-from wmrkit.kinematics.wheel_ik import checked_rates, checked_steering_config
+from wmrkit.kinematics.loop_ik import checked_rates, checked_steering_config
 
 RUNS = {"ackermann circle": ("ackermann", "circle", {"duration": 12.0}),
         "ackermann figure-eight gain 3": ("ackermann", "figure-eight", {"duration": 8.0, "gain": 3.0}),

@@ -16,7 +16,8 @@ from wmrkit import catalog
 from wmrkit.control import builtin_reference, control_point, track
 from wmrkit.control.trackers import EPS_FRACTION, default_wheelbase
 from wmrkit.kinematics import _ik_fast
-from wmrkit.kinematics.wheel_ik import checked_castor_rates, wheel_commands
+from wmrkit.kinematics.loop_ik import checked_castor_rates
+from wmrkit.kinematics.wheel_ik import wheel_commands
 
 
 def test_stanley_s_cross_track_error_on_a_line_obeys_its_ode():

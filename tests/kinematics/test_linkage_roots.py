@@ -24,8 +24,9 @@ from hypothesis import strategies as st
 from wmrkit import Robot, catalog
 from wmrkit.kinematics.codegen import write_code
 from wmrkit.kinematics.linkage_check import LinkageAngleWarning
+from wmrkit.kinematics.loop_ik import checked_steering_config
 from wmrkit.kinematics.realtime import realtime
-from wmrkit.kinematics.wheel_ik import checked_steering_config, forward_kinematics_check, wheel_commands
+from wmrkit.kinematics.wheel_ik import forward_kinematics_check, wheel_commands
 
 from .test_codegen import load_module
 from .test_linkage_ik import ackermann_car, synchro

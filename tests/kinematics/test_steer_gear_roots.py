@@ -19,8 +19,9 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from wmrkit import Robot
+from wmrkit.kinematics.loop_ik import checked_steering_config
 from wmrkit.kinematics.realtime import realtime
-from wmrkit.kinematics.wheel_ik import checked_steering_config, forward_kinematics, wheel_commands
+from wmrkit.kinematics.wheel_ik import forward_kinematics, wheel_commands
 
 ULPS = 2 * float(np.spacing(2 * np.pi))  # atan2 of the plain-float and SIMD paths (tests/kinematics/test_linkage_roots)
 

@@ -15,7 +15,8 @@ from .._shapes import readonly
 from ..kinematics import _ik_fast
 from ..kinematics._ik_fast import in_range_one, wrap_one
 from ..kinematics.linalg import solve_assigned
-from ..kinematics.wheel_ik import checked_castor_rates, checked_rates, checked_steering_config, forward_kinematics
+from ..kinematics.loop_ik import checked_castor_rates, checked_rates, checked_steering_config
+from ..kinematics.wheel_ik import forward_kinematics
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
 from .actuators import LowLevelLoops

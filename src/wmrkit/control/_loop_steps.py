@@ -8,7 +8,7 @@ import itertools
 
 import numpy as np
 
-from ..kinematics.wheel_ik import checked_rates
+from ..kinematics.loop_ik import checked_rates
 from ..limits import MAX_QUERY_RATE, MAX_SPEED
 from ..wheels import wrap_angle
 from ._loop_plant import HOLD_MARGIN, _Sim
