@@ -25,6 +25,8 @@ from ..wheels import heading_from_beta, heading_in_range, wrap_angle
 TWO_PI = 2.0 * math.pi
 #: Turns of a gear's first wheel tried either way in :meth:`LinkedRanges.settle`.
 GEAR_TURNS = 2
+#: Refits of a gear's least-squares turn from its current one at most (:func:`_local_fit`; one or two in practice).
+LOCAL_REFITS = 16
 
 
 @dataclass(frozen=True)
@@ -74,24 +76,27 @@ class LinkedRanges:
                 narrowed[lead] = arc
         return cls(tuple(links), leaders, np.array([k.follower for k in links], dtype=int), narrowed, tuple(gears))
 
-    def settle(self, heading: np.ndarray, rest: np.ndarray) -> None:
-        """Set, in place, each gear's leader in `heading` ``(n_steer,)`` [rad] at the least-squares turn ``u = k .
-        d / k . k`` of the headings asked of its wheels, ``d`` their turns from the `rest` headings (the least
-        -squares fit :func:`wmrkit.couplings.gear_fill` makes of given rates): the gear's motion nearest to them.
-        A heading is an orientation: each wheel's turn is taken by whole turns nearest the gear's at a turn that puts
-        its first wheel at its heading (:data:`GEAR_TURNS` of those tried either way), the fit whose headings miss
-        the asked ones least kept (ties: the smallest turn). Before, each turn was wrapped to (-pi, pi] on its own:
-        1:2 units asked on the gear at u = 2 rad (the rear at 4 rad, read -2.28) were fitted at u = -0.51."""
+    def settle(self, heading: np.ndarray, rest: np.ndarray, current: np.ndarray | None = None,
+               hold: bool = False) -> None:
+        """Set, in place, each gear's leader in `heading` ``(n_steer,)`` [rad] at a least-squares turn ``u = k . d /
+        k . k`` of the headings asked of its wheels, ``d`` their turns from the `rest` headings (the least-squares fit
+        :func:`wmrkit.couplings.gear_fill` makes of given rates): the gear's motion nearest to them. A heading is an
+        orientation, so the miss ``sum((k u - d) mod 2 pi)^2`` has a fit per whole turn of each wheel: the best one
+        (:func:`_best_fit`), or, with the `current` headings (on the gear), the fit reached from the gear's turn there
+        (:func:`_local_fit`, continuous along a run) when it misses as little, or always when `hold` (the gear turns
+        continuously: it leaves its fit only where that fit ends, a wheel half a turn from the heading asked).
+
+        Before, the best fit was taken at every call: where two fits miss alike (1:2 units whose rear is asked half a
+        turn off twice the front: ``u = d0 +- 2 pi / 5``) it jumped 144 deg back and forth, and the continuous loop of
+        ``track examples/robots/geared.json --reference circle --size 3`` slid along that tie (steps of 1e-6 s at
+        t = 3.76 s) until 'too stiff' after 2 min of computing."""
         for idx, k in self.gears:
             d = np.remainder(heading[idx] - rest[idx] + math.pi, TWO_PI) - math.pi
-            best, miss = 0.0, math.inf
-            for m in range(-GEAR_TURNS, GEAR_TURNS + 1):
-                anchor = (d[0] + TWO_PI * m) / k[0]
-                turn = d + TWO_PI * np.round((k * anchor - d) / TWO_PI)
-                u = float(k @ turn) / float(k @ k)
-                off = float(np.sum((np.remainder(k * u - d + math.pi, TWO_PI) - math.pi) ** 2))
-                if off < miss - 1e-12 or (off <= miss + 1e-12 and abs(u) < abs(best)):
-                    best, miss = u, min(off, miss)
+            best, miss = _best_fit(k, d)
+            if current is not None:
+                local = _local_fit(k, d, float(current[idx[0]] - rest[idx[0]]) / float(k[0]))
+                if hold or _miss(k, local, d) <= miss + 1e-12:
+                    best = local
             heading[idx[0]] = rest[idx[0]] + k[0] * best
 
     def held_end(self, lead: int, asked: np.ndarray, current: float, kept: float, margin: float) -> float:
@@ -124,6 +129,41 @@ class LinkedRanges:
             reverse[link.follower] = abs(math.remainder(f - heading[link.follower], TWO_PI)) > 0.5 * math.pi
             heading[link.follower] = f
         return reverse
+
+
+def _miss(k: np.ndarray, u: float, d: np.ndarray) -> float:
+    """The squared misses [rad^2] of a gear's headings at turn `u` from the turns `d` asked (each mod 2 pi)."""
+    return float(np.sum((np.remainder(k * u - d + math.pi, TWO_PI) - math.pi) ** 2))
+
+
+def _best_fit(k: np.ndarray, d: np.ndarray) -> tuple[float, float]:
+    """The least-squares turn of ratios `k` to the turns `d` asked whose headings miss them least, and that miss: each
+    wheel's turn by the whole turns nearest the gear's at a turn that puts its first wheel at its heading
+    (:data:`GEAR_TURNS` of those tried either way; ties: the smallest turn). Before, each turn was wrapped to (-pi,
+    pi] on its own: 1:2 units asked on the gear at u = 2 rad (the rear at 4 rad, read -2.28) were fitted at -0.51."""
+    best, miss = 0.0, math.inf
+    for m in range(-GEAR_TURNS, GEAR_TURNS + 1):
+        anchor = (d[0] + TWO_PI * m) / k[0]
+        turn = d + TWO_PI * np.round((k * anchor - d) / TWO_PI)
+        u = float(k @ turn) / float(k @ k)
+        off = _miss(k, u, d)
+        if off < miss - 1e-12 or (off <= miss + 1e-12 and abs(u) < abs(best)):
+            best, miss = u, min(off, miss)
+    return best, miss
+
+
+def _local_fit(k: np.ndarray, d: np.ndarray, u: float) -> float:
+    """The least-squares turn of ratios `k` to the turns `d` asked reached from turn `u` [rad]: each wheel's turn by
+    the whole turns nearest the gear's at `u`, refitted until they hold (the miss decreases at each refit, so it
+    stops, at most :data:`LOCAL_REFITS` times). It moves continuously with `d` while that fit exists: the gear's
+    branch along a run."""
+    kk = float(k @ k)
+    for _ in range(LOCAL_REFITS):
+        fitted = float(k @ (d + TWO_PI * np.round((k * u - d) / TWO_PI))) / kk
+        if fitted == u:
+            break
+        u = fitted
+    return u
 
 
 def _linkage_links(robot: Robot) -> list[_Link]:

@@ -194,7 +194,8 @@ def range_keeper(robot: Robot, policy: str = "closest") -> Callable[..., np.ndar
     The wheels of a ``linkage``, or of a ``gear`` between steering joints, are not kept one by
     one (that breaks it): its leader is kept within the arc where every wheel held with it fits its range, and the
     followers are set from it by the linkage's law or the gear's ratios (:class:`.linked_ranges.LinkedRanges`; a
-    gear's leader first at the gear's least-squares turn to the headings asked),
+    gear's leader first at the gear's least-squares turn to the headings asked: the one reached from the
+    `current` turn, always with a `hold_margin`, else when no other misses less),
     their spins negated where they turn half round; when the leader is held at an end of that arc, none of those
     wheels fitted, and the end is the one nearer the headings asked of them all
     (:meth:`.linked_ranges.LinkedRanges.held_end`)."""
@@ -211,7 +212,7 @@ def range_keeper(robot: Robot, policy: str = "closest") -> Callable[..., np.ndar
     def keep(heading: np.ndarray, rates: np.ndarray, current: np.ndarray, hold_margin: float = 0.0) -> np.ndarray:
         fits, reversed_ = np.ones(len(heading), dtype=bool), np.zeros(len(heading), dtype=bool)
         if links is not None:
-            links.settle(heading, rest)
+            links.settle(heading, rest, current, hold_margin > 0)
         asked = heading.copy()
         if chosen.any():  # the IK's headings and spins (finite), the policy checked above
             heading[chosen], _, fits[chosen], reversed_[chosen] = checked_steering(
