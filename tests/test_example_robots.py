@@ -6,9 +6,7 @@ that names one runs and says what the page quotes."""
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
 import re
 import shlex
 
@@ -42,16 +40,6 @@ def test_each_example_robot_has_a_documented_command():
         assert (ROOT / "examples" / "robots" / name).is_file()
 
 
-@contextlib.contextmanager
-def _at_root():
-    cwd = os.getcwd()
-    os.chdir(ROOT)
-    try:
-        yield
-    finally:
-        os.chdir(cwd)
-
-
 #: What the pages say each command answers: its exit code and a piece of its output or warning they quote.
 SAYS = {("ik", "geared.json"): (1, "feasible: NO (a steering gear cannot set these headings)"),
         ("ik", "synchro.yaml"): (1, "linkage(a.steer, b.steer, c.steer) (law parallel) sets a at heading -2.63485 deg "
@@ -63,13 +51,13 @@ SAYS = {("ik", "geared.json"): (1, "feasible: NO (a steering gear cannot set the
 
 
 @pytest.mark.parametrize(("page", "command"), COMMANDS, ids=[c for _, c in COMMANDS])
-def test_a_documented_command_on_an_example_robot_runs(page, command, capsys):
+def test_a_documented_command_on_an_example_robot_runs(page, command, capsys, monkeypatch):
     """Each answers as its page says (an answer that is no, 1, for ik's 'feasible: NO'), never an error, and says
     what the page quotes of it."""
     argv = shlex.split(command)[1:]
     code, said = SAYS[argv[0], argv[1].rpartition("/")[2]]
-    with _at_root():
-        assert main(argv) == code, (page, command, capsys.readouterr().err)
+    monkeypatch.chdir(ROOT)
+    assert main(argv) == code, (page, command, capsys.readouterr().err)
     out, err = capsys.readouterr()
     assert "wmrkit: error" not in err and said in out + err, (page, command, out, err)
 
@@ -83,7 +71,7 @@ def _heading(px: float, py: float, vx: float, vy: float, omega: float) -> float:
     return math.degrees(math.atan2(vy + omega * px, vx - omega * py))
 
 
-def test_the_geared_units_turn_their_steering_1_to_2_and_ik_holds_them_to_it(capsys):
+def test_the_geared_units_turn_their_steering_1_to_2_and_ik_holds_them_to_it(capsys, monkeypatch):
     """docs/wheel-ik.md: units at (0.3, 0.2) and (-0.3, -0.2) m whose steering a gear turns 1:2; asked (1, 0, 1) the
     twist needs each unit's own heading (closed form) and the gear sets the front at half the rear's."""
     robot = _robot("geared.json")
@@ -91,24 +79,23 @@ def test_the_geared_units_turn_their_steering_1_to_2_and_ik_holds_them_to_it(cap
     (gear,) = robot.couplings
     assert (gear.kind, tuple(gear.joints), tuple(gear.ratios)) == ("gear", ("front.steer", "rear.steer"), (1.0, 2.0))
     front, rear = _heading(0.3, 0.2, 1, 0, 1), _heading(-0.3, -0.2, 1, 0, 1)
-    with _at_root():
-        assert main(["ik", "examples/robots/geared.json", "--twist", "1", "0", "1"]) == 1
+    monkeypatch.chdir(ROOT)
+    assert main(["ik", "examples/robots/geared.json", "--twist", "1", "0", "1"]) == 1
     out, err = capsys.readouterr()
     assert out.rstrip().endswith("feasible: NO (a steering gear cannot set these headings)")
     assert (f"gear(front.steer, rear.steer) (ratios 1, 2) sets front at heading {rear / 2:.6g} deg with rear at "
             f"{rear:.6g} deg, not {front:.6g} deg, which the twist needs") in err
-    with _at_root():
-        assert main(["ik", "examples/robots/geared.json", "--twist", "1", "0", "0"]) == 0  # both straight: 0 = 2 * 0
+    assert main(["ik", "examples/robots/geared.json", "--twist", "1", "0", "0"]) == 0  # both straight: 0 = 2 * 0
     assert "feasible: yes" in capsys.readouterr().out
 
 
-def test_the_cart_s_solid_axle_leaves_it_one_degree_of_mobility(capsys):
+def test_the_cart_s_solid_axle_leaves_it_one_degree_of_mobility(capsys, monkeypatch):
     """docs/analysis.md: a solid axle (a gear of both spins of a differential drive, 1:1) has coupled mobility 1
     where m is 2; docs/wheel-ik.md: fk with the two spins apart warns, 10 and 5 rad/s being 50 % apart."""
     found = analyze(_robot("cart.yaml")).to_dict()
     assert (found["mobility"], found["steerability"], found["coupled_mobility"]) == (2, 0, 1)
-    with _at_root():
-        assert main(["fk", "examples/robots/cart.yaml", "--spin", "left=10", "--spin", "right=5"]) == 0
+    monkeypatch.chdir(ROOT)
+    assert main(["fk", "examples/robots/cart.yaml", "--spin", "left=10", "--spin", "right=5"]) == 0
     assert ("the joints of gear(left.spin, right.spin) (ratios 1, 1) do not turn together (left.spin 10, right.spin 5 "
             "rad/s; 50% apart)") in capsys.readouterr().err
 

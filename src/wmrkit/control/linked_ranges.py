@@ -143,13 +143,17 @@ def _best_fit(k: np.ndarray, d: np.ndarray) -> tuple[float, float]:
     pi] on its own: 1:2 units asked on the gear at u = 2 rad (the rear at 4 rad, read -2.28) were fitted at -0.51."""
     best, miss = 0.0, math.inf
     for m in range(-GEAR_TURNS, GEAR_TURNS + 1):
-        anchor = (d[0] + TWO_PI * m) / k[0]
-        turn = d + TWO_PI * np.round((k * anchor - d) / TWO_PI)
-        u = float(k @ turn) / float(k @ k)
+        u = _refit(k, d, (d[0] + TWO_PI * m) / k[0])
         off = _miss(k, u, d)
         if off < miss - 1e-12 or (off <= miss + 1e-12 and abs(u) < abs(best)):
             best, miss = u, min(off, miss)
     return best, miss
+
+
+def _refit(k: np.ndarray, d: np.ndarray, u: float) -> float:
+    """The least-squares turn of ratios `k` to the turns `d` asked, each wheel's turn taken by the whole turns
+    nearest the gear's at turn `u` [rad]."""
+    return float(k @ (d + TWO_PI * np.round((k * u - d) / TWO_PI))) / float(k @ k)
 
 
 def _local_fit(k: np.ndarray, d: np.ndarray, u: float) -> float:
@@ -157,9 +161,8 @@ def _local_fit(k: np.ndarray, d: np.ndarray, u: float) -> float:
     the whole turns nearest the gear's at `u`, refitted until they hold (the miss decreases at each refit, so it
     stops, at most :data:`LOCAL_REFITS` times). It moves continuously with `d` while that fit exists: the gear's
     branch along a run."""
-    kk = float(k @ k)
     for _ in range(LOCAL_REFITS):
-        fitted = float(k @ (d + TWO_PI * np.round((k * u - d) / TWO_PI))) / kk
+        fitted = _refit(k, d, u)
         if fitted == u:
             break
         u = fitted
