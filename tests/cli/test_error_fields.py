@@ -28,6 +28,9 @@ CASES = [
     (["slip-study", "nope"], "STUDY", "invalid choice: 'nope'"),
     (["simulate", "forklift"], "--torques", "one of the arguments --torques --path is required"),
     (["vision", "locate", "--camera", CAMERA], "IMAGE", "one of the arguments IMAGE --points is required"),
+    # words argparse does not know: the first of them, an option or a stray word
+    (["analyze", "forklift", "abc", "def"], "abc", "unrecognized arguments: abc def"),
+    (["park", "thesis-9.2", "--space", "1"], "--space", "unrecognized arguments: --space 1"),
     # a robot: no such catalog name, or one the command cannot drive
     (["show", "nope"], "ROBOT", "no robot 'nope' in the catalog"),
     (["track", "nope", "--reference", "circle"], "ROBOT", "no robot 'nope' in the catalog"),

@@ -202,11 +202,12 @@ def report_error(err: WmrkitError, as_json: bool, argv: Sequence[str] = (),
 #: The option that starts an error's message, as the message names it: ``--chunk: ...``, ``-n/--runs: ...``,
 #: ``--configs must be ...``, ``--steer front=1e7 turn: ...``; and the argument argparse names in a usage error
 #: (``sweep: argument --metric: invalid choice ...``), or the first of those it lists (``park: unrecognized
-#: arguments: --space 1``, ``tyre: ambiguous option: --slip could match ...``, ``odometry: the following arguments
-#: are required: ROBOT, LOG``, ``simulate: one of the arguments --torques --path is required``).
+#: arguments: --space 1``, a stray word: ``analyze: unrecognized arguments: abc``, ``tyre: ambiguous option: --slip
+#: could match ...``, ``odometry: the following arguments are required: ROBOT, LOG``, ``simulate: one of the
+#: arguments --torques --path is required``).
 _OPTION_FIRST = re.compile(r"(-\w/--[\w-]+|--[\w-]+)(?=[\s:=]|$)")
 _ARGPARSE_ARGUMENT = re.compile(r"(?:[\w -]+: )?(?:argument ([^\s:]+): |(?:unrecognized arguments|ambiguous option): "
-                                r"(--[\w-]+)|the following arguments are required: ([^\s,]+)|one of the arguments "
+                                r"(\S+)|the following arguments are required: ([^\s,]+)|one of the arguments "
                                 r"(\S+) .*is required)")
 #: The option a message names in parentheses, after the name of its value (``blur (--blur): ...``, ``line width
 #: (--line-width) 100 m ...``, ``duration 1e+12 s ...; give a shorter duration (--duration)``).
