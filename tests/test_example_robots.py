@@ -47,7 +47,7 @@ SAYS = {("ik", "geared.json"): (1, "feasible: NO (a steering gear cannot set the
         ("fk", "cart.yaml"): (0, "do not turn together"),
         ("fk", "synchro.yaml"): (0, "the headings break a steering linkage: linkage(a.steer, b.steer, c.steer) (law "
                                     "parallel) sets b at heading 0 deg with a at 0 deg, not 10 deg"),
-        ("track", "geared.json"): (0, "held wheels 'front', 'rear'")}
+        ("track", "geared.json"): (0, "robot geared-units, reference circle of radius 3 m, controller p")}
 
 
 @pytest.mark.parametrize(("page", "command"), COMMANDS, ids=[c for _, c in COMMANDS])

@@ -16,9 +16,11 @@ import pytest
 
 from wmrkit import Robot
 from wmrkit.control import builtin_reference
-from wmrkit.control.loop import HOLD_MARGIN
+from wmrkit.control.laws import PositionLaw
+from wmrkit.control.loop import HOLD_MARGIN, law_controller, simulate
+from wmrkit.control.points import control_point
 from wmrkit.control.steering import range_keeper
-from wmrkit.control.track import track
+from wmrkit.control.track import initial_pose_on
 
 ROBOT = Robot.from_file(Path(__file__).parents[2] / "examples" / "robots" / "geared.json")
 D0 = 0.3
@@ -60,12 +62,16 @@ def test_a_gear_without_hysteresis_takes_the_better_fit_and_with_it_keeps_its_ow
 
 
 def test_the_continuous_loop_of_the_geared_units_passes_the_tie():
-    """``track geared.json --reference circle --size 3 --duration 4``: the asked headings cross the tie (e below
-    -pi) and the commanded front heading is the closed-form fit ``d0 + 2 e / 5`` of the asked axles (from the wheel
-    positions, ``v + omega z x p``, each root mod pi nearest the commanded heading) with ``e`` unwrapped along the
-    run: continuous. Before: 'too stiff' at t = 3.76 s after 30 s of computing."""
-    run = track(ROBOT, builtin_reference("circle", size=3.0), duration=4.0)
-    twist, commanded = run.twist, run.commanded
+    """The geared units on the 3 m circle for 4 s under a law blind to the gear (the full pose's, which ``track``
+    gave them before it controlled their reduced point, control/coupled_point.py): the asked headings cross the tie
+    (e below -pi) and the commanded front heading is the closed-form fit ``d0 + 2 e / 5`` of the asked axles (from
+    the wheel positions, ``v + omega z x p``, each root mod pi nearest the commanded heading) with ``e`` unwrapped
+    along the run: continuous. Before: 'too stiff' at t = 3.76 s after 30 s of computing."""
+    reference = builtin_reference("circle", size=3.0)
+    blind = control_point(ROBOT, reduced=False)
+    out = simulate(ROBOT, law_controller(blind, PositionLaw.uniform("p", 1.0), reference),
+                   initial_pose_on(blind, reference), 4.0, breaks=reference.breaks)
+    twist, commanded = out["twist"], np.asarray(ROBOT.heading_of_beta(out["target"]))
     asked = np.zeros(commanded.shape)
     for k, name in enumerate(ROBOT.steer_names):
         x, y = ROBOT.wheel(name).position

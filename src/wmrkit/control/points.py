@@ -13,6 +13,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -23,6 +24,9 @@ from ..kinematics.wheel_ik import wheel_commands
 from ..limits import MAX_SIZE
 from ..robot import Robot
 from ..wheels import heading_from_beta
+
+if TYPE_CHECKING:
+    from .coupled_point import CoupledSteering
 
 __all__ = ["ControlError", "ControlPoint", "StoppedRun", "control_point", "point_pose", "robot_reach",
            "twist_for_velocity"]
@@ -58,7 +62,9 @@ class ControlPoint:
     perpendicular from ``point`` to the fixed axle (the origin without fixed wheels). ``skid``: the fixed wheels
     have parallel but distinct axles (skid steering, degenerate in Table 5.1): turning makes them slip, and the
     admissible space is that of the linear part of their rows. ``gain`` ``(3, 2)`` (reduced): the twist that gives
-    the point a unit velocity along each robot axis.
+    the point a unit velocity along each robot axis (None with ``coupled``). ``coupled``: a robot without fixed
+    wheels whose gears or linkages leave one steering degree of freedom (:mod:`.coupled_point`): reduced, its
+    twist solved on the coupled headings' admissible twists; ``forward`` and ``axle_point`` of its virtual axle.
     """
 
     robot: Robot
@@ -69,6 +75,7 @@ class ControlPoint:
     axle_point: np.ndarray
     skid: bool = False
     gain: np.ndarray | None = None  # (3, 2): twist = gain @ (point velocity in R), reduced only
+    coupled: CoupledSteering | None = None  # one steering degree of freedom left by couplings, no fixed wheel
 
     @property
     def n_controlled(self) -> int:
@@ -93,6 +100,13 @@ def _cached(robot: Robot, point: tuple[float, float] | None, reduced: bool | Non
     scale = max(1.0, float(np.max(np.abs(rows))) if len(rows) else 1.0)
     rank = int(np.sum(s > 1e-9 * scale)) if len(rows) else 0
     basis = vt[rank:].T  # (3, 3 - rank)
+    if rank == 0 and reduced is not False:
+        from .coupled_point import coupled_steering
+
+        coupled = coupled_steering(robot, None if point is None else np.asarray(point, dtype=float))
+        if coupled is not None:
+            return ControlPoint(robot, True, coupled.point, readonly(np.ascontiguousarray(basis)), coupled.forward,
+                                coupled.axle_point, coupled=coupled)
     fixed = [w for w in robot.wheels if w.type == "fixed"]
     forward = float(heading_from_beta(fixed[0].beta)) if fixed else 0.0
     if math.cos(forward) < -1e-9 or (abs(math.cos(forward)) <= 1e-9 and math.sin(forward) < 0):
@@ -144,9 +158,11 @@ def _point_map(p: np.ndarray) -> np.ndarray:
 def control_point(robot: Robot, point: ArrayLike | None = None, *, reduced: bool | None = None) -> ControlPoint:
     """What the loop controls for `robot` (§8.2): full pose, or ``(x, y)`` of `point` [m, robot frame].
 
-    `reduced`: None picks it from the robot (fixed wheels -> reduced). Default point: the robot origin, or when the
-    origin lies on the fixed axle, a point ahead of it at the robot's largest wheel distance (its largest wheel radius
-    when every wheel is at the origin).
+    `reduced`: None picks it from the robot (fixed wheels, or steering couplings that leave one steering degree of
+    freedom without them, :mod:`.coupled_point` -> reduced; False keeps the full pose of the latter). Default point:
+    the robot origin, or when the origin lies on the fixed axle, a point ahead of it at the robot's largest wheel
+    distance (its largest wheel radius when every wheel is at the origin); a coupled robot's, that distance ahead of
+    its virtual axle.
     """
     key = None if point is None else tuple(float(v) for v in as_vectors(point, 2, "point"))
     if key is not None and not all(abs(v) <= MAX_SIZE for v in key):  # NaN included
@@ -174,4 +190,6 @@ def twist_for_velocity(cp: ControlPoint, pose_world_robot: ArrayLike, velocity_w
     vr0, vr1 = c * v0 + s * v1, -s * v0 + c * v1
     if not cp.reduced:
         return np.array([vr0, vr1, float(velocity_world[2])])
+    if cp.coupled is not None:
+        return cp.coupled.twist(np.array([vr0, vr1]))
     return cp.gain[:, 0] * vr0 + cp.gain[:, 1] * vr1

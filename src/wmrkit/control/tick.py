@@ -51,14 +51,21 @@ class ControlTick:
     tick: Any
 
 
-def control_tick(robot: Robot, law: PositionLaw | None = None, point: ArrayLike | None = None) -> ControlTick:
-    """Compile the single-call tick of `robot` for `law` (``"p"``, gated or not; default P with a = 1 s^-1)."""
+def control_tick(robot: Robot, law: PositionLaw | None = None, point: ArrayLike | None = None, *,
+                 reduced: bool | None = None) -> ControlTick:
+    """Compile the single-call tick of `robot` for `law` (``"p"``, gated or not; default P with a = 1 s^-1) at the
+    control point ``control_point(robot, point, reduced=reduced)``; refused for a robot whose steering couplings
+    leave one steering degree of freedom (its twist is solved by Newton's method) unless `reduced` is False."""
     from ..kinematics.realtime import realtime
 
     law = law or PositionLaw.uniform("p", 1.0)
     if law.kind != "p":
         raise ControlError(f"control_tick: only the P + feedforward law (8.2)/(8.53), got '{law.kind}'")
-    cp = control_point(robot, point)
+    cp = control_point(robot, point, reduced=reduced)
+    if cp.coupled is not None:
+        raise ControlError(f"control_tick: robot '{robot.name}' steers through couplings that leave it one steering "
+                           "degree of freedom; its twist is solved by Newton's method (control.coupled_point), not "
+                           "compiled (reduced=False compiles the full pose's law, blind to the couplings)")
     gain = tuple(float(v) for v in np.asarray(cp.gain).ravel()) if cp.reduced else ()
     kernel = _tick_kernel(realtime(robot).ik, scalar_law(cp, law))
     return ControlTick(robot, cp.reduced, (float(cp.point[0]), float(cp.point[1])), gain, law.a,
@@ -74,8 +81,9 @@ def scalar_law(cp: ControlPoint, law: PositionLaw):
     reduced, integral, feedforward = bool(cp.reduced), law.kind == "pi", law.kind != "point"
     (a0, a1, a2), (b0, b1, b2) = law.a, law.b
     gate = math.inf if law.gate is None else float(law.gate)
-    g00, g01, g10, g11, g20, g21 = (float(v) for v in (np.asarray(cp.gain, dtype=float).ravel() if reduced
-                                                       else np.zeros(6)))
+    coupled = cp.coupled  # its law gives the point's velocity in R, then the coupled twist (plain Python)
+    gains = np.eye(3, 2) if coupled is not None else cp.gain if reduced else np.zeros((3, 2))
+    g00, g01, g10, g11, g20, g21 = (float(v) for v in np.asarray(gains, dtype=float).ravel())
 
     def law_twist(x, y, theta, x_ref, y_ref, theta_ref, vx_ref, vy_ref, omega_ref, i0, i1, i2):
         c, s = math.cos(theta), math.sin(theta)
@@ -97,7 +105,15 @@ def scalar_law(cp: ControlPoint, law: PositionLaw):
             return g00 * r0 + g01 * r1, g10 * r0 + g11 * r1, g20 * r0 + g21 * r1, e0, e1, e2
         return r0, r1, u2, e0, e1, e2
 
-    return law_twist
+    if coupled is None:
+        return law_twist
+
+    def coupled_twist(*args):
+        r0, r1, _, e0, e1, e2 = law_twist(*args)
+        vx, vy, w = coupled.twist(np.array([r0, r1])).tolist()
+        return vx, vy, w, e0, e1, e2
+
+    return coupled_twist
 
 
 def _tick_kernel(ik, law_twist):

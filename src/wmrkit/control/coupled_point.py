@@ -1,0 +1,275 @@
+"""The reduced control point of a robot whose steering couplings leave it one steering degree of freedom.
+
+Two steered units turned by one ``gear`` (or a ``linkage``) and no fixed wheel: classified by their generic ranks
+as type 5 (δm = 1, δs = 2), but the coupling leaves one turn ``u`` of the leader's heading (``h = h0 + u``, the
+followers set by the ratios or the law, :mod:`.linked_ranges`), so the robot is a type (1, 1) without fixed wheels:
+maneuverability 2, as the car. The thesis merges coupled orientable wheels into one equivalent wheel (§5.2, digest
+ch5-6 2.3) and controls types 2 and 4 by the ``(x, y)`` of a point off the axle, the heading as zero dynamics
+(§8.4-8.5, Table 8.1); it has no closed form for a coupling whose ICR curve is not a line. Here, at turn ``u`` the
+admissible twists are the null space ``n(u)`` of the wheels' constraint lines (6.18) at the coupled headings
+(one-dimensional: the ICR fixed by ``u``), so the velocity of a body point ``P`` is ``s g(u)``, ``g = M_P n``
+(rigid body, speed ``s``), and the law's wanted velocity of ``P`` gives ``(s, u)``: ``u`` where ``g(u)`` points
+along it (Newton on the angle, from the branch's table), then ``s``. The commanded twist ``s n(u)`` is admissible by
+construction: every wheel's lateral constraint holds at the coupled headings.
+
+``u`` is sought on one branch: the interval around straight driving (``n`` a translation, ``u0``) where the
+direction of ``P``'s velocity turns monotonically with ``u`` (it folds beyond: 1:2 units at ``P`` ahead turn it
+by -0.6 a radian of ``u`` at ``u0`` and fold at ``u = -0.84`` and ``1.20`` rad, where it has turned +99 and
+-103 deg). A direction within the branch's arc is driven forward, else backward if its opposite is within, else the
+branch's nearer end is held (the coupling's stop). Near straight driving the ICRs lie on a line, the virtual axle
+(the limit of the ICR as ``u -> u0``); the default ``P`` is ahead of it by the robot's size, as the car's point
+ahead of its rear axle: the heading's zero dynamics are then stable driving forward (the error of the heading decays
+at ``speed / distance``), and the map is well conditioned there (``d angle / du = distance / wheelbase``).
+"""
+
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._shapes import readonly
+from ..analysis.lines import constraint_lines
+from ..robot import Robot
+from .linked_ranges import LinkedRanges
+from .points import ControlError, robot_reach
+from .steering import steer_ranges
+
+__all__ = ["CoupledSteering", "coupled_steering"]
+
+#: Samples of the leader's turn over a whole turn: the branch and Newton's first guess.
+SAMPLES = 1440
+#: Newton iterations at most (2 to 4 from the table's guess; bisection where a step leaves the bracket).
+NEWTON_STEPS = 40
+#: The angle of P's velocity is solved to this [rad].
+ANGLE_TOL = 1e-12
+#: Step [rad] of the central difference of a follower's heading per the leader's (exact for a gear's ratio).
+LAW_STEP = 1e-6
+#: Relative size below which a singular value is a null direction (the admissible twists are one-dimensional).
+RANK_TOL = 1e-9
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledSteering:
+    """One steering degree of freedom: the turn ``u`` [rad] of the leader's heading (``robot.steer_names[leader]``)
+    from its rest, the followers set by their couplings. ``point (2,)`` [m]: the controlled point; ``forward`` [rad]:
+    the direction of straight driving (towards +x); ``axle_point (2,)``: the point's foot on the virtual axle (the
+    point itself when no turn rotates the robot). ``turns (n,)`` [rad] and ``angles (n,)`` [rad, robot frame,
+    increasing]: the branch's table of the angle of ``P``'s velocity, ``sign`` that of ``d angle / du``; ``u0`` the
+    turn of straight driving. Read-only arrays."""
+
+    robot: Robot
+    leader: int
+    point: np.ndarray
+    forward: float
+    axle_point: np.ndarray
+    turns: np.ndarray
+    angles: np.ndarray
+    sign: float
+    u0: float
+    _links: LinkedRanges
+    _pivots: np.ndarray  # (n_lines, 2): the steering pivot of each line's wheel
+    _wheel: np.ndarray  # (n_lines,): its steer index
+    _grid: np.ndarray  # (SAMPLES,): turns over a whole turn of the leader
+    _null: np.ndarray  # (SAMPLES, 3): n oriented continuously from forward driving
+
+    def headings(self, u: float) -> np.ndarray:
+        """The steered wheels' headings ``(n_steer,)`` [rad] at turn `u`."""
+        return _headings(self.robot, self._links, self.leader, u)
+
+    def lines(self, u: float) -> np.ndarray:
+        """The constraint lines (6.18) at turn `u` ``(n_lines, 3)``: ``line . twist = 0`` for admissible twists."""
+        return constraint_lines(self.robot).lines(self.robot.steering(heading=self.headings(u)))
+
+    def twist_direction(self, u: float) -> tuple[np.ndarray, np.ndarray]:
+        """The unit admissible twist ``n(u)`` ``(3,)`` (oriented continuously from forward driving) and ``dn/du``
+        ``= -A^+ A' n``: ``A'`` each line turned about its wheel's pivot at its heading's rate per turn."""
+        a = self.lines(u)
+        left, sv, vt = np.linalg.svd(a, full_matrices=False)
+        n = vt[-1]
+        k = int(np.argmin(np.abs(np.remainder(self._grid - u + math.pi, 2 * math.pi) - math.pi)))
+        n = n if n @ self._null[k] >= 0 else -n
+        rate = ((self.headings(u + LAW_STEP) - self.headings(u - LAW_STEP)) / (2 * LAW_STEP))[self._wheel]
+        turned = np.column_stack([-a[:, 1], a[:, 0], self._pivots[:, 0] * a[:, 0] + self._pivots[:, 1] * a[:, 1]])
+        pinv = (vt[:2].T / sv[:2]) @ left[:, :2].T  # A^+ on its rank 2
+        return n, -pinv @ ((turned * rate[:, None]) @ n)
+
+    def point_velocity(self, speed: float, u: float) -> tuple[np.ndarray, np.ndarray]:
+        """The velocity ``s g(u)`` ``(2,)`` [m/s, robot frame] of the control point at `speed` ``s`` and turn `u`,
+        and its Jacobian ``(2, 2)`` in ``(s, u)``."""
+        n, dn = self.twist_direction(u)
+        g = _at_point(self.point, n)
+        return speed * g, np.column_stack([g, speed * _at_point(self.point, dn)])
+
+    def solve(self, velocity: np.ndarray) -> tuple[float, float, np.ndarray]:
+        """``(s, u, n(u))`` giving the control point `velocity` ``(2,)`` [m/s, robot frame]: forward when its
+        direction is within the branch's arc, else backward when the opposite one is, else at the branch's nearer end
+        (least squares in ``s`` there); at rest ``(0, u0, n(u0))``."""
+        vx, vy = float(velocity[0]), float(velocity[1])
+        if vx == 0.0 and vy == 0.0:
+            return 0.0, self.u0, self.twist_direction(self.u0)[0]
+        want, lo, hi = math.atan2(vy, vx), float(self.angles[0]), float(self.angles[-1])
+        forward, backward = _into(want, lo), _into(want + math.pi, lo)
+        if forward <= hi:
+            target = forward
+        elif backward <= hi:
+            target = backward
+        else:  # the nearer end of the branch, either way
+            target = min((lo, hi), key=lambda e: min(abs(math.remainder(want - e, 2 * math.pi)),
+                                                     abs(math.remainder(want + math.pi - e, 2 * math.pi))))
+        u, n = self._newton(target)
+        g = _at_point(self.point, n)
+        return float(g @ np.array([vx, vy])) / float(g @ g), u, n
+
+    def twist(self, velocity: np.ndarray) -> np.ndarray:
+        """The admissible body twist ``s n(u)`` ``(3,)`` giving the control point `velocity` ``(2,)`` [m/s, robot
+        frame] (:meth:`solve`)."""
+        s, _, n = self.solve(velocity)
+        return s * n
+
+    def _newton(self, target: float) -> tuple[float, np.ndarray]:
+        """The turn at which the angle of ``P``'s velocity is `target` on the branch: Newton's method from the
+        table's interpolation, within the table's bracket (bisection where a step leaves it); and ``n`` there."""
+        k = int(np.clip(np.searchsorted(self.angles, target), 1, len(self.angles) - 1))
+        lo, hi = sorted((float(self.turns[k - 1]), float(self.turns[k])))
+        u = float(np.interp(target, self.angles, self.turns))
+        for _ in range(NEWTON_STEPS):
+            n, dn = self.twist_direction(u)
+            g, dg = _at_point(self.point, n), _at_point(self.point, dn)
+            near = float(np.interp(u, self.turns[::int(self.sign)], self.angles[::int(self.sign)]))
+            f = near + math.remainder(math.atan2(g[1], g[0]) - near, 2 * math.pi) - target
+            if abs(f) <= ANGLE_TOL:
+                return u, n
+            if f * self.sign < 0:
+                lo = u
+            else:
+                hi = u
+            slope = float(g[0] * dg[1] - g[1] * dg[0]) / float(g @ g)
+            step = u - f / slope if slope * self.sign > 0 else math.nan
+            u = step if lo < step < hi else 0.5 * (lo + hi)
+        return u, self.twist_direction(u)[0]
+
+
+def _headings(robot: Robot, links: LinkedRanges, leader: int, u: float) -> np.ndarray:
+    h = _rest(robot).copy()
+    h[leader] += u
+    links.follow(h)
+    return h
+
+
+@functools.lru_cache(maxsize=64)
+def _rest(robot: Robot) -> np.ndarray:
+    """The described headings (read-only; ``robot.heading`` converts them at each call)."""
+    return readonly(np.array(robot.heading, dtype=float))
+
+
+def _into(angle: float, lo: float) -> float:
+    """`angle` plus the whole turns that put it in ``[lo, lo + 2 pi)``."""
+    return lo + (angle - lo) % (2 * math.pi)
+
+
+def _at_point(p: np.ndarray, twist: np.ndarray) -> np.ndarray:
+    """Velocity ``(..., 2)`` of the body point `p` under `twist` ``(..., 3)`` (rigid body, as ``points._point_map``)."""
+    t = np.asarray(twist)
+    return np.stack([t[..., 0] - t[..., 2] * p[1], t[..., 1] + t[..., 2] * p[0]], axis=-1)
+
+
+def coupled_steering(robot: Robot, point: np.ndarray | None) -> CoupledSteering | None:
+    """The one steering degree of freedom of `robot` controlled at `point` ``(2,)`` [m] (default: ahead of the
+    virtual axle by the robot's size, or the origin when no turn rotates the robot), or None unless the robot has
+    no fixed wheel, its constraint lines are all of steered wheels held with one leader by gears or linkages, and
+    they leave one-dimensional twists at the rest turn (None too when the default point's velocity cannot be
+    assigned near straight driving). Raises :class:`ControlError` for a given point on the virtual axle (its velocity
+    cannot be assigned there)."""
+    if any(w.type == "fixed" for w in robot.wheels):
+        return None
+    links = LinkedRanges.of(robot, steer_ranges(robot))
+    if links is None or len(links.leaders) != 1:
+        return None
+    leader = int(links.leaders[0])
+    group = {robot.steer_names[leader], *(robot.steer_names[f] for f in links.followers.tolist())}
+    cl = constraint_lines(robot)
+    if not cl.wheels or any(w not in group for w in cl.wheels):
+        return None
+    grid = np.linspace(-math.pi, math.pi, SAMPLES, endpoint=False)
+    heads = np.array([_headings(robot, links, leader, float(u)) for u in grid])
+    _, sv, vt = np.linalg.svd(cl.lines(robot.steering(heading=heads)))
+    one = (sv[:, -1] <= RANK_TOL * sv[:, 0]) & (sv[:, -2] > RANK_TOL * sv[:, 0])  # a one-dimensional null space
+    mid = SAMPLES // 2  # u = 0
+    if not one[mid]:
+        return None
+    null = vt[:, -1].copy()
+    for order in (range(mid + 1, SAMPLES), range(mid - 1, -1, -1)):  # oriented continuously from u = 0
+        prev = mid
+        for k in order:
+            if null[k] @ null[prev] < 0:
+                null[k] *= -1
+            prev = k
+    u0, forward = _straight(grid, null, mid)
+    t = np.array([math.cos(forward), math.sin(forward)])
+    k0 = int(np.argmin(np.abs(grid - u0)))
+    if null[k0, :2] @ t < 0:
+        null *= -1
+    pivots = np.array([robot.wheel(w).position for w in cl.wheels], dtype=float)
+    wheel = np.array([robot.steer_names.index(w) for w in cl.wheels], dtype=int)
+    cs = CoupledSteering(robot, leader, np.zeros(2), forward, np.zeros(2), np.zeros(0), np.zeros(0), 1.0, u0, links,
+                         readonly(pivots), readonly(wheel), readonly(grid), readonly(null))
+    n0, dn0 = cs.twist_direction(u0)
+    axle = None if abs(dn0[2]) <= RANK_TOL else (dn0[0] * n0[1] - dn0[1] * n0[0]) / (dn0[2] * math.hypot(*n0[:2]))
+    if point is not None:
+        p = np.asarray(point, dtype=float)
+    elif axle is None:
+        p = np.zeros(2)
+    else:
+        p = (axle + robot_reach(robot)) * t
+    foot = p if axle is None else p - t * (p @ t - axle)
+    g0, dg0 = _at_point(p, n0), _at_point(p, dn0)
+    slope = float(g0[0] * dg0[1] - g0[1] * dg0[0]) / max(float(g0 @ g0), 1e-300)  # d angle / du at u0
+    if not (float(np.hypot(*g0)) > RANK_TOL and abs(slope) > RANK_TOL):
+        if point is None:  # no point of its own well placed (no first-order virtual axle): the full pose, as before
+            return None
+        raise ControlError(f"control point ({p[0]:g}, {p[1]:g}) m of robot '{robot.name}' lies on the virtual axle of "
+                           "its coupled steering: its velocity cannot be assigned near straight driving (choose a "
+                           "point ahead of it)")
+    kept = links.ranges[leader] - robot.heading[leader]
+    turns, angles, sign = _branch(grid, null, one, p, k0, kept, math.copysign(1.0, slope))
+    return CoupledSteering(robot, leader, readonly(p), forward, readonly(foot), readonly(turns), readonly(angles),
+                           sign, u0, links, readonly(pivots), readonly(wheel), readonly(grid), readonly(null))
+
+
+def _straight(grid: np.ndarray, null: np.ndarray, mid: int) -> tuple[float, float]:
+    """The turn nearest 0 at which the admissible twist translates (``omega`` changes sign, refined linearly), and
+    the direction of that translation towards +x [rad]; u = 0's direction when every turn translates."""
+    w = null[:, 2]
+    u0, k = 0.0, mid
+    if abs(w[mid]) > RANK_TOL:
+        cross = np.flatnonzero(np.sign(w[:-1]) != np.sign(w[1:]))
+        if len(cross):
+            k = int(cross[np.argmin(np.abs(grid[cross]))])
+            u0 = float(grid[k] - w[k] * (grid[k + 1] - grid[k]) / (w[k + 1] - w[k]))
+    forward = math.atan2(null[k, 1], null[k, 0])
+    if math.cos(forward) < -1e-9 or (abs(math.cos(forward)) <= 1e-9 and math.sin(forward) < 0):
+        forward = math.remainder(forward + math.pi, 2 * math.pi)  # ahead = towards +x, as points.control_point
+    return u0, forward
+
+
+def _branch(grid: np.ndarray, null: np.ndarray, one: np.ndarray, p: np.ndarray, k0: int, kept: np.ndarray,
+            sign: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """The branch's table: the turns around straight driving (sample `k0`) where the angle of `p`'s velocity turns
+    monotonically with the `sign` it has there, the null space is one-dimensional, `p` moves, and the leader is
+    within its `kept` arc; sorted by increasing angle, with that sign."""
+    g = _at_point(p, null)
+    speed = np.hypot(g[:, 0], g[:, 1])
+    angle = np.unwrap(np.arctan2(g[:, 1], g[:, 0]))
+    step = np.diff(angle)
+    ok = one & (speed > RANK_TOL) & (grid >= kept[0]) & (grid <= kept[1])
+    lo = hi = k0
+    while lo > 0 and ok[lo - 1] and step[lo - 1] * sign > 0:
+        lo -= 1
+    while hi < len(grid) - 1 and ok[hi + 1] and step[hi] * sign > 0:
+        hi += 1
+    turns, angles = grid[lo:hi + 1], angle[lo:hi + 1]
+    return (turns, angles, sign) if sign > 0 else (turns[::-1].copy(), angles[::-1].copy(), sign)
