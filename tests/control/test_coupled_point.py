@@ -122,3 +122,17 @@ def test_a_point_on_the_virtual_axle_and_the_compiled_tick_are_refused():
         track(GEARED, builtin_reference("line"), point=(0.9, 0.0), duration=1.0)
     with pytest.raises(ControlError, match="not compiled"):
         control_tick(GEARED)
+
+
+def test_a_turn_beyond_the_steering_ranges_is_held_at_their_end_and_reported():
+    """Units geared 1:2 within +-0.3 rad each (the front within +-0.15 rad, where the rear fits): the 3 m circle needs
+    the front at -0.160 rad (closed form above), so the keeper holds it at -0.15 rad and reports it, as the car's
+    wheels at their stops; the law is not cut at the ranges (it would miss the circle without a word)."""
+    data = GEARED.to_dict()
+    for wheel in data["wheels"]:
+        wheel["steer_range"] = [-0.3, 0.3]
+    robot = Robot.from_dict(data)
+    run = track(robot, builtin_reference("circle", size=3.0), duration=5.0)
+    front = run.range_violations()[0]
+    assert front["wheel"] == "front" and front["held_by"] == "gear(front.steer, rear.steer)"
+    assert front["headings"] == pytest.approx([-0.15, -0.15], abs=1e-12) and front["to"] == 5.0

@@ -234,8 +234,7 @@ def coupled_steering(robot: Robot, point: np.ndarray | None) -> CoupledSteering 
         raise ControlError(f"control point ({p[0]:g}, {p[1]:g}) m of robot '{robot.name}' lies on the virtual axle of "
                            "its coupled steering: its velocity cannot be assigned near straight driving (choose a "
                            "point ahead of it)")
-    kept = links.ranges[leader] - robot.heading[leader]
-    turns, angles, sign = _branch(grid, null, one, p, k0, kept, math.copysign(1.0, slope))
+    turns, angles, sign = _branch(grid, null, one, p, k0, math.copysign(1.0, slope))
     return CoupledSteering(robot, leader, readonly(p), forward, readonly(foot), readonly(turns), readonly(angles),
                            sign, u0, links, readonly(pivots), readonly(wheel), readonly(grid), readonly(null))
 
@@ -256,16 +255,17 @@ def _straight(grid: np.ndarray, null: np.ndarray, mid: int) -> tuple[float, floa
     return u0, forward
 
 
-def _branch(grid: np.ndarray, null: np.ndarray, one: np.ndarray, p: np.ndarray, k0: int, kept: np.ndarray,
+def _branch(grid: np.ndarray, null: np.ndarray, one: np.ndarray, p: np.ndarray, k0: int,
             sign: float) -> tuple[np.ndarray, np.ndarray, float]:
     """The branch's table: the turns around straight driving (sample `k0`) where the angle of `p`'s velocity turns
-    monotonically with the `sign` it has there, the null space is one-dimensional, `p` moves, and the leader is
-    within its `kept` arc; sorted by increasing angle, with that sign."""
+    monotonically with the `sign` it has there, the null space is one-dimensional and `p` moves; sorted by
+    increasing angle, with that sign. Steering ranges do not cut it: a turn beyond them is held at their end by the
+    loop's keeper and reported, as the car's (:mod:`.linked_ranges`)."""
     g = _at_point(p, null)
     speed = np.hypot(g[:, 0], g[:, 1])
     angle = np.unwrap(np.arctan2(g[:, 1], g[:, 0]))
     step = np.diff(angle)
-    ok = one & (speed > RANK_TOL) & (grid >= kept[0]) & (grid <= kept[1])
+    ok = one & (speed > RANK_TOL)
     lo = hi = k0
     while lo > 0 and ok[lo - 1] and step[lo - 1] * sign > 0:
         lo -= 1
