@@ -82,18 +82,19 @@ def test_a_linkage_on_the_commanded_axles_is_not_reported():
     assert run.held_off_axle() == [] and run.moved is not None
 
 
-def test_feasibility_says_a_linkage_or_steering_gear_that_steers_wheels_together_is_not_considered(tmp_path, capsys):
+def test_feasibility_judges_a_robot_its_couplings_leave_one_steering_degree_of_freedom_as_type_4(tmp_path, capsys):
     """A synchro drive (three wheels on one parallel linkage: it cannot turn) answered "feasible: yes" to a circle
     without a word of its linkage; the geared units' warning sent the user to ``wmrkit ik``, which then did not check a
-    steering gear's angles (it answered "feasible: yes" to headings out of the ratios)."""
+    steering gear's angles (it answered "feasible: yes" to headings out of the ratios). Then both said their coupling
+    "is not considered". Now the laws control both as the type 4 they are (one steering degree of freedom, no fixed
+    wheel: control/coupled_point.py), and Table 8.1 judges them so: ``(x, y)`` of the point, chi continuous."""
     synchro, geared = tmp_path / "synchro.yaml", tmp_path / "geared.json"
     synchro.write_text(SYNCHRO)
     geared.write_text(json.dumps(_geared().to_dict()))
-    said = "is not considered: Table 8.1 judges the wheels alone, each steered on its own, and it steers them together"
-    assert main(["feasibility", str(synchro), "--reference", "circle"]) == 0
-    assert f"linkage(a.steer, b.steer, c.steer) {said}" in capsys.readouterr().err
-    assert main(["feasibility", str(geared), "--reference", "circle", "--size", "3"]) == 0
-    err = capsys.readouterr().err
-    assert f"{GEAR} {said}" in err and "wmrkit ik" not in err
+    said = "steers through couplings that leave it one steering degree of freedom and has no fixed wheel: Table 8.1 "
+    for path, size in ((synchro, []), (geared, ["--size", "3"])):
+        assert main(["feasibility", str(path), "--reference", "circle", *size]) == 0
+        out, err = capsys.readouterr()
+        assert said in err and "is not considered" not in err and "column 'type 4, off axle'" in out
     assert main(["feasibility", "ackermann", "--reference", "circle"]) == 0  # its linkage sets the axles d asks
     assert capsys.readouterr().err == ""

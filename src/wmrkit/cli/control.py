@@ -379,7 +379,8 @@ def run_feasibility(args: argparse.Namespace) -> int:
     if result.requirement.note:  # a skid steer, judged as a differential drive
         warn(result.requirement.note)
     fewer = None  # whether the linkages command fewer steering angles than the wheels' steerability d
-    for c in robot.couplings:  # Table 8.1 classifies the wheels' geometry only
+    coupled = result.requirement.type == 4 and not any(w.type == "fixed" for w in robot.wheels)  # judged with them
+    for c in () if coupled else robot.couplings:  # Table 8.1 classifies the wheels' geometry only
         if c.kind == "gear" and not steers_together(c):
             warn(f"{c.channel_name} is not considered: Table 8.1 judges the wheels alone; check the reference's "
                  "twists with 'wmrkit ik' (a gear may forbid them)")

@@ -73,7 +73,7 @@ class Requirement:
     """The Table 8.1 cell of a robot: ``column``, vehicle ``type``, number of pose ``references`` (2 or 3), the
     ``signals`` that must be continuous in the chosen ``framework``, and the ``remedy`` when one is not; ``note``:
     why a robot outside the table is judged by a column of it (a skid steer, as the differential drive it drives
-    as), or empty."""
+    as; a robot whose steering couplings leave one steering degree of freedom, as type 4), or empty."""
 
     column: str
     type: int
@@ -136,6 +136,10 @@ def requirement(robot: Robot, framework: Literal["kinematic", "dynamic"] = "kine
     if p.shape != (2,) or not (np.abs(p) <= MAX_SIZE).all():  # NaN read as a point on the axle
         raise ControlError(f"point: expected (x, y), finite and within {MAX_SIZE:g} m of the robot origin, got "
                            f"{p.tolist()}")
+    if kind in (3, 5) and control_point(robot).coupled is not None:
+        kind, note = 4, (f"robot '{robot.name}' steers through couplings that leave it one steering degree of "
+                         "freedom and has no fixed wheel: Table 8.1 judges it as type 4, (x, y) of the tracked point, "
+                         "the heading free (docs/control.md)")
     if kind in (2, 4):
         on_axle = _on_axle(robot, p)
         column = f"type {kind}, {'on' if on_axle else 'off'} axle"
