@@ -37,3 +37,4 @@ def _no_compile_notice(request, monkeypatch):
         import wmrkit.cli.main as cli
 
         monkeypatch.setattr(cli, "COMPILE_NOTICE_AFTER", math.inf)
+        monkeypatch.setattr(cli, "DYNAMICS_NOTICE_AFTER", math.inf)

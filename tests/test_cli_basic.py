@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -105,7 +106,7 @@ def test_missing_file_and_text_summary(tmp_path, capsys):
 
 def test_a_long_first_compilation_is_announced_once(monkeypatch, capsys):
     """While another thread holds numba's compiler lock past the threshold the CLI says why it is quiet (a first
-    run compiles the dynamics kernels for about 20 s); with the lock free it says nothing."""
+    run compiles kernels for seconds); with the lock free it says nothing."""
     import threading
 
     from numba.core.compiler_lock import global_compiler_lock
@@ -135,6 +136,30 @@ def test_a_long_first_compilation_is_announced_once(monkeypatch, capsys):
     err = capsys.readouterr().err
     assert not watcher.is_alive() and err.count("compiling numerical kernels") == 1
 
+
+
+@pytest.mark.parametrize("first", [True, False])
+def test_the_dynamics_first_compile_is_announced_at_once_with_its_duration(monkeypatch, capsys, first):
+    """The dynamics kernels not yet cached (about 15 s to compile) are announced as soon as they compile, once, with
+    how long they take; cached (or another command's kernels), the notice waits for its threshold as before."""
+    import threading
+
+    import wmrkit.cli.main as cli
+
+    monkeypatch.setattr(cli, "COMPILE_NOTICE_AFTER", 0.5)
+    monkeypatch.setattr(cli, "DYNAMICS_NOTICE_AFTER", 0.02)
+    monkeypatch.setattr(cli, "_compiling", lambda: True)
+    monkeypatch.setattr(cli, "_first_dynamics_compile", lambda: first)
+    watcher = threading.Thread(target=cli._compile_notice, args=(threading.Event(), 0.01))
+    start = time.perf_counter()
+    watcher.start()
+    watcher.join(5)
+    elapsed, err = time.perf_counter() - start, capsys.readouterr().err
+    assert not watcher.is_alive()
+    if first:
+        assert err == cli.DYNAMICS_NOTICE + "\n" and "about 15 s" in err and elapsed < 0.5
+    else:
+        assert err == cli.COMPILE_NOTICE + "\n" and elapsed >= 0.5
 
 @pytest.mark.parametrize("value, expected", [("-5deg", -np.radians(5)), ("-0.5rad", -0.5), ("-1e-2", -0.01),
                                              ("-.25", -0.25), ("-5 deg", -np.radians(5))])

@@ -183,6 +183,27 @@ def test_a_kernel_numba_cannot_cache_is_named_and_the_notice_says_it_compiles_at
     assert err == cli.COMPILE_NOTICE_UNCACHED + "\n" and "NUMBA_CACHE_DIR" in err and "first run only" not in err
 
 
+def test_disk_cached_tells_a_kernel_numba_will_load_from_one_it_will_compile(tmp_path, monkeypatch):
+    """The CLI announces the dynamics' first compile at once when their step loop is not in numba's disk cache
+    (:func:`jit.disk_cached`, which reads numba's private index): False before the first call, True after it, for
+    a new dispatcher of the same source too (a later process), None with no cache directory."""
+    import numba
+    from numba.core.caching import FunctionCache
+
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "numba-cache"))
+
+    def thrice(x):
+        return 3.0 * x
+
+    kernel = jit.compile_cached(thrice)
+    assert jit.disk_cached(kernel) is False
+    assert kernel(1.5) == 4.5
+    assert jit.disk_cached(kernel) is True and jit.disk_cached(jit.compile_cached(thrice)) is True
+    monkeypatch.setattr(FunctionCache._impl_class, "_locator_classes", [])  # numba finds no cache directory
+    monkeypatch.setattr(jit, "UNCACHED", set())
+    assert jit.disk_cached(jit.compile_cached(thrice)) is None
+
+
 def test_a_kernel_cache_past_its_limit_is_dropped_and_no_other(tmp_path, monkeypatch):
     """Numba caches one copy per robot of the realtime kernels (their constants are the robot's): drop_oversized_cache
     drops a file's cached kernels once together they pass the limit, and keeps them below it and other files'."""

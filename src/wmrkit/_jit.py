@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+import pickle
 import types
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -127,6 +128,17 @@ def _closure_key(fn: types.FunctionType) -> bytes:
     return b"".join(hashlib.sha256(part).digest() for part in parts)
 
 
+def disk_cached(kernel: Dispatcher) -> bool | None:
+    """Whether numba's disk cache holds compiled code of `kernel` (a dispatcher of :func:`compile_cached`) for its
+    current source, so that its first call loads it rather than compiles it; None when the kernel has no disk cache
+    (:data:`UNCACHED`) or numba's cache is not laid out as this reads it (its index: numba's private API)."""
+    index = getattr(getattr(kernel, "_cache", None), "_cache_file", None)
+    try:
+        return None if index is None else bool(index._load_index())
+    except (AttributeError, OSError, EOFError, ValueError, pickle.UnpicklingError):
+        return None
+
+
 def cache_dir(source: str | Path) -> Path | None:
     """The directory numba caches the kernels of the file `source` in (its cache locators' choice: ``NUMBA_CACHE_DIR``,
     the file's ``__pycache__``, the user's cache directory), None when none is writable."""
@@ -194,3 +206,15 @@ def float64_vector(a) -> bool:
 def _float64_vector(a):
     answer = isinstance(a, numba.types.Array) and a.dtype == numba.types.float64 and a.ndim == 1
     return lambda a: answer
+
+
+def runtime_value(x):
+    """`x` as a value known only at run time, in compiled code: numba compiles a called kernel once per constant it
+    is given (``Literal[bool](True)``), so a flag passed as a constant by one caller and as a variable by another
+    compiled the kernel twice; through this, once, for the constant's type."""
+    return x
+
+
+@overload(runtime_value)
+def _runtime_value(x):
+    return lambda x: x  # typed for the argument's type without its constant value (numba tries that first)

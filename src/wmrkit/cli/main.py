@@ -152,13 +152,27 @@ COMPILE_NOTICE_UNCACHED = ("wmrkit: compiling numerical kernels for this machine
                            "cache directory; set NUMBA_CACHE_DIR to one)...")
 
 
+#: The line instead when the dynamics kernels compile for the first time (``simulate``, ``track --dynamics``, the slip
+#: studies), printed as soon as they start: they take the longest.
+DYNAMICS_NOTICE = ("wmrkit: compiling the dynamics kernels for this machine (first run only, about 15 s; cached for "
+                   "the next runs)...")
+#: Seconds of compilation after which :data:`DYNAMICS_NOTICE` is printed.
+DYNAMICS_NOTICE_AFTER = 0.25
+
+
 def _compile_notice(done: threading.Event, poll: float = 0.25) -> None:
     """Say once on stderr that numba is compiling, when it has compiled for :data:`COMPILE_NOTICE_AFTER` s without
-    a pause (a first run on a machine, e.g. the dynamics kernels: about 20 s, silent otherwise); numba is never
-    imported here, only watched once a command has imported it."""
-    busy = 0.0
+    a pause (a first run on a machine, silent otherwise), or for :data:`DYNAMICS_NOTICE_AFTER` s the dynamics
+    kernels that are not cached yet (about 15 s); numba is never imported here, only watched once a command has
+    imported it."""
+    busy, dynamics = 0.0, None
     while not done.wait(poll):
         busy = busy + poll if _compiling() else 0.0
+        if dynamics is None and busy > 0:
+            dynamics = _first_dynamics_compile()
+        if dynamics and busy >= DYNAMICS_NOTICE_AFTER:
+            print(DYNAMICS_NOTICE, file=sys.stderr, flush=True)
+            return
         if busy >= COMPILE_NOTICE_AFTER:
             uncached = getattr(sys.modules.get("wmrkit._jit"), "UNCACHED", ())
             print(COMPILE_NOTICE_UNCACHED if uncached else COMPILE_NOTICE, file=sys.stderr, flush=True)
@@ -318,6 +332,13 @@ def _version() -> str:
     from .. import __version__
 
     return __version__
+
+
+def _first_dynamics_compile() -> bool | None:
+    """Whether a command compiles the dynamics step for the first time (``dynamics._integrate.first_compile``); None
+    until it has imported it."""
+    first_compile = getattr(sys.modules.get("wmrkit.dynamics._integrate"), "first_compile", None)
+    return None if first_compile is None else first_compile()
 
 
 def _compiling() -> bool:

@@ -11,15 +11,17 @@ wrap(beta_ref - beta) - kd beta_dot``, saturated smoothly as ``steer_max tanh(u 
 Speed (issue 10): the kernels of a step are inlined into :func:`run_semi_implicit`, which is compiled without numba's
 reference counting (nothing in it allocates), but for the mass matrix and the normal loads, called (compiled once:
 :func:`wmrkit.dynamics._kernels._called`); a record reuses the assembly of the step that starts at its time.
+The first compile (docs/limits.md, "First run on a machine"): the step is written in the loop, not inlined from
+nested functions (:func:`_semi_implicit_kernel`), and every kernel is compiled for one set of argument types.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
 
+from .._jit import disk_cached, runtime_value
 from ._kernels import (
     _inline,
     _njit,
@@ -157,34 +159,33 @@ def solve_geared(mat, rhs, t, red, y):
     (``model.gear_basis``; the plain solve when ``p = 0``, no gear); `mat` is overwritten, `red` ``(p, p)`` and
     `y` ``(p,)`` are scratch."""
     n, p = t.shape
-    if p == 0:
-        solve_in_place(mat, rhs)
-        return
-    for i in range(p):
-        acc = 0.0
-        for k in range(n):
-            acc += t[k, i] * rhs[k]
-        y[i] = acc
-    for k in range(n):  # mat <- mat T, in its first p columns
+    if p > 0:
         for i in range(p):
-            acc = 0.0
-            for l in range(n):
-                acc += mat[k, l] * t[l, i]
-            rhs[i] = acc  # rhs is free once y holds T' rhs: a row of (mat T)
-        for i in range(p):
-            mat[k, i] = rhs[i]
-    for i in range(p):
-        for j in range(p):
             acc = 0.0
             for k in range(n):
-                acc += t[k, i] * mat[k, j]
-            red[i, j] = acc
-    solve_in_place(red, y)
-    for k in range(n):
-        acc = 0.0
+                acc += t[k, i] * rhs[k]
+            y[i] = acc
+        for k in range(n):  # mat <- mat T, in its first p columns
+            for i in range(p):
+                acc = 0.0
+                for l in range(n):
+                    acc += mat[k, l] * t[l, i]
+                rhs[i] = acc  # rhs is free once y holds T' rhs: a row of (mat T)
+            for i in range(p):
+                mat[k, i] = rhs[i]
         for i in range(p):
-            acc += t[k, i] * y[i]
-        rhs[k] = acc
+            for j in range(p):
+                acc = 0.0
+                for k in range(n):
+                    acc += t[k, i] * mat[k, j]
+                red[i, j] = acc
+    solve_in_place(red if p > 0 else mat, y if p > 0 else rhs)  # one copy of the elimination to compile
+    if p > 0:
+        for k in range(n):
+            acc = 0.0
+            for i in range(p):
+                acc += t[k, i] * y[i]
+            rhs[k] = acc
 
 
 @_inline
@@ -205,13 +206,12 @@ def solve_held(mat, rhs, pack, w):
             rhs[i] += c[i]
 
 
-@functools.partial(_njit, nrt=False)
-def assembled(t, s, acc, pack, inp, jac, w):
-    """:func:`assemble` compiled once, for the records (:func:`observe`, the last one of a run) and the explicit
-    derivative. Inlined into each of them the model was compiled once more per caller: 100 s of CPU the first time
-    ``wmrkit simulate`` ran, against 60 s. The step loop keeps its own inlined copy: called, the model's and work
-    arrays are passed by value at every step (measured up to 10 % more a step, under load)."""
-    assemble(t, s, acc, pack, inp, jac, w)
+#: :func:`assemble` compiled once and called, for the records (:func:`observe`, the last one of a run) and the explicit
+#: derivative: its own source compiled (inlined into each of them the model was compiled once more per caller, 100 s
+#: of CPU the first time ``wmrkit simulate`` ran, against 60 s; inlined into a wrapper, once more for the wrapper).
+#: The step loop keeps its own inlined copy: called, the model's and work arrays are passed by value at every step
+#: (measured up to 10 % more a step, under load).
+assembled = _njit(assemble.py_func, nrt=False)
 
 
 @_njit
@@ -221,7 +221,7 @@ def derivative(t, s, acc, pack, inp, w):
     if pack[17].shape[0] > 0:
         s = s.copy()
         hold_linkages(s, pack, w[19], w[20], True)
-    assembled(t, s, acc, pack, inp, False, w)
+    assembled(t, s, acc, pack, inp, runtime_value(False), w)
     n = w[9].shape[0]
     out = np.empty(2 * n)
     th = s[2]
@@ -261,48 +261,6 @@ def _implicit_matrix(a, m, g, kdiag, pack, dt, mat):
                     mat[c, d] -= dt * kdiag[c] * ratio[d] / ratio[c]
 
 
-@_inline
-def _update_semi_implicit(s, dt, acc, w, pack, linked):
-    """One linearly implicit Euler step from the assembled work arrays `w` (:func:`assemble`): friction and servo
-    Jacobians implicit, then positions with the new velocity.
-
-    The tyre Jacobian ``dF/dv_slip`` is refreshed when the assembly was asked for it and reused otherwise (a W-method).
-    A step whose linearised tyre forces exceed their grip is linearised again where it arrived and solved again,
-    Newton iterations of the implicit step (:mod:`._newton`), at most ``GRIP_ITERATIONS``; the next step then
-    refreshes the Jacobian. One loop solves them all: one copy of the solve to compile (docs/limits.md).
-    """
-    a, m, fz, f, g, kdiag, rhs, mat = w[0], w[1], w[3], w[4], w[5], w[8], w[9], w[14]
-    n = rhs.shape[0]
-    for c in range(n):
-        w[21][c] = rhs[c]
-        w[24][c] = 0.0
-    if linked:
-        hold_linkages(s, pack, w[19], w[20], False)  # the linkages' basis at the step's start
-    w[26][0] = 0.0
-    it = 0
-    while True:
-        _implicit_matrix(a, m, g, kdiag, pack, dt, mat)
-        solve_held(mat, rhs, pack, w)  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt, gears and linkages held
-        beyond = beyond_grip(a, rhs, w[24], w[23] if it > 0 else f, g, fz, pack, dt, w[27])
-        if it == GRIP_ITERATIONS or (it == 0 and not beyond):
-            break
-        w[26][0] = 1.0  # `g` becomes the Jacobian where the step arrived: the next step refreshes it at its start
-        if relinearise(s, dt, w, pack):
-            break
-        it += 1
-    dnu = rhs
-    for c in range(n):
-        acc[c] = dnu[c]
-        s[n + c] += dt * dnu[c]
-    th = s[2] + 0.5 * dt * s[n + 2]
-    s[0] += dt * (math.cos(th) * s[n] - math.sin(th) * s[n + 1])
-    s[1] += dt * (math.sin(th) * s[n] + math.cos(th) * s[n + 1])
-    for c in range(2, n):
-        s[c] += dt * s[n + c]
-    if linked:
-        hold_linkages(s, pack, w[19], w[20], True)  # the followers set from their leaders (no drift)
-
-
 @_njit
 def step_rk4(t, s, dt, acc, pack, inp, w):
     """One classical Runge-Kutta step (explicit; for smooth, non-stiff cases such as frictionless checks)."""
@@ -316,7 +274,7 @@ def step_rk4(t, s, dt, acc, pack, inp, w):
 
 @_inline
 def _observe(t, s, acc, pack, inp, w, rec, i):
-    assembled(t, s, acc, pack, inp, False, w)
+    assembled(t, s, acc, pack, inp, runtime_value(False), w)
     _store(t, s, w, rec, i)
 
 
@@ -340,50 +298,91 @@ def _store(t, s, w, rec, i):
 
 
 @_njit
-def observe(t, s, acc, pack, inp, w, rec, i):
-    """Store the state's outputs in the record arrays ``rec`` at row `i`, `s` first set on the linkages (an
-    adaptive run's states: the solver integrates the followers too)."""
-    hold_linkages(s, pack, w[19], w[20], True)
-    _observe(t, s, acc, pack, inp, w, rec, i)
-
-
-@_njit
 def _hold(s, pack, w):
     hold_linkages(s, pack, w[19], w[20], True)
 
 
-@_inline
-def _semi_implicit_steps(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0, linked):
-    i = i0
-    for j in range(n_steps):
-        k = k0 + j
-        assemble(k * dt, s, acc, pack, inp, (k - jac_phase) % jac_every == 0 or w[26][0] == 1.0, w)
-        if j > 0 and k % every == 0 and i < rec[0].shape[0]:  # the step's assembly is the record at t = k dt
-            _store(k * dt, s, w, rec, i)
+def observe(t, s, acc, pack, inp, w, rec, i):
+    """Store the state's outputs in the record arrays ``rec`` at row `i`, `s` first set on the linkages (an
+    adaptive run's states: the solver integrates the followers too). Calls from Python into kernels the step loop
+    compiles anyway (:func:`assembled`) or small ones, and :func:`_store`'s few products as Python (the same
+    arithmetic): compiled as one kernel, they took 2.5 s of a first run to compile."""
+    if pack[17].shape[0] > 0:
+        _hold(s, pack, w)
+    assembled(t, s, acc, pack, inp, False, w)
+    _store.py_func(t, s, w, rec, i)
+
+
+def _semi_implicit_kernel(linked: bool):
+    """:func:`run_semi_implicit` compiled with `linked` a constant of its closure: for a robot without a linkage the
+    linkages' code is compiled out of its loop (in it, not taken, it cost 5-7 %).
+
+    The step is written in the loop rather than inlined from shared functions: numba inlines a function by copying
+    its IR block by block, each block with a copy of every variable of the function, a cost that grows with the
+    square of its size and again at each level of nesting; the loop and the step, each inlined, took 60 % of the
+    first compile of ``wmrkit simulate`` (docs/limits.md, "First run on a machine")."""
+
+    def run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0):
+        """`n_steps` linearly implicit Euler steps from `s` (changed in place) at step `k0` (``t = k0 dt``); a record
+        every `every` steps from row `i0`; returns the next row. Compiled without reference counting (it allocates
+        nothing).
+
+        Each step assembles the model (:func:`assemble`), then takes the friction and servo Jacobians implicit and
+        the positions with the new velocity. The tyre Jacobian ``dF/dv_slip`` is refreshed at the steps ``k =
+        jac_phase (mod jac_every)`` and reused otherwise (a W-method). A step whose linearised tyre forces exceed
+        their grip is linearised again where it arrived and solved again, Newton iterations of the implicit step
+        (:mod:`._newton`), at most ``GRIP_ITERATIONS``; the next step then refreshes the Jacobian. One loop solves
+        them all: one copy of the solve to compile (docs/limits.md)."""
+        a, m, fz, f, g, kdiag, rhs, mat = w[0], w[1], w[3], w[4], w[5], w[8], w[9], w[14]
+        n = rhs.shape[0]
+        i = i0
+        for j in range(n_steps):
+            k = k0 + j
+            assemble(k * dt, s, acc, pack, inp, (k - jac_phase) % jac_every == 0 or w[26][0] == 1.0, w)
+            if j > 0 and k % every == 0 and i < rec[0].shape[0]:  # the step's assembly is the record at t = k dt
+                _store(k * dt, s, w, rec, i)
+                i += 1
+            for c in range(n):
+                w[21][c] = rhs[c]
+                w[24][c] = 0.0
+            if linked:
+                hold_linkages(s, pack, w[19], w[20], False)  # the linkages' basis at the step's start
+            w[26][0] = 0.0
+            it = 0
+            while True:
+                _implicit_matrix(a, m, g, kdiag, pack, dt, mat)
+                solve_held(mat, rhs, pack, w)  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt, gears, linkages held
+                beyond = beyond_grip(a, rhs, w[24], w[23] if it > 0 else f, g, fz, pack, dt, w[27])
+                if it == GRIP_ITERATIONS or (it == 0 and not beyond):
+                    break
+                w[26][0] = 1.0  # `g` becomes the Jacobian where the step arrived: the next step refreshes it
+                if relinearise(s, dt, w, pack):
+                    break
+                it += 1
+            dnu = rhs
+            for c in range(n):
+                acc[c] = dnu[c]
+                s[n + c] += dt * dnu[c]
+            th = s[2] + 0.5 * dt * s[n + 2]
+            s[0] += dt * (math.cos(th) * s[n] - math.sin(th) * s[n + 1])
+            s[1] += dt * (math.sin(th) * s[n] + math.cos(th) * s[n + 1])
+            for c in range(2, n):
+                s[c] += dt * s[n + c]
+            if linked:
+                hold_linkages(s, pack, w[19], w[20], True)  # the followers set from their leaders (no drift)
+        k = k0 + n_steps
+        if n_steps > 0 and k % every == 0 and i < rec[0].shape[0]:
+            _observe(k * dt, s, acc, pack, inp, w, rec, i)
             i += 1
-        _update_semi_implicit(s, dt, acc, w, pack, linked)
-    k = k0 + n_steps
-    if n_steps > 0 and k % every == 0 and i < rec[0].shape[0]:
-        _observe(k * dt, s, acc, pack, inp, w, rec, i)
-        i += 1
-    return i
+        return i
+
+    return _njit(run_semi_implicit, nrt=False)
 
 
-@functools.partial(_njit, nrt=False)
-def run_semi_implicit(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0):
-    """`n_steps` semi-implicit steps (:func:`_update_semi_implicit`) from `s` (changed in place) at step `k0`
-    (``t = k0 dt``), refreshing the tyre Jacobian at the steps ``k = jac_phase (mod jac_every)``; a record every
-    `every` steps from row `i0`; returns the next row. Compiled without reference counting (it allocates nothing).
-    For a robot without a linkage: the linkages' code is compiled out of its loop (in it, not taken, it cost 5-7 %).
-    """
-    return _semi_implicit_steps(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0, False)
-
-
-@functools.partial(_njit, nrt=False)
-def run_semi_implicit_linked(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0):
-    """:func:`run_semi_implicit` holding the linkages (``pack[17]``): each step sets the followers from their leaders;
-    compiled at its first use, by a robot with a linkage."""
-    return _semi_implicit_steps(s, k0, dt, n_steps, every, jac_every, jac_phase, acc, pack, inp, w, rec, i0, True)
+run_semi_implicit = _semi_implicit_kernel(False)
+#: :func:`run_semi_implicit` holding the linkages (``pack[17]``): each step sets the followers from their leaders;
+#: compiled at its first use, by a robot with a linkage.
+run_semi_implicit_linked = _semi_implicit_kernel(True)
 
 
 @_njit
@@ -417,3 +416,9 @@ def run(s, k0, dt, n_steps, every, method, jac_every, acc, pack, inp, w, rec, i0
     except ZeroDivisionError:
         s[:] = math.nan
         return i0
+
+
+def first_compile() -> bool:
+    """Whether the step loops are about to be compiled rather than loaded from numba's disk cache: a first run on a
+    machine, which compiles the dynamics kernels for about 15 s (the CLI says so before)."""
+    return [disk_cached(kernel) for kernel in (run_semi_implicit, run_semi_implicit_linked)] == [False, False]

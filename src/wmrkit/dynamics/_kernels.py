@@ -25,6 +25,7 @@ import math
 import types
 from pathlib import Path
 
+from .._jit import __file__ as jit_file
 from .._jit import compile_cached, drop_stale_cache
 from ..kinematics import linkage_law
 from ..wheels import __file__ as wheels_file
@@ -90,7 +91,8 @@ def _compiled_namespace():
 
 
 _STEPS = [str(Path(__file__).with_name(f)) for f in ("_integrate.py", "_newton.py")]  # step kernels
-drop_stale_cache([__file__, *_STEPS, tyres.__file__], [wheels_file, linkages.__file__, linkage_law.__file__])
+drop_stale_cache([__file__, *_STEPS, tyres.__file__],
+                 [wheels_file, linkages.__file__, linkage_law.__file__, jit_file])  # _jit: runtime_value
 _NS = _compiled_namespace()
 _linear, _coulomb, _dugoff, _pacejka = (_NS[n] for n in ("linear_forces", "coulomb_forces", "dugoff_forces",
                                                           "pacejka_forces"))

@@ -4,7 +4,7 @@ The step linearises the tyre forces at its start, ``F + dt G A dnu``, and a tyre
 rest (zero slip) the first step would grip at many times ``mu Fz`` and the next step's load transfer would empty the
 drive wheels (docs/dynamics.md, "a start from rest"). A step whose linearised force exceeds the tyre's grip
 (:func:`~._kernels.grip`, :func:`beyond_grip`) is linearised again where it arrived (:func:`relinearise`) and
-solved again (:func:`wmrkit.dynamics._integrate._update_semi_implicit`), until its forces are those its
+solved again (:func:`wmrkit.dynamics._integrate.run_semi_implicit`), until its forces are those its
 linearisation predicted. The re-linearisation is rare: it is compiled once and called, not inlined into the step
 loop, and its tyre forces are the compiled copy the step and the records call (:func:`~._kernels.contact_forces`).
 
@@ -16,6 +16,7 @@ forces the linearisation predicts.
 
 from __future__ import annotations
 
+from .._jit import runtime_value
 from ._kernels import _called, _inline, contact_forces, grip
 
 #: Newton iterations at most in a semi-implicit step whose linearised tyre forces exceed their grip.
@@ -75,7 +76,7 @@ def relinearise(s, dt, w, pack):
     for c in range(n):
         d_lin[c] = rhs[c]
         nu_i[c] = s[n + c] + dt * rhs[c]
-    contact_forces(a, nu_i, pack, fz, f_i, g, vw, True)
+    contact_forces(a, nu_i, pack, fz, f_i, g, vw, runtime_value(True))  # one compiled _contacts
     if _converged(f_i, w[27], fz, pack):
         return True
     for c in range(n):

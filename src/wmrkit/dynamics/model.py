@@ -289,13 +289,14 @@ def _build(robot: Robot, tyre: Tyre | None, gravity: float) -> DynamicModel:
             np.array(steer_prm, dtype=float).reshape(-1, 5), diag_i, carry,
             np.array([body.mass, body.inertia, *body.com, body.com_height, gravity]),
             np.array(np.linalg.pinv(geo), order="C"), np.array([0 if moving else 1], dtype=np.int64),
-            *_differentials(robot, names))
+            *_differentials(robot, names),
+            np.zeros(n_el),  # 15: the contacts loaded at rest (lift-off: _integrate.assemble), set below
+            *_coupling_pack(robot, tuple(names)))  # 16, 17: the motions the couplings allow, the linkages
     from ._kernels import normal_loads
 
-    static = np.zeros(n_el)
+    static = np.zeros(n_el)  # from the whole pack (the loads read none of 15-17): one compiled normal_loads
     normal_loads(np.array(robot.beta, dtype=float), np.zeros(n), np.zeros(n), pack, static)
-    pack = (*pack, (static > 0).astype(float),  # 15: the contacts loaded at rest (lift-off: _integrate.assemble)
-            *_coupling_pack(robot, tuple(names)))  # 16, 17: the motions the couplings allow, the linkages
+    pack[15][:] = static > 0
     contacts = contact_names(robot)
     spread = np.linalg.svd(geo, compute_uv=False)
     if len(spread) < 3 or spread[2] <= 1e-9 * spread[0]:  # (7.64) has no solution: a pitch moment would be left
