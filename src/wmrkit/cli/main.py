@@ -335,9 +335,9 @@ def _version() -> str:
 
 
 def _first_dynamics_compile() -> bool | None:
-    """Whether a command compiles the dynamics step for the first time (``dynamics._integrate.first_compile``); None
-    until it has imported it."""
-    first_compile = getattr(sys.modules.get("wmrkit.dynamics._integrate"), "first_compile", None)
+    """Whether a command compiles the dynamics kernels for the first time (``dynamics._kernels.first_compile``); None
+    until it has imported them."""
+    first_compile = getattr(sys.modules.get("wmrkit.dynamics._kernels"), "first_compile", None)
     return None if first_compile is None else first_compile()
 
 

@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from .._jit import disk_cached, runtime_value
+from .._jit import runtime_value
 from ._kernels import (
     _inline,
     _njit,
@@ -159,33 +159,33 @@ def solve_geared(mat, rhs, t, red, y):
     (``model.gear_basis``; the plain solve when ``p = 0``, no gear); `mat` is overwritten, `red` ``(p, p)`` and
     `y` ``(p,)`` are scratch."""
     n, p = t.shape
-    if p > 0:
+    for i in range(p):  # no gear (p = 0): these loops are empty and `mat` itself is solved
+        acc = 0.0
+        for k in range(n):
+            acc += t[k, i] * rhs[k]
+        y[i] = acc
+    for k in range(n):  # mat <- mat T, in its first p columns
         for i in range(p):
+            acc = 0.0
+            for l in range(n):
+                acc += mat[k, l] * t[l, i]
+            rhs[i] = acc  # rhs is free once y holds T' rhs: a row of (mat T)
+        for i in range(p):
+            mat[k, i] = rhs[i]
+    for i in range(p):
+        for j in range(p):
             acc = 0.0
             for k in range(n):
-                acc += t[k, i] * rhs[k]
-            y[i] = acc
-        for k in range(n):  # mat <- mat T, in its first p columns
-            for i in range(p):
-                acc = 0.0
-                for l in range(n):
-                    acc += mat[k, l] * t[l, i]
-                rhs[i] = acc  # rhs is free once y holds T' rhs: a row of (mat T)
-            for i in range(p):
-                mat[k, i] = rhs[i]
-        for i in range(p):
-            for j in range(p):
-                acc = 0.0
-                for k in range(n):
-                    acc += t[k, i] * mat[k, j]
-                red[i, j] = acc
+                acc += t[k, i] * mat[k, j]
+            red[i, j] = acc
     solve_in_place(red if p > 0 else mat, y if p > 0 else rhs)  # one copy of the elimination to compile
-    if p > 0:
-        for k in range(n):
-            acc = 0.0
-            for i in range(p):
-                acc += t[k, i] * y[i]
-            rhs[k] = acc
+    if p == 0:
+        return
+    for k in range(n):
+        acc = 0.0
+        for i in range(p):
+            acc += t[k, i] * y[i]
+        rhs[k] = acc
 
 
 @_inline
@@ -417,8 +417,3 @@ def run(s, k0, dt, n_steps, every, method, jac_every, acc, pack, inp, w, rec, i0
         s[:] = math.nan
         return i0
 
-
-def first_compile() -> bool:
-    """Whether the step loops are about to be compiled rather than loaded from numba's disk cache: a first run on a
-    machine, which compiles the dynamics kernels for about 15 s (the CLI says so before)."""
-    return [disk_cached(kernel) for kernel in (run_semi_implicit, run_semi_implicit_linked)] == [False, False]

@@ -26,7 +26,7 @@ import types
 from pathlib import Path
 
 from .._jit import __file__ as jit_file
-from .._jit import compile_cached, drop_stale_cache
+from .._jit import compile_cached, disk_cached, drop_stale_cache
 from ..kinematics import linkage_law
 from ..wheels import __file__ as wheels_file
 from ..wheels import slip_row_entries
@@ -362,3 +362,10 @@ def solve_in_place(a, x):
         for c in range(i + 1, n):
             s -= a[i, c] * x[c]
         x[i] = s / a[i, i]
+
+
+def first_compile() -> bool:
+    """Whether the dynamics kernels are about to be compiled rather than loaded from numba's disk cache: neither the
+    normal loads (a model's first kernel) nor the tyre forces (every run's) are there. A first run on a machine, which
+    compiles them for about 15 s (the CLI says so as it starts)."""
+    return [disk_cached(kernel) for kernel in (normal_loads, _contacts)] == [False, False]
