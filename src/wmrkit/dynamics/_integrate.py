@@ -159,7 +159,10 @@ def solve_geared(mat, rhs, t, red, y):
     (``model.gear_basis``; the plain solve when ``p = 0``, no gear); `mat` is overwritten, `red` ``(p, p)`` and
     `y` ``(p,)`` are scratch."""
     n, p = t.shape
-    for i in range(p):  # no gear (p = 0): these loops are empty and `mat` itself is solved
+    if p == 0:
+        solve_in_place(mat, rhs)
+        return
+    for i in range(p):
         acc = 0.0
         for k in range(n):
             acc += t[k, i] * rhs[k]
@@ -178,9 +181,7 @@ def solve_geared(mat, rhs, t, red, y):
             for k in range(n):
                 acc += t[k, i] * mat[k, j]
             red[i, j] = acc
-    solve_in_place(red if p > 0 else mat, y if p > 0 else rhs)  # one copy of the elimination to compile
-    if p == 0:
-        return
+    solve_in_place(red, y)
     for k in range(n):
         acc = 0.0
         for i in range(p):
