@@ -44,7 +44,9 @@ def test_a_stepper_spun_beyond_the_physical_range_stops_there(spun, pieces, rech
                         r"\(limits\.MAX_SPEED\)\); use smaller torques or speeds", str(err.value)), str(err.value)
     assert 0.05 <= err.value.t <= 0.1 + 1e-9 and err.value.t == pytest.approx(stepper.t)
     rim = np.abs(stepper.state[model.n + 3:model.n + 5]).max() * RADIUS  # its state where it stopped
-    assert MAX_SPEED < rim < TORQUE / SPIN_INERTIA * RADIUS * err.value.t
+    # at most free spinning: equal since the step's loads are those of its own acceleration, whose reaction tips
+    # the robot onto its castor (the drive wheels unloaded, their tyres hold nothing)
+    assert MAX_SPEED < rim <= TORQUE / SPIN_INERTIA * RADIUS * err.value.t
 
 
 def test_advance_stops_there_too(spun):

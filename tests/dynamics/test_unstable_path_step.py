@@ -64,20 +64,22 @@ def _runs_at(model, inputs, duration, step):
     return coarse, fine
 
 
-def test_a_robot_without_load_transfer_off_its_path_at_20_ms_is_refused(tmp_path, capsys):
-    """At 20 ms the flat forklift backs off its rectangle (-0.25 m/s at t = 2 s where 2 are asked; 0.5 m off by
-    0.64 s); at 1 ms it keeps to it. The numbers of the refusal are those of the two runs made here."""
+def test_a_robot_without_load_transfer_off_its_path_at_25_ms_is_refused(tmp_path, capsys):
+    """At 25 ms the flat forklift crawls along its rectangle (0.08 m/s at t = 2 s where 2 are asked; 0.5 m off by
+    0.78 s); at 1 ms it keeps to it. The numbers of the refusal are those of the two runs made here. (At 20 ms it
+    backed off at -0.25 m/s until the step's Newton iterations searched along their direction, December 2026: it now
+    keeps within 1.26 m of the path there, under the tolerance.)"""
     flat = _flat_forklift(tmp_path)
     model = DynamicModel.of(catalog.resolve(flat))
     inputs, duration = path_program(model, "rectangle")
-    coarse, fine = _runs_at(model, inputs, duration, 0.02)
+    coarse, fine = _runs_at(model, inputs, duration, 0.025)
     assert coarse.deviation().large and not fine.deviation().large
-    err = _refused(capsys, "simulate", str(flat), "--path", "rectangle", "--step", "0.02")
-    assert (f"at step 0.02 s (up to {coarse.deviation().max_position:.3g} m from it), but a run at step 0.001 s to "
+    err = _refused(capsys, "simulate", str(flat), "--path", "rectangle", "--step", "0.025")
+    assert (f"at step 0.025 s (up to {coarse.deviation().max_position:.3g} m from it), but a run at step 0.001 s to "
             f"t = {coarse.t[-1]:g} s keeps within {fine.deviation().max_position:.3g} m of the path") in err
     assert "use a step of at most 0.001 s" in err
-    early = simulate(model, inputs, 1.0, step=0.02)
-    exact = simulate(model, inputs, 1.0, method="rk4", step=1e-4, record_step=0.02)  # the premise, by explicit rk4
+    early = simulate(model, inputs, 1.0, step=0.025)
+    exact = simulate(model, inputs, 1.0, method="rk4", step=1e-4, record_step=0.025)  # the premise, by explicit rk4
     assert exact.twist[-1, 0] > 1.9 and np.hypot(*(exact.pose[-1, :2] - exact.nominal_pose[-1, :2])) < 0.1
     assert np.hypot(*(early.pose[:, :2] - early.nominal_pose[:, :2]).T).max() > 0.5
 

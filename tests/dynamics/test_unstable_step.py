@@ -5,8 +5,10 @@ torques; a lift-off that the shorter step and the adaptive integrator reproduce 
 The stops of a step too long are those of an unstable integration: their times depend on the floating point of the
 CPU (numba compiles for the host), so no test pins one. Each expected stop is that of an independent run of the
 same inputs at the same step without the re-check (:func:`coarse_stop`), and the examples are ones whose stop a
-relative change of 1e-12 in the program's speed does not move (the forklift's rectangle at 2 m/s and 25 ms stops at
-4.275 s for every one of nine such speeds, where at 20 ms it ran, stopped at 5.64 s or ran)."""
+relative change of 1e-12 in the program's speed does not move (the forklift's rectangle at 2 m/s and 80 ms stops at
+6.72 s for every one of nine such speeds, where at 62.5 ms it stopped between 6.81 and 17.4 s). Since the step's
+Newton iterations search along their direction (``_newton.line_search``, December 2026) the rectangle at 2 and 2.5
+m/s runs at every step up to 50 ms, which 'lifted off' at 20 to 33 ms before."""
 
 from __future__ import annotations
 
@@ -24,8 +26,15 @@ from wmrkit.dynamics.runs import RECHECK_MAX_STEP, LiftOffError, recheck_step
 from wmrkit.dynamics.simulate import Stepper, simulate
 from wmrkit.errors import WmrkitError
 
-#: (speed [m/s], step [s]) of the forklift's rectangle whose 'lift-off' the 1 ms step does not have.
-STEP_STOPS = [(2.0, 0.025), (2.5, 0.02), (2.5, 0.033)]
+#: Steps [s] of the forklift's rectangle at 2 m/s whose 'lift-off' the 1 ms step does not have (at 6.72, 9.875 and
+#: 3.6 s). `wmrkit simulate --path` refuses steps longer than its servos' time constant (1/30 s), where the rectangle
+#: now runs at every step: these are Python calls, and the command's door is shown on rk4's stop (RK4_TURN).
+STEP_STOPS = [0.08, 0.125, 0.2]
+#: The rectangle's step [s] of the tests below, and the figure-eight's at 2.8 m/s ('left_drive' at 6.5 s, where the
+#: 1 ms step loses it at 7.81 s).
+STEP, EIGHT_STEP = 0.125, 0.1
+#: A stop of rk4's step that `wmrkit simulate` takes (the forklift's turn, rk4 at 5 ms).
+RK4_TURN = ("simulate", "forklift", "--path", "turn", "--method", "rk4", "--step", "0.005")
 
 
 def _error(capsys, *argv: str) -> str:
@@ -48,19 +57,21 @@ def forklift():
     return DynamicModel.of(catalog.load("forklift"))
 
 
-@pytest.mark.parametrize(("speed", "step"), STEP_STOPS)
-def test_a_lift_off_of_the_step_not_the_robot_is_called_the_step(forklift, speed, step, capsys):
-    inputs, duration = path_program(forklift, "rectangle", speed=speed)
+@pytest.mark.parametrize("step", STEP_STOPS)
+def test_a_lift_off_of_the_step_not_the_robot_is_called_the_step(forklift, step):
+    inputs, duration = path_program(forklift, "rectangle")
     stop = coarse_stop(forklift, inputs, step)
-    err = _error(capsys, "simulate", "forklift", "--path", "rectangle", "--speed", f"{speed:g}", "--step", f"{step:g}")
-    assert err == (f"wmrkit: error: contact '{stop.contact}' lost its load at t = {stop.t:.6g} s at step {step:g} s, "
-                   f"but a run at step 0.001 s goes on to t = {round(duration / step) * step:.6g} s without it: the "
-                   "step is too long for the tyres (the integration is unstable, not the robot); use a step of at "
-                   "most 0.001 s (--step) or the adaptive method\n")
+    with pytest.raises(WmrkitError) as err:
+        simulate(forklift, inputs, duration, step=step)
+    assert str(err.value) == (
+        f"contact '{stop.contact}' lost its load at t = {stop.t:.6g} s at step {step:g} s, but a run at step 0.001 s "
+        f"goes on to t = {round(duration / step) * step:.6g} s without it: the step is too long for the tyres (the "
+        "integration is unstable, not the robot); use a step of at most 0.001 s (the step keyword) or "
+        "method='adaptive'")
 
 
 def test_the_refusal_under_json_is_one_error_object(capsys):
-    assert main(["simulate", "forklift", "--path", "rectangle", "--step", "0.025", "--json"]) == 2
+    assert main([*RK4_TURN, "--json"]) == 2
     out, err = capsys.readouterr()
     assert out == "" and len(err.splitlines()) == 1
     assert "the step is too long for the tyres" in json.loads(err)["error"]
@@ -68,15 +79,15 @@ def test_the_refusal_under_json_is_one_error_object(capsys):
 
 def test_the_premise_the_robot_keeps_its_wheels_down_by_two_other_integrators(forklift):
     """Independently of the re-check: the explicit rk4 at 0.1 ms and the semi-implicit method at 1 ms drive the
-    rectangle at 2 m/s past the 25 ms run's stop with every wheel's load far from 0, where 25 ms 'lost' one (LSODA
+    rectangle at 2 m/s past the 80 ms run's stop with every wheel's load far from 0, where 80 ms 'lost' one (LSODA
     agrees, 0.84 of the load at rest at least, but takes 13 s for it)."""
     inputs, _ = path_program(forklift, "rectangle")
-    stop = coarse_stop(forklift, inputs, 0.025)
+    stop = coarse_stop(forklift, inputs, STEP_STOPS[0])
     at_rest = forklift.normal_loads()
     for method, step in (("rk4", 1e-4), ("semi-implicit", 1e-3)):
         sim = simulate(forklift, inputs, stop.t + 0.5, method=method, step=step, record_step=0.01)
         assert (sim.loads.min(axis=0) > 0.5 * at_rest).all()
-    coarse = simulate(forklift, inputs, stop.t, step=0.025, record_step=0.025, allow_lift_off=True)
+    coarse = simulate(forklift, inputs, stop.t, step=STEP_STOPS[0], record_step=STEP_STOPS[0], allow_lift_off=True)
     assert coarse.loads[:, forklift.contacts.index(stop.contact)].min() == 0.0  # its own lift-off
 
 
@@ -118,17 +129,20 @@ def test_the_recheck_step_is_a_whole_fraction_of_the_step_at_most_a_quarter_and_
 
 
 def test_a_robot_lift_off_the_shorter_step_reaches_late_is_not_blamed_on_the_step(forklift, capsys):
-    """The forklift's figure-eight at 2.8 m/s 'loses' a drive wheel's load at 30 ms about 2 s in, and the robot
-    loses it at 1 ms about 7.8 s in: the error is that later stop, naming both (each time that of a run without the
-    re-check: at 1 ms, the re-check's step from t = 0, the same run)."""
+    """The forklift's figure-eight at 2.8 m/s 'loses' a drive wheel's load at 100 ms 6.5 s in (at 30 ms 2 s in
+    before the step's line search; 30 to 50 ms now run on), and the robot loses it at 1 ms about 7.8 s in: the error
+    is that later stop, naming both (each time that of a run without the re-check: at 1 ms, the re-check's step from
+    t = 0, the same run)."""
     inputs, _ = path_program(forklift, "figure-eight", speed=2.8)
-    coarse, fine = coarse_stop(forklift, inputs, 0.03), coarse_stop(forklift, inputs, 0.001)
-    assert fine.t > runs.recheck_end(coarse.t, 0.03)  # the premise: the robot's stop, later
-    err = _error(capsys, "simulate", "forklift", "--path", "figure-eight", "--speed", "2.8", "--step", "0.03")
-    assert err == (f"wmrkit: error: contact '{coarse.contact}' lost its load at t = {coarse.t:.6g} s at step 0.03 s, "
-                   f"but a run at step 0.001 s goes on without it until contact '{fine.contact}' lost its load at t = "
-                   f"{fine.t:.6g} s: the robot's stop, which the step brought early; use smaller torques or speeds, "
-                   "and a step of at most 0.001 s (--step) or the adaptive method\n")
+    coarse, fine = coarse_stop(forklift, inputs, EIGHT_STEP), coarse_stop(forklift, inputs, 0.001)
+    assert fine.t > runs.recheck_end(coarse.t, EIGHT_STEP)  # the premise: the robot's stop, later
+    with pytest.raises(LiftOffError) as err:
+        simulate(forklift, inputs, inputs.time[-1], step=EIGHT_STEP)
+    assert str(err.value) == (
+        f"contact '{coarse.contact}' lost its load at t = {coarse.t:.6g} s at step 0.1 s, but a run at step 0.001 s "
+        f"goes on without it until contact '{fine.contact}' lost its load at t = {fine.t:.6g} s: the robot's stop, "
+        "which the step brought early; use smaller torques or speeds, and a step of at most 0.001 s (the step "
+        "keyword) or method='adaptive'")
     # independently, by the loads: the 1 ms run keeps that wheel loaded to just before its stop, and empties it
     sim = simulate(forklift, inputs, fine.t + 0.05, record_step=0.01, allow_lift_off=True)
     load = sim.loads[:, forklift.contacts.index(fine.contact)]
@@ -136,17 +150,17 @@ def test_a_robot_lift_off_the_shorter_step_reaches_late_is_not_blamed_on_the_ste
 
 
 def test_a_recheck_whose_budget_ends_before_the_run_does_says_so(forklift, monkeypatch):
-    """The re-check of the rectangle's stop at 25 ms at 1 ms with a budget of 2 s of steps (from the last record
+    """The re-check of the rectangle's stop at 125 ms at 1 ms with a budget of 2 s of steps (from the last record
     before the stop) cannot reach the run's end: the verdict is not known."""
     monkeypatch.setattr(runs, "RECHECK_STEPS", 2000)
     inputs, duration = path_program(forklift, "rectangle")
-    stop = coarse_stop(forklift, inputs, 0.025)
+    stop = coarse_stop(forklift, inputs, STEP)
     with pytest.raises(WmrkitError) as err:
-        simulate(forklift, inputs, duration, step=0.025)
+        simulate(forklift, inputs, duration, step=STEP)
     assert str(err.value) == (
-        f"contact '{stop.contact}' lost its load at t = {stop.t:.6g} s at step 0.025 s; a run at step 0.001 s goes on "
-        f"without it to t = {stop.t - 0.025 + 2:.6g} s, where the re-check's budget ends, short of the end at t = "
-        f"{round(duration / 0.025) * 0.025:.6g} s: whether the step (the integration unstable) or the robot stops "
+        f"contact '{stop.contact}' lost its load at t = {stop.t:.6g} s at step {STEP:g} s; a run at step 0.001 s goes "
+        f"on without it to t = {stop.t - STEP + 2:.6g} s, where the re-check's budget ends, short of the end at t = "
+        f"{round(duration / STEP) * STEP:.6g} s: whether the step (the integration unstable) or the robot stops "
         "it is not known; use a step of at most 0.001 s (the step keyword) or method='adaptive' to tell, or smaller "
         "torques or speeds")
     assert not isinstance(err.value, LiftOffError)
@@ -154,13 +168,16 @@ def test_a_recheck_whose_budget_ends_before_the_run_does_says_so(forklift, monke
 
 def test_python_simulate_names_its_keyword_and_the_cli_its_option(forklift, capsys):
     """simulate() told Python callers "use a step of at most 0.001 s (--step) or the adaptive method", the CLI's
-    option; now its keyword, and `wmrkit simulate` its option (the later stop's advice as well)."""
-    for name, speed, step in (("rectangle", 2.0, 0.025), ("figure-eight", 2.8, 0.03)):
+    option; now its keyword (the later stop's advice as well: the test above), and `wmrkit simulate` its option."""
+    for name, speed, step in (("rectangle", 2.0, STEP), ("figure-eight", 2.8, EIGHT_STEP)):
         inputs, duration = path_program(forklift, name, speed=speed)
         with pytest.raises(WmrkitError) as err:
             simulate(forklift, inputs, duration, step=step, record_step=step)
         assert str(err.value).endswith("a step of at most 0.001 s (the step keyword) or method='adaptive'")
         assert "--step" not in str(err.value)
-        cli = _error(capsys, "simulate", "forklift", "--path", name, "--speed", str(speed), "--step", str(step))
-        assert cli == f"wmrkit: error: {err.value}\n".replace("(the step keyword) or method='adaptive'",
-                                                               "(--step) or the adaptive method")
+    inputs, duration = path_program(forklift, "turn")
+    with pytest.raises(WmrkitError) as err:
+        simulate(forklift, inputs, duration, method="rk4", step=0.005)
+    assert str(err.value).endswith("a step of at most 0.0001 s (the step keyword) or method='adaptive'")
+    assert _error(capsys, *RK4_TURN) == f"wmrkit: error: {err.value}\n".replace(
+        "(the step keyword) or method='adaptive'", "(--step) or the adaptive method")

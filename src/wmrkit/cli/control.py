@@ -275,7 +275,12 @@ def run_track(args: argparse.Namespace) -> int:
     if failed is not None:  # the sampling warning that foretold it, in the one line of the error
         if not foretold:
             raise failed
-        raise type(failed)(f"{failed} ({'; '.join(foretold)})") from None
+        message = f"{failed} ({'; '.join(foretold)})"
+        try:
+            joined = type(failed)(message)
+        except TypeError:  # a class that takes more (UnstableStepError: the steps and the door): said as it is
+            joined = WmrkitError(message)
+        raise joined from None
     for v in run.range_violations():
         when = f"for {v['duration']:.3g} s (t = {v['from']:.4g} to {v['to']:.4g} s)"
         if "held_by" in v:  # short of its own ends: held there by its linkage or gear, another wheel at its end

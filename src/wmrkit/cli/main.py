@@ -154,7 +154,7 @@ COMPILE_NOTICE_UNCACHED = ("wmrkit: compiling numerical kernels for this machine
 
 #: The line instead when the dynamics kernels compile for the first time (``simulate``, ``track --dynamics``, the slip
 #: studies), printed as soon as they start: they take the longest.
-DYNAMICS_NOTICE = ("wmrkit: compiling the dynamics kernels for this machine (first run only, about 15 s; cached for "
+DYNAMICS_NOTICE = ("wmrkit: compiling the dynamics kernels for this machine (first run only, about 20 s; cached for "
                    "the next runs)...")
 #: Seconds of compilation after which :data:`DYNAMICS_NOTICE` is printed.
 DYNAMICS_NOTICE_AFTER = 0.25
@@ -163,7 +163,7 @@ DYNAMICS_NOTICE_AFTER = 0.25
 def _compile_notice(done: threading.Event, poll: float = 0.25) -> None:
     """Say once on stderr that numba is compiling, when it has compiled for :data:`COMPILE_NOTICE_AFTER` s without
     a pause (a first run on a machine, silent otherwise), or for :data:`DYNAMICS_NOTICE_AFTER` s the dynamics
-    kernels that are not cached yet (about 15 s); numba is never imported here, only watched once a command has
+    kernels that are not cached yet (about 20 s); numba is never imported here, only watched once a command has
     imported it."""
     busy, dynamics = 0.0, None
     while not done.wait(poll):

@@ -33,7 +33,7 @@ from ._kernels import (
     slip_matrix,
     solve_in_place,
 )
-from ._newton import GRIP_ITERATIONS, beyond_grip, relinearise
+from ._newton import GRIP_ITERATIONS, beyond_grip, line_search, loads_moved, newton_matrix, relinearise
 
 
 @_inline
@@ -136,13 +136,16 @@ def assemble(t, s, acc, pack, inp, jac, w):
 
 def work_arrays(n: int, n_el: int, n_steer: int, n_geared: int = 0) -> tuple:
     """Scratch arrays of :func:`assemble`, of :func:`solve_geared` (`n_geared`: the columns of the model's gear
-    basis, ``pack[16]``) and of the step's Newton iterations at the grip (``w[21:28]``: :mod:`._newton`)."""
+    basis, ``pack[16]``) and of the step's Newton iterations at the grip and the loads (``w[21:40]``:
+    :mod:`._newton`)."""
     return (np.zeros((2 * n_el, n)), np.zeros((n, n)), np.zeros((n_steer, n, n)), np.zeros(n_el),
             np.zeros((n_el, 2)), np.zeros((n_el, 2, 2)), np.zeros(n_el), np.zeros(n), np.zeros(n), np.zeros(n),
             np.zeros(n_steer), np.zeros(n_steer), np.zeros(n), np.zeros(n_steer), np.zeros((n, n)),
             np.zeros(1), np.zeros(3), np.zeros((n_geared, n_geared)), np.zeros(n_geared), np.zeros((n, n_geared)),
             np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n_el, 2)), np.zeros(n), np.zeros(n_el),
-            np.zeros(1), np.zeros((n_el, 2)))
+            np.zeros(1), np.zeros((n_el, 2)), np.zeros(n_el), np.zeros((n, n)), np.zeros((n_el, 2)),
+            np.zeros(n_el), np.zeros((n_el, 2)), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+            np.zeros(n), np.zeros(n))
 
 
 def model_work_arrays(model) -> tuple:
@@ -331,9 +334,10 @@ def _semi_implicit_kernel(linked: bool):
         Each step assembles the model (:func:`assemble`), then takes the friction and servo Jacobians implicit and
         the positions with the new velocity. The tyre Jacobian ``dF/dv_slip`` is refreshed at the steps ``k =
         jac_phase (mod jac_every)`` and reused otherwise (a W-method). A step whose linearised tyre forces exceed
-        their grip is linearised again where it arrived and solved again, Newton iterations of the implicit step
-        (:mod:`._newton`), at most ``GRIP_ITERATIONS``; the next step then refreshes the Jacobian. One loop solves
-        them all: one copy of the solve to compile (docs/limits.md)."""
+        their grip, or whose acceleration transfers loads that move them, is linearised again where it arrived, at
+        those loads, and solved again: Newton iterations of the implicit step in the forces and the loads
+        (:mod:`._newton`, a line search along each), at most ``GRIP_ITERATIONS``; the next step then refreshes the
+        Jacobian. One loop solves them all: one copy of the solve to compile (docs/limits.md)."""
         a, m, fz, f, g, kdiag, rhs, mat = w[0], w[1], w[3], w[4], w[5], w[8], w[9], w[14]
         n = rhs.shape[0]
         i = i0
@@ -349,15 +353,28 @@ def _semi_implicit_kernel(linked: bool):
             if linked:
                 hold_linkages(s, pack, w[19], w[20], False)  # the linkages' basis at the step's start
             w[26][0] = 0.0
-            it = 0
+            basis = w[19] if linked else pack[16]
+            it, lam = 0, 1.0
             while True:
                 _implicit_matrix(a, m, g, kdiag, pack, dt, mat)
+                if it > 0:  # the loads' share of the Newton matrix, the residual where the iteration was linearised
+                    newton_matrix(mat, rhs, w[29], w[24], basis, w[34])
                 solve_held(mat, rhs, pack, w)  # (M - dt K) dnu/dt = rhs: rhs becomes dnu/dt, gears, linkages held
+                if it > 0:
+                    lam = line_search(s, dt, w, pack, basis)  # a Newton step that does not reduce the residual
                 beyond = beyond_grip(a, rhs, w[24], w[23] if it > 0 else f, g, fz, pack, dt, w[27])
-                if it == GRIP_ITERATIONS or (it == 0 and not beyond):
+                moved = loads_moved(s, rhs, w[10], fz, w[28], w[27], pack)
+                if it == 0:
+                    at_grip = beyond
+                    for c in range(n):
+                        w[33][c] = rhs[c]  # the step at the previous step's loads
+                if it == GRIP_ITERATIONS or (it == 0 and not beyond and not moved):
+                    if it > 0 and not at_grip:  # the loads' iterations did not converge: the previous loads' step
+                        for c in range(n):
+                            rhs[c] = w[33][c]
                     break
                 w[26][0] = 1.0  # `g` becomes the Jacobian where the step arrived: the next step refreshes it
-                if relinearise(s, dt, w, pack):
+                if relinearise(s, dt, w, pack, lam < 1.0):
                     break
                 it += 1
             dnu = rhs

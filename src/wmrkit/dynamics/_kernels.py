@@ -367,5 +367,5 @@ def solve_in_place(a, x):
 def first_compile() -> bool:
     """Whether the dynamics kernels are about to be compiled rather than loaded from numba's disk cache: neither the
     normal loads (a model's first kernel) nor the tyre forces (every run's) are there. A first run on a machine, which
-    compiles them for about 15 s (the CLI says so as it starts)."""
+    compiles them for about 20 s (the CLI says so as it starts)."""
     return [disk_cached(kernel) for kernel in (normal_loads, _contacts)] == [False, False]
