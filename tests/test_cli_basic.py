@@ -144,12 +144,14 @@ def test_the_dynamics_first_compile_is_announced_at_once_with_its_duration(monke
     how long they take; cached (or another command's kernels), the notice waits for its threshold as before."""
     import threading
 
+    import wmrkit._jit as jit
     import wmrkit.cli.main as cli
 
     monkeypatch.setattr(cli, "COMPILE_NOTICE_AFTER", 0.5)
     monkeypatch.setattr(cli, "DYNAMICS_NOTICE_AFTER", 0.02)
     monkeypatch.setattr(cli, "_compiling", lambda: True)
     monkeypatch.setattr(cli, "_first_dynamics_compile", lambda: first)
+    monkeypatch.setattr(jit, "UNCACHED", set())  # not another test's uncached kernel (that notice is test_jit's)
     watcher = threading.Thread(target=cli._compile_notice, args=(threading.Event(), 0.01))
     start = time.perf_counter()
     watcher.start()
