@@ -35,7 +35,7 @@ from .._shapes import readonly
 from ..analysis.lines import constraint_lines
 from ..robot import Robot
 from .linked_ranges import LinkedRanges
-from .points import ControlError, robot_reach
+from .points import ControlError, _point_map, robot_reach
 from .steering import steer_ranges
 
 __all__ = ["CoupledSteering", "coupled_steering"]
@@ -172,9 +172,8 @@ def _into(angle: float, lo: float) -> float:
 
 
 def _at_point(p: np.ndarray, twist: np.ndarray) -> np.ndarray:
-    """Velocity ``(..., 2)`` of the body point `p` under `twist` ``(..., 3)`` (rigid body, as ``points._point_map``)."""
-    t = np.asarray(twist)
-    return np.stack([t[..., 0] - t[..., 2] * p[1], t[..., 1] + t[..., 2] * p[0]], axis=-1)
+    """Velocity ``(..., 2)`` of the body point `p` under `twist` ``(..., 3)`` (rigid body: ``points._point_map``)."""
+    return np.asarray(twist) @ _point_map(p).T
 
 
 def coupled_steering(robot: Robot, point: np.ndarray | None) -> CoupledSteering | None:
