@@ -52,14 +52,14 @@ def test_the_premise_lsoda_drives_the_turn_on_its_path():
     inputs, _ = path_program(model, "turn")
     good = simulate(model, inputs, 0.999, method="adaptive", record_step=0.0333).deviation()
     assert not good.large and good.max_position < 0.05
-    bad = simulate(model, inputs, 0.999, method="rk4", step=0.0333).deviation()
+    bad = simulate(model, inputs, 0.999, method="rk4", step=0.0333, check=False).deviation()
     assert bad.large and bad.max_position > 0.9
 
 
 def _runs_at(model, inputs, duration, step):
     """The CLI's run at `step` [s] (recorded every step from 10 ms) and, independently of check_step, one at its
     re-check's 1 ms on the same record times."""
-    coarse = simulate(model, inputs, duration, step=step, record_step=max(step, 0.01))
+    coarse = simulate(model, inputs, duration, step=step, record_step=max(step, 0.01), check=False)
     fine = simulate(model, inputs, coarse.t[-1], step=1e-3, record_step=max(step, 0.01))
     return coarse, fine
 
@@ -78,7 +78,7 @@ def test_a_robot_without_load_transfer_off_its_path_at_25_ms_is_refused(tmp_path
     assert (f"at step 0.025 s (up to {coarse.deviation().max_position:.3g} m from it), but a run at step 0.001 s to "
             f"t = {coarse.t[-1]:g} s keeps within {fine.deviation().max_position:.3g} m of the path") in err
     assert "use a step of at most 0.001 s" in err
-    early = simulate(model, inputs, 1.0, step=0.025)
+    early = simulate(model, inputs, 1.0, step=0.025, check=False)
     exact = simulate(model, inputs, 1.0, method="rk4", step=1e-4, record_step=0.025)  # the premise, by explicit rk4
     assert exact.twist[-1, 0] > 1.9 and np.hypot(*(exact.pose[-1, :2] - exact.nominal_pose[-1, :2])) < 0.1
     assert np.hypot(*(early.pose[:, :2] - early.nominal_pose[:, :2]).T).max() > 0.5
@@ -122,9 +122,9 @@ def test_a_real_deviation_at_a_stable_step_still_warns(argv, capsys):
 def test_check_step_passes_runs_on_their_path_and_adaptive_runs():
     model = DynamicModel.of(catalog.load("forklift"))
     inputs, _ = path_program(model, "turn")
-    check_step(model, inputs, simulate(model, inputs, 1.0, step=0.005))  # on its path: nothing re-run
+    check_step(model, inputs, simulate(model, inputs, 1.0, step=0.005, check=False))  # on its path: passes
     with pytest.raises(WmrkitError, match=r"at step 0\.0333 s .* use a step of at most 0\.0001 s"):
-        check_step(model, inputs, simulate(model, inputs, 2.997, method="rk4", step=0.0333))
+        check_step(model, inputs, simulate(model, inputs, 2.997, method="rk4", step=0.0333, check=False))
 
 
 def test_check_step_names_the_step_keyword_and_the_cli_its_option(capsys):
@@ -133,7 +133,8 @@ def test_check_step_names_the_step_keyword_and_the_cli_its_option(capsys):
     model = DynamicModel.of(catalog.load("forklift"))
     inputs, duration = path_program(model, "turn")
     with pytest.raises(WmrkitError) as err:
-        check_step(model, inputs, simulate(model, inputs, duration, method="rk4", step=0.0333, record_step=0.0333))
+        check_step(model, inputs, simulate(model, inputs, duration, method="rk4", step=0.0333, record_step=0.0333,
+                                          check=False))
     assert str(err.value).endswith("use a step of at most 0.0001 s (the step keyword) or method='adaptive'")
     assert "--step" not in str(err.value)
     cli = _refused(capsys, "simulate", "forklift", "--path", "turn", "--method", "rk4", "--step", "0.0333")
@@ -160,7 +161,8 @@ def test_a_stop_of_check_steps_rerun_says_the_step_as_each_door_sets_it(monkeypa
     model = DynamicModel.of(catalog.load("forklift"))
     inputs, duration = path_program(model, "turn")
     with pytest.raises(WmrkitError, match=r"to check it stops: the re-run stopped; .* \(the step keyword\) or"):
-        check_step(model, inputs, real(model, inputs, duration, method="rk4", step=0.0333, record_step=0.0333))
+        check_step(model, inputs, real(model, inputs, duration, method="rk4", step=0.0333, record_step=0.0333,
+                                       check=False))
     assert main(["simulate", "forklift", "--path", "turn", "--method", "rk4", "--step", "0.0333"]) == 2
     err = capsys.readouterr().err
     assert err.endswith("to check it stops: the re-run stopped; use a step of at most 1e-05 s (--step) or the adaptive "

@@ -87,7 +87,8 @@ def test_the_premise_the_robot_keeps_its_wheels_down_by_two_other_integrators(fo
     for method, step in (("rk4", 1e-4), ("semi-implicit", 1e-3)):
         sim = simulate(forklift, inputs, stop.t + 0.5, method=method, step=step, record_step=0.01)
         assert (sim.loads.min(axis=0) > 0.5 * at_rest).all()
-    coarse = simulate(forklift, inputs, stop.t, step=STEP_STOPS[0], record_step=STEP_STOPS[0], allow_lift_off=True)
+    coarse = simulate(forklift, inputs, stop.t, step=STEP_STOPS[0], record_step=STEP_STOPS[0], allow_lift_off=True,
+                      check=False)
     assert coarse.loads[:, forklift.contacts.index(stop.contact)].min() == 0.0  # its own lift-off
 
 

@@ -162,7 +162,7 @@ def _check_program_step(step: float, name: str) -> None:
 
 def run_simulate(args: argparse.Namespace) -> int:
     """Simulate, print a summary, write and plot on request."""
-    from ..dynamics.deviation import check_step, deviation_warning
+    from ..dynamics.deviation import deviation_warning
     from ..dynamics.linkages import SetpointKnotsError
     from ..dynamics.programs import path_program, read_torques
     from ..dynamics.runs import at_door
@@ -206,8 +206,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         with renaming({"initial twist ": "--initial-twist "}):
             sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
                            record_step=recordable_step(model, duration, step, max(step, min(0.01, duration))),
-                           progress=False if args.json else None)
-        check_step(model, inputs, sim, initial_twist=twist)  # a run off its path at an unstable step is refused
+                           progress=False if args.json else None)  # re-checked at a shorter step where needed
     except SetpointKnotsError as err:  # the knots between the torque file's rows (the program's)
         raise WmrkitError(f"{args.torques or f'--path {args.path}'}: {err}") from None
     except WmrkitError as err:  # a stop's re-check, or the step's, names the step as the CLI sets it
@@ -229,7 +228,8 @@ def run_simulate(args: argparse.Namespace) -> int:
         print_json({"robot": model.robot.name, "method": sim.method, "step": step, "duration": duration,
                     "samples": len(sim.t), "final_time": end, "final_pose": pose.tolist(), "final_twist": tw.tolist(),
                     "path_length": travelled, "max_slip_speed": max_slip,
-                    "deviation": deviation.to_dict() if deviation else None, "out": args.out})
+                    "deviation": deviation.to_dict() if deviation else None,
+                    "step_check": sim.step_check.to_dict() if sim.step_check else None, "out": args.out})
     else:
         print(f"{model.robot.name}: {duration:g} s simulated ({sim.method}, step {step:g} s), {len(sim.t)} samples")
         print(f"final pose (t = {end:g} s): x = {pose[0]:.6g} m, y = {pose[1]:.6g} m, theta = {pose[2]:.6g} rad")
@@ -238,6 +238,10 @@ def run_simulate(args: argparse.Namespace) -> int:
         if deviation:
             print(f"from the programmed path: {deviation.max_position:.3g} m at most (t = {deviation.max_time:g} s), "
                   f"{deviation.end_position:.3g} m and {deviation.end_heading:.3g} rad at the end")
+        if sim.step_check:
+            c = sim.step_check
+            print(f"step check: a run at step {c.step:g} s to t = {c.until:g} s is within {c.apart.max_position:.3g} m "
+                  f"and {abs(c.apart.max_heading):.3g} rad of this one")
     return 0
 
 

@@ -148,44 +148,71 @@ def deviation_warning(model, inputs, deviation: PathDeviation, max_slip: float) 
                    "(docs/dynamics.md)")
 
 
-def check_step(model, inputs, sim, initial_twist=(0.0, 0.0, 0.0), jac_every: int = 20) -> None:
-    """Refuse a fixed-step run `sim` of `inputs` (a twist program, from `initial_twist` at ``sim.pose[0]``) that
-    left its program's path when a run at :func:`~wmrkit.dynamics.runs.recheck_step` is as far from it as the
-    path's own tolerance (:attr:`PathDeviation.large` with the program's size and turn): the deviation is then the
-    step's (an integrator unstable or far from converged with stiff tyres), not the robot's. The re-run goes from
-    t = 0 over at most :data:`~wmrkit.dynamics.runs.RECHECK_STEPS` of its steps (a quarter for rk4), on the run's
-    record times; a run that left its path by as much at both steps passes (its deviation is the robot's). Its
-    error names the step keyword (:data:`~wmrkit.dynamics.runs.SIMULATE_STEP`; the CLI its option: ``at_door``)."""
-    from .runs import SIMULATE_STEP, recheck_budget, recheck_step
+@dataclass(frozen=True)
+class StepCheck:
+    """A fixed-step run against its re-run at a shorter ``step`` [s] from t = 0 to ``until`` [s]: ``apart``, the
+    run's :class:`PathDeviation` from the re-run (its size and turn the program's, else the re-run's)."""
+
+    step: float
+    until: float
+    apart: PathDeviation
+
+    def to_dict(self) -> dict:
+        """Plain data for JSON (m, rad, s)."""
+        return {"step": self.step, "until": self.until, "max_position": self.apart.max_position,
+                "max_heading": self.apart.max_heading}
+
+
+def check_step(model, inputs, sim, initial_twist=(0.0, 0.0, 0.0), jac_every: int = 20,
+               allow_lift_off: bool = False) -> StepCheck | None:
+    """Refuse a fixed-step run `sim` of `inputs` (from `initial_twist` at ``sim.pose[0]``) whose result is the
+    step's, not the robot's. The run is re-run from t = 0 at :func:`~wmrkit.dynamics.runs.recheck_step` over at most
+    :data:`~wmrkit.dynamics.runs.RECHECK_STEPS` of its steps (a quarter for rk4), on the run's record times, when
+
+    - it left its twist program's path (:attr:`PathDeviation.large`): refused when the two runs are as far apart as
+      that yardstick (the program's size and turn); a run that left its path by as much at both steps passes;
+    - its step is longer than :data:`~wmrkit.dynamics.runs.RECHECK_MAX_STEP` (torque inputs too): refused when the
+      re-run stops (a long step can damp a lift-off away, docs/dynamics.md) or the two are that far apart (the
+      re-run's own size and turn without a program).
+
+    Returns the comparison of a run that passes (:class:`StepCheck`), None when it was not re-run. Its error names
+    the step keyword (:data:`~wmrkit.dynamics.runs.SIMULATE_STEP`; the CLI its option: ``at_door``)."""
+    from .runs import RECHECK_MAX_STEP, SIMULATE_STEP, recheck_budget, recheck_step
     from .simulate import simulate
 
-    deviation = sim.deviation()
-    if sim.method == "adaptive" or deviation is None or not deviation.large or len(sim.t) < 2:
-        return
+    if sim.method == "adaptive" or len(sim.t) < 2:
+        return None
     method = 0 if sim.method == "semi-implicit" else 1
+    deviation = sim.deviation()
+    off_path = deviation is not None and deviation.large
+    if not off_path and sim.step <= RECHECK_MAX_STEP[method] * (1 + 1e-9):
+        return None
     step, fine = sim.step, recheck_step(sim.step, method)
     every = round((sim.t[1] - sim.t[0]) / step)  # steps between records
     m = min(len(sim.t), recheck_budget(method) // (every * round(step / fine)) + 1)
     if m < 2:
-        return
+        return None
+    what = (f"the robot left the programmed path at step {step:g} s (up to {deviation.max_position:.3g} m from it)"
+            if off_path else f"the run at step {step:g} s (longer than the {RECHECK_MAX_STEP[method]:g} s at which "
+            f"the tyres' integration is checked) went on")
     try:
         check = simulate(model, inputs, (m - 1) * every * step, step=fine, method=sim.method,
                          initial_twist=initial_twist, initial_pose=sim.pose[0], record_step=every * step,
-                         progress=False, jac_every=jac_every)
+                         progress=False, jac_every=jac_every, allow_lift_off=allow_lift_off, check=False)
     except WmrkitError as e:
-        err = WmrkitError(f"the robot left the programmed path at step {step:g} s (up to {deviation.max_position:.3g} "
-                          f"m from it), and a run at step {fine:.3g} s to check it stops: {e}")
+        err = WmrkitError(f"{what}, and a run at step {fine:.3g} s to check it stops: {e}")
         err.where = getattr(e, "where", "")  # the stop's advice, said at each door its own way (runs.at_door)
         raise err from None
-    t, nominal = sim.t[:m], sim.nominal_pose[:m]
-    along = PathDeviation.of(t, check.pose, nominal)
+    t = sim.t[:m]
+    along = PathDeviation.of(t, check.pose, check.pose if sim.nominal_pose is None else sim.nominal_pose[:m])
     apart = dataclasses.replace(PathDeviation.of(t, sim.pose[:m], check.pose), size=along.size, turn=along.turn)
     if apart.large:
+        kept = (f", but a run at step {fine:.3g} s to t = {t[-1]:g} s keeps within {along.max_position:.3g} m of the "
+                "path and" if off_path else f"; a run at step {fine:.3g} s to t = {t[-1]:g} s")
         err = WmrkitError(
-            f"the robot left the programmed path at step {step:g} s (up to {deviation.max_position:.3g} m from it), "
-            f"but a run at step {fine:.3g} s to t = {t[-1]:g} s keeps within {along.max_position:.3g} m of the path "
-            f"and is up to {apart.max_position:.3g} m and {abs(apart.max_heading):.3g} rad from that run: the step is "
-            f"too long for the tyres (the integration's error, not the robot's path); use a step of at most "
-            f"{fine:.3g} s {SIMULATE_STEP}")
+            f"{what}{kept} is up to {apart.max_position:.3g} m and {abs(apart.max_heading):.3g} rad from that run: "
+            f"the step is too long for the tyres (the integration's error, not the robot's "
+            f"{'path' if off_path else 'motion'}); use a step of at most {fine:.3g} s {SIMULATE_STEP}")
         err.where = SIMULATE_STEP  # the CLI says its option (runs.at_door)
         raise err
+    return StepCheck(fine, float(t[-1]), apart)

@@ -22,7 +22,7 @@ from ..errors import WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
-from .deviation import PathDeviation, nominal_poses
+from .deviation import PathDeviation, StepCheck, check_step, nominal_poses
 from .inputs import (  # noqa: F401  (Inputs, joint_column: API)
     Inputs,
     compiled_inputs,
@@ -83,6 +83,7 @@ class Simulation:
     info: dict = field(default_factory=dict)
     steered: tuple[str, ...] = ()  # the wheels of the heading columns
     nominal_pose: np.ndarray | None = None
+    step_check: StepCheck | None = None  # the re-run at a shorter step that checked this one (simulate's `check`)
 
     def deviation(self) -> PathDeviation | None:
         """How far the run is from its program's path (:class:`~wmrkit.dynamics.deviation.PathDeviation`: end
@@ -140,7 +141,8 @@ def recordable_step(model: DynamicModel, duration: float, step: float, wanted: f
 def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, step: float = 1e-3,
              method: Method = "semi-implicit", tyre: Tyre | str | None = None, initial_twist: ArrayLike = (0, 0, 0),
              initial_pose: ArrayLike = (0, 0, 0), record_step: float | None = None, rtol: float = 1e-6,
-             progress: bool | None = None, jac_every: int = 20, allow_lift_off: bool = False) -> Simulation:
+             progress: bool | None = None, jac_every: int = 20, allow_lift_off: bool = False,
+             check: bool = True) -> Simulation:
     """Integrate the dynamic model for `duration` [s] from `inputs`.
 
     The initial velocities roll without slip at `initial_twist` (wheel IK, §8.4) with the steering at its IK
@@ -156,7 +158,9 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     (:func:`~wmrkit.dynamics.runs.recheck_step`); when that one does not stop, the error says the step was too long
     for the tyres (the integrator unstable, not the robot) and names the step that ran; when it stops later, it
     names that stop too; when the re-check's budget ends first, it says the verdict is not known
-    (:func:`~wmrkit.dynamics.runs.judge`).
+    (:func:`~wmrkit.dynamics.runs.judge`). A fixed-step run that goes on is re-run at that shorter step, when `check`,
+    if its step is longer than :data:`~wmrkit.dynamics.runs.RECHECK_MAX_STEP` or it left its twist program's path,
+    and refused when the two runs are far apart or the shorter one stops (:func:`~.deviation.check_step`).
     """
     model = robot if isinstance(robot, DynamicModel) else DynamicModel.of(robot, tyre)
     if method not in METHODS:
@@ -186,10 +190,13 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
         rec, info = fixed_run(model, s0, inp, duration, step, every, 0 if method == "semi-implicit" else 1, progress,
                            jac_every, allow_lift_off)
     sim = _result(model, rec, method, step, info)
-    if inputs.twist is None:
-        return sim
-    nominal = nominal_poses(np.atleast_1d(inputs.twist_time), inputs.twist, sim.t, s0[:3])
-    return dataclasses.replace(sim, nominal_pose=readonly(nominal))
+    if inputs.twist is not None:
+        nominal = nominal_poses(np.atleast_1d(inputs.twist_time), inputs.twist, sim.t, s0[:3])
+        sim = dataclasses.replace(sim, nominal_pose=readonly(nominal))
+    if check:
+        sim = dataclasses.replace(sim, step_check=check_step(model, inputs, sim, initial_twist, jac_every,
+                                                             allow_lift_off))
+    return sim
 
 
 class Stepper:
