@@ -38,3 +38,14 @@ def _no_compile_notice(request, monkeypatch):
 
         monkeypatch.setattr(cli, "COMPILE_NOTICE_AFTER", math.inf)
         monkeypatch.setattr(cli, "DYNAMICS_NOTICE_AFTER", math.inf)
+
+
+@pytest.fixture(autouse=True)
+def _uncached_kernels_of_this_test(monkeypatch):
+    """A kernel compiled while a test refuses the file system (every ``os.makedirs`` failing: a report folder that
+    cannot be made) finds no cache directory and is named in ``wmrkit._jit.UNCACHED``, which named it for the rest
+    of the xdist worker: the CLI's compile notice in a later test said "again at every run" (a fresh clone's run).
+    Each test gets its own copy."""
+    import wmrkit._jit as jit
+
+    monkeypatch.setattr(jit, "UNCACHED", set(jit.UNCACHED))

@@ -10,6 +10,8 @@ from wmrkit import catalog
 from wmrkit.odometry.pipeline import odometry
 from wmrkit.odometry.synthetic import TwistProfile, simulate
 
+pytest_plugins = ["pytester"]  # a session of two tests run in this one (its conftest: tests/conftest.py)
+
 
 def _fresh(monkeypatch, budget: int):
     """Reload the kernel modules so their lazy wrappers start uncompiled, under `budget`."""
@@ -222,3 +224,42 @@ def test_a_kernel_cache_past_its_limit_is_dropped_and_no_other(tmp_path, monkeyp
     assert all(f.exists() for f in (*mine, other))
     jit.drop_oversized_cache(str(kernel), 599)
     assert not any(f.exists() for f in mine) and other.exists()
+
+
+#: Two tests in one session: the first refuses every ``os.makedirs``, as a test of a folder that cannot be made does
+#: (tests/hostile/test_hostile_sweep6.py, mkdir failing late), while a kernel compiles: numba finds no cache
+#: directory it can make and compile_cached names the kernel uncached; the second runs after it.
+_LEAKING_SESSION = """\
+import os
+
+import wmrkit._jit as jit
+
+
+def twice(x):
+    return 2.0 * x
+
+
+def test_a_kernel_compiles_while_no_folder_can_be_made(monkeypatch):
+    def refuse(name, *args, **kwargs):
+        raise OSError(2, "No such file or directory", str(name))
+
+    monkeypatch.setattr(os, "makedirs", refuse)
+    jit.compile_cached(twice)
+    assert jit.UNCACHED
+
+
+def test_a_later_test_of_the_worker_sees_no_uncached_kernel():
+    assert jit.UNCACHED == set()
+"""
+
+
+def test_a_kernel_one_test_leaves_uncached_is_not_another_test_s(pytester):
+    """A test that made every folder fail to be made (a report folder that cannot be made, mkdir failing late)
+    while the skid steer's study compiled the odometry kernel left ``_jit.UNCACHED`` naming it for the rest of its
+    xdist worker: a later test of the CLI's compile notice read "again at every run" (a fresh clone's full run at
+    df7a707; ``pip install .`` itself leaves no kernel uncached). tests/conftest.py gives each test its own."""
+    from pathlib import Path
+
+    pytester.makeconftest(Path(__file__).with_name("conftest.py").read_text())
+    pytester.makepyfile(test_two=_LEAKING_SESSION)
+    pytester.runpytest_inprocess("-p", "no:cacheprovider", "-o", "addopts=").assert_outcomes(passed=2)
