@@ -354,9 +354,17 @@ def test_cli_refuses_closed_squares_that_all_turn_one_way(diff, tmp_path, capsys
     true = apply_parameters(diff, params, [0.01, 0.03])
     for i, run in enumerate(_squares(true, [False] * 3, 1e-5)):
         write_log(tmp_path / f"run{i}.csv", run)
-    assert main(["batch", "calibrate", "diff-drive", str(tmp_path / "run*.csv"), "--closed", "--workers", "0"]) == 2
+    argv = ["batch", "calibrate", "diff-drive", str(tmp_path / "run*.csv"), "--closed", "--workers", "0"]
+    assert main(argv) == 2
     err = capsys.readouterr().err
     assert "cannot tell these parameters apart" in err and "the 3 closed runs all turn counter-clockwise" in err
+    # under --json the place of the refusal was null: the logs for the default parameters, --param for chosen ones
+    assert main([*argv, "--json"]) == 2
+    assert json.loads(capsys.readouterr().err) == {"error": err.removeprefix("wmrkit: error: ").rstrip("\n"),
+                                                   "file": None, "wheel": None, "field": "LOG", "line": None}
+    assert main([*argv, "--param", "left.r,-right.r", "--param", "left.l,right.l", "--json"]) == 2
+    chosen = json.loads(capsys.readouterr().err)
+    assert "cannot tell these parameters apart" in chosen["error"] and chosen["field"] == "--param"
 
 
 def test_bootstrap_drops_replicates_that_do_not_determine_the_parameters(diff):

@@ -119,6 +119,25 @@ def test_equal_closed_squares_all_turning_one_way_are_refused(clockwise, noise):
         calibrate(nominal, runs, RATIO_TRACK)
 
 
+def test_one_log_and_a_fleet_refuse_undetermined_runs_alike():
+    """The refusal was written twice (odometry.calibrate and batch's fleet_calibrate): one text now, an
+    UndeterminedError either way (the fleet's also a BatchError), which the CLI places at --param or the logs."""
+    from wmrkit.batch.calibrate import fleet_calibrate
+    from wmrkit.batch.engine import BatchError
+    from wmrkit.odometry.calibration import UndeterminedError
+
+    nominal = catalog.load("diff-drive")
+    true = apply_parameters(nominal, RATIO_TRACK, [0.01, 0.03])
+    runs = [CalibrationRun.closed_path(simulate(true, square_path(1.5, pause=0.3), 10.0, spin_noise_per_rad=1e-5,
+                                                seed=i).log) for i in range(3)]
+    with pytest.raises(UndeterminedError) as one:
+        calibrate(nominal, runs, RATIO_TRACK)
+    with pytest.raises(UndeterminedError) as fleet:
+        fleet_calibrate(nominal, runs, RATIO_TRACK)
+    assert isinstance(fleet.value, BatchError) and str(fleet.value) == str(one.value)
+    assert str(one.value).startswith("calibrate: the runs cannot tell these parameters apart: ")
+
+
 def test_closed_squares_of_different_sizes_turning_one_way_are_accepted():
     """Not a turning-direction rule: the heading drift of unequal radii grows with the side and the turn error of
     the track does not, so one-way squares of several sizes determine both (a decision on the data, not the

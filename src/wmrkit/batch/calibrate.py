@@ -36,6 +36,7 @@ from ..odometry.calibration import (
     CalibrationRun,
     Parameter,
     RunWeights,
+    UndeterminedError,
     apply_parameters,
     check_options,
     fitted_robot,
@@ -119,6 +120,11 @@ def _jacobian_of(args: tuple[CalibrationProblem, np.ndarray, np.ndarray]) -> np.
 def _curvature_of(args: tuple[CalibrationProblem, np.ndarray]) -> np.ndarray:
     """The Jacobian of `problem`'s runs at `p` in one round trip (:func:`~wmrkit.batch.consistency.judge`'s)."""
     return args[0].jacobian(args[1])
+
+
+class FleetUndeterminedError(BatchError, UndeterminedError):
+    """A fleet whose runs cannot tell the parameters apart (its fit's refusal: a :class:`BatchError` as every refusal
+    of the fleet's, and the :class:`~wmrkit.odometry.calibration.UndeterminedError` of one log's fit)."""
 
 
 #: Least fraction of bootstrap replicates that must determine the parameters (the others are dropped and counted).
@@ -212,10 +218,7 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
         if m <= n:
             raise BatchError(f"calibrate: {m} residuals cannot fix {n} parameters with an interval; add runs")
         fit = solve(residuals, n, jacobian=jacobian)
-        reason = problem.undetermined(fit.x, fit.jac, fit.fun)
-        if reason is not None:
-            raise BatchError(f"calibrate: the runs cannot tell these parameters apart: {reason}{problem.hint()}; add "
-                             f"runs of other shapes or fit fewer parameters")
+        problem.refuse_undetermined(fit, FleetUndeterminedError)
         if len(runs) < 2:  # every bootstrap resample of one run is that run: a zero-width interval whatever the noise
             raise BatchError("calibrate: a confidence interval needs at least two runs")
         notes = () if fit.success else (f"the fit did not converge ({' '.join(str(fit.message).split())}): the "

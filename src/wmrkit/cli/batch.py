@@ -230,7 +230,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
         load_runs,
     )
     from ..batch.fleet import expand_logs
-    from ..odometry.calibration import apply_parameters
+    from ..odometry.calibration import UndeterminedError, apply_parameters
 
     robot = load_robot(args.robot)
     if args.slip and (args.param or args.ci or args.sensed or args.reference_noise):  # the slip fit has its own two
@@ -266,9 +266,12 @@ def run_calibrate(args: argparse.Namespace) -> int:
             result = fleet_slip_calibrate(robot, runs, runner=runner, level=args.level, method=args.method,
                                           progress=_progress(args))
         else:
-            result = fleet_calibrate(robot, runs, params, runner=runner, ci=args.ci, level=args.level,
-                                     n_boot=args.bootstrap, method=args.method, sensed=args.sensed,
-                                     progress=_progress(args), reference_noise=noise)
+            try:
+                result = fleet_calibrate(robot, runs, params, runner=runner, ci=args.ci, level=args.level,
+                                         n_boot=args.bootstrap, method=args.method, sensed=args.sensed,
+                                         progress=_progress(args), reference_noise=noise)
+            except UndeterminedError as err:  # at fault: the parameters chosen, else the runs given
+                raise OptionError(str(err), field="--param" if args.param else "LOG") from None
     for warning in () if args.slip else result.warnings:  # the slip fit has none
         warn(warning)
     if args.json:

@@ -69,6 +69,11 @@ RANK_TOL = 1e-4
 MAX_STANDARD_ERROR = 0.1
 
 
+class UndeterminedError(WmrkitError):
+    """The runs cannot tell the fitted parameters apart (:meth:`CalibrationProblem.refuse_undetermined`): the
+    parameters chosen, or the runs, are at fault (the CLI names ``--param`` when given, else the logs)."""
+
+
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
 class CalibrationRun:
     """A log with ground truth: ``reference`` ``(M, 3)`` true poses at samples ``at`` ``(M,)`` of ``log``.
@@ -237,6 +242,14 @@ class CalibrationProblem:
                     f"(at most {MAX_STANDARD_ERROR:.0%})")
         return None
 
+    def refuse_undetermined(self, fit, error: type[UndeterminedError] = UndeterminedError) -> None:
+        """Raise `error` when the runs cannot tell the parameters apart at `fit` (:func:`solve`'s result;
+        :meth:`undetermined`), saying why and what to add: the refusal of one log's fit and of a fleet's."""
+        reason = self.undetermined(fit.x, fit.jac, fit.fun)
+        if reason is not None:
+            raise error(f"calibrate: the runs cannot tell these parameters apart: {reason}{self.hint()}; add runs of "
+                        "other shapes or fit fewer parameters")
+
     def _direction(self, v: np.ndarray) -> str:
         """A direction `v` ``(n,)`` of parameter space in words: one parameter, or a combination."""
         names = [",".join((g,) if isinstance(g, str) else g) for g in self.parameters]
@@ -367,10 +380,7 @@ def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence
     if r0.size < len(groups):
         raise WmrkitError(f"calibrate: {r0.size} residuals cannot fix {len(groups)} parameters; add runs or references")
     fit = solve(problem.residuals, len(groups), jacobian=problem.jacobian)
-    reason = problem.undetermined(fit.x, fit.jac, fit.fun)
-    if reason is not None:
-        raise WmrkitError(f"calibrate: the runs cannot tell these parameters apart: {reason}{problem.hint()}; add "
-                          f"runs of other shapes or fit fewer parameters")
+    problem.refuse_undetermined(fit)
     return Calibration(fitted_robot(robot, parameters, fit.x), problem.values(fit.x), rms(r0), rms(fit.fun),
                        bool(fit.success), problem.warnings())
 
