@@ -297,7 +297,9 @@ def test_a_refused_jacobian_interval_names_the_run_by_its_file(capsys, tmp_path)
     argv = ["batch", "calibrate", "diff-drive", str(tmp_path / "r*.csv"), "--reference", str(tmp_path / "ref"),
             "--workers", "0"]
     assert main([*argv, "--json"]) == 2
-    error = json.loads(capsys.readouterr().err)["error"]
+    answer = json.loads(capsys.readouterr().err)
+    error = answer["error"]
+    assert answer["field"] == "LOG"  # the runs given cannot tell the parameters apart (was null)
     assert error.startswith(f"calibrate: without {tmp_path / 'r3.csv'} the other runs cannot tell these parameters")
     assert "check the runs" in error and "closed squares" not in error
     assert main(argv) == 2

@@ -293,8 +293,9 @@ def _sandwich_interval(problem: CalibrationProblem, fit, level: float) -> tuple[
         others = np.r_[0:a, b:fit.fun.size]
         reason = problem.undetermined(fit.x, fit.jac[others], fit.fun[others])
         if reason is not None:
-            raise BatchError(f"calibrate: without {names(problem.runs)[k]} the other runs cannot tell these parameters "
-                             f"apart ({reason}), so the jacobian interval cannot be estimated; {_more_runs(problem)}")
+            raise FleetUndeterminedError(f"calibrate: without {names(problem.runs)[k]} the other runs cannot tell "
+                                        f"these parameters apart ({reason}), so the jacobian interval cannot be "
+                                        f"estimated; {_more_runs(problem)}")
         change.append(np.linalg.solve(jtj - jg.T @ jg, jg.T @ fit.fun[a:b]))
     change = np.array(change)
     cov = change.T @ change * (g - 1) / g
