@@ -14,6 +14,7 @@ import pytest
 from scipy.optimize import brentq
 
 from wmrkit import Robot, catalog
+from wmrkit.analysis.lines import constraint_lines
 from wmrkit.control import builtin_reference
 from wmrkit.control.points import ControlError, control_point
 from wmrkit.control.tick import control_tick
@@ -117,11 +118,11 @@ def test_the_car_and_the_full_pose_robots_keep_their_control_points():
         assert control_point(catalog.load(name)).coupled is None
 
 
-def test_a_point_on_the_virtual_axle_and_the_compiled_tick_are_refused():
+def test_a_point_on_the_virtual_axle_is_refused():
     with pytest.raises(ControlError, match="lies on the virtual axle"):
         track(GEARED, builtin_reference("line"), point=(0.9, 0.0), duration=1.0)
-    with pytest.raises(ControlError, match="not compiled"):
-        control_tick(GEARED)
+    with pytest.raises(ControlError, match="lies on the virtual axle"):
+        control_tick(GEARED, point=(0.9, 0.0))
 
 
 def test_a_turn_beyond_the_steering_ranges_is_held_at_their_end_and_reported():
@@ -136,3 +137,27 @@ def test_a_turn_beyond_the_steering_ranges_is_held_at_their_end_and_reported():
     front = run.range_violations()[0]
     assert front["wheel"] == "front" and front["held_by"] == "gear(front.steer, rear.steer)"
     assert front["headings"] == pytest.approx([-0.15, -0.15], abs=1e-12) and front["to"] == 5.0
+
+
+@pytest.mark.parametrize("path", ["geared.json", "synchro.yaml"])
+def test_the_lines_turned_about_their_pivots_are_the_constraint_lines_at_the_coupled_headings(path):
+    """The solver turns the lines at u = 0 about their wheels' pivots by ``ratio u`` (control/coupled_solve.py);
+    the constraint lines (6.18) computed from the coupled headings (``wheel rows`` at each turn) are the same."""
+    robot = Robot.from_file(ROBOTS / path)
+    cs = control_point(robot).coupled
+    lines = constraint_lines(robot)
+    for u in (-2.5, -0.7, 0.0, 0.3, 1.1, 3.0):
+        np.testing.assert_allclose(cs.lines(u), lines.lines(robot.steering(heading=cs.headings(u))), atol=1e-14)
+
+
+def test_two_steered_wheels_on_a_linkage_give_their_two_lines_a_null_twist():
+    """Two steerable wheels on a parallel linkage (a two-wheel synchro drive) have two constraint lines: their
+    one-dimensional null space was missed (the SVD of two rows has two singular values, both nonzero), so the
+    robot kept the full pose its wheels cannot give (0.28 m off the 3 m circle); now its point tracks it."""
+    unit = {"type": "steerable", "heading": 0.0, "r": 0.08}
+    robot = Robot.from_dict({"name": "two", "wheels": [{**unit, "name": "f", "position": [0.3, 0.2]},
+                                                        {**unit, "name": "b", "position": [-0.3, -0.2]}],
+                             "couplings": [{"kind": "linkage", "joints": ["f.steer", "b.steer"]}]})
+    assert control_point(robot).coupled is not None
+    run = track(robot, builtin_reference("circle", size=3.0), duration=5.0)
+    assert run.summary()["max_error"] < 1e-8 and np.ptp(run.pose[:, 2]) < 1e-12

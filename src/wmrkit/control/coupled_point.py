@@ -34,20 +34,14 @@ import numpy as np
 from .._shapes import readonly
 from ..analysis.lines import constraint_lines
 from ..robot import Robot
+from . import coupled_solve
+from .coupled_solve import SAMPLES
 from .linked_ranges import LinkedRanges
 from .points import ControlError, _point_map, robot_reach
 from .steering import steer_ranges
 
 __all__ = ["CoupledSteering", "coupled_steering"]
 
-#: Samples of the leader's turn over a whole turn: the branch and Newton's first guess.
-SAMPLES = 1440
-#: Newton iterations at most (2 to 4 from the table's guess; bisection where a step leaves the bracket).
-NEWTON_STEPS = 40
-#: The angle of P's velocity is solved to this [rad].
-ANGLE_TOL = 1e-12
-#: Step [rad] of the central difference of a follower's heading per the leader's (exact for a gear's ratio).
-LAW_STEP = 1e-6
 #: Relative size below which a singular value is a null direction (the admissible twists are one-dimensional).
 RANK_TOL = 1e-9
 
@@ -59,7 +53,8 @@ class CoupledSteering:
     the direction of straight driving (towards +x); ``axle_point (2,)``: the point's foot on the virtual axle (the
     point itself when no turn rotates the robot). ``turns (n,)`` [rad] and ``angles (n,)`` [rad, robot frame,
     increasing]: the branch's table of the angle of ``P``'s velocity, ``sign`` that of ``d angle / du``; ``u0`` the
-    turn of straight driving. Read-only arrays."""
+    turn of straight driving. Read-only arrays; ``arrays`` the robot's for :mod:`.coupled_solve` (the formulas,
+    shared with the compiled tick)."""
 
     robot: Robot
     leader: int
@@ -71,10 +66,15 @@ class CoupledSteering:
     sign: float
     u0: float
     _links: LinkedRanges
+    _lines: np.ndarray  # (n_lines, 3): the constraint lines at u = 0
     _pivots: np.ndarray  # (n_lines, 2): the steering pivot of each line's wheel
-    _wheel: np.ndarray  # (n_lines,): its steer index
-    _grid: np.ndarray  # (SAMPLES,): turns over a whole turn of the leader
+    _ratios: np.ndarray  # (n_lines,): its heading's turn per turn of the leader
     _null: np.ndarray  # (SAMPLES, 3): n oriented continuously from forward driving
+
+    @property
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        """``(lines, pivots, ratios, null, turns, angles)`` of :mod:`.coupled_solve`."""
+        return self._lines, self._pivots, self._ratios, self._null, self.turns, self.angles
 
     def headings(self, u: float) -> np.ndarray:
         """The steered wheels' headings ``(n_steer,)`` [rad] at turn `u`."""
@@ -82,20 +82,15 @@ class CoupledSteering:
 
     def lines(self, u: float) -> np.ndarray:
         """The constraint lines (6.18) at turn `u` ``(n_lines, 3)``: ``line . twist = 0`` for admissible twists."""
-        return constraint_lines(self.robot).lines(self.robot.steering(heading=self.headings(u)))
+        out = np.empty((len(self._lines), 3))
+        coupled_solve.rotated_lines(u, self._lines, self._pivots, self._ratios, out, np.empty_like(out))
+        return out
 
     def twist_direction(self, u: float) -> tuple[np.ndarray, np.ndarray]:
         """The unit admissible twist ``n(u)`` ``(3,)`` (oriented continuously from forward driving) and ``dn/du``
-        ``= -A^+ A' n``: ``A'`` each line turned about its wheel's pivot at its heading's rate per turn."""
-        a = self.lines(u)
-        left, sv, vt = np.linalg.svd(a, full_matrices=False)
-        n = vt[-1]
-        k = int(np.argmin(np.abs(np.remainder(self._grid - u + math.pi, 2 * math.pi) - math.pi)))
-        n = n if n @ self._null[k] >= 0 else -n
-        rate = ((self.headings(u + LAW_STEP) - self.headings(u - LAW_STEP)) / (2 * LAW_STEP))[self._wheel]
-        turned = np.column_stack([-a[:, 1], a[:, 0], self._pivots[:, 0] * a[:, 0] + self._pivots[:, 1] * a[:, 1]])
-        pinv = (vt[:2].T / sv[:2]) @ left[:, :2].T  # A^+ on its rank 2
-        return n, -pinv @ ((turned * rate[:, None]) @ n)
+        ``(3,)`` (:func:`.coupled_solve.direction`: each line turned about its wheel's pivot at its ratio)."""
+        d = coupled_solve.direction(float(u), self._lines, self._pivots, self._ratios, self._null)
+        return np.array(d[:3]), np.array(d[3:])
 
     def point_velocity(self, speed: float, u: float) -> tuple[np.ndarray, np.ndarray]:
         """The velocity ``s g(u)`` ``(2,)`` [m/s, robot frame] of the control point at `speed` ``s`` and turn `u`,
@@ -107,22 +102,9 @@ class CoupledSteering:
     def solve(self, velocity: np.ndarray) -> tuple[float, float, np.ndarray]:
         """``(s, u, n(u))`` giving the control point `velocity` ``(2,)`` [m/s, robot frame]: forward when its
         direction is within the branch's arc, else backward when the opposite one is, else at the branch's nearer end
-        (least squares in ``s`` there); at rest ``(0, u0, n(u0))``."""
-        vx, vy = float(velocity[0]), float(velocity[1])
-        if vx == 0.0 and vy == 0.0:
-            return 0.0, self.u0, self.twist_direction(self.u0)[0]
-        want, lo, hi = math.atan2(vy, vx), float(self.angles[0]), float(self.angles[-1])
-        forward, backward = _into(want, lo), _into(want + math.pi, lo)
-        if forward <= hi:
-            target = forward
-        elif backward <= hi:
-            target = backward
-        else:  # the nearer end of the branch, either way
-            target = min((lo, hi), key=lambda e: min(abs(math.remainder(want - e, 2 * math.pi)),
-                                                     abs(math.remainder(want + math.pi - e, 2 * math.pi))))
-        u, n = self._newton(target)
-        g = _at_point(self.point, n)
-        return float(g @ np.array([vx, vy])) / float(g @ g), u, n
+        (least squares in ``s`` there); at rest ``(0, u0, n(u0))`` (:func:`.coupled_solve.solve`)."""
+        s, u, *n = coupled_solve.solve(float(velocity[0]), float(velocity[1]), *self._scalars, *self.arrays)
+        return s, u, np.array(n)
 
     def twist(self, velocity: np.ndarray) -> np.ndarray:
         """The admissible body twist ``s n(u)`` ``(3,)`` giving the control point `velocity` ``(2,)`` [m/s, robot
@@ -130,27 +112,9 @@ class CoupledSteering:
         s, _, n = self.solve(velocity)
         return s * n
 
-    def _newton(self, target: float) -> tuple[float, np.ndarray]:
-        """The turn at which the angle of ``P``'s velocity is `target` on the branch: Newton's method from the
-        table's interpolation, within the table's bracket (bisection where a step leaves it); and ``n`` there."""
-        k = int(np.clip(np.searchsorted(self.angles, target), 1, len(self.angles) - 1))
-        lo, hi = sorted((float(self.turns[k - 1]), float(self.turns[k])))
-        u = float(np.interp(target, self.angles, self.turns))
-        for _ in range(NEWTON_STEPS):
-            n, dn = self.twist_direction(u)
-            g, dg = _at_point(self.point, n), _at_point(self.point, dn)
-            near = float(np.interp(u, self.turns[::int(self.sign)], self.angles[::int(self.sign)]))
-            f = near + math.remainder(math.atan2(g[1], g[0]) - near, 2 * math.pi) - target
-            if abs(f) <= ANGLE_TOL:
-                return u, n
-            if f * self.sign < 0:
-                lo = u
-            else:
-                hi = u
-            slope = float(g[0] * dg[1] - g[1] * dg[0]) / float(g @ g)
-            step = u - f / slope if slope * self.sign > 0 else math.nan
-            u = step if lo < step < hi else 0.5 * (lo + hi)
-        return u, self.twist_direction(u)[0]
+    @property
+    def _scalars(self) -> tuple[float, float, float, float]:
+        return float(self.point[0]), float(self.point[1]), float(self.sign), float(self.u0)
 
 
 def _headings(robot: Robot, links: LinkedRanges, leader: int, u: float) -> np.ndarray:
@@ -164,11 +128,6 @@ def _headings(robot: Robot, links: LinkedRanges, leader: int, u: float) -> np.nd
 def _rest(robot: Robot) -> np.ndarray:
     """The described headings (read-only; ``robot.heading`` converts them at each call)."""
     return readonly(np.array(robot.heading, dtype=float))
-
-
-def _into(angle: float, lo: float) -> float:
-    """`angle` plus the whole turns that put it in ``[lo, lo + 2 pi)``."""
-    return lo + (angle - lo) % (2 * math.pi)
 
 
 def _at_point(p: np.ndarray, twist: np.ndarray) -> np.ndarray:
@@ -193,9 +152,16 @@ def coupled_steering(robot: Robot, point: np.ndarray | None) -> CoupledSteering 
     cl = constraint_lines(robot)
     if not cl.wheels or any(w not in group for w in cl.wheels):
         return None
+    ratio = np.ones(len(robot.steer_names))  # each steered wheel's heading turn per turn of the leader
+    for link in links.links:
+        if link.ratio is None:  # a law that is not a turn in proportion (an Ackermann linkage: with fixed wheels)
+            return None
+        ratio[link.follower] = link.ratio
     grid = np.linspace(-math.pi, math.pi, SAMPLES, endpoint=False)
     heads = np.array([_headings(robot, links, leader, float(u)) for u in grid])
-    _, sv, vt = np.linalg.svd(cl.lines(robot.steering(heading=heads)))
+    lines = cl.lines(robot.steering(heading=heads))
+    padded = np.concatenate([lines, np.zeros((SAMPLES, max(0, 3 - lines.shape[1]), 3))], axis=1)  # two lines: rank 2
+    _, sv, vt = np.linalg.svd(padded)
     one = (sv[:, -1] <= RANK_TOL * sv[:, 0]) & (sv[:, -2] > RANK_TOL * sv[:, 0])  # a one-dimensional null space
     mid = SAMPLES // 2  # u = 0
     if not one[mid]:
@@ -213,9 +179,11 @@ def coupled_steering(robot: Robot, point: np.ndarray | None) -> CoupledSteering 
     if null[k0, :2] @ t < 0:
         null *= -1
     pivots = np.array([robot.wheel(w).position for w in cl.wheels], dtype=float)
-    wheel = np.array([robot.steer_names.index(w) for w in cl.wheels], dtype=int)
+    ratios = ratio[[robot.steer_names.index(w) for w in cl.wheels]]
+    rest = cl.lines(robot.steering(heading=_headings(robot, links, leader, 0.0)))  # u = 0
+    arrays = (readonly(rest), readonly(pivots), readonly(ratios), readonly(null))
     cs = CoupledSteering(robot, leader, np.zeros(2), forward, np.zeros(2), np.zeros(0), np.zeros(0), 1.0, u0, links,
-                         readonly(pivots), readonly(wheel), readonly(grid), readonly(null))
+                         *arrays)
     n0, dn0 = cs.twist_direction(u0)
     axle = None if abs(dn0[2]) <= RANK_TOL else (dn0[0] * n0[1] - dn0[1] * n0[0]) / (dn0[2] * math.hypot(*n0[:2]))
     if point is not None:
@@ -235,7 +203,7 @@ def coupled_steering(robot: Robot, point: np.ndarray | None) -> CoupledSteering 
                            "point ahead of it)")
     turns, angles, sign = _branch(grid, null, one, p, k0, math.copysign(1.0, slope))
     return CoupledSteering(robot, leader, readonly(p), forward, readonly(foot), readonly(turns), readonly(angles),
-                           sign, u0, links, readonly(pivots), readonly(wheel), readonly(grid), readonly(null))
+                           sign, u0, links, *arrays)
 
 
 def _straight(grid: np.ndarray, null: np.ndarray, mid: int) -> tuple[float, float]:

@@ -42,6 +42,7 @@ class _Link:
     increasing: bool
     angular: bool
     fixed: bool = False
+    ratio: float | None = None  # the follower's turn per turn of the leader, when its law is one (gear, parallel)
 
 
 @dataclass(frozen=True)
@@ -181,7 +182,7 @@ def _linkage_links(robot: Robot) -> list[_Link]:
         to_i = (lambda h, row=row, i=i, j=j:  # noqa: E731
                 float(heading_from_beta(leader_of(row, h - delta[j] + 0.5 * math.pi), delta[i])))
         out.append(_Link(j, i, to_j, to_i, not (row[3] == 1.0 and row[4] * row[5] < 0), True,
-                         row[3] == 1.0 and row[5] == 0.0))
+                         row[3] == 1.0 and row[5] == 0.0, 1.0 if row[3] == 0.0 else None))
     return out
 
 
@@ -201,7 +202,7 @@ def _gear_links(robot: Robot, idx: list[int], k: np.ndarray) -> list[_Link]:
     rest, i, out = robot.heading, idx[0], []
     for j, r in zip(idx[1:], k[1:] / k[0], strict=True):
         out.append(_Link(j, i, lambda h, j=j, r=r: float(rest[j] + r * (h - rest[i])),
-                         lambda h, j=j, r=r: float(rest[i] + (h - rest[j]) / r), r > 0, False))
+                         lambda h, j=j, r=r: float(rest[i] + (h - rest[j]) / r), r > 0, False, ratio=float(r)))
     return out
 
 

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 
 from ..limits import MAX_COORDINATE
 from ..robot import Robot
+from . import coupled_solve
 from .laws import PositionLaw
 from .points import ControlError, ControlPoint, control_point
 
@@ -45,7 +46,7 @@ class ControlTick:
     robot: Robot
     reduced: bool
     point: tuple[float, float]
-    gain_matrix: tuple[float, ...]  # row-major (3, 2) of ControlPoint.gain, reduced only
+    gain_matrix: tuple[float, ...]  # row-major (3, 2) of ControlPoint.gain, reduced only (not coupled: none)
     a: tuple[float, float, float]
     gate: float
     tick: Any
@@ -62,26 +63,23 @@ def control_tick(robot: Robot, law: PositionLaw | None = None, point: ArrayLike 
     if law.kind != "p":
         raise ControlError(f"control_tick: only the P + feedforward law (8.2)/(8.53), got '{law.kind}'")
     cp = control_point(robot, point, reduced=reduced)
-    if cp.coupled is not None:
-        raise ControlError(f"control_tick: robot '{robot.name}' steers through couplings that leave it one steering "
-                           "degree of freedom; its twist is solved by Newton's method (control.coupled_point), not "
-                           "compiled (reduced=False compiles the full pose's law, blind to the couplings)")
-    gain = tuple(float(v) for v in np.asarray(cp.gain).ravel()) if cp.reduced else ()
-    kernel = _tick_kernel(realtime(robot).ik, scalar_law(cp, law))
+    gain = tuple(float(v) for v in np.asarray(cp.gain).ravel()) if cp.gain is not None else ()
+    kernel = _tick_kernel(realtime(robot).ik, scalar_law(cp, law, compiled=True))
     return ControlTick(robot, cp.reduced, (float(cp.point[0]), float(cp.point[1])), gain, law.a,
                        math.inf if law.gate is None else float(law.gate), kernel)
 
 
-def scalar_law(cp: ControlPoint, law: PositionLaw):
+def scalar_law(cp: ControlPoint, law: PositionLaw, *, compiled: bool = False):
     """The laws (8.1)-(8.3) with the gate (8.53) at control point `cp`, then the admissible twist (3.15), on scalars:
     ``law(x, y, theta, x_ref, y_ref, theta_ref, vx_ref, vy_ref, omega_ref, i0, i1, i2) -> (vx, vy, omega, e0, e1,
     e2)`` (pose, reference and its velocity in G, the error's integral; the body twist and the error). Reduced
-    control points ignore ``theta_ref`` and ``omega_ref``. Plain Python that numba also compiles (the tick)."""
+    control points ignore ``theta_ref`` and ``omega_ref``. Plain Python that numba also compiles (the tick: `compiled`,
+    a coupled robot's twist then solved by the compiled :mod:`._coupled_kernel`)."""
     px, py = float(cp.point[0]), float(cp.point[1])
     reduced, integral, feedforward = bool(cp.reduced), law.kind == "pi", law.kind != "point"
     (a0, a1, a2), (b0, b1, b2) = law.a, law.b
     gate = math.inf if law.gate is None else float(law.gate)
-    coupled = cp.coupled  # its law gives the point's velocity in R, then the coupled twist (plain Python)
+    coupled = cp.coupled  # its law gives the point's velocity in R, then the coupled twist (.coupled_solve)
     gains = np.eye(3, 2) if coupled is not None else cp.gain if reduced else np.zeros((3, 2))
     g00, g01, g10, g11, g20, g21 = (float(v) for v in np.asarray(gains, dtype=float).ravel())
 
@@ -107,10 +105,19 @@ def scalar_law(cp: ControlPoint, law: PositionLaw):
 
     if coupled is None:
         return law_twist
+    cx, cy, sign, u0 = coupled._scalars
+    lines, pivots, ratios, null, turns, angles = coupled.arrays
+    if compiled:  # the pieces numba calls from the tick: compiled as they are
+        import numba
 
-    def coupled_twist(*args):
-        r0, r1, _, e0, e1, e2 = law_twist(*args)
-        vx, vy, w = coupled.twist(np.array([r0, r1])).tolist()
+        from ._coupled_kernel import twist as point_twist
+        law_twist = numba.njit(inline="always")(law_twist)
+    else:
+        point_twist = coupled_solve.twist
+
+    def coupled_twist(x, y, theta, x_ref, y_ref, theta_ref, vx_ref, vy_ref, omega_ref, i0, i1, i2):
+        r0, r1, _, e0, e1, e2 = law_twist(x, y, theta, x_ref, y_ref, theta_ref, vx_ref, vy_ref, omega_ref, i0, i1, i2)
+        vx, vy, w = point_twist(r0, r1, cx, cy, sign, u0, lines, pivots, ratios, null, turns, angles)
         return vx, vy, w, e0, e1, e2
 
     return coupled_twist
@@ -148,7 +155,9 @@ def _drop_stale_ticks() -> None:
     """Bound the ticks' cache and drop it when the code compiled into them changed (once per process, before the
     first tick compiles or loads: :func:`~wmrkit._jit.drop_stale_cache`)."""
     from .. import _jit
-    from ..kinematics import realtime
+    from ..kinematics import linkage_law, realtime
+    from . import _coupled_kernel
 
-    _jit.drop_stale_cache([__file__], [realtime.__file__, _jit.__file__])
+    _jit.drop_stale_cache([__file__], [realtime.__file__, _jit.__file__, coupled_solve.__file__,
+                                       _coupled_kernel.__file__, linkage_law.__file__])
     _jit.drop_oversized_cache(__file__, MAX_CACHE_BYTES)
