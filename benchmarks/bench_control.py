@@ -5,6 +5,9 @@
   ``DifferentialDriveKinematics.toWheelSpeeds``, called once per tick from Python in both cases;
 - the same tick for a swerve-4 (full pose) against ``HolonomicDriveController.calculate`` + ``toSwerveModuleStates``;
 - both again through the single-call path :func:`wmrkit.control.tick.control_tick` (scalar law, compiled IK);
+- the single-call tick of the geared units (examples/robots/geared.json: steering geared 1:2, one steering degree of
+  freedom, the twist solved by Newton's method compiled in the tick) against the batched path of the same law
+  (``law_controller`` + ``wheel_commands``: WPILib has no controller for such a robot);
 - closed-loop simulation of the forklift on the figure-eight (30 s, continuous, ideal loops), with the real
   truck's low-level loops at a 0.1 s period, and through the chapter-7 dynamics with Pacejka tyres at 1 kHz
   (control at 50 Hz): how many times faster than real time (issue target for the last: 200x).
@@ -13,10 +16,11 @@
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import numpy as np
 
-from wmrkit import catalog
+from wmrkit import Robot, catalog
 from wmrkit.control import builtin_reference, control_point, forklift_real_loops, law_controller, track
 from wmrkit.control.laws import PositionLaw
 from wmrkit.kinematics.wheel_ik import wheel_commands
@@ -102,6 +106,9 @@ def run(quick: bool) -> list[Result]:
             Result("swerve-4 single-call tick (control_tick)", n, _single_call(catalog.load("swerve-4"), ref, n),
                    "wpimath HolonomicDriveController + toSwerveModuleStates", _holonomic(n),
                    target="no slower than WPILib")]
+    geared = Robot.from_file(Path(__file__).parents[1] / "examples" / "robots" / "geared.json")
+    out.append(Result("geared-units single-call tick (Newton, compiled)", n, _single_call(geared, ref, n),
+                      "wmrkit batched path of the same law", _ticks(geared, ref, min(n, 2_000)) * n / min(n, 2_000)))
     fork = catalog.load("forklift")
     for label, kwargs in (("ideal, continuous", {}),
                           ("real loops, T = 0.1 s", {"loops": forklift_real_loops(), "period": 0.1, "delay": 1})):

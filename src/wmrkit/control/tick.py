@@ -1,8 +1,10 @@
 """One control tick in a single call (issue item 4): position law (8.2)/(8.53), admissible twist, per-wheel IK.
 
-For a controller that runs once per sample: scalars in, caller-owned arrays out, nothing allocated per call. The
-law and the point-velocity map are :func:`scalar_law` (a few scalar operations, also the dynamic loop's
-controller), compiled here together with the robot's per-wheel IK kernel of
+For a controller that runs once per sample: scalars in, caller-owned arrays out, nothing allocated per call (but
+two small work arrays per Newton step inside the compiled call of a robot with coupled steering). The law and the
+point-velocity map are :func:`scalar_law` (a few scalar operations, also the dynamic loop's controller; for a robot
+whose steering couplings leave one steering degree of freedom, the Newton solve of :mod:`.coupled_solve`, compiled
+once by :mod:`._coupled_kernel`), compiled here together with the robot's per-wheel IK kernel of
 :func:`wmrkit.kinematics.realtime.realtime`. The numbers are those of :func:`.loop.law_controller` followed by
 :func:`~wmrkit.kinematics.wheel_ik.wheel_commands` (tested).
 """
@@ -55,8 +57,9 @@ class ControlTick:
 def control_tick(robot: Robot, law: PositionLaw | None = None, point: ArrayLike | None = None, *,
                  reduced: bool | None = None) -> ControlTick:
     """Compile the single-call tick of `robot` for `law` (``"p"``, gated or not; default P with a = 1 s^-1) at the
-    control point ``control_point(robot, point, reduced=reduced)``; refused for a robot whose steering couplings
-    leave one steering degree of freedom (its twist is solved by Newton's method) unless `reduced` is False."""
+    control point ``control_point(robot, point, reduced=reduced)`` (a robot whose steering couplings leave one
+    steering degree of freedom: its twist solved by Newton's method, :mod:`.coupled_solve`, unless `reduced` is
+    False)."""
     from ..kinematics.realtime import realtime
 
     law = law or PositionLaw.uniform("p", 1.0)
