@@ -86,7 +86,7 @@ def test_the_realtime_ik_and_the_control_tick_agree_with_wheel_commands():
         one = wheel_commands(robot, t)
         assert bool(one.feasible) == bool(batch.feasible[i])
         assert rt.ik(*t.tolist(), np.zeros(2), rates, out) == bool(one.feasible)
-    tick = control_tick(robot, reduced=False).tick  # the full pose's law (the reduced one is not compiled)
+    tick = control_tick(robot, reduced=False).tick  # the full pose's law, blind to the gear (reduced=False)
     twist = np.empty(3)
     # the reference's velocity (1, 0, 1) is the twist: the robot on its reference
     assert not tick(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, np.zeros(2), twist, rates, out)
