@@ -375,3 +375,18 @@ def test_plots_label_every_axis_and_close_on_a_failed_write(capsys, monkeypatch,
     assert code == 2 and "disk full" in err
     assert seen and all(x and "[" in y for x, y in seen[0]), seen
     assert set(plt.get_fignums()) == before
+
+
+def test_an_adaptive_run_states_its_tolerance_not_a_step(capsys):
+    """LSODA chooses its own steps: 'wmrkit simulate --method adaptive' printed '(adaptive, step 0.001 s)' and JSON
+    "step": 0.001, the default fixed step it never took. It states the tolerance it ran at and the record step."""
+    argv = ["simulate", "forklift", "--path", "straight", "--duration", "0.05", "--method", "adaptive"]
+    code, out, _ = run(capsys, *argv)
+    assert code == 0 and "(adaptive, LSODA, rtol 1e-06, recorded every 0.01 s), 6 samples" in out
+    assert "step 0.001" not in out
+    code, out, _ = run(capsys, *argv, "--json")
+    data = json.loads(out)
+    assert code == 0 and data["step"] is None and data["rtol"] == 1e-6
+    code, out, _ = run(capsys, *argv[:-2], "--json")  # a fixed step keeps saying it
+    data = json.loads(out)
+    assert code == 0 and data["step"] == 1e-3 and data["rtol"] is None

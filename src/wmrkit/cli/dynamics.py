@@ -25,6 +25,9 @@ from ._common import (
 
 #: ``simulate --step`` when not given [s].
 DEFAULT_STEP = 0.001
+#: ``simulate --method adaptive``'s relative tolerance (LSODA has no fixed step; ``--step`` only sets how often a
+#: run longer than 0.01 s per step records).
+ADAPTIVE_RTOL = 1e-6
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -202,11 +205,11 @@ def run_simulate(args: argparse.Namespace) -> int:
     twist = [0.0, 0.0, 0.0] if args.initial_twist is None else [
         parse_value(v, "number", "--initial-twist") for v in args.initial_twist]
     _check_rolling(model, twist)
-    try:
+    record = recordable_step(model, duration, step, max(step, min(0.01, duration)))
+    try:  # re-checked at a shorter step where needed
         with renaming({"initial twist ": "--initial-twist "}):
             sim = simulate(model, inputs, duration, step=step, method=args.method, initial_twist=twist,
-                           record_step=recordable_step(model, duration, step, max(step, min(0.01, duration))),
-                           progress=False if args.json else None)  # re-checked at a shorter step where needed
+                           record_step=record, rtol=ADAPTIVE_RTOL, progress=False if args.json else None)
     except SetpointKnotsError as err:  # the knots between the torque file's rows (the program's)
         raise WmrkitError(f"{args.torques or f'--path {args.path}'}: {err}") from None
     except WmrkitError as err:  # a stop's re-check, or the step's, names the step as the CLI sets it
@@ -225,13 +228,17 @@ def run_simulate(args: argparse.Namespace) -> int:
     for warning in warnings:
         warn(warning)
     if args.json:
-        print_json({"robot": model.robot.name, "method": sim.method, "step": step, "duration": duration,
+        adaptive = sim.method == "adaptive"  # no fixed step: its tolerance instead ('step 0.001 s' was printed)
+        print_json({"robot": model.robot.name, "method": sim.method, "step": None if adaptive else step,
+                    "rtol": ADAPTIVE_RTOL if adaptive else None, "duration": duration,
                     "samples": len(sim.t), "final_time": end, "final_pose": pose.tolist(), "final_twist": tw.tolist(),
                     "path_length": travelled, "max_slip_speed": max_slip,
                     "deviation": deviation.to_dict() if deviation else None,
                     "step_check": sim.step_check.to_dict() if sim.step_check else None, "out": args.out})
     else:
-        print(f"{model.robot.name}: {duration:g} s simulated ({sim.method}, step {step:g} s), {len(sim.t)} samples")
+        how = (f"LSODA, rtol {ADAPTIVE_RTOL:g}, recorded every {record:g} s" if sim.method == "adaptive" else
+               f"step {step:g} s")
+        print(f"{model.robot.name}: {duration:g} s simulated ({sim.method}, {how}), {len(sim.t)} samples")
         print(f"final pose (t = {end:g} s): x = {pose[0]:.6g} m, y = {pose[1]:.6g} m, theta = {pose[2]:.6g} rad")
         print(f"final twist (t = {end:g} s): vx = {tw[0]:.6g} m/s, vy = {tw[1]:.6g} m/s, omega = {tw[2]:.6g} rad/s")
         print(f"distance travelled: {travelled:.6g} m; largest slip speed {max_slip:.3g} m/s")
