@@ -301,3 +301,18 @@ def test_a_filter_whose_pose_leaves_the_range_handled_is_refused_at_that_row(gap
         else:
             assert code == 0 and err == ""
             assert json.loads(out)["final_pose"][2] == pytest.approx(0.075 * (0.24 - 0.16) * 11 / 0.4, rel=1e-12)
+
+
+def test_the_plot_legend_names_the_slip_aware_method(tmp_path, monkeypatch):
+    """`wmrkit odometry LOG --method fk2 --plot P` labelled its path 'diff-drive (exact)', the integration scheme
+    alone: a plot of each estimator said the same. The legend names the estimator and its scheme."""
+    from wmrkit.odometry import plot
+
+    robot = catalog.load("diff-drive")
+    path = tmp_path / "log.csv"
+    write_log(path, simulate(robot, PROFILE, 50.0).log, robot)
+    drawn = []
+    monkeypatch.setattr(plot, "save_trajectory_plot", lambda out, paths, **_: drawn.append(list(paths)))
+    for method in ("fk2", "wls", "exact"):
+        assert main(["odometry", "diff-drive", str(path), "--method", method, "--plot", str(tmp_path / "p.png")]) == 0
+    assert drawn == [["diff-drive (fk2, exact)"], ["diff-drive (wls, exact)"], ["diff-drive (exact)"]]

@@ -178,7 +178,8 @@ def run(args: argparse.Namespace) -> int:
         plot=args.plot, progress=not args.quiet and sys.stderr.isatty(), chunk_size=args.chunk_size,
         topic=args.topic, joint_names=parse_assignments(args.joint_name, "--joint-name"),
         weights=weights,
-        sinks=[check] if check else (), check=check.judge if check else None)
+        sinks=[check] if check else (), check=check.judge if check else None,
+        label=f"{spec.name}, {spec.scheme}" if spec is not None else None)
     if spec is not None:
         summary = replace(summary, method=spec.label)
     if args.method in ("fk1", "fk2") and (line := slip_model.conditioning_warning()):

@@ -97,7 +97,7 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
                   joint_names: Mapping[str, str] | None = None,
                   weights: Mapping[str, float] | None = None, model=None,
                   sinks: Sequence[Callable[[Trajectory], object]] = (),
-                  check: Callable[[], object] | None = None) -> OdometrySummary:
+                  check: Callable[[], object] | None = None, label: str | None = None) -> OdometrySummary:
     """Run odometry over the log at `log_path` and write the requested outputs (module docstring).
 
     `fmt` describes a CSV log; `topic` and `joint_names` (ROS name -> robot joint) a bag. `sensed` and `weights`
@@ -106,7 +106,8 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
     WLS, :func:`wmrkit.slip.weights.wls_model`) or an estimator with ``joints`` and ``run(chunks, method=,
     pose0=, sinks=)`` (the Kalman filters of :mod:`wmrkit.slip.estimators`). `sinks` get every chunk of the
     trajectory too (after the outputs), e.g. :class:`~.diagnostics.ImuCheck`; ``check()``, called after the run,
-    fails it like an error of the run (the output removed, no plot) when it raises.
+    fails it like an error of the run (the output removed, no plot) when it raises. `label` names the odometry in
+    the plot's legend (default `method`, the integration scheme: a Kalman filter's plot said only ``exact``).
     """
     from tqdm import tqdm
 
@@ -160,5 +161,5 @@ def odometry_file(robot: Robot, log_path: str | os.PathLike[str], *, fmt: LogFor
         from .plot import save_trajectory_plot
 
         _time, poses = decimated.result()
-        save_trajectory_plot(plot, {f"{robot.name} ({method})": poses})
+        save_trajectory_plot(plot, {f"{robot.name} ({label or method})": poses})
     return summary
