@@ -114,6 +114,23 @@ def test_study_output_and_figures(study):
         assert opt[name]["J_k"] <= start + 1e-12
 
 
+def test_study_text_says_which_parameters_each_line_holds(study):
+    """The text printed the held-out check as a sixth path ('held_out: WLS 0.203 %, ...', the parameters tuned on
+    seed 0 judged on seed 1) among the paths' lines, whose 'WLS' (the sweep's k11, k12) next to 'WLS (thesis k)'
+    did not say where its k came from."""
+    from wmrkit.slip.study import format_study
+
+    result, _ = study
+    lines = format_study(result).splitlines()
+    held = result["paths"]["held_out"]
+    assert not [line for line in lines if line.lstrip().startswith("held_out")]
+    assert (f"tuned on seed 0, judged on fresh runs of seed {held['seed']}, mean J_k: "
+            f"WLS {100 * held['J_k']['WLS']:.3g} %") in lines[-4]
+    runs = [line for line in lines if line.startswith("  ")]
+    assert len(runs) == sum(isinstance(r, dict) and "speed" in r for r in result["paths"].values())
+    assert all("WLS (sweep k) " in line and "WLS (thesis k) " in line for line in runs)
+
+
 @pytest.mark.parametrize("seed", [1, 2])
 def test_tuned_paths_rank_the_estimators_as_the_thesis(seed):
     """§7.5.4's finding on the five paths driven through the forklift's open differential, each estimator tuned on

@@ -285,12 +285,18 @@ def format_study(result: dict) -> str:
              f"k12 = {s['k12']:.4g}, mean |MCD - WLS| = {s['mean_abs_difference']:.3g}"]
     for e in result["examples"]:
         lines.append(f"example {e['example']}: " + ", ".join(f"J_{m} = {100 * v:.3g} %" for m, v in e["J"].items()))
-    for name, run in result["paths"].items():
-        if isinstance(run, dict) and "J_k" in run:
-            lines.append(f"{name}: " + ", ".join(f"{k} {100 * v:.3g} %" for k, v in run["J_k"].items()))
-    lines.append("mean J_k: " + ", ".join(f"{k} {100 * v:.3g} %" for k, v in result["paths"]["mean_J_k"].items()))
-    lines.append("optimised mean J_k: " + ", ".join(f"{k} {100 * v['J_k']:.3g} %"
-                                                    for k, v in result["paths"]["optimised"].items()))
+    p = result["paths"]
+    named = lambda jk: ", ".join(f"{'WLS (sweep k)' if k == 'WLS' else k} {100 * v:.3g} %"  # noqa: E731
+                                 for k, v in jk.items())
+    lines.append("J_k per path (WLS with the sweep's k11, k12 and with the thesis's; FK1, FK2 the thesis's):")
+    for name, run in p.items():
+        if isinstance(run, dict) and "speed" in run:  # a path's run ('held_out' has J_k too: printed as a path)
+            lines.append(f"  {name} ({run['speed']:.3g} m/s): {named(run['J_k'])}")
+    lines.append(f"mean J_k: {named(p['mean_J_k'])}")
+    lines.append("tuned on these runs, mean J_k: " + ", ".join(f"{k} {100 * v['J_k']:.3g} %"
+                                                               for k, v in p["optimised"].items()))
+    lines.append(f"tuned on seed {p['seed']}, judged on fresh runs of seed {p['held_out']['seed']}, mean J_k: "
+                 + ", ".join(f"{k} {100 * v:.3g} %" for k, v in p["held_out"]["J_k"].items()))
     for what, r in result["paths"]["ranking"].items():
         lines.append(f"ranking ({what}): {' < '.join(r['order'])}; WLS and FK2 better than FK1 and differential: "
                      f"{'yes' if r['reproduced'] else 'no'} (margin x{r['margin']:.3g})")
