@@ -143,6 +143,26 @@ def test_torque_file(tmp_path, forklift):
     assert read_torques(forklift, path).torques[0, forklift.names.index("left_drive.spin")] == 9
 
 
+def test_a_torque_file_may_write_its_units_as_the_other_csv_files_do(tmp_path, forklift):
+    """'time [s],left_drive.spin [N m]' (the header style of every other CSV of wmrkit, `simulate --out`'s too) was
+    refused as "expected a header 'time,<wheel>.<joint>,...'". Units are read; a unit a column does not take is
+    refused naming the column."""
+    bare, units = tmp_path / "bare.csv", tmp_path / "units.csv"
+    bare.write_text("time,right_drive.spin,left_drive.spin,steer.heading\n0,50,50,0\n1,50,40,0.2\n")
+    units.write_text("time [s],right_drive.spin [N m],left_drive.spin [Nm],steer.heading [deg]\n"
+                     f"0,50,50,0\n1,50,40,{math.degrees(0.2)!r}\n")
+    a, b = read_torques(forklift, bare), read_torques(forklift, units)
+    np.testing.assert_array_equal(a.time, b.time)
+    np.testing.assert_array_equal(a.torques, b.torques)
+    np.testing.assert_allclose(b.heading_reference, a.heading_reference, rtol=1e-15)
+    for header, match in (("time [ms],left_drive.spin", r"column 'time \[ms\]': the time is read in \[s\]"),
+                          ("time,left_drive.spin [rad]", r"column 'left_drive.spin \[rad\]': a torque .* \[N m\]"),
+                          ("time,steer.heading [N m]", r"column 'steer.heading \[N m\]': a heading is read in")):
+        units.write_text(f"{header}\n0,1\n")
+        with pytest.raises(WmrkitError, match=r"units.csv:1: " + match):
+            read_torques(forklift, units)
+
+
 def test_a_heading_column_for_a_passive_castor_is_refused(tmp_path):
     """'caster.heading' gave the castor, whose steering no motor drives, a PD servo (kp 37 N m/rad) that steered
     it; torque columns on joints that are not actuated were already refused."""

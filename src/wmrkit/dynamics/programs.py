@@ -3,7 +3,8 @@
 A torque file is a CSV with a header ``time,<wheel>.<joint>,...``: times [s] strictly increasing from at most 0,
 torques [N m] on actuated joints (``spin``, ``spin1``/``spin2``, ``steer``), linear between rows, the last row held;
 a ``<wheel>.heading`` column [rad] is a steering-servo reference instead (the users' heading, 0 = straight ahead;
-actuated steering only: a castor steers passively); the set-points of one held linkage on its law at each row
+actuated steering only: a castor steers passively). A column may write its unit in brackets, as the other CSV files
+of wmrkit do (:data:`TORQUE_FILE_UNITS`: ``time [s]``, ``<wheel>.spin [N m]``, ``<wheel>.heading [deg]``); the set-points of one held linkage on its law at each row
 (:func:`~wmrkit.dynamics.linkages.heading_breach`) and, between rows, the linkage's other columns set by its law
 from its reference column's interpolation (:class:`~wmrkit.dynamics.inputs.Inputs`).
 
@@ -298,6 +299,29 @@ def _check_setpoints(source: str, model: DynamicModel, href: np.ndarray, command
                           f"column per {kind} (docs/dynamics.md)")
 
 
+#: The units a torque file's header may write in brackets, per column, with their factor to SI ('time [s]' was
+#: refused as "expected a header 'time,<wheel>.<joint>,...'").
+TORQUE_FILE_UNITS = {"time": {"s": 1.0}, "heading": {"rad": 1.0, "deg": math.pi / 180.0},
+                     "torque": {"N m": 1.0, "Nm": 1.0, "N*m": 1.0}}
+
+
+def _header_unit(source: str, column: str) -> tuple[str, float]:
+    """A torque file's `column` without its bracketed unit, and that unit's factor to SI (1 without one); a unit
+    the column does not take (``time [ms]``, a ``--out`` file's ``spin [rad]``) is refused naming both."""
+    name, bracket, unit = column.partition("[")
+    if not bracket:
+        return column, 1.0
+    name = name.strip()
+    kind = "time" if name == "time" else "heading" if name.endswith(".heading") else "torque"
+    units = TORQUE_FILE_UNITS[kind]
+    unit = unit.strip()
+    if not unit.endswith("]") or unit[:-1].strip() not in units:
+        what = {"time": "the time", "heading": "a heading", "torque": "a torque (any column but time and headings)"}
+        raise WmrkitError(f"{source}:1: column '{column}': {what[kind]} is read in "
+                          f"{' or '.join(f'[{u}]' for u in units)} in a torque file")
+    return name, units[unit[:-1].strip()]
+
+
 def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
     """:class:`Inputs` from a torque CSV (module docstring); errors name the file, the line and the column."""
     source = str(path)
@@ -307,9 +331,9 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
             rows = list(csv.reader(fh))
     except (OSError, UnicodeDecodeError) as err:
         raise WmrkitError(f"{source}: cannot read the file ({err.__class__.__name__})") from None
-    if not rows or not rows[0] or rows[0][0].strip() != "time" or len(rows) < 2:
+    header, scale = zip(*(_header_unit(source, h.strip()) for h in rows[0])) if rows and rows[0] else ((), ())
+    if not header or header[0] != "time" or len(rows) < 2:
         raise WmrkitError(f"{source}:1: expected a header 'time,<wheel>.<joint>,...' and at least one row")
-    header = [h.strip() for h in rows[0]]
     twice = next((h for i, h in enumerate(header) if h in header[:i]), None)
     if twice is not None:
         raise WmrkitError(f"{source}:1: column '{twice}' given twice")
@@ -321,7 +345,7 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
             problem = number_problem(cell)
             if problem is not None:
                 raise WmrkitError(f"{source}:{i}: column '{header[j]}': {problem}")
-            values[i - 2, j] = float(cell)
+            values[i - 2, j] = float(cell) * scale[j]
     if np.any(np.diff(values[:, 0]) <= 0):
         raise WmrkitError(f"{source}: times must be strictly increasing")
     if values[0, 0] > 0:  # held before the first row, the first torques would act from t = 0
