@@ -4,7 +4,8 @@ A torque file is a CSV with a header ``time,<wheel>.<joint>,...``: times [s] str
 torques [N m] on actuated joints (``spin``, ``spin1``/``spin2``, ``steer``), linear between rows, the last row held;
 a ``<wheel>.heading`` column [rad] is a steering-servo reference instead (the users' heading, 0 = straight ahead;
 actuated steering only: a castor steers passively). A column may write its unit in brackets, as the other CSV files
-of wmrkit do (:data:`TORQUE_FILE_UNITS`: ``time [s]``, ``<wheel>.spin [N m]``, ``<wheel>.heading [deg]``); the set-points of one held linkage on its law at each row
+of wmrkit do (:data:`TORQUE_FILE_UNITS`: ``time [s]``, ``<wheel>.spin [N m]``, ``<wheel>.heading [deg]``); the
+set-points of one held linkage on its law at each row
 (:func:`~wmrkit.dynamics.linkages.heading_breach`) and, between rows, the linkage's other columns set by its law
 from its reference column's interpolation (:class:`~wmrkit.dynamics.inputs.Inputs`).
 
@@ -331,7 +332,8 @@ def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:
             rows = list(csv.reader(fh))
     except (OSError, UnicodeDecodeError) as err:
         raise WmrkitError(f"{source}: cannot read the file ({err.__class__.__name__})") from None
-    header, scale = zip(*(_header_unit(source, h.strip()) for h in rows[0])) if rows and rows[0] else ((), ())
+    named = [_header_unit(source, h.strip()) for h in (rows[0] if rows else ())]
+    header, scale = [h for h, _ in named], [k for _, k in named]
     if not header or header[0] != "time" or len(rows) < 2:
         raise WmrkitError(f"{source}:1: expected a header 'time,<wheel>.<joint>,...' and at least one row")
     twice = next((h for i, h in enumerate(header) if h in header[:i]), None)
