@@ -208,7 +208,8 @@ def check_step(model, inputs, sim, initial_twist=(0.0, 0.0, 0.0), jac_every: int
     t = sim.t[:m]
     along = PathDeviation.of(t, check.pose, check.pose if sim.nominal_pose is None else sim.nominal_pose[:m])
     apart = dataclasses.replace(PathDeviation.of(t, sim.pose[:m], check.pose), size=along.size, turn=along.turn)
-    if apart.large or (off_path and not along.large):  # far from the re-run, or off a path the re-run keeps to
+    off_within = off_path and PathDeviation.of(t, sim.pose[:m], sim.nominal_pose[:m]).large  # over the re-run's time
+    if apart.large or (off_within and not along.large):  # far from the re-run, or off a path the re-run keeps to
         kept = (f", but a run at step {fine:.3g} s to t = {t[-1]:g} s keeps within {along.max_position:.3g} m of the "
                 "path and" if off_path else f"; a run at step {fine:.3g} s to t = {t[-1]:g} s")
         err = WmrkitError(
