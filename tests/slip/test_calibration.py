@@ -259,3 +259,23 @@ def test_cli_calibrate_reads_the_log_header_units(tmp_path, capsys, husky_run):
         fits.append(json.loads(capsys.readouterr().out))
     for key in ("ratio", "wheel_separation_multiplier"):  # times / 1000 differ in the last bits: the fit's tolerance
         assert fits[1][key] == pytest.approx(fits[0][key], rel=1e-7)
+
+
+@pytest.mark.parametrize(("rms", "best", "block", "track_line"), [
+    ((0.155, 0.147, 0.050), "effective_track", True, True),  # the forklift's rectangle (2 m/s, simulated)
+    ((0.049, 0.041, 0.042), "wls", True, False),
+    ((0.030, 0.031, 0.035), "no_slip", False, False),
+])
+def test_the_summary_recommends_what_fits_the_run(rms, best, block, track_line):
+    """`wmrkit calibrate` offered WLS's description block whatever the errors: on the forklift's rectangle WLS was
+    three times the effective track's rms error; a WLS no better than no slip is no recommendation at all."""
+    from wmrkit.slip.calibration import SlipCalibration
+
+    names = ("no_slip", "wls", "effective_track")
+    cal = SlipCalibration("r", 0.35, 1.0065, tuple(zip(names, rms, strict=True)),
+                          tuple((n, 0.0, 0.0) for n in names))
+    text = cal.format()
+    assert cal.best == best and cal.to_dict()["best"] == best
+    assert ("to use WLS by default" in text) == block and ("  method: wls" in text) == block
+    assert ("the effective track fits this run best" in text) == track_line
+    assert ("no slip weights to add" in text) == (not block)

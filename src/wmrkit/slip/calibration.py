@@ -46,6 +46,11 @@ class SlipCalibration:
     final: tuple[tuple[str, float, float], ...]
 
     @property
+    def best(self) -> str:
+        """The model of least RMS position error on this run: ``no_slip``, ``wls`` or ``effective_track``."""
+        return min(self.rms, key=lambda item: item[1])[0]
+
+    @property
     def weights(self) -> SlipWeights:
         """The WLS coefficients to use in ``odometry --method wls``."""
         return SlipWeights.uniform(self.ratio, 1.0)
@@ -62,7 +67,7 @@ class SlipCalibration:
         """JSON-ready; ``weights`` is what ``wmrkit odometry --slip-weights FILE`` reads, ``description`` the block
         for the robot's description."""
         return {"robot": self.robot, "weights": self.weights.to_dict(), "description": self.description,
-                "ratio": self.ratio,
+                "ratio": self.ratio, "best": self.best,
                 "wheel_separation_multiplier": self.multiplier,
                 "rms_position_error": dict(self.rms),
                 "final_position_error": {n: p for n, p, _ in self.final},
@@ -74,9 +79,16 @@ class SlipCalibration:
                  f"effective track multiplier = {self.multiplier:.6g}"]
         for (name, rms), (_, p, h) in zip(self.rms, self.final, strict=True):
             lines.append(f"  {name:<16} rms position error {rms:.4g} m, final {p:.4g} m, {math.degrees(h):.3g} deg")
+        rms = dict(self.rms)
+        if self.best == "effective_track":  # not an estimator of wmrkit's: ROS's diff_drive_controller parameter
+            lines.append(f"the effective track fits this run best (rms {rms['effective_track']:.4g} m, WLS "
+                         f"{rms['wls']:.4g} m): it is the wheel_separation_multiplier of ROS's diff_drive_controller")
+        if rms["wls"] >= rms["no_slip"]:
+            lines.append("WLS fits this run no better than the no-slip odometry: no slip weights to add")
+            return "\n".join(lines)
         block = self.description["odometry"]
-        lines += ["to use it by default, add to the robot's description:", "odometry:",
-                  f"  method: {block['method']}",
+        lines += [f"to use WLS by default (rms {rms['wls']:.4g} m, no slip {rms['no_slip']:.4g} m), add to the robot's "
+                  "description:", "odometry:", f"  method: {block['method']}",
                   f"  slip: {{lateral: {self.ratio!r}, longitudinal: 1.0}}   # WLS friction coefficients (7.59)"]
         return "\n".join(lines)
 
