@@ -390,3 +390,13 @@ def test_an_adaptive_run_states_its_tolerance_not_a_step(capsys):
     code, out, _ = run(capsys, *argv[:-2], "--json")  # a fixed step keeps saying it
     data = json.loads(out)
     assert code == 0 and data["step"] == 1e-3 and data["rtol"] is None
+
+
+def test_step_with_the_adaptive_method_is_refused(capsys):
+    """LSODA chooses its own steps: '--method adaptive --step 0.001' ran recording every 0.01 s, and '--step 0.05'
+    recorded every 0.05 s, both exit 0, where the help calls --step the integration step."""
+    for step in ("0.001", "0.05"):
+        code, out, err = run(capsys, "simulate", "forklift", "--path", "straight", "--method", "adaptive", "--step",
+                             step)
+        assert code == 2 and out == "" and err.count("\n") == 1
+        assert err.startswith(f"wmrkit: error: --step {step}: the adaptive method chooses its own steps")

@@ -62,7 +62,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     source.add_argument("--path", metavar="NAME", choices=list(PATHS), help=f"built-in program: {', '.join(PATHS)}")
     p.add_argument("--tyre", choices=list(TYRES), help="tyre model for every wheel (default: each wheel's own)")
     p.add_argument("--duration", metavar="S", help="simulated time [s] (default: the program's or the file's)")
-    p.add_argument("--step", metavar="DT", help=f"integration step [s] (default {DEFAULT_STEP:g})")
+    p.add_argument("--step", metavar="DT",
+                   help=f"integration step [s] of the fixed-step methods (default {DEFAULT_STEP:g})")
     p.add_argument("--method", default="semi-implicit", choices=["semi-implicit", "rk4", "adaptive"],
                    help="integrator: semi-implicit Euler (default; stable with stiff tyres at 1 ms), rk4 (fixed "
                         "step, non-stiff tyres only: docs/dynamics.md) or adaptive (LSODA)")
@@ -188,6 +189,9 @@ def run_simulate(args: argparse.Namespace) -> int:
             raise WmrkitError(f"{args.torques}: the file ends at t = {duration:g} s: give --duration")
     if args.duration is not None:
         duration = _positive(parse_value(args.duration, "number", "--duration"), "--duration")
+    if args.step is not None and args.method == "adaptive":  # below 0.01 s it was dropped, above it set the records
+        raise WmrkitError(f"--step {args.step}: the adaptive method chooses its own steps (LSODA, to a relative "
+                          "tolerance of 1e-6; it records every 0.01 s); --step applies to semi-implicit and rk4")
     step = _positive(parse_value(f"{DEFAULT_STEP}" if args.step is None else args.step, "number", "--step"), "--step")
     source = ("--duration" if args.duration is not None else f"{args.torques}: the file ends at t =" if args.torques
               else f"--path {args.path} at --speed {speed:g} m/s lasts")  # what set the duration
