@@ -400,3 +400,13 @@ def test_step_with_the_adaptive_method_is_refused(capsys):
                              step)
         assert code == 2 and out == "" and err.count("\n") == 1
         assert err.startswith(f"wmrkit: error: --step {step}: the adaptive method chooses its own steps")
+
+
+def test_tyre_says_where_a_force_at_zero_slip_comes_from(capsys):
+    """`wmrkit tyre pacejka --load 8175` printed Fx = -314 N at zero slip under '(force of the ground on the tyre,
+    opposing the slip)': there is no slip; the force is the magic formula's shifts (shifts = 0 removes it)."""
+    code, out, _ = run(capsys, "tyre", "pacejka", "--load", "8175")
+    assert code == 0 and "Fx (longitudinal) = 0 N" not in out and "shifts add a force at any slip" in out
+    code, out, _ = run(capsys, "tyre", "pacejka", "--load", "8175", "--param", "shifts=0")
+    assert code == 0 and "Fx (longitudinal) = 0 N" in out and "Fy (lateral)      = 0 N" in out
+    assert "shifts" not in out

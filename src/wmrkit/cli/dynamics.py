@@ -116,7 +116,9 @@ def run_tyre(args: argparse.Namespace) -> int:
               f"slip angle {a:g} rad, wheel speed {speed:g} m/s")
         print(f"Fx (longitudinal) = {fx:.6g} N")
         print(f"Fy (lateral)      = {fy:.6g} N")
-        print("(force of the ground on the tyre, opposing the slip)")
+        print("(force of the ground on the tyre, opposing the slip"
+              + ("; with shifts = 1 the magic formula's shifts add a force at any slip, zero slip included: rolling "
+                 "resistance and a lateral bias, appendix 7.A1)" if tyre.as_dict().get("shifts") else ")"))
     return 0
 
 
