@@ -279,3 +279,15 @@ def test_the_summary_recommends_what_fits_the_run(rms, best, block, track_line):
     assert ("to use WLS by default" in text) == block and ("  method: wls" in text) == block
     assert ("the effective track fits this run best" in text) == track_line
     assert ("no slip weights to add" in text) == (not block)
+
+
+def test_the_multiplier_has_one_json_name(capsys):
+    """slip-study skid-steer-4 --json called it 'multiplier' where calibrate --json says
+    'wheel_separation_multiplier' (the ROS parameter)."""
+    import json
+
+    from wmrkit.cli.main import main
+
+    assert main(["slip-study", "skid-steer-4", "--source", "quasi-static", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert "multiplier" not in data and data["wheel_separation_multiplier"] > 1

@@ -298,7 +298,8 @@ def run_study(args: argparse.Namespace) -> int:
         if args.json:
             print_json(data)
         else:
-            print(f"calibrated: WLS ratio {data['ratio']:.4g}, effective track multiplier {data['multiplier']:.4g}")
+            print(f"calibrated: WLS ratio {data['ratio']:.4g}, effective track multiplier "
+                  f"{data['wheel_separation_multiplier']:.4g}")
             for name, models in data["runs"].items():
                 print(f"{name}: " + ", ".join(f"{m} rms {v['rms_position_error']:.3g} m" for m, v in models.items()))
         return 0

@@ -71,7 +71,7 @@ def skid_comparison(robot: Robot, *, rate: float = 50.0, calibration=CALIBRATION
                     tests: Mapping[str, Sequence] | None = None, source: str = "md") -> dict:
     """Calibrate on `calibration` segments, evaluate on `tests`: JSON-ready results plus the paths.
 
-    Returns ``{"ratio", "multiplier", "runs": {name: {model: {"rms_position_error": m,
+    Returns ``{"ratio", "wheel_separation_multiplier", "runs": {name: {model: {"rms_position_error": m,
     "final_position_error": m}}}, "paths": {name: {label:
     poses}}}`` (``paths`` holds arrays, for plotting).
     """
@@ -91,7 +91,8 @@ def skid_comparison(robot: Robot, *, rate: float = 50.0, calibration=CALIBRATION
             runs[name][label] = {"rms_position_error": float(np.sqrt(np.mean(d * d))),
                                       "final_position_error": float(d[-1])}
             paths[name][label] = p
-    return {"source": source, "ratio": cal.ratio, "multiplier": cal.multiplier, "runs": runs, "paths": paths}
+    return {"source": source, "ratio": cal.ratio, "wheel_separation_multiplier": cal.multiplier, "runs": runs,
+            "paths": paths}  # the multiplier's name as calibrate's JSON (and ROS's diff_drive_controller) say it
 
 
 def save_skid_figures(result: dict, directory: str | os.PathLike[str]) -> list[str]:
