@@ -41,3 +41,15 @@ def test_a_flag_given_as_a_constant_and_as_a_variable_compiles_its_kernel_once()
 
     assert callers(1.0, False) == 6.0
     assert (len(once.signatures), len(twice.signatures)) == (1, 2)
+
+
+def test_the_step_loop_calls_its_solve_and_its_records_and_no_kernel_has_a_c_callable_wrapper():
+    # docs/limits.md, "First run on a machine": each inlined copy is compiled anew in the step loop (the solve had
+    # two call sites, a record's row two), and numba's C-callable wrapper of the loop's tuples was as large as the loop
+    from wmrkit.dynamics import _integrate
+
+    for kernel in (_kernels.solve_in_place, _integrate._row):
+        assert kernel.targetoptions["inline"] == "never"
+    for kernel in (_integrate.run_semi_implicit, _integrate.run_semi_implicit_linked, _integrate.assembled,
+                   _kernels.solve_in_place, _kernels._contacts):
+        assert kernel.targetoptions["no_cfunc_wrapper"] is True

@@ -9,8 +9,9 @@ wrap(beta_ref - beta) - kd beta_dot``, saturated smoothly as ``steer_max tanh(u 
 0``: the damping stays in the implicit matrix, so a saturated servo does not chatter between its limits.
 
 Speed (issue 10): the kernels of a step are inlined into :func:`run_semi_implicit`, which is compiled without numba's
-reference counting (nothing in it allocates), but for the mass matrix and the normal loads, called (compiled once:
-:func:`wmrkit.dynamics._kernels._called`); a record reuses the assembly of the step that starts at its time.
+reference counting (nothing in it allocates), but for the mass matrix, the normal loads, the tyre forces, the linear
+solve and a record's row, called (compiled once: :func:`wmrkit.dynamics._kernels._called`); a record reuses the
+assembly of the step that starts at its time.
 The first compile (docs/limits.md, "First run on a machine"): the step is written in the loop, not inlined from
 nested functions (:func:`_semi_implicit_kernel`), and every kernel is compiled for one set of argument types.
 """
@@ -23,6 +24,7 @@ import numpy as np
 
 from .._jit import runtime_value
 from ._kernels import (
+    _called,
     _inline,
     _njit,
     bias,
@@ -284,21 +286,28 @@ def _observe(t, s, acc, pack, inp, w, rec, i):
 
 @_inline
 def _store(t, s, w, rec, i):
-    """Row `i` of the records from the state `s` at time `t` and its assembly `w`."""
+    """Row `i` of the records from the state `s` at time `t` and its assembly `w` (:func:`_row`)."""
+    _row(t, s, w[0], w[7], w[3], w[4], w[6], rec, i)
+
+
+@_called
+def _row(t, s, a, tau, fz, f, vw, rec, i):
+    """:func:`_store` on the work arrays it reads. Called, not inlined: the step loop and the last record share one
+    compiled copy (a record is a row in every tenth step or fewer; inlined twice it was a tenth of the loop's code)."""
     r_t, r_s, r_f, r_fz, r_v, r_vw, r_tau = rec
-    a, n = w[0], w[9].shape[0]
+    n = tau.shape[0]
     r_t[i] = t
     for c in range(2 * n):
         r_s[i, c] = s[c]
     for c in range(n):
-        r_tau[i, c] = w[7][c]
+        r_tau[i, c] = tau[c]
     for e in range(r_v.shape[1]):
-        r_fz[i, e], r_vw[i, e] = w[3][e], w[6][e]
+        r_fz[i, e], r_vw[i, e] = fz[e], vw[e]
         for k in range(2):
             v = 0.0
             for c in range(n):
                 v += a[2 * e + k, c] * s[n + c]
-            r_v[i, e, k], r_f[i, e, k] = v, w[4][e, k]
+            r_v[i, e, k], r_f[i, e, k] = v, f[e, k]
 
 
 @_njit
@@ -314,7 +323,7 @@ def observe(t, s, acc, pack, inp, w, rec, i):
     if pack[17].shape[0] > 0:
         _hold(s, pack, w)
     assembled(t, s, acc, pack, inp, False, w)
-    _store.py_func(t, s, w, rec, i)
+    _row.py_func(t, s, w[0], w[7], w[3], w[4], w[6], rec, i)
 
 
 def _semi_implicit_kernel(linked: bool):

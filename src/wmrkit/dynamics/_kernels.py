@@ -42,8 +42,10 @@ FASTMATH = ("nnan", "ninf", "nsz")
 
 
 def _compile(fn, inline: str = "never", nrt: bool = True):
-    """``numba.njit`` with the :data:`FASTMATH` flags, cached on disk where possible."""
-    return compile_cached(fn, fastmath=set(FASTMATH), inline=inline, _nrt=nrt)
+    """``numba.njit`` with the :data:`FASTMATH` flags, cached on disk where possible, without the C-callable wrapper
+    numba adds for a kernel passed as a first-class function value (none is): the wrapper unboxes every argument,
+    and for the step loop's tuples of arrays it was as large as the loop (docs/limits.md, "First run on a machine")."""
+    return compile_cached(fn, fastmath=set(FASTMATH), inline=inline, _nrt=nrt, no_cfunc_wrapper=True)
 
 
 def _inline(fn):
@@ -336,10 +338,11 @@ def _contact_offset(beta, el, el_steer, e, gx, gy):
             el[e, 0] * math.sin(el[e, 1]) + el[e, 2] * math.cos(be) - gy)
 
 
-@_inline
+@_called
 def solve_in_place(a, x):
     """Gaussian elimination with partial pivoting (small dense systems; no LAPACK call overhead): `x` becomes
-    ``a^-1 x``; `a` is overwritten."""
+    ``a^-1 x``; `a` is overwritten. Called, not inlined: the geared solve has two call sites, each inlined copy
+    compiled anew in the step loop (docs/limits.md, "First run on a machine")."""
     n = x.shape[0]
     for i in range(n):
         p = i
