@@ -122,6 +122,17 @@ def _example(kind: Kind) -> str:
     return {"length": "'0.25' or '250 mm'", "angle": "'1.57' or '90 deg'", "number": "'0.5'"}[kind]
 
 
+#: A CSV column name carrying its unit in brackets: ``time [ms]``, ``left.spin [N m]``.
+_BRACKETED = re.compile(r"^\s*([^\[\]]*?)\s*\[\s*([^\[\]]+?)\s*\]\s*$")
+
+
+def split_unit(column: str) -> tuple[str, str] | None:
+    """``(name, unit)`` of a column name ending in a bracketed unit (``'time [ms]'`` -> ``('time', 'ms')``), else
+    None; the CSV headers of logs and of torque files."""
+    match = _BRACKETED.match(column)
+    return None if match is None else (match.group(1), match.group(2))
+
+
 def si_unit(kind: Kind) -> str:
     """The SI unit wmrkit uses inside for `kind` ("m", "rad" or "")."""
     return _SI[kind]

@@ -25,8 +25,7 @@ from ._common import (
 
 #: ``simulate --step`` when not given [s].
 DEFAULT_STEP = 0.001
-#: ``simulate --method adaptive``'s relative tolerance (LSODA has no fixed step; ``--step`` only sets how often a
-#: run longer than 0.01 s per step records).
+#: ``simulate --method adaptive``'s relative tolerance (LSODA chooses its steps: ``--step`` is refused with it).
 ADAPTIVE_RTOL = 1e-6
 
 
@@ -193,7 +192,8 @@ def run_simulate(args: argparse.Namespace) -> int:
         duration = _positive(parse_value(args.duration, "number", "--duration"), "--duration")
     if args.step is not None and args.method == "adaptive":  # below 0.01 s it was dropped, above it set the records
         raise WmrkitError(f"--step {args.step}: the adaptive method chooses its own steps (LSODA, to a relative "
-                          "tolerance of 1e-6; it records every 0.01 s); --step applies to semi-implicit and rk4")
+                          f"tolerance of {ADAPTIVE_RTOL:g}; it records every 0.01 s); --step applies to semi-implicit "
+                          "and rk4")
     step = _positive(parse_value(f"{DEFAULT_STEP}" if args.step is None else args.step, "number", "--step"), "--step")
     source = ("--duration" if args.duration is not None else f"{args.torques}: the file ends at t =" if args.torques
               else f"--path {args.path} at --speed {speed:g} m/s lasts")  # what set the duration

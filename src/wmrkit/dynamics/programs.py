@@ -29,7 +29,7 @@ from .._numbers import number_problem
 from .._shapes import readonly
 from ..errors import WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, MAX_TORQUE, check_table_size
-from ..units import BARE_ANGLE_LIMIT
+from ..units import BARE_ANGLE_LIMIT, UNITS, split_unit
 from .inputs import Inputs, joint_column, knots
 from .linkages import SETPOINT_TOL, first_breach, first_ik_breach, gear_breach, heading_breach, linkage_breach
 from .model import DynamicModel
@@ -302,25 +302,25 @@ def _check_setpoints(source: str, model: DynamicModel, href: np.ndarray, command
 
 #: The units a torque file's header may write in brackets, per column, with their factor to SI ('time [s]' was
 #: refused as "expected a header 'time,<wheel>.<joint>,...'").
-TORQUE_FILE_UNITS = {"time": {"s": 1.0}, "heading": {"rad": 1.0, "deg": math.pi / 180.0},
+TORQUE_FILE_UNITS = {"time": {"s": 1.0}, "heading": {"rad": 1.0, "deg": UNITS["angle"]["deg"]},
                      "torque": {"N m": 1.0, "Nm": 1.0, "N*m": 1.0}}
 
 
 def _header_unit(source: str, column: str) -> tuple[str, float]:
-    """A torque file's `column` without its bracketed unit, and that unit's factor to SI (1 without one); a unit
-    the column does not take (``time [ms]``, a ``--out`` file's ``spin [rad]``) is refused naming both."""
-    name, bracket, unit = column.partition("[")
-    if not bracket:
+    """A torque file's `column` without its bracketed unit (:func:`~wmrkit.units.split_unit`), and that unit's factor
+    to SI (1 without one); a unit the column does not take (``time [ms]``, a ``--out`` file's ``spin [rad]``) is
+    refused naming both."""
+    parts = split_unit(column)
+    if parts is None:
         return column, 1.0
-    name = name.strip()
+    name, unit = parts
     kind = "time" if name == "time" else "heading" if name.endswith(".heading") else "torque"
     units = TORQUE_FILE_UNITS[kind]
-    unit = unit.strip()
-    if not unit.endswith("]") or unit[:-1].strip() not in units:
+    if unit not in units:
         what = {"time": "the time", "heading": "a heading", "torque": "a torque (any column but time and headings)"}
         raise WmrkitError(f"{source}:1: column '{column}': {what[kind]} is read in "
                           f"{' or '.join(f'[{u}]' for u in units)} in a torque file")
-    return name, units[unit[:-1].strip()]
+    return name, units[unit]
 
 
 def read_torques(model: DynamicModel, path: str | os.PathLike[str]) -> Inputs:

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..errors import WmrkitError
 from ..limits import regular_file_problem
-from ..units import UNITS
+from ..units import UNITS, split_unit
 
 if TYPE_CHECKING:
     from ..robot import Robot
@@ -51,7 +51,6 @@ TIME_UNITS = ("s", "ms", "us", "ns")
 #: they are read in the first (a WPILib gyro's angle is in degrees: ``yaw [deg]``, ``gz [deg/s]``).
 EXTERNAL_UNITS = {"heading": ("rad", "deg"), "gyro": ("rad/s", "deg/s")}
 
-_NAME = re.compile(r"^\s*([^\[\]]*?)\s*\[\s*([^\[\]]+?)\s*\]\s*$")
 _COUNTER = re.compile(r"^counts:([us])(\d{1,2})$")
 #: What a unit in brackets looks like (``ms``, ``rad/s``, ``counts:u16``, ``deg:heading``, ``min``), unlike an index.
 _UNIT_WORD = re.compile(r"^[A-Za-z][A-Za-z0-9/:^*._-]*$")
@@ -113,10 +112,10 @@ def parse_header_units(names: list[str], *, source: str = "<log>", time_column: 
     columns, modes, bits, signed, time_unit = [], {"spin": set(), "steer": set()}, set(), set(), None
     conventions, roles, external_degrees, spin_units = set(), dict(roles or {}), False, set()
     for written in names:
-        match = _NAME.match(written)
-        if match is None:
+        parts = split_unit(written)
+        if parts is None:
             continue
-        plain, unit = match.group(1), match.group(2)
+        plain, unit = parts
         columns.append((plain, written))
         joint = plain.rpartition(".")[2] if "." in plain else None
         kind = roles.get(plain, joint if joint in ("spin", "steer") else None)
@@ -190,8 +189,8 @@ def _plain(name: str) -> str:
     """A column name without the unit it may carry (``'time [ms]'`` -> ``'time'``, ``'time [min]'`` -> ``'time'``,
     whose unit the header's reader then refuses by name); a name whose brackets hold no unit word (``'position[0]'``,
     an exported array) is a name."""
-    match = _NAME.match(name)
-    return match.group(1) if match is not None and _UNIT_WORD.match(match.group(2)) else name
+    parts = split_unit(name)
+    return parts[0] if parts is not None and _UNIT_WORD.match(parts[1]) else name
 
 
 def bare_heading_problem(column: str, heading: Sequence[float]) -> tuple[int, str] | None:

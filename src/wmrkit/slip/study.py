@@ -286,17 +286,18 @@ def format_study(result: dict) -> str:
     for e in result["examples"]:
         lines.append(f"example {e['example']}: " + ", ".join(f"J_{m} = {100 * v:.3g} %" for m, v in e["J"].items()))
     p = result["paths"]
-    named = lambda jk: ", ".join(f"{'WLS (sweep k)' if k == 'WLS' else k} {100 * v:.3g} %"  # noqa: E731
-                                 for k, v in jk.items())
+
+    def percents(jk: dict, sweep: str = "") -> str:  # 'WLS' -> 'WLS (sweep k)' where WLS holds the sweep's k
+        return ", ".join(f"{k}{sweep if k == 'WLS' else ''} {100 * v:.3g} %" for k, v in jk.items())
+
     lines.append("J_k per path (WLS with the sweep's k11, k12 and with the thesis's; FK1, FK2 the thesis's):")
     for name, run in p.items():
         if isinstance(run, dict) and "speed" in run:  # a path's run ('held_out' has J_k too: printed as a path)
-            lines.append(f"  {name} ({run['speed']:.3g} m/s): {named(run['J_k'])}")
-    lines.append(f"mean J_k: {named(p['mean_J_k'])}")
-    lines.append("tuned on these runs, mean J_k: " + ", ".join(f"{k} {100 * v['J_k']:.3g} %"
-                                                               for k, v in p["optimised"].items()))
+            lines.append(f"  {name} ({run['speed']:.3g} m/s): {percents(run['J_k'], ' (sweep k)')}")
+    lines.append(f"mean J_k: {percents(p['mean_J_k'], ' (sweep k)')}")
+    lines.append(f"tuned on these runs, mean J_k: {percents({k: v['J_k'] for k, v in p['optimised'].items()})}")
     lines.append(f"tuned on seed {p['seed']}, judged on fresh runs of seed {p['held_out']['seed']}, mean J_k: "
-                 + ", ".join(f"{k} {100 * v:.3g} %" for k, v in p["held_out"]["J_k"].items()))
+                 f"{percents(p['held_out']['J_k'])}")
     for what, r in result["paths"]["ranking"].items():
         lines.append(f"ranking ({what}): {' < '.join(r['order'])}; WLS and FK2 better than FK1 and differential: "
                      f"{'yes' if r['reproduced'] else 'no'} (margin x{r['margin']:.3g})")
