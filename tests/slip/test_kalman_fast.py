@@ -32,9 +32,14 @@ def drive(robot, n: int, *, quantum: float, seed: int = 0, hold: int = 1) -> Joi
     return JointLog(time, model.joints, np.column_stack(cols))
 
 
-def textbook(model, log: JointLog, x0, p0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Twists ``(N, 3)``, slip ``(N,)`` and the final covariance: predict ``P + Q``, gain
-    ``K = P C^T (C P C^T + R)^-1``, update ``x + K (y - C x)``, ``(I - K C) P`` (Joseph's form), with
+def periods(dt: float, period: float | None) -> int:
+    """The nominal periods in a step of `dt` [s]: the nearest whole number, at least 1 (1 without a period)."""
+    return 1 if period is None else max(1, math.floor(dt / period + 0.5))
+
+
+def textbook(model, log: JointLog, x0, p0, period=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Twists ``(N, 3)``, slip ``(N,)`` and the final covariance: predict ``P + n Q`` (`n` the `period`s in the
+    step), gain ``K = P C^T (C P C^T + R)^-1``, update ``x + K (y - C x)``, ``(I - K C) P`` (Joseph's form), with
     ``y = -A_a qdot``."""
     om = model.odometry
     robot = om.robot
@@ -55,7 +60,7 @@ def textbook(model, log: JointLog, x0, p0) -> tuple[np.ndarray, np.ndarray, np.n
         c, aa = a[:, :3], a[:, cols]
         qdot = (p[k, rate] - p[k - 1, rate]) / dt
         y = -aa @ qdot
-        cov = cov + q
+        cov = cov + q * periods(dt, period)
         gain = cov @ c.T @ np.linalg.inv(c @ cov @ c.T + r)
         x = x + gain @ (y - c @ x)
         keep = np.eye(3) - gain @ c
@@ -100,10 +105,10 @@ def test_filter_equals_the_textbook_kalman_filter(kernels, name, kind, noise):
     np.testing.assert_allclose(poses[-1], [x, y, th], rtol=0, atol=1e-12 * len(log))
 
 
-def plain_recursion(model, log: JointLog, x0, p0) -> tuple[np.ndarray, int]:
+def plain_recursion(model, log: JointLog, x0, p0, period=None) -> tuple[np.ndarray, int]:
     """The information-form recursion of :mod:`wmrkit.slip._kalman_kernel` with both inverses computed at every
-    step (no reuse), in Python floats with the kernel's own 3x3 inverse: the twists ``(N, 3)``, and how many steps
-    gave back the covariance they started from (bit for bit)."""
+    step (no reuse), in Python floats with the kernel's own 3x3 inverse, ``n Q`` over a step of `n` periods: the
+    twists ``(N, 3)``, and how many steps of one period gave back the covariance they started from (bit for bit)."""
     inverse = _kalman_kernel._inverse_sym.py_func
     om = model.odometry
     p = log.select(om.joints).positions
@@ -120,14 +125,16 @@ def plain_recursion(model, log: JointLog, x0, p0) -> tuple[np.ndarray, int]:
         u = maps.find((p[k - 1, steer] + 0.5 * step)[None])[0]
         h, m = maps.arrays[0][u], maps.arrays[1][u]
         rates = [(p[k, j] - p[k - 1, j]) / d for j in rate]
-        i00, i01, i02, i11, i12, i22 = inverse(cov[0] + q, cov[1], cov[2], cov[3] + q, cov[4], cov[5] + q)
+        n = periods(d, period)
+        i00, i01, i02, i11, i12, i22 = inverse(cov[0] + q * n, cov[1], cov[2], cov[3] + q * n, cov[4], cov[5] + q * n)
         before, cov = cov, list(inverse(i00 + h[0, 0], i01 + h[0, 1], i02 + h[0, 2], i11 + h[1, 1],
                                         i12 + h[1, 2], i22 + h[2, 2]))
-        fixed += cov == before
+        at_fixed_point = cov == before and n == 1
+        fixed += at_fixed_point
         u00, u01, u02, u11, u12, u22 = cov
         pu = ((u00, u01, u02), (u01, u11, u12), (u02, u12, u22))
         pi = ((i00, i01, i02), (i01, i11, i12), (i02, i12, i22))
-        if cov == before:  # a fixed point: x+ = A x + G qdot with A = P+ P-^-1, G = P+ M
+        if at_fixed_point:  # a fixed point: x+ = A x + G qdot with A = P+ P-^-1, G = P+ M
             a = [[pr[0] * pi[0][col] + pr[1] * pi[1][col] + pr[2] * pi[2][col] for col in range(3)] for pr in pu]
             g = [[pr[0] * m[0, col] + pr[1] * m[1, col] + pr[2] * m[2, col] for col in range(len(rates))] for pr in pu]
             c = [sum((g[r][col] * rates[col] for col in range(len(rates))), 0.0) for r in range(3)]
@@ -150,6 +157,41 @@ def test_the_covariance_kept_at_its_fixed_point_changes_no_bit(kernels):
     assert fixed > 1000  # most steps start at the fixed point: the kernel skips their inverses
     np.testing.assert_array_equal(run.increments, reference * np.diff(log.time)[:, None])
     assert _kalman_kernel.kalman_chunk.is_compiled() == (kernels == "compiled")
+
+
+def with_gaps(log: JointLog, count: int, seed: int) -> JointLog:
+    """`log` with `count` of its steps (not the first ten) made 0.02 to 3 s long: 2 to 300 periods."""
+    rng = np.random.default_rng(seed)
+    steps = np.diff(log.time)
+    steps[rng.choice(np.arange(10, len(steps)), count, replace=False)] = rng.uniform(0.02, 3.0, count)
+    return JointLog(np.concatenate([log.time[:1], log.time[0] + np.cumsum(steps)]), log.joints, log.positions)
+
+
+@pytest.mark.parametrize(("name", "kind", "noise"), CASES[:3])
+def test_long_steps_add_their_periods_of_process_noise(name, kind, noise):
+    """A step of n nominal periods predicts ``P + n Q`` (the textbook filter with that Q), the period the median
+    of the log's steps (0.01 s, jittered by 10%)."""
+    robot = catalog.load(name)
+    model = kalman_model(robot, kind, noise)
+    log = with_gaps(drive(robot, 400, quantum=math.radians(1.4118), seed=1), 20, seed=2)
+    x0, p0 = [0.1, 0.0, 0.0], np.diag([0.5, 0.2, 0.3])
+    run = kalman_filter(model, log, x0=x0, p0=p0)
+    assert run.period == np.median(np.diff(log.time)) and abs(run.period - 0.01) < 1e-4
+    twists, slip, cov = textbook(model, log, x0, p0, run.period)
+    scale = np.abs(twists).max()
+    np.testing.assert_allclose(run.twist, twists, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(run.covariance, cov, rtol=0, atol=1e-12 * np.abs(cov).max())
+
+
+def test_a_long_step_leaves_the_fixed_point_and_the_recursion_finds_it_again_bit_for_bit(kernels):
+    fork = catalog.load("forklift")
+    model = kalman_model(fork, "fk2", fk2_noise(0.28, 3.57, 0.28))
+    log = with_gaps(drive(fork, 1500, quantum=math.radians(1.4118), seed=2, hold=300), 12, seed=3)
+    x0, p0 = [0.2, 0.0, 0.0], np.eye(3)
+    run = kalman_filter(model, log, x0=x0, p0=p0)
+    reference, fixed = plain_recursion(model, log, x0, p0, run.period)
+    assert fixed > 600  # the fixed point found again after each of the 12 long steps
+    np.testing.assert_array_equal(run.increments, reference * np.diff(log.time)[:, None])
 
 
 def test_new_configurations_met_mid_run_give_the_same_numbers():

@@ -1,20 +1,23 @@
 """Compiled loop of the velocity Kalman filters FK1/FK2 (thesis (7.71)-(7.75)) in information form (numba).
 
 Per sample, with ``H = C^T R^-1 C`` and ``M = -C^T R^-1 A_a`` of the sample's steering configuration:
-``P- = P + Q``, ``P+ = (P-^-1 + H)^-1``, ``x+ = P+ (P-^-1 x + M qdot_a)`` (the Woodbury form of the gain
-(7.73)-(7.75); two symmetric 3x3 inverses, no m x m inverse). ``double_q`` adds Q once more after the update, as
-(7.75) is printed. The increment of the sample is ``x+ dt``; its slip indicator ``|C x+ + A_a qdot_a| dt`` [m],
-computed as ``|T (x+, qdot_a)| dt`` with T the triangular factor of ``[C, A_a]`` (an orthogonal change of rows).
+``P- = P + n Q``, ``P+ = (P-^-1 + H)^-1``, ``x+ = P+ (P-^-1 x + M qdot_a)`` (the Woodbury form of the gain
+(7.73)-(7.75); two symmetric 3x3 inverses, no m x m inverse), with ``n = max(1, round(dt / T))`` the nominal sample
+periods T in the step (halves rounded up; 1 for every step shorter than 1.5 T, so a uniform or jittered log runs the
+thesis's recursion, Q per sample). ``double_q`` adds ``n Q`` once more after the update, as (7.75) is printed. The
+increment of the sample is ``x+ dt``; its slip indicator ``|C x+ + A_a qdot_a| dt`` [m], computed as
+``|T (x+, qdot_a)| dt`` with T the triangular factor of ``[C, A_a]`` (an orthogonal change of rows).
 
-The covariance recursion does not depend on the data: when a step gives back the covariance it started from
-(bitwise) and the configuration stays the same, every next step would compute the same two inverses, so they are
-kept instead of recomputed, and such steps update ``x+ = A x + G qdot_a`` with the transition ``A = P+ P-^-1`` and
-the gain ``G = P+ M`` formed once (only ``A x`` is then on the chain from sample to sample; the rates' part is
-summed first in both forms). Exact, not an approximation: the results are those of the plain recursion that
-computes both inverses at every step and takes this form at its fixed points, bit for bit, and they do not depend
-on where the log is cut into chunks. One pass reads the joint positions and times (increments, rates, the steering
-configuration at mid-interval, as :mod:`wmrkit.odometry.model` defines them), filters, and composes the poses with
-the blocks of :mod:`wmrkit.odometry._kernels`.
+The covariance recursion depends on the data only through the configurations and the long steps (n > 1): when a
+step of one period gives back the covariance it started from (bitwise) and the configuration stays the same, every
+next step of one period would compute the same two inverses, so they are kept instead of recomputed, and such
+steps update ``x+ = A x + G qdot_a`` with the transition ``A = P+ P-^-1`` and the gain ``G = P+ M`` formed once
+(only ``A x`` is then on the chain from sample to sample; the rates' part is summed first in both forms), until the
+configuration changes or a long step leaves the fixed point. Exact, not an approximation: the results are those of
+the plain recursion that computes both inverses at every step and takes this form at its fixed points, bit for bit,
+and they do not depend on where the log is cut into chunks. One pass reads the joint positions and times
+(increments, rates, the steering configuration at mid-interval, as :mod:`wmrkit.odometry.model` defines them),
+filters, and composes the poses with the blocks of :mod:`wmrkit.odometry._kernels`.
 """
 
 from __future__ import annotations
@@ -36,6 +39,10 @@ _IN = numba.types.Array(numba.float64, 2, "A", readonly=True)
 _IN1 = numba.types.Array(numba.float64, 1, "A", readonly=True)
 _IN3 = numba.types.Array(numba.float64, 3, "A", readonly=True)
 _INDEX = numba.types.Array(numba.int64, 1, "A", readonly=True)
+#: Most periods a step's process variance counts: ``P + n Q`` keeps the cubes of its entries (the 3x3 inverses) far
+#: from overflow. Below it what the prediction adds over a step is about ``(R / Q) x T`` whatever its length; beyond
+#: it (a step longer than 1e90 periods: times near 1e308 s) that grows with the step, and the pose goes out of range.
+MAX_PERIODS = 1e90
 
 
 @numba.njit(inline="always")
@@ -51,11 +58,12 @@ def _inverse_sym(a00, a01, a02, a11, a12, a22):
 
 
 @_jit(numba.types.UniTuple(numba.int64, 2)(_IN, _IN1, _IN1, numba.float64, _INDEX, _INDEX, numba.int64, _IN, _INDEX,
-                                           _IN3, _IN3, _IN3, numba.float64, numba.boolean, numba.float64[:],
+                                           _IN3, _IN3, _IN3, numba.float64, numba.float64, numba.boolean,
+                                           numba.float64[:],
                                            numba.float64[:], numba.float64, numba.boolean, numba.float64[:, :],
                                            numba.float64[:, :], numba.float64[:], numba.float64[:, :]))
 def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, start, keys, ids, h, m, ca, q,
-                 double_q, filt, pose, fraction, exact, increments, poses, slip, missing):
+                 period, double_q, filt, pose, fraction, exact, increments, poses, slip, missing):
     """Filter the intervals of joint `positions` ``(N, n_j)`` [rad] at `time` ``(N,)`` [s], each from the sample
     before (`before` ``(n_j,)`` at `time_before` for the first), from interval `start` on.
 
@@ -63,7 +71,8 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
     the known configurations sorted lexicographically, ``ids (U,)`` their rows in ``h (V, 3, 3)``, ``m (V, 3,
     n_a)``, ``ca (V, r, 3 + n_a)`` the triangular factor T (QR) of ``[C, A_a]``, so that ``|C x + A_a qdot| =
     |T (x, qdot)|`` (without steering: one key of length 0); `q` the process
-    variance per step. ``filt (9,)``: the state ``x`` then the upper entries of ``P`` (00, 01, 02, 11, 12, 22),
+    variance per nominal sample `period` [s] (a step of ``n = max(1, round(dt / period))`` periods adds ``n q``).
+    ``filt (9,)``: the state ``x`` then the upper entries of ``P`` (00, 01, 02, 11, 12, 22),
     updated. Body increments into `increments` ``(N, 3)`` and poses composed from ``pose (7,)`` (pose, path sums as
     :func:`wmrkit.odometry._kernels.steered_chunk`, updated) into `poses` ``(N, 3)``, each skipped when empty
     ``(0, 3)``; slip into `slip` ``(N,)``. Returns ``(reached, count)`` as
@@ -77,6 +86,7 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
     a00 = a01 = a02 = a10 = a11 = a12 = a20 = a21 = a22 = 0.0
     gain = np.zeros((3, n_a))
     steady, last_u = False, -1
+    long_step = 1.5 * period  # the shortest step of two periods or more
     mid = np.full(n_s, np.nan)
     seg_u, seg_start = np.empty(BLOCK, dtype=np.int64), np.empty(BLOCK + 1, dtype=np.int64)
     z, buf = np.empty((3 + n_a, BLOCK)), np.empty((11, BLOCK))  # z: the twist, then the rates
@@ -88,18 +98,41 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
         bm, count = _block_segments(positions, before, steer_cols, block, full, keys, ids, mid, seg_u, seg_start)
         unknown = bm < full  # the block ends at an unknown configuration
         _rates(positions, before, time, time_before, rate_cols, steer_cols, block, bm, dt, rates)
+        gap = _next_gap(dt, 0, bm, long_step)
         for g in range(count):  # the recursion, sequential, over the runs of one configuration
             u, j, end = seg_u[g], seg_start[g], seg_start[g + 1]
             if u != last_u:
                 steady, last_u = False, u
-            while j < end and not steady:  # a transient: prediction (7.71)-(7.72), the update's covariance
-                i00, i01, i02, i11, i12, i22 = _inverse_sym(p00 + q, p01, p02, p11 + q, p12, p22 + q)
+            while j < end:
+                if steady:  # at the fixed point: x+ = A x + G qdot_a, A = P+ P-^-1, G = P+ M kept
+                    stop = min(end, gap)
+                    for k in range(j, stop):  # the rates' part first: only A x is on the chain between samples
+                        c0 = c1 = c2 = 0.0
+                        for a in range(n_a):
+                            c0 += gain[0, a] * rates[a, k]
+                            c1 += gain[1, a] * rates[a, k]
+                            c2 += gain[2, a] * rates[a, k]
+                        x_0, x_1, x_2 = ((c0 + a00 * x_0) + (a01 * x_1 + a02 * x_2),
+                                         (c1 + a10 * x_0) + (a11 * x_1 + a12 * x_2),
+                                         (c2 + a20 * x_0) + (a21 * x_1 + a22 * x_2))
+                        z[0, k], z[1, k], z[2, k] = x_0, x_1, x_2
+                    j = stop
+                    if j == end:
+                        break
+                    steady = False  # a long step: Q grows with it, the covariance leaves its fixed point
+                q_j = q
+                if j == gap:  # n periods in the step: Q n (a random walk's variance grows with time)
+                    q_j = q * np.floor(min(dt[j] / period, MAX_PERIODS) + 0.5)
+                    gap = _next_gap(dt, j + 1, bm, long_step)
+                # a transient: prediction (7.71)-(7.72), the update's covariance
+                i00, i01, i02, i11, i12, i22 = _inverse_sym(p00 + q_j, p01, p02, p11 + q_j, p12, p22 + q_j)
                 u00, u01, u02, u11, u12, u22 = _inverse_sym(i00 + h[u, 0, 0], i01 + h[u, 0, 1], i02 + h[u, 0, 2],
                                                             i11 + h[u, 1, 1], i12 + h[u, 1, 2], i22 + h[u, 2, 2])
-                n00, n11, n22 = (u00 + q, u11 + q, u22 + q) if double_q else (u00, u11, u22)  # (7.75) as printed
-                steady = (n00 == p00 and u01 == p01 and u02 == p02 and n11 == p11 and u12 == p12 and n22 == p22)
+                n00, n11, n22 = (u00 + q_j, u11 + q_j, u22 + q_j) if double_q else (u00, u11, u22)  # (7.75) printed
+                steady = q_j == q and (n00 == p00 and u01 == p01 and u02 == p02 and n11 == p11 and u12 == p12
+                                       and n22 == p22)
                 p00, p01, p02, p11, p12, p22 = n00, u01, u02, n11, u12, n22
-                if steady:  # a fixed point: this sample and the rest of the run take the form below
+                if steady:  # a fixed point: this sample and the rest of the run take the form above
                     a00, a01, a02 = u00 * i00 + u01 * i01 + u02 * i02, u00 * i01 + u01 * i11 + u02 * i12, \
                         u00 * i02 + u01 * i12 + u02 * i22
                     a10, a11, a12 = u01 * i00 + u11 * i01 + u12 * i02, u01 * i01 + u11 * i11 + u12 * i12, \
@@ -110,7 +143,7 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
                         gain[0, a] = u00 * m[u, 0, a] + u01 * m[u, 1, a] + u02 * m[u, 2, a]
                         gain[1, a] = u01 * m[u, 0, a] + u11 * m[u, 1, a] + u12 * m[u, 2, a]
                         gain[2, a] = u02 * m[u, 0, a] + u12 * m[u, 1, a] + u22 * m[u, 2, a]
-                    break
+                    continue
                 c0 = c1 = c2 = 0.0  # x+ = P+ b, information vector b = P-^-1 x + M qdot_a, the rates' part first
                 for a in range(n_a):
                     c0 += m[u, 0, a] * rates[a, j]
@@ -124,15 +157,6 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
                 x_2 = u02 * b0 + u12 * b1 + u22 * b2
                 z[0, j], z[1, j], z[2, j] = x_0, x_1, x_2
                 j += 1
-            for k in range(j, end):  # at the fixed point: x+ = A x + G qdot_a, A = P+ P-^-1, G = P+ M kept
-                c0 = c1 = c2 = 0.0  # the rates' part first: only A x is on the chain from sample to sample
-                for a in range(n_a):
-                    c0 += gain[0, a] * rates[a, k]
-                    c1 += gain[1, a] * rates[a, k]
-                    c2 += gain[2, a] * rates[a, k]
-                x_0, x_1, x_2 = ((c0 + a00 * x_0) + (a01 * x_1 + a02 * x_2), (c1 + a10 * x_0) + (a11 * x_1 + a12 * x_2),
-                                 (c2 + a20 * x_0) + (a21 * x_1 + a22 * x_2))
-                z[0, k], z[1, k], z[2, k] = x_0, x_1, x_2
         for j in range(bm):
             d = dt[j]
             bx[j], by[j], bth[j] = z[0, j] * d, z[1, j] * d, z[2, j] * d
@@ -152,6 +176,15 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
             return block + bm, _configurations_from(positions, before, steer_cols, block + bm, missing)
     _store(filt, x_0, x_1, x_2, p00, p01, p02, p11, p12, p22)
     return n, 0
+
+
+@numba.njit(inline="always")
+def _next_gap(dt, first, m, long_step):
+    """The first of the steps ``dt[first:m]`` of at least `long_step` [s]; `m` if none."""
+    for j in range(first, m):
+        if dt[j] >= long_step:
+            return j
+    return m
 
 
 @numba.njit

@@ -9,8 +9,9 @@ out (the slip indicator is the norm of the measurement residual times the step [
 
 from __future__ import annotations
 
+import itertools
 import math
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,7 +24,8 @@ from ..odometry.model import OdometryModel
 from ..odometry.pipeline import OdometrySummary, check_poses, start_pose
 from ..odometry.trajectories import Trajectory
 from ..robot import Robot
-from .kalman import FILTERS, ILL_CONDITIONED, KalmanModel, KalmanNoise, _filter, check_log, kalman_model
+from .kalman import (FILTERS, ILL_CONDITIONED, PERIOD_INTERVALS, KalmanModel, KalmanNoise, _filter, check_log,
+                     kalman_model, nominal_period)
 from .weights import SlipWeights, wls_model
 
 ESTIMATORS = ("wls", *FILTERS)
@@ -63,6 +65,16 @@ class KalmanEstimator:
         return (f"{self.name}: {at}its measurement rows {fix}: there the filter carries its prediction and the "
                 f"trajectory can be far off{'; use --method fk2 or wls' if self.name == 'fk1' else ''}")
 
+    def _checked(self, chunks: Iterable[JointLog]) -> Iterator[JointLog]:
+        """The non-empty chunks, with the filter's columns, each checked (:func:`.kalman.check_log`)."""
+        prev = None
+        for raw in chunks:
+            chunk = raw if raw.joints == self.joints else raw.select(self.joints)
+            if len(chunk):
+                check_log(chunk, prev, self.name)
+                yield chunk
+                prev = chunk
+
     def run(self, chunks: Iterable[JointLog], *, method: Method = "exact", pose0: ArrayLike = (0.0, 0.0, 0.0),
             sinks: Sequence[Callable[[Trajectory], object]] = ()) -> OdometrySummary:
         """Filter and integrate every chunk; each sink gets each :class:`Trajectory` chunk."""
@@ -71,11 +83,8 @@ class KalmanEstimator:
         prev: JointLog | None = None
         x = p = None
         n_total, t0, t1, dist, rot, max_slip, sq, max_dt = 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        for raw in chunks:
-            chunk = raw if raw.joints == self.joints else raw.select(self.joints)
-            if len(chunk) == 0:
-                continue
-            check_log(chunk, prev, self.name)
+        period, checked = _first_period(self._checked(chunks))
+        for chunk in checked:
             if prev is None:
                 t0 = float(chunk.time[0])
                 first = Trajectory(chunk.time[:1], pose[None].copy(), np.zeros(1))
@@ -86,7 +95,7 @@ class KalmanEstimator:
                 chunk = JointLog(np.concatenate([prev.time[-1:], chunk.time]), chunk.joints,
                                  np.vstack([prev.positions[-1:], chunk.positions]), source=chunk.source)
             if len(chunk) >= 2:
-                run = _filter(self.model, chunk, x, p)
+                run = _filter(self.model, chunk, x, p, period)
                 x, p = run.twist[-1], run.covariance
                 with np.errstate(over="ignore", invalid="ignore"):  # an overflow is named by check_poses
                     poses = integrate_increments(pose, run.increments, method)
@@ -107,6 +116,20 @@ class KalmanEstimator:
         rms = math.sqrt(sq / (n_total - 1)) if n_total > 1 else 0.0
         return OdometrySummary(self.robot.name, self.name, n_total, t0, t1, tuple(float(v) for v in pose),
                                dist, rot, max_slip, rms, max_dt)
+
+
+def _first_period(chunks: Iterator[JointLog]) -> tuple[float | None, Iterator[JointLog]]:
+    """The log's nominal sample period (:func:`.kalman.nominal_period`, None for fewer than two samples), read
+    ahead over as many `chunks` as its first :data:`.kalman.PERIOD_INTERVALS` intervals take (so that it does not
+    depend on where the stream is cut), and all the chunks again."""
+    ahead, times, count = [], [], 0
+    for chunk in chunks:
+        ahead.append(chunk)
+        times.append(chunk.time[:PERIOD_INTERVALS + 1 - count])
+        count += len(times[-1])
+        if count > PERIOD_INTERVALS:
+            break
+    return (nominal_period(np.concatenate(times)) if count >= 2 else None), itertools.chain(ahead, chunks)
 
 
 @dataclass(frozen=True)

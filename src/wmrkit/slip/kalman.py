@@ -1,7 +1,8 @@
 """Velocity Kalman filters FK1 and FK2 (thesis §7.5.2, (7.68)-(7.77)) for any robot, and Kalman odometry.
 
 State: the body twist ``x = (vx, vy, omega)``, a random walk (7.68) with process variance ``Q = k13^2 I`` per
-sample. Measurements: the no-slip rows (3.22) that hold only the twist and sensed rates,
+sample of the log's nominal period T, and ``n Q`` over a step of ``n = max(1, round(dt / T))`` periods (a wmrkit
+extension for gaps, ``docs/errata.md``: the thesis samples uniformly; T defaults to :func:`nominal_period`). Measurements: the no-slip rows (3.22) that hold only the twist and sensed rates,
 ``A_p x = -A_a qdot_a`` (the rows (7.69)/(7.70): a wheel's rolling row is a wheel-speed reading, a lateral row a
 pseudo-measurement with the steering angle inside ``C``), with noise ``R = diag(sigma^2)`` per row. Rows with an
 unknown wheel rate (the steered wheel's free spin) are left out; a ``gear``'s unsensed joint is known from its
@@ -39,6 +40,8 @@ from ..odometry.trajectories import Trajectory
 from ..robot import Robot
 
 FILTERS = ("fk1", "fk2")
+#: Intervals of a log's start whose median is its nominal sample period (:func:`nominal_period`)
+PERIOD_INTERVALS = 1000
 #: Widest spread of the filter's standard deviations (process and rows), and their range: the information form
 #: adds inverse variances, so beyond a spread of 1e6 (1e12 in variance) the smaller ones are lost to round-off; only
 #: their ratios matter (scaling all of them scales the covariance and leaves the gain), and the range keeps their
@@ -238,39 +241,60 @@ def known_columns(model: OdometryModel) -> np.ndarray:
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
 class KalmanRun:
     """Filter output over a log: ``twist`` ``(N, 3)`` per interval, ``increments`` ``(N, 3)``, the final
-    covariance ``covariance`` ``(3, 3)`` of the twist, ``slip`` ``(N,)`` [m]."""
+    covariance ``covariance`` ``(3, 3)`` of the twist, ``slip`` ``(N,)`` [m], the nominal sample ``period`` [s] used
+    (give it, with the last twist and the covariance, to the call filtering the log's next piece)."""
 
     twist: np.ndarray
     increments: np.ndarray
     covariance: np.ndarray
     slip: np.ndarray
+    period: float
+
+
+def nominal_period(time: ArrayLike) -> float:
+    """The nominal sample period [s] of a log sampled at `time` ``(N,)`` (increasing, N >= 2): the median of its
+    first :data:`PERIOD_INTERVALS` intervals, which a few gaps or a jittered clock do not move, and which only the
+    log's start sets (the same whatever the pieces a stream cuts it into)."""
+    return float(np.median(np.diff(np.asarray(time, dtype=float)[:PERIOD_INTERVALS + 1])))
 
 
 def kalman_filter(model: KalmanModel, log: JointLog, *, x0: ArrayLike | None = None,
-                  p0: ArrayLike | None = None) -> KalmanRun:
+                  p0: ArrayLike | None = None, period: float | None = None) -> KalmanRun:
     """Run the filter over the intervals of `log` (positions: cumulative spin angles, steering angles).
 
     `x0` defaults to the least-squares twist of the first interval, `p0` to Q (the spec's choice; the thesis
-    gives neither). Rates are the increments over each interval divided by its duration.
+    gives neither). Rates are the increments over each interval divided by its duration. `period`: the nominal
+    sample period T [s] of Q, default :func:`nominal_period` of `log` (module docstring).
     """
     check_log(_selected(model, log))
-    return _filter(model, log, x0, p0)
+    return _filter(model, log, x0, p0, period)
 
 
-def _filter(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike | None) -> KalmanRun:
+def _filter(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike | None,
+            period: float | None) -> KalmanRun:
     """:func:`kalman_filter` on a log already checked (:func:`check_log`)."""
     t = np.asarray(log.time, dtype=float)
     increments = np.empty((max(len(t) - 1, 0), 3))
-    slip, filt = _run(model, log, x0, p0, increments, np.empty((0, 3)), np.zeros(7), "exact")
+    period = _period(period, t)
+    slip, filt = _run(model, log, x0, p0, increments, np.empty((0, 3)), np.zeros(7), "exact", period)
     p = filt[[3, 4, 5, 4, 6, 7, 5, 7, 8]].reshape(3, 3)
-    return KalmanRun(increments / np.diff(t)[:, None], increments, p, slip)
+    return KalmanRun(increments / np.diff(t)[:, None], increments, p, slip, period)
+
+
+def _period(period: float | None, time: np.ndarray) -> float:
+    """`period` [s] checked, or the nominal one of a log sampled at `time` (:func:`nominal_period`)."""
+    if period is None:
+        return nominal_period(time) if len(time) >= 2 else 1.0  # one sample: refused by _run
+    if not (finite_number(period) and period > 0):
+        raise WmrkitError(f"period: the nominal sample period must be a finite number of seconds > 0, got {period}")
+    return float(period)
 
 
 def _run(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike | None, increments: np.ndarray,
-         poses: np.ndarray, pose: np.ndarray, method: Method) -> tuple[np.ndarray, np.ndarray]:
+         poses: np.ndarray, pose: np.ndarray, method: Method, period: float) -> tuple[np.ndarray, np.ndarray]:
     """One compiled pass (:func:`._kalman_kernel.kalman_chunk`) over the intervals of `log`: increments and poses
-    into the given arrays (each skipped when ``(0, 3)``), from ``pose (7,)`` (pose, then path sums); the slip
-    ``(N,)`` and the final filter state ``(9,)`` (x, upper entries of P)."""
+    into the given arrays (each skipped when ``(0, 3)``), from ``pose (7,)`` (pose, then path sums), with Q per
+    nominal `period` [s]; the slip ``(N,)`` and the final filter state ``(9,)`` (x, upper entries of P)."""
     from . import _kalman_kernel
 
     om = model.odometry
@@ -300,7 +324,7 @@ def _run(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike 
     while True:
         start, count = _kalman_kernel.kalman_chunk(p[1:], p[0], t[1:], t[0], rate_cols, steer_cols, start, maps.keys,
                                                    maps.ids, maps.arrays[0], maps.arrays[1], maps.arrays[4],
-                                                   1.0, model.thesis_double_q,
+                                                   1.0, period, model.thesis_double_q,
                                                    filt, pose, HEADING_FRACTION[method], method == "exact",
                                                    increments, poses, slip, missing)
         if count == 0:
@@ -311,9 +335,9 @@ def _run(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike 
 
 def kalman_odometry(model: KalmanModel, log: JointLog, *, method: Method = "exact",
                     pose0: ArrayLike = (0.0, 0.0, 0.0), x0: ArrayLike | None = None,
-                    p0: ArrayLike | None = None) -> Trajectory:
+                    p0: ArrayLike | None = None, period: float | None = None) -> Trajectory:
     """Poses from the filtered twists (one per sample, the first `pose0`), composed with `method` in the same
-    pass as the filter; `x0`, `p0` as in :func:`kalman_filter`."""
+    pass as the filter; `x0`, `p0`, `period` as in :func:`kalman_filter`."""
     check_method(method)
     pose0 = start_pose(pose0)
     check_log(_selected(model, log))
@@ -322,7 +346,8 @@ def kalman_odometry(model: KalmanModel, log: JointLog, *, method: Method = "exac
     poses[0] = pose0
     slip = np.empty(n)
     slip[0] = 0.0
-    slip[1:] = _run(model, log, x0, p0, np.empty((0, 3)), poses[1:], np.concatenate([pose0, np.zeros(4)]), method)[0]
+    slip[1:] = _run(model, log, x0, p0, np.empty((0, 3)), poses[1:], np.concatenate([pose0, np.zeros(4)]), method,
+                    _period(period, np.asarray(log.time, dtype=float)))[0]
     return Trajectory(np.asarray(log.time, dtype=float), poses, slip)
 
 
