@@ -180,6 +180,7 @@ def test_long_steps_add_their_periods_of_process_noise(name, kind, noise):
     twists, slip, cov = textbook(model, log, x0, p0, run.period)
     scale = np.abs(twists).max()
     np.testing.assert_allclose(run.twist, twists, rtol=0, atol=1e-12 * scale)
+    assert np.all(np.abs(run.slip - slip) <= 1e-12 * scale * np.diff(log.time))  # [m]: over each step
     np.testing.assert_allclose(run.covariance, cov, rtol=0, atol=1e-12 * np.abs(cov).max())
 
 

@@ -181,6 +181,11 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
 @numba.njit(inline="always")
 def _next_gap(dt, first, m, long_step):
     """The first of the steps ``dt[first:m]`` of at least `long_step` [s]; `m` if none."""
+    count = 0
+    for j in range(first, m):  # counted first, a loop the compiler vectorises: most blocks have none
+        count += dt[j] >= long_step
+    if count == 0:
+        return m
     for j in range(first, m):
         if dt[j] >= long_step:
             return j

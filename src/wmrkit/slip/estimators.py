@@ -24,8 +24,17 @@ from ..odometry.model import OdometryModel
 from ..odometry.pipeline import OdometrySummary, check_poses, start_pose
 from ..odometry.trajectories import Trajectory
 from ..robot import Robot
-from .kalman import (FILTERS, ILL_CONDITIONED, PERIOD_INTERVALS, KalmanModel, KalmanNoise, _filter, check_log,
-                     kalman_model, nominal_period)
+from .kalman import (
+    FILTERS,
+    ILL_CONDITIONED,
+    PERIOD_INTERVALS,
+    KalmanModel,
+    KalmanNoise,
+    _filter,
+    check_log,
+    kalman_model,
+    nominal_period,
+)
 from .weights import SlipWeights, wls_model
 
 ESTIMATORS = ("wls", *FILTERS)

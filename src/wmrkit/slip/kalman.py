@@ -2,9 +2,10 @@
 
 State: the body twist ``x = (vx, vy, omega)``, a random walk (7.68) with process variance ``Q = k13^2 I`` per
 sample of the log's nominal period T, and ``n Q`` over a step of ``n = max(1, round(dt / T))`` periods (a wmrkit
-extension for gaps, ``docs/errata.md``: the thesis samples uniformly; T defaults to :func:`nominal_period`). Measurements: the no-slip rows (3.22) that hold only the twist and sensed rates,
-``A_p x = -A_a qdot_a`` (the rows (7.69)/(7.70): a wheel's rolling row is a wheel-speed reading, a lateral row a
-pseudo-measurement with the steering angle inside ``C``), with noise ``R = diag(sigma^2)`` per row. Rows with an
+extension for gaps, ``docs/errata.md``: the thesis samples uniformly; T defaults to :func:`nominal_period`).
+Measurements: the no-slip rows (3.22) that hold only the twist and sensed rates, ``A_p x = -A_a qdot_a`` (the rows
+(7.69)/(7.70): a wheel's rolling row is a wheel-speed reading, a lateral row a pseudo-measurement with the steering
+angle inside ``C``), with noise ``R = diag(sigma^2)`` per row. Rows with an
 unknown wheel rate (the steered wheel's free spin) are left out; a ``gear``'s unsensed joint is known from its
 sensed ones (``A_a`` maps the sensed rates through the odometry model's ``fill``, as odometry and ``fk`` use it),
 and a gear none of whose joints is sensed is one unknown, its turn ``u`` (:func:`wmrkit.couplings.gear_free`, as
