@@ -52,8 +52,8 @@ MAX_SPREAD, NOISE_RANGE = 1e6, (1e-150, 1e150)
 
 @dataclass(frozen=True, slots=True)
 class KalmanNoise:
-    """Noise of the velocity filter: ``process`` (k13) [m/s per sample, rad/s for omega], ``lateral`` and
-    ``longitudinal`` standard deviations [m/s] of every wheel's rows, per wheel in ``wheels``
+    """Noise of the velocity filter: ``process`` (k13) [m/s per nominal sample period, rad/s for omega],
+    ``lateral`` and ``longitudinal`` standard deviations [m/s] of every wheel's rows, per wheel in ``wheels``
     ``((name, lateral, longitudinal), ...)``."""
 
     process: float = 1.0
