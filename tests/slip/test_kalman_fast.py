@@ -39,8 +39,8 @@ def periods(dt: float, period: float | None) -> int:
 
 def textbook(model, log: JointLog, x0, p0, period=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Twists ``(N, 3)``, slip ``(N,)`` and the final covariance: predict ``P + n Q`` (`n` the `period`s in the
-    step), gain ``K = P C^T (C P C^T + R)^-1``, update ``x + K (y - C x)``, ``(I - K C) P`` (Joseph's form), with
-    ``y = -A_a qdot``."""
+    step), gain ``K = P C^T (C P C^T + R)^-1``, update ``x + K (y - C x)``, ``(I - K C) P`` (Joseph's form; ``+ n Q``
+    again with the model's ``thesis_double_q``, (7.75) as printed), with ``y = -A_a qdot``."""
     om = model.odometry
     robot = om.robot
     p = log.select(om.joints).positions
@@ -60,11 +60,13 @@ def textbook(model, log: JointLog, x0, p0, period=None) -> tuple[np.ndarray, np.
         c, aa = a[:, :3], a[:, cols]
         qdot = (p[k, rate] - p[k - 1, rate]) / dt
         y = -aa @ qdot
-        cov = cov + q * periods(dt, period)
+        n = periods(dt, period)
+        cov = cov + q * n
         gain = cov @ c.T @ np.linalg.inv(c @ cov @ c.T + r)
         x = x + gain @ (y - c @ x)
         keep = np.eye(3) - gain @ c
         cov = keep @ cov @ keep.T + gain @ r @ gain.T  # Joseph's form: (I - K C) P, symmetric and stable
+        cov = cov + q * n if model.thesis_double_q else cov
         twists.append(x)
         slip.append(np.linalg.norm(c @ x - y) * dt)
     return np.array(twists), np.array(slip), cov
@@ -167,12 +169,12 @@ def with_gaps(log: JointLog, count: int, seed: int) -> JointLog:
     return JointLog(np.concatenate([log.time[:1], log.time[0] + np.cumsum(steps)]), log.joints, log.positions)
 
 
-@pytest.mark.parametrize(("name", "kind", "noise"), CASES[:3])
-def test_long_steps_add_their_periods_of_process_noise(name, kind, noise):
-    """A step of n nominal periods predicts ``P + n Q`` (the textbook filter with that Q), the period the median
-    of the log's steps (0.01 s, jittered by 10%)."""
+@pytest.mark.parametrize(("name", "kind", "noise", "double_q"), [(*c, False) for c in CASES[:3]] + [(*CASES[0], True)])
+def test_long_steps_add_their_periods_of_process_noise(name, kind, noise, double_q):
+    """A step of n nominal periods predicts ``P + n Q`` (the textbook filter with that Q; (7.75) as printed adds it
+    again), the period the median of the log's steps (0.01 s, jittered by 10%)."""
     robot = catalog.load(name)
-    model = kalman_model(robot, kind, noise)
+    model = kalman_model(robot, kind, noise, thesis_double_q=double_q)
     log = with_gaps(drive(robot, 400, quantum=math.radians(1.4118), seed=1), 20, seed=2)
     x0, p0 = [0.1, 0.0, 0.0], np.diag([0.5, 0.2, 0.3])
     run = kalman_filter(model, log, x0=x0, p0=p0)
