@@ -100,63 +100,59 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
         _rates(positions, before, time, time_before, rate_cols, steer_cols, block, bm, dt, rates)
         gap = _next_gap(dt, 0, bm, long_step)
         for g in range(count):  # the recursion, sequential, over the runs of one configuration
-            u, j, end = seg_u[g], seg_start[g], seg_start[g + 1]
+            u, j, run_end = seg_u[g], seg_start[g], seg_start[g + 1]
             if u != last_u:
                 steady, last_u = False, u
-            while j < end:
-                if steady:  # at the fixed point: x+ = A x + G qdot_a, A = P+ P-^-1, G = P+ M kept
-                    stop = min(end, gap)
-                    for k in range(j, stop):  # the rates' part first: only A x is on the chain between samples
-                        c0 = c1 = c2 = 0.0
-                        for a in range(n_a):
-                            c0 += gain[0, a] * rates[a, k]
-                            c1 += gain[1, a] * rates[a, k]
-                            c2 += gain[2, a] * rates[a, k]
-                        x_0, x_1, x_2 = ((c0 + a00 * x_0) + (a01 * x_1 + a02 * x_2),
-                                         (c1 + a10 * x_0) + (a11 * x_1 + a12 * x_2),
-                                         (c2 + a20 * x_0) + (a21 * x_1 + a22 * x_2))
-                        z[0, k], z[1, k], z[2, k] = x_0, x_1, x_2
-                    j = stop
-                    if j == end:
-                        break
-                    steady = False  # a long step: Q grows with it, the covariance leaves its fixed point
-                q_j = q
-                if j == gap:  # n periods in the step: Q n (a random walk's variance grows with time)
-                    q_j = q * np.floor(min(dt[j] / period, MAX_PERIODS) + 0.5)
+            while j < run_end:  # the run's parts between long steps, a long step a part of its own
+                q_j, end = q, min(run_end, gap)
+                if j == gap:  # n periods in the step: n Q (a random walk's variance grows with time)
+                    q_j, end, steady = q * np.floor(min(dt[j] / period, MAX_PERIODS) + 0.5), j + 1, False
                     gap = _next_gap(dt, j + 1, bm, long_step)
-                # a transient: prediction (7.71)-(7.72), the update's covariance
-                i00, i01, i02, i11, i12, i22 = _inverse_sym(p00 + q_j, p01, p02, p11 + q_j, p12, p22 + q_j)
-                u00, u01, u02, u11, u12, u22 = _inverse_sym(i00 + h[u, 0, 0], i01 + h[u, 0, 1], i02 + h[u, 0, 2],
-                                                            i11 + h[u, 1, 1], i12 + h[u, 1, 2], i22 + h[u, 2, 2])
-                n00, n11, n22 = (u00 + q_j, u11 + q_j, u22 + q_j) if double_q else (u00, u11, u22)  # (7.75) printed
-                steady = q_j == q and (n00 == p00 and u01 == p01 and u02 == p02 and n11 == p11 and u12 == p12
-                                       and n22 == p22)
-                p00, p01, p02, p11, p12, p22 = n00, u01, u02, n11, u12, n22
-                if steady:  # a fixed point: this sample and the rest of the run take the form above
-                    a00, a01, a02 = u00 * i00 + u01 * i01 + u02 * i02, u00 * i01 + u01 * i11 + u02 * i12, \
-                        u00 * i02 + u01 * i12 + u02 * i22
-                    a10, a11, a12 = u01 * i00 + u11 * i01 + u12 * i02, u01 * i01 + u11 * i11 + u12 * i12, \
-                        u01 * i02 + u11 * i12 + u12 * i22
-                    a20, a21, a22 = u02 * i00 + u12 * i01 + u22 * i02, u02 * i01 + u12 * i11 + u22 * i12, \
-                        u02 * i02 + u12 * i12 + u22 * i22
+                while j < end and not steady:  # a transient: prediction (7.71)-(7.72), the update's covariance
+                    i00, i01, i02, i11, i12, i22 = _inverse_sym(p00 + q_j, p01, p02, p11 + q_j, p12, p22 + q_j)
+                    u00, u01, u02, u11, u12, u22 = _inverse_sym(i00 + h[u, 0, 0], i01 + h[u, 0, 1],
+                                                                i02 + h[u, 0, 2], i11 + h[u, 1, 1],
+                                                                i12 + h[u, 1, 2], i22 + h[u, 2, 2])
+                    n00, n11, n22 = (u00 + q_j, u11 + q_j, u22 + q_j) if double_q else (u00, u11, u22)  # (7.75)
+                    steady = q_j == q and (n00 == p00 and u01 == p01 and u02 == p02 and n11 == p11 and u12 == p12
+                                           and n22 == p22)
+                    p00, p01, p02, p11, p12, p22 = n00, u01, u02, n11, u12, n22
+                    if steady:  # a fixed point: this sample and the rest of the part take the form below
+                        a00, a01, a02 = u00 * i00 + u01 * i01 + u02 * i02, u00 * i01 + u01 * i11 + u02 * i12, \
+                            u00 * i02 + u01 * i12 + u02 * i22
+                        a10, a11, a12 = u01 * i00 + u11 * i01 + u12 * i02, u01 * i01 + u11 * i11 + u12 * i12, \
+                            u01 * i02 + u11 * i12 + u12 * i22
+                        a20, a21, a22 = u02 * i00 + u12 * i01 + u22 * i02, u02 * i01 + u12 * i11 + u22 * i12, \
+                            u02 * i02 + u12 * i12 + u22 * i22
+                        for a in range(n_a):
+                            gain[0, a] = u00 * m[u, 0, a] + u01 * m[u, 1, a] + u02 * m[u, 2, a]
+                            gain[1, a] = u01 * m[u, 0, a] + u11 * m[u, 1, a] + u12 * m[u, 2, a]
+                            gain[2, a] = u02 * m[u, 0, a] + u12 * m[u, 1, a] + u22 * m[u, 2, a]
+                        break
+                    c0 = c1 = c2 = 0.0  # x+ = P+ b, information vector b = P-^-1 x + M qdot_a, the rates' part first
                     for a in range(n_a):
-                        gain[0, a] = u00 * m[u, 0, a] + u01 * m[u, 1, a] + u02 * m[u, 2, a]
-                        gain[1, a] = u01 * m[u, 0, a] + u11 * m[u, 1, a] + u12 * m[u, 2, a]
-                        gain[2, a] = u02 * m[u, 0, a] + u12 * m[u, 1, a] + u22 * m[u, 2, a]
-                    continue
-                c0 = c1 = c2 = 0.0  # x+ = P+ b, information vector b = P-^-1 x + M qdot_a, the rates' part first
-                for a in range(n_a):
-                    c0 += m[u, 0, a] * rates[a, j]
-                    c1 += m[u, 1, a] * rates[a, j]
-                    c2 += m[u, 2, a] * rates[a, j]
-                b0 = (c0 + i00 * x_0) + (i01 * x_1 + i02 * x_2)
-                b1 = (c1 + i01 * x_0) + (i11 * x_1 + i12 * x_2)
-                b2 = (c2 + i02 * x_0) + (i12 * x_1 + i22 * x_2)
-                x_0 = u00 * b0 + u01 * b1 + u02 * b2
-                x_1 = u01 * b0 + u11 * b1 + u12 * b2
-                x_2 = u02 * b0 + u12 * b1 + u22 * b2
-                z[0, j], z[1, j], z[2, j] = x_0, x_1, x_2
-                j += 1
+                        c0 += m[u, 0, a] * rates[a, j]
+                        c1 += m[u, 1, a] * rates[a, j]
+                        c2 += m[u, 2, a] * rates[a, j]
+                    b0 = (c0 + i00 * x_0) + (i01 * x_1 + i02 * x_2)
+                    b1 = (c1 + i01 * x_0) + (i11 * x_1 + i12 * x_2)
+                    b2 = (c2 + i02 * x_0) + (i12 * x_1 + i22 * x_2)
+                    x_0 = u00 * b0 + u01 * b1 + u02 * b2
+                    x_1 = u01 * b0 + u11 * b1 + u12 * b2
+                    x_2 = u02 * b0 + u12 * b1 + u22 * b2
+                    z[0, j], z[1, j], z[2, j] = x_0, x_1, x_2
+                    j += 1
+                for k in range(j, end):  # at the fixed point: x+ = A x + G qdot_a, A = P+ P-^-1, G = P+ M kept
+                    c0 = c1 = c2 = 0.0  # the rates' part first: only A x is on the chain from sample to sample
+                    for a in range(n_a):
+                        c0 += gain[0, a] * rates[a, k]
+                        c1 += gain[1, a] * rates[a, k]
+                        c2 += gain[2, a] * rates[a, k]
+                    x_0, x_1, x_2 = ((c0 + a00 * x_0) + (a01 * x_1 + a02 * x_2),
+                                     (c1 + a10 * x_0) + (a11 * x_1 + a12 * x_2),
+                                     (c2 + a20 * x_0) + (a21 * x_1 + a22 * x_2))
+                    z[0, k], z[1, k], z[2, k] = x_0, x_1, x_2
+                j = end
         for j in range(bm):
             d = dt[j]
             bx[j], by[j], bth[j] = z[0, j] * d, z[1, j] * d, z[2, j] * d
