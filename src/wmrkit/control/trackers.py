@@ -42,6 +42,7 @@ import numpy as np
 
 from ..limits import MAX_COORDINATE
 from ..robot import Robot
+from .coupled_arcs import arc_twist, front_steering, rotates, within
 from .loop import TwistController
 from .points import ControlError, ControlPoint, robot_reach
 from .references import Reference
@@ -290,6 +291,12 @@ def _axle_state(cp: ControlPoint, pose: np.ndarray) -> tuple[np.ndarray, float]:
     return np.array([pose[0] + c * a[0] - s * a[1], pose[1] + s * a[0] + c * a[1]]), pose[2] + cp.forward
 
 
+def _rotate(angle: float, x: float, y: float = 0.0) -> np.ndarray:
+    """``(x, y)`` turned by `angle` [rad]."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([c * x - s * y, s * x + c * y])
+
+
 def _twist_at_origin(cp: ControlPoint, v: float, omega: float) -> np.ndarray:
     """Body twist of the origin for speed `v` of the axle point along the rolling direction and rate `omega`."""
     ax, ay = cp.axle_point
@@ -359,10 +366,14 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float | None
         lookahead = default_lookahead(cp, top_speed(reference))
     check_lookahead(lookahead)
     path, aim = PathIndex(reference), AIM_FRACTION * lookahead
+    coupled = cp.coupled
+    level = coupled is not None and not rotates(coupled)  # a synchro drive: it heads along the path
 
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         a, psi = _axle_state(cp, pose)
-        s_near, _, _ = path.project(a, t)
+        s_near, chi, _ = path.project(a, t)
+        if level:
+            psi = chi
         if path.done(a, s_near, psi, aim=aim):  # the path is driven: stop
             return np.zeros(3), np.zeros(3)
         c, s = math.cos(psi), math.sin(psi)
@@ -373,7 +384,8 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float | None
             d = path.point_at(ahead) - a  # on along the end's tangent
             x_g, y_g = c * d[0] + s * d[1], -s * d[0] + c * d[1]
         dist2 = x_g * x_g + y_g * y_g
-        if dist2 <= (1e-3 * aim) ** 2:  # at the goal (1e-6 of the lookahead: a round-off guard)
+        at_goal, ahead_of = dist2 <= (1e-3 * aim) ** 2, x_g > 0 or level  # (1e-6 of the lookahead: round-off)
+        if at_goal:
             kappa = 0.0
         elif x_g > 0:
             kappa = 2.0 * y_g / dist2
@@ -382,7 +394,11 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float | None
         kappa = min(max(kappa, -curvature), curvature)
         to_end = float(np.hypot(*(path.xy[-1] - a)))  # beside the end, on the arc to it: its projection is the end
         v = path.speed(s_near) * path.approach(s_near, lookahead, to_end)  # the path's speed where it is on it
-        return _twist_at_origin(cp, v, v * kappa), np.zeros(3)
+        if coupled is None:
+            return _twist_at_origin(cp, v, v * kappa), np.zeros(3)
+        turn = psi - pose[2]  # the heading's direction in the robot frame (forward; a synchro drive's: the path's)
+        goal = cp.axle_point + _rotate(turn, x_g, y_g)
+        return arc_twist(coupled, cp.axle_point, goal if ahead_of and not at_goal else None, v, kappa), np.zeros(3)
 
     return PathFollower(path, lambda pose: _axle_state(cp, pose)[0], control, lambda pose: _axle_state(cp, pose)[1],
                         curvature, lambda pose: _axle_state(cp, pose), length=lookahead)
@@ -405,6 +421,9 @@ def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase
         a, psi = _axle_state(cp, pose)
         return a + length * np.array([math.cos(psi), math.sin(psi)])
 
+    coupled = None if cp.coupled is None else front_steering(cp.coupled, cp.axle_point + _rotate(cp.forward, length))
+    level = coupled is not None and not rotates(coupled)  # a synchro drive: it heads along the path
+
     def control(t: float, pose: np.ndarray, integral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         psi = _axle_state(cp, pose)[1]
         f = front(pose)
@@ -412,9 +431,14 @@ def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase
         if path.done(f, s_front):  # the path is driven: stop
             return np.zeros(3), np.zeros(3)
         v_front = path.speed(s_front) * path.approach(s_front, stopping)  # the front point's (Hoffmann et al. 2007)
+        psi = chi if level else psi
         psi_e = math.remainder(chi - psi, 2 * math.pi)
         delta = psi_e - math.atan2(gain * e, v_front + eps)
+        if coupled is not None and not level:  # F's velocity along psi + delta: within the coupling's arc
+            return coupled.twist(_rotate(within(coupled, psi + delta - pose[2]), v_front)), np.zeros(3)
         delta = min(max(delta, -max_steer), max_steer)
+        if coupled is not None:  # a synchro drive's F: along the path's direction psi + delta
+            return coupled.twist(_rotate(psi + delta - pose[2], v_front)), np.zeros(3)
         v = v_front * math.cos(delta)  # the axle point's: the front one's along the heading
         return _twist_at_origin(cp, v, v_front * math.sin(delta) / length), np.zeros(3)
 
