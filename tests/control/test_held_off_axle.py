@@ -2,9 +2,10 @@
 (``TrackingRun.held_off_axle``, JSON ``held_off_axle``, a warning of ``wmrkit track``). Before, ``wmrkit track
 geared.json --reference circle --size 3`` (two double wheels whose steering a gear turns 1:2) ended 0.46 m off the
 circle without a word: the gear held the wheels up to 75 deg off the commanded twist's axles and the kinematic loop
-moved the robot with the least-squares twist of its wheels, 1.5 rad/s off the commanded turn rate. The thesis's laws
-now command the twists the geared headings allow (control/coupled_point.py: nothing to report, below); pure pursuit,
-which steers the units as a car about their virtual axle, still asks axles the gear holds its wheels off."""
+moved the robot with the least-squares twist of its wheels, 1.5 rad/s off the commanded turn rate. The thesis's laws,
+pure pursuit and Stanley now command the twists the geared headings allow (control/coupled_point.py,
+control/coupled_arcs.py: nothing to report); a car whose front wheels a parallel linkage turns together (not
+Ackermann's) still has its wheels held off the axles of pure pursuit's turns about its rear axle, reported below."""
 
 from __future__ import annotations
 
@@ -20,9 +21,18 @@ from wmrkit import catalog
 from wmrkit.cli.main import main
 from wmrkit.control import builtin_reference
 from wmrkit.control.track import track
+from wmrkit.robot import Robot
 
 GEAR = "gear(front.steer, rear.steer)"
+PARALLEL = "linkage(front_left.steer, front_right.steer)"
 CIRCLE = builtin_reference("circle", size=3.0)
+
+
+def _parallel_car():
+    """The catalog car, its front wheels on a parallel linkage: no turn of its rear axle puts both on their axles."""
+    data = catalog.load("ackermann").to_dict()
+    data["couplings"][1] = {"kind": "linkage", "joints": ["front_left.steer", "front_right.steer"], "law": "parallel"}
+    return Robot.from_dict(data)
 
 
 def _axle_miss(robot, twist: np.ndarray, commanded: np.ndarray) -> np.ndarray:
@@ -36,11 +46,11 @@ def _axle_miss(robot, twist: np.ndarray, commanded: np.ndarray) -> np.ndarray:
     return out
 
 
-def test_a_steering_gear_off_the_commanded_axles_is_reported_with_the_twist_the_robot_moved_with():
-    robot = _geared()
-    run = track(robot, CIRCLE, duration=3.0, controller="pure-pursuit")
+def test_a_linkage_off_the_commanded_axles_is_reported_with_the_twist_the_robot_moved_with():
+    robot = _parallel_car()
+    run = track(robot, builtin_reference("circle", size=8.0), duration=3.0, controller="pure-pursuit")
     (v,) = run.held_off_axle()
-    assert (v["coupling"], v["wheels"], v["from"], v["to"]) == (GEAR, ["front", "rear"], 0.0, 3.0)
+    assert (v["coupling"], v["wheels"], v["from"], v["to"]) == (PARALLEL, ["front_left", "front_right"], 0.0, 3.0)
     miss = _axle_miss(robot, run.twist, run.commanded)
     assert v["axle_miss"] == pytest.approx(miss.max(), abs=1e-9) and v["axle_miss"] > 0.02
     # the twist the robot moved with, against the poses' own rates (central differences, 0.05 s apart)
@@ -48,20 +58,21 @@ def test_a_steering_gear_off_the_commanded_axles_is_reported_with_the_twist_the_
     c, s = np.cos(run.pose[1:-1, 2]), np.sin(run.pose[1:-1, 2])
     body = np.stack([c * dpose[:, 0] + s * dpose[:, 1], -s * dpose[:, 0] + c * dpose[:, 1], dpose[:, 2]], axis=1)
     np.testing.assert_allclose(run.moved[1:-1], body, atol=1e-3)
-    assert v["twist_miss"][1] > 0.01  # the commanded turn rate is off the one the geared wheels give
+    assert v["twist_miss"][1] > 1e-3  # the commanded turn rate is off the one the linked wheels give
     assert json.loads(json.dumps(run.to_dict()))["held_off_axle"] == [v]
 
 
-def test_track_warns_of_a_gear_holding_its_wheels_off_the_commanded_axles(tmp_path, capsys):
-    path = tmp_path / "geared.json"
-    path.write_text(json.dumps(_geared().to_dict()))
-    assert main(["track", str(path), "--reference", "circle", "--size", "3", "--duration", "3", "--json",
+def test_track_warns_of_a_linkage_holding_its_wheels_off_the_commanded_axles(tmp_path, capsys):
+    path = tmp_path / "parallel.json"
+    path.write_text(json.dumps(_parallel_car().to_dict()))
+    assert main(["track", str(path), "--reference", "circle", "--size", "8", "--duration", "3", "--json",
                  "--controller", "pure-pursuit"]) == 0
     answer = json.loads(capsys.readouterr().out)
-    (said,) = [w for w in answer["warnings"] if GEAR in w]
+    (said,) = [w for w in answer["warnings"] if PARALLEL in w]
     v = answer["held_off_axle"][0]
-    assert said.startswith(f"the {GEAR} held wheels 'front', 'rear' up to {math.degrees(v['axle_miss']):.3g} deg off "
-                           "the axles the commanded twist needs for 3 s (t = 0 to 3 s): that twist is not realisable")
+    assert said.startswith(f"the {PARALLEL} held wheels 'front_left', 'front_right' up to "
+                           f"{math.degrees(v['axle_miss']):.3g} deg off the axles the commanded twist needs for 3 s "
+                           "(t = 0 to 3 s): that twist is not realisable")
     assert f"{v['twist_miss'][0]:.3g} m/s and {v['twist_miss'][1]:.3g} rad/s off the commanded one" in said
 
 

@@ -27,7 +27,12 @@ pursuit's lookahead, Stanley's stopping length), or to the reference's top speed
 
 Both limit the curvature to the robot's tightest turn (:func:`max_curvature`: a car's steering stops).
 The resulting unicycle twist ``(v, omega)`` at ``A`` along the robot's rolling direction is moved to the origin
-(rigid body) and goes through the same per-wheel IK as the thesis's controller. Neither has a time law: each stops
+(rigid body) and goes through the same per-wheel IK as the thesis's controller. A robot whose steering couplings
+leave it one steering turn ``u`` (:mod:`.coupled_point`) is steered on that turn instead (:mod:`.coupled_arcs`):
+pure pursuit's arc is the circle ``A`` drives about the ICR of ``n(u)``, through the goal; Stanley's ``psi + delta``
+the direction of ``F``'s velocity, within the coupling's arc (its steering limit, not ``max_steer``); a synchro
+drive, which turns no way but its wheels, takes the path's direction as its heading. Their twists ``s n(u)`` are
+admissible. Neither has a time law: each stops
 once its point has passed the path's end (pure pursuit: and the end is no longer ahead of it, or it is at the end;
 :class:`PathFollower`), and a default run of :func:`.track.track` lasts
 until then, or at most :func:`follower_duration` (:class:`ArrivalWarning` when it ends away from the end).
@@ -406,7 +411,8 @@ def pure_pursuit(cp: ControlPoint, reference: Reference, lookahead: float | None
 
 def stanley(cp: ControlPoint, reference: Reference, gain: float = 1.0, wheelbase: float | None = None,
             max_steer: float = 1.2) -> PathFollower:
-    """Stanley controller (see module doc); cross-track `gain` [1/s], steering limited to ``+-max_steer`` [rad]."""
+    """Stanley controller (see module doc); cross-track `gain` [1/s], steering limited to ``+-max_steer`` [rad] (a
+    robot with coupled steering: to its coupling's arc, a synchro drive to ``+-max_steer`` off the path)."""
     length = default_wheelbase(cp) if wheelbase is None else wheelbase
     if not 0 <= gain < math.inf:
         raise ControlError(f"stanley gain: expected a cross-track gain >= 0 (1/s), got {gain}")
