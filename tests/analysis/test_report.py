@@ -95,8 +95,10 @@ def test_degenerate_robot_json(capsys):
 
 def test_text_summary_and_report_flag(capsys, tmp_path):
     assert main(["analyze", "thesis-tricycle", "--report", str(tmp_path / "r"), "--resolution", "12"]) == 0
-    text = capsys.readouterr().out
-    assert "type 4" in text and "m = 1" in text and "singular" in text and "report written to" in text
+    out = capsys.readouterr()
+    text = out.out
+    assert "type 4" in text and "m = 1" in text and "singular" in text
+    assert out.err == f"wmrkit: report written to {tmp_path / 'r' / 'index.html'}\n"
     assert (tmp_path / "r" / "index.html").exists()
 
 

@@ -154,8 +154,10 @@ def test_each_bag_is_checked_against_its_imu_on_the_cluster(capsys, tmp_path, fl
     assert {b: (r["consistent"], r["imu"]) for b, r in table.items()} == {
         b: (s["consistent"], s["imu"]) for b, s in single.items()}
     assert main([*command, "--quiet"]) == 0  # the rerun resumes every row, the check's verdict kept
-    out_lines = capsys.readouterr().out.splitlines()
-    assert out_lines[0] == f"3 logs: 3 done (3 from an earlier run), 0 failed, 1 inconsistent ({slips}); table {out}"
+    said = capsys.readouterr()
+    out_lines = said.out.splitlines()
+    assert out_lines[0] == f"3 logs: 3 done (3 from an earlier run), 0 failed, 1 inconsistent ({slips})"
+    assert f"wmrkit: table written to {out}\n" in said.err
 
 
 def test_a_named_imu_is_the_one_checked(capsys, tmp_path, fleet):

@@ -124,16 +124,18 @@ def print_json(data: Any) -> None:
     if isinstance(data, dict):
         own = list(data.get("warnings") or [])
         data = {**data, "warnings": own + [m for m in said() if m not in own]}
-    print(json.dumps(_finite(data), indent=2, allow_nan=False))  # a NaN left is a bug: raised, never printed
+    print(json.dumps(json_values(data), indent=2, allow_nan=False))  # a NaN left is a bug: raised, never printed
 
 
-def _finite(x: Any) -> Any:
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
+def json_values(x: Any) -> Any:
+    """`x` (nested dicts, lists, tuples) ready for JSON: NaN and infinities None (JSON has none), -0.0 written 0.0
+    (a computed zero's sign is no result)."""
+    if isinstance(x, float):
+        return x + 0.0 if math.isfinite(x) else None
     if isinstance(x, dict):
-        return {k: _finite(v) for k, v in x.items()}
+        return {k: json_values(v) for k, v in x.items()}
     if isinstance(x, list | tuple):
-        return [_finite(v) for v in x]
+        return [json_values(v) for v in x]
     return x
 
 

@@ -17,6 +17,7 @@ from ._common import (
     steered_robot,
     warn,
 )
+from ._shown import written
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -44,10 +45,8 @@ def run(args: argparse.Namespace) -> int:
     if args.report:
         from ..analysis.report import write_report
 
-        path = write_report(result, args.report, resolution=args.resolution)
+        written("report", write_report(result, args.report, resolution=args.resolution))
     print_json(result.to_dict()) if args.json else print(result.format_text())
-    if args.report and not args.json:
-        print(f"report written to {path}")
     return 0
 
 

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from ..errors import WmrkitError, name_list
+from ..kinematics.linalg import characteristic_length
 from ._common import (
     SCHEMES_HELP,
     OptionError,
@@ -24,6 +25,7 @@ from ._common import (
     seed,
     warn,
 )
+from ._shown import fixed, tidy_pose, written
 from .slip import ESTIMATOR_METHODS, add_estimator_options, check_estimator_options, estimator_from_args, resolve_method
 
 
@@ -177,6 +179,10 @@ def run_odometry(args: argparse.Namespace) -> int:
                                 closed=args.closed, resume=not args.no_resume, progress=_progress(args),
                                 imu=args.imu, imu_mount=mount, imu_mount_option="--imu-mount", **estimator,
                                 **_options(args))
+    if args.out:
+        written("table", args.out)
+    if args.trajectories:
+        written("trajectories", args.trajectories)
     for r in result.rows:  # they were only in the table's 'warnings' column (or nowhere, without --out)
         if r["warnings"]:  # a failed log's too, said before its error as wmrkit odometry says them
             warn(f"{r['log']}: {r['warnings']}")
@@ -190,13 +196,14 @@ def run_odometry(args: argparse.Namespace) -> int:
         return 1 if result.failed else 0
     odd = result.inconsistent
     print(f"{len(result.rows)} logs: {len(result.rows) - result.failed} done ({result.skipped} from an earlier run), "
-          f"{result.failed} failed, {len(odd)} inconsistent" + (f" ({name_list(odd, NAMED)})" if odd else "")
-          + (f"; table {args.out}" if args.out else ""))
+          f"{result.failed} failed, {len(odd)} inconsistent" + (f" ({name_list(odd, NAMED)})" if odd else ""))
+    size = characteristic_length(robot)
     for r in result.rows:
         if r["error"]:  # a worker that died more often than allowed: its message does not name the log
             print(f"  failed: {r['error'] if r['error'].startswith(r['log']) else r['log'] + ': ' + r['error']}")
-        elif not args.out:
-            print(f"  {r['log']}: x {r['x']:.4f} m, y {r['y']:.4f} m, theta {r['theta']:.4f} rad, "
+        elif not args.out:  # round-off printed as 0 (._shown)
+            x, y, theta = (fixed(v, 4) for v in tidy_pose((r["x"], r["y"], r["theta"]), r["path_length"], size))
+            print(f"  {r['log']}: x {x} m, y {y} m, theta {theta} rad, "
                   f"path {r['path_length']:.4g} m" + (f", heading checked against the IMU on {r['imu']}"
                                                       if r["imu"] else ""))
     return 1 if result.failed else 0  # a pipeline must tell a batch with failed logs from a complete one
@@ -324,6 +331,7 @@ def run_montecarlo(args: argparse.Namespace) -> int:
                              method=args.method, seed=args.seed, runner=runner, progress=_progress(args))
     if args.plot:
         plot_monte_carlo(result, args.plot)
+        written("plot", args.plot)
     castors = [j for j in model.rate_joints if j in model.steer_joints]
     if castors:  # their noisy angles are both increments and configuration
         warn(f"the analytic covariance (003, first order) leaves out the configuration error that the noise of the "
@@ -353,8 +361,11 @@ def run_sweep(args: argparse.Namespace) -> int:
     with _runner(args) as runner:
         result = sweep(robot, axes, args.metric, runner=runner, chunk=args.chunk, out=args.out, top=args.top,
                        length=length, configs=args.configs, progress=_progress(args))
+    if args.out:
+        written("table", args.out)
     if args.plot:
         plot_sweep(result, args.plot)
+        written("plot", args.plot)
     if args.json:
         print_json(result.to_dict())
         return 0

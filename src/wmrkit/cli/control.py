@@ -22,6 +22,7 @@ from ._common import (
     say_caught,
     warn,
 )
+from ._shown import written
 
 if TYPE_CHECKING:
     from ..control.feasibility import Feasibility
@@ -322,8 +323,10 @@ def run_track(args: argparse.Namespace) -> int:
 
         if args.plot:
             plot_run(run, args.plot)
+            written("plot", args.plot)
         if args.animate:
             animate_run(run, args.animate)
+            written("animation", args.animate)
     if args.json:
         looked = {"lookahead": lookahead} if args.controller == "pure-pursuit" else {}
         print_json({**run.to_dict(), "reference_name": reference.name, "reference_size": size, **looked})
@@ -403,6 +406,7 @@ def run_feasibility(args: argparse.Namespace) -> int:
         from ..control.plots import plot_feasibility
 
         plot_feasibility(result, reference, args.plot)
+        written("plot", args.plot)
     if args.json:
         print_json({"robot": robot.name, "reference_name": reference.name, "reference_size": size,
                     **result.to_dict()})
@@ -413,5 +417,16 @@ def run_feasibility(args: argparse.Namespace) -> int:
     print(f"reference {described}")
     print(_feasible(result))
     for v in result.violations:
-        print(f"  t = {v.t:8.3f} s  {v.kind}, jump {v.size:.3g}: {v.remedy}")
+        print(f"  t = {v.t:8.3f} s  {v.kind}, jump {_jump(v.signal, v.size)}: {v.remedy}")
     return 0 if result.feasible else 1
+
+
+#: The unit of a Table 8.1 violation's size, per signal (``control.feasibility.KINDS``); angles also in degrees.
+JUMP_UNITS = {"position": "m", "theta": "rad", "velocity": "m/s", "omega": "rad/s", "acceleration": "m/s^2",
+              "omega_rate": "rad/s^2", "chi": "rad", "chi_rate": "rad/s", "kappa": "1/m", "kappa_rate": "1/(m s)"}
+
+
+def _jump(signal: str, size: float) -> str:
+    """A violation's size with its unit: ``1.57 rad (90 deg)``, ``0.5 m/s``."""
+    unit = JUMP_UNITS[signal]
+    return f"{size:.3g} {unit}" + (f" ({math.degrees(size):.3g} deg)" if unit == "rad" else "")

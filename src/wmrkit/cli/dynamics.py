@@ -9,12 +9,14 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import WmrkitError
+from ..kinematics.linalg import characteristic_length
 from ..limits import MAX_SPEED
 from ._common import (
     add_json_flag,
     add_robot_argument,
     check_plot_path,
     dynamic_model,
+    json_values,
     load_robot,
     parse_assignments,
     parse_value,
@@ -22,6 +24,7 @@ from ._common import (
     renaming,
     warn,
 )
+from ._shown import no_negative_zero, tidy_pose, tidy_twist, written
 
 #: ``simulate --step`` when not given [s].
 DEFAULT_STEP = 0.001
@@ -103,6 +106,7 @@ def run_tyre(args: argparse.Namespace) -> int:
                           f"forces ({fx:.6g} N, {fy:.6g} N) overflow (its forces do not scale with the load)")
     if args.plot:
         _plot_tyre(tyre, load, s, a, speed, args.plot)
+        written("plot", args.plot)
     warning = beyond_fit(tyre.model, speed)
     if warning:
         warn(warning)
@@ -222,8 +226,10 @@ def run_simulate(args: argparse.Namespace) -> int:
         raise at_door(err, "(--step) or the adaptive method") from None
     if args.out:
         _write(sim, args.out)
+        written("samples", args.out)
     if args.plot:
         _plot_simulation(sim, model.robot.name, args.plot)
+        written("plot", args.plot)
     pose, tw, end = sim.pose[-1], sim.twist[-1], float(sim.t[-1])  # the last sample: the record step's multiple
     travelled = float(np.sum(np.hypot(*np.diff(sim.pose[:, :2], axis=0).T)))
     max_slip = float(np.hypot(sim.slip[..., 0], sim.slip[..., 1]).max())  # a contact's slip speed, not a component
@@ -245,8 +251,11 @@ def run_simulate(args: argparse.Namespace) -> int:
         how = (f"LSODA, rtol {ADAPTIVE_RTOL:g}, recorded every {record:g} s" if sim.method == "adaptive" else
                f"step {step:g} s")
         print(f"{model.robot.name}: {duration:g} s simulated ({sim.method}, {how}), {len(sim.t)} samples")
-        print(f"final pose (t = {end:g} s): x = {pose[0]:.6g} m, y = {pose[1]:.6g} m, theta = {pose[2]:.6g} rad")
-        print(f"final twist (t = {end:g} s): vx = {tw[0]:.6g} m/s, vy = {tw[1]:.6g} m/s, omega = {tw[2]:.6g} rad/s")
+        size = characteristic_length(model.robot)  # round-off printed as 0 (._shown)
+        x, y, theta = tidy_pose(pose, travelled, size)
+        vx, vy, omega = tidy_twist(tw, size)
+        print(f"final pose (t = {end:g} s): x = {x:.6g} m, y = {y:.6g} m, theta = {theta:.6g} rad")
+        print(f"final twist (t = {end:g} s): vx = {vx:.6g} m/s, vy = {vy:.6g} m/s, omega = {omega:.6g} rad/s")
         print(f"distance travelled: {travelled:.6g} m; largest slip speed {max_slip:.3g} m/s")
         if deviation:
             print(f"from the programmed path: {deviation.max_position:.3g} m at most (t = {deviation.max_time:g} s), "
@@ -314,7 +323,7 @@ def _write(sim, out: str) -> None:
         if path.suffix.lower() == ".json":
             import json
 
-            path.write_text(json.dumps(sim.to_dict()) + "\n", encoding="utf-8")
+            path.write_text(json.dumps(json_values(sim.to_dict())) + "\n", encoding="utf-8")
             return
         position_names, positions = sim.joint_table()
         # a joint log as `wmrkit odometry` and `calibrate` read it: units in the header, a steered wheel's heading
@@ -326,7 +335,7 @@ def _write(sim, out: str) -> None:
                 *(f"{c}.{k} [N]" for c in sim.contacts for k in ("f_lat", "f_long", "load"))]
         data = np.column_stack([sim.t, sim.pose, sim.twist, positions, sim.joint_rates,
                                 np.concatenate([sim.forces, sim.loads[..., None]], axis=-1).reshape(len(sim.t), -1)])
-        np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.9g")
+        np.savetxt(path, no_negative_zero(data), delimiter=",", header=",".join(cols), comments="", fmt="%.9g")
     except OSError as err:
         raise WmrkitError(f"--out {out}: cannot write ({err.strerror or err})") from None
 

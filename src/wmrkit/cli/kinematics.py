@@ -14,6 +14,7 @@ from ._common import (
     steered_robot,
     warn,
 )
+from ._shown import written
 
 CODEGEN_LANGUAGES = ("c", "python")
 
@@ -52,12 +53,12 @@ def run(args: argparse.Namespace) -> int:
         from ..kinematics.codegen import write_code
 
         summary["generated"] = [str(p) for p in write_code(robot, lang, directory)]
+        for path in summary["generated"]:
+            written("code", path)
     if args.json:
         print_json(summary)
         return 0
     print(format_kinematics_summary(summary, limit=None if args.all else 12))
     if args.symbolic:
         print(summary["symbolic"])
-    for path in summary.get("generated", []):
-        print(f"wrote {path}")
     return 0

@@ -11,6 +11,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import WmrkitError
+from ..kinematics.linalg import characteristic_length
 from ..limits import check_chunk_size
 from ..odometry.bags import imu_topic
 from ..odometry.covariance import CrowleyNoise
@@ -37,6 +38,7 @@ from ._common import (
     renaming,
     warn,
 )
+from ._shown import fixed, tidy, tidy_pose, written
 from .slip import ESTIMATOR_METHODS, add_estimator_options, check_estimator_options, estimator_from_args, resolve_method
 
 
@@ -180,6 +182,9 @@ def run(args: argparse.Namespace) -> int:
         weights=weights,
         sinks=[check] if check else (), check=check.judge if check else None,
         label=f"{spec.name}, {spec.scheme}" if spec is not None else None)
+    for what, path in (("trajectory", args.out), ("plot", args.plot)):
+        if path:
+            written(what, path)
     if spec is not None:
         summary = replace(summary, method=spec.label)
     if args.method in ("fk1", "fk2") and (line := slip_model.conditioning_warning()):
@@ -204,18 +209,24 @@ def run(args: argparse.Namespace) -> int:
         print_json(summary.to_dict() | {"consistent": consistent}
                    | ({"imu": imu, "imu_mount": mounted} if is_bag(args.log) else {}))
     else:
-        print(format_summary(summary) + (f"\nheading checked against the IMU on {imu}, its mounting "
-                                         f"{'' if mounted == ASSUMED_LEVEL else 'from '}{mounted}" if imu else ""))
+        print(format_summary(summary, characteristic_length(robot))
+              + (f"\nheading checked against the IMU on {imu}, its mounting "
+                 f"{'' if mounted == ASSUMED_LEVEL else 'from '}{mounted}" if imu else ""))
     return 0
 
 
-def format_summary(s: OdometrySummary) -> str:
-    """Human-readable summary of an odometry run."""
-    x, y, th = s.final_pose
+def format_summary(s: OdometrySummary, size: float) -> str:
+    """Human-readable summary of an odometry run of a robot of characteristic length `size` [m], round-off printed
+    as 0 (:mod:`._shown`): the rotation's scale is the path length over `size`, the slip indicator's an interval's
+    mean travel (path length and rotation times `size`, over the intervals)."""
+    x, y, th = tidy_pose(s.final_pose, s.path_length, size)
+    rotation = tidy(s.rotation, s.path_length / size)
+    step = (s.path_length + s.rotation * size) / max(s.samples - 1, 1)
     lines = [f"robot {s.robot}, method {s.method}: {s.samples} samples over {s.end_time - s.start_time:.6g} s",
-             f"final pose: x = {x:.6f} m, y = {y:.6f} m, theta = {th:.6f} rad ({math.degrees(th):.3f} deg)",
-             f"path length {s.path_length:.6g} m, rotation {s.rotation:.6g} rad, longest step {s.max_dt:.6g} s",
-             f"slip indicator: max {s.max_slip:.3g} m, rms {s.rms_slip:.3g} m per interval"]
+             f"final pose: x = {fixed(x, 6)} m, y = {fixed(y, 6)} m, theta = {fixed(th, 6)} rad "
+             f"({fixed(math.degrees(th), 3)} deg)",
+             f"path length {s.path_length:.6g} m, rotation {rotation:.6g} rad, longest step {s.max_dt:.6g} s",
+             f"slip indicator: max {tidy(s.max_slip, step):.3g} m, rms {tidy(s.rms_slip, step):.3g} m per interval"]
     if s.final_covariance is not None:
         c = s.final_covariance
         lines.append(f"final std: x {math.sqrt(c[0][0]):.4g} m, y {math.sqrt(c[1][1]):.4g} m, "

@@ -6,6 +6,7 @@ import argparse
 
 from ..errors import WmrkitError
 from ._common import add_json_flag, check_plot_path, print_json, warn
+from ._shown import written
 from .control import check_animation_path, verdict_line, warn_infeasible
 
 
@@ -88,8 +89,10 @@ def run(args: argparse.Namespace) -> int:
 
         if args.animate and execution is not None:
             plot.animate_plan(solution.plan, args.animate, execution, max_frames=frames)
+            written("animation", args.animate)
         if args.plot:
             plot.save_plan_figure(solution.plan, args.plot, execution)
+            written("plot", args.plot)
     return 0 if parked(solution, executed) else 1
 
 

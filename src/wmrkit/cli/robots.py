@@ -9,6 +9,7 @@ from .. import catalog
 from ..description import described_type
 from ..robot import Robot
 from ._common import add_json_flag, add_robot_argument, check_plot_path, load_robot, print_json, wheel_column_width
+from ._shown import written
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -44,12 +45,11 @@ def run_show(args: argparse.Namespace) -> int:
         from ..plotting.robot import save_robot_figure
 
         save_robot_figure(robot, args.plot)
+        written("drawing", args.plot)
     if args.json:
         print_json(summary(robot))
     else:
         print(format_summary(robot))
-        if args.plot:
-            print(f"drawing written to {args.plot}")
     return 0
 
 

@@ -19,6 +19,7 @@ from ._common import (
     print_json,
     seed,
 )
+from ._shown import written
 
 ESTIMATOR_METHODS = ("wls", "fk1", "fk2")
 
@@ -294,6 +295,8 @@ def run_study(args: argparse.Namespace) -> int:
 
         result = skid_comparison(load_robot("skid-steer-4"), source=args.source or "md")
         figures = save_skid_figures(result, args.report) if args.report else []
+        for figure in figures:
+            written("figure", figure)
         data = {"robot": args.study} | {k: v for k, v in result.items() if k != "paths"} | {"figures": figures}
         if args.json:
             print_json(data)
@@ -307,6 +310,8 @@ def run_study(args: argparse.Namespace) -> int:
 
     result = forklift_study(report=args.report, quick=args.quick, seed=0 if args.seed is None else args.seed,
                             drive=args.drive or "differential")
+    for figure in result["figures"]:
+        written("figure", figure)
     if args.json:
         print_json({"robot": args.study, **result})  # the study's robot, as every command's answer names it
     else:

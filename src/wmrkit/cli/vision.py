@@ -22,6 +22,7 @@ from ._common import (
     renaming,
     seed,
 )
+from ._shown import fixed, written
 from .control import check_animation_path
 
 
@@ -174,9 +175,9 @@ def run_locate(args: argparse.Namespace) -> int:
     if args.json:
         print_json(fix.to_dict())
     else:
-        print(f"psi = {_fixed(fix.psi, 6)} rad ({_fixed(math.degrees(fix.psi), 3)} deg), h = {_fixed(fix.h, 5)} m")
+        print(f"psi = {fixed(fix.psi, 6)} rad ({fixed(math.degrees(fix.psi), 3)} deg), h = {fixed(fix.h, 5)} m")
         for line in fix.lines:
-            print(f"  line n = {line.n:+d}: psi = {_fixed(math.degrees(line.psi), 3)} deg, h = {_fixed(line.h, 5)} m")
+            print(f"  line n = {line.n:+d}: psi = {fixed(math.degrees(line.psi), 3)} deg, h = {fixed(line.h, 5)} m")
     return 0
 
 
@@ -215,11 +216,12 @@ def run_calibrate(args: argparse.Namespace) -> int:
         rows, width = image.shape
     if args.out:
         cal.camera(width=width, rows=rows).to_file(args.out)
+        written("camera file", args.out)
     if args.json:
         print_json(cal.to_dict())
     else:
         print(f"tilt = {cal.tilt:.6f} rad ({math.degrees(cal.tilt):.3f} deg), focal = {cal.focal_px:.2f} px, "
-              f"height = {cal.height:.5g} m" + (f"; camera file {args.out}" if args.out else ""))
+              f"height = {cal.height:.5g} m")
     return 0
 
 
@@ -244,6 +246,7 @@ def run_follow(args: argparse.Namespace) -> int:
         from ..vision.animation import save_animation
 
         save_animation(run, robot, camera, args.animate)
+        written("animation", args.animate)
     failure = run.failure()
     if failure is not None:  # a run that did not follow the line is no result (as track's diverged loop)
         raise WmrkitError(failure)
@@ -255,12 +258,8 @@ def run_follow(args: argparse.Namespace) -> int:
                     else "not reached within the run" if summary["settling_time_95"] is None
                     else f"{summary['settling_time_95']:.1f} s")
         print(f"robot {robot.name}: a = {run.gain:g} 1/s, T = {run.period:g} s, {len(run.time) - 1} periods; "
-              f"final h = {_fixed(summary['final_h'] * 100)} cm, psi = {_fixed(math.degrees(summary['final_psi']))} "
-              f"deg, overshoot {_fixed(summary['overshoot'] * 100)} cm, 95 % settling {settling}"
-              + (f"; animation {args.animate}" if args.animate else ""))
+              f"final h = {fixed(summary['final_h'] * 100, 2)} cm, "
+              f"psi = {fixed(math.degrees(summary['final_psi']), 2)} deg, "
+              f"overshoot {fixed(summary['overshoot'] * 100, 2)} cm, 95 % settling {settling}")
     return 0
 
-
-def _fixed(x: float, digits: int = 2) -> str:
-    """`digits` decimals, without the sign of a value that rounds to zero ("0.00", not "-0.00")."""
-    return f"{round(x, digits) + 0.0:.{digits}f}"
