@@ -30,7 +30,7 @@ def _spy_on_nulls(common) -> list[str]:
     """Record the JSON path of every number that ``print_json`` turns into null (NaN, infinities) in the returned
     list, which the caller empties before each case."""
     seen: list[str] = []
-    convert, outermost = common._finite, [True]
+    convert, outermost = common.json_values, [True]
 
     def walk(x, path: str) -> None:
         if isinstance(x, float) and not math.isfinite(x):
@@ -52,7 +52,7 @@ def _spy_on_nulls(common) -> list[str]:
         finally:
             outermost[0] = True
 
-    common._finite = finite
+    common.json_values = finite
     return seen
 
 

@@ -37,8 +37,19 @@ def tidy_twist(twist: Iterable[float], size: float) -> tuple[float, float, float
     """A twist ``(vx, vy [m/s], omega [rad/s])`` with its round-off printed as 0: the scale is the largest of |vx|,
     |vy| and ``|omega| size`` (in m/s; over `size` for omega), `size` the robot's characteristic length [m]."""
     vx, vy, omega = (float(v) for v in twist)
-    speed = max(abs(vx), abs(vy), abs(omega) * size)
+    speed = twist_speed((vx, vy, omega), size)
     return tidy(vx, speed), tidy(vy, speed), tidy(omega, speed / size)
+
+
+def twist_speed(twist: Iterable[float], size: float) -> float:
+    """The speed scale [m/s] of a twist ``(vx, vy, omega)``: the largest of |vx|, |vy| and ``|omega| size``."""
+    vx, vy, omega = (abs(float(v)) for v in twist)
+    return max(vx, vy, omega * size)
+
+
+def cell(value: float, scale: float) -> str:
+    """A table cell: ``-`` for an undefined value (NaN), else :func:`tidy` with 6 significant digits."""
+    return "-" if value != value else f"{tidy(value, scale):.6g}"
 
 
 def fixed(value: float, decimals: int) -> str:

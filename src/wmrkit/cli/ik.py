@@ -11,6 +11,7 @@ from ..couplings import GearWarning
 from ..description import described_type
 from ..errors import WmrkitError, said_warnings
 from ..kinematics.gear_check import steer_breaches
+from ..kinematics.linalg import characteristic_length
 from ..kinematics.linkage_check import LinkageAngleWarning, ik_breaches
 from ..kinematics.wheel_ik import (
     SLIP_TOL,
@@ -35,6 +36,7 @@ from ._common import (
     wheel_column_width,
     with_steer,
 )
+from ._shown import cell, tidy, tidy_twist, twist_speed
 
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
@@ -107,9 +109,11 @@ def run_fk(args: argparse.Namespace) -> int:
         print_json({"robot": robot.name, "twist": twist.tolist(), "determined": determined, "residual": fk.residual,
                     "consistent": fk.consistent, "slipping": list(fk.slipping)})
     else:
-        vx, vy, omega = (_num(v) for v in twist)
-        print(f"twist (robot frame): vx = {vx} m/s, vy = {vy} m/s, omega = {omega} rad/s")
-        print(f"residual (slip norm): {fk.residual:.3g} m/s ({'consistent' if fk.consistent else 'INCONSISTENT'})")
+        size = characteristic_length(robot)  # round-off printed as 0 (._shown), the residual's in the twist's speed
+        vx, vy, omega = tidy_twist(twist, size)
+        residual = tidy(fk.residual, twist_speed(twist, size))
+        print(f"twist (robot frame): vx = {vx:.6g} m/s, vy = {vy:.6g} m/s, omega = {omega:.6g} rad/s")
+        print(f"residual (slip norm): {residual:.3g} m/s ({'consistent' if fk.consistent else 'INCONSISTENT'})")
     return 0
 
 
@@ -133,16 +137,21 @@ def _check_finite(what: str, *arrays) -> None:
 
 
 def format_commands(robot: Robot, commands: WheelCommands, twist) -> str:
-    """Human-readable table of one twist's wheel commands: heading in degrees (0 = rolling straight ahead)."""
+    """Human-readable table of one twist's wheel commands: heading in degrees (0 = rolling straight ahead). Round-off
+    printed as 0 (:mod:`._shown`): a heading's scale is 180 deg, a rate's the largest joint rate, a slip's the
+    twist's speed."""
     data, width = commands.to_dict(), wheel_column_width(robot)
+    rates, speed = _rate_scale(commands), twist_speed(twist, characteristic_length(robot))
     lines = [f"{'wheel':<{width}}{'type':<14}{'heading [deg]':>14}{'spin [rad/s]':>14}{'steer rate [rad/s]':>20}"
              f"{'slip [m/s]':>12}  other rates [rad/s]"]
     for w in robot.wheels:
         entry = data["wheels"][w.name]
-        other = ", ".join(f"{k} {_num(v)}" for k, v in entry.items() if k not in ("heading", "spin", "steer_rate"))
+        other = ", ".join(f"{k} {cell(v, rates)}" for k, v in entry.items()
+                          if k not in ("heading", "spin", "steer_rate"))
         heading = math.degrees(entry.get("heading", math.nan))
-        lines.append(f"{w.name:<{width}}{described_type(w):<14}{_num(heading):>14}{_num(entry['spin']):>14}"
-                     f"{_num(entry['steer_rate']):>20}{_num(data['slip'][w.name]):>12}  {other}".rstrip())
+        lines.append(f"{w.name:<{width}}{described_type(w):<14}{cell(heading, 180.0):>14}"
+                     f"{cell(entry['spin'], rates):>14}{cell(entry['steer_rate'], rates):>20}"
+                     f"{cell(data['slip'][w.name], speed):>12}  {other}".rstrip())
     reasons = dict.fromkeys(why.split(":")[0] for why in _infeasible(robot, commands, twist))  # each reason once
     lines.append("feasible: " + ("yes" if data["feasible"] else f"NO ({'; '.join(reasons)})"))
     return "\n".join(lines)
@@ -159,7 +168,8 @@ def _infeasible(robot, commands: WheelCommands, twist) -> list[str]:
                    f"{commands.slip[worst]:+.6g} m/s (fixed wheels allow no lateral motion)")
     for c, ok in zip(robot.couplings, commands.in_gear.tolist(), strict=True):
         if not ok:
-            asked = ", ".join(f"{j} {_num(commands.rates[robot.rate_names.index(j)])}" for j in c.joints)
+            asked = ", ".join(f"{j} {cell(commands.rates[robot.rate_names.index(j)], _rate_scale(commands))}"
+                              for j in c.joints)
             out.append(f"a gear coupling cannot turn its joints so: {c.channel_name} turns them in the ratios "
                        f"{', '.join(f'{k:g}' for k in c.ratios)}, the twist needs {asked} rad/s")
     if not commands.in_steer_gear.all():
@@ -176,6 +186,6 @@ def _infeasible(robot, commands: WheelCommands, twist) -> list[str]:
     return out
 
 
-def _num(x: float) -> str:
-    """A table cell: '-' for undefined, rounding noise below 1e-12 printed as 0."""
-    return "-" if math.isnan(x) else f"{0.0 if abs(x) < 1e-12 else x:.6g}"
+def _rate_scale(commands: WheelCommands) -> float:
+    """The largest joint rate of `commands` [rad/s], the scale of each rate's round-off."""
+    return float(np.max(np.abs(np.nan_to_num(commands.rates)), initial=0.0))
