@@ -100,7 +100,7 @@ def test_skid_steer_rectangle_warns_that_it_left_the_path(capsys, tmp_path):
     text, err = capsys.readouterr()
     data = json.loads(text)
     assert code == 0
-    assert len(data["warnings"]) == 1 and err.count("\n") == 1
+    assert len(data["warnings"]) == 1 and err.count("\n") == 2 and err.startswith(f"wmrkit: samples written to {out}\n")
     warning = data["warnings"][0]
     assert warning.startswith("the robot left the programmed path: up to 24.2 m from it")
     assert "no no-slip motion" in warning and "wmrkit calibrate" in warning and "docs/slip.md" in warning

@@ -317,7 +317,8 @@ def run_track(args: argparse.Namespace) -> int:
              f"sideways to move as commanded (t = {min(v['from'] for v in slipping):.4g} to "
              f"{max(v['to'] for v in slipping):.4g} s): the kinematic loop moved the robot as commanded, so its errors "
              "do not show the scrubbing (--dynamics simulates it with tyres)")
-    warn_infeasible(run.feasibility, reference.duration if run.t[-1] > reference.duration else None)
+    warn_infeasible(run.feasibility, reference.duration if run.t[-1] > reference.duration else None,
+                    instant=not args.dynamics)
     if args.plot or args.animate:
         from ..control.plots import animate_run, plot_run
 
@@ -343,6 +344,11 @@ def run_track(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Said after a remedy that re-orients a wheel alone, in a kinematic run (its plant steers the wheels instantly).
+INSTANT_NOTE = (" (this kinematic run steers the wheels instantly, so its errors do not show it; --dynamics drives "
+                "the steering servos)")
+
+
 def verdict_line(verdict: Feasibility, point: str = "the tracked point") -> str:
     """One line: Table 8.1's column for `point`, the framework, and whether the reference can be followed."""
     r = verdict.requirement
@@ -354,10 +360,12 @@ def _feasible(verdict: Feasibility) -> str:
     return "feasible: yes" if verdict.feasible else f"feasible: NO ({len(verdict.violations)} violation(s))"
 
 
-def warn_infeasible(verdict: Feasibility | None, end: float | None = None) -> None:
+def warn_infeasible(verdict: Feasibility | None, end: float | None = None, *, instant: bool = False) -> None:
     """Warn where Table 8.1 says the robot cannot follow the reference it tracked (`verdict`: a run's
     ``feasibility``), a line per remedy and set of times, in feasibility's words; `end` [s]: where the reference
-    ended before the run did (it then holds its last pose at rest: the stop is judged as any jump)."""
+    ended before the run did (it then holds its last pose at rest: the stop is judged as any jump); `instant`: the
+    run's plant turned the wheels instantly (the kinematic loop), so where the remedy re-orients a wheel alone the
+    run's errors do not show it, and the line says so (it read as contradicting the 1e-10 m the run printed)."""
     broken: dict[tuple[str, tuple[float, ...]], list[str]] = {}
     for kind, remedy in dict.fromkeys((v.kind, v.remedy) for v in verdict.violations) if verdict else ():
         times = tuple(v.t for v in verdict.violations if (v.kind, v.remedy) == (kind, remedy))
@@ -368,7 +376,8 @@ def warn_infeasible(verdict: Feasibility | None, end: float | None = None) -> No
                 "where the reference stops, holding its last pose)" if end in times else "")
         warn(f"the robot cannot follow this reference with zero error (Table 8.1, column "
              f"'{verdict.requirement.column}' for the tracked point, {verdict.requirement.framework} framework): "
-             f"{' and '.join(kinds)} at t = {', '.join(f'{t:.4g}' for t in times[:5])} s{more}{stop}: {remedy}")
+             f"{' and '.join(kinds)} at t = {', '.join(f'{t:.4g}' for t in times[:5])} s{more}{stop}: {remedy}"
+             + (INSTANT_NOTE if instant and remedy.startswith("stop and re-orient the orientable wheel") else ""))
 
 
 def run_feasibility(args: argparse.Namespace) -> int:
