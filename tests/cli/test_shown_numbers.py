@@ -110,3 +110,17 @@ def test_a_feasibility_jump_has_its_unit(capsys):
     jumps = re.findall(r"tangent-angle jump \(chi not C0\), jump (\S+) rad \((\S+) deg\):", out)
     assert len(jumps) == 3 and all(float(r) == pytest.approx(math.pi / 2, rel=1e-2)
                                    and float(d) == pytest.approx(90, rel=1e-2) for r, d in jumps), out
+
+
+def test_track_prints_a_tiny_error_and_no_roundoff(capsys):
+    """The p law makes the error e0 exp(-a t) (a = 1/s). From on the 3 m circle it is 0 (the solver's 1.8e-12 m,
+    on positions up to 6 m, was printed). From 1e-9 m off: max 1e-9 m, rms e0 / sqrt(2 T) over the circle's
+    T = 2 pi 3 / 0.5 = 12 pi s (sampled every 0.05 s: 2.5 % more), and 1e-9 exp(-37.7) at the end, round-off. The
+    diff drive tracks a point 0.25 m ahead of its axle (its origin)."""
+    out = _out(capsys, ["track", "diff-drive", "--reference", "circle"])
+    assert "tracking error [m]: rms 0, max 0, final 0\ncross-track error [m]: rms 0, max 0\n" in out
+    out = _out(capsys, ["track", "diff-drive", "--reference", "circle", "--from", "-0.25", "1e-9", "0"])
+    rms, top, final = (float(v) for v in re.search(r"tracking error \[m\]: rms (\S+), max (\S+), final (\S+)\n",
+                                                   out).groups())
+    assert top == pytest.approx(1e-9, rel=1e-3) and final == 0.0
+    assert rms == pytest.approx(1e-9 / math.sqrt(2 * 12 * math.pi), rel=0.05)

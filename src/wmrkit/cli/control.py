@@ -9,6 +9,8 @@ import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ..errors import WmrkitError
 from ._common import (
     add_json_flag,
@@ -22,7 +24,7 @@ from ._common import (
     say_caught,
     warn,
 )
-from ._shown import written
+from ._shown import tidy, written
 
 if TYPE_CHECKING:
     from ..control.feasibility import Feasibility
@@ -332,7 +334,8 @@ def run_track(args: argparse.Namespace) -> int:
         looked = {"lookahead": lookahead} if args.controller == "pure-pursuit" else {}
         print_json({**run.to_dict(), "reference_name": reference.name, "reference_size": size, **looked})
     else:
-        s = run.summary()
+        reach = max(float(np.abs(reference.pose[:, :2]).max()), float(np.abs(run.tracked[:, :2]).max()))
+        s = {k: tidy(v, reach) for k, v in run.summary().items()}  # errors of positions of this reach: round-off 0
         print(f"robot {robot.name}, reference {described}, controller {args.controller}{ahead_words}, "
               f"{'continuous' if run.period is None else f'period {run.period:g} s, delay {args.delay}'}"
               f"{', through the dynamics' if args.dynamics else ''}"
