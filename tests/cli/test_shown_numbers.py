@@ -124,3 +124,14 @@ def test_track_prints_a_tiny_error_and_no_roundoff(capsys):
                                                    out).groups())
     assert top == pytest.approx(1e-9, rel=1e-3) and final == 0.0
     assert rms == pytest.approx(1e-9 / math.sqrt(2 * 12 * math.pi), rel=0.05)
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".tum"])
+def test_odometry_writes_no_negative_zero(suffix, tmp_path, capsys):
+    """A start pose given as '-0' was written as '-0' cells (and the TUM quaternion's sin(-0 / 2) as -0)."""
+    out = tmp_path / f"o{suffix}"
+    log = _log(tmp_path / "b.csv", lambda t: -10 * t, lambda t: -10 * t)
+    _out(capsys, ["odometry", "diff-drive", log, "--pose", "0", "-0", "-0", "--out", str(out)])
+    cells = [c for line in out.read_text().splitlines() if not line.startswith(("#", "time"))
+             for c in re.split(r"[, ]", line)]
+    assert cells and not [c for c in cells if c.startswith("-") and float(c) == 0.0]

@@ -93,6 +93,7 @@ class TrajectoryWriter:
             z = np.zeros((len(chunk), 1))
             values = np.hstack([chunk.time[:, None], chunk.poses[:, :2], z, quaternion_z(chunk.poses[:, 2])])
             row = "%.9f " + " ".join(["%.12g"] * 7) + "\n"
+        values = values + 0.0  # no "-0" (a start pose given as -0, its quaternion's sin(-0 / 2))
         self._f.write((row * len(values)) % tuple(values.ravel().tolist()))  # one formatting call per chunk
 
     def close(self) -> None:
