@@ -23,7 +23,7 @@ from wmrkit.control.trackers import default_wheelbase
 WARNING = "wmrkit: warning: the robot cannot follow this reference with zero error (Table 8.1, column "
 #: After a wheel's re-orientation in a kinematic run, whose errors stay at round-off there (it read as contradicting
 #: them): what it does not simulate.
-INSTANT_NOTE = (" (this kinematic run steers the wheels instantly, so its errors do not show it; --dynamics drives "
+INSTANT_NOTE = (" (this kinematic run turns the wheels instantly, without the stop; --dynamics drives "
                 "the steering servos)")
 
 

@@ -348,7 +348,7 @@ def run_track(args: argparse.Namespace) -> int:
 
 
 #: Said after a remedy that re-orients a wheel alone, in a kinematic run (its plant steers the wheels instantly).
-INSTANT_NOTE = (" (this kinematic run steers the wheels instantly, so its errors do not show it; --dynamics drives "
+INSTANT_NOTE = (" (this kinematic run turns the wheels instantly, without the stop; --dynamics drives "
                 "the steering servos)")
 
 
@@ -368,7 +368,7 @@ def warn_infeasible(verdict: Feasibility | None, end: float | None = None, *, in
     ``feasibility``), a line per remedy and set of times, in feasibility's words; `end` [s]: where the reference
     ended before the run did (it then holds its last pose at rest: the stop is judged as any jump); `instant`: the
     run's plant turned the wheels instantly (the kinematic loop), so where the remedy re-orients a wheel alone the
-    run's errors do not show it, and the line says so (it read as contradicting the 1e-10 m the run printed)."""
+    run did not stop, and the line says so (it read as contradicting the 1e-10 m errors the run printed)."""
     broken: dict[tuple[str, tuple[float, ...]], list[str]] = {}
     for kind, remedy in dict.fromkeys((v.kind, v.remedy) for v in verdict.violations) if verdict else ():
         times = tuple(v.t for v in verdict.violations if (v.kind, v.remedy) == (kind, remedy))
