@@ -38,8 +38,9 @@ def add_estimator_options(p: argparse.ArgumentParser) -> None:
                         "odometry.slip, else 1,1)")
     g.add_argument("--slip-weights", metavar="FILE", help="WLS: coefficients from 'wmrkit calibrate --json' output")
     g.add_argument("--kf-noise", nargs=3, type=float, metavar=("PROCESS", "LAT", "LONG"),
-                   help="FK1/FK2: process noise (the thesis's k13, (7.68)) [m/s per sample] and the lateral / "
-                        "longitudinal row noise [m/s] (default: the description's odometry.noise, else 1 1 1)")
+                   help="FK1/FK2: process noise (the thesis's k13, (7.68)) [m/s per nominal sample period] and "
+                        "the lateral / longitudinal row noise [m/s] (default: the description's odometry.noise, "
+                        "else 1 1 1)")
     g.add_argument("--kf-wheel", action="append", metavar="WHEEL=LAT,LONG", default=[],
                    help="FK1/FK2: row noise of one wheel (default: the wheel's slip.noise in the description, "
                         "else --kf-noise's; repeat)")
