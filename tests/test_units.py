@@ -16,13 +16,21 @@ FACTORS = {
     "length": {"m": 1.0, "mm": 0.001, "cm": 0.01, "dm": 0.1, "km": 1000.0, "um": 1e-6, "\u00b5m": 1e-6, "in": 0.0254,
                "ft": 0.3048},
     "angle": {"rad": 1.0, "mrad": 0.001, "deg": math.pi / 180, "°": math.pi / 180, "turn": 2 * math.pi},
+    "speed": {"m/s": 1.0, "mm/s": 0.001, "cm/s": 0.01, "km/h": 1000 / 3600, "mph": 1609.344 / 3600,
+              "ft/s": 0.3048, "in/s": 0.0254},
+    "angular rate": {"rad/s": 1.0, "mrad/s": 0.001, "deg/s": math.pi / 180, "°/s": math.pi / 180,
+                     "rpm": 2 * math.pi / 60, "rev/s": 2 * math.pi, "turn/s": 2 * math.pi},
 }
 
 
+def _kind(unit: str) -> str:
+    return next(kind for kind, table in FACTORS.items() if unit.replace("\u03bc", "\u00b5") in table)
+
+
 def test_the_unit_tables_are_the_documented_ones():
-    assert {k: set(v) for k, v in UNITS.items()} == {"length": set(FACTORS["length"]),
-                                                     "angle": set(FACTORS["angle"]), "number": set()}
-    assert (si_unit("length"), si_unit("angle"), si_unit("number")) == ("m", "rad", "")
+    assert {k: set(v) for k, v in UNITS.items()} == {**{k: set(v) for k, v in FACTORS.items()}, "number": set()}
+    assert [si_unit(k) for k in ("length", "angle", "speed", "angular rate", "number")] == ["m", "rad", "m/s",
+                                                                                           "rad/s", ""]
 
 
 @pytest.mark.parametrize(("text", "kind", "si"), [
@@ -30,7 +38,9 @@ def test_the_unit_tables_are_the_documented_ones():
     ("0.5 km", "length", 500.0), ("3 dm", "length", 0.3), ("  1.5 m ", "length", 1.5), ("1e-3", "length", 0.001),
     ("90 deg", "angle", math.pi / 2), ("90°", "angle", math.pi / 2), ("0.25 turn", "angle", math.pi / 2),
     ("1500 mrad", "angle", 1.5), ("-0.5rad", "angle", -0.5), ("+.5 rad", "angle", 0.5),
-    ("-45 deg", "angle", -math.pi / 4),
+    ("-45 deg", "angle", -math.pi / 4), ("3.6 km/h", "speed", 1.0), ("500 mm/s", "speed", 0.5),
+    ("10 mph", "speed", 4.4704), ("60 rpm", "angular rate", 2 * math.pi), ("30 deg/s", "angular rate", math.pi / 6),
+    ("-0.5 rev/s", "angular rate", -math.pi), ("1e3", "angular rate", 1000.0),
     (3, "angle", 3.0), (0.25, "length", 0.25), ("0.5", "number", 0.5), (-2, "number", -2.0),
 ])
 def test_examples(text, kind, si):
@@ -40,11 +50,11 @@ def test_examples(text, kind, si):
 @settings(max_examples=500)
 @given(x=st.floats(-1e6, 1e6), data=st.data())
 def test_any_number_with_any_unit(x, data):
-    kind = data.draw(st.sampled_from(["length", "angle"]))
+    kind = data.draw(st.sampled_from(sorted(FACTORS)))
     unit = data.draw(st.sampled_from(sorted(FACTORS[kind])))
     text = data.draw(st.sampled_from(["{}{}", "{} {}", " {}  {} "])).format(repr(x), unit)
     assert parse_quantity(text, kind) == pytest.approx(x * FACTORS[kind][unit], rel=1e-15, abs=1e-300)
-    if kind == "length" or abs(x) <= 2 * math.pi:
+    if kind != "angle" or abs(x) <= 2 * math.pi:  # only a bare angle has a limit (a turn: degrees written bare)
         assert parse_quantity(x, kind) == x  # a plain number is SI
     else:  # a bare angle beyond a turn is refused (issue 8: "beta: 90" read as 90 rad)
         with pytest.raises(UnitError, match="more than a turn"):
@@ -113,7 +123,8 @@ def test_micrometres_are_read(text):
 
 # Exact decimal factors of the units that have one, written out independently of units.py.
 DECIMAL_FACTORS = {"mm": "0.001", "cm": "0.01", "dm": "0.1", "km": "1000", "um": "0.000001", "\u00b5m": "0.000001",
-                   "\u03bcm": "0.000001", "in": "0.0254", "ft": "0.3048", "mrad": "0.001"}
+                   "\u03bcm": "0.000001", "in": "0.0254", "ft": "0.3048", "mrad": "0.001", "mm/s": "0.001",
+                   "cm/s": "0.01", "mph": "0.44704", "ft/s": "0.3048", "in/s": "0.0254", "mrad/s": "0.001"}
 
 
 @pytest.mark.parametrize("unit", sorted(DECIMAL_FACTORS))
@@ -123,7 +134,7 @@ def test_decimal_units_give_the_float_nearest_the_quantity_written(unit):
     0.30000000000000004. Fraction -> float rounds once, to the nearest."""
     from fractions import Fraction
 
-    kind = "angle" if unit == "mrad" else "length"
+    kind = _kind(unit)
     for text in [*(str(n) for n in range(1, 1001)), "0.1", "2.5", "12.7", "1e3", "-7", "3.3e-2"]:
         assert parse_quantity(f"{text} {unit}", kind) == float(Fraction(text) * Fraction(DECIMAL_FACTORS[unit])), text
 
@@ -134,5 +145,5 @@ def test_decimal_units_give_the_float_nearest_the_quantity_written(unit):
 def test_any_decimal_with_a_decimal_unit_is_read_exactly(number, unit):
     from fractions import Fraction
 
-    kind = "angle" if unit == "mrad" else "length"
+    kind = _kind(unit)
     assert parse_quantity(f"{number}{unit}", kind) == float(Fraction(number) * Fraction(DECIMAL_FACTORS[unit]))

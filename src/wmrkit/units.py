@@ -15,21 +15,27 @@ from typing import Literal
 
 from ._numbers import NUMBER
 
-Kind = Literal["length", "angle", "number"]
+Kind = Literal["length", "angle", "speed", "angular rate", "number"]
 
 #: Factor to SI for every unit accepted, by kind.
 UNITS: dict[str, dict[str, float]] = {
     "length": {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "dm": 0.1, "km": 1e3, "um": 1e-6, "\u00b5m": 1e-6, "in": 0.0254,
                "ft": 0.3048},
     "angle": {"rad": 1.0, "mrad": 1e-3, "deg": math.pi / 180, "°": math.pi / 180, "turn": 2 * math.pi},
+    "speed": {"m/s": 1.0, "mm/s": 1e-3, "cm/s": 1e-2, "km/h": 1 / 3.6, "mph": 0.44704, "ft/s": 0.3048,
+              "in/s": 0.0254},
+    "angular rate": {"rad/s": 1.0, "mrad/s": 1e-3, "deg/s": math.pi / 180, "°/s": math.pi / 180,
+                     "rpm": 2 * math.pi / 60, "rev/s": 2 * math.pi, "turn/s": 2 * math.pi},
     "number": {},
 }
-_SI = {"length": "m", "angle": "rad", "number": ""}
+_SI = {"length": "m", "angle": "rad", "speed": "m/s", "angular rate": "rad/s", "number": ""}
+#: The units whose factor is 1, or no decimal (pi's, 1/3.6): a quantity in them is the number times the factor.
+_NOT_DECIMAL = ("m", "rad", "deg", "°", "turn", "m/s", "km/h", "rad/s", "deg/s", "°/s", "rpm", "rev/s", "turn/s")
 #: The units whose factor is a decimal number, exactly: a quantity in them is read as the decimal it is ("9 mm" is
 #: 0.009, the float nearest 9e-3), not as the product of two rounded floats (9 * 1e-3 = 0.009000000000000001):
-#: every unit of UNITS but the ones of pi, its factor as the decimal it was written as (repr gives it back).
-_DECIMAL = {unit: decimal.Decimal(repr(factor)) for unit, factor in (*UNITS["length"].items(), *UNITS["angle"].items())
-            if unit not in ("m", "rad", "deg", "°", "turn")}
+#: every unit of UNITS but those of _NOT_DECIMAL, its factor as the decimal it was written as (repr gives it back).
+_DECIMAL = {unit: decimal.Decimal(repr(factor)) for table in UNITS.values() for unit, factor in table.items()
+            if unit not in _NOT_DECIMAL}
 #: Enough digits for any number a description holds; no traps: an overflow gives inf, refused as not finite.
 _CONTEXT = decimal.Context(prec=10_000, Emax=decimal.MAX_EMAX, Emin=decimal.MIN_EMIN, traps=[])
 #: The number of the tables' fields (ASCII digits only: ``\d`` also matched '٣' and '１', which float() read as 3 and
@@ -42,10 +48,10 @@ class UnitError(ValueError):
 
 
 def parse_quantity(value: object, kind: Kind) -> float:
-    """Return `value` in SI units (m or rad) as a finite float.
+    """Return `value` in SI units (m, rad, m/s or rad/s) as a finite float.
 
     Accepts real numbers (Python's, NumPy's of any precision) and strings such as ``"90 deg"``, ``"250 mm"``,
-    ``"-0.5rad"``, ``"1e-3"``.
+    ``"-0.5rad"``, ``"1e-3"``, ``"30 deg/s"``, ``"120 rpm"``, ``"3.6 km/h"``.
     Raises :class:`UnitError` for booleans, NaN, infinities, unknown units and units of the wrong kind, and for
     a bare angle (no unit, so radians) beyond a turn, ``|angle| > 2 pi``: almost surely degrees written bare; and
     for an angle beyond :data:`MAX_TURNS` turns in any unit.
@@ -119,7 +125,8 @@ def _a(kind: str) -> str:
 
 
 def _example(kind: Kind) -> str:
-    return {"length": "'0.25' or '250 mm'", "angle": "'1.57' or '90 deg'", "number": "'0.5'"}[kind]
+    return {"length": "'0.25' or '250 mm'", "angle": "'1.57' or '90 deg'", "speed": "'0.5' or '500 mm/s'",
+            "angular rate": "'0.5' or '30 deg/s' or '60 rpm'", "number": "'0.5'"}[kind]
 
 
 #: A CSV column name carrying its unit in brackets: ``time [ms]``, ``left.spin [N m]``.

@@ -116,13 +116,14 @@ def test_user_mistakes_exit_2_with_one_line(capsys, argv, message):
     assert err.startswith("wmrkit: error: ") and message in err and err.count("\n") == 1
 
 
-def test_bad_twist_is_a_usage_error(capsys):
+def test_bad_twist_is_one_line_naming_its_component(capsys):
     assert main(["ik", "swerve-4", "--twist", "1", "0", "inf"]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("usage: wmrkit ik") and "wmrkit: error: ik: argument --twist: cannot read 'inf'" in err
+    assert err == "wmrkit: error: ik: --twist OMEGA: cannot read 'inf' as an angular rate (write e.g. '0.5' or " \
+                  "'30 deg/s' or '60 rpm')\n"
     assert main(["ik", "swerve-4", "--twist", "1", "0", "inf", "--json"]) == 2
     data = json.loads(capsys.readouterr().err)
-    assert "argument --twist" in data["error"] and data["file"] is None
+    assert "--twist OMEGA" in data["error"] and data["file"] is None
     assert set(data) == {"error", "file", "wheel", "field", "line"}  # every error has the five keys ("line" lacked)
 
 
@@ -244,3 +245,36 @@ def test_every_number_column_of_the_ik_table_names_its_unit(capsys):
     header = capsys.readouterr().out.splitlines()[0]
     columns = re.split(r"\s{2,}", header.strip())
     assert columns[:2] == ["wheel", "type"] and all(re.search(r"\[[^]]+\]$", c) for c in columns[2:]), columns
+
+
+def test_ik_twist_takes_speed_and_angular_rate_units(capsys):
+    """'--twist "1.8 km/h" 0 "30 deg/s"' is the twist (0.5, 0, pi/6) in SI: it was refused ("accepted: none")."""
+    code, out, _ = run(capsys, "ik", "swerve-4", "--twist", "1.8 km/h", "250 mm/s", "30 deg/s", "--json")
+    assert code == 0
+    robot = catalog.load("swerve-4")
+    for name, (x, y) in zip(robot.wheel_names, (w.position for w in robot.wheels), strict=True):
+        ux, uy = 0.5 - math.pi / 6 * y, 0.25 + math.pi / 6 * x
+        assert json.loads(out)["wheels"][name]["spin"] == pytest.approx(math.hypot(ux, uy) / 0.0508, rel=1e-12)
+
+
+@pytest.mark.parametrize(("twist", "message"), [
+    (("0.5 rad", "0", "0"), "--twist VX: '0.5 rad' is an angle, expected a speed"),
+    (("0", "0", "10 mm/s"), "--twist OMEGA: '10 mm/s' is a speed, expected an angular rate"),
+    (("0", "1e10 mm/s", "0"), "--twist VY 1e10 mm/s: beyond"),
+])
+def test_ik_twist_units_of_the_wrong_kind_or_too_fast_are_refused_by_component(capsys, twist, message):
+    code, out, err = run(capsys, "ik", "swerve-4", "--twist", *twist)
+    assert code == 2 and out == "" and message in err and len(err.strip().splitlines()) == 1
+
+
+def test_fk_spin_takes_rpm_and_its_twist_speeds_take_speed_units(capsys):
+    """120 rpm on both wheels of the diff drive (r = 0.075 m, read from the catalog) is vx = 4 pi r; a gyro's
+    '0 deg/s' and vx in cm/s agree with it."""
+    r = catalog.load("diff-drive").wheels[0].r
+    code, out, _ = run(capsys, "fk", "diff-drive", "--spin", "left=120 rpm", "--spin", "right=2 rev/s",
+                       "--spin", f"vx={400 * math.pi * r} cm/s", "--spin", "omega=0 deg/s", "--json")
+    assert code == 0
+    data = json.loads(out)
+    assert data["twist"] == pytest.approx([4 * math.pi * r, 0, 0], abs=1e-12) and data["residual"] < 1e-12
+    code, _, err = run(capsys, "fk", "diff-drive", "--spin", "left=1 m")
+    assert code == 2 and "--spin left: '1 m' is a length, expected an angular rate" in err

@@ -99,7 +99,7 @@ PATH_FOLLOWER_NOTE = (" (from the reference's pose at the same time: this contro
 def _reference_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--reference", required=True, metavar="FILE|NAME",
                    help="line, circle, figure-eight, square, arc-line, corner; or a TUM / CSV (t,x,y,theta) file")
-    p.add_argument("--speed", metavar="V", help="speed of a built-in reference [m/s] (default 0.5)")
+    p.add_argument("--speed", metavar="V", help="speed of a built-in reference [m/s, or e.g. '1.8 km/h'] (default 0.5)")
     p.add_argument("--size", metavar="L", help="size of a built-in reference [m]: circle radius (default 3), "
                                                "figure-eight half width (6), square side (6), arc-line radius (1.5), "
                                                "corner leg (3); a line has none; the circle, figure-eight and "
@@ -128,7 +128,7 @@ def _reference(args: argparse.Namespace, robot) -> tuple[Reference, float | None
         resolve_reference,
     )
 
-    speed = None if args.speed is None else _positive(args.speed, "--speed", "number")
+    speed = None if args.speed is None else _positive(args.speed, "--speed", "speed")
     size = None if args.size is None else _positive(args.size, "--size", "length")
     name = args.reference
     turning = min_turning_radius(robot)

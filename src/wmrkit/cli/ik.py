@@ -17,12 +17,12 @@ from ..kinematics.wheel_ik import (
     SLIP_TOL,
     WheelCommands,
     forward_kinematics_check,
+    rate_kind,
     twist_is_determined,
     wheel_commands,
 )
 from ..limits import MAX_QUERY_RATE
-from ..robot import Robot
-from ..units import UnitError, parse_quantity
+from ..robot import TWIST_NAMES, Robot
 from ._common import (
     add_json_flag,
     add_robot_argument,
@@ -43,8 +43,9 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     """Register ``ik`` and ``fk``."""
     p = commands.add_parser("ik", help="per-wheel steering angles and rates for a body twist (thesis 8.4)")
     add_robot_argument(p)
-    p.add_argument("--twist", nargs=3, type=_finite, required=True, metavar=("VX", "VY", "OMEGA"),
-                   help="body twist: vx, vy [m/s], omega [rad/s] (x forward, y left)")
+    p.add_argument("--twist", nargs=3, required=True, metavar=("VX", "VY", "OMEGA"),
+                   help="body twist: vx, vy [m/s], omega [rad/s] (x forward, y left; or with a unit: '500 mm/s', "
+                        "'3.6 km/h', '30 deg/s')")
     add_steer_option(p, "current heading of a steered wheel (default: as described)",
                      "; a steerable wheel keeps, of its two solutions (h, spin) and (h + 180 deg, -spin), the one "
                      "closest to it; a castor's is the angle it is at")
@@ -54,8 +55,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p = commands.add_parser("fk", help="body twist from joint rates by least squares (thesis 4.11)")
     add_robot_argument(p)
     p.add_argument("--spin", action="append", metavar="NAME=RATE", default=[],
-                   help="a joint rate [rad/s]: a wheel name means its spin, or 'wheel.joint'; also vx, vy [m/s] "
-                        "or omega [rad/s] (a gyro) (repeat)")
+                   help="a joint rate [rad/s, or with a unit: '120 rpm', '30 deg/s']: a wheel name means its spin, "
+                        "or 'wheel.joint'; also vx, vy [m/s] or omega [rad/s] (a gyro) (repeat)")
     add_steer_option(p, "heading of a steered wheel (default: as described)")
     add_json_flag(p)
     p.set_defaults(run=run_fk)
@@ -65,14 +66,15 @@ def run_ik(args: argparse.Namespace) -> int:
     """Print the per-wheel commands; warn when the twist makes a fixed wheel slip or a wheel steer out of range, and
     exit 1 then (the answer is no: the commands printed do not give the twist)."""
     robot = load_robot(args.robot)  # as described: its linkages' rest angles (with_steer)
-    commands = wheel_commands(robot, args.twist, with_steer(robot, args.steer).beta)
+    twist = _twist(args.twist)
+    commands = wheel_commands(robot, twist, with_steer(robot, args.steer).beta)
     _check_finite("ik", commands.rates, commands.slip)
-    for why in _infeasible(robot, commands, args.twist):
+    for why in _infeasible(robot, commands, twist):
         warn(f"twist not feasible for robot '{robot.name}': {why}")
     if args.json:
         print_json({"robot": robot.name, **commands.to_dict()})
     else:
-        print(format_commands(robot, commands, args.twist))
+        print(format_commands(robot, commands, twist))
     return 0 if commands.feasible else 1  # an answer that is no (docs/limits.md, Exit codes)
 
 
@@ -85,7 +87,7 @@ def run_fk(args: argparse.Namespace) -> int:
         spins = [w.name for w in robot.wheels if "spin" in w.kind.rates]
         raise WmrkitError(f"--spin: give at least one joint rate of robot '{robot.name}' as NAME=RATE, e.g. --spin "
                           f"{spins[0] if spins else robot.rate_names[0]}=10 (names: {', '.join(robot.rate_names)})")
-    rates = {name: parse_value(value, "number", f"--spin {name}") for name, value in given.items()}
+    rates = {name: parse_value(value, rate_kind(name), f"--spin {name}") for name, value in given.items()}
     for name, value in rates.items():
         if abs(value) > MAX_QUERY_RATE:
             raise WmrkitError(f"--spin {name}: {value:g} is beyond {MAX_QUERY_RATE:g} rad/s (m/s), no wheel turns so "
@@ -117,15 +119,16 @@ def run_fk(args: argparse.Namespace) -> int:
     return 0
 
 
-def _finite(text: str) -> float:
-    try:
-        value = parse_quantity(text, "number")
-    except UnitError as err:
-        raise argparse.ArgumentTypeError(str(err)) from None
-    if abs(value) > MAX_QUERY_RATE:  # a value out of range, not a mistake in the command's syntax: no usage line
-        raise WmrkitError(f"ik: --twist {text}: beyond {MAX_QUERY_RATE:g} (m/s or rad/s), no wheeled robot moves "
-                          "so fast")
-    return value
+def _twist(texts: list[str]) -> np.ndarray:
+    """``--twist VX VY OMEGA``: SI, or each with a unit of its kind (``500 mm/s``, ``30 deg/s``), within
+    :data:`MAX_QUERY_RATE`; a refusal names the component."""
+    twist = np.array([parse_value(text, rate_kind(name), f"ik: --twist {name.upper()}")
+                      for name, text in zip(TWIST_NAMES, texts, strict=True)])
+    for name, text, value in zip(TWIST_NAMES, texts, twist, strict=True):
+        if abs(value) > MAX_QUERY_RATE:
+            raise WmrkitError(f"ik: --twist {name.upper()} {text}: beyond {MAX_QUERY_RATE:g} (m/s or rad/s), no "
+                              "wheeled robot moves so fast")
+    return twist
 
 
 def _check_finite(what: str, *arrays) -> None:

@@ -21,7 +21,7 @@ from ..couplings import Coupling, GearWarning
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
-from ..units import UnitError, parse_quantity
+from ..units import Kind, UnitError, parse_quantity
 from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
 from ._ik_fast import wrap_angle
@@ -447,10 +447,16 @@ def _check_finite_rates(names: list[str], q_assigned: np.ndarray) -> None:
                          f"got {_first_bad(q_assigned[..., j])}")
 
 
+def rate_kind(name: str) -> Kind:
+    """The kind of quantity a rate named `name` is: a speed [m/s] for the twist's ``vx``/``vy``, else an angular
+    rate [rad/s] (a joint's, the twist's ``omega``), so that ``"500 mm/s"``, ``"120 rpm"``, ``"30 deg/s"`` read."""
+    return "speed" if name in ("vx", "vy") else "angular rate"
+
+
 def _rate_value(name: str, value: ArrayLike) -> ArrayLike:
     if isinstance(value, str):  # e.g. from a file or the command line
         try:
-            return parse_quantity(value, "number")
+            return parse_quantity(value, rate_kind(name))
         except UnitError as err:
             raise ShapeError(f"rates: {name}: {err}") from None
     return value
