@@ -135,3 +135,29 @@ def test_odometry_writes_no_negative_zero(suffix, tmp_path, capsys):
     cells = [c for line in out.read_text().splitlines() if not line.startswith(("#", "time"))
              for c in re.split(r"[, ]", line)]
     assert cells and not [c for c in cells if c.startswith("-") and float(c) == 0.0]
+
+
+def test_simulate_prints_no_roundoff_heading_off_its_path_and_keeps_a_real_one(capsys):
+    """A straight run ended '-1.03e-18 rad' off its programmed path: 0 at the end; the figure-eight's real offset
+    is printed as computed."""
+    out = _out(capsys, ["simulate", "skid-steer-4", "--path", "straight", "--duration", "0.5", "--json"])
+    heading = json.loads(out)["deviation"]["end_heading"]
+    assert heading != 0 and abs(heading) < 1e-14  # the round-off the text hides
+    text = _out(capsys, ["simulate", "skid-steer-4", "--path", "straight", "--duration", "0.5"])
+    assert re.search(r"m and 0 rad at the end", text)
+
+
+@pytest.mark.parametrize(("argv", "option", "si"), [
+    (["simulate", "skid-steer-4", "--path", "straight", "--duration", "0.2"], "--speed", "1"),
+    (["tyre", "pacejka", "--load", "5000", "--slip-ratio", "0.05"], "--speed", "10"),
+])
+def test_speed_options_take_speed_units(capsys, argv, option, si):
+    """'--speed "3.6 km/h"' is 1 m/s, '36 km/h' 10 m/s: the same output as the SI number (it was refused)."""
+    with_unit = f"{float(si) * 3.6:g} km/h"
+    assert _out(capsys, [*argv, option, with_unit]) == _out(capsys, [*argv, option, si])
+
+
+def test_an_initial_twist_component_of_the_wrong_kind_is_refused_by_name(capsys):
+    assert main(["simulate", "skid-steer-4", "--path", "straight", "--initial-twist", "1 m/s", "0", "1 mm/s"]) == 2
+    assert capsys.readouterr().err == ("wmrkit: error: --initial-twist OMEGA: '1 mm/s' is a speed, expected an "
+                                       "angular rate\n")

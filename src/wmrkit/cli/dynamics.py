@@ -10,7 +10,9 @@ import numpy as np
 
 from ..errors import WmrkitError
 from ..kinematics.linalg import characteristic_length
+from ..kinematics.wheel_ik import rate_kind
 from ..limits import MAX_SPEED
+from ..robot import TWIST_NAMES
 from ._common import (
     add_json_flag,
     add_robot_argument,
@@ -24,7 +26,7 @@ from ._common import (
     renaming,
     warn,
 )
-from ._shown import no_negative_zero, tidy_pose, tidy_twist, written
+from ._shown import no_negative_zero, tidy, tidy_pose, tidy_twist, written
 
 #: ``simulate --step`` when not given [s].
 DEFAULT_STEP = 0.001
@@ -92,7 +94,7 @@ def run_tyre(args: argparse.Namespace) -> int:
     if load > MAX_LOAD:
         raise WmrkitError(f"--load: at most {MAX_LOAD:g} N (a thousand tonnes on one tyre), got {load:g} N")
     a = parse_value(args.slip_angle, "angle", "--slip-angle")
-    speed = _positive(parse_value(args.speed, "number", "--speed"), "--speed")
+    speed = _positive(parse_value(args.speed, "speed", "--speed"), "--speed")
     with renaming({f"{name.replace('-', ' ')}: ": f"--{name}: " for name in ("kappa", "slip-ratio", "slip-angle",
                                                                            "speed")}):
         s, kappa = _slip_ratio(args)
@@ -183,7 +185,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     check_plot_path(args.plot)
     if args.speed is not None and not args.path:  # it sets a program's speed: with --torques it would be ignored
         raise WmrkitError("--speed applies to --path (the speed of a built-in program; it would be ignored)")
-    speed = _positive(parse_value("2" if args.speed is None else args.speed, "number", "--speed"), "--speed")
+    speed = _positive(parse_value("2" if args.speed is None else args.speed, "speed", "--speed"), "--speed")
     if args.path:
         with renaming({"speed: ": "--speed: "}):
             inputs, duration = path_program(model, args.path, speed=speed)
@@ -213,7 +215,8 @@ def run_simulate(args: argparse.Namespace) -> int:
         raise WmrkitError(f"{source} {duration:g} s{which} not a whole number of --step {step:g} s steps: the run "
                           f"would end at t = {steps * step:g} s; give a step that divides it")
     twist = [0.0, 0.0, 0.0] if args.initial_twist is None else [
-        parse_value(v, "number", "--initial-twist") for v in args.initial_twist]
+        parse_value(v, rate_kind(name), f"--initial-twist {name.upper()}")
+        for name, v in zip(TWIST_NAMES, args.initial_twist, strict=True)]
     _check_rolling(model, twist)
     record = recordable_step(model, duration, step, max(step, min(0.01, duration)))
     try:  # re-checked at a shorter step where needed
@@ -257,9 +260,10 @@ def run_simulate(args: argparse.Namespace) -> int:
         print(f"final pose (t = {end:g} s): x = {x:.6g} m, y = {y:.6g} m, theta = {theta:.6g} rad")
         print(f"final twist (t = {end:g} s): vx = {vx:.6g} m/s, vy = {vy:.6g} m/s, omega = {omega:.6g} rad/s")
         print(f"distance travelled: {travelled:.6g} m; largest slip speed {max_slip:.3g} m/s")
-        if deviation:
+        if deviation:  # the heading's round-off as the final pose's (tidy_pose)
+            end_heading = tidy(deviation.end_heading, max(abs(deviation.end_heading), travelled / size))
             print(f"from the programmed path: {deviation.max_position:.3g} m at most (t = {deviation.max_time:g} s), "
-                  f"{deviation.end_position:.3g} m and {deviation.end_heading:.3g} rad at the end")
+                  f"{deviation.end_position:.3g} m and {end_heading:.3g} rad at the end")
         if sim.step_check:
             c = sim.step_check
             print(f"step check: a run at step {c.step:g} s to t = {c.until:g} s is within {c.apart.max_position:.3g} m "

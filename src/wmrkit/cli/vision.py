@@ -237,7 +237,7 @@ def run_follow(args: argparse.Namespace) -> int:
     start = (0.0, parse_value(args.start[0], "length", "--start H"), parse_angle(args.start[1], "--start THETA"))
     with renaming({"scene: width ": "--line-width: width "}):
         scene = Scene(ns=(0,), width=parse_value(args.line_width, "length", "--line-width"))
-    run = follow_line(robot, camera, gain=args.gain, speed=parse_value(args.speed, "number", "--speed"),
+    run = follow_line(robot, camera, gain=args.gain, speed=parse_value(args.speed, "speed", "--speed"),
                       period=args.period, duration=args.duration, start=start,
                       z_p=parse_value(args.z_p, "length", "--z-p"), noise=noise, image_noise=args.image_noise,
                       blur=args.blur, clutter=args.clutter, seed=args.seed, keep_images=bool(args.animate),
