@@ -176,12 +176,15 @@ def kalman_chunk(positions, before, time, time_before, rate_cols, steer_cols, st
 
 @numba.njit(inline="always")
 def _next_gap(dt, first, m, long_step):
-    """The first of the steps ``dt[first:m]`` of at least `long_step` [s]; `m` if none."""
-    count = 0
-    for j in range(first, m):  # counted first, a loop the compiler vectorises: most blocks have none
-        count += dt[j] >= long_step
-    if count == 0:
-        return m
+    """The first of the steps ``dt[first:m]`` of at least `long_step` [s]; `m` if none. A block's first call
+    (`first` 0) counts them first, a loop the compiler vectorises: most blocks have none; the calls after a long
+    step search on (counting the rest again at each of them made a block of long steps quadratic)."""
+    if first == 0:
+        count = 0
+        for j in range(m):
+            count += dt[j] >= long_step
+        if count == 0:
+            return m
     for j in range(first, m):
         if dt[j] >= long_step:
             return j
