@@ -122,13 +122,13 @@ def run_fk(args: argparse.Namespace) -> int:
 def _twist(texts: list[str]) -> np.ndarray:
     """``--twist VX VY OMEGA``: SI, or each with a unit of its kind (``500 mm/s``, ``30 deg/s``), within
     :data:`MAX_QUERY_RATE`; a refusal names the component."""
-    twist = np.array([parse_value(text, rate_kind(name), f"ik: --twist {name.upper()}")
-                      for name, text in zip(TWIST_NAMES, texts, strict=True)])
-    for name, text, value in zip(TWIST_NAMES, texts, twist, strict=True):
-        if abs(value) > MAX_QUERY_RATE:
+    twist = []
+    for name, text in zip(TWIST_NAMES, texts, strict=True):
+        twist.append(parse_value(text, rate_kind(name), f"ik: --twist {name.upper()}"))
+        if abs(twist[-1]) > MAX_QUERY_RATE:
             raise WmrkitError(f"ik: --twist {name.upper()} {text}: beyond {MAX_QUERY_RATE:g} (m/s or rad/s), no "
                               "wheeled robot moves so fast")
-    return twist
+    return np.array(twist)
 
 
 def _check_finite(what: str, *arrays) -> None:
@@ -169,9 +169,10 @@ def _infeasible(robot, commands: WheelCommands, twist) -> list[str]:
         worst = int(np.argmax(np.abs(commands.slip)))
         out.append(f"a fixed wheel would slip sideways: wheel '{robot.wheel_names[worst]}' slips at "
                    f"{commands.slip[worst]:+.6g} m/s (fixed wheels allow no lateral motion)")
+    scale = _rate_scale(commands)
     for c, ok in zip(robot.couplings, commands.in_gear.tolist(), strict=True):
         if not ok:
-            asked = ", ".join(f"{j} {cell(commands.rates[robot.rate_names.index(j)], _rate_scale(commands))}"
+            asked = ", ".join(f"{j} {cell(commands.rates[robot.rate_names.index(j)], scale)}"
                               for j in c.joints)
             out.append(f"a gear coupling cannot turn its joints so: {c.channel_name} turns them in the ratios "
                        f"{', '.join(f'{k:g}' for k in c.ratios)}, the twist needs {asked} rad/s")
