@@ -244,7 +244,7 @@ def test_park_shows_table_8_1_s_verdict_on_the_timed_plan(capsys, monkeypatch):
         assert main(["park", name]) == 0
         out, err = capsys.readouterr()
         assert "Table 8.1 (column 'type 4, off axle' for the steering axle's midpoint, kinematic framework): " \
-               "feasible: yes" in out.splitlines() and err == ""
+               "feasible: yes" in out.splitlines() and "cannot follow" not in err  # (9.2's dx2 warning said)
         assert main(["park", name, "--json"]) == 0
         data = json.loads(capsys.readouterr().out)
         assert data["feasibility"]["feasible"] and data["feasibility"]["column"] == "type 4, off axle"
@@ -347,3 +347,16 @@ def test_json_poses_are_as_many_at_any_scale(capsys, tmp_path, scale):
     assert len(poses[0]) > 100 and poses[1].shape == poses[0].shape
     np.testing.assert_allclose(poses[1][:, :2] / scale, poses[0][:, :2], rtol=0, atol=1e-9)
     np.testing.assert_allclose(poses[1][:, 2], poses[0][:, 2], rtol=0, atol=1e-9)
+
+
+def test_the_plan_s_warnings_are_said_on_stderr_as_every_command_s(capsys):
+    """park printed its plan's warnings in its text answer on stdout ('warning: dx2 = ...'), unlike every other
+    command ('wmrkit: warning: ...' on stderr). Under --json stdout stays the JSON answer, the warning in it once."""
+    dx2 = "dx2 = 0.17 m puts the car over the parked cars (c1/2 = 1.75 m)"  # Table 9.2: 17 cm, c1 = 3.5 m
+    code, out, err = run(capsys, "thesis-9.2")
+    assert code == 0 and "warning" not in out and out.startswith("problem thesis-9.2: ")
+    assert [line for line in err.splitlines() if dx2 in line] == [f"wmrkit: warning: {dx2}; the detection pass is "
+                                                                  "driven at c1/2 + MS = 1.87 m"]
+    code, out, err = run(capsys, "thesis-9.2", "--json")
+    assert code == 0 and [w for w in json.loads(out)["warnings"] if w.startswith(dx2)] and dx2 in err
+    assert len(json.loads(out)["warnings"]) == 1

@@ -47,6 +47,8 @@ def run(args: argparse.Namespace) -> int:
     check_plot_path(args.plot)  # before the answer is printed
     check_animation_path(args.animate, (".gif", ".html"))
     solution = solve(load_problem(args.problem), check=args.check)
+    for line in solution.plan.warnings:  # on stderr, as every command's (they were 'warning: ...' lines on stdout)
+        warn(line)
     execution = executed = None
     if solution.plan.feasible and (args.animate or (args.check and args.controller)):
         from ..parking.execute import execute_plan

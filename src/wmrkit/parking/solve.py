@@ -112,13 +112,13 @@ def _count(n: int, noun: str) -> str:
 
 
 def describe(solution: Solution) -> str:
-    """The text ``wmrkit park`` prints without ``--json``."""
+    """The text ``wmrkit park`` prints without ``--json`` (the plan's ``warnings`` apart: the command says them on
+    stderr, as every command's)."""
     p, sp, v = solution.plan, solution.problem.space, solution.problem.vehicle
     big, m, small, cm = units(v)
     lines = [f"problem {solution.problem.name}: slot {sp.H / m:.4g} x {sp.J / m:.4g} {big}, car {v.length / m:.4g} x "
              f"{v.c1 / m:.4g} {big} "
              f"(length ratio {100 * length_ratio(v, sp):.1f} %)"]
-    lines += [f"warning: {w}" for w in p.warnings]
     if p.feasible:
         changes = direction_changes(p.segments)
         lines.append(f"feasible: {_count(p.maneuvers, 'manoeuvre')}, final gap to the curb {p.final_gap / cm:.1f} "
