@@ -53,7 +53,7 @@ def figures() -> None:
     fig.savefig(HERE / "forklift-real-loops.png", dpi=110)
     plt.close(fig)
     plot_feasibility(feasibility(fork, builtin_reference("square")), builtin_reference("square"),
-                     HERE / "feasibility-forklift-square.png")
+                     HERE / "feasibility-forklift-square.png", robot=fork.name)
 
 
 CASES = {"forklift": 1.0, "diff-drive": 1.0, "swerve-4": 1.0, "ackermann": 3.0}

@@ -417,7 +417,7 @@ def run_feasibility(args: argparse.Namespace) -> int:
     if args.plot:
         from ..control.plots import plot_feasibility
 
-        plot_feasibility(result, reference, args.plot)
+        plot_feasibility(result, reference, args.plot, robot=robot.name)
         written("plot", args.plot)
     if args.json:
         print_json({"robot": robot.name, "reference_name": reference.name, "reference_size": size,

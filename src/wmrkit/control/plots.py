@@ -52,19 +52,42 @@ def plot_run(run: TrackingRun, path: str | os.PathLike[str]) -> None:
     ax.set_ylabel("y [m]")
     ax.legend(fontsize=8)
     ax.set_title(f"{run.robot.name}: {run.controller}")
-    axes[1].semilogy(run.t, np.maximum(run.error, 1e-12), label="tracking error")
-    axes[1].semilogy(run.t, np.maximum(run.cross_track, 1e-12), label="cross-track error")
-    axes[1].set_xlabel("t [s]")
-    axes[1].set_ylabel("error [m]")
-    axes[1].legend(fontsize=8)
+    _errors(axes[1], run.t, {"tracking error": run.error, "cross-track error": run.cross_track})
     if run.heading.shape[1]:
         for k, name in enumerate(run.robot.steer_names):
             axes[2].plot(run.t, np.degrees(run.heading[:, k]), label=name)
         axes[2].legend(fontsize=8)
+    else:  # an empty panel read as a plot that failed
+        axes[2].text(0.5, 0.5, "no steered wheels", ha="center", va="center", transform=axes[2].transAxes)
     axes[2].set_xlabel("t [s]")
     axes[2].set_ylabel("steering heading [deg]")
     fig.tight_layout()
     _save(fig, path)
+
+
+#: The least error [m] the error panel's log axis shows: a smaller one (round-off; 0 on a straight line) is drawn at
+#: it, and the panel says so (a user read the flat 1e-12 as the error).
+ERROR_FLOOR = 1e-12
+
+
+def _errors(ax, t: np.ndarray, errors: dict[str, np.ndarray]) -> None:
+    """The error panel: each of `errors` [m] against `t` [s], on a log axis from :data:`ERROR_FLOOR`, the values
+    below it drawn at it with a legend entry saying so; on a linear axis when every value is below it (round-off
+    alone: a log axis would show flat lines at the floor, as if the error were 1e-12 m)."""
+    below = [bool(np.any(e < ERROR_FLOOR)) for e in errors.values()]
+    if all(bool(np.all(e < ERROR_FLOOR)) for e in errors.values()):
+        for label, e in errors.items():
+            ax.plot(t, e, label=label)
+        ax.set_title(f"every error below {ERROR_FLOOR:g} m (round-off)", fontsize=9)
+    else:
+        for label, e in errors.items():
+            ax.semilogy(t, np.maximum(e, ERROR_FLOOR), label=label)
+        if any(below):
+            ax.axhline(ERROR_FLOOR, color="0.5", lw=0.8, ls=":",
+                       label=f"errors below {ERROR_FLOOR:g} m drawn at {ERROR_FLOOR:g} m")
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("error [m]")
+    ax.legend(fontsize=8)
 
 
 #: Most frames of a tracking animation, as park --animate's (:data:`wmrkit.parking.plot.MAX_FRAMES`): each is kept,
@@ -130,8 +153,10 @@ def animate_run(run: TrackingRun, path: str | os.PathLike[str], *, frames: int =
         plt.close(fig)
 
 
-def plot_feasibility(result: Feasibility, reference: Reference, path: str | os.PathLike[str]) -> None:
-    """The reference path with its violations marked and labelled by kind."""
+def plot_feasibility(result: Feasibility, reference: Reference, path: str | os.PathLike[str], *,
+                     robot: str | None = None) -> None:
+    """The reference path with its violations marked and labelled by kind; `robot`: the name the title starts
+    with (as every other figure's)."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 5))
     ax.plot(reference.pose[:, 0], reference.pose[:, 1], "k", lw=1.2, label="reference")
@@ -140,7 +165,8 @@ def plot_feasibility(result: Feasibility, reference: Reference, path: str | os.P
         ax.plot(p[0], p[1], "rx", ms=9, mew=2, label="violation" if k == 0 else None)
         ax.annotate(f"{v.signal} @ {v.t:.1f} s", (p[0], p[1]), fontsize=7, xytext=(4, 4), textcoords="offset points")
     r = result.requirement
-    ax.set_title(f"{r.column}, {r.framework}: {'feasible' if result.feasible else 'NOT feasible'}", fontsize=10)
+    ax.set_title(f"{'' if robot is None else f'{robot}: '}Table 8.1 '{r.column}', {r.framework}: "
+                 f"{'feasible' if result.feasible else 'NOT feasible'}", fontsize=10)
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
