@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -360,3 +361,31 @@ def test_the_plan_s_warnings_are_said_on_stderr_as_every_command_s(capsys):
     code, out, err = run(capsys, "thesis-9.2", "--json")
     assert code == 0 and [w for w in json.loads(out)["warnings"] if w.startswith(dx2)] and dx2 in err
     assert len(json.loads(out)["warnings"]) == 1
+
+
+def test_the_plan_figure_s_legend_names_every_element_drawn(tmp_path):
+    """The legend named the executed path alone (and a plan drawn without one had no legend): the planned path's
+    two colours, the cars at the stops, the parked car, the scene were left to guess."""
+    from matplotlib.colors import to_hex
+
+    from wmrkit.parking.execute import execute_plan
+    from wmrkit.parking.plot import BACKWARD, FORWARD, plot_plan
+    from wmrkit.parking.problem import load_problem
+
+    problem = load_problem("thesis-9.1")
+    plan = plan_parking(problem.vehicle, problem.space)
+    ax = plot_plan(plan, execute_plan(plan), name="thesis-9.1").axes[0]
+    legend = {t.get_text(): h for t, h in zip(ax.get_legend().get_texts(), ax.get_legend().legend_handles,
+                                              strict=True)}
+    assert list(legend) == ["planned path of the rear axle's midpoint, forward",
+                            "planned path of the rear axle's midpoint, backward", "executed path (open-loop)",
+                            "car at each stop", "car parked (goal)", "parked cars", "curb", "slot",
+                            "safety margins (MS)"]
+    drawn = {to_hex(line.get_color()) for line in ax.lines}  # the legend's colours are those drawn
+    assert {FORWARD, BACKWARD} <= drawn and to_hex(legend["planned path of the rear axle's midpoint, forward"]
+                                                   .get_color()) == FORWARD
+    assert ax.get_title().startswith("thesis-9.1: H = 3.35 m")
+    short = load_problem("thesis-9.1")
+    impossible = plan_parking(short.vehicle, replace(short.space, H=2.0))  # nothing drawn but the scene
+    texts = [t.get_text() for t in plot_plan(impossible).axes[0].get_legend().get_texts()]
+    assert not impossible.feasible and texts == ["parked cars", "curb", "slot", "safety margins (MS)"]

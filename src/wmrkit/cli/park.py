@@ -93,7 +93,9 @@ def run(args: argparse.Namespace) -> int:
             plot.animate_plan(solution.plan, args.animate, execution, max_frames=frames)
             written("animation", args.animate)
         if args.plot:
-            plot.save_plan_figure(solution.plan, args.plot, execution)
+            robot = solution.problem.robot
+            name = solution.problem.name + ("" if robot is None else f" (robot {robot.name})")
+            plot.save_plan_figure(solution.plan, args.plot, execution, name=name)
             written("plot", args.plot)
     return 0 if parked(solution, executed) else 1
 

@@ -70,9 +70,10 @@ def draw_car(ax: Axes, vehicle: Vehicle, pose: np.ndarray, steering: float = 0.0
     return [body, wheel, axle]
 
 
-def plot_plan(plan: ParkingPlan, execution: Execution | None = None) -> Figure:
-    """The scene, P_f's path (blue forward, red backward), the car at every stop, the final car filled."""
-    fig = Figure(figsize=(9, 5.2))
+def plot_plan(plan: ParkingPlan, execution: Execution | None = None, *, name: str | None = None) -> Figure:
+    """The scene, P_f's path (blue forward, red backward), the car at every stop, the final car filled, and a legend
+    naming each (outside the frame); `name` (the problem's, and its robot's) starts the title."""
+    fig = Figure(figsize=(11, 5.2))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     v, sp = plan.vehicle, plan.space
@@ -83,27 +84,47 @@ def plot_plan(plan: ParkingPlan, execution: Execution | None = None) -> Figure:
         if seg.phase == 3:
             draw_car(ax, v, np.array(seg.end), seg.steering, color="0.35", alpha=0.45)
     if execution is not None:
-        ax.plot(execution.pose[:, 0], execution.pose[:, 1], color="k", lw=0.8, ls="--", zorder=2,
-                label=f"executed ({execution.mode})")
-        ax.legend(loc="upper left", fontsize=8)
+        ax.plot(execution.pose[:, 0], execution.pose[:, 1], color="k", lw=0.8, ls="--", zorder=2)
     if plan.segments:
         draw_car(ax, v, np.array(plan.final_pose), 0.0, color="#2ca02c", alpha=0.5, fill=True)
     plural = "" if plan.maneuvers == 1 else "s"
     verdict = f"{plan.maneuvers} manoeuvre{plural}" if plan.feasible else f"infeasible: {plan.reason[:70]}"
     part = "" if plan.used_H is None else f" (parks in the {plan.used_H:.3g} m behind the front car)"
-    ax.set_title(f"H = {sp.H:.3g} m{part}, J = {sp.J:.3g} m, car {v.length:.3g} x {v.c1:.3g} m: {verdict}",
-                 fontsize=9)
+    ax.set_title(f"{'' if name is None else f'{name}: '}H = {sp.H:.3g} m{part}, J = {sp.J:.3g} m, car "
+                 f"{v.length:.3g} x {v.c1:.3g} m: {verdict}", fontsize=9)
+    ax.legend(handles=_legend(plan, execution), loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0,
+              fontsize=8)
     _frame(ax, plan)
     fig.tight_layout()
     return fig
 
 
-def save_plan_figure(plan: ParkingPlan, path: str | os.PathLike[str], execution: Execution | None = None) -> None:
+def _legend(plan: ParkingPlan, execution: Execution | None) -> list:
+    """Legend entries of :func:`plot_plan`, one per kind of element drawn (it named the executed path alone)."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    drawn = {s.direction for s in plan.segments}
+    handles = [Line2D([], [], color=color, lw=1.4, label=f"planned path of the rear axle's midpoint, {way}")
+               for way, color, d in (("forward", FORWARD, 1), ("backward", BACKWARD, -1)) if d in drawn]
+    if execution is not None:
+        handles.append(Line2D([], [], color="k", lw=0.8, ls="--", label=f"executed path ({execution.mode})"))
+    if any(s.phase == 3 for s in plan.segments):
+        handles.append(Patch(facecolor="none", edgecolor="0.35", alpha=0.45, label="car at each stop"))
+    if plan.segments:
+        handles.append(Patch(facecolor="#2ca02c", edgecolor="#2ca02c", alpha=0.5, label="car parked (goal)"))
+    return handles + [Patch(color="0.75", label="parked cars"), Patch(color="0.45", label="curb"),
+                      Line2D([], [], color="0.3", lw=0.8, ls="--", label="slot"),
+                      Line2D([], [], color="0.5", lw=0.6, ls=":", label="safety margins (MS)")]
+
+
+def save_plan_figure(plan: ParkingPlan, path: str | os.PathLike[str], execution: Execution | None = None, *,
+                     name: str | None = None) -> None:
     """Write :func:`plot_plan` to a PNG, SVG or PDF file."""
     from ..plotting.files import check_figure_path
 
     check_figure_path(path)
-    plot_plan(plan, execution).savefig(path, dpi=120)
+    plot_plan(plan, execution, name=name).savefig(path, dpi=120)
 
 
 def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Execution | None = None, *,
