@@ -155,26 +155,43 @@ def test_follow_line_refuses_a_line_wider_than_the_view(tmp_path, capsys):
     assert "--line-width" in err and "0.7538 m" in err and len(err.strip().splitlines()) == 1
 
 
-def test_follow_line_with_lost_images_is_a_failed_run(tmp_path, capsys, monkeypatch):
-    # a run in which images lost the line printed a summary and exited 0 (the robot drove on stale positions)
+def _lose_the_line_after(images: int, monkeypatch) -> None:
+    """follow-line's positioning finds no line in any image after the first `images`."""
     from wmrkit.errors import WmrkitError
     from wmrkit.vision import follow as follow_module
 
-    Camera(150.0, math.radians(60), 0.3, 160, 120).to_file(tmp_path / "cam.yaml")
     real, calls = follow_module.locate_image, []
 
     def flaky(*args, **kwargs):
         calls.append(1)
-        if len(calls) > 3:
+        if len(calls) > images:
             raise WmrkitError("image: found 0 line(s), expected 1")
         return real(*args, **kwargs)
 
     monkeypatch.setattr(follow_module, "locate_image", flaky)
+
+
+def test_follow_line_with_lost_images_is_a_failed_run(tmp_path, capsys, monkeypatch):
+    # a run in which images lost the line printed a summary and exited 0 (the robot drove on stale positions)
+    _lose_the_line_after(3, monkeypatch)
+    Camera(150.0, math.radians(60), 0.3, 160, 120).to_file(tmp_path / "cam.yaml")
     code, out, err = run(["follow-line", "line-follower", "--camera", str(tmp_path / "cam.yaml"), "--duration", "3",
                           "--json"], capsys)
     assert code == 2 and out == ""
     error = json.loads(err)["error"]
     assert "the line was lost in 4 of 6 images (first at t = 1 s" in error
+
+
+def test_a_failed_follow_line_run_writes_no_animation(tmp_path, capsys, monkeypatch):
+    """The GIF was written before the run's failure check: a run that lost the line left a GIF and a 'written'
+    line beside its error (exit 2). A failed run is no result: one error line, no file."""
+    _lose_the_line_after(3, monkeypatch)
+    Camera(150.0, math.radians(60), 0.3, 160, 120).to_file(tmp_path / "cam.yaml")
+    gif = tmp_path / "run.gif"
+    code, out, err = run(["follow-line", "line-follower", "--camera", str(tmp_path / "cam.yaml"), "--duration", "3",
+                          "--animate", str(gif)], capsys)
+    assert code == 2 and out == "" and not gif.exists()
+    assert err.startswith("wmrkit: error: follow-line: the line was lost in 4 of 6 images") and err.count("\n") == 1
 
 
 def test_follow_line_that_does_not_settle_says_so(tmp_path, capsys):

@@ -242,14 +242,14 @@ def run_follow(args: argparse.Namespace) -> int:
                       z_p=parse_value(args.z_p, "length", "--z-p"), noise=noise, image_noise=args.image_noise,
                       blur=args.blur, clutter=args.clutter, seed=args.seed, keep_images=bool(args.animate),
                       scene=scene)
+    failure = run.failure()
+    if failure is not None:  # a run that did not follow the line is no result (as track's diverged loop): no
+        raise WmrkitError(failure)  # animation either (it was written and announced beside the error)
     if args.animate:
         from ..vision.animation import save_animation
 
         save_animation(run, robot, camera, args.animate)
         written("animation", args.animate)
-    failure = run.failure()
-    if failure is not None:  # a run that did not follow the line is no result (as track's diverged loop)
-        raise WmrkitError(failure)
     summary = run.to_dict()
     if args.json:
         print_json(summary)
