@@ -68,9 +68,10 @@ def test_track_warns_of_a_linkage_holding_its_wheels_off_the_commanded_axles(tmp
     assert main(["track", str(path), "--reference", "circle", "--size", "8", "--duration", "3", "--json",
                  "--controller", "pure-pursuit"]) == 0
     answer = json.loads(capsys.readouterr().out)
-    (said,) = [w for w in answer["warnings"] if PARALLEL in w]
+    (said,) = [w for w in answer["warnings"] if "axles the commanded twist needs" in w]
     v = answer["held_off_axle"][0]
-    assert said.startswith(f"the {PARALLEL} held wheels 'front_left', 'front_right' up to "
+    assert v["coupling"] == PARALLEL  # the JSON's channel name; the warning speaks the description's terms
+    assert said.startswith("the steering linkage of wheels 'front_left' and 'front_right' held them up to "
                            f"{math.degrees(v['axle_miss']):.3g} deg off the axles the commanded twist needs for 3 s "
                            "(t = 0 to 3 s): that twist is not realisable")
     assert f"{v['twist_miss'][0]:.3g} m/s and {v['twist_miss'][1]:.3g} rad/s off the commanded one" in said

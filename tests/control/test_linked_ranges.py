@@ -197,7 +197,8 @@ def test_a_follower_held_by_its_linkage_is_not_said_to_be_beyond_its_range(capsy
     """``wmrkit track lcar.json --reference corner --size 1 --duration 10 --json``: fl, the inner wheel of the left
     turn, is held at its end 0.5 rad, and fr where the law sets it from there (closed form: 0.411 rad), within its
     range. Before, both were listed alike and fr's warning said it "was asked to steer beyond its range ... and was
-    held at its end"; now fr's entry names the linkage and the heading it was held at, and so does its warning."""
+    held at its end"; now fr's entry names the linkage and the heading it was held at, and so does the linkage's one
+    warning (it said a line per wheel, naming the linkage by its channel name, 'linkage(fl.steer, fr.steer)')."""
     import json
 
     from wmrkit.cli.main import main
@@ -210,7 +211,9 @@ def test_a_follower_held_by_its_linkage_is_not_said_to_be_beyond_its_range(capsy
     assert (fl["wheel"], fr["wheel"], "held_by" in fl) == ("fl", "fr", False)
     assert fr["held_by"] == "linkage(fl.steer, fr.steer)"
     assert fr["headings"] == pytest.approx([_right(LIMIT)] * 2, abs=1e-12) and abs(_right(LIMIT)) < LIMIT - 0.05
-    said = {w.split("'")[1]: w for w in answer["warnings"] if w.startswith("wheel ")}
-    assert "beyond its range" in said["fl"] and "held at its end" in said["fl"]
-    assert "beyond its range" not in said["fr"] and "held at its end" in said["fr"]  # the other wheel's end
-    assert f"held by its linkage(fl.steer, fr.steer) at heading {math.degrees(_right(LIMIT)):.4g} deg" in said["fr"]
+    (said,) = [w for w in answer["warnings"] if "'fr'" in w]
+    assert said.startswith("the steering linkage of wheels 'fl' and 'fr' held them at a steering limit: 'fl' was "
+                           f"asked to steer beyond its range [-{math.degrees(LIMIT):g}, {math.degrees(LIMIT):g}] deg "
+                           f"for {fl['duration']:.3g} s (t = {fl['from']:.4g} to {fl['to']:.4g} s), held at its end, "
+                           f"and 'fr' at {math.degrees(_right(LIMIT)):.4g} deg with it (within its range): ")
+    assert "linkage(" not in said and "'fr' was asked" not in said

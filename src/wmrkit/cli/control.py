@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import WmrkitError
+from ..errors import WmrkitError, name_list
 from ._common import (
     add_json_flag,
     add_robot_argument,
@@ -284,27 +284,15 @@ def run_track(args: argparse.Namespace) -> int:
         except TypeError:  # a class that takes more (UnstableStepError: the steps and the door): said as it is
             joined = WmrkitError(message)
         raise joined from None
-    for v in run.range_violations():
-        when = f"for {v['duration']:.3g} s (t = {v['from']:.4g} to {v['to']:.4g} s)"
-        if "held_by" in v:  # short of its own ends: held there by its linkage or gear, another wheel at its end
-            lo, hi = (math.degrees(a) for a in v["headings"])
-            at = f"{lo:.4g} deg" if f"{lo:.4g}" == f"{hi:.4g}" else f"{lo:.4g} to {hi:.4g} deg"
-            warn(f"wheel '{v['wheel']}' was held by its {v['held_by']} at heading {at}, within its range, {when}, "
-                 "while another of its wheels was held at its end: the robot cannot follow this reference there "
-                 "(its wheels scrub; the tracking errors are the result)")
-            continue
-        lo, hi = (math.degrees(a) for a in robot.wheel(v["wheel"]).steer_range)
-        warn(f"wheel '{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg {when} and was held at "
-             "its end: the robot cannot follow this reference there (its wheels scrub; the tracking errors are the "
-             "result)")
+    for line in range_warnings(robot, run.range_violations()):
+        warn(line)
     for v in run.held_off_axle():  # no twist_miss through the dynamics
         moved = (f"so the kinematic loop moved the robot with the least-squares twist of its wheels, up to "
                  f"{v['twist_miss'][0]:.3g} m/s and {v['twist_miss'][1]:.3g} rad/s off the commanded one"
                  if "twist_miss" in v else "and through the dynamics their tyres slip sideways")
-        warn(f"the {v['coupling']} held wheel{'s' if len(v['wheels']) > 1 else ''} "
-             f"{', '.join(repr(w) for w in v['wheels'])} up to {math.degrees(v['axle_miss']):.3g} deg off the axles "
-             f"the commanded twist needs for {v['duration']:.3g} s (t = {v['from']:.4g} to {v['to']:.4g} s): that "
-             f"twist is not realisable without the wheels scrubbing, {moved}; the tracking errors are the result")
+        warn(f"{coupling_words(robot, v['coupling'])} held them up to {math.degrees(v['axle_miss']):.3g} deg off the "
+             f"axles the commanded twist needs for {v['duration']:.3g} s (t = {v['from']:.4g} to {v['to']:.4g} s): "
+             f"that twist is not realisable without the wheels scrubbing, {moved}; the tracking errors are the result")
     for c, ok in zip(robot.couplings, run.commands.in_gear.all(axis=0).tolist(), strict=True):
         if not ok:  # the kinematic plants hold a gear of steering joints only; the dynamics hold every gear
             warn(f"the commands turn the joints of {c.channel_name} out of its ratios (ratios "
@@ -345,6 +333,52 @@ def run_track(args: argparse.Namespace) -> int:
               f"{PATH_FOLLOWER_NOTE if args.controller in ('pure-pursuit', 'stanley') else ''}")
         print(f"cross-track error [m]: rms {s['rms_cross_track']:.4g}, max {s['max_cross_track']:.4g}")
     return 0
+
+
+#: How every warning of a wheel held at a steering range's end ends.
+CANNOT_FOLLOW = "the robot cannot follow this reference there (its wheels scrub; the tracking errors are the result)"
+
+
+def coupling_words(robot, channel: str) -> str:
+    """A steering linkage or gear (by its channel name, ``linkage(fl.steer, fr.steer)``: the library's) in the
+    description's terms: ``the steering linkage of wheels 'fl' and 'fr'``."""
+    c = next(c for c in robot.couplings if c.channel_name == channel)
+    wheels = [f"'{j.removesuffix('.steer')}'" for j in c.joints if j.endswith(".steer")]
+    return f"the steering {c.kind} of wheels {name_list(wheels[:-1])} and {wheels[-1]}"
+
+
+def range_warnings(robot, violations: list[dict]) -> list[str]:
+    """The warnings of a run's :meth:`~wmrkit.control.tracking_run.TrackingRun.range_violations`: one per wheel
+    steered on its own, and one per linkage or steering gear, naming each wheel it held at its end and those it held
+    with it (the catalog car's corner said four lines, two of them the same event, naming the linkage by its channel
+    name)."""
+    from ..control.tracking_run import steers_together
+
+    def asked(v: dict) -> str:
+        lo, hi = (math.degrees(a) for a in robot.wheel(v["wheel"]).steer_range)
+        return (f"'{v['wheel']}' was asked to steer beyond its range [{lo:g}, {hi:g}] deg for {v['duration']:.3g} s "
+                f"(t = {v['from']:.4g} to {v['to']:.4g} s), held at its end")
+
+    def at(v: dict) -> str:
+        lo, hi = (f"{math.degrees(a):.4g}" for a in v["headings"])
+        return f"'{v['wheel']}' at {lo if lo == hi else f'{lo} to {hi}'} deg"
+
+    holders = {j.removesuffix(".steer"): c.channel_name for c in robot.couplings if steers_together(c)
+               for j in c.joints if j.endswith(".steer")}
+    out = [f"wheel {asked(v)}: {CANNOT_FOLLOW}" for v in violations if v["wheel"] not in holders]
+    for channel in dict.fromkeys(holders[v["wheel"]] for v in violations if v["wheel"] in holders):
+        vs = [v for v in violations if holders.get(v["wheel"]) == channel]
+        held = [v for v in vs if "held_by" in v]
+        parts = []
+        for v in (v for v in vs if "held_by" not in v):  # a wheel at its own end, and those held with it then
+            with_it = [at(h) for h in held if (h["from"], h["to"]) == (v["from"], v["to"])]
+            parts.append(asked(v) + (f", and {', '.join(with_it)} with it (within its range)" if with_it else ""))
+        paired = {(v["from"], v["to"]) for v in vs if "held_by" not in v}
+        parts += [f"{at(h)} (within its range) for {h['duration']:.3g} s (t = {h['from']:.4g} to {h['to']:.4g} s)"
+                  for h in held if (h["from"], h["to"]) not in paired]
+        out.append(f"{coupling_words(robot, channel)} held them at a steering limit: {'; '.join(parts)}: "
+                   f"{CANNOT_FOLLOW}")
+    return out
 
 
 #: Said after a remedy that re-orients a wheel alone, in a kinematic run (its plant steers the wheels instantly).
