@@ -38,6 +38,7 @@ def test_errors_below_the_log_axis_floor_are_said_to_be_drawn_at_it(drawn, tmp_p
     plots_module.plot_run(run, tmp_path / "run.png")
     ax = drawn[0].axes[1]
     assert ax.get_yscale() == "log" and "errors below 1e-12 m drawn at 1e-12 m" in _texts(ax)
+    assert drawn[0].axes[0].get_title() == "diff-drive, controller p"  # it was 'diff-drive: p'
 
 
 def test_errors_that_are_all_round_off_get_a_linear_axis_that_says_so(drawn, tmp_path):

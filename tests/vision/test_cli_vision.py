@@ -452,3 +452,20 @@ def test_locate_prints_no_negative_zero(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "psi = 0.000000 rad (0.000 deg), h = 0.00000 m" in out and "n = +0: psi = 0.000 deg" in out
     assert "-0.000 " not in out
+
+
+def test_the_line_following_animation_names_the_robot_and_the_path(tmp_path, monkeypatch):
+    """The GIF named the robot nowhere and its plan view's legend said 'P' alone."""
+    from wmrkit import catalog
+    from wmrkit.vision import animation
+    from wmrkit.vision.follow import follow_line
+
+    figures = []
+    monkeypatch.setattr(animation, "save_gif", lambda fig, *args, **kwargs: figures.append(fig))
+    camera = Camera(150.0, math.radians(60), 0.3, 160, 120)
+    robot = catalog.load("line-follower")
+    run = follow_line(robot, camera, duration=1.0, keep_images=True)
+    animation.save_animation(run, robot, camera, tmp_path / "run.gif")
+    plan = figures[0].axes[1]
+    assert plan.get_title() == "line-follower: plan view"
+    assert [t.get_text() for t in plan.get_legend().get_texts()] == ["line", "path of P (tracked point)"]

@@ -51,7 +51,7 @@ def plot_run(run: TrackingRun, path: str | os.PathLike[str]) -> None:
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.legend(fontsize=8)
-    ax.set_title(f"{run.robot.name}: {run.controller}")
+    ax.set_title(f"{run.robot.name}, controller {run.controller}")
     _errors(axes[1], run.t, {"tracking error": run.error, "cross-track error": run.cross_track})
     if run.heading.shape[1]:
         for k, name in enumerate(run.robot.steer_names):

@@ -89,7 +89,8 @@ def save_animation(run: LineFollowing, robot: Robot, camera: Camera, path: str |
     plan_ax.set_aspect("equal")
     plan_ax.set_xlabel("x along the line [m]")
     plan_ax.set_ylabel("y [m]")
-    path_line, = plan_ax.plot([], [], "--", color="#1f77b4", label="P")
+    plan_ax.set_title(f"{robot.name}: plan view", fontsize=9)  # the robot was named nowhere in the GIF
+    path_line, = plan_ax.plot([], [], "--", color="#1f77b4", label="path of P (tracked point)")
     body = plan_ax.fill([], [], color="#c9d6e3", edgecolor="#6b7f94")[0]
     plan_ax.legend(loc="upper right", fontsize=8)
     text = fig.text(0.02, 0.02, "", fontsize=8)
