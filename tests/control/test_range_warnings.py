@@ -6,9 +6,9 @@ import json
 import math
 
 from wmrkit import catalog
-from wmrkit.control.forklift import with_steer_range
 from wmrkit.cli.control import range_warnings
 from wmrkit.cli.main import main
+from wmrkit.control.forklift import with_steer_range
 
 
 def test_the_catalog_car_s_corner_says_one_warning_for_its_linkage(capsys):
@@ -20,7 +20,7 @@ def test_the_catalog_car_s_corner_says_one_warning_for_its_linkage(capsys):
     entries = answer["beyond_steer_range"]
     assert sorted((v["wheel"], "held_by" in v) for v in entries) == [  # the run's record, as before
         ("front_left", False), ("front_left", True), ("front_right", False), ("front_right", True)]
-    held = [w for w in answer["warnings"] if "steering limit" in w or "range" in w and "Table 8.1" not in w]
+    held = [w for w in answer["warnings"] if "steering limit" in w or ("range" in w and "Table 8.1" not in w)]
     assert len(held) == 1 and not [w for w in answer["warnings"] if ".steer" in w]
     (said,) = held
     assert said.startswith("the steering linkage of wheels 'front_left' and 'front_right' held them at a steering "

@@ -113,9 +113,9 @@ def _legend(plan: ParkingPlan, execution: Execution | None) -> list:
         handles.append(Patch(facecolor="none", edgecolor="0.35", alpha=0.45, label="car at each stop"))
     if plan.segments:
         handles.append(Patch(facecolor="#2ca02c", edgecolor="#2ca02c", alpha=0.5, label="car parked (goal)"))
-    return handles + [Patch(color="0.75", label="parked cars"), Patch(color="0.45", label="curb"),
-                      Line2D([], [], color="0.3", lw=0.8, ls="--", label="slot"),
-                      Line2D([], [], color="0.5", lw=0.6, ls=":", label="safety margins (MS)")]
+    return [*handles, Patch(color="0.75", label="parked cars"), Patch(color="0.45", label="curb"),
+            Line2D([], [], color="0.3", lw=0.8, ls="--", label="slot"),
+            Line2D([], [], color="0.5", lw=0.6, ls=":", label="safety margins (MS)")]
 
 
 def save_plan_figure(plan: ParkingPlan, path: str | os.PathLike[str], execution: Execution | None = None, *,
