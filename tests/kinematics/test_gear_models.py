@@ -168,7 +168,7 @@ def test_a_gear_that_locks_the_cart_leaves_no_motion(tmp_path, capsys):
     assert main(["kinematics", str(path)]) == 0
     out = capsys.readouterr().out
     assert "  with its gear couplings m = 0 (gear(left.spin, right.spin)" in out
-    assert "  with its 1 steering rate (extended solutions, §4.5), 1 velocity can be assigned\n" in out
+    assert "  with its 1 steering angle (extended solutions, §4.5), 1 velocity can be assigned\n" in out
     assert "    the robot cannot move (m = 0): every velocity is zero" in out
     assert "  direct model:\n" in out and "  inverse model:\n" in out and "assigned: )" not in out  # was "(inverse,
     # assigned: )" for both

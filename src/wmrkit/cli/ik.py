@@ -38,6 +38,9 @@ from ._common import (
 )
 from ._shown import cell, tidy, tidy_twist, twist_speed
 
+#: slipping wheels a not-feasible warning names, the fastest first (a robot of 64 fixed wheels: the rest counted)
+MAX_NAMED = 4
+
 
 def add_parsers(commands: argparse._SubParsersAction) -> None:
     """Register ``ik`` and ``fk``."""
@@ -165,10 +168,13 @@ def _infeasible(robot, commands: WheelCommands, twist) -> list[str]:
     joints would turn out of its ratios, a linkage whose law the headings break, steered wheels whose heading is
     outside their steer_range (each ``"reason: detail"``)."""
     out = []
-    if np.any(np.abs(commands.slip) > 1e-9):
-        worst = int(np.argmax(np.abs(commands.slip)))
-        out.append(f"a fixed wheel would slip sideways: wheel '{robot.wheel_names[worst]}' slips at "
-                   f"{commands.slip[worst]:+.6g} m/s (fixed wheels allow no lateral motion)")
+    slipping = np.flatnonzero(np.abs(commands.slip) > 1e-9)
+    if slipping.size:  # every one, the fastest first (a diff drive asked for vy: both wheels, not one)
+        order = slipping[np.argsort(-np.abs(commands.slip[slipping]), kind="stable")]
+        named = ", wheel ".join(f"'{robot.wheel_names[i]}'{' slips' * (k == 0)} at {commands.slip[i]:+.6g} m/s"
+                                for k, i in enumerate(order[:MAX_NAMED]))
+        more = f" and {order.size - MAX_NAMED} more" if order.size > MAX_NAMED else ""
+        out.append(f"a fixed wheel would slip sideways: wheel {named}{more} (fixed wheels allow no lateral motion)")
     scale = _rate_scale(commands)
     for c, ok in zip(robot.couplings, commands.in_gear.tolist(), strict=True):
         if not ok:

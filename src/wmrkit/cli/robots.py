@@ -78,9 +78,9 @@ def format_summary(robot: Robot) -> str:
             j + ("[" + "A" * (j in w.actuated) + "S" * (j in w.sensed) + "]" if j in w.actuated + w.sensed else "")
             for j in w.kind.joints
         )
-        extra = {"castor": f"  d={_g(w.d)} delta={_g(math.degrees(w.delta))}deg",
-                 "double_castor": f"  d={_g(w.d)} b={_g(w.b)}", "double": f"  b={_g(w.b)}",
-                 "swedish": f"  gamma={_g(math.degrees(w.gamma))}deg r_r={_g(w.r_r)}"}.get(w.type, "")
+        extra = {"castor": f"  d={_g(w.d)} m delta={_g(math.degrees(w.delta))} deg",
+                 "double_castor": f"  d={_g(w.d)} m b={_g(w.b)} m", "double": f"  b={_g(w.b)} m",
+                 "swedish": f"  gamma={_g(math.degrees(w.gamma))} deg r_r={_g(w.r_r)} m"}.get(w.type, "")
         row = (f"  {w.name:<{width}}{described_type(w):<14}{_g(_zero(x)):>10}{_g(_zero(y)):>10}"
                f"{_g(_zero(math.degrees(w.heading))) + '°':>10}{_g(w.r):>10}")
         lines.append(f"{row}  {joints}{extra}")

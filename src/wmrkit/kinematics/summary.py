@@ -138,7 +138,7 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
     if self_motions > 0:
         mobility += (f" (4.3): {summary['vehicle_dof']} of the body (G, 4.22; the classification's m) and "
                      f"{self_motions} of the joints with the body at rest")
-    extra = summary["extended_dof"] - coupled
+    extra = summary["extended_dof"] - generic  # n_o: extended_dof is m at generic steering plus n_o (4.76)
     lines = [f"robot {summary['robot']} ({steer or 'no steering'})", mobility]
     if gears:
         lines.append(f"  with its gear couplings m = {coupled}{special} ({', '.join(gears)}, q_j = ratio_j * u): "
@@ -146,7 +146,7 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
     if extra > 0:
         n = summary["extended_dof"]
         linked = summary.get("linkages")
-        lines.append(f"  with its {extra} steering rate{'s' if extra > 1 else ''} (extended solutions, §4.5), "
+        lines.append(f"  with its {extra} steering angle{'s' if extra > 1 else ''} (extended solutions, §4.5), "
                      f"{n} velocit{'ies' if n > 1 else 'y'} can be assigned"
                      + (f" (each steered wheel counted, {', '.join(linked)} not as one: the solutions judge their "
                         "angles against its law)"
