@@ -139,7 +139,7 @@ def check_table_size(path: str | os.PathLike[str], error: type[Exception], what:
 
 def _check_size(size: int, unit: str, source: str, what: str = "description") -> None:
     if size > MAX_FILE_SIZE:
-        raise DescriptionError(f"{size} {unit}: a {what} holds at most {MAX_FILE_SIZE} (docs/limits.md)",
+        raise DescriptionError(f"{size} {unit}: a {what} holds at most {MAX_FILE_SIZE} {unit} (docs/limits.md)",
                                source=source)
 
 

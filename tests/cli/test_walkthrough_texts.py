@@ -59,3 +59,12 @@ def test_show_gives_every_length_its_unit(tmp_path, capsys):
     assert rows["c"].endswith("  d=0.04 m delta=0 deg")
     assert rows["u"].endswith("  b=0.06 m")
     assert rows["m"].endswith(f"  gamma=45 deg r_r={0.05 / 4:g} m")
+
+
+def test_kinematics_says_the_units_of_its_tables(capsys):
+    """The model tables print `vx = 0.0375 left.spin` with no unit anywhere in the text: the velocities line now says
+    them. diff-drive's direct model: vx = r/2 per wheel spin (r = 0.075 m), in m/s per rad/s."""
+    out = _out(capsys, ["kinematics", "diff-drive"]).out
+    assert "  velocities (vx, vy [m/s]; omega, joint rates [rad/s]): vx, vy, omega, left.spin" in out
+    row = next(x for x in out.splitlines() if x.strip().startswith("vx ") and "=" in x)
+    assert [float(v) for v in row.split("=")[1].split()] == [0.075 / 2, 0.075 / 2]

@@ -151,7 +151,7 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
                      + (f" (each steered wheel counted, {', '.join(linked)} not as one: the solutions judge their "
                         "angles against its law)"
                         if linked else ""))
-    lines += [f"  velocities: {', '.join(summary['velocity_names'])}",
+    lines += [f"  velocities (vx, vy [m/s]; omega, joint rates [rad/s]): {', '.join(summary['velocity_names'])}",
               f"  assignable sets ({len(summary['assignable_sets'])}):", *_sets(summary["assignable_sets"], limit)]
     lost = [s for s in summary["lost_here"] if s]
     if lost:
