@@ -146,9 +146,19 @@ class FieldReader:
                 self.fail(f"unknown field '{key}'{hint(key, allowed)}", (*loc, key))
 
 
+#: words users bring from other tools for a field spelled otherwise here (suggested when that field is allowed)
+SYNONYMS = {"radius": "r", "wheel_radius": "r", "roller_radius": "r_r", "offset": "d", "castor_offset": "d",
+            "angle": "heading", "steering": "heading", "steer": "heading", "yaw": "heading", "pos": "position",
+            "xy": "position", "location": "position", "translation": "position"}
+
+
 def hint(word: str, choices: Any) -> str:
-    """`` (did you mean '...'?)`` for the closest of `choices`, or an empty string."""
-    close = difflib.get_close_matches(str(word), list(choices), n=1)
+    """`` (did you mean '...'?)`` for the closest of `choices` (or its synonym among them), or an empty string."""
+    choices = list(choices)
+    alias = SYNONYMS.get(str(word).lower())
+    if alias in choices:
+        return f" (did you mean '{alias}'?)"
+    close = difflib.get_close_matches(str(word), choices, n=1)
     return f" (did you mean '{close[0]}'?)" if close else ""
 
 
