@@ -4,6 +4,7 @@ the descriptions here, not taken from the code's output."""
 
 from __future__ import annotations
 
+import math
 import re
 
 import pytest
@@ -68,3 +69,32 @@ def test_kinematics_says_the_units_of_its_tables(capsys):
     assert "  velocities (vx, vy [m/s]; omega, joint rates [rad/s]): vx, vy, omega, left.spin" in out
     row = next(x for x in out.splitlines() if x.strip().startswith("vx ") and "=" in x)
     assert [float(v) for v in row.split("=")[1].split()] == [0.075 / 2, 0.075 / 2]
+
+
+def _numbers(text):
+    return [float(v) for v in re.findall(r"-?\d+\.\d+", text)]
+
+
+def test_analyze_shows_a_small_robots_icr_to_its_scale(tmp_path, capsys):
+    """ICR coordinates were printed to 3 decimals of a metre at any scale: a 2 mm diff drive's axle at x = 0.4 mm read
+    `line through (0.000, 0.000) m`, a 3 mm tricycle's ICR at (0.4, 7.14) mm `(0.000, 0.007) m`. Now to 1 % of the
+    robot's size. The expected points are the axle intersections computed here."""
+    path = tmp_path / "micro.yaml"
+    diff = ("name: micro\nwheels:\n  - {name: l, type: fixed, position: [0.4 mm, 1 mm], heading: 0, r: 0.2 mm}\n"
+            "  - {name: r, type: fixed, position: [0.4 mm, -1 mm], heading: 0, r: 0.2 mm}\n")
+    path.write_text(diff)
+    line = _out(capsys, ["analyze", str(path)]).out.splitlines()[1]
+    assert line.startswith("  ICR anywhere on the line through (")
+    x, y, ux, uy = _numbers(line)
+    assert abs(x - 0.0004) < 1e-5 and y == 0 and (ux, uy) == (0, 1)  # 1 % of its 1 mm size
+    path.write_text(diff + "  - {name: f, type: steerable, position: [3 mm, 0], heading: 20 deg, r: 0.2 mm}\n")
+    line = _out(capsys, ["analyze", str(path)]).out.splitlines()[1]
+    t = 0.0026 / math.sin(math.radians(20))  # along the front axle from (3 mm, 0) to x = 0.4 mm
+    (x, y), size = _numbers(line), 0.0026  # the wheels' spread about their centroid is below 2.6 mm
+    assert abs(x - 0.0004) < 0.01 * size and abs(y - t * math.cos(math.radians(20))) < 0.01 * size, line
+
+
+def test_a_robot_of_metres_keeps_its_icr_in_millimetres(capsys):
+    """A robot of metres (the §4.6 tricycle): 3 decimals, as before."""
+    line = _out(capsys, ["analyze", "thesis-tricycle-ch4"]).out.splitlines()[1]
+    assert re.fullmatch(r"  ICR at \(-?\d+\.\d{3}, -?\d+\.\d{3}\) m", line), line

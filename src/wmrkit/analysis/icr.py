@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -73,6 +73,8 @@ class ICRSet:
     # wheel that misses most with its miss [rad] (rounded headings, not a robot that cannot move)
     consistent: tuple[tuple[str, float], ...] | None = None
     miss: tuple[str, float] | None = None
+    #: decimals of the coordinates [m] in :meth:`describe` (:func:`coordinate_decimals` of the robot: 3 from 10 cm up)
+    decimals: int = field(default=3, compare=False)
 
     def homogeneous(self) -> np.ndarray | None:
         """The ICR as a homogeneous point ``(x, y, w)``: the point (w = 1), at infinity (w = 0, perpendicular to the
@@ -88,14 +90,16 @@ class ICRSet:
 
     def describe(self) -> str:
         """One line for people, e.g. ``ICR at (0.000, -2.747) m``."""
-        f = format_coordinate
+        f = functools.partial(format_coordinate, decimals=self.decimals)
         if self.kind == "point":
             return f"ICR at ({f(self.point[0])}, {f(self.point[1])}) m"
         if self.kind == "infinity":
-            return f"ICR at infinity: translation only, along +-({f(self.direction[0])}, {f(self.direction[1])})"
+            u = format_coordinate  # a unit vector: 3 decimals at any scale
+            return f"ICR at infinity: translation only, along +-({u(self.direction[0])}, {u(self.direction[1])})"
         if self.kind == "line":
             lx, ly, d = self.line
-            return f"ICR anywhere on the line through ({f(d * ly)}, {f(-d * lx)}) m along ({f(lx)}, {f(ly)})"
+            return (f"ICR anywhere on the line through ({f(d * ly)}, {f(-d * lx)}) m along ({format_coordinate(lx)}, "
+                    f"{format_coordinate(ly)})")
         if self.kind == "plane":
             return "ICR anywhere in the plane (no wheel axle constrains it)"
         text = "no ICR: the robot cannot move without slipping"
@@ -114,10 +118,17 @@ ROUNDING = math.radians(0.5)
 ROUNDING_W = 1e3 * np.finfo(float).eps
 
 
-def format_coordinate(x: float) -> str:
-    """`x` with 3 decimals, never "-0.000" (the ICR texts)."""
-    text = f"{x:.3f}"
-    return "0.000" if text == "-0.000" else text
+def format_coordinate(x: float, decimals: int = 3) -> str:
+    """`x` with `decimals` decimals, never "-0.000" (the ICR texts)."""
+    text = f"{x:.{decimals}f}"
+    return text.removeprefix("-") if float(text) == 0 else text
+
+
+def coordinate_decimals(robot: Robot) -> int:
+    """Decimals that show an ICR's coordinates [m] to 1 % of the robot's size (``characteristic_length``), at
+    least 3 (mm): a 2 mm robot's ICR at (0.4 mm, 7.1 mm) read ``(0.000, 0.007)``, its axle ``through (0.000,
+    0.000)``."""
+    return max(3, math.ceil(-math.log10(0.01 * characteristic_length(robot))))
 
 
 def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None,
@@ -128,7 +139,11 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
     `geared`: with the robot's ``gear`` couplings held (as ``analyze``, ``fk`` and the actuation analysis hold them):
     the ICR also lies on the line each gear adds (:func:`.lines.constraint_lines` with ``coupled``), e.g. the line
     of ICRs two omni wheels' spins on one gear leave, or the one point a solid axle's ratio fixes."""
-    beta = configuration(robot, beta, heading)
+    found = _admissible(robot, configuration(robot, beta, heading), geared)
+    return replace(found, decimals=coordinate_decimals(robot))
+
+
+def _admissible(robot: Robot, beta: np.ndarray, geared: bool) -> ICRSet:
     cl = constraint_lines(robot, coupled=geared and any(c.kind == "gear" for c in robot.couplings))
     g = cl.lines(beta)
     rank = line_rank(robot, g)
