@@ -16,7 +16,15 @@ from ..plotting.robot import draw_robot
 from ..robot import Robot
 from ..wheels import heading_from_beta
 from .classification import Classification
-from .icr import icr, line_rank, meeting_point, steer_to_icr, twist_of_icr
+from .icr import (
+    coordinate_decimals,
+    format_coordinate,
+    icr,
+    line_rank,
+    meeting_point,
+    steer_to_icr,
+    twist_of_icr,
+)
 from .isotropy import condition_map, natural_length, twist_condition_number
 from .lines import common_point, constraint_lines
 from .singularity import SingularSet, robot_size
@@ -141,6 +149,7 @@ def motions_figure(robot: Robot, cls: Classification) -> Figure | None:
     if not samples:
         return None
     size = robot_size(robot)
+    decimals = coordinate_decimals(robot) - 1  # cm from 10 cm up, as analyze's ICR text to 10 % of the size
     n = len(samples)
     cols = 2 if n > 1 else 1
     fig = Figure(figsize=(5 * cols, 4.6 * math.ceil(n / cols)), dpi=90, layout="constrained")
@@ -155,9 +164,10 @@ def motions_figure(robot: Robot, cls: Classification) -> Figure | None:
             c = h[:2] / h[2]
             for w in robot.wheels:
                 ax.plot([w.position[0], c[0]], [w.position[1], c[1]], color=ICR_COLOR, linewidth=0.6, alpha=0.5)
-        what = "translation" if abs(h[2]) < 1e-12 else f"turn about ({h[0] / h[2]:.2f}, {h[1] / h[2]:.2f}) m"
+        c = [format_coordinate(v / h[2], decimals) for v in h[:2]] if abs(h[2]) >= 1e-12 else None
+        what = f"turn about ({c[0]}, {c[1]}) m" if c else "translation"
         headings = robot.heading_of_beta(beta)
-        steer = ", ".join(f"{n} {math.degrees(b):.0f}°" for n, b in zip(robot.steer_names, headings, strict=True)
+        steer = ", ".join(f"{n} {round(math.degrees(b)):d}°" for n, b in zip(robot.steer_names, headings, strict=True)
                           if n in set(constraint_lines(robot).wheels))
         what += f"; {far}" if far and abs(h[2]) > 1e-12 else ""
         ax.set_title(what + (f"\nheadings: {steer}" if steer else ""), fontsize=9)
