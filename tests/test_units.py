@@ -20,6 +20,7 @@ FACTORS = {
               "ft/s": 0.3048, "in/s": 0.0254},
     "angular rate": {"rad/s": 1.0, "mrad/s": 0.001, "deg/s": math.pi / 180, "°/s": math.pi / 180,
                      "rpm": 2 * math.pi / 60, "rev/s": 2 * math.pi, "turn/s": 2 * math.pi},
+    "time": {"s": 1.0, "ms": 0.001, "us": 1e-6, "\u00b5s": 1e-6, "ns": 1e-9},
 }
 
 
@@ -29,8 +30,8 @@ def _kind(unit: str) -> str:
 
 def test_the_unit_tables_are_the_documented_ones():
     assert {k: set(v) for k, v in UNITS.items()} == {**{k: set(v) for k, v in FACTORS.items()}, "number": set()}
-    assert [si_unit(k) for k in ("length", "angle", "speed", "angular rate", "number")] == ["m", "rad", "m/s",
-                                                                                           "rad/s", ""]
+    assert [si_unit(k) for k in ("length", "angle", "speed", "angular rate", "time", "number")] == [
+        "m", "rad", "m/s", "rad/s", "s", ""]
 
 
 @pytest.mark.parametrize(("text", "kind", "si"), [
@@ -78,6 +79,9 @@ def test_angles_within_a_turn_or_with_a_unit_are_read(value):
     ("1 m", "number", "'1 m' is a length, expected a number"),
     ("3 furlong", "length", "unknown unit 'furlong' in '3 furlong' (accepted: m, mm, cm, dm, km, um, \u00b5m, in, ft)"),
     ("3 x", "number", "unknown unit 'x' in '3 x' (accepted: none (a plain number))"),
+    ("10 m", "time", "'10 m' is a length, expected a time"),  # 'm' is no minute
+    ("10 ms", "speed", "'10 ms' is a time, expected a speed"),  # nor 'ms' a metre per second
+    ("10 min", "time", "unknown unit 'min' in '10 min' (accepted: s, ms, us, \u00b5s, ns)"),
     ("pi/2", "angle", "cannot read 'pi/2' as an angle (write e.g. '1.57' or '90 deg')"),
     ("90 deg deg", "angle", "cannot read '90 deg deg' as an angle (write e.g. '1.57' or '90 deg')"),
     ("", "length", "cannot read '' as a length (write e.g. '0.25' or '250 mm')"),
@@ -124,7 +128,8 @@ def test_micrometres_are_read(text):
 # Exact decimal factors of the units that have one, written out independently of units.py.
 DECIMAL_FACTORS = {"mm": "0.001", "cm": "0.01", "dm": "0.1", "km": "1000", "um": "0.000001", "\u00b5m": "0.000001",
                    "\u03bcm": "0.000001", "in": "0.0254", "ft": "0.3048", "mrad": "0.001", "mm/s": "0.001",
-                   "cm/s": "0.01", "mph": "0.44704", "ft/s": "0.3048", "in/s": "0.0254", "mrad/s": "0.001"}
+                   "cm/s": "0.01", "mph": "0.44704", "ft/s": "0.3048", "in/s": "0.0254", "mrad/s": "0.001",
+                   "ms": "0.001", "us": "0.000001", "\u00b5s": "0.000001", "ns": "0.000000001"}
 
 
 @pytest.mark.parametrize("unit", sorted(DECIMAL_FACTORS))

@@ -45,6 +45,8 @@ def _run(capsys, argv: list[str], code: int = 0) -> tuple[dict, list[str]]:
 @pytest.mark.parametrize("options", [
     ["--method", "wls"], ["--method", "wls", "--mu-default", "1,0.2", "--scheme", "rk2"],
     ["--method", "fk2"], ["--method", "fk2", "--kf-noise", "0.05", "0.5", "0.1", "--thesis-double-q"],
+    ["--method", "fk2", "--kf-period", "10 ms"],  # 5 periods a 20 Hz step
+    ["--method", "fk2", "--kf-period", "0.2"],  # 4 times the logs' intervals: a warning line in each row
 ])
 def test_each_row_is_what_wmrkit_odometry_gives_that_log(capsys, skid_logs, options):
     data, _ = _run(capsys, ["batch", "odometry", "skid-steer-4", str(skid_logs), "--workers", "0", "--json",
@@ -81,7 +83,7 @@ def test_a_rerun_redoes_the_logs_only_when_the_estimator_changed(capsys, skid_lo
     again, _ = _run(capsys, [*base, "--method", "fk2"])
     assert (first["skipped"], again["skipped"]) == (0, 2)
     for changed in (["--method", "fk2", "--kf-noise", "0.1", "1", "1"], ["--method", "wls"],
-                    ["--method", "fk2", "--scheme", "euler"]):
+                    ["--method", "fk2", "--scheme", "euler"], ["--method", "fk2", "--kf-period", "10 ms"]):
         redone, _ = _run(capsys, [*base, *changed])
         assert redone["skipped"] == 0, changed
 
@@ -109,6 +111,8 @@ def test_fk1_says_where_its_rows_do_not_fix_the_twist_in_the_row(capsys, tmp_pat
     (["--method", "exact", "--scheme", "rk2"], "--scheme applies to --method wls, fk1 or fk2"),
     (["--method", "fk2", "--mu-default", "1,1"], "--mu-default applies to --method wls, not to --method fk2"),
     (["--method", "wls", "--kf-noise", "1", "1", "1"], "--kf-noise applies to --method fk1 or fk2"),
+    (["--method", "wls", "--kf-period", "10 ms"], "--kf-period applies to --method fk1 or fk2"),
+    (["--method", "fk2", "--kf-period", "10 m"], "--kf-period: '10 m' is a length, expected a time"),
     (["--method", "fk1"], "fk1: the sensed rows of robot 'skid-steer-4' do not determine its twist"),
     (["--method", "wls", "--mu", "nope=1,1"], "--mu nope: robot 'skid-steer-4' has no wheel 'nope'"),
     (["--imu-mount", "0", "0", "1"], "--imu-mount applies to the IMU of ROS 2 bags; none of the 2 logs is one"),

@@ -164,16 +164,16 @@ def process_log(job: LogJob) -> dict[str, Any]:
             s = odometry_file(job.robot, job.path, method=job.method, out=job.trajectory, model=estimator or model,
                               sinks=[check] if check else (), check=check.judge if check else None, **options)
             diagnosis = _diagnose(job, s, model, options)
-            conditioning = estimator.conditioning_warning() if isinstance(estimator, KalmanEstimator) else None
+            filtered = estimator.notes() if isinstance(estimator, KalmanEstimator) else []
         except Exception as err:  # what was said before it failed stays said (wmrkit odometry says it too)
             said = [" ".join(str(w.message).split()) for w in caught] + ([unread] if unread else [])
             row.update(error=_message(err), trajectory=None, warnings="; ".join(said) or None,
                        wall_time=time.perf_counter() - t0)
             return row
     x, y, theta = s.final_pose
-    notes = [" ".join(str(w.message).split()) for w in caught] + list(diagnosis.warnings)
-    if conditioning:  # a filter's rows barely fixing the twist at a steering heading of this log
-        notes.append(conditioning)
+    # a filter's notes (its rows barely fixing the twist at a steering heading of this log, its period), then the
+    # diagnosis, in wmrkit odometry's order
+    notes = [" ".join(str(w.message).split()) for w in caught] + filtered + list(diagnosis.warnings)
     imu = check.topic if check and check.checked else None
     if check and check.mounting.note:  # the given mounting and the bag's /tf_static disagree
         notes.append(check.mounting.note)

@@ -187,7 +187,7 @@ def run(args: argparse.Namespace) -> int:
             written(what, path)
     if spec is not None:
         summary = replace(summary, method=spec.label)
-    if args.method in ("fk1", "fk2") and (line := slip_model.conditioning_warning()):
+    for line in slip_model.notes() if args.method in ("fk1", "fk2") else ():
         warn(line)
     names = parse_assignments(args.joint_name, "--joint-name")
     filtered = args.method if args.method in ("fk1", "fk2") else None

@@ -16,6 +16,7 @@ from ._common import (
     add_robot_argument,
     load_robot,
     parse_assignments,
+    parse_value,
     print_json,
     seed,
 )
@@ -41,6 +42,10 @@ def add_estimator_options(p: argparse.ArgumentParser) -> None:
                    help="FK1/FK2: process noise (the thesis's k13, (7.68)) [m/s per nominal sample period] and "
                         "the lateral / longitudinal row noise [m/s] (default: the description's odometry.noise, "
                         "else 1 1 1)")
+    g.add_argument("--kf-period", metavar="TIME",
+                   help="FK1/FK2: the nominal sample period T of the process noise, seconds or with a unit ('10 ms'): "
+                        "a step of n = max(1, round(dt / T)) periods adds n Q (default: the description's "
+                        "odometry.noise.period, else the median of the log's first 1000 intervals)")
     g.add_argument("--kf-wheel", action="append", metavar="WHEEL=LAT,LONG", default=[],
                    help="FK1/FK2: row noise of one wheel (default: the wheel's slip.noise in the description, "
                         "else --kf-noise's; repeat)")
@@ -163,8 +168,8 @@ def check_estimator_options(args: argparse.Namespace) -> None:
     friction coefficients belong to wls, the noises to fk1 and fk2."""
     groups = {("wls",): {"--mu": args.mu, "--mu-default": args.mu_default is not None,
                          "--slip-weights": args.slip_weights},
-              ("fk1", "fk2"): {"--kf-noise": args.kf_noise, "--kf-wheel": args.kf_wheel,
-                               "--thesis-double-q": args.thesis_double_q}}
+              ("fk1", "fk2"): {"--kf-noise": args.kf_noise, "--kf-period": args.kf_period is not None,
+                               "--kf-wheel": args.kf_wheel, "--thesis-double-q": args.thesis_double_q}}
     for applies, given in groups.items():
         option = next((o for o, value in given.items() if value), None)
         if option is not None and args.method not in applies:
@@ -175,7 +180,7 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
     """The estimator of ``--method wls|fk1|fk2`` (:class:`~wmrkit.slip.estimators.EstimatorSpec`, integrated by
     ``--scheme``) with its options over the description's `settings`, checked by building it once."""
     from ..slip.estimators import EstimatorSpec
-    from ..slip.kalman import noise_from_options
+    from ..slip.kalman import check_period, noise_from_options
 
     if getattr(args, "weight", None):
         other = "--mu WHEEL=LAT,LONG" if args.method == "wls" else "--kf-wheel WHEEL=LAT,LONG"
@@ -189,8 +194,11 @@ def estimator_from_args(robot: Robot, args: argparse.Namespace, settings=None):
     for n, v in parse_assignments(args.kf_wheel, "--kf-wheel").items():
         _check_wheel(robot, n, "--kf-wheel")
         wheels[n] = _pair(v, f"--kf-wheel {n}")
+    period = described.period if described else None
+    if args.kf_period is not None:  # a time with its unit, then the filter's range, named by the option
+        period = check_period(parse_value(args.kf_period, "time", "--kf-period"), "--kf-period")
     try:
-        noise = noise_from_options(k[0], k[1], k[2], wheels) if args.method != "wls" else None
+        noise = noise_from_options(k[0], k[1], k[2], wheels, period) if args.method != "wls" else None
     except WmrkitError as e:  # the description's noise was checked when it was read: an option is at fault
         given = [o for o, v in (("--kf-noise", args.kf_noise), ("--kf-wheel", args.kf_wheel)) if v]
         raise WmrkitError(f"{' with '.join(given)}: {e}") from None

@@ -12,7 +12,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -38,6 +38,9 @@ from .kalman import (
 from .weights import SlipWeights, wls_model
 
 ESTIMATORS = ("wls", *FILTERS)
+#: A filter's given nominal sample period more than this times the log's is said (:meth:`KalmanEstimator.
+#: period_warning`): the log's steps then all round to one period (n = 1 below 1.5 T).
+PERIOD_MISMATCH = 2.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -46,6 +49,8 @@ class KalmanEstimator:
 
     model: KalmanModel
     name: str = "fk2"
+    # the nominal period of the log last run (its first intervals' median, :func:`.kalman.nominal_period`)
+    _seen: dict = field(init=False, default_factory=dict, compare=False, repr=False)
 
     @property
     def joints(self) -> tuple[str, ...]:
@@ -74,6 +79,22 @@ class KalmanEstimator:
         return (f"{self.name}: {at}its measurement rows {fix}: there the filter carries its prediction and the "
                 f"trajectory can be far off{'; use --method fk2 or wls' if self.name == 'fk1' else ''}")
 
+    def period_warning(self) -> str | None:
+        """The line saying that the nominal sample period T given the filter (:attr:`~.kalman.KalmanNoise.period`)
+        is more than :data:`PERIOD_MISMATCH` times the log's (the median of its first intervals): every step
+        shorter than 1.5 T counts one period of ``Q``, so each of the log's steps gets about T / (its period) times
+        the process noise it spans; None when no period was given or it is within that factor."""
+        given, log = self.model.period, self._seen.get("period")
+        if given is None or log is None or given <= PERIOD_MISMATCH * log:
+            return None
+        return (f"{self.name}: the nominal sample period of the process noise, {given:g} s, is {given / log:.3g} times "
+                f"the log's ({log:g} s, the median of its first {PERIOD_INTERVALS} intervals): every step counts "
+                f"as one period (n = 1), about {given / log:.3g} times the process noise it spans")
+
+    def notes(self) -> list[str]:
+        """The warning lines of the last run: :meth:`conditioning_warning`, :meth:`period_warning`."""
+        return [line for line in (self.conditioning_warning(), self.period_warning()) if line]
+
     def _checked(self, chunks: Iterable[JointLog]) -> Iterator[JointLog]:
         """The non-empty chunks, with the filter's columns, each checked (:func:`.kalman.check_log`)."""
         prev = None
@@ -93,6 +114,8 @@ class KalmanEstimator:
         x = p = None
         n_total, t0, t1, dist, rot, max_slip, sq, max_dt = 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
         period, checked = _first_period(self._checked(chunks))
+        self._seen["period"] = period
+        period = period if self.model.period is None else self.model.period
         for chunk in checked:
             if prev is None:
                 t0 = float(chunk.time[0])

@@ -2,7 +2,8 @@
 
 State: the body twist ``x = (vx, vy, omega)``, a random walk (7.68) with process variance ``Q = k13^2 I`` per
 sample of the log's nominal period T, and ``n Q`` over a step of ``n = max(1, round(dt / T))`` periods (a wmrkit
-extension for gaps, ``docs/errata.md``: the thesis samples uniformly; T defaults to :func:`nominal_period`).
+extension for gaps, ``docs/errata.md``: the thesis samples uniformly; T is :attr:`KalmanNoise.period` when given,
+else :func:`nominal_period`).
 Measurements: the no-slip rows (3.22) that hold only the twist and sensed rates, ``A_p x = -A_a qdot_a`` (the rows
 (7.69)/(7.70): a wheel's rolling row is a wheel-speed reading, a lateral row a pseudo-measurement with the steering
 angle inside ``C``), with noise ``R = diag(sigma^2)`` per row. Rows with an
@@ -50,18 +51,36 @@ PERIOD_INTERVALS = 1000
 MAX_SPREAD, NOISE_RANGE = 1e6, (1e-150, 1e150)
 
 
+#: The nominal sample periods T [s] a filter accepts (:func:`check_period`): 1 ns (a log's finest time unit) to a day.
+PERIOD_RANGE = (1e-9, 86400.0)
+
+
+def check_period(period: object, name: str = "period") -> float:
+    """`period` [s], the nominal sample period T of ``Q``, as a float: a real number (SI seconds; a unit string is the
+    CLI's and the description's, which read it) in :data:`PERIOD_RANGE`, else :class:`WmrkitError` naming `name`."""
+    lo, hi = PERIOD_RANGE
+    if isinstance(period, bool) or not (finite_number(period) and lo <= period <= hi):  # type: ignore[operator]
+        raise WmrkitError(f"{name}: the nominal sample period must be a finite number of seconds in [{lo:g}, {hi:g}], "
+                          f"got {period!r}")
+    return float(period)  # type: ignore[arg-type]
+
+
 @dataclass(frozen=True, slots=True)
 class KalmanNoise:
     """Noise of the velocity filter: ``process`` (k13) [m/s per nominal sample period, rad/s for omega],
     ``lateral`` and ``longitudinal`` standard deviations [m/s] of every wheel's rows, per wheel in ``wheels``
-    ``((name, lateral, longitudinal), ...)``."""
+    ``((name, lateral, longitudinal), ...)``; ``period``: the nominal sample period T [s] of ``process`` (None: the
+    log's, :func:`nominal_period`)."""
 
     process: float = 1.0
     lateral: float = 1.0
     longitudinal: float = 1.0
     wheels: tuple[tuple[str, float, float], ...] = ()
+    period: float | None = None
 
     def __post_init__(self) -> None:
+        if self.period is not None:
+            check_period(self.period, "Kalman noise period")
         named = (("process", self.process), ("lateral", self.lateral), ("longitudinal", self.longitudinal),
                  *((f"{w} ({d})", x) for w, a, b in self.wheels for d, x in (("lateral", a), ("longitudinal", b))))
         lo, hi = NOISE_RANGE
@@ -105,6 +124,8 @@ class KalmanModel:
     thesis_double_q: bool = False
     #: (n_velocities, p): the turns of the gears with no known joint (None: no such gear in the kept rows)
     gears: np.ndarray | None = None
+    #: the nominal sample period T [s] of ``process`` (:attr:`KalmanNoise.period`; None: the log's)
+    period: float | None = None
     # matrices per steering configuration met so far; not an init field, so dataclasses.replace starts a new one
     _cache: dict = field(init=False, default_factory=dict, compare=False, repr=False)
     # the worst-conditioned configuration met so far: {"condition": kappa, "config": (s,) angles}
@@ -217,7 +238,7 @@ def kalman_model(robot: Robot, kind: str = "fk2", noise: KalmanNoise | None = No
     rows_a = np.array(rows, dtype=int)
     if gears is not None and not np.any(a[:, rows_a] @ gears):
         gears = None  # no kept row turns with the gear: nothing to eliminate
-    model = KalmanModel(base, rows_a, np.array(sigma), float(noise.process) ** 2, thesis_double_q, gears)
+    model = KalmanModel(base, rows_a, np.array(sigma), float(noise.process) ** 2, thesis_double_q, gears, noise.period)
     if np.linalg.matrix_rank(model.matrices(probe[:1])[2][0]) < 3:  # the random walk would carry those directions
         dropped = " (fk1 leaves out the lateral rows of fixed wheels, (7.69): use fk2)" if kind == "fk1" else ""
         raise WmrkitError(f"{kind}: the sensed rows of robot '{robot.name}' do not determine its twist{dropped}")
@@ -265,7 +286,8 @@ def kalman_filter(model: KalmanModel, log: JointLog, *, x0: ArrayLike | None = N
 
     `x0` defaults to the least-squares twist of the first interval, `p0` to Q (the spec's choice; the thesis
     gives neither). Rates are the increments over each interval divided by its duration. `period`: the nominal
-    sample period T [s] of Q, default :func:`nominal_period` of `log` (module docstring).
+    sample period T [s] of Q (a number of seconds, :func:`check_period`), default the model's noise's
+    (:attr:`KalmanNoise.period`), else :func:`nominal_period` of `log` (module docstring).
     """
     check_log(_selected(model, log))
     return _filter(model, log, x0, p0, period)
@@ -276,19 +298,20 @@ def _filter(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLi
     """:func:`kalman_filter` on a log already checked (:func:`check_log`)."""
     t = np.asarray(log.time, dtype=float)
     increments = np.empty((max(len(t) - 1, 0), 3))
-    period = _period(period, t)
+    period = _period(model, period, t)
     slip, filt = _run(model, log, x0, p0, increments, np.empty((0, 3)), np.zeros(7), "exact", period)
     p = filt[[3, 4, 5, 4, 6, 7, 5, 7, 8]].reshape(3, 3)
     return KalmanRun(increments / np.diff(t)[:, None], increments, p, slip, period)
 
 
-def _period(period: float | None, time: np.ndarray) -> float:
-    """`period` [s] checked, or the nominal one of a log sampled at `time` (:func:`nominal_period`)."""
+def _period(model: KalmanModel, period: float | None, time: np.ndarray) -> float:
+    """`period` [s] checked, else `model`'s (its noise's), else the nominal one of a log sampled at `time`
+    (:func:`nominal_period`)."""
+    if period is None:
+        period = model.period
     if period is None:
         return nominal_period(time) if len(time) >= 2 else 1.0  # one sample: refused by _run
-    if not (finite_number(period) and period > 0):
-        raise WmrkitError(f"period: the nominal sample period must be a finite number of seconds > 0, got {period}")
-    return float(period)
+    return check_period(period)
 
 
 def _run(model: KalmanModel, log: JointLog, x0: ArrayLike | None, p0: ArrayLike | None, increments: np.ndarray,
@@ -348,7 +371,7 @@ def kalman_odometry(model: KalmanModel, log: JointLog, *, method: Method = "exac
     slip = np.empty(n)
     slip[0] = 0.0
     slip[1:] = _run(model, log, x0, p0, np.empty((0, 3)), poses[1:], np.concatenate([pose0, np.zeros(4)]), method,
-                    _period(period, np.asarray(log.time, dtype=float)))[0]
+                    _period(model, period, np.asarray(log.time, dtype=float)))[0]
     return Trajectory(np.asarray(log.time, dtype=float), poses, slip)
 
 
@@ -370,7 +393,8 @@ def _selected(model: KalmanModel, log: JointLog) -> JointLog:
 
 
 def noise_from_options(process: float, lateral: float, longitudinal: float,
-                       wheels: Mapping[str, tuple[float, float]] | None = None) -> KalmanNoise:
+                       wheels: Mapping[str, tuple[float, float]] | None = None,
+                       period: float | None = None) -> KalmanNoise:
     """A :class:`KalmanNoise` from plain numbers (the CLI's options)."""
     return KalmanNoise(process, lateral, longitudinal, tuple((k, float(a), float(b))
-                                                            for k, (a, b) in (wheels or {}).items()))
+                                                            for k, (a, b) in (wheels or {}).items()), period)

@@ -6,7 +6,8 @@ A description may say how ``wmrkit odometry`` estimates the robot's motion (``do
       method: wls                 # exact | rk2 | euler | paper002 (no-slip model) | wls | fk1 | fk2
       scheme: exact               # integration of the estimated twists (wls, fk1, fk2)
       slip: {lateral: 1, longitudinal: 1}                  # friction coefficients (7.59) of the wheels below
-      noise: {process: 1, lateral: 1, longitudinal: 1}     # FK1/FK2 noise (7.77): k13 and row std-devs [m/s]
+      noise: {process: 1, lateral: 1, longitudinal: 1, period: 10 ms}   # FK1/FK2 noise (7.77): k13 per nominal
+                                  # sample period T (default: the log's) and row std-devs [m/s]
     wheels:
       - name: right_drive
         ...
@@ -38,7 +39,8 @@ class OdometrySettings:
     """What a description says about its odometry; every field None (or empty) when not said.
 
     ``slip``: default ``(mu_lateral, mu_longitudinal)``; ``wheel_slip``: ``((wheel, lateral, longitudinal), ...)``;
-    ``noise``: default ``(process, lateral, longitudinal)``; ``wheel_noise``: ``((wheel, lateral, longitudinal), ...)``.
+    ``noise``: default ``(process, lateral, longitudinal)``; ``wheel_noise``: ``((wheel, lateral, longitudinal), ...)``;
+    ``period``: the nominal sample period T [s] of the process noise.
     """
 
     method: str | None = None
@@ -47,6 +49,7 @@ class OdometrySettings:
     wheel_slip: tuple[tuple[str, float, float], ...] = ()
     noise: tuple[float, float, float] | None = None
     wheel_noise: tuple[tuple[str, float, float], ...] = ()
+    period: float | None = None
 
     def weights(self):
         """The WLS friction coefficients as :class:`~wmrkit.slip.weights.SlipWeights` (unit when not said)."""
@@ -58,7 +61,7 @@ class OdometrySettings:
         """The FK1/FK2 noise as :class:`~wmrkit.slip.kalman.KalmanNoise` (unit when not said)."""
         from .kalman import KalmanNoise
 
-        return KalmanNoise(*(self.noise or (1.0, 1.0, 1.0)), self.wheel_noise)
+        return KalmanNoise(*(self.noise or (1.0, 1.0, 1.0)), self.wheel_noise, self.period)
 
 
 def settings_from_dict(data: Mapping[str, Any], check: Any) -> OdometrySettings:
@@ -67,20 +70,22 @@ def settings_from_dict(data: Mapping[str, Any], check: Any) -> OdometrySettings:
     loc: tuple[str | int, ...] = ("odometry",)
     if not isinstance(block, Mapping):
         check.fail("must be a mapping {method, scheme, slip: {lateral, longitudinal}, noise: {process, lateral, "
-                   "longitudinal}}", loc)
+                   "longitudinal, period}}", loc)
     check.reject_unknown(block, BLOCK_FIELDS, loc)
     method = _choice(block, "method", METHODS, check, loc)
     scheme = _choice(block, "scheme", SCHEMES, check, loc)
     slip = _pair(block["slip"], check, (*loc, "slip"), ("noise",)) if "slip" in block else None
-    noise = None
+    noise = period = None
     if "noise" in block:
         item = block["noise"]
         if not isinstance(item, Mapping):
-            check.fail("must be a mapping {process, lateral, longitudinal} of standard deviations [m/s]",
-                       (*loc, "noise"))
-        check.reject_unknown(item, ("process", "lateral", "longitudinal"), (*loc, "noise"))
+            check.fail("must be a mapping {process, lateral, longitudinal} of standard deviations [m/s] and the "
+                       "nominal sample period of process [s]", (*loc, "noise"))
+        check.reject_unknown(item, ("process", "lateral", "longitudinal", "period"), (*loc, "noise"))
         noise = tuple(_positive(item.get(k, 1.0), check, (*loc, "noise", k))
                       for k in ("process", "lateral", "longitudinal"))
+        if "period" in item:
+            period = _period(item["period"], check, (*loc, "noise", "period"))
     wheel_slip, wheel_noise = [], []
     noise_at = [(*loc, "noise")] if noise is not None else []
     for i, item in enumerate(data.get("wheels", [])):
@@ -93,7 +98,8 @@ def settings_from_dict(data: Mapping[str, Any], check: Any) -> OdometrySettings:
         if "noise" in item["slip"]:
             wheel_noise.append((name, *_pair(item["slip"]["noise"], check, (*where, "noise"), ())))
             noise_at.append((*where, "noise"))
-    settings = OdometrySettings(method, scheme, slip, tuple(wheel_slip), noise, tuple(wheel_noise))  # type: ignore[arg-type]
+    settings = OdometrySettings(method, scheme, slip, tuple(wheel_slip), noise, tuple(wheel_noise),  # type: ignore[arg-type]
+                                period)
     _check_slip_spread(data, settings, check)
     if noise_at:
         try:
@@ -147,6 +153,8 @@ def settings_to_dict(settings: OdometrySettings) -> dict[str, Any]:
         block["slip"] = {"lateral": settings.slip[0], "longitudinal": settings.slip[1]}
     if settings.noise is not None:
         block["noise"] = dict(zip(("process", "lateral", "longitudinal"), settings.noise, strict=True))
+        if settings.period is not None:
+            block["noise"]["period"] = settings.period
     wheels: dict[str, Any] = {n: {"slip": {"lateral": a, "longitudinal": b}} for n, a, b in settings.wheel_slip}
     for n, a, b in settings.wheel_noise:
         wheels.setdefault(n, {"slip": {}})["slip"]["noise"] = {"lateral": a, "longitudinal": b}
@@ -177,6 +185,18 @@ def _pair(item: Any, check: Any, loc: tuple, extra: tuple[str, ...]) -> tuple[fl
     check.reject_unknown(item, ("lateral", "longitudinal", *extra), loc)
     return (_positive(check.require(item, "lateral", loc), check, (*loc, "lateral")),
             _positive(check.require(item, "longitudinal", loc), check, (*loc, "longitudinal")))
+
+
+def _period(value: Any, check: Any, loc: tuple) -> float:
+    """``noise.period``: a time [s, or with a unit: '10 ms'] in the filters' range (:func:`.kalman.check_period`)."""
+    from .kalman import check_period
+
+    seconds = check.quantity(value, "time", loc)
+    try:
+        return check_period(seconds, "period")
+    except WmrkitError as err:
+        check.fail(str(err).removeprefix("period: "), loc)
+        raise AssertionError from None  # unreachable: fail raises
 
 
 def _positive(value: Any, check: Any, loc: tuple) -> float:
