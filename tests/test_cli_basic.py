@@ -261,7 +261,7 @@ def test_odometry_options_a_description_may_default_say_so():
     `--kf-wheel` said nothing of their defaults."""
     from cli_options import options
 
-    described = ("--method", "--scheme", "--mu", "--mu-default", "--kf-noise", "--kf-wheel")
+    described = ("--method", "--scheme", "--mu", "--mu-default", "--kf-noise", "--kf-period", "--kf-wheel")
     helps = {a.option_strings[-1]: a.help for words, a in options() if words == ("odometry",)}
     assert [o for o in described if "description" not in helps[o]] == []
 

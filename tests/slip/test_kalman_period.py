@@ -123,11 +123,10 @@ def test_bad_periods_are_refused_by_name(capsys, log_file, tmp_path, value, said
     path, _ = log_file
     error, lines = _run(capsys, ["odometry", "forklift", str(path), "--method", "fk2", "--kf-period", value,
                                  "--json"], 2)
-    assert error["error"].startswith(f"--kf-period: ") and said in error["error"] and len(lines) == 1
-    if value != "inf":  # YAML reads 'inf' as text, as the option does; nan too
-        with pytest.raises(DescriptionError, match=r"odometry\.noise\.period") as err:
-            catalog.resolve(_described(tmp_path, value))
-        assert said.removeprefix("got ") in str(err.value)
+    assert error["error"].startswith("--kf-period: ") and said in error["error"] and len(lines) == 1
+    with pytest.raises(DescriptionError, match=r"odometry\.noise\.period") as err:  # the same text in a file
+        catalog.resolve(_described(tmp_path, value))
+    assert said in str(err.value)
 
 
 def test_a_period_for_another_method_is_refused(capsys, log_file):
