@@ -101,9 +101,12 @@ def _real_array(x: object, name: str, angles: bool) -> np.ndarray:
             a = np.asarray(x)
             if a.dtype.kind in "fiu":
                 return a.astype(float, copy=False)
-            if a.dtype.kind == "O":
+            text = next((v for v in a.flat if isinstance(v, str | bytes)), None) if a.dtype.kind == "O" else None
+            if a.dtype.kind == "O" and text is None:
                 return a.astype(float)  # Fraction, Decimal; None reads as NaN, which the callers' checks refuse
             got = _REFUSED_KINDS.get(a.dtype.kind, f"values of type {a.dtype}")
+            if text is not None:  # [Fraction(1, 10), "30"] was read as 30 rad: text among numbers of an object array
+                got = f"the text {text!r}"
             if a.dtype.kind == "U":
                 got = f"the text {str(next((v for v in a.flat if not reads_as_number(v)), a.flat[0]))!r}"
         except (TypeError, ValueError, OverflowError):  # a ragged nested list, an element that is no number

@@ -21,7 +21,7 @@ from ..couplings import Coupling, GearWarning
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot
-from ..units import Kind, UnitError, parse_quantity
+from ..units import Kind
 from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
 from ._ik_fast import wrap_angle
@@ -300,18 +300,16 @@ def forward_kinematics(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Body twist from some joint rates: the rest solved by least squares, ranks method (4.9)-(4.11).
 
-    `rates`: name -> rate [rad/s] (or [m/s] for ``vx``/``vy``), each ``(...)``; names as in
+    `rates`: name -> rate [rad/s] (or [m/s] for ``vx``/``vy``), real numbers each ``(...)`` (text is refused: the
+    Python API reads no units; ``wmrkit.parse_quantity(text, rate_kind(name))`` reads it as the CLI); names as in
     :func:`resolve_rate_name`. Steering ``(..., n_steer)`` [rad] as the thesis's `beta` or the users' `heading`
     (default the described ones).
     Returns ``(twist_robot (..., 3), residual (...))``: the residual is the norm of the slip ``A q_dot`` [m/s]
     left by the assignment, 0 when the rates are consistent (the slip indicator of (4.11)/(4.82)). When the
     given rates do not determine the twist the minimum-norm one is returned: check :func:`twist_is_determined`.
     """
-    if not isinstance(rates, Mapping):  # an array was read as names ("numpy.float64 is not iterable")
-        raise ShapeError(f"rates: expected a mapping {{joint name: rate}} such as {{'{robot.rate_names[0]}': 10.0}}, "
-                         f"got {type(rates).__name__}")
-    columns = _assigned_columns(robot, list(rates))
-    given = {k: as_reals(_rate_value(k, v), f"rates: {k}") for k, v in rates.items()}
+    columns = _assigned_columns(robot, list(_mapping(robot, rates)))
+    given = {k: _rate_value(k, v) for k, v in rates.items()}
     try:
         values = np.broadcast_arrays(*given.values())
     except ValueError:
@@ -354,7 +352,8 @@ def forward_kinematics_check(
     robot: Robot, rates: Mapping[str, float], beta: ArrayLike | None = None, *, heading: ArrayLike | None = None,
     rtol: float = FK_SLIP_RTOL,
 ) -> ForwardKinematics:
-    """:func:`forward_kinematics` for one sample, with the slip split by wheel and judged against a tolerance.
+    """:func:`forward_kinematics` for one sample (`rates`: name -> one real number), with the slip split by wheel
+    and judged against a tolerance.
 
     The tolerance is `rtol` times the fastest speed a given rate stands for (:func:`_speed_per_rate`: a spin's
     ``|r phi_dot|``, a Swedish roller's ``|r_r phi_r_dot|``, a steering rate's contact speed, ``omega`` times the
@@ -368,8 +367,13 @@ def forward_kinematics_check(
     """
     if not (finite_number(rtol) and not isinstance(rtol, bool) and 0.0 <= rtol <= 1.0):
         raise ShapeError(f"rtol: expected a fraction of the fastest wheel's speed in [0, 1], got {rtol!r}")
-    columns = _assigned_columns(robot, list(rates))
-    q_assigned = np.array([float(_rate_value(k, v)) for k, v in rates.items()])
+    columns = _assigned_columns(robot, list(_mapping(robot, rates)))
+    given = {k: _rate_value(k, v) for k, v in rates.items()}
+    shaped = next((k for k, v in given.items() if v.size != 1), None)
+    if shaped is not None:  # float() of an array of two said "only length-1 arrays can be converted"
+        raise ShapeError(f"rates: {shaped}: expected one number (one sample; forward_kinematics takes arrays), got "
+                         f"shape {given[shaped].shape}")
+    q_assigned = np.array([float(v.reshape(())) for v in given.values()])
     _check_finite_rates(list(rates), q_assigned)
     a = robot.constraint_matrix(beta, heading=heading)
     q_dot, slip = robot_solve(robot, a, columns, q_assigned)
@@ -453,13 +457,24 @@ def rate_kind(name: str) -> Kind:
     return "speed" if name in ("vx", "vy") else "angular rate"
 
 
-def _rate_value(name: str, value: ArrayLike) -> ArrayLike:
-    if isinstance(value, str):  # e.g. from a file or the command line
-        try:
-            return parse_quantity(value, rate_kind(name))
-        except UnitError as err:
-            raise ShapeError(f"rates: {name}: {err}") from None
-    return value
+def _mapping(robot: Robot, rates: object) -> Mapping:
+    """`rates` if a mapping, else :class:`ShapeError` (an array was read as names: "numpy.float64 is not
+    iterable")."""
+    if not isinstance(rates, Mapping):
+        raise ShapeError(f"rates: expected a mapping {{joint name: rate}} such as {{'{robot.rate_names[0]}': 10.0}}, "
+                         f"got {type(rates).__name__}")
+    return rates
+
+
+def _rate_value(name: str, value: ArrayLike) -> np.ndarray:
+    """The rate `value` of `name` as a float array: real numbers in SI units (the Python API reads no units,
+    docs/conventions.md). Text, which was read here with its unit, is refused with the way to read it as
+    ``wmrkit fk --spin`` does (:func:`wmrkit.parse_quantity` of :func:`rate_kind`)."""
+    if isinstance(value, str):
+        raise ShapeError(f"rates: {name}: got the text {value!r}, but the Python API reads no units: pass real numbers "
+                         f"in {'m/s' if rate_kind(name) == 'speed' else 'rad/s'} (text as 'wmrkit fk --spin' reads "
+                         f"it: wmrkit.parse_quantity({value!r}, {rate_kind(name)!r}))")
+    return as_reals(value, f"rates: {name}")
 
 
 def _columns(rates: np.ndarray, select: slice | np.ndarray | None, batch: tuple[int, ...], n: int) -> np.ndarray:
