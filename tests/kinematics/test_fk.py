@@ -110,7 +110,7 @@ def test_names_resolve_and_bad_names_list_the_valid_ones():
         forward_kinematics(diff, {"left": 1.0, "left.spin": 1.0})
     with pytest.raises(ShapeError, match="at least one joint rate"):
         forward_kinematics(diff, {})
-    with pytest.raises(ShapeError, match=r"rates: left: cannot read 'fast'"):
+    with pytest.raises(ShapeError, match=r"rates: left: got the text 'fast', but the Python API reads no units"):
         forward_kinematics(diff, {"left": "fast"})
     zoo = Robot.from_dict({"name": "z", "wheels": [{"name": "d", "type": "double", "position": [0, 0], "b": 0.1,
                                                     "r": 0.05}]})
