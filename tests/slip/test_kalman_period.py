@@ -160,3 +160,15 @@ def test_a_period_far_longer_than_the_log_s_intervals_is_said_once(capsys, tmp_p
         assert "0.01 s" in warned[0] and "0.001 s" in warned[0] and "n = 1" in warned[0]
     est = estimator(fork, "fk1", noise=KalmanNoise(period=0.01))
     assert est.period_warning() is None  # nothing run yet
+
+
+def test_track_s_fk2_feedback_takes_the_period_of_its_noise():
+    """``track --feedback fk2`` filters one control period at a time with the description's noise: without a period
+    each control period is one T (as before); T = 0.01 s makes a 0.05 s period five of them."""
+    from wmrkit.control import track
+    from wmrkit.control.references import builtin_reference
+
+    fork, ref = catalog.load("forklift"), builtin_reference("circle", speed=1.0, size=3.0)
+    runs = {p: track(fork, ref, dynamics=True, period=0.05, duration=1.0, feedback="fk2", slip_model="mqe",
+                     noise=None if p is None else KalmanNoise(period=p)).estimate for p in (None, 0.05, 0.01)}
+    assert runs[None].tolist() == runs[0.05].tolist() and runs[0.01].tolist() != runs[None].tolist()
