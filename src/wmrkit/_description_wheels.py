@@ -10,7 +10,7 @@ import math
 import re
 import warnings
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .documents import DescriptionError, FieldReader, Loc, hint
 from .dynamics import mass
@@ -25,6 +25,9 @@ from .wheels import (
     heading_in_range,
     heading_limit,
 )
+
+if TYPE_CHECKING:
+    from .robot import Robot
 
 #: Types a description may use: the wheel kinds, and ``mecanum`` (a Swedish wheel with the standard rollers).
 WHEEL_TYPES = (*KINDS, "mecanum")
@@ -189,13 +192,17 @@ def _mecanum_from_dict(item: Mapping[str, Any], check: FieldReader, loc: Loc) ->
         data["r_r"] = r / 4
     wheel = _wheel_from_dict(data, check, loc, "swedish")
     if abs(abs(math.remainder(wheel.gamma, math.pi)) - MECANUM_GAMMA) > 1e-6:  # a roller line: gamma mod 180 deg
-        where = (*loc, "gamma")
-        warnings.warn(str(DescriptionError(
-            f"wheel '{wheel.name}' is of type mecanum with gamma {math.degrees(wheel.gamma):g} deg, not the +-45 deg "
-            "of Mecanum rollers" + (" (an omni wheel)" if abs(math.cos(wheel.gamma)) < 1e-6 else "") + ": write "
-            "'type: swedish' for this roller angle, or leave gamma out for the standard layout",
-            source=check.source, loc=where, line=check.line_of(where))), DescriptionWarning, stacklevel=2)
+        _warn(check, f"wheel '{wheel.name}' is of type mecanum with gamma {math.degrees(wheel.gamma):g} deg, not the "
+              "+-45 deg of Mecanum rollers" + (" (an omni wheel)" if abs(math.cos(wheel.gamma)) < 1e-6 else "") +
+              ": write 'type: swedish' for this roller angle, or leave gamma out for the standard layout",
+              (*loc, "gamma"))
     return wheel
+
+
+def _warn(check: FieldReader, message: str, loc: Loc) -> None:
+    """Say `message` as a :class:`DescriptionWarning` located at `loc` (``source:line: field: message``)."""
+    warnings.warn(str(DescriptionError(message, source=check.source, loc=loc, line=check.line_of(loc))),
+                  DescriptionWarning, stacklevel=3)
 
 
 class DescriptionWarning(UserWarning):
@@ -207,3 +214,25 @@ def _check_geometry(type_name: str, v: dict[str, float], check: FieldReader, loc
     problem = geometry_problem(type_name, v)
     if problem is not None:
         check.fail(problem[1], (*loc, problem[0]))
+
+
+def _warn_coincident(robot: Robot, items: list[Any], check: FieldReader) -> None:
+    """Say each wheel mounted where an earlier wheel is (closer than the round-off of the robot's size,
+    ``analysis.conditioning.ROUNDING`` ``L``; ``wmrkit analyze`` says the wider gaps up to ``NEAR L``): a wheel
+    copied and renamed but not moved, read as written. Not said for two wheels whose steering joints one gear or
+    linkage turns together (a double castor written as its two castors): the description says it on purpose."""
+    from .analysis.conditioning import ROUNDING
+    from .kinematics.linalg import characteristic_length
+
+    size = characteristic_length(robot)
+    steered = [{w.name for w in robot.wheels if f"{w.name}.steer" in c.joints} for c in robot.couplings
+               if c.kind in ("gear", "linkage")]
+    for j, b in enumerate(robot.wheels):
+        a = next((a for a in robot.wheels[:j] if math.dist(a.position, b.position) <= ROUNDING * size
+                  and not any({a.name, b.name} <= names for names in steered)), None)
+        if a is not None:
+            x, y = (f"{v if abs(v) > ROUNDING * size else 0.0:.6g}" for v in a.position)  # cos(90 deg): 6e-17
+            field = "position" if "position" in items[j] else "l"
+            _warn(check, f"wheels '{a.name}' and '{b.name}' are mounted at one place, ({x}, {y}) m: a wheel copied "
+                  "and renamed but not moved? Read as written; a double wheel or double castor is one wheel of type "
+                  "double or double_castor (docs/description-format.md)", ("wheels", j, field))

@@ -18,6 +18,7 @@ from ._description_wheels import (  # noqa: F401  (the wheel entries' names are 
     WHEEL_NAME,
     WHEEL_TYPES,
     DescriptionWarning,
+    _warn_coincident,
     _wheel_from_dict,
     accepted_fields,
     kind_of_type,
@@ -105,6 +106,7 @@ def robot_from_dict(data: Any, *, source: str = "<dict>", line_of: LineOf | None
     robot = Robot(name=name, wheels=tuple(wheels), notes=notes, couplings=couplings,
                   body=mass.body_from_dict(data, check), odometry=odometry)
     _check_derived(data, robot, check)
+    _warn_coincident(robot, wheels_data, check)
     return robot
 
 

@@ -182,7 +182,9 @@ def _check_envelope(wheels: list[Wheel], check: Any, positioned: Collection[int]
             check.fail(f"at most {MAX_NAME} characters, got {len(w.name)}", ("wheels", i, "name"))
         given = ("l", *(k for k in ("r", "r_r", "d", "b") if k in w.kind.required or k in w.kind.optional))
         lengths += [(abs(getattr(w, k)), i, k) for k in given]
-    size, i, key = max(lengths)
+    size = max(value for value, _, _ in lengths)
+    # the first length in file order that is too long, else the first that is the robot's size (not the last)
+    size, i, key = next(x for x in lengths if not x[0] <= MAX_SIZE or x[0] == size)
     if not size <= MAX_SIZE:
         check.fail(f"{what(size, i, key)}: longer than {MAX_SIZE:g} m, outside the lengths wmrkit handles "
                    "(1 um to 1 km)", where(i, key))
