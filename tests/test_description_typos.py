@@ -127,3 +127,11 @@ def test_of_wheels_all_too_small_the_first_largest_is_named(tmp_path, capsys):
     assert main(["show", path]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"wmrkit: error: {path}:4: wheels[1].position[0]: the robot's size (4e-07 m"), err
+
+
+def test_one_place_is_where_analyze_stops_saying_wheels_too_close():
+    """The description's one place and ``wmrkit analyze``'s ill-conditioned gaps meet: every gap is said once."""
+    from wmrkit.analysis.conditioning import ROUNDING
+    from wmrkit.limits import ONE_PLACE
+
+    assert ONE_PLACE == ROUNDING

@@ -14,6 +14,8 @@ from typing import TYPE_CHECKING, Any
 
 from .documents import DescriptionError, FieldReader, Loc, hint
 from .dynamics import mass
+from .kinematics.linalg import characteristic_length
+from .limits import ONE_PLACE
 from .units import MAX_TURNS
 from .wheels import (
     GEOMETRY_FIELDS,
@@ -218,20 +220,17 @@ def _check_geometry(type_name: str, v: dict[str, float], check: FieldReader, loc
 
 def _warn_coincident(robot: Robot, items: list[Any], check: FieldReader) -> None:
     """Say each wheel mounted where an earlier wheel is (closer than the round-off of the robot's size,
-    ``analysis.conditioning.ROUNDING`` ``L``; ``wmrkit analyze`` says the wider gaps up to ``NEAR L``): a wheel
-    copied and renamed but not moved, read as written. Not said for two wheels whose steering joints one gear or
-    linkage turns together (a double castor written as its two castors): the description says it on purpose."""
-    from .analysis.conditioning import ROUNDING
-    from .kinematics.linalg import characteristic_length
-
-    size = characteristic_length(robot)
+    ``limits.ONE_PLACE`` ``L``; ``wmrkit analyze`` says the wider gaps up to ``analysis.conditioning.NEAR L``): a
+    wheel copied and renamed but not moved, read as written. Not said for two wheels whose steering joints one gear
+    or linkage turns together (a double castor written as its two castors): the description says it on purpose."""
+    within = ONE_PLACE * characteristic_length(robot)
     steered = [{w.name for w in robot.wheels if f"{w.name}.steer" in c.joints} for c in robot.couplings
                if c.kind in ("gear", "linkage")]
     for j, b in enumerate(robot.wheels):
-        a = next((a for a in robot.wheels[:j] if math.dist(a.position, b.position) <= ROUNDING * size
+        a = next((a for a in robot.wheels[:j] if math.dist(a.position, b.position) <= within
                   and not any({a.name, b.name} <= names for names in steered)), None)
         if a is not None:
-            x, y = (f"{v if abs(v) > ROUNDING * size else 0.0:.6g}" for v in a.position)  # cos(90 deg): 6e-17
+            x, y = (f"{v if abs(v) > within else 0.0:.6g}" for v in a.position)  # cos(90 deg): 6e-17
             field = "position" if "position" in items[j] else "l"
             _warn(check, f"wheels '{a.name}' and '{b.name}' are mounted at one place, ({x}, {y}) m: a wheel copied "
                   "and renamed but not moved? Read as written; a double wheel or double castor is one wheel of type "

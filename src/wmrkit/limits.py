@@ -53,6 +53,10 @@ MIN_RATIO = 1e-4
 #: A coupling's ratios: each of magnitude in [MIN_COUPLING_RATIO, MAX_COUPLING_RATIO], the largest at most
 #: 1 / MIN_RATIO times the smallest (rank decisions would lose the smaller to round-off).
 MIN_COUPLING_RATIO, MAX_COUPLING_RATIO = 1e-6, 1e6
+#: Two mount points closer than ONE_PLACE times the robot's size L are at one place, as described (a warning when
+#: read: ``_description_wheels._warn_coincident``); ``analysis.conditioning.ROUNDING``, the same, is not imported
+#: with every description (the analysis package takes 0.3 s to import).
+ONE_PLACE = 1e-12
 #: Swedish gamma at least this far from 0 and 180 deg; castor delta at least this far from +-90 deg [rad].
 ANGLE_MARGIN = math.radians(1.0)
 
