@@ -135,3 +135,23 @@ def test_one_place_is_where_analyze_stops_saying_wheels_too_close():
     from wmrkit.limits import ONE_PLACE
 
     assert ONE_PLACE == ROUNDING
+
+
+@pytest.mark.parametrize(("rows", "named"), [
+    # a roller angle on the first wheel and a radius too small for the robot's size on the second
+    (["name: s, type: swedish, position: [0.2, 0], heading: 0, gamma: 0.5 deg, r: 0.05, r_r: 0.01",
+      "name: f, type: fixed, position: [0, 0.2], heading: 0, r: 1e-6"], "wheels[0].gamma: gamma = 0.5 deg"),
+    # a castor axle along its arm on the first wheel and a name too long on the second
+    (["name: c, type: castor, position: [0.2, 0], d: 0.05, delta: 89.9 deg, r: 0.05",
+      f"name: {'n' * 65}, type: fixed, position: [0, 0.2], heading: 0, r: 0.05"], "wheels[0].delta: delta = 89.9 deg"),
+    # a wheel too far: named, not the other wheels' radii, too small for that size
+    (["name: a, type: fixed, position: [0, 0.2], heading: 0, r: 0.05",
+      "name: b, type: fixed, position: [0, 1e308], heading: 0, r: 0.05"], "wheels[1].position[1]: 1e+308 m from"),
+])
+def test_the_envelope_names_the_first_wheel_in_file_order(tmp_path, capsys, rows, named):
+    """The envelope's checks ran one after the other over all wheels: the second wheel's radius was named before
+    the first wheel's roller angle. Now wheel by wheel, after the robot's size."""
+    path = _write(tmp_path, rows)
+    assert main(["show", path]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f": {named}" in err[0], err

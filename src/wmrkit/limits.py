@@ -180,26 +180,25 @@ def _check_envelope(wheels: list[Wheel], check: Any, positioned: Collection[int]
         text = f"{shown(size, MAX_SIZE)} m"
         return text if key != "l" or i not in positioned else f"{text} from the robot's origin"
 
-    lengths = []
-    for i, w in enumerate(wheels):
-        if len(w.name) > MAX_NAME:
-            check.fail(f"at most {MAX_NAME} characters, got {len(w.name)}", ("wheels", i, "name"))
-        given = ("l", *(k for k in ("r", "r_r", "d", "b") if k in w.kind.required or k in w.kind.optional))
-        lengths += [(abs(getattr(w, k)), i, k) for k in given]
-    size = max(value for value, _, _ in lengths)
-    # the first length in file order that is too long, else the first that is the robot's size (not the last)
-    size, i, key = next(x for x in lengths if not x[0] <= MAX_SIZE or x[0] == size)
-    if not size <= MAX_SIZE:
-        check.fail(f"{what(size, i, key)}: longer than {MAX_SIZE:g} m, outside the lengths wmrkit handles "
-                   "(1 um to 1 km)", where(i, key))
-    if size < MIN_SIZE:
+    lengths = [[(abs(getattr(w, k)), i, k) for k in
+                ("l", *(k for k in ("r", "r_r", "d", "b") if k in w.kind.required or k in w.kind.optional))]
+               for i, w in enumerate(wheels)]
+    size = max(value for own in lengths for value, _, _ in own)
+    if size < MIN_SIZE:  # the robot's, not a wheel's: said before any wheel's, at the first length of that size
+        _, i, key = next(x for own in lengths for x in own if x[0] == size)
         check.fail(f"the robot's size ({shown(size, MIN_SIZE)} m, its largest length) is below {MIN_SIZE:g} m (1 um)",
                    where(i, key))
-    for value, i, key in lengths:
-        if key != "l" and below(value, MIN_RATIO * size):
-            check.fail(f"{shown(value, MIN_RATIO * size)} m is less than {MIN_RATIO:g} of the robot's size ({size:g} "
-                       "m, its largest length): too small to tell from 0 in the rank decisions", ("wheels", i, key))
-    for i, w in enumerate(wheels):
+    for i, w in enumerate(wheels):  # each wheel's mistakes in file order, the first wheel's first (not the last's)
+        if len(w.name) > MAX_NAME:
+            check.fail(f"at most {MAX_NAME} characters, got {len(w.name)}", ("wheels", i, "name"))
+        for value, _, key in lengths[i]:
+            if not value <= MAX_SIZE:
+                check.fail(f"{what(value, i, key)}: longer than {MAX_SIZE:g} m, outside the lengths wmrkit handles "
+                           "(1 um to 1 km)", where(i, key))
+            if key != "l" and size <= MAX_SIZE and below(value, MIN_RATIO * size):  # else a length is too long
+                check.fail(f"{shown(value, MIN_RATIO * size)} m is less than {MIN_RATIO:g} of the robot's size "
+                           f"({size:g} m, its largest length): too small to tell from 0 in the rank decisions",
+                           ("wheels", i, key))
         if w.type == "swedish" and abs(math.sin(w.gamma)) < math.sin(ANGLE_MARGIN):
             check.fail(f"gamma = {math.degrees(w.gamma):.6g} deg: rollers within {math.degrees(ANGLE_MARGIN):g} "
                        "deg of the axle roll (almost) nowhere: the roller rate ~ 1/sin(gamma) explodes (eq. 3.19)",
