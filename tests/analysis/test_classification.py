@@ -123,36 +123,43 @@ def test_icr_sets():
 
 
 @pytest.mark.parametrize("phi", [0.0, 0.5, 1.0, -2.0])
-def test_axles_parallel_within_rounding_do_not_meet_far_away(phi):
-    """Two fixed wheels turned alike, 6e-8 m apart along x (hypothesis's example): their axles are parallel, so the
-    robot translates. Turning the frame by `phi` leaves their directions equal only to rounding, which made them
-    meet 5e8 m to one side in one frame and 6e8 m to the other in the next. Within rounding of the condition of
+@pytest.mark.parametrize(("gap", "kind"), [(5.960464477539063e-08, "line"), (1e-5, "infinity")])
+def test_axles_parallel_within_rounding_do_not_meet_far_away(phi, gap, kind):
+    """Two fixed wheels turned alike, `gap` m apart along x (6e-8 m: hypothesis's example): their axles are parallel,
+    so the robot translates. Turning the frame by `phi` leaves their directions equal only to rounding, which made
+    them meet 5e8 m to one side in one frame and 6e8 m to the other in the next. Within rounding of the condition of
     the two axles, the ICR is at infinity, along the wheels, in every frame; a genuine meeting 1e4 sizes away is
-    still a point."""
+    still a point. Axles 6e-8 m apart on a robot of size 0.5 m (1.2e-7 of it) are one axle to the rank rule
+    (``linalg.RANK_RTOL`` 1e-6), in every frame too: any point on it."""
     rolling = (-math.sin(1.0 - phi), math.cos(1.0 - phi))  # the axles' direction is beta, 1 - phi when turned
 
     def turned(name, x, beta=1.0):  # a fixed wheel at (x, 0) of the original frame, in the turned frame
         return Wheel(name, "fixed", l=abs(x), alpha=math.atan2(-math.sin(phi) * x, math.cos(phi) * x),
                      beta=beta - phi, r=0.5)
 
-    got = icr(Robot("r", (turned("w0", 0.0), turned("w1", 5.960464477539063e-08))))
-    assert got.kind == "infinity"
+    got = icr(Robot("r", (turned("w0", 0.0), turned("w1", gap))))
+    assert got.kind == kind
+    if kind == "line":  # the line through both wheels' mount points, along their axles
+        return
     assert min(np.abs(np.array(got.direction) - sign * np.array(rolling)).max() for sign in (1, -1)) < 1e-9
     apart = Robot("r", (turned("w0", 0.0), turned("w1", 1.0, beta=1.0 + 1e-4)))  # axles 1e-4 rad apart: 8.4e3 m
     assert icr(apart).kind == "point" and 1e3 < math.hypot(*icr(apart).point) < 1e5
 
 
-@pytest.mark.parametrize(("outer", "hint"), [(23.4429, True), (24.0, True), (25.0, False), (30.0, False)])
-def test_nearly_meeting_steered_axles_give_the_headings_at_which_they_meet(outer, hint):
+@pytest.mark.parametrize(("outer", "kind", "hint"), [(23.4429, "point", True), (24.0, "none", True),
+                                                     (25.0, "none", False), (30.0, "none", False)])
+def test_nearly_meeting_steered_axles_give_the_headings_at_which_they_meet(outer, kind, hint):
     """An Ackermann car steered 30 deg inside has no ICR unless the outside wheel is at atan(L / (L / tan 30 deg +
-    track)) = 23.44289865 deg (closed form): headings rounded to 0.0001 deg gave "cannot move" and no more. When the
-    steered wheels miss one point by at most 0.5 deg, the headings at which the axles meet come with it; they keep
-    the rear axle (fixed) and turn about one point on it."""
+    track)) = 23.44289865 deg (closed form): headings rounded to 0.0001 deg gave "cannot move" and no more. Now
+    the rank rule reads them as rounding (``linalg.HEADING_RESOLUTION``): the ICR, with the headings they were
+    rounded from. When the steered wheels miss one point by more, and at most 0.5 deg, the headings at which the
+    axles meet come with "no ICR"; they keep the rear axle (fixed) and turn about one point on it."""
     car = catalog.load("ackermann")
     exact = math.degrees(math.atan(2.7 / (2.7 / math.tan(math.radians(30)) + 1.55)))
     assert icr(car, heading=np.radians([30.0, exact])).kind == "point"
+    assert icr(car, heading=np.radians([30.0, exact])).consistent is None  # exact headings: no note
     got = icr(car, heading=np.radians([30.0, outer]))
-    assert got.kind == "none" and (got.consistent is not None) == hint
+    assert got.kind == kind and (got.consistent is not None) == hint
     if hint:
         headings = np.array([h for _, h in got.consistent])
         meet = icr(car, heading=headings)
@@ -161,7 +168,11 @@ def test_nearly_meeting_steered_axles_give_the_headings_at_which_they_meet(outer
         assert math.degrees(math.atan(2.7 / (2.7 / math.tan(math.radians(inner)) + 1.55))) == pytest.approx(
             outer_aimed, abs=1e-9)  # the closed form holds at the aimed headings
         assert max(abs(inner - 30.0), abs(outer_aimed - outer)) == pytest.approx(math.degrees(got.miss[1]))
-        assert got.describe().startswith("no ICR: the robot cannot move without slipping; its steered axles miss")
+        start = "no ICR: the robot cannot move without slipping; its steered axles miss one point by"
+        if kind == "point":
+            start = "ICR at (0.000, 5.452) m; its steered axles miss the ICR by"  # 2.7 / tan(30 deg) + 1.55 / 2
+            assert abs(got.point[0]) < 1e-6 and got.miss[1] < 1e-6  # on the rear axle, to the headings' rounding
+        assert got.describe().startswith(start)
 
 
 # ---- random robots: the classification agrees with the rank of the constraint matrix -------------------------
@@ -222,17 +233,20 @@ def test_random_robots_agree_with_the_rank_of_the_constraint_matrix(r, seed):
         assert got.type is None and got.reasons
 
 
-def test_generic_ranks_do_not_depend_on_the_seed_near_a_special_configuration():
-    """Two steerable wheels 100 nm apart (and a ball): any two axles meet, so m = 1, d = 2, type 5 and no
+@pytest.mark.parametrize(("gap", "expected"), [(1e-5, (1, 2, 5, False)), (1e-7, (2, 1, 3, True))])
+def test_generic_ranks_do_not_depend_on_the_seed_near_a_special_configuration(gap, expected):
+    """Two steerable wheels `gap` m apart (and a ball): any two axles meet, so m = 1, d = 2, type 5 and no
     coordination (5.13)-(5.15). The m of a generic configuration is the least met: an ICR drawn 100 m away makes the
     two axles one line to the rank tolerance (m = 2 there). Before, m was the largest met, and 10 of these 40 seeds (the
-    first: 8) printed "type 3, m = 2, d = 1; the steered wheels must be coordinated"."""
+    first: 8) printed "type 3, m = 2, d = 1; the steered wheels must be coordinated" for wheels 100 nm apart. Wheels
+    100 nm apart on this 1 m robot are at one point to the rank rule (1e-7 of its size, below ``linalg.RANK_RTOL``):
+    one steered wheel, type 3, with every seed."""
     two = Robot(name="r", wheels=(Wheel(name="a", type="steerable", l=0.0, alpha=0.0, beta=0.0, r=0.5),
-                                  Wheel(name="b", type="steerable", l=1e-7, alpha=0.0, beta=0.0, r=0.5),
+                                  Wheel(name="b", type="steerable", l=gap, alpha=0.0, beta=0.0, r=0.5),
                                   Wheel(name="c", type="ball", l=1.0, alpha=-1.0, beta=0.0, r=0.5)))
     for seed in range(40):
         got = classify(two, seed=seed)
-        assert (got.mobility, got.steerability, got.type, got.coordinated) == (1, 2, 5, False), seed
+        assert (got.mobility, got.steerability, got.type, got.coordinated) == expected, seed
 
 
 def test_synchro_drive_as_its_equivalent_wheel():

@@ -32,10 +32,11 @@ def _parallel(gap: float, third: Wheel) -> Robot:
 _STEERED = Wheel(name="w2", type="steerable", l=0.8, alpha=2.0, beta=0.3, r=0.2)
 
 
-def test_two_parallel_axles_22_nm_apart_have_no_icr_in_every_frame():
-    """Axles y = 0 and y = 2.2e-8 m and a steered wheel's axle meet nowhere: the lines about the centroid have their
-    least singular value 10x the cut-off (before, moved 1 m along x the same robot had "ICR at (-3.685, 0.000) m")."""
-    robot = _parallel(2.2e-8, _STEERED)
+def test_two_parallel_axles_22_um_apart_have_no_icr_in_every_frame():
+    """Axles y = 0 and y = 2.2e-5 m and a steered wheel's axle meet nowhere: the lines about the centroid have their
+    least singular value about 10x the cut-off (before, axles 2.2e-8 m apart, 10x the cut-off of then, 1e-9 times
+    the size, moved 1 m along x the same robot had "ICR at (-3.685, 0.000) m")."""
+    robot = _parallel(2.2e-5, _STEERED)
     for c in ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (-1.0, -1.0), (300.0, 0.0)):
         assert icr(moved(robot, c, 0.7)).kind == "none", c
 
@@ -124,13 +125,14 @@ def test_a_rigid_change_of_frame_keeps_the_verdicts_of_a_nearly_degenerate_robot
     assert _verdicts(moved(robot, c, phi)) == _verdicts(robot)
 
 
-def test_two_steered_wheels_100_nm_apart_are_type_5_in_every_turned_frame():
-    """Two steerable wheels 100 nm apart (and a ball, L = 2/3 m): any two axles meet, so m = 1 and d = 3 - 0 - 1 = 2
-    (5.13)-(5.15), type 5 of Table 5.1, no coordination needed. Before, the frame turned by 0.1 rad (and 11 of 61
-    turns in [-3, 3]) drew an ICR far enough for the two nearly coincident axles to read as one line: "type 3, m = 2,
-    the steered wheels must be coordinated"."""
+def test_two_steered_wheels_10_um_apart_are_type_5_in_every_turned_frame():
+    """Two steerable wheels 10 um apart (and a ball, L = 2/3 m): any two axles meet, so m = 1 and d = 3 - 0 - 1 = 2
+    (5.13)-(5.15), type 5 of Table 5.1, no coordination needed. Before, wheels 100 nm apart (as far above the cut-off
+    of then, 1e-9 times the size, as these are above ``linalg.RANK_RTOL``) in the frame turned by 0.1 rad (and 11 of
+    61 turns in [-3, 3]) drew an ICR far enough for the two nearly coincident axles to read as one line: "type 3,
+    m = 2, the steered wheels must be coordinated"."""
     robot = Robot(name="r", wheels=(Wheel(name="a", type="steerable", l=0.0, alpha=0.0, beta=0.0, r=0.5),
-                                    Wheel(name="b", type="steerable", l=1e-7, alpha=0.0, beta=0.0, r=0.5),
+                                    Wheel(name="b", type="steerable", l=1e-5, alpha=0.0, beta=0.0, r=0.5),
                                     Wheel(name="c", type="ball", l=1.0, alpha=-1.0, beta=0.0, r=0.5)))
     for phi in np.linspace(-3.0, 3.0, 61):
         cls = classify(moved(robot, (0.3, -0.2), float(phi)))

@@ -69,8 +69,9 @@ class ICRSet:
     point: tuple[float, float] | None = None
     direction: tuple[float, float] | None = None
     line: tuple[float, float, float] | None = None
-    # "none" whose steered axles miss one point by at most ROUNDING: the headings [rad] at which they meet, and the
-    # wheel that misses most with its miss [rad] (rounded headings, not a robot that cannot move)
+    # "none" whose steered axles miss one point by at most ROUNDING, or a point (at infinity) they miss by more than
+    # ROUNDOFF_MISS (the rank rule read rounded headings as meeting there): the headings [rad] at which they meet,
+    # and the wheel that misses most with its miss [rad] (rounded headings, not a robot that cannot move)
     consistent: tuple[tuple[str, float], ...] | None = None
     miss: tuple[str, float] | None = None
     #: decimals of the coordinates [m] in :meth:`describe` (:func:`coordinate_decimals` of the robot: 3 from 10 cm up)
@@ -92,10 +93,11 @@ class ICRSet:
         """One line for people, e.g. ``ICR at (0.000, -2.747) m``."""
         f = functools.partial(format_coordinate, decimals=self.decimals)
         if self.kind == "point":
-            return f"ICR at ({f(self.point[0])}, {f(self.point[1])}) m"
+            return f"ICR at ({f(self.point[0])}, {f(self.point[1])}) m" + self.rounding_note()
         if self.kind == "infinity":
             u = format_coordinate  # a unit vector: 3 decimals at any scale
-            return f"ICR at infinity: translation only, along +-({u(self.direction[0])}, {u(self.direction[1])})"
+            return (f"ICR at infinity: translation only, along +-({u(self.direction[0])}, {u(self.direction[1])})"
+                    + self.rounding_note())
         if self.kind == "line":
             lx, ly, d = self.line
             return (f"ICR anywhere on the line through ({f(d * ly)}, {f(-d * lx)}) m along ({format_coordinate(lx)}, "
@@ -103,11 +105,26 @@ class ICRSet:
         if self.kind == "plane":
             return "ICR anywhere in the plane (no wheel axle constrains it)"
         text = "no ICR: the robot cannot move without slipping"
-        if self.consistent is None:
-            return text
+        return text + (f"; {self.heading_note()}" if self.consistent is not None else "")
+
+    def rounding_note(self) -> str:
+        """``"; "`` and :meth:`heading_note` for a point (at infinity) the rank rule reads rounded axles as meeting
+        at, else ``""``."""
+        return f"; {self.heading_note()}" if self.kind in ("point", "infinity") and self.consistent else ""
+
+    def heading_note(self) -> str | None:
+        """What the steered axles miss when the headings look rounded from consistent ones (None if not): at an ICR
+        the rank rule reads them as meeting at (within ``linalg.HEADING_RESOLUTION``), ``"its steered axles miss the ICR
+        by 7.3e-06 deg at most ...: rounded headings, read as front_left 32.58070728 deg, ..."``; with no
+        ICR (missing one point by at most :data:`ROUNDING`), ``"... miss one point by ...: rounded headings? They
+        meet at headings ..."``."""
+        if self.consistent is None or self.miss is None:
+            return None
         aimed = ", ".join(f"{name} {math.degrees(h):.10g} deg" for name, h in self.consistent)
-        return (f"{text}; its steered axles miss one point by {math.degrees(self.miss[1]):.2g} deg at most "
-                f"({self.miss[0]}): rounded headings? They meet at headings {aimed}")
+        by = f"by {math.degrees(self.miss[1]):.2g} deg at most ({self.miss[0]})"
+        if self.kind == "none":
+            return f"its steered axles miss one point {by}: rounded headings? They meet at headings {aimed}"
+        return f"its steered axles miss the ICR {by}: rounded headings, read as {aimed}"
 
 
 #: Largest heading error [rad] :func:`icr` reads as rounding of consistent headings (0.5 deg).
@@ -154,7 +171,7 @@ def _admissible(robot: Robot, beta: np.ndarray, geared: bool) -> ICRSet:
     if rank == 1:
         row = g[np.argmax(np.linalg.norm(g, axis=-1))]
         return ICRSet("line", line=tuple(float(v) for v in row))
-    return meeting_point(robot, g)
+    return _rounded(robot, beta, cl, g, meeting_point(robot, g))
 
 
 def meeting_point(robot: Robot, lines: np.ndarray) -> ICRSet:
@@ -170,6 +187,42 @@ def meeting_point(robot: Robot, lines: np.ndarray) -> ICRSet:
     return ICRSet("point", point=(float(cx + size * x / w), float(cy + size * y / w)))
 
 
+#: Largest miss [rad] of a steered axle at the ICR read as the float round-off of consistent headings: beyond it
+#: the headings were rounded (to the rank rule's resolution, ``linalg.HEADING_RESOLUTION``) and the ICR says so.
+ROUNDOFF_MISS = 1e-9
+
+
+def _rounded(robot: Robot, beta: np.ndarray, cl: ConstraintLines, lines: np.ndarray, found: ICRSet) -> ICRSet:
+    """`found` (a point or a point at infinity), with the headings that aim every steered axle exactly at the point
+    of the fixed axles nearest them (:func:`_aimed`) and the largest miss, when some axle misses it by more than
+    :data:`ROUNDOFF_MISS`: the rank rule read rounded headings as consistent ones (:meth:`ICRSet.rounding_note`)."""
+    got = _aimed(robot, beta, cl, lines)
+    if got is None or got[1].max() <= ROUNDOFF_MISS:
+        return found
+    return _with_headings(robot, found, *got)
+
+
+def _with_headings(robot: Robot, found: ICRSet, aimed: np.ndarray, miss: np.ndarray) -> ICRSet:
+    worst = int(np.argmax(miss))
+    headings = robot.heading_of_beta(aimed)
+    return replace(found, consistent=tuple(zip(robot.steer_names, headings.tolist(), strict=True)),
+                   miss=(robot.steer_names[worst], float(miss[worst])))
+
+
+def _aimed(robot: Robot, beta: np.ndarray, cl: ConstraintLines,
+           lines: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The steering that aims every steered axle at the point of the fixed axles nearest them, and each steering
+    angle's miss [rad] ``(n_steer,)``; None without a steered axle or a point on every fixed one. `lines`: those of
+    `cl` at `beta`."""
+    steered = np.array(cl.steered, dtype=bool)
+    fixed = null_space(lines[~steered]) if (~steered).any() else np.eye(3)  # points on every fixed axle
+    if not steered.any() or fixed.shape[1] == 0:
+        return None
+    v = fixed @ np.linalg.svd(lines[steered] @ fixed)[2][-1]  # of those, the nearest to the steered axles
+    aimed = steer_to_icr(robot, np.array([-v[1], v[0], v[2]]))  # as common_point maps a line-space vector
+    return aimed, np.abs(np.angle(np.exp(1j * (aimed - beta))))
+
+
 def line_rank(robot: Robot, lines: np.ndarray) -> int:
     """Rank of the constraint lines, about the wheels' centroid and nondimensional (``linalg.centred``; 0: no
     line): the same in every robot frame."""
@@ -180,19 +233,10 @@ def _nearly_consistent(robot: Robot, beta: np.ndarray, cl: ConstraintLines, line
     """"none", with the headings that make the axles meet when re-aiming the steered wheels at the nearest common
     point moves none of them by more than :data:`ROUNDING` (e.g. Ackermann headings given to 0.001 deg). `lines`:
     those of `cl` at `beta` (a gear's line moves with the steering of any of its wheels)."""
-    steered = np.array(cl.steered, dtype=bool)
-    fixed = null_space(lines[~steered]) if (~steered).any() else np.eye(3)  # points on every fixed axle
-    if not steered.any() or fixed.shape[1] == 0:
+    got = _aimed(robot, beta, cl, lines)
+    if got is None or got[1].max() > ROUNDING or line_rank(robot, cl.lines(got[0])) == 3:
         return ICRSet("none")
-    v = fixed @ np.linalg.svd(lines[steered] @ fixed)[2][-1]  # of those, the nearest to the steered axles
-    aimed = steer_to_icr(robot, np.array([-v[1], v[0], v[2]]))  # as common_point maps a line-space vector
-    miss = np.abs(np.angle(np.exp(1j * (aimed - beta))))
-    worst = int(np.argmax(miss))
-    if miss[worst] > ROUNDING or line_rank(robot, cl.lines(aimed)) == 3:
-        return ICRSet("none")
-    headings = robot.heading_of_beta(aimed)
-    return ICRSet("none", consistent=tuple(zip(robot.steer_names, headings.tolist(), strict=True)),
-                  miss=(robot.steer_names[worst], float(miss[worst])))
+    return _with_headings(robot, ICRSet("none"), *got)
 
 
 def icr_points(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | None = None) -> np.ndarray:

@@ -25,7 +25,7 @@ from scipy.linalg import block_diag
 from .._shapes import as_names, as_vectors, readonly
 from ..couplings import Coupling, coupled_columns
 from ..errors import ShapeError, UnknownNameError
-from ..kinematics.linalg import nondimensional, rref
+from ..kinematics.linalg import nondimensional, rank_cutoff, rref, unit_columns
 from ..robot import TWIST_NAMES, Robot, element_table
 from ._fast import cancel_roundoff
 
@@ -157,11 +157,11 @@ def _compile(robot: Robot, assigned: tuple[str, ...], coupled: bool = False) -> 
         names = tuple(n for w in members for n in w.rate_names)
         selected = tuple(j for j, n in enumerate(names) if n in assigned)
         if couplings:
-            sub = w_block @ coupled_columns(couplings, names, selected)[2]
+            sub = w_block @ unit_columns(coupled_columns(couplings, names, selected)[2])
         else:
             sub = w_block[:, [j for j in range(len(names)) if j not in selected]]
         u, s, _ = np.linalg.svd(sub) if sub.size else (np.eye(len(rows)), np.zeros(0), None)
-        rank = int(np.sum(s > 1e-12 * max(1.0, s.max(initial=0.0))))
+        rank = int(np.sum(s > rank_cutoff(s)))
         if rank < sub.shape[1]:
             internal.append(" + ".join(w.name for w in members))
         for n in _clean(u[:, rank:].T):

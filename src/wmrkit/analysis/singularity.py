@@ -26,7 +26,7 @@ from scipy.optimize import minimize
 from .._shapes import as_names
 from ..couplings import coupled_columns
 from ..errors import UnknownNameError, WmrkitError
-from ..kinematics.linalg import centred, matrix_rank, nondimensional, robot_size
+from ..kinematics.linalg import centred, matrix_rank, nondimensional, robot_size, unit_columns
 from ..kinematics.models import configuration
 from ..robot import Robot
 from . import _fast
@@ -51,7 +51,8 @@ def is_singular_rank(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, 
         a = centred(robot, a)
     if coupled:
         rates = robot.rate_names
-        rest = coupled_columns(robot.couplings, rates, tuple(rates.index(n) for n in assigned if n in rates))[2]
+        rest = unit_columns(coupled_columns(robot.couplings, rates, tuple(rates.index(n) for n in assigned
+                                                                          if n in rates))[2])
         twist = [j for j in range(3) if j not in cols]
         free = np.concatenate([a[..., twist], a[..., 3:] @ rest], axis=-1)
         return matrix_rank(free) < free.shape[-1]

@@ -33,12 +33,23 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
+def headings_note(robot) -> str | None:
+    """What `robot`'s steered axles miss when its headings look rounded from consistent ones, as ``analyze`` says it
+    (:meth:`wmrkit.analysis.icr.ICRSet.heading_note`); None otherwise or without steering."""
+    if not robot.steer_names:
+        return None
+    from ..analysis.icr import icr
+
+    return icr(robot, geared=True).heading_note()
+
+
 def run(args: argparse.Namespace) -> int:
     """Print the chapter-4 summary; --symbolic and --codegen add closed forms and generated files."""
     if args.codegen and args.codegen[0] not in CODEGEN_LANGUAGES:  # before the work, not after it
         raise WmrkitError(f"--codegen: language must be one of {', '.join(CODEGEN_LANGUAGES)}, got '{args.codegen[0]}'")
     robot = steered_robot(args.robot, args.steer)
     summary = kinematics_summary(robot)
+    summary["headings_note"] = headings_note(robot)
     if args.symbolic:
         from ..kinematics.symbolic import format_symbolic
 

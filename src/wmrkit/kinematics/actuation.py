@@ -21,7 +21,7 @@ from .._shapes import as_vectors, matvec, readonly
 from ..couplings import channel_names, coupled_columns, gear_fill, gear_free, linked_steering
 from ..errors import SingularError
 from ..robot import TWIST_NAMES, Robot
-from .linalg import coupled_constraints, matrix_rank, nondimensional
+from .linalg import coupled_constraints, nondimensional, nullity, unit_columns
 from .models import bounded, configuration
 from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
 from .trees import (
@@ -50,12 +50,14 @@ def split_jacobian(
 
 
 def coupled_split(
-    robot: Robot, columns: Sequence[int], beta: ArrayLike | None = None
+    robot: Robot, columns: Sequence[int], beta: ArrayLike | None = None, *, decisions: bool = False
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[str, ...]]:
     """:func:`split_jacobian` under the robot's mechanical couplings (``wmrkit.couplings``), with channel names.
 
     Without couplings the selected joints are the channels; a differential or gear coupling makes its joints one
-    channel (``"differential(a.spin, b.spin)"``), and a gear holds the rates across its ratios at zero.
+    channel (``"differential(a.spin, b.spin)"``), and a gear holds the rates across its ratios at zero. With
+    `decisions` (rank decisions only) each channel in units that make its direction a unit vector
+    (:func:`~.linalg.unit_columns`).
     """
     if not any(c.rates for c in robot.couplings):
         i_bar, j_sel, j_rest = split_jacobian(robot, columns, beta)
@@ -63,6 +65,8 @@ def coupled_split(
         return i_bar, j_sel, j_rest, tuple(names[c] for c in columns)
     i_bar, j = robot.jacobian_form(configuration(robot, beta))
     t_sel, channels, t_rest, _ = coupled_columns(robot.couplings, jacobian_names(robot), tuple(columns))
+    if decisions:
+        t_sel, t_rest = unit_columns(t_sel), unit_columns(t_rest)
     return i_bar, j @ t_sel, j @ t_rest, channels
 
 
@@ -113,7 +117,7 @@ def actuation_tree(
     (``ActuationAnalysis.actuated``).
     """
     columns, _ = select_columns(robot, robot.actuated if actuated is None else actuated, "actuated")
-    i_bar, j_u, j_nu, _ = coupled_split(nondimensional(robot), columns, beta)  # rates are angular: same units
+    i_bar, j_u, j_nu, _ = coupled_split(nondimensional(robot), columns, beta, decisions=True)  # rates: angular
     return eliminated_tree(i_bar, j_u, j_nu, q_dot_u)
 
 
@@ -296,10 +300,10 @@ def actuation_analysis(
     steering = linked_steering(robot.couplings, steering)
     unit = nondimensional(robot)  # rank decisions: the tolerance policy of .linalg
     a = coupled_constraints(unit, beta)
-    i_bar1, j_u1, j_nu1, _ = coupled_split(unit, columns, beta)
+    i_bar1, j_u1, j_nu1, _ = coupled_split(unit, columns, beta, decisions=True)
     return ActuationAnalysis(
         robot.name, channels, steering, steering_split(robot, steering),
-        readonly(np.asarray(a.shape[-1] - matrix_rank(a))),
+        readonly(np.asarray(nullity(robot, a))),
         eliminated_tree(i_bar1, j_u1, j_nu1),
         readonly(partitioned_solution(j_u, j_nu) @ i_bar),
         readonly(undriven_motions(i_bar1, j_nu1)),
@@ -343,7 +347,7 @@ def minimal_set_search(robot: Robot, beta: np.ndarray, size: int, wanted: str, w
 
     unit = nondimensional(robot)
     a = coupled_constraints(unit, beta) if couplings else unit.constraint_matrix(beta)
-    m = np.unique(a.shape[-1] - matrix_rank(a))
+    m = np.unique(nullity(robot, a))
     prefilter = null_space_prefilter(a, size, offset=3) if len(m) == 1 and m[0] == size else None
     sets, complete, note = search_sets(selectable_rates(robot), size, exact, prefilter=prefilter,
                                        limit=MAX_MINIMAL_SETS, max_exact=exact_budget(
@@ -387,6 +391,7 @@ def _split_sets(robot: Robot, beta: np.ndarray, sel: np.ndarray,
             t_sel[i, :, :chosen.shape[1]] = chosen
         t_rest[i, :, :free.shape[1]] = free
         zeroed[i] = n_w - free.shape[1] if couplings == "sensed" or chosen.shape[1] == size else -1
+    t_sel, t_rest = unit_columns(t_sel), unit_columns(t_rest)  # each channel's unit: rank decisions only
     return i_bar, np.einsum("...rn,snk->s...rk", j, t_sel), np.einsum("...rn,snk->s...rk", j, t_rest), zeroed
 
 
@@ -403,7 +408,7 @@ def minimal_actuator_sets(robot: Robot, beta: ArrayLike | None = None, *,
     """
     beta = configuration(robot, beta, heading)
     a = coupled_constraints(nondimensional(robot), beta)  # m counts a gear's motions, as actuation_analysis does
-    m = np.unique(a.shape[-1] - matrix_rank(a))
+    m = np.unique(nullity(robot, a))
     if len(m) != 1 or m[0] == 0:
         return SetList()
     found = minimal_set_search(robot, beta, int(m[0]), "determined", "minimal actuator sets", drive_all=True,

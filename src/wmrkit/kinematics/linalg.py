@@ -30,28 +30,58 @@ from .._shapes import matvec
 if TYPE_CHECKING:
     from ..robot import Robot
 
-#: Relative tolerance on singular values for numeric rank (times the largest singular value and the size).
-RANK_RTOL = 1e-9
+#: Resolution [rad] at which steering headings are given: a heading printed or typed to 4 decimals of a degree is off
+#: by at most 5e-5 deg = 8.7e-7 rad (``wmrkit ik`` prints 32.5807 deg for 32.58070741 deg).
+HEADING_RESOLUTION = 1e-6
+
+#: Relative tolerance on singular values for numeric rank: a singular value at or below ``RANK_RTOL * max(s_max, 1)``
+#: counts as 0 (:func:`rank_cutoff`). Tied to :data:`HEADING_RESOLUTION`: headings off a consistent configuration
+#: by ``h`` [rad] move the least singular value of a nondimensional constraint matrix by at most about
+#: ``0.3 h s_max`` (random robots aimed at random ICRs; 0.08 for the Ackermann car), so headings given to that
+#: resolution keep the configuration's rank, while headings 0.01 rad off the law move it by 4e-4 of that at least
+#: (1e-6 s_max or more); radii and offsets, at least ``limits.MIN_RATIO / 2`` of ``L`` (5e-5), stay far above it.
+RANK_RTOL = HEADING_RESOLUTION
 
 
 def matrix_rank(m: ArrayLike, *, rtol: float = RANK_RTOL) -> np.ndarray:
-    """Numeric rank by SVD, ``(..., r, c) -> (...)`` int; singular values below ``rtol * max(r, c) * s_max`` count as 0.
+    """Numeric rank by SVD, ``(..., r, c) -> (...)`` int; singular values at or below :func:`rank_cutoff` count as 0.
 
-    The scale floor is 1: a matrix of tiny but meaningful entries (lengths in km) keeps its rank; an all-zero
-    matrix has rank 0.
+    The one rank rule of the chapter-4 and chapter-5 decisions (mobility, assignable sets, models, actuation,
+    sensing, classification, ICR), made on nondimensional matrices. The scale floor is 1: a matrix of tiny but
+    meaningful entries (lengths in km) keeps its rank; an all-zero matrix has rank 0.
     """
     m = np.asarray(m, dtype=float)
     if m.shape[-1] == 0 or m.shape[-2] == 0:
         return np.zeros(m.shape[:-2], dtype=int)
     s = np.linalg.svd(m, compute_uv=False)
-    return np.sum(s > rank_cutoff(s, m.shape, rtol), axis=-1)
+    return np.sum(s > rank_cutoff(s, rtol), axis=-1)
 
 
-def rank_cutoff(s: np.ndarray, shape: tuple[int, ...], rtol: float = RANK_RTOL) -> np.ndarray:
+def rank_cutoff(s: np.ndarray, rtol: float = RANK_RTOL) -> np.ndarray:
     """The singular value at and below which :func:`matrix_rank` counts one as 0, ``(..., n) -> (..., 1)``: `s` the
-    singular values (descending) of matrices of `shape` ``(..., r, c)``; ``rtol * max(r, c) * max(s_max, 1)``.
-    The one rank tolerance, shared by the least squares of :func:`solve_assigned` given an `rtol`."""
-    return rtol * max(shape[-2:]) * np.maximum(s[..., :1], 1.0)
+    singular values (descending); ``rtol * max(s_max, 1)`` (:data:`RANK_RTOL`, relative to the matrix's scale).
+    The one rank tolerance, shared by the least squares of :func:`solve_assigned` given an `rtol` and the pruned
+    walk of :mod:`.search`."""
+    return rtol * np.maximum(s[..., :1], 1.0)
+
+
+def unit_columns(t: ArrayLike) -> np.ndarray:
+    """`t` ``(..., n, c)`` with each nonzero column scaled to norm 1. For the variables of a coupling's channel
+    (``q_j = k_j u``, ratios from 1e-6 to 1e6, ``wmrkit.couplings``) in a rank decision: a change of each channel's
+    unit, which keeps every rank, so a channel of ratios 1e6 neither hides the other columns below the cut-off,
+    relative to the largest singular value (:func:`rank_cutoff`), nor falls below it itself."""
+    t = np.asarray(t, dtype=float)
+    norms = np.linalg.norm(t, axis=-2, keepdims=True)
+    return t / np.where(norms > 0, norms, 1.0)
+
+
+def nullity(robot: Robot, a: ArrayLike) -> np.ndarray:
+    """``k - rank A`` of `robot`'s nondimensional slip matrix `a` ``(..., R, k)`` (3.22, with a gear's rows or not):
+    the mobility m (4.3), ``(...)`` int. The rank is :func:`matrix_rank`'s on the twist of the wheels' centroid
+    (:func:`centred`), the same in every frame: the one m of the mobility, the assignable sets and models, the
+    actuation and sensing analyses and their minimal sets."""
+    a = np.asarray(a, dtype=float)
+    return a.shape[-1] - matrix_rank(centred(robot, a))
 
 
 def free_columns(m: ArrayLike, *, rtol: float = RANK_RTOL) -> np.ndarray:
@@ -323,14 +353,14 @@ def rref(m: ArrayLike, *, rtol: float = RANK_RTOL) -> tuple[np.ndarray, np.ndarr
     ``(..., r, c) -> ((..., r, c), (..., c) bool)``: the RREF and which columns hold a pivot. Pivots are taken
     left to right, so the free (non-pivot) columns are the right-most set of columns that can act as the
     mobility vector of (4.2): put the variables to assign last and read ``q_na = -R[:g, free] @ q_a``.
-    A pivot candidate below ``rtol * max(r, c) * max(|m|_max, 1)`` counts as zero (as in :func:`matrix_rank`).
+    A pivot candidate below ``rtol * max(|m|_max, 1)`` counts as zero (as in :func:`matrix_rank`).
     """
     m = np.asarray(m, dtype=float)
     n_rows, n_cols = m.shape[-2:]
     out = m.reshape(-1, n_rows, n_cols).copy()
     n_batch = out.shape[0]
     scale = np.maximum(np.abs(out).max(axis=(1, 2), initial=0.0), 1.0)
-    tol = rtol * max(n_rows, n_cols) * scale
+    tol = rtol * scale
     next_row = np.zeros(n_batch, dtype=int)
     pivots = np.zeros((n_batch, n_cols), dtype=bool)
     batch, rows = np.arange(n_batch), np.arange(n_rows)
@@ -360,7 +390,7 @@ def _pinv(a: np.ndarray, rtol: float) -> np.ndarray:
     if a.shape[-1] == 0 or a.shape[-2] == 0:
         return np.zeros((*a.shape[:-2], a.shape[-1], a.shape[-2]))
     u, s, vt = np.linalg.svd(a, full_matrices=False)
-    keep = s > rank_cutoff(s, a.shape, rtol)
+    keep = s > rank_cutoff(s, rtol)
     inverse = np.divide(1.0, s, out=np.zeros_like(s), where=keep)
     return np.swapaxes(vt, -1, -2) @ (inverse[..., None] * np.swapaxes(u, -1, -2))
 

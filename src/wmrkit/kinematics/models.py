@@ -24,7 +24,7 @@ from .._shapes import as_names, as_vectors, matvec, readonly
 from ..errors import ShapeError, SingularError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..robot import TWIST_NAMES, Robot
-from .linalg import centred, coupled_constraints, matrix_rank, nondimensional, velocity_scale
+from .linalg import coupled_constraints, matrix_rank, nondimensional, nullity, velocity_scale
 from .nullspace import null_space_assignable, null_space_basis, null_space_solution, rref_solution
 from .ranks import ranks_assignable, ranks_solution
 from .search import SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
@@ -129,7 +129,7 @@ def mobility(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike 
     robot's ``gear`` couplings (a row per direction a gear forbids), as the models here do; ``gears=False``: the
     wheels' alone, the thesis's m (equal without a gear)."""
     a = constraints(robot, configuration(robot, beta, heading), gears)
-    return a.shape[-1] - matrix_rank(centred(robot, a))  # the twist of the centroid: the same in every frame
+    return nullity(robot, a)
 
 
 def bounded(q: np.ndarray, names: Sequence[str], argument: str, limit: float = MAX_QUERY_RATE) -> np.ndarray:
@@ -173,7 +173,7 @@ def is_assignable(
 
 
 def _sets_at(robot: Robot, a: np.ndarray, method: Method) -> tuple[tuple[str, ...], ...]:
-    m = np.unique(a.shape[-1] - matrix_rank(a))
+    m = np.unique(nullity(robot, a))
     if len(m) != 1:  # the mobility changes within the batch: no set fits every configuration
         return SetList()
     sets, complete, note = search_sets(  # bounded, pruned by the null-space test (.search)
@@ -216,7 +216,7 @@ def generically_assignable_sets(robot: Robot) -> tuple[tuple[str, ...], ...]:
     samples = generic_configurations(robot)
     a = constraints(robot, samples)
     m = generic_mobility(robot)
-    generic = a.shape[-1] - matrix_rank(a) == m  # one at least: m is the smallest of the samples' mobilities
+    generic = nullity(robot, a) == m  # one at least: m is the smallest of the samples' mobilities
     sets, complete, note = search_sets(  # bounded, pruned by the null-space test at one generic sample at least
         range(a.shape[-1]), m, lambda s: (ranks_assignable(a, s) & generic).any(axis=1),
         prefilter=null_space_prefilter(a[generic], m, every=False), max_exact=exact_budget(a.shape, 2),
@@ -312,7 +312,7 @@ def direct_model(
     if rates is not None:
         return kinematic_model(robot, rates, beta)
     a = constraints(robot, beta)
-    m = int(np.max(a.shape[-1] - matrix_rank(a)))
+    m = int(np.max(nullity(robot, a)))
     usable = [n for n in robot.rate_names if not n.endswith(".roller")]
     sensed = [n for n in usable if n in robot.sensed]
     choice, note = _first_assignable(robot, a, sensed, m)
@@ -346,9 +346,9 @@ def generic_inputs(robot: Robot, samples: int = 8) -> tuple[tuple[str, ...], int
     generic steering (the least m over `samples` :func:`random_steering` configurations, and the inputs on those
     that meet it): the inputs of the closed forms and of the generated code."""
     a = constraints(robot, random_steering(robot, samples, np.random.default_rng(7)))
-    nullity = a.shape[-1] - matrix_rank(a)
-    dof = int(nullity.min())
-    return _free_steering(robot, a[nullity == dof], dof), dof
+    m = nullity(robot, a)
+    dof = int(m.min())
+    return _free_steering(robot, a[m == dof], dof), dof
 
 
 def inverse_model(
@@ -365,7 +365,7 @@ def inverse_model(
     if twist_names is not None:
         return kinematic_model(robot, twist_names, beta)
     a = constraints(robot, beta)
-    dof = int(np.max(a.shape[-1] - matrix_rank(a)))
+    dof = int(np.max(nullity(robot, a)))
     free = _free_steering(robot, a, dof)  # double wheels' steering rates that no twist determines
     m = dof - len(free)  # assigned, unless the gears lock everything (dof 0: the empty model, as the direct one's)
     if free:

@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterator, Sequence
 
 import numpy as np
 
-from .linalg import RANK_RTOL, matrix_rank
+from .linalg import matrix_rank, rank_cutoff
 
 #: Most sets a search lists; more are reported as "more than MAX_SETS".
 MAX_SETS = 1000
@@ -98,7 +98,7 @@ class PrunedCombinations:
         """Per configuration ``(...)`` bool: the rows of `cols` have rank `rank`."""
         self.nodes += 1
         s = np.linalg.svd(self.rows(cols), compute_uv=False)
-        return s[..., rank - 1] > RANK_RTOL * self.size if s.shape[-1] >= rank else np.zeros(s.shape[:-1], bool)
+        return s[..., rank - 1] > rank_cutoff(s)[..., 0] if s.shape[-1] >= rank else np.zeros(s.shape[:-1], bool)
 
     def _keep(self, cand: list[int], rest: list[int]) -> bool:
         ok = self._full(cand, len(cand))

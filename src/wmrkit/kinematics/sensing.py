@@ -27,7 +27,7 @@ from .actuation import (
     verdict_texts,
     where_determined,
 )
-from .linalg import coupled_constraints, matrix_rank, nondimensional
+from .linalg import coupled_constraints, nondimensional, nullity, unit_columns
 from .models import bounded, configuration
 from .search import SetList
 from .trees import (
@@ -43,15 +43,18 @@ from .trees import (
 )
 
 
-def _split(robot: Robot, sensed: Sequence[str] | None, beta: ArrayLike | None):
+def _split(robot: Robot, sensed: Sequence[str] | None, beta: ArrayLike | None, decisions: bool = False):
     """Sensed columns, sensed steering, ``(I_bar, J_s, J_ns)``: a gear's unsensed joints turn with its sensed ones
     (:func:`wmrkit.couplings.gear_fill`, as ``fk`` and ``odometry`` fill them), so they are known, not columns of
     ``J_ns``, and ``J_s`` carries them; a gear with no sensed joint is one unknown, its turn
-    (:func:`wmrkit.couplings.gear_free`); last, the names of the unknowns of ``J_ns``."""
+    (:func:`wmrkit.couplings.gear_free`); last, the names of the unknowns of ``J_ns``. With `decisions` (rank
+    decisions only) the columns of both changes of variables are unit vectors (:func:`~.linalg.unit_columns`)."""
     columns, steering = select_columns(robot, robot.sensed if sensed is None else sensed, "sensed")
     names = jacobian_names(robot)
     filled, fill = gear_fill(robot.couplings, names, columns)
     free, free_names = gear_free(robot.couplings, names, columns)
+    if decisions:
+        fill, free = unit_columns(fill), unit_columns(free)
     i_bar, j = robot.jacobian_form(configuration(robot, beta))
     return columns, steering, i_bar, j[..., list(filled)] @ fill, j @ free, free_names
 
@@ -61,7 +64,7 @@ def sensing_equation(
 ) -> tuple[np.ndarray, np.ndarray]:
     """The vehicle sensing equation (4.34), ``I_s @ twist_robot = J_s @ q_dot_s``: ``(I_s (..., 3E, 3), J_s)``."""
     columns, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
-    _, _, _, j_s1, j_ns1, _ = _split(nondimensional(robot), sensed, beta)  # rank decisions: the tolerance policy
+    _, _, _, j_s1, j_ns1, _ = _split(nondimensional(robot), sensed, beta, True)  # rank decisions: linalg
     require_determined(reduction_exact(j_s1, j_ns1), not_reduced(robot, columns, "sensed", "(4.34)"))
     return reduced_equation(i_bar, j_s, j_ns), j_s
 
@@ -77,7 +80,7 @@ def sensed_direct_matrix(
     pseudo-inverse's minimum-norm twist would be one of many.
     """
     columns, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
-    _, _, i_bar1, _, j_ns1, _ = _split(nondimensional(robot), sensed, beta)  # rank decisions: the tolerance policy
+    _, _, i_bar1, _, j_ns1, _ = _split(nondimensional(robot), sensed, beta, True)  # rank decisions: linalg
     names = jacobian_names(robot)
     require_determined(selected_determined(i_bar1, j_ns1), twist_not_fixed(robot.name, [names[c] for c in columns]))
     return partitioned_solution(i_bar, j_ns) @ j_s
@@ -95,7 +98,7 @@ def sensed_full_matrix(
     pseudo-inverse's pick would be one of many (``SensingAnalysis.direct`` still gives a fixed twist).
     """
     columns, _, i_bar, j_s, j_ns, _ = _split(robot, sensed, beta)
-    _, _, i_bar1, _, j_ns1, _ = _split(nondimensional(robot), sensed, beta)  # rank decisions: the tolerance policy
+    _, _, i_bar1, _, j_ns1, _ = _split(nondimensional(robot), sensed, beta, True)  # rank decisions: linalg
     names = [jacobian_names(robot)[c] for c in columns]
     require_determined(selected_determined(i_bar1, j_ns1), twist_not_fixed(robot.name, names))
     require_determined(undriven_motions(i_bar1, j_ns1) == 0, (
@@ -236,13 +239,13 @@ def sensing_analysis(
     columns, steering, i_bar, j_s, j_ns, unknown = _split(robot, sensed, beta)
     unit = nondimensional(robot)  # rank decisions: the tolerance policy of .linalg
     a = coupled_constraints(unit, beta)  # the motions a gear allows, as the actuation analysis counts them
-    _, _, i_bar1, j_s1, j_ns1, _ = _split(unit, sensed, beta)
+    _, _, i_bar1, j_s1, j_ns1, _ = _split(unit, sensed, beta, True)
     names = jacobian_names(robot)
     full = _full(i_bar, j_s, j_ns)
     i_ns = np.concatenate([np.broadcast_to(i_bar, (*j_ns.shape[:-2], *i_bar.shape)), -j_ns], axis=-1)
     return SensingAnalysis(
         robot.name, tuple(names[c] for c in columns), steering, steering_split(robot, steering),
-        readonly(np.asarray(a.shape[-1] - matrix_rank(a))),
+        readonly(np.asarray(nullity(robot, a))),
         eliminated_tree(i_bar1, j_s1, j_ns1),
         readonly(partitioned_solution(i_bar, j_ns) @ j_s), readonly(full),
         TWIST_NAMES + unknown,
@@ -264,7 +267,7 @@ def minimal_sensor_sets(
     """
     beta = configuration(robot, beta, heading)
     a = coupled_constraints(nondimensional(robot), beta)  # m counts a gear's motions, as sensing_analysis does
-    m = np.unique(a.shape[-1] - matrix_rank(a))
+    m = np.unique(nullity(robot, a))
     if len(m) != 1 or m[0] == 0:
         return SetList()
     names, steer = jacobian_names(robot), tuple(f"{w}.steer" for w in steering_split(robot, ()))

@@ -11,7 +11,7 @@ from ..errors import SingularError
 from ..robot import Robot
 from .actuation import actuation_analysis, minimal_actuator_sets
 from .extended import extended_dof
-from .linalg import characteristic_length
+from .linalg import RANK_RTOL, characteristic_length
 from .models import (
     KinematicModel,
     assignable_sets,
@@ -71,19 +71,25 @@ def kinematics_summary(robot: Robot) -> dict[str, Any]:
     }
 
 
-#: A model entry printed as 0: within this fraction of the matrix's largest entry, both in the robot's size L
-#: (vx, vy in L/s), where the models are solved: least-squares round-off (5.5e-12 rad/s per rad/s on 64 castors
-#: whose largest entry is 415), not a value. The JSON keeps the computed values.
+#: A computed value printed as 0: within this fraction of its scale, round-off (docs: cli._shown).
 ROUNDOFF = 1e-12
+
+#: A model entry printed as 0: within this fraction of the matrix's largest entry, both in the robot's size L
+#: (vx, vy in L/s), where the models are solved: what the rank rule cannot tell from 0 (``linalg.RANK_RTOL``, the
+#: heading resolution), least-squares round-off (5.5e-12 rad/s per rad/s on 64 castors whose largest entry is 415)
+#: or the slip of headings rounded to that resolution (vy = 7.7e-9 m/s per rad/s of a car's rear spin at headings
+#: printed to 4 decimals of a degree), not a value. The JSON keeps the computed values.
+MODEL_ROUNDOFF = RANK_RTOL
 
 
 def printed_matrix(model: dict[str, Any], size: float) -> np.ndarray:
-    """`model`'s matrix ``(n_solved, n_assigned)`` with the entries within :data:`ROUNDOFF` of its scale set to 0."""
+    """`model`'s matrix ``(n_solved, n_assigned)`` with the entries within :data:`MODEL_ROUNDOFF` of its scale set
+    to 0."""
     matrix = np.asarray(model["matrix"], dtype=float).reshape(len(model["solved"]), len(model["assigned"]))
     in_l = [1.0 / size if n in ("vx", "vy") else 1.0 for n in model["solved"]]  # rows: the solved velocities
     per_l = [size if n in ("vx", "vy") else 1.0 for n in model["assigned"]]
     scaled = np.abs(matrix) * np.array(in_l)[:, None] * np.array(per_l)
-    return np.where(scaled <= ROUNDOFF * scaled.max(initial=0.0), 0.0, matrix)
+    return np.where(scaled <= MODEL_ROUNDOFF * scaled.max(initial=0.0), 0.0, matrix)
 
 
 def _cell(v: float, width: int) -> str:
@@ -140,6 +146,8 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
                      f"{self_motions} of the joints with the body at rest")
     extra = summary["extended_dof"] - generic  # n_o: extended_dof is m at generic steering plus n_o (4.76)
     lines = [f"robot {summary['robot']} ({steer or 'no steering'})", mobility]
+    if summary.get("headings_note"):  # rounded headings (wmrkit kinematics adds it: analysis.icr)
+        lines.append(f"  note: {summary['headings_note']}")
     if gears:
         lines.append(f"  with its gear couplings m = {coupled}{special} ({', '.join(gears)}, q_j = ratio_j * u): "
                      "the sets and models below hold them")
