@@ -219,8 +219,13 @@ def _aimed(robot: Robot, beta: np.ndarray, cl: ConstraintLines,
     if not steered.any() or fixed.shape[1] == 0:
         return None
     v = fixed @ np.linalg.svd(lines[steered] @ fixed)[2][-1]  # of those, the nearest to the steered axles
-    aimed = steer_to_icr(robot, np.array([-v[1], v[0], v[2]]))  # as common_point maps a line-space vector
-    return aimed, np.abs(np.angle(np.exp(1j * (aimed - beta))))
+    point = np.array([-v[1], v[0], v[2]])  # as common_point maps a line-space vector (unit norm)
+    aimed = steer_to_icr(robot, point)
+    miss = np.abs(np.remainder(aimed - beta + np.pi / 2, np.pi) - np.pi / 2)  # an axle is a line: beta ~ beta + pi
+    _, j, cx, cy, _, _ = _aimed_axles(robot)
+    at = np.hypot(point[0] - point[2] * cx, point[1] - point[2] * cy) <= 1e-9 * characteristic_length(robot)
+    miss[j[at]] = 0.0  # a wheel at the point: its axle passes through it at any angle (steer_to_icr keeps it)
+    return aimed, miss
 
 
 def line_rank(robot: Robot, lines: np.ndarray) -> int:
