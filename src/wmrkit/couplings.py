@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ._shapes import as_names, finite_number
-from .errors import UnknownNameError, WmrkitError
+from .errors import UnknownNameError, WmrkitError, name_list
 from .limits import MAX_COUPLING_RATIO, MIN_COUPLING_RATIO, MIN_RATIO, below, shown
 
 if TYPE_CHECKING:
@@ -394,3 +394,11 @@ def gear_breaches(couplings: tuple[Coupling, ...], names: tuple[str, ...], q: np
         if scale >= least and off > rtol * scale:
             out.append(GearBreach(gear, tuple(i for i, _ in read), off / scale))
     return out
+
+
+def coupling_words(couplings: tuple[Coupling, ...], channel: str) -> str:
+    """A steering linkage or gear of `couplings` by its channel name (``linkage(fl.steer, fr.steer)``: the library's,
+    kept in JSON) in the description's terms, for text: ``the steering linkage of wheels 'fl' and 'fr'``."""
+    c = next(c for c in couplings if c.channel_name == channel)
+    wheels = [f"'{j.removesuffix('.steer')}'" for j in c.joints if j.endswith(".steer")]
+    return f"the steering {c.kind} of wheels {name_list(wheels[:-1])} and {wheels[-1]}"

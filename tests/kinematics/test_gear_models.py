@@ -185,5 +185,5 @@ def test_the_extended_count_says_a_linkage_is_not_used(tmp_path, capsys):
     assert data["linkages"] == ["linkage(a.steer, b.steer, c.steer)"] and data["extended_dof"] == 3
     assert main(["kinematics", str(path)]) == 0
     out = capsys.readouterr().out
-    assert ("3 velocities can be assigned (each steered wheel counted, linkage(a.steer, b.steer, c.steer) not as one: "
-            "the solutions judge their angles against its law)\n") in out
+    assert ("3 velocities can be assigned (each steered wheel counted, the steering linkage of wheels 'a', 'b' and "
+            "'c' not as one: the solutions judge their angles against its law)\n") in out  # the description's terms

@@ -11,7 +11,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import WmrkitError, name_list
+from ..couplings import coupling_words
+from ..errors import WmrkitError
 from ._common import (
     add_json_flag,
     add_robot_argument,
@@ -290,7 +291,8 @@ def run_track(args: argparse.Namespace) -> int:
         moved = (f"so the kinematic loop moved the robot with the least-squares twist of its wheels, up to "
                  f"{v['twist_miss'][0]:.3g} m/s and {v['twist_miss'][1]:.3g} rad/s off the commanded one"
                  if "twist_miss" in v else "and through the dynamics their tyres slip sideways")
-        warn(f"{coupling_words(robot, v['coupling'])} held them up to {math.degrees(v['axle_miss']):.3g} deg off the "
+        linkage = coupling_words(robot.couplings, v["coupling"])
+        warn(f"{linkage} held them up to {math.degrees(v['axle_miss']):.3g} deg off the "
              f"axles the commanded twist needs for {v['duration']:.3g} s (t = {v['from']:.4g} to {v['to']:.4g} s): "
              f"that twist is not realisable without the wheels scrubbing, {moved}; the tracking errors are the result")
     for c, ok in zip(robot.couplings, run.commands.in_gear.all(axis=0).tolist(), strict=True):
@@ -339,14 +341,6 @@ def run_track(args: argparse.Namespace) -> int:
 CANNOT_FOLLOW = "the robot cannot follow this reference there (its wheels scrub; the tracking errors are the result)"
 
 
-def coupling_words(robot, channel: str) -> str:
-    """A steering linkage or gear (by its channel name, ``linkage(fl.steer, fr.steer)``: the library's) in the
-    description's terms: ``the steering linkage of wheels 'fl' and 'fr'``."""
-    c = next(c for c in robot.couplings if c.channel_name == channel)
-    wheels = [f"'{j.removesuffix('.steer')}'" for j in c.joints if j.endswith(".steer")]
-    return f"the steering {c.kind} of wheels {name_list(wheels[:-1])} and {wheels[-1]}"
-
-
 def range_warnings(robot, violations: list[dict]) -> list[str]:
     """The warnings of a run's :meth:`~wmrkit.control.tracking_run.TrackingRun.range_violations`: one per wheel
     steered on its own, and one per linkage or steering gear, naming each wheel it held at its end and those it held
@@ -376,7 +370,7 @@ def range_warnings(robot, violations: list[dict]) -> list[str]:
         paired = {(v["from"], v["to"]) for v in vs if "held_by" not in v}
         parts += [f"{at(h)} (within its range) for {h['duration']:.3g} s (t = {h['from']:.4g} to {h['to']:.4g} s)"
                   for h in held if (h["from"], h["to"]) not in paired]
-        out.append(f"{coupling_words(robot, channel)} held them at a steering limit: {'; '.join(parts)}: "
+        out.append(f"{coupling_words(robot.couplings, channel)} held them at a steering limit: {'; '.join(parts)}: "
                    f"{CANNOT_FOLLOW}")
     return out
 

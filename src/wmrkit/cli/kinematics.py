@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(summary)
         return 0
-    print(format_kinematics_summary(summary, limit=None if args.all else 12))
+    print(format_kinematics_summary(summary, limit=None if args.all else 12, couplings=robot.couplings))
     if args.symbolic:
         print(summary["symbolic"])
     return 0

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from ..couplings import coupling_words
 from ..errors import SingularError
 from ..robot import Robot
 from .actuation import actuation_analysis, minimal_actuator_sets
@@ -128,11 +129,12 @@ def _sets(sets: list[list[str]], limit: int | None, indent: str = "    ") -> lis
     return lines
 
 
-def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12) -> str:
+def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12, couplings: tuple = ()) -> str:
     """Human-readable text of :func:`kinematics_summary`: counts, sets, model tables, verdicts.
 
     Steering angles are headings in degrees (0 = rolling straight ahead). At most `limit` sets are listed per
-    list (None: all).
+    list (None: all). The robot's `couplings` name its steering linkages in the description's terms
+    (:func:`wmrkit.couplings.coupling_words`; without them, by channel name, as the JSON does).
     """
     steer = ", ".join(f"heading {n} = {math.degrees(v):.6g} deg" for n, v in summary["steering"].items())
     m, generic, coupled = summary["mobility"], summary["generic_mobility"], summary["coupled_mobility"]
@@ -153,11 +155,13 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
                      "the sets and models below hold them")
     if extra > 0:
         n = summary["extended_dof"]
-        linked = summary.get("linkages")
+        named = {c.channel_name for c in couplings}
+        linked = [coupling_words(couplings, c) if c in named else c for c in summary.get("linkages") or ()]
         lines.append(f"  with its {extra} steering angle{'s' if extra > 1 else ''} (extended solutions, §4.5), "
                      f"{n} velocit{'ies' if n > 1 else 'y'} can be assigned"
                      + (f" (each steered wheel counted, {', '.join(linked)} not as one: the solutions judge their "
-                        "angles against its law)"
+                        f"angles against {'its' if len(linked) == 1 else 'their'} law"
+                        f"{'' if len(linked) == 1 else 's'})"
                         if linked else ""))
     lines += [f"  velocities (vx, vy [m/s]; omega, joint rates [rad/s]): {', '.join(summary['velocity_names'])}",
               f"  assignable sets ({len(summary['assignable_sets'])}):", *_sets(summary["assignable_sets"], limit)]
