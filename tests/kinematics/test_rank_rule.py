@@ -12,12 +12,14 @@ import json
 import math
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from strategies import robots
 from wmrkit import (
+    Robot,
     SingularError,
+    Wheel,
     actuation_analysis,
     assignable_sets,
     catalog,
@@ -129,11 +131,17 @@ def test_headings_a_tenth_of_a_micro_radian_off_the_law_move_on_one_a_hundredth_
         assert all(len(s) == m for s in assignable_sets(CAR, heading=h))
 
 
+#: Two fixed wheels on parallel axles 3.1e-6 m apart (hypothesis's example): the least singular value of the matrix
+#: sat below the cut-off on the origin's twist and above it on the centroid's, so m = 1 came with no assignable set.
+_NEAR_AXLES = Robot(name="r", wheels=tuple(Wheel(name=f"w{i}", type="fixed", l=x, alpha=0.0, r=0.5,
+                                                 beta=2.5007353837002683e-05) for i, x in enumerate((0.5, 0.4375))))
+
+
 @settings(max_examples=40, deadline=None)
-@given(robot=robots(max_wheels=3), data=st.data())
-def test_the_mobility_is_the_size_of_every_assignable_set_and_of_the_models(robot, data):
-    beta = np.array(data.draw(st.lists(st.floats(-math.pi, math.pi), min_size=len(robot.steer_names),
-                                       max_size=len(robot.steer_names))))
+@example(robot=_NEAR_AXLES, beta=())
+@given(robot=robots(max_wheels=3), beta=st.lists(st.floats(-math.pi, math.pi), max_size=3))
+def test_the_mobility_is_the_size_of_every_assignable_set_and_of_the_models(robot, beta):
+    beta = np.resize(np.array(beta, dtype=float), len(robot.steer_names))  # random headings, one per steered joint
     m = int(mobility(robot, beta))
     sets = assignable_sets(robot, beta)
     assert sets and all(len(s) == m for s in sets)  # k - rank A columns outside a column basis: one set at least

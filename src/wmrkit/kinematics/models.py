@@ -24,7 +24,7 @@ from .._shapes import as_names, as_vectors, matvec, readonly
 from ..errors import ShapeError, SingularError, WmrkitError
 from ..limits import MAX_QUERY_RATE
 from ..robot import TWIST_NAMES, Robot
-from .linalg import coupled_constraints, matrix_rank, nondimensional, nullity, velocity_scale
+from .linalg import centred, coupled_constraints, matrix_rank, nondimensional, nullity, velocity_scale
 from .nullspace import null_space_assignable, null_space_basis, null_space_solution, rref_solution
 from .ranks import ranks_assignable, ranks_solution
 from .search import SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
@@ -152,9 +152,16 @@ def velocity_indices(robot: Robot, names: Sequence[str]) -> np.ndarray:
     return np.array([robot.velocity_index(n) for n in names], dtype=int).reshape(len(names))
 
 
-def _assignable(a: np.ndarray, subsets: np.ndarray, method: Method) -> np.ndarray:
+def _ranks(robot: Robot, a: np.ndarray) -> dict[str, np.ndarray]:
+    """The keywords of :func:`~.ranks.ranks_assignable` that tie its sets to `robot`'s mobility (:func:`mobility`)
+    for its nondimensional matrix `a`: the centroid's matrix and the rank m is read from."""
+    whole = centred(robot, a)
+    return {"whole": whole, "rank_a": matrix_rank(whole)}
+
+
+def _assignable(robot: Robot, a: np.ndarray, subsets: np.ndarray, method: Method) -> np.ndarray:
     if method == "ranks":
-        return ranks_assignable(a, subsets)
+        return ranks_assignable(a, subsets, **_ranks(robot, a))
     if method == "nullspace":
         return null_space_assignable(a, subsets)
     if method == "rref":
@@ -169,15 +176,21 @@ def is_assignable(
     """Whether the velocities `names` can be assigned, (4.5)/(4.6)/(4.10): ``(..., n_steer) -> (...)`` bool;
     steering `beta` (thesis) or `heading` (0 = rolling forward)."""
     a = constraints(robot, configuration(robot, beta, heading))
-    return _assignable(a, velocity_indices(robot, names)[None, :], method)[0]
+    return _assignable(robot, a, velocity_indices(robot, names)[None, :], method)[0]
 
 
 def _sets_at(robot: Robot, a: np.ndarray, method: Method) -> tuple[tuple[str, ...], ...]:
     m = np.unique(nullity(robot, a))
     if len(m) != 1:  # the mobility changes within the batch: no set fits every configuration
         return SetList()
+    ranks = _ranks(robot, a) if method == "ranks" else {}
+
+    def test(s: np.ndarray) -> np.ndarray:
+        ok = ranks_assignable(a, s, **ranks) if ranks else _assignable(robot, a, s, method)
+        return ok.reshape(len(s), -1).all(axis=1)
+
     sets, complete, note = search_sets(  # bounded, pruned by the null-space test (.search)
-        range(a.shape[-1]), int(m[0]), lambda s: _assignable(a, s, method).reshape(len(s), -1).all(axis=1),
+        range(a.shape[-1]), int(m[0]), test,
         prefilter=null_space_prefilter(a, int(m[0])), max_exact=exact_budget(a.shape, 2),
         walk_cost=null_space_cost(a.shape, int(m[0])), what="assignable sets")
     names = robot.velocity_names
@@ -217,8 +230,9 @@ def generically_assignable_sets(robot: Robot) -> tuple[tuple[str, ...], ...]:
     a = constraints(robot, samples)
     m = generic_mobility(robot)
     generic = nullity(robot, a) == m  # one at least: m is the smallest of the samples' mobilities
+    ranks = _ranks(robot, a)
     sets, complete, note = search_sets(  # bounded, pruned by the null-space test at one generic sample at least
-        range(a.shape[-1]), m, lambda s: (ranks_assignable(a, s) & generic).any(axis=1),
+        range(a.shape[-1]), m, lambda s: (ranks_assignable(a, s, **ranks) & generic).any(axis=1),
         prefilter=null_space_prefilter(a[generic], m, every=False), max_exact=exact_budget(a.shape, 2),
         walk_cost=null_space_cost(a[generic].shape, m), what="generically assignable sets")
     names = robot.velocity_names
@@ -257,7 +271,7 @@ def kinematic_model(
     idx = velocity_indices(robot, assigned)
     a = constraints(robot, beta)
     if method == "ranks":
-        ok, matrix = ranks_assignable(a, idx[None, :])[0], ranks_solution(a, idx)
+        ok, matrix = ranks_assignable(a, idx[None, :], **_ranks(robot, a))[0], ranks_solution(a, idx)
     elif method in ("nullspace", "rref"):
         matrix, ok = (null_space_solution if method == "nullspace" else rref_solution)(a, idx)
     else:
@@ -283,8 +297,9 @@ def _first_assignable(robot: Robot, a: np.ndarray, candidates: Sequence[str],
     stopped before its end, its note (else ``""``)."""
     names = robot.velocity_names
     columns = [names.index(n) for n in candidates]
+    ranks = _ranks(robot, a)
     found, complete, note = search_sets(
-        columns, m, lambda s: ranks_assignable(a, s).reshape(len(s), -1).all(axis=1),
+        columns, m, lambda s: ranks_assignable(a, s, **ranks).reshape(len(s), -1).all(axis=1),
         prefilter=null_space_prefilter(a, m), limit=1, max_exact=exact_budget(a.shape, 2),
         walk_cost=null_space_cost(a.shape, m))
     return (tuple(names[i] for i in found[0]) if found else None), "" if complete else note
@@ -371,8 +386,9 @@ def inverse_model(
     if free:
         fixed = [robot.velocity_index(n) for n in free]
         combinations = itertools.combinations(TWIST_NAMES, m) if 0 < m <= 3 else ()  # gears can leave m <= 0
+        ranks = _ranks(robot, a)
         choice = next((c + free for c in combinations if ranks_assignable(
-            a, [[robot.velocity_index(n) for n in c] + fixed]).all()), None)
+            a, [[robot.velocity_index(n) for n in c] + fixed], **ranks).all()), None)
         note = ""
     else:
         choice, note = _first_assignable(robot, a, TWIST_NAMES, m)

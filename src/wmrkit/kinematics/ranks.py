@@ -13,17 +13,25 @@ from numpy.typing import ArrayLike
 from .linalg import RANK_RTOL, matrix_rank, solve_assigned
 
 
-def ranks_assignable(a: ArrayLike, subsets: ArrayLike) -> np.ndarray:
+def ranks_assignable(a: ArrayLike, subsets: ArrayLike, *, whole: ArrayLike | None = None,
+                     rank_a: ArrayLike | None = None) -> np.ndarray:
     """Assignability test (4.10) of many sets at once: ``(..., R, k), (S, n_a) -> (S, ...)`` bool.
 
-    True where ``rank A_na = rank A`` and ``n_a = k - rank A`` (a set of the size of the mobility).
+    True where ``rank A_na = rank A`` and ``n_a = k - rank A`` (a set of the size of the mobility). `whole`: `a` on
+    the twist of the wheels' centroid (``linalg.centred``), whose columns a set assigning no twist component takes
+    for ``A_na`` (the same rank: a change of the unknowns), and `rank_a` ``(...)`` the rank of ``A`` the mobility
+    was read from (``linalg.nullity``): the sets then have exactly the mobility's size, whatever side of the cut-off
+    a least singular value near it falls on in the other matrix.
     """
     a = np.asarray(a, dtype=float)
     subsets = np.asarray(subsets, dtype=int)
     k, n_a = a.shape[-1], subsets.shape[-1]
     keep = np.array([np.setdiff1d(np.arange(k), s) for s in subsets], dtype=int).reshape(len(subsets), k - n_a)
     a_na = np.moveaxis(a[..., keep], -2, 0)  # (..., R, S, k - n_a) -> (S, ..., R, k - n_a)
-    rank_a = matrix_rank(a)
+    inner = ~np.isin(subsets, (0, 1, 2)).any(axis=-1)  # (S,): no twist component assigned
+    if whole is not None and inner.any():
+        a_na[inner] = np.moveaxis(np.asarray(whole, dtype=float)[..., keep[inner]], -2, 0)
+    rank_a = matrix_rank(a) if rank_a is None else np.asarray(rank_a)
     return (matrix_rank(a_na) == rank_a) & (k - rank_a == n_a)
 
 
