@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numba
 import numpy as np
-from numba.core.caching import FunctionCache
+from numba.core.caching import FunctionCache, IndexDataCacheFile
 from numba.core.dispatcher import Dispatcher
 from numba.core.serialize import dumps
 from numba.extending import overload
@@ -99,17 +99,65 @@ def compile_cached(fn: Callable, signature=None, **options) -> Callable:
     docstring), else in memory only. The one place a wmrkit kernel asks for caching: ``cache=True`` itself raises
     at import when no directory is writable."""
     args = () if signature is None else (signature,)  # None: compiled for the types of its first call
+    if fn.__closure__:  # named by what it computes: see _content_named
+        try:
+            fn.__qualname__ = _content_named(fn)
+        except (pickle.PicklingError, TypeError, AttributeError):  # a cell numba cannot pickle either: no disk cache
+            pass
     try:
         kernel = numba.njit(*args, cache=True, **options)(fn)
     except RuntimeError:  # numba: "cannot cache function ...: no locator available for file ..."
         UNCACHED.add(f"{fn.__module__}.{fn.__qualname__}")
         return numba.njit(*args, **options)(fn)
-    if any(isinstance(c.cell_contents, Dispatcher) for c in fn.__closure__ or ()):
-        kernel._cache = _KernelsKeyedCache(fn)
+    nested = any(isinstance(c.cell_contents, Dispatcher) for c in fn.__closure__ or ())
+    kernel._cache = (_KernelsKeyedCache if nested else _KeyedCache)(fn)
     return kernel
 
 
-class _KernelsKeyedCache(FunctionCache):
+def _content_named(fn: types.FunctionType) -> str:
+    """`fn`'s qualified name followed by a digest of its code and closure (:func:`_closure_key`).
+
+    Numba names a compiled function's symbol by its qualified name and a number counted in each process, and a kernel
+    loaded from the disk cache keeps the symbols of the process that compiled it: the control ticks of three robots,
+    each compiled in its own process (each robot's IK there the first IK compiled), all called the first tick's IK
+    when a later process loaded them (the same symbol, linked once: swerve-4's and the Ackermann car's ticks refused
+    their headings as the forklift's IK's; robots of as many wheels would have answered with its geometry). Named by
+    their content, kernels of different constants never share a symbol; those of the same share the same code."""
+    return f"{fn.__qualname__}_{hashlib.sha256(_closure_key(fn)).hexdigest()[:16]}"
+
+
+class _KeyedFile(IndexDataCacheFile):
+    """Numba's index and data files, each entry's data file named by its key and holding the key, checked on load.
+
+    Numba names a new entry's data file by the first number its index does not use, read, changed and written back
+    without a lock: two processes saving one kernel with different constants at once could both take number 1, and
+    the index keep one's key over the other's code, which later processes would load as theirs
+    (``tests/test_jit_cache_race.py`` plays that interleaving). Named by the key, two keys never share a file; a
+    lost index entry costs a compile, and a file holding another key (or written by numba's own scheme) is not
+    loaded. (Kernels of different constants also have index files of their own: :func:`_content_named`.)"""
+
+    def save(self, key, data):
+        name = self._data_name(int(hashlib.sha256(repr(key).encode()).hexdigest()[:15], 16))
+        overloads = self._load_index()
+        if overloads.get(key) != name:
+            overloads[key] = name
+            self._save_index(overloads)
+        self._save_data(name, (key, data))
+
+    def load(self, key):
+        stored = super().load(key)
+        return stored[1] if isinstance(stored, tuple) and len(stored) == 2 and stored[0] == key else None
+
+
+class _KeyedCache(FunctionCache):
+    """Numba's disk cache of a kernel, its entries in :class:`_KeyedFile`."""
+
+    def __init__(self, py_func) -> None:
+        super().__init__(py_func)
+        self._cache_file = _KeyedFile(self._cache_path, self._impl.filename_base, self._impl.locator.get_source_stamp())
+
+
+class _KernelsKeyedCache(_KeyedCache):
     """Numba's disk cache of a kernel whose closure holds other kernels (``control.tick``: the robot's IK), keyed by
     what they compute: numba keys a closure by the pickle of its cells, and a kernel pickles with an identifier drawn
     at random in each process, so that such a kernel was compiled again in every process (and its cache grew by one
