@@ -1,5 +1,5 @@
 """Generated C on small stacks: the forward model's workspace (A_na, b, x: rows x unknowns doubles) was a local array,
-271 KB for 64 double wheels sensing one spin each, 38 KB for 48 fixed wheels sensing three; a controller thread or a
+409 KB for 64 double wheels sensing one spin each, 56 KB for 48 fixed wheels sensing three; a controller thread or a
 microcontroller task of 32 KiB crashed (SIGSEGV) in the first call. Above codegen.MAX_STACK_WORK it is static now,
 and NAME_forward_work takes the caller's buffer (reentrant)."""
 
@@ -57,7 +57,7 @@ def _fixed_ring(n: int, sensed: int) -> Robot:
 
 @pytest.mark.skipif(GCC is None, reason="gcc not installed")
 def test_the_forward_model_of_many_wheels_runs_on_a_32_kib_stack(tmp_path):
-    """48 fixed wheels sensing 3 spins: 96 rows x 48 unknowns, a 38 KB workspace. Before: SIGSEGV (exit -11) in a
+    """48 fixed wheels sensing 3 spins: 96 rows x 48 unknowns, a 56 KB workspace. Before: SIGSEGV (exit -11) in a
     thread of 32 KiB. Now both forward and forward_work answer the least-squares twist and residual (4.11), checked
     against numpy's lstsq of the numeric constraint matrix."""
     robot = _fixed_ring(48, 3)

@@ -19,7 +19,7 @@ from ..errors import SingularError, WmrkitError, name_list
 from ..robot import TWIST_NAMES, Robot
 from ._symbolic_held import combine, held_gears, substituted_form
 from .gear_check import gear_table, steer_gears
-from .linalg import free_columns, matrix_rank, nondimensional
+from .linalg import centroid, characteristic_length, free_columns, matrix_rank, nondimensional
 from .linkage_check import _plan as linkage_plan
 from .models import generic_inputs
 from .symbolic import sensed_rates, symbolic_constraint_matrix, symbolic_model
@@ -70,6 +70,7 @@ class Plan:
         self.free, self.known = gear_unknowns(robot.couplings, names, given)
         self.unknown_names = gear_free(robot.couplings, names, given)[1]
         self._check_forward()
+        self.decide = self._decision_transform()
         # the double wheels' steering rates no twist determines: inputs besides the twist, as the inverse model's
         self.free_steer = generic_inputs(robot)[0]
         self.steer_rate = tuple(sp.Symbol(f"s{i}", real=True) for i in range(len(self.free_steer)))
@@ -97,6 +98,22 @@ class Plan:
             raise SingularError(f"robot '{self.robot.name}': the sensed rates ({name_list(self.sensed)}) do not "
                                 f"determine ({names}); sense more joints (the wheels' 'sensed' field of the "
                                 "description, or sensed= in Python)")
+
+    def _decision_transform(self) -> np.ndarray:
+        """``S`` ``(p, p)``: ``A_na @ S`` is the library's decision matrix of the forward model's unknowns
+        (:func:`~.linalg.decision_matrix`: lengths over ``L``, the twist of the wheels' centroid; gears as
+        :func:`~.linalg.geared_twist_determined` holds them), on which the generated code decides "twist not
+        determined" with :data:`~.linalg.RANK_RTOL` and solves; ``S @ y`` the unknowns of ``A_na``. The twist is
+        the first three unknowns (the sensed rates are joints)."""
+        p = len(self.unknown_names)
+        if not np.array_equal(self.free[:3, :3], np.eye(3)) or np.any(self.free[:3, 3:]):
+            raise CodegenError("the forward model's unknowns do not start with the twist")  # sensed are joints
+        size = characteristic_length(self.robot)
+        cx, cy = centroid(self.robot)
+        out = np.eye(p) / size
+        out[0, 0] = out[1, 1] = 1.0  # vx, vy: / (1 / L) / L
+        out[0, 2], out[1, 2] = cy / size, -cx / size  # the centroid's twist (linalg.centred)
+        return out
 
     def _inverse_form(self, inputs: tuple[str, ...]) -> tuple[tuple[str, ...], sp.Matrix, bool]:
         """The rates not in `inputs`, ``M`` with ``rates = M @ inputs``, and whether it is exact: least squares per

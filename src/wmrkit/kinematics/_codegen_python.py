@@ -11,6 +11,7 @@ from . import _codegen_steer_gear
 from ._codegen_linkage import has_linkages, py_constants, py_in_linkage
 from ._codegen_plan import Plan, cse
 from .gear_check import GEAR_RTOL
+from .linalg import RANK_RTOL
 from .symbolic import printable
 from .wheel_ik import SLIP_TOL
 
@@ -45,6 +46,15 @@ def _py_gears(plan: Plan) -> tuple[tuple[tuple[int, ...], tuple[float, ...], tup
     t = plan.gear_table
     spans = [slice(int(t.start[g]), int(t.start[g + 1])) for g in range(len(t.coupling))]
     return tuple((tuple(t.joint[s].tolist()), tuple(t.ratio[s].tolist()), tuple(t.lever[s].tolist())) for s in spans)
+
+
+def _py_decision(plan: Plan) -> str:
+    """The constants of the forward model's rank decision (``Plan.decide``, ``linalg.RANK_RTOL``)."""
+    return "\n".join([
+        f"RANK_RTOL = {RANK_RTOL!r}  # wmrkit.kinematics.linalg.RANK_RTOL: the library's rank rule",
+        "# the unknowns' columns times _DECIDE: the library's decision matrix (lengths over the robot's size L, the",
+        "# twist of the wheels' centroid); the unknowns are _DECIDE @ its unknowns",
+        f"_DECIDE = numpy.array({plan.decide.tolist()!r})"])
 
 
 def _py_forward_system(plan: Plan) -> str:
@@ -149,7 +159,8 @@ FREE_STEER_NAMES = {tuple(plan.free_steer)!r}
 VELOCITY_NAMES = {tuple(r.velocity_names)!r}
 HEADING_DESCRIBED = {tuple(float(h) for h in r.heading)!r}
 _BETA_OFFSET = {tuple(plan.offsets)!r}  # the thesis's beta = heading + pi/2 - delta
-{_py_unknowns(plan)}{py_constants(plan)}{_codegen_steer_gear.py_constants(plan)}
+{_py_unknowns(plan)}
+{_py_decision(plan)}{py_constants(plan)}{_codegen_steer_gear.py_constants(plan)}
 
 
 def _beta(heading):
@@ -197,8 +208,9 @@ def forward_with_residual(sensed, heading=None):
     """Least-squares twist (4.11) and slip residual ``|A q|`` [m/s].
 
     ``(..., {len(plan.sensed)}) -> (..., 3), (...)``. Both are NaN where the sensed rates do not determine the twist
-    at those headings (the smallest singular value of the unknowns' columns, each scaled to norm 1 whatever its
-    units, <= 1e-9 rows) or an input is not finite, as the C code's -1.
+    at those headings or an input is not finite, as the C code's -1: wmrkit's rank rule (``twist_is_determined``),
+    ``rank D = 3 + rank D_joints`` with singular values at or below ``RANK_RTOL * max(s_max, 1)`` counted as 0, ``D``
+    the unknowns' columns nondimensional and for the wheels' centroid's twist (``_DECIDE``), solved as ``fk``.
     """
     sensed = _vectors(sensed, {len(plan.sensed)}, "sensed")
     a = constraint_matrix(heading)
@@ -206,12 +218,22 @@ def forward_with_residual(sensed, heading=None):
     a = numpy.where(finite[..., None, None], a, 0.0)
     sensed = numpy.where(finite[..., None], sensed, 0.0)
 {_py_forward_system(plan)}
-    norms = numpy.linalg.norm(a_na, axis=-2, keepdims=True)  # columns of norm 1: m/s and m alike
-    unit = a_na / numpy.where(norms > 0, norms, 1.0)
-    x = (numpy.linalg.pinv(unit) @ rhs) / numpy.where(norms > 0, norms, 1.0).swapaxes(-1, -2)
-    residual = numpy.linalg.norm((a_na @ x - rhs)[..., 0], axis=-1)
-    ok = finite & (numpy.linalg.svd(unit, compute_uv=False)[..., -1] > 1e-9 * a_na.shape[-2])
-    return numpy.where(ok[..., None], x[..., :3, 0], numpy.nan), numpy.where(ok, residual, numpy.nan)
+    d = a_na @ _DECIDE
+    u, s, vt = numpy.linalg.svd(d, full_matrices=False)
+    keep = s > RANK_RTOL * numpy.maximum(s[..., :1], 1.0)
+    y = vt.swapaxes(-1, -2) @ (numpy.divide(1.0, s, out=numpy.zeros_like(s), where=keep)[..., None]
+                               * (u.swapaxes(-1, -2) @ rhs))
+    residual = numpy.linalg.norm((d @ y - rhs)[..., 0], axis=-1)
+    ok = finite & (keep.sum(axis=-1) == 3 + _rank(d[..., 3:]))
+    return numpy.where(ok[..., None], (_DECIDE[:3] @ y)[..., 0], numpy.nan), numpy.where(ok, residual, numpy.nan)
+
+
+def _rank(m):
+    """The rank of ``(..., r, c)`` by wmrkit's rule: singular values above ``RANK_RTOL * max(s_max, 1)``."""
+    if m.shape[-1] == 0:
+        return numpy.zeros(m.shape[:-2], dtype=int)
+    s = numpy.linalg.svd(m, compute_uv=False)
+    return (s > RANK_RTOL * numpy.maximum(s[..., :1], 1.0)).sum(axis=-1)
 
 
 def forward(sensed, heading=None):

@@ -3,8 +3,10 @@
 ``inverse(twist, heading) -> wheel rates`` is the closed form of :func:`~wmrkit.kinematics.symbolic.symbolic_model`
 with the twist assigned (4.11): exact when the twist is assignable, else least squares per wheel, as a
 controller needs it. ``forward(sensed, heading) -> twist`` solves the no-slip equations for the twist and every
-unsensed rate by least squares (4.11): the generated C carries a small Householder-QR routine (no closed form
-to blow up), the generated Python calls ``numpy.linalg.pinv``; the residual ``|A q|`` [m/s] is the slip (4.16).
+unsensed rate by least squares (4.11): both decide "twist not determined" with the library's rank rule
+(:data:`~.linalg.RANK_RTOL` on its decision matrix, as ``twist_is_determined``) and solve as ``fk`` (the generated C
+by a small one-sided Jacobi SVD, no closed form to blow up; the generated Python by ``numpy.linalg.svd``); the
+residual ``|A q|`` [m/s] is the slip (4.16).
 Both are printed from the same symbolic constraint matrix (3.22), with common-subexpression elimination.
 A ``gear`` coupling is held as ``fk`` and ``ik`` hold it: the forward model's unknowns are those of
 :func:`wmrkit.couplings.gear_unknowns` (a gear's unsensed joints filled from its sensed ones, its turn an unknown
@@ -29,6 +31,7 @@ from . import _codegen_linkage, _codegen_steer_gear
 from ._codegen_plan import C_KEYWORDS, CodegenError, Plan, cse, identifier
 from ._codegen_python import python_file
 from .gear_check import GEAR_RTOL
+from .linalg import RANK_RTOL
 from .symbolic import printable
 from .wheel_ik import SLIP_TOL
 
@@ -102,39 +105,84 @@ def _head(path: Path) -> list[str]:
 
 # ---- C ---------------------------------------------------------------------------------------------------
 _C_LSTSQ = """\
-/* min |A x - b| by Householder QR; A: m x n row-major (m >= n), A and b are overwritten.
- * Returns 0, or -1 if A is rank deficient (what is left of a column once the previous ones are projected out is
- * <= 1e-9 * m (the rows) times its norm, whatever its units: then x is not set).
- * *residual (if not NULL) = |A x - b|. */
-static int lstsq(int m, int n, double *a, double *b, double *x, double *residual)
+/* The norm of column j of A, m x n row-major. */
+static double hypot_norm(int m, int n, const double *a, int j)
 {
-    for (int k = 0; k < n; ++k) {
-        double norm = 0.0, column = 0.0; /* the reflections keep the column's norm: rows < k hold its R part */
-        for (int i = k; i < m; ++i) norm = hypot(norm, a[i * n + k]);
-        for (int i = 0; i < k; ++i) column = hypot(column, a[i * n + k]);
-        if (norm <= 1e-9 * m * hypot(column, norm)) return -1;
-        const double alpha = a[k * n + k] > 0.0 ? -norm : norm;
-        a[k * n + k] -= alpha; /* column k below the diagonal is now v = x - alpha e_k */
-        double vv = 0.0;
-        for (int i = k; i < m; ++i) vv += a[i * n + k] * a[i * n + k];
-        for (int j = k + 1; j <= n; ++j) { /* j == n: the right-hand side b */
-            double s = 0.0;
-            for (int i = k; i < m; ++i) s += a[i * n + k] * (j < n ? a[i * n + j] : b[i]);
-            s *= 2.0 / vv;
-            for (int i = k; i < m; ++i) {
-                if (j < n) a[i * n + j] -= s * a[i * n + k]; else b[i] -= s * a[i * n + k];
+    double s = 0.0;
+    for (int i = 0; i < m; ++i) s = hypot(s, a[i * n + j]);
+    return s;
+}
+
+/* One-sided Jacobi (Hestenes) on columns first..n-1 of A, m x n row-major, rotated until orthogonal and
+ * overwritten with A V = U S (column j is u_j s_j); V (n x n) accumulates the rotations. Returns the rank of those
+ * columns by wmrkit's rule: their norms s_j above *cut = RANK_RTOL * max(s_max, 1) (linalg.rank_cutoff). */
+static int jacobi_rank(int m, int n, int first, double *a, double *v, double *cut)
+{
+    for (int sweep = 0, rotated = 1; rotated && sweep < 60; ++sweep) {
+        rotated = 0;
+        for (int p = first; p + 1 < n; ++p) for (int q = p + 1; q < n; ++q) {
+            double alpha = 0.0, beta = 0.0, gamma = 0.0;
+            for (int i = 0; i < m; ++i) {
+                alpha += a[i * n + p] * a[i * n + p];
+                beta += a[i * n + q] * a[i * n + q];
+                gamma += a[i * n + p] * a[i * n + q];
+            }
+            if (!(fabs(gamma) > 1e-15 * sqrt(alpha * beta))) continue; /* orthogonal to round-off */
+            rotated = 1;
+            const double zeta = (beta - alpha) / (2.0 * gamma);
+            const double t = (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + hypot(1.0, zeta));
+            const double c = 1.0 / sqrt(1.0 + t * t), s = c * t;
+            for (int i = 0; i < m; ++i) {
+                const double x = a[i * n + p], y = a[i * n + q];
+                a[i * n + p] = c * x - s * y;
+                a[i * n + q] = s * x + c * y;
+            }
+            for (int i = 0; i < n; ++i) {
+                const double x = v[i * n + p], y = v[i * n + q];
+                v[i * n + p] = c * x - s * y;
+                v[i * n + q] = s * x + c * y;
             }
         }
-        a[k * n + k] = alpha; /* R_kk */
     }
-    for (int k = n - 1; k >= 0; --k) {
-        double s = b[k];
-        for (int j = k + 1; j < n; ++j) s -= a[k * n + j] * x[j];
-        x[k] = s / a[k * n + k];
+    double s_max = 0.0;
+    for (int j = first; j < n; ++j) s_max = hypot_norm(m, n, a, j) > s_max ? hypot_norm(m, n, a, j) : s_max;
+    *cut = RANK_RTOL * (s_max > 1.0 ? s_max : 1.0);
+    int rank = 0;
+    for (int j = first; j < n; ++j) rank += hypot_norm(m, n, a, j) > *cut;
+    return rank;
+}
+
+/* min |D y - b| with D m x n row-major (m >= n >= 3, the twist's 3 columns first; overwritten) and v (n x n) work:
+ * y = V S^+ U^T b, singular values at or below the cut-off dropped, as wmrkit's fk. Returns 0, or -1 if the twist
+ * is not determined: rank D != 3 + rank of D's other columns (wmrkit's twist_is_determined); then y is not set.
+ * *residual (if not NULL) = |D y - b|. The rotations of D's other columns keep the column space: D's rank follows. */
+static int lstsq(int m, int n, double *d, const double *b, double *v, double *y, double *residual)
+{
+    double cut;
+    for (int i = 0; i < n; ++i) for (int j = 0; j < n; ++j) v[i * n + j] = i == j;
+    const int joints = jacobi_rank(m, n, 3, d, v, &cut);
+    if (jacobi_rank(m, n, 0, d, v, &cut) != 3 + joints) return -1;
+    for (int j = 0; j < n; ++j) y[j] = 0.0;
+    for (int k = 0; k < n; ++k) {
+        const double s = hypot_norm(m, n, d, k);
+        if (!(s > cut)) continue;
+        double ub = 0.0; /* u_k . b */
+        for (int i = 0; i < m; ++i) ub += d[i * n + k] * b[i] / s;
+        for (int j = 0; j < n; ++j) y[j] += v[j * n + k] * (ub / s);
     }
-    if (residual) {
+    if (residual) { /* |b - U U^T b|: the part of b no kept column reaches */
         double r = 0.0;
-        for (int i = n; i < m; ++i) r = hypot(r, b[i]);
+        for (int i = 0; i < m; ++i) {
+            double e = b[i];
+            for (int k = 0; k < n; ++k) {
+                const double s = hypot_norm(m, n, d, k);
+                if (!(s > cut)) continue;
+                double ub = 0.0;
+                for (int l = 0; l < m; ++l) ub += d[l * n + k] * b[l];
+                e -= d[i * n + k] * ub / (s * s);
+            }
+            r = hypot(r, e);
+        }
         *residual = r;
     }
     return 0;
@@ -179,7 +227,7 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
     beta_param = f"const double heading[{p}_N_STEER]" if plan.beta else "const double *heading"
     rows, na = plan.a.rows, len(plan.unknown_names)
     sizes = {"N_STEER": len(plan.beta), "N_RATES": len(plan.rates), "N_SENSED": len(plan.sensed),
-             "N_ROWS": rows, "N_VEL": plan.a.cols, "N_UNKNOWN": na, "N_WORK": rows * na + rows + na}
+             "N_ROWS": rows, "N_VEL": plan.a.cols, "N_UNKNOWN": na, "N_WORK": rows * na + na * na + rows + na}
     on_stack = sizes["N_WORK"] <= MAX_STACK_WORK
     steer_param = ""
     if plan.free_steer:  # double wheels: their steering rates are inputs of the inverse model
@@ -244,10 +292,13 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
     ])
     a_targets = [f"a[{i * plan.a.cols + j}]" for i in range(plan.a.rows) for j in range(plan.a.cols)]
     a_na, b = plan.forward_exprs()
+    d = plan.decide.tolist()
     fw_targets = [f"a[{k}]" for k in range(len(a_na))] + [f"b[{i}]" for i in range(len(b))]
     source = "\n".join([
         f"/* {n}_kinematics.c: generated by wmrkit from robot '{_c_comment(r.name)}'; see {n}_kinematics.h. */",
-        "#include <math.h>", f'#include "{n}_kinematics.h"', "", _C_LSTSQ,
+        "#include <math.h>", f'#include "{n}_kinematics.h"', "",
+        f"static const double RANK_RTOL = {RANK_RTOL!r}; /* wmrkit.kinematics.linalg.RANK_RTOL: its rank rule */", "",
+        _C_LSTSQ,
         protos[0][:-1], "{", _c_unpack(plan), _c_body(plan, list(plan.a), a_targets), "}", "",
         protos[1][:-1], "{", _c_unpack(plan, twist=True),
         _c_body(plan, plan.inverse, [f"rates[{i}]" for i in range(len(plan.rates))], list(plan.rates)), "}", "",
@@ -256,13 +307,25 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
         f"{'' if on_stack else f' /* {work_bytes} bytes: too many for small stacks; not reentrant */'}",
         f"    return {n}_forward_work(sensed, heading, twist, residual, work);", "}", "",
         protos[3][:-1], "{",
-        f"    double *a = work, *b = work + {p}_N_ROWS * {p}_N_UNKNOWN, *x = b + {p}_N_ROWS;",
+        f"    double *a = work, *b = work + {p}_N_ROWS * {p}_N_UNKNOWN, *y = b + {p}_N_ROWS, *v = y + {na};",
         _c_unpack(plan, sensed=True),
-        f"    /* unknowns x: {_c_comment(', '.join(plan.unknown_names))} */",
+        f"    /* unknowns: {_c_comment(', '.join(plan.unknown_names))} */",
         _c_body(plan, a_na + b, fw_targets),
-        f"    int status = lstsq({p}_N_ROWS, {na}, a, b, x, residual);",
-        f"    for (int i = 0; status == 0 && i < {na}; ++i) if (!isfinite(x[i])) status = -1; /* NaN or inf input */",
-        "    for (int i = 0; i < 3; ++i) twist[i] = status == 0 ? x[i] : (double)NAN;",
+        "    int status = 0; /* a NaN or inf input: -1 */",
+        f"    for (int i = 0; i < {p}_N_ROWS * ({na} + 1); ++i) if (!isfinite(work[i])) status = -1;",
+        "    /* the library's decision matrix: lengths over the robot's size, the twist of the wheels' centroid */",
+        f"    for (int i = 0; i < {p}_N_ROWS; ++i) {{",
+        f"        double *row = a + i * {na};",
+        f"        row[2] = {d[2][2]!r} * row[2] + {d[0][2]!r} * row[0] + {d[1][2]!r} * row[1];",
+        f"        for (int j = 3; j < {na}; ++j) row[j] *= {d[2][2]!r};",
+        "    }",
+        f"    if (status == 0) status = lstsq({p}_N_ROWS, {na}, a, b, v, y, residual);",
+        "    if (status == 0) { /* the unknowns from the decision matrix's */",
+        f"        twist[0] = y[0] + {d[0][2]!r} * y[2];",
+        f"        twist[1] = y[1] + {d[1][2]!r} * y[2];",
+        f"        twist[2] = {d[2][2]!r} * y[2];",
+        "    }",
+        "    else for (int i = 0; i < 3; ++i) twist[i] = (double)NAN;",
         "    if (status != 0 && residual) *residual = NAN;",
         "    return status;", "}", "", *_c_in_gear(plan, protos[4] if plan.geared else ""),
         *_codegen_linkage.c_in_linkage(plan, protos[-2] if steer_geared else protos[-1]),
