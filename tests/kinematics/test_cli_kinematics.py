@@ -159,3 +159,20 @@ def test_a_steer_heading_beyond_the_angle_limit_names_the_option(capsys):
     err = capsys.readouterr().err
     assert err.startswith("wmrkit: error: --steer steer=1e6turn: ") and "1e+06 turns" in err
     assert err.count("\n") == 1
+
+
+def test_json_models_carry_headings_beside_beta(capsys):
+    """The models' configuration was given only as the thesis's beta; users read headings (0 = straight ahead):
+    each model object carries `heading`, the top-level `steering`'s values in steer_names order, and keeps `beta`."""
+    from wmrkit import catalog
+
+    robot = catalog.load("ackermann")
+    data = run_json(capsys, ["kinematics", "ackermann", "--steer", "front_left=20 deg", "--steer",
+                             "front_right=-15 deg"])
+    steered = robot.with_steering({"front_left": math.radians(20), "front_right": math.radians(-15)})
+    for key in ("direct_model", "inverse_model"):
+        model = data[key]
+        assert model["heading"] == pytest.approx([data["steering"][n] for n in robot.steer_names])
+        assert model["heading"] == pytest.approx([math.radians(20), math.radians(-15)])
+        assert model["beta"] == pytest.approx(steered.beta.tolist())  # unchanged: the thesis's angles
+        assert model["beta"] == pytest.approx([data["beta"][n] for n in robot.steer_names])

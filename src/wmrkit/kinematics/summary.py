@@ -31,7 +31,9 @@ def _model(build, robot: Robot) -> dict[str, Any]:
         model: KinematicModel = build(robot)
     except SingularError as err:
         return {"error": str(err)}
-    return model.as_dict()
+    out = model.as_dict()
+    beta = out.pop("beta")  # the users' headings (0 = straight ahead) beside the thesis's beta, in its order
+    return {**out, "heading": robot.heading_of_beta(model.beta).tolist(), "beta": beta}
 
 
 def kinematics_summary(robot: Robot) -> dict[str, Any]:
