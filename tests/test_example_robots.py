@@ -42,8 +42,8 @@ def test_each_example_robot_has_a_documented_command():
 
 #: What the pages say each command answers: its exit code and a piece of its output or warning they quote.
 SAYS = {("ik", "geared.json"): (1, "feasible: NO (a steering gear cannot set these headings)"),
-        ("ik", "synchro.yaml"): (1, "linkage(a.steer, b.steer, c.steer) (law parallel) sets a at heading -2.63485 deg "
-                                    "with c at -2.63485 deg, not 5.71059 deg"),
+        ("ik", "synchro.yaml"): (1, "the steering linkage of wheels 'a', 'b' and 'c' (law parallel) sets a at heading "
+                                    "-2.63485 deg with c at -2.63485 deg, not 5.71059 deg"),
         ("fk", "cart.yaml"): (0, "do not turn together"),
         ("fk", "synchro.yaml"): (0, "the headings break a steering linkage: linkage(a.steer, b.steer, c.steer) (law "
                                     "parallel) sets b at heading 0 deg with a at 0 deg, not 10 deg"),
@@ -83,7 +83,8 @@ def test_the_geared_units_turn_their_steering_1_to_2_and_ik_holds_them_to_it(cap
     assert main(["ik", "examples/robots/geared.json", "--twist", "1", "0", "1"]) == 1
     out, err = capsys.readouterr()
     assert out.rstrip().endswith("feasible: NO (a steering gear cannot set these headings)")
-    assert (f"gear(front.steer, rear.steer) (ratios 1, 2) sets front at heading {rear / 2:.6g} deg with rear at "
+    assert (f"the steering gear of wheels 'front' and 'rear' (ratios 1, 2) sets front at heading {rear / 2:.6g} deg "
+            "with rear at "
             f"{rear:.6g} deg, not {front:.6g} deg, which the twist needs") in err
     assert main(["ik", "examples/robots/geared.json", "--twist", "1", "0", "0"]) == 0  # both straight: 0 = 2 * 0
     assert "feasible: yes" in capsys.readouterr().out

@@ -396,9 +396,20 @@ def gear_breaches(couplings: tuple[Coupling, ...], names: tuple[str, ...], q: np
     return out
 
 
-def coupling_words(couplings: tuple[Coupling, ...], channel: str) -> str:
-    """A steering linkage or gear of `couplings` by its channel name (``linkage(fl.steer, fr.steer)``: the library's,
-    kept in JSON) in the description's terms, for text: ``the steering linkage of wheels 'fl' and 'fr'``."""
-    c = next(c for c in couplings if c.channel_name == channel)
-    wheels = [f"'{j.removesuffix('.steer')}'" for j in c.joints if j.endswith(".steer")]
-    return f"the steering {c.kind} of wheels {name_list(wheels[:-1])} and {wheels[-1]}"
+def coupling_words(couplings: tuple[Coupling, ...], channel: str, *, short: bool = False) -> str:
+    """A coupling of `couplings` by its channel name (``linkage(fl.steer, fr.steer)``: the library's, kept in JSON) in
+    the description's terms, for text: ``the steering linkage of wheels 'fl' and 'fr'``, ``the differential of
+    wheels 'rl' and 'rr'`` (each wheel's one joint of the kind: its spin or its steering), else by joints (``the gear
+    of joints 'd.spin1' and 'd.spin2'``). `short`: the compact form for a list of identifiers,
+    ``linkage of fl and fr``, ``gear of d.spin1 and d.spin2``. A `channel` no coupling has (a joint's name) as is."""
+    c = next((c for c in couplings if c.channel_name == channel), None)
+    if c is None:
+        return channel
+    wheel, _, joint = zip(*(j.partition(".") for j in c.joints), strict=True)
+    by_wheel = len(set(joint)) == 1 and joint[0] in ("spin", "steer") and len(set(wheel)) == len(wheel)
+    names = list(wheel) if by_wheel else list(c.joints)
+    if short:
+        return f"{c.kind} of {name_list(names[:-1])} and {names[-1]}"
+    quoted = [f"'{n}'" for n in names]
+    kind = f"steering {c.kind}" if joint[0] == "steer" and by_wheel else c.kind
+    return f"the {kind} of {'wheels' if by_wheel else 'joints'} {name_list(quoted[:-1])} and {quoted[-1]}"

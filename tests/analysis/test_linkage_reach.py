@@ -43,8 +43,9 @@ def test_a_synchro_drive_s_singular_icr_at_a_wheel_is_said_to_be_out_of_its_reac
     assert len(headings) == 1 and abs(headings[0, 1] - headings[0, 2]) % 180 > 1.0  # b, c not parallel
     text = analyze(r).format_text()
     assert ("  singular (sensed: w0.spin): with coordinated steering, when the ICR is at (0.200, 0.000) m\n"
-            "    not reachable: linkage(w0.steer, w1.steer, w2.steer) (law parallel) cannot set the steering of this "
-            "singular configuration (the thesis's coordinated steering turns each wheel on its own)") in text
+            "    not reachable: the steering linkage of wheels 'w0', 'w1' and 'w2' (law parallel) cannot set the "
+            "steering of this singular configuration (the thesis's coordinated steering turns each wheel on its "
+            "own)") in text
     path = tmp_path / "synchro.json"
     path.write_text(json.dumps(r.to_dict()))
     assert main(["analyze", str(path), "--json"]) == 0

@@ -123,7 +123,7 @@ def test_a_front_linked_four_wheel_steer_also_turns_about_its_front_axle_line():
 
 def test_a_linkage_is_one_steering_actuator(capsys):
     robot = car("parallel")
-    assert "(differential(rear_left.spin, rear_right.spin), linkage(front_left.steer, front_right.steer))" in \
+    assert "(differential of rear_left and rear_right, linkage of front_left and front_right)" in \
         analyze(robot, resolution=8).format_text()
     assert actuation_analysis(robot).steering_actuators == ("linkage(front_left.steer, front_right.steer)",)
     sets = minimal_actuator_sets(robot)

@@ -69,7 +69,7 @@ def test_analyze_names_a_differential_as_one_actuator_as_kinematics_does(capsys)
     own singular line and `kinematics` named the channel."""
     assert main(["analyze", "forklift"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    channel = "differential(right_drive.spin, left_drive.spin)"
+    channel = "differential of right_drive and left_drive"  # the JSON's differential(right_drive.spin, ...)
     actuation = next(x for x in lines if x.strip().startswith("actuation:"))
     assert actuation.endswith(f"({channel}, steer.steer)")
     assert any(x.strip().startswith(f"singular (actuated: {channel})") for x in lines)

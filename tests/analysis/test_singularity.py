@@ -245,7 +245,7 @@ def test_the_forklift_differential_cannot_drive_a_turn_about_the_drive_axle_midd
     assert main(["analyze", "forklift", "--steer", "steer=90deg"]) == 0
     out = capsys.readouterr().out
     assert "actuation: insufficient" in out
-    assert ("singular (actuated: differential(right_drive.spin, left_drive.spin)): at heading steer = 90.00, "
+    assert ("singular (actuated: differential of right_drive and left_drive): at heading steer = 90.00, "
             "-90.00 deg") in out
     assert "singular (sensed: right_drive.spin, left_drive.spin): never" in out
     assert main(["analyze", "forklift", "--json"]) == 0

@@ -88,8 +88,8 @@ def test_ik_names_the_gear_and_the_rates(capsys, tmp_path):
     car.to_file(path)
     code, out, err = run(capsys, "ik", str(path), "--twist", "1", "0", "0.2")
     assert code == 1 and "feasible: NO (a gear coupling cannot turn its joints so)" in out
-    assert ("a gear coupling cannot turn its joints so: gear(rear_left.spin, rear_right.spin) turns them in the "
-            "ratios 1, 1, the twist needs rear_left.spin 2.56061, rear_right.spin 3.5 rad/s") in err
+    assert ("a gear coupling cannot turn its joints so: the gear of wheels 'rear_left' and 'rear_right' turns them in "
+            "the ratios 1, 1, the twist needs rear_left.spin 2.56061, rear_right.spin 3.5 rad/s") in err
     code, out, err = run(capsys, "ik", str(path), "--twist", "1", "0", "0.2", "--json")
     data = json.loads(out)
     assert data["feasible"] is False and data["out_of_gear"] == ["gear(rear_left.spin, rear_right.spin)"]

@@ -143,7 +143,7 @@ def test_cli_says_both_mobilities_and_that_the_models_hold_the_gear(tmp_path, ca
     assert main(["kinematics", str(path)]) == 0
     out = capsys.readouterr().out
     assert "  mobility m = 2 of the wheels alone\n" in out
-    assert ("  with its gear couplings m = 1 (gear(left.spin, right.spin), q_j = ratio_j * u): the sets and models "
+    assert ("  with its gear couplings m = 1 (gear of left and right, q_j = ratio_j * u): the sets and models "
             "below hold them") in out
     sets = "(vx)  (omega)  (left.spin)  (right.spin)  (caster.steer)  (caster.spin)"
     assert f"  assignable sets (6):\n    {sets}\n" in out
@@ -167,7 +167,7 @@ def test_a_gear_that_locks_the_cart_leaves_no_motion(tmp_path, capsys):
     path.write_text(cart_yaml(-1.0, STEERED))
     assert main(["kinematics", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "  with its gear couplings m = 0 (gear(left.spin, right.spin)" in out
+    assert "  with its gear couplings m = 0 (gear of left and right," in out
     assert "  with its 1 steering angle (extended solutions, §4.5), 1 velocity can be assigned\n" in out
     assert "    the robot cannot move (m = 0): every velocity is zero" in out
     assert "  direct model:\n" in out and "  inverse model:\n" in out and "assigned: )" not in out  # was "(inverse,

@@ -67,7 +67,8 @@ def test_the_cli_says_no_naming_the_linkage_and_the_wheels(tmp_path, capsys):
     out, err = capsys.readouterr()
     assert out.rstrip().endswith("feasible: NO (a steering linkage cannot set these headings)")
     assert err.startswith("wmrkit: warning: twist not feasible for robot 'synchro': a steering linkage cannot set "
-                          "these headings: linkage(a.steer, b.steer, c.steer) (law parallel) sets a at heading")
+                          "these headings: the steering linkage of wheels 'a', 'b' and 'c' (law parallel) sets a at "
+                          "heading")
     assert err.count("\n") == 1
     assert main(["ik", str(path), "--twist", "1", "0", "0.5", "--json"]) == 1
     data = json.loads(capsys.readouterr()[0])

@@ -100,7 +100,8 @@ def test_ik_names_the_steering_gear_and_how_far_off(tmp_path, capsys):
     answer = json.loads(capsys.readouterr().out)
     assert answer["out_of_steer_gear"] == [GEAR] and answer["feasible"] is False
     (said,) = answer["warnings"]
-    assert (f"a steering gear cannot set these headings: {GEAR} (ratios 1, 2) sets front at heading -7.01812 deg with "
+    assert ("a steering gear cannot set these headings: the steering gear of wheels 'front' and 'rear' (ratios 1, 2) "
+            "sets front at heading -7.01812 deg with "
             "rear at -14.0362 deg, not 20.556 deg, which the twist needs (27.6 deg off") in said
     assert main(["ik", str(path), "--twist", "1", "0", "0"]) == 0
     assert "feasible: yes" in capsys.readouterr().out

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..couplings import linkage_law
+from ..couplings import coupling_words, linkage_law
 from ..kinematics.linkage_check import _plan, _speeds, linkage_holds
 from ..kinematics.wheel_ik import SLIP_TOL
 from ..robot import Robot
@@ -205,10 +205,20 @@ def unreachable(robot: Robot, s: SingularSet) -> tuple[np.ndarray, tuple[str, ..
     """``(n,)`` bool over ``s.configurations``: True where a held linkage cannot set that steering (judged at a unit
     twist about its ICR, as ``ik``; a configuration with no single ICR is not judged), and the linkages that break,
     each as ``"<channel> (law <law>)"``. Only coordinated sets over every steering angle are judged."""
+    out, broken = _unreachable(robot, s)
+    return out, tuple(_law_named(robot, k, robot.couplings[k].channel_name) for k in broken)
+
+
+def _law_named(robot: Robot, k: int, name: str) -> str:
+    return f"{name} (law {linkage_law(robot.couplings[k], robot.wheels)})"
+
+
+def _unreachable(robot: Robot, s: SingularSet) -> tuple[np.ndarray, list[int]]:
+    """:func:`unreachable` with the broken linkages as their indices in ``robot.couplings``."""
     n = len(s.configurations)
     none = np.zeros(n, dtype=bool)
     if not n or not s.coordinated or not len(_plan(robot).lead) or s.variables != robot.steer_names:
-        return none, ()
+        return none, []
     out, broken = none.copy(), set()
     for i, beta in enumerate(np.asarray(s.configurations, dtype=float)):
         h = icr(robot, beta).homogeneous()
@@ -217,15 +227,16 @@ def unreachable(robot: Robot, s: SingularSet) -> tuple[np.ndarray, tuple[str, ..
         holds = _holds(robot, h[None], beta[None])[0]
         out[i] = not holds.all()
         broken.update(int(k) for k in np.flatnonzero(~holds))
-    names = tuple(f"{robot.couplings[k].channel_name} (law {linkage_law(robot.couplings[k], robot.wheels)})"
-                  for k in sorted(broken))
-    return out, names
+    return out, sorted(broken)
 
 
-def unreachable_note(robot: Robot, s: SingularSet) -> str | None:
+def unreachable_note(robot: Robot, s: SingularSet, *, words: bool = False) -> str | None:
     """One line for the report under a singular set: how many of its configurations a held linkage cannot set, or
-    None when it can set them all."""
-    bad, names = unreachable(robot, s)
+    None when it can set them all. `words`: each linkage named in the description's terms (text; the JSON keeps its
+    channel name, :func:`wmrkit.couplings.coupling_words`)."""
+    bad, broken = _unreachable(robot, s)
+    names = [_law_named(robot, k, coupling_words(robot.couplings, robot.couplings[k].channel_name) if words else
+                        robot.couplings[k].channel_name) for k in broken]
     if not bad.any():
         return None
     n, k = len(bad), int(bad.sum())

@@ -145,7 +145,7 @@ def _summary_table(a: Analysis) -> str:
             rows.append(("characteristic length D",
                          f"{a.characteristic_length:.4g} m ({'natural' if a.natural else 'given'})"))
     for key, s in a.singular.items():
-        note = unreachable_note(a.robot, s)
+        note = unreachable_note(a.robot, s, words=True)
         rows.append((f"singular {key} model",
                      f"({', '.join(assigned_names(s, a.robot)) or '-'}): {describe_singular(s, a.robot)}"
                      + ("" if note is None else f"; {note}")))

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ..couplings import channel_names, gear_fill
+from ..couplings import channel_names, coupling_words, gear_fill
 from ..errors import WmrkitError
 from ..kinematics.actuation import actuation_analysis, actuator_names
 from ..kinematics.sensing import sensing_analysis
@@ -126,7 +126,8 @@ class Analysis:
             lines.append(f"  at the described steering: m = {self.instantaneous_mobility}")
         lines += [f"  {s.description}" for s in c.special]
         lines.append(f"  {self.icr.describe()}")
-        actuators = actuator_names(r, r.actuated)  # a differential's, a linkage's joints are one actuator
+        # a differential's, a linkage's joints are one actuator, named in the description's terms (JSON: channels)
+        actuators = [coupling_words(r.couplings, a, short=True) for a in actuator_names(r, r.actuated)]
         lines.append(f"  actuation: {actuation_words(self.actuation)} ({', '.join(actuators) or 'nothing declared'})")
         lines.append(f"  sensing: {_yes(self.sensing['sufficient'], 'sufficient', 'insufficient')} "
                      f"({', '.join(r.sensed) or 'nothing declared'})")
@@ -135,8 +136,9 @@ class Analysis:
         else:
             lines.append(f"  condition number {self.condition_words()}, joints {', '.join(self.joints) or '-'}")
         for key, s in self.singular.items():
-            lines.append(f"  singular ({key}: {', '.join(assigned_names(s, r)) or '-'}): {describe_singular(s, r)}")
-            if (note := unreachable_note(r, s)) is not None:  # a held linkage cannot set them
+            assigned = [coupling_words(r.couplings, a, short=True) for a in assigned_names(s, r)]
+            lines.append(f"  singular ({key}: {', '.join(assigned) or '-'}): {describe_singular(s, r)}")
+            if (note := unreachable_note(r, s, words=True)) is not None:  # a held linkage cannot set them
                 lines.append(f"    {note}")
         return "\n".join(lines)
 

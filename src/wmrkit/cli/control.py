@@ -430,7 +430,8 @@ def run_feasibility(args: argparse.Namespace) -> int:
     coupled = result.requirement.type == 4 and not any(w.type == "fixed" for w in robot.wheels)  # judged with them
     for c in () if coupled else robot.couplings:  # Table 8.1 classifies the wheels' geometry only
         if c.kind == "gear" and not steers_together(c):
-            warn(f"{c.channel_name} is not considered: Table 8.1 judges the wheels alone; check the reference's "
+            warn(f"{coupling_words(robot.couplings, c.channel_name)} is not considered: Table 8.1 judges the wheels "
+                 "alone; check the reference's "
                  "twists with 'wmrkit ik' (a gear may forbid them)")
         elif steers_together(c):
             if c.kind == "linkage" and fewer is None:
@@ -439,7 +440,8 @@ def run_feasibility(args: argparse.Namespace) -> int:
                 k = classify(robot)
                 fewer = k.commanded_steerability < k.steerability
             if c.kind == "gear" or fewer:
-                warn(f"{c.channel_name} is not considered: Table 8.1 judges the wheels alone, each steered on its "
+                warn(f"{coupling_words(robot.couplings, c.channel_name)} is not considered: Table 8.1 judges the "
+                     "wheels alone, each steered on its "
                      "own, and it steers them together, so it may forbid the reference's twists; 'wmrkit track' "
                      "says where it holds the wheels off the axles the commanded twist needs")
     if args.plot:

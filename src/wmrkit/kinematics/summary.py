@@ -135,8 +135,9 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
     """Human-readable text of :func:`kinematics_summary`: counts, sets, model tables, verdicts.
 
     Steering angles are headings in degrees (0 = rolling straight ahead). At most `limit` sets are listed per
-    list (None: all). The robot's `couplings` name its steering linkages in the description's terms
-    (:func:`wmrkit.couplings.coupling_words`; without them, by channel name, as the JSON does).
+    list (None: all). The robot's `couplings` name its couplings in the description's terms
+    (:func:`wmrkit.couplings.coupling_words`: ``linkage of fl and fr`` in a list of identifiers; without them, by
+    channel name, as the JSON does).
     """
     steer = ", ".join(f"heading {n} = {math.degrees(v):.6g} deg" for n, v in summary["steering"].items())
     m, generic, coupled = summary["mobility"], summary["generic_mobility"], summary["coupled_mobility"]
@@ -153,12 +154,12 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
     if summary.get("headings_note"):  # rounded headings (wmrkit kinematics adds it: analysis.icr)
         lines.append(f"  note: {summary['headings_note']}")
     if gears:
-        lines.append(f"  with its gear couplings m = {coupled}{special} ({', '.join(gears)}, q_j = ratio_j * u): "
+        named = ", ".join(coupling_words(couplings, g, short=True) for g in gears)
+        lines.append(f"  with its gear couplings m = {coupled}{special} ({named}, q_j = ratio_j * u): "
                      "the sets and models below hold them")
     if extra > 0:
         n = summary["extended_dof"]
-        named = {c.channel_name for c in couplings}
-        linked = [coupling_words(couplings, c) if c in named else c for c in summary.get("linkages") or ()]
+        linked = [coupling_words(couplings, c) for c in summary.get("linkages") or ()]
         lines.append(f"  with its {extra} steering angle{'s' if extra > 1 else ''} (extended solutions, §4.5), "
                      f"{n} velocit{'ies' if n > 1 else 'y'} can be assigned"
                      + (f" (each steered wheel counted, {', '.join(linked)} not as one: the solutions judge their "
@@ -177,7 +178,8 @@ def format_kinematics_summary(summary: dict[str, Any], *, limit: int | None = 12
             f" ({model['kind']}, assigned: {', '.join(model['assigned'])})")
         lines += [f"  {title}{kind}:", *_matrix_table(model, summary["size"])]
     act, sen = summary["actuation"], summary["sensing"]
-    lines.append(f"  actuation [{', '.join(act['actuated'] + act['steering_actuators'])}]: "
+    actuators = [coupling_words(couplings, a, short=True) for a in act["actuated"] + act["steering_actuators"]]
+    lines.append(f"  actuation [{', '.join(actuators)}]: "
                  f"{act['verdict']}")
     lines.append(f"  sensing [{', '.join(sen['sensed'] + [s + '.steer' for s in sen['steering_sensed']])}]: "
                  f"{sen['verdict']}")
