@@ -160,7 +160,14 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
     return replace(found, decimals=coordinate_decimals(robot))
 
 
-def _admissible(robot: Robot, beta: np.ndarray, geared: bool) -> ICRSet:
+def icr_homogeneous(robot: Robot, beta: np.ndarray) -> np.ndarray | None:
+    """:meth:`ICRSet.homogeneous` of :func:`icr` at the thesis's steering `beta` ``(n_steer,)``, without what only
+    its text uses (the rounded-headings note: a third of a call, and a loop over a singular set's configurations
+    reads the point alone)."""
+    return _admissible(robot, beta, False, noted=False).homogeneous()
+
+
+def _admissible(robot: Robot, beta: np.ndarray, geared: bool, *, noted: bool = True) -> ICRSet:
     cl = constraint_lines(robot, coupled=geared and any(c.kind == "gear" for c in robot.couplings))
     g = cl.lines(beta)
     rank = line_rank(robot, g)
@@ -171,7 +178,8 @@ def _admissible(robot: Robot, beta: np.ndarray, geared: bool) -> ICRSet:
     if rank == 1:
         row = g[np.argmax(np.linalg.norm(g, axis=-1))]
         return ICRSet("line", line=tuple(float(v) for v in row))
-    return _rounded(robot, beta, cl, g, meeting_point(robot, g))
+    found = meeting_point(robot, g)
+    return _rounded(robot, beta, cl, g, found) if noted else found
 
 
 def meeting_point(robot: Robot, lines: np.ndarray) -> ICRSet:

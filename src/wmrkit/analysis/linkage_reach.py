@@ -28,7 +28,7 @@ from ..robot import Robot
 from ._fast import CHUNK
 from .classification import classify
 from .coordinated import admissible_icrs
-from .icr import ICRSet, icr, twist_of_icr
+from .icr import ICRSet, icr, icr_homogeneous, twist_of_icr
 from .singularity import SingularSet
 
 #: Isolated reachable ICRs listed by :class:`LinkedReach` (and ``analyze --json``).
@@ -221,7 +221,7 @@ def _unreachable(robot: Robot, s: SingularSet) -> tuple[np.ndarray, list[int]]:
         return none, []
     out, broken = none.copy(), set()
     for i, beta in enumerate(np.asarray(s.configurations, dtype=float)):
-        h = icr(robot, beta).homogeneous()
+        h = icr_homogeneous(robot, beta)
         if h is None:
             continue
         holds = _holds(robot, h[None], beta[None])[0]

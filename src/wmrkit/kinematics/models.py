@@ -180,13 +180,13 @@ def is_assignable(
 
 
 def _sets_at(robot: Robot, a: np.ndarray, method: Method) -> tuple[tuple[str, ...], ...]:
-    m = np.unique(nullity(robot, a))
+    ranks = _ranks(robot, a)
+    m = np.unique(a.shape[-1] - ranks["rank_a"])  # nullity(robot, a), from the rank the sets are tied to
     if len(m) != 1:  # the mobility changes within the batch: no set fits every configuration
         return SetList()
-    ranks = _ranks(robot, a) if method == "ranks" else {}
 
     def test(s: np.ndarray) -> np.ndarray:
-        ok = ranks_assignable(a, s, **ranks) if ranks else _assignable(robot, a, s, method)
+        ok = ranks_assignable(a, s, **ranks) if method == "ranks" else _assignable(robot, a, s, method)
         return ok.reshape(len(s), -1).all(axis=1)
 
     sets, complete, note = search_sets(  # bounded, pruned by the null-space test (.search)
@@ -229,8 +229,8 @@ def generically_assignable_sets(robot: Robot) -> tuple[tuple[str, ...], ...]:
     samples = generic_configurations(robot)
     a = constraints(robot, samples)
     m = generic_mobility(robot)
-    generic = nullity(robot, a) == m  # one at least: m is the smallest of the samples' mobilities
     ranks = _ranks(robot, a)
+    generic = a.shape[-1] - ranks["rank_a"] == m  # nullity: one at least, m is the smallest of the samples'
     sets, complete, note = search_sets(  # bounded, pruned by the null-space test at one generic sample at least
         range(a.shape[-1]), m, lambda s: (ranks_assignable(a, s, **ranks) & generic).any(axis=1),
         prefilter=null_space_prefilter(a[generic], m, every=False), max_exact=exact_budget(a.shape, 2),

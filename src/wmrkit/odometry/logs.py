@@ -33,6 +33,7 @@ import numpy as np
 from .._shapes import as_names, as_reals, finite_number
 from ..errors import WmrkitError
 from ..limits import check_chunk_size, regular_file_problem
+from ..units import UNITS
 from ._text import check_lines, did_you_mean, encoded, parse_rows, read_lines, short
 from .encoders import AbsoluteEncoder, Encoder, EncoderError, IncrementalEncoder
 from .header import SPIN_MODES, bare_heading_problem, header_names, travel_radii
@@ -42,8 +43,8 @@ from .steering import CONVENTIONS, check_robot, check_steer_range, convert_steer
 if TYPE_CHECKING:
     from ..robot import Robot
 
-#: Seconds per unit of the time column.
-TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+#: Seconds per unit of the time column (the ASCII ones of the time units, :data:`wmrkit.units.UNITS`).
+TIME_UNITS = {u: UNITS["time"][u] for u in ("s", "ms", "us", "ns")}
 
 #: Default largest plausible spin rate of a wheel [rad/s] (about 95,000 rpm): faster is an encoder glitch.
 MAX_RATE = 1e4
