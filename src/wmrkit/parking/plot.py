@@ -96,6 +96,7 @@ def plot_plan(plan: ParkingPlan, execution: Execution | None = None, *, name: st
               fontsize=8)
     _frame(ax, plan)
     fig.tight_layout()
+    ax.set_anchor("E")
     return fig
 
 
@@ -124,7 +125,7 @@ def save_plan_figure(plan: ParkingPlan, path: str | os.PathLike[str], execution:
     from ..plotting.files import check_figure_path
 
     check_figure_path(path)
-    plot_plan(plan, execution, name=name).savefig(path, dpi=120)
+    plot_plan(plan, execution, name=name).savefig(path, dpi=120, bbox_inches="tight")
 
 
 def animate_plan(plan: ParkingPlan, path: str | os.PathLike[str], execution: Execution | None = None, *,
