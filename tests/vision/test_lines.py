@@ -255,14 +255,38 @@ def test_render_refuses_a_pose_that_is_not_finite(pose, z_p):
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [
-    ({"ns": (-1, 0, 1), "spacing": math.nan}, "scene: spacing must be in [0, 1000] m, got nan"),
-    ({"ns": (-1, 0, 1), "spacing": -0.5}, "scene: spacing must be in [0, 1000] m, got -0.5"),
-    ({"ns": (), "extra": (0.1, math.inf)}, "scene: extra stripes must lie within 1000 m of the line, got (0.1, inf)"),
+    ({"ns": (-1, 0, 1), "spacing": math.nan}, "scene: spacing must be a real number in [0, 1000] m, got nan"),
+    ({"ns": (-1, 0, 1), "spacing": -0.5}, "scene: spacing must be a real number in [0, 1000] m, got -0.5"),
+    ({"ns": (), "extra": (0.1, math.inf)}, "scene: extra must be a tuple of real numbers within 1000 m of the line "
+                                           "(lateral positions of further stripes), got (0.1, inf)"),
 ])
 def test_scene_refuses_stripe_positions_that_are_not_lengths(kwargs, message):
     """A NaN spacing rendered the image with a numpy 'invalid value' warning, the stripes nowhere."""
     with pytest.raises(CameraError, match=f"^{re.escape(message)}$"):
         Scene(**kwargs)
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [
+    ({"width": "0.02"}, "scene: width must be a real number in [1e-06, 1000] m, got '0.02'"),
+    ({"width": True}, "scene: width must be a real number in [1e-06, 1000] m, got True"),
+    ({"ns": (-1, 1), "spacing": "0.5"}, "scene: spacing must be a real number in [0, 1000] m, got '0.5'"),
+    ({"ns": ("1",)}, "scene: ns must be a tuple of whole numbers (stripe n at n * spacing), got ('1',)"),
+    ({"ns": (0.5,)}, "scene: ns must be a tuple of whole numbers (stripe n at n * spacing), got (0.5,)"),
+    ({"extra": 0.3}, "scene: extra must be a tuple of real numbers within 1000 m of the line (lateral positions of "
+                     "further stripes), got 0.3"),
+    ({"ns": tuple(range(600)), "extra": (0.0,) * 401, "spacing": 0.1},
+     "scene: at most 1000 stripes (ns and extra; each is a pass over the image), got 1001"),
+])
+def test_scene_refuses_values_that_are_not_numbers_of_its_kind(kwargs, message):
+    """The Python API reads no units: width="0.02" raised a bare TypeError from a comparison, ns=("1",) one from
+    "1" * spacing, extra=0.3 one from iterating a float; and a million stripes was a million passes over the image."""
+    with pytest.raises(CameraError, match=f"^{re.escape(message)}$"):
+        Scene(**kwargs)
+
+
+def test_scene_takes_numpy_integers_and_a_list_of_stripes():
+    scene = Scene(ns=[np.int64(-1), 0, 1], spacing=np.float32(0.5), extra=[0.2])
+    np.testing.assert_allclose(scene.offsets, [-0.5, 0.0, 0.5, 0.2])
 
 
 @pytest.mark.parametrize(("image", "message"), [
