@@ -36,6 +36,17 @@ def as_reals(x: ArrayLike, name: str) -> np.ndarray:
     return x if isinstance(x, np.ndarray) and x.dtype == float else _real_array(x, name, False)
 
 
+def as_real(x: object, name: str) -> float:
+    """`x` as one Python float, refusing what :func:`as_vectors` refuses (text, booleans, ...) and arrays, with a
+    :class:`ShapeError` naming `name`; NaN and infinities pass (the callers' range checks name them)."""
+    if type(x) is float:  # the common case, without building an array
+        return x
+    a = _real_array(x, name, False)
+    if a.ndim:
+        raise ShapeError(f"{name}: expected one real number, got an array of shape {a.shape}")
+    return float(a)
+
+
 def as_angles(x: ArrayLike, n: int, name: str) -> np.ndarray:
     """:func:`as_vectors` for angles [rad]: also raise :class:`ShapeError` naming `name` for NaN, infinities and
     angles beyond :data:`wmrkit.units.MAX_ANGLE` (1e6 turns), whose sine and cosine are round-off."""

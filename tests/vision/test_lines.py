@@ -255,8 +255,8 @@ def test_render_refuses_a_pose_that_is_not_finite(pose, z_p):
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [
-    ({"ns": (-1, 0, 1), "spacing": math.nan}, "scene: spacing must be a real number in [0, 1000] m, got nan"),
-    ({"ns": (-1, 0, 1), "spacing": -0.5}, "scene: spacing must be a real number in [0, 1000] m, got -0.5"),
+    ({"ns": (-1, 0, 1), "spacing": math.nan}, "scene: spacing must be in [0, 1000] m, got nan"),
+    ({"ns": (-1, 0, 1), "spacing": -0.5}, "scene: spacing must be in [0, 1000] m, got -0.5"),
     ({"ns": (), "extra": (0.1, math.inf)}, "scene: extra must be a tuple of real numbers within 1000 m of the line "
                                            "(lateral positions of further stripes), got (0.1, inf)"),
 ])
@@ -267,9 +267,9 @@ def test_scene_refuses_stripe_positions_that_are_not_lengths(kwargs, message):
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [
-    ({"width": "0.02"}, "scene: width must be a real number in [1e-06, 1000] m, got '0.02'"),
-    ({"width": True}, "scene: width must be a real number in [1e-06, 1000] m, got True"),
-    ({"ns": (-1, 1), "spacing": "0.5"}, "scene: spacing must be a real number in [0, 1000] m, got '0.5'"),
+    ({"width": "0.02"}, "scene: width must be in [1e-06, 1000] m, got '0.02'"),
+    ({"width": True}, "scene: width must be in [1e-06, 1000] m, got True"),
+    ({"ns": (-1, 1), "spacing": "0.5"}, "scene: spacing must be in [0, 1000] m, got '0.5'"),
     ({"ns": ("1",)}, "scene: ns must be a tuple of whole numbers (stripe n at n * spacing), got ('1',)"),
     ({"ns": (0.5,)}, "scene: ns must be a tuple of whole numbers (stripe n at n * spacing), got (0.5,)"),
     ({"extra": 0.3}, "scene: extra must be a tuple of real numbers within 1000 m of the line (lateral positions of "

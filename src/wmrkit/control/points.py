@@ -48,7 +48,7 @@ class StoppedRun(ControlError):
 def check_delay(delay: int) -> None:
     """A measurement delay is a whole number of samples >= 0."""
     if isinstance(delay, bool) or not isinstance(delay, int | np.integer) or delay < 0:
-        raise ControlError(f"delay: expected a number of samples >= 0, got {delay}")
+        raise ControlError(f"delay: expected a number of samples >= 0, got {delay!r}")
 
 
 @dataclass(frozen=True, eq=False)

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from .._numbers import number_problem
-from .._shapes import readonly
+from .._shapes import as_real, readonly
 from ..errors import UnknownNameError, WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_table_size
 from ..units import BARE_ANGLE_LIMIT
@@ -321,6 +321,10 @@ def builtin_reference(name: str, *, speed: float | None = None, size: float | No
     leg length of ``corner``; ``line`` has none, and refuses one), `duration` [s] (default: one lap); defaults
     per shape in :data:`BUILTIN`.
     """
+    if not isinstance(name, str):
+        raise ReferenceError(f"reference: expected a built-in reference's name ({', '.join(BUILTIN)}), got {name!r}")
+    speed, size, duration, dt = (None if v is None else as_real(v, what) for what, v in
+                                 (("speed", speed), ("size", size), ("duration", duration), ("dt", dt)))
     if name not in BUILTIN:
         import difflib
 

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, readonly
+from .._shapes import as_real, as_vectors, readonly
 from ..kinematics.wheel_ik import wheel_commands
 from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
@@ -95,8 +95,16 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     """
     if controller not in CONTROLLERS:
         raise ControlError(f"unknown controller '{controller}' (controllers: {', '.join(CONTROLLERS)})")
+    # the Python API reads no units: text ("1" read as 1 s, or a bare TypeError) and booleans are refused
+    gain, stanley_gain, output_dt = (as_real(v, what) for what, v in
+                                     (("gain", gain), ("stanley_gain", stanley_gain), ("output_dt", output_dt)))
+    integral_gain, gate, period, duration, lookahead = (
+        None if v is None else as_real(v, what) for what, v in (
+            ("integral_gain", integral_gain), ("gate", gate), ("period", period), ("duration", duration),
+            ("lookahead", lookahead)))
     if not (math.isfinite(gain) and gain >= 0):
         raise ControlError(f"gain: expected a pole a >= 0 (1/s), got {gain}")
+    check_delay(delay)
     if period is None and delay and not dynamics:
         raise ControlError("delay: a measurement delay in samples needs a sample period (--period)")
     cp = control_point(robot, point)
@@ -115,7 +123,6 @@ def track(robot: Robot, reference: Reference, *, controller: str = "p", gain: fl
     else:
         duration = reference.duration
     _check_timing(duration, sampled, output_dt)
-    check_delay(delay)
     if sampled is not None and delay > 0 and delay * sampled >= duration:
         raise ControlError(f"delay: {delay} samples of {sampled:g} s reach past the run ({duration:g} s): the loop "
                            "would never see a measurement (open loop)")
@@ -324,8 +331,10 @@ def _check_timing(duration: float, period: float | None, output_dt: float) -> No
         raise ControlError(f"duration: expected a positive number of seconds, got {duration}")
     if period is not None and not (math.isfinite(period) and 0 < period <= duration):
         raise ControlError(f"period: expected a sample period in (0, duration = {duration:g} s], got {period:g} s")
+    if not (math.isfinite(output_dt) and output_dt > 0):
+        raise ControlError(f"output_dt: expected a positive number of seconds, got {output_dt:g}")
     step = output_dt if period is None else period
-    if not (math.isfinite(step) and step > 0) or duration / step > MAX_SAMPLES:
+    if duration / step > MAX_SAMPLES:
         raise ControlError(f"duration {duration:g} s at {'a period' if period else 'an output step'} of {step:g} s: "
                            f"more than {MAX_SAMPLES} samples; give a shorter duration (--duration)"
                            f"{' or a longer period (--period)' if period else ''}")

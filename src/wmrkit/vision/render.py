@@ -56,10 +56,9 @@ class Scene:
         # real numbers only (the Python API reads no units: width="0.02" raised a bare TypeError), in the lengths
         # wmrkit handles (1e-320 m overflowed the coverage; a NaN spacing rendered garbage with a numpy warning)
         if not (_length(self.width) and MIN_SIZE <= self.width <= MAX_SIZE):
-            raise CameraError(f"scene: width must be a real number in [{MIN_SIZE:g}, {MAX_SIZE:g}] m, "
-                              f"got {self.width!r}")
+            raise CameraError(f"scene: width must be in [{MIN_SIZE:g}, {MAX_SIZE:g}] m, got {self.width!r}")
         if not (_length(self.spacing) and 0 <= self.spacing <= MAX_SIZE):
-            raise CameraError(f"scene: spacing must be a real number in [0, {MAX_SIZE:g}] m, got {self.spacing!r}")
+            raise CameraError(f"scene: spacing must be in [0, {MAX_SIZE:g}] m, got {self.spacing!r}")
         if not (isinstance(self.ns, tuple | list) and all(isinstance(n, int | np.integer) and not isinstance(n, bool)
                                                            for n in self.ns)):
             raise CameraError(f"scene: ns must be a tuple of whole numbers (stripe n at n * spacing), got {self.ns!r}")
