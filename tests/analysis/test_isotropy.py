@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -23,6 +24,7 @@ from wmrkit.analysis.isotropy import (
 )
 from wmrkit.analysis.optimize import best_configurations, isotropic_configurations
 from wmrkit.analysis.singularity import robot_size
+from wmrkit.errors import ShapeError, WmrkitError
 
 
 def _roots(f, lo=-np.pi, hi=np.pi, n=2880):
@@ -403,3 +405,14 @@ def test_the_natural_length_of_a_robot_mounted_at_its_origin_scales_with_it(k):
     assert scan.min() * (1 - 1e-3) <= kappa <= scan.min()  # at the minimum, between the scan's lengths
     assert math.isclose(d / k, 0.5 / math.sqrt(3), rel_tol=1e-6)  # where the scan's minimum lies, below
     assert math.isclose(np.geomspace(0.01, 100, 4001)[scan.argmin()], 0.5 / math.sqrt(3), rel_tol=5e-3)
+
+
+@pytest.mark.parametrize(("tol", "error", "message"), [
+    ("1", ShapeError, "tol: got the text '1', but the Python API reads no units"),
+    (math.nan, WmrkitError, "tol: expected a tolerance >= 0 on the condition number, got nan"),
+    (-1e-3, WmrkitError, "tol: expected a tolerance >= 0 on the condition number, got -0.001"),
+])
+def test_isotropic_configurations_refuses_a_tolerance_that_is_not_one(tol, error, message):
+    """Text raised a bare TypeError ('int' + 'str'); NaN kept no configuration, read as 'not isotropic'."""
+    with pytest.raises(error, match=f"^{re.escape(message)}"):
+        isotropic_configurations(catalog.load("thesis-omni-swedish"), tol=tol)

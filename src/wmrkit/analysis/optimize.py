@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
-from .._shapes import as_names
+from .._shapes import as_names, as_real
 from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
 from . import _fast
@@ -140,6 +140,9 @@ def isotropic_configurations(robot: Robot, *, joints: tuple[str, ...] | None = N
 
     The search of :func:`best_configurations` (16 starts; grid or seeded sample of at most `max_samples`).
     """
+    tol = as_real(tol, "tol")
+    if not (tol >= 0 and np.isfinite(tol)):  # NaN included: it kept nothing, read as 'not isotropic'
+        raise WmrkitError(f"tol: expected a tolerance >= 0 on the condition number, got {tol}")
     best = best_configurations(robot, joints=joints, variables=variables, resolution=resolution,
                                max_samples=max_samples, count=16)
     return tuple(c for c in best if c.condition_number < 1 + tol)
