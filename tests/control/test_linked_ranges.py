@@ -217,3 +217,37 @@ def test_a_follower_held_by_its_linkage_is_not_said_to_be_beyond_its_range(capsy
                            f"for {fl['duration']:.3g} s (t = {fl['from']:.4g} to {fl['to']:.4g} s), held at its end, "
                            f"and 'fr' at {math.degrees(_right(LIMIT)):.4g} deg with it (within its range): ")
     assert "linkage(" not in said and "'fr' was asked" not in said
+
+
+@pytest.mark.parametrize("v", [-1e-4, 1e-4])
+@pytest.mark.parametrize("held", ["left", "right"])
+def test_a_linkage_held_at_a_stop_keeps_it_within_the_hold_margin(v, held):
+    """The twist (v, 0, 1 rad/s) with v a hair from 0: the car asked to turn about its rear axle's middle, where
+    its two stops serve the asked axles alike (the sum of the misses ties at v = 0: forward the left stop turns
+    it left, reversing the right one does). Held at either stop, the linkage stays there within the hold margin.
+    Before, it stayed only where the leader fl alone would also go: its inner-wheel root near -72 deg is nearer
+    the right stop, so held at the left one it swapped at the first hair of reversal (the catalog car on
+    ``wmrkit track ackermann --reference corner``: right stop for 0.1 s after the corner, then back)."""
+    from wmrkit.kinematics.loop_ik import checked_rates
+
+    robot = _ranged_car()
+    rates, beta, _ = checked_rates(robot, np.array([v, 0.0, 1.0]), np.array(robot.beta, dtype=float))
+    headings, rates = np.array(robot.heading_of_beta(beta)), np.array(rates)
+    stop = (LIMIT, _right(LIMIT)) if held == "left" else (_left(-LIMIT), -LIMIT)
+    range_keeper(robot)(headings, rates, np.array(stop), math.radians(2.0))
+    assert tuple(headings) == pytest.approx(stop, abs=1e-12)
+
+
+@pytest.mark.parametrize("v", [-0.05, 0.05])
+def test_a_linkage_held_at_a_stop_changes_stops_where_the_car_reverses(v):
+    """Beyond the margin the stop follows the twist: turning left (1 rad/s) forward the left stop, reversing the
+    right one (a car backing up steers right to turn left), whichever it was held at."""
+    from wmrkit.kinematics.loop_ik import checked_rates
+
+    robot = _ranged_car()
+    for stop in ((LIMIT, _right(LIMIT)), (_left(-LIMIT), -LIMIT)):
+        rates, beta, _ = checked_rates(robot, np.array([v, 0.0, 1.0]), np.array(robot.beta, dtype=float))
+        headings, rates = np.array(robot.heading_of_beta(beta)), np.array(rates)
+        range_keeper(robot)(headings, rates, np.array(stop), math.radians(2.0))
+        assert math.copysign(1.0, headings[0]) == math.copysign(1.0, v)
+        assert abs(headings[0] if v > 0 else headings[1]) == pytest.approx(LIMIT, abs=1e-12)

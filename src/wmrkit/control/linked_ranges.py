@@ -105,9 +105,13 @@ class LinkedRanges:
         at which the axles of its wheels (itself and its followers, set by the law or the ratios) are nearest those
         `asked` ``(n_steer,)`` of them (the sum of their misses, mod pi). A car's inner wheel asked a turn sharper
         than its stop, near 90 deg, is nearly as far from both, but the outer wheel is not: the leader alone chose
-        the wrong stop, and the catalog car turned away from its reference for over 9 s at a corner. `kept`: the
-        end the leader alone chose; it stays when `current` is there and the other end is not nearer by more than
-        `margin`."""
+        the wrong stop, and the catalog car turned away from its reference for over 9 s at a corner. The end the
+        leader is `current` ly held at stays unless the other end is nearer by more than `margin` (for a car the
+        ends tie where the twist asked stops and reverses); `kept`: the end the leader alone chose, taken at an
+        exact tie when it is held at neither. Before, the end held stayed only when the leader alone chose it too:
+        the car at its left stop on the corner of ``track ackermann --reference corner``, asked to turn on the
+        spot (its inner wheel at 106 deg, whose other root -74 deg is nearer the right stop), swapped to the right
+        stop at the first round-off of a reversal and back 0.1 s later."""
         wheels = [lead, *(k.follower for k in self.links if k.leader == lead)]
         ends = [float(e) for e in self.ranges[lead]]
         miss = []
@@ -116,9 +120,9 @@ class LinkedRanges:
             h[lead] = end
             self.follow(h)
             miss.append(sum(abs(math.remainder(float(h[w] - asked[w]), math.pi)) for w in wheels))
-        held = abs(math.remainder(current - kept, TWO_PI)) <= 1e-9 and kept in ends
-        if held and abs(miss[0] - miss[1]) <= margin:
-            return kept
+        at = [abs(math.remainder(current - end, TWO_PI)) <= 1e-9 for end in ends]
+        if any(at) and abs(miss[0] - miss[1]) <= margin:
+            return ends[0] if at[0] else ends[1]
         return ends[0] if miss[0] < miss[1] else ends[1] if miss[1] < miss[0] else kept
 
     def follow(self, heading: np.ndarray) -> np.ndarray:
