@@ -251,3 +251,36 @@ def test_a_linkage_held_at_a_stop_changes_stops_where_the_car_reverses(v):
         range_keeper(robot)(headings, rates, np.array(stop), math.radians(2.0))
         assert math.copysign(1.0, headings[0]) == math.copysign(1.0, v)
         assert abs(headings[0] if v > 0 else headings[1]) == pytest.approx(LIMIT, abs=1e-12)
+
+
+@pytest.mark.parametrize("omega", [1.0, -1.0])
+@pytest.mark.parametrize("other_root", [False, True])
+def test_a_turn_on_the_spot_from_straight_takes_the_stop_that_rolls_forward(omega, other_root):
+    """The twist (0, 0, +-1 rad/s) from straight ahead: both stops miss the asked axles alike (mirror images), a
+    tie that round-off used to break (the sampled catalog car took its right stop at the left corner of ``wmrkit
+    track ackermann --reference corner --period 0.05``, by the sign of a speed of 3e-17 m/s, and reversed for
+    0.15 s). Now the stop of the turn, rolling forward, whichever root of (8.9) the wheels are handed."""
+    from wmrkit.kinematics.loop_ik import checked_rates
+
+    robot = _ranged_car()
+    rates, beta, _ = checked_rates(robot, np.array([0.0, 0.0, omega]), np.array(robot.beta, dtype=float))
+    headings, rates = np.array(robot.heading_of_beta(beta)), np.array(rates)
+    if other_root:
+        for k, name in enumerate(("fl", "fr")):
+            headings[k] += math.pi
+            rates[robot.rate_names.index(f"{name}.spin")] *= -1
+    range_keeper(robot)(headings, rates, np.zeros(2), math.radians(2.0))
+    stop = (LIMIT, _right(LIMIT)) if omega > 0 else (_left(-LIMIT), -LIMIT)
+    assert tuple(headings) == pytest.approx(stop, abs=1e-12)
+    assert rates[robot.rate_names.index("fl.spin")] > 0 and rates[robot.rate_names.index("fr.spin")] > 0
+
+
+def test_the_sampled_car_turns_forward_into_a_corner():
+    """``wmrkit track ackermann --reference corner --period 0.05`` through its left corner (16 s): the linkage at
+    its left stop from the corner, never at the right one (it was there from 16 to 16.1 s, the car reversing)."""
+    from wmrkit import catalog
+
+    run = track(catalog.load("ackermann"), builtin_reference("corner", size=8.0), period=0.05, duration=17.0)
+    front_left = run.heading[:, 0]
+    assert np.all(front_left[run.t >= 16.0] == pytest.approx(math.radians(40.0), abs=1e-12))
+    assert np.all(front_left >= -1e-12)

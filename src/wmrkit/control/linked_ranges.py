@@ -27,6 +27,8 @@ TWO_PI = 2.0 * math.pi
 GEAR_TURNS = 2
 #: Refits of a gear's least-squares turn from its current one at most (:func:`_local_fit`; one or two in practice).
 LOCAL_REFITS = 16
+#: Misses [rad] of a linkage's two ends within this of each other tie (:meth:`LinkedRanges.held_end`): round-off.
+TIE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -100,18 +102,21 @@ class LinkedRanges:
                     best = local
             heading[idx[0]] = rest[idx[0]] + k[0] * best
 
-    def held_end(self, lead: int, asked: np.ndarray, current: float, kept: float, margin: float) -> float:
+    def held_end(self, lead: int, asked: np.ndarray, current: float, forward: float, margin: float) -> float:
         """The end of leader `lead`'s kept arc to hold it at, when no root of the heading `asked` of it fits: the one
         at which the axles of its wheels (itself and its followers, set by the law or the ratios) are nearest those
         `asked` ``(n_steer,)`` of them (the sum of their misses, mod pi). A car's inner wheel asked a turn sharper
         than its stop, near 90 deg, is nearly as far from both, but the outer wheel is not: the leader alone chose
         the wrong stop, and the catalog car turned away from its reference for over 9 s at a corner. The end the
         leader is `current` ly held at stays unless the other end is nearer by more than `margin` (for a car the
-        ends tie where the twist asked stops and reverses); `kept`: the end the leader alone chose, taken at an
-        exact tie when it is held at neither. Before, the end held stayed only when the leader alone chose it too:
-        the car at its left stop on the corner of ``track ackermann --reference corner``, asked to turn on the
-        spot (its inner wheel at 106 deg, whose other root -74 deg is nearer the right stop), swapped to the right
-        stop at the first round-off of a reversal and back 0.1 s later."""
+        ends tie where the twist asked stops and reverses). Held at neither, a tie (within :data:`TIE`, round-off)
+        takes the end nearer the root of (8.9) at which the leader rolls forward, the heading `forward`: a car
+        asked to turn on the spot drives forward into the turn. Before, the end held stayed only when the leader
+        alone chose it too, and a tie took the leader's own choice: the car at its left stop on the corner of
+        ``track ackermann --reference corner``, asked to turn on the spot (its inner wheel at 106 deg, whose other
+        root -74 deg is nearer the right stop), swapped to the right stop at the first round-off of a reversal and
+        back 0.1 s later; sampled (``--period 0.05``) it took the right stop at the corner itself, by the sign of
+        a speed of 3e-17 m/s."""
         wheels = [lead, *(k.follower for k in self.links if k.leader == lead)]
         ends = [float(e) for e in self.ranges[lead]]
         miss = []
@@ -123,7 +128,9 @@ class LinkedRanges:
         at = [abs(math.remainder(current - end, TWO_PI)) <= 1e-9 for end in ends]
         if any(at) and abs(miss[0] - miss[1]) <= margin:
             return ends[0] if at[0] else ends[1]
-        return ends[0] if miss[0] < miss[1] else ends[1] if miss[1] < miss[0] else kept
+        if abs(miss[0] - miss[1]) <= TIE:
+            return min(ends, key=lambda end: abs(math.remainder(forward - end, TWO_PI)))
+        return ends[0] if miss[0] < miss[1] else ends[1]
 
     def follow(self, heading: np.ndarray) -> np.ndarray:
         """Set, in place, each follower's heading in `heading` ``(n_steer,)`` [rad] from its leader's; returns which

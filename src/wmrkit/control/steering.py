@@ -213,7 +213,7 @@ def range_keeper(robot: Robot, policy: str = "closest") -> Callable[..., np.ndar
         fits, reversed_ = np.ones(len(heading), dtype=bool), np.zeros(len(heading), dtype=bool)
         if links is not None:
             links.settle(heading, rest, current, hold_margin > 0)
-        asked = heading.copy()
+        asked, spin = heading.copy(), unit_spin(rates, columns)  # the IK's roots and spins
         if chosen.any():  # the IK's headings and spins (finite), the policy checked above
             heading[chosen], _, fits[chosen], reversed_[chosen] = checked_steering(
                 heading[chosen], unit_spin(rates, steered), np.asarray(current, dtype=float)[chosen], policy,
@@ -221,7 +221,8 @@ def range_keeper(robot: Robot, policy: str = "closest") -> Callable[..., np.ndar
             reverse_spins(rates, steered, reversed_[chosen])
         if links is not None:
             for lead in links.leaders[~fits[links.leaders] & chosen[links.leaders]].tolist():
-                heading[lead] = links.held_end(lead, asked, float(current[lead]), float(heading[lead]), hold_margin)
+                forward = float(asked[lead]) + (0.0 if spin[lead] >= 0 else math.pi)  # the root rolling forward
+                heading[lead] = links.held_end(lead, asked, float(current[lead]), forward, hold_margin)
                 if (abs(float(wrap_angle(asked[lead] - heading[lead]))) > 0.5 * math.pi) != reversed_[lead]:
                     reverse_spins(rates, columns[[lead]], np.ones(1, dtype=bool))  # the other root's spin
             reverse_spins(rates, columns, links.follow(heading) & (columns[:, 0] >= 0))
