@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..control.turn_limits import min_turning_radius, tight_turn
 from ..couplings import coupling_words
 from ..errors import WmrkitError
 from ._common import (
@@ -151,18 +152,6 @@ def _reference(args: argparse.Namespace, robot) -> tuple[Reference, float | None
     return reference, size, words
 
 
-def min_turning_radius(robot) -> float:
-    """The radius [m] of the tightest circle the rear axle's midpoint of a car-like `robot` drives within its
-    steering wheels' ``steer_range`` (:func:`wmrkit.parking.problem.curvature_limit`); 0 for any other robot, or
-    one whose ranges do not limit it."""
-    from ..parking.problem import curvature_limit
-
-    try:
-        return 1.0 / curvature_limit(robot)
-    except (WmrkitError, ZeroDivisionError):  # not car-like; or it cannot roll straight ahead
-        return 0.0
-
-
 def _lookahead(args: argparse.Namespace, robot, reference) -> tuple[float | None, str]:
     """Pure pursuit's ``--lookahead`` [m] (default :func:`wmrkit.control.trackers.default_lookahead` on
     `reference`) and the words the summary line names it with (None and empty for another controller)."""
@@ -285,6 +274,15 @@ def run_track(args: argparse.Namespace) -> int:
         except TypeError:  # a class that takes more (UnstableStepError: the steps and the door): said as it is
             joined = WmrkitError(message)
         raise joined from None
+    (x, y, th), (px, py) = run.pose[0], run.tracked[0, :2]  # the tracked point in the robot frame
+    point = (math.cos(th) * (px - x) + math.sin(th) * (py - y), math.cos(th) * (py - y) - math.sin(th) * (px - x))
+    tight = tight_turn(robot, reference.name, size, point, "the tracked point")
+    if tight:  # and where the law asks the car to back up (its reference beside it), at the other stop
+        back = run.t[run.twist[:, 0] < -1e-9]
+        warn(f"{tight}: it cannot follow this reference (its steering is held at its stops)" + (
+            f"; the law backs it up where the reference runs beside it (t = {back[0]:.4g} to {back[-1]:.4g} s; "
+            "backing up, a car turns the other way at the same steering, so its steering swings to the other stop)"
+            if len(back) else ""))
     for line in range_warnings(robot, run.range_violations()):
         warn(line)
     for v in run.held_off_axle():  # no twist_miss through the dynamics
@@ -426,6 +424,9 @@ def run_feasibility(args: argparse.Namespace) -> int:
         result = feasibility(robot, reference, args.framework, point=point)
     if result.requirement.note:  # a skid steer, judged as a differential drive
         warn(result.requirement.note)
+    tight = tight_turn(robot, reference.name, size, (0.0, 0.0) if point is None else point, "the point judged")
+    if tight:
+        warn(f"{tight}: Table 8.1 judges the reference's continuity only, not this")
     fewer = None  # whether the linkages command fewer steering angles than the wheels' steerability d
     coupled = result.requirement.type == 4 and not any(w.type == "fixed" for w in robot.wheels)  # judged with them
     for c in () if coupled else robot.couplings:  # Table 8.1 classifies the wheels' geometry only
