@@ -80,6 +80,20 @@ class Coupling:
         """The name of the one actuator or sensor it makes of its joints: ``differential(a.spin, b.spin)``."""
         return f"{self.kind}({', '.join(self.joints)})"
 
+    def words(self, *, short: bool = False) -> str:
+        """The coupling in the description's terms, for text (JSON keeps :attr:`channel_name`): ``the steering
+        linkage of wheels 'fl' and 'fr'``, ``the differential of wheels 'rl' and 'rr'`` (each wheel's one joint of the
+        kind: its spin or its steering), else by joints (``the gear of joints 'd.spin1' and 'd.spin2'``). `short`:
+        the compact form for a list of identifiers, ``linkage of fl and fr``, ``gear of d.spin1 and d.spin2``."""
+        wheel, _, joint = zip(*(j.partition(".") for j in self.joints), strict=True)
+        by_wheel = len(set(joint)) == 1 and joint[0] in ("spin", "steer") and len(set(wheel)) == len(wheel)
+        names = list(wheel) if by_wheel else list(self.joints)
+        if short:
+            return f"{self.kind} of {name_list(names[:-1])} and {names[-1]}"
+        quoted = [f"'{n}'" for n in names]
+        kind = f"steering {self.kind}" if joint[0] == "steer" and by_wheel else self.kind
+        return f"the {kind} of {'wheels' if by_wheel else 'joints'} {name_list(quoted[:-1])} and {quoted[-1]}"
+
 
 def ratios_problem(ratios: tuple[float, ...]) -> tuple[int | None, str] | None:
     """Why `ratios` are no coupling's, or None: the index of the ratio at fault (None: the set, too spread) and the
@@ -367,7 +381,7 @@ class GearBreach:
     def head(self) -> str:
         """The start of a warning naming the coupling and its ratios."""
         ratios = ", ".join(f"{k:g}" for k in self.coupling.ratios)
-        return f"the joints of {self.coupling.channel_name} (ratios {ratios}) do not turn together"
+        return f"the joints of {self.coupling.words()} (ratios {ratios}) do not turn together"
 
     def warning(self, names: tuple[str, ...], values: np.ndarray) -> str:
         """The warning of ``fk`` (and the extended solutions) on given `values` of the joints `names` (one row)."""
@@ -398,18 +412,6 @@ def gear_breaches(couplings: tuple[Coupling, ...], names: tuple[str, ...], q: np
 
 def coupling_words(couplings: tuple[Coupling, ...], channel: str, *, short: bool = False) -> str:
     """A coupling of `couplings` by its channel name (``linkage(fl.steer, fr.steer)``: the library's, kept in JSON) in
-    the description's terms, for text: ``the steering linkage of wheels 'fl' and 'fr'``, ``the differential of
-    wheels 'rl' and 'rr'`` (each wheel's one joint of the kind: its spin or its steering), else by joints (``the gear
-    of joints 'd.spin1' and 'd.spin2'``). `short`: the compact form for a list of identifiers,
-    ``linkage of fl and fr``, ``gear of d.spin1 and d.spin2``. A `channel` no coupling has (a joint's name) as is."""
+    the description's terms (:meth:`Coupling.words`); a `channel` no coupling has (a joint's name) as is."""
     c = next((c for c in couplings if c.channel_name == channel), None)
-    if c is None:
-        return channel
-    wheel, _, joint = zip(*(j.partition(".") for j in c.joints), strict=True)
-    by_wheel = len(set(joint)) == 1 and joint[0] in ("spin", "steer") and len(set(wheel)) == len(wheel)
-    names = list(wheel) if by_wheel else list(c.joints)
-    if short:
-        return f"{c.kind} of {name_list(names[:-1])} and {names[-1]}"
-    quoted = [f"'{n}'" for n in names]
-    kind = f"steering {c.kind}" if joint[0] == "steer" and by_wheel else c.kind
-    return f"the {kind} of {'wheels' if by_wheel else 'joints'} {name_list(quoted[:-1])} and {quoted[-1]}"
+    return channel if c is None else c.words(short=short)

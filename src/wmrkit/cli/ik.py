@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ..couplings import GearWarning, coupling_words
+from ..couplings import GearWarning
 from ..description import described_type
 from ..errors import WmrkitError, said_warnings
 from ..kinematics.gear_check import steer_breaches
@@ -180,27 +180,20 @@ def _infeasible(robot, commands: WheelCommands, twist) -> list[str]:
         if not ok:
             asked = ", ".join(f"{j} {cell(commands.rates[robot.rate_names.index(j)], scale)}"
                               for j in c.joints)
-            out.append(f"a gear coupling cannot turn its joints so: {coupling_words(robot.couplings, c.channel_name)} "
-                       "turns them in the ratios "
+            out.append(f"a gear coupling cannot turn its joints so: {c.words()} turns them in the ratios "
                        f"{', '.join(f'{k:g}' for k in c.ratios)}, the twist needs {asked} rad/s")
     if not commands.in_steer_gear.all():
         for b in steer_breaches(robot, np.asarray(twist, dtype=float), commands.beta, SLIP_TOL):
-            out.append(f"a steering gear cannot set these headings: {b.describe(robot, _words(robot, b))}")
+            out.append(f"a steering gear cannot set these headings: {b.describe(robot)}")
     if not commands.in_linkage.all():
         for b in ik_breaches(robot, np.asarray(twist, dtype=float), commands.beta, SLIP_TOL):
-            out.append(f"a steering linkage cannot set these headings: {b.describe(robot, _words(robot, b))}, which "
-                       "the twist needs "
-                       f"(set by the linkage, the wheel would slip sideways at {b.slip:.3g} m/s)")
+            out.append(f"a steering linkage cannot set these headings: {b.describe(robot)}, which the "
+                       f"twist needs (set by the linkage, the wheel would slip sideways at {b.slip:.3g} m/s)")
     for i in np.flatnonzero(~commands.in_range):
         lo, hi = (math.degrees(a) for a in robot.wheels[i].steer_range)
         out.append(f"a wheel cannot steer there: wheel '{robot.wheel_names[i]}' would steer to heading "
                    f"{math.degrees(commands.heading[i]):.6g} deg, outside its steer_range [{lo:g}, {hi:g}] deg")
     return out
-
-
-def _words(robot: Robot, breach: object) -> str:
-    """The coupling a breach names, in the description's terms (text; the JSON keeps its channel name)."""
-    return coupling_words(robot.couplings, robot.couplings[breach.coupling].channel_name)
 
 
 def _rate_scale(commands: WheelCommands) -> float:

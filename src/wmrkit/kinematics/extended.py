@@ -110,33 +110,37 @@ def extended_solution(
     held ``linkage``'s law by more than ``asin(FK_SLIP_RTOL)`` (1.15 deg), as ``fk`` judges given headings: the
     linkage cannot set them, :class:`LinkageAngleWarning`, ``in_linkage`` False.
     """
-    return _extended_solution(robot, assigned, q_assigned, configuration(robot, beta, heading), 4, given=True)
+    given = "the headings" if heading is not None else "the described headings" if beta is None else "the angles beta"
+    return _extended_solution(robot, assigned, q_assigned, configuration(robot, beta, heading), 4, given=given)
 
 
 def _extended_solution(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: np.ndarray,
-                       stacklevel: int | None, *, given: bool) -> ExtendedSolution:
+                       stacklevel: int | None, *, given: str | None) -> ExtendedSolution:
     """:func:`extended_solution` at the thesis's `beta`; `stacklevel`: of the warnings on a broken gear or linkage
-    (None: the caller warned); `given`: `beta` judged as ``fk`` judges given angles, else as ``ik`` judges its
-    angles for the solution's twist (:func:`_in_linkage`)."""
+    (None: the caller warned); `given`: `beta` judged as ``fk`` judges given angles, the user's name for them
+    (``"the headings"``, ``"the angles beta"``), else (None) as ``ik`` judges its angles for the solution's twist
+    (:func:`_in_linkage`)."""
     idx, q = _assigned(robot, assigned, q_assigned)
     in_gear = _in_gear(robot, idx, q, stacklevel)
     q_dot, residual = _solve(robot, robot.constraint_matrix(beta), idx, q)
     batch = q_dot.shape[:-1]
     beta = np.array(np.broadcast_to(beta, (*batch, beta.shape[-1])))
-    in_linkage = _in_linkage(robot, beta, None if given else q_dot[..., :3], stacklevel)
+    in_linkage = _in_linkage(robot, beta, None if given else q_dot[..., :3], stacklevel, given)
     return ExtendedSolution(robot.name, robot.velocity_names, tuple(assigned), readonly(beta),
                             readonly(q_dot), readonly(residual),
                             readonly(np.array(np.broadcast_to(in_gear, (*batch, in_gear.shape[-1])))),
                             readonly(in_linkage))
 
 
-def _in_linkage(robot: Robot, beta: np.ndarray, twist: np.ndarray | None, stacklevel: int | None) -> np.ndarray:
+def _in_linkage(robot: Robot, beta: np.ndarray, twist: np.ndarray | None, stacklevel: int | None,
+                given: str | None = None) -> np.ndarray:
     """``(..., n_couplings)`` bool: False where the steering `beta` ``(..., n_steer)`` breaks a held ``linkage``'s law
     (:mod:`.linkage_check`, the judge of ``ik`` and ``fk``): with the solution's `twist` ``(..., 3)``, as ``ik``
     judges its angles for a twist (:func:`~.linkage_check.linkage_holds`: a wheel off the law would slip sideways
     beyond the slip floor); `twist` None, as ``fk`` judges given angles (:func:`~.linkage_check.given_breaches`,
-    off by more than ``asin(FK_SLIP_RTOL)``). A :class:`LinkageAngleWarning` per linkage broken in the first row
-    that breaks one, at `stacklevel` (None: no warning)."""
+    off by more than ``asin(FK_SLIP_RTOL)``; `given`: what the user gave them as, for the warning). A
+    :class:`LinkageAngleWarning` per linkage broken in the first row that breaks one, at `stacklevel` (None: no
+    warning); the headings it shows are users' (0 = rolling straight ahead) whether given as headings or beta."""
     out = np.ones((*beta.shape[:-1], len(robot.couplings)), dtype=bool)
     if not any(c.kind == "linkage" for c in robot.couplings):
         return out
@@ -146,7 +150,7 @@ def _in_linkage(robot: Robot, beta: np.ndarray, twist: np.ndarray | None, stackl
         if stacklevel is not None and len(bad):
             row = tuple(bad[0])
             for b in ik_breaches(robot, twist[row], beta[row], SLIP_TOL):
-                warnings.warn(f"a steering linkage cannot set these steering angles: {b.describe(robot)}, which the "
+                warnings.warn(f"a steering linkage cannot set these headings: {b.describe(robot)}, which the "
                               f"assigned velocities need (set by the linkage, the wheel would slip sideways at "
                               f"{b.slip:.3g} m/s)", LinkageAngleWarning, stacklevel=stacklevel)
         return out
@@ -159,8 +163,8 @@ def _in_linkage(robot: Robot, beta: np.ndarray, twist: np.ndarray | None, stackl
         if stacklevel is not None and off and not said:
             said = True
             for b in off:
-                warnings.warn(f"the steering angles break a steering linkage: {b.describe(robot)}: it cannot set "
-                              "them, so the solution at them is not the robot's motion; check the angles",
+                warnings.warn(f"{given} break a steering linkage: {b.describe(robot)}: it cannot set them, so the "
+                              f"solution at them is not the robot's motion; check {given}",
                               LinkageAngleWarning, stacklevel=stacklevel)
     return out
 
@@ -328,4 +332,4 @@ def no_slip_extended_solution(
     angles for the solution's twist (:class:`LinkageAngleWarning` where a held linkage cannot set them).
     """
     beta = _solve_steering(robot, assigned, q_assigned, beta_guess, heading, 8, 60, 4)  # warns: gear, linkage
-    return _extended_solution(robot, assigned, q_assigned, beta, None, given=False)
+    return _extended_solution(robot, assigned, q_assigned, beta, None, given=None)

@@ -357,14 +357,14 @@ class SteerBreach(Breach):
     `slip` [m/s] the side speed the wheel would roll at, so set (a linkage's :class:`.linkage_check.Breach`, worded
     for a gear)."""
 
-    def describe(self, robot: Robot, name: str | None = None) -> str:
+    def describe(self, robot: Robot) -> str:
         """``"<gear> (ratios ...) sets <wheel> at heading ... deg with <reference> at ... deg, not ... deg (... deg
-        off; ... m/s)"``; the gear by its channel name, or `name` (text: :func:`wmrkit.couplings.coupling_words`)."""
+        off; ... m/s)"``, the gear in the description's terms (:meth:`wmrkit.couplings.Coupling.words`)."""
         c, names = robot.couplings[self.coupling], robot.steer_names
         head = [math.degrees(float(heading_from_beta(b, robot.wheel(names[k]).delta)))
                 for k, b in ((self.column, self.want), (self.reference, self.ref_beta), (self.column, self.beta))]
         ratios = ", ".join(f"{k:g}" for k in c.ratios)
-        return (f"{name or c.channel_name} (ratios {ratios}) sets {names[self.column]} at "
+        return (f"{c.words()} (ratios {ratios}) sets {names[self.column]} at "
                 f"heading {head[0]:.6g} deg with {names[self.reference]} at {head[1]:.6g} deg, not {head[2]:.6g} deg, "
                 f"which the twist needs ({math.degrees(abs(self.want - self.beta)):.3g} deg off; set by the gear, the "
                 f"wheel would slip sideways at {self.slip:.3g} m/s)")

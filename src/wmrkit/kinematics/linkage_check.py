@@ -197,16 +197,16 @@ class Breach:
     ref_beta: float
     slip: float = 0.0
 
-    def describe(self, robot: Robot, name: str | None = None) -> str:
-        """``"<linkage> (law ...) sets <wheel> at heading ... deg with <reference> at ... deg, not ... deg"``; the
-        linkage by its channel name, or `name` (text: :func:`wmrkit.couplings.coupling_words`)."""
+    def describe(self, robot: Robot) -> str:
+        """``"<linkage> (law ...) sets <wheel> at heading ... deg with <reference> at ... deg, not ... deg"``, the
+        linkage in the description's terms (:meth:`wmrkit.couplings.Coupling.words`; the JSON keeps its channel)."""
         from ..couplings import linkage_law
 
         c = robot.couplings[self.coupling]
         names = robot.steer_names
         head = [math.degrees(float(heading_from_beta(b, robot.wheel(names[k]).delta)))
                 for k, b in ((self.column, self.want), (self.reference, self.ref_beta), (self.column, self.beta))]
-        return (f"{name or c.channel_name} (law {linkage_law(c, robot.wheels)}) sets {names[self.column]} at heading "
+        return (f"{c.words()} (law {linkage_law(c, robot.wheels)}) sets {names[self.column]} at heading "
                 f"{head[0]:.6g} deg with {names[self.reference]} at {head[1]:.6g} deg, not {head[2]:.6g} deg")
 
 
