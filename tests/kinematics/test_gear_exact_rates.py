@@ -21,7 +21,8 @@ from wmrkit.kinematics.extended import GearWarning, extended_solution
 from wmrkit.kinematics.wheel_ik import forward_kinematics_check
 
 GEAR = "gear(left.spin, right.spin)"
-WORDS = f"the joints of {GEAR} (ratios 1, 2) do not turn together (left.spin 1, right.spin 1.9 rad/s; 5% apart)"
+WORDS = ("the joints of the gear of wheels 'left' and 'right' (ratios 1, 2) do not turn together (left.spin 1, "
+         "right.spin 1.9 rad/s; 5% apart)")
 IN_RATIO = [2.0, 2.0 * (1 + 1e-15)]  # the ratio, and the ratio to round-off
 
 

@@ -43,8 +43,8 @@ def test_a_synchro_drive_assigned_a_turn_breaks_its_linkage_and_the_linkage_is_n
     assert float(sol.slip) < 1e-9 and sol.in_gear.all()  # each wheel its own angle: no slip, as before
     assert sol.in_linkage.tolist() == [False] and sol.as_dict()["in_linkage"] == [False]
     assert len(msgs) == 1 and msgs[0].startswith(
-        "a steering linkage cannot set these steering angles: linkage(w0.steer, w1.steer, w2.steer) (law parallel) "
-        "sets w0 at heading -2.63485 deg with w2 at -2.63485 deg, not 5.71059 deg")
+        "a steering linkage cannot set these headings: the steering linkage of wheels 'w0', 'w1' and 'w2' (law "
+        "parallel) sets w0 at heading -2.63485 deg with w2 at -2.63485 deg, not 5.71059 deg")
     assert said(lambda: solve_steering(robot, TWIST, [1.0, 0.0, 0.5]))[1] == msgs  # the angles alone say it too
     straight, msgs = said(lambda: no_slip_extended_solution(robot, TWIST, [1.0, 0.3, 0.0]))
     assert all_parallel(TRIANGLE, (1.0, 0.3, 0.0), 1e-12)
@@ -66,8 +66,8 @@ def test_a_car_at_headings_off_its_ackermann_law_is_not_consistent_though_nothin
     assert float(sol.slip) == 0.0 and sol.in_gear.all()  # at rest nothing slips: before, this was consistent
     assert sol.in_linkage.tolist() == [True, False]  # the differential, the linkage
     assert len(msgs) == 1 and msgs[0].startswith(
-        "the steering angles break a steering linkage: linkage(front_left.steer, front_right.steer) (law ackermann) "
-        f"sets front_right at heading {fr:.6g} deg with front_left at 20 deg, not {fr + 5.0:.6g} deg")
+        "the headings break a steering linkage: the steering linkage of wheels 'front_left' and 'front_right' (law "
+        f"ackermann) sets front_right at heading {fr:.6g} deg with front_left at 20 deg, not {fr + 5.0:.6g} deg")
     sol, msgs = said(lambda: extended_solution(robot, rear, [0.0, 0.0], heading=np.radians([fl, fr])))
     assert sol.in_linkage.tolist() == [True, True] and msgs == []
 

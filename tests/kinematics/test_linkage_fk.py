@@ -42,8 +42,8 @@ def test_a_parallel_linkage_s_given_headings_are_judged_within_fk_s_slip_toleran
     if broken:
         shown = abs(b_deg) if abs(b_deg) == 180 else b_deg  # headings print in (-180, 180]
         assert out.out_of_linkage == ("linkage(a.steer, b.steer, c.steer)",) and not out.consistent
-        assert said[0].startswith("the headings break a steering linkage: linkage(a.steer, b.steer, c.steer) (law "
-                                  f"parallel) sets b at heading 0 deg with a at 0 deg, not {shown:g} deg")
+        assert said[0].startswith("the headings break a steering linkage: the steering linkage of wheels 'a', 'b' "
+                                  f"and 'c' (law parallel) sets b at heading 0 deg with a at 0 deg, not {shown:g} deg")
 
 
 def test_headings_that_leave_no_slip_but_break_the_linkage_are_flagged():
@@ -75,8 +75,8 @@ def test_the_cli_warns_and_says_inconsistent(tmp_path, capsys):
     assert main(["fk", str(path), "--spin", "a=10", "--steer", "b=10deg"]) == 0
     out, err = capsys.readouterr()
     assert "INCONSISTENT" in out
-    assert err.startswith("wmrkit: warning: the headings break a steering linkage: linkage(a.steer, b.steer, c.steer)"
-                          " (law parallel) sets b at heading 0 deg with a at 0 deg, not 10 deg")
+    assert err.startswith("wmrkit: warning: the headings break a steering linkage: the steering linkage of wheels "
+                          "'a', 'b' and 'c' (law parallel) sets b at heading 0 deg with a at 0 deg, not 10 deg")
     assert main(["fk", str(path), "--spin", "a=10", "--steer", "b=10deg", "--json"]) == 0
     data = json.loads(capsys.readouterr()[0])
     assert data["consistent"] is False and data["warnings"][0].startswith("the headings break a steering linkage")
