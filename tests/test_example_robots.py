@@ -45,8 +45,8 @@ SAYS = {("ik", "geared.json"): (1, "feasible: NO (a steering gear cannot set the
         ("ik", "synchro.yaml"): (1, "the steering linkage of wheels 'a', 'b' and 'c' (law parallel) sets a at heading "
                                     "-2.63485 deg with c at -2.63485 deg, not 5.71059 deg"),
         ("fk", "cart.yaml"): (0, "do not turn together"),
-        ("fk", "synchro.yaml"): (0, "the headings break a steering linkage: linkage(a.steer, b.steer, c.steer) (law "
-                                    "parallel) sets b at heading 0 deg with a at 0 deg, not 10 deg"),
+        ("fk", "synchro.yaml"): (0, "the headings break a steering linkage: the steering linkage of wheels 'a', 'b' "
+                                    "and 'c' (law parallel) sets b at heading 0 deg with a at 0 deg, not 10 deg"),
         ("track", "geared.json"): (0, "robot geared-units, reference circle of radius 3 m, controller p")}
 
 
@@ -97,8 +97,8 @@ def test_the_cart_s_solid_axle_leaves_it_one_degree_of_mobility(capsys, monkeypa
     assert (found["mobility"], found["steerability"], found["coupled_mobility"]) == (2, 0, 1)
     monkeypatch.chdir(ROOT)
     assert main(["fk", "examples/robots/cart.yaml", "--spin", "left=10", "--spin", "right=5"]) == 0
-    assert ("the joints of gear(left.spin, right.spin) (ratios 1, 1) do not turn together (left.spin 10, right.spin 5 "
-            "rad/s; 50% apart)") in capsys.readouterr().err
+    assert ("the joints of the gear of wheels 'left' and 'right' (ratios 1, 1) do not turn together (left.spin 10, "
+            "right.spin 5 rad/s; 50% apart)") in capsys.readouterr().err
 
 
 def test_the_synchro_drive_has_two_degrees_of_steerability_and_commands_one():

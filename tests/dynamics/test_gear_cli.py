@@ -46,11 +46,11 @@ def test_simulate_refuses_a_start_the_gear_forbids_and_names_it_in_a_program(tmp
     axle = _axle(tmp_path)
     assert main(["simulate", axle, "--path", "straight", "--initial-twist", "0.5", "0", "1", "--json"]) == 2
     error = json.loads(capsys.readouterr().err)["error"]
-    assert "gear(left.spin, right.spin) out of its ratios (1, 1)" in error and "\n" not in error
+    assert "the gear of wheels 'left' and 'right' out of its ratios (1, 1)" in error and "\n" not in error
     assert main(["simulate", axle, "--path", "turn", "--speed", "0.5", "--json"]) == 0
     answer = json.loads(capsys.readouterr().out)
     assert abs(answer["final_pose"][2]) < 1e-3  # a solid axle does not turn (the turn programs 0.65 rad)
-    assert any("gear(left.spin, right.spin) out of its ratios" in w for w in answer["warnings"])
+    assert any("the gear of wheels 'left' and 'right' out of its ratios" in w for w in answer["warnings"])
 
 
 def test_simulate_holds_a_linkage_and_refuses_a_start_it_forbids(tmp_path, capsys):
@@ -85,4 +85,4 @@ def test_simulate_holds_a_linkage_and_refuses_a_start_it_forbids(tmp_path, capsy
     path.write_text(json.dumps(chain))
     assert main(["simulate", str(path), "--path", "straight", "--initial-twist", "0.2", "0", "0.5", "--json"]) == 2
     error = json.loads(capsys.readouterr().err)["error"]
-    assert "linkage(left.steer, right.steer, fl.steer, fr.steer)" in error and "\n" not in error
+    assert "the steering linkage of wheels 'left', 'right', 'fl' and 'fr'" in error and "\n" not in error

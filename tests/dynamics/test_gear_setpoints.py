@@ -32,10 +32,10 @@ def test_a_torque_file_off_the_ratios_is_refused_naming_its_row_and_column(tmp_p
     with pytest.raises(WmrkitError) as err:
         read_torques(model, _file(tmp_path, front, front))
     assert str(err.value) == (
-        f"{_file(tmp_path, front, front)}:3: column 'rear.heading': {front:g} rad breaks gear(front.steer, "
-        f"rear.steer), which sets rear at heading {rear:.6g} rad with column 'front.heading' at {front:g} rad: the "
-        "steering servos would fight the gear the dynamics hold; give headings on its ratios (within 1e-05 rad) or "
-        "one heading column per gear (docs/dynamics.md)")
+        f"{_file(tmp_path, front, front)}:3: column 'rear.heading': {front:g} rad breaks the steering "
+        f"gear of wheels 'front' and 'rear', which sets rear at heading {rear:.6g} rad with column 'front.heading' at "
+        f"{front:g} rad: the steering servos would fight the gear the dynamics hold; give headings on its ratios "
+        "(within 1e-05 rad) or one heading column per gear (docs/dynamics.md)")
     sim = simulate(model, read_torques(model, _file(tmp_path, front, rear)), 2.0, record_step=0.5)
     np.testing.assert_allclose(sim.heading[-1], [front, rear], atol=1e-3)  # no fight: both reach their set-points
 
@@ -52,14 +52,16 @@ def test_python_inputs_off_the_ratios_are_refused_unless_let_fight():
     off = _inputs(model, [0.1, 0.1])
     for run in (lambda: simulate(model, off, 0.01), lambda: Stepper(model).advance(off, 0.01)):
         with pytest.raises(WmrkitError, match=r"^heading_reference: at t = 1 s, rear's 0.1 rad breaks "
-                                              r"gear\(front.steer, rear.steer\), which sets rear at heading 0.2 rad"):
+                                              r"the steering gear of wheels 'front' and 'rear', which sets rear at "
+                                              r"heading 0.2 rad"):
             run()
     simulate(model, _inputs(model, [0.1, 0.1], fight_linkages=True), 0.01)
     simulate(model, _inputs(model, [0.1, 0.2]), 0.01)
     stepper = Stepper(model)
     stepper.advance(_inputs(model, [0.0, 0.0]), 0.01)
     stepper.hold(heading_reference=[-0.2, -0.4])
-    with pytest.raises(WmrkitError, match=r"^hold: heading_reference: at t = 0.01 s, rear's -0.2 rad breaks gear"):
+    with pytest.raises(WmrkitError, match=r"^hold: heading_reference: at t = 0.01 s, rear's -0.2 rad breaks the "
+                                          r"steering gear"):
         stepper.hold(heading_reference=[-0.2, -0.2])
 
 
@@ -67,8 +69,9 @@ def test_a_twist_program_whose_steering_breaks_the_ratios_is_refused_unless_allo
     """Crabbing at 0.1 rad steers both units to 0.1 rad, which the 1:2 gear cannot (before: run, fighting)."""
     model = _geared_units((1.0, 2.0))
     twist = (math.cos(0.1), math.sin(0.1), 0.0)
-    with pytest.raises(WmrkitError, match=r"breaks the ratios of gear\(front.steer, rear.steer\) \(it sets rear at "
-                                          r"heading 0.2 rad with front's at 0.1 rad, the wheel IK 0.1 rad\)"):
+    with pytest.raises(WmrkitError, match=r"breaks the ratios of the steering gear of wheels 'front' and 'rear' "
+                                          r"\(it sets rear at heading 0.2 rad with front's at 0.1 rad, the wheel IK "
+                                          r"0.1 rad\)"):
         twist_program(model, [0.0], [twist])
     inputs = twist_program(model, [0.0], [twist], allow_slip=True)
     assert inputs.fight_linkages

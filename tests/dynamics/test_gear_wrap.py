@@ -28,7 +28,7 @@ def test_a_breach_across_the_turn_is_still_found_at_its_wrapped_size():
     """179 deg against -179 deg is 2 deg off the 1:1 gear (not 358): refused, naming the heading the gear gives."""
     model = _geared_units((1.0, 1.0))
     headings = np.array([179.0, -179.0]) * DEG
-    j, ref, want, name = gear_breach(model, headings, {0, 1})
-    assert (j, ref, name) == (1, 0, "gear(front.steer, rear.steer)")
+    j, ref, want, gear = gear_breach(model, headings, {0, 1})
+    assert (j, ref, gear.channel_name) == (1, 0, "gear(front.steer, rear.steer)")
     assert want == pytest.approx(179.0 * DEG)
     assert first_breach(model, np.vstack([[0.0, 0.0], headings]), {0, 1}) == 1

@@ -122,7 +122,7 @@ def test_the_start_is_in_gear_and_a_state_out_of_gear_is_refused():
     assert s[n:n + 3].tolist() == [0.5, 0.0, 1.0]
     assert s[n + i] == pytest.approx(0.5 / 0.08) and s[n + j] == pytest.approx(0.5 / 0.08)
     s[n + i] += 1.0
-    with pytest.raises(WmrkitError, match=r"gear\(left.spin, right.spin\)"):
+    with pytest.raises(WmrkitError, match=r"the gear of wheels 'left' and 'right'"):
         Stepper(model, s)
 
 
@@ -130,7 +130,7 @@ def test_twist_program_refuses_a_twist_the_gear_forbids_unless_allowed_to_slip()
     """A solid axle turning about its middle rolls without side slip but turns its wheels apart: no motion of the
     robot; allow_slip lets the servos fight through the gear."""
     model = DynamicModel.of(_geared(castor_robot(), SPINS))
-    with pytest.raises(WmrkitError, match=r"gear\(left.spin, right.spin\) out of its ratios \(1, 1\)"):
+    with pytest.raises(WmrkitError, match=r"the gear of wheels 'left' and 'right' out of its ratios \(1, 1\)"):
         twist_program(model, [0.0], [(0.5, 0.0, 1.0)])
     inputs = twist_program(model, [0.0], [(0.5, 0.0, 1.0)], allow_slip=True)
     sim = simulate(model, inputs, 1.0, initial_twist=(0.5, 0.0, 0.0))  # rolling: no step at the grip

@@ -40,8 +40,8 @@ def test_python_set_points_off_the_law_are_refused_naming_the_knot_and_the_wheel
     with pytest.raises(WmrkitError) as err:
         simulate(model, inputs, 0.01)
     assert str(err.value).startswith(
-        f"heading_reference: at t = 1 s, fr's 0 rad breaks linkage(fl.steer, fr.steer), which sets fr at heading "
-        f"{right_of(0.3):.6g} rad with fl's at 0.3 rad: the steering servos would fight")
+        f"heading_reference: at t = 1 s, fr's 0 rad breaks the steering linkage of wheels 'fl' and 'fr', which sets fr "
+        f"at heading {right_of(0.3):.6g} rad with fl's at 0.3 rad: the steering servos would fight")
     on_law = _servo_inputs(model, [0.0, 1.0], [[0.0, 0.0], [0.3, right_of(0.3) + 0.5 * SETPOINT_TOL]])
     simulate(model, on_law, 0.01)
 
@@ -114,8 +114,8 @@ def test_a_stepper_holds_headings_on_the_law_and_refuses_others(fight):
     with pytest.raises(WmrkitError) as err:
         stepper.hold(heading_reference=[0.3, 0.0])
     assert str(err.value).startswith(
-        f"hold: heading_reference: at t = 0.01 s, fr's 0 rad breaks linkage(fl.steer, fr.steer), which sets fr at "
-        f"heading {right_of(0.3):.6g} rad with fl's at 0.3 rad: the steering servos would fight")
+        f"hold: heading_reference: at t = 0.01 s, fr's 0 rad breaks the steering linkage of wheels 'fl' and 'fr', "
+        f"which sets fr at heading {right_of(0.3):.6g} rad with fl's at 0.3 rad: the steering servos would fight")
     stepper.advance(None, 0.2)
     fl, fr = model.robot.heading_of_beta(stepper.state[list(model.steer_columns)])
     assert fl > 0.1 and fr == pytest.approx(right_of(fl), abs=1e-9)  # turning to the held on-law headings

@@ -57,7 +57,7 @@ def test_a_four_wheel_steer_car_without_a_law_is_warned_and_not_held(tmp_path, c
     answer, _, heading = _simulate(tmp_path, capsys, four_wheel_steer())
     said = [w for w in answer["warnings"] if "not held" in w]
     assert len(said) == 2 and all("law: parallel" in w and "law field" in w for w in said)
-    assert said[0].startswith("linkage(fl.steer, fr.steer) is not held by the dynamics")
+    assert said[0].startswith("the steering linkage of wheels 'fl' and 'fr' is not held by the dynamics")
     assert heading["fl"][-1] == pytest.approx(TAU * DURATION ** 2 / (2 * I_STEER), rel=2e-3)
     assert np.abs(heading["fr"]).max() < 1e-3 * heading["fl"][-1]
     with pytest.warns(LinkageWarning, match="not held"):
@@ -71,8 +71,9 @@ def test_the_warning_is_one_stderr_line_per_linkage(tmp_path, capsys):
     path.write_text(json.dumps(four_wheel_steer()))
     assert main(["simulate", str(path), "--path", "straight", "--speed", "0.5"]) == 0
     lines = [x for x in capsys.readouterr().err.splitlines() if "not held" in x]
-    assert [x.split(" is not held")[0] for x in lines] == ["wmrkit: warning: linkage(fl.steer, fr.steer)",
-                                                         "wmrkit: warning: linkage(rl.steer, rr.steer)"]
+    assert [x.split(" is not held")[0] for x in lines] == [
+        "wmrkit: warning: the steering linkage of wheels 'fl' and 'fr'",
+        "wmrkit: warning: the steering linkage of wheels 'rl' and 'rr'"]
 
 
 def test_law_parallel_holds_each_pair_parallel(tmp_path, capsys):
@@ -95,7 +96,7 @@ def test_a_synchro_drive_holds_parallel_by_default_and_not_over_some_of_its_whee
     assert model.steering_inertia() == pytest.approx([4 * I_STEER] * 4, rel=1e-12)
     assert model.pack[17].shape == (3, 10) and not model.pack[17][:, 3].any()  # law 0: parallel
     some = four_wheel_steer(linkages=[STEERS[:3]])
-    with pytest.warns(LinkageWarning, match=r"linkage\(fl.steer, fr.steer, rl.steer\) is not held"):
+    with pytest.warns(LinkageWarning, match=r"the steering linkage of wheels 'fl', 'fr' and 'rl' is not held"):
         model = DynamicModel.of(Robot.from_dict(some))
     assert model.pack[17].shape == (0, 10)
     assert model.steering_inertia() == pytest.approx([I_STEER] * 4, rel=1e-12)
@@ -112,7 +113,8 @@ def test_law_parallel_on_a_car_with_fixed_wheels_turns_the_pair_together():
     nu[i] = nu[j] = 0.7
     model.accelerations(beta, nu, forces=np.zeros(8))  # held: accepted
     ackermann = model.robot.beta_of_heading([0.3, math.atan2(0.6, 0.6 / math.tan(0.3) + 0.4)])
-    with pytest.raises(WmrkitError, match=r"linkage\(fl.steer, fr.steer\) sets fr.steer at heading 0.3 rad"):
+    with pytest.raises(WmrkitError, match=r"the steering linkage of wheels 'fl' and 'fr' sets fr.steer at heading "
+                                          r"0.3 rad"):
         model.accelerations(ackermann, nu, forces=np.zeros(8))
     data["couplings"][0]["law"] = "ackermann"  # stated as the default is: the same model
     assert np.array_equal(DynamicModel.of(Robot.from_dict(data)).pack[17], DynamicModel.of(linked_car()).pack[17])

@@ -51,8 +51,8 @@ def test_a_follower_off_the_ackermann_law_is_refused_at_its_row_and_columns(tmp_
     out, err = capsys.readouterr()
     assert out == "" and len(err.splitlines()) == 1
     assert err.startswith(f"wmrkit: error: {torques}:3: column 'front_right.heading': 0 rad breaks "
-                          f"linkage(front_left.steer, front_right.steer), which sets front_right at heading "
-                          f"{right:.6g} rad with column 'front_left.heading' at 0.3 rad")
+                          f"the steering linkage of wheels 'front_left' and 'front_right', which sets front_right at "
+                          f"heading {right:.6g} rad with column 'front_left.heading' at 0.3 rad")
     assert main([*argv, "--json"]) == 2
     data = json.loads(capsys.readouterr().err)
     assert (data["file"], data["line"], data["field"]) == (str(torques), 3, "front_right.heading")
@@ -77,7 +77,7 @@ def test_the_tolerance_is_the_documented_one(heading, tmp_path):
         if ok:
             read_torques(model, path)
         else:
-            with pytest.raises(WmrkitError, match=r"h\.csv:3: column 'fr\.heading': .* breaks linkage"):
+            with pytest.raises(WmrkitError, match=r"h\.csv:3: column 'fr\.heading': .* breaks the steering linkage"):
                 read_torques(model, path)
 
 

@@ -17,8 +17,8 @@ from wmrkit.dynamics.linkages import LinkageWarning
 from wmrkit.dynamics.model import DynamicModel
 from wmrkit.dynamics.simulate import Inputs, Stepper, simulate
 
-HEADS = ["linkage(fl.steer, fr.steer) is not held by the dynamics",
-         "linkage(rl.steer, rr.steer) is not held by the dynamics"]
+HEADS = ["the steering linkage of wheels 'fl' and 'fr' is not held by the dynamics",
+         "the steering linkage of wheels 'rl' and 'rr' is not held by the dynamics"]
 
 
 def _said(run) -> tuple[object, list[warnings.WarningMessage]]:

@@ -45,7 +45,7 @@ def test_a_chain_turned_at_a_late_knot_is_refused_there_judged_at_once(monkeypat
     calls = _counted(monkeypatch)
     with pytest.raises(WmrkitError, match=rf"^twist \(0.3, 0.0, 0.5\) at t = {LATE * 0.01:g} s has no no-slip "
                                           r"motion for 'synchro': its wheels' steering breaks a linkage "
-                                          r"\(linkage\(a.steer, b.steer, c.steer\) sets b.steer"):
+                                          r"\(the steering linkage of wheels 'a', 'b' and 'c' sets b.steer"):
         programs.twist_program(model, *_late((0.3, 0.0, 0.5)))
     assert calls["linkage_breach"] <= 1 and calls["gear_breach"] <= 1
     assert programs.twist_program(model, *_late((0.3, 0.0, 0.5)), allow_slip=True).fight_linkages
@@ -59,7 +59,7 @@ def test_geared_units_crabbing_at_a_late_knot_are_refused_there_judged_at_once(m
     t, twists = _late((math.cos(0.1), math.sin(0.1), 0.0))
     twists[:LATE] = (1.0, 0.0, 0.0)
     with pytest.raises(WmrkitError, match=rf"^twist .* at t = {LATE * 0.01:g} s .* breaks the ratios of "
-                                          r"gear\(front.steer, rear.steer\) \(it sets rear at heading 0.2 rad with "
-                                          r"front's at 0.1 rad, the wheel IK 0.1 rad\)"):
+                                          r"the steering gear of wheels 'front' and 'rear' \(it sets rear at heading "
+                                          r"0.2 rad with front's at 0.1 rad, the wheel IK 0.1 rad\)"):
         programs.twist_program(model, t, twists)
     assert calls["linkage_breach"] <= 1 and calls["gear_breach"] <= 1

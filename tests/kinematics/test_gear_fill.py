@@ -124,10 +124,11 @@ def test_fk_warns_of_given_rates_out_of_the_gear_as_odometry_does(tmp_path, caps
         assert out["warnings"] == [] and out["consistent"] is True
         return
     assert out["consistent"] is False and len(out["warnings"]) == 1
-    want = (f"the joints of the gear of wheels 'left' and 'right' (ratios 1, {ratio:g}) do not turn together (left.spin 10, "
-            f"right.spin {right:g} rad/s; {spread:.0%} apart)")
+    want = (f"the joints of the gear of wheels 'left' and 'right' (ratios 1, {ratio:g}) do not turn together "
+            f"(left.spin 10, right.spin {right:g} rad/s; {spread:.0%} apart)")
     assert out["warnings"][0].startswith(want)
     assert main(["fk", str(path), "--spin", "left=10", "--spin", f"right={right!r}"]) == 0
     text = capsys.readouterr()
-    assert text.err.count("\n") == 1 and text.err.startswith("wmrkit: warning: the joints of the gear of wheels 'left' and 'right' (")
+    assert text.err.count("\n") == 1
+    assert text.err.startswith("wmrkit: warning: the joints of the gear of wheels 'left' and 'right' (")
     assert "(INCONSISTENT)" in text.out

@@ -81,4 +81,5 @@ def test_a_bag_breaking_a_gear_coupling_warns_as_its_csv_does(capsys, tmp_path, 
     said = [w for w in csv["warnings"] if "do not turn together" in w]
     assert len(said) == (0 if agrees else 1)
     if not agrees:
-        assert said[0].startswith("the joints of gear(left.spin, right.spin) (ratios 1, 1) do not turn together")
+        assert said[0].startswith("the joints of the gear of wheels 'left' and 'right' (ratios 1, 1) do not turn "
+                                  "together")

@@ -567,7 +567,8 @@ def test_a_log_that_breaks_a_gear_coupling_warns_and_says_inconsistent(capsys, t
         assert out.err == ""
     else:
         assert out.err.count("\n") == 1 and out.err.startswith(
-            f"wmrkit: warning: the joints of gear(left.spin, right.spin) (ratios 1, {ratio:g}) do not turn together")
+            f"wmrkit: warning: the joints of the gear of wheels 'left' and 'right' (ratios 1, {ratio:g}) do not turn "
+            "together")
 
 
 @pytest.mark.parametrize("name", ["traj.json", "t.TUM.bak", "odom.bag2"])

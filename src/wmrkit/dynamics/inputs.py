@@ -167,12 +167,12 @@ def setpoint_problem(model: DynamicModel, headings: np.ndarray, commanded: set[i
     breach = heading_breach(model, headings, commanded)
     if breach is None:
         return None
-    j, ref, want, name = breach
+    j, ref, want, c = breach
     steered = model.robot.steer_names
     by = "whatever the others do" if ref is None else f"with {steered[ref]}'s at {headings[ref]:.6g} rad"
-    kind = name.partition("(")[0]
-    return (f"{steered[j]}'s {headings[j]:.6g} rad breaks {name}, which sets {steered[j]} at heading {want:.6g} rad "
-            f"{by}: the steering servos would fight the {kind} the dynamics hold; give headings on its "
+    kind = c.kind
+    return (f"{steered[j]}'s {headings[j]:.6g} rad breaks {c.words()}, which sets {steered[j]} at heading "
+            f"{want:.6g} rad {by}: the steering servos would fight the {kind} the dynamics hold; give headings on its "
             f"{'law' if kind == 'linkage' else 'ratios'} (within {SETPOINT_TOL:g} rad), steer_kp > 0 on one wheel per "
             f"{kind}, or fight_linkages=True")
 

@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from ..couplings import linkage_law
+from ..couplings import Coupling, linkage_law
 from ..errors import WmrkitError
 from ..kinematics.linkage_law import LINKAGE_TOL, law
 from ..wheels import wrap_angle
@@ -44,7 +44,7 @@ class LinkageWarning(UserWarning):
 def unheld(robot) -> list[str]:
     """The warnings of the linkages of `robot` the dynamics do not hold (no law stated and none to default to:
     :func:`wmrkit.couplings.linkage_law`): each steering angle follows its own servo (:class:`LinkageWarning`)."""
-    return [f"{c.channel_name} is not held by the dynamics: the robot has no fixed wheel and the linkage does not link "
+    return [f"{c.words()} is not held by the dynamics: the robot has no fixed wheel and the linkage does not link "
             "every steerable wheel, so its law is not known and each steering angle follows its own servo; state it "
             "in the coupling's law field (law: parallel if the linked wheels turn together; "
             "docs/description-format.md)"
@@ -84,7 +84,7 @@ def linkage_breach(model, beta: np.ndarray, nu: np.ndarray | None = None) -> str
     for row in table:
         j, i = cols.index(int(row[0])), cols.index(int(row[1]))
         f, slope, _ = law(row, beta[i])
-        name = next(c.channel_name for c in model.robot.couplings
+        name = next(c.words() for c in model.robot.couplings
                     if c.kind == "linkage" and f"{model.names[int(row[0])]}" in c.joints)
         if abs(math.remainder(beta[j] - f, 2 * math.pi)) > LINKAGE_TOL:
             return (f"{name} sets {model.names[int(row[0])]} at heading {_heading(model, j, f):.6g} rad from "
@@ -113,17 +113,17 @@ def setpoint_breach(model, beta: np.ndarray, commanded: set[int],
     return j, src if src in commanded else None, float(at[0, off[0]])
 
 
-def heading_breach(model, headings: np.ndarray, commanded: set[int]) -> tuple[int, int | None, float, str] | None:
+def heading_breach(model, headings: np.ndarray, commanded: set[int]) -> tuple[int, int | None, float, Coupling] | None:
     """:func:`setpoint_breach` of heading set-points `headings` ``(n_steer,)`` [rad] as users read it, then
     :func:`gear_breach`: ``(follower, reference, heading the law (the gear) gives the follower [rad], the
-    coupling's name)``; None when they agree."""
+    coupling)``; None when they agree."""
     breach = setpoint_breach(model, model.robot.beta_of_heading(headings), commanded)
     if breach is None:
         return gear_breach(model, headings, commanded)
     j, ref, f = breach
     steer = f"{model.robot.steer_names[j]}.steer"
-    name = next(c.channel_name for c in model.robot.couplings if c.kind == "linkage" and steer in c.joints)
-    return j, ref, _heading(model, j, f), name
+    linkage = next(c for c in model.robot.couplings if c.kind == "linkage" and steer in c.joints)
+    return j, ref, _heading(model, j, f), linkage
 
 
 def first_breach(model, headings: np.ndarray, commanded: set[int]) -> int | None:
@@ -155,15 +155,15 @@ def first_ik_breach(model, headings: np.ndarray, servoed: set[int]) -> int | Non
 
 
 def gear_breach(model, headings: np.ndarray, commanded: set[int],
-                tol: float = SETPOINT_TOL) -> tuple[int, int, float, str] | None:
+                tol: float = SETPOINT_TOL) -> tuple[int, int, float, Coupling] | None:
     """The first heading set-point of `headings` ``(n_steer,)`` [rad] (the indices `commanded` servoed) that breaks
     a ``gear`` the dynamics hold between steering joints (:func:`_geared`): ``(follower, reference, heading the gear
-    gives it, the gear's name)``; None when they agree (within `tol` [rad])."""
+    gives it, the gear)``; None when they agree (within `tol` [rad])."""
     for j, ref, want in _geared(model, headings, commanded):
         if _gear_off(headings[j], want) > tol:
             steer = f"{model.robot.steer_names[j]}.steer"
-            name = next(c.channel_name for c in model.robot.couplings if c.kind == "gear" and steer in c.joints)
-            return j, ref, float(want), name
+            gear = next(c for c in model.robot.couplings if c.kind == "gear" and steer in c.joints)
+            return j, ref, float(want), gear
     return None
 
 

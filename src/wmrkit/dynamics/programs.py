@@ -149,7 +149,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
         k, g = (int(i) for i in np.argwhere(~geared)[0])
         c = robot.couplings[g]
         raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion for "
-                          f"'{robot.name}': it would turn the joints of {c.channel_name} out of its ratios "
+                          f"'{robot.name}': it would turn the joints of {c.words()} out of its ratios "
                           f"({', '.join(f'{r:g}' for r in c.ratios)}), which the gear holds together; use "
                           "allow_slip=True to let its servos fight and the tyres slip")
     headings = np.zeros((len(t), len(model.steer_columns)))
@@ -202,11 +202,11 @@ def _check_linkages(model: DynamicModel, t: np.ndarray, twists: np.ndarray, head
         return k is not None
     geared = gear_breach(model, headings[k], servoed)
     if geared:
-        j, ref, want, name = geared
+        j, ref, want, gear = geared
         steered = model.robot.steer_names
         raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion "
-                          f"for '{model.robot.name}': its wheels' steering breaks the ratios of {name} (it sets "
-                          f"{steered[j]} at heading {want:.6g} rad with {steered[ref]}'s at "
+                          f"for '{model.robot.name}': its wheels' steering breaks the ratios of {gear.words()} "
+                          f"(it sets {steered[j]} at heading {want:.6g} rad with {steered[ref]}'s at "
                           f"{headings[k, ref]:.6g} rad, the wheel IK {headings[k, j]:.6g} rad), which the "
                           "dynamics hold; use allow_slip=True to let its servos fight and the tyres slip")
     breach = linkage_breach(model, model.robot.beta_of_heading(headings[k]))
@@ -289,11 +289,11 @@ def _check_setpoints(source: str, model: DynamicModel, href: np.ndarray, command
     steered, k = model.robot.steer_names, first_breach(model, href, set(commanded))
     breach = None if k is None else heading_breach(model, href[k], set(commanded))
     if breach is not None:
-        j, ref, want, name = breach
+        j, ref, want, c = breach
         by = "whatever the others do" if ref is None else (f"with column '{steered[ref]}.heading' at "
                                                         f"{href[k, ref]:.6g} rad")
-        kind = name.partition("(")[0]
-        raise WmrkitError(f"{source}:{k + 2}: column '{steered[j]}.heading': {href[k, j]:.6g} rad breaks {name}, "
+        kind = c.kind
+        raise WmrkitError(f"{source}:{k + 2}: column '{steered[j]}.heading': {href[k, j]:.6g} rad breaks {c.words()}, "
                           f"which sets {steered[j]} at heading {want:.6g} rad {by}: the steering servos would fight "
                           f"the {kind} the dynamics hold; give headings on its "
                           f"{'law' if kind == 'linkage' else 'ratios'} (within {SETPOINT_TOL:g} rad) or one heading "
