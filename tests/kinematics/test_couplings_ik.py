@@ -135,8 +135,8 @@ def test_closed_forms_say_a_gear_is_not_used(capsys, tmp_path):
     assert code == 0 and "warning" not in err
     code, _, err = run(capsys, "kinematics", str(path), "--symbolic")
     assert code == 0 and err == ("wmrkit: warning: the closed-form direct model (sensed) (left.spin, right.spin) is of "
-                                 "the wheels alone, not holding gear(left.spin, right.spin): it may give rates they "
-                                 "forbid (check a twist with 'wmrkit ik')\n")
+                                 "the wheels alone, not holding the gear of wheels 'left' and 'right': it may give "
+                                 "rates they forbid (check a twist with 'wmrkit ik')\n")
     code, _, err = run(capsys, "kinematics", str(path))
     assert code == 0 and err == ""
     code, _, err = run(capsys, "kinematics", "forklift", "--symbolic")  # a differential: nothing to say

@@ -56,8 +56,8 @@ def substituted_form(robot: Robot, inputs: tuple[str, ...], a: sp.MatrixBase, he
         unknown = gear_free(held, names, given)[1]
         left = free_columns(values[int(np.argmax(ranks_na))][:, na])
         raise SingularError(f"robot '{robot.name}': assigning ({name_list(inputs)}) does not determine "
-                            f"({name_list([n for n, f in zip(unknown, left, strict=True) if f])}), gears "
-                            f"{name_list([c.channel_name for c in held])} held")
+                            f"({name_list([n for n, f in zip(unknown, left, strict=True) if f])}) with "
+                            f"{name_list([c.words() for c in held])} held")
     exact = max(ranks_na) == rank
     if guard is not None:
         guard(system, na, exact)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .._shapes import as_names
+from ..couplings import coupling_words
 from ..errors import SingularError, WmrkitError, name_list
 from ..robot import TWIST_NAMES, Robot
 from ._exact_linalg import _components, closed_form, generic_ranks
@@ -317,7 +318,8 @@ def unheld_gears(robot: Robot) -> list[str]:
             continue
         alone = "is of the wheels alone, not holding" if unheld == gears else "does not hold"
         if unheld:
-            out.append(f"the closed-form {title} ({', '.join(names)}) {alone} {', '.join(unheld)}: it may give rates "
+            words = name_list([coupling_words(robot.couplings, g) for g in unheld])
+            out.append(f"the closed-form {title} ({', '.join(names)}) {alone} {words}: it may give rates "
                        "they forbid (check a twist with 'wmrkit ik')")
     return out
 
@@ -338,7 +340,8 @@ def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, late
              f"{comment}  steering [rad]: {_steering_note(robot)}; geometry: the robot's numbers, exact (m, rad)"]
     gears = [c.channel_name for c in robot.couplings if c.kind == "gear"]
     if gears:
-        lines.append(f"{comment}  gears: {', '.join(gears)}, q_j = ratio_j * u (rows q_i/ratio_i - q_j/ratio_j = 0 "
+        named = ", ".join(coupling_words(robot.couplings, g, short=True) for g in gears)
+        lines.append(f"{comment}  gears: {named}, q_j = ratio_j * u (rows q_i/ratio_i - q_j/ratio_j = 0 "
                      "under A): held by every form below that does not say otherwise")
     for title, names in sets:
         lines.append("")
@@ -362,7 +365,8 @@ def format_symbolic(robot: Robot, assigned: Sequence[str] | None = None, *, late
         if unheld and len(unheld) == len(gears):
             how += "; of the wheels alone, the gears not held (no exact form holds them: check with 'wmrkit ik')"
         elif unheld:
-            how += (f"; holding the gears that set double wheels' steering rates, not {', '.join(unheld)} (no exact "
+            how += (f"; holding the gears that set double wheels' steering rates, not "
+                    f"{name_list([coupling_words(robot.couplings, g) for g in unheld])} (no exact "
                     "form holds them: check with 'wmrkit ik')")
         lines.append(f"{comment}  {how}")
         lines += _latex_block(model) if latex else [f"    {n} = {_linear_form(model, i)}" for i, n in
