@@ -63,8 +63,8 @@ def test_the_law_is_the_ackermann_geometry_and_a_broken_description_is_refused()
     data = linked_car(front_heading=0.3).to_dict()
     data["wheels"][3]["heading"] = 0.3
     data["wheels"][3].pop("beta", None)
-    with pytest.raises(WmrkitError, match=r"linkage\(fl.steer, fr.steer\): at the described headings .*\(fr would be "
-                                          r"at 14.38 deg"):  # atan(0.6 / (0.6 / tan 0.3 + 0.4))
+    with pytest.raises(WmrkitError, match=r"the steering linkage of wheels 'fl' and 'fr': at the described headings "
+                                          r".*\(fr would be at 14.38 deg"):  # atan(0.6 / (0.6 / tan 0.3 + 0.4))
         DynamicModel.of(Robot.from_dict(data))
 
 

@@ -81,7 +81,7 @@ def linkage_table(robot, names: tuple[str, ...], strict: bool = True) -> np.ndar
         if lead is None:
             if not strict:
                 continue
-            raise WmrkitError(f"robot '{robot.name}': {c.channel_name}: every linked wheel is on the fixed wheels' "
+            raise WmrkitError(f"robot '{robot.name}': {c.words()}: every linked wheel is on the fixed wheels' "
                               "axle line, so no steering angle sets the ICR; the dynamics cannot hold it")
         xi, yi, psi_i = frame[lead]
         wi = wheels[lead]
@@ -100,7 +100,7 @@ def linkage_table(robot, names: tuple[str, ...], strict: bool = True) -> np.ndar
                     heads = ", ".join(f"{w.name} {math.degrees(float(heading_from_beta(w.beta, w.delta))):.4g} deg"
                                       for w in (wi, wj))
                     raise WmrkitError(
-                        f"robot '{robot.name}': {c.channel_name}: at the described headings ({heads}) the linked "
+                        f"robot '{robot.name}': {c.words()}: at the described headings ({heads}) the linked "
                         f"wheels' axles do not meet on the fixed wheels' axle line ({wj.name} would be at "
                         f"{math.degrees(float(heading_from_beta(wj.beta + off, wj.delta))):.4g} deg): "
                         "the dynamics hold a linkage on one ICR; describe headings that agree (docs/dynamics.md)")
@@ -139,7 +139,7 @@ def _axle(robot, c) -> tuple[np.ndarray, float]:
     meet; :class:`WmrkitError` naming it when the wheels give none (:func:`wmrkit.couplings.axle_problem`)."""
     problem = axle_problem(robot.wheels)
     if problem is not None:
-        raise WmrkitError(f"robot '{robot.name}': {c.channel_name}: law ackermann: {problem}; the dynamics cannot "
+        raise WmrkitError(f"robot '{robot.name}': {c.words()}: law ackermann: {problem}; the dynamics cannot "
                           "hold the linkage")
     p0, h0, _ = fixed_axle(robot.wheels)
     return p0, h0
