@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..couplings import coupling_words, linkage_law
+from ..couplings import linkage_law
 from ..kinematics.linkage_check import _plan, _speeds, linkage_holds
 from ..kinematics.wheel_ik import SLIP_TOL
 from ..robot import Robot
@@ -233,10 +233,10 @@ def _unreachable(robot: Robot, s: SingularSet) -> tuple[np.ndarray, list[int]]:
 def unreachable_note(robot: Robot, s: SingularSet, *, words: bool = False) -> str | None:
     """One line for the report under a singular set: how many of its configurations a held linkage cannot set, or
     None when it can set them all. `words`: each linkage named in the description's terms (text; the JSON keeps its
-    channel name, :func:`wmrkit.couplings.coupling_words`)."""
+    channel name, :meth:`wmrkit.couplings.Coupling.words`)."""
     bad, broken = _unreachable(robot, s)
-    names = [_law_named(robot, k, coupling_words(robot.couplings, robot.couplings[k].channel_name) if words else
-                        robot.couplings[k].channel_name) for k in broken]
+    names = [_law_named(robot, k, robot.couplings[k].words() if words else robot.couplings[k].channel_name)
+             for k in broken]
     if not bad.any():
         return None
     n, k = len(bad), int(bad.sum())
