@@ -10,6 +10,7 @@ from wmrkit.cli.main import main
 from wmrkit.couplings import Coupling
 
 GEAR = "gear(rear_left.spin, rear_right.spin)"
+WORDS = "the gear of wheels 'rear_left' and 'rear_right'"
 
 
 def kart(tmp_path, ratios=(1.0, 1.0)):
@@ -33,7 +34,7 @@ def test_track_warns_when_its_commands_break_a_gear(tmp_path, capsys):
     path = kart(tmp_path)
     assert main(["track", path, "--reference", "circle", "--duration", "3"]) == 0
     err = capsys.readouterr().err
-    assert f"the commands turn the joints of {GEAR} out of its ratios (ratios 1, 1)" in err
+    assert f"the commands turn the joints of {WORDS} out of its ratios (ratios 1, 1)" in err
     # the kinematic loop holds a steering gear's ratios (control.linked_ranges), not a gear of spins
     assert "the kinematic loop holds the ratios of steering joints only, not these (it drives each on its own)" in err
     assert main(["track", path, "--reference", "line", "--duration", "3"]) == 0  # straight: the axle turns as one
@@ -49,5 +50,6 @@ def test_track_dynamics_holds_the_gear_and_says_its_servos_fight(tmp_path, capsy
     dataclasses.replace(fork, couplings=(Coupling("gear", drives, (1.0, 1.0)),)).to_file(path)
     assert main(["track", str(path), "--reference", "circle", "--duration", "2", "--dynamics"]) == 0
     err = capsys.readouterr().err
-    assert f"gear({', '.join(drives)}) out of its ratios (ratios 1, 1); the dynamics hold the gear" in err
+    assert ("the commands turn the joints of the gear of wheels 'right_drive' and 'left_drive' out of its ratios "
+            "(ratios 1, 1); the dynamics hold the gear") in err
     assert "does not model" not in err
