@@ -72,6 +72,17 @@ def test_a_reference_of_another_run_is_refused(husky_run):
         calibrate_slip(catalog.load("skid-steer-4"), husky_run.log, (husky_run.log.time, mirrored))
 
 
+def test_a_fit_stopped_a_hair_inside_its_bound_is_refused():
+    """scipy's trf stops strictly inside a bound and need not flag it active: a reference with x and y swapped ran
+    the ratio to 1.0000012e-06 (5e-7 decades from the bound), which was reported as a fit, exit 0 (`wmrkit
+    calibrate` offered `lateral: 1.0000003981745279e-06` as a description block on a simulated turn)."""
+    robot = catalog.load("skid-steer-4")
+    run = wheel_speed_run(robot, [(1.0, [10, 10, 10, 10]), (2.0, [10, 12, 10, 12])], 50.0, model="mqe")
+    swapped = run.truth[:, [1, 0, 2]]
+    with pytest.raises(WmrkitError, match="the WLS ratio ran to the bound of its search"):
+        calibrate_slip(robot, run.log, (run.log.time, swapped))
+
+
 def test_cli_calibrate_then_odometry(tmp_path, capsys, husky_run):
     log = husky_run.log
     log_path, ref_path, w_path = tmp_path / "log.csv", tmp_path / "ref.tum", tmp_path / "w.json"
