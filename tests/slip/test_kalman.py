@@ -162,3 +162,22 @@ def test_the_filter_refuses_a_log_or_start_pose_that_odometry_refuses(time, spin
             kalman_filter(model, log)
         else:
             kalman_odometry(model, log, **({} if call == "odometry" else call))
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    # a mapping raised AttributeError "'dict' object has no attribute 'wheels'"
+    (lambda: kalman_model(catalog.load("forklift"), "fk2", {"process": 1.0}),
+     r"noise: expected KalmanNoise or None \(KalmanNoise\(process, lateral, longitudinal\)"),
+    # a string raised ValueError "not enough values to unpack (expected 3, got 1)"
+    (lambda: KalmanNoise(wheels="steer"), r"Kalman noise wheels: expected \(\(wheel name, lateral, longitudinal\)"),
+    (lambda: KalmanNoise(wheels=(("steer", 1.0),)), "Kalman noise wheels: expected"),
+    # text was printed bare ("got 1", as if 1 were refused); a boolean was read as 1
+    (lambda: KalmanNoise("1"), r"Kalman noise process: must be a finite number in \[1e-150, 1e\+150\], got '1'"),
+    (lambda: KalmanNoise(True), "Kalman noise process: must be a finite number .*, got True"),
+    # fk2_noise's merged lateral noise raised numpy's TypeError "can't multiply sequence by non-int" for text
+    (lambda: fk2_noise("1", 1.0, 1.0), r"Kalman noise right_drive \(lateral\): .*, got '1'"),
+    (lambda: fk2_noise(True, 1.0, 1.0), r"Kalman noise right_drive \(lateral\): .*, got True"),
+])
+def test_the_filters_python_doors_refuse_what_is_not_their_noise(call, message):
+    with pytest.raises(WmrkitError, match=message):
+        call()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -154,12 +155,47 @@ def test_bad_weights_are_refused():
     with pytest.raises(SlipWeightError, match="lacks"):
         SlipWeights.of({"nope": (1.0, 1.0)}).row_mu(catalog.load("diff-drive"))
     # a string was read as its characters ("12": (1, 2)) and a third value dropped; a lone number raised a TypeError
-    for value in ("12", (1.0, 2.0, 3.0), (1.0,), 5.0, ("a", 1.0), None):
-        with pytest.raises(SlipWeightError, match=r"wheel 'left': expected a pair of numbers \(lateral, longitudinal"):
+    for value in ("12", (1.0, 2.0, 3.0), (1.0,), 5.0, None):
+        with pytest.raises(SlipWeightError, match=r"mu\['left'\]: expected a pair of friction coefficients"):
             SlipWeights.of({"left": value})  # type: ignore[dict-item]
-        with pytest.raises(SlipWeightError, match="wheel 'default': expected a pair of numbers"):
+        with pytest.raises(SlipWeightError, match=r"default: expected a pair of friction coefficients \(lateral, "):
             SlipWeights.of({}, value)  # type: ignore[arg-type]
     assert SlipWeights.of({"left": np.array([1.0, 2.0])}, [3, 4]) == SlipWeights((("left", 1.0, 2.0),), (3.0, 4.0))
+    assert SlipWeights.of({"left": (Fraction(1, 2), np.float32(2))}) == SlipWeights((("left", 0.5, 2.0),))
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    # not a mapping: AttributeError "'str' object has no attribute 'items'"
+    (lambda: SlipWeights.of("1"), r"mu: expected a mapping \{wheel name: \(mu_lateral, mu_longitudinal\)\}"),
+    (lambda: SlipWeights.of([("left", (1.0, 2.0))]), "mu: expected a mapping"),
+    (lambda: SlipWeights.of(None), "mu: expected a mapping"),
+    (lambda: SlipWeights.of({1: (1.0, 2.0)}), "mu: expected a mapping"),  # a wheel's name is text
+    # text and booleans were read as numbers: ("1", "2") as (1, 2), (True, 1) as (1, 1)
+    (lambda: SlipWeights.of({"left": ("1", "2")}), r"mu\['left'\]: got the text '1', but the Python API reads no"),
+    (lambda: SlipWeights.of({"left": (1.0, 2.0)}, (1, "2 deg")), "default: got the text '2 deg'"),
+    (lambda: SlipWeights.of({"left": (True, 1)}), r"mu\['left'\]: expected a pair of friction coefficients"),
+    (lambda: SlipWeights.uniform("1"), "default: got the text '1'"),
+    (lambda: SlipWeights.uniform(True), "default: expected a pair of friction coefficients"),
+    (lambda: SlipWeights((("left", True, 1.0),)), r"wheel 'left' \(lateral\) must be a finite number > 0, got True"),
+])
+def test_slip_weights_refuse_what_is_not_a_mapping_of_real_pairs(call, message):
+    with pytest.raises(SlipWeightError, match=message):
+        call()
+    with pytest.raises(ValueError):  # SlipWeightError is a ValueError, as the Python doors' errors are
+        call()
+
+
+@pytest.mark.parametrize("door", ["wls", "wls_model", "from_weights"])
+def test_weights_arguments_take_slip_weights_only(door):
+    """A mapping passed as `weights` raised AttributeError "'dict' object has no attribute 'row_mu'"."""
+    from wmrkit.slip.weights import wls_model
+
+    dd = catalog.load("diff-drive")
+    calls = {"wls": lambda w: wls(dd, ["left.spin", "right.spin"], [1.0, 1.0], weights=w),
+             "wls_model": lambda w: wls_model(dd, w), "from_weights": lambda w: LinearFriction.from_weights(dd, w)}
+    with pytest.raises(SlipWeightError, match=r"weights: expected SlipWeights or None \(SlipWeights.of\("):
+        calls[door]({"left": (1.0, 2.0)})
+    calls[door](SlipWeights.uniform(1.0, 2.0))
 
 
 def test_mqe_from_a_start_with_round_off_zeros_converges():

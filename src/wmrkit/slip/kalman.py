@@ -23,6 +23,7 @@ The recursion is (7.71)-(7.74) with the standard covariance update; (7.75) as pr
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -81,12 +82,16 @@ class KalmanNoise:
     def __post_init__(self) -> None:
         if self.period is not None:
             check_period(self.period, "Kalman noise period")
+        if isinstance(self.wheels, str) or not all(isinstance(w, tuple | list) and len(w) == 3 and isinstance(w[0], str)
+                                                   for w in self.wheels):
+            raise WmrkitError(f"Kalman noise wheels: expected ((wheel name, lateral, longitudinal), ...), got "
+                              f"{self.wheels!r:.60}")  # a string raised "not enough values to unpack"
         named = (("process", self.process), ("lateral", self.lateral), ("longitudinal", self.longitudinal),
                  *((f"{w} ({d})", x) for w, a, b in self.wheels for d, x in (("lateral", a), ("longitudinal", b))))
         lo, hi = NOISE_RANGE
         for name, v in named:
-            if not (finite_number(v) and lo <= v <= hi):  # text raised numpy's TypeError
-                raise WmrkitError(f"Kalman noise {name}: must be a finite number in [{lo:g}, {hi:g}], got {v}")
+            if isinstance(v, bool) or not (finite_number(v) and lo <= v <= hi):  # text raised numpy's TypeError
+                raise WmrkitError(f"Kalman noise {name}: must be a finite number in [{lo:g}, {hi:g}], got {v!r}")
         (small, a), (large, b) = min(named, key=lambda nv: nv[1]), max(named, key=lambda nv: nv[1])
         if b > MAX_SPREAD * a:
             raise WmrkitError(f"Kalman noise {small} ({a:g}) and {large} ({b:g}) differ by more than a factor "
@@ -108,7 +113,7 @@ def fk1_noise(k14: float, k15: float, k13: float = 1.0) -> KalmanNoise:
 def fk2_noise(k16: float, k17: float, k18: float, k13: float = 1.0) -> KalmanNoise:
     """FK2 of the thesis's forklift (7.77): merged drive lateral row ``k16`` (each row ``sqrt(2) k16``), drive
     speeds ``k17``, steer lateral constraint ``k18``."""
-    s = float(np.sqrt(2.0) * k16)
+    s = math.sqrt(2.0) * k16 if finite_number(k16) and not isinstance(k16, bool) else k16  # KalmanNoise refuses it
     return KalmanNoise(k13, k18, k18, (("right_drive", s, k17), ("left_drive", s, k17)))
 
 
@@ -212,6 +217,9 @@ def kalman_model(robot: Robot, kind: str = "fk2", noise: KalmanNoise | None = No
     """FK1 or FK2 (module docstring) of `robot` with its sensed joints (default ``robot.sensed``)."""
     if kind not in FILTERS:
         raise WmrkitError(f"filter must be one of {', '.join(FILTERS)}, got '{kind}'")
+    if noise is not None and not isinstance(noise, KalmanNoise):  # a mapping raised "no attribute 'wheels'"
+        raise WmrkitError(f"noise: expected KalmanNoise or None (KalmanNoise(process, lateral, longitudinal), "
+                          f"fk1_noise, fk2_noise), got {type(noise).__name__} {noise!r:.60}")
     noise = noise or KalmanNoise()
     for name, _, _ in noise.wheels:
         robot.wheel(name)

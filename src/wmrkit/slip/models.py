@@ -58,7 +58,7 @@ class LinearFriction:
     @classmethod
     def from_weights(cls, robot: Robot, weights: SlipWeights) -> LinearFriction:
         """The law whose coefficients are `weights`."""
-        return cls(tuple(weights.row_mu(robot).tolist()))
+        return cls(tuple(SlipWeights.checked(weights).row_mu(robot).tolist()))
 
     def __call__(self, v_slip: np.ndarray, v_body: np.ndarray, loads: np.ndarray) -> np.ndarray:
         return -np.asarray(self.mu).reshape(-1, 2) * v_slip
@@ -146,7 +146,7 @@ def wls(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: Arra
         weights: SlipWeights | None = None, *, heading: ArrayLike | None = None) -> SlipSolution:
     """Weighted least squares (7.52): ``(..., n_a) -> SlipSolution``; steering `beta` (thesis) or `heading`
     (0 = rolling forward) ``(..., n_steer)``, default as described."""
-    mu = (weights or SlipWeights()).row_mu(robot)
+    mu = SlipWeights.checked(weights).row_mu(robot)
     a = robot.constraint_matrix(beta, heading=heading)
     cols, q_a = _assigned(robot, assigned, q_assigned)
     q, _ = geared_solve(np.sqrt(mu)[:, None] * a, robot.couplings, robot.velocity_names, cols, q_a)

@@ -14,8 +14,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .._shapes import finite_number
-from ..errors import WmrkitError
+from .._shapes import as_reals, finite_number
+from ..errors import ShapeError, WmrkitError
 from ..odometry.model import OdometryModel, frozen, odometry_model, solution_maps
 from ..robot import Robot
 
@@ -46,19 +46,35 @@ class SlipWeights:
         """Every coefficient a finite number > 0 (zero or NaN weights gave a zero or NaN twist)."""
         for name, lat, lon in (*self.mu, ("default", *self.default)):
             for what, v in (("lateral", lat), ("longitudinal", lon)):
-                if not (finite_number(v) and v > 0):
+                if isinstance(v, bool) or not (finite_number(v) and v > 0):
                     raise SlipWeightError(f"friction coefficient of wheel '{name}' ({what}) must be a finite "
                                           f"number > 0, got {v!r}")
 
     @classmethod
     def of(cls, mu: Mapping[str, tuple[float, float]], default: tuple[float, float] = (1.0, 1.0)) -> SlipWeights:
-        """From a mapping ``{wheel: (mu_lateral, mu_longitudinal)}``."""
-        return cls(tuple((str(k), *_pair(str(k), v)) for k, v in mu.items()), _pair("default", default))
+        """From a mapping ``{wheel: (mu_lateral, mu_longitudinal)}``; :class:`SlipWeightError` naming the argument for
+        anything else (``SlipWeights.of('1')`` raised a bare AttributeError) and for coefficients that are not real
+        numbers (text, booleans: the Python API reads no units)."""
+        if not isinstance(mu, Mapping) or not all(isinstance(k, str) for k in mu):
+            raise SlipWeightError(f"mu: expected a mapping {{wheel name: (mu_lateral, mu_longitudinal)}}, such as "
+                                  f"{{'left': (1.0, 0.5)}}, got {type(mu).__name__} {mu!r:.60}")
+        return cls(tuple((k, *_pair(f"mu['{k}']", v)) for k, v in mu.items()), _pair("default", default))
 
     @classmethod
     def uniform(cls, lateral: float = 1.0, longitudinal: float = 1.0) -> SlipWeights:
         """The same coefficients on every wheel."""
         return cls.of({}, (lateral, longitudinal))
+
+    @classmethod
+    def checked(cls, weights: object, argument: str = "weights") -> SlipWeights:
+        """`weights`, or the default weights for None; :class:`SlipWeightError` naming `argument` for anything else
+        (a mapping raised "'dict' object has no attribute 'row_mu'")."""
+        if weights is None:
+            return cls()
+        if not isinstance(weights, SlipWeights):
+            raise SlipWeightError(f"{argument}: expected SlipWeights or None (SlipWeights.of({{wheel: (mu_lateral, "
+                                  f"mu_longitudinal)}}) builds one), got {type(weights).__name__} {weights!r:.60}")
+        return weights
 
     def of_wheel(self, name: str) -> tuple[float, float]:
         """``(mu_lateral, mu_longitudinal)`` of wheel `name`."""
@@ -95,16 +111,19 @@ class SlipWeights:
         return mu
 
 
-def _pair(name: str, value: object) -> tuple[float, float]:
-    """``(lateral, longitudinal)`` of wheel `name`; a string or a sequence of another length is refused (``"12"``
-    read as (1, 2), a third value dropped)."""
-    try:
-        if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray) or len(value) != 2:
-            raise TypeError
-        return float(value[0]), float(value[1])  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise SlipWeightError(f"friction coefficients of wheel '{name}': expected a pair of numbers (lateral, "
-                              f"longitudinal), got {value!r}") from None
+def _pair(argument: str, value: object) -> tuple[float, float]:
+    """``(lateral, longitudinal)`` given as `argument`; a string, a sequence of another length and values that are
+    not real numbers are refused (``"12"`` read as (1, 2), a third value dropped, ``("1", "2")`` and ``(True, 1)``
+    read as numbers)."""
+    if not isinstance(value, str | bytes) and isinstance(value, Sequence | np.ndarray) and len(value) == 2:
+        try:
+            pair = as_reals(value, argument)
+        except ShapeError as err:
+            raise SlipWeightError(str(err)) from None
+        if pair.shape == (2,) and not any(isinstance(v, bool | np.bool_) for v in value):  # (True, 1) read as ints
+            return float(pair[0]), float(pair[1])
+    raise SlipWeightError(f"{argument}: expected a pair of friction coefficients (lateral, longitudinal), got "
+                          f"{value!r:.60}")
 
 
 def wls_model(robot: Robot, weights: SlipWeights | None = None, sensed=None) -> OdometryModel:
@@ -115,8 +134,9 @@ def wls_model(robot: Robot, weights: SlipWeights | None = None, sensed=None) -> 
     ``sqrt(mu)`` of its wheel and direction. Without slip the sensors satisfy ``A dq = 0`` exactly and every
     weighting gives the same (exact) odometry.
     """
+    weights = SlipWeights.checked(weights)
     base = odometry_model(robot, sensed)
-    w = np.sqrt((weights or SlipWeights()).row_mu(robot)[base.rows])
+    w = np.sqrt(weights.row_mu(robot)[base.rows])
     if not base.constant:
         return replace(base, row_weights=frozen(w))
     s, rm = solution_maps(robot, robot.beta, base.rows, base.cols, base.sensed, w)
