@@ -330,3 +330,15 @@ def test_cli_simulate_records_within_the_memory_bound(capsys, tmp_path, monkeypa
     assert main(["simulate", "forklift", "--path", "straight", "--duration", "3", "--json"]) == 0
     samples = json.loads(capsys.readouterr().out)["samples"]
     assert 50 < samples <= 100  # at 0.01 s, 301 samples
+
+
+@pytest.mark.parametrize(("time", "torques", "message"), [
+    # a list raised "'list' object has no attribute 'items'"
+    ([0.0, 1.0], [100.0, 100.0], r"torques: expected a mapping \{joint: values \[N m\]\}"),
+    # text was read as numbers: "100" as 100 N m, times "0", "1" as seconds
+    ([0.0, 1.0], {"right_drive.spin": "100"}, r"torques\['right_drive.spin'\]: got the text '100'"),
+    (["0", "1"], {"right_drive.spin": 100.0}, "time: got the text '0'"),
+])
+def test_torques_only_refuses_what_is_not_a_mapping_of_numbers(forklift, time, torques, message):
+    with pytest.raises(ValueError, match=message):
+        Inputs.torques_only(forklift, time, torques)

@@ -246,7 +246,7 @@ def test_the_constructor_is_of_with_the_defaults_and_the_checks():
     f = Tyre("pacejka").forces(1000, 0.1, 0.1, 2.0, -1.9)
     assert f == Tyre.of("pacejka").forces(1000, 0.1, 0.1, 2.0, -1.9) and f.longitudinal < -400
     for params, message in (((("cs", -1.0),), "tyre parameter cs: must be >= 0"),
-                            ((("mu", math.nan),), "tyre parameter mu must be finite"),
+                            ((("mu", math.nan),), "tyre parameter mu must be a finite number, got nan"),
                             ((("cz", 1.0),), "no parameter 'cz'"),
                             ((("mu", 0.5), ("mu", 0.6)), "parameter 'mu' given twice")):
         with pytest.raises(WmrkitError, match=message):
@@ -404,3 +404,25 @@ def test_the_grip_is_mu_fz_and_reached_and_the_linear_tyre_has_none():
     pacejka = Tyre.of("pacejka")  # its lateral peak 1.25 at standstill is reached at a slow wheel's slip angle
     lateral = pacejka.forces(100.0, np.linspace(0, 1, 2001) * 0.02, 0.0, 0.001, -0.001).lateral
     assert np.abs(lateral).max() == pytest.approx(pacejka.grip(100.0).lateral, rel=0.01)
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    # text was read as a number: Tyre.of("dugoff", {"mu": "0.8"}) gave mu = 0.8, forces_at_slip("1000", ...) 1000 N
+    (lambda: Tyre.of("dugoff", {"mu": "0.8"}), r"tyre parameter mu must be a finite number, got '0.8'"),
+    (lambda: Tyre.of("dugoff", {"mu": True}), "tyre parameter mu must be a finite number, got True"),
+    # a string raised dict()'s "dictionary update sequence element #0 has length 1; 2 is required"
+    (lambda: Tyre.of("dugoff", "mu"), r"tyre parameters: expected a mapping \{name: value\}"),
+    (lambda: Tyre.of("dugoff").forces_at_slip("1000", 0.1, 0.0), "fz: got the text '1000', but the Python API reads"),
+    (lambda: Tyre.of("dugoff").forces_at_slip(1000.0, 0.1, "10 deg"), "slip_angle: got the text '10 deg'"),
+    (lambda: Tyre.of("dugoff").forces(1000.0, "0", 0.0, 1.0, -1.0), "v_lat: got the text '0'"),
+    (lambda: Tyre.of("dugoff").grip("1 kN"), "fz: got the text '1 kN'"),
+])
+def test_tyre_doors_refuse_text_and_booleans_by_name(call, message):
+    with pytest.raises(WmrkitError, match=message):
+        call()
+
+
+def test_tyre_parameters_as_pairs_or_a_mapping_of_real_numbers():
+    """What the refusals above leave: a mapping or pairs, NumPy numbers, the discontinuous Coulomb's k = inf."""
+    assert Tyre.of("dugoff", {"mu": np.float32(0.5)}) == Tyre.of("dugoff", [("mu", 0.5)]) == Tyre("dugoff", {"mu": 0.5})
+    assert Tyre("coulomb", (("k", math.inf),)).as_dict()["k"] == math.inf

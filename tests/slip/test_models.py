@@ -185,6 +185,21 @@ def test_slip_weights_refuse_what_is_not_a_mapping_of_real_pairs(call, message):
         call()
 
 
+
+@pytest.mark.parametrize(("call", "message"), [
+    # text was read as numbers: wls(..., ["120", "120"]) as 120 rad/s (meant as rpm?), loads ["8175", ...] as N
+    (lambda fk, b: wls(fk, ["right_drive.spin", "left_drive.spin"], ["120", "120"], b), "q_assigned: got the text"),
+    (lambda fk, b: mcd(fk, ["right_drive.spin", "left_drive.spin"], [8.0, 8.0], LinearFriction((1.0,) * 6), b,
+                       loads=["8175", "8175", "8175"]), "loads: got the text '8175'"),
+    (lambda fk, b: normal_loads(fk, accel_cm=("1", "0")), "accel_cm: got the text '1'"),
+    # a unit raised numpy's bare "could not convert string to float", naming no argument
+    (lambda fk, b: wls(fk, ["right_drive.spin", "left_drive.spin"], ["10 rpm", 1.0], b), "q_assigned: got the text"),
+])
+def test_slip_models_refuse_text_where_numbers_go(call, message):
+    fk = catalog.load("forklift")
+    with pytest.raises(ValueError, match=message + ".*the Python API reads no units"):
+        call(fk, fk.beta)
+
 @pytest.mark.parametrize("door", ["wls", "wls_model", "from_weights"])
 def test_weights_arguments_take_slip_weights_only(door):
     """A mapping passed as `weights` raised AttributeError "'dict' object has no attribute 'row_mu'"."""

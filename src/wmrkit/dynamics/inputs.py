@@ -4,12 +4,13 @@ are made, and compiled for the kernels against a model (:func:`compiled_inputs`)
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import readonly
+from .._shapes import as_reals, readonly
 from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_TORQUE
 from .linkages import SETPOINT_TOL, continued, first_breach, heading_breach, setpoint_knots
@@ -57,10 +58,13 @@ class Inputs:
     @classmethod
     def torques_only(cls, model: DynamicModel, time: ArrayLike, torques: dict[str, ArrayLike]) -> Inputs:
         """Pure torque inputs: `torques` maps actuated joints (``wheel.spin``, ``wheel.steer``) to values (K,)."""
+        if not isinstance(torques, Mapping):  # a list raised "'list' object has no attribute 'items'"
+            raise ShapeError(f"torques: expected a mapping {{joint: values [N m]}} such as {{'left.spin': 1.0}}, got "
+                             f"{type(torques).__name__} {torques!r:.60}")
         t = knots(time)
         tau = np.zeros((len(t), model.n))
         for name, values in torques.items():
-            column, values = joint_column(model, name), np.asarray(values, dtype=float)
+            column, values = joint_column(model, name), as_reals(values, f"torques['{name}']")
             if values.shape not in ((), (1,), t.shape):
                 raise ShapeError(f"torques['{name}']: expected one value or {len(t)}, one per time, got shape "
                                  f"{values.shape}")
@@ -82,7 +86,7 @@ def joint_column(model: DynamicModel, name: str) -> int:
 
 def knots(time: ArrayLike) -> np.ndarray:
     """`time` as the knots of inputs ``(K,)`` [s], or a one-line error: at least one, finite, strictly increasing."""
-    t = np.atleast_1d(np.asarray(time, dtype=float))  # strictly increasing with finite ends: finite
+    t = np.atleast_1d(as_reals(time, "time"))  # strictly increasing with finite ends: finite
     if t.ndim != 1 or not len(t) or not (math.isfinite(t[0]) and math.isfinite(t[-1]) and (t[1:] > t[:-1]).all()):
         raise WmrkitError(f"time: input times must be at least one, finite and strictly increasing, got "
                           f"{t.tolist() if t.size <= 6 else f'shape {t.shape}'}")

@@ -25,6 +25,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._shapes import as_reals, finite_number
 from ..errors import ShapeError, UnknownNameError, WmrkitError
 from ..limits import MAX_SPEED
 
@@ -337,6 +338,11 @@ class Tyre:
         """Complete the parameters given (pairs or a mapping) with the model's defaults, in its order, and check
         them: ``Tyre(model, params)`` is :meth:`of` (``Tyre("dugoff")`` had every parameter 0, and no force)."""
         kind = tyre_kind(self.model)
+        if isinstance(self.params, str) or not all(isinstance(p, tuple | list) and len(p) == 2 for p in
+                                                   (self.params.items() if isinstance(self.params, Mapping) else
+                                                    self.params)):  # "mu" raised dict()'s "update sequence element"
+            raise WmrkitError(f"tyre parameters: expected a mapping {{name: value}} such as {{'mu': 0.8}}, got "
+                              f"{self.params!r:.60}")
         pairs = list(self.params.items() if isinstance(self.params, Mapping) else self.params)
         params = dict(pairs)
         if len(params) < len(pairs):
@@ -347,8 +353,8 @@ class Tyre:
             raise UnknownNameError(f"tyre model '{self.model}' has no parameter '{unknown[0]}' "
                                    f"(parameters: {', '.join(kind.defaults)})")
         for n, v in params.items():
-            if not (math.isfinite(float(v)) or (n == "k" and v == math.inf)):  # k = inf: discontinuous Coulomb
-                raise WmrkitError(f"tyre parameter {n} must be finite, got {v}")
+            if isinstance(v, bool) or not (finite_number(v) or (n == "k" and v == math.inf)):  # inf: plain Coulomb
+                raise WmrkitError(f"tyre parameter {n} must be a finite number, got {v!r}")  # "0.8" was read
             problem = param_problem(n, float(v))
             if problem:
                 raise WmrkitError(f"tyre parameter {n}: {problem}")
@@ -357,7 +363,7 @@ class Tyre:
     @classmethod
     def of(cls, model: str, params: Mapping[str, float] | None = None) -> Tyre:
         """A tyre of `model`; parameters not given take the model's defaults; unknown names raise."""
-        return cls(model, tuple(dict(params or {}).items()))
+        return cls(model, params or ())
 
     @property
     def kind(self) -> TyreKind:
@@ -399,7 +405,7 @@ class Tyre:
     def grip(self, fz: ArrayLike) -> TyreForces:
         """The largest force components ``(|F_lat|, |F_long|)`` [N] the model gives at normal load `fz` [N] (any
         slip): ``mu Fz`` and the like; infinite for the linear model, which does not saturate. ``(...) -> (...)``."""
-        fz = np.asarray(fz, dtype=float)
+        fz = as_reals(fz, "fz")
         if self.kind.grip is None:
             return TyreForces(np.full(fz.shape, np.inf), np.full(fz.shape, np.inf))
         lat, long = self.kind.grip(*self.vector(), fz)
@@ -441,7 +447,7 @@ def slip_velocities(s: ArrayLike, alpha: ArrayLike, speed: ArrayLike) -> tuple[n
 
 def _broadcast(**arrays: ArrayLike) -> list[np.ndarray]:
     """The arrays as floats broadcast together, or :class:`ShapeError` naming each one's shape."""
-    values = [np.asarray(a, dtype=float) for a in arrays.values()]
+    values = [as_reals(a, name) for name, a in arrays.items()]  # text refused by name ("1000" was read as 1000 N)
     try:
         return list(np.broadcast_arrays(*values))
     except ValueError:

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_names, batch_shape
+from .._shapes import as_names, as_reals, batch_shape
 from ..couplings import gear_unknowns
 from ..dynamics.mass import Body, body_problem
 from ..errors import WmrkitError
@@ -130,7 +130,7 @@ def _assigned(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike) -> t
     if not assigned or len(set(assigned)) != len(assigned):
         raise WmrkitError(f"assigned: expected distinct velocity names, at least one, got {list(assigned)}")
     cols = assigned_columns(robot, assigned)
-    q_a = np.asarray(q_assigned, dtype=float)
+    q_a = as_reals(q_assigned, "q_assigned")  # text ("120", meant as rpm) was read as rad/s
     if q_a.shape[-1:] != (len(cols),):
         raise WmrkitError(f"q_assigned: expected shape (..., {len(cols)}), one value per assigned velocity "
                           f"({', '.join(assigned)}), got {q_a.shape}")
@@ -200,7 +200,7 @@ def normal_loads(robot: Robot, body: Body | None = None, accel_cm: ArrayLike = (
     `beta` (thesis) or `heading` (0 = rolling forward), default as described.
     """
     body, beta = _body(robot, body), robot.steering(beta, heading)
-    a = np.asarray(accel_cm, dtype=float)
+    a = as_reals(accel_cm, "accel_cm")
     if not (0 < g < np.inf) or a.shape[-1:] != (2,) or not np.isfinite(a).all():
         raise WmrkitError(f"normal_loads: expected a gravity g > 0 and finite accelerations accel_cm (..., 2), got "
                           f"g = {g}, accel_cm of shape {a.shape}")
@@ -269,7 +269,7 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
     # scipy's hybr differences each unknown with a step relative to its size: a start of 1e-17 (round-off of an
     # exact 0) gives it a useless Jacobian column and it stalls (skid steer, tests/slip/test_models.py)
     q0 = np.where(np.abs(q0) < 1e-9 * np.maximum(1.0, np.abs(q0).max(axis=-1, keepdims=True)), 0.0, q0)
-    static = np.ones(n_e) if loads is None else np.asarray(loads, dtype=float)
+    static = np.ones(n_e) if loads is None else as_reals(loads, "loads")
     if static.shape != (n_e,):
         raise WmrkitError(f"loads: expected {n_e} normal loads, one per contact, got shape {static.shape}")
     if not (static >= 0).all() or not np.isfinite(static).all() or not static.any():
