@@ -7,7 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors
+from .._shapes import as_reals, as_vectors
 from ..errors import WmrkitError
 from ..odometry.model import wrap_angle
 
@@ -17,7 +17,7 @@ def j_model(twist_reference: ArrayLike, twist_model: ArrayLike) -> float:
 
     Mixes m/s and rad/s as the thesis does; the thesis reports it in percent (times 100).
     """
-    ref, mod = np.asarray(twist_reference, dtype=float), np.asarray(twist_model, dtype=float)
+    ref, mod = as_reals(twist_reference, "twist_reference"), as_reals(twist_model, "twist_model")  # text refused
     if ref.shape != mod.shape or ref.ndim != 2 or ref.shape[1] != 3:
         raise WmrkitError(f"j_model: expected two (N, 3) twist arrays, got {ref.shape} and {mod.shape}")
     if not len(ref) or not (np.isfinite(ref).all() and np.isfinite(mod).all()):
