@@ -19,6 +19,12 @@ def finite_number(value: object) -> bool:
         return False
 
 
+def real_number(value: object) -> bool:
+    """Whether `value` is one finite real number and not a boolean (Python, NumPy scalar): a scalar argument of the
+    Python API, which reads no units (``"1"`` and ``True`` are refused, as :func:`as_vectors` refuses them)."""
+    return not isinstance(value, bool | np.bool_) and finite_number(value)
+
+
 def as_vectors(x: ArrayLike, n: int, name: str, *, angles: bool = False) -> np.ndarray:
     """Return `x` as a float array of shape ``(..., n)``, or raise :class:`ShapeError` naming `name`.
 

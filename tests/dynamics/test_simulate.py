@@ -342,3 +342,24 @@ def test_cli_simulate_records_within_the_memory_bound(capsys, tmp_path, monkeypa
 def test_torques_only_refuses_what_is_not_a_mapping_of_numbers(forklift, time, torques, message):
     with pytest.raises(ValueError, match=message):
         Inputs.torques_only(forklift, time, torques)
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    # text raised TypeError "must be real number, not str" (no argument named); True ran for 1 s
+    (lambda m, i: simulate(m, i, "1"), "duration and step must be finite numbers .*, got '1', 0.001"),
+    (lambda m, i: simulate(m, i, True), "duration and step must be finite numbers .*, got True, 0.001"),
+    (lambda m, i: simulate(m, i, 0.1, step="0.001"), "duration and step .*, got 0.1, '0.001'"),
+    (lambda m, i: simulate(m, i, 0.1, record_step="0.01"), r"record_step: expected a finite number > 0 \[s\]"),
+    # AttributeError "'dict' object has no attribute 'torques'", "'str' object has no attribute 'body'"
+    (lambda m, i: simulate(m, {"right_drive.spin": 1.0}, 0.1), r"inputs: expected Inputs \(Inputs.torques_only"),
+    (lambda m, i: simulate("forklift", i, 0.1), r"robot: expected a Robot \(wmrkit.catalog.load\(name\)"),
+    (lambda m, i: DynamicModel.of(catalog.load("forklift"), gravity="9.81"), "gravity: expected a finite number"),
+    # text raised "'<' not supported between instances of 'int' and 'str'"; twists' text was read as numbers
+    (lambda m, i: path_program(m, "straight", speed="2"), r"speed: expected a program speed in .*, got '2'"),
+    (lambda m, i: twist_program(m, [0.0, 1.0], [["1", 0, 0], [1, 0, 0]]), "twists: got the text '1'"),
+    (lambda m, i: twist_program(m, [0.0, 1.0], [[1.0, 0, 0]]), r"twists: expected one \(vx, vy, omega\) per time"),
+])
+def test_simulation_doors_refuse_what_is_not_their_argument_by_name(forklift, call, message):
+    inputs = Inputs.torques_only(forklift, [0.0], {"right_drive.spin": 1.0})
+    with pytest.raises((WmrkitError, TypeError), match=message):
+        call(forklift, inputs)

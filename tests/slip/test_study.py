@@ -19,7 +19,7 @@ def test_j_model_is_the_mean_absolute_twist_error():
     a = np.zeros((4, 3))
     b = np.array([[0.1, 0, 0], [0, -0.2, 0], [0, 0, 0.3], [0, 0, 0]])
     assert math.isclose(j_model(a, b), 0.6 / 12)
-    with pytest.raises(ValueError, match="twist_model: got the text '0.1', but the Python API reads no units"):
+    with pytest.raises(ValueError, match=r"twist_model: got the text '0\.1', but the Python API reads no units"):
         j_model(a, b.astype(str))  # read as numbers
 
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_angles, readonly
+from .._shapes import as_angles, readonly, real_number
 from ..couplings import gear_free
 from ..errors import DescriptionError, ShapeError, WmrkitError
 from ..kinematics.linkage_law import linkage_table
@@ -67,12 +67,15 @@ class DynamicModel:
         the dynamics do not hold (no ``law`` and none to default to) gives a
         :class:`~wmrkit.dynamics.linkages.LinkageWarning` each (:func:`~wmrkit.dynamics.linkages.unheld`).
         """
+        if not isinstance(robot, Robot):  # a catalog name raised "'str' object has no attribute 'body'"
+            raise TypeError(f"robot: expected a Robot (wmrkit.catalog.load(name), Robot.from_file(path)), got "
+                            f"{type(robot).__name__} {robot!r:.60}")
         if isinstance(tyre, str):
             tyre = Tyre.of(tyre)
         elif not (tyre is None or isinstance(tyre, Tyre)):
             raise TypeError(f"tyre: expected a Tyre, a tyre model's name or None, got {type(tyre).__name__}")
-        if not 0 < float(gravity) < math.inf:  # NaN included
-            raise WmrkitError(f"gravity: expected a finite number > 0 m/s^2, got {gravity}")
+        if not (real_number(gravity) and 0 < gravity < math.inf):  # NaN included; "9.81" was read as a number
+            raise WmrkitError(f"gravity: expected a finite number > 0 m/s^2, got {gravity!r}")
         model = _build(robot, tyre, float(gravity))
         for message in unheld(robot):  # here, not in the cached _build: every model built says it
             warnings.warn(message, LinkageWarning, stacklevel=2)

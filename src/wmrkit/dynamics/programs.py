@@ -26,8 +26,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._numbers import number_problem
-from .._shapes import readonly
-from ..errors import WmrkitError
+from .._shapes import as_reals, readonly, real_number
+from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_SIZE, MAX_SPEED, MAX_TORQUE, check_table_size
 from ..units import BARE_ANGLE_LIMIT, UNITS, split_unit
 from .inputs import Inputs, joint_column, knots
@@ -61,10 +61,11 @@ def path_program(model: DynamicModel, name: str, *, speed: float = 2.0, radius_s
     """
     if name not in PATHS:
         raise WmrkitError(f"unknown program '{name}' (programs: {', '.join(PATHS)})")
-    if not 0 < speed <= MAX_SPEED:
-        raise WmrkitError(f"speed: expected a program speed in (0, {MAX_SPEED:g}] m/s, got {speed:g} m/s")
-    if not 0 < radius_scale <= MAX_SIZE:
-        raise WmrkitError(f"radius_scale: expected a number in (0, {MAX_SIZE:g}], got {radius_scale:g}")
+    if not (real_number(speed) and 0 < speed <= MAX_SPEED):  # text raised "'<' not supported"
+        got = f"{speed:g} m/s" if real_number(speed) else repr(speed)
+        raise WmrkitError(f"speed: expected a program speed in (0, {MAX_SPEED:g}] m/s, got {got}")
+    if not (real_number(radius_scale) and 0 < radius_scale <= MAX_SIZE):
+        raise WmrkitError(f"radius_scale: expected a number in (0, {MAX_SIZE:g}], got {radius_scale!r}")
     scale = radius_scale * 2.0 / speed
     times, twists, t = [0.0], [(0.0, 0.0, 0.0)], 0.0
     for k, (duration, v, curvature) in enumerate(PATHS[name]):
@@ -125,7 +126,10 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
 
     t = knots(time)
     _check_bandwidth(bandwidth)
-    twists = np.array(twists, dtype=float).reshape(len(t), 3)  # a copy: the inputs keep it (read-only)
+    twists = np.array(as_reals(twists, "twists"), dtype=float)  # a copy: the inputs keep it (read-only); no text
+    if twists.size != 3 * len(t):
+        raise ShapeError(f"twists: expected one (vx, vy, omega) per time, ({len(t)}, 3), got shape {twists.shape}")
+    twists = twists.reshape(len(t), 3)
     bad = ~(np.abs(twists) <= MAX_SPEED).all(axis=1)  # NaN included
     if bad.any():
         k = int(np.argmax(bad))

@@ -17,7 +17,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, readonly
+from .._shapes import as_vectors, readonly, real_number
 from ..errors import WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
@@ -165,12 +165,16 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     model = robot if isinstance(robot, DynamicModel) else DynamicModel.of(robot, tyre)
     if method not in METHODS:
         raise WmrkitError(f"unknown method '{method}' (methods: {', '.join(METHODS)})")
-    if not (math.isfinite(duration) and duration > 0 and math.isfinite(step) and 0 < step <= duration):
-        raise WmrkitError(f"duration and step must be finite with 0 < step <= duration, got {duration}, {step}")
+    if not isinstance(inputs, Inputs):  # a mapping raised "'dict' object has no attribute 'torques'"
+        raise WmrkitError(f"inputs: expected Inputs (Inputs.torques_only, twist_program, path_program), got "
+                          f"{type(inputs).__name__}")
+    if not (real_number(duration) and real_number(step) and duration > 0 and 0 < step <= duration):  # text: TypeError
+        raise WmrkitError(f"duration and step must be finite numbers [s] with 0 < step <= duration, got {duration!r}, "
+                          f"{step!r}")
     if method != "adaptive" and duration / step > MAX_STEPS:
         raise WmrkitError(f"duration {duration:g} s at step {step:g} s: more than {MAX_STEPS:.0e} integration steps")
-    if record_step is not None and not 0 < record_step < math.inf:  # NaN included
-        raise WmrkitError(f"record_step: expected a finite number > 0 [s] (None: the step), got {record_step}")
+    if record_step is not None and not (real_number(record_step) and record_step > 0):  # NaN included
+        raise WmrkitError(f"record_step: expected a finite number > 0 [s] (None: the step), got {record_step!r}")
     record = record_step or (max(step, 1e-3) if method == "adaptive" else step)
     if duration / record > MAX_STEPS:
         raise WmrkitError(f"record_step: {record:g} s over {duration:g} s is more than {MAX_STEPS:.0e} samples")

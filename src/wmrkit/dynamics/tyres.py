@@ -25,7 +25,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_reals, finite_number
+from .._shapes import as_reals, real_number
 from ..errors import ShapeError, UnknownNameError, WmrkitError
 from ..limits import MAX_SPEED
 
@@ -353,7 +353,7 @@ class Tyre:
             raise UnknownNameError(f"tyre model '{self.model}' has no parameter '{unknown[0]}' "
                                    f"(parameters: {', '.join(kind.defaults)})")
         for n, v in params.items():
-            if isinstance(v, bool) or not (finite_number(v) or (n == "k" and v == math.inf)):  # inf: plain Coulomb
+            if not (real_number(v) or (n == "k" and v == math.inf)):  # k = inf: the discontinuous Coulomb
                 raise WmrkitError(f"tyre parameter {n} must be a finite number, got {v!r}")  # "0.8" was read
             problem = param_problem(n, float(v))
             if problem:

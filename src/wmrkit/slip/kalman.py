@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import finite_number
+from .._shapes import real_number
 from ..couplings import gear_free
 from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_QUERY_RATE
@@ -60,7 +60,7 @@ def check_period(period: object, name: str = "period") -> float:
     """`period` [s], the nominal sample period T of ``Q``, as a float: a real number (SI seconds; a unit string is the
     CLI's and the description's, which read it) in :data:`PERIOD_RANGE`, else :class:`WmrkitError` naming `name`."""
     lo, hi = PERIOD_RANGE
-    if isinstance(period, bool) or not (finite_number(period) and lo <= period <= hi):  # type: ignore[operator]
+    if not (real_number(period) and lo <= period <= hi):  # type: ignore[operator]
         raise WmrkitError(f"{name}: the nominal sample period must be a finite number of seconds in [{lo:g}, {hi:g}], "
                           f"got {period!r}")
     return float(period)  # type: ignore[arg-type]
@@ -90,7 +90,7 @@ class KalmanNoise:
                  *((f"{w} ({d})", x) for w, a, b in self.wheels for d, x in (("lateral", a), ("longitudinal", b))))
         lo, hi = NOISE_RANGE
         for name, v in named:
-            if isinstance(v, bool) or not (finite_number(v) and lo <= v <= hi):  # text raised numpy's TypeError
+            if not (real_number(v) and lo <= v <= hi):  # text raised numpy's TypeError
                 raise WmrkitError(f"Kalman noise {name}: must be a finite number in [{lo:g}, {hi:g}], got {v!r}")
         (small, a), (large, b) = min(named, key=lambda nv: nv[1]), max(named, key=lambda nv: nv[1])
         if b > MAX_SPREAD * a:
@@ -113,7 +113,7 @@ def fk1_noise(k14: float, k15: float, k13: float = 1.0) -> KalmanNoise:
 def fk2_noise(k16: float, k17: float, k18: float, k13: float = 1.0) -> KalmanNoise:
     """FK2 of the thesis's forklift (7.77): merged drive lateral row ``k16`` (each row ``sqrt(2) k16``), drive
     speeds ``k17``, steer lateral constraint ``k18``."""
-    s = math.sqrt(2.0) * k16 if finite_number(k16) and not isinstance(k16, bool) else k16  # KalmanNoise refuses it
+    s = math.sqrt(2.0) * k16 if real_number(k16) else k16  # else KalmanNoise refuses it
     return KalmanNoise(k13, k18, k18, (("right_drive", s, k17), ("left_drive", s, k17)))
 
 

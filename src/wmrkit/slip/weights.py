@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .._shapes import as_reals, finite_number
+from .._shapes import as_reals, real_number
 from ..errors import ShapeError, WmrkitError
 from ..odometry.model import OdometryModel, frozen, odometry_model, solution_maps
 from ..robot import Robot
@@ -46,7 +46,7 @@ class SlipWeights:
         """Every coefficient a finite number > 0 (zero or NaN weights gave a zero or NaN twist)."""
         for name, lat, lon in (*self.mu, ("default", *self.default)):
             for what, v in (("lateral", lat), ("longitudinal", lon)):
-                if isinstance(v, bool) or not (finite_number(v) and v > 0):
+                if not (real_number(v) and v > 0):
                     raise SlipWeightError(f"friction coefficient of wheel '{name}' ({what}) must be a finite "
                                           f"number > 0, got {v!r}")
 
