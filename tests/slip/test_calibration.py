@@ -83,6 +83,15 @@ def test_a_fit_stopped_a_hair_inside_its_bound_is_refused():
         calibrate_slip(robot, run.log, (run.log.time, swapped))
 
 
+def test_a_reference_covering_a_straight_part_of_a_turning_log_says_so(husky_run):
+    """Two reference poses 0.05 s apart on a log that turns later: the refusal said "a run without turning?" of a
+    run that turns, as if the whole log were straight; it now names the part the reference covers."""
+    log = husky_run.log
+    with pytest.raises(WmrkitError, match=r"a run without turning\?; that is between the reference's poses, t = 3\.5 "
+                                          r"to 3\.55 s of the log's 0 to 10 s\); calibrate on a log that turns"):
+        calibrate_slip(catalog.load("skid-steer-4"), log, (log.time[70:72], husky_run.truth[70:72]))
+
+
 def test_cli_calibrate_then_odometry(tmp_path, capsys, husky_run):
     log = husky_run.log
     log_path, ref_path, w_path = tmp_path / "log.csv", tmp_path / "ref.tum", tmp_path / "w.json"

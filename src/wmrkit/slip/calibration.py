@@ -183,6 +183,9 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
                       f"independent of the {what}" if turns else "a run without turning?" if turned <= TURNING else
                       f"the log's wheels do not turn it, where the reference turns {turned:.3g} rad: do they record "
                       "the same run?")  # 'the log turns' was said of a straight log whose reference turned
+            if t_ref[-1] - t_ref[0] < 0.9 * (t[-1] - t[0]):  # "a run without turning?" of a log that turns after it
+                reason += (f"; that is between the reference's poses, t = {t_ref[0]:.6g} to {t_ref[-1]:.6g} s of the "
+                           f"log's {t[0]:.6g} to {t[-1]:.6g} s")
             raise WmrkitError(f"the log does not determine the {what}: the odometry moves less than "
                               f"{IDENTIFIED * scale:.2g} m when it changes tenfold ({reason}); "
                               "calibrate on a log that turns" + (" and slips" if turns else ""))
