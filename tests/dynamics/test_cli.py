@@ -45,6 +45,8 @@ def test_tyre_friction_coefficients_are_the_forces_over_the_load(capsys):
     (["--load", "1e300", "--slip-ratio", "0.1"], "--load: at most 1e+07 N"),  # printed Fx = -6.8e299 N, exit 0
     (["--load", "3000", "--speed", "1e300"], "--speed: must be in (0, 1000] m/s, got 1e+300"),
     (["--load", "3000", "--slip-angle", "90deg"], "--slip-angle: must be in (-pi/2, pi/2) rad"),
+    (["--load", "3000", "--slip-angle", "-100deg"], "--slip-angle: must be in (-pi/2, pi/2) rad (-90 to 90 deg), got "
+                                                    "-1.74533 rad (-100 deg)"),  # "got -1.74533" of -100deg
     (["--load", "3000", "--slip-ratio", "2.5"], "--slip-ratio: must be in (-1, 2], got 2.5")])
 def test_tyre_refusals_name_the_option(capsys, args, message):
     """One line naming the option (it was one line naming the three slip inputs together)."""

@@ -440,7 +440,9 @@ def slip_velocities(s: ArrayLike, alpha: ArrayLike, speed: ArrayLike) -> tuple[n
               ("speed", v, (v > 0) & (v <= MAX_SPEED), f"in (0, {MAX_SPEED:g}] m/s"))
     for name, values, ok, allowed in checks:
         if not np.all(ok):
-            raise WmrkitError(f"{name}: must be {allowed}, got {values[~ok].flat[0]:g}")
+            bad = float(values[~ok].flat[0])  # an angle in degrees too: '--slip-angle 90deg' said "got 1.5708"
+            shown = f"{bad:g} rad ({math.degrees(bad):g} deg)" if name == "slip angle" else f"{bad:g}"
+            raise WmrkitError(f"{name}: must be {allowed}, got {shown}")
     v_roll = np.where(s >= 0, v * (s - 1), -v / (1 + np.minimum(s, 0.0)))  # each branch where it is taken
     return v * np.tan(alpha), v + v_roll, v, v_roll
 
