@@ -44,7 +44,8 @@ def as_reals(x: ArrayLike, name: str) -> np.ndarray:
 
 def as_real(x: object, name: str) -> float:
     """`x` as one Python float, refusing what :func:`as_vectors` refuses (text, booleans, ...) and arrays, with a
-    :class:`ShapeError` naming `name`; NaN and infinities pass (the callers' range checks name them)."""
+    :class:`ShapeError` naming `name`; NaN and infinities pass (the callers' range checks name them). The
+    predicate for a caller's own message: :func:`real_number`."""
     if type(x) is float:  # the common case, without building an array
         return x
     a = _real_array(x, name, False)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, finite_number
+from .._shapes import as_vectors, real_number
 from ..limits import MAX_SIZE, MIN_SIZE
 from .camera import Camera, CameraError, extrinsics, ground_from_image, undistort
 
@@ -28,10 +28,6 @@ MAX_BLUR, MAX_CLUTTER = 50.0, 100
 MAX_NOISE = 255.0
 #: Most stripes in a scene (``ns`` and ``extra``): each is one pass over the image.
 MAX_STRIPES = 1000
-
-
-def _length(value: object) -> bool:
-    return finite_number(value) and not isinstance(value, bool)
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,14 +51,15 @@ class Scene:
             raise CameraError(f"scene: style must be 'paint' or 'crops', got {self.style!r}")
         # real numbers only (the Python API reads no units: width="0.02" raised a bare TypeError), in the lengths
         # wmrkit handles (1e-320 m overflowed the coverage; a NaN spacing rendered garbage with a numpy warning)
-        if not (_length(self.width) and MIN_SIZE <= self.width <= MAX_SIZE):
+        if not (real_number(self.width) and MIN_SIZE <= self.width <= MAX_SIZE):
             raise CameraError(f"scene: width must be in [{MIN_SIZE:g}, {MAX_SIZE:g}] m, got {self.width!r}")
-        if not (_length(self.spacing) and 0 <= self.spacing <= MAX_SIZE):
+        if not (real_number(self.spacing) and 0 <= self.spacing <= MAX_SIZE):
             raise CameraError(f"scene: spacing must be in [0, {MAX_SIZE:g}] m, got {self.spacing!r}")
         if not (isinstance(self.ns, tuple | list) and all(isinstance(n, int | np.integer) and not isinstance(n, bool)
                                                            for n in self.ns)):
             raise CameraError(f"scene: ns must be a tuple of whole numbers (stripe n at n * spacing), got {self.ns!r}")
-        if not (isinstance(self.extra, tuple | list) and all(_length(x) and abs(x) <= MAX_SIZE for x in self.extra)):
+        if not (isinstance(self.extra, tuple | list)
+                and all(real_number(x) and abs(x) <= MAX_SIZE for x in self.extra)):
             raise CameraError(f"scene: extra must be a tuple of real numbers within {MAX_SIZE:g} m of the line "
                               f"(lateral positions of further stripes), got {self.extra!r}")
         if len(self.ns) + len(self.extra) > MAX_STRIPES:
