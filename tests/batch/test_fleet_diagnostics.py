@@ -88,7 +88,7 @@ def test_a_log_breaking_a_gear_says_so_per_log_as_odometry_does(capsys, tmp_path
     single = _same_as_single(capsys, robot, [tmp_path / "breaks.csv", tmp_path / "keeps.csv"])
     assert not any("do not turn together" in w for w in single[str(tmp_path / "keeps.csv")])
     (line,) = [w for w in single[str(tmp_path / "breaks.csv")] if "do not turn together" in w]
-    assert line.startswith("the joints of gear(left.spin, right.spin) (ratios 1, 1) do not turn together")
+    assert line.startswith("the joints of the gear of wheels 'left' and 'right' (ratios 1, 1) do not turn together")
 
 
 def test_a_bag_in_a_batch_gets_its_csv_s_diagnostics(capsys, tmp_path):
