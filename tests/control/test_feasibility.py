@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from continuity import feasibility  # Table 8.1's verdict: these shapes are tighter than the car's stops
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from wmrkit import catalog
-from wmrkit.control.feasibility import COLUMNS, feasibility, requirement, signals
+from wmrkit.control.feasibility import COLUMNS, requirement, signals
 from wmrkit.control.points import ControlError
 from wmrkit.control.references import builtin_reference, load_reference, reference_from_samples
 from wmrkit.control.track import track

@@ -8,11 +8,12 @@ import math
 
 import numpy as np
 import pytest
+from continuity import feasibility  # Table 8.1's verdict: these shapes are tighter than the car's stops
 from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 from wmrkit import catalog
-from wmrkit.control.feasibility import feasibility, requirement
+from wmrkit.control.feasibility import requirement
 from wmrkit.control.references import reference_from_samples
 
 ROBOTS = {name: catalog.load(name) for name in ("swerve-4", "thesis-two-steer-castor", "thesis-two-steer-swedish")}

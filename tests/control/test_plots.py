@@ -70,3 +70,16 @@ def test_the_feasibility_figure_names_the_robot(drawn, tmp_path, capsys):
     column = capsys.readouterr().out.split("'")[1]  # 'robot forklift: Table 8.1 column 'type 4, off axle', ...'
     title = drawn[0].axes[0].get_title()
     assert title == f"forklift: Table 8.1 '{column}', kinematic: NOT feasible"
+
+
+def test_the_feasibility_figure_marks_a_turn_tighter_than_the_stops(drawn, tmp_path, capsys):
+    """The car's 1 m circle: no jump, a stretch tighter than its stops (drawn over the lap it spans); before, the
+    figure said 'feasible' with nothing marked."""
+    assert main(["feasibility", "ackermann", "--reference", "circle", "--size", "1", "--plot",
+                 str(tmp_path / "f.png")]) == 1
+    capsys.readouterr()
+    ax = drawn[0].axes[0]
+    assert "tighter than the steering stops" in _texts(ax) and ax.get_title().endswith("NOT feasible")
+    (stretch,) = [line for line in ax.get_lines() if line.get_label() == "tighter than the steering stops"]
+    assert np.hypot(stretch.get_xdata(), stretch.get_ydata() - 1.0) == pytest.approx(1.0, abs=1e-9)  # on it
+    assert len(stretch.get_xdata()) > 0.9 * len(builtin_reference("circle", size=1.0).t)

@@ -16,9 +16,10 @@ from wmrkit.analysis.classification import classify
 from wmrkit.cli.main import main
 from wmrkit.control.feasibility import feasibility
 from wmrkit.control.points import control_point
-from wmrkit.control.references import builtin_reference
+from wmrkit.control.references import builtin_reference, default_size
 from wmrkit.control.track import track
 from wmrkit.control.trackers import default_wheelbase
+from wmrkit.control.turn_limits import min_turning_radius
 
 WARNING = "wmrkit: warning: the robot cannot follow this reference with zero error (Table 8.1, column "
 #: After a wheel's re-orientation in a kinematic run, whose errors stay at round-off there (it read as contradicting
@@ -144,11 +145,13 @@ def test_smooth_references_are_followed_by_every_catalog_robot_at_every_tracked_
     """Not noisy: the circle, the line and the figure-eight have a continuous pose, velocity, acceleration, tangent,
     curvature and their rates, so no column of Table 8.1 refuses them, in either framework, at the point of any
     controller (the law's, pure pursuit's axle point, Stanley's front point), which track judges as here."""
-    references = [builtin_reference(name) for name in ("line", "circle", "figure-eight")]
     for name in catalog.names():
         robot = catalog.load(name)
         if classify(robot).type is None:
             continue
+        # at the size the CLI gives it: the catalog car turns on 3.993 m at least, tighter than the 3 m circle
+        references = [builtin_reference(shape, size=default_size(shape, min_turning_radius(robot)))
+                      for shape in ("line", "circle", "figure-eight")]
         cp = control_point(robot)
         front = cp.axle_point + default_wheelbase(cp) * np.array([math.cos(cp.forward), math.sin(cp.forward)])
         for point in (cp.point, cp.axle_point, front):

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..control.turn_limits import min_turning_radius, tight_turn
+from ..control.turn_limits import min_turning_radius
 from ..couplings import coupling_words
 from ..errors import WmrkitError
 from ._common import (
@@ -274,15 +274,13 @@ def run_track(args: argparse.Namespace) -> int:
         except TypeError:  # a class that takes more (UnstableStepError: the steps and the door): said as it is
             joined = WmrkitError(message)
         raise joined from None
-    (x, y, th), (px, py) = run.pose[0], run.tracked[0, :2]  # the tracked point in the robot frame
-    point = (math.cos(th) * (px - x) + math.sin(th) * (py - y), math.cos(th) * (py - y) - math.sin(th) * (px - x))
-    tight = tight_turn(robot, reference.name, size, point, "the tracked point")
-    if tight:  # and where the law asks the car to back up (its reference beside it), at the other stop
+    for tight in tight_turns(run.feasibility):  # and where the law asks the car to back up, at the other stop
         back = run.t[run.twist[:, 0] < -1e-9]
-        warn(f"{tight}: it cannot follow this reference (its steering is held at its stops)" + (
-            f"; the law backs it up where the reference runs beside it (t = {back[0]:.4g} to {back[-1]:.4g} s; "
-            "backing up, a car turns the other way at the same steering, so its steering swings to the other stop)"
-            if len(back) else ""))
+        warn(f"{tight_words(tight, 'the tracked point')}: it cannot follow this reference (its steering is held at "
+             "its stops)" + (
+                 f"; the law backs it up where the reference runs beside it (t = {back[0]:.4g} to {back[-1]:.4g} s; "
+                 "backing up, a car turns the other way at the same steering, so its steering swings to the other "
+                 "stop)" if len(back) else ""))
     for line in range_warnings(robot, run.range_violations()):
         warn(line)
     for v in run.held_off_axle():  # no twist_miss through the dynamics
@@ -308,7 +306,7 @@ def run_track(args: argparse.Namespace) -> int:
              f"{max(v['to'] for v in slipping):.4g} s): the kinematic loop moved the robot as commanded, so its errors "
              "do not show the scrubbing (--dynamics simulates it with tyres)")
     warn_infeasible(run.feasibility, reference.duration if run.t[-1] > reference.duration else None,
-                    instant=not args.dynamics)
+                    instant=not args.dynamics, turns=False)
     if args.plot or args.animate:
         from ..control.plots import animate_run, plot_run
 
@@ -389,15 +387,30 @@ def _feasible(verdict: Feasibility) -> str:
     return "feasible: yes" if verdict.feasible else f"feasible: NO ({len(verdict.violations)} violation(s))"
 
 
-def warn_infeasible(verdict: Feasibility | None, end: float | None = None, *, instant: bool = False) -> None:
+def tight_turns(verdict: Feasibility | None) -> list:
+    """The :class:`~wmrkit.control.feasibility.TightTurn` violations of `verdict` (None: none)."""
+    from ..control.feasibility import TightTurn
+
+    return [v for v in verdict.violations if isinstance(v, TightTurn)] if verdict else []
+
+
+def tight_words(v, whose: str) -> str:
+    """The words of a tight turn `v` (``TightTurn``), `whose`: the point judged, for ``track`` and ``feasibility``."""
+    return f"the reference {v.words()}, tighter than the robot can drive: {v.remedy.replace('the point', whose, 1)}"
+
+
+def warn_infeasible(verdict: Feasibility | None, end: float | None = None, *, instant: bool = False,
+                    turns: bool = True) -> None:
     """Warn where Table 8.1 says the robot cannot follow the reference it tracked (`verdict`: a run's
     ``feasibility``), a line per remedy and set of times, in feasibility's words; `end` [s]: where the reference
     ended before the run did (it then holds its last pose at rest: the stop is judged as any jump); `instant`: the
     run's plant turned the wheels instantly (the kinematic loop), so where the remedy re-orients a wheel alone the
-    run did not stop, and the line says so (it read as contradicting the 1e-10 m errors the run printed)."""
+    run did not stop, and the line says so (it read as contradicting the 1e-10 m errors the run printed); `turns`:
+    a line per stretch tighter than the steering stops allow too (``track`` says them itself)."""
     broken: dict[tuple[str, tuple[float, ...]], list[str]] = {}
-    for kind, remedy in dict.fromkeys((v.kind, v.remedy) for v in verdict.violations) if verdict else ():
-        times = tuple(v.t for v in verdict.violations if (v.kind, v.remedy) == (kind, remedy))
+    table = [v for v in verdict.violations if v not in tight_turns(verdict)] if verdict else []  # said apart
+    for kind, remedy in dict.fromkeys((v.kind, v.remedy) for v in table):
+        times = tuple(v.t for v in table if (v.kind, v.remedy) == (kind, remedy))
         broken.setdefault((remedy, times), []).append(kind)
     for (remedy, times), kinds in broken.items():
         more = f" and {len(times) - 5} more times" if len(times) > 5 else ""
@@ -407,6 +420,8 @@ def warn_infeasible(verdict: Feasibility | None, end: float | None = None, *, in
              f"'{verdict.requirement.column}' for the tracked point, {verdict.requirement.framework} framework): "
              f"{' and '.join(kinds)} at t = {', '.join(f'{t:.4g}' for t in times[:5])} s{more}{stop}: {remedy}"
              + (INSTANT_NOTE if instant and remedy.startswith("stop and re-orient the orientable wheel") else ""))
+    for tight in tight_turns(verdict) if turns else ():
+        warn(f"{tight_words(tight, 'the tracked point')}: the robot cannot follow this reference")
 
 
 def run_feasibility(args: argparse.Namespace) -> int:
@@ -424,9 +439,6 @@ def run_feasibility(args: argparse.Namespace) -> int:
         result = feasibility(robot, reference, args.framework, point=point)
     if result.requirement.note:  # a skid steer, judged as a differential drive
         warn(result.requirement.note)
-    tight = tight_turn(robot, reference.name, size, (0.0, 0.0) if point is None else point, "the point judged")
-    if tight:
-        warn(f"{tight}: Table 8.1 judges the reference's continuity only, not this")
     fewer = None  # whether the linkages command fewer steering angles than the wheels' steerability d
     coupled = result.requirement.type == 4 and not any(w.type == "fixed" for w in robot.wheels)  # judged with them
     for c in () if coupled else robot.couplings:  # Table 8.1 classifies the wheels' geometry only
@@ -458,9 +470,16 @@ def run_feasibility(args: argparse.Namespace) -> int:
     print(f"robot {robot.name}: Table 8.1 column '{r.column}', {r.references} pose references; "
           f"{r.framework} framework needs continuous: {', '.join(r.signals)}")
     print(f"reference {described}")
+    turns = tight_turns(result)
+    if turns:  # Table 8.1's own verdict, apart from the steering stops'
+        table = len(result.violations) - len(turns)
+        print(f"Table 8.1 (continuity): {'yes' if not table else f'NO ({table} violation(s))'}; steering stops: NO")
     print(_feasible(result))
     for v in result.violations:
-        print(f"  t = {v.t:8.3f} s  {v.kind}, jump {_jump(v.signal, v.size)}: {v.remedy}")
+        if v in turns:
+            print(f"  t = {v.t:8.3f} s  {v.kind}: the reference {v.words()}: {v.remedy}")
+        else:
+            print(f"  t = {v.t:8.3f} s  {v.kind}, jump {_jump(v.signal, v.size)}: {v.remedy}")
     return 0 if result.feasible else 1
 
 

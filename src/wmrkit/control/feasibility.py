@@ -15,6 +15,10 @@ derivative around a step of its signal is that step, reported once), and whether
 :mod:`.steered_turns`. ``kappa`` and the rates are not judged where the reference rests or starts or stops, ``chi``
 at rest: a jump across such samples is still found, across a rest only for a car's tangent (R on the fixed axle of a
 type 4 cannot turn at rest; any other vehicle re-orients there, the remedy of Table 8.1).
+
+Beyond Table 8.1: a car-like robot's steering stops bound how tightly the judged point turns
+(:mod:`.turn_limits`); a stretch between the table's breaks that turns tighter is a :class:`TightTurn`, and the
+reference is not feasible (:attr:`Feasibility.continuous` keeps the table's own verdict).
 """
 
 from __future__ import annotations
@@ -34,8 +38,9 @@ from .points import ControlError, control_point
 from .reference_signals import _CURVATURE, _curvature_reference, signals
 from .references import Reference
 from .steered_turns import _STEERED, _slow_turns, _steered_turn
+from .turn_limits import TurnExcess, turn_excess
 
-__all__ = ["COLUMNS", "Feasibility", "Requirement", "Violation", "feasibility", "requirement"]
+__all__ = ["COLUMNS", "Feasibility", "Requirement", "TightTurn", "Violation", "feasibility", "requirement"]
 
 _VEHICLE = "stop and re-orient the vehicle"
 _WHEEL = "stop and re-orient the orientable wheel"
@@ -100,9 +105,52 @@ class Violation:
         return {"t": self.t, "kind": self.kind, "signal": self.signal, "size": self.size, "remedy": self.remedy}
 
 
+#: The kind of a :class:`TightTurn`.
+TIGHT_KIND = "turn tighter than the steering stops allow"
+
+
+@dataclass(frozen=True)
+class TightTurn(Violation):
+    """A stretch from ``t`` to ``until`` [s] where the reference turns by ``turn`` [rad] over ``length`` [m], more
+    than the judged point of a car-like robot can (:func:`.turn_limits.turn_excess`); ``size``: its mean radius
+    ``length / turn`` [m]; ``radius``: the point's tightest turn, ``turning``: the robot's minimum turning radius
+    (of its rear axle's midpoint) [m]; ``limit``: the most the point turns over ``length`` [rad]."""
+
+    until: float = 0.0
+    turn: float = 0.0
+    length: float = 0.0
+    radius: float = 0.0
+    turning: float = 0.0
+    limit: float = 0.0
+
+    @classmethod
+    def of(cls, e: TurnExcess) -> TightTurn:
+        """The violation of a stretch."""
+        limit = e.length / e.radius + e.span
+        again = (f"on {e.radius:.4g} m at its tightest, and {math.degrees(e.span):.3g} deg more by re-steering; "
+                 if e.span > 1e-9 else "")
+        remedy = (f"a wider turn: over {e.length:.4g} m the point turns by {math.degrees(limit):.4g} deg at most "
+                  f"({again}the robot's minimum turning radius is {e.turning:.4g} m, of its rear axle's midpoint at "
+                  "its steering stops)")
+        return cls(e.t, "turn", TIGHT_KIND, e.length / e.turn, remedy, e.until, e.turn, e.length, e.radius, e.turning,
+                   limit)
+
+    def to_dict(self) -> dict[str, object]:
+        """:meth:`Violation.to_dict` and ``until``, ``turn`` [rad], ``length``, ``radius``, ``turning`` [m],
+        ``limit`` [rad]."""
+        return {**super().to_dict(), "until": self.until, "turn": self.turn, "length": self.length,
+                "radius": self.radius, "turning": self.turning, "limit": self.limit}
+
+    def words(self) -> str:
+        """``turns by 349.6 deg over 6.105 m (t = 0 to 12.41 s; on 1 m on average)``."""
+        return (f"turns by {math.degrees(self.turn):.4g} deg over {self.length:.4g} m (t = {self.t:.4g} to "
+                f"{self.until:.4g} s; on {self.size:.4g} m on average)")
+
+
 @dataclass(frozen=True)
 class Feasibility:
-    """Result of :func:`feasibility`: ``feasible`` and the ``violations`` of ``requirement``."""
+    """Result of :func:`feasibility`: ``feasible`` and the ``violations`` of ``requirement`` (Table 8.1's, and a
+    :class:`TightTurn` where the steering stops forbid the reference)."""
 
     requirement: Requirement
     violations: tuple[Violation, ...]
@@ -112,11 +160,18 @@ class Feasibility:
         """No violation: the reference is followed with zero error by ideal blocks from matching initial conditions."""
         return not self.violations
 
+    @property
+    def continuous(self) -> bool:
+        """Table 8.1's own verdict: no continuity violation (a :class:`TightTurn` is none)."""
+        return not any(not isinstance(v, TightTurn) for v in self.violations)
+
     def to_dict(self) -> dict[str, object]:
-        """``{"feasible", "column", "type", "framework", "signals", "violations": [...]}`` (the CLI's JSON)."""
+        """``{"feasible", "continuous", "column", "type", "framework", "signals", "violations": [...]}`` (the CLI's
+        JSON; ``continuous``: Table 8.1's verdict)."""
         r = self.requirement
-        return {"feasible": self.feasible, "column": r.column, "type": r.type, "framework": r.framework,
-                "signals": list(r.signals), "violations": [v.to_dict() for v in self.violations]}
+        return {"feasible": self.feasible, "continuous": self.continuous, "column": r.column, "type": r.type,
+                "framework": r.framework, "signals": list(r.signals),
+                "violations": [v.to_dict() for v in self.violations]}
 
 
 def requirement(robot: Robot, framework: Literal["kinematic", "dynamic"] = "kinematic", *,
@@ -179,7 +234,9 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
     """Check `reference` against the Table 8.1 cell of `robot` (§8.5): every discontinuity and its remedy.
 
     A jump is a step of a signal larger than `jump_factor` (> 1) times the typical step where it is (the median of
-    its block of ``BLOCK`` steps, or of a neighbouring block when larger) and than a floor."""
+    its block of ``BLOCK`` steps, or of a neighbouring block when larger) and than a floor. For a car-like robot, a
+    stretch between those jumps that turns tighter than its steering stops let the point turn is a
+    :class:`TightTurn` (:mod:`.turn_limits`), in either framework."""
     if not 1 < jump_factor < math.inf:  # NaN included: at 0 or NaN every step above the floor was a jump
         raise ControlError(f"jump_factor: expected a finite number > 1 (times the median step), got {jump_factor}")
     req = requirement(robot, framework, point=point)
@@ -226,6 +283,10 @@ def feasibility(robot: Robot, reference: Reference, framework: Literal["kinemati
             if any(v.t == t and v.signal in ("chi", "position") for v in found) and name != "position":
                 continue  # already reported by a lower-order signal at the same instant
             found.append(Violation(t, name, KINDS[name], size, _remedy(req, name, turns)))
+    tight = turn_excess(robot, reference.t, reference.pose[:, :2], (0.0, 0.0) if point is None else point,
+                        [v.t for v in found])
+    if tight is not None:  # the steering stops: the same in both frameworks (they bound an angle, not its rate)
+        found.append(TightTurn.of(tight))
     found.sort(key=lambda v: v.t)
     return Feasibility(req, tuple(found))
 

@@ -160,10 +160,15 @@ def plot_feasibility(result: Feasibility, reference: Reference, path: str | os.P
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 5))
     ax.plot(reference.pose[:, 0], reference.pose[:, 1], "k", lw=1.2, label="reference")
-    for k, v in enumerate(result.violations):
+    jumps = [v for v in result.violations if v.signal != "turn"]
+    for k, v in enumerate(jumps):
         p = reference.sample(np.array([v.t]))[0]
         ax.plot(p[0], p[1], "rx", ms=9, mew=2, label="violation" if k == 0 else None)
         ax.annotate(f"{v.signal} @ {v.t:.1f} s", (p[0], p[1]), fontsize=7, xytext=(4, 4), textcoords="offset points")
+    for k, v in enumerate(v for v in result.violations if v.signal == "turn"):  # a stretch: TightTurn
+        inside = (reference.t >= v.t) & (reference.t <= v.until)  # type: ignore[attr-defined]
+        ax.plot(reference.pose[inside, 0], reference.pose[inside, 1], "r", lw=3, alpha=0.6,
+                label="tighter than the steering stops" if k == 0 else None)
     r = result.requirement
     ax.set_title(f"{'' if robot is None else f'{robot}: '}Table 8.1 '{r.column}', {r.framework}: "
                  f"{'feasible' if result.feasible else 'NOT feasible'}", fontsize=10)
