@@ -159,3 +159,15 @@ def test_a_circle_at_the_stops_is_within_reach_and_a_tighter_one_is_not(tmp_path
     assert main(["feasibility", "ackermann", "--reference", path, "--json"]) == (1 if flagged else 0)
     got = [v for v in json.loads(capsys.readouterr().out)["violations"] if v["signal"] == "turn"]
     assert len(got) == flagged
+
+
+def test_a_stopped_run_names_no_tight_turn_as_its_jump():
+    """A run that stops names the last Table 8.1 jump before it; a TightTurn is no jump (it read 'found a jump the
+    robot cannot follow: turn tighter than the steering stops allow')."""
+    from wmrkit.control.points import StoppedRun
+    from wmrkit.control.references import builtin_reference
+    from wmrkit.control.track import _stopped
+
+    stop = StoppedRun("the loop diverged at t = 5 s", 5.0)
+    got = _stopped(stop, catalog.load("ackermann"), builtin_reference("circle", size=1.0), np.zeros(2), "kinematic")
+    assert str(got) == "the loop diverged at t = 5 s"

@@ -273,10 +273,11 @@ def _stopped(err: StoppedRun, robot: Robot, reference: Reference, point: np.ndar
     """`err`, naming the last jump of `reference` at or before the run stopped that Table 8.1 says the robot
     tracked at `point` cannot follow (the likely cause: a step of the commands), if there is one."""
     verdict = _feasibility(robot, reference, point, framework, err.t)
-    if verdict is None or verdict.feasible:
+    found = [v for v in verdict.violations if v.signal != "turn"] if verdict else []  # jumps, not a TightTurn
+    if not found:
         return err
-    last = verdict.violations[-1].t
-    jumps = [v for v in verdict.violations if v.t == last]
+    last = found[-1].t
+    jumps = [v for v in found if v.t == last]
     end = " (the reference's end, where it stops)" if last == reference.t[-1] else ""
     return StoppedRun(f"{err}; before it, at t = {last:.4g} s{end}, Table 8.1 (column '{verdict.requirement.column}' "
                       f"for the tracked point, {framework} framework) found a jump the robot cannot follow: "
