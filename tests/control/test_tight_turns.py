@@ -171,3 +171,12 @@ def test_a_stopped_run_names_no_tight_turn_as_its_jump():
     stop = StoppedRun("the loop diverged at t = 5 s", 5.0)
     got = _stopped(stop, catalog.load("ackermann"), builtin_reference("circle", size=1.0), np.zeros(2), "kinematic")
     assert str(got) == "the loop diverged at t = 5 s"
+
+
+def test_a_path_of_zero_length_turns_nowhere():
+    """A reference at rest (every sample at one point) raised an IndexError from its empty set of chords, in
+    feasibility and in every track of the car."""
+    from wmrkit.control.turn_limits import turn_excess
+
+    t = np.linspace(0.0, 2.0, 5)
+    assert turn_excess(catalog.load("ackermann"), t, np.tile([1.0, 2.0], (5, 1)), (0.0, 0.0)) is None

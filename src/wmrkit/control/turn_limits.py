@@ -117,6 +117,8 @@ def turn_excess(robot: Robot, t: np.ndarray, xy: np.ndarray, point: ArrayLike,
     if span is None or len(t) < 3:
         return None
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(xy, axis=0).T))])  # the polyline's length
+    if not s[-1] > 0:  # a reference at rest: no turn (an empty set of chords raised an IndexError)
+        return None
     step = min(CHORD, radius / 20)
     keep = np.unique(np.searchsorted(s, np.arange(0.0, s[-1], step)))
     keep = keep[np.concatenate([[True], np.diff(s[keep]) >= step / 2])]  # chords of step / 2 at least
