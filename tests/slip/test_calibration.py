@@ -66,21 +66,24 @@ def test_a_reference_that_starts_after_the_log_gives_the_same_fit(husky_run, sta
 
 
 def test_a_reference_of_another_run_is_refused(husky_run):
-    """A fit that runs to the bound of its search is not a calibration: here the reference turns the other way."""
+    """A reference that turns the other way: it ran the fit to the bound of its search; now refused before the fit
+    (tests/slip/test_reference_consistency.py)."""
     mirrored = husky_run.truth * [1.0, -1.0, -1.0]
-    with pytest.raises(WmrkitError, match="ran to the bound of its search"):
+    with pytest.raises(WmrkitError, match="slip scales a turn, it does not reverse it"):
         calibrate_slip(catalog.load("skid-steer-4"), husky_run.log, (husky_run.log.time, mirrored))
 
 
 def test_a_fit_stopped_a_hair_inside_its_bound_is_refused():
     """scipy's trf stops strictly inside a bound and need not flag it active: a reference with x and y swapped ran
     the ratio to 1.0000012e-06 (5e-7 decades from the bound), which was reported as a fit, exit 0 (`wmrkit
-    calibrate` offered `lateral: 1.0000003981745279e-06` as a description block on a simulated turn)."""
+    calibrate` offered `lateral: 1.0000003981745279e-06` as a description block on a simulated turn). A swapped
+    reference is now refused before the fit; a reference turning three times as fast as the log's wheels allow
+    (the same way, so not refused as a mirror image) stops the fit 1.5e-5 decades inside the bound, not active."""
     robot = catalog.load("skid-steer-4")
     run = wheel_speed_run(robot, [(1.0, [10, 10, 10, 10]), (2.0, [10, 12, 10, 12])], 50.0, model="mqe")
-    swapped = run.truth[:, [1, 0, 2]]
+    faster = wheel_speed_run(robot, [(1.0, [10, 10, 10, 10]), (2.0, [10, 16, 10, 16])], 50.0, model="mqe")
     with pytest.raises(WmrkitError, match="the WLS ratio ran to the bound of its search"):
-        calibrate_slip(robot, run.log, (run.log.time, swapped))
+        calibrate_slip(robot, run.log, (run.log.time, faster.truth))
 
 
 def test_a_reference_covering_a_straight_part_of_a_turning_log_says_so(husky_run):

@@ -19,6 +19,7 @@ from ._common import (
     parse_value,
     print_json,
     seed,
+    warn,
 )
 from ._shown import written
 
@@ -264,6 +265,8 @@ def run_calibrate(args: argparse.Namespace) -> int:
     except ValueError as err:
         raise WmrkitError(f"{args.reference}: not a TUM trajectory ({err})") from None
     result = calibrate_slip(robot, log, ref, method=args.scheme, source=args.reference)
+    for line in result.warnings:
+        warn(line)
     if args.json:
         print_json(result.to_dict())
     else:

@@ -27,6 +27,7 @@ from ..odometry.logs import JointLog
 from ..odometry.model import wrap_angle
 from ..odometry.pipeline import odometry
 from ..robot import Robot
+from .consistency import check_reference
 from .weights import SlipWeights, wls_model
 
 #: Lateral weight of the effective-track model (rolling rows only, to round-off).
@@ -37,13 +38,14 @@ IGNORED = 1e-9
 class SlipCalibration:
     """Fitted ``ratio`` (WLS, mu_lateral / mu_longitudinal) and ``multiplier`` (effective track); RMS position
     errors [m] and final position / heading errors against the reference for ``no_slip`` (unweighted LS),
-    ``wls`` and ``effective_track``."""
+    ``wls`` and ``effective_track``; ``warnings``: what makes the reference suspicious (one line each)."""
 
     robot: str
     ratio: float
     multiplier: float
     rms: tuple[tuple[str, float], ...]
     final: tuple[tuple[str, float, float], ...]
+    warnings: tuple[str, ...] = ()  # a suspicious reference (:func:`.consistency.check_reference`)
 
     @property
     def best(self) -> str:
@@ -126,8 +128,9 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
     reference may start after the log), and interpolated linearly at the reference's times within the log's span.
     A fit that runs to a bound of its search (ratio 1e-6 or 1e6, multiplier 0.01 or 100) is refused: the log and
     the reference then disagree (another run, another time base), and so is a reference that travels more than
-    ``MAX_SCALE`` times farther or less far than the no-slip odometry (another run, other units). `source` names the
-    reference in errors.
+    ``MAX_SCALE`` times farther or less far than the no-slip odometry (another run, other units), and one that turns
+    or travels in ways slip cannot explain (:func:`.consistency.check_reference`: a mirror image, a turn reversed,
+    missing or made up; its warnings go to ``warnings``). `source` names the reference in errors.
     """
     from scipy.optimize import least_squares
 
@@ -167,6 +170,7 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
         raise WmrkitError(f"{source}: the reference travels {travelled[0]:.4g} m where the log's odometry travels "
                           f"{travelled[1]:.4g} m (more than a factor {MAX_SCALE:g} apart): the log and the reference "
                           "disagree; check that they record the same run, in metres and seconds")
+    warnings = check_reference(t_ref, ref, plain, source)  # refuses what cannot be one run, whatever the slip
     models = {"WLS ratio": lambda p: wls_model(robot, SlipWeights.uniform(10.0 ** p, 1.0)),
               "effective track": lambda p: effective_track_model(robot, 10.0 ** p)}
     fit_k = least_squares(lambda p: residuals(poses_of(models["WLS ratio"](p[0]))),
@@ -201,7 +205,7 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
         d = np.hypot(*(p[:, :2] - ref[:, :2]).T)
         rms.append((name, float(np.sqrt(np.mean(d * d)))))
         final.append((name, float(d[-1]), float(abs(wrap_angle(p[-1, 2] - ref[-1, 2])))))
-    return SlipCalibration(robot.name, ratio, multiplier, tuple(rms), tuple(final))
+    return SlipCalibration(robot.name, ratio, multiplier, tuple(rms), tuple(final), tuple(warnings))
 
 
 _BOUNDS = {"WLS ratio": "1e-6 to 1e6", "effective track": "multiplier 0.01 to 100"}
