@@ -1,19 +1,22 @@
 """Whether a reference trajectory can record the run of a joint log, judged in ways slip cannot explain away.
 
-Slip scales a turn (a skid steer turns 1.8 times slower on arcs, 4 times on the spot, than its no-slip odometry
+Slip scales a turn (a skid steer turns 1.8 times slower on arcs, 4 times on the spot, than its differential kinematics
 says) and turns the path a few degrees off the heading (lateral slip angles), but it does not reverse a turn, stop
-one, make one out of nothing, or drive the robot sideways. Two checks, at the reference's poses (``wmrkit
+one, make one out of nothing, or drive the robot sideways. Three checks, at the reference's poses (``wmrkit
 calibrate``, :func:`wmrkit.slip.calibration.calibrate_slip`; thresholds and their reasons in ``docs/slip.md``):
 
 - **turning**: the log's no-slip heading is cut into legs where it turns one way (reversals of less than
   :data:`HYSTERESIS` are kept inside a leg). Over each leg that turns more than :data:`TURN` rad, the reference must
   turn the same way and by at least :data:`MIN_SHARE` of it; and over each leg of the reference's own heading that
   turns more than :data:`TURN`, so must the log.
-- **direction of travel**: over chords of the path (about :data:`CHORD` s), the reference's direction of travel in
-  its own body frame against the one the log's no-slip odometry gives (along the heading, forwards or backwards, for
-  a robot that cannot move sideways without slipping; whatever the wheels allow for others). The median difference
-  over the chords where both move must be below :data:`REFUSE_ANGLE` (refused) and should be below
-  :data:`WARN_ANGLE` (a warning).
+- **the path's turning**: the direction of travel along chords of about :data:`CHORD` s (modulo pi: forwards or
+  backwards), where both move at least :data:`MIN_CHORD` m, must on balance turn the way the no-slip odometry's does
+  (a positive least-squares slope of its turns on the odometry's, once those add up to :data:`TURN`): x and y
+  swapped mirror the path while the heading column still turns the log's way.
+- **direction of travel**: over the same chords, the reference's direction of travel in its own body frame against
+  the one the log's no-slip odometry gives (along the heading for a robot that cannot move sideways without
+  slipping; whatever the wheels allow for others). The median difference must be below :data:`REFUSE_ANGLE`
+  (refused) and should be below :data:`WARN_ANGLE` (a warning).
 
 Only stretches where the reference is sampled at least every :data:`MAX_GAP` s are judged (a run's start and end
 poses say nothing of how it turned).
@@ -107,9 +110,14 @@ def _same_turns(t: np.ndarray, log: np.ndarray, ref: np.ndarray, dense: np.ndarr
             turn, follow = mine[b] - mine[a], other[b] - other[a]
             if abs(turn) > TURN and follow * math.copysign(1.0, turn) < MIN_SHARE * abs(turn):
                 raise WmrkitError(
-                    f"{source}: from t = {t[a]:.6g} to {t[b]:.6g} s {whose} turns {turn:+.3g} rad and {theirs} "
-                    f"{follow:+.3g} rad: slip scales a turn, it does not reverse it, stop it or make one; the log and "
+                    f"{source}: from t = {t[a]:.6g} to {t[b]:.6g} s {whose} turns {_rad(turn)} rad and {theirs} "
+                    f"{_rad(follow)} rad: slip scales a turn, it does not reverse it, stop it or make one; the log and "
                     "the reference do not record the same run (another run? x and y swapped, a sign flipped?)")
+
+
+def _rad(angle: float) -> str:
+    """`angle` [rad] signed, to 3 digits; round-off of 0 is 0 (a straight log's heading ended at -7.63e-16 rad)."""
+    return f"{round(angle, 9) + 0.0:+.3g}"
 
 
 def _courses(t: np.ndarray, ref: np.ndarray, odo: np.ndarray):
