@@ -322,3 +322,40 @@ def test_the_plot_legend_names_the_slip_aware_method(tmp_path, monkeypatch):
     for method in ("fk2", "wls", "exact"):
         assert main(["odometry", "diff-drive", str(path), "--method", method, "--plot", str(tmp_path / "p.png")]) == 0
     assert drawn == [["diff-drive (fk2, exact)"], ["diff-drive (wls, exact)"], ["diff-drive (exact)"]]
+
+
+@pytest.mark.parametrize("sensed", [("front_left.spin",), ("front_left.spin", "rear_left.spin")])
+def test_one_side_of_a_skid_steer_is_refused_for_the_slip_aware_methods(tmp_path, capsys, sensed):
+    """One side's wheels of a skid steer: the no-slip lateral rows fix its turn rate at 0, so `--method wls` (and
+    fk2) drove a turning run straight, exit 0. They never report the turn the four wheels report: refused as plain
+    odometry refuses sensors that do not determine the no-slip motion, '--sensed: ...', exit 2."""
+    from wmrkit.odometry.model import SensingError
+    from wmrkit.slip.synthetic import wheel_speed_run
+
+    robot = catalog.load("skid-steer-4")
+    run = wheel_speed_run(robot, [(3.0, [8, 12, 8, 12])], 20.0)
+    assert run.truth[-1, 2] > 0.5  # the run turns (its no-slip rows would say it cannot)
+    for name in ("wls", "fk1", "fk2"):
+        with pytest.raises(SensingError, match=r"they never report a turn \(the no-slip rows hold omega at 0"):
+            estimator(robot, name, sensed=sensed)
+    log = tmp_path / "skid.csv"
+    write_log(log, run.log)
+    args = ["odometry", "skid-steer-4", str(log), *(a for s in sensed for a in ("--sensed", s))]
+    for method in ("wls", "fk2"):
+        assert main([*args, "--method", method]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("wmrkit: error: --sensed: the sensed joints of robot 'skid-steer-4' (") \
+            and "do not determine its motion with slip" in err and err.count("\n") == 1
+
+
+def test_sensors_that_see_every_turn_are_not_refused():
+    """Both front wheels of the skid steer report its turn; the forklift's drive wheels alone (differential odometry,
+    (7.79)) or one of them with the steering (its sideways speed at the fork tips tied to the turn), and a car's rear
+    wheels (its sideways speed held at 0 at their axle, as by the no-slip model): all run."""
+    cases = {"skid-steer-4": [("front_left.spin", "front_right.spin"), ("front_left.spin", "rear_right.spin")],
+             "forklift": [("right_drive.spin", "left_drive.spin"), ("right_drive.spin", "steer.steer")],
+             "ackermann": [("rear_left.spin", "rear_right.spin")]}
+    for robot, sets in cases.items():
+        for sensed in sets:
+            for name in ("wls", "fk2"):
+                estimator(catalog.load(robot), name, sensed=sensed)

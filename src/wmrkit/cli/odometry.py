@@ -23,6 +23,7 @@ from ..odometry.integrators import METHODS
 from ..odometry.logs import TIME_UNITS
 from ..odometry.model import odometry_model
 from ..odometry.pipeline import OdometrySummary, check_start_pose
+from ..slip.estimators import check_slip_sensing
 from ._common import (
     SCHEMES_HELP,
     OptionError,
@@ -120,6 +121,8 @@ def run(args: argparse.Namespace) -> int:
         raise WmrkitError(f"--crowley: coefficients must be finite and >= 0, got {' '.join(map(str, args.crowley))}")
     with renaming({"": "--sensed: "} if args.sensed else {}):  # a joint the robot has not, or that cannot tell
         model = odometry_model(robot, args.sensed)  # the no-slip model of the diagnostics (the run's, no weights)
+        if args.sensed and args.method in ESTIMATOR_METHODS:  # and with slip: one side of a skid steer
+            check_slip_sensing(robot, args.sensed)
     weights = _weights(robot, args)
     joints = model.joints
     steer_option = "--steer" if args.steer else "--steer-convention" if args.steer_convention else None

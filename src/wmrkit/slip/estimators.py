@@ -191,9 +191,47 @@ class EstimatorSpec:
 def estimator(robot: Robot, name: str, *, sensed: Sequence[str] | None = None, weights: SlipWeights | None = None,
               noise: KalmanNoise | None = None, thesis_double_q: bool = False) -> OdometryModel | KalmanEstimator:
     """The estimator `name` (``wls``, ``fk1``, ``fk2``) of `robot`: WLS with friction coefficients `weights`, a
-    filter with `noise` (defaults: unit coefficients, unit noise)."""
+    filter with `noise` (defaults: unit coefficients, unit noise). Sensed joints that see fewer directions of the
+    twist than the robot's described ones are refused (:func:`check_slip_sensing`)."""
+    if sensed is not None and name in ESTIMATORS:
+        check_slip_sensing(robot, sensed)
     if name == "wls":
         return wls_model(robot, weights, sensed)
     if name in FILTERS:
         return KalmanEstimator(kalman_model(robot, name, noise, sensed, thesis_double_q=thesis_double_q), name)
     raise WmrkitError(f"estimator must be one of {', '.join(ESTIMATORS)}, got '{name}'")
+
+
+#: Steering offsets [rad] from the described angles at which a steering model's twist maps are taken (a sensed
+#: steering angle moves the twist: the forklift's one drive wheel and steering report its turn).
+STEERING_PROBES = (0.0, 0.3, -0.3, 0.7)
+
+
+def check_slip_sensing(robot: Robot, sensed: Sequence[str]) -> None:
+    """Refuse `sensed` joints whose twist maps (over steering configurations, :data:`STEERING_PROBES`) hold the turn
+    rate at 0 whatever the log, where the robot's described sensors report it: the no-slip rows alone then fix it,
+    which a slip-aware estimator exists to relax. A skid steer read by one side's wheels: its lateral rows fix the
+    turn rate at 0, so a turning run was driven straight with no word (plain odometry refuses sensors that do not
+    determine the no-slip motion; this is the same refusal for the motion with slip). Only the turn: a sideways speed
+    held at 0 depends on the origin (a car's rear wheels alone hold it at 0 at their axle, as the no-slip model does),
+    and sensors that tie the turn to others (the forklift's drive wheels alone; one of them with its steering) report
+    it. :class:`~wmrkit.odometry.model.SensingError`."""
+    from ..odometry.model import SensingError, odometry_model
+
+    def turns(joints) -> bool:
+        """Whether the model of `joints` maps some rates to a turn."""
+        model = odometry_model(robot, joints)
+        if model.constant:
+            maps = np.asarray(model.solution)[None]
+        else:
+            maps = model.configuration_maps(robot.beta[model.steer_index] + np.array(STEERING_PROBES)[:, None])[0]
+            maps = np.asarray(maps.arrays[0])
+        if not maps.size:
+            return False
+        return bool(np.abs(maps[:, 2]).max() > 1e-9 * np.abs(maps[:, :3]).max())
+
+    if not turns(sensed) and turns(robot.sensed):
+        raise SensingError(f"the sensed joints of robot '{robot.name}' ({', '.join(sensed) or 'none'}) do not "
+                           "determine its motion with slip: they never report a turn (the no-slip rows hold omega at "
+                           f"0 whatever the log), which its described sensors ({', '.join(robot.sensed)}) report (a "
+                           "skid steer read by one side's wheels drives straight)")
