@@ -191,8 +191,8 @@ class EstimatorSpec:
 def estimator(robot: Robot, name: str, *, sensed: Sequence[str] | None = None, weights: SlipWeights | None = None,
               noise: KalmanNoise | None = None, thesis_double_q: bool = False) -> OdometryModel | KalmanEstimator:
     """The estimator `name` (``wls``, ``fk1``, ``fk2``) of `robot`: WLS with friction coefficients `weights`, a
-    filter with `noise` (defaults: unit coefficients, unit noise). Sensed joints that see fewer directions of the
-    twist than the robot's described ones are refused (:func:`check_slip_sensing`)."""
+    filter with `noise` (defaults: unit coefficients, unit noise). Sensed joints that never report a turn the
+    robot's described ones report are refused (:func:`check_slip_sensing`)."""
     if sensed is not None and name in ESTIMATORS:
         check_slip_sensing(robot, sensed)
     if name == "wls":
