@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import functools
 import json
 import math
 import os
 import sys
 import tempfile
 import warnings
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextvars import ContextVar
 from pathlib import Path
 from typing import Any
@@ -263,6 +264,13 @@ def parse_value(text: str, kind: Kind, what: str) -> float:
         return parse_quantity(text, kind)
     except UnitError as err:
         raise WmrkitError(f"{what}: {err}") from None
+
+
+def quantity(kind: Kind, option: str) -> Callable[[str], float]:
+    """An argparse ``type=`` reading an option's value as :func:`parse_value` does: a bare number in SI, or with a
+    unit of `kind` (``--duration 2s``, ``--period 50ms``). A value refused is the house one-line error naming the
+    option, exit 2 (a :class:`WmrkitError`, which argparse passes on), not argparse's 'invalid float value'."""
+    return functools.partial(parse_value, kind=kind, what=option)
 
 
 def parse_angle(text: str, what: str) -> float:

@@ -21,6 +21,7 @@ from ._common import (
     parse_mount,
     parse_value,
     print_json,
+    quantity,
     renaming,
     seed,
     warn,
@@ -77,7 +78,7 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    help="a parameter: WHEEL.FIELD names moved together, comma-separated, '-' to oppose (repeat; "
                         "default: spin wheels' radii (their ratio with --closed) and the track)")
     p.add_argument("--ci", choices=("jacobian", "bootstrap"), help="interval method (default jacobian)")
-    p.add_argument("--level", type=float, default=0.95, help="confidence level (default 0.95)")
+    p.add_argument("--level", type=quantity("number", "--level"), default=0.95, help="confidence level (default 0.95)")
     p.add_argument("--bootstrap", type=int, metavar="B", help="bootstrap replicates of --ci bootstrap (default 200)")
     p.add_argument("--method", choices=METHODS, default="exact",
                    help=f"integration scheme: {SCHEMES_HELP} (default: exact)")
@@ -94,12 +95,13 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("log", nargs="?", metavar="LOG", help="CSV log taken as the truth (or --path)")
     p.add_argument("--path", metavar="NAME", help="a built-in path: square, loop, arc")
     p.add_argument("-n", "--runs", type=int, default=1000, help="Monte Carlo runs (default 1000)")
-    p.add_argument("--noise", type=float, default=1e-4, metavar="RAD2_PER_RAD",
+    p.add_argument("--noise", type=quantity("number", "--noise"), default=1e-4, metavar="RAD2_PER_RAD",
                    help="random-walk variance per radian of joint travel (default 1e-4)")
     p.add_argument("--resolution", metavar="ANGLE", default="0", help="encoder resolution [rad or deg] (default 0)")
-    p.add_argument("--slip", type=float, default=0.0, metavar="STD",
+    p.add_argument("--slip", type=quantity("number", "--slip"), default=0.0, metavar="STD",
                    help="std of a run's wheel slip ratio (default 0: no slip)")
-    p.add_argument("--rate", type=float, help="sample rate of a built-in path [Hz] (default 20)")
+    p.add_argument("--rate", type=quantity("number", "--rate"), metavar="HZ",
+                   help="sample rate of a built-in path [Hz, a bare number] (default 20)")
     p.add_argument("--seed", type=seed, default=0, help="random seed of the runs (default 0)")
     p.add_argument("--method", choices=METHODS, default="exact",
                    help=f"integration scheme: {SCHEMES_HELP} (default: exact)")

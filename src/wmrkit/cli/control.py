@@ -51,12 +51,13 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                                                     "(default: the wheelbase of a robot with steered wheels, "
                                                     "else 2 s at the reference's top speed: 1 m at 0.5 m/s)")
     p.add_argument("--stanley-gain", metavar="K", help="stanley: cross-track gain [1/s] (default 1)")
-    p.add_argument("--period", metavar="T", help="sample period [s]; without it the loop is continuous")
+    p.add_argument("--period", metavar="T", help="sample period [s, or with a unit: '50 ms']; without it the loop is "
+                                                   "continuous")
     p.add_argument("--delay", type=int, default=0, metavar="N",
                    help="measurement delay in samples (with --period; default 0)")
-    p.add_argument("--duration", metavar="S", help="seconds to simulate (default: the reference's length; pure "
-                   "pursuit and Stanley: until they reach the path's end, at most 50%% (10 s at least) longer, "
-                   "within the loop's limits)")
+    p.add_argument("--duration", metavar="S", help="time to simulate [s, or with a unit: '2 s'] (default: the "
+                   "reference's length; pure pursuit and Stanley: until they reach the path's end, at most 50%% "
+                   "(10 s at least) longer, within the loop's limits)")
     p.add_argument("--steering", default="closest", choices=("closest", "4-quadrant", "2-quadrant"),
                    help="which of the two steering solutions (8.9) a wheel takes (within its steer_range; default "
                         "closest)")
@@ -239,8 +240,8 @@ def run_track(args: argparse.Namespace) -> int:
     gain = 1.0 if args.gain is None else _non_negative(args.gain, "--gain")
     lookahead, ahead_words = _lookahead(args, robot, reference)
     stanley_gain = 1.0 if args.stanley_gain is None else _non_negative(args.stanley_gain, "--stanley-gain")
-    period = None if args.period is None else _positive(args.period, "--period")
-    duration = None if args.duration is None else _positive(args.duration, "--duration")
+    period = None if args.period is None else _positive(args.period, "--period", "time")
+    duration = None if args.duration is None else _positive(args.duration, "--duration", "time")
     gate = None if args.gate is None else _positive(args.gate, "--gate", "length")
     weights = noise = None
     if (args.slip_model != "none" or args.feedback != "pose" or args.ramp) and not args.dynamics:

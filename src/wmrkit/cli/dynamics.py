@@ -65,9 +65,11 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     source.add_argument("--torques", metavar="FILE", help="CSV 'time,<wheel>.spin,...' of torques [N m]")
     source.add_argument("--path", metavar="NAME", choices=list(PATHS), help=f"built-in program: {', '.join(PATHS)}")
     p.add_argument("--tyre", choices=list(TYRES), help="tyre model for every wheel (default: each wheel's own)")
-    p.add_argument("--duration", metavar="S", help="simulated time [s] (default: the program's or the file's)")
+    p.add_argument("--duration", metavar="S", help="simulated time [s, or with a unit: '500 ms'] (default: the "
+                                                   "program's or the file's)")
     p.add_argument("--step", metavar="DT",
-                   help=f"integration step [s] of the fixed-step methods (default {DEFAULT_STEP:g})")
+                   help=f"integration step [s, or with a unit: '1 ms'] of the fixed-step methods (default "
+                        f"{DEFAULT_STEP:g})")
     p.add_argument("--method", default="semi-implicit", choices=["semi-implicit", "rk4", "adaptive"],
                    help="integrator: semi-implicit Euler (default; stable with stiff tyres at 1 ms), rk4 (fixed "
                         "step, non-stiff tyres only: docs/dynamics.md) or adaptive (LSODA)")
@@ -195,12 +197,12 @@ def run_simulate(args: argparse.Namespace) -> int:
         if duration <= 0 and args.duration is None:
             raise WmrkitError(f"{args.torques}: the file ends at t = {duration:g} s: give --duration")
     if args.duration is not None:
-        duration = _positive(parse_value(args.duration, "number", "--duration"), "--duration")
+        duration = _positive(parse_value(args.duration, "time", "--duration"), "--duration")
     if args.step is not None and args.method == "adaptive":  # below 0.01 s it was dropped, above it set the records
         raise WmrkitError(f"--step {args.step}: the adaptive method chooses its own steps (LSODA, to a relative "
                           f"tolerance of {ADAPTIVE_RTOL:g}; it records every 0.01 s); --step applies to semi-implicit "
                           "and rk4")
-    step = _positive(parse_value(f"{DEFAULT_STEP}" if args.step is None else args.step, "number", "--step"), "--step")
+    step = _positive(parse_value(f"{DEFAULT_STEP}" if args.step is None else args.step, "time", "--step"), "--step")
     source = ("--duration" if args.duration is not None else f"{args.torques}: the file ends at t =" if args.torques
               else f"--path {args.path} at --speed {speed:g} m/s lasts")  # what set the duration
     culprit = (f"--duration {duration:g} s" if args.duration is not None else

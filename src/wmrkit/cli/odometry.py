@@ -36,6 +36,7 @@ from ._common import (
     parse_mount,
     parse_value,
     print_json,
+    quantity,
     renaming,
     warn,
 )
@@ -65,7 +66,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--covariance", action="store_true",
                    help="propagate the pose covariance of Crowley's error model (Bermudez, paper 003 (17): "
                         "docs/odometry.md)")
-    p.add_argument("--crowley", nargs=3, type=float, metavar=("K_D", "K_DTHETA", "K_THETA"),
+    p.add_argument("--crowley", nargs=3, type=quantity("number", "--crowley"),
+                   metavar=("K_D", "K_DTHETA", "K_THETA"),
                    help="with --covariance: Crowley's coefficients (default 0.001 0.003 0.001)")
     g = p.add_argument_group("CSV logs")
     g.add_argument("--time-column", default="time", help="name of the time column (default: time)")
@@ -81,9 +83,10 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     g.add_argument("--steer-convention", choices=("heading", "beta"),
                    help="steer columns hold headings (0 = straight ahead) or the thesis's beta (logs of older "
                         "wmrkit versions; default: the header's 'steer.steer [deg:beta]', else heading)")
-    g.add_argument("--cpr", type=float, help="encoder counts per revolution (default: the catalog's, if any)")
-    g.add_argument("--gear", type=float, help="encoder revolutions per wheel revolution (default: the catalog's, "
-                   "else 1)")
+    g.add_argument("--cpr", type=quantity("number", "--cpr"),
+                   help="encoder counts per revolution (default: the catalog's, if any)")
+    g.add_argument("--gear", type=quantity("number", "--gear"),
+                   help="encoder revolutions per wheel revolution (default: the catalog's, else 1)")
     g.add_argument("--counter-bits", type=int, help="width of a wrapping hardware counter (default: the header's)")
     g.add_argument("--signed-counter", action="store_true", help="the counter is signed")
     g.add_argument("--steer-resolution", metavar="ANGLE", help="steering encoder resolution [rad, or 'deg']")
@@ -91,7 +94,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
                    "deg when its header says so ('yaw [deg]')")
     g.add_argument("--gyro-column", help="yaw-rate column integrated instead of the wheels' heading: rad/s, or deg/s "
                    "when its header says so ('gz [deg/s]')")
-    g.add_argument("--max-gap", type=float, metavar="SECONDS", help="refuse time steps longer than this")
+    g.add_argument("--max-gap", type=quantity("time", "--max-gap"), metavar="TIME",
+                   help="refuse time steps longer than this: seconds, or with a unit ('50 ms')")
     g = p.add_argument_group("ROS 2 bags")
     g.add_argument("--topic", default="/joint_states", help="JointState topic (default: /joint_states)")
     g.add_argument("--joint-name", action="append", metavar="ROS=JOINT", default=[],

@@ -18,6 +18,7 @@ from ._common import (
     parse_assignments,
     parse_value,
     print_json,
+    quantity,
     seed,
     warn,
 )
@@ -39,7 +40,7 @@ def add_estimator_options(p: argparse.ArgumentParser) -> None:
                    help="WLS: coefficients of the wheels not named by --mu (default: the description's "
                         "odometry.slip, else 1,1)")
     g.add_argument("--slip-weights", metavar="FILE", help="WLS: coefficients from 'wmrkit calibrate --json' output")
-    g.add_argument("--kf-noise", nargs=3, type=float, metavar=("PROCESS", "LAT", "LONG"),
+    g.add_argument("--kf-noise", nargs=3, type=quantity("number", "--kf-noise"), metavar=("PROCESS", "LAT", "LONG"),
                    help="FK1/FK2: process noise (the thesis's k13, (7.68)) [m/s per nominal sample period] and "
                         "the lateral / longitudinal row noise [m/s] (default: the description's odometry.noise, "
                         "else 1 1 1)")

@@ -19,6 +19,7 @@ from ._common import (
     parse_angle,
     parse_value,
     print_json,
+    quantity,
     renaming,
     seed,
 )
@@ -51,9 +52,11 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
 
     cal = sub.add_parser("calibrate", help="tilt, focal length and height from two parallel stripes (9.18-9.24)")
     cal.add_argument("image", nargs="?", metavar="IMAGE", help="image of two stripes in the calibration pose")
-    cal.add_argument("--rows", required=True, type=float, metavar="A", help="image rows +-A [px] used")
-    cal.add_argument("--x1", type=float, help="half-distance between the stripes on row +A [px] (instead of IMAGE)")
-    cal.add_argument("--x2", type=float, help="half-distance between the stripes on row -A [px]")
+    cal.add_argument("--rows", required=True, type=quantity("number", "--rows"),
+                     metavar="A", help="image rows +-A [px] used")
+    cal.add_argument("--x1", type=quantity("number", "--x1"),
+                     help="half-distance between the stripes on row +A [px] (instead of IMAGE)")
+    cal.add_argument("--x2", type=quantity("number", "--x2"), help="half-distance between the stripes on row -A [px]")
     cal.add_argument("--half-separation", required=True, metavar="XW",
                      help="real half-distance between the stripes [m]")
     cal.add_argument("--row-distance", required=True, metavar="YW",
@@ -67,20 +70,22 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     f = commands.add_parser("follow-line", help="simulate vision line following (thesis 9.2.3)")
     add_robot_argument(f)
     f.add_argument("--camera", required=True, metavar="FILE", help="camera file of the robot's camera")
-    f.add_argument("--gain", type=float, default=0.3, metavar="A", help="lateral gain a_x [1/s] (default 0.3)")
+    f.add_argument("--gain", type=quantity("number", "--gain"),
+                   default=0.3, metavar="A", help="lateral gain a_x [1/s] (default 0.3)")
     f.add_argument("--speed", default="0.1", metavar="V", help="following speed [m/s] (default 0.1)")
-    f.add_argument("--period", type=float, default=0.5, metavar="T",
-                   help="control period = image time [s] (default 0.5)")
-    f.add_argument("--duration", type=float, default=20.0, metavar="S", help="simulated time [s]: the whole periods "
-                   "within it (default 20)")
+    f.add_argument("--period", type=quantity("time", "--period"), default=0.5, metavar="T",
+                   help="control period = image time [s, or with a unit: '500 ms'] (default 0.5)")
+    f.add_argument("--duration", type=quantity("time", "--duration"), default=20.0, metavar="S",
+                   help="simulated time [s, or with a unit]: the whole periods within it (default 20)")
     f.add_argument("--start", nargs=2, default=("0.3", "0"), metavar=("H", "THETA"),
                    help="start: distance to the line [m, left positive] and heading [rad, or 'deg'] (default "
                         "0.3 0: the thesis's p(0) = (-0.3 m, 0, 0))")
     f.add_argument("--noise", nargs=2, metavar=("H", "PSI"), help="bounds of uniform noise on h [m] and psi [rad, "
                    "or 'deg'] (the thesis's example 2: 0.02 3deg)")
-    f.add_argument("--image-noise", type=float, default=0.0, metavar="SIGMA",
+    f.add_argument("--image-noise", type=quantity("number", "--image-noise"), default=0.0, metavar="SIGMA",
                    help="image noise [grey levels] (default 0)")
-    f.add_argument("--blur", type=float, default=0.0, metavar="SIGMA", help="image blur [px] (default 0)")
+    f.add_argument("--blur", type=quantity("number", "--blur"),
+                   default=0.0, metavar="SIGMA", help="image blur [px] (default 0)")
     f.add_argument("--clutter", type=int, default=0, metavar="N", help="bright blobs on the ground (default 0)")
     f.add_argument("--line-width", default="0.02", metavar="W", help="painted line width [m] (default 0.02)")
     f.add_argument("--z-p", default="0", metavar="Z",
