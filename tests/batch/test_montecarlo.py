@@ -281,7 +281,7 @@ def test_noise_keywords_must_be_numbers(diff, square, keyword, value):
 
 @pytest.mark.parametrize(("option", "said"), [
     (["-n", "1"], "-n/--runs: a Monte Carlo study needs at least 2 runs and at most 1000000, got 1"),
-    (["--noise", "nan"], "--noise: noise must be in [0, 1] (per rad), got nan"),
+    (["--noise", "2"], "--noise: noise must be in [0, 1] (per rad), got 2"),  # 'nan': not a number (the door's)
     (["--resolution", "4"], "--resolution: resolution must be in [0, pi] rad, got 4"),
     (["--slip", "2"], "--slip: expected a slip in [0, 1] (the standard deviation of a slip ratio), got 2"),
 ])

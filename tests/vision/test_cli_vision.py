@@ -101,8 +101,8 @@ def test_calibrate_prints_the_height_at_its_own_precision(capsys):
 @pytest.mark.parametrize(("x1", "x2", "size", "message"), [
     ("71.2357", "49.0727", ["0", "0"], "calibrate: --size: the image is 0 x 0 px, expected 8 to 4096 px a side"),
     ("71.2357", "49.0727", ["100000", "480"], "calibrate: --size: the image is 100000 x 480 px, expected 8 to 4096"),
-    ("nan", "49.0727", [], "--x1: x1 must be > 0, got nan"),
-    ("71.2357", "nan", [], "--x2: x2 must be > 0, got nan"),
+    ("0", "49.0727", [], "--x1: x1 must be > 0, got 0"),  # 'nan': refused as no number (test_option_units.py)
+    ("71.2357", "-1", [], "--x2: x2 must be > 0, got -1"),
 ])
 def test_calibrate_names_a_bad_size_or_measurement(x1, x2, size, message, tmp_path, capsys):
     """'--size 0 0' said 'A must be below 0 px and x1, x2 below 0 px', '--size 100000 480' was refused after the

@@ -207,7 +207,7 @@ def test_a_camera_too_noisy_to_see_the_line_is_an_error_with_its_reason(capsys):
 
 
 @pytest.mark.parametrize("option, named", [
-    (["--image-noise", "nan"], "image_noise (--image-noise): image noise must be in [0, 255] grey levels"),
+    (["--image-noise", "300"], "image_noise (--image-noise): image noise must be in [0, 255] grey levels"),
     (["--image-noise", "-1"], "image_noise (--image-noise): image noise must be in [0, 255] grey levels"),
     (["--blur", "60"], "blur (--blur): expected a blur in [0, 50] px (a Gaussian sigma), got 60"),
     (["--clutter", "1000"], "clutter (--clutter): clutter must be an integer in [0, 100] blobs, got 1000"),
