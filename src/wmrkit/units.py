@@ -15,7 +15,7 @@ from typing import Literal
 
 from ._numbers import NUMBER
 
-Kind = Literal["length", "angle", "speed", "angular rate", "time", "number"]
+Kind = Literal["length", "angle", "speed", "angular rate", "time", "frequency", "number"]
 
 #: Factor to SI for every unit accepted, by kind.
 UNITS: dict[str, dict[str, float]] = {
@@ -27,11 +27,13 @@ UNITS: dict[str, dict[str, float]] = {
     "angular rate": {"rad/s": 1.0, "mrad/s": 1e-3, "deg/s": math.pi / 180, "°/s": math.pi / 180,
                      "rpm": 2 * math.pi / 60, "rev/s": 2 * math.pi, "turn/s": 2 * math.pi},
     "time": {"s": 1.0, "ms": 1e-3, "us": 1e-6, "\u00b5s": 1e-6, "ns": 1e-9},
+    "frequency": {"Hz": 1.0, "kHz": 1e3},
     "number": {},
 }
-_SI = {"length": "m", "angle": "rad", "speed": "m/s", "angular rate": "rad/s", "time": "s", "number": ""}
+_SI = {"length": "m", "angle": "rad", "speed": "m/s", "angular rate": "rad/s", "time": "s", "frequency": "Hz",
+       "number": ""}
 #: The units whose factor is 1, or no decimal (pi's, 1/3.6): a quantity in them is the number times the factor.
-_NOT_DECIMAL = ("m", "rad", "deg", "°", "turn", "m/s", "km/h", "rad/s", "deg/s", "°/s", "rpm", "rev/s", "turn/s", "s")
+_NOT_DECIMAL = ("m", "rad", "deg", "°", "turn", "m/s", "km/h", "rad/s", "deg/s", "°/s", "rpm", "rev/s", "turn/s", "s", "Hz")
 #: The units whose factor is a decimal number, exactly: a quantity in them is read as the decimal it is ("9 mm" is
 #: 0.009, the float nearest 9e-3), not as the product of two rounded floats (9 * 1e-3 = 0.009000000000000001):
 #: every unit of UNITS but those of _NOT_DECIMAL, its factor as the decimal it was written as (repr gives it back).
@@ -128,7 +130,7 @@ def _a(kind: str) -> str:
 def _example(kind: Kind) -> str:
     return {"length": "'0.25' or '250 mm'", "angle": "'1.57' or '90 deg'", "speed": "'0.5' or '500 mm/s'",
             "angular rate": "'0.5' or '30 deg/s' or '60 rpm'", "time": "'0.01' or '10 ms'",
-            "number": "'0.5'"}[kind]
+            "frequency": "'20' or '1 kHz'", "number": "'0.5'"}[kind]
 
 
 #: A CSV column name carrying its unit in brackets: ``time [ms]``, ``left.spin [N m]``.
@@ -143,5 +145,5 @@ def split_unit(column: str) -> tuple[str, str] | None:
 
 
 def si_unit(kind: Kind) -> str:
-    """The SI unit wmrkit uses inside for `kind` ("m", "rad", "m/s", "rad/s", "s" or "")."""
+    """The SI unit wmrkit uses inside for `kind` ("m", "rad", "m/s", "rad/s", "s", "Hz" or "")."""
     return _SI[kind]

@@ -28,11 +28,13 @@ STRIPES = ["vision", "calibrate", "--rows", "100", "--half-separation", "0.1", "
 TIMES = [(TRACK, "--duration", 1), (TRACK, "--period", 1), (SIMULATE, "--duration", 1), (SIMULATE, "--step", 1),
          (ODOMETRY, "--max-gap", 1), (FOLLOW, "--period", 1), (FOLLOW, "--duration", 1),
          (["odometry", "mecanum-4", LOG, "--method", "fk1"], "--kf-period", 1)]
-#: ... and of those whose value is a bare number (counts, gains, pixels, probabilities, Hz, noise coefficients).
+#: ... of those whose value is a frequency [Hz, or 'kHz'] ...
+FREQUENCIES = [(MONTECARLO, "--rate", 1)]
+#: ... and of those whose value is a bare number (counts, gains, pixels, probabilities, noise coefficients).
 NUMBERS = [([*ODOMETRY, "--covariance"], "--crowley", 3), (ODOMETRY, "--cpr", 1), (ODOMETRY, "--gear", 1),
            (["odometry", "mecanum-4", LOG, "--method", "fk1"], "--kf-noise", 3),
            (["batch", "calibrate", "mecanum-4", LOG, "--workers", "0"], "--level", 1), (MONTECARLO, "--noise", 1),
-           (MONTECARLO, "--slip", 1), (MONTECARLO, "--rate", 1), (STRIPES, "--rows", 1), (STRIPES, "--x1", 1),
+           (MONTECARLO, "--slip", 1), (STRIPES, "--rows", 1), (STRIPES, "--x1", 1),
            (STRIPES, "--x2", 1), (FOLLOW, "--gain", 1), (FOLLOW, "--image-noise", 1), (FOLLOW, "--blur", 1)]
 
 
@@ -51,21 +53,26 @@ def _given(option: str, count: int, value: str) -> list[str]:
     return [option, *["1"] * (count - 1), value]
 
 
+def _kind(case: tuple) -> str:
+    return "a time" if case in TIMES else "a frequency" if case in FREQUENCIES else "a number"
+
+
 @pytest.mark.parametrize("case", [(*c, k) for c in TIMES for k in ("2 deg", "0.5 m")] +
-                         [(*c, k) for c in NUMBERS for k in ("2 s", "2 deg")], ids=lambda c: f"{_ids(c)} {c[3]}")
+                         [(*c, k) for c in NUMBERS + FREQUENCIES for k in ("2 s", "2 deg")],
+                         ids=lambda c: f"{_ids(c)} {c[3]}")
 def test_a_unit_of_another_kind_is_refused_in_one_line_naming_the_option(case, capsys):
     argv, option, count, value = case
-    kind = "a time" if (argv, option, count) in TIMES else "a number"
+    kind = _kind((argv, option, count))
     code, out, err = _run([*argv, *_given(option, count, value)], capsys)
     assert (code, out) == (2, ""), err
     assert err.count("\n") == 1 and err.startswith(f"wmrkit: error: {option}: '{value}' is "), err
     assert err.endswith(f", expected {kind}\n"), err
 
 
-@pytest.mark.parametrize("case", TIMES + NUMBERS, ids=_ids)
+@pytest.mark.parametrize("case", TIMES + NUMBERS + FREQUENCIES, ids=_ids)
 def test_text_that_is_no_number_is_refused_with_the_house_message_under_json_too(case, capsys):
     argv, option, count = case
-    kind = "a time" if case in TIMES else "a number"
+    kind = _kind(case)
     for text in ("abc", "nan"):
         code, out, err = _run([*argv, *_given(option, count, text), "--json"], capsys)
         assert (code, out, err.count("\n")) == (2, "", 1), err
@@ -81,8 +88,9 @@ def test_text_that_is_no_number_is_refused_with_the_house_message_under_json_too
     ([*ODOMETRY, "--json"], ["--max-gap", "500 ms"], ["--max-gap", "0.5"]),
     ([*ODOMETRY, "--json"], ["--max-gap", "1ms"], ["--max-gap", "0.001"]),  # refused: the log's steps are longer
     ([*FOLLOW, "--json"], ["--period", "500ms", "--duration", "1 s"], ["--period", "0.5", "--duration", "1"]),
+    ([*MONTECARLO, "-n", "2", "--quiet", "--json"], ["--rate", "0.05 kHz"], ["--rate", "50"]),
 ], ids=["track --duration", "track --period", "simulate", "odometry --max-gap", "odometry --max-gap refused",
-        "follow-line"])
+        "follow-line", "montecarlo --rate"])
 def test_a_time_with_its_unit_gives_the_run_of_the_bare_seconds(argv, with_unit, bare, capsys):
     bare_run = _run([*argv, *bare], capsys)
     assert bare_run[0] in (0, 2) and (bare_run[1] or bare_run[2]), bare_run  # an answer, or a refusal of the log

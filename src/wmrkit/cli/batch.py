@@ -100,8 +100,8 @@ def add_parsers(commands: argparse._SubParsersAction) -> None:
     p.add_argument("--resolution", metavar="ANGLE", default="0", help="encoder resolution [rad or deg] (default 0)")
     p.add_argument("--slip", type=quantity("number", "--slip"), default=0.0, metavar="STD",
                    help="std of a run's wheel slip ratio (default 0: no slip)")
-    p.add_argument("--rate", type=quantity("number", "--rate"), metavar="HZ",
-                   help="sample rate of a built-in path [Hz, a bare number] (default 20)")
+    p.add_argument("--rate", type=quantity("frequency", "--rate"), metavar="HZ",
+                   help="sample rate of a built-in path [Hz, or with a unit: '1 kHz'] (default 20)")
     p.add_argument("--seed", type=seed, default=0, help="random seed of the runs (default 0)")
     p.add_argument("--method", choices=METHODS, default="exact",
                    help=f"integration scheme: {SCHEMES_HELP} (default: exact)")
