@@ -21,6 +21,7 @@ FACTORS = {
     "angular rate": {"rad/s": 1.0, "mrad/s": 0.001, "deg/s": math.pi / 180, "°/s": math.pi / 180,
                      "rpm": 2 * math.pi / 60, "rev/s": 2 * math.pi, "turn/s": 2 * math.pi},
     "time": {"s": 1.0, "ms": 0.001, "us": 1e-6, "\u00b5s": 1e-6, "ns": 1e-9},
+    "frequency": {"Hz": 1.0, "kHz": 1000.0},
 }
 
 
@@ -30,8 +31,8 @@ def _kind(unit: str) -> str:
 
 def test_the_unit_tables_are_the_documented_ones():
     assert {k: set(v) for k, v in UNITS.items()} == {**{k: set(v) for k, v in FACTORS.items()}, "number": set()}
-    assert [si_unit(k) for k in ("length", "angle", "speed", "angular rate", "time", "number")] == [
-        "m", "rad", "m/s", "rad/s", "s", ""]
+    assert [si_unit(k) for k in ("length", "angle", "speed", "angular rate", "time", "frequency", "number")] == [
+        "m", "rad", "m/s", "rad/s", "s", "Hz", ""]
 
 
 @pytest.mark.parametrize(("text", "kind", "si"), [
@@ -41,7 +42,8 @@ def test_the_unit_tables_are_the_documented_ones():
     ("1500 mrad", "angle", 1.5), ("-0.5rad", "angle", -0.5), ("+.5 rad", "angle", 0.5),
     ("-45 deg", "angle", -math.pi / 4), ("3.6 km/h", "speed", 1.0), ("500 mm/s", "speed", 0.5),
     ("10 mph", "speed", 4.4704), ("60 rpm", "angular rate", 2 * math.pi), ("30 deg/s", "angular rate", math.pi / 6),
-    ("-0.5 rev/s", "angular rate", -math.pi), ("1e3", "angular rate", 1000.0),
+    ("-0.5 rev/s", "angular rate", -math.pi), ("1e3", "angular rate", 1000.0), ("1.5 kHz", "frequency", 1500.0),
+    ("20Hz", "frequency", 20.0),
     (3, "angle", 3.0), (0.25, "length", 0.25), ("0.5", "number", 0.5), (-2, "number", -2.0),
 ])
 def test_examples(text, kind, si):
@@ -129,7 +131,8 @@ def test_micrometres_are_read(text):
 DECIMAL_FACTORS = {"mm": "0.001", "cm": "0.01", "dm": "0.1", "km": "1000", "um": "0.000001", "\u00b5m": "0.000001",
                    "\u03bcm": "0.000001", "in": "0.0254", "ft": "0.3048", "mrad": "0.001", "mm/s": "0.001",
                    "cm/s": "0.01", "mph": "0.44704", "ft/s": "0.3048", "in/s": "0.0254", "mrad/s": "0.001",
-                   "ms": "0.001", "us": "0.000001", "\u00b5s": "0.000001", "ns": "0.000000001"}
+                   "ms": "0.001", "us": "0.000001", "\u00b5s": "0.000001", "ns": "0.000000001",
+                   "kHz": "1000"}
 
 
 @pytest.mark.parametrize("unit", sorted(DECIMAL_FACTORS))

@@ -33,7 +33,8 @@ UNITS: dict[str, dict[str, float]] = {
 _SI = {"length": "m", "angle": "rad", "speed": "m/s", "angular rate": "rad/s", "time": "s", "frequency": "Hz",
        "number": ""}
 #: The units whose factor is 1, or no decimal (pi's, 1/3.6): a quantity in them is the number times the factor.
-_NOT_DECIMAL = ("m", "rad", "deg", "°", "turn", "m/s", "km/h", "rad/s", "deg/s", "°/s", "rpm", "rev/s", "turn/s", "s", "Hz")
+_NOT_DECIMAL = ("m", "rad", "deg", "°", "turn", "m/s", "km/h", "rad/s", "deg/s", "°/s", "rpm", "rev/s", "turn/s", "s",
+                "Hz")
 #: The units whose factor is a decimal number, exactly: a quantity in them is read as the decimal it is ("9 mm" is
 #: 0.009, the float nearest 9e-3), not as the product of two rounded floats (9 * 1e-3 = 0.009000000000000001):
 #: every unit of UNITS but those of _NOT_DECIMAL, its factor as the decimal it was written as (repr gives it back).
