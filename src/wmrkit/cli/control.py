@@ -409,7 +409,8 @@ def warn_infeasible(verdict: Feasibility | None, end: float | None = None, *, in
     run did not stop, and the line says so (it read as contradicting the 1e-10 m errors the run printed); `turns`:
     a line per stretch tighter than the steering stops allow too (``track`` says them itself)."""
     broken: dict[tuple[str, tuple[float, ...]], list[str]] = {}
-    table = [v for v in verdict.violations if v not in tight_turns(verdict)] if verdict else []  # said apart
+    tight = tight_turns(verdict)
+    table = [v for v in verdict.violations if v not in tight] if verdict else []  # the tight turns: said apart
     for kind, remedy in dict.fromkeys((v.kind, v.remedy) for v in table):
         times = tuple(v.t for v in table if (v.kind, v.remedy) == (kind, remedy))
         broken.setdefault((remedy, times), []).append(kind)
@@ -421,8 +422,8 @@ def warn_infeasible(verdict: Feasibility | None, end: float | None = None, *, in
              f"'{verdict.requirement.column}' for the tracked point, {verdict.requirement.framework} framework): "
              f"{' and '.join(kinds)} at t = {', '.join(f'{t:.4g}' for t in times[:5])} s{more}{stop}: {remedy}"
              + (INSTANT_NOTE if instant and remedy.startswith("stop and re-orient the orientable wheel") else ""))
-    for tight in tight_turns(verdict) if turns else ():
-        warn(f"{tight_words(tight, 'the tracked point')}: the robot cannot follow this reference")
+    for v in tight if turns else ():
+        warn(f"{tight_words(v, 'the tracked point')}: the robot cannot follow this reference")
 
 
 def run_feasibility(args: argparse.Namespace) -> int:

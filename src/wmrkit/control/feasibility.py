@@ -163,7 +163,7 @@ class Feasibility:
     @property
     def continuous(self) -> bool:
         """Table 8.1's own verdict: no continuity violation (a :class:`TightTurn` is none)."""
-        return not any(not isinstance(v, TightTurn) for v in self.violations)
+        return all(isinstance(v, TightTurn) for v in self.violations)
 
     def to_dict(self) -> dict[str, object]:
         """``{"feasible", "continuous", "column", "type", "framework", "signals", "violations": [...]}`` (the CLI's

@@ -54,9 +54,9 @@ def min_turning_radius(robot: Robot) -> float:
 
 def _from_rear_axle(robot: Robot, point: ArrayLike) -> tuple[float, float]:
     """`point` ``(x, y)`` [m, robot frame] from the rear axle's midpoint."""
-    rear = [w for w in robot.wheels if w.type == "fixed"]
-    mx = sum(w.l * math.cos(w.alpha) for w in rear) / len(rear)
-    my = sum(w.l * math.sin(w.alpha) for w in rear) / len(rear)
+    from ..parking.problem import rear_axle_midpoint
+
+    mx, my = rear_axle_midpoint(robot)
     px, py = (float(c) for c in point)  # type: ignore[union-attr]
     return px - mx, py - my
 

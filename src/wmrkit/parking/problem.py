@@ -197,8 +197,8 @@ def car_axles(robot: Robot) -> tuple[float, float]:
     if len(rear) == 2 and abs(rear[0][0] - rear[1][0]) > tol:
         raise WmrkitError(f"robot '{robot.name}': its fixed wheels are not on one axle (x = {rear[0][0]:.6g} and "
                           f"{rear[1][0]:.6g} m): a car has one rear axle")
-    rx, ry = (sum(p[0] for p in rear) / len(rear), sum(p[1] for p in rear) / len(rear))
-    fx, fy = (sum(p[0] for p in front) / len(front), sum(p[1] for p in front) / len(front))
+    rx, ry = _midpoint(rear)
+    fx, fy = _midpoint(front)
     track = math.dist(rear[0], rear[1]) if len(rear) == 2 else 0.0
     wheelbase = fx - rx
     if wheelbase <= tol:
@@ -227,6 +227,15 @@ def _axles(robot: Robot) -> tuple[list[tuple[float, float]], list[tuple[float, f
     return [xy(w) for w in fixed], [xy(w) for w in steer], fixed
 
 
+def rear_axle_midpoint(robot: Robot) -> tuple[float, float]:
+    """P_f, the midpoint of a car-like `robot`'s rear axle (its fixed wheels) [m, robot frame]."""
+    return _midpoint(_axles(robot)[0])
+
+
+def _midpoint(points: list[tuple[float, float]]) -> tuple[float, float]:
+    return sum(p[0] for p in points) / len(points), sum(p[1] for p in points) / len(points)
+
+
 def curvature_limit(robot: Robot) -> float:
     """Largest path curvature of P_f [1/m] the car-like `robot`'s steerable wheels reach within their
     ``steer_range`` (either root of (8.9): a wheel may also roll reversed), turning either way; inf without ranges.
@@ -237,7 +246,7 @@ def curvature_limit(robot: Robot) -> float:
     """
     rear, front, _ = _axles(robot)
     car_axles(robot)
-    rx, ry = (sum(p[0] for p in rear) / len(rear), sum(p[1] for p in rear) / len(rear))
+    rx, ry = _midpoint(rear)
     limit = math.inf
     for w, (x, y) in zip([w for w in robot.wheels if w.type == "steerable"], front, strict=True):
         if w.steer_range is None or w.steer_range[1] - w.steer_range[0] >= math.pi:  # one root always fits

@@ -29,6 +29,7 @@ import math
 import numpy as np
 
 from ..errors import WmrkitError
+from ..odometry.model import wrap_angle
 
 #: A turn [rad] that no noise and no lag can fake: legs turning less are not judged.
 TURN = 0.5
@@ -144,5 +145,5 @@ def _direction_difference(ref: np.ndarray, odo: np.ndarray, href: np.ndarray, a:
         mid = 0.5 * (heading[a] + heading[b])
         c, s = np.cos(mid), np.sin(mid)
         angles.append(np.arctan2(c * d[:, 1] - s * d[:, 0], c * d[:, 0] + s * d[:, 1]))
-    off = np.abs(np.angle(np.exp(1j * (angles[0] - angles[1])[judged])))
+    off = np.abs(wrap_angle((angles[0] - angles[1])[judged]))
     return float(np.degrees(np.median(off)))
