@@ -57,7 +57,7 @@ def _fixed_ring(n: int, sensed: int) -> Robot:
 
 @pytest.mark.skipif(GCC is None, reason="gcc not installed")
 def test_the_forward_model_of_many_wheels_runs_on_a_32_kib_stack(tmp_path):
-    """48 fixed wheels sensing 3 spins: 96 rows x 48 unknowns, a 56 KB workspace. Before: SIGSEGV (exit -11) in a
+    """48 fixed wheels sensing 3 spins: 96 rows x 48 unknowns, a 57 KB workspace. Before: SIGSEGV (exit -11) in a
     thread of 32 KiB. Now both forward and forward_work answer the least-squares twist and residual (4.11), checked
     against numpy's lstsq of the numeric constraint matrix."""
     robot = _fixed_ring(48, 3)

@@ -105,18 +105,22 @@ def _head(path: Path) -> list[str]:
 
 # ---- C ---------------------------------------------------------------------------------------------------
 _C_LSTSQ = """\
-/* The norm of column j of A, m x n row-major. */
-static double hypot_norm(int m, int n, const double *a, int j)
+/* The norms of columns first..n-1 of A, m x n row-major, into s[first..n-1]. A plain sum of squares (hypot at every
+ * entry cost 4 us a call for a swerve-4): the decision matrix's entries are lengths over the robot's size, unit
+ * vectors and coupling ratios (at most 1e6), so no square overflows, and one below 1e-154 is far under the cut-off. */
+static void column_norms(int m, int n, int first, const double *a, double *s)
 {
-    double s = 0.0;
-    for (int i = 0; i < m; ++i) s = hypot(s, a[i * n + j]);
-    return s;
+    for (int j = first; j < n; ++j) {
+        double t = 0.0;
+        for (int i = 0; i < m; ++i) t += a[i * n + j] * a[i * n + j];
+        s[j] = sqrt(t);
+    }
 }
 
 /* One-sided Jacobi (Hestenes) on columns first..n-1 of A, m x n row-major, rotated until orthogonal and
- * overwritten with A V = U S (column j is u_j s_j); V (n x n) accumulates the rotations. Returns the rank of those
- * columns by wmrkit's rule: their norms s_j above *cut = RANK_RTOL * max(s_max, 1) (linalg.rank_cutoff). */
-static int jacobi_rank(int m, int n, int first, double *a, double *v, double *cut)
+ * overwritten with A V = U S (column j is u_j s_j); V (n x n) accumulates the rotations, s[j] gets s_j. Returns the
+ * rank of those columns by wmrkit's rule: s_j above *cut = RANK_RTOL * max(s_max, 1) (linalg.rank_cutoff). */
+static int jacobi_rank(int m, int n, int first, double *a, double *v, double *s, double *cut)
 {
     for (int sweep = 0, rotated = 1; rotated && sweep < 60; ++sweep) {
         rotated = 0;
@@ -130,60 +134,66 @@ static int jacobi_rank(int m, int n, int first, double *a, double *v, double *cu
             if (!(fabs(gamma) > 1e-15 * sqrt(alpha * beta))) continue; /* orthogonal to round-off */
             rotated = 1;
             const double zeta = (beta - alpha) / (2.0 * gamma);
-            const double t = (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + hypot(1.0, zeta));
-            const double c = 1.0 / sqrt(1.0 + t * t), s = c * t;
+            const double t = fabs(zeta) > 1e150 ? 0.5 / zeta /* the limit of the next form (zeta^2 overflows) */
+                : (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + sqrt(1.0 + zeta * zeta));
+            const double c = 1.0 / sqrt(1.0 + t * t), sn = c * t;
             for (int i = 0; i < m; ++i) {
                 const double x = a[i * n + p], y = a[i * n + q];
-                a[i * n + p] = c * x - s * y;
-                a[i * n + q] = s * x + c * y;
+                a[i * n + p] = c * x - sn * y;
+                a[i * n + q] = sn * x + c * y;
             }
             for (int i = 0; i < n; ++i) {
                 const double x = v[i * n + p], y = v[i * n + q];
-                v[i * n + p] = c * x - s * y;
-                v[i * n + q] = s * x + c * y;
+                v[i * n + p] = c * x - sn * y;
+                v[i * n + q] = sn * x + c * y;
             }
         }
     }
+    column_norms(m, n, first, a, s);
     double s_max = 0.0;
-    for (int j = first; j < n; ++j) s_max = hypot_norm(m, n, a, j) > s_max ? hypot_norm(m, n, a, j) : s_max;
+    for (int j = first; j < n; ++j) s_max = s[j] > s_max ? s[j] : s_max;
     *cut = RANK_RTOL * (s_max > 1.0 ? s_max : 1.0);
     int rank = 0;
-    for (int j = first; j < n; ++j) rank += hypot_norm(m, n, a, j) > *cut;
+    for (int j = first; j < n; ++j) rank += s[j] > *cut;
     return rank;
 }
 
-/* min |D y - b| with D m x n row-major (m >= n >= 3, the twist's 3 columns first; overwritten) and v (n x n) work:
- * y = V S^+ U^T b, singular values at or below the cut-off dropped, as wmrkit's fk. Returns 0, or -1 if the twist
- * is not determined: rank D != 3 + rank of D's other columns (wmrkit's twist_is_determined); then y is not set.
- * *residual (if not NULL) = |D y - b|. The rotations of D's other columns keep the column space: D's rank follows. */
-static int lstsq(int m, int n, double *d, const double *b, double *v, double *y, double *residual)
+/* b_i less row i of D (n entries) times c: entry i of the part of b the kept columns do not reach. */
+static double unreached(int n, const double *row, double b_i, const double *c)
+{
+    for (int k = 0; k < n; ++k) b_i -= row[k] * c[k];
+    return b_i;
+}
+
+/* min |D y - b| with D m x n row-major (m >= n >= 3, the twist's 3 columns first; overwritten), v (n x n) and
+ * s, c (n) work: y = V S^+ U^T b, singular values at or below the cut-off dropped, as wmrkit's fk. Returns 0, or -1
+ * if the twist is not determined: rank D != 3 + rank of D's other columns (wmrkit's twist_is_determined); then y is
+ * not set. *residual (if not NULL) = |D y - b|. The rotations of D's other columns keep the column space: D's rank
+ * follows. */
+static int lstsq(int m, int n, double *d, const double *b, double *v, double *s, double *c, double *y,
+                 double *residual)
 {
     double cut;
     for (int i = 0; i < n; ++i) for (int j = 0; j < n; ++j) v[i * n + j] = i == j;
-    const int joints = jacobi_rank(m, n, 3, d, v, &cut);
-    if (jacobi_rank(m, n, 0, d, v, &cut) != 3 + joints) return -1;
+    const int joints = jacobi_rank(m, n, 3, d, v, s, &cut);
+    if (jacobi_rank(m, n, 0, d, v, s, &cut) != 3 + joints) return -1;
     for (int j = 0; j < n; ++j) y[j] = 0.0;
-    for (int k = 0; k < n; ++k) {
-        const double s = hypot_norm(m, n, d, k);
-        if (!(s > cut)) continue;
-        double ub = 0.0; /* u_k . b */
-        for (int i = 0; i < m; ++i) ub += d[i * n + k] * b[i] / s;
-        for (int j = 0; j < n; ++j) y[j] += v[j * n + k] * (ub / s);
+    for (int k = 0; k < n; ++k) { /* c_k = u_k . b / s_k, as a multiple of column k (u_k s_k): 0 if dropped */
+        c[k] = 0.0;
+        if (!(s[k] > cut)) continue;
+        double ub = 0.0;
+        for (int i = 0; i < m; ++i) ub += d[i * n + k] * b[i];
+        c[k] = ub / (s[k] * s[k]);
+        for (int j = 0; j < n; ++j) y[j] += v[j * n + k] * c[k];
     }
-    if (residual) { /* |b - U U^T b|: the part of b no kept column reaches */
-        double r = 0.0;
-        for (int i = 0; i < m; ++i) {
-            double e = b[i];
-            for (int k = 0; k < n; ++k) {
-                const double s = hypot_norm(m, n, d, k);
-                if (!(s > cut)) continue;
-                double ub = 0.0;
-                for (int l = 0; l < m; ++l) ub += d[l * n + k] * b[l];
-                e -= d[i * n + k] * ub / (s * s);
-            }
-            r = hypot(r, e);
+    if (residual) { /* |b - U U^T b|, the part of b no kept column reaches, scaled by its largest entry */
+        double big = 0.0, r = 0.0;
+        for (int i = 0; i < m; ++i) big = fmax(big, fabs(unreached(n, d + i * n, b[i], c)));
+        if (big > 0.0) for (int i = 0; i < m; ++i) {
+            const double e = unreached(n, d + i * n, b[i], c) / big;
+            r += e * e;
         }
-        *residual = r;
+        *residual = big * sqrt(r);
     }
     return 0;
 }
@@ -227,7 +237,7 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
     beta_param = f"const double heading[{p}_N_STEER]" if plan.beta else "const double *heading"
     rows, na = plan.a.rows, len(plan.unknown_names)
     sizes = {"N_STEER": len(plan.beta), "N_RATES": len(plan.rates), "N_SENSED": len(plan.sensed),
-             "N_ROWS": rows, "N_VEL": plan.a.cols, "N_UNKNOWN": na, "N_WORK": rows * na + na * na + rows + na}
+             "N_ROWS": rows, "N_VEL": plan.a.cols, "N_UNKNOWN": na, "N_WORK": rows * na + na * na + rows + 3 * na}
     on_stack = sizes["N_WORK"] <= MAX_STACK_WORK
     steer_param = ""
     if plan.free_steer:  # double wheels: their steering rates are inputs of the inverse model
@@ -307,7 +317,7 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
         f"{'' if on_stack else f' /* {work_bytes} bytes: too many for small stacks; not reentrant */'}",
         f"    return {n}_forward_work(sensed, heading, twist, residual, work);", "}", "",
         protos[3][:-1], "{",
-        f"    double *a = work, *b = work + {p}_N_ROWS * {p}_N_UNKNOWN, *y = b + {p}_N_ROWS, *v = y + {na};",
+        f"    double *a = work, *b = work + {p}_N_ROWS * {p}_N_UNKNOWN, *y = b + {p}_N_ROWS, *v = y + {na}, *s = v + {na} * {na}, *c = s + {na};",
         _c_unpack(plan, sensed=True),
         f"    /* unknowns: {_c_comment(', '.join(plan.unknown_names))} */",
         _c_body(plan, a_na + b, fw_targets),
@@ -319,7 +329,7 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
         f"        row[2] = {d[2][2]!r} * row[2] + {d[0][2]!r} * row[0] + {d[1][2]!r} * row[1];",
         f"        for (int j = 3; j < {na}; ++j) row[j] *= {d[2][2]!r};",
         "    }",
-        f"    if (status == 0) status = lstsq({p}_N_ROWS, {na}, a, b, v, y, residual);",
+        f"    if (status == 0) status = lstsq({p}_N_ROWS, {na}, a, b, v, s, c, y, residual);",
         "    if (status == 0) { /* the unknowns from the decision matrix's */",
         f"        twist[0] = y[0] + {d[0][2]!r} * y[2];",
         f"        twist[1] = y[1] + {d[1][2]!r} * y[2];",
