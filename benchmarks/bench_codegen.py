@@ -1,8 +1,8 @@
 """Generated C against WPILib's C++, per call, in compiled loops: the code a controller embeds.
 
 wmrkit: ``wmrkit kinematics ROBOT --codegen c``, ``NAME_forward`` (sensed spins and steering headings to the
-least-squares twist, its slip residual and the rank decision of ``fk``) and ``NAME_inverse`` (twist to wheel rates
-at given headings), compiled with ``cc -O2``. WPILib (the C++ library inside robotpy-wpimath, headers and shared
+least-squares twist with the rank decision of ``fk``; ``forward+slip`` also its slip residual, which WPILib does not
+give) and ``NAME_inverse`` (twist to wheel rates at given headings), compiled with ``cc -O2``. WPILib (the C++ library inside robotpy-wpimath, headers and shared
 libraries of its ``native`` packages, ``g++ -O2``): ``SwerveDriveKinematics<4>::ToChassisSpeeds`` from module
 states built from the angles (a ``Rotation2d`` each, as from encoders), ``MecanumDriveKinematics`` and
 ``DifferentialDriveKinematics`` ``ToChassisSpeeds`` / ``ToWheelSpeeds``. Same catalog robots, same 1024 inputs
@@ -74,7 +74,10 @@ def _ours_driver(n: int) -> str:
         h = f"{x}_h + k * {p}_N_STEER" if len(steered) else "NULL"
         loops.append(_LOOP.format(
             warm=n // 10, n=n, mask=SAMPLES - 1, label=f"{r}:forward", body=(
-                f"double tw[3], res; {x}_forward({x}_q + k * {p}_N_SENSED, {h}, tw, &res); acc += tw[0] + tw[2];")))
+                f"double tw[3]; {x}_forward({x}_q + k * {p}_N_SENSED, {h}, tw, NULL); acc += tw[0] + tw[2];")))
+        loops.append(_LOOP.format(
+            warm=n // 10, n=n, mask=SAMPLES - 1, label=f"{r}:forward+slip", body=(
+                f"double tw[3], res; {x}_forward({x}_q + k * {p}_N_SENSED, {h}, tw, &res); acc += tw[0] + res;")))
         loops.append(_LOOP.format(
             warm=n // 10, n=n, mask=SAMPLES - 1, label=f"{r}:inverse", body=(
                 f"double q[{p}_N_RATES]; {x}_inverse({x}_t + 3 * k, {h}, q); acc += q[0];")))
@@ -114,7 +117,8 @@ def _peer_driver(n: int) -> str:
         "diff-drive:inverse": f"auto w = dd.ToWheelSpeeds({chassis.replace('{x}', 'diff_drive')}); "
                               "acc += w.left.value();",
     }
-    loops = [_LOOP.format(warm=n // 10, n=n, mask=SAMPLES - 1, label=label, body=body) for label, body in bodies.items()]
+    loops = [_LOOP.format(warm=n // 10, n=n, mask=SAMPLES - 1, label=label, body=body)
+             for label, body in bodies.items()]
     for r, obj, arg in (("swerve-4", "sw", f"wpi::array<frc::SwerveModuleState, 4>{{{sw_state}}}"),
                         ("mecanum-4", "me", me_speeds), ("diff-drive", "dd", dd_speeds)):
         loops.append("    { const int k = 0; " + f"auto c = {obj}.ToChassisSpeeds({arg}); "
@@ -138,7 +142,7 @@ def _parse(out: str) -> tuple[dict[str, float], dict[str, np.ndarray]]:
 
 def _native(name: str) -> Path | None:
     spec = importlib.util.find_spec(f"native.{name}") if importlib.util.find_spec("native") else None
-    return Path(list(spec.submodule_search_locations)[0]) if spec and spec.submodule_search_locations else None
+    return Path(next(iter(spec.submodule_search_locations))) if spec and spec.submodule_search_locations else None
 
 
 def _run_peer(work: Path, n: int) -> str | None:
@@ -173,6 +177,7 @@ def run(quick: bool) -> list[Result]:
     for r, tw in their_twists.items():  # the same job: the same twist from the same wheel readings
         if not np.allclose(our_twists[r], tw, rtol=1e-9, atol=1e-9):
             raise AssertionError(f"{r}: generated C twist {our_twists[r]} but WPILib {tw}")
-    return [Result(f"generated C: {label.replace(':', ' ')}", 1, seconds, "WPILib C++", theirs.get(label),
-                   "ratio >= 1" if label in theirs or peer_out is None else "no peer")
+    return [Result(f"generated C: {label.replace(':', ' ')}", 1, seconds,
+                   "WPILib C++" if label in theirs or peer_out is None else "none (WPILib has no such call)",
+                   theirs.get(label), "ratio >= 1" if label in theirs or peer_out is None else "")
             for label, seconds in ours.items() if not math.isnan(seconds)]

@@ -23,11 +23,13 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Literal
 
+import numpy as np
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
 from ..robot import Robot
 from . import _codegen_linkage, _codegen_steer_gear
+from ._codegen_fixed import c_fixed_forward, fixed_decision_matrix
 from ._codegen_plan import C_KEYWORDS, CodegenError, Plan, cse, identifier
 from ._codegen_python import python_file
 from .gear_check import GEAR_RTOL
@@ -104,6 +106,16 @@ def _head(path: Path) -> list[str]:
 
 
 # ---- C ---------------------------------------------------------------------------------------------------
+_C_UNREACHED = """\
+/* b_i less row i of D (n entries) times c: entry i of the part of b the kept columns do not reach. */
+static double unreached(int n, const double *row, double b_i, const double *c)
+{
+    for (int k = 0; k < n; ++k) b_i -= row[k] * c[k];
+    return b_i;
+}
+
+"""
+
 _C_LSTSQ = """\
 /* The norms of columns first..n-1 of A, m x n row-major, into s[first..n-1]. A plain sum of squares (hypot at every
  * entry cost 4 us a call for a swerve-4): the decision matrix's entries are lengths over the robot's size, unit
@@ -156,13 +168,6 @@ static int jacobi_rank(int m, int n, int first, double *a, double *v, double *s,
     int rank = 0;
     for (int j = first; j < n; ++j) rank += s[j] > *cut;
     return rank;
-}
-
-/* b_i less row i of D (n entries) times c: entry i of the part of b the kept columns do not reach. */
-static double unreached(int n, const double *row, double b_i, const double *c)
-{
-    for (int k = 0; k < n; ++k) b_i -= row[k] * c[k];
-    return b_i;
 }
 
 /* min |D y - b| with D m x n row-major (m >= n >= 3, the twist's 3 columns first; overwritten), v (n x n) and
@@ -230,6 +235,45 @@ def _c_unpack(plan: Plan, sensed: bool = False, twist: bool = False) -> str:
     names += [f"b{i}" for i in range(len(plan.beta))] or ["heading"]
     lines.append("    " + " ".join(f"(void){n};" for n in names))
     return "\n".join(lines)
+
+
+def _c_forward_body(plan: Plan, fixed: np.ndarray | None) -> list[str]:
+    """``NAME_forward_work``'s body: ``A_na`` and ``b`` at the headings, the decision matrix's least squares by the
+    Jacobi SVD, or, for a robot without steering angles (``fixed``: its constant decision matrix), ``b`` alone and
+    the least squares factored when the code was generated (:mod:`._codegen_fixed`)."""
+    p, na = plan.name.upper(), len(plan.unknown_names)
+    a_na, b = plan.forward_exprs()
+    d = plan.decide.tolist()
+    head = [f"    double *a = work, *b = work + {p}_N_ROWS * {p}_N_UNKNOWN, *y = b + {p}_N_ROWS, *v = y + {na}, "
+            f"*s = v + {na} * {na}, *c = s + {na};",
+            _c_unpack(plan, sensed=True),
+            f"    /* unknowns: {_c_comment(', '.join(plan.unknown_names))} */"]
+    if fixed is not None:
+        return [*head, "    (void)a; (void)y; (void)v; (void)s; (void)c;",
+                _c_body(plan, b, [f"b[{i}]" for i in range(len(b))]),
+                "    int status = 0; /* a NaN or inf input: -1 */",
+                f"    for (int i = 0; i < {p}_N_ROWS; ++i) if (!isfinite(b[i])) status = -1;",
+                *c_fixed_forward(fixed, np.array(d, dtype=float), p), "}", ""]
+    return [
+        *head,
+        _c_body(plan, a_na + b, [f"a[{k}]" for k in range(len(a_na))] + [f"b[{i}]" for i in range(len(b))]),
+        "    int status = 0; /* a NaN or inf input: -1 */",
+        f"    for (int i = 0; i < {p}_N_ROWS * ({na} + 1); ++i) if (!isfinite(work[i])) status = -1;",
+        "    /* the library's decision matrix: lengths over the robot's size, the twist of the wheels' centroid */",
+        f"    for (int i = 0; i < {p}_N_ROWS; ++i) {{",
+        f"        double *row = a + i * {na};",
+        f"        row[2] = {d[2][2]!r} * row[2] + {d[0][2]!r} * row[0] + {d[1][2]!r} * row[1];",
+        f"        for (int j = 3; j < {na}; ++j) row[j] *= {d[2][2]!r};",
+        "    }",
+        f"    if (status == 0) status = lstsq({p}_N_ROWS, {na}, a, b, v, s, c, y, residual);",
+        "    if (status == 0) { /* the unknowns from the decision matrix's */",
+        f"        twist[0] = y[0] + {d[0][2]!r} * y[2];",
+        f"        twist[1] = y[1] + {d[1][2]!r} * y[2];",
+        f"        twist[2] = {d[2][2]!r} * y[2];",
+        "    }",
+        "    else for (int i = 0; i < 3; ++i) twist[i] = (double)NAN;",
+        "    if (status != 0 && residual) *residual = NAN;",
+        "    return status;", "}", ""]
 
 
 def _c_files(plan: Plan) -> list[tuple[str, str]]:
@@ -301,14 +345,14 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
         f"#endif /* {p}_KINEMATICS_H */", "",
     ])
     a_targets = [f"a[{i * plan.a.cols + j}]" for i in range(plan.a.rows) for j in range(plan.a.cols)]
-    a_na, b = plan.forward_exprs()
-    d = plan.decide.tolist()
-    fw_targets = [f"a[{k}]" for k in range(len(a_na))] + [f"b[{i}]" for i in range(len(b))]
+    fixed = fixed_decision_matrix(plan)
     source = "\n".join([
         f"/* {n}_kinematics.c: generated by wmrkit from robot '{_c_comment(r.name)}'; see {n}_kinematics.h. */",
         "#include <math.h>", f'#include "{n}_kinematics.h"', "",
-        f"static const double RANK_RTOL = {RANK_RTOL!r}; /* wmrkit.kinematics.linalg.RANK_RTOL: its rank rule */", "",
-        _C_LSTSQ,
+        f"static const double RANK_RTOL = {RANK_RTOL!r}; /* wmrkit.kinematics.linalg.RANK_RTOL: its rank rule */"
+        if fixed is None else f"/* the forward model's rank rule (RANK_RTOL = {RANK_RTOL!r}) applied when generated */",
+        "",
+        _C_UNREACHED + ("" if fixed is not None else _C_LSTSQ),
         protos[0][:-1], "{", _c_unpack(plan), _c_body(plan, list(plan.a), a_targets), "}", "",
         protos[1][:-1], "{", _c_unpack(plan, twist=True),
         _c_body(plan, plan.inverse, [f"rates[{i}]" for i in range(len(plan.rates))], list(plan.rates)), "}", "",
@@ -316,28 +360,7 @@ def _c_files(plan: Plan) -> list[tuple[str, str]]:
         f"    {'' if on_stack else 'static '}double work[{p}_N_WORK];"
         f"{'' if on_stack else f' /* {work_bytes} bytes: too many for small stacks; not reentrant */'}",
         f"    return {n}_forward_work(sensed, heading, twist, residual, work);", "}", "",
-        protos[3][:-1], "{",
-        f"    double *a = work, *b = work + {p}_N_ROWS * {p}_N_UNKNOWN, *y = b + {p}_N_ROWS, *v = y + {na}, *s = v + {na} * {na}, *c = s + {na};",
-        _c_unpack(plan, sensed=True),
-        f"    /* unknowns: {_c_comment(', '.join(plan.unknown_names))} */",
-        _c_body(plan, a_na + b, fw_targets),
-        "    int status = 0; /* a NaN or inf input: -1 */",
-        f"    for (int i = 0; i < {p}_N_ROWS * ({na} + 1); ++i) if (!isfinite(work[i])) status = -1;",
-        "    /* the library's decision matrix: lengths over the robot's size, the twist of the wheels' centroid */",
-        f"    for (int i = 0; i < {p}_N_ROWS; ++i) {{",
-        f"        double *row = a + i * {na};",
-        f"        row[2] = {d[2][2]!r} * row[2] + {d[0][2]!r} * row[0] + {d[1][2]!r} * row[1];",
-        f"        for (int j = 3; j < {na}; ++j) row[j] *= {d[2][2]!r};",
-        "    }",
-        f"    if (status == 0) status = lstsq({p}_N_ROWS, {na}, a, b, v, s, c, y, residual);",
-        "    if (status == 0) { /* the unknowns from the decision matrix's */",
-        f"        twist[0] = y[0] + {d[0][2]!r} * y[2];",
-        f"        twist[1] = y[1] + {d[1][2]!r} * y[2];",
-        f"        twist[2] = {d[2][2]!r} * y[2];",
-        "    }",
-        "    else for (int i = 0; i < 3; ++i) twist[i] = (double)NAN;",
-        "    if (status != 0 && residual) *residual = NAN;",
-        "    return status;", "}", "", *_c_in_gear(plan, protos[4] if plan.geared else ""),
+        protos[3][:-1], "{", *_c_forward_body(plan, fixed), *_c_in_gear(plan, protos[4] if plan.geared else ""),
         *_codegen_linkage.c_in_linkage(plan, protos[-2] if steer_geared else protos[-1]),
         *_codegen_steer_gear.c_in_steer_gear(plan, protos[-1]),
     ])
