@@ -36,8 +36,10 @@ class Result:
 
 
 def _time(seconds: float) -> str:
-    """Milliseconds, or microseconds below one millisecond (single calls)."""
-    return f"{seconds * 1e3:9.2f} ms" if seconds >= 1e-3 else f"{seconds * 1e6:9.2f} us"
+    """Milliseconds, microseconds below one millisecond (single calls), nanoseconds below one microsecond."""
+    if seconds >= 1e-3:
+        return f"{seconds * 1e3:9.2f} ms"
+    return f"{seconds * 1e6:9.2f} us" if seconds >= 1e-6 else f"{seconds * 1e9:9.2f} ns"
 
 
 def best_time(fn: Callable[[], object], *, repeat: int = 3) -> float:

@@ -1,16 +1,20 @@
-"""The generated C forward model of robots without steering angles: the least squares factored when the code is
-generated (kinematics._codegen_fixed), checked against the library's fk and twist_is_determined, and the generated
-Python, on every branch: determined, never determined, non-finite input, a reading with slip."""
+"""The generated C forward model whose least squares is factored when the code is generated (robots without steering
+angles, or whose steered rows are absorbed: kinematics._codegen_fixed), checked against the library's fk and the
+generated Python, on every branch: determined, never determined, non-finite input, a reading with slip."""
 
 from __future__ import annotations
 
 import ctypes
+from dataclasses import replace
 
 import numpy as np
 import pytest
+import sympy as sp
 from test_codegen import GCC, _ptr, compile_c, load_module
 
 from wmrkit import Robot, catalog
+from wmrkit.kinematics._codegen_fixed import _bound
+from wmrkit.kinematics._codegen_plan import Plan
 from wmrkit.kinematics.codegen import write_code
 from wmrkit.kinematics.symbolic import sensed_rates
 from wmrkit.kinematics.wheel_ik import forward_kinematics
@@ -71,3 +75,79 @@ def test_huge_readings_keep_a_finite_residual(tmp_path):
     assert status == 0
     np.testing.assert_allclose(tw, small_tw * 1e200, rtol=1e-12)
     assert res == pytest.approx(small_res * 1e200, rel=1e-12)
+
+
+def test_a_diff_drives_castor_rows_are_absorbed_at_every_heading(tmp_path):
+    """The catalog diff-drive: its castor's steering and spin rates (not sensed) absorb the castor's rows, so the
+    forward model is one map of the wheels' rows, whatever the castor's heading: fk's twist at random castor
+    headings (fk solves the whole system), and -1 for a heading that is not finite, as the generated Python."""
+    robot = catalog.load("diff-drive")
+    _, source = write_code(robot, "c", tmp_path / "src")
+    assert "the rows kept: 0, 1, 2, 3 of 6" in source.read_text()
+    lib, ident = compile_c(robot, tmp_path)
+    forward = getattr(lib, f"{ident}_forward")
+    forward.restype = ctypes.c_int
+    rng = np.random.default_rng(3)
+    for heading, q in zip(rng.uniform(-np.pi, np.pi, 50), rng.normal(0, 10, (50, 2)), strict=True):
+        tw, res = np.zeros(3), ctypes.c_double(-1.0)
+        assert forward(_ptr(q), _ptr(np.array([heading])), _ptr(tw), ctypes.byref(res)) == 0
+        fk_twist, fk_slip = forward_kinematics(robot, {"left.spin": q[0], "right.spin": q[1]}, heading=[heading])
+        np.testing.assert_allclose(tw, fk_twist, rtol=1e-12, atol=1e-12)
+        assert res.value == pytest.approx(float(fk_slip), abs=1e-12)
+    tw = np.zeros(3)
+    assert forward(_ptr(np.array([1.0, 2.0])), _ptr(np.array([np.nan])), _ptr(tw), None) == -1
+    assert np.isnan(tw).all()
+
+
+def test_a_castor_too_short_to_absorb_its_rows_is_left_to_the_run_time_svd(tmp_path):
+    """A castor offset of 1 um on a 0.3 m robot: its block's least singular value (d over the robot's size, 3e-6)
+    is too close to the rank rule's cut-off to prove every heading keeps it, so the Jacobi SVD decides at run time
+    (and still gives fk's twist)."""
+    base = catalog.load("diff-drive")
+    robot = replace(base, name="short-castor", wheels=tuple(
+        replace(w, d=1e-6) if w.type == "castor" else w for w in base.wheels))
+    _, source = write_code(robot, "c", tmp_path / "src")
+    assert "factored when" not in source.read_text() and "jacobi_rank" in source.read_text()
+    lib, ident = compile_c(robot, tmp_path)
+    status, tw, _ = _forward_at(lib, ident, np.array([4.0, 6.0]), np.array([0.4]))
+    fk_twist, _ = forward_kinematics(robot, {"left.spin": 4.0, "right.spin": 6.0}, heading=[0.4])
+    assert status == 0  # D's condition number is about 1 / 3e-6: the two SVDs agree to about 3e5 ulp
+    np.testing.assert_allclose(tw, fk_twist, rtol=1e-9, atol=1e-10)
+
+
+def _forward_at(lib, ident: str, q: np.ndarray, heading: np.ndarray) -> tuple[int, np.ndarray, float]:
+    forward = getattr(lib, f"{ident}_forward")
+    forward.restype = ctypes.c_int
+    tw, res = np.zeros(3), ctypes.c_double(-1.0)
+    return forward(_ptr(q), _ptr(heading), _ptr(tw), ctypes.byref(res)), tw, res.value
+
+
+def test_the_least_singular_value_bound_of_absorbed_rows():
+    """The lemma the absorption rests on: D = [[P, 0], [Q, B]] has least singular value at least
+    s_P s_B / (s_P + s_B + |Q|) (random blocks, some nearly singular)."""
+    rng = np.random.default_rng(5)
+    for _ in range(2000):
+        m, n, k = rng.integers(3, 7), 3, rng.integers(1, 4)
+        p = rng.normal(size=(m, n)) * rng.choice([1.0, 1e-3], size=n)
+        b = rng.normal(size=(k, k)) * rng.choice([1.0, 1e-2], size=k)
+        q = rng.normal(size=(k, n)) * rng.choice([0.1, 1.0, 30.0])
+        d = np.block([[p, np.zeros((m, k))], [q, b]])
+        s_p, s_b = np.linalg.svd(p, compute_uv=False)[-1], np.linalg.svd(b, compute_uv=False)[-1]
+        bound = s_p * s_b / (s_p + s_b + np.linalg.norm(q, 2))
+        assert np.linalg.svd(d, compute_uv=False)[-1] >= bound * (1 - 1e-12)
+
+
+@pytest.mark.parametrize("name", ["forklift", "swerve-4", "diff-drive"])
+def test_the_entry_bound_holds_at_every_sampled_heading(name):
+    """_bound(e) >= |e(heading)| for every entry of A_na (sines and cosines of the steering angles) at random
+    steering angles: the q of the absorption's lower bound."""
+    plan = Plan(catalog.load(name), None)
+    a_na, _ = plan.forward_exprs()
+    rng = np.random.default_rng(11)
+    samples = rng.uniform(-np.pi, np.pi, (200, len(plan.beta)))
+    for e in a_na:
+        bound = _bound(e)
+        assert bound is not None
+        f = sp.lambdify(plan.beta, e, "numpy")
+        values = np.abs(np.broadcast_to(f(*samples.T), (len(samples),)))
+        assert values.max() <= bound + 1e-12
