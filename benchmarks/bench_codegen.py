@@ -9,7 +9,8 @@ inside robotpy-wpimath, headers and shared libraries of its ``native`` packages,
 from encoders), ``MecanumDriveKinematics`` and ``DifferentialDriveKinematics`` ``ToChassisSpeeds`` /
 ``ToWheelSpeeds``. Same catalog robots, same 1024 inputs cycled, the twists checked equal. No timing from Python:
 each driver times its own loop (steady clock). Target: no slower than WPILib per call (ratio >= 1). The catalog's
-diff-drive has a castor: its inverse gives the castor's rates too, where WPILib's template ignores the castor.
+diff-drive has a castor: its inverse gives the castor's rates too, where WPILib's template ignores the castor. The
+forklift (no peer) is the run-time Jacobi SVD's case: its steered wheel's rows carry the twist.
 """
 
 from __future__ import annotations
@@ -26,11 +27,12 @@ import numpy as np
 
 from wmrkit import catalog, wheel_commands
 from wmrkit.kinematics.codegen import identifier, write_code
+from wmrkit.kinematics.symbolic import sensed_rates
 
 from ._harness import Result
 
 SAMPLES = 1024
-ROBOTS = ("swerve-4", "mecanum-4", "diff-drive")
+ROBOTS = ("swerve-4", "mecanum-4", "diff-drive", "forklift")  # the forklift (a tricycle) has no WPILib peer
 
 
 def _inputs(robot_name: str) -> dict[str, np.ndarray]:
@@ -69,7 +71,8 @@ def _ours_driver(n: int) -> str:
     for r in ROBOTS:
         x, p, data = identifier(r), identifier(r).upper(), _inputs(r)
         steered = np.flatnonzero([w.kind.steers for w in catalog.load(r).wheels])
-        sensed = [i for i, w in enumerate(catalog.load(r).wheels) if w.type != "castor"]
+        names = [w.name for w in catalog.load(r).wheels]
+        sensed = [names.index(n.split(".")[0]) for n in sensed_rates(catalog.load(r))]  # spins, in its order
         parts += [_c_array(f"{x}_q", data["spin"][:, sensed]), _c_array(f"{x}_h", data["heading"][:, steered]),
                   _c_array(f"{x}_t", data["twist"])]
         h = f"{x}_h + k * {p}_N_STEER" if len(steered) else "NULL"
@@ -96,7 +99,7 @@ def _peer_driver(n: int) -> str:
              "#include <frc/kinematics/DifferentialDriveKinematics.h>", "#include <chrono>", "#include <cstdio>",
              "static double now() { return std::chrono::duration<double>("
              "std::chrono::steady_clock::now().time_since_epoch()).count(); }"]
-    for r in ROBOTS:
+    for r in ROBOTS[:3]:
         data = _inputs(r)
         v = data["spin"] * data["r"]  # wheel speeds [m/s]
         parts += [_c_array(f"{identifier(r)}_v", v), _c_array(f"{identifier(r)}_t", data["twist"])]

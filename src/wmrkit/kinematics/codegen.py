@@ -192,7 +192,10 @@ static int lstsq(int m, int n, double *d, const double *b, double *v, double *s,
     }
     if (residual) { /* |b - U U^T b|, the part of b no kept column reaches, scaled by its largest entry */
         double big = 0.0, r = 0.0;
-        for (int i = 0; i < m; ++i) big = fmax(big, fabs(unreached(n, d + i * n, b[i], c)));
+        for (int i = 0; i < m; ++i) {
+            const double e = fabs(unreached(n, d + i * n, b[i], c));
+            big = e > big ? e : big;
+        }
         if (big > 0.0) for (int i = 0; i < m; ++i) {
             const double e = unreached(n, d + i * n, b[i], c) / big;
             r += e * e;
