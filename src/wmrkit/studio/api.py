@@ -26,13 +26,14 @@ from ..analysis.optimize import isotropic_configurations
 from ..analysis.singularity import SINGULAR_RTOL, robot_size, singularity_distance
 from ..analysis.summary import describe_singular, described_analysis, model_rates, model_singular_set, singular_dict
 from ..description import DescriptionWarning, accepted_fields, kind_of_type, robot_from_dict, robot_to_dict
+from ..documents import hint
 from ..dynamics.mass import inertia_joints
 from ..errors import ShapeError, WmrkitError, said_warnings
-from ..kinematics.wheel_ik import wheel_commands
+from ..kinematics.wheel_ik import rate_kind, wheel_commands
 from ..limits import MAX_QUERY_RATE
 from ..odometry.integrators import integrate_exact
-from ..robot import Robot
-from ..units import UnitError, parse_quantity
+from ..robot import TWIST_NAMES, Robot
+from ..units import Kind, UnitError, parse_quantity
 from ..wheels import KINDS
 
 #: Distance to singularity (``sigma_min / sigma_max`` of the constraint lines, 6.17) below which the page warns.
@@ -210,7 +211,9 @@ def kappa_map(request: Any) -> dict[str, Any]:
     names = request.get("wheels", list(steer[:2]))
     if (not isinstance(names, list) or not 1 <= len(names) <= 2 or any(n not in steer for n in names)
             or len(set(names)) != len(names)):  # a wheel twice: its second angle overwrote the first axis
-        raise StudioError(f"wheels: one or two different steering wheels of {', '.join(steer)}")
+        other = next((n for n in names if n not in steer), None) if isinstance(names, list) else None
+        said = f"{hint(other, steer)}" if isinstance(other, str) and len(other) <= 80 else ""
+        raise StudioError(f"wheels: one or two different steering wheels of {', '.join(steer)}{said}")
     res = _integer(request.get("resolution", 72), "resolution", 8, MAX_RESOLUTION)
     axis = np.linspace(-np.pi, np.pi, res, endpoint=False)
     grids = np.meshgrid(*([axis] * len(names)), indexing="ij")
@@ -241,15 +244,14 @@ def drive(request: Any) -> dict[str, Any]:
     """
     check_fields(request, "description", "twist", "heading", "duration", "samples")
     robot = robot_of(request)
-    twist = np.array(_numbers(request.get("twist"), "twist", 3))
-    if np.abs(twist).max() > MAX_QUERY_RATE:
-        raise StudioError(f"twist: beyond {MAX_QUERY_RATE:g} (m/s or rad/s), no wheeled robot moves so fast")
+    twist = _twist(request.get("twist"))
     steering = request.get("heading", {})
     if not isinstance(steering, Mapping):
         raise StudioError("heading: a mapping {steering wheel: heading [rad]}")
     unknown = [n for n in steering if n not in robot.steer_names]
     if unknown:
-        raise StudioError(f"heading: '{unknown[0][:80]}' is not a steering wheel of '{robot.name}' "
+        raise StudioError(f"heading: '{unknown[0][:80]}' is not a steering wheel of '{robot.name}'"
+                          f"{hint(unknown[0][:80], robot.steer_names)} "
                           f"(steering: {', '.join(robot.steer_names) or 'none'})")
     current = robot.heading.copy()
     for name, value in steering.items():  # an angle: "30 deg" accepted, a bare number beyond a turn refused
@@ -274,7 +276,7 @@ def drive(request: Any) -> dict[str, Any]:
     scale = max(1.0, float(np.abs(twist[:2]).sum() + abs(twist[2]) * robot_size(robot)))
     slips = not residual <= 1e-9 * scale
     out_of_range = [w.name for w, ok in zip(robot.wheels, c.in_range.tolist(), strict=True) if not ok]
-    duration = float(_numbers([request.get("duration", 4.0)], "duration", 1)[0])
+    duration = _quantity(request.get("duration", 4.0), "time", "duration")
     samples = _integer(request.get("samples", 120), "samples", 2, 2000)
     if not 0 < duration <= 600:
         raise StudioError(f"duration: between 0 and 600 s, got {duration}")
@@ -319,7 +321,8 @@ def check_fields(request: Any, *fields: str) -> None:
         raise StudioError("the request body must be a JSON object")
     unknown = [k for k in request if k not in fields]
     if unknown:
-        raise StudioError(f"unknown field {unknown[0][:80]!r} (this request takes {', '.join(fields)})")
+        word = unknown[0][:80]
+        raise StudioError(f"unknown field {word!r}{hint(word, fields)} (this request takes {', '.join(fields)})")
 
 
 def _field(request: Any, key: str, kind: type) -> Any:
@@ -333,22 +336,33 @@ def _field(request: Any, key: str, kind: type) -> Any:
     return value
 
 
-def _numbers(value: Any, what: str, n: int) -> list[float]:
-    if not isinstance(value, list | tuple) or len(value) != n:
-        raise StudioError(f"{what}: expected a list of {n} numbers")
-    out = []
-    for v in value:
-        try:
-            x = parse_quantity(v, "number") if isinstance(v, str) else v
-        except UnitError as err:
-            raise StudioError(f"{what}: {err}") from None
-        if isinstance(x, bool) or not isinstance(x, int | float) or not math.isfinite(x):
-            raise StudioError(f"{what}: expected finite numbers, got {v!r}")
-        out.append(float(x))
-    return out
+def _twist(value: Any) -> np.ndarray:
+    """``[vx, vy, omega]``: SI numbers, or each with a unit of its kind as ``wmrkit ik --twist`` reads them
+    (``"500 mm/s"``, ``"30 deg/s"``), within :data:`MAX_QUERY_RATE`; a refusal names the component."""
+    if not isinstance(value, list) or len(value) != 3:
+        raise StudioError("twist: expected a list [vx, vy, omega] of 3 numbers (m/s, m/s, rad/s)")
+    twist = np.array([_quantity(v, rate_kind(name), f"twist.{name}") for name, v in zip(TWIST_NAMES, value)])
+    if np.abs(twist).max() > MAX_QUERY_RATE:
+        name = TWIST_NAMES[int(np.abs(twist).argmax())]
+        raise StudioError(f"twist.{name}: beyond {MAX_QUERY_RATE:g} (m/s or rad/s), no wheeled robot moves so fast")
+    return twist
+
+
+def _quantity(value: Any, kind: Kind, what: str) -> float:
+    """`value` in SI (a number, or a string with a unit of `kind`); a :class:`StudioError` naming `what`."""
+    try:
+        return parse_quantity(value, kind)
+    except UnitError as err:
+        raise StudioError(f"{what}: {err}") from None
 
 
 def _integer(value: Any, what: str, lo: int, hi: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
-        raise StudioError(f"{what}: an integer from {lo} to {hi}, got {value!r}")
+        raise StudioError(f"{what}: an integer from {lo} to {hi}, got {_shown(value)}")
     return value
+
+
+def _shown(value: Any) -> str:
+    """`value` quoted for a message: at most 40 characters (a request may hold a value of a megabyte)."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
