@@ -106,3 +106,17 @@ def test_a_huge_value_is_quoted_short(client, endpoint, body):
     """samples of 100,000 digits was quoted whole in the error line."""
     r = client.post(endpoint, json={"description": desc("swerve-4"), **body})
     assert r.status_code == 400 and len(r.json()["error"]) < 200, r.json()["error"][:300]
+
+
+def test_another_host_name_is_refused_in_json(tmp_path):
+    """The DNS-rebinding refusal was Starlette's plain text 'Invalid host header', not the studio's JSON error
+    naming the host and the names it answers; the security headers stay."""
+    from wmrkit.studio.app import LOCAL_HOSTS
+
+    app = create_app(tmp_path, allowed_hosts=LOCAL_HOSTS)
+    r = TestClient(app, base_url="http://evil.example:8765").get("/api/meta")
+    assert r.status_code == 400 and r.headers["content-type"] == "application/json", r.text
+    assert r.json()["error"].startswith("host 'evil.example:8765' refused: the studio answers only 127.0.0.1,")
+    assert r.headers["x-frame-options"] == "DENY"
+    for base in ("http://127.0.0.1:8765", "http://[::1]:8765", "http://LOCALHOST"):
+        assert TestClient(app, base_url=base).get("/api/files").status_code == 200, base

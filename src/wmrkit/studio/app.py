@@ -161,9 +161,7 @@ def create_app(root: str | Path = ".", robot: Robot | None = None, *, robot_spec
     ]
     middleware = [Middleware(_SecurityHeaders)]
     if allowed_hosts is not None:
-        from starlette.middleware.trustedhost import TrustedHostMiddleware
-
-        middleware.append(Middleware(TrustedHostMiddleware, allowed_hosts=allowed_hosts))
+        middleware.append(Middleware(_HostCheck, allowed_hosts=allowed_hosts))
     return Starlette(routes=routes, middleware=middleware, exception_handlers={HTTPException: http_error})
 
 
@@ -188,6 +186,45 @@ class _SecurityHeaders:
             await send(message)
 
         await self.app(scope, receive, with_headers)
+
+
+class _HostCheck:
+    """Starlette's ``TrustedHostMiddleware`` (only the ``Host`` names `allowed_hosts`: against DNS rebinding), its
+    refusal answered as every other mistake, ``{"error": ...}`` naming the host and the names answered (it was the
+    plain text 'Invalid host header')."""
+
+    def __init__(self, app, allowed_hosts: list[str]) -> None:
+        from starlette.middleware.trustedhost import TrustedHostMiddleware
+
+        self.app, self.allowed = app, allowed_hosts
+        self.check = TrustedHostMiddleware(self._passed, allowed_hosts=allowed_hosts, www_redirect=False)
+
+    async def _passed(self, scope, receive, send) -> None:
+        scope["wmrkit.host_passed"] = True
+        await self.app(scope, receive, send)
+
+    async def __call__(self, scope, receive, send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        answer = send
+
+        async def refused(message) -> None:  # the check's own plain-text answer: replaced below
+            if not scope.get("wmrkit.host_passed"):
+                return
+            await answer(message)
+
+        await self.check(scope, receive, refused)
+        if not scope.get("wmrkit.host_passed"):
+            from starlette.datastructures import Headers
+            from starlette.responses import Response
+
+            host = Headers(scope=scope).get("host", "")
+            shown = repr(host) if len(host) <= 80 else repr(host[:77] + "...")
+            message = (f"host {shown} refused: the studio answers only {', '.join(dict.fromkeys(self.allowed))} "
+                       "(a web site whose name leads here must not reach it; docs/studio.md)")
+            body = json.dumps({"error": message}, ensure_ascii=True)
+            await Response(body, status_code=400, media_type="application/json")(scope, receive, send)
 
 
 async def _read_json(request) -> Any:
