@@ -1274,3 +1274,29 @@ def test_a_kappa_map_is_asked_only_of_the_description_analysed(page):
     pg.evaluate("refresh()")
     settle(pg)
     assert pg.evaluate("S.kappa") is None  # omni-3 does not steer: no map
+
+
+def test_what_analyze_says_of_the_type_is_shown(page, server):
+    """omni-3 with two wheels on a 1:2 gear showed 'm = 3, s = 0' where `wmrkit analyze` says 'its gear couplings
+    leave m = 2'; two steered wheels on a parallel linkage showed 'm = 1, s = 2' without analyze's line on what the
+    linkage leaves ('only 2 ICRs ...; the type is of the wheels alone') nor 'its steering linkages command d = 1'."""
+    pg = page
+    _, root = server
+    geared = catalog.load("omni-3").to_dict()
+    geared["couplings"] = [{"kind": "gear", "joints": ["front_left.spin", "back.spin"], "ratios": [1, 2]}]
+    linked = catalog.load("thesis-two-steer-castor").to_dict()
+    linked["couplings"] = [{"kind": "linkage", "joints": ["o1.steer", "o2.steer"], "ratios": [1, 1], "law": "parallel"}]
+    for name, d, said in (("geared.json", geared, ["its gear couplings leave m = 2 (couplings)"]),
+                          ("linked.json", linked, ["with its steering linkages held: m = 1, d = 0: only 2 ICRs",
+                                                   "its steering linkages command d = 1"])):
+        text = analyze(robot_from_dict(d)).format_text()
+        open_file(pg, root, name, d)
+        cell = pg.inner_text("#a-ms")
+        for words in said:
+            assert words in text
+            assert words.replace("command d =", "command s =") in cell, cell
+        under = [line.strip() for line in text.splitlines()[1:] if line.startswith("  with its steering linkages")]
+        assert all(line in cell for line in under), (under, cell)
+    open_catalog(pg, "swerve-4")  # nothing to add
+    assert pg.inner_text("#a-ms") == "m = 1, s = 2; steering must be coordinated"
+    assert not pg.errors

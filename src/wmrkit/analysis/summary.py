@@ -114,14 +114,25 @@ class Analysis:
         how = "natural length" if self.natural else "given length"
         return f"{self.condition_number:.4g} at the {how} D = {self.characteristic_length:.4g} m"
 
+    def gears_note(self) -> str | None:
+        """What the type line adds when gear couplings leave fewer motions than the wheels (None otherwise)."""
+        g = self.gear_mobility
+        return None if g is None else f"its gear couplings leave m = {g} (couplings)"
+
+    def linkage_note(self) -> str | None:
+        """The line under the type when held steering linkages leave the robot fewer ICRs than its wheels allow
+        (None otherwise): the type line is the wheels' geometry alone."""
+        if self.linked is None or self.linked.every:
+            return None
+        return f"{self.linked.describe()}; the type is of the wheels alone (thesis Table 5.1)"
+
     def format_text(self) -> str:
         """A concise terminal summary."""
         c, r = self.classification, self.robot
-        g = self.gear_mobility
-        gears = "" if g is None else f"; its gear couplings leave m = {g} (couplings)"
-        lines = [f"{r.name}: {c.describe()}{gears}"]
-        if self.linked is not None and not self.linked.every:  # the type line is the wheels' geometry alone
-            lines.append(f"  {self.linked.describe()}; the type is of the wheels alone (thesis Table 5.1)")
+        gears, linked = self.gears_note(), self.linkage_note()
+        lines = [f"{r.name}: {c.describe()}" + ("" if gears is None else f"; {gears}")]
+        if linked is not None:
+            lines.append(f"  {linked}")
         if self.instantaneous_mobility != c.mobility:
             lines.append(f"  at the described steering: m = {self.instantaneous_mobility}")
         lines += [f"  {s.description}" for s in c.special]

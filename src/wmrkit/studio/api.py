@@ -149,6 +149,9 @@ def live_summary(robot: Robot) -> dict[str, Any]:
         "condition_number": _finite(full["condition_number"]),  # inf (undetermined twist): null, as JSON has no inf
         "characteristic_length": _finite(full["characteristic_length"]),
         "isotropy_note": a.isotropy_note(),  # m <= 1, of the wheels or left by gears: no condition number to give
+        # what analyze says of the type beyond the wheels' m and d: the gears' m, the ICRs held linkages leave
+        "type_notes": [n for n in (a.gears_note(), a.linkage_note()) if n is not None],
+        "linkages": full["linkages"],
         "steering": dict(zip(robot.steer_names, robot.heading.tolist(), strict=True)),
         "singular_here": here,
     }
@@ -341,7 +344,7 @@ def _twist(value: Any) -> np.ndarray:
     (``"500 mm/s"``, ``"30 deg/s"``), within :data:`MAX_QUERY_RATE`; a refusal names the component."""
     if not isinstance(value, list) or len(value) != 3:
         raise StudioError("twist: expected a list [vx, vy, omega] of 3 numbers (m/s, m/s, rad/s)")
-    twist = np.array([_quantity(v, rate_kind(name), f"twist.{name}") for name, v in zip(TWIST_NAMES, value)])
+    twist = np.array([_quantity(v, rate_kind(n), f"twist.{n}") for n, v in zip(TWIST_NAMES, value, strict=True)])
     if np.abs(twist).max() > MAX_QUERY_RATE:
         name = TWIST_NAMES[int(np.abs(twist).argmax())]
         raise StudioError(f"twist.{name}: beyond {MAX_QUERY_RATE:g} (m/s or rad/s), no wheeled robot moves so fast")

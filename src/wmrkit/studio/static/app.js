@@ -613,7 +613,10 @@ function renderAnalysis() {
   setCell("a-ms", `m = ${a.mobility}, s = ${a.steerability}` +
     (a.instantaneous_mobility !== a.mobility ? ` (here m = ${a.instantaneous_mobility})` : "") +
     (a.coordinated_steering ? "; steering must be coordinated" : "") +
-    // the steering configurations where m is higher, as `wmrkit analyze` prints them under its type line
+    (a.commanded_steerability < a.steerability ? `; its steering linkages command s = ${a.commanded_steerability}` : "") +
+    // what `wmrkit analyze` says of the type beyond the wheels' m and s (the m gears leave, the ICRs linkages
+    // leave), then the steering configurations where m is higher, as it prints them under its type line
+    a.type_notes.map((n) => `<br><span class="hint">${esc(n)}</span>`).join("") +
     a.special_configurations.map((c) => `<br><span class="hint">${esc(c.description)}</span>`).join(""),
     [a.mobility, a.steerability]);
   setCell("a-degenerate", a.degenerate ? `<span class="bad">yes</span>: ${esc(a.reasons.join("; "))}`
