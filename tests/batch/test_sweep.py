@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import sys
 
 import numpy as np
@@ -282,3 +283,57 @@ def test_the_table_prints_angles_in_degrees(capsys):
     assert main([*argv, "--json"]) == 0
     axis = json.loads(capsys.readouterr().out)["axes"][0]
     assert axis["unit"] == "rad" and axis["start"] == pytest.approx(-math.pi / 6)
+
+
+def test_an_output_file_of_another_kind_is_refused_not_replaced(tmp_path):
+    """'sweep ... --out run.csv' replaced a joint log (any file not a sweep's table) with the table, exit 0; a
+    batch odometry table too. A sweep's own table is replaced, as before."""
+    pa = pytest.importorskip("pyarrow")
+    pq = pytest.importorskip("pyarrow.parquet")
+    robot = catalog.load("omni-3")
+    axes = [parse_vary("wheels[0].l=0.1:0.2:2", robot)]
+    log = tmp_path / "run.csv"
+    log.write_text("time,a.spin\n0,0\n")
+    with pytest.raises(BatchError, match=r"run\.csv: not a readable Parquet table"):
+        sweep(robot, axes, out=log)
+    assert log.read_text() == "time,a.spin\n0,0\n"
+    other = tmp_path / "fleet.parquet"
+    pq.write_table(pa.table({"log": ["a.csv"], "x": [1.0]}), other)
+    with pytest.raises(BatchError, match=r"fleet\.parquet: not a table of this command \(no column 'index'"):
+        sweep(robot, axes, out=other)
+    assert pq.read_table(other).column_names == ["log", "x"]
+    own = tmp_path / "s.parquet"
+    sweep(robot, axes, out=own)
+    sweep(robot, [parse_vary("wheels[1].l=0.1:0.3:3", robot)], out=own)  # a sweep's table: replaced
+    assert pq.read_table(own).num_rows == 3 and list(tmp_path.glob(".*.tmp")) == []
+
+
+def test_a_sweep_that_fails_leaves_no_temporary_file(tmp_path, monkeypatch):
+    """A chunk that raised left '.s.parquet.PID.tmp' behind, the half-written table, at every failed run."""
+    module = sys.modules["wmrkit.batch.sweep"]  # the module, not the function
+    robot = catalog.load("omni-3")
+
+    def broken(flat, spec):
+        raise RuntimeError("a worker's failure")
+
+    monkeypatch.setattr(module, "evaluate", broken)
+    with pytest.raises(RuntimeError, match="worker's failure"):
+        sweep(robot, [parse_vary("wheels[0].l=0.1:0.2:2", robot)], out=tmp_path / "s.parquet")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_misspelt_wheel_or_field_gets_a_suggestion():
+    robot = catalog.load("omni-3")
+    for bad, msg in [("wheels.bak.l=0:1:2", "no wheel 'bak' (did you mean 'back'?)"),
+                     ("wheels[0].alph=0:1:2", "'alph' is not a geometry field (did you mean 'alpha'?)"),
+                     ("wheels[0].radius=0:1:2", "did you mean 'r'?")]:
+        with pytest.raises(BatchError, match=re.escape(msg)):
+            parse_vary(bad, robot)
+
+
+def test_an_axis_of_a_wheel_the_robot_lacks_is_refused():
+    """An Axis made by hand for wheel 9 of a 3-wheel robot was swept as if it moved nothing (every design equal)."""
+    from wmrkit.batch.sweep_kernel import Axis
+
+    with pytest.raises(BatchError, match=r"wheels\[9\]\.r: the robot has 3 wheels"):
+        sweep(catalog.load("omni-3"), [Axis("wheels[9].r", ((9, "r"),), np.array([0.05, 0.1]))])

@@ -22,6 +22,7 @@ import numpy as np
 from .._shapes import readonly
 from ..robot import Robot
 from .engine import BatchError, Engine, engine, need_extra
+from .parquet import check_table
 from .sweep_kernel import METRICS, Axis, build_spec, evaluate
 
 #: Most designs x steering configurations evaluated in one chunk (4096 x 128, the documented example; the chunk is
@@ -30,6 +31,8 @@ MAX_CHUNK_COLUMNS = 2**19
 #: Most best designs kept and reported (``top``): they are kept in memory and sorted at every chunk, so a larger
 #: `top` made the memory grow with the number of designs (about 2 kB each); every design goes to ``out``.
 MAX_TOP = 10**4
+#: Columns every sweep table has besides its axes': an existing --out without them is not replaced.
+TABLE_KEYS = (("index", "int64"), ("metric", "float64"), ("length", "float64"))
 #: Whether a metric is better when smaller.
 LOWER_IS_BETTER = {"kappa_mean": True, "kappa_max": True, "inv_kappa_mean": False, "singular_margin": False}
 
@@ -103,11 +106,13 @@ def sweep(robot: Robot, axes: Sequence[Axis], metric: str = "kappa_mean", *, run
             key = np.where(np.isnan(values[:, 0]), np.inf if lower else -np.inf, values[:, 0])
             (np.minimum if lower else np.maximum).at(grid, sub, key)
             best = _keep_best(np.vstack([best, np.column_stack([index, values])]), top, lower)
+        if writer is not None:
+            writer.close()
     finally:
         if own:
             runner.close()
-    if writer is not None:
-        writer.close()
+        if writer is not None:  # a failed sweep left its half-written '.NAME.PID.tmp' behind
+            writer.abort()
     rows = []
     for idx, value, d in best:
         sub = np.unravel_index(int(idx), spec.shape)
@@ -165,6 +170,8 @@ class _Writer:
             raise BatchError(f"{self.path}: the folder {self.path.parent} does not exist")
         if self.path.is_dir():
             raise BatchError(f"{self.path}: a folder, not a file")
+        if self.path.exists():  # a log or another command's table was replaced without a word; a sweep's is replaced
+            check_table(self.path, TABLE_KEYS, [name for name, _ in TABLE_KEYS])
         names = [a.label for a in axes]
         if len(set(names)) != len(names):
             raise BatchError("two --vary axes have the same fields")
@@ -189,6 +196,11 @@ class _Writer:
     def close(self) -> None:
         self._w.close()
         os.replace(self.tmp, self.path)
+
+    def abort(self) -> None:
+        """Remove the temporary file of a sweep that did not finish (nothing once :meth:`close` renamed it)."""
+        self._w.close()
+        self.tmp.unlink(missing_ok=True)
 
 
 def plot_sweep(result: SweepResult, path: str | os.PathLike[str]) -> None:

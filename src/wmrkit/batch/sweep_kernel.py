@@ -79,6 +79,7 @@ class Axis:
 
 def parse_vary(text: str, robot: Robot) -> Axis:
     """An :class:`Axis` from ``FIELD[,FIELD...]=START:STOP:N`` (values with units, e.g. ``30deg``, ``250mm``)."""
+    from ..documents import hint
     from ..units import UnitError, parse_quantity
 
     lhs, sep, rng = text.partition("=")
@@ -93,12 +94,14 @@ def parse_vary(text: str, robot: Robot) -> Axis:
             raise BatchError(f"--vary {text}: '{item}' is not wheels.NAME.FIELD or wheels[I].FIELD")
         name, index, fld = m.groups()
         if name is not None and name not in names:
-            raise BatchError(f"--vary {text}: robot '{robot.name}' has no wheel '{name}' (wheels: {', '.join(names)})")
+            raise BatchError(f"--vary {text}: robot '{robot.name}' has no wheel '{name}'{hint(name, names)} "
+                             f"(wheels: {', '.join(names)})")
         i = names.index(name) if name is not None else int(index)
         if i >= len(names):
             raise BatchError(f"--vary {text}: wheel index {i} out of range (the robot has {len(names)} wheels)")
         if fld not in VARY_FIELDS:
-            raise BatchError(f"--vary {text}: '{fld}' is not a geometry field ({', '.join(VARY_FIELDS)})")
+            raise BatchError(f"--vary {text}: '{fld}' is not a geometry field{hint(fld, VARY_FIELDS)} "
+                             f"({', '.join(VARY_FIELDS)})")
         targets.append((i, fld))
         kinds.add(VARY_FIELDS[fld])
     if len(kinds) != 1:
@@ -181,6 +184,9 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
         raise BatchError(f"--configs must be in [1, {MAX_CONFIGS}] (a whole number), got {configs!r}")
     check_seed(seed, BatchError)  # -1 and 2.5 reached numpy's ValueError and TypeError
     targets = [t for a in axes for t in a.targets]
+    for a in axes:  # an Axis made by hand (parse_vary checks its own): a wheel beyond the robot's moved nothing
+        if any(not 0 <= i < len(robot.wheels) for i, _ in a.targets):
+            raise BatchError(f"--vary {a.label}: the robot has {len(robot.wheels)} wheels")
     if len(set(targets)) != len(targets) or any((i, "beta") in targets for i, f in targets if f == "heading") \
             or any((i, f) in targets for i, g in targets if g in ("x", "y") for f in ("l", "alpha")):
         raise BatchError("two --vary axes move the same field (one would overwrite the other; heading is beta - 90 "
