@@ -260,3 +260,26 @@ def test_one_path_where_a_sequence_is_expected_is_refused(diff, fleet_dir, calib
             batch_odometry(diff, logs)
     with pytest.raises(BatchError, match=r"paths: expected a sequence .* single path '.*c0\.csv'"):
         load_runs(diff, str(calibration_data / "c0.csv"), reference_dir=calibration_data / "ref")
+
+
+def test_a_log_whose_name_is_not_utf8_is_written_and_resumed(fleet_dir, diff, tmp_path):
+    """A log named with a byte that is not UTF-8 (an old Latin-1 file system) ended the batch in pyarrow's
+    UnicodeEncodeError when its row was written to --out (a traceback after the work); with --trajectories, two
+    such logs of one name in two folders raised it when their trajectory names were made."""
+    logs = []
+    for sub in ("a", "b"):
+        folder = os.fsencode(tmp_path / sub)
+        os.mkdir(folder)
+        with open(os.path.join(folder, b"cami\xf3n.csv"), "wb") as f:
+            f.write((fleet_dir / "run0.csv").read_bytes())
+        logs.append(os.fsdecode(os.path.join(folder, b"cami\xf3n.csv")))
+    out = tmp_path / "res.parquet"
+    first = batch_odometry(diff, logs, out=out, trajectories=tmp_path / "traj")
+    assert first.failed == 0 and len(first.rows) == 2
+    assert len({r["trajectory"] for r in first.rows}) == 2 and all(os.path.exists(r["trajectory"]) for r in first.rows)
+    table = pq.read_table(out).to_pylist()
+    assert [r["log"] for r in table] == [log.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+                                         for log in logs]  # the byte shown as an escape: cami\xf3n.csv
+    assert table[0]["x"] == first.rows[0]["x"]
+    again = batch_odometry(diff, logs, out=out, trajectories=tmp_path / "traj")
+    assert again.skipped == 2 and [r["x"] for r in again.rows] == [r["x"] for r in first.rows]

@@ -29,7 +29,7 @@ import numpy as np
 from ..odometry.logs import LogFormat
 from ..robot import Robot
 from .engine import BatchError, Engine, TaskFailure, engine
-from .parquet import RowSink, check_table, parts_dir, read_rows
+from .parquet import RowSink, check_table, parts_dir, read_rows, stored_text
 
 if TYPE_CHECKING:
     from ..odometry.diagnostics import Diagnosis, ImuCheck
@@ -372,18 +372,20 @@ def _done(out, robot: Robot, method: str, targets: Mapping[str, str | None],
     """Rows of an earlier run that need no redoing: same log, robot and method, made with the same settings
     (robot description, options, log file: ``settings``), no error, trajectory present."""
     keep: dict[str, Mapping[str, Any]] = {}
+    logs = {stored_text(p): p for p in targets}  # the table holds a name that is not UTF-8 as escapes
     for row in read_rows(out):
-        p = row.get("log")
-        if p not in targets or row.get("robot") != robot.name or row.get("method") != method:
+        p = logs.get(row.get("log"))
+        if p is None or row.get("robot") != robot.name or row.get("method") != method:
             continue
         if row.get("settings") != settings[p]:  # another geometry of the same name, --closed, --sensed, a new log
             keep.pop(p, None)
             continue
         want = targets[p]
-        if row.get("error") or (want is not None and (row.get("trajectory") != want or not Path(want).exists())):
+        if row.get("error") or (want is not None and (row.get("trajectory") != stored_text(want)
+                                                      or not Path(want).exists())):
             keep.pop(p, None)
             continue
-        keep[p] = row
+        keep[p] = row | {"log": p, "trajectory": want}
     return keep
 
 
@@ -419,7 +421,7 @@ def _trajectory_names(paths: Sequence[str], folder, fmt: str) -> dict[str, str |
     out = {}
     for p, stem in zip(paths, stems, strict=True):
         if stems.count(stem) > 1:
-            stem = f"{stem}-{hashlib.sha1(os.path.abspath(p).encode()).hexdigest()[:8]}"
+            stem = f"{stem}-{hashlib.sha1(os.fsencode(os.path.abspath(p))).hexdigest()[:8]}"  # a name not UTF-8 too
         out[p] = os.fspath(Path(folder) / f"{stem}.{fmt}")
     return out
 

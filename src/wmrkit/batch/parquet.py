@@ -33,12 +33,23 @@ def _schema(schema: Schema):
     return pa.schema(fields)
 
 
+def stored_text(value: Any) -> Any:
+    """`value` as a string column holds it: a file name's bytes that are not UTF-8 (read as lone surrogates, which
+    Parquet's UTF-8 strings cannot hold: pyarrow raised UnicodeEncodeError) written as escapes (``cami\\xf3n.csv``);
+    any other value unchanged."""
+    if isinstance(value, str):
+        return value.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    return value
+
+
 def write_rows(path: str | os.PathLike[str], rows: Sequence[Mapping[str, Any]], schema: Schema) -> None:
-    """Write `rows` (mappings of column -> value, None for null) as one Parquet file, atomically."""
+    """Write `rows` (mappings of column -> value, None for null) as one Parquet file, atomically; text that is not
+    UTF-8 is written as escapes (:func:`stored_text`)."""
     pa = need_extra("pyarrow")
     pq = need_extra("pyarrow.parquet")
     sch = _schema(schema)
-    table = pa.Table.from_pylist([{name: row.get(name) for name, _ in schema} for row in rows], schema=sch)
+    table = pa.Table.from_pylist([{name: stored_text(row.get(name)) for name, _ in schema} for row in rows],
+                                 schema=sch)
     path = Path(path)
     if path.parent and not path.parent.exists():
         raise BatchError(f"{path}: the folder {path.parent} does not exist")
