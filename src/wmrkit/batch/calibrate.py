@@ -51,6 +51,7 @@ from .motions import REFERENCE_NOISE, check_reference_noise
 from .runs import find_reference as find_reference  # read from log files (re-exported: their public home was here)
 from .runs import load_run as load_run
 from .runs import load_runs as load_runs
+from .runs import repeated_runs
 
 
 @dataclass(frozen=True)
@@ -223,6 +224,7 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
             raise BatchError("calibrate: a confidence interval needs at least two runs")
         notes = () if fit.success else (f"the fit did not converge ({' '.join(str(fit.message).split())}): the "
                                         "values are where it stopped",)
+        notes += repeated_runs(problem, fit.fun)
         if ci == "jacobian":
             lo, hi = _sandwich_interval(problem, fit, level)
         else:

@@ -4,6 +4,7 @@ name in a folder) or as a closed path (:func:`load_runs`, on the engine). :mod:`
 
 from __future__ import annotations
 
+import hashlib
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -108,3 +109,22 @@ def load_runs(robot: Robot, paths: Sequence[str], *, reference_dir: str | os.Pat
             raise BatchError(f"{p}: {run}" if p not in str(run) else str(run))
     return out
 
+
+
+def repeated_runs(problem, residuals: np.ndarray) -> tuple[str, ...]:
+    """A warning per run whose samples (times and joint positions) equal an earlier run's, a copy of one log or a link
+    to it under another name, when its residuals at the fit exceed round-off: one run's noise counted as two runs'
+    (3 of 6 runs copied narrowed an interval by 36 %). Runs that fit exactly (noise-free, simulated) change nothing
+    however often they are given, and are not named. `problem`: the fleet's ``CalibrationProblem``."""
+    from .consistency import ROUNDOFF, names, travel
+
+    logs, seen, said = names(problem.runs), {}, []
+    parts = np.split(np.asarray(residuals, dtype=float), np.cumsum(problem.sizes())[:-1])
+    for k, run in enumerate(problem.runs):
+        digest = hashlib.sha1(np.ascontiguousarray(run.log.time).tobytes()
+                              + np.ascontiguousarray(run.log.positions).tobytes()).hexdigest()
+        first = seen.setdefault(digest, k)
+        if first != k and np.sqrt(np.mean(parts[k] ** 2)) > ROUNDOFF * travel(problem.robot, run):
+            said.append(f"{logs[k]}: the same samples as {logs[first]} (a copy of one log, or a link to it): its "
+                        "noise is counted twice and the intervals are too narrow; give each log once")
+    return tuple(said)
