@@ -283,3 +283,14 @@ def test_a_log_whose_name_is_not_utf8_is_written_and_resumed(fleet_dir, diff, tm
     assert table[0]["x"] == first.rows[0]["x"]
     again = batch_odometry(diff, logs, out=out, trajectories=tmp_path / "traj")
     assert again.skipped == 2 and [r["x"] for r in again.rows] == [r["x"] for r in first.rows]
+
+
+def test_a_link_to_nothing_is_named_so(tmp_path):
+    """A link in a loop (or to a missing file) was 'no such file or folder', though ls lists it."""
+    (tmp_path / "loop.csv").symlink_to("loop.csv")
+    (tmp_path / "gone.csv").symlink_to(tmp_path / "missing.csv")
+    for name in ("loop.csv", "gone.csv"):
+        with pytest.raises(BatchError, match=rf"{name}: a symbolic link to nothing \(its target is missing, or a loop"):
+            expand_logs([tmp_path / name])
+    with pytest.raises(BatchError, match=r"missing\.csv: no such file or folder"):
+        expand_logs([tmp_path / "missing.csv"])

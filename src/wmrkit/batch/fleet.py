@@ -121,7 +121,8 @@ def expand_logs(patterns: Sequence[str | os.PathLike[str]]) -> list[str]:
         for m in matches:
             p = Path(m)
             if not p.exists():
-                raise BatchError(f"{m}: no such file or folder")
+                raise BatchError(f"{m}: " + ("a symbolic link to nothing (its target is missing, or a loop of links)"
+                                             if p.is_symlink() else "no such file or folder"))  # ls lists a link
             if not (p.is_file() or p.is_dir()):  # a FIFO: reading it waited for a writer forever
                 raise BatchError(f"{m}: not a regular file or folder (a FIFO, socket or device)")
             if p.is_dir() and not (p / "metadata.yaml").exists():
