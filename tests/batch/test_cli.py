@@ -304,3 +304,20 @@ def test_a_refused_jacobian_interval_names_the_run_by_its_file(capsys, tmp_path)
     assert "check the runs" in error and "closed squares" not in error
     assert main(argv) == 2
     assert capsys.readouterr().err == f"wmrkit: error: {error}\n"
+
+
+def test_a_log_name_with_a_line_break_stays_on_one_line(capsys, fleet_dir, tmp_path):
+    """A log named 'a<newline>b.csv' split its row (and its warning) over two lines of the answer."""
+    import shutil
+
+    odd = tmp_path / "a\nb.csv"
+    shutil.copy(fleet_dir / "run0.csv", odd)
+    (tmp_path / "c\nd.csv").write_text("time,left.spin,right.spin\n0,0,0\n")  # one sample: a warning
+    (tmp_path / "e\nf.csv").write_text("time,left.spin,right.spin\n0,0,0\n0,1,1\n")  # a failure
+    assert main(["batch", "odometry", "diff-drive", str(tmp_path), "--workers", "0"]) == 1
+    captured = capsys.readouterr()
+    out = captured.out.splitlines()
+    assert len(out) == 4 and out[1].startswith(f"  {tmp_path}/a\\nb.csv: x ")
+    assert out[3].startswith(f"  failed: {tmp_path}/e\\nf.csv:")
+    assert next(line for line in captured.err.splitlines() if "warning" in line).startswith(
+        f"wmrkit: warning: {tmp_path}/c\\nd.csv: ")

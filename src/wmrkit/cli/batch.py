@@ -27,6 +27,7 @@ from ._common import (
     warn,
 )
 from ._shown import fixed, tidy_pose, written
+from .main import one_line  # a log's name may hold a line break: the answer stays one line per log
 from .slip import ESTIMATOR_METHODS, add_estimator_options, check_estimator_options, estimator_from_args, resolve_method
 
 
@@ -187,7 +188,7 @@ def run_odometry(args: argparse.Namespace) -> int:
         written("trajectories", args.trajectories)
     for r in result.rows:  # they were only in the table's 'warnings' column (or nowhere, without --out)
         if r["warnings"]:  # a failed log's too, said before its error as wmrkit odometry says them
-            warn(f"{r['log']}: {r['warnings']}")
+            warn(one_line(f"{r['log']}: {r['warnings']}"))  # a name with a line break: one line still
     found = [r["imu"] for r in result.rows if r["imu"] and not r["error"]]
     if found and args.imu is None:  # each bag's own Imu topic, found by itself: wmrkit odometry's note
         print(f"wmrkit: note: heading of {len(found)} bag{'s' if len(found) > 1 else ''} checked against the IMU on "
@@ -198,14 +199,15 @@ def run_odometry(args: argparse.Namespace) -> int:
         return 1 if result.failed else 0
     odd = result.inconsistent
     print(f"{len(result.rows)} logs: {len(result.rows) - result.failed} done ({result.skipped} from an earlier run), "
-          f"{result.failed} failed, {len(odd)} inconsistent" + (f" ({name_list(odd, NAMED)})" if odd else ""))
+          f"{result.failed} failed, {len(odd)} inconsistent" + (f" ({one_line(name_list(odd, NAMED))})" if odd else ""))
     size = characteristic_length(robot)
     for r in result.rows:
         if r["error"]:  # a worker that died more often than allowed: its message does not name the log
-            print(f"  failed: {r['error'] if r['error'].startswith(r['log']) else r['log'] + ': ' + r['error']}")
+            failed = r["error"] if r["error"].startswith(r["log"]) else f"{r['log']}: {r['error']}"
+            print(f"  failed: {one_line(failed)}")
         elif not args.out:  # round-off printed as 0 (._shown)
             x, y, theta = (fixed(v, 4) for v in tidy_pose((r["x"], r["y"], r["theta"]), r["path_length"], size))
-            print(f"  {r['log']}: x {x} m, y {y} m, theta {theta} rad, "
+            print(f"  {one_line(r['log'])}: x {x} m, y {y} m, theta {theta} rad, "
                   f"path {r['path_length']:.4g} m" + (f", heading checked against the IMU on {r['imu']}"
                                                       if r["imu"] else ""))
     return 1 if result.failed else 0  # a pipeline must tell a batch with failed logs from a complete one
@@ -282,7 +284,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
             except UndeterminedError as err:  # at fault: the parameters chosen, else the runs given
                 raise OptionError(str(err), field="--param" if args.param else "LOG") from None
     for warning in () if args.slip else result.warnings:  # the slip fit has none
-        warn(warning)
+        warn(one_line(warning))  # a run's name with a line break: one line still
     if args.json:
         print_json(result.to_dict())
         return 0
