@@ -337,3 +337,27 @@ def test_an_axis_of_a_wheel_the_robot_lacks_is_refused():
 
     with pytest.raises(BatchError, match=r"wheels\[9\]\.r: the robot has 3 wheels"):
         sweep(catalog.load("omni-3"), [Axis("wheels[9].r", ((9, "r"),), np.array([0.05, 0.1]))])
+
+
+def test_the_variants_of_one_wheel_are_bounded_before_they_are_built(monkeypatch):
+    """Three 1000-point axes of one wheel (1e9 designs, allowed) made a table of 1e9 robots rebuilt one by one
+    (about 10 ms each: months, and the memory of the table) with no refusal: a wheel's table is the product of its
+    own axes, not their sum. At most MAX_POINTS variants a wheel, refused before any rebuild."""
+    import wmrkit.batch.sweep_kernel as kernel
+
+    robot = catalog.load("omni-3")
+
+    def no_rebuild(*args, **kwargs):
+        raise AssertionError("a robot was rebuilt before the refusal")
+
+    monkeypatch.setattr(kernel, "variant", no_rebuild)
+    axes = [parse_vary(v, robot) for v in ("wheels[0].l=0.1:0.2:1000", "wheels[0].alpha=0:1:1000",
+                                           "wheels[0].r=0.01:0.1:1000")]
+    with pytest.raises(BatchError, match=r"wheel 'front_left': its --vary axes make 1000 x 1000 x 1000 variants"):
+        build_spec(robot, axes, "kappa_mean")
+    monkeypatch.setattr(kernel, "variant", variant)
+    monkeypatch.setattr(kernel, "MAX_POINTS", 4)  # at the bound, 2 x 2 variants of one wheel are built; 2 x 3 not
+    axes = [parse_vary(v, robot) for v in ("wheels[0].l=0.1:0.2:2", "wheels[0].r=0.01:0.1:2", "wheels[1].r=0.01:0.1:3")]
+    assert build_spec(robot, axes, "kappa_mean").tables[0]["l"].shape == (4,)
+    with pytest.raises(BatchError, match=r"wheel 'front_left': its --vary axes make 2 x 3 variants"):
+        build_spec(robot, [axes[0], parse_vary("wheels[0].r=0.01:0.1:3", robot)], "kappa_mean")

@@ -43,8 +43,9 @@ METRICS = ("kappa_mean", "kappa_max", "inv_kappa_mean", "singular_margin")
 _TARGET = re.compile(r"^wheels(?:\.([A-Za-z_][A-Za-z0-9_-]*)|\[(\d+)\])\.([a-z_]+)$")
 
 
-#: Most points of one --vary axis, designs of a sweep, designs over the first two axes (the map of the result,
-#: kept in memory), and steering configurations per design.
+#: Most points of one --vary axis (and variants of one wheel, the product of its axes: each a robot rebuilt),
+#: designs of a sweep, designs over the first two axes (the map of the result, kept in memory), and steering
+#: configurations per design.
 MAX_POINTS, MAX_DESIGNS, MAX_MAP, MAX_CONFIGS = 10**6, 10**9, 10**7, 10**4
 
 
@@ -219,6 +220,11 @@ def build_spec(robot: Robot, axes: list[Axis], metric: str, *, length: float | N
     beta = rng.uniform(-np.pi, np.pi, (configs, n_steer)) if n_steer else np.zeros((1, 0))
     wheel_axes = [tuple(k for k, ax in enumerate(axes) if any(i == w for i, _ in ax.targets))
                   for w in range(len(robot.wheels))]
+    for w, mine in enumerate(wheel_axes):  # a wheel's table is the product of its own axes: one rebuild each
+        if math.prod(shape[k] for k in mine) > MAX_POINTS:
+            raise BatchError(f"wheel '{robot.wheels[w].name}': its --vary axes make "
+                             f"{' x '.join(str(shape[k]) for k in mine)} variants, each a robot rebuilt (about 10 "
+                             f"ms): at most {MAX_POINTS:.0e} a wheel; sweep fewer fields of one wheel, or fewer points")
     with tqdm(total=sum(math.prod(shape[k] for k in mine) for mine in wheel_axes), desc="robots", unit="robot",
               disable=not progress, leave=False) as bar:
         tables = [_wheel_table(robot, axes, w, mine, joints, p0, bar) for w, mine in enumerate(wheel_axes)]
