@@ -294,3 +294,12 @@ def test_a_link_to_nothing_is_named_so(tmp_path):
             expand_logs([tmp_path / name])
     with pytest.raises(BatchError, match=r"missing\.csv: no such file or folder"):
         expand_logs([tmp_path / "missing.csv"])
+
+
+def test_a_bag_that_cannot_be_read_is_its_error_alone(diff, tmp_path):
+    """An unreadable bag (a .db3 that is not a database) failed, and its row's warnings repeated the error as the IMU
+    note ('x.db3: x.db3: cannot read as a ROS 2 bag (...) (the odometry is not checked against it)'), printed as a
+    warning too; 'wmrkit odometry' says the error alone."""
+    (tmp_path / "x.db3").write_text("not sqlite")
+    row = batch_odometry(diff, [tmp_path / "x.db3"]).rows[0]
+    assert row["error"].startswith(f"{tmp_path / 'x.db3'}: cannot read as a ROS 2 bag") and row["warnings"] is None

@@ -167,6 +167,8 @@ def process_log(job: LogJob) -> dict[str, Any]:
             diagnosis = _diagnose(job, s, model, options)
             filtered = estimator.notes() if isinstance(estimator, KalmanEstimator) else []
         except Exception as err:  # what was said before it failed stays said (wmrkit odometry says it too)
+            if unread and " ".join(unread.split()).startswith(_message(err)):  # the bag itself unreadable: said once,
+                unread = None  # as wmrkit odometry says it (its IMU's note repeated the error, the name twice)
             said = [" ".join(str(w.message).split()) for w in caught] + ([unread] if unread else [])
             row.update(error=_message(err), trajectory=None, warnings="; ".join(said) or None,
                        wall_time=time.perf_counter() - t0)
