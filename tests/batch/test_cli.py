@@ -321,3 +321,18 @@ def test_a_log_name_with_a_line_break_stays_on_one_line(capsys, fleet_dir, tmp_p
     assert out[3].startswith(f"  failed: {tmp_path}/e\\nf.csv:")
     assert next(line for line in captured.err.splitlines() if "warning" in line).startswith(
         f"wmrkit: warning: {tmp_path}/c\\nd.csv: ")
+
+
+def test_no_trajectory_written_is_not_said_written(capsys, fleet_dir, tmp_path):
+    """Every log failed (here: --trajectories naming the logs' own folder, csv: each trajectory would be its log), and
+    the command still said 'trajectories written to DIR'."""
+    import shutil
+
+    shutil.copy(fleet_dir / "run0.csv", tmp_path / "run0.csv")
+    assert main(["batch", "odometry", "diff-drive", str(tmp_path), "--workers", "0", "--trajectories", str(tmp_path),
+                 "--trajectory-format", "csv"]) == 1
+    captured = capsys.readouterr()
+    assert "the output file is the log itself" in captured.out and "written" not in captured.err
+    assert main(["batch", "odometry", "diff-drive", str(tmp_path), "--workers", "0", "--trajectories",
+                 str(tmp_path / "t")]) == 0
+    assert f"trajectories written to {tmp_path / 't'}" in capsys.readouterr().err

@@ -184,7 +184,7 @@ def run_odometry(args: argparse.Namespace) -> int:
                                 **_options(args))
     if args.out:
         written("table", args.out)
-    if args.trajectories:
+    if args.trajectories and any(r["trajectory"] for r in result.rows):  # every log failed: none was written
         written("trajectories", args.trajectories)
     for r in result.rows:  # they were only in the table's 'warnings' column (or nowhere, without --out)
         if r["warnings"]:  # a failed log's too, said before its error as wmrkit odometry says them
