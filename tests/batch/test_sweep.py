@@ -361,3 +361,11 @@ def test_the_variants_of_one_wheel_are_bounded_before_they_are_built(monkeypatch
     assert build_spec(robot, axes, "kappa_mean").tables[0]["l"].shape == (4,)
     with pytest.raises(BatchError, match=r"wheel 'front_left': its --vary axes make 2 x 3 variants"):
         build_spec(robot, [axes[0], parse_vary("wheels[0].r=0.01:0.1:3", robot)], "kappa_mean")
+
+
+def test_one_point_between_two_ends_is_refused():
+    """'wheels[1].l=0.1:0.3:1' swept 0.1 m alone, the 0.3 m dropped without a word."""
+    robot = catalog.load("omni-3")
+    with pytest.raises(BatchError, match=r"N = 1 is the one value START; STOP differs"):
+        parse_vary("wheels[1].l=0.1:0.3:1", robot)
+    np.testing.assert_array_equal(parse_vary("wheels[1].l=100mm:0.1:1", robot).values, [0.1])

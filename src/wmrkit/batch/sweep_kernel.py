@@ -116,6 +116,9 @@ def parse_vary(text: str, robot: Robot) -> Axis:
     if not 1 <= n <= MAX_POINTS:
         raise BatchError(f"--vary {text}: N must be a whole number of points in [1, {MAX_POINTS}], got "
                          f"{parts[2].strip()!r}")
+    if n == 1 and stop != start:  # linspace's one value is START: STOP was dropped without a word
+        raise BatchError(f"--vary {text}: N = 1 is the one value START; STOP differs and would be ignored (write "
+                         "START:START:1, or N >= 2)")
     if kind == "angle" and max(abs(start), abs(stop)) > 2 * math.pi * (1 + 1e-12):
         raise BatchError(f"--vary {text}: an angle beyond one turn repeats a geometry of the sweep; sweep within "
                          "-360 deg to 360 deg")
