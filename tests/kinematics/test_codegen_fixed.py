@@ -5,14 +5,16 @@ generated Python, on every branch: determined, never determined, non-finite inpu
 from __future__ import annotations
 
 import ctypes
+import subprocess
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 import sympy as sp
 from test_codegen import GCC, _ptr, compile_c, load_module
 
-from wmrkit import Robot, catalog
+from wmrkit import Robot, SingularError, catalog
 from wmrkit.kinematics._codegen_fixed import _bound
 from wmrkit.kinematics._codegen_plan import Plan
 from wmrkit.kinematics.codegen import write_code
@@ -151,3 +153,64 @@ def test_the_entry_bound_holds_at_every_sampled_heading(name):
         f = sp.lambdify(plan.beta, e, "numpy")
         values = np.abs(np.broadcast_to(f(*samples.T), (len(samples),)))
         assert values.max() <= bound + 1e-12
+
+
+def _random_robot(rng: np.random.Generator, k: int) -> Robot:
+    """2-5 wheels: fixed and Swedish wheels sensing their spins, castors sensing nothing (absorbed), steerable
+    wheels sensing spin and steering (the Jacobi SVD at run time); random mounts, radii and offsets."""
+    wheels = []
+    for i in range(int(rng.integers(2, 6))):
+        kind = rng.choice(["fixed", "swedish", "castor", "castor", "steerable"])
+        w = {"name": f"w{i}", "type": str(kind), "position": rng.uniform(-0.5, 0.5, 2).tolist(),
+             "heading": float(rng.uniform(-np.pi, np.pi)), "r": float(rng.uniform(0.02, 0.1))}
+        if kind == "swedish":
+            w |= {"gamma": float(rng.choice([-1, 1]) * rng.uniform(0.4, 1.57)), "r_r": 0.01, "sensed": ["spin"]}
+        elif kind == "castor":
+            w |= {"d": float(rng.choice([-1, 1]) * 10 ** rng.uniform(-3.3, -1)), "heading": 0.0}
+        elif kind == "steerable":
+            w |= {"sensed": ["spin", "steer"], "heading": 0.0}
+        else:
+            w |= {"sensed": ["spin"]}
+        wheels.append(w)
+    return Robot.from_dict({"name": f"random{k}", "wheels": wheels})
+
+
+def test_random_robots_forward_models_are_fks(tmp_path):
+    """Random robots with castors (offsets from 0.5 mm to 10 cm, sensing nothing: absorbed), Swedish, fixed and
+    steered wheels, all compiled into one library: each generated forward model gives fk's twist and slip at random
+    headings and readings (or -1 where the library's twist_is_determined says no); both paths are met."""
+    from wmrkit.kinematics.wheel_ik import twist_is_determined
+
+    rng = np.random.default_rng(2026)
+    robots, sources = [], []
+    while len(robots) < 24:
+        robot = _random_robot(rng, len(robots))
+        try:
+            _, source = write_code(robot, "c", tmp_path / robot.name)
+        except SingularError:  # sensing that never determines the twist: refused, as tested elsewhere
+            continue
+        robots.append(robot)
+        sources.append(str(source))
+    lib_path = tmp_path / "librandom.so"
+    subprocess.run([GCC, "-O2", "-shared", "-fPIC", "-std=c99", "-Wall", "-Wextra", "-Werror", "-o", str(lib_path),
+                    *sources, "-lm"], check=True, capture_output=True, text=True)
+    lib = ctypes.CDLL(str(lib_path))
+    fast = sum("factored when" in Path(s).read_text() for s in sources)
+    assert 4 <= fast <= len(robots) - 4  # both paths met (7 of 24)
+    for robot in robots:
+        sensed = sensed_rates(robot)
+        forward = getattr(lib, f"{robot.name}_forward")
+        forward.restype = ctypes.c_int
+        for _ in range(8):
+            heading = rng.uniform(-np.pi, np.pi, len(robot.steer_names))
+            q = rng.normal(0, 10, len(sensed))
+            tw, res = np.zeros(3), ctypes.c_double(-1.0)
+            status = forward(_ptr(q), _ptr(heading) if len(heading) else None, _ptr(tw), ctypes.byref(res))
+            if not twist_is_determined(robot, sensed, heading=heading):
+                assert status == -1, robot.name
+                continue
+            fk_twist, fk_slip = forward_kinematics(robot, dict(zip(sensed, q, strict=True)), heading=heading)
+            assert status == 0, robot.name
+            scale = 1.0 + float(np.abs(fk_twist).max())
+            np.testing.assert_allclose(tw, fk_twist, rtol=1e-7, atol=1e-7 * scale, err_msg=robot.name)
+            assert res.value == pytest.approx(float(fk_slip), rel=1e-7, abs=1e-7 * scale), robot.name
