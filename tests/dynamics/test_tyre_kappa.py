@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 
 from wmrkit.cli.main import main
 from wmrkit.dynamics.tyres import MAX_KAPPA, Tyre, kappa_from_slip_ratio, slip_ratio, slip_ratio_from_kappa
-from wmrkit.errors import WmrkitError
+from wmrkit.errors import ShapeError
 
 FZ = 8175.0
 
@@ -49,8 +49,11 @@ def test_driving_is_positive_kappa_and_a_forward_force():
     assert float(tyre.forces_at_slip(FZ, slip_ratio_from_kappa(0.1), 0.0).longitudinal) > 0  # driving: pushed ahead
     assert float(tyre.forces_at_slip(FZ, slip_ratio_from_kappa(-0.1), 0.0).longitudinal) < 0
     for bad in (np.nan, np.inf, -2.0001, 1.01 * MAX_KAPPA):
-        with pytest.raises(WmrkitError, match="kappa: must be a number in"):
+        with pytest.raises(ShapeError, match=r"^kappa: must be a number in"):
             slip_ratio_from_kappa(bad)
+    for bad in (np.nan, -1.0, 2.0001):
+        with pytest.raises(ShapeError, match=r"^slip ratio: must be in \(-1, 2\]"):
+            kappa_from_slip_ratio(bad)
 
 
 def test_braking_forces_are_the_pacejka_packages_at_the_same_kappa():

@@ -7,7 +7,7 @@ import pytest
 from slip_helpers import L3, L12, R, forklift_at_axle, thesis_twist_to_rep
 
 from wmrkit import catalog
-from wmrkit.errors import WmrkitError
+from wmrkit.errors import ShapeError, WmrkitError
 from wmrkit.odometry.logs import JointLog
 from wmrkit.slip.kalman import KalmanNoise, fk1_noise, fk2_noise, kalman_filter, kalman_model, kalman_odometry
 from wmrkit.slip.models import wls
@@ -177,7 +177,12 @@ def test_the_filter_refuses_a_log_or_start_pose_that_odometry_refuses(time, spin
     # fk2_noise's merged lateral noise raised numpy's TypeError "can't multiply sequence by non-int" for text
     (lambda: fk2_noise("1", 1.0, 1.0), r"Kalman noise right_drive \(lateral\): .*, got '1'"),
     (lambda: fk2_noise(True, 1.0, 1.0), r"Kalman noise right_drive \(lateral\): .*, got True"),
+    (lambda: KalmanNoise(lateral=-1.0), r"Kalman noise lateral: must be a finite number in .*, got -1.0"),
+    (lambda: KalmanNoise(1e-4, 1e4), r"Kalman noise process \(0.0001\) and lateral \(10000\) differ by more"),
+    (lambda: KalmanNoise(period=0.0), r"Kalman noise period: the nominal sample period must be a finite number"),
 ])
 def test_the_filters_python_doors_refuse_what_is_not_their_noise(call, message):
-    with pytest.raises(WmrkitError, match=message):
+    """A ShapeError (a ValueError) naming the argument, as every keyword door of the Python API (docs/conventions.md):
+    these raised a bare WmrkitError, which ``except ValueError`` did not catch."""
+    with pytest.raises(ShapeError, match=message):
         call()

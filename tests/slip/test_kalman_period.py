@@ -13,6 +13,7 @@ import yaml
 from wmrkit import DescriptionError, catalog
 from wmrkit.cli.main import main
 from wmrkit.description import robot_from_text
+from wmrkit.errors import ShapeError
 from wmrkit.odometry.header import header_format
 from wmrkit.odometry.integrators import integrate_increments
 from wmrkit.odometry.log_writer import write_log
@@ -139,9 +140,9 @@ def test_python_takes_seconds_only():
     """A Python keyword takes a number of seconds (docs/conventions.md): text is refused, as a bool."""
     model = kalman_model(catalog.load("forklift"), "fk2")
     for bad in ("10 ms", "0.01", True):
-        with pytest.raises(Exception, match="period: the nominal sample period must be"):
+        with pytest.raises(ShapeError, match=r"^period: the nominal sample period must be"):
             kalman_filter(model, turning_log(0.01, 5), period=bad)
-        with pytest.raises(Exception, match="Kalman noise period: the nominal sample period must be"):
+        with pytest.raises(ShapeError, match=r"^Kalman noise period: the nominal sample period must be"):
             KalmanNoise(period=bad)
 
 

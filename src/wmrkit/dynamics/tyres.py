@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_reals, real_number
-from ..errors import ShapeError, UnknownNameError, WmrkitError
+from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_SPEED
 
 TINY = 1e-300
@@ -89,7 +89,7 @@ def slip_ratio_from_kappa(kappa: ArrayLike) -> np.ndarray:
     k = _asarray(kappa)
     ok = np.isfinite(k) & (k >= -2) & (k <= MAX_KAPPA)
     if not np.all(ok):
-        raise WmrkitError(f"kappa: must be a number in [-2, {MAX_KAPPA:g}], got {k[~ok].flat[0]:g}")
+        raise ShapeError(f"kappa: must be a number in [-2, {MAX_KAPPA:g}], got {k[~ok].flat[0]:g}")
     return np.where(k > 0, -k / (1 + np.maximum(k, 0.0)), -k) + 0.0
 
 
@@ -98,7 +98,7 @@ def kappa_from_slip_ratio(s: ArrayLike) -> np.ndarray:
     of :func:`slip_ratio_from_kappa`, ``-s / (1 + s)`` driving (``s < 0``), ``-s`` braking. ``(...) -> (...)``."""
     s = _asarray(s)
     if not np.all((s > -1) & (s <= 2)):
-        raise WmrkitError(f"slip ratio: must be in (-1, 2], got {s[~((s > -1) & (s <= 2))].flat[0]:g}")
+        raise ShapeError(f"slip ratio: must be in (-1, 2], got {s[~((s > -1) & (s <= 2))].flat[0]:g}")
     return np.where(s < 0, -s / (1 + np.minimum(s, 0.0)), -s) + 0.0
 
 
@@ -341,23 +341,23 @@ class Tyre:
         if isinstance(self.params, str) or not all(isinstance(p, tuple | list) and len(p) == 2 for p in
                                                    (self.params.items() if isinstance(self.params, Mapping) else
                                                     self.params)):  # "mu" raised dict()'s "update sequence element"
-            raise WmrkitError(f"tyre parameters: expected a mapping {{name: value}} such as {{'mu': 0.8}}, got "
-                              f"{self.params!r:.60}")
+            raise ShapeError(f"tyre parameters: expected a mapping {{name: value}} such as {{'mu': 0.8}}, got "
+                             f"{self.params!r:.60}")
         pairs = list(self.params.items() if isinstance(self.params, Mapping) else self.params)
         params = dict(pairs)
         if len(params) < len(pairs):
             twice = next(n for j, (n, _) in enumerate(pairs) if n in (m for m, _ in pairs[:j]))
-            raise WmrkitError(f"tyre parameter '{twice}' given twice")
+            raise ShapeError(f"tyre parameter '{twice}' given twice")
         unknown = [n for n in params if n not in kind.defaults]
         if unknown:
             raise UnknownNameError(f"tyre model '{self.model}' has no parameter '{unknown[0]}' "
                                    f"(parameters: {', '.join(kind.defaults)})")
         for n, v in params.items():
             if not (real_number(v) or (n == "k" and v == math.inf)):  # k = inf: the discontinuous Coulomb
-                raise WmrkitError(f"tyre parameter {n} must be a finite number, got {v!r}")  # "0.8" was read
+                raise ShapeError(f"tyre parameter {n} must be a finite number, got {v!r}")  # "0.8" was read
             problem = param_problem(n, float(v))
             if problem:
-                raise WmrkitError(f"tyre parameter {n}: {problem}")
+                raise ShapeError(f"tyre parameter {n}: {problem}")
         object.__setattr__(self, "params", tuple((n, float(params.get(n, d))) for n, d, _ in kind.params))
 
     @classmethod
@@ -387,10 +387,10 @@ class Tyre:
         fz, *slips = _broadcast(fz=fz, v_lat=v_lat, v_long=v_long, v_wheel=v_wheel, v_roll=v_roll)
         bad = ~((fz >= 0) & (fz <= MAX_LOAD))  # NaN included
         if bad.any():
-            raise WmrkitError(f"fz: expected normal loads in [0, {MAX_LOAD:g}] N, got {fz[bad].flat[0]:g}")
+            raise ShapeError(f"fz: expected normal loads in [0, {MAX_LOAD:g}] N, got {fz[bad].flat[0]:g}")
         for name, v in zip(("v_lat", "v_long", "v_wheel", "v_roll"), slips, strict=True):
             if not np.isfinite(v).all():
-                raise WmrkitError(f"{name}: expected finite velocities [m/s], got {v[~np.isfinite(v)].flat[0]:g}")
+                raise ShapeError(f"{name}: expected finite velocities [m/s], got {v[~np.isfinite(v)].flat[0]:g}")
         return self._forces(fz, *slips)
 
     def _forces(self, fz: ArrayLike, v_lat: ArrayLike, v_long: ArrayLike, v_wheel: ArrayLike,
@@ -422,9 +422,9 @@ class Tyre:
         v_lat, v_long, v_wheel, v_roll = slip_velocities(slip_ratio, slip_angle, speed)
         eps = self.as_dict().get("eps")
         if eps is not None and np.any(v_wheel < eps):
-            raise WmrkitError(f"speed: must be at least the {self.model} tyre's eps = {eps:g} m/s, got "
-                              f"{v_wheel[v_wheel < eps].flat[0]:g} (below eps the model divides the slip by eps, not "
-                              "by the speed: the forces would be those of a smaller slip ratio and angle)")
+            raise ShapeError(f"speed: must be at least the {self.model} tyre's eps = {eps:g} m/s, got "
+                             f"{v_wheel[v_wheel < eps].flat[0]:g} (below eps the model divides the slip by eps, not "
+                             "by the speed: the forces would be those of a smaller slip ratio and angle)")
         return self.forces(fz, v_lat, v_long, v_wheel, v_roll)
 
 
@@ -442,7 +442,7 @@ def slip_velocities(s: ArrayLike, alpha: ArrayLike, speed: ArrayLike) -> tuple[n
         if not np.all(ok):
             bad = float(values[~ok].flat[0])  # an angle in degrees too: '--slip-angle 90deg' said "got 1.5708"
             shown = f"{bad:g} rad ({math.degrees(bad):g} deg)" if name == "slip angle" else f"{bad:g}"
-            raise WmrkitError(f"{name}: must be {allowed}, got {shown}")
+            raise ShapeError(f"{name}: must be {allowed}, got {shown}")
     v_roll = np.where(s >= 0, v * (s - 1), -v / (1 + np.minimum(s, 0.0)))  # each branch where it is taken
     return v * np.tan(alpha), v + v_roll, v, v_roll
 

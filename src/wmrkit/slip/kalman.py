@@ -58,11 +58,11 @@ PERIOD_RANGE = (1e-9, 86400.0)
 
 def check_period(period: object, name: str = "period") -> float:
     """`period` [s], the nominal sample period T of ``Q``, as a float: a real number (SI seconds; a unit string is the
-    CLI's and the description's, which read it) in :data:`PERIOD_RANGE`, else :class:`WmrkitError` naming `name`."""
+    CLI's and the description's, which read it) in :data:`PERIOD_RANGE`, else :class:`ShapeError` naming `name`."""
     lo, hi = PERIOD_RANGE
     if not (real_number(period) and lo <= period <= hi):  # type: ignore[operator]
-        raise WmrkitError(f"{name}: the nominal sample period must be a finite number of seconds in [{lo:g}, {hi:g}], "
-                          f"got {period!r}")
+        raise ShapeError(f"{name}: the nominal sample period must be a finite number of seconds in [{lo:g}, {hi:g}], "
+                         f"got {period!r}")
     return float(period)  # type: ignore[arg-type]
 
 
@@ -84,18 +84,18 @@ class KalmanNoise:
             check_period(self.period, "Kalman noise period")
         if isinstance(self.wheels, str) or not all(isinstance(w, tuple | list) and len(w) == 3 and isinstance(w[0], str)
                                                    for w in self.wheels):
-            raise WmrkitError(f"Kalman noise wheels: expected ((wheel name, lateral, longitudinal), ...), got "
-                              f"{self.wheels!r:.60}")  # a string raised "not enough values to unpack"
+            raise ShapeError(f"Kalman noise wheels: expected ((wheel name, lateral, longitudinal), ...), got "
+                             f"{self.wheels!r:.60}")  # a string raised "not enough values to unpack"
         named = (("process", self.process), ("lateral", self.lateral), ("longitudinal", self.longitudinal),
                  *((f"{w} ({d})", x) for w, a, b in self.wheels for d, x in (("lateral", a), ("longitudinal", b))))
         lo, hi = NOISE_RANGE
         for name, v in named:
             if not (real_number(v) and lo <= v <= hi):  # text raised numpy's TypeError
-                raise WmrkitError(f"Kalman noise {name}: must be a finite number in [{lo:g}, {hi:g}], got {v!r}")
+                raise ShapeError(f"Kalman noise {name}: must be a finite number in [{lo:g}, {hi:g}], got {v!r}")
         (small, a), (large, b) = min(named, key=lambda nv: nv[1]), max(named, key=lambda nv: nv[1])
         if b > MAX_SPREAD * a:
-            raise WmrkitError(f"Kalman noise {small} ({a:g}) and {large} ({b:g}) differ by more than a factor "
-                              f"{MAX_SPREAD:g}: the filter would lose the smaller to round-off (only ratios matter)")
+            raise ShapeError(f"Kalman noise {small} ({a:g}) and {large} ({b:g}) differ by more than a factor "
+                             f"{MAX_SPREAD:g}: the filter would lose the smaller to round-off (only ratios matter)")
 
     def of_wheel(self, name: str) -> tuple[float, float]:
         """``(lateral, longitudinal)`` standard deviations of wheel `name`."""
@@ -218,8 +218,8 @@ def kalman_model(robot: Robot, kind: str = "fk2", noise: KalmanNoise | None = No
     if kind not in FILTERS:
         raise WmrkitError(f"filter must be one of {', '.join(FILTERS)}, got '{kind}'")
     if noise is not None and not isinstance(noise, KalmanNoise):  # a mapping raised "no attribute 'wheels'"
-        raise WmrkitError(f"noise: expected KalmanNoise or None (KalmanNoise(process, lateral, longitudinal), "
-                          f"fk1_noise, fk2_noise), got {type(noise).__name__} {noise!r:.60}")
+        raise ShapeError(f"noise: expected KalmanNoise or None (KalmanNoise(process, lateral, longitudinal), "
+                         f"fk1_noise, fk2_noise), got {type(noise).__name__} {noise!r:.60}")
     noise = noise or KalmanNoise()
     for name, _, _ in noise.wheels:
         robot.wheel(name)
