@@ -113,8 +113,8 @@ def test_law_parallel_on_a_car_with_fixed_wheels_turns_the_pair_together():
     nu[i] = nu[j] = 0.7
     model.accelerations(beta, nu, forces=np.zeros(8))  # held: accepted
     ackermann = model.robot.beta_of_heading([0.3, math.atan2(0.6, 0.6 / math.tan(0.3) + 0.4)])
-    with pytest.raises(WmrkitError, match=r"the steering linkage of wheels 'fl' and 'fr' sets fr.steer at heading "
-                                          r"0.3 rad"):
+    with pytest.raises(WmrkitError, match=r"the steering linkage of wheels 'fl' and 'fr' sets fr at heading "
+                                          r"0.3 rad with fl at 0.3 rad, not 0.2"):
         model.accelerations(ackermann, nu, forces=np.zeros(8))
     data["couplings"][0]["law"] = "ackermann"  # stated as the default is: the same model
     assert np.array_equal(DynamicModel.of(Robot.from_dict(data)).pack[17], DynamicModel.of(linked_car()).pack[17])

@@ -55,10 +55,12 @@ def test_the_law_is_the_ackermann_geometry_and_a_broken_description_is_refused()
         nu[i], nu[j] = 0.7, 0.7 * slopes(h)[0]
         model.accelerations(beta, nu, forces=np.zeros(8))  # held: accepted
         nu[j] *= 1.001
-        with pytest.raises(WmrkitError, match=r"the steering linkage of wheels 'fl' and 'fr' turns fr.steer at"):
+        with pytest.raises(WmrkitError, match=r"the steering linkage of wheels 'fl' and 'fr' turns fr's steering "
+                                              r"at [-\d.e]+ rad/s with fl's at 0.7 rad/s, not "):
             model.accelerations(beta, nu, forces=np.zeros(8))
         bad = model.robot.beta_of_heading([h, ackermann(h) + 1e-6])
-        with pytest.raises(WmrkitError, match=r"the steering linkage of wheels 'fl' and 'fr' sets fr.steer at heading"):
+        with pytest.raises(WmrkitError, match=r"the steering linkage of wheels 'fl' and 'fr' sets fr at heading "
+                                              rf"{ackermann(h):.6g} rad with fl at {h:.6g} rad, not "):
             model.accelerations(bad, np.zeros(model.n), forces=np.zeros(8))
     data = linked_car(front_heading=0.3).to_dict()
     data["wheels"][3]["heading"] = 0.3
@@ -156,9 +158,9 @@ def test_a_state_the_linkage_forbids_is_refused():
     model = DynamicModel.of(linked_car())
     s = initial_state(model)
     s[model.names.index("fr.steer")] += 0.01
-    with pytest.raises(WmrkitError, match=r"state: the steering linkage of wheels 'fl' and 'fr' sets fr.steer at "
-                                          r"heading 0 rad"):
-        Stepper(model, s)
+    with pytest.raises(WmrkitError, match=r"^state: the steering linkage of wheels 'fl' and 'fr' sets fr at heading "
+                                          r"0 rad with fl at 0 rad, not 0.01 rad: the dynamics hold the linkage"):
+        Stepper(model, s)  # by wheel, as Coupling.words() names them (it said 'sets fr.steer ... from fl.steer')
 
 
 def _synchro() -> Robot:
@@ -180,7 +182,9 @@ def test_a_chain_turns_its_wheels_together_and_refuses_a_turn():
     turns all three by the same angle."""
     model = DynamicModel.of(_synchro())
     assert model.steering_inertia()[0] == pytest.approx(3 * 0.01)
-    with pytest.raises(WmrkitError, match=r"the steering linkage of wheels 'a', 'b' and 'c' sets b.steer"):
+    a, b = math.atan2(0.5 * 0.25, 0.3), math.atan2(-0.5 * 0.15, 0.3 - 0.5 * 0.2)  # their IK headings (v + w x r)
+    with pytest.raises(WmrkitError, match=rf"the steering linkage of wheels 'a', 'b' and 'c' sets b at heading "
+                                          rf"{a:.6g} rad with a at {a:.6g} rad, not {b:.6g} rad\)"):
         twist_program(model, [0.0], [(0.3, 0.0, 0.5)])
     with pytest.raises(WmrkitError, match=r"initial twist .*the steering linkage of wheels 'a', 'b' and 'c'"):
         initial_state(model, (0.3, 0.0, 0.5))

@@ -45,7 +45,7 @@ def test_a_chain_turned_at_a_late_knot_is_refused_there_judged_at_once(monkeypat
     calls = _counted(monkeypatch)
     with pytest.raises(WmrkitError, match=rf"^twist \(0.3, 0.0, 0.5\) at t = {LATE * 0.01:g} s has no no-slip "
                                           r"motion for 'synchro': its wheels' steering breaks a linkage "
-                                          r"\(the steering linkage of wheels 'a', 'b' and 'c' sets b.steer"):
+                                          r"\(the steering linkage of wheels 'a', 'b' and 'c' sets b at heading "):
         programs.twist_program(model, *_late((0.3, 0.0, 0.5)))
     assert calls["linkage_breach"] <= 1 and calls["gear_breach"] <= 1
     assert programs.twist_program(model, *_late((0.3, 0.0, 0.5)), allow_slip=True).fight_linkages

@@ -78,21 +78,22 @@ def reduced(table: np.ndarray, base: np.ndarray, beta_of, nu: np.ndarray | None)
 
 
 def linkage_breach(model, beta: np.ndarray, nu: np.ndarray | None = None) -> str | None:
-    """Why steering angles `beta` ``(n_steer,)`` (and velocities `nu`) break a linkage of `model`, naming it and
-    the angle (or rate) it gives; None when they hold every linkage."""
-    table, cols = model.pack[17], list(model.steer_columns)
+    """Why steering angles `beta` ``(n_steer,)`` (and velocities `nu`) break a linkage of `model`, naming it
+    (:meth:`~wmrkit.couplings.Coupling.words`), its wheels as it does, and the heading (or steering rate) it gives the
+    follower with its leader's; None when they hold every linkage."""
+    table, cols, wheels = model.pack[17], list(model.steer_columns), model.robot.steer_names
     for row in table:
         j, i = cols.index(int(row[0])), cols.index(int(row[1]))
         f, slope, _ = law(row, beta[i])
         name = next(c.words() for c in model.robot.couplings
                     if c.kind == "linkage" and f"{model.names[int(row[0])]}" in c.joints)
         if abs(math.remainder(beta[j] - f, 2 * math.pi)) > LINKAGE_TOL:
-            return (f"{name} sets {model.names[int(row[0])]} at heading {_heading(model, j, f):.6g} rad from "
-                    f"{model.names[int(row[1])]}, not {_heading(model, j, beta[j]):.6g} rad")
+            return (f"{name} sets {wheels[j]} at heading {_heading(model, j, f):.6g} rad with {wheels[i]} at "
+                    f"{_heading(model, i, beta[i]):.6g} rad, not {_heading(model, j, beta[j]):.6g} rad")
         if nu is not None and abs(nu[int(row[0])] - slope * nu[int(row[1])]) > LINKAGE_TOL * (
                 1 + abs(nu[int(row[1])])):
-            return (f"{name} turns {model.names[int(row[0])]} at {slope * nu[int(row[1])]:.6g} rad/s with "
-                    f"{model.names[int(row[1])]}, not {nu[int(row[0])]:.6g} rad/s")
+            return (f"{name} turns {wheels[j]}'s steering at {slope * nu[int(row[1])]:.6g} rad/s with {wheels[i]}'s "
+                    f"at {nu[int(row[1])]:.6g} rad/s, not {nu[int(row[0])]:.6g} rad/s")
     return None
 
 
