@@ -85,14 +85,31 @@ class Coupling:
         linkage of wheels 'fl' and 'fr'``, ``the differential of wheels 'rl' and 'rr'`` (each wheel's one joint of the
         kind: its spin or its steering), else by joints (``the gear of joints 'd.spin1' and 'd.spin2'``). `short`:
         the compact form for a list of identifiers, ``linkage of fl and fr``, ``gear of d.spin1 and d.spin2``."""
-        wheel, _, joint = zip(*(j.partition(".") for j in self.joints), strict=True)
-        by_wheel = len(set(joint)) == 1 and joint[0] in ("spin", "steer") and len(set(wheel)) == len(wheel)
-        names = list(wheel) if by_wheel else list(self.joints)
+        names, by_wheel, steer = self._names()
         if short:
             return f"{self.kind} of {name_list(names[:-1])} and {names[-1]}"
-        quoted = [f"'{n}'" for n in names]
-        kind = f"steering {self.kind}" if joint[0] == "steer" and by_wheel else self.kind
-        return f"the {kind} of {'wheels' if by_wheel else 'joints'} {name_list(quoted[:-1])} and {quoted[-1]}"
+        kind = f"steering {self.kind}" if steer and by_wheel else self.kind
+        return f"the {kind} of {'wheels' if by_wheel else 'joints'} {_quoted(names)}"
+
+    def joints_words(self) -> str:
+        """Its joints in text, for a sentence about them (``... do not turn together``, ``turn ... out of its
+        ratios``): ``the joints of the gear of wheels 'left' and 'right'``, and named by joint (:meth:`words`) ``the
+        gear's joints 'd.spin1' and 'd.spin2'``, not ``the joints of the gear of joints ...``."""
+        names, by_wheel, _ = self._names()
+        return f"the joints of {self.words()}" if by_wheel else f"the {self.kind}'s joints {_quoted(names)}"
+
+    def _names(self) -> tuple[list[str], bool, bool]:
+        """The names text gives its joints, whether they are its wheels' (each wheel's one joint of the kind: its
+        spin or its steering), and whether they are steering joints."""
+        wheel, _, joint = zip(*(j.partition(".") for j in self.joints), strict=True)
+        by_wheel = len(set(joint)) == 1 and joint[0] in ("spin", "steer") and len(set(wheel)) == len(wheel)
+        return (list(wheel) if by_wheel else list(self.joints)), by_wheel, joint[0] == "steer"
+
+
+def _quoted(names: list[str]) -> str:
+    """``'a', 'b' and 'c'`` (past :data:`~wmrkit.errors.MAX_LISTED` names, the first ones and a count)."""
+    quoted = [f"'{n}'" for n in names]
+    return f"{name_list(quoted[:-1])} and {quoted[-1]}"
 
 
 def ratios_problem(ratios: tuple[float, ...]) -> tuple[int | None, str] | None:
@@ -381,7 +398,7 @@ class GearBreach:
     def head(self) -> str:
         """The start of a warning naming the coupling and its ratios."""
         ratios = ", ".join(f"{k:g}" for k in self.coupling.ratios)
-        return f"the joints of {self.coupling.words()} (ratios {ratios}) do not turn together"
+        return f"{self.coupling.joints_words()} (ratios {ratios}) do not turn together"
 
     def warning(self, names: tuple[str, ...], values: np.ndarray) -> str:
         """The warning of ``fk`` (and the extended solutions) on given `values` of the joints `names` (one row)."""

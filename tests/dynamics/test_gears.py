@@ -139,6 +139,33 @@ def test_twist_program_refuses_a_twist_the_gear_forbids_unless_allowed_to_slip()
     twist_program(model, [0.0], [(0.5, 0.0, 0.0)])  # straight: the axle turns as one
 
 
+def test_a_gear_named_by_its_joints_reads_as_the_gear_s_joints(tmp_path, capsys):
+    """A double wheel's two spins geared 1:1 cannot turn the unit, which a turn on the spot needs (its pivot at
+    x = 0.3 m keeps heading 90 deg in the body as the body turns): refused by twist_program, `simulate
+    --initial-twist`, and a state with the spins apart by the Stepper, naming 'the gear's joints' (they said 'the
+    joints of the gear of joints ...')."""
+    from dynamics_robots import double_unit_robot
+
+    from wmrkit.cli.main import main
+
+    robot = _geared(double_unit_robot(), ("drive.spin1", "drive.spin2"))
+    robot.to_file(tmp_path / "unit.yaml")
+    assert main(["simulate", str(tmp_path / "unit.yaml"), "--path", "straight", "--initial-twist", "0", "0", "1"]) == 2
+    assert capsys.readouterr().err == ("wmrkit: error: --initial-twist 0 0 1: it turns the gear's joints 'drive.spin1' "
+                                       "and 'drive.spin2' out of its ratios (1, 1), which the gear holds together, and "
+                                       "the simulation starts rolling without slip (wmrkit ik says which twists the "
+                                       "gear allows)\n")
+    model = DynamicModel.of(robot)
+    with pytest.raises(WmrkitError, match=r"it would turn the gear's joints 'drive.spin1' and 'drive.spin2' out of "
+                                          r"its ratios \(1, 1\), which the gear holds together"):
+        twist_program(model, [0.0], [(0.0, 0.0, 1.0)])
+    s = initial_state(model)
+    s[model.n + model.names.index("drive.spin1")] = 1.0
+    with pytest.raises(WmrkitError, match=r"^state: the gear's joints 'drive.spin1' and 'drive.spin2' \(ratios 1, "
+                                          r"1\) do not turn together \(drive.spin1 1, drive.spin2 0 rad/s"):
+        Stepper(model, s)
+
+
 @pytest.mark.parametrize("ratios", [(1.0, 1.0), (1.0, 2.0)])
 def test_steering_inertia_turns_the_joints_geared_to_the_steering(ratios):
     """A double wheel whose two spins are geared (ratios 1:1 or 1:2) cannot counter-rotate them to turn under the

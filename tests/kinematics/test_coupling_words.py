@@ -12,7 +12,7 @@ import numpy as np
 
 from wmrkit import catalog
 from wmrkit.cli.main import main
-from wmrkit.couplings import Coupling, coupling_words
+from wmrkit.couplings import Coupling, GearBreach, coupling_words
 from wmrkit.kinematics.extended import extended_solution
 from wmrkit.kinematics.linkage_check import LinkageAngleWarning
 
@@ -34,6 +34,41 @@ def test_other_joints_are_named_by_joint_and_a_joint_as_is():
     assert coupling_words(couplings, gear.channel_name) == long
     assert coupling_words(couplings, gear.channel_name, short=True) == "gear of unit.spin1, unit.spin2 and rear.spin"
     assert coupling_words(couplings, "rear.spin") == "rear.spin"  # not a channel: a joint's own name
+
+
+def test_the_joints_of_a_coupling_read_by_wheel_or_by_joint():
+    """Sentences about a coupling's joints ('do not turn together', 'out of its ratios') said 'the joints of the
+    gear of joints 'd.spin1' and 'd.spin2''; named by joint, the joints are now the gear's: a gear of one double
+    wheel's spins, a mixed one (two wheels, one of them twice), a gear and a linkage by wheel."""
+    double = Coupling("gear", ("d.spin1", "d.spin2"), (1.0, 2.0))
+    mixed = Coupling("gear", ("unit.spin1", "unit.spin2", "rear.spin"), (1.0, -1.0, 2.0))
+    axle = Coupling("gear", ("left.spin", "right.spin"), (1.0, 1.0))
+    link = Coupling("linkage", ("fl.steer", "fr.steer"), (1.0, 1.0))
+    assert double.joints_words() == "the gear's joints 'd.spin1' and 'd.spin2'"
+    assert mixed.joints_words() == "the gear's joints 'unit.spin1', 'unit.spin2' and 'rear.spin'"
+    assert axle.joints_words() == "the joints of the gear of wheels 'left' and 'right'"
+    assert link.joints_words() == "the joints of the steering linkage of wheels 'fl' and 'fr'"
+    assert double.words() == "the gear of joints 'd.spin1' and 'd.spin2'"  # alone, as before
+    breach = GearBreach(double, (0, 1), 0.5)
+    assert breach.head == "the gear's joints 'd.spin1' and 'd.spin2' (ratios 1, 2) do not turn together"
+    assert GearBreach(axle, (0, 1), 0.5).head.startswith("the joints of the gear of wheels 'left' and 'right' (")
+
+
+def test_fk_warns_of_a_double_wheel_s_gear_by_its_joints(tmp_path, capsys):
+    """The whole warning of `fk` on a double wheel whose two spins are geared 1:1 and given apart."""
+    data = {"name": "geared-unit", "wheels": [
+        {"name": "d", "type": "double", "position": [0.3, 0.0], "heading": 0, "b": 0.06, "r": 0.08,
+         "actuated": ["spin1", "spin2"], "sensed": ["steer", "spin1", "spin2"]},
+        {"name": "left", "type": "castor", "position": [-0.3, 0.2], "beta": "90 deg", "d": 0.05, "r": 0.05},
+        {"name": "right", "type": "castor", "position": [-0.3, -0.2], "beta": "90 deg", "d": 0.05, "r": 0.05}],
+        "couplings": [{"kind": "gear", "joints": ["d.spin1", "d.spin2"], "ratios": [1, 1]}]}
+    path = tmp_path / "unit.json"
+    path.write_text(json.dumps(data))
+    assert main(["fk", str(path), "--spin", "d.spin1=10", "--spin", "d.spin2=5", "--steer", "d=0"]) == 0
+    err = capsys.readouterr().err
+    assert ("\nwmrkit: warning: the gear's joints 'd.spin1' and 'd.spin2' (ratios 1, 1) do not turn together "
+            "(d.spin1 10, d.spin2 5 rad/s; 50% apart): the rates contradict") in err
+    assert "joints of the gear of joints" not in err
 
 
 def test_kinematics_text_names_the_couplings_json_keeps_channels(capsys):

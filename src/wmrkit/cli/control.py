@@ -294,7 +294,7 @@ def run_track(args: argparse.Namespace) -> int:
              f"that twist is not realisable without the wheels scrubbing, {moved}; the tracking errors are the result")
     for c, ok in zip(robot.couplings, run.commands.in_gear.all(axis=0).tolist(), strict=True):
         if not ok:  # the kinematic plants hold a gear of steering joints only; the dynamics hold every gear
-            warn(f"the commands turn the joints of {c.words()} out of its ratios (ratios "
+            warn(f"the commands turn {c.joints_words()} out of its ratios (ratios "
                  f"{', '.join(f'{k:g}' for k in c.ratios)}); " + (
                      "the dynamics hold the gear, so its servos fight and the robot cannot follow them"
                      if args.dynamics else "the kinematic loop holds the ratios of steering joints only, not these "

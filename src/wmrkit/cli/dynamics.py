@@ -288,8 +288,8 @@ def _check_rolling(model, twist: list[float]) -> None:
     if slip.max() <= SLIP_TOL:
         for c, ok in zip(model.robot.couplings, cmd.in_gear.tolist(), strict=True):
             if not ok:
-                raise WmrkitError(f"--initial-twist {' '.join(f'{v:g}' for v in twist)}: it turns the joints of "
-                                  f"{c.words()} out of its ratios ({', '.join(f'{k:g}' for k in c.ratios)}), "
+                raise WmrkitError(f"--initial-twist {' '.join(f'{v:g}' for v in twist)}: it turns "
+                                  f"{c.joints_words()} out of its ratios ({', '.join(f'{k:g}' for k in c.ratios)}), "
                                   "which the gear holds together, and the simulation starts rolling without slip "
                                   "(wmrkit ik says which twists the gear allows)")
         breach = linkage_breach(model, np.asarray(cmd.beta, dtype=float))

@@ -136,7 +136,7 @@ def deviation_warning(model, inputs, deviation: PathDeviation, max_slip: float) 
     broken = [c for c, ok in zip(model.robot.couplings, geared, strict=True) if not ok]
     if broken:
         ratios = ", ".join(f"{k:g}" for k in broken[0].ratios)
-        return line + (f"its twists turn the joints of {broken[0].words()} out of its ratios ({ratios}), and the "
+        return line + (f"its twists turn {broken[0].joints_words()} out of its ratios ({ratios}), and the "
                        "gear holds them together: its servos fight and the robot cannot follow those twists (wmrkit "
                        "ik says which twists a gear allows)")
     if slip.max() > SLIP_TOL:

@@ -153,7 +153,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
         k, g = (int(i) for i in np.argwhere(~geared)[0])
         c = robot.couplings[g]
         raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s has no no-slip motion for "
-                          f"'{robot.name}': it would turn the joints of {c.words()} out of its ratios "
+                          f"'{robot.name}': it would turn {c.joints_words()} out of its ratios "
                           f"({', '.join(f'{r:g}' for r in c.ratios)}), which the gear holds together; use "
                           "allow_slip=True to let its servos fight and the tyres slip")
     headings = np.zeros((len(t), len(model.steer_columns)))
