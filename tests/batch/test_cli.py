@@ -96,6 +96,31 @@ def test_sweep_text_says_what_an_infinite_metric_means(capsys):
     assert "kappa_mean infinite (singular at a configuration sampled)" in out and err == ""
 
 
+@pytest.mark.parametrize(("robot", "vary", "status", "words"), [
+    # two steering joints at one point: singular wherever sampled (inf in the table)
+    ("thesis-steer-castor", ["wheels.c2.alpha=0:0:1", "wheels.o1.l=0.5:0.5:1"], ["infinite"], "infinite (singular"),
+    # a fixed wheel turned 45 or 90 deg off its axle's partner: no configuration moves (NaN in the table)
+    ("diff-drive", ["wheels[0].heading=0:90deg:3"], ["finite", "undefined", "undefined"], "undefined (it cannot"),
+])
+def test_sweep_json_tells_a_singular_design_from_one_that_cannot_move(capsys, tmp_path, robot, vary, status, words):
+    """Both had "kappa_mean": null in the JSON, where the text says "infinite" or "undefined": a JSON reader could
+    not tell them apart. Each best design now has a "status", as the text and the Parquet table (inf, NaN) say."""
+    import math
+
+    import pyarrow.parquet as pq
+
+    argv = ["sweep", robot, *[a for v in vary for a in ("--vary", v)], "--workers", "0"]
+    data = _json(capsys, [*argv, "--json", "--out", str(tmp_path / "s.parquet")])
+    assert [b["status"] for b in data["best"]] == status
+    assert all((b["kappa_mean"] is None) == (s != "finite") for b, s in zip(data["best"], status, strict=True))
+    table = pq.read_table(tmp_path / "s.parquet").to_pydict()
+    metric = dict(zip(table["index"], table["metric"], strict=True))
+    kind = lambda v: "finite" if math.isfinite(v) else "infinite" if v == math.inf else "undefined"  # noqa: E731
+    assert [kind(metric[b["index"]]) for b in data["best"]] == status
+    assert main(argv) == 0
+    assert capsys.readouterr().out.count(f"kappa_mean {words}") == status.count(status[-1])
+
+
 @pytest.mark.parametrize("argv", [
     ["sweep", "omni-3", "--vary", "wheels[0].l=0:1", "--workers", "0"],
     ["sweep", "omni-3", "--vary", "wheels[0].l=0.1:0.2:2", "--workers", "0", "--length", "-1"],

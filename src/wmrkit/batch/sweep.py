@@ -35,6 +35,15 @@ MAX_TOP = 10**4
 TABLE_KEYS = (("index", "int64"), ("metric", "float64"), ("length", "float64"))
 #: Whether a metric is better when smaller.
 LOWER_IS_BETTER = {"kappa_mean": True, "kappa_max": True, "inv_kappa_mean": False, "singular_margin": False}
+#: What a design's metric that is not a number means (the JSON's ``status``, the text's words; null in JSON for both):
+#: ``infinite``, singular at a configuration sampled (inf in Parquet); ``undefined``, it cannot move at any
+#: configuration sampled (NaN in Parquet). A finite metric's status is ``finite``.
+STATUS = {"infinite": "singular at a configuration sampled", "undefined": "it cannot move at any configuration sampled"}
+
+
+def metric_status(value: float) -> str:
+    """``finite``, ``infinite`` (+inf: singular) or ``undefined`` (NaN: cannot move) (:data:`STATUS`)."""
+    return "finite" if math.isfinite(value) else "infinite" if value == math.inf else "undefined"
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
@@ -59,7 +68,7 @@ class SweepResult:
                 "axes": [{"field": a.label, "start": float(a.values[0]), "stop": float(a.values[-1]),
                           "n": len(a.values), "unit": a.unit} for a in self.axes],
                 "best": [{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in b.items()}
-                         for b in self.best]}
+                         | {"status": metric_status(b[self.metric])} for b in self.best]}
 
 
 def check_counts(chunk: int, top: int, names: tuple[str, str] = ("chunk", "top")) -> None:

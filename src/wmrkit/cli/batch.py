@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
@@ -352,7 +351,7 @@ def run_montecarlo(args: argparse.Namespace) -> int:
 
 def run_sweep(args: argparse.Namespace) -> int:
     """A design sweep; prints the best designs."""
-    from ..batch.sweep import check_counts, plot_sweep, sweep
+    from ..batch.sweep import STATUS, check_counts, metric_status, plot_sweep, sweep
     from ..batch.sweep_kernel import parse_vary
 
     check_counts(args.chunk, args.top, ("--chunk", "--top"))  # by the options' names, before the robot is read
@@ -376,8 +375,7 @@ def run_sweep(args: argparse.Namespace) -> int:
     print(f"robot {robot.name}: {args.metric} over {result.total:,} designs in {result.wall_time:.3g} s")
     for b in result.best:
         fields = ", ".join(f"{a.label} = {a.shown(b[a.label]):.6g} {a.shown_unit}" for a in axes)
-        value = b[args.metric]
-        shown = (f"{value:.6g}" if math.isfinite(value) else "infinite (singular at a configuration sampled)"
-                 if value == math.inf else "undefined (it cannot move at any configuration sampled)")
+        status = metric_status(b[args.metric])
+        shown = f"{b[args.metric]:.6g}" if status == "finite" else f"{status} ({STATUS[status]})"
         print(f"  {args.metric} {shown} (D {b['length']:.4g} m): {fields}")
     return 0
