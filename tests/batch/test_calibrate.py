@@ -400,6 +400,40 @@ def test_bootstrap_refuses_when_most_replicates_do_not_determine_the_parameters(
         fleet_calibrate(diff, runs[:1], params, ci="bootstrap", n_boot=40)
 
 
+def test_a_log_given_twice_to_the_slip_fit_is_named(skid_runs, tmp_path, capsys):
+    """'batch calibrate --slip' weighed a copy of a log (or a link to it) as another run without a word (the plain
+    fit names it): its values counted twice in the mean, the interval's runs one too many. Now a warning names it,
+    on stderr and in the JSON's "warnings" (the answer had none), by the same check; noise-free runs too (their
+    values differ by path, so a copy moves the mean)."""
+    import json
+    import shutil
+
+    from batch_params import write_log
+
+    from wmrkit.cli.main import main
+    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+
+    robot, sims = skid_runs
+    (tmp_path / "ref").mkdir()
+    for i, r in enumerate(sims[:3]):
+        write_log(tmp_path / f"s{i}.csv", r)
+        write_trajectory(tmp_path / "ref" / f"s{i}.tum", Trajectory(r.log.time, r.truth, np.zeros(len(r.log))), "tum")
+    shutil.copy(tmp_path / "ref" / "s1.tum", tmp_path / "ref" / "t.tum")
+    argv = ["--reference", str(tmp_path / "ref"), "--slip", "--workers", "0"]
+    assert main(["batch", "calibrate", "skid-steer-4", str(tmp_path / "s*.csv"), *argv, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["warnings"] == []
+    (tmp_path / "t.csv").symlink_to(tmp_path / "s1.csv")
+    said = (f"{tmp_path / 't.csv'}: the same samples as {tmp_path / 's1.csv'} (a copy of one log, or a link to it): "
+            "its values are counted twice in the mean and the intervals are too narrow; give each log once")
+    logs = [str(tmp_path / f"s{i}.csv") for i in range(3)] + [str(tmp_path / "t.csv")]
+    assert fleet_slip_calibrate(robot, load_runs(robot, logs, reference_dir=tmp_path / "ref")).warnings == (said,)
+    assert main(["batch", "calibrate", "skid-steer-4", *logs, *argv, "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["warnings"] == [said] and err == f"wmrkit: warning: {said}\n"
+    assert main(["batch", "calibrate", "skid-steer-4", *logs, *argv]) == 0
+    assert capsys.readouterr().err == f"wmrkit: warning: {said}\n"
+
+
 def test_a_log_the_slip_fit_refuses_is_named(diff, fleet_dir):
     """A differential drive's squares do not determine the WLS ratio: the error said 'task 0 failed: ...', which
     log of the fleet it was not."""

@@ -48,10 +48,10 @@ from ..robot import Robot
 from .consistency import SLIP_NOT_JUDGED, Consistency, judge, names
 from .engine import BatchError, Engine, TaskFailure, engine
 from .motions import REFERENCE_NOISE, check_reference_noise
+from .runs import copies, copy_warning, repeated_runs
 from .runs import find_reference as find_reference  # read from log files (re-exported: their public home was here)
 from .runs import load_run as load_run
 from .runs import load_runs as load_runs
-from .runs import repeated_runs
 
 
 @dataclass(frozen=True)
@@ -343,7 +343,8 @@ class FleetSlipCalibration:
     multiplier, each the geometric mean over the runs with its interval at ``level`` (Student's t over the runs'
     log values: run-to-run variation, e.g. floors and loads); ``per_run``: ``(ratio, multiplier)`` of each run, its
     file in ``logs``; ``not_judged``: the runs are not checked against each other (why:
-    :data:`~wmrkit.batch.consistency.SLIP_NOT_JUDGED`)."""
+    :data:`~wmrkit.batch.consistency.SLIP_NOT_JUDGED`); ``warnings``: a log given twice (a copy or a link: its
+    values counted twice in the mean)."""
 
     robot: str
     ratio: float
@@ -354,6 +355,7 @@ class FleetSlipCalibration:
     level: float
     not_judged: str = SLIP_NOT_JUDGED
     logs: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
     @property
     def weights(self):
@@ -376,7 +378,7 @@ class FleetSlipCalibration:
         return {"robot": self.robot, "weights": self.weights.to_dict(), "level": self.level, "runs": len(self.per_run),
                 "ratio": self.ratio, "ratio_interval": list(self.ratio_interval),
                 "wheel_separation_multiplier": self.multiplier, "multiplier_interval": list(self.multiplier_interval),
-                "not_judged": self.not_judged,
+                "not_judged": self.not_judged, "warnings": list(self.warnings),
                 "per_run": [{"file": f, "ratio": k, "wheel_separation_multiplier": m}
                             for f, (k, m) in zip(self.logs or (None,) * len(self.per_run), self.per_run, strict=True)]}
 
@@ -419,9 +421,11 @@ def fleet_slip_calibrate(robot: Robot, runs: Sequence[CalibrationRun], *, runner
     half = _t_quantile(level, g - 1) * logs.std(axis=0, ddof=1) / np.sqrt(g)
     mean = logs.mean(axis=0)
     lo, hi, mid = np.exp(mean - half), np.exp(mean + half), np.exp(mean)
+    twice = tuple(copy_warning(names(runs), k, first, "values are counted twice in the mean")
+                  for k, first in copies(runs))  # noise-free runs too: each path has values of its own
     return FleetSlipCalibration(robot.name, float(mid[0]), (float(lo[0]), float(hi[0])), float(mid[1]),
                                 (float(lo[1]), float(hi[1])), tuple((float(k), float(m)) for k, m in per_run), level,
-                                logs=names(runs))
+                                logs=names(runs), warnings=twice)
 
 
 def default_parameters(robot: Robot, *, closed: bool, sensed: Sequence[str] | None = None) -> list[Parameter]:

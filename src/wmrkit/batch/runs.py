@@ -110,21 +110,33 @@ def load_runs(robot: Robot, paths: Sequence[str], *, reference_dir: str | os.Pat
     return out
 
 
-
-def repeated_runs(problem, residuals: np.ndarray) -> tuple[str, ...]:
-    """A warning per run whose samples (times and joint positions) equal an earlier run's, a copy of one log or a link
-    to it under another name, when its residuals at the fit exceed round-off: one run's noise counted as two runs'
-    (3 of 6 runs copied narrowed an interval by 36 %). Runs that fit exactly (noise-free, simulated) change nothing
-    however often they are given, and are not named. `problem`: the fleet's ``CalibrationProblem``."""
-    from .consistency import ROUNDOFF, names, travel
-
-    logs, seen, said = names(problem.runs), {}, []
-    parts = np.split(np.asarray(residuals, dtype=float), np.cumsum(problem.sizes())[:-1])
-    for k, run in enumerate(problem.runs):
+def copies(runs: Sequence[CalibrationRun]) -> list[tuple[int, int]]:
+    """``(k, first)`` for each run `k` whose samples (times and joint positions) equal those of an earlier run
+    `first`: a copy of one log, or a link to it, under another name."""
+    seen: dict[str, int] = {}
+    found = []
+    for k, run in enumerate(runs):
         digest = hashlib.sha1(np.ascontiguousarray(run.log.time).tobytes()
                               + np.ascontiguousarray(run.log.positions).tobytes()).hexdigest()
-        first = seen.setdefault(digest, k)
-        if first != k and np.sqrt(np.mean(parts[k] ** 2)) > ROUNDOFF * travel(problem.robot, run):
-            said.append(f"{logs[k]}: the same samples as {logs[first]} (a copy of one log, or a link to it): its "
-                        "noise is counted twice and the intervals are too narrow; give each log once")
-    return tuple(said)
+        if (first := seen.setdefault(digest, k)) != k:
+            found.append((k, first))
+    return found
+
+
+def copy_warning(logs: Sequence[str], k: int, first: int, counted: str = "noise is counted twice") -> str:
+    """The warning naming run `k` as a copy of run `first` (`logs`: the runs' names), what of it is `counted`."""
+    return (f"{logs[k]}: the same samples as {logs[first]} (a copy of one log, or a link to it): its {counted} and "
+            "the intervals are too narrow; give each log once")
+
+
+def repeated_runs(problem, residuals: np.ndarray) -> tuple[str, ...]:
+    """A warning per run whose samples equal an earlier run's (:func:`copies`) when its residuals at the fit exceed
+    round-off: one run's noise counted as two runs' (3 of 6 runs copied narrowed an interval by 36 %). Runs that
+    fit exactly (noise-free, simulated) change nothing however often they are given, and are not named. `problem`:
+    the fleet's ``CalibrationProblem``."""
+    from .consistency import ROUNDOFF, names, travel
+
+    logs = names(problem.runs)
+    parts = np.split(np.asarray(residuals, dtype=float), np.cumsum(problem.sizes())[:-1])
+    return tuple(copy_warning(logs, k, first) for k, first in copies(problem.runs)
+                 if np.sqrt(np.mean(parts[k] ** 2)) > ROUNDOFF * travel(problem.robot, problem.runs[k]))

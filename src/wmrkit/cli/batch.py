@@ -282,7 +282,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
                                          progress=_progress(args), reference_noise=noise)
             except UndeterminedError as err:  # at fault: the parameters chosen, else the runs given
                 raise OptionError(str(err), field="--param" if args.param else "LOG") from None
-    for warning in () if args.slip else result.warnings:  # the slip fit has none
+    for warning in result.warnings:
         warn(one_line(warning))  # a run's name with a line break: one line still
     if args.json:
         print_json(result.to_dict())
