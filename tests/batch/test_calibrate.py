@@ -434,6 +434,38 @@ def test_a_log_given_twice_to_the_slip_fit_is_named(skid_runs, tmp_path, capsys)
     assert capsys.readouterr().err == f"wmrkit: warning: {said}\n"
 
 
+def test_the_slip_fit_says_a_suspicious_reference(skid_runs, tmp_path, capsys):
+    """A reference whose heading is 30 deg off the robot's (direction of travel beyond a skid steer's 25 deg of
+    lateral slip) is a warning of 'wmrkit calibrate' (slip.consistency.check_reference); the fleet's slip fit
+    dropped it: exit 0, no word, and that run moved the fleet's ratio from 0.77 to 1.4 with an interval of
+    [0.22, 8.7]. Now the run's warning is the fleet's, naming its log."""
+    import json
+
+    from batch_params import write_log
+
+    from wmrkit.cli.main import main
+    from wmrkit.odometry.trajectories import Trajectory, write_trajectory
+    from wmrkit.slip.calibration import calibrate_slip
+
+    robot, sims = skid_runs
+    turned = sims[0].truth + np.array([0.0, 0.0, np.radians(30)])
+    single = calibrate_slip(robot, sims[0].log, (sims[0].log.time, turned)).warnings
+    assert len(single) == 1 and "direction of travel is 30" in single[0]  # the single fit's own check says it
+    runs = [CalibrationRun(sims[0].log, turned)] + [CalibrationRun(r.log, r.truth) for r in sims[1:3]]
+    assert fleet_slip_calibrate(robot, runs).warnings == (f"run 1 (<slip-synthetic>): {single[0]}",)
+    (tmp_path / "ref").mkdir()
+    for i, r in enumerate(sims[:3]):
+        write_log(tmp_path / f"s{i}.csv", r)
+        write_trajectory(tmp_path / "ref" / f"s{i}.tum", Trajectory(r.log.time, turned if i == 0 else r.truth,
+                                                                     np.zeros(len(r.log))), "tum")
+    assert main(["batch", "calibrate", "skid-steer-4", str(tmp_path / "s*.csv"), "--reference", str(tmp_path / "ref"),
+                 "--slip", "--workers", "0", "--json"]) == 0
+    out, err = capsys.readouterr()
+    warnings = json.loads(out)["warnings"]
+    assert len(warnings) == 1 and warnings[0].startswith(f"{tmp_path / 's0.csv'}: reference: its direction of travel")
+    assert err == f"wmrkit: warning: {warnings[0]}\n"
+
+
 def test_a_log_the_slip_fit_refuses_is_named(diff, fleet_dir):
     """A differential drive's squares do not determine the WLS ratio: the error said 'task 0 failed: ...', which
     log of the fleet it was not."""

@@ -343,8 +343,9 @@ class FleetSlipCalibration:
     multiplier, each the geometric mean over the runs with its interval at ``level`` (Student's t over the runs'
     log values: run-to-run variation, e.g. floors and loads); ``per_run``: ``(ratio, multiplier)`` of each run, its
     file in ``logs``; ``not_judged``: the runs are not checked against each other (why:
-    :data:`~wmrkit.batch.consistency.SLIP_NOT_JUDGED`); ``warnings``: a log given twice (a copy or a link: its
-    values counted twice in the mean)."""
+    :data:`~wmrkit.batch.consistency.SLIP_NOT_JUDGED`); ``warnings``: a run's suspicious reference (the single fit's
+    warnings, :func:`wmrkit.slip.consistency.check_reference`), a log given twice (a copy or a link: its values
+    counted twice in the mean)."""
 
     robot: str
     ratio: float
@@ -383,7 +384,7 @@ class FleetSlipCalibration:
                             for f, (k, m) in zip(self.logs or (None,) * len(self.per_run), self.per_run, strict=True)]}
 
 
-def _slip_of(args: tuple) -> tuple[float, float]:
+def _slip_of(args: tuple) -> tuple[float, float, tuple[str, ...]]:
     from ..slip.calibration import calibrate_slip
 
     robot, run, method, heading_weight = args
@@ -391,7 +392,7 @@ def _slip_of(args: tuple) -> tuple[float, float]:
     if at[0] != 0:  # the start pose is a reference pose too (a closed path's only other one)
         at, ref = np.concatenate([[0], at]), np.vstack([run.start()[None], ref])
     cal = calibrate_slip(robot, run.log, (run.log.time[at], ref), method=method, heading_weight=heading_weight)
-    return cal.ratio, cal.multiplier
+    return cal.ratio, cal.multiplier, cal.warnings  # a suspicious reference (the single fit's warnings)
 
 
 def fleet_slip_calibrate(robot: Robot, runs: Sequence[CalibrationRun], *, runner: Engine | None = None,
@@ -416,16 +417,17 @@ def fleet_slip_calibrate(robot: Robot, runs: Sequence[CalibrationRun], *, runner
     for run, value in zip(runs, per_run, strict=True):
         if isinstance(value, TaskFailure):  # named by its log (the message said 'task 0 failed')
             raise BatchError(f"{run.log.source}: {value}")
-    logs = np.log(np.array(per_run, dtype=float))  # (G, 2)
+    logs = np.log(np.array([value[:2] for value in per_run], dtype=float))  # (G, 2)
     g = len(per_run)
     half = _t_quantile(level, g - 1) * logs.std(axis=0, ddof=1) / np.sqrt(g)
     mean = logs.mean(axis=0)
     lo, hi, mid = np.exp(mean - half), np.exp(mean + half), np.exp(mean)
-    twice = tuple(copy_warning(names(runs), k, first, "values are counted twice in the mean")
+    said = tuple(f"{name}: {w}" for name, value in zip(names(runs), per_run, strict=True) for w in value[2])
+    said += tuple(copy_warning(names(runs), k, first, "values are counted twice in the mean")
                   for k, first in copies(runs))  # noise-free runs too: each path has values of its own
     return FleetSlipCalibration(robot.name, float(mid[0]), (float(lo[0]), float(hi[0])), float(mid[1]),
-                                (float(lo[1]), float(hi[1])), tuple((float(k), float(m)) for k, m in per_run), level,
-                                logs=names(runs), warnings=twice)
+                                (float(lo[1]), float(hi[1])), tuple((float(k), float(m)) for k, m, _ in per_run),
+                                level, logs=names(runs), warnings=said)
 
 
 def default_parameters(robot: Robot, *, closed: bool, sensed: Sequence[str] | None = None) -> list[Parameter]:
