@@ -466,6 +466,19 @@ def test_the_slip_fit_says_a_suspicious_reference(skid_runs, tmp_path, capsys):
     assert err == f"wmrkit: warning: {warnings[0]}\n"
 
 
+def test_the_slip_fit_names_closed_runs_cut_short(skid_runs):
+    """A closed run whose log ends while its wheels still turn is named by the geometry fit (its closure is not at
+    the last sample: the fit is biased); the slip fit, which takes the same return pose as its reference, said
+    nothing. The same runs with a measured final pose (not closed) are not named."""
+    robot, sims = skid_runs
+    runs = [CalibrationRun(r.log, r.truth[-1:], pose0=tuple(r.truth[0]), closed=k > 0) for k, r in enumerate(sims[:3])]
+    said = fleet_slip_calibrate(robot, runs).warnings
+    assert len(said) == 2 and all("the log ends while the wheels still turn" in w for w in said)
+    assert [w.partition(":")[0] for w in said] == [r.log.source for r in runs[1:]]
+    rest = [CalibrationRun(r.log, r.truth[-1:], pose0=tuple(r.truth[0])) for r in sims[:3]]  # not closed: fine
+    assert fleet_slip_calibrate(robot, rest).warnings == ()
+
+
 def test_a_log_the_slip_fit_refuses_is_named(diff, fleet_dir):
     """A differential drive's squares do not determine the WLS ratio: the error said 'task 0 failed: ...', which
     log of the fleet it was not."""

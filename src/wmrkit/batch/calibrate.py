@@ -343,8 +343,9 @@ class FleetSlipCalibration:
     multiplier, each the geometric mean over the runs with its interval at ``level`` (Student's t over the runs'
     log values: run-to-run variation, e.g. floors and loads); ``per_run``: ``(ratio, multiplier)`` of each run, its
     file in ``logs``; ``not_judged``: the runs are not checked against each other (why:
-    :data:`~wmrkit.batch.consistency.SLIP_NOT_JUDGED`); ``warnings``: a run's suspicious reference (the single fit's
-    warnings, :func:`wmrkit.slip.consistency.check_reference`), a log given twice (a copy or a link: its values
+    :data:`~wmrkit.batch.consistency.SLIP_NOT_JUDGED`); ``warnings``: a closed run cut short (as the geometry fit's),
+    a run's suspicious reference (the single fit's warnings, :func:`wmrkit.slip.consistency.check_reference`), a
+    log given twice (a copy or a link: its values
     counted twice in the mean)."""
 
     robot: str
@@ -422,7 +423,9 @@ def fleet_slip_calibrate(robot: Robot, runs: Sequence[CalibrationRun], *, runner
     half = _t_quantile(level, g - 1) * logs.std(axis=0, ddof=1) / np.sqrt(g)
     mean = logs.mean(axis=0)
     lo, hi, mid = np.exp(mean - half), np.exp(mean + half), np.exp(mean)
-    said = tuple(f"{name}: {w}" for name, value in zip(names(runs), per_run, strict=True) for w in value[2])
+    # closed runs cut short (as the geometry fit says), suspicious references (as wmrkit calibrate says), copies
+    said = tuple(w for w in (run.warning() for run in runs) if w is not None)
+    said += tuple(f"{name}: {w}" for name, value in zip(names(runs), per_run, strict=True) for w in value[2])
     said += tuple(copy_warning(names(runs), k, first, "values are counted twice in the mean")
                   for k, first in copies(runs))  # noise-free runs too: each path has values of its own
     return FleetSlipCalibration(robot.name, float(mid[0]), (float(lo[0]), float(hi[0])), float(mid[1]),
