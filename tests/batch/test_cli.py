@@ -136,6 +136,20 @@ def test_errors_exit_2(capsys, argv):
     assert err.startswith("wmrkit: error:") and "Traceback" not in err
 
 
+@pytest.mark.parametrize(("robot", "path", "words"), [
+    ("skid-steer-4", "square", "at t = 4 s the twist [0.0, 0.0, 0.5] is not possible for robot 'skid-steer-4'"),
+    ("forklift", "arc", "at t = 0 s the twist [0.5, 0.0, 0.15] is not possible for robot 'forklift'"),
+])
+def test_montecarlo_names_the_built_in_path_a_robot_cannot_drive(capsys, robot, path, words):
+    """A built-in path the robot cannot drive was refused as 'profile: at t = 4 s ...': no option is called
+    profile. The error names --path and the path (the JSON's field too)."""
+    argv = ["batch", "montecarlo", robot, "--path", path, "-n", "3", "--workers", "0"]
+    assert main(argv) == 2
+    assert capsys.readouterr().err.startswith(f"wmrkit: error: --path {path}: {words}")
+    assert main([*argv, "--json"]) == 2
+    assert json.loads(capsys.readouterr().err)["field"] == "--path"
+
+
 def test_montecarlo_refuses_a_built_in_path_the_robot_cannot_steer(capsys):
     # the square turns in place: the car's front wheels would steer to -74 deg, beyond their +-40 deg; the run was
     # integrated anyway and its covariance printed with exit 0 (smoke matrix)

@@ -327,7 +327,8 @@ def run_montecarlo(args: argparse.Namespace) -> int:
         rate = 20.0 if args.rate is None else args.rate
         if not rate > 0:
             raise WmrkitError(f"--rate must be > 0 Hz, got {rate}")
-        with renaming({"rate": "--rate", "unknown path": "--path: unknown path"}):  # 'rate: expected a finite ...'
+        with renaming({"rate": "--rate", "unknown path": "--path: unknown path",  # 'rate: expected a finite ...'
+                       "profile: ": f"--path {args.path}: "}):  # a path the robot cannot drive (no option 'profile')
             log = path_log(robot, args.path, rate)
     with _runner(args) as runner:
         result = monte_carlo(robot, log, args.runs, per_rad=args.noise, resolution=resolution, slip_std=args.slip,
