@@ -150,6 +150,20 @@ def test_montecarlo_names_the_built_in_path_a_robot_cannot_drive(capsys, robot, 
     assert json.loads(capsys.readouterr().err)["field"] == "--path"
 
 
+@pytest.mark.parametrize("name", ["run.mcap", "run.DB3"])
+def test_montecarlo_names_a_bag_given_as_its_log(capsys, tmp_path, name):
+    """A ROS 2 bag file (which 'batch odometry' and 'batch calibrate' read) given as the LOG was read as CSV text:
+    'run.mcap:1: bytes that are not UTF-8 text (a binary file, or another encoding?)'. It is named a bag now."""
+    import shutil
+    from pathlib import Path
+
+    bag = tmp_path / name
+    shutil.copy(Path(__file__).parents[1] / "hostile" / "bags" / "garbage.mcap", bag)
+    assert main(["batch", "montecarlo", "diff-drive", str(bag), "-n", "3", "--workers", "0"]) == 2
+    assert capsys.readouterr().err == (f"wmrkit: error: {bag}: a ROS 2 bag: batch montecarlo takes a CSV joint log "
+                                       "as the truth (LOG), or a built-in --path\n")
+
+
 def test_montecarlo_refuses_a_built_in_path_the_robot_cannot_steer(capsys):
     # the square turns in place: the car's front wheels would steer to -74 deg, beyond their +-40 deg; the run was
     # integrated anyway and its covariance printed with exit 0 (smoke matrix)

@@ -307,6 +307,7 @@ def run_montecarlo(args: argparse.Namespace) -> int:
     check_plot_path(args.plot)
     if (args.log is None) == (args.path is None):  # both: --path is the one too many, as argparse names it
         raise OptionError("give a LOG or --path NAME (one of the two)", field="LOG" if args.path is None else "--path")
+    from ..odometry.files import is_bag
     from ..odometry.model import odometry_model
 
     model = odometry_model(robot)
@@ -316,6 +317,9 @@ def run_montecarlo(args: argparse.Namespace) -> int:
         raise WmrkitError("--rate sets the sample rate of a built-in --path; a LOG keeps its own times")
     if args.log is not None and Path(args.log).exists() and not Path(args.log).is_file():  # a FIFO: read forever
         raise WmrkitError(f"{args.log}: not a regular file (a folder, FIFO or device); LOG is a CSV log")
+    if args.log is not None and Path(args.log).is_file() and is_bag(args.log):  # read as CSV: 'bytes not UTF-8'
+        raise WmrkitError(f"{args.log}: a ROS 2 bag: batch montecarlo takes a CSV joint log as the truth (LOG), or a "
+                          "built-in --path")
     if args.log is not None:  # read as its header says, as 'wmrkit odometry' reads it
         from ..limits import check_table_size
         from ..odometry.header import header_format
