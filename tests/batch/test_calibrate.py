@@ -437,8 +437,8 @@ def test_a_log_given_twice_to_the_slip_fit_is_named(skid_runs, tmp_path, capsys)
 def test_the_slip_fit_says_a_suspicious_reference(skid_runs, tmp_path, capsys):
     """A reference whose heading is 30 deg off the robot's (direction of travel beyond a skid steer's 25 deg of
     lateral slip) is a warning of 'wmrkit calibrate' (slip.consistency.check_reference); the fleet's slip fit
-    dropped it: exit 0, no word, and that run moved the fleet's ratio from 0.77 to 1.4 with an interval of
-    [0.22, 8.7]. Now the run's warning is the fleet's, naming its log."""
+    dropped it: exit 0, no word (one such run among four of these logs moved the fleet's ratio from 0.77 to 1.4,
+    interval [0.22, 8.7]). Now the run's warning is the fleet's, naming its log."""
     import json
 
     from batch_params import write_log
