@@ -14,7 +14,7 @@ from wmrkit.dynamics.model import DynamicModel
 from wmrkit.dynamics.programs import PATHS, feasible_twists, path_program, read_torques, twist_program
 from wmrkit.dynamics.simulate import METHODS, Inputs, simulate
 from wmrkit.dynamics.tyres import Tyre
-from wmrkit.errors import WmrkitError
+from wmrkit.errors import ShapeError, WmrkitError
 
 
 @pytest.fixture(scope="module")
@@ -114,7 +114,7 @@ def test_a_twist_without_a_no_slip_motion_is_refused_unless_slip_is_allowed(fork
         twist_program(skid, [0.0], feasible_twists(skid, [(1.0, 0.0, 0.3)]))
     twist_program(skid, [0.0], [(1.0, 0.0, 0.3)], allow_slip=True)
     for wrong in (math.nan, math.inf, 1e300):  # one line naming the knot, no overflow warnings
-        with pytest.raises(WmrkitError, match=r"at t = 1 s: expected finite speeds within 1000 m/s"):
+        with pytest.raises(ShapeError, match=r"at t = 1 s: expected finite speeds within 1000 m/s"):
             twist_program(forklift, [0.0, 1.0], [(1.0, 0.0, 0.0), (wrong, 0.0, 0.0)], allow_slip=True)
 
 
@@ -176,7 +176,7 @@ def test_a_heading_column_for_a_passive_castor_is_refused(tmp_path):
 
 def test_bad_arguments_are_errors(forklift):
     inputs = Inputs.torques_only(forklift, [0.0], {})
-    with pytest.raises(WmrkitError):
+    with pytest.raises(ShapeError):
         simulate(forklift, inputs, -1.0)
     with pytest.raises(WmrkitError):
         simulate(forklift, inputs, 1.0, method="euler")  # type: ignore[arg-type]
@@ -311,7 +311,7 @@ def test_recorded_samples_are_bounded_in_memory_and_the_refusal_names_a_step_tha
     capacity = module.record_capacity(forklift)
     assert capacity == module.MAX_RECORD_VALUES // (3 * forklift.n + 6 * len(forklift.contacts) + 1)
     for method in METHODS:  # refused before integrating: no time is spent on a run that cannot be kept
-        with pytest.raises(WmrkitError, match=r"records \d+ samples, more than the \d+ of robot 'forklift'"):
+        with pytest.raises(ShapeError, match=r"records \d+ samples, more than the \d+ of robot 'forklift'"):
             simulate(forklift, inputs, 49_000.0, step=1e-3, record_step=1e-3, method=method)
     every = module.recordable_step(forklift, 49_000.0, 1e-3, 1e-3)
     steps = round(every / 1e-3)  # the least whole number of steps that fits

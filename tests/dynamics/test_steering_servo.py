@@ -19,7 +19,7 @@ from wmrkit.control.track import track
 from wmrkit.dynamics.model import DynamicModel
 from wmrkit.dynamics.programs import path_program
 from wmrkit.dynamics.simulate import LiftOffError, simulate
-from wmrkit.errors import WmrkitError
+from wmrkit.errors import ShapeError
 from wmrkit.kinematics.wheel_ik import wheel_commands
 from wmrkit.wheels import wrap_angle
 
@@ -214,7 +214,7 @@ def test_steering_limits_are_torques_above_zero():
     assert np.isfinite(inputs.steer_limit[0]) and np.isinf(inputs.steer_limit[1:]).all()  # the castors: none
     assert inputs.steer_limit[0] == pytest.approx(model.normal_loads()[:2].sum() * 0.06)
     for bad in ([0.0, 1.0, 1.0], [np.nan, 1.0, 1.0], [1.0, 1.0]):
-        with pytest.raises(WmrkitError, match="steer_limit: expected 3 torques > 0 N m"):
+        with pytest.raises(ShapeError, match="steer_limit: expected 3 torques > 0 N m"):
             simulate(model, dataclasses.replace(inputs, steer_limit=np.array(bad)), 0.01)
 
 
@@ -223,12 +223,12 @@ def test_steering_gains_refuse_columns_that_are_not_joints():
 
     model = DynamicModel.of(tricycle())
     for held in ([99], [-1], ["a"], [1.5], [2]):
-        with pytest.raises(WmrkitError, match="held: expected joint columns"):
+        with pytest.raises(ShapeError, match="held: expected joint columns"):
             model.steering_inertia(held)
-    with pytest.raises(WmrkitError, match="servoed: expected steering columns"):
+    with pytest.raises(ShapeError, match="servoed: expected steering columns"):
         steering_gains(model, [3])
     for bandwidth in (float("nan"), 0.0, -30.0):
-        with pytest.raises(WmrkitError, match="bandwidth: expected a natural frequency"):
+        with pytest.raises(ShapeError, match="bandwidth: expected a natural frequency"):
             steering_gains(model, list(model.steer_columns), bandwidth=bandwidth)
-        with pytest.raises(WmrkitError, match="bandwidth: expected a natural frequency"):
+        with pytest.raises(ShapeError, match="bandwidth: expected a natural frequency"):
             twist_program(model, [0.0], [(1.0, 0.0, 0.0)], bandwidth=bandwidth)

@@ -9,7 +9,7 @@ from wmrkit import catalog
 from wmrkit.dynamics.model import DynamicModel
 from wmrkit.dynamics.programs import feasible_twists, path_program, twist_program
 from wmrkit.dynamics.simulate import Stepper, advance, initial_state, simulate
-from wmrkit.errors import WmrkitError
+from wmrkit.errors import ShapeError, WmrkitError
 
 
 @pytest.fixture(scope="module")
@@ -76,15 +76,15 @@ def test_stepper_refuses_bad_arguments(forklift):
     model, inputs = forklift
     with pytest.raises(WmrkitError, match="state"):
         Stepper(model, np.zeros(3))
-    with pytest.raises(WmrkitError, match="finite"):
+    with pytest.raises(ShapeError, match="finite"):
         Stepper(model, np.full(2 * model.n, np.nan))
     with pytest.raises(WmrkitError, match="no inputs"):
         Stepper(model).advance(None, 0.1)
-    with pytest.raises(WmrkitError, match="duration"):
+    with pytest.raises(ShapeError, match="duration"):
         Stepper(model).advance(inputs, -1.0)
     with pytest.raises(WmrkitError, match="method"):
         Stepper(model, method="adaptive")  # type: ignore[arg-type]
-    with pytest.raises(WmrkitError, match="jac_every"):
+    with pytest.raises(ShapeError, match="jac_every"):
         Stepper(model, jac_every=0)
 
 
@@ -98,7 +98,7 @@ def test_hold_equals_advancing_with_the_held_inputs(forklift):
     b.hold(program.rate_reference[0], program.heading_reference[0], program.torques[0])
     b.advance(None, 0.5)
     np.testing.assert_array_equal(a.state, b.state)
-    with pytest.raises(WmrkitError, match="heading_reference"):
+    with pytest.raises(ShapeError, match="heading_reference"):
         b.hold(heading_reference=np.zeros(5))
     with pytest.raises(WmrkitError, match="first"):
         Stepper(model).hold(torques=np.zeros(model.n))

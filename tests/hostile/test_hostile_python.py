@@ -247,7 +247,7 @@ def test_the_slip_models_refuse_their_inputs_by_name(call, message):
     from wmrkit import slip
 
     robot = catalog.load("skid-steer-4")
-    with pytest.raises(WmrkitError) as err:
+    with pytest.raises(ShapeError) as err:  # a ValueError, as docs/conventions.md says
         call(slip, robot, ["front_left.spin", "front_right.spin"])
     assert str(err.value).startswith(message)
 

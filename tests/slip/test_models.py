@@ -13,7 +13,7 @@ from slip_helpers import L3, L12, R, forklift_at_axle, thesis_twist_to_rep
 
 from wmrkit import catalog
 from wmrkit.dynamics.mass import Body
-from wmrkit.errors import WmrkitError
+from wmrkit.errors import ShapeError
 from wmrkit.slip.models import LinearFriction, mcd, mqe, normal_loads, wls
 from wmrkit.slip.weights import SlipWeightError, SlipWeights
 
@@ -300,11 +300,11 @@ def test_a_friction_law_that_does_not_fit_the_robot_is_refused_by_name():
     rates = [1.0, 1.0, 1.0, 1.0]
     for mu, match in (((1.0,) * 4, "2 pairs of coefficients for 4 contacts"), ((1.0, math.nan) * 4, "finite"),
                       ((-1.0, 1.0) * 4, "> 0"), ((), "a .lateral, longitudinal. pair")):
-        with pytest.raises(WmrkitError, match=match):
+        with pytest.raises(ShapeError, match=match):
             mcd(robot, robot.actuated, rates, LinearFriction(mu))
-    with pytest.raises(WmrkitError, match=r"shape \(4, 2\), one pair per contact, got shape \(2, 2\)"):
+    with pytest.raises(ShapeError, match=r"shape \(4, 2\), one pair per contact, got shape \(2, 2\)"):
         mqe(robot, robot.actuated, rates, lambda slip, v, loads: -slip[:2])
-    with pytest.raises(WmrkitError, match="non-finite"):
+    with pytest.raises(ShapeError, match="non-finite"):
         mcd(robot, robot.actuated, rates, lambda slip, v, loads: slip * math.inf)
     good = mcd(robot, robot.actuated, rates, LinearFriction((1.0,) * 8))
     assert good.converged.all()
@@ -317,7 +317,7 @@ def test_a_lone_name_for_the_assigned_velocities_is_refused_as_a_string(model):
     ``odometry_model`` refuses a lone `sensed` name."""
     robot = catalog.load("skid-steer-4")
     law = () if model is wls else (LinearFriction((1.0,) * 8),)
-    with pytest.raises(WmrkitError, match=r"expected a sequence of velocity names, got the string 'front_left\.spin'"):
+    with pytest.raises(ShapeError, match=r"expected a sequence of velocity names, got the string 'front_left\.spin'"):
         model(robot, "front_left.spin", [1.0], *law)
     assert model(robot, ("front_left.spin",), [1.0], *law).converged.all()  # a sequence of one name is fine
 
@@ -362,7 +362,7 @@ def test_a_start_of_one_sample_serves_a_batch_and_a_start_of_another_batch_is_re
     one = mcd(robot, robot.sensed, rates, law, start=wls(robot, robot.sensed, rates[:1]))
     assert one.converged.all()
     np.testing.assert_allclose(one.q_dot, want.q_dot, atol=1e-9)
-    with pytest.raises(WmrkitError, match=r"start: expected velocities of shape \(3, 7\)"):
+    with pytest.raises(ShapeError, match=r"start: expected velocities of shape \(3, 7\)"):
         mcd(robot, robot.sensed, rates, law, start=wls(robot, robot.sensed, rates[:2]))
 
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from wmrkit.cli.main import main
-from wmrkit.errors import WmrkitError
+from wmrkit.errors import ShapeError, WmrkitError
 from wmrkit.odometry.integrators import integrate_increments
 from wmrkit.slip.metrics import closure_error, j_closure, j_model
 
@@ -53,9 +53,9 @@ def test_closure_index_refuses_a_true_final_pose_that_is_not_finite_and_finals_o
     n = 100
     inc = np.tile([2 * np.pi / n, 0.0, 2 * np.pi / n], (n, 1))
     poses = np.vstack([[0, 0, 0], integrate_increments([0, 0, 0], inc)])
-    with pytest.raises(WmrkitError, match=r"truth_final: must be finite, got \[1.0, 2.0, nan\]"):
+    with pytest.raises(ShapeError, match=r"truth_final: must be finite, got \[1.0, 2.0, nan\]"):
         closure_error(poses, [1.0, 2.0, np.nan])
-    with pytest.raises(WmrkitError, match="j_closure: 2 runs and 1 true final poses"):
+    with pytest.raises(ShapeError, match="j_closure: 2 runs and 1 true final poses"):
         j_closure([poses, poses], [poses[-1]])
 
 

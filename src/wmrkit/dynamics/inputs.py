@@ -88,7 +88,7 @@ def knots(time: ArrayLike) -> np.ndarray:
     """`time` as the knots of inputs ``(K,)`` [s], or a one-line error: at least one, finite, strictly increasing."""
     t = np.atleast_1d(as_reals(time, "time"))  # strictly increasing with finite ends: finite
     if t.ndim != 1 or not len(t) or not (math.isfinite(t[0]) and math.isfinite(t[-1]) and (t[1:] > t[:-1]).all()):
-        raise WmrkitError(f"time: input times must be at least one, finite and strictly increasing, got "
+        raise ShapeError(f"time: input times must be at least one, finite and strictly increasing, got "
                           f"{t.tolist() if t.size <= 6 else f'shape {t.shape}'}")
     return t
 
@@ -102,7 +102,7 @@ _INPUT_FIELDS = (("torques", f"torques within {MAX_TORQUE:g} N m (limits.MAX_TOR
 
 
 def _check_inputs(inputs: Inputs) -> None:
-    """Raise :class:`WmrkitError` naming the field of `inputs` whose shape does not agree with the others (K times,
+    """Raise :class:`ShapeError` naming the field of `inputs` whose shape does not agree with the others (K times,
     n velocities, n_steer steering joints) or whose values make no sense (times not strictly increasing, values not
     finite, gains or limits below 0); the model's sizes are checked by :func:`compiled_inputs`."""
     k = len(knots(inputs.time))
@@ -121,7 +121,7 @@ def _check_inputs(inputs: Inputs) -> None:
         if name == "torques":
             bad = ~(np.abs(a) <= MAX_TORQUE)  # NaN included
         if bad.any():
-            raise WmrkitError(f"{name}: expected {want}, got {float(a[bad].flat[0])!r}")
+            raise ShapeError(f"{name}: expected {want}, got {float(a[bad].flat[0])!r}")
     if (inputs.twist is None) != (inputs.twist_time is None):
         raise WmrkitError("twist, twist_time: give both (body twists at their knots) or neither")
     if inputs.twist is not None:
@@ -187,7 +187,7 @@ def _steer_limits(model: DynamicModel, limit: ArrayLike | None) -> np.ndarray:
         return np.zeros(len(model.steer_columns))
     limit = np.asarray(limit, dtype=float)
     if limit.shape != (len(model.steer_columns),) or not np.all(limit > 0):  # NaN included
-        raise WmrkitError(f"steer_limit: expected {len(model.steer_columns)} torques > 0 N m (inf: none), got "
+        raise ShapeError(f"steer_limit: expected {len(model.steer_columns)} torques > 0 N m (inf: none), got "
                           f"{limit.tolist()}")
     return np.where(np.isinf(limit), 0.0, limit)
 
@@ -196,5 +196,5 @@ def held_values(value: ArrayLike, size: int, name: str) -> np.ndarray:
     """`value` as `size` floats for :meth:`~.simulate.Stepper.hold` (its argument `name`), or a one-line error."""
     value = np.asarray(value, dtype=float)
     if value.shape != (size,):
-        raise WmrkitError(f"hold: {name} must be {size} numbers, got shape {value.shape}")
+        raise ShapeError(f"hold: {name} must be {size} numbers, got shape {value.shape}")
     return value  # not checked for NaN here: a NaN reference makes the state NaN, which advance() reports

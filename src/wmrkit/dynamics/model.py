@@ -75,7 +75,7 @@ class DynamicModel:
         elif not (tyre is None or isinstance(tyre, Tyre)):
             raise TypeError(f"tyre: expected a Tyre, a tyre model's name or None, got {type(tyre).__name__}")
         if not (real_number(gravity) and 0 < gravity < math.inf):  # NaN included; "9.81" was read as a number
-            raise WmrkitError(f"gravity: expected a finite number > 0 m/s^2, got {gravity!r}")
+            raise ShapeError(f"gravity: expected a finite number > 0 m/s^2, got {gravity!r}")
         model = _build(robot, tyre, float(gravity))
         for message in unheld(robot):  # here, not in the cached _build: every model built says it
             warnings.warn(message, LinkageWarning, stacklevel=2)
@@ -150,7 +150,7 @@ class DynamicModel:
         else:
             loads = _one(loads, e, "loads")
             if not (loads >= 0).all():
-                raise WmrkitError(f"loads: expected normal loads >= 0 N, got {loads.tolist()}")
+                raise ShapeError(f"loads: expected normal loads >= 0 N, got {loads.tolist()}")
         f, g, vw = np.zeros((e, 2)), np.zeros((e, 2, 2)), np.zeros(e)
         contact_forces(np.array(self.slip_matrix(beta)), nu, self.pack, np.array(loads, dtype=float),
                        f, g, vw, False)
@@ -197,7 +197,7 @@ class DynamicModel:
         held = sorted(set(held))
         bad = [j for j in held if not (isinstance(j, int | np.integer) and 3 <= j < self.n)]
         if bad:
-            raise WmrkitError(f"held: expected joint columns of model.names (3 to {self.n - 1}), got {bad}")
+            raise ShapeError(f"held: expected joint columns of model.names (3 to {self.n - 1}), got {bad}")
         t = self._basis(self.robot.beta)[0]  # the motions the couplings allow
         a, m = self.slip_matrix() @ t, self.mass_matrix()
         out = np.zeros(len(self.steer_columns))
@@ -227,14 +227,13 @@ class DynamicModel:
 
 def _one(x: ArrayLike, size: int, name: str, columns: int | None = None) -> np.ndarray:
     """`x` as a writable float array (one compiled signature) of shape ``(size,)`` (or ``(size, columns)``) with
-    finite entries; :class:`ShapeError` (the model's methods take one state at a time) or :class:`WmrkitError`
-    naming `name` otherwise."""
+    finite entries, else :class:`ShapeError` naming `name` (the model's methods take one state at a time)."""
     a = np.array(x, dtype=float)
     shape = (size,) if columns is None else (size, columns)
     if a.shape != shape:
         raise ShapeError(f"{name}: expected shape {shape}, one state at a time, got {a.shape}")
     if not np.isfinite(a).all():
-        raise WmrkitError(f"{name}: expected finite numbers, got {a.tolist()}")
+        raise ShapeError(f"{name}: expected finite numbers, got {a.tolist()}")
     return a
 
 

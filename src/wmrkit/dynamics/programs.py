@@ -63,9 +63,9 @@ def path_program(model: DynamicModel, name: str, *, speed: float = 2.0, radius_s
         raise WmrkitError(f"unknown program '{name}' (programs: {', '.join(PATHS)})")
     if not (real_number(speed) and 0 < speed <= MAX_SPEED):  # text raised "'<' not supported"
         got = f"{speed:g} m/s" if real_number(speed) else repr(speed)
-        raise WmrkitError(f"speed: expected a program speed in (0, {MAX_SPEED:g}] m/s, got {got}")
+        raise ShapeError(f"speed: expected a program speed in (0, {MAX_SPEED:g}] m/s, got {got}")
     if not (real_number(radius_scale) and 0 < radius_scale <= MAX_SIZE):
-        raise WmrkitError(f"radius_scale: expected a number in (0, {MAX_SIZE:g}], got {radius_scale!r}")
+        raise ShapeError(f"radius_scale: expected a number in (0, {MAX_SIZE:g}], got {radius_scale!r}")
     scale = radius_scale * 2.0 / speed
     times, twists, t = [0.0], [(0.0, 0.0, 0.0)], 0.0
     for k, (duration, v, curvature) in enumerate(PATHS[name]):
@@ -75,7 +75,7 @@ def path_program(model: DynamicModel, name: str, *, speed: float = 2.0, radius_s
         twists += [twist, twist] if k else [twist]
         t += dt
     if not math.isfinite(t):  # its knots at inf s: twist_program refused them under the name 'time'
-        raise WmrkitError(f"speed: {speed:g} m/s: program '{name}' would never end (its segments last "
+        raise ShapeError(f"speed: {speed:g} m/s: program '{name}' would never end (its segments last "
                           f"{radius_scale:g} x 2 m/s / speed times their durations at 2 m/s)")
     feasible = feasible_twists(model, np.array(twists))  # the slip left (a skid steer's turns) is the robot's
     return twist_program(model, np.array(times), feasible, bandwidth=bandwidth, allow_slip=True), t
@@ -133,7 +133,7 @@ def twist_program(model: DynamicModel, time: ArrayLike, twists: ArrayLike, *, ba
     bad = ~(np.abs(twists) <= MAX_SPEED).all(axis=1)  # NaN included
     if bad.any():
         k = int(np.argmax(bad))
-        raise WmrkitError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s: expected finite speeds "
+        raise ShapeError(f"twist {tuple(float(v) for v in twists[k])} at t = {t[k]:g} s: expected finite speeds "
                           f"within {MAX_SPEED:g} m/s and a turn rate within {MAX_SPEED:g} rad/s")
     robot, n = model.robot, model.n
     if not robot.actuated:
@@ -220,8 +220,8 @@ def _check_linkages(model: DynamicModel, t: np.ndarray, twists: np.ndarray, head
 
 
 def _check_bandwidth(bandwidth: float) -> None:
-    if not (math.isfinite(bandwidth) and bandwidth > 0):
-        raise WmrkitError(f"bandwidth: expected a natural frequency > 0 rad/s, got {bandwidth}")
+    if not (real_number(bandwidth) and bandwidth > 0):  # text raised math's TypeError
+        raise ShapeError(f"bandwidth: expected a natural frequency > 0 rad/s, got {bandwidth}")
 
 
 def _contacts_of(model: DynamicModel, wheel: str) -> list[int]:
@@ -245,7 +245,7 @@ def steering_gains(model: DynamicModel, servoed: Sequence[int], *, held: Sequenc
     """
     kp, kd = np.zeros(len(model.steer_columns)), np.zeros(len(model.steer_columns))
     if not set(servoed) <= set(model.steer_columns):
-        raise WmrkitError(f"servoed: expected steering columns of model.names {list(model.steer_columns)}, got "
+        raise ShapeError(f"servoed: expected steering columns of model.names {list(model.steer_columns)}, got "
                           f"{list(servoed)}")
     _check_bandwidth(bandwidth)
     if not servoed:

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly, real_number
-from ..errors import WmrkitError
+from ..errors import ShapeError, WmrkitError
 from ..limits import MAX_COORDINATE, MAX_SPEED
 from ..robot import Robot
 from ..wheels import heading_from_beta
@@ -166,26 +166,26 @@ def simulate(robot: Robot | DynamicModel, inputs: Inputs, duration: float, *, st
     if method not in METHODS:
         raise WmrkitError(f"unknown method '{method}' (methods: {', '.join(METHODS)})")
     if not isinstance(inputs, Inputs):  # a mapping raised "'dict' object has no attribute 'torques'"
-        raise WmrkitError(f"inputs: expected Inputs (Inputs.torques_only, twist_program, path_program), got "
+        raise ShapeError(f"inputs: expected Inputs (Inputs.torques_only, twist_program, path_program), got "
                           f"{type(inputs).__name__}")
     if not (real_number(duration) and real_number(step) and duration > 0 and 0 < step <= duration):  # text: TypeError
-        raise WmrkitError(f"duration and step must be finite numbers [s] with 0 < step <= duration, got {duration!r}, "
+        raise ShapeError(f"duration and step must be finite numbers [s] with 0 < step <= duration, got {duration!r}, "
                           f"{step!r}")
     if method != "adaptive" and duration / step > MAX_STEPS:
-        raise WmrkitError(f"duration {duration:g} s at step {step:g} s: more than {MAX_STEPS:.0e} integration steps")
+        raise ShapeError(f"duration {duration:g} s at step {step:g} s: more than {MAX_STEPS:.0e} integration steps")
     if record_step is not None and not (real_number(record_step) and record_step > 0):  # NaN included
-        raise WmrkitError(f"record_step: expected a finite number > 0 [s] (None: the step), got {record_step!r}")
+        raise ShapeError(f"record_step: expected a finite number > 0 [s] (None: the step), got {record_step!r}")
     record = record_step or (max(step, 1e-3) if method == "adaptive" else step)
     if duration / record > MAX_STEPS:
-        raise WmrkitError(f"record_step: {record:g} s over {duration:g} s is more than {MAX_STEPS:.0e} samples")
+        raise ShapeError(f"record_step: {record:g} s over {duration:g} s is more than {MAX_STEPS:.0e} samples")
     every = max(1, round(record / step))
     samples = adaptive_samples(duration, record) if method == "adaptive" else round(duration / step) // every + 1
     if samples > record_capacity(model):
-        raise WmrkitError(f"record_step: {record:g} s over {duration:g} s records {samples} samples, more than the "
+        raise ShapeError(f"record_step: {record:g} s over {duration:g} s records {samples} samples, more than the "
                           f"{record_capacity(model)} of robot '{model.robot.name}' that fit in 1 GiB "
                           f"(MAX_RECORD_VALUES); record every {recordable_step(model, duration, step, step):g} s")
-    if not 0 < rtol < 1:
-        raise WmrkitError(f"rtol: expected a relative tolerance in (0, 1), got {rtol}")
+    if not (real_number(rtol) and 0 < rtol < 1):  # text raised "'<' not supported"
+        raise ShapeError(f"rtol: expected a relative tolerance in (0, 1), got {rtol}")
     s0 = initial_state(model, initial_twist, initial_pose)
     inp = compiled_inputs(model, inputs)
     if method == "adaptive":
@@ -228,10 +228,10 @@ class Stepper:
         self.model = model if isinstance(model, DynamicModel) else DynamicModel.of(model, tyre)
         if method not in ("semi-implicit", "rk4"):
             raise WmrkitError(f"unknown stepping method '{method}' (methods: semi-implicit, rk4)")
-        if not (math.isfinite(step) and step > 0 and math.isfinite(t)):
-            raise WmrkitError(f"step must be finite and > 0 and t finite, got {step}, {t}")
+        if not (real_number(step) and step > 0 and real_number(t)):  # text raised math's TypeError
+            raise ShapeError(f"step must be finite and > 0 and t finite, got {step}, {t}")
         if not (isinstance(jac_every, int) and jac_every >= 1):
-            raise WmrkitError(f"jac_every must be an integer >= 1, got {jac_every!r}")
+            raise ShapeError(f"jac_every must be an integer >= 1, got {jac_every!r}")
         n = self.model.n
         if state is None:
             state = initial_state(self.model)
@@ -239,7 +239,7 @@ class Stepper:
                   and state.flags.writeable and state.shape == (2 * n,)):
             state = np.array(as_vectors(state, 2 * n, "state"), dtype=float)
         if not np.all(np.isfinite(state)):
-            raise WmrkitError("state: every entry must be finite")
+            raise ShapeError("state: every entry must be finite")
         for breach in given_gear_breaches(self.model.robot, self.model.names, state[n:], SLIP_TOL):
             rates = ", ".join(f"{self.model.names[i]} {state[n + i]:.6g}" for i in breach.given)
             raise WmrkitError(f"state: {breach.head} ({rates} rad/s): the dynamics hold the gear, so a state turns "
@@ -281,8 +281,8 @@ class Stepper:
             self._inputs, self._fight = compiled_inputs(self.model, inputs), inputs.fight_linkages
         if self._inputs is None:
             raise WmrkitError("advance: no inputs given yet")
-        if not 0 <= duration / self.step <= MAX_STEPS:  # NaN and infinities included
-            raise WmrkitError(f"duration must be >= 0 and at most {MAX_STEPS:.0e} steps of {self.step:g} s, got "
+        if not (real_number(duration) and 0 <= duration / self.step <= MAX_STEPS):  # text: a TypeError
+            raise ShapeError(f"duration must be >= 0 and at most {MAX_STEPS:.0e} steps of {self.step:g} s, got "
                               f"{duration}")
         n_steps, log, far = round(duration / self.step), self._log, None
         piece, n = max(1, round(RANGE_CHECK / self.step)), self.model.n  # the range judged after each piece
@@ -368,10 +368,10 @@ def initial_state(model: DynamicModel, twist: ArrayLike = (0, 0, 0), pose: Array
 
     twist, pose, n = as_vectors(twist, 3, "initial_twist"), as_vectors(pose, 3, "initial_pose"), model.n
     if twist.shape != (3,) or not np.all(np.abs(twist) <= MAX_SPEED):  # NaN included
-        raise WmrkitError(f"initial twist {twist.tolist()}: expected three finite numbers, speeds within "
+        raise ShapeError(f"initial twist {twist.tolist()}: expected three finite numbers, speeds within "
                           f"{MAX_SPEED:g} m/s and a turn rate within {MAX_SPEED:g} rad/s")
     if pose.shape != (3,) or not (np.all(np.abs(pose[:2]) <= MAX_COORDINATE) and math.isfinite(pose[2])):
-        raise WmrkitError(f"initial pose {pose.tolist()}: expected a position within {MAX_COORDINATE:g} m and a "
+        raise ShapeError(f"initial pose {pose.tolist()}: expected a position within {MAX_COORDINATE:g} m and a "
                           "finite heading")
     s = np.zeros(2 * n)
     s[:3] = pose

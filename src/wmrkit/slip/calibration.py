@@ -21,7 +21,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import WmrkitError
+from .._shapes import real_number
+from ..errors import ShapeError, WmrkitError
 from ..odometry.integrators import Method
 from ..odometry.logs import JointLog
 from ..odometry.model import wrap_angle
@@ -97,8 +98,8 @@ class SlipCalibration:
 
 def effective_track_model(robot: Robot, multiplier: float):
     """The ``wheel_separation_multiplier`` model: lateral wheel positions times `multiplier`, rolling rows only."""
-    if not (math.isfinite(multiplier) and multiplier > 0):
-        raise WmrkitError(f"wheel separation multiplier must be a finite number > 0, got {multiplier}")
+    if not (real_number(multiplier) and multiplier > 0):  # text raised math's TypeError
+        raise ShapeError(f"wheel separation multiplier must be a finite number > 0, got {multiplier}")
     wheels = []
     for w in robot.wheels:
         x, y = w.position
@@ -134,8 +135,8 @@ def calibrate_slip(robot: Robot, log: JointLog, reference: tuple[ArrayLike, Arra
     """
     from scipy.optimize import least_squares
 
-    if not (math.isfinite(heading_weight) and heading_weight >= 0):
-        raise WmrkitError(f"heading_weight: expected a finite number >= 0 [m/rad], got {heading_weight!r}")
+    if not (real_number(heading_weight) and heading_weight >= 0):
+        raise ShapeError(f"heading_weight: expected a finite number >= 0 [m/rad], got {heading_weight!r}")
     t_ref, ref = (np.asarray(a, dtype=float) for a in reference)
     if t_ref.ndim != 1 or ref.shape != (len(t_ref), 3):
         raise WmrkitError(f"{source}: expected times (M,) and poses (M, 3), got shapes {t_ref.shape} and {ref.shape}")

@@ -19,7 +19,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import WmrkitError
+from .._shapes import real_number
+from ..errors import ShapeError, WmrkitError
 
 
 @dataclass(frozen=True, slots=True)
@@ -37,8 +38,9 @@ class TractionLoop:
               control_period: float = 0.01) -> TractionLoop:
         """Gains placing the poles of ``inertia * rate' = tau`` under PI at the damping of `overshoot` (second-order
         rule ``zeta = -ln(os) / sqrt(pi^2 + ln(os)^2)``) and the 2 % `settling` time ``4 / (zeta wn)``."""
-        if not (inertia > 0 and settling > 0 and 0 < overshoot < 1 and torque_limit > 0):
-            raise WmrkitError("traction loop: inertia, settling and torque limit > 0, 0 < overshoot < 1")
+        if not (all(real_number(v) for v in (inertia, settling, overshoot, torque_limit)) and inertia > 0
+                and settling > 0 and 0 < overshoot < 1 and torque_limit > 0):  # text raised "'>' not supported"
+            raise ShapeError("traction loop: inertia, settling and torque limit > 0, 0 < overshoot < 1")
         lo = math.log(overshoot)
         zeta = -lo / math.sqrt(math.pi ** 2 + lo * lo)
         wn = 4.0 / (zeta * settling)
@@ -99,7 +101,7 @@ def simulate_differential(model, inputs, duration: float, loop: TractionLoop, *,
     period = loop.control_period
     per, every = round(duration / period), round(record_step / period)
     if per < 1 or every < 1 or abs(every * period - record_step) > 1e-9 * record_step:
-        raise WmrkitError("the duration and the record step must be multiples of the control period")
+        raise ShapeError("the duration and the record step must be multiples of the control period")
     stepper = Stepper(model, step=step)
     s, n = stepper.state, model.n
     rows, integral = [], 0.0

@@ -8,7 +8,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_reals, as_vectors
-from ..errors import WmrkitError
+from ..errors import ShapeError, WmrkitError
 from ..odometry.model import wrap_angle
 
 
@@ -19,9 +19,9 @@ def j_model(twist_reference: ArrayLike, twist_model: ArrayLike) -> float:
     """
     ref, mod = as_reals(twist_reference, "twist_reference"), as_reals(twist_model, "twist_model")  # text refused
     if ref.shape != mod.shape or ref.ndim != 2 or ref.shape[1] != 3:
-        raise WmrkitError(f"j_model: expected two (N, 3) twist arrays, got {ref.shape} and {mod.shape}")
+        raise ShapeError(f"j_model: expected two (N, 3) twist arrays, got {ref.shape} and {mod.shape}")
     if not len(ref) or not (np.isfinite(ref).all() and np.isfinite(mod).all()):
-        raise WmrkitError(f"j_model: expected at least one sample, every twist finite, got {len(ref)} samples")
+        raise ShapeError(f"j_model: expected at least one sample, every twist finite, got {len(ref)} samples")
     return float(np.mean(np.abs(ref - mod)))
 
 
@@ -34,13 +34,13 @@ def closure_error(poses: ArrayLike, truth_final: ArrayLike | None = None) -> tup
     """
     p = as_vectors(poses, 3, "poses")
     if p.ndim != 2 or len(p) < 2:
-        raise WmrkitError(f"closure_error: poses must be a path of at least 2 poses (N, 3), got shape {p.shape}")
+        raise ShapeError(f"closure_error: poses must be a path of at least 2 poses (N, 3), got shape {p.shape}")
     if not np.isfinite(p).all():  # it said 'the path neither moves nor turns'
-        raise WmrkitError(f"closure_error: poses must be finite, pose {int(np.argmin(np.isfinite(p).all(axis=1)))} "
+        raise ShapeError(f"closure_error: poses must be finite, pose {int(np.argmin(np.isfinite(p).all(axis=1)))} "
                           "is not")
     goal = p[0] if truth_final is None else as_vectors(truth_final, 3, "truth_final").reshape(3)
     if not np.isfinite(goal).all():  # the heading term was nan
-        raise WmrkitError(f"closure_error: truth_final: must be finite, got {goal.tolist()}")
+        raise ShapeError(f"closure_error: truth_final: must be finite, got {goal.tolist()}")
     steps = np.diff(p, axis=0)
     distance = float(np.sum(np.hypot(steps[:, 0], steps[:, 1])))
     rotation = float(np.sum(np.abs(wrap_angle(steps[:, 2]))))
@@ -59,8 +59,8 @@ def j_closure(runs: Sequence[ArrayLike], truth_finals: Sequence[ArrayLike] | Non
     against `truth_finals` as in :func:`closure_error`)."""
     runs = list(runs)
     if not runs:
-        raise WmrkitError("j_closure: no runs")
+        raise ShapeError("j_closure: no runs")
     finals = [None] * len(runs) if truth_finals is None else list(truth_finals)
     if len(finals) != len(runs):  # zip() said 'argument 2 is shorter than argument 1'
-        raise WmrkitError(f"j_closure: {len(runs)} runs and {len(finals)} true final poses: expected one per run")
+        raise ShapeError(f"j_closure: {len(runs)} runs and {len(finals)} true final poses: expected one per run")
     return float(sum(sum(closure_error(p, f)) for p, f in zip(runs, finals, strict=True)) / (2 * len(runs)))

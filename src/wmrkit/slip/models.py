@@ -28,10 +28,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_names, as_reals, batch_shape
+from .._shapes import as_names, as_reals, batch_shape, real_number
 from ..couplings import gear_unknowns
 from ..dynamics.mass import Body, body_problem
-from ..errors import WmrkitError
+from ..errors import ShapeError, WmrkitError
 from ..kinematics.linalg import geared_solve
 from ..limits import MAX_QUERY_RATE
 from ..robot import Robot, element_beta
@@ -49,11 +49,11 @@ class LinearFriction:
 
     def __post_init__(self) -> None:
         """Pairs of finite coefficients > 0 (as :class:`SlipWeights`: a NaN or negative one gave a wrong twist)."""
-        mu = np.asarray(self.mu, dtype=float)
+        mu = as_reals(self.mu, "LinearFriction")  # text ("0.8") was read as a number
         if mu.ndim != 1 or mu.size == 0 or mu.size % 2:
-            raise WmrkitError(f"LinearFriction: expected a (lateral, longitudinal) pair per contact, got {self.mu!r}")
+            raise ShapeError(f"LinearFriction: expected a (lateral, longitudinal) pair per contact, got {self.mu!r}")
         if not (np.isfinite(mu) & (mu > 0)).all():
-            raise WmrkitError(f"LinearFriction: every coefficient must be a finite number > 0, got {self.mu!r}")
+            raise ShapeError(f"LinearFriction: every coefficient must be a finite number > 0, got {self.mu!r}")
 
     @classmethod
     def from_weights(cls, robot: Robot, weights: SlipWeights) -> LinearFriction:
@@ -124,20 +124,20 @@ def assigned_columns(robot: Robot, assigned: Sequence[str]) -> np.ndarray:
 
 
 def _assigned(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-    """Columns and values ``(..., n_a)`` of the assigned velocities; :class:`WmrkitError` naming `q_assigned` when
+    """Columns and values ``(..., n_a)`` of the assigned velocities; :class:`ShapeError` naming `q_assigned` when
     its last axis is not one value per name or a value is not a finite number within ``MAX_QUERY_RATE``."""
-    assigned = as_names(assigned, "assigned", "velocity names", WmrkitError)
+    assigned = as_names(assigned, "assigned", "velocity names")
     if not assigned or len(set(assigned)) != len(assigned):
-        raise WmrkitError(f"assigned: expected distinct velocity names, at least one, got {list(assigned)}")
+        raise ShapeError(f"assigned: expected distinct velocity names, at least one, got {list(assigned)}")
     cols = assigned_columns(robot, assigned)
     q_a = as_reals(q_assigned, "q_assigned")  # text ("120", meant as rpm) was read as rad/s
     if q_a.shape[-1:] != (len(cols),):
-        raise WmrkitError(f"q_assigned: expected shape (..., {len(cols)}), one value per assigned velocity "
+        raise ShapeError(f"q_assigned: expected shape (..., {len(cols)}), one value per assigned velocity "
                           f"({', '.join(assigned)}), got {q_a.shape}")
     bad = ~(np.abs(q_a) <= MAX_QUERY_RATE).reshape(-1, len(cols))  # NaN included
     if bad.any():
         i, j = (int(x) for x in np.argwhere(bad)[0])
-        raise WmrkitError(f"q_assigned: {assigned[j]}: expected finite numbers within {MAX_QUERY_RATE:g} (rad/s or "
+        raise ShapeError(f"q_assigned: {assigned[j]}: expected finite numbers within {MAX_QUERY_RATE:g} (rad/s or "
                           f"m/s), got {float(q_a.reshape(-1, len(cols))[i, j])}")
     return cols, q_a
 
@@ -201,8 +201,8 @@ def normal_loads(robot: Robot, body: Body | None = None, accel_cm: ArrayLike = (
     """
     body, beta = _body(robot, body), robot.steering(beta, heading)
     a = as_reals(accel_cm, "accel_cm")
-    if not (0 < g < np.inf) or a.shape[-1:] != (2,) or not np.isfinite(a).all():
-        raise WmrkitError(f"normal_loads: expected a gravity g > 0 and finite accelerations accel_cm (..., 2), got "
+    if not (real_number(g) and 0 < g < np.inf) or a.shape[-1:] != (2,) or not np.isfinite(a).all():
+        raise ShapeError(f"normal_loads: expected a gravity g > 0 and finite accelerations accel_cm (..., 2), got "
                           f"g = {g}, accel_cm of shape {a.shape}")
     h = body.com_height
     rhs = np.stack(np.broadcast_arrays(np.full(a.shape[:-1], body.mass * g), -h * body.mass * a[..., 0],
@@ -230,22 +230,24 @@ def _load_map(robot: Robot, body: Body, beta: ArrayLike | None) -> np.ndarray:
 
 
 def _body(robot: Robot, body: Body | None) -> Body:
-    body = robot.body if body is None else body
+    """`body`, or the robot's when None; a bad `body` argument is a :class:`ShapeError`, a bad robot's a
+    :class:`WmrkitError` (both name the field)."""
+    given, body = body is not None, robot.body if body is None else body
     if body is None:
         raise WmrkitError(f"robot '{robot.name}' has no mass properties ('body:' in its description)")
     problem = body_problem(body)
     if problem:
-        raise WmrkitError(problem)
+        raise (ShapeError if given else WmrkitError)(problem)
     return body
 
 
 def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, start, tol) -> SlipSolution:
     from scipy.optimize import root
 
-    if not 0 < tol < np.inf:
-        raise WmrkitError(f"tol: expected a finite tolerance > 0, got {tol}")
-    if quasi_static is not None and not 0 < quasi_static[1] < np.inf:
-        raise WmrkitError(f"g: expected a finite gravity > 0 m/s^2, got {quasi_static[1]}")
+    if not (real_number(tol) and 0 < tol < np.inf):  # text raised "'<' not supported"
+        raise ShapeError(f"tol: expected a finite tolerance > 0, got {tol}")
+    if quasi_static is not None and not (real_number(quasi_static[1]) and 0 < quasi_static[1] < np.inf):
+        raise ShapeError(f"g: expected a finite gravity > 0 m/s^2, got {quasi_static[1]}")
 
     cols, q_a = _assigned(robot, assigned, q_assigned)
     if quasi_static is not None and np.isin(cols, (0, 1, 2)).any():
@@ -263,7 +265,7 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
              else np.broadcast_to(np.asarray(beta, float), (*batch, n_s)).reshape(-1, n_s))
     q0 = wls(robot, assigned, q_a, betas).q_dot if start is None else np.asarray(start.q_dot, dtype=float)
     if q0.shape[-1:] != (k,) or q0.size // k not in (1, len(q_a)):  # one for every sample, or one per sample
-        raise WmrkitError(f"start: expected velocities of shape {(*batch, k)} (one solution per sample, or one for "
+        raise ShapeError(f"start: expected velocities of shape {(*batch, k)} (one solution per sample, or one for "
                           f"all), got {q0.shape}")
     q0 = np.broadcast_to(q0.reshape(-1, k), (len(q_a), k))
     # scipy's hybr differences each unknown with a step relative to its size: a start of 1e-17 (round-off of an
@@ -271,9 +273,9 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
     q0 = np.where(np.abs(q0) < 1e-9 * np.maximum(1.0, np.abs(q0).max(axis=-1, keepdims=True)), 0.0, q0)
     static = np.ones(n_e) if loads is None else as_reals(loads, "loads")
     if static.shape != (n_e,):
-        raise WmrkitError(f"loads: expected {n_e} normal loads, one per contact, got shape {static.shape}")
+        raise ShapeError(f"loads: expected {n_e} normal loads, one per contact, got shape {static.shape}")
     if not (static >= 0).all() or not np.isfinite(static).all() or not static.any():
-        raise WmrkitError(f"loads: expected finite normal loads >= 0, not all 0, got {static.tolist()}")
+        raise ShapeError(f"loads: expected finite normal loads >= 0, not all 0, got {static.tolist()}")
     q_out = np.empty((len(q_a), k))
     res = np.empty(len(q_a))
     ok = np.empty(len(q_a), dtype=bool)
@@ -323,15 +325,15 @@ def _solve(robot, assigned, q_assigned, friction, beta, loads, quasi_static, sta
 def _check_law(friction: FrictionLaw, slip_shape: tuple[int, int], loads: np.ndarray | None) -> None:
     """Refuse a friction law that does not give one finite (lateral, longitudinal) force per contact."""
     if isinstance(friction, LinearFriction) and len(friction.mu) != 2 * slip_shape[0]:
-        raise WmrkitError(f"LinearFriction: {len(friction.mu) // 2} pairs of coefficients for {slip_shape[0]} "
+        raise ShapeError(f"LinearFriction: {len(friction.mu) // 2} pairs of coefficients for {slip_shape[0]} "
                           "contacts (one (lateral, longitudinal) pair per contact)")
     probe = np.full(slip_shape, 0.1)
     try:
         f = np.asarray(friction(probe, probe, np.ones(slip_shape[0]) if loads is None else loads), dtype=float)
     except (ValueError, TypeError, IndexError) as err:
-        raise WmrkitError(f"friction law: fails on {slip_shape[0]} contacts ({err})") from None
+        raise ShapeError(f"friction law: fails on {slip_shape[0]} contacts ({err})") from None
     if f.shape != slip_shape or not np.isfinite(f).all():
-        raise WmrkitError(f"friction law: expected finite forces of shape {slip_shape}, one pair per contact, got "
+        raise ShapeError(f"friction law: expected finite forces of shape {slip_shape}, one pair per contact, got "
                           f"shape {f.shape}" + ("" if f.shape != slip_shape else " with non-finite values"))
 
 

@@ -10,13 +10,13 @@ they were not fitted to.
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..errors import WmrkitError
+from .._shapes import real_number
+from ..errors import ShapeError, WmrkitError
 from ..odometry.pipeline import odometry
 from ..odometry.plot import save_trajectory_plot
 from ..robot import Robot
@@ -43,8 +43,8 @@ def segment_run(robot: Robot, segments: Sequence[tuple[float, float, float]], ra
 
     if source not in ("md", "quasi-static"):  # any other name ran the dynamic model
         raise WmrkitError(f"source must be 'md' or 'quasi-static', got {source!r}")
-    if not (math.isfinite(rate) and rate > 0):  # 0 divided by zero in the dynamic model's record step
-        raise WmrkitError(f"rate must be a finite number > 0 [Hz], got {rate!r}")
+    if not (real_number(rate) and rate > 0):  # 0 divided by zero in the dynamic model's record step; text: TypeError
+        raise ShapeError(f"rate must be a finite number > 0 [Hz], got {rate!r}")
     if source == "quasi-static":
         spins = [robot.rate_names.index(j) for j in odometry_model(robot).rate_joints]
         run = wheel_speed_run(robot, [(d, wheel_commands(robot, [v, 0.0, w]).rates[spins]) for d, v, w in segments],

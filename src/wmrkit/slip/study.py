@@ -17,7 +17,7 @@ import os
 import numpy as np
 
 from .. import catalog
-from ..errors import WmrkitError
+from ..errors import ShapeError, WmrkitError
 from ..limits import check_seed
 from ..odometry.logs import JointLog
 from ..odometry.model import odometry_model
@@ -262,7 +262,7 @@ def forklift_study(report: str | os.PathLike[str] | None = None, quick: bool = F
                    drive: str = "differential") -> dict:
     """Everything of §7.5 the simulator allows (module docstring); figures into `report` when given; `seed` and
     `drive` as in :func:`paths`."""
-    check_seed(seed, WmrkitError)
+    check_seed(seed, ShapeError)
     robot = catalog.load("forklift")
     if robot.body is None or any(w.tyre is None for w in robot.wheels):
         raise WmrkitError("the catalog forklift lacks mass properties or tyres")

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import WmrkitError
+from .._shapes import real_number
+from ..errors import ShapeError, WmrkitError
 from ..odometry.integrators import integrate_increments
 from ..odometry.logs import JointLog
 from ..odometry.synthetic import MAX_SAMPLES
@@ -49,10 +50,11 @@ def wheel_speed_run(robot: Robot, segments: Sequence[tuple[float, Sequence[float
     rates = np.array([list(r) for _, r in segments], dtype=float).reshape(len(segments), -1)
     if rates.shape[1] != len(joints) or not np.all((durations > 0) & np.isfinite(durations)) \
             or not np.isfinite(rates).all():
-        raise WmrkitError(f"segments: need finite durations > 0 and {len(joints)} finite rates each "
+        raise ShapeError(f"segments: need finite durations > 0 and {len(joints)} finite rates each "
                           f"({', '.join(joints)})")
-    if not (1e-6 <= rate and durations.sum() * rate <= MAX_SAMPLES):  # NaN too: it failed in numpy, 1e9 Hz in memory
-        raise WmrkitError(f"rate {rate:g} Hz over the segments' {durations.sum():g} s: need a rate >= 1e-06 Hz and "
+    if not (real_number(rate) and 1e-6 <= rate and durations.sum() * rate <= MAX_SAMPLES):  # NaN too: it failed in
+        got = f"{rate:g}" if real_number(rate) else repr(rate)  # numpy, 1e9 Hz in memory; text: a TypeError
+        raise ShapeError(f"rate {got} Hz over the segments' {durations.sum():g} s: need a rate >= 1e-06 Hz and "
                           f"at most {MAX_SAMPLES} sample periods")
     if model == "mqe":
         sol = mqe(robot, joints, rates, law, beta)
