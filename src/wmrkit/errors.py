@@ -16,7 +16,8 @@ class WmrkitError(Exception):
 
 
 class ShapeError(WmrkitError, ValueError):
-    """An array argument has the wrong shape (or angles that are not finite); the message names the argument."""
+    """A bad argument at a Python array or keyword door: a wrong shape or type, text where a number is expected, a
+    value that is not finite or out of range (docs/conventions.md); the message names the argument."""
 
 
 class UnknownNameError(WmrkitError, LookupError):
