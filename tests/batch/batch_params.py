@@ -23,9 +23,14 @@ def die_once(args):
     return process_log(job)
 
 
-def write_log(path, run) -> str:
-    """The run's log as a default-format CSV; the path as a string."""
-    write_csv(path, ("time", *run.log.joints), np.column_stack([run.log.time, run.log.positions]))
+def write_log(path, run, robot=None) -> str:
+    """The run's log as a default-format CSV (steering columns as headings, what the reader takes: `robot` needed
+    then); the path as a string."""
+    steered = any(j.endswith(".steer") for j in run.log.joints)
+    if steered and robot is None:
+        raise ValueError("write_log: a log with steering columns needs the robot (its files hold headings)")
+    positions = run.log.heading_positions(robot) if steered else run.log.positions
+    write_csv(path, ("time", *run.log.joints), np.column_stack([run.log.time, positions]))
     return str(path)
 
 
