@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._shapes import as_real
 from ..limits import MAX_SIZE, MIN_SIZE
 from .camera import MAX_FOCAL_PX, MIN_FOCAL_PX, Camera, CameraError
 
@@ -79,6 +80,10 @@ def calibrate(x1: float, x2: float, rows_a: float, half_separation: float, row_d
     MAX_SIZE]`` of :mod:`wmrkit.limits`, a focal length outside :data:`.camera.MIN_FOCAL_PX` to
     :data:`.camera.MAX_FOCAL_PX`, rows A below :data:`MIN_ROWS_PX`).
     """
+    # the Python API reads no units: text raised a bare TypeError from math.isfinite
+    x1, x2, rows_a, half_separation, row_distance = (as_real(v, name) for name, v in (
+        ("x1", x1), ("x2", x2), ("rows_a", rows_a), ("half_separation", half_separation),
+        ("row_distance", row_distance)))
     for name, value in (("x1", x1), ("x2", x2), ("rows A", rows_a), ("half-separation", half_separation),
                         ("row distance", row_distance)):
         if not (math.isfinite(value) and value > 0):
@@ -125,9 +130,10 @@ def calibrate_image(image: ArrayLike, rows_a: float, half_separation: float, row
     stripes' vanishing point must lie on the image's vertical centre line (``psi = 0``) within
     `max_vanishing_px`, else :class:`CameraError` says to turn the camera.
     """
-    from .lines import extract_lines
+    from .lines import _grey, extract_lines
 
-    img = np.asarray(image)
+    img = _grey(image)  # a number raised IndexError from its shape
+    rows_a = as_real(rows_a, "rows_a")
     if not 0 < rows_a < img.shape[0] / 2:
         raise CameraError(f"calibration: rows A must be in (0, {img.shape[0] / 2:g}) px, got {rows_a:g}")
     lines = extract_lines(img, n_lines=3, mode=mode, k1=k1, focal_px=focal_guess or float(max(img.shape[:2])))

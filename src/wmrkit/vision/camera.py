@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors
+from .._shapes import as_angle_array, as_reals, as_vectors
 from ..documents import LineOf, read_document, read_file, write_document
 from ..errors import DescriptionError, WmrkitError
 from ..limits import MAX_SIZE
@@ -168,6 +168,14 @@ class Camera:
             raise CameraError(f"{path}: cannot write the camera file ({err.strerror or err})") from None
 
 
+def check_type(value: object, kind: type, argument: str, advice: str) -> None:
+    """Raise :class:`CameraError` naming `argument` unless `value` is a `kind` (a camera's name or a dict raised
+    AttributeError deep inside); `advice` says how to build one."""
+    if not isinstance(value, kind):
+        raise CameraError(f"{argument}: expected a {kind.__name__} ({advice}), got {type(value).__name__} "
+                          f"{value!r:.60}")
+
+
 def read_located(path: str | Path, what: str, fmt: str, *, lines: bool = False) -> Any:
     """The data of a YAML or JSON file read as :func:`wmrkit.documents.read_file` and ``read_document`` do
     (bounded size, safe YAML, duplicate keys refused), with `lines` ``(data, line_of)``; their located errors as
@@ -187,7 +195,8 @@ def rotation(psi: ArrayLike, tilt: ArrayLike) -> np.ndarray:
     Rows are the camera axes in W: ``X_c = (c psi, -s psi, 0)``, ``Y_c = (-s psi c phi, -c psi c phi, -s phi)``,
     ``Z_c = (s psi s phi, c psi s phi, -c phi)`` (the optical axis, tilted down by phi from the vertical).
     """
-    psi, tilt = np.broadcast_arrays(np.asarray(psi, dtype=float), np.asarray(tilt, dtype=float))
+    # the Python API reads no units: psi='1' was read as 1 rad; NaN gave a matrix of NaN
+    psi, tilt = np.broadcast_arrays(as_angle_array(psi, "psi"), as_angle_array(tilt, "tilt"))
     cp, sp, cf, sf = np.cos(psi), np.sin(psi), np.cos(tilt), np.sin(tilt)
     z = np.zeros_like(psi)
     return np.stack([np.stack([cp, -sp, z], -1), np.stack([-sp * cf, -cp * cf, -sf], -1),
@@ -206,10 +215,7 @@ def camera_coordinates(points_w: ArrayLike, psi: ArrayLike, tilt: ArrayLike, t: 
 def _focal(focal_px: ArrayLike, where: str) -> np.ndarray:
     """`focal_px` as a float array, or :class:`CameraError` naming it unless every value is finite and > 0 (f = 0
     put every point at the centre, f < 0 mirrored the image)."""
-    try:
-        f = np.asarray(focal_px, dtype=float)
-    except (TypeError, ValueError):
-        raise CameraError(f"{where}: focal_px: expected numbers, got {focal_px!r}") from None
+    f = as_reals(focal_px, f"{where}: focal_px")  # '1' was read as 1 px
     bad = ~((f > 0) & (f < math.inf))  # NaN included
     if bad.any():
         raise CameraError(f"{where}: focal_px: expected finite numbers > 0 [px], got {float(f[bad].flat[0])}")
@@ -233,9 +239,14 @@ def extrinsics(pose_line_robot: ArrayLike, camera: Camera, z_p: ArrayLike = 0.0)
 
     ``psi = -theta`` (9.25); the lens is at height ``camera.height``, ``z_p sin(tilt)`` behind the robot origin P.
     """
+    check_type(camera, Camera, "camera", "Camera.from_file(path) or Camera(focal_px, tilt, height)")
     pose = as_vectors(pose_line_robot, 3, "pose_line_robot")
     x, y, theta = pose[..., 0], pose[..., 1], pose[..., 2]
-    back = np.asarray(z_p, dtype=float) * math.sin(camera.tilt)
+    z_p = as_reals(z_p, "z_p")  # '1' was read as 1 m
+    bad = ~(np.abs(z_p) <= MAX_SIZE)  # NaN included: it gave a translation of NaN
+    if bad.any():
+        raise CameraError(f"z_p: expected lengths in [-{MAX_SIZE:g}, {MAX_SIZE:g}] m, got {float(z_p[bad].flat[0])}")
+    back = z_p * math.sin(camera.tilt)
     lens_w = np.stack(np.broadcast_arrays(-(y - back * np.sin(theta)), x - back * np.cos(theta),
                                           np.full_like(x, camera.height)), -1)
     psi = -theta

@@ -19,13 +19,14 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, readonly
+from .._shapes import as_real, as_vectors, readonly
 from ..control.laws import PositionLaw, law_velocity
 from ..control.points import ControlError, control_point, twist_for_velocity
 from ..errors import WmrkitError
@@ -34,9 +35,9 @@ from ..limits import MAX_COORDINATE, MAX_SIZE, MAX_SPEED, check_seed
 from ..odometry.integrators import integrate_exact
 from ..robot import Robot
 from ..wheels import wrap_angle
-from .camera import Camera, CameraError, extrinsics
+from .camera import Camera, CameraError, check_type, extrinsics
 from .lines import extract_lines
-from .positioning import Positioning, locate_points
+from .positioning import Positioning, check_placement, locate_points
 from .render import MAX_BLUR, MAX_CLUTTER, MAX_NOISE, Scene, render
 
 __all__ = ["LineFollowing", "follow_line", "line_following_law", "line_following_twist", "locate_image",
@@ -55,6 +56,10 @@ def locate_image(camera: Camera, image: ArrayLike, *, spacing: float = 0.0, ns: 
     the far one halfway to the horizon when ``-rows_a`` is above it).
     Raises :class:`WmrkitError` when fewer lines than expected are found, or the image is not the camera's size.
     """
+    check_type(camera, Camera, "camera", "Camera.from_file(path) or Camera(focal_px, tilt, height)")
+    check_placement(spacing, z_p)  # before spacing > 0: '1' raised a bare TypeError
+    if ns is not None and (isinstance(ns, str) or not isinstance(ns, Sequence)):
+        raise CameraError(f"ns: expected a sequence of line indices n such as (-1, 0, 1), got {ns!r:.60}")  # TypeError
     ns = ns if ns is not None else ((-1, 0, 1) if spacing > 0 else (0,))
     shape = np.shape(image)[:2]
     if shape != (camera.rows, camera.width):  # the camera model's centre and rows: another image was misread
@@ -63,7 +68,7 @@ def locate_image(camera: Camera, image: ArrayLike, *, spacing: float = 0.0, ns: 
     found = extract_lines(image, n_lines=len(ns) + 4, mode=mode, k1=camera.k1, focal_px=camera.focal_px)
     if len(found) < len(ns):
         raise WmrkitError(f"image: found {len(found)} line(s), expected {len(ns)}")
-    a = rows_a if rows_a is not None else camera.rows / 4
+    a = as_real(rows_a, "rows_a") if rows_a is not None else camera.rows / 4  # '1': a bare TypeError
     horizon = camera.focal_px / math.tan(camera.tilt)  # rows above -horizon see no ground: the far point is taken
     far = a if a < horizon else horizon / 2  # below it (any two points of a line give the same position)
     undistorted = replace(camera, k1=0.0)  # the extracted lines are already undistorted
@@ -104,6 +109,7 @@ def line_following_twist(robot: Robot, psi: float, h: float, gain: float, speed:
     `speed` [m/s] finite and > 0 (at most ``limits.MAX_SPEED``, as ``gain * |h|``), else :class:`WmrkitError` names
     the argument.
     """
+    check_type(robot, Robot, "line_following_twist: robot", "wmrkit.catalog.load(name) or Robot.from_file(path)")
     for name, value, low in (("psi", psi, -math.inf), ("h", h, -math.inf), ("gain", gain, 0.0),
                              ("speed", speed, 0.0)):
         if isinstance(value, bool | str) or not isinstance(value, numbers.Real | np.ndarray) or np.ndim(value) \
@@ -235,6 +241,11 @@ def follow_line(robot: Robot, camera: Camera, *, gain: float = 0.3, speed: float
     `image_noise`, `blur`, `clutter`: options of the synthetic camera. ``from_image=False`` skips the camera and
     measures the exact (psi, h) of the pose (what the thesis's simulation did), for comparison.
     """
+    check_type(robot, Robot, "follow-line: robot", "wmrkit.catalog.load(name) or Robot.from_file(path)")
+    check_type(camera, Camera, "follow-line: camera", "Camera.from_file(path) or Camera(focal_px, tilt, height)")
+    # the Python API reads no units: text raised a bare TypeError, blur=True reached OpenCV
+    z_p, image_noise, blur = (as_real(v, f"follow-line: {name}") for name, v in (
+        ("z_p", z_p), ("image_noise", image_noise), ("blur", blur)))
     for name, value, unit in (("gain", gain, "1/s"), ("period", period, "s"), ("duration", duration, "s"),
                               ("speed", speed, "m/s")):
         number = isinstance(value, numbers.Real) and not isinstance(value, bool)  # "0.3" raised a bare TypeError

@@ -23,6 +23,7 @@ from types import ModuleType
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._shapes import as_real
 from ..errors import WmrkitError
 from .camera import CameraError, check_lens_image, distort, undistort
 
@@ -308,6 +309,11 @@ def extract_lines(image: ArrayLike, *, n_lines: int = 1, mode: str = "threshold"
     cv2 = cv2_module()
     if isinstance(n_lines, bool) or not isinstance(n_lines, int | np.integer) or n_lines < 1:
         raise CameraError(f"n_lines must be an integer >= 1, got {n_lines!r}")
+    # the Python API reads no units: text ('1' raised a bare TypeError, k1='1' was read as 1) and booleans
+    k1, max_angle, max_band_px, min_separation_px = (as_real(v, f"extract_lines: {name}") for name, v in (
+        ("k1", k1), ("max_angle", max_angle), ("max_band_px", max_band_px), ("min_separation_px", min_separation_px)))
+    focal_px, hough_scale = (None if v is None else as_real(v, f"extract_lines: {name}") for name, v in (
+        ("focal_px", focal_px), ("hough_scale", hough_scale)))  # focal_px was ignored, whatever it was, when k1 = 0
     if not 0 < max_angle <= math.pi / 2:  # NaN included: OpenCV raised its own error
         raise CameraError(f"extract_lines: max_angle: expected an angle in (0, pi/2] rad, got {max_angle}")
     for name, value in (("max_band_px", max_band_px), ("min_separation_px", min_separation_px)):

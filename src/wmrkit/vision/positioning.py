@@ -8,7 +8,7 @@ in closed form (9.10), and the distance h of the tracked point P to the followed
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -16,10 +16,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors
+from .._shapes import as_real, as_reals, as_vectors
 from ..errors import ShapeError
 from ..limits import MAX_SIZE
-from .camera import Camera, CameraError, read_located
+from .camera import Camera, CameraError, check_type, read_located
 
 __all__ = ["SPACING_TOLERANCE", "LineFix", "Positioning", "check_spacing", "line_position", "locate_points",
            "read_points"]
@@ -37,13 +37,15 @@ def line_position(points_u: ArrayLike, n: ArrayLike, *, focal_px: float, tilt: f
     ``h`` [m] the signed distance from P to the followed line, positive when P is left of it (``h = -x_w(P)``).
     Points on one image row (``y_u1 = y_u2``) give NaN; non-finite points or `n` are refused (:class:`ShapeError`).
     """
-    p = np.asarray(points_u, dtype=float)
+    p = as_reals(points_u, "points_u")  # the Python API reads no units: text raised numpy's ValueError, n='1' was 1
     if p.shape[-2:] != (2, 2):
         raise ShapeError(f"points_u: expected shape (..., 2, 2), got {p.shape}")
     if not np.all(np.isfinite(p)):
         raise ShapeError("points_u: expected finite image coordinates [px], got "
                          f"{float(p[~np.isfinite(p)].flat[0])}")
-    n_arr = np.asarray(n, dtype=float)
+    n_arr = as_reals(n, "n")
+    focal_px, tilt, height, spacing, z_p = (as_real(v, name) for name, v in (  # text: a bare TypeError
+        ("focal_px", focal_px), ("tilt", tilt), ("height", height), ("spacing", spacing), ("z_p", z_p)))
     if not np.all(np.isfinite(n_arr)):
         raise ShapeError(f"n: expected finite line indices, got {float(n_arr[~np.isfinite(n_arr)].flat[0])}")
     for name, value in (("focal_px", focal_px), ("height", height)):
@@ -100,13 +102,18 @@ def locate_points(camera: Camera, lines: Sequence[tuple[int, ArrayLike]], *, spa
     """
     from .camera import undistort
 
+    check_type(camera, Camera, "camera", "Camera.from_file(path) or Camera(focal_px, tilt, height)")
+    if isinstance(lines, str | Mapping | np.ndarray) or not isinstance(lines, Sequence) or \
+            not all(isinstance(ln, Sequence) and not isinstance(ln, str) and len(ln) == 2 for ln in lines):
+        raise CameraError(f"lines: expected a sequence of (n, [[xu, yu], [xu, yu]]), got {type(lines).__name__} "
+                          f"{lines!r:.60}")  # a number or a list of points raised TypeError, 'abc' unpacked letters
     if not lines:
         raise CameraError("points: no lines given")
     check_placement(spacing, z_p)
     horizon = -camera.focal_px / math.tan(camera.tilt)  # image row of the horizon [px, y down]
     fixes = []
     for i, (n, pts) in enumerate(lines):
-        pts = np.asarray(pts, dtype=float)
+        pts = as_reals(pts, f"points: lines[{i}]")
         if pts.shape != (2, 2) or not np.all(np.isfinite(pts)):
             raise CameraError(f"points: lines[{i}]: expected two finite points [[xu, yu], [xu, yu]]")
         if isinstance(n, bool) or n not in (-1, 0, 1):  # True == 1: read as the line right of the followed one
@@ -142,7 +149,9 @@ SPACING_TOLERANCE = 0.25
 
 def check_placement(spacing: float, z_p: float, names: tuple[str, str] = ("spacing", "z_p")) -> None:
     """Refuse (:class:`CameraError` naming it by `names`) a `spacing` outside ``[0, limits.MAX_SIZE]`` m or a `z_p`
-    beyond ``limits.MAX_SIZE`` m, NaN included (a negative spacing was read as none, one line, silently)."""
+    beyond ``limits.MAX_SIZE`` m, NaN included (a negative spacing was read as none, one line, silently). Text
+    and booleans are refused (:func:`~wmrkit._shapes.as_real`: '1' raised a bare TypeError, True was 1 m)."""
+    spacing, z_p = as_real(spacing, names[0]), as_real(z_p, names[1])
     if not 0 <= spacing <= MAX_SIZE:
         raise CameraError(f"{names[0]}: expected a length in [0, {MAX_SIZE:g}] m (0: one line), got {spacing:g}")
     if not abs(z_p) <= MAX_SIZE:

@@ -13,9 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_vectors, real_number
-from ..limits import MAX_SIZE, MIN_SIZE
-from .camera import Camera, CameraError, extrinsics, ground_from_image, undistort
+from .._shapes import as_real, as_vectors, real_number
+from ..limits import MAX_SIZE, MIN_SIZE, check_seed
+from .camera import Camera, CameraError, check_type, extrinsics, ground_from_image, undistort
 
 __all__ = ["Scene", "render"]
 
@@ -100,17 +100,23 @@ def render(camera: Camera, pose_line_robot: ArrayLike, scene: Scene, *, z_p: flo
     Gaussian noise [grey levels]; `blur`: Gaussian blur sigma [px]; `clutter`: number of bright blobs scattered
     on the ground in view (drawn anew for each image); `seed` makes noise and clutter reproducible.
     """
+    # the Python API reads no units: text ('1' raised a bare TypeError) and booleans (blur=True reached OpenCV)
+    noise, blur = as_real(noise, "render: noise"), as_real(blur, "render: blur")
     if not (0 <= noise <= MAX_NOISE and 0 <= blur <= MAX_BLUR):  # NaN fails both
         raise CameraError(f"render: image noise must be in [0, {MAX_NOISE:g}] grey levels and blur in [0, "
                           f"{MAX_BLUR:g}] px, got {noise:g}, {blur:g}")
-    if not (isinstance(clutter, int | np.integer) and 0 <= clutter <= MAX_CLUTTER):
+    if isinstance(clutter, bool) or not (isinstance(clutter, int | np.integer) and 0 <= clutter <= MAX_CLUTTER):
         raise CameraError(f"render: clutter must be an integer in [0, {MAX_CLUTTER}] blobs, got {clutter!r}")
+    check_type(scene, Scene, "render: scene", "Scene(ns=(0,), width=0.02)")
     pose = as_vectors(pose_line_robot, 3, "render: pose_line_robot")
+    z_p = z_p if np.ndim(z_p) else as_real(z_p, "render: z_p")
     if pose.shape != (3,) or np.ndim(z_p):  # one image: (2, 3) poses or an array z_p raised numpy's ValueError
         raise CameraError(f"render: one pose (x, y, theta) and one z_p make an image, got shapes {pose.shape} and "
                           f"{np.shape(z_p)}")
     if not (np.all(np.isfinite(pose)) and np.isfinite(z_p)):  # NaN: a blank image
         raise CameraError(f"render: pose and z_p must be finite, got {pose_line_robot!r}, {z_p!r}")
+    if seed is not None:  # '1' or 1.5 raised numpy's TypeError
+        check_seed(seed, CameraError, "render: seed")
     rng = np.random.default_rng(seed)
     psi, t = extrinsics(pose, camera, z_p)
     ground = ground_from_image(_pixel_grid(camera), psi, camera.tilt, t, camera.focal_px)
