@@ -13,6 +13,7 @@ import math
 import numbers
 from dataclasses import dataclass
 
+from .._shapes import as_real
 from ..errors import WmrkitError
 
 
@@ -182,9 +183,20 @@ def arcs_through(X: float, Y: float) -> tuple[float, float]:
     return (X * X + Y * Y) / (4 * X), xi
 
 
+def check_problem(vehicle: object, *space: object) -> None:
+    """:class:`WmrkitError` naming `vehicle` or `space` unless they are a :class:`Vehicle` and (when given) a
+    :class:`Space`: a problem's name or a dict raised AttributeError ('str' object has no attribute 'phi_max')."""
+    for name, value, kind, fields in (("vehicle", vehicle, Vehicle, "a1, b1, c1, h1, track, phi_max"),
+                                      *(("space", s, Space, "H, J, MS, dx2, final_gap") for s in space)):
+        if not isinstance(value, kind):
+            raise WmrkitError(f"{name}: expected a wmrkit.parking.{kind.__name__}({fields}), got "
+                              f"{type(value).__name__} {value!r:.60}")
+
+
 def length_ratio(vehicle: Vehicle, space: Space) -> float:
     """Free longitudinal space as a fraction, eq. (9.37) over 100: ``((H - 2 MS) - (a1 + b1)) / (H - 2 MS)`` (the
     thesis gives it in percent)."""
+    check_problem(vehicle, space)
     free = space.effective_length
     return (free - vehicle.length) / free
 
@@ -203,7 +215,8 @@ def blackburn_min_length(vehicle: Vehicle, rho: float | None = None) -> float:
 
     S. Blackburn, "The geometry of perfect parking", Royal Holloway, University of London (2009).
     """
-    rho = max(vehicle.rho_min, vehicle.c1 / 2) if rho is None else rho
+    check_problem(vehicle)
+    rho = max(vehicle.rho_min, vehicle.c1 / 2) if rho is None else as_real(rho, "rho")  # '1': a bare TypeError
     if not rho >= vehicle.c1 / 2 or not math.isfinite(rho):  # NaN included
         raise WmrkitError(f"blackburn_min_length: rho = {rho:.6g} m: a finite radius >= c1/2 (an ICR outside the "
                           "body) is needed")

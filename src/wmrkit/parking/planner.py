@@ -14,6 +14,7 @@ import numbers
 from dataclasses import dataclass, replace
 from typing import Literal
 
+from .._shapes import as_real
 from ..errors import WmrkitError
 from .collisions import approach_offset_closed_form, front_rear_collision, lateral_reach, trailing_dip
 from .geometry import (
@@ -22,6 +23,7 @@ from .geometry import (
     arcs_displacement,
     arcs_through,
     blackburn_min_length,
+    check_problem,
     steering_angle,
     xi_from_lateral,
     xi_from_longitudinal,
@@ -108,7 +110,8 @@ def plan_parking(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
     rear obstacle only lies farther back. Algorithm 3 reverses along the whole slot, so a long slot meant a long,
     shallow S and, past about 11 car lengths, no plan at all.
     """
-    _check_options(vehicle, phi_step, max_maneuvers)
+    check_problem(vehicle, space)
+    phi_step = _check_options(vehicle, phi_step, max_maneuvers)
     roomy = roomy_length(vehicle, space)
     plan = None
     if space.H <= roomy:
@@ -145,7 +148,7 @@ def plan_thesis(vehicle: Vehicle, space: Space, *, phi_step: float = PHI_STEP,
     `skip_angles` > 0 starts Algorithm 3 that many steps of `phi_step` below ``phi_max`` (not the thesis's:
     :func:`plan_parking`'s retry)."""
     v, sp = vehicle, space
-    _check_options(v, phi_step, max_maneuvers)
+    phi_step = _check_options(v, phi_step, max_maneuvers)
     tol = TOL * size(v)
     warnings: list[str] = []
     pass_offset = sp.dx2
@@ -371,6 +374,8 @@ def shortest_slot(vehicle: Vehicle, space: Space, *, step: float = 0.01, span: f
     for huge cars), then bisects the last step to 1 mm. None when no length in the range works (e.g. the slot is
     too narrow).
     """
+    check_problem(vehicle, space)
+    step, span = as_real(step, "step"), None if span is None else as_real(span, "span")  # '1': a bare TypeError
     for name, value in (("step", step), ("span", span)):
         if value is not None and not 0 < value < math.inf:  # NaN included
             raise WmrkitError(f"{name}: must be a finite length > 0 m, got {value}")
@@ -442,12 +447,15 @@ def _in_slot(part: ParkingPlan, space: Space) -> ParkingPlan:
     return replace(part, space=space, segments=(detection, *part.segments[1:]), used_H=part.space.H)
 
 
-def _check_options(vehicle: Vehicle, phi_step: float, max_maneuvers: object) -> None:
+def _check_options(vehicle: Vehicle, phi_step: float, max_maneuvers: object) -> float:
+    """`phi_step` as a float, or :class:`WmrkitError` naming it (or `max_maneuvers`)."""
+    phi_step = as_real(phi_step, "phi_step")  # the Python API reads no units: '1' raised a bare TypeError
     if not vehicle.phi_max / MAX_PHI_STEPS <= phi_step < math.inf:  # NaN included
         raise WmrkitError(f"phi_step: must be a finite angle >= phi_max / {MAX_PHI_STEPS} = "
                           f"{vehicle.phi_max / MAX_PHI_STEPS:.3g} rad (at most {MAX_PHI_STEPS} steering angles "
                           f"tried), got {phi_step} rad")
     _check_max_maneuvers(max_maneuvers)
+    return phi_step
 
 
 def _check_max_maneuvers(max_maneuvers: object) -> None:
