@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_names, readonly
+from .._shapes import as_names, as_reals, readonly
 from ..couplings import gear_fill
 from ..errors import ShapeError, UnknownNameError
 from ..kinematics.linalg import centred, matrix_rank, reach
@@ -48,7 +48,7 @@ def condition_number(h: ArrayLike) -> np.ndarray:
     coordinates) to the `f` outputs (joint rates): with fewer outputs than inputs some inputs give no output
     (``inf``). Each matrix is divided by its largest entry first (kappa does not change): its SVD can neither
     overflow (entries of 1.7e308 gave kappa inf for 1) nor lose sigma_min to underflow."""
-    h = np.asarray(h, dtype=float)
+    h = as_reals(h, "condition_number: h")  # text raised numpy's 'could not convert string to float'
     if h.ndim < 2 or 0 in h.shape[-2:] or not np.all(np.isfinite(h)):
         raise ShapeError(f"condition_number: expected matrices (..., f, f') with f, f' >= 1 and finite entries, got "
                          f"shape {h.shape}" + ("" if np.all(np.isfinite(h)) else " with entries that are not finite"))
@@ -70,7 +70,7 @@ def isotropy_matrix(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, .
     basis of the null space of the slip matrix (6.7); H does not depend on which basis. Steering: `beta` (thesis,
     None: as described) or `heading` (0 = rolling forward).
     """
-    check_positive_length(length)
+    length = check_positive_length(length)
     beta = robot.steering(beta, heading)
     assigned, selected = (as_names(v, k, "velocity names", UnknownNameError)
                           for k, v in (("assigned", assigned), ("selected", selected)))
@@ -202,7 +202,7 @@ def twist_condition_number(robot: Robot, beta: ArrayLike | None = None, *, joint
     if length is None:
         length = natural_length(robot, joints=model.joints, geared=geared)[0]
     else:
-        check_positive_length(length)
+        length = check_positive_length(length)
     return _kappa(model, beta, float(length))
 
 

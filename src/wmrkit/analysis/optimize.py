@@ -16,14 +16,15 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
-from .._shapes import as_names, as_real
-from ..errors import UnknownNameError, WmrkitError
+from .._shapes import as_names, as_real, as_reals
+from ..errors import ShapeError, UnknownNameError, WmrkitError
+from ..limits import check_seed
 from ..robot import Robot
 from . import _fast
 from ._sym import eigvalsh2_entries
 from .isotropy import _kappa, _natural_length, golden_section, kappa_function, natural_length, twist_model
 from .lines import constraint_lines, line_parameters
-from .singularity import robot_size
+from .singularity import check_positive_length, robot_size
 
 
 @dataclass(frozen=True)
@@ -54,9 +55,9 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
     steering wheels that change kappa (those with an axle constraint or among the joints). Only configurations
     where kappa is finite are returned: none when the joints determine the twist nowhere (fewer joints than m).
     """
-    for value, what in ((resolution, "resolution"), (max_samples, "max_samples"), (count, "count")):
-        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
-            raise WmrkitError(f"{what} must be an integer >= 1, got {value!r}")
+    _check_counts(resolution=resolution, max_samples=max_samples, count=count)
+    if length is not None:  # NaN, 0, -1 and inf were taken and returned as the configurations' length; '1' as 1 m
+        length = check_positive_length(length)
     model = twist_model(robot, joints)
     steer = robot.steer_names
     if variables is None:
@@ -179,6 +180,10 @@ def _grid_kappa(model, beta: np.ndarray, length: float | None) -> np.ndarray:
     return out.reshape(beta.shape[:-1])
 
 
+#: Most random steering configurations the ``"global"`` objective of :func:`optimize_geometry` averages over.
+MAX_GLOBAL_SAMPLES = 100_000
+
+
 @dataclass(frozen=True, eq=False)
 class GeometryOptimum:
     """Result of :func:`optimize_geometry`: parameters ``x``, the robot, its length D [m] and objective value."""
@@ -198,9 +203,23 @@ def optimize_geometry(family: Callable[[np.ndarray], Robot], x0: ArrayLike, *,
     `family` maps a parameter vector to a :class:`~wmrkit.Robot` (raise a WmrkitError for invalid ones).
     ``objective="described"``: kappa at the described configuration and natural length. ``"global"``
     (Kim et al. 05): ``1 / mean(1 / kappa)`` over `samples` random steering configurations at the best common
-    length. Nelder-Mead from `x0` and ``starts - 1`` random points within `bounds`.
+    length (`samples` at most :data:`MAX_GLOBAL_SAMPLES`). Nelder-Mead from `x0` and ``starts - 1`` random points
+    within `bounds` (one finite ``(low, high)`` per parameter).
     """
-    x0 = np.atleast_1d(np.asarray(x0, dtype=float))
+    # the Python API reads no units: x0='1' was read as 1, None and NaN optimised nothing and returned x = nan
+    x0 = np.atleast_1d(as_reals(x0, "x0"))
+    if x0.ndim != 1 or not x0.size or not np.all(np.isfinite(x0)):
+        raise ShapeError(f"x0: expected a vector of finite numbers (the family's parameters), got {x0.tolist()}")
+    if bounds is not None:  # a number raised 'iteration over a 0-d array'
+        bounds = as_reals(bounds, "bounds")
+        if bounds.shape != (len(x0), 2) or not np.all(np.isfinite(bounds)) or np.any(bounds[:, 0] > bounds[:, 1]):
+            raise ShapeError(f"bounds: expected one finite (low, high) per parameter, shape ({len(x0)}, 2), got "
+                             f"{bounds.tolist()}")
+        bounds = [tuple(b) for b in bounds.tolist()]
+    _check_counts(samples=samples, starts=starts)  # starts=1e9 raised "'float' object cannot be interpreted as an ..."
+    if samples > MAX_GLOBAL_SAMPLES:  # 10**9 drew 8 GB of configurations per steering wheel
+        raise WmrkitError(f"samples must be at most {MAX_GLOBAL_SAMPLES}, got {samples}")
+    check_seed(seed, WmrkitError)  # '1' raised numpy's TypeError
     rng = np.random.default_rng(seed)
 
     def evaluate(x: np.ndarray) -> tuple[float, float]:
@@ -236,3 +255,10 @@ def optimize_geometry(family: Callable[[np.ndarray], Robot], x0: ArrayLike, *,
             best = res
     value, d = evaluate(best.x)
     return GeometryOptimum(best.x, family(best.x), float(d), float(value))
+
+
+def _check_counts(**counts: object) -> None:
+    """:class:`WmrkitError` naming the first of `counts` that is not an integer >= 1 (text, booleans, floats)."""
+    for what, value in counts.items():
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+            raise WmrkitError(f"{what} must be an integer >= 1, got {value!r}")

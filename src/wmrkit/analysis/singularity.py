@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
-from .._shapes import as_names
+from .._shapes import as_names, as_real
 from ..couplings import coupled_columns
 from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import centred, matrix_rank, nondimensional, robot_size, unit_columns
@@ -70,6 +70,9 @@ def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...],
     (thesis, None: as described) or `heading` (0 = rolling forward). `coupled`: through the robot's rate couplings
     (:func:`wmrkit.analysis.lines.constraint_lines`).
     """
+    rtol = as_real(rtol, "rtol")  # '1' raised numpy's UFuncTypeError; NaN answered False everywhere
+    if not 0 <= rtol < np.inf:
+        raise WmrkitError(f"rtol: expected a finite relative tolerance >= 0, got {rtol}")
     cl = constraint_lines(robot, assigned, coupled=coupled)
     beta = configuration(robot, beta, heading)
     if cl.internal or len(cl.labels) < 3:
@@ -97,7 +100,7 @@ def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[s
     flat = beta.reshape(int(np.prod(beta.shape[:-1])), beta.shape[-1])
     out = np.empty(len(flat))
     if length is not None:
-        check_positive_length(length)
+        length = check_positive_length(length)
     p, length = line_parameters(robot), float(robot_size(robot) if length is None else length)
     for s in range(0, len(flat), _fast.CHUNK):
         rows = _fast.element_rows_cm(p, flat[s:s + _fast.CHUNK])
@@ -105,12 +108,16 @@ def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[s
     return out.reshape(beta.shape[:-1])
 
 
-def check_positive_length(length: float) -> None:
-    """Raise :class:`WmrkitError` unless the characteristic length `length` [m] is a finite number > 0 (it divides
-    the omega column). Internal searches (natural lengths, their figures) reach beyond the lengths a user may give,
-    which the user's doors bound with :func:`wmrkit.limits.check_length` (``analyze``, ``--length``)."""
+def check_positive_length(length: float) -> float:
+    """`length` as a float; :class:`WmrkitError` unless the characteristic length `length` [m] is a finite number
+    > 0 (it divides the omega column), a :class:`~wmrkit.errors.ShapeError` for text and booleans (the Python API
+    reads no units: '1' raised a bare TypeError). Internal searches (natural lengths, their figures) reach beyond
+    the lengths a user may give, which the user's doors bound with :func:`wmrkit.limits.check_length`
+    (``analyze``, ``--length``)."""
+    length = as_real(length, "length")
     if not 0 < length < np.inf:  # NaN included
         raise WmrkitError(f"length: must be a finite number > 0 m, got {length}")
+    return length
 
 
 @dataclass(frozen=True, eq=False)

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from .._shapes import as_real
 from ..couplings import channel_names, coupling_words, gear_fill
 from ..errors import WmrkitError
 from ..kinematics.actuation import actuation_analysis, actuator_names
@@ -265,6 +266,7 @@ def described_analysis(robot: Robot, *, length: float | None = None, resolution:
     linkages leave on a grid of `resolution` points per turn)."""
     cls = classify(robot)
     if length is not None:  # as analyze --length: at 1e-9 m the twist read as undetermined
+        length = as_real(length, "length")  # the Python API reads no units: '1' raised a bare TypeError
         check_length(length, WmrkitError)
     joints, d, kappa = described_condition(robot, length)
     act, sen = actuation_analysis(robot), sensing_analysis(robot)
