@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import re
 
+import numpy as np
 import pytest
 
 from wmrkit import catalog
@@ -23,6 +24,24 @@ from wmrkit.analysis import (
     twist_condition_number,
 )
 from wmrkit.errors import WmrkitError
+from wmrkit.odometry import (
+    AbsoluteEncoder,
+    CalibrationRun,
+    IncrementalEncoder,
+    JointLog,
+    LogFormat,
+    Slip,
+    TwistProfile,
+    apply_parameters,
+    calibrate,
+    catalog_encoders,
+    integrate_increments,
+    odometry,
+    odometry_model,
+    propagate_covariance,
+    simulate,
+    square_path_error,
+)
 from wmrkit.parking import Space, Vehicle, blackburn_min_length, length_ratio, plan_parking, shortest_slot
 
 CAR = Vehicle(a1=3.5, b1=0.9, c1=1.7, h1=2.6, track=1.4, phi_max=0.6)
@@ -62,8 +81,6 @@ def test_parking_names_a_vehicle_or_space_that_is_none(call, message):
 
 
 def test_parking_takes_numpy_numbers():
-    import numpy as np
-
     assert blackburn_min_length(CAR, np.float32(4.0)) == blackburn_min_length(CAR, 4.0)
     assert plan_parking(CAR, SLOT, phi_step=np.float64(0.02)).arcs == plan_parking(CAR, SLOT, phi_step=0.02).arcs
 
@@ -118,8 +135,75 @@ def test_analysis_values_that_were_taken_or_raised_bare_errors_are_named(call, m
 
 
 def test_analysis_takes_numpy_numbers():
-    import numpy as np
-
     np.testing.assert_array_equal(twist_condition_number(SWERVE, length=np.float32(0.5)),
                                   twist_condition_number(SWERVE, length=float(np.float32(0.5))))
     assert is_singular(SWERVE, None, TWIST, rtol=np.float64(1e-8)) == is_singular(SWERVE, None, TWIST)
+
+
+DIFF = catalog.load("diff-drive")
+PROFILE = TwistProfile([1.0], [[0.5, 0.0, 0.1]])
+RUN = simulate(DIFF, TwistProfile(np.array([1.0]), np.array([[0.5, 0.0, 0.1]])), 10.0)
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    (lambda: integrate_increments([0.0, 0.0, 0.0], [["1 m", 0.0, 0.0]]), "increments_robot: got the text '1 m'"),
+    (lambda: integrate_increments([0.0, 0.0, 0.0], [[0.1, 0.0, 0.0]], heading_world=["1", "2"]),
+     "heading_world: got the text '1'"),
+    (lambda: integrate_increments([0.0, 0.0, 0.0], [[0.1, 0.0, 0.0]], ["exact"]), "unknown integration method "
+                                                                                  "'['exact']'"),
+    (lambda: propagate_covariance([[0.0] * 3] * 2, 0.1, [[[0.0] * 3] * 3]), "propagate_covariance: expected shapes "
+                                                                             "(N + 1, 3), (N, 3), (N, 3, 3); got"),
+    (lambda: propagate_covariance([["1 m"] * 3] * 2, [[0.1] * 3], [[[0.0] * 3] * 3]), "poses_world_robot: got the "
+                                                                                       "text '1 m'"),
+    (lambda: square_path_error([["1 m", 0.0]], [[0.1, 0.1]]), "errors_cw: got the text '1 m'"),
+    (lambda: TwistProfile(["1 s"], [[0.5, 0.0, 0.0]]), "profile: durations: got the text '1 s'"),
+    (lambda: TwistProfile(["1"], [[0.5, 0.0, 0.0]]), "profile: durations: got the text '1'"),
+    (lambda: Slip("left.spin", "1", 2.0, 0.5), "slip: start: got the text '1'"),
+    (lambda: Slip("left.spin", 0.0, 2.0, True), "slip: ratio: expected real numbers in SI units"),
+    (lambda: Slip(1, 0.0, 2.0, 0.5), "slip: joint: expected a joint's name such as 'left.spin', got 1"),
+    (lambda: simulate(DIFF, PROFILE, 10.0, pose0=["1 m", 0.0, 0.0]), "pose0: got the text '1 m'"),
+    (lambda: simulate(DIFF, PROFILE, 10.0, sensed="left.spin"), "sensed: expected a sequence of joint names, got the "
+                                                               "string 'left.spin'"),
+    (lambda: simulate(DIFF, PROFILE, 10.0, slips=[0.5]), "slips: expected a sequence of Slip(joint, start, stop, "
+                                                        "ratio), got [0.5]"),
+    (lambda: simulate(DIFF, PROFILE, 10.0, encoders=["left.spin"]), "encoders: expected a mapping {joint: encoder}, "
+                                                                   "got list"),
+    (lambda: simulate(DIFF, [(1.0, 0.5, 0.0, 0.0)], 10.0), "profile: expected a TwistProfile"),
+    (lambda: odometry_model("diff-drive"), "robot: expected a Robot (wmrkit.catalog.load(name), Robot.from_file("
+                                           "path)), got str 'diff-drive'"),
+    (lambda: odometry_model(DIFF, weights=["left"]), "weights: expected a mapping {wheel name: weight}, got list"),
+    (lambda: odometry(DIFF, "run.csv"), "log: expected a JointLog (read_csv(path, joints, robot=robot), "
+                                        "JointLog.from_headings), got str 'run.csv'"),
+    (lambda: JointLog(1.0, ("left.spin",), [[0.0]]), "<log>: expected time (N,) and positions (N, 1), got () and "
+                                                     "(1, 1)"),
+    (lambda: apply_parameters(DIFF, ["left.r"], 0.01), "p: expected 1 finite values, one per parameter group, got "
+                                                       "0.01"),
+    (lambda: apply_parameters(DIFF, [0.01], [0.01]), "calibrate: parameters: expected a sequence of parameter names"),
+    (lambda: calibrate(DIFF, "run.csv", ["left.r"]), "calibrate: runs: expected a sequence of CalibrationRun, got "
+                                                     "str"),
+    (lambda: CalibrationRun(RUN.log, RUN.truth[-1], pose0="1 m"), "CalibrationRun.pose0: got the text '1 m'"),
+    (lambda: CalibrationRun(RUN.log, RUN.truth[-1], pose0=[0.0, math.nan, 0.0]), "CalibrationRun.pose0: expected a "
+                                                                                  "finite pose (x, y, theta)"),
+    (lambda: CalibrationRun(RUN.log, [["1 m", 0.0, 0.0]]), "CalibrationRun.reference: got the text '1 m'"),
+    (lambda: calibrate(DIFF, [CalibrationRun(RUN.log, RUN.truth[-1])], ["left.r"], run_weights=1.0),
+     "calibrate: run_weights: expected a function of a CalibrationRun, got float"),
+    (lambda: IncrementalEncoder(1024, sign=True), "sign must be +1 or -1, got True"),
+    (lambda: AbsoluteEncoder(0.01, sign=np.array([])), "sign must be +1 or -1, got array"),
+    (lambda: LogFormat(columns=3), "LogFormat.columns: expected (joint, column) pairs"),
+    (lambda: catalog_encoders(["forklift"]), "no encoder data for robot '['forklift']'"),
+])
+def test_odometry_doors_name_what_is_wrong(call, message):
+    """Each raised a bare error (numpy's 'could not convert string to float', IndexError, 'unhashable type: list',
+    "'str' object has no attribute 'sensed'", "len() of unsized object", "'float' object is not callable" deep in
+    the solver), or took the value: TwistProfile's '1' as 1 s, a CalibrationRun's pose0 of text or NaN, an encoder's
+    sign True."""
+    with pytest.raises(WmrkitError, match=f"^{re.escape(message)}"):
+        call()
+
+
+def test_a_twist_profile_given_as_lists_drives_its_arc():
+    """TwistProfile kept the lists it was given: simulate raised "'list' object has no attribute 'sum'"."""
+    assert PROFILE.duration == 1.0
+    v, omega = 0.5, 0.1  # one second on the arc of radius v / omega
+    arc_end = [v / omega * math.sin(omega), v / omega * (1 - math.cos(omega)), omega]
+    np.testing.assert_allclose(simulate(DIFF, PROFILE, 10.0).truth[-1], arc_end, atol=1e-12)

@@ -40,13 +40,13 @@ fits are refused.
 from __future__ import annotations
 
 import copy
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_names, finite_number
+from .._shapes import as_names, as_reals, finite_number
 from ..errors import UnknownNameError, WmrkitError
 from ..robot import Robot
 from ..wheels import GEOMETRY_FIELDS, Wheel
@@ -92,7 +92,11 @@ class CalibrationRun:
     def __post_init__(self) -> None:
         """Refuse references that are not finite poses ``(M, 3)`` and samples ``at`` that are not indices of the
         log, one per reference pose (they reached the solver as NaN residuals or numpy index errors)."""
-        ref = np.asarray(self.reference, dtype=float)
+        ref = as_reals(self.reference, "CalibrationRun.reference")  # text raised numpy's ValueError
+        if self.pose0 is not None:  # taken unchecked: '1 m' or NaN reached the odometry
+            pose0 = as_reals(self.pose0, "CalibrationRun.pose0")
+            if pose0.shape != (3,) or not np.isfinite(pose0).all():
+                raise WmrkitError(f"CalibrationRun.pose0: expected a finite pose (x, y, theta), got {pose0.tolist()}")
         shaped = ref.ndim in (1, 2) and ref.size > 0 and ref.shape[-1] == 3
         if not (shaped and np.isfinite(ref).all()):
             raise WmrkitError(f"CalibrationRun.reference: expected finite poses (M, 3), got shape {ref.shape}"
@@ -319,9 +323,12 @@ class Calibration:
 
 def apply_parameters(robot: Robot, parameters: Sequence[Parameter], p: ArrayLike) -> Robot:
     """`robot` with parameter `k` changed by ``p[k]`` (lengths scaled by ``1 + p``, angles offset by ``p``)."""
-    p = np.asarray(p, dtype=float)
+    groups = _groups(robot, parameters)
+    p = as_reals(p, "p")  # a number or a list of another length raised a bare TypeError or ValueError from zip
+    if p.shape != (len(groups),) or not np.isfinite(p).all():
+        raise WmrkitError(f"p: expected {len(groups)} finite values, one per parameter group, got {p.tolist()}")
     wheels = {w.name: w for w in robot.wheels}
-    for group, value in zip(_groups(robot, parameters), p.tolist(), strict=True):
+    for group, value in zip(groups, p.tolist(), strict=True):
         for wheel, fld, sign in group:
             w, v = wheels[wheel], sign * value
             old = getattr(w, fld)
@@ -370,6 +377,12 @@ def calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Sequence
     :meth:`CalibrationProblem.undetermined`). `sensed` and `weights` choose the model as in
     :func:`~.model.odometry_model`; `run_weights` as in :class:`CalibrationProblem`.
     """
+    if isinstance(runs, CalibrationRun) or not isinstance(runs, Sequence) or \
+            not all(isinstance(r, CalibrationRun) for r in runs):  # a log or a run raised AttributeError or TypeError
+        raise WmrkitError(f"calibrate: runs: expected a sequence of CalibrationRun, got {type(runs).__name__}")
+    if run_weights is not None and not callable(run_weights):  # 'str' object is not callable, in the solver
+        raise WmrkitError(f"calibrate: run_weights: expected a function of a CalibrationRun, got "
+                          f"{type(run_weights).__name__}")
     if not runs:
         raise WmrkitError("calibrate: no runs")
     sensed = check_options(heading_weight, sensed)
@@ -403,7 +416,7 @@ def square_path_error(errors_cw: ArrayLike, errors_ccw: ArrayLike) -> float:
 def _return_errors(errors: ArrayLike, name: str) -> np.ndarray:
     """`errors` as ``(n, 2)`` with ``n >= 1``, finite, or :class:`WmrkitError` naming `name` (an empty list gave
     NaN, three columns were read as pairs)."""
-    e = np.asarray(errors, dtype=float)
+    e = as_reals(errors, name)  # text raised numpy's 'could not convert string to float'
     e = e[None] if e.ndim == 1 else e
     if e.ndim != 2 or e.shape[1] != 2 or len(e) == 0 or not np.isfinite(e).all():
         raise WmrkitError(f"{name}: expected the finite return-position errors (n, 2) of one or more runs, got "
@@ -416,8 +429,9 @@ def _groups(robot: Robot, parameters: Sequence[Parameter]) -> list[list[tuple[st
         raise WmrkitError(f"calibrate: parameters: expected a sequence of parameters, got the string '{parameters}' "
                           f"(write ['{parameters}'])")
     groups = []
-    for param in parameters:
-        names = (param,) if isinstance(param, str) else tuple(param)
+    for param in parameters if isinstance(parameters, Iterable) else (parameters,):
+        names = (param,) if isinstance(param, str) else as_names(param, "calibrate: parameters", "parameter names "
+                                                                  "('wheel.field') or groups of them", WmrkitError)
         group = []
         for signed in names:
             name, sign = (signed[1:], -1.0) if signed.startswith("-") else (signed, 1.0)

@@ -174,10 +174,11 @@ def propagate_covariance(poses_world_robot: ArrayLike, increments_robot: ArrayLi
     :meth:`CrowleyNoise.increment_covariance`); `initial` ``(3, 3)`` is the start pose's covariance (default 0).
     Equal to the recursion ``P = F P F^T + G Q G^T`` to round-off.
     """
-    poses = np.asarray(poses_world_robot, dtype=float)
-    inc = np.asarray(increments_robot, dtype=float)
-    q = np.asarray(increment_covariance, dtype=float)
-    n = inc.shape[0]
+    # the Python API reads no units: text raised numpy's ValueError; a number as increments IndexError
+    poses, inc, q = (as_reals(v, name) for name, v in (("poses_world_robot", poses_world_robot),
+                                                       ("increments_robot", increments_robot),
+                                                       ("increment_covariance", increment_covariance)))
+    n = len(inc) if inc.ndim else 0
     if poses.shape != (n + 1, 3) or inc.shape != (n, 3) or q.shape != (n, 3, 3):
         raise WmrkitError(f"propagate_covariance: expected shapes (N + 1, 3), (N, 3), (N, 3, 3); got {poses.shape}, "
                           f"{inc.shape}, {q.shape}")

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_names, finite_number
+from .._shapes import as_names, finite_number, real_number
 from ..errors import UnknownNameError, WmrkitError
 
 
@@ -67,8 +67,8 @@ class IncrementalEncoder:
         if self.counts_per_rev * self.gear_ratio > MAX_COUNTS_PER_REV:  # a count below round-off, or 0 rad
             raise EncoderError(f"counts_per_rev x gear_ratio = {self.counts_per_rev * self.gear_ratio:g} counts per "
                                f"wheel revolution: at most {MAX_COUNTS_PER_REV:g}")
-        if self.sign not in (1, -1):
-            raise EncoderError(f"sign must be +1 or -1, got {self.sign}")
+        if not (real_number(self.sign) and self.sign in (1, -1)):  # True was taken as +1, an array raised numpy's
+            raise EncoderError(f"sign must be +1 or -1, got {self.sign!r}")
 
     @property
     def radians_per_count(self) -> float:
@@ -135,8 +135,8 @@ class AbsoluteEncoder:
             raise EncoderError(f"resolution must be a finite number > 0 [rad], got {self.resolution!r}")
         if isinstance(self.offset, bool) or not finite_number(self.offset):
             raise EncoderError(f"offset must be a finite angle [rad], got {self.offset!r}")
-        if self.sign not in (1, -1):
-            raise EncoderError(f"sign must be +1 or -1, got {self.sign}")
+        if not (real_number(self.sign) and self.sign in (1, -1)):  # True was taken as +1, an array raised numpy's
+            raise EncoderError(f"sign must be +1 or -1, got {self.sign!r}")
 
     def angle(self, counts: ArrayLike, *, name: str = "counts") -> np.ndarray:
         """Angles [rad] of raw readings `counts` (whole numbers, else :class:`EncoderError` naming `name`).
@@ -184,7 +184,7 @@ CATALOG_ENCODERS: Mapping[str, Mapping[str, Encoder]] = {
 
 def catalog_encoders(robot_name: str) -> Mapping[str, Encoder]:
     """Encoders of catalog robot `robot_name` by joint, or :class:`UnknownNameError`."""
-    if robot_name not in CATALOG_ENCODERS:
+    if not isinstance(robot_name, str) or robot_name not in CATALOG_ENCODERS:  # a list: "unhashable type"
         raise UnknownNameError(f"no encoder data for robot '{robot_name}' (known: {', '.join(CATALOG_ENCODERS)}); "
                                "give the counts per revolution")
     return CATALOG_ENCODERS[robot_name]

@@ -46,7 +46,7 @@ _SMALL = 1e-4
 
 def check_method(method: str) -> str:
     """`method` if it is one of :data:`METHODS`, else :class:`WmrkitError` listing them."""
-    if method not in HEADING_FRACTION:
+    if not isinstance(method, str) or method not in HEADING_FRACTION:  # a list raised "unhashable type"
         raise WmrkitError(f"unknown integration method '{method}' (methods: {', '.join(METHODS)})")
     return method
 
@@ -170,12 +170,12 @@ def integrate_increments(
     """
     check_method(method)
     pose0 = as_vectors(pose_world_robot, 3, "pose_world_robot")
-    inc = np.asarray(increments_robot, dtype=float)
+    inc = as_reals(increments_robot, "increments_robot")  # the Python API reads no units: text was numpy's error
     if inc.ndim < 2 or inc.shape[-1] != 3:
         raise WmrkitError(f"increments_robot: expected shape (..., N, 3), got {inc.shape}")
     _finite(pose0, "pose_world_robot"), _finite(inc, "increments_robot")
     if heading_world is not None:
-        _finite(np.asarray(heading_world, dtype=float), "heading_world")
+        _finite(as_reals(heading_world, "heading_world"), "heading_world")
     return compose_columns(pose0, inc[..., 0], inc[..., 1], inc[..., 2], method, heading_world=heading_world)
 
 

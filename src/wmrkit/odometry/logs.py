@@ -24,7 +24,7 @@ from __future__ import annotations
 import difflib
 import numbers
 import os
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Literal
 
@@ -86,7 +86,7 @@ class JointLog:
             if (value := getattr(self, name)) is not None and not (isinstance(value, np.ndarray)
                                                                    and value.dtype == float):
                 object.__setattr__(self, name, as_reals(value, f"{self.source}: {name}"))
-        n = len(self.time)
+        n = len(self.time) if np.ndim(self.time) else -1  # a number raised "len() of unsized object"
         if np.ndim(self.time) != 1 or np.shape(self.positions) != (n, len(self.joints)):
             raise LogError(f"{self.source}: expected time (N,) and positions (N, {len(self.joints)}), got "
                            f"{np.shape(self.time)} and {np.shape(self.positions)}")
@@ -170,8 +170,9 @@ class LogFormat:
                                     ("encoders", Encoder, "IncrementalEncoder(1024)")):
             value = getattr(self, name)
             pairs = tuple(value.items()) if isinstance(value, Mapping) else value  # a dict reads as its pairs
-            if isinstance(pairs, str) or not all(isinstance(p, tuple | list) and len(p) == 2 and isinstance(p[0], str)
-                                                 and isinstance(p[1], kind) for p in pairs):
+            if isinstance(pairs, str) or not isinstance(pairs, Iterable) or not all(  # a number: a bare TypeError
+                    isinstance(p, tuple | list) and len(p) == 2 and isinstance(p[0], str) and isinstance(p[1], kind)
+                    for p in pairs):
                 raise LogError(f"LogFormat.{name}: expected (joint, {name[:-1]}) pairs, e.g. (('left.spin', "
                                f"{example}),), got {value!r}")
             object.__setattr__(self, name, tuple(tuple(p) for p in pairs))
@@ -179,7 +180,7 @@ class LogFormat:
             value = getattr(self, name)
             if value is not None and not (isinstance(value, numbers.Real) and not isinstance(value, bool)):
                 raise LogError(f"LogFormat.{name}: expected a number or None, got {value!r}")
-        if self.time_unit not in TIME_UNITS:
+        if not isinstance(self.time_unit, str) or self.time_unit not in TIME_UNITS:  # a list: "unhashable type"
             raise LogError(f"unknown time unit '{self.time_unit}' (units: {', '.join(TIME_UNITS)})")
         if self.spin not in SPIN_MODES or self.steer not in ("angle", "degrees", "counts"):
             raise LogError(f"spin must be one of {', '.join(SPIN_MODES)} and steer angle, degrees or counts; got "

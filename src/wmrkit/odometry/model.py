@@ -344,7 +344,13 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
     unweighted ``A dq``. Raises :class:`SensingError` when the joints cannot give the motion,
     :class:`UnknownNameError` for a name the robot lacks.
     """
+    if not isinstance(robot, Robot):  # a catalog name raised "'str' object has no attribute 'sensed'"
+        raise SensingError(f"robot: expected a Robot (wmrkit.catalog.load(name), Robot.from_file(path)), got "
+                           f"{type(robot).__name__} {robot!r:.60}")
     sensed = robot.sensed if sensed is None else as_names(sensed, "sensed", "'wheel.joint' names", SensingError)
+    if weights is not None and not isinstance(weights, Mapping):  # 'abc' or 1.0: dict()'s TypeError or ValueError
+        raise SensingError(f"weights: expected a mapping {{wheel name: weight}}, got {type(weights).__name__} "
+                           f"{weights!r:.60}")
     weights = dict(weights or {})
     for name, w in weights.items():
         robot.wheel(name)

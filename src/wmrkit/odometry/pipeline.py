@@ -163,6 +163,9 @@ def odometry(robot: Robot | OdometryModel, log: JointLog, *, method: Method = "e
     `robot` may be an :class:`OdometryModel` to choose the sensed joints (default: ``robot.sensed``).
     """
     check_chunk_size(chunk_size, LogError)
+    if not isinstance(log, JointLog):  # a path or an array raised AttributeError or TypeError
+        raise LogError(f"log: expected a JointLog (read_csv(path, joints, robot=robot), JointLog.from_headings), "
+                       f"got {type(log).__name__} {log!r:.60}")
     model = robot if isinstance(robot, OdometryModel) else odometry_model(robot)
     n = len(log)
     # slip from calloc: robots without redundant sensors leave it untouched (no page is written)

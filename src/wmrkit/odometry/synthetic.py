@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_reals, finite_number
+from .._shapes import as_names, as_real, as_reals, finite_number
 from ..errors import WmrkitError
 from ..kinematics.linalg import solve_assigned
 from ..limits import MAX_COORDINATE, MAX_SPEED, check_seed
@@ -42,7 +42,9 @@ class TwistProfile:
     twists: np.ndarray
 
     def __post_init__(self) -> None:
-        d, tw = np.asarray(self.durations, dtype=float), np.asarray(self.twists, dtype=float)
+        d, tw = as_reals(self.durations, "profile: durations"), as_reals(self.twists, "profile: twists")
+        object.__setattr__(self, "durations", d)  # lists given in Python: duration raised "'list' has no 'sum'"
+        object.__setattr__(self, "twists", tw)
         if d.ndim != 1 or tw.shape != (len(d), 3):
             raise WmrkitError(f"profile: expected durations (S,) and twists (S, 3), got {d.shape} and {tw.shape}")
         if not len(d):
@@ -116,6 +118,12 @@ class Slip:
     stop: float
     ratio: float
 
+    def __post_init__(self) -> None:  # the Python API reads no units: start='1' raised a bare TypeError in simulate
+        if not isinstance(self.joint, str):
+            raise WmrkitError(f"slip: joint: expected a joint's name such as 'left.spin', got {self.joint!r}")
+        for name in ("start", "stop", "ratio"):
+            object.__setattr__(self, name, as_real(getattr(self, name), f"slip: {name}"))
+
 
 @dataclass(frozen=True, eq=False)  # eq=False: array fields
 class SyntheticRun:
@@ -156,7 +164,14 @@ def simulate(robot: Robot, profile: TwistProfile, rate: float, *, pose0: ArrayLi
     steering: nearest reading). `spin_noise_per_rad` [rad^2/rad], `steer_noise` [rad] (standard deviation).
     `oversample`: fine steps per sample interval for the joint kinematics. Deterministic for a given `seed`.
     """
-    sensed = tuple(robot.sensed if sensed is None else sensed)
+    if not isinstance(profile, TwistProfile):  # a list of segments raised AttributeError
+        raise WmrkitError(f"profile: expected a TwistProfile (TwistProfile.from_segments, square_path), got "
+                          f"{type(profile).__name__}")
+    sensed = robot.sensed if sensed is None else as_names(sensed, "sensed", "joint names", WmrkitError)
+    if encoders is not None and not isinstance(encoders, Mapping):  # a list raised "has no attribute 'items'"
+        raise WmrkitError(f"encoders: expected a mapping {{joint: encoder}}, got {type(encoders).__name__}")
+    if isinstance(slips, str) or not isinstance(slips, Sequence) or not all(isinstance(s, Slip) for s in slips):
+        raise WmrkitError(f"slips: expected a sequence of Slip(joint, start, stop, ratio), got {slips!r:.60}")
     _check_arguments(robot, sensed, pose0, spin_noise_per_rad, steer_noise, slips, oversample, seed)
     if isinstance(rate, bool) or not finite_number(rate):
         raise WmrkitError(f"rate: expected a finite number [Hz], got {rate!r}")
@@ -251,7 +266,7 @@ def _check_arguments(robot: Robot, sensed: tuple[str, ...], pose0: ArrayLike, sp
         if joint not in robot.rate_names and not (kind == "steer" and robot.wheel(wheel).kind.steers):
             raise WmrkitError(f"sensed: robot '{robot.name}' has no joint '{joint}' that can be sensed "
                               f"(joints: {', '.join(robot.rate_names)})")
-    pose = np.asarray(pose0, dtype=float)
+    pose = as_reals(pose0, "pose0")  # text raised numpy's 'could not convert string to float'
     if pose.shape != (3,) or not (np.abs(pose) <= MAX_COORDINATE).all():
         raise WmrkitError(f"pose0: expected (x, y, theta), finite and within {MAX_COORDINATE:g}, got {pose.tolist()}")
     for name, value in (("spin_noise_per_rad", spin_noise_per_rad), ("steer_noise", steer_noise)):
