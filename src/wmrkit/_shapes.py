@@ -88,6 +88,13 @@ def as_names(names: object, argument: str, what: str = "names", error: type[Exce
     return items
 
 
+def check_kind(value: object, kind: type, argument: str, advice: str, error: type[Exception] = ShapeError) -> None:
+    """Raise `error` naming `argument` unless `value` is a `kind` (a name or a dict where an object goes raised an
+    AttributeError deep inside); `advice` says how to build one."""
+    if not isinstance(value, kind):
+        raise error(f"{argument}: expected a {kind.__name__} ({advice}), got {type(value).__name__} {value!r:.60}")
+
+
 def matvec(m: np.ndarray, v: np.ndarray, name: str) -> np.ndarray:
     """``m @ v`` over leading batch axes, ``(..., r, n), (..., n) -> (..., r)``, or :class:`ShapeError` naming `name`
     when the two batch shapes do not broadcast (numpy's message named neither)."""

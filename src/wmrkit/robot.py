@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._shapes import as_angles, as_vectors, readonly
+from ._shapes import as_angles, as_vectors, check_kind, readonly
 from .couplings import Coupling, check_couplings
 from .dynamics.mass import Body
 from .errors import ShapeError, UnknownNameError
@@ -392,3 +392,13 @@ def element_beta(robot: Robot, beta: ArrayLike | None) -> np.ndarray:
     if len(t.steer_wheels) == 0:
         return np.broadcast_to(described, (*beta.shape[:-1], len(described)))
     return np.where(t.element_steers, beta[..., t.element_steer_index], 0.0) + t.element_beta_fixed
+
+
+#: How to build a :class:`Robot`, said where something else was given.
+ROBOT_ADVICE = "wmrkit.catalog.load(name), Robot.from_file(path)"
+
+
+def check_robot(robot: object, error: type[Exception] = ShapeError) -> None:
+    """Raise `error` naming the argument unless `robot` is a :class:`Robot`: a catalog name given instead raised
+    "'str' object has no attribute 'steering'" deep inside."""
+    check_kind(robot, Robot, "robot", ROBOT_ADVICE, error)

@@ -29,7 +29,7 @@ from ..errors import WmrkitError
 from ..kinematics.linalg import centred, centroid, characteristic_length, matrix_rank
 from ..kinematics.models import configuration, own_turn, random_steering
 from ..limits import check_seed
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from .icr import steer_to_icr
 from .lines import constraint_lines, line_residual
 
@@ -92,6 +92,7 @@ def instantaneous_mobility(robot: Robot, beta: ArrayLike | None = None, *,
     Equals ``k - rank A`` (6.8) for robots whose wheel rates are all fixed by the twist (all but double wheels:
     their joints also move with the body at rest, which this m does not count).
     """
+    check_robot(robot)
     beta = configuration(robot, beta, heading)
     cl = constraint_lines(robot, coupled=geared and any(c.kind == "gear" for c in robot.couplings))
     if not cl.labels:
@@ -106,6 +107,7 @@ def classify(robot: Robot, *, samples: int = 8, seed: int = 0) -> Classification
     rank met, i.e. the least m, since a rank only drops on a special set of configurations (and numerically near
     it: two axles 100 nm apart aimed at an ICR 100 m away read as one line).
     """
+    check_robot(robot)
     if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or not 1 <= samples <= 10_000:
         raise WmrkitError(f"samples must be an integer in [1, 10000], got {samples!r}")
     check_seed(seed, WmrkitError)

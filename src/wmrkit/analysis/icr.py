@@ -21,7 +21,7 @@ from .._shapes import as_vectors
 from ..errors import ShapeError
 from ..kinematics.linalg import centred, centroid, characteristic_length, matrix_rank
 from ..kinematics.models import configuration
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from ..units import MAX_ANGLE
 from .lines import ConstraintLines, common_point, constraint_lines, element_rows
 
@@ -156,6 +156,7 @@ def icr(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike | Non
     `geared`: with the robot's ``gear`` couplings held (as ``analyze``, ``fk`` and the actuation analysis hold them):
     the ICR also lies on the line each gear adds (:func:`.lines.constraint_lines` with ``coupled``), e.g. the line
     of ICRs two omni wheels' spins on one gear leave, or the one point a solid axle's ratio fixes."""
+    check_robot(robot)
     found = _admissible(robot, configuration(robot, beta, heading), geared)
     return replace(found, decimals=coordinate_decimals(robot))
 
@@ -259,6 +260,7 @@ def icr_points(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLik
     Meaningful where the robot has one degree of mobility (types 4 and 5, eqs. 5.18-5.21 corrected): then it is
     the ICR. Least-squares nearest point otherwise.
     """
+    check_robot(robot)
     return common_point(constraint_lines(robot).lines(configuration(robot, beta, heading)))
 
 
@@ -271,6 +273,7 @@ def steer_to_icr(robot: Robot, icr_h: ArrayLike) -> np.ndarray:
     turns); castors and wheels at the ICR keep their described angle. This is the coordination (Ackermann, swerve)
     that lets a robot with several steered wheels move (§5.3, consequence 3 of 5.12).
     """
+    check_robot(robot)
     h = _homogeneous(icr_h)
     steering, j, cx, cy, offset, described = _aimed_axles(robot)
     beta = np.broadcast_to(steering, (*h.shape[:-1], len(steering))).copy()

@@ -31,7 +31,7 @@ from ..couplings import gear_fill
 from ..errors import ShapeError, UnknownNameError
 from ..kinematics.linalg import centred, matrix_rank, reach
 from ..kinematics.models import configuration
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from . import _fast
 from .classification import classify
 from .lines import _rate_block, constraint_lines, element_rows, line_parameters, rows_at
@@ -70,6 +70,7 @@ def isotropy_matrix(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, .
     basis of the null space of the slip matrix (6.7); H does not depend on which basis. Steering: `beta` (thesis,
     None: as described) or `heading` (0 = rolling forward).
     """
+    check_robot(robot)
     length = check_positive_length(length)
     beta = robot.steering(beta, heading)
     assigned, selected = (as_names(v, k, "velocity names", UnknownNameError)
@@ -97,6 +98,7 @@ def isotropy_length(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, .
 
     Without omega among the velocities there is no D to choose: returns ``(nan, kappa)``.
     """
+    check_robot(robot)
     beta = robot.steering(beta, heading)
     assigned, selected = (as_names(v, k, "velocity names", UnknownNameError)
                           for k, v in (("assigned", assigned), ("selected", selected)))
@@ -108,6 +110,7 @@ def isotropy_length(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, .
 
 def default_joints(robot: Robot) -> tuple[str, ...]:
     """The actuated joint rates that enter the velocity vector, or every wheel spin if none is declared."""
+    check_robot(robot)
     rates = set(robot.rate_names)
     actuated = tuple(n for n in robot.actuated if n in rates)
     return actuated or tuple(n for n in robot.rate_names if n.split(".")[-1].startswith("spin"))
@@ -148,6 +151,7 @@ def twist_model(robot: Robot, joints: tuple[str, ...] | None = None, *, geared: 
     rank at the described configuration (a gear of two omni wheels' spins leaves m = 2: one line the ICR lies on,
     the thesis's (v, D omega) pair about it, as for a fixed axle).
     """
+    check_robot(robot)
     joints = default_joints(robot) if joints is None else as_names(joints, "joints", "joint rate names",
                                                                    UnknownNameError)
     for n in joints:
@@ -197,6 +201,7 @@ def twist_condition_number(robot: Robot, beta: ArrayLike | None = None, *, joint
     defined: isotropy does not apply to types 4 and 5 (§5.5.4-5.5.5). Steering as `beta` or `heading`;
     `geared`: over the motions the robot's gears allow (:func:`twist_model`).
     """
+    check_robot(robot)
     model = twist_model(robot, joints, geared=geared)
     beta = configuration(robot, beta, heading)
     if length is None:
@@ -240,6 +245,7 @@ def natural_length(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple
     three-wheel omni robot). Where kappa does not depend on D (m = 1) D is the robot size. Steering: `beta`
     (thesis) or `heading` (0 = rolling forward), default as described; `geared` as :func:`twist_model`.
     """
+    check_robot(robot)
     model = twist_model(robot, joints, geared=geared)
     beta = configuration(robot, beta, heading)
     if beta.ndim != 1:
@@ -368,4 +374,5 @@ def condition_map(robot: Robot, beta: ArrayLike | None = None, *, joints: tuple[
 
     Closed-form eigenvalues in cache-sized chunks: 10^6 configurations in well under 2 s (benchmarks/).
     """
+    check_robot(robot)
     return twist_condition_number(robot, beta, joints=joints, length=length, heading=heading, geared=geared)

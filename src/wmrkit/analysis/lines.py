@@ -26,7 +26,7 @@ from .._shapes import as_names, as_vectors, readonly
 from ..couplings import Coupling, coupled_columns
 from ..errors import ShapeError, UnknownNameError
 from ..kinematics.linalg import nondimensional, rank_cutoff, rref, unit_columns
-from ..robot import TWIST_NAMES, Robot, element_table
+from ..robot import TWIST_NAMES, Robot, check_robot, element_table
 from ._fast import cancel_roundoff
 
 #: Rows added for assigned vehicle velocities (rules 5-6 of §6.3): the X axis, the Y axis, the line at infinity.
@@ -133,6 +133,7 @@ def constraint_lines(robot: Robot, assigned: tuple[str, ...] = (), *, coupled: b
     its joints together. The free rates of the coupled wheels are then eliminated together, so a line may combine
     the rows of several wheels (the actuated model of a robot driven through a differential).
     """
+    check_robot(robot)
     assigned = as_names(assigned, "assigned", "velocity names", UnknownNameError)
     for name in assigned:
         robot.velocity_index(name)

@@ -19,7 +19,7 @@ from scipy.optimize import minimize
 from .._shapes import as_names, as_real, as_reals
 from ..errors import ShapeError, UnknownNameError, WmrkitError
 from ..limits import check_seed
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from . import _fast
 from ._sym import eigvalsh2_entries
 from .isotropy import _kappa, _natural_length, golden_section, kappa_function, natural_length, twist_model
@@ -55,6 +55,7 @@ def best_configurations(robot: Robot, *, joints: tuple[str, ...] | None = None, 
     steering wheels that change kappa (those with an axle constraint or among the joints). Only configurations
     where kappa is finite are returned: none when the joints determine the twist nowhere (fewer joints than m).
     """
+    check_robot(robot)
     _check_counts(resolution=resolution, max_samples=max_samples, count=count)
     if length is not None:  # NaN, 0, -1 and inf were taken and returned as the configurations' length; '1' as 1 m
         length = check_positive_length(length)
@@ -141,6 +142,7 @@ def isotropic_configurations(robot: Robot, *, joints: tuple[str, ...] | None = N
 
     The search of :func:`best_configurations` (16 starts; grid or seeded sample of at most `max_samples`).
     """
+    check_robot(robot)
     tol = as_real(tol, "tol")
     if not (tol >= 0 and np.isfinite(tol)):  # NaN included: it kept nothing, read as 'not isotropic'
         raise WmrkitError(f"tol: expected a tolerance >= 0 on the condition number, got {tol}")

@@ -28,7 +28,7 @@ from ..couplings import coupled_columns
 from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import centred, matrix_rank, nondimensional, robot_size, unit_columns
 from ..kinematics.models import configuration
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from . import _fast
 from .lines import constraint_lines, element_rows, line_parameters
 
@@ -45,6 +45,7 @@ def is_singular_rank(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, 
     (:func:`wmrkit.couplings.coupled_columns`): ``A_na`` is the slip matrix in the free variables, the twist
     components not assigned and the free rate combinations ``T_rest``.
     """
+    check_robot(robot)
     cols = [robot.velocity_index(n) for n in assigned]
     a = nondimensional(robot).constraint_matrix(beta, heading=heading)  # kinematics.linalg's tolerances
     if not {0, 1, 2} & set(cols):  # the whole twist free: that of the centroid, the same in every frame
@@ -70,6 +71,7 @@ def is_singular(robot: Robot, beta: ArrayLike | None, assigned: tuple[str, ...],
     (thesis, None: as described) or `heading` (0 = rolling forward). `coupled`: through the robot's rate couplings
     (:func:`wmrkit.analysis.lines.constraint_lines`).
     """
+    check_robot(robot)
     rtol = as_real(rtol, "rtol")  # '1' raised numpy's UFuncTypeError; NaN answered False everywhere
     if not 0 <= rtol < np.inf:
         raise WmrkitError(f"rtol: expected a finite relative tolerance >= 0, got {rtol}")
@@ -93,6 +95,7 @@ def singularity_distance(robot: Robot, beta: ArrayLike | None, assigned: tuple[s
     Steering: `beta` (thesis, None: as described) or `heading` (0 = rolling forward). `coupled`: through the
     robot's rate couplings.
     """
+    check_robot(robot)
     cl = constraint_lines(robot, assigned, coupled=coupled)
     beta = configuration(robot, beta, heading)
     if cl.internal or len(cl.labels) < 3:
@@ -159,6 +162,7 @@ def singular_set(robot: Robot, assigned: tuple[str, ...], *, variables: tuple[st
     solved exactly. `coupled`: through the robot's rate couplings (the actuated model of a robot with a
     differential: :func:`wmrkit.analysis.lines.constraint_lines`).
     """
+    check_robot(robot)
     for key, value in (("resolution", resolution), ("max_samples", max_samples)):
         if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:  # none: 'always'
             raise WmrkitError(f"singular_set: {key} must be a whole number >= 1, got {value!r}")

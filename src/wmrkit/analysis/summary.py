@@ -21,7 +21,7 @@ from ..errors import WmrkitError
 from ..kinematics.actuation import actuation_analysis, actuator_names
 from ..kinematics.sensing import sensing_analysis
 from ..limits import check_length
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from ..wheels import heading_from_beta
 from .classification import Classification, classify, instantaneous_mobility
 from .coordinated import coordinated_singular_set
@@ -249,6 +249,7 @@ def analyze(robot: Robot, *, length: float | None = None, resolution: int = 90) 
     grid points per turn for singular sets over two or more steering angles (:func:`check_resolution`, as
     ``--resolution``).
     """
+    check_robot(robot)
     check_resolution(resolution)
     here = described_analysis(robot, length=length, resolution=resolution)
     cls = here.classification

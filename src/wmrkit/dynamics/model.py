@@ -32,7 +32,7 @@ from .._shapes import as_angles, readonly, real_number
 from ..couplings import gear_free
 from ..errors import DescriptionError, ShapeError, WmrkitError
 from ..kinematics.linkage_law import linkage_table
-from ..robot import Robot, element_table
+from ..robot import Robot, check_robot, element_table
 from .linkages import LinkageWarning, coupling_basis, linkage_breach, reduced, unheld
 from .mass import CASTOR_TYPES, Body, body_problem
 from .tyres import Tyre
@@ -67,9 +67,7 @@ class DynamicModel:
         the dynamics do not hold (no ``law`` and none to default to) gives a
         :class:`~wmrkit.dynamics.linkages.LinkageWarning` each (:func:`~wmrkit.dynamics.linkages.unheld`).
         """
-        if not isinstance(robot, Robot):  # a catalog name raised "'str' object has no attribute 'body'"
-            raise TypeError(f"robot: expected a Robot (wmrkit.catalog.load(name), Robot.from_file(path)), got "
-                            f"{type(robot).__name__} {robot!r:.60}")
+        check_robot(robot, TypeError)  # a catalog name raised "'str' object has no attribute 'body'"
         if isinstance(tyre, str):
             tyre = Tyre.of(tyre)
         elif not (tyre is None or isinstance(tyre, Tyre)):

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_vectors, matvec, readonly
 from ..couplings import channel_names, coupled_columns, gear_fill, gear_free, linked_steering
 from ..errors import SingularError
-from ..robot import TWIST_NAMES, Robot
+from ..robot import TWIST_NAMES, Robot, check_robot
 from .linalg import coupled_constraints, nondimensional, nullity, unit_columns
 from .models import bounded, configuration
 from .search import MAX_MINIMAL_SETS, SetList, exact_budget, null_space_cost, null_space_prefilter, search_sets
@@ -294,6 +294,7 @@ def actuation_analysis(
     :class:`ActuationAnalysis` for ``.consistent``, ``.sufficient``, ``.verdict`` and the actuated inverse
     solution ``.inverse``.
     """
+    check_robot(robot)
     beta = configuration(robot, beta, heading)
     columns, steering = select_columns(robot, robot.actuated if actuated is None else actuated, "actuated")
     i_bar, j_u, j_nu, channels = coupled_split(robot, columns, beta)

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 from .._shapes import as_names, as_vectors, matvec, readonly
 from ..errors import ShapeError, SingularError, WmrkitError
 from ..limits import MAX_QUERY_RATE
-from ..robot import TWIST_NAMES, Robot
+from ..robot import TWIST_NAMES, Robot, check_robot
 from .linalg import centred, coupled_constraints, matrix_rank, nondimensional, nullity, velocity_scale
 from .nullspace import null_space_assignable, null_space_basis, null_space_solution, rref_solution
 from .ranks import ranks_assignable, ranks_solution
@@ -128,6 +128,7 @@ def mobility(robot: Robot, beta: ArrayLike | None = None, *, heading: ArrayLike 
     """Degree of mobility ``m = k - rank A`` (4.3): ``(..., n_steer) -> (...)`` int (β or `heading`). ``A`` holds the
     robot's ``gear`` couplings (a row per direction a gear forbids), as the models here do; ``gears=False``: the
     wheels' alone, the thesis's m (equal without a gear)."""
+    check_robot(robot)
     a = constraints(robot, configuration(robot, beta, heading), gears)
     return nullity(robot, a)
 
@@ -205,6 +206,7 @@ def assignable_sets(
 
     Sets are tuples of velocity names in the robot's order, listed lexicographically.
     """
+    check_robot(robot)
     return _sets_at(robot, constraints(robot, configuration(robot, beta, heading)), method)
 
 
@@ -267,6 +269,7 @@ def kinematic_model(
     :class:`~wmrkit.errors.SingularError` naming the set and the first configuration where it is not
     assignable, and whether it is assignable at generic angles. Steering as the thesis's `beta` or as `heading`.
     """
+    check_robot(robot)
     beta = configuration(robot, beta, heading)
     idx = velocity_indices(robot, assigned)
     a = constraints(robot, beta)
@@ -323,6 +326,7 @@ def direct_model(
     ``rates=None`` takes the first assignable set of the robot's *sensed* rates, or failing that of all its
     wheel rates (roller rates excluded: they cannot be measured, §3.3.3).
     """
+    check_robot(robot)
     beta = configuration(robot, beta, heading)
     if rates is not None:
         return kinematic_model(robot, rates, beta)
@@ -376,6 +380,7 @@ def inverse_model(
     rates of double wheels that no twist determines (``robot.free_steering``, but those the gears tie to the twist
     or to another) assigned too.
     """
+    check_robot(robot)
     beta = configuration(robot, beta, heading)
     if twist_names is not None:
         return kinematic_model(robot, twist_names, beta)

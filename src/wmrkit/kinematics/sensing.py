@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, matvec, readonly
 from ..couplings import gear_fill, gear_free
-from ..robot import TWIST_NAMES, Robot
+from ..robot import TWIST_NAMES, Robot, check_robot
 from .actuation import (
     body_only,
     minimal_set_search,
@@ -235,6 +235,7 @@ def sensing_analysis(
     :class:`SensingAnalysis` for ``.sufficient``, ``.slip_detectable``, ``.verdict``, and the sensed direct
     solution ``.twist`` / ``.direct``.
     """
+    check_robot(robot)
     beta = configuration(robot, beta, heading)
     columns, steering, i_bar, j_s, j_ns, unknown = _split(robot, sensed, beta)
     unit = nondimensional(robot)  # rank decisions: the tolerance policy of .linalg

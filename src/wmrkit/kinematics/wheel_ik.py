@@ -20,7 +20,7 @@ from .._shapes import as_names, as_reals, as_vectors, finite_number, readonly
 from ..couplings import Coupling, GearWarning
 from ..errors import ShapeError, UnknownNameError
 from ..limits import MAX_QUERY_RATE
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from ..units import Kind
 from ..wheels import heading_from_beta, heading_in_range
 from . import _ik_fast
@@ -164,6 +164,7 @@ def wheel_commands(
     - a ``linkage`` whose held law the angles break (a synchro drive's wheels, turning together, asked to turn the
       robot) makes it False too: ``in_linkage`` (:mod:`~wmrkit.kinematics.linkage_check`).
     """
+    check_robot(robot)
     check_tolerances(speed_tol, slip_tol)
     p = _ik_fast.plan(robot)
     twist = as_vectors(twist_robot, 3, "twist_robot")
@@ -308,6 +309,7 @@ def forward_kinematics(
     left by the assignment, 0 when the rates are consistent (the slip indicator of (4.11)/(4.82)). When the
     given rates do not determine the twist the minimum-norm one is returned: check :func:`twist_is_determined`.
     """
+    check_robot(robot)
     columns = _assigned_columns(robot, list(_mapping(robot, rates)))
     given = {k: _rate_value(k, v) for k, v in rates.items()}
     try:

@@ -30,7 +30,7 @@ from .._shapes import as_names, readonly
 from ..couplings import gear_fill
 from ..errors import UnknownNameError, WmrkitError
 from ..kinematics.linalg import geared_solve, geared_twist_determined
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from ..wheels import heading_from_beta
 from .integrators import _finite
 
@@ -344,9 +344,7 @@ def odometry_model(robot: Robot, sensed: Sequence[str] | None = None, *,
     unweighted ``A dq``. Raises :class:`SensingError` when the joints cannot give the motion,
     :class:`UnknownNameError` for a name the robot lacks.
     """
-    if not isinstance(robot, Robot):  # a catalog name raised "'str' object has no attribute 'sensed'"
-        raise SensingError(f"robot: expected a Robot (wmrkit.catalog.load(name), Robot.from_file(path)), got "
-                           f"{type(robot).__name__} {robot!r:.60}")
+    check_robot(robot, SensingError)  # a catalog name raised "'str' object has no attribute 'sensed'"
     sensed = robot.sensed if sensed is None else as_names(sensed, "sensed", "'wheel.joint' names", SensingError)
     if weights is not None and not isinstance(weights, Mapping):  # 'abc' or 1.0: dict()'s TypeError or ValueError
         raise SensingError(f"weights: expected a mapping {{wheel name: weight}}, got {type(weights).__name__} "

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._shapes import as_angle_array, as_reals, as_vectors
+from .._shapes import as_angle_array, as_reals, as_vectors, check_kind
 from ..documents import LineOf, read_document, read_file, write_document
 from ..errors import DescriptionError, WmrkitError
 from ..limits import MAX_SIZE
@@ -169,11 +169,8 @@ class Camera:
 
 
 def check_type(value: object, kind: type, argument: str, advice: str) -> None:
-    """Raise :class:`CameraError` naming `argument` unless `value` is a `kind` (a camera's name or a dict raised
-    AttributeError deep inside); `advice` says how to build one."""
-    if not isinstance(value, kind):
-        raise CameraError(f"{argument}: expected a {kind.__name__} ({advice}), got {type(value).__name__} "
-                          f"{value!r:.60}")
+    """Raise :class:`CameraError` naming `argument` unless `value` is a `kind` (:func:`wmrkit._shapes.check_kind`)."""
+    check_kind(value, kind, argument, advice, CameraError)
 
 
 def read_located(path: str | Path, what: str, fmt: str, *, lines: bool = False) -> Any:
