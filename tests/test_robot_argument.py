@@ -1,6 +1,7 @@
-"""Every public function of wmrkit and wmrkit.analysis whose first argument is `robot` names it when given a
-catalog name (or anything that is not a Robot): "'str' object has no attribute 'steering'" came from deep inside
-(wmrkit.robot.check_robot). The list is derived from ``__all__``, so a new function is held to it too."""
+"""Every public function of wmrkit, wmrkit.analysis, .batch, .control and .slip whose first argument is `robot`
+names it when given a catalog name (or anything that is not a Robot): "'str' object has no attribute 'steering'"
+came from deep inside (wmrkit.robot.check_robot; batch's as a BatchError). The list is derived from ``__all__``,
+so a new function is held to it too."""
 
 from __future__ import annotations
 
@@ -10,7 +11,10 @@ import pytest
 
 import wmrkit
 import wmrkit.analysis
-from wmrkit import ShapeError, catalog
+import wmrkit.batch
+import wmrkit.control
+import wmrkit.slip
+from wmrkit import WmrkitError, catalog
 
 _SKIP = {"robot_to_dict"}  # writes what it is given (a Robot's fields); its own test refuses other objects
 
@@ -26,25 +30,28 @@ def _robot_first(module) -> list[tuple[str, object]]:
     return out
 
 
-FUNCTIONS = _robot_first(wmrkit) + _robot_first(wmrkit.analysis)
+FUNCTIONS = [f for m in (wmrkit, wmrkit.analysis, wmrkit.batch, wmrkit.control, wmrkit.slip) for f in _robot_first(m)]
 
 
 def _call(f, robot):
-    """`f(robot, ...)` with a placeholder for each other required positional argument (the robot is checked first)."""
-    required = [p for p in list(inspect.signature(f).parameters.values())[1:]
-                if p.default is inspect.Parameter.empty and p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
-    return f(robot, *([None] * len(required)))
+    """`f(robot, ...)` with a placeholder for each other required argument (the robot is checked first)."""
+    params = list(inspect.signature(f).parameters.values())[1:]
+    required = [p for p in params if p.default is inspect.Parameter.empty]
+    positional = [p for p in required if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    keywords = {p.name: None for p in required if p.kind == p.KEYWORD_ONLY}
+    return f(robot, *([None] * len(positional)), **keywords)
 
 
 def test_the_list_is_not_empty():
     names = {n for n, _ in FUNCTIONS}
-    assert len(names) >= 25 and "wmrkit.wheel_commands" in names and "wmrkit.analysis.classify" in names
+    assert len(names) >= 50 and {"wmrkit.wheel_commands", "wmrkit.analysis.classify", "wmrkit.batch.sweep",
+                                 "wmrkit.control.simulate", "wmrkit.slip.wls"} <= names
 
 
 @pytest.mark.parametrize(("name", "f"), FUNCTIONS, ids=[n for n, _ in FUNCTIONS])
 @pytest.mark.parametrize("given", ["diff-drive", {"name": "x", "wheels": []}, None])
 def test_a_name_where_a_robot_goes_is_named(name, f, given):
-    with pytest.raises(ShapeError, match=r"^robot: expected a Robot \(wmrkit\.catalog\.load\(name\), "):
+    with pytest.raises(WmrkitError, match=r"^robot: expected a Robot \(wmrkit\.catalog\.load\(name\), "):
         _call(f, given)
 
 

@@ -44,7 +44,7 @@ from ..odometry.calibration import (
     solve,
 )
 from ..odometry.integrators import check_method
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from .consistency import SLIP_NOT_JUDGED, Consistency, judge, names
 from .engine import BatchError, Engine, TaskFailure, engine
 from .motions import REFERENCE_NOISE, check_reference_noise
@@ -169,6 +169,7 @@ def fleet_calibrate(robot: Robot, runs: Sequence[CalibrationRun], parameters: Se
     """Fit `parameters` of `robot` to all `runs` at once (module docstring); intervals at `level`;
     `reference_noise` ``(m, rad)``: the references' noise, below which a still robot's reference may move unsaid
     (:data:`~wmrkit.batch.motions.REFERENCE_NOISE`)."""
+    check_robot(robot, BatchError)
     if not runs:
         raise BatchError("calibrate: no runs")
     if ci not in ("jacobian", "bootstrap"):
@@ -437,6 +438,7 @@ def default_parameters(robot: Robot, *, closed: bool, sensed: Sequence[str] | No
     """Radii of the wheels with a sensed spin (among `sensed`, default the robot's sensed joints) and the common
     scale of the wheel placement (``l``: the track of a differential drive); with only closed paths, the radius
     *ratio* of two such wheels instead of both radii (a closed path returns to its start at any scale)."""
+    check_robot(robot, BatchError)
     spun = [j.partition(".")[0] for j in (sensed or robot.sensed) if j.endswith(".spin")]
     placed = tuple(f"{w.name}.l" for w in robot.wheels if w.l > 0 and w.name in spun)
     if closed:

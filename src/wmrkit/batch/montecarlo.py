@@ -37,7 +37,7 @@ from .._shapes import readonly
 from ..limits import check_seed
 from ..odometry.logs import JointLog
 from ..odometry.model import OdometryModel, odometry_model
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from .engine import BatchError, Engine, engine
 
 
@@ -142,6 +142,7 @@ def run_block(block: _Block) -> np.ndarray:
 
 def path_log(robot: Robot, name: str, rate: float = 20.0) -> JointLog:
     """The noise-free log of `robot` driving the built-in path `name` (:data:`PATHS`) at `rate` [Hz]."""
+    check_robot(robot, BatchError)
     from ..odometry.synthetic import simulate
 
     if name not in PATHS:
@@ -207,6 +208,7 @@ def monte_carlo(robot: Robot, log: JointLog, runs: int, *, per_rad: float = 1e-4
                 slip_std: float = 0.0, method: str = "exact", seed: int = 0, block: int = 256,
                 runner: Engine | None = None, progress: bool = False) -> MonteCarloResult:
     """`runs` perturbed copies of `log` integrated on `runner` (module docstring), blocks of `block` runs."""
+    check_robot(robot, BatchError)
     from ..odometry.covariance import JointNoise
     from ..odometry.pipeline import odometry
 

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..odometry.calibration import CalibrationRun
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from .engine import BatchError, Engine, engine
 
 
@@ -83,6 +83,7 @@ def load_runs(robot: Robot, paths: Sequence[str], *, reference_dir: str | os.Pat
               closed: bool = False, runner: Engine | None = None, options: Mapping[str, Any] | None = None,
               progress: bool = False) -> list[CalibrationRun]:
     """Runs of many logs, read on the engine (the first bad log raises its error; a tqdm bar with `progress`)."""
+    check_robot(robot, BatchError)
     from ..odometry.model import odometry_model
     from .fleet import check_paths
 

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .._shapes import readonly
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from .engine import BatchError, Engine, engine, need_extra
 from .parquet import check_table
 from .sweep_kernel import METRICS, Axis, build_spec, evaluate
@@ -87,6 +87,7 @@ def sweep(robot: Robot, axes: Sequence[Axis], metric: str = "kappa_mean", *, run
           configs: int = 64, seed: int = 0, progress: bool = False) -> SweepResult:
     """Evaluate `metric` over the product of `axes` (module docstring); `length` fixes D [m] (default: the
     natural length of each design); `configs` steering configurations per design for steered robots."""
+    check_robot(robot, BatchError)
     if metric not in METRICS:
         raise BatchError(f"unknown metric '{metric}' (metrics: {', '.join(METRICS)})")
     check_counts(chunk, top)

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WmrkitError
+from ..robot import check_robot
 from ..wheels import beta_from_heading, heading_from_beta
 from ._loop_steps import LAW_ADVICE
 from .laws import PositionLaw
@@ -55,6 +56,7 @@ def simulate_dynamics(robot, controller: TwistController, initial_pose: np.ndarr
     period)`` (tested), with the per-period work done in place. A stop is re-checked at a shorter step
     (:func:`rechecked`).
     """
+    check_robot(robot)
     return rechecked(lambda d, h, _: _dynamics_loop(robot, controller, initial_pose, d, period=period, delay=delay,
                                                     tyre=tyre, step=h, feedback=feedback, policy=policy,
                                                     until=until), duration, step, period)

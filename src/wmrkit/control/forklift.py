@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from .actuators import ActuatorLoop, LowLevelLoops
 
 __all__ = ["ForkliftIK", "forklift_ik", "forklift_real_loops", "from_thesis_pose", "with_steer_range"]
@@ -73,6 +73,7 @@ def from_thesis_pose(pose_thesis: ArrayLike) -> np.ndarray:
 
 def with_steer_range(robot: Robot, wheel: str, lo: float, hi: float) -> Robot:
     """The robot with wheel `wheel`'s steering range set to headings ``[lo, hi]`` [rad] (the forklift: +-90 deg)."""
+    check_robot(robot)
     w = robot.wheel(wheel)
     return replace(robot, wheels=tuple(replace(x, steer_range=(float(lo), float(hi))) if x is w else x
                                        for x in robot.wheels))

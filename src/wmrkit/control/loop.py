@@ -24,7 +24,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from ._loop_plant import HOLD_MARGIN, Plant, _Sim
 from ._loop_steps import (
     _advance,
@@ -126,6 +126,7 @@ def simulate(robot: Robot, controller: TwistController, initial_pose: np.ndarray
     ``(t, pose) -> bool``: the run ends at the first output sample (or period) where it holds (a path follower that
     has driven its path).
     """
+    check_robot(robot)
     plant = plant or Plant()
     sim = _Sim(robot, plant)
     n_s = len(robot.steer_names)

@@ -22,7 +22,7 @@ from .._shapes import as_vectors, readonly
 from ..errors import WmrkitError
 from ..kinematics.wheel_ik import wheel_commands
 from ..limits import MAX_SIZE
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from ..wheels import heading_from_beta
 
 if TYPE_CHECKING:
@@ -164,6 +164,7 @@ def control_point(robot: Robot, point: ArrayLike | None = None, *, reduced: bool
     distance (its largest wheel radius when every wheel is at the origin); a coupled robot's, that distance ahead of
     its virtual axle.
     """
+    check_robot(robot)  # before the cache: a dict is no key
     key = None if point is None else tuple(float(v) for v in as_vectors(point, 2, "point"))
     if key is not None and not all(abs(v) <= MAX_SIZE for v in key):  # NaN included
         raise ControlError(f"point: expected finite coordinates within {MAX_SIZE:g} m of the robot origin, got {key}")

@@ -34,7 +34,7 @@ from ..dynamics.mass import Body
 from ..errors import WmrkitError
 from ..kinematics.models import configuration
 from ..kinematics.wheel_ik import wheel_commands
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from ..slip.models import FrictionLaw, G, SlipSolution, mcd, mqe, tyre_friction
 from ..wheels import heading_from_beta
 from .points import ControlError, control_point
@@ -101,6 +101,7 @@ def slip_inverse(robot: Robot, model: str = "mqe", *, friction: FrictionLaw | No
     wheels) get equal drive torques (an open differential, wheel inertia neglected), so they do not fight each
     other for the yaw moment; False: each spin is free.
     """
+    check_robot(robot)
     if model not in ("mqe", "mcd"):
         raise ControlError(f"slip model must be one of {', '.join(SLIP_MODELS[1:])}, got '{model}'")
     if model == "mqe" and body is None and robot.body is None:

@@ -28,7 +28,7 @@ import numpy as np
 
 from .._shapes import readonly
 from ..kinematics.wheel_ik import WheelCommands
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from ..slip.kalman import KalmanNoise
 from ..slip.weights import SlipWeights
 from .dynamic_plant import rechecked, rolling_start
@@ -65,6 +65,7 @@ def simulate_slip_control(robot: Robot, controller: TwistController, initial_pos
     (dict: ``assigned``, ``failures``, ``worst_error`` [m/s] of the inverse, ``evaluations``). A stop is re-checked
     at a shorter step (:func:`.dynamic_plant.rechecked`).
     """
+    check_robot(robot)
     return rechecked(lambda d, h, again: _slip_loop(
         robot, controller, initial_pose, d, period=period, delay=delay, tyre=tyre, step=h, slip_model=slip_model,
         feedback=feedback, weights=weights, noise=noise, inverse=inverse, ramp=ramp, progress=progress and not again,

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike
 
 from .._shapes import as_vectors, readonly
 from ..limits import MAX_QUERY_RATE
-from ..robot import Robot
+from ..robot import Robot, check_robot
 from ..wheels import heading_in_range, wrap_angle
 from .linked_ranges import LinkedRanges
 from .points import ControlError
@@ -52,6 +52,7 @@ def _finite(named: dict[str, ArrayLike]) -> list[np.ndarray]:
 
 def steer_ranges(robot: Robot) -> np.ndarray:
     """``(n_steer, 2)`` heading ranges [rad] of the steering wheels; ``(-inf, inf)`` where none is described."""
+    check_robot(robot)
     out = np.tile([-np.inf, np.inf], (len(robot.steer_names), 1))
     for k, name in enumerate(robot.steer_names):
         rng = getattr(robot.wheel(name), "steer_range", None)

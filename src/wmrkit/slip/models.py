@@ -34,7 +34,7 @@ from ..dynamics.mass import Body, body_problem
 from ..errors import ShapeError, WmrkitError
 from ..kinematics.linalg import geared_solve
 from ..limits import MAX_QUERY_RATE
-from ..robot import Robot, element_beta
+from ..robot import Robot, check_robot, element_beta
 from .weights import SlipWeights
 
 FrictionLaw = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
@@ -88,6 +88,7 @@ class TyreFriction:
 
 def tyre_friction(robot: Robot) -> TyreFriction:
     """The friction law of `robot`'s described tyres (every wheel needs ``tyre:`` in its description)."""
+    check_robot(robot)
     missing = [w.name for w in robot.wheels if w.tyre is None]
     if missing:
         raise WmrkitError(f"robot '{robot.name}': wheel '{missing[0]}' has no tyre model ('tyre:' in its description)")
@@ -146,6 +147,7 @@ def wls(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, beta: Arra
         weights: SlipWeights | None = None, *, heading: ArrayLike | None = None) -> SlipSolution:
     """Weighted least squares (7.52): ``(..., n_a) -> SlipSolution``; steering `beta` (thesis) or `heading`
     (0 = rolling forward) ``(..., n_steer)``, default as described."""
+    check_robot(robot)
     mu = SlipWeights.checked(weights).row_mu(robot)
     a = robot.constraint_matrix(beta, heading=heading)
     cols, q_a = _assigned(robot, assigned, q_assigned)
@@ -164,6 +166,7 @@ def mcd(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, friction: 
     sample by Newton's method (``scipy.optimize.root``) from `start` (default: the unweighted WLS solution).
     Steering: `beta` (thesis) or `heading` (0 = rolling forward), default as described.
     """
+    check_robot(robot)
     return _solve(robot, assigned, q_assigned, friction, robot.steering(beta, heading), loads, None, start, tol)
 
 
@@ -175,6 +178,7 @@ def mqe(robot: Robot, assigned: Sequence[str], q_assigned: ArrayLike, friction: 
     `body`: the mass properties (default the robot's described ``body``). Steering: `beta` (thesis) or `heading`
     (0 = rolling forward), default as described.
     """
+    check_robot(robot)
     return _solve(robot, assigned, q_assigned, friction, robot.steering(beta, heading), None,
                   (_body(robot, body), g), start, tol)
 
@@ -199,6 +203,7 @@ def normal_loads(robot: Robot, body: Body | None = None, accel_cm: ArrayLike = (
     The thesis's drive-torque reaction term of (7.64) is not included. `body`: default the robot's. Steering:
     `beta` (thesis) or `heading` (0 = rolling forward), default as described.
     """
+    check_robot(robot)
     body, beta = _body(robot, body), robot.steering(beta, heading)
     a = as_reals(accel_cm, "accel_cm")
     if not (real_number(g) and 0 < g < np.inf) or a.shape[-1:] != (2,) or not np.isfinite(a).all():
