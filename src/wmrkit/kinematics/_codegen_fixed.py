@@ -93,10 +93,9 @@ def fast_forward(plan: Plan) -> FastForward | None:
         return None
     d_p = np.array(p_sym.tolist(), dtype=float).reshape(len(kept_rows), len(kept_cols))
     d_p = d_p @ decide[np.ix_(kept_cols, kept_cols)]
-    s = np.linalg.svd(d_p, compute_uv=False)
+    fast = FastForward(kept_rows, d_p, decide[np.ix_(kept_cols, kept_cols)])
     if not absorbed_rows:  # D itself is constant: the rule decides it now as it would at run time
-        determined = int(np.sum(s > rank_cutoff(s))) == 3 + int(matrix_rank(d_p[:, 3:]))
-        return FastForward(kept_rows, d_p, decide[np.ix_(kept_cols, kept_cols)]) if determined else None
+        return fast if int(matrix_rank(d_p)) == 3 + int(matrix_rank(d_p[:, 3:])) else None
     q_raw = [_bound(m[i, j]) for i in absorbed_rows for j in range(3)]
     if any(v is None for v in q_raw):
         return None
@@ -104,9 +103,9 @@ def fast_forward(plan: Plan) -> FastForward | None:
     b_frob = float(np.linalg.norm(np.array(m.extract(absorbed_rows, absorbed_cols).tolist(), dtype=float)
                                   @ decide[np.ix_(absorbed_cols, absorbed_cols)]))
     s_max = float(np.sqrt(np.sum(d_p**2) + q**2 + b_frob**2))
-    least = float(s[-1]) * s_b / (float(s[-1]) + s_b + q)
-    whole = least > MARGIN * RANK_RTOL * max(s_max, 1.0)
-    return FastForward(kept_rows, d_p, decide[np.ix_(kept_cols, kept_cols)]) if whole else None
+    s_p = float(np.linalg.svd(d_p, compute_uv=False)[-1])
+    least = s_p * s_b / (s_p + s_b + q)
+    return fast if least > MARGIN * RANK_RTOL * max(s_max, 1.0) else None
 
 
 def _c_matrix(name: str, m: np.ndarray) -> str:
@@ -132,21 +131,12 @@ def c_fixed_forward(fast: FastForward) -> list[str]:
         "        twist[i] = 0.0;",
         f"        for (int j = 0; j < {rows}; ++j) twist[i] += T[i * {rows} + j] * b[j];",
         "    }",
-        "    if (residual) { /* |b - U U^T b|, scaled by its largest entry */",
+        "    if (residual) { /* |b - U U^T b| */",
         f"        for (int j = 0; j < {k}; ++j) {{ /* c = U^T b, in the workspace */",
         "            c[j] = 0.0;",
         f"            for (int i = 0; i < {rows}; ++i) c[j] += U[i * {k} + j] * b[i];",
         "        }",
-        "        double e_max = 0.0, r = 0.0;",
-        f"        for (int i = 0; i < {rows}; ++i) {{",
-        f"            const double e = fabs(unreached({k}, U + i * {k}, b[i], c));",
-        "            e_max = e > e_max ? e : e_max;",
-        "        }",
-        f"        if (e_max > 0.0) for (int i = 0; i < {rows}; ++i) {{",
-        f"            const double e = unreached({k}, U + i * {k}, b[i], c) / e_max;",
-        "            r += e * e;",
-        "        }",
-        "        *residual = e_max * sqrt(r);",
+        f"        *residual = unreached_norm({rows}, {k}, U, b, c);",
         "    }",
         "    return status;",
     ]

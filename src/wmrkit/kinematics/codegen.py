@@ -113,6 +113,21 @@ static double unreached(int n, const double *row, double b_i, const double *c)
     return b_i;
 }
 
+/* |b - D c| for D m x n row-major, scaled by its largest entry (no square overflows): the residual. */
+static double unreached_norm(int m, int n, const double *d, const double *b, const double *c)
+{
+    double big = 0.0, r = 0.0;
+    for (int i = 0; i < m; ++i) {
+        const double e = fabs(unreached(n, d + i * n, b[i], c));
+        big = e > big ? e : big;
+    }
+    if (big > 0.0) for (int i = 0; i < m; ++i) {
+        const double e = unreached(n, d + i * n, b[i], c) / big;
+        r += e * e;
+    }
+    return big * sqrt(r);
+}
+
 """
 
 _C_LSTSQ = """\
@@ -190,18 +205,7 @@ static int lstsq(int m, int n, double *d, const double *b, double *v, double *s,
         c[k] = ub / (s[k] * s[k]);
         for (int j = 0; j < n; ++j) y[j] += v[j * n + k] * c[k];
     }
-    if (residual) { /* |b - U U^T b|, the part of b no kept column reaches, scaled by its largest entry */
-        double big = 0.0, r = 0.0;
-        for (int i = 0; i < m; ++i) {
-            const double e = fabs(unreached(n, d + i * n, b[i], c));
-            big = e > big ? e : big;
-        }
-        if (big > 0.0) for (int i = 0; i < m; ++i) {
-            const double e = unreached(n, d + i * n, b[i], c) / big;
-            r += e * e;
-        }
-        *residual = big * sqrt(r);
-    }
+    if (residual) *residual = unreached_norm(m, n, d, b, c); /* |b - U U^T b|: what no kept column reaches */
     return 0;
 }
 """
